@@ -1,0 +1,38 @@
+# Everything a fresh machine needs: `make demo` and `make test` create .venv and install on first use.
+PYTHON ?= python3
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed-stamp
+
+.PHONY: demo test test-slow bench lint format clean
+
+$(STAMP): pyproject.toml
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --upgrade pip
+	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	touch $(STAMP)
+
+demo: $(STAMP)  ## complete the embedded partial strawberry, write out/demo/
+	$(BIN)/symfruit complete examples/strawberry_partial.ply --camera examples/camera.json \
+		--output out/demo/strawberry_completed.ply
+
+test: $(STAMP)  ## lint and the test suite (slow evaluation runs excluded)
+	$(BIN)/ruff check src tests examples
+	$(BIN)/ruff format --check src tests examples
+	$(BIN)/python -m pytest -m "not slow"
+
+test-slow: $(STAMP)  ## the whole suite, slow evaluation runs included
+	$(BIN)/python -m pytest
+
+bench: $(STAMP)  ## the project's benchmark
+	$(BIN)/symfruit bench
+
+lint: $(STAMP)
+	$(BIN)/ruff check src tests examples
+
+format: $(STAMP)
+	$(BIN)/ruff format src tests examples
+	$(BIN)/ruff check --fix src tests examples
+
+clean:
+	rm -rf $(VENV) out .pytest_cache .ruff_cache

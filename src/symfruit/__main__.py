@@ -1,0 +1,7 @@
+"""``python -m symfruit``: the command-line interface."""
+
+import sys
+
+from .cli import main
+
+sys.exit(main())

@@ -1,0 +1,80 @@
+"""Axis-aligned 3D boxes (paper section 3.6) and their overlap (paper Eq. 12)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Box", "box_iou", "centre_deviation"]
+
+
+@dataclass(frozen=True)
+class Box:
+    """An axis-aligned box in the camera frame.
+
+    Attributes
+    ----------
+    min, max : (3,) float, metres
+    """
+
+    min: np.ndarray
+    max: np.ndarray
+
+    @classmethod
+    def from_points(cls, points: np.ndarray) -> Box:
+        """The tightest box around ``points`` : (n, 3) float, n >= 1."""
+        points = np.asarray(points, dtype=np.float64)
+        return cls(min=points.min(axis=0), max=points.max(axis=0))
+
+    @property
+    def centre(self) -> np.ndarray:
+        """(3,) float, metres."""
+        return (self.min + self.max) / 2.0
+
+    @property
+    def size(self) -> np.ndarray:
+        """(3,) float, metres: extent along x, y, z."""
+        return self.max - self.min
+
+    @property
+    def volume(self) -> float:
+        """Cubic metres."""
+        return float(np.prod(self.size))
+
+    def union(self, other: Box) -> Box:
+        """The smallest box containing both."""
+        return Box(min=np.minimum(self.min, other.min), max=np.maximum(self.max, other.max))
+
+    def contains(self, points: np.ndarray, *, tol: float = 0.0) -> bool:
+        """Whether every point of ``points`` : (n, 3) lies in the box (within ``tol`` metres)."""
+        points = np.asarray(points, dtype=np.float64)
+        return bool(np.all(points >= self.min - tol) and np.all(points <= self.max + tol))
+
+    def corners(self) -> np.ndarray:
+        """(8, 3) float: the corners, bit i of the index choosing max over min on axis i."""
+        bits = (np.arange(8)[:, None] >> np.arange(3)[None, :]) & 1
+        return np.where(bits == 1, self.max, self.min)
+
+    def to_dict(self) -> dict[str, list[float]]:
+        return {"min": self.min.tolist(), "max": self.max.tolist(), "size": self.size.tolist()}
+
+
+def box_iou(a: Box, b: Box) -> float:
+    """Intersection over union of two axis-aligned boxes (paper Eq. 12), in [0, 1].
+
+    Examples
+    --------
+    >>> unit = Box(np.zeros(3), np.ones(3))
+    >>> box_iou(unit, Box(np.array([0.5, 0, 0]), np.array([1.5, 1, 1])))
+    0.3333333333333333
+    """
+    overlap = np.clip(np.minimum(a.max, b.max) - np.maximum(a.min, b.min), 0.0, None)
+    inter = float(np.prod(overlap))
+    union = a.volume + b.volume - inter
+    return inter / union if union > 0 else 0.0
+
+
+def centre_deviation(a: Box, b: Box) -> float:
+    """Euclidean distance between the two box centres, metres."""
+    return float(np.linalg.norm(a.centre - b.centre))

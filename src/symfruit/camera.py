@@ -1,0 +1,115 @@
+"""Pinhole camera model in the REP-103 optical frame (x right, y down, z forward), metres.
+
+Pixel ``(u, v)`` has its centre at integer coordinates: a point projects to
+``u = fx * x / z + cx`` and falls into pixel column ``round(u)``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from .errors import InputError
+
+__all__ = ["DEFAULT_CAMERA", "Camera"]
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Pinhole intrinsics.
+
+    Parameters
+    ----------
+    fx, fy : float
+        Focal lengths in pixels, > 0.
+    cx, cy : float
+        Principal point in pixels.
+    width, height : int
+        Image size in pixels, > 0.
+
+    Examples
+    --------
+    >>> cam = Camera(fx=615.0, fy=615.0, cx=320.0, cy=240.0, width=640, height=480)
+    >>> cam.project([[0.0, 0.0, 0.5]])
+    array([[320., 240.]])
+    """
+
+    fx: float
+    fy: float
+    cx: float
+    cy: float
+    width: int
+    height: int
+
+    def __post_init__(self) -> None:
+        for name in ("fx", "fy", "cx", "cy"):
+            value = getattr(self, name)
+            try:
+                value = float(value)
+            except (TypeError, ValueError):
+                raise InputError(f"camera {name} must be a number, got {value!r}") from None
+            if not np.isfinite(value):
+                raise InputError(f"camera {name} must be finite, got {value!r}")
+            object.__setattr__(self, name, value)
+        for name in ("width", "height"):
+            value = getattr(self, name)
+            if isinstance(value, float) and value.is_integer():
+                value = int(value)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
+                raise InputError(f"camera {name} must be a positive whole number of pixels, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        if self.fx <= 0 or self.fy <= 0:
+            raise InputError(f"camera focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+
+    @property
+    def matrix(self) -> np.ndarray:
+        """(3, 3) float: the intrinsic matrix K."""
+        return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def to_dict(self) -> dict[str, float | int]:
+        """The six intrinsics as a plain dict (the layout :func:`symfruit.io.load_camera` reads)."""
+        return asdict(self)
+
+    def project(self, points: np.ndarray) -> np.ndarray:
+        """Project camera-frame points to sub-pixel image coordinates.
+
+        Parameters
+        ----------
+        points : (..., 3) float, metres
+            Points with ``z > 0``; other points give non-finite or meaningless coordinates.
+
+        Returns
+        -------
+        (..., 2) float, pixels
+            ``(u, v)`` per point.
+        """
+        points = np.asarray(points, dtype=np.float64)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            inv_z = 1.0 / points[..., 2]
+        u = self.fx * points[..., 0] * inv_z + self.cx
+        v = self.fy * points[..., 1] * inv_z + self.cy
+        return np.stack([u, v], axis=-1)
+
+    def deproject(self, uv: np.ndarray, depth: np.ndarray) -> np.ndarray:
+        """Lift pixel coordinates with depth to camera-frame points.
+
+        Parameters
+        ----------
+        uv : (..., 2) float, pixels
+        depth : (...) float, metres along z
+
+        Returns
+        -------
+        (..., 3) float, metres
+        """
+        uv = np.asarray(uv, dtype=np.float64)
+        depth = np.asarray(depth, dtype=np.float64)
+        x = (uv[..., 0] - self.cx) / self.fx * depth
+        y = (uv[..., 1] - self.cy) / self.fy * depth
+        return np.stack([x, y, depth], axis=-1)
+
+
+#: Intel RealSense D435 colour stream at 640x480 (typical factory calibration), used when a cloud
+#: comes without intrinsics.
+DEFAULT_CAMERA = Camera(fx=615.0, fy=615.0, cx=320.0, cy=240.0, width=640, height=480)

@@ -1,0 +1,197 @@
+"""Command-line interface: ``symfruit complete | bench | settings | methods``.
+
+Thin by design: parse, import lazily, call the library, print. Errors a user can cause print one
+line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the traceback instead.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+
+__all__ = ["main"]
+
+
+def _add_complete(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("complete", help="complete one fruit's partial cloud and box it")
+    p.add_argument("cloud", type=Path, help="PLY, PCD, XYZ/TXT/CSV or NPY file of the visible points")
+    p.add_argument(
+        "--camera",
+        type=Path,
+        help="intrinsics (JSON/YAML: plain, RealSense, Open3D, ROS); default: Intel D435 colour 640x480",
+    )
+    p.add_argument("--method", default="paper", help="completion method (see `symfruit methods`)")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`)")
+    p.add_argument("--units", choices=("m", "mm"), default="m", help="units of the input cloud")
+    p.add_argument(
+        "--output",
+        type=Path,
+        help="write the completed cloud to OUT.ply and the result with the effective settings to OUT.json",
+    )
+    p.add_argument("--json", action="store_true", help="print the result as JSON")
+
+
+def _add_bench(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("bench", help="time `complete` on a fixed partial strawberry (the project benchmark)")
+    p.add_argument("--repeat", type=int, default=200, help="timed runs per case (default 200)")
+    p.add_argument(
+        "--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)"
+    )
+    p.add_argument("--json", action="store_true", help="print the rows as JSON")
+
+
+def _parser() -> argparse.ArgumentParser:
+    from . import __version__
+
+    parser = argparse.ArgumentParser(
+        prog="symfruit",
+        description="Locate fruit from one RGB-D view by completing its hidden side through mirror symmetry.",
+    )
+    parser.add_argument("--version", action="version", version=f"symfruit {__version__}")
+    parser.add_argument("--debug", action="store_true", help="show tracebacks on errors")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    _add_complete(sub)
+    _add_bench(sub)
+    p = sub.add_parser(
+        "settings", help="print the effective settings as YAML (defaults, or merged with --config)"
+    )
+    p.add_argument("--config", type=Path)
+    sub.add_parser("methods", help="list the completion methods")
+    return parser
+
+
+def _fmt(values: Sequence[float], scale: float = 1000.0) -> str:
+    return "(" + ", ".join(f"{v * scale:.1f}" for v in values) + ")"
+
+
+def _complete(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from .camera import DEFAULT_CAMERA
+    from .complete import complete
+    from .config import Settings, load_settings
+    from .errors import FileFormatError
+    from .io import load_camera, read_cloud, write_json, write_ply
+
+    settings = load_settings(args.config) if args.config else Settings()
+    camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
+    if args.output is not None and args.output.suffix.lower() != ".ply":
+        raise FileFormatError(f"{args.output}: --output must end in .ply")
+    points = read_cloud(args.cloud)
+    if args.units == "mm":
+        points = points / 1000.0
+    result = complete(points, camera=camera, method=args.method, settings=settings)
+    summary = result.to_dict()
+    if args.output is not None:
+        labels = np.r_[
+            np.zeros(len(result.visible), np.uint8),
+            np.ones(len(result.points) - len(result.visible), np.uint8),
+        ]
+        write_ply(args.output, result.points, labels=labels)
+        write_json(
+            args.output.with_suffix(".json"),
+            {
+                **summary,
+                "input": str(args.cloud),
+                "units": args.units,
+                "camera": camera.to_dict(),
+                "extras": result.extras,
+                "settings": settings.to_dict(),
+            },
+        )
+    if args.json:
+        print(json.dumps(summary, indent=2))
+        return 0
+    box = result.box
+    print(f"{'method':<10} {result.method}")
+    print(f"{'centre':<10} {_fmt(box.centre)} mm")
+    print(f"{'size':<10} {_fmt(box.size)} mm")
+    print(f"{'box min':<10} {_fmt(box.min)} mm")
+    print(f"{'box max':<10} {_fmt(box.max)} mm")
+    if result.plane is not None:
+        print(f"{'plane':<10} point {_fmt(result.plane.point)} mm, normal {_fmt(result.plane.normal, 1.0)}")
+        print(f"{'score':<10} {result.score:.3f} (best of {len(result.scores)} planes)")
+    dropped = f", {result.n_dropped} non-finite dropped" if result.n_dropped else ""
+    print(f"{'points':<10} {len(result.visible)} visible -> {len(result.points)} completed{dropped}")
+    print(f"{'time':<10} {result.seconds * 1000:.2f} ms")
+    if args.output is not None:
+        print(f"{'written':<10} {args.output} and {args.output.with_suffix('.json')}")
+    return 0
+
+
+def _bench(args: argparse.Namespace) -> int:
+    from .bench import machine, run_bench
+    from .errors import InputError
+
+    if args.repeat < 1 or any(n < 10 for n in args.points):
+        raise InputError("--repeat must be >= 1 and every --points >= 10")
+    rows = run_bench(repeat=args.repeat, points=tuple(args.points))
+    if args.json:
+        print(json.dumps({"machine": machine(), "rows": [r.to_dict() for r in rows]}, indent=2))
+        return 0
+    info = machine()
+    print(
+        f"symfruit bench: median of {args.repeat} runs per fruit, one process "
+        f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
+    )
+    print(f"{'case':<20} {'points':>6} {'planes':>6} {'median ms':>10} {'p10':>8} {'p90':>8}")
+    for r in rows:
+        print(
+            f"{r.case:<20} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}"
+        )
+    return 0
+
+
+def _settings(args: argparse.Namespace) -> int:
+    import yaml
+
+    from .config import Settings, load_settings
+
+    settings = load_settings(args.config) if args.config else Settings()
+    print(yaml.safe_dump(settings.to_dict(), sort_keys=False), end="")
+    return 0
+
+
+def _methods(args: argparse.Namespace) -> int:
+    from .methods import available, get
+
+    for name in available():
+        doc = (get(name).__doc__ or "").strip().splitlines()
+        print(f"{name:<10} {doc[0] if doc else ''}")
+    return 0
+
+
+_COMMANDS = {"complete": _complete, "bench": _bench, "settings": _settings, "methods": _methods}
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Entry point of the ``symfruit`` console script; returns the exit status."""
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if args.command is None:
+        parser.print_help()
+        return 2
+    from .errors import SymfruitError
+
+    try:
+        return _COMMANDS[args.command](args)
+    except SymfruitError as exc:
+        if args.debug:
+            raise
+        print(f"symfruit: error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("symfruit: interrupted", file=sys.stderr)
+        return 130
+    except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
+        import os
+
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,17 @@
+"""Readers and writers: point clouds, intrinsics, JSON. Everything here names the file in its errors."""
+
+from __future__ import annotations
+
+from .atomic import atomic_write, write_json
+from .clouds import CLOUD_READERS, read_cloud, write_ply
+from .intrinsics import camera_from_dict, load_camera
+
+__all__ = [
+    "CLOUD_READERS",
+    "atomic_write",
+    "camera_from_dict",
+    "load_camera",
+    "read_cloud",
+    "write_json",
+    "write_ply",
+]

@@ -1,0 +1,279 @@
+"""Point-cloud files: PLY, PCD (ascii, binary, binary_compressed), XYZ/TXT/CSV and NPY.
+
+Each reader returns an ``(n, 3)`` float64 array of x, y, z and raises
+:class:`~symfruit.errors.FileFormatError` naming the file and the problem. Sizes read from headers are
+checked against the file's length before anything is allocated.
+"""
+
+from __future__ import annotations
+
+import io
+import re
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import FileFormatError
+from .atomic import atomic_write
+
+__all__ = ["CLOUD_READERS", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
+
+#: Largest header we read before giving up on finding its end.
+_MAX_HEADER = 1 << 16
+
+
+def read_cloud(path: str | Path) -> np.ndarray:
+    """Read x, y, z from a cloud file, choosing the reader by extension (:data:`CLOUD_READERS`).
+
+    Returns
+    -------
+    (n, 3) float64
+    """
+    path = Path(path)
+    reader = CLOUD_READERS.get(path.suffix.lower())
+    if reader is None:
+        known = ", ".join(sorted(CLOUD_READERS))
+        raise FileFormatError(f"{path}: unknown cloud extension {path.suffix!r}; use one of {known}")
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such file")
+    try:
+        points = reader(path)
+    except FileFormatError:
+        raise
+    except (ValueError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({exc})") from None
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")
+    return np.ascontiguousarray(points, dtype=np.float64)
+
+
+def _header(path: Path, kind: str, magic: bytes, end: re.Pattern[bytes]) -> tuple[bytes, int, int]:
+    """Header bytes, offset of the data after it, and the file size."""
+    size = path.stat().st_size
+    with path.open("rb") as handle:
+        head = handle.read(_MAX_HEADER)
+    if not head.startswith(magic):
+        raise FileFormatError(f"{path}: not a {kind} file (it does not start with {magic!r})")
+    match = end.search(head)
+    if match is None:
+        raise FileFormatError(
+            f"{path}: {kind} header has no end within its first {_MAX_HEADER} bytes "
+            "(truncated or not a {kind} file)".replace("{kind}", kind)
+        )
+    return head[: match.end()], match.end(), size
+
+
+_PLY_TYPES = {
+    "char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2, "ushort": 2, "uint16": 2,
+    "int": 4, "int32": 4, "uint": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8,
+}  # fmt: skip
+
+
+def read_ply(path: Path) -> np.ndarray:
+    """PLY (ascii or binary) through ``plyfile``; the vertex count is checked against the file size first."""
+    from plyfile import PlyData, PlyParseError
+
+    header, start, size = _header(path, "PLY", b"ply", re.compile(rb"end_header\r?\n"))
+    text = header.decode("ascii", errors="replace")
+    fmt = re.search(r"^format\s+(\S+)", text, re.M)
+    vertex = re.search(r"^element\s+vertex\s+(\d+)", text, re.M)
+    if fmt is None or vertex is None:
+        raise FileFormatError(f"{path}: PLY header lacks a format line or a vertex element")
+    count = int(vertex.group(1))
+    # Bytes per vertex, from the properties listed after "element vertex" (lists count as 1 byte).
+    after = text[vertex.end() :].split("\nelement", 1)[0]
+    props = re.findall(r"^property\s+(?!list)(\S+)\s+\S+", after, re.M)
+    row = sum(_PLY_TYPES.get(t, 4) for t in props) or 12
+    least = count * (row if fmt.group(1) != "ascii" else 2 * max(len(props), 1))
+    if least > size - start:
+        raise FileFormatError(
+            f"{path}: header promises {count} vertices (at least {least} bytes) but the file holds "
+            f"{size - start} bytes of data (truncated or corrupt)"
+        )
+    try:
+        data = PlyData.read(str(path))
+        element = data["vertex"]
+        return np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
+    except PlyParseError as exc:
+        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
+    except KeyError as exc:
+        raise FileFormatError(f"{path}: PLY has no {exc} property or vertex element") from None
+
+
+_PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4",
+              ("I", 8): "i8", ("U", 1): "u1", ("U", 2): "u2", ("U", 4): "u4", ("U", 8): "u8"}  # fmt: skip
+
+
+def read_pcd(path: Path) -> np.ndarray:
+    """PCD v0.7 (``DATA ascii``, ``binary`` or ``binary_compressed``), fields x, y, z."""
+    header, start, size = _header(path, "PCD", b"", re.compile(rb"^DATA[^\n]*\n", re.M))
+    fields: dict[str, list[str]] = {}
+    for line in header.decode("ascii", errors="replace").splitlines():
+        parts = line.split()
+        if parts and not parts[0].startswith("#"):
+            fields[parts[0].upper()] = parts[1:]
+    try:
+        names = fields["FIELDS"]
+        sizes = [int(s) for s in fields["SIZE"]]
+        types = fields["TYPE"]
+        counts = [int(c) for c in fields.get("COUNT", ["1"] * len(names))]
+        n = (
+            int(fields["POINTS"][0])
+            if "POINTS" in fields
+            else int(fields["WIDTH"][0]) * int(fields["HEIGHT"][0])
+        )
+        mode = fields["DATA"][0].lower()
+    except (KeyError, ValueError, IndexError):
+        raise FileFormatError(f"{path}: PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA") from None
+    if not (len(names) == len(sizes) == len(types) == len(counts)) or n < 0:
+        raise FileFormatError(f"{path}: PCD header's FIELDS, SIZE, TYPE and COUNT disagree")
+    missing = [c for c in ("x", "y", "z") if c not in names]
+    if missing:
+        raise FileFormatError(f"{path}: PCD has no field {missing[0]!r} (fields: {' '.join(names)})")
+    try:
+        dtypes = [np.dtype(_PCD_TYPES[(t.upper(), s)]) for t, s in zip(types, sizes, strict=True)]
+    except KeyError:
+        raise FileFormatError(f"{path}: PCD has an unsupported TYPE/SIZE pair") from None
+    row = sum(s * c for s, c in zip(sizes, counts, strict=True))
+    body_size = size - start
+    with path.open("rb") as handle:
+        handle.seek(start)
+        if mode == "ascii":
+            if n * 2 * len(names) > body_size + 1:
+                raise FileFormatError(f"{path}: header promises {n} points but the file is too short")
+            body = handle.read()
+            values = np.loadtxt(io.BytesIO(body), ndmin=2, dtype=np.float64)
+            if len(values) < n:
+                raise FileFormatError(f"{path}: header promises {n} points, the file holds {len(values)}")
+            columns = np.cumsum([0, *counts])
+            return np.column_stack([values[:n, columns[names.index(c)]] for c in ("x", "y", "z")])
+        if mode == "binary":
+            if n * row > body_size:
+                raise FileFormatError(
+                    f"{path}: header promises {n} points ({n * row} bytes) but the file holds {body_size}"
+                )
+            dtype = np.dtype(
+                [(f"f{i}", d, (c,)) for i, (d, c) in enumerate(zip(dtypes, counts, strict=True))]
+            )
+            rec = np.frombuffer(handle.read(n * row), dtype=dtype, count=n)
+            return np.column_stack(
+                [rec[f"f{names.index(c)}"][:, 0].astype(np.float64) for c in ("x", "y", "z")]
+            )
+        if mode == "binary_compressed":
+            raw = handle.read(8)
+            if len(raw) < 8:
+                raise FileFormatError(f"{path}: truncated binary_compressed PCD (no size words)")
+            packed, unpacked = np.frombuffer(raw, dtype="<u4")
+            if unpacked != n * row or packed > body_size - 8:
+                raise FileFormatError(f"{path}: binary_compressed sizes do not match the header or the file")
+            data = _lzf_decompress(handle.read(int(packed)), int(unpacked), path)
+            out, offset = [], 0
+            for d, c in zip(dtypes, counts, strict=True):  # column-major: field after field
+                out.append(np.frombuffer(data, dtype=d, count=n * c, offset=offset).reshape(n, c))
+                offset += n * c * d.itemsize
+            return np.column_stack([out[names.index(c)][:, 0].astype(np.float64) for c in ("x", "y", "z")])
+    raise FileFormatError(f"{path}: unknown PCD DATA mode {mode!r} (ascii, binary, binary_compressed)")
+
+
+def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
+    """Decompress LZF (as PCL writes ``binary_compressed``)."""
+    out = bytearray(size)
+    i = o = 0
+    n = len(data)
+    try:
+        while i < n:
+            ctrl = data[i]
+            i += 1
+            if ctrl < 32:  # literal run of ctrl + 1 bytes
+                length = ctrl + 1
+                out[o : o + length] = data[i : i + length]
+                if i + length > n or o + length > size:
+                    raise IndexError
+                i += length
+                o += length
+            else:  # back reference
+                length = ctrl >> 5
+                ref = o - ((ctrl & 0x1F) << 8) - 1
+                if length == 7:
+                    length += data[i]
+                    i += 1
+                ref -= data[i]
+                i += 1
+                length += 2
+                if ref < 0 or o + length > size:
+                    raise IndexError
+                for k in range(length):  # may overlap, so byte by byte
+                    out[o + k] = out[ref + k]
+                o += length
+    except IndexError:
+        raise FileFormatError(f"{path}: corrupt LZF data in binary_compressed PCD") from None
+    if o != size:
+        raise FileFormatError(f"{path}: binary_compressed PCD decompressed to {o} bytes, expected {size}")
+    return bytes(out)
+
+
+def read_text(path: Path) -> np.ndarray:
+    """Text columns x y z [...] separated by spaces, tabs, commas or semicolons; header lines skipped."""
+    text = path.read_text(encoding="utf-8", errors="strict")
+    rows = []
+    for number, line in enumerate(text.splitlines(), 1):
+        line = line.strip()
+        if not line or line.startswith(("#", "//", "%")):
+            continue
+        parts = re.split(r"[\s,;]+", line)
+        try:
+            rows.append([float(p) for p in parts[:3]])
+        except ValueError:
+            if rows:
+                raise FileFormatError(f"{path}: line {number} is not numeric: {line[:60]!r}") from None
+            continue  # a header line before the data
+        if len(parts) < 3:
+            raise FileFormatError(f"{path}: line {number} has {len(parts)} columns, need x y z")
+    if not rows:
+        raise FileFormatError(f"{path}: no numeric x y z rows found")
+    return np.asarray(rows, dtype=np.float64)
+
+
+def read_npy(path: Path) -> np.ndarray:
+    """NumPy ``.npy``: an (n, >=3) numeric array or a structured array with x, y, z; never pickles."""
+    arr = np.load(path, allow_pickle=False, mmap_mode="r")
+    if arr.dtype.names:
+        missing = [c for c in ("x", "y", "z") if c not in arr.dtype.names]
+        if missing:
+            raise FileFormatError(f"{path}: structured array lacks field {missing[0]!r}")
+        return np.column_stack([np.asarray(arr[c], dtype=np.float64) for c in ("x", "y", "z")])
+    if arr.ndim != 2 or arr.shape[1] < 3 or not np.issubdtype(arr.dtype, np.number):
+        raise FileFormatError(f"{path}: expected a numeric (n, 3) array, got {arr.dtype} {arr.shape}")
+    return np.asarray(arr[:, :3], dtype=np.float64)
+
+
+#: Cloud readers by lower-case extension; add an entry to support another format.
+CLOUD_READERS: dict[str, Callable[[Path], np.ndarray]] = {
+    ".ply": read_ply,
+    ".pcd": read_pcd,
+    ".xyz": read_text,
+    ".txt": read_text,
+    ".csv": read_text,
+    ".pts": read_text,
+    ".npy": read_npy,
+}
+
+
+def write_ply(path: str | Path, points: np.ndarray, *, labels: np.ndarray | None = None) -> None:
+    """Write a binary little-endian PLY of ``points`` : (n, 3) float, metres, atomically.
+
+    ``labels`` : (n,) int, optional, is stored as a ``uchar`` property ``label`` (symfruit writes 0 for
+    visible and 1 for completed points) and is ignored by viewers that do not know it.
+    """
+    from plyfile import PlyData, PlyElement
+
+    fields = [("x", "f4"), ("y", "f4"), ("z", "f4")]
+    if labels is not None:
+        fields.append(("label", "u1"))
+    vertex = np.empty(len(points), dtype=fields)
+    vertex["x"], vertex["y"], vertex["z"] = points[:, 0], points[:, 1], points[:, 2]
+    if labels is not None:
+        vertex["label"] = labels
+    with atomic_write(path, "wb") as handle:
+        PlyData([PlyElement.describe(vertex, "vertex")], text=False).write(handle)

@@ -1,0 +1,125 @@
+"""Camera intrinsics files in the common layouts.
+
+=====================  ==================================================================
+layout                 keys
+=====================  ==================================================================
+plain (symfruit)       ``fx, fy, cx, cy, width, height``
+RealSense              ``fx, fy, ppx, ppy, width, height`` (``rs2_intrinsics``; may sit under
+                       ``intrinsics``, ``color`` or ``colour``)
+Open3D                 ``width, height, intrinsic_matrix`` (9 numbers, column-major), as written by
+                       ``o3d.io.write_pinhole_camera_intrinsic``
+ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with ``width, height``;
+                       also ``camera_matrix: {data: [...]}`` with ``image_width, image_height``
+                       (``camera_calibration_parsers`` YAML)
+=====================  ==================================================================
+
+JSON or YAML by extension (YAML through ``yaml.safe_load`` only).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from ..camera import Camera
+from ..errors import FileFormatError, InputError
+
+__all__ = ["camera_from_dict", "load_camera"]
+
+_NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
+
+
+def load_camera(path: str | Path) -> Camera:
+    """Read intrinsics from a ``.json``, ``.yaml`` or ``.yml`` file in any layout above."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise FileFormatError(f"{path}: no such intrinsics file") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise FileFormatError(f"{path}: cannot read intrinsics ({exc})") from None
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".json":
+            data = json.loads(text)
+        elif suffix in (".yaml", ".yml"):
+            import yaml
+
+            data = yaml.safe_load(text)
+        else:
+            raise FileFormatError(f"{path}: intrinsics must be .json, .yaml or .yml, not {suffix!r}")
+    except FileFormatError:
+        raise
+    except Exception as exc:  # JSONDecodeError / YAMLError carry the position
+        raise FileFormatError(f"{path}: not valid {suffix.lstrip('.').upper()} ({exc})") from None
+    try:
+        return camera_from_dict(data)
+    except InputError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+
+
+def _number(data: dict[str, Any], key: str) -> float:
+    value = data[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise InputError(f"intrinsics field {key!r} must be a number, got {value!r}")
+    return float(value)
+
+
+def _matrix(values: Any, name: str) -> list[float]:
+    if isinstance(values, dict) and "data" in values:
+        values = values["data"]
+    if (
+        not isinstance(values, list)
+        or len(values) != 9
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+    ):
+        raise InputError(f"intrinsics field {name!r} must hold 9 numbers")
+    return [float(v) for v in values]
+
+
+def _size(data: dict[str, Any]) -> tuple[Any, Any]:
+    width = data.get("width", data.get("image_width"))
+    height = data.get("height", data.get("image_height"))
+    if width is None or height is None:
+        raise InputError("intrinsics lack the image size (width and height)")
+    return width, height
+
+
+def camera_from_dict(data: Any) -> Camera:
+    """Build a :class:`Camera` from a parsed intrinsics mapping in any supported layout.
+
+    Raises
+    ------
+    InputError
+        Naming the missing or invalid field.
+    """
+    if not isinstance(data, dict):
+        raise InputError(f"intrinsics must be a mapping, got {type(data).__name__}")
+    if not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)):
+        for key in _NESTS:
+            if isinstance(data.get(key), dict):
+                return camera_from_dict(data[key])
+    if "intrinsic_matrix" in data:  # Open3D, column-major
+        m = _matrix(data["intrinsic_matrix"], "intrinsic_matrix")
+        fx, fy, cx, cy = m[0], m[4], m[6], m[7]
+    elif any(k in data for k in ("K", "k", "camera_matrix")):  # ROS, row-major
+        key = next(k for k in ("K", "k", "camera_matrix") if k in data)
+        m = _matrix(data[key], key)
+        fx, fy, cx, cy = m[0], m[4], m[2], m[5]
+    elif "fx" in data:
+        if "fy" not in data:
+            raise InputError("intrinsics lack field 'fy'")
+        for key, alias in (("cx", "ppx"), ("cy", "ppy")):
+            if key not in data and alias not in data:
+                raise InputError(f"intrinsics lack field {key!r} (or {alias!r})")
+        cx_key = "cx" if "cx" in data else "ppx"
+        cy_key = "cy" if "cy" in data else "ppy"
+        fx, fy, cx, cy = (_number(data, k) for k in ("fx", "fy", cx_key, cy_key))
+    else:
+        raise InputError(
+            "intrinsics layout not recognised: expected fx/fy/cx/cy, RealSense ppx/ppy, "
+            "Open3D intrinsic_matrix or ROS K/k, each with width and height"
+        )
+    width, height = _size(data)
+    return Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=width, height=height)

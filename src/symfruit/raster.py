@@ -1,0 +1,177 @@
+"""Rasterise what the camera saw of one fruit: the visible mask ``Mp`` and the seen depth (section 3.5.2).
+
+Only a window of the image around the fruit is rasterised; look-ups outside the window are answered
+exactly for the mask test and with an upper bound (distance to the window plus the distance inside it)
+for the distance to the mask, which only matters for points already far outside it.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from .camera import Camera
+from .errors import InputError
+
+__all__ = ["View", "rasterise"]
+
+
+@dataclass(frozen=True)
+class View:
+    """The seen fruit in an image window whose top-left pixel is ``(u0, v0)``.
+
+    Attributes
+    ----------
+    mask : (h, w) bool
+        ``Mp``: pixels covered by the fruit (points splatted, gaps closed, holes filled).
+    dist : (h * w,) float, pixels
+        Distance of each pixel to the nearest mask pixel (0 inside the mask).
+    near_u, near_v : (h * w,) float, pixels
+        Image coordinates of that nearest mask pixel (the pixel itself inside the mask).
+    near_depth : (h * w,) float, metres
+        Seen depth at that nearest mask pixel. Mask pixels that no point hit take the depth of the
+        nearest pixel that one did.
+    fill_radius : float, pixels
+        Half-width of the square used to close the gaps between points.
+    """
+
+    u0: int
+    v0: int
+    mask: np.ndarray
+    dist: np.ndarray
+    near_u: np.ndarray
+    near_v: np.ndarray
+    near_depth: np.ndarray
+    fill_radius: float
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.mask.shape
+
+    def lookup(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Window index of the pixel nearest to each ``uv`` and the extra distance to reach it.
+
+        Parameters
+        ----------
+        uv : (...) x 2 float, pixels
+            Non-finite coordinates are sent to the window's corner with an infinite extra distance.
+
+        Returns
+        -------
+        index : (...) int
+            Flat index into the window's per-pixel arrays.
+        extra : (...) float, pixels
+            0 for pixels inside the window, else the distance from ``uv``'s pixel to the window.
+        """
+        h, w = self.mask.shape
+        finite = np.isfinite(uv[..., 0]) & np.isfinite(uv[..., 1])
+        u = np.where(finite, uv[..., 0], -1e9)
+        v = np.where(finite, uv[..., 1], -1e9)
+        col = np.rint(np.clip(u, -1e9, 1e9)) - self.u0
+        row = np.rint(np.clip(v, -1e9, 1e9)) - self.v0
+        col_c = np.clip(col, 0, w - 1)
+        row_c = np.clip(row, 0, h - 1)
+        extra = np.hypot(col - col_c, row - row_c)
+        extra[~finite] = np.inf
+        index = row_c.astype(np.intp) * w + col_c.astype(np.intp)
+        return index, extra
+
+
+def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:
+    """Rasterise visible points into a mask and a seen-depth map at the camera's resolution.
+
+    Each point marks its pixel (the nearest depth wins). The mask ``Mp`` is the closing of the marked
+    pixels by a square of half-width ``fill_radius`` with the holes filled, so a sparse cloud of a few
+    hundred points still gives a solid silhouette. Mask pixels no point hit take the mean depth of
+    the marked pixels within the same square (or, past that, of the nearest marked pixel).
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        Visible points with ``z > 0``.
+    camera : Camera
+    fill_radius : float, pixels, optional
+        Default: ``0.7 * sqrt(area / n)``, with ``area`` the ellipse inscribed in the points' pixel
+        box: 1.5 times the expected median nearest-neighbour spacing of ``n`` points spread over the
+        silhouette, and at least 1.
+
+    Raises
+    ------
+    InputError
+        When no point projects into the image.
+    """
+    uv = camera.project(points)
+    col = np.rint(uv[:, 0]).astype(np.intp)
+    row = np.rint(uv[:, 1]).astype(np.intp)
+    inside = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
+    if not inside.any():
+        raise InputError(
+            f"no point projects into the {camera.width}x{camera.height} image; "
+            "are the points in the camera's optical frame (z forward) and is this the right camera?"
+        )
+    col, row, z = col[inside], row[inside], points[inside, 2]
+    c0, c1, r0, r1 = int(col.min()), int(col.max()), int(row.min()), int(row.max())
+    if fill_radius is None:
+        area = np.pi / 4.0 * (c1 - c0 + 1) * (r1 - r0 + 1)
+        fill_radius = max(1.0, 0.7 * float(np.sqrt(area / len(col))))
+    half = int(np.ceil(fill_radius))
+    pad = half + 2
+    u0, v0 = max(c0 - pad, 0), max(r0 - pad, 0)
+    u1, v1 = min(c1 + pad + 1, camera.width), min(r1 + pad + 1, camera.height)
+    h, w = v1 - v0, u1 - u0
+    flat = (row - v0) * w + (col - u0)
+
+    zbuf = np.full(h * w, np.inf)
+    np.minimum.at(zbuf, flat, z)
+    zbuf = zbuf.reshape(h, w)
+    hit = np.isfinite(zbuf)
+
+    # Closing by a square, as box means: dilation = any hit in the square, erosion = all dilated.
+    # "nearest" keeps a silhouette that the image edge cuts from being eroded there.
+    size = 2 * half + 1
+    hit32 = hit.astype(np.float32)
+    weight = ndimage.uniform_filter(hit32, size=size, mode="constant")
+    dilated = (weight > 1e-6).astype(np.float32)
+    closed = ndimage.uniform_filter(dilated, size=size, mode="nearest") > 1.0 - 1e-3
+    closed |= hit
+    # Fill holes: background components (4-connected) not touching the window's edge.
+    labels, _ = ndimage.label(~closed)
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    background = np.zeros(labels.max() + 1, dtype=bool)
+    background[edge] = True
+    background[0] = False
+    mask = ~background[labels]
+
+    # Seen depth on the mask: marked pixels keep theirs, the others the mean of the marked pixels in
+    # the same square (tripled in size until every mask pixel has one, or at worst the median).
+    seed = np.where(hit, zbuf, 0.0).astype(np.float32)
+    depth = seed.copy()
+    todo = mask & ~hit
+    box = size
+    while todo.any():
+        if box > 3 * max(h, w):
+            depth[todo] = np.median(zbuf[hit])
+            break
+        if box != size:
+            weight = ndimage.uniform_filter(hit32, size=box, mode="constant")
+        local = ndimage.uniform_filter(seed, size=box, mode="constant")
+        done = todo & (weight > 1e-6)
+        depth[done] = local[done] / weight[done]
+        todo &= ~done
+        box *= 3
+    depth = depth.astype(np.float64)
+    depth[hit] = zbuf[hit]
+
+    dist, (mr, mc) = ndimage.distance_transform_edt(~mask, return_indices=True)
+    return View(
+        u0=u0,
+        v0=v0,
+        mask=mask,
+        dist=dist.ravel(),
+        near_u=(mc + u0).ravel().astype(np.float64),
+        near_v=(mr + v0).ravel().astype(np.float64),
+        near_depth=depth[mr, mc].ravel(),
+        fill_radius=float(fill_radius),
+    )

@@ -1,0 +1,14 @@
+import numpy as np
+
+from symfruit.bench import DENSE_GRID, bench_view
+
+
+def test_bench_view_is_fixed_and_partial():
+    a, b = bench_view(), bench_view()
+    assert a.shape == (600, 3) and np.array_equal(a, b)
+    assert 0.28 < a[:, 2].min() < a[:, 2].max() < 0.33
+    assert not np.array_equal(bench_view(seed=1), a)
+
+
+def test_dense_grid_is_ten_times_the_papers():
+    assert DENSE_GRID["translations"] * DENSE_GRID["rotations_x"] * DENSE_GRID["rotations_y"] == 1320

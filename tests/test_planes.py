@@ -1,0 +1,75 @@
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from symfruit.planes import hypothesis_planes, mirror
+
+coords = arrays(np.float64, (12, 3), elements=st.floats(-1.0, 1.0))
+unit = arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)).filter(lambda v: np.linalg.norm(v) > 0.1)
+
+
+@given(coords, arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)), unit)
+def test_mirror_is_an_involution_and_an_isometry(points, q, n):
+    once = mirror(points, q, n)
+    assert np.allclose(mirror(once, q, n), points, atol=1e-9)
+    d_before = np.linalg.norm(points[:, None] - points[None], axis=-1)
+    d_after = np.linalg.norm(once[:, None] - once[None], axis=-1)
+    assert np.allclose(d_before, d_after, atol=1e-9)
+
+
+@given(arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)), unit, st.floats(-1.0, 1.0), st.floats(-1.0, 1.0))
+def test_points_on_the_plane_stay_put(q, n, a, b):
+    n = n / np.linalg.norm(n)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(n[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    e1 = np.cross(n, helper)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(n, e1)
+    p = (q + a * e1 + b * e2)[None]
+    assert np.allclose(mirror(p, q, n), p, atol=1e-9)
+
+
+def test_mirror_through_z_plane_known_answer():
+    p = np.array([[0.1, 0.2, 0.30]])
+    assert np.allclose(mirror(p, [0, 0, 0.35], [0, 0, 1]), [[0.1, 0.2, 0.40]])
+
+
+def test_batched_mirror_matches_single_planes():
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(50, 3))
+    qs, ns = rng.normal(size=(7, 3)), rng.normal(size=(7, 3))
+    batch = mirror(pts, qs, ns)
+    assert batch.shape == (7, 50, 3)
+    for i in range(7):
+        assert np.allclose(batch[i], mirror(pts, qs[i], ns[i]))
+
+
+def test_default_grid_is_the_papers(sphere_view):
+    planes = hypothesis_planes(sphere_view)
+    assert len(planes) == 132  # m=4, j=11, k=3
+    assert np.allclose(np.linalg.norm(planes.normals, axis=1), 1.0)
+    assert sorted(set(np.round(planes.angles_x, 6))) == [5.0 * i for i in range(-5, 6)]
+    assert sorted(set(np.round(planes.angles_y, 6))) == [-5.0, 0.0, 5.0]
+    len_depth = np.ptp(sphere_view[:, 2])
+    assert np.allclose(sorted(set(np.round(planes.offsets / len_depth, 9))), [0.0, 0.2, 0.4, 0.6])
+    # Translation-major order; the first plane is the initial hypothesis (section 3.2) rotated to the
+    # first angles; the unrotated initial plane is through the centroid with normal +z.
+    centre = np.flatnonzero((planes.offsets == 0) & (planes.angles_x == 0) & (planes.angles_y == 0))
+    assert len(centre) == 1
+    assert np.allclose(planes.normals[centre[0]], [0, 0, 1])
+    assert np.allclose(planes.points[centre[0]], sphere_view.mean(axis=0))
+    assert np.all(np.diff(planes.offsets) >= 0)
+
+
+def test_rotations_are_about_x_and_y_not_z(sphere_view):
+    # Eq. 3 of the paper prints a rotation about z, which would leave every normal at +z.
+    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=3, rotations_y=1, rotation_x_step=10)
+    assert np.allclose(planes.normals[0], [0.0, np.sin(np.radians(10)), np.cos(np.radians(10))])
+    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=1, rotations_y=3, rotation_y_step=10)
+    assert np.allclose(planes.normals[2], [np.sin(np.radians(10)), 0.0, np.cos(np.radians(10))])
+
+
+@pytest.mark.parametrize("m, j, k", [(1, 1, 1), (2, 5, 7), (10, 22, 6)])
+def test_grid_sizes(sphere_view, m, j, k):
+    assert len(hypothesis_planes(sphere_view, translations=m, rotations_x=j, rotations_y=k)) == m * j * k
