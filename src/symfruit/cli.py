@@ -1,4 +1,4 @@
-"""Command-line interface: ``symfruit complete | bench | settings | methods``.
+"""Command-line interface: ``symfruit complete | evaluate | bench | settings | methods``.
 
 Thin by design: parse, import lazily, call the library, print. Errors a user can cause print one
 line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the traceback instead.
@@ -43,6 +43,31 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
 
 
+def _add_evaluate(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("evaluate", help="run an evaluation protocol and write tables, CSV, JSON and plots")
+    p.add_argument(
+        "--protocol",
+        choices=("paper", "camera"),
+        default="paper",
+        help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views",
+    )
+    p.add_argument(
+        "--fruit",
+        default="strawberry",
+        help="strawberry, apple, citrus, tomato, all, or a folder of complete scans; comma-separated",
+    )
+    p.add_argument("--methods", default="raw,sphere,ellipsoid,paper", help="comma-separated methods")
+    p.add_argument(
+        "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
+    )
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
+    p.add_argument("--output", type=Path, default=Path("results"), help="results root (default results/)")
+    p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
+    p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
+    p.add_argument("--config", type=Path, help="settings file for the methods")  # fmt: skip
+
+
 def _parser() -> argparse.ArgumentParser:
     from . import __version__
 
@@ -55,6 +80,7 @@ def _parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     _add_complete(sub)
     _add_bench(sub)
+    _add_evaluate(sub)
     p = sub.add_parser(
         "settings", help="print the effective settings as YAML (defaults, or merged with --config)"
     )
@@ -145,6 +171,42 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _evaluate(args: argparse.Namespace) -> int:
+    from .config import Settings, load_settings
+    from .errors import InputError
+    from .evaluate import evaluate
+    from .methods import get
+    from .shapes import FRUITS
+
+    fruits = [f.strip() for f in args.fruit.split(",") if f.strip()]
+    if fruits == ["all"]:
+        fruits = list(FRUITS)
+    for fruit in fruits:
+        if fruit not in FRUITS and not Path(fruit).is_dir():
+            raise InputError(
+                f"--fruit {fruit!r}: not a fruit kind ({', '.join(FRUITS)}, all) nor a folder of scans"
+            )
+    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    for method in methods:
+        get(method)
+    try:
+        occlusions = [float(x) for x in args.occlusion.split(",")]
+    except ValueError:
+        raise InputError(f"--occlusion {args.occlusion!r}: expected numbers such as 0,0.25,0.5") from None
+    if any(not 0.0 <= x < 1.0 for x in occlusions):
+        raise InputError("--occlusion levels must be in [0, 1)")
+    if args.n is not None and args.n < 1:
+        raise InputError("--n must be at least 1")
+    settings = load_settings(args.config) if args.config else Settings()
+    result = evaluate(
+        protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
+        occlusions=occlusions, quick=args.quick, settings=settings, output=args.output, jobs=args.jobs,
+    )  # fmt: skip
+    print(result.table)
+    print(f"results: {result.folder}")
+    return 0
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -164,7 +226,13 @@ def _methods(args: argparse.Namespace) -> int:
     return 0
 
 
-_COMMANDS = {"complete": _complete, "bench": _bench, "settings": _settings, "methods": _methods}
+_COMMANDS = {
+    "complete": _complete,
+    "bench": _bench,
+    "evaluate": _evaluate,
+    "settings": _settings,
+    "methods": _methods,
+}
 
 
 def main(argv: Sequence[str] | None = None) -> int:

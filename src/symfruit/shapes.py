@@ -1,18 +1,48 @@
-"""Parametric fruit surfaces for tests, benchmarks and evaluation, in metres, seeded.
+"""Parametric fruit surfaces for tests, benchmarks, scenes and evaluation: metres, seeded.
 
-A fruit is a closed triangle mesh built by revolving a profile about the y axis (the fruit's long
-axis, calyx or stem end at -y, which is "up" in the optical frame), with a slightly elliptic cross
-section and a slight bend so it is not an exact solid of revolution. Surface points are sampled
-uniformly by area.
+A fruit is a closed triangle mesh made by revolving a profile about the y axis (the fruit's long
+axis; the stem or calyx end at -y, which is "up" in the optical frame), then made imperfect: an
+elliptic cross-section, a lopsided bulge, a slight bend, and per-kind detail (a strawberry's dimpled
+calyx end, an apple's stem cavity and calyx basin, a tomato's shoulders and ribs). Every fruit is
+centred on the centre of its own box. Surface points are sampled uniformly by area.
+
+=========== ===================== ===============================================================
+kind        size                  shape
+=========== ===================== ===============================================================
+strawberry  length 25-50 mm       classes conic, long-conic, globose, wedge (heart); width/length
+                                  0.65-1.1; flattened calyx end with a shallow dimple; pointed or
+                                  blunt tip
+apple       diameter 60-90 mm     height/diameter 0.8-0.95, stem cavity, calyx basin, lopsided
+citrus      diameter 60-90 mm     near-spherical, height/diameter 0.88-0.98
+tomato      diameter 40-80 mm     oblate (height/diameter 0.65-0.85), shoulders, shallow ribs
+=========== ===================== ===============================================================
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
-__all__ = ["Fruit", "paper_visible", "rotation_x", "sample_surface", "strawberry"]
+from .errors import FileFormatError
+
+__all__ = [
+    "FRUITS",
+    "STRAWBERRY_CLASSES",
+    "Fruit",
+    "apple",
+    "citrus",
+    "load_scans",
+    "make_fruit",
+    "paper_visible",
+    "rotation",
+    "rotation_x",
+    "sample_surface",
+    "strawberry",
+    "tomato",
+]
 
 
 @dataclass(frozen=True)
@@ -24,45 +54,27 @@ class Fruit:
     vertices : (v, 3) float, metres
     faces : (f, 3) int
     kind : str
+        e.g. ``"strawberry/conic"``, ``"apple"``, ``"scan/berry_01"``.
+    points : (p, 3) float, optional
+        The measured points of a scan that came without a mesh: samples are drawn from these, and
+        the mesh is their convex hull (used only to render the scan).
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     kind: str
+    points: np.ndarray | None = None
 
     def sample(self, n: int, rng: np.random.Generator) -> np.ndarray:
         """(n, 3) float: ``n`` points uniformly distributed over the surface."""
+        if self.points is not None:
+            return self.points[rng.choice(len(self.points), size=n, replace=n > len(self.points))]
         return sample_surface(self.vertices, self.faces, n, rng)
 
-
-def _revolve(
-    radius: np.ndarray, axial: np.ndarray, n_phi: int, squash: float, bend: float
-) -> tuple[np.ndarray, np.ndarray]:
-    """Mesh of a profile ``radius(t), axial(t)`` (t from pole to pole, radius 0 at both ends)."""
-    phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
-    ring_r = radius[1:-1, None]
-    ring_y = axial[1:-1, None]
-    x = ring_r * np.cos(phi)[None, :] * squash
-    z = ring_r * np.sin(phi)[None, :] / squash
-    y = np.broadcast_to(ring_y, x.shape)
-    span = axial[-1] - axial[0]
-    x = x + bend * span * ((ring_y - axial[0]) / span) ** 2
-    rings = np.stack([x, y, z], axis=-1).reshape(-1, 3)
-    top = np.array([[bend * 0.0, axial[0], 0.0]])
-    bottom = np.array([[bend * span, axial[-1], 0.0]])
-    vertices = np.vstack([top, rings, bottom])
-    n_rings = len(radius) - 2
-    faces = []
-    j = np.arange(n_phi)
-    jn = (j + 1) % n_phi
-    faces.append(np.stack([np.zeros(n_phi, int), 1 + jn, 1 + j], axis=1))
-    for i in range(n_rings - 1):
-        a, b = 1 + i * n_phi, 1 + (i + 1) * n_phi
-        faces.append(np.stack([a + j, a + jn, b + j], axis=1))
-        faces.append(np.stack([a + jn, b + jn, b + j], axis=1))
-    last = 1 + (n_rings - 1) * n_phi
-    faces.append(np.stack([last + j, last + jn, np.full(n_phi, len(vertices) - 1)], axis=1))
-    return vertices, np.vstack(faces)
+    def transformed(self, rotation_matrix: np.ndarray, translation: np.ndarray) -> Fruit:
+        """The fruit rotated about its centre, then moved by ``translation`` (metres)."""
+        pts = None if self.points is None else self.points @ rotation_matrix.T + translation
+        return Fruit(self.vertices @ rotation_matrix.T + translation, self.faces, self.kind, pts)
 
 
 def sample_surface(vertices: np.ndarray, faces: np.ndarray, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -77,17 +89,62 @@ def sample_surface(vertices: np.ndarray, faces: np.ndarray, n: int, rng: np.rand
     return t[:, 0] + u[:, None] * (t[:, 1] - t[:, 0]) + v[:, None] * (t[:, 2] - t[:, 0])
 
 
-#: Profile exponents (shoulder, tip) and width/length ratio range per strawberry shape class.
-STRAWBERRY_CLASSES = {
-    "conic": (0.40, 0.85, (0.80, 0.95)),
-    "long-conic": (0.35, 1.00, (0.65, 0.80)),
-    "globose": (0.55, 0.60, (0.95, 1.10)),
-    "wedge": (0.25, 1.10, (0.85, 1.00)),
+def _revolve(
+    radius: np.ndarray,
+    axial: np.ndarray,
+    *,
+    n_phi: int = 64,
+    squash: float = 1.0,
+    bend: float = 0.0,
+    lopsided: float = 0.0,
+    lopsided_phase: float = 0.0,
+    ribs: tuple[int, float] = (0, 0.0),
+    name: str,
+) -> Fruit:
+    """Closed mesh of the profile ``radius(t), axial(t)`` (t from the top pole to the bottom pole).
+
+    ``squash`` makes the cross-section elliptic (x scaled by it, z by its inverse), ``lopsided``
+    swells one side (``1 + lopsided * cos(phi - phase)``), ``ribs = (count, depth)`` adds ribs, and
+    ``bend`` curves the axis sideways by ``bend`` times the length at the bottom pole.
+    """
+    phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
+    count, depth = ribs
+    scale = 1.0 + lopsided * np.cos(phi - lopsided_phase) + depth * np.cos(count * phi)
+    ring_r = radius[1:-1, None] * scale[None, :]
+    ring_y = np.broadcast_to(axial[1:-1, None], ring_r.shape)
+    span = axial[-1] - axial[0]
+    shift = bend * span * ((axial - axial[0]) / span) ** 2
+    x = ring_r * np.cos(phi)[None, :] * squash + shift[1:-1, None]
+    z = ring_r * np.sin(phi)[None, :] / squash
+    rings = np.stack([x, ring_y, z], axis=-1).reshape(-1, 3)
+    top = np.array([[shift[0], axial[0], 0.0]])
+    bottom = np.array([[shift[-1], axial[-1], 0.0]])
+    vertices = np.vstack([top, rings, bottom])
+    n_rings = len(radius) - 2
+    j = np.arange(n_phi)
+    jn = (j + 1) % n_phi
+    faces = [np.stack([np.zeros(n_phi, int), 1 + jn, 1 + j], axis=1)]
+    a = 1 + np.arange(n_rings - 1)[:, None] * n_phi
+    b = a + n_phi
+    faces.append(np.stack([a + j, a + jn, b + j], axis=-1).reshape(-1, 3))
+    faces.append(np.stack([a + jn, b + jn, b + j], axis=-1).reshape(-1, 3))
+    last = 1 + (n_rings - 1) * n_phi
+    faces.append(np.stack([last + j, last + jn, np.full(n_phi, len(vertices) - 1)], axis=1))
+    centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
+    return Fruit(vertices=vertices - centre, faces=np.vstack(faces), kind=name)
+
+
+#: Strawberry classes: (shoulder exponent, tip exponent range, width/length range, cross-section squash).
+STRAWBERRY_CLASSES: dict[str, tuple[float, tuple[float, float], tuple[float, float], tuple[float, float]]] = {
+    "conic": (0.40, (0.75, 1.0), (0.80, 0.95), (0.95, 1.05)),
+    "long-conic": (0.35, (0.9, 1.15), (0.65, 0.80), (0.95, 1.05)),
+    "globose": (0.55, (0.45, 0.65), (0.95, 1.10), (0.95, 1.05)),
+    "wedge": (0.25, (0.9, 1.2), (0.85, 1.00), (0.82, 0.92)),
 }
 
 
 def strawberry(rng: np.random.Generator, *, shape: str | None = None, length: float | None = None) -> Fruit:
-    """A strawberry-like surface: flattened calyx end with a shallow dimple, tapering to the tip.
+    """A strawberry: flattened calyx end (top, -y) with a shallow dimple, tapering to the tip.
 
     Parameters
     ----------
@@ -99,22 +156,151 @@ def strawberry(rng: np.random.Generator, *, shape: str | None = None, length: fl
     """
     if shape is None:
         shape = str(rng.choice(list(STRAWBERRY_CLASSES)))
-    alpha, beta, ratio_range = STRAWBERRY_CLASSES[shape]
+    if shape not in STRAWBERRY_CLASSES:
+        raise ValueError(f"unknown strawberry class {shape!r}; known: {', '.join(STRAWBERRY_CLASSES)}")
+    alpha, beta_range, ratio_range, squash_range = STRAWBERRY_CLASSES[shape]
     length = float(rng.uniform(0.025, 0.050)) if length is None else float(length)
     width = length * rng.uniform(*ratio_range)
-    t = np.linspace(0.0, 1.0, 64)
+    beta = rng.uniform(*beta_range)  # < 0.7: blunt tip, > 0.9: pointed
+    t = np.linspace(0.0, 1.0, 72)
     f = t**alpha * (1.0 - t) ** beta
     f /= f.max()
     radius = 0.5 * width * f
-    # Flattened calyx end with a shallow dimple: pull the axial position of the first rings inward.
-    dimple = 0.06 * length * np.exp(-((t / 0.08) ** 2))
+    # Flattened calyx end with a shallow dimple: pull the first rings' axial position inward.
+    dimple = rng.uniform(0.03, 0.07) * length * np.exp(-((t / 0.09) ** 2))
     axial = t * length + dimple
-    axial[0] = dimple[0] * 0.6
-    vertices, faces = _revolve(
-        radius, axial, 48, squash=rng.uniform(0.95, 1.05), bend=rng.uniform(-0.06, 0.06)
-    )
-    centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
-    return Fruit(vertices=vertices - centre, faces=faces, kind=f"strawberry/{shape}")
+    return _revolve(
+        radius, axial, squash=rng.uniform(*squash_range), bend=rng.uniform(-0.06, 0.06),
+        lopsided=rng.uniform(0.0, 0.05), lopsided_phase=rng.uniform(0, 2 * np.pi),
+        name=f"strawberry/{shape}",
+    )  # fmt: skip
+
+
+def _pome(
+    rng: np.random.Generator,
+    *,
+    diameter: float,
+    height_ratio: float,
+    top_cavity: float,
+    top_width: float,
+    bottom_cavity: float,
+    bottom_width: float,
+    shoulder: float,
+    ribs: tuple[int, float],
+    lopsided: float,
+    name: str,
+) -> Fruit:
+    """A round fruit: ellipse profile, cavities at the poles, optional shoulders."""
+    theta = np.linspace(0.0, np.pi, 80)
+    a, b = diameter / 2.0, diameter * height_ratio / 2.0
+    radius = a * np.sin(theta) * (1.0 + shoulder * np.sin(theta) * np.cos(theta))
+    axial = -b * np.cos(theta)
+    axial = axial + top_cavity * diameter * np.exp(-((theta / top_width) ** 2))
+    axial = axial - bottom_cavity * diameter * np.exp(-(((np.pi - theta) / bottom_width) ** 2))
+    return _revolve(
+        radius, axial, squash=rng.uniform(0.97, 1.03), bend=rng.uniform(-0.02, 0.02),
+        lopsided=lopsided, lopsided_phase=rng.uniform(0, 2 * np.pi), ribs=ribs, name=name,
+    )  # fmt: skip
+
+
+def apple(rng: np.random.Generator, *, diameter: float | None = None) -> Fruit:
+    """An apple, 60-90 mm: slightly oblate and lopsided, with a stem cavity and a calyx basin."""
+    return _pome(
+        rng,
+        diameter=rng.uniform(0.060, 0.090) if diameter is None else diameter,
+        height_ratio=rng.uniform(0.80, 0.95),
+        top_cavity=rng.uniform(0.08, 0.14), top_width=0.35,
+        bottom_cavity=rng.uniform(0.04, 0.08), bottom_width=0.3,
+        shoulder=rng.uniform(0.0, 0.12), ribs=(5, rng.uniform(0.0, 0.015)),
+        lopsided=rng.uniform(0.02, 0.06), name="apple",
+    )  # fmt: skip
+
+
+def citrus(rng: np.random.Generator, *, diameter: float | None = None) -> Fruit:
+    """An orange, 60-90 mm: near-spherical, slightly oblate."""
+    return _pome(
+        rng,
+        diameter=rng.uniform(0.060, 0.090) if diameter is None else diameter,
+        height_ratio=rng.uniform(0.88, 0.98),
+        top_cavity=rng.uniform(0.0, 0.02), top_width=0.2,
+        bottom_cavity=rng.uniform(0.0, 0.015), bottom_width=0.2,
+        shoulder=0.0, ribs=(0, 0.0), lopsided=rng.uniform(0.0, 0.02), name="citrus",
+    )  # fmt: skip
+
+
+def tomato(rng: np.random.Generator, *, diameter: float | None = None) -> Fruit:
+    """A tomato, 40-80 mm: oblate, with shoulders by the stem and shallow ribs."""
+    return _pome(
+        rng,
+        diameter=rng.uniform(0.040, 0.080) if diameter is None else diameter,
+        height_ratio=rng.uniform(0.65, 0.85),
+        top_cavity=rng.uniform(0.03, 0.07), top_width=0.3,
+        bottom_cavity=rng.uniform(0.0, 0.02), bottom_width=0.25,
+        shoulder=rng.uniform(0.05, 0.15), ribs=(int(rng.integers(4, 8)), rng.uniform(0.01, 0.03)),
+        lopsided=rng.uniform(0.0, 0.04), name="tomato",
+    )  # fmt: skip
+
+
+#: Fruit generators by kind: ``FRUITS[kind](rng) -> Fruit``.
+FRUITS: dict[str, Callable[[np.random.Generator], Fruit]] = {
+    "strawberry": strawberry,
+    "apple": apple,
+    "citrus": citrus,
+    "tomato": tomato,
+}
+
+
+def make_fruit(kind: str, rng: np.random.Generator) -> Fruit:
+    """A random fruit of ``kind`` (a key of :data:`FRUITS`)."""
+    try:
+        return FRUITS[kind](rng)
+    except KeyError:
+        raise ValueError(f"unknown fruit kind {kind!r}; known: {', '.join(FRUITS)}") from None
+
+
+def load_scans(folder: str | Path) -> list[Fruit]:
+    """Load complete fruit scans from a folder as an evaluation set.
+
+    Every ``.ply``, ``.pcd``, ``.xyz``, ``.txt``, ``.csv``, ``.npy`` (point clouds) and ``.obj`` or
+    meshed ``.ply`` (triangle meshes) file is one fruit, in metres, in any pose: each is centred on
+    its box centre. Files are taken in name order. A cloud without faces is rendered (``camera``
+    protocol) through its convex hull, which suits fruit, being nearly convex; its own points are
+    what is sampled (``paper`` protocol) and what the truth is measured on.
+
+    Raises
+    ------
+    FileFormatError
+        When the folder is missing or holds no readable scan; a bad file names itself.
+    """
+    from .io import read_cloud, read_mesh
+
+    folder = Path(folder)
+    if not folder.is_dir():
+        raise FileFormatError(f"{folder}: no such folder of fruit scans")
+    fruits = []
+    for path in sorted(folder.iterdir()):
+        suffix = path.suffix.lower()
+        if suffix not in (".ply", ".pcd", ".xyz", ".txt", ".csv", ".npy", ".obj"):
+            continue
+        vertices, faces = read_mesh(path) if suffix in (".obj", ".ply") else (read_cloud(path), None)
+        if len(vertices) < 100:
+            raise FileFormatError(f"{path}: a complete scan needs at least 100 points, got {len(vertices)}")
+        centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
+        vertices = vertices - centre
+        kind = f"scan/{path.stem}"
+        if faces is None or len(faces) == 0:
+            from scipy.spatial import ConvexHull, QhullError
+
+            try:
+                hull = ConvexHull(vertices)
+            except QhullError:
+                raise FileFormatError(f"{path}: the scan's points are flat or degenerate") from None
+            fruits.append(Fruit(vertices, hull.simplices.astype(np.int64), kind, points=vertices))
+        else:
+            fruits.append(Fruit(vertices, faces, kind))
+    if not fruits:
+        raise FileFormatError(f"{folder}: no fruit scans found (.ply, .pcd, .xyz, .txt, .csv, .npy, .obj)")
+    return fruits
 
 
 def rotation_x(degrees: float) -> np.ndarray:
@@ -122,6 +308,14 @@ def rotation_x(degrees: float) -> np.ndarray:
     a = np.radians(degrees)
     c, s = np.cos(a), np.sin(a)
     return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+def rotation(rx: float, ry: float, rz: float) -> np.ndarray:
+    """(3, 3) rotation ``R_z(rz) @ R_y(ry) @ R_x(rx)``, angles in degrees."""
+    x, y, z = np.radians([rx, ry, rz])
+    rot_y = np.array([[np.cos(y), 0.0, np.sin(y)], [0.0, 1.0, 0.0], [-np.sin(y), 0.0, np.cos(y)]])
+    rot_z = np.array([[np.cos(z), -np.sin(z), 0.0], [np.sin(z), np.cos(z), 0.0], [0.0, 0.0, 1.0]])
+    return rot_z @ rot_y @ rotation_x(np.degrees(x))
 
 
 def paper_visible(points: np.ndarray) -> np.ndarray:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from .atomic import atomic_write, write_json
 from .clouds import CLOUD_READERS, read_cloud, write_ply
 from .intrinsics import camera_from_dict, load_camera
+from .meshes import read_mesh
 
 __all__ = [
     "CLOUD_READERS",
@@ -12,6 +13,7 @@ __all__ = [
     "camera_from_dict",
     "load_camera",
     "read_cloud",
+    "read_mesh",
     "write_json",
     "write_ply",
 ]

@@ -1,0 +1,107 @@
+"""Evaluation: protocols that make instances, a parallel runner, and reports.
+
+``evaluate(...)`` is what ``symfruit evaluate`` calls; it drives the same public
+:func:`symfruit.complete` a user calls.
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import os
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from ..config import Settings
+from .protocols import PAPER_ANGLES, Spec, build, specs
+from .report import markdown_table, write_results
+from .runner import Row, run, summarise
+
+__all__ = ["Evaluation", "Row", "Spec", "build", "evaluate", "markdown_table", "run", "specs", "summarise"]
+
+#: ``--quick``: a handful of instances, well under a minute.
+QUICK = {"paper": {"n": 4, "angles": (-45, -30, -15, 0, 15, 30, 45)}, "camera": {"n": 8}}
+
+
+@dataclass(frozen=True)
+class Evaluation:
+    """What :func:`evaluate` returns."""
+
+    folder: Path | None
+    rows: list[Row]
+    summary: list[dict[str, Any]]
+    table: str
+
+
+def evaluate(
+    *,
+    protocol: str = "paper",
+    fruits: Sequence[str] = ("strawberry",),
+    methods: Sequence[str] = ("raw", "sphere", "ellipsoid", "paper"),
+    n: int | None = None,
+    seed: int = 0,
+    occlusions: Sequence[float] = (0.0,),
+    quick: bool = False,
+    settings: Settings | None = None,
+    output: Path | None = Path("results"),
+    jobs: int | None = None,
+    progress: bool = True,
+) -> Evaluation:
+    """Run a protocol for some fruit kinds (or scan folders) and methods; write the results.
+
+    ``n`` is the number of fruits (``paper``: each in 19 poses; default 10, as in the paper) or of
+    views per occlusion level (``camera``; default 100). Results go to a new timestamped folder under
+    ``output`` with a ``latest`` link to it; ``output=None`` writes nothing.
+    """
+    settings = settings or Settings()
+    angles = tuple(QUICK["paper"]["angles"]) if quick and protocol == "paper" else PAPER_ANGLES
+    if n is None:
+        n = QUICK[protocol]["n"] if quick else (10 if protocol == "paper" else 100)
+    all_specs = [
+        s for fruit in fruits
+        for s in specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions))
+    ]  # fmt: skip
+    rows = run(all_specs, methods, settings, jobs=jobs, progress=progress)
+    summary = summarise(rows)
+    title = f"symfruit evaluation: {protocol} protocol"
+    table = markdown_table(summary, protocol=protocol, title=title)
+    folder = None
+    if output is not None:
+        folder = _new_folder(Path(output), protocol)
+        from .. import __version__
+
+        meta = {
+            "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
+            "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "quick": quick,
+            "instances": len(all_specs), "settings": settings.to_dict(),
+        }  # fmt: skip
+        from ..io import write_json
+
+        write_json(folder / "settings.json", meta)
+        write_results(folder, rows, summary, protocol=protocol, meta=meta)
+        _link_latest(folder)
+    return Evaluation(folder=folder, rows=rows, summary=summary, table=table)
+
+
+def _new_folder(root: Path, protocol: str) -> Path:
+    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    folder = root / f"{stamp}-{protocol}"
+    k = 1
+    while folder.exists():
+        k += 1
+        folder = root / f"{stamp}-{protocol}-{k}"
+    folder.mkdir(parents=True)
+    return folder
+
+
+def _link_latest(folder: Path) -> None:
+    link = folder.parent / "latest"
+    tmp = folder.parent / f".latest-{os.getpid()}"
+    try:
+        if tmp.is_symlink() or tmp.exists():
+            tmp.unlink()
+        tmp.symlink_to(folder.name)
+        os.replace(tmp, link)
+    except OSError:  # file systems without symlinks: the timestamped folder is still there
+        pass

@@ -1,0 +1,230 @@
+"""Evaluation protocols: how a test instance (visible points + truth) is made from a fruit.
+
+``paper``
+    Algorithm 2 and section 4.1 of Ge et al., to the letter: 600 random surface points of a whole
+    fruit, rotated about x from -45 to +45 degrees in 5-degree steps (19 poses), the paper's visibility
+    rule (keep the points in front of the plane through the lowest- and highest-y points that contains
+    the x direction), the fruit's box centre placed :data:`PAPER_DISTANCE` in front of the default
+    camera. Truth: the box of the 600 points in the same pose (the paper's "3D position of randomly
+    chosen points").
+``camera``
+    What a D435 on a harvester sees: the fruit's mesh rendered with a z-buffer at the camera's
+    resolution, random pose (about x within +-45 deg, about y any angle, about z within +-45 deg: hanging
+    fruit, never upside down), distance 0.25-0.6 m, anywhere in the image where the whole fruit is in
+    view, D435-like depth noise (:class:`~symfruit.render.SensorNoise`), and optionally a leaf-like
+    occluder in front hiding a set share of the fruit's silhouette. Truth: the box of the whole mesh in
+    the same pose.
+
+Instances are described by small :class:`Spec` tuples and built deterministically from them, so
+that worker processes build their own and the same seed always gives the same instances.
+"""
+
+from __future__ import annotations
+
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..box import Box
+from ..camera import DEFAULT_CAMERA, Camera
+from ..render import SensorNoise, render
+from ..shapes import FRUITS, Fruit, load_scans, paper_visible, rotation, rotation_x
+
+__all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "Instance", "Spec", "build", "specs"]
+
+#: Distance of the fruit's centre from the camera in the ``paper`` protocol (metres). The paper does
+#: not give one (its rule needs none); 0.3 m is a typical harvester working distance.
+PAPER_DISTANCE = 0.30
+#: Poses of the ``paper`` protocol, degrees about x.
+PAPER_ANGLES = tuple(range(-45, 50, 5))
+#: Surface points sampled for the truth surface (Chamfer, F1) in the ``camera`` protocol.
+TRUTH_POINTS = 5000
+_KIND_IDS = {kind: i for i, kind in enumerate(FRUITS)}
+
+
+@dataclass(frozen=True)
+class Spec:
+    """What identifies one instance: build it with :func:`build`."""
+
+    protocol: str
+    fruit: str  # a kind of FRUITS, or a folder of scans
+    index: int  # which fruit
+    pose: int  # which pose (paper: index into PAPER_ANGLES; camera: the view number)
+    occlusion: float = 0.0  # target hidden share of the silhouette (camera protocol)
+    seed: int = 0
+
+
+@dataclass(frozen=True)
+class Instance:
+    """A visible view with its truth."""
+
+    spec: Spec
+    kind: str
+    visible: np.ndarray
+    truth_box: Box
+    truth_surface: np.ndarray
+    camera: Camera
+    angles: tuple[float, float, float]
+    distance: float
+    hidden: float = 0.0
+    extras: dict = field(default_factory=dict)
+
+
+def specs(
+    protocol: str, fruit: str, *, n: int, seed: int = 0, angles: tuple[int, ...] = PAPER_ANGLES,
+    occlusions: tuple[float, ...] = (0.0,),
+) -> list[Spec]:  # fmt: skip
+    """All instance specs of a protocol: ``n`` fruits x the 19 poses (paper) or ``n`` views per
+    occlusion level (camera); for a scan folder, ``n`` is capped by the number of scans."""
+    if protocol == "paper":
+        if fruit not in FRUITS:
+            n = min(n, len(_scans(fruit)))
+        return [Spec("paper", fruit, i, PAPER_ANGLES.index(a), 0.0, seed) for i in range(n) for a in angles]
+    if protocol == "camera":
+        count = len(_scans(fruit)) if fruit not in FRUITS else None
+        return [
+            Spec("camera", fruit, i % count if count else i, i, occ, seed)
+            for occ in occlusions
+            for i in range(n)
+        ]
+    raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
+
+
+@functools.lru_cache(maxsize=4)
+def _scans(folder: str) -> tuple[Fruit, ...]:
+    return tuple(load_scans(folder))
+
+
+def _fruit(spec: Spec) -> Fruit:
+    if spec.fruit in FRUITS:
+        rng = np.random.default_rng([spec.seed, _KIND_IDS[spec.fruit], spec.index])
+        return FRUITS[spec.fruit](rng)
+    return _scans(spec.fruit)[spec.index]
+
+
+def build(spec: Spec, camera: Camera = DEFAULT_CAMERA) -> Instance:
+    """Make the instance a spec describes."""
+    if spec.protocol == "paper":
+        return _paper(spec)
+    return _camera(spec, camera)
+
+
+def _paper(spec: Spec) -> Instance:
+    fruit = _fruit(spec)
+    rng = np.random.default_rng([spec.seed, 1000 + _KIND_IDS.get(spec.fruit, 99), spec.index])
+    points = fruit.sample(600, rng)  # the same 600 points in every pose of this fruit
+    angle = float(PAPER_ANGLES[spec.pose])
+    posed = points @ rotation_x(angle).T
+    truth = Box.from_points(posed)
+    posed = posed - truth.centre + [0.0, 0.0, PAPER_DISTANCE]
+    visible = posed[paper_visible(posed)]
+    return Instance(
+        spec=spec, kind=fruit.kind, visible=visible, truth_box=Box.from_points(posed), truth_surface=posed,
+        camera=DEFAULT_CAMERA, angles=(angle, 0.0, 0.0), distance=PAPER_DISTANCE,
+    )  # fmt: skip
+
+
+_NOISE = SensorNoise()
+
+
+def _camera(spec: Spec, camera: Camera, noise: SensorNoise = _NOISE) -> Instance:
+    fruit = _fruit(spec)
+    rng = np.random.default_rng([spec.seed, 2000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
+                                 round(spec.occlusion * 1000)])  # fmt: skip
+    angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
+    rot = rotation(*angles)
+    distance = float(rng.uniform(0.25, 0.60))
+    radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
+    # Anywhere in the image where the whole fruit stays in view (a 10-pixel margin).
+    half_u = (camera.width / 2 - 10) * distance / camera.fx - radius
+    half_v = (camera.height / 2 - 10) * distance / camera.fy - radius
+    centre = np.array([
+        (camera.width / 2 - camera.cx) * distance / camera.fx + rng.uniform(-1, 1) * max(half_u, 0.0),
+        (camera.height / 2 - camera.cy) * distance / camera.fy + rng.uniform(-1, 1) * max(half_v, 0.0),
+        distance,
+    ])  # fmt: skip
+    posed = fruit.transformed(rot, centre)
+    meshes = [(posed.vertices, posed.faces)]
+    leaf = None
+    if spec.occlusion > 0:
+        leaf = _leaf(posed, camera, spec.occlusion, rng)
+        meshes.append(leaf)
+    shot = render(meshes, camera)
+    depth, jitter = noise.apply(shot, rng)
+    fruit_px = (shot.ids == 0) & (depth > 0)
+    rows, cols = np.nonzero(fruit_px)
+    uv = np.c_[cols, rows] + jitter[rows, cols]
+    visible = camera.deproject(uv, depth[rows, cols])
+    silhouette = (
+        render([(posed.vertices, posed.faces)], camera).ids == 0 if leaf is not None else shot.ids == 0
+    )
+    hidden = 1.0 - (shot.ids == 0).sum() / max(silhouette.sum(), 1)
+    surface = posed.sample(TRUTH_POINTS, np.random.default_rng([spec.seed, 3000, spec.index]))
+    truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
+    return Instance(
+        spec=spec, kind=fruit.kind, visible=visible, truth_box=truth, truth_surface=surface, camera=camera,
+        angles=angles, distance=distance, hidden=float(hidden),
+    )  # fmt: skip
+
+
+def _leaf(
+    fruit: Fruit, camera: Camera, share: float, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray]:
+    """A flat, pointed-oval leaf between the camera and the fruit hiding about ``share`` of its silhouette.
+
+    The leaf lies 5-30 mm in front of the fruit's nearest point, tilted up to 30 degrees; its size is
+    drawn relative to the fruit and its offset across the fruit is solved so that the hidden share of
+    the fruit's silhouette (the projected leaf polygon over the fruit's pixels) matches ``share``.
+    """
+    rows, cols = np.nonzero(render([(fruit.vertices, fruit.faces)], camera).ids == 0)
+    extent = float(np.ptp(fruit.vertices, axis=0).max())
+    length = extent * rng.uniform(1.2, 2.0)
+    width = length * rng.uniform(0.4, 0.6)
+    z = float(fruit.vertices[:, 2].min()) - rng.uniform(0.005, 0.03)
+    spin = rng.uniform(0, np.pi)
+    direction = rng.uniform(0, 2 * np.pi)
+    tilt = rotation(rng.uniform(-30, 30), rng.uniform(-30, 30), 0.0)
+    t = np.linspace(0, 2 * np.pi, 48, endpoint=False)
+    # Pointed oval: an ellipse whose ends are sharpened.
+    outline = np.c_[
+        length / 2 * np.cos(t), width / 2 * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)
+    ]
+    outline = outline @ rotation(0, 0, np.degrees(spin)).T @ tilt.T
+    centre_fruit = np.array([np.mean(cols), np.mean(rows)])
+
+    def place(offset: float) -> np.ndarray:
+        shift_px = centre_fruit + offset * np.array([np.cos(direction), np.sin(direction)])
+        centre = camera.deproject(shift_px, np.array(z))
+        return outline + centre
+
+    def hidden(offset: float) -> float:
+        poly = camera.project(place(offset))
+        return float(_inside(poly, np.c_[cols, rows]).mean())
+
+    lo, hi = 0.0, 3.0 * max(np.ptp(cols), np.ptp(rows)) + 1.0
+    if hidden(lo) < share:  # even centred the leaf hides too little: scale it up
+        scale = 1.0
+        while hidden(lo) < share and scale < 8:
+            outline = outline * 1.25
+            scale *= 1.25
+    for _ in range(30):
+        mid = (lo + hi) / 2.0
+        if hidden(mid) > share:
+            lo = mid
+        else:
+            hi = mid
+    ring = place((lo + hi) / 2.0)
+    vertices = np.vstack([ring.mean(axis=0, keepdims=True), ring])
+    n = len(ring)
+    faces = np.c_[np.zeros(n, int), 1 + np.arange(n), 1 + (np.arange(n) + 1) % n]
+    return vertices, faces
+
+
+def _inside(poly: np.ndarray, pts: np.ndarray) -> np.ndarray:
+    """Even-odd point-in-polygon test, vectorised over points; (n,) bool."""
+    x, y = pts[:, 0][:, None], pts[:, 1][:, None]
+    x0, y0 = poly[:, 0][None, :], poly[:, 1][None, :]
+    x1, y1 = np.roll(poly[:, 0], -1)[None, :], np.roll(poly[:, 1], -1)[None, :]
+    crosses = ((y0 > y) != (y1 > y)) & (x < (x1 - x0) * (y - y0) / np.where(y1 == y0, 1e-12, y1 - y0) + x0)
+    return crosses.sum(axis=1) % 2 == 1
