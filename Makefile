@@ -12,9 +12,8 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	touch $(STAMP)
 
-demo: $(STAMP)  ## complete the embedded partial strawberry, write out/demo/
-	$(BIN)/symfruit complete examples/strawberry_partial.ply --camera examples/camera.json \
-		--output out/demo/strawberry_completed.ply
+demo: $(STAMP)  ## locate the fruit of the shipped RGB-D frame, write out/demo/
+	$(BIN)/symfruit demo --output out/demo
 
 test: $(STAMP)  ## lint and the test suite (slow evaluation runs excluded)
 	$(BIN)/ruff check src tests examples

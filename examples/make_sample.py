@@ -3,8 +3,9 @@
     python examples/make_sample.py
 
 Writes ``strawberry_partial.ply`` (the visible points, metres, camera optical frame),
-``strawberry_truth.json`` (the box of the whole berry) and ``camera.json`` (Intel D435 colour,
-640x480) next to this file. Seeded: the same files every time.
+``strawberry_truth.json`` (the box of the whole berry), ``camera.json`` (Intel D435 colour,
+640x480) and ``frame/`` (an RGB-D frame of hanging strawberries with ``truth.json``) next to this
+file. Seeded: the same files every time.
 """
 
 from __future__ import annotations
@@ -15,6 +16,8 @@ import numpy as np
 
 from symfruit import DEFAULT_CAMERA, Box
 from symfruit.io import write_json, write_ply
+from symfruit.io.frames import write_frame
+from symfruit.scenes import make_scene
 from symfruit.shapes import paper_visible, rotation_x, strawberry
 
 HERE = Path(__file__).parent
@@ -31,6 +34,13 @@ def main() -> None:
     truth = Box.from_points(fruit.vertices @ rotation_x(-15.0).T + [0.012, -0.008, 0.32])
     write_json(HERE / "strawberry_truth.json", {"centre": truth.centre.tolist(), **truth.to_dict()})
     write_json(HERE / "camera.json", DEFAULT_CAMERA.to_dict())
+    # The example RGB-D frame: six ripe strawberries (two touching, some behind leaves), two unripe.
+    scene = make_scene(FRAME_SEED)
+    write_frame(HERE / "frame", scene.color, scene.depth, scene.camera, truth=scene.truth())
+
+
+#: Seed of the shipped frame (a scene with touching fruit and leaves in front).
+FRAME_SEED = 1
 
 
 if __name__ == "__main__":

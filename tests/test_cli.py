@@ -144,9 +144,7 @@ def test_console_script_runs():
     import subprocess
     import sys
 
-    done = subprocess.run(
-        [sys.executable, "-m", "symfruit", "--version"], capture_output=True, text=True, check=True
-    )
+    done = subprocess.run([sys.executable, "-m", "symfruit", "--version"], capture_output=True, text=True, check=True)
     assert done.stdout.startswith("symfruit ")
 
 

@@ -102,9 +102,7 @@ def test_scan_folder_runs_both_protocols(tmp_path):
 
 
 def test_evaluate_command(tmp_path, capsys):
-    assert (
-        main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
-    )
+    assert main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
     out = capsys.readouterr().out
     assert "| raw |" in out and "results: " in out
     assert main(["evaluate", "--fruit", "banana"]) == 2

@@ -165,9 +165,7 @@ def test_written_ply_is_atomic_and_labelled(tmp_path):
 
 
 LAYOUTS = {
-    "plain.json": json.dumps(
-        {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}
-    ),
+    "plain.json": json.dumps({"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}),
     "realsense.json": json.dumps(
         {
             "color": {

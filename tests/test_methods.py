@@ -75,9 +75,7 @@ def test_sphere_fit_refuses_a_plane():
 def test_raw_is_the_box_of_the_visible_points():
     visible = front_half(sphere_cloud())
     result = complete(visible, method="raw")
-    assert np.allclose(result.box.min, visible.min(axis=0)) and np.allclose(
-        result.box.max, visible.max(axis=0)
-    )
+    assert np.allclose(result.box.min, visible.min(axis=0)) and np.allclose(result.box.max, visible.max(axis=0))
     assert result.plane is None and np.isnan(result.score)
 
 

@@ -24,9 +24,7 @@ def test_box_iou_known_answers(other, iou):
 
 
 def test_centre_deviation():
-    assert centre_deviation(UNIT, Box(np.array([3.0, 4.0, 0.0]), np.array([4.0, 5.0, 1.0]))) == pytest.approx(
-        5.0
-    )
+    assert centre_deviation(UNIT, Box(np.array([3.0, 4.0, 0.0]), np.array([4.0, 5.0, 1.0]))) == pytest.approx(5.0)
 
 
 def test_chamfer_and_f1_known_answers():

@@ -138,9 +138,7 @@ def test_fast_means_equal_per_point_means(scene, camera, scoring, dtype, tol):
     points = centroid + rng.normal(scale=0.005, size=(40, 3))
     s = PaperSettings(scoring=scoring)
     fast = rate_planes(visible, points, normals, view, camera, centroid, r, s, dtype=dtype)
-    slow = rate_planes(
-        visible, points, normals, view, camera, centroid, r, s, dtype=np.float64, per_point=True
-    )
+    slow = rate_planes(visible, points, normals, view, camera, centroid, r, s, dtype=np.float64, per_point=True)
     assert np.allclose(fast, slow.scores.mean(axis=1), atol=tol)
 
 

@@ -18,7 +18,7 @@ from .complete import complete
 from .config import Settings
 from .shapes import paper_visible, rotation_x, strawberry
 
-__all__ = ["DENSE_GRID", "BenchRow", "bench_view", "run_bench"]
+__all__ = ["DENSE_GRID", "BenchRow", "bench_frame", "bench_view", "run_bench"]
 
 #: 10 x 22 x 6 = 1,320 planes: finer depth steps (0.08 len_depth), 2.5 deg about x, 4 deg about y.
 DENSE_GRID = {
@@ -104,6 +104,22 @@ def run_bench(*, repeat: int = 200, points: tuple[int, ...] = (600, 3000)) -> li
                 )
             )
     return rows
+
+
+def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "paper") -> BenchRow:
+    """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
+    on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore)."""
+    from .detect import detect
+    from .io.frames import Frame
+    from .scenes import make_scene
+
+    scene = make_scene(seed, n_ripe=8, n_unripe=2)
+    frame = Frame("bench", scene.color, scene.depth, scene.camera)
+    found = detect(frame, method=method)
+    ms = _time(lambda: detect(frame, method=method), repeat)
+    n = sum(d.result is not None for d in found.detections)
+    return BenchRow(f"frame, {n} fruit", method, Settings().paper.n_hypotheses, n, float(np.median(ms)),
+                    float(np.percentile(ms, 10)), float(np.percentile(ms, 90)), repeat)  # fmt: skip
 
 
 def machine() -> dict[str, Any]:

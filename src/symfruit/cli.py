@@ -37,10 +37,9 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
 def _add_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="time `complete` on a fixed partial strawberry (the project benchmark)")
     p.add_argument("--repeat", type=int, default=200, help="timed runs per case (default 200)")
-    p.add_argument(
-        "--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)"
-    )
+    p.add_argument("--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
+    p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
@@ -65,7 +64,26 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--output", type=Path, default=Path("results"), help="results root (default results/)")
     p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
-    p.add_argument("--config", type=Path, help="settings file for the methods")  # fmt: skip
+    p.add_argument("--config", type=Path, help="settings file for the methods")
+    p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
+    p.add_argument("--masks", default="auto", help="with --frames: mask source (see `symfruit detect`)")  # fmt: skip
+
+
+def _add_detect(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("detect", help="locate the fruit of RGB-D frames: a frame folder, a folder of frames or a bag")
+    p.add_argument("input", type=Path, help="frame folder (color.png, depth.png, camera.json), folder of them, or bag")
+    p.add_argument(
+        "--masks",
+        default="auto",
+        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, or maskrcnn:CHECKPOINT.pth",
+    )
+    p.add_argument("--method", default="paper", help="completion method (see `symfruit methods`)")
+    p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON)")
+    p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
+    p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
+    p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.add_argument("--method", default="paper")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -81,9 +99,8 @@ def _parser() -> argparse.ArgumentParser:
     _add_complete(sub)
     _add_bench(sub)
     _add_evaluate(sub)
-    p = sub.add_parser(
-        "settings", help="print the effective settings as YAML (defaults, or merged with --config)"
-    )
+    _add_detect(sub)
+    p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, or merged with --config)")
     p.add_argument("--config", type=Path)
     sub.add_parser("methods", help="list the completion methods")
     return parser
@@ -154,20 +171,23 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
-    rows = run_bench(repeat=args.repeat, points=tuple(args.points))
+    if args.frame:
+        from .bench import bench_frame
+
+        rows = [bench_frame(repeat=min(args.repeat, 50))]
+    else:
+        rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:
         print(json.dumps({"machine": machine(), "rows": [r.to_dict() for r in rows]}, indent=2))
         return 0
     info = machine()
     print(
-        f"symfruit bench: median of {args.repeat} runs per fruit, one process "
+        f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process "
         f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
     )
     print(f"{'case':<20} {'points':>6} {'planes':>6} {'median ms':>10} {'p10':>8} {'p90':>8}")
     for r in rows:
-        print(
-            f"{r.case:<20} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}"
-        )
+        print(f"{r.case:<20} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}")
     return 0
 
 
@@ -183,9 +203,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         fruits = list(FRUITS)
     for fruit in fruits:
         if fruit not in FRUITS and not Path(fruit).is_dir():
-            raise InputError(
-                f"--fruit {fruit!r}: not a fruit kind ({', '.join(FRUITS)}, all) nor a folder of scans"
-            )
+            raise InputError(f"--fruit {fruit!r}: not a fruit kind ({', '.join(FRUITS)}, all) nor a folder of scans")
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     for method in methods:
         get(method)
@@ -198,6 +216,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     if args.n is not None and args.n < 1:
         raise InputError("--n must be at least 1")
     settings = load_settings(args.config) if args.config else Settings()
+    if args.frames is not None:
+        return _evaluate_frames(args, methods, settings)
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, quick=args.quick, settings=settings, output=args.output, jobs=args.jobs,
@@ -205,6 +225,50 @@ def _evaluate(args: argparse.Namespace) -> int:
     print(result.table)
     print(f"results: {result.folder}")
     return 0
+
+
+def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> int:
+    import datetime
+
+    from .evaluate.frames import evaluate_frames, summary_dict, table3
+    from .io import write_json
+    from .io.atomic import atomic_write
+
+    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=args.masks, settings=settings)
+    table = table3(scores, totals, methods)
+    folder = args.output / f"{datetime.datetime.now():%Y%m%d-%H%M%S}-frames"
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json(folder / "summary.json", {**summary_dict(scores, totals, failed), "settings": settings.to_dict()})
+    with atomic_write(folder / "table.md", "w") as handle:
+        handle.write(table)
+    print(table)
+    for name, reason in failed.items():
+        print(f"skipped {name}: {reason}")
+    print(f"results: {folder}")
+    return 0
+
+
+def _detect(args: argparse.Namespace) -> int:
+    from .batch import run_batch
+    from .config import Settings, load_settings
+    from .methods import get
+
+    get(args.method)
+    settings = load_settings(args.config) if args.config else Settings()
+    report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
+                       resume=args.resume)  # fmt: skip
+    print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
+          f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
+    for name, reason in report.failed.items():
+        print(f"  failed {name}: {reason}")
+    print(f"results: {args.output}")
+    return 0 if report.ok else 1
+
+
+def _demo(args: argparse.Namespace) -> int:
+    from .demo import run_demo
+
+    return run_demo(args.output, method=args.method)
 
 
 def _settings(args: argparse.Namespace) -> int:
@@ -230,6 +294,8 @@ _COMMANDS = {
     "complete": _complete,
     "bench": _bench,
     "evaluate": _evaluate,
+    "detect": _detect,
+    "demo": _demo,
     "settings": _settings,
     "methods": _methods,
 }

@@ -107,8 +107,7 @@ def check_points(points: Any, settings: InputSettings | None = None) -> tuple[np
     if len(arr) < s.min_points:
         extra = f" after dropping {n_dropped} non-finite" if n_dropped else ""
         raise InputError(
-            f"a fruit needs at least {s.min_points} points, got {len(arr)}{extra} "
-            "(input.min_points sets the limit)"
+            f"a fruit needs at least {s.min_points} points, got {len(arr)}{extra} (input.min_points sets the limit)"
         )
     if arr[:, 2].min() <= 0:
         behind = int((arr[:, 2] <= 0).sum())

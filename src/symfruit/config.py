@@ -16,7 +16,15 @@ from typing import Any, Literal
 
 from .errors import ConfigError
 
-__all__ = ["InputSettings", "PaperSettings", "Settings", "SphereSettings", "load_settings"]
+__all__ = [
+    "ExtractSettings",
+    "InputSettings",
+    "PaperSettings",
+    "SegmentSettings",
+    "Settings",
+    "SphereSettings",
+    "load_settings",
+]
 
 
 @dataclass(frozen=True)
@@ -89,7 +97,16 @@ class PaperSettings:
         points (paper) or the centre of their box.
     fill_radius : float or None, pixels
         Radius of the disc that closes the gaps between projected points when the visible mask
-        ``Mp`` is rasterised. None estimates it from the median spacing of the projected points.
+        ``Mp`` is rasterised. None estimates it from the density of the projected points.
+    precision : {"single", "double"}
+        Floating-point precision of the rating (the hot path). Single precision works relative to
+        the visible centre, so it keeps well under a micrometre at fruit scale and is about twice as
+        fast; the chosen plane and the completed cloud are always computed in double precision.
+    rating_points : int or None
+        Rate the hypotheses on a fixed random subset of at most this many visible points (the mask
+        and the completion use all of them). The paper's fruit had about 600 points; a fruit close
+        to a D435 has several thousand, and a 1,500-point subset ranks the planes alike while keeping
+        the cost flat. None rates every point.
     """
 
     translations: int = 4
@@ -111,8 +128,13 @@ class PaperSettings:
     centre: Literal["centroid", "box"] = "centroid"
     fill_radius: float | None = None
     precision: Literal["single", "double"] = "single"
+    rating_points: int | None = 1500
 
     def __post_init__(self) -> None:
+        _check(
+            self.rating_points is None or self.rating_points >= 10,
+            "paper.rating_points must be >= 10 or null",
+        )
         for name in ("translations", "rotations_x", "rotations_y"):
             _check(getattr(self, name) >= 1, f"paper.{name} must be at least 1")
         _check(
@@ -160,10 +182,101 @@ class SphereSettings:
 
 
 @dataclass(frozen=True)
+class SegmentSettings:
+    """The built-in colour segmenter (:mod:`symfruit.segment`): ripe red fruit, no weights needed.
+
+    Attributes
+    ----------
+    hue_low, hue_high : float, degrees
+        Red hues wrap around 0: a pixel is red when its hue is >= ``hue_low`` or <= ``hue_high``.
+    sat_min, val_min : float in [0, 1]
+        Least saturation and value (brightness) of a ripe fruit pixel; unripe (white, green) fruit fail.
+    open_px, close_px : int
+        Radii of the disc opening (removes specks) and closing (fills seeds, glints and the gaps
+        thin stems cut).
+    min_diameter : float, metres
+        Regions smaller than a fruit of this diameter would look at their depth are ignored.
+    split : {"both", "depth", "watershed", "none"}
+        How touching fruit are split: at depth discontinuities, by a distance-transform watershed
+        when the region has a waist, both, or not at all.
+    depth_jump : float, metres
+        A depth step between neighbouring pixels larger than this separates two fruit.
+    crease_curvature : float, 1/metres
+        A seam between touching fruit at the same depth shows as a concave crease of the depth
+        surface: the smoothed depth's Laplacian below ``-crease_curvature`` (in metres per metre
+        squared) separates fruit. Convex fruit surfaces never reach it.
+    crease_sigma : float, pixels
+        Smoothing of the depth before the crease test (the sensor noise must not look like creases).
+    waist : float
+        Split two distance-transform peaks only if the region between them narrows below this share
+        of the smaller peak's width.
+    """
+
+    hue_low: float = 340.0
+    hue_high: float = 15.0
+    sat_min: float = 0.45
+    val_min: float = 0.15
+    open_px: int = 1
+    close_px: int = 2
+    min_diameter: float = 0.012
+    split: Literal["both", "depth", "watershed", "none"] = "both"
+    depth_jump: float = 0.015
+    crease_curvature: float = 1500.0
+    crease_sigma: float = 2.0
+    waist: float = 0.75
+
+    def __post_init__(self) -> None:
+        _check(0 <= self.hue_low <= 360 and 0 <= self.hue_high <= 360, "segment: hues are degrees in [0, 360]")
+        _check(0 <= self.sat_min <= 1 and 0 <= self.val_min <= 1, "segment: sat_min and val_min are in [0, 1]")
+        _check(self.open_px >= 0 and self.close_px >= 0, "segment: morphology radii must not be negative")
+        _check(
+            self.min_diameter > 0 and self.depth_jump > 0,
+            "segment: min_diameter and depth_jump must be positive",
+        )
+        _check(0 < self.waist <= 1, "segment.waist must be in (0, 1]")
+
+
+@dataclass(frozen=True)
+class ExtractSettings:
+    """Turning a mask into the fruit's points (:mod:`symfruit.extract`).
+
+    Attributes
+    ----------
+    min_depth, max_depth : float, metres
+        Depth outside this range is invalid (the D435 reads from about 0.1 m).
+    erode_px : int
+        Pixels dropped along the mask's border, where flying pixels (depth mixed with the background)
+        sit.
+    cluster_distance : float, metres
+        Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
+        cluster nearest the camera among those with at least ``cluster_share`` of the largest's points.
+    cluster_share : float
+    min_points : int
+        A fruit with fewer points left is reported as failed.
+    """
+
+    min_depth: float = 0.1
+    max_depth: float = 2.0
+    erode_px: int = 1
+    cluster_distance: float = 0.006
+    cluster_share: float = 0.3
+    min_points: int = 30
+
+    def __post_init__(self) -> None:
+        _check(0 <= self.min_depth < self.max_depth, "extract: need 0 <= min_depth < max_depth")
+        _check(self.erode_px >= 0, "extract.erode_px must not be negative")
+        _check(self.cluster_distance > 0, "extract.cluster_distance must be positive")
+        _check(0 < self.cluster_share <= 1, "extract.cluster_share must be in (0, 1]")
+        _check(self.min_points >= 4, "extract.min_points must be at least 4")
+
+
+@dataclass(frozen=True)
 class Settings:
     """All settings, grouped per stage. Every field has a default; files override only what they name."""
 
     input: InputSettings = field(default_factory=InputSettings)
+    segment: SegmentSettings = field(default_factory=SegmentSettings)
+    extract: ExtractSettings = field(default_factory=ExtractSettings)
     paper: PaperSettings = field(default_factory=PaperSettings)
     sphere: SphereSettings = field(default_factory=SphereSettings)
 

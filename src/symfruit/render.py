@@ -33,9 +33,7 @@ class Rendering:
     facing: np.ndarray
 
 
-def render(
-    meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_candidates: int = 1 << 21
-) -> Rendering:
+def render(meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_candidates: int = 1 << 21) -> Rendering:
     """Render triangle meshes with a z-buffer.
 
     Parameters
@@ -118,7 +116,9 @@ def _candidates(idx, side, lo, size, uv, normal, offset, camera, w, cand_pix, ca
         )
 
     e0, e1, e2 = edge(a, b), edge(b, c), edge(c, a)
-    inside &= ((e0 >= 0) & (e1 >= 0) & (e2 >= 0)) | ((e0 <= 0) & (e1 <= 0) & (e2 <= 0))
+    # A small tolerance so that pixels exactly on an edge shared by two triangles are not lost.
+    eps = 1e-6
+    inside &= ((e0 >= -eps) & (e1 >= -eps) & (e2 >= -eps)) | ((e0 <= eps) & (e1 <= eps) & (e2 <= eps))
     t_i, k = np.nonzero(inside)
     if len(t_i) == 0:
         return
@@ -177,9 +177,7 @@ class SensorNoise:
         drop = rng.random(depth.shape) < self.dropout
         drop |= edge & (rng.random(depth.shape) < self.edge_dropout)
         drop |= seen & (rendering.facing < self.grazing) & (rng.random(depth.shape) < self.grazing_dropout)
-        noisy = np.where(
-            seen, depth + rng.normal(size=depth.shape) * self.sigma(np.where(seen, depth, 0.0)), 0.0
-        )
+        noisy = np.where(seen, depth + rng.normal(size=depth.shape) * self.sigma(np.where(seen, depth, 0.0)), 0.0)
         noisy[drop | ~seen] = 0.0
         jitter = rng.normal(scale=self.lateral_px, size=depth.shape + (2,))
         return noisy, jitter

@@ -83,11 +83,7 @@ def specs(
         return [Spec("paper", fruit, i, PAPER_ANGLES.index(a), 0.0, seed) for i in range(n) for a in angles]
     if protocol == "camera":
         count = len(_scans(fruit)) if fruit not in FRUITS else None
-        return [
-            Spec("camera", fruit, i % count if count else i, i, occ, seed)
-            for occ in occlusions
-            for i in range(n)
-        ]
+        return [Spec("camera", fruit, i % count if count else i, i, occ, seed) for occ in occlusions for i in range(n)]
     raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
 
 
@@ -156,9 +152,7 @@ def _camera(spec: Spec, camera: Camera, noise: SensorNoise = _NOISE) -> Instance
     rows, cols = np.nonzero(fruit_px)
     uv = np.c_[cols, rows] + jitter[rows, cols]
     visible = camera.deproject(uv, depth[rows, cols])
-    silhouette = (
-        render([(posed.vertices, posed.faces)], camera).ids == 0 if leaf is not None else shot.ids == 0
-    )
+    silhouette = render([(posed.vertices, posed.faces)], camera).ids == 0 if leaf is not None else shot.ids == 0
     hidden = 1.0 - (shot.ids == 0).sum() / max(silhouette.sum(), 1)
     surface = posed.sample(TRUTH_POINTS, np.random.default_rng([spec.seed, 3000, spec.index]))
     truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
@@ -168,9 +162,7 @@ def _camera(spec: Spec, camera: Camera, noise: SensorNoise = _NOISE) -> Instance
     )  # fmt: skip
 
 
-def _leaf(
-    fruit: Fruit, camera: Camera, share: float, rng: np.random.Generator
-) -> tuple[np.ndarray, np.ndarray]:
+def _leaf(fruit: Fruit, camera: Camera, share: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
     """A flat, pointed-oval leaf between the camera and the fruit hiding about ``share`` of its silhouette.
 
     The leaf lies 5-30 mm in front of the fruit's nearest point, tilted up to 30 degrees; its size is
@@ -187,9 +179,7 @@ def _leaf(
     tilt = rotation(rng.uniform(-30, 30), rng.uniform(-30, 30), 0.0)
     t = np.linspace(0, 2 * np.pi, 48, endpoint=False)
     # Pointed oval: an ellipse whose ends are sharpened.
-    outline = np.c_[
-        length / 2 * np.cos(t), width / 2 * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)
-    ]
+    outline = np.c_[length / 2 * np.cos(t), width / 2 * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)]
     outline = outline @ rotation(0, 0, np.degrees(spin)).T @ tilt.T
     centre_fruit = np.array([np.mean(cols), np.mean(rows)])
 

@@ -77,9 +77,7 @@ def write_results(
         writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.to_dict().items()})
     with atomic_write(folder / "instances.csv", "w") as handle:
         handle.write(buf.getvalue())
-    clean = [
-        {k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()} for s in summary
-    ]
+    clean = [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()} for s in summary]
     write_json(folder / "summary.json", {**meta, "summary": clean})
     table = markdown_table(summary, protocol=protocol, title=meta.get("title", ""))
     with atomic_write(folder / "table.md", "w") as handle:
@@ -113,9 +111,7 @@ def write_plots(folder: Path, rows: Sequence[Row], *, protocol: str) -> list[Pat
             (axes[1], "centre_mm", "centre deviation (mm)"),
         ):
             data = [[getattr(r, metric) for r in mine if r.method == m] for m in methods]
-            ax.boxplot(
-                data, tick_labels=methods, showmeans=True, meanprops={"marker": "x", "markeredgecolor": "k"}
-            )
+            ax.boxplot(data, tick_labels=methods, showmeans=True, meanprops={"marker": "x", "markeredgecolor": "k"})
             ax.set_ylabel(label)
             ax.grid(axis="y", alpha=0.3)
         fig.suptitle(f"{protocol} protocol, {name}: {len(mine) // max(len(methods), 1)} instances")
@@ -166,8 +162,7 @@ def _by_occlusion(plt: Any, folder: Path, name: str, rows: Sequence[Row], method
         hidden = [np.mean([r.hidden for r in rows if r.method == m and r.occlusion == lv]) for lv in levels]
         for ax, metric in ((axes[0], "iou"), (axes[1], "centre_mm")):
             means = [
-                np.mean([getattr(r, metric) for r in rows if r.method == m and r.occlusion == lv])
-                for lv in levels
+                np.mean([getattr(r, metric) for r in rows if r.method == m and r.occlusion == lv]) for lv in levels
             ]
             ax.plot(hidden, means, marker="o", label=m)
     axes[0].set_ylabel("mean 3D box IoU")

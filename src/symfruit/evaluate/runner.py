@@ -113,9 +113,7 @@ def run(
                 bar.update(len(b))
         else:
             with ProcessPoolExecutor(max_workers=jobs, initializer=_single_thread) as pool:
-                for b, rows in zip(
-                    batches, pool.map(_batch, [(b, methods, settings) for b in batches]), strict=True
-                ):
+                for b, rows in zip(batches, pool.map(_batch, [(b, methods, settings) for b in batches]), strict=True):
                     out.append(rows)
                     bar.update(len(b))
     return [row for rows in out for row in rows]
@@ -132,9 +130,7 @@ def _single_thread() -> None:
         pass
 
 
-def summarise(
-    rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion", "method")
-) -> list[dict[str, Any]]:
+def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion", "method")) -> list[dict[str, Any]]:
     """Mean and median metrics per group (failed runs counted, left out of the statistics)."""
     groups: dict[tuple, list[Row]] = {}
     for row in rows:

@@ -118,11 +118,7 @@ def read_pcd(path: Path) -> np.ndarray:
         sizes = [int(s) for s in fields["SIZE"]]
         types = fields["TYPE"]
         counts = [int(c) for c in fields.get("COUNT", ["1"] * len(names))]
-        n = (
-            int(fields["POINTS"][0])
-            if "POINTS" in fields
-            else int(fields["WIDTH"][0]) * int(fields["HEIGHT"][0])
-        )
+        n = int(fields["POINTS"][0]) if "POINTS" in fields else int(fields["WIDTH"][0]) * int(fields["HEIGHT"][0])
         mode = fields["DATA"][0].lower()
     except (KeyError, ValueError, IndexError):
         raise FileFormatError(f"{path}: PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA") from None
@@ -153,13 +149,9 @@ def read_pcd(path: Path) -> np.ndarray:
                 raise FileFormatError(
                     f"{path}: header promises {n} points ({n * row} bytes) but the file holds {body_size}"
                 )
-            dtype = np.dtype(
-                [(f"f{i}", d, (c,)) for i, (d, c) in enumerate(zip(dtypes, counts, strict=True))]
-            )
+            dtype = np.dtype([(f"f{i}", d, (c,)) for i, (d, c) in enumerate(zip(dtypes, counts, strict=True))])
             rec = np.frombuffer(handle.read(n * row), dtype=dtype, count=n)
-            return np.column_stack(
-                [rec[f"f{names.index(c)}"][:, 0].astype(np.float64) for c in ("x", "y", "z")]
-            )
+            return np.column_stack([rec[f"f{names.index(c)}"][:, 0].astype(np.float64) for c in ("x", "y", "z")])
         if mode == "binary_compressed":
             raw = handle.read(8)
             if len(raw) < 8:

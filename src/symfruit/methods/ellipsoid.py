@@ -38,9 +38,7 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     mean = points.mean(axis=0)
     scale = float(np.sqrt(((points - mean) ** 2).sum(axis=1).mean())) or 1.0
     x, y, z = ((points - mean) / scale).T
-    d = np.column_stack(
-        [x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)]
-    )
+    d = np.column_stack([x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)])
     s = d.T @ d
     s11, s12, s22 = s[:6, :6], s[:6, 6:], s[6:, 6:]
     k = 4.0

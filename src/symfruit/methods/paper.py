@@ -39,8 +39,12 @@ def paper(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     dist_ref = float((hi - lo).max())
 
     dtype = np.float32 if s.precision == "single" else np.float64
+    rated = points
+    if s.rating_points is not None and len(points) > s.rating_points:
+        pick = np.random.default_rng(0).choice(len(points), size=s.rating_points, replace=False)
+        rated = points[np.sort(pick)]
     hypothesis_scores = rate_planes(
-        points, planes.points, planes.normals, view, camera, centre, dist_ref, s, dtype=dtype
+        rated, planes.points, planes.normals, view, camera, centre, dist_ref, s, dtype=dtype
     )
 
     best = int(np.argmax(hypothesis_scores))  # argmax returns the first of equal maxima

@@ -1,0 +1,134 @@
+"""From a fruit's mask to its 3D points: de-project, drop invalid depth and flying pixels, keep the
+fruit's own cluster (points of a leaf or of a fruit behind leak in through a mask)."""
+
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from .camera import Camera
+from .config import ExtractSettings
+
+__all__ = ["Extraction", "cluster", "extract"]
+
+
+@dataclass(frozen=True)
+class Extraction:
+    """The points of one fruit and what was dropped on the way.
+
+    Attributes
+    ----------
+    points : (n, 3) float, metres
+    mask_area : int, pixels
+    n_invalid : int
+        Mask pixels without valid depth (0, NaN, out of range).
+    n_border : int
+        Pixels dropped at the mask's border (flying pixels).
+    n_other_clusters : int
+        Points dropped because they belong to another cluster.
+    truncated : bool
+        The mask touches the image border: the fruit may continue outside the image.
+    """
+
+    points: np.ndarray
+    mask_area: int
+    n_invalid: int
+    n_border: int
+    n_other_clusters: int
+    truncated: bool
+
+
+def cluster(points: np.ndarray, distance: float) -> np.ndarray:
+    """Euclidean clustering: (n,) int cluster labels, 0 the largest cluster.
+
+    Points are first cut into depth slabs wherever consecutive depths differ by more than
+    ``distance`` (such points can never be neighbours); within a slab, points fall into cubes of side
+    ``distance / 2`` and occupied cubes that touch (26-neighbourhood) form a cluster. Two points of
+    different clusters are at least ``distance / 2`` apart, and points up to ``distance / 2`` apart
+    always share one.
+    """
+    n = len(points)
+    if n == 0:
+        return np.zeros(0, np.int64)
+    order = np.argsort(points[:, 2], kind="stable")
+    gaps = np.flatnonzero(np.diff(points[order, 2]) > distance) + 1
+    bounds = np.r_[0, gaps, n]
+    labels = np.empty(n, np.int64)
+    next_label = 0
+    for lo, hi in itertools.pairwise(bounds):
+        idx = order[lo:hi]
+        if hi - lo == 1:
+            labels[idx] = next_label
+            next_label += 1
+            continue
+        sub = _grid_clusters(points[idx], distance / 2.0)
+        labels[idx] = sub + next_label
+        next_label += int(sub.max()) + 1
+    counts = np.bincount(labels)
+    rank = np.empty(len(counts), np.int64)
+    rank[np.argsort(-counts, kind="stable")] = np.arange(len(counts))
+    return rank[labels]
+
+
+def _grid_clusters(points: np.ndarray, voxel: float) -> np.ndarray:
+    cells = np.floor((points - points.min(axis=0)) / voxel).astype(np.int64)
+    shape = cells.max(axis=0) + 1
+    if np.prod(shape) > 2e7:  # too sparse for a dense grid: link the occupied cells through a tree
+        from scipy.sparse import coo_matrix
+        from scipy.sparse.csgraph import connected_components
+        from scipy.spatial import cKDTree
+
+        uniq, inverse = np.unique(cells, axis=0, return_inverse=True)
+        pairs = cKDTree(uniq).query_pairs(np.sqrt(3) + 1e-9, output_type="ndarray")
+        graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(len(uniq),) * 2)
+        _, cell_labels = connected_components(graph, directed=False)
+        return cell_labels[inverse.ravel()]
+    grid = np.zeros(shape, bool)
+    grid[cells[:, 0], cells[:, 1], cells[:, 2]] = True
+    lab, _ = ndimage.label(grid, structure=np.ones((3, 3, 3), bool))
+    return lab[cells[:, 0], cells[:, 1], cells[:, 2]] - 1
+
+
+def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None) -> Extraction:
+    """The 3D points of the fruit under ``mask``.
+
+    Parameters
+    ----------
+    mask : (h, w) bool
+    depth : (h, w) float, metres (0 or NaN = no depth)
+    camera : Camera
+    settings : ExtractSettings
+
+    Returns
+    -------
+    Extraction
+        Its points are the cluster nearest the camera among the clusters holding at least
+        ``cluster_share`` of the largest one's points.
+    """
+    s = settings or ExtractSettings()
+    area = int(mask.sum())
+    truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
+    core = mask
+    if s.erode_px:
+        eroded = ndimage.minimum_filter(mask.view(np.uint8), size=2 * s.erode_px + 1, mode="constant").astype(bool)
+        if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
+            core = eroded
+    rows, cols = np.nonzero(core)
+    z = depth[rows, cols].astype(np.float64)
+    valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth)
+    n_invalid = int((~valid).sum())
+    rows, cols, z = rows[valid], cols[valid], z[valid]
+    points = camera.deproject(np.c_[cols, rows].astype(np.float64), z)
+    dropped = 0
+    if len(points) >= 2:
+        labels = cluster(points, s.cluster_distance)
+        counts = np.bincount(labels)
+        big = np.flatnonzero(counts >= s.cluster_share * counts.max())
+        near = big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
+        keep = labels == near
+        dropped = int((~keep).sum())
+        points = points[keep]
+    return Extraction(points, area, n_invalid, int(area - core.sum()), dropped, truncated)

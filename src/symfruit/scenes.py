@@ -1,0 +1,206 @@
+"""Synthetic RGB-D frames of table-top strawberries, with the truth, for tests, the demo and evaluation.
+
+A scene holds strawberries hanging from a gutter at 0.25-0.6 m (calyx up, tilted, some touching),
+ripe ones red and unripe ones white or green (which a segmenter must ignore), a green calyx on each,
+stems up to the gutter, leaves in front of some fruit, and a backdrop. It is rendered with the exact
+z-buffer of :mod:`symfruit.render`, shaded, and given the D435-like depth noise of the evaluation's
+``camera`` protocol. ``truth`` lists every fruit's true box (the box of its whole surface).
+"""
+
+from __future__ import annotations
+
+import colorsys
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .box import Box
+from .camera import DEFAULT_CAMERA, Camera
+from .render import SensorNoise, render
+from .shapes import rotation, strawberry
+
+__all__ = ["Scene", "SceneFruit", "make_scene"]
+
+
+@dataclass(frozen=True)
+class SceneFruit:
+    """One strawberry of a scene and its truth."""
+
+    id: int
+    ripe: bool
+    kind: str
+    box: Box
+    mesh_index: int
+
+    def to_dict(self) -> dict:
+        return {"id": self.id, "ripe": self.ripe, "kind": self.kind, "centre": self.box.centre.tolist(),
+                **self.box.to_dict()}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class Scene:
+    """A rendered frame: colour (h, w, 3) uint8, depth (h, w) float metres (0 = no depth), the camera,
+    the instance labels of the true fruit pixels (0 = none, k = fruit k), and the fruit."""
+
+    color: np.ndarray
+    depth: np.ndarray
+    camera: Camera
+    labels: np.ndarray
+    fruits: list[SceneFruit] = field(default_factory=list)
+
+    def truth(self) -> dict:
+        """The ``truth.json`` layout: ripe and unripe fruit with their boxes, metres, camera frame."""
+        return {"fruits": [f.to_dict() for f in self.fruits]}
+
+
+def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    axis = b - a
+    axis_n = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis_n[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
+    u = np.cross(axis_n, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(axis_n, u)
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    ring = radius * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
+    vertices = np.vstack([a + ring, b + ring])
+    j = np.arange(n)
+    jn = (j + 1) % n
+    faces = np.vstack([np.c_[j, jn, n + j], np.c_[jn, n + jn, n + j]])
+    return vertices, faces
+
+
+def _disc(centre: np.ndarray, normal: np.ndarray, radius: float, lobes: int = 0, n: int = 40) -> tuple:
+    normal = normal / np.linalg.norm(normal)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(normal, helper)
+    u /= np.linalg.norm(u)
+    v = np.cross(normal, u)
+    t = np.linspace(0, 2 * np.pi, n, endpoint=False)
+    r = radius * (1.0 if lobes == 0 else 0.55 + 0.45 * np.abs(np.cos(lobes * t / 2)))
+    ring = centre + (r * np.cos(t))[:, None] * u + (r * np.sin(t))[:, None] * v
+    vertices = np.vstack([centre, ring])
+    faces = np.c_[np.zeros(n, int), 1 + np.arange(n), 1 + (np.arange(n) + 1) % n]
+    return vertices, faces
+
+
+def _leaf(centre: np.ndarray, length: float, spin: float, tilt: np.ndarray) -> tuple:
+    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
+    outline = np.c_[length / 2 * np.cos(t), 0.25 * length * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)]
+    outline = outline @ rotation(0, 0, np.degrees(spin)).T @ tilt.T + centre
+    vertices = np.vstack([centre, outline])
+    faces = np.c_[np.zeros(40, int), 1 + np.arange(40), 1 + (np.arange(40) + 1) % 40]
+    return vertices, faces
+
+
+def make_scene(
+    seed: int = 0,
+    *,
+    n_ripe: int = 6,
+    n_unripe: int = 2,
+    n_leaves: int = 3,
+    camera: Camera = DEFAULT_CAMERA,
+    noise: SensorNoise | None = None,
+) -> Scene:
+    """Render one seeded scene of hanging strawberries.
+
+    Parameters
+    ----------
+    seed : int
+    n_ripe, n_unripe : int
+        Red fruit to find, and white or green fruit to ignore.
+    n_leaves : int
+        Leaves placed in front of (some of) the fruit.
+    camera : Camera
+    noise : SensorNoise, optional
+        Depth sensor model; default :class:`~symfruit.render.SensorNoise`.
+    """
+    rng = np.random.default_rng(seed)
+    noise = noise or SensorNoise()
+    meshes: list[tuple[np.ndarray, np.ndarray]] = []
+    colours: list[tuple[float, float, float]] = []  # HSV per mesh
+    fruits: list[SceneFruit] = []
+    placed: list[tuple[float, float, float]] = []  # projected (u, v, radius px)
+    gutter_y = -0.12
+    for k in range(n_ripe + n_unripe):
+        ripe = k < n_ripe
+        berry = strawberry(rng, length=rng.uniform(0.030, 0.048) if ripe else rng.uniform(0.022, 0.035))
+        rot = rotation(rng.uniform(-30, 30), rng.uniform(-180, 180), rng.uniform(-30, 30))
+        touching = placed and ripe and rng.random() < 0.3
+        for _ in range(200):
+            z = rng.uniform(0.25, 0.6)
+            if touching:  # beside the previous fruit, at about its depth
+                pu, pv, pr = placed[-1]
+                ang = rng.uniform(0, 2 * np.pi)
+                zr = fruits[-1].box.centre[2] + rng.uniform(-0.01, 0.01)
+                radius_px = camera.fx * 0.5 * np.ptp(berry.vertices[:, 0]) / zr
+                u = pu + np.cos(ang) * (pr + radius_px) * 0.95
+                v = pv + np.sin(ang) * (pr + radius_px) * 0.95
+                z = zr
+            else:
+                u = rng.uniform(70, camera.width - 70)
+                v = rng.uniform(90, camera.height - 60)
+            radius_px = camera.fx * 0.5 * np.ptp(berry.vertices, axis=0).max() / z
+            if not (
+                radius_px + 5 < u < camera.width - radius_px - 5 and radius_px + 5 < v < camera.height - radius_px - 5
+            ):
+                continue
+            clear = all(np.hypot(u - pu, v - pv) > 0.9 * (pr + radius_px) for pu, pv, pr in placed)
+            if clear or (touching and all(np.hypot(u - pu, v - pv) > 0.8 * (pr + radius_px) for pu, pv, pr in placed)):
+                break
+        centre = camera.deproject(np.array([u, v]), np.array(z))
+        posed = berry.transformed(rot, centre)
+        fruits.append(SceneFruit(k + 1, ripe, berry.kind, Box.from_points(posed.vertices), len(meshes)))
+        placed.append((u, v, radius_px))
+        meshes.append((posed.vertices, posed.faces))
+        if ripe:
+            colours.append((rng.uniform(-0.02, 0.015) % 1.0, rng.uniform(0.75, 0.92), rng.uniform(0.55, 0.85)))
+        elif rng.random() < 0.5:
+            colours.append((rng.uniform(0.12, 0.2), rng.uniform(0.35, 0.6), rng.uniform(0.55, 0.8)))  # green
+        else:
+            colours.append((rng.uniform(0.08, 0.14), rng.uniform(0.08, 0.2), rng.uniform(0.75, 0.9)))  # white
+        # Calyx (green, star-shaped) at the top of the berry, and a stem up to the gutter.
+        top = posed.vertices[np.argmin(posed.vertices @ (rot @ [0.0, 1.0, 0.0]))]
+        up = rot @ np.array([0.0, -1.0, 0.0])
+        width = np.ptp(berry.vertices[:, 0])
+        meshes.append(_disc(top + 0.002 * up, up, 0.55 * width, lobes=5))
+        colours.append((0.28, 0.7, 0.45))
+        stem_top = np.array([top[0] + rng.uniform(-0.01, 0.01), gutter_y * top[2] / 0.4, top[2]])
+        meshes.append(_cylinder(top, stem_top, 0.0012))
+        colours.append((0.25, 0.55, 0.5))
+    ripe_boxes = [f.box for f in fruits if f.ripe]
+    for _ in range(n_leaves):
+        target = ripe_boxes[int(rng.integers(len(ripe_boxes)))]
+        centre = target.centre + np.array([rng.uniform(-1, 1) * target.size[0], rng.uniform(-1, 1) * target.size[1],
+                                           -target.size[2] / 2 - rng.uniform(0.01, 0.04)])  # fmt: skip
+        meshes.append(_leaf(centre, rng.uniform(0.04, 0.07), rng.uniform(0, np.pi),
+                            rotation(rng.uniform(-35, 35), rng.uniform(-35, 35), 0)))  # fmt: skip
+        colours.append((rng.uniform(0.22, 0.33), rng.uniform(0.55, 0.8), rng.uniform(0.3, 0.55)))
+    # Gutter (dark box along the top) and backdrop (grey-green plane far behind).
+    gutter = np.array([[-0.6, gutter_y * 1.6, 0.45], [0.6, gutter_y * 1.6, 0.45], [0.6, gutter_y * 0.55, 0.6],
+                       [-0.6, gutter_y * 0.55, 0.6]])  # fmt: skip
+    meshes.append((gutter, np.array([[0, 1, 2], [0, 2, 3]])))
+    colours.append((0.0, 0.0, 0.18))
+    back = np.array([[-1.5, -1.2, 1.3], [1.5, -1.2, 1.3], [1.5, 1.2, 1.1], [-1.5, 1.2, 1.1]])
+    meshes.append((back, np.array([[0, 1, 2], [0, 2, 3]])))
+    colours.append((0.2, 0.18, 0.42))
+
+    shot = render(meshes, camera)
+    depth, _ = noise.apply(shot, rng)
+    depth[depth > 3.0] = 0.0
+    color = _shade(shot, colours, rng)
+    labels = np.zeros(shot.ids.shape, np.int32)
+    for f in fruits:
+        labels[shot.ids == f.mesh_index] = f.id
+    return Scene(color=color, depth=depth.astype(np.float32), camera=camera, labels=labels, fruits=fruits)
+
+
+def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Generator) -> np.ndarray:
+    rgb = np.array([colorsys.hsv_to_rgb(*c) for c in colours])
+    h, w = shot.ids.shape
+    image = np.full((h, w, 3), 0.08)
+    seen = shot.ids >= 0
+    light = 0.35 + 0.65 * shot.facing[seen]
+    image[seen] = rgb[shot.ids[seen]] * light[:, None]
+    # Achenes: small pale specks on ripe fruit, and mild sensor noise everywhere.
+    image += rng.normal(scale=0.015, size=image.shape)
+    return (np.clip(image, 0, 1) * 255).astype(np.uint8)
