@@ -106,9 +106,10 @@ def test_result_is_deterministic_and_translation_equivariant_in_depth():
 
 
 def test_to_dict_has_the_documented_keys():
-    result = complete(front_half(sphere_cloud()))
+    result = complete(front_half(sphere_cloud()), method="paper")
     d = result.to_dict()
     assert set(d) >= {"method", "centre", "box", "plane", "score", "n_visible", "n_completed", "seconds"}
+    assert d["confidence"] is None and d["reliable"] is None
     assert set(d["box"]) == {"min", "max", "size"} and set(d["plane"]) == {"point", "normal"}
     assert d["n_completed"] == 2 * d["n_visible"]
 

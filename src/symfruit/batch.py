@@ -47,7 +47,7 @@ def run_batch(
     output: str | Path,
     *,
     masks: str = "auto",
-    method: str = "paper",
+    method: str = "fused",
     settings: Settings | None = None,
     resume: bool = False,
     progress: bool = True,

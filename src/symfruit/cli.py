@@ -23,8 +23,9 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
         type=Path,
         help="intrinsics (JSON/YAML: plain, RealSense, Open3D, ROS); default: Intel D435 colour 640x480",
     )
-    p.add_argument("--method", default="paper", help="completion method (see `symfruit methods`)")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`)")
+    p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
+    p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`), over the profile")
     p.add_argument("--units", choices=("m", "mm"), default="m", help="units of the input cloud")
     p.add_argument(
         "--output",
@@ -55,7 +56,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         default="strawberry",
         help="strawberry, apple, citrus, tomato, all, or a folder of complete scans; comma-separated",
     )
-    p.add_argument("--methods", default="raw,sphere,ellipsoid,paper", help="comma-separated methods")
+    p.add_argument("--methods", default="raw,sphere,ellipsoid,paper,fused", help="comma-separated methods")
     p.add_argument(
         "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
@@ -77,13 +78,14 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
         default="auto",
         help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, or maskrcnn:CHECKPOINT.pth",
     )
-    p.add_argument("--method", default="paper", help="completion method (see `symfruit methods`)")
+    p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
     p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON)")
+    p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
     p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    p.add_argument("--method", default="paper")
+    p.add_argument("--method", default="fused")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -110,16 +112,27 @@ def _fmt(values: Sequence[float], scale: float = 1000.0) -> str:
     return "(" + ", ".join(f"{v * scale:.1f}" for v in values) + ")"
 
 
+def _settings_for(args: argparse.Namespace):
+    """Defaults, then the fruit profile (``--fruit``), then ``--config``."""
+    from .config import Settings, load_settings
+
+    settings = Settings()
+    if getattr(args, "fruit", None):
+        from .profiles import load_profile
+
+        settings = load_profile(args.fruit)
+    return load_settings(args.config, base=settings) if args.config else settings
+
+
 def _complete(args: argparse.Namespace) -> int:
     import numpy as np
 
     from .camera import DEFAULT_CAMERA
     from .complete import complete
-    from .config import Settings, load_settings
     from .errors import FileFormatError
     from .io import load_camera, read_cloud, write_json, write_ply
 
-    settings = load_settings(args.config) if args.config else Settings()
+    settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
     if args.output is not None and args.output.suffix.lower() != ".ply":
         raise FileFormatError(f"{args.output}: --output must end in .ply")
@@ -215,12 +228,15 @@ def _evaluate(args: argparse.Namespace) -> int:
         raise InputError("--occlusion levels must be in [0, 1)")
     if args.n is not None and args.n < 1:
         raise InputError("--n must be at least 1")
-    settings = load_settings(args.config) if args.config else Settings()
     if args.frames is not None:
+        from .profiles import available_profiles, load_profile
+
+        base = load_profile(fruits[0]) if len(fruits) == 1 and fruits[0] in available_profiles() else Settings()
+        settings = load_settings(args.config, base=base) if args.config else base
         return _evaluate_frames(args, methods, settings)
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
-        occlusions=occlusions, quick=args.quick, settings=settings, output=args.output, jobs=args.jobs,
+        occlusions=occlusions, quick=args.quick, config=args.config, output=args.output, jobs=args.jobs,
     )  # fmt: skip
     print(result.table)
     print(f"results: {result.folder}")
@@ -250,11 +266,10 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
 
 def _detect(args: argparse.Namespace) -> int:
     from .batch import run_batch
-    from .config import Settings, load_settings
     from .methods import get
 
     get(args.method)
-    settings = load_settings(args.config) if args.config else Settings()
+    settings = _settings_for(args)
     report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
                        resume=args.resume)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "

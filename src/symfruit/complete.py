@@ -68,6 +68,18 @@ class Result:
         """(3,) float, metres: centre of :attr:`box`."""
         return self.box.centre
 
+    @property
+    def confidence(self) -> float | None:
+        """How far to trust the box, in [0, 1] (methods that estimate it, e.g. ``fused``), else None."""
+        value = self.extras.get("confidence")
+        return None if value is None else float(value)
+
+    @property
+    def reliable(self) -> bool | None:
+        """Whether :attr:`confidence` reaches the method's threshold (None when it has none)."""
+        value = self.extras.get("reliable")
+        return None if value is None else bool(value)
+
     def to_dict(self) -> dict[str, Any]:
         """The JSON summary printed by ``symfruit complete --json``."""
         score = None if not np.isfinite(self.score) else float(self.score)
@@ -80,6 +92,8 @@ class Result:
             "n_visible": len(self.visible),
             "n_completed": len(self.points),
             "n_dropped": int(self.n_dropped),
+            "confidence": self.confidence,
+            "reliable": self.reliable,
             "seconds": float(self.seconds),
         }
 
@@ -144,7 +158,7 @@ def complete(
     points: Any,
     *,
     camera: Camera | None = None,
-    method: str = "paper",
+    method: str = "fused",
     settings: Settings | dict | None = None,
 ) -> Result:
     """Complete one fruit seen from one view and box it.
@@ -157,7 +171,8 @@ def complete(
         Intrinsics of the camera that saw them; None means :data:`~symfruit.camera.DEFAULT_CAMERA`
         (Intel D435 colour, 640x480).
     method : str
-        A registered method: ``paper``, ``raw``, ``sphere``, ... (:func:`symfruit.methods.available`).
+        A registered method: ``fused`` (default), ``paper``, ``sphere``, ``ellipsoid``, ``raw``, ...
+        (:func:`symfruit.methods.available`).
     settings : Settings or dict, optional
         Settings, or a nested dict of overrides (``{"paper": {"rotations_x": 21}}``).
 

@@ -18,6 +18,7 @@ from .errors import ConfigError
 
 __all__ = [
     "ExtractSettings",
+    "FusedSettings",
     "InputSettings",
     "PaperSettings",
     "SegmentSettings",
@@ -182,6 +183,71 @@ class SphereSettings:
 
 
 @dataclass(frozen=True)
+class FusedSettings:
+    """Settings of the default ``fused`` method (:mod:`symfruit.methods.fused`); fruit profiles set these.
+
+    Attributes
+    ----------
+    clean_ratio : float
+        Data count as a clean scan when the local plane-fit residual grows by at least this factor from
+        8 to 30 neighbours (curvature, not noise): measured 4.5-6.7 on clean scans of every fruit kind,
+        1.5-2.2 on D435-like views, so 3.3 separates them with room on both sides.
+    revolution : bool
+        On clean data, also fit a solid of revolution and average its box with the ellipsoid's
+        (on for strawberries, whose tapered shape an ellipsoid misses).
+    depth_prior, depth_ratio : float
+        Noisy data: weight of the prior that the depth semi-axis is ``depth_ratio`` times the geometric
+        mean of the lateral ones.
+    huber : float, metres
+        Noisy data: residuals beyond this count linearly (outliers, flying pixels).
+    mirror_weight : float in [0, 1]
+        Noisy data: share of the mirror completion in the centre (the rest is the aligned fit's).
+    mirror_size : float in [0, 1]
+        Noisy data: share of the mirror completion in the box size.
+    mirror_translations, mirror_translation_step, mirror_j2, mirror_j3 : int, float, float, float
+        The mirror completion's grid of depth offsets and its reasonable region (``paper.j2``,
+        ``paper.j3``); the paper's 4 x 0.2 stops short of the true plane for shallow views and its
+        0.6-1.2 region penalises the true back of elongated fruit (see docs/ablation.md).
+    fit_points : int
+        Fits and the mirror completion use a fixed random subset of at most this many points (the
+        box always covers every visible point).
+    mirror_points : int
+        Points rated per hypothesis by the mirror completion (``paper.rating_points``).
+    spread_scale, min_support, reliable_at : float
+        Confidence = coverage * exp(-spread / (spread_scale * size)) * min(1, n / min_support), with
+        ``coverage`` the share of the fitted silhouette the camera saw and ``spread`` the largest
+        distance between the estimates' centres; ``reliable`` when it is at least ``reliable_at``.
+    """
+
+    clean_ratio: float = 3.3
+    revolution: bool = False
+    depth_prior: float = 1.0
+    depth_ratio: float = 1.0
+    huber: float = 0.002
+    mirror_weight: float = 0.5
+    mirror_size: float = 0.0
+    mirror_translations: int = 8
+    mirror_translation_step: float = 0.1
+    mirror_j2: float = 0.4
+    mirror_j3: float = 1.0
+    fit_points: int = 2000
+    mirror_points: int = 1000
+    spread_scale: float = 0.1
+    min_support: float = 150.0
+    reliable_at: float = 0.4
+
+    def __post_init__(self) -> None:
+        _check(self.clean_ratio > 0, "fused.clean_ratio must be positive")
+        _check(self.depth_prior >= 0 and self.depth_ratio > 0, "fused: depth_prior >= 0 and depth_ratio > 0")
+        _check(self.huber > 0, "fused.huber must be positive")
+        _check(0 <= self.mirror_weight <= 1 and 0 <= self.mirror_size <= 1, "fused: mirror shares are in [0, 1]")
+        _check(self.mirror_translations >= 1 and self.mirror_translation_step >= 0, "fused: bad mirror grid")
+        _check(self.fit_points >= 20 and self.mirror_points >= 10, "fused: fit_points >= 20, mirror_points >= 10")
+        _check(self.spread_scale > 0 and self.min_support > 0, "fused: spread_scale and min_support must be > 0")
+        _check(0 <= self.reliable_at <= 1, "fused.reliable_at must be in [0, 1]")
+
+
+@dataclass(frozen=True)
 class SegmentSettings:
     """The built-in colour segmenter (:mod:`symfruit.segment`): ripe red fruit, no weights needed.
 
@@ -279,6 +345,7 @@ class Settings:
     extract: ExtractSettings = field(default_factory=ExtractSettings)
     paper: PaperSettings = field(default_factory=PaperSettings)
     sphere: SphereSettings = field(default_factory=SphereSettings)
+    fused: FusedSettings = field(default_factory=FusedSettings)
 
     def to_dict(self) -> dict[str, Any]:
         """Plain nested dict, the layout :func:`load_settings` reads back."""
@@ -362,8 +429,8 @@ def from_dict(data: dict[str, Any]) -> Settings:
     return _build(Settings, data, "")
 
 
-def load_settings(path: str | Path) -> Settings:
-    """Read settings from a ``.yaml``/``.yml`` or ``.json`` file.
+def load_settings(path: str | Path, base: Settings | None = None) -> Settings:
+    """Read settings from a ``.yaml``/``.yml`` or ``.json`` file, laid over ``base`` (default: defaults).
 
     Raises
     ------
@@ -390,6 +457,13 @@ def load_settings(path: str | Path) -> Settings:
         raise ConfigError(f"{path}: not valid {path.suffix.lstrip('.').upper()}: {exc}") from None
     if data is None:
         data = {}
+    if base is not None and isinstance(data, dict):
+        merged = base.to_dict()
+        for section, values in data.items():
+            merged[section] = (
+                {**merged[section], **values} if isinstance(values, dict) and section in merged else values
+            )
+        data = merged
     try:
         return from_dict(data)
     except ConfigError as exc:

@@ -25,10 +25,14 @@ def example_frame() -> Path:
     raise FileFormatError("the example frame (examples/frame) is not here; run from a clone of the repository")
 
 
-def run_demo(output: Path, *, method: str = "paper") -> int:
+def run_demo(output: Path, *, method: str = "fused", fruit: str | None = "strawberry") -> int:
     """Detect, write the outputs, print a per-fruit table; returns the exit status."""
     frame = read_frame(example_frame())
     settings = Settings()
+    if fruit:
+        from .profiles import load_profile
+
+        settings = load_profile(fruit)
     found = detect(frame, method=method, settings=settings)
     write_detections(output, found, settings=settings)
     truth = frame.truth or []

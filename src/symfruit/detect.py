@@ -70,6 +70,8 @@ class Detection:
             plane=None if r.plane is None else r.plane.to_dict(),
             score=None if not np.isfinite(r.score) else float(r.score),
             seconds=r.seconds,
+            confidence=r.confidence,
+            reliable=r.reliable,
         )
         return out
 
@@ -134,7 +136,7 @@ def detect(
     frame: Frame,
     *,
     masks: str | Path | Segmenter = "auto",
-    method: str = "paper",
+    method: str = "fused",
     settings: Settings | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.

@@ -38,12 +38,13 @@ def evaluate(
     *,
     protocol: str = "paper",
     fruits: Sequence[str] = ("strawberry",),
-    methods: Sequence[str] = ("raw", "sphere", "ellipsoid", "paper"),
+    methods: Sequence[str] = ("raw", "sphere", "ellipsoid", "paper", "fused"),
     n: int | None = None,
     seed: int = 0,
     occlusions: Sequence[float] = (0.0,),
     quick: bool = False,
     settings: Settings | None = None,
+    config: Path | None = None,
     output: Path | None = Path("results"),
     jobs: int | None = None,
     progress: bool = True,
@@ -53,19 +54,39 @@ def evaluate(
     ``n`` is the number of fruits (``paper``: each in 19 poses; default 10, as in the paper) or of
     views per occlusion level (``camera``; default 100). Results go to a new timestamped folder under
     ``output`` with a ``latest`` link to it; ``output=None`` writes nothing.
+
+    Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
+    (:mod:`symfruit.profiles`), with the settings file ``config`` laid over it.
     """
-    settings = settings or Settings()
+    from ..config import load_settings
+    from ..profiles import available_profiles, load_profile
+
+    def settings_for(fruit: str) -> Settings:
+        if settings is not None:
+            return settings
+        base = load_profile(fruit) if fruit in available_profiles() else Settings()
+        return load_settings(config, base=base) if config else base
+
     angles = tuple(QUICK["paper"]["angles"]) if quick and protocol == "paper" else PAPER_ANGLES
     if n is None:
         n = QUICK[protocol]["n"] if quick else (10 if protocol == "paper" else 100)
-    all_specs = [
-        s for fruit in fruits
-        for s in specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions))
-    ]  # fmt: skip
-    rows = run(all_specs, methods, settings, jobs=jobs, progress=progress)
+    rows, all_specs, used = [], [], {}
+    for fruit in fruits:
+        these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions))
+        used[fruit] = settings_for(fruit)
+        rows += run(these, methods, used[fruit], jobs=jobs, progress=progress)
+        all_specs += these
     summary = summarise(rows)
+    pooled = [s for s in summarise(rows, by=("fruit", "method")) if s.get("spearman") == s.get("spearman")]
     title = f"symfruit evaluation: {protocol} protocol"
     table = markdown_table(summary, protocol=protocol, title=title)
+    if pooled:
+        table += "\n## Confidence over all instances of a fruit (every occlusion level)\n\n"
+        table += "| fruit | method | Spearman (confidence, centre dev) | centre dev (mm): all "
+        table += "| 80 % most confident | reliable |\n|---|---|---|---|---|---|\n"
+        for s in pooled:
+            table += f"| {Path(str(s['fruit'])).name} | {s['method']} | {s['spearman']:.2f} "
+            table += f"| {s['centre_mm_mean']:.1f} | {s['centre_mm_top80']:.1f} | {s['reliable_share']:.0%} |\n"
     folder = None
     if output is not None:
         folder = _new_folder(Path(output), protocol)
@@ -74,12 +95,16 @@ def evaluate(
         meta = {
             "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
             "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "quick": quick,
-            "instances": len(all_specs), "settings": settings.to_dict(),
+            "instances": len(all_specs), "settings": {f: s.to_dict() for f, s in used.items()},
         }  # fmt: skip
         from ..io import write_json
 
         write_json(folder / "settings.json", meta)
-        write_results(folder, rows, summary, protocol=protocol, meta=meta)
+        write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled})
+        from ..io.atomic import atomic_write
+
+        with atomic_write(folder / "table.md", "w") as handle:
+            handle.write(table)
         _link_latest(folder)
     return Evaluation(folder=folder, rows=rows, summary=summary, table=table)
 

@@ -50,6 +50,11 @@ def markdown_table(summary: Sequence[dict[str, Any]], *, protocol: str, title: s
                 f"| {_f(s['chamfer_mm_mean'], 2)} | {_f(s['f1_mean'], 3)} "
                 f"| {_f(s['ms_median'], 2)} | {s['failed']} |"
             )
+        for s in rows:
+            if s.get("spearman") is not None and not math.isnan(s.get("spearman", float("nan"))):
+                lines += ["", f"Confidence of `{s['method']}`: Spearman {s['spearman']:.2f} against the centre "
+                          f"deviation; the 80 % most confident fruit deviate {s['centre_mm_top80']:.1f} mm on average "
+                          f"(all: {s['centre_mm_mean']:.1f} mm)."]  # fmt: skip
         if protocol == "paper" and str(fruit) == "strawberry":
             (ri, rc), (pi, pc) = PAPER_TABLE2["raw"], PAPER_TABLE2["paper"]
             lines += [

@@ -23,7 +23,7 @@ __all__ = ["Row", "run"]
 COLUMNS = (
     "protocol", "fruit", "kind", "fruit_index", "pose", "angle_x", "angle_y", "angle_z", "distance_m",
     "occlusion", "hidden", "n_visible", "method", "iou", "centre_mm", "chamfer_mm", "f1", "precision",
-    "recall", "seconds", "error",
+    "recall", "seconds", "confidence", "error",
 )  # fmt: skip
 
 
@@ -51,6 +51,8 @@ class Row:
     precision: float
     recall: float
     seconds: float
+    confidence: float = float("nan")
+    reliable: bool = False
     error: str = ""
 
     def to_dict(self) -> dict[str, Any]:
@@ -75,8 +77,10 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
                             precision=nan, recall=nan, seconds=nan, error=str(exc)))  # fmt: skip
             continue
         s = score_completion(result.box, result.points, inst.truth_box, inst.truth_surface)
+        conf = float("nan") if result.confidence is None else result.confidence
         rows.append(Row(**base, method=method, iou=s.iou, centre_mm=s.centre_mm, chamfer_mm=s.chamfer_mm,
-                        f1=s.f1, precision=s.precision, recall=s.recall, seconds=result.seconds))  # fmt: skip
+                        f1=s.f1, precision=s.precision, recall=s.recall, seconds=result.seconds,
+                        confidence=conf, reliable=bool(result.reliable)))  # fmt: skip
     return rows
 
 
@@ -130,6 +134,21 @@ def _single_thread() -> None:
         pass
 
 
+def _confidence_stats(rows: Sequence[Row]) -> dict[str, Any]:
+    """How well confidence predicts the centre error: Spearman rank correlation (negative is good) and
+    the mean centre error of the 80 % most confident fruit (what a robot skipping the rest would get)."""
+    conf = np.array([r.confidence for r in rows], dtype=float)
+    err = np.array([r.centre_mm for r in rows], dtype=float)
+    if len(conf) < 3 or not np.isfinite(conf).all():
+        return {"spearman": float("nan"), "centre_mm_top80": float("nan"), "reliable_share": float("nan")}
+    from scipy.stats import spearmanr
+
+    rho = spearmanr(conf, err).statistic if np.ptp(conf) > 0 else float("nan")
+    keep = conf >= np.quantile(conf, 0.2)
+    return {"spearman": float(rho), "centre_mm_top80": float(err[keep].mean()),
+            "reliable_share": float(np.mean([r.reliable for r in rows]))}  # fmt: skip
+
+
 def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion", "method")) -> list[dict[str, Any]]:
     """Mean and median metrics per group (failed runs counted, left out of the statistics)."""
     groups: dict[tuple, list[Row]] = {}
@@ -147,5 +166,6 @@ def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion",
         secs = np.array([r.seconds for r in ok], dtype=float)
         stats["ms_median"] = float(np.median(secs) * 1000) if len(secs) else float("nan")
         stats["hidden_mean"] = float(np.mean([r.hidden for r in members]))
+        stats.update(_confidence_stats(ok))
         summary.append(stats)
     return summary

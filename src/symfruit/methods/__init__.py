@@ -80,4 +80,4 @@ def available() -> list[str]:
     return sorted(_REGISTRY)
 
 
-from . import ellipsoid, paper, raw, sphere  # noqa: E402,F401  (register the built-in methods)
+from . import ellipsoid, fused, paper, raw, sphere  # noqa: E402,F401  (register the built-in methods)
