@@ -330,7 +330,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SymfruitError as exc:
         if args.debug:
             raise
-        print(f"symfruit: error: {exc}", file=sys.stderr)
+        message = f"symfruit: error: {exc}".replace("\n", " ")
+        # Paths that are not valid UTF-8 must not crash the error report itself.
+        print(message.encode("utf-8", "backslashreplace").decode("utf-8"), file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("symfruit: interrupted", file=sys.stderr)

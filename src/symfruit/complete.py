@@ -148,6 +148,11 @@ def check_points(points: Any, settings: InputSettings | None = None) -> tuple[np
         raise InputError("all points are identical; a fruit needs points spread over its surface")
     if spread[1] <= 1e-12 * spread[2]:
         raise InputError("all points lie on a line; a fruit needs points spread over its surface")
+    if spread[0] <= 1e-12 * spread[2]:
+        raise InputError(
+            "all points lie on a plane; a fruit's visible surface is curved (is this a depth image "
+            "of a flat object, or a cloud with its depth dropped?)"
+        )
     if len(arr) > s.max_points:
         keep = np.random.default_rng(0).choice(len(arr), size=s.max_points, replace=False)
         arr = arr[np.sort(keep)]

@@ -229,7 +229,10 @@ def read_text(path: Path) -> np.ndarray:
 
 def read_npy(path: Path) -> np.ndarray:
     """NumPy ``.npy``: an (n, >=3) numeric array or a structured array with x, y, z; never pickles."""
-    arr = np.load(path, allow_pickle=False, mmap_mode="r")
+    try:
+        arr = np.load(path, allow_pickle=False, mmap_mode="r")
+    except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...
+        raise FileFormatError(f"{path}: not a valid .npy file ({type(exc).__name__}: {exc})") from None
     if arr.dtype.names:
         missing = [c for c in ("x", "y", "z") if c not in arr.dtype.names]
         if missing:

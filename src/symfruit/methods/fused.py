@@ -197,6 +197,7 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     sample = points
     if len(points) > s.fit_points:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
+    extent = float(np.ptp(points, axis=0).max())
     ratio, noise, normals = surface_noise(sample)
     step = max(1, len(sample) // 200)
     centres: list[np.ndarray] = []
@@ -205,9 +206,12 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         extras["regime"] = "clean"
         try:
             c, shape = fit_ellipsoid(sample)
-            half = np.sqrt(np.diag(np.linalg.inv(shape)))
+            with np.errstate(invalid="ignore"):
+                half = np.sqrt(np.diag(np.linalg.inv(shape)))
+            if not (np.all(np.isfinite(half)) and np.all(np.isfinite(c)) and half.max() < 10 * extent):
+                raise InputError("the ellipsoid fit is degenerate")
             boxes = [Box(c - half, c + half)]
-        except InputError:
+        except (InputError, np.linalg.LinAlgError):
             c, r = fit_sphere(sample)
             boxes = [Box(c - r, c + r)]
         if s.revolution:
@@ -220,6 +224,9 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     else:
         extras["regime"] = "noisy"
         c, axes = fit_aligned_ellipsoid(sample, prior=s.depth_prior, depth_ratio=s.depth_ratio, huber=s.huber)
+        if not (np.all(np.isfinite(c)) and np.all(np.isfinite(axes)) and axes.max() < 10 * extent):
+            c, radius = fit_sphere(sample)  # a degenerate fit: fall back to the sphere
+            axes = np.full(3, radius)
         fit_box = Box(c - axes, c + axes)
         mirrored = get("paper")(sample, camera, _mirror_settings(settings))
         w = s.mirror_weight
@@ -257,20 +264,22 @@ def silhouette_coverage(points: np.ndarray, box: Box, camera: Camera) -> float:
     cut or sparse views cover less."""
     from ..raster import rasterise
 
-    view = rasterise(points, camera)
     c, half = box.centre, box.size / 2.0
+    if not (np.all(np.isfinite(c)) and np.all(np.isfinite(half)) and c[2] > 0):
+        return 0.0
+    view = rasterise(points, camera)
     uc, vc = camera.project(c[None])[0]
     au, av = max(camera.fx * half[0] / c[2], 1.0), max(camera.fy * half[1] / c[2], 1.0)
-    u0, u1 = int(np.floor(uc - au)), int(np.ceil(uc + au)) + 1
-    v0, v1 = int(np.floor(vc - av)), int(np.ceil(vc + av)) + 1
+    # Only the window where the camera saw anything can be covered; the area counts the whole ellipse.
+    h, w = view.mask.shape
+    u0, u1 = max(int(np.floor(uc - au)), view.u0), min(int(np.ceil(uc + au)) + 1, view.u0 + w)
+    v0, v1 = max(int(np.floor(vc - av)), view.v0), min(int(np.ceil(vc + av)) + 1, view.v0 + h)
+    if u1 <= u0 or v1 <= v0:
+        return 0.0
     vv, uu = np.mgrid[v0:v1, u0:u1]
     inside = ((uu - uc) / au) ** 2 + ((vv - vc) / av) ** 2 <= 1.0
-    h, w = view.mask.shape
-    r, q = vv - view.v0, uu - view.u0
-    ok = inside & (r >= 0) & (r < h) & (q >= 0) & (q < w)
-    seen = np.zeros(inside.shape, bool)
-    seen[ok] = view.mask[r[ok], q[ok]]
-    return float(seen.sum() / max(inside.sum(), 1))
+    seen = inside & view.mask[vv - view.v0, uu - view.u0]
+    return float(min(1.0, seen.sum() / (np.pi * au * av)))
 
 
 def _confidence(spread: float, coverage: float, size: float, n: int, s) -> float:
