@@ -145,5 +145,5 @@ def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
     assert "Table 3" in capsys.readouterr().out
     assert main(["bench", "--frame", "--repeat", "1", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]
-    assert row["points"] >= 6 and row["median_ms"] > 0
+    assert row["points"] >= 6 and row["median_ms"] > 0 and row["method"] == "paper"
     assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2

@@ -44,7 +44,7 @@ def test_roughness_ratio_tells_clean_from_noisy():
     ratio_noisy, noise, _ = surface_noise(noisy)
     assert ratio_clean > 3.3 > ratio_noisy
     assert 0.0003 < noise < 0.002
-    assert np.all(np.einsum("ni,ni->n", normals, clean[:: max(1, len(clean) // 200)][: len(normals)]) < 0)
+    assert np.all(np.einsum("ni,ni->n", normals, clean[:: max(1, len(clean) // 120)][: len(normals)]) < 0)
 
 
 def test_aligned_ellipsoid_fit_known_answer():

@@ -111,7 +111,7 @@ def run_bench(*, repeat: int = 200, points: tuple[int, ...] = (600, 3000)) -> li
     return rows
 
 
-def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "paper") -> BenchRow:
+def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "fused") -> BenchRow:
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore)."""
     from .detect import detect
@@ -123,7 +123,7 @@ def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "paper") -> Be
     found = detect(frame, method=method)
     ms = _time(lambda: detect(frame, method=method), repeat)
     n = sum(d.result is not None for d in found.detections)
-    return BenchRow(f"frame, {n} fruit", method, Settings().paper.n_hypotheses, n, float(np.median(ms)),
+    return BenchRow(f"frame, {n} fruit, {method}", method, Settings().paper.n_hypotheses, n, float(np.median(ms)),
                     float(np.percentile(ms, 10)), float(np.percentile(ms, 90)), repeat)  # fmt: skip
 
 

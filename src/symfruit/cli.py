@@ -187,7 +187,7 @@ def _bench(args: argparse.Namespace) -> int:
     if args.frame:
         from .bench import bench_frame
 
-        rows = [bench_frame(repeat=min(args.repeat, 50))]
+        rows = [bench_frame(repeat=min(args.repeat, 50), method=m) for m in ("paper", "fused")]
     else:
         rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:
@@ -198,9 +198,9 @@ def _bench(args: argparse.Namespace) -> int:
         f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process "
         f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
     )
-    print(f"{'case':<20} {'points':>6} {'planes':>6} {'median ms':>10} {'p10':>8} {'p90':>8}")
+    print(f"{'case':<26} {'points':>6} {'planes':>6} {'median ms':>10} {'p10':>8} {'p90':>8}")
     for r in rows:
-        print(f"{r.case:<20} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}")
+        print(f"{r.case:<26} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}")
     return 0
 
 

@@ -35,15 +35,17 @@ from ..box import Box
 from ..camera import Camera
 from ..config import Settings
 from ..errors import InputError
-from . import Completion, get, register
+from ..raster import View, rasterise
+from . import Completion, register
 from .ellipsoid import fit_ellipsoid
+from .paper import mirror_complete
 from .sphere import fit_sphere
 
 __all__ = ["fit_aligned_ellipsoid", "fit_revolution", "surface_noise"]
 
 
 def surface_noise(
-    points: np.ndarray, small: int = 8, large: int = 30, queries: int = 200
+    points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120
 ) -> tuple[float, float, np.ndarray]:
     """How much of the surface's roughness is noise: ``(ratio, noise, normals)``.
 
@@ -81,11 +83,17 @@ def _residuals(theta, points, prior, ratio, delta, jac=True):
     w = np.sqrt(np.where(np.abs(res) <= delta, 1.0, delta / np.maximum(np.abs(res), 1e-15)))
     weight = prior * np.sqrt(len(points)) * mean_axis
     prior_res = weight * (theta[5] - 0.5 * (theta[3] + theta[4]) - np.log(ratio))
-    b = np.r_[res * w, prior_res]
+    b = np.empty(len(points) + 1)
+    b[:-1] = res * w
+    b[-1] = prior_res
     if not jac:
         return b, None
-    j = np.c_[-(u / axes) / r[:, None], -(u**2) / r[:, None]] * mean_axis * w[:, None]
-    return b, np.vstack([j, weight * np.array([0.0, 0.0, 0.0, -0.5, -0.5, 1.0])])
+    j = np.empty((len(points) + 1, 6))
+    scale = (mean_axis * w / r)[:, None]
+    j[:-1, :3] = -(u / axes) * scale
+    j[:-1, 3:] = -(u * u) * scale
+    j[-1] = weight * np.array([0.0, 0.0, 0.0, -0.5, -0.5, 1.0])
+    return b, j
 
 
 def fit_aligned_ellipsoid(
@@ -104,7 +112,7 @@ def fit_aligned_ellipsoid(
     semi_axes : (3,) float, metres
     """
     centre, radius = fit_sphere(points, refine=False)
-    theta = np.r_[centre, np.log([radius, radius, radius * depth_ratio])]
+    theta = np.concatenate([centre, np.log([radius, radius, radius * depth_ratio])])
     b, jac = _residuals(theta, points, prior, depth_ratio, huber)
     cost, mu = float(b @ b), 1e-3
     for _ in range(iterations):
@@ -199,8 +207,9 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
     extent = float(np.ptp(points, axis=0).max())
     ratio, noise, normals = surface_noise(sample)
-    step = max(1, len(sample) // 200)
+    step = max(1, len(sample) // 120)
     centres: list[np.ndarray] = []
+    view = None
     extras: dict = {"noise": noise, "roughness_ratio": ratio}
     if ratio >= s.clean_ratio:
         extras["regime"] = "clean"
@@ -223,12 +232,14 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         centres = [box.centre, *(b.centre for b in boxes), sphere_centre]  # the spread feeds the confidence
     else:
         extras["regime"] = "noisy"
-        c, axes = fit_aligned_ellipsoid(sample, prior=s.depth_prior, depth_ratio=s.depth_ratio, huber=s.huber)
+        thin = sample[:: max(1, -(-len(sample) // s.shape_points))]  # a spread subset for the fit
+        c, axes = fit_aligned_ellipsoid(thin, prior=s.depth_prior, depth_ratio=s.depth_ratio, huber=s.huber)
         if not (np.all(np.isfinite(c)) and np.all(np.isfinite(axes)) and axes.max() < 10 * extent):
             c, radius = fit_sphere(sample)  # a degenerate fit: fall back to the sphere
             axes = np.full(3, radius)
         fit_box = Box(c - axes, c + axes)
-        mirrored = get("paper")(sample, camera, _mirror_settings(settings))
+        view = rasterise(sample, camera)
+        mirrored = mirror_complete(sample, camera, _mirror_settings(settings).paper, view)
         w = s.mirror_weight
         centre = (1.0 - w) * fit_box.centre + w * mirrored.box.centre
         size = (1.0 - s.mirror_size) * fit_box.size + s.mirror_size * mirrored.box.size
@@ -237,7 +248,7 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         extras.update(plane=mirrored.plane.to_dict() if mirrored.plane else None, semi_axes=axes.tolist())
     box = box.union(Box.from_points(points))
     spread = max(float(np.linalg.norm(c - centres[0])) for c in centres)
-    coverage = silhouette_coverage(sample, box, camera)
+    coverage = silhouette_coverage(view if view is not None else rasterise(sample, camera), box, camera)
     confidence = _confidence(spread, coverage, float(box.size.max()), len(points), s)
     extras.update(confidence=confidence, reliable=confidence >= s.reliable_at, spread=spread, coverage=coverage)
     completed = np.vstack([points, 2.0 * box.centre - points])
@@ -258,16 +269,13 @@ def _mirror_settings(settings: Settings) -> Settings:
     return settings.replace(paper=grid)
 
 
-def silhouette_coverage(points: np.ndarray, box: Box, camera: Camera) -> float:
+def silhouette_coverage(view: View, box: Box, camera: Camera) -> float:
     """Share of the fitted fruit's silhouette that the camera saw: how much of the ellipse inscribed in
-    the box's projection (at the box centre's depth) the rasterised visible points cover. Occluded,
-    cut or sparse views cover less."""
-    from ..raster import rasterise
-
+    the box's projection (at the box centre's depth) the rasterised visible points (``view``) cover.
+    Occluded, cut or sparse views cover less."""
     c, half = box.centre, box.size / 2.0
     if not (np.all(np.isfinite(c)) and np.all(np.isfinite(half)) and c[2] > 0):
         return 0.0
-    view = rasterise(points, camera)
     uc, vc = camera.project(c[None])[0]
     au, av = max(camera.fx * half[0] / c[2], 1.0), max(camera.fy * half[1] / c[2], 1.0)
     # Only the window where the camera saw anything can be covered; the area counts the whole ellipse.

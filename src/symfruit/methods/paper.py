@@ -9,20 +9,21 @@ import numpy as np
 
 from ..box import Box
 from ..camera import Camera
-from ..config import Settings
+from ..config import PaperSettings, Settings
 from ..planes import hypothesis_planes, mirror
-from ..raster import rasterise
+from ..raster import View, rasterise
 from ..rating import rate_planes
 from . import Completion, register
-
-#: Mirrored points rated per chunk (bounds the temporaries to a few hundred MB).
-_CHUNK_POINTS = 2000000
 
 
 @register("paper")
 def paper(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     """Hypothesise planes, mirror, rate, keep the best mean score (ties to the first), merge, box."""
-    s = settings.paper
+    return mirror_complete(points, camera, settings.paper)
+
+
+def mirror_complete(points: np.ndarray, camera: Camera, s: PaperSettings, view: View | None = None) -> Completion:
+    """The ``paper`` method with its settings section; ``view`` reuses a rasterised view of ``points``."""
     planes = hypothesis_planes(
         points,
         translations=s.translations,
@@ -33,7 +34,8 @@ def paper(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         rotations_y=s.rotations_y,
         rotation_y_step=s.rotation_y_step,
     )
-    view = rasterise(points, camera, fill_radius=s.fill_radius)
+    if view is None:
+        view = rasterise(points, camera, fill_radius=s.fill_radius)
     lo, hi = points.min(axis=0), points.max(axis=0)
     centre = points.mean(axis=0) if s.centre == "centroid" else (lo + hi) / 2.0
     dist_ref = float((hi - lo).max())
