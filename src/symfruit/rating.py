@@ -169,26 +169,8 @@ def rate_planes(
     t = np.einsum("hi,hi->h", np.asarray(plane_points, dtype=np.float64) - centre, normals)
     n_pts, n_planes = len(rel), len(normals)
     per_block = max(1, BLOCK_POINTS // max(n_pts, 1))
-    if per_point:
-        parts = [
-            _rate_block(
-                rel,
-                normals[a : a + per_block],
-                t[a : a + per_block],
-                view,
-                camera,
-                centre,
-                dist_ref,
-                settings,
-                dtype,
-                per_point=True,
-            )
-            for a in range(0, n_planes, per_block)
-        ]
-        return Rating(*(np.concatenate([getattr(p, f) for p in parts]) for f in Rating.__dataclass_fields__))
-    means = np.empty(n_planes)
-    for a in range(0, n_planes, per_block):
-        means[a : a + per_block] = _rate_block(
+    blocks = [
+        _rate_block(
             rel,
             normals[a : a + per_block],
             t[a : a + per_block],
@@ -198,9 +180,13 @@ def rate_planes(
             dist_ref,
             settings,
             dtype,
-            per_point=False,
+            per_point=per_point,
         )
-    return means
+        for a in range(0, n_planes, per_block)
+    ]
+    if per_point:
+        return Rating(*(np.concatenate([getattr(b, f) for b in blocks]) for f in Rating.__dataclass_fields__))
+    return np.concatenate(blocks)
 
 
 def _rate_block(rel, normals, t, view, camera, centre, dist_ref, s, dtype, *, per_point):

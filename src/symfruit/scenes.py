@@ -17,7 +17,7 @@ import numpy as np
 from .box import Box
 from .camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
-from .shapes import rotation, strawberry
+from .shapes import leaf_outline, rotation, strawberry
 
 __all__ = ["Scene", "SceneFruit", "make_scene"]
 
@@ -53,13 +53,17 @@ class Scene:
         return {"fruits": [f.to_dict() for f in self.fruits]}
 
 
-def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    axis = b - a
-    axis_n = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis_n[0]) < 0.9 else np.array([0.0, 0.0, 1.0])
-    u = np.cross(axis_n, helper)
+def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors perpendicular to ``axis`` and to each other."""
+    axis = axis / np.linalg.norm(axis)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(axis, helper)
     u /= np.linalg.norm(u)
-    v = np.cross(axis_n, u)
+    return u, np.cross(axis, u)
+
+
+def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[np.ndarray, np.ndarray]:
+    u, v = _basis(b - a)
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     ring = radius * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
     vertices = np.vstack([a + ring, b + ring])
@@ -70,11 +74,7 @@ def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[
 
 
 def _disc(centre: np.ndarray, normal: np.ndarray, radius: float, lobes: int = 0, n: int = 40) -> tuple:
-    normal = normal / np.linalg.norm(normal)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(normal[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(normal, helper)
-    u /= np.linalg.norm(u)
-    v = np.cross(normal, u)
+    u, v = _basis(normal)
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     r = radius * (1.0 if lobes == 0 else 0.55 + 0.45 * np.abs(np.cos(lobes * t / 2)))
     ring = centre + (r * np.cos(t))[:, None] * u + (r * np.sin(t))[:, None] * v
@@ -84,9 +84,7 @@ def _disc(centre: np.ndarray, normal: np.ndarray, radius: float, lobes: int = 0,
 
 
 def _leaf(centre: np.ndarray, length: float, spin: float, tilt: np.ndarray) -> tuple:
-    t = np.linspace(0, 2 * np.pi, 40, endpoint=False)
-    outline = np.c_[length / 2 * np.cos(t), 0.25 * length * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)]
-    outline = outline @ rotation(0, 0, np.degrees(spin)).T @ tilt.T + centre
+    outline = leaf_outline(length, 0.5 * length) @ rotation(0, 0, np.degrees(spin)).T @ tilt.T + centre
     vertices = np.vstack([centre, outline])
     faces = np.c_[np.zeros(40, int), 1 + np.arange(40), 1 + (np.arange(40) + 1) % 40]
     return vertices, faces

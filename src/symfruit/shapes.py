@@ -34,6 +34,7 @@ __all__ = [
     "Fruit",
     "apple",
     "citrus",
+    "leaf_outline",
     "load_scans",
     "make_fruit",
     "paper_visible",
@@ -316,6 +317,12 @@ def rotation(rx: float, ry: float, rz: float) -> np.ndarray:
     rot_y = np.array([[np.cos(y), 0.0, np.sin(y)], [0.0, 1.0, 0.0], [-np.sin(y), 0.0, np.cos(y)]])
     rot_z = np.array([[np.cos(z), -np.sin(z), 0.0], [np.sin(z), np.cos(z), 0.0], [0.0, 0.0, 1.0]])
     return rot_z @ rot_y @ rotation_x(np.degrees(x))
+
+
+def leaf_outline(length: float, width: float, n: int = 40) -> np.ndarray:
+    """(n, 3) float: a flat, pointed-oval leaf outline in the x-y plane, centred on the origin."""
+    t = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return np.c_[length / 2 * np.cos(t), width / 2 * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)]
 
 
 def paper_visible(points: np.ndarray) -> np.ndarray:

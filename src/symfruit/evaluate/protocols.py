@@ -29,7 +29,7 @@ import numpy as np
 from ..box import Box
 from ..camera import DEFAULT_CAMERA, Camera
 from ..render import SensorNoise, render
-from ..shapes import FRUITS, Fruit, load_scans, paper_visible, rotation, rotation_x
+from ..shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "Instance", "Spec", "build", "specs"]
 
@@ -177,10 +177,7 @@ def _leaf(fruit: Fruit, camera: Camera, share: float, rng: np.random.Generator) 
     spin = rng.uniform(0, np.pi)
     direction = rng.uniform(0, 2 * np.pi)
     tilt = rotation(rng.uniform(-30, 30), rng.uniform(-30, 30), 0.0)
-    t = np.linspace(0, 2 * np.pi, 48, endpoint=False)
-    # Pointed oval: an ellipse whose ends are sharpened.
-    outline = np.c_[length / 2 * np.cos(t), width / 2 * np.sin(t) * np.abs(np.sin(t)) ** 0.3, np.zeros_like(t)]
-    outline = outline @ rotation(0, 0, np.degrees(spin)).T @ tilt.T
+    outline = leaf_outline(length, width, 48) @ rotation(0, 0, np.degrees(spin)).T @ tilt.T
     centre_fruit = np.array([np.mean(cols), np.mean(rows)])
 
     def place(offset: float) -> np.ndarray:
