@@ -1,8 +1,7 @@
 """Rasterise what the camera saw of one fruit: the visible mask ``Mp`` and the seen depth (section 3.5.2).
 
-Only a window of the image around the fruit is rasterised; look-ups outside the window are answered
-exactly for the mask test and with an upper bound (distance to the window plus the distance inside it)
-for the distance to the mask, which only matters for points already far outside it.
+Only a window of the image around the fruit is rasterised (:mod:`symfruit.rating` answers points
+falling outside it with an upper bound of their distance to the mask).
 """
 
 from __future__ import annotations
@@ -45,38 +44,6 @@ class View:
     near_v: np.ndarray
     near_depth: np.ndarray
     fill_radius: float
-
-    @property
-    def shape(self) -> tuple[int, int]:
-        return self.mask.shape
-
-    def lookup(self, uv: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Window index of the pixel nearest to each ``uv`` and the extra distance to reach it.
-
-        Parameters
-        ----------
-        uv : (...) x 2 float, pixels
-            Non-finite coordinates are sent to the window's corner with an infinite extra distance.
-
-        Returns
-        -------
-        index : (...) int
-            Flat index into the window's per-pixel arrays.
-        extra : (...) float, pixels
-            0 for pixels inside the window, else the distance from ``uv``'s pixel to the window.
-        """
-        h, w = self.mask.shape
-        finite = np.isfinite(uv[..., 0]) & np.isfinite(uv[..., 1])
-        u = np.where(finite, uv[..., 0], -1e9)
-        v = np.where(finite, uv[..., 1], -1e9)
-        col = np.rint(np.clip(u, -1e9, 1e9)) - self.u0
-        row = np.rint(np.clip(v, -1e9, 1e9)) - self.v0
-        col_c = np.clip(col, 0, w - 1)
-        row_c = np.clip(row, 0, h - 1)
-        extra = np.hypot(col - col_c, row - row_c)
-        extra[~finite] = np.inf
-        index = row_c.astype(np.intp) * w + col_c.astype(np.intp)
-        return index, extra
 
 
 def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:

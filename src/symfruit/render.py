@@ -9,7 +9,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from .camera import Camera
 
@@ -181,8 +180,3 @@ class SensorNoise:
         noisy[drop | ~seen] = 0.0
         jitter = rng.normal(scale=self.lateral_px, size=depth.shape + (2,))
         return noisy, jitter
-
-
-def erode_ids(ids: np.ndarray, k: int, iterations: int = 1) -> np.ndarray:
-    """The pixels of object ``k`` that are not on its silhouette (eroded ``iterations`` times)."""
-    return ndimage.binary_erosion(ids == k, iterations=iterations)
