@@ -245,7 +245,8 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         size = (1.0 - s.mirror_size) * fit_box.size + s.mirror_size * mirrored.box.size
         box = Box(centre - size / 2.0, centre + size / 2.0)
         centres = [box.centre, fit_box.centre, mirrored.box.centre]
-        extras.update(plane=mirrored.plane.to_dict() if mirrored.plane else None, semi_axes=axes.tolist())
+        extras.update(plane=mirrored.plane.to_dict() if mirrored.plane else None, semi_axes=axes.tolist(),
+                      mirror_score=mirrored.score)  # fmt: skip
     box = box.union(Box.from_points(points))
     spread = max(float(np.linalg.norm(c - centres[0])) for c in centres)
     coverage = silhouette_coverage(view if view is not None else rasterise(sample, camera), box, camera)
