@@ -169,7 +169,10 @@ def _complete(args: argparse.Namespace) -> int:
     print(f"{'box max':<10} {_fmt(box.max)} mm")
     if result.plane is not None:
         print(f"{'plane':<10} point {_fmt(result.plane.point)} mm, normal {_fmt(result.plane.normal, 1.0)}")
-        print(f"{'score':<10} {result.score:.3f} (best of {len(result.scores)} planes)")
+        if len(result.scores):
+            print(f"{'score':<10} {result.score:.3f} (best of {len(result.scores)} planes)")
+    if result.confidence is not None:
+        print(f"{'confidence':<10} {result.confidence:.2f} ({'reliable' if result.reliable else 'not reliable'})")
     dropped = f", {result.n_dropped} non-finite dropped" if result.n_dropped else ""
     print(f"{'points':<10} {len(result.visible)} visible -> {len(result.points)} completed{dropped}")
     print(f"{'time':<10} {result.seconds * 1000:.2f} ms")
