@@ -190,11 +190,10 @@ def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -
     return Box(lo, hi), a0, d
 
 
-def _mean_box(boxes: list[Box], weights: list[float] | None = None) -> Box:
-    w = np.ones(len(boxes)) if weights is None else np.asarray(weights, float)
-    w = w / w.sum()
-    centre = sum(wi * b.centre for wi, b in zip(w, boxes, strict=True))
-    size = sum(wi * b.size for wi, b in zip(w, boxes, strict=True))
+def _mean_box(boxes: list[Box]) -> Box:
+    """The box with the mean centre and the mean size of ``boxes``."""
+    centre = np.mean([b.centre for b in boxes], axis=0)
+    size = np.mean([b.size for b in boxes], axis=0)
     return Box(centre - size / 2.0, centre + size / 2.0)
 
 
@@ -209,7 +208,7 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     ratio, noise, normals = surface_noise(sample)
     step = max(1, len(sample) // 120)
     centres: list[np.ndarray] = []
-    view = None
+    view, plane = None, None
     extras: dict = {"noise": noise, "roughness_ratio": ratio}
     if ratio >= s.clean_ratio:
         extras["regime"] = "clean"
@@ -245,19 +244,14 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
         size = (1.0 - s.mirror_size) * fit_box.size + s.mirror_size * mirrored.box.size
         box = Box(centre - size / 2.0, centre + size / 2.0)
         centres = [box.centre, fit_box.centre, mirrored.box.centre]
-        extras.update(plane=mirrored.plane.to_dict() if mirrored.plane else None, semi_axes=axes.tolist(),
-                      mirror_score=mirrored.score)  # fmt: skip
+        plane = mirrored.plane
+        extras.update(semi_axes=axes.tolist(), mirror_score=mirrored.score)
     box = box.union(Box.from_points(points))
-    spread = max(float(np.linalg.norm(c - centres[0])) for c in centres)
+    spread = max(float(np.linalg.norm(other - centres[0])) for other in centres)
     coverage = silhouette_coverage(view if view is not None else rasterise(sample, camera), box, camera)
     confidence = _confidence(spread, coverage, float(box.size.max()), len(points), s)
     extras.update(confidence=confidence, reliable=confidence >= s.reliable_at, spread=spread, coverage=coverage)
     completed = np.vstack([points, 2.0 * box.centre - points])
-    plane = None
-    if extras.get("plane"):
-        from ..planes import Plane
-
-        plane = Plane(np.array(extras["plane"]["point"]), np.array(extras["plane"]["normal"]))
     return Completion(points=completed, box=box, plane=plane, extras=extras)
 
 
