@@ -462,14 +462,17 @@ def load_settings(path: str | Path, base: Settings | None = None) -> Settings:
         raise ConfigError(f"{path}: not valid {path.suffix.lstrip('.').upper()}: {exc}") from None
     if data is None:
         data = {}
-    if base is not None and isinstance(data, dict):
-        merged = base.to_dict()
-        for section, values in data.items():
-            merged[section] = (
-                {**merged[section], **values} if isinstance(values, dict) and section in merged else values
-            )
-        data = merged
     try:
-        return from_dict(data)
+        return overlay(base or Settings(), data)
     except ConfigError as exc:
         raise ConfigError(f"{path}: {exc}") from None
+
+
+def overlay(base: Settings, data: Any) -> Settings:
+    """``base`` with the sections of a parsed settings mapping laid over it (only the keys it names)."""
+    if not isinstance(data, dict):
+        raise ConfigError(f"settings must be a mapping of sections, got {type(data).__name__}")
+    merged = base.to_dict()
+    for section, values in data.items():
+        merged[section] = {**merged[section], **values} if isinstance(values, dict) and section in merged else values
+    return from_dict(merged)

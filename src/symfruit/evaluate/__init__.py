@@ -100,11 +100,7 @@ def evaluate(
         from ..io import write_json
 
         write_json(folder / "settings.json", meta)
-        write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled})
-        from ..io.atomic import atomic_write
-
-        with atomic_write(folder / "table.md", "w") as handle:
-            handle.write(table)
+        write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled}, table=table)
         _link_latest(folder)
     return Evaluation(folder=folder, rows=rows, summary=summary, table=table)
 

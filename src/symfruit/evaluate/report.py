@@ -72,8 +72,10 @@ def write_results(
     *,
     protocol: str,
     meta: dict[str, Any],
+    table: str | None = None,
 ) -> list[Path]:
-    """Write ``instances.csv``, ``summary.json``, ``table.md`` and the plots into ``folder``."""
+    """Write ``instances.csv``, ``summary.json``, ``table.md`` (``table``, or the per-group tables) and
+    the plots into ``folder``."""
     folder.mkdir(parents=True, exist_ok=True)
     buf = io.StringIO()
     writer = csv.DictWriter(buf, fieldnames=list(COLUMNS))
@@ -84,7 +86,8 @@ def write_results(
         handle.write(buf.getvalue())
     clean = [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()} for s in summary]
     write_json(folder / "summary.json", {**meta, "summary": clean})
-    table = markdown_table(summary, protocol=protocol, title=meta.get("title", ""))
+    if table is None:
+        table = markdown_table(summary, protocol=protocol, title=meta.get("title", ""))
     with atomic_write(folder / "table.md", "w") as handle:
         handle.write(table)
     written = [folder / "instances.csv", folder / "summary.json", folder / "table.md"]

@@ -116,10 +116,11 @@ def read_frame(folder: str | Path) -> Frame:
     cam_path = _first(folder, "camera.json", "camera.yaml", "camera.yml")
     if cam_path is None:
         raise FileFormatError(f"{folder}: no camera.json (intrinsics)")
-    from .intrinsics import load_camera
+    from .intrinsics import camera_from_file_data, read_mapping
 
-    camera = load_camera(cam_path)
-    scale = _depth_scale(cam_path)
+    cam_data = read_mapping(cam_path)
+    camera = camera_from_file_data(cam_path, cam_data)
+    scale = _depth_scale(cam_path, cam_data)
     color = _image(color_path)
     if color.ndim == 2:
         color = np.repeat(color[:, :, None], 3, axis=2)
@@ -145,13 +146,8 @@ def read_frame(folder: str | Path) -> Frame:
     return Frame(folder.name, color, depth, camera, masks, truth, str(folder))
 
 
-def _depth_scale(cam_path: Path) -> float:
-    if cam_path.suffix.lower() == ".json":
-        data = json.loads(cam_path.read_text(encoding="utf-8"))
-    else:
-        import yaml
-
-        data = yaml.safe_load(cam_path.read_text(encoding="utf-8"))
+def _depth_scale(cam_path: Path, data: Any) -> float:
+    """Metres per depth unit from the parsed camera file (``depth_scale`` or ``depth_units``)."""
     scale = data.get("depth_scale", DEFAULT_DEPTH_SCALE) if isinstance(data, dict) else DEFAULT_DEPTH_SCALE
     units = data.get("depth_units") if isinstance(data, dict) else None
     if units is not None:

@@ -33,6 +33,19 @@ _NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
 def load_camera(path: str | Path) -> Camera:
     """Read intrinsics from a ``.json``, ``.yaml`` or ``.yml`` file in any layout above."""
     path = Path(path)
+    return camera_from_file_data(path, read_mapping(path))
+
+
+def camera_from_file_data(path: Path, data: Any) -> Camera:
+    """:func:`camera_from_dict` with errors naming the file the data came from."""
+    try:
+        return camera_from_dict(data)
+    except InputError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+
+
+def read_mapping(path: Path) -> Any:
+    """Parse an intrinsics file (JSON, or YAML through the safe loader); errors name the file."""
     try:
         text = path.read_text(encoding="utf-8")
     except FileNotFoundError:
@@ -53,10 +66,7 @@ def load_camera(path: str | Path) -> Camera:
         raise
     except Exception as exc:  # JSONDecodeError / YAMLError carry the position
         raise FileFormatError(f"{path}: not valid {suffix.lstrip('.').upper()} ({exc})") from None
-    try:
-        return camera_from_dict(data)
-    except InputError as exc:
-        raise FileFormatError(f"{path}: {exc}") from None
+    return data
 
 
 def _number(data: dict[str, Any], key: str) -> float:
