@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: demo test test-slow bench lint format clean
+.PHONY: demo test test-slow test-long bench lint format clean
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -15,13 +15,17 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)  ## locate the fruit of the shipped RGB-D frame, write out/demo/
 	$(BIN)/symfruit demo --output out/demo
 
-test: $(STAMP)  ## lint and the test suite (slow evaluation runs excluded)
+test: $(STAMP)  ## lint, type check and the test suite (slow evaluation runs excluded)
 	$(BIN)/ruff check src tests examples
 	$(BIN)/ruff format --check src tests examples
+	$(BIN)/mypy
 	$(BIN)/python -m pytest -m "not slow"
 
 test-slow: $(STAMP)  ## the whole suite, slow evaluation runs included
 	$(BIN)/python -m pytest
+
+test-long: $(STAMP)  ## property and fuzz tests with fresh random cases and many more of them
+	SYMFRUIT_HYPOTHESIS=long $(BIN)/python -m pytest -m "not slow"
 
 bench: $(STAMP)  ## the project's benchmark
 	$(BIN)/symfruit bench

@@ -3,9 +3,10 @@
     python examples/make_sample.py
 
 Writes ``strawberry_partial.ply`` (the visible points, metres, camera optical frame),
-``strawberry_truth.json`` (the box of the whole berry), ``camera.json`` (Intel D435 colour,
-640x480) and ``frame/`` (an RGB-D frame of hanging strawberries with ``truth.json``) next to this
-file. Seeded: the same files every time.
+``strawberry_truth.json`` (the box of the whole berry) and ``camera.json`` (Intel D435 colour,
+640x480) next to this file, and the demo frame (an RGB-D frame of hanging strawberries with
+``truth.json``) into the package data, ``src/symfruit/data/example_frame``, where ``symfruit demo``
+finds it however symfruit was installed. Seeded: the same files every time.
 """
 
 from __future__ import annotations
@@ -15,12 +16,14 @@ from pathlib import Path
 import numpy as np
 
 from symfruit import DEFAULT_CAMERA, Box
+from symfruit.demo import FRAME_SEED
 from symfruit.io import write_json, write_ply
 from symfruit.io.frames import write_frame
 from symfruit.scenes import make_scene
 from symfruit.shapes import paper_visible, rotation_x, strawberry
 
 HERE = Path(__file__).parent
+FRAME = HERE.parent / "src" / "symfruit" / "data" / "example_frame"
 
 
 def main() -> None:
@@ -36,11 +39,7 @@ def main() -> None:
     write_json(HERE / "camera.json", DEFAULT_CAMERA.to_dict())
     # The example RGB-D frame: six ripe strawberries (two touching, some behind leaves), two unripe.
     scene = make_scene(FRAME_SEED)
-    write_frame(HERE / "frame", scene.color, scene.depth, scene.camera, truth=scene.truth())
-
-
-#: Seed of the shipped frame (a scene with touching fruit and leaves in front).
-FRAME_SEED = 1
+    write_frame(FRAME, scene.color, scene.depth, scene.camera, truth=scene.truth())
 
 
 if __name__ == "__main__":

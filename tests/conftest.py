@@ -1,11 +1,40 @@
-"""Shared fixtures: known-answer solids seen by the default camera."""
+"""Shared fixtures and helpers: known-answer solids seen by the default camera, the shipped example data,
+and the hypothesis profiles.
+
+Property and fuzz tests run the derandomised ``ci`` profile by default: the same cases on every run,
+``SYMFRUIT_FUZZ_EXAMPLES`` of them (default 40), so a failure in CI is a failure on every machine. The
+``long`` profile (``make test-long``, or ``SYMFRUIT_HYPOTHESIS=long``) draws fresh random cases, 1,000 per
+test unless ``SYMFRUIT_FUZZ_EXAMPLES`` says otherwise.
+"""
 
 from __future__ import annotations
 
+import os
+from pathlib import Path
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 import symfruit
+
+_QUIET = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large]
+settings.register_profile(
+    "ci", derandomize=True, database=None, deadline=None, suppress_health_check=_QUIET, print_blob=True,
+    max_examples=int(os.environ.get("SYMFRUIT_FUZZ_EXAMPLES", "40")),
+)  # fmt: skip
+settings.register_profile(
+    "long", derandomize=False, deadline=None, suppress_health_check=_QUIET, print_blob=True,
+    max_examples=int(os.environ.get("SYMFRUIT_FUZZ_EXAMPLES", "1000")),
+)  # fmt: skip
+settings.load_profile(os.environ.get("SYMFRUIT_HYPOTHESIS", "ci"))
+
+#: Examples per property test under the loaded profile (tests that are costlier run a share of it).
+FUZZ_EXAMPLES = settings.default.max_examples
+
+#: The repository's examples folder (sample cloud, camera) and the demo frame shipped as package data.
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+EXAMPLE_FRAME = Path(symfruit.__file__).resolve().parent / "data" / "example_frame"
 
 CENTRE = np.array([0.01, -0.02, 0.35])
 

@@ -10,10 +10,9 @@ from symfruit import __version__
 from symfruit.cli import main
 from symfruit.io import read_cloud
 
-from .conftest import front_half, sphere_cloud
+from .conftest import EXAMPLES, front_half, sphere_cloud
 from .test_io import write_pcd
 
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
 VISIBLE = front_half(sphere_cloud())
 
 

@@ -3,7 +3,8 @@ import json
 import pytest
 
 from symfruit import ConfigError, Settings, load_settings
-from symfruit.config import PaperSettings, from_dict
+from symfruit.methods.paper import PaperSettings
+from symfruit.settings import from_dict
 
 
 def test_defaults_are_the_papers():
@@ -40,12 +41,18 @@ def test_round_trip():
         ({"paper": {"rotatons_x": 3}}, r"unknown setting paper.rotatons_x"),
         ({"papr": {}}, r"unknown setting papr"),
         ({"paper": {"scoring": "smooth"}}, r"paper.scoring: expected one of"),
-        ({"paper": {"j2": 1.5}}, r"j2 must be smaller than paper.j3"),
-        ({"paper": {"translations": 0}}, r"at least 1"),
-        ({"paper": {"k2": -1}}, r"k2 must be positive"),
+        ({"paper": {"j2": 1.5}}, r"paper.j2: must be smaller than j3"),
+        ({"paper": {"translations": 0}}, r"paper.translations: must be >= 1, got 0"),
+        ({"paper": {"k2": -1}}, r"paper.k2: must be > 0"),
         ({"paper": {"j1": float("nan")}}, r"finite"),
         ({"sphere": {"refine": "yes"}}, r"true or false"),
-        ({"input": {"min_points": 2}}, r"at least 4"),
+        ({"input": {"min_points": 2}}, r"input.min_points: must be >= 4"),
+        ({"fused": {"mirror": {"j2": 2.0}}}, r"fused.mirror.j2: must be smaller than j3"),
+        ({"fused": {"mirror": {"rating_points": 1}}}, r"fused.mirror.rating_points: must be >= 10"),
+        ({"segment": {"close_px": 100000}}, r"segment.close_px: must be <= 50"),
+        ({"paper": {"fill_radius": 1e300}}, r"paper.fill_radius: must be <= 100"),
+        ({"paper": {1: 2}}, r"setting names must be text"),
+        ({1: {}}, r"section names must be text"),
         ({"paper": 3}, r"expected a mapping"),
         ([1, 2], r"mapping of sections"),
     ],
@@ -64,7 +71,7 @@ def test_bad_files_name_the_file(tmp_path):
     wrong.write_text('{"paper": {"rotations_x": true}}')
     with pytest.raises(ConfigError, match=r"wrong.json: paper.rotations_x"):
         load_settings(wrong)
-    with pytest.raises(ConfigError, match="cannot read"):
+    with pytest.raises(ConfigError, match="no such settings file"):
         load_settings(tmp_path / "missing.yaml")
     other = tmp_path / "s.toml"
     other.write_text("")

@@ -2,23 +2,23 @@
 
 import json
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from symfruit.batch import run_batch, safe_name
+from symfruit.batch import frame_folder_name, run_batch
 from symfruit.cli import main
-from symfruit.detect import detect, write_detections
+from symfruit.detect import detect
 from symfruit.evaluate.frames import evaluate_frames, match
 from symfruit.io.frames import read_frame
+from symfruit.writers import write_detections
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "frame"
+from .conftest import EXAMPLE_FRAME
 
 
 @pytest.fixture(scope="module")
 def example():
-    return read_frame(EXAMPLE)
+    return read_frame(EXAMPLE_FRAME)
 
 
 @pytest.fixture(scope="module")
@@ -41,7 +41,7 @@ def test_outputs_map_onto_detection3d(tmp_path, found):
     written = write_detections(tmp_path, found)
     assert {p.name for p in written} >= {"detections.json", "overlay.png", "fruit_001.ply"}
     data = json.loads((tmp_path / "detections.json").read_text())
-    assert data["header"]["frame_id"] == "camera_color_optical_frame" and data["frame"] == "frame"
+    assert data["header"]["frame_id"] == "camera_color_optical_frame" and data["frame"] == "example_frame"
     fruit = data["fruits"][0]
     for key in (
         "id",
@@ -109,7 +109,7 @@ def test_a_fruit_without_depth_is_reported_not_fatal(example):
 def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
     frames = tmp_path / "rec"
     for name in ("f1", "f2", "f3"):
-        shutil.copytree(EXAMPLE, frames / name)
+        shutil.copytree(EXAMPLE_FRAME, frames / name)
     (frames / "f2" / "depth.png").write_bytes(b"not a png")
     out = tmp_path / "out"
     report = run_batch(frames, out, method="raw", progress=False)
@@ -121,13 +121,15 @@ def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
     assert again.skipped == ["f1", "f3"] and (out / "f1" / "detections.json").read_bytes() == before
 
 
-def test_safe_names_stay_in_their_folder():
-    assert safe_name("../../etc/passwd") == "etc_passwd"
-    assert safe_name("a b/c") == "a_b_c" and safe_name("...") == "frame"
+def test_frame_folder_names_stay_in_their_folder_and_never_collide():
+    assert frame_folder_name("f1") == "f1"
+    assert frame_folder_name("../../etc/passwd").startswith("etc_passwd-")
+    assert frame_folder_name("a b/c").startswith("a_b_c-") and frame_folder_name("...").startswith("frame-")
+    assert frame_folder_name("a b") != frame_folder_name("a?b")  # sanitised alike, told apart by the hash
 
 
 def test_table3_on_frames(tmp_path):
-    shutil.copytree(EXAMPLE, tmp_path / "a")
+    shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
     scores, totals, failed = evaluate_frames(tmp_path, methods=("raw", "paper"))
     assert totals["matched"] == 6 and totals["missed"] == 0 and totals["false"] == 0 and not failed
     raw = np.mean([s.centre_mm for s in scores if s.method == "raw"])
@@ -136,12 +138,13 @@ def test_table3_on_frames(tmp_path):
 
 
 def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
-    assert main(["detect", str(EXAMPLE), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
-    assert (tmp_path / "d" / "frame" / "detections.json").exists()
+    assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
+    assert (tmp_path / "d" / "example_frame" / "detections.json").exists()
     assert main(["demo", "--output", str(tmp_path / "demo")]) == 0
     out = capsys.readouterr().out
     assert "mean centre error: raw" in out and "overlay:" in out
-    assert main(["evaluate", "--frames", str(EXAMPLE.parent), "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
+    frames = str(EXAMPLE_FRAME.parent)
+    assert main(["evaluate", "--frames", frames, "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
     assert "Table 3" in capsys.readouterr().out
     assert main(["bench", "--frame", "--repeat", "1", "--json"]) == 0
     row = json.loads(capsys.readouterr().out)["rows"][0]

@@ -1,20 +1,20 @@
 """Frames on disk, the segmenter, mask sources, extraction, bags."""
 
 import json
-from pathlib import Path
 
 import numpy as np
 import pytest
 
 from symfruit import Camera, FileFormatError, InputError
-from symfruit.config import ExtractSettings
-from symfruit.extract import cluster, extract
-from symfruit.io.frames import iter_frames, read_frame, write_frame
+from symfruit.extract import ExtractSettings, cluster, extract
+from symfruit.io.frames import read_frame, write_frame
 from symfruit.io.masks import read_masks, rle_decode
+from symfruit.io.sources import open_source
 from symfruit.scenes import make_scene
 from symfruit.segment import segment
 
-EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "frame"
+from .conftest import EXAMPLE_FRAME
+
 CAM = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
 
 
@@ -32,13 +32,10 @@ def disc_frame(centres, radius=20, z=0.3, colour=(200, 20, 30)):
 
 
 def test_segmenter_on_the_shipped_frame():
-    import importlib.util
+    from symfruit.demo import FRAME_SEED
 
-    spec = importlib.util.spec_from_file_location("make_sample", EXAMPLE.parent / "make_sample.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    frame = read_frame(EXAMPLE)
-    scene = make_scene(module.FRAME_SEED)  # the same scene, with its true instance labels
+    frame = read_frame(EXAMPLE_FRAME)
+    scene = make_scene(FRAME_SEED)  # the same scene, with its true instance labels
     assert np.array_equal(frame.color, scene.color)
     labels = segment(frame.color, frame.depth, frame.camera)
     found = []
@@ -121,9 +118,11 @@ def test_iter_frames_reports_bad_frames_and_goes_on(tmp_path):
     for name in ("a", "b", "c"):
         write_frame(tmp_path / name, color, depth, CAM)
     (tmp_path / "b" / "depth.png").unlink()
-    got = list(iter_frames(tmp_path))
-    assert [n for n, _ in got] == ["a", "b", "c"]
-    assert isinstance(got[1][1], FileFormatError) and not isinstance(got[0][1], Exception)
+    src = open_source(tmp_path)
+    assert src.names() == ["a", "b", "c"]
+    assert src.read(0).name == "a" and src.read(2).name == "c"
+    with pytest.raises(FileFormatError, match="depth"):
+        src.read(1)
 
 
 def test_label_png_and_coco_masks(tmp_path):
@@ -238,9 +237,9 @@ def test_tiny_ros2_bag(tmp_path):
             dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=0, step=320,
                         data=mm.view(np.uint8).ravel())  # fmt: skip
             writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
-    frames = list(iter_frames(path))
-    assert len(frames) == 2
-    _, frame = frames[0]
+    src = open_source(path)
+    assert len(src) == 2
+    frame = src.read(0)
     assert np.array_equal(frame.color, color) and np.allclose(frame.depth, mm / 1000.0)
     assert frame.camera == CAM
     from symfruit.detect import detect

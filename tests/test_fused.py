@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from symfruit import Box, ConfigError, box_iou, centre_deviation, complete
-from symfruit.methods.fused import fit_aligned_ellipsoid, fit_revolution, surface_noise
+from symfruit.core.fits import fit_aligned_ellipsoid, fit_revolution, surface_noise
 from symfruit.profiles import available_profiles, load_profile
 from symfruit.shapes import rotation
 
@@ -92,7 +92,7 @@ def test_profiles_ship_and_load(tmp_path):
         load_profile("banana")
     bad = tmp_path / "bad.yaml"
     bad.write_text("fused:\n  mirror_weight: 2\n")
-    with pytest.raises(ConfigError, match="mirror shares"):
+    with pytest.raises(ConfigError, match=r"fused\.mirror_weight: must be <= 1"):
         load_profile(bad)
 
 

@@ -5,8 +5,8 @@ import pytest
 
 import symfruit
 from symfruit import Box, InputError, box_iou, centre_deviation, complete
+from symfruit.core.fits import fit_sphere
 from symfruit.methods import Completion, available, register
-from symfruit.methods.sphere import fit_sphere
 
 from .conftest import CENTRE, ellipsoid_cloud, front_half, revolution_cloud, sphere_cloud
 
@@ -40,7 +40,7 @@ def test_paper_completes_with_the_mirror_of_the_visible_points():
     result = complete(visible, method="paper")
     mirrored = result.points[len(visible) :]
     assert np.array_equal(result.points[: len(visible)], visible)
-    assert np.allclose(symfruit.planes.mirror(mirrored, result.plane.point, result.plane.normal), visible)
+    assert np.allclose(symfruit.core.planes.mirror(mirrored, result.plane.point, result.plane.normal), visible)
     assert np.allclose(result.box.min, result.points.min(axis=0))
 
 

@@ -4,7 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from symfruit.planes import hypothesis_planes, mirror
+from symfruit.core.planes import hypothesis_planes, mirror
 
 coords = arrays(np.float64, (12, 3), elements=st.floats(-1.0, 1.0))
 unit = arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)).filter(lambda v: np.linalg.norm(v) > 0.1)

@@ -2,7 +2,7 @@ import numpy as np
 import pytest
 
 from symfruit import Camera, InputError
-from symfruit.raster import rasterise
+from symfruit.core.raster import rasterise
 
 from .conftest import CENTRE, front_half, sphere_cloud
 

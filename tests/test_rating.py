@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 import symfruit
-from symfruit.config import PaperSettings
-from symfruit.raster import rasterise
-from symfruit.rating import rate_planes
+from symfruit.core.raster import rasterise
+from symfruit.core.rating import rate_planes, rate_points
+from symfruit.methods.paper import PaperSettings
 
 from .conftest import CENTRE
 
@@ -26,9 +26,8 @@ def rate_targets(scene, camera, targets, settings, dtype=np.float64):
     targets = np.atleast_2d(targets)
     normals = targets - source
     points = (targets + source) / 2.0
-    rating = rate_planes(
-        source, points, normals, view, camera, centroid, dist_ref, settings, dtype=dtype, per_point=True
-    )
+    rating = rate_points(source, points, normals, view, camera, centre=centroid, dist_ref=dist_ref,
+                         table=settings.table, scoring=settings.scoring, dtype=dtype)  # fmt: skip
     return rating.scores[:, 0], rating.locations[:, 0], rating
 
 
@@ -137,19 +136,20 @@ def test_fast_means_equal_per_point_means(scene, camera, scoring, dtype, tol):
     normals = rng.normal(size=(40, 3)) * [0.3, 0.3, 1.0]
     points = centroid + rng.normal(scale=0.005, size=(40, 3))
     s = PaperSettings(scoring=scoring)
-    fast = rate_planes(visible, points, normals, view, camera, centroid, r, s, dtype=dtype)
-    slow = rate_planes(visible, points, normals, view, camera, centroid, r, s, dtype=np.float64, per_point=True)
+    kw = {"centre": centroid, "dist_ref": r, "table": s.table, "scoring": s.scoring}
+    fast = rate_planes(visible, points, normals, view, camera, dtype=dtype, **kw)
+    slow = rate_points(visible, points, normals, view, camera, dtype=np.float64, **kw)
     assert np.allclose(fast, slow.scores.mean(axis=1), atol=tol)
 
 
 def test_blocks_do_not_change_the_result(scene, camera, monkeypatch):
-    from symfruit import rating
+    from symfruit.core import rating
 
     visible, view, centroid, r = scene
-    planes = symfruit.planes.hypothesis_planes(visible)
-    whole = rate_planes(visible, planes.points, planes.normals, view, camera, centroid, r, PaperSettings())
+    planes = symfruit.core.planes.hypothesis_planes(visible)
+    whole = rate_planes(visible, planes.points, planes.normals, view, camera, centre=centroid, dist_ref=r)
     monkeypatch.setattr(rating, "BLOCK_POINTS", len(visible) * 5)
-    blocked = rate_planes(visible, planes.points, planes.normals, view, camera, centroid, r, PaperSettings())
+    blocked = rate_planes(visible, planes.points, planes.normals, view, camera, centre=centroid, dist_ref=r)
     assert np.array_equal(whole, blocked)
 
 

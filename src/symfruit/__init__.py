@@ -1,16 +1,24 @@
-"""symfruit: locate fruit from one RGB-D view by completing its hidden side through mirror symmetry."""
+"""symfruit: locate fruit from one RGB-D view by completing its hidden side through mirror symmetry.
+
+The package follows the data's way: :mod:`symfruit.io` (files -> arrays), :mod:`symfruit.segment` and
+:mod:`symfruit.extract` (frame -> each fruit's points), :func:`complete` (points -> completed fruit and box,
+through :mod:`symfruit.methods` and the numerical :mod:`symfruit.core`), :mod:`symfruit.detect` (a whole
+frame), :mod:`symfruit.writers` (results -> files), :mod:`symfruit.evaluate` and :mod:`symfruit.cli`.
+"""
 
 from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from .box import Box, box_iou, centre_deviation
-from .camera import DEFAULT_CAMERA, Camera
+from . import extract as _extract  # noqa: F401  (registers the "extract" settings section)
+from . import segment as _segment  # noqa: F401  (registers the "segment" settings section)
 from .complete import Result, complete
-from .config import Settings, load_settings
+from .core.box import Box, box_iou, centre_deviation
+from .core.camera import DEFAULT_CAMERA, Camera
+from .core.planes import Plane
 from .errors import ConfigError, FileFormatError, InputError, SymfruitError
 from .methods import available as available_methods
-from .planes import Plane
+from .settings import Settings, load_settings, resolve_settings
 
 try:
     __version__ = version("symfruit")
@@ -34,4 +42,5 @@ __all__ = [
     "centre_deviation",
     "complete",
     "load_settings",
+    "resolve_settings",
 ]

@@ -10,15 +10,25 @@ import os
 import platform
 import time
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from .complete import complete
-from .config import Settings
+from .settings import Settings
 from .shapes import paper_visible, rotation_x, strawberry
 
-__all__ = ["DENSE_GRID", "BenchRow", "bench_frame", "bench_view", "run_bench"]
+__all__ = [
+    "DENSE_GRID",
+    "BenchRow",
+    "RecordingRow",
+    "bench_frame",
+    "bench_recording",
+    "bench_view",
+    "make_recording",
+    "run_bench",
+]
 
 #: 10 x 22 x 6 = 1,320 planes: finer depth steps (0.08 len_depth), 2.5 deg about x, 4 deg about y.
 DENSE_GRID = {
@@ -115,7 +125,7 @@ def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "fused") -> Be
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore)."""
     from .detect import detect
-    from .io.frames import Frame
+    from .frame import Frame
     from .scenes import make_scene
 
     scene = make_scene(seed, n_ripe=8, n_unripe=2)
@@ -125,6 +135,93 @@ def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "fused") -> Be
     n = sum(d.result is not None for d in found.detections)
     return BenchRow(f"frame, {n} fruit, {method}", method, Settings().paper.n_hypotheses, n, float(np.median(ms)),
                     float(np.percentile(ms, 10)), float(np.percentile(ms, 90)), repeat)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class RecordingRow:
+    """Peak memory and speed of ``symfruit detect`` over a generated recording (in a child process)."""
+
+    frames: int
+    method: str
+    seconds: float
+    peak_rss_mb: float
+    frames_done: int
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def make_recording(folder: str | Path, frames: int, *, distinct: int = 4, seed: int = 0) -> Path:
+    """A folder of ``frames`` frame folders made from ``distinct`` generated scenes (8 ripe strawberries, 2
+    unripe), the repeats hard-linked (copied where links are not possible) so a long recording costs
+    little disk. Returns ``folder``."""
+    import shutil
+
+    from .io.frames import write_frame
+    from .scenes import make_scene
+
+    folder = Path(folder)
+    sources = []
+    for k in range(min(distinct, frames)):
+        scene = make_scene(seed + k, n_ripe=8, n_unripe=2)
+        sources.append(write_frame(folder / f"frame_{k:05d}", scene.color, scene.depth, scene.camera,
+                                   truth=scene.truth()))  # fmt: skip
+    for i in range(len(sources), frames):
+        target = folder / f"frame_{i:05d}"
+        target.mkdir(parents=True, exist_ok=True)
+        for path in sources[i % len(sources)].iterdir():
+            try:
+                os.link(path, target / path.name)
+            except OSError:
+                shutil.copy2(path, target / path.name)
+    return folder
+
+
+#: Run in the child of :func:`bench_recording`: ``symfruit detect``, then the child's own peak RSS (the high
+#: water mark of its memory map, ``VmHWM``; ``ru_maxrss`` would also count the parent it was forked from).
+_MEASURED_DETECT = """
+import json, resource, sys
+from symfruit.cli import main
+status = main(sys.argv[1:])
+peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+try:
+    for line in open("/proc/self/status"):
+        if line.startswith("VmHWM:"):
+            peak = int(line.split()[1]) / 1024.0
+except OSError:
+    pass
+print(json.dumps({"status": status, "peak_rss_mb": peak}))
+"""
+
+
+def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[int, float, str]:
+    """Run ``symfruit detect ARGS`` in a child process: ``(exit status, its peak RSS in MB, its stderr)``."""
+    import json
+    import subprocess
+    import sys
+
+    proc = subprocess.run([sys.executable, "-c", _MEASURED_DETECT, "detect", *args], capture_output=True, text=True,
+                          timeout=timeout, check=False)  # fmt: skip
+    lines = proc.stdout.strip().splitlines()
+    if proc.returncode != 0 or not lines:
+        return proc.returncode, float("nan"), proc.stderr
+    data = json.loads(lines[-1])
+    return int(data["status"]), float(data["peak_rss_mb"]), proc.stderr
+
+
+def bench_recording(frames: int = 500, *, method: str = "fused", workdir: str | Path | None = None) -> RecordingRow:
+    """Run ``symfruit detect`` on a generated ``frames``-frame recording in a child process and report its
+    peak resident memory and wall time: memory must not grow with ``frames``."""
+    import tempfile
+
+    with tempfile.TemporaryDirectory(dir=workdir) as tmp:
+        rec = make_recording(Path(tmp) / "rec", frames)
+        out = Path(tmp) / "out"
+        start = time.perf_counter()
+        _, peak, _ = measured_detect([str(rec), "--output", str(out), "--method", method])
+        seconds = time.perf_counter() - start
+        done = len(list(out.glob("*/detections.json")))
+    return RecordingRow(frames, method, seconds, peak, done)
 
 
 def machine() -> dict[str, Any]:

@@ -11,6 +11,10 @@ import json
 import sys
 from collections.abc import Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 __all__ = ["main"]
 
@@ -41,6 +45,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
+    p.add_argument("--recording", type=int, metavar="N",
+                   help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
+    p.add_argument("--method", default="fused", help="with --recording: the completion method (default fused)")
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
@@ -85,7 +92,9 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
     p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    p.add_argument("--method", default="fused")
+    p.add_argument("--method", default="fused", help="completion method (default fused)")
+    p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -102,64 +111,45 @@ def _parser() -> argparse.ArgumentParser:
     _add_bench(sub)
     _add_evaluate(sub)
     _add_detect(sub)
-    p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, or merged with --config)")
-    p.add_argument("--config", type=Path)
+    p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
+    p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     sub.add_parser("methods", help="list the completion methods")
     return parser
 
 
-def _fmt(values: Sequence[float], scale: float = 1000.0) -> str:
+def _fmt(values: Sequence[float] | np.ndarray, scale: float = 1000.0) -> str:
     return "(" + ", ".join(f"{v * scale:.1f}" for v in values) + ")"
 
 
-def _settings_for(args: argparse.Namespace):
-    """Defaults, then the fruit profile (``--fruit``), then ``--config``."""
-    from .config import Settings, load_settings
+def _settings_for(args: argparse.Namespace, fruit: str | None = None):
+    """Defaults, then the fruit profile (``--fruit``), then ``--config``: :func:`symfruit.resolve_settings`."""
+    from .settings import resolve_settings
 
-    settings = Settings()
-    if getattr(args, "fruit", None):
-        from .profiles import load_profile
-
-        settings = load_profile(args.fruit)
-    return load_settings(args.config, base=settings) if args.config else settings
+    return resolve_settings(fruit=fruit if fruit is not None else getattr(args, "fruit", None),
+                            config=getattr(args, "config", None))  # fmt: skip
 
 
 def _complete(args: argparse.Namespace) -> int:
-    import numpy as np
-
-    from .camera import DEFAULT_CAMERA
     from .complete import complete
-    from .errors import FileFormatError
-    from .io import load_camera, read_cloud, write_json, write_ply
+    from .core.camera import DEFAULT_CAMERA
+    from .io import load_camera, read_cloud
+    from .writers import write_result
 
     settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
-    if args.output is not None and args.output.suffix.lower() != ".ply":
-        raise FileFormatError(f"{args.output}: --output must end in .ply")
+    if args.output is not None:
+        _check_output_file(args.output, ".ply")
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
     result = complete(points, camera=camera, method=args.method, settings=settings)
-    summary = result.to_dict()
+    written = None
     if args.output is not None:
-        labels = np.r_[
-            np.zeros(len(result.visible), np.uint8),
-            np.ones(len(result.points) - len(result.visible), np.uint8),
-        ]
-        write_ply(args.output, result.points, labels=labels)
-        write_json(
-            args.output.with_suffix(".json"),
-            {
-                **summary,
-                "input": str(args.cloud),
-                "units": args.units,
-                "camera": camera.to_dict(),
-                "extras": result.extras,
-                "settings": settings.to_dict(),
-            },
-        )
+        meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}
+        written = write_result(args.output, result, meta=meta)
     if args.json:
-        print(json.dumps(summary, indent=2))
+        print(json.dumps(result.to_dict(), indent=2))
         return 0
     box = result.box
     print(f"{'method':<10} {result.method}")
@@ -176,9 +166,18 @@ def _complete(args: argparse.Namespace) -> int:
     dropped = f", {result.n_dropped} non-finite dropped" if result.n_dropped else ""
     print(f"{'points':<10} {len(result.visible)} visible -> {len(result.points)} completed{dropped}")
     print(f"{'time':<10} {result.seconds * 1000:.2f} ms")
-    if args.output is not None:
-        print(f"{'written':<10} {args.output} and {args.output.with_suffix('.json')}")
+    if written is not None:
+        print(f"{'written':<10} {written[0]} and {written[1]}")
     return 0
+
+
+def _check_output_file(path: Path, suffix: str) -> None:
+    from .errors import FileFormatError
+
+    if path.suffix.lower() != suffix:
+        raise FileFormatError(f"{path}: --output must end in {suffix}")
+    if path.is_dir():
+        raise FileFormatError(f"{path}: --output is a folder; give a file name ending in {suffix}")
 
 
 def _bench(args: argparse.Namespace) -> int:
@@ -187,6 +186,19 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
+    if args.recording is not None:
+        from .bench import bench_recording
+
+        if not 1 <= args.recording <= 100_000:
+            raise InputError("--recording must be between 1 and 100000 frames")
+        rec = bench_recording(args.recording, method=args.method)
+        if args.json:
+            print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
+            return 0
+        print(f"symfruit bench --recording: {rec.frames} frames ({rec.frames_done} written), method {rec.method}: "
+              f"{rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "
+              f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
+        return 0
     if args.frame:
         from .bench import bench_frame
 
@@ -208,7 +220,6 @@ def _bench(args: argparse.Namespace) -> int:
 
 
 def _evaluate(args: argparse.Namespace) -> int:
-    from .config import Settings, load_settings
     from .errors import InputError
     from .evaluate import evaluate
     from .methods import get
@@ -232,11 +243,10 @@ def _evaluate(args: argparse.Namespace) -> int:
     if args.n is not None and args.n < 1:
         raise InputError("--n must be at least 1")
     if args.frames is not None:
-        from .profiles import available_profiles, load_profile
+        from .profiles import available_profiles
 
-        base = load_profile(fruits[0]) if len(fruits) == 1 and fruits[0] in available_profiles() else Settings()
-        settings = load_settings(args.config, base=base) if args.config else base
-        return _evaluate_frames(args, methods, settings)
+        fruit = fruits[0] if len(fruits) == 1 and fruits[0] in available_profiles() else None
+        return _evaluate_frames(args, methods, _settings_for(args, fruit))
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, quick=args.quick, config=args.config, output=args.output, jobs=args.jobs,
@@ -247,16 +257,13 @@ def _evaluate(args: argparse.Namespace) -> int:
 
 
 def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> int:
-    import datetime
-
     from .evaluate.frames import evaluate_frames, summary_dict, table3
-    from .io import write_json
-    from .io.atomic import atomic_write
+    from .io import atomic_write, write_json
+    from .writers import new_results_folder
 
     scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=args.masks, settings=settings)
     table = table3(scores, totals, methods)
-    folder = args.output / f"{datetime.datetime.now():%Y%m%d-%H%M%S}-frames"
-    folder.mkdir(parents=True, exist_ok=True)
+    folder = new_results_folder(args.output, "frames")
     write_json(folder / "summary.json", {**summary_dict(scores, totals, failed), "settings": settings.to_dict()})
     with atomic_write(folder / "table.md", "w") as handle:
         handle.write(table)
@@ -279,6 +286,8 @@ def _detect(args: argparse.Namespace) -> int:
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
         print(f"  failed {name}: {reason}")
+    if report.stopped:
+        print(f"symfruit: {report.stopped}", file=sys.stderr)
     print(f"results: {args.output}")
     return 0 if report.ok else 1
 
@@ -286,16 +295,39 @@ def _detect(args: argparse.Namespace) -> int:
 def _demo(args: argparse.Namespace) -> int:
     from .demo import run_demo
 
-    return run_demo(args.output, method=args.method)
+    report = run_demo(args.output, method=args.method, settings=_settings_for(args))
+    found = report.found
+    frame = found.frame
+    print(f"symfruit demo: {frame.name} ({frame.camera.width}x{frame.camera.height}), {len(found.detections)} fruit "
+          f"found, {report.n_truth} ripe fruit in the truth, method {args.method}")  # fmt: skip
+    print(f"{'fruit':>5} {'points':>6}  {'centre x, y, z (mm)':<24} {'size x, y, z (mm)':<20} "
+          f"{'raw err':>8} {'completed err':>13}")  # fmt: skip
+    for d in report.located:
+        assert d.result is not None
+        c, size = d.result.centre * 1000, d.result.box.size * 1000
+        line = f"{d.id:>5} {len(d.extraction.points):>6}  {c[0]:7.1f} {c[1]:7.1f} {c[2]:7.1f}  "
+        line += f"{size[0]:5.1f} {size[1]:5.1f} {size[2]:5.1f}  "
+        err = report.errors.get(d.id)
+        line += f"{err[0]:6.1f} mm {err[1]:10.1f} mm" if err else f"{'-':>8} {'-':>13}  (no true fruit matched)"
+        print(line + (" (truncated)" if d.extraction.truncated else ""))
+    for d in found.detections:
+        if d.result is None:
+            print(f"{d.id:>5} failed: {d.error}")
+    means = report.mean_errors()
+    if means:
+        print(f"mean centre error: raw {means[0]:.1f} mm, completed {means[1]:.1f} mm")
+    t = found.timings
+    print(f"time: {t['total'] * 1000:.0f} ms (segment {t['segment'] * 1000:.0f}, extract {t['extract'] * 1000:.0f}, "
+          f"complete {t['complete'] * 1000:.0f})")  # fmt: skip
+    print(f"overlay: {report.output / 'overlay.png'}")
+    print(f"detections: {report.output / 'detections.json'}")
+    return 0
 
 
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
-    from .config import Settings, load_settings
-
-    settings = load_settings(args.config) if args.config else Settings()
-    print(yaml.safe_dump(settings.to_dict(), sort_keys=False), end="")
+    print(yaml.safe_dump(_settings_for(args).to_dict(), sort_keys=False), end="")
     return 0
 
 
@@ -303,8 +335,7 @@ def _methods(args: argparse.Namespace) -> int:
     from .methods import available, get
 
     for name in available():
-        doc = (get(name).__doc__ or "").strip().splitlines()
-        print(f"{name:<10} {doc[0] if doc else ''}")
+        print(f"{name:<10} {get(name).summary}")
     return 0
 
 

@@ -3,19 +3,53 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
-from .box import Box
-from .camera import DEFAULT_CAMERA, Camera
-from .config import InputSettings, Settings, from_dict
+from .core.box import Box
+from .core.camera import DEFAULT_CAMERA, Camera
+from .core.planes import Plane, Planes
+from .core.points import check_cloud
 from .errors import InputError
 from .methods import get
-from .planes import Plane, Planes
+from .settings import Section, SettingError, Settings, from_dict, register_section, setting
 
-__all__ = ["Result", "check_points", "complete"]
+__all__ = ["InputSettings", "Result", "complete"]
+
+
+@dataclass(frozen=True)
+class InputSettings(Section):
+    """Checks applied to every cloud before completion.
+
+    Attributes
+    ----------
+    min_points : int
+        Fewest finite points a fruit needs; fewer raise :class:`~symfruit.errors.InputError`.
+    max_points : int
+        Larger clouds are down-sampled (seeded, reproducible) to this many points.
+    max_extent : float, metres
+        A cloud wider than this in any axis is refused as "not a single fruit, or in millimetres".
+    min_extent : float, metres
+        A cloud whose largest extent is smaller than this is refused as "not a fruit, or in the
+        wrong units" (e.g. metres read with ``--units mm``).
+    """
+
+    min_points: int = setting(10, ge=4, le=1_000_000)
+    max_points: int = setting(20000, ge=4, le=5_000_000)
+    max_extent: float = setting(1.0, gt=0.0, le=100.0)
+    min_extent: float = setting(0.003, gt=0.0, le=100.0)
+
+    def check(self) -> None:
+        if self.max_points < self.min_points:
+            raise SettingError("max_points", "must be >= min_points")
+        if self.min_extent >= self.max_extent:
+            raise SettingError("min_extent", "must be smaller than max_extent")
+
+
+register_section("input", InputSettings)
 
 
 @dataclass(frozen=True)
@@ -60,8 +94,8 @@ class Result:
     seconds: float
     n_input: int
     n_dropped: int
-    extras: dict = field(default_factory=dict)
-    settings: Settings = field(default_factory=Settings)
+    extras: dict[str, Any] = field(default_factory=dict)
+    settings: Settings = field(default_factory=lambda: Settings())
 
     @property
     def centre(self) -> np.ndarray:
@@ -98,73 +132,12 @@ class Result:
         }
 
 
-def check_points(points: Any, settings: InputSettings | None = None) -> tuple[np.ndarray, int]:
-    """Validate a cloud at the boundary and return ``(clean (n, 3) float64 points, n_dropped)``.
-
-    Non-finite rows are dropped (and counted); clouds over ``max_points`` are down-sampled with a
-    fixed seed. Raises :class:`InputError` for anything a fruit cannot be: wrong shape, too few
-    points, points at or behind the camera, all points identical or on a line, or a cloud wider
-    than ``max_extent`` (most often a cloud in millimetres).
-    """
-    s = settings or InputSettings()
-    try:
-        arr = np.asarray(points, dtype=np.float64)
-    except (TypeError, ValueError):
-        raise InputError("points must be a numeric (n, 3) array of x, y, z in metres") from None
-    if arr.ndim != 2 or arr.shape[1] != 3:
-        raise InputError(f"points must have shape (n, 3), got {arr.shape}")
-    finite = np.isfinite(arr).all(axis=1)
-    n_dropped = 0
-    if not finite.all():
-        n_dropped = int(len(arr) - finite.sum())
-        arr = arr[finite]
-    if len(arr) < s.min_points:
-        extra = f" after dropping {n_dropped} non-finite" if n_dropped else ""
-        raise InputError(
-            f"a fruit needs at least {s.min_points} points, got {len(arr)}{extra} (input.min_points sets the limit)"
-        )
-    if arr[:, 2].min() <= 0:
-        behind = int((arr[:, 2] <= 0).sum())
-        raise InputError(
-            f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
-            "the camera optical frame (x right, y down, z forward), in metres"
-        )
-    extent = float((arr.max(axis=0) - arr.min(axis=0)).max())
-    if extent > s.max_extent:
-        raise InputError(
-            f"the cloud is {extent:.3g} m across, too large for one fruit (input.max_extent = "
-            f"{s.max_extent} m); if it is in millimetres, use --units mm (or divide by 1000)"
-        )
-    if extent < s.min_extent:
-        if extent == 0:
-            raise InputError("all points are identical; a fruit needs points spread over its surface")
-        raise InputError(
-            f"the cloud is only {extent * 1000:.3g} mm across, too small for a fruit (input.min_extent = "
-            f"{s.min_extent * 1000:g} mm); check the units (--units m for metres)"
-        )
-    centred = arr - arr.mean(axis=0)
-    spread = np.linalg.eigvalsh(centred.T @ centred)  # ascending variances (times n)
-    if spread[2] <= 1e-18 * len(arr):
-        raise InputError("all points are identical; a fruit needs points spread over its surface")
-    if spread[1] <= 1e-12 * spread[2]:
-        raise InputError("all points lie on a line; a fruit needs points spread over its surface")
-    if spread[0] <= 1e-12 * spread[2]:
-        raise InputError(
-            "all points lie on a plane; a fruit's visible surface is curved (is this a depth image "
-            "of a flat object, or a cloud with its depth dropped?)"
-        )
-    if len(arr) > s.max_points:
-        keep = np.random.default_rng(0).choice(len(arr), size=s.max_points, replace=False)
-        arr = arr[np.sort(keep)]
-    return arr, n_dropped
-
-
 def complete(
     points: Any,
     *,
-    camera: Camera | None = None,
+    camera: Camera | Mapping[str, Any] | None = None,
     method: str = "fused",
-    settings: Settings | dict | None = None,
+    settings: Settings | Mapping[str, Any] | None = None,
 ) -> Result:
     """Complete one fruit seen from one view and box it.
 
@@ -172,18 +145,26 @@ def complete(
     ----------
     points : (n, 3) float, metres
         The fruit's visible points in the camera optical frame (x right, y down, z forward).
-    camera : Camera, optional
-        Intrinsics of the camera that saw them; None means :data:`~symfruit.camera.DEFAULT_CAMERA`
-        (Intel D435 colour, 640x480).
+    camera : Camera or mapping, optional
+        Intrinsics of the camera that saw them (a mapping in any layout :func:`symfruit.io.camera_from_dict`
+        reads); None means :data:`~symfruit.core.camera.DEFAULT_CAMERA` (Intel D435 colour, 640x480).
     method : str
         A registered method: ``fused`` (default), ``paper``, ``sphere``, ``ellipsoid``, ``raw``, ...
         (:func:`symfruit.methods.available`).
-    settings : Settings or dict, optional
-        Settings, or a nested dict of overrides (``{"paper": {"rotations_x": 21}}``).
+    settings : Settings or mapping, optional
+        Settings (e.g. from :func:`symfruit.resolve_settings`), or a nested mapping of overrides
+        (``{"paper": {"rotations_x": 21}}``).
 
     Returns
     -------
     Result
+
+    Raises
+    ------
+    InputError
+        For points that cannot be a fruit, an unknown method, or arguments of the wrong type.
+    ConfigError
+        For invalid settings.
 
     Examples
     --------
@@ -195,16 +176,19 @@ def complete(
     >>> np.round(r.centre, 3).tolist()
     [0.0, 0.0, 0.3]
     """
-    if settings is None:
-        settings = Settings()
-    elif isinstance(settings, dict):
-        settings = from_dict(settings)
-    fn = get(method)
-    camera = DEFAULT_CAMERA if camera is None else camera
-    n_input = len(points) if hasattr(points, "__len__") else 0
+    settings = _settings(settings)
+    camera = _camera(camera)
+    info = get(method)
+    try:
+        n_input = len(points)
+    except TypeError:  # a scalar or 0-d array: check_cloud names the problem
+        n_input = 0
     start = time.perf_counter()
-    clean, n_dropped = check_points(points, settings.input)
-    done = fn(clean, camera, settings)
+    s = settings.input
+    clean, n_dropped = check_cloud(points, min_points=s.min_points, max_points=s.max_points,
+                                   min_extent=s.min_extent, max_extent=s.max_extent, section="input")  # fmt: skip
+    section = settings.section(method) if info.settings is not None else None
+    done = info.fn(clean, camera, section)
     seconds = time.perf_counter() - start
     return Result(
         method=method,
@@ -221,3 +205,28 @@ def complete(
         extras=done.extras,
         settings=settings,
     )
+
+
+def _settings(settings: Any) -> Settings:
+    if settings is None:
+        return Settings()
+    if isinstance(settings, Settings):
+        return settings
+    if isinstance(settings, Mapping):
+        return from_dict(settings)
+    raise InputError(
+        f"settings must be a Settings or a mapping of sections, got {type(settings).__name__} "
+        "(to read a file, use symfruit.resolve_settings(config=path))"
+    )
+
+
+def _camera(camera: Any) -> Camera:
+    if camera is None:
+        return DEFAULT_CAMERA
+    if isinstance(camera, Camera):
+        return camera
+    if isinstance(camera, Mapping):
+        from .io.intrinsics import camera_from_dict
+
+        return camera_from_dict(camera)
+    raise InputError(f"camera must be a Camera or a mapping of intrinsics, got {type(camera).__name__}")

@@ -1,70 +1,75 @@
-"""``symfruit demo``: detect the fruit of the shipped example frame and compare with its truth."""
+"""``symfruit demo``: detect the fruit of the shipped example frame and compare them with its truth.
+
+The frame ships as package data (``symfruit/data/example_frame``), so the demo runs from any folder
+however symfruit was installed; ``examples/make_sample.py`` regenerates it from :data:`FRAME_SEED`.
+"""
 
 from __future__ import annotations
 
+import contextlib
+from collections.abc import Iterator
+from dataclasses import dataclass
+from importlib import resources
 from pathlib import Path
 
 import numpy as np
 
-from .box import centre_deviation
-from .config import Settings
-from .detect import detect, write_detections
-from .errors import FileFormatError
+from .core.box import centre_deviation
+from .detect import Detection, FrameDetections, detect
 from .evaluate.frames import match
 from .io.frames import read_frame
+from .settings import Settings
+from .writers import write_detections
 
-__all__ = ["example_frame", "run_demo"]
+__all__ = ["FRAME_SEED", "DemoReport", "example_frame", "run_demo"]
 
-
-def example_frame() -> Path:
-    """The shipped example frame: ``examples/frame`` of the source tree (or of the working folder)."""
-    for base in (Path.cwd(), Path(__file__).resolve().parents[2]):
-        folder = base / "examples" / "frame"
-        if (folder / "color.png").is_file():
-            return folder
-    raise FileFormatError("the example frame (examples/frame) is not here; run from a clone of the repository")
+#: Seed of the shipped frame (:func:`symfruit.scenes.make_scene`: touching fruit, leaves in front).
+FRAME_SEED = 1
 
 
-def run_demo(output: Path, *, method: str = "fused", fruit: str | None = "strawberry") -> int:
-    """Detect, write the outputs, print a per-fruit table; returns the exit status."""
-    frame = read_frame(example_frame())
-    settings = Settings()
-    if fruit:
-        from .profiles import load_profile
+@contextlib.contextmanager
+def example_frame() -> Iterator[Path]:
+    """The shipped example frame folder, as a real path for the duration of the ``with`` block."""
+    with resources.as_file(resources.files("symfruit") / "data" / "example_frame") as path:
+        yield Path(path)
 
-        settings = load_profile(fruit)
+
+@dataclass(frozen=True)
+class DemoReport:
+    """What the demo found: the detections, the ripe fruit of the truth, and per-fruit centre errors
+    (mm) of the visible box and of the completed box against the matched true fruit (None: unmatched)."""
+
+    found: FrameDetections
+    n_truth: int
+    errors: dict[int, tuple[float, float] | None]
+    output: Path
+
+    @property
+    def located(self) -> list[Detection]:
+        return [d for d in self.found.detections if d.result is not None]
+
+    def mean_errors(self) -> tuple[float, float] | None:
+        """Mean centre error (mm) of the raw and the completed boxes over the matched fruit."""
+        pairs = [e for e in self.errors.values() if e is not None]
+        return (float(np.mean([p[0] for p in pairs])), float(np.mean([p[1] for p in pairs]))) if pairs else None
+
+
+def run_demo(output: str | Path, *, method: str = "fused", settings: Settings | None = None) -> DemoReport:
+    """Detect the example frame's fruit, write the outputs to ``output``, score them against the truth."""
+    output = Path(output)
+    with example_frame() as folder:
+        frame = read_frame(folder)
+    settings = settings or Settings()
     found = detect(frame, method=method, settings=settings)
     write_detections(output, found, settings=settings)
     truth = frame.truth or []
     ok = [d for d in found.detections if d.result is not None]
     pairs = dict(match([d.visible_box for d in ok], [b for _, b in truth]))
-    print(f"symfruit demo: {frame.name} ({frame.camera.width}x{frame.camera.height}), "
-          f"{len(found.detections)} fruit found, {len(truth)} ripe fruit in the truth, method {method}")  # fmt: skip
-    print(f"{'fruit':>5} {'points':>6}  {'centre x, y, z (mm)':<24} {'size x, y, z (mm)':<20} "
-          f"{'raw err':>8} {'completed err':>13}")  # fmt: skip
-    raw_err, done_err = [], []
+    errors: dict[int, tuple[float, float] | None] = {}
     for i, d in enumerate(ok):
-        c, s = d.result.centre * 1000, d.result.box.size * 1000
-        line = f"{d.id:>5} {len(d.extraction.points):>6}  {c[0]:7.1f} {c[1]:7.1f} {c[2]:7.1f}  "
-        line += f"{s[0]:5.1f} {s[1]:5.1f} {s[2]:5.1f}  "
-        if i in pairs:
+        if i in pairs and d.result is not None and d.visible_box is not None:
             tbox = truth[pairs[i]][1]
-            e_raw = centre_deviation(d.visible_box, tbox) * 1000
-            e_done = centre_deviation(d.result.box, tbox) * 1000
-            raw_err.append(e_raw)
-            done_err.append(e_done)
-            line += f"{e_raw:6.1f} mm {e_done:10.1f} mm"
+            errors[d.id] = (centre_deviation(d.visible_box, tbox) * 1000, centre_deviation(d.result.box, tbox) * 1000)
         else:
-            line += f"{'-':>8} {'-':>13}  (no true fruit matched)"
-        print(line + (" (truncated)" if d.extraction.truncated else ""))
-    for d in found.detections:
-        if d.result is None:
-            print(f"{d.id:>5} failed: {d.error}")
-    if raw_err:
-        print(f"mean centre error: raw {np.mean(raw_err):.1f} mm, completed {np.mean(done_err):.1f} mm")
-    print(f"time: {found.timings['total'] * 1000:.0f} ms (segment {found.timings['segment'] * 1000:.0f}, "
-          f"extract {found.timings['extract'] * 1000:.0f}, "
-          f"complete {found.timings['complete'] * 1000:.0f})")  # fmt: skip
-    print(f"overlay: {output / 'overlay.png'}")
-    print(f"detections: {output / 'detections.json'}")
-    return 0
+            errors[d.id] = None
+    return DemoReport(found=found, n_truth=len(truth), errors=errors, output=output)

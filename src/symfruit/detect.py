@@ -1,8 +1,8 @@
-"""The per-frame job of a harvesting robot: masks -> points -> completion -> boxes -> outputs.
+"""The per-frame job of a harvesting robot: masks -> points -> completion -> boxes.
 
-``detect(frame)`` finds the fruit of one RGB-D frame; ``write_detections`` writes what a robot and a
-person need: ``detections.json`` (laid out to map one-to-one onto ROS 2 ``vision_msgs/Detection3D``),
-each fruit's completed cloud as PLY, and an overlay PNG.
+``detect(frame)`` finds, extracts, completes and boxes the fruit of one RGB-D frame and returns them as
+:class:`FrameDetections`; :mod:`symfruit.writers` turns that into files (``detections.json``, PLYs, an
+overlay) and the ROS node into messages.
 """
 
 from __future__ import annotations
@@ -11,22 +11,22 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from .box import Box
 from .complete import Result, complete
-from .config import Settings
-from .errors import FileFormatError, InputError, SymfruitError
+from .core.box import Box
+from .core.camera import Camera
+from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
-from .io.frames import Frame
+from .frame import Frame
 from .segment import segment
+from .settings import Settings
 
-__all__ = ["Detection", "FrameDetections", "detect", "frame_masks", "write_detections"]
+__all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
 
-#: ``frame_id`` written into detections.json: the colour camera's optical frame (REP-103).
-OPTICAL_FRAME = "camera_color_optical_frame"
+#: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
+MAX_FRUIT_PER_FRAME = 1000
 
 
 @dataclass(frozen=True)
@@ -44,37 +44,6 @@ class Detection:
         pts = self.extraction.points
         return Box.from_points(pts) if len(pts) else None
 
-    def to_dict(self) -> dict[str, Any]:
-        """One entry of ``detections.json``; ``bbox`` is a ``vision_msgs/BoundingBox3D``."""
-        ex = self.extraction
-        out: dict[str, Any] = {
-            "id": self.id, "mask_area": ex.mask_area, "n_points": len(ex.points), "truncated": ex.truncated,
-            "n_invalid_depth": ex.n_invalid, "n_dropped_clusters": ex.n_other_clusters,
-        }  # fmt: skip
-        if self.error or self.result is None:
-            return {**out, "error": self.error}
-        r = self.result
-        c, size = r.box.centre, r.box.size
-        out.update(
-            centre=c.tolist(),
-            box=r.box.to_dict(),
-            visible_box=self.visible_box.to_dict(),
-            bbox={
-                "center": {
-                    "position": dict(zip("xyz", c.tolist(), strict=True)),
-                    "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
-                },
-                "size": dict(zip("xyz", size.tolist(), strict=True)),
-            },
-            method=r.method,
-            plane=None if r.plane is None else r.plane.to_dict(),
-            score=None if not np.isfinite(r.score) else float(r.score),
-            seconds=r.seconds,
-            confidence=r.confidence,
-            reliable=r.reliable,
-        )
-        return out
-
 
 @dataclass(frozen=True)
 class FrameDetections:
@@ -84,19 +53,6 @@ class FrameDetections:
     detections: list[Detection]
     timings: dict[str, float] = field(default_factory=dict)
     mask_source: str = ""
-
-    def to_dict(self) -> dict[str, Any]:
-        """``detections.json``: a ``vision_msgs/Detection3DArray``-like object with symfruit's extras."""
-        return {
-            "frame": self.frame.name,
-            "source": self.frame.source,
-            "header": {"frame_id": OPTICAL_FRAME},
-            "camera": self.frame.camera.to_dict(),
-            "units": "metres",
-            "mask_source": self.mask_source,
-            "timings": self.timings,
-            "fruits": [d.to_dict() for d in self.detections],
-        }
 
 
 Segmenter = Callable[[Frame, Settings], np.ndarray]
@@ -150,6 +106,15 @@ def detect(
     t1 = time.perf_counter()
     if not (frame.depth > 0).any():
         raise InputError(f"frame {frame.name}: the depth image holds no valid depth")
+    if labels.size and labels.min() < 0:
+        raise InputError(f"frame {frame.name}: masks hold negative labels")
+    if labels.size and int(labels.max()) > MAX_FRUIT_PER_FRAME:  # sparse ids: number them 1..k first
+        values, inverse = np.unique(labels, return_inverse=True)
+        count = len(values) - int(values[0] == 0)
+        if count > MAX_FRUIT_PER_FRAME:
+            raise InputError(f"frame {frame.name}: masks hold {count} instances; at most {MAX_FRUIT_PER_FRAME} "
+                             "fruit per frame are read")  # fmt: skip
+        labels = (inverse.reshape(labels.shape) + int(values[0] != 0)).astype(np.int32)
     detections, t_extract, t_complete = [], 0.0, 0.0
     from scipy import ndimage
 
@@ -187,85 +152,8 @@ def _extract_window(mask: np.ndarray, sl: tuple[slice, slice], frame: Frame, set
     pad = settings.extract.erode_px + 1
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-    from .camera import Camera
-
     cam = frame.camera
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
     ex = extract(mask[r0:r1, c0:c1], frame.depth[r0:r1, c0:c1], local, settings.extract)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated)
-
-
-def write_detections(folder: str | Path, found: FrameDetections, *, settings: Settings | None = None) -> list[Path]:
-    """Write ``detections.json``, ``fruit_<id>.ply`` per completed fruit and ``overlay.png``, atomically."""
-    from .io import write_json, write_ply
-    from .io.atomic import atomic_write
-
-    folder = Path(folder)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FileFormatError(f"{folder}: cannot create output folder ({exc.strerror or exc})") from None
-    written = []
-    for d in found.detections:
-        if d.result is not None:
-            path = folder / f"fruit_{d.id:03d}.ply"
-            n_vis = len(d.result.visible)
-            labels = np.r_[np.zeros(n_vis, np.uint8), np.ones(len(d.result.points) - n_vis, np.uint8)]
-            write_ply(path, d.result.points, labels=labels)
-            written.append(path)
-    overlay = draw_overlay(found)
-    with atomic_write(folder / "overlay.png", "wb") as handle:
-        overlay.save(handle, format="PNG")
-    written.append(folder / "overlay.png")
-    data = found.to_dict()
-    if settings is not None:
-        data["settings"] = settings.to_dict()
-    write_json(folder / "detections.json", data)  # last: its presence marks the frame as done
-    written.append(folder / "detections.json")
-    return written
-
-
-_EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
-VISIBLE_COLOUR = (255, 170, 0)
-COMPLETED_COLOUR = (0, 220, 255)
-
-
-def draw_overlay(found: FrameDetections):
-    """The colour image with each fruit's mask, the box of its visible points (orange) and of the
-    completed fruit (cyan) as projected wireframe cuboids, and the completed centre marked."""
-    from PIL import Image, ImageDraw
-
-    frame = found.frame
-    image = frame.color.astype(np.float32)
-    palette = np.array([[230, 25, 75], [60, 180, 75], [255, 225, 25], [67, 99, 216], [245, 130, 49],
-                        [145, 30, 180], [70, 240, 240], [240, 50, 230], [188, 246, 12], [250, 190, 190]])  # fmt: skip
-    for i, d in enumerate(found.detections):
-        image[d.mask] = 0.55 * image[d.mask] + 0.45 * palette[i % len(palette)]
-    img = Image.fromarray(np.clip(image, 0, 255).astype(np.uint8))
-    draw = ImageDraw.Draw(img)
-    cam = frame.camera
-    for d in found.detections:
-        boxes = [(d.visible_box, VISIBLE_COLOUR)] if d.visible_box is not None else []
-        if d.result is not None:
-            boxes.append((d.result.box, COMPLETED_COLOUR))
-        for box, colour in boxes:
-            uv = cam.project(box.corners())
-            for a, b in _EDGES:
-                draw.line([tuple(uv[a]), tuple(uv[b])], fill=colour, width=1)
-        rows, cols = np.nonzero(d.mask)
-        label_at = (int(cols.min()), max(int(rows.min()) - 12, 0))
-        if d.result is not None:
-            u, v = cam.project(d.result.centre[None])[0]
-            draw.line([(u - 4, v), (u + 4, v)], fill=COMPLETED_COLOUR, width=2)
-            draw.line([(u, v - 4), (u, v + 4)], fill=COMPLETED_COLOUR, width=2)
-            z = d.result.centre[2] * 1000
-            draw.text(
-                label_at,
-                f"{d.id}: {z:.0f} mm" + (" (cut)" if d.extraction.truncated else ""),
-                fill=(255, 255, 255),
-            )
-        else:
-            draw.text(label_at, f"{d.id}: failed", fill=(255, 80, 80))
-    draw.text((5, cam.height - 14), "orange: visible points   cyan: completed fruit", fill=(255, 255, 255))
-    return img

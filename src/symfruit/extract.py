@@ -9,10 +9,47 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .camera import Camera
-from .config import ExtractSettings
+from .core.camera import Camera
+from .settings import Section, SettingError, register_section, setting
 
-__all__ = ["Extraction", "cluster", "extract"]
+__all__ = ["ExtractSettings", "Extraction", "cluster", "extract"]
+
+#: Largest border erosion a setting may ask for (pixels).
+MAX_RADIUS_PX = 50
+
+
+@dataclass(frozen=True)
+class ExtractSettings(Section):
+    """Turning a mask into the fruit's points (:mod:`symfruit.extract`).
+
+    Attributes
+    ----------
+    min_depth, max_depth : float, metres
+        Depth outside this range is invalid (the D435 reads from about 0.1 m).
+    erode_px : int
+        Pixels dropped along the mask's border, where flying pixels (depth mixed with the background)
+        sit.
+    cluster_distance : float, metres
+        Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
+        cluster nearest the camera among those with at least ``cluster_share`` of the largest's points.
+    cluster_share : float
+    min_points : int
+        A fruit with fewer points left is reported as failed.
+    """
+
+    min_depth: float = setting(0.1, ge=0.0, le=100.0)
+    max_depth: float = setting(2.0, gt=0.0, le=100.0)
+    erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
+    cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
+    cluster_share: float = setting(0.3, gt=0.0, le=1.0)
+    min_points: int = setting(30, ge=4, le=1_000_000)
+
+    def check(self) -> None:
+        if self.min_depth >= self.max_depth:
+            raise SettingError("min_depth", "must be smaller than max_depth")
+
+
+register_section("extract", ExtractSettings)
 
 
 @dataclass(frozen=True)

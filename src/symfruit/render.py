@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .camera import Camera
+from .core.camera import Camera
 
 __all__ = ["Rendering", "SensorNoise", "render"]
 
@@ -48,18 +48,19 @@ def render(meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_c
     Rendering
     """
     h, w = camera.height, camera.width
-    tris, owner = [], []
+    tris: list[np.ndarray] = []
+    owners: list[np.ndarray] = []
     for k, (vertices, faces) in enumerate(meshes):
         if len(faces):
             tris.append(np.asarray(vertices, dtype=np.float64)[np.asarray(faces)])
-            owner.append(np.full(len(faces), k))
+            owners.append(np.full(len(faces), k))
     zbuf = np.full(h * w, np.inf)
     ids = np.full(h * w, -1)
     facing = np.zeros(h * w)
     if not tris:
         return Rendering(zbuf.reshape(h, w), ids.reshape(h, w), facing.reshape(h, w))
     tri = np.concatenate(tris)
-    owner = np.concatenate(owner)
+    owner = np.concatenate(owners)
     keep = (tri[:, :, 2] > 1e-3).all(axis=1)
     tri, owner = tri[keep], owner[keep]
     uv = camera.project(tri)  # (t, 3, 2)
@@ -79,7 +80,9 @@ def render(meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_c
 
     # Batch triangles by the side of their pixel box so the candidate grids stay small.
     sides = size.max(axis=1)
-    cand_pix, cand_z, cand_t = [], [], []
+    cand_pix: list[np.ndarray] = []
+    cand_z: list[np.ndarray] = []
+    cand_t: list[np.ndarray] = []
     for side in np.unique(sides):
         group = np.flatnonzero(sides == side)
         per_batch = max(1, max_candidates // int(side * side))

@@ -14,8 +14,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from .box import Box
-from .camera import DEFAULT_CAMERA, Camera
+from .core.box import Box
+from .core.camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
 from .shapes import leaf_outline, rotation, strawberry
 

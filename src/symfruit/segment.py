@@ -8,13 +8,67 @@ of regions too small to be a fruit at their depth.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+from typing import Literal
+
 import numpy as np
 from scipy import ndimage
 
-from .camera import Camera
-from .config import SegmentSettings
+from .core.camera import Camera
+from .settings import Section, register_section, setting
 
-__all__ = ["red_mask", "segment"]
+__all__ = ["SegmentSettings", "red_mask", "segment"]
+
+#: Largest morphology or smoothing radius a setting may ask for (pixels).
+MAX_RADIUS_PX = 50
+
+
+@dataclass(frozen=True)
+class SegmentSettings(Section):
+    """The built-in colour segmenter (:mod:`symfruit.segment`): ripe red fruit, no weights needed.
+
+    Attributes
+    ----------
+    hue_low, hue_high : float, degrees
+        Red hues wrap around 0: a pixel is red when its hue is >= ``hue_low`` or <= ``hue_high``.
+    sat_min, val_min : float in [0, 1]
+        Least saturation and value (brightness) of a ripe fruit pixel; unripe (white, green) fruit fail.
+    open_px, close_px : int
+        Radii of the disc opening (removes specks) and closing (fills seeds, glints and the gaps
+        thin stems cut).
+    min_diameter : float, metres
+        Regions smaller than a fruit of this diameter would look at their depth are ignored.
+    split : {"both", "depth", "watershed", "none"}
+        How touching fruit are split: at depth discontinuities, by a distance-transform watershed
+        when the region has a waist, both, or not at all.
+    depth_jump : float, metres
+        A depth step between neighbouring pixels larger than this separates two fruit.
+    crease_curvature : float, 1/metres
+        A seam between touching fruit at the same depth shows as a concave crease of the depth
+        surface: the smoothed depth's Laplacian below ``-crease_curvature`` (in metres per metre
+        squared) separates fruit. Convex fruit surfaces never reach it.
+    crease_sigma : float, pixels
+        Smoothing of the depth before the crease test (the sensor noise must not look like creases).
+    waist : float
+        Split two distance-transform peaks only if the region between them narrows below this share
+        of the smaller peak's width.
+    """
+
+    hue_low: float = setting(340.0, ge=0.0, le=360.0)
+    hue_high: float = setting(15.0, ge=0.0, le=360.0)
+    sat_min: float = setting(0.45, ge=0.0, le=1.0)
+    val_min: float = setting(0.15, ge=0.0, le=1.0)
+    open_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
+    close_px: int = setting(2, ge=0, le=MAX_RADIUS_PX)
+    min_diameter: float = setting(0.012, gt=0.0, le=1.0)
+    split: Literal["both", "depth", "watershed", "none"] = setting("both")
+    depth_jump: float = setting(0.015, gt=0.0, le=10.0)
+    crease_curvature: float = setting(1500.0, gt=0.0, le=1e7)
+    crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
+    waist: float = setting(0.75, gt=0.0, le=1.0)
+
+
+register_section("segment", SegmentSettings)
 
 
 def red_mask(color: np.ndarray, settings: SegmentSettings | None = None) -> np.ndarray:

@@ -6,14 +6,12 @@
 
 from __future__ import annotations
 
-import datetime as _dt
-import os
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from ..config import Settings
+from ..settings import Settings
 from .protocols import PAPER_ANGLES, Spec, build, specs
 from .report import markdown_table, write_results
 from .runner import Row, run, summarise
@@ -21,7 +19,7 @@ from .runner import Row, run, summarise
 __all__ = ["Evaluation", "Row", "Spec", "build", "evaluate", "markdown_table", "run", "specs", "summarise"]
 
 #: ``--quick``: a handful of instances, well under a minute.
-QUICK = {"paper": {"n": 4, "angles": (-45, -30, -15, 0, 15, 30, 45)}, "camera": {"n": 8}}
+QUICK: dict[str, dict[str, Any]] = {"paper": {"n": 4, "angles": (-45, -30, -15, 0, 15, 30, 45)}, "camera": {"n": 8}}
 
 
 @dataclass(frozen=True)
@@ -58,14 +56,13 @@ def evaluate(
     Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
     (:mod:`symfruit.profiles`), with the settings file ``config`` laid over it.
     """
-    from ..config import load_settings
-    from ..profiles import available_profiles, load_profile
+    from ..profiles import available_profiles
+    from ..settings import resolve_settings
 
     def settings_for(fruit: str) -> Settings:
         if settings is not None:
             return settings
-        base = load_profile(fruit) if fruit in available_profiles() else Settings()
-        return load_settings(config, base=base) if config else base
+        return resolve_settings(fruit=fruit if fruit in available_profiles() else None, config=config)
 
     angles = tuple(QUICK["paper"]["angles"]) if quick and protocol == "paper" else PAPER_ANGLES
     if n is None:
@@ -89,8 +86,10 @@ def evaluate(
             table += f"| {s['centre_mm_mean']:.1f} | {s['centre_mm_top80']:.1f} | {s['reliable_share']:.0%} |\n"
     folder = None
     if output is not None:
-        folder = _new_folder(Path(output), protocol)
         from .. import __version__
+        from ..writers import new_results_folder
+
+        folder = new_results_folder(output, protocol)
 
         meta = {
             "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
@@ -101,28 +100,4 @@ def evaluate(
 
         write_json(folder / "settings.json", meta)
         write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled}, table=table)
-        _link_latest(folder)
     return Evaluation(folder=folder, rows=rows, summary=summary, table=table)
-
-
-def _new_folder(root: Path, protocol: str) -> Path:
-    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
-    folder = root / f"{stamp}-{protocol}"
-    k = 1
-    while folder.exists():
-        k += 1
-        folder = root / f"{stamp}-{protocol}-{k}"
-    folder.mkdir(parents=True)
-    return folder
-
-
-def _link_latest(folder: Path) -> None:
-    link = folder.parent / "latest"
-    tmp = folder.parent / f".latest-{os.getpid()}"
-    try:
-        if tmp.is_symlink() or tmp.exists():
-            tmp.unlink()
-        tmp.symlink_to(folder.name)
-        os.replace(tmp, link)
-    except OSError:  # file systems without symlinks: the timestamped folder is still there
-        pass

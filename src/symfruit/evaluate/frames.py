@@ -15,12 +15,13 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from ..box import Box, box_iou, centre_deviation
 from ..complete import complete
-from ..config import Settings
+from ..core.box import Box, box_iou, centre_deviation
 from ..detect import FrameDetections, detect
 from ..errors import SymfruitError
-from ..io.frames import Frame, iter_frames
+from ..frame import Frame
+from ..io.sources import open_source
+from ..settings import Settings
 
 __all__ = ["FrameScore", "evaluate_frames", "match"]
 
@@ -39,11 +40,13 @@ class FrameScore:
     truncated: bool
 
 
-def match(found: Sequence[Box], truth: Sequence[Box], gate: float = 0.03) -> list[tuple[int, int]]:
-    """Pairs ``(found index, truth index)`` minimising total centre distance, each within ``gate``."""
+def match(found: Sequence[Box | None], truth: Sequence[Box], gate: float = 0.03) -> list[tuple[int, int]]:
+    """Pairs ``(found index, truth index)`` minimising total centre distance, each within ``gate`` metres
+    (a ``None`` among ``found`` matches nothing)."""
     if not found or not truth:
         return []
-    cost = np.array([[np.linalg.norm(f.centre - t.centre) for t in truth] for f in found])
+    far = np.inf
+    cost = np.array([[far if f is None else np.linalg.norm(f.centre - t.centre) for t in truth] for f in found])
     rows, cols = linear_sum_assignment(np.where(cost <= gate, cost, 1e6))
     return [(int(r), int(c)) for r, c in zip(rows, cols, strict=True) if cost[r, c] <= gate]
 
@@ -86,23 +89,25 @@ def evaluate_frames(
     scores: list[FrameScore] = []
     totals = {"frames": 0, "truth": 0, "found": 0, "matched": 0, "missed": 0, "false": 0}
     failed: dict[str, str] = {}
-    for name, frame in iter_frames(source):
-        if isinstance(frame, Exception):
-            failed[name] = str(frame)
-            continue
-        if frame.truth is None:
-            failed[name] = "no truth.json"
-            continue
-        try:
-            found = detect(frame, masks=masks, method="raw", settings=settings)
-        except SymfruitError as exc:
-            failed[name] = str(exc)
-            continue
-        s, counts = score_frame(frame, found, methods, settings, gate)
-        scores += s
-        totals["frames"] += 1
-        for k, v in counts.items():
-            totals[k] += v
+    src = open_source(source)
+    try:
+        for index, name in enumerate(src.names()):
+            try:
+                frame = src.read(index)
+                if frame.truth is None:
+                    failed[name] = "no truth.json"
+                    continue
+                found = detect(frame, masks=masks, method="raw", settings=settings)
+            except SymfruitError as exc:
+                failed[name] = str(exc)
+                continue
+            s, counts = score_frame(frame, found, methods, settings, gate)
+            scores += s
+            totals["frames"] += 1
+            for k, v in counts.items():
+                totals[k] += v
+    finally:
+        src.close()
     return scores, totals, failed
 
 

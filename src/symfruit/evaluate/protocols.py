@@ -26,8 +26,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..box import Box
-from ..camera import DEFAULT_CAMERA, Camera
+from ..core.box import Box
+from ..core.camera import DEFAULT_CAMERA, Camera
 from ..render import SensorNoise, render
 from ..shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 

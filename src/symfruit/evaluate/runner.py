@@ -11,10 +11,10 @@ from typing import Any
 import numpy as np
 
 from ..complete import complete
-from ..config import Settings
 from ..errors import SymfruitError
 from ..metrics import score_completion
 from ..progress import Progress
+from ..settings import Settings
 from .protocols import Spec, build
 
 __all__ = ["Row", "run"]
@@ -62,7 +62,7 @@ class Row:
 def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
     """Build one instance and run every method on it (runs in a worker process)."""
     inst = build(spec)
-    base = dict(
+    base: dict[str, Any] = dict(
         protocol=spec.protocol, fruit=spec.fruit, kind=inst.kind, fruit_index=spec.index, pose=spec.pose,
         angle_x=inst.angles[0], angle_y=inst.angles[1], angle_z=inst.angles[2], distance_m=inst.distance,
         occlusion=spec.occlusion, hidden=inst.hidden, n_visible=len(inst.visible),
@@ -127,7 +127,7 @@ def _single_thread() -> None:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     try:  # numpy is already imported in a forked worker: limit its pools directly where possible
-        from threadpoolctl import threadpool_limits  # type: ignore[import-not-found]
+        from threadpoolctl import threadpool_limits
 
         threadpool_limits(1)
     except ImportError:

@@ -1,24 +1,38 @@
 """Frames from ROS 1 / ROS 2 bags, through the pure-Python ``rosbags`` package (optional extra ``bag``).
 
-Colour (``sensor_msgs/Image`` rgb8/bgr8/rgba8/bgra8, or ``CompressedImage``), depth (``Image`` 16UC1 in
-millimetres or 32FC1 in metres) and ``CameraInfo`` topics are found by type and name (a topic whose
-name contains "depth" is depth); each depth image is paired with the colour image nearest in time
-(within ``max_skew``) and the latest camera info.
+Colour (``sensor_msgs/Image`` rgb8/bgr8/rgba8/bgra8/mono8, or ``CompressedImage``), depth (``Image``
+16UC1 in millimetres or 32FC1 in metres) and ``CameraInfo`` topics are found by type and name (a topic
+whose name contains "depth" is depth). Each depth image is one frame, paired with the colour image nearest
+in time (within ``max_skew``) and the latest camera info at or before it.
+
+The bag is indexed once (timestamps only; the raw message bytes pass through without being kept or
+decoded) and each frame is then decoded on demand, so memory stays flat however long the recording.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterator
+import bisect
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from ..errors import FileFormatError, SymfruitError
+from ..core.camera import Camera
+from ..errors import FileFormatError, InputError, SymfruitError
+from ..frame import Frame
 
-__all__ = ["iter_bag"]
+__all__ = ["BagSource", "image_array"]
+
+_ENCODINGS: dict[str, tuple[type, int]] = {
+    "rgb8": (np.uint8, 3), "bgr8": (np.uint8, 3), "rgba8": (np.uint8, 4), "bgra8": (np.uint8, 4),
+    "mono8": (np.uint8, 1), "8uc1": (np.uint8, 1), "8uc3": (np.uint8, 3), "16uc1": (np.uint16, 1),
+    "mono16": (np.uint16, 1), "32fc1": (np.float32, 1),
+}  # fmt: skip
+#: Largest image a message may claim (pixels), checked before its data is touched.
+MAX_MESSAGE_PIXELS = 40_000_000
 
 
-def _require_rosbags():
+def _require_rosbags() -> Any:
     try:
         from rosbags.highlevel import AnyReader
     except ImportError:
@@ -28,82 +42,174 @@ def _require_rosbags():
     return AnyReader
 
 
-def _to_array(msg, typename: str) -> np.ndarray:
+def image_array(msg: Any, typename: str) -> np.ndarray:
+    """The pixels of a ``sensor_msgs/Image`` or ``CompressedImage``: ``(h, w)`` or ``(h, w, 3)``.
+
+    Colour comes back RGB (``bgr*`` reordered, alpha dropped, ``mono8`` stays one channel); depth keeps
+    its dtype (uint16 units or float32 metres).
+
+    Raises
+    ------
+    FileFormatError
+        For an unknown encoding, a ``compressedDepth`` image, a size that is not positive or too large,
+        or data shorter than ``height x step``.
+    """
     if typename.endswith("CompressedImage"):
-        import io
+        fmt = str(getattr(msg, "format", ""))
+        if "compresseddepth" in fmt.lower():
+            raise FileFormatError(f"compressedDepth images ({fmt!r}) are not supported; record raw depth")
+        from .images import decode_color
 
-        from PIL import Image
-
-        return np.asarray(Image.open(io.BytesIO(bytes(msg.data))).convert("RGB"))
-    enc = msg.encoding.lower()
-    dtype, channels = {
-        "rgb8": (np.uint8, 3), "bgr8": (np.uint8, 3), "rgba8": (np.uint8, 4), "bgra8": (np.uint8, 4),
-        "mono8": (np.uint8, 1), "16uc1": (np.uint16, 1), "mono16": (np.uint16, 1), "32fc1": (np.float32, 1),
-    }.get(enc, (None, 0))  # fmt: skip
-    if dtype is None:
-        raise FileFormatError(f"unsupported image encoding {msg.encoding!r}")
+        return decode_color(bytes(msg.data), "compressed image")
+    enc = str(msg.encoding).lower()
+    if enc not in _ENCODINGS:
+        raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of {', '.join(_ENCODINGS)})")
+    dtype, channels = _ENCODINGS[enc]
+    h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
+        raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
     dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
-    row = np.frombuffer(bytes(msg.data), dtype=np.uint8).reshape(msg.height, msg.step)
-    img = row[:, : msg.width * channels * dt.itemsize].copy().view(dt).reshape(msg.height, msg.width, channels)
-    img = img.astype(dtype)
+    row_bytes = w * channels * dt.itemsize
+    if step < row_bytes:
+        raise FileFormatError(f"image step {step} is shorter than a row of {w} {enc} pixels ({row_bytes} bytes)")
+    data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
+    if len(data) < h * step:
+        raise FileFormatError(f"image data holds {len(data)} bytes, {h} rows of {step} need {h * step}")
+    rows = data[: h * step].reshape(h, step)
+    img = rows[:, :row_bytes].copy().view(dt).reshape(h, w, channels).astype(dtype)
     if enc.startswith("bgr"):
         img = img[:, :, [2, 1, 0]]
     return img[:, :, 0] if channels == 1 else img[:, :, :3]
 
 
-def iter_bag(path: Path, *, max_skew: float = 0.05) -> Iterator[tuple[str, object]]:
-    """Yield ``(name, Frame or error)`` for every depth image of the bag that has a colour partner."""
-    from ..camera import Camera
-    from .frames import Frame
+def _camera(msg: Any) -> Camera:
+    k = [float(v) for v in getattr(msg, "k", getattr(msg, "K", []))]
+    if len(k) != 9:
+        raise InputError("CameraInfo has no 3x3 K matrix")
+    return Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(msg.width), height=int(msg.height))
 
-    reader_cls = _require_rosbags()
-    try:
-        reader = reader_cls([path])
-        reader.open()
-    except Exception as exc:  # rosbags raises its own ReaderError / AnyReaderError types
-        raise FileFormatError(f"{path}: cannot open bag ({exc})") from None
-    try:
-        conns = reader.connections
+
+def _stamp(msg: Any, fallback: int) -> int:
+    """The header stamp in nanoseconds (``sec``/``nanosec`` or ``secs``/``nsecs``), else ``fallback``."""
+    stamp = getattr(getattr(msg, "header", None), "stamp", None)
+    if stamp is None:
+        return fallback
+    sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
+    nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
+    value = int(sec) * 1_000_000_000 + int(nsec)
+    return value if value > 0 else fallback
+
+
+class BagSource:
+    """A bag as a recording: one frame per depth image (see the module docstring)."""
+
+    def __init__(self, path: Path, *, max_skew: float = 0.05) -> None:
+        self.path = Path(path)
+        self.max_skew = max_skew
+        reader_cls = _require_rosbags()
+        try:
+            self._reader = reader_cls([self.path])
+            self._reader.open()
+        except Exception as exc:  # rosbags raises its own ReaderError / AnyReaderError types
+            raise FileFormatError(f"{self.path}: cannot open bag ({exc})") from None
+        try:
+            self._index()
+        except SymfruitError as exc:
+            self.close()
+            raise FileFormatError(f"{self.path}: {exc}") from None
+        except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
+            self.close()
+            raise FileFormatError(f"{self.path}: cannot index bag ({type(exc).__name__}: {exc})") from None
+
+    def _index(self) -> None:
+        conns = self._reader.connections
         info = [c for c in conns if c.msgtype.endswith("CameraInfo")]
         images = [c for c in conns if c.msgtype.endswith(("/Image", "/CompressedImage"))]
-        depth_c = [c for c in images if "depth" in c.topic.lower()]
-        color_c = [c for c in images if "depth" not in c.topic.lower()]
-        if not depth_c or not color_c:
-            raise FileFormatError(f"{path}: bag needs a colour and a depth image topic (topics: "
-                                  f"{', '.join(c.topic for c in conns)})")  # fmt: skip
-        colours: list[tuple[int, object, str]] = []
-        depths: list[tuple[int, object, str]] = []
-        camera = None
-        for conn, stamp, raw in reader.messages(connections=info + depth_c[:1] + color_c[:1]):
+        depth = [c for c in images if "depth" in c.topic.lower()]
+        color = [c for c in images if "depth" not in c.topic.lower()]
+        if not depth or not color:
+            raise FileFormatError(f"bag needs a colour and a depth image topic (topics: "
+                                  f"{', '.join(c.topic for c in conns) or 'none'})")  # fmt: skip
+        if not info:
+            raise FileFormatError("bag has no CameraInfo topic")
+        self._depth, self._color = depth[0], color[0]
+        self._depth_stamps: list[int] = []
+        self._color_stamps: list[int] = []
+        self._cameras: list[tuple[int, Camera | str]] = []  # (stamp, camera or why it is invalid), on change
+        last: Any = None
+        for conn, stamp, raw in self._reader.messages(connections=[*info, self._depth, self._color]):
+            if conn == self._depth:
+                self._depth_stamps.append(stamp)
+            elif conn == self._color:
+                self._color_stamps.append(stamp)
+            elif bytes(raw) != last:
+                last = bytes(raw)
+                try:
+                    camera: Camera | str = _camera(self._reader.deserialize(raw, conn.msgtype))
+                except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
+                    camera = f"invalid CameraInfo on {conn.topic} ({exc})"
+                self._cameras.append((stamp, camera))
+        if not self._color_stamps:
+            raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
+        self._camera_stamps = [s for s, _ in self._cameras]
+
+    def __len__(self) -> int:
+        return len(self._depth_stamps)
+
+    def names(self) -> list[str]:
+        return [f"{self.path.stem}_{i:05d}_{s}" for i, s in enumerate(self._depth_stamps)]
+
+    def _message(self, conn: Any, stamp: int) -> Any:
+        for _, _, raw in self._reader.messages(connections=[conn], start=stamp, stop=stamp + 1):
             try:
-                msg = reader.deserialize(raw, conn.msgtype)
+                return self._reader.deserialize(raw, conn.msgtype)
             except Exception as exc:
-                raise FileFormatError(f"{path}: corrupt message on {conn.topic} ({exc})") from None
-            if conn in info:
-                k = list(getattr(msg, "k", getattr(msg, "K", [])))
-                camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=msg.width, height=msg.height)
-            elif conn in depth_c:
-                depths.append((stamp, msg, conn.msgtype))
-            else:
-                colours.append((stamp, msg, conn.msgtype))
-    finally:
-        reader.close()
-    if camera is None:
-        raise FileFormatError(f"{path}: bag has no CameraInfo topic")
-    stamps = np.array([c[0] for c in colours])
-    for i, (stamp, dmsg, dtype) in enumerate(depths):
-        name = f"{Path(path).stem}_{i:05d}_{stamp}"
+                raise FileFormatError(f"{self.path}: corrupt message on {conn.topic} at {stamp} ({exc})") from None
+        raise FileFormatError(f"{self.path}: no message on {conn.topic} at {stamp}")  # pragma: no cover
+
+    def read(self, index: int) -> Frame:
+        if not 0 <= index < len(self._depth_stamps):
+            raise IndexError(f"frame index {index} out of range for {len(self._depth_stamps)} frames")
+        stamp = self._depth_stamps[index]
+        name = f"{self.path.stem}_{index:05d}_{stamp}"
+        j = bisect.bisect_left(self._color_stamps, stamp)
+        near = min((k for k in (j - 1, j) if 0 <= k < len(self._color_stamps)),
+                   key=lambda k: abs(self._color_stamps[k] - stamp))  # fmt: skip
+        if abs(self._color_stamps[near] - stamp) > self.max_skew * 1e9:
+            raise FileFormatError(f"{self.path}: no colour image within {self.max_skew} s of depth at {stamp}")
+        c = max(bisect.bisect_right(self._camera_stamps, stamp) - 1, 0)
+        camera = self._cameras[c][1]
+        if isinstance(camera, str):
+            raise FileFormatError(f"{self.path}: {camera}")
         try:
-            j = int(np.argmin(np.abs(stamps - stamp)))
-            if abs(int(stamps[j]) - stamp) > max_skew * 1e9:
-                raise FileFormatError(f"no colour image within {max_skew} s of depth at {stamp}")
-            color = _to_array(colours[j][1], colours[j][2])
-            raw = _to_array(dmsg, dtype)
-            depth = raw.astype(np.float32) * (0.001 if raw.dtype == np.uint16 else 1.0)
-            depth = np.nan_to_num(depth, nan=0.0, posinf=0.0, neginf=0.0)
-            yield (
-                name,
-                Frame(name, np.ascontiguousarray(color, dtype=np.uint8), depth, camera, source=f"{path}@{stamp}"),
-            )
-        except SymfruitError as exc:
-            yield name, exc
+            dmsg = self._message(self._depth, stamp)
+            color = image_array(self._message(self._color, self._color_stamps[near]), self._color.msgtype)
+            raw = image_array(dmsg, self._depth.msgtype)
+        except FileFormatError as exc:
+            message = str(exc)
+            named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
+            raise FileFormatError(named) from None
+        if raw.ndim != 2:
+            raise FileFormatError(f"{self.path}: depth image at {stamp} has {raw.shape[2]} channels, expected 1")
+        depth = raw.astype(np.float32) * np.float32(0.001 if raw.dtype == np.uint16 else 1.0)
+        depth = np.nan_to_num(depth, nan=0.0, posinf=0.0, neginf=0.0)
+        if color.ndim == 2:
+            color = np.repeat(color[:, :, None], 3, axis=2)
+        return Frame(name, np.ascontiguousarray(color, dtype=np.uint8), depth, camera,
+                     source=f"{self.path}@{stamp}", stamp=_stamp(dmsg, stamp))  # fmt: skip
+
+    def close(self) -> None:
+        """Close the bag."""
+        reader = getattr(self, "_reader", None)
+        if reader is not None:
+            try:
+                reader.close()
+            except Exception:
+                pass
+            self._reader = None
+
+    def __enter__(self) -> BagSource:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -17,7 +17,7 @@ import numpy as np
 from ..errors import FileFormatError
 from .atomic import atomic_write
 
-__all__ = ["CLOUD_READERS", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
+__all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
 
 #: Largest header we read before giving up on finding its end.
 _MAX_HEADER = 1 << 16
@@ -227,8 +227,46 @@ def read_text(path: Path) -> np.ndarray:
     return np.asarray(rows, dtype=np.float64)
 
 
+def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
+    """``(shape, dtype)`` from a ``.npy`` header, without reading the data; checks that the file holds it.
+
+    Raises
+    ------
+    FileFormatError
+        For a file that is not ``.npy`` (an ``.npz`` archive is named as such), a header numpy cannot
+        parse, an object (pickled) dtype, or data shorter than the header promises.
+    """
+    try:
+        with open(path, "rb") as handle:
+            magic = handle.read(6)
+            if magic.startswith(b"PK"):
+                raise FileFormatError(f"{path}: is an .npz archive (zip), not a single .npy array")
+            if magic != b"\x93NUMPY":
+                raise FileFormatError(f"{path}: not a .npy file (no NumPy magic)")
+            handle.seek(0)
+            version = np.lib.format.read_magic(handle)
+            if version == (1, 0):
+                shape, _, dtype = np.lib.format.read_array_header_1_0(handle)
+            else:
+                shape, _, dtype = np.lib.format.read_array_header_2_0(handle)
+            start = handle.tell()
+        size = path.stat().st_size
+    except FileFormatError:
+        raise
+    except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...
+        raise FileFormatError(f"{path}: not a valid .npy file ({type(exc).__name__}: {exc})") from None
+    if dtype.hasobject:
+        raise FileFormatError(f"{path}: .npy holds Python objects; symfruit never unpickles files")
+    need = int(np.prod(shape, dtype=np.float64) * dtype.itemsize)
+    if need > size - start:
+        raise FileFormatError(f"{path}: .npy header promises {shape} {dtype} ({need} bytes) but the file holds "
+                              f"{size - start} bytes of data")  # fmt: skip
+    return tuple(int(v) for v in shape), dtype
+
+
 def read_npy(path: Path) -> np.ndarray:
     """NumPy ``.npy``: an (n, >=3) numeric array or a structured array with x, y, z; never pickles."""
+    npy_header(path)
     try:
         arr = np.load(path, allow_pickle=False, mmap_mode="r")
     except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...

@@ -11,78 +11,34 @@ A frame folder holds::
     masks.json                optional: COCO-style annotations (polygons or RLE)
     truth.json                optional: {"fruits": [{"id", "min", "max", ...}]}, true boxes in metres
 
-A folder whose sub-folders are frame folders is a recording; so is a ROS 1 ``.bag`` or ROS 2 bag
-folder, read with the ``rosbags`` package (``pip install 'symfruit[bag]'``).
+A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
+ROS 2 bag folder (:mod:`.bags`).
 """
 
 from __future__ import annotations
 
-import json
-from collections.abc import Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from ..box import Box
-from ..camera import Camera
+from ..core.box import Box
+from ..core.camera import Camera
 from ..errors import FileFormatError, InputError
+from ..frame import Frame
 from .atomic import atomic_write, write_json
+from .images import read_color, read_depth_units
+from .text import read_structured
 
-__all__ = ["Frame", "is_frame_folder", "iter_frames", "read_frame", "write_frame"]
+__all__ = ["COLOR_NAMES", "DEFAULT_DEPTH_SCALE", "is_frame_folder", "read_frame", "read_truth", "write_frame"]
 
 DEFAULT_DEPTH_SCALE = 0.001
-
-
-@dataclass(frozen=True)
-class Frame:
-    """One RGB-D frame.
-
-    Attributes
-    ----------
-    name : str
-    color : (h, w, 3) uint8
-    depth : (h, w) float32, metres; 0 where the sensor returned nothing
-    camera : Camera
-    masks : (h, w) int, optional; instance labels from the frame's own ``masks.*``
-    truth : list of (id, Box), optional
-    source : str
-        Where it came from (folder, or bag and timestamp).
-    """
-
-    name: str
-    color: np.ndarray
-    depth: np.ndarray
-    camera: Camera
-    masks: np.ndarray | None = None
-    truth: list[tuple[int, Box]] | None = None
-    source: str = ""
-    extras: dict[str, Any] = field(default_factory=dict)
-
-    def __post_init__(self) -> None:
-        h, w = self.depth.shape[:2]
-        if self.color.shape[:2] != (h, w):
-            raise InputError(
-                f"frame {self.name}: colour is {self.color.shape[1]}x{self.color.shape[0]} but depth is {w}x{h}; "
-                "depth must be aligned to the colour image"
-            )
-        if (self.camera.width, self.camera.height) != (w, h):
-            raise InputError(
-                f"frame {self.name}: intrinsics are for {self.camera.width}x{self.camera.height} "
-                f"but the images are {w}x{h}"
-            )
-
-
-def _image(path: Path) -> np.ndarray:
-    from PIL import Image, UnidentifiedImageError
-
-    try:
-        with Image.open(path) as img:
-            img.load()
-            return np.asarray(img)
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
-        raise FileFormatError(f"{path}: cannot read image ({exc})") from None
+#: Colour image names a frame folder may use, in order of preference.
+COLOR_NAMES = ("color.png", "color.jpg", "color.jpeg")
+#: Largest truth.json read (bytes).
+MAX_TRUTH_BYTES = 16 << 20
+#: Largest depth.npy read (elements): a 40-megapixel image.
+MAX_DEPTH_ELEMENTS = 40_000_000
 
 
 def _first(folder: Path, *names: str) -> Path | None:
@@ -93,7 +49,8 @@ def _first(folder: Path, *names: str) -> Path | None:
 
 
 def is_frame_folder(folder: Path) -> bool:
-    return folder.is_dir() and _first(folder, "color.png", "color.jpg", "color.jpeg") is not None
+    """Whether ``folder`` holds a colour image under one of :data:`COLOR_NAMES`."""
+    return folder.is_dir() and _first(folder, *COLOR_NAMES) is not None
 
 
 def read_frame(folder: str | Path) -> Frame:
@@ -105,45 +62,48 @@ def read_frame(folder: str | Path) -> Frame:
         Naming the file and the problem: missing file, unreadable image, sizes that disagree, unknown
         depth units.
     """
+    from .intrinsics import camera_from_file_data, read_mapping
     from .masks import read_masks
 
     folder = Path(folder)
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such frame folder")
-    color_path = _first(folder, "color.png", "color.jpg", "color.jpeg")
+    color_path = _first(folder, *COLOR_NAMES)
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")
     cam_path = _first(folder, "camera.json", "camera.yaml", "camera.yml")
     if cam_path is None:
         raise FileFormatError(f"{folder}: no camera.json (intrinsics)")
-    from .intrinsics import camera_from_file_data, read_mapping
-
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
-    color = _image(color_path)
-    if color.ndim == 2:
-        color = np.repeat(color[:, :, None], 3, axis=2)
-    color = np.ascontiguousarray(color[:, :, :3]).astype(np.uint8)
+    color = read_color(color_path)
     depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
     if depth_png.is_file():
-        raw = _image(depth_png)
-        if raw.ndim != 2 or raw.dtype not in (np.uint16, np.int32, np.uint8):
-            raise FileFormatError(f"{depth_png}: depth PNG must be single-channel 16-bit, got {raw.dtype} {raw.shape}")
-        depth = raw.astype(np.float32) * np.float32(scale)
+        depth = read_depth_units(depth_png).astype(np.float32) * np.float32(scale)
     elif depth_npy.is_file():
-        try:
-            depth = np.load(depth_npy, allow_pickle=False)
-        except (ValueError, OSError, EOFError) as exc:
-            raise FileFormatError(f"{depth_npy}: cannot read ({exc})") from None
-        if depth.ndim != 2 or not np.issubdtype(depth.dtype, np.floating):
-            raise FileFormatError(f"{depth_npy}: depth must be a 2-D float array in metres")
-        depth = np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+        depth = _read_depth_npy(depth_npy)
     else:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
-    truth = _read_truth(folder / "truth.json") if (folder / "truth.json").is_file() else None
+    truth = read_truth(folder / "truth.json") if (folder / "truth.json").is_file() else None
     return Frame(folder.name, color, depth, camera, masks, truth, str(folder))
+
+
+def _read_depth_npy(path: Path) -> np.ndarray:
+    """A float depth image in metres from ``.npy`` (never unpickled; size checked from the header)."""
+    from .clouds import npy_header
+
+    shape, dtype = npy_header(path)
+    if len(shape) != 2 or dtype.kind != "f":
+        raise FileFormatError(f"{path}: depth must be a 2-D float array in metres, got {dtype} {shape}")
+    if int(np.prod(shape)) > MAX_DEPTH_ELEMENTS:
+        raise FileFormatError(f"{path}: depth is {shape[1]}x{shape[0]}; at most {MAX_DEPTH_ELEMENTS:,} pixels are read")
+    try:
+        depth = np.load(path, allow_pickle=False)
+    except (ValueError, OSError, EOFError) as exc:
+        raise FileFormatError(f"{path}: cannot read ({exc})") from None
+    return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
 
 
 def _depth_scale(cam_path: Path, data: Any) -> float:
@@ -160,17 +120,28 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
     return float(scale)
 
 
-def _read_truth(path: Path) -> list[tuple[int, Box]]:
+def read_truth(path: Path) -> list[tuple[int, Box]]:
+    """The ripe fruit of a ``truth.json``: ``[(id, Box)]`` (unripe fruit, ``"ripe": false``, are no targets)."""
+    data = read_structured(path, what="truth file", max_bytes=MAX_TRUTH_BYTES)
     try:
-        data = json.loads(path.read_text(encoding="utf-8"))
         fruits = data["fruits"] if isinstance(data, dict) else data
+        if not isinstance(fruits, list):
+            raise TypeError("'fruits' is not a list")
         out = []
         for k, item in enumerate(fruits, 1):
+            if not isinstance(item, dict):
+                raise TypeError(f"fruit {k} is not an object")
             if item.get("ripe", True) is False:
-                continue  # unripe fruit are not targets
-            out.append((int(item.get("id", k)), Box(np.array(item["min"], float), np.array(item["max"], float))))
+                continue
+            lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
+            if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
+                raise ValueError(f"fruit {k}: min and max need three finite numbers each")
+            fid = item.get("id", k)
+            if isinstance(fid, bool) or not isinstance(fid, int):
+                raise ValueError(f"fruit {k}: id must be a whole number")
+            out.append((fid, Box(lo, hi)))
         return out
-    except (ValueError, KeyError, TypeError, AttributeError) as exc:
+    except (ValueError, KeyError, TypeError) as exc:
         raise FileFormatError(
             f"{path}: expected {{'fruits': [{{'min': [x, y, z], 'max': [x, y, z]}}]}} ({exc})"
         ) from None
@@ -196,31 +167,3 @@ def write_frame(
         with atomic_write(folder / "masks.png", "wb") as handle:
             Image.fromarray(masks.astype(np.uint16 if masks.max() > 255 else np.uint8)).save(handle, format="PNG")
     return folder
-
-
-def iter_frames(source: str | Path) -> Iterator[tuple[str, Frame | Exception]]:
-    """Frames of a frame folder, a folder of frame folders, or a bag: ``(name, frame or the error)``.
-
-    A frame that cannot be read comes back as its error, so a batch can record it and go on.
-    """
-    source = Path(source)
-    if source.suffix == ".bag" or (source.is_dir() and (source / "metadata.yaml").is_file()):
-        from .bags import iter_bag
-
-        yield from iter_bag(source)
-        return
-    if is_frame_folder(source):
-        folders = [source]
-    elif source.is_dir():
-        folders = sorted(p for p in source.iterdir() if p.is_dir() and not p.name.startswith("."))
-        if not folders:
-            raise FileFormatError(
-                f"{source}: neither a frame folder (color.png, depth.png, camera.json) nor a folder of them"
-            )
-    else:
-        raise FileFormatError(f"{source}: no such frame folder, folder of frames or bag")
-    for folder in folders:
-        try:
-            yield folder.name, read_frame(folder)
-        except (FileFormatError, InputError) as exc:
-            yield folder.name, exc

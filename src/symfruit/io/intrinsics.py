@@ -18,14 +18,17 @@ JSON or YAML by extension (YAML through ``yaml.safe_load`` only).
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
-from ..camera import Camera
+from ..core.camera import Camera
 from ..errors import FileFormatError, InputError
+from .text import read_structured
 
 __all__ = ["camera_from_dict", "load_camera"]
+
+#: Largest intrinsics file read (bytes).
+MAX_INTRINSICS_BYTES = 1 << 20
 
 _NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
 
@@ -46,27 +49,10 @@ def camera_from_file_data(path: Path, data: Any) -> Camera:
 
 def read_mapping(path: Path) -> Any:
     """Parse an intrinsics file (JSON, or YAML through the safe loader); errors name the file."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise FileFormatError(f"{path}: no such intrinsics file") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise FileFormatError(f"{path}: cannot read intrinsics ({exc})") from None
     suffix = path.suffix.lower()
-    try:
-        if suffix == ".json":
-            data = json.loads(text)
-        elif suffix in (".yaml", ".yml"):
-            import yaml
-
-            data = yaml.safe_load(text)
-        else:
-            raise FileFormatError(f"{path}: intrinsics must be .json, .yaml or .yml, not {suffix!r}")
-    except FileFormatError:
-        raise
-    except Exception as exc:  # JSONDecodeError / YAMLError carry the position
-        raise FileFormatError(f"{path}: not valid {suffix.lstrip('.').upper()} ({exc})") from None
-    return data
+    if suffix not in (".json", ".yaml", ".yml"):
+        raise FileFormatError(f"{path}: intrinsics must be .json, .yaml or .yml, not {suffix!r}")
+    return read_structured(path, what="intrinsics file", max_bytes=MAX_INTRINSICS_BYTES)
 
 
 def _number(data: dict[str, Any], key: str) -> float:

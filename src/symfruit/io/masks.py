@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
 from ..errors import FileFormatError
+from .images import read_labels
+from .text import read_structured
+
+#: Largest COCO annotation file read (bytes).
+MAX_COCO_BYTES = 256 << 20
 
 __all__ = ["coco_masks", "read_masks", "rle_decode"]
 
@@ -22,17 +26,7 @@ def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
     if path.is_dir():
         path = path / "masks.png" if (path / "masks.png").is_file() else path / "masks.json"
     if path.suffix.lower() == ".png":
-        from .frames import _image
-
-        labels = _image(path)
-        if labels.ndim == 3:  # an RGB label image: one id per distinct colour
-            flat = labels[:, :, :3].reshape(-1, 3).astype(np.int64)
-            keys = flat[:, 0] << 16 | flat[:, 1] << 8 | flat[:, 2]
-            _, inverse = np.unique(keys, return_inverse=True)
-            labels = inverse.reshape(labels.shape[:2])  # background (black, key 0) sorts first: label 0
-            if keys.min() != 0:
-                labels = labels + 1
-        labels = labels.astype(np.int32)
+        labels = read_labels(path)
     elif path.suffix.lower() == ".json":
         labels = coco_masks(path, shape)
     else:
@@ -50,10 +44,7 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     """
     from PIL import Image, ImageDraw
 
-    try:
-        data = json.loads(path.read_text(encoding="utf-8"))
-    except (OSError, UnicodeDecodeError, ValueError) as exc:
-        raise FileFormatError(f"{path}: not valid JSON ({exc})") from None
+    data = read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES)
     anns = data.get("annotations", data) if isinstance(data, dict) else data
     if not isinstance(anns, list):
         raise FileFormatError(f"{path}: expected a COCO 'annotations' list")

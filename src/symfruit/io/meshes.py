@@ -61,7 +61,7 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def _fans(polygons: list, n_vertices: int, path: Path) -> np.ndarray:
-    faces = []
+    faces: list[list[int]] = []
     for poly in polygons:
         poly = [int(i) for i in poly]
         if len(poly) < 3:

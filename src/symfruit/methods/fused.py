@@ -26,168 +26,89 @@ centre spread relative to the fruit's size), times the support (number of points
 
 from __future__ import annotations
 
-import functools
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
-from scipy.spatial import cKDTree
 
-from ..box import Box
-from ..camera import Camera
-from ..config import Settings
+from ..core.box import Box
+from ..core.camera import Camera
+from ..core.fits import (
+    ellipsoid_half_extents,
+    fit_aligned_ellipsoid,
+    fit_ellipsoid,
+    fit_revolution,
+    fit_sphere,
+    surface_noise,
+)
+from ..core.raster import View, rasterise, silhouette_coverage
+from ..core.symmetry import complete_by_symmetry
 from ..errors import InputError
-from ..raster import View, rasterise
-from . import Completion, register
-from .ellipsoid import fit_ellipsoid
-from .paper import mirror_complete
-from .sphere import fit_sphere
+from ..settings import Section, SettingError, setting
+from .paper import PaperSettings
+from .registry import Completion, register
 
-__all__ = ["fit_aligned_ellipsoid", "fit_revolution", "surface_noise"]
+__all__ = ["FusedSettings"]
 
 
-def surface_noise(
-    points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120
-) -> tuple[float, float, np.ndarray]:
-    """How much of the surface's roughness is noise: ``(ratio, noise, normals)``.
+@dataclass(frozen=True)
+class FusedSettings(Section):
+    """Settings of the default ``fused`` method; fruit profiles set these.
 
-    The RMS distance of a point's neighbours to their best plane grows with the square of the
-    neighbourhood's size where it comes from the surface's curvature (a clean scan) and not at all
-    where it comes from sensor noise. ``ratio`` is that residual for the ``large`` nearest neighbours
-    over the one for the ``small`` nearest (medians over the points): about 5 on clean scans, about
-    2 on depth-camera views, whatever the density. ``noise`` is the small-scale residual (metres);
-    ``normals`` (from the small neighbourhoods of the first ``queries`` points, a fixed spread
-    subset) face the camera.
+    Attributes
+    ----------
+    clean_ratio : float
+        Data count as a clean scan when the local plane-fit residual grows by at least this factor from
+        8 to 30 neighbours (curvature, not noise): measured 4.5-6.7 on clean scans of every fruit kind,
+        1.5-2.2 on D435-like views, so 3.3 separates them with room on both sides.
+    revolution : bool
+        On clean data, also fit a solid of revolution and average its box with the ellipsoid's
+        (on for strawberries, whose tapered shape an ellipsoid misses).
+    depth_prior, depth_ratio : float
+        Noisy data: weight of the prior that the depth semi-axis is ``depth_ratio`` times the geometric
+        mean of the lateral ones.
+    huber : float, metres
+        Noisy data: residuals beyond this count linearly (outliers, flying pixels).
+    mirror_weight : float in [0, 1]
+        Noisy data: share of the mirror completion in the centre (the rest is the aligned fit's).
+    mirror_size : float in [0, 1]
+        Noisy data: share of the mirror completion in the box size.
+    mirror : PaperSettings
+        The mirror completion (a ``paper`` section of its own): by default a deeper grid of depth offsets
+        (8 x 0.1 ``len_depth``) and a reasonable region of 0.4-1.0 ``Dist_ref``, rated on 600 points;
+        the paper's 4 x 0.2 stops short of the true plane for shallow views and its 0.6-1.2 region
+        penalises the true back of elongated fruit (see docs/ablation.md).
+    fit_points : int
+        Fits and the mirror completion use a fixed random subset of at most this many points (the
+        box always covers every visible point).
+    shape_points : int
+        Points the camera-aligned ellipsoid is fitted to (a spread subset: the fit averages the
+        noise of a few hundred points as well as of thousands, at a fraction of the cost).
+    spread_scale, min_support, reliable_at : float
+        Confidence = coverage * exp(-spread / (spread_scale * size)) * min(1, n / min_support), with
+        ``coverage`` the share of the fitted silhouette the camera saw and ``spread`` the largest
+        distance between the estimates' centres; ``reliable`` when it is at least ``reliable_at``.
     """
-    k_large = min(large, len(points))
-    step = max(1, len(points) // queries)
-    _, idx = cKDTree(points).query(points[::step], k=k_large)
-    hood = points[idx]
-    k = min(small, k_large)
-    near = hood[:, :k] - hood[:, :k].mean(axis=1, keepdims=True)
-    values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near) / k)
-    small_res, normals = np.sqrt(max(float(np.median(values[:, 0])), 0.0)), vectors[:, :, 0]
-    wide = hood - hood.mean(axis=1, keepdims=True)
-    large_res = np.sqrt(
-        max(float(np.median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
+
+    clean_ratio: float = setting(3.3, gt=0.0, le=100.0)
+    revolution: bool = setting(False)
+    depth_prior: float = setting(1.0, ge=0.0, le=1e6)
+    depth_ratio: float = setting(1.0, gt=0.0, le=100.0)
+    huber: float = setting(0.002, gt=0.0, le=1.0)
+    mirror_weight: float = setting(0.5, ge=0.0, le=1.0)
+    mirror_size: float = setting(0.0, ge=0.0, le=1.0)
+    mirror: PaperSettings = setting(
+        PaperSettings(translations=8, translation_step=0.1, j2=0.4, j3=1.0, rating_points=600)
     )
-    flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
-    normals[flip] *= -1.0
-    return large_res / max(small_res, 1e-15), small_res, normals
+    fit_points: int = setting(2000, ge=20, le=1_000_000)
+    shape_points: int = setting(800, ge=10, le=1_000_000)
+    spread_scale: float = setting(0.1, gt=0.0, le=100.0)
+    min_support: float = setting(150.0, gt=0.0, le=1e9)
+    reliable_at: float = setting(0.4, ge=0.0, le=1.0)
 
-
-def _residuals(theta, points, prior, ratio, delta, jac=True):
-    centre, axes = theta[:3], np.exp(theta[3:])
-    u = (points - centre) / axes
-    r = np.maximum(np.linalg.norm(u, axis=1), 1e-12)
-    mean_axis = axes.mean()
-    res = (r - 1.0) * mean_axis  # about the distance to the surface, metres
-    w = np.sqrt(np.where(np.abs(res) <= delta, 1.0, delta / np.maximum(np.abs(res), 1e-15)))
-    weight = prior * np.sqrt(len(points)) * mean_axis
-    prior_res = weight * (theta[5] - 0.5 * (theta[3] + theta[4]) - np.log(ratio))
-    b = np.empty(len(points) + 1)
-    b[:-1] = res * w
-    b[-1] = prior_res
-    if not jac:
-        return b, None
-    j = np.empty((len(points) + 1, 6))
-    scale = (mean_axis * w / r)[:, None]
-    j[:-1, :3] = -(u / axes) * scale
-    j[:-1, 3:] = -(u * u) * scale
-    j[-1] = weight * np.array([0.0, 0.0, 0.0, -0.5, -0.5, 1.0])
-    return b, j
-
-
-def fit_aligned_ellipsoid(
-    points: np.ndarray, *, prior: float = 1.0, depth_ratio: float = 1.0, huber: float = 0.002, iterations: int = 15
-) -> tuple[np.ndarray, np.ndarray]:
-    """Fit an ellipsoid with axes along the camera's x, y, z (its box is the fruit's box).
-
-    Minimises robust (Huber, ``huber`` metres) distances of the points to the surface plus ``prior``
-    times the squared log-ratio of the depth semi-axis to ``depth_ratio`` times the geometric mean of
-    the lateral ones (the depth of a fruit is barely seen from the front). Levenberg-Marquardt from
-    the sphere fit.
-
-    Returns
-    -------
-    centre : (3,) float, metres
-    semi_axes : (3,) float, metres
-    """
-    centre, radius = fit_sphere(points, refine=False)
-    theta = np.concatenate([centre, np.log([radius, radius, radius * depth_ratio])])
-    b, jac = _residuals(theta, points, prior, depth_ratio, huber)
-    cost, mu = float(b @ b), 1e-3
-    for _ in range(iterations):
-        h, g = jac.T @ jac, jac.T @ b
-        while True:
-            step = -np.linalg.solve(h + mu * np.diag(np.diag(h) + 1e-12), g)
-            trial = theta + step
-            b_new, _ = _residuals(trial, points, prior, depth_ratio, huber, jac=False)
-            new = float(b_new @ b_new)
-            if new < cost:
-                mu = max(mu / 3.0, 1e-9)
-                break
-            mu *= 4.0
-            if mu > 1e8:
-                return theta[:3], np.exp(theta[3:])
-        theta = trial
-        done = cost - new < 1e-6 * cost
-        cost = new
-        b, jac = _residuals(theta, points, prior, depth_ratio, huber)
-        if done:
-            break
-    return theta[:3], np.exp(theta[3:])
-
-
-def _hemisphere(n: int) -> np.ndarray:
-    i = np.arange(2 * n) + 0.5
-    phi = np.arccos(1.0 - 2.0 * i / (2 * n))
-    theta = np.pi * (1.0 + 5**0.5) * i
-    d = np.c_[np.cos(theta) * np.sin(phi), np.sin(theta) * np.sin(phi), np.cos(phi)]
-    return d[d[:, 2] >= 0]
-
-
-_DIRECTIONS = _hemisphere(300)
-
-
-def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -> tuple[Box, np.ndarray, np.ndarray]:
-    """The box of the solid of revolution that best explains the points.
-
-    The axis (point ``a``, direction ``d``) makes every normal line meet it: for each of ~300
-    directions at once, ``a`` solves a 3x3 least-squares problem and the direction with the smallest
-    trimmed residual wins. The profile is the 90th percentile of the distance to the axis in ``bins``
-    slices along it; each slice's ring contributes its exact axis-aligned extent.
-
-    Returns
-    -------
-    box : Box
-    axis_point, axis_direction : (3,) float
-    """
-    c = points.mean(axis=0)
-    q = points - c
-    m = np.cross(_DIRECTIONS[:, None, :], normals[None, :, :])  # (k, n, 3)
-    b = np.einsum("ni,kni->kn", q, m)
-    mm = np.einsum("kni,knj->kij", m, m)
-    mm = mm + (1e-9 * np.trace(mm, axis1=1, axis2=2)[:, None, None] + 1e-18) * np.eye(3)
-    a = np.linalg.solve(mm, np.einsum("kni,kn->ki", m, b)[..., None])[..., 0]
-    res = b - np.einsum("ki,kni->kn", a, m)
-    keep = max(1, int(0.8 * res.shape[1]))
-    cost = np.partition(res**2, keep - 1, axis=1)[:, :keep].mean(axis=1)
-    k = int(np.argmin(cost))
-    a0, d = a[k] + c, _DIRECTIONS[k]
-    t = (points - a0) @ d
-    rho = np.linalg.norm((points - a0) - t[:, None] * d, axis=1)
-    edges = np.quantile(t, np.linspace(0.0, 1.0, bins + 1))
-    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
-    spread = np.sqrt(np.clip(1.0 - d**2, 0.0, None))
-    lo, hi = points.min(axis=0), points.max(axis=0)
-    for j in range(bins):  # a loop over profile slices (24), not over points or hypotheses
-        sel = which == j
-        if sel.sum() < 3:
-            continue
-        r = np.quantile(rho[sel], 0.9)
-        for tt in (t[sel].min(), t[sel].max()):
-            ring = a0 + tt * d
-            lo, hi = np.minimum(lo, ring - r * spread), np.maximum(hi, ring + r * spread)
-    return Box(lo, hi), a0, d
+    def check(self) -> None:
+        if not isinstance(self.mirror, PaperSettings):
+            raise SettingError("mirror", f"must be a paper settings section, got {type(self.mirror).__name__}")
 
 
 def _mean_box(boxes: list[Box]) -> Box:
@@ -197,10 +118,10 @@ def _mean_box(boxes: list[Box]) -> Box:
     return Box(centre - size / 2.0, centre + size / 2.0)
 
 
-@register("fused")
-def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
-    """A shape fit and symmetric completion, fused by the noise level; with a confidence."""
-    s = settings.fused
+@register("fused", settings=FusedSettings)
+def fused(points: np.ndarray, camera: Camera, settings: FusedSettings) -> Completion:
+    """Shape fit and mirror completion, fused by the data's noise level; with a confidence."""
+    s = settings
     sample = points
     if len(points) > s.fit_points:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
@@ -208,14 +129,15 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     ratio, noise, normals = surface_noise(sample)
     step = max(1, len(sample) // 120)
     centres: list[np.ndarray] = []
-    view, plane = None, None
-    extras: dict = {"noise": noise, "roughness_ratio": ratio}
+    view: View | None = None
+    plane = None
+    extras: dict[str, Any] = {"noise": noise, "roughness_ratio": ratio}
     if ratio >= s.clean_ratio:
         extras["regime"] = "clean"
         try:
             c, shape = fit_ellipsoid(sample)
             with np.errstate(invalid="ignore"):
-                half = np.sqrt(np.diag(np.linalg.inv(shape)))
+                half = ellipsoid_half_extents(shape)
             if not (np.all(np.isfinite(half)) and np.all(np.isfinite(c)) and half.max() < 10 * extent):
                 raise InputError("the ellipsoid fit is degenerate")
             boxes = [Box(c - half, c + half)]
@@ -238,7 +160,7 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
             axes = np.full(3, radius)
         fit_box = Box(c - axes, c + axes)
         view = rasterise(sample, camera)
-        mirrored = mirror_complete(sample, camera, _mirror_settings(settings).paper, view)
+        mirrored = complete_by_symmetry(sample, camera, **s.mirror.options(), view=view)
         w = s.mirror_weight
         centre = (1.0 - w) * fit_box.centre + w * mirrored.box.centre
         size = (1.0 - s.mirror_size) * fit_box.size + s.mirror_size * mirrored.box.size
@@ -255,37 +177,7 @@ def fused(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
     return Completion(points=completed, box=box, plane=plane, extras=extras)
 
 
-@functools.lru_cache(maxsize=32)
-def _mirror_settings(settings: Settings) -> Settings:
-    """The ``paper`` settings of the fused mirror completion (cached: settings are immutable)."""
-    s = settings.fused
-    grid = {"translations": s.mirror_translations, "translation_step": s.mirror_translation_step,
-            "j2": s.mirror_j2, "j3": s.mirror_j3, "rating_points": s.mirror_points}  # fmt: skip
-    return settings.replace(paper=grid)
-
-
-def silhouette_coverage(view: View, box: Box, camera: Camera) -> float:
-    """Share of the fitted fruit's silhouette that the camera saw: how much of the ellipse inscribed in
-    the box's projection (at the box centre's depth) the rasterised visible points (``view``) cover.
-    Occluded, cut or sparse views cover less."""
-    c, half = box.centre, box.size / 2.0
-    if not (np.all(np.isfinite(c)) and np.all(np.isfinite(half)) and c[2] > 0):
-        return 0.0
-    uc, vc = camera.project(c[None])[0]
-    au, av = max(camera.fx * half[0] / c[2], 1.0), max(camera.fy * half[1] / c[2], 1.0)
-    # Only the window where the camera saw anything can be covered; the area counts the whole ellipse.
-    h, w = view.mask.shape
-    u0, u1 = max(int(np.floor(uc - au)), view.u0), min(int(np.ceil(uc + au)) + 1, view.u0 + w)
-    v0, v1 = max(int(np.floor(vc - av)), view.v0), min(int(np.ceil(vc + av)) + 1, view.v0 + h)
-    if u1 <= u0 or v1 <= v0:
-        return 0.0
-    vv, uu = np.mgrid[v0:v1, u0:u1]
-    inside = ((uu - uc) / au) ** 2 + ((vv - vc) / av) ** 2 <= 1.0
-    seen = inside & view.mask[vv - view.v0, uu - view.u0]
-    return float(min(1.0, seen.sum() / (np.pi * au * av)))
-
-
-def _confidence(spread: float, coverage: float, size: float, n: int, s) -> float:
+def _confidence(spread: float, coverage: float, size: float, n: int, s: FusedSettings) -> float:
     """Silhouette coverage x agreement of the estimates x support, in [0, 1]."""
     agree = np.exp(-spread / (s.spread_scale * size))
     support = min(1.0, n / s.min_support)

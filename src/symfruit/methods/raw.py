@@ -4,13 +4,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..box import Box
-from ..camera import Camera
-from ..config import Settings
-from . import Completion, register
+from ..core.box import Box
+from ..core.camera import Camera
+from .registry import Completion, register
 
 
 @register("raw")
-def raw(points: np.ndarray, camera: Camera, settings: Settings) -> Completion:
-    """Return the visible points unchanged and their box."""
+def raw(points: np.ndarray, camera: Camera, settings: None) -> Completion:
+    """The box of the visible points (no completion)."""
     return Completion(points=points.copy(), box=Box.from_points(points))

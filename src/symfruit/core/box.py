@@ -6,6 +6,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
+from .points import as_points
+
 __all__ = ["Box", "box_iou", "centre_deviation"]
 
 
@@ -21,10 +24,23 @@ class Box:
     min: np.ndarray
     max: np.ndarray
 
+    def __post_init__(self) -> None:
+        lo, hi = (np.asarray(v, dtype=np.float64) for v in (self.min, self.max))
+        if lo.shape != (3,) or hi.shape != (3,):
+            raise InputError(f"a box needs min and max of shape (3,), got {lo.shape} and {hi.shape}")
+        object.__setattr__(self, "min", lo)
+        object.__setattr__(self, "max", hi)
+
     @classmethod
     def from_points(cls, points: np.ndarray) -> Box:
-        """The tightest box around ``points`` : (n, 3) float, n >= 1."""
-        points = np.asarray(points, dtype=np.float64)
+        """The tightest box around ``points`` : (n, 3) float, n >= 1.
+
+        Raises
+        ------
+        InputError
+            When ``points`` is not an ``(n, 3)`` array with at least one row.
+        """
+        points = as_points(points, min_count=1)
         return cls(min=points.min(axis=0), max=points.max(axis=0))
 
     @property
@@ -48,7 +64,7 @@ class Box:
 
     def contains(self, points: np.ndarray, *, tol: float = 0.0) -> bool:
         """Whether every point of ``points`` : (n, 3) lies in the box (within ``tol`` metres)."""
-        points = np.asarray(points, dtype=np.float64)
+        points = as_points(points, min_count=0)
         return bool(np.all(points >= self.min - tol) and np.all(points <= self.max + tol))
 
     def corners(self) -> np.ndarray:

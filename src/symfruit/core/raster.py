@@ -11,10 +11,12 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from ..errors import InputError
+from .box import Box
 from .camera import Camera
-from .errors import InputError
+from .points import as_points
 
-__all__ = ["View", "rasterise"]
+__all__ = ["View", "rasterise", "silhouette_coverage"]
 
 
 @dataclass(frozen=True)
@@ -69,6 +71,7 @@ def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None =
     InputError
         When no point projects into the image.
     """
+    points = as_points(points, min_count=1)
     uv = camera.project(points)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
@@ -90,9 +93,9 @@ def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None =
     h, w = v1 - v0, u1 - u0
     flat = (row - v0) * w + (col - u0)
 
-    zbuf = np.full(h * w, np.inf)
-    np.minimum.at(zbuf, flat, z)
-    zbuf = zbuf.reshape(h, w)
+    flat_z = np.full(h * w, np.inf)
+    np.minimum.at(flat_z, flat, z)
+    zbuf = flat_z.reshape(h, w)
     hit = np.isfinite(zbuf)
 
     # Closing by a square, as box means: dilation = any hit in the square, erosion = all dilated.
@@ -142,3 +145,26 @@ def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None =
         near_depth=depth[mr, mc].ravel(),
         fill_radius=float(fill_radius),
     )
+
+
+def silhouette_coverage(view: View, box: Box, camera: Camera) -> float:
+    """Share of a fitted fruit's silhouette that the camera saw, in [0, 1].
+
+    How much of the ellipse inscribed in the box's projection (at the box centre's depth) the
+    rasterised visible points (``view``) cover. Occluded, cut or sparse views cover less.
+    """
+    c, half = box.centre, box.size / 2.0
+    if not (np.all(np.isfinite(c)) and np.all(np.isfinite(half)) and c[2] > 0):
+        return 0.0
+    uc, vc = camera.project(c[None])[0]
+    au, av = max(camera.fx * half[0] / c[2], 1.0), max(camera.fy * half[1] / c[2], 1.0)
+    # Only the window where the camera saw anything can be covered; the area counts the whole ellipse.
+    h, w = view.mask.shape
+    u0, u1 = max(int(np.floor(uc - au)), view.u0), min(int(np.ceil(uc + au)) + 1, view.u0 + w)
+    v0, v1 = max(int(np.floor(vc - av)), view.v0), min(int(np.ceil(vc + av)) + 1, view.v0 + h)
+    if u1 <= u0 or v1 <= v0:
+        return 0.0
+    vv, uu = np.mgrid[v0:v1, u0:u1]
+    inside = ((uu - uc) / au) ** 2 + ((vv - vc) / av) ** 2 <= 1.0
+    seen = inside & view.mask[vv - view.v0, uu - view.u0]
+    return float(min(1.0, seen.sum() / (np.pi * au * av)))

@@ -1,0 +1,121 @@
+"""Point arrays at the boundary: normalise what a caller hands in, and check that it can be a fruit.
+
+Every exported core function starts with :func:`as_points`, so a list, a tuple or an integer array works
+and anything else fails with an :class:`~symfruit.errors.InputError` that says what was expected, not with
+an error from deep inside numpy.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+
+__all__ = ["as_points", "check_cloud"]
+
+
+def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.ndarray:
+    """``points`` as a C-contiguous ``(n, 3)`` float64 array with ``n >= min_count``.
+
+    Parameters
+    ----------
+    points : array_like, (n, 3), metres
+    min_count : int
+        Fewest rows accepted.
+    name : str
+        What to call the argument in error messages.
+
+    Raises
+    ------
+    InputError
+        When ``points`` is not numeric, not real, not ``(n, 3)``, or has fewer than ``min_count`` rows.
+
+    Examples
+    --------
+    >>> as_points([[0, 0, 1]]).dtype
+    dtype('float64')
+    """
+    if isinstance(points, np.ndarray) and np.iscomplexobj(points):
+        raise InputError(f"{name} must be real numbers, got a complex array")
+    try:
+        arr = np.asarray(points, dtype=np.float64)
+    except (TypeError, ValueError):
+        raise InputError(f"{name} must be a numeric (n, 3) array of x, y, z in metres") from None
+    if arr.ndim != 2 or arr.shape[1] != 3:
+        raise InputError(f"{name} must have shape (n, 3), got {arr.shape}")
+    if len(arr) < min_count:
+        raise InputError(f"{name} must hold at least {min_count} points, got {len(arr)}")
+    return np.ascontiguousarray(arr)
+
+
+def check_cloud(
+    points: Any,
+    *,
+    min_points: int = 10,
+    max_points: int = 20000,
+    min_extent: float = 0.003,
+    max_extent: float = 1.0,
+    section: str = "",
+) -> tuple[np.ndarray, int]:
+    """Validate one fruit's visible points and return ``(clean (n, 3) float64 points, n_dropped)``.
+
+    Non-finite rows are dropped (and counted); clouds over ``max_points`` are down-sampled with a
+    fixed seed. Raises :class:`InputError` for anything a fruit cannot be: wrong shape, too few
+    points, points at or behind the camera, all points identical or on a line or a plane, or a cloud
+    wider than ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, camera optical frame
+    min_points, max_points : int
+    min_extent, max_extent : float, metres
+    section : str
+        The settings section the limits come from (e.g. ``"input"``), named in the messages.
+    """
+    arr = as_points(points, min_count=0)
+    finite = np.isfinite(arr).all(axis=1)
+    n_dropped = 0
+    if not finite.all():
+        n_dropped = int(len(arr) - finite.sum())
+        arr = arr[finite]
+    key = f"{section}." if section else ""
+    if len(arr) < min_points:
+        extra = f" after dropping {n_dropped} non-finite" if n_dropped else ""
+        limit = f" ({key}min_points sets the limit)" if section else ""
+        raise InputError(f"a fruit needs at least {min_points} points, got {len(arr)}{extra}{limit}")
+    if arr[:, 2].min() <= 0:
+        behind = int((arr[:, 2] <= 0).sum())
+        raise InputError(
+            f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
+            "the camera optical frame (x right, y down, z forward), in metres"
+        )
+    extent = float((arr.max(axis=0) - arr.min(axis=0)).max())
+    if extent > max_extent:
+        raise InputError(
+            f"the cloud is {extent:.3g} m across, too large for one fruit ({key}max_extent = {max_extent} m); "
+            "if it is in millimetres, use --units mm (or divide by 1000)"
+        )
+    if extent < min_extent:
+        if extent == 0:
+            raise InputError("all points are identical; a fruit needs points spread over its surface")
+        raise InputError(
+            f"the cloud is only {extent * 1000:.3g} mm across, too small for a fruit ({key}min_extent = "
+            f"{min_extent * 1000:g} mm); check the units (--units m for metres)"
+        )
+    centred = arr - arr.mean(axis=0)
+    spread = np.linalg.eigvalsh(centred.T @ centred)  # ascending variances (times n)
+    if spread[2] <= 1e-18 * len(arr):
+        raise InputError("all points are identical; a fruit needs points spread over its surface")
+    if spread[1] <= 1e-12 * spread[2]:
+        raise InputError("all points lie on a line; a fruit needs points spread over its surface")
+    if spread[0] <= 1e-12 * spread[2]:
+        raise InputError(
+            "all points lie on a plane; a fruit's visible surface is curved (is this a depth image "
+            "of a flat object, or a cloud with its depth dropped?)"
+        )
+    if len(arr) > max_points:
+        keep = np.random.default_rng(0).choice(len(arr), size=max_points, replace=False)
+        arr = arr[np.sort(keep)]
+    return arr, n_dropped

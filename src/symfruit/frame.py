@@ -1,0 +1,68 @@
+"""One RGB-D frame: the unit of work of the pipeline (segment -> extract -> complete -> boxes)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from .core.box import Box
+from .core.camera import Camera
+from .errors import InputError
+
+__all__ = ["Frame"]
+
+
+@dataclass(frozen=True)
+class Frame:
+    """One RGB-D frame, depth aligned to colour.
+
+    Attributes
+    ----------
+    name : str
+    color : (h, w, 3) uint8, RGB
+    depth : (h, w) float32, metres; 0 where the sensor returned nothing
+    camera : Camera
+        Intrinsics of the colour image (``width x height`` must match the images).
+    masks : (h, w) int, optional
+        Instance labels from the frame's own ``masks.*`` (0 background).
+    truth : list of (id, Box), optional
+        True boxes of the ripe fruit.
+    source : str
+        Where it came from (folder, or bag and timestamp).
+    stamp : int, optional
+        Acquisition time, nanoseconds since the epoch (bags carry one).
+    extras : dict
+    """
+
+    name: str
+    color: np.ndarray
+    depth: np.ndarray
+    camera: Camera
+    masks: np.ndarray | None = None
+    truth: list[tuple[int, Box]] | None = None
+    source: str = ""
+    stamp: int | None = None
+    extras: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        if self.color.ndim != 3 or self.color.shape[2] != 3 or self.color.dtype != np.uint8:
+            raise InputError(f"frame {self.name}: colour must be (h, w, 3) uint8 RGB, got {self.color.dtype} "
+                             f"{self.color.shape}")  # fmt: skip
+        if self.depth.ndim != 2:
+            raise InputError(f"frame {self.name}: depth must be a 2-D image, got shape {self.depth.shape}")
+        h, w = self.depth.shape
+        if self.color.shape[:2] != (h, w):
+            raise InputError(
+                f"frame {self.name}: colour is {self.color.shape[1]}x{self.color.shape[0]} but depth is {w}x{h}; "
+                "depth must be aligned to the colour image"
+            )
+        if (self.camera.width, self.camera.height) != (w, h):
+            raise InputError(
+                f"frame {self.name}: intrinsics are for {self.camera.width}x{self.camera.height} "
+                f"but the images are {w}x{h}"
+            )
+        if self.masks is not None and self.masks.shape != (h, w):
+            raise InputError(f"frame {self.name}: masks are {self.masks.shape[1]}x{self.masks.shape[0]}, "
+                             f"the image {w}x{h}")  # fmt: skip

@@ -1,0 +1,176 @@
+"""Frame sources: recordings read one frame at a time.
+
+A source is anything that follows :class:`FrameSource`: it knows how many frames it has and their names
+without decoding any, and decodes one frame when asked (:meth:`FrameSource.read`). A frame that cannot be
+read raises a :class:`~symfruit.errors.SymfruitError` for that index only, so a batch records it and goes
+on; decisions such as "already done, skip" are taken from the names, before anything is decoded. Memory
+therefore does not grow with the length of a recording.
+
+Sources are found through one registry (:func:`register_source`), tried in order:
+
+==========  =====================================================================================
+name        recognises
+==========  =====================================================================================
+bag         a ROS 1 ``.bag`` file or a ROS 2 bag folder (``metadata.yaml``) (:mod:`.bags`)
+frame       one frame folder (:mod:`.frames`)
+folder      a folder of frame folders, in name order (hidden folders and ``exclude`` skipped)
+==========  =====================================================================================
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Protocol, runtime_checkable
+
+from ..errors import FileFormatError
+from ..frame import Frame
+from .frames import is_frame_folder, read_frame
+
+__all__ = ["FolderSource", "FrameFolderSource", "FrameSource", "open_source", "register_source", "source_kinds"]
+
+
+@runtime_checkable
+class FrameSource(Protocol):
+    """The contract of a recording."""
+
+    path: Path
+
+    def __len__(self) -> int:
+        """Number of frames."""
+        ...
+
+    def names(self) -> list[str]:
+        """Frame names, in order, known without decoding any frame."""
+        ...
+
+    def read(self, index: int) -> Frame:
+        """Decode frame ``index``; raises :class:`~symfruit.errors.SymfruitError` for this frame only."""
+        ...
+
+    def close(self) -> None:
+        """Release open files."""
+        ...
+
+
+class _Closing:
+    path: Path
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+    def __enter__(self) -> _Closing:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+class FrameFolderSource(_Closing):
+    """One frame folder as a one-frame recording."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def __len__(self) -> int:
+        return 1
+
+    def names(self) -> list[str]:
+        return [self.path.name]
+
+    def read(self, index: int) -> Frame:
+        _check_index(index, 1)
+        return read_frame(self.path)
+
+
+class FolderSource(_Closing):
+    """A folder of frame folders (sub-folders in name order; hidden ones and ``exclude`` skipped)."""
+
+    def __init__(self, path: Path, *, exclude: Sequence[Path] = ()) -> None:
+        self.path = path
+        skip = {p.resolve() for p in exclude}
+        self._folders = sorted(
+            p for p in path.iterdir() if p.is_dir() and not p.name.startswith(".") and p.resolve() not in skip
+        )
+
+    def __len__(self) -> int:
+        return len(self._folders)
+
+    def names(self) -> list[str]:
+        return [p.name for p in self._folders]
+
+    def read(self, index: int) -> Frame:
+        _check_index(index, len(self._folders))
+        return read_frame(self._folders[index])
+
+
+def _check_index(index: int, n: int) -> None:
+    if not 0 <= index < n:
+        raise IndexError(f"frame index {index} out of range for {n} frames")
+
+
+@dataclass(frozen=True)
+class _Kind:
+    name: str
+    probe: Callable[[Path], bool]
+    open: Callable[[Path, Sequence[Path]], FrameSource]
+
+
+_KINDS: list[_Kind] = []
+
+
+def register_source(
+    name: str, probe: Callable[[Path], bool], opener: Callable[[Path, Sequence[Path]], FrameSource]
+) -> None:
+    """Add a kind of recording: ``probe(path)`` says whether it is one, ``opener(path, exclude)`` opens it.
+
+    Kinds are tried in registration order; the built-in ones are ``bag``, ``frame`` and ``folder``.
+    """
+    if any(k.name == name for k in _KINDS):
+        raise ValueError(f"frame source {name!r} is already registered")
+    _KINDS.append(_Kind(name, probe, opener))
+
+
+def source_kinds() -> list[str]:
+    """Names of the registered kinds, in the order they are tried."""
+    return [k.name for k in _KINDS]
+
+
+def open_source(path: str | Path, *, exclude: Sequence[Path] = ()) -> FrameSource:
+    """Open a recording: a bag, a frame folder or a folder of frame folders.
+
+    ``exclude`` lists folders that are not frames even if they sit inside (e.g. the output folder).
+
+    Raises
+    ------
+    FileFormatError
+        When ``path`` is none of the registered kinds.
+    """
+    path = Path(path)
+    for kind in _KINDS:
+        if kind.probe(path):
+            return kind.open(path, exclude)
+    if not path.exists():
+        raise FileFormatError(f"{path}: no such frame folder, folder of frames or bag")
+    raise FileFormatError(f"{path}: neither a frame folder (color.png, depth.png, camera.json), a folder of them, "
+                          "nor a bag")  # fmt: skip
+
+
+def _is_bag(path: Path) -> bool:
+    return (path.suffix == ".bag" and path.is_file()) or (path.is_dir() and (path / "metadata.yaml").is_file())
+
+
+def _open_bag(path: Path, exclude: Sequence[Path]) -> FrameSource:
+    from .bags import BagSource
+
+    return BagSource(path)
+
+
+def _is_folder(path: Path) -> bool:
+    return path.is_dir() and any(p.is_dir() and not p.name.startswith(".") for p in path.iterdir())
+
+
+register_source("bag", _is_bag, _open_bag)
+register_source("frame", is_frame_folder, lambda path, exclude: FrameFolderSource(path))
+register_source("folder", _is_folder, lambda path, exclude: FolderSource(path, exclude=exclude))

@@ -1,0 +1,83 @@
+"""Small structured files (settings, intrinsics, truth, COCO annotations): read with a size bound, parsed
+safely, errors naming the file.
+
+* At most ``max_bytes`` are ever read, whatever the file claims to be (a symlink to ``/dev/zero``, a
+  device, a huge file): larger input is refused before it is parsed.
+* YAML goes through a safe loader that also refuses aliases (``*name``): an alias refers to a shared node,
+  and a few lines of nested aliases expand into billions of values as soon as anything walks them.
+* Nesting deeper than Python's recursion allows is refused, not a traceback.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+from ..errors import FileFormatError, SymfruitError
+
+__all__ = ["read_limited", "read_structured"]
+
+
+def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError) -> bytes:
+    """The bytes of ``path``, refusing anything over ``max_bytes`` (read is bounded, not trusted to stat)."""
+    try:
+        with open(path, "rb") as handle:
+            data = handle.read(max_bytes + 1)
+    except FileNotFoundError:
+        raise error(f"{path}: no such {what}") from None
+    except IsADirectoryError:
+        raise error(f"{path}: is a folder, not a {what}") from None
+    except OSError as exc:
+        raise error(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
+    if len(data) > max_bytes:
+        raise error(f"{path}: {what} is larger than {max_bytes // 1024} kB; this cannot be a {what}")
+    return data
+
+
+def _yaml_loader() -> type:
+    import yaml
+
+    class _NoAliasLoader(yaml.SafeLoader):
+        def compose_node(self, parent: Any, index: Any) -> Any:
+            if self.check_event(yaml.AliasEvent):
+                event = self.peek_event()
+                raise yaml.composer.ComposerError(
+                    None, None, f"YAML aliases (*{event.anchor}) are not allowed here", event.start_mark
+                )
+            return super().compose_node(parent, index)
+
+    return _NoAliasLoader
+
+
+def read_structured(
+    path: str | Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError
+) -> Any:
+    """Parse a ``.json`` or ``.yaml``/``.yml`` file (by extension) into Python data.
+
+    Raises
+    ------
+    error
+        Naming the file: unreadable, too large, not UTF-8, not valid JSON/YAML, aliases, nesting too deep.
+    """
+    path = Path(path)
+    raw = read_limited(path, what=what, max_bytes=max_bytes, error=error)
+    try:
+        text = raw.decode("utf-8-sig")  # a UTF-8 byte-order mark is allowed and dropped
+    except UnicodeDecodeError as exc:
+        raise error(f"{path}: {what} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
+    suffix = path.suffix.lower()
+    kind = "JSON" if suffix == ".json" else "YAML"
+    try:
+        if kind == "JSON":
+            return json.loads(text)
+        loader = _yaml_loader()(text)  # a SafeLoader that also refuses aliases
+        try:
+            return loader.get_single_data()
+        finally:
+            loader.dispose()
+    except RecursionError:
+        raise error(f"{path}: {what} is nested too deeply to be a {what}") from None
+    except Exception as exc:  # json.JSONDecodeError / yaml.YAMLError carry the position
+        message = str(exc).replace("\n", " ")
+        raise error(f"{path}: not valid {kind}: {message}") from None

@@ -1,0 +1,339 @@
+"""Settings: one frozen dataclass section per stage, owned and registered by that stage, grouped under
+:class:`Settings`, and resolved in one place (:func:`resolve_settings`): defaults, then a fruit profile,
+then a settings file, then overrides.
+
+A stage declares its section beside its code::
+
+    @dataclass(frozen=True)
+    class SphereSettings(Section):
+        refine: bool = setting(True, doc="...")
+
+    register_section("sphere", SphereSettings)      # methods do it through methods.register(..., settings=)
+
+Values read from a mapping (a file, a profile, overrides) are validated: unknown keys, wrong types and
+non-finite numbers raise :class:`~symfruit.errors.ConfigError` with the dotted path of the key, e.g.
+``paper.rotations_x: expected a whole number, got 'eleven'``. Every section checks its fields' declared
+bounds (``setting(..., ge=1)``) and its cross-field rules (:meth:`Section.check`) when it is made, from a
+file or from Python; a failure names the field, and the path is added when it came from a mapping.
+
+Merging has one rule (:func:`merge`): a mapping laid over a mapping replaces only the keys it names, at
+every depth; anything else replaces the value.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Literal, TypeVar
+
+from .errors import ConfigError
+
+__all__ = [
+    "Section",
+    "SettingError",
+    "Settings",
+    "from_dict",
+    "load_settings",
+    "merge",
+    "read_settings_file",
+    "register_section",
+    "resolve_settings",
+    "section_types",
+    "setting",
+]
+
+T = TypeVar("T")
+
+#: Largest settings file read (bytes): settings are a few kB; anything larger is not a settings file.
+MAX_SETTINGS_BYTES = 1 << 20
+
+_SECTIONS: dict[str, type] = {}
+
+
+class SettingError(ConfigError):
+    """A check inside a section failed; ``key`` is the field it concerns (relative to the section)."""
+
+    def __init__(self, key: str, message: str) -> None:
+        super().__init__(f"{key}: {message}" if key else message)
+        self.key, self.message = key, message
+
+
+def setting(default: Any, *, ge: float | None = None, gt: float | None = None, le: float | None = None,
+            lt: float | None = None) -> Any:  # fmt: skip
+    """A section field with a default and optional inclusive (``ge``, ``le``) or strict (``gt``, ``lt``)
+    bounds, checked whenever the section is made. A nested section default is given as an instance."""
+    bounds = {k: v for k, v in (("ge", ge), ("gt", gt), ("le", le), ("lt", lt)) if v is not None}
+    metadata = {"bounds": bounds}
+    if dataclasses.is_dataclass(default) and not isinstance(default, type):
+        return dataclasses.field(default_factory=lambda: default, metadata=metadata)
+    return dataclasses.field(default=default, metadata=metadata)
+
+
+class Section:
+    """Base of every settings section: checks the declared bounds of its fields, then :meth:`check`."""
+
+    def __post_init__(self) -> None:
+        for f in dataclasses.fields(self):  # type: ignore[arg-type]
+            value = getattr(self, f.name)
+            bounds = f.metadata.get("bounds", {})
+            if bounds and isinstance(value, (int, float)) and not isinstance(value, bool):
+                for op, limit in bounds.items():
+                    ok = {"ge": value >= limit, "gt": value > limit, "le": value <= limit, "lt": value < limit}[op]
+                    if not ok:
+                        sign = {"ge": ">=", "gt": ">", "le": "<=", "lt": "<"}[op]
+                        raise SettingError(f.name, f"must be {sign} {limit:g}, got {value!r}")
+        self.check()
+
+    def check(self) -> None:
+        """Cross-field rules; raise :class:`SettingError` naming the field."""
+
+
+def register_section(name: str, cls: type[T]) -> type[T]:
+    """Make ``cls`` (a frozen dataclass whose every field has a default) the settings section ``name``."""
+    if not (dataclasses.is_dataclass(cls) and isinstance(cls, type)):
+        raise TypeError(f"settings section {name!r} must be a dataclass type, got {cls!r}")
+    if name in _SECTIONS and _SECTIONS[name] is not cls:
+        raise ValueError(f"settings section {name!r} is already registered by {_SECTIONS[name].__qualname__}")
+    _SECTIONS[name] = cls
+    return cls
+
+
+def section_types() -> dict[str, type]:
+    """The registered sections, by name, in registration order."""
+    return dict(_SECTIONS)
+
+
+class Settings:
+    """All settings, one section per stage; every field has a default.
+
+    ``Settings()`` holds the defaults; ``settings.paper`` (or ``settings.section("paper")``) is a section.
+    Immutable, comparable, hashable and picklable.
+
+    Examples
+    --------
+    >>> s = Settings().replace(paper={"rotations_x": 21})
+    >>> s.paper.rotations_x, s.paper.translations
+    (21, 4)
+    """
+
+    __slots__ = ("_sections",)
+    _sections: dict[str, Any]
+
+    def __init__(self, **sections: Any) -> None:
+        unknown = sorted(set(sections) - set(_SECTIONS))
+        if unknown:
+            raise ConfigError(f"unknown settings section {unknown[0]!r}; known: {', '.join(_SECTIONS)}")
+        values = {}
+        for name, cls in _SECTIONS.items():
+            value = sections.get(name)
+            if value is None:
+                value = cls()
+            elif not isinstance(value, cls):
+                raise ConfigError(f"settings section {name!r} must be a {cls.__name__}, got {type(value).__name__}")
+            values[name] = value
+        object.__setattr__(self, "_sections", values)
+
+    def section(self, name: str) -> Any:
+        """The section ``name``; raises :class:`ConfigError` listing the known ones."""
+        try:
+            return self._sections[name]
+        except KeyError:
+            raise ConfigError(f"unknown settings section {name!r}; known: {', '.join(self._sections)}") from None
+
+    def __getattr__(self, name: str) -> Any:
+        try:
+            return object.__getattribute__(self, "_sections")[name]
+        except KeyError:
+            raise AttributeError(f"Settings has no section {name!r}") from None
+
+    def __setattr__(self, name: str, value: Any) -> None:
+        raise AttributeError("Settings are immutable; use replace()")
+
+    def __eq__(self, other: object) -> bool:
+        return isinstance(other, Settings) and self._sections == other._sections
+
+    def __hash__(self) -> int:
+        return hash(tuple(self._sections.items()))
+
+    def __repr__(self) -> str:
+        return f"Settings({', '.join(f'{k}={v!r}' for k, v in self._sections.items())})"
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (_rebuild, (self._sections,))
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain nested dict, the layout :func:`from_dict` and settings files read back."""
+        return {name: dataclasses.asdict(value) for name, value in self._sections.items()}
+
+    def replace(self, **overrides: Any) -> Settings:
+        """A copy with sections overridden by mappings (only the keys they name) or section objects."""
+        data = {
+            k: dataclasses.asdict(v) if dataclasses.is_dataclass(v) and not isinstance(v, type) else v
+            for k, v in overrides.items()
+        }
+        return from_dict(merge(self.to_dict(), data))
+
+
+def _rebuild(sections: dict[str, Any]) -> Settings:
+    return Settings(**sections)
+
+
+def merge(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
+    """``base`` with ``over`` laid over it: mappings merge key by key at every depth, other values replace."""
+    out = dict(base)
+    for key, value in over.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = value
+    return out
+
+
+def _coerce(value: Any, hint: Any, where: str) -> Any:
+    origin = typing.get_origin(hint)
+    if origin is Literal:
+        choices = typing.get_args(hint)
+        if not isinstance(value, str) or value not in choices:
+            raise ConfigError(f"{where}: expected one of {', '.join(repr(a) for a in choices)}, got {value!r}")
+        return value
+    if origin in (typing.Union, types.UnionType):
+        args = typing.get_args(hint)
+        if value is None and type(None) in args:
+            return None
+        (inner,) = [a for a in args if a is not type(None)]
+        return _coerce(value, inner, where)
+    if dataclasses.is_dataclass(hint):
+        if not isinstance(value, Mapping):
+            raise ConfigError(f"{where}: expected a mapping of settings, got {type(value).__name__}")
+        return _build(typing.cast(type, hint), value, where)
+    if hint is bool:
+        if not isinstance(value, bool):
+            raise ConfigError(f"{where}: expected true or false, got {value!r}")
+        return value
+    if hint is int:
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise ConfigError(f"{where}: expected a whole number, got {value!r}")
+        return value
+    if hint is float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise ConfigError(f"{where}: expected a number, got {value!r}")
+        if not math.isfinite(value):
+            raise ConfigError(f"{where}: expected a finite number, got {value!r}")
+        return float(value)
+    if hint is str:
+        if not isinstance(value, str):
+            raise ConfigError(f"{where}: expected text, got {value!r}")
+        return value
+    raise ConfigError(f"{where}: unsupported setting type {hint!r}")  # pragma: no cover
+
+
+def _build(cls: type, data: Mapping[str, Any], where: str) -> Any:
+    hints = typing.get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    prefix = f"{where}." if where else ""
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise ConfigError(f"{where or 'settings'}: setting names must be text, got {bad[0]!r}")
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise ConfigError(f"unknown setting {prefix}{unknown[0]}; known: {', '.join(sorted(fields))}")
+    kwargs = {name: _coerce(value, hints[name], prefix + name) for name, value in data.items()}
+    try:
+        return cls(**kwargs)
+    except SettingError as exc:
+        raise ConfigError(f"{prefix}{exc.key}: {exc.message}" if exc.key else f"{where}: {exc.message}") from None
+
+
+def from_dict(data: Any) -> Settings:
+    """Validated :class:`Settings` from a nested mapping (missing keys keep their defaults)."""
+    if not isinstance(data, Mapping):
+        raise ConfigError(f"settings must be a mapping of sections, got {type(data).__name__}")
+    bad = [k for k in data if not isinstance(k, str)]
+    if bad:
+        raise ConfigError(f"settings section names must be text, got {bad[0]!r}")
+    unknown = sorted(set(data) - set(_SECTIONS))
+    if unknown:
+        raise ConfigError(f"unknown setting {unknown[0]}; known sections: {', '.join(_SECTIONS)}")
+    return Settings(**{name: _build(_SECTIONS[name], value, name) if isinstance(value, Mapping) else
+                       _not_a_mapping(name, value) for name, value in data.items()})  # fmt: skip
+
+
+def _not_a_mapping(name: str, value: Any) -> Any:
+    raise ConfigError(f"{name}: expected a mapping of settings, got {type(value).__name__}")
+
+
+def read_settings_file(path: str | Path) -> dict[str, Any]:
+    """Parse a ``.yaml``/``.yml`` or ``.json`` settings file into a mapping (not yet validated).
+
+    Raises
+    ------
+    ConfigError
+        Naming the file and the problem: unreadable, too large, not YAML/JSON, not a mapping.
+    """
+    path = Path(path)
+    suffix = path.suffix.lower()
+    if suffix not in (".yaml", ".yml", ".json"):
+        raise ConfigError(f"{path}: settings file must end in .yaml, .yml or .json")
+    from .io.text import read_structured
+
+    return read_structured(path, what="settings file", max_bytes=MAX_SETTINGS_BYTES, error=ConfigError)
+
+
+def load_settings(path: str | Path, base: Settings | None = None) -> Settings:
+    """Settings from a file laid over ``base`` (default: the defaults); errors name the file."""
+    return resolve_settings(config=path, base=base)
+
+
+def resolve_settings(
+    *,
+    fruit: str | Path | None = None,
+    config: str | Path | None = None,
+    overrides: Mapping[str, Any] | None = None,
+    base: Settings | None = None,
+) -> Settings:
+    """The effective settings: ``base`` (default: the defaults), then the fruit profile, then the settings
+    file, then ``overrides``; each names only what it changes.
+
+    Every command and the API resolve settings here, so they mean the same everywhere.
+
+    Parameters
+    ----------
+    fruit : str or path, optional
+        A shipped profile name (:func:`symfruit.profiles.available_profiles`) or a profile file.
+    config : path, optional
+        A settings file (YAML or JSON).
+    overrides : mapping, optional
+        Nested ``{section: {key: value}}``.
+
+    Raises
+    ------
+    ConfigError
+        Naming the profile or file and the key.
+    """
+    data = (base or Settings()).to_dict()
+    if fruit is not None:
+        from .profiles import profile_data
+
+        label, layer = profile_data(fruit)
+        data = _lay(data, layer, label)
+    if config is not None:
+        data = _lay(data, read_settings_file(config), str(config))
+    if overrides:
+        data = _lay(data, overrides, "")
+    return from_dict(data)
+
+
+def _lay(data: dict[str, Any], layer: Any, label: str) -> dict[str, Any]:
+    """``layer`` over ``data``, validated, with errors prefixed by ``label``."""
+    try:
+        if not isinstance(layer, Mapping):
+            raise ConfigError(f"settings must be a mapping of sections, got {type(layer).__name__}")
+        merged = merge(data, layer)
+        from_dict(merged)
+    except ConfigError as exc:
+        raise ConfigError(f"{label}: {exc}" if label else str(exc)) from None
+    return merged

@@ -1,0 +1,243 @@
+"""Every file symfruit writes, in one place, each written atomically (a temporary file renamed over the
+target, so an interrupted run never leaves a half-written file).
+
+==================  ===================================================================================
+what                files
+==================  ===================================================================================
+one completion      ``OUT.ply`` (visible + completed points, ``label`` 0/1) and ``OUT.json`` (the result,
+                    the input, the camera and the effective settings): :func:`write_result`
+one frame           ``detections.json`` (maps one-to-one onto ROS 2 ``vision_msgs/Detection3DArray``),
+                    ``fruit_NNN.ply`` per completed fruit, ``overlay.png``: :func:`write_detections`;
+                    the folder holds exactly the current run's files
+a results folder    ``ROOT/<timestamp>-<tag>[-k]`` with a ``latest`` link: :func:`new_results_folder`
+==================  ===================================================================================
+"""
+
+from __future__ import annotations
+
+import contextlib
+import datetime as _dt
+import os
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .complete import Result
+from .detect import Detection, FrameDetections
+from .errors import FileFormatError
+from .io.atomic import atomic_write, write_json
+from .io.clouds import write_ply
+from .settings import Settings
+
+__all__ = [
+    "OPTICAL_FRAME",
+    "detection_record",
+    "detections_record",
+    "draw_overlay",
+    "new_results_folder",
+    "write_detections",
+    "write_result",
+]
+
+#: ``frame_id`` written into detections.json: the colour camera's optical frame (REP-103).
+OPTICAL_FRAME = "camera_color_optical_frame"
+#: Files a frame's output folder may hold; anything else matching these patterns is a previous run's.
+_FRAME_OUTPUTS = ("fruit_*.ply", "overlay.png", "detections.json")
+
+
+def _labels(result: Result) -> np.ndarray:
+    """0 for the visible points, 1 for the completed ones (the order of ``result.points``)."""
+    n_vis = len(result.visible)
+    return np.r_[np.zeros(n_vis, np.uint8), np.ones(len(result.points) - n_vis, np.uint8)]
+
+
+def write_result(path: str | Path, result: Result, *, meta: dict[str, Any] | None = None) -> tuple[Path, Path]:
+    """Write ``path`` (``.ply``: the completed cloud) and the same name ``.json`` (record, extras, settings).
+
+    Raises
+    ------
+    FileFormatError
+        When ``path`` does not end in ``.ply`` or is a folder.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".ply":
+        raise FileFormatError(f"{path}: the output must end in .ply")
+    if path.is_dir():
+        raise FileFormatError(f"{path}: is a folder; give a file name ending in .ply")
+    write_ply(path, result.points, labels=_labels(result))
+    record = {**result.to_dict(), **(meta or {}), "extras": result.extras,
+              "settings": result.settings.to_dict()}  # fmt: skip
+    json_path = path.with_suffix(".json")
+    write_json(json_path, record)
+    return path, json_path
+
+
+def detection_record(d: Detection) -> dict[str, Any]:
+    """One entry of ``detections.json``; ``bbox`` is a ``vision_msgs/BoundingBox3D``."""
+    ex = d.extraction
+    out: dict[str, Any] = {
+        "id": d.id, "mask_area": ex.mask_area, "n_points": len(ex.points), "truncated": ex.truncated,
+        "n_invalid_depth": ex.n_invalid, "n_dropped_clusters": ex.n_other_clusters,
+    }  # fmt: skip
+    if d.error or d.result is None:
+        return {**out, "error": d.error}
+    r = d.result
+    c, size = r.box.centre, r.box.size
+    visible = d.visible_box
+    out.update(
+        centre=c.tolist(),
+        box=r.box.to_dict(),
+        visible_box=None if visible is None else visible.to_dict(),
+        bbox={
+            "center": {
+                "position": dict(zip("xyz", c.tolist(), strict=True)),
+                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+            },
+            "size": dict(zip("xyz", size.tolist(), strict=True)),
+        },
+        method=r.method,
+        plane=None if r.plane is None else r.plane.to_dict(),
+        score=None if not np.isfinite(r.score) else float(r.score),
+        seconds=r.seconds,
+        confidence=r.confidence,
+        reliable=r.reliable,
+    )
+    return out
+
+
+def detections_record(found: FrameDetections, *, settings: Settings | None = None) -> dict[str, Any]:
+    """``detections.json``: a ``vision_msgs/Detection3DArray``-like object with symfruit's extras."""
+    frame = found.frame
+    header: dict[str, Any] = {"frame_id": OPTICAL_FRAME}
+    if frame.stamp is not None:
+        header["stamp"] = {"sec": frame.stamp // 1_000_000_000, "nanosec": frame.stamp % 1_000_000_000}
+    data: dict[str, Any] = {
+        "frame": frame.name,
+        "source": frame.source,
+        "header": header,
+        "camera": frame.camera.to_dict(),
+        "units": "metres",
+        "mask_source": found.mask_source,
+        "timings": found.timings,
+        "fruits": [detection_record(d) for d in found.detections],
+    }
+    if settings is not None:
+        data["settings"] = settings.to_dict()
+    return data
+
+
+def write_detections(folder: str | Path, found: FrameDetections, *, settings: Settings | None = None) -> list[Path]:
+    """Write a frame's ``fruit_<id>.ply`` files, ``overlay.png`` and, last, ``detections.json``.
+
+    ``detections.json`` is written last: its presence marks the frame as done. Files a previous run left
+    in the folder that this run does not write (``fruit_004.ply`` when there are now three fruit, stale
+    temporary files of a killed run) are removed, so the folder holds exactly this run's results.
+    """
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FileFormatError(f"{folder}: cannot create output folder ({exc.strerror or exc})") from None
+    written = []
+    for d in found.detections:
+        if d.result is not None:
+            path = folder / f"fruit_{d.id:03d}.ply"
+            write_ply(path, d.result.points, labels=_labels(d.result))
+            written.append(path)
+    with atomic_write(folder / "overlay.png", "wb") as handle:
+        draw_overlay(found).save(handle, format="PNG")
+    written.append(folder / "overlay.png")
+    remove_stale(folder, keep=[*written, folder / "detections.json"])
+    write_json(folder / "detections.json", detections_record(found, settings=settings))
+    written.append(folder / "detections.json")
+    return written
+
+
+def remove_stale(folder: Path, *, keep: list[Path]) -> None:
+    """Delete a previous run's frame outputs and temporary files in ``folder`` that are not in ``keep``."""
+    keep_names = {p.name for p in keep}
+    stale = [p for pattern in _FRAME_OUTPUTS for p in folder.glob(pattern) if p.name not in keep_names]
+    stale += list(folder.glob(".*.tmp"))
+    for path in stale:
+        with contextlib.suppress(FileNotFoundError):
+            path.unlink()
+
+
+def new_results_folder(root: str | Path, tag: str) -> Path:
+    """A new folder ``root/<YYYYmmdd-HHMMSS>-<tag>`` (``-2``, ``-3``... if taken) and a ``latest`` link to it.
+
+    Raises
+    ------
+    FileFormatError
+        When ``root`` cannot be written.
+    """
+    root = Path(root)
+    stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
+    k = 1
+    while True:
+        folder = root / (f"{stamp}-{tag}" if k == 1 else f"{stamp}-{tag}-{k}")
+        try:
+            folder.mkdir(parents=True)
+            break
+        except FileExistsError:
+            k += 1
+        except OSError as exc:
+            raise FileFormatError(f"{root}: cannot create a results folder ({exc.strerror or exc})") from None
+    _link_latest(folder)
+    return folder
+
+
+def _link_latest(folder: Path) -> None:
+    link = folder.parent / "latest"
+    tmp = folder.parent / f".latest-{os.getpid()}"
+    try:
+        if tmp.is_symlink() or tmp.exists():
+            tmp.unlink()
+        tmp.symlink_to(folder.name)
+        os.replace(tmp, link)
+    except OSError:  # file systems without symlinks: the timestamped folder is still there
+        pass
+
+
+_EDGES = [(a, b) for a in range(8) for b in range(a + 1, 8) if bin(a ^ b).count("1") == 1]
+VISIBLE_COLOUR = (255, 170, 0)
+COMPLETED_COLOUR = (0, 220, 255)
+_PALETTE = np.array([[230, 25, 75], [60, 180, 75], [255, 225, 25], [67, 99, 216], [245, 130, 49],
+                     [145, 30, 180], [70, 240, 240], [240, 50, 230], [188, 246, 12], [250, 190, 190]])  # fmt: skip
+
+
+def draw_overlay(found: FrameDetections) -> Any:
+    """The colour image (a PIL image) with each fruit's mask, the box of its visible points (orange) and
+    of the completed fruit (cyan) as projected wireframe cuboids, and the completed centre marked."""
+    from PIL import Image, ImageDraw
+
+    frame = found.frame
+    image = frame.color.astype(np.float32)
+    for i, d in enumerate(found.detections):
+        image[d.mask] = 0.55 * image[d.mask] + 0.45 * _PALETTE[i % len(_PALETTE)]
+    img = Image.fromarray(np.clip(image, 0, 255).astype(np.uint8))
+    draw = ImageDraw.Draw(img)
+    cam = frame.camera
+    for d in found.detections:
+        visible = d.visible_box
+        boxes = [(visible, VISIBLE_COLOUR)] if visible is not None else []
+        if d.result is not None:
+            boxes.append((d.result.box, COMPLETED_COLOUR))
+        for box, colour in boxes:
+            uv = cam.project(box.corners())
+            for a, b in _EDGES:
+                draw.line([tuple(uv[a]), tuple(uv[b])], fill=colour, width=1)
+        rows, cols = np.nonzero(d.mask)
+        label_at = (int(cols.min()), max(int(rows.min()) - 12, 0))
+        if d.result is not None:
+            u, v = cam.project(d.result.centre[None])[0]
+            draw.line([(u - 4, v), (u + 4, v)], fill=COMPLETED_COLOUR, width=2)
+            draw.line([(u, v - 4), (u, v + 4)], fill=COMPLETED_COLOUR, width=2)
+            z = d.result.centre[2] * 1000
+            draw.text(label_at, f"{d.id}: {z:.0f} mm" + (" (cut)" if d.extraction.truncated else ""),
+                      fill=(255, 255, 255))  # fmt: skip
+        else:
+            draw.text(label_at, f"{d.id}: failed", fill=(255, 80, 80))
+    draw.text((5, cam.height - 14), "orange: visible points   cyan: completed fruit", fill=(255, 255, 255))
+    return img
