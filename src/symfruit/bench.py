@@ -26,7 +26,7 @@ __all__ = [
     "bench_frame",
     "bench_recording",
     "bench_view",
-    "make_recording",
+    "measured_detect",
     "run_bench",
 ]
 
@@ -151,32 +151,6 @@ class RecordingRow:
         return dict(self.__dict__)
 
 
-def make_recording(folder: str | Path, frames: int, *, distinct: int = 4, seed: int = 0) -> Path:
-    """A folder of ``frames`` frame folders made from ``distinct`` generated scenes (8 ripe strawberries, 2
-    unripe), the repeats hard-linked (copied where links are not possible) so a long recording costs
-    little disk. Returns ``folder``."""
-    import shutil
-
-    from .io.frames import write_frame
-    from .scenes import make_scene
-
-    folder = Path(folder)
-    sources = []
-    for k in range(min(distinct, frames)):
-        scene = make_scene(seed + k, n_ripe=8, n_unripe=2)
-        sources.append(write_frame(folder / f"frame_{k:05d}", scene.color, scene.depth, scene.camera,
-                                   truth=scene.truth()))  # fmt: skip
-    for i in range(len(sources), frames):
-        target = folder / f"frame_{i:05d}"
-        target.mkdir(parents=True, exist_ok=True)
-        for path in sources[i % len(sources)].iterdir():
-            try:
-                os.link(path, target / path.name)
-            except OSError:
-                shutil.copy2(path, target / path.name)
-    return folder
-
-
 #: Run in the child of :func:`bench_recording`: ``symfruit detect``, then the child's own peak RSS (the high
 #: water mark of its memory map, ``VmHWM``; ``ru_maxrss`` would also count the parent it was forked from).
 _MEASURED_DETECT = """
@@ -215,7 +189,10 @@ def bench_recording(frames: int = 500, *, method: str = "fused", workdir: str | 
     import tempfile
 
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
-        rec = make_recording(Path(tmp) / "rec", frames)
+        from .scenes import write_scenes
+
+        rec = Path(tmp) / "rec"
+        write_scenes(rec, frames, distinct=4, n_ripe=8, n_unripe=2)
         out = Path(tmp) / "out"
         start = time.perf_counter()
         _, peak, _ = measured_detect([str(rec), "--output", str(out), "--method", method])

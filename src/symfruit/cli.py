@@ -111,6 +111,12 @@ def _parser() -> argparse.ArgumentParser:
     _add_bench(sub)
     _add_evaluate(sub)
     _add_detect(sub)
+    p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries (with truth)")
+    p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
+    p.add_argument("--n", type=int, default=12, help="frames (default 12)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
+    p.add_argument("--ripe", type=int, default=6, help="ripe fruit per frame (default 6)")
+    p.add_argument("--unripe", type=int, default=2, help="unripe (white or green) fruit per frame (default 2)")
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
@@ -324,6 +330,17 @@ def _demo(args: argparse.Namespace) -> int:
     return 0
 
 
+def _scenes(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .scenes import write_scenes
+
+    if not 1 <= args.n <= 100_000 or not 0 <= args.ripe <= 50 or not 0 <= args.unripe <= 50 or args.seed < 0:
+        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")
+    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=args.ripe, n_unripe=args.unripe)
+    print(f"wrote {len(folders)} frames to {args.output} (seeds {args.seed}-{args.seed + args.n - 1})")
+    return 0
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -345,6 +362,7 @@ _COMMANDS = {
     "evaluate": _evaluate,
     "detect": _detect,
     "demo": _demo,
+    "scenes": _scenes,
     "settings": _settings,
     "methods": _methods,
 }

@@ -12,7 +12,7 @@ import numpy as np
 from .core.box import Box
 from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane, Planes
-from .core.points import check_cloud
+from .core.points import check_cloud, check_view
 from .errors import InputError
 from .methods import get
 from .settings import Section, SettingError, Settings, from_dict, register_section, setting
@@ -187,8 +187,10 @@ def complete(
     s = settings.input
     clean, n_dropped = check_cloud(points, min_points=s.min_points, max_points=s.max_points,
                                    min_extent=s.min_extent, max_extent=s.max_extent, section="input")  # fmt: skip
+    check_view(clean, camera)
     section = settings.section(method) if info.settings is not None else None
     done = info.fn(clean, camera, section)
+    _check_completion(done.box, clean, method, s.max_extent)
     seconds = time.perf_counter() - start
     return Result(
         method=method,
@@ -205,6 +207,18 @@ def complete(
         extras=done.extras,
         settings=settings,
     )
+
+
+def _check_completion(box: Box, visible: np.ndarray, method: str, max_extent: float) -> None:
+    """A completed box must be finite, hold the visible points and stay a fruit's size."""
+    size = box.size
+    if not (np.all(np.isfinite(box.min)) and np.all(np.isfinite(box.max))):
+        raise InputError(f"method {method!r} gave a non-finite box for these points (degenerate geometry)")
+    if size.max() > max_extent:
+        raise InputError(
+            f"method {method!r} completed these points to a box {size.max():.3g} m across, larger than one fruit "
+            f"(input.max_extent = {max_extent} m): the visible points do not constrain a fruit (degenerate geometry)"
+        )
 
 
 def _settings(settings: Any) -> Settings:

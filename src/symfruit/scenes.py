@@ -10,7 +10,10 @@ z-buffer of :mod:`symfruit.render`, shaded, and given the D435-like depth noise 
 from __future__ import annotations
 
 import colorsys
+import os
+import shutil
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -19,7 +22,7 @@ from .core.camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
 from .shapes import leaf_outline, rotation, strawberry
 
-__all__ = ["Scene", "SceneFruit", "make_scene"]
+__all__ = ["Scene", "SceneFruit", "make_scene", "write_scenes"]
 
 
 @dataclass(frozen=True)
@@ -202,3 +205,37 @@ def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Gener
     # Achenes: small pale specks on ripe fruit, and mild sensor noise everywhere.
     image += rng.normal(scale=0.015, size=image.shape)
     return (np.clip(image, 0, 1) * 255).astype(np.uint8)
+
+
+def write_scenes(
+    folder: str | Path, n: int, *, seed: int = 0, distinct: int | None = None, n_ripe: int = 6, n_unripe: int = 2,
+    n_leaves: int = 3,
+) -> list[Path]:  # fmt: skip
+    """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
+    ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
+    (copies where links are impossible), so a long recording costs little time and disk.
+
+    Returns
+    -------
+    list of Path
+        The frame folders, in order.
+    """
+    from .io.frames import write_frame
+
+    folder = Path(folder)
+    unique = n if distinct is None else max(1, min(distinct, n))
+    written: list[Path] = []
+    for i in range(n):
+        target = folder / f"scene_{i:05d}"
+        if i < unique:
+            scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves)
+            written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth()))
+            continue
+        target.mkdir(parents=True, exist_ok=True)
+        for path in written[i % unique].iterdir():
+            try:
+                os.link(path, target / path.name)
+            except OSError:
+                shutil.copy2(path, target / path.name)
+        written.append(target)
+    return written

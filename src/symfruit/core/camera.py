@@ -12,7 +12,14 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["DEFAULT_CAMERA", "Camera"]
+__all__ = ["DEFAULT_CAMERA", "MAX_FOCAL_PX", "MAX_IMAGE_PIXELS", "MAX_IMAGE_SIDE", "Camera"]
+
+#: Largest image side accepted (pixels) and largest image (pixels): an 8K x 5K sensor fits; a depth
+#: camera gives about 1 MP. Intrinsics beyond these are refused before anything is allocated for them.
+MAX_IMAGE_SIDE = 16384
+MAX_IMAGE_PIXELS = 40_000_000
+#: Largest focal length accepted (pixels): a 16K-pixel sensor behind a 60x telephoto stays below it.
+MAX_FOCAL_PX = 1e6
 
 
 @dataclass(frozen=True)
@@ -58,9 +65,20 @@ class Camera:
                 value = int(value)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
                 raise InputError(f"camera {name} must be a positive whole number of pixels, got {value!r}")
+            if value > MAX_IMAGE_SIDE:
+                raise InputError(f"camera {name} is {value} pixels; at most {MAX_IMAGE_SIDE} are supported")
             object.__setattr__(self, name, int(value))
+        if self.width * self.height > MAX_IMAGE_PIXELS:
+            raise InputError(f"camera image of {self.width}x{self.height} pixels exceeds {MAX_IMAGE_PIXELS:,} pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise InputError(f"camera focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+        if self.fx > MAX_FOCAL_PX or self.fy > MAX_FOCAL_PX:
+            raise InputError(f"camera focal lengths must be at most {MAX_FOCAL_PX:g} pixels, got fx={self.fx:g}, "
+                             f"fy={self.fy:g}")  # fmt: skip
+        for name in ("cx", "cy"):
+            if abs(getattr(self, name)) > MAX_FOCAL_PX:
+                raise InputError(f"camera {name} = {getattr(self, name):g} is implausible (more than "
+                                 f"{MAX_FOCAL_PX:g} pixels from the image corner)")  # fmt: skip
 
     @property
     def matrix(self) -> np.ndarray:

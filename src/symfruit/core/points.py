@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["as_points", "check_cloud"]
+__all__ = ["as_points", "check_cloud", "check_view"]
 
 
 def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.ndarray:
@@ -119,3 +119,28 @@ def check_cloud(
         keep = np.random.default_rng(0).choice(len(arr), size=max_points, replace=False)
         arr = arr[np.sort(keep)]
     return arr, n_dropped
+
+
+def check_view(points: np.ndarray, camera: Any, *, min_pixels: int = 3) -> None:
+    """Refuse a cloud that cannot be a fruit's visible surface in this camera's image.
+
+    A fruit's surface seen by a camera spreads over many pixels; a cloud whose points all fall within
+    fewer than ``min_pixels`` pixels across in both image directions is a streak along the line of sight
+    (flying pixels, or points that are not a surface), and any completion of it is meaningless.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, ``z > 0``
+    camera : Camera
+
+    Raises
+    ------
+    InputError
+    """
+    uv = camera.project(as_points(points, min_count=1))
+    span = np.ptp(uv, axis=0)
+    if not np.all(np.isfinite(span)) or span.max() < min_pixels:
+        raise InputError(
+            f"the visible points fall within {span.max():.1f} pixels of the image (fewer than {min_pixels} across): "
+            "a streak along the line of sight, not a fruit's surface"
+        )

@@ -16,7 +16,11 @@ from .box import Box
 from .camera import Camera
 from .points import as_points
 
-__all__ = ["View", "rasterise", "silhouette_coverage"]
+__all__ = ["MAX_WINDOW_PIXELS", "View", "rasterise", "silhouette_coverage"]
+
+#: Largest image window one fruit may cover (pixels): 2000 x 2000, far more than any fruit in a
+#: harvesting camera's view; beyond it the intrinsics or the units are wrong (and the buffers would be).
+MAX_WINDOW_PIXELS = 4_000_000
 
 
 @dataclass(frozen=True)
@@ -91,6 +95,11 @@ def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None =
     u0, v0 = max(c0 - pad, 0), max(r0 - pad, 0)
     u1, v1 = min(c1 + pad + 1, camera.width), min(r1 + pad + 1, camera.height)
     h, w = v1 - v0, u1 - u0
+    if h * w > MAX_WINDOW_PIXELS:
+        raise InputError(
+            f"the visible points span {w}x{h} pixels of the {camera.width}x{camera.height} image, more than one "
+            "fruit can; check the intrinsics and that the points are in metres"
+        )
     flat = (row - v0) * w + (col - u0)
 
     flat_z = np.full(h * w, np.inf)

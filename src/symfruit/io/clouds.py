@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import io
 import re
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -21,6 +22,11 @@ __all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", 
 
 #: Largest header we read before giving up on finding its end.
 _MAX_HEADER = 1 << 16
+#: Most points any cloud file may hold (a 1280x720 depth frame is 0.9 million); more is refused before
+#: it is allocated.
+MAX_CLOUD_POINTS = 5_000_000
+#: Largest text cloud read (bytes): 5 million rows of three numbers.
+MAX_TEXT_BYTES = 256 << 20
 
 
 def read_cloud(path: str | Path) -> np.ndarray:
@@ -70,34 +76,61 @@ _PLY_TYPES = {
 }  # fmt: skip
 
 
-def read_ply(path: Path) -> np.ndarray:
-    """PLY (ascii or binary) through ``plyfile``; the vertex count is checked against the file size first."""
-    from plyfile import PlyData, PlyParseError
+def ply_elements(path: Path) -> tuple[str, list[tuple[str, int]]]:
+    """``(format, [(element name, count), ...])`` of a PLY header, checked against the file's size.
 
+    Every element's rows need a least number of bytes (binary: the scalar properties' sizes plus each
+    list's count field; ascii: two characters per property), so a header promising more rows than the file
+    can hold is refused before :mod:`plyfile` allocates them, whichever element it is.
+    """
     header, start, size = _header(path, "PLY", b"ply", re.compile(rb"end_header\r?\n"))
     text = header.decode("ascii", errors="replace")
     fmt = re.search(r"^format\s+(\S+)", text, re.M)
-    vertex = re.search(r"^element\s+vertex\s+(\d+)", text, re.M)
-    if fmt is None or vertex is None:
-        raise FileFormatError(f"{path}: PLY header lacks a format line or a vertex element")
-    count = int(vertex.group(1))
-    # Bytes per vertex, from the properties listed after "element vertex" (lists count as 1 byte).
-    after = text[vertex.end() :].split("\nelement", 1)[0]
-    props = re.findall(r"^property\s+(?!list)(\S+)\s+\S+", after, re.M)
-    row = sum(_PLY_TYPES.get(t, 4) for t in props) or 12
-    least = count * (row if fmt.group(1) != "ascii" else 2 * max(len(props), 1))
+    if fmt is None:
+        raise FileFormatError(f"{path}: PLY header lacks a format line")
+    elements: list[tuple[str, int]] = []
+    least = 0
+    for block in re.split(r"^element\s+", text, flags=re.M)[1:]:
+        head = block.split(None, 2)
+        if len(head) < 2 or not head[1].isdigit():
+            raise FileFormatError(f"{path}: PLY element line is not 'element NAME COUNT'")
+        name, count = head[0], int(head[1])
+        props = re.findall(r"^property\s+(list\s+\S+\s+\S+|\S+)\s+\S+", block, re.M)
+        if fmt.group(1) == "ascii":
+            row = 2 * max(len(props), 1)
+        else:
+            row = sum(_PLY_TYPES.get(p.split()[1] if p.startswith("list") else p, 4) for p in props) or 1
+        least += count * row
+        elements.append((name, count))
     if least > size - start:
         raise FileFormatError(
-            f"{path}: header promises {count} vertices (at least {least} bytes) but the file holds "
-            f"{size - start} bytes of data (truncated or corrupt)"
+            f"{path}: header promises {', '.join(_rows(n, c) for n, c in elements)} (at least {least} bytes) but "
+            f"the file holds {size - start} bytes of data (truncated or corrupt)"
         )
+    return fmt.group(1), elements
+
+
+def _rows(name: str, count: int) -> str:
+    return f"{count} vertices" if name == "vertex" else f"{count} {name} rows"
+
+
+def read_ply(path: Path) -> np.ndarray:
+    """PLY (ascii or binary) through ``plyfile``; every element's row count is checked against the file first."""
+    from plyfile import PlyData, PlyParseError
+
+    _, elements = ply_elements(path)
+    counts = dict(elements)
+    if "vertex" not in counts:
+        raise FileFormatError(f"{path}: PLY has no vertex element")
+    if counts["vertex"] > MAX_CLOUD_POINTS:
+        raise FileFormatError(f"{path}: PLY holds {counts['vertex']:,} vertices; at most {MAX_CLOUD_POINTS:,} are read")
     try:
         data = PlyData.read(str(path))
         element = data["vertex"]
         return np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
-    except KeyError as exc:
+    except (KeyError, ValueError) as exc:
         raise FileFormatError(f"{path}: PLY has no {exc} property or vertex element") from None
 
 
@@ -206,25 +239,59 @@ def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
 
 
 def read_text(path: Path) -> np.ndarray:
-    """Text columns x y z [...] separated by spaces, tabs, commas or semicolons; header lines skipped."""
-    text = path.read_text(encoding="utf-8", errors="strict")
-    rows = []
-    for number, line in enumerate(text.splitlines(), 1):
+    """Text columns x y z [...]: one separator per file, read from its first data row.
+
+    ``;`` separates columns in European CSV, whose numbers may then use a decimal comma (``0,31;0,02;...``);
+    otherwise ``,``, tabs or spaces separate. Lines starting with ``#``, ``//`` or ``%`` are comments;
+    non-numeric lines before the data (a header) are skipped; a UTF-8 byte-order mark is dropped. At most
+    :data:`MAX_TEXT_BYTES` are read and :data:`MAX_CLOUD_POINTS` rows parsed.
+    """
+    from .text import read_limited
+
+    raw = read_limited(path, what="text cloud", max_bytes=MAX_TEXT_BYTES)
+    text = raw.decode("utf-8-sig")
+    lines = text.splitlines()
+    first, sep = None, None
+    for number, line in enumerate(lines):
         line = line.strip()
-        if not line or line.startswith(("#", "//", "%")):
+        if not line or line.startswith(_COMMENTS):
             continue
-        parts = re.split(r"[\s,;]+", line)
+        sep = ";" if ";" in line else "," if "," in line else None
+        parts = _split(line, sep)
         try:
-            rows.append([float(p) for p in parts[:3]])
+            [float(p) for p in parts[:3]]
         except ValueError:
-            if rows:
-                raise FileFormatError(f"{path}: line {number} is not numeric: {line[:60]!r}") from None
             continue  # a header line before the data
         if len(parts) < 3:
-            raise FileFormatError(f"{path}: line {number} has {len(parts)} columns, need x y z")
-    if not rows:
+            raise FileFormatError(f"{path}: line {number + 1} has {len(parts)} columns, need x y z")
+        first = number
+        break
+    if first is None:
         raise FileFormatError(f"{path}: no numeric x y z rows found")
-    return np.asarray(rows, dtype=np.float64)
+    body = "\n".join(lines[first:])
+    if sep == ";":
+        body = body.replace(",", ".")  # decimal commas
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")  # an empty or ragged body must be an error, not a warning
+            values = np.loadtxt(io.StringIO(body), delimiter=sep, comments=list(_COMMENTS), usecols=(0, 1, 2),
+                                ndmin=2, max_rows=MAX_CLOUD_POINTS + 1, dtype=np.float64)  # fmt: skip
+    except (ValueError, UserWarning) as exc:
+        message = str(exc).replace("\n", " ")
+        raise FileFormatError(f"{path}: rows after line {first + 1} are not all x y z numbers ({message})") from None
+    if len(values) > MAX_CLOUD_POINTS:
+        raise FileFormatError(f"{path}: more than {MAX_CLOUD_POINTS:,} rows; at most that many points are read")
+    return values
+
+
+_COMMENTS = ("#", "//", "%")
+
+
+def _split(line: str, sep: str | None) -> list[str]:
+    parts = [p.strip() for p in (line.split(sep) if sep else line.split())]
+    if sep == ";":
+        parts = [p.replace(",", ".") for p in parts]
+    return [p for p in parts if p] if sep is None else parts
 
 
 def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:

@@ -25,13 +25,11 @@ from typing import Any
 
 import numpy as np
 
+from ..core.camera import MAX_IMAGE_PIXELS  # checked from the header, before any pixel is decoded
 from ..errors import FileFormatError
 
 __all__ = ["MAX_IMAGE_PIXELS", "decode_color", "read_color", "read_depth_units", "read_labels"]
 
-#: Largest image accepted, in pixels (checked from the header, before any pixel is decoded): 40 MP is
-#: an 8K x 5K frame; a depth camera gives at most about 1 MP.
-MAX_IMAGE_PIXELS = 40_000_000
 
 _COLOUR_MODES = {"RGB", "RGBA", "RGBX", "RGBa", "P", "PA", "L", "LA", "La", "1", "CMYK", "YCbCr", "LAB", "HSV"}
 _WIDE_GREY = {"I;16", "I;16B", "I;16L", "I;16N", "I"}

@@ -7,7 +7,12 @@ from pathlib import Path
 import numpy as np
 
 from ..errors import FileFormatError
-from .clouds import read_cloud
+from .clouds import MAX_CLOUD_POINTS, ply_elements
+from .text import read_limited
+
+#: Most faces a mesh file may hold, and the largest OBJ file read (bytes).
+MAX_FACES = 10_000_000
+MAX_OBJ_BYTES = 64 << 20
 
 __all__ = ["read_mesh"]
 
@@ -19,25 +24,42 @@ def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
     if suffix == ".obj":
         return _read_obj(path)
     if suffix == ".ply":
-        vertices = read_cloud(path)  # checks the header against the file size first
-        from plyfile import PlyData
-
-        data = PlyData.read(str(path))
-        if "face" not in data:
-            return vertices, None
-        face = data["face"]
-        name = next((n for n in ("vertex_indices", "vertex_index") if n in face.data.dtype.names), None)
-        if name is None:
-            return vertices, None
-        return vertices, _fans(list(face.data[name]), len(vertices), path)
+        return _read_ply_mesh(path)
     raise FileFormatError(f"{path}: meshes must be .obj or .ply")
+
+
+def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
+    from plyfile import PlyData, PlyParseError
+
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such file")
+    _, elements = ply_elements(path)  # every element's count checked against the file size first
+    counts = dict(elements)
+    if counts.get("vertex", 0) > MAX_CLOUD_POINTS or counts.get("face", 0) > MAX_FACES:
+        raise FileFormatError(f"{path}: mesh of {counts.get('vertex', 0):,} vertices and {counts.get('face', 0):,} "
+                              f"faces; at most {MAX_CLOUD_POINTS:,} and {MAX_FACES:,} are read")  # fmt: skip
+    try:
+        data = PlyData.read(str(path))
+        vertex = data["vertex"]
+        vertices = np.column_stack([np.asarray(vertex[c], dtype=np.float64) for c in ("x", "y", "z")])
+    except PlyParseError as exc:
+        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
+    except (KeyError, ValueError) as exc:
+        raise FileFormatError(f"{path}: PLY has no {exc} property or vertex element") from None
+    if "face" not in data:
+        return vertices, None
+    face = data["face"]
+    name = next((n for n in ("vertex_indices", "vertex_index") if n in face.data.dtype.names), None)
+    if name is None:
+        return vertices, None
+    return vertices, _fans(list(face.data[name]), len(vertices), path)
 
 
 def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     vertices, polygons = [], []
     try:
-        text = path.read_text(encoding="utf-8", errors="strict")
-    except (OSError, UnicodeDecodeError) as exc:
+        text = read_limited(path, what="OBJ mesh", max_bytes=MAX_OBJ_BYTES).decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
         raise FileFormatError(f"{path}: cannot read OBJ ({exc})") from None
     for number, line in enumerate(text.splitlines(), 1):
         parts = line.split()
@@ -61,6 +83,12 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def _fans(polygons: list, n_vertices: int, path: Path) -> np.ndarray:
+    lengths = np.fromiter(map(len, polygons), dtype=np.int64, count=len(polygons))
+    if len(polygons) and (lengths == 3).all():  # a triangle mesh: no fans to make
+        arr = np.asarray(np.stack([np.asarray(p, dtype=np.int64) for p in polygons]), dtype=np.int64)
+        if arr.min() < 0 or arr.max() >= n_vertices:
+            raise FileFormatError(f"{path}: a face refers to a vertex that does not exist")
+        return arr
     faces: list[list[int]] = []
     for poly in polygons:
         poly = [int(i) for i in poly]
