@@ -246,8 +246,12 @@ def _evaluate(args: argparse.Namespace) -> int:
         raise InputError(f"--occlusion {args.occlusion!r}: expected numbers such as 0,0.25,0.5") from None
     if any(not 0.0 <= x < 1.0 for x in occlusions):
         raise InputError("--occlusion levels must be in [0, 1)")
-    if args.n is not None and args.n < 1:
-        raise InputError("--n must be at least 1")
+    if args.n is not None and not 1 <= args.n <= 100_000:
+        raise InputError("--n must be between 1 and 100000")
+    if not 0 <= args.seed < 2**63:
+        raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
+    if args.jobs is not None and not 1 <= args.jobs <= 256:
+        raise InputError(f"--jobs must be between 1 and 256, got {args.jobs}")
     if args.frames is not None:
         from .profiles import available_profiles
 

@@ -100,6 +100,10 @@ def detect(
     A fruit that cannot be completed (too few points, degenerate) is kept with its ``error``; the
     others are unaffected. A mask covering the whole image is refused (it is not a fruit).
     """
+    if not isinstance(frame, Frame):
+        raise InputError(f"detect needs a Frame (symfruit.io.read_frame or a frame source), got {type(frame).__name__}")
+    if settings is not None and not isinstance(settings, Settings):
+        raise InputError(f"settings must be a Settings (symfruit.resolve_settings), got {type(settings).__name__}")
     settings = settings or Settings()
     t0 = time.perf_counter()
     labels, source = frame_masks(frame, masks, settings)

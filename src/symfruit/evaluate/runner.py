@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..complete import complete
-from ..errors import SymfruitError
+from ..errors import InputError, SymfruitError
 from ..metrics import score_completion
 from ..progress import Progress
 from ..settings import Settings
@@ -106,6 +106,8 @@ def run(
         single-threaded BLAS so workers do not fight over cores.
     """
     settings = settings or Settings()
+    if jobs is not None and (isinstance(jobs, bool) or not isinstance(jobs, int) or jobs < 1):
+        raise InputError(f"jobs must be a whole number >= 1, got {jobs!r}")
     jobs = jobs or os.cpu_count() or 1
     chunk = max(1, min(8, len(specs) // (4 * jobs) or 1))
     batches = [list(specs[i : i + chunk]) for i in range(0, len(specs), chunk)]

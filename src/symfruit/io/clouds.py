@@ -41,8 +41,10 @@ def read_cloud(path: str | Path) -> np.ndarray:
     if reader is None:
         known = ", ".join(sorted(CLOUD_READERS))
         raise FileFormatError(f"{path}: unknown cloud extension {path.suffix!r}; use one of {known}")
-    if not path.is_file():
+    if not path.exists():
         raise FileFormatError(f"{path}: no such file")
+    if not path.is_file():
+        raise FileFormatError(f"{path}: not a regular file (a folder or a device)")
     try:
         points = reader(path)
     except FileFormatError:
@@ -155,8 +157,10 @@ def read_pcd(path: Path) -> np.ndarray:
         mode = fields["DATA"][0].lower()
     except (KeyError, ValueError, IndexError):
         raise FileFormatError(f"{path}: PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA") from None
-    if not (len(names) == len(sizes) == len(types) == len(counts)) or n < 0:
+    if not (len(names) == len(sizes) == len(types) == len(counts)) or n < 0 or min(counts, default=1) < 1:
         raise FileFormatError(f"{path}: PCD header's FIELDS, SIZE, TYPE and COUNT disagree")
+    if n > MAX_CLOUD_POINTS:
+        raise FileFormatError(f"{path}: PCD holds {n:,} points; at most {MAX_CLOUD_POINTS:,} are read")
     missing = [c for c in ("x", "y", "z") if c not in names]
     if missing:
         raise FileFormatError(f"{path}: PCD has no field {missing[0]!r} (fields: {' '.join(names)})")
@@ -171,8 +175,8 @@ def read_pcd(path: Path) -> np.ndarray:
         if mode == "ascii":
             if n * 2 * len(names) > body_size + 1:
                 raise FileFormatError(f"{path}: header promises {n} points but the file is too short")
-            body = handle.read()
-            values = np.loadtxt(io.BytesIO(body), ndmin=2, dtype=np.float64)
+            text = io.TextIOWrapper(handle, encoding="ascii", errors="replace")
+            values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
             if len(values) < n:
                 raise FileFormatError(f"{path}: header promises {n} points, the file holds {len(values)}")
             columns = np.cumsum([0, *counts])
@@ -189,10 +193,11 @@ def read_pcd(path: Path) -> np.ndarray:
             raw = handle.read(8)
             if len(raw) < 8:
                 raise FileFormatError(f"{path}: truncated binary_compressed PCD (no size words)")
-            packed, unpacked = np.frombuffer(raw, dtype="<u4")
-            if unpacked != n * row or packed > body_size - 8:
+            packed, unpacked = (int(v) for v in np.frombuffer(raw, dtype="<u4"))
+            # LZF expands at most ~132-fold (a 3-byte back reference copies up to 264 bytes).
+            if unpacked != n * row or packed > body_size - 8 or unpacked > 132 * packed + 64:
                 raise FileFormatError(f"{path}: binary_compressed sizes do not match the header or the file")
-            data = _lzf_decompress(handle.read(int(packed)), int(unpacked), path)
+            data = _lzf_decompress(handle.read(packed), unpacked, path)
             out, offset = [], 0
             for d, c in zip(dtypes, counts, strict=True):  # column-major: field after field
                 out.append(np.frombuffer(data, dtype=d, count=n * c, offset=offset).reshape(n, c))
@@ -202,7 +207,11 @@ def read_pcd(path: Path) -> np.ndarray:
 
 
 def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
-    """Decompress LZF (as PCL writes ``binary_compressed``)."""
+    """Decompress LZF (as PCL writes ``binary_compressed``); ``size`` is bounded by the caller.
+
+    Our own decoder (the format is 30 lines; PyPI's python-lzf ships no wheels, only a C source to build):
+    literal runs and non-overlapping back references are slice copies, so it runs at tens of MB/s.
+    """
     out = bytearray(size)
     i = o = 0
     n = len(data)
@@ -228,8 +237,11 @@ def _lzf_decompress(data: bytes, size: int, path: Path) -> bytes:
                 length += 2
                 if ref < 0 or o + length > size:
                     raise IndexError
-                for k in range(length):  # may overlap, so byte by byte
-                    out[o + k] = out[ref + k]
+                if ref + length <= o:  # no overlap: one slice copy
+                    out[o : o + length] = out[ref : ref + length]
+                else:  # overlapping (a repeated run): byte by byte
+                    for k in range(length):
+                        out[o + k] = out[ref + k]
                 o += length
     except IndexError:
         raise FileFormatError(f"{path}: corrupt LZF data in binary_compressed PCD") from None
@@ -333,7 +345,9 @@ def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
 
 def read_npy(path: Path) -> np.ndarray:
     """NumPy ``.npy``: an (n, >=3) numeric array or a structured array with x, y, z; never pickles."""
-    npy_header(path)
+    shape, _ = npy_header(path)
+    if shape and shape[0] > MAX_CLOUD_POINTS:
+        raise FileFormatError(f"{path}: .npy holds {shape[0]:,} rows; at most {MAX_CLOUD_POINTS:,} points are read")
     try:
         arr = np.load(path, allow_pickle=False, mmap_mode="r")
     except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...
@@ -345,6 +359,8 @@ def read_npy(path: Path) -> np.ndarray:
         return np.column_stack([np.asarray(arr[c], dtype=np.float64) for c in ("x", "y", "z")])
     if arr.ndim != 2 or arr.shape[1] < 3 or not np.issubdtype(arr.dtype, np.number):
         raise FileFormatError(f"{path}: expected a numeric (n, 3) array, got {arr.dtype} {arr.shape}")
+    if np.iscomplexobj(arr):
+        raise FileFormatError(f"{path}: complex numbers cannot be coordinates")
     return np.asarray(arr[:, :3], dtype=np.float64)
 
 
