@@ -1,5 +1,10 @@
-"""Shared fixtures and helpers: known-answer solids seen by the default camera, the shipped example data,
-and the hypothesis profiles.
+"""Shared fixtures and helpers: known-answer solids seen by the default camera, small synthetic RGB-D
+frames, point-cloud writers the readers are tested against, the shipped example data, and the hypothesis
+profiles.
+
+The test tree mirrors ``src/symfruit``: ``tests/core/test_box.py`` tests ``symfruit/core/box.py`` and so on.
+Test modules never import each other; what two of them share lives here, as a fixture or as a helper
+imported with ``from ..conftest import NAME`` (``from .conftest import NAME`` at the top level).
 
 Property and fuzz tests run the derandomised ``ci`` profile by default: the same cases on every run,
 ``SYMFRUIT_FUZZ_EXAMPLES`` of them (default 40), so a failure in CI is a failure on every machine. The
@@ -17,6 +22,7 @@ import pytest
 from hypothesis import HealthCheck, settings
 
 import symfruit
+from symfruit import Camera
 
 _QUIET = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large]
 settings.register_profile(
@@ -32,11 +38,17 @@ settings.load_profile(os.environ.get("SYMFRUIT_HYPOTHESIS", "ci"))
 #: Examples per property test under the loaded profile (tests that are costlier run a share of it).
 FUZZ_EXAMPLES = settings.default.max_examples
 
-#: The repository's examples folder (sample cloud, camera) and the demo frame shipped as package data.
-EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+#: The repository's root, its examples folder (sample cloud, camera) and its package source.
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+SRC = ROOT / "src" / "symfruit"
+#: The demo frame shipped as package data.
 EXAMPLE_FRAME = Path(symfruit.__file__).resolve().parent / "data" / "example_frame"
 
 CENTRE = np.array([0.01, -0.02, 0.35])
+
+
+# --- known-answer solids -------------------------------------------------------------------------------
 
 
 def fibonacci_sphere(n: int) -> np.ndarray:
@@ -49,6 +61,12 @@ def fibonacci_sphere(n: int) -> np.ndarray:
 
 def sphere_cloud(radius: float = 0.02, n: int = 1200, centre: np.ndarray = CENTRE) -> np.ndarray:
     return radius * fibonacci_sphere(n) + centre
+
+
+def random_sphere(n: int = 2000, radius: float = 0.03, seed: int = 0) -> np.ndarray:
+    """(n, 3) seeded random points on a sphere of ``radius`` about :data:`CENTRE`."""
+    d = np.random.default_rng(seed).normal(size=(n, 3))
+    return radius * d / np.linalg.norm(d, axis=1, keepdims=True) + CENTRE
 
 
 def ellipsoid_cloud(axes=(0.018, 0.025, 0.015), n: int = 1200, centre: np.ndarray = CENTRE) -> np.ndarray:
@@ -70,6 +88,102 @@ def front_half(cloud: np.ndarray, centre: np.ndarray = CENTRE) -> np.ndarray:
     return cloud[cloud[:, 2] < centre[2]]
 
 
+#: The front half of the default sphere: the visible points of most end-to-end tests.
+VISIBLE = front_half(sphere_cloud())
+
+
+# --- small synthetic RGB-D frames ----------------------------------------------------------------------
+
+#: A 160x120 camera for small synthetic frames.
+SMALL_CAM = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
+
+
+def disc_frame(centres, radius=20, z=0.3, colour=(200, 20, 30)) -> tuple[np.ndarray, np.ndarray]:
+    """``(color (120, 160, 3) uint8, depth (120, 160) float32)`` of spheres seen by :data:`SMALL_CAM`.
+
+    Each ``(u, v)`` of ``centres`` is a sphere whose silhouette is a disc of ``radius`` pixels, its front
+    pole ``z`` metres away (``z`` may be one depth per sphere); the background is grey and 1 m away.
+    """
+    color = np.full((120, 160, 3), 90, np.uint8)
+    depth = np.full((120, 160), 1.0, np.float32)
+    yy, xx = np.mgrid[:120, :160]
+    zs = np.broadcast_to(np.asarray(z, dtype=np.float64), (len(centres),))
+    for (cx, cy), zk in zip(centres, zs, strict=True):
+        inside = (xx - cx) ** 2 + (yy - cy) ** 2 <= radius**2
+        color[inside] = colour
+        r_m = radius * zk / 600
+        d2 = ((xx - cx) ** 2 + (yy - cy) ** 2) * (zk / 600) ** 2
+        depth[inside] = np.minimum(depth[inside], (zk - np.sqrt(np.clip(r_m**2 - d2, 0, None)))[inside])
+    return color, depth
+
+
+# --- cloud files -----------------------------------------------------------------------------------------
+
+#: A small seeded cloud the readers and writers round-trip.
+POINTS = np.random.default_rng(0).normal(size=(40, 3)) * 0.01 + [0.0, 0.0, 0.3]
+
+
+def lzf_compress(data: bytes) -> bytes:
+    """A small greedy LZF compressor, to test the reader's back references."""
+    out, i, lit = bytearray(), 0, bytearray()
+
+    def flush():
+        while lit:
+            chunk = lit[:32]
+            out.append(len(chunk) - 1)
+            out.extend(chunk)
+            del lit[:32]
+
+    while i < len(data):
+        best_len, best_off = 0, 0
+        for off in range(1, min(i, 8192) + 1):
+            n = 0
+            while i + n < len(data) and n < 264 and data[i - off + n] == data[i + n]:
+                n += 1
+            if n > best_len:
+                best_len, best_off = n, off
+        if best_len >= 3:
+            flush()
+            length, ref = best_len - 2, best_off - 1
+            if length < 7:
+                out.append((length << 5) | (ref >> 8))
+            else:
+                out.append((7 << 5) | (ref >> 8))
+                out.append(length - 7)
+            out.append(ref & 0xFF)
+            i += best_len
+        else:
+            lit.append(data[i])
+            i += 1
+    flush()
+    return bytes(out)
+
+
+def write_pcd(path, points, mode, extra_field=False):
+    """Write a PCD v0.7 file in ``mode`` ``ascii``, ``binary`` or ``binary_compressed``."""
+    names = ["x", "y", "z"] + (["intensity"] if extra_field else [])
+    cols = np.c_[points, np.arange(len(points))] if extra_field else points
+    head = (
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\n"
+        f"FIELDS {' '.join(names)}\nSIZE {' '.join(['4'] * len(names))}\n"
+        f"TYPE {' '.join(['F'] * len(names))}\nCOUNT {' '.join(['1'] * len(names))}\n"
+        f"WIDTH {len(points)}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {len(points)}\nDATA {mode}\n"
+    )
+    arr = cols.astype("<f4")
+    if mode == "ascii":
+        body = "\n".join(" ".join(f"{v:.9g}" for v in row) for row in arr).encode() + b"\n"
+    elif mode == "binary":
+        body = arr.tobytes()
+    else:
+        raw = arr.T.copy().tobytes()  # field after field
+        packed = lzf_compress(raw)
+        body = np.array([len(packed), len(raw)], "<u4").tobytes() + packed
+    path.write_bytes(head.encode() + body)
+
+
+# --- fixtures --------------------------------------------------------------------------------------------
+
+
 @pytest.fixture
 def camera() -> symfruit.Camera:
     return symfruit.DEFAULT_CAMERA
@@ -78,3 +192,40 @@ def camera() -> symfruit.Camera:
 @pytest.fixture
 def sphere_view() -> np.ndarray:
     return front_half(sphere_cloud())
+
+
+def _read_only(frame):
+    """The frame with its arrays made read-only: a test or a stage that writes into a shared frame fails."""
+    for arr in (frame.color, frame.depth, frame.masks):
+        if arr is not None:
+            arr.flags.writeable = False
+    return frame
+
+
+@pytest.fixture(scope="session")
+def example():
+    """The shipped example frame (read once; its arrays are read-only)."""
+    from symfruit.io.frames import read_frame
+
+    return _read_only(read_frame(EXAMPLE_FRAME))
+
+
+@pytest.fixture(scope="session")
+def example_found(example):
+    """``detect(example, method="paper")``, computed once."""
+    from symfruit.detect import detect
+
+    return detect(example, method="paper")
+
+
+@pytest.fixture
+def isolated_registry(monkeypatch):
+    """Lets a test register completion methods, settings sections and frame sources without leaking
+    them into other tests: the registries are copies, restored afterwards."""
+    from symfruit import settings as settings_module
+    from symfruit.io import sources
+    from symfruit.methods import registry
+
+    monkeypatch.setattr(settings_module, "_SECTIONS", dict(settings_module._SECTIONS))
+    monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
+    monkeypatch.setattr(sources, "_KINDS", list(sources._KINDS))

@@ -1,19 +1,18 @@
-"""The command line: round trip on each format, outputs, errors on one line."""
+"""The command line: round trip on each format, every command, outputs, errors on one line."""
 
 import json
+import os
+import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from symfruit import __version__
+from symfruit import Settings, __version__
 from symfruit.cli import main
 from symfruit.io import read_cloud
 
-from .conftest import EXAMPLES, front_half, sphere_cloud
-from .test_io import write_pcd
-
-VISIBLE = front_half(sphere_cloud())
+from .conftest import EXAMPLE_FRAME, EXAMPLES, VISIBLE, front_half, sphere_cloud, write_pcd
 
 
 def write(path: Path, points: np.ndarray) -> None:
@@ -157,3 +156,114 @@ def test_bench_runs_and_reports(capsys):
     assert [r["method"] for r in rows] == ["paper", "paper", "fused", "fused", "sphere", "ellipsoid", "raw"]
     assert [r["planes"] for r in rows][:2] == [132, 1320]
     assert all(r["median_ms"] > 0 for r in rows)
+
+
+def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
+    assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
+    assert (tmp_path / "d" / "example_frame" / "detections.json").exists()
+    assert main(["demo", "--output", str(tmp_path / "demo")]) == 0
+    out = capsys.readouterr().out
+    assert "mean centre error: raw" in out and "overlay:" in out
+    frames = str(EXAMPLE_FRAME.parent)
+    assert main(["evaluate", "--frames", frames, "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
+    assert "Table 3" in capsys.readouterr().out
+    assert main(["bench", "--frame", "--repeat", "1", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["rows"][0]
+    assert row["points"] >= 6 and row["median_ms"] > 0 and row["method"] == "paper"
+    assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
+
+
+def test_evaluate_command(tmp_path, capsys):
+    assert main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
+    out = capsys.readouterr().out
+    assert "| raw |" in out and "results: " in out
+    assert main(["evaluate", "--fruit", "banana"]) == 2
+    assert "not a fruit kind" in capsys.readouterr().err
+    assert main(["evaluate", "--methods", "raw,nope"]) == 2
+    assert main(["evaluate", "--protocol", "camera", "--occlusion", "0,1.5"]) == 2
+
+
+def test_cli_fruit_profile(tmp_path, capsys):
+    import json
+
+    from symfruit.cli import main
+
+    np.save(tmp_path / "a.npy", front_half(sphere_cloud()))
+    assert (
+        main(["complete", str(tmp_path / "a.npy"), "--fruit", "citrus", "--json", "--output", str(tmp_path / "o.ply")])
+        == 0
+    )
+    capsys.readouterr()
+    saved = json.loads((tmp_path / "o.json").read_text())
+    assert saved["settings"]["fused"]["depth_ratio"] == 1.1
+    assert main(["complete", str(tmp_path / "a.npy"), "--fruit", "banana"]) == 2
+
+
+def test_odd_path_names(tmp_path, capsys):
+    from symfruit.io import write_ply
+
+    odd = Path(os.fsdecode(bytes(tmp_path) + b"/fr\xfcit \xe2\x80\x94 [1].ply"))  # Latin-1 byte: not UTF-8
+    write_ply(odd, VISIBLE)
+    assert main(["complete", str(odd), "--json"]) == 0
+    capsys.readouterr()
+    missing = Path(os.fsdecode(bytes(tmp_path) + b"/n\xfcll.ply"))
+    assert main(["complete", str(missing)]) == 2
+    err = capsys.readouterr().err
+    assert "no such file" in err and err.count("\n") == 1
+
+
+def test_output_folder_that_cannot_be_written(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    np.save(tmp_path / "a.npy", VISIBLE)
+    assert main(["complete", str(tmp_path / "a.npy"), "--output", str(blocker / "out.ply")]) == 2
+    assert "cannot write to folder" in capsys.readouterr().err
+    assert main(["detect", str(EXAMPLE_FRAME), "--output", str(blocker / "out")]) == 2
+    assert "cannot write to folder" in capsys.readouterr().err
+
+
+def test_detect_exits_1_when_a_frame_failed_and_names_it(tmp_path, capsys):
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "good")
+    shutil.copytree(EXAMPLE_FRAME, rec / "bad")
+    (rec / "bad" / "color.png").write_bytes(b"broken")
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
+    out = capsys.readouterr().out
+    assert "frames: 1 done, 0 skipped (resume), 1 failed; fruit: 6 located, 0 failed" in out
+    assert "  failed bad: " in out and "color.png" in out and f"results: {tmp_path / 'out'}" in out
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "nope"]) == 2
+
+
+def test_settings_prints_the_resolved_settings(tmp_path, capsys):
+    import yaml
+
+    config = tmp_path / "s.yaml"
+    config.write_text("fused:\n  mirror_weight: 0.3\n")
+    assert main(["settings", "--fruit", "strawberry", "--config", str(config)]) == 0
+    printed = yaml.safe_load(capsys.readouterr().out)
+    assert printed["fused"]["revolution"] is True and printed["fused"]["mirror_weight"] == 0.3
+    assert list(printed) == list(Settings().to_dict())  # every section, in order
+
+
+def test_complete_refuses_an_output_folder_and_prints_a_table(tmp_path, capsys):
+    np.save(tmp_path / "a.npy", VISIBLE)
+    (tmp_path / "taken.ply").mkdir()
+    assert main(["complete", str(tmp_path / "a.npy"), "--output", str(tmp_path / "taken.ply")]) == 2
+    assert "--output is a folder" in capsys.readouterr().err
+    assert main(["complete", str(tmp_path / "a.npy"), "--output", str(tmp_path / "o.ply")]) == 0
+    out = capsys.readouterr().out
+    for label in ("method", "centre", "size", "box min", "box max", "confidence", "points", "time", "written"):
+        assert any(line.startswith(label) for line in out.splitlines()), label
+    assert f"written    {tmp_path / 'o.ply'} and {tmp_path / 'o.json'}" in out
+
+
+def test_bench_arguments_are_checked(capsys):
+    assert main(["bench", "--repeat", "0"]) == 2
+    assert main(["bench", "--points", "5"]) == 2
+    assert main(["bench", "--recording", "0"]) == 2
+    assert "--recording must be between 1 and 100000 frames" in capsys.readouterr().err
+
+
+def test_no_command_prints_help(capsys):
+    assert main([]) == 2
+    assert "usage: symfruit" in capsys.readouterr().out

@@ -1,29 +1,21 @@
-"""The frame pipeline: detect, outputs, batches, the demo, Table 3 and the frame benchmark."""
+"""The frame pipeline: masks -> points -> completion -> boxes, for every fruit of a frame."""
 
-import json
-import shutil
+from dataclasses import replace
 
 import numpy as np
 import pytest
 
-from symfruit.batch import frame_folder_name, run_batch
-from symfruit.cli import main
-from symfruit.detect import detect
-from symfruit.evaluate.frames import evaluate_frames, match
-from symfruit.io.frames import read_frame
-from symfruit.writers import write_detections
+from symfruit import InputError, Settings
+from symfruit.detect import MAX_FRUIT_PER_FRAME, Detection, FrameDetections, detect, frame_masks
+from symfruit.evaluate.frames import match
+from symfruit.frame import Frame
 
-from .conftest import EXAMPLE_FRAME
+from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 
 
-@pytest.fixture(scope="module")
-def example():
-    return read_frame(EXAMPLE_FRAME)
-
-
-@pytest.fixture(scope="module")
-def found(example):
-    return detect(example, method="paper")
+@pytest.fixture
+def found(example_found):
+    return example_found
 
 
 def test_every_fruit_is_located_better_than_raw(example, found):
@@ -35,36 +27,6 @@ def test_every_fruit_is_located_better_than_raw(example, found):
     done = [np.linalg.norm(found.detections[i].result.centre - truth[j].centre) for i, j in pairs]
     # Measured: raw 10.4 mm, completed 3.6 mm on average.
     assert np.mean(done) < 0.6 * np.mean(raw) and np.mean(done) < 0.006
-
-
-def test_outputs_map_onto_detection3d(tmp_path, found):
-    written = write_detections(tmp_path, found)
-    assert {p.name for p in written} >= {"detections.json", "overlay.png", "fruit_001.ply"}
-    data = json.loads((tmp_path / "detections.json").read_text())
-    assert data["header"]["frame_id"] == "camera_color_optical_frame" and data["frame"] == "example_frame"
-    fruit = data["fruits"][0]
-    for key in (
-        "id",
-        "mask_area",
-        "n_points",
-        "centre",
-        "box",
-        "method",
-        "plane",
-        "score",
-        "truncated",
-        "bbox",
-    ):
-        assert key in fruit
-    bbox = fruit["bbox"]
-    assert [bbox["center"]["position"][k] for k in "xyz"] == fruit["centre"]
-    assert [bbox["size"][k] for k in "xyz"] == fruit["box"]["size"]
-    assert bbox["center"]["orientation"] == {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
-    from PIL import Image
-
-    overlay = np.asarray(Image.open(tmp_path / "overlay.png"))
-    assert overlay.shape == (480, 640, 3)
-    assert (np.abs(overlay.astype(int) - [0, 220, 255]).sum(axis=2) == 0).sum() > 100  # cyan cuboids drawn
 
 
 def test_methods_and_mask_sources(example, tmp_path):
@@ -86,7 +48,6 @@ def test_a_mask_over_the_whole_image_and_empty_depth_are_refused(example):
 
     with pytest.raises(InputError, match="covers the whole image"):
         detect(example, masks=lambda f, s: np.ones(f.depth.shape, np.int32))
-    from dataclasses import replace
 
     empty = replace(example, depth=np.zeros_like(example.depth))
     with pytest.raises(InputError, match="no valid depth"):
@@ -94,7 +55,6 @@ def test_a_mask_over_the_whole_image_and_empty_depth_are_refused(example):
 
 
 def test_a_fruit_without_depth_is_reported_not_fatal(example):
-    from dataclasses import replace
 
     from symfruit.segment import segment
 
@@ -106,47 +66,88 @@ def test_a_fruit_without_depth_is_reported_not_fatal(example):
     assert all(d.result is not None for d in found.detections[1:])
 
 
-def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
-    frames = tmp_path / "rec"
-    for name in ("f1", "f2", "f3"):
-        shutil.copytree(EXAMPLE_FRAME, frames / name)
-    (frames / "f2" / "depth.png").write_bytes(b"not a png")
-    out = tmp_path / "out"
-    report = run_batch(frames, out, method="raw", progress=False)
-    assert report.done == ["f1", "f3"] and list(report.failed) == ["f2"] and not report.ok
-    errors = json.loads((out / "errors.json").read_text())
-    assert errors["failed"][0]["frame"] == "f2" and "depth.png" in errors["failed"][0]["reason"]
-    before = (out / "f1" / "detections.json").read_bytes()
-    again = run_batch(frames, out, method="raw", resume=True, progress=False)
-    assert again.skipped == ["f1", "f3"] and (out / "f1" / "detections.json").read_bytes() == before
+def test_an_empty_mask_gives_no_fruit_and_no_error():
+    from symfruit.detect import detect
+    from symfruit.io.frames import read_frame
+
+    frame = read_frame(EXAMPLE_FRAME)
+    found = detect(frame, masks=lambda f, s: np.zeros(f.depth.shape, np.int32))
+    assert found.detections == []
 
 
-def test_frame_folder_names_stay_in_their_folder_and_never_collide():
-    assert frame_folder_name("f1") == "f1"
-    assert frame_folder_name("../../etc/passwd").startswith("etc_passwd-")
-    assert frame_folder_name("a b/c").startswith("a_b_c-") and frame_folder_name("...").startswith("frame-")
-    assert frame_folder_name("a b") != frame_folder_name("a?b")  # sanitised alike, told apart by the hash
+def small_frame(**kw):
+    color, depth = disc_frame([(40, 60), (120, 60)], radius=15)
+    return Frame("small", color, depth, SMALL_CAM, **kw)
 
 
-def test_table3_on_frames(tmp_path):
-    shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
-    scores, totals, failed = evaluate_frames(tmp_path, methods=("raw", "paper"))
-    assert totals["matched"] == 6 and totals["missed"] == 0 and totals["false"] == 0 and not failed
-    raw = np.mean([s.centre_mm for s in scores if s.method == "raw"])
-    paper = np.mean([s.centre_mm for s in scores if s.method == "paper"])
-    assert paper < raw
+def test_each_fruit_is_numbered_boxed_and_timed():
+    found = detect(small_frame(), method="raw")
+    assert isinstance(found, FrameDetections) and found.mask_source == "colour segmenter"
+    assert [d.id for d in found.detections] == [1, 2] and all(isinstance(d, Detection) for d in found.detections)
+    left, right = found.detections
+    assert left.visible_box.centre[0] < 0 < right.visible_box.centre[0]
+    assert left.mask[60, 40] and not left.mask[60, 120] and left.mask.shape == (120, 160)
+    assert np.array_equal(left.result.box.min, left.extraction.points.min(axis=0))  # raw: the visible box
+    assert set(found.timings) == {"segment", "extract", "complete", "total"}
+    assert all(v >= 0 for v in found.timings.values()) and found.timings["total"] >= found.timings["segment"]
 
 
-def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
-    assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
-    assert (tmp_path / "d" / "example_frame" / "detections.json").exists()
-    assert main(["demo", "--output", str(tmp_path / "demo")]) == 0
-    out = capsys.readouterr().out
-    assert "mean centre error: raw" in out and "overlay:" in out
-    frames = str(EXAMPLE_FRAME.parent)
-    assert main(["evaluate", "--frames", frames, "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
-    assert "Table 3" in capsys.readouterr().out
-    assert main(["bench", "--frame", "--repeat", "1", "--json"]) == 0
-    row = json.loads(capsys.readouterr().out)["rows"][0]
-    assert row["points"] >= 6 and row["median_ms"] > 0 and row["method"] == "paper"
-    assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
+def test_mask_sources_in_order_of_preference(tmp_path):
+    labels = np.zeros((120, 160), np.int32)
+    labels[45:76, 105:136] = 7  # only the right fruit
+    frame = small_frame(masks=labels)
+    got, source = frame_masks(frame)
+    assert source == "frame masks file" and np.array_equal(got, labels)
+    got, source = frame_masks(frame, "color")
+    assert source == "colour segmenter" and got.max() == 2
+
+    def my_masks(frame, settings):
+        assert isinstance(settings, Settings)
+        return labels.astype(np.uint8)
+
+    got, source = frame_masks(frame, my_masks)
+    assert source == "my_masks" and got.dtype == np.int32 and np.array_equal(got, labels)
+    found = detect(frame, method="raw")
+    assert [d.id for d in found.detections] == [7] and found.mask_source == "frame masks file"
+
+
+def test_masks_that_do_not_fit_the_frame_are_refused():
+    frame = small_frame()
+    with pytest.raises(InputError, match=r"frame small: masks are \(10, 10\), the image \(160, 120\)"):
+        frame_masks(frame, lambda f, s: np.zeros((10, 10), np.int32))
+    negative = np.zeros((120, 160), np.int32)
+    negative[0, 0] = -1
+    with pytest.raises(InputError, match="masks hold negative labels"):
+        detect(frame, masks=lambda f, s: negative)
+
+
+def test_sparse_instance_ids_are_kept_and_too_many_instances_refused():
+    labels = np.zeros((120, 160), np.int32)
+    labels[45:76, 25:56] = 5000
+    labels[45:76, 105:136] = 70_000
+    found = detect(small_frame(), masks=lambda f, s: labels, method="raw")
+    assert len(found.detections) == 2 and all(d.result is not None for d in found.detections)
+    assert found.detections[0].mask[60, 40] and found.detections[1].mask[60, 120]
+    many = np.arange(120 * 160, dtype=np.int32).reshape(120, 160) % (MAX_FRUIT_PER_FRAME + 2)
+    with pytest.raises(InputError, match=f"masks hold {MAX_FRUIT_PER_FRAME + 1} instances; at most"):
+        detect(small_frame(), masks=lambda f, s: many)
+
+
+def test_a_fruit_that_cannot_be_completed_is_kept_with_its_reason():
+    labels = np.zeros((120, 160), np.int32)
+    labels[45:76, 25:56] = 1
+    labels[2:4, 2:4] = 2  # four pixels: too few points
+    found = detect(small_frame(), masks=lambda f, s: labels, method="raw")
+    ok, tiny = found.detections
+    assert ok.result is not None and ok.error == ""
+    assert tiny.result is None and tiny.id == 2
+    assert tiny.error == "only 4 points with valid depth (extract.min_points = 30); 0 of 4 mask pixels had no depth"
+
+
+def test_the_method_and_settings_reach_every_fruit(example):
+    few = Settings().replace(paper={"translations": 1, "rotations_x": 1, "rotations_y": 1})
+    found = detect(example, method="paper", settings=few)
+    assert all(len(d.result.scores) == 1 and d.result.settings == few for d in found.detections)
+    assert EXAMPLE_FRAME.name == example.name
+    pairs = match([d.visible_box for d in found.detections], [b for _, b in example.truth])
+    assert len(pairs) == 6

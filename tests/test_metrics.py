@@ -1,30 +1,12 @@
+"""Metrics of a completion against the truth: Chamfer distance, F1, and the box scores in millimetres.
+
+(Box IoU and centre deviation live with the box, in ``tests/core/test_box.py``.)"""
+
 import numpy as np
 import pytest
 
-from symfruit import Box, box_iou, centre_deviation
-from symfruit.metrics import chamfer_f1, score_completion
-
-UNIT = Box(np.zeros(3), np.ones(3))
-
-
-@pytest.mark.parametrize(
-    "other, iou",
-    [
-        (UNIT, 1.0),  # identical
-        (Box(np.full(3, 2.0), np.full(3, 3.0)), 0.0),  # disjoint
-        (Box(np.full(3, 1.0), np.full(3, 2.0)), 0.0),  # touching at a corner
-        (Box(np.full(3, 0.25), np.full(3, 0.75)), 0.125),  # nested: 0.5^3 / 1
-        (Box(np.array([0.5, 0, 0]), np.array([1.5, 1, 1])), 1 / 3),  # shifted by half along x
-        (Box(np.array([0.5, 0.5, 0]), np.array([1.5, 1.5, 1])), 0.25 / 1.75),  # shifted along x and y
-    ],
-)
-def test_box_iou_known_answers(other, iou):
-    assert box_iou(UNIT, other) == pytest.approx(iou)
-    assert box_iou(other, UNIT) == pytest.approx(iou)
-
-
-def test_centre_deviation():
-    assert centre_deviation(UNIT, Box(np.array([3.0, 4.0, 0.0]), np.array([4.0, 5.0, 1.0]))) == pytest.approx(5.0)
+from symfruit import Box
+from symfruit.metrics import Scores, chamfer_f1, score_completion
 
 
 def test_chamfer_and_f1_known_answers():
@@ -49,3 +31,15 @@ def test_score_completion_in_millimetres():
     moved = Box(box.min + [0.003, 0.004, 0], box.max + [0.003, 0.004, 0])
     s = score_completion(moved, pts, box, pts)
     assert s.centre_mm == pytest.approx(5.0) and s.chamfer_mm == 0.0 and s.f1 == 1.0 and 0 < s.iou < 1
+
+
+def test_chamfer_is_the_mean_of_both_directions_and_the_threshold_is_a_keyword():
+    a = np.array([[0.0, 0.0, 0.0]])
+    b = np.array([[0.0, 0.0, 0.0], [0.004, 0.0, 0.0]])
+    chamfer, f1, precision, recall = chamfer_f1(a, b)
+    assert chamfer == pytest.approx((0.0 + 0.002) / 2) and precision == 1.0 and recall == 1.0 and f1 == 1.0
+    chamfer, f1, precision, recall = chamfer_f1(a, b, threshold=0.003)
+    assert (precision, recall) == (1.0, 0.5) and f1 == pytest.approx(2 / 3)
+    cube = Box(np.zeros(3), np.full(3, 0.004))
+    s = score_completion(cube, a, cube, b)
+    assert isinstance(s, Scores) and s.iou == 1.0 and s.centre_mm == 0.0 and s.chamfer_mm == pytest.approx(1.0)

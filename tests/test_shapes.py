@@ -1,8 +1,8 @@
+"""Parametric fruit surfaces and scans: closed, centred, sized, seeded."""
+
 import numpy as np
 import pytest
 
-from symfruit import Camera
-from symfruit.render import SensorNoise, render
 from symfruit.shapes import FRUITS, STRAWBERRY_CLASSES, load_scans, paper_visible, rotation, strawberry
 
 from .conftest import fibonacci_sphere
@@ -58,25 +58,6 @@ def test_sampling_is_uniform_on_a_sphere():
     pts = sample_surface(hull.points, hull.simplices, 20000, np.random.default_rng(0))
     assert np.abs(pts.mean(axis=0)).max() < 0.02
     assert np.allclose(np.linalg.norm(pts, axis=1), 1.0, atol=0.01)
-
-
-def test_render_sphere_depth_is_exact():
-    from scipy.spatial import ConvexHull
-
-    cam = Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
-    hull = ConvexHull(fibonacci_sphere(4000))
-    centre = np.array([0.0, 0.0, 0.4])
-    shot = render([(hull.points * 0.03 + centre, hull.simplices)], cam)
-    assert shot.depth[240, 320] == pytest.approx(0.37, abs=2e-4)
-    radius_px = 600 * 0.03 / np.sqrt(0.4**2 - 0.03**2)
-    assert (shot.ids == 0).sum() == pytest.approx(np.pi * radius_px**2, rel=0.03)
-    assert shot.facing[240, 320] == pytest.approx(1.0, abs=1e-3)
-    assert np.all(np.isinf(shot.depth[shot.ids < 0]))
-
-
-def test_sensor_noise_grows_with_distance():
-    noise = SensorNoise()
-    assert noise.sigma(0.3) == pytest.approx(0.001) and noise.sigma(0.6) == pytest.approx(0.004)
 
 
 def test_paper_visibility_rule_keeps_the_front_half_of_a_sphere():

@@ -1,4 +1,5 @@
-"""The evaluation: protocols, the quick run CI relies on, reports and the command."""
+"""The evaluation entry point (:func:`symfruit.evaluate.evaluate`): the quick run CI relies on, every output,
+the camera protocol with occlusion, scan folders, and the full paper protocol (slow)."""
 
 import csv
 import json
@@ -6,39 +7,7 @@ import json
 import numpy as np
 import pytest
 
-from symfruit.cli import main
 from symfruit.evaluate import evaluate
-from symfruit.evaluate.protocols import PAPER_ANGLES, PAPER_DISTANCE, build, specs
-
-
-def test_paper_protocol_is_algorithm_2():
-    all_specs = specs("paper", "strawberry", n=10)
-    assert len(all_specs) == 190 and len(PAPER_ANGLES) == 19
-    assert PAPER_ANGLES[0] == -45 and PAPER_ANGLES[-1] == 45
-    inst = build(all_specs[0])
-    assert 100 < len(inst.visible) < 600
-    assert inst.truth_box.contains(inst.visible)
-    assert np.allclose(inst.truth_box.centre, [0, 0, PAPER_DISTANCE])
-    again = build(all_specs[0])
-    assert np.array_equal(inst.visible, again.visible)
-    # The same 600 points in every pose of a fruit: the truth box volume changes only by rotation.
-    other = build(all_specs[9])
-    assert len(other.truth_surface) == len(inst.truth_surface) == 600
-
-
-def test_camera_protocol_instances():
-    spec = specs("camera", "strawberry", n=3, occlusions=(0.0, 0.3))
-    assert len(spec) == 6
-    clear, covered = build(spec[0]), build(spec[3])
-    assert clear.hidden == 0.0 and 0.2 < covered.hidden < 0.4
-    assert 0.25 <= clear.distance <= 0.6
-    assert len(covered.visible) < len(clear.visible)
-    # Noisy points lie near the true surface, and inside an enlarged truth box.
-    assert clear.truth_box.contains(clear.visible, tol=0.01)
-    from scipy.spatial import cKDTree
-
-    d, _ = cKDTree(clear.truth_surface).query(clear.visible)
-    assert np.median(d) < 0.003
 
 
 @pytest.fixture(scope="module")
@@ -102,16 +71,6 @@ def test_scan_folder_runs_both_protocols(tmp_path):
     assert len(camera.rows) == 3 and all(r.n_visible > 50 for r in camera.rows)
 
 
-def test_evaluate_command(tmp_path, capsys):
-    assert main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
-    out = capsys.readouterr().out
-    assert "| raw |" in out and "results: " in out
-    assert main(["evaluate", "--fruit", "banana"]) == 2
-    assert "not a fruit kind" in capsys.readouterr().err
-    assert main(["evaluate", "--methods", "raw,nope"]) == 2
-    assert main(["evaluate", "--protocol", "camera", "--occlusion", "0,1.5"]) == 2
-
-
 @pytest.mark.slow
 @pytest.mark.parametrize("fruit", ["strawberry", "apple", "citrus", "tomato"])
 def test_full_paper_protocol(fruit):
@@ -120,3 +79,25 @@ def test_full_paper_protocol(fruit):
     assert by["raw"]["n"] == 190
     assert by["paper"]["iou_mean"] > by["raw"]["iou_mean"] + 0.1
     assert by["paper"]["centre_mm_mean"] < by["raw"]["centre_mm_mean"]
+
+
+def test_settings_given_are_used_for_every_fruit_and_nothing_is_written_without_an_output(tmp_path):
+    from symfruit import Settings
+
+    mine = Settings().replace(paper={"translations": 2})
+    result = evaluate(protocol="paper", fruits=("apple", "tomato"), n=1, methods=("paper",), settings=mine,
+                      output=None, jobs=1, progress=False)  # fmt: skip
+    assert result.folder is None and len(result.rows) == 2 * 19
+    assert {r.fruit for r in result.rows} == {"apple", "tomato"} and not any(r.error for r in result.rows)
+    assert "## paper protocol: apple" in result.table and "## paper protocol: tomato" in result.table
+
+
+def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path):
+    config = tmp_path / "s.yaml"
+    config.write_text("fused:\n  depth_ratio: 1.7\n")
+    result = evaluate(protocol="paper", fruits=("strawberry", "apple"), n=1, methods=("raw",), config=config,
+                      output=tmp_path / "out", jobs=1, progress=False, quick=True)  # fmt: skip
+    saved = json.loads((result.folder / "settings.json").read_text())["settings"]
+    assert saved["strawberry"]["fused"]["depth_ratio"] == 1.7 and saved["strawberry"]["fused"]["revolution"] is True
+    assert saved["apple"]["fused"]["depth_ratio"] == 1.7 and saved["apple"]["fused"]["mirror_weight"] == 0.25
+    assert saved["apple"]["fused"]["mirror"]["translations"] == 4  # the apple profile's nested mirror section

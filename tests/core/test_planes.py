@@ -73,3 +73,51 @@ def test_rotations_are_about_x_and_y_not_z(sphere_view):
 @pytest.mark.parametrize("m, j, k", [(1, 1, 1), (2, 5, 7), (10, 22, 6)])
 def test_grid_sizes(sphere_view, m, j, k):
     assert len(hypothesis_planes(sphere_view, translations=m, rotations_x=j, rotations_y=k)) == m * j * k
+
+
+def test_mirror_accepts_lists_and_integers():
+    assert np.allclose(mirror([[1, 2, 3]], [0, 0, 0], [0, 0, 2]), [[1.0, 2.0, -3.0]])  # the normal is normalised
+    batch = mirror([[1, 2, 3]], [[0, 0, 0], [1, 0, 0]], [[0, 0, 1], [1, 0, 0]])
+    assert batch.shape == (2, 1, 3) and np.allclose(batch, [[[1.0, 2.0, -3.0]], [[1.0, 2.0, 3.0]]])
+
+
+def test_planes_index_to_copies_and_serialise(sphere_view):
+    planes = hypothesis_planes(sphere_view, translations=2, rotations_x=1, rotations_y=1)
+    first = planes[1]
+    assert np.array_equal(first.point, planes.points[1]) and np.array_equal(first.normal, planes.normals[1])
+    first.point[0] = 99.0
+    assert planes.points[1, 0] != 99.0  # a copy: the batch is untouched
+    assert planes[0].to_dict() == {"point": planes.points[0].tolist(), "normal": [0.0, 0.0, 1.0]}
+
+
+def test_first_translation_and_negative_steps(sphere_view):
+    len_depth = np.ptp(sphere_view[:, 2])
+    planes = hypothesis_planes(sphere_view, translations=2, translation_first=-1.0, rotations_x=1, rotations_y=1)
+    assert np.allclose(planes.offsets, [-0.2 * len_depth, 0.0])
+    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=3, rotation_x_step=-10.0, rotations_y=1)
+    assert np.allclose(planes.angles_x, [10.0, 0.0, -10.0])
+
+
+@pytest.mark.xfail(
+    strict=True, reason="src bug: hypothesis_planes does not normalise its input (list -> AttributeError)"
+)
+def test_hypothesis_planes_accept_a_list(sphere_view):
+    assert len(hypothesis_planes(sphere_view.tolist())) == 132
+
+
+@pytest.mark.xfail(strict=True, reason="src bug: hypothesis_planes((n, 2)) raises a bare IndexError, not InputError")
+def test_hypothesis_planes_refuse_wrong_shapes():
+    from symfruit import InputError
+
+    with pytest.raises(InputError, match="shape"):
+        hypothesis_planes(np.zeros((5, 2)))
+
+
+@pytest.mark.xfail(
+    strict=True, reason="src bug: mirror((n, 2) points) raises numpy's broadcast ValueError, not InputError"
+)
+def test_mirror_refuses_wrong_shapes():
+    from symfruit import InputError
+
+    with pytest.raises(InputError, match="shape"):
+        mirror(np.zeros((5, 2)), [0.0, 0.0, 0.0], [0.0, 0.0, 1.0])

@@ -5,10 +5,9 @@ import pytest
 
 import symfruit
 from symfruit.core.raster import rasterise
-from symfruit.core.rating import rate_planes, rate_points
-from symfruit.methods.paper import PaperSettings
+from symfruit.core.rating import Table1, rate_planes, rate_points
 
-from .conftest import CENTRE
+from ..conftest import CENTRE
 
 
 @pytest.fixture
@@ -19,7 +18,7 @@ def scene(sphere_view, camera):
     return sphere_view, view, centroid, dist_ref
 
 
-def rate_targets(scene, camera, targets, settings, dtype=np.float64):
+def rate_targets(scene, camera, targets, table, scoring="continuous", dtype=np.float64):
     """Rate one mirrored point per target: the plane maps a visible point onto the target."""
     visible, view, centroid, dist_ref = scene
     source = visible[np.argmin(visible[:, 2])][None]  # the front pole
@@ -27,7 +26,7 @@ def rate_targets(scene, camera, targets, settings, dtype=np.float64):
     normals = targets - source
     points = (targets + source) / 2.0
     rating = rate_points(source, points, normals, view, camera, centre=centroid, dist_ref=dist_ref,
-                         table=settings.table, scoring=settings.scoring, dtype=dtype)  # fmt: skip
+                         table=table, scoring=scoring, dtype=dtype)  # fmt: skip
     return rating.scores[:, 0], rating.locations[:, 0], rating
 
 
@@ -42,7 +41,7 @@ def centre_pixel(camera):
 
 @pytest.mark.parametrize("scoring", ["continuous", "literal"])
 def test_each_location_is_hit_and_scored(scene, camera, scoring):
-    s = PaperSettings(scoring=scoring)
+    s = Table1()
     _, view, centroid, r = scene
     u, v = centre_pixel(camera)
     seen = view.near_depth[(round(v) - view.v0) * view.mask.shape[1] + round(u) - view.u0]
@@ -55,7 +54,7 @@ def test_each_location_is_hit_and_scored(scene, camera, scoring):
         43: CENTRE + [0.0, 0.0, 0.07],  # far behind
         1: CENTRE + [0.06, 0.0, 0.0],  # beside the fruit, outside the mask
     }
-    scores, locations, rating = rate_targets(scene, camera, np.array(list(targets.values())), s)
+    scores, locations, rating = rate_targets(scene, camera, np.array(list(targets.values())), s, scoring)
     assert locations.tolist() == list(targets)
     gap, d2c = rating.gap[:, 0], rating.dist2c[:, 0]
     assert np.allclose(d2c, np.linalg.norm(np.array(list(targets.values())) - centroid, axis=1))
@@ -86,7 +85,7 @@ def test_each_location_is_hit_and_scored(scene, camera, scoring):
 
 
 def test_continuous_scores_have_no_jumps_but_the_documented_one(scene, camera):
-    s = PaperSettings()
+    s = Table1()
     u, v = centre_pixel(camera)
     z = np.arange(0.30, 0.45, 2e-5)
     scores, locations, rating = rate_targets(scene, camera, ray(camera, u, v, z), s)
@@ -104,17 +103,17 @@ def test_continuous_scores_have_no_jumps_but_the_documented_one(scene, camera):
 
 
 def test_literal_scores_jump_at_borders(scene, camera):
-    s = PaperSettings(scoring="literal")
+    s = Table1()
     u, v = centre_pixel(camera)
     z = np.arange(0.30, 0.45, 2e-5)
-    scores, locations, _ = rate_targets(scene, camera, ray(camera, u, v, z), s)
+    scores, locations, _ = rate_targets(scene, camera, ray(camera, u, v, z), s, "literal")
     border = np.flatnonzero((locations[:-1] == 41) & (locations[1:] == 42))[0]
     assert scores[border] == pytest.approx(-1 / s.j2**2, rel=1e-3)  # Eq. 9 at Dist2c_0
     assert scores[border + 1] == s.k3
 
 
 def test_outside_penalty_grows_with_distance_and_is_continuous_at_the_silhouette(scene, camera):
-    s = PaperSettings()
+    s = Table1()
     u, v = centre_pixel(camera)
     us = np.arange(u, u + 120, 0.25)  # walk right along the image row at the centre's depth + 20 mm
     targets = ray(camera, us, np.full_like(us, v), np.full_like(us, CENTRE[2] + 0.02))
@@ -135,8 +134,7 @@ def test_fast_means_equal_per_point_means(scene, camera, scoring, dtype, tol):
     rng = np.random.default_rng(7)
     normals = rng.normal(size=(40, 3)) * [0.3, 0.3, 1.0]
     points = centroid + rng.normal(scale=0.005, size=(40, 3))
-    s = PaperSettings(scoring=scoring)
-    kw = {"centre": centroid, "dist_ref": r, "table": s.table, "scoring": s.scoring}
+    kw = {"centre": centroid, "dist_ref": r, "table": Table1(), "scoring": scoring}
     fast = rate_planes(visible, points, normals, view, camera, dtype=dtype, **kw)
     slow = rate_points(visible, points, normals, view, camera, dtype=np.float64, **kw)
     assert np.allclose(fast, slow.scores.mean(axis=1), atol=tol)
@@ -154,5 +152,5 @@ def test_blocks_do_not_change_the_result(scene, camera, monkeypatch):
 
 
 def test_points_behind_the_camera_score_badly(scene, camera):
-    scores, _, _ = rate_targets(scene, camera, [[0.05, 0.0, -0.1], [0.0, 0.0, -0.05]], PaperSettings())
+    scores, _, _ = rate_targets(scene, camera, [[0.05, 0.0, -0.1], [0.0, 0.0, -0.05]], Table1())
     assert np.all(scores < -5)

@@ -50,3 +50,23 @@ def test_invalid_intrinsics_are_refused(bad, message):
     args = {"fx": 600.0, "fy": 600.0, "cx": 320.0, "cy": 240.0, "width": 640, "height": 480, **bad}
     with pytest.raises(InputError, match=message):
         Camera(**args)
+
+
+def test_project_and_deproject_keep_leading_shapes(camera):
+    grid = np.zeros((4, 5, 3)) + [0.0, 0.0, 0.5]
+    assert camera.project(grid).shape == (4, 5, 2)
+    assert camera.deproject([[320, 240], [330, 250]], [1, 2]).tolist() == [
+        [0.0, 0.0, 1.0],
+        [pytest.approx(20 / 615), pytest.approx(20 / 615), 2.0],
+    ]
+
+
+def test_whole_float_sizes_are_taken_and_the_camera_is_frozen():
+    cam = Camera(fx=600, fy=600, cx=320, cy=240, width=640.0, height=480.0)
+    assert (cam.width, cam.height) == (640, 480) and isinstance(cam.width, int) and isinstance(cam.fx, float)
+    with pytest.raises(InputError, match="width"):
+        Camera(fx=600, fy=600, cx=320, cy=240, width=True, height=480)
+    import dataclasses
+
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        cam.fx = 1.0  # type: ignore[misc]

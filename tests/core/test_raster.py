@@ -1,10 +1,10 @@
 import numpy as np
 import pytest
 
-from symfruit import Camera, InputError
-from symfruit.core.raster import rasterise
+from symfruit import Box, Camera, InputError
+from symfruit.core.raster import rasterise, silhouette_coverage
 
-from .conftest import CENTRE, front_half, sphere_cloud
+from ..conftest import CENTRE, front_half, sphere_cloud
 
 
 def test_sparse_sphere_gives_a_solid_disc(camera):
@@ -63,3 +63,32 @@ def test_fruit_cut_by_the_image_edge_is_not_eroded():
 def test_nothing_in_the_image_is_an_error(camera):
     with pytest.raises(InputError, match="no point projects"):
         rasterise(np.array([[5.0, 5.0, 0.3], [5.1, 5.0, 0.3]]), camera)
+
+
+def test_lists_are_accepted_and_wrong_shapes_refused(camera, sphere_view):
+    a, b = rasterise(sphere_view, camera), rasterise(sphere_view.tolist(), camera)
+    assert np.array_equal(a.mask, b.mask) and np.array_equal(a.near_depth, b.near_depth)
+    with pytest.raises(InputError, match="shape"):
+        rasterise(sphere_view[:, :2], camera)
+    with pytest.raises(InputError, match="at least 1 points"):
+        rasterise(np.zeros((0, 3)), camera)
+
+
+def test_a_given_fill_radius_is_used(camera, sphere_view):
+    assert rasterise(sphere_view, camera, fill_radius=4.0).fill_radius == 4.0
+    assert rasterise(sphere_view, camera).fill_radius >= 1.0
+
+
+def test_silhouette_coverage_known_answers(camera):
+    visible = front_half(sphere_cloud(n=4000))
+    box = Box(CENTRE - 0.02, CENTRE + 0.02)
+    full = rasterise(visible, camera)
+    assert silhouette_coverage(full, box, camera) > 0.99  # the whole disc was seen
+    half = rasterise(visible[visible[:, 0] < CENTRE[0]], camera)
+    assert silhouette_coverage(half, box, camera) == pytest.approx(0.5, abs=0.03)
+    # A box twice as wide: the seen disc is a quarter of its ellipse.
+    assert silhouette_coverage(full, Box(CENTRE - 0.04, CENTRE + 0.04), camera) == pytest.approx(0.25, abs=0.02)
+    assert silhouette_coverage(full, Box(CENTRE - [0.02, 0.02, 1.02], CENTRE - [-0.02, -0.02, 0.98]), camera) == 0.0
+    aside = Box(CENTRE + [0.18, -0.02, -0.02], CENTRE + [0.22, 0.02, 0.02])  # beside the seen window
+    assert silhouette_coverage(full, aside, camera) == 0.0
+    assert silhouette_coverage(full, Box(np.full(3, np.nan), np.full(3, np.nan)), camera) == 0.0

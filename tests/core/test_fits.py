@@ -1,0 +1,190 @@
+"""Shape fits: sphere, ellipsoid (any orientation and camera-aligned), solid of revolution, surface noise.
+
+Known answers on exact solids, input normalisation (lists, integers) and clear errors for wrong shapes.
+"""
+
+import itertools
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit import Box, InputError, box_iou
+from symfruit.core.fits import (
+    ellipsoid_half_extents,
+    fit_aligned_ellipsoid,
+    fit_ellipsoid,
+    fit_revolution,
+    fit_sphere,
+    surface_noise,
+)
+from symfruit.shapes import rotation
+
+from ..conftest import CENTRE, fibonacci_sphere, front_half, random_sphere, revolution_cloud
+
+#: The 30 integer points at distance exactly 5 from the origin: (+-5, 0, 0), (+-3, +-4, 0) and permutations.
+LATTICE_SPHERE = np.array([p for p in itertools.product(range(-5, 6), repeat=3) if sum(v * v for v in p) == 25])
+
+# --- sphere ----------------------------------------------------------------------------------------------
+
+
+def test_sphere_fit_is_exact_on_a_sphere():
+    rng = np.random.default_rng(1)
+    d = rng.normal(size=(300, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    pts = front_half(0.03 * d + CENTRE)
+    centre, radius = fit_sphere(pts)
+    assert np.allclose(centre, CENTRE, atol=1e-9) and radius == pytest.approx(0.03, abs=1e-9)
+
+
+def test_sphere_fit_with_noise_is_close():
+    rng = np.random.default_rng(2)
+    d = rng.normal(size=(600, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    pts = front_half(0.02 * d + CENTRE)
+    pts = pts + rng.normal(scale=0.0003, size=pts.shape)
+    centre, radius = fit_sphere(pts)
+    assert np.linalg.norm(centre - CENTRE) < 0.001 and abs(radius - 0.02) < 0.0005
+
+
+def test_sphere_fit_refuses_a_plane():
+    xy = np.random.default_rng(0).random((50, 2))
+    with pytest.raises(InputError, match="coplanar"):
+        fit_sphere(np.c_[xy, np.full(50, 0.3)])
+
+
+def test_sphere_fit_takes_integer_lists():
+    points = (LATTICE_SPHERE + [10, -3, 40]).tolist()  # a list of lists of ints
+    for refine in (True, False):
+        centre, radius = fit_sphere(points, refine=refine)
+        assert np.allclose(centre, [10.0, -3.0, 40.0], atol=1e-9) and radius == pytest.approx(5.0, abs=1e-9)
+    centre, radius = fit_sphere(np.asarray(points, dtype=np.int8))
+    assert np.allclose(centre, [10.0, -3.0, 40.0], atol=1e-9) and radius == pytest.approx(5.0, abs=1e-9)
+
+
+def test_algebraic_fit_alone_is_exact_on_exact_data():
+    centre, radius = fit_sphere(front_half(random_sphere(500, seed=4)), refine=False)
+    assert np.allclose(centre, CENTRE, atol=1e-9) and radius == pytest.approx(0.03, abs=1e-9)
+
+
+@given(st.floats(-0.2, 0.2), st.floats(-0.2, 0.2), st.floats(0.2, 1.0), st.floats(0.005, 0.08), st.integers(20, 400))
+def test_sphere_fit_recovers_any_sphere_from_its_front_cap(x, y, z, radius, n):
+    centre = np.array([x, y, z])
+    cap = front_half(radius * fibonacci_sphere(2 * n) + centre, centre)
+    c, r = fit_sphere(cap)
+    assert np.allclose(c, centre, atol=1e-9 + 1e-7 * radius) and r == pytest.approx(radius, rel=1e-7)
+
+
+@pytest.mark.parametrize(
+    "points, message",
+    [
+        (np.zeros((10, 2)), r"shape \(n, 3\)"),
+        (LATTICE_SPHERE[:3], "at least 4 points, got 3"),
+        ([["a", "b", "c"]] * 5, "numeric"),
+    ],
+)
+def test_sphere_fit_refuses_wrong_shapes(points, message):
+    with pytest.raises(InputError, match=message):
+        fit_sphere(points)
+
+
+# --- ellipsoids ------------------------------------------------------------------------------------------
+
+TILT = rotation(20, 30, 40)
+AXES = np.array([0.02, 0.03, 0.025])
+SHAPE = TILT @ np.diag(1.0 / AXES**2) @ TILT.T  # (x - c)^T A (x - c) = 1
+
+
+@pytest.mark.parametrize("part", ["whole", "front half"])
+def test_general_ellipsoid_fit_is_exact_on_a_tilted_ellipsoid(part):
+    cloud = (fibonacci_sphere(2000) * AXES) @ TILT.T + CENTRE
+    if part == "front half":
+        cloud = front_half(cloud)
+    centre, shape = fit_ellipsoid(cloud)
+    assert np.allclose(centre, CENTRE, atol=1e-9)
+    assert np.allclose(shape, SHAPE, rtol=1e-6, atol=1e-6 * np.abs(SHAPE).max())
+
+
+def test_ellipsoid_fit_takes_lists_and_refuses_planes_and_wrong_shapes():
+    cloud = fibonacci_sphere(300) * AXES + CENTRE
+    centre, shape = fit_ellipsoid(cloud.tolist())
+    assert np.allclose(centre, CENTRE, atol=1e-9) and np.allclose(np.diag(shape), 1 / AXES**2, rtol=1e-6)
+    with pytest.raises(InputError, match="ellipsoid"):
+        fit_ellipsoid(np.c_[np.random.default_rng(0).random((50, 2)), np.full(50, 0.3)])
+    with pytest.raises(InputError, match="at least 10 points"):
+        fit_ellipsoid(cloud[:9])
+    with pytest.raises(InputError, match="shape"):
+        fit_ellipsoid(cloud[:, :2])
+
+
+def test_half_extents_of_an_ellipsoid_are_its_box():
+    assert np.allclose(ellipsoid_half_extents(np.diag(1.0 / AXES**2)), AXES)
+    half = ellipsoid_half_extents(SHAPE.tolist())  # a list works too
+    dense = (fibonacci_sphere(200_000) * AXES) @ TILT.T  # the tilted surface, about the origin
+    assert np.allclose(half, np.abs(dense).max(axis=0), rtol=1e-5)
+
+
+def test_aligned_ellipsoid_fit_known_answer():
+    axes = np.array([0.02, 0.03, 0.025])
+    cap = front_half(fibonacci_sphere(3000) * axes + CENTRE)
+    centre, semi = fit_aligned_ellipsoid(cap, prior=0.0)
+    assert np.allclose(centre, CENTRE, atol=2e-4) and np.allclose(semi, axes, atol=3e-4)
+
+
+def test_aligned_ellipsoid_prior_pulls_the_depth_axis_to_its_ratio():
+    # A cap of a sphere: its depth is barely seen; with a strong prior the depth semi-axis follows
+    # depth_ratio times the lateral ones.
+    cap = front_half(random_sphere(2000, radius=0.02, seed=5))
+    _, semi = fit_aligned_ellipsoid(cap.tolist(), prior=1e4, depth_ratio=1.5)
+    assert semi[2] == pytest.approx(1.5 * np.sqrt(semi[0] * semi[1]), rel=0.02)
+    with pytest.raises(InputError, match="shape"):
+        fit_aligned_ellipsoid(np.zeros((10, 4)))
+
+
+# --- solid of revolution and surface noise --------------------------------------------------------------
+
+
+def test_roughness_ratio_tells_clean_from_noisy():
+    clean = front_half(random_sphere(3000))
+    noisy = clean + np.random.default_rng(2).normal(scale=0.001, size=clean.shape)
+    ratio_clean, _, normals = surface_noise(clean)
+    ratio_noisy, noise, _ = surface_noise(noisy)
+    assert ratio_clean > 3.3 > ratio_noisy
+    assert 0.0003 < noise < 0.002
+    assert np.all(np.einsum("ni,ni->n", normals, clean[:: max(1, len(clean) // 120)][: len(normals)]) < 0)
+
+
+def test_surface_noise_of_a_plane_patch_is_nil_and_normals_face_the_camera():
+    xy = np.random.default_rng(3).random((400, 2)) * 0.03
+    patch = np.c_[xy, np.full(400, 0.3)].tolist()  # a list, flat at z = 0.3
+    _, noise, normals = surface_noise(patch)
+    assert noise == pytest.approx(0.0, abs=1e-12)
+    assert np.allclose(normals, [0.0, 0.0, -1.0])
+    with pytest.raises(InputError, match="shape"):
+        surface_noise(np.zeros((10, 2)))
+
+
+def test_revolution_axis_from_normals():
+    tilt = rotation(20, 0, 15)
+    cloud = (revolution_cloud() - CENTRE) @ tilt.T + CENTRE
+    visible = front_half(cloud)
+    _, _, normals = surface_noise(visible, queries=len(visible))
+    box, _, direction = fit_revolution(visible, normals)
+    true_axis = tilt @ [0.0, 1.0, 0.0]
+    assert abs(direction @ true_axis) > np.cos(np.radians(6))
+    assert box_iou(box, Box.from_points(cloud)) > 0.85
+
+
+def test_revolution_needs_one_normal_per_point():
+    visible = front_half(revolution_cloud())
+    _, _, normals = surface_noise(visible, queries=len(visible))
+    assert len(normals) == len(visible)
+    with pytest.raises(InputError, match="one normal per point, got 100 for 90 points"):
+        fit_revolution(visible[:90], normals[:100])
+    with pytest.raises(InputError, match="normals must hold at least 100 points, got 90"):
+        fit_revolution(visible[:100], normals[:90])
+    with pytest.raises(InputError, match="normals must have shape"):
+        fit_revolution(visible, normals[:, :2])
+    box, _, _ = fit_revolution(visible.tolist(), normals.tolist())
+    assert box.contains(visible)

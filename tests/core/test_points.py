@@ -1,0 +1,108 @@
+"""Point arrays at the core's boundary: normalisation (:func:`as_points`) and the fruit checks (:func:`check_cloud`)."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit import InputError
+from symfruit.core.points import as_points, check_cloud
+
+from ..conftest import VISIBLE
+
+
+def test_lists_tuples_and_integers_become_contiguous_float64():
+    for given_points in ([[1, 2, 3], [4, 5, 6]], ((1, 2, 3), (4, 5, 6)), np.array([[1, 2, 3], [4, 5, 6]], np.int32)):
+        arr = as_points(given_points)
+        assert arr.dtype == np.float64 and arr.shape == (2, 3) and arr.flags.c_contiguous
+        assert arr.tolist() == [[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]
+    strided = np.arange(18, dtype=np.float32).reshape(6, 3)[::2]
+    assert as_points(strided).flags.c_contiguous and as_points(strided).tolist() == strided.tolist()
+
+
+def test_float64_arrays_pass_through_unchanged():
+    arr = np.random.default_rng(0).random((5, 3))
+    out = as_points(arr)
+    assert out is arr or np.shares_memory(out, arr)
+    assert np.array_equal(out, arr)
+
+
+@pytest.mark.parametrize(
+    "points, message",
+    [
+        (np.zeros(3), r"shape \(n, 3\), got \(3,\)"),
+        (np.zeros((5, 2)), r"got \(5, 2\)"),
+        (np.zeros((5, 4)), r"got \(5, 4\)"),
+        (np.zeros((2, 3, 3)), r"got \(2, 3, 3\)"),
+        (5.0, r"got \(\)"),
+        ([[1, 2], [3, 4, 5]], "numeric"),
+        ([["x", "y", "z"]], "numeric"),
+        (np.ones((2, 3), complex), "real numbers"),
+        (None, "numeric|shape"),
+    ],
+)
+def test_anything_else_is_refused_with_what_was_expected(points, message):
+    with pytest.raises(InputError, match=message):
+        as_points(points)
+
+
+def test_minimum_count_and_name_are_in_the_message():
+    with pytest.raises(InputError, match="normals must hold at least 4 points, got 2"):
+        as_points(np.zeros((2, 3)), min_count=4, name="normals")
+    assert as_points(np.zeros((0, 3)), min_count=0).shape == (0, 3)
+
+
+@given(st.lists(st.tuples(st.integers(-1000, 1000), st.integers(-1000, 1000), st.integers(-1000, 1000)), min_size=1))
+def test_integer_lists_keep_their_values(rows):
+    assert np.array_equal(as_points(rows), np.array(rows, dtype=np.float64))
+
+
+def test_a_clean_cloud_passes_unchanged():
+    clean, dropped = check_cloud(VISIBLE)
+    assert dropped == 0 and np.array_equal(clean, VISIBLE)
+    listed, _ = check_cloud(VISIBLE.tolist())
+    assert np.array_equal(listed, VISIBLE)
+
+
+def test_non_finite_rows_are_dropped_and_counted():
+    dirty = np.vstack([VISIBLE[:5], [[np.nan, 0, 0.3]], VISIBLE[5:], [[0, np.inf, 0.3], [0, 0, -np.inf]]])
+    clean, dropped = check_cloud(dirty)
+    assert dropped == 3 and np.array_equal(clean, VISIBLE)
+
+
+def test_large_clouds_are_down_sampled_to_a_fixed_ordered_subset():
+    rng = np.random.default_rng(1)
+    d = rng.normal(size=(5000, 3))
+    cloud = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + [0.0, 0.0, 0.4]
+    a, _ = check_cloud(cloud, max_points=1000)
+    b, _ = check_cloud(cloud.copy(), max_points=1000)
+    assert len(a) == 1000 and np.array_equal(a, b)
+    index = {tuple(p): i for i, p in enumerate(cloud)}
+    picked = [index[tuple(p)] for p in a]
+    assert picked == sorted(picked)  # a subset of the input rows, in their order
+
+
+@pytest.mark.parametrize(
+    "points, kwargs, message",
+    [
+        (VISIBLE[:8], {}, r"at least 10 points, got 8"),
+        (VISIBLE[:8], {"section": "input"}, r"\(input\.min_points sets the limit\)"),
+        (np.vstack([VISIBLE[:5], np.full((6, 3), np.nan)]), {}, "got 5 after dropping 6 non-finite"),
+        (VISIBLE - [0, 0, 0.34], {}, "at or behind the camera"),
+        (VISIBLE * 100, {"section": "input"}, r"too large for one fruit \(input\.max_extent = 1\.0 m\)"),
+        (VISIBLE * 0.01 + [0, 0, 0.3], {"min_extent": 0.003}, r"too small for a fruit \(min_extent = 3 mm\)"),
+        (np.tile([[0.0, 0.0, 0.3]], (20, 1)), {}, "identical"),
+        (np.c_[np.linspace(0, 0.02, 20), np.linspace(0, 0.02, 20), np.full(20, 0.3)], {}, "on a line"),
+        (np.c_[np.random.default_rng(0).random((30, 2)) * 0.02, np.full(30, 0.3)], {}, "on a plane"),
+    ],
+)
+def test_what_cannot_be_a_fruit_is_refused(points, kwargs, message):
+    with pytest.raises(InputError, match=message):
+        check_cloud(points, **kwargs)
+
+
+def test_limits_are_keywords():
+    clean, _ = check_cloud(VISIBLE[:8], min_points=4)
+    assert len(clean) == 8
+    with pytest.raises(InputError, match="too large"):
+        check_cloud(VISIBLE, max_extent=0.01)

@@ -1,0 +1,74 @@
+"""Evaluation protocols: Algorithm 2 of the paper, and rendered D435-like camera views."""
+
+import numpy as np
+import pytest
+
+from symfruit.evaluate.protocols import PAPER_ANGLES, PAPER_DISTANCE, Spec, build, specs
+from symfruit.evaluate.protocols import _inside as inside_polygon
+
+
+def test_paper_protocol_is_algorithm_2():
+    all_specs = specs("paper", "strawberry", n=10)
+    assert len(all_specs) == 190 and len(PAPER_ANGLES) == 19
+    assert PAPER_ANGLES[0] == -45 and PAPER_ANGLES[-1] == 45
+    inst = build(all_specs[0])
+    assert 100 < len(inst.visible) < 600
+    assert inst.truth_box.contains(inst.visible)
+    assert np.allclose(inst.truth_box.centre, [0, 0, PAPER_DISTANCE])
+    again = build(all_specs[0])
+    assert np.array_equal(inst.visible, again.visible)
+    # The same 600 points in every pose of a fruit: the truth box volume changes only by rotation.
+    other = build(all_specs[9])
+    assert len(other.truth_surface) == len(inst.truth_surface) == 600
+
+
+def test_camera_protocol_instances():
+    spec = specs("camera", "strawberry", n=3, occlusions=(0.0, 0.3))
+    assert len(spec) == 6
+    clear, covered = build(spec[0]), build(spec[3])
+    assert clear.hidden == 0.0 and 0.2 < covered.hidden < 0.4
+    assert 0.25 <= clear.distance <= 0.6
+    assert len(covered.visible) < len(clear.visible)
+    # Noisy points lie near the true surface, and inside an enlarged truth box.
+    assert clear.truth_box.contains(clear.visible, tol=0.01)
+    from scipy.spatial import cKDTree
+
+    d, _ = cKDTree(clear.truth_surface).query(clear.visible)
+    assert np.median(d) < 0.003
+
+
+def test_specs_enumerate_fruits_poses_and_occlusions():
+    paper = specs("paper", "apple", n=2, seed=3, angles=(-45, 0, 45))
+    assert [(s.index, s.pose) for s in paper] == [(0, 0), (0, 9), (0, 18), (1, 0), (1, 9), (1, 18)]
+    assert all(s.protocol == "paper" and s.fruit == "apple" and s.seed == 3 for s in paper)
+    camera = specs("camera", "tomato", n=2, occlusions=(0.0, 0.5))
+    assert [(s.index, s.pose, s.occlusion) for s in camera] == [(0, 0, 0.0), (1, 1, 0.0), (0, 0, 0.5), (1, 1, 0.5)]
+    with pytest.raises(ValueError, match="unknown protocol 'lab'; use paper or camera"):
+        specs("lab", "apple", n=1)
+
+
+def test_instances_are_built_from_their_spec_alone():
+    spec = Spec("camera", "citrus", 1, 4, 0.0, seed=7)
+    a, b = build(spec), build(Spec("camera", "citrus", 1, 4, 0.0, seed=7))
+    assert np.array_equal(a.visible, b.visible) and np.array_equal(a.truth_box.min, b.truth_box.min)
+    other = build(Spec("camera", "citrus", 1, 4, 0.0, seed=8))
+    assert not np.array_equal(other.visible, a.visible)
+    assert a.spec == spec and a.kind == "citrus" and -45 <= a.angles[0] <= 45 and -45 <= a.angles[2] <= 45
+
+
+def test_paper_poses_rotate_the_same_fruit_about_x():
+    flat, tilted = build(Spec("paper", "tomato", 0, PAPER_ANGLES.index(0))), build(Spec("paper", "tomato", 0, 0))
+    assert tilted.angles == (-45.0, 0.0, 0.0) and flat.angles == (0.0, 0.0, 0.0)
+    # The same 600 points, rotated about x by -45 degrees (up to the move of the box centre).
+    centred = [s.truth_surface - s.truth_box.centre for s in (flat, tilted)]
+    c, s = np.cos(np.radians(-45)), np.sin(np.radians(-45))
+    rx = np.array([[1, 0, 0], [0, c, -s], [0, s, c]])
+    rotated = centred[0] @ rx.T
+    assert np.allclose(rotated - (rotated.min(axis=0) + rotated.max(axis=0)) / 2, centred[1], atol=1e-12)
+    assert flat.distance == PAPER_DISTANCE and flat.camera.width == 640
+
+
+def test_the_polygon_test_of_the_occluder():
+    square = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
+    pts = np.array([[1, 1], [3.9, 0.1], [5, 1], [-1, 2], [2, 4.5]], float)
+    assert inside_polygon(square, pts).tolist() == [True, True, False, False, False]

@@ -1,0 +1,92 @@
+"""The runner: every method on every instance through the public ``complete``, rows in spec order, failures
+recorded; and the summary statistics."""
+
+import math
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from symfruit import InputError, Settings
+from symfruit.evaluate.protocols import Spec, build
+from symfruit.evaluate.runner import COLUMNS, Row, run, summarise
+from symfruit.methods import register
+from symfruit.metrics import score_completion
+
+SPECS = [Spec("paper", "strawberry", 0, 9), Spec("paper", "strawberry", 1, 0)]
+
+
+def test_rows_come_in_spec_then_method_order_with_the_metrics_of_complete():
+    from symfruit import complete
+
+    rows = run(SPECS, ("raw", "sphere"), jobs=1, progress=False)
+    assert [(r.fruit_index, r.pose, r.method) for r in rows] == [(0, 9, "raw"), (0, 9, "sphere"), (1, 0, "raw"),
+                                                                  (1, 0, "sphere")]  # fmt: skip
+    inst = build(SPECS[1])
+    result = complete(inst.visible, camera=inst.camera, method="sphere")
+    expected = score_completion(result.box, result.points, inst.truth_box, inst.truth_surface)
+    row = rows[3]
+    assert (row.iou, row.centre_mm, row.chamfer_mm, row.f1) == (expected.iou, expected.centre_mm,
+                                                                expected.chamfer_mm, expected.f1)  # fmt: skip
+    assert row.n_visible == len(inst.visible) and row.angle_x == -45.0 and row.distance_m == 0.3 and row.error == ""
+    assert math.isnan(row.confidence) and row.reliable is False  # sphere estimates no confidence
+    assert list(row.to_dict()) == list(COLUMNS)
+
+
+def test_settings_reach_every_method():
+    few = Settings().replace(paper={"translations": 1, "rotations_x": 1, "rotations_y": 1})
+    rows = run(SPECS[:1], ("paper",), few, jobs=1, progress=False)
+    default = run(SPECS[:1], ("paper",), jobs=1, progress=False)
+    assert rows[0].iou != default[0].iou
+
+
+def test_a_failing_method_is_recorded_and_the_others_go_on(isolated_registry):
+    @register("test-fails")
+    def fails(points, camera, settings):
+        """Always refuses."""
+        raise InputError("cannot do this one")
+
+    rows = run(SPECS[:1], ("test-fails", "raw"), jobs=1, progress=False)
+    assert [r.method for r in rows] == ["test-fails", "raw"]
+    assert rows[0].error == "cannot do this one" and math.isnan(rows[0].iou) and math.isnan(rows[0].seconds)
+    assert rows[1].error == "" and 0 < rows[1].iou < 1
+
+
+def row(method="raw", iou=0.5, centre_mm=2.0, confidence=float("nan"), error="", occlusion=0.0, **kw):
+    base = dict(protocol="paper", fruit="apple", kind="apple", fruit_index=0, pose=0, angle_x=0.0, angle_y=0.0,
+                angle_z=0.0, distance_m=0.3, occlusion=occlusion, hidden=0.1, n_visible=100, method=method, iou=iou,
+                centre_mm=centre_mm, chamfer_mm=1.0, f1=0.9, precision=0.9, recall=0.9, seconds=0.002,
+                confidence=confidence, error=error)  # fmt: skip
+    return Row(**{**base, **kw})
+
+
+def test_summary_known_answers():
+    rows = [row(iou=0.2, centre_mm=1.0), row(iou=0.4, centre_mm=5.0), row(iou=0.9, centre_mm=3.0),
+            row(error="failed", iou=float("nan")), row(method="paper", iou=0.8)]  # fmt: skip
+    by = {s["method"]: s for s in summarise(rows)}
+    raw = by["raw"]
+    assert (raw["fruit"], raw["occlusion"], raw["n"], raw["failed"]) == ("apple", 0.0, 4, 1)
+    assert raw["iou_mean"] == pytest.approx(0.5) and raw["iou_median"] == pytest.approx(0.4)
+    assert raw["centre_mm_mean"] == pytest.approx(3.0) and raw["centre_mm_median"] == pytest.approx(3.0)
+    assert raw["ms_median"] == pytest.approx(2.0) and raw["hidden_mean"] == pytest.approx(0.1)
+    assert math.isnan(raw["spearman"])  # no confidence: no statistics of it
+    assert by["paper"]["n"] == 1 and by["paper"]["iou_mean"] == pytest.approx(0.8)
+    grouped = summarise(rows, by=("method",))
+    assert [s["method"] for s in grouped] == ["raw", "paper"] and set(grouped[0]) >= {"n", "iou_mean"}
+
+
+def test_summary_of_groups_that_all_failed_is_nan():
+    (only,) = summarise([row(error="x", iou=float("nan"))])
+    assert only["n"] == 1 and only["failed"] == 1 and math.isnan(only["iou_mean"]) and math.isnan(only["ms_median"])
+
+
+def test_confidence_statistics():
+    # Confidence falls exactly as the error grows: Spearman -1; the 80 % most confident skip the worst.
+    pairs = zip(np.linspace(1, 0.1, 10), np.arange(1.0, 11.0), strict=True)
+    rows = [row(confidence=c, centre_mm=e, reliable=c > 0.45) for c, e in pairs]
+    (s,) = summarise(rows)
+    assert s["spearman"] == pytest.approx(-1.0)
+    assert s["centre_mm_top80"] == pytest.approx(np.mean(np.arange(1.0, 9.0)))
+    assert s["reliable_share"] == pytest.approx(0.6)
+    flat = [replace(r, confidence=0.5) for r in rows]
+    assert math.isnan(summarise(flat)[0]["spearman"])  # no spread in confidence: no correlation

@@ -1,0 +1,56 @@
+"""Atomic output: a file is either the old one or the whole new one, never half-written."""
+
+import json
+import os
+import stat
+
+import pytest
+
+from symfruit import FileFormatError
+from symfruit.io import atomic_write, write_json
+
+
+def test_a_written_file_appears_whole_with_the_usual_permissions(tmp_path):
+    target = tmp_path / "sub" / "out.bin"  # the folder is made
+    with atomic_write(target, "wb") as handle:
+        handle.write(b"hello")
+        assert not target.exists()  # nothing under the final name until the block ends
+        (temporary,) = target.parent.iterdir()
+        assert temporary.name.startswith(".out.bin.") and temporary.name.endswith(".tmp")
+    assert target.read_bytes() == b"hello" and [p.name for p in target.parent.iterdir()] == ["out.bin"]
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(target.stat().st_mode) == 0o666 & ~mask
+
+
+def test_a_failure_keeps_the_old_file_and_leaves_no_temporary(tmp_path):
+    target = tmp_path / "out.txt"
+    target.write_text("old")
+    with pytest.raises(RuntimeError, match="boom"), atomic_write(target, "w") as handle:
+        handle.write("new, half")
+        raise RuntimeError("boom")
+    assert target.read_text() == "old" and [p.name for p in tmp_path.iterdir()] == ["out.txt"]
+
+
+def test_text_mode_writes_utf8(tmp_path):
+    with atomic_write(tmp_path / "t.txt", "w") as handle:
+        handle.write("fr\u00fcit \u2014 \u00e9")
+    assert (tmp_path / "t.txt").read_bytes() == "fr\u00fcit \u2014 \u00e9".encode()
+
+
+def test_a_folder_that_cannot_be_made_is_named(tmp_path):
+    blocker = tmp_path / "file"
+    blocker.write_text("not a folder")
+    with pytest.raises(FileFormatError, match=r"out\.json: cannot write to folder .*file"):
+        write_json(blocker / "out.json", {})
+
+
+def test_json_is_indented_ends_with_a_newline_and_refuses_nan(tmp_path):
+    path = tmp_path / "a.json"
+    write_json(path, {"b": [1, 2], "a": "\u00fc"})
+    text = path.read_text()
+    assert text.endswith("}\n") and '\n  "b": [\n' in text and json.loads(text) == {"b": [1, 2], "a": "\u00fc"}
+    write_json(path, {"x": 1})
+    with pytest.raises(ValueError, match="Out of range float"):
+        write_json(path, {"x": float("nan")})
+    assert json.loads(path.read_text()) == {"x": 1} and [p.name for p in tmp_path.iterdir()] == ["a.json"]

@@ -1,0 +1,169 @@
+"""Frames from ROS bags (optional extra ``bag``): a tiny ROS 2 bag end to end, image messages decoded
+by encoding, and broken bags named."""
+
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from symfruit import FileFormatError
+from symfruit.io.bags import image_array
+from symfruit.io.sources import open_source
+
+from ..conftest import SMALL_CAM, disc_frame
+
+CAM = SMALL_CAM
+
+
+def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_topic=True):
+    """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    Image, Info = ts.types["sensor_msgs/msg/Image"], ts.types["sensor_msgs/msg/CameraInfo"]
+    Header, Time = ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
+    with Writer(path, version=9) as writer:
+        c_col = writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
+        for i in range(frames):
+            t = 1_000_000_000 * (i + 1)
+            head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="camera_color_optical_frame")
+            info = Info(header=head, height=120, width=160, distortion_model="plumb_bob", d=np.zeros(5),
+                        k=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]), r=np.eye(3).ravel(),
+                        p=np.array([600.0, 0, 80, 0, 0, 600, 60, 0, 0, 0, 1, 0]), binning_x=0, binning_y=0,
+                        roi=RoI(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False))  # fmt: skip
+            if camera_info:
+                writer.write(c_inf, t, ts.serialize_cdr(info, "sensor_msgs/msg/CameraInfo"))
+            img = Image(header=head, height=120, width=160, encoding="rgb8", is_bigendian=0, step=480,
+                        data=color.ravel())  # fmt: skip
+            if colour_topic:
+                writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
+            dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=0, step=320,
+                        data=depth_mm.view(np.uint8).ravel())  # fmt: skip
+            writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
+    return path
+
+
+def test_tiny_ros2_bag(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+    mm = (depth * 1000).astype(np.uint16)
+    path = write_ros2_bag(tmp_path / "bag", color, mm)
+    src = open_source(path)
+    assert len(src) == 2
+    frame = src.read(0)
+    assert np.array_equal(frame.color, color) and np.allclose(frame.depth, mm / 1000.0)
+    assert frame.camera == CAM
+    from symfruit.detect import detect
+
+    found = detect(frame, method="raw")
+    assert len(found.detections) == 2 and all(d.result is not None for d in found.detections)
+
+
+def test_bag_frames_are_named_stamped_and_read_on_demand(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    src = open_source(write_ros2_bag(tmp_path / "rec", color, (depth * 1000).astype(np.uint16), frames=3))
+    with src:
+        assert src.names() == [f"rec_{i:05d}_{1_000_000_000 * (i + 1) + 1000}" for i in range(3)]
+        frame = src.read(2)
+        assert frame.name == src.names()[2] and frame.stamp == 3_000_000_000  # the header's stamp
+        assert frame.source == f"{tmp_path / 'rec'}@{3_000_001_000}"
+        with pytest.raises(IndexError, match="frame index 3 out of range for 3 frames"):
+            src.read(3)
+    src.close()  # closing twice is harmless
+
+
+def test_a_bag_whose_colour_topic_is_empty_is_named(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), colour_topic=False)
+    with pytest.raises(FileFormatError, match=r"bad: colour topic /camera/color/image_raw holds no messages"):
+        open_source(path)
+
+
+@pytest.mark.xfail(strict=True, reason="src bug: a bag whose CameraInfo topic holds no message opens, then every "
+                   "read raises a bare IndexError (BagSource.read indexes an empty camera list)")  # fmt: skip
+def test_a_bag_whose_camera_info_topic_is_empty_is_named(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), camera_info=False)
+    with pytest.raises(FileFormatError, match=r"bad: .*CameraInfo"):
+        open_source(path).read(0)  # refused when opened, or when the frame is read: either names the bag
+
+
+def test_corrupt_bag(tmp_path):
+    pytest.importorskip("rosbags")
+
+    bag = tmp_path / "broken.bag"
+    bag.write_bytes(b"#ROSBAG V2.0\n" + np.random.default_rng(0).bytes(300))
+    with pytest.raises(FileFormatError, match=r"broken\.bag"):
+        open_source(bag)
+
+
+def message(pixels: np.ndarray, encoding: str, *, step: int | None = None, bigendian: bool = False):
+    h, w = pixels.shape[:2]
+    raw = pixels.astype(pixels.dtype.newbyteorder(">" if bigendian else "<")).tobytes()
+    row = len(raw) // h
+    step = step or row
+    data = b"".join(raw[i * row : (i + 1) * row] + b"\0" * (step - row) for i in range(h))
+    return SimpleNamespace(height=h, width=w, step=step, encoding=encoding, is_bigendian=int(bigendian), data=data)
+
+
+RGB = np.arange(2 * 3 * 3, dtype=np.uint8).reshape(2, 3, 3)
+
+
+def test_colour_encodings_come_back_rgb():
+    assert np.array_equal(image_array(message(RGB, "rgb8"), "sensor_msgs/msg/Image"), RGB)
+    assert np.array_equal(image_array(message(RGB[:, :, ::-1], "bgr8"), "sensor_msgs/msg/Image"), RGB)
+    rgba = np.concatenate([RGB, np.full((2, 3, 1), 255, np.uint8)], axis=2)
+    assert np.array_equal(image_array(message(rgba, "rgba8"), "sensor_msgs/msg/Image"), RGB)
+    assert np.array_equal(image_array(message(rgba[:, :, [2, 1, 0, 3]], "BGRA8"), "sensor_msgs/msg/Image"), RGB)
+    mono = RGB[:, :, 0]
+    assert np.array_equal(image_array(message(mono, "mono8"), "sensor_msgs/msg/Image"), mono)
+    padded = message(RGB, "rgb8", step=16)  # rows padded to 16 bytes
+    assert np.array_equal(image_array(padded, "sensor_msgs/msg/Image"), RGB)
+
+
+def test_depth_encodings_keep_their_type():
+    units = np.array([[0, 1, 1000], [65535, 300, 2]], np.uint16)
+    for bigendian in (False, True):
+        out = image_array(message(units, "16UC1", bigendian=bigendian), "sensor_msgs/msg/Image")
+        assert out.dtype == np.uint16 and np.array_equal(out, units)
+    metres = np.array([[0.3, np.nan], [0.25, 1.0]], np.float32)
+    out = image_array(message(metres, "32FC1"), "sensor_msgs/msg/Image")
+    assert out.dtype == np.float32 and np.array_equal(out, metres, equal_nan=True)
+
+
+def test_compressed_images(tmp_path):
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(RGB).save(buf, format="PNG")
+    msg = SimpleNamespace(format="rgb8; png compressed", data=buf.getvalue())
+    assert np.array_equal(image_array(msg, "sensor_msgs/msg/CompressedImage"), RGB)
+    depth = SimpleNamespace(format="16UC1; compressedDepth png", data=b"")
+    with pytest.raises(FileFormatError, match=r"compressedDepth images .* are not supported"):
+        image_array(depth, "sensor_msgs/msg/CompressedImage")
+
+
+@pytest.mark.parametrize(
+    "msg, error",
+    [
+        (message(RGB, "yuv422"), "unsupported image encoding 'yuv422'"),
+        (message(RGB, "rgb8", step=4), "image step 4 is shorter than a row of 3 rgb8 pixels"),
+        (SimpleNamespace(height=0, width=3, step=9, encoding="rgb8", is_bigendian=0, data=b""), "empty or larger"),
+        (SimpleNamespace(height=10**5, width=10**5, step=3 * 10**5, encoding="rgb8", is_bigendian=0, data=b""),
+         "larger than 40,000,000 pixels"),
+        (SimpleNamespace(height=2, width=3, step=9, encoding="rgb8", is_bigendian=0, data=bytes(10)),
+         "image data holds 10 bytes, 2 rows of 9 need 18"),
+    ],
+)  # fmt: skip
+def test_bad_messages_are_refused_before_their_data_is_used(msg, error):
+    with pytest.raises(FileFormatError, match=error):
+        image_array(msg, "sensor_msgs/msg/Image")

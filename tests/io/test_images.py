@@ -1,0 +1,162 @@
+"""Images: every mode Pillow opens is normalised to what the pipeline needs, or refused by name; sizes are
+checked from the header before any pixel is decoded."""
+
+import io
+import struct
+import zlib
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from symfruit import FileFormatError
+from symfruit.io import images
+from symfruit.io.images import MAX_IMAGE_PIXELS, decode_color, read_color, read_depth_units, read_labels
+
+
+def save(img: Image.Image, path, **kwargs):
+    img.save(path, **kwargs)
+    return path
+
+
+def rgb_of(path):
+    out = read_color(path)
+    assert out.dtype == np.uint8 and out.ndim == 3 and out.shape[2] == 3 and out.flags.c_contiguous
+    return out
+
+
+def test_rgb_is_read_as_is(tmp_path):
+    pixels = np.random.default_rng(0).integers(0, 256, size=(7, 5, 3), dtype=np.uint8)
+    assert np.array_equal(rgb_of(save(Image.fromarray(pixels), tmp_path / "c.png")), pixels)
+
+
+def test_palette_png(tmp_path):
+    img = Image.new("P", (4, 3))
+    img.putpalette([0, 0, 0, 10, 20, 30, 200, 100, 50] + [0] * (256 * 3 - 9))
+    img.putdata([0, 1, 2, 1] * 3)
+    out = rgb_of(save(img, tmp_path / "p.png"))
+    assert out.shape == (3, 4, 3)
+    assert out[0].tolist() == [[0, 0, 0], [10, 20, 30], [200, 100, 50], [10, 20, 30]]
+
+
+@pytest.mark.parametrize(
+    "mode, value, rgb",
+    [
+        ("LA", (100, 7), (100, 100, 100)),
+        ("L", 42, (42, 42, 42)),
+        ("RGBA", (1, 2, 3, 0), (1, 2, 3)),
+        ("1", 1, (255,) * 3),
+    ],
+)
+def test_grey_and_alpha_modes(tmp_path, mode, value, rgb):
+    out = rgb_of(save(Image.new(mode, (6, 4), value), tmp_path / "g.png"))
+    assert out.shape == (4, 6, 3) and np.all(out == rgb)
+
+
+def test_cmyk_jpeg(tmp_path):
+    path = save(Image.new("CMYK", (16, 16), (0, 255, 255, 0)), tmp_path / "c.jpg", quality=95)
+    assert Image.open(path).mode == "CMYK"
+    out = rgb_of(path)
+    assert out.shape == (16, 16, 3) and np.abs(out.astype(int) - [255, 0, 0]).max() <= 3  # cyan-free: red
+
+
+def test_16_bit_grey_is_scaled_to_8_bits(tmp_path):
+    grey = np.full((3, 5), 0x1234, np.uint16)
+    grey[0, 0] = 0xFFFF
+    out = rgb_of(save(Image.fromarray(grey), tmp_path / "g16.png"))
+    assert out.shape == (3, 5, 3) and out[1, 1].tolist() == [0x12] * 3 and out[0, 0].tolist() == [255] * 3
+
+
+def test_encoded_bytes_are_read_too():
+    buf = io.BytesIO()
+    Image.new("RGB", (3, 2), (9, 8, 7)).save(buf, format="PNG")
+    out = decode_color(buf.getvalue(), "message 3")
+    assert out.shape == (2, 3, 3) and np.all(out == [9, 8, 7])
+    with pytest.raises(FileFormatError, match="message 3: cannot read image"):
+        decode_color(b"not an image", "message 3")
+
+
+def _chunk(kind: bytes, data: bytes) -> bytes:
+    return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+
+def png_header(width: int, height: int) -> bytes:
+    """A PNG claiming ``width x height`` 8-bit RGB pixels that holds only a few bytes of pixel data."""
+    ihdr = struct.pack(">IIBBBBB", width, height, 8, 2, 0, 0, 0)
+    idat = zlib.compress(b"\0" * 64)
+    return b"\x89PNG\r\n\x1a\n" + _chunk(b"IHDR", ihdr) + _chunk(b"IDAT", idat) + _chunk(b"IEND", b"")
+
+
+def test_a_header_claiming_too_many_pixels_is_refused_before_decoding(tmp_path, monkeypatch):
+    decoded = []
+    monkeypatch.setattr(images, "_decode", lambda img, label: decoded.append(label) or img)
+    side = int(np.sqrt(MAX_IMAGE_PIXELS)) + 10  # over our bound, under Pillow's own
+    (tmp_path / "wide.png").write_bytes(png_header(side, side))
+    with pytest.raises(FileFormatError, match=rf"wide\.png: image is {side}x{side} pixels; at most 40,000,000"):
+        read_color(tmp_path / "wide.png")
+    (tmp_path / "bomb.png").write_bytes(png_header(100_000, 100_000))  # over Pillow's bound as well
+    with pytest.raises(FileFormatError, match=r"bomb\.png: image (too large|is 100000x100000)"):
+        read_color(tmp_path / "bomb.png")
+    with pytest.raises(FileFormatError, match="at most"):
+        read_depth_units(tmp_path / "wide.png")
+    with pytest.raises(FileFormatError, match="at most"):
+        read_labels(tmp_path / "wide.png")
+    assert decoded == []  # refused from the header alone
+
+
+def test_the_bound_applies_to_real_images(tmp_path, monkeypatch):
+    path = save(Image.new("RGB", (20, 10)), tmp_path / "c.png")
+    monkeypatch.setattr(images, "MAX_IMAGE_PIXELS", 199)
+    with pytest.raises(FileFormatError, match="image is 20x10 pixels; at most 199 pixels"):
+        read_color(path)
+
+
+def test_what_is_not_an_image_is_refused_by_name(tmp_path):
+    (tmp_path / "notes.png").write_text("hello")
+    with pytest.raises(FileFormatError, match=r"notes\.png: cannot read image"):
+        read_color(tmp_path / "notes.png")
+    with pytest.raises(FileFormatError, match=r"missing\.png: no such image"):
+        read_color(tmp_path / "missing.png")
+    (tmp_path / "empty.png").write_bytes(b"")
+    with pytest.raises(FileFormatError, match=r"empty\.png: cannot read image"):
+        read_color(tmp_path / "empty.png")
+    truncated = io.BytesIO()
+    Image.fromarray(np.random.default_rng(1).integers(0, 256, (64, 64, 3), dtype=np.uint8)).save(truncated, "PNG")
+    (tmp_path / "cut.png").write_bytes(truncated.getvalue()[:200])
+    with pytest.raises(FileFormatError, match=r"cut\.png: cannot (decode|read) image"):
+        read_color(tmp_path / "cut.png")
+
+
+def test_modes_that_cannot_be_colour_are_refused(tmp_path):
+    path = save(Image.new("F", (4, 4), 0.5), tmp_path / "f.tif")
+    with pytest.raises(FileFormatError, match=r"f\.tif: image mode 'F' cannot be read as colour"):
+        read_color(path)
+
+
+def test_depth_units(tmp_path):
+    units = np.array([[0, 1, 65535], [300, 1000, 2]], np.uint16)
+    out = read_depth_units(save(Image.fromarray(units), tmp_path / "d.png"))
+    assert out.dtype == np.uint16 and np.array_equal(out, units)
+    eight = read_depth_units(save(Image.fromarray(units.astype(np.uint8)), tmp_path / "d8.png"))
+    assert eight.dtype == np.uint16 and np.array_equal(eight, units.astype(np.uint8))
+    with pytest.raises(FileFormatError, match=r"c\.png: depth PNG must be single-channel 16-bit, got mode 'RGB'"):
+        read_depth_units(save(Image.new("RGB", (2, 2)), tmp_path / "c.png"))
+
+
+def test_labels_from_grey_palette_and_colour_images(tmp_path):
+    labels = np.array([[0, 1, 1], [2, 0, 300]], np.uint16)
+    assert np.array_equal(read_labels(save(Image.fromarray(labels), tmp_path / "l16.png")), labels)
+    pal = Image.new("P", (3, 1))
+    pal.putpalette([v for i in range(256) for v in (i, 255 - i, 7 * i % 256)])  # distinct colours
+    pal.putdata([0, 5, 3])
+    assert read_labels(save(pal, tmp_path / "p.png")).tolist() == [[0, 5, 3]]  # indices, not colours
+    rgb = np.zeros((2, 3, 3), np.uint8)
+    rgb[0, 1] = rgb[1, 2] = (255, 0, 0)
+    rgb[1, 0] = (0, 0, 9)
+    out = read_labels(save(Image.fromarray(rgb), tmp_path / "rgb.png"))
+    assert out.dtype == np.int32 and out.tolist() == [[0, 2, 0], [1, 0, 2]]  # black stays background
+    full = np.full((1, 2, 3), 7, np.uint8)
+    full[0, 1] = 8
+    assert read_labels(save(Image.fromarray(full), tmp_path / "nobg.png")).tolist() == [[1, 2]]
+    with pytest.raises(FileFormatError, match="is not an instance label image"):
+        read_labels(save(Image.new("LA", (2, 2)), tmp_path / "la.png"))

@@ -1,0 +1,91 @@
+"""Camera intrinsics files: every supported layout loads, bad files name the file and the field."""
+
+import json
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from symfruit import Camera, FileFormatError, SymfruitError
+from symfruit.io import camera_from_dict, load_camera
+
+LAYOUTS = {
+    "plain.json": json.dumps({"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}),
+    "realsense.json": json.dumps(
+        {
+            "color": {
+                "fx": 615.0,
+                "fy": 616.0,
+                "ppx": 321.0,
+                "ppy": 239.0,
+                "width": 640,
+                "height": 480,
+                "model": "Brown Conrady",
+                "coeffs": [0, 0, 0, 0, 0],
+            }
+        }
+    ),
+    "open3d.json": json.dumps(
+        {"width": 640, "height": 480, "intrinsic_matrix": [615.0, 0, 0, 0, 616.0, 0, 321.0, 239.0, 1.0]}
+    ),
+    "ros1.yaml": "header: {frame_id: camera_color_optical_frame}\nheight: 480\nwidth: 640\n"
+    "distortion_model: plumb_bob\nD: [0, 0, 0, 0, 0]\n"
+    "K: [615.0, 0.0, 321.0, 0.0, 616.0, 239.0, 0.0, 0.0, 1.0]\n",
+    "ros2.yaml": "height: 480\nwidth: 640\nk: [615.0, 0.0, 321.0, 0.0, 616.0, 239.0, 0.0, 0.0, 1.0]\n",
+    "calibration.yml": "image_width: 640\nimage_height: 480\ncamera_name: d435\ncamera_matrix:\n"
+    "  rows: 3\n  cols: 3\n  data: [615.0, 0.0, 321.0, 0.0, 616.0, 239.0, 0.0, 0.0, 1.0]\n",
+}
+
+
+@pytest.mark.parametrize("name", LAYOUTS)
+def test_intrinsics_layouts(tmp_path, name):
+    path = tmp_path / name
+    path.write_text(LAYOUTS[name])
+    assert load_camera(path) == Camera(fx=615.0, fy=616.0, cx=321.0, cy=239.0, width=640, height=480)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ('{"fx": 615, "fy": 615, "cx": 320, "width": 640, "height": 480}', "lack field 'cy' \\(or 'ppy'\\)"),
+        ('{"fx": 0, "fy": 615, "cx": 320, "cy": 240, "width": 640, "height": 480}', "positive"),
+        ('{"fx": 615, "fy": 615, "cx": 320, "cy": 240}', "width and height"),
+        ('{"K": [1, 2, 3], "width": 640, "height": 480}', "9 numbers"),
+        ('{"foo": 1}', "not recognised"),
+        ("[1, 2]", "mapping"),
+        ("{not json", "not valid JSON"),
+    ],
+)
+def test_bad_intrinsics_name_the_file_and_field(tmp_path, text, message):
+    path = tmp_path / "cam.json"
+    path.write_text(text)
+    with pytest.raises(FileFormatError, match=rf"cam.json: .*{message}"):
+        load_camera(path)
+
+
+@settings()
+@given(st.binary(max_size=2048), st.sampled_from([".json", ".yaml"]))
+def test_readers_survive_random_bytes(tmp_path, data, suffix):
+    path = tmp_path / f"fuzz{suffix}"
+    path.write_bytes(data)
+    try:
+        load_camera(path)
+    except SymfruitError:
+        pass
+
+
+def test_nested_layouts_and_wrong_extensions(tmp_path):
+    plain = {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}
+    expected = Camera(fx=615.0, fy=616.0, cx=321.0, cy=239.0, width=640, height=480)
+    for key in ("intrinsics", "colour", "camera_info"):
+        assert camera_from_dict({key: plain, "other": 1}) == expected
+    assert camera_from_dict({**plain, "width": 640.0}) == expected  # a whole float is a size
+    path = tmp_path / "cam.txt"
+    path.write_text(json.dumps(plain))
+    with pytest.raises(FileFormatError, match=r"cam\.txt: intrinsics must be \.json, \.yaml or \.yml"):
+        load_camera(path)
+    with pytest.raises(FileFormatError, match="no such intrinsics file"):
+        load_camera(tmp_path / "missing.json")
+    (tmp_path / "bool.json").write_text(json.dumps({**plain, "fx": True}))
+    with pytest.raises(FileFormatError, match="'fx' must be a number"):
+        load_camera(tmp_path / "bool.json")

@@ -1,0 +1,56 @@
+"""Triangle meshes: OBJ (polygons split into fans, negative indices, ``v/vt/vn`` faces) and PLY."""
+
+import numpy as np
+import pytest
+from plyfile import PlyData, PlyElement
+
+from symfruit import FileFormatError
+from symfruit.io import read_mesh, write_ply
+
+CUBE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
+
+
+def test_obj_quads_become_fans_and_indices_count_from_one(tmp_path):
+    path = tmp_path / "cube.obj"
+    lines = ["# a unit cube", "o cube", *(f"v {x} {y} {z}" for x, y, z in CUBE), "vt 0 0", ""]
+    lines += ["f 1 2 3 4", "f 5/1 6/1 7/1 8/1", "f 1//1 2//1 6//1", "f -8 -7 -3"]  # negative: from the end
+    path.write_text("\n".join(lines))
+    vertices, faces = read_mesh(path)
+    assert np.array_equal(vertices, CUBE)
+    assert faces.tolist() == [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7], [0, 1, 5], [0, 1, 5]]
+
+
+def test_obj_without_faces_and_broken_objs(tmp_path):
+    (tmp_path / "pts.obj").write_text("v 0 0 0\nv 1 0 0\n")
+    vertices, faces = read_mesh(tmp_path / "pts.obj")
+    assert vertices.shape == (2, 3) and faces is None
+    for name, text, message in [
+        ("none.obj", "# nothing\n", "OBJ has no vertices"),
+        ("bad.obj", "v 0 0 0\nv 0 x 0\n", "line 2 is not a valid OBJ vertex or face"),
+        ("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "a face refers to a vertex that does not exist"),
+        ("short.obj", "v 0 0\n", "OBJ vertices need x y z"),
+    ]:
+        (tmp_path / name).write_text(text)
+        with pytest.raises(FileFormatError, match=rf"{name.replace('.', '[.]')}: {message}"):
+            read_mesh(tmp_path / name)
+    (tmp_path / "latin.obj").write_bytes(b"v 0 0 0 # \xfc\n")
+    with pytest.raises(FileFormatError, match="cannot read OBJ"):
+        read_mesh(tmp_path / "latin.obj")
+
+
+def test_ply_with_and_without_faces(tmp_path):
+    vertex = np.array([tuple(v) for v in CUBE], dtype=[("x", "f4"), ("y", "f4"), ("z", "f4")])
+    face = np.empty(2, dtype=[("vertex_indices", object)])
+    face["vertex_indices"] = [np.array([0, 1, 2, 3]), np.array([4, 5, 6])]
+    PlyData([PlyElement.describe(vertex, "vertex"), PlyElement.describe(face, "face")]).write(str(tmp_path / "m.ply"))
+    vertices, faces = read_mesh(tmp_path / "m.ply")
+    assert np.allclose(vertices, CUBE) and faces.tolist() == [[0, 1, 2], [0, 2, 3], [4, 5, 6]]
+    write_ply(tmp_path / "cloud.ply", CUBE)
+    vertices, faces = read_mesh(tmp_path / "cloud.ply")
+    assert np.allclose(vertices, CUBE) and faces is None
+
+
+def test_other_extensions_are_refused(tmp_path):
+    (tmp_path / "m.stl").write_text("solid")
+    with pytest.raises(FileFormatError, match=r"m\.stl: meshes must be \.obj or \.ply"):
+        read_mesh(tmp_path / "m.stl")

@@ -1,0 +1,93 @@
+"""Small structured files (settings, intrinsics, truth, COCO): bounded, parsed safely, errors naming the file."""
+
+import json
+import os
+
+import pytest
+
+from symfruit import ConfigError, FileFormatError, load_settings
+from symfruit.io.text import read_limited, read_structured
+
+
+def test_json_and_yaml_by_extension(tmp_path):
+    (tmp_path / "a.json").write_text('{"a": [1, 2.5, "x"]}')
+    (tmp_path / "a.yaml").write_text("a: [1, 2.5, x]\n")
+    (tmp_path / "a.yml").write_text("a: [1, 2.5, x]\n")
+    for name in ("a.json", "a.yaml", "a.yml"):
+        assert read_structured(tmp_path / name, what="file", max_bytes=100) == {"a": [1, 2.5, "x"]}
+    (tmp_path / "empty.yaml").write_text("")
+    assert read_structured(tmp_path / "empty.yaml", what="file", max_bytes=100) is None
+
+
+def test_a_file_over_the_bound_is_refused(tmp_path):
+    path = tmp_path / "big.json"
+    path.write_text(json.dumps({"a": "x" * 2000}))
+    with pytest.raises(FileFormatError, match=r"big\.json: settings file is larger than 1 kB"):
+        read_structured(path, what="settings file", max_bytes=1024)
+    assert len(read_limited(path, what="file", max_bytes=4096)) == path.stat().st_size
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")
+def test_a_symlink_to_an_endless_file_is_refused_after_the_bound(tmp_path):
+    link = tmp_path / "settings.yaml"
+    link.symlink_to("/dev/zero")
+    # The read stops at the bound (1 MB for settings): it never tries to hold the endless file.
+    with pytest.raises(ConfigError, match=r"settings\.yaml: settings file is larger than 1024 kB"):
+        load_settings(link)
+    with pytest.raises(FileFormatError, match="larger than 0 kB"):
+        read_limited(link, what="file", max_bytes=10)
+
+
+def test_yaml_aliases_are_refused(tmp_path):
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text('a: &a ["x", "x"]\nb: &b [*a, *a]\nc: &c [*b, *b]\n')
+    with pytest.raises(FileFormatError, match=r"bomb\.yaml: not valid YAML: .*aliases \(\*a\) are not allowed"):
+        read_structured(bomb, what="file", max_bytes=1 << 20)
+    anchor_only = tmp_path / "anchor.yaml"
+    anchor_only.write_text("a: &a 1\nb: 2\n")  # an anchor without an alias is harmless
+    assert read_structured(anchor_only, what="file", max_bytes=100) == {"a": 1, "b": 2}
+
+
+def test_yaml_is_loaded_safely(tmp_path):
+    evil = tmp_path / "evil.yaml"
+    evil.write_text("x: !!python/object/apply:os.system ['echo hacked']\n")
+    with pytest.raises(FileFormatError, match="not valid YAML"):
+        read_structured(evil, what="file", max_bytes=1000)
+
+
+@pytest.mark.parametrize("suffix", [".json", ".yaml"])
+def test_deep_nesting_is_refused_with_a_clear_error(tmp_path, suffix):
+    path = tmp_path / f"deep{suffix}"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(FileFormatError, match=rf"deep\{suffix}: .*(nested too deeply|not valid)"):
+        read_structured(path, what="truth file", max_bytes=1 << 20)
+
+
+def test_deep_json_names_the_nesting(tmp_path):
+    path = tmp_path / "deep.json"
+    path.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(FileFormatError, match=r"deep\.json: truth file is nested too deeply to be a truth file"):
+        read_structured(path, what="truth file", max_bytes=1 << 20)
+
+
+def test_a_utf8_byte_order_mark_is_accepted(tmp_path):
+    (tmp_path / "bom.json").write_bytes(b"\xef\xbb\xbf" + b'{"a": 1}')
+    (tmp_path / "bom.yaml").write_bytes(b"\xef\xbb\xbf" + b"a: 1\n")
+    assert read_structured(tmp_path / "bom.json", what="file", max_bytes=100) == {"a": 1}
+    assert read_structured(tmp_path / "bom.yaml", what="file", max_bytes=100) == {"a": 1}
+
+
+def test_other_problems_name_the_file(tmp_path):
+    (tmp_path / "latin1.json").write_bytes(b'{"a": "\xfc"}')
+    with pytest.raises(FileFormatError, match=r"latin1\.json: file is not UTF-8 text \(invalid start byte at byte 7\)"):
+        read_structured(tmp_path / "latin1.json", what="file", max_bytes=100)
+    (tmp_path / "bad.json").write_text('{"a": }')
+    with pytest.raises(FileFormatError, match=r"bad\.json: not valid JSON: .*line 1 column 7"):
+        read_structured(tmp_path / "bad.json", what="file", max_bytes=100)
+    with pytest.raises(FileFormatError, match="no such camera file"):
+        read_structured(tmp_path / "missing.json", what="camera file", max_bytes=100)
+    (tmp_path / "folder.json").mkdir()
+    with pytest.raises(FileFormatError, match="is a folder, not a camera file"):
+        read_structured(tmp_path / "folder.json", what="camera file", max_bytes=100)
+    with pytest.raises(ConfigError, match="no such thing"):
+        read_structured(tmp_path / "missing.yaml", what="thing", max_bytes=100, error=ConfigError)

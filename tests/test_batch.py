@@ -1,0 +1,246 @@
+"""Batches over a recording: every frame gets its folder, a bad frame is recorded and the batch goes on,
+resume skips finished frames before decoding them, and a killed batch resumes to the same results."""
+
+import errno
+import json
+import re
+import shutil
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from PIL import Image
+
+from symfruit import batch
+from symfruit.batch import BatchReport, frame_folder_name, run_batch
+from symfruit.cli import main
+from symfruit.io.sources import FolderSource
+
+from .conftest import EXAMPLE_FRAME
+
+
+def recording(root: Path, *names: str) -> Path:
+    for name in names:
+        shutil.copytree(EXAMPLE_FRAME, root / name)
+    return root
+
+
+def _fruits(folder: Path) -> dict:
+    out = {}
+    for path in sorted(folder.glob("*/detections.json")):
+        data = json.loads(path.read_text())
+        out[path.parent.name] = [{k: v for k, v in f.items() if k != "seconds"} for f in data["fruits"]]
+    return out
+
+
+def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
+    frames = tmp_path / "rec"
+    for name in ("f1", "f2", "f3"):
+        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    (frames / "f2" / "depth.png").write_bytes(b"not a png")
+    out = tmp_path / "out"
+    report = run_batch(frames, out, method="raw", progress=False)
+    assert report.done == ["f1", "f3"] and list(report.failed) == ["f2"] and not report.ok
+    errors = json.loads((out / "errors.json").read_text())
+    assert errors["failed"][0]["frame"] == "f2" and "depth.png" in errors["failed"][0]["reason"]
+    before = (out / "f1" / "detections.json").read_bytes()
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == ["f1", "f3"] and (out / "f1" / "detections.json").read_bytes() == before
+
+
+def test_frame_folder_names_stay_in_their_folder_and_never_collide():
+    assert frame_folder_name("f1") == "f1"
+    assert frame_folder_name("../../etc/passwd").startswith("etc_passwd-")
+    assert frame_folder_name("a b/c").startswith("a_b_c-") and frame_folder_name("...").startswith("frame-")
+    assert frame_folder_name("a b") != frame_folder_name("a?b")  # sanitised alike, told apart by the hash
+
+
+def test_frame_names_from_a_recording_cannot_escape_the_output(tmp_path):
+    import shutil
+
+    from symfruit.batch import frame_folder_name, run_batch
+
+    rec = tmp_path / "rec"
+
+    shutil.copytree(EXAMPLE_FRAME, rec / "x..y ;$(rm -rf)")
+    out = tmp_path / "out"
+    report = run_batch(rec, out, method="raw", progress=False)
+    assert report.done == ["x..y ;$(rm -rf)"] and (out / frame_folder_name("x..y ;$(rm -rf)")).is_dir()
+    written = [p.resolve() for p in out.rglob("*")]
+    assert all(str(p).startswith(str(out.resolve())) for p in written)
+
+
+@given(st.lists(st.text(min_size=0, max_size=30), min_size=2, max_size=8, unique=True))
+def test_frame_folder_names_are_safe_and_distinct(names):
+    folders = [frame_folder_name(n) for n in names]
+    assert len(set(folders)) == len(folders)
+    for folder in folders:
+        assert re.fullmatch(r"[A-Za-z0-9._-]+", folder) and folder not in (".", "..") and len(folder) <= 109
+
+
+@pytest.mark.xfail(strict=True, reason="src bug: a frame named like another frame's sanitised name plus hash "
+                   "is safe, so it is kept as is and shares that frame's output folder")  # fmt: skip
+def test_a_name_that_looks_like_a_hashed_name_does_not_collide():
+    hashed = frame_folder_name("a b")  # "a_b-<8 hex digits>"
+    assert frame_folder_name(hashed) != hashed
+
+
+def test_an_unexpected_error_in_one_frame_is_recorded_and_the_batch_goes_on(tmp_path, monkeypatch):
+    rec = recording(tmp_path / "rec", "f1", "f2", "f3")
+    real = batch.detect
+
+    def detect(frame, **kwargs):
+        if frame.name == "f2":
+            raise RuntimeError("the segmenter fell over")
+        return real(frame, **kwargs)
+
+    monkeypatch.setattr(batch, "detect", detect)
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["f1", "f3"] and report.failed == {"f2": "RuntimeError: the segmenter fell over"}
+    assert not report.ok and report.stopped == "" and report.fruits == 12 and report.failed_fruits == 0
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    assert errors == {"failed": [{"frame": "f2", "reason": "RuntimeError: the segmenter fell over"}], "stopped": ""}
+    assert not (tmp_path / "out" / "f2").exists()
+
+
+def test_resume_decides_before_decoding(tmp_path, monkeypatch):
+    rec = recording(tmp_path / "rec", "a", "b", "c")
+    out = tmp_path / "out"
+    reads = []
+    real = FolderSource.read
+
+    def read(self, index):
+        reads.append(self.names()[index])
+        return real(self, index)
+
+    monkeypatch.setattr(FolderSource, "read", read)
+    run_batch(rec, out, method="raw", progress=False)
+    assert reads == ["a", "b", "c"]
+    shutil.rmtree(out / "b")
+    reads.clear()
+    again = run_batch(rec, out, method="raw", resume=True, progress=False)
+    assert reads == ["b"]  # finished frames are never decoded
+    assert again.skipped == ["a", "c"] and again.done == ["b"] and again.ok
+    reads.clear()
+    run_batch(rec, out, method="raw", resume=False, progress=False)
+    assert reads == ["a", "b", "c"]  # without resume every frame is redone
+
+
+def test_an_output_folder_inside_the_recording_is_not_a_frame(tmp_path):
+    rec = recording(tmp_path / "rec", "f1", "f2")
+    out = rec / "out"
+    for _ in range(2):  # the second time, out/ holds frame-like folders of results
+        report = run_batch(rec, out, method="raw", progress=False)
+        assert report.done == ["f1", "f2"] and report.ok
+    assert sorted(p.name for p in out.iterdir()) == ["errors.json", "f1", "f2"]
+
+
+def test_a_rerun_with_fewer_fruit_leaves_no_stale_clouds(tmp_path):
+    rec = recording(tmp_path / "rec", "f1")
+    out = tmp_path / "out"
+    run_batch(rec, out, method="raw", progress=False)
+    assert sorted(p.name for p in (out / "f1").glob("fruit_*.ply")) == [f"fruit_{k:03d}.ply" for k in range(1, 7)]
+    from symfruit.io.frames import read_frame
+    from symfruit.segment import segment
+
+    frame = read_frame(rec / "f1")
+    labels = segment(frame.color, frame.depth, frame.camera)
+    labels[labels > 2] = 0  # the frame's own masks now hold two fruit
+    Image.fromarray(labels.astype(np.uint8)).save(rec / "f1" / "masks.png")
+    report = run_batch(rec, out, method="raw", progress=False)
+    assert report.fruits == 2
+    assert sorted(p.name for p in (out / "f1").iterdir()) == ["detections.json", "fruit_001.ply", "fruit_002.ply",
+                                                              "overlay.png"]  # fmt: skip
+
+
+def test_errors_json_when_nothing_failed_and_when_the_disk_is_full(tmp_path, monkeypatch):
+    rec = recording(tmp_path / "rec", "f1", "f2", "f3")
+    report = run_batch(rec, tmp_path / "ok", method="raw", progress=False)
+    assert report.ok and json.loads((tmp_path / "ok" / "errors.json").read_text()) == {"failed": [], "stopped": ""}
+    real = batch.write_detections
+
+    def write_detections(folder, found, **kwargs):
+        if folder.name == "f2":
+            raise OSError(errno.ENOSPC, "No space left on device")
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write_detections)
+    report = run_batch(rec, tmp_path / "full", method="raw", progress=False)
+    assert report.done == ["f1"] and list(report.failed) == ["f2"] and not report.ok  # f3 is not attempted
+    assert report.failed["f2"] == f"cannot write {tmp_path / 'full' / 'f2'}: No space left on device"
+    assert report.stopped == "stopped at frame f2: the output is full (No space left on device)"
+    errors = json.loads((tmp_path / "full" / "errors.json").read_text())
+    assert errors["stopped"] == report.stopped and errors["failed"][0]["frame"] == "f2"
+
+
+def test_a_report_is_ok_only_without_failures_or_a_stop():
+    assert BatchReport().ok and BatchReport(done=["a"], skipped=["b"]).ok
+    assert not BatchReport(failed={"a": "x"}).ok and not BatchReport(stopped="full").ok
+
+
+def test_a_source_that_cannot_be_opened_or_an_output_that_cannot_be_made_raises(tmp_path):
+    from symfruit import FileFormatError
+
+    with pytest.raises(FileFormatError, match="no such frame folder, folder of frames or bag"):
+        run_batch(tmp_path / "missing", tmp_path / "out", progress=False)
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(FileFormatError, match="cannot write to folder"):
+        run_batch(EXAMPLE_FRAME, blocker / "out", progress=False)
+
+
+#: Runs ``symfruit detect ARGS`` and SIGKILLs itself while writing the ``detections.json`` of frame
+#: ``sys.argv[1]``: after that frame's clouds and overlay, with its record half written to a temporary file.
+KILLED_WHILE_WRITING = """
+import os, signal, sys
+from pathlib import Path
+
+import symfruit.writers as writers
+from symfruit.io.atomic import atomic_write
+
+real = writers.write_json
+
+
+def write_json(path, data):
+    path = Path(path)
+    if path.name == "detections.json" and path.parent.name == sys.argv[1]:
+        with atomic_write(path, "w") as handle:
+            handle.write('{"frame": ')
+            handle.flush()
+            os.kill(os.getpid(), signal.SIGKILL)
+    real(path, data)
+
+
+writers.write_json = write_json
+from symfruit.cli import main
+
+sys.exit(main(sys.argv[2:]))
+"""
+
+
+def test_killed_batch_resumes_to_identical_results(tmp_path, capsys):
+    rec = recording(tmp_path / "rec", *(f"f{i}" for i in range(6)))
+    whole, part = tmp_path / "whole", tmp_path / "part"
+    cmd = ["detect", str(rec), "--method", "raw"]
+    assert main([*cmd, "--output", str(whole)]) == 0
+    # Killed at a fixed moment, the worst one: frame f3's outputs written but its record still a temporary file.
+    killed = subprocess.run([sys.executable, "-c", KILLED_WHILE_WRITING, "f3", *cmd, "--output", str(part)],
+                            capture_output=True, text=True, timeout=300)  # fmt: skip
+    assert killed.returncode == -signal.SIGKILL, killed.stderr
+    done_before = len(list(part.glob("*/detections.json")))
+    assert 1 <= done_before <= 6
+    assert done_before == 3  # f0, f1, f2
+    for path in part.glob("*/detections.json"):  # a file that exists is whole (written atomically)
+        assert json.loads(path.read_text())["fruits"]
+    assert [p.name.startswith(".detections.json.") for p in part.rglob("*.tmp")] == [True]  # the half-written record
+    capsys.readouterr()
+    assert main([*cmd, "--output", str(part), "--resume"]) == 0
+    assert f"{done_before} skipped" in capsys.readouterr().out
+    assert _fruits(part) == _fruits(whole)
+    assert not list(part.rglob("*.tmp"))  # the resumed run removed what the kill left half-written
+    assert {p.name for p in part.rglob("*")} == {p.name for p in whole.rglob("*")}

@@ -1,0 +1,139 @@
+"""From a fruit's mask to its points: exact de-projection, invalid depth dropped and counted, the border
+eroded, the fruit's own cluster kept."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit import ConfigError
+from symfruit.extract import ExtractSettings, cluster, extract
+
+from .conftest import SMALL_CAM, disc_frame
+
+CAM = SMALL_CAM
+NO_EROSION = ExtractSettings(erode_px=0)
+
+
+def test_extract_drops_invalid_depth_flying_pixels_and_other_clusters():
+    _, depth = disc_frame([(80, 60)])
+    mask = np.zeros((120, 160), bool)
+    yy, xx = np.mgrid[:120, :160]
+    mask[(xx - 80) ** 2 + (yy - 60) ** 2 <= 22**2] = True  # a little larger than the fruit: background leaks in
+    depth[60, 70:75] = 0.0  # no depth
+    ex = extract(mask, depth, CAM, ExtractSettings())
+    assert ex.n_invalid >= 5 and ex.n_other_clusters > 0
+    assert ex.points[:, 2].max() < 0.31 and not ex.truncated
+    ex2 = extract(np.roll(mask, -70, axis=1), np.roll(depth, -70, axis=1), CAM)
+    assert ex2.truncated
+
+
+def test_cluster_labels_largest_first():
+    rng = np.random.default_rng(0)
+    a = rng.random((600, 3)) * 0.01
+    b = rng.random((300, 3)) * 0.01 + [0, 0, 0.2]  # behind: another depth slab
+    c = rng.random((150, 3)) * 0.01 + [0.1, 0, 0]  # beside: same depths, another cluster
+    labels = cluster(np.vstack([b, a, c]), 0.006)
+    assert set(labels[300:900]) == {0} and set(labels[:300]) == {1} and set(labels[900:]) == {2}
+
+
+def test_known_pixels_and_depths_are_deprojected_exactly():
+    mask = np.zeros((120, 160), bool)
+    depth = np.zeros((120, 160), np.float32)
+    pixels = [(10, 20, 0.5), (10, 21, 0.5), (11, 20, 0.5), (60, 80, 0.5), (100, 150, 0.5)]  # (row, col, z)
+    for r, c, z in pixels:
+        mask[r, c] = True
+        depth[r, c] = z
+    # One cluster needs neighbours: spread is 1 px at 0.5 m, under a cluster distance of 1 m.
+    ex = extract(mask, depth, CAM, ExtractSettings(erode_px=0, cluster_distance=1.0, min_points=4))
+    expected = np.array([[(c - 80) / 600 * z, (r - 60) / 600 * z, z] for r, c, z in pixels])
+    assert ex.points.shape == (5, 3) and np.allclose(ex.points, expected, rtol=0, atol=1e-12)
+    assert (ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, ex.truncated) == (5, 0, 0, 0, False)
+
+
+def test_invalid_depth_is_dropped_and_counted():
+    mask = np.zeros((120, 160), bool)
+    mask[50:60, 70:80] = True  # 100 pixels
+    depth = np.full((120, 160), 0.4, np.float32)
+    depth[50, 70:74] = [0.0, np.nan, np.inf, -0.4]  # no depth, NaN, infinite, negative
+    depth[51, 70:72] = [0.05, 2.5]  # nearer than min_depth, farther than max_depth
+    depth[59, 79] = 0.1  # exactly min_depth: valid
+    ex = extract(mask, depth, CAM, NO_EROSION)
+    assert ex.n_invalid == 6 and len(ex.points) == 94 - 1 and ex.n_other_clusters == 1
+    assert np.isfinite(ex.points).all() and ex.points[:, 2].max() == pytest.approx(0.4)
+    kept = extract(mask, depth, CAM, ExtractSettings(erode_px=0, min_depth=0.01, max_depth=3.0))
+    assert kept.n_invalid == 4  # the range is a setting
+
+
+def test_a_far_cluster_is_dropped_and_the_nearest_big_one_kept():
+    mask = np.zeros((120, 160), bool)
+    mask[40:80, 40:80] = True  # 1600 pixels
+    depth = np.full((120, 160), 0.8, np.float32)  # background behind the fruit, leaking in through the mask
+    depth[40:80, 40:60] = 0.3  # the fruit: the left half, 800 pixels
+    ex = extract(mask, depth, CAM, NO_EROSION)
+    assert len(ex.points) == 800 and ex.n_other_clusters == 800 and np.all(ex.points[:, 2] == np.float32(0.3))
+    # A small near cluster (a leaf edge) is not the fruit: it holds under cluster_share of the largest.
+    depth[40:42, 60:62] = 0.2
+    ex = extract(mask, depth, CAM, NO_EROSION)
+    assert len(ex.points) == 800 and ex.n_other_clusters == 800 and ex.points[:, 2].min() == np.float32(0.3)
+    big_leaf = extract(mask, depth, CAM, ExtractSettings(erode_px=0, cluster_share=0.001))
+    assert len(big_leaf.points) == 4 and big_leaf.points[:, 2].max() == np.float32(0.2)
+
+
+def test_erosion_drops_the_border_unless_the_mask_is_small():
+    mask = np.zeros((120, 160), bool)
+    mask[40:60, 60:80] = True  # 20 x 20
+    depth = np.full((120, 160), 0.4, np.float32)
+    ex = extract(mask, depth, CAM, ExtractSettings(erode_px=1))
+    assert ex.mask_area == 400 and ex.n_border == 400 - 18 * 18 and len(ex.points) == 18 * 18
+    ex2 = extract(mask, depth, CAM, ExtractSettings(erode_px=2))
+    assert ex2.n_border == 400 - 16 * 16
+    assert extract(mask, depth, CAM, NO_EROSION).n_border == 0
+    small = np.zeros((120, 160), bool)
+    small[40:46, 60:66] = True  # 6 x 6: eroded it would keep 16 pixels, under min_points (30)
+    ex3 = extract(small, depth, CAM, ExtractSettings(erode_px=1))
+    assert ex3.n_border == 0 and len(ex3.points) == 36
+
+
+def test_a_mask_touching_the_image_border_is_truncated():
+    depth = np.full((120, 160), 0.4, np.float32)
+    for sl in [np.s_[0:10, 50:60], np.s_[110:120, 50:60], np.s_[50:60, 0:10], np.s_[50:60, 150:160]]:
+        mask = np.zeros((120, 160), bool)
+        mask[sl] = True
+        assert extract(mask, depth, CAM).truncated
+    mask = np.zeros((120, 160), bool)
+    mask[1:11, 1:11] = True
+    assert not extract(mask, depth, CAM).truncated
+
+
+def test_an_empty_mask_gives_no_points():
+    ex = extract(np.zeros((120, 160), bool), np.ones((120, 160), np.float32), CAM)
+    assert ex.points.shape == (0, 3) and ex.mask_area == 0 and ex.n_invalid == 0
+
+
+def test_settings_are_checked():
+    with pytest.raises(ConfigError, match="min_depth: must be smaller than max_depth"):
+        ExtractSettings(min_depth=2.0, max_depth=1.0)
+    with pytest.raises(ConfigError, match="erode_px: must be <= 50"):
+        ExtractSettings(erode_px=51)
+
+
+def test_clustering_edge_cases():
+    assert cluster(np.zeros((0, 3)), 0.01).shape == (0,)
+    assert cluster(np.array([[0.0, 0.0, 0.3]]), 0.01).tolist() == [0]
+    far = np.array([[0.0, 0.0, 0.3], [0.0, 0.0, 0.9], [0.0, 0.0, 0.3005]])
+    assert cluster(far, 0.01).tolist() == [0, 1, 0]
+    sparse = np.array([[0.0, 0.0, 0.3], [50.0, 50.0, 0.3], [0.001, 0.0, 0.3]])  # a huge, sparse grid
+    assert cluster(sparse, 0.002).tolist() == [0, 1, 0]
+
+
+@given(st.integers(0, 10_000), st.floats(0.002, 0.02))
+def test_points_closer_than_half_the_distance_share_a_cluster(seed, distance):
+    rng = np.random.default_rng(seed)
+    walk = np.cumsum(rng.uniform(-1, 1, size=(50, 3)) * distance * 0.49 / np.sqrt(3), axis=0) + [0, 0, 0.4]
+    labels = cluster(walk, distance)  # every step is shorter than distance / 2: one chain
+    assert set(labels.tolist()) == {0}
+    apart = np.vstack([walk, walk + [10 * distance + np.ptp(walk[:, 0]), 0, 0]])
+    labels = cluster(apart, distance)
+    assert set(labels[:50].tolist()) == {labels[0]} and set(labels[50:].tolist()) == {labels[50]}
+    assert labels[0] != labels[50]

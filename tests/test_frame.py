@@ -1,0 +1,39 @@
+"""One RGB-D frame: the pipeline's unit of work checks that its images, intrinsics and masks agree."""
+
+import numpy as np
+import pytest
+
+from symfruit import Box, InputError
+from symfruit.frame import Frame
+
+from .conftest import SMALL_CAM, disc_frame
+
+COLOR, DEPTH = disc_frame([(80, 60)])
+
+
+def test_a_consistent_frame_keeps_what_it_is_given():
+    masks = np.zeros((120, 160), np.int32)
+    truth = [(1, Box(np.zeros(3), np.ones(3)))]
+    frame = Frame("f", COLOR, DEPTH, SMALL_CAM, masks=masks, truth=truth, source="here", stamp=5)
+    assert frame.color is COLOR and frame.depth is DEPTH and frame.masks is masks and frame.truth == truth
+    assert (frame.source, frame.stamp, frame.extras) == ("here", 5, {})
+    bare = Frame("g", COLOR, DEPTH, SMALL_CAM)
+    assert bare.masks is None and bare.truth is None and bare.source == "" and bare.stamp is None
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"color": COLOR.astype(np.float32)}, r"frame f: colour must be \(h, w, 3\) uint8 RGB, got float32"),
+        ({"color": COLOR[:, :, 0]}, r"colour must be \(h, w, 3\) uint8 RGB, got uint8 \(120, 160\)"),
+        ({"color": np.dstack([COLOR, COLOR[:, :, :1]])}, r"got uint8 \(120, 160, 4\)"),
+        ({"depth": DEPTH[None]}, r"depth must be a 2-D image, got shape \(1, 120, 160\)"),
+        ({"color": COLOR[:100]}, "colour is 160x100 but depth is 160x120; depth must be aligned"),
+        ({"depth": DEPTH[:, :150], "color": COLOR[:, :150]}, "intrinsics are for 160x120 but the images are 150x120"),
+        ({"masks": np.zeros((120, 150), np.int32)}, "masks are 150x120, the image 160x120"),
+    ],
+)
+def test_inconsistent_frames_are_refused_by_name(change, message):
+    args = {"name": "f", "color": COLOR, "depth": DEPTH, "camera": SMALL_CAM, **change}
+    with pytest.raises(InputError, match=message):
+        Frame(**args)

@@ -1,0 +1,105 @@
+"""The z-buffer renderer and the RGB-D sensor model: analytic depths and silhouettes at known poses."""
+
+import numpy as np
+import pytest
+
+from symfruit import Camera
+from symfruit.render import Rendering, SensorNoise, render
+
+from .conftest import fibonacci_sphere
+
+CAM = Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
+#: A triangle 0.5 m in front of the camera, facing it: 240 px wide at the base, 240 px high.
+TRIANGLE = (np.array([[-0.1, 0.1, 0.5], [0.1, 0.1, 0.5], [0.0, -0.1, 0.5]]), np.array([[0, 1, 2]]))
+
+
+def test_render_sphere_depth_is_exact():
+    from scipy.spatial import ConvexHull
+
+    cam = Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
+    hull = ConvexHull(fibonacci_sphere(4000))
+    centre = np.array([0.0, 0.0, 0.4])
+    shot = render([(hull.points * 0.03 + centre, hull.simplices)], cam)
+    assert shot.depth[240, 320] == pytest.approx(0.37, abs=2e-4)
+    radius_px = 600 * 0.03 / np.sqrt(0.4**2 - 0.03**2)
+    assert (shot.ids == 0).sum() == pytest.approx(np.pi * radius_px**2, rel=0.03)
+    assert shot.facing[240, 320] == pytest.approx(1.0, abs=1e-3)
+    assert np.all(np.isinf(shot.depth[shot.ids < 0]))
+
+
+def test_sensor_noise_grows_with_distance():
+    noise = SensorNoise()
+    assert noise.sigma(0.3) == pytest.approx(0.001) and noise.sigma(0.6) == pytest.approx(0.004)
+
+
+def test_a_fronto_parallel_triangle_known_depth_silhouette_and_facing():
+    shot = render([TRIANGLE], CAM)
+    assert isinstance(shot, Rendering) and shot.depth.shape == (480, 640) and shot.ids.shape == (480, 640)
+    assert shot.depth[240, 320] == pytest.approx(0.5, abs=1e-12) and shot.ids[240, 320] == 0
+    hit = shot.ids == 0
+    assert np.allclose(shot.depth[hit], 0.5, atol=1e-12) and np.all(np.isinf(shot.depth[~hit]))
+    assert hit.sum() == pytest.approx(0.5 * 240 * 240, rel=0.01)
+    rows, cols = np.nonzero(hit)
+    assert (rows.min(), rows.max(), cols.min(), cols.max()) == (120, 360, 200, 440)  # the projected corners
+    u = np.arange(640) - 320.0
+    expected = 1.0 / np.sqrt(1.0 + (u / 600.0) ** 2)  # |cos| of the ray along row 240 against the normal
+    row = hit[240]
+    assert np.allclose(shot.facing[240, row], expected[row], atol=1e-12) and shot.facing[240, 320] == 1.0
+
+
+def test_a_tilted_plane_gives_the_ray_plane_intersection():
+    # The plane z = 0.5 + 0.5 x, as two triangles; the ray through (u, v) meets it at z = 0.5 / (1 - 0.5 a),
+    # a = (u - cx) / fx.
+    corners = np.array([[-0.2, -0.2], [0.2, -0.2], [0.2, 0.2], [-0.2, 0.2]])
+    vertices = np.c_[corners, 0.5 + 0.5 * corners[:, 0]]
+    shot = render([(vertices, np.array([[0, 1, 2], [0, 2, 3]]))], CAM)
+    for u, v in [(320, 240), (380, 240), (260, 300), (400, 200), (330, 241)]:
+        a = (u - 320) / 600
+        assert shot.depth[v, u] == pytest.approx(0.5 / (1 - 0.5 * a), rel=1e-12)
+    assert shot.facing[240, 320] == pytest.approx(1 / np.sqrt(1.25))  # normal (0.5, 0, -1) / |.|
+
+
+def test_the_nearest_surface_wins_and_meshes_keep_their_index():
+    behind = (TRIANGLE[0] * [2.0, 2.0, 1.0] + [0.0, 0.0, 0.3], TRIANGLE[1])  # bigger, 0.8 m away
+    shot = render([behind, TRIANGLE], CAM)
+    assert shot.ids[240, 320] == 1 and shot.depth[240, 320] == pytest.approx(0.5)
+    assert shot.ids[380, 320] == 0 and shot.depth[380, 320] == pytest.approx(0.8)  # only the far one there
+    assert set(np.unique(shot.ids).tolist()) == {-1, 0, 1}
+
+
+def test_what_cannot_be_seen_renders_nothing():
+    empty = render([], CAM)
+    assert np.all(np.isinf(empty.depth)) and np.all(empty.ids == -1) and np.all(empty.facing == 0)
+    behind = render([(TRIANGLE[0] * [1, 1, -1], TRIANGLE[1])], CAM)  # behind the camera: skipped
+    assert np.all(behind.ids == -1)
+    aside = render([(TRIANGLE[0] + [5.0, 0.0, 0.0], TRIANGLE[1])], CAM)  # outside the image
+    assert np.all(aside.ids == -1)
+    flat = render([(np.array([[0, 0, 0.5], [0.1, 0, 0.5], [0.2, 0, 0.5]]), np.array([[0, 1, 2]]))], CAM)
+    assert np.all(flat.ids == -1)  # a degenerate triangle has no area
+    assert np.all(render([(TRIANGLE[0], np.zeros((0, 3), int))], CAM).ids == -1)
+
+
+def test_batches_do_not_change_the_image():
+    from scipy.spatial import ConvexHull
+
+    hull = ConvexHull(fibonacci_sphere(1000))
+    mesh = [(hull.points * 0.03 + [0.0, 0.0, 0.4], hull.simplices)]
+    a, b = render(mesh, CAM), render(mesh, CAM, max_candidates=50)
+    assert np.array_equal(a.depth, b.depth) and np.array_equal(a.ids, b.ids) and np.array_equal(a.facing, b.facing)
+
+
+def test_sensor_noise_is_seeded_and_a_perfect_sensor_returns_the_ideal_depth():
+    shot = render([TRIANGLE], CAM)
+    noise = SensorNoise()
+    a, jitter_a = noise.apply(shot, np.random.default_rng(3))
+    b, jitter_b = noise.apply(shot, np.random.default_rng(3))
+    assert np.array_equal(a, b) and np.array_equal(jitter_a, jitter_b) and jitter_a.shape == (480, 640, 2)
+    assert np.all(a[shot.ids < 0] == 0)  # no return where nothing was hit
+    seen = (shot.ids == 0) & (a > 0)
+    assert 0.0005 < np.std(a[seen] - 0.5) < 0.003  # sigma(0.5) = 2.8 mm
+    perfect = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
+    depth, jitter = perfect.apply(shot, np.random.default_rng(0))
+    assert np.array_equal(depth, np.where(shot.ids == 0, shot.depth, 0.0)) and not jitter.any()
+    edges = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=1.0, grazing_dropout=0.0, dropout=0.0)
+    depth, _ = edges.apply(shot, np.random.default_rng(0))
+    assert depth[240, 320] == 0.5 and depth[360, 320] == 0.0  # the silhouette's bottom edge drops out

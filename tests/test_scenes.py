@@ -1,0 +1,68 @@
+"""Synthetic RGB-D scenes of hanging strawberries: seeded, with truth that holds what was rendered."""
+
+import numpy as np
+import pytest
+
+from symfruit import Camera
+from symfruit.render import SensorNoise
+from symfruit.scenes import Scene, SceneFruit, make_scene
+from symfruit.segment import red_mask
+
+PERFECT = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
+
+
+@pytest.fixture(scope="module")
+def exact():
+    return make_scene(4, noise=PERFECT)
+
+
+def test_the_same_seed_gives_the_same_scene():
+    a, b = make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1), make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1)
+    assert np.array_equal(a.color, b.color) and np.array_equal(a.depth, b.depth)
+    assert np.array_equal(a.labels, b.labels) and a.truth() == b.truth()
+    c = make_scene(3, n_ripe=3, n_unripe=1, n_leaves=1)
+    assert not np.array_equal(a.color, c.color) and a.truth() != c.truth()
+
+
+def test_images_and_labels_have_the_cameras_size():
+    cam = Camera(fx=400, fy=400, cx=160, cy=120, width=320, height=240)
+    scene = make_scene(0, n_ripe=2, n_unripe=1, n_leaves=0, camera=cam)
+    assert isinstance(scene, Scene) and scene.camera == cam
+    assert scene.color.shape == (240, 320, 3) and scene.color.dtype == np.uint8
+    assert scene.depth.shape == (240, 320) and scene.depth.dtype == np.float32 and scene.labels.dtype == np.int32
+    assert set(np.unique(scene.labels).tolist()) <= {0, 1, 2, 3}
+
+
+def test_truth_boxes_contain_the_rendered_fruit_points(exact):
+    assert [f.id for f in exact.fruits] == list(range(1, 9))
+    for fruit in exact.fruits:
+        rows, cols = np.nonzero((exact.labels == fruit.id) & (exact.depth > 0))
+        assert len(rows) > 50  # every fruit is seen
+        points = exact.camera.deproject(np.c_[cols, rows].astype(float), exact.depth[rows, cols].astype(float))
+        assert fruit.box.contains(points, tol=1e-4), fruit.id  # float32 depth: 0.1 mm
+        # ... and the seen points reach across most of the box (the box is the fruit's, not a bigger one).
+        assert np.ptp(points[:, 0]) > 0.7 * fruit.box.size[0] and np.ptp(points[:, 1]) > 0.7 * fruit.box.size[1]
+
+
+def test_noisy_depth_stays_near_the_exact_one(exact):
+    noisy = make_scene(4)
+    assert np.array_equal(noisy.labels, exact.labels)
+    both = (noisy.depth > 0) & (exact.depth > 0) & (exact.labels > 0)
+    error = noisy.depth[both] - exact.depth[both]
+    assert abs(float(np.median(error))) < 0.0005 and float(np.percentile(np.abs(error), 99)) < 0.02
+    assert (noisy.depth[exact.labels > 0] == 0).mean() > (exact.depth[exact.labels > 0] == 0).mean()  # dropouts
+
+
+def test_unripe_fruit_are_flagged_and_not_red(exact):
+    ripe = [f for f in exact.fruits if f.ripe]
+    unripe = [f for f in exact.fruits if not f.ripe]
+    assert len(ripe) == 6 and len(unripe) == 2 and all(isinstance(f, SceneFruit) for f in exact.fruits)
+    red = red_mask(exact.color)
+    for f in ripe:
+        assert red[exact.labels == f.id].mean() > 0.8
+    for f in unripe:
+        assert red[exact.labels == f.id].mean() < 0.02
+    truth = exact.truth()["fruits"]
+    assert [t["ripe"] for t in truth] == [f.ripe for f in exact.fruits]
+    assert truth[0]["kind"].startswith("strawberry/") and truth[0]["centre"] == exact.fruits[0].box.centre.tolist()
+    assert set(truth[0]) == {"id", "ripe", "kind", "centre", "min", "max", "size"}

@@ -1,0 +1,186 @@
+"""Every file symfruit writes: a completion's PLY and JSON, a frame's detections (ROS 2
+``vision_msgs/Detection3DArray``), PLYs and overlay, and results folders with a ``latest`` link."""
+
+import datetime
+import json
+import os
+from dataclasses import replace
+
+import numpy as np
+import pytest
+from plyfile import PlyData
+
+from symfruit import FileFormatError, complete
+from symfruit.detect import FrameDetections
+from symfruit.writers import (
+    OPTICAL_FRAME,
+    detections_record,
+    draw_overlay,
+    new_results_folder,
+    write_detections,
+    write_result,
+)
+
+from .conftest import VISIBLE
+
+#: The fields of ``vision_msgs/BoundingBox3D`` (geometry_msgs/Pose center, geometry_msgs/Vector3 size).
+BOUNDING_BOX_3D = {
+    "center": {"position": {"x", "y", "z"}, "orientation": {"x", "y", "z", "w"}},
+    "size": {"x", "y", "z"},
+}
+
+
+@pytest.fixture
+def found(example_found):
+    return example_found
+
+
+def test_outputs_map_onto_detection3d(tmp_path, found):
+    written = write_detections(tmp_path, found)
+    assert {p.name for p in written} >= {"detections.json", "overlay.png", "fruit_001.ply"}
+    data = json.loads((tmp_path / "detections.json").read_text())
+    assert data["header"]["frame_id"] == "camera_color_optical_frame" and data["frame"] == "example_frame"
+    fruit = data["fruits"][0]
+    for key in (
+        "id",
+        "mask_area",
+        "n_points",
+        "centre",
+        "box",
+        "method",
+        "plane",
+        "score",
+        "truncated",
+        "bbox",
+    ):
+        assert key in fruit
+    bbox = fruit["bbox"]
+    assert [bbox["center"]["position"][k] for k in "xyz"] == fruit["centre"]
+    assert [bbox["size"][k] for k in "xyz"] == fruit["box"]["size"]
+    assert bbox["center"]["orientation"] == {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0}
+    from PIL import Image
+
+    overlay = np.asarray(Image.open(tmp_path / "overlay.png"))
+    assert overlay.shape == (480, 640, 3)
+    assert (np.abs(overlay.astype(int) - [0, 220, 255]).sum(axis=2) == 0).sum() > 100  # cyan cuboids drawn
+
+
+def test_every_record_is_a_bounding_box_3d_in_the_optical_frame(found):
+    data = detections_record(found)
+    assert data["header"] == {"frame_id": OPTICAL_FRAME} and data["units"] == "metres"
+    assert data["camera"] == found.frame.camera.to_dict() and "settings" not in data
+    assert [f["id"] for f in data["fruits"]] == [d.id for d in found.detections]
+    for fruit, d in zip(data["fruits"], found.detections, strict=True):
+        bbox = fruit["bbox"]
+        assert set(bbox) == set(BOUNDING_BOX_3D) and set(bbox["size"]) == BOUNDING_BOX_3D["size"]
+        assert {k: set(v) for k, v in bbox["center"].items()} == BOUNDING_BOX_3D["center"]
+        lo, hi = np.array(fruit["box"]["min"]), np.array(fruit["box"]["max"])
+        centre = np.array([bbox["center"]["position"][k] for k in "xyz"])
+        size = np.array([bbox["size"][k] for k in "xyz"])
+        assert np.allclose(centre, (lo + hi) / 2) and np.allclose(size, hi - lo) and np.all(size > 0)
+        assert fruit["n_points"] == len(d.extraction.points) and fruit["visible_box"] == d.visible_box.to_dict()
+    json.dumps(data, allow_nan=False)  # plain JSON, no NaN
+
+
+def test_stamps_go_into_the_header_and_failures_into_the_record(found):
+    stamped = replace(found, frame=replace(found.frame, stamp=1_700_000_000_123_456_789))
+    assert detections_record(stamped)["header"]["stamp"] == {"sec": 1_700_000_000, "nanosec": 123_456_789}
+    failed = replace(found.detections[0], result=None, error="too few points")
+    record = detections_record(replace(found, detections=[failed]))["fruits"][0]
+    assert record["error"] == "too few points" and "bbox" not in record and record["id"] == failed.id
+    from symfruit import Settings
+
+    assert detections_record(found, settings=Settings())["settings"] == Settings().to_dict()
+
+
+def test_a_rerun_with_fewer_fruit_leaves_exactly_its_own_files(tmp_path, found):
+    write_detections(tmp_path, found)
+    assert len(list(tmp_path.glob("fruit_*.ply"))) == 6
+    (tmp_path / ".detections.json.abc123.tmp").write_text("{half")  # a killed run's temporary file
+    (tmp_path / "notes.txt").write_text("mine")  # not a frame output: kept
+    fewer = replace(found, detections=found.detections[:2])
+    written = write_detections(tmp_path, fewer)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["detections.json", "fruit_001.ply", "fruit_002.ply",
+                                                          "notes.txt", "overlay.png"]  # fmt: skip
+    assert [p.name for p in written] == ["fruit_001.ply", "fruit_002.ply", "overlay.png", "detections.json"]
+    assert len(json.loads((tmp_path / "detections.json").read_text())["fruits"]) == 2
+
+
+def test_fruit_clouds_label_visible_and_completed_points(tmp_path, found):
+    write_detections(tmp_path, found)
+    d = found.detections[0]
+    vertex = PlyData.read(str(tmp_path / f"fruit_{d.id:03d}.ply"))["vertex"]
+    labels = np.asarray(vertex["label"])
+    n_vis = len(d.result.visible)
+    assert len(labels) == len(d.result.points) and not labels[:n_vis].any() and labels[n_vis:].all()
+    assert np.allclose(np.c_[vertex["x"], vertex["y"], vertex["z"]], d.result.points, atol=1e-6)
+
+
+def test_the_overlay_is_the_frame_with_boxes_drawn(found):
+    img = draw_overlay(found)
+    assert img.size == (640, 480) and img.mode == "RGB"
+    pixels = np.asarray(img)
+    assert not np.array_equal(pixels, found.frame.color)
+    assert (np.abs(pixels.astype(int) - [255, 170, 0]).sum(axis=2) == 0).sum() > 100  # orange visible boxes
+    empty = draw_overlay(FrameDetections(found.frame, []))
+    same = np.asarray(empty)[:440] == found.frame.color[:440]  # only the legend at the bottom is drawn
+    assert same.all()
+
+
+def test_write_result_writes_the_cloud_and_its_record(tmp_path):
+    result = complete(VISIBLE, method="sphere")
+    ply, record = write_result(tmp_path / "out" / "fruit.ply", result, meta={"input": "fruit.npy", "units": "m"})
+    assert (ply, record) == (tmp_path / "out" / "fruit.ply", tmp_path / "out" / "fruit.json")
+    vertex = PlyData.read(str(ply))["vertex"]
+    assert len(vertex) == len(result.points) and int(np.sum(vertex["label"])) == len(result.points) - len(VISIBLE)
+    data = json.loads(record.read_text())
+    assert data["input"] == "fruit.npy" and data["units"] == "m" and data["method"] == "sphere"
+    assert data["extras"]["radius"] == result.extras["radius"] and data["settings"] == result.settings.to_dict()
+    assert data["centre"] == result.centre.tolist() and data["n_completed"] == len(result.points)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["fruit.json", "fruit.ply"]
+
+
+@pytest.mark.parametrize("name", ["fruit.txt", "fruit", "fruit.PLY.json"])
+def test_write_result_refuses_other_extensions(tmp_path, name):
+    with pytest.raises(FileFormatError, match=r"the output must end in \.ply"):
+        write_result(tmp_path / name, complete(VISIBLE, method="raw"))
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_write_result_refuses_a_folder(tmp_path):
+    (tmp_path / "taken.ply").mkdir()
+    with pytest.raises(FileFormatError, match=r"taken\.ply: is a folder; give a file name ending in \.ply"):
+        write_result(tmp_path / "taken.ply", complete(VISIBLE, method="raw"))
+    assert write_result(tmp_path / "UPPER.PLY", complete(VISIBLE, method="raw"))[1].name == "UPPER.json"
+
+
+class FixedClock(datetime.datetime):
+    @classmethod
+    def now(cls, tz=None):
+        return cls(2024, 5, 6, 7, 8, 9)
+
+
+def test_results_folders_never_collide_and_latest_follows(tmp_path, monkeypatch):
+    from symfruit import writers
+
+    monkeypatch.setattr(writers._dt, "datetime", FixedClock)
+    first = new_results_folder(tmp_path, "paper")
+    second = new_results_folder(tmp_path, "paper")
+    third = new_results_folder(tmp_path, "paper")
+    other = new_results_folder(tmp_path, "camera")
+    names = [p.name for p in (first, second, third, other)]
+    assert names == ["20240506-070809-paper", "20240506-070809-paper-2", "20240506-070809-paper-3",
+                     "20240506-070809-camera"]  # fmt: skip
+    assert all(p.is_dir() for p in (first, second, third, other))
+    latest = tmp_path / "latest"
+    assert latest.is_symlink() and os.readlink(latest) == other.name and latest.resolve() == other.resolve()
+    assert sorted(p.name for p in tmp_path.iterdir() if p.name.startswith(".")) == []  # no temporary link left
+
+
+def test_a_results_root_that_cannot_be_written_is_named(tmp_path, found):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    with pytest.raises(FileFormatError, match=r"file: cannot create a results folder"):
+        new_results_folder(blocker, "paper")
+    with pytest.raises(FileFormatError, match=r"cannot create output folder"):
+        write_detections(blocker / "frame", found)
