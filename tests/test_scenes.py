@@ -5,7 +5,7 @@ import pytest
 
 from symfruit import Camera
 from symfruit.render import SensorNoise
-from symfruit.scenes import Scene, SceneFruit, make_scene
+from symfruit.scenes import Scene, SceneFruit, make_scene, write_scenes
 from symfruit.segment import red_mask
 
 PERFECT = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
@@ -66,3 +66,21 @@ def test_unripe_fruit_are_flagged_and_not_red(exact):
     assert [t["ripe"] for t in truth] == [f.ripe for f in exact.fruits]
     assert truth[0]["kind"].startswith("strawberry/") and truth[0]["centre"] == exact.fruits[0].box.centre.tolist()
     assert set(truth[0]) == {"id", "ripe", "kind", "centre", "min", "max", "size"}
+
+
+def test_a_generated_recording_repeats_its_scenes_cheaply(tmp_path):
+    import os
+
+    from symfruit.io.sources import open_source
+
+    write_scenes(tmp_path / "rec", 5, distinct=2, n_ripe=8)
+    rec = tmp_path / "rec"
+    src = open_source(rec)
+    assert src.names() == [f"scene_{i:05d}" for i in range(5)]
+    for i in (2, 4):  # frame i repeats scene i % 2
+        for name in ("color.png", "depth.png", "camera.json", "truth.json"):
+            a, b = rec / f"scene_{i:05d}" / name, rec / f"scene_{i % 2:05d}" / name
+            assert a.read_bytes() == b.read_bytes()
+            assert os.path.samefile(a, b) or a.stat().st_nlink == 1  # a hard link where the file system has them
+    assert not np.array_equal(src.read(0).color, src.read(1).color)
+    assert len(src.read(3).truth) == 8

@@ -23,11 +23,6 @@ def test_maskrcnn_without_torch_says_which_extra():
 
 
 @pytest.mark.skipif(HAS_TORCH, reason="torch is installed")
-@pytest.mark.xfail(
-    strict=True,
-    reason="src bug: maskrcnn_labels imports torch before load_maskrcnn can say which extra is missing, so "
-    "detect --masks maskrcnn:... without torch raises ModuleNotFoundError",
-)
 def test_detect_with_maskrcnn_masks_without_torch_says_which_extra(example):
     with pytest.raises(SymfruitError, match=r"pip install 'symfruit\[seg\]'"):
         frame_masks(example, "maskrcnn:weights.pth")

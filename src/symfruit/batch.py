@@ -30,13 +30,14 @@ _NO_SPACE = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
 
 
 def frame_folder_name(name: str) -> str:
-    """The output folder name of a frame: ``name`` itself when it is a safe file name, else a sanitised
-    name plus a short hash of the original, so two names never share a folder however the recording grows."""
+    """The output folder name of a frame: ``name`` itself when it is a safe file name (letters, digits,
+    ``._-``), else a sanitised name, ``+`` and a short hash of the original. A safe name never holds ``+``,
+    so no two names share a folder however the recording grows."""
     clean = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:100]
     if clean == name and name:
         return name
     digest = hashlib.sha1(name.encode("utf-8", "surrogateescape")).hexdigest()[:8]
-    return f"{clean or 'frame'}-{digest}"
+    return f"{clean or 'frame'}+{digest}"
 
 
 @dataclass

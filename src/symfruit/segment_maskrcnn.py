@@ -47,9 +47,9 @@ def load_maskrcnn(checkpoint: str, num_classes: int = 2):
 
 def maskrcnn_labels(color: np.ndarray, checkpoint: str, *, score: float = 0.5, fruit_class: int = 1) -> np.ndarray:
     """Instance labels (0 background) of the detections of ``fruit_class`` scoring at least ``score``."""
+    model = load_maskrcnn(checkpoint)  # first: it says which extra to install when torch is missing
     import torch
 
-    model = load_maskrcnn(checkpoint)
     with torch.no_grad():
         out = model([torch.from_numpy(np.ascontiguousarray(color)).permute(2, 0, 1).float() / 255.0])[0]
     keep = (out["scores"] >= score) & (out["labels"] == fruit_class)

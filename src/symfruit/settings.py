@@ -171,11 +171,16 @@ class Settings:
 
     def replace(self, **overrides: Any) -> Settings:
         """A copy with sections overridden by mappings (only the keys they name) or section objects."""
-        data = {
-            k: dataclasses.asdict(v) if dataclasses.is_dataclass(v) and not isinstance(v, type) else v
-            for k, v in overrides.items()
-        }
-        return from_dict(merge(self.to_dict(), data))
+        return from_dict(merge(self.to_dict(), _plain(overrides)))
+
+
+def _plain(value: Any) -> Any:
+    """Section objects, at any depth of a mapping, as plain dicts."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return dataclasses.asdict(value)
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    return value
 
 
 def _rebuild(sections: dict[str, Any]) -> Settings:

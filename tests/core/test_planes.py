@@ -98,14 +98,10 @@ def test_first_translation_and_negative_steps(sphere_view):
     assert np.allclose(planes.angles_x, [10.0, 0.0, -10.0])
 
 
-@pytest.mark.xfail(
-    strict=True, reason="src bug: hypothesis_planes does not normalise its input (list -> AttributeError)"
-)
 def test_hypothesis_planes_accept_a_list(sphere_view):
     assert len(hypothesis_planes(sphere_view.tolist())) == 132
 
 
-@pytest.mark.xfail(strict=True, reason="src bug: hypothesis_planes((n, 2)) raises a bare IndexError, not InputError")
 def test_hypothesis_planes_refuse_wrong_shapes():
     from symfruit import InputError
 
@@ -113,9 +109,6 @@ def test_hypothesis_planes_refuse_wrong_shapes():
         hypothesis_planes(np.zeros((5, 2)))
 
 
-@pytest.mark.xfail(
-    strict=True, reason="src bug: mirror((n, 2) points) raises numpy's broadcast ValueError, not InputError"
-)
 def test_mirror_refuses_wrong_shapes():
     from symfruit import InputError
 

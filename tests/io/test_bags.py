@@ -85,8 +85,6 @@ def test_a_bag_whose_colour_topic_is_empty_is_named(tmp_path):
         open_source(path)
 
 
-@pytest.mark.xfail(strict=True, reason="src bug: a bag whose CameraInfo topic holds no message opens, then every "
-                   "read raises a bare IndexError (BagSource.read indexes an empty camera list)")  # fmt: skip
 def test_a_bag_whose_camera_info_topic_is_empty_is_named(tmp_path):
     pytest.importorskip("rosbags")
     color, depth = disc_frame([(80, 60)])

@@ -7,6 +7,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ..errors import InputError
+from .points import as_points
+
 __all__ = ["Plane", "Planes", "hypothesis_planes", "mirror", "mirror_xyz"]
 
 
@@ -87,6 +90,7 @@ def hypothesis_planes(
     Planes
         Ordered translation-major, then angle about x, then angle about y.
     """
+    points = as_points(points, min_count=1)
     centroid = points.mean(axis=0)
     z = points[:, 2]
     len_depth = float(z.max() - z.min())
@@ -159,9 +163,14 @@ def mirror(points: np.ndarray, plane_points: np.ndarray, normals: np.ndarray) ->
     -------
     (h, n, 3) float, or (n, 3) for a single plane
     """
-    if np.ndim(normals) == 1:  # one plane: the direct formula
-        p = np.asarray(points, dtype=np.float64)
-        n = np.asarray(normals, dtype=np.float64)
+    p = as_points(points, min_count=0)
+    n = np.asarray(normals, dtype=np.float64)
+    q = np.asarray(plane_points, dtype=np.float64)
+    if n.shape[-1:] != (3,) or q.shape[-1:] != (3,) or n.ndim > 2 or q.ndim > 2:
+        raise InputError(f"planes need points and normals of shape (3,) or (h, 3), got {q.shape} and {n.shape}")
+    if not np.all(np.linalg.norm(np.atleast_2d(n), axis=1) > 0):
+        raise InputError("a plane normal must not be zero")
+    if n.ndim == 1:  # one plane: the direct formula
         n = n / np.linalg.norm(n)
-        return p - 2.0 * ((p - np.asarray(plane_points, dtype=np.float64)) @ n)[:, None] * n
-    return np.stack(mirror_xyz(points, plane_points, normals), axis=-1)
+        return p - 2.0 * ((p - q) @ n)[:, None] * n
+    return np.stack(mirror_xyz(p, q, n), axis=-1)

@@ -151,6 +151,8 @@ class BagSource:
                 self._cameras.append((stamp, camera))
         if not self._color_stamps:
             raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
+        if not self._cameras:
+            raise FileFormatError(f"CameraInfo topic {info[0].topic} holds no messages")
         self._camera_stamps = [s for s, _ in self._cameras]
 
     def __len__(self) -> int:

@@ -115,8 +115,8 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
         if units not in known:
             raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
         scale = known[units]
-    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale < 1:
-        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1), got {scale!r}")
+    if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:
+        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {scale!r}")
     return float(scale)
 
 
