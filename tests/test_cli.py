@@ -110,6 +110,11 @@ def test_embedded_sample(capsys):
             "too small for a fruit; check the units|too small for a fruit",
         ),
         (["complete", "{sample}", "--camera", "nocam.json"], "nocam.json: no such intrinsics file"),
+        (["evaluate", "--quick", "--jobs", "-1"], "--jobs must be between 1 and 256, got -1"),
+        (["evaluate", "--quick", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
+        (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
+        (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
+        (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
     ],
 )
 def test_errors_are_one_line_with_status_2(capsys, args, message):
@@ -267,3 +272,43 @@ def test_bench_arguments_are_checked(capsys):
 def test_no_command_prints_help(capsys):
     assert main([]) == 2
     assert "usage: symfruit" in capsys.readouterr().out
+
+
+def test_inputs_claiming_huge_sizes_fail_cleanly_inside_a_memory_limit(tmp_path):
+    """Each file claims gigabytes; in a child capped at 2 GB of address space every one must end in a
+    one-line error with status 2, never a MemoryError or a kill: the sizes are checked before allocating."""
+    import resource
+    import struct
+    import subprocess
+    import sys
+
+    files = {}
+    pcd = tmp_path / "big.pcd"
+    head = b"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4000000\nHEIGHT 1\nPOINTS 4000000\n"
+    pcd.write_bytes(head + b"DATA binary_compressed\n" + struct.pack("<II", 64, 48_000_000) + b"\0" * 64)
+    files[pcd] = "binary_compressed sizes do not match"
+    ply = tmp_path / "big.ply"
+    ply.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    b"property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\nend_header\n"
+                    + bytes(36))  # fmt: skip
+    files[ply] = "4000000000 face rows"
+    npy = tmp_path / "big.npy"
+    with npy.open("wb") as handle:
+        np.lib.format.write_array_header_1_0(
+            handle, {"descr": "<f8", "fortran_order": False, "shape": (100000, 100000)}
+        )
+    files[npy] = "header promises"
+    cam = tmp_path / "cam.json"
+    cam.write_text('{"fx": 615, "fy": 615, "cx": 320, "cy": 240, "width": 100000, "height": 100000}')
+    sample = str(EXAMPLES / "strawberry_partial.ply")
+
+    def cap() -> None:
+        resource.setrlimit(resource.RLIMIT_AS, (2 << 30, 2 << 30))
+
+    runs = [[str(path)] for path in files] + [[sample, "--camera", str(cam)]]
+    messages = [*files.values(), "width is 100000 pixels"]
+    for args, message in zip(runs, messages, strict=True):
+        proc = subprocess.run([sys.executable, "-m", "symfruit", "complete", *args], capture_output=True, text=True,
+                              preexec_fn=cap, timeout=120)  # fmt: skip
+        assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
+        assert proc.stderr.startswith("symfruit: error: ") and message in proc.stderr

@@ -160,3 +160,25 @@ def test_scalars_and_other_objects_are_refused_as_input():
     for bad in (3.0, None, "points", {"x": 1}):
         with pytest.raises(InputError, match=r"numeric \(n, 3\) array|must have shape \(n, 3\), got \(\)"):
             complete(bad)
+
+
+def test_a_streak_along_the_line_of_sight_is_refused_by_every_method():
+    rng = np.random.default_rng(0)
+    z = np.linspace(0.30, 0.33, 200)
+    streak = np.c_[rng.normal(0, 1e-4, 200) * z, rng.normal(0, 1e-4, 200) * z, z]  # all within one pixel
+    for method in ("fused", "paper", "sphere", "ellipsoid", "raw"):
+        with pytest.raises(InputError, match="a streak along the line of sight"):
+            complete(streak, method=method)
+
+
+def test_a_completion_larger_than_a_fruit_is_refused_naming_the_method(isolated_registry):
+    from symfruit.core.box import Box
+    from symfruit.methods import Completion, register
+
+    @register("huge")
+    def huge(points, camera, settings):
+        """Completes anything to a 3-metre box."""
+        return Completion(points=points, box=Box(points.min(axis=0) - 1.5, points.max(axis=0) + 1.5))
+
+    with pytest.raises(InputError, match=r"method 'huge' completed these points to a box 3\.\d+ m across"):
+        complete(VISIBLE, method="huge")

@@ -6,6 +6,8 @@ import pickle
 from dataclasses import dataclass
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from symfruit import ConfigError, Settings, load_settings, resolve_settings
 from symfruit.methods.fused import FusedSettings
@@ -47,6 +49,9 @@ def test_round_trip():
         ({"fused": {"mirror": {"rating_points": 1}}}, r"fused.mirror.rating_points: must be >= 10"),
         ({"segment": {"close_px": 100000}}, r"segment.close_px: must be <= 50"),
         ({"paper": {"fill_radius": 1e300}}, r"paper.fill_radius: must be <= 100"),
+        ({"extract": {"erode_px": 1_000_000_000}}, r"extract.erode_px: must be <= 50"),
+        ({"segment": {"crease_sigma": 1e300}}, r"segment.crease_sigma: must be <= 50"),
+        ({"input": {"max_points": 10**12}}, r"input.max_points: must be <= 5e\+06"),
         ({"paper": {1: 2}}, r"setting names must be text"),
         ({1: {}}, r"section names must be text"),
         ({"paper": 3}, r"expected a mapping"),
@@ -264,3 +269,31 @@ def test_merge_replaces_only_what_it_names_at_every_depth():
     assert merge(base, {"a": {"c": {"d": 5}}, "f": [3]}) == {"a": {"b": 1, "c": {"d": 5, "e": 3}}, "f": [3]}
     assert merge(base, {"a": 7}) == {"a": 7, "f": [1, 2]} and base["a"]["c"]["d"] == 2  # the base is untouched
     assert merge({"a": 1}, {"a": {"b": 2}}) == {"a": {"b": 2}}
+
+
+# --- fuzz: every registered section takes only valid values, whatever a file holds ---------------------
+
+_VALUES = st.one_of(
+    st.none(), st.booleans(), st.integers(-(10**12), 10**12), st.floats(allow_nan=True, allow_infinity=True),
+    st.text(max_size=12), st.lists(st.integers(), max_size=3),
+    st.dictionaries(st.text(max_size=5), st.integers(), max_size=2),
+)  # fmt: skip
+
+
+@pytest.mark.parametrize("name", sorted(section_types()))
+@settings()
+@given(data=st.data())
+def test_every_section_survives_random_values(name, data):
+    import dataclasses
+
+    fields = [f.name for f in dataclasses.fields(section_types()[name])]
+    keys = st.one_of(st.sampled_from(fields), st.text(max_size=8), st.integers(-3, 3))
+    layer = data.draw(st.dictionaries(keys, _VALUES, max_size=4))
+    try:
+        result = from_dict({name: layer})
+    except ConfigError:
+        return
+    section = result.section(name)
+    for key, value in layer.items():  # what was accepted is what is there (numbers as floats where floats)
+        got = getattr(section, key)
+        assert got == value or (isinstance(got, float) and got == float(value)) or dataclasses.is_dataclass(got)

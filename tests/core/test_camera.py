@@ -70,3 +70,22 @@ def test_whole_float_sizes_are_taken_and_the_camera_is_frozen():
 
     with pytest.raises(dataclasses.FrozenInstanceError):
         cam.fx = 1.0  # type: ignore[misc]
+
+
+@pytest.mark.parametrize(
+    "bad, message",
+    [
+        ({"width": 100000, "height": 100000}, "width is 100000 pixels; at most 16384"),
+        ({"width": 16000, "height": 16000}, "exceeds 40,000,000 pixels"),
+        ({"fx": 1e300}, "focal lengths must be at most"),
+        ({"cy": -1e300}, "cy = -1e[+]300 is implausible"),
+    ],
+)
+def test_absurd_intrinsics_are_refused_without_numpy_warnings(bad, message):
+    import warnings
+
+    args = {"fx": 615.0, "fy": 615.0, "cx": 320.0, "cy": 240.0, "width": 640, "height": 480, **bad}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # a RuntimeWarning from numpy would fail here
+        with pytest.raises(InputError, match=message):
+            Camera(**args)

@@ -139,3 +139,97 @@ def test_readers_survive_corrupted_valid_files(tmp_path, kind, cut, byte, where)
         read_cloud(path)
     except SymfruitError:
         pass
+
+
+# --- sizes claimed by headers, and files that are not what their name says (issue 13) ------------------
+
+
+def _pcd_header(points: int, mode: str) -> bytes:
+    return (
+        f"VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH {points}\nHEIGHT 1\n"
+        f"VIEWPOINT 0 0 0 1 0 0 0\nPOINTS {points}\nDATA {mode}\n"
+    ).encode()
+
+
+def test_a_compressed_pcd_claiming_gigabytes_is_refused_before_allocating(tmp_path):
+    import struct
+
+    huge = tmp_path / "huge.pcd"  # 4 GB of points claimed
+    huge.write_bytes(_pcd_header(333_333_334, "binary_compressed") + struct.pack("<II", 16, 4_000_000_008) + b"\0" * 16)
+    with pytest.raises(FileFormatError, match=r"huge\.pcd: PCD holds 333,333,334 points; at most"):
+        read_cloud(huge)
+    ratio = tmp_path / "ratio.pcd"  # a legal count whose 1.2 MB could never come out of 16 bytes of LZF
+    ratio.write_bytes(_pcd_header(100_000, "binary_compressed") + struct.pack("<II", 16, 1_200_000) + b"\0" * 16)
+    with pytest.raises(FileFormatError, match=r"ratio\.pcd: binary_compressed sizes do not match"):
+        read_cloud(ratio)
+
+
+def test_a_ply_face_element_of_billions_of_rows_is_refused_before_plyfile_reads_it(tmp_path):
+    path = tmp_path / "faces.ply"
+    path.write_bytes(
+        b"ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+        b"property float z\nelement face 4000000000\nproperty list uchar int vertex_indices\nend_header\n"
+        + np.zeros(9, "<f4").tobytes()
+    )
+    with pytest.raises(FileFormatError, match=r"faces\.ply: header promises 3 vertices, 4000000000 face rows"):
+        read_cloud(path)
+
+
+def test_a_huge_npy_header_and_an_npz_named_npy_are_refused(tmp_path):
+    header = tmp_path / "huge.npy"
+    with header.open("wb") as handle:
+        np.lib.format.write_array_header_1_0(
+            handle, {"descr": "<f8", "fortran_order": False, "shape": (100000, 100000)}
+        )
+        handle.write(b"\0" * 64)
+    with pytest.raises(FileFormatError, match=r"huge\.npy: \.npy header promises \(100000, 100000\)"):
+        read_cloud(header)
+    npz = tmp_path / "points.npy"
+    np.savez(tmp_path / "points.npz", points=POINTS)
+    (tmp_path / "points.npz").rename(npz)
+    with pytest.raises(FileFormatError, match=r"points\.npy: is an \.npz archive"):
+        read_cloud(npz)
+
+
+def test_text_clouds_are_bounded_in_rows_and_bytes(tmp_path, monkeypatch):
+    from symfruit.io import clouds
+
+    path = tmp_path / "rows.xyz"
+    path.write_text("\n".join("0.1 0.2 0.3" for _ in range(20)) + "\n")
+    monkeypatch.setattr(clouds, "MAX_CLOUD_POINTS", 10)
+    with pytest.raises(FileFormatError, match=r"rows\.xyz: more than 10 rows"):
+        read_cloud(path)
+    monkeypatch.setattr(clouds, "MAX_TEXT_BYTES", 100)
+    with pytest.raises(FileFormatError, match=r"rows\.xyz: text cloud is larger than"):
+        read_cloud(path)
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "x;y;z\n0,031;-0,002;0,305\n0,032;-0,001;0,306\n",  # European CSV: ';' columns, decimal commas
+        "\ufeff0.031 -0.002 0.305\n0.032 -0.001 0.306\n",  # a UTF-8 byte-order mark before the first row
+        "0.031,-0.002,0.305\n0.032,-0.001,0.306\n",
+        "# comment\n0.031\t-0.002\t0.305\t7\n0.032 -0.001 0.306 8\n",
+    ],
+)
+def test_text_clouds_keep_every_row_and_every_digit(tmp_path, text):
+    path = tmp_path / "cloud.csv"
+    path.write_text(text, encoding="utf-8")
+    assert np.array_equal(read_cloud(path), [[0.031, -0.002, 0.305], [0.032, -0.001, 0.306]])
+
+
+def test_a_device_or_a_folder_is_not_a_cloud(tmp_path):
+    link = tmp_path / "zero.xyz"
+    link.symlink_to("/dev/zero")
+    with pytest.raises(FileFormatError, match=r"zero\.xyz: not a regular file"):
+        read_cloud(link)
+    (tmp_path / "dir.ply").mkdir()
+    with pytest.raises(FileFormatError, match=r"dir\.ply: not a regular file"):
+        read_cloud(tmp_path / "dir.ply")
+
+
+def test_complex_npy_is_refused(tmp_path):
+    np.save(tmp_path / "c.npy", POINTS.astype(np.complex128))
+    with pytest.raises(FileFormatError, match="complex numbers cannot be coordinates"):
+        read_cloud(tmp_path / "c.npy")

@@ -5,6 +5,8 @@ import shutil
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 
 from symfruit import FileFormatError, InputError, SymfruitError
@@ -164,3 +166,80 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
     labels[40:80, 100:140] = 300  # needs 16 bits
     write_frame(tmp_path / "f", color, depth, CAM, masks=labels)
     assert np.array_equal(read_frame(tmp_path / "f").masks, labels)
+
+
+@pytest.mark.parametrize(
+    "truth, message",
+    [
+        ({"fruits": [{"min": [0.0, 0.0], "max": [0.1, 0.1, 0.4]}]}, "three finite numbers"),
+        ({"fruits": [5]}, "fruit 1 is not an object"),
+        ({"fruits": "none"}, "'fruits' is not a list"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": "one"}]}, "id must be a whole number"),
+    ],
+)
+def test_malformed_truth_names_the_file(tmp_path, truth, message):
+    path = tmp_path / "truth.json"
+    path.write_text(json.dumps(truth))
+    with pytest.raises(FileFormatError, match=rf"truth\.json: expected .*{message}"):
+        read_truth(path)
+
+
+def test_an_unreadable_truth_file_is_named(tmp_path, monkeypatch):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, SMALL_CAM, truth={"fruits": []})
+    real_open = open
+
+    def refuse(path, *args, **kwargs):  # root reads any file, so the permission error is simulated
+        if str(path).endswith("truth.json"):
+            raise PermissionError(13, "Permission denied")
+        return real_open(path, *args, **kwargs)
+
+    monkeypatch.setattr("builtins.open", refuse)
+    with pytest.raises(FileFormatError, match=r"truth\.json: cannot read truth file \(Permission denied\)"):
+        read_frame(tmp_path / "f")
+
+
+def test_an_npz_named_depth_npy_is_refused(tmp_path):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, SMALL_CAM)
+    (tmp_path / "f" / "depth.png").unlink()
+    np.savez(tmp_path / "d.npz", depth=depth)
+    (tmp_path / "d.npz").rename(tmp_path / "f" / "depth.npy")
+    with pytest.raises(FileFormatError, match=r"depth\.npy: is an \.npz archive"):
+        read_frame(tmp_path / "f")
+
+
+@pytest.mark.parametrize("mode, suffix", [("P", "png"), ("CMYK", "jpg"), ("RGBA", "png")])
+def test_colour_in_any_mode_gives_the_same_fruit(tmp_path, example, mode, suffix):
+    from symfruit.detect import detect
+
+    folder = tmp_path / "f"
+    shutil.copytree(EXAMPLE_FRAME, folder)
+    (folder / "color.png").unlink()
+    img = Image.fromarray(example.color).convert(mode)
+    img.save(folder / f"color.{suffix}", **({"quality": 98} if suffix == "jpg" else {}))
+    frame = read_frame(folder)
+    assert frame.color.shape == example.color.shape and frame.color.dtype == np.uint8
+    found = detect(frame, method="raw")
+    assert len(found.detections) == 6  # what the RGB frame gives (a palette or a JPEG shifts colours a little)
+
+
+_LEAVES = st.none() | st.booleans() | st.integers(-5, 5) | st.floats(allow_nan=False, allow_infinity=False)
+_KEYS = st.sampled_from(["fruits", "min", "max", "id", "ripe"])
+_JSON = st.recursive(
+    _LEAVES | st.text(max_size=4),
+    lambda inner: st.lists(inner, max_size=4) | st.dictionaries(_KEYS, inner, max_size=4),
+    max_leaves=20,
+)
+
+
+@settings()
+@given(_JSON)
+def test_truth_survives_any_json(tmp_path, data):
+    path = tmp_path / "truth.json"
+    path.write_text(json.dumps(data))
+    try:
+        truth = read_truth(path)
+    except SymfruitError:
+        return
+    assert all(isinstance(k, int) and box.min.shape == (3,) for k, box in truth)

@@ -7,9 +7,11 @@ import zlib
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from PIL import Image
 
-from symfruit import FileFormatError
+from symfruit import FileFormatError, SymfruitError
 from symfruit.io import images
 from symfruit.io.images import MAX_IMAGE_PIXELS, decode_color, read_color, read_depth_units, read_labels
 
@@ -160,3 +162,34 @@ def test_labels_from_grey_palette_and_colour_images(tmp_path):
     assert read_labels(save(Image.fromarray(full), tmp_path / "nobg.png")).tolist() == [[1, 2]]
     with pytest.raises(FileFormatError, match="is not an instance label image"):
         read_labels(save(Image.new("LA", (2, 2)), tmp_path / "la.png"))
+
+
+@settings()
+@given(
+    st.binary(max_size=4096),
+    st.sampled_from(["png", "jpg", "tiff", "bmp"]),
+    st.sampled_from(["color", "depth", "labels"]),
+)
+def test_image_readers_survive_random_bytes(tmp_path, data, suffix, use):
+    path = tmp_path / f"fuzz.{suffix}"
+    path.write_bytes(data)
+    reader = {"color": read_color, "depth": read_depth_units, "labels": read_labels}[use]
+    try:
+        reader(path)
+    except SymfruitError:
+        pass
+
+
+@settings()
+@given(st.integers(0, 4000), st.integers(0, 255), st.integers(1, 400))
+def test_image_readers_survive_corrupted_pngs(tmp_path, where, byte, cut):
+    path = tmp_path / "c.png"
+    Image.fromarray(np.arange(48 * 64 * 3, dtype=np.uint8).reshape(48, 64, 3)).save(path)
+    data = bytearray(path.read_bytes())
+    data[where % len(data)] = byte
+    path.write_bytes(bytes(data[: max(1, len(data) - cut)]))
+    for reader in (read_color, read_depth_units, read_labels):
+        try:
+            reader(path)
+        except SymfruitError:
+            pass

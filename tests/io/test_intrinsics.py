@@ -89,3 +89,26 @@ def test_nested_layouts_and_wrong_extensions(tmp_path):
     (tmp_path / "bool.json").write_text(json.dumps({**plain, "fx": True}))
     with pytest.raises(FileFormatError, match="'fx' must be a number"):
         load_camera(tmp_path / "bool.json")
+
+
+def test_intrinsics_files_that_would_expand_or_never_end_are_refused(tmp_path):
+    bomb = tmp_path / "bomb.yaml"
+    bomb.write_text("a: &a [1, 1, 1, 1, 1, 1, 1, 1, 1]\nb: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+                    "c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]\nfx: 615\n")  # fmt: skip
+    with pytest.raises(FileFormatError, match=r"bomb\.yaml: .*aliases"):
+        load_camera(bomb)
+    deep = tmp_path / "deep.json"
+    deep.write_text("[" * 100_000 + "]" * 100_000)
+    with pytest.raises(FileFormatError, match=r"deep\.json: intrinsics file is nested too deeply"):
+        load_camera(deep)
+    zero = tmp_path / "zero.json"
+    zero.symlink_to("/dev/zero")
+    with pytest.raises(FileFormatError, match=r"zero\.json: intrinsics file is larger than"):
+        load_camera(zero)
+
+
+def test_a_sensor_of_100000_pixels_a_side_is_refused_naming_the_file(tmp_path):
+    path = tmp_path / "cam.json"
+    path.write_text('{"fx": 615, "fy": 615, "cx": 320, "cy": 240, "width": 100000, "height": 100000}')
+    with pytest.raises(FileFormatError, match=r"cam\.json: camera width is 100000 pixels"):
+        load_camera(path)

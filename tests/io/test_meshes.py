@@ -2,9 +2,11 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from plyfile import PlyData, PlyElement
 
-from symfruit import FileFormatError
+from symfruit import FileFormatError, SymfruitError
 from symfruit.io import read_mesh, write_ply
 
 CUBE = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0, 0, 1], [1, 0, 1], [1, 1, 1], [0, 1, 1]], float)
@@ -54,3 +56,38 @@ def test_other_extensions_are_refused(tmp_path):
     (tmp_path / "m.stl").write_text("solid")
     with pytest.raises(FileFormatError, match=r"m\.stl: meshes must be \.obj or \.ply"):
         read_mesh(tmp_path / "m.stl")
+
+
+def test_a_mesh_claiming_more_faces_than_the_file_holds_is_refused(tmp_path):
+    path = tmp_path / "m.ply"
+    path.write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        b"element face 4000000000\nproperty list uchar int vertex_indices\nend_header\n0 0 1\n1 0 1\n0 1 1\n3 0 1 2\n"
+    )
+    with pytest.raises(FileFormatError, match=r"m\.ply: header promises 3 vertices, 4000000000 face rows"):
+        read_mesh(path)
+
+
+def test_a_mesh_within_the_file_but_over_the_face_bound_is_refused(tmp_path, monkeypatch):
+    from symfruit.io import meshes
+
+    path = tmp_path / "m.ply"
+    path.write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        b"element face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 1\n1 0 1\n0 1 1\n3 0 1 2\n3 0 2 1\n"
+    )
+    assert read_mesh(path)[1].shape == (2, 3)
+    monkeypatch.setattr(meshes, "MAX_FACES", 1)
+    with pytest.raises(FileFormatError, match=r"m\.ply: mesh of 3 vertices and 2 faces; at most"):
+        read_mesh(path)
+
+
+@settings()
+@given(st.binary(max_size=2048), st.sampled_from([".ply", ".obj"]))
+def test_mesh_readers_survive_random_bytes(tmp_path, data, suffix):
+    path = tmp_path / f"fuzz{suffix}"
+    path.write_bytes(data)
+    try:
+        read_mesh(path)
+    except SymfruitError:
+        pass
