@@ -15,7 +15,7 @@ from ..conftest import SMALL_CAM, disc_frame
 CAM = SMALL_CAM
 
 
-def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_topic=True):
+def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_topic=True, k=None, encoding="rgb8"):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
@@ -32,12 +32,14 @@ def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_
             t = 1_000_000_000 * (i + 1)
             head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="camera_color_optical_frame")
             info = Info(header=head, height=120, width=160, distortion_model="plumb_bob", d=np.zeros(5),
-                        k=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]), r=np.eye(3).ravel(),
+                        k=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]) if k is None else np.asarray(k, float),
+                        r=np.eye(3).ravel(),
                         p=np.array([600.0, 0, 80, 0, 0, 600, 60, 0, 0, 0, 1, 0]), binning_x=0, binning_y=0,
                         roi=RoI(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False))  # fmt: skip
             if camera_info:
                 writer.write(c_inf, t, ts.serialize_cdr(info, "sensor_msgs/msg/CameraInfo"))
-            img = Image(header=head, height=120, width=160, encoding="rgb8", is_bigendian=0, step=480,
+            step = color.shape[1] * (color.shape[2] if color.ndim == 3 else 1)
+            img = Image(header=head, height=120, width=160, encoding=encoding, is_bigendian=0, step=step,
                         data=color.ravel())  # fmt: skip
             if colour_topic:
                 writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
@@ -165,3 +167,21 @@ def test_compressed_images(tmp_path):
 def test_bad_messages_are_refused_before_their_data_is_used(msg, error):
     with pytest.raises(FileFormatError, match=error):
         image_array(msg, "sensor_msgs/msg/Image")
+
+
+def test_a_camera_info_with_k_all_zero_names_the_bag(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "zerok", color, (depth * 1000).astype(np.uint16), k=np.zeros(9))
+    src = open_source(path)
+    with pytest.raises(FileFormatError, match=r"zerok: invalid CameraInfo on /camera/color/camera_info .*focal"):
+        src.read(0)
+
+
+def test_a_mono8_colour_topic_gives_grey_rgb_frames(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    grey = np.ascontiguousarray(color[:, :, 0])
+    src = open_source(write_ros2_bag(tmp_path / "mono", grey, (depth * 1000).astype(np.uint16), encoding="mono8"))
+    frame = src.read(0)
+    assert frame.color.shape == (120, 160, 3) and np.array_equal(frame.color[:, :, 1], grey)
