@@ -62,7 +62,7 @@ def run_batch(
     output: str | Path,
     *,
     masks: str = "auto",
-    method: str = "fused",
+    method: str = "evidence",
     settings: Settings | None = None,
     resume: bool = False,
     progress: bool = True,

@@ -54,7 +54,7 @@ class DemoReport:
         return (float(np.mean([p[0] for p in pairs])), float(np.mean([p[1] for p in pairs]))) if pairs else None
 
 
-def run_demo(output: str | Path, *, method: str = "fused", settings: Settings | None = None) -> DemoReport:
+def run_demo(output: str | Path, *, method: str = "evidence", settings: Settings | None = None) -> DemoReport:
     """Detect the example frame's fruit, write the outputs to ``output``, score them against the truth."""
     output = Path(output)
     with example_frame() as folder:

@@ -92,7 +92,7 @@ def detect(
     frame: Frame,
     *,
     masks: str | Path | Segmenter = "auto",
-    method: str = "fused",
+    method: str = "evidence",
     settings: Settings | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.
