@@ -6,7 +6,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit import DEFAULT_CAMERA
-from symfruit.core.candidates import candidates, constrain_box
+from symfruit.core.candidates import REACH, candidates, constrain_box
 from symfruit.core.evidence import observe
 from symfruit.core.raster import silhouette
 
@@ -15,7 +15,7 @@ from ..conftest import ball_mesh, rendered_view
 coord = st.floats(-0.05, 0.05, allow_nan=False)
 
 
-@given(st.lists(coord, min_size=12, max_size=12), st.floats(0.25, 1.0))
+@given(st.lists(coord, min_size=12, max_size=12), st.floats(0.0, 1.0))
 def test_constrained_boxes_hold_the_seen_box_behind_the_front(values, contour):
     v = np.array(values)
     seen_lo, seen_hi = np.minimum(v[:3], v[3:6]) + [0, 0, 0.4], np.maximum(v[:3], v[3:6]) + [0, 0, 0.4]
@@ -25,7 +25,7 @@ def test_constrained_boxes_hold_the_seen_box_behind_the_front(values, contour):
     assert out_lo[2] == front and out_hi[2] >= max(seen_hi[2], front)
     assert np.all(out_lo[:2] <= seen_lo[:2]) and np.all(out_hi[:2] >= seen_hi[:2])
     near, far = np.r_[seen_lo[:2], front], np.maximum(seen_hi, np.r_[seen_lo[:2], front])
-    reach = 2.0 / contour * (far - near)
+    reach = REACH / max(contour, 0.5) * (far - near)
     assert np.all(out_hi <= np.maximum(near + reach, far + [0, 0, 1e-4]) + 1e-12)
     assert np.all(out_lo >= np.minimum(far - reach, near) - 1e-12)
 
@@ -48,7 +48,7 @@ def test_candidates_of_a_noisy_ball():
     front = 0.4 - 0.035
     cands = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front)
     by = {c.name: c for c in cands}
-    assert list(by) == ["sphere", "ellipsoid", "revolution", "raw"]
+    assert list(by) == ["sphere", "ellipsoid", "cone", "revolution", "raw"]
     assert all(c.lo[2] == front for c in cands)
     assert by["raw"].evidence is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
     s = by["sphere"]
@@ -57,4 +57,7 @@ def test_candidates_of_a_noisy_ball():
     assert s.hi[2] == pytest.approx(0.435, abs=0.003)
     with_mirror = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front,
                              mirror={"translations": 8, "translation_step": 0.1})  # fmt: skip
-    assert [c.name for c in with_mirror] == ["sphere", "ellipsoid", "revolution", "mirror", "raw"]
+    assert [c.name for c in with_mirror] == ["sphere", "ellipsoid", "cone", "revolution", "mirror", "raw"]
+    cone = by["cone"]  # tangent to the silhouette's cone: its box is the ball's, back face included
+    np.testing.assert_allclose(cone.centre, [0.01, 0.0, 0.4], atol=0.001)
+    assert cone.hi[2] == pytest.approx(0.435, abs=0.0015)

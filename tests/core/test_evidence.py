@@ -55,3 +55,16 @@ def test_a_cut_cloud_is_not_a_contour(camera):
     inst = build(Spec("paper", "citrus", 0, 0))
     obs = observe(inst.visible, silhouette(inst.visible, camera), camera)
     assert obs.contour < 0.8
+
+
+def test_outside_rays_beside_a_cut_are_no_evidence(camera):
+    from symfruit.evaluate.protocols import Spec, build
+
+    inst = build(Spec("paper", "citrus", 0, 0))
+    obs = observe(inst.visible, silhouette(inst.visible, camera), camera)
+    weights = np.concatenate(obs.out_weights)
+    assert 0.0 < weights.mean() < 0.9  # part of the edge is the cut, part the fruit's outline
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.01, seed=3)
+    whole = observe(visible[::10], silhouette(visible, camera), camera, dense=visible)
+    assert np.concatenate(whole.out_weights).mean() > 0.95 and whole.contour > 0.95
+    assert len(whole.interior) > 0.8 * len(visible[::10])

@@ -15,8 +15,10 @@ from symfruit import Box, InputError, box_iou
 from symfruit.core.fits import (
     Revolution,
     closed_profile,
+    cone_ellipsoid,
     ellipsoid_half_extents,
     fit_aligned_ellipsoid,
+    fit_cone_ellipsoid,
     fit_ellipsoid,
     fit_revolution,
     fit_revolution_slices,
@@ -251,3 +253,40 @@ def test_slice_revolution_refuses_too_few_points():
         fit_revolution_slices(np.zeros((5, 3)))
     with pytest.raises(InputError, match="shape"):
         fit_revolution_slices(np.zeros((30, 2)))
+
+
+# --- ellipsoid tangent to the silhouette's cone ------------------------------------------------------------
+
+
+def _tangent_cone(centre, shape):
+    """The exact viewing cone ``x^T C x = 0`` of an ellipsoid (its dual is ``m m^T - S``)."""
+    return np.linalg.inv(np.outer(centre, centre) - shape)
+
+
+@given(st.lists(st.floats(-0.3, 0.3), min_size=2, max_size=2), st.floats(-6, 6))
+def test_every_cone_parameter_is_an_ellipsoid_with_that_outline(offset, tau):
+    centre, shape = np.array([0.02, -0.01, 0.4]), np.diag([0.03, 0.02, 0.025]) ** 2
+    cone = _tangent_cone(centre, shape)
+    if np.linalg.eigvalsh(cone)[-1] < 0:  # signature (+, +, -) with negative inside
+        cone = -cone
+    axis = centre / centre[2]
+    m, s, valid = cone_ellipsoid(np.array([[offset[0] * 0.1, offset[1] * 0.1, np.log(0.4), tau]]), cone, axis)
+    if not valid[0]:
+        return
+    assert np.all(np.linalg.eigvalsh(s[0]) > 0)
+    other = _tangent_cone(m[0], s[0])
+    np.testing.assert_allclose(other / np.abs(other).max() * np.sign(other[2, 2] * cone[2, 2]),
+                               cone / np.abs(cone).max(), atol=1e-6)  # fmt: skip
+
+
+def test_cone_ellipsoid_of_a_noisy_ball_is_the_ball():
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    visible, _ = rendered_view(ball_mesh(0.03), [0.05, -0.03, 0.38], noise=0.01, seed=7)
+    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    centre, shape = fit_cone_ellipsoid(visible[::5], cone=cone, axis=axis, front=0.35, extent=0.06)
+    np.testing.assert_allclose(centre, [0.05, -0.03, 0.38], atol=6e-4)
+    np.testing.assert_allclose(np.sqrt(np.diag(shape)), 0.03, atol=6e-4)
+    with pytest.raises(InputError):
+        fit_cone_ellipsoid(visible[:5], cone=cone, axis=axis, front=0.35, extent=0.06)

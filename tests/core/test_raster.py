@@ -129,3 +129,19 @@ def test_silhouette_window_stops_at_the_image_edge():
     assert region.u0 == 0 and region.mask[:, 0].any()
     with pytest.raises(InputError, match="no point projects"):
         silhouette(pts + [1.0, 0.0, 0.0], cam)
+
+
+def test_silhouette_cone_of_a_ball_is_its_tangent_cone(camera):
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    from ..conftest import ball_mesh, rendered_view
+
+    c, r = np.array([0.04, 0.02, 0.4]), 0.035
+    visible, _ = rendered_view(ball_mesh(r), c)
+    cone, axis = silhouette_cone(silhouette(visible, camera), camera)
+    exact = np.linalg.inv(np.outer(c, c) - r * r * np.eye(3))  # the ball's viewing cone (up to scale)
+    exact = exact / np.abs(np.linalg.eigvalsh(exact)).max() * np.sign(exact[2, 2] * cone[2, 2])
+    np.testing.assert_allclose(cone, exact, atol=0.01)
+    ray = c / c[2]
+    assert ray @ cone @ ray < 0  # the centre's ray is inside
+    np.testing.assert_allclose(axis, ray, atol=0.003)

@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 
 from symfruit import ConfigError, box_iou, centre_deviation, complete
+from symfruit.core.candidates import Candidate
+from symfruit.core.evidence import Evidence
 from symfruit.evaluate.protocols import Spec, build
-from symfruit.methods.evidence import EvidenceSettings, _weighted_median
+from symfruit.methods.evidence import EvidenceSettings, _weighted_median, clean_share, combine
 from symfruit.settings import Settings
 from symfruit.shapes import FRUITS, rotation
 
@@ -50,7 +52,7 @@ def test_deterministic_with_its_candidates_reported():
     inst = build(Spec("camera", "lemon", 0, 3, sensor="heldback"))
     a, b = complete(inst.visible), complete(inst.visible)
     np.testing.assert_array_equal(a.box.min, b.box.min)
-    assert set(a.extras["candidates"]) == {"sphere", "ellipsoid", "revolution", "raw"}
+    assert set(a.extras["candidates"]) == {"sphere", "ellipsoid", "cone", "revolution", "raw"}
     assert a.extras["reliable"] is (a.extras["confidence"] >= EvidenceSettings().reliable_at)
     mirrored = complete(inst.visible, settings={"evidence": {"mirror_candidate": True}})
     assert "mirror" in mirrored.extras["candidates"]
@@ -88,3 +90,21 @@ def test_real_pear_camera_views_beat_the_sphere_and_the_raw_box(tmp_path):
     mean_centre = {m: float(np.mean(v)) for m, v in centre.items()}
     assert mean_iou["evidence"] > max(mean_iou["sphere"], mean_iou["raw"]) + 0.05
     assert mean_centre["evidence"] < min(mean_centre["sphere"], mean_centre["raw"]) - 0.003
+
+
+def test_clean_share_ramps_between_depth_views_and_clean_scans():
+    assert clean_share(1.8, 3.3) == 0.0 and clean_share(5.0, 3.3) == 1.0 and clean_share(3.3, 3.3) == 0.5
+
+
+def test_premises_the_view_contradicts_cost_energy():
+    box = (np.zeros(3), np.ones(3) * 0.01)
+    good = Evidence(0.001, 0.0, 0.0)
+    cands = [Candidate("cone", *box, good, np.zeros(3)), Candidate("ellipsoid", *box, good, np.zeros(3)),
+             Candidate("raw", *box, None, np.zeros(3))]  # fmt: skip
+    s = EvidenceSettings()
+    whole = combine(cands, contour=1.0, clean=0.0, s=s).energies
+    cut = combine(cands, contour=0.4, clean=1.0, s=s).energies
+    assert whole["cone"] == 0.0 and whole["ellipsoid"] == pytest.approx(s.noise_energy)
+    assert whole["raw"] == pytest.approx(s.raw_energy)
+    assert cut["cone"] == pytest.approx(0.6 * s.cut_energy) and cut["ellipsoid"] == 0.0
+    assert cut["raw"] == pytest.approx(s.raw_energy + 0.6 * s.cut_energy)

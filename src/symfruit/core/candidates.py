@@ -6,6 +6,9 @@ Every candidate is a different assumption about the hidden side:
     a ball (least-squares sphere, geometric refinement);
 ``ellipsoid``
     a general ellipsoid (Li-Griffiths, any orientation);
+``cone``
+    the ellipsoid whose outline is the silhouette (tangent to its viewing cone) and whose front best fits
+    the seen depths (:func:`symfruit.core.fits.fit_cone_ellipsoid`);
 ``revolution``
     a solid of revolution (:func:`symfruit.core.fits.fit_revolution_slices`): its axis from slice circles,
     its profile from the seen arcs, an end left unseen closed by symmetry about the widest slice;
@@ -32,6 +35,7 @@ from .camera import Camera
 from .evidence import Evidence, Inside, Observation, explain
 from .fits import (
     ellipsoid_half_extents,
+    fit_cone_ellipsoid,
     fit_ellipsoid,
     fit_revolution_slices,
     fit_sphere,
@@ -43,6 +47,10 @@ from .raster import View
 from .symmetry import complete_by_symmetry
 
 __all__ = ["Candidate", "candidates", "constrain_box"]
+
+#: No face of a candidate's box lies farther than this many seen extents from the opposite seen face (see
+#: :func:`constrain_box`).
+REACH = 3.0
 
 
 @dataclass(frozen=True)
@@ -80,17 +88,18 @@ def constrain_box(
     """A candidate's box made consistent with the view: ``(lo (3,), hi (3,))``, metres.
 
     1. joined with the seen points' box, its front face set to ``front``;
-    2. no face beyond ``2 / contour`` times the seen extent from the opposite seen face: a camera's view
-       of a convex fruit shows at least half its extent along every axis (front to rim in depth, the
-       whole silhouette across); where the seen edge is partly a cut (``contour`` < 1) less may be seen
-       (this only stops runaway fits);
+    2. no face beyond :data:`REACH` ``/ max(contour, 0.5)`` times the seen extent from the opposite seen
+       face: a camera's view of a convex fruit shows about half its extent along every axis (front to rim
+       in depth, a little less under perspective: a ball's rim lies ``r^2 / d`` in front of its centre;
+       the whole silhouette across); where the seen edge is partly a cut (``contour`` < 1) less may be
+       seen. This only stops runaway fits;
     3. with ``cone = ((u_min, v_min, u_max, v_max), camera)``, the silhouette's pixel box: lateral faces
        beyond the silhouette's viewing cone (widest over the box's depth range) are pulled back, by the
        share ``contour`` (the whole fruit projects inside its silhouette, as far as its edge is a contour).
     """
     seen_lo = np.r_[seen_lo[:2], front]
     seen_hi = np.maximum(seen_hi, seen_lo)
-    reach = 2.0 / max(contour, 0.25) * (seen_hi - seen_lo)
+    reach = REACH / max(contour, 0.5) * (seen_hi - seen_lo)
     lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)
     hi = np.maximum(np.minimum(np.asarray(hi, dtype=np.float64), seen_lo + reach), seen_hi)
     lo[2] = front
@@ -142,8 +151,8 @@ def candidates(
 
     Returns
     -------
-    list of Candidate, in the order sphere, ellipsoid, revolution, [mirror,] raw (a shape whose fit fails
-    or runs away is left out).
+    list of Candidate, in the order sphere, ellipsoid, cone, revolution, [mirror,] raw (a shape whose fit
+    fails or runs away is left out).
     """
     points = as_points(points, min_count=4)
     sample = as_points(sample, min_count=4, name="sample")
@@ -177,6 +186,15 @@ def candidates(
                lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce), ce)  # fmt: skip
     except (InputError, np.linalg.LinAlgError):
         pass
+
+    if obs.cone is not None and obs.axis is not None and obs.interior is not None and len(obs.interior) >= 8:
+        try:
+            cc, cs = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=front, extent=extent)
+            ch = np.sqrt(np.diag(cs))
+            inv = np.linalg.inv(cs)
+            closed("cone", cc - ch, cc + ch, lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc), cc)
+        except (InputError, np.linalg.LinAlgError):
+            pass
 
     try:
         rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)], extra_directions=axes)

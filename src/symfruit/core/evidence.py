@@ -29,7 +29,7 @@ from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .points import as_points
-from .raster import Silhouette
+from .raster import Silhouette, silhouette_cone
 
 __all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
 
@@ -55,6 +55,14 @@ class Observation:
         whose surface is seen at a grazing angle (normal within 60 degrees of perpendicular to the ray).
         A camera's view of a whole fruit gives about 1; a cloud cut by a plane (the paper's visibility
         rule) or by an occluder less, and there "outside the edge" is no evidence of background.
+    cone, axis : (3, 3) float, (3,) float
+        The silhouette's viewing cone and the ray through its centroid
+        (:func:`~symfruit.core.raster.silhouette_cone`).
+    interior : (k, 3) float, metres
+        The sampled points at least ``edge`` pixels inside the silhouette (where depths are reliable).
+    out_weights : tuple of (k,) float
+        Per outside band, 1 for a ray beside a contour part of the edge, 0 beside a cut (no evidence of
+        background there); None: every ray counts.
     """
 
     rays: np.ndarray
@@ -62,6 +70,10 @@ class Observation:
     rays_in: tuple[np.ndarray, ...]
     rays_out: tuple[np.ndarray, ...]
     contour: float = 1.0
+    cone: np.ndarray | None = None
+    axis: np.ndarray | None = None
+    interior: np.ndarray | None = None
+    out_weights: tuple[np.ndarray, ...] | None = None
 
 
 @dataclass(frozen=True)
@@ -94,6 +106,8 @@ def observe(
     n_band: int = 64,
     bands: tuple[float, ...] = (2.0, 5.0),
     contour_points: int = 150,
+    edge: float = 3.0,
+    dense: np.ndarray | None = None,
 ) -> Observation:
     """Reduce a view to sample rays and silhouette-band rays.
 
@@ -112,6 +126,12 @@ def observe(
         window (pixels the camera did not see are no evidence).
     contour_points : int
         Edge points whose normals decide :attr:`Observation.contour`.
+    edge : float, pixels
+        Points at least this far inside the silhouette's edge are :attr:`Observation.interior`.
+    dense : (N, 3) float, metres, optional
+        Every seen point, when ``points`` is a subset: the surface normals along the edge that decide
+        :attr:`Observation.contour` are taken over neighbourhoods of these (at full density a
+        neighbourhood spans a millimetre or two, small enough to follow even a thin fruit's rim).
     """
     points = as_points(points, min_count=3)
     sample = points[:: max(1, len(points) // n_rays)]
@@ -125,29 +145,57 @@ def observe(
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
         return _rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0, camera)
 
-    rays_in = tuple(spread(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5))) for b in bands)
-    rays_out = tuple(spread(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5))) for b in bands)
-    contour = _contour_share(points, region, camera, inner, contour_points)
-    return Observation(rays=rays, depth=sample[:, 2], rays_in=rays_in, rays_out=rays_out, contour=contour)
+    depth_px = _inside_px(points, region, camera, inner)
+    edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
+    edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner)
+    edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
+    contour = float(is_contour.mean()) if len(is_contour) else 1.0
+    tree = cKDTree(edge_uv) if len(is_contour) else None
+
+    def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray]:
+        if len(rc) > n_band:
+            rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
+        uv = np.c_[rc[:, 1] + region.u0, rc[:, 0] + region.v0].astype(np.float64)
+        weight = np.ones(len(rc))
+        if outside and tree is not None and len(rc):
+            weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
+        return _rays(uv[:, 0], uv[:, 1], camera), weight
+
+    ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
+    outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
+    cone, axis = silhouette_cone(region, camera)
+    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(r for r, _ in ins),
+                       rays_out=tuple(r for r, _ in outs), contour=contour, cone=cone, axis=axis,
+                       interior=points[depth_px >= edge], out_weights=tuple(w for _, w in outs))  # fmt: skip
 
 
-def _contour_share(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray, count: int,
-                   k: int = 12) -> float:  # fmt: skip
-    """Share of the points within 3 px of the region's edge whose local plane (PCA of their ``k``
-    nearest points) is within 60 degrees of containing their ray."""
+def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:
+    """(n,) float: how far inside the region's edge each point's pixel lies (``inner``: its distance map)."""
     uv = camera.project(points)
     col = np.clip(np.rint(uv[:, 0]).astype(np.intp) - region.u0, 0, inner.shape[1] - 1)
     row = np.clip(np.rint(uv[:, 1]).astype(np.intp) - region.v0, 0, inner.shape[0] - 1)
-    edge = np.flatnonzero(inner[row, col] <= 3.0)
-    if len(edge) < 3 or len(points) < k:
-        return 1.0
+    return inner[row, col]
+
+
+def _contour_points(
+    points: np.ndarray, depth_px: np.ndarray, camera: Camera, count: int, k: int = 30
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(uv (m, 2), contour (m,) bool)`` of up to ``count`` points within 1.5 px of the region's edge
+    (``depth_px``: each point's distance inside it): whether their local plane (PCA of their ``k`` nearest
+    points among those within 8 px of the edge) is within 60 degrees of containing their ray."""
+    near = np.flatnonzero(depth_px <= 8.0)
+    edge = np.flatnonzero(depth_px[near] <= 1.5)
+    k = min(k, len(near))
+    if len(edge) < 3 or k < 6:
+        return np.empty((0, 2)), np.empty(0, dtype=bool)
     edge = edge[:: max(1, len(edge) // count)]
+    points = points[near]
     _, idx = cKDTree(points).query(points[edge], k=k)
     nb = points[idx] - points[idx].mean(axis=1, keepdims=True)
     _, vec = np.linalg.eigh(np.einsum("nki,nkj->nij", nb, nb))
     normal = vec[:, :, 0]
     ray = points[edge] / np.linalg.norm(points[edge], axis=1, keepdims=True)
-    return float(np.mean(np.abs(np.einsum("ni,ni->n", normal, ray)) < 0.5))
+    return camera.project(points[edge]), np.abs(np.einsum("ni,ni->n", normal, ray)) < 0.5
 
 
 def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int = 24) -> tuple[np.ndarray, np.ndarray]:
@@ -212,7 +260,8 @@ def explain(
     for r in obs.rays_in:
         ins.append(1.0 - hits[k : k + len(r)].mean() if len(r) else 0.0)
         k += len(r)
-    for r in obs.rays_out:
-        outs.append(hits[k : k + len(r)].mean() if len(r) else 0.0)
+    for i, r in enumerate(obs.rays_out):
+        w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
+        outs.append(float((hits[k : k + len(r)] * w).sum() / w.sum()) if w.sum() > 0 else 0.0)
         k += len(r)
     return Evidence(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

@@ -20,8 +20,10 @@ from .points import as_points
 __all__ = [
     "Revolution",
     "closed_profile",
+    "cone_ellipsoid",
     "ellipsoid_half_extents",
     "fit_aligned_ellipsoid",
+    "fit_cone_ellipsoid",
     "fit_ellipsoid",
     "fit_revolution",
     "fit_revolution_slices",
@@ -534,3 +536,140 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     return r - rho - past
+
+
+# --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------
+
+
+def cone_ellipsoid(params: np.ndarray, cone: np.ndarray, axis: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The ellipsoids tangent to a viewing cone, from their parameters ``(a, b, log d, tau)`` (k, 4).
+
+    An ellipsoid ``(x - m)^T S^-1 (x - m) = 1`` seen from the origin has the tangent cone whose dual is
+    ``m m^T - S``; so every ellipsoid with the silhouette's cone ``x^T C x = 0`` (``C`` with signature
+    ``(+, +, -)``, negative inside) is ``S = lambda C^-1 + m m^T`` for a centre ``m`` inside the cone and
+    ``0 < lambda < -m^T C m`` (then ``S`` is positive definite). Here ``m = d (axis + (a, b, 0))`` and
+    ``lambda = -m^T C m / (1 + exp(-tau))``, so every parameter vector is a valid ellipsoid with exactly
+    that outline; ``tau`` trades depth for width (large: flat across the line of sight).
+
+    Returns
+    -------
+    centre : (k, 3) float, metres
+    shape : (k, 3, 3) float, ``S`` (NaN where the centre falls outside the cone)
+    valid : (k,) bool
+    """
+    p = np.atleast_2d(np.asarray(params, dtype=np.float64))
+    m = np.exp(p[:, 2:3]) * (axis[None, :] + np.c_[p[:, 0], p[:, 1], np.zeros(len(p))])
+    q = -np.einsum("ki,ij,kj->k", m, cone, m)
+    valid = q > 0
+    lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-p[:, 3]))
+    shape = lam[:, None, None] * np.linalg.inv(cone)[None] + m[:, :, None] * m[:, None, :]
+    return m, shape, valid
+
+
+def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarray:
+    """Front depth (k, n) of ellipsoids (k) along rays (n, ``z = 1``); NaN where a ray misses."""
+    inv = np.linalg.inv(shape)
+    a = np.einsum("ni,kij,nj->kn", rays, inv, rays)
+    im = np.einsum("kij,kj->ki", inv, m)
+    b = rays @ im.T  # (n, k)
+    c = np.einsum("ki,ki->k", m, im) - 1.0
+    disc = b.T * b.T - a * c[:, None]
+    with np.errstate(invalid="ignore"):
+        return (b.T - np.sqrt(disc)) / a
+
+
+def fit_cone_ellipsoid(
+    points: np.ndarray,
+    *,
+    cone: np.ndarray,
+    axis: np.ndarray,
+    front: float,
+    extent: float,
+    huber: float = 0.003,
+    iterations: int = 20,
+) -> tuple[np.ndarray, np.ndarray]:
+    """The ellipsoid whose outline is the silhouette and whose front best fits the seen depths.
+
+    The silhouette fixes five of an ellipsoid's nine degrees of freedom (its tangent cone from the camera,
+    :func:`cone_ellipsoid`); the remaining four (the centre's depth and lateral offset, the depth/width
+    trade) are fitted to the seen depths along the seen points' rays, which is where a depth camera's
+    noise lies (axial), by Levenberg-Marquardt with Huber weights (``huber`` metres), from the best of a
+    grid of depths and elongations. The lateral extent never depends on the noisy depths, and the back
+    of the fruit follows from the front by the ellipsoid's symmetry.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, n >= 8
+        Seen points away from the silhouette's edge (near the edge the depth is steep and unreliable).
+    cone : (3, 3) float
+        The silhouette's viewing cone in normalised image coordinates (:func:`symfruit.core.raster.
+        silhouette_cone`).
+    axis : (3,) float
+        A ray inside the cone (``z = 1``), e.g. through the silhouette's centroid.
+    front : float, metres
+        Depth of the nearest surface point (where the grid search starts).
+    extent : float, metres
+        About the fruit's size (the grid's depth range).
+
+    Returns
+    -------
+    centre : (3,) float, metres
+    shape : (3, 3) float, ``S`` with the ellipsoid ``(x - c)^T S^-1 (x - c) <= 1``; its box has half-widths
+        ``sqrt(diag(S))``.
+
+    Raises
+    ------
+    InputError
+        On too few points, or when no ellipsoid of the cone meets the rays.
+    """
+    points = as_points(points, min_count=8)
+    cone = np.asarray(cone, dtype=np.float64)
+    axis = np.asarray(axis, dtype=np.float64)
+    rays = points / points[:, 2:3]
+    z = points[:, 2]
+    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 10)
+    grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 9)])
+
+    def residuals(p: np.ndarray) -> np.ndarray:
+        m, shape, valid = cone_ellipsoid(p, cone, axis)
+        res = np.full((len(p), len(z)), 0.05)
+        if valid.any():
+            res[valid] = z[None, :] - _cone_front(m[valid], shape[valid], rays)
+        return np.where(np.isfinite(res), res, 0.02)
+
+    def cost(res: np.ndarray) -> np.ndarray:
+        a = np.abs(res)
+        return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
+
+    costs = cost(residuals(grid))
+    if not np.isfinite(costs).any():
+        raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
+    p = grid[int(np.argmin(costs))]
+    r = residuals(p[None])[0]
+    current, mu = float(cost(r)), 1e-2
+    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
+    for _ in range(iterations):
+        done = False
+        jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]  # (4, n), forward differences
+        a = np.abs(r)
+        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        jtj = (jac * w) @ jac.T
+        g = (jac * w) @ r
+        improved = False
+        while mu < 1e6:
+            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
+            trial = p + delta
+            r_new = residuals(trial[None])[0]
+            new = float(cost(r_new))
+            if new < current:
+                p, r, mu, improved = trial, r_new, max(mu / 3.0, 1e-7), True
+                done = current - new < 1e-6 * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
+    m, shape, valid = cone_ellipsoid(p[None], cone, axis)
+    if not valid[0]:
+        raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
+    return m[0], shape[0]

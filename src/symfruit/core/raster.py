@@ -17,7 +17,15 @@ from .box import Box
 from .camera import Camera
 from .points import as_points
 
-__all__ = ["MAX_WINDOW_PIXELS", "Silhouette", "View", "rasterise", "silhouette", "silhouette_coverage"]
+__all__ = [
+    "MAX_WINDOW_PIXELS",
+    "Silhouette",
+    "View",
+    "rasterise",
+    "silhouette",
+    "silhouette_cone",
+    "silhouette_coverage",
+]
 
 #: Largest image window one fruit may cover (pixels): 2000 x 2000, far more than any fruit in a
 #: harvesting camera's view; beyond it the intrinsics or the units are wrong (and the buffers would be).
@@ -154,6 +162,29 @@ def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius:
     hit = np.zeros((h, w), dtype=bool)
     hit[row - v0, col - u0] = True
     return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
+
+
+def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    """The viewing cone of the ellipse with the silhouette's area moments: ``(cone (3, 3), axis (3,))``.
+
+    The ellipse with the region's centroid and second moments (each pixel a unit square: its covariance
+    plus 1/12) is exact for an elliptic silhouette and a robust summary of any other. In normalised
+    image coordinates ``x = ((u - cx) / fx, (v - cy) / fy, 1)`` the cone is ``x^T C x = 0``, negative
+    inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
+    """
+    rows, cols = np.nonzero(region.mask)
+    uv = np.c_[cols + region.u0, rows + region.v0].astype(np.float64)
+    mu = uv.mean(axis=0)
+    d = uv - mu
+    inv = np.linalg.inv(4.0 * (d.T @ d / len(uv) + np.eye(2) / 12.0))
+    conic = np.zeros((3, 3))
+    conic[:2, :2] = inv
+    conic[:2, 2] = conic[2, :2] = -inv @ mu
+    conic[2, 2] = mu @ inv @ mu - 1.0
+    k = camera.matrix
+    cone = k.T @ conic @ k
+    axis = np.r_[(mu[0] - camera.cx) / camera.fx, (mu[1] - camera.cy) / camera.fy, 1.0]
+    return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
 
 
 def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:

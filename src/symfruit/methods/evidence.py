@@ -1,23 +1,31 @@
 """``evidence``: the default method. The candidate completions that best explain what the camera saw.
 
 Why: a sphere is right for round fruit and wrong for a pear; a solid of revolution is right for a pear
-and can take the wrong axis on a near-round tomato; a general ellipsoid fitted to a noisy partial view
+and can take the wrong axis on a near-round fruit; a general ellipsoid fitted to a noisy partial view
 comes out too thin; mirror symmetry (the paper) is blind to how deep its plane should be. No single
 completion is right for every fruit, and the view itself says which ones fit. This method
 
 1. estimates the front depth from a quadric fitted around the nearest part of the surface
    (:func:`~symfruit.core.front.apex_depth`; the noisy minimum of a D435's depths sits 3-4 mm in front of
    the fruit), shared by every candidate;
-2. fits the candidates of :mod:`symfruit.core.candidates` (sphere, ellipsoid, solid of revolution,
-   optionally the mirror completion, and the raw box);
+2. fits the candidates of :mod:`symfruit.core.candidates`: a sphere, a general (Li-Griffiths) ellipsoid,
+   the ellipsoid whose outline is the silhouette (``cone``: five of its nine degrees of freedom come from
+   the silhouette, which a depth camera measures far better than depth), a solid of revolution,
+   optionally the mirror completion, and the raw box;
 3. measures every closed candidate against the view (:func:`~symfruit.core.evidence.explain`): its
-   predicted silhouette against the seen one, its predicted front depth against the seen depth;
-4. weighs the candidates by ``exp(-energy)``: for a closed candidate ``depth_weight * (rms / best rms - 1)
-   + silhouette_weight * (inside + contour * outside)``, for the mirror and raw candidates a fixed energy
-   (they reproduce the view by construction, so the view cannot rank them; only the closed shapes'
-   failure to explain it can), and takes the weighted median of every box face (robust to one wrong
-   candidate, unlike a mean);
-5. reports a confidence from how well the best closed shape explains the silhouette and how far the
+   predicted front depth against the seen depths and its predicted outline against the seen one (rays
+   just inside the silhouette must hit it, rays just outside a contour part of the edge must miss it);
+4. weighs the candidates by ``exp(-energy)``, with the energy of a closed candidate
+   ``depth_weight * log(rms / best rms) + silhouette_weight * (inside + outside)`` (the profile
+   log-likelihood of the depths, tempered, and the shares of band rays it gets wrong); candidates whose
+   premise the view can contradict pay for it: the ``cone`` ellipsoid and the raw box (both assume the
+   seen outline is the fruit's silhouette) ``cut_energy`` times the share of the edge that is a cut rather
+   than a contour, the unconstrained ellipsoid ``noise_energy`` times how far the view is a noisy depth
+   view rather than a clean scan; the raw box ("nothing hidden") and the mirror completion, which
+   reproduce the view by construction, have fixed energies (raw: the fallback when the best closed shape
+   gets about half the band rays wrong);
+5. takes the weighted median of every box face (robust to one wrong candidate, unlike a mean);
+6. reports a confidence from how well the best closed shape explains the silhouette and how far the
    weighted candidates agree.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
@@ -35,13 +43,14 @@ from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import Candidate, candidates
 from ..core.evidence import observe
+from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.raster import silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
 
-__all__ = ["Combined", "EvidenceSettings", "combine"]
+__all__ = ["Combined", "EvidenceSettings", "clean_share", "combine"]
 
 
 @dataclass(frozen=True)
@@ -60,10 +69,20 @@ class EvidenceSettings(Section):
     march_steps : int
         Ray-march steps per ray through each candidate.
     depth_weight, silhouette_weight : float
-        Energy per unit of relative depth misfit (``rms / best rms - 1``) and per unit share of
-        silhouette-band rays a closed candidate gets wrong.
+        Energy per unit of ``log(rms / best rms)`` (the depth misfit against the best closed candidate's)
+        and per unit share of silhouette-band rays a closed candidate gets wrong (inside plus outside).
+    cut_energy : float
+        Energy of the candidates whose premise is that the seen outline is the fruit's silhouette (the
+        ``cone`` ellipsoid, and ``raw``: "nothing beyond the outline"), times the share of the outline
+        that is not an occluding contour (a cut: the paper's visibility rule, an occluder).
+    noise_energy, clean_ratio, noise_queries : float, float, int
+        Energy of the unconstrained (Li-Griffiths) ellipsoid times how far the view is a depth camera's
+        rather than a clean scan (:func:`clean_share` of the roughness ratio of
+        :func:`~symfruit.core.fits.surface_noise` on ``noise_queries`` points, ``clean_ratio`` its
+        midpoint): an algebraic fit of a noisy partial view comes out too thin; on a clean scan it is the
+        best shape there is.
     mirror_energy, raw_energy : float
-        Fixed energies of the mirror and raw candidates.
+        Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
     silhouette_scale, spread_scale : float
         Confidence ``exp(-e / silhouette_scale) * exp(-spread / (spread_scale * size))``, ``e`` the best
         closed candidate's share of silhouette-band rays wrong, ``spread`` the weighted mean distance of
@@ -84,10 +103,14 @@ class EvidenceSettings(Section):
     rays: int = setting(160, ge=8, le=100_000)
     band_rays: int = setting(64, ge=4, le=100_000)
     march_steps: int = setting(24, ge=4, le=1000)
-    depth_weight: float = setting(1.0, ge=0.0, le=1e6)
-    silhouette_weight: float = setting(5.0, ge=0.0, le=1e6)
+    depth_weight: float = setting(3.0, ge=0.0, le=1e6)
+    silhouette_weight: float = setting(10.0, ge=0.0, le=1e6)
+    cut_energy: float = setting(10.0, ge=0.0, le=1e6)
+    noise_energy: float = setting(3.0, ge=0.0, le=1e6)
+    clean_ratio: float = setting(3.3, gt=0.0, le=100.0)
+    noise_queries: int = setting(60, ge=3, le=100_000)
     mirror_energy: float = setting(5.0, ge=0.0, le=1e6)
-    raw_energy: float = setting(3.0, ge=0.0, le=1e6)
+    raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     silhouette_scale: float = setting(0.15, gt=0.0, le=100.0)
     spread_scale: float = setting(0.1, gt=0.0, le=100.0)
     reliable_at: float = setting(0.25, ge=0.0, le=1.0)
@@ -138,19 +161,32 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
     return np.take_along_axis(values, np.take_along_axis(order, pick[None, :], axis=0), axis=0)[0]
 
 
-def combine(cands: list[Candidate], *, contour: float, s: EvidenceSettings) -> Combined:
+def clean_share(ratio: float, threshold: float) -> float:
+    """How far a view is a clean scan rather than a depth camera's view, in [0, 1], from the growth of its
+    local plane-fit residual with scale (:func:`~symfruit.core.fits.surface_noise`): 0 below
+    ``threshold - 0.8``, 1 above ``threshold + 0.8``, linear between (clean scans measure 4.5-6.7,
+    depth-camera views 1.5-2.2)."""
+    return float(np.clip((ratio - threshold + 0.8) / 1.6, 0.0, 1.0))
+
+
+def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings) -> Combined:
     """Weigh the candidates by their evidence and take the weighted median box (see the module)."""
     closed = [c for c in cands if c.evidence is not None]
     energies: dict[str, float] = {}
     best_rms = max(min((c.evidence.depth for c in closed if c.evidence is not None), default=1.0), 1e-6)
+    cut = s.cut_energy * (1.0 - contour)
     for c in cands:
         ev = c.evidence
         if ev is None:
-            energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy
-        else:
-            energies[c.name] = s.depth_weight * (ev.depth / best_rms - 1.0) + s.silhouette_weight * (
-                ev.inside + contour * ev.outside
-            )
+            energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
+            continue
+        energy = s.depth_weight * np.log(max(ev.depth, 1e-6) / best_rms)
+        energy += s.silhouette_weight * (ev.inside + ev.outside)
+        if c.name == "cone":
+            energy += cut  # its premise: the seen outline is the fruit's silhouette
+        elif c.name == "ellipsoid":
+            energy += s.noise_energy * (1.0 - clean)  # an algebraic fit of a noisy partial view comes out thin
+        energies[c.name] = energy
     names = [c.name for c in cands]
     e = np.array([energies[n] for n in names])
     w = np.exp(-(e - e.min()))
@@ -160,7 +196,7 @@ def combine(cands: list[Candidate], *, contour: float, s: EvidenceSettings) -> C
     box = Box(box_faces[:3], box_faces[3:])
     centres = 0.5 * (faces[:, :3] + faces[:, 3:])
     spread = float((w * np.linalg.norm(centres - box.centre, axis=1)).sum())
-    wrong = min((c.evidence.inside + contour * c.evidence.outside for c in closed if c.evidence is not None),
+    wrong = min((c.evidence.inside + c.evidence.outside for c in closed if c.evidence is not None),
                 default=2.0)  # fmt: skip
     size = max(float(box.size.max()), 1e-9)
     confidence = float(np.exp(-wrong / s.silhouette_scale) * np.exp(-spread / (s.spread_scale * size)))
@@ -176,7 +212,7 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
     if len(points) > s.fit_points:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
     region = silhouette(points, camera)
-    obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays)
+    obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points)
     apex, _ = apex_depth(sample)
     front = max(float(points[:, 2].min()), apex)
     cands = candidates(
@@ -184,7 +220,8 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
         mirror=s.mirror.options() if s.mirror_candidate else None,
         revolution_points=s.revolution_points, steps=s.march_steps,
     )  # fmt: skip
-    combined = combine(cands, contour=obs.contour, s=s)
+    ratio, _, _ = surface_noise(sample, queries=s.noise_queries)
+    combined = combine(cands, contour=obs.contour, clean=clean_share(ratio, s.clean_ratio), s=s)
     box = combined.box
     extras: dict[str, Any] = {
         "confidence": combined.confidence,
