@@ -222,9 +222,23 @@ def _check_completion(box: Box, visible: np.ndarray, method: str, max_extent: fl
         )
 
 
+_DEFAULTS: dict[tuple[Any, ...], Settings] = {}
+
+
+def _default_settings() -> Settings:
+    """``Settings()``, made once per set of registered sections (immutable, so it can be shared)."""
+    from .settings import section_types
+
+    key = tuple(section_types().items())
+    if key not in _DEFAULTS:
+        _DEFAULTS.clear()
+        _DEFAULTS[key] = Settings()
+    return _DEFAULTS[key]
+
+
 def _settings(settings: Any) -> Settings:
     if settings is None:
-        return Settings()
+        return _default_settings()
     if isinstance(settings, Settings):
         return settings
     if isinstance(settings, Mapping):

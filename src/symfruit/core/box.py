@@ -7,7 +7,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..errors import InputError
-from .points import as_points
+from .points import as_points, bounds
 
 __all__ = ["Box", "box_iou", "centre_deviation"]
 
@@ -41,7 +41,7 @@ class Box:
             When ``points`` is not an ``(n, 3)`` array with at least one row.
         """
         points = as_points(points, min_count=1)
-        return cls(min=points.min(axis=0), max=points.max(axis=0))
+        return cls(*bounds(points))
 
     @property
     def centre(self) -> np.ndarray:

@@ -42,15 +42,17 @@ from .fits import (
     revolution_box,
     revolution_inside,
 )
-from .points import as_points
+from .points import as_points, bounds
 from .raster import View
 from .symmetry import complete_by_symmetry
 
-__all__ = ["Candidate", "candidates", "constrain_box"]
+__all__ = ["REACH", "SHAPES", "Candidate", "candidates", "constrain_box"]
 
 #: No face of a candidate's box lies farther than this many seen extents from the opposite seen face (see
 #: :func:`constrain_box`).
 REACH = 3.0
+#: The closed candidates, in the order they are fitted.
+SHAPES = ("sphere", "ellipsoid", "cone", "revolution")
 
 
 @dataclass(frozen=True)
@@ -124,7 +126,10 @@ def candidates(
     mirror: Mapping[str, Any] | None = None,
     view: View | None = None,
     revolution_points: int = 600,
+    revolution_coarse: int = 64,
     steps: int = 24,
+    shapes: tuple[str, ...] = SHAPES,
+    explained: float | None = None,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -146,8 +151,15 @@ def candidates(
         ``sample`` rasterised, for the mirror candidate (made when needed).
     revolution_points : int
         The solid of revolution is fitted to at most this many points of ``sample``.
+    revolution_coarse : int
+        Directions of its coarse axis search over the hemisphere (besides the ellipsoids' axes).
     steps : int
         Ray-march steps of the evidence.
+    shapes : tuple of str
+        The closed candidates to fit, of :data:`SHAPES`.
+    explained : float, optional
+        When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
+        explained and the solid of revolution is not fitted (no other shape can explain the outline better).
 
     Returns
     -------
@@ -156,7 +168,7 @@ def candidates(
     """
     points = as_points(points, min_count=4)
     sample = as_points(sample, min_count=4, name="sample")
-    seen_lo, seen_hi = points.min(axis=0), points.max(axis=0)
+    seen_lo, seen_hi = bounds(points)
     extent = float((seen_hi - seen_lo).max())
     uv = camera.project(points[:: max(1, len(points) // 4000)])
     cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
@@ -170,42 +182,62 @@ def candidates(
         box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour)
         out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64)))
 
-    try:
-        c, r = fit_sphere(sample)
-        closed("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
-    except InputError:
-        pass
-
-    axes = None
-    try:
-        ce, shape = fit_ellipsoid(sample)
-        with np.errstate(invalid="ignore"):
-            half = ellipsoid_half_extents(shape)
-        axes = np.linalg.eigh(shape)[1].T
-        closed("ellipsoid", ce - half, ce + half,
-               lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce), ce)  # fmt: skip
-    except (InputError, np.linalg.LinAlgError):
-        pass
-
-    if obs.cone is not None and obs.axis is not None and obs.interior is not None and len(obs.interior) >= 8:
+    if "sphere" in shapes:
         try:
-            cc, cs = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=front, extent=extent)
+            c, r = fit_sphere(sample)
+            closed("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
+        except InputError:
+            pass
+
+    axes: list[np.ndarray] = []
+    if "ellipsoid" in shapes:
+        try:
+            ce, shape = fit_ellipsoid(sample)
+            with np.errstate(invalid="ignore"):
+                half = ellipsoid_half_extents(shape)
+            axes.append(np.linalg.eigh(shape)[1].T)
+            closed("ellipsoid", ce - half, ce + half,
+                   lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce), ce)  # fmt: skip
+        except (InputError, np.linalg.LinAlgError):
+            pass
+
+    view_cone, view_axis, interior = obs.cone, obs.axis, obs.interior
+    if (
+        "cone" in shapes
+        and view_cone is not None
+        and view_axis is not None
+        and interior is not None
+        and len(interior) >= 8
+    ):
+        try:
+            cc, cs = fit_cone_ellipsoid(interior, cone=view_cone, axis=view_axis, front=front, extent=extent)
             ch = np.sqrt(np.diag(cs))
             inv = np.linalg.inv(cs)
+            axes.append(np.linalg.eigh(cs)[1].T)
             closed("cone", cc - ch, cc + ch, lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc), cc)
         except (InputError, np.linalg.LinAlgError):
             pass
 
-    try:
-        rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)], extra_directions=axes)
-        lo, hi = revolution_box(rev)
-        closed("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
-    except InputError:
-        pass
+    done = (
+        explained is not None
+        and bool(out)
+        and out[-1].name == "cone"
+        and out[-1].evidence is not None
+        and (out[-1].evidence.inside + out[-1].evidence.outside <= explained)
+    )
+    if "revolution" in shapes and not done:
+        try:
+            rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)],
+                                        extra_directions=np.vstack(axes) if axes else None,
+                                        coarse=revolution_coarse)  # fmt: skip
+            lo, hi = revolution_box(rev)
+            closed("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
+        except InputError:
+            pass
 
     if mirror is not None:
-        done = complete_by_symmetry(sample, camera, **mirror, view=view)
-        back = done.points[len(sample) :]
+        mirrored = complete_by_symmetry(sample, camera, **mirror, view=view)
+        back = mirrored.points[len(sample) :]
         lo, hi = constrain_box(back.min(axis=0), back.max(axis=0), seen_lo, seen_hi, front, cone=cone,
                                contour=obs.contour)  # fmt: skip
         out.append(Candidate("mirror", lo, hi, None, 0.5 * (lo + hi)))

@@ -148,7 +148,10 @@ def observe(
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
     edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner)
-    edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
+    if len(edge_points) >= 0.5 * mask.sum():  # about one point per pixel: neighbours from the image grid
+        edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
+    else:
+        edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
     contour = float(is_contour.mean()) if len(is_contour) else 1.0
     tree = cKDTree(edge_uv) if len(is_contour) else None
 
@@ -177,6 +180,44 @@ def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np
     return inner[row, col]
 
 
+def _grazing(normal: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(m,) bool: whether each unit ``normal`` is within 60 degrees of perpendicular to the ray to its point."""
+    ray = points / np.linalg.norm(points, axis=1, keepdims=True)
+    return np.abs(np.einsum("ni,ni->n", normal, ray)) < 0.5
+
+
+def _contour_pixels(
+    points: np.ndarray, depth_px: np.ndarray, region: Silhouette, camera: Camera, count: int, half: int = 3
+) -> tuple[np.ndarray, np.ndarray]:
+    """As :func:`_contour_points` for a cloud with about one point per pixel: each edge point's neighbours
+    are the points of the ``(2 half + 1)^2`` pixels around its own (no search tree)."""
+    near = np.flatnonzero(depth_px <= half + 1.5)  # every neighbour of an edge point lies this close
+    points, depth_px = points[near], depth_px[near]
+    edge = np.flatnonzero(depth_px <= 1.5)
+    if len(edge) < 3:
+        return np.empty((0, 2)), np.empty(0, dtype=bool)
+    edge = edge[:: max(1, len(edge) // count)]
+    h, w = region.mask.shape
+    uv = camera.project(points)
+    col = np.rint(uv[:, 0]).astype(np.intp) - region.u0 + half
+    row = np.rint(uv[:, 1]).astype(np.intp) - region.v0 + half
+    ok = (col >= half) & (col < w + half) & (row >= half) & (row < h + half)
+    grid = np.full((h + 2 * half, w + 2 * half, 3), np.nan)
+    grid[row[ok], col[ok]] = points[ok]
+    d = np.arange(-half, half + 1)
+    rr = row[edge][:, None, None] + d[None, :, None]
+    cc = col[edge][:, None, None] + d[None, None, :]
+    patch = grid[rr, cc].reshape(len(edge), -1, 3)  # (m, (2 half + 1)^2, 3), NaN where no point
+    valid = np.isfinite(patch[..., 0])
+    n = valid.sum(axis=1)
+    patch = np.where(valid[..., None], patch, 0.0)
+    mean = patch.sum(axis=1) / np.maximum(n, 1)[:, None]
+    centred = np.where(valid[..., None], patch - mean[:, None, :], 0.0)
+    _, vec = np.linalg.eigh(np.einsum("nki,nkj->nij", centred, centred))
+    keep = n >= 6
+    return uv[edge][keep], _grazing(vec[keep, :, 0], points[edge][keep])
+
+
 def _contour_points(
     points: np.ndarray, depth_px: np.ndarray, camera: Camera, count: int, k: int = 30
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -193,9 +234,7 @@ def _contour_points(
     _, idx = cKDTree(points).query(points[edge], k=k)
     nb = points[idx] - points[idx].mean(axis=1, keepdims=True)
     _, vec = np.linalg.eigh(np.einsum("nki,nkj->nij", nb, nb))
-    normal = vec[:, :, 0]
-    ray = points[edge] / np.linalg.norm(points[edge], axis=1, keepdims=True)
-    return camera.project(points[edge]), np.abs(np.einsum("ni,ni->n", normal, ray)) < 0.5
+    return camera.project(points[edge]), _grazing(vec[:, :, 0], points[edge])
 
 
 def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int = 24) -> tuple[np.ndarray, np.ndarray]:

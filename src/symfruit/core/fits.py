@@ -341,10 +341,13 @@ class Revolution:
 
 def _basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors completing each row of ``d`` (k, 3) to an orthonormal basis."""
-    helper = np.where(np.abs(d[:, :1]) < 0.9, np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]))
-    e1 = np.cross(d, helper)
-    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
-    return e1, np.cross(d, e1)
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    use_x = np.abs(x) < 0.9  # cross with (1, 0, 0) where d is not near x, else with (0, 1, 0)
+    zero = np.zeros_like(x)
+    e1 = np.where(use_x[:, None], np.stack([zero, z, -y], axis=1), np.stack([-z, zero, x], axis=1))
+    e1 /= np.sqrt((e1 * e1).sum(axis=1))[:, None]
+    e2 = np.stack([y * e1[:, 2] - z * e1[:, 1], z * e1[:, 0] - x * e1[:, 2], x * e1[:, 1] - y * e1[:, 0]], axis=1)
+    return e1, e2
 
 
 def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
@@ -359,31 +362,31 @@ def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     """
     k, n = len(dirs), len(q)
     e1, e2 = _basis(dirs)
-    t = q @ dirs.T  # (n, k)
-    u = q @ e1.T
-    v = q @ e2.T
+    t = dirs @ q.T  # (k, n): one row per direction, reductions along contiguous rows
+    u = e1 @ q.T
+    v = e2 @ q.T
     y = u * u + v * v
-    lo, hi = t.min(axis=0), t.max(axis=0)
+    lo, hi = t.min(axis=1, keepdims=True), t.max(axis=1, keepdims=True)
     b = np.minimum(((t - lo) / np.maximum(hi - lo, 1e-12) * bins).astype(np.int64), bins - 1)
-    idx = (b + bins * np.arange(k)[None, :]).ravel()
+    idx = (b + bins * np.arange(k)[:, None]).ravel()
     safe = np.maximum(np.bincount(idx, minlength=k * bins), 1).astype(np.float64)
 
     def centred(x: np.ndarray) -> np.ndarray:
         mean = np.bincount(idx, weights=x.ravel(), minlength=k * bins) / safe
-        return x - mean[idx].reshape(n, k)
+        return x - mean[idx].reshape(k, n)
 
     du, dv, dy = centred(u), centred(v), centred(y)
-    a11, a12, a22 = (du * du).sum(0), (du * dv).sum(0), (dv * dv).sum(0)
-    b1, b2 = (du * dy).sum(0), (dv * dy).sum(0)
+    a11, a12, a22 = (du * du).sum(1), (du * dv).sum(1), (dv * dv).sum(1)
+    b1, b2 = (du * dy).sum(1), (dv * dy).sum(1)
     det = a11 * a22 - a12 * a12
     det = np.where(np.abs(det) > 1e-30, det, 1e-30)
-    au = 0.5 * (a22 * b1 - a12 * b2) / det
-    av = 0.5 * (a11 * b2 - a12 * b1) / det
-    res = dy - 2.0 * (au[None, :] * du + av[None, :] * dv)
-    rho2 = (u - au[None, :]) ** 2 + (v - av[None, :]) ** 2
+    au = (0.5 * (a22 * b1 - a12 * b2) / det)[:, None]
+    av = (0.5 * (a11 * b2 - a12 * b1) / det)[:, None]
+    res = dy - 2.0 * (au * du + av * dv)
+    rho2 = (u - au) ** 2 + (v - av) ** 2
     dist2 = res * res / (4.0 * np.maximum(rho2, 1e-12))
     keep = max(1, int(0.8 * n))
-    return np.partition(dist2, keep - 1, axis=0)[:keep].mean(axis=0)
+    return np.partition(dist2, keep - 1, axis=1)[:, :keep].mean(axis=1)
 
 
 def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
@@ -411,6 +414,7 @@ def fit_revolution_slices(
     refine_n: int = 16,
     gauss_newton_steps: int = 5,
     search_points: int = 240,
+    coarse: int = 64,
 ) -> Revolution:
     """Fit a solid of revolution to points seen from one side, without normals.
 
@@ -437,6 +441,8 @@ def fit_revolution_slices(
     gauss_newton_steps : int
     search_points : int
         The direction search uses an evenly spread subset of at most this many points.
+    coarse : int
+        Directions of the coarse stage over the hemisphere (about; 0: ``extra_directions`` only).
 
     Returns
     -------
@@ -454,11 +460,13 @@ def fit_revolution_slices(
     centre = pts.mean(axis=0)
     q = pts - centre
     qs = q[:: max(1, len(q) // search_points)]
-    dirs = _COARSE
+    dirs = _COARSE if coarse == 64 else _hemisphere(coarse) if coarse > 0 else np.empty((0, 3))
     if extra_directions is not None:
         extra = np.asarray(extra_directions, dtype=np.float64).reshape(-1, 3)
         extra = extra / np.linalg.norm(extra, axis=1, keepdims=True)
         dirs = np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
+    if not len(dirs):
+        raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
     best = dirs[int(np.argmin(_slice_costs(qs, dirs, bins)))]
     for spread in refine_deg:
         cand = _cap(best, spread, refine_n)
@@ -480,12 +488,15 @@ def fit_revolution_slices(
     a2 = sol + w.mean(axis=0)
     for _ in range(gauss_newton_steps):
         diff = w - a2
-        rho = np.maximum(np.linalg.norm(diff, axis=1), 1e-12)
+        rho = np.maximum(np.sqrt((diff * diff).sum(axis=1)), 1e-12)
         jac = -diff / rho[:, None]
         res = rho - (np.bincount(which, weights=rho, minlength=profile_bins) / cnt)[which]
         jac = jac - np.stack([np.bincount(which, weights=jac[:, i], minlength=profile_bins) / cnt
                               for i in range(2)], axis=1)[which]  # fmt: skip
-        step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
+        jtj = jac.T @ jac
+        if abs(np.linalg.det(jtj)) < 1e-30:
+            break
+        step = np.linalg.solve(jtj, -(jac.T @ res))  # the normal equations of the 2-unknown step
         a2 = a2 + step
         if np.abs(step).max() < 1e-7:
             break
@@ -541,7 +552,9 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
 # --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------
 
 
-def cone_ellipsoid(params: np.ndarray, cone: np.ndarray, axis: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def cone_ellipsoid(
+    params: np.ndarray, cone: np.ndarray, axis: np.ndarray, *, cone_inv: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The ellipsoids tangent to a viewing cone, from their parameters ``(a, b, log d, tau)`` (k, 4).
 
     An ellipsoid ``(x - m)^T S^-1 (x - m) = 1`` seen from the origin has the tangent cone whose dual is
@@ -551,6 +564,8 @@ def cone_ellipsoid(params: np.ndarray, cone: np.ndarray, axis: np.ndarray) -> tu
     ``lambda = -m^T C m / (1 + exp(-tau))``, so every parameter vector is a valid ellipsoid with exactly
     that outline; ``tau`` trades depth for width (large: flat across the line of sight).
 
+    ``cone_inv``, ``C^-1``, may be passed when known.
+
     Returns
     -------
     centre : (k, 3) float, metres
@@ -558,24 +573,27 @@ def cone_ellipsoid(params: np.ndarray, cone: np.ndarray, axis: np.ndarray) -> tu
     valid : (k,) bool
     """
     p = np.atleast_2d(np.asarray(params, dtype=np.float64))
-    m = np.exp(p[:, 2:3]) * (axis[None, :] + np.c_[p[:, 0], p[:, 1], np.zeros(len(p))])
-    q = -np.einsum("ki,ij,kj->k", m, cone, m)
+    offset = np.zeros((len(p), 3))
+    offset[:, :2] = p[:, :2]
+    m = np.exp(p[:, 2:3]) * (axis[None, :] + offset)
+    q = -((m @ cone) * m).sum(axis=1)
     valid = q > 0
-    lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-p[:, 3]))
-    shape = lam[:, None, None] * np.linalg.inv(cone)[None] + m[:, :, None] * m[:, None, :]
+    lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
+    inv = np.linalg.inv(cone) if cone_inv is None else cone_inv
+    shape = lam[:, None, None] * inv[None] + m[:, :, None] * m[:, None, :]
     return m, shape, valid
 
 
 def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarray:
     """Front depth (k, n) of ellipsoids (k) along rays (n, ``z = 1``); NaN where a ray misses."""
     inv = np.linalg.inv(shape)
-    a = np.einsum("ni,kij,nj->kn", rays, inv, rays)
-    im = np.einsum("kij,kj->ki", inv, m)
-    b = rays @ im.T  # (n, k)
-    c = np.einsum("ki,ki->k", m, im) - 1.0
-    disc = b.T * b.T - a * c[:, None]
-    with np.errstate(invalid="ignore"):
-        return (b.T - np.sqrt(disc)) / a
+    a = ((rays[None] @ inv) * rays[None]).sum(axis=2)  # (k, n)
+    im = (inv @ m[:, :, None])[:, :, 0]
+    b = im @ rays.T  # (k, n)
+    c = (m * im).sum(axis=1) - 1.0
+    disc = b * b - a * c[:, None]
+    root = np.sqrt(np.maximum(disc, 0.0))
+    return np.where(disc >= 0, (b - root) / a, np.nan)
 
 
 def fit_cone_ellipsoid(
@@ -586,7 +604,9 @@ def fit_cone_ellipsoid(
     front: float,
     extent: float,
     huber: float = 0.003,
-    iterations: int = 20,
+    iterations: int = 10,
+    tolerance: float = 1e-4,
+    max_points: int = 300,
 ) -> tuple[np.ndarray, np.ndarray]:
     """The ellipsoid whose outline is the silhouette and whose front best fits the seen depths.
 
@@ -610,6 +630,13 @@ def fit_cone_ellipsoid(
         Depth of the nearest surface point (where the grid search starts).
     extent : float, metres
         About the fruit's size (the grid's depth range).
+    huber : float, metres
+    iterations, tolerance : int, float
+        Levenberg-Marquardt stops after this many iterations, or when a step lowers the cost by less than
+        ``tolerance`` of it.
+    max_points : int
+        The fit uses an evenly spread subset of at most this many points (four parameters are set by a
+        few hundred depths as well as by thousands).
 
     Returns
     -------
@@ -623,15 +650,18 @@ def fit_cone_ellipsoid(
         On too few points, or when no ellipsoid of the cone meets the rays.
     """
     points = as_points(points, min_count=8)
+    points = points[:: max(1, -(-len(points) // max_points))]
     cone = np.asarray(cone, dtype=np.float64)
     axis = np.asarray(axis, dtype=np.float64)
     rays = points / points[:, 2:3]
     z = points[:, 2]
-    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 10)
-    grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 9)])
+    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 7)
+    grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 7)])
+
+    cone_inv = np.linalg.inv(cone)
 
     def residuals(p: np.ndarray) -> np.ndarray:
-        m, shape, valid = cone_ellipsoid(p, cone, axis)
+        m, shape, valid = cone_ellipsoid(p, cone, axis, cone_inv=cone_inv)
         res = np.full((len(p), len(z)), 0.05)
         if valid.any():
             res[valid] = z[None, :] - _cone_front(m[valid], shape[valid], rays)
@@ -663,7 +693,7 @@ def fit_cone_ellipsoid(
             new = float(cost(r_new))
             if new < current:
                 p, r, mu, improved = trial, r_new, max(mu / 3.0, 1e-7), True
-                done = current - new < 1e-6 * current
+                done = current - new < tolerance * current
                 current = new
                 break
             mu *= 4.0

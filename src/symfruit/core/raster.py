@@ -172,11 +172,16 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     image coordinates ``x = ((u - cx) / fx, (v - cy) / fy, 1)`` the cone is ``x^T C x = 0``, negative
     inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
     """
-    rows, cols = np.nonzero(region.mask)
-    uv = np.c_[cols + region.u0, rows + region.v0].astype(np.float64)
-    mu = uv.mean(axis=0)
-    d = uv - mu
-    inv = np.linalg.inv(4.0 * (d.T @ d / len(uv) + np.eye(2) / 12.0))
+    m = region.mask.astype(np.float64)
+    h, w = m.shape
+    u = np.arange(w, dtype=np.float64) + region.u0
+    v = np.arange(h, dtype=np.float64) + region.v0
+    col_sums, row_sums = m.sum(axis=0), m.sum(axis=1)
+    n = col_sums.sum()
+    mu = np.array([col_sums @ u, row_sums @ v]) / n
+    du, dv = u - mu[0], v - mu[1]
+    cov = np.array([[col_sums @ (du * du), dv @ m @ du], [dv @ m @ du, row_sums @ (dv * dv)]]) / n
+    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
     conic = np.zeros((3, 3))
     conic[:2, :2] = inv
     conic[:2, 2] = conic[2, :2] = -inv @ mu
