@@ -285,8 +285,11 @@ def test_cone_ellipsoid_of_a_noisy_ball_is_the_ball():
 
     visible, _ = rendered_view(ball_mesh(0.03), [0.05, -0.03, 0.38], noise=0.01, seed=7)
     cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
-    centre, shape = fit_cone_ellipsoid(visible[::5], cone=cone, axis=axis, front=0.35, extent=0.06)
-    np.testing.assert_allclose(centre, [0.05, -0.03, 0.38], atol=6e-4)
-    np.testing.assert_allclose(np.sqrt(np.diag(shape)), 0.03, atol=6e-4)
+    fit = fit_cone_ellipsoid(visible[::5], cone=cone, axis=axis, front=0.35, extent=0.06)
+    np.testing.assert_allclose(fit.centre, [0.05, -0.03, 0.38], atol=6e-4)
+    np.testing.assert_allclose(np.sqrt(np.diag(fit.shape)), 0.03, atol=6e-4)
+    assert fit.rms == pytest.approx(0.01 * 0.36**2, rel=0.3)  # the sensor's noise
+    back_error = fit.centre[2] + np.sqrt(fit.shape[2, 2]) - 0.41
+    assert 0 < fit.back_std < 0.002 and abs(back_error) < 4 * fit.back_std + 1e-4
     with pytest.raises(InputError):
         fit_cone_ellipsoid(visible[:5], cone=cone, axis=axis, front=0.35, extent=0.06)

@@ -56,7 +56,9 @@ def test_deterministic_with_its_candidates_reported():
     assert set(a.extras["candidates"]) <= {"cone", "revolution", "raw"} and "cone" in a.extras["candidates"]
     paper = complete(build(Spec("paper", "lemon", 0, 3)).visible)
     assert set(paper.extras["candidates"]) == {"sphere", "ellipsoid", "cone", "revolution", "raw"}
-    assert a.extras["reliable"] is (a.extras["confidence"] >= EvidenceSettings().reliable_at)
+    s = EvidenceSettings()
+    assert a.extras["reliable"] is (a.extras["uncertainty"] <= s.reliable_uncertainty)
+    assert a.extras["confidence"] == pytest.approx(np.exp(-a.extras["uncertainty"] / s.uncertainty_scale))
     mirrored = complete(inst.visible, settings={"evidence": {"mirror_candidate": True}})
     assert "mirror" in mirrored.extras["candidates"]
 

@@ -68,6 +68,9 @@ class Candidate:
         How it explains the view (closed candidates only).
     centre : (3,) float, metres
         Its own centre estimate (the shape's centre; the box centre for mirror and raw).
+    back_std : float, metres
+        Standard deviation of its back face from its own fit, where the fit says (the ``cone``
+        ellipsoid); NaN otherwise.
     """
 
     name: str
@@ -75,6 +78,7 @@ class Candidate:
     hi: np.ndarray
     evidence: Evidence | None
     centre: np.ndarray
+    back_std: float = float("nan")
 
 
 def constrain_box(
@@ -174,13 +178,14 @@ def candidates(
     cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
     out: list[Candidate] = []
 
-    def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray) -> None:
+    def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray,
+               back_std: float = float("nan")) -> None:  # fmt: skip
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
             return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
         ev = explain(inside, (lo, hi), obs, steps=steps)
         box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour)
-        out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64)))
+        out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64), back_std))
 
     if "sphere" in shapes:
         try:
@@ -210,11 +215,20 @@ def candidates(
         and len(interior) >= 8
     ):
         try:
-            cc, cs = fit_cone_ellipsoid(interior, cone=view_cone, axis=view_axis, front=front, extent=extent)
+            fit = fit_cone_ellipsoid(interior, cone=view_cone, axis=view_axis, front=front, extent=extent)
+            cc, cs = fit.centre, fit.shape
+            back_std = fit.back_std
             ch = np.sqrt(np.diag(cs))
             inv = np.linalg.inv(cs)
             axes.append(np.linalg.eigh(cs)[1].T)
-            closed("cone", cc - ch, cc + ch, lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc), cc)
+            closed(
+                "cone",
+                cc - ch,
+                cc + ch,
+                lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc),
+                cc,
+                back_std,
+            )
         except (InputError, np.linalg.LinAlgError):
             pass
 

@@ -18,6 +18,7 @@ from .box import Box
 from .points import as_points
 
 __all__ = [
+    "ConeFit",
     "Revolution",
     "closed_profile",
     "cone_ellipsoid",
@@ -596,6 +597,29 @@ def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarra
     return np.where(disc >= 0, (b - root) / a, np.nan)
 
 
+@dataclass(frozen=True)
+class ConeFit:
+    """The ellipsoid of :func:`fit_cone_ellipsoid`.
+
+    Attributes
+    ----------
+    centre : (3,) float, metres
+    shape : (3, 3) float
+        ``S``: the ellipsoid is ``(x - centre)^T S^-1 (x - centre) <= 1``; its box has half-widths
+        ``sqrt(diag(S))``.
+    back_std : float, metres
+        Standard deviation of its back face's depth from the fit (the depths' noise carried through the
+        four parameters; NaN when it cannot be had).
+    rms : float, metres
+        Robust RMS of the depth residuals.
+    """
+
+    centre: np.ndarray
+    shape: np.ndarray
+    back_std: float
+    rms: float
+
+
 def fit_cone_ellipsoid(
     points: np.ndarray,
     *,
@@ -607,7 +631,7 @@ def fit_cone_ellipsoid(
     iterations: int = 10,
     tolerance: float = 1e-4,
     max_points: int = 300,
-) -> tuple[np.ndarray, np.ndarray]:
+) -> ConeFit:
     """The ellipsoid whose outline is the silhouette and whose front best fits the seen depths.
 
     The silhouette fixes five of an ellipsoid's nine degrees of freedom (its tangent cone from the camera,
@@ -640,9 +664,7 @@ def fit_cone_ellipsoid(
 
     Returns
     -------
-    centre : (3,) float, metres
-    shape : (3, 3) float, ``S`` with the ellipsoid ``(x - c)^T S^-1 (x - c) <= 1``; its box has half-widths
-        ``sqrt(diag(S))``.
+    ConeFit
 
     Raises
     ------
@@ -702,4 +724,18 @@ def fit_cone_ellipsoid(
     m, shape, valid = cone_ellipsoid(p[None], cone, axis)
     if not valid[0]:
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
-    return m[0], shape[0]
+    # The back face's standard deviation: the parameters' covariance sigma^2 (J^T W J)^-1 (sigma from the
+    # residuals, the Jacobian of the last step), carried to z_c + sqrt(S_zz) by finite differences.
+    a = np.abs(r)
+    w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+    sigma2 = float((w * r * r).sum() / max(w.sum() - 4.0, 1.0))
+    jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]
+    try:
+        cov = sigma2 * np.linalg.inv((jac * w) @ jac.T + 1e-18 * np.eye(4))
+    except np.linalg.LinAlgError:
+        cov = np.full((4, 4), np.nan)
+    mb, sb, vb = cone_ellipsoid(p[None] + np.diag(step), cone, axis, cone_inv=cone_inv)
+    back = m[0, 2] + np.sqrt(shape[0, 2, 2])
+    grad = (mb[:, 2] + np.sqrt(sb[:, 2, 2]) - back) / step
+    back_std = float(np.sqrt(max(grad @ cov @ grad, 0.0))) if vb.all() else float("nan")
+    return ConeFit(m[0], shape[0], back_std, float(np.sqrt(sigma2)))

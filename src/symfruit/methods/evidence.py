@@ -25,8 +25,9 @@ completion is right for every fruit, and the view itself says which ones fit. Th
    reproduce the view by construction, have fixed energies (raw: the fallback when the best closed shape
    gets about half the band rays wrong);
 5. takes the weighted median of every box face (robust to one wrong candidate, unlike a mean);
-6. reports a confidence from how well the best closed shape explains the silhouette and how far the
-   weighted candidates agree.
+6. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
+   own noise, the candidates' disagreement and what no candidate explains, and reports
+   ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
 behind every constant are in ``docs/ablation.md``.
@@ -92,12 +93,13 @@ class EvidenceSettings(Section):
         best shape there is.
     mirror_energy, raw_energy : float
         Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
-    silhouette_scale, spread_scale : float
-        Confidence ``exp(-e / silhouette_scale) * exp(-spread / (spread_scale * size))``, ``e`` the best
-        closed candidate's share of silhouette-band rays wrong, ``spread`` the weighted mean distance of
-        the candidates' centres from the result's, ``size`` the result's largest side.
-    reliable_at : float
-        ``reliable`` when the confidence is at least this.
+    misfit_scale, uncertainty_scale, reliable_uncertainty : float, float (metres), float (metres)
+        The predicted centre uncertainty ``u = hypot(back_std, spread) + misfit_scale * wrong * size``:
+        ``back_std`` the ``cone`` ellipsoid's back-face standard deviation from its own fit (the sensor's
+        noise), ``spread`` the weighted mean distance of the candidates' centres from the result's (what
+        the shapes disagree on), ``wrong`` the best closed candidate's share of silhouette-band rays
+        wrong and ``size`` the result's largest side (what no shape explains). ``confidence = exp(-u /
+        uncertainty_scale)``; ``reliable`` when ``u <= reliable_uncertainty``.
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
@@ -123,9 +125,9 @@ class EvidenceSettings(Section):
     noise_queries: int = setting(40, ge=3, le=100_000)
     mirror_energy: float = setting(5.0, ge=0.0, le=1e6)
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
-    silhouette_scale: float = setting(0.15, gt=0.0, le=100.0)
-    spread_scale: float = setting(0.1, gt=0.0, le=100.0)
-    reliable_at: float = setting(0.25, ge=0.0, le=1.0)
+    misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
+    uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
+    reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     mirror_candidate: bool = setting(False)
     mirror: PaperSettings = setting(
         PaperSettings(translations=8, translation_step=0.1, j2=0.4, j3=1.0, rating_points=400)
@@ -154,6 +156,8 @@ class Combined:
         Share of silhouette-band rays the best closed candidate gets right.
     contour : float in [0, 1]
         The observation's contour share.
+    uncertainty : float, metres
+        The predicted centre uncertainty (see :class:`EvidenceSettings`).
     """
 
     box: Box
@@ -163,6 +167,7 @@ class Combined:
     spread: float
     explained: float
     contour: float
+    uncertainty: float
 
 
 def _weighted_median(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
@@ -210,10 +215,12 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     spread = float((w * np.linalg.norm(centres - box.centre, axis=1)).sum())
     wrong = min((c.evidence.inside + c.evidence.outside for c in closed if c.evidence is not None),
                 default=2.0)  # fmt: skip
-    size = max(float(box.size.max()), 1e-9)
-    confidence = float(np.exp(-wrong / s.silhouette_scale) * np.exp(-spread / (s.spread_scale * size)))
+    size = float(box.size.max())
+    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    uncertainty = float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
+    confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     return Combined(box, dict(zip(names, w.tolist(), strict=True)), energies, confidence, spread,
-                    1.0 - wrong / 2.0, contour)  # fmt: skip
+                    1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
 
 
 @register("evidence", settings=EvidenceSettings)
@@ -249,7 +256,8 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
     box = combined.box
     extras: dict[str, Any] = {
         "confidence": combined.confidence,
-        "reliable": combined.confidence >= s.reliable_at,
+        "reliable": combined.uncertainty <= s.reliable_uncertainty,
+        "uncertainty": combined.uncertainty,
         "weights": combined.weights,
         "energies": combined.energies,
         "spread": combined.spread,
@@ -259,6 +267,7 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
             c.name: {
                 "min": c.lo.tolist(), "max": c.hi.tolist(),
                 "evidence": None if c.evidence is None else [c.evidence.depth, c.evidence.inside, c.evidence.outside],
+                "back_std": None if not np.isfinite(c.back_std) else c.back_std,
             }
             for c in cands
         },
