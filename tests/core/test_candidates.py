@@ -61,3 +61,20 @@ def test_candidates_of_a_noisy_ball():
     cone = by["cone"]  # tangent to the silhouette's cone: its box is the ball's, back face included
     np.testing.assert_allclose(cone.centre, [0.01, 0.0, 0.4], atol=0.001)
     assert cone.hi[2] == pytest.approx(0.435, abs=0.0015)
+
+
+def test_the_outline_candidate_takes_its_profile_from_the_silhouette():
+    from symfruit.shapes import FRUITS, rotation
+
+    visible, _ = rendered_view(FRUITS["strawberry"](np.random.default_rng(2)), [0.0, 0.02, 0.35], noise=0.01,
+                               rotation=rotation(20, 60, 10), seed=1)  # fmt: skip
+    sample = visible[::8]
+    region = silhouette(visible, DEFAULT_CAMERA)
+    obs = observe(sample, region, DEFAULT_CAMERA, dense=visible)
+    cands = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=float(visible[:, 2].min()),
+                       shapes=("revolution",), region=region, outline_profile="add")  # fmt: skip
+    assert [c.name for c in cands] == ["outline", "revolution", "raw"]
+    replaced = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=float(visible[:, 2].min()),
+                          shapes=("revolution",), region=region, outline_profile="replace")  # fmt: skip
+    assert [c.name for c in replaced] == ["revolution", "raw"]
+    np.testing.assert_allclose(replaced[0].hi, cands[0].hi)

@@ -23,6 +23,7 @@ from symfruit.core.fits import (
     fit_revolution,
     fit_revolution_slices,
     fit_sphere,
+    outline_radii,
     revolution_box,
     revolution_inside,
     surface_noise,
@@ -293,3 +294,21 @@ def test_cone_ellipsoid_of_a_noisy_ball_is_the_ball():
     assert 0 < fit.back_std < 0.002 and abs(back_error) < 4 * fit.back_std + 1e-4
     with pytest.raises(InputError):
         fit_cone_ellipsoid(visible[:5], cone=cone, axis=axis, front=0.35, extent=0.06)
+
+
+def test_outline_radii_of_a_tilted_cylinder_like_lemon_follow_its_silhouette():
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette
+
+    fruit = FRUITS["lemon"](np.random.default_rng(1))
+    tilt = rotation(10, 30, 60)
+    visible, posed = rendered_view(fruit, [0.02, 0.0, 0.35], noise=0.01, rotation=tilt, seed=3)
+    rev = fit_revolution_slices(visible[::10])
+    region = silhouette(visible, DEFAULT_CAMERA)
+    radii = outline_radii(rev, region.mask, (region.u0, region.v0), DEFAULT_CAMERA)
+    ok = np.isfinite(radii) & np.isfinite(rev.radii)
+    assert ok.sum() >= 0.6 * len(radii)
+    # The outline's radii are the points' radii within a millimetre or two (noise), never far off.
+    assert np.median(np.abs(radii[ok] - rev.radii[ok])) < 0.0015
+    truth = 0.5 * np.ptp((posed.vertices - posed.vertices.mean(axis=0)) @ (tilt @ [1.0, 0.0, 0.0]))
+    assert np.nanmax(radii) == pytest.approx(truth, abs=0.0015)

@@ -9,6 +9,9 @@ Every candidate is a different assumption about the hidden side:
 ``cone``
     the ellipsoid whose outline is the silhouette (tangent to its viewing cone) and whose front best fits
     the seen depths (:func:`symfruit.core.fits.fit_cone_ellipsoid`);
+``outline``
+    the same solid of revolution with its radii read off the silhouette's outline
+    (:func:`symfruit.core.fits.outline_radii`), when the outline is given;
 ``revolution``
     a solid of revolution (:func:`symfruit.core.fits.fit_revolution_slices`): its axis from slice circles,
     its profile from the seen arcs, an end left unseen closed by symmetry about the widest slice;
@@ -25,7 +28,7 @@ Closed candidates (sphere, ellipsoid, solid of revolution) are measured against 
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -39,11 +42,12 @@ from .fits import (
     fit_ellipsoid,
     fit_revolution_slices,
     fit_sphere,
+    outline_radii,
     revolution_box,
     revolution_inside,
 )
 from .points import as_points, bounds
-from .raster import View
+from .raster import Silhouette, View
 from .symmetry import complete_by_symmetry
 
 __all__ = ["REACH", "SHAPES", "Candidate", "candidates", "constrain_box"]
@@ -134,6 +138,8 @@ def candidates(
     steps: int = 24,
     shapes: tuple[str, ...] = SHAPES,
     explained: float | None = None,
+    region: Silhouette | None = None,
+    outline_profile: str = "off",
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -161,6 +167,11 @@ def candidates(
         Ray-march steps of the evidence.
     shapes : tuple of str
         The closed candidates to fit, of :data:`SHAPES`.
+    region : Silhouette, optional
+        The seen region, for the ``outline`` candidate.
+    outline_profile : {"off", "add", "replace"}
+        With ``region``: add the ``outline`` candidate, replace the solid of revolution's profile with the
+        outline's, or neither.
     explained : float, optional
         When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
         explained and the solid of revolution is not fitted (no other shape can explain the outline better).
@@ -244,6 +255,14 @@ def candidates(
             rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)],
                                         extra_directions=np.vstack(axes) if axes else None,
                                         coarse=revolution_coarse)  # fmt: skip
+            if region is not None and outline_profile != "off":
+                r_out = outline_radii(rev, region.mask, (region.u0, region.v0), camera)
+                shaped = replace(rev, radii=np.where(np.isfinite(r_out) & np.isfinite(rev.radii), r_out, rev.radii))
+                if outline_profile == "replace":
+                    rev = shaped
+                else:
+                    olo, ohi = revolution_box(shaped)
+                    closed("outline", olo, ohi, lambda x: revolution_inside(shaped, x), 0.5 * (olo + ohi))
             lo, hi = revolution_box(rev)
             closed("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
         except InputError:

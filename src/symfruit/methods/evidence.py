@@ -36,7 +36,7 @@ behind every constant are in ``docs/ablation.md``.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -103,6 +103,11 @@ class EvidenceSettings(Section):
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
+    outline_profile : {"off", "add", "replace"}
+        In a depth camera's view of a whole fruit, a second solid of revolution on the same axis whose
+        radii are read off the silhouette (:func:`~symfruit.core.fits.outline_radii`: the outline is
+        measured to a pixel, the points' radii are blurred by depth noise): ``add`` it as the ``outline``
+        candidate, ``replace`` the points' profile with it, or ``off``.
     mirror : PaperSettings
         The mirror candidate's grid and rating: 8 depth offsets of 0.1 ``len_depth`` and the reasonable
         region 0.4-1.0 ``Dist_ref`` (the paper's 4 x 0.2 stops short of the symmetry plane of a shallow
@@ -129,6 +134,7 @@ class EvidenceSettings(Section):
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     mirror_candidate: bool = setting(False)
+    outline_profile: Literal["off", "add", "replace"] = setting("add")
     mirror: PaperSettings = setting(
         PaperSettings(translations=8, translation_step=0.1, j2=0.4, j3=1.0, rating_points=400)
     )
@@ -251,6 +257,7 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
         points, sample=sample, obs=obs, camera=camera, front=front,
         mirror=s.mirror.options() if s.mirror_candidate else None, revolution_points=s.revolution_points,
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
+        region=region, outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s)
     box = combined.box
