@@ -55,6 +55,8 @@ __all__ = ["REACH", "SHAPES", "Candidate", "candidates", "constrain_box"]
 #: No face of a candidate's box lies farther than this many seen extents from the opposite seen face (see
 #: :func:`constrain_box`).
 REACH = 3.0
+#: ... and :data:`REACH` ``/ REACH_FLOOR`` where the outline is mostly cut.
+REACH_FLOOR = 0.5
 #: The closed candidates, in the order they are fitted.
 SHAPES = ("sphere", "ellipsoid", "cone", "revolution")
 
@@ -98,7 +100,7 @@ def constrain_box(
     """A candidate's box made consistent with the view: ``(lo (3,), hi (3,))``, metres.
 
     1. joined with the seen points' box, its front face set to ``front``;
-    2. no face beyond :data:`REACH` ``/ max(contour, 0.5)`` times the seen extent from the opposite seen
+    2. no face beyond :data:`REACH` ``/ max(contour, REACH_FLOOR)`` times the seen extent from the opposite seen
        face: a camera's view of a convex fruit shows about half its extent along every axis (front to rim
        in depth, a little less under perspective: a ball's rim lies ``r^2 / d`` in front of its centre;
        the whole silhouette across); where the seen edge is partly a cut (``contour`` < 1) less may be
@@ -109,7 +111,7 @@ def constrain_box(
     """
     seen_lo = np.r_[seen_lo[:2], front]
     seen_hi = np.maximum(seen_hi, seen_lo)
-    reach = REACH / max(contour, 0.5) * (seen_hi - seen_lo)
+    reach = REACH / max(contour, REACH_FLOOR) * (seen_hi - seen_lo)
     lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)
     hi = np.maximum(np.minimum(np.asarray(hi, dtype=np.float64), seen_lo + reach), seen_hi)
     lo[2] = front

@@ -26,7 +26,7 @@ BAD_MM = 10.0
 COLUMNS = (
     "protocol", "fruit", "kind", "fruit_index", "pose", "angle_x", "angle_y", "angle_z", "distance_m",
     "occlusion", "hidden", "n_visible", "method", "iou", "centre_mm", "chamfer_mm", "f1", "precision",
-    "recall", "seconds", "confidence", "error",
+    "recall", "seconds", "confidence", "reliable", "error",
 )  # fmt: skip
 
 
