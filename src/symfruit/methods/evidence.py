@@ -243,7 +243,12 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
     shapes: tuple[str, ...] = SHAPES
     explained: float | None = None
     clean = 0.0
-    if obs.contour >= s.covered_contour and len(points) >= 0.5 * region.mask.sum():
+    dense = len(points) >= 0.5 * region.mask.sum()  # about a point per pixel: a depth camera's view
+    if not dense:
+        # The cone ellipsoid's fit reads each point as the nearest surface along its ray, as a depth camera
+        # sees it; a sparse cloud (a scan's points, possibly on both sides of the fruit) is not that.
+        shapes = tuple(name for name in SHAPES if name != "cone")
+    if dense and obs.contour >= s.covered_contour:
         # A depth camera's view of a whole fruit (a point for about every pixel, the outline a contour): the
         # ellipsoid tangent to the silhouette's cone is the better-posed version of both the sphere and the
         # unconstrained ellipsoid (which noise thins), so they cannot win and are not fitted (the ablation:
