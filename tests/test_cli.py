@@ -189,6 +189,11 @@ def test_evaluate_command(tmp_path, capsys):
     assert "not a fruit kind" in capsys.readouterr().err
     assert main(["evaluate", "--methods", "raw,nope"]) == 2
     assert main(["evaluate", "--protocol", "camera", "--occlusion", "0,1.5"]) == 2
+    assert main(["evaluate", "--quick", "--no-profile", "--methods", "fused", "--output", str(tmp_path), "--jobs", "1",
+                 "--n", "1"]) == 0  # fmt: skip
+    saved = json.loads((tmp_path / "latest" / "settings.json").read_text())["settings"]["strawberry"]
+    assert saved["fused"]["revolution"] is False  # the defaults, not the strawberry profile
+    capsys.readouterr()
     assert main(["evaluate", "--pose", "uniform"]) == 2  # the paper protocol has its own poses
     assert "camera protocol" in capsys.readouterr().err
 

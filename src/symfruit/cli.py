@@ -81,6 +81,11 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
     p.add_argument("--config", type=Path, help="settings file for the methods")
+    p.add_argument(
+        "--no-profile",
+        action="store_true",
+        help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
+    )
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
     p.add_argument("--masks", default="auto", help="with --frames: mask source (see `symfruit detect`)")  # fmt: skip
 
@@ -270,11 +275,18 @@ def _evaluate(args: argparse.Namespace) -> int:
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, sensor=args.sensor, poses=args.pose, quick=args.quick, config=args.config,
-        output=args.output, jobs=args.jobs,
+        output=args.output, jobs=args.jobs, settings=_plain_settings(args) if args.no_profile else None,
     )  # fmt: skip
     print(result.table)
     print(f"results: {result.folder}")
     return 0
+
+
+def _plain_settings(args: argparse.Namespace):
+    """The defaults with ``--config`` over them, no fruit profile."""
+    from .settings import resolve_settings
+
+    return resolve_settings(config=args.config)
 
 
 def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> int:
