@@ -145,3 +145,22 @@ def test_silhouette_cone_of_a_ball_is_its_tangent_cone(camera):
     ray = c / c[2]
     assert ray @ cone @ ray < 0  # the centre's ray is inside
     np.testing.assert_allclose(axis, ray, atol=0.003)
+
+
+def test_a_ragged_outline_is_closed_and_a_clean_one_kept(camera):
+    from symfruit.core.raster import close_ragged, silhouette
+
+    from ..conftest import ball_mesh, rendered_view
+
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4])
+    clean = silhouette(visible, camera)
+    assert close_ragged(clean) is clean  # a clean render's outline is left as it is
+    uv = np.rint(camera.project(visible)).astype(int)
+    centre = uv.mean(axis=0)
+    r = np.linalg.norm(uv - centre, axis=1)
+    drop = (r > r.max() - 3) & (np.random.default_rng(0).random(len(r)) < 0.6)  # dropout at the rim
+    ragged = silhouette(visible[~drop], camera)
+    closed = close_ragged(ragged)
+    assert closed is not ragged and closed.mask.sum() > ragged.mask.sum()
+    lost = int(clean.mask.sum()) - int(ragged.mask.sum())
+    assert 0 <= int(clean.mask.sum()) - int(closed.mask.sum()) < 0.5 * lost  # most of the rim is back

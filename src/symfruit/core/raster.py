@@ -21,6 +21,7 @@ __all__ = [
     "MAX_WINDOW_PIXELS",
     "Silhouette",
     "View",
+    "close_ragged",
     "rasterise",
     "silhouette",
     "silhouette_cone",
@@ -162,6 +163,31 @@ def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius:
     hit = np.zeros((h, w), dtype=bool)
     hit[row - v0, col - u0] = True
     return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
+
+
+def close_ragged(region: Silhouette, *, radius: int = 3, ragged: float = 0.3) -> Silhouette:
+    """The region with the gaps of a ragged outline closed, or as it is.
+
+    A depth sensor drops pixels at the rim (mixed and grazing pixels), so a dense view's outline recedes
+    in a ragged way; closing by a square of half-width ``radius`` fills those gaps, but would also round a
+    clean outline's concave corners. So the closing is kept only when it adds more than ``ragged`` pixels
+    per outline pixel (a clean render's outline gains about 0.15, the repository's D435 model's 0.4 and
+    more).
+
+    Parameters
+    ----------
+    region : Silhouette
+    radius : int, pixels
+    ragged : float
+    """
+    mask = region.mask
+    if radius <= 0 or not mask.any():
+        return region
+    closed = _closed_mask(np.pad(mask, radius), radius)[radius:-radius, radius:-radius]
+    outline = int((mask & ~ndimage.binary_erosion(mask)).sum())
+    if (closed & ~mask).sum() <= ragged * max(outline, 1):
+        return region
+    return Silhouette(region.u0, region.v0, closed, max(region.fill_radius, float(radius)))
 
 
 def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.ndarray]:

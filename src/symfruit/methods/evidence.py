@@ -46,7 +46,7 @@ from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.evidence import observe
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
-from ..core.raster import silhouette
+from ..core.raster import close_ragged, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -65,6 +65,10 @@ class EvidenceSettings(Section):
         silhouette use every point).
     revolution_points : int
         The solid of revolution is fitted to at most this many of them.
+    ragged_close_px, ragged_at : int, float
+        The seen region's gaps are closed by a square of this half-width when its outline is ragged
+        (:func:`~symfruit.core.raster.close_ragged`: a sensor's dropout at the rim shrinks the outline,
+        and with it every shape fitted to it).
     rays, band_rays : int
         Depth rays sampled over the seen points, and rays per silhouette band and side.
     march_steps : int
@@ -115,6 +119,8 @@ class EvidenceSettings(Section):
     """
 
     fit_points: int = setting(1000, ge=20, le=1_000_000)
+    ragged_close_px: int = setting(3, ge=0, le=50)
+    ragged_at: float = setting(0.3, ge=0.0, le=100.0)
     revolution_points: int = setting(600, ge=20, le=1_000_000)
     rays: int = setting(160, ge=8, le=100_000)
     band_rays: int = setting(64, ge=4, le=100_000)
@@ -236,7 +242,7 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
     sample = points
     if len(points) > s.fit_points:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
-    region = silhouette(points, camera)
+    region = close_ragged(silhouette(points, camera), radius=s.ragged_close_px, ragged=s.ragged_at)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points)
     apex, _ = apex_depth(sample)
     front = max(float(points[:, 2].min()), apex)
