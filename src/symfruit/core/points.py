@@ -137,8 +137,11 @@ def check_view(points: np.ndarray, camera: Any, *, min_pixels: int = 3) -> None:
     ------
     InputError
     """
-    uv = camera.project(as_points(points, min_count=1))
-    span = np.ptp(uv, axis=0)
+    points = as_points(points, min_count=1)
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    if hi[2] > 0 and max(camera.fx * (hi[0] - lo[0]), camera.fy * (hi[1] - lo[1])) / hi[2] >= min_pixels:
+        return  # a lower bound of the span in pixels already passes: no need to project every point
+    span = np.ptp(camera.project(points), axis=0)
     if not np.all(np.isfinite(span)) or span.max() < min_pixels:
         raise InputError(
             f"the visible points fall within {span.max():.1f} pixels of the image (fewer than {min_pixels} across): "
