@@ -283,7 +283,8 @@ def make_photo(
         for _ in range(int(r * r / 40)):  # achenes: small pale dots
             a, rho = rng.uniform(0, 2 * np.pi), r * np.sqrt(rng.uniform(0, 0.8))
             x, y = int(cx + rho * np.cos(a)), int(cy + rho * np.sin(a))
-            img[max(y - 1, 0) : y + 1, max(x - 1, 0) : x + 1] = (230, 200, 90)
+            if 1 <= x < w and 1 <= y < h:
+                img[y - 1 : y + 1, x - 1 : x + 1] = (230, 200, 90)
         hx, hy = cx - r / 3, cy - r / 3
         img[(xx - hx) ** 2 + (yy - hy) ** 2 <= (r / 5) ** 2] = (250, 250, 250)
         if calyx:  # a five-lobed green star over the top of the fruit

@@ -387,7 +387,11 @@ def _red_windows(c: np.ndarray, s: SegmentSettings) -> list[Window]:
     _, weak = ripe_seeds(c[::step, ::step], s)
     if not weak.any():
         return []
-    lab, _ = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    sizes[0] = 0
+    # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
+    lab, _ = ndimage.label(ndimage.binary_dilation((sizes >= 2)[lab], structure=np.ones((3, 3), bool)))
     boxes = [[max(sl[0].start * step - step, 0), min(sl[0].stop * step + step, h),
               max(sl[1].start * step - step, 0), min(sl[1].stop * step + step, w)]
              for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
@@ -598,27 +602,49 @@ def _centres(region: np.ndarray, least: float, waist: float, loose: float) -> li
     different connected component of the points deeper than ``loose * r`` than every larger centre;
     ``firm`` when it is so even at ``waist * r`` (the region narrows to a ``waist`` between them).
     """
+    step = 2 if least >= 8 else 1  # a fruit at least 16 pixels across is found as well on every other pixel
+    if step > 1:
+        found = _centres(region[::step, ::step], least / step, waist, loose)
+        return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
     edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
     if float(edt.max()) < least:
         return []
-    peaks = (edt >= ndimage.maximum_filter(edt, size=3)) & (edt >= least)
+    # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
+    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
     pr, pc = np.nonzero(peaks)
     order = np.argsort(-edt[pr, pc], kind="stable")
     centres: list[tuple[int, int, float, bool]] = []
+    budget = [MAX_WAIST_TESTS]
     for i in order[:400]:
         p, q, r = int(pr[i]), int(pc[i]), float(edt[pr[i], pc[i]])
         if any((p - a) ** 2 + (q - b) ** 2 <= ra * ra for a, b, ra, _ in centres):
             continue  # inside a larger fruit's inscribed disc
         firm = True
         if centres:
-            if not _separate(edt, (p, q), centres, loose * r):
+            if not _separate(edt, (p, q), centres, loose * r, budget):
                 continue  # joined to a larger peak without a waist: the same fruit
             if waist < loose:
-                firm = _separate(edt, (p, q), centres, waist * r)
+                firm = _separate(edt, (p, q), centres, waist * r, budget)
         centres.append((p, q, r, firm))
-        if len(centres) >= 8:
+        if len(centres) >= 8 or budget[0] <= 0:
             break
     return centres
+
+
+#: Most connected-component labellings one region's waist tests may take (a hand or a vine with many
+#: bumps is not a cluster of fruit; this bounds the time such a region costs).
+MAX_WAIST_TESTS = 16
+
+
+def _on_path(edt: np.ndarray, p: tuple[int, int], others: list[tuple[int, int]], t: float) -> bool:
+    """Whether a straight path from ``p`` to one of ``others`` stays deeper than ``t``."""
+    for a, b in others:
+        n = int(max(abs(a - p[0]), abs(b - p[1]))) + 1
+        rows = np.rint(np.linspace(p[0], a, n + 1)).astype(np.int64)
+        cols = np.rint(np.linspace(p[1], b, n + 1)).astype(np.int64)
+        if float(edt[rows, cols].min()) > t:
+            return True
+    return False
 
 
 def _supported(
@@ -728,19 +754,19 @@ def _disc(r: int) -> np.ndarray:
     return xx * xx + yy * yy <= r * r
 
 
-def _separate(edt: np.ndarray, p: tuple[int, int], centres: list[tuple[int, int, float, bool]], t: float) -> bool:
+def _separate(
+    edt: np.ndarray, p: tuple[int, int], centres: list[tuple[int, int, float, bool]], t: float, budget: list[int]
+) -> bool:
     """Whether ``p`` lies in another connected component of ``edt > t`` than every centre (a straight path
-    that stays above ``t`` joins them without labelling the window)."""
-    joined = []
-    for a, b, _, _ in centres:
-        n = int(max(abs(a - p[0]), abs(b - p[1]))) + 1
-        rows = np.rint(np.linspace(p[0], a, n + 1)).astype(np.int64)
-        cols = np.rint(np.linspace(p[1], b, n + 1)).astype(np.int64)
-        if float(edt[rows, cols].min()) > t:
-            return False
-        joined.append((a, b))
+    that stays above ``t`` joins them without labelling the window; ``budget`` counts the labellings
+    left: with none left, ``p`` is taken as joined)."""
+    if _on_path(edt, p, [(a, b) for a, b, _, _ in centres], t):
+        return False
+    if budget[0] <= 0:
+        return False
+    budget[0] -= 1
     deep = ndimage.label(edt > t)[0]
-    return all(deep[a, b] != deep[p] for a, b in joined)
+    return all(deep[a, b] != deep[p] for a, b, _, _ in centres)
 
 
 def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: float) -> list[np.ndarray]:

@@ -342,7 +342,8 @@ def draw_contact_sheet(entries: Any, *, tile: int = 256, columns: int = 4, thres
         img[ndimage.binary_dilation(_outline(labels), iterations=grow)] = (255, 0, 255)
         s = score_masks(truth, labels, threshold=threshold)
         pic = Image.fromarray(img)
-        pic = pic.resize((max(1, round(pic.width * scale)), max(1, round(pic.height * scale))), Image.Resampling.BILINEAR)
+        size = (max(1, round(pic.width * scale)), max(1, round(pic.height * scale)))
+        pic = pic.resize(size, Image.Resampling.BILINEAR)
         draw = ImageDraw.Draw(pic)
         iou = f"{s.best_iou.mean():.2f}" if s.n_true else "-"
         text = f"{Path(str(name)).name[:36]}\niou {iou} true {s.n_true} pred {s.n_pred} false {s.false}"
