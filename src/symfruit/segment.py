@@ -577,7 +577,9 @@ def _split(
     if depth is not None and (depth[region] > 0).any():
         least = 0.5 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
-    centres = _centres(carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist)
+    centres = _centres(
+        carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
+    )
     if len(centres) < 2:
         return [region]
     cells = _cells(region, [(a, b, r) for a, b, r, _ in centres], CANDIDATE_WAIST if use_depth else s.waist)
@@ -593,7 +595,9 @@ def _split(
 CANDIDATE_WAIST = 0.9
 
 
-def _centres(region: np.ndarray, least: float, waist: float, loose: float) -> list[tuple[int, int, float, bool]]:
+def _centres(
+    region: np.ndarray, least: float, waist: float, loose: float, *, coarse: bool = True
+) -> list[tuple[int, int, float, bool]]:
     """Fruit centres ``(row, col, inscribed radius, firm)``: peaks of the distance transform, largest first,
     each outside the inscribed discs of the larger ones and separated from each by a waist.
 
@@ -601,10 +605,11 @@ def _centres(region: np.ndarray, least: float, waist: float, loose: float) -> li
     deeper than some radius is connected. A peak of radius ``r`` is another fruit when it lies in a
     different connected component of the points deeper than ``loose * r`` than every larger centre;
     ``firm`` when it is so even at ``waist * r`` (the region narrows to a ``waist`` between them).
+    With ``coarse``, fruit-sized regions are searched on every other pixel (four times fewer).
     """
-    step = 2 if least >= 8 else 1  # a fruit at least 16 pixels across is found as well on every other pixel
-    if step > 1:
-        found = _centres(region[::step, ::step], least / step, waist, loose)
+    if coarse and least >= 8:  # a fruit at least 16 pixels across is found as well on every other pixel
+        step = 2
+        found = _centres(region[::step, ::step], least / step, waist, loose, coarse=False)
         return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
     edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
     if float(edt.max()) < least:
