@@ -237,7 +237,7 @@ def mask_source(
     """The labeller :func:`segment_images` runs on each image, and a word on what it is.
 
     ``masks`` is ``"color"`` (the built-in segmenter), ``"maskrcnn:CHECKPOINT"`` (a torchvision Mask R-CNN,
-    extra ``seg``), a COCO JSON
+    extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation export, extra ``onnx``), a COCO JSON
     (each image's annotations, by file name), a folder of label PNGs (``<stem>.png``), or a callable
     ``(color, depth=, camera=) -> labels``. Checkpoints and files are checked here, before any image.
     """
@@ -258,6 +258,12 @@ def mask_source(
         checkpoint = text.split(":", 1)[1]
         load_maskrcnn(checkpoint)  # a missing extra or a bad checkpoint fails once, before the images
         return (lambda path, color, depth, camera: maskrcnn_labels(color, checkpoint)), text
+    if text.startswith("onnx:"):
+        from .segment_onnx import load_onnx, onnx_labels
+
+        model = text.split(":", 1)[1]
+        load_onnx(model)
+        return (lambda path, color, depth, camera: onnx_labels(color, model)), text
     source = Path(text)
     if source.suffix.lower() == ".json":
         from .io.masks import read_coco
@@ -286,7 +292,7 @@ def mask_source(
         from .io.images import read_labels
 
         return (lambda path, color, depth, camera: read_labels(source)), str(source)
-    raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, a COCO .json, "
+    raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
                      "a folder of label PNGs, or one label .png for one image")  # fmt: skip
 
 

@@ -84,7 +84,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
     p.add_argument("--masks", default=None,
                    help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
-                   "color (default) or maskrcnn:CHECKPOINT")  # fmt: skip
+                   "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=Path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=Path, help="masks protocol: COCO JSON of the photographs' instance masks")
     p.add_argument("--category", type=int, default=1,
@@ -98,7 +98,8 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--masks",
         default="auto",
-        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, or maskrcnn:CHECKPOINT.pth",
+        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, maskrcnn:CHECKPOINT.pth "
+        "or onnx:MODEL.onnx",
     )
     p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
     p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
@@ -109,8 +110,8 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
     p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
                    "<stem>_overlay.png")  # fmt: skip
-    p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, a COCO .json or a "
-                   "folder of label PNGs")  # fmt: skip
+    p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
+                   ".json or a folder of label PNGs")  # fmt: skip
     p.add_argument("--depth", type=Path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
     p.add_argument("--camera", type=Path, help="intrinsics file (needed with --depth)")
     p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
