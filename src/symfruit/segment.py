@@ -572,10 +572,11 @@ def _split(
         assert depth is not None
         edges = _depth_edges(region, depth, s, geo.focal)
         carved = ndimage.binary_fill_holes(region & ~edges)
-    # the smallest fruit worth cutting off: fruit-sized at its depth
+    # the smallest fruit worth cutting off: fruit-sized (with depth: at its depth, and half of it may be
+    # hidden behind the fruit in front or a leaf)
     least = np.sqrt(min_area / np.pi)
-    if depth is not None and (depth[region] > 0).any():
-        least = 0.5 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
+    if use_depth and depth is not None:
+        least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
