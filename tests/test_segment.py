@@ -110,6 +110,17 @@ def test_overlapping_fruit_are_split_by_their_depth_surfaces():
     assert s.n_pred == 2 and s.matched == 2
 
 
+def test_the_split_setting_picks_the_evidence():
+    fruit = [(125, 120, 45), (190, 120, 45)]
+    color, _ = make_photo([(*f, RED) for f in fruit])
+    depth = sphere_depth(fruit, [0.40, 0.41])
+    assert segment(color, depth, CAM, SegmentSettings(split="depth")).max() == 2
+    assert segment(color, depth, CAM, SegmentSettings(split="watershed")).max() == 1  # shape alone cannot
+    touching, _ = make_photo([(110, 120, 45, RED), (198, 120, 45, RED)])
+    assert segment(touching, settings=SegmentSettings(split="depth")).max() == 1  # no depth, no depth split
+    assert segment(touching, settings=SegmentSettings(split="watershed")).max() == 2
+
+
 def test_one_sphere_with_a_stem_in_front_stays_one_fruit_with_depth():
     color, truth = make_photo([(160, 120, 55, RED)])
     color[:, 157:163] = (70, 120, 40)

@@ -91,11 +91,12 @@ class SegmentSettings(Section):
         pixels over it left out; what the extraction of points needs). "auto": the surface with depth,
         the hull without.
     split : {"both", "depth", "watershed", "none"}
-        How touching fruit are split: at depth steps and creases, at waists of the distance transform
-        ("watershed"), both, or not at all.
+        The evidence a cut between touching fruit may rest on: the shape of the region (a waist with
+        convexity defects, "watershed"), its depth (steps, creases, two surfaces; with depth only),
+        both, or none (touching fruit stay one region).
     waist : float in (0, 1]
-        Two distance-transform peaks are separate fruit when the region between them narrows below this
-        share of the smaller peak's inscribed radius.
+        By shape, two distance-transform peaks are separate fruit when the region between them narrows
+        below this share of the smaller peak's inscribed radius.
     max_elongation : float
         Without depth, parts whose hull is more elongated than this (ratio of principal axes) are not fruit
         (a finger, a rim of skin); with depth the size rule in metres decides, and a sliver of a fruit
@@ -111,12 +112,13 @@ class SegmentSettings(Section):
     crease_curvature : float, 1/metres
         With depth: a concave crease of the smoothed depth (Laplacian below ``-crease_curvature``
         metres per metre squared) separates fruit at the same depth. Convex fruit surfaces never reach it.
+    crease_sigma : float, pixels
+        Smoothing of the depth before the crease test (the sensor noise must not look like creases).
     sphere_apart : float
         With depth: two touching parts are two fruit when the spheres fitted to their depth points have
         centres farther apart than this share of the sum of their radii (touching fruit: about 1; one
-        fruit cut in two: about 0).
-    crease_sigma : float, pixels
-        Smoothing of the depth before the crease test (the sensor noise must not look like creases).
+        fruit cut in two: about 0); two fragments are one fruit when the smaller lies on the larger's
+        sphere within this share of its radius.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -126,7 +128,6 @@ class SegmentSettings(Section):
     close_px: int = setting(0, ge=0, le=MAX_RADIUS_PX)
     min_area_share: float = setting(0.002, ge=0.0, lt=1.0)
     merge_slack: float = setting(0.08, ge=0.0, le=1.0)
-    sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
     fill: Literal["auto", "hull", "surface"] = setting("auto")
     split: Literal["both", "depth", "watershed", "none"] = setting("both")
     waist: float = setting(0.6, gt=0.0, le=1.0)
@@ -136,6 +137,7 @@ class SegmentSettings(Section):
     depth_jump: float = setting(0.015, gt=0.0, le=10.0)
     crease_curvature: float = setting(1500.0, gt=0.0, le=1e7)
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
+    sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -441,11 +443,15 @@ def _depth(
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
-    focal = float(np.sqrt(float(camera.fx) * float(camera.fy)))
-    if not np.isfinite(focal) or focal <= 0:
+    try:
+        fx, fy = float(camera.fx), float(camera.fy)
+        cx, cy = float(getattr(camera, "cx", shape[1] / 2)), float(getattr(camera, "cy", shape[0] / 2))
+    except (TypeError, ValueError):
+        raise InputError("segment: camera fx, fy (cx, cy) must be numbers") from None
+    if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
-    cx, cy = (float(getattr(camera, name, mid)) for name, mid in (("cx", shape[1] / 2), ("cy", shape[0] / 2)))
-    return z, _Geometry(focal, cy if np.isfinite(cy) else shape[0] / 2, cx if np.isfinite(cx) else shape[1] / 2)
+    cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
+    return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
@@ -468,7 +474,7 @@ class _Piece:
 
     window: Window
     mask: np.ndarray
-    source: int  # a bit set of the regions it came from (0: the parts being tried, which may join)
+    source: int  # a bit set of the colour regions it came from
     hull: float = -1.0
 
     def __post_init__(self) -> None:
@@ -568,14 +574,12 @@ def _split(
     if s.split == "none" or (s.split == "depth" and not use_depth):
         return [region]
     carved, edges = region, None
-    if use_depth:
-        assert depth is not None
-        edges = _depth_edges(region, depth, s, geo.focal)
-        carved = ndimage.binary_fill_holes(region & ~edges)
     # the smallest fruit worth cutting off: fruit-sized (with depth: at its depth, and half of it may be
     # hidden behind the fruit in front or a leaf)
     least = np.sqrt(min_area / np.pi)
     if use_depth and depth is not None:
+        edges = _depth_edges(region, depth, s, geo.focal)
+        carved = ndimage.binary_fill_holes(region & ~edges)
         least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
@@ -588,7 +592,7 @@ def _split(
         return [region]
     firm = [f for *_, f in centres]
     spheres = [_sphere(c, depth, geo, origin) if use_depth and depth is not None else None for c in cells]
-    return _supported(cells, firm, spheres, edges, s)
+    return _supported(cells, firm, spheres, edges, s, by_shape=s.split in ("watershed", "both"))
 
 
 #: With depth, a peak of the distance transform is a candidate fruit centre when any path to a larger peak
@@ -659,6 +663,8 @@ def _supported(
     spheres: list[tuple[np.ndarray, float] | None],
     edges: np.ndarray | None,
     s: SegmentSettings,
+    *,
+    by_shape: bool = True,
 ) -> list[np.ndarray]:
     """Join again the neighbouring cells whose cut no evidence of two bodies backs. The evidence is
 
@@ -666,8 +672,9 @@ def _supported(
       the two cells' depth points lie apart, their centres farther than ``sphere_apart`` times the sum of
       their radii (one fruit cut in two gives two fits about one centre; two touching fruit, two spheres
       touching: centres a sum of radii apart);
-    * shape: a waist between their centres (``firm``) and convexity defects: the convex hull of the
-      two cells exceeds their own hulls by more than ``merge_slack`` (they are not one convex body).
+    * shape (``by_shape``), when a cell lacks a sphere: a waist between their centres (``firm``) and
+      convexity defects: the convex hull of the two cells exceeds their own hulls by more than
+      ``merge_slack`` (they are not one convex body).
     """
     n = len(cells)
     grown = [ndimage.binary_dilation(c, structure=np.ones((3, 3), bool)) for c in cells]
@@ -692,6 +699,7 @@ def _supported(
                 continue  # two surfaces
             if (
                 two is None
+                and by_shape
                 and firm[j]
                 and _hull_area(cells[i] | cells[j]) > (1 + s.merge_slack) * (hulls[i] + hulls[j])
             ):
