@@ -4,6 +4,8 @@ import json
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from symfruit import FileFormatError
 from symfruit.io import masks as io_masks
@@ -96,3 +98,24 @@ def test_rle_decoder_bounds_and_string_form():
         rle_decode({"size": [10**6, 10**6], "counts": [1]})
     with pytest.raises(ValueError):
         rle_decode({"size": [7, 5], "counts": "\x7f\x7f"})  # a truncated compressed string
+
+
+_json = st.recursive(
+    st.none() | st.booleans() | st.integers(-(10**12), 10**12) | st.floats(allow_nan=True) | st.text(max_size=8),
+    lambda inner: (
+        st.lists(inner, max_size=6) | st.dictionaries(st.sampled_from(["size", "counts", "x"]), inner, max_size=3)
+    ),
+    max_leaves=20,
+)
+
+
+@given(segmentation=_json, height=st.one_of(st.integers(-5, 50), st.text(max_size=3)), width=st.integers(1, 40))
+def test_any_annotation_gives_masks_or_a_file_format_error(tmp_path_factory, segmentation, height, width):
+    path = tmp_path_factory.mktemp("fuzz") / "c.json"
+    coco = _coco(segmentation, height=height, width=width)
+    path.write_text(json.dumps(coco))
+    try:
+        masks = read_coco(path).instances("a.jpg", (20, 30))
+    except FileFormatError:
+        return
+    assert masks.dtype == bool and masks.shape == (1, 20, 30)
