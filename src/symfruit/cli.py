@@ -1,4 +1,5 @@
-"""Command-line interface: ``symfruit complete | evaluate | bench | settings | methods``.
+"""Command-line interface: ``symfruit complete | detect | segment | evaluate | bench | demo | scenes | settings |
+methods``.
 
 Thin by design: parse, import lazily, call the library, print. Errors a user can cause print one
 line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the traceback instead.
@@ -48,15 +49,22 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
     p.add_argument("--method", default="fused", help="with --recording: the completion method (default fused)")
+    p.add_argument(
+        "--segment",
+        action="store_true",
+        help="instead: time the colour segmenter per 640x480 image (photos from --images, else synthetic)",
+    )
+    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to 640x480)")
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("evaluate", help="run an evaluation protocol and write tables, CSV, JSON and plots")
     p.add_argument(
         "--protocol",
-        choices=("paper", "camera"),
+        choices=("paper", "camera", "masks"),
         default="paper",
-        help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views",
+        help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views; masks: mask "
+        "quality of a segmenter on photographs (--images, --truth) or on rendered scenes (--n, --seed)",
     )
     p.add_argument(
         "--fruit",
@@ -74,7 +82,14 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
     p.add_argument("--config", type=Path, help="settings file for the methods")
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
-    p.add_argument("--masks", default="auto", help="with --frames: mask source (see `symfruit detect`)")  # fmt: skip
+    p.add_argument("--masks", default=None,
+                   help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
+                   "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
+    p.add_argument("--images", type=Path, help="masks protocol: folder of photographs")
+    p.add_argument("--truth", type=Path, help="masks protocol: COCO JSON of the photographs' instance masks")
+    p.add_argument("--category", type=int, default=1,
+                   help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
+    p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
 
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
@@ -83,13 +98,25 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--masks",
         default="auto",
-        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, or maskrcnn:CHECKPOINT.pth",
+        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, maskrcnn:CHECKPOINT.pth "
+        "or onnx:MODEL.onnx",
     )
     p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
     p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
+    p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
+    p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
+    p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
+                   "<stem>_overlay.png")  # fmt: skip
+    p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
+                   ".json or a folder of label PNGs")  # fmt: skip
+    p.add_argument("--depth", type=Path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
+    p.add_argument("--camera", type=Path, help="intrinsics file (needed with --depth)")
+    p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
+    p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
     p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
     p.add_argument("--method", default="fused", help="completion method (default fused)")
@@ -192,6 +219,17 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
+    if args.segment:
+        from .bench import bench_segment
+
+        row = bench_segment(args.images)
+        if args.json:
+            print(json.dumps({"machine": machine(), "segment": row.to_dict()}, indent=2))
+            return 0
+        print(f"symfruit bench --segment: {row.images} {row.source} at {row.width}x{row.height}, colour alone, "
+              f"one process: median {row.median_ms:.2f} ms, p90 {row.p90_ms:.2f} ms, max {row.max_ms:.1f} ms "
+              "per image")  # fmt: skip
+        return 0
     if args.recording is not None:
         from .bench import bench_recording
 
@@ -231,6 +269,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .methods import get
     from .shapes import FRUITS
 
+    if args.protocol == "masks":
+        return _evaluate_masks(args)
     fruits = [f.strip() for f in args.fruit.split(",") if f.strip()]
     if fruits == ["all"]:
         fruits = list(FRUITS)
@@ -271,7 +311,8 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
     from .io import atomic_write, write_json
     from .writers import new_results_folder
 
-    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=args.masks, settings=settings)
+    masks = args.masks or "auto"
+    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=masks, settings=settings)
     table = table3(scores, totals, methods)
     folder = new_results_folder(args.output, "frames")
     write_json(folder / "summary.json", {**summary_dict(scores, totals, failed), "settings": settings.to_dict()})
@@ -282,6 +323,72 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
         print(f"skipped {name}: {reason}")
     print(f"results: {folder}")
     return 0
+
+
+def _evaluate_masks(args: argparse.Namespace) -> int:
+    from .batch import mask_source
+    from .errors import InputError
+    from .evaluate.masks import evaluate_masks, evaluate_scene_masks
+    from .writers import new_results_folder, write_mask_report
+
+    settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
+    labeller, source = mask_source(args.masks or "color", settings=settings)
+
+    def run(color: np.ndarray, depth: np.ndarray | None = None, camera: object = None) -> np.ndarray:
+        return labeller(Path(""), color, depth, camera)
+
+    if args.images is not None or args.truth is not None:
+        if args.images is None or args.truth is None:
+            raise InputError("--protocol masks needs both --images DIR and --truth COCO.json")
+        category = None if args.category < 0 else args.category
+        ev = evaluate_masks(args.images, args.truth, run, category=category)
+        meta = {"images": str(args.images), "truth": str(args.truth), "category": category, "depth": False}
+        what = f"{args.images}"
+    else:
+        if args.n is not None and not 1 <= args.n <= 10_000:
+            raise InputError("--n must be 1-10000 scenes")
+        n = args.n or 20
+        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth)
+        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth}
+        what = f"rendered scenes {args.seed}-{args.seed + n - 1} ({'colour alone' if args.no_depth else 'with depth'})"
+    folder = new_results_folder(args.output, "masks")
+    write_mask_report(folder, ev, meta={**meta, "mask_source": source, "settings": settings.to_dict()["segment"]})
+    s = ev.summary
+    iou = "-" if s["mean_best_iou"] is None else f"{s['mean_best_iou']:.3f}"
+    share = "-" if s["matched_share"] is None else f"{s['matched_share']:.1%}"
+    ms = "" if s["ms_median"] is None else f"; {s['ms_median']:.1f} ms per image (median), {s['ms_p90']:.1f} (p90)"
+    print(f"masks ({source}) on {what}: {s['images']} images, {s['true_fruit']} true fruit, {s['detections']} "
+          f"found; mean best-match IoU {iou}; matched {s['matched']} ({share}), missed {s['missed']}, false "
+          f"{s['false']} ({s['false_share']:.1%} of found){ms}")  # fmt: skip
+    print(f"results: {folder} (masks.csv, summary.json, worst.png)")
+    return 0
+
+
+def _segment(args: argparse.Namespace) -> int:
+    from .batch import segment_images
+    from .io import load_camera
+
+    camera = load_camera(args.camera) if args.camera else None
+    report = segment_images(args.inputs, output=args.output, masks=args.masks, depth=args.depth, camera=camera,
+                            depth_scale=args.depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
+    if len(report.done) <= 20:
+        for d in report.done:
+            print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
+                  f"{d.ms:.1f} ms)")  # fmt: skip
+    for name, reason in report.failed.items():
+        print(f"  failed {name}: {reason}")
+    alone = sum(not d.used_depth for d in report.done)
+    note = ""
+    if alone and report.mask_source == "colour segmenter":
+        note = (f"; {alone} on colour alone (no depth split; least fruit = segment.min_area_share of the image, "
+                "whole outlines)")  # fmt: skip
+    ms = sorted(d.ms for d in report.done)
+    median = f", {ms[len(ms) // 2]:.1f} ms per image (median)" if ms else ""
+    print(f"segment ({report.mask_source}): {len(report.done)} images, {report.fruit} fruit, {len(report.failed)} "
+          f"failed{note}{median}; labels and overlays in {args.output}")  # fmt: skip
+    if report.stopped:
+        print(f"symfruit: {report.stopped}", file=sys.stderr)
+    return 0 if report.ok else 1
 
 
 def _detect(args: argparse.Namespace) -> int:
@@ -365,6 +472,7 @@ _COMMANDS = {
     "bench": _bench,
     "evaluate": _evaluate,
     "detect": _detect,
+    "segment": _segment,
     "demo": _demo,
     "scenes": _scenes,
     "settings": _settings,

@@ -65,7 +65,8 @@ def frame_masks(
 
     ``masks`` is ``"auto"`` (the frame's own masks file if it has one, else the colour segmenter),
     ``"color"`` (the built-in segmenter), a label PNG or COCO JSON path, ``"maskrcnn:CHECKPOINT"``
-    (a torchvision Mask R-CNN, optional extra ``seg``), or a callable ``(frame, settings) -> labels``.
+    (a torchvision Mask R-CNN, optional extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation
+    export, optional extra ``onnx``), or a callable ``(frame, settings) -> labels``.
     """
     settings = settings or Settings()
     shape = frame.depth.shape
@@ -79,6 +80,10 @@ def frame_masks(
         from .segment_maskrcnn import maskrcnn_labels
 
         labels, source = maskrcnn_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
+    elif str(masks).startswith("onnx:"):
+        from .segment_onnx import onnx_labels
+
+        labels, source = onnx_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
     else:
         from .io.masks import read_masks
 
