@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from .detect import detect
+from .detect import FrameDetections, detect
 from .errors import FileFormatError, InputError, SymfruitError
 from .io.atomic import write_json
 from .io.sources import open_source
@@ -81,8 +81,14 @@ def run_batch(
     settings: Settings | None = None,
     resume: bool = False,
     progress: bool = True,
+    on_frame: Callable[[int, FrameDetections], None] | None = None,
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``.
+
+    ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
+    inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
+    a frame whose every step succeeded; e.g. to append it to a ROS 2 bag
+    (:meth:`symfruit.ros.bag2.Ros2DetectionBag.write_frame`). Frames skipped by ``resume`` are not passed.
 
     Raises
     ------
@@ -111,6 +117,8 @@ def run_batch(
                     continue
                 try:
                     found = detect(src.read(index), masks=masks, method=method, settings=settings)
+                    if on_frame is not None:
+                        on_frame(index, found)
                     write_detections(folder, found, settings=settings)
                 except SymfruitError as exc:
                     report.failed[name] = str(exc)

@@ -8,11 +8,13 @@ line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the tr
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import shutil
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import numpy as np
@@ -106,6 +108,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
+    _add_ros2_bag_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
     p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
     p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
@@ -124,6 +127,20 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
 
 
+def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--ros2-bag", type=Path, metavar="BAG",
+                   help="also write the detections into this new ROS 2 bag folder (vision_msgs/msg/Detection3DArray "
+                   "on /symfruit/detections, stamped like the input frames)")  # fmt: skip
+    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default="mcap",
+                   help="storage of --ros2-bag (default mcap)")  # fmt: skip
+
+
+def _add_ros(sub: argparse._SubParsersAction) -> None:
+    # Everything after `ros` belongs to the node (name:=value, __name:=, --help): no option prefix of ours.
+    p = sub.add_parser("ros", help="run the ROS 1 node (see `symfruit ros --help`)", add_help=False, prefix_chars="+")
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="ROS remappings and _param:=value")
+
+
 def _parser() -> argparse.ArgumentParser:
     from . import __version__
 
@@ -138,6 +155,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_bench(sub)
     _add_evaluate(sub)
     _add_detect(sub)
+    _add_ros(sub)
     p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries (with truth)")
     p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
@@ -397,8 +415,9 @@ def _detect(args: argparse.Namespace) -> int:
 
     get(args.method)
     settings = _settings_for(args)
-    report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
-                       resume=args.resume)  # fmt: skip
+    with _ros2_bag(args) as bag:
+        report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
+                           resume=args.resume, on_frame=None if bag is None else bag.write_frame)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
@@ -406,7 +425,32 @@ def _detect(args: argparse.Namespace) -> int:
     if report.stopped:
         print(f"symfruit: {report.stopped}", file=sys.stderr)
     print(f"results: {args.output}")
+    if bag is not None:
+        print(f"ROS 2 bag: {args.ros2_bag} ({bag.count} frames on {bag.topic})")
     return 0 if report.ok else 1
+
+
+@contextlib.contextmanager
+def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
+    """The ``--ros2-bag`` writer (None without the option); a bag left by a batch that could not start is
+    removed again."""
+    if args.ros2_bag is None:
+        yield None
+        return
+    from .errors import InputError
+    from .ros.bag2 import Ros2DetectionBag
+
+    if args.resume:
+        raise InputError("--ros2-bag writes every frame into a new bag; it cannot be combined with --resume")
+    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage, class_id=Path(args.fruit).stem).open()
+    try:
+        yield bag
+    except BaseException:
+        bag.close()
+        if bag.count == 0:
+            shutil.rmtree(args.ros2_bag, ignore_errors=True)
+        raise
+    bag.close()
 
 
 def _demo(args: argparse.Namespace) -> int:
@@ -452,6 +496,12 @@ def _scenes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ros(args: argparse.Namespace) -> int:
+    from .ros.node import main as ros_main
+
+    return ros_main(args.ros_args)
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -475,6 +525,7 @@ _COMMANDS = {
     "segment": _segment,
     "demo": _demo,
     "scenes": _scenes,
+    "ros": _ros,
     "settings": _settings,
     "methods": _methods,
 }

@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .complete import Result
+from .core.box import Box
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError
 from .io.atomic import atomic_write, write_json
@@ -37,6 +38,7 @@ from .settings import Settings
 
 __all__ = [
     "OPTICAL_FRAME",
+    "bbox_record",
     "detection_record",
     "detections_record",
     "draw_contact_sheet",
@@ -83,6 +85,17 @@ def write_result(path: str | Path, result: Result, *, meta: dict[str, Any] | Non
     return path, json_path
 
 
+def bbox_record(box: Box) -> dict[str, Any]:
+    """``bbox`` of a ``detections.json`` entry: a ``vision_msgs/BoundingBox3D`` (centre pose, size; metres)."""
+    return {
+        "center": {
+            "position": dict(zip("xyz", box.centre.tolist(), strict=True)),
+            "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+        },
+        "size": dict(zip("xyz", box.size.tolist(), strict=True)),
+    }
+
+
 def detection_record(d: Detection) -> dict[str, Any]:
     """One entry of ``detections.json``; ``bbox`` is a ``vision_msgs/BoundingBox3D``."""
     ex = d.extraction
@@ -93,19 +106,12 @@ def detection_record(d: Detection) -> dict[str, Any]:
     if d.error or d.result is None:
         return {**out, "error": d.error}
     r = d.result
-    c, size = r.box.centre, r.box.size
     visible = d.visible_box
     out.update(
-        centre=c.tolist(),
+        centre=r.box.centre.tolist(),
         box=r.box.to_dict(),
         visible_box=None if visible is None else visible.to_dict(),
-        bbox={
-            "center": {
-                "position": dict(zip("xyz", c.tolist(), strict=True)),
-                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
-            },
-            "size": dict(zip("xyz", size.tolist(), strict=True)),
-        },
+        bbox=bbox_record(r.box),
         method=r.method,
         plane=None if r.plane is None else r.plane.to_dict(),
         score=None if not np.isfinite(r.score) else float(r.score),
