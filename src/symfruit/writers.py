@@ -125,7 +125,7 @@ def detection_record(d: Detection) -> dict[str, Any]:
 def detections_record(found: FrameDetections, *, settings: Settings | None = None) -> dict[str, Any]:
     """``detections.json``: a ``vision_msgs/Detection3DArray``-like object with symfruit's extras."""
     frame = found.frame
-    header: dict[str, Any] = {"frame_id": OPTICAL_FRAME}
+    header: dict[str, Any] = {"frame_id": frame.frame_id or OPTICAL_FRAME}
     if frame.stamp is not None:
         header["stamp"] = {"sec": frame.stamp // 1_000_000_000, "nanosec": frame.stamp % 1_000_000_000}
     data: dict[str, Any] = {

@@ -72,9 +72,8 @@ def test_frame_header(example_images):
     def frame(**kw) -> Frame:
         return Frame("f", rgb, depth, cam, **kw)
 
-    extras = {"color_stamp": 5, "color_frame_id": "cam_optical"}
-    assert frame_header(frame(stamp=7, extras=extras), 3) == (5, "cam_optical")  # the colour header first
-    assert frame_header(frame(stamp=7), 3) == (7, "camera_color_optical_frame")  # then the frame's stamp
+    assert frame_header(frame(stamp=5, frame_id="cam_optical"), 3) == (5, "cam_optical")  # the colour header
+    assert frame_header(frame(stamp=7), 3) == (7, "camera_color_optical_frame")
     assert frame_header(frame(), 3) == (3_000_000_000, "camera_color_optical_frame")  # folders: the index
 
 
@@ -121,8 +120,8 @@ def test_bag_frames_know_the_colour_header(tmp_path, example_images):
     write_ros1_bag(tmp_path / "in.bag", example_images, [1_650_000_000_000_000_000], color_offset=1_000_000)
     with open_source(tmp_path / "in.bag") as src:
         frame = src.read(0)
-    assert frame.stamp == 1_650_000_000_000_000_000  # the depth image's header
-    assert frame.extras == {"color_stamp": 1_650_000_000_001_000_000, "color_frame_id": "camera_color_optical_frame"}
+    assert frame.stamp == 1_650_000_000_001_000_000  # the colour image's header, not the depth image's
+    assert frame.frame_id == "camera_color_optical_frame"
 
 
 @pytest.mark.parametrize("storage", ["mcap", "sqlite3"])

@@ -7,8 +7,8 @@ in time (within ``max_skew``) and the latest camera info at or before it.
 
 The bag is indexed once (timestamps only; the raw message bytes pass through without being kept or
 decoded) and each frame is then decoded on demand, so memory stays flat however long the recording. A
-frame's ``stamp`` is its depth image's header stamp; ``extras`` hold the colour image's (``color_stamp``,
-``color_frame_id``), which ROS outputs copy.
+frame's ``stamp`` and ``frame_id`` are its colour image's header's (the detections are in the colour
+camera's frame; ROS outputs and detections.json copy them).
 
 :func:`image_array` is the one decoder of ``sensor_msgs/Image`` (:func:`color_image`, :func:`depth_image`
 on top of it, and :func:`camera_from_info`): the live ROS node (:mod:`symfruit.ros.core`) uses them too.
@@ -260,10 +260,9 @@ class BagSource:
             message = str(exc)
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
             raise FileFormatError(named) from None
-        # the colour image's header too: the detections are in its frame (ROS outputs copy its header)
-        extras = {"color_stamp": _stamp(cmsg, cstamp), "color_frame_id": header_frame_id(cmsg)}
-        return Frame(name, color, depth, camera, source=f"{self.path}@{stamp}", stamp=_stamp(dmsg, stamp),
-                     extras=extras)  # fmt: skip
+        # stamped like the colour image: the detections are in its frame (ROS outputs copy its header)
+        return Frame(name, color, depth, camera, source=f"{self.path}@{stamp}", stamp=_stamp(cmsg, cstamp),
+                     frame_id=header_frame_id(cmsg))  # fmt: skip
 
     def close(self) -> None:
         """Close the bag."""

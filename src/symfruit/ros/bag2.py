@@ -68,14 +68,12 @@ def ros2_typestore():
 
 
 def frame_header(frame: Frame, index: int = 0) -> tuple[int, str]:
-    """``(stamp in ns, frame_id)`` of a frame's detections: the colour image's header when the source has
-    one (``extras`` ``color_stamp``, ``color_frame_id``: bags, the node), as the ROS 1 node's outputs copy
-    it; else ``frame.stamp``; else ``index`` seconds (frame folders carry no time). ``frame_id`` defaults to
-    the colour camera's optical frame, as in ``detections.json``."""
-    stamp = frame.extras.get("color_stamp")
-    if stamp is None:
-        stamp = frame.stamp if frame.stamp is not None else index * 1_000_000_000
-    return int(stamp), str(frame.extras.get("color_frame_id") or OPTICAL_FRAME)
+    """``(stamp in ns, frame_id)`` of a frame's detections: the colour image's header (``frame.stamp`` and
+    ``frame.frame_id``: bags and the node carry it), as the ROS 1 node's outputs and ``detections.json`` copy
+    it; a frame without a stamp (a frame folder) is stamped ``index`` seconds; ``frame_id`` defaults to the
+    colour camera's optical frame."""
+    stamp = frame.stamp if frame.stamp is not None else index * 1_000_000_000
+    return int(stamp), frame.frame_id or OPTICAL_FRAME
 
 
 class Ros2DetectionBag:

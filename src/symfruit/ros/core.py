@@ -103,7 +103,7 @@ def message_frame(
     source: str = "ros",
 ) -> Frame:
     """A :class:`~symfruit.frame.Frame` of a colour image, the depth image aligned to it and the colour
-    camera's info; stamped with the colour header (``stamp``; ``extras`` ``color_stamp``, ``color_frame_id``).
+    camera's info; stamped with the colour header (``stamp``, ``frame_id``).
 
     Raises
     ------
@@ -115,9 +115,7 @@ def message_frame(
     metres = depth_image(depth, depth_scale=depth_scale)
     h, w = metres.shape
     camera = camera_from_info(info, width=w, height=h)
-    stamp = header_stamp(color)
-    extras = {"color_stamp": stamp, "color_frame_id": header_frame_id(color)}
-    return Frame(name, rgb, metres, camera, source=source, stamp=stamp, extras=extras)
+    return Frame(name, rgb, metres, camera, source=source, stamp=header_stamp(color), frame_id=header_frame_id(color))
 
 
 @dataclass(frozen=True)
