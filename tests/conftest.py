@@ -92,6 +92,43 @@ def front_half(cloud: np.ndarray, centre: np.ndarray = CENTRE) -> np.ndarray:
 VISIBLE = front_half(sphere_cloud())
 
 
+def rendered_view(fruit, centre, *, noise: float = 0.0, rotation=None, seed: int = 0) -> tuple[np.ndarray, object]:
+    """``(visible (n, 3), posed fruit)``: a fruit mesh posed at ``centre`` (metres) and rendered by the default
+    camera, one point per pixel at the pixel centre, axial noise ``noise * z^2`` metres (seeded)."""
+    from symfruit.render import render
+
+    cam = symfruit.DEFAULT_CAMERA
+    posed = fruit.transformed(np.eye(3) if rotation is None else rotation, np.asarray(centre, dtype=float))
+    shot = render([(posed.vertices, posed.faces)], cam)
+    rows, cols = np.nonzero(shot.ids == 0)
+    z = shot.depth[rows, cols]
+    z = z + np.random.default_rng(seed).normal(size=z.shape) * noise * z**2
+    return cam.deproject(np.c_[cols, rows].astype(float), z), posed
+
+
+def ball_mesh(radius: float = 0.035):
+    """A closed triangle-mesh ball (a revolved half circle, 96 x 90)."""
+    from symfruit.shapes import _revolve
+
+    t = np.linspace(0, np.pi, 90)
+    return _revolve(radius * np.sin(t), -radius * np.cos(t), name="ball", n_phi=96)
+
+
+def _find_real_scans() -> Path | None:
+    """``shared/data/real-scans`` beside the repository or one of its parent folders (a worktree)."""
+    for parent in ROOT.parents:
+        folder = parent / "shared" / "data" / "real-scans"
+        if folder.is_dir():
+            return folder
+    return None
+
+
+#: The shared real scans (YCB object set, Calli et al. 2015, CC BY 4.0), or None where they are absent.
+REAL_SCANS = _find_real_scans()
+#: Skip marker of tests that need them.
+needs_real_scans = pytest.mark.skipif(REAL_SCANS is None, reason="the shared real scans (../shared/data) are absent")
+
+
 # --- small synthetic RGB-D frames ----------------------------------------------------------------------
 
 #: A 160x120 camera for small synthetic frames.

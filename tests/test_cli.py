@@ -46,16 +46,16 @@ def test_complete_json_round_trip(tmp_path, capsys, ext):
         "n_completed",
         "seconds",
     }
-    assert printed["method"] == "fused" and printed["n_completed"] == 2 * len(VISIBLE)
+    assert printed["method"] == "evidence" and printed["n_completed"] == 2 * len(VISIBLE)
     assert 0.0 <= printed["confidence"] <= 1.0 and isinstance(printed["reliable"], bool)
     completed = read_cloud(out)
     assert len(completed) == printed["n_completed"]
-    # The box holds the completed cloud (fused boxes its fitted shape, which may reach beyond it).
+    # The box holds the completed cloud (the default boxes its candidates' shapes, which may reach beyond it).
     assert np.all(completed.min(axis=0) >= np.array(printed["box"]["min"]) - 1e-6)
     assert np.all(completed.max(axis=0) <= np.array(printed["box"]["max"]) + 1e-6)
     saved = json.loads(out.with_suffix(".json").read_text())
     assert saved["settings"]["paper"]["rotations_x"] == 11 and saved["camera"]["fx"] == 615.0
-    assert saved["extras"]["regime"] in ("clean", "noisy")
+    assert set(saved["extras"]["weights"]) >= {"sphere", "raw"}
     assert saved["centre"] == printed["centre"]
 
 
@@ -158,7 +158,10 @@ def test_console_script_runs():
 def test_bench_runs_and_reports(capsys):
     assert main(["bench", "--repeat", "2", "--points", "200", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)["rows"]
-    assert [r["method"] for r in rows] == ["paper", "paper", "fused", "fused", "sphere", "ellipsoid", "raw"]
+    assert [r["method"] for r in rows] == ["paper", "paper", "evidence", "evidence", "fused", "fused", "superellipsoid",
+                                           "sphere", "ellipsoid", "raw", "evidence", "fused", "superellipsoid",
+                                           "sphere", "paper"]  # fmt: skip
+    assert 14000 < rows[-1]["points"] < 16000  # the depth-camera view
     assert [r["planes"] for r in rows][:2] == [132, 1320]
     assert all(r["median_ms"] > 0 for r in rows)
 
@@ -182,10 +185,12 @@ def test_evaluate_command(tmp_path, capsys):
     assert main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
     out = capsys.readouterr().out
     assert "| raw |" in out and "results: " in out
-    assert main(["evaluate", "--fruit", "banana"]) == 2
+    assert main(["evaluate", "--fruit", "kiwi"]) == 2
     assert "not a fruit kind" in capsys.readouterr().err
     assert main(["evaluate", "--methods", "raw,nope"]) == 2
     assert main(["evaluate", "--protocol", "camera", "--occlusion", "0,1.5"]) == 2
+    assert main(["evaluate", "--pose", "uniform"]) == 2  # the paper protocol has its own poses
+    assert "camera protocol" in capsys.readouterr().err
 
 
 def test_cli_fruit_profile(tmp_path, capsys):

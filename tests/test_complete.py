@@ -70,7 +70,7 @@ def test_a_million_points_are_down_sampled(monkeypatch):
     cloud = front_half(0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + CENTRE)
     # The method is handed the down-sampled cloud only (what keeps a million points at about a second;
     # asserted on the count, not on a wall clock, so a loaded machine cannot fail it).
-    info = get("fused")
+    info = get("evidence")
     handed = []
 
     def spy(points, camera, section):

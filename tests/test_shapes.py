@@ -7,8 +7,11 @@ from symfruit.shapes import FRUITS, STRAWBERRY_CLASSES, load_scans, paper_visibl
 
 from .conftest import fibonacci_sphere
 
+#: Per kind: 1 = the length (y extent) is checked, 0 = the width (the larger of the x and z extents).
 SIZES = {"strawberry": (1, (0.025, 0.050)), "apple": (0, (0.058, 0.095)), "citrus": (0, (0.058, 0.095)),
-         "tomato": (0, (0.038, 0.085))}  # fmt: skip
+         "tomato": (0, (0.038, 0.085)), "pear": (1, (0.055, 0.125)), "lemon": (1, (0.055, 0.100)),
+         "peach": (0, (0.050, 0.090)), "plum": (1, (0.030, 0.070)), "banana": (1, (0.100, 0.200)),
+         "lopsided": (0, (0.035, 0.130))}  # fmt: skip
 
 
 def closed(faces: np.ndarray) -> bool:
@@ -26,7 +29,7 @@ def test_fruits_are_closed_centred_sized_and_seeded(kind):
         lo, hi = fruit.vertices.min(axis=0), fruit.vertices.max(axis=0)
         assert np.allclose((lo + hi) / 2, 0, atol=1e-12)
         axis, (small, large) = SIZES[kind]
-        size = (hi - lo)[axis] if kind == "strawberry" else max((hi - lo)[0], (hi - lo)[2])
+        size = (hi - lo)[axis] if axis == 1 else max((hi - lo)[0], (hi - lo)[2])
         assert small <= size <= large, (kind, seed, size)
         again = FRUITS[kind](np.random.default_rng(seed))
         assert np.array_equal(fruit.vertices, again.vertices)

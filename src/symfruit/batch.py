@@ -25,6 +25,7 @@ from .detect import FrameDetections, detect
 from .errors import FileFormatError, InputError, SymfruitError
 from .io.atomic import write_json
 from .io.sources import open_source
+from .methods import DEFAULT_METHOD
 from .progress import Progress
 from .settings import Settings
 from .writers import write_detections
@@ -77,7 +78,7 @@ def run_batch(
     output: str | Path,
     *,
     masks: str = "auto",
-    method: str = "fused",
+    method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
     resume: bool = False,
     progress: bool = True,

@@ -1,7 +1,9 @@
 """The project's benchmark: time :func:`symfruit.complete` on a fixed, seeded partial strawberry view.
 
 ``symfruit bench`` prints the median wall time per fruit (one process, after a warm-up) for the
-paper's 132 planes and for a 10x denser grid of 1,320 planes, beside the simple baselines.
+paper's 132 planes and for a 10x denser grid of 1,320 planes, the default ``evidence``, the previous
+default ``fused``, ``superellipsoid`` and the simple baselines, on a partial strawberry of 600 and 3,000
+points and on a depth-camera view of about 15,000 points.
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .complete import complete
+from .methods import DEFAULT_METHOD
 from .settings import Settings
 from .shapes import paper_visible, rotation_x, strawberry
 
@@ -23,6 +26,7 @@ __all__ = [
     "DENSE_GRID",
     "BenchRow",
     "RecordingRow",
+    "bench_camera_view",
     "bench_frame",
     "bench_recording",
     "bench_segment",
@@ -78,6 +82,33 @@ def bench_view(n_points: int = 600, *, seed: int = 0, noise: float = 0.0) -> np.
     return view + rng.normal(scale=noise, size=view.shape) if noise > 0 else view
 
 
+def bench_camera_view(n_points: int = 15000, *, seed: int = 0) -> np.ndarray:
+    """A fixed depth-camera view of a 75 mm orange with about ``n_points`` points.
+
+    The fruit is rendered by the default camera (640x480, ``fx = fy = 615``) at the distance where its
+    silhouette covers about ``n_points`` pixels, one point per pixel, with axial noise of ``0.01 z^2``
+    metres (the ``heldback`` sensor of the evaluation). Same ``seed``, same points.
+
+    Returns
+    -------
+    (n, 3) float, metres, n within a few per cent of ``n_points``
+    """
+    from .core.camera import DEFAULT_CAMERA as cam
+    from .render import render
+    from .shapes import citrus
+
+    rng = np.random.default_rng(seed)
+    fruit = citrus(rng, diameter=0.075)
+    radius = 0.5 * float(np.ptp(fruit.vertices[:, 0]))
+    distance = radius * cam.fx * float(np.sqrt(np.pi / n_points))
+    posed = fruit.transformed(rotation_x(20.0), np.array([0.0, 0.0, distance]))
+    shot = render([(posed.vertices, posed.faces)], cam)
+    rows, cols = np.nonzero(shot.ids == 0)
+    z = shot.depth[rows, cols]
+    z = z + rng.normal(size=z.shape) * 0.01 * z**2
+    return cam.deproject(np.c_[cols, rows].astype(np.float64), z)
+
+
 def _time(fn: Any, repeat: int) -> np.ndarray:
     for _ in range(min(10, repeat)):
         fn()
@@ -89,21 +120,36 @@ def _time(fn: Any, repeat: int) -> np.ndarray:
     return times * 1000.0
 
 
-def run_bench(*, repeat: int = 200, points: tuple[int, ...] = (600, 3000)) -> list[BenchRow]:
-    """Run every case ``repeat`` times; return one row per case."""
+def run_bench(
+    *, repeat: int = 200, points: tuple[int, ...] = (600, 3000), camera_points: tuple[int, ...] = (15000,)
+) -> list[BenchRow]:
+    """Run every case ``repeat`` times; return one row per case.
+
+    ``points``: sizes of the partial strawberry (:func:`bench_view`); ``camera_points``: sizes of the
+    depth-camera view (:func:`bench_camera_view`), timed for the default and the fitting methods.
+    """
     dense = Settings().replace(paper=DENSE_GRID)
     rows = []
+    jobs: list[tuple[int, list[tuple[str, str, Settings, np.ndarray]]]] = []
     for n in points:
         clean, noisy = bench_view(n), bench_view(n, noise=0.001)
-        cases = [
+        jobs.append((n, [
             ("paper 132 planes", "paper", Settings(), clean),
             ("paper 1,320 planes", "paper", dense, clean),
+            ("evidence, clean view", "evidence", Settings(), clean),
+            ("evidence, 1 mm noise", "evidence", Settings(), noisy),
             ("fused, clean view", "fused", Settings(), clean),
             ("fused, 1 mm noise", "fused", Settings(), noisy),
+            ("superellipsoid", "superellipsoid", Settings(), clean),
             ("sphere", "sphere", Settings(), clean),
             ("ellipsoid", "ellipsoid", Settings(), clean),
             ("raw", "raw", Settings(), clean),
-        ]
+        ]))  # fmt: skip
+    for n in camera_points:
+        view = bench_camera_view(n)
+        jobs.append((len(view), [(f"{m}, camera view", m, Settings(), view)
+                                 for m in ("evidence", "fused", "superellipsoid", "sphere", "paper")]))  # fmt: skip
+    for n, cases in jobs:
         for name, method, settings, view in cases:
             ms = _time(lambda m=method, s=settings, v=view: complete(v, method=m, settings=s), repeat)
             planes = settings.paper.n_hypotheses if method == "paper" else 0
@@ -122,7 +168,7 @@ def run_bench(*, repeat: int = 200, points: tuple[int, ...] = (600, 3000)) -> li
     return rows
 
 
-def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "fused") -> BenchRow:
+def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD) -> BenchRow:
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore)."""
     from .detect import detect
@@ -247,7 +293,9 @@ def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[i
     return int(data["status"]), float(data["peak_rss_mb"]), proc.stderr
 
 
-def bench_recording(frames: int = 500, *, method: str = "fused", workdir: str | Path | None = None) -> RecordingRow:
+def bench_recording(
+    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None
+) -> RecordingRow:
     """Run ``symfruit detect`` on a generated ``frames``-frame recording in a child process and report its
     peak resident memory and wall time: memory must not grow with ``frames``."""
     import tempfile

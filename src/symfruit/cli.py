@@ -30,7 +30,7 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
         type=Path,
         help="intrinsics (JSON/YAML: plain, RealSense, Open3D, ROS); default: Intel D435 colour 640x480",
     )
-    p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
+    p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`), over the profile")
     p.add_argument("--units", choices=("m", "mm"), default="m", help="units of the input cloud")
@@ -50,7 +50,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
-    p.add_argument("--method", default="fused", help="with --recording: the completion method (default fused)")
+    p.add_argument("--method", default=None, help="with --recording: the completion method (default evidence)")
     p.add_argument(
         "--segment",
         action="store_true",
@@ -71,14 +71,22 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fruit",
         default="strawberry",
-        help="strawberry, apple, citrus, tomato, all, or a folder of complete scans; comma-separated",
+        help="a generated kind (strawberry, apple, citrus, tomato, pear, lemon, peach, plum, banana, lopsided), "
+        "all, or a folder of complete scans (one table row per scan); comma-separated",
     )
-    p.add_argument("--methods", default="raw,sphere,ellipsoid,paper,fused", help="comma-separated methods")
+    p.add_argument("--methods", default="raw,sphere,ellipsoid,superellipsoid,paper,fused,evidence",
+                   help="comma-separated methods")  # fmt: skip
     p.add_argument(
         "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
+    p.add_argument("--sensor", choices=("d435", "heldback"), default="d435",
+                   help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m) or heldback (issue 11's measurement: "
+                   "0.01 z^2 noise, no dropout, 0.3-0.5 m)")  # fmt: skip
+    p.add_argument("--pose", choices=("hanging", "upright", "uniform"), default="hanging",
+                   help="pose distribution: hanging (stem up; scans as in their file), upright (scans stood up "
+                   "first), uniform (any orientation; camera protocol)")  # fmt: skip
     p.add_argument("--output", type=Path, default=Path("results"), help="results root (default results/)")
     p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
@@ -103,7 +111,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
         help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, maskrcnn:CHECKPOINT.pth "
         "or onnx:MODEL.onnx",
     )
-    p.add_argument("--method", default="fused", help="completion method (see `symfruit methods`; default fused)")
+    p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
     p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
@@ -122,7 +130,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
     p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    p.add_argument("--method", default="fused", help="completion method (default fused)")
+    p.add_argument("--method", default=None, help="completion method (default evidence)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
 
@@ -173,6 +181,13 @@ def _fmt(values: Sequence[float] | np.ndarray, scale: float = 1000.0) -> str:
     return "(" + ", ".join(f"{v * scale:.1f}" for v in values) + ")"
 
 
+def _method(args: argparse.Namespace) -> str:
+    """``--method``, or the default method when it is not given."""
+    from .methods import DEFAULT_METHOD
+
+    return str(args.method or DEFAULT_METHOD)
+
+
 def _settings_for(args: argparse.Namespace, fruit: str | None = None):
     """Defaults, then the fruit profile (``--fruit``), then ``--config``: :func:`symfruit.resolve_settings`."""
     from .settings import resolve_settings
@@ -194,7 +209,7 @@ def _complete(args: argparse.Namespace) -> int:
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
-    result = complete(points, camera=camera, method=args.method, settings=settings)
+    result = complete(points, camera=camera, method=_method(args), settings=settings)
     written = None
     if args.output is not None:
         meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}
@@ -253,7 +268,7 @@ def _bench(args: argparse.Namespace) -> int:
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
-        rec = bench_recording(args.recording, method=args.method)
+        rec = bench_recording(args.recording, method=_method(args))
         if args.json:
             print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
             return 0
@@ -264,7 +279,7 @@ def _bench(args: argparse.Namespace) -> int:
     if args.frame:
         from .bench import bench_frame
 
-        rows = [bench_frame(repeat=min(args.repeat, 50), method=m) for m in ("paper", "fused")]
+        rows = [bench_frame(repeat=min(args.repeat, 50), method=m) for m in ("paper", "fused", "evidence")]
     else:
         rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:
@@ -306,6 +321,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         raise InputError("--occlusion levels must be in [0, 1)")
     if args.n is not None and not 1 <= args.n <= 100_000:
         raise InputError("--n must be between 1 and 100000")
+    if args.protocol == "paper" and args.pose == "uniform":
+        raise InputError("--pose uniform is for the camera protocol (the paper protocol has its own 19 poses)")
     if not 0 <= args.seed < 2**63:
         raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
     if args.jobs is not None and not 1 <= args.jobs <= 256:
@@ -317,7 +334,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         return _evaluate_frames(args, methods, _settings_for(args, fruit))
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
-        occlusions=occlusions, quick=args.quick, config=args.config, output=args.output, jobs=args.jobs,
+        occlusions=occlusions, sensor=args.sensor, poses=args.pose, quick=args.quick, config=args.config,
+        output=args.output, jobs=args.jobs,
     )  # fmt: skip
     print(result.table)
     print(f"results: {result.folder}")
@@ -413,10 +431,10 @@ def _detect(args: argparse.Namespace) -> int:
     from .batch import run_batch
     from .methods import get
 
-    get(args.method)
+    get(_method(args))
     settings = _settings_for(args)
     with _ros2_bag(args) as bag:
-        report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
+        report = run_batch(args.input, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
@@ -456,11 +474,11 @@ def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
 def _demo(args: argparse.Namespace) -> int:
     from .demo import run_demo
 
-    report = run_demo(args.output, method=args.method, settings=_settings_for(args))
+    report = run_demo(args.output, method=_method(args), settings=_settings_for(args))
     found = report.found
     frame = found.frame
     print(f"symfruit demo: {frame.name} ({frame.camera.width}x{frame.camera.height}), {len(found.detections)} fruit "
-          f"found, {report.n_truth} ripe fruit in the truth, method {args.method}")  # fmt: skip
+          f"found, {report.n_truth} ripe fruit in the truth, method {_method(args)}")  # fmt: skip
     print(f"{'fruit':>5} {'points':>6}  {'centre x, y, z (mm)':<24} {'size x, y, z (mm)':<20} "
           f"{'raw err':>8} {'completed err':>13}")  # fmt: skip
     for d in report.located:

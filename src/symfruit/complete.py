@@ -14,7 +14,7 @@ from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane, Planes
 from .core.points import check_cloud, check_view
 from .errors import InputError
-from .methods import get
+from .methods import DEFAULT_METHOD, get
 from .settings import Section, SettingError, Settings, from_dict, register_section, setting
 
 __all__ = ["InputSettings", "Result", "complete"]
@@ -104,7 +104,7 @@ class Result:
 
     @property
     def confidence(self) -> float | None:
-        """How far to trust the box, in [0, 1] (methods that estimate it, e.g. ``fused``), else None."""
+        """How far to trust the box, in [0, 1] (methods that estimate it, e.g. ``evidence``), else None."""
         value = self.extras.get("confidence")
         return None if value is None else float(value)
 
@@ -136,7 +136,7 @@ def complete(
     points: Any,
     *,
     camera: Camera | Mapping[str, Any] | None = None,
-    method: str = "fused",
+    method: str = DEFAULT_METHOD,
     settings: Settings | Mapping[str, Any] | None = None,
 ) -> Result:
     """Complete one fruit seen from one view and box it.
@@ -149,7 +149,8 @@ def complete(
         Intrinsics of the camera that saw them (a mapping in any layout :func:`symfruit.io.camera_from_dict`
         reads); None means :data:`~symfruit.core.camera.DEFAULT_CAMERA` (Intel D435 colour, 640x480).
     method : str
-        A registered method: ``fused`` (default), ``paper``, ``sphere``, ``ellipsoid``, ``raw``, ...
+        A registered method: ``evidence`` (default), ``paper``, ``superellipsoid``, ``sphere``, ``ellipsoid``,
+        ``fused`` (the previous default), ``raw``, ...
         (:func:`symfruit.methods.available`).
     settings : Settings or mapping, optional
         Settings (e.g. from :func:`symfruit.resolve_settings`), or a nested mapping of overrides

@@ -20,6 +20,7 @@ from .core.camera import Camera
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
 from .frame import Frame
+from .methods import DEFAULT_METHOD
 from .segment import segment
 from .settings import Settings
 
@@ -97,7 +98,7 @@ def detect(
     frame: Frame,
     *,
     masks: str | Path | Segmenter = "auto",
-    method: str = "fused",
+    method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.

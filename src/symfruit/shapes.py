@@ -15,7 +15,21 @@ strawberry  length 25-50 mm       classes conic, long-conic, globose, wedge (hea
 apple       diameter 60-90 mm     height/diameter 0.8-0.95, stem cavity, calyx basin, lopsided
 citrus      diameter 60-90 mm     near-spherical, height/diameter 0.88-0.98
 tomato      diameter 40-80 mm     oblate (height/diameter 0.65-0.85), shoulders, shallow ribs
+pear        length 55-125 mm      two bulbs (neck and body, radius ratio 0.45-0.8) blended by a
+                                  p-norm (a smooth waist); leaning, lopsided, elliptic cross-section
+lemon       length 55-100 mm      prolate, width/length 0.65-0.85, pointed ends with nipples
+peach       diameter 50-90 mm     near-spherical, suture groove, one fuller cheek, stem cavity,
+                                  slight tip
+plum        length 30-70 mm       oval (width/length 0.78-0.95), shallow suture, flattened sides
+banana      length 100-200 mm     curved (sagitta 8-22 % of the length), five-sided, tapered ends:
+                                  a fruit no plane mirrors and no closed shape fits
+lopsided    diameter 35-130 mm    a generic asymmetric fruit: one side swollen, the axis bent
+                                  (mango- or kidney-like)
 =========== ===================== ===============================================================
+
+The four original kinds are near-symmetric solids of revolution with a small lean; the other six make
+sure a method cannot win only on near-spherical shapes (the real pear of the YCB set, for one, is tilted
+and lopsided).
 """
 
 from __future__ import annotations
@@ -33,11 +47,17 @@ __all__ = [
     "STRAWBERRY_CLASSES",
     "Fruit",
     "apple",
+    "banana",
     "citrus",
     "leaf_outline",
+    "lemon",
     "load_scans",
+    "lopsided",
     "make_fruit",
     "paper_visible",
+    "peach",
+    "pear",
+    "plum",
     "rotation",
     "rotation_x",
     "sample_surface",
@@ -100,27 +120,49 @@ def _revolve(
     lopsided: float = 0.0,
     lopsided_phase: float = 0.0,
     ribs: tuple[int, float] = (0, 0.0),
+    lopsided_mid: bool = False,
+    groove: tuple[float, float, float] = (0.0, 0.3, 0.0),
+    arc: float = 0.0,
     name: str,
 ) -> Fruit:
     """Closed mesh of the profile ``radius(t), axial(t)`` (t from the top pole to the bottom pole).
 
     ``squash`` makes the cross-section elliptic (x scaled by it, z by its inverse), ``lopsided``
-    swells one side (``1 + lopsided * cos(phi - phase)``), ``ribs = (count, depth)`` adds ribs, and
-    ``bend`` curves the axis sideways by ``bend`` times the length at the bottom pole.
+    swells one side (``1 + lopsided * cos(phi - phase)``; with ``lopsided_mid`` the swelling grows from
+    nothing at the poles to its full size at mid-height, ``sin(pi s)``), ``ribs = (count, depth)`` adds
+    ribs, ``groove = (depth, width, phase)`` a suture (ring radius times ``1 - depth exp(-(dphi /
+    width)^2)`` around ``phi = phase``), ``bend`` curves the axis sideways by ``bend`` times the length at
+    the bottom pole, and ``arc`` (1/metres) bends the whole fruit along a circle in the x-y plane, keeping
+    cross-sections perpendicular to the bent axis (a banana).
     """
     phi = np.linspace(0.0, 2.0 * np.pi, n_phi, endpoint=False)
     count, depth = ribs
-    scale = 1.0 + lopsided * np.cos(phi - lopsided_phase) + depth * np.cos(count * phi)
-    ring_r = radius[1:-1, None] * scale[None, :]
-    ring_y = np.broadcast_to(axial[1:-1, None], ring_r.shape)
     span = axial[-1] - axial[0]
-    shift = bend * span * ((axial - axial[0]) / span) ** 2
+    s = (axial - axial[0]) / span
+    if lopsided_mid:
+        scale = (1.0 + depth * np.cos(count * phi))[None, :] + lopsided * np.sin(np.pi * s)[1:-1, None] * np.cos(
+            phi - lopsided_phase
+        )[None, :]
+    else:
+        scale = (1.0 + lopsided * np.cos(phi - lopsided_phase) + depth * np.cos(count * phi))[None, :]
+    g_depth, g_width, g_phase = groove
+    if g_depth:
+        dphi = np.angle(np.exp(1j * (phi - g_phase)))
+        scale = scale - g_depth * np.exp(-((dphi / g_width) ** 2))[None, :]
+    ring_r = radius[1:-1, None] * scale
+    ring_y = np.broadcast_to(axial[1:-1, None], ring_r.shape)
+    shift = bend * span * s**2
     x = ring_r * np.cos(phi)[None, :] * squash + shift[1:-1, None]
     z = ring_r * np.sin(phi)[None, :] / squash
     rings = np.stack([x, ring_y, z], axis=-1).reshape(-1, 3)
     top = np.array([[shift[0], axial[0], 0.0]])
     bottom = np.array([[shift[-1], axial[-1], 0.0]])
     vertices = np.vstack([top, rings, bottom])
+    if arc:
+        mid, bend_radius = 0.5 * (axial[0] + axial[-1]), 1.0 / arc
+        theta = (vertices[:, 1] - mid) / bend_radius
+        dist = bend_radius - vertices[:, 0]
+        vertices = np.c_[bend_radius - dist * np.cos(theta), mid + dist * np.sin(theta), vertices[:, 2]]
     n_rings = len(radius) - 2
     j = np.arange(n_phi)
     jn = (j + 1) % n_phi
@@ -242,12 +284,124 @@ def tomato(rng: np.random.Generator, *, diameter: float | None = None) -> Fruit:
     )  # fmt: skip
 
 
-#: Fruit generators by kind: ``FRUITS[kind](rng) -> Fruit``.
+def _two_bulbs(r_top: float, r_bottom: float, gap: float, p: float, n: int = 96) -> tuple[np.ndarray, np.ndarray]:
+    """Profile ``(radius, axial)`` of two spheres (radii ``r_top``, ``r_bottom``, centres ``gap`` apart on the
+    axis) joined by the p-norm of their ring radii: a smooth waist, round poles."""
+    y0, y1 = -r_top, gap + r_bottom
+    t = 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, n))  # samples clustered at the poles
+    y = y0 + (y1 - y0) * t
+    ra = np.sqrt(np.clip(r_top**2 - y**2, 0.0, None))
+    rb = np.sqrt(np.clip(r_bottom**2 - (y - gap) ** 2, 0.0, None))
+    r = (ra**p + rb**p) ** (1.0 / p)
+    r[0] = r[-1] = 0.0
+    return r, y
+
+
+def _round(diameter: float, height_ratio: float, cavity: float, tip: float) -> tuple[np.ndarray, np.ndarray]:
+    """Profile ``(radius, axial)`` of an ellipse with a stem cavity at the top pole and a tip at the bottom."""
+    theta = np.linspace(0.0, np.pi, 90)
+    a, b = diameter / 2.0, diameter * height_ratio / 2.0
+    r = a * np.sin(theta)
+    y = -b * np.cos(theta)
+    y += cavity * diameter * np.exp(-((theta / 0.35) ** 2))
+    y += tip * diameter * np.exp(-(((np.pi - theta) / 0.25) ** 2))
+    r[0] = r[-1] = 0.0
+    return r, y
+
+
+def pear(rng: np.random.Generator) -> Fruit:
+    """A pear, 55-125 mm long: a narrow neck bulb and a wide body bulb, leaning and lopsided."""
+    r_body = rng.uniform(0.024, 0.040)
+    r_neck = r_body * rng.uniform(0.45, 0.8)
+    gap = r_body * rng.uniform(0.7, 1.4)
+    r, y = _two_bulbs(r_neck, r_body, gap, rng.uniform(1.8, 3.5))
+    return _revolve(
+        r, y, name="pear", n_phi=72, squash=rng.uniform(0.93, 1.07), bend=rng.uniform(-0.12, 0.12),
+        lopsided=rng.uniform(0.0, 0.08), lopsided_phase=rng.uniform(0, 2 * np.pi), lopsided_mid=True,
+    )  # fmt: skip
+
+
+def lemon(rng: np.random.Generator) -> Fruit:
+    """A lemon, 55-100 mm long (nipples included): prolate, pointed ends, a nipple at one or both poles."""
+    length = rng.uniform(0.055, 0.085)
+    width = length * rng.uniform(0.65, 0.85)
+    u = -np.cos(np.linspace(0.0, np.pi, 96))  # -1 .. 1 along the axis, clustered at the poles
+    r = 0.5 * width * (1.0 - u**2) ** rng.uniform(0.5, 0.75)  # exponent > 0.5: pointed ends
+    nipple_top, nipple_bottom = rng.uniform(0.0, 0.08), rng.uniform(0.03, 0.12)
+    y = 0.5 * length * u
+    y -= nipple_top * length * np.exp(-(((u + 1.0) / 0.12) ** 2))
+    y += nipple_bottom * length * np.exp(-(((1.0 - u) / 0.12) ** 2))
+    return _revolve(
+        r, y, name="lemon", n_phi=72, squash=rng.uniform(0.95, 1.05), bend=rng.uniform(-0.05, 0.05),
+        lopsided=rng.uniform(0.0, 0.05), lopsided_phase=rng.uniform(0, 2 * np.pi), lopsided_mid=True,
+    )  # fmt: skip
+
+
+def peach(rng: np.random.Generator) -> Fruit:
+    """A peach, 50-90 mm across: near-spherical, a suture groove, one fuller cheek, a stem cavity, a slight tip."""
+    d = rng.uniform(0.055, 0.080)
+    r, y = _round(d, rng.uniform(0.88, 1.05), rng.uniform(0.04, 0.09), rng.uniform(0.0, 0.04))
+    phase = rng.uniform(0, 2 * np.pi)
+    return _revolve(
+        r, y, name="peach", n_phi=72, squash=rng.uniform(0.92, 1.04), bend=rng.uniform(-0.04, 0.04),
+        lopsided=rng.uniform(0.02, 0.07), lopsided_phase=phase + np.pi / 2, lopsided_mid=True,
+        groove=(rng.uniform(0.03, 0.08), rng.uniform(0.12, 0.3), phase),
+    )  # fmt: skip
+
+
+def plum(rng: np.random.Generator) -> Fruit:
+    """A plum, 30-70 mm long: oval, flattened across the suture, a shallow groove."""
+    length = rng.uniform(0.035, 0.060)
+    r, y = _round(length * rng.uniform(0.78, 0.95), rng.uniform(1.05, 1.28), rng.uniform(0.02, 0.05),
+                  rng.uniform(0.0, 0.03))  # fmt: skip
+    phase = rng.uniform(0, 2 * np.pi)
+    return _revolve(
+        r, y, name="plum", n_phi=72, squash=rng.uniform(0.85, 0.97), bend=rng.uniform(-0.06, 0.06),
+        lopsided=rng.uniform(0.0, 0.05), lopsided_phase=phase + np.pi / 2, lopsided_mid=True,
+        groove=(rng.uniform(0.015, 0.05), rng.uniform(0.12, 0.3), phase),
+    )  # fmt: skip
+
+
+def banana(rng: np.random.Generator) -> Fruit:
+    """A banana, 120-200 mm along its curve (100-200 mm end to end): tapered, five-sided, bent (no plane
+    mirrors it)."""
+    length = rng.uniform(0.12, 0.20)
+    radius = length * rng.uniform(0.09, 0.12)
+    t = 0.5 - 0.5 * np.cos(np.linspace(0.0, np.pi, 96))
+    r = radius * np.sin(np.pi * t) ** rng.uniform(0.3, 0.5) * (1.0 - 0.35 * t**3)
+    r[0] = r[-1] = 0.0
+    sagitta = length * rng.uniform(0.08, 0.22)
+    return _revolve(
+        r, t * length, name="banana", n_phi=72, squash=rng.uniform(0.9, 1.1), ribs=(5, rng.uniform(0.02, 0.05)),
+        arc=8.0 * sagitta / length**2 * rng.choice([-1.0, 1.0]),
+    )  # fmt: skip
+
+
+def lopsided(rng: np.random.Generator) -> Fruit:
+    """A generic asymmetric fruit, 35-130 mm across (40-90 mm before its swelling): an egg whose one side is
+    swollen and whose axis is bent (mango- or kidney-like)."""
+    r_body = rng.uniform(0.040, 0.090) / 2.0
+    r_top = r_body * rng.uniform(0.6, 1.0)
+    r, y = _two_bulbs(r_top, r_body, r_body * rng.uniform(0.2, 0.8), rng.uniform(2.0, 4.0))
+    return _revolve(
+        r, y, name="lopsided", n_phi=72, squash=rng.uniform(0.85, 1.15), bend=rng.uniform(-0.2, 0.2),
+        lopsided=rng.uniform(0.06, 0.15), lopsided_phase=rng.uniform(0, 2 * np.pi), lopsided_mid=True,
+    )  # fmt: skip
+
+
+#: Fruit generators by kind: ``FRUITS[kind](rng) -> Fruit``; the first four are the original kinds (with
+#: fruit profiles), the others widen the evaluation to elongated, grooved, asymmetric and curved fruit.
 FRUITS: dict[str, Callable[[np.random.Generator], Fruit]] = {
     "strawberry": strawberry,
     "apple": apple,
     "citrus": citrus,
     "tomato": tomato,
+    "pear": pear,
+    "lemon": lemon,
+    "peach": peach,
+    "plum": plum,
+    "banana": banana,
+    "lopsided": lopsided,
 }
 
 

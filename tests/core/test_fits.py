@@ -1,4 +1,5 @@
-"""Shape fits: sphere, ellipsoid (any orientation and camera-aligned), solid of revolution, surface noise.
+"""Shape fits: sphere, ellipsoid (any orientation and camera-aligned), solids of revolution (from normals and
+from slice circles), surface noise.
 
 Known answers on exact solids, input normalisation (lists, integers) and clear errors for wrong shapes.
 """
@@ -12,16 +13,21 @@ from hypothesis import strategies as st
 
 from symfruit import Box, InputError, box_iou
 from symfruit.core.fits import (
+    Revolution,
+    closed_profile,
     ellipsoid_half_extents,
     fit_aligned_ellipsoid,
     fit_ellipsoid,
     fit_revolution,
+    fit_revolution_slices,
     fit_sphere,
+    revolution_box,
+    revolution_inside,
     surface_noise,
 )
-from symfruit.shapes import rotation
+from symfruit.shapes import FRUITS, rotation
 
-from ..conftest import CENTRE, fibonacci_sphere, front_half, random_sphere, revolution_cloud
+from ..conftest import CENTRE, ball_mesh, fibonacci_sphere, front_half, random_sphere, rendered_view, revolution_cloud
 
 #: The 30 integer points at distance exactly 5 from the origin: (+-5, 0, 0), (+-3, +-4, 0) and permutations.
 LATTICE_SPHERE = np.array([p for p in itertools.product(range(-5, 6), repeat=3) if sum(v * v for v in p) == 25])
@@ -188,3 +194,60 @@ def test_revolution_needs_one_normal_per_point():
         fit_revolution(visible, normals[:, :2])
     box, _, _ = fit_revolution(visible.tolist(), normals.tolist())
     assert box.contains(visible)
+
+
+# --- solid of revolution from slice circles (no normals) ---------------------------------------------------
+
+
+def test_slice_revolution_finds_the_axis_of_a_tilted_noisy_lemon():
+    fruit = FRUITS["lemon"](np.random.default_rng(0))
+    tilt = rotation(35, 20, -50)
+    visible, posed = rendered_view(fruit, [0.0, 0.0, 0.35], noise=0.01, rotation=tilt, seed=6)
+    rev = fit_revolution_slices(visible[:: max(1, len(visible) // 800)])
+    axis = tilt @ np.array([0.0, 1.0, 0.0])
+    assert np.degrees(np.arccos(min(1.0, abs(axis @ rev.direction)))) < 8.0
+    lo, hi = revolution_box(rev)
+    truth = Box.from_points(posed.vertices)
+    assert np.abs(0.5 * (lo + hi) - truth.centre).max() < 0.005
+
+
+def test_slice_revolution_of_an_exact_solid():
+    visible = front_half(revolution_cloud())
+    rev = fit_revolution_slices(visible)
+    # The search's finest step is a few degrees, and a slice's radius varies within it (a small bias).
+    assert abs(rev.direction @ [0.0, 1.0, 0.0]) > np.cos(np.radians(4.0))
+    np.testing.assert_allclose(rev.point[[0, 2]], CENTRE[[0, 2]], atol=1e-3)
+    assert np.sqrt(rev.cost) < 5e-4
+    assert np.median(revolution_inside(rev, visible)) > -1e-3
+    assert revolution_inside(rev, CENTRE + [0.05, 0.0, 0.0]) < 0
+
+
+def test_an_end_still_widening_is_closed_by_symmetry():
+    """The profile of a ball's front half along the line of sight widens to where the data stop: the unseen
+    half is its mirror image about the widest slice; a profile narrowing at both ends is left as it is."""
+    edges = np.linspace(0.365, 0.40, 8)
+    t = 0.5 * (edges[:-1] + edges[1:])
+    ball = Revolution(np.array([0.0, 0.0, 0.4]), np.array([0.0, 0.0, 1.0]), edges - 0.4,
+                      np.sqrt(np.clip(0.035**2 - (t - 0.4) ** 2, 0, None)), 0.0)  # fmt: skip
+    t_open, _ = closed_profile(ball, close=False)
+    t_closed, r_closed = closed_profile(ball)
+    assert len(t_closed) == 2 * len(t_open) - 1 and np.allclose(r_closed, r_closed[::-1])
+    lo, hi = revolution_box(ball)
+    widest = 0.4 + t_open[-1]
+    assert hi[2] - widest == pytest.approx(widest - lo[2], abs=1e-12) and hi[2] > 0.425
+    lemon = Revolution(np.zeros(3), np.array([0.0, 1.0, 0.0]), np.linspace(-1, 1, 5), np.array([1.0, 2.0, 2.0, 1.0]),
+                       0.0)  # fmt: skip
+    assert len(closed_profile(lemon)[0]) == 4
+
+
+def test_slice_revolution_of_a_noisy_ball_view_reaches_its_back():
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.01, seed=2)
+    _, hi = revolution_box(fit_revolution_slices(visible[::10]))
+    assert hi[2] == pytest.approx(0.435, abs=0.006)
+
+
+def test_slice_revolution_refuses_too_few_points():
+    with pytest.raises(InputError, match="at least 20 points"):
+        fit_revolution_slices(np.zeros((5, 3)))
+    with pytest.raises(InputError, match="shape"):
+        fit_revolution_slices(np.zeros((30, 2)))

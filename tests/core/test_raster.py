@@ -92,3 +92,40 @@ def test_silhouette_coverage_known_answers(camera):
     aside = Box(CENTRE + [0.18, -0.02, -0.02], CENTRE + [0.22, 0.02, 0.02])  # beside the seen window
     assert silhouette_coverage(full, aside, camera) == 0.0
     assert silhouette_coverage(full, Box(np.full(3, np.nan), np.full(3, np.nan)), camera) == 0.0
+
+
+# --- the seen region alone ------------------------------------------------------------------------------
+
+
+def test_silhouette_of_a_dense_view_is_its_pixels(camera):
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, rendered_view
+
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4])
+    region = silhouette(visible, camera, pad=8)
+    assert region.fill_radius == 0.0 and region.mask.sum() == len(visible)
+    rows, cols = np.nonzero(region.mask)
+    assert rows.min() == 8 + 2 and cols.min() == 8 + 2  # the margin: pad + 2 pixels (no gap closing)
+
+
+def test_silhouette_of_a_sparse_cloud_matches_the_rasterised_mask(camera):
+    from symfruit.core.raster import silhouette
+
+    rng = np.random.default_rng(1)
+    d = rng.normal(size=(1200, 3))
+    visible = front_half(0.02 * d / np.linalg.norm(d, axis=1, keepdims=True) + CENTRE)
+    region, view = silhouette(visible, camera, pad=0), rasterise(visible, camera)
+    assert region.fill_radius == pytest.approx(view.fill_radius)
+    assert (region.u0, region.v0) == (view.u0, view.v0) and np.array_equal(region.mask, view.mask)
+
+
+def test_silhouette_window_stops_at_the_image_edge():
+    from symfruit.core.raster import silhouette
+
+    cam = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
+    pts = np.array([[x, y, 0.3] for x in np.linspace(-0.04, -0.03, 25) for y in np.linspace(-0.005, 0.005, 25)])
+    region = silhouette(pts, cam, pad=8)
+    assert region.u0 == 0 and region.mask[:, 0].any()
+    with pytest.raises(InputError, match="no point projects"):
+        silhouette(pts + [1.0, 0.0, 0.0], cam)

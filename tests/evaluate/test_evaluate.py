@@ -35,7 +35,8 @@ def test_quick_paper_run_writes_every_output(quick_paper):
     assert {"strawberry-methods.png", "strawberry-by-angle.png"} <= names
     with (folder / "instances.csv").open() as f:
         rows = list(csv.DictReader(f))
-    assert len(rows) == 28 * 5 and {r["method"] for r in rows} == {"raw", "sphere", "ellipsoid", "paper", "fused"}
+    methods = {"raw", "sphere", "ellipsoid", "superellipsoid", "paper", "fused", "evidence"}
+    assert len(rows) == 28 * len(methods) and {r["method"] for r in rows} == methods
     summary = json.loads((folder / "summary.json").read_text())
     assert summary["settings"]["strawberry"]["paper"]["translations"] == 4 and summary["instances"] == 28
     assert summary["settings"]["strawberry"]["fused"]["revolution"] is True  # the strawberry profile

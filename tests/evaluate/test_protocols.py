@@ -3,7 +3,8 @@
 import numpy as np
 import pytest
 
-from symfruit.evaluate.protocols import PAPER_ANGLES, PAPER_DISTANCE, Spec, build, specs
+from symfruit import DEFAULT_CAMERA
+from symfruit.evaluate.protocols import PAPER_ANGLES, PAPER_DISTANCE, SENSORS, Spec, build, specs
 from symfruit.evaluate.protocols import _inside as inside_polygon
 
 
@@ -72,3 +73,49 @@ def test_the_polygon_test_of_the_occluder():
     square = np.array([[0, 0], [4, 0], [4, 4], [0, 4]], float)
     pts = np.array([[1, 1], [3.9, 0.1], [5, 1], [-1, 2], [2, 4.5]], float)
     assert inside_polygon(square, pts).tolist() == [True, True, False, False, False]
+
+
+def test_the_heldback_sensor_sees_every_pixel_of_the_fruit():
+    from symfruit.render import render
+
+    from ..conftest import ball_mesh
+
+    noise = SENSORS["heldback"].noise
+    assert noise.sigma(0.4) == pytest.approx(0.01 * 0.4**2) and SENSORS["heldback"].distance == (0.30, 0.50)
+    ball = ball_mesh().transformed(np.eye(3), np.array([0.0, 0.0, 0.4]))
+    shot = render([(ball.vertices, ball.faces)], DEFAULT_CAMERA)
+    depth, _ = noise.apply(shot, np.random.default_rng(0))
+    seen = shot.ids == 0
+    assert np.all(depth[seen] > 0) and np.all(depth[~seen] == 0)  # no dropout, not even at the edge
+    z = shot.depth[seen]
+    assert np.std((depth[seen] - z) / (0.01 * z**2)) == pytest.approx(1.0, rel=0.05)
+    d435, _ = SENSORS["d435"].noise.apply(shot, np.random.default_rng(0))
+    assert (d435[seen] == 0).sum() > 0.01 * seen.sum()
+    inst = build(Spec("camera", "apple", 0, 2, sensor="heldback"))
+    assert 0.30 <= inst.distance <= 0.50
+
+
+def test_pose_distributions():
+    uniform = [build(Spec("camera", "lemon", 0, k, poses="uniform")) for k in range(3)]
+    assert all(np.isnan(u.angles[0]) for u in uniform) and len({len(u.visible) for u in uniform}) == 3
+    with pytest.raises(ValueError, match="unknown pose distribution"):
+        Spec("camera", "lemon", 0, 0, poses="sideways")
+    with pytest.raises(ValueError, match="unknown sensor"):
+        Spec("camera", "lemon", 0, 0, sensor="kinect")
+    with pytest.raises(ValueError, match="camera protocol"):
+        Spec("paper", "lemon", 0, 0, poses="uniform")
+    # A generated fruit already hangs stem up: "upright" changes nothing for it.
+    a, b = build(Spec("camera", "pear", 1, 1)), build(Spec("camera", "pear", 1, 1, poses="upright"))
+    assert np.array_equal(a.visible, b.visible)
+
+
+def test_upright_stands_a_scan_up(tmp_path):
+    from symfruit.io import write_ply
+    from symfruit.shapes import FRUITS
+
+    fruit = FRUITS["lemon"](np.random.default_rng(0))  # long axis along y; stood on end: along z in the file
+    write_ply(tmp_path / "lemon.ply", fruit.sample(4000, np.random.default_rng(0))[:, [0, 2, 1]] * [1, 1, -1])
+    lying = build(Spec("paper", str(tmp_path), 0, PAPER_ANGLES.index(0)))
+    upright = build(Spec("paper", str(tmp_path), 0, PAPER_ANGLES.index(0), poses="upright"))
+    assert lying.kind == "scan/lemon"
+    assert np.argmax(upright.truth_box.size) == 1 and np.argmax(lying.truth_box.size) == 2

@@ -25,8 +25,8 @@ def test_paper_table_known_values():
     table = markdown_table(summarise(ROWS), protocol="paper", title="my run")
     lines = table.splitlines()
     assert lines[0] == "# my run" and "## paper protocol: strawberry" in lines and "2 instances." in lines
-    assert "| raw | 0.550 | 0.550 | 9.0 | 9.0 | 1.25 | 0.875 | 1.50 | 0 |" in lines
-    assert "| paper | 0.750 | 0.750 | 4.0 | 4.0 | 1.25 | 0.875 | 1.50 | 1 |" in lines
+    assert "| raw | 0.550 | 0.550 | 9.0 | 9.0 | 10.0 | 0 | 0 | 1.25 | 0.875 | 1.50 | 0 |" in lines
+    assert "| paper | 0.750 | 0.750 | 4.0 | 4.0 | 4.0 | 0 | 0 | 1.25 | 0.875 | 1.50 | 1 |" in lines
     (ri, rc), (pi, pc) = PAPER_TABLE2["raw"], PAPER_TABLE2["paper"]
     assert f"Ge et al. 2020, Table 2 (mean): input points {ri} / {rc} mm, completed {pi} / {pc} mm." in lines
     other = markdown_table(summarise([row("raw", 0.5, 1.0, fruit="/scans/pears")]), protocol="paper")
@@ -37,7 +37,7 @@ def test_failed_groups_print_dashes_and_camera_tables_name_the_occlusion():
     rows = [row("raw", float("nan"), float("nan"), error="x", occlusion=0.25, hidden=0.3)]
     table = markdown_table(summarise(rows), protocol="camera")
     assert "## camera protocol: strawberry, occluder target 25% (hidden 30% on average)" in table
-    assert "| raw | - | - | - | - | - | - | - | 1 |" in table and "Table 2" not in table
+    assert "| raw | - | - | - | - | - | - | - | - | - | - | 1 |" in table and "Table 2" not in table
 
 
 def test_confidence_lines_appear_for_methods_that_estimate_it():

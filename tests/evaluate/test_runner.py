@@ -90,3 +90,21 @@ def test_confidence_statistics():
     assert s["reliable_share"] == pytest.approx(0.6)
     flat = [replace(r, confidence=0.5) for r in rows]
     assert math.isnan(summarise(flat)[0]["spearman"])  # no spread in confidence: no correlation
+
+
+def test_worst_case_statistics():
+    rows = [row(pose=0, iou=0.5, centre_mm=12.0), row(pose=1, iou=0.6, centre_mm=8.0),
+            row("fit", pose=0, iou=0.4, centre_mm=11.0, confidence=0.1), row("fit", pose=1, iou=0.9, centre_mm=1.0,
+                                                                           confidence=0.9, reliable=True)]  # fmt: skip
+    by = {s["method"]: s for s in summarise(rows)}
+    assert (by["raw"]["centre_mm_max"], by["raw"]["over_10mm"], by["raw"]["below_raw"]) == (12.0, 1, 0)
+    assert (by["fit"]["centre_mm_max"], by["fit"]["over_10mm"], by["fit"]["below_raw"]) == (11.0, 1, 1)
+    assert by["fit"]["bad_flagged"] == 1.0  # the one view off by more than 10 mm is flagged unreliable
+    alone = summarise([r for r in rows if r.method == "fit"])
+    assert math.isnan(alone[0]["below_raw"])  # no raw run: nothing to compare with
+
+
+def test_scans_are_grouped_by_scan():
+    rows = [row(fruit="/data/scans", kind="scan/pear", pose=0), row(fruit="/data/scans", kind="scan/banana", pose=1)]
+    assert {s["fruit"] for s in summarise(rows)} == {"scan/pear", "scan/banana"}
+    assert rows[0].label == "scan/pear" and row().label == "apple"

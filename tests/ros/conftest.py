@@ -59,7 +59,7 @@ def example_fruits() -> list:
 
     with example_frame() as folder:
         frame = read_frame(folder)
-    return fruits_of(detect(frame, method="fused", settings=resolve_settings(fruit="strawberry")))
+    return fruits_of(detect(frame, settings=resolve_settings(fruit="strawberry")))
 
 
 @pytest.fixture(scope="session")

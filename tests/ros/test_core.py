@@ -126,7 +126,7 @@ def test_camera_info_ros1_and_ros2_names_and_image_size():
 @pytest.mark.parametrize(("color_encoding", "depth_encoding"), [("rgb8", "16UC1"), ("bgr8", "32FC1")])
 def test_processor_equals_detect_on_the_example_frame(example_images, example_fruits, color_encoding,
                                                       depth_encoding):  # fmt: skip
-    core = FrameProcessor(method="fused", fruit="strawberry")
+    core = FrameProcessor(fruit="strawberry")
     got = core.process(*example_messages(example_images, color_encoding, depth_encoding))
     assert len(got.fruits) == len(example_fruits) > 0
     for a, b in zip(got.fruits, example_fruits, strict=True):

@@ -213,7 +213,7 @@ def ros_world(ros1, tmp_path_factory):
             rospy.Publisher("/camera/color/camera_info", CameraInfo, queue_size=10),
         ]
         env = {**master.env, "PYTHONUNBUFFERED": "1"}
-        cmd = [sys.executable, "-m", "symfruit", "ros", f"__name:={NODE[1:]}", "_method:=fused", "_fruit:=strawberry"]
+        cmd = [sys.executable, "-m", "symfruit", "ros", f"__name:={NODE[1:]}", "_fruit:=strawberry"]
         node = start(cmd, env, log)
         wait_until(lambda: all(p.get_num_connections() > 0 for p in pubs), "the node to subscribe", node, log)
         wait_until(lambda: all(s.get_num_connections() > 0 for s in subs), "the node's topics", node, log)

@@ -1,11 +1,14 @@
 """Shape fits to a fruit's visible points: sphere, ellipsoid (any orientation and camera-aligned), solid
-of revolution, and the surface-noise measure that tells clean scans from depth-camera views.
+of revolution (axis from the normal lines, or from slice circles without normals), and the surface-noise
+measure that tells clean scans from depth-camera views.
 
 Every function takes ``points : (n, 3) float, metres`` first and normalises it (:func:`as_points`), takes
 its options as keywords, and returns arrays; none knows settings objects or files.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.spatial import cKDTree
@@ -15,11 +18,16 @@ from .box import Box
 from .points import as_points
 
 __all__ = [
+    "Revolution",
+    "closed_profile",
     "ellipsoid_half_extents",
     "fit_aligned_ellipsoid",
     "fit_ellipsoid",
     "fit_revolution",
+    "fit_revolution_slices",
     "fit_sphere",
+    "revolution_box",
+    "revolution_inside",
     "surface_noise",
 ]
 
@@ -280,14 +288,249 @@ def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -
     rho = np.linalg.norm((points - a0) - t[:, None] * d, axis=1)
     edges = np.quantile(t, np.linspace(0.0, 1.0, bins + 1))
     which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
-    spread = np.sqrt(np.clip(1.0 - d**2, 0.0, None))
     lo, hi = points.min(axis=0), points.max(axis=0)
+    ring_t, ring_r = [], []
     for j in range(bins):  # a loop over profile slices (24), not over points or hypotheses
         sel = which == j
         if sel.sum() < 3:
             continue
         r = np.quantile(rho[sel], 0.9)
-        for tt in (t[sel].min(), t[sel].max()):
-            ring = a0 + tt * d
-            lo, hi = np.minimum(lo, ring - r * spread), np.maximum(hi, ring + r * spread)
+        ring_t += [t[sel].min(), t[sel].max()]
+        ring_r += [r, r]
+    if ring_t:
+        rlo, rhi = _rings_box(a0, d, np.array(ring_t), np.array(ring_r))
+        lo, hi = np.minimum(lo, rlo), np.maximum(hi, rhi)
     return Box(lo, hi), a0, d
+
+
+def _rings_box(point: np.ndarray, direction: np.ndarray, t: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned box ``(min, max)`` of rings of radius ``r`` (k,) centred on ``point + t direction`` (k,)
+    in the planes perpendicular to ``direction`` (unit): a ring spans ``r sqrt(1 - d_i^2)`` along axis ``i``."""
+    spread = np.sqrt(np.clip(1.0 - direction**2, 0.0, None))
+    centres = point[None, :] + t[:, None] * direction[None, :]
+    return (centres - r[:, None] * spread).min(axis=0), (centres + r[:, None] * spread).max(axis=0)
+
+
+# --- solid of revolution without normals: slice circles ---------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Revolution:
+    """A solid of revolution: axis ``point + t * direction``, radius ``radii[j]`` over slice ``j``.
+
+    Attributes
+    ----------
+    point : (3,) float, metres
+    direction : (3,) float, unit
+    edges : (b + 1,) float, metres
+        Slice borders along the axis (``t``), covering the fitted points.
+    radii : (b,) float, metres
+        Radius of each slice (NaN where a slice had fewer than 3 points).
+    cost : float, metres^2
+        Robust mean squared distance of the points to their slice circles.
+    """
+
+    point: np.ndarray
+    direction: np.ndarray
+    edges: np.ndarray
+    radii: np.ndarray
+    cost: float
+
+
+def _basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors completing each row of ``d`` (k, 3) to an orthonormal basis."""
+    helper = np.where(np.abs(d[:, :1]) < 0.9, np.array([[1.0, 0.0, 0.0]]), np.array([[0.0, 1.0, 0.0]]))
+    e1 = np.cross(d, helper)
+    e1 /= np.linalg.norm(e1, axis=1, keepdims=True)
+    return e1, np.cross(d, e1)
+
+
+def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
+    """Robust cost (k,) of every axis direction ``dirs`` (k, 3) for centred points ``q`` (n, 3).
+
+    For one direction the points, projected on the plane perpendicular to it (coordinates ``w``) and
+    grouped in ``bins`` slices along it, must lie on circles with one common centre ``c``: ``|w|^2 = 2 c . w
+    + (r_j^2 - |c|^2)``. Centring ``|w|^2`` and ``w`` within each slice removes the per-slice offsets and
+    leaves a 2-unknown least-squares problem per direction, solved for all directions at once; the
+    algebraic residual over ``2 rho`` is about the distance to the circle. The lower 80 % of the squared
+    distances count (stems, calyx, flying pixels).
+    """
+    k, n = len(dirs), len(q)
+    e1, e2 = _basis(dirs)
+    t = q @ dirs.T  # (n, k)
+    u = q @ e1.T
+    v = q @ e2.T
+    y = u * u + v * v
+    lo, hi = t.min(axis=0), t.max(axis=0)
+    b = np.minimum(((t - lo) / np.maximum(hi - lo, 1e-12) * bins).astype(np.int64), bins - 1)
+    idx = (b + bins * np.arange(k)[None, :]).ravel()
+    safe = np.maximum(np.bincount(idx, minlength=k * bins), 1).astype(np.float64)
+
+    def centred(x: np.ndarray) -> np.ndarray:
+        mean = np.bincount(idx, weights=x.ravel(), minlength=k * bins) / safe
+        return x - mean[idx].reshape(n, k)
+
+    du, dv, dy = centred(u), centred(v), centred(y)
+    a11, a12, a22 = (du * du).sum(0), (du * dv).sum(0), (dv * dv).sum(0)
+    b1, b2 = (du * dy).sum(0), (dv * dy).sum(0)
+    det = a11 * a22 - a12 * a12
+    det = np.where(np.abs(det) > 1e-30, det, 1e-30)
+    au = 0.5 * (a22 * b1 - a12 * b2) / det
+    av = 0.5 * (a11 * b2 - a12 * b1) / det
+    res = dy - 2.0 * (au[None, :] * du + av[None, :] * dv)
+    rho2 = (u - au[None, :]) ** 2 + (v - av[None, :]) ** 2
+    dist2 = res * res / (4.0 * np.maximum(rho2, 1e-12))
+    keep = max(1, int(0.8 * n))
+    return np.partition(dist2, keep - 1, axis=0)[:keep].mean(axis=0)
+
+
+def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
+    """``direction`` and ``n`` directions within ``spread_deg`` of it (a Fibonacci cap), unit rows, z >= 0."""
+    i = np.arange(n) + 0.5
+    z = 1.0 - (1.0 - np.cos(np.radians(spread_deg))) * i / n
+    r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
+    theta = np.pi * (1.0 + 5**0.5) * i
+    e1, e2 = _basis(direction[None, :])
+    rot = np.stack([e1[0], e2[0], direction], axis=1)
+    out = np.vstack([direction[None, :], np.c_[r * np.cos(theta), r * np.sin(theta), z] @ rot.T])
+    return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
+
+
+_COARSE = _hemisphere(64)
+
+
+def fit_revolution_slices(
+    points: np.ndarray,
+    *,
+    bins: int = 12,
+    profile_bins: int = 16,
+    extra_directions: np.ndarray | None = None,
+    refine_deg: tuple[float, ...] = (12.0, 4.0),
+    refine_n: int = 16,
+    gauss_newton_steps: int = 5,
+    search_points: int = 240,
+) -> Revolution:
+    """Fit a solid of revolution to points seen from one side, without normals.
+
+    A surface of revolution meets every plane perpendicular to its axis in a circle centred on the axis,
+    so the axis direction is the one for which the points, sliced along it, lie on concentric circles
+    (:func:`_slice_costs`, every direction at once). Unlike :func:`fit_revolution` (normal lines), it
+    uses only positions, so it holds up under depth noise that ruins local normals, and a slice needs
+    only an arc of its circle. The search is coarse to fine: ~64 directions over the hemisphere (plus
+    ``extra_directions``), then ``refine_n`` directions within each ``refine_deg``. The axis position is
+    refined by Gauss-Newton on the distances to the slice circles (the algebraic fit of an arc seen
+    from one side is biased towards the arc); the profile is the mean distance to the axis per slice.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, n >= 20
+    bins : int
+        Slices along each candidate direction during the search.
+    profile_bins : int
+        Slices of the final profile.
+    extra_directions : (m, 3) float, optional
+        More candidate directions for the coarse stage (e.g. an ellipsoid fit's axes).
+    refine_deg : tuple of float, degrees
+    refine_n : int
+    gauss_newton_steps : int
+    search_points : int
+        The direction search uses an evenly spread subset of at most this many points.
+
+    Returns
+    -------
+    Revolution
+
+    Raises
+    ------
+    InputError
+        On fewer than 20 finite points.
+    """
+    pts = as_points(points, min_count=1)
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    if len(pts) < 20:
+        raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
+    centre = pts.mean(axis=0)
+    q = pts - centre
+    qs = q[:: max(1, len(q) // search_points)]
+    dirs = _COARSE
+    if extra_directions is not None:
+        extra = np.asarray(extra_directions, dtype=np.float64).reshape(-1, 3)
+        extra = extra / np.linalg.norm(extra, axis=1, keepdims=True)
+        dirs = np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
+    best = dirs[int(np.argmin(_slice_costs(qs, dirs, bins)))]
+    for spread in refine_deg:
+        cand = _cap(best, spread, refine_n)
+        best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
+    e1, e2 = _basis(best[None, :])
+    t = q @ best
+    w = np.c_[q @ e1[0], q @ e2[0]]
+    edges = np.linspace(t.min(), t.max(), profile_bins + 1)
+    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, profile_bins - 1)
+    counts = np.bincount(which, minlength=profile_bins)
+    cnt = np.maximum(counts, 1)
+    # Start: the algebraic axis offset on the profile slices, then Gauss-Newton on rho_i - mean_slice(rho).
+    ww = w - w.mean(axis=0)
+    y = (ww * ww).sum(axis=1)
+    dy = y - (np.bincount(which, weights=y, minlength=profile_bins) / cnt)[which]
+    dw = ww - np.stack([np.bincount(which, weights=ww[:, i], minlength=profile_bins) / cnt for i in range(2)],
+                       axis=1)[which]  # fmt: skip
+    sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
+    a2 = sol + w.mean(axis=0)
+    for _ in range(gauss_newton_steps):
+        diff = w - a2
+        rho = np.maximum(np.linalg.norm(diff, axis=1), 1e-12)
+        jac = -diff / rho[:, None]
+        res = rho - (np.bincount(which, weights=rho, minlength=profile_bins) / cnt)[which]
+        jac = jac - np.stack([np.bincount(which, weights=jac[:, i], minlength=profile_bins) / cnt
+                              for i in range(2)], axis=1)[which]  # fmt: skip
+        step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
+        a2 = a2 + step
+        if np.abs(step).max() < 1e-7:
+            break
+    axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
+    rho = np.linalg.norm(w - a2, axis=1)
+    mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
+    radii = np.where(counts >= 3, mean_r, np.nan)
+    res2 = np.sort((rho - mean_r[which]) ** 2)
+    cost = float(res2[: max(1, int(0.8 * len(res2)))].mean())
+    edges = edges + float(centre @ best - axis_point @ best)
+    return Revolution(axis_point, best, edges, radii, cost)
+
+
+def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Slice positions and radii of a fitted solid, an unseen end closed: ``(t (m,), r (m,))``, metres.
+
+    A fruit's profile closes at both ends. Where the seen profile is still widening when the data stop
+    (its widest slice is the first or the last: the far half of a fruit seen end-on hides behind its
+    widest ring), the missing half is the mirror image of the seen one about that slice. A profile that
+    narrows towards an end, however bluntly, ends there. ``close=False``: the seen profile as it is.
+    """
+    mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
+    ok = np.isfinite(rev.radii)
+    t, r = mid[ok], rev.radii[ok]
+    if len(t) < 2:
+        return np.r_[rev.edges[0], rev.edges[-1]], np.zeros(2)
+    widest = int(np.argmax(r))
+    if close and widest == len(t) - 1:
+        t, r = np.r_[t, 2 * t[-1] - t[:-1][::-1]], np.r_[r, r[:-1][::-1]]
+    elif close and widest == 0:
+        t, r = np.r_[2 * t[0] - t[1:][::-1], t], np.r_[r[1:][::-1], r]
+    return t, r
+
+
+def revolution_box(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Axis-aligned box ``(min (3,), max (3,))``, metres, of a fitted solid (see :func:`closed_profile`)."""
+    t, r = closed_profile(rev, close=close)
+    return _rings_box(rev.point, rev.direction, t, r)
+
+
+def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> np.ndarray:
+    """Signed inside measure of points ``x`` (..., 3): the profile's radius minus the distance to the axis,
+    metres (positive inside; beyond the profile's ends, minus the distance past the end as well)."""
+    t_prof, r_prof = closed_profile(rev, close=close)
+    rel = np.asarray(x, dtype=np.float64) - rev.point
+    t = rel @ rev.direction
+    rho = np.linalg.norm(rel - t[..., None] * rev.direction, axis=-1)
+    r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
+    past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
+    return r - rho - past

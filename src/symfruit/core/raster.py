@@ -1,4 +1,5 @@
-"""Rasterise what the camera saw of one fruit: the visible mask ``Mp`` and the seen depth (section 3.5.2).
+"""Rasterise what the camera saw of one fruit: the visible mask ``Mp`` and the seen depth (section 3.5.2), or
+the seen region alone (:func:`silhouette`).
 
 Only a window of the image around the fruit is rasterised (:mod:`symfruit.rating` answers points
 falling outside it with an upper bound of their distance to the mask).
@@ -16,7 +17,7 @@ from .box import Box
 from .camera import Camera
 from .points import as_points
 
-__all__ = ["MAX_WINDOW_PIXELS", "View", "rasterise", "silhouette_coverage"]
+__all__ = ["MAX_WINDOW_PIXELS", "Silhouette", "View", "rasterise", "silhouette", "silhouette_coverage"]
 
 #: Largest image window one fruit may cover (pixels): 2000 x 2000, far more than any fruit in a
 #: harvesting camera's view; beyond it the intrinsics or the units are wrong (and the buffers would be).
@@ -52,6 +53,109 @@ class View:
     fill_radius: float
 
 
+def _pixels(points: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Pixel column, row and depth of the points that project into the image."""
+    uv = camera.project(points)
+    col = np.rint(uv[:, 0]).astype(np.intp)
+    row = np.rint(uv[:, 1]).astype(np.intp)
+    inside = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
+    if not inside.any():
+        raise InputError(
+            f"no point projects into the {camera.width}x{camera.height} image; "
+            "are the points in the camera's optical frame (z forward) and is this the right camera?"
+        )
+    return col[inside], row[inside], points[inside, 2]
+
+
+def _window(col: np.ndarray, row: np.ndarray, camera: Camera, margin: int) -> tuple[int, int, int, int]:
+    """``(u0, v0, h, w)``: the pixels' box grown by ``margin``, clipped to the image, bounded in size."""
+    c0, c1, r0, r1 = int(col.min()), int(col.max()), int(row.min()), int(row.max())
+    u0, v0 = max(c0 - margin, 0), max(r0 - margin, 0)
+    u1, v1 = min(c1 + margin + 1, camera.width), min(r1 + margin + 1, camera.height)
+    h, w = v1 - v0, u1 - u0
+    if h * w > MAX_WINDOW_PIXELS:
+        raise InputError(
+            f"the visible points span {w}x{h} pixels of the {camera.width}x{camera.height} image, more than one "
+            "fruit can; check the intrinsics and that the points are in metres"
+        )
+    return u0, v0, h, w
+
+
+def _default_fill(col: np.ndarray, row: np.ndarray) -> float:
+    """0.7 sqrt(area / n), ``area`` the ellipse inscribed in the pixels' box: 1.5 times the expected
+    median nearest-neighbour spacing of ``n`` points spread over the silhouette."""
+    area = np.pi / 4.0 * (np.ptp(col) + 1) * (np.ptp(row) + 1)
+    return 0.7 * float(np.sqrt(area / len(col)))
+
+
+def _closed_mask(hit: np.ndarray, half: int) -> np.ndarray:
+    """The marked pixels closed by a square of half-width ``half`` (0: as they are), holes filled."""
+    closed = hit
+    if half > 0:
+        # Closing by a square, as box means: dilation = any hit in the square, erosion = all dilated.
+        # "nearest" keeps a silhouette that the image edge cuts from being eroded there.
+        size = 2 * half + 1
+        weight = ndimage.uniform_filter(hit.astype(np.float32), size=size, mode="constant")
+        dilated = (weight > 1e-6).astype(np.float32)
+        closed = ndimage.uniform_filter(dilated, size=size, mode="nearest") > 1.0 - 1e-3
+        closed |= hit
+    # Fill holes: background components (4-connected) not touching the window's edge.
+    labels, _ = ndimage.label(~closed)
+    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
+    background = np.zeros(labels.max() + 1, dtype=bool)
+    background[edge] = True
+    background[0] = False
+    return ~background[labels]
+
+
+@dataclass(frozen=True)
+class Silhouette:
+    """The region the seen points cover in an image window whose top-left pixel is ``(u0, v0)``.
+
+    Attributes
+    ----------
+    u0, v0 : int
+    mask : (h, w) bool
+    fill_radius : float, pixels
+        Half-width of the square that closed the gaps between points (0: none).
+    """
+
+    u0: int
+    v0: int
+    mask: np.ndarray
+    fill_radius: float
+
+
+def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius: float | None = None) -> Silhouette:
+    """The seen region of one fruit: every point's pixel, gaps between neighbouring points closed, holes
+    filled, in a window ``pad`` pixels wider than the region on every side (clipped to the image).
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, z > 0
+    camera : Camera
+    pad : int, pixels
+        Margin around the region (at least as wide as any band of pixels outside it that is examined).
+    fill_radius : float, pixels, optional
+        Default: as :func:`rasterise` (``0.7 sqrt(area / n)``) for a sparse cloud, and 0 (every pixel as
+        it is) once there is a point for at least every second pixel of the region (a depth camera).
+
+    Raises
+    ------
+    InputError
+        When no point projects into the image.
+    """
+    col, row, _ = _pixels(as_points(points, min_count=1), camera)
+    if fill_radius is None:
+        area = np.pi / 4.0 * (np.ptp(col) + 1) * (np.ptp(row) + 1)
+        fill_radius = _default_fill(col, row) if len(col) < 0.5 * area else 0.0
+    half = int(np.ceil(fill_radius))
+    u0, v0, h, w = _window(col, row, camera, pad + half + 2)
+    hit = np.zeros((h, w), dtype=bool)
+    hit[row - v0, col - u0] = True
+    return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
+
+
 def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:
     """Rasterise visible points into a mask and a seen-depth map at the camera's resolution.
 
@@ -76,55 +180,24 @@ def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None =
         When no point projects into the image.
     """
     points = as_points(points, min_count=1)
-    uv = camera.project(points)
-    col = np.rint(uv[:, 0]).astype(np.intp)
-    row = np.rint(uv[:, 1]).astype(np.intp)
-    inside = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
-    if not inside.any():
-        raise InputError(
-            f"no point projects into the {camera.width}x{camera.height} image; "
-            "are the points in the camera's optical frame (z forward) and is this the right camera?"
-        )
-    col, row, z = col[inside], row[inside], points[inside, 2]
-    c0, c1, r0, r1 = int(col.min()), int(col.max()), int(row.min()), int(row.max())
+    col, row, z = _pixels(points, camera)
     if fill_radius is None:
-        area = np.pi / 4.0 * (c1 - c0 + 1) * (r1 - r0 + 1)
-        fill_radius = max(1.0, 0.7 * float(np.sqrt(area / len(col))))
+        fill_radius = max(1.0, _default_fill(col, row))
     half = int(np.ceil(fill_radius))
-    pad = half + 2
-    u0, v0 = max(c0 - pad, 0), max(r0 - pad, 0)
-    u1, v1 = min(c1 + pad + 1, camera.width), min(r1 + pad + 1, camera.height)
-    h, w = v1 - v0, u1 - u0
-    if h * w > MAX_WINDOW_PIXELS:
-        raise InputError(
-            f"the visible points span {w}x{h} pixels of the {camera.width}x{camera.height} image, more than one "
-            "fruit can; check the intrinsics and that the points are in metres"
-        )
+    u0, v0, h, w = _window(col, row, camera, half + 2)
     flat = (row - v0) * w + (col - u0)
 
     flat_z = np.full(h * w, np.inf)
     np.minimum.at(flat_z, flat, z)
     zbuf = flat_z.reshape(h, w)
     hit = np.isfinite(zbuf)
-
-    # Closing by a square, as box means: dilation = any hit in the square, erosion = all dilated.
-    # "nearest" keeps a silhouette that the image edge cuts from being eroded there.
-    size = 2 * half + 1
-    hit32 = hit.astype(np.float32)
-    weight = ndimage.uniform_filter(hit32, size=size, mode="constant")
-    dilated = (weight > 1e-6).astype(np.float32)
-    closed = ndimage.uniform_filter(dilated, size=size, mode="nearest") > 1.0 - 1e-3
-    closed |= hit
-    # Fill holes: background components (4-connected) not touching the window's edge.
-    labels, _ = ndimage.label(~closed)
-    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
-    background = np.zeros(labels.max() + 1, dtype=bool)
-    background[edge] = True
-    background[0] = False
-    mask = ~background[labels]
+    mask = _closed_mask(hit, half)
 
     # Seen depth on the mask: marked pixels keep theirs, the others the mean of the marked pixels in
     # the same square (tripled in size until every mask pixel has one, or at worst the median).
+    size = 2 * half + 1
+    hit32 = hit.astype(np.float32)
+    weight = ndimage.uniform_filter(hit32, size=size, mode="constant")
     seed = np.where(hit, zbuf, 0.0).astype(np.float32)
     depth = seed.copy()
     todo = mask & ~hit

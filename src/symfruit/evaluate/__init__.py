@@ -36,10 +36,12 @@ def evaluate(
     *,
     protocol: str = "paper",
     fruits: Sequence[str] = ("strawberry",),
-    methods: Sequence[str] = ("raw", "sphere", "ellipsoid", "paper", "fused"),
+    methods: Sequence[str] = ("raw", "sphere", "ellipsoid", "superellipsoid", "paper", "fused", "evidence"),
     n: int | None = None,
     seed: int = 0,
     occlusions: Sequence[float] = (0.0,),
+    sensor: str = "d435",
+    poses: str = "hanging",
     quick: bool = False,
     settings: Settings | None = None,
     config: Path | None = None,
@@ -50,8 +52,11 @@ def evaluate(
     """Run a protocol for some fruit kinds (or scan folders) and methods; write the results.
 
     ``n`` is the number of fruits (``paper``: each in 19 poses; default 10, as in the paper) or of
-    views per occlusion level (``camera``; default 100). Results go to a new timestamped folder under
-    ``output`` with a ``latest`` link to it; ``output=None`` writes nothing.
+    views per occlusion level (``camera``; default 100). ``sensor`` and ``poses`` choose the camera
+    protocol's sensor model and pose distribution (:data:`~symfruit.evaluate.protocols.SENSORS`,
+    :data:`~symfruit.evaluate.protocols.POSES`; ``poses="upright"`` also stands scans up in the paper
+    protocol). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
+    ``output=None`` writes nothing. Tables have a row per fruit kind, and per scan of a scan folder.
 
     Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
     (:mod:`symfruit.profiles`), with the settings file ``config`` laid over it.
@@ -69,21 +74,29 @@ def evaluate(
         n = QUICK[protocol]["n"] if quick else (10 if protocol == "paper" else 100)
     rows, all_specs, used = [], [], {}
     for fruit in fruits:
-        these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions))
+        these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions), sensor=sensor,
+                      poses=poses)  # fmt: skip
         used[fruit] = settings_for(fruit)
         rows += run(these, methods, used[fruit], jobs=jobs, progress=progress)
         all_specs += these
     summary = summarise(rows)
     pooled = [s for s in summarise(rows, by=("fruit", "method")) if s.get("spearman") == s.get("spearman")]
     title = f"symfruit evaluation: {protocol} protocol"
+    if protocol == "camera":
+        title += f", {sensor} sensor, {poses} poses"
+    elif poses != "hanging":
+        title += f", {poses} scans"
     table = markdown_table(summary, protocol=protocol, title=title)
     if pooled:
         table += "\n## Confidence over all instances of a fruit (every occlusion level)\n\n"
         table += "| fruit | method | Spearman (confidence, centre dev) | centre dev (mm): all "
-        table += "| 80 % most confident | reliable |\n|---|---|---|---|---|---|\n"
+        table += "| 80 % most confident | reliable | views > 10 mm flagged unreliable |\n"
+        table += "|---|---|---|---|---|---|---|\n"
         for s in pooled:
+            flagged = "-" if s["bad_flagged"] != s["bad_flagged"] else f"{s['bad_flagged']:.0%} of {s['over_10mm']}"
             table += f"| {Path(str(s['fruit'])).name} | {s['method']} | {s['spearman']:.2f} "
-            table += f"| {s['centre_mm_mean']:.1f} | {s['centre_mm_top80']:.1f} | {s['reliable_share']:.0%} |\n"
+            table += f"| {s['centre_mm_mean']:.1f} | {s['centre_mm_top80']:.1f} | {s['reliable_share']:.0%} "
+            table += f"| {flagged} |\n"
     folder = None
     if output is not None:
         from .. import __version__
@@ -93,7 +106,8 @@ def evaluate(
 
         meta = {
             "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
-            "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "quick": quick,
+            "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "sensor": sensor,
+            "poses": poses, "quick": quick,
             "instances": len(all_specs), "settings": {f: s.to_dict() for f, s in used.items()},
         }  # fmt: skip
         from ..io import write_json

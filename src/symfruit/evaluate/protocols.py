@@ -8,12 +8,37 @@
     camera. Truth: the box of the 600 points in the same pose (the paper's "3D position of randomly
     chosen points").
 ``camera``
-    What a D435 on a harvester sees: the fruit's mesh rendered with a z-buffer at the camera's
-    resolution, random pose (about x within +-45 deg, about y any angle, about z within +-45 deg: hanging
-    fruit, never upside down), distance 0.25-0.6 m, anywhere in the image where the whole fruit is in
-    view, D435-like depth noise (:class:`~symfruit.render.SensorNoise`), and optionally a leaf-like
-    occluder in front hiding a set share of the fruit's silhouette. Truth: the box of the whole mesh in
-    the same pose.
+    What a depth camera on a harvester sees: the fruit's mesh rendered with a z-buffer at the camera's
+    resolution, in a random pose (:data:`POSES`), at a random distance within the sensor's working range,
+    anywhere in the image where the whole fruit is in view, through a sensor model (:data:`SENSORS`), and
+    optionally a leaf-like occluder in front hiding a set share of the fruit's silhouette. Truth: the box
+    of the whole mesh in the same pose.
+
+A fruit is a generated kind (:data:`symfruit.shapes.FRUITS`) or a scan of a folder of meshes
+(:func:`symfruit.shapes.load_scans`, e.g. the YCB scans of ``../shared/data/real-scans``).
+
+Sensor models (``--sensor``):
+
+``d435`` (default)
+    A D435-like camera as the repository has always modelled it (:class:`~symfruit.render.SensorNoise`
+    defaults): axial noise 1 mm at 0.3 m growing with the square of the depth, 0.3 px lateral jitter, half
+    of the silhouette's edge pixels and 60 % of grazing pixels dropped, 1 % random dropout; 0.25-0.60 m.
+``heldback``
+    The measurement of issue 11 (the held-back real scans): 640x480, ``fx = fy = 615``, axial noise of
+    standard deviation ``0.01 z^2`` metres, 0.3 px lateral jitter, one point per fruit pixel, no dropout;
+    0.30-0.50 m.
+
+Pose distributions (``--pose``):
+
+``hanging`` (default)
+    About x within +-45 deg, about y any angle, about z within +-45 deg, applied to the fruit in its own
+    frame: a generated fruit hangs stem up (its stem end is at -y), a scan keeps the frame of its file
+    (the YCB scans stand on a table, z up, so the camera looks at them from below or above).
+``upright``
+    As ``hanging``, but a scan is first stood up like a generated fruit (its file's +z turned to -y, up
+    in the image); generated fruit are unchanged.
+``uniform``
+    A rotation drawn uniformly over all orientations (camera protocol only).
 
 Instances are described by small :class:`Spec` tuples and built deterministically from them, so
 that worker processes build their own and the same seed always gives the same instances.
@@ -31,7 +56,7 @@ from ..core.camera import DEFAULT_CAMERA, Camera
 from ..render import SensorNoise, render
 from ..shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
-__all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "Instance", "Spec", "build", "specs"]
+__all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
 
 #: Distance of the fruit's centre from the camera in the ``paper`` protocol (metres). The paper does
 #: not give one (its rule needs none); 0.3 m is a typical harvester working distance.
@@ -44,6 +69,34 @@ _KIND_IDS = {kind: i for i, kind in enumerate(FRUITS)}
 
 
 @dataclass(frozen=True)
+class Sensor:
+    """A camera setup of the ``camera`` protocol: the depth sensor's model and its working distances.
+
+    Attributes
+    ----------
+    noise : SensorNoise
+    distance : (float, float), metres
+        The fruit's box centre is drawn uniformly this far from the camera.
+    """
+
+    noise: SensorNoise
+    distance: tuple[float, float]
+
+
+#: The sensor models of the ``camera`` protocol (see the module docstring).
+SENSORS: dict[str, Sensor] = {
+    "d435": Sensor(SensorNoise(), (0.25, 0.60)),
+    "heldback": Sensor(
+        SensorNoise(axial_at_03=0.0009, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0), (0.30, 0.50)
+    ),
+}
+#: The pose distributions (see the module docstring).
+POSES = ("hanging", "upright", "uniform")
+#: A scan stood up: its file's +z (YCB: up) becomes the optical frame's -y (up in the image).
+UPRIGHT = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])
+
+
+@dataclass(frozen=True)
 class Spec:
     """What identifies one instance: build it with :func:`build`."""
 
@@ -53,6 +106,16 @@ class Spec:
     pose: int  # which pose (paper: index into PAPER_ANGLES; camera: the view number)
     occlusion: float = 0.0  # target hidden share of the silhouette (camera protocol)
     seed: int = 0
+    sensor: str = "d435"  # a key of SENSORS (camera protocol)
+    poses: str = "hanging"  # a pose distribution of POSES
+
+    def __post_init__(self) -> None:
+        if self.sensor not in SENSORS:
+            raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join(SENSORS)}")
+        if self.poses not in POSES:
+            raise ValueError(f"unknown pose distribution {self.poses!r}; known: {', '.join(POSES)}")
+        if self.protocol == "paper" and self.poses == "uniform":
+            raise ValueError("the paper protocol has its own 19 poses; --pose uniform is for the camera protocol")
 
 
 @dataclass(frozen=True)
@@ -73,17 +136,20 @@ class Instance:
 
 def specs(
     protocol: str, fruit: str, *, n: int, seed: int = 0, angles: tuple[int, ...] = PAPER_ANGLES,
-    occlusions: tuple[float, ...] = (0.0,),
+    occlusions: tuple[float, ...] = (0.0,), sensor: str = "d435", poses: str = "hanging",
 ) -> list[Spec]:  # fmt: skip
     """All instance specs of a protocol: ``n`` fruits x the 19 poses (paper) or ``n`` views per
-    occlusion level (camera); for a scan folder, ``n`` is capped by the number of scans."""
+    occlusion level (camera; the views of a scan folder go round its scans); for a scan folder, the
+    paper protocol's ``n`` is capped by the number of scans."""
     if protocol == "paper":
         if fruit not in FRUITS:
             n = min(n, len(_scans(fruit)))
-        return [Spec("paper", fruit, i, PAPER_ANGLES.index(a), 0.0, seed) for i in range(n) for a in angles]
+        return [Spec("paper", fruit, i, PAPER_ANGLES.index(a), 0.0, seed, sensor, poses) for i in range(n)
+                for a in angles]  # fmt: skip
     if protocol == "camera":
         count = len(_scans(fruit)) if fruit not in FRUITS else None
-        return [Spec("camera", fruit, i % count if count else i, i, occ, seed) for occ in occlusions for i in range(n)]
+        return [Spec("camera", fruit, i % count if count else i, i, occ, seed, sensor, poses) for occ in occlusions
+                for i in range(n)]  # fmt: skip
     raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
 
 
@@ -96,7 +162,19 @@ def _fruit(spec: Spec) -> Fruit:
     if spec.fruit in FRUITS:
         rng = np.random.default_rng([spec.seed, _KIND_IDS[spec.fruit], spec.index])
         return FRUITS[spec.fruit](rng)
-    return _scans(spec.fruit)[spec.index]
+    scan = _scans(spec.fruit)[spec.index]
+    return scan.transformed(UPRIGHT, np.zeros(3)) if spec.poses == "upright" else scan
+
+
+def _uniform_rotation(rng: np.random.Generator) -> np.ndarray:
+    """(3, 3) rotation drawn uniformly from SO(3): a normalised Gaussian quaternion."""
+    q = rng.normal(size=4)
+    w, x, y, z = q / np.linalg.norm(q)
+    return np.array([
+        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+    ])  # fmt: skip
 
 
 def build(spec: Spec, camera: Camera = DEFAULT_CAMERA) -> Instance:
@@ -121,16 +199,19 @@ def _paper(spec: Spec) -> Instance:
     )  # fmt: skip
 
 
-_NOISE = SensorNoise()
-
-
-def _camera(spec: Spec, camera: Camera, noise: SensorNoise = _NOISE) -> Instance:
+def _camera(spec: Spec, camera: Camera) -> Instance:
     fruit = _fruit(spec)
+    sensor = SENSORS[spec.sensor]
+    noise = sensor.noise
     rng = np.random.default_rng([spec.seed, 2000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
                                  round(spec.occlusion * 1000)])  # fmt: skip
-    angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
-    rot = rotation(*angles)
-    distance = float(rng.uniform(0.25, 0.60))
+    if spec.poses == "uniform":
+        rot = _uniform_rotation(rng)
+        angles = (float("nan"),) * 3
+    else:
+        angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
+        rot = rotation(*angles)
+    distance = float(rng.uniform(*sensor.distance))
     radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
     # Anywhere in the image where the whole fruit stays in view (a 10-pixel margin).
     half_u = (camera.width / 2 - 10) * distance / camera.fx - radius

@@ -22,7 +22,11 @@ PAPER_TABLE2 = {"raw": (0.56, 14.1), "paper": (0.77, 6.9)}
 PAPER_TABLE3 = {"raw": (0.47, 8.9), "paper": (0.61, 5.7)}
 
 
-def _f(value: float, digits: int) -> str:
+def _count(value: Any) -> str:
+    return "-" if value is None or isinstance(value, float) else str(value)
+
+
+def _f(value: float | None, digits: int) -> str:
     return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.{digits}f}"
 
 
@@ -39,14 +43,15 @@ def markdown_table(summary: Sequence[dict[str, Any]], *, protocol: str, title: s
             heading += f", occluder target {occlusion:.0%} (hidden {hidden:.0%} on average)"
         lines += [heading, "", f"{n} instances.", ""]
         lines += [
-            "| method | IoU mean | IoU median | centre dev mean (mm) | centre dev median (mm) "
-            "| Chamfer (mm) | F1 @ 5 mm | ms / fruit | failed |",
-            "|---|---|---|---|---|---|---|---|---|",
+            "| method | IoU mean | IoU median | centre dev mean (mm) | centre dev median (mm) | worst (mm) "
+            "| views > 10 mm | below raw | Chamfer (mm) | F1 @ 5 mm | ms / fruit | failed |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|",
         ]
         for s in rows:
             lines.append(
                 f"| {s['method']} | {_f(s['iou_mean'], 3)} | {_f(s['iou_median'], 3)} "
-                f"| {_f(s['centre_mm_mean'], 1)} | {_f(s['centre_mm_median'], 1)} "
+                f"| {_f(s['centre_mm_mean'], 1)} | {_f(s['centre_mm_median'], 1)} | {_f(s.get('centre_mm_max'), 1)} "
+                f"| {_count(s.get('over_10mm'))} | {_count(s.get('below_raw'))} "
                 f"| {_f(s['chamfer_mm_mean'], 2)} | {_f(s['f1_mean'], 3)} "
                 f"| {_f(s['ms_median'], 2)} | {s['failed']} |"
             )
@@ -84,8 +89,12 @@ def write_results(
         writer.writerow({k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in row.to_dict().items()})
     with atomic_write(folder / "instances.csv", "w") as handle:
         handle.write(buf.getvalue())
-    clean = [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()} for s in summary]
-    write_json(folder / "summary.json", {**meta, "summary": clean})
+
+    def clean(rows: Sequence[dict[str, Any]]) -> list[dict[str, Any]]:
+        return [{k: (None if isinstance(v, float) and math.isnan(v) else v) for k, v in s.items()} for s in rows]
+
+    meta = {**meta, "confidence": clean(meta["confidence"])} if "confidence" in meta else meta
+    write_json(folder / "summary.json", {**meta, "summary": clean(summary)})
     if table is None:
         table = markdown_table(summary, protocol=protocol, title=meta.get("title", ""))
     with atomic_write(folder / "table.md", "w") as handle:

@@ -19,6 +19,9 @@ from .protocols import Spec, build
 
 __all__ = ["Row", "run"]
 
+#: A view is badly off when its centre deviation exceeds this (mm): the worst-case columns count them.
+BAD_MM = 10.0
+
 #: Columns of the per-instance CSV, in order.
 COLUMNS = (
     "protocol", "fruit", "kind", "fruit_index", "pose", "angle_x", "angle_y", "angle_z", "distance_m",
@@ -57,6 +60,16 @@ class Row:
 
     def to_dict(self) -> dict[str, Any]:
         return {c: getattr(self, c) for c in COLUMNS}
+
+    @property
+    def label(self) -> str:
+        """What tables group by: the fruit kind, or the scan (``scan/016_pear``) of a scan folder."""
+        return self.kind if self.kind.startswith("scan/") else self.fruit
+
+    @property
+    def instance(self) -> tuple[Any, ...]:
+        """What identifies the instance (the same for every method run on it)."""
+        return (self.protocol, self.fruit, self.fruit_index, self.pose, self.occlusion)
 
 
 def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
@@ -137,25 +150,37 @@ def _single_thread() -> None:
 
 
 def _confidence_stats(rows: Sequence[Row]) -> dict[str, Any]:
-    """How well confidence predicts the centre error: Spearman rank correlation (negative is good) and
-    the mean centre error of the 80 % most confident fruit (what a robot skipping the rest would get)."""
+    """How well confidence predicts the centre error: Spearman rank correlation (negative is good), the
+    mean centre error of the 80 % most confident fruit (what a robot skipping the rest would get), the
+    share flagged reliable, and the share of badly-off views (> :data:`BAD_MM`) flagged unreliable."""
     conf = np.array([r.confidence for r in rows], dtype=float)
     err = np.array([r.centre_mm for r in rows], dtype=float)
-    if len(conf) < 3 or not np.isfinite(conf).all():
-        return {"spearman": float("nan"), "centre_mm_top80": float("nan"), "reliable_share": float("nan")}
+    nan = float("nan")
+    if not len(conf) or not np.isfinite(conf).all():
+        return {"spearman": nan, "centre_mm_top80": nan, "reliable_share": nan, "bad_flagged": nan}
+    bad = err > BAD_MM
+    flagged = float(np.mean([not r.reliable for r, b in zip(rows, bad, strict=True) if b])) if bad.any() else nan
+    stats = {"reliable_share": float(np.mean([r.reliable for r in rows])), "bad_flagged": flagged}
+    if len(conf) < 3:
+        return {**stats, "spearman": nan, "centre_mm_top80": nan}
     from scipy.stats import spearmanr
 
-    rho = spearmanr(conf, err).statistic if np.ptp(conf) > 0 else float("nan")
+    rho = spearmanr(conf, err).statistic if np.ptp(conf) > 0 else nan
     keep = conf >= np.quantile(conf, 0.2)
-    return {"spearman": float(rho), "centre_mm_top80": float(err[keep].mean()),
-            "reliable_share": float(np.mean([r.reliable for r in rows]))}  # fmt: skip
+    return {**stats, "spearman": float(rho), "centre_mm_top80": float(err[keep].mean())}
 
 
 def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion", "method")) -> list[dict[str, Any]]:
-    """Mean and median metrics per group (failed runs counted, left out of the statistics)."""
+    """Mean and median metrics per group (failed runs counted, left out of the statistics).
+
+    ``fruit`` groups by :attr:`Row.label` (a scan folder's rows by scan). Worst cases: ``centre_mm_max``,
+    ``over_10mm`` (views off by more than :data:`BAD_MM`) and ``below_raw`` (views whose IoU is below the
+    ``raw`` box's on the same instance; NaN when ``raw`` was not run).
+    """
+    raw = {r.instance: r.iou for r in rows if r.method == "raw" and not r.error}
     groups: dict[tuple, list[Row]] = {}
     for row in rows:
-        groups.setdefault(tuple(getattr(row, k) for k in by), []).append(row)
+        groups.setdefault(tuple(row.label if k == "fruit" else getattr(row, k) for k in by), []).append(row)
     summary = []
     for key, members in groups.items():
         ok = [r for r in members if not r.error]
@@ -165,6 +190,11 @@ def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion",
             values = np.array([getattr(r, metric) for r in ok], dtype=float)
             stats[f"{metric}_mean"] = float(values.mean()) if len(values) else float("nan")
             stats[f"{metric}_median"] = float(np.median(values)) if len(values) else float("nan")
+        centre = np.array([r.centre_mm for r in ok], dtype=float)
+        stats["centre_mm_max"] = float(centre.max()) if len(centre) else float("nan")
+        stats["over_10mm"] = int((centre > BAD_MM).sum()) if ok else float("nan")
+        below = [r.method != "raw" and r.iou < raw[r.instance] - 1e-9 for r in ok if r.instance in raw]
+        stats["below_raw"] = int(sum(below)) if len(below) == len(ok) and ok else float("nan")
         secs = np.array([r.seconds for r in ok], dtype=float)
         stats["ms_median"] = float(np.median(secs) * 1000) if len(secs) else float("nan")
         stats["hidden_mean"] = float(np.mean([r.hidden for r in members]))

@@ -5,7 +5,21 @@ Importing this package registers the built-in methods; :mod:`.registry` holds th
 
 from __future__ import annotations
 
-from . import ellipsoid, fused, paper, raw, sphere
-from .registry import Completion, MethodInfo, available, get, register
+from . import ellipsoid, evidence, fused, paper, raw, sphere, superellipsoid
+from .registry import DEFAULT_METHOD, Completion, MethodInfo, available, get, register
 
-__all__ = ["Completion", "MethodInfo", "available", "ellipsoid", "fused", "get", "paper", "raw", "register", "sphere"]
+__all__ = [
+    "DEFAULT_METHOD",
+    "Completion",
+    "MethodInfo",
+    "available",
+    "ellipsoid",
+    "evidence",
+    "fused",
+    "get",
+    "paper",
+    "raw",
+    "register",
+    "sphere",
+    "superellipsoid",
+]

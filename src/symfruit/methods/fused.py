@@ -1,4 +1,5 @@
-"""``fused``: the default method. A shape fit and symmetric completion fused by the data's noise level.
+"""``fused``: the previous default method (kept for the comparison tables; the default is now ``evidence``).
+A shape fit and symmetric completion fused by the data's noise level.
 
 Why: a least-squares sphere is excellent for round fruit and poor for elongated ones; the paper's
 mirror completion handles any symmetric shape but samples planes coarsely; a general ellipsoid fits
@@ -53,7 +54,7 @@ __all__ = ["FusedSettings"]
 
 @dataclass(frozen=True)
 class FusedSettings(Section):
-    """Settings of the default ``fused`` method; fruit profiles set these.
+    """Settings of the ``fused`` method (the previous default); fruit profiles set these.
 
     Attributes
     ----------

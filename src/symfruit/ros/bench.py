@@ -26,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from ..methods import DEFAULT_METHOD
+
 __all__ = ["bench_node", "main"]
 
 #: The node's per-frame log line: total, detect, node overhead and its parts (ms).
@@ -77,7 +79,12 @@ def _example_messages(stamp, images=None):
 
 
 def bench_node(
-    frames: int = 30, *, rate: float = 30.0, method: str = "fused", fruit: str = "strawberry", timeout: float = 120.0
+    frames: int = 30,
+    *,
+    rate: float = 30.0,
+    method: str = DEFAULT_METHOD,
+    fruit: str = "strawberry",
+    timeout: float = 120.0,
 ) -> dict:
     """Run the three measurements; returns their statistics in milliseconds (and fps, drops)."""
     from .core import FrameProcessor
@@ -229,7 +236,7 @@ def main(argv=None) -> int:
     parser = argparse.ArgumentParser(prog="python -m symfruit.ros.bench", description=__doc__.splitlines()[0])
     parser.add_argument("--frames", type=int, default=30)
     parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
-    parser.add_argument("--method", default="fused")
+    parser.add_argument("--method", default=DEFAULT_METHOD)
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
     args = parser.parse_args(argv)
     res = bench_node(args.frames, rate=args.rate, method=args.method)

@@ -30,6 +30,7 @@ from ..detect import FrameDetections, detect
 from ..errors import InputError
 from ..frame import Frame
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
+from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
 from ..settings import resolve_settings
 from ..writers import bbox_record
@@ -157,7 +158,7 @@ class FrameProcessor:
     def __init__(
         self,
         *,
-        method: str = "fused",
+        method: str = DEFAULT_METHOD,
         fruit: str | None = "strawberry",
         config: str | Path | None = None,
         masks: str = "auto",

@@ -34,6 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import SymfruitError
+from ..methods import DEFAULT_METHOD
 from .core import FrameProcessor, Fruit, LatestOnly
 
 __all__ = ["DEFAULT_TOPICS", "SymfruitNode", "main"]
@@ -183,7 +184,7 @@ class SymfruitNode:
         self.vision_msgs = load_vision_msgs()
         param = rospy.get_param
         self.core = FrameProcessor(
-            method=str(param("~method", "fused")),
+            method=str(param("~method", "")) or DEFAULT_METHOD,
             fruit=str(param("~fruit", "strawberry")) or None,
             config=str(param("~config", "")) or None,
             masks=str(param("~masks", "auto")),

@@ -1,0 +1,197 @@
+"""Candidate completions of one view, each with its box and how well it explains the view.
+
+Every candidate is a different assumption about the hidden side:
+
+``sphere``
+    a ball (least-squares sphere, geometric refinement);
+``ellipsoid``
+    a general ellipsoid (Li-Griffiths, any orientation);
+``revolution``
+    a solid of revolution (:func:`symfruit.core.fits.fit_revolution_slices`): its axis from slice circles,
+    its profile from the seen arcs, an end left unseen closed by symmetry about the widest slice;
+``mirror``
+    the paper's mirror symmetry (:func:`symfruit.core.symmetry.complete_by_symmetry`), optional;
+``raw``
+    nothing hidden: the box of what was seen.
+
+Closed candidates (sphere, ellipsoid, solid of revolution) are measured against the view by
+:func:`symfruit.core.evidence.explain`. All boxes share the front depth estimated from the data
+(:func:`symfruit.core.front.apex_depth`) and otherwise contain every seen point.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError
+from .camera import Camera
+from .evidence import Evidence, Inside, Observation, explain
+from .fits import (
+    ellipsoid_half_extents,
+    fit_ellipsoid,
+    fit_revolution_slices,
+    fit_sphere,
+    revolution_box,
+    revolution_inside,
+)
+from .points import as_points
+from .raster import View
+from .symmetry import complete_by_symmetry
+
+__all__ = ["Candidate", "candidates", "constrain_box"]
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One completion hypothesis.
+
+    Attributes
+    ----------
+    name : str
+    lo, hi : (3,) float, metres
+        Its box (see :func:`constrain_box`).
+    evidence : Evidence or None
+        How it explains the view (closed candidates only).
+    centre : (3,) float, metres
+        Its own centre estimate (the shape's centre; the box centre for mirror and raw).
+    """
+
+    name: str
+    lo: np.ndarray
+    hi: np.ndarray
+    evidence: Evidence | None
+    centre: np.ndarray
+
+
+def constrain_box(
+    lo: np.ndarray,
+    hi: np.ndarray,
+    seen_lo: np.ndarray,
+    seen_hi: np.ndarray,
+    front: float,
+    *,
+    cone: tuple[tuple[float, float, float, float], Camera] | None = None,
+    contour: float = 1.0,
+) -> tuple[np.ndarray, np.ndarray]:
+    """A candidate's box made consistent with the view: ``(lo (3,), hi (3,))``, metres.
+
+    1. joined with the seen points' box, its front face set to ``front``;
+    2. no face beyond ``2 / contour`` times the seen extent from the opposite seen face: a camera's view
+       of a convex fruit shows at least half its extent along every axis (front to rim in depth, the
+       whole silhouette across); where the seen edge is partly a cut (``contour`` < 1) less may be seen
+       (this only stops runaway fits);
+    3. with ``cone = ((u_min, v_min, u_max, v_max), camera)``, the silhouette's pixel box: lateral faces
+       beyond the silhouette's viewing cone (widest over the box's depth range) are pulled back, by the
+       share ``contour`` (the whole fruit projects inside its silhouette, as far as its edge is a contour).
+    """
+    seen_lo = np.r_[seen_lo[:2], front]
+    seen_hi = np.maximum(seen_hi, seen_lo)
+    reach = 2.0 / max(contour, 0.25) * (seen_hi - seen_lo)
+    lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)
+    hi = np.maximum(np.minimum(np.asarray(hi, dtype=np.float64), seen_lo + reach), seen_hi)
+    lo[2] = front
+    hi[2] = max(hi[2], front + 1e-4)
+    if cone is not None:
+        (u_lo, v_lo, u_hi, v_hi), camera = cone
+        zs = np.array([lo[2], hi[2]])
+        bound_lo = np.array([((u_lo - camera.cx) / camera.fx * zs).min(), ((v_lo - camera.cy) / camera.fy * zs).min()])
+        bound_hi = np.array([((u_hi - camera.cx) / camera.fx * zs).max(), ((v_hi - camera.cy) / camera.fy * zs).max()])
+        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + contour * np.maximum(bound_lo - lo[:2], 0.0))
+        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - contour * np.maximum(hi[:2] - bound_hi, 0.0))
+    return lo, hi
+
+
+def candidates(
+    points: np.ndarray,
+    *,
+    sample: np.ndarray,
+    obs: Observation,
+    camera: Camera,
+    front: float,
+    mirror: Mapping[str, Any] | None = None,
+    view: View | None = None,
+    revolution_points: int = 600,
+    steps: int = 24,
+) -> list[Candidate]:
+    """Fit and measure every candidate of one view.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres
+        All seen points (their box bounds every candidate's box).
+    sample : (m, 3) float, metres
+        A spread subset the shapes are fitted to.
+    obs : Observation
+        The view reduced for :func:`~symfruit.core.evidence.explain`.
+    camera : Camera
+    front : float, metres
+        The shared front depth (nearest surface point).
+    mirror : mapping, optional
+        Keyword options of :func:`~symfruit.core.symmetry.complete_by_symmetry` for the mirror candidate
+        (fitted to ``sample``); None leaves it out.
+    view : View, optional
+        ``sample`` rasterised, for the mirror candidate (made when needed).
+    revolution_points : int
+        The solid of revolution is fitted to at most this many points of ``sample``.
+    steps : int
+        Ray-march steps of the evidence.
+
+    Returns
+    -------
+    list of Candidate, in the order sphere, ellipsoid, revolution, [mirror,] raw (a shape whose fit fails
+    or runs away is left out).
+    """
+    points = as_points(points, min_count=4)
+    sample = as_points(sample, min_count=4, name="sample")
+    seen_lo, seen_hi = points.min(axis=0), points.max(axis=0)
+    extent = float((seen_hi - seen_lo).max())
+    uv = camera.project(points[:: max(1, len(points) // 4000)])
+    cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
+    out: list[Candidate] = []
+
+    def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray) -> None:
+        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
+        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
+            return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
+        ev = explain(inside, (lo, hi), obs, steps=steps)
+        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour)
+        out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64)))
+
+    try:
+        c, r = fit_sphere(sample)
+        closed("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
+    except InputError:
+        pass
+
+    axes = None
+    try:
+        ce, shape = fit_ellipsoid(sample)
+        with np.errstate(invalid="ignore"):
+            half = ellipsoid_half_extents(shape)
+        axes = np.linalg.eigh(shape)[1].T
+        closed("ellipsoid", ce - half, ce + half,
+               lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce), ce)  # fmt: skip
+    except (InputError, np.linalg.LinAlgError):
+        pass
+
+    try:
+        rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)], extra_directions=axes)
+        lo, hi = revolution_box(rev)
+        closed("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
+    except InputError:
+        pass
+
+    if mirror is not None:
+        done = complete_by_symmetry(sample, camera, **mirror, view=view)
+        back = done.points[len(sample) :]
+        lo, hi = constrain_box(back.min(axis=0), back.max(axis=0), seen_lo, seen_hi, front, cone=cone,
+                               contour=obs.contour)  # fmt: skip
+        out.append(Candidate("mirror", lo, hi, None, 0.5 * (lo + hi)))
+
+    lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
+    out.append(Candidate("raw", lo, hi, None, 0.5 * (lo + hi)))
+    return out

@@ -1,0 +1,60 @@
+"""The default method's candidate completions: their boxes made consistent with the view, and their evidence."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit import DEFAULT_CAMERA
+from symfruit.core.candidates import candidates, constrain_box
+from symfruit.core.evidence import observe
+from symfruit.core.raster import silhouette
+
+from ..conftest import ball_mesh, rendered_view
+
+coord = st.floats(-0.05, 0.05, allow_nan=False)
+
+
+@given(st.lists(coord, min_size=12, max_size=12), st.floats(0.25, 1.0))
+def test_constrained_boxes_hold_the_seen_box_behind_the_front(values, contour):
+    v = np.array(values)
+    seen_lo, seen_hi = np.minimum(v[:3], v[3:6]) + [0, 0, 0.4], np.maximum(v[:3], v[3:6]) + [0, 0, 0.4]
+    lo, hi = np.minimum(v[6:9], v[9:]) + [0, 0, 0.4], np.maximum(v[6:9], v[9:]) + [0, 0, 0.4]
+    front = seen_lo[2] + 0.001
+    out_lo, out_hi = constrain_box(lo, hi, seen_lo, seen_hi, front, contour=contour)
+    assert out_lo[2] == front and out_hi[2] >= max(seen_hi[2], front)
+    assert np.all(out_lo[:2] <= seen_lo[:2]) and np.all(out_hi[:2] >= seen_hi[:2])
+    near, far = np.r_[seen_lo[:2], front], np.maximum(seen_hi, np.r_[seen_lo[:2], front])
+    reach = 2.0 / contour * (far - near)
+    assert np.all(out_hi <= np.maximum(near + reach, far + [0, 0, 1e-4]) + 1e-12)
+    assert np.all(out_lo >= np.minimum(far - reach, near) - 1e-12)
+
+
+def test_a_box_wider_than_the_silhouette_cone_is_pulled_back():
+    seen_lo, seen_hi = np.array([-0.01, -0.01, 0.39]), np.array([0.01, 0.01, 0.40])
+    uv_lo = DEFAULT_CAMERA.project(np.array([[-0.01, -0.01, 0.40]]))[0]
+    uv_hi = DEFAULT_CAMERA.project(np.array([[0.01, 0.01, 0.40]]))[0]
+    cone = ((uv_lo[0], uv_lo[1], uv_hi[0], uv_hi[1]), DEFAULT_CAMERA)
+    lo, hi = constrain_box([-0.03, -0.01, 0.39], [0.03, 0.01, 0.41], seen_lo, seen_hi, 0.39, cone=cone)
+    assert lo[0] == pytest.approx(-0.01 * 0.41 / 0.40) and hi[0] == pytest.approx(0.01 * 0.41 / 0.40)
+    half = constrain_box([-0.03, -0.01, 0.39], [0.03, 0.01, 0.41], seen_lo, seen_hi, 0.39, cone=cone, contour=0.5)[0]
+    assert half[0] == pytest.approx(0.5 * (-0.03 - 0.01 * 0.41 / 0.40))
+
+
+def test_candidates_of_a_noisy_ball():
+    visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=4)
+    sample = visible[::8]
+    obs = observe(sample, silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    front = 0.4 - 0.035
+    cands = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front)
+    by = {c.name: c for c in cands}
+    assert list(by) == ["sphere", "ellipsoid", "revolution", "raw"]
+    assert all(c.lo[2] == front for c in cands)
+    assert by["raw"].evidence is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
+    s = by["sphere"]
+    assert s.evidence.inside + s.evidence.outside < 0.1 and s.evidence.depth < 0.003
+    np.testing.assert_allclose(s.centre, [0.01, 0.0, 0.4], atol=0.002)
+    assert s.hi[2] == pytest.approx(0.435, abs=0.003)
+    with_mirror = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front,
+                             mirror={"translations": 8, "translation_step": 0.1})  # fmt: skip
+    assert [c.name for c in with_mirror] == ["sphere", "ellipsoid", "revolution", "mirror", "raw"]

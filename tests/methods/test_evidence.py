@@ -1,0 +1,90 @@
+"""The default method, ``evidence``: known answers on noisy and clean views, its settings, its candidates and
+confidence, and a quick real-scan case (the YCB pear: Calli et al., "The YCB object and model set", 2015,
+ycbbenchmarks.com, CC BY 4.0, read from ``../shared/data/real-scans``)."""
+
+import numpy as np
+import pytest
+
+from symfruit import ConfigError, box_iou, centre_deviation, complete
+from symfruit.evaluate.protocols import Spec, build
+from symfruit.methods.evidence import EvidenceSettings, _weighted_median
+from symfruit.settings import Settings
+from symfruit.shapes import FRUITS, rotation
+
+from ..conftest import REAL_SCANS, ball_mesh, needs_real_scans, rendered_view
+
+
+def test_locates_a_noisy_ball_and_is_confident():
+    visible, _ = rendered_view(ball_mesh(), [0.03, 0.02, 0.42], noise=0.01, seed=4)
+    r = complete(visible)
+    assert r.method == "evidence"
+    assert np.linalg.norm(r.centre - [0.03, 0.02, 0.42]) < 0.0015
+    assert 0.0 <= r.confidence <= 1.0 and r.reliable
+    # Every seen point is inside the box, except noise in front of its (robust) front face.
+    inside = np.all((visible >= r.box.min - 1e-12) & (visible <= r.box.max + 1e-12), axis=1)
+    assert np.all(inside | (visible[:, 2] < r.box.min[2]))
+    assert r.box.min[2] == pytest.approx(0.42 - 0.035, abs=6e-4)  # the ball's nearest point
+    assert sum(r.extras["weights"].values()) == pytest.approx(1.0)
+
+
+def test_a_tilted_pear_is_completed_by_its_solid_of_revolution():
+    fruit = FRUITS["pear"](np.random.default_rng(3))
+    visible, posed = rendered_view(fruit, [0.0, 0.0, 0.4], noise=0.01, rotation=rotation(30, 40, 20), seed=5)
+    truth = posed.vertices.min(axis=0), posed.vertices.max(axis=0)
+    from symfruit import Box
+
+    truth_box = Box(*truth)
+    evidence = complete(visible)
+    sphere = complete(visible, method="sphere")
+    assert box_iou(evidence.box, truth_box) > max(0.8, box_iou(sphere.box, truth_box))
+    assert max(evidence.extras["weights"], key=evidence.extras["weights"].get) != "sphere"
+
+
+def test_paper_protocol_view():
+    inst = build(Spec("paper", "citrus", 0, 13))
+    r = complete(inst.visible)
+    assert box_iou(r.box, inst.truth_box) > 0.9 and centre_deviation(r.box, inst.truth_box) < 0.002
+
+
+def test_deterministic_with_its_candidates_reported():
+    inst = build(Spec("camera", "lemon", 0, 3, sensor="heldback"))
+    a, b = complete(inst.visible), complete(inst.visible)
+    np.testing.assert_array_equal(a.box.min, b.box.min)
+    assert set(a.extras["candidates"]) == {"sphere", "ellipsoid", "revolution", "raw"}
+    assert a.extras["reliable"] is (a.extras["confidence"] >= EvidenceSettings().reliable_at)
+    mirrored = complete(inst.visible, settings={"evidence": {"mirror_candidate": True}})
+    assert "mirror" in mirrored.extras["candidates"]
+
+
+def test_settings_are_bounded_and_checked():
+    with pytest.raises(ConfigError, match=r"evidence\.silhouette_weight: must be >= 0"):
+        Settings().replace(evidence={"silhouette_weight": -1.0})
+    with pytest.raises(ConfigError, match="revolution_points: must be <= fit_points"):
+        Settings().replace(evidence={"fit_points": 100, "revolution_points": 200})
+    with pytest.raises(ConfigError, match=r"mirror\.translations"):
+        Settings().replace(evidence={"mirror": {"translations": 0}})
+
+
+def test_weighted_median_is_a_median():
+    v = np.array([[1.0, 5.0], [2.0, 4.0], [3.0, 3.0], [10.0, -1.0]])
+    np.testing.assert_array_equal(_weighted_median(v, np.ones(4)), [2.0, 3.0])
+    np.testing.assert_array_equal(_weighted_median(v, np.array([0.1, 0.1, 0.1, 5.0])), [10.0, -1.0])
+
+
+@needs_real_scans
+def test_real_pear_camera_views_beat_the_sphere_and_the_raw_box(tmp_path):
+    """Quick real-scan case: six held-back-like camera views of the YCB pear."""
+    (tmp_path / "016_pear.ply").symlink_to(REAL_SCANS / "016_pear.ply")
+    iou: dict[str, list[float]] = {"raw": [], "sphere": [], "evidence": []}
+    centre = {m: [] for m in iou}
+    for k in range(6):
+        inst = build(Spec("camera", str(tmp_path), 0, k, sensor="heldback", poses="upright"))
+        assert inst.kind == "scan/016_pear"
+        for method in iou:
+            r = complete(inst.visible, camera=inst.camera, method=method)
+            iou[method].append(box_iou(r.box, inst.truth_box))
+            centre[method].append(centre_deviation(r.box, inst.truth_box))
+    mean_iou = {m: float(np.mean(v)) for m, v in iou.items()}
+    mean_centre = {m: float(np.mean(v)) for m, v in centre.items()}
+    assert mean_iou["evidence"] > max(mean_iou["sphere"], mean_iou["raw"]) + 0.05
+    assert mean_centre["evidence"] < min(mean_centre["sphere"], mean_centre["raw"]) - 0.003
