@@ -4,7 +4,7 @@ VENV := .venv
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 
-.PHONY: demo test test-slow test-long bench lint format clean
+.PHONY: demo test test-slow test-long bench lint format clean ros-env ros-bench
 
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
@@ -15,7 +15,13 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)  ## locate the fruit of the shipped RGB-D frame, write out/demo/
 	$(BIN)/symfruit demo --output out/demo
 
-test: $(STAMP)  ## lint, type check and the test suite (slow evaluation runs excluded)
+# Debian's ROS 1 packages for `symfruit ros` and its real-master test: apt-get installs them when they are
+# missing and apt is usable (root or password-less sudo); the venv then sees exactly those packages through
+# a .pth file. Elsewhere it prints why it skipped and the ROS tests skip; under CI a skip is an error.
+ros-env: $(STAMP)  ## make Debian's ROS 1 (rospy, rosmaster, message packages) usable from the venv
+	$(BIN)/python -m symfruit.ros.debian --install $(if $(filter true 1,$(CI) $(SYMFRUIT_REQUIRE_ROS)),--require,)
+
+test: $(STAMP) ros-env  ## lint, type check and the test suite (slow evaluation runs excluded)
 	$(BIN)/ruff check src tests examples
 	$(BIN)/ruff format --check src tests examples
 	$(BIN)/mypy
@@ -29,6 +35,9 @@ test-long: $(STAMP)  ## property and fuzz tests with fresh random cases and many
 
 bench: $(STAMP)  ## the project's benchmark
 	$(BIN)/symfruit bench
+
+ros-bench: ros-env  ## latency of the ROS node on the example frame (real master, node subprocess)
+	$(BIN)/python -m symfruit.ros.bench
 
 lint: $(STAMP)
 	$(BIN)/ruff check src tests examples

@@ -115,18 +115,16 @@ def ball_mesh(radius: float = 0.035):
 
 
 def _find_real_scans() -> Path | None:
-    """``shared/data/real-scans`` beside the repository or one of its parent folders (a worktree)."""
-    for parent in ROOT.parents:
-        folder = parent / "shared" / "data" / "real-scans"
-        if folder.is_dir():
-            return folder
-    return None
+    """The repository's copy of the two shared real scans (``examples/scans``: the same vertices and faces
+    as ``../shared/data/real-scans``, binary PLY), so CI runs the real-shape tests wherever it clones."""
+    folder = ROOT / "examples" / "scans"
+    return folder if (folder / "016_pear.ply").is_file() else None
 
 
-#: The shared real scans (YCB object set, Calli et al. 2015, CC BY 4.0), or None where they are absent.
+#: The real scans (YCB object set, Calli et al. 2015, CC BY 4.0; examples/scans/README.md).
 REAL_SCANS = _find_real_scans()
-#: Skip marker of tests that need them.
-needs_real_scans = pytest.mark.skipif(REAL_SCANS is None, reason="the shared real scans (../shared/data) are absent")
+#: Skip marker of tests that need them (only a checkout without examples/ lacks them).
+needs_real_scans = pytest.mark.skipif(REAL_SCANS is None, reason="examples/scans (the real scans) is absent")
 
 
 # --- small synthetic RGB-D frames ----------------------------------------------------------------------

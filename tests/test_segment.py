@@ -1,21 +1,218 @@
-"""The built-in colour segmenter: ripe red fruit found and numbered left to right, unripe fruit and specks
-ignored, touching fruit split at depth steps and at waists."""
+"""The colour segmenter (symfruit.segment) on photo-like synthetic images and on rendered depth."""
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
+from symfruit import Camera, ConfigError, InputError
+from symfruit.evaluate.masks import score_masks
 from symfruit.io.frames import read_frame
-from symfruit.scenes import make_scene
-from symfruit.segment import SegmentSettings, red_mask, segment
+from symfruit.scenes import make_photo, make_scene
+from symfruit.segment import SegmentSettings, convex_hull_mask, redness, ripe_seeds, segment
 
 from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 
-CAM = SMALL_CAM
-YY, XX = np.mgrid[:120, :160]
+H, W = 240, 320
+YY, XX = np.mgrid[:H, :W]
+RED = (200, 30, 40)
+CAM = Camera(fx=600, fy=600, cx=W / 2, cy=H / 2, width=W, height=H)
 
 
-def disc(cx, cy, r):
-    return (XX - cx) ** 2 + (YY - cy) ** 2 <= r**2
+def sphere_depth(fruit, z, background=1.5):
+    """Depth of spheres ``(cx, cy, r)`` (pixels) whose centres lie at depth ``z`` (one per fruit), nearest
+    surface wins; ``background`` elsewhere."""
+    depth = np.full((H, W), background)
+    for (cx, cy, r), zc in zip(fruit, z, strict=True):
+        r_m = r * zc / CAM.fx
+        d2 = ((XX - cx) ** 2 + (YY - cy) ** 2) * (zc / CAM.fx) ** 2
+        inside = d2 < r_m * r_m
+        depth = np.where(inside, np.minimum(depth, zc - np.sqrt(np.clip(r_m * r_m - d2, 0, None))), depth)
+    return depth
+
+
+def test_one_fruit_with_seeds_and_highlight_is_found_whole():
+    color, truth = make_photo([(160, 120, 50, RED)])
+    labels = segment(color)
+    assert labels.dtype == np.int32 and labels.shape == (H, W) and labels.max() == 1
+    s = score_masks(truth, labels)
+    assert s.matched == 1 and s.best_iou[0] > 0.95  # the seeds and the highlight are filled
+
+
+def test_a_calyx_over_the_fruit_is_inside_its_outline():
+    color, truth = make_photo([(160, 120, 50, RED)], calyx=True)
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 1 and s.best_iou[0] > 0.95
+
+
+def test_white_green_and_blushed_fruit_are_not_ripe():
+    for colour in ((235, 230, 215), (120, 180, 60), (220, 190, 180)):
+        color, _ = make_photo([(160, 120, 50, colour)])
+        assert segment(color).max() == 0, colour
+
+
+def test_two_touching_fruit_are_split_and_three_too():
+    color, truth = make_photo([(110, 120, 45, RED), (198, 120, 45, RED)])
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 2 and s.matched == 2 and s.best_iou.min() > 0.9
+    color, truth = make_photo([(80, 120, 38, RED), (155, 120, 38, RED), (230, 120, 38, RED)], seed=1)
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 3 and s.matched == 3 and s.best_iou.min() > 0.9
+
+
+def test_overlapping_fruit_of_two_sizes_are_split():
+    color, truth = make_photo([(120, 120, 45, RED), (200, 125, 40, RED)], calyx=True)
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 2 and s.matched == 2 and s.best_iou.min() > 0.9
+
+
+def test_without_a_split_touching_fruit_stay_one_region():
+    color, _ = make_photo([(110, 120, 45, RED), (198, 120, 45, RED)])
+    assert segment(color, settings=SegmentSettings(split="none")).max() == 1
+
+
+def test_one_fruit_cut_by_a_stem_is_one_fruit():
+    color, truth = make_photo([(160, 120, 50, RED)])
+    color[:, 158:163] = (70, 120, 40)  # a green stem across the fruit: two red fragments
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 1 and s.best_iou[0] > 0.95
+
+
+def test_fruit_cut_by_the_border_is_kept_and_a_speck_is_not():
+    color, truth = make_photo([(10, 120, 50, RED)])
+    color[5:8, 300:303] = RED
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 1 and s.best_iou[0] > 0.9
+
+
+def test_fruit_are_numbered_left_to_right():
+    color, _ = make_photo([(250, 60, 30, RED), (60, 180, 30, RED), (150, 120, 30, RED)])
+    labels = segment(color)
+    assert [labels[180, 60], labels[120, 150], labels[60, 250]] == [1, 2, 3]
+
+
+def test_depth_is_optional_and_used_when_given():
+    color, _ = make_photo([(160, 120, 50, RED)])
+    flat = np.full((H, W), 0.4)
+    assert np.array_equal(segment(color, flat, CAM) > 0, segment(color) > 0)
+    tiny, _ = make_photo([(160, 120, 4, RED)])
+    assert segment(tiny, np.full((H, W), 0.3), CAM).max() == 0  # 8 px across at 0.3 m: a 4 mm blob
+    assert np.array_equal(segment(color, np.zeros((H, W)), None), segment(color))  # no valid depth: colour alone
+    with pytest.raises(InputError, match="camera"):
+        segment(color, flat)
+    with pytest.raises(InputError, match="depth is"):
+        segment(color, np.ones((10, 10)), CAM)
+
+
+def test_overlapping_fruit_are_split_by_their_depth_surfaces():
+    fruit = [(125, 120, 45), (190, 120, 45)]  # centres 1.44 radii apart: no waist a colour split trusts
+    color, truth = make_photo([(*f, RED) for f in fruit])
+    assert segment(color).max() == 1
+    depth = sphere_depth(fruit, [0.40, 0.41])
+    s = score_masks(truth, segment(color, depth, CAM))
+    assert s.n_pred == 2 and s.matched == 2
+
+
+def test_the_split_setting_picks_the_evidence():
+    fruit = [(125, 120, 45), (190, 120, 45)]
+    color, _ = make_photo([(*f, RED) for f in fruit])
+    depth = sphere_depth(fruit, [0.40, 0.41])
+    assert segment(color, depth, CAM, SegmentSettings(split="depth")).max() == 2
+    assert segment(color, depth, CAM, SegmentSettings(split="watershed")).max() == 1  # shape alone cannot
+    touching, _ = make_photo([(110, 120, 45, RED), (198, 120, 45, RED)])
+    assert segment(touching, settings=SegmentSettings(split="depth")).max() == 1  # no depth, no depth split
+    assert segment(touching, settings=SegmentSettings(split="watershed")).max() == 2
+
+
+def test_one_sphere_with_a_stem_in_front_stays_one_fruit_with_depth():
+    color, truth = make_photo([(160, 120, 55, RED)])
+    color[:, 157:163] = (70, 120, 40)
+    depth = sphere_depth([(160, 120, 55)], [0.4])
+    depth[:, 157:163] = 0.33  # the stem is in front
+    s = score_masks(truth, segment(color, depth, CAM))
+    assert s.n_pred == 1 and s.best_iou[0] > 0.9  # the stem is not fruit surface: left out
+    assert segment(color, depth, CAM)[120, 160] == 0
+
+
+def test_the_old_positional_call_of_detect_still_works():
+    scene = make_scene(1, n_ripe=3, n_unripe=1, n_leaves=0)
+    labels = segment(scene.color, scene.depth, scene.camera, SegmentSettings())
+    assert labels.max() >= 2
+
+
+def test_rendered_touching_fruit_are_split_with_depth():
+    scene = make_scene(0)  # fruit 3 and 4, and 5 and 6, touch
+    labels = segment(scene.color, scene.depth, scene.camera)
+    ripe = [f.id for f in scene.fruits if f.ripe]
+    truth = scene.labels[None] == np.array(ripe)[:, None, None]
+    s = score_masks(truth, labels)
+    assert s.matched == s.n_true == 6 and s.best_iou.mean() > 0.9
+    best = {k: np.bincount(labels[scene.labels == k]).argmax() for k in ripe}
+    assert best[3] != best[4] and best[5] != best[6] and min(best.values()) > 0
+
+
+def test_settings_are_bounded_and_checked():
+    with pytest.raises(ConfigError, match="red_low"):
+        SegmentSettings(red_low=0.5, red_high=0.3)
+    with pytest.raises(ConfigError, match="waist"):
+        SegmentSettings(waist=0.0)
+    with pytest.raises(ConfigError, match="close_px"):
+        SegmentSettings(close_px=500)
+    from symfruit.settings import Settings
+
+    assert Settings().replace(segment={"fill": "surface"}).segment.fill == "surface"
+    with pytest.raises(ConfigError, match=r"segment\.split"):
+        Settings().replace(segment={"split": "sometimes"})
+
+
+def test_bad_colour_input_is_refused():
+    with pytest.raises(InputError):
+        segment(np.zeros((10, 10)))
+    with pytest.raises(InputError):
+        segment(np.full((10, 10, 3), np.nan))
+    assert segment(np.zeros((1, 1, 3), np.uint8)).shape == (1, 1)
+
+
+def test_redness_and_seeds_known_answers():
+    px = np.array([[[200, 50, 40], [100, 25, 20], [90, 90, 90], [30, 5, 5], [210, 120, 40]]], np.uint8)
+    assert np.allclose(redness(px)[0, :3], [0.75, 0.75, 0.0])
+    strong, weak = ripe_seeds(px)
+    assert strong[0].tolist() == [True, True, False, False, False]  # dark pixels never red; orange never seeds
+    assert weak[0].tolist() == [True, True, False, False, True]
+
+
+def test_convex_hull_mask_fills_a_c_shape():
+    m = (XX - 100) ** 2 + (YY - 100) ** 2 <= 40**2
+    c = m & ~((XX > 100) & (abs(YY - 100) < 10))
+    hull = convex_hull_mask(c)
+    assert hull[100, 120] and (hull | m).sum() <= 1.01 * m.sum() and (hull >= c).all()
+    assert not convex_hull_mask(np.zeros((4, 4), bool)).any()
+
+
+@given(
+    cx=st.floats(0, W),
+    cy=st.floats(0, H),
+    r=st.floats(18, 60),
+    seed=st.integers(0, 1000),
+)
+def test_a_single_fruit_anywhere_is_one_region(cx, cy, r, seed):
+    color, truth = make_photo([(cx, cy, r, RED)], seed=seed)
+    labels = segment(color)
+    assert labels.dtype == np.int32 and labels.shape == (H, W) and labels.min() == 0
+    visible = int(truth[0].sum())
+    if visible >= 0.002 * H * W * 2:  # clearly larger than the least fruit
+        s = score_masks(truth, labels)
+        assert s.n_pred == 1 and s.best_iou[0] > 0.8
+    assert labels.max() <= 1
+
+
+# --- carried over from the previous segmenter's tests -------------------------------------------------
+
+_YY, _XX = np.mgrid[:120, :160]
+
+
+def _disc(cx, cy, r):
+    return (_XX - cx) ** 2 + (_YY - cy) ** 2 <= r**2
 
 
 def test_segmenter_on_the_shipped_frame():
@@ -41,7 +238,7 @@ def test_segmenter_on_the_shipped_frame():
 def test_touching_fruit_are_split_and_specks_ignored():
     color, depth = disc_frame([(55, 60), (95, 60)])  # two discs touching at the same depth
     color[5:7, 5:7] = (200, 20, 30)  # a red speck: too small for a fruit
-    labels = segment(color, depth, CAM)
+    labels = segment(color, depth, SMALL_CAM)
     assert labels.max() == 2
     assert labels[60, 55] != labels[60, 95]
 
@@ -49,62 +246,52 @@ def test_touching_fruit_are_split_and_specks_ignored():
 def test_white_and_green_fruit_are_ignored():
     for colour in ((230, 230, 220), (120, 180, 60)):
         color, depth = disc_frame([(80, 60)], colour=colour)
-        assert segment(color, depth, CAM).max() == 0
+        assert segment(color, depth, SMALL_CAM).max() == 0
 
 
 def test_red_discs_are_found_and_numbered_left_to_right():
     color, depth = disc_frame([(130, 40), (30, 80), (80, 60)], radius=15)
-    labels = segment(color, depth, CAM)
+    labels = segment(color, depth, SMALL_CAM)
     assert labels.dtype == np.int32 and labels.shape == (120, 160) and labels.max() == 3
     for k, (cx, cy) in enumerate([(30, 80), (80, 60), (130, 40)], 1):
         found = labels == k
-        assert np.all(found[disc(cx, cy, 14)]) and not np.any(found & ~disc(cx, cy, 16))
-    assert not labels[~(disc(30, 80, 16) | disc(80, 60, 16) | disc(130, 40, 16))].any()
+        assert np.all(found[_disc(cx, cy, 14)]) and not np.any(found & ~_disc(cx, cy, 16))
+    assert not labels[~(_disc(30, 80, 16) | _disc(80, 60, 16) | _disc(130, 40, 16))].any()
 
 
 def test_touching_fruit_at_different_depths_are_split_at_the_depth_step():
     # The front fruit (30 cm) hides part of the one behind (36 cm); their silhouettes overlap without a waist.
     color, depth = disc_frame([(70, 60), (92, 60)], radius=20, z=[0.30, 0.36])
-    front, back = disc(70, 60, 20), disc(92, 60, 20) & ~disc(70, 60, 20)
+    front, back = _disc(70, 60, 20), _disc(92, 60, 20) & ~_disc(70, 60, 20)
     for split in ("both", "depth"):
-        labels = segment(color, depth, CAM, SegmentSettings(split=split))
+        labels = segment(color, depth, SMALL_CAM, SegmentSettings(split=split))
         assert labels.max() == 2
         # The cut follows the front fruit's rim to within 3 pixels.
-        assert np.all(labels[disc(70, 60, 18)] == 1) and np.all(
-            labels[back & ~disc(70, 60, 23) & disc(92, 60, 18)] == 2
+        assert np.all(labels[_disc(70, 60, 18)] == 1) and np.all(
+            labels[back & ~_disc(70, 60, 23) & _disc(92, 60, 18)] == 2
         )
-        assert not np.any((labels == 2) & disc(70, 60, 18)) and not np.any((labels == 1) & ~disc(70, 60, 23))
+        assert not np.any((labels == 2) & _disc(70, 60, 18)) and not np.any((labels == 1) & ~_disc(70, 60, 23))
         assert abs(int((labels == 1).sum()) - int(front.sum())) < 0.1 * front.sum()
     for split in ("watershed", "none"):  # no waist to cut at: one region
-        assert segment(color, depth, CAM, SegmentSettings(split=split)).max() == 1
+        assert segment(color, depth, SMALL_CAM, SegmentSettings(split=split)).max() == 1
 
 
 def test_touching_fruit_at_the_same_depth_are_split_at_the_waist_only_when_asked():
     color, depth = disc_frame([(62, 60), (98, 60)], radius=20)
-    assert segment(color, depth, CAM, SegmentSettings(split="watershed")).max() == 2
-    assert segment(color, depth, CAM, SegmentSettings(split="none")).max() == 1
+    assert segment(color, depth, SMALL_CAM, SegmentSettings(split="watershed")).max() == 2
+    assert segment(color, depth, SMALL_CAM, SegmentSettings(split="none")).max() == 1
 
 
 def test_a_fruit_too_small_for_its_depth_is_ignored():
     color, depth = disc_frame([(80, 60)], radius=4, z=0.3)  # 4 px at 30 cm: 4 mm across
-    assert segment(color, depth, CAM).max() == 0
-    assert segment(color, depth, CAM, SegmentSettings(min_diameter=0.002)).max() == 1
+    assert segment(color, depth, SMALL_CAM).max() == 0
+    assert segment(color, depth, SMALL_CAM, SegmentSettings(min_diameter=0.002)).max() == 1
     color, _ = disc_frame([(80, 60)], radius=15)
-    assert segment(color, np.zeros((120, 160), np.float32), CAM).max() == 0  # no depth: no size, no fruit
+    # an all-zero depth image is no depth: the colour-only size rule (a share of the image) applies
+    assert segment(color, np.zeros((120, 160), np.float32), SMALL_CAM).max() == 1
 
 
 def test_nothing_red_gives_an_empty_label_image():
     color = np.full((120, 160, 3), 90, np.uint8)
-    labels = segment(color, np.ones((120, 160), np.float32), CAM)
+    labels = segment(color, np.ones((120, 160), np.float32), SMALL_CAM)
     assert labels.shape == (120, 160) and not labels.any()
-
-
-@pytest.mark.parametrize(
-    "rgb, red",
-    [((200, 20, 30), True), ((255, 0, 0), True), ((200, 30, 80), True), ((120, 180, 60), False),
-     ((230, 230, 220), False), ((30, 5, 5), False), ((200, 120, 30), False), ((90, 90, 90), False)],
-)  # fmt: skip
-def test_the_red_test_on_known_colours(rgb, red):
-    color = np.zeros((2, 2, 3), np.uint8) + np.array(rgb, np.uint8)
-    assert red_mask(color).all() == red and red_mask(color).any() == red
-    assert red_mask(color, SegmentSettings(hue_low=0.0, hue_high=360.0, sat_min=0.0, val_min=0.0)).all()

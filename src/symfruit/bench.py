@@ -18,6 +18,7 @@ from typing import Any
 import numpy as np
 
 from .complete import complete
+from .methods import DEFAULT_METHOD
 from .settings import Settings
 from .shapes import paper_visible, rotation_x, strawberry
 
@@ -28,6 +29,7 @@ __all__ = [
     "bench_camera_view",
     "bench_frame",
     "bench_recording",
+    "bench_segment",
     "bench_view",
     "measured_detect",
     "run_bench",
@@ -166,7 +168,7 @@ def run_bench(
     return rows
 
 
-def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "evidence") -> BenchRow:
+def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD) -> BenchRow:
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore)."""
     from .detect import detect
@@ -180,6 +182,69 @@ def bench_frame(*, repeat: int = 20, seed: int = 0, method: str = "evidence") ->
     n = sum(d.result is not None for d in found.detections)
     return BenchRow(f"frame, {n} fruit, {method}", method, Settings().paper.n_hypotheses, n, float(np.median(ms)),
                     float(np.percentile(ms, 10)), float(np.percentile(ms, 90)), repeat)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class SegmentRow:
+    """Time of the colour segmenter per image (milliseconds; one process, after a warm-up)."""
+
+    images: int
+    source: str
+    width: int
+    height: int
+    median_ms: float
+    p90_ms: float
+    max_ms: float
+
+    def to_dict(self) -> dict[str, Any]:
+        return dict(self.__dict__)
+
+
+def bench_segment(
+    images: str | Path | None = None, *, size: tuple[int, int] = (640, 480), limit: int = 1000, repeat: int = 1
+) -> SegmentRow:
+    """Time :func:`symfruit.segment.segment` (colour alone) per image, the images resized to ``size``
+    (width, height) before timing.
+
+    ``images`` is a folder of photographs (the first ``limit`` in name order); without it, 24 seeded
+    synthetic photos (:func:`symfruit.scenes.make_photo`: one to three fruit with seeds, highlights and a
+    calyx). Each image is timed ``repeat`` times and its fastest run kept.
+    """
+    from PIL import Image
+
+    from .segment import segment
+
+    if images is not None:
+        from .batch import expand_images
+        from .io.images import read_color
+
+        paths = expand_images([images])[: max(1, limit)]
+        frames = [np.asarray(Image.fromarray(read_color(p)).resize(size, Image.Resampling.BILINEAR)) for p in paths]
+        source = str(images)
+    else:
+        from .scenes import make_photo
+
+        rng = np.random.default_rng(0)
+        frames = []
+        for k in range(24):
+            n = 1 + k % 3
+            r = float(rng.uniform(0.08, 0.14)) * size[1]
+            fruit = [(float(rng.uniform(r, size[0] - r)), float(rng.uniform(r, size[1] - r)), r, (200, 35, 45))
+                     for _ in range(n)]  # fmt: skip
+            frames.append(make_photo(fruit, shape=(size[1], size[0]), seed=k, calyx=True)[0])
+        source = "synthetic photos"
+    segment(frames[0])
+    ms = []
+    for frame in frames:
+        best = float("inf")
+        for _ in range(max(1, repeat)):
+            start = time.perf_counter()
+            segment(frame)
+            best = min(best, time.perf_counter() - start)
+        ms.append(best * 1000.0)
+    t = np.array(ms)
+    return SegmentRow(len(t), source, size[0], size[1], float(np.median(t)), float(np.percentile(t, 90)),
+                      float(t.max()))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -228,7 +293,9 @@ def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[i
     return int(data["status"]), float(data["peak_rss_mb"]), proc.stderr
 
 
-def bench_recording(frames: int = 500, *, method: str = "evidence", workdir: str | Path | None = None) -> RecordingRow:
+def bench_recording(
+    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None
+) -> RecordingRow:
     """Run ``symfruit detect`` on a generated ``frames``-frame recording in a child process and report its
     peak resident memory and wall time: memory must not grow with ``frames``."""
     import tempfile

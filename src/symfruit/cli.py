@@ -1,4 +1,5 @@
-"""Command-line interface: ``symfruit complete | evaluate | bench | settings | methods``.
+"""Command-line interface: ``symfruit complete | detect | segment | evaluate | bench | demo | scenes | settings |
+methods``.
 
 Thin by design: parse, import lazily, call the library, print. Errors a user can cause print one
 line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the traceback instead.
@@ -7,11 +8,13 @@ line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the tr
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import shutil
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import numpy as np
@@ -27,7 +30,7 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
         type=Path,
         help="intrinsics (JSON/YAML: plain, RealSense, Open3D, ROS); default: Intel D435 colour 640x480",
     )
-    p.add_argument("--method", default="evidence", help="completion method (see `symfruit methods`; default evidence)")
+    p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`), over the profile")
     p.add_argument("--units", choices=("m", "mm"), default="m", help="units of the input cloud")
@@ -47,16 +50,23 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
-    p.add_argument("--method", default="evidence", help="with --recording: the completion method (default evidence)")
+    p.add_argument("--method", default=None, help="with --recording: the completion method (default evidence)")
+    p.add_argument(
+        "--segment",
+        action="store_true",
+        help="instead: time the colour segmenter per 640x480 image (photos from --images, else synthetic)",
+    )
+    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to 640x480)")
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("evaluate", help="run an evaluation protocol and write tables, CSV, JSON and plots")
     p.add_argument(
         "--protocol",
-        choices=("paper", "camera"),
+        choices=("paper", "camera", "masks"),
         default="paper",
-        help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views",
+        help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views; masks: mask "
+        "quality of a segmenter on photographs (--images, --truth) or on rendered scenes (--n, --seed)",
     )
     p.add_argument(
         "--fruit",
@@ -87,7 +97,14 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
-    p.add_argument("--masks", default="auto", help="with --frames: mask source (see `symfruit detect`)")  # fmt: skip
+    p.add_argument("--masks", default=None,
+                   help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
+                   "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
+    p.add_argument("--images", type=Path, help="masks protocol: folder of photographs")
+    p.add_argument("--truth", type=Path, help="masks protocol: COCO JSON of the photographs' instance masks")
+    p.add_argument("--category", type=int, default=1,
+                   help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
+    p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
 
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
@@ -96,18 +113,45 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--masks",
         default="auto",
-        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, or maskrcnn:CHECKPOINT.pth",
+        help="auto (the frame's masks file, else colour), color, a label PNG or COCO JSON, maskrcnn:CHECKPOINT.pth "
+        "or onnx:MODEL.onnx",
     )
-    p.add_argument("--method", default="evidence", help="completion method (see `symfruit methods`; default evidence)")
+    p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
     p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
-    p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
-    p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
-    p.add_argument("--method", default="evidence", help="completion method (default evidence)")
+    _add_ros2_bag_options(p)
+    p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
+    p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
+    p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
+                   "<stem>_overlay.png")  # fmt: skip
+    p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
+                   ".json or a folder of label PNGs")  # fmt: skip
+    p.add_argument("--depth", type=Path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
+    p.add_argument("--camera", type=Path, help="intrinsics file (needed with --depth)")
+    p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+    p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
+    p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.add_argument("--method", default=None, help="completion method (default evidence)")
+    p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
+    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+
+
+def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--ros2-bag", type=Path, metavar="BAG",
+                   help="also write the detections into this new ROS 2 bag folder (vision_msgs/msg/Detection3DArray "
+                   "on /symfruit/detections, stamped like the input frames)")  # fmt: skip
+    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default="mcap",
+                   help="storage of --ros2-bag (default mcap)")  # fmt: skip
+
+
+def _add_ros(sub: argparse._SubParsersAction) -> None:
+    # Everything after `ros` belongs to the node (name:=value, __name:=, --help): no option prefix of ours.
+    p = sub.add_parser("ros", help="run the ROS 1 node (see `symfruit ros --help`)", add_help=False, prefix_chars="+")
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="ROS remappings and _param:=value")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -124,6 +168,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_bench(sub)
     _add_evaluate(sub)
     _add_detect(sub)
+    _add_ros(sub)
     p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries (with truth)")
     p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
@@ -139,6 +184,13 @@ def _parser() -> argparse.ArgumentParser:
 
 def _fmt(values: Sequence[float] | np.ndarray, scale: float = 1000.0) -> str:
     return "(" + ", ".join(f"{v * scale:.1f}" for v in values) + ")"
+
+
+def _method(args: argparse.Namespace) -> str:
+    """``--method``, or the default method when it is not given."""
+    from .methods import DEFAULT_METHOD
+
+    return str(args.method or DEFAULT_METHOD)
 
 
 def _settings_for(args: argparse.Namespace, fruit: str | None = None):
@@ -162,7 +214,7 @@ def _complete(args: argparse.Namespace) -> int:
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
-    result = complete(points, camera=camera, method=args.method, settings=settings)
+    result = complete(points, camera=camera, method=_method(args), settings=settings)
     written = None
     if args.output is not None:
         meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}
@@ -205,12 +257,23 @@ def _bench(args: argparse.Namespace) -> int:
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
+    if args.segment:
+        from .bench import bench_segment
+
+        row = bench_segment(args.images)
+        if args.json:
+            print(json.dumps({"machine": machine(), "segment": row.to_dict()}, indent=2))
+            return 0
+        print(f"symfruit bench --segment: {row.images} {row.source} at {row.width}x{row.height}, colour alone, "
+              f"one process: median {row.median_ms:.2f} ms, p90 {row.p90_ms:.2f} ms, max {row.max_ms:.1f} ms "
+              "per image")  # fmt: skip
+        return 0
     if args.recording is not None:
         from .bench import bench_recording
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
-        rec = bench_recording(args.recording, method=args.method)
+        rec = bench_recording(args.recording, method=_method(args))
         if args.json:
             print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
             return 0
@@ -244,6 +307,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .methods import get
     from .shapes import FRUITS
 
+    if args.protocol == "masks":
+        return _evaluate_masks(args)
     fruits = [f.strip() for f in args.fruit.split(",") if f.strip()]
     if fruits == ["all"]:
         fruits = list(FRUITS)
@@ -294,7 +359,8 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
     from .io import atomic_write, write_json
     from .writers import new_results_folder
 
-    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=args.masks, settings=settings)
+    masks = args.masks or "auto"
+    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=masks, settings=settings)
     table = table3(scores, totals, methods)
     folder = new_results_folder(args.output, "frames")
     write_json(folder / "summary.json", {**summary_dict(scores, totals, failed), "settings": settings.to_dict()})
@@ -307,14 +373,81 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
     return 0
 
 
+def _evaluate_masks(args: argparse.Namespace) -> int:
+    from .batch import mask_source
+    from .errors import InputError
+    from .evaluate.masks import evaluate_masks, evaluate_scene_masks
+    from .writers import new_results_folder, write_mask_report
+
+    settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
+    labeller, source = mask_source(args.masks or "color", settings=settings)
+
+    def run(color: np.ndarray, depth: np.ndarray | None = None, camera: object = None) -> np.ndarray:
+        return labeller(Path(""), color, depth, camera)
+
+    if args.images is not None or args.truth is not None:
+        if args.images is None or args.truth is None:
+            raise InputError("--protocol masks needs both --images DIR and --truth COCO.json")
+        category = None if args.category < 0 else args.category
+        ev = evaluate_masks(args.images, args.truth, run, category=category)
+        meta = {"images": str(args.images), "truth": str(args.truth), "category": category, "depth": False}
+        what = f"{args.images}"
+    else:
+        if args.n is not None and not 1 <= args.n <= 10_000:
+            raise InputError("--n must be 1-10000 scenes")
+        n = args.n or 20
+        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth)
+        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth}
+        what = f"rendered scenes {args.seed}-{args.seed + n - 1} ({'colour alone' if args.no_depth else 'with depth'})"
+    folder = new_results_folder(args.output, "masks")
+    write_mask_report(folder, ev, meta={**meta, "mask_source": source, "settings": settings.to_dict()["segment"]})
+    s = ev.summary
+    iou = "-" if s["mean_best_iou"] is None else f"{s['mean_best_iou']:.3f}"
+    share = "-" if s["matched_share"] is None else f"{s['matched_share']:.1%}"
+    ms = "" if s["ms_median"] is None else f"; {s['ms_median']:.1f} ms per image (median), {s['ms_p90']:.1f} (p90)"
+    print(f"masks ({source}) on {what}: {s['images']} images, {s['true_fruit']} true fruit, {s['detections']} "
+          f"found; mean best-match IoU {iou}; matched {s['matched']} ({share}), missed {s['missed']}, false "
+          f"{s['false']} ({s['false_share']:.1%} of found){ms}")  # fmt: skip
+    print(f"results: {folder} (masks.csv, summary.json, worst.png)")
+    return 0
+
+
+def _segment(args: argparse.Namespace) -> int:
+    from .batch import segment_images
+    from .io import load_camera
+
+    camera = load_camera(args.camera) if args.camera else None
+    report = segment_images(args.inputs, output=args.output, masks=args.masks, depth=args.depth, camera=camera,
+                            depth_scale=args.depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
+    if len(report.done) <= 20:
+        for d in report.done:
+            print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
+                  f"{d.ms:.1f} ms)")  # fmt: skip
+    for name, reason in report.failed.items():
+        print(f"  failed {name}: {reason}")
+    alone = sum(not d.used_depth for d in report.done)
+    note = ""
+    if alone and report.mask_source == "colour segmenter":
+        note = (f"; {alone} on colour alone (no depth split; least fruit = segment.min_area_share of the image, "
+                "whole outlines)")  # fmt: skip
+    ms = sorted(d.ms for d in report.done)
+    median = f", {ms[len(ms) // 2]:.1f} ms per image (median)" if ms else ""
+    print(f"segment ({report.mask_source}): {len(report.done)} images, {report.fruit} fruit, {len(report.failed)} "
+          f"failed{note}{median}; labels and overlays in {args.output}")  # fmt: skip
+    if report.stopped:
+        print(f"symfruit: {report.stopped}", file=sys.stderr)
+    return 0 if report.ok else 1
+
+
 def _detect(args: argparse.Namespace) -> int:
     from .batch import run_batch
     from .methods import get
 
-    get(args.method)
+    get(_method(args))
     settings = _settings_for(args)
-    report = run_batch(args.input, args.output, masks=args.masks, method=args.method, settings=settings,
-                       resume=args.resume)  # fmt: skip
+    with _ros2_bag(args) as bag:
+        report = run_batch(args.input, args.output, masks=args.masks, method=_method(args), settings=settings,
+                           resume=args.resume, on_frame=None if bag is None else bag.write_frame)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
@@ -322,17 +455,42 @@ def _detect(args: argparse.Namespace) -> int:
     if report.stopped:
         print(f"symfruit: {report.stopped}", file=sys.stderr)
     print(f"results: {args.output}")
+    if bag is not None:
+        print(f"ROS 2 bag: {args.ros2_bag} ({bag.count} frames on {bag.topic})")
     return 0 if report.ok else 1
+
+
+@contextlib.contextmanager
+def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
+    """The ``--ros2-bag`` writer (None without the option); a bag left by a batch that could not start is
+    removed again."""
+    if args.ros2_bag is None:
+        yield None
+        return
+    from .errors import InputError
+    from .ros.bag2 import Ros2DetectionBag
+
+    if args.resume:
+        raise InputError("--ros2-bag writes every frame into a new bag; it cannot be combined with --resume")
+    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage, class_id=Path(args.fruit).stem).open()
+    try:
+        yield bag
+    except BaseException:
+        bag.close()
+        if bag.count == 0:
+            shutil.rmtree(args.ros2_bag, ignore_errors=True)
+        raise
+    bag.close()
 
 
 def _demo(args: argparse.Namespace) -> int:
     from .demo import run_demo
 
-    report = run_demo(args.output, method=args.method, settings=_settings_for(args))
+    report = run_demo(args.output, method=_method(args), settings=_settings_for(args))
     found = report.found
     frame = found.frame
     print(f"symfruit demo: {frame.name} ({frame.camera.width}x{frame.camera.height}), {len(found.detections)} fruit "
-          f"found, {report.n_truth} ripe fruit in the truth, method {args.method}")  # fmt: skip
+          f"found, {report.n_truth} ripe fruit in the truth, method {_method(args)}")  # fmt: skip
     print(f"{'fruit':>5} {'points':>6}  {'centre x, y, z (mm)':<24} {'size x, y, z (mm)':<20} "
           f"{'raw err':>8} {'completed err':>13}")  # fmt: skip
     for d in report.located:
@@ -368,6 +526,12 @@ def _scenes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _ros(args: argparse.Namespace) -> int:
+    from .ros.node import main as ros_main
+
+    return ros_main(args.ros_args)
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -388,8 +552,10 @@ _COMMANDS = {
     "bench": _bench,
     "evaluate": _evaluate,
     "detect": _detect,
+    "segment": _segment,
     "demo": _demo,
     "scenes": _scenes,
+    "ros": _ros,
     "settings": _settings,
     "methods": _methods,
 }

@@ -14,7 +14,7 @@ from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane, Planes
 from .core.points import check_cloud, check_view
 from .errors import InputError
-from .methods import get
+from .methods import DEFAULT_METHOD, get
 from .settings import Section, SettingError, Settings, from_dict, register_section, setting
 
 __all__ = ["InputSettings", "Result", "complete"]
@@ -136,7 +136,7 @@ def complete(
     points: Any,
     *,
     camera: Camera | Mapping[str, Any] | None = None,
-    method: str = "evidence",
+    method: str = DEFAULT_METHOD,
     settings: Settings | Mapping[str, Any] | None = None,
 ) -> Result:
     """Complete one fruit seen from one view and box it.

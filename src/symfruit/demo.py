@@ -18,6 +18,7 @@ from .core.box import centre_deviation
 from .detect import Detection, FrameDetections, detect
 from .evaluate.frames import match
 from .io.frames import read_frame
+from .methods import DEFAULT_METHOD
 from .settings import Settings
 from .writers import write_detections
 
@@ -54,7 +55,7 @@ class DemoReport:
         return (float(np.mean([p[0] for p in pairs])), float(np.mean([p[1] for p in pairs]))) if pairs else None
 
 
-def run_demo(output: str | Path, *, method: str = "evidence", settings: Settings | None = None) -> DemoReport:
+def run_demo(output: str | Path, *, method: str = DEFAULT_METHOD, settings: Settings | None = None) -> DemoReport:
     """Detect the example frame's fruit, write the outputs to ``output``, score them against the truth."""
     output = Path(output)
     with example_frame() as folder:

@@ -20,6 +20,7 @@ from .core.camera import Camera
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
 from .frame import Frame
+from .methods import DEFAULT_METHOD
 from .segment import segment
 from .settings import Settings
 
@@ -65,7 +66,8 @@ def frame_masks(
 
     ``masks`` is ``"auto"`` (the frame's own masks file if it has one, else the colour segmenter),
     ``"color"`` (the built-in segmenter), a label PNG or COCO JSON path, ``"maskrcnn:CHECKPOINT"``
-    (a torchvision Mask R-CNN, optional extra ``seg``), or a callable ``(frame, settings) -> labels``.
+    (a torchvision Mask R-CNN, optional extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation
+    export, optional extra ``onnx``), or a callable ``(frame, settings) -> labels``.
     """
     settings = settings or Settings()
     shape = frame.depth.shape
@@ -79,6 +81,10 @@ def frame_masks(
         from .segment_maskrcnn import maskrcnn_labels
 
         labels, source = maskrcnn_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
+    elif str(masks).startswith("onnx:"):
+        from .segment_onnx import onnx_labels
+
+        labels, source = onnx_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
     else:
         from .io.masks import read_masks
 
@@ -92,7 +98,7 @@ def detect(
     frame: Frame,
     *,
     masks: str | Path | Segmenter = "auto",
-    method: str = "evidence",
+    method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.

@@ -32,7 +32,11 @@ class Frame:
     source : str
         Where it came from (folder, or bag and timestamp).
     stamp : int, optional
-        Acquisition time, nanoseconds since the epoch (bags carry one).
+        Acquisition time of the colour image, nanoseconds since the epoch (bags and ROS messages carry
+        one; detections are stamped with it).
+    frame_id : str, optional
+        The colour image's coordinate frame (a ROS header's ``frame_id``); detections are in it.
+        None: ``camera_color_optical_frame``.
     extras : dict
     """
 
@@ -44,6 +48,7 @@ class Frame:
     truth: list[tuple[int, Box]] | None = None
     source: str = ""
     stamp: int | None = None
+    frame_id: str | None = None
     extras: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:

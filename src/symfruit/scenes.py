@@ -12,6 +12,7 @@ from __future__ import annotations
 import colorsys
 import os
 import shutil
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,7 +23,7 @@ from .core.camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
 from .shapes import leaf_outline, rotation, strawberry
 
-__all__ = ["Scene", "SceneFruit", "make_scene", "write_scenes"]
+__all__ = ["Scene", "SceneFruit", "make_photo", "make_scene", "write_scenes"]
 
 
 @dataclass(frozen=True)
@@ -239,3 +240,60 @@ def write_scenes(
                 shutil.copy2(path, target / path.name)
         written.append(target)
     return written
+
+
+def make_photo(
+    fruit: Sequence[tuple[float, float, float, tuple[int, int, int]]],
+    *,
+    shape: tuple[int, int] = (240, 320),
+    seed: int = 0,
+    background: tuple[int, int, int] = (225, 225, 222),
+    calyx: bool = False,
+) -> tuple[np.ndarray, np.ndarray]:
+    """A photo-like test image (no depth): shaded fruit discs on a light background, each with pale
+    seeds, a white specular highlight and (``calyx``) a green calyx over its top, and mild noise.
+
+    Parameters
+    ----------
+    fruit : sequence of (cx, cy, r, (R, G, B))
+        Disc centres and radii (pixels) and colours; later discs lie in front of earlier ones.
+    shape : (h, w)
+    seed : int
+        Seeds, highlights and noise are drawn from this seed.
+    background : (R, G, B)
+    calyx : bool
+
+    Returns
+    -------
+    color : (h, w, 3) uint8
+    truth : (n, h, w) bool
+        Each fruit's outline as an annotator draws it: its disc, less the fruit in front of it.
+    """
+    rng = np.random.default_rng(seed)
+    h, w = shape
+    yy, xx = np.mgrid[:h, :w]
+    img = np.empty((h, w, 3), np.float64)
+    img[:] = background
+    discs = []
+    for cx, cy, r, colour in fruit:
+        d2 = (xx - cx) ** 2 + (yy - cy) ** 2
+        inside = d2 <= r * r
+        shade = 0.6 + 0.4 * np.sqrt(np.clip(1 - d2 / (r * r), 0, 1))
+        img[inside] = np.asarray(colour, float) * shade[inside, None]
+        for _ in range(int(r * r / 40)):  # achenes: small pale dots
+            a, rho = rng.uniform(0, 2 * np.pi), r * np.sqrt(rng.uniform(0, 0.8))
+            x, y = int(cx + rho * np.cos(a)), int(cy + rho * np.sin(a))
+            if 1 <= x < w and 1 <= y < h:
+                img[y - 1 : y + 1, x - 1 : x + 1] = (230, 200, 90)
+        hx, hy = cx - r / 3, cy - r / 3
+        img[(xx - hx) ** 2 + (yy - hy) ** 2 <= (r / 5) ** 2] = (250, 250, 250)
+        if calyx:  # a five-lobed green star over the top of the fruit
+            ang = np.arctan2(yy - (cy - 0.8 * r), xx - cx)
+            star = np.hypot(xx - cx, yy - (cy - 0.8 * r)) <= 0.35 * r * (0.6 + 0.4 * np.cos(5 * ang))
+            img[star] = (70, 120, 40)
+        discs.append(inside)
+    img += rng.normal(scale=3, size=img.shape)
+    truth = np.zeros((len(discs), h, w), bool)
+    for k, disc in enumerate(discs):
+        truth[k] = disc & ~np.any(discs[k + 1 :], axis=0) if k + 1 < len(discs) else disc
+    return np.clip(img, 0, 255).astype(np.uint8), truth

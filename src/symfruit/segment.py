@@ -1,26 +1,66 @@
-"""The built-in segmenter: ripe red fruit by colour, split where fruit touch. No weights needed.
+"""The built-in segmenter: ripe red fruit by colour, each fruit whole, touching fruit apart. No weights.
 
-Steps: HSV thresholds (red hue, enough saturation and brightness, so white and green unripe fruit and
-the green calyx fall out), an opening and a closing, connected components, splitting of touching fruit
-at depth discontinuities and by a distance-transform watershed where a region has a waist, and removal
-of regions too small to be a fruit at their depth.
+A strawberry is a convex red body; what is not red on it (seeds, specular highlights, the green calyx
+lying over it) sits inside that body's outline. So the segmenter
+
+1. classes pixels by *chromaticity*, which shading does not change: redness ``(R - max(G, B)) / R``
+   (0 for white, grey and green, 1 for pure red) and hue. A region grows from strongly red seed pixels
+   (``redness >= red_high`` and a red, not orange, hue) through weakly red ones (``redness >= red_low``):
+   hysteresis. White and green (unripe) fruit, the calyx, stems, skin tones too weak to seed and the
+   light background never start a region; very dark pixels (deep shadow, black borders) are never red.
+   Red is looked for on a coarse grid first and at full resolution only around what it finds.
+2. splits each region where it is not one convex body. A convex body's *distance transform* (the
+   distance of each pixel to the region's outline) is concave: one peak, and the points deeper than any
+   radius stay connected. Two touching or overlapping fruit give two peaks joined by a *waist*. A peak
+   cut off from every larger one by a waist (below ``waist`` times its radius) is another fruit's
+   centre; the region is cut between the centres (each centre's deep core, every other pixel to the
+   nearest core). With depth, depth steps and concave depth creases count as outline, and every
+   saddle is a candidate. A cut is kept only where evidence backs two bodies:
+
+   * with depth: steps or creases along most of the cut, or two *surfaces*: the spheres fitted to the
+     two parts' depth points have centres more than ``sphere_apart`` of the sum of their radii apart
+     (touching fruit: about one sum of radii; one fruit cut in two: one centre);
+   * by shape: a waist, and *convexity defects* where the parts meet: the hull of the two parts exceeds
+     their own hulls by more than ``merge_slack`` (they are not one convex body).
+3. merges the fragments of one fruit (pieces the calyx, a stem or a highlight band cut apart): two
+   pieces whose union's hull, less the green pixels in it, exceeds their own hulls by at most
+   ``merge_slack`` are one convex body; with depth, the smaller one must also lie on the larger one's
+   sphere.
+4. reports each fruit as its convex hull: seeds, highlights and the calyx inside the outline are filled
+   (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
+   green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
+5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
+   depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
+   berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
+
+Fruit cut by the image border are kept (their hull is cut by the border too).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, Protocol
 
 import numpy as np
 from scipy import ndimage
 
-from .core.camera import Camera
-from .settings import Section, register_section, setting
+from .errors import InputError
+from .settings import Section, SettingError, register_section, setting
 
-__all__ = ["SegmentSettings", "red_mask", "segment"]
+__all__ = ["SegmentSettings", "convex_hull_mask", "redness", "ripe_seeds", "segment"]
 
 #: Largest morphology or smoothing radius a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
+
+Window = tuple[slice, slice]
+
+
+class _Focal(Protocol):
+    @property
+    def fx(self) -> float: ...
+
+    @property
+    def fy(self) -> float: ...
 
 
 @dataclass(frozen=True)
@@ -29,83 +69,237 @@ class SegmentSettings(Section):
 
     Attributes
     ----------
-    hue_low, hue_high : float, degrees
-        Red hues wrap around 0: a pixel is red when its hue is >= ``hue_low`` or <= ``hue_high``.
-    sat_min, val_min : float in [0, 1]
-        Least saturation and value (brightness) of a ripe fruit pixel; unripe (white, green) fruit fail.
-    open_px, close_px : int
-        Radii of the disc opening (removes specks) and closing (fills seeds, glints and the gaps
-        thin stems cut).
-    min_diameter : float, metres
-        Regions smaller than a fruit of this diameter would look at their depth are ignored.
+    red_high, red_low : float in (0, 1)
+        Redness ``(R - max(G, B)) / R`` a seed pixel needs, and that a pixel needs to join a region
+        grown from seeds. White, grey and green pixels have redness <= 0.
+    hue_max : float, degrees
+        Seed pixels must have a hue below this (red-magenta to red-orange: ``atan2(sqrt(3) (G - B),
+        2R - G - B)``); skin and orange tones above it do not seed.
+    dark : int, 0-255
+        Pixels with red channel at or below this are never fruit (black borders, deep shadow, where
+        the chromaticity is noise).
+    close_px : int, pixels
+        Radius of a closing of each region before it is split (bridges seeds on its outline); 0: none.
+    min_area_share : float
+        Without depth, the least area of a fruit as a share of the image.
+    merge_slack : float
+        Two pieces are one fruit when the convex hull of their union exceeds the sum of their own hulls
+        by at most this share; a region is split only where its parts exceed it.
+    fill : {"auto", "hull", "surface"}
+        What of a fruit's convex hull is reported: the whole hull (its outline, as annotators draw it:
+        the calyx lying over the fruit included), or its visible surface (green calyx, leaf and stem
+        pixels over it left out; what the extraction of points needs). "auto": the surface with depth,
+        the hull without.
     split : {"both", "depth", "watershed", "none"}
-        How touching fruit are split: at depth discontinuities, by a distance-transform watershed
-        when the region has a waist, both, or not at all.
+        The evidence a cut between touching fruit may rest on: the shape of the region (a waist with
+        convexity defects, "watershed"), its depth (steps, creases, two surfaces; with depth only),
+        both, or none (touching fruit stay one region).
+    waist : float in (0, 1]
+        By shape, two distance-transform peaks are separate fruit when the region between them narrows
+        below this share of the smaller peak's inscribed radius.
+    max_elongation : float
+        Without depth, parts whose hull is more elongated than this (ratio of principal axes) are not fruit
+        (a finger, a rim of skin); with depth the size rule in metres decides, and a sliver of a fruit
+        seen past a leaf is kept.
+    ripe_median : float
+        A ripe fruit is red over most of its body: the median redness of a part's red pixels must reach
+        this. Skin, and fruit that are only blushed (white or green with a pink tinge), fall short.
+    min_diameter : float, metres
+        With depth: parts smaller than a fruit of this diameter at their depth are ignored.
     depth_jump : float, metres
-        A depth step between neighbouring pixels larger than this separates two fruit.
+        With depth: a step between neighbouring pixels larger than this separates fruit; hull pixels
+        farther than this from the fruit's median depth are dropped.
     crease_curvature : float, 1/metres
-        A seam between touching fruit at the same depth shows as a concave crease of the depth
-        surface: the smoothed depth's Laplacian below ``-crease_curvature`` (in metres per metre
-        squared) separates fruit. Convex fruit surfaces never reach it.
+        With depth: a concave crease of the smoothed depth (Laplacian below ``-crease_curvature``
+        metres per metre squared) separates fruit at the same depth. Convex fruit surfaces never reach it.
     crease_sigma : float, pixels
         Smoothing of the depth before the crease test (the sensor noise must not look like creases).
-    waist : float
-        Split two distance-transform peaks only if the region between them narrows below this share
-        of the smaller peak's width.
+    sphere_apart : float
+        With depth: two touching parts are two fruit when the spheres fitted to their depth points have
+        centres farther apart than this share of the sum of their radii (touching fruit: about 1; one
+        fruit cut in two: about 0); two fragments are one fruit when the smaller lies on the larger's
+        sphere within this share of its radius.
     """
 
-    hue_low: float = setting(340.0, ge=0.0, le=360.0)
-    hue_high: float = setting(15.0, ge=0.0, le=360.0)
-    sat_min: float = setting(0.45, ge=0.0, le=1.0)
-    val_min: float = setting(0.15, ge=0.0, le=1.0)
-    open_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
-    close_px: int = setting(2, ge=0, le=MAX_RADIUS_PX)
-    min_diameter: float = setting(0.012, gt=0.0, le=1.0)
+    red_high: float = setting(0.30, gt=0.0, lt=1.0)
+    red_low: float = setting(0.12, gt=0.0, lt=1.0)
+    hue_max: float = setting(25.0, gt=0.0, lt=90.0)
+    dark: int = setting(40, ge=0, le=254)
+    close_px: int = setting(0, ge=0, le=MAX_RADIUS_PX)
+    min_area_share: float = setting(0.002, ge=0.0, lt=1.0)
+    merge_slack: float = setting(0.08, ge=0.0, le=1.0)
+    fill: Literal["auto", "hull", "surface"] = setting("auto")
     split: Literal["both", "depth", "watershed", "none"] = setting("both")
+    waist: float = setting(0.6, gt=0.0, le=1.0)
+    max_elongation: float = setting(3.0, ge=1.0, le=100.0)
+    ripe_median: float = setting(0.20, ge=0.0, lt=1.0)
+    min_diameter: float = setting(0.012, gt=0.0, le=1.0)
     depth_jump: float = setting(0.015, gt=0.0, le=10.0)
     crease_curvature: float = setting(1500.0, gt=0.0, le=1e7)
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
-    waist: float = setting(0.75, gt=0.0, le=1.0)
+    sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
+
+    def check(self) -> None:
+        if self.red_low > self.red_high:
+            raise SettingError("red_low", f"must not exceed red_high ({self.red_high:g}), got {self.red_low:g}")
 
 
 register_section("segment", SegmentSettings)
 
 
-def red_mask(color: np.ndarray, settings: SegmentSettings | None = None) -> np.ndarray:
-    """(h, w) bool: pixels whose colour is ripe-fruit red."""
-    from PIL import Image
-
-    s = settings or SegmentSettings()
-    hsv = np.asarray(Image.fromarray(color).convert("HSV"))
-    hue = hsv[:, :, 0].astype(np.float32) * (360.0 / 256.0)
-    red = (hue >= s.hue_low) | (hue <= s.hue_high)
-    return red & (hsv[:, :, 1] >= s.sat_min * 255) & (hsv[:, :, 2] >= s.val_min * 255)
-
-
-def _disc(r: int) -> np.ndarray:
-    yy, xx = np.mgrid[-r : r + 1, -r : r + 1]
-    return xx * xx + yy * yy <= r * r
+def _color(color: np.ndarray) -> np.ndarray:
+    c = np.asarray(color)
+    if c.ndim != 3 or c.shape[2] not in (3, 4) or c.shape[0] < 1 or c.shape[1] < 1:
+        raise InputError(f"color must be an (h, w, 3) image, got shape {c.shape}")
+    if c.dtype != np.uint8:
+        if not np.issubdtype(c.dtype, np.number) or not np.isfinite(c).all():
+            raise InputError("color must be a finite uint8 image (0-255)")
+        c = np.clip(c, 0, 255).astype(np.uint8)
+    return c[:, :, :3]
 
 
-def _window(mask: np.ndarray, pad: int) -> tuple[slice, slice] | None:
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if len(rows) == 0:
-        return None
-    h, w = mask.shape
-    return (slice(max(rows[0] - pad, 0), min(rows[-1] + pad + 1, h)),
-            slice(max(cols[0] - pad, 0), min(cols[-1] + pad + 1, w)))  # fmt: skip
+def redness(color: np.ndarray) -> np.ndarray:
+    """Chromatic redness ``(R - max(G, B)) / R`` of each pixel (negative when not red).
+
+    Parameters
+    ----------
+    color : (h, w, 3) uint8, or (n, 3)
+
+    Returns
+    -------
+    (h, w) float32 (or (n,)), at most 1; independent of the brightness (shading) of a pixel.
+
+    Examples
+    --------
+    >>> redness(np.array([[[200, 50, 40], [100, 25, 20], [90, 90, 90]]], np.uint8)).round(2)
+    array([[0.75, 0.75, 0.  ]], dtype=float32)
+    """
+    c = np.asarray(color)
+    if c.ndim == 2 and c.shape[-1] in (3, 4):
+        c = c[None]
+    c = _color(c)
+    r = c[..., 0].astype(np.float32)
+    gb = np.maximum(c[..., 1], c[..., 2]).astype(np.float32)
+    out = (r - gb) / np.maximum(r, 1.0)
+    return out[0] if np.asarray(color).ndim == 2 else out
 
 
-def segment(
-    color: np.ndarray, depth: np.ndarray, camera: Camera, settings: SegmentSettings | None = None
-) -> np.ndarray:
-    """Instance labels of the ripe fruit in a frame.
+def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """The seed (strongly red) and grow (weakly red) pixel masks of :func:`segment`.
 
     Parameters
     ----------
     color : (h, w, 3) uint8
-    depth : (h, w) float, metres (0 = no depth)
-    camera : Camera
+    settings : SegmentSettings
+
+    Returns
+    -------
+    strong, weak : (h, w) bool
+    """
+    s = settings or SegmentSettings()
+    c = _color(color)
+    r, g, b = c[:, :, 0], c[:, :, 1], c[:, :, 2]
+    mgb = np.maximum(g, b)
+    # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
+    levels = np.arange(256, dtype=np.float64)
+    low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
+    high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
+    low[: s.dark + 1] = -1  # dark pixels are never red
+    high[: s.dark + 1] = -1
+    weak = mgb <= low[r]
+    strong = mgb <= high[r]
+    # hue < hue_max  <=>  sqrt(3) (G - B) < tan(hue_max) (2R - G - B)  (2R - G - B > 0 on red pixels);
+    # tested on the strongly red pixels only
+    idx = np.flatnonzero(strong)
+    rs, gs, bs = (ch.ravel()[idx].astype(np.int16) for ch in (r, g, b))
+    ok = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
+    strong = np.zeros(r.shape, bool)
+    strong.ravel()[idx[ok]] = True
+    return strong, weak
+
+
+def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
+    """The filled convex hull of a mask's pixels (pixel centres, edges included).
+
+    Parameters
+    ----------
+    mask : (h, w) bool
+
+    Returns
+    -------
+    (h, w) bool, a superset of ``mask``.
+
+    Examples
+    --------
+    >>> m = np.zeros((5, 5), bool); m[0, 0] = m[0, 4] = m[4, 0] = True
+    >>> int(convex_hull_mask(m).sum())
+    15
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if mask.ndim != 2:
+        raise InputError(f"mask must be (h, w), got shape {mask.shape}")
+    vertices = _hull_vertices(mask)
+    if vertices is None:
+        return mask.copy()
+    return _fill_polygon(vertices, mask.shape) | mask
+
+
+def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
+    """(m, 2) float (x, y) vertices of the convex hull of the mask's pixels; None when degenerate."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    rows = np.flatnonzero(mask.any(axis=1))
+    if len(rows) == 0:
+        return None
+    sub = mask[rows]
+    first = np.argmax(sub, axis=1)
+    last = mask.shape[1] - 1 - np.argmax(sub[:, ::-1], axis=1)
+    pts = np.r_[np.c_[first, rows], np.c_[last, rows]].astype(np.float64)  # row ends span every pixel's hull
+    if len(rows) < 2 and np.all(first == last):
+        return None
+    try:
+        return pts[ConvexHull(pts).vertices]
+    except QhullError:  # all on a line
+        return None
+
+
+def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    from PIL import Image, ImageDraw
+
+    img = Image.new("L", (shape[1], shape[0]), 0)
+    ImageDraw.Draw(img).polygon([tuple(v) for v in vertices.tolist()], fill=1, outline=1)
+    return np.asarray(img, dtype=bool)
+
+
+def _hull_area(mask: np.ndarray) -> float:
+    """Area of the hull polygon of the mask's pixel centres, plus its half-perimeter (the pixels' own area
+    beyond the centres): the filled hull's pixel count, without drawing it."""
+    v = _hull_vertices(mask)
+    if v is None:
+        return float(mask.sum())
+    x, y = v[:, 0], v[:, 1]
+    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+    perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+    return area + 0.5 * perimeter + 1.0
+
+
+def segment(
+    color: np.ndarray,
+    depth: np.ndarray | None = None,
+    camera: _Focal | None = None,
+    settings: SegmentSettings | None = None,
+) -> np.ndarray:
+    """Instance labels of the ripe fruit in an image, each fruit whole.
+
+    Parameters
+    ----------
+    color : (h, w, 3) uint8
+    depth : (h, w) float, metres, optional
+        0 = no depth. Without depth (or with none valid) the rules that need it are skipped: no
+        depth split, and the size rule is ``min_area_share`` of the image.
+    camera : object with ``fx``, ``fy`` (pixels), optional
+        Needed with depth (the size rule and the depth tests convert metres to pixels); its ``cx``,
+        ``cy`` are used when it has them (else the image centre).
     settings : SegmentSettings
 
     Returns
@@ -113,143 +307,585 @@ def segment(
     (h, w) int32: 0 background, 1..k the fruit, numbered left to right.
     """
     s = settings or SegmentSettings()
-    red = red_mask(color, s)
-    mask = np.zeros_like(red)
-    window = _window(red, pad=2 * (s.open_px + s.close_px) + 2)
-    if window is not None:  # morphology only where there is red: the rest of the image stays empty
-        part = red[window]
-        if s.open_px:
-            part = ndimage.binary_opening(part, structure=_disc(s.open_px))
-        if s.close_px:
-            part = ndimage.binary_closing(part, structure=_disc(s.close_px)) | part
-        mask[window] = part
-    labels, _ = ndimage.label(mask)
-    out = np.zeros(mask.shape, np.int32)
-    next_id = 1
-    for k, sl in enumerate(ndimage.find_objects(labels), 1):
-        if sl is None:
+    c = _color(color)
+    h, w = c.shape[:2]
+    z, geo = _depth(depth, camera, (h, w))
+    min_area = max(s.min_area_share * h * w, 4.0)
+
+    # Red pixels are looked for on a coarse grid first, then at full resolution around what it found: a
+    # region that no grid point falls in is far smaller than a fruit.
+    strong = np.zeros((h, w), bool)
+    weak = np.zeros((h, w), bool)
+    pieces: list[_Piece] = []
+    sources = 0
+    for win in _red_windows(c, s):
+        strong[win], weak[win] = ripe_seeds(c[win], s)
+        labels, n = ndimage.label(weak[win], structure=np.ones((3, 3), bool))
+        if n == 0:
             continue
-        sl = (slice(max(sl[0].start - 1, 0), sl[0].stop + 1), slice(max(sl[1].start - 1, 0), sl[1].stop + 1))
-        region = labels[sl] == k
-        # Depth is trusted only on red pixels: pixels the closing added may be stems or leaves in front.
-        parts = _split(region, np.where(red[sl], depth[sl], 0.0), s, camera)
-        for part in parts:
-            if _big_enough(part, depth[sl], s, camera):
-                out[sl][part] = next_id
-                next_id += 1
-    return _renumber(out, next_id - 1)
+        seeded = np.zeros(n + 1, bool)
+        seeded[labels[strong[win]]] = True
+        seeded[0] = False
+        sizes = np.bincount(labels.ravel(), minlength=n + 1)
+        keep = seeded & (sizes >= 0.25 * min_area)  # fragments down to a quarter of a fruit may join one
+        for k, sl in enumerate(ndimage.find_objects(labels), 1):
+            if not keep[k] or sl is None:
+                continue
+            sl = _pad(sl, 1, labels.shape)
+            region = labels[sl] == k
+            sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
+                  slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
+            sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
+            origin = (sl[0].start, sl[1].start)
+            pieces += [_Piece(sl, part, 1 << sources) for part in _split(region, sub_z, s, geo, origin, min_area)]
+            sources += 1
+    if not pieces:
+        return np.zeros((h, w), np.int32)
+    pieces = _merge(pieces, s, c, weak, z, geo)
+
+    pieces = sorted(pieces, key=lambda p: -p.area)
+    owner = np.zeros((h, w), np.int32)  # which piece each red pixel is part of: no hull takes another's
+    for k, piece in enumerate(pieces, 1):
+        owner[piece.window][piece.mask] = k
+    out = np.zeros((h, w), np.int32)
+    found: list[tuple[Window, np.ndarray]] = []
+    for k, piece in enumerate(pieces, 1):
+        sl, part = piece.window, piece.mask
+        red = part & weak[sl]
+        if not red.any() or np.median(redness(c[sl][red])) < s.ripe_median:
+            continue
+        hull = convex_hull_mask(part) & ((owner[sl] == 0) | (owner[sl] == k))
+        sub_z = None if z is None else z[sl]
+        if s.fill == "surface" or (s.fill == "auto" and sub_z is not None):
+            hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
+        if sub_z is not None:
+            hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
+        if not _fruit_sized(hull, sub_z, s, geo.focal, min_area):
+            continue
+        if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
+            continue
+        free = hull & (out[sl] == 0)
+        if free.sum() < 0.5 * hull.sum():  # mostly inside a larger fruit: a piece of it, not a fruit
+            continue
+        out[sl][free] = -1
+        found.append((sl, free))
+    # number the fruit left to right (then top to bottom) by their box centres, for stable ids
+    order = sorted(range(len(found)), key=lambda i: _box_centre(*found[i]))
+    for new, i in enumerate(order, 1):
+        sl, free = found[i]
+        out[sl][free] = new
+    return out
 
 
-def _split(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, camera: Camera) -> list[np.ndarray]:
-    parts = [region]
-    if s.split in ("depth", "both"):
-        focal = float(np.sqrt(camera.fx * camera.fy))
-        parts = [p for part in parts for p in _split_depth(part, depth, s, focal)]
-    if s.split in ("watershed", "both"):
-        parts = [p for part in parts for p in _split_waist(part, s)]
-    return parts
+#: Grid step of the first, coarse look for red pixels (pixels).
+COARSE_STEP = 4
 
 
-def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
-    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam.
+def _red_windows(c: np.ndarray, s: SegmentSettings) -> list[Window]:
+    """Disjoint image windows holding every weakly red region with a grid point in it (a coarse grid of
+    step :data:`COARSE_STEP`), each with a margin of one grid step."""
+    h, w = c.shape[:2]
+    step = COARSE_STEP
+    _, weak = ripe_seeds(c[::step, ::step], s)
+    if not weak.any():
+        return []
+    lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    sizes[0] = 0
+    # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
+    lab, _ = ndimage.label(ndimage.binary_dilation((sizes >= 2)[lab], structure=np.ones((3, 3), bool)))
+    boxes = [[max(sl[0].start * step - step, 0), min(sl[0].stop * step + step, h),
+              max(sl[1].start * step - step, 0), min(sl[1].stop * step + step, w)]
+             for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
+    merged = True
+    while merged:  # join overlapping windows, so that each region lies in one window only
+        merged = False
+        for i in range(len(boxes)):
+            for j in range(i + 1, len(boxes)):
+                a, b = boxes[i], boxes[j]
+                if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]:
+                    boxes[i] = [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])]
+                    del boxes[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in boxes]
 
-    Fruit bulge toward the camera, so inside a fruit the smoothed depth is convex (positive
-    Laplacian); the seam between two touching fruit is a sharp ridge of depth (strongly negative).
+
+def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    x = sl[1].start + (cols[0] + cols[-1] + 1) / 2
+    y = sl[0].start + (rows[0] + rows[-1] + 1) / 2
+    return round(x / 20), y
+
+
+def _green(color: np.ndarray) -> np.ndarray:
+    """(h, w) bool: green pixels (calyx, leaves, stems): green the largest channel, and saturated (a third
+    above the smallest; a grey-green backdrop is not)."""
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    return (g > r) & (g >= b) & (3 * (g - np.minimum(r, b)) >= g)
+
+
+def _depth(
+    depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]
+) -> tuple[np.ndarray | None, _Geometry]:
+    """The depth (0 where invalid) and the camera geometry (the principal point defaults to the image
+    centre), or ``(None, ...)`` without usable depth."""
+    none = _Geometry(0.0, shape[0] / 2, shape[1] / 2)
+    if depth is None:
+        return None, none
+    z = np.asarray(depth, dtype=np.float64)
+    if z.shape != shape:
+        raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
+    z = np.where(np.isfinite(z) & (z > 0), z, 0.0)
+    if not (z > 0).any():
+        return None, none
+    if camera is None:
+        raise InputError("segment: a camera (fx, fy) is needed with depth")
+    try:
+        fx, fy = float(camera.fx), float(camera.fy)
+        cx, cy = float(getattr(camera, "cx", shape[1] / 2)), float(getattr(camera, "cy", shape[0] / 2))
+    except (TypeError, ValueError):
+        raise InputError("segment: camera fx, fy (cx, cy) must be numbers") from None
+    if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
+        raise InputError("segment: camera fx, fy must be positive")
+    cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
+    return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+
+
+def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
+    return (slice(max(sl[0].start - pad, 0), min(sl[0].stop + pad, shape[0])),
+            slice(max(sl[1].start - pad, 0), min(sl[1].stop + pad, shape[1])))  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _Geometry:
+    """What the depth rules need of the camera: the focal length and principal point (pixels)."""
+
+    focal: float
+    cy: float
+    cx: float
+
+
+@dataclass
+class _Piece:
+    """A candidate fruit: its mask inside an image window, the region it came from, its hull area."""
+
+    window: Window
+    mask: np.ndarray
+    source: int  # a bit set of the colour regions it came from
+    hull: float = -1.0
+
+    def __post_init__(self) -> None:
+        self.area = int(self.mask.sum())
+        if self.hull < 0:
+            self.hull = _hull_area(self.mask)
+
+
+def _merge(
+    pieces: list[_Piece],
+    s: SegmentSettings,
+    color: np.ndarray,
+    weak: np.ndarray,
+    depth: np.ndarray | None,
+    geo: _Geometry,
+) -> list[_Piece]:
+    """Join pieces of one convex body (greedy, largest first): the hull of their union, less the green
+    pixels in it that are neither piece (a stem, a leaf or the calyx lying across the fruit), exceeds
+    their own hulls by at most ``merge_slack``; with depth, the smaller piece's points must also lie on
+    the sphere of the larger (:func:`_same_surface`). Parts cut from one region (the same ``source``)
+    were kept apart on purpose and are not joined again."""
+    slack = s.merge_slack
+    pieces = sorted(pieces, key=lambda p: -p.area)
+    merged = True
+    while merged and len(pieces) > 1:
+        merged = False
+        for i in range(len(pieces)):
+            for j in range(i + 1, len(pieces)):
+                a, b = pieces[i], pieces[j]
+                gap = max(2, int(0.5 * np.sqrt(min(a.area, b.area))))  # an occluder narrower than the fruit
+                if (a.source & b.source) or not _near(a.window, b.window, gap=gap):
+                    continue
+                window, union = _union(a, b)
+                hull = _hull_area(union)
+                if hull > (1.0 + slack) * (a.hull + b.hull):
+                    hull -= float((convex_hull_mask(union) & ~union & _green(color[window])).sum())
+                if hull <= (1.0 + slack) * (a.hull + b.hull) and (
+                    depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
+                ):
+                    pieces[i] = _Piece(window, union, a.source | b.source, hull)
+                    del pieces[j]
+                    merged = True
+                    break
+            if merged:
+                break
+    return pieces
+
+
+def _same_surface(
+    a: _Piece, b: _Piece, depth: np.ndarray, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
+) -> bool | None:
+    """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
+    distance off it at most ``sphere_apart`` times its radius); None when there is no fit."""
+    big, small = (a, b) if a.area >= b.area else (b, a)
+    origin = (big.window[0].start, big.window[1].start)
+    fit = _sphere(big.mask & weak[big.window], depth[big.window], geo, origin)
+    p = _points(
+        small.mask & weak[small.window], depth[small.window], geo, (small.window[0].start, small.window[1].start)
+    )
+    if fit is None or len(p) < 20:
+        return None
+    off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
+    return bool(np.median(off) <= s.sphere_apart * fit[1])
+
+
+def _near(a: Window, b: Window, *, gap: int) -> bool:
+    return (a[0].start - gap < b[0].stop and b[0].start - gap < a[0].stop
+            and a[1].start - gap < b[1].stop and b[1].start - gap < a[1].stop)  # fmt: skip
+
+
+def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
+    sa, sb = a.window, b.window
+    r0, r1 = min(sa[0].start, sb[0].start), max(sa[0].stop, sb[0].stop)
+    c0, c1 = min(sa[1].start, sb[1].start), max(sa[1].stop, sb[1].stop)
+    out = np.zeros((r1 - r0, c1 - c0), bool)
+    out[sa[0].start - r0 : sa[0].stop - r0, sa[1].start - c0 : sa[1].stop - c0] |= a.mask
+    out[sb[0].start - r0 : sb[0].stop - r0, sb[1].start - c0 : sb[1].stop - c0] |= b.mask
+    return (slice(r0, r1), slice(c0, c1)), out
+
+
+def _split(
+    region: np.ndarray,
+    depth: np.ndarray | None,
+    s: SegmentSettings,
+    geo: _Geometry,
+    origin: tuple[int, int],
+    min_area: float,
+) -> list[np.ndarray]:
+    """Cut a region into fruit (see the module docstring): at waists of its distance transform (the depth
+    steps and creases taken as part of its outline), keeping the cuts that evidence backs."""
+    region = ndimage.binary_fill_holes(region)
+    if s.close_px:
+        r = s.close_px
+        padded = np.pad(region, r + 1)
+        region = ndimage.binary_closing(padded, structure=_disc(r))[r + 1 : -r - 1, r + 1 : -r - 1] | region
+    use_depth = depth is not None and s.split in ("depth", "both") and int((depth[region] > 0).sum()) >= 20
+    if s.split == "none" or (s.split == "depth" and not use_depth):
+        return [region]
+    carved, edges = region, None
+    # the smallest fruit worth cutting off: fruit-sized (with depth: at its depth, and half of it may be
+    # hidden behind the fruit in front or a leaf)
+    least = np.sqrt(min_area / np.pi)
+    if use_depth and depth is not None:
+        edges = _depth_edges(region, depth, s, geo.focal)
+        carved = ndimage.binary_fill_holes(region & ~edges)
+        least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
+    # with depth, every saddle of the distance transform is tried: the depth surface decides
+    centres = _centres(
+        carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
+    )
+    if len(centres) < 2:
+        return [region]
+    cells = _cells(region, [(a, b, r) for a, b, r, _ in centres], CANDIDATE_WAIST if use_depth else s.waist)
+    if len(cells) < 2:
+        return [region]
+    firm = [f for *_, f in centres]
+    spheres = [_sphere(c, depth, geo, origin) if use_depth and depth is not None else None for c in cells]
+    parts = _supported(cells, firm, spheres, edges, s, by_shape=s.split in ("watershed", "both"))
+    return parts if edges is None or len(parts) < 2 else _follow_edges(parts, region, edges)
+
+
+def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray) -> list[np.ndarray]:
+    """Move the cut between fruit onto the depth steps and creases where they run: every piece of the region
+    that the edges enclose goes whole to the fruit holding most of it (when one holds at least
+    :data:`EDGE_PURITY` of it), and the edge pixels to the nearest piece. A front fruit's rim, not a straight
+    line through the one behind, then separates them."""
+    pieces, n = ndimage.label(region & ~edges)
+    if n < 2:
+        return parts
+    owner = np.zeros(region.shape, np.int64)
+    for k, part in enumerate(parts, 1):
+        owner[part] = k
+    counts = np.zeros((n + 1, len(parts) + 1), np.int64)
+    np.add.at(counts, (pieces.ravel(), owner.ravel()), 1)
+    major = counts[:, 1:].argmax(axis=1) + 1
+    total = counts[:, 1:].sum(axis=1)
+    pure = counts[np.arange(n + 1), major] >= EDGE_PURITY * np.maximum(total, 1)
+    seeds = np.where(pure[pieces], major[pieces], owner)
+    seeds[(pieces == 0) | ~region] = 0  # edge pixels and the outside: to the nearest piece
+    if not seeds.any():
+        return parts
+    _, (ri, ci) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
+    grown = np.where(region, seeds[ri, ci], 0)
+    return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
+
+
+#: Share of an edge-enclosed piece that one fruit must already hold for the whole piece to go to it.
+EDGE_PURITY = 0.9
+
+
+#: With depth, a peak of the distance transform is a candidate fruit centre when any path to a larger peak
+#: dips below this share of its radius; whether it is a fruit is then decided by the depth surface.
+CANDIDATE_WAIST = 0.9
+
+
+def _centres(
+    region: np.ndarray, least: float, waist: float, loose: float, *, coarse: bool = True
+) -> list[tuple[int, int, float, bool]]:
+    """Fruit centres ``(row, col, inscribed radius, firm)``: peaks of the distance transform, largest first,
+    each outside the inscribed discs of the larger ones and separated from each by a waist.
+
+    A convex body's distance transform is concave: it has a single peak, and every set of its points
+    deeper than some radius is connected. A peak of radius ``r`` is another fruit when it lies in a
+    different connected component of the points deeper than ``loose * r`` than every larger centre;
+    ``firm`` when it is so even at ``waist * r`` (the region narrows to a ``waist`` between them).
+    With ``coarse``, fruit-sized regions are searched on every other pixel (four times fewer).
     """
-    valid = region & (depth > 0)
-    if valid.sum() < 20:
-        return np.zeros(region.shape, bool)
-    _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
-    filled = depth[ri, ci].astype(np.float64)
-    smooth = ndimage.gaussian_filter(filled, s.crease_sigma)
-    lap = ndimage.laplace(smooth)
-    z = float(np.median(depth[valid]))
-    threshold = s.crease_curvature * (z / focal) ** 2  # metres per pixel^2 at this depth
-    return region & (lap < -threshold)
+    if coarse and least >= 8:  # a fruit at least 16 pixels across is found as well on every other pixel
+        step = 2
+        found = _centres(region[::step, ::step], least / step, waist, loose, coarse=False)
+        return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
+    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    if float(edt.max()) < least:
+        return []
+    # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
+    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
+    pr, pc = np.nonzero(peaks)
+    order = np.argsort(-edt[pr, pc], kind="stable")
+    centres: list[tuple[int, int, float, bool]] = []
+    budget = [MAX_WAIST_TESTS]
+    for i in order[:400]:
+        p, q, r = int(pr[i]), int(pc[i]), float(edt[pr[i], pc[i]])
+        if any((p - a) ** 2 + (q - b) ** 2 <= ra * ra for a, b, ra, _ in centres):
+            continue  # inside a larger fruit's inscribed disc
+        firm = True
+        if centres:
+            if not _separate(edt, (p, q), centres, loose * r, budget):
+                continue  # joined to a larger peak without a waist: the same fruit
+            if waist < loose:
+                firm = _separate(edt, (p, q), centres, waist * r, budget)
+        centres.append((p, q, r, firm))
+        if len(centres) >= 8 or budget[0] <= 0:
+            break
+    return centres
 
 
-def _split_depth(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> list[np.ndarray]:
-    """Cut a region along depth steps larger than ``depth_jump`` and along concave creases."""
+#: Most connected-component labellings one region's waist tests may take (a hand or a vine with many
+#: bumps is not a cluster of fruit; this bounds the time such a region costs).
+MAX_WAIST_TESTS = 16
+
+
+def _on_path(edt: np.ndarray, p: tuple[int, int], others: list[tuple[int, int]], t: float) -> bool:
+    """Whether a straight path from ``p`` to one of ``others`` stays deeper than ``t``."""
+    for a, b in others:
+        n = int(max(abs(a - p[0]), abs(b - p[1]))) + 1
+        rows = np.rint(np.linspace(p[0], a, n + 1)).astype(np.int64)
+        cols = np.rint(np.linspace(p[1], b, n + 1)).astype(np.int64)
+        if float(edt[rows, cols].min()) > t:
+            return True
+    return False
+
+
+def _supported(
+    cells: list[np.ndarray],
+    firm: list[bool],
+    spheres: list[tuple[np.ndarray, float] | None],
+    edges: np.ndarray | None,
+    s: SegmentSettings,
+    *,
+    by_shape: bool = True,
+) -> list[np.ndarray]:
+    """Join again the neighbouring cells whose cut no evidence of two bodies backs. The evidence is
+
+    * with depth: depth steps or creases along most of the cut, or two surfaces: the spheres that fit
+      the two cells' depth points lie apart, their centres farther than ``sphere_apart`` times the sum of
+      their radii (one fruit cut in two gives two fits about one centre; two touching fruit, two spheres
+      touching: centres a sum of radii apart);
+    * shape (``by_shape``), when a cell lacks a sphere: a waist between their centres (``firm``) and
+      convexity defects: the convex hull of the two cells exceeds their own hulls by more than
+      ``merge_slack`` (they are not one convex body).
+    """
+    n = len(cells)
+    grown = [ndimage.binary_dilation(c, structure=np.ones((3, 3), bool)) for c in cells]
+    hulls = [_hull_area(c) for c in cells]
+    near_edges = None if edges is None else ndimage.binary_dilation(edges, iterations=2)
+    owner = list(range(n))
+
+    def root(i: int) -> int:
+        while owner[i] != i:
+            i = owner[i]
+        return i
+
+    for i in range(n):
+        for j in range(i + 1, n):
+            cut = (cells[i] & grown[j]) | (cells[j] & grown[i])
+            if not cut.any():
+                continue
+            if near_edges is not None and near_edges[cut].mean() >= 0.5:
+                continue  # a depth step or crease runs along the cut
+            two = _two_spheres(spheres[i], spheres[j], s)
+            if two:
+                continue  # two surfaces
+            if (
+                two is None
+                and by_shape
+                and firm[j]
+                and _hull_area(cells[i] | cells[j]) > (1 + s.merge_slack) * (hulls[i] + hulls[j])
+            ):
+                continue  # a waist, and concave where they meet: two convex bodies touching
+            owner[root(j)] = root(i)
+    groups: dict[int, np.ndarray] = {}
+    for i in range(n):
+        r = root(i)
+        groups[r] = groups[r] | cells[i] if r in groups else cells[i]
+    return list(groups.values())
+
+
+def _points(
+    mask: np.ndarray, depth: np.ndarray, geo: _Geometry, origin: tuple[int, int], most: int = 1500
+) -> np.ndarray:
+    """(n, 3) camera-frame points (metres) of the mask's pixels with depth, in a window at ``origin``; at
+    most ``most`` of them, evenly picked."""
+    rows, cols = np.nonzero(mask & (depth > 0))
+    if len(rows) > most:
+        pick = np.linspace(0, len(rows) - 1, most).astype(np.int64)
+        rows, cols = rows[pick], cols[pick]
+    z = depth[rows, cols]
+    return np.c_[(cols + origin[1] - geo.cx) * z / geo.focal, (rows + origin[0] - geo.cy) * z / geo.focal, z]
+
+
+def _two_spheres(
+    a: tuple[np.ndarray, float] | None, b: tuple[np.ndarray, float] | None, s: SegmentSettings
+) -> bool | None:
+    """Whether two fitted spheres are two fruit (centres more than ``sphere_apart`` of the sum of their
+    radii apart) or one; None when either fit is missing."""
+    if a is None or b is None:
+        return None
+    return bool(np.linalg.norm(a[0] - b[0]) > s.sphere_apart * (a[1] + b[1]))
+
+
+def _sphere(
+    mask: np.ndarray, depth: np.ndarray, geo: _Geometry, origin: tuple[int, int], most: int = 1500
+) -> tuple[np.ndarray, float] | None:
+    """The sphere (centre in the camera frame, metres; radius) that best fits the depth points of a mask in
+    the window at ``origin`` (algebraic least squares, once more without the points far off it); None
+    with fewer than 20 points or when the fit is not a fruit-like cap (its radius off the points' own
+    spread by more than 4x either way)."""
+    p = _points(mask, depth, geo, origin, most)
+    if len(p) < 20:
+        return None
+    z = p[:, 2]
+    spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
+    p = p[np.abs(z - np.median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+    centre, radius = np.zeros(3), 0.0
+    for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
+        if len(p) < 20:
+            return None
+        a = np.c_[2.0 * p, np.ones(len(p))]
+        sol, *_ = np.linalg.lstsq(a, (p * p).sum(axis=1), rcond=None)
+        centre = sol[:3]
+        radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
+        res = np.abs(np.linalg.norm(p - centre, axis=1) - radius)
+        p = p[res <= max(3.0 * float(np.median(res)) * 1.4826, 1e-4)]
+    if not (np.isfinite(radius) and 0.25 * spread <= radius <= 4.0 * spread):
+        return None
+    return centre, radius
+
+
+def _disc(r: int) -> np.ndarray:
+    yy, xx = np.mgrid[-r : r + 1, -r : r + 1]
+    return xx * xx + yy * yy <= r * r
+
+
+def _separate(
+    edt: np.ndarray, p: tuple[int, int], centres: list[tuple[int, int, float, bool]], t: float, budget: list[int]
+) -> bool:
+    """Whether ``p`` lies in another connected component of ``edt > t`` than every centre (a straight path
+    that stays above ``t`` joins them without labelling the window; ``budget`` counts the labellings
+    left: with none left, ``p`` is taken as joined)."""
+    if _on_path(edt, p, [(a, b) for a, b, _, _ in centres], t):
+        return False
+    if budget[0] <= 0:
+        return False
+    budget[0] -= 1
+    deep = ndimage.label(edt > t)[0]
+    return all(deep[a, b] != deep[p] for a, b, _, _ in centres)
+
+
+def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: float) -> list[np.ndarray]:
+    """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
+    times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
+    touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
+    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    cen = np.array(centres, dtype=np.float64)
+    deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
+    rows, cols = np.nonzero(deep)
+    power = (rows[:, None] - cen[None, :, 0]) ** 2 + (cols[:, None] - cen[None, :, 1]) ** 2 - cen[None, :, 2] ** 2
+    near = np.argmin(power, axis=1)
+    at = deep[cen[:, 0].astype(int), cen[:, 1].astype(int)]
+    keep = deep[rows, cols] == at[near]  # in the deep component of the centre it is nearest to
+    cores = np.zeros(region.shape, np.int32)
+    cores[rows[keep], cols[keep]] = near[keep] + 1
+    cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
+    _, (ri, ci) = ndimage.distance_transform_edt(cores == 0, return_indices=True)
+    cells = np.where(region, cores[ri, ci], 0)
+    return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
+
+
+def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
+    """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
+    crease of the depth surface: where one fruit ends and another begins."""
     z = np.where(region & (depth > 0), depth, np.nan)
     edge = _creases(region, depth, s, focal)
     for axis in (0, 1):
-        dz = np.abs(np.diff(z, axis=axis))
-        step = np.nan_to_num(dz, nan=0.0) > s.depth_jump
+        step = np.nan_to_num(np.abs(np.diff(z, axis=axis)), nan=0.0) > s.depth_jump
         if axis == 0:
             edge[:-1] |= step
             edge[1:] |= step
         else:
             edge[:, :-1] |= step
             edge[:, 1:] |= step
-    core, n = ndimage.label(region & ~edge)
-    if n < 2:
-        return [region]
-    sizes = ndimage.sum(np.ones_like(core), core, index=np.arange(1, n + 1))
-    keep = np.flatnonzero(sizes >= max(20, 0.1 * sizes.max())) + 1
-    if len(keep) < 2:
-        return [region]
-    seeds = np.where(np.isin(core, keep), core, 0)
-    _, (ri, ci) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
-    grown = np.where(region, seeds[ri, ci], 0)
-    return [grown == k for k in keep]
+    return edge & region
 
 
-def _split_waist(region: np.ndarray, s: SegmentSettings) -> list[np.ndarray]:
-    """Split a region at a waist between distance-transform peaks (touching round fruit)."""
-    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
-    top = edt.max()
-    if top < 3:
-        return [region]
-    size = max(3, int(top) | 1)
-    peaks = (edt == ndimage.maximum_filter(edt, size=size)) & (edt >= 0.5 * top)
-    pr, pc = np.nonzero(peaks)
-    order = np.argsort(-edt[pr, pc])
-    chosen: list[tuple[int, int]] = []
-    for i in order:
-        p = (int(pr[i]), int(pc[i]))
-        if all(not _same_blob(edt, p, q, s.waist) for q in chosen):
-            chosen.append(p)
-    if len(chosen) < 2:
-        return [region]
-    # Each pixel goes to the peak whose inscribed disc it lies deepest in (distance / disc radius):
-    # for touching round fruit the cut falls at the waist.
-    rows, cols = np.nonzero(region)
-    peaks = np.array(chosen, dtype=np.float64)
-    radii = edt[peaks[:, 0].astype(int), peaks[:, 1].astype(int)]
-    d = np.hypot(rows[:, None] - peaks[None, :, 0], cols[:, None] - peaks[None, :, 1]) / radii[None, :]
-    owner = np.argmin(d, axis=1)
-    parts = []
-    for k in range(len(chosen)):
-        part = np.zeros(region.shape, bool)
-        part[rows[owner == k], cols[owner == k]] = True
-        parts.append(part)
-    return parts
+def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
+    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam."""
+    valid = region & (depth > 0)
+    if valid.sum() < 20:
+        return np.zeros(region.shape, bool)
+    _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
+    smooth = ndimage.gaussian_filter(depth[ri, ci], s.crease_sigma) if s.crease_sigma > 0 else depth[ri, ci]
+    lap = ndimage.laplace(smooth)
+    z = float(np.median(depth[valid]))
+    return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
-def _same_blob(edt: np.ndarray, p: tuple[int, int], q: tuple[int, int], waist: float) -> bool:
-    """Whether two peaks belong to one fruit: no waist narrower than ``waist`` x the smaller peak."""
-    n = int(np.hypot(p[0] - q[0], p[1] - q[1])) + 2
-    rows = np.rint(np.linspace(p[0], q[0], n)).astype(int)
-    cols = np.rint(np.linspace(p[1], q[1], n)).astype(int)
-    return bool(edt[rows, cols].min() >= waist * min(edt[p], edt[q]))
-
-
-def _big_enough(part: np.ndarray, depth: np.ndarray, s: SegmentSettings, camera: Camera) -> bool:
+def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
+    """Drop hull pixels (outside the colour part) whose depth is far from the part's median depth."""
     z = depth[part & (depth > 0)]
     if len(z) == 0:
+        return hull
+    zm = float(np.median(z))
+    off = (depth > 0) & (np.abs(depth - zm) > jump)
+    return part | (hull & ~off)
+
+
+def _fruit_sized(mask: np.ndarray, depth: np.ndarray | None, s: SegmentSettings, focal: float, min_area: float) -> bool:
+    area = int(mask.sum())
+    if depth is None:
+        return area >= min_area
+    z = depth[mask & (depth > 0)]
+    if len(z) == 0:
         return False
-    diameter_px = np.sqrt(camera.fx * camera.fy) * s.min_diameter / float(np.median(z))
-    return part.sum() >= np.pi / 4 * diameter_px**2
+    diameter_px = focal * s.min_diameter / float(np.median(z))
+    return area >= np.pi / 4 * diameter_px**2
 
 
-def _renumber(labels: np.ndarray, n: int) -> np.ndarray:
-    """Number fruit left to right (then top to bottom) by their box centres, for stable ids."""
-    if n == 0:
-        return labels
-    slices = ndimage.find_objects(labels, max_label=n)
-    centres = [((sl[1].start + sl[1].stop) / 2, (sl[0].start + sl[0].stop) / 2) for sl in slices]
-    order = sorted(range(n), key=lambda i: (round(centres[i][0] / 20), centres[i][1]))
-    lut = np.zeros(n + 1, np.int32)
-    for new, i in enumerate(order, 1):
-        lut[i + 1] = new
-    return lut[labels]
+def _elongation(mask: np.ndarray) -> float:
+    rows, cols = np.nonzero(mask)
+    if len(rows) < 3:
+        return float("inf")
+    cov = np.cov(np.stack([rows, cols]).astype(np.float64))
+    ev = np.linalg.eigvalsh(cov)
+    return float(np.sqrt(ev[1] / max(ev[0], 1e-9)))

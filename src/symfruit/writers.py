@@ -10,6 +10,11 @@ one frame           ``detections.json`` (maps one-to-one onto ROS 2 ``vision_msg
                     ``fruit_NNN.ply`` per completed fruit, ``overlay.png``: :func:`write_detections`;
                     the folder holds exactly the current run's files
 a results folder    ``ROOT/<timestamp>-<tag>[-k]`` with a ``latest`` link: :func:`new_results_folder`
+instance masks      ``<stem>.png`` (16-bit instance labels, 0 background) and ``<stem>_overlay.png`` (the
+                    image with each fruit tinted and outlined): :func:`write_labels`,
+                    :func:`draw_label_overlay`
+a masks evaluation  ``masks.csv`` (one row per image), ``summary.json``, ``worst.png`` (contact sheet of the
+                    worst images, truth green and prediction magenta): :func:`write_mask_report`
 ==================  ===================================================================================
 """
 
@@ -24,6 +29,7 @@ from typing import Any
 import numpy as np
 
 from .complete import Result
+from .core.box import Box
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError
 from .io.atomic import atomic_write, write_json
@@ -32,11 +38,17 @@ from .settings import Settings
 
 __all__ = [
     "OPTICAL_FRAME",
+    "bbox_record",
     "detection_record",
     "detections_record",
+    "draw_contact_sheet",
+    "draw_label_overlay",
     "draw_overlay",
     "new_results_folder",
     "write_detections",
+    "write_label_overlay",
+    "write_labels",
+    "write_mask_report",
     "write_result",
 ]
 
@@ -73,6 +85,17 @@ def write_result(path: str | Path, result: Result, *, meta: dict[str, Any] | Non
     return path, json_path
 
 
+def bbox_record(box: Box) -> dict[str, Any]:
+    """``bbox`` of a ``detections.json`` entry: a ``vision_msgs/BoundingBox3D`` (centre pose, size; metres)."""
+    return {
+        "center": {
+            "position": dict(zip("xyz", box.centre.tolist(), strict=True)),
+            "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+        },
+        "size": dict(zip("xyz", box.size.tolist(), strict=True)),
+    }
+
+
 def detection_record(d: Detection) -> dict[str, Any]:
     """One entry of ``detections.json``; ``bbox`` is a ``vision_msgs/BoundingBox3D``."""
     ex = d.extraction
@@ -83,19 +106,12 @@ def detection_record(d: Detection) -> dict[str, Any]:
     if d.error or d.result is None:
         return {**out, "error": d.error}
     r = d.result
-    c, size = r.box.centre, r.box.size
     visible = d.visible_box
     out.update(
-        centre=c.tolist(),
+        centre=r.box.centre.tolist(),
         box=r.box.to_dict(),
         visible_box=None if visible is None else visible.to_dict(),
-        bbox={
-            "center": {
-                "position": dict(zip("xyz", c.tolist(), strict=True)),
-                "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
-            },
-            "size": dict(zip("xyz", size.tolist(), strict=True)),
-        },
+        bbox=bbox_record(r.box),
         method=r.method,
         plane=None if r.plane is None else r.plane.to_dict(),
         score=None if not np.isfinite(r.score) else float(r.score),
@@ -109,7 +125,7 @@ def detection_record(d: Detection) -> dict[str, Any]:
 def detections_record(found: FrameDetections, *, settings: Settings | None = None) -> dict[str, Any]:
     """``detections.json``: a ``vision_msgs/Detection3DArray``-like object with symfruit's extras."""
     frame = found.frame
-    header: dict[str, Any] = {"frame_id": OPTICAL_FRAME}
+    header: dict[str, Any] = {"frame_id": frame.frame_id or OPTICAL_FRAME}
     if frame.stamp is not None:
         header["stamp"] = {"sec": frame.stamp // 1_000_000_000, "nanosec": frame.stamp % 1_000_000_000}
     data: dict[str, Any] = {
@@ -241,3 +257,131 @@ def draw_overlay(found: FrameDetections) -> Any:
             draw.text(label_at, f"{d.id}: failed", fill=(255, 80, 80))
     draw.text((5, cam.height - 14), "orange: visible points   cyan: completed fruit", fill=(255, 255, 255))
     return img
+
+
+def _outline(labels: np.ndarray) -> np.ndarray:
+    """(h, w) bool: the pixels of each labelled region that touch another label or the background."""
+    from scipy import ndimage
+
+    fg = labels > 0
+    return fg & ((ndimage.grey_erosion(labels, size=3) != labels) | (ndimage.grey_dilation(labels, size=3) != labels))
+
+
+def draw_label_overlay(color: np.ndarray, labels: np.ndarray, *, alpha: float = 0.45) -> Any:
+    """The colour image (a PIL image) with each labelled fruit tinted in its own colour and outlined.
+
+    Parameters
+    ----------
+    color : (h, w, 3) uint8
+    labels : (h, w) int, 0 background
+    alpha : float in [0, 1]
+        Tint strength.
+    """
+    from PIL import Image
+
+    color, labels = np.asarray(color), np.asarray(labels)
+    if color.ndim != 3 or color.shape[:2] != labels.shape:
+        raise FileFormatError(f"labels are {labels.shape[::-1]}, the image {color.shape[1::-1]}")
+    img = color[:, :, :3].astype(np.float32)
+    tint = _PALETTE[(labels.astype(np.int64) - 1) % len(_PALETTE)].astype(np.float32)
+    fg = labels > 0
+    img[fg] = (1 - alpha) * img[fg] + alpha * tint[fg]
+    edge = _outline(labels)
+    img[edge] = tint[edge]
+    return Image.fromarray(np.clip(img, 0, 255).astype(np.uint8))
+
+
+def write_labels(path: str | Path, labels: np.ndarray) -> Path:
+    """Write instance labels as a 16-bit greyscale PNG (0 background, 1..k fruit).
+
+    Raises
+    ------
+    FileFormatError
+        When the labels are not a 2-D image of integers in 0-65535, or ``path`` is not a ``.png``.
+    """
+    from PIL import Image
+
+    path = Path(path)
+    labels = np.asarray(labels)
+    if path.suffix.lower() != ".png":
+        raise FileFormatError(f"{path}: instance labels are written as .png")
+    if labels.ndim != 2 or not np.issubdtype(labels.dtype, np.integer):
+        raise FileFormatError(f"{path}: labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
+    if labels.size and (labels.min() < 0 or labels.max() > 65535):
+        raise FileFormatError(f"{path}: labels must be 0-65535 to fit a 16-bit PNG")
+    with atomic_write(path, "wb") as handle:
+        Image.fromarray(labels.astype(np.uint16)).save(handle, format="PNG")
+    return path
+
+
+def write_label_overlay(path: str | Path, color: np.ndarray, labels: np.ndarray) -> Path:
+    """Write :func:`draw_label_overlay` as a PNG."""
+    path = Path(path)
+    image = draw_label_overlay(color, labels)
+    with atomic_write(path, "wb") as handle:
+        image.save(handle, format="PNG")
+    return path
+
+
+def draw_contact_sheet(entries: Any, *, tile: int = 256, columns: int = 4, threshold: float = 0.5) -> Any:
+    """A PIL image of ``(name, color, truth masks, labels)`` tiles: truth outlines green, predicted
+    outlines magenta, the name and the image's scores written on each tile."""
+    from PIL import Image, ImageDraw
+    from scipy import ndimage
+
+    from .evaluate.masks import score_masks, truth_stack
+
+    entries = list(entries)
+    if not entries:
+        return Image.new("RGB", (tile, tile // 4), (40, 40, 40))
+    rows = (len(entries) + columns - 1) // columns
+    sheet = Image.new("RGB", (columns * tile, rows * tile), (40, 40, 40))
+    for k, (name, color, truth, labels) in enumerate(entries):
+        img = np.asarray(color, dtype=np.uint8)[:, :, :3].copy()
+        truth = truth_stack(truth, labels.shape)
+        edge_t = np.zeros(labels.shape, bool)
+        for m in truth:
+            edge_t |= m & ~ndimage.binary_erosion(m)
+        scale = tile / max(img.shape[:2])
+        grow = max(1, int(np.ceil(1.0 / scale)))  # outlines stay visible once the tile is scaled down
+        img[ndimage.binary_dilation(edge_t, iterations=grow)] = (0, 230, 0)
+        img[ndimage.binary_dilation(_outline(labels), iterations=grow)] = (255, 0, 255)
+        s = score_masks(truth, labels, threshold=threshold)
+        pic = Image.fromarray(img)
+        size = (max(1, round(pic.width * scale)), max(1, round(pic.height * scale)))
+        pic = pic.resize(size, Image.Resampling.BILINEAR)
+        draw = ImageDraw.Draw(pic)
+        iou = f"{s.best_iou.mean():.2f}" if s.n_true else "-"
+        text = f"{Path(str(name)).name[:36]}\niou {iou} true {s.n_true} pred {s.n_pred} false {s.false}"
+        draw.rectangle([0, 0, pic.width, 24], fill=(0, 0, 0))
+        draw.text((2, 1), text, fill=(255, 255, 255))
+        sheet.paste(pic, ((k % columns) * tile, (k // columns) * tile))
+    return sheet
+
+
+def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, Any] | None = None) -> list[Path]:
+    """Write a masks evaluation (:class:`symfruit.evaluate.masks.MaskEvaluation`) into ``folder``:
+    ``masks.csv`` (one row per image), ``summary.json`` (``meta`` and the summary) and ``worst.png``."""
+    import csv
+    import io
+    import math
+
+    from .evaluate.masks import CSV_COLUMNS
+
+    folder = Path(folder)
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise FileFormatError(f"{folder}: cannot create output folder ({exc.strerror or exc})") from None
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(CSV_COLUMNS))
+    writer.writeheader()
+    for score in evaluation.scores:
+        writer.writerow({k: (f"{v:.4f}" if isinstance(v, float) else v) for k, v in score.to_dict().items()})
+    with atomic_write(folder / "masks.csv", "w") as handle:
+        handle.write(buf.getvalue())
+    clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in evaluation.summary.items()}
+    write_json(folder / "summary.json", {**(meta or {}), "protocol": "masks", "summary": clean})
+    with atomic_write(folder / "worst.png", "wb") as handle:
+        draw_contact_sheet(evaluation.worst).save(handle, format="PNG")
+    return [folder / "masks.csv", folder / "summary.json", folder / "worst.png"]

@@ -153,8 +153,12 @@ def check_view(points: np.ndarray, camera: Any, *, min_pixels: int = 3) -> None:
     ------
     InputError
     """
-    lo, hi = bounds(camera.project(as_points(points, min_count=1)))
-    span = hi - lo
+    points = as_points(points, min_count=1)
+    lo, hi = bounds(points)
+    if hi[2] > 0 and max(camera.fx * (hi[0] - lo[0]), camera.fy * (hi[1] - lo[1])) / hi[2] >= min_pixels:
+        return  # a lower bound of the span in pixels already passes: no need to project every point
+    uv_lo, uv_hi = bounds(camera.project(points))
+    span = uv_hi - uv_lo
     if not np.all(np.isfinite(span)) or span.max() < min_pixels:
         raise InputError(
             f"the visible points fall within {span.max():.1f} pixels of the image (fewer than {min_pixels} across): "

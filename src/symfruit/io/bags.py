@@ -6,7 +6,12 @@ whose name contains "depth" is depth). Each depth image is one frame, paired wit
 in time (within ``max_skew``) and the latest camera info at or before it.
 
 The bag is indexed once (timestamps only; the raw message bytes pass through without being kept or
-decoded) and each frame is then decoded on demand, so memory stays flat however long the recording.
+decoded) and each frame is then decoded on demand, so memory stays flat however long the recording. A
+frame's ``stamp`` and ``frame_id`` are its colour image's header's (the detections are in the colour
+camera's frame; ROS outputs and detections.json copy them).
+
+:func:`image_array` is the one decoder of ``sensor_msgs/Image`` (:func:`color_image`, :func:`depth_image`
+on top of it, and :func:`camera_from_info`): the live ROS node (:mod:`symfruit.ros.core`) uses them too.
 """
 
 from __future__ import annotations
@@ -21,7 +26,15 @@ from ..core.camera import Camera
 from ..errors import FileFormatError, InputError, SymfruitError
 from ..frame import Frame
 
-__all__ = ["BagSource", "image_array"]
+__all__ = [
+    "BagSource",
+    "camera_from_info",
+    "color_image",
+    "depth_image",
+    "header_frame_id",
+    "header_stamp",
+    "image_array",
+]
 
 _ENCODINGS: dict[str, tuple[type, int]] = {
     "rgb8": (np.uint8, 3), "bgr8": (np.uint8, 3), "rgba8": (np.uint8, 4), "bgra8": (np.uint8, 4),
@@ -76,28 +89,82 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if len(data) < h * step:
         raise FileFormatError(f"image data holds {len(data)} bytes, {h} rows of {step} need {h * step}")
     rows = data[: h * step].reshape(h, step)
-    img = rows[:, :row_bytes].copy().view(dt).reshape(h, w, channels).astype(dtype)
+    img = rows[:, :row_bytes].copy().view(dt).reshape(h, w, channels).astype(dtype, copy=False)
     if enc.startswith("bgr"):
         img = img[:, :, [2, 1, 0]]
     return img[:, :, 0] if channels == 1 else img[:, :, :3]
 
 
-def _camera(msg: Any) -> Camera:
-    k = [float(v) for v in getattr(msg, "k", getattr(msg, "K", []))]
+def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray:
+    """(h, w, 3) uint8 RGB of a colour image message (:func:`image_array`; ``mono8`` repeated to grey RGB)."""
+    img = image_array(msg, typename)
+    if img.ndim == 2:
+        img = np.repeat(img[:, :, None], 3, axis=2)
+    return np.ascontiguousarray(img, dtype=np.uint8)
+
+
+def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scale: float = 0.001) -> np.ndarray:
+    """(h, w) float32 metres of a depth image message (:func:`image_array`): 16-bit units times
+    ``depth_scale`` (millimetres by default, as RealSense cameras record) or 32FC1 metres; 0 where invalid.
+
+    Raises
+    ------
+    FileFormatError
+        For anything :func:`image_array` refuses, or an image that is not one-channel depth.
+    """
+    raw = image_array(msg, typename)
+    if raw.ndim != 2:
+        raise FileFormatError(f"depth image has {raw.shape[2]} channels, expected 1")
+    if raw.dtype not in (np.uint16, np.float32):
+        raise FileFormatError(f"depth image encoding {msg.encoding!r}: expected 16UC1/mono16 units or 32FC1 metres")
+    if raw.dtype == np.uint16:  # one pass, float32 as everywhere (units x scale)
+        return np.multiply(raw, np.float32(depth_scale), dtype=np.float32)
+    return np.nan_to_num(raw, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # image_array's own copy
+
+
+def camera_from_info(msg: Any, *, width: int | None = None, height: int | None = None) -> Camera:
+    """Pinhole intrinsics of a ``sensor_msgs/CameraInfo`` (``K`` in ROS 1, ``k`` in ROS 2).
+
+    A camera info whose width or height is 0 takes ``width`` / ``height`` (the image's) when given.
+    Distortion is ignored: symfruit works on rectified or near-distortion-free colour images.
+
+    Raises
+    ------
+    InputError
+        When there is no 3x3 ``K`` or the intrinsics are invalid.
+    """
+    k = getattr(msg, "k", None)
+    if k is None:
+        k = getattr(msg, "K", [])
+    try:
+        k = [float(v) for v in k]
+    except (TypeError, ValueError):
+        raise InputError("CameraInfo K holds something that is not a number") from None
     if len(k) != 9:
         raise InputError("CameraInfo has no 3x3 K matrix")
-    return Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(msg.width), height=int(msg.height))
+    w, h = int(msg.width) or (width or 0), int(msg.height) or (height or 0)
+    return Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
+
+
+def header_stamp(msg: Any) -> int | None:
+    """A message's header stamp in nanoseconds (``sec``/``nanosec`` or ``secs``/``nsecs``); None without one."""
+    stamp = getattr(getattr(msg, "header", None), "stamp", None)
+    if stamp is None:
+        return None
+    sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
+    nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
+    return int(sec) * 1_000_000_000 + int(nsec)
+
+
+def header_frame_id(msg: Any) -> str:
+    """A message's header ``frame_id`` ("" without one)."""
+    return str(getattr(getattr(msg, "header", None), "frame_id", "") or "")
 
 
 def _stamp(msg: Any, fallback: int) -> int:
-    """The header stamp in nanoseconds (``sec``/``nanosec`` or ``secs``/``nsecs``), else ``fallback``."""
-    stamp = getattr(getattr(msg, "header", None), "stamp", None)
-    if stamp is None:
-        return fallback
-    sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
-    nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
-    value = int(sec) * 1_000_000_000 + int(nsec)
-    return value if value > 0 else fallback
+    """The header stamp in nanoseconds, else ``fallback`` (also for a zero stamp)."""
+    value = header_stamp(msg)
+    return value if value else fallback
 
 
 class BagSource:
@@ -145,7 +212,7 @@ class BagSource:
             elif bytes(raw) != last:
                 last = bytes(raw)
                 try:
-                    camera: Camera | str = _camera(self._reader.deserialize(raw, conn.msgtype))
+                    camera: Camera | str = camera_from_info(self._reader.deserialize(raw, conn.msgtype))
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
                 self._cameras.append((stamp, camera))
@@ -185,20 +252,17 @@ class BagSource:
             raise FileFormatError(f"{self.path}: {camera}")
         try:
             dmsg = self._message(self._depth, stamp)
-            color = image_array(self._message(self._color, self._color_stamps[near]), self._color.msgtype)
-            raw = image_array(dmsg, self._depth.msgtype)
+            cstamp = self._color_stamps[near]
+            cmsg = self._message(self._color, cstamp)
+            color = color_image(cmsg, self._color.msgtype)
+            depth = depth_image(dmsg, self._depth.msgtype)
         except FileFormatError as exc:
             message = str(exc)
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
             raise FileFormatError(named) from None
-        if raw.ndim != 2:
-            raise FileFormatError(f"{self.path}: depth image at {stamp} has {raw.shape[2]} channels, expected 1")
-        depth = raw.astype(np.float32) * np.float32(0.001 if raw.dtype == np.uint16 else 1.0)
-        depth = np.nan_to_num(depth, nan=0.0, posinf=0.0, neginf=0.0)
-        if color.ndim == 2:
-            color = np.repeat(color[:, :, None], 3, axis=2)
-        return Frame(name, np.ascontiguousarray(color, dtype=np.uint8), depth, camera,
-                     source=f"{self.path}@{stamp}", stamp=_stamp(dmsg, stamp))  # fmt: skip
+        # stamped like the colour image: the detections are in its frame (ROS outputs copy its header)
+        return Frame(name, color, depth, camera, source=f"{self.path}@{stamp}", stamp=_stamp(cmsg, cstamp),
+                     frame_id=header_frame_id(cmsg))  # fmt: skip
 
     def close(self) -> None:
         """Close the bag."""

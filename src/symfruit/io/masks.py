@@ -1,20 +1,33 @@
-"""Fruit masks from files: instance label PNGs and COCO-style JSON (polygons and RLE)."""
+"""Fruit masks from files: instance label PNGs and COCO-style JSON (polygons and RLE).
+
+A COCO file is read with a size bound (:func:`symfruit.io.text.read_structured`) and nothing it says about
+sizes is trusted: an image entry's ``height``/``width`` and an RLE's ``size`` must agree with the image the
+masks are for *before* anything of that size is allocated, polygon coordinates must be finite numbers,
+and the number of annotations per image and of vertices per polygon are bounded.
+"""
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..core.camera import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
 from ..errors import FileFormatError
 from .images import read_labels
 from .text import read_structured
 
 #: Largest COCO annotation file read (bytes).
 MAX_COCO_BYTES = 256 << 20
+#: Most annotations of one image that are rasterised (a fruit photo holds a handful).
+MAX_INSTANCES_PER_IMAGE = 1000
+#: Most vertices of one polygon, and most values in one uncompressed RLE.
+MAX_POLYGON_POINTS = 100_000
+MAX_RLE_RUNS = 10_000_000
 
-__all__ = ["coco_masks", "read_masks", "rle_decode"]
+__all__ = ["CocoSet", "coco_masks", "read_coco", "read_masks", "rle_decode"]
 
 
 def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
@@ -36,56 +49,205 @@ def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
     return labels
 
 
+def _check_shape(shape: tuple[int, int], where: str) -> tuple[int, int]:
+    h, w = (int(v) for v in shape)
+    if not (0 < h <= MAX_IMAGE_SIDE and 0 < w <= MAX_IMAGE_SIDE and h * w <= MAX_IMAGE_PIXELS):
+        raise FileFormatError(f"{where}: image size {w}x{h} is out of range")
+    return h, w
+
+
+def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
+    """``(h, w)`` bool: one COCO annotation's polygons (filled, edges included) or RLE, for an image of
+    ``shape``. An RLE whose ``size`` is not ``shape`` is refused before it is decoded."""
+    from PIL import Image, ImageDraw
+
+    h, w = shape
+    try:
+        seg = ann["segmentation"]
+        if isinstance(seg, dict):
+            size = seg.get("size")
+            if not (isinstance(size, list) and len(size) == 2 and [int(size[0]), int(size[1])] == [h, w]):
+                raise FileFormatError(f"{where}: RLE size {size!r} is not the image's {[h, w]}")
+            return rle_decode(seg)
+        if not isinstance(seg, list):
+            raise TypeError(f"segmentation is a {type(seg).__name__}")
+        img = Image.new("L", (w, h), 0)
+        draw = ImageDraw.Draw(img)
+        for poly in seg:
+            if not isinstance(poly, list) or len(poly) > 2 * MAX_POLYGON_POINTS:
+                raise ValueError("a polygon must be a list of at most 100,000 x, y pairs")
+            xy = np.asarray(poly, dtype=np.float64)
+            if xy.ndim != 1 or not np.isfinite(xy).all():
+                raise ValueError("polygon coordinates must be finite numbers")
+            # far-off vertices are clipped (the drawn mask is the same inside the image)
+            xy = np.clip(xy[: len(xy) // 2 * 2].reshape(-1, 2), -4.0 * max(h, w), 5.0 * max(h, w))
+            if len(xy) >= 3:
+                draw.polygon([tuple(p) for p in xy.tolist()], fill=1, outline=1)
+        return np.asarray(img, dtype=bool)
+    except FileFormatError:
+        raise
+    except (KeyError, TypeError, ValueError, IndexError, OverflowError) as exc:
+        raise FileFormatError(f"{where} has no valid segmentation ({exc})") from None
+
+
 def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     """Rasterise COCO annotations (polygons, uncompressed or compressed RLE) into instance labels.
 
     If the file holds several images, the annotations of the first image are used. Later annotations
     are drawn over earlier ones.
     """
-    from PIL import Image, ImageDraw
-
+    path = Path(path)
     data = read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES)
     anns = data.get("annotations", data) if isinstance(data, dict) else data
     if not isinstance(anns, list):
         raise FileFormatError(f"{path}: expected a COCO 'annotations' list")
     images = data.get("images") if isinstance(data, dict) else None
-    if images:
+    if images and isinstance(images[0], dict):
         first = images[0].get("id")
-        anns = [a for a in anns if a.get("image_id", first) == first]
-    h, w = shape
+        anns = [a for a in anns if isinstance(a, dict) and a.get("image_id", first) == first]
+    if len(anns) > MAX_INSTANCES_PER_IMAGE:
+        raise FileFormatError(f"{path}: {len(anns)} annotations for one image; at most {MAX_INSTANCES_PER_IMAGE}")
+    h, w = _check_shape(shape, str(path))
     labels = np.zeros((h, w), np.int32)
     for k, ann in enumerate(anns, 1):
-        try:
-            seg = ann["segmentation"]
-            if isinstance(seg, dict):
-                mask = rle_decode(seg)
-            else:
-                img = Image.new("L", (w, h), 0)
-                draw = ImageDraw.Draw(img)
-                for poly in seg:
-                    xy = [(float(poly[i]), float(poly[i + 1])) for i in range(0, len(poly) - 1, 2)]
-                    if len(xy) >= 3:
-                        draw.polygon(xy, fill=1, outline=1)
-                mask = np.asarray(img, dtype=bool)
-        except (KeyError, TypeError, ValueError, IndexError) as exc:
-            raise FileFormatError(f"{path}: annotation {k} has no valid segmentation ({exc})") from None
-        if mask.shape != (h, w):
-            raise FileFormatError(f"{path}: annotation {k} is {mask.shape[1]}x{mask.shape[0]}, the image {w}x{h}")
-        labels[mask] = int(ann.get("id", k)) if isinstance(ann.get("id"), int) and ann.get("id") > 0 else k
+        if not isinstance(ann, dict):
+            raise FileFormatError(f"{path}: annotation {k} is not an object")
+        mask = annotation_mask(ann, (h, w), f"{path}: annotation {k}")
+        ident = ann.get("id")
+        labels[mask] = ident if isinstance(ident, int) and not isinstance(ident, bool) and 0 < ident < 2**31 else k
     return labels
+
+
+@dataclass(frozen=True)
+class CocoSet:
+    """A COCO instance-segmentation file, indexed by image file name.
+
+    Attributes
+    ----------
+    path : Path
+    images : dict
+        File name (as written in the file, and its base name) -> the ``images`` entry.
+    annotations : dict
+        Image id -> its annotations, in file order.
+    categories : dict
+        Category id -> name.
+    """
+
+    path: Path
+    images: dict[str, dict[str, Any]]
+    annotations: dict[Any, list[dict[str, Any]]]
+    categories: dict[int, str]
+
+    def entries(self) -> list[dict[str, Any]]:
+        """Every ``images`` entry once, by file name."""
+        unique = {id(e): e for e in self.images.values()}
+        return sorted(unique.values(), key=lambda e: str(e["file_name"]))
+
+    def image(self, name: str | Path) -> dict[str, Any]:
+        """The ``images`` entry of ``name`` (a file name or path; matched on the base name too)."""
+        key = str(name)
+        entry = self.images.get(key) or self.images.get(Path(key).name)
+        if entry is None:
+            raise FileFormatError(f"{self.path}: no image {Path(key).name!r} in this COCO file")
+        return entry
+
+    def instances(self, name: str | Path, shape: tuple[int, int], *, category: int | None = 1) -> np.ndarray:
+        """The true instance masks of one image.
+
+        Parameters
+        ----------
+        name : str or Path
+            The image's file name (or a path ending in it).
+        shape : (h, w)
+            The size of the image as read. The entry's ``height`` and ``width``, when given, must agree.
+        category : int or None
+            Keep annotations of this category id only; ``None`` keeps all.
+
+        Returns
+        -------
+        (n, h, w) bool, one mask per annotation (masks may overlap).
+        """
+        entry = self.image(name)
+        label = f"{self.path}: image {entry.get('file_name')!r}"
+        h, w = _check_shape(shape, label)
+        if "height" in entry or "width" in entry:
+            try:
+                stated = (int(entry["height"]), int(entry["width"]))
+            except (KeyError, TypeError, ValueError, OverflowError):
+                raise FileFormatError(f"{label}: height/width are not whole numbers") from None
+            if stated != (h, w):
+                raise FileFormatError(f"{label} is {stated[1]}x{stated[0]} in the file but {w}x{h} on disk")
+        anns = [a for a in self.annotations.get(_key(entry.get("id")), [])
+                if category is None or a.get("category_id") == category]  # fmt: skip
+        if len(anns) > MAX_INSTANCES_PER_IMAGE:
+            raise FileFormatError(f"{label}: {len(anns)} annotations; at most {MAX_INSTANCES_PER_IMAGE} are read")
+        out = np.zeros((len(anns), h, w), bool)
+        for k, ann in enumerate(anns):
+            out[k] = annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
+        return out
+
+
+def _key(value: Any) -> Any:
+    """Image ids as dictionary keys: numbers and text as given, anything unhashable as its repr."""
+    try:
+        hash(value)
+    except TypeError:
+        return repr(value)
+    return value
+
+
+def read_coco(path: str | Path) -> CocoSet:
+    """Read a COCO instance-segmentation JSON (``images``, ``annotations``, optional ``categories``).
+
+    Raises
+    ------
+    FileFormatError
+        When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists.
+    """
+    path = Path(path)
+    data = read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES)
+    if (
+        not isinstance(data, dict)
+        or not isinstance(data.get("images"), list)
+        or not isinstance(data.get("annotations"), list)
+    ):
+        raise FileFormatError(f"{path}: expected a COCO object with 'images' and 'annotations' lists")
+    images: dict[str, dict[str, Any]] = {}
+    for entry in data["images"]:
+        if not isinstance(entry, dict) or not isinstance(entry.get("file_name"), str):
+            raise FileFormatError(f"{path}: an 'images' entry has no file_name")
+        images[entry["file_name"]] = entry
+        images.setdefault(Path(entry["file_name"]).name, entry)
+    annotations: dict[Any, list[dict[str, Any]]] = {}
+    for ann in data["annotations"]:
+        if not isinstance(ann, dict):
+            raise FileFormatError(f"{path}: an 'annotations' entry is not an object")
+        annotations.setdefault(_key(ann.get("image_id")), []).append(ann)
+    categories: dict[int, str] = {}
+    raw = data.get("categories", [])
+    for c in raw if isinstance(raw, list) else []:
+        if isinstance(c, dict) and isinstance(c.get("id"), int) and not isinstance(c.get("id"), bool):
+            categories[c["id"]] = str(c.get("name", c["id"]))
+    return CocoSet(path, images, annotations, categories)
 
 
 def rle_decode(rle: dict[str, Any]) -> np.ndarray:
     """Decode a COCO RLE (``{"size": [h, w], "counts": list or compressed string}``) to a bool mask.
 
-    Uses ``pycocotools`` when installed; the pure-Python decoder below gives the same result.
+    The same result as ``pycocotools``; sizes are bounded (:data:`MAX_IMAGE_PIXELS`) before decoding.
     """
     h, w = (int(v) for v in rle["size"])
+    if not (0 < h <= MAX_IMAGE_SIDE and 0 < w <= MAX_IMAGE_SIDE and h * w <= MAX_IMAGE_PIXELS):
+        raise ValueError(f"RLE size {w}x{h} is out of range")
     counts = rle["counts"]
     if isinstance(counts, str):
+        if len(counts) > 8 * MAX_RLE_RUNS:
+            raise ValueError("RLE string too long")
         counts = _rle_string_counts(counts)
+    if len(counts) > MAX_RLE_RUNS:
+        raise ValueError("RLE has too many runs")
     counts = np.asarray(counts, dtype=np.int64)
-    if counts.sum() != h * w or (counts < 0).any():
+    if counts.ndim != 1 or (counts < 0).any() or counts.sum() != h * w:
         raise ValueError(f"RLE counts add up to {counts.sum()}, expected {h * w}")
     values = np.zeros(len(counts), bool)
     values[1::2] = True
@@ -101,6 +263,8 @@ def _rle_string_counts(s: str) -> list[int]:
     while p < len(data):
         x, k, more = 0, 0, True
         while more:
+            if p >= len(data) or k > 12:
+                raise ValueError("truncated or malformed RLE string")
             c = data[p] - 48
             x |= (c & 0x1F) << (5 * k)
             more = bool(c & 0x20)

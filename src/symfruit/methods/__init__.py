@@ -6,9 +6,10 @@ Importing this package registers the built-in methods; :mod:`.registry` holds th
 from __future__ import annotations
 
 from . import ellipsoid, evidence, fused, paper, raw, sphere, superellipsoid
-from .registry import Completion, MethodInfo, available, get, register
+from .registry import DEFAULT_METHOD, Completion, MethodInfo, available, get, register
 
 __all__ = [
+    "DEFAULT_METHOD",
     "Completion",
     "MethodInfo",
     "available",

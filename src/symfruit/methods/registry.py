@@ -20,7 +20,10 @@ from ..core.planes import Plane, Planes
 from ..errors import InputError
 from ..settings import register_section
 
-__all__ = ["Completion", "MethodInfo", "available", "get", "register"]
+__all__ = ["DEFAULT_METHOD", "Completion", "MethodInfo", "available", "get", "register"]
+
+#: The method used wherever none is named (the API, the CLI, the ROS node, the benchmarks).
+DEFAULT_METHOD = "evidence"
 
 
 @dataclass(frozen=True)

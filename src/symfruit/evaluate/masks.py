@@ -1,0 +1,360 @@
+"""Mask quality: how well a segmenter finds every fruit, whole (``symfruit evaluate --protocol masks``).
+
+Per image, each true fruit is scored by its *best-match IoU* (the highest mask IoU of any predicted
+region, 0 when none overlaps), and true and predicted regions are matched one to one at IoU >= 0.5
+(the assignment that maximises the summed IoU of the matched pairs): a matched true fruit is *found*,
+an unmatched one *missed*, an unmatched prediction *false*. The summary gives the mean best-match IoU
+over all true fruit, the matched share of true fruit and the false share of the predictions.
+
+Truth comes from a COCO file (polygons or RLE, one category kept; :func:`evaluate_masks`) or from the
+instance labels of rendered scenes (:func:`evaluate_scene_masks`). :func:`symfruit.writers.write_mask_report`
+writes the per-image CSV, the summary JSON and a contact sheet of the worst images.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterable, Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import FileFormatError, InputError
+
+__all__ = [
+    "CSV_COLUMNS",
+    "ImageScore",
+    "MaskEvaluation",
+    "coco_items",
+    "evaluate_mask_items",
+    "evaluate_masks",
+    "evaluate_scene_masks",
+    "mask_ious",
+    "match_masks",
+    "score_masks",
+    "summarise_masks",
+]
+
+#: Columns of the per-image CSV.
+CSV_COLUMNS = ("image", "n_true", "n_pred", "matched", "missed", "false", "mean_best_iou", "min_best_iou", "ms")
+
+#: A segmenter as the protocol calls it: ``segment(color, **extra) -> (h, w) int labels``.
+Segmenter = Callable[..., np.ndarray]
+#: One evaluation item: ``(name, color, truth)`` or ``(name, color, truth, extra keyword arguments)``.
+Item = tuple[str, np.ndarray, np.ndarray] | tuple[str, np.ndarray, np.ndarray, dict[str, Any]]
+
+
+def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
+    """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none)."""
+    t = np.asarray(truth)
+    if t.ndim == 2:
+        ids = np.unique(t[t > 0])
+        t = t[None] == ids[:, None, None]
+    if t.ndim != 3:
+        raise InputError(f"truth must be (n, h, w) masks or (h, w) labels, got shape {t.shape}")
+    if shape is not None and t.shape[1:] != tuple(shape):
+        raise InputError(f"truth masks are {t.shape[2]}x{t.shape[1]}, the labels {shape[1]}x{shape[0]}")
+    return t.astype(bool, copy=False)
+
+
+def mask_ious(truth: np.ndarray, labels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """IoU of every true mask with every predicted region.
+
+    Parameters
+    ----------
+    truth : (n, h, w) bool, or (h, w) int instance labels (0 = none)
+        True fruit masks; they may overlap.
+    labels : (h, w) int
+        Predicted instance labels, 0 background.
+
+    Returns
+    -------
+    ious : (n, k) float
+        IoU of true mask ``i`` with predicted region ``ids[j]``.
+    ids : (k,) int
+        The predicted labels present, ascending.
+
+    Examples
+    --------
+    >>> truth = np.zeros((1, 4, 4), bool); truth[0, :2] = True
+    >>> labels = np.zeros((4, 4), np.int32); labels[:1] = 3
+    >>> mask_ious(truth, labels)
+    (array([[0.5]]), array([3]))
+    """
+    labels = np.asarray(labels)
+    if labels.ndim != 2 or not np.issubdtype(labels.dtype, np.integer):
+        raise InputError(f"labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
+    if labels.size and labels.min() < 0:
+        raise InputError("labels must not be negative")
+    truth = truth_stack(truth, labels.shape)
+    ids, inverse = np.unique(labels, return_inverse=True)
+    inverse = inverse.reshape(labels.shape)
+    keep = ids > 0
+    k_all = len(ids)
+    pred_area = np.bincount(inverse.ravel(), minlength=k_all)
+    n = len(truth)
+    inter = np.zeros((n, k_all), np.int64)
+    for i in range(n):  # one bincount per true fruit (a handful per image)
+        inter[i] = np.bincount(inverse[truth[i]], minlength=k_all)
+    true_area = truth.reshape(n, labels.size).sum(axis=1)
+    union = true_area[:, None] + pred_area[None, :] - inter
+    ious = np.where(union > 0, inter / np.maximum(union, 1), 0.0)
+    return ious[:, keep], ids[keep].astype(np.int64)
+
+
+def match_masks(ious: np.ndarray, *, threshold: float = 0.5) -> np.ndarray:
+    """One-to-one matching of true and predicted regions at IoU >= ``threshold``.
+
+    The assignment maximises the summed IoU over pairs that reach the threshold (Hungarian).
+
+    Parameters
+    ----------
+    ious : (n, k) float
+    threshold : float in (0, 1]
+
+    Returns
+    -------
+    (m, 2) int: rows ``(true index, predicted index)``.
+    """
+    from scipy.optimize import linear_sum_assignment
+
+    ious = np.asarray(ious, dtype=np.float64)
+    if ious.ndim != 2:
+        raise InputError(f"ious must be (n, k), got shape {ious.shape}")
+    if not 0 < threshold <= 1:
+        raise InputError(f"threshold must be in (0, 1], got {threshold}")
+    if ious.size == 0:
+        return np.zeros((0, 2), np.int64)
+    gain = np.where(ious >= threshold, ious, 0.0)
+    rows, cols = linear_sum_assignment(gain, maximize=True)
+    good = gain[rows, cols] > 0
+    return np.stack([rows[good], cols[good]], axis=1).astype(np.int64)
+
+
+@dataclass(frozen=True)
+class ImageScore:
+    """The mask scores of one image.
+
+    Attributes
+    ----------
+    image : str
+    best_iou : (n,) float
+        Best-match IoU of each true fruit.
+    n_pred, matched : int
+        Predicted regions, and true fruit matched one to one at the threshold.
+    ms : float
+        Segmentation time, milliseconds (NaN when not timed).
+    """
+
+    image: str
+    best_iou: np.ndarray
+    n_pred: int
+    matched: int
+    ms: float = float("nan")
+
+    @property
+    def n_true(self) -> int:
+        return len(self.best_iou)
+
+    @property
+    def missed(self) -> int:
+        return self.n_true - self.matched
+
+    @property
+    def false(self) -> int:
+        return self.n_pred - self.matched
+
+    def badness(self) -> float:
+        """How bad the image is, for picking the worst: lost IoU plus one per false region."""
+        return float(np.sum(1.0 - self.best_iou) + self.false)
+
+    def to_dict(self) -> dict[str, Any]:
+        b = self.best_iou
+        return {
+            "image": self.image, "n_true": self.n_true, "n_pred": self.n_pred, "matched": self.matched,
+            "missed": self.missed, "false": self.false,
+            "mean_best_iou": float(b.mean()) if len(b) else float("nan"),
+            "min_best_iou": float(b.min()) if len(b) else float("nan"), "ms": self.ms,
+        }  # fmt: skip
+
+
+def score_masks(
+    truth: np.ndarray, labels: np.ndarray, *, threshold: float = 0.5, image: str = "", ms: float = float("nan")
+) -> ImageScore:
+    """Score one image's predicted labels against its true masks.
+
+    Parameters
+    ----------
+    truth : (n, h, w) bool or (h, w) int labels
+    labels : (h, w) int, 0 background
+    threshold : float
+        IoU a match needs.
+    """
+    ious, _ = mask_ious(truth, labels)
+    best = ious.max(axis=1) if ious.shape[1] else np.zeros(ious.shape[0])
+    pairs = match_masks(ious, threshold=threshold)
+    return ImageScore(image, best, int(ious.shape[1]), len(pairs), float(ms))
+
+
+def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
+    """Totals over images: mean best-match IoU over true fruit, matched / missed / false, shares, time."""
+    best = np.concatenate([s.best_iou for s in scores]) if scores else np.zeros(0)
+    n_true = int(sum(s.n_true for s in scores))
+    n_pred = int(sum(s.n_pred for s in scores))
+    matched = int(sum(s.matched for s in scores))
+    ms = np.array([s.ms for s in scores], dtype=np.float64)
+    ms = ms[np.isfinite(ms)]
+    return {
+        "images": len(scores),
+        "true_fruit": n_true,
+        "detections": n_pred,
+        "matched": matched,
+        "missed": n_true - matched,
+        "false": n_pred - matched,
+        "mean_best_iou": float(best.mean()) if len(best) else None,
+        "median_best_iou": float(np.median(best)) if len(best) else None,
+        "matched_share": matched / n_true if n_true else None,
+        "false_share": (n_pred - matched) / n_pred if n_pred else 0.0,
+        "images_with_false": int(sum(s.false > 0 for s in scores)),
+        "ms_median": float(np.median(ms)) if len(ms) else None,
+        "ms_p90": float(np.percentile(ms, 90)) if len(ms) else None,
+    }
+
+
+@dataclass(frozen=True)
+class MaskEvaluation:
+    """What the masks protocol returns: per-image scores, the summary, and the worst images kept for
+    the contact sheet as ``(name, color, truth masks, labels)``."""
+
+    scores: list[ImageScore]
+    summary: dict[str, Any]
+    worst: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+
+
+def evaluate_mask_items(
+    items: Iterable[Item], segment: Segmenter, *, threshold: float = 0.5, keep_worst: int = 12
+) -> MaskEvaluation:
+    """Run ``segment(color, **extra) -> labels`` on each ``(name, color, truth[, extra])`` and score it.
+
+    Parameters
+    ----------
+    items : iterable of (str, (h, w, 3) uint8, (n, h, w) bool or (h, w) int[, dict])
+        The optional dict holds keyword arguments for ``segment`` (e.g. ``depth`` and ``camera``).
+    segment : callable
+        Colour image to instance labels; timed per image (the segmentation alone, no file reading).
+    threshold : float
+    keep_worst : int
+        How many of the worst images to keep (with their pixels) for the contact sheet.
+    """
+    scores: list[ImageScore] = []
+    worst: list[tuple[float, int, tuple[str, np.ndarray, np.ndarray, np.ndarray]]] = []
+    for k, item in enumerate(items):
+        name, color, truth = item[0], item[1], item[2]
+        extra: dict[str, Any] = item[3] if len(item) > 3 else {}
+        t0 = time.perf_counter()
+        labels = np.asarray(segment(color, **extra))
+        ms = (time.perf_counter() - t0) * 1000.0
+        truth = truth_stack(truth, labels.shape)
+        score = score_masks(truth, labels, threshold=threshold, image=name, ms=ms)
+        scores.append(score)
+        if keep_worst > 0:
+            worst.append((score.badness(), k, (name, color, truth, labels)))
+            worst.sort(key=lambda w: (-w[0], w[1]))
+            del worst[keep_worst:]
+    kept = [w[2] for w in worst if w[0] > 0]
+    return MaskEvaluation(scores, summarise_masks(scores), kept)
+
+
+def coco_items(
+    images: str | Path, truth: str | Path, *, category: int | None = 1, names: Sequence[str] | None = None
+) -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
+    """``(file name, colour, true masks)`` for every image of a COCO file found in ``images``, by name.
+
+    Raises
+    ------
+    FileFormatError
+        When ``images`` is not a folder, no image is left to evaluate, or an image listed in the file
+        (and wanted) is missing from the folder.
+    """
+    from ..io.images import read_color
+    from ..io.masks import read_coco
+
+    folder = Path(images)
+    if not folder.is_dir():
+        raise FileFormatError(f"{folder}: not a folder of images")
+    coco = read_coco(truth)
+    entries = coco.entries()
+    if names is not None:
+        wanted = {Path(n).name for n in names}
+        entries = [e for e in entries if Path(str(e["file_name"])).name in wanted]
+    if not entries:
+        raise FileFormatError(f"{coco.path}: no images to evaluate")
+    for entry in entries:
+        name = str(entry["file_name"])
+        path = folder / name
+        if not path.is_file():
+            path = folder / Path(name).name
+        if not path.is_file():
+            raise FileFormatError(f"{folder / name}: listed in {coco.path.name} but not in {folder}")
+        color = read_color(path)
+        yield name, color, coco.instances(name, color.shape[:2], category=category)
+
+
+def evaluate_masks(
+    images: str | Path,
+    truth: str | Path,
+    segment: Segmenter,
+    *,
+    category: int | None = 1,
+    threshold: float = 0.5,
+    keep_worst: int = 12,
+    names: Sequence[str] | None = None,
+) -> MaskEvaluation:
+    """The masks protocol on a folder of photographs with COCO truth.
+
+    Parameters
+    ----------
+    images : folder
+        The photographs; every image of the COCO file is evaluated (images in the folder without an
+        entry are skipped; an image listed but missing from the folder is an error).
+    truth : COCO JSON path
+    segment : callable ``(h, w, 3) uint8 -> (h, w) int labels``
+    category : int or None
+        The COCO category of the fruit (annotations of other categories are ignored: a region predicted
+        on them is false); ``None`` takes every annotation as fruit.
+    names : sequence of str, optional
+        Evaluate only these file names (e.g. one half of a split).
+    """
+    items = coco_items(images, truth, category=category, names=names)
+    return evaluate_mask_items(items, segment, threshold=threshold, keep_worst=keep_worst)
+
+
+def evaluate_scene_masks(
+    seeds: Sequence[int],
+    segment: Segmenter,
+    *,
+    threshold: float = 0.5,
+    keep_worst: int = 12,
+    depth: bool = True,
+    **scene_options: Any,
+) -> MaskEvaluation:
+    """The masks protocol on rendered scenes (:func:`symfruit.scenes.make_scene`): truth is the ripe
+    fruit's visible pixels; a region on an unripe fruit counts as false.
+
+    With ``depth`` (default), ``segment(color, depth=..., camera=...)`` is given the scene's depth and
+    camera; without, ``segment(color)`` sees the colour alone.
+    """
+    from ..scenes import make_scene
+
+    def items() -> Iterator[Item]:
+        for seed in seeds:
+            scene = make_scene(int(seed), **scene_options)
+            ripe = np.array([f.id for f in scene.fruits if f.ripe], dtype=np.int32)
+            truth = scene.labels[None] == ripe[:, None, None]
+            truth = truth[truth.reshape(len(ripe), -1).any(axis=1)]  # fruit hidden entirely are not truth
+            extra = {"depth": scene.depth, "camera": scene.camera} if depth else {}
+            yield f"scene-{seed}", scene.color, truth, extra
+
+    return evaluate_mask_items(items(), segment, threshold=threshold, keep_worst=keep_worst)

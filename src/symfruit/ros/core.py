@@ -1,0 +1,264 @@
+"""The ROS-agnostic core of the symfruit node: camera messages in, located fruit out. No ROS import.
+
+Everything here works on any object with the fields of ``sensor_msgs/Image`` and ``sensor_msgs/CameraInfo``
+(rospy, rclpy and rosbags messages alike: ``K`` or ``k``, ``secs``/``nsecs`` or ``sec``/``nanosec``), so the
+ROS 1 wrapper (:mod:`symfruit.ros.node`), a ROS 2 (rclpy) wrapper and the bag writer share it:
+
+- :class:`FrameProcessor`: settings resolved once (:func:`symfruit.settings.resolve_settings`, as every
+  command does), then ``process(color, depth, info)`` -> :class:`Processed`. The messages are decoded by
+  :mod:`symfruit.io.bags` (the one decoder of ``sensor_msgs/Image``, shared with bag recordings) into a
+  :class:`~symfruit.frame.Frame` stamped with the colour image's header, then :func:`~symfruit.detect.detect`;
+- :func:`fruits_of`: the located fruit of a :class:`~symfruit.detect.FrameDetections`, built as
+  :func:`~symfruit.writers.detections_record` builds ``detections.json`` (its ``bbox_record``), so every ROS
+  message carries exactly ``detections.json``'s centres, sizes and confidences;
+- :class:`LatestOnly`: a worker thread with a one-slot buffer, so a slow frame drops the frames that
+  arrived meanwhile instead of queueing them.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..detect import FrameDetections, detect
+from ..errors import InputError
+from ..frame import Frame
+from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
+from ..methods import DEFAULT_METHOD
+from ..methods import get as get_method
+from ..settings import resolve_settings
+from ..writers import bbox_record
+
+__all__ = ["FrameProcessor", "Fruit", "LatestOnly", "Processed", "fruits_of", "message_frame"]
+
+
+# ---------------------------------------------------------------------------------------------------
+# frames in, fruit out
+# ---------------------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Fruit:
+    """One located fruit as a ROS message needs it: an entry of ``detections.json`` plus its cloud.
+
+    Attributes
+    ----------
+    id : int
+        The fruit's id in ``detections.json`` (its mask label).
+    centre, size : (3,) float, metres
+        Centre and extent of the completed fruit's axis-aligned box (``bbox`` of ``detections.json``),
+        camera optical frame.
+    score : float
+        ``confidence`` of ``detections.json`` in [0, 1] (``fused``); NaN for methods that give none.
+    points : (m, 3) float, metres
+        Visible then completed points.
+    n_visible : int
+        How many of ``points`` were seen.
+    """
+
+    id: int
+    centre: np.ndarray
+    size: np.ndarray
+    score: float
+    points: np.ndarray
+    n_visible: int
+
+
+def fruits_of(found: FrameDetections) -> list[Fruit]:
+    """The completed fruit of ``found`` as ``detections.json`` lists them (failed fruit left out): ``bbox``
+    from :func:`~symfruit.writers.bbox_record`, the function that writes it there, ``score`` its
+    ``confidence``."""
+    out = []
+    for d in found.detections:
+        r = d.result
+        if d.error or r is None:  # an entry with "error" in detections.json
+            continue
+        bbox = bbox_record(r.box)
+        conf = r.confidence
+        out.append(
+            Fruit(
+                id=int(d.id),
+                centre=np.array([bbox["center"]["position"][k] for k in "xyz"], dtype=np.float64),
+                size=np.array([bbox["size"][k] for k in "xyz"], dtype=np.float64),
+                score=float(conf) if conf is not None and np.isfinite(conf) else float("nan"),
+                points=r.points,
+                n_visible=len(r.visible),
+            )
+        )
+    return out
+
+
+def message_frame(
+    color: Any,
+    depth: Any,
+    info: Any,
+    *,
+    depth_scale: float = 0.001,
+    name: str = "frame",
+    source: str = "ros",
+) -> Frame:
+    """A :class:`~symfruit.frame.Frame` of a colour image, the depth image aligned to it and the colour
+    camera's info; stamped with the colour header (``stamp``, ``frame_id``).
+
+    Raises
+    ------
+    SymfruitError
+        (``FileFormatError``, ``InputError``) for an unknown encoding, truncated data, invalid intrinsics,
+        or sizes that disagree.
+    """
+    rgb = color_image(color)
+    metres = depth_image(depth, depth_scale=depth_scale)
+    h, w = metres.shape
+    camera = camera_from_info(info, width=w, height=h)
+    return Frame(name, rgb, metres, camera, source=source, stamp=header_stamp(color), frame_id=header_frame_id(color))
+
+
+@dataclass(frozen=True)
+class Processed:
+    """The outcome of one frame: the fruit, everything detect found, and how long each part took (s)."""
+
+    fruits: list[Fruit]
+    found: FrameDetections
+    seconds: dict[str, float] = field(default_factory=dict)
+
+
+class FrameProcessor:
+    """Settings resolved once (defaults, ``fruit`` profile, ``config`` file, ``overrides``); then one call per
+    frame.
+
+    Parameters
+    ----------
+    method : str
+        Completion method (``symfruit methods``).
+    fruit : str or None
+        Fruit profile name or profile file.
+    config : path or None
+        Settings file over the profile.
+    masks : str
+        Mask source as ``symfruit detect --masks``: ``auto``/``color`` (the colour segmenter on a
+        live stream), a label PNG / COCO JSON, or ``maskrcnn:CHECKPOINT``.
+    depth_scale : float
+        Metres per unit of 16-bit depth images (0.001: millimetres).
+    overrides : mapping, optional
+        Nested ``{section: {key: value}}`` over the file.
+
+    Raises
+    ------
+    SymfruitError
+        At construction, for an unknown method, profile or an invalid settings file, so that a node
+        fails at start-up rather than on every frame.
+    """
+
+    def __init__(
+        self,
+        *,
+        method: str = DEFAULT_METHOD,
+        fruit: str | None = "strawberry",
+        config: str | Path | None = None,
+        masks: str = "auto",
+        depth_scale: float = 0.001,
+        overrides: Mapping[str, Any] | None = None,
+    ) -> None:
+        get_method(method)
+        if not 0 < depth_scale < 1:
+            raise InputError(f"depth_scale must be metres per unit in (0, 1), got {depth_scale!r}")
+        self.method, self.masks, self.depth_scale = method, masks, float(depth_scale)
+        self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
+
+    def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
+        """The :class:`~symfruit.frame.Frame` of the three messages (:func:`message_frame`)."""
+        return message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source)
+
+    def process(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Processed:
+        """Decode, detect, and list the located fruit. Raises ``SymfruitError`` for a bad frame."""
+        t0 = time.perf_counter()
+        frame = self.frame(color, depth, info, name=name, source=source)
+        t1 = time.perf_counter()
+        found = detect(frame, masks=self.masks, method=self.method, settings=self.settings)
+        t2 = time.perf_counter()
+        fruits = fruits_of(found)
+        t3 = time.perf_counter()
+        return Processed(fruits, found, {"decode": t1 - t0, "detect": t2 - t1, "collect": t3 - t2})
+
+
+# ---------------------------------------------------------------------------------------------------
+# the newest frame only
+# ---------------------------------------------------------------------------------------------------
+
+
+class LatestOnly:
+    """Run ``handle(item)`` on one worker thread for the newest item only.
+
+    ``put`` never blocks: an item still waiting when a newer one arrives is dropped (and counted),
+    so a node that falls behind skips frames instead of queueing them. ``handle`` exceptions go to
+    ``on_error(item, exc)``; the worker keeps running.
+    """
+
+    def __init__(
+        self,
+        handle: Callable[[Any], None],
+        *,
+        on_error: Callable[[Any, BaseException], None],
+        name: str = "symfruit-worker",
+    ) -> None:
+        self._handle, self._on_error = handle, on_error
+        self._cond = threading.Condition()
+        self._item: Any = None
+        self._has_item = False
+        self._busy = False
+        self._stop = False
+        self.dropped = 0
+        self.handled = 0
+        self._thread = threading.Thread(target=self._run, name=name, daemon=True)
+
+    def start(self) -> LatestOnly:
+        self._thread.start()
+        return self
+
+    def put(self, item: Any) -> bool:
+        """Offer an item; True when it replaced one that was never handled."""
+        with self._cond:
+            replaced = self._has_item
+            if replaced:
+                self.dropped += 1
+            self._item, self._has_item = item, True
+            self._cond.notify_all()
+        return replaced
+
+    def wait_idle(self, timeout: float | None = None) -> bool:
+        """Block until no item waits and none is being handled; False on timeout."""
+        with self._cond:
+            return self._cond.wait_for(lambda: not self._has_item and not self._busy, timeout)
+
+    def stop(self, timeout: float | None = 10.0) -> None:
+        """Let the current item finish, drop a waiting one, and end the thread."""
+        with self._cond:
+            self._stop = True
+            self._cond.notify_all()
+        if self._thread.is_alive():
+            self._thread.join(timeout)
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                while not self._has_item and not self._stop:
+                    self._cond.wait()
+                if self._stop:
+                    return
+                item, self._item, self._has_item = self._item, None, False
+                self._busy = True
+            try:
+                self._handle(item)
+            except Exception as exc:  # never let a frame end the worker
+                self._on_error(item, exc)
+            finally:
+                with self._cond:
+                    self.handled += 1
+                    self._busy = False
+                    self._cond.notify_all()

@@ -1,0 +1,136 @@
+"""The masks protocol (symfruit.evaluate.masks): IoU, one-to-one matching, summaries, COCO photos, scenes."""
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from symfruit import FileFormatError, InputError
+from symfruit.evaluate.masks import (
+    evaluate_mask_items,
+    evaluate_masks,
+    evaluate_scene_masks,
+    mask_ious,
+    match_masks,
+    score_masks,
+    summarise_masks,
+)
+from symfruit.scenes import make_photo
+from symfruit.segment import segment
+from symfruit.writers import draw_contact_sheet, write_mask_report
+
+RED = (200, 30, 40)
+
+
+def test_iou_and_one_to_one_matching_known_answer():
+    truth = np.zeros((2, 10, 10), bool)
+    truth[0, :5, :5] = True
+    truth[1, 5:, 5:] = True
+    labels = np.zeros((10, 10), np.int32)
+    labels[:5, :4] = 7  # 20 of 25: IoU 0.8
+    labels[5:, :5] = 9  # on no fruit: false
+    ious, ids = mask_ious(truth, labels)
+    assert ids.tolist() == [7, 9] and np.allclose(ious, [[0.8, 0.0], [0.0, 0.0]])
+    assert match_masks(ious).tolist() == [[0, 0]]
+    s = score_masks(truth, labels)
+    assert (s.n_true, s.n_pred, s.matched, s.missed, s.false) == (2, 2, 1, 1, 1)
+    assert np.allclose(s.best_iou, [0.8, 0.0])
+
+
+def test_matching_is_one_to_one_and_maximises_the_summed_iou():
+    ious = np.array([[0.9, 0.6], [0.7, 0.0]])  # greedy would take 0.9 and leave fruit 1 unmatched
+    pairs = match_masks(ious)
+    assert sorted(map(tuple, pairs.tolist())) == [(0, 1), (1, 0)]
+    assert len(match_masks(np.array([[0.4, 0.45]]))) == 0  # below the threshold: no match
+    assert match_masks(np.zeros((0, 3))).shape == (0, 2)
+
+
+def test_truth_as_labels_and_bad_input():
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    assert score_masks(labels, labels).best_iou.tolist() == [1.0]
+    with pytest.raises(InputError):
+        mask_ious(np.zeros((1, 5, 5), bool), labels)  # sizes differ
+    with pytest.raises(InputError):
+        mask_ious(labels, labels.astype(float))
+    with pytest.raises(InputError):
+        match_masks(np.zeros((2, 2)), threshold=0)
+
+
+def test_summary_totals_and_shares():
+    t = np.zeros((1, 8, 8), bool)
+    t[0, :4] = True
+    a = score_masks(t, t[0].astype(np.int32), image="a", ms=2.0)
+    b = score_masks(np.zeros((0, 8, 8), bool), np.ones((8, 8), np.int32), image="b", ms=4.0)
+    s = summarise_masks([a, b])
+    assert (s["true_fruit"], s["detections"], s["matched"], s["false"]) == (1, 2, 1, 1)
+    assert s["mean_best_iou"] == 1.0 and s["matched_share"] == 1.0 and s["false_share"] == 0.5
+    assert s["ms_median"] == 3.0 and s["images_with_false"] == 1
+
+
+def _coco_folder(tmp_path):
+    color, _ = make_photo([(80, 120, 40, RED), (230, 120, 40, RED)])
+    Image.fromarray(color).save(tmp_path / "a.png")
+    blank, _ = make_photo([])
+    Image.fromarray(blank).save(tmp_path / "b.jpg", quality=95)
+    t = np.linspace(0, 2 * np.pi, 60, endpoint=False)
+    polys = [[float(v) for p in zip(cx + 40 * np.cos(t), 120 + 40 * np.sin(t), strict=True) for v in p]
+             for cx in (80, 230)]  # fmt: skip
+    coco = {
+        "images": [{"id": 7, "file_name": "a.png", "height": 240, "width": 320},
+                   {"id": 8, "file_name": "b.jpg", "height": 240, "width": 320}],
+        "annotations": [{"id": k + 1, "image_id": 7, "category_id": 1, "segmentation": [p]}
+                        for k, p in enumerate(polys)]
+        + [{"id": 9, "image_id": 7, "category_id": 2, "segmentation": [polys[0]]}],
+        "categories": [{"id": 1, "name": "fruit"}, {"id": 2, "name": "people"}],
+    }  # fmt: skip
+    (tmp_path / "c.json").write_text(json.dumps(coco))
+    return tmp_path / "c.json"
+
+
+def test_masks_protocol_on_a_tiny_coco_set_and_its_report(tmp_path):
+    truth = _coco_folder(tmp_path)
+    ev = evaluate_masks(tmp_path, truth, segment, keep_worst=4)
+    s = ev.summary
+    assert (s["images"], s["true_fruit"], s["matched"], s["false"]) == (2, 2, 2, 0)
+    assert s["mean_best_iou"] > 0.9
+    everything = evaluate_masks(tmp_path, truth, segment, category=None)
+    assert everything.summary["true_fruit"] == 3  # the category-2 annotation counted too
+    assert evaluate_masks(tmp_path, truth, segment, names=["b.jpg"]).summary["true_fruit"] == 0
+    written = write_mask_report(tmp_path / "out", ev, meta={"what": "test"})
+    assert [p.name for p in written] == ["masks.csv", "summary.json", "worst.png"]
+    assert all(p.is_file() for p in written)
+    summary = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert summary["summary"]["matched"] == 2 and summary["what"] == "test" and summary["protocol"] == "masks"
+    rows = (tmp_path / "out" / "masks.csv").read_text().splitlines()
+    assert rows[0].startswith("image,n_true,n_pred,matched") and len(rows) == 3
+
+
+def test_masks_protocol_refuses_a_missing_image_or_folder(tmp_path):
+    truth = _coco_folder(tmp_path)
+    (tmp_path / "a.png").unlink()
+    with pytest.raises(FileFormatError, match="not in"):
+        evaluate_masks(tmp_path, truth, segment)
+    with pytest.raises(FileFormatError, match="not a folder"):
+        evaluate_masks(tmp_path / "nope", truth, segment)
+    with pytest.raises(FileFormatError, match="no images"):
+        evaluate_masks(tmp_path, truth, segment, names=["zzz.png"])
+
+
+def test_the_worst_images_are_kept_for_the_contact_sheet():
+    good, gt = make_photo([(160, 120, 50, RED)])
+    items = [("good", good, gt), ("empty", good, np.zeros((0, 240, 320), bool))]
+    ev = evaluate_mask_items(items, segment, keep_worst=1)
+    assert [w[0] for w in ev.worst] == ["empty"]  # one false region is worse than a near-perfect mask
+    sheet = draw_contact_sheet(ev.worst, tile=128, columns=2)
+    assert sheet.size == (256, 128)
+    assert draw_contact_sheet([]).size[0] > 0
+
+
+def test_masks_protocol_on_rendered_scenes_with_and_without_depth():
+    with_depth = evaluate_scene_masks([1], segment, keep_worst=0)
+    s = with_depth.summary
+    assert s["true_fruit"] == 6 and s["matched"] == 6 and s["false"] == 0  # the demo frame: 6 of 6, none unripe
+    alone = evaluate_scene_masks([1], segment, depth=False, keep_worst=0)
+    assert alone.summary["true_fruit"] == 6 and alone.summary["detections"] >= 1

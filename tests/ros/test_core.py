@@ -1,0 +1,204 @@
+"""symfruit.ros.core: messages in (decoded by symfruit.io.bags), fruit out, the latest-only worker. No ROS needed."""
+
+from __future__ import annotations
+
+import threading
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from symfruit import SymfruitError
+from symfruit.errors import InputError
+from symfruit.ros.core import FrameProcessor, LatestOnly, fruits_of, message_frame
+
+
+def header(secs: int = 7, nsecs: int = 5, frame_id: str = "cam") -> SimpleNamespace:
+    return SimpleNamespace(stamp=SimpleNamespace(secs=secs, nsecs=nsecs), frame_id=frame_id)
+
+
+def image_msg(array: np.ndarray, encoding: str, *, pad: int = 0, bigendian: bool = False) -> SimpleNamespace:
+    """A duck-typed sensor_msgs/Image of ``array`` (h, w[, c]) with ``pad`` bytes at the end of every row."""
+    a = np.ascontiguousarray(array)
+    if bigendian:
+        a = a.astype(a.dtype.newbyteorder(">"))
+    h, w = a.shape[:2]
+    rows = a.reshape(h, -1).view(np.uint8)
+    rows = np.hstack([rows, np.full((h, pad), 7, np.uint8)])
+    return SimpleNamespace(height=h, width=w, encoding=encoding, is_bigendian=int(bigendian), step=rows.shape[1],
+                           data=rows.tobytes(), header=header())  # fmt: skip
+
+
+def info_msg(fx=615.0, fy=615.0, cx=320.0, cy=240.0, width=640, height=480, key="K") -> SimpleNamespace:
+    return SimpleNamespace(width=width, height=height, header=header(),
+                           **{key: [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]})  # fmt: skip
+
+
+def example_messages(images, color_encoding="rgb8", depth_encoding="16UC1"):
+    rgb, raw, cam = images
+    color = {"rgb8": rgb, "bgr8": rgb[:, :, ::-1]}[color_encoding]
+    depth = raw if depth_encoding == "16UC1" else raw.astype(np.float32) * np.float32(0.001)
+    info = info_msg(cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height)
+    return image_msg(color, color_encoding), image_msg(depth, depth_encoding), info
+
+
+def frame_of(color, depth=None, info=None):
+    h, w = color.height, color.width
+    depth = depth or image_msg(np.full((h, w), 500, np.uint16), "16UC1")
+    return message_frame(color, depth, info or info_msg(width=w, height=h, cx=w / 2, cy=h / 2))
+
+
+@pytest.mark.parametrize("encoding", ["rgb8", "bgr8", "rgba8", "bgra8"])
+@pytest.mark.parametrize("pad", [0, 3])
+def test_colour_encodings(encoding, pad):
+    rng = np.random.default_rng(1)
+    rgb = rng.integers(0, 256, (5, 7, 3), dtype=np.uint8)
+    order = {"rgb8": [0, 1, 2], "bgr8": [2, 1, 0], "rgba8": [0, 1, 2], "bgra8": [2, 1, 0]}[encoding]
+    img = rgb[:, :, order]
+    if encoding.endswith("a8"):
+        img = np.dstack([img, np.full((5, 7), 255, np.uint8)])
+    frame = frame_of(image_msg(img, encoding, pad=pad))
+    assert frame.color.dtype == np.uint8 and frame.color.shape == (5, 7, 3) and np.array_equal(frame.color, rgb)
+
+
+def test_mono8_is_grey_rgb():
+    grey = np.arange(12, dtype=np.uint8).reshape(3, 4)
+    frame = frame_of(image_msg(grey, "mono8", pad=2))
+    assert frame.color.shape == (3, 4, 3) and all(np.array_equal(frame.color[:, :, c], grey) for c in range(3))
+
+
+@pytest.mark.parametrize("bigendian", [False, True])
+def test_depth_16uc1_millimetres(bigendian):
+    mm = np.array([[0, 1000], [65535, 250]], np.uint16)
+    frame = frame_of(image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8"), image_msg(mm, "16UC1", pad=1,
+                     bigendian=bigendian))  # fmt: skip
+    assert frame.depth.dtype == np.float32
+    assert np.array_equal(frame.depth, mm.astype(np.float32) * np.float32(0.001))
+
+
+def test_depth_32fc1_metres_invalid_to_zero():
+    m = np.array([[0.5, np.nan], [np.inf, 0.25]], np.float32)
+    frame = frame_of(image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8"), image_msg(m, "32FC1"))
+    assert np.array_equal(frame.depth, np.array([[0.5, 0.0], [0.0, 0.25]], np.float32))
+
+
+def test_frame_carries_the_colour_header():
+    color = image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8")
+    color.header = header(12, 345, "camera_color_optical_frame")
+    frame = frame_of(color)
+    assert frame.stamp == 12_000_000_345 and frame.frame_id == "camera_color_optical_frame"
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [({"encoding": "yuv422"}, "encoding"), ({"data": b"\x00" * 10}, "image data holds 10 bytes"),
+     ({"step": 2}, "step"), ({"height": 0}, "empty")],
+)  # fmt: skip
+def test_bad_images_raise_symfruit_errors(change, match):
+    msg = image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8")
+    for k, v in change.items():
+        setattr(msg, k, v)
+    with pytest.raises(SymfruitError, match=match):
+        frame_of(msg, image_msg(np.ones((4, 4), np.uint16), "16UC1"), info_msg(width=4, height=4, cx=2, cy=2))
+
+
+def test_depth_rejects_colour_encodings():
+    color = image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8")
+    for bad in (image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8"), image_msg(np.zeros((2, 2), np.uint8), "mono8")):
+        with pytest.raises(SymfruitError, match="depth image"):
+            frame_of(color, bad)
+
+
+def test_camera_info_ros1_and_ros2_names_and_image_size():
+    color = image_msg(np.zeros((48, 64, 3), np.uint8), "rgb8")
+    depth = image_msg(np.zeros((48, 64), np.uint16), "16UC1")
+    for key in ("K", "k"):
+        cam = frame_of(color, depth, info_msg(fx=600, fy=601, cx=30, cy=20, width=64, height=48, key=key)).camera
+        assert (cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height) == (600, 601, 30, 20, 64, 48)
+    cam = frame_of(color, depth, info_msg(width=0, height=0)).camera  # an unset size is the image's
+    assert (cam.width, cam.height) == (64, 48)
+    with pytest.raises(InputError, match="focal"):
+        frame_of(color, depth, info_msg(fx=0.0, width=64, height=48))
+    with pytest.raises(InputError, match="intrinsics are for 640x480"):  # info of another resolution
+        frame_of(color, depth, info_msg())
+
+
+@pytest.mark.parametrize(("color_encoding", "depth_encoding"), [("rgb8", "16UC1"), ("bgr8", "32FC1")])
+def test_processor_equals_detect_on_the_example_frame(example_images, example_fruits, color_encoding,
+                                                      depth_encoding):  # fmt: skip
+    core = FrameProcessor(fruit="strawberry")
+    got = core.process(*example_messages(example_images, color_encoding, depth_encoding))
+    assert len(got.fruits) == len(example_fruits) > 0
+    for a, b in zip(got.fruits, example_fruits, strict=True):
+        assert a.id == b.id and a.n_visible == b.n_visible
+        np.testing.assert_allclose(a.centre, b.centre, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(a.size, b.size, rtol=0, atol=1e-9)
+        assert a.score == pytest.approx(b.score, abs=1e-12)
+    assert set(got.seconds) == {"decode", "detect", "collect"}
+
+
+def test_fruits_are_the_detections_json_entries(example_fruits, detect_json):
+    located = [e for e in detect_json["fruits"] if "error" not in e]
+    assert [f.id for f in example_fruits] == [e["id"] for e in located]
+    for f, e in zip(example_fruits, located, strict=True):
+        assert f.centre.tolist() == [e["bbox"]["center"]["position"][k] for k in "xyz"] == e["centre"]
+        assert f.size.tolist() == [e["bbox"]["size"][k] for k in "xyz"]
+        assert f.score == e["confidence"] and len(f.points) > f.n_visible == e["n_points"]
+
+
+def test_fruits_of_leaves_failed_fruit_out(example_images):
+    from symfruit.detect import Detection, FrameDetections
+
+    found = FrameProcessor().process(*example_messages(example_images)).found
+    first = found.detections[0]
+    failed = Detection(99, first.mask, first.extraction, None, "too few points")
+    with_failure = FrameDetections(found.frame, [*found.detections, failed], found.timings, found.mask_source)
+    assert [f.id for f in fruits_of(with_failure)] == [f.id for f in fruits_of(found)]
+
+
+def test_settings_resolve_like_the_cli(tmp_path):
+    from symfruit.settings import resolve_settings
+
+    config = tmp_path / "s.yaml"
+    config.write_text("extract:\n  min_points: 77\n")
+    core = FrameProcessor(fruit="apple", config=str(config))
+    assert core.settings == resolve_settings(fruit="apple", config=config)
+    assert core.settings.extract.min_points == 77
+    assert FrameProcessor(fruit="", config="").settings == resolve_settings()  # empty ROS parameters: unset
+
+
+def test_processor_refuses_bad_settings_at_start(tmp_path):
+    for kwargs in ({"method": "no-such-method"}, {"fruit": "no-such-fruit"}, {"config": tmp_path / "none.yaml"},
+                   {"depth_scale": 1.0}):  # fmt: skip
+        with pytest.raises(SymfruitError):
+            FrameProcessor(**kwargs)
+
+
+def test_latest_only_drops_waiting_items_and_survives_errors():
+    entered, release = threading.Event(), threading.Event()
+    handled, errors = [], []
+
+    def handle(item):
+        handled.append(item)
+        if item == 1:
+            entered.set()
+            assert release.wait(60)
+        if item == "boom":
+            raise ValueError("bad frame")
+
+    worker = LatestOnly(handle, on_error=lambda item, exc: errors.append((item, type(exc)))).start()
+    try:
+        assert worker.put(1) is False
+        assert entered.wait(60)  # 1 is being handled: 2 waits, 3 replaces it
+        assert worker.put(2) is False
+        assert worker.put(3) is True
+        release.set()
+        assert worker.wait_idle(60)  # 1, then 3
+        worker.put("boom")
+        assert worker.wait_idle(60)
+        worker.put(4)
+        assert worker.wait_idle(60)
+    finally:
+        worker.stop()
+    assert handled == [1, 3, "boom", 4] and worker.handled == 4
+    assert worker.dropped == 1 and errors == [("boom", ValueError)]

@@ -1,0 +1,131 @@
+"""`symfruit segment` and its batch (symfruit.batch.segment_images), label writers, the learned mask sources."""
+
+import importlib.util
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from symfruit import Camera, FileFormatError, InputError, SymfruitError
+from symfruit.batch import segment_images
+from symfruit.cli import main
+from symfruit.scenes import make_photo
+from symfruit.writers import draw_label_overlay, write_labels
+
+RED = (200, 30, 40)
+
+
+def _photos(folder, n=2):
+    folder.mkdir(parents=True, exist_ok=True)
+    for k in range(n):
+        color, _ = make_photo([(80, 120, 40, RED), (230, 120, 40, RED)][: k + 1], seed=k)
+        Image.fromarray(color).save(folder / f"p{k}.jpg", quality=95)
+    return folder
+
+
+def test_segment_images_writes_16_bit_labels_overlays_and_a_record(tmp_path):
+    report = segment_images([_photos(tmp_path / "in")], output=tmp_path / "out")
+    assert report.ok and [d.fruit for d in report.done] == [1, 2] and not any(d.used_depth for d in report.done)
+    with Image.open(tmp_path / "out" / "p1.png") as img:
+        assert img.mode.startswith("I;16") and np.asarray(img).max() == 2
+    with Image.open(tmp_path / "out" / "p1_overlay.png") as img:
+        assert img.size == (320, 240) and img.mode == "RGB"
+    record = json.loads((tmp_path / "out" / "segment.json").read_text())
+    assert record["mask_source"] == "colour segmenter" and len(record["images"]) == 2 and record["failed"] == []
+
+
+def test_a_bad_image_is_reported_and_the_batch_goes_on(tmp_path):
+    folder = _photos(tmp_path / "in")
+    (folder / "broken.png").write_bytes(b"not a png")
+    report = segment_images([folder], output=tmp_path / "out")
+    assert not report.ok and len(report.done) == 2
+    assert (
+        list(report.failed) == [str(folder / "broken.png")]
+        and "cannot read image" in report.failed[str(folder / "broken.png")]
+    )
+
+
+def test_a_mask_source_that_raises_is_contained(tmp_path):
+    def flaky(color, depth=None, camera=None):
+        if color[0, 0, 0] > 0:
+            raise RuntimeError("boom")
+        return np.zeros(color.shape[:2], np.int32)
+
+    report = segment_images([_photos(tmp_path / "in")], output=tmp_path / "out", masks=flaky)
+    assert len(report.failed) == 2 and all("RuntimeError: boom" in v for v in report.failed.values())
+
+
+def test_depth_from_a_folder_is_used_and_needs_a_camera(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "p0.png")
+    cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
+    report = segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert report.done[0].used_depth and report.done[0].fruit == 1
+    np.save(depth / "p0.npy", np.full((240, 320), 0.4))
+    (depth / "p0.png").unlink()
+    assert segment_images([folder], output=tmp_path / "o2", depth=depth, camera=cam).done[0].used_depth
+    np.save(depth / "p0.npy", np.full((10, 10), 0.4))
+    bad = segment_images([folder], output=tmp_path / "o3", depth=depth, camera=cam)
+    assert "depth is" in next(iter(bad.failed.values()))
+    with pytest.raises(InputError, match="camera"):
+        segment_images([folder], output=tmp_path / "out", depth=depth)
+
+
+def test_coco_and_label_folders_as_mask_sources(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    coco = {"images": [{"id": 1, "file_name": "p0.jpg", "height": 240, "width": 320}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1,
+                             "segmentation": [[40, 80, 120, 80, 120, 160, 40, 160]]}]}  # fmt: skip
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    report = segment_images([folder], output=tmp_path / "out", masks=tmp_path / "t.json")
+    assert report.done[0].fruit == 1 and report.mask_source.endswith("t.json")
+    labels = tmp_path / "labels"
+    labels.mkdir()
+    write_labels(labels / "p0.png", np.eye(240, 320, dtype=np.int32) * 3)
+    assert segment_images([folder], output=tmp_path / "o2", masks=labels).done[0].fruit == 1
+    with pytest.raises(InputError, match="--masks"):
+        segment_images([folder], output=tmp_path / "o3", masks="nonsense")
+
+
+def test_label_writer_and_overlay_refuse_what_does_not_fit(tmp_path):
+    with pytest.raises(FileFormatError, match="0-65535"):
+        write_labels(tmp_path / "a.png", np.full((4, 4), 70000))
+    with pytest.raises(FileFormatError, match=r"\.png"):
+        write_labels(tmp_path / "a.jpg", np.zeros((4, 4), np.int32))
+    with pytest.raises(FileFormatError, match="integer"):
+        write_labels(tmp_path / "a.png", np.zeros((4, 4)))
+    with pytest.raises(FileFormatError):
+        draw_label_overlay(np.zeros((4, 4, 3), np.uint8), np.zeros((5, 5), np.int32))
+
+
+@pytest.mark.skipif(importlib.util.find_spec("torch") is not None, reason="torch is installed")
+def test_maskrcnn_without_torch_says_which_extra_through_segment(tmp_path, capsys):
+    folder = _photos(tmp_path / "in", n=1)
+    with pytest.raises(SymfruitError, match=r"symfruit\[seg\]"):
+        segment_images([folder], output=tmp_path / "out", masks="maskrcnn:model.pth")
+    assert main(["segment", str(folder), "--output", str(tmp_path / "out"), "--masks", "maskrcnn:model.pth"]) == 2
+    assert "symfruit[seg]" in capsys.readouterr().err
+
+
+def test_cli_segment_evaluate_masks_and_bench_segment(tmp_path, capsys):
+    folder = _photos(tmp_path / "in")
+    assert main(["segment", str(folder), "--output", str(tmp_path / "out")]) == 0
+    out = capsys.readouterr().out
+    assert "p1.jpg: 2 fruit (colour alone" in out and "segment (colour segmenter): 2 images, 3 fruit, 0 failed" in out
+    coco = {"images": [{"id": 1, "file_name": "p0.jpg", "height": 240, "width": 320}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1,
+                             "segmentation": [[40, 80, 120, 80, 120, 160, 40, 160]]}]}  # fmt: skip
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    args = ["evaluate", "--protocol", "masks", "--images", str(folder), "--truth", str(tmp_path / "t.json")]
+    assert main([*args, "--output", str(tmp_path / "res")]) == 0
+    out = capsys.readouterr().out
+    assert "1 true fruit" in out and "mean best-match IoU" in out
+    assert (tmp_path / "res" / "latest" / "worst.png").is_file()
+    assert main(["evaluate", "--protocol", "masks", "--images", str(folder), "--output", str(tmp_path)]) == 2
+    assert "needs both" in capsys.readouterr().err
+    assert main(["bench", "--segment", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["segment"]
+    assert row["images"] == 24 and row["width"] == 640 and row["median_ms"] > 0
