@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import signal
 import subprocess
 import sys
 import threading
@@ -23,6 +22,7 @@ import numpy as np
 import pytest
 
 from symfruit.ros.core import Fruit
+from symfruit.ros.master import stop_group
 
 REPO = Path(__file__).resolve().parents[2]
 TIMEOUT = float(os.environ.get("SYMFRUIT_ROS_TIMEOUT", "120"))
@@ -170,14 +170,8 @@ def start(cmd: list[str], env: dict[str, str], log: Path) -> subprocess.Popen:
 
 
 def stop(process: subprocess.Popen) -> None:
-    """SIGINT (rospy's and roslaunch's clean shutdown) to the process group, SIGKILL if it lingers."""
-    if process.poll() is None:
-        os.killpg(process.pid, signal.SIGINT)
-        try:
-            process.wait(60)
-        except subprocess.TimeoutExpired:
-            os.killpg(process.pid, signal.SIGKILL)
-            process.wait(30)
+    """SIGINT to the process group (rospy's and roslaunch's clean shutdown), SIGKILL if it lingers."""
+    stop_group(process, 60)
 
 
 @pytest.fixture(scope="module")

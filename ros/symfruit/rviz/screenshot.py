@@ -10,7 +10,6 @@ with its coloured depth cloud on /scene_points, and after ~25 s grabs the screen
 from __future__ import annotations
 
 import os
-import signal
 import subprocess
 import sys
 import time
@@ -35,7 +34,7 @@ def scene_cloud(rgb: np.ndarray, raw: np.ndarray, cam) -> np.ndarray:
 
 
 def main(out: Path, seconds: float = 25.0) -> None:
-    from symfruit.ros.master import RosMaster
+    from symfruit.ros.master import RosMaster, stop_group
 
     procs: list[subprocess.Popen] = []
 
@@ -84,13 +83,7 @@ def main(out: Path, seconds: float = 25.0) -> None:
             rospy.signal_shutdown("done")
         finally:
             for p in reversed(procs):
-                if p.poll() is None:
-                    os.killpg(p.pid, signal.SIGINT)
-                    try:
-                        p.wait(15)
-                    except subprocess.TimeoutExpired:
-                        os.killpg(p.pid, signal.SIGKILL)
-                        p.wait(5)
+                stop_group(p, 15)
     print(f"wrote {out}")
 
 

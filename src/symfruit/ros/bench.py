@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import os
 import re
-import signal
 import subprocess
 import sys
 import threading
@@ -27,6 +26,7 @@ from typing import Any
 import numpy as np
 
 from ..methods import DEFAULT_METHOD
+from .master import stop_group
 
 __all__ = ["bench_node", "main"]
 
@@ -178,12 +178,7 @@ def bench_node(
             delivered = sorted(t for (s, _), t in got.items() if s >= 5000)
             span = delivered[-1] - sent_at[0] if delivered else float("nan")
         finally:
-            os.killpg(node.pid, signal.SIGINT)
-            try:
-                node.wait(30)
-            except subprocess.TimeoutExpired:
-                os.killpg(node.pid, signal.SIGKILL)
-                node.wait(30)
+            stop_group(node, 30)
             rospy.signal_shutdown("bench done")
         lines = [m.groups() for m in map(_LINE.search, log.read_text(errors="replace").splitlines()) if m]
     closed = {int(g[0]): tuple(map(float, g[2:])) for g in lines if 1001 <= int(g[0]) < 5000}

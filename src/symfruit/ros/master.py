@@ -23,7 +23,7 @@ from typing import Any
 
 from ..errors import SymfruitError
 
-__all__ = ["RosMaster", "free_port"]
+__all__ = ["RosMaster", "free_port", "stop_group"]
 
 
 def free_port() -> int:
@@ -39,6 +39,21 @@ def _command(port: int) -> list[str]:
         return [exe, "--core", "-p", str(port)]
     # no script on PATH: run the module with this interpreter (it must see Debian's dist-packages)
     return [sys.executable, "-c", "import rosmaster; rosmaster.rosmaster_main()", "--core", "-p", str(port)]
+
+
+def stop_group(process: subprocess.Popen, timeout: float = 10.0) -> None:
+    """Stop a process started with ``start_new_session=True`` and everything it started: SIGINT to its
+    process group (rospy's and roslaunch's clean shutdown), SIGKILL if it is still there after ``timeout``."""
+    if process.poll() is not None:
+        return
+    try:
+        os.killpg(process.pid, signal.SIGINT)
+        process.wait(timeout)
+    except subprocess.TimeoutExpired:
+        os.killpg(process.pid, signal.SIGKILL)
+        process.wait(timeout)
+    except ProcessLookupError:  # the group is gone already
+        pass
 
 
 class RosMaster:
@@ -108,15 +123,8 @@ class RosMaster:
     def stop(self, timeout: float = 10.0) -> None:
         """SIGINT the master and wait; SIGKILL its process group if it is still there after ``timeout``."""
         p, self.process = self.process, None
-        if p is not None and p.poll() is None:
-            try:
-                os.killpg(p.pid, signal.SIGINT)
-                p.wait(timeout)
-            except subprocess.TimeoutExpired:
-                os.killpg(p.pid, signal.SIGKILL)
-                p.wait(timeout)
-            except ProcessLookupError:
-                pass
+        if p is not None:
+            stop_group(p, timeout)
 
     def close(self) -> None:
         self.stop()
