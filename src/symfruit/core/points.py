@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["as_points", "bounds", "check_cloud", "check_view", "mean_point"]
+__all__ = ["as_points", "bounds", "check_cloud", "check_view", "mean_point", "subsample"]
 
 
 def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -131,10 +131,7 @@ def check_cloud(
             "all points lie on a plane; a fruit's visible surface is curved (is this a depth image "
             "of a flat object, or a cloud with its depth dropped?)"
         )
-    if len(arr) > max_points:
-        keep = np.random.default_rng(0).choice(len(arr), size=max_points, replace=False)
-        arr = arr[np.sort(keep)]
-    return arr, n_dropped
+    return subsample(arr, max_points), n_dropped
 
 
 def check_view(points: np.ndarray, camera: Any, *, min_pixels: int = 3) -> None:
@@ -164,3 +161,12 @@ def check_view(points: np.ndarray, camera: Any, *, min_pixels: int = 3) -> None:
             f"the visible points fall within {span.max():.1f} pixels of the image (fewer than {min_pixels} across): "
             "a streak along the line of sight, not a fruit's surface"
         )
+
+
+def subsample(points: np.ndarray, n: int | None, *, seed: int = 0) -> np.ndarray:
+    """At most ``n`` rows of ``points``: a fixed random subset (seeded, so the same cloud always gives the
+    same subset), in the original order; ``points`` itself when it is small enough or ``n`` is None."""
+    if n is None or len(points) <= n:
+        return points
+    keep = np.random.default_rng(seed).choice(len(points), size=n, replace=False)
+    return points[np.sort(keep)]

@@ -15,7 +15,7 @@ import numpy as np
 from .box import Box
 from .camera import Camera
 from .planes import Plane, Planes, hypothesis_planes, mirror
-from .points import as_points
+from .points import as_points, subsample
 from .raster import View, rasterise
 from .rating import Scoring, Table1, rate_planes
 
@@ -133,10 +133,7 @@ def complete_by_symmetry(
     ref = points.mean(axis=0) if centre == "centroid" else (lo + hi) / 2.0
     dist_ref = float((hi - lo).max())
     dtype = np.float32 if precision == "single" else np.float64
-    rated = points
-    if rating_points is not None and len(points) > rating_points:
-        pick = np.random.default_rng(0).choice(len(points), size=rating_points, replace=False)
-        rated = points[np.sort(pick)]
+    rated = subsample(points, rating_points)
     scores = rate_planes(rated, planes.points, planes.normals, view, camera, centre=ref, dist_ref=dist_ref,
                          table=table, scoring=scoring, dtype=dtype)  # fmt: skip
     best = int(np.argmax(scores))  # argmax returns the first of equal maxima

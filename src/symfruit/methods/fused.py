@@ -42,6 +42,7 @@ from ..core.fits import (
     fit_sphere,
     surface_noise,
 )
+from ..core.points import subsample
 from ..core.raster import View, rasterise, silhouette_coverage
 from ..core.symmetry import complete_by_symmetry
 from ..errors import InputError
@@ -123,9 +124,7 @@ def _mean_box(boxes: list[Box]) -> Box:
 def fused(points: np.ndarray, camera: Camera, settings: FusedSettings) -> Completion:
     """Shape fit and mirror completion, fused by the data's noise level; with a confidence."""
     s = settings
-    sample = points
-    if len(points) > s.fit_points:
-        sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
+    sample = subsample(points, s.fit_points)
     extent = float(np.ptp(points, axis=0).max())
     ratio, noise, normals = surface_noise(sample)
     step = max(1, len(sample) // 120)
