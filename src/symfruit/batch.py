@@ -211,17 +211,13 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
 
 def _read_depth(path: Path, scale: float, shape: tuple[int, int]) -> np.ndarray:
     """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape``."""
+    from .io.frames import read_depth_npy
     from .io.images import read_depth_units
 
     if path.suffix.lower() == ".npy":
-        try:
-            arr = np.load(path, mmap_mode="r", allow_pickle=False)
-        except (OSError, ValueError) as exc:
-            raise FileFormatError(f"{path}: cannot read depth ({exc})") from None
-        if arr.shape != shape or arr.dtype.kind not in "fiu":  # checked from the header, before reading it
-            raise FileFormatError(f"{path}: depth is {arr.dtype} {arr.shape}, the image {shape}")
-        return np.asarray(arr, dtype=np.float64)
-    depth = read_depth_units(path).astype(np.float64) * scale
+        depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
+    else:
+        depth = read_depth_units(path).astype(np.float64) * scale
     if depth.shape != shape:
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth
@@ -251,7 +247,7 @@ def mask_source(
     (each image's annotations, by file name), a folder of label PNGs (``<stem>.png``), or a callable
     ``(color, depth=, camera=) -> labels``. Checkpoints and files are checked here, before any image.
     """
-    from .segment import segment
+    from .segment import learned_masks, segment
 
     settings = settings or Settings()
     if callable(masks):
@@ -262,18 +258,9 @@ def mask_source(
     text = str(masks)
     if text == "color":
         return (lambda path, color, depth, camera: segment(color, depth, camera, settings.segment)), "colour segmenter"
-    if text.startswith("maskrcnn:"):
-        from .segment_maskrcnn import load_maskrcnn, maskrcnn_labels
-
-        checkpoint = text.split(":", 1)[1]
-        load_maskrcnn(checkpoint)  # a missing extra or a bad checkpoint fails once, before the images
-        return (lambda path, color, depth, camera: maskrcnn_labels(color, checkpoint)), text
-    if text.startswith("onnx:"):
-        from .segment_onnx import load_onnx, onnx_labels
-
-        model = text.split(":", 1)[1]
-        load_onnx(model)
-        return (lambda path, color, depth, camera: onnx_labels(color, model)), text
+    learned = learned_masks(text)  # a missing extra or a bad model fails once, before the images
+    if learned is not None:
+        return (lambda path, color, depth, camera: learned(color)), text
     source = Path(text)
     if source.suffix.lower() == ".json":
         from .io.masks import read_coco

@@ -21,7 +21,7 @@ from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
 from .frame import Frame
 from .methods import DEFAULT_METHOD
-from .segment import segment
+from .segment import learned_masks, segment
 from .settings import Settings
 
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
@@ -77,14 +77,8 @@ def frame_masks(
         labels, source = frame.masks, "frame masks file"
     elif masks in ("auto", "color"):
         labels, source = segment(frame.color, frame.depth, frame.camera, settings.segment), "colour segmenter"
-    elif str(masks).startswith("maskrcnn:"):
-        from .segment_maskrcnn import maskrcnn_labels
-
-        labels, source = maskrcnn_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
-    elif str(masks).startswith("onnx:"):
-        from .segment_onnx import onnx_labels
-
-        labels, source = onnx_labels(frame.color, str(masks).split(":", 1)[1]), str(masks)
+    elif (learned := learned_masks(str(masks))) is not None:
+        labels, source = learned(frame.color), str(masks)
     else:
         from .io.masks import read_masks
 

@@ -38,6 +38,7 @@ Fruit cut by the image border are kept (their hull is cut by the border too).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
 
@@ -47,7 +48,7 @@ from scipy import ndimage
 from .errors import InputError
 from .settings import Section, SettingError, register_section, setting
 
-__all__ = ["SegmentSettings", "convex_hull_mask", "redness", "ripe_seeds", "segment"]
+__all__ = ["SegmentSettings", "convex_hull_mask", "learned_masks", "redness", "ripe_seeds", "segment"]
 
 #: Largest morphology or smoothing radius a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -281,6 +282,27 @@ def _hull_area(mask: np.ndarray) -> float:
     area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
     perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
     return area + 0.5 * perimeter + 1.0
+
+
+def learned_masks(spec: str) -> Callable[[np.ndarray], np.ndarray] | None:
+    """The labeller ``color -> (h, w) int32 labels`` of a learned mask source, or None if ``spec`` names none.
+
+    ``"maskrcnn:CHECKPOINT"`` is a torchvision Mask R-CNN (optional extra ``seg``), ``"onnx:MODEL"`` an ONNX
+    instance-segmentation export (optional extra ``onnx``). The model is loaded (and checked) here, once;
+    a missing extra or a bad file raises here, naming it.
+    """
+    prefix, _, path = spec.partition(":")
+    if prefix == "maskrcnn" and path:
+        from .segment_maskrcnn import load_maskrcnn, maskrcnn_labels
+
+        load_maskrcnn(path)
+        return lambda color: maskrcnn_labels(color, path)
+    if prefix == "onnx" and path:
+        from .segment_onnx import load_onnx, onnx_labels
+
+        load_onnx(path)
+        return lambda color: onnx_labels(color, path)
+    return None
 
 
 def segment(

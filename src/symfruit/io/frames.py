@@ -30,7 +30,15 @@ from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
 from .text import read_structured
 
-__all__ = ["COLOR_NAMES", "DEFAULT_DEPTH_SCALE", "is_frame_folder", "read_frame", "read_truth", "write_frame"]
+__all__ = [
+    "COLOR_NAMES",
+    "DEFAULT_DEPTH_SCALE",
+    "is_frame_folder",
+    "read_depth_npy",
+    "read_frame",
+    "read_truth",
+    "write_frame",
+]
 
 DEFAULT_DEPTH_SCALE = 0.001
 #: Colour image names a frame folder may use, in order of preference.
@@ -82,7 +90,7 @@ def read_frame(folder: str | Path) -> Frame:
     if depth_png.is_file():
         depth = read_depth_units(depth_png).astype(np.float32) * np.float32(scale)
     elif depth_npy.is_file():
-        depth = _read_depth_npy(depth_npy)
+        depth = read_depth_npy(depth_npy)
     else:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
@@ -90,7 +98,7 @@ def read_frame(folder: str | Path) -> Frame:
     return Frame(folder.name, color, depth, camera, masks, truth, str(folder))
 
 
-def _read_depth_npy(path: Path) -> np.ndarray:
+def read_depth_npy(path: Path) -> np.ndarray:
     """A float depth image in metres from ``.npy`` (never unpickled; size checked from the header)."""
     from .clouds import npy_header
 
