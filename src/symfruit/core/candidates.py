@@ -131,6 +131,20 @@ def constrain_box(
     return lo, hi
 
 
+def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray,
+               reach: tuple[float, float], *, lateral: bool = True) -> bool:  # fmt: skip
+    """Whether a box could be the fruit's: its hidden depth beyond the deepest seen point at most
+    ``reach[1]`` times the seen box's largest lateral side, and (``lateral``) no lateral face beyond the seen
+    box by more than ``reach[0]`` times the seen extent along that axis."""
+    seen = seen_hi - seen_lo
+    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1]):
+        return False
+    if lateral:
+        over = np.maximum(seen_lo[:2] - lo[:2], hi[:2] - seen_hi[:2])
+        return bool(np.all(over <= reach[0] * seen[:2]))
+    return True
+
+
 def candidates(
     points: np.ndarray,
     *,
@@ -147,6 +161,7 @@ def candidates(
     explained: float | None = None,
     region: Silhouette | None = None,
     outline_profile: str = "off",
+    plausible: tuple[float, float] | None = None,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -179,6 +194,11 @@ def candidates(
     outline_profile : {"off", "add", "replace"}
         With ``region``: add the ``outline`` candidate, replace the solid of revolution's profile with the
         outline's, or neither.
+    plausible : (float, float), optional
+        ``(lateral, depth)``: a closed candidate whose fitted box reaches beyond the seen box by more than
+        ``lateral`` seen extents on a lateral side (not checked when ``obs.extent`` bounds where the fruit can
+        project), or whose back lies more than ``depth`` times the seen box's largest lateral side behind
+        the deepest seen point, is left out: implausible for what was seen (a runaway fit).
     explained : float, optional
         When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
         explained and the solid of revolution is not fitted (no other shape can explain the outline better).
@@ -206,6 +226,8 @@ def candidates(
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
             return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
+        if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible, lateral=sides is None):
+            return
         ev = explain(inside, (lo, hi), obs, steps=steps)
         box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, sides=sides)
         out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64), back_std))

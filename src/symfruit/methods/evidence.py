@@ -100,6 +100,14 @@ class EvidenceSettings(Section):
     contour_cut_energy : float
         The ``cone`` ellipsoid's energy per unit cut share when it was fitted to the contour part of the
         outline alone (its premise, that this part is the silhouette, then holds).
+    lateral_reach, depth_reach : float
+        A candidate whose box is implausible for what was seen is left out (it must not win, and the
+        weighted median must not follow it): one reaching beyond the seen box by more than
+        ``lateral_reach`` seen extents on a side (the hidden part of a fruit is no larger than the seen
+        part; not checked with occlusion information, which bounds where the fruit can project), or whose
+        hidden depth beyond the deepest seen point exceeds ``depth_reach`` times the seen box's largest
+        lateral side (a fruit is no deeper behind its rim than its silhouette is long;
+        :func:`~symfruit.core.candidates.candidates`).
     noise_energy, clean_ratio, noise_queries : float, float, int
         Energy of the unconstrained (Li-Griffiths) ellipsoid times how far the view is a depth camera's
         rather than a clean scan (:func:`clean_share` of the roughness ratio of
@@ -154,6 +162,8 @@ class EvidenceSettings(Section):
     thin_px: int = setting(3, ge=0, le=50)
     contour_cone: float = setting(0.3, ge=0.0, le=1.0)
     contour_cut_energy: float = setting(0.0, ge=0.0, le=1e6)
+    lateral_reach: float = setting(1.0, gt=0.0, le=100.0)
+    depth_reach: float = setting(1.0, gt=0.0, le=100.0)
     mirror_candidate: bool = setting(False)
     outline_profile: Literal["off", "add", "replace"] = setting("add")
     mirror: PaperSettings = setting(
@@ -291,7 +301,8 @@ def evidence(
         points, sample=sample, obs=obs, camera=camera, front=front,
         mirror=s.mirror.options() if s.mirror_candidate else None, revolution_points=s.revolution_points,
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
-        region=region, outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
+        region=region, plausible=(s.lateral_reach, s.depth_reach),
+        outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     box = combined.box
