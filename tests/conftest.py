@@ -106,6 +106,28 @@ def rendered_view(fruit, centre, *, noise: float = 0.0, rotation=None, seed: int
     return cam.deproject(np.c_[cols, rows].astype(float), z), posed
 
 
+def occluded_view(fruit, centre, *, below: float, occluder_z: float, noise: float = 0.0, seed: int = 0,
+                  rotation=None) -> tuple[np.ndarray, np.ndarray, np.ndarray, object]:  # fmt: skip
+    """``(visible (n, 3), depth (h, w), mask (h, w), posed fruit)``: as :func:`rendered_view`, with a flat
+    occluder at depth ``occluder_z`` (metres) hiding every pixel below image row ``below`` and a backdrop at
+    1 m; ``depth`` is the whole rendered depth image (0 where nothing), ``mask`` the fruit's seen pixels."""
+    from symfruit.render import render
+
+    cam = symfruit.DEFAULT_CAMERA
+    posed = fruit.transformed(np.eye(3) if rotation is None else rotation, np.asarray(centre, dtype=float))
+    y = (below - cam.cy) / cam.fy
+    quad = np.array([[-2.0, y * occluder_z, occluder_z], [2.0, y * occluder_z, occluder_z],
+                     [2.0, 2.0, occluder_z], [-2.0, 2.0, occluder_z]])  # fmt: skip
+    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    shot = render([(posed.vertices, posed.faces), (quad, faces), (back, faces)], cam)
+    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    depth = depth + np.random.default_rng(seed).normal(size=depth.shape) * noise * depth**2
+    mask = shot.ids == 0
+    rows, cols = np.nonzero(mask)
+    return cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols]), depth, mask, posed
+
+
 def ball_mesh(radius: float = 0.035):
     """A closed triangle-mesh ball (a revolved half circle, 96 x 90)."""
     from symfruit.shapes import _revolve

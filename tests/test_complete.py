@@ -73,9 +73,9 @@ def test_a_million_points_are_down_sampled(monkeypatch):
     info = get("evidence")
     handed = []
 
-    def spy(points, camera, section):
+    def spy(points, camera, section, *, occlusion=None):
         handed.append(len(points))
-        return info.fn(points, camera, section)
+        return info.fn(points, camera, section, occlusion=occlusion)
 
     monkeypatch.setattr(sys.modules["symfruit.complete"], "get", lambda name: replace(info, fn=spy))
     result = complete(cloud)

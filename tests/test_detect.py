@@ -151,3 +151,24 @@ def test_the_method_and_settings_reach_every_fruit(example):
     assert EXAMPLE_FRAME.name == example.name
     pairs = match([d.visible_box for d in found.detections], [b for _, b in example.truth])
     assert len(pairs) == 6
+
+
+def test_every_fruit_gets_the_frames_occlusion_information(example):
+    found = detect(example, method="raw")
+    assert all(d.occlusion is not None and d.occlusion.width == example.camera.width for d in found.detections)
+    # Another fruit's pixels beside a fruit are hidden from it unless clearly behind it, its own never.
+    for d in found.detections:
+        h, w = d.occlusion.hidden.shape
+        own = d.mask[d.occlusion.v0 : d.occlusion.v0 + h, d.occlusion.u0 : d.occlusion.u0 + w]
+        assert not (d.occlusion.hidden & own).any()
+    off = detect(example, method="raw", settings=Settings().replace(occlusion={"enabled": False}))
+    assert all(d.occlusion is None for d in off.detections)
+
+
+def test_the_occlusion_settings_are_bounded():
+    from symfruit import ConfigError
+
+    with pytest.raises(ConfigError, match="tolerance"):
+        Settings().replace(occlusion={"tolerance": 5.0})
+    with pytest.raises(ConfigError, match="reach_px"):
+        Settings().replace(occlusion={"reach_px": -1})

@@ -13,6 +13,7 @@ from .core.box import Box
 from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane, Planes
 from .core.points import check_cloud, check_view
+from .core.view import Occlusion
 from .errors import InputError
 from .methods import DEFAULT_METHOD, get
 from .settings import Section, SettingError, Settings, from_dict, register_section, setting
@@ -138,6 +139,7 @@ def complete(
     camera: Camera | Mapping[str, Any] | None = None,
     method: str = DEFAULT_METHOD,
     settings: Settings | Mapping[str, Any] | None = None,
+    occlusion: Occlusion | None = None,
 ) -> Result:
     """Complete one fruit seen from one view and box it.
 
@@ -155,6 +157,10 @@ def complete(
     settings : Settings or mapping, optional
         Settings (e.g. from :func:`symfruit.resolve_settings`), or a nested mapping of overrides
         (``{"paper": {"rotations_x": 21}}``).
+    occlusion : Occlusion, optional
+        Where the camera could not have seen this fruit (:func:`symfruit.core.view.occlusion` of the frame's
+        depth image and masks; :func:`symfruit.detect.detect` computes it), for the methods that use it
+        (``evidence``); the others ignore it. None: the points are all there is.
 
     Returns
     -------
@@ -180,6 +186,13 @@ def complete(
     settings = _settings(settings)
     camera = _camera(camera)
     info = get(method)
+    if occlusion is not None:
+        if not isinstance(occlusion, Occlusion):
+            raise InputError(f"occlusion must be a symfruit.core.view.Occlusion or None, got "
+                             f"{type(occlusion).__name__}")  # fmt: skip
+        if (occlusion.width, occlusion.height) != (camera.width, camera.height):
+            raise InputError(f"occlusion is for a {occlusion.width}x{occlusion.height} image, the camera's is "
+                             f"{camera.width}x{camera.height}")  # fmt: skip
     try:
         n_input = len(points)
     except TypeError:  # a scalar or 0-d array: check_cloud names the problem
@@ -190,7 +203,7 @@ def complete(
                                    min_extent=s.min_extent, max_extent=s.max_extent, section="input")  # fmt: skip
     check_view(clean, camera)
     section = settings.section(method) if info.settings is not None else None
-    done = info.fn(clean, camera, section)
+    done = info.fn(clean, camera, section, occlusion=occlusion) if info.occlusion else info.fn(clean, camera, section)
     _check_completion(done.box, clean, method, s.max_extent)
     seconds = time.perf_counter() - start
     return Result(

@@ -17,10 +17,12 @@ import numpy as np
 from .complete import Result, complete
 from .core.box import Box
 from .core.camera import Camera
+from .core.view import Occlusion
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
 from .frame import Frame
 from .methods import DEFAULT_METHOD
+from .occlusion import fruit_occlusion
 from .segment import learned_masks, segment
 from .settings import Settings
 
@@ -39,6 +41,7 @@ class Detection:
     extraction: Extraction
     result: Result | None = None
     error: str = ""
+    occlusion: Occlusion | None = None
 
     @property
     def visible_box(self) -> Box | None:
@@ -139,11 +142,14 @@ def detect(
                    "had no depth")  # fmt: skip
             detections.append(Detection(int(k), mask, ex, error=why))
             continue
+        occ = None
         try:
-            result = complete(ex.points, camera=frame.camera, method=method, settings=settings)
-            detections.append(Detection(int(k), mask, ex, result))
+            occ = fruit_occlusion(frame.depth, mask, ex.points, frame.camera, settings.occlusion,
+                                  others=(labels > 0) & ~mask)  # fmt: skip
+            result = complete(ex.points, camera=frame.camera, method=method, settings=settings, occlusion=occ)
+            detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
         except SymfruitError as exc:
-            detections.append(Detection(int(k), mask, ex, error=str(exc)))
+            detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
         t_complete += time.perf_counter() - b
     total = time.perf_counter() - t0
     timings = {"segment": t1 - t0, "extract": t_extract, "complete": t_complete, "total": total}

@@ -78,3 +78,17 @@ def test_the_outline_candidate_takes_its_profile_from_the_silhouette():
                           shapes=("revolution",), region=region, outline_profile="replace")  # fmt: skip
     assert [c.name for c in replaced] == ["revolution", "raw"]
     np.testing.assert_allclose(replaced[0].hi, cands[0].hi)
+
+
+def test_a_box_implausible_for_what_was_seen_is_no_candidate():
+    from symfruit.core.candidates import _plausible
+
+    seen_lo, seen_hi = np.array([0.0, 0.0, 0.30]), np.array([0.04, 0.06, 0.33])
+    reach = (1.0, 1.0)
+    assert _plausible(seen_lo - [0.01, 0.0, 0.0], seen_hi + [0.0, 0.02, 0.05], seen_lo, seen_hi, reach)
+    # Hidden depth beyond the deepest seen point: at most one largest lateral side (0.06 m).
+    assert not _plausible(seen_lo, seen_hi + [0.0, 0.0, 0.061], seen_lo, seen_hi, reach)
+    # A lateral face beyond the seen box by more than the seen extent along that axis (0.04 m in x) ...
+    assert not _plausible(seen_lo - [0.041, 0.0, 0.0], seen_hi, seen_lo, seen_hi, reach)
+    # ... unless where the fruit can project is known (occlusion information): then it is only clipped.
+    assert _plausible(seen_lo - [0.041, 0.0, 0.0], seen_hi, seen_lo, seen_hi, reach, lateral=False)

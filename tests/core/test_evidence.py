@@ -68,3 +68,33 @@ def test_outside_rays_beside_a_cut_are_no_evidence(camera):
     whole = observe(visible[::10], silhouette(visible, camera), camera, dense=visible)
     assert np.concatenate(whole.out_weights).mean() > 0.95 and whole.contour > 0.95
     assert len(whole.interior) > 0.8 * len(visible[::10])
+
+
+def test_an_occluders_edge_is_a_cut_with_the_occlusion_information(camera):
+    """A leaf hides the lower third of a ball: from the points alone its edge looks like the ball's outline;
+    the frame's depth says it is a cut, its outside rays are no evidence, and the cone is the ball's."""
+    from symfruit.core.raster import silhouette_cone
+    from symfruit.core.view import occlusion
+
+    from ..conftest import occluded_view
+
+    centre = np.array([0.0, 0.0, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=255, occluder_z=0.33, noise=0.01, seed=2)
+    region = silhouette(visible, camera)
+    blind = observe(visible[::10], region, camera, dense=visible)
+    occ = occlusion(depth, mask, visible, camera)
+    seen = observe(visible[::10], region, camera, dense=visible, occlusion=occ)
+    assert blind.contour > 0.9 and blind.cone_source == "moments"
+    assert 0.55 < seen.contour < 0.85 and seen.cone_source == "contour"
+    assert 0.0 < np.concatenate(seen.out_weights).mean() < 0.9
+    whole, _ = observe(*_whole_ball(camera)).cone, None
+    assert np.abs(seen.cone - whole).max() < np.abs(blind.cone - whole).max() / 3
+    rows = np.nonzero(region.mask.any(axis=1))[0] + region.v0
+    assert seen.extent is not None and seen.extent[1] == pytest.approx(rows[0] - 0.5)  # the ball's own top
+    assert seen.extent[3] > rows[-1] + 40  # below, the ball may reach as far as the leaf (the window) goes
+    assert silhouette_cone(region, camera)[0] == pytest.approx(blind.cone)
+
+
+def _whole_ball(camera):
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.01, seed=2)
+    return visible[::10], silhouette(visible, camera), camera

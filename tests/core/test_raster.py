@@ -164,3 +164,38 @@ def test_a_ragged_outline_is_closed_and_a_clean_one_kept(camera):
     assert closed is not ragged and closed.mask.sum() > ragged.mask.sum()
     lost = int(clean.mask.sum()) - int(ragged.mask.sum())
     assert 0 <= int(clean.mask.sum()) - int(closed.mask.sum()) < 0.5 * lost  # most of the rim is back
+
+
+def test_outline_cracks_are_the_pixel_squares_edges():
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    mask = np.zeros((5, 6), bool)
+    mask[1:3, 2:5] = True  # a 3 x 2 block of pixels, columns 2-4 and rows 1-2
+    cracks = outline_cracks(Silhouette(10, 20, mask, 0.0))
+    assert len(cracks) == 2 * 3 + 2 * 2  # its perimeter in pixel edges
+    assert cracks[:, 0].min() == 10 + 1.5 and cracks[:, 0].max() == 10 + 4.5
+    assert cracks[:, 1].min() == 20 + 0.5 and cracks[:, 1].max() == 20 + 2.5
+
+
+def test_an_ellipse_is_recovered_from_part_of_its_outline(camera):
+    from symfruit.core.raster import Silhouette, outline_cone, silhouette_cone
+
+    vv, uu = np.mgrid[:120, :140]
+    a, b, cu, cv = 40.0, 25.0, 70.0, 60.0
+    full = ((uu - cu) / a) ** 2 + ((vv - cv) / b) ** 2 <= 1.0
+    seen = full & (vv < cv + 5)  # an occluder hides the lower part
+    t = np.linspace(np.pi, 2 * np.pi, 200)  # the upper, seen arc of the outline (v = cv + b sin t < cv)
+    arc = np.c_[cu + a * np.cos(t), cv + b * np.sin(t)]
+    region = Silhouette(250, 180, seen, 0.0)
+    cone, axis = outline_cone(region, camera, arc + [250, 180])
+    whole, whole_axis = silhouette_cone(Silhouette(250, 180, full, 0.0), camera)
+    assert np.allclose(cone, whole, atol=0.02) and np.allclose(axis, whole_axis, atol=2e-3)
+    cut, _ = silhouette_cone(region, camera)
+    assert not np.allclose(cut, whole, atol=0.02)  # the cut region's moments are not the fruit's
+    assert outline_cone(region, camera, arc[:5] + [250, 180]) is None  # too few points
+    line = np.c_[np.linspace(0, 100, 50), np.linspace(0, 50, 50)]
+    assert outline_cone(region, camera, line + [250, 180]) is None  # no ellipse through a line
+    small = np.c_[cu + 5 * np.cos(t), cv + 5 * np.sin(t)]
+    assert outline_cone(region, camera, small + [250, 180]) is None  # would not hold the seen region
+    with pytest.raises(InputError, match="shape"):
+        outline_cone(region, camera, np.zeros((10, 3)))

@@ -119,3 +119,18 @@ def test_upright_stands_a_scan_up(tmp_path):
     upright = build(Spec("paper", str(tmp_path), 0, PAPER_ANGLES.index(0), poses="upright"))
     assert lying.kind == "scan/lemon"
     assert np.argmax(upright.truth_box.size) == 1 and np.argmax(lying.truth_box.size) == 2
+
+
+def test_a_view_with_an_occluder_keeps_its_depth_and_mask():
+    from symfruit.occlusion import OcclusionSettings, fruit_occlusion
+
+    clear, covered = (
+        build(Spec("camera", "apple", 0, 0, 0.0, sensor="heldback")),
+        build(Spec("camera", "apple", 0, 0, 0.4, sensor="heldback")),
+    )
+    assert clear.depth is None and clear.mask is None  # the held-back measurement: points and camera only
+    assert covered.depth is not None and covered.mask.sum() == len(covered.visible)
+    occ = fruit_occlusion(covered.depth, covered.mask, covered.visible, covered.camera, OcclusionSettings())
+    assert occ is not None and occ.hidden.sum() > 0.2 * covered.mask.sum()
+    assert fruit_occlusion(covered.depth, covered.mask, covered.visible, covered.camera,
+                           OcclusionSettings(enabled=False)) is None  # fmt: skip

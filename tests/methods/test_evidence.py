@@ -5,7 +5,7 @@ ycbbenchmarks.com, CC BY 4.0, read from ``../shared/data/real-scans``)."""
 import numpy as np
 import pytest
 
-from symfruit import ConfigError, box_iou, centre_deviation, complete
+from symfruit import DEFAULT_CAMERA, ConfigError, box_iou, centre_deviation, complete
 from symfruit.core.candidates import Candidate
 from symfruit.core.evidence import Evidence
 from symfruit.evaluate.protocols import Spec, build
@@ -114,3 +114,36 @@ def test_premises_the_view_contradicts_cost_energy():
     assert whole["raw"] == pytest.approx(s.raw_energy)
     assert cut["cone"] == pytest.approx(0.6 * s.cut_energy) and cut["ellipsoid"] == 0.0
     assert cut["raw"] == pytest.approx(s.raw_energy + 0.6 * s.cut_energy)
+
+
+def test_the_frames_occlusion_information_completes_an_occluded_fruit():
+    """A leaf hides the lower part of a lemon: from its points alone the leaf's edge looks like the fruit's
+    outline and the box is cut short; with the occlusion information it is not."""
+    from symfruit import Box
+    from symfruit.core.view import occlusion
+
+    from ..conftest import occluded_view
+
+    fruit = FRUITS["lemon"](np.random.default_rng(3))
+    visible, depth, mask, posed = occluded_view(fruit, [0.0, 0.0, 0.4], below=250, occluder_z=0.35, noise=0.01,
+                                                seed=1, rotation=rotation(20, 40, 10))  # fmt: skip
+    truth = Box(posed.vertices.min(axis=0), posed.vertices.max(axis=0))
+    occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
+    blind = complete(visible)
+    seen = complete(visible, occlusion=occ)
+    assert centre_deviation(seen.box, truth) < 0.5 * centre_deviation(blind.box, truth)
+    assert box_iou(seen.box, truth) > box_iou(blind.box, truth) + 0.05
+    assert seen.extras["contour"] < blind.extras["contour"]
+    # Methods that do not use it ignore it.
+    assert np.array_equal(complete(visible, method="sphere", occlusion=occ).box.min,
+                          complete(visible, method="sphere").box.min)  # fmt: skip
+
+
+def test_a_runaway_fit_does_not_win():
+    """The paper protocol's generated banana of seed 1 whose solid of revolution and sphere ran away (245 mm)."""
+    inst = build(Spec("paper", "banana", 2, 1, seed=1))
+    r = complete(inst.visible, camera=inst.camera)
+    assert centre_deviation(r.box, inst.truth_box) < 0.015
+    loose = complete(inst.visible, camera=inst.camera,
+                     settings={"evidence": {"lateral_reach": 100.0, "depth_reach": 100.0}})  # fmt: skip
+    assert centre_deviation(loose.box, inst.truth_box) > 0.1

@@ -80,3 +80,31 @@ def test_a_method_brings_its_own_settings_section(isolated_registry):
     with pytest.raises(ConfigError, match=r"test-shrink\.factor: must be <= 1, got 2"):
         complete(visible, method="test-shrink", settings={"test-shrink": {"factor": 2}})
     assert get("test-shrink").summary.startswith("The visible box shrunk")
+
+
+def test_only_methods_that_take_it_get_the_occlusion_information(isolated_registry):
+    from symfruit.core.view import Occlusion
+
+    seen = {}
+
+    @register("test-occ", occlusion=True)
+    def takes(points, camera, settings, *, occlusion=None):
+        seen["occlusion"] = occlusion
+        return Completion(points=points, box=Box.from_points(points))
+
+    @register("test-plain")
+    def plain(points, camera, settings):
+        return Completion(points=points, box=Box.from_points(points))
+
+    cloud = front_half(sphere_cloud())
+    occ = Occlusion(0, 0, np.zeros((4, 4), bool), 640, 480)
+    complete(cloud, method="test-occ", occlusion=occ)
+    assert seen["occlusion"] is occ and get("test-occ").occlusion and not get("test-plain").occlusion
+    complete(cloud, method="test-occ")
+    assert seen["occlusion"] is None
+    assert complete(cloud, method="test-plain", occlusion=occ).method == "test-plain"
+    assert get("evidence").occlusion and not get("paper").occlusion
+    with pytest.raises(InputError, match="occlusion must be"):
+        complete(cloud, occlusion=np.zeros((4, 4), bool))
+    with pytest.raises(InputError, match="320x240 image"):
+        complete(cloud, occlusion=Occlusion(0, 0, np.zeros((4, 4), bool), 320, 240))

@@ -5,7 +5,8 @@ Imports numpy and scipy only; knows no settings objects, files or command line. 
 mirroring), :mod:`.raster` (what the camera saw), :mod:`.rating` (Algorithm 1), :mod:`.symmetry` (the
 paper's completion), :mod:`.fits` (sphere, ellipsoids, solids of revolution), :mod:`.superellipsoid`
 (Marangoz et al.'s fit), :mod:`.front` (the front surface's depth), :mod:`.evidence` (how well a closed
-shape explains the view), :mod:`.candidates` (the default method's candidate completions).
+shape explains the view), :mod:`.candidates` (the default method's candidate completions), :mod:`.view`
+(where a frame's camera could not have seen a fruit: its occlusion information).
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ from .raster import Silhouette, View, rasterise, silhouette, silhouette_coverage
 from .rating import LOCATIONS, Rating, Table1, rate_planes, rate_points
 from .superellipsoid import Superellipsoid, fit_superellipsoid, missing_surface, superellipsoid_box
 from .symmetry import SymmetryCompletion, complete_by_symmetry
+from .view import Occlusion, occlusion
 
 __all__ = [
     "DEFAULT_CAMERA",
@@ -42,6 +44,7 @@ __all__ = [
     "Candidate",
     "Evidence",
     "Observation",
+    "Occlusion",
     "Plane",
     "Planes",
     "Rating",
@@ -72,6 +75,7 @@ __all__ = [
     "mirror",
     "missing_surface",
     "observe",
+    "occlusion",
     "rasterise",
     "rate_planes",
     "rate_points",

@@ -96,6 +96,7 @@ def constrain_box(
     *,
     cone: tuple[tuple[float, float, float, float], Camera] | None = None,
     contour: float = 1.0,
+    sides: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """A candidate's box made consistent with the view: ``(lo (3,), hi (3,))``, metres.
 
@@ -107,7 +108,10 @@ def constrain_box(
        seen. This only stops runaway fits;
     3. with ``cone = ((u_min, v_min, u_max, v_max), camera)``, the silhouette's pixel box: lateral faces
        beyond the silhouette's viewing cone (widest over the box's depth range) are pulled back, by the
-       share ``contour`` (the whole fruit projects inside its silhouette, as far as its edge is a contour).
+       share ``contour`` (the whole fruit projects inside its silhouette, as far as its edge is a contour),
+       or side by side by the shares ``sides`` (left, top, right, bottom) where they are known (with
+       occlusion information the box is where the fruit can project at all, and every side is pulled back
+       to it).
     """
     seen_lo = np.r_[seen_lo[:2], front]
     seen_hi = np.maximum(seen_hi, seen_lo)
@@ -121,9 +125,24 @@ def constrain_box(
         zs = np.array([lo[2], hi[2]])
         bound_lo = np.array([((u_lo - camera.cx) / camera.fx * zs).min(), ((v_lo - camera.cy) / camera.fy * zs).min()])
         bound_hi = np.array([((u_hi - camera.cx) / camera.fx * zs).max(), ((v_hi - camera.cy) / camera.fy * zs).max()])
-        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + contour * np.maximum(bound_lo - lo[:2], 0.0))
-        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - contour * np.maximum(hi[:2] - bound_hi, 0.0))
+        pull_lo, pull_hi = (contour, contour) if sides is None else (sides[:2], sides[2:])
+        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + pull_lo * np.maximum(bound_lo - lo[:2], 0.0))
+        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - pull_hi * np.maximum(hi[:2] - bound_hi, 0.0))
     return lo, hi
+
+
+def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray,
+               reach: tuple[float, float], *, lateral: bool = True) -> bool:  # fmt: skip
+    """Whether a box could be the fruit's: its hidden depth beyond the deepest seen point at most
+    ``reach[1]`` times the seen box's largest lateral side, and (``lateral``) no lateral face beyond the seen
+    box by more than ``reach[0]`` times the seen extent along that axis."""
+    seen = seen_hi - seen_lo
+    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1]):
+        return False
+    if lateral:
+        over = np.maximum(seen_lo[:2] - lo[:2], hi[:2] - seen_hi[:2])
+        return bool(np.all(over <= reach[0] * seen[:2]))
+    return True
 
 
 def candidates(
@@ -142,6 +161,7 @@ def candidates(
     explained: float | None = None,
     region: Silhouette | None = None,
     outline_profile: str = "off",
+    plausible: tuple[float, float] | None = None,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -174,6 +194,11 @@ def candidates(
     outline_profile : {"off", "add", "replace"}
         With ``region``: add the ``outline`` candidate, replace the solid of revolution's profile with the
         outline's, or neither.
+    plausible : (float, float), optional
+        ``(lateral, depth)``: a closed candidate whose fitted box reaches beyond the seen box by more than
+        ``lateral`` seen extents on a lateral side (not checked when ``obs.extent`` bounds where the fruit can
+        project), or whose back lies more than ``depth`` times the seen box's largest lateral side behind
+        the deepest seen point, is left out: implausible for what was seen (a runaway fit).
     explained : float, optional
         When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
         explained and the solid of revolution is not fitted (no other shape can explain the outline better).
@@ -189,6 +214,11 @@ def candidates(
     extent = float((seen_hi - seen_lo).max())
     uv = camera.project(points[:: max(1, len(points) // 4000)])
     cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
+    sides = None
+    if obs.extent is not None:
+        # With occlusion information: as far as the fruit can project (the seen region and what may hide it).
+        box_px = tuple(float(x) for x in obs.extent)
+        cone, sides = ((box_px[0], box_px[1], box_px[2], box_px[3]), camera), np.ones(4)
     out: list[Candidate] = []
 
     def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray,
@@ -196,8 +226,10 @@ def candidates(
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
             return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
+        if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible, lateral=sides is None):
+            return
         ev = explain(inside, (lo, hi), obs, steps=steps)
-        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour)
+        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, sides=sides)
         out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64), back_std))
 
     if "sphere" in shapes:
@@ -258,7 +290,7 @@ def candidates(
                                         extra_directions=np.vstack(axes) if axes else None,
                                         coarse=revolution_coarse)  # fmt: skip
             if region is not None and outline_profile != "off":
-                r_out = outline_radii(rev, region.mask, (region.u0, region.v0), camera)
+                r_out = outline_radii(rev, region.mask, (region.u0, region.v0), camera, hidden=obs.hidden)
                 shaped = replace(rev, radii=np.where(np.isfinite(r_out) & np.isfinite(rev.radii), r_out, rev.radii))
                 if outline_profile == "replace":
                     rev = shaped
@@ -274,7 +306,7 @@ def candidates(
         mirrored = complete_by_symmetry(sample, camera, **mirror, view=view)
         back = mirrored.points[len(sample) :]
         lo, hi = constrain_box(back.min(axis=0), back.max(axis=0), seen_lo, seen_hi, front, cone=cone,
-                               contour=obs.contour)  # fmt: skip
+                               contour=obs.contour, sides=sides)  # fmt: skip
         out.append(Candidate("mirror", lo, hi, None, 0.5 * (lo + hi)))
 
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)

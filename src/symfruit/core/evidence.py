@@ -29,7 +29,8 @@ from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .points import as_points
-from .raster import Silhouette, silhouette_cone
+from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
+from .view import Occlusion
 
 __all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
 
@@ -63,6 +64,15 @@ class Observation:
     out_weights : tuple of (k,) float
         Per outside band, 1 for a ray beside a contour part of the edge, 0 beside a cut (no evidence of
         background there); None: every ray counts.
+    cone_source : {"moments", "contour"}
+        Whether :attr:`cone` is the seen region's moment ellipse's or the ellipse fitted to the contour part
+        of the outline (see :func:`observe`).
+    extent : (4,) float, pixels, optional
+        With occlusion information: the pixel box the fruit can project into at most (``u_min, v_min, u_max,
+        v_max``; :meth:`~symfruit.core.view.Occlusion.extent`).
+    hidden : (h, w) bool, optional
+        With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
+        outline crossing onto one is an occluder's edge).
     """
 
     rays: np.ndarray
@@ -74,6 +84,9 @@ class Observation:
     axis: np.ndarray | None = None
     interior: np.ndarray | None = None
     out_weights: tuple[np.ndarray, ...] | None = None
+    cone_source: str = "moments"
+    extent: np.ndarray | None = None
+    hidden: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -108,6 +121,10 @@ def observe(
     contour_points: int = 150,
     edge: float = 3.0,
     dense: np.ndarray | None = None,
+    occlusion: Occlusion | None = None,
+    occluded_px: int = 4,
+    contour_cone: float = 0.3,
+    thin_px: int = 3,
 ) -> Observation:
     """Reduce a view to sample rays and silhouette-band rays.
 
@@ -132,6 +149,17 @@ def observe(
         Every seen point, when ``points`` is a subset: the surface normals along the edge that decide
         :attr:`Observation.contour` are taken over neighbourhoods of these (at full density a
         neighbourhood spans a millimetre or two, small enough to follow even a thin fruit's rim).
+    occlusion : Occlusion, optional
+        Where the camera could not have seen the fruit (:func:`symfruit.core.view.occlusion`). The contour
+        share is then measured on the region's own outline pixels: a pixel with a hidden pixel within
+        ``occluded_px`` pixels is a cut whatever the normals say (an occluder's edge, the image border);
+        rays of the outside bands landing on hidden pixels are no evidence; when part of the outline is a
+        cut but at least ``contour_cone`` of it is a contour, the viewing cone is that of the ellipse fitted
+        to the contour part (:func:`~symfruit.core.raster.outline_cone`: a cut region's moments are not the
+        fruit's); and :attr:`Observation.extent` bounds where the fruit can project, hidden structures
+        narrower than ``2 thin_px + 1`` pixels (stems) left out.
+    occluded_px, thin_px : int, pixels
+    contour_cone : float in [0, 1]
     """
     points = as_points(points, min_count=3)
     sample = points[:: max(1, len(points) // n_rays)]
@@ -152,6 +180,8 @@ def observe(
         edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
     else:
         edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
+    if occlusion is not None:
+        edge_uv, is_contour = _occluded_edges(region, occlusion, edge_uv, is_contour, contour_points, occluded_px)
     contour = float(is_contour.mean()) if len(is_contour) else 1.0
     tree = cKDTree(edge_uv) if len(is_contour) else None
 
@@ -162,14 +192,39 @@ def observe(
         weight = np.ones(len(rc))
         if outside and tree is not None and len(rc):
             weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
+        if outside and occlusion is not None and len(rc):
+            weight = weight * ~occlusion.at(uv[:, 0], uv[:, 1])  # a hidden pixel: no evidence either
         return _rays(uv[:, 0], uv[:, 1], camera), weight
 
     ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
     outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
     cone, axis = silhouette_cone(region, camera)
+    source = "moments"
+    if occlusion is not None and tree is not None and contour_cone <= contour < 1.0:
+        cracks = outline_cracks(region)
+        fitted = outline_cone(region, camera, cracks[is_contour[tree.query(cracks)[1]]])
+        if fitted is not None:
+            (cone, axis), source = fitted, "contour"
     return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(r for r, _ in ins),
                        rays_out=tuple(r for r, _ in outs), contour=contour, cone=cone, axis=axis,
-                       interior=points[depth_px >= edge], out_weights=tuple(w for _, w in outs))  # fmt: skip
+                       interior=points[depth_px >= edge], out_weights=tuple(w for _, w in outs),
+                       cone_source=source,
+                       extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
+                       hidden=None if occlusion is None else occlusion.window(region, radius=2))  # fmt: skip
+
+
+def _occluded_edges(
+    region: Silhouette, occlusion: Occlusion, edge_uv: np.ndarray, is_contour: np.ndarray, count: int, radius: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """``(uv (m, 2), contour (m,) bool)`` of up to ``2 count`` of the region's own outline pixels: a contour
+    where the normal of the nearest edge point (``edge_uv``, ``is_contour``; none: every one) says so and
+    no hidden pixel lies within ``radius`` pixels."""
+    mask = region.mask
+    rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask))
+    step = max(1, len(rows) // (2 * count))
+    uv = np.c_[cols[::step] + region.u0, rows[::step] + region.v0].astype(np.float64)
+    labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
+    return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
 
 
 def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:

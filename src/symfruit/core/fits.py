@@ -514,7 +514,7 @@ def fit_revolution_slices(
 
 
 def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], camera: Camera,
-                  *, step: float = 0.25) -> np.ndarray:  # fmt: skip
+                  *, step: float = 0.25, hidden: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """Each slice's radius as the seen outline shows it: ``(b,)`` float, metres (NaN where it cannot).
 
     The ring of slice ``j`` (centre ``c = point + t_j direction``) reaches farthest across the line of
@@ -532,6 +532,9 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     mask : (h, w) bool
         The seen region, whose top-left pixel is ``origin = (u0, v0)``.
     camera : Camera
+    hidden : (h, w) bool, optional
+        Pixels (same window) where the camera could not have seen the fruit: a crossing onto one is an
+        occluder's edge, not the outline: that slice gets no radius.
     """
     mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     c = rev.point[None, :] + mid[:, None] * rev.direction[None, :]  # (b, 3)
@@ -556,6 +559,10 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
         out = ~hit
         first = np.argmax(out, axis=1)
         ok = start & out.any(axis=1) & inside[np.arange(len(mid)), first]  # the outline, not the window's edge
+        if hidden is not None:
+            rows_ = np.arange(len(mid))
+            r_, c_ = np.clip(row[rows_, first], 0, h - 1), np.clip(col[rows_, first], 0, w - 1)
+            ok &= ~hidden[r_, c_]
         edge_px = (first - 0.5) * step  # halfway between the last pixel in and the first out
         bu = uc[:, 0] + sign * edge_px * du[:, 0]
         bv = uc[:, 1] + sign * edge_px * du[:, 1]

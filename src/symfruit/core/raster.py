@@ -22,6 +22,8 @@ __all__ = [
     "Silhouette",
     "View",
     "close_ragged",
+    "outline_cone",
+    "outline_cracks",
     "rasterise",
     "silhouette",
     "silhouette_cone",
@@ -216,6 +218,106 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     cone = k.T @ conic @ k
     axis = np.r_[(mu[0] - camera.cx) / camera.fx, (mu[1] - camera.cy) / camera.fy, 1.0]
     return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
+
+
+def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    """An image conic (negative inside) as a viewing cone scaled to a largest eigenvalue of magnitude 1, and
+    the ray through ``centre`` (pixels)."""
+    k = camera.matrix
+    cone = k.T @ conic @ k
+    axis = np.r_[(centre[0] - camera.cx) / camera.fx, (centre[1] - camera.cy) / camera.fy, 1.0]
+    return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
+
+
+def outline_cracks(region: Silhouette) -> np.ndarray:
+    """(m, 2) float, pixels: the region's outline as the midpoints of the pixel edges between a region pixel
+    and a 4-neighbour outside it (image coordinates: the exact boundary of the pixel squares)."""
+    m = np.pad(region.mask, 1)
+    inner = m[1:-1, 1:-1]
+    out = []
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        rows, cols = np.nonzero(inner & ~m[1 + dr : m.shape[0] - 1 + dr, 1 + dc : m.shape[1] - 1 + dc])
+        out.append(np.c_[cols + 0.5 * dc + region.u0, rows + 0.5 * dr + region.v0])
+    return np.vstack(out).astype(np.float64)
+
+
+def outline_cone(
+    region: Silhouette, camera: Camera, points: np.ndarray, *, min_points: int = 20, inside: float = 0.97,
+    max_area: float = 3.0,
+) -> tuple[np.ndarray, np.ndarray] | None:  # fmt: skip
+    """The viewing cone of the ellipse fitted to part of the silhouette's outline: ``(cone (3, 3), axis (3,))``
+    as :func:`silhouette_cone`, or None when no credible ellipse fits.
+
+    Where part of the outline is an occluder's edge rather than the fruit's, the moment ellipse of the seen
+    region is the wrong one; the ellipse through the rest (the occluding contour, ``points``) is not. The
+    conic is the direct least-squares ellipse fit (Fitzgibbon, Pilu and Fisher 1999, in the numerically
+    stable form of Halir and Flusser 1998) of the points, accepted when it holds at least ``inside`` of the
+    region's pixels and its area is at most ``max_area`` times the region's.
+
+    Parameters
+    ----------
+    region : Silhouette
+    camera : Camera
+    points : (m, 2) float, pixels
+        Outline points on the fruit's own silhouette (e.g. :func:`outline_cracks` beside contour edges).
+    min_points : int
+    inside, max_area : float
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise InputError(f"outline points must have shape (m, 2), got {pts.shape}")
+    if len(pts) < max(min_points, 6):
+        return None
+    mu = pts.mean(axis=0)
+    scale = float(np.sqrt(((pts - mu) ** 2).sum(axis=1).mean())) or 1.0
+    x, y = (pts[:, 0] - mu[0]) / scale, (pts[:, 1] - mu[1]) / scale
+    d1 = np.c_[x * x, x * y, y * y]
+    d2 = np.c_[x, y, np.ones_like(x)]
+    s1, s2, s3 = d1.T @ d1, d1.T @ d2, d2.T @ d2
+    try:
+        t = -np.linalg.solve(s3, s2.T)
+    except np.linalg.LinAlgError:
+        return None
+    m = s1 + s2 @ t
+    m = np.array([m[2] / 2.0, -m[1], m[0] / 2.0])
+    try:
+        _, vecs = np.linalg.eig(m)
+    except np.linalg.LinAlgError:
+        return None
+    vecs = np.real(vecs)
+    cond = 4.0 * vecs[0] * vecs[2] - vecs[1] ** 2
+    good = np.flatnonzero(cond > 0)
+    if not len(good):
+        return None
+    a1 = vecs[:, good[0]]
+    a, b, c, d, e, f = np.r_[a1, t @ a1]
+    # Back to pixels: x = (u - mu_u) / s, y = (v - mu_v) / s.
+    q = np.array([[a, b / 2, d / 2], [b / 2, c, e / 2], [d / 2, e / 2, f]])
+    tr = np.array([[1 / scale, 0, -mu[0] / scale], [0, 1 / scale, -mu[1] / scale], [0, 0, 1]])
+    conic = tr.T @ q @ tr
+    a2 = conic[:2, :2]
+    try:
+        centre = np.linalg.solve(a2, -conic[:2, 2])
+    except np.linalg.LinAlgError:
+        return None
+    value = float(centre @ conic[:2, 2] + conic[2, 2])
+    if value == 0 or not np.isfinite(value):
+        return None
+    conic = conic / -value  # -1 at the centre, 0 on the ellipse
+    eig = np.linalg.eigvalsh(conic[:2, :2])
+    if eig.min() <= 0:
+        return None
+    area = np.pi / np.sqrt(eig[0] * eig[1])
+    rows, cols = np.nonzero(region.mask)
+    n = len(rows)
+    if not n or area > max_area * n:
+        return None
+    u, v = cols + region.u0 - centre[0], rows + region.v0 - centre[1]
+    a2 = conic[:2, :2]
+    held = (a2[0, 0] * u * u + 2 * a2[0, 1] * u * v + a2[1, 1] * v * v) <= 1.0 + 1e-9
+    if held.mean() < inside:
+        return None
+    return _image_cone(conic, centre, camera)
 
 
 def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:

@@ -65,7 +65,8 @@ def score_frame(
         tid, tbox = truth[j]
         for method in methods:
             try:
-                box = complete(d.extraction.points, camera=frame.camera, method=method, settings=settings).box
+                box = complete(d.extraction.points, camera=frame.camera, method=method, settings=settings,
+                               occlusion=d.occlusion).box  # fmt: skip
             except SymfruitError:
                 continue
             scores.append(FrameScore(frame.name, d.id, tid, method, box_iou(box, tbox),

@@ -120,7 +120,9 @@ class Spec:
 
 @dataclass(frozen=True)
 class Instance:
-    """A visible view with its truth."""
+    """A visible view with its truth; a camera view with an occluder keeps its rendered ``depth`` image
+    (metres, 0: none) and the fruit's ``mask`` (its visible pixels), from which the evaluation makes the
+    occlusion information a robot's ``detect`` would have (:func:`symfruit.occlusion.fruit_occlusion`)."""
 
     spec: Spec
     kind: str
@@ -132,6 +134,8 @@ class Instance:
     distance: float
     hidden: float = 0.0
     extras: dict = field(default_factory=dict)
+    depth: np.ndarray | None = None
+    mask: np.ndarray | None = None
 
 
 def specs(
@@ -239,7 +243,8 @@ def _camera(spec: Spec, camera: Camera) -> Instance:
     truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
     return Instance(
         spec=spec, kind=fruit.kind, visible=visible, truth_box=truth, truth_surface=surface, camera=camera,
-        angles=angles, distance=distance, hidden=float(hidden),
+        angles=angles, distance=distance, hidden=float(hidden), depth=depth if leaf is not None else None,
+        mask=shot.ids == 0 if leaf is not None else None,
     )  # fmt: skip
 
 

@@ -13,6 +13,7 @@ import numpy as np
 from ..complete import complete
 from ..errors import InputError, SymfruitError
 from ..metrics import score_completion
+from ..occlusion import fruit_occlusion
 from ..progress import Progress
 from ..settings import Settings
 from .protocols import Spec, build
@@ -81,9 +82,12 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
         occlusion=spec.occlusion, hidden=inst.hidden, n_visible=len(inst.visible),
     )  # fmt: skip
     rows = []
+    occlusion = None
+    if inst.depth is not None and inst.mask is not None and len(inst.visible):
+        occlusion = fruit_occlusion(inst.depth, inst.mask, inst.visible, inst.camera, settings.occlusion)
     for method in methods:
         try:
-            result = complete(inst.visible, camera=inst.camera, method=method, settings=settings)
+            result = complete(inst.visible, camera=inst.camera, method=method, settings=settings, occlusion=occlusion)
         except SymfruitError as exc:
             nan = float("nan")
             rows.append(Row(**base, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan,

@@ -47,6 +47,7 @@ from ..core.evidence import observe
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.raster import close_ragged, silhouette
+from ..core.view import Occlusion, with_own
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -89,6 +90,24 @@ class EvidenceSettings(Section):
         Energy of the candidates whose premise is that the seen outline is the fruit's silhouette (the
         ``cone`` ellipsoid, and ``raw``: "nothing beyond the outline"), times the share of the outline
         that is not an occluding contour (a cut: the paper's visibility rule, an occluder).
+    occluded_px, thin_px, contour_cone : int, int, float
+        With the frame's occlusion information (:class:`~symfruit.core.view.Occlusion`): an outline pixel
+        with a hidden pixel within ``occluded_px`` is a cut; hidden structures narrower than ``2 thin_px +
+        1`` pixels (a stem) do not widen where the fruit can project; with at least ``contour_cone`` of the
+        outline a contour (and some of it cut) the ``cone`` ellipsoid is tangent to the ellipse through the
+        contour part (:func:`~symfruit.core.evidence.observe`). The seen region then includes the fruit's
+        own mask.
+    contour_cut_energy : float
+        The ``cone`` ellipsoid's energy per unit cut share when it was fitted to the contour part of the
+        outline alone (its premise, that this part is the silhouette, then holds).
+    lateral_reach, depth_reach : float
+        A candidate whose box is implausible for what was seen is left out (it must not win, and the
+        weighted median must not follow it): one reaching beyond the seen box by more than
+        ``lateral_reach`` seen extents on a side (the hidden part of a fruit is no larger than the seen
+        part; not checked with occlusion information, which bounds where the fruit can project), or whose
+        hidden depth beyond the deepest seen point exceeds ``depth_reach`` times the seen box's largest
+        lateral side (a fruit is no deeper behind its rim than its silhouette is long;
+        :func:`~symfruit.core.candidates.candidates`).
     noise_energy, clean_ratio, noise_queries : float, float, int
         Energy of the unconstrained (Li-Griffiths) ellipsoid times how far the view is a depth camera's
         rather than a clean scan (:func:`clean_share` of the roughness ratio of
@@ -139,6 +158,12 @@ class EvidenceSettings(Section):
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
+    occluded_px: int = setting(4, ge=0, le=50)
+    thin_px: int = setting(3, ge=0, le=50)
+    contour_cone: float = setting(0.3, ge=0.0, le=1.0)
+    contour_cut_energy: float = setting(0.0, ge=0.0, le=1e6)
+    lateral_reach: float = setting(1.0, gt=0.0, le=100.0)
+    depth_reach: float = setting(1.0, gt=0.0, le=100.0)
     mirror_candidate: bool = setting(False)
     outline_profile: Literal["off", "add", "replace"] = setting("add")
     mirror: PaperSettings = setting(
@@ -198,7 +223,8 @@ def clean_share(ratio: float, threshold: float) -> float:
     return float(np.clip((ratio - threshold + 0.8) / 1.6, 0.0, 1.0))
 
 
-def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings) -> Combined:
+def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings,
+            cone_source: str = "moments") -> Combined:  # fmt: skip
     """Weigh the candidates by their evidence and take the weighted median box (see the module)."""
     closed = [c for c in cands if c.evidence is not None]
     energies: dict[str, float] = {}
@@ -212,7 +238,8 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
         energy = s.depth_weight * np.log(max(ev.depth, 1e-6) / best_rms)
         energy += s.silhouette_weight * (ev.inside + ev.outside)
         if c.name == "cone":
-            energy += cut  # its premise: the seen outline is the fruit's silhouette
+            # its premise: the seen outline is the fruit's silhouette (or, fitted to its contour part, that part)
+            energy += cut if cone_source == "moments" else s.contour_cut_energy * (1.0 - contour)
         elif c.name == "ellipsoid":
             energy += s.noise_energy * (1.0 - clean)  # an algebraic fit of a noisy partial view comes out thin
         energies[c.name] = energy
@@ -235,15 +262,21 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
 
 
-@register("evidence", settings=EvidenceSettings)
-def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> Completion:
+@register("evidence", settings=EvidenceSettings, occlusion=True)
+def evidence(
+    points: np.ndarray, camera: Camera, settings: EvidenceSettings, *, occlusion: Occlusion | None = None
+) -> Completion:
     """Candidates weighed by how well they explain the view; weighted-median box; confidence."""
     s = settings
     sample = points
     if len(points) > s.fit_points:
         sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
     region = close_ragged(silhouette(points, camera), radius=s.ragged_close_px, ragged=s.ragged_at)
-    obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points)
+    if occlusion is not None:
+        region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
+    obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
+                  occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
+                  thin_px=s.thin_px)  # fmt: skip
     apex, _ = apex_depth(sample)
     front = max(float(points[:, 2].min()), apex)
     shapes: tuple[str, ...] = SHAPES
@@ -268,9 +301,10 @@ def evidence(points: np.ndarray, camera: Camera, settings: EvidenceSettings) -> 
         points, sample=sample, obs=obs, camera=camera, front=front,
         mirror=s.mirror.options() if s.mirror_candidate else None, revolution_points=s.revolution_points,
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
-        region=region, outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
+        region=region, plausible=(s.lateral_reach, s.depth_reach),
+        outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
-    combined = combine(cands, contour=obs.contour, clean=clean, s=s)
+    combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     box = combined.box
     extras: dict[str, Any] = {
         "confidence": combined.confidence,

@@ -1,9 +1,12 @@
 """The registry of completion methods.
 
 A method is a function ``(points, camera, section) -> Completion``; ``section`` is the method's own
-settings section (or None when it has none). Registering it with :func:`register` makes it available
-to :func:`symfruit.complete`, the CLI and the evaluation, and makes its settings section part of
-:class:`~symfruit.settings.Settings`. Adding a method touches no other method.
+settings section (or None when it has none). A method registered with ``occlusion=True`` is called as
+``fn(points, camera, section, occlusion=...)`` and receives the frame's occlusion information
+(:class:`~symfruit.core.view.Occlusion`, or None when the caller has none); the others never see it.
+Registering it with :func:`register` makes it available to :func:`symfruit.complete`, the CLI and the
+evaluation, and makes its settings section part of :class:`~symfruit.settings.Settings`. Adding a method
+touches no other method.
 """
 
 from __future__ import annotations
@@ -15,7 +18,6 @@ from typing import Any
 import numpy as np
 
 from ..core.box import Box
-from ..core.camera import Camera
 from ..core.planes import Plane, Planes
 from ..errors import InputError
 from ..settings import register_section
@@ -56,16 +58,18 @@ class Completion:
     extras: dict[str, Any] = field(default_factory=dict)
 
 
-Method = Callable[[np.ndarray, Camera, Any], Completion]
+Method = Callable[..., Completion]
 
 
 @dataclass(frozen=True)
 class MethodInfo:
-    """A registered method: its function and the settings section it reads (its name), if any."""
+    """A registered method: its function, the settings section it reads (its name), if any, and whether it
+    takes the frame's occlusion information."""
 
     name: str
     fn: Method
     settings: type | None
+    occlusion: bool = False
 
     @property
     def summary(self) -> str:
@@ -77,16 +81,17 @@ class MethodInfo:
 _REGISTRY: dict[str, MethodInfo] = {}
 
 
-def register(name: str, *, settings: type | None = None) -> Callable[[Method], Method]:
+def register(name: str, *, settings: type | None = None, occlusion: bool = False) -> Callable[[Method], Method]:
     """Decorator: make ``fn`` available as method ``name``, reading the settings section ``name`` of type
-    ``settings`` (a :class:`~symfruit.settings.Section` dataclass; registered as a section here)."""
+    ``settings`` (a :class:`~symfruit.settings.Section` dataclass; registered as a section here); with
+    ``occlusion``, ``fn`` takes the keyword ``occlusion`` (see the module)."""
 
     def decorate(fn: Method) -> Method:
         if name in _REGISTRY and _REGISTRY[name].fn is not fn:
             raise ValueError(f"completion method {name!r} is already registered")
         if settings is not None:
             register_section(name, settings)
-        _REGISTRY[name] = MethodInfo(name, fn, settings)
+        _REGISTRY[name] = MethodInfo(name, fn, settings, occlusion)
         return fn
 
     return decorate

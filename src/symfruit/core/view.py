@@ -1,0 +1,254 @@
+"""Where the camera could not have seen one fruit: the occlusion information of a frame.
+
+From a fruit's points alone, the edge of whatever lies in front of it (a leaf, a calyx, a stem, another
+fruit) or the image border looks like the fruit's own outline, and a shape fitted to that outline is cut
+short. The frame knows better: beside an occluding contour (the fruit seen edge-on) the camera sees
+something clearly *behind* the fruit (the background), beside an occluder something at the fruit's
+depth or in front of it. :func:`occlusion` marks, in an image window around the fruit, the pixels where
+the camera could not have seen the fruit (:class:`Occlusion`); a completion method then treats outline
+parts beside them as cuts and band rays landing on them as no evidence.
+
+Numpy and scipy only; the same function serves a frame (:func:`symfruit.detect.detect`) and the
+evaluation's rendered views, so both measure what a robot gets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from ..errors import InputError
+from .camera import Camera
+from .points import as_points
+from .raster import Silhouette
+
+__all__ = ["Occlusion", "occlusion", "with_own"]
+
+
+@dataclass(frozen=True)
+class Occlusion:
+    """Pixels of an image window where the camera could not have seen a fruit.
+
+    Attributes
+    ----------
+    u0, v0 : int
+        Image column and row of the window's top-left pixel.
+    hidden : (h, w) bool
+        Pixels where something at the fruit's depth or in front of it was seen (it may hide the fruit),
+        or another fruit's mask lies (unless clearly behind the fruit).
+    width, height : int
+        The image's size: every pixel outside it is hidden (the camera saw nothing there). Pixels inside the
+        image but outside the window are not.
+    own : (h, w) bool, optional
+        The fruit's own pixels in the window (its instance mask), which may reach beyond its points' pixels
+        (a border dropped against flying pixels, pixels without depth).
+    """
+
+    u0: int
+    v0: int
+    hidden: np.ndarray
+    width: int
+    height: int
+    own: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        hidden = np.asarray(self.hidden)
+        if hidden.ndim != 2 or hidden.dtype != bool:
+            raise InputError(f"occlusion hidden must be a 2-D bool image, got {hidden.dtype} {hidden.shape}")
+        if self.width <= 0 or self.height <= 0:
+            raise InputError(f"occlusion image size must be positive, got {self.width}x{self.height}")
+
+    def at(self, u: np.ndarray, v: np.ndarray, *, radius: int = 0) -> np.ndarray:
+        """Whether pixels ``(u, v)`` are hidden, or have a hidden pixel within ``radius`` (a square).
+
+        Parameters
+        ----------
+        u, v : (m,) float, pixels
+            Image coordinates (rounded to the nearest pixel).
+        radius : int, pixels
+
+        Returns
+        -------
+        (m,) bool
+        """
+        col = np.rint(np.asarray(u, dtype=np.float64)).astype(np.intp)
+        row = np.rint(np.asarray(v, dtype=np.float64)).astype(np.intp)
+        out = (col < radius) | (col >= self.width - radius) | (row < radius) | (row >= self.height - radius)
+        hidden = self.hidden
+        if radius > 0 and hidden.any():
+            hidden = ndimage.maximum_filter(hidden, size=2 * radius + 1, mode="constant", cval=False)
+        h, w = hidden.shape
+        c, r = col - self.u0, row - self.v0
+        inside = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+        out[inside] |= hidden[r[inside], c[inside]]
+        return out
+
+    def window(self, region: Silhouette, *, radius: int = 0) -> np.ndarray:
+        """(h, w) bool in ``region``'s window: :meth:`at` of every pixel."""
+        h, w = region.mask.shape
+        vv, uu = np.mgrid[region.v0 : region.v0 + h, region.u0 : region.u0 + w]
+        return self.at(uu.ravel(), vv.ravel(), radius=radius).reshape(h, w)
+
+    def allowed(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
+        """(h, w) bool, this window: where the fruit seen as ``region`` may project.
+
+        Its silhouette covers the region and cannot reach pixels where the camera saw something clearly behind
+        it, so it lies within the connected part of the region and the hidden pixels (joined across gaps of
+        up to ``gap`` pixels) that holds the region. With ``thin``, hidden structures narrower than ``2 thin
+        + 1`` pixels (a stem) are left out first: a fruit cannot hide behind them.
+        """
+        h, w = self.hidden.shape
+        hidden = self.hidden
+        if thin > 0 and hidden.any():
+            hidden = ndimage.binary_opening(hidden, structure=np.ones((2 * thin + 1,) * 2, bool))
+        rh, rw = region.mask.shape
+        r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
+        r1, c1 = min(region.v0 + rh, self.v0 + h), min(region.u0 + rw, self.u0 + w)
+        seen = np.zeros((h, w), dtype=bool)
+        if r1 > r0 and c1 > c0:
+            seen[r0 - self.v0 : r1 - self.v0, c0 - self.u0 : c1 - self.u0] = region.mask[
+                r0 - region.v0 : r1 - region.v0, c0 - region.u0 : c1 - region.u0
+            ]
+        if not seen.any():
+            return seen
+        allowed = hidden.copy()
+        if gap > 0:
+            size = 2 * gap + 1
+            grown = ndimage.maximum_filter(seen, size=size, mode="constant", cval=False)
+            allowed |= grown & ndimage.maximum_filter(hidden, size=size, mode="constant", cval=False)
+        allowed |= seen
+        labels, _ = ndimage.label(allowed, structure=np.ones((3, 3), bool))
+        keep = np.unique(labels[seen])
+        return np.isin(labels, keep[keep > 0])
+
+    def extent(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
+        """Where the fruit seen as ``region`` can project at most: ``(u_min, v_min, u_max, v_max)``, pixels
+        (pixel edges): the box of :meth:`allowed`; a side where it reaches the image's border is unbounded
+        (``-inf`` / ``+inf``), one where it reaches the window's edge ends there."""
+        part = self.allowed(region, gap=gap, thin=thin)
+        if not part.any():
+            return np.array([-np.inf, -np.inf, np.inf, np.inf])
+        rows, cols = np.nonzero(part.any(axis=1))[0], np.nonzero(part.any(axis=0))[0]
+        box = np.array([cols[0] + self.u0 - 0.5, rows[0] + self.v0 - 0.5, cols[-1] + self.u0 + 0.5,
+                        rows[-1] + self.v0 + 0.5])  # fmt: skip
+        box[0] = -np.inf if cols[0] + self.u0 == 0 else box[0]
+        box[1] = -np.inf if rows[0] + self.v0 == 0 else box[1]
+        box[2] = np.inf if cols[-1] + self.u0 == self.width - 1 else box[2]
+        box[3] = np.inf if rows[-1] + self.v0 == self.height - 1 else box[3]
+        return box
+
+    def share(self) -> float:
+        """Share of the window's pixels that are hidden (for reports)."""
+        return float(self.hidden.mean()) if self.hidden.size else 0.0
+
+
+def occlusion(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    points: np.ndarray,
+    camera: Camera,
+    *,
+    others: np.ndarray | None = None,
+    tolerance: float = 0.005,
+    reach: int = 3,
+    pad: int = 16,
+) -> Occlusion:
+    """The pixels around one fruit where the camera could not have seen it.
+
+    A pixel beside the fruit's mask is hidden when what the camera saw there is not clearly behind the
+    fruit: its depth is less than the fruit's own depth at the nearest of its points' pixels plus
+    ``tolerance``, or it belongs to another fruit's mask that is not clearly behind. If the fruit
+    continued there, its surface would lie at about that nearest depth, so the camera would have seen the
+    fruit in front of anything clearly behind it (background: the fruit's edge there is its occluding
+    contour); anything nearer, or at the fruit's own depth (a calyx lying on it, a touching fruit), may
+    hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
+    pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden.
+
+    Parameters
+    ----------
+    depth : (H, W) float, metres
+        The frame's depth image, aligned to the camera (0 or NaN: no depth).
+    mask : (H, W) bool
+        The fruit's own pixels (its instance mask): never hidden.
+    points : (n, 3) float, metres
+        The fruit's points (camera frame), which give its depth beside each pixel.
+    camera : Camera
+        Its image is ``W x H``; every pixel outside it is hidden (:meth:`Occlusion.at`).
+    others : (H, W) bool, optional
+        Other fruit's masks.
+    tolerance : float, metres
+        How far behind the fruit's nearest depth something must lie to count as seen behind it.
+    reach : int, pixels
+    pad : int, pixels
+        The window is the points' pixel box grown on every side by this much plus the box's own size (a
+        fruit hidden by half is no larger than that), clipped to the image.
+
+    Returns
+    -------
+    Occlusion
+
+    Raises
+    ------
+    InputError
+        On images of the wrong shape or no point in the image.
+    """
+    depth = np.asarray(depth)
+    mask = np.asarray(mask, dtype=bool)
+    shape = (camera.height, camera.width)
+    if depth.shape != shape or mask.shape != shape:
+        raise InputError(f"occlusion needs depth and mask images of {shape[1]}x{shape[0]} (the camera's), got "
+                         f"{depth.shape[::-1]} and {mask.shape[::-1]}")  # fmt: skip
+    if others is not None and np.shape(others) != shape:
+        raise InputError(f"occlusion others must be a {shape[1]}x{shape[0]} image, got {np.shape(others)[::-1]}")
+    points = as_points(points, min_count=1)
+    uv = camera.project(points)
+    col = np.rint(uv[:, 0]).astype(np.intp)
+    row = np.rint(uv[:, 1]).astype(np.intp)
+    ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
+    if not ok.any():
+        raise InputError("occlusion: no point of the fruit projects into the image")
+    col, row, z = col[ok], row[ok], points[ok, 2]
+    span_u, span_v = int(col.max() - col.min()) + pad, int(row.max() - row.min()) + pad
+    u0, v0 = max(int(col.min()) - span_u, 0), max(int(row.min()) - span_v, 0)
+    u1, v1 = min(int(col.max()) + span_u + 1, camera.width), min(int(row.max()) + span_v + 1, camera.height)
+    h, w = v1 - v0, u1 - u0
+    flat = np.full(h * w, np.inf)
+    np.minimum.at(flat, (row - v0) * w + (col - u0), z)
+    own_z = flat.reshape(h, w)
+    seen_own = np.isfinite(own_z)
+    # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
+    _, (nr, nc) = ndimage.distance_transform_edt(~seen_own, return_indices=True)
+    z_ref = own_z[nr, nc]
+    own = mask[v0:v1, u0:u1] | seen_own
+    d = np.asarray(depth[v0:v1, u0:u1], dtype=np.float64)
+    valid = np.isfinite(d) & (d > 0) & ~own
+    d = np.where(valid, d, np.nan)
+    if reach > 0 and valid.any():
+        dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
+        d = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
+    with np.errstate(invalid="ignore"):
+        behind = d >= z_ref + tolerance  # NaN compares False: no depth is not "seen behind"
+        near = d < z_ref + tolerance
+    hidden = near & ~own
+    if others is not None:
+        hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
+    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy())
+
+
+def with_own(region: Silhouette, occ: Occlusion) -> Silhouette:
+    """``region`` joined with the fruit's own pixels (:attr:`Occlusion.own`), in a window holding both."""
+    if occ.own is None or not occ.own.any():
+        return region
+    rows, cols = np.nonzero(occ.own.any(axis=1))[0], np.nonzero(occ.own.any(axis=0))[0]
+    h, w = region.mask.shape
+    u0, v0 = min(region.u0, occ.u0 + int(cols[0])), min(region.v0, occ.v0 + int(rows[0]))
+    u1, v1 = max(region.u0 + w, occ.u0 + int(cols[-1]) + 1), max(region.v0 + h, occ.v0 + int(rows[-1]) + 1)
+    mask = np.zeros((v1 - v0, u1 - u0), dtype=bool)
+    mask[region.v0 - v0 : region.v0 - v0 + h, region.u0 - u0 : region.u0 - u0 + w] = region.mask
+    oh, ow = occ.own.shape
+    r0, c0 = max(occ.v0, v0), max(occ.u0, u0)
+    r1, c1 = min(occ.v0 + oh, v1), min(occ.u0 + ow, u1)
+    mask[r0 - v0 : r1 - v0, c0 - u0 : c1 - u0] |= occ.own[r0 - occ.v0 : r1 - occ.v0, c0 - occ.u0 : c1 - occ.u0]
+    return Silhouette(u0, v0, mask, region.fill_radius)

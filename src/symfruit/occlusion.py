@@ -1,0 +1,59 @@
+"""The occlusion information of a frame's fruit, with its settings section ``occlusion``.
+
+:func:`fruit_occlusion` is the one place it is made, from a depth image, the fruit's mask and points and the
+other fruit's masks: :func:`symfruit.detect.detect` calls it for every fruit of a frame and the evaluation
+for its rendered views with occluders, so the tables measure what a robot gets.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .core.camera import Camera
+from .core.view import Occlusion, occlusion
+from .settings import Section, register_section, setting
+
+__all__ = ["OcclusionSettings", "fruit_occlusion"]
+
+
+@dataclass(frozen=True)
+class OcclusionSettings(Section):
+    """The occlusion information ``detect`` and the evaluation compute for every fruit from the frame's depth
+    image, masks and border (:func:`symfruit.core.view.occlusion`) and hand to the methods that use it.
+
+    Attributes
+    ----------
+    enabled : bool
+        Compute and pass it (off: every fruit is completed from its points alone).
+    tolerance : float, metres
+        What the camera saw beside the fruit hides it unless it lies at least this far behind the fruit's
+        depth there.
+    reach_px : int
+        A pixel without depth takes the depth of the nearest pixel with depth (not the fruit's) within this
+        many pixels (sensor dropout beside edges).
+    """
+
+    enabled: bool = setting(True)
+    tolerance: float = setting(0.005, ge=-1.0, le=1.0)
+    reach_px: int = setting(3, ge=0, le=50)
+
+
+register_section("occlusion", OcclusionSettings)
+
+
+def fruit_occlusion(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    points: np.ndarray,
+    camera: Camera,
+    settings: OcclusionSettings,
+    others: np.ndarray | None = None,
+) -> Occlusion | None:
+    """:func:`~symfruit.core.view.occlusion` with the section's values, or None when it is disabled (the one
+    place both ``detect`` and the evaluation's rendered views make it)."""
+    if not settings.enabled:
+        return None
+    return occlusion(depth, mask, points, camera, others=others, tolerance=settings.tolerance,
+                     reach=settings.reach_px)  # fmt: skip
