@@ -3,10 +3,14 @@ hand-made depth images), and where the fruit may project."""
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+from scipy import ndimage
 
 from symfruit.core.camera import Camera
 from symfruit.core.raster import Silhouette, silhouette
-from symfruit.core.view import Occlusion, occlusion, with_own
+from symfruit.core.view import Occlusion, occlusion, open_square, with_own
 from symfruit.errors import InputError
 
 from ..conftest import ball_mesh, occluded_view
@@ -107,3 +111,9 @@ def test_bad_input_is_refused():
         occlusion(depth, disc, points + [5.0, 0.0, 0.0], CAM)
     with pytest.raises(InputError, match="bool"):
         Occlusion(0, 0, np.zeros((3, 3)), 40, 30)
+
+
+@given(arrays(bool, st.tuples(st.integers(1, 40), st.integers(1, 40))), st.sampled_from([1, 3, 5, 7]))
+def test_open_square_is_binary_opening_by_a_square(mask, size):
+    expected = ndimage.binary_opening(mask, structure=np.ones((size, size), bool))
+    assert np.array_equal(open_square(mask, size), expected)
