@@ -125,6 +125,7 @@ def detect(
     detections, t_extract, t_complete = [], 0.0, 0.0
     from scipy import ndimage
 
+    fruit_px = labels > 0
     for k, sl in enumerate(ndimage.find_objects(labels), 1):
         if sl is None:
             continue
@@ -145,7 +146,7 @@ def detect(
         occ = None
         try:
             occ = fruit_occlusion(frame.depth, mask, ex.points, frame.camera, settings.occlusion,
-                                  others=(labels > 0) & ~mask)  # fmt: skip
+                                  others=fruit_px & ~mask)  # fmt: skip
             result = complete(ex.points, camera=frame.camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
         except SymfruitError as exc:

@@ -214,10 +214,7 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     conic[:2, :2] = inv
     conic[:2, 2] = conic[2, :2] = -inv @ mu
     conic[2, 2] = mu @ inv @ mu - 1.0
-    k = camera.matrix
-    cone = k.T @ conic @ k
-    axis = np.r_[(mu[0] - camera.cx) / camera.fx, (mu[1] - camera.cy) / camera.fy, 1.0]
-    return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
+    return _image_cone(conic, mu, camera)
 
 
 def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray]:

@@ -46,6 +46,7 @@ from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.evidence import observe
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
+from ..core.points import subsample
 from ..core.raster import close_ragged, silhouette
 from ..core.view import Occlusion, with_own
 from ..settings import Section, SettingError, setting
@@ -268,9 +269,7 @@ def evidence(
 ) -> Completion:
     """Candidates weighed by how well they explain the view; weighted-median box; confidence."""
     s = settings
-    sample = points
-    if len(points) > s.fit_points:
-        sample = points[np.sort(np.random.default_rng(0).choice(len(points), s.fit_points, replace=False))]
+    sample = subsample(points, s.fit_points)
     region = close_ragged(silhouette(points, camera), radius=s.ragged_close_px, ragged=s.ragged_at)
     if occlusion is not None:
         region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
