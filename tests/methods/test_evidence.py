@@ -1,6 +1,6 @@
 """The default method, ``evidence``: known answers on noisy and clean views, its settings, its candidates and
 confidence, and a quick real-scan case (the YCB pear: Calli et al., "The YCB object and model set", 2015,
-ycbbenchmarks.com, CC BY 4.0, read from ``../shared/data/real-scans``)."""
+ycbbenchmarks.com, CC BY 4.0, ``examples/scans``, a copy of ``../shared/data/real-scans``)."""
 
 import numpy as np
 import pytest
