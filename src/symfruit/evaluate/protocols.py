@@ -15,7 +15,7 @@
     of the whole mesh in the same pose.
 
 A fruit is a generated kind (:data:`symfruit.shapes.FRUITS`) or a scan of a folder of meshes
-(:func:`symfruit.shapes.load_scans`, e.g. the YCB scans of ``../shared/data/real-scans``).
+(:func:`symfruit.shapes.load_scans`, e.g. the YCB scans of ``examples/scans``).
 
 Sensor models (``--sensor``):
 
