@@ -50,7 +50,8 @@ def example_images() -> tuple[np.ndarray, np.ndarray, Any]:
 
 @pytest.fixture(scope="session")
 def example_fruits() -> list:
-    """``fruits_of(detect(...))`` on the example frame with the CLI's defaults (fused, strawberry)."""
+    """``fruits_of(detect(...))`` on the example frame with the CLI's defaults (the default method, the
+    strawberry profile)."""
     from symfruit.demo import example_frame
     from symfruit.detect import detect
     from symfruit.io.frames import read_frame
@@ -64,7 +65,8 @@ def example_fruits() -> list:
 
 @pytest.fixture(scope="session")
 def detect_json(tmp_path_factory) -> dict:
-    """``detections.json`` of ``symfruit detect`` on the example frame (defaults: fused, strawberry)."""
+    """``detections.json`` of ``symfruit detect`` on the example frame (defaults: the default method, the
+    strawberry profile)."""
     from symfruit.cli import main
     from symfruit.demo import example_frame
 

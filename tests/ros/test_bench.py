@@ -1,0 +1,54 @@
+"""symfruit.ros.bench: its statistics, its reading of the node's log line, the example messages, and one
+short real run (a master, the node as a subprocess, three frames)."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+
+from symfruit.ros.bench import _LINE, _stats
+
+
+def test_stats_known_answer():
+    s = _stats([5.0, 1.0, 3.0, 2.0, 4.0])
+    assert s == {"n": 5, "median": 3.0, "p10": 1.4, "p90": 4.6}
+    empty = _stats([])
+    assert empty["n"] == 0 and np.isnan(empty["median"])
+
+
+def test_the_node_log_line_is_read():
+    line = ("[INFO] [1764619200.1]: symfruit: frame 1003.500000000: 6 fruit in 89.2 ms (detect 88.2 ms, node 0.9 ms: "
+            "wait 0.1, decode 0.2, collect 0.0, publish 0.5), 0 dropped so far")  # fmt: skip
+    m = _LINE.search(line)
+    assert m is not None
+    assert m.groups() == ("1003", "500000000", "89.2", "88.2", "0.9", "0.1", "0.2", "0.0", "0.5")
+    assert _LINE.search(line.replace("6 fruit", "1 fruit (2 failed)")) is not None
+
+
+def test_example_images_are_what_a_camera_driver_publishes(example_images):
+    from symfruit.demo import example_frame
+    from symfruit.io.frames import read_frame
+
+    rgb, raw, cam = example_images
+    assert rgb.dtype == np.uint8 and rgb.shape == (cam.height, cam.width, 3)
+    assert raw.dtype == np.dtype("<u2") and raw.shape == (cam.height, cam.width)
+    with example_frame() as folder:
+        frame = read_frame(folder)
+    np.testing.assert_allclose(raw / 1000.0, frame.depth, rtol=0, atol=1e-6)  # millimetres (16UC1); depth is float32
+    assert np.array_equal(rgb, frame.color)
+
+
+def test_a_short_real_run(ros1, tmp_path):
+    out = tmp_path / "bench.json"
+    proc = subprocess.run([sys.executable, "-m", "symfruit.ros.bench", "--frames", "3", "--json", str(out)],
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    res = json.loads(out.read_text())
+    assert res["frames"] == 3 and res["process_alone_ms"]["n"] == 3
+    assert res["node_total_ms"]["n"] == 3 and res["end_to_end_ms"]["n"] == 3
+    assert 0.0 <= res["node_overhead_ms"]["median"] < res["node_total_ms"]["median"]
+    assert 1 <= res["open_loop"]["delivered"] <= 3  # the last frame is never dropped
+    assert "node: overhead" in proc.stdout
