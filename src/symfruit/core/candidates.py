@@ -96,7 +96,7 @@ def constrain_box(
     *,
     cone: tuple[tuple[float, float, float, float], Camera] | None = None,
     contour: float = 1.0,
-    sides: np.ndarray | None = None,
+    pull: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     """A candidate's box made consistent with the view: ``(lo (3,), hi (3,))``, metres.
 
@@ -108,10 +108,9 @@ def constrain_box(
        seen. This only stops runaway fits;
     3. with ``cone = ((u_min, v_min, u_max, v_max), camera)``, the silhouette's pixel box: lateral faces
        beyond the silhouette's viewing cone (widest over the box's depth range) are pulled back, by the
-       share ``contour`` (the whole fruit projects inside its silhouette, as far as its edge is a contour),
-       or side by side by the shares ``sides`` (left, top, right, bottom) where they are known (with
-       occlusion information the box is where the fruit can project at all, and every side is pulled back
-       to it).
+       share ``pull`` (default ``contour``: the whole fruit projects inside its silhouette, as far as its
+       edge is a contour; with occlusion information the box is where the fruit can project at all, and
+       ``pull = 1`` brings every side back to it).
     """
     seen_lo = np.r_[seen_lo[:2], front]
     seen_hi = np.maximum(seen_hi, seen_lo)
@@ -125,9 +124,9 @@ def constrain_box(
         zs = np.array([lo[2], hi[2]])
         bound_lo = np.array([((u_lo - camera.cx) / camera.fx * zs).min(), ((v_lo - camera.cy) / camera.fy * zs).min()])
         bound_hi = np.array([((u_hi - camera.cx) / camera.fx * zs).max(), ((v_hi - camera.cy) / camera.fy * zs).max()])
-        pull_lo, pull_hi = (contour, contour) if sides is None else (sides[:2], sides[2:])
-        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + pull_lo * np.maximum(bound_lo - lo[:2], 0.0))
-        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - pull_hi * np.maximum(hi[:2] - bound_hi, 0.0))
+        share = contour if pull is None else pull
+        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + share * np.maximum(bound_lo - lo[:2], 0.0))
+        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - share * np.maximum(hi[:2] - bound_hi, 0.0))
     return lo, hi
 
 
@@ -214,11 +213,11 @@ def candidates(
     extent = float((seen_hi - seen_lo).max())
     uv = camera.project(points[:: max(1, len(points) // 4000)])
     cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
-    sides = None
+    pull: float | None = None
     if obs.extent is not None:
         # With occlusion information: as far as the fruit can project (the seen region and what may hide it).
-        box_px = tuple(float(x) for x in obs.extent)
-        cone, sides = ((box_px[0], box_px[1], box_px[2], box_px[3]), camera), np.ones(4)
+        u_lo, v_lo, u_hi, v_hi = (float(x) for x in obs.extent)
+        cone, pull = ((u_lo, v_lo, u_hi, v_hi), camera), 1.0
     out: list[Candidate] = []
 
     def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray,
@@ -226,10 +225,10 @@ def candidates(
         lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
         if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
             return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
-        if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible, lateral=sides is None):
+        if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible, lateral=obs.extent is None):
             return
         ev = explain(inside, (lo, hi), obs, steps=steps)
-        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, sides=sides)
+        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, pull=pull)
         out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64), back_std))
 
     if "sphere" in shapes:
@@ -306,7 +305,7 @@ def candidates(
         mirrored = complete_by_symmetry(sample, camera, **mirror, view=view)
         back = mirrored.points[len(sample) :]
         lo, hi = constrain_box(back.min(axis=0), back.max(axis=0), seen_lo, seen_hi, front, cone=cone,
-                               contour=obs.contour, sides=sides)  # fmt: skip
+                               contour=obs.contour, pull=pull)  # fmt: skip
         out.append(Candidate("mirror", lo, hi, None, 0.5 * (lo + hi)))
 
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
