@@ -217,12 +217,14 @@ def test_the_built_in_sections_belong_to_their_stages():
     from symfruit.extract import ExtractSettings
     from symfruit.methods.fused import FusedSettings
     from symfruit.methods.sphere import SphereSettings
+    from symfruit.occlusion import OcclusionSettings
     from symfruit.segment import SegmentSettings
 
     types = section_types()
     assert types["input"] is InputSettings and types["extract"] is ExtractSettings
     assert types["segment"] is SegmentSettings and types["paper"] is PaperSettings
     assert types["fused"] is FusedSettings and types["sphere"] is SphereSettings
+    assert types["occlusion"] is OcclusionSettings
     assert set(Settings().to_dict()) == set(types)
 
 
