@@ -128,6 +128,14 @@ def occluded_view(fruit, centre, *, below: float, occluder_z: float, noise: floa
     return cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols]), depth, mask, posed
 
 
+def hidden_image(occ) -> np.ndarray:
+    """An :class:`~symfruit.core.view.Occlusion`'s hidden pixels as a whole image (``height x width`` bool)."""
+    full = np.zeros((occ.height, occ.width), bool)
+    h, w = occ.hidden.shape
+    full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
+    return full
+
+
 def ball_mesh(radius: float = 0.035):
     """A closed triangle-mesh ball (a revolved half circle, 96 x 90)."""
     from symfruit.shapes import _revolve

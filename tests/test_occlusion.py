@@ -9,6 +9,8 @@ from symfruit.errors import SymfruitError
 from symfruit.occlusion import OcclusionSettings, fruit_occlusion
 from symfruit.settings import resolve_settings
 
+from .conftest import hidden_image
+
 CAM = Camera(fx=100.0, fy=100.0, cx=20.0, cy=15.0, width=40, height=30)
 
 
@@ -25,10 +27,7 @@ def _frame():
 
 
 def _hidden_left(occ) -> bool:
-    full = np.zeros((30, 40), bool)
-    h, w = occ.hidden.shape
-    full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
-    return bool(full[:, :10].any())
+    return bool(hidden_image(occ)[:, :10].any())
 
 
 def test_tolerance_decides_whether_a_surface_just_behind_hides_the_fruit():
@@ -52,9 +51,8 @@ def test_other_fruit_masks_are_hidden():
     depth[:, 30:] = 0.3
     occ = fruit_occlusion(depth, disc, points, CAM, OcclusionSettings(), others=others)
     assert occ is not None
-    full = np.zeros((30, 40), bool)
-    h, w = occ.hidden.shape
-    full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
+    full = hidden_image(occ)
+    w = occ.hidden.shape[1]
     assert occ.u0 + w > 31  # the window reaches into the other fruit
     assert full[:, 30 : occ.u0 + w].all()
     assert not full[:, 27:30].any()  # the gap between them, background, is not hidden

@@ -13,7 +13,7 @@ from symfruit.core.raster import Silhouette, silhouette
 from symfruit.core.view import Occlusion, occlusion, open_square, with_own
 from symfruit.errors import InputError
 
-from ..conftest import ball_mesh, occluded_view
+from ..conftest import ball_mesh, hidden_image, occluded_view
 
 CAM = Camera(fx=100.0, fy=100.0, cx=20.0, cy=15.0, width=40, height=30)
 
@@ -47,9 +47,7 @@ def test_an_occluder_in_front_and_a_touching_neighbour_are_hidden():
     depth[0:3, 18:22] = 0.0  # no depth here, far from anything: not hidden
     depth[22, 14] = 0.0  # no depth beside the disc, next to background: takes the background's
     occ = occlusion(depth, disc, points, CAM, tolerance=0.005)
-    full = np.zeros((30, 40), bool)
-    h, w = occ.hidden.shape
-    full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
+    full = hidden_image(occ)
     assert full[:, 27:].all() and full[:, :10].all()
     assert not full[:, 10:27][~disc[:, 10:27]].any()
     assert not (full & disc).any()
@@ -62,9 +60,7 @@ def test_another_fruit_is_hidden_unless_clearly_behind():
     depth[:, 35:] = 0.6  # the right part of the other fruit lies clearly behind
     depth[:, 30:35] = 0.0  # ... its left part has no depth (out of reach of any pixel with depth)
     occ = occlusion(depth, disc, points, CAM, others=others, reach=0)
-    full = np.zeros((30, 40), bool)
-    h, w = occ.hidden.shape
-    full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
+    full = hidden_image(occ)
     assert full[:, 30:35].all() and not full[:, 35:].any()
 
 
