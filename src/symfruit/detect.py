@@ -17,6 +17,7 @@ import numpy as np
 from .complete import Result, complete
 from .core.box import Box
 from .core.camera import Camera
+from .core.limits import MAX_INSTANCES
 from .core.view import Occlusion
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
@@ -29,7 +30,7 @@ from .settings import Settings
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
 
 #: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
-MAX_FRUIT_PER_FRAME = 1000
+MAX_FRUIT_PER_FRAME = MAX_INSTANCES
 
 
 @dataclass(frozen=True)

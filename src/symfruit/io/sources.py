@@ -100,6 +100,10 @@ class FolderSource(_Closing):
     def names(self) -> list[str]:
         return [p.name for p in self._folders]
 
+    def folders(self) -> list[Path]:
+        """The frame folders, in order (a batch writes nothing into them)."""
+        return list(self._folders)
+
     def read(self, index: int) -> Frame:
         _check_index(index, len(self._folders))
         return read_frame(self._folders[index])
