@@ -3,7 +3,7 @@
 A scene holds strawberries hanging from a gutter at 0.25-0.6 m (calyx up, tilted, some touching),
 ripe ones red and unripe ones white or green (which a segmenter must ignore), a green calyx on each,
 stems up to the gutter, leaves in front of some fruit, and a backdrop. It is rendered with the exact
-z-buffer of :mod:`symfruit.render`, shaded, and given the D435-like depth noise of the evaluation's
+z-buffer of :mod:`symfruit.synthetic.render`, shaded, and given the D435-like depth noise of the evaluation's
 ``camera`` protocol. ``truth`` lists every fruit's true box (the box of its whole surface).
 """
 
@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.box import Box
-from .core.camera import DEFAULT_CAMERA, Camera
+from ..core.box import Box
+from ..core.camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
 from .shapes import leaf_outline, rotation, strawberry
 
@@ -114,7 +114,7 @@ def make_scene(
         Leaves placed in front of (some of) the fruit.
     camera : Camera
     noise : SensorNoise, optional
-        Depth sensor model; default :class:`~symfruit.render.SensorNoise`.
+        Depth sensor model; default :class:`~symfruit.synthetic.render.SensorNoise`.
     """
     rng = np.random.default_rng(seed)
     noise = noise or SensorNoise()
@@ -221,7 +221,7 @@ def write_scenes(
     list of Path
         The frame folders, in order.
     """
-    from .io.frames import write_frame
+    from ..io.frames import write_frame
 
     folder = Path(folder)
     unique = n if distinct is None else max(1, min(distinct, n))
