@@ -32,7 +32,7 @@ from .occlusion import Occlusion
 from .points import as_points
 from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
 
-__all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
+__all__ = ["Agreement", "Inside", "Observation", "explain", "march", "observe"]
 
 #: ``inside(x)`` for points ``x`` (..., 3), metres: positive inside the shape (a signed distance, or any
 #: function with the same sign), shape ``x.shape[:-1]``.
@@ -90,7 +90,7 @@ class Observation:
 
 
 @dataclass(frozen=True)
-class Evidence:
+class Agreement:
     """How a candidate explains the view (smaller is better for all three).
 
     Attributes
@@ -325,7 +325,7 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
 
 def explain(
     inside: Inside, box: tuple[np.ndarray, np.ndarray], obs: Observation, *, steps: int = 24, trim: float = 0.8
-) -> Evidence:
+) -> Agreement:
     """Measure one closed candidate against the observation.
 
     Parameters
@@ -358,4 +358,4 @@ def explain(
         w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
         outs.append(float((hits[k : k + len(r)] * w).sum() / w.sum()) if w.sum() > 0 else 0.0)
         k += len(r)
-    return Evidence(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))
+    return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

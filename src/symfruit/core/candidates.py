@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .agreement import Evidence, Inside, Observation, explain
+from .agreement import Agreement, Inside, Observation, explain
 from .camera import Camera
 from .fits import (
     ellipsoid_half_extents,
@@ -70,7 +70,7 @@ class Candidate:
     name : str
     lo, hi : (3,) float, metres
         Its box (see :func:`constrain_box`).
-    evidence : Evidence or None
+    agreement : Agreement or None
         How it explains the view (closed candidates only).
     centre : (3,) float, metres
         Its own centre estimate (the shape's centre; the box centre for mirror and raw).
@@ -82,7 +82,7 @@ class Candidate:
     name: str
     lo: np.ndarray
     hi: np.ndarray
-    evidence: Evidence | None
+    agreement: Agreement | None
     centre: np.ndarray
     back_std: float = float("nan")
 
@@ -280,8 +280,8 @@ def candidates(
         explained is not None
         and bool(out)
         and out[-1].name == "cone"
-        and out[-1].evidence is not None
-        and (out[-1].evidence.inside + out[-1].evidence.outside <= explained)
+        and out[-1].agreement is not None
+        and (out[-1].agreement.inside + out[-1].agreement.outside <= explained)
     )
     if "revolution" in shapes and not done:
         try:
