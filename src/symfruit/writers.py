@@ -29,13 +29,13 @@ from typing import Any
 
 import numpy as np
 
-from .complete import Result
 from .core.box import Box
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError, OutputError
 from .io.atomic import atomic_write, folder_fd, stale_temporaries, write_json
 from .io.clouds import write_ply
 from .io.images import BAND_PIXELS
+from .methods.complete import Result
 from .settings import Settings
 
 __all__ = [

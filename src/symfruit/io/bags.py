@@ -23,9 +23,9 @@ from typing import Any
 import numpy as np
 
 from ..core.camera import Camera
+from ..core.frame import Frame
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
-from ..frame import Frame
 
 __all__ = [
     "BagSource",

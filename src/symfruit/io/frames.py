@@ -24,9 +24,9 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import Camera
+from ..core.frame import Frame
 from ..core.limits import MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
-from ..frame import Frame
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
 from .text import read_structured

@@ -62,7 +62,9 @@ def _open(source: Path | bytes, label: str) -> Any:
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
         raise FileFormatError(f"{label}: cannot read image ({exc})") from None
     try:
-        check_image_size(*img.size, label, error=FileFormatError, max_pixels=MAX_IMAGE_PIXELS)  # sides and pixels, from the header
+        check_image_size(
+            *img.size, label, error=FileFormatError, max_pixels=MAX_IMAGE_PIXELS
+        )  # sides and pixels, from the header
     except FileFormatError:
         img.close()
         raise
