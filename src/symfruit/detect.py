@@ -17,7 +17,7 @@ import numpy as np
 from .core.box import Box
 from .core.camera import Camera
 from .core.frame import Frame
-from .core.limits import MAX_INSTANCES
+from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
@@ -89,7 +89,8 @@ def frame_masks(
         labels, source = read_masks(masks, shape), str(masks)
     if labels.shape != shape:
         raise InputError(f"frame {frame.name}: masks are {labels.shape[::-1]}, the image {shape[::-1]}")
-    return labels.astype(np.int32, copy=False), source
+    # whole numbers, at most MAX_INSTANCES fruit; ids beyond 32 bits refused, never truncated into others
+    return instance_labels(labels, f"frame {frame.name}: masks ({source})"), source
 
 
 def detect(

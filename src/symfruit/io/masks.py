@@ -207,9 +207,9 @@ class CocoSet:
             out[k] = annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
         return out
 
-    def crowd(self, name: str | Path, shape: tuple[int, int], *, category: int | None = 1) -> np.ndarray:
-        """``(h, w)`` bool: the union of one image's crowd regions (``iscrowd: 1``) of ``category``; a
-        prediction lying in them is neither matched nor false, as in COCO's evaluation."""
+    def crowd(self, name: str | Path, shape: tuple[int, int], *, category: int | None = 1) -> tuple[np.ndarray, int]:
+        """``(h, w)`` bool: the union of one image's crowd regions (``iscrowd: 1``) of ``category``, and how
+        many there are; a prediction lying in them is neither matched nor false, as in COCO's evaluation."""
         entry, (h, w) = self._entry(name, shape)
         anns = self._wanted(entry, category, crowd=True)
         if len(anns) > MAX_INSTANCES_PER_IMAGE:
@@ -218,7 +218,7 @@ class CocoSet:
         out = np.zeros((h, w), bool)
         for k, ann in enumerate(anns):
             out |= annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
-        return out
+        return out, len(anns)
 
     def _entry(self, name: str | Path, shape: tuple[int, int]) -> tuple[dict[str, Any], tuple[int, int]]:
         """The entry of ``name`` and the image's ``(h, w)``, checked against the entry's stated size."""
