@@ -25,6 +25,7 @@ from .core.limits import instance_labels
 from .detect import FrameDetections, detect
 from .errors import FileFormatError, InputError, SymfruitError
 from .io.atomic import folder_fd
+from .io.frames import is_frame_folder
 from .io.images import image_suffixes
 from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, unique_names, write_record
 from .io.sources import open_source
@@ -117,6 +118,8 @@ def run_batch(
     src = open_source(source, exclude=[output, *map(Path, exclude)])
     try:
         files, folders = _source_inputs(src)
+        if is_frame_folder(output):  # a frame left out of the recording as the output is still an input
+            folders.append(output)
         out = OutputFolder(output, inputs=files, input_folders=folders).open()
     except BaseException:
         src.close()

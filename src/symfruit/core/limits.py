@@ -140,7 +140,7 @@ def depth_metres(depth: Any, what: str, *, error: type[SymfruitError] = InputErr
     """
     arr = np.asarray(depth)
     if arr.ndim != 2:
-        raise error(f"{what}: depth must be an (h, w) image, got shape {arr.shape}")
+        raise error(f"{what}: depth must be a 2-D image, got shape {arr.shape}")
     check_image_size(arr.shape[1], arr.shape[0], what, error=error)
     if not np.issubdtype(arr.dtype, np.floating):
         raise error(f"{what}: depth is {arr.dtype}; depth must be float metres (raw units such as 16-bit "

@@ -160,6 +160,8 @@ def atomic_write(path: str | Path, mode: str = "wb", *, root: Path | OutputFolde
     root = root if root is not None else active_root(path)
     if root is not None and not isinstance(root, Path):
         root.check(path)
+    for folder in _ACTIVE.get():  # a run's inputs are never written, wherever the path points
+        folder.check(path)
     name = path.name
     if name in ("", ".", ".."):
         raise OutputError(f"{path}: not a file name")

@@ -150,7 +150,6 @@ def _color(color: np.ndarray) -> np.ndarray:
     c = np.asarray(color)
     if c.ndim != 3 or c.shape[2] not in (3, 4) or c.shape[0] < 1 or c.shape[1] < 1:
         raise InputError(f"color must be an (h, w, 3) image, got shape {c.shape}")
-    check_image_size(c.shape[1], c.shape[0], "segment: colour image")  # the bounds of every entry point
     if c.dtype != np.uint8:
         if not np.issubdtype(c.dtype, np.number) or not np.isfinite(c).all():
             raise InputError("color must be a finite uint8 image (0-255)")
@@ -329,6 +328,7 @@ def segment(
     """
     s = settings or SegmentSettings()
     c = _color(color)
+    check_image_size(c.shape[1], c.shape[0], "segment: colour image")  # the bounds of every entry point
     h, w = c.shape[:2]
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
