@@ -58,6 +58,7 @@ class Occlusion:
         hidden = np.asarray(self.hidden)
         if hidden.ndim != 2 or hidden.dtype != bool:
             raise InputError(f"occlusion hidden must be a 2-D bool image, got {hidden.dtype} {hidden.shape}")
+        object.__setattr__(self, "hidden", hidden)
         for name in ("u0", "v0", "width", "height"):  # NaN, inf or fractions would index nonsense later
             value = getattr(self, name)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
