@@ -210,7 +210,9 @@ def test_mask_sources_beyond_the_bounds_are_refused(tmp_path):
 def test_an_image_beyond_16384_pixels_a_side_is_refused_by_name(tmp_path):
     Image.new("RGB", (30000, 20), (200, 30, 40)).save(tmp_path / "wide.png")
     report = segment_images([tmp_path / "wide.png"], output=tmp_path / "out")
-    assert "wide.png: image is 30000x20 pixels; at most 16384 pixels a side" in report.failed[str(tmp_path / "wide.png")]
+    assert (
+        "wide.png: image is 30000x20 pixels; at most 16384 pixels a side" in report.failed[str(tmp_path / "wide.png")]
+    )
 
 
 def test_a_full_disk_records_every_image(tmp_path, monkeypatch):

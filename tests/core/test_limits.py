@@ -30,7 +30,9 @@ def _limits_table() -> dict[str, str]:
 def _numbers(cell: str) -> list[float]:
     """The numbers a cell states, with units: '40 megapixels' is 40e6, '256 MB' is 256 MiB, '1e6' is 1e6."""
     out = []
-    for value, unit in re.findall(r"(\d[\d,.]*(?:e\d+)?)\s*(megapixels|million|MB|kB|pixels|instances|faces|points)?", cell):
+    for value, unit in re.findall(
+        r"(\d[\d,.]*(?:e\d+)?)\s*(megapixels|million|MB|kB|pixels|instances|faces|points)?", cell
+    ):
         v = float(value.replace(",", ""))
         out.append(v * {"megapixels": 1e6, "million": 1e6, "MB": 1 << 20, "kB": 1 << 10}.get(unit, 1))
     return out
@@ -49,7 +51,11 @@ def test_readme_limits_are_the_enforced_constants():
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
     masks = _numbers(next(v for k, v in table.items() if k.startswith("fruit per")))
-    assert masks[0] == limits.MAX_INSTANCES and limits.MAX_LABEL_ID == 2**31 - 1 and "32 bits" in table["fruit per image (masks)"]
+    assert (
+        masks[0] == limits.MAX_INSTANCES
+        and limits.MAX_LABEL_ID == 2**31 - 1
+        and "32 bits" in table["fruit per image (masks)"]
+    )
 
 
 def test_the_modules_use_the_one_set_of_bounds():

@@ -155,7 +155,9 @@ def test_colour_segmenter_on_real_photos():
 
 def test_a_category_no_annotation_has_is_refused(tmp_path):
     truth = _coco_folder(tmp_path)
-    with pytest.raises(InputError, match=r"no annotation has category 5; the annotations have 1 \(fruit\), 2 \(people\)"):
+    with pytest.raises(
+        InputError, match=r"no annotation has category 5; the annotations have 1 \(fruit\), 2 \(people\)"
+    ):
         evaluate_masks(tmp_path, truth, segment, category=5)
 
 

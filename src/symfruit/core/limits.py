@@ -114,7 +114,7 @@ def instance_labels(labels: Any, what: str, *, error: type[SymfruitError] = Inpu
         return arr.astype(np.int32)
     lo, hi = int(arr.min()), int(arr.max())
     if lo < 0:
-        raise error(f"{what}: instance labels must not be negative, got {lo}")
+        raise error(f"{what}: masks hold negative labels (got {lo}); 0 is background, 1..k the fruit")
     if hi > MAX_LABEL_ID:
         raise error(f"{what}: label id {hi} is beyond 32 bits (at most {MAX_LABEL_ID}); number the fruit 1..k")
     if hi > MAX_INSTANCES:  # more ids than fruit allowed may still be few fruit: count them

@@ -80,7 +80,11 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if enc not in _ENCODINGS:
         raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of {', '.join(_ENCODINGS)})")
     dtype, channels = _ENCODINGS[enc]
-    h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    try:
+        h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    except (TypeError, ValueError, OverflowError, AttributeError):
+        raise FileFormatError(f"image height, width and step must be whole numbers, got {getattr(msg, 'height', None)!r}, "
+                              f"{getattr(msg, 'width', None)!r}, {getattr(msg, 'step', None)!r}") from None  # fmt: skip
     if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
         raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
