@@ -309,7 +309,7 @@ def test_a_second_batch_on_one_output_folder_is_refused_at_once(tmp_path):
     from symfruit.io.outputs import OutputFolder
 
     rec = recording(tmp_path / "rec", "f1")
-    with OutputFolder(tmp_path / "out"), pytest.raises(OutputError, match="another symfruit run .* is writing"):
+    with OutputFolder(tmp_path / "out"), pytest.raises(OutputError, match=r"another symfruit run .* is writing"):
         run_batch(rec, tmp_path / "out", method="raw", progress=False)
     assert not (tmp_path / "out" / "f1").exists()
     assert run_batch(rec, tmp_path / "out", method="raw", progress=False).done == ["f1"]  # released

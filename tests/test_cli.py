@@ -381,8 +381,9 @@ def test_detect_refuses_writing_into_its_input_and_names_a_linked_frame(tmp_path
 
 def test_evaluate_masks_with_a_category_no_annotation_has_is_exit_2(tmp_path, capsys):
     photos = EXAMPLES / "photos"
-    assert main(["evaluate", "--protocol", "masks", "--images", str(photos), "--truth",
-                 str(photos / "_annotations.coco.json"), "--category", "77", "--output", str(tmp_path)]) == 2  # fmt: skip
+    truth = str(photos / "_annotations.coco.json")
+    args = ["evaluate", "--protocol", "masks", "--images", str(photos), "--truth", truth, "--category", "77"]
+    assert main([*args, "--output", str(tmp_path)]) == 2
     _one_line_error(capsys, "no annotation has category 77")
 
 

@@ -249,10 +249,10 @@ def test_two_images_sharing_an_id_or_a_name_are_refused(tmp_path):
     from symfruit.io.masks import read_coco
 
     same_id = [{"id": 3, "file_name": "a.png"}, {"id": 3, "file_name": "b.png"}]
-    with pytest.raises(FileFormatError, match="'a.png' and 'b.png' share the image id 3"):
+    with pytest.raises(FileFormatError, match=r"'a\.png' and 'b\.png' share the image id 3"):
         read_coco(_coco_file(tmp_path, same_id, []))
     same_name = [{"id": 1, "file_name": "a.png"}, {"id": 2, "file_name": "a.png"}]
-    with pytest.raises(FileFormatError, match="two 'images' entries are named 'a.png'"):
+    with pytest.raises(FileFormatError, match=r"two 'images' entries are named 'a\.png'"):
         read_coco(_coco_file(tmp_path, same_name, []))
 
 

@@ -83,8 +83,8 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     try:
         h, w, step = int(msg.height), int(msg.width), int(msg.step)
     except (TypeError, ValueError, OverflowError, AttributeError):
-        raise FileFormatError(f"image height, width and step must be whole numbers, got {getattr(msg, 'height', None)!r}, "
-                              f"{getattr(msg, 'width', None)!r}, {getattr(msg, 'step', None)!r}") from None  # fmt: skip
+        sizes = ", ".join(repr(getattr(msg, k, None)) for k in ("height", "width", "step"))
+        raise FileFormatError(f"image height, width and step must be whole numbers, got {sizes}") from None
     if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
         raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
