@@ -1,5 +1,7 @@
 """Every file symfruit writes, in one place, each written atomically (a temporary file renamed over the
-target, so an interrupted run never leaves a half-written file).
+target, so an interrupted run never leaves a half-written file; :mod:`symfruit.io.atomic`). Inside a run's
+output folder (:class:`symfruit.io.outputs.OutputFolder`: names, inputs, links, one writer) every file
+written here goes through that folder's checks.
 
 ==================  ===================================================================================
 what                files
