@@ -1,0 +1,17 @@
+"""The benchmark: its dense grid and the segmenter's timing on synthetic photos."""
+
+import pytest
+
+from symfruit.evaluate.bench import DENSE_GRID
+
+
+def test_dense_grid_is_ten_times_the_papers():
+    assert DENSE_GRID["translations"] * DENSE_GRID["rotations_x"] * DENSE_GRID["rotations_y"] == 1320
+
+
+@pytest.mark.slow
+def test_bench_segment_times_24_synthetic_photos():
+    from symfruit.evaluate.bench import bench_segment
+
+    row = bench_segment()
+    assert row.images == 24 and row.source == "synthetic photos" and row.width == 640 and row.median_ms > 0
