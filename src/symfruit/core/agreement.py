@@ -106,10 +106,6 @@ class Agreement:
     outside: float
 
 
-def _rays(u: np.ndarray, v: np.ndarray, camera: Camera) -> np.ndarray:
-    return np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones_like(u, dtype=float)], -1)
-
-
 def observe(
     points: np.ndarray,
     region: Silhouette,
@@ -171,7 +167,7 @@ def observe(
     def spread(rc: np.ndarray) -> np.ndarray:
         if len(rc) > n_band:
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        return _rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0, camera)
+        return camera.rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
@@ -194,7 +190,7 @@ def observe(
             weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
         if outside and occlusion is not None and len(rc):
             weight = weight * ~occlusion.at(uv[:, 0], uv[:, 1])  # a hidden pixel: no evidence either
-        return _rays(uv[:, 0], uv[:, 1], camera), weight
+        return camera.rays(uv[:, 0], uv[:, 1]), weight
 
     ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
     outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]

@@ -555,7 +555,7 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
         edge_px = (first - 0.5) * step  # halfway between the last pixel in and the first out
         bu = uc[:, 0] + sign * edge_px * du[:, 0]
         bv = uc[:, 1] + sign * edge_px * du[:, 1]
-        ray = np.stack([(bu - camera.cx) / camera.fx, (bv - camera.cy) / camera.fy, np.ones_like(bu)], axis=1)
+        ray = camera.rays(bu, bv)
         # The point c + s e nearest the ray lambda * ray: least squares in (s, lambda).
         a11, a12, a22 = (e * e).sum(1), -(e * ray).sum(1), (ray * ray).sum(1)
         b1, b2 = -(e * c).sum(1), (ray * c).sum(1)

@@ -1,2 +1,3 @@
-"""Synthetic data: fruit shapes (:mod:`.shapes`), a depth renderer with sensor models (:mod:`.render`) and
-whole RGB-D scenes (:mod:`.scenes`), for the evaluation, the benchmark, the demo frame and the tests."""
+"""Synthetic data: fruit shapes (:mod:`.shapes`), a depth renderer with sensor models (:mod:`.render`), whole
+RGB-D scenes (:mod:`.scenes`) and the benchmark's fixed views (:mod:`.views`), for the evaluation, the
+benchmark, the demo frame and the tests."""
