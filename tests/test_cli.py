@@ -393,3 +393,15 @@ def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
     _one_line_error(capsys, "larger than")
     assert main(["bench", "--points", "3"]) == 2
     _one_line_error(capsys, "--points")
+
+
+def test_a_ros2_bag_written_inside_the_recording_is_no_failed_frame(tmp_path, capsys):
+    pytest.importorskip("rosbags")
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "f1")
+    args = ["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw", "--ros2-bag", str(rec / "bag")]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "frames: 1 done, 0 skipped (resume), 0 failed" in out and (rec / "bag" / "metadata.yaml").is_file()
+    assert main(["detect", str(rec), "--output", str(tmp_path / "o2"), "--method", "raw"]) == 0  # a later run too
+    assert "frames: 1 done, 0 skipped (resume), 0 failed" in capsys.readouterr().out
