@@ -107,7 +107,7 @@ def record(path: Path, frames: list[tuple[np.ndarray, np.ndarray]]) -> None:
     streams[0].register_extrinsics_to(streams[1], ext)
     recorder = rs.recorder(str(path), device, True)  # LZ4, as the Viewer records
     queues = [rs.frame_queue(8), rs.frame_queue(8)]
-    for sensor, profile, queue in zip((depth_sensor, color_sensor), streams, queues):
+    for sensor, profile, queue in zip((depth_sensor, color_sensor), streams, queues, strict=True):
         sensor.open(profile)
         sensor.start(queue)
     keep = []
@@ -137,7 +137,9 @@ def main(folder: str) -> None:
     color, _, truth_depth, boxes = rendered[0]
     truth = {"fruits": [{"id": i + 1, **b.to_dict()} for i, b in enumerate(boxes)]}
     write_frame(out / "aligned_00000", color, truth_depth, COLOR_CAMERA, truth=truth, depth_scale=DEPTH_UNITS)
-    print(f"wrote {out / 'fruit.bag'} ({(out / 'fruit.bag').stat().st_size} bytes) and {out / 'aligned_00000'}")
+    sys.stdout.write(
+        f"wrote {out / 'fruit.bag'} ({(out / 'fruit.bag').stat().st_size} bytes) and {out / 'aligned_00000'}\n"
+    )
 
 
 if __name__ == "__main__":

@@ -55,7 +55,9 @@ def test_lens_models_agree_with_the_sdk(model):
     assert np.abs(project(lens, pts) - sdk).max() < 1e-3  # float32 in the SDK
     if model != "modified_brown_conrady":
         uv, z = pixels(COLOR, 50, rng), rng.uniform(0.3, 1.0, 50)
-        sdk = np.array([rs.rs2_deproject_pixel_to_point(intr, p.tolist(), float(d)) for p, d in zip(uv, z)])
+        sdk = np.array(
+            [rs.rs2_deproject_pixel_to_point(intr, p.tolist(), float(d)) for p, d in zip(uv, z, strict=True)]
+        )
         assert np.abs(deproject(lens, uv, z) - sdk).max() < 1e-5
 
 

@@ -105,7 +105,9 @@ def project(lens: Lens, points: np.ndarray) -> np.ndarray:
     points = np.asarray(points, dtype=np.float64)
     with np.errstate(divide="ignore", invalid="ignore"):
         x, y = points[:, 0] / points[:, 2], points[:, 1] / points[:, 2]
-    if lens.model in ("modified_brown_conrady", "inverse_brown_conrady"):
+    if not any(lens.coeffs):  # every model is the identity then
+        pass
+    elif lens.model in ("modified_brown_conrady", "inverse_brown_conrady"):
         x, y = _forward(x, y, lens.coeffs, modified=True)
     elif lens.model == "brown_conrady":
         x, y = _forward(x, y, lens.coeffs, modified=False)
@@ -149,7 +151,10 @@ def deproject(lens: Lens, uv: np.ndarray, depth: np.ndarray) -> np.ndarray:
 
 def transform(points: np.ndarray, rotation: np.ndarray, translation: np.ndarray) -> np.ndarray:
     """``rotation @ p + translation`` for each point (``rs2_transform_point_to_point``); (n, 3) metres."""
-    return np.asarray(points, dtype=np.float64) @ np.asarray(rotation, dtype=np.float64).T + np.asarray(translation)
+    p = np.asarray(points, dtype=np.float64)
+    r, t = np.asarray(rotation, dtype=np.float64), np.asarray(translation, dtype=np.float64)
+    # column by column: a (n, 3) @ (3, 3) product goes through BLAS, much slower for this shape
+    return np.stack([p[:, 0] * r[i, 0] + p[:, 1] * r[i, 1] + p[:, 2] * r[i, 2] + t[i] for i in range(3)], axis=-1)
 
 
 def _fov(cam: Camera) -> tuple[float, float]:

@@ -29,9 +29,9 @@ from __future__ import annotations
 import bisect
 import re
 import struct
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from collections.abc import Iterator
 from typing import Any
 
 import numpy as np
@@ -45,6 +45,7 @@ from .bags import _require_rosbags, color_image, image_array
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
 _IMAGE = re.compile(r"^/device_(\d+)/sensor_(\d+)/(Depth|Color)_(\d+)/image/data$")
+_SENSOR = re.compile(r"^/device_\d+/sensor_\d+/")
 _TF = re.compile(r"^/(device_\d+/sensor_\d+/(?:Depth|Color)_\d+)/tf/(\d+)$")
 #: File versions of librealsense's ROS 1 layout read here (2 and below are the pre-2.10 "legacy" layout).
 FILE_VERSIONS = (3, 4)
@@ -52,7 +53,7 @@ _DEPTH_ENCODINGS = ("mono16", "16uc1")
 
 
 def is_realsense(path: Path) -> bool:
-    """Whether a ROS 1 bag holds librealsense's topics (a ``/device_N/sensor_N/Depth_N/image/data`` topic).
+    """Whether a ROS 1 bag holds librealsense's topics (``/device_N/sensor_N/...``).
 
     Reads only the bag's index; a bag rosbags cannot open is not one (the generic reader then names why).
     """
@@ -63,7 +64,7 @@ def is_realsense(path: Path) -> bool:
             topics = list(reader.topics)
     except Exception:
         return False
-    return any(_IMAGE.match(t) and "/Depth_" in t for t in topics)
+    return any(_SENSOR.match(t) for t in topics)
 
 
 def quaternion_matrix(x: float, y: float, z: float, w: float) -> np.ndarray:
@@ -281,8 +282,9 @@ class RealSenseBagSource:
         color, units, scale, stamp = self.read_raw(index)
         depth = np.multiply(units, np.float32(scale), dtype=np.float32)
         aligned = align_depth(depth, self.depth_stream.lens, self.color_stream.lens, self.rotation, self.translation)
-        return Frame(f"{self.path.stem}_{index:05d}_{self._depth_stamps[index][0]}", color, aligned, self.color_stream.lens.camera,
-                     source=f"{self.path}@{self._depth_stamps[index][0]}", stamp=stamp,
+        depth_stamp = self._depth_stamps[index][0]
+        return Frame(f"{self.path.stem}_{index:05d}_{depth_stamp}", color, aligned, self.color_stream.lens.camera,
+                     source=f"{self.path}@{depth_stamp}", stamp=stamp,
                      extras={"depth_units": scale, "aligned_by": "symfruit"})  # fmt: skip
 
     def close(self) -> None:
@@ -340,19 +342,25 @@ def sdk_aligned(path: str | Path, *, timeout_ms: int = 5000) -> Iterator[tuple[i
         raise FileFormatError(f"{path}: the SDK cannot play it ({exc})") from None
     try:
         device = profile.get_device()
-        device.as_playback().set_real_time(False)
+        playback = device.as_playback()
+        playback.set_real_time(False)
         scale = device.first_depth_sensor().get_depth_scale()
         align = rs.align(rs.stream.color)
         seen: set[int] = set()
+        waited = 0
         while True:
-            ok, frames = pipeline.try_wait_for_frames(timeout_ms)
-            if not ok:
-                return
+            ok, frames = pipeline.try_wait_for_frames(100)
+            if not ok:  # the end of the file, or the SDK is slow: give it timeout_ms in all
+                waited += 100
+                if playback.current_status() == rs.playback_status.stopped or waited >= timeout_ms:
+                    return
+                continue
+            waited = 0
             aligned = align.process(frames)
             depth = aligned.get_depth_frame()
             if not depth:
                 continue
-            stamp = int(round(depth.get_timestamp() * 1e6))  # ms -> ns, as the image header holds it
+            stamp = round(depth.get_timestamp() * 1e6)  # ms -> ns, as the image header holds it
             if stamp in seen:
                 continue
             seen.add(stamp)
