@@ -202,9 +202,9 @@ def _settings_for(args: argparse.Namespace, fruit: str | None = None):
 
 
 def _complete(args: argparse.Namespace) -> int:
-    from .complete import complete
     from .core.camera import DEFAULT_CAMERA
     from .io import load_camera, read_cloud
+    from .methods.complete import complete
     from .writers import write_result
 
     settings = _settings_for(args)
@@ -252,13 +252,13 @@ def _check_output_file(path: Path, suffix: str) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from .bench import machine, run_bench
     from .errors import InputError
+    from .evaluate.bench import machine, run_bench
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
     if args.segment:
-        from .bench import bench_segment
+        from .evaluate.bench import bench_segment
 
         row = bench_segment(args.images)
         if args.json:
@@ -269,7 +269,7 @@ def _bench(args: argparse.Namespace) -> int:
               "per image")  # fmt: skip
         return 0
     if args.recording is not None:
-        from .bench import bench_recording
+        from .evaluate.bench import bench_recording
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
@@ -282,7 +282,7 @@ def _bench(args: argparse.Namespace) -> int:
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
     if args.frame:
-        from .bench import bench_frame
+        from .evaluate.bench import bench_frame
 
         rows = [bench_frame(repeat=min(args.repeat, 50), method=m) for m in ("paper", "fused", "evidence")]
     else:
@@ -305,7 +305,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
     from .methods import get
-    from .shapes import FRUITS
+    from .synthetic.shapes import FRUITS
 
     if args.protocol == "masks":
         return _evaluate_masks(args)
@@ -517,7 +517,7 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _scenes(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .scenes import write_scenes
+    from .synthetic.scenes import write_scenes
 
     if not 1 <= args.n <= 100_000 or not 0 <= args.ripe <= 50 or not 0 <= args.unripe <= 50 or args.seed < 0:
         raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")

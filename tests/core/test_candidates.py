@@ -6,8 +6,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit import DEFAULT_CAMERA
+from symfruit.core.agreement import observe
 from symfruit.core.candidates import REACH, candidates, constrain_box
-from symfruit.core.evidence import observe
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -50,9 +50,9 @@ def test_candidates_of_a_noisy_ball():
     by = {c.name: c for c in cands}
     assert list(by) == ["sphere", "ellipsoid", "cone", "revolution", "raw"]
     assert all(c.lo[2] == front for c in cands)
-    assert by["raw"].evidence is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
+    assert by["raw"].agreement is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
     s = by["sphere"]
-    assert s.evidence.inside + s.evidence.outside < 0.1 and s.evidence.depth < 0.003
+    assert s.agreement.inside + s.agreement.outside < 0.1 and s.agreement.depth < 0.003
     np.testing.assert_allclose(s.centre, [0.01, 0.0, 0.4], atol=0.002)
     assert s.hi[2] == pytest.approx(0.435, abs=0.003)
     with_mirror = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front,
@@ -64,7 +64,7 @@ def test_candidates_of_a_noisy_ball():
 
 
 def test_the_outline_candidate_takes_its_profile_from_the_silhouette():
-    from symfruit.shapes import FRUITS, rotation
+    from symfruit.synthetic.shapes import FRUITS, rotation
 
     visible, _ = rendered_view(FRUITS["strawberry"](np.random.default_rng(2)), [0.0, 0.02, 0.35], noise=0.01,
                                rotation=rotation(20, 60, 10), seed=1)  # fmt: skip

@@ -21,7 +21,7 @@ Every candidate is a different assumption about the hidden side:
     nothing hidden: the box of what was seen.
 
 Closed candidates (sphere, ellipsoid, solid of revolution) are measured against the view by
-:func:`symfruit.core.evidence.explain`. All boxes share the front depth estimated from the data
+:func:`symfruit.core.agreement.explain`. All boxes share the front depth estimated from the data
 (:func:`symfruit.core.front.apex_depth`) and otherwise contain every seen point.
 """
 
@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .agreement import Agreement, Inside, Observation, explain
 from .camera import Camera
-from .evidence import Evidence, Inside, Observation, explain
 from .fits import (
     ellipsoid_half_extents,
     fit_cone_ellipsoid,
@@ -70,7 +70,7 @@ class Candidate:
     name : str
     lo, hi : (3,) float, metres
         Its box (see :func:`constrain_box`).
-    evidence : Evidence or None
+    agreement : Agreement or None
         How it explains the view (closed candidates only).
     centre : (3,) float, metres
         Its own centre estimate (the shape's centre; the box centre for mirror and raw).
@@ -82,7 +82,7 @@ class Candidate:
     name: str
     lo: np.ndarray
     hi: np.ndarray
-    evidence: Evidence | None
+    agreement: Agreement | None
     centre: np.ndarray
     back_std: float = float("nan")
 
@@ -171,7 +171,7 @@ def candidates(
     sample : (m, 3) float, metres
         A spread subset the shapes are fitted to.
     obs : Observation
-        The view reduced for :func:`~symfruit.core.evidence.explain`.
+        The view reduced for :func:`~symfruit.core.agreement.explain`.
     camera : Camera
     front : float, metres
         The shared front depth (nearest surface point).
@@ -280,8 +280,8 @@ def candidates(
         explained is not None
         and bool(out)
         and out[-1].name == "cone"
-        and out[-1].evidence is not None
-        and (out[-1].evidence.inside + out[-1].evidence.outside <= explained)
+        and out[-1].agreement is not None
+        and (out[-1].agreement.inside + out[-1].agreement.outside <= explained)
     )
     if "revolution" in shapes and not done:
         try:

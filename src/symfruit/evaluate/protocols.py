@@ -14,13 +14,13 @@
     optionally a leaf-like occluder in front hiding a set share of the fruit's silhouette. Truth: the box
     of the whole mesh in the same pose.
 
-A fruit is a generated kind (:data:`symfruit.shapes.FRUITS`) or a scan of a folder of meshes
-(:func:`symfruit.shapes.load_scans`, e.g. the YCB scans of ``examples/scans``).
+A fruit is a generated kind (:data:`symfruit.synthetic.shapes.FRUITS`) or a scan of a folder of meshes
+(:func:`symfruit.synthetic.shapes.load_scans`, e.g. the YCB scans of ``examples/scans``).
 
 Sensor models (``--sensor``):
 
 ``d435`` (default)
-    A D435-like camera as the repository has always modelled it (:class:`~symfruit.render.SensorNoise`
+    A D435-like camera as the repository has always modelled it (:class:`~symfruit.synthetic.render.SensorNoise`
     defaults): axial noise 1 mm at 0.3 m growing with the square of the depth, 0.3 px lateral jitter, half
     of the silhouette's edge pixels and 60 % of grazing pixels dropped, 1 % random dropout; 0.25-0.60 m.
 ``heldback``
@@ -53,8 +53,8 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
-from ..render import SensorNoise, render
-from ..shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
+from ..synthetic.render import SensorNoise, render
+from ..synthetic.shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
 

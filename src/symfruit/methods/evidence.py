@@ -12,7 +12,7 @@ completion is right for every fruit, and the view itself says which ones fit. Th
    the ellipsoid whose outline is the silhouette (``cone``: five of its nine degrees of freedom come from
    the silhouette, which a depth camera measures far better than depth), a solid of revolution,
    optionally the mirror completion, and the raw box;
-3. measures every closed candidate against the view (:func:`~symfruit.core.evidence.explain`): its
+3. measures every closed candidate against the view (:func:`~symfruit.core.agreement.explain`): its
    predicted front depth against the seen depths and its predicted outline against the seen one (rays
    just inside the silhouette must hit it, rays just outside a contour part of the edge must miss it);
 4. weighs the candidates by ``exp(-energy)``, with the energy of a closed candidate
@@ -40,15 +40,15 @@ from typing import Any, Literal
 
 import numpy as np
 
+from ..core.agreement import observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
-from ..core.evidence import observe
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
+from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
 from ..core.raster import close_ragged, silhouette
-from ..core.view import Occlusion, with_own
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -92,11 +92,11 @@ class EvidenceSettings(Section):
         ``cone`` ellipsoid, and ``raw``: "nothing beyond the outline"), times the share of the outline
         that is not an occluding contour (a cut: the paper's visibility rule, an occluder).
     occluded_px, thin_px, contour_cone : int, int, float
-        With the frame's occlusion information (:class:`~symfruit.core.view.Occlusion`): an outline pixel
+        With the frame's occlusion information (:class:`~symfruit.core.occlusion.Occlusion`): an outline pixel
         with a hidden pixel within ``occluded_px`` is a cut; hidden structures narrower than ``2 thin_px +
         1`` pixels (a stem) do not widen where the fruit can project; with at least ``contour_cone`` of the
         outline a contour (and some of it cut) the ``cone`` ellipsoid is tangent to the ellipse through the
-        contour part (:func:`~symfruit.core.evidence.observe`). The seen region then includes the fruit's
+        contour part (:func:`~symfruit.core.agreement.observe`). The seen region then includes the fruit's
         own mask.
     contour_cut_energy : float
         The ``cone`` ellipsoid's energy per unit cut share when it was fitted to the contour part of the
@@ -231,12 +231,12 @@ def clean_share(ratio: float, threshold: float) -> float:
 def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings,
             cone_source: str = "moments") -> Combined:  # fmt: skip
     """Weigh the candidates by their evidence and take the weighted median box (see the module)."""
-    closed = [c for c in cands if c.evidence is not None]
+    closed = [c for c in cands if c.agreement is not None]
     energies: dict[str, float] = {}
-    best_rms = max(min((c.evidence.depth for c in closed if c.evidence is not None), default=1.0), 1e-6)
+    best_rms = max(min((c.agreement.depth for c in closed if c.agreement is not None), default=1.0), 1e-6)
     cut = s.cut_energy * (1.0 - contour)
     for c in cands:
-        ev = c.evidence
+        ev = c.agreement
         if ev is None:
             energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
             continue
@@ -257,7 +257,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     box = Box(box_faces[:3], box_faces[3:])
     centres = 0.5 * (faces[:, :3] + faces[:, 3:])
     spread = float((w * np.linalg.norm(centres - box.centre, axis=1)).sum())
-    wrong = min((c.evidence.inside + c.evidence.outside for c in closed if c.evidence is not None),
+    wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
     size = float(box.size.max())
     back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
@@ -321,7 +321,7 @@ def evidence(
         "candidates": {
             c.name: {
                 "min": c.lo.tolist(), "max": c.hi.tolist(),
-                "evidence": None if c.evidence is None else [c.evidence.depth, c.evidence.inside, c.evidence.outside],
+                "evidence": None if (a := c.agreement) is None else [a.depth, a.inside, a.outside],
                 "back_std": None if not np.isfinite(c.back_std) else c.back_std,
             }
             for c in cands

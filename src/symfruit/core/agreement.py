@@ -28,11 +28,11 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .camera import Camera
+from .occlusion import Occlusion
 from .points import as_points
 from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
-from .view import Occlusion
 
-__all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
+__all__ = ["Agreement", "Inside", "Observation", "explain", "march", "observe"]
 
 #: ``inside(x)`` for points ``x`` (..., 3), metres: positive inside the shape (a signed distance, or any
 #: function with the same sign), shape ``x.shape[:-1]``.
@@ -69,7 +69,7 @@ class Observation:
         of the outline (see :func:`observe`).
     extent : (4,) float, pixels, optional
         With occlusion information: the pixel box the fruit can project into at most (``u_min, v_min, u_max,
-        v_max``; :meth:`~symfruit.core.view.Occlusion.extent`).
+        v_max``; :meth:`~symfruit.core.occlusion.Occlusion.extent`).
     hidden : (h, w) bool, optional
         With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
         outline crossing onto one is an occluder's edge).
@@ -90,7 +90,7 @@ class Observation:
 
 
 @dataclass(frozen=True)
-class Evidence:
+class Agreement:
     """How a candidate explains the view (smaller is better for all three).
 
     Attributes
@@ -150,7 +150,7 @@ def observe(
         :attr:`Observation.contour` are taken over neighbourhoods of these (at full density a
         neighbourhood spans a millimetre or two, small enough to follow even a thin fruit's rim).
     occlusion : Occlusion, optional
-        Where the camera could not have seen the fruit (:func:`symfruit.core.view.occlusion`). The contour
+        Where the camera could not have seen the fruit (:func:`symfruit.core.occlusion.occlusion`). The contour
         share is then measured on the region's own outline pixels: a pixel with a hidden pixel within
         ``occluded_px`` pixels is a cut whatever the normals say (an occluder's edge, the image border);
         rays of the outside bands landing on hidden pixels are no evidence; when part of the outline is a
@@ -325,7 +325,7 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
 
 def explain(
     inside: Inside, box: tuple[np.ndarray, np.ndarray], obs: Observation, *, steps: int = 24, trim: float = 0.8
-) -> Evidence:
+) -> Agreement:
     """Measure one closed candidate against the observation.
 
     Parameters
@@ -358,4 +358,4 @@ def explain(
         w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
         outs.append(float((hits[k : k + len(r)] * w).sum() / w.sum()) if w.sum() > 0 else 0.0)
         k += len(r)
-    return Evidence(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))
+    return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

@@ -3,7 +3,7 @@
 A scene holds strawberries hanging from a gutter at 0.25-0.6 m (calyx up, tilted, some touching),
 ripe ones red and unripe ones white or green (which a segmenter must ignore), a green calyx on each,
 stems up to the gutter, leaves in front of some fruit, and a backdrop. It is rendered with the exact
-z-buffer of :mod:`symfruit.render`, shaded, and given the D435-like depth noise of the evaluation's
+z-buffer of :mod:`symfruit.synthetic.render`, shaded, and given the D435-like depth noise of the evaluation's
 ``camera`` protocol. ``truth`` lists every fruit's true box (the box of its whole surface).
 """
 
@@ -18,8 +18,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.box import Box
-from .core.camera import DEFAULT_CAMERA, Camera
+from ..core.box import Box
+from ..core.camera import DEFAULT_CAMERA, Camera
+from ..core.points import perpendicular_basis
 from .render import SensorNoise, render
 from .shapes import leaf_outline, rotation, strawberry
 
@@ -57,17 +58,8 @@ class Scene:
         return {"fruits": [f.to_dict() for f in self.fruits]}
 
 
-def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors perpendicular to ``axis`` and to each other."""
-    axis = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(axis, helper)
-    u /= np.linalg.norm(u)
-    return u, np.cross(axis, u)
-
-
 def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    u, v = _basis(b - a)
+    (u,), (v,) = perpendicular_basis(((b - a) / np.linalg.norm(b - a))[None, :])
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     ring = radius * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
     vertices = np.vstack([a + ring, b + ring])
@@ -78,7 +70,7 @@ def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[
 
 
 def _disc(centre: np.ndarray, normal: np.ndarray, radius: float, lobes: int = 0, n: int = 40) -> tuple:
-    u, v = _basis(normal)
+    (u,), (v,) = perpendicular_basis((normal / np.linalg.norm(normal))[None, :])
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     r = radius * (1.0 if lobes == 0 else 0.55 + 0.45 * np.abs(np.cos(lobes * t / 2)))
     ring = centre + (r * np.cos(t))[:, None] * u + (r * np.sin(t))[:, None] * v
@@ -114,7 +106,7 @@ def make_scene(
         Leaves placed in front of (some of) the fruit.
     camera : Camera
     noise : SensorNoise, optional
-        Depth sensor model; default :class:`~symfruit.render.SensorNoise`.
+        Depth sensor model; default :class:`~symfruit.synthetic.render.SensorNoise`.
     """
     rng = np.random.default_rng(seed)
     noise = noise or SensorNoise()
@@ -221,7 +213,7 @@ def write_scenes(
     list of Path
         The frame folders, in order.
     """
-    from .io.frames import write_frame
+    from ..io.frames import write_frame
 
     folder = Path(folder)
     unique = n if distinct is None else max(1, min(distinct, n))
