@@ -1,6 +1,6 @@
 """Make ``fruit.bag``: a RealSense recording in librealsense's own ROS 1 format, of fruit the project renders.
 
-Three strawberries on stems in front of a backdrop, rendered by ``symfruit.render`` twice per frame: depth
+Three strawberries on stems in front of a backdrop, rendered by ``symfruit.synthetic.render`` twice per frame: depth
 by a D435-like depth camera (wider field of view, Brown-Conrady lens with zero coefficients, depth units of
 0.1 mm) and colour by a colour camera 25 mm to its right, turned by 1 degree (Inverse Brown-Conrady, zero
 coefficients, as D400 colour streams report). The frames go through pyrealsense2's software device into
@@ -25,8 +25,8 @@ import numpy as np
 from symfruit.core.box import Box
 from symfruit.core.camera import Camera
 from symfruit.io.frames import write_frame
-from symfruit.render import render
-from symfruit.shapes import rotation, strawberry
+from symfruit.synthetic.render import render
+from symfruit.synthetic.shapes import rotation, strawberry
 
 DEPTH_CAMERA = Camera(fx=212.0, fy=212.0, cx=211.5, cy=119.5, width=424, height=240)
 COLOR_CAMERA = Camera(fx=308.0, fy=308.0, cx=160.5, cy=119.0, width=320, height=240)

@@ -38,8 +38,8 @@ import numpy as np
 
 from ..core.align import LENS_MODELS, Lens, align_depth
 from ..core.camera import Camera
+from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
-from ..frame import Frame
 from .bags import _require_rosbags, color_image, image_array
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
