@@ -31,7 +31,7 @@ from .fits import (
 )
 from .front import apex_depth
 from .occlusion import Occlusion
-from .planes import Plane, Planes, hypothesis_planes, mirror
+from .planes import Plane, PlaneGrid, Planes, hypothesis_planes, mirror
 from .points import as_points, check_cloud
 from .raster import Silhouette, View, rasterise, silhouette, silhouette_coverage
 from .rating import LOCATIONS, Rating, Table1, rate_planes, rate_points
@@ -48,6 +48,7 @@ __all__ = [
     "Observation",
     "Occlusion",
     "Plane",
+    "PlaneGrid",
     "Planes",
     "Rating",
     "Revolution",
