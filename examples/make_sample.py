@@ -19,8 +19,8 @@ from symfruit import DEFAULT_CAMERA, Box
 from symfruit.demo import FRAME_SEED
 from symfruit.io import write_json, write_ply
 from symfruit.io.frames import write_frame
-from symfruit.scenes import make_scene
-from symfruit.shapes import paper_visible, rotation_x, strawberry
+from symfruit.synthetic.scenes import make_scene
+from symfruit.synthetic.shapes import paper_visible, rotation_x, strawberry
 
 HERE = Path(__file__).parent
 FRAME = HERE.parent / "src" / "symfruit" / "data" / "example_frame"

@@ -95,7 +95,7 @@ VISIBLE = front_half(sphere_cloud())
 def rendered_view(fruit, centre, *, noise: float = 0.0, rotation=None, seed: int = 0) -> tuple[np.ndarray, object]:
     """``(visible (n, 3), posed fruit)``: a fruit mesh posed at ``centre`` (metres) and rendered by the default
     camera, one point per pixel at the pixel centre, axial noise ``noise * z^2`` metres (seeded)."""
-    from symfruit.render import render
+    from symfruit.synthetic.render import render
 
     cam = symfruit.DEFAULT_CAMERA
     posed = fruit.transformed(np.eye(3) if rotation is None else rotation, np.asarray(centre, dtype=float))
@@ -111,7 +111,7 @@ def occluded_view(fruit, centre, *, below: float, occluder_z: float, noise: floa
     """``(visible (n, 3), depth (h, w), mask (h, w), posed fruit)``: as :func:`rendered_view`, with a flat
     occluder at depth ``occluder_z`` (metres) hiding every pixel below image row ``below`` and a backdrop at
     1 m; ``depth`` is the whole rendered depth image (0 where nothing), ``mask`` the fruit's seen pixels."""
-    from symfruit.render import render
+    from symfruit.synthetic.render import render
 
     cam = symfruit.DEFAULT_CAMERA
     posed = fruit.transformed(np.eye(3) if rotation is None else rotation, np.asarray(centre, dtype=float))
@@ -129,7 +129,7 @@ def occluded_view(fruit, centre, *, below: float, occluder_z: float, noise: floa
 
 
 def hidden_image(occ) -> np.ndarray:
-    """An :class:`~symfruit.core.view.Occlusion`'s hidden pixels as a whole image (``height x width`` bool)."""
+    """An :class:`~symfruit.core.occlusion.Occlusion`'s hidden pixels as a whole image (``height x width`` bool)."""
     full = np.zeros((occ.height, occ.width), bool)
     h, w = occ.hidden.shape
     full[occ.v0 : occ.v0 + h, occ.u0 : occ.u0 + w] = occ.hidden
@@ -138,7 +138,7 @@ def hidden_image(occ) -> np.ndarray:
 
 def ball_mesh(radius: float = 0.035):
     """A closed triangle-mesh ball (a revolved half circle, 96 x 90)."""
-    from symfruit.shapes import _revolve
+    from symfruit.synthetic.shapes import _revolve
 
     t = np.linspace(0, np.pi, 90)
     return _revolve(radius * np.sin(t), -radius * np.cos(t), name="ball", n_phi=96)

@@ -144,7 +144,7 @@ def test_a_rerun_with_fewer_fruit_leaves_no_stale_clouds(tmp_path):
     run_batch(rec, out, method="raw", progress=False)
     assert sorted(p.name for p in (out / "f1").glob("fruit_*.ply")) == [f"fruit_{k:03d}.ply" for k in range(1, 7)]
     from symfruit.io.frames import read_frame
-    from symfruit.segment import segment
+    from symfruit.segment.colour import segment
 
     frame = read_frame(rec / "f1")
     labels = segment(frame.color, frame.depth, frame.camera)
@@ -270,8 +270,8 @@ def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tm
 def test_memory_stays_flat_over_a_recording(tmp_path):
     """Peak resident memory of a detect child (its own VmHWM) over 40 frames stays far under the bound the
     issue sets for 2,000 frames; frames are decoded one at a time."""
-    from symfruit.bench import measured_detect
-    from symfruit.scenes import write_scenes
+    from symfruit.evaluate.bench import measured_detect
+    from symfruit.synthetic.scenes import write_scenes
 
     write_scenes(tmp_path / "rec", 40, distinct=3, n_ripe=8)
     status, peak_mb, err = measured_detect([str(tmp_path / "rec"), "--output", str(tmp_path / "out")], timeout=600)

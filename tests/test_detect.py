@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 
 from symfruit import InputError, Settings
+from symfruit.core.frame import Frame
 from symfruit.detect import MAX_FRUIT_PER_FRAME, Detection, FrameDetections, detect, frame_masks
 from symfruit.evaluate.frames import match
-from symfruit.frame import Frame
 
 from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 
@@ -32,7 +32,7 @@ def test_every_fruit_is_located_better_than_raw(example, found):
 def test_methods_and_mask_sources(example, tmp_path):
     from PIL import Image
 
-    from symfruit.segment import segment
+    from symfruit.segment.colour import segment
 
     labels = segment(example.color, example.depth, example.camera)
     Image.fromarray(labels.astype(np.uint8)).save(tmp_path / "m.png")
@@ -56,7 +56,7 @@ def test_a_mask_over_the_whole_image_and_empty_depth_are_refused(example):
 
 def test_a_fruit_without_depth_is_reported_not_fatal(example):
 
-    from symfruit.segment import segment
+    from symfruit.segment.colour import segment
 
     labels = segment(example.color, example.depth, example.camera)
     depth = example.depth.copy()

@@ -1,4 +1,4 @@
-"""The occlusion section: its values reach :func:`symfruit.core.view.occlusion`, disabling it gives None, and
+"""The occlusion section: its values reach :func:`symfruit.core.occlusion.occlusion`, disabling it gives None, and
 the settings validation bounds it by key."""
 
 import numpy as np

@@ -10,7 +10,7 @@ from PIL import Image
 from symfruit import Camera, FileFormatError, InputError, SymfruitError
 from symfruit.batch import segment_images
 from symfruit.cli import main
-from symfruit.scenes import make_photo
+from symfruit.synthetic.scenes import make_photo
 from symfruit.writers import draw_label_overlay, write_labels
 
 RED = (200, 30, 40)

@@ -213,12 +213,12 @@ def test_a_registered_section_appears_everywhere_and_validates(isolated_registry
 
 
 def test_the_built_in_sections_belong_to_their_stages():
-    from symfruit.complete import InputSettings
     from symfruit.extract import ExtractSettings
+    from symfruit.methods.complete import InputSettings
     from symfruit.methods.fused import FusedSettings
     from symfruit.methods.sphere import SphereSettings
     from symfruit.occlusion import OcclusionSettings
-    from symfruit.segment import SegmentSettings
+    from symfruit.segment.colour import SegmentSettings
 
     types = section_types()
     assert types["input"] is InputSettings and types["extract"] is ExtractSettings

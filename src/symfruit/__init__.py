@@ -13,12 +13,12 @@ from importlib.metadata import PackageNotFoundError, version
 from . import extract as _extract  # noqa: F401  (registers the "extract" settings section)
 from . import occlusion as _occlusion  # noqa: F401  (registers the "occlusion" settings section)
 from . import segment as _segment  # noqa: F401  (registers the "segment" settings section)
-from .complete import Result, complete
 from .core.box import Box, box_iou, centre_deviation
 from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane
 from .errors import ConfigError, FileFormatError, InputError, SymfruitError
 from .methods import available as available_methods
+from .methods.complete import Result, complete
 from .settings import Settings, load_settings, resolve_settings
 
 try:

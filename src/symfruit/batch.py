@@ -247,7 +247,7 @@ def mask_source(
     (each image's annotations, by file name), a folder of label PNGs (``<stem>.png``), or a callable
     ``(color, depth=, camera=) -> labels``. Checkpoints and files are checked here, before any image.
     """
-    from .segment import learned_masks, segment
+    from .segment.colour import learned_masks, segment
 
     settings = settings or Settings()
     if callable(masks):

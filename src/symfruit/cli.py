@@ -16,7 +16,7 @@ from collections.abc import Iterator, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-#: The real camera models of ``--sensor`` (the keys of :data:`symfruit.sensors.SENSOR_MODELS`, named here so
+#: The real camera models of ``--sensor`` (the keys of :data:`symfruit.synthetic.sensors.SENSOR_MODELS`, named here so
 #: that building the parser imports nothing heavy; a test checks they agree).
 REAL_SENSORS = ("azure-kinect", "realsense-l515", "realsense-d435", "realsense-d405")
 
@@ -89,7 +89,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
     p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS), default="d435",
                    help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m), heldback (issue 11's measurement: "
-                   "0.01 z^2 noise, no dropout, 0.3-0.5 m), or a real camera model (symfruit.sensors: rim "
+                   "0.01 z^2 noise, no dropout, 0.3-0.5 m), or a real camera model (symfruit.synthetic.sensors: rim "
                    "invalidation or edge fattening, flying pixels, registration, masks that overshoot, clutter; "
                    "1920x1080 or 1280x720, 0.25-2 m)")  # fmt: skip
     p.add_argument("--pose", choices=("hanging", "upright", "uniform"), default="hanging",
@@ -184,9 +184,9 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("--ripe", type=int, default=6, help="ripe fruit per frame (default 6)")
     p.add_argument("--unripe", type=int, default=2, help="unripe (white or green) fruit per frame (default 2)")
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
-                   help="through a real camera model (symfruit.sensors) at its resolution, fruit at its working "
-                   "distances within 0.25-2 m, with the annotators' masks.png (default: the 640x480 D435-like "
-                   "frames)")  # fmt: skip
+                   help="through a real camera model (symfruit.synthetic.sensors) at its resolution, fruit at "
+                   "its working distances within 0.25-2 m, with the annotators' masks.png (default: the 640x480 "
+                   "D435-like frames)")  # fmt: skip
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
@@ -214,9 +214,9 @@ def _settings_for(args: argparse.Namespace, fruit: str | None = None):
 
 
 def _complete(args: argparse.Namespace) -> int:
-    from .complete import complete
     from .core.camera import DEFAULT_CAMERA
     from .io import load_camera, read_cloud
+    from .methods.complete import complete
     from .writers import write_result
 
     settings = _settings_for(args)
@@ -264,13 +264,13 @@ def _check_output_file(path: Path, suffix: str) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from .bench import machine, run_bench
     from .errors import InputError
+    from .evaluate.bench import machine, run_bench
 
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
     if args.segment:
-        from .bench import bench_segment
+        from .evaluate.bench import bench_segment
 
         row = bench_segment(args.images)
         if args.json:
@@ -281,7 +281,7 @@ def _bench(args: argparse.Namespace) -> int:
               "per image")  # fmt: skip
         return 0
     if args.recording is not None:
-        from .bench import bench_recording
+        from .evaluate.bench import bench_recording
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
@@ -294,7 +294,7 @@ def _bench(args: argparse.Namespace) -> int:
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
     if args.frame:
-        from .bench import bench_frame
+        from .evaluate.bench import bench_frame
 
         rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor)
                 for m in ("paper", "fused", "evidence")]  # fmt: skip
@@ -318,7 +318,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
     from .methods import get
-    from .shapes import FRUITS
+    from .synthetic.shapes import FRUITS
 
     if args.protocol == "masks":
         return _evaluate_masks(args)
@@ -530,13 +530,13 @@ def _demo(args: argparse.Namespace) -> int:
 
 def _scenes(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .scenes import write_scenes
+    from .synthetic.scenes import write_scenes
 
     if not 1 <= args.n <= 100_000 or not 0 <= args.ripe <= 50 or not 0 <= args.unripe <= 50 or args.seed < 0:
         raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")
     sensor = None
     if args.sensor is not None:
-        from .sensors import sensor_model
+        from .synthetic.sensors import sensor_model
 
         sensor = sensor_model(args.sensor)
     folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=args.ripe, n_unripe=args.unripe, sensor=sensor)

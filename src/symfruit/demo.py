@@ -24,7 +24,7 @@ from .writers import write_detections
 
 __all__ = ["FRAME_SEED", "DemoReport", "example_frame", "run_demo"]
 
-#: Seed of the shipped frame (:func:`symfruit.scenes.make_scene`: touching fruit, leaves in front).
+#: Seed of the shipped frame (:func:`symfruit.synthetic.scenes.make_scene`: touching fruit, leaves in front).
 FRAME_SEED = 1
 
 

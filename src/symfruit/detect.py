@@ -14,16 +14,16 @@ from pathlib import Path
 
 import numpy as np
 
-from .complete import Result, complete
 from .core.box import Box
 from .core.camera import Camera
-from .core.view import Occlusion
+from .core.frame import Frame
+from .core.occlusion import Occlusion
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
-from .frame import Frame
 from .methods import DEFAULT_METHOD
+from .methods.complete import Result, complete
 from .occlusion import fruit_occlusion
-from .segment import learned_masks, segment
+from .segment.colour import learned_masks, segment
 from .settings import Settings
 
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]

@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .core.camera import Camera
-from .core.view import Occlusion, occlusion
+from .core.occlusion import Occlusion, occlusion
 from .settings import Section, register_section, setting
 
 __all__ = ["OcclusionSettings", "fruit_occlusion"]
@@ -21,7 +21,7 @@ __all__ = ["OcclusionSettings", "fruit_occlusion"]
 @dataclass(frozen=True)
 class OcclusionSettings(Section):
     """The occlusion information ``detect`` and the evaluation compute for every fruit from the frame's depth
-    image, masks and border (:func:`symfruit.core.view.occlusion`) and hand to the methods that use it.
+    image, masks and border (:func:`symfruit.core.occlusion.occlusion`) and hand to the methods that use it.
 
     Attributes
     ----------
@@ -51,7 +51,7 @@ def fruit_occlusion(
     settings: OcclusionSettings,
     others: np.ndarray | None = None,
 ) -> Occlusion | None:
-    """:func:`~symfruit.core.view.occlusion` with the section's values, or None when it is disabled (the one
+    """:func:`~symfruit.core.occlusion.occlusion` with the section's values, or None when it is disabled (the one
     place both ``detect`` and the evaluation's rendered views make it)."""
     if not settings.enabled:
         return None

@@ -28,12 +28,12 @@ from typing import Any
 
 import numpy as np
 
-from .complete import Result
 from .core.box import Box
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError
 from .io.atomic import atomic_write, write_json
 from .io.clouds import write_ply
+from .methods.complete import Result
 from .settings import Settings
 
 __all__ = [

@@ -6,8 +6,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit import DEFAULT_CAMERA
+from symfruit.core.agreement import observe
 from symfruit.core.candidates import REACH, candidates, constrain_box
-from symfruit.core.evidence import observe
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -64,7 +64,7 @@ def test_candidates_of_a_noisy_ball():
 
 
 def test_the_outline_candidate_takes_its_profile_from_the_silhouette():
-    from symfruit.shapes import FRUITS, rotation
+    from symfruit.synthetic.shapes import FRUITS, rotation
 
     visible, _ = rendered_view(FRUITS["strawberry"](np.random.default_rng(2)), [0.0, 0.02, 0.35], noise=0.01,
                                rotation=rotation(20, 60, 10), seed=1)  # fmt: skip

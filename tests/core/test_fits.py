@@ -28,7 +28,7 @@ from symfruit.core.fits import (
     revolution_inside,
     surface_noise,
 )
-from symfruit.shapes import FRUITS, rotation
+from symfruit.synthetic.shapes import FRUITS, rotation
 
 from ..conftest import CENTRE, ball_mesh, fibonacci_sphere, front_half, random_sphere, rendered_view, revolution_cloud
 

@@ -58,7 +58,7 @@ def test_camera_run_with_occlusion_and_every_fruit(tmp_path):
 
 def test_scan_folder_runs_both_protocols(tmp_path):
     from symfruit.io import write_ply
-    from symfruit.shapes import FRUITS
+    from symfruit.synthetic.shapes import FRUITS
 
     scans = tmp_path / "scans"
     for i in range(2):

@@ -17,8 +17,8 @@ from symfruit.evaluate.masks import (
     score_masks,
     summarise_masks,
 )
-from symfruit.scenes import make_photo
-from symfruit.segment import segment
+from symfruit.segment.colour import segment
+from symfruit.synthetic.scenes import make_photo
 from symfruit.writers import draw_contact_sheet, write_mask_report
 
 RED = (200, 30, 40)

@@ -76,7 +76,7 @@ def test_the_polygon_test_of_the_occluder():
 
 
 def test_the_heldback_sensor_sees_every_pixel_of_the_fruit():
-    from symfruit.render import render
+    from symfruit.synthetic.render import render
 
     from ..conftest import ball_mesh
 
@@ -111,7 +111,7 @@ def test_pose_distributions():
 
 def test_upright_stands_a_scan_up(tmp_path):
     from symfruit.io import write_ply
-    from symfruit.shapes import FRUITS
+    from symfruit.synthetic.shapes import FRUITS
 
     fruit = FRUITS["lemon"](np.random.default_rng(0))  # long axis along y; stood on end: along z in the file
     write_ply(tmp_path / "lemon.ply", fruit.sample(4000, np.random.default_rng(0))[:, [0, 2, 1]] * [1, 1, -1])

@@ -8,10 +8,10 @@ import numpy as np
 import pytest
 
 from symfruit import InputError, Settings
+from symfruit.evaluate.metrics import score_completion
 from symfruit.evaluate.protocols import Spec, build
 from symfruit.evaluate.runner import COLUMNS, Row, run, summarise
 from symfruit.methods import register
-from symfruit.metrics import score_completion
 
 SPECS = [Spec("paper", "strawberry", 0, 9), Spec("paper", "strawberry", 1, 0)]
 

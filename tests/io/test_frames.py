@@ -11,7 +11,7 @@ from PIL import Image
 
 from symfruit import FileFormatError, InputError, SymfruitError
 from symfruit.io.frames import is_frame_folder, read_frame, read_truth, write_frame
-from symfruit.scenes import make_scene
+from symfruit.synthetic.scenes import make_scene
 
 from ..conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 

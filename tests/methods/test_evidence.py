@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 
 from symfruit import DEFAULT_CAMERA, ConfigError, box_iou, centre_deviation, complete
+from symfruit.core.agreement import Evidence
 from symfruit.core.candidates import Candidate
-from symfruit.core.evidence import Evidence
 from symfruit.evaluate.protocols import Spec, build
 from symfruit.methods.evidence import EvidenceSettings, _weighted_median, clean_share, combine
 from symfruit.settings import Settings
-from symfruit.shapes import FRUITS, rotation
+from symfruit.synthetic.shapes import FRUITS, rotation
 
 from ..conftest import REAL_SCANS, ball_mesh, needs_real_scans, rendered_view
 
@@ -120,7 +120,7 @@ def test_the_frames_occlusion_information_completes_an_occluded_fruit():
     """A leaf hides the lower part of a lemon: from its points alone the leaf's edge looks like the fruit's
     outline and the box is cut short; with the occlusion information it is not."""
     from symfruit import Box
-    from symfruit.core.view import occlusion
+    from symfruit.core.occlusion import occlusion
 
     from ..conftest import occluded_view
 

@@ -83,7 +83,7 @@ def test_a_method_brings_its_own_settings_section(isolated_registry):
 
 
 def test_only_methods_that_take_it_get_the_occlusion_information(isolated_registry):
-    from symfruit.core.view import Occlusion
+    from symfruit.core.occlusion import Occlusion
 
     seen = {}
 

@@ -9,8 +9,8 @@ import numpy as np
 import pytest
 
 from symfruit.cli import main
+from symfruit.core.frame import Frame
 from symfruit.errors import FileFormatError
-from symfruit.frame import Frame
 from symfruit.ros.bag2 import MSGTYPE, TOPIC, Ros2DetectionBag, frame_header
 
 pytest.importorskip("rosbags")
@@ -160,7 +160,7 @@ def test_detect_cli_ros2_bag_of_a_frame_folder_and_refusals(tmp_path, example_fr
 
 def test_run_batch_on_frame_sees_every_frame_and_its_failures_are_the_frames(tmp_path):
     from symfruit.batch import run_batch
-    from symfruit.scenes import write_scenes
+    from symfruit.synthetic.scenes import write_scenes
 
     write_scenes(tmp_path / "rec", 3, seed=0, n_ripe=2, n_unripe=0)
     names = sorted(p.name for p in (tmp_path / "rec").iterdir())

@@ -11,10 +11,10 @@ shape explains the view), :mod:`.candidates` (the default method's candidate com
 
 from __future__ import annotations
 
+from .agreement import Evidence, Observation, explain, march, observe
 from .box import Box, box_iou, centre_deviation
 from .camera import DEFAULT_CAMERA, Camera
 from .candidates import Candidate, candidates, constrain_box
-from .evidence import Evidence, Observation, explain, march, observe
 from .fits import (
     Revolution,
     ellipsoid_half_extents,
@@ -28,13 +28,13 @@ from .fits import (
     surface_noise,
 )
 from .front import apex_depth
+from .occlusion import Occlusion, occlusion
 from .planes import Plane, Planes, hypothesis_planes, mirror
 from .points import as_points, check_cloud
 from .raster import Silhouette, View, rasterise, silhouette, silhouette_coverage
 from .rating import LOCATIONS, Rating, Table1, rate_planes, rate_points
 from .superellipsoid import Superellipsoid, fit_superellipsoid, missing_surface, superellipsoid_box
 from .symmetry import SymmetryCompletion, complete_by_symmetry
-from .view import Occlusion, occlusion
 
 __all__ = [
     "DEFAULT_CAMERA",

@@ -21,7 +21,7 @@ Every candidate is a different assumption about the hidden side:
     nothing hidden: the box of what was seen.
 
 Closed candidates (sphere, ellipsoid, solid of revolution) are measured against the view by
-:func:`symfruit.core.evidence.explain`. All boxes share the front depth estimated from the data
+:func:`symfruit.core.agreement.explain`. All boxes share the front depth estimated from the data
 (:func:`symfruit.core.front.apex_depth`) and otherwise contain every seen point.
 """
 
@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .agreement import Evidence, Inside, Observation, explain
 from .camera import Camera
-from .evidence import Evidence, Inside, Observation, explain
 from .fits import (
     ellipsoid_half_extents,
     fit_cone_ellipsoid,
@@ -171,7 +171,7 @@ def candidates(
     sample : (m, 3) float, metres
         A spread subset the shapes are fitted to.
     obs : Observation
-        The view reduced for :func:`~symfruit.core.evidence.explain`.
+        The view reduced for :func:`~symfruit.core.agreement.explain`.
     camera : Camera
     front : float, metres
         The shared front depth (nearest surface point).

@@ -15,12 +15,12 @@ from typing import Any
 import numpy as np
 from scipy.optimize import linear_sum_assignment
 
-from ..complete import complete
 from ..core.box import Box, box_iou, centre_deviation
+from ..core.frame import Frame
 from ..detect import FrameDetections, detect
 from ..errors import SymfruitError
-from ..frame import Frame
 from ..io.sources import open_source
+from ..methods.complete import complete
 from ..settings import Settings
 
 __all__ = ["FrameScore", "evaluate_frames", "match"]

@@ -340,13 +340,13 @@ def evaluate_scene_masks(
     depth: bool = True,
     **scene_options: Any,
 ) -> MaskEvaluation:
-    """The masks protocol on rendered scenes (:func:`symfruit.scenes.make_scene`): truth is the ripe
+    """The masks protocol on rendered scenes (:func:`symfruit.synthetic.scenes.make_scene`): truth is the ripe
     fruit's visible pixels; a region on an unripe fruit counts as false.
 
     With ``depth`` (default), ``segment(color, depth=..., camera=...)`` is given the scene's depth and
     camera; without, ``segment(color)`` sees the colour alone.
     """
-    from ..scenes import make_scene
+    from ..synthetic.scenes import make_scene
 
     def items() -> Iterator[Item]:
         for seed in seeds:

@@ -14,13 +14,13 @@
     optionally a leaf-like occluder in front hiding a set share of the fruit's silhouette. Truth: the box
     of the whole mesh in the same pose.
 
-A fruit is a generated kind (:data:`symfruit.shapes.FRUITS`) or a scan of a folder of meshes
-(:func:`symfruit.shapes.load_scans`, e.g. the YCB scans of ``examples/scans``).
+A fruit is a generated kind (:data:`symfruit.synthetic.shapes.FRUITS`) or a scan of a folder of meshes
+(:func:`symfruit.synthetic.shapes.load_scans`, e.g. the YCB scans of ``examples/scans``).
 
 Sensor models (``--sensor``):
 
 ``d435`` (default)
-    A D435-like camera as the repository has always modelled it (:class:`~symfruit.render.SensorNoise`
+    A D435-like camera as the repository has always modelled it (:class:`~symfruit.synthetic.render.SensorNoise`
     defaults): axial noise 1 mm at 0.3 m growing with the square of the depth, 0.3 px lateral jitter, half
     of the silhouette's edge pixels and 60 % of grazing pixels dropped, 1 % random dropout; 0.25-0.60 m.
 ``heldback``
@@ -28,9 +28,9 @@ Sensor models (``--sensor``):
     standard deviation ``0.01 z^2`` metres, 0.3 px lateral jitter, one point per fruit pixel, no dropout;
     0.30-0.50 m.
 ``azure-kinect``, ``realsense-l515``, ``realsense-d435``, ``realsense-d405``
-    Real cameras (:data:`symfruit.sensors.SENSOR_MODELS`, issue 18): the view is rendered at the camera's
+    Real cameras (:data:`symfruit.synthetic.sensors.SENSOR_MODELS`, issue 18): the view is rendered at the camera's
     colour resolution (1920x1080 or 1280x720; a window around the fruit) with leaves and a background
-    2-20 cm behind and beside the fruit, through :func:`symfruit.sensors.apply_sensor` (rim invalidation
+    2-20 cm behind and beside the fruit, through :func:`symfruit.synthetic.sensors.apply_sensor` (rim invalidation
     or edge fattening, flying pixels, registration offset, multipath, noise and bias growing with
     distance), at the camera's working distances within 0.25-2 m. The fruit's points are what
     ``detect`` would take: :func:`symfruit.extract.extract` under the annotators' mask (which may
@@ -61,9 +61,9 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
-from ..render import SensorNoise, render
-from ..sensors import SENSOR_MODELS, SensorModel, apply_sensor
-from ..shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
+from ..synthetic.render import SensorNoise, render
+from ..synthetic.sensors import SENSOR_MODELS, SensorModel, apply_sensor
+from ..synthetic.shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
 

@@ -10,13 +10,13 @@ from typing import Any
 
 import numpy as np
 
-from ..complete import complete
 from ..errors import InputError, SymfruitError
 from ..extract import extract
-from ..metrics import score_completion
+from ..methods.complete import complete
 from ..occlusion import fruit_occlusion
 from ..progress import Progress
 from ..settings import Settings
+from .metrics import score_completion
 from .protocols import Spec, build
 
 __all__ = ["Row", "run"]

@@ -23,8 +23,8 @@ from typing import Any
 import numpy as np
 
 from ..core.camera import Camera
+from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
-from ..frame import Frame
 
 __all__ = [
     "BagSource",

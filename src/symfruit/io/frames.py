@@ -24,8 +24,8 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import Camera
+from ..core.frame import Frame
 from ..errors import FileFormatError, InputError
-from ..frame import Frame
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
 from .text import read_structured

@@ -24,8 +24,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Protocol, runtime_checkable
 
+from ..core.frame import Frame
 from ..errors import FileFormatError
-from ..frame import Frame
 from .frames import is_frame_folder, read_frame
 
 __all__ = ["FolderSource", "FrameFolderSource", "FrameSource", "open_source", "register_source", "source_kinds"]

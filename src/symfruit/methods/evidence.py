@@ -12,7 +12,7 @@ completion is right for every fruit, and the view itself says which ones fit. Th
    the ellipsoid whose outline is the silhouette (``cone``: five of its nine degrees of freedom come from
    the silhouette, which a depth camera measures far better than depth), a solid of revolution,
    optionally the mirror completion, and the raw box;
-3. measures every closed candidate against the view (:func:`~symfruit.core.evidence.explain`): its
+3. measures every closed candidate against the view (:func:`~symfruit.core.agreement.explain`): its
    predicted front depth against the seen depths and its predicted outline against the seen one (rays
    just inside the silhouette must hit it, rays just outside a contour part of the edge must miss it);
 4. weighs the candidates by ``exp(-energy)``, with the energy of a closed candidate
@@ -40,15 +40,15 @@ from typing import Any, Literal
 
 import numpy as np
 
+from ..core.agreement import observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
-from ..core.evidence import observe
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
+from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
 from ..core.raster import close_ragged, silhouette
-from ..core.view import Occlusion, with_own
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -92,11 +92,11 @@ class EvidenceSettings(Section):
         ``cone`` ellipsoid, and ``raw``: "nothing beyond the outline"), times the share of the outline
         that is not an occluding contour (a cut: the paper's visibility rule, an occluder).
     occluded_px, thin_px, contour_cone : int, int, float
-        With the frame's occlusion information (:class:`~symfruit.core.view.Occlusion`): an outline pixel
+        With the frame's occlusion information (:class:`~symfruit.core.occlusion.Occlusion`): an outline pixel
         with a hidden pixel within ``occluded_px`` is a cut; hidden structures narrower than ``2 thin_px +
         1`` pixels (a stem) do not widen where the fruit can project; with at least ``contour_cone`` of the
         outline a contour (and some of it cut) the ``cone`` ellipsoid is tangent to the ellipse through the
-        contour part (:func:`~symfruit.core.evidence.observe`). The seen region then includes the fruit's
+        contour part (:func:`~symfruit.core.agreement.observe`). The seen region then includes the fruit's
         own mask.
     contour_cut_energy : float
         The ``cone`` ellipsoid's energy per unit cut share when it was fitted to the contour part of the

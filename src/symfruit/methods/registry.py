@@ -3,7 +3,7 @@
 A method is a function ``(points, camera, section) -> Completion``; ``section`` is the method's own
 settings section (or None when it has none). A method registered with ``occlusion=True`` is called as
 ``fn(points, camera, section, occlusion=...)`` and receives the frame's occlusion information
-(:class:`~symfruit.core.view.Occlusion`, or None when the caller has none); the others never see it.
+(:class:`~symfruit.core.occlusion.Occlusion`, or None when the caller has none); the others never see it.
 Registering it with :func:`register` makes it available to :func:`symfruit.complete`, the CLI and the
 evaluation, and makes its settings section part of :class:`~symfruit.settings.Settings`. Adding a method
 touches no other method.

@@ -25,9 +25,9 @@ from typing import Any
 
 import numpy as np
 
+from ..core.frame import Frame
 from ..detect import FrameDetections
 from ..errors import FileFormatError, SymfruitError
-from ..frame import Frame
 from ..writers import OPTICAL_FRAME
 from .core import Fruit, fruits_of
 

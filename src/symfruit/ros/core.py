@@ -7,7 +7,7 @@ ROS 1 wrapper (:mod:`symfruit.ros.node`), a ROS 2 (rclpy) wrapper and the bag wr
 - :class:`FrameProcessor`: settings resolved once (:func:`symfruit.settings.resolve_settings`, as every
   command does), then ``process(color, depth, info)`` -> :class:`Processed`. The messages are decoded by
   :mod:`symfruit.io.bags` (the one decoder of ``sensor_msgs/Image``, shared with bag recordings) into a
-  :class:`~symfruit.frame.Frame` stamped with the colour image's header, then :func:`~symfruit.detect.detect`;
+  :class:`~symfruit.core.frame.Frame` stamped with the colour image's header, then :func:`~symfruit.detect.detect`;
 - :func:`fruits_of`: the located fruit of a :class:`~symfruit.detect.FrameDetections`, built as
   :func:`~symfruit.writers.detections_record` builds ``detections.json`` (its ``bbox_record``), so every ROS
   message carries exactly ``detections.json``'s centres, sizes and confidences;
@@ -26,9 +26,9 @@ from typing import Any
 
 import numpy as np
 
+from ..core.frame import Frame
 from ..detect import FrameDetections, detect
 from ..errors import InputError
-from ..frame import Frame
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
@@ -103,7 +103,7 @@ def message_frame(
     name: str = "frame",
     source: str = "ros",
 ) -> Frame:
-    """A :class:`~symfruit.frame.Frame` of a colour image, the depth image aligned to it and the colour
+    """A :class:`~symfruit.core.frame.Frame` of a colour image, the depth image aligned to it and the colour
     camera's info; stamped with the colour header (``stamp``, ``frame_id``).
 
     Raises
@@ -172,7 +172,7 @@ class FrameProcessor:
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
 
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
-        """The :class:`~symfruit.frame.Frame` of the three messages (:func:`message_frame`)."""
+        """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`)."""
         return message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source)
 
     def process(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Processed:

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.spatial import cKDTree
 
-from .core.box import Box, box_iou, centre_deviation
+from ..core.box import Box, box_iou, centre_deviation
 
 __all__ = ["Scores", "chamfer_f1", "score_completion"]
 

@@ -1,4 +1,4 @@
-"""ONNX instance-segmentation decoding (symfruit.segment_onnx) on tiny models built here: a Mask R-CNN-like
+"""ONNX instance-segmentation decoding (symfruit.segment.onnx) on tiny models built here: a Mask R-CNN-like
 export and a YOLO-like segmentation head, through `symfruit segment` too."""
 
 import numpy as np
@@ -10,7 +10,7 @@ onnx = pytest.importorskip("onnx")
 pytest.importorskip("onnxruntime")
 from onnx import TensorProto, helper, numpy_helper  # noqa: E402
 
-from symfruit.segment_onnx import decode_yolo, letterbox, load_onnx, onnx_labels  # noqa: E402
+from symfruit.segment.onnx import decode_yolo, letterbox, load_onnx, onnx_labels  # noqa: E402
 
 
 def _save(graph, path):

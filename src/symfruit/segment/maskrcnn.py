@@ -11,7 +11,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FileFormatError, SymfruitError
+from ..errors import FileFormatError, SymfruitError
 
 __all__ = ["load_maskrcnn", "maskrcnn_labels"]
 

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .errors import FileFormatError
+from ..errors import FileFormatError
 
 __all__ = [
     "FRUITS",
@@ -427,7 +427,7 @@ def load_scans(folder: str | Path) -> list[Fruit]:
     FileFormatError
         When the folder is missing or holds no readable scan; a bad file names itself.
     """
-    from .io import read_cloud, read_mesh
+    from ..io import read_cloud, read_mesh
 
     folder = Path(folder)
     if not folder.is_dir():

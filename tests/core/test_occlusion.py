@@ -9,8 +9,8 @@ from hypothesis.extra.numpy import arrays
 from scipy import ndimage
 
 from symfruit.core.camera import Camera
+from symfruit.core.occlusion import Occlusion, occlusion, open_square, with_own
 from symfruit.core.raster import Silhouette, silhouette
-from symfruit.core.view import Occlusion, occlusion, open_square, with_own
 from symfruit.errors import InputError
 
 from ..conftest import ball_mesh, hidden_image, occluded_view

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .core.camera import Camera
+from ..core.camera import Camera
 
 __all__ = ["Rendering", "SensorNoise", "render"]
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from symfruit import Camera
-from symfruit.render import Rendering, SensorNoise, render
+from symfruit.synthetic.render import Rendering, SensorNoise, render
 
-from .conftest import fibonacci_sphere
+from ..conftest import fibonacci_sphere
 
 CAM = Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
 #: A triangle 0.5 m in front of the camera, facing it: 240 px wide at the base, 240 px high.

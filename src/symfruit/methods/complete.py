@@ -9,14 +9,14 @@ from typing import Any
 
 import numpy as np
 
-from .core.box import Box
-from .core.camera import DEFAULT_CAMERA, Camera
-from .core.planes import Plane, Planes
-from .core.points import check_cloud, check_view
-from .core.view import Occlusion
-from .errors import InputError
-from .methods import DEFAULT_METHOD, get
-from .settings import Section, SettingError, Settings, from_dict, register_section, setting
+from ..core.box import Box
+from ..core.camera import DEFAULT_CAMERA, Camera
+from ..core.occlusion import Occlusion
+from ..core.planes import Plane, Planes
+from ..core.points import check_cloud, check_view
+from ..errors import InputError
+from ..settings import Section, SettingError, Settings, from_dict, register_section, setting
+from .registry import DEFAULT_METHOD, get
 
 __all__ = ["InputSettings", "Result", "complete"]
 
@@ -158,7 +158,7 @@ def complete(
         Settings (e.g. from :func:`symfruit.resolve_settings`), or a nested mapping of overrides
         (``{"paper": {"rotations_x": 21}}``).
     occlusion : Occlusion, optional
-        Where the camera could not have seen this fruit (:func:`symfruit.core.view.occlusion` of the frame's
+        Where the camera could not have seen this fruit (:func:`symfruit.core.occlusion.occlusion` of the frame's
         depth image and masks; :func:`symfruit.detect.detect` computes it), for the methods that use it
         (``evidence``); the others ignore it. None: the points are all there is.
 
@@ -188,7 +188,7 @@ def complete(
     info = get(method)
     if occlusion is not None:
         if not isinstance(occlusion, Occlusion):
-            raise InputError(f"occlusion must be a symfruit.core.view.Occlusion or None, got "
+            raise InputError(f"occlusion must be a symfruit.core.occlusion.Occlusion or None, got "
                              f"{type(occlusion).__name__}")  # fmt: skip
         if (occlusion.width, occlusion.height) != (camera.width, camera.height):
             raise InputError(f"occlusion is for a {occlusion.width}x{occlusion.height} image, the camera's is "
@@ -240,7 +240,7 @@ _DEFAULTS: dict[tuple[Any, ...], Settings] = {}
 
 def _default_settings() -> Settings:
     """``Settings()``, made once per set of registered sections (immutable, so it can be shared)."""
-    from .settings import section_types
+    from ..settings import section_types
 
     key = tuple(section_types().items())
     if key not in _DEFAULTS:
@@ -268,7 +268,7 @@ def _camera(camera: Any) -> Camera:
     if isinstance(camera, Camera):
         return camera
     if isinstance(camera, Mapping):
-        from .io.intrinsics import camera_from_dict
+        from ..io.intrinsics import camera_from_dict
 
         return camera_from_dict(camera)
     raise InputError(f"camera must be a Camera or a mapping of intrinsics, got {type(camera).__name__}")

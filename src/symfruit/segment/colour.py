@@ -45,8 +45,8 @@ from typing import Literal, Protocol
 import numpy as np
 from scipy import ndimage
 
-from .errors import InputError
-from .settings import Section, SettingError, register_section, setting
+from ..errors import InputError
+from ..settings import Section, SettingError, register_section, setting
 
 __all__ = ["SegmentSettings", "convex_hull_mask", "learned_masks", "redness", "ripe_seeds", "segment"]
 
@@ -66,7 +66,7 @@ class _Focal(Protocol):
 
 @dataclass(frozen=True)
 class SegmentSettings(Section):
-    """The built-in colour segmenter (:mod:`symfruit.segment`): ripe red fruit, no weights needed.
+    """The built-in colour segmenter (:mod:`symfruit.segment.colour`): ripe red fruit, no weights needed.
 
     Attributes
     ----------
@@ -293,12 +293,12 @@ def learned_masks(spec: str) -> Callable[[np.ndarray], np.ndarray] | None:
     """
     prefix, _, path = spec.partition(":")
     if prefix == "maskrcnn" and path:
-        from .segment_maskrcnn import load_maskrcnn, maskrcnn_labels
+        from .maskrcnn import load_maskrcnn, maskrcnn_labels
 
         load_maskrcnn(path)
         return lambda color: maskrcnn_labels(color, path)
     if prefix == "onnx" and path:
-        from .segment_onnx import load_onnx, onnx_labels
+        from .onnx import load_onnx, onnx_labels
 
         load_onnx(path)
         return lambda color: onnx_labels(color, path)

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from symfruit import Box
-from symfruit.metrics import Scores, chamfer_f1, score_completion
+from symfruit.evaluate.metrics import Scores, chamfer_f1, score_completion
 
 
 def test_chamfer_and_f1_known_answers():

@@ -28,7 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from .errors import FileFormatError, InputError, SymfruitError
+from ..errors import FileFormatError, InputError, SymfruitError
 
 __all__ = ["OnnxModel", "decode_maskrcnn", "decode_yolo", "letterbox", "load_onnx", "onnx_labels"]
 

@@ -3,7 +3,7 @@ and active stereo (RealSense D435, D405), every artefact a parameter with its va
 
 :class:`SensorModel` describes a camera (colour resolution and intrinsics, the depth sensor's own
 resolution, noise, edges, registration) and the annotators' masks and the clutter of the scenes it is
-used in; :func:`apply_sensor` turns a clean render (:func:`symfruit.render.render`) at the colour
+used in; :func:`apply_sensor` turns a clean render (:func:`symfruit.synthetic.render.render`) at the colour
 camera's resolution into the registered depth image and masks that camera and its annotators give.
 :data:`SENSOR_MODELS` holds the four cameras.
 
@@ -44,7 +44,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from scipy import ndimage
 
-from .core.camera import Camera
+from ..core.camera import Camera
 
 __all__ = ["SENSOR_MODELS", "SensorFrame", "SensorModel", "apply_sensor", "sensor_model"]
 

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from symfruit.bench import DENSE_GRID, bench_view
+from symfruit.evaluate.bench import DENSE_GRID, bench_view
 
 
 def test_bench_view_is_fixed_and_partial():

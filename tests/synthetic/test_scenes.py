@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from symfruit import Camera
-from symfruit.render import SensorNoise
-from symfruit.scenes import Scene, SceneFruit, make_scene, write_scenes
-from symfruit.segment import ripe_seeds
+from symfruit.segment.colour import ripe_seeds
+from symfruit.synthetic.render import SensorNoise
+from symfruit.synthetic.scenes import Scene, SceneFruit, make_scene, write_scenes
 
 PERFECT = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
 

@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 
 from symfruit import Box, InputError
-from symfruit.frame import Frame
+from symfruit.core.frame import Frame
 
-from .conftest import SMALL_CAM, disc_frame
+from ..conftest import SMALL_CAM, disc_frame
 
 COLOR, DEPTH = disc_frame([(80, 60)])
 

@@ -11,10 +11,10 @@ from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
 from symfruit import ConfigError, InputError, Settings, SymfruitError, complete
-from symfruit.complete import InputSettings, Result
 from symfruit.methods import get
+from symfruit.methods.complete import InputSettings, Result
 
-from .conftest import CENTRE, FUZZ_EXAMPLES, VISIBLE, front_half, sphere_cloud
+from ..conftest import CENTRE, FUZZ_EXAMPLES, VISIBLE, front_half, sphere_cloud
 
 
 def test_to_dict_has_the_documented_keys():
@@ -77,7 +77,7 @@ def test_a_million_points_are_down_sampled(monkeypatch):
         handed.append(len(points))
         return info.fn(points, camera, section, occlusion=occlusion)
 
-    monkeypatch.setattr(sys.modules["symfruit.complete"], "get", lambda name: replace(info, fn=spy))
+    monkeypatch.setattr(sys.modules["symfruit.methods.complete"], "get", lambda name: replace(info, fn=spy))
     result = complete(cloud)
     assert len(result.visible) == 20000 and result.n_input == len(cloud)
     assert handed == [20000]

@@ -3,7 +3,7 @@
 A scene holds strawberries hanging from a gutter at 0.25-0.6 m (calyx up, tilted, some touching),
 ripe ones red and unripe ones white or green (which a segmenter must ignore), a green calyx on each,
 stems up to the gutter, leaves in front of some fruit, and a backdrop. It is rendered with the exact
-z-buffer of :mod:`symfruit.render`, shaded, and given the D435-like depth noise of the evaluation's
+z-buffer of :mod:`symfruit.synthetic.render`, shaded, and given the D435-like depth noise of the evaluation's
 ``camera`` protocol. ``truth`` lists every fruit's true box (the box of its whole surface).
 """
 
@@ -18,8 +18,8 @@ from pathlib import Path
 
 import numpy as np
 
-from .core.box import Box
-from .core.camera import DEFAULT_CAMERA, Camera
+from ..core.box import Box
+from ..core.camera import DEFAULT_CAMERA, Camera
 from .render import SensorNoise, render
 from .sensors import SensorModel, apply_sensor
 from .shapes import leaf_outline, rotation, strawberry
@@ -46,8 +46,8 @@ class SceneFruit:
 class Scene:
     """A rendered frame: colour (h, w, 3) uint8, depth (h, w) float metres (0 = no depth), the camera,
     the instance labels of the true fruit pixels (0 = none, k = fruit k), and the fruit; through a
-    :class:`~symfruit.sensors.SensorModel`, also the masks annotators would draw of the ripe fruit
-    (overshooting, some over the leaf in front: :func:`symfruit.sensors.annotate`)."""
+    :class:`~symfruit.synthetic.sensors.SensorModel`, also the masks annotators would draw of the ripe fruit
+    (overshooting, some over the leaf in front: :func:`symfruit.synthetic.sensors.annotate`)."""
 
     color: np.ndarray
     depth: np.ndarray
@@ -119,12 +119,12 @@ def make_scene(
         Leaves placed in front of (some of) the fruit.
     camera : Camera
     noise : SensorNoise, optional
-        Depth sensor model; default :class:`~symfruit.render.SensorNoise`.
+        Depth sensor model; default :class:`~symfruit.synthetic.render.SensorNoise`.
     sensor : SensorModel, optional
         A real camera instead (``camera`` and ``noise`` are then ignored): the frame at its colour
         resolution, the fruit at its working distances within 0.25-2 m (one cluster per frame, log-uniform
-        depth), leaves and the backdrop 2-20 cm behind them, through :func:`symfruit.sensors.apply_sensor`,
-        with the annotators' masks in :attr:`Scene.masks`.
+        depth), leaves and the backdrop 2-20 cm behind them, through
+        :func:`symfruit.synthetic.sensors.apply_sensor`, with the annotators' masks in :attr:`Scene.masks`.
     """
     if sensor is not None:
         return _sensor_scene(seed, sensor, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves)
@@ -316,7 +316,7 @@ def write_scenes(
     list of Path
         The frame folders, in order.
     """
-    from .io.frames import write_frame
+    from ..io.frames import write_frame
 
     folder = Path(folder)
     unique = n if distinct is None else max(1, min(distinct, n))

@@ -1,4 +1,4 @@
-"""The colour segmenter (symfruit.segment) on photo-like synthetic images and on rendered depth."""
+"""The colour segmenter (symfruit.segment.colour) on photo-like synthetic images and on rendered depth."""
 
 import numpy as np
 import pytest
@@ -8,10 +8,10 @@ from hypothesis import strategies as st
 from symfruit import Camera, ConfigError, InputError
 from symfruit.evaluate.masks import score_masks
 from symfruit.io.frames import read_frame
-from symfruit.scenes import make_photo, make_scene
-from symfruit.segment import SegmentSettings, convex_hull_mask, redness, ripe_seeds, segment
+from symfruit.segment.colour import SegmentSettings, convex_hull_mask, redness, ripe_seeds, segment
+from symfruit.synthetic.scenes import make_photo, make_scene
 
-from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
+from ..conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 
 H, W = 240, 320
 YY, XX = np.mgrid[:H, :W]

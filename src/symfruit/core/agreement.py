@@ -28,9 +28,9 @@ from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .camera import Camera
+from .occlusion import Occlusion
 from .points import as_points
 from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
-from .view import Occlusion
 
 __all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
 
@@ -69,7 +69,7 @@ class Observation:
         of the outline (see :func:`observe`).
     extent : (4,) float, pixels, optional
         With occlusion information: the pixel box the fruit can project into at most (``u_min, v_min, u_max,
-        v_max``; :meth:`~symfruit.core.view.Occlusion.extent`).
+        v_max``; :meth:`~symfruit.core.occlusion.Occlusion.extent`).
     hidden : (h, w) bool, optional
         With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
         outline crossing onto one is an occluder's edge).
@@ -150,7 +150,7 @@ def observe(
         :attr:`Observation.contour` are taken over neighbourhoods of these (at full density a
         neighbourhood spans a millimetre or two, small enough to follow even a thin fruit's rim).
     occlusion : Occlusion, optional
-        Where the camera could not have seen the fruit (:func:`symfruit.core.view.occlusion`). The contour
+        Where the camera could not have seen the fruit (:func:`symfruit.core.occlusion.occlusion`). The contour
         share is then measured on the region's own outline pixels: a pixel with a hidden pixel within
         ``occluded_px`` pixels is a cut whatever the normals say (an occluder's edge, the image border);
         rays of the outside bands landing on hidden pixels are no evidence; when part of the outline is a

@@ -16,7 +16,7 @@ def test_maskrcnn_without_torch_says_which_extra():
     if importlib.util.find_spec("torch") is not None:
         pytest.skip("torch is installed")
     from symfruit import SymfruitError
-    from symfruit.segment_maskrcnn import load_maskrcnn
+    from symfruit.segment.maskrcnn import load_maskrcnn
 
     with pytest.raises(SymfruitError, match=r"symfruit\[seg\]"):
         load_maskrcnn("model.pth")
@@ -32,7 +32,7 @@ def test_detect_with_maskrcnn_masks_without_torch_says_which_extra(example):
 
 @pytest.mark.skipif(not HAS_TORCH, reason="needs torch and torchvision")
 def test_a_missing_checkpoint_is_named(tmp_path):
-    from symfruit.segment_maskrcnn import load_maskrcnn
+    from symfruit.segment.maskrcnn import load_maskrcnn
 
     with pytest.raises(FileFormatError, match=r"nothing\.pth: no such Mask R-CNN checkpoint"):
         load_maskrcnn(str(tmp_path / "nothing.pth"))

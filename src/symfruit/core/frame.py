@@ -7,9 +7,9 @@ from typing import Any
 
 import numpy as np
 
-from .core.box import Box
-from .core.camera import Camera
-from .errors import InputError
+from ..errors import InputError
+from .box import Box
+from .camera import Camera
 
 __all__ = ["Frame"]
 

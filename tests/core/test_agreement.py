@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from symfruit.core.evidence import explain, march, observe
+from symfruit.core.agreement import explain, march, observe
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -73,8 +73,8 @@ def test_outside_rays_beside_a_cut_are_no_evidence(camera):
 def test_an_occluders_edge_is_a_cut_with_the_occlusion_information(camera):
     """A leaf hides the lower third of a ball: from the points alone its edge looks like the ball's outline;
     the frame's depth says it is a cut, its outside rays are no evidence, and the cone is the ball's."""
+    from symfruit.core.occlusion import occlusion
     from symfruit.core.raster import silhouette_cone
-    from symfruit.core.view import occlusion
 
     from ..conftest import occluded_view
 

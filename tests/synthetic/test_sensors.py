@@ -6,10 +6,10 @@ import numpy as np
 import pytest
 
 from symfruit import Camera
-from symfruit.render import render
-from symfruit.sensors import SENSOR_MODELS, SensorModel, annotate, apply_sensor, sensor_model
+from symfruit.synthetic.render import render
+from symfruit.synthetic.sensors import SENSOR_MODELS, SensorModel, annotate, apply_sensor, sensor_model
 
-from .conftest import ball_mesh
+from ..conftest import ball_mesh
 
 #: Everything random switched off: the artefact under test is the only one left.
 QUIET = dict(sigma_const=0.0, sigma_linear=0.0, bias_const=0.0, bias_linear=0.0, lateral_px=0.0, dropout=0.0,

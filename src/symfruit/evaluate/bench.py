@@ -17,10 +17,10 @@ from typing import Any
 
 import numpy as np
 
-from .complete import complete
-from .methods import DEFAULT_METHOD
-from .settings import Settings
-from .shapes import paper_visible, rotation_x, strawberry
+from ..methods import DEFAULT_METHOD
+from ..methods.complete import complete
+from ..settings import Settings
+from ..synthetic.shapes import paper_visible, rotation_x, strawberry
 
 __all__ = [
     "DENSE_GRID",
@@ -93,9 +93,9 @@ def bench_camera_view(n_points: int = 15000, *, seed: int = 0) -> np.ndarray:
     -------
     (n, 3) float, metres, n within a few per cent of ``n_points``
     """
-    from .core.camera import DEFAULT_CAMERA as cam
-    from .render import render
-    from .shapes import citrus
+    from ..core.camera import DEFAULT_CAMERA as cam
+    from ..synthetic.render import render
+    from ..synthetic.shapes import citrus
 
     rng = np.random.default_rng(seed)
     fruit = citrus(rng, diameter=0.075)
@@ -173,12 +173,12 @@ def bench_frame(
 ) -> BenchRow:
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore); with ``sensor``
-    (a key of :data:`symfruit.sensors.SENSOR_MODELS`) the frame is rendered through that camera model at
-    its colour resolution (1920x1080 or 1280x720), still segmented by the colour segmenter."""
-    from .detect import detect
-    from .frame import Frame
-    from .scenes import make_scene
-    from .sensors import sensor_model
+    (a key of :data:`symfruit.synthetic.sensors.SENSOR_MODELS`) the frame is rendered through that camera
+    model at its colour resolution (1920x1080 or 1280x720), still segmented by the colour segmenter."""
+    from ..core.frame import Frame
+    from ..detect import detect
+    from ..synthetic.scenes import make_scene
+    from ..synthetic.sensors import sensor_model
 
     model = None if sensor is None else sensor_model(sensor)
     scene = make_scene(seed, n_ripe=8, n_unripe=2, sensor=model)
@@ -211,26 +211,26 @@ class SegmentRow:
 def bench_segment(
     images: str | Path | None = None, *, size: tuple[int, int] = (640, 480), limit: int = 1000, repeat: int = 1
 ) -> SegmentRow:
-    """Time :func:`symfruit.segment.segment` (colour alone) per image, the images resized to ``size``
+    """Time :func:`symfruit.segment.colour.segment` (colour alone) per image, the images resized to ``size``
     (width, height) before timing.
 
     ``images`` is a folder of photographs (the first ``limit`` in name order); without it, 24 seeded
-    synthetic photos (:func:`symfruit.scenes.make_photo`: one to three fruit with seeds, highlights and a
+    synthetic photos (:func:`symfruit.synthetic.scenes.make_photo`: one to three fruit with seeds, highlights and a
     calyx). Each image is timed ``repeat`` times and its fastest run kept.
     """
     from PIL import Image
 
-    from .segment import segment
+    from ..segment.colour import segment
 
     if images is not None:
-        from .batch import expand_images
-        from .io.images import read_color
+        from ..batch import expand_images
+        from ..io.images import read_color
 
         paths = expand_images([images])[: max(1, limit)]
         frames = [np.asarray(Image.fromarray(read_color(p)).resize(size, Image.Resampling.BILINEAR)) for p in paths]
         source = str(images)
     else:
-        from .scenes import make_photo
+        from ..synthetic.scenes import make_photo
 
         rng = np.random.default_rng(0)
         frames = []
@@ -309,7 +309,7 @@ def bench_recording(
     import tempfile
 
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
-        from .scenes import write_scenes
+        from ..synthetic.scenes import write_scenes
 
         rec = Path(tmp) / "rec"
         write_scenes(rec, frames, distinct=4, n_ripe=8, n_unripe=2)

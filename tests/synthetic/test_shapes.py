@@ -3,9 +3,9 @@
 import numpy as np
 import pytest
 
-from symfruit.shapes import FRUITS, STRAWBERRY_CLASSES, load_scans, paper_visible, rotation, strawberry
+from symfruit.synthetic.shapes import FRUITS, STRAWBERRY_CLASSES, load_scans, paper_visible, rotation, strawberry
 
-from .conftest import fibonacci_sphere
+from ..conftest import fibonacci_sphere
 
 #: Per kind: 1 = the length (y extent) is checked, 0 = the width (the larger of the x and z extents).
 SIZES = {"strawberry": (1, (0.025, 0.050)), "apple": (0, (0.058, 0.095)), "citrus": (0, (0.058, 0.095)),
@@ -56,7 +56,7 @@ def test_sampling_is_uniform_on_a_sphere():
     from scipy.spatial import ConvexHull
 
     hull = ConvexHull(fibonacci_sphere(800))
-    from symfruit.shapes import sample_surface
+    from symfruit.synthetic.shapes import sample_surface
 
     pts = sample_surface(hull.points, hull.simplices, 20000, np.random.default_rng(0))
     assert np.abs(pts.mean(axis=0)).max() < 0.02

@@ -1,0 +1,11 @@
+"""Segmenters: an RGB-D frame's colour image to instance labels, one label per fruit.
+
+:mod:`.colour` is the built-in one (ripe red fruit by colour, no weights); :mod:`.onnx` and
+:mod:`.maskrcnn` run learned models (optional extras ``onnx`` and ``seg``).
+"""
+
+from __future__ import annotations
+
+from .colour import SegmentSettings, convex_hull_mask, learned_masks, redness, ripe_seeds, segment
+
+__all__ = ["SegmentSettings", "convex_hull_mask", "learned_masks", "redness", "ripe_seeds", "segment"]
