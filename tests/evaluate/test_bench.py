@@ -20,3 +20,9 @@ def test_noisy_views_are_the_clean_view_plus_seeded_noise():
     clean, noisy = bench_view(300), bench_view(300, noise=0.001)
     assert noisy.shape == clean.shape and np.array_equal(noisy, bench_view(300, noise=0.001))
     assert 0.0008 < np.std(noisy - clean) < 0.0012
+
+
+@pytest.mark.slow
+def test_a_frame_through_a_real_camera_is_timed_at_its_resolution():
+    row = bench_frame(repeat=1, method="raw", sensor="realsense-d405")
+    assert "realsense-d405 1280x720" in row.case and row.median_ms > 0 and row.points >= 1

@@ -227,7 +227,7 @@ def _sensor_scene(seed: int, sensor: SensorModel, *, n_ripe: int, n_unripe: int,
         berry = strawberry(rng, length=rng.uniform(0.030, 0.048) if ripe else rng.uniform(0.022, 0.035))
         rot = rotation(rng.uniform(-30, 30), rng.uniform(-180, 180), rng.uniform(-30, 30))
         for _ in range(200):
-            z = z0 + rng.uniform(-0.04, 0.04)
+            z = float(np.clip(z0 + rng.uniform(-0.04, 0.04), near, far))
             u = camera.cx + rng.uniform(-half_u, half_u)
             v = camera.cy + rng.uniform(-half_v, half_v) * 0.8 + 0.1 * half_v
             radius_px = camera.fx * 0.5 * np.ptp(berry.vertices, axis=0).max() / z
