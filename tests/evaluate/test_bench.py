@@ -1,8 +1,9 @@
 """The benchmark's fixed inputs: the seeded partial view and the dense grid."""
 
 import numpy as np
+import pytest
 
-from symfruit.evaluate.bench import DENSE_GRID, bench_view
+from symfruit.evaluate.bench import DENSE_GRID, bench_frame, bench_view
 
 
 def test_bench_view_is_fixed_and_partial():
