@@ -25,7 +25,7 @@ test: $(STAMP) ros-env  ## lint, type check and the test suite (slow evaluation 
 	$(BIN)/ruff check src tests examples
 	$(BIN)/ruff format --check src tests examples
 	$(BIN)/mypy
-	$(BIN)/python -m pytest -m "not slow"
+	$(BIN)/python -m pytest -m "not slow" -n auto --durations=15
 
 test-slow: $(STAMP)  ## the whole suite, slow evaluation runs included
 	$(BIN)/python -m pytest

@@ -130,3 +130,19 @@ def test_no_eval_or_pickle_anywhere():
     assert not re.search(r"(?<![.\w])(eval|exec)\(", text)
     assert not re.search(r"import pickle|pickle\.load|allow_pickle=True|yaml\.load\(|yaml\.unsafe_load", text)
     assert text.count("allow_pickle=False") >= 2 and "weights_only=True" in text
+
+
+def test_no_module_is_shadowed_by_an_attribute_of_its_package():
+    """``import symfruit.a.b as m`` gives the module: no function or class of ``symfruit.a`` is called ``b``."""
+    import importlib
+    import pkgutil
+
+    shadowed = []
+    for info in pkgutil.walk_packages(symfruit.__path__, "symfruit."):
+        if info.name.endswith("__main__"):
+            continue
+        module = importlib.import_module(info.name)
+        parent, _, name = info.name.rpartition(".")
+        if getattr(sys.modules[parent], name) is not module:
+            shadowed.append(info.name)
+    assert not shadowed

@@ -10,9 +10,6 @@ from __future__ import annotations
 
 from importlib.metadata import PackageNotFoundError, version
 
-from . import extract as _extract  # noqa: F401  (registers the "extract" settings section)
-from . import occlusion as _occlusion  # noqa: F401  (registers the "occlusion" settings section)
-from . import segment as _segment  # noqa: F401  (registers the "segment" settings section)
 from .core.box import Box, box_iou, centre_deviation
 from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane

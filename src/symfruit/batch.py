@@ -17,7 +17,7 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import numpy as np
 
@@ -27,6 +27,7 @@ from .io.atomic import write_json
 from .io.sources import open_source
 from .methods import DEFAULT_METHOD
 from .progress import Progress
+from .segment import MaskSource, mask_source
 from .settings import Settings
 from .writers import write_detections
 
@@ -36,7 +37,6 @@ __all__ = [
     "SegmentedImage",
     "expand_images",
     "frame_folder_name",
-    "mask_source",
     "run_batch",
     "segment_images",
 ]
@@ -116,22 +116,19 @@ def run_batch(
                     report.skipped.append(name)
                     bar.update()
                     continue
-                try:
+
+                def one_frame(index: int = index, folder: Path = folder) -> FrameDetections:
                     found = detect(src.read(index), masks=masks, method=method, settings=settings)
                     if on_frame is not None:
                         on_frame(index, found)
                     write_detections(folder, found, settings=settings)
-                except SymfruitError as exc:
-                    report.failed[name] = str(exc)
-                except OSError as exc:
-                    if exc.errno in _NO_SPACE:
-                        report.failed[name] = f"cannot write {folder}: {exc.strerror}"
-                        report.stopped = f"stopped at frame {name}: the output is full ({exc.strerror})"
-                        break
-                    report.failed[name] = f"{type(exc).__name__}: {exc}"
-                except Exception as exc:  # the per-frame error boundary: record anything and go on
-                    report.failed[name] = f"{type(exc).__name__}: {exc}"
-                else:
+                    return found
+
+                done, found, report.stopped = _guarded(one_frame, item=name, failed=report.failed, target=folder,
+                                                       at=f"frame {name}")  # fmt: skip
+                if report.stopped:
+                    break
+                if done and found is not None:
                     report.done.append(name)
                     report.fruits += sum(d.result is not None for d in found.detections)
                     report.failed_fruits += sum(d.result is None for d in found.detections)
@@ -237,67 +234,52 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
     return depth
 
 
-def mask_source(
-    masks: str | Path | Masker, *, settings: Settings | None = None, names: Sequence[Path] = ()
+def _labeller(
+    masks: str | Path | MaskSource | Masker, settings: Settings | None, images: Sequence[Path]
 ) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any], np.ndarray], str]:
-    """The labeller :func:`segment_images` runs on each image, and a word on what it is.
-
-    ``masks`` is ``"color"`` (the built-in segmenter), ``"maskrcnn:CHECKPOINT"`` (a torchvision Mask R-CNN,
-    extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation export, extra ``onnx``), a COCO JSON
-    (each image's annotations, by file name), a folder of label PNGs (``<stem>.png``), or a callable
-    ``(color, depth=, camera=) -> labels``. Checkpoints and files are checked here, before any image.
-    """
-    from .segment.colour import learned_masks, segment
-
-    settings = settings or Settings()
-    if callable(masks):
+    """What :func:`segment_images` runs on each image ``(path, color, depth, camera) -> labels``, and a word on
+    it: a callable ``(color, depth=, camera=) -> labels`` as it is, anything else through
+    :func:`symfruit.segment.mask_source` (checked here, before any image)."""
+    if callable(masks) and not isinstance(masks, MaskSource):
         fn = masks
         return (lambda path, color, depth, camera: np.asarray(fn(color, depth=depth, camera=camera))), getattr(
             masks, "__name__", "callable"
         )
-    text = str(masks)
-    if text == "color":
-        return (lambda path, color, depth, camera: segment(color, depth, camera, settings.segment)), "colour segmenter"
-    learned = learned_masks(text)  # a missing extra or a bad model fails once, before the images
-    if learned is not None:
-        return (lambda path, color, depth, camera: learned(color)), text
-    source = Path(text)
-    if source.suffix.lower() == ".json":
-        from .io.masks import read_coco
+    source = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings, images=images)
+    return (lambda path, color, depth, camera: source(color, depth, camera, name=path.name)[0]), source.name
 
-        coco = read_coco(source)
 
-        def from_coco(path: Path, color: np.ndarray, depth: Any, camera: Any) -> np.ndarray:
-            masks_ = coco.instances(path.name, color.shape[:2], category=None)
-            labels = np.zeros(color.shape[:2], np.int32)
-            for k, m in enumerate(masks_, 1):
-                labels[m] = k
-            return labels
+T = TypeVar("T")
 
-        return from_coco, str(source)
-    if source.is_dir():
-        from .io.images import read_labels
 
-        def from_folder(path: Path, color: np.ndarray, depth: Any, camera: Any) -> np.ndarray:
-            label_path = source / f"{path.stem}.png"
-            if not label_path.is_file():
-                raise FileFormatError(f"{label_path}: no label image for {path.name}")
-            return read_labels(label_path)
+def _guarded(
+    work: Callable[[], T], *, item: str, failed: dict[str, str], target: Path, at: str
+) -> tuple[bool, T | None, str]:
+    """One item of a batch inside its error boundary: ``(done, result, stop)``.
 
-        return from_folder, str(source)
-    if source.suffix.lower() == ".png" and source.is_file() and len(names) == 1:
-        from .io.images import read_labels
-
-        return (lambda path, color, depth, camera: read_labels(source)), str(source)
-    raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
-                     "a folder of label PNGs, or one label .png for one image")  # fmt: skip
+    A :class:`~symfruit.errors.SymfruitError`, an ``OSError`` or any other exception is recorded in
+    ``failed[item]`` and the batch goes on; a full disk (``ENOSPC``, ``EFBIG``, ``EDQUOT``) while writing
+    ``target`` also returns ``stop``, the reason to stop the batch (``at``: where, e.g. ``frame 0007``).
+    """
+    try:
+        return True, work(), ""
+    except SymfruitError as exc:
+        failed[item] = str(exc)
+    except OSError as exc:
+        if exc.errno in _NO_SPACE:
+            failed[item] = f"cannot write {target}: {exc.strerror}"
+            return False, None, f"stopped at {at}: the output is full ({exc.strerror})"
+        failed[item] = f"{type(exc).__name__}: {exc}"
+    except Exception as exc:  # the per-item error boundary: record anything and go on
+        failed[item] = f"{type(exc).__name__}: {exc}"
+    return False, None, ""
 
 
 def segment_images(
     paths: Sequence[str | Path],
     *,
     output: str | Path,
-    masks: str | Path | Masker = "color",
+    masks: str | Path | MaskSource | Masker = "color",
     depth: str | Path | None = None,
     camera: Any = None,
     depth_scale: float = 0.001,
@@ -312,7 +294,8 @@ def segment_images(
     ----------
     paths : image files or folders
     output : folder
-    masks : see :func:`mask_source`
+    masks : a spec of :func:`symfruit.segment.mask_source`, a :class:`~symfruit.segment.MaskSource`, or a callable
+        ``(color, depth=, camera=) -> labels``
     depth : file or folder, optional
         Depth for the images (a folder: ``<stem>.png`` / ``<stem>.npy`` / ``<stem>_depth.*``); 16-bit PNG
         depth is ``depth_scale`` metres per unit, ``.npy`` is metres. Images without depth are segmented
@@ -342,7 +325,7 @@ def segment_images(
             raise FileFormatError(f"{depth_path}: no such depth image or folder")
     if not (np.isfinite(depth_scale) and 0 < depth_scale <= 1.0):
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
-    labeller, source = mask_source(masks, settings=settings, names=images)
+    labeller, source = _labeller(masks, settings, images)
     output = Path(output)
     try:
         output.mkdir(parents=True, exist_ok=True)
@@ -357,7 +340,8 @@ def segment_images(
                 stems[stem] += 1
                 stem = f"{stem}-{stems[stem]}"
             stems.setdefault(stem, 1)
-            try:
+
+            def one_image(path: Path = path, stem: str = stem) -> SegmentedImage:
                 color = read_color(path)
                 dfile = _depth_file(path, depth_path, len(images))
                 z = _read_depth(dfile, depth_scale, color.shape[:2]) if dfile is not None else None
@@ -369,20 +353,15 @@ def segment_images(
                                      f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
                 written = (write_labels(output / f"{stem}.png", labels),
                            write_label_overlay(output / f"{stem}_overlay.png", color, labels))  # fmt: skip
-            except SymfruitError as exc:
-                report.failed[str(path)] = str(exc)
-            except OSError as exc:
-                if exc.errno in _NO_SPACE:
-                    report.failed[str(path)] = f"cannot write {output}: {exc.strerror}"
-                    report.stopped = f"stopped at {path.name}: the output is full ({exc.strerror})"
-                    break
-                report.failed[str(path)] = f"{type(exc).__name__}: {exc}"
-            except Exception as exc:  # the per-image error boundary: record anything and go on
-                report.failed[str(path)] = f"{type(exc).__name__}: {exc}"
-            else:
                 used = z is not None and bool((z > 0).any())
-                fruit = len(np.unique(labels[labels > 0]))
-                report.done.append(SegmentedImage(path, fruit, used, ms, written))
+                return SegmentedImage(path, len(np.unique(labels[labels > 0])), used, ms, written)
+
+            done, image, report.stopped = _guarded(one_image, item=str(path), failed=report.failed, target=output,
+                                                   at=path.name)  # fmt: skip
+            if report.stopped:
+                break
+            if done and image is not None:
+                report.done.append(image)
             bar.update()
     record = {
         "mask_source": source,

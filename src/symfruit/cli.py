@@ -387,16 +387,18 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
 
 
 def _evaluate_masks(args: argparse.Namespace) -> int:
-    from .batch import mask_source
     from .errors import InputError
     from .evaluate.masks import evaluate_masks, evaluate_scene_masks
     from .writers import new_results_folder, write_mask_report
 
     settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
-    labeller, source = mask_source(args.masks or "color", settings=settings)
+    from .segment import mask_source
+
+    labeller = mask_source(args.masks or "color", settings=settings, images=())
+    source = labeller.name
 
     def run(color: np.ndarray, depth: np.ndarray | None = None, camera: object = None) -> np.ndarray:
-        return labeller(Path(""), color, depth, camera)
+        return labeller(color, depth, camera)[0]
 
     if args.images is not None or args.truth is not None:
         if args.images is None or args.truth is None:

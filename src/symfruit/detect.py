@@ -23,7 +23,7 @@ from .extract import Extraction, extract
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .occlusion import fruit_occlusion
-from .segment.colour import learned_masks, segment
+from .segment import MaskSource, mask_source
 from .settings import Settings
 
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
@@ -63,29 +63,22 @@ Segmenter = Callable[[Frame, Settings], np.ndarray]
 
 
 def frame_masks(
-    frame: Frame, masks: str | Path | Segmenter = "auto", settings: Settings | None = None
+    frame: Frame, masks: str | Path | MaskSource | Segmenter = "auto", settings: Settings | None = None
 ) -> tuple[np.ndarray, str]:
     """Instance labels for a frame, and a word on where they came from.
 
-    ``masks`` is ``"auto"`` (the frame's own masks file if it has one, else the colour segmenter),
-    ``"color"`` (the built-in segmenter), a label PNG or COCO JSON path, ``"maskrcnn:CHECKPOINT"``
-    (a torchvision Mask R-CNN, optional extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation
-    export, optional extra ``onnx``), or a callable ``(frame, settings) -> labels``.
+    ``masks`` is a spec of :func:`symfruit.segment.mask_source` (``"auto"``: the frame's own masks file if it
+    has one, else the colour segmenter; ``"color"``; a label PNG or COCO JSON path; ``"maskrcnn:CHECKPOINT"``;
+    ``"onnx:MODEL"``), a :class:`~symfruit.segment.MaskSource` made from one, or a callable
+    ``(frame, settings) -> labels``.
     """
     settings = settings or Settings()
     shape = frame.depth.shape
-    if callable(masks):
+    if callable(masks) and not isinstance(masks, MaskSource):
         labels, source = np.asarray(masks(frame, settings)), getattr(masks, "__name__", "callable")
-    elif masks == "auto" and frame.masks is not None:
-        labels, source = frame.masks, "frame masks file"
-    elif masks in ("auto", "color"):
-        labels, source = segment(frame.color, frame.depth, frame.camera, settings.segment), "colour segmenter"
-    elif (learned := learned_masks(str(masks))) is not None:
-        labels, source = learned(frame.color), str(masks)
     else:
-        from .io.masks import read_masks
-
-        labels, source = read_masks(masks, shape), str(masks)
+        source_of = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings)
+        labels, source = source_of(frame.color, frame.depth, frame.camera, name=frame.name, own=frame.masks)
     if labels.shape != shape:
         raise InputError(f"frame {frame.name}: masks are {labels.shape[::-1]}, the image {shape[::-1]}")
     return labels.astype(np.int32, copy=False), source
@@ -94,7 +87,7 @@ def frame_masks(
 def detect(
     frame: Frame,
     *,
-    masks: str | Path | Segmenter = "auto",
+    masks: str | Path | MaskSource | Segmenter = "auto",
     method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
 ) -> FrameDetections:

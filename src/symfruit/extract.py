@@ -10,7 +10,7 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
-from .settings import Section, SettingError, register_section, setting
+from .settings import Section, SettingError, setting
 
 __all__ = ["ExtractSettings", "Extraction", "cluster", "extract"]
 
@@ -47,9 +47,6 @@ class ExtractSettings(Section):
     def check(self) -> None:
         if self.min_depth >= self.max_depth:
             raise SettingError("min_depth", "must be smaller than max_depth")
-
-
-register_section("extract", ExtractSettings)
 
 
 @dataclass(frozen=True)

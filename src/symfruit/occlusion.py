@@ -13,7 +13,7 @@ import numpy as np
 
 from .core.camera import Camera
 from .core.occlusion import Occlusion, occlusion
-from .settings import Section, register_section, setting
+from .settings import Section, setting
 
 __all__ = ["OcclusionSettings", "fruit_occlusion"]
 
@@ -38,9 +38,6 @@ class OcclusionSettings(Section):
     enabled: bool = setting(True)
     tolerance: float = setting(0.005, ge=-1.0, le=1.0)
     reach_px: int = setting(3, ge=0, le=50)
-
-
-register_section("occlusion", OcclusionSettings)
 
 
 def fruit_occlusion(

@@ -1,4 +1,4 @@
-"""Settings: one frozen dataclass section per stage, owned and registered by that stage, grouped under
+"""Settings: one frozen dataclass section per stage, declared by that stage, grouped under
 :class:`Settings`, and resolved in one place (:func:`resolve_settings`): defaults, then a fruit profile,
 then a settings file, then overrides.
 
@@ -8,7 +8,9 @@ A stage declares its section beside its code::
     class SphereSettings(Section):
         refine: bool = setting(True, doc="...")
 
-    register_section("sphere", SphereSettings)      # methods do it through methods.register(..., settings=)
+and the built-in sections are listed here, in :data:`BUILT_IN_SECTIONS` (nothing registers by being
+imported). A section from outside the package (a method of one's own, :func:`symfruit.methods.register`
+with ``settings=``) is added with :func:`register_section` and follows the built-in ones.
 
 Values read from a mapping (a file, a profile, overrides) are validated: unknown keys, wrong types and
 non-finite numbers raise :class:`~symfruit.errors.ConfigError` with the dotted path of the key, e.g.
@@ -51,7 +53,33 @@ T = TypeVar("T")
 #: Largest settings file read (bytes): settings are a few kB; anything larger is not a settings file.
 MAX_SETTINGS_BYTES = 1 << 20
 
-_SECTIONS: dict[str, type] = {}
+#: The built-in sections in the order ``Settings``, settings files and ``symfruit settings`` list them:
+#: name, the module declaring the section and its class. The stages import this module, so their classes
+#: are imported when the sections are first needed, not here.
+BUILT_IN_SECTIONS: tuple[tuple[str, str, str], ...] = (
+    ("extract", "symfruit.extract", "ExtractSettings"),
+    ("occlusion", "symfruit.occlusion", "OcclusionSettings"),
+    ("segment", "symfruit.segment.colour", "SegmentSettings"),
+    ("paper", "symfruit.methods.paper", "PaperSettings"),
+    ("evidence", "symfruit.methods.evidence", "EvidenceSettings"),
+    ("fused", "symfruit.methods.fused", "FusedSettings"),
+    ("sphere", "symfruit.methods.sphere", "SphereSettings"),
+    ("superellipsoid", "symfruit.methods.superellipsoid", "SuperellipsoidSettings"),
+    ("input", "symfruit.methods.complete", "InputSettings"),
+)
+
+_BUILT_IN: dict[str, type] = {}  # BUILT_IN_SECTIONS' classes, once imported
+_SECTIONS: dict[str, type] = {}  # sections registered with register_section, in registration order
+
+
+def _sections() -> dict[str, type]:
+    """Every section by name: the built-in ones, then the registered ones."""
+    if not _BUILT_IN:
+        import importlib
+
+        _BUILT_IN.update({name: getattr(importlib.import_module(module), cls)
+                          for name, module, cls in BUILT_IN_SECTIONS})  # fmt: skip
+    return {**_BUILT_IN, **{name: cls for name, cls in _SECTIONS.items() if name not in _BUILT_IN}}
 
 
 class SettingError(ConfigError):
@@ -96,15 +124,20 @@ def register_section(name: str, cls: type[T]) -> type[T]:
     """Make ``cls`` (a frozen dataclass whose every field has a default) the settings section ``name``."""
     if not (dataclasses.is_dataclass(cls) and isinstance(cls, type)):
         raise TypeError(f"settings section {name!r} must be a dataclass type, got {cls!r}")
+    built_in = {entry[0]: entry[1:] for entry in BUILT_IN_SECTIONS}
+    if name in built_in and built_in[name] != (cls.__module__, cls.__qualname__):
+        raise ValueError(f"settings section {name!r} is the built-in {built_in[name][1]}")
     if name in _SECTIONS and _SECTIONS[name] is not cls:
         raise ValueError(f"settings section {name!r} is already registered by {_SECTIONS[name].__qualname__}")
-    _SECTIONS[name] = cls
+    if name not in built_in:
+        _SECTIONS[name] = cls
     return cls
 
 
 def section_types() -> dict[str, type]:
-    """The registered sections, by name, in registration order."""
-    return dict(_SECTIONS)
+    """Every section, by name: the built-in ones (:data:`BUILT_IN_SECTIONS`), then the registered ones in
+    registration order."""
+    return _sections()
 
 
 class Settings:
@@ -124,11 +157,12 @@ class Settings:
     _sections: dict[str, Any]
 
     def __init__(self, **sections: Any) -> None:
-        unknown = sorted(set(sections) - set(_SECTIONS))
+        known = _sections()
+        unknown = sorted(set(sections) - set(known))
         if unknown:
-            raise ConfigError(f"unknown settings section {unknown[0]!r}; known: {', '.join(_SECTIONS)}")
+            raise ConfigError(f"unknown settings section {unknown[0]!r}; known: {', '.join(known)}")
         values = {}
-        for name, cls in _SECTIONS.items():
+        for name, cls in known.items():
             value = sections.get(name)
             if value is None:
                 value = cls()
@@ -260,10 +294,11 @@ def from_dict(data: Any) -> Settings:
     bad = [k for k in data if not isinstance(k, str)]
     if bad:
         raise ConfigError(f"settings section names must be text, got {bad[0]!r}")
-    unknown = sorted(set(data) - set(_SECTIONS))
+    known = _sections()
+    unknown = sorted(set(data) - set(known))
     if unknown:
-        raise ConfigError(f"unknown setting {unknown[0]}; known sections: {', '.join(_SECTIONS)}")
-    return Settings(**{name: _build(_SECTIONS[name], value, name) if isinstance(value, Mapping) else
+        raise ConfigError(f"unknown setting {unknown[0]}; known sections: {', '.join(known)}")
+    return Settings(**{name: _build(known[name], value, name) if isinstance(value, Mapping) else
                        _not_a_mapping(name, value) for name, value in data.items()})  # fmt: skip
 
 

@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from symfruit import DEFAULT_CAMERA
 from symfruit.core.agreement import observe
 from symfruit.core.candidates import REACH, candidates, constrain_box
+from symfruit.core.planes import PlaneGrid
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -50,13 +51,13 @@ def test_candidates_of_a_noisy_ball():
     by = {c.name: c for c in cands}
     assert list(by) == ["sphere", "ellipsoid", "cone", "revolution", "raw"]
     assert all(c.lo[2] == front for c in cands)
-    assert by["raw"].evidence is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
+    assert by["raw"].agreement is None and by["raw"].hi[2] == pytest.approx(visible[:, 2].max())
     s = by["sphere"]
-    assert s.evidence.inside + s.evidence.outside < 0.1 and s.evidence.depth < 0.003
+    assert s.agreement.inside + s.agreement.outside < 0.1 and s.agreement.depth < 0.003
     np.testing.assert_allclose(s.centre, [0.01, 0.0, 0.4], atol=0.002)
     assert s.hi[2] == pytest.approx(0.435, abs=0.003)
     with_mirror = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front,
-                             mirror={"translations": 8, "translation_step": 0.1})  # fmt: skip
+                             mirror={"grid": PlaneGrid(translations=8, translation_step=0.1)})  # fmt: skip
     assert [c.name for c in with_mirror] == ["sphere", "ellipsoid", "cone", "revolution", "mirror", "raw"]
     cone = by["cone"]  # tangent to the silhouette's cone: its box is the ball's, back face included
     np.testing.assert_allclose(cone.centre, [0.01, 0.0, 0.4], atol=0.001)

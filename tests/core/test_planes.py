@@ -4,7 +4,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from symfruit.core.planes import hypothesis_planes, mirror
+from symfruit.core.planes import PlaneGrid, hypothesis_planes, mirror
 
 coords = arrays(np.float64, (12, 3), elements=st.floats(-1.0, 1.0))
 unit = arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)).filter(lambda v: np.linalg.norm(v) > 0.1)
@@ -64,15 +64,15 @@ def test_default_grid_is_the_papers(sphere_view):
 
 def test_rotations_are_about_x_and_y_not_z(sphere_view):
     # Eq. 3 of the paper prints a rotation about z, which would leave every normal at +z.
-    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=3, rotations_y=1, rotation_x_step=10)
+    planes = hypothesis_planes(sphere_view, PlaneGrid(translations=1, rotations_x=3, rotations_y=1, rotation_x_step=10))
     assert np.allclose(planes.normals[0], [0.0, np.sin(np.radians(10)), np.cos(np.radians(10))])
-    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=1, rotations_y=3, rotation_y_step=10)
+    planes = hypothesis_planes(sphere_view, PlaneGrid(translations=1, rotations_x=1, rotations_y=3, rotation_y_step=10))
     assert np.allclose(planes.normals[2], [np.sin(np.radians(10)), 0.0, np.cos(np.radians(10))])
 
 
 @pytest.mark.parametrize("m, j, k", [(1, 1, 1), (2, 5, 7), (10, 22, 6)])
 def test_grid_sizes(sphere_view, m, j, k):
-    assert len(hypothesis_planes(sphere_view, translations=m, rotations_x=j, rotations_y=k)) == m * j * k
+    assert len(hypothesis_planes(sphere_view, PlaneGrid(translations=m, rotations_x=j, rotations_y=k))) == m * j * k
 
 
 def test_mirror_accepts_lists_and_integers():
@@ -82,7 +82,7 @@ def test_mirror_accepts_lists_and_integers():
 
 
 def test_planes_index_to_copies_and_serialise(sphere_view):
-    planes = hypothesis_planes(sphere_view, translations=2, rotations_x=1, rotations_y=1)
+    planes = hypothesis_planes(sphere_view, PlaneGrid(translations=2, rotations_x=1, rotations_y=1))
     first = planes[1]
     assert np.array_equal(first.point, planes.points[1]) and np.array_equal(first.normal, planes.normals[1])
     first.point[0] = 99.0
@@ -92,9 +92,13 @@ def test_planes_index_to_copies_and_serialise(sphere_view):
 
 def test_first_translation_and_negative_steps(sphere_view):
     len_depth = np.ptp(sphere_view[:, 2])
-    planes = hypothesis_planes(sphere_view, translations=2, translation_first=-1.0, rotations_x=1, rotations_y=1)
+    planes = hypothesis_planes(
+        sphere_view, PlaneGrid(translations=2, translation_first=-1.0, rotations_x=1, rotations_y=1)
+    )
     assert np.allclose(planes.offsets, [-0.2 * len_depth, 0.0])
-    planes = hypothesis_planes(sphere_view, translations=1, rotations_x=3, rotation_x_step=-10.0, rotations_y=1)
+    planes = hypothesis_planes(
+        sphere_view, PlaneGrid(translations=1, rotations_x=3, rotation_x_step=-10.0, rotations_y=1)
+    )
     assert np.allclose(planes.angles_x, [10.0, 0.0, -10.0])
 
 

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from symfruit import Box, InputError, box_iou
-from symfruit.core.planes import hypothesis_planes, mirror
+from symfruit.core.planes import PlaneGrid, hypothesis_planes, mirror
 from symfruit.core.raster import rasterise
 from symfruit.core.rating import Table1
 from symfruit.core.symmetry import complete_by_symmetry
@@ -16,7 +16,7 @@ ON_AXIS = np.array([0.0, 0.0, 0.35])
 #: The front half of a 20 mm sphere on the optical axis: its centroid is 10 mm in front of the centre
 #: and its depth extent is 20 mm, so a translation of half the depth extent puts the plane through the centre.
 HEMISPHERE = front_half(sphere_cloud(centre=ON_AXIS, n=2400), ON_AXIS)
-GRID = {"translations": 2, "translation_step": 0.5, "rotations_x": 3, "rotations_y": 3}
+GRID = {"grid": PlaneGrid(translations=2, translation_step=0.5, rotations_x=3, rotations_y=3)}
 
 
 def test_the_plane_through_the_centre_wins_and_completes_the_sphere(camera):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from symfruit import DEFAULT_CAMERA, ConfigError, box_iou, centre_deviation, complete
-from symfruit.core.agreement import Evidence
+from symfruit.core.agreement import Agreement
 from symfruit.core.candidates import Candidate
 from symfruit.evaluate.protocols import Spec, build
 from symfruit.methods.evidence import EvidenceSettings, _weighted_median, clean_share, combine
@@ -104,7 +104,7 @@ def test_clean_share_ramps_between_depth_views_and_clean_scans():
 
 def test_premises_the_view_contradicts_cost_energy():
     box = (np.zeros(3), np.ones(3) * 0.01)
-    good = Evidence(0.001, 0.0, 0.0)
+    good = Agreement(0.001, 0.0, 0.0)
     cands = [Candidate("cone", *box, good, np.zeros(3)), Candidate("ellipsoid", *box, good, np.zeros(3)),
              Candidate("raw", *box, None, np.zeros(3))]  # fmt: skip
     s = EvidenceSettings()

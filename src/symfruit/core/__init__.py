@@ -4,17 +4,19 @@ Imports numpy and scipy only; knows no settings objects, files or command line. 
 :mod:`.camera` (pinhole model), :mod:`.points` (input checks), :mod:`.box`, :mod:`.planes` (hypotheses,
 mirroring), :mod:`.raster` (what the camera saw), :mod:`.rating` (Algorithm 1), :mod:`.symmetry` (the
 paper's completion), :mod:`.fits` (sphere, ellipsoids, solids of revolution), :mod:`.superellipsoid`
-(Marangoz et al.'s fit), :mod:`.front` (the front surface's depth), :mod:`.evidence` (how well a closed
-shape explains the view), :mod:`.candidates` (the default method's candidate completions), :mod:`.view`
-(where a frame's camera could not have seen a fruit: its occlusion information).
+(Marangoz et al.'s fit), :mod:`.front` (the front surface's depth), :mod:`.agreement` (how well a closed
+shape explains the view), :mod:`.candidates` (the default method's candidate completions), :mod:`.occlusion`
+(where a frame's camera could not have seen a fruit: its occlusion information), :mod:`.frame` (one RGB-D
+frame). A module's main function (``candidates.candidates``, ``occlusion.occlusion``) is not re-exported
+here, so that ``symfruit.core.candidates`` stays the module.
 """
 
 from __future__ import annotations
 
-from .agreement import Evidence, Observation, explain, march, observe
+from .agreement import Agreement, Observation, explain, march, observe
 from .box import Box, box_iou, centre_deviation
 from .camera import DEFAULT_CAMERA, Camera
-from .candidates import Candidate, candidates, constrain_box
+from .candidates import Candidate, constrain_box
 from .fits import (
     Revolution,
     ellipsoid_half_extents,
@@ -28,8 +30,8 @@ from .fits import (
     surface_noise,
 )
 from .front import apex_depth
-from .occlusion import Occlusion, occlusion
-from .planes import Plane, Planes, hypothesis_planes, mirror
+from .occlusion import Occlusion
+from .planes import Plane, PlaneGrid, Planes, hypothesis_planes, mirror
 from .points import as_points, check_cloud
 from .raster import Silhouette, View, rasterise, silhouette, silhouette_coverage
 from .rating import LOCATIONS, Rating, Table1, rate_planes, rate_points
@@ -39,13 +41,14 @@ from .symmetry import SymmetryCompletion, complete_by_symmetry
 __all__ = [
     "DEFAULT_CAMERA",
     "LOCATIONS",
+    "Agreement",
     "Box",
     "Camera",
     "Candidate",
-    "Evidence",
     "Observation",
     "Occlusion",
     "Plane",
+    "PlaneGrid",
     "Planes",
     "Rating",
     "Revolution",
@@ -57,7 +60,6 @@ __all__ = [
     "apex_depth",
     "as_points",
     "box_iou",
-    "candidates",
     "centre_deviation",
     "check_cloud",
     "complete_by_symmetry",
@@ -75,7 +77,6 @@ __all__ = [
     "mirror",
     "missing_surface",
     "observe",
-    "occlusion",
     "rasterise",
     "rate_planes",
     "rate_points",

@@ -32,7 +32,7 @@ from .occlusion import Occlusion
 from .points import as_points
 from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
 
-__all__ = ["Evidence", "Inside", "Observation", "explain", "march", "observe"]
+__all__ = ["Agreement", "Inside", "Observation", "explain", "march", "observe"]
 
 #: ``inside(x)`` for points ``x`` (..., 3), metres: positive inside the shape (a signed distance, or any
 #: function with the same sign), shape ``x.shape[:-1]``.
@@ -90,7 +90,7 @@ class Observation:
 
 
 @dataclass(frozen=True)
-class Evidence:
+class Agreement:
     """How a candidate explains the view (smaller is better for all three).
 
     Attributes
@@ -104,10 +104,6 @@ class Evidence:
     depth: float
     inside: float
     outside: float
-
-
-def _rays(u: np.ndarray, v: np.ndarray, camera: Camera) -> np.ndarray:
-    return np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones_like(u, dtype=float)], -1)
 
 
 def observe(
@@ -171,7 +167,7 @@ def observe(
     def spread(rc: np.ndarray) -> np.ndarray:
         if len(rc) > n_band:
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        return _rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0, camera)
+        return camera.rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
@@ -194,7 +190,7 @@ def observe(
             weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
         if outside and occlusion is not None and len(rc):
             weight = weight * ~occlusion.at(uv[:, 0], uv[:, 1])  # a hidden pixel: no evidence either
-        return _rays(uv[:, 0], uv[:, 1], camera), weight
+        return camera.rays(uv[:, 0], uv[:, 1]), weight
 
     ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
     outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
@@ -325,7 +321,7 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
 
 def explain(
     inside: Inside, box: tuple[np.ndarray, np.ndarray], obs: Observation, *, steps: int = 24, trim: float = 0.8
-) -> Evidence:
+) -> Agreement:
     """Measure one closed candidate against the observation.
 
     Parameters
@@ -358,4 +354,4 @@ def explain(
         w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
         outs.append(float((hits[k : k + len(r)] * w).sum() / w.sum()) if w.sum() > 0 else 0.0)
         k += len(r)
-    return Evidence(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))
+    return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

@@ -109,6 +109,26 @@ class Camera:
         v = self.fy * points[..., 1] * inv_z + self.cy
         return np.stack([u, v], axis=-1)
 
+    def rays(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Viewing rays through pixels, scaled to ``z = 1``.
+
+        Parameters
+        ----------
+        u, v : (...) float or int, pixels
+
+        Returns
+        -------
+        (..., 3) float, ``((u - cx) / fx, (v - cy) / fy, 1)``
+
+        Examples
+        --------
+        >>> Camera(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480).rays(820.0, 240.0)
+        array([1., 0., 1.])
+        """
+        x = (np.asarray(u) - self.cx) / self.fx
+        y = (np.asarray(v) - self.cy) / self.fy
+        return np.stack([x, y, np.ones_like(x, dtype=np.float64)], axis=-1)
+
     def deproject(self, uv: np.ndarray, depth: np.ndarray) -> np.ndarray:
         """Lift pixel coordinates with depth to camera-frame points.
 

@@ -27,14 +27,14 @@ Closed candidates (sphere, ellipsoid, solid of revolution) are measured against 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Iterator, Mapping
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
 
 from ..errors import InputError
-from .agreement import Evidence, Inside, Observation, explain
+from .agreement import Agreement, Inside, Observation, explain
 from .camera import Camera
 from .fits import (
     ellipsoid_half_extents,
@@ -70,7 +70,7 @@ class Candidate:
     name : str
     lo, hi : (3,) float, metres
         Its box (see :func:`constrain_box`).
-    evidence : Evidence or None
+    agreement : Agreement or None
         How it explains the view (closed candidates only).
     centre : (3,) float, metres
         Its own centre estimate (the shape's centre; the box centre for mirror and raw).
@@ -82,7 +82,7 @@ class Candidate:
     name: str
     lo: np.ndarray
     hi: np.ndarray
-    evidence: Evidence | None
+    agreement: Agreement | None
     centre: np.ndarray
     back_std: float = float("nan")
 
@@ -218,87 +218,25 @@ def candidates(
         # With occlusion information: as far as the fruit can project (the seen region and what may hide it).
         u_lo, v_lo, u_hi, v_hi = (float(x) for x in obs.extent)
         cone, pull = ((u_lo, v_lo, u_hi, v_hi), camera), 1.0
+    fit = _Fitting(sample, obs, camera, front, extent, region, outline_profile, revolution_points,
+                   revolution_coarse)  # fmt: skip
     out: list[Candidate] = []
-
-    def closed(name: str, lo: np.ndarray, hi: np.ndarray, inside: Inside, centre: np.ndarray,
-               back_std: float = float("nan")) -> None:  # fmt: skip
-        lo, hi = np.asarray(lo, dtype=np.float64), np.asarray(hi, dtype=np.float64)
-        if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
-            return  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
-        if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible, lateral=obs.extent is None):
-            return
-        ev = explain(inside, (lo, hi), obs, steps=steps)
-        box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, pull=pull)
-        out.append(Candidate(name, *box, ev, np.asarray(centre, dtype=np.float64), back_std))
-
-    if "sphere" in shapes:
+    for name, (fitter, failures) in _FITTERS.items():
+        if name not in shapes or _explained(out, explained):
+            continue
         try:
-            c, r = fit_sphere(sample)
-            closed("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
-        except InputError:
-            pass
-
-    axes: list[np.ndarray] = []
-    if "ellipsoid" in shapes:
-        try:
-            ce, shape = fit_ellipsoid(sample)
-            with np.errstate(invalid="ignore"):
-                half = ellipsoid_half_extents(shape)
-            axes.append(np.linalg.eigh(shape)[1].T)
-            closed("ellipsoid", ce - half, ce + half,
-                   lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce), ce)  # fmt: skip
-        except (InputError, np.linalg.LinAlgError):
-            pass
-
-    view_cone, view_axis, interior = obs.cone, obs.axis, obs.interior
-    if (
-        "cone" in shapes
-        and view_cone is not None
-        and view_axis is not None
-        and interior is not None
-        and len(interior) >= 8
-    ):
-        try:
-            fit = fit_cone_ellipsoid(interior, cone=view_cone, axis=view_axis, front=front, extent=extent)
-            cc, cs = fit.centre, fit.shape
-            back_std = fit.back_std
-            ch = np.sqrt(np.diag(cs))
-            inv = np.linalg.inv(cs)
-            axes.append(np.linalg.eigh(cs)[1].T)
-            closed(
-                "cone",
-                cc - ch,
-                cc + ch,
-                lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc),
-                cc,
-                back_std,
-            )
-        except (InputError, np.linalg.LinAlgError):
-            pass
-
-    done = (
-        explained is not None
-        and bool(out)
-        and out[-1].name == "cone"
-        and out[-1].evidence is not None
-        and (out[-1].evidence.inside + out[-1].evidence.outside <= explained)
-    )
-    if "revolution" in shapes and not done:
-        try:
-            rev = fit_revolution_slices(sample[:: max(1, len(sample) // revolution_points)],
-                                        extra_directions=np.vstack(axes) if axes else None,
-                                        coarse=revolution_coarse)  # fmt: skip
-            if region is not None and outline_profile != "off":
-                r_out = outline_radii(rev, region.mask, (region.u0, region.v0), camera, hidden=obs.hidden)
-                shaped = replace(rev, radii=np.where(np.isfinite(r_out) & np.isfinite(rev.radii), r_out, rev.radii))
-                if outline_profile == "replace":
-                    rev = shaped
-                else:
-                    olo, ohi = revolution_box(shaped)
-                    closed("outline", olo, ohi, lambda x: revolution_inside(shaped, x), 0.5 * (olo + ohi))
-            lo, hi = revolution_box(rev)
-            closed("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
-        except InputError:
+            for shape in fitter(fit):
+                lo, hi = np.asarray(shape.lo, dtype=np.float64), np.asarray(shape.hi, dtype=np.float64)
+                if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
+                    continue  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
+                if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible,
+                                                            lateral=obs.extent is None):  # fmt: skip
+                    continue
+                ev = explain(shape.inside, (lo, hi), obs, steps=steps)
+                box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, pull=pull)
+                out.append(Candidate(shape.name, *box, ev, np.asarray(shape.centre, dtype=np.float64),
+                                     shape.back_std))  # fmt: skip
+        except failures:
             pass
 
     if mirror is not None:
@@ -311,3 +249,98 @@ def candidates(
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
     out.append(Candidate("raw", lo, hi, None, 0.5 * (lo + hi)))
     return out
+
+
+def _explained(out: list[Candidate], explained: float | None) -> bool:
+    """Whether the ``cone`` ellipsoid, just fitted, gets at most ``explained`` of the band rays wrong (then no
+    other shape can explain the outline better)."""
+    if explained is None or not out or out[-1].name != "cone" or (ev := out[-1].agreement) is None:
+        return False
+    return ev.inside + ev.outside <= explained
+
+
+@dataclass
+class _Fitting:
+    """What every shape's fitter reads; ``axes`` collects the ellipsoids' axes for the solid of revolution's
+    axis search."""
+
+    sample: np.ndarray
+    obs: Observation
+    camera: Camera
+    front: float
+    extent: float
+    region: Silhouette | None
+    outline_profile: str
+    revolution_points: int
+    revolution_coarse: int
+    axes: list[np.ndarray] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class _Shape:
+    """A fitted closed shape: its own box (before :func:`constrain_box`), inside test and centre."""
+
+    name: str
+    lo: np.ndarray
+    hi: np.ndarray
+    inside: Inside
+    centre: np.ndarray
+    back_std: float = float("nan")
+
+
+def _sphere(fit: _Fitting) -> Iterator[_Shape]:
+    c, r = fit_sphere(fit.sample)
+    yield _Shape("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
+
+
+def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
+    ce, shape = fit_ellipsoid(fit.sample)
+    with np.errstate(invalid="ignore"):
+        half = ellipsoid_half_extents(shape)
+    fit.axes.append(np.linalg.eigh(shape)[1].T)
+    inside = lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce)  # noqa: E731
+    yield _Shape("ellipsoid", ce - half, ce + half, inside, ce)
+
+
+def _cone(fit: _Fitting) -> Iterator[_Shape]:
+    obs = fit.obs
+    if obs.cone is None or obs.axis is None or obs.interior is None or len(obs.interior) < 8:
+        return
+    found = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=fit.front, extent=fit.extent)
+    cc, cs = found.centre, found.shape
+    ch = np.sqrt(np.diag(cs))
+    inv = np.linalg.inv(cs)
+    fit.axes.append(np.linalg.eigh(cs)[1].T)
+    yield _Shape("cone", cc - ch, cc + ch, lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc), cc,
+                 found.back_std)  # fmt: skip
+
+
+def _revolution(fit: _Fitting) -> Iterator[_Shape]:
+    rev = fit_revolution_slices(fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)],
+                                extra_directions=np.vstack(fit.axes) if fit.axes else None,
+                                coarse=fit.revolution_coarse)  # fmt: skip
+    if fit.region is not None and fit.outline_profile != "off":
+        region = fit.region
+        r_out = outline_radii(rev, region.mask, (region.u0, region.v0), fit.camera, hidden=fit.obs.hidden)
+        shaped = replace(rev, radii=np.where(np.isfinite(r_out) & np.isfinite(rev.radii), r_out, rev.radii))
+        if fit.outline_profile == "replace":
+            rev = shaped
+        else:
+            olo, ohi = revolution_box(shaped)
+            yield _Shape("outline", olo, ohi, lambda x: revolution_inside(shaped, x), 0.5 * (olo + ohi))
+    lo, hi = revolution_box(rev)
+    yield _Shape("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
+
+
+_Fitter = Callable[[_Fitting], Iterator[_Shape]]
+_LINALG: tuple[type[Exception], ...] = (InputError, np.linalg.LinAlgError)
+
+#: Each closed shape's fitter, in :data:`SHAPES` order, and the errors that leave it out (a failed fit, or its
+#: measurement, drops that shape and what it had still to yield): a fitter yields the shapes it fits (the
+#: solid of revolution may yield the ``outline`` one first).
+_FITTERS: dict[str, tuple[_Fitter, tuple[type[Exception], ...]]] = {
+    "sphere": (_sphere, (InputError,)),
+    "ellipsoid": (_ellipsoid, _LINALG),
+    "cone": (_cone, _LINALG),
+    "revolution": (_revolution, (InputError,)),
+}

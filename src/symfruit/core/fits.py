@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points
+from .points import as_points, perpendicular_basis
 
 __all__ = [
     "ConeFit",
@@ -342,17 +342,6 @@ class Revolution:
     cost: float
 
 
-def _basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors completing each row of ``d`` (k, 3) to an orthonormal basis."""
-    x, y, z = d[:, 0], d[:, 1], d[:, 2]
-    use_x = np.abs(x) < 0.9  # cross with (1, 0, 0) where d is not near x, else with (0, 1, 0)
-    zero = np.zeros_like(x)
-    e1 = np.where(use_x[:, None], np.stack([zero, z, -y], axis=1), np.stack([-z, zero, x], axis=1))
-    e1 /= np.sqrt((e1 * e1).sum(axis=1))[:, None]
-    e2 = np.stack([y * e1[:, 2] - z * e1[:, 1], z * e1[:, 0] - x * e1[:, 2], x * e1[:, 1] - y * e1[:, 0]], axis=1)
-    return e1, e2
-
-
 def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     """Robust cost (k,) of every axis direction ``dirs`` (k, 3) for centred points ``q`` (n, 3).
 
@@ -364,7 +353,7 @@ def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     distances count (stems, calyx, flying pixels).
     """
     k, n = len(dirs), len(q)
-    e1, e2 = _basis(dirs)
+    e1, e2 = perpendicular_basis(dirs)
     t = dirs @ q.T  # (k, n): one row per direction, reductions along contiguous rows
     u = e1 @ q.T
     v = e2 @ q.T
@@ -398,7 +387,7 @@ def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
     z = 1.0 - (1.0 - np.cos(np.radians(spread_deg))) * i / n
     r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
     theta = np.pi * (1.0 + 5**0.5) * i
-    e1, e2 = _basis(direction[None, :])
+    e1, e2 = perpendicular_basis(direction[None, :])
     rot = np.stack([e1[0], e2[0], direction], axis=1)
     out = np.vstack([direction[None, :], np.c_[r * np.cos(theta), r * np.sin(theta), z] @ rot.T])
     return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
@@ -474,7 +463,7 @@ def fit_revolution_slices(
     for spread in refine_deg:
         cand = _cap(best, spread, refine_n)
         best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
-    e1, e2 = _basis(best[None, :])
+    e1, e2 = perpendicular_basis(best[None, :])
     t = q @ best
     w = np.c_[q @ e1[0], q @ e2[0]]
     edges = np.linspace(t.min(), t.max(), profile_bins + 1)
@@ -566,7 +555,7 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
         edge_px = (first - 0.5) * step  # halfway between the last pixel in and the first out
         bu = uc[:, 0] + sign * edge_px * du[:, 0]
         bv = uc[:, 1] + sign * edge_px * du[:, 1]
-        ray = np.stack([(bu - camera.cx) / camera.fx, (bv - camera.cy) / camera.fy, np.ones_like(bu)], axis=1)
+        ray = camera.rays(bu, bv)
         # The point c + s e nearest the ray lambda * ray: least squares in (s, lambda).
         a11, a12, a22 = (e * e).sum(1), -(e * ray).sum(1), (ray * ray).sum(1)
         b1, b2 = -(e * c).sum(1), (ray * c).sum(1)

@@ -10,7 +10,7 @@ import numpy as np
 from ..errors import InputError
 from .points import as_points
 
-__all__ = ["Plane", "Planes", "hypothesis_planes", "mirror", "mirror_xyz"]
+__all__ = ["PAPER_GRID", "Plane", "PlaneGrid", "Planes", "hypothesis_planes", "mirror", "mirror_xyz"]
 
 
 @dataclass(frozen=True)
@@ -57,21 +57,44 @@ class Planes:
         return Plane(point=self.points[index].copy(), normal=self.normals[index].copy())
 
 
+@dataclass(frozen=True)
+class PlaneGrid:
+    """The paper's grid of ``m * j * k`` symmetry-plane hypotheses (section 3.2; paper: 4, 0.2, 0, 11, 5, 3, 5).
+
+    Attributes
+    ----------
+    translations : int
+        ``m``, steps of the plane along +z.
+    translation_step : float
+        One step, as a share of the points' z extent.
+    translation_first : float
+        Offset of the first translation, in steps.
+    rotations_x, rotations_y : int
+        ``j`` and ``k``, angles about x and y centred on zero: ``(i - (j - 1) / 2) * step``.
+    rotation_x_step, rotation_y_step : float, degrees
+    """
+
+    translations: int = 4
+    translation_step: float = 0.2
+    translation_first: float = 0.0
+    rotations_x: int = 11
+    rotation_x_step: float = 5.0
+    rotations_y: int = 3
+    rotation_y_step: float = 5.0
+
+    def __len__(self) -> int:
+        return self.translations * self.rotations_x * self.rotations_y
+
+
+#: The paper's grid (4, 0.2, 0, 11, 5, 3, 5): 132 planes.
+PAPER_GRID = PlaneGrid()
+
+
 def _centred(count: int, step: float) -> np.ndarray:
     return (np.arange(count) - (count - 1) / 2.0) * step
 
 
-def hypothesis_planes(
-    points: np.ndarray,
-    *,
-    translations: int = 4,
-    translation_step: float = 0.2,
-    translation_first: float = 0.0,
-    rotations_x: int = 11,
-    rotation_x_step: float = 5.0,
-    rotations_y: int = 3,
-    rotation_y_step: float = 5.0,
-) -> Planes:
+def hypothesis_planes(points: np.ndarray, grid: PlaneGrid = PAPER_GRID) -> Planes:
     """Generate the paper's ``m * j * k`` symmetry-plane hypotheses.
 
     The initial plane (section 3.2) passes through the centroid of ``points`` with normal +z. Its point
@@ -84,6 +107,8 @@ def hypothesis_planes(
     ----------
     points : (n, 3) float, metres
         Visible points in the camera frame.
+    grid : PlaneGrid
+        ``m`` (``translations``), ``translation_step``, ``translation_first``, ``j``, ``k`` and the steps.
 
     Returns
     -------
@@ -94,10 +119,8 @@ def hypothesis_planes(
     centroid = points.mean(axis=0)
     z = points[:, 2]
     len_depth = float(z.max() - z.min())
-    steps, a, b, normals = _grid(
-        translations, translation_first, rotations_x, rotation_x_step, rotations_y, rotation_y_step
-    )
-    off = steps * (translation_step * len_depth)
+    steps, a, b, normals = _grid(grid)
+    off = steps * (grid.translation_step * len_depth)
     plane_points = np.empty((len(off), 3))
     plane_points[:] = centroid
     plane_points[:, 2] += off
@@ -105,13 +128,11 @@ def hypothesis_planes(
 
 
 @functools.lru_cache(maxsize=64)
-def _grid(
-    translations: int, first: float, rotations_x: int, step_x: float, rotations_y: int, step_y: float
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _grid(grid: PlaneGrid) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Translation steps, angles and normals of a hypothesis grid (cached: they depend on settings only)."""
-    steps = first + np.arange(translations, dtype=np.float64)
-    ax = _centred(rotations_x, step_x)
-    ay = _centred(rotations_y, step_y)
+    steps = grid.translation_first + np.arange(grid.translations, dtype=np.float64)
+    ax = _centred(grid.rotations_x, grid.rotation_x_step)
+    ay = _centred(grid.rotations_y, grid.rotation_y_step)
     off, a, b = (g.ravel() for g in np.meshgrid(steps, ax, ay, indexing="ij"))
     ar, br = np.radians(a), np.radians(b)
     normals = np.stack([np.cos(ar) * np.sin(br), -np.sin(ar), np.cos(ar) * np.cos(br)], axis=1)

@@ -13,7 +13,7 @@ import numpy as np
 
 from ..errors import InputError
 
-__all__ = ["as_points", "bounds", "check_cloud", "check_view", "mean_point", "subsample"]
+__all__ = ["as_points", "bounds", "check_cloud", "check_view", "mean_point", "perpendicular_basis", "subsample"]
 
 
 def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -170,3 +170,15 @@ def subsample(points: np.ndarray, n: int | None, *, seed: int = 0) -> np.ndarray
         return points
     keep = np.random.default_rng(seed).choice(len(points), size=n, replace=False)
     return points[np.sort(keep)]
+
+
+def perpendicular_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit vectors completing each unit row of ``d`` (k, 3) to an orthonormal basis: ``e1, e2`` (k, 3),
+    ``e2 = d x e1``."""
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]
+    use_x = np.abs(x) < 0.9  # cross with (1, 0, 0) where d is not near x, else with (0, 1, 0)
+    zero = np.zeros_like(x)
+    e1 = np.where(use_x[:, None], np.stack([zero, z, -y], axis=1), np.stack([-z, zero, x], axis=1))
+    e1 /= np.sqrt((e1 * e1).sum(axis=1))[:, None]
+    e2 = np.stack([y * e1[:, 2] - z * e1[:, 1], z * e1[:, 0] - x * e1[:, 2], x * e1[:, 1] - y * e1[:, 0]], axis=1)
+    return e1, e2

@@ -222,7 +222,7 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
     the ray through ``centre`` (pixels)."""
     k = camera.matrix
     cone = k.T @ conic @ k
-    axis = np.r_[(centre[0] - camera.cx) / camera.fx, (centre[1] - camera.cy) / camera.fy, 1.0]
+    axis = camera.rays(centre[0], centre[1])
     return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
 
 

@@ -161,7 +161,7 @@ class Rating:
 
 
 @dataclass
-class _Geometry:
+class _Mirrored:
     """Where every mirrored point of a block of planes falls (arrays ``(h, n)``, some of them scratch)."""
 
     z: np.ndarray  # mirrored depth, metres (clamped 1 mm in front of the camera)
@@ -244,10 +244,10 @@ def rate_planes(
     for a in range(0, len(normals), per_block):
         nb, tb = normals[a : a + per_block], t[a : a + per_block]
         if scoring == "continuous":
-            g = _geometry(rel, nb, tb, view, camera, centre, dtype, _WORK.get, with_xy=False)
+            g = _mirrored(rel, nb, tb, view, camera, centre, dtype, _WORK.get, with_xy=False)
             means.append(_continuous_mean(g, dist_ref, table, camera, dtype, len(rel)))
         else:
-            g = _geometry(rel, nb, tb, view, camera, centre, dtype, _fresh, with_xy=True)
+            g = _mirrored(rel, nb, tb, view, camera, centre, dtype, _fresh, with_xy=True)
             scores = _literal_scores(g, view, camera, centre, dist_ref, table, dtype)
             means.append(scores.mean(axis=1, dtype=np.float64))
     return np.concatenate(means)
@@ -274,13 +274,13 @@ def rate_points(
     centre, rel, normals, t, per_block = _prepare(source, plane_points, normals, centre)
     blocks = []
     for a in range(0, len(normals), per_block):
-        g = _geometry(rel, normals[a : a + per_block], t[a : a + per_block], view, camera, centre, dtype, _fresh,
+        g = _mirrored(rel, normals[a : a + per_block], t[a : a + per_block], view, camera, centre, dtype, _fresh,
                       with_xy=True)  # fmt: skip
         blocks.append(_per_point(g, view, camera, centre, dist_ref, table, scoring, dtype))
     return Rating(*(np.concatenate([getattr(b, f) for b in blocks]) for f in Rating.__dataclass_fields__))
 
 
-def _geometry(rel, normals, t, view, camera, centre, dtype, buffer: Buffers, *, with_xy: bool) -> _Geometry:
+def _mirrored(rel, normals, t, view, camera, centre, dtype, buffer: Buffers, *, with_xy: bool) -> _Mirrored:
     """Mirror and locate one block of planes; arrays come from ``buffer``."""
     h, n = len(normals), len(rel)
     shape = (h, n)
@@ -350,10 +350,10 @@ def _geometry(rel, normals, t, view, camera, centre, dtype, buffer: Buffers, *, 
     d2c += (px * px + py * py + pz * pz)[None, :]
     np.maximum(d2c, 0, out=d2c)
     np.sqrt(d2c, out=d2c)
-    return _Geometry(z=z, e=e, index=index, gap=gap, d2c=d2c, scratch1=uc, scratch2=vc, mx=mx, my=my)
+    return _Mirrored(z=z, e=e, index=index, gap=gap, d2c=d2c, scratch1=uc, scratch2=vc, mx=mx, my=my)
 
 
-def _continuous_penalty(g: _Geometry, dist_ref: float, table: Table1, camera: Camera, dtype: type,
+def _continuous_penalty(g: _Mirrored, dist_ref: float, table: Table1, camera: Camera, dtype: type,
                         behind: np.ndarray) -> np.ndarray:  # fmt: skip
     """``k3`` minus the continuous score of every point, computed in place (consumes ``g.d2c``, ``g.e``)."""
     f, r = dtype, float(dist_ref)
@@ -381,7 +381,7 @@ def _continuous_penalty(g: _Geometry, dist_ref: float, table: Table1, camera: Ca
     return tmp
 
 
-def _continuous_mean(g: _Geometry, dist_ref: float, table: Table1, camera: Camera, dtype: type, n: int) -> np.ndarray:
+def _continuous_mean(g: _Mirrored, dist_ref: float, table: Table1, camera: Camera, dtype: type, n: int) -> np.ndarray:
     tol = dtype(table.j1 * float(dist_ref))
     behind = _WORK.get("behind", g.gap.shape, np.bool_)
     np.greater(g.gap, tol, out=behind)
@@ -389,7 +389,7 @@ def _continuous_mean(g: _Geometry, dist_ref: float, table: Table1, camera: Camer
     return table.k3 - penalty.sum(axis=1, dtype=np.float64) / n
 
 
-def _literal_scores(g: _Geometry, view: View, camera: Camera, centre, dist_ref: float, table: Table1,
+def _literal_scores(g: _Mirrored, view: View, camera: Camera, centre, dist_ref: float, table: Table1,
                     dtype: type) -> np.ndarray:  # fmt: skip
     """Eqs. 6-10 as printed, per point."""
     f, r = dtype, float(dist_ref)
@@ -415,7 +415,7 @@ def _literal_scores(g: _Geometry, view: View, camera: Camera, centre, dist_ref: 
     return scores
 
 
-def _per_point(g: _Geometry, view: View, camera: Camera, centre, dist_ref: float, table: Table1, scoring: Scoring,
+def _per_point(g: _Mirrored, view: View, camera: Camera, centre, dist_ref: float, table: Table1, scoring: Scoring,
                dtype: type) -> Rating:  # fmt: skip
     f, r = dtype, float(dist_ref)
     tol, d0, d1 = f(table.j1 * r), f(table.j2 * r), f(table.j3 * r)

@@ -14,7 +14,7 @@ import numpy as np
 
 from .box import Box
 from .camera import Camera
-from .planes import Plane, Planes, hypothesis_planes, mirror
+from .planes import PAPER_GRID, Plane, PlaneGrid, Planes, hypothesis_planes, mirror
 from .points import as_points, subsample
 from .raster import View, rasterise
 from .rating import Scoring, Table1, rate_planes
@@ -73,13 +73,7 @@ def complete_by_symmetry(
     points: np.ndarray,
     camera: Camera,
     *,
-    translations: int = 4,
-    translation_step: float = 0.2,
-    translation_first: float = 0.0,
-    rotations_x: int = 11,
-    rotation_x_step: float = 5.0,
-    rotations_y: int = 3,
-    rotation_y_step: float = 5.0,
+    grid: PlaneGrid = PAPER_GRID,
     table: Table1 | None = None,
     scoring: Scoring = "continuous",
     centre: Literal["centroid", "box"] = "centroid",
@@ -95,8 +89,8 @@ def complete_by_symmetry(
     points : (n, 3) float, metres
         The visible points, camera optical frame.
     camera : Camera
-    translations, translation_step, translation_first, rotations_x, rotation_x_step, rotations_y, rotation_y_step
-        The hypothesis grid (:func:`~symfruit.core.planes.hypothesis_planes`; paper: 4, 0.2, 0, 11, 5, 3, 5).
+    grid : PlaneGrid
+        The hypothesis grid (:func:`~symfruit.core.planes.hypothesis_planes`; the paper's by default).
     table : Table1, optional
         Rating constants (default: the paper's Table 1).
     scoring : {"continuous", "literal"}
@@ -117,16 +111,7 @@ def complete_by_symmetry(
     SymmetryCompletion
     """
     points = as_points(points, min_count=3)
-    planes = hypothesis_planes(
-        points,
-        translations=translations,
-        translation_step=translation_step,
-        translation_first=translation_first,
-        rotations_x=rotations_x,
-        rotation_x_step=rotation_x_step,
-        rotations_y=rotations_y,
-        rotation_y_step=rotation_y_step,
-    )
+    planes = hypothesis_planes(points, grid)
     if view is None:
         view = rasterise(points, camera, fill_radius=fill_radius)
     lo, hi = points.min(axis=0), points.max(axis=0)

@@ -15,7 +15,7 @@ from ..core.occlusion import Occlusion
 from ..core.planes import Plane, Planes
 from ..core.points import check_cloud, check_view
 from ..errors import InputError
-from ..settings import Section, SettingError, Settings, from_dict, register_section, setting
+from ..settings import Section, SettingError, Settings, from_dict, setting
 from .registry import DEFAULT_METHOD, get
 
 __all__ = ["InputSettings", "Result", "complete"]
@@ -48,9 +48,6 @@ class InputSettings(Section):
             raise SettingError("max_points", "must be >= min_points")
         if self.min_extent >= self.max_extent:
             raise SettingError("min_extent", "must be smaller than max_extent")
-
-
-register_section("input", InputSettings)
 
 
 @dataclass(frozen=True)

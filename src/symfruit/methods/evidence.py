@@ -231,12 +231,12 @@ def clean_share(ratio: float, threshold: float) -> float:
 def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings,
             cone_source: str = "moments") -> Combined:  # fmt: skip
     """Weigh the candidates by their evidence and take the weighted median box (see the module)."""
-    closed = [c for c in cands if c.evidence is not None]
+    closed = [c for c in cands if c.agreement is not None]
     energies: dict[str, float] = {}
-    best_rms = max(min((c.evidence.depth for c in closed if c.evidence is not None), default=1.0), 1e-6)
+    best_rms = max(min((c.agreement.depth for c in closed if c.agreement is not None), default=1.0), 1e-6)
     cut = s.cut_energy * (1.0 - contour)
     for c in cands:
-        ev = c.evidence
+        ev = c.agreement
         if ev is None:
             energies[c.name] = s.mirror_energy if c.name == "mirror" else s.raw_energy + cut
             continue
@@ -257,7 +257,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     box = Box(box_faces[:3], box_faces[3:])
     centres = 0.5 * (faces[:, :3] + faces[:, 3:])
     spread = float((w * np.linalg.norm(centres - box.centre, axis=1)).sum())
-    wrong = min((c.evidence.inside + c.evidence.outside for c in closed if c.evidence is not None),
+    wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
     size = float(box.size.max())
     back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
@@ -321,7 +321,7 @@ def evidence(
         "candidates": {
             c.name: {
                 "min": c.lo.tolist(), "max": c.hi.tolist(),
-                "evidence": None if c.evidence is None else [c.evidence.depth, c.evidence.inside, c.evidence.outside],
+                "evidence": None if (a := c.agreement) is None else [a.depth, a.inside, a.outside],
                 "back_std": None if not np.isfinite(c.back_std) else c.back_std,
             }
             for c in cands

@@ -13,6 +13,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ..core.camera import Camera
+from ..core.planes import PlaneGrid
 from ..core.rating import Table1
 from ..core.symmetry import complete_by_symmetry
 from ..settings import Section, SettingError, setting
@@ -125,16 +126,19 @@ class PaperSettings(Section):
         return self.table.k5_value
 
     @property
+    def grid(self) -> PlaneGrid:
+        """The hypothesis grid these settings describe."""
+        return PlaneGrid(self.translations, self.translation_step, self.translation_first, self.rotations_x,
+                         self.rotation_x_step, self.rotations_y, self.rotation_y_step)  # fmt: skip
+
+    @property
     def n_hypotheses(self) -> int:
-        return self.translations * self.rotations_x * self.rotations_y
+        return len(self.grid)
 
     def options(self) -> dict[str, Any]:
         """Keyword arguments of :func:`~symfruit.core.symmetry.complete_by_symmetry`."""
         return {
-            "translations": self.translations, "translation_step": self.translation_step,
-            "translation_first": self.translation_first, "rotations_x": self.rotations_x,
-            "rotation_x_step": self.rotation_x_step, "rotations_y": self.rotations_y,
-            "rotation_y_step": self.rotation_y_step, "table": self.table, "scoring": self.scoring,
+            "grid": self.grid, "table": self.table, "scoring": self.scoring,
             "centre": self.centre, "fill_radius": self.fill_radius, "precision": self.precision,
             "rating_points": self.rating_points,
         }  # fmt: skip

@@ -32,6 +32,7 @@ from ..errors import InputError
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
+from ..segment import mask_source
 from ..settings import resolve_settings
 from ..writers import bbox_record
 
@@ -151,7 +152,7 @@ class FrameProcessor:
     Raises
     ------
     SymfruitError
-        At construction, for an unknown method, profile or an invalid settings file, so that a node
+        At construction, for an unknown method, profile, mask source or an invalid settings file, so that a node
         fails at start-up rather than on every frame.
     """
 
@@ -170,6 +171,7 @@ class FrameProcessor:
             raise InputError(f"depth_scale must be metres per unit in (0, 1), got {depth_scale!r}")
         self.method, self.masks, self.depth_scale = method, masks, float(depth_scale)
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
+        self.mask_source = mask_source(masks, settings=self.settings)  # a bad model fails here, once
 
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
         """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`)."""
@@ -180,7 +182,7 @@ class FrameProcessor:
         t0 = time.perf_counter()
         frame = self.frame(color, depth, info, name=name, source=source)
         t1 = time.perf_counter()
-        found = detect(frame, masks=self.masks, method=self.method, settings=self.settings)
+        found = detect(frame, masks=self.mask_source, method=self.method, settings=self.settings)
         t2 = time.perf_counter()
         fruits = fruits_of(found)
         t3 = time.perf_counter()

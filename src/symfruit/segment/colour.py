@@ -46,7 +46,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
-from ..settings import Section, SettingError, register_section, setting
+from ..settings import Section, SettingError, setting
 
 __all__ = ["SegmentSettings", "convex_hull_mask", "learned_masks", "redness", "ripe_seeds", "segment"]
 
@@ -143,9 +143,6 @@ class SegmentSettings(Section):
     def check(self) -> None:
         if self.red_low > self.red_high:
             raise SettingError("red_low", f"must not exceed red_high ({self.red_high:g}), got {self.red_low:g}")
-
-
-register_section("segment", SegmentSettings)
 
 
 def _color(color: np.ndarray) -> np.ndarray:

@@ -97,7 +97,7 @@ def render(meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_c
     pix, t = pix[win], t[win]
     ids[pix] = owner[t]
     u, v = pix % w, pix // w
-    ray = np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones(len(u))], axis=1)
+    ray = camera.rays(u, v)
     ray /= np.linalg.norm(ray, axis=1, keepdims=True)
     facing[pix] = np.abs(np.einsum("ti,ti->t", normal[t], ray))
     return Rendering(zbuf.reshape(h, w), ids.reshape(h, w), facing.reshape(h, w))
@@ -126,7 +126,7 @@ def _candidates(idx, side, lo, size, uv, normal, offset, camera, w, cand_pix, ca
         return
     u, v = pu[t_i, k], pv[t_i, k]
     tt = idx[t_i]
-    ray = np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones(len(u))], axis=1)
+    ray = camera.rays(u, v)
     denom = np.einsum("ti,ti->t", normal[tt], ray)
     with np.errstate(divide="ignore", invalid="ignore"):
         z = offset[tt] / denom

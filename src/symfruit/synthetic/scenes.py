@@ -20,6 +20,7 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
+from ..core.points import perpendicular_basis
 from .render import SensorNoise, render
 from .sensors import SensorModel, apply_sensor
 from .shapes import leaf_outline, rotation, strawberry
@@ -61,17 +62,8 @@ class Scene:
         return {"fruits": [f.to_dict() for f in self.fruits]}
 
 
-def _basis(axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Two unit vectors perpendicular to ``axis`` and to each other."""
-    axis = axis / np.linalg.norm(axis)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(axis, helper)
-    u /= np.linalg.norm(u)
-    return u, np.cross(axis, u)
-
-
 def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[np.ndarray, np.ndarray]:
-    u, v = _basis(b - a)
+    (u,), (v,) = perpendicular_basis(((b - a) / np.linalg.norm(b - a))[None, :])
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     ring = radius * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
     vertices = np.vstack([a + ring, b + ring])
@@ -82,7 +74,7 @@ def _cylinder(a: np.ndarray, b: np.ndarray, radius: float, n: int = 8) -> tuple[
 
 
 def _disc(centre: np.ndarray, normal: np.ndarray, radius: float, lobes: int = 0, n: int = 40) -> tuple:
-    u, v = _basis(normal)
+    (u,), (v,) = perpendicular_basis((normal / np.linalg.norm(normal))[None, :])
     t = np.linspace(0, 2 * np.pi, n, endpoint=False)
     r = radius * (1.0 if lobes == 0 else 0.55 + 0.45 * np.abs(np.cos(lobes * t / 2)))
     ring = centre + (r * np.cos(t))[:, None] * u + (r * np.sin(t))[:, None] * v

@@ -1,0 +1,135 @@
+"""One parser for mask specs: ``--masks`` of ``symfruit detect`` and ``symfruit segment``, the ROS nodes'
+``masks`` parameter, :func:`symfruit.detect.detect` and :func:`symfruit.batch.segment_images`.
+
+A spec is ``"auto"`` (a frame's own masks file if it has one, else the colour segmenter), ``"color"`` (the
+built-in colour segmenter, :func:`symfruit.segment.colour.segment`), ``"maskrcnn:CHECKPOINT"`` (a
+torchvision Mask R-CNN, extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segmentation export, extra
+``onnx``), or files:
+
+* for a frame: a label PNG or COCO JSON holding that frame's masks, or a frame folder with ``masks.png`` /
+  ``masks.json`` (:func:`symfruit.io.masks.read_masks`, read for every frame);
+* for a set of image files (``images`` given): a COCO JSON (each image's annotations, by file name), a
+  folder of label PNGs (``<stem>.png``), or one label PNG for one image; ``auto`` is a frame's word only.
+  Files are checked here, before any image.
+
+A learned model fails here, once, when its extra is missing or the model cannot be read.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import FileFormatError, InputError
+from ..settings import Settings
+
+__all__ = ["MaskSource", "mask_source"]
+
+#: ``(color, depth, camera, name, own) -> (labels, word)``: see :class:`MaskSource`.
+Labeller = Callable[[np.ndarray, Any, Any, str, Any], tuple[np.ndarray, str]]
+
+
+@dataclass(frozen=True)
+class MaskSource:
+    """Instance labels for images, from one spec (:func:`mask_source`).
+
+    Attributes
+    ----------
+    name : str
+        A word on where the labels come from, as outputs record it (``colour segmenter``, a path, the spec).
+    """
+
+    name: str
+    _labeller: Labeller
+
+    def __call__(self, color: np.ndarray, depth: np.ndarray | None = None, camera: Any = None, *, name: str = "",
+                 own: np.ndarray | None = None) -> tuple[np.ndarray, str]:  # fmt: skip
+        """Labels for one image and the word on where they came from (``frame masks file`` for a frame's own).
+
+        Parameters
+        ----------
+        color : (h, w, 3) uint8, RGB
+        depth : (h, w) float, metres, optional
+        camera : Camera-like, optional
+            Needed with ``depth`` by the colour segmenter's depth rules.
+        name : str
+            The image's file name (a COCO JSON's images are found by it; a folder's label PNGs by its stem).
+        own : (h, w) int, optional
+            The frame's own masks (``auto``).
+
+        Returns
+        -------
+        labels : (h, w) int array (not yet checked)
+        word : str
+        """
+        return self._labeller(color, depth, camera, name, own)
+
+
+def mask_source(spec: str | Path, *, settings: Settings | None = None,
+                images: Sequence[Path] | None = None) -> MaskSource:  # fmt: skip
+    """The :class:`MaskSource` a spec names (see the module); ``images``: the image files a set of images is
+    segmented from (None: frames)."""
+    from .colour import learned_masks, segment
+
+    settings = settings or Settings()
+    text = str(spec)
+    colour = "colour segmenter"
+
+    def by_colour(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+        return segment(color, depth, camera, settings.segment), colour
+
+    if images is None and text == "auto":
+
+        def auto(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+            return (own, "frame masks file") if own is not None else by_colour(color, depth, camera, name, own)
+
+        return MaskSource("auto", auto)
+    if text == "color":
+        return MaskSource(colour, by_colour)
+    learned = learned_masks(text)  # a missing extra or a bad model fails once, here
+    if learned is not None:
+        model = learned
+        return MaskSource(text, lambda color, depth, camera, name, own: (model(color), text))
+    if images is None:
+        from ..io.masks import read_masks
+
+        return MaskSource(text, lambda color, depth, camera, name, own: (read_masks(spec, color.shape[:2]), text))
+    return _image_files(text, images)
+
+
+def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
+    """Masks of a set of image files from files: a COCO JSON, a folder of label PNGs, one label PNG."""
+    source = Path(text)
+    where = str(source)
+    if source.suffix.lower() == ".json":
+        from ..io.masks import read_coco
+
+        coco = read_coco(source)
+
+        def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+            labels = np.zeros(color.shape[:2], np.int32)
+            for k, m in enumerate(coco.instances(name, color.shape[:2], category=None), 1):
+                labels[m] = k
+            return labels, where
+
+        return MaskSource(where, from_coco)
+    if source.is_dir():
+        from ..io.images import read_labels
+
+        def from_folder(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+            label_path = source / f"{Path(name).stem}.png"
+            if not label_path.is_file():
+                raise FileFormatError(f"{label_path}: no label image for {name}")
+            return read_labels(label_path), where
+
+        return MaskSource(where, from_folder)
+    if source.suffix.lower() == ".png" and source.is_file() and len(images) == 1:
+        from ..io.images import read_labels
+
+        return MaskSource(where, lambda color, depth, camera, name, own: (read_labels(source), where))
+    raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
+                     "a folder of label PNGs, or one label .png for one image")  # fmt: skip

@@ -1,0 +1,67 @@
+"""symfruit.segment.mask_source: one parser for every mask spec, frames and image sets alike."""
+
+import json
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from symfruit import InputError
+from symfruit.segment import MaskSource, mask_source
+from symfruit.synthetic.scenes import make_photo
+
+RED = (200, 30, 40)
+
+
+@pytest.fixture(scope="module")
+def photo():
+    color, truth = make_photo([(80, 120, 40, RED), (230, 120, 40, RED)], seed=0)
+    return color, truth
+
+
+def test_auto_takes_a_frames_own_masks_else_the_colour_segmenter(photo):
+    color, _ = photo
+    own = np.zeros(color.shape[:2], np.int32)
+    own[10:20, 10:20] = 1
+    source = mask_source("auto")
+    labels, word = source(color, own=own)
+    assert labels is own and word == "frame masks file"
+    labels, word = source(color)
+    assert word == "colour segmenter" and len(np.unique(labels[labels > 0])) == 2
+    assert np.array_equal(mask_source("color")(color)[0], labels)
+
+
+def test_a_frames_label_png_and_a_set_of_images_label_folder(photo, tmp_path):
+    color, _ = photo
+    labels = np.zeros(color.shape[:2], np.uint16)
+    labels[5:50, 5:50] = 3
+    Image.fromarray(labels).save(tmp_path / "p0.png")
+    got, word = mask_source(tmp_path / "p0.png")(color)
+    assert word == str(tmp_path / "p0.png") and np.array_equal(got, labels)
+    folder = mask_source(tmp_path, images=[tmp_path / "p0.jpg"])
+    assert isinstance(folder, MaskSource) and folder.name == str(tmp_path)
+    assert np.array_equal(folder(color, name="p0.jpg")[0], labels)
+    with pytest.raises(Exception, match=r"no label image for p1\.jpg"):
+        folder(color, name="p1.jpg")
+    one = mask_source(tmp_path / "p0.png", images=[tmp_path / "x.jpg"])  # one label PNG for one image
+    assert np.array_equal(one(color, name="x.jpg")[0], labels)
+
+
+def test_a_coco_file_gives_each_image_its_annotations_by_name(photo, tmp_path):
+    color, _ = photo
+    h, w = color.shape[:2]
+    coco = {"images": [{"id": 1, "file_name": "a.jpg", "width": w, "height": h}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1,
+                             "segmentation": [[10, 10, 40, 10, 40, 40, 10, 40]]}],
+            "categories": [{"id": 1, "name": "fruit"}]}  # fmt: skip
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    source = mask_source(tmp_path / "t.json", images=[tmp_path / "a.jpg"])
+    labels, _ = source(color, name="a.jpg")
+    assert labels.max() == 1 and labels[25, 25] == 1 and labels[60, 60] == 0
+
+
+def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):
+    with pytest.raises(InputError, match="expected color, maskrcnn:CHECKPOINT"):
+        mask_source("auto", images=[tmp_path / "a.jpg"])  # `auto` is a frame's word only
+    with pytest.raises(InputError, match=r"one label \.png for one image"):
+        mask_source(tmp_path / "nothing.txt", images=[tmp_path / "a.jpg"])
