@@ -331,6 +331,7 @@ def test_the_cli_names_every_real_camera_model():
     assert REAL_SENSORS == tuple(SENSOR_MODELS)
 
 
+@pytest.mark.slow
 def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
     out = tmp_path / "frames"
     assert main(["scenes", str(out), "--n", "1", "--ripe", "2", "--unripe", "0", "--sensor", "realsense-d405"]) == 0
