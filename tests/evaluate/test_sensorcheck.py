@@ -8,7 +8,10 @@ import pytest
 from symfruit import Camera
 from symfruit.evaluate.sensorcheck import measure_sphere, model_frame, real_frames, table
 
-REAL = Path(__file__).resolve().parents[3] / "shared" / "data" / "real-frames"
+#: The shared real frames: ``../shared`` beside the clone (CI), or beside the folder of worktrees.
+_ROOT = Path(__file__).resolve().parents[2]
+_CANDIDATES = [p / "shared" / "data" / "real-frames" for p in (_ROOT.parent, _ROOT.parent.parent)]
+REAL = next((p for p in _CANDIDATES if p.is_dir()), _CANDIDATES[0])
 
 
 def test_a_shifted_sphere_with_a_hole_ring_is_measured_as_built():
