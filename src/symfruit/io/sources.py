@@ -11,7 +11,8 @@ Sources are found through one registry (:func:`register_source`), tried in order
 ==========  =====================================================================================
 name        recognises
 ==========  =====================================================================================
-bag         a ROS 1 ``.bag`` file or a ROS 2 bag folder (``metadata.yaml``) (:mod:`.bags`)
+bag         a ROS 1 ``.bag`` file or a ROS 2 bag folder (``metadata.yaml``) (:mod:`.bags`); a RealSense
+            Viewer / ``rs.recorder`` ``.bag`` (``/device_0/...`` topics) is aligned by :mod:`.realsense`
 frame       one frame folder (:mod:`.frames`)
 folder      a folder of frame folders, in name order (hidden folders and ``exclude`` skipped)
 ==========  =====================================================================================
@@ -163,7 +164,10 @@ def _is_bag(path: Path) -> bool:
 
 def _open_bag(path: Path, exclude: Sequence[Path]) -> FrameSource:
     from .bags import BagSource
+    from .realsense import RealSenseBagSource, is_realsense
 
+    if path.suffix == ".bag" and is_realsense(path):
+        return RealSenseBagSource(path)
     return BagSource(path)
 
 
