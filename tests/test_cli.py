@@ -322,3 +322,21 @@ def test_inputs_claiming_huge_sizes_fail_cleanly_inside_a_memory_limit(tmp_path)
                               preexec_fn=cap, timeout=120)  # fmt: skip
         assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
         assert proc.stderr.startswith("symfruit: error: ") and message in proc.stderr
+
+
+def test_the_cli_names_every_real_camera_model():
+    from symfruit.cli import REAL_SENSORS
+    from symfruit.synthetic.sensors import SENSOR_MODELS
+
+    assert REAL_SENSORS == tuple(SENSOR_MODELS)
+
+
+@pytest.mark.slow
+def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
+    out = tmp_path / "frames"
+    assert main(["scenes", str(out), "--n", "1", "--ripe", "2", "--unripe", "0", "--sensor", "realsense-d405"]) == 0
+    assert "realsense-d405 at 1280x720 with masks.png" in capsys.readouterr().out
+    assert (out / "scene_00000" / "masks.png").is_file()
+    code = main(["evaluate", "--frames", str(out), "--methods", "raw,evidence", "--output", str(tmp_path / "r")])
+    assert code == 0
+    assert "2 true fruit" in capsys.readouterr().out
