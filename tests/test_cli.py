@@ -405,3 +405,21 @@ def test_a_ros2_bag_written_inside_the_recording_is_no_failed_frame(tmp_path, ca
     assert "frames: 1 done, 0 skipped (resume), 0 failed" in out and (rec / "bag" / "metadata.yaml").is_file()
     assert main(["detect", str(rec), "--output", str(tmp_path / "o2"), "--method", "raw"]) == 0  # a later run too
     assert "frames: 1 done, 0 skipped (resume), 0 failed" in capsys.readouterr().out
+
+
+def test_the_cli_names_every_real_camera_model():
+    from symfruit.cli import REAL_SENSORS
+    from symfruit.synthetic.sensors import SENSOR_MODELS
+
+    assert REAL_SENSORS == tuple(SENSOR_MODELS)
+
+
+@pytest.mark.slow
+def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
+    out = tmp_path / "frames"
+    assert main(["scenes", str(out), "--n", "1", "--ripe", "2", "--unripe", "0", "--sensor", "realsense-d405"]) == 0
+    assert "realsense-d405 at 1280x720 with masks.png" in capsys.readouterr().out
+    assert (out / "scene_00000" / "masks.png").is_file()
+    code = main(["evaluate", "--frames", str(out), "--methods", "raw,evidence", "--output", str(tmp_path / "r")])
+    assert code == 0
+    assert "2 true fruit" in capsys.readouterr().out

@@ -15,3 +15,11 @@ def test_bench_segment_times_24_synthetic_photos():
 
     row = bench_segment()
     assert row.images == 24 and row.source == "synthetic photos" and row.width == 640 and row.median_ms > 0
+
+
+@pytest.mark.slow
+def test_a_frame_through_a_real_camera_is_timed_at_its_resolution():
+    from symfruit.evaluate.bench import bench_frame
+
+    row = bench_frame(repeat=1, method="raw", sensor="realsense-d405")
+    assert "realsense-d405 1280x720" in row.case and row.median_ms > 0 and row.points >= 1

@@ -102,3 +102,26 @@ def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path):
     assert saved["strawberry"]["fused"]["depth_ratio"] == 1.7 and saved["strawberry"]["fused"]["revolution"] is True
     assert saved["apple"]["fused"]["depth_ratio"] == 1.7 and saved["apple"]["fused"]["mirror_weight"] == 0.25
     assert saved["apple"]["fused"]["mirror"]["translations"] == 4  # the apple profile's nested mirror section
+
+
+@pytest.mark.parametrize("sensor", ["azure-kinect", "realsense-l515", "realsense-d435", "realsense-d405"])
+def test_quick_camera_run_through_each_real_camera(sensor):
+    ev = evaluate(protocol="camera", fruits=("apple",), methods=("raw", "sphere", "evidence"), n=3, sensor=sensor,
+                  output=None, jobs=1, progress=False)  # fmt: skip
+    by = {s["method"]: s for s in ev.summary}
+    assert all(s["failed"] == 0 and s["n"] == 3 for s in by.values())
+    assert 0.1 < by["raw"]["iou_mean"] < by["evidence"]["iou_mean"] < 1.0  # completion still helps
+    assert f"{sensor} sensor" in ev.table
+    assert all(r.n_visible > 30 for r in ev.rows)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("sensor", ["azure-kinect", "realsense-l515", "realsense-d435", "realsense-d405"])
+def test_camera_run_through_each_real_camera_on_the_proxies(sensor):
+    fruits = ("strawberry", "apple", "citrus", "lemon", "peach", "pear", "plum")
+    ev = evaluate(protocol="camera", fruits=fruits, methods=("raw", "evidence"), n=4, sensor=sensor, output=None,
+                  jobs=2, progress=False)  # fmt: skip
+    rows = [r for r in ev.rows if r.method == "evidence"]
+    assert sum(bool(r.error) for r in rows) <= 2
+    raw = np.mean([r.iou for r in ev.rows if r.method == "raw" and not r.error])
+    assert raw < np.mean([r.iou for r in rows if not r.error])

@@ -6,6 +6,7 @@ import pytest
 from symfruit import DEFAULT_CAMERA
 from symfruit.evaluate.protocols import PAPER_ANGLES, PAPER_DISTANCE, SENSORS, Spec, build, specs
 from symfruit.evaluate.protocols import _inside as inside_polygon
+from symfruit.synthetic.sensors import SENSOR_MODELS
 
 
 def test_paper_protocol_is_algorithm_2():
@@ -134,3 +135,27 @@ def test_a_view_with_an_occluder_keeps_its_depth_and_mask():
     assert occ is not None and occ.hidden.sum() > 0.2 * covered.mask.sum()
     assert fruit_occlusion(covered.depth, covered.mask, covered.visible, covered.camera,
                            OcclusionSettings(enabled=False)) is None  # fmt: skip
+
+
+@pytest.mark.parametrize("name", list(SENSOR_MODELS))
+def test_a_real_camera_view_is_extracted_under_the_annotators_mask(name):
+    model = SENSOR_MODELS[name]
+    inst = build(Spec("camera", "apple", 0, 0, 0.25, 0, name))
+    again = build(Spec("camera", "apple", 0, 0, 0.25, 0, name))
+    assert np.array_equal(inst.depth, again.depth) and np.array_equal(inst.visible, again.visible)
+    cam, full = inst.camera, model.camera()
+    assert inst.extract and inst.depth.shape == inst.mask.shape == (cam.height, cam.width)
+    assert cam.fx == full.fx and cam.width <= full.width and cam.height <= full.height  # a window of the frame
+    assert model.distance[0] <= inst.distance <= model.distance[1] and 0.1 < inst.hidden < 0.5
+    assert inst.depth.dtype == np.float32 and (inst.depth == 0).any()  # holes: the camera's artefacts
+    assert len(inst.visible) == ((inst.depth > 0) & inst.mask).sum()
+    # Through the camera the mask's pixels are no longer all the fruit's own surface.
+    far = inst.visible[:, 2] > inst.truth_box.max[2] + 0.005
+    near = inst.visible[:, 2] < inst.truth_box.min[2] - 0.005
+    assert (far | near).any()
+
+
+def test_real_camera_sensors_are_named_in_specs():
+    with pytest.raises(ValueError, match="azure-kinect"):
+        Spec("camera", "apple", 0, 0, sensor="kinect")
+    assert {s.sensor for s in specs("camera", "plum", n=2, sensor="realsense-d405")} == {"realsense-d405"}

@@ -99,3 +99,19 @@ def test_write_scenes_never_writes_through_a_link_and_holds_its_folder(tmp_path)
     assert list(elsewhere.iterdir()) == []
     with OutputFolder(tmp_path / "o2"), pytest.raises(OutputError, match="another symfruit run"):
         write_scenes(tmp_path / "o2", 1)
+
+
+def test_a_scene_through_a_real_camera_has_its_resolution_and_the_annotators_masks():
+    from symfruit.synthetic.sensors import SENSOR_MODELS
+
+    model = SENSOR_MODELS["realsense-d405"]
+    scene = make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1, sensor=model)  # seeded: tests/synthetic/test_sensors
+    assert scene.color.shape == (720, 1280, 3) and scene.depth.shape == scene.masks.shape == (720, 1280)
+    ripe = [f.id for f in scene.fruits if f.ripe]
+    assert set(np.unique(scene.masks)) <= {0, *ripe}  # unripe fruit are not annotated
+    for k in ripe:
+        own = scene.labels == k
+        if own.any():
+            assert (scene.masks[own] == k).mean() > 0.95 and (scene.masks == k).sum() >= own.sum()
+    z = np.array([f.box.centre[2] for f in scene.fruits])
+    assert 0.24 <= z.min() and z.max() <= 0.52 and np.ptp(z) <= 0.1  # one cluster within the D405 range

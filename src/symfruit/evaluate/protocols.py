@@ -27,6 +27,14 @@ Sensor models (``--sensor``):
     The measurement of issue 11 (the held-back real scans): 640x480, ``fx = fy = 615``, axial noise of
     standard deviation ``0.01 z^2`` metres, 0.3 px lateral jitter, one point per fruit pixel, no dropout;
     0.30-0.50 m.
+``azure-kinect``, ``realsense-l515``, ``realsense-d435``, ``realsense-d405``
+    Real cameras (:data:`symfruit.synthetic.sensors.SENSOR_MODELS`, issue 18): the view is rendered at the camera's
+    colour resolution (1920x1080 or 1280x720; a window around the fruit) with leaves and a background
+    2-20 cm behind and beside the fruit, through :func:`symfruit.synthetic.sensors.apply_sensor` (rim invalidation
+    or edge fattening, flying pixels, registration offset, multipath, noise and bias growing with
+    distance), at the camera's working distances within 0.25-2 m. The fruit's points are what
+    ``detect`` would take: :func:`symfruit.extract.extract` under the annotators' mask (which may
+    overshoot the fruit or cover the leaf), with the occlusion information from the frame's depth.
 
 Pose distributions (``--pose``):
 
@@ -54,6 +62,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
 from ..synthetic.render import SensorNoise, render
+from ..synthetic.sensors import SENSOR_MODELS, SensorModel, apply_sensor
 from ..synthetic.shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
@@ -110,8 +119,8 @@ class Spec:
     poses: str = "hanging"  # a pose distribution of POSES
 
     def __post_init__(self) -> None:
-        if self.sensor not in SENSORS:
-            raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join(SENSORS)}")
+        if self.sensor not in SENSORS and self.sensor not in SENSOR_MODELS:
+            raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join([*SENSORS, *SENSOR_MODELS])}")
         if self.poses not in POSES:
             raise ValueError(f"unknown pose distribution {self.poses!r}; known: {', '.join(POSES)}")
         if self.protocol == "paper" and self.poses == "uniform":
@@ -122,7 +131,10 @@ class Spec:
 class Instance:
     """A visible view with its truth; a camera view with an occluder keeps its rendered ``depth`` image
     (metres, 0: none) and the fruit's ``mask`` (its visible pixels), from which the evaluation makes the
-    occlusion information a robot's ``detect`` would have (:func:`symfruit.occlusion.fruit_occlusion`)."""
+    occlusion information a robot's ``detect`` would have (:func:`symfruit.occlusion.fruit_occlusion`).
+    A view through a real camera model (``extract``) keeps the camera's depth and the annotators' mask
+    (in the ``camera`` window around the fruit); ``visible`` is then every mask pixel with depth, and the
+    runner extracts the fruit's points from them as ``detect`` does."""
 
     spec: Spec
     kind: str
@@ -136,6 +148,7 @@ class Instance:
     extras: dict = field(default_factory=dict)
     depth: np.ndarray | None = None
     mask: np.ndarray | None = None
+    extract: bool = False  # the runner extracts the points from ``mask`` and ``depth`` as ``detect`` does
 
 
 def specs(
@@ -204,6 +217,8 @@ def _paper(spec: Spec) -> Instance:
 
 
 def _camera(spec: Spec, camera: Camera) -> Instance:
+    if spec.sensor in SENSOR_MODELS:
+        return _real_camera(spec, SENSOR_MODELS[spec.sensor])
     fruit = _fruit(spec)
     sensor = SENSORS[spec.sensor]
     noise = sensor.noise
@@ -246,6 +261,80 @@ def _camera(spec: Spec, camera: Camera) -> Instance:
         angles=angles, distance=distance, hidden=float(hidden), depth=depth if leaf is not None else None,
         mask=shot.ids == 0 if leaf is not None else None,
     )  # fmt: skip
+
+
+def _real_camera(spec: Spec, model: SensorModel) -> Instance:
+    """A view through a real camera model: the fruit, an optional occluding leaf, clutter behind and beside,
+    rendered in a window of the camera's colour image around the fruit."""
+    fruit = _fruit(spec)
+    full = model.camera()
+    rng = np.random.default_rng([spec.seed, 4000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
+                                 round(spec.occlusion * 1000), list(SENSOR_MODELS).index(model.name)])  # fmt: skip
+    if spec.poses == "uniform":
+        rot = _uniform_rotation(rng)
+        angles = (float("nan"),) * 3
+    else:
+        angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
+        rot = rotation(*angles)
+    distance = float(rng.uniform(*model.distance))
+    radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
+    # Anywhere the whole fruit is in both cameras' view (the Azure Kinect's depth is narrower than its colour).
+    tan_u = min((full.width / 2 - 10) / full.fx, np.tan(np.radians(model.depth_hfov) / 2) * 0.97)
+    tan_v = min((full.height / 2 - 10) / full.fy, np.tan(np.radians(model.depth_vfov) / 2) * 0.97)
+    half_u, half_v = max(tan_u * distance - radius, 0.0), max(tan_v * distance - radius, 0.0)
+    centre = np.array([rng.uniform(-1, 1) * half_u, rng.uniform(-1, 1) * half_v, distance])
+    posed = fruit.transformed(rot, centre)
+    # The window: the fruit and what lies around it within about its own size (the rest of the frame does not
+    # reach its mask, extraction or occlusion information).
+    u, v = full.project(centre[None])[0]
+    reach = 1.8 * full.fx * radius / distance + 24
+    c0, c1 = max(int(u - reach), 0), min(int(u + reach) + 1, full.width)
+    r0, r1 = max(int(v - reach), 0), min(int(v + reach) + 1, full.height)
+    cam = Camera(fx=full.fx, fy=full.fy, cx=full.cx - c0, cy=full.cy - r0, width=c1 - c0, height=r1 - r0)
+    meshes = [(posed.vertices, posed.faces)]
+    if spec.occlusion > 0:
+        meshes.append(_leaf(posed, cam, spec.occlusion, rng))
+    meshes += _clutter(posed, model, rng)
+    shot = render(meshes, cam)
+    alone = render([(posed.vertices, posed.faces)], cam).ids == 0
+    seen = shot.ids == 0
+    out = apply_sensor(model, shot.depth, shot.ids, cam, rng, facing=shot.facing, labels=seen.astype(np.int32),
+                       amodal=alone.astype(np.int32))  # fmt: skip
+    mask = np.asarray(out.labels) == 1
+    rows, cols = np.nonzero(mask & (out.depth > 0))
+    visible = cam.deproject(np.c_[cols, rows].astype(np.float64), out.depth[rows, cols].astype(np.float64))
+    surface = posed.sample(TRUTH_POINTS, np.random.default_rng([spec.seed, 3000, spec.index]))
+    truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
+    return Instance(
+        spec=spec, kind=fruit.kind, visible=visible, truth_box=truth, truth_surface=surface, camera=cam,
+        angles=angles, distance=distance, hidden=float(1.0 - seen.sum() / max(alone.sum(), 1)),
+        depth=out.depth, mask=mask, extract=True,
+    )  # fmt: skip
+
+
+def _clutter(fruit: Fruit, model: SensorModel, rng: np.random.Generator) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Leaves behind and beside the fruit and a background plane, ``model.clutter_gap`` behind its back
+    (issue 18: leaves, branches and background 2-20 cm behind and beside the fruit)."""
+    lo, hi = fruit.vertices.min(axis=0), fruit.vertices.max(axis=0)
+    centre, extent = (lo + hi) / 2, float((hi - lo).max())
+    meshes = []
+    for _ in range(model.clutter_leaves):
+        angle = rng.uniform(0, 2 * np.pi)
+        offset = rng.uniform(0.3, 1.2) * extent * np.array([np.cos(angle), np.sin(angle), 0.0])
+        z = hi[2] + rng.uniform(*model.clutter_gap) * rng.uniform(0.1, 1.0)
+        length = extent * rng.uniform(1.0, 2.0)
+        tilt = rotation(rng.uniform(-40, 40), rng.uniform(-40, 40), 0.0)
+        ring = leaf_outline(length, length * rng.uniform(0.4, 0.6), 40) @ rotation(0, 0, rng.uniform(0, 180)).T
+        ring = ring @ tilt.T + np.array([centre[0] + offset[0], centre[1] + offset[1], z])
+        vertices = np.vstack([ring.mean(axis=0, keepdims=True), ring])
+        n = len(ring)
+        meshes.append((vertices, np.c_[np.zeros(n, int), 1 + np.arange(n), 1 + (np.arange(n) + 1) % n]))
+    z_back = hi[2] + rng.uniform(*model.clutter_gap)
+    side = 2.0 * z_back  # far wider than any window
+    back = np.array([[-side, -side, 0.0], [side, -side, 0.0], [side, side, 0.0], [-side, side, 0.0]])
+    back = back @ rotation(rng.uniform(-20, 20), rng.uniform(-20, 20), 0.0).T + [centre[0], centre[1], z_back]
+    meshes.append((back, np.array([[0, 1, 2], [0, 2, 3]])))
+    return meshes
 
 
 def _leaf(fruit: Fruit, camera: Camera, share: float, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:

@@ -11,6 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SymfruitError
+from ..extract import extract
 from ..methods.complete import complete
 from ..occlusion import fruit_occlusion
 from ..progress import Progress
@@ -76,18 +77,26 @@ class Row:
 def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
     """Build one instance and run every method on it (runs in a worker process)."""
     inst = build(spec)
+    visible = inst.visible
+    failed = ""
+    if inst.extract and inst.mask is not None and inst.depth is not None:  # as ``detect`` takes a fruit's points
+        visible = extract(inst.mask, inst.depth, inst.camera, settings.extract).points
+        if len(visible) < settings.extract.min_points:
+            failed = f"only {len(visible)} points extracted (extract.min_points = {settings.extract.min_points})"
     base: dict[str, Any] = dict(
         protocol=spec.protocol, fruit=spec.fruit, kind=inst.kind, fruit_index=spec.index, pose=spec.pose,
         angle_x=inst.angles[0], angle_y=inst.angles[1], angle_z=inst.angles[2], distance_m=inst.distance,
-        occlusion=spec.occlusion, hidden=inst.hidden, n_visible=len(inst.visible),
+        occlusion=spec.occlusion, hidden=inst.hidden, n_visible=len(visible),
     )  # fmt: skip
     rows = []
     occlusion = None
-    if inst.depth is not None and inst.mask is not None and len(inst.visible):
-        occlusion = fruit_occlusion(inst.depth, inst.mask, inst.visible, inst.camera, settings.occlusion)
+    if inst.depth is not None and inst.mask is not None and len(visible) and not failed:
+        occlusion = fruit_occlusion(inst.depth, inst.mask, visible, inst.camera, settings.occlusion)
     for method in methods:
         try:
-            result = complete(inst.visible, camera=inst.camera, method=method, settings=settings, occlusion=occlusion)
+            if failed:
+                raise InputError(failed)
+            result = complete(visible, camera=inst.camera, method=method, settings=settings, occlusion=occlusion)
         except SymfruitError as exc:
             nan = float("nan")
             rows.append(Row(**base, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan,

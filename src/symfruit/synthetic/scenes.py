@@ -23,6 +23,7 @@ from ..core.camera import DEFAULT_CAMERA, Camera
 from ..core.points import perpendicular_basis
 from ..errors import OutputError
 from .render import SensorNoise, render
+from .sensors import SensorModel, apply_sensor
 from .shapes import leaf_outline, rotation, strawberry
 
 __all__ = ["Scene", "SceneFruit", "make_photo", "make_scene", "write_scenes"]
@@ -46,13 +47,16 @@ class SceneFruit:
 @dataclass(frozen=True)
 class Scene:
     """A rendered frame: colour (h, w, 3) uint8, depth (h, w) float metres (0 = no depth), the camera,
-    the instance labels of the true fruit pixels (0 = none, k = fruit k), and the fruit."""
+    the instance labels of the true fruit pixels (0 = none, k = fruit k), and the fruit; through a
+    :class:`~symfruit.synthetic.sensors.SensorModel`, also the masks annotators would draw of the ripe fruit
+    (overshooting, some over the leaf in front: :func:`symfruit.synthetic.sensors.annotate`)."""
 
     color: np.ndarray
     depth: np.ndarray
     camera: Camera
     labels: np.ndarray
     fruits: list[SceneFruit] = field(default_factory=list)
+    masks: np.ndarray | None = None  # through a real camera model: the annotators' masks of the ripe fruit
 
     def truth(self) -> dict:
         """The ``truth.json`` layout: ripe and unripe fruit with their boxes, metres, camera frame."""
@@ -95,6 +99,7 @@ def make_scene(
     n_leaves: int = 3,
     camera: Camera = DEFAULT_CAMERA,
     noise: SensorNoise | None = None,
+    sensor: SensorModel | None = None,
 ) -> Scene:
     """Render one seeded scene of hanging strawberries.
 
@@ -108,7 +113,14 @@ def make_scene(
     camera : Camera
     noise : SensorNoise, optional
         Depth sensor model; default :class:`~symfruit.synthetic.render.SensorNoise`.
+    sensor : SensorModel, optional
+        A real camera instead (``camera`` and ``noise`` are then ignored): the frame at its colour
+        resolution, the fruit at its working distances within 0.25-2 m (one cluster per frame, log-uniform
+        depth), leaves and the backdrop 2-20 cm behind them, through
+        :func:`symfruit.synthetic.sensors.apply_sensor`, with the annotators' masks in :attr:`Scene.masks`.
     """
+    if sensor is not None:
+        return _sensor_scene(seed, sensor, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves)
     rng = np.random.default_rng(seed)
     noise = noise or SensorNoise()
     meshes: list[tuple[np.ndarray, np.ndarray]] = []
@@ -189,6 +201,87 @@ def make_scene(
     return Scene(color=color, depth=depth.astype(np.float32), camera=camera, labels=labels, fruits=fruits)
 
 
+def _sensor_scene(seed: int, sensor: SensorModel, *, n_ripe: int, n_unripe: int, n_leaves: int) -> Scene:
+    """:func:`make_scene` through a real camera model (see there)."""
+    rng = np.random.default_rng([seed, 18])
+    camera = sensor.camera()
+    near, far = max(0.25, sensor.distance[0]), min(2.0, sensor.distance[1])
+    z0 = float(np.exp(rng.uniform(np.log(near), np.log(far))))
+    # Where both cameras see: the depth camera may be narrower than the colour camera.
+    half_u = min(0.39 * camera.width, 0.97 * np.tan(np.radians(sensor.depth_hfov) / 2) * camera.fx)
+    half_v = min(0.34 * camera.height, 0.97 * np.tan(np.radians(sensor.depth_vfov) / 2) * camera.fy)
+    meshes: list[tuple[np.ndarray, np.ndarray]] = []
+    colours: list[tuple[float, float, float]] = []
+    fruits: list[SceneFruit] = []
+    placed: list[tuple[float, float, float]] = []
+    gutter_y = -0.12 * z0 / 0.4
+    for k in range(n_ripe + n_unripe):
+        ripe = k < n_ripe
+        berry = strawberry(rng, length=rng.uniform(0.030, 0.048) if ripe else rng.uniform(0.022, 0.035))
+        rot = rotation(rng.uniform(-30, 30), rng.uniform(-180, 180), rng.uniform(-30, 30))
+        for _ in range(200):
+            z = float(np.clip(z0 + rng.uniform(-0.04, 0.04), near, far))
+            u = camera.cx + rng.uniform(-half_u, half_u)
+            v = camera.cy + rng.uniform(-half_v, half_v) * 0.8 + 0.1 * half_v
+            radius_px = camera.fx * 0.5 * np.ptp(berry.vertices, axis=0).max() / z
+            if all(np.hypot(u - pu, v - pv) > 0.9 * (pr + radius_px) for pu, pv, pr in placed):
+                break
+        centre = camera.deproject(np.array([u, v]), np.array(z))
+        posed = berry.transformed(rot, centre)
+        fruits.append(SceneFruit(k + 1, ripe, berry.kind, Box.from_points(posed.vertices), len(meshes)))
+        placed.append((u, v, radius_px))
+        meshes.append((posed.vertices, posed.faces))
+        if ripe:
+            colours.append((rng.uniform(-0.02, 0.015) % 1.0, rng.uniform(0.75, 0.92), rng.uniform(0.55, 0.85)))
+        else:
+            colours.append((rng.uniform(0.12, 0.2), rng.uniform(0.35, 0.6), rng.uniform(0.55, 0.8)))
+        top = posed.vertices[np.argmin(posed.vertices @ (rot @ [0.0, 1.0, 0.0]))]
+        up = rot @ np.array([0.0, -1.0, 0.0])
+        meshes.append(_disc(top + 0.002 * up, up, 0.55 * np.ptp(berry.vertices[:, 0]), lobes=5))
+        colours.append((0.28, 0.7, 0.45))
+        meshes.append(_cylinder(top, np.array([top[0] + rng.uniform(-0.01, 0.01), gutter_y, top[2]]), 0.0012))
+        colours.append((0.25, 0.55, 0.5))
+    ripe_boxes = [f.box for f in fruits if f.ripe]
+    for _ in range(n_leaves if ripe_boxes else 0):  # in front of some fruit
+        target = ripe_boxes[int(rng.integers(len(ripe_boxes)))]
+        centre = target.centre + np.array([rng.uniform(-1, 1) * target.size[0], rng.uniform(-1, 1) * target.size[1],
+                                           -target.size[2] / 2 - rng.uniform(0.01, 0.04)])  # fmt: skip
+        meshes.append(_leaf(centre, rng.uniform(0.04, 0.07), rng.uniform(0, np.pi),
+                            rotation(rng.uniform(-35, 35), rng.uniform(-35, 35), 0)))  # fmt: skip
+        colours.append((rng.uniform(0.22, 0.33), rng.uniform(0.55, 0.8), rng.uniform(0.3, 0.55)))
+    back_z = max(f.box.max[2] for f in fruits)
+    for f in fruits if sensor.clutter_leaves else []:  # behind and beside each fruit
+        angle = rng.uniform(0, 2 * np.pi)
+        offset = rng.uniform(0.3, 1.2) * f.box.size.max() * np.array([np.cos(angle), np.sin(angle), 0.0])
+        centre = np.array([*(f.box.centre[:2] + offset[:2]), f.box.max[2] + rng.uniform(*sensor.clutter_gap)])
+        meshes.append(_leaf(centre, rng.uniform(0.04, 0.08), rng.uniform(0, np.pi),
+                            rotation(rng.uniform(-40, 40), rng.uniform(-40, 40), 0)))  # fmt: skip
+        colours.append((rng.uniform(0.22, 0.33), rng.uniform(0.55, 0.8), rng.uniform(0.3, 0.55)))
+    span = 3.0 * z0
+    gutter = np.array([[-span, gutter_y * 1.4, z0 + 0.05], [span, gutter_y * 1.4, z0 + 0.05],
+                       [span, gutter_y * 1.1, z0 + 0.2], [-span, gutter_y * 1.1, z0 + 0.2]])  # fmt: skip
+    meshes.append((gutter, np.array([[0, 1, 2], [0, 2, 3]])))
+    colours.append((0.0, 0.0, 0.18))
+    bz = back_z + rng.uniform(*sensor.clutter_gap)
+    back = np.array([[-span, -span, bz], [span, -span, bz], [span, span, bz + 0.1], [-span, span, bz + 0.1]])
+    meshes.append((back, np.array([[0, 1, 2], [0, 2, 3]])))
+    colours.append((0.2, 0.18, 0.42))
+
+    shot = render(meshes, camera)
+    labels = np.zeros(shot.ids.shape, np.int32)
+    amodal = np.zeros(shot.ids.shape, np.int32)
+    for f in fruits:
+        labels[shot.ids == f.mesh_index] = f.id
+        if f.ripe:
+            vertices, faces = meshes[f.mesh_index]
+            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
+    ripe_labels = np.where(np.isin(labels, [f.id for f in fruits if f.ripe]), labels, 0)
+    out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
+                       amodal=amodal)  # fmt: skip
+    color = _shade(shot, colours, rng)
+    return Scene(color=color, depth=out.depth, camera=camera, labels=labels, fruits=fruits, masks=out.labels)
+
+
 def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Generator) -> np.ndarray:
     rgb = np.array([colorsys.hsv_to_rgb(*c) for c in colours])
     h, w = shot.ids.shape
@@ -203,11 +296,13 @@ def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Gener
 
 def write_scenes(
     folder: str | Path, n: int, *, seed: int = 0, distinct: int | None = None, n_ripe: int = 6, n_unripe: int = 2,
-    n_leaves: int = 3,
+    n_leaves: int = 3, sensor: SensorModel | None = None,
 ) -> list[Path]:  # fmt: skip
     """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
     ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
-    (copies where links are impossible), so a long recording costs little time and disk.
+    (copies where links are impossible), so a long recording costs little time and disk. Through a real
+    camera model (``sensor``) each folder also gets the annotators' ``masks.png`` (which ``detect`` and
+    ``evaluate --frames`` then use instead of the colour segmenter).
 
     Returns
     -------
@@ -231,8 +326,9 @@ def _write_scenes(
     for i in range(n):
         target = folder / f"scene_{i:05d}"
         if i < unique:
-            scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves)
-            written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth()))
+            scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves, sensor=sensor)
+            written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth(),
+                                       masks=scene.masks))  # fmt: skip
             continue
         if target.is_symlink():
             raise OutputError(f"{target}: is a symbolic link; symfruit does not write through links inside {folder}")

@@ -1,0 +1,44 @@
+"""The sensor check: measurements of a sphere's registration, invalid band and noise, on a known case."""
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from symfruit import Camera
+from symfruit.evaluate.sensorcheck import measure_sphere, model_frame, real_frames, table
+
+#: The shared real frames: ``../shared`` beside the clone (CI), or beside the folder of worktrees.
+_ROOT = Path(__file__).resolve().parents[2]
+_CANDIDATES = [p / "shared" / "data" / "real-frames" for p in (_ROOT.parent, _ROOT.parent.parent)]
+REAL = next((p for p in _CANDIDATES if p.is_dir()), _CANDIDATES[0])
+
+
+def test_a_shifted_sphere_with_a_hole_ring_is_measured_as_built():
+    cam = Camera(fx=900.0, fy=900.0, cx=100.0, cy=100.0, width=200, height=200)
+    yy, xx = np.mgrid[:200, :200].astype(float)
+    z_c, radius = 1.0, 0.03
+    r_px = cam.fx * radius / z_c
+    # The depth silhouette 4 px right and 6 px down of the mask, a 3 px ring of no depth around it, a wall behind.
+    rho = np.hypot(xx - 104, yy - 106)
+    depth = np.full((200, 200), 1.3)
+    on = rho <= r_px
+    lateral = rho[on] / cam.fx * z_c
+    depth[on] = z_c - np.sqrt(np.maximum(radius**2 - lateral**2, 0.0))
+    depth[(rho > r_px) & (rho <= r_px + 3)] = 0.0
+    mask = np.hypot(xx - 100, yy - 100) <= r_px
+    m = measure_sphere(depth, mask, cam, search=8)
+    assert (m["du"], m["dv"]) == (4.0, 6.0) and m["iou"] > 0.95
+    assert m["band_px"] == pytest.approx(3.0, abs=1.0)
+    assert m["flying"] == 0.0 and m["noise_mm"] < 0.5 and m["mask_no_depth"] < 0.2
+    assert "| 1 |" in table([{"frame": "x", "sphere": 1, **m}])
+
+
+@pytest.mark.slow
+def test_the_model_and_the_real_frames_side_by_side():
+    rows = model_frame(seed=0)
+    assert len(rows) == 4 and all(3.0 < r["shift_px"] < 15.0 and 1.0 < r["band_px"] < 10.0 for r in rows)
+    if not REAL.is_dir():
+        pytest.skip(f"{REAL} not found")
+    real = real_frames(REAL)
+    assert len(real) == 8 and all(r["mask_no_depth"] > 0.05 for r in real)  # holes under every real mask

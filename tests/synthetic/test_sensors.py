@@ -1,0 +1,201 @@
+"""Sensor models of real RGB-D cameras: each artefact's known answer on a rendered sphere or plane."""
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from symfruit import Camera
+from symfruit.synthetic.render import render
+from symfruit.synthetic.sensors import SENSOR_MODELS, SensorModel, annotate, apply_sensor, sensor_model
+
+from ..conftest import ball_mesh
+
+#: Everything random switched off: the artefact under test is the only one left.
+QUIET = dict(sigma_const=0.0, sigma_linear=0.0, bias_const=0.0, bias_linear=0.0, lateral_px=0.0, dropout=0.0,
+             grazing_dropout=0.0, flying_share=0.0, multipath_bias=0.0, registration_px=0.0, colour_baseline=0.0,
+             mask_overshoot_px=0.0, mask_amodal_share=0.0)  # fmt: skip
+SIDE = 240
+
+
+def window(model: SensorModel) -> Camera:
+    """A SIDE x SIDE window at the centre of the model's colour image (fast to render, same optics)."""
+    cam = model.camera()
+    return Camera(fx=cam.fx, fy=cam.fy, cx=SIDE / 2, cy=SIDE / 2, width=SIDE, height=SIDE)
+
+
+def sphere_scene(cam: Camera, z: float, *, radius: float = 0.035, behind: float = 0.15):
+    """A ball at depth ``z`` (its centre) on the optical axis, a fronto-parallel plane ``behind`` metres behind."""
+    ball = ball_mesh(radius)
+    vertices, faces = ball.vertices, ball.faces
+    back = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]]) + [0.0, 0.0, z + behind]
+    return render([(vertices + [0.0, 0.0, z], faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+
+
+def run(model, shot, cam, seed=0, **kw):
+    return apply_sensor(model, shot.depth, shot.ids, cam, np.random.default_rng(seed), facing=shot.facing, **kw)
+
+
+def test_the_four_models_and_their_cameras():
+    assert set(SENSOR_MODELS) == {"azure-kinect", "realsense-l515", "realsense-d435", "realsense-d405"}
+    ak = sensor_model("azure-kinect").camera()
+    assert (ak.width, ak.height) == (1920, 1080) and ak.fx == pytest.approx(960.0)  # 90 deg across 1920 px
+    assert sensor_model("realsense-d435").camera().width == 1280
+    assert sensor_model("azure-kinect").at(1280, 720).camera().fx == pytest.approx(640.0)
+    assert sensor_model("azure-kinect").at(1280, 720).registration_px == pytest.approx(4.0)
+    with pytest.raises(ValueError, match="known: azure-kinect"):
+        sensor_model("kinect-v1")
+    with pytest.raises(ValueError, match="baseline"):
+        replace(SENSOR_MODELS["realsense-d435"], baseline=0.0)
+
+
+def test_tof_rim_band_width_on_a_sphere():
+    model = replace(SENSOR_MODELS["azure-kinect"], **QUIET)
+    cam = window(model)
+    shot = sphere_scene(cam, 1.0)
+    out = run(model, shot, cam)
+    row = out.depth[SIDE // 2]
+    fruit = shot.ids[SIDE // 2] == 0
+    right = int(np.flatnonzero(fruit).max())
+    # Invalid run across the right silhouette: the mixed depth pixel and one depth pixel on each side.
+    zero = row == 0
+    first = right
+    while zero[first]:
+        first -= 1
+    last = right + 1
+    while zero[last]:
+        last += 1
+    width = last - first - 1
+    assert 2 * model.footprint <= width <= 4 * model.footprint + 1
+    assert (out.depth[shot.ids == 0] > 0).mean() > 0.7  # the inside keeps its depth
+    assert not (out.depth[60:180, 60:180] == 0)[np.hypot(*np.mgrid[-60:60, -60:60]) < 20].any()
+
+
+def test_tof_flying_pixels_lie_between_fruit_and_background():
+    model = replace(SENSOR_MODELS["azure-kinect"], **{**QUIET, "flying_share": 1.0, "rim_invalid_px": 0})
+    cam = window(model)
+    z, behind = 1.0, 0.15
+    shot = sphere_scene(cam, z, behind=behind)
+    d = out_depth = run(model, shot, cam).depth
+    front, back = z - 0.035, z + behind
+    valid = out_depth > 0
+    assert np.all((d[valid] >= front - 1e-3) & (d[valid] <= back + 1e-3))
+    between = valid & (d > z + 0.01) & (d < back - 0.01)
+    assert between.sum() > 20  # a ring of flying pixels...
+    ring = np.abs(np.hypot(*(np.mgrid[:SIDE, :SIDE] - SIDE / 2)) - 0.035 * cam.fx / z) < 2 * model.footprint + 1
+    assert ring[between].all()  # ...only along the silhouette
+
+
+def test_stereo_fattening_and_occlusion_band():
+    model = replace(SENSOR_MODELS["realsense-d435"], **QUIET)
+    cam = window(model)
+    z, behind = 0.5, 0.2
+    shot = sphere_scene(cam, z, behind=behind)
+    d = run(model, shot, cam).depth
+    row, fruit = d[SIDE // 2], shot.ids[SIDE // 2] == 0
+    cols = np.arange(SIDE)
+    left, right = int(np.flatnonzero(fruit).min()), int(np.flatnonzero(fruit).max())
+    fringe = (row > 0) & (row < z + 0.05) & ~fruit
+    # Right side: foreground depth spreads over the background by about fatten_px depth pixels.
+    spread = int((fringe & (cols > right)).sum())
+    assert (model.fatten_px - 1) * model.footprint <= spread <= (model.fatten_px + 1) * model.footprint + 1
+    # Left side: background the right imager cannot see, f B (1/z_edge - 1/z_far) depth pixels wide, z_edge
+    # between the ball's centre and its front.
+    fb = model.depth_focal * model.baseline
+    band = int(((row == 0) & (cols < left)).sum())
+    low, high = fb * (1 / z - 1 / (z + behind)), fb * (1 / (z - 0.035) - 1 / (z + behind))
+    assert (low - model.fatten_px - 1) * model.footprint <= band <= (high + 1) * model.footprint
+    assert ((row == 0) & (cols > right)).sum() <= model.footprint + 1  # no band on the right (a self-hidden limb pixel)
+
+
+def test_registration_shift_moves_depth_against_the_masks():
+    model = replace(SENSOR_MODELS["azure-kinect"], **{**QUIET, "registration_px": 6.0})
+    cam = window(model)
+    shot = sphere_scene(cam, 1.0)
+    out = run(model, shot, cam, seed=3, labels=(shot.ids == 0).astype(int))
+    fg = (out.depth > 0) & (out.depth < 1.05)
+    rows, cols = np.nonzero(fg)
+    mrows, mcols = np.nonzero(out.labels == 1)
+    du, dv = out.shift
+    assert np.hypot(du, dv) == pytest.approx(6.0)
+    assert cols.mean() - mcols.mean() == pytest.approx(du, abs=1.0)
+    assert rows.mean() - mrows.mean() == pytest.approx(dv, abs=1.0)
+
+
+@pytest.mark.parametrize("name", ["realsense-d435", "azure-kinect"])
+def test_noise_and_bias_grow_with_distance_as_the_model_says(name):
+    model = replace(SENSOR_MODELS[name], lateral_px=0.0, dropout=0.0, registration_px=0.0, colour_baseline=0.0)
+    cam = window(model)
+    plane = np.array([[-2.0, -2.0, 0.0], [2.0, -2.0, 0.0], [2.0, 2.0, 0.0], [-2.0, 2.0, 0.0]])
+    measured = {}
+    for z in (1.0, 2.0):
+        shot = render([(plane + [0.0, 0.0, z], np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+        d = run(model, shot, cam, seed=int(z)).depth
+        # One value per depth pixel (registration repeats it over its footprint).
+        step = int(np.ceil(model.footprint))
+        values = d[::step, ::step][d[::step, ::step] > 0].astype(float)
+        measured[z] = values.std()
+        assert values.std() == pytest.approx(np.hypot(model.sigma(z), 0.001 / np.sqrt(12)), rel=0.1)
+        assert values.mean() - z == pytest.approx(float(model.bias(z)), abs=3 * values.std() / np.sqrt(values.size)
+                                                  + 3e-4)  # fmt: skip
+    if model.family == "stereo":
+        assert model.sigma(2.0) / model.sigma(1.0) == pytest.approx(4.0)  # z^2
+        assert model.sigma(1.0) == pytest.approx(1.0 * 0.08 / (model.depth_focal * 0.05))
+    else:
+        assert model.sigma(2.0) - model.sigma(1.0) == pytest.approx(model.sigma_linear)
+    assert measured[2.0] > measured[1.0]
+
+
+def test_multipath_pushes_depth_away_near_a_junction():
+    model = replace(SENSOR_MODELS["azure-kinect"], **{**QUIET, "multipath_bias": 0.005, "rim_invalid_px": 0})
+    cam = window(model)
+    # A ball half sunk in a plane: depth near the junction is pushed away, far from it barely.
+    shot = sphere_scene(cam, 1.0, behind=0.0)  # the plane through its centre: a junction along the silhouette
+    d = run(model, shot, cam).depth.astype(float)
+    clean = np.where(np.isfinite(shot.depth), shot.depth, 0)
+    valid = (d > 0) & (clean > 0)
+    dist = np.hypot(*(np.mgrid[:SIDE, :SIDE] - SIDE / 2))
+    r_px = 0.035 * cam.fx / 1.0
+    near = valid & (np.abs(dist - r_px) < 6) & (shot.ids == 1)
+    centre = valid & (dist < 5)
+    assert (d - clean)[near].mean() > 0.002
+    assert abs((d - clean)[centre].mean()) < 0.0015
+
+
+def test_no_depth_outside_the_depth_cameras_field_of_view():
+    model = replace(SENSOR_MODELS["azure-kinect"], **QUIET)  # NFOV 75 deg inside a 90 deg colour image
+    full = model.camera()
+    cam = Camera(fx=full.fx, fy=full.fy, cx=full.cx, cy=40.0, width=full.width, height=80)  # a strip across
+    plane = np.array([[-5.0, -5.0, 1.0], [5.0, -5.0, 1.0], [5.0, 5.0, 1.0], [-5.0, 5.0, 1.0]])
+    shot = render([(plane, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+    d = run(model, shot, cam).depth
+    edge = full.fx * np.tan(np.radians(37.5))
+    cols = np.flatnonzero(d[40] > 0)
+    assert cols.min() == pytest.approx(full.cx - edge, abs=3) and cols.max() == pytest.approx(full.cx + edge, abs=3)
+
+
+def test_masks_overshoot_and_cover_an_occluder():
+    model = replace(SENSOR_MODELS["azure-kinect"], mask_overshoot_px=4.0, mask_amodal_share=1.0)
+    yy, xx = np.mgrid[:100, :100]
+    whole = np.hypot(yy - 50, xx - 50) <= 20
+    leaf = xx < 45
+    labels = (whole & ~leaf).astype(int)
+    masks = annotate(model, labels, np.random.default_rng(0), amodal=whole.astype(int))
+    assert (masks[labels == 1] == 1).all() and (masks[whole] == 1).all()  # covers the leaf
+    grown = np.hypot(yy - 50, xx - 50)[masks == 1]
+    assert grown.max() <= 20 + 4.0 + 1e-9
+    plain = annotate(replace(model, mask_amodal_share=0.0, mask_overshoot_px=0.0), labels, np.random.default_rng(0),
+                     amodal=whole.astype(int))  # fmt: skip
+    assert (plain == labels).all()
+
+
+def test_seeded_reproducibility():
+    model = SENSOR_MODELS["realsense-l515"]
+    cam = window(model)
+    shot = sphere_scene(cam, 0.8)
+    labels = (shot.ids == 0).astype(int)
+    a, b = run(model, shot, cam, seed=7, labels=labels), run(model, shot, cam, seed=7, labels=labels)
+    c = run(model, shot, cam, seed=8, labels=labels)
+    assert np.array_equal(a.depth, b.depth) and np.array_equal(a.labels, b.labels) and a.shift == b.shift
+    assert np.array_equal(a.jitter, b.jitter) and not np.array_equal(a.depth, c.depth)
+    assert a.depth.dtype == np.float32 and a.depth.shape == (SIDE, SIDE)
