@@ -313,12 +313,13 @@ def write_scenes(
 
     folder = Path(folder)
     with OutputFolder(folder):  # locked while written; no link inside it followed
-        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves)
+        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor)
 
 
 def _write_scenes(
-    folder: Path, n: int, seed: int, distinct: int | None, n_ripe: int, n_unripe: int, n_leaves: int
-) -> list[Path]:
+    folder: Path, n: int, seed: int, distinct: int | None, n_ripe: int, n_unripe: int, n_leaves: int,
+    sensor: SensorModel | None,
+) -> list[Path]:  # fmt: skip
     from ..io.frames import write_frame
 
     unique = n if distinct is None else max(1, min(distinct, n))
