@@ -284,3 +284,89 @@ def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     assert status == 0, err
     assert len(list((tmp_path / "out").glob("*/detections.json"))) == frames
     assert peak_mb < 400  # measured: about 105 MB for 1 to 500 frames
+
+
+def test_a_frame_folder_that_links_out_of_the_output_is_refused_and_recorded(tmp_path):
+    rec = recording(tmp_path / "rec", "f1", "f2")
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "f1").symlink_to(elsewhere, target_is_directory=True)
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["f2"] and "f1: is a symbolic link" in report.failed["f1"]
+    assert list(elsewhere.iterdir()) == []  # nothing written (or removed) outside the output folder
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    assert [e["frame"] for e in errors["failed"]] == ["f1"]
+
+
+def test_a_frame_named_like_the_batchs_own_files_cannot_take_them(tmp_path):
+    rec = recording(tmp_path / "rec", "errors.json", "f2")
+    shutil.copytree(EXAMPLE_FRAME, rec / ".symfruit.lock")  # hidden: not a frame at all
+    (rec / "errors.json" / "depth.png").unlink()  # this frame fails: its record must survive
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["f2"] and list(report.failed) == ["errors.json"]
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    assert [e["frame"] for e in errors["failed"]] == ["errors.json"] and "depth" in errors["failed"][0]["reason"]
+    assert (tmp_path / "out" / "errors.json").is_file()
+
+
+def test_a_second_batch_on_one_output_folder_is_refused_at_once(tmp_path):
+    from symfruit import OutputError
+    from symfruit.io.outputs import OutputFolder
+
+    rec = recording(tmp_path / "rec", "f1")
+    with OutputFolder(tmp_path / "out"), pytest.raises(OutputError, match=r"another symfruit run .* is writing"):
+        run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert not (tmp_path / "out" / "f1").exists()
+    assert run_batch(rec, tmp_path / "out", method="raw", progress=False).done == ["f1"]  # released
+
+
+def test_the_output_may_not_be_the_recording_or_one_of_its_frames(tmp_path):
+    from symfruit import OutputError
+
+    rec = recording(tmp_path / "rec", "f1", "f2")
+    before = sorted(p.name for p in (rec / "f1").iterdir())
+    for output in (rec, rec / "f1"):
+        with pytest.raises(OutputError, match="also an input folder"):
+            run_batch(rec, output, method="raw", progress=False)
+    with pytest.raises(OutputError, match="also an input folder"):
+        run_batch(rec / "f1", rec / "f1", method="raw", progress=False)
+    assert sorted(p.name for p in (rec / "f1").iterdir()) == before
+
+
+def test_a_bag_the_run_writes_inside_the_recording_is_no_frame(tmp_path):
+    rec = recording(tmp_path / "rec", "f1")
+    (rec / "bag").mkdir()
+    (rec / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False, exclude=[rec / "bag"])
+    assert report.ok and report.done == ["f1"]
+
+
+def test_a_full_disk_leaves_every_frame_done_or_recorded(tmp_path, monkeypatch):
+    from symfruit import OutputError
+
+    rec = recording(tmp_path / "rec", "f1", "f2", "f3", "f4")
+    real = batch.write_detections
+
+    def write(folder, found, **kwargs):
+        if folder.name == "f2":
+            (folder / "fruit_001.ply").parent.mkdir(parents=True, exist_ok=True)
+            (folder / "fruit_001.ply").write_text("half")  # written before the disk filled up
+            raise OutputError(f"{folder}/overlay.png: cannot write (No space left on device)", errno.ENOSPC)
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write)
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["f1"] and list(report.failed) == ["f2"] and report.unprocessed == ["f3", "f4"]
+    assert "output is full" in report.stopped
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    recorded = {e["frame"] for e in errors["failed"]} | set(errors["unprocessed"])
+    assert recorded | {"f1"} == {"f1", "f2", "f3", "f4"} and not (tmp_path / "out" / "f2" / "fruit_001.ply").exists()
+
+
+def test_a_frame_that_fails_on_a_rerun_keeps_no_old_results(tmp_path):
+    rec = recording(tmp_path / "rec", "f1")
+    assert run_batch(rec, tmp_path / "out", method="raw", progress=False).ok
+    (rec / "f1" / "depth.png").write_bytes(b"broken")
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert list(report.failed) == ["f1"] and sorted(p.name for p in (tmp_path / "out" / "f1").iterdir()) == []

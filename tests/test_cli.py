@@ -324,6 +324,89 @@ def test_inputs_claiming_huge_sizes_fail_cleanly_inside_a_memory_limit(tmp_path)
         assert proc.stderr.startswith("symfruit: error: ") and message in proc.stderr
 
 
+def _one_line_error(capsys, *needles):
+    err = capsys.readouterr().err
+    assert err.startswith("symfruit: error: ") and err.count("\n") == 1 and "Traceback" not in err, err
+    assert all(n in err for n in needles), err
+
+
+def test_complete_json_to_an_output_whose_json_is_a_folder_is_one_line(tmp_path, capsys):
+    np.save(tmp_path / "a.npy", VISIBLE)
+    (tmp_path / "o.json").mkdir()
+    assert main(["complete", str(tmp_path / "a.npy"), "--json", "--output", str(tmp_path / "o.ply")]) == 2
+    _one_line_error(capsys, "o.json: is a folder")
+    assert not (tmp_path / "o.ply").exists()  # neither half of the result is written
+    (tmp_path / "d.ply").mkdir()
+    assert main(["complete", str(tmp_path / "d.ply"), "--json"]) == 2
+    _one_line_error(capsys, "not a regular file")
+
+
+def test_an_unwritable_output_is_exit_2_for_every_writing_command(tmp_path, capsys):
+    blocker = tmp_path / "file"
+    blocker.write_text("x")
+    photo = tmp_path / "p.png"
+    from PIL import Image
+
+    Image.new("RGB", (32, 24), (200, 30, 40)).save(photo)
+    for args in (["detect", str(EXAMPLE_FRAME), "--output", str(blocker)],
+                 ["segment", str(photo), "--output", str(blocker / "o")],
+                 ["demo", "--output", str(blocker)], ["scenes", str(blocker), "--n", "1"]):  # fmt: skip
+        assert main(args) == 2, args
+        _one_line_error(capsys, "cannot write to folder")
+
+
+def test_a_second_writer_on_one_output_folder_is_exit_2(tmp_path, capsys):
+    from symfruit.io.outputs import OutputFolder
+
+    with OutputFolder(tmp_path / "out"):
+        for args in (["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "out"), "--method", "raw"],
+                     ["demo", "--output", str(tmp_path / "out"), "--method", "raw"],
+                     ["scenes", str(tmp_path / "out"), "--n", "1"]):  # fmt: skip
+            assert main(args) == 2, args
+            _one_line_error(capsys, "another symfruit run", "is writing into this output folder")
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == []
+
+
+def test_detect_refuses_writing_into_its_input_and_names_a_linked_frame(tmp_path, capsys):
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "f1")
+    assert main(["detect", str(rec), "--output", str(rec), "--method", "raw"]) == 2
+    _one_line_error(capsys, "also an input folder")
+    (tmp_path / "out").mkdir()
+    (tmp_path / "elsewhere").mkdir()
+    (tmp_path / "out" / "f1").symlink_to(tmp_path / "elsewhere")
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
+    assert "f1: is a symbolic link" in capsys.readouterr().out and not list((tmp_path / "elsewhere").iterdir())
+
+
+def test_evaluate_masks_with_a_category_no_annotation_has_is_exit_2(tmp_path, capsys):
+    photos = EXAMPLES / "photos"
+    truth = str(photos / "_annotations.coco.json")
+    args = ["evaluate", "--protocol", "masks", "--images", str(photos), "--truth", truth, "--category", "77"]
+    assert main([*args, "--output", str(tmp_path)]) == 2
+    _one_line_error(capsys, "no annotation has category 77")
+
+
+def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
+    (tmp_path / "big.yaml").write_text("a: [" + "1, " * 400_000 + "1]\n")
+    assert main(["settings", "--config", str(tmp_path / "big.yaml")]) == 2
+    _one_line_error(capsys, "larger than")
+    assert main(["bench", "--points", "3"]) == 2
+    _one_line_error(capsys, "--points")
+
+
+def test_a_ros2_bag_written_inside_the_recording_is_no_failed_frame(tmp_path, capsys):
+    pytest.importorskip("rosbags")
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "f1")
+    args = ["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw", "--ros2-bag", str(rec / "bag")]
+    assert main(args) == 0
+    out = capsys.readouterr().out
+    assert "frames: 1 done, 0 skipped (resume), 0 failed" in out and (rec / "bag" / "metadata.yaml").is_file()
+    assert main(["detect", str(rec), "--output", str(tmp_path / "o2"), "--method", "raw"]) == 0  # a later run too
+    assert "frames: 1 done, 0 skipped (resume), 0 failed" in capsys.readouterr().out
+
+
 def test_the_cli_names_every_real_camera_model():
     from symfruit.cli import REAL_SENSORS
     from symfruit.synthetic.sensors import SENSOR_MODELS

@@ -17,8 +17,9 @@ import symfruit.methods
 PACKAGE = Path(symfruit.__file__).resolve().parent
 
 PUBLIC = {
-    "DEFAULT_CAMERA", "Box", "Camera", "ConfigError", "FileFormatError", "InputError", "Plane", "Result", "Settings",
-    "SymfruitError", "__version__", "available_methods", "box_iou", "centre_deviation", "complete", "load_settings",
+    "DEFAULT_CAMERA", "Box", "Camera", "ConfigError", "FileFormatError", "InputError", "OutputError", "Plane", "Result",
+    "Settings", "SymfruitError", "__version__", "available_methods", "box_iou", "centre_deviation", "complete",
+    "load_settings",
     "resolve_settings",
 }  # fmt: skip
 
@@ -40,7 +41,7 @@ def test_every_listed_name_exists(module):
 
 
 def test_every_error_is_a_symfruit_error_and_a_value_error():
-    for cls in (symfruit.InputError, symfruit.FileFormatError, symfruit.ConfigError):
+    for cls in (symfruit.InputError, symfruit.FileFormatError, symfruit.ConfigError, symfruit.OutputError):
         assert issubclass(cls, symfruit.SymfruitError) and issubclass(cls, ValueError)
     from symfruit.settings import SettingError
 

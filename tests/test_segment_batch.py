@@ -129,3 +129,105 @@ def test_cli_segment_evaluate_masks_and_bench_segment(tmp_path, capsys):
     assert main(["bench", "--segment", "--images", str(folder), "--json"]) == 0  # the 24 synthetic: test_bench
     row = json.loads(capsys.readouterr().out)["segment"]
     assert row["images"] == 2 and row["width"] == 640 and row["median_ms"] > 0
+
+
+def _photo(path, k=0, fmt=None):
+    color, _ = make_photo([(80, 120, 40, RED), (230, 120, 40, RED)][: k + 1], seed=k)
+    Image.fromarray(color).save(path, format=fmt)
+    return color
+
+
+def test_stems_that_collide_get_names_that_cannot(tmp_path):
+    folder = tmp_path / "in"
+    folder.mkdir()
+    for k, name in enumerate(["a.png", "a-2.png", "a.jpg", "a_overlay.png"]):
+        _photo(folder / name, k % 2)
+    report = segment_images([folder], output=tmp_path / "out")
+    assert report.ok and len(report.done) == 4
+    written = [p for d in report.done for p in d.written]
+    assert len(set(written)) == 8 and all(p.is_file() for p in written)  # nothing written twice
+    for d in report.done:  # every label image is its own image's: its fruit count
+        with Image.open(d.written[0]) as img:
+            assert int(np.asarray(img).max()) == d.fruit
+    record = json.loads((tmp_path / "out" / "segment.json").read_text())
+    assert sorted(w for i in record["images"] for w in i["written"]) == sorted(map(str, written))
+
+
+def test_the_input_folder_as_output_is_refused_and_the_photos_stay(tmp_path):
+    from symfruit import OutputError
+
+    folder = _photos(tmp_path / "in")
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    with pytest.raises(OutputError, match="also an input folder"):
+        segment_images([folder], output=folder)
+    with pytest.raises(OutputError, match="also an input folder"):
+        segment_images([folder / "p0.jpg"], output=folder)
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+    assert main(["segment", str(folder), "--output", str(folder)]) == 2
+
+
+def test_a_folder_yields_every_format_read_when_named(tmp_path):
+    folder = tmp_path / "in"
+    folder.mkdir()
+    _photo(folder / "g.gif", fmt="GIF")
+    _photo(folder / "p.ppm", fmt="PPM")
+    (folder / "notes.txt").write_text("not an image")
+    (folder / ".hidden.png").write_bytes(b"")
+    report = segment_images([folder], output=tmp_path / "out")
+    assert sorted(d.path.name for d in report.done) == ["g.gif", "p.ppm"] and report.ok
+
+
+def test_intrinsics_of_another_resolution_are_refused_with_depth(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "p0.png")
+    cam = Camera(fx=900, fy=900, cx=640, cy=360, width=1280, height=720)
+    report = segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert not report.done and "intrinsics (--camera) are for 1280x720 but the image is 320x240" in next(
+        iter(report.failed.values())
+    )
+
+
+def test_mask_sources_beyond_the_bounds_are_refused(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    labels = tmp_path / "labels"
+    labels.mkdir()
+    many = (np.arange(240 * 320).reshape(240, 320) % 1500 + 1).astype(np.uint16)
+    Image.fromarray(many).save(labels / "p0.png")
+    report = segment_images([folder], output=tmp_path / "out", masks=labels)
+    assert "1500 instances; at most 1000" in next(iter(report.failed.values()))
+
+    def huge_ids(color, depth=None, camera=None):
+        out = np.zeros(color.shape[:2], np.int64)
+        out[:10, :10], out[-10:, -10:] = 1, 2**32 + 1
+        return out
+
+    report = segment_images([folder], output=tmp_path / "o2", masks=huge_ids)
+    assert "beyond 32 bits" in next(iter(report.failed.values())) and not (tmp_path / "o2" / "p0.png").exists()
+
+
+def test_an_image_beyond_16384_pixels_a_side_is_refused_by_name(tmp_path):
+    Image.new("RGB", (30000, 20), (200, 30, 40)).save(tmp_path / "wide.png")
+    report = segment_images([tmp_path / "wide.png"], output=tmp_path / "out")
+    assert (
+        "wide.png: image is 30000x20 pixels; at most 16384 pixels a side" in report.failed[str(tmp_path / "wide.png")]
+    )
+
+
+def test_a_full_disk_records_every_image(tmp_path, monkeypatch):
+    import errno
+
+    from symfruit import OutputError, batch
+
+    folder = _photos(tmp_path / "in", n=2)
+    _photo(folder / "p2.png")
+
+    def full(path, labels):
+        raise OutputError(f"{path}: cannot write (No space left on device)", errno.ENOSPC)
+
+    monkeypatch.setattr("symfruit.writers.write_labels", full)
+    report = batch.segment_images([folder], output=tmp_path / "out")
+    assert len(report.failed) == 1 and len(report.unprocessed) == 2 and "output is full" in report.stopped
+    record = json.loads((tmp_path / "out" / "segment.json").read_text())
+    assert len(record["failed"]) + len(record["unprocessed"]) == 3

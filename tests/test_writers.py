@@ -4,6 +4,8 @@
 import datetime
 import json
 import os
+import subprocess
+import sys
 from dataclasses import replace
 
 import numpy as np
@@ -184,3 +186,31 @@ def test_a_results_root_that_cannot_be_written_is_named(tmp_path, found):
         new_results_folder(blocker, "paper")
     with pytest.raises(FileFormatError, match=r"cannot create output folder"):
         write_detections(blocker / "frame", found)
+
+
+PEAK = """
+import resource, sys
+import numpy as np
+from PIL import Image
+w, h = int(sys.argv[2]), int(sys.argv[3])
+Image.new("RGB", (w, h), (200, 30, 40)).save(sys.argv[1] + "/big.png", compress_level=1)
+from symfruit.io.images import read_color
+from symfruit.writers import write_label_overlay, write_labels
+base = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+color = read_color(sys.argv[1] + "/big.png")
+labels = np.zeros((h, w), np.int32)
+labels[h // 4 : h // 2, w // 4 : w // 2] = 1
+write_labels(sys.argv[1] + "/big_labels.png", labels)
+write_label_overlay(sys.argv[1] + "/big_overlay.png", color, labels)
+print((resource.getrusage(resource.RUSAGE_SELF).ru_maxrss - base) * 1024 / (w * h))
+"""
+
+
+@pytest.mark.parametrize("size", [(3200, 2400), pytest.param((7200, 5400), marks=pytest.mark.slow)])
+def test_reading_a_large_photo_and_drawing_its_overlay_stays_within_a_few_bytes_a_pixel(tmp_path, size):
+    # Measured in a child process (peak resident memory): the image itself is 3 bytes a pixel, its labels 4;
+    # full-size float temporaries cost 50 (a 39-megapixel photo peaked at 2 GB).
+    run = subprocess.run([sys.executable, "-c", PEAK, str(tmp_path), *map(str, size)], capture_output=True,
+                         text=True, timeout=600)  # fmt: skip
+    assert run.returncode == 0, run.stderr
+    assert float(run.stdout) < 20.0

@@ -10,26 +10,31 @@ so with ``resume=True`` a re-run skips exactly the frames already done, deciding
 
 from __future__ import annotations
 
+import contextlib
 import errno
-import hashlib
-import re
+import os
 import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 from typing import Any, TypeVar
 
 import numpy as np
 
+from .core.limits import instance_labels
 from .detect import FrameDetections, detect
 from .errors import FileFormatError, InputError, SymfruitError
-from .io.atomic import write_json
+from .io.atomic import folder_fd
+from .io.frames import is_frame_folder
+from .io.images import image_suffixes
+from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, unique_names, write_record
 from .io.sources import open_source
 from .methods import DEFAULT_METHOD
 from .progress import Progress
 from .segment import MaskSource, mask_source
 from .settings import Settings
-from .writers import write_detections
+from .writers import remove_stale, write_detections
 
 __all__ = [
     "BatchReport",
@@ -45,15 +50,16 @@ __all__ = [
 _NO_SPACE = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
 
 
-def frame_folder_name(name: str) -> str:
+#: Names a batch keeps for its own files in the output folder: a frame called so gets a hashed folder name.
+BATCH_FILES = ("errors.json", LOCK_NAME)
+
+
+def frame_folder_name(name: str, reserved: Sequence[str] = BATCH_FILES) -> str:
     """The output folder name of a frame: ``name`` itself when it is a safe file name (letters, digits,
-    ``._-``), else a sanitised name, ``+`` and a short hash of the original. A safe name never holds ``+``,
-    so no two names share a folder however the recording grows."""
-    clean = re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._")[:100]
-    if clean == name and name:
-        return name
-    digest = hashlib.sha1(name.encode("utf-8", "surrogateescape")).hexdigest()[:8]
-    return f"{clean or 'frame'}+{digest}"
+    ``._-``) that the batch does not keep for its own files (``errors.json``), else a sanitised name, ``+``
+    and a short hash of the original. A safe name never holds ``+``, so no two names share a folder however
+    the recording grows (:func:`symfruit.io.outputs.entry_name`)."""
+    return entry_name(name, reserved=reserved)
 
 
 @dataclass
@@ -67,6 +73,8 @@ class BatchReport:
     fruits: int = 0
     failed_fruits: int = 0
     stopped: str = ""
+    #: Frames not reached because the batch stopped (a full disk): recorded in ``errors.json`` too.
+    unprocessed: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -83,6 +91,7 @@ def run_batch(
     resume: bool = False,
     progress: bool = True,
     on_frame: Callable[[int, FrameDetections], None] | None = None,
+    exclude: Sequence[str | Path] = (),
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``.
 
@@ -90,28 +99,41 @@ def run_batch(
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
     a frame whose every step succeeded; e.g. to append it to a ROS 2 bag
     (:meth:`symfruit.ros.bag2.Ros2DetectionBag.write_frame`). Frames skipped by ``resume`` are not passed.
+    ``exclude``: further outputs of the run (a ROS 2 bag folder) that are no frames if they lie in the
+    source, and whose names no frame folder takes if they lie in ``output``.
+
+    The output folder is locked while the batch runs (a second batch on it is refused), is never an input
+    folder, and nothing is written through a link out of it (:class:`symfruit.io.outputs.OutputFolder`).
+    Every frame ends done or recorded in ``errors.json``: failed with its reason, or, after a full disk
+    stopped the batch, unprocessed.
 
     Raises
     ------
     SymfruitError
-        Only when the source itself cannot be opened; per-frame problems go into the report.
+        Only when the source itself cannot be opened or the output folder cannot be used (not writable, an
+        input folder, held by another run); per-frame problems go into the report.
     """
     settings = settings or Settings()
     output = Path(output)
     report = BatchReport()
-    src = open_source(source, exclude=[output])
+    src = open_source(source, exclude=[output, *map(Path, exclude)])
     try:
-        output.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
+        files, folders = _source_inputs(src)
+        if is_frame_folder(output):  # a frame left out of the recording as the output is still an input
+            folders.append(output)
+        out = OutputFolder(output, inputs=files, input_folders=folders).open()
+    except BaseException:
         src.close()
-        raise FileFormatError(f"{output}: cannot write to folder ({exc.strerror or exc})") from None
-    for stale in output.glob(".*.tmp"):  # a killed run's half-written errors.json
-        stale.unlink(missing_ok=True)
+        raise
+    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
+    names: list[str] = []
     try:
         names = src.names()
+        reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
+                       entries=len(names), root=out)  # fmt: skip
         with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
             for index, name in enumerate(names):
-                folder = output / frame_folder_name(name)
+                folder = output / frame_folder_name(name, reserved)
                 if resume and (folder / "detections.json").is_file():
                     report.skipped.append(name)
                     bar.update()
@@ -124,27 +146,65 @@ def run_batch(
                     write_detections(folder, found, settings=settings)
                     return found
 
+                clear = partial(_clear_frame, folder, out)
                 done, found, report.stopped = _guarded(one_frame, item=name, failed=report.failed, target=folder,
-                                                       at=f"frame {name}")  # fmt: skip
+                                                       at=f"frame {name}", cleanup=clear)  # fmt: skip
                 if report.stopped:
+                    report.unprocessed = names[index + 1 :]
                     break
                 if done and found is not None:
                     report.done.append(name)
                     report.fruits += sum(d.result is not None for d in found.detections)
                     report.failed_fruits += sum(d.result is None for d in found.detections)
                 bar.update()
+        errors = _errors_record(report.failed, report.unprocessed, report.stopped)
+        try:
+            how = write_record(output / "errors.json", errors, root=out)
+            if how and report.stopped:
+                report.stopped += f"; errors.json {how}"
+        except SymfruitError as exc:
+            report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
     finally:
         src.close()
-    errors = {"failed": [{"frame": k, "reason": v} for k, v in report.failed.items()], "stopped": report.stopped}
-    try:
-        write_json(output / "errors.json", errors)
-    except (SymfruitError, OSError) as exc:
-        report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
+        out.close()
     return report
 
 
-#: Image file suffixes taken from a folder by :func:`segment_images`.
-IMAGE_SUFFIXES = (".jpg", ".jpeg", ".png", ".bmp", ".tif", ".tiff", ".webp")
+def _errors_record(failed: dict[str, str], unprocessed: list[str], stopped: str) -> dict[str, Any]:
+    """``errors.json``: every failed frame with its reason, why the batch stopped, and (when it did) every
+    frame it did not reach."""
+    record: dict[str, Any] = {"failed": [{"frame": k, "reason": v} for k, v in failed.items()], "stopped": stopped}
+    if unprocessed:
+        record["unprocessed"] = unprocessed
+    return record
+
+
+def _source_inputs(src: Any) -> tuple[list[Path], list[Path]]:
+    """What a batch must not write over or into: the source's files and folders (a recording's frames)."""
+    path = Path(src.path)
+    folders = list(src.folders()) if hasattr(src, "folders") else []
+    return ([], [path, *folders]) if path.is_dir() else ([path], folders)
+
+
+def _first_part(path: Path, output: Path) -> str:
+    """The name under ``output`` that ``path`` takes (its first part there), or ``""``."""
+    try:
+        rel = Path(os.path.realpath(path)).relative_to(os.path.realpath(output))
+    except ValueError:
+        return ""
+    return rel.parts[0] if rel.parts else ""
+
+
+def _clear_frame(folder: Path, out: OutputFolder) -> None:
+    """Remove what a frame that failed left in its folder (its outputs of this run or an earlier one)."""
+    if folder.is_dir() and not folder.is_symlink():
+        with contextlib.suppress(SymfruitError, OSError):
+            remove_stale(folder, keep=[])
+
+
+#: Image file suffixes taken from a folder by :func:`segment_images`: every format read when named
+#: (:func:`symfruit.io.images.image_suffixes`; GIF, PPM, TIFF, WebP, ...).
+IMAGE_SUFFIXES = tuple(sorted(image_suffixes()))
 
 #: A mask source as :func:`segment_images` calls it: ``(color, depth=, camera=) -> (h, w) int labels``.
 Masker = Callable[..., np.ndarray]
@@ -175,6 +235,8 @@ class SegmentReport:
     failed: dict[str, str] = field(default_factory=dict)
     stopped: str = ""
     mask_source: str = ""
+    #: Images not reached because the batch stopped (a full disk): recorded in ``segment.json`` too.
+    unprocessed: list[str] = field(default_factory=list)
 
     @property
     def ok(self) -> bool:
@@ -186,7 +248,8 @@ class SegmentReport:
 
 
 def expand_images(paths: Sequence[str | Path]) -> list[Path]:
-    """Image files from files and folders (a folder's images in name order, not recursive).
+    """Image files from files and folders (a folder's images in name order, not recursive: every file in a
+    format that is read when named, :data:`IMAGE_SUFFIXES`; hidden files are left out).
 
     Raises
     ------
@@ -196,7 +259,8 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     out: list[Path] = []
     for p in map(Path, paths):
         if p.is_dir():
-            out += sorted(q for q in p.iterdir() if q.is_file() and q.suffix.lower() in IMAGE_SUFFIXES)
+            listed = [q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES and not q.name.startswith(".")]
+            out += sorted(q for q in listed if q.is_file())
         elif p.is_file():
             out.append(p)
         else:
@@ -253,24 +317,36 @@ T = TypeVar("T")
 
 
 def _guarded(
-    work: Callable[[], T], *, item: str, failed: dict[str, str], target: Path, at: str
+    work: Callable[[], T],
+    *,
+    item: str,
+    failed: dict[str, str],
+    target: Path,
+    at: str,
+    cleanup: Callable[[], None] | None = None,
 ) -> tuple[bool, T | None, str]:
     """One item of a batch inside its error boundary: ``(done, result, stop)``.
 
     A :class:`~symfruit.errors.SymfruitError`, an ``OSError`` or any other exception is recorded in
-    ``failed[item]`` and the batch goes on; a full disk (``ENOSPC``, ``EFBIG``, ``EDQUOT``) while writing
-    ``target`` also returns ``stop``, the reason to stop the batch (``at``: where, e.g. ``frame 0007``).
+    ``failed[item]``, ``cleanup()`` removes what the item left (so a failed item keeps no results, of this run
+    or an earlier one) and the batch goes on; a full disk (``ENOSPC``, ``EFBIG``, ``EDQUOT``, also as an
+    :class:`~symfruit.errors.OutputError`'s ``errno``) while writing ``target`` also returns ``stop``, the
+    reason to stop the batch (``at``: where, e.g. ``frame 0007``).
     """
     try:
         return True, work(), ""
-    except SymfruitError as exc:
-        failed[item] = str(exc)
-    except OSError as exc:
-        if exc.errno in _NO_SPACE:
-            failed[item] = f"cannot write {target}: {exc.strerror}"
-            return False, None, f"stopped at {at}: the output is full ({exc.strerror})"
-        failed[item] = f"{type(exc).__name__}: {exc}"
+    except (SymfruitError, OSError) as exc:
+        if cleanup is not None:
+            cleanup()
+        code = getattr(exc, "errno", None)
+        if code in _NO_SPACE:
+            why = os.strerror(code)
+            failed[item] = f"cannot write {target}: {why}"
+            return False, None, f"stopped at {at}: the output is full ({why})"
+        failed[item] = str(exc) if isinstance(exc, SymfruitError) else f"{type(exc).__name__}: {exc}"
     except Exception as exc:  # the per-item error boundary: record anything and go on
+        if cleanup is not None:
+            cleanup()
         failed[item] = f"{type(exc).__name__}: {exc}"
     return False, None, ""
 
@@ -290,6 +366,12 @@ def segment_images(
     fruit) and ``<stem>_overlay.png`` per image under ``output``, and ``segment.json`` (every image's
     result and every failure).
 
+    Output names never collide: a stem two images share (``a.png``, ``a.jpg``; or one name in two folders)
+    or one that is another image's overlay name (``a_overlay``) becomes ``<stem>+<hash of its path>``
+    (:func:`symfruit.io.outputs.unique_names`); ``segment.json`` lists what each image wrote. The output
+    folder may not be an input folder (the photos', the depth's or the masks'), is locked while the batch
+    runs, and nothing is written over an input or through a link out of it.
+
     Parameters
     ----------
     paths : image files or folders
@@ -301,6 +383,8 @@ def segment_images(
         depth is ``depth_scale`` metres per unit, ``.npy`` is metres. Images without depth are segmented
         on colour alone (``used_depth`` False: no depth split, the size rule a share of the image).
     camera : Camera-like (``fx``, ``fy``; ``cx``, ``cy``), needed with ``depth``
+        With ``width`` and ``height`` (a :class:`~symfruit.core.camera.Camera`) they must be the size of each
+        image segmented with depth (intrinsics of another resolution are refused, as ``detect`` does).
     settings : Settings, optional
     progress : bool
 
@@ -327,50 +411,81 @@ def segment_images(
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
     labeller, source = _labeller(masks, settings, images)
     output = Path(output)
-    try:
-        output.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FileFormatError(f"{output}: cannot write to folder ({exc.strerror or exc})") from None
+    inputs: list[Path] = list(images)
+    folders: list[Path] = sorted({p.parent for p in images})
+    for extra in (depth_path, None if callable(masks) else Path(str(masks))):
+        if extra is not None and extra.is_dir():
+            folders.append(extra)
+        elif extra is not None and extra.is_file():
+            inputs.append(extra)
+    stems = unique_names([p.stem for p in images], [os.path.realpath(p) for p in images], derived=["_overlay"])
     report = SegmentReport(mask_source=source)
-    stems: dict[str, int] = {}
-    with Progress(len(images), "segment", enabled=progress and len(images) > 1) as bar:
-        for path in images:
-            stem = frame_folder_name(path.stem)
-            if stem in stems:  # two images of one name in different folders: both are kept
-                stems[stem] += 1
-                stem = f"{stem}-{stems[stem]}"
-            stems.setdefault(stem, 1)
+    with OutputFolder(output, inputs=inputs, input_folders=folders, what="output folder") as out:
+        reserve_record(output / "segment.json", _segment_record(source, report, [str(p) for p in images],
+                       "the batch is running (or was killed)"), entries=len(images), root=out)  # fmt: skip
+        with Progress(len(images), "segment", enabled=progress and len(images) > 1) as bar:
+            for index, (path, stem) in enumerate(zip(images, stems, strict=True)):
+                targets = (output / f"{stem}.png", output / f"{stem}_overlay.png")
 
-            def one_image(path: Path = path, stem: str = stem) -> SegmentedImage:
-                color = read_color(path)
-                dfile = _depth_file(path, depth_path, len(images))
-                z = _read_depth(dfile, depth_scale, color.shape[:2]) if dfile is not None else None
-                t0 = time.perf_counter()
-                labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
-                ms = (time.perf_counter() - t0) * 1000.0
-                if labels.shape != color.shape[:2] or not np.issubdtype(labels.dtype, np.integer):
-                    raise InputError(f"{path.name}: the mask source gave labels {labels.dtype} {labels.shape}, "
-                                     f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
-                written = (write_labels(output / f"{stem}.png", labels),
-                           write_label_overlay(output / f"{stem}_overlay.png", color, labels))  # fmt: skip
-                used = z is not None and bool((z > 0).any())
-                return SegmentedImage(path, len(np.unique(labels[labels > 0])), used, ms, written)
+                def one_image(path: Path = path, targets: tuple[Path, Path] = targets) -> SegmentedImage:
+                    color = read_color(path)
+                    dfile = _depth_file(path, depth_path, len(images))
+                    z = _read_depth(dfile, depth_scale, color.shape[:2]) if dfile is not None else None
+                    if z is not None:
+                        _check_camera(camera, color.shape[:2], path)
+                    t0 = time.perf_counter()
+                    labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
+                    ms = (time.perf_counter() - t0) * 1000.0
+                    if labels.shape != color.shape[:2]:
+                        raise InputError(f"{path.name}: the mask source gave labels {labels.dtype} {labels.shape}, "
+                                         f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
+                    labels = instance_labels(labels, f"{path.name}: the mask source's labels")
+                    written = (write_labels(targets[0], labels),
+                               write_label_overlay(targets[1], color, labels))  # fmt: skip
+                    used = z is not None and bool((z > 0).any())
+                    return SegmentedImage(path, len(np.unique(labels[labels > 0])), used, ms, written)
 
-            done, image, report.stopped = _guarded(one_image, item=str(path), failed=report.failed, target=output,
-                                                   at=path.name)  # fmt: skip
-            if report.stopped:
-                break
-            if done and image is not None:
-                report.done.append(image)
-            bar.update()
-    record = {
-        "mask_source": source,
-        "images": [d.to_dict() for d in report.done],
-        "failed": [{"image": k, "reason": v} for k, v in report.failed.items()],
-        "stopped": report.stopped,
-    }
-    try:
-        write_json(output / "segment.json", record)
-    except (SymfruitError, OSError) as exc:
-        report.stopped = report.stopped or f"cannot write {output / 'segment.json'} ({exc})"
+                done, image, report.stopped = _guarded(one_image, item=str(path), failed=report.failed,
+                                                       target=output, at=path.name,
+                                                       cleanup=partial(_remove, targets, out))  # fmt: skip
+                if report.stopped:
+                    report.unprocessed = [str(p) for p in images[index + 1 :]]
+                    break
+                if done and image is not None:
+                    report.done.append(image)
+                bar.update()
+        try:
+            how = write_record(output / "segment.json", _segment_record(source, report, report.unprocessed,
+                               report.stopped), root=out)  # fmt: skip
+            if how and report.stopped:
+                report.stopped += f"; segment.json {how}"
+        except SymfruitError as exc:
+            report.stopped = report.stopped or f"cannot write {output / 'segment.json'} ({exc})"
     return report
+
+
+def _segment_record(source: str, report: SegmentReport, unprocessed: list[str], stopped: str) -> dict[str, Any]:
+    """``segment.json``: every image done (what it wrote), every failure, every image not reached."""
+    record = {"mask_source": source, "images": [d.to_dict() for d in report.done],
+              "failed": [{"image": k, "reason": v} for k, v in report.failed.items()], "stopped": stopped}  # fmt: skip
+    if unprocessed:
+        record["unprocessed"] = unprocessed
+    return record
+
+
+def _check_camera(camera: Any, shape: tuple[int, ...], path: Path) -> None:
+    """Intrinsics with a size must be for this image's size (as ``detect`` refuses them for a frame)."""
+    w, h = getattr(camera, "width", None), getattr(camera, "height", None)
+    if w is not None and h is not None and (int(w), int(h)) != (shape[1], shape[0]):
+        raise InputError(f"{path}: the intrinsics (--camera) are for {w}x{h} but the image is {shape[1]}x{shape[0]}; "
+                         "give the intrinsics of this resolution")  # fmt: skip
+
+
+def _remove(paths: Sequence[Path], out: OutputFolder) -> None:
+    """Remove an image's outputs left from a failed attempt (never through a link; never an input)."""
+    for path in paths:
+        with contextlib.suppress(SymfruitError, OSError):
+            out.check(path)
+            with folder_fd(path.parent, root=out, create=False) as fd:
+                with contextlib.suppress(FileNotFoundError, IsADirectoryError):
+                    os.unlink(path.name, dir_fd=fd)

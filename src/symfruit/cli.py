@@ -423,6 +423,9 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     print(f"masks ({source}) on {what}: {s['images']} images, {s['true_fruit']} true fruit, {s['detections']} "
           f"found; mean best-match IoU {iou}; matched {s['matched']} ({share}), missed {s['missed']}, false "
           f"{s['false']} ({s['false_share']:.1%} of found){ms}")  # fmt: skip
+    if s.get("crowd_regions"):
+        print(f"{s['crowd_regions']} crowd regions (iscrowd) ignored as COCO does: not counted as fruit, and "
+              f"{s['ignored_in_crowd']} regions found in them counted neither matched nor false")  # fmt: skip
     print(f"results: {folder} (masks.csv, summary.json, worst.png)")
     return 0
 
@@ -462,11 +465,14 @@ def _detect(args: argparse.Namespace) -> int:
     settings = _settings_for(args)
     with _ros2_bag(args) as bag:
         report = run_batch(args.input, args.output, masks=args.masks, method=_method(args), settings=settings,
-                           resume=args.resume, on_frame=None if bag is None else bag.write_frame)  # fmt: skip
+                           resume=args.resume, on_frame=None if bag is None else bag.write_frame,
+                           exclude=[] if bag is None else [args.ros2_bag])  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
         print(f"  failed {name}: {reason}")
+    if report.unprocessed:
+        print(f"  not processed: {len(report.unprocessed)} frames (listed in errors.json)")
     if report.stopped:
         print(f"symfruit: {report.stopped}", file=sys.stderr)
     print(f"results: {args.output}")

@@ -18,6 +18,7 @@ from .core.box import centre_deviation
 from .detect import Detection, FrameDetections, detect
 from .evaluate.frames import match
 from .io.frames import read_frame
+from .io.outputs import OutputFolder
 from .methods import DEFAULT_METHOD
 from .settings import Settings
 from .writers import write_detections
@@ -62,7 +63,8 @@ def run_demo(output: str | Path, *, method: str = DEFAULT_METHOD, settings: Sett
         frame = read_frame(folder)
     settings = settings or Settings()
     found = detect(frame, method=method, settings=settings)
-    write_detections(output, found, settings=settings)
+    with OutputFolder(output):  # locked while written; no link inside it followed
+        write_detections(output, found, settings=settings)
     truth = frame.truth or []
     ok = [d for d in found.detections if d.result is not None]
     pairs = dict(match([d.visible_box for d in ok], [b for _, b in truth]))

@@ -17,6 +17,7 @@ import numpy as np
 from .core.box import Box
 from .core.camera import Camera
 from .core.frame import Frame
+from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract
@@ -29,7 +30,7 @@ from .settings import Settings
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
 
 #: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
-MAX_FRUIT_PER_FRAME = 1000
+MAX_FRUIT_PER_FRAME = MAX_INSTANCES
 
 
 @dataclass(frozen=True)
@@ -81,7 +82,8 @@ def frame_masks(
         labels, source = source_of(frame.color, frame.depth, frame.camera, name=frame.name, own=frame.masks)
     if labels.shape != shape:
         raise InputError(f"frame {frame.name}: masks are {labels.shape[::-1]}, the image {shape[::-1]}")
-    return labels.astype(np.int32, copy=False), source
+    # whole numbers, at most MAX_INSTANCES fruit; ids beyond 32 bits refused, never truncated into others
+    return instance_labels(labels, f"frame {frame.name}: masks ({source})"), source
 
 
 def detect(

@@ -6,7 +6,7 @@ Every error a user can cause derives from :class:`SymfruitError`, which is also 
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "FileFormatError", "InputError", "SymfruitError"]
+__all__ = ["ConfigError", "FileFormatError", "InputError", "OutputError", "SymfruitError"]
 
 
 class SymfruitError(ValueError):
@@ -23,3 +23,16 @@ class FileFormatError(SymfruitError):
 
 class ConfigError(SymfruitError):
     """A settings file or settings value is invalid."""
+
+
+class OutputError(FileFormatError):
+    """A file cannot be written: the folder is not writable, the disk is full, the target is a folder, an
+    input, or lies behind a link out of the output folder, or another run holds the output folder.
+
+    ``errno`` is the operating system's error number when there was one (``errno.ENOSPC``: the disk is
+    full), else None.
+    """
+
+    def __init__(self, message: str, errno: int | None = None) -> None:
+        super().__init__(message)
+        self.errno = errno

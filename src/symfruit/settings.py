@@ -32,6 +32,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
+from .core.limits import MAX_SETTINGS_BYTES  # settings are a few kB; anything larger is not settings
 from .errors import ConfigError
 
 __all__ = [
@@ -50,8 +51,6 @@ __all__ = [
 
 T = TypeVar("T")
 
-#: Largest settings file read (bytes): settings are a few kB; anything larger is not a settings file.
-MAX_SETTINGS_BYTES = 1 << 20
 
 #: The built-in sections in the order ``Settings``, settings files and ``symfruit settings`` list them:
 #: name, the module declaring the section and its class. The stages import this module, so their classes

@@ -1,5 +1,7 @@
 """Every file symfruit writes, in one place, each written atomically (a temporary file renamed over the
-target, so an interrupted run never leaves a half-written file).
+target, so an interrupted run never leaves a half-written file; :mod:`symfruit.io.atomic`). Inside a run's
+output folder (:class:`symfruit.io.outputs.OutputFolder`: names, inputs, links, one writer) every file
+written here goes through that folder's checks.
 
 ==================  ===================================================================================
 what                files
@@ -22,6 +24,7 @@ from __future__ import annotations
 
 import contextlib
 import datetime as _dt
+import fnmatch
 import os
 from pathlib import Path
 from typing import Any
@@ -30,9 +33,10 @@ import numpy as np
 
 from .core.box import Box
 from .detect import Detection, FrameDetections
-from .errors import FileFormatError
-from .io.atomic import atomic_write, write_json
+from .errors import FileFormatError, OutputError
+from .io.atomic import atomic_write, folder_fd, stale_temporaries, write_json
 from .io.clouds import write_ply
+from .io.images import BAND_PIXELS
 from .methods.complete import Result
 from .settings import Settings
 
@@ -75,12 +79,14 @@ def write_result(path: str | Path, result: Result, *, meta: dict[str, Any] | Non
     path = Path(path)
     if path.suffix.lower() != ".ply":
         raise FileFormatError(f"{path}: the output must end in .ply")
-    if path.is_dir():
-        raise FileFormatError(f"{path}: is a folder; give a file name ending in .ply")
-    write_ply(path, result.points, labels=_labels(result))
+    json_path = path.with_suffix(".json")
+    for target in (path, json_path):  # both checked before either is written
+        if target.is_dir():
+            raise OutputError(f"{target}: is a folder; give a file name ending in .ply (the result goes to "
+                              f"{path.name} and {json_path.name})")  # fmt: skip
     record = {**result.to_dict(), **(meta or {}), "extras": result.extras,
               "settings": result.settings.to_dict()}  # fmt: skip
-    json_path = path.with_suffix(".json")
+    write_ply(path, result.points, labels=_labels(result))
     write_json(json_path, record)
     return path, json_path
 
@@ -148,13 +154,17 @@ def write_detections(folder: str | Path, found: FrameDetections, *, settings: Se
 
     ``detections.json`` is written last: its presence marks the frame as done. Files a previous run left
     in the folder that this run does not write (``fruit_004.ply`` when there are now three fruit, stale
-    temporary files of a killed run) are removed, so the folder holds exactly this run's results.
+    temporary files of a killed run) are removed, so the folder holds exactly this run's results. Inside an
+    open :class:`~symfruit.io.outputs.OutputFolder` (a batch's), a link in the way is refused, never followed.
+
+    Raises
+    ------
+    OutputError
+        When a file cannot be written (``errno`` set for a full disk); the frame is then not done.
     """
     folder = Path(folder)
-    try:
-        folder.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise FileFormatError(f"{folder}: cannot create output folder ({exc.strerror or exc})") from None
+    with folder_fd(folder) as fd, contextlib.suppress(FileNotFoundError, IsADirectoryError):
+        os.unlink("detections.json", dir_fd=fd)  # the frame is not done until its new record is written
     written = []
     for d in found.detections:
         if d.result is not None:
@@ -170,14 +180,20 @@ def write_detections(folder: str | Path, found: FrameDetections, *, settings: Se
     return written
 
 
+def frame_outputs(name: str) -> bool:
+    """Whether ``name`` is one of the files :func:`write_detections` writes into a frame's folder."""
+    return any(fnmatch.fnmatchcase(name, pattern) for pattern in _FRAME_OUTPUTS)
+
+
 def remove_stale(folder: Path, *, keep: list[Path]) -> None:
-    """Delete a previous run's frame outputs and temporary files in ``folder`` that are not in ``keep``."""
+    """Delete a previous run's frame outputs and a killed run's temporary files in ``folder`` that are not
+    in ``keep`` (a live run's temporary files are left alone; inside an output folder links are not followed)."""
     keep_names = {p.name for p in keep}
-    stale = [p for pattern in _FRAME_OUTPUTS for p in folder.glob(pattern) if p.name not in keep_names]
-    stale += list(folder.glob(".*.tmp"))
-    for path in stale:
-        with contextlib.suppress(FileNotFoundError):
-            path.unlink()
+    with folder_fd(folder, create=False) as fd:
+        stale = [n for n in os.listdir(fd) if frame_outputs(n) and n not in keep_names] + stale_temporaries(fd)
+        for name in stale:
+            with contextlib.suppress(FileNotFoundError, IsADirectoryError):
+                os.unlink(name, dir_fd=fd)
 
 
 def new_results_folder(root: str | Path, tag: str) -> Path:
@@ -229,10 +245,12 @@ def draw_overlay(found: FrameDetections) -> Any:
     from PIL import Image, ImageDraw
 
     frame = found.frame
-    image = frame.color.astype(np.float32)
+    image = frame.color.copy()  # tinted fruit by fruit (their masks are disjoint): no full-size float copy
     for i, d in enumerate(found.detections):
-        image[d.mask] = 0.55 * image[d.mask] + 0.45 * _PALETTE[i % len(_PALETTE)]
-    img = Image.fromarray(np.clip(image, 0, 255).astype(np.uint8))
+        tinted = 0.55 * image[d.mask].astype(np.float32) + 0.45 * _PALETTE[i % len(_PALETTE)].astype(np.float32)
+        image[d.mask] = np.clip(tinted, 0, 255).astype(np.uint8)
+    img = Image.fromarray(image)
+    del image
     draw = ImageDraw.Draw(img)
     cam = frame.camera
     for d in found.detections:
@@ -282,13 +300,22 @@ def draw_label_overlay(color: np.ndarray, labels: np.ndarray, *, alpha: float = 
     color, labels = np.asarray(color), np.asarray(labels)
     if color.ndim != 3 or color.shape[:2] != labels.shape:
         raise FileFormatError(f"labels are {labels.shape[::-1]}, the image {color.shape[1::-1]}")
-    img = color[:, :, :3].astype(np.float32)
-    tint = _PALETTE[(labels.astype(np.int64) - 1) % len(_PALETTE)].astype(np.float32)
-    fg = labels > 0
-    img[fg] = (1 - alpha) * img[fg] + alpha * tint[fg]
-    edge = _outline(labels)
-    img[edge] = tint[edge]
-    return Image.fromarray(np.clip(img, 0, 255).astype(np.uint8))
+    h, w = labels.shape
+    out = Image.new("RGB", (w, h))
+    rows = max(1, BAND_PIXELS // max(w, 1))
+    palette = _PALETTE.astype(np.float32)
+    for r0 in range(0, h, rows):  # in bands of rows (one row more each side for the outline): memory stays small
+        r1 = min(r0 + rows, h)
+        a0, a1 = max(r0 - 1, 0), min(r1 + 1, h)
+        lab = labels[r0:r1]
+        edge = _outline(labels[a0:a1])[r0 - a0 : r0 - a0 + (r1 - r0)]
+        img = color[r0:r1, :, :3].astype(np.float32)
+        fg = lab > 0
+        tint = palette[(lab[fg].astype(np.int64) - 1) % len(palette)]
+        img[fg] = (1 - alpha) * img[fg] + alpha * tint
+        img[edge] = palette[(lab[edge].astype(np.int64) - 1) % len(palette)]
+        out.paste(Image.fromarray(np.clip(img, 0, 255).astype(np.uint8)), (0, r0))
+    return out
 
 
 def write_labels(path: str | Path, labels: np.ndarray) -> Path:

@@ -37,3 +37,20 @@ def test_inconsistent_frames_are_refused_by_name(change, message):
     args = {"name": "f", "color": COLOR, "depth": DEPTH, "camera": SMALL_CAM, **change}
     with pytest.raises(InputError, match=message):
         Frame(**args)
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"camera": SMALL_CAM.to_dict()}, "camera must be a symfruit Camera .* got dict"),
+        ({"camera": "camera.json"}, "got str"),
+        ({"depth": np.rint(DEPTH * 1000).astype(np.uint16)}, "depth is uint16; depth must be float metres"),
+        ({"depth": DEPTH * 1000}, "look like millimetres"),
+        ({"masks": np.where(DEPTH > 0, 2**40, 0)}, "beyond 32 bits"),
+        ({"masks": np.zeros((120, 160))}, "whole numbers"),
+    ],
+)
+def test_api_inputs_of_the_wrong_kind_or_units_are_refused(change, message):
+    args = {"name": "f", "color": COLOR, "depth": DEPTH, "camera": SMALL_CAM, **change}
+    with pytest.raises(InputError, match=message):
+        Frame(**args)

@@ -113,3 +113,28 @@ def test_bad_input_is_refused():
 def test_open_square_is_binary_opening_by_a_square(mask, size):
     expected = ndimage.binary_opening(mask, structure=np.ones((size, size), bool))
     assert np.array_equal(open_square(mask, size), expected)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ((float("nan"), 0, np.zeros((3, 3), bool), 40, 30), "u0 must be a whole number of pixels, got nan"),
+        ((0, 0, np.zeros((3, 3), bool), float("inf"), 30), "width must be a whole number"),
+        ((0, 0.5, np.zeros((3, 3), bool), 40, 30), "v0 must be a whole number"),
+        ((39, 0, np.zeros((3, 3), bool), 40, 30), "does not lie in its 40x30 image"),
+        ((0, 0, np.zeros((3, 3), bool), 40, 30, np.zeros((2, 2), bool)), "own must be a bool image"),
+        ((0, 0, np.zeros((3, 3), bool), 30000, 1), "at most 16384 pixels a side"),
+    ],
+)
+def test_an_occlusion_holding_nonsense_is_a_clear_error(args, message):
+    with pytest.raises(InputError, match=message):
+        Occlusion(*args)
+    assert Occlusion(np.int64(2), 1.0, np.zeros((3, 3), bool), 40, 30).v0 == 1
+
+
+def test_occlusion_refuses_a_camera_of_the_wrong_type_and_raw_depth():
+    depth, disc, points = _disc_frame()
+    with pytest.raises(InputError, match="camera must be a symfruit Camera, got dict"):
+        occlusion(depth, disc, points, CAM.to_dict())
+    with pytest.raises(InputError, match="uint16; depth must be float metres"):
+        occlusion(np.rint(depth * 1000).astype(np.uint16), disc, points, CAM)

@@ -151,3 +151,33 @@ def test_colour_segmenter_on_real_photos():
     assert s["mean_best_iou"] >= 0.84
     assert s["matched"] >= 29
     assert s["false"] <= 2
+
+
+def test_a_category_no_annotation_has_is_refused(tmp_path):
+    truth = _coco_folder(tmp_path)
+    with pytest.raises(
+        InputError, match=r"no annotation has category 5; the annotations have 1 \(fruit\), 2 \(people\)"
+    ):
+        evaluate_masks(tmp_path, truth, segment, category=5)
+
+
+def test_crowd_regions_are_ignored_as_coco_does(tmp_path):
+    truth = _coco_folder(tmp_path)
+    coco = json.loads(truth.read_text())
+    coco["annotations"][1]["iscrowd"] = 1  # the right-hand fruit becomes a crowd region: found there, not false
+    truth.write_text(json.dumps(coco))
+    s = evaluate_masks(tmp_path, truth, segment).summary
+    assert (s["true_fruit"], s["matched"], s["false"], s["detections"]) == (1, 1, 0, 1)
+    assert s["crowd_regions"] == 1 and s["ignored_in_crowd"] == 1
+
+
+def test_scoring_with_crowd_regions_known_answer():
+    labels = np.zeros((10, 10), np.int32)
+    labels[0:4, 0:4], labels[6:10, 6:10], labels[0:2, 8:10] = 1, 2, 3
+    truth = np.zeros((1, 10, 10), bool)
+    truth[0, 0:4, 0:4] = True
+    crowd = np.zeros((10, 10), bool)
+    crowd[5:10, 5:10] = True  # holds region 2 whole; region 3 lies outside
+    s = score_masks(truth, labels, ignore=crowd, crowd=1)
+    assert (s.matched, s.n_pred, s.false, s.ignored, s.crowd) == (1, 2, 1, 1, 1)
+    assert score_masks(truth, labels).false == 2

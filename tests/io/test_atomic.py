@@ -3,6 +3,8 @@
 import json
 import os
 import stat
+import subprocess
+import sys
 
 import pytest
 
@@ -54,3 +56,51 @@ def test_json_is_indented_ends_with_a_newline_and_refuses_nan(tmp_path):
     with pytest.raises(ValueError, match="Out of range float"):
         write_json(path, {"x": float("nan")})
     assert json.loads(path.read_text()) == {"x": 1} and [p.name for p in tmp_path.iterdir()] == ["a.json"]
+
+
+def test_a_link_inside_an_output_folder_is_refused_never_followed(tmp_path):
+    from symfruit import OutputError
+    from symfruit.io.outputs import OutputFolder
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "frame").symlink_to(elsewhere, target_is_directory=True)
+    with OutputFolder(tmp_path / "out"):
+        with pytest.raises(OutputError, match=r"frame: is a symbolic link .*does not write through links"):
+            write_json(tmp_path / "out" / "frame" / "detections.json", {})
+        with pytest.raises(OutputError, match="is a symbolic link"):
+            write_json(tmp_path / "out" / "frame" / "deeper" / "x.json", {})
+        write_json(tmp_path / "out" / "real" / "x.json", {"ok": True})  # plain folders are made as needed
+    assert list(elsewhere.iterdir()) == [] and (tmp_path / "out" / "real" / "x.json").is_file()
+    # outside an output folder, a path the user names is theirs: its links are followed
+    write_json(tmp_path / "out" / "frame" / "mine.json", {})
+    assert (elsewhere / "mine.json").is_file()
+
+
+def test_a_file_link_at_the_target_is_replaced_not_written_through(tmp_path):
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep")
+    (tmp_path / "out.json").symlink_to(victim)
+    write_json(tmp_path / "out.json", {"new": 1})
+    assert victim.read_text() == "keep" and not (tmp_path / "out.json").is_symlink()
+
+
+def test_a_target_that_is_a_folder_is_one_clear_error(tmp_path):
+    from symfruit import OutputError
+
+    (tmp_path / "out.json").mkdir()
+    with pytest.raises(OutputError, match=r"out\.json: is a folder"):
+        write_json(tmp_path / "out.json", {})
+    assert [p.name for p in tmp_path.iterdir()] == ["out.json"]  # no temporary left
+
+
+def test_only_a_dead_runs_temporaries_are_stale(tmp_path):
+    from symfruit.io.atomic import folder_fd, stale_temporaries
+
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    names = [f".a.json.{os.getpid()}-0001.tmp", f".b.json.{int(dead.stdout)}-0002.tmp", ".c.json.xyz.tmp", "d.tmp"]
+    for name in names:
+        (tmp_path / name).write_text("")
+    with folder_fd(tmp_path) as fd:
+        assert sorted(stale_temporaries(fd)) == sorted(names[1:3])  # this live run's one is kept

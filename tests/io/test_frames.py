@@ -108,7 +108,11 @@ def test_depth_units_and_scale(tmp_path, units, scale):
     write_frame(tmp_path / "f", color, depth, CAM)
     raw = np.asarray(Image.open(tmp_path / "f" / "depth.png")).astype(np.float32)
     (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), "depth_units": units}))
-    assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
+    if units == "m":  # millimetre values declared as metres: 1000 m to every pixel is refused, not used
+        with pytest.raises(InputError, match="look like millimetres"):
+            read_frame(tmp_path / "f")
+    else:
+        assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
     (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 0.0002}))
     assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(0.0002))
 

@@ -236,3 +236,52 @@ def test_any_annotation_gives_masks_or_a_file_format_error(tmp_path_factory, seg
     except FileFormatError:
         return
     assert masks.dtype == bool and masks.shape == (1, 20, 30)
+
+
+def _coco_file(tmp_path, images, annotations, name="c.json"):
+    path = tmp_path / name
+    path.write_text(json.dumps({"images": images, "annotations": annotations,
+                                "categories": [{"id": 1, "name": "strawberry"}]}))  # fmt: skip
+    return path
+
+
+def test_two_images_sharing_an_id_or_a_name_are_refused(tmp_path):
+    from symfruit.io.masks import read_coco
+
+    same_id = [{"id": 3, "file_name": "a.png"}, {"id": 3, "file_name": "b.png"}]
+    with pytest.raises(FileFormatError, match=r"'a\.png' and 'b\.png' share the image id 3"):
+        read_coco(_coco_file(tmp_path, same_id, []))
+    same_name = [{"id": 1, "file_name": "a.png"}, {"id": 2, "file_name": "a.png"}]
+    with pytest.raises(FileFormatError, match=r"two 'images' entries are named 'a\.png'"):
+        read_coco(_coco_file(tmp_path, same_name, []))
+
+
+def test_annotations_that_are_not_objects_are_refused_not_an_empty_frame(tmp_path):
+    from symfruit.io.masks import coco_masks
+
+    path = _coco_file(tmp_path, [{"id": 1, "file_name": "a.png"}], [[1, 2, 3], "x"])
+    with pytest.raises(FileFormatError, match="annotation 1 is a list, not an object"):
+        coco_masks(path, (10, 10))
+    bad_images = tmp_path / "d.json"
+    bad_images.write_text(json.dumps({"images": ["a.png"], "annotations": []}))
+    with pytest.raises(FileFormatError, match="'images' must be a list of objects"):
+        coco_masks(bad_images, (10, 10))
+
+
+def test_crowd_regions_are_no_instances_and_a_missing_category_is_named(tmp_path):
+    from symfruit import InputError
+    from symfruit.io.masks import coco_masks, read_coco
+
+    box = [[1, 1, 6, 1, 6, 6, 1, 6]]
+    anns = [{"id": 1, "image_id": 1, "category_id": 1, "segmentation": box},
+            {"id": 2, "image_id": 1, "category_id": 1, "iscrowd": 1, "segmentation": [[8, 8, 9, 8, 9, 9]]}]  # fmt: skip
+    path = _coco_file(tmp_path, [{"id": 1, "file_name": "a.png", "height": 10, "width": 10}], anns)
+    coco = read_coco(path)
+    assert coco.instances("a.png", (10, 10)).shape == (1, 10, 10)
+    crowd, n = coco.crowd("a.png", (10, 10))
+    assert n == 1 and crowd[8, 8] and not crowd[2, 2]
+    assert set(np.unique(coco_masks(path, (10, 10)))) == {0, 1}
+    with pytest.raises(InputError, match=r"no annotation has category 2; the annotations have 1 \(strawberry\)"):
+        coco.check_category(2)
+    coco.check_category(None)
+    coco.check_category(1)

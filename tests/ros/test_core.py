@@ -202,3 +202,44 @@ def test_latest_only_drops_waiting_items_and_survives_errors():
         worker.stop()
     assert handled == [1, 3, "boom", 4] and worker.handled == 4
     assert worker.dropped == 1 and errors == [("boom", ValueError)]
+
+
+@pytest.mark.parametrize(
+    ("change", "match"),
+    [({"width": 30000, "height": 20}, "at most 16384 pixels a side"),
+     ({"width": 100_000, "height": 100_000}, "larger than 40,000,000 pixels"),
+     ({"height": -3}, "empty"), ({"height": "many"}, "must be whole numbers"),
+     ({"step": -1}, "step"), ({"is_bigendian": 1, "encoding": "rgb8"}, None)],
+)  # fmt: skip
+def test_malformed_colour_messages_are_refused_before_their_data_is_touched(change, match):
+    msg = image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8")
+    for k, v in change.items():
+        setattr(msg, k, v)
+    args = (image_msg(np.ones((4, 4), np.uint16), "16UC1"), info_msg(width=4, height=4, cx=2, cy=2))
+    if match is None:  # byte order means nothing for 8-bit data: the frame is read as it is
+        assert frame_of(msg, *args).color.shape == (4, 4, 3)
+        return
+    with pytest.raises((SymfruitError, ValueError), match=match) as err:
+        frame_of(msg, *args)
+    assert isinstance(err.value, SymfruitError)
+
+
+def test_depth_in_millimetres_as_float_metres_and_non_finite_depth():
+    color = image_msg(np.zeros((8, 8, 3), np.uint8), "rgb8")
+    info = info_msg(width=8, height=8, cx=4, cy=4)
+    with pytest.raises(InputError, match="look like millimetres"):
+        frame_of(color, image_msg(np.full((8, 8), 450.0, np.float32), "32FC1"), info)
+    odd = np.full((8, 8), 0.5, np.float32)
+    odd[0, :3] = [np.nan, np.inf, -np.inf]
+    assert frame_of(color, image_msg(odd, "32FC1"), info).depth[0, :3].tolist() == [0.0, 0.0, 0.0]
+
+
+def test_stamps_out_of_order_and_odd_headers_are_carried_as_given():
+    color = image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8")
+    depth = image_msg(np.ones((4, 4), np.uint16), "16UC1")
+    info = info_msg(width=4, height=4, cx=2, cy=2)
+    stamps = []
+    for secs in (9, 3, 7):  # a replayed or reordered stream: each frame keeps its own stamp
+        color.header = header(secs=secs, nsecs=0)
+        stamps.append(message_frame(color, depth, info).stamp)
+    assert stamps == [9_000_000_000, 3_000_000_000, 7_000_000_000]

@@ -86,6 +86,21 @@ def test_a_generated_recording_repeats_its_scenes_cheaply(tmp_path):
     assert len(src.read(3).truth) == 8
 
 
+def test_write_scenes_never_writes_through_a_link_and_holds_its_folder(tmp_path):
+    from symfruit import OutputError
+    from symfruit.io.outputs import OutputFolder
+
+    elsewhere = tmp_path / "elsewhere"
+    elsewhere.mkdir()
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "scene_00000").symlink_to(elsewhere, target_is_directory=True)
+    with pytest.raises(OutputError, match="scene_00000: is a symbolic link"):
+        write_scenes(tmp_path / "out", 1, n_ripe=1, n_unripe=0, n_leaves=0)
+    assert list(elsewhere.iterdir()) == []
+    with OutputFolder(tmp_path / "o2"), pytest.raises(OutputError, match="another symfruit run"):
+        write_scenes(tmp_path / "o2", 1)
+
+
 def test_a_scene_through_a_real_camera_has_its_resolution_and_the_annotators_masks():
     from symfruit.synthetic.sensors import SENSOR_MODELS
 

@@ -11,15 +11,11 @@ from dataclasses import asdict, dataclass
 import numpy as np
 
 from ..errors import InputError
+from .limits import MAX_FOCAL_PX, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
 
 __all__ = ["DEFAULT_CAMERA", "MAX_FOCAL_PX", "MAX_IMAGE_PIXELS", "MAX_IMAGE_SIDE", "Camera"]
 
-#: Largest image side accepted (pixels) and largest image (pixels): an 8K x 5K sensor fits; a depth
-#: camera gives about 1 MP. Intrinsics beyond these are refused before anything is allocated for them.
-MAX_IMAGE_SIDE = 16384
-MAX_IMAGE_PIXELS = 40_000_000
-#: Largest focal length accepted (pixels): a 16K-pixel sensor behind a 60x telephoto stays below it.
-MAX_FOCAL_PX = 1e6
+# The bounds (image side and size, focal length) live with every other bound in .limits.
 
 
 @dataclass(frozen=True)

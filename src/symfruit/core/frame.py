@@ -10,6 +10,7 @@ import numpy as np
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
+from .limits import depth_metres, instance_labels
 
 __all__ = ["Frame"]
 
@@ -52,6 +53,14 @@ class Frame:
     extras: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.camera, Camera):
+            raise InputError(f"frame {self.name}: camera must be a symfruit Camera (symfruit.Camera or "
+                             f"symfruit.io.camera_from_dict), got {type(self.camera).__name__}")  # fmt: skip
+        object.__setattr__(self, "color", np.asarray(self.color))
+        # float metres, within the image bounds: uint16 millimetres handed over as metres are refused here
+        object.__setattr__(self, "depth", depth_metres(self.depth, f"frame {self.name}"))
+        if self.masks is not None:
+            object.__setattr__(self, "masks", instance_labels(self.masks, f"frame {self.name}: masks"))
         if self.color.ndim != 3 or self.color.shape[2] != 3 or self.color.dtype != np.uint8:
             raise InputError(f"frame {self.name}: colour must be (h, w, 3) uint8 RGB, got {self.color.dtype} "
                              f"{self.color.shape}")  # fmt: skip

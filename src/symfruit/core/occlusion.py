@@ -21,6 +21,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from .camera import Camera
+from .limits import check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette
 
@@ -57,8 +58,24 @@ class Occlusion:
         hidden = np.asarray(self.hidden)
         if hidden.ndim != 2 or hidden.dtype != bool:
             raise InputError(f"occlusion hidden must be a 2-D bool image, got {hidden.dtype} {hidden.shape}")
-        if self.width <= 0 or self.height <= 0:
-            raise InputError(f"occlusion image size must be positive, got {self.width}x{self.height}")
+        object.__setattr__(self, "hidden", hidden)
+        for name in ("u0", "v0", "width", "height"):  # NaN, inf or fractions would index nonsense later
+            value = getattr(self, name)
+            if isinstance(value, bool) or not isinstance(value, (int, np.integer, float, np.floating)):
+                raise InputError(f"occlusion {name} must be a whole number of pixels, got {value!r}")
+            if not np.isfinite(value) or float(value) != int(value):
+                raise InputError(f"occlusion {name} must be a whole number of pixels, got {value!r}")
+            object.__setattr__(self, name, int(value))
+        check_image_size(self.width, self.height, "occlusion")
+        h, w = hidden.shape
+        if not (0 <= self.u0 and 0 <= self.v0 and self.u0 + w <= self.width and self.v0 + h <= self.height):
+            raise InputError(f"occlusion window {w}x{h} at ({self.u0}, {self.v0}) does not lie in its "
+                             f"{self.width}x{self.height} image")  # fmt: skip
+        if self.own is not None:
+            own = np.asarray(self.own)
+            if own.shape != hidden.shape or own.dtype != bool:
+                raise InputError(f"occlusion own must be a bool image of the window's {w}x{h}, got {own.dtype} "
+                                 f"{own.shape}")  # fmt: skip
 
     def at(self, u: np.ndarray, v: np.ndarray, *, radius: int = 0) -> np.ndarray:
         """Whether pixels ``(u, v)`` are hidden, or have a hidden pixel within ``radius`` (a square).
@@ -194,7 +211,9 @@ def occlusion(
     InputError
         On images of the wrong shape or no point in the image.
     """
-    depth = np.asarray(depth)
+    if not isinstance(camera, Camera):
+        raise InputError(f"occlusion: camera must be a symfruit Camera, got {type(camera).__name__}")
+    depth = depth_metres(depth, "occlusion depth")
     mask = np.asarray(mask, dtype=bool)
     shape = (camera.height, camera.width)
     if depth.shape != shape or mask.shape != shape:

@@ -15,6 +15,7 @@ from scipy import ndimage
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
+from .limits import MAX_WINDOW_PIXELS
 from .points import as_points
 
 __all__ = [
@@ -30,9 +31,8 @@ __all__ = [
     "silhouette_coverage",
 ]
 
-#: Largest image window one fruit may cover (pixels): 2000 x 2000, far more than any fruit in a
-#: harvesting camera's view; beyond it the intrinsics or the units are wrong (and the buffers would be).
-MAX_WINDOW_PIXELS = 4_000_000
+# MAX_WINDOW_PIXELS (.limits): the largest image window one fruit may cover, 2000 x 2000, far more than any
+# fruit in a harvesting camera's view; beyond it the intrinsics or the units are wrong (and the buffers would be).
 
 
 @dataclass(frozen=True)

@@ -43,7 +43,12 @@ CSV_COLUMNS = ("image", "n_true", "n_pred", "matched", "missed", "false", "mean_
 #: A segmenter as the protocol calls it: ``segment(color, **extra) -> (h, w) int labels``.
 Segmenter = Callable[..., np.ndarray]
 #: One evaluation item: ``(name, color, truth)`` or ``(name, color, truth, extra keyword arguments)``.
-Item = tuple[str, np.ndarray, np.ndarray] | tuple[str, np.ndarray, np.ndarray, dict[str, Any]]
+#: A fifth element ``(crowd mask, crowd count)`` gives the image's crowd regions (:func:`score_masks` ``ignore``).
+Item = (
+    tuple[str, np.ndarray, np.ndarray]
+    | tuple[str, np.ndarray, np.ndarray, dict[str, Any]]
+    | tuple[str, np.ndarray, np.ndarray, dict[str, Any], tuple[np.ndarray, int]]
+)
 
 
 def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
@@ -153,6 +158,10 @@ class ImageScore:
     n_pred: int
     matched: int
     ms: float = float("nan")
+    #: Crowd regions of the image (COCO ``iscrowd``: no fruit to find), and predictions lying in them, which
+    #: count neither as matched nor as false (left out of ``n_pred``), as COCO's evaluation does.
+    crowd: int = 0
+    ignored: int = 0
 
     @property
     def n_true(self) -> int:
@@ -181,7 +190,14 @@ class ImageScore:
 
 
 def score_masks(
-    truth: np.ndarray, labels: np.ndarray, *, threshold: float = 0.5, image: str = "", ms: float = float("nan")
+    truth: np.ndarray,
+    labels: np.ndarray,
+    *,
+    threshold: float = 0.5,
+    image: str = "",
+    ms: float = float("nan"),
+    ignore: np.ndarray | None = None,
+    crowd: int = 0,
 ) -> ImageScore:
     """Score one image's predicted labels against its true masks.
 
@@ -191,11 +207,26 @@ def score_masks(
     labels : (h, w) int, 0 background
     threshold : float
         IoU a match needs.
+    ignore : (h, w) bool, optional
+        Crowd regions (``crowd`` of them): an unmatched prediction with at least ``threshold`` of its area
+        in them is ignored, neither matched nor false (COCO's rule for ``iscrowd`` annotations).
     """
-    ious, _ = mask_ious(truth, labels)
+    ious, ids = mask_ious(truth, labels)
     best = ious.max(axis=1) if ious.shape[1] else np.zeros(ious.shape[0])
     pairs = match_masks(ious, threshold=threshold)
-    return ImageScore(image, best, int(ious.shape[1]), len(pairs), float(ms))
+    ignored = 0
+    if ignore is not None and len(ids):
+        ignore = np.asarray(ignore, dtype=bool)
+        if ignore.shape != np.shape(labels):
+            raise InputError(f"crowd regions are {ignore.shape[::-1]}, the labels {np.shape(labels)[::-1]}")
+        values, inverse = np.unique(np.asarray(labels), return_inverse=True)
+        area = np.bincount(inverse.ravel(), minlength=len(values))
+        inside = np.bincount(inverse.ravel()[ignore.ravel()], minlength=len(values))
+        share = inside[values > 0] / np.maximum(area[values > 0], 1)
+        unmatched = np.ones(len(ids), bool)
+        unmatched[pairs[:, 1]] = False
+        ignored = int(np.count_nonzero(unmatched & (share >= threshold)))
+    return ImageScore(image, best, int(ious.shape[1]) - ignored, len(pairs), float(ms), int(crowd), ignored)
 
 
 def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
@@ -218,6 +249,8 @@ def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
         "matched_share": matched / n_true if n_true else None,
         "false_share": (n_pred - matched) / n_pred if n_pred else 0.0,
         "images_with_false": int(sum(s.false > 0 for s in scores)),
+        "crowd_regions": int(sum(s.crowd for s in scores)),
+        "ignored_in_crowd": int(sum(s.ignored for s in scores)),
         "ms_median": float(np.median(ms)) if len(ms) else None,
         "ms_p90": float(np.percentile(ms, 90)) if len(ms) else None,
     }
@@ -253,11 +286,12 @@ def evaluate_mask_items(
     for k, item in enumerate(items):
         name, color, truth = item[0], item[1], item[2]
         extra: dict[str, Any] = item[3] if len(item) > 3 else {}
+        ignore, crowd = item[4] if len(item) > 4 else (None, 0)
         t0 = time.perf_counter()
         labels = np.asarray(segment(color, **extra))
         ms = (time.perf_counter() - t0) * 1000.0
         truth = truth_stack(truth, labels.shape)
-        score = score_masks(truth, labels, threshold=threshold, image=name, ms=ms)
+        score = score_masks(truth, labels, threshold=threshold, image=name, ms=ms, ignore=ignore, crowd=crowd)
         scores.append(score)
         if keep_worst > 0:
             worst.append((score.badness(), k, (name, color, truth, labels)))
@@ -269,14 +303,17 @@ def evaluate_mask_items(
 
 def coco_items(
     images: str | Path, truth: str | Path, *, category: int | None = 1, names: Sequence[str] | None = None
-) -> Iterator[tuple[str, np.ndarray, np.ndarray]]:
-    """``(file name, colour, true masks)`` for every image of a COCO file found in ``images``, by name.
+) -> Iterator[Item]:
+    """``(file name, colour, true masks, {}, (crowd mask, crowd count))`` for every image of a COCO file found
+    in ``images``, by name. Crowd regions (``iscrowd: 1``) are no true fruit; predictions in them are ignored.
 
     Raises
     ------
     FileFormatError
         When ``images`` is not a folder, no image is left to evaluate, or an image listed in the file
         (and wanted) is missing from the folder.
+    InputError
+        When no annotation has ``category``.
     """
     from ..io.images import read_color
     from ..io.masks import read_coco
@@ -285,6 +322,7 @@ def coco_items(
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: not a folder of images")
     coco = read_coco(truth)
+    coco.check_category(category)  # a category no annotation has would score every image as fruitless
     entries = coco.entries()
     if names is not None:
         wanted = {Path(n).name for n in names}
@@ -299,7 +337,8 @@ def coco_items(
         if not path.is_file():
             raise FileFormatError(f"{folder / name}: listed in {coco.path.name} but not in {folder}")
         color = read_color(path)
-        yield name, color, coco.instances(name, color.shape[:2], category=category)
+        crowd = coco.crowd(name, color.shape[:2], category=category)
+        yield name, color, coco.instances(name, color.shape[:2], category=category), {}, crowd
 
 
 def evaluate_masks(

@@ -11,11 +11,13 @@ from .frames import is_frame_folder, read_frame, write_frame
 from .images import read_color, read_depth_units, read_labels
 from .intrinsics import camera_from_dict, load_camera
 from .meshes import read_mesh
+from .outputs import OutputFolder
 from .sources import FrameSource, open_source, register_source
 
 __all__ = [
     "CLOUD_READERS",
     "FrameSource",
+    "OutputFolder",
     "atomic_write",
     "camera_from_dict",
     "is_frame_folder",

@@ -24,6 +24,7 @@ import numpy as np
 
 from ..core.camera import Camera
 from ..core.frame import Frame
+from ..core.limits import MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 
 __all__ = [
@@ -41,8 +42,9 @@ _ENCODINGS: dict[str, tuple[type, int]] = {
     "mono8": (np.uint8, 1), "8uc1": (np.uint8, 1), "8uc3": (np.uint8, 3), "16uc1": (np.uint16, 1),
     "mono16": (np.uint16, 1), "32fc1": (np.float32, 1),
 }  # fmt: skip
-#: Largest image a message may claim (pixels), checked before its data is touched.
-MAX_MESSAGE_PIXELS = 40_000_000
+#: Largest image a message may claim (pixels), checked before its data is touched (with the largest side:
+#: :func:`symfruit.core.limits.check_image_size`).
+MAX_MESSAGE_PIXELS = MAX_IMAGE_PIXELS
 
 
 def _require_rosbags() -> Any:
@@ -78,9 +80,14 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if enc not in _ENCODINGS:
         raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of {', '.join(_ENCODINGS)})")
     dtype, channels = _ENCODINGS[enc]
-    h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    try:
+        h, w, step = int(msg.height), int(msg.width), int(msg.step)
+    except (TypeError, ValueError, OverflowError, AttributeError):
+        sizes = ", ".join(repr(getattr(msg, k, None)) for k in ("height", "width", "step"))
+        raise FileFormatError(f"image height, width and step must be whole numbers, got {sizes}") from None
     if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
         raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
+    check_image_size(w, h, f"{enc} image message", error=FileFormatError)
     dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
     row_bytes = w * channels * dt.itemsize
     if step < row_bytes:

@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
 from ..errors import FileFormatError
 from .atomic import atomic_write
 
@@ -22,11 +23,9 @@ __all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", 
 
 #: Largest header we read before giving up on finding its end.
 _MAX_HEADER = 1 << 16
-#: Most points any cloud file may hold (a 1280x720 depth frame is 0.9 million); more is refused before
-#: it is allocated.
-MAX_CLOUD_POINTS = 5_000_000
-#: Largest text cloud read (bytes): 5 million rows of three numbers.
-MAX_TEXT_BYTES = 256 << 20
+#: Most points any cloud file may hold (a 1280x720 depth frame is 0.9 million; more is refused before it is
+#: allocated), and the largest text cloud read (bytes): :mod:`symfruit.core.limits`.
+MAX_TEXT_BYTES = MAX_TEXT_CLOUD_BYTES
 
 
 def read_cloud(path: str | Path) -> np.ndarray:

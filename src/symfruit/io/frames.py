@@ -25,6 +25,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
+from ..core.limits import MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
@@ -43,10 +44,8 @@ __all__ = [
 DEFAULT_DEPTH_SCALE = 0.001
 #: Colour image names a frame folder may use, in order of preference.
 COLOR_NAMES = ("color.png", "color.jpg", "color.jpeg")
-#: Largest truth.json read (bytes).
-MAX_TRUTH_BYTES = 16 << 20
-#: Largest depth.npy read (elements): a 40-megapixel image.
-MAX_DEPTH_ELEMENTS = 40_000_000
+#: Largest truth.json read (bytes), and largest depth.npy (elements): :mod:`symfruit.core.limits`.
+MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
 
 
 def _first(folder: Path, *names: str) -> Path | None:
@@ -107,6 +106,7 @@ def read_depth_npy(path: Path) -> np.ndarray:
         raise FileFormatError(f"{path}: depth must be a 2-D float array in metres, got {dtype} {shape}")
     if int(np.prod(shape)) > MAX_DEPTH_ELEMENTS:
         raise FileFormatError(f"{path}: depth is {shape[1]}x{shape[0]}; at most {MAX_DEPTH_ELEMENTS:,} pixels are read")
+    check_image_size(shape[1], shape[0], str(path), error=FileFormatError)
     try:
         depth = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:

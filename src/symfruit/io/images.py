@@ -25,10 +25,22 @@ from typing import Any
 
 import numpy as np
 
-from ..core.camera import MAX_IMAGE_PIXELS  # checked from the header, before any pixel is decoded
+from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  # checked before decoding
 from ..errors import FileFormatError
 
-__all__ = ["MAX_IMAGE_PIXELS", "decode_color", "read_color", "read_depth_units", "read_labels"]
+__all__ = ["MAX_IMAGE_PIXELS", "decode_color", "image_suffixes", "read_color", "read_depth_units", "read_labels"]
+
+#: Suffixes Pillow opens that symfruit reads as something else (``.pcd``: a point cloud, not a Kodak PhotoCD).
+_NOT_IMAGES = {".pcd"}
+
+
+def image_suffixes() -> frozenset[str]:
+    """The file suffixes (lower case, with the dot) of every format :func:`read_color` opens: a folder
+    listing takes exactly these, so a folder yields every image that would be read if named on its own."""
+    from PIL import Image
+
+    Image.init()
+    return frozenset(e.lower() for e, fmt in Image.registered_extensions().items() if fmt in Image.OPEN) - _NOT_IMAGES
 
 
 _COLOUR_MODES = {"RGB", "RGBA", "RGBX", "RGBa", "P", "PA", "L", "LA", "La", "1", "CMYK", "YCbCr", "LAB", "HSV"}
@@ -49,10 +61,13 @@ def _open(source: Path | bytes, label: str) -> Any:
         raise FileFormatError(f"{label}: image too large ({exc})") from None
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
         raise FileFormatError(f"{label}: cannot read image ({exc})") from None
-    w, h = img.size
-    if w <= 0 or h <= 0 or w * h > MAX_IMAGE_PIXELS:
+    try:
+        check_image_size(
+            *img.size, label, error=FileFormatError, max_pixels=MAX_IMAGE_PIXELS
+        )  # sides and pixels, from the header
+    except FileFormatError:
         img.close()
-        raise FileFormatError(f"{label}: image is {w}x{h} pixels; at most {MAX_IMAGE_PIXELS:,} pixels are read")
+        raise
     return img
 
 
@@ -68,18 +83,40 @@ def _decode(img: Any, label: str) -> Any:
     return img
 
 
+#: Pixels converted at a time: a decoded image is copied out of Pillow in bands of rows, so reading one costs
+#: its decoded size plus the result, not several full-size temporaries (a 39-MP photo: ~0.3 GB, not ~1 GB).
+BAND_PIXELS = 1 << 20
+
+
+def _banded(img: Any, out: np.ndarray, convert: Any) -> np.ndarray:
+    """Fill ``out`` (``(h, w, ...)``) with ``convert(band)`` of each band of rows of the decoded ``img``."""
+    w, h = img.size
+    rows = max(1, BAND_PIXELS // max(w, 1))
+    for r0 in range(0, h, rows):
+        r1 = min(r0 + rows, h)
+        out[r0:r1] = convert(img.crop((0, r0, w, r1)))
+    return out
+
+
 def _to_rgb(img: Any, label: str) -> np.ndarray:
     mode = img.mode
+    w, h = img.size
+    out = np.empty((h, w, 3), np.uint8)
     if mode == "RGB":
-        return np.asarray(img, dtype=np.uint8)
+        return _banded(img, out, lambda band: np.asarray(band, dtype=np.uint8))
     if mode in _COLOUR_MODES:
-        return np.asarray(img.convert("RGB"), dtype=np.uint8)
+        return _banded(img, out, lambda band: np.asarray(band.convert("RGB"), dtype=np.uint8))
     if mode in _WIDE_GREY:
-        grey = np.asarray(img).astype(np.int64)
-        if grey.size and (grey.min() < 0 or grey.max() > 65535):
+        lo, hi = img.getextrema()
+        if lo < 0 or hi > 65535:
             raise FileFormatError(f"{label}: 32-bit grey values outside 0-65535 cannot be a colour image")
-        grey8 = (grey >> 8 if mode != "I" or (grey.size and grey.max() > 255) else grey).astype(np.uint8)
-        return np.repeat(grey8[:, :, None], 3, axis=2)
+        shift = 8 if mode != "I" or hi > 255 else 0
+
+        def grey(band: Any) -> np.ndarray:
+            g = (np.asarray(band).astype(np.int64) >> shift).astype(np.uint8)
+            return g[:, :, None]
+
+        return _banded(img, out, grey)
     raise FileFormatError(f"{label}: image mode {mode!r} cannot be read as colour (use 8-bit RGB)")
 
 
@@ -87,13 +124,13 @@ def read_color(path: str | Path) -> np.ndarray:
     """A colour image as ``(h, w, 3) uint8`` RGB, from any mode listed in the module docstring."""
     path = Path(path)
     with _open(path, str(path)) as img:
-        return np.ascontiguousarray(_to_rgb(_decode(img, str(path)), str(path)))
+        return _to_rgb(_decode(img, str(path)), str(path))
 
 
 def decode_color(data: bytes, label: str) -> np.ndarray:
     """:func:`read_color` for encoded bytes (a ``CompressedImage``'s JPEG or PNG)."""
     with _open(bytes(data), label) as img:
-        return np.ascontiguousarray(_to_rgb(_decode(img, label), label))
+        return _to_rgb(_decode(img, label), label)
 
 
 def read_depth_units(path: str | Path) -> np.ndarray:
@@ -124,12 +161,14 @@ def read_labels(path: str | Path) -> np.ndarray:
             keys = rgb[:, :, 0] << 16 | rgb[:, :, 1] << 8 | rgb[:, :, 2]
             _, inverse = np.unique(keys.ravel(), return_inverse=True)
             labels = inverse.reshape(keys.shape).astype(np.int32)  # black (key 0) sorts first: label 0
-            return labels if keys.min() == 0 else labels + 1
+            return instance_labels(labels if keys.min() == 0 else labels + 1, str(path), error=FileFormatError)
         if mode in ("1", "L", "P") or mode in _WIDE_GREY:
-            labels = np.asarray(img).astype(np.int64)
+            w, h = img.size
+            # every single-channel mode Pillow reads holds 32-bit signed values at most
+            labels = _banded(img, np.empty((h, w), np.int32), lambda band: np.asarray(band).astype(np.int32))
         else:
             raise FileFormatError(f"{path}: label image mode {mode!r} is not an instance label image (use a "
                                   "single-channel 8- or 16-bit PNG, or RGB with one colour per fruit)")  # fmt: skip
     if labels.size and labels.min() < 0:
         raise FileFormatError(f"{path}: negative labels")
-    return labels.astype(np.int32)
+    return instance_labels(labels, str(path), error=FileFormatError)

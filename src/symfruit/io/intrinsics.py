@@ -22,13 +22,14 @@ from pathlib import Path
 from typing import Any
 
 from ..core.camera import Camera
+from ..core.limits import MAX_SETTINGS_BYTES
 from ..errors import FileFormatError, InputError
 from .text import read_structured
 
 __all__ = ["camera_from_dict", "load_camera"]
 
-#: Largest intrinsics file read (bytes).
-MAX_INTRINSICS_BYTES = 1 << 20
+#: Largest intrinsics file read (bytes): that of a settings file (:mod:`symfruit.core.limits`).
+MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
 
 _NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
 

@@ -14,15 +14,14 @@ from typing import Any
 
 import numpy as np
 
-from ..core.camera import MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
-from ..errors import FileFormatError
+from ..core.limits import MAX_COCO_BYTES, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_INSTANCES, check_image_size
+from ..errors import FileFormatError, InputError
 from .images import read_labels
 from .text import read_structured
 
-#: Largest COCO annotation file read (bytes).
-MAX_COCO_BYTES = 256 << 20
-#: Most annotations of one image that are rasterised (a fruit photo holds a handful).
-MAX_INSTANCES_PER_IMAGE = 1000
+#: Largest COCO annotation file read (bytes) and most annotations of one image that are rasterised (a fruit
+#: photo holds a handful): :mod:`symfruit.core.limits`.
+MAX_INSTANCES_PER_IMAGE = MAX_INSTANCES
 #: Most vertices of one polygon, and most values in one uncompressed RLE.
 MAX_POLYGON_POINTS = 100_000
 MAX_RLE_RUNS = 10_000_000
@@ -50,9 +49,7 @@ def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
 
 
 def _check_shape(shape: tuple[int, int], where: str) -> tuple[int, int]:
-    h, w = (int(v) for v in shape)
-    if not (0 < h <= MAX_IMAGE_SIDE and 0 < w <= MAX_IMAGE_SIDE and h * w <= MAX_IMAGE_PIXELS):
-        raise FileFormatError(f"{where}: image size {w}x{h} is out of range")
+    w, h = check_image_size(shape[1], shape[0], where, error=FileFormatError)
     return h, w
 
 
@@ -101,10 +98,17 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     anns = data.get("annotations", data) if isinstance(data, dict) else data
     if not isinstance(anns, list):
         raise FileFormatError(f"{path}: expected a COCO 'annotations' list")
+    for k, ann in enumerate(anns, 1):
+        if not isinstance(ann, dict):  # never dropped quietly: that would read as a frame without fruit
+            raise FileFormatError(f"{path}: annotation {k} is a {type(ann).__name__}, not an object")
     images = data.get("images") if isinstance(data, dict) else None
-    if images and isinstance(images[0], dict):
-        first = images[0].get("id")
-        anns = [a for a in anns if isinstance(a, dict) and a.get("image_id", first) == first]
+    if images is not None:
+        if not isinstance(images, list) or not all(isinstance(e, dict) for e in images):
+            raise FileFormatError(f"{path}: 'images' must be a list of objects")
+        if images:
+            first = images[0].get("id")
+            anns = [a for a in anns if a.get("image_id", first) == first]
+    anns = [a for a in anns if not a.get("iscrowd")]  # crowd regions are no instance (COCO ignores them)
     if len(anns) > MAX_INSTANCES_PER_IMAGE:
         raise FileFormatError(f"{path}: {len(anns)} annotations for one image; at most {MAX_INSTANCES_PER_IMAGE}")
     h, w = _check_shape(shape, str(path))
@@ -138,6 +142,31 @@ class CocoSet:
     annotations: dict[Any, list[dict[str, Any]]]
     categories: dict[int, str]
 
+    def annotation_categories(self) -> set[Any]:
+        """The ``category_id`` values the annotations use."""
+        return {a.get("category_id") for anns in self.annotations.values() for a in anns}
+
+    def check_category(self, category: int | None) -> None:
+        """Refuse a category no annotation has (every image would be scored as holding no fruit).
+
+        Raises
+        ------
+        InputError
+            Naming the categories the file does have.
+        """
+        used = self.annotation_categories()
+        if category is None or category in used or not used:
+            return
+        names = ", ".join(f"{c} ({self.categories[c]})" if c in self.categories else repr(c)
+                          for c in sorted(used, key=repr))  # fmt: skip
+        raise InputError(f"{self.path}: no annotation has category {category}; the annotations have {names} "
+                         "(--category -1 takes every annotation)")  # fmt: skip
+
+    def _wanted(self, entry: dict[str, Any], category: int | None, crowd: bool) -> list[dict[str, Any]]:
+        anns = self.annotations.get(_key(entry.get("id")), [])
+        return [a for a in anns if (category is None or a.get("category_id") == category)
+                and bool(a.get("iscrowd")) == crowd]  # fmt: skip
+
     def entries(self) -> list[dict[str, Any]]:
         """Every ``images`` entry once, by file name."""
         unique = {id(e): e for e in self.images.values()}
@@ -165,8 +194,34 @@ class CocoSet:
 
         Returns
         -------
-        (n, h, w) bool, one mask per annotation (masks may overlap).
+        (n, h, w) bool, one mask per annotation (masks may overlap). Crowd regions (``iscrowd: 1``) are
+        no instances: :meth:`crowd` gives them, as COCO's evaluation ignores them.
         """
+        entry, (h, w) = self._entry(name, shape)
+        label = f"{self.path}: image {entry.get('file_name')!r}"
+        anns = self._wanted(entry, category, crowd=False)
+        if len(anns) > MAX_INSTANCES_PER_IMAGE:
+            raise FileFormatError(f"{label}: {len(anns)} annotations; at most {MAX_INSTANCES_PER_IMAGE} are read")
+        out = np.zeros((len(anns), h, w), bool)
+        for k, ann in enumerate(anns):
+            out[k] = annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
+        return out
+
+    def crowd(self, name: str | Path, shape: tuple[int, int], *, category: int | None = 1) -> tuple[np.ndarray, int]:
+        """``(h, w)`` bool: the union of one image's crowd regions (``iscrowd: 1``) of ``category``, and how
+        many there are; a prediction lying in them is neither matched nor false, as in COCO's evaluation."""
+        entry, (h, w) = self._entry(name, shape)
+        anns = self._wanted(entry, category, crowd=True)
+        if len(anns) > MAX_INSTANCES_PER_IMAGE:
+            raise FileFormatError(f"{self.path}: image {entry.get('file_name')!r}: {len(anns)} crowd regions; at "
+                                  f"most {MAX_INSTANCES_PER_IMAGE} are read")  # fmt: skip
+        out = np.zeros((h, w), bool)
+        for k, ann in enumerate(anns):
+            out |= annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
+        return out, len(anns)
+
+    def _entry(self, name: str | Path, shape: tuple[int, int]) -> tuple[dict[str, Any], tuple[int, int]]:
+        """The entry of ``name`` and the image's ``(h, w)``, checked against the entry's stated size."""
         entry = self.image(name)
         label = f"{self.path}: image {entry.get('file_name')!r}"
         h, w = _check_shape(shape, label)
@@ -177,14 +232,7 @@ class CocoSet:
                 raise FileFormatError(f"{label}: height/width are not whole numbers") from None
             if stated != (h, w):
                 raise FileFormatError(f"{label} is {stated[1]}x{stated[0]} in the file but {w}x{h} on disk")
-        anns = [a for a in self.annotations.get(_key(entry.get("id")), [])
-                if category is None or a.get("category_id") == category]  # fmt: skip
-        if len(anns) > MAX_INSTANCES_PER_IMAGE:
-            raise FileFormatError(f"{label}: {len(anns)} annotations; at most {MAX_INSTANCES_PER_IMAGE} are read")
-        out = np.zeros((len(anns), h, w), bool)
-        for k, ann in enumerate(anns):
-            out[k] = annotation_mask(ann, (h, w), f"{self.path}: annotation {ann.get('id', k)}")
-        return out
+        return entry, (h, w)
 
 
 def _key(value: Any) -> Any:
@@ -213,11 +261,20 @@ def read_coco(path: str | Path) -> CocoSet:
     ):
         raise FileFormatError(f"{path}: expected a COCO object with 'images' and 'annotations' lists")
     images: dict[str, dict[str, Any]] = {}
+    ids: dict[Any, str] = {}
     for entry in data["images"]:
         if not isinstance(entry, dict) or not isinstance(entry.get("file_name"), str):
             raise FileFormatError(f"{path}: an 'images' entry has no file_name")
-        images[entry["file_name"]] = entry
-        images.setdefault(Path(entry["file_name"]).name, entry)
+        name = entry["file_name"]
+        if name in images and images[name].get("file_name") == name:
+            raise FileFormatError(f"{path}: two 'images' entries are named {name!r}")
+        key = _key(entry.get("id"))
+        if key in ids:  # both would be scored against the same annotations
+            raise FileFormatError(f"{path}: {ids[key]!r} and {name!r} share the image id {entry.get('id')!r}; "
+                                  "each image needs its own id")  # fmt: skip
+        ids[key] = name
+        images[name] = entry
+        images.setdefault(Path(name).name, entry)
     annotations: dict[Any, list[dict[str, Any]]] = {}
     for ann in data["annotations"]:
         if not isinstance(ann, dict):

@@ -6,13 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ..core.limits import MAX_FACES, MAX_OBJ_BYTES  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
 from .clouds import MAX_CLOUD_POINTS, ply_elements
 from .text import read_limited
-
-#: Most faces a mesh file may hold, and the largest OBJ file read (bytes).
-MAX_FACES = 10_000_000
-MAX_OBJ_BYTES = 64 << 20
 
 __all__ = ["read_mesh"]
 

@@ -14,7 +14,7 @@ name        recognises
 bag         a ROS 1 ``.bag`` file or a ROS 2 bag folder (``metadata.yaml``) (:mod:`.bags`); a RealSense
             Viewer / ``rs.recorder`` ``.bag`` (``/device_0/...`` topics) is aligned by :mod:`.realsense`
 frame       one frame folder (:mod:`.frames`)
-folder      a folder of frame folders, in name order (hidden folders and ``exclude`` skipped)
+folder      a folder of frame folders, in name order (hidden folders, ROS 2 bags and ``exclude`` skipped)
 ==========  =====================================================================================
 """
 
@@ -92,7 +92,9 @@ class FolderSource(_Closing):
         self.path = path
         skip = {p.resolve() for p in exclude}
         self._folders = sorted(
-            p for p in path.iterdir() if p.is_dir() and not p.name.startswith(".") and p.resolve() not in skip
+            p
+            for p in path.iterdir()
+            if p.is_dir() and not p.name.startswith(".") and p.resolve() not in skip and not _is_bag_output(p)
         )
 
     def __len__(self) -> int:
@@ -100,6 +102,10 @@ class FolderSource(_Closing):
 
     def names(self) -> list[str]:
         return [p.name for p in self._folders]
+
+    def folders(self) -> list[Path]:
+        """The frame folders, in order (a batch writes nothing into them)."""
+        return list(self._folders)
 
     def read(self, index: int) -> Frame:
         _check_index(index, len(self._folders))
@@ -173,6 +179,12 @@ def _open_bag(path: Path, exclude: Sequence[Path]) -> FrameSource:
 
 def _is_folder(path: Path) -> bool:
     return path.is_dir() and any(p.is_dir() and not p.name.startswith(".") for p in path.iterdir())
+
+
+def _is_bag_output(folder: Path) -> bool:
+    """A ROS 2 bag folder (``metadata.yaml``, no colour image) inside a recording of frame folders, e.g. the
+    ``--ros2-bag`` an earlier run wrote there: not a frame (a frame folder missing its files still is one)."""
+    return (folder / "metadata.yaml").is_file() and not is_frame_folder(folder)
 
 
 register_source("bag", _is_bag, _open_bag)

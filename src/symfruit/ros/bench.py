@@ -239,7 +239,10 @@ def main(argv=None) -> int:
     if args.json:
         import json
 
-        args.json.write_text(json.dumps(res, indent=2))
+        from ..io.atomic import atomic_write
+
+        with atomic_write(args.json, "w") as handle:  # whole or not at all, like every file symfruit writes
+            handle.write(json.dumps(res, indent=2))
     return 0
 
 

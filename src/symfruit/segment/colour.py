@@ -45,6 +45,7 @@ from typing import Literal, Protocol
 import numpy as np
 from scipy import ndimage
 
+from ..core.limits import check_image_size, depth_metres
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -327,6 +328,7 @@ def segment(
     """
     s = settings or SegmentSettings()
     c = _color(color)
+    check_image_size(c.shape[1], c.shape[0], "segment: colour image")  # the bounds of every entry point
     h, w = c.shape[:2]
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
@@ -454,9 +456,13 @@ def _depth(
     none = _Geometry(0.0, shape[0] / 2, shape[1] / 2)
     if depth is None:
         return None, none
-    z = np.asarray(depth, dtype=np.float64)
+    z = np.asarray(depth)
     if z.shape != shape:
         raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
+    z = np.asarray(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units
+    size = (getattr(camera, "width", None), getattr(camera, "height", None))
+    if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
+        raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
     z = np.where(np.isfinite(z) & (z > 0), z, 0.0)
     if not (z > 0).any():
         return None, none

@@ -21,6 +21,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
 from ..core.points import perpendicular_basis
+from ..errors import OutputError
 from .render import SensorNoise, render
 from .sensors import SensorModel, apply_sensor
 from .shapes import leaf_outline, rotation, strawberry
@@ -308,9 +309,19 @@ def write_scenes(
     list of Path
         The frame folders, in order.
     """
-    from ..io.frames import write_frame
+    from ..io.outputs import OutputFolder
 
     folder = Path(folder)
+    with OutputFolder(folder):  # locked while written; no link inside it followed
+        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor)
+
+
+def _write_scenes(
+    folder: Path, n: int, seed: int, distinct: int | None, n_ripe: int, n_unripe: int, n_leaves: int,
+    sensor: SensorModel | None,
+) -> list[Path]:  # fmt: skip
+    from ..io.frames import write_frame
+
     unique = n if distinct is None else max(1, min(distinct, n))
     written: list[Path] = []
     for i in range(n):
@@ -320,6 +331,8 @@ def write_scenes(
             written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth(),
                                        masks=scene.masks))  # fmt: skip
             continue
+        if target.is_symlink():
+            raise OutputError(f"{target}: is a symbolic link; symfruit does not write through links inside {folder}")
         target.mkdir(parents=True, exist_ok=True)
         for path in written[i % unique].iterdir():
             try:

@@ -1,0 +1,155 @@
+"""Every documented bound, in one place, and the checks every entry point (each command, each reader, the
+Python API) applies with them.
+
+The numbers here are the ones README's limits table states (a test parses that table and compares).
+A size read from a file or handed to the API is checked against them *before* anything of that size is
+allocated; a value beyond a bound is refused by name, never truncated or wrapped.
+
+Numpy only: the checks take sizes and arrays, and raise :class:`~symfruit.errors.InputError` (or the error
+class the caller names, e.g. :class:`~symfruit.errors.FileFormatError` for a file).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from ..errors import InputError, SymfruitError
+
+__all__ = [
+    "MAX_CLOUD_POINTS",
+    "MAX_COCO_BYTES",
+    "MAX_DEPTH_METRES",
+    "MAX_FACES",
+    "MAX_FOCAL_PX",
+    "MAX_IMAGE_PIXELS",
+    "MAX_IMAGE_SIDE",
+    "MAX_INSTANCES",
+    "MAX_LABEL_ID",
+    "MAX_OBJ_BYTES",
+    "MAX_SETTINGS_BYTES",
+    "MAX_TEXT_CLOUD_BYTES",
+    "MAX_TRUTH_BYTES",
+    "MAX_WINDOW_PIXELS",
+    "check_image_size",
+    "depth_metres",
+    "instance_labels",
+]
+
+#: Largest image side (pixels) and largest image (pixels), for every image (colour, depth, labels, a bag or
+#: ROS message, a COCO entry) and the camera: an 8K x 5K sensor fits; a depth camera gives about 1 MP.
+MAX_IMAGE_SIDE = 16384
+MAX_IMAGE_PIXELS = 40_000_000
+#: Largest focal length and principal-point offset (pixels): a 16K sensor behind a 60x telephoto fits.
+MAX_FOCAL_PX = 1e6
+#: One fruit's window in the image (the rating's raster), pixels.
+MAX_WINDOW_PIXELS = 4_000_000
+#: Largest cloud read from a file (points), and largest text cloud (bytes).
+MAX_CLOUD_POINTS = 5_000_000
+MAX_TEXT_CLOUD_BYTES = 256 << 20
+#: Largest mesh (faces) and OBJ file (bytes) of the evaluation's scans.
+MAX_FACES = 10_000_000
+MAX_OBJ_BYTES = 64 << 20
+#: Largest settings / profile / intrinsics file, truth file and COCO file (bytes).
+MAX_SETTINGS_BYTES = 1 << 20
+MAX_TRUTH_BYTES = 16 << 20
+MAX_COCO_BYTES = 256 << 20
+#: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
+MAX_INSTANCES = 1000
+MAX_LABEL_ID = 2**31 - 1
+#: Depth handed over as metres whose typical value is beyond this is refused as "raw units, not metres"
+#: (millimetres from a 16-bit depth image are hundreds to thousands).
+MAX_DEPTH_METRES = 100.0
+
+
+def check_image_size(
+    width: Any,
+    height: Any,
+    what: str,
+    *,
+    error: type[SymfruitError] = InputError,
+    max_pixels: int | None = None,
+    max_side: int | None = None,
+) -> tuple[int, int]:
+    """``(width, height)`` as ints, or ``error`` naming ``what`` when a side is not 1-:data:`MAX_IMAGE_SIDE`
+    pixels or the image holds more than :data:`MAX_IMAGE_PIXELS` (``max_pixels``, ``max_side``: tighter
+    bounds a caller keeps)."""
+    max_pixels = MAX_IMAGE_PIXELS if max_pixels is None else max_pixels
+    max_side = MAX_IMAGE_SIDE if max_side is None else max_side
+    try:
+        w, h = int(width), int(height)
+    except (TypeError, ValueError, OverflowError):
+        raise error(f"{what}: image size {width!r}x{height!r} is not whole numbers of pixels") from None
+    if w <= 0 or h <= 0:
+        raise error(f"{what}: image is {w}x{h} pixels; it must not be empty")
+    if w > max_side or h > max_side:
+        raise error(f"{what}: image is {w}x{h} pixels; at most {max_side} pixels a side are read")
+    if w * h > max_pixels:
+        raise error(f"{what}: image is {w}x{h} pixels; at most {max_pixels:,} pixels are read")
+    return w, h
+
+
+def instance_labels(labels: Any, what: str, *, error: type[SymfruitError] = InputError) -> np.ndarray:
+    """Instance labels as ``(h, w) int32`` (0 background), checked: a 2-D image of whole numbers in
+    0-:data:`MAX_LABEL_ID` holding at most :data:`MAX_INSTANCES` fruit, within the image bounds.
+
+    Ids beyond 32 bits are refused, never truncated (truncation would merge two fruit or drop one); bool
+    masks are one fruit.
+
+    Raises
+    ------
+    error
+        Naming ``what`` and the problem.
+    """
+    arr = np.asarray(labels)
+    if arr.ndim != 2:
+        raise error(f"{what}: instance labels must be an (h, w) image, got shape {arr.shape}")
+    check_image_size(arr.shape[1], arr.shape[0], what, error=error)
+    if arr.dtype == bool:
+        return arr.astype(np.int32)
+    if not np.issubdtype(arr.dtype, np.integer):
+        raise error(f"{what}: instance labels must be whole numbers, got {arr.dtype}")
+    if arr.size == 0:
+        return arr.astype(np.int32)
+    lo, hi = int(arr.min()), int(arr.max())
+    if lo < 0:
+        raise error(f"{what}: masks hold negative labels (got {lo}); 0 is background, 1..k the fruit")
+    if hi > MAX_LABEL_ID:
+        raise error(f"{what}: label id {hi} is beyond 32 bits (at most {MAX_LABEL_ID}); number the fruit 1..k")
+    if hi > MAX_INSTANCES:  # more ids than fruit allowed may still be few fruit: count them
+        if hi <= 1 << 22:
+            count = int(np.count_nonzero(np.bincount(arr.ravel(), minlength=hi + 1)[1:]))
+        else:
+            values = np.unique(arr)
+            count = len(values) - int(values[0] == 0)
+        if count > MAX_INSTANCES:
+            raise error(f"{what}: masks hold {count} instances; at most {MAX_INSTANCES} fruit per image are read")
+    return arr.astype(np.int32, copy=False)
+
+
+def depth_metres(depth: Any, what: str, *, error: type[SymfruitError] = InputError) -> np.ndarray:
+    """A depth image handed over as metres, checked: ``(h, w)`` floating point within the image bounds, and
+    not raw sensor units (integer images, or typical values beyond :data:`MAX_DEPTH_METRES`, are millimetres
+    or another unit: multiply by the depth scale first). 0 or NaN is "no depth".
+
+    Raises
+    ------
+    error
+        Naming ``what`` and the problem.
+    """
+    arr = np.asarray(depth)
+    if arr.ndim != 2:
+        raise error(f"{what}: depth must be a 2-D image, got shape {arr.shape}")
+    check_image_size(arr.shape[1], arr.shape[0], what, error=error)
+    if not np.issubdtype(arr.dtype, np.floating):
+        raise error(f"{what}: depth is {arr.dtype}; depth must be float metres (raw units such as 16-bit "
+                    "millimetres: multiply by the depth scale, e.g. 0.001, first)")  # fmt: skip
+    step = max(1, arr.size // 100_000)  # a spread sample of the pixels is enough to tell units apart
+    sample = arr.ravel()[::step]
+    with np.errstate(invalid="ignore"):
+        valid = sample[np.isfinite(sample) & (sample > 0)]
+    if len(valid) and float(np.median(valid)) > MAX_DEPTH_METRES:
+        raise error(f"{what}: depth is {float(np.median(valid)):g} m typically; depth must be metres (these look "
+                    "like millimetres or raw units: multiply by the depth scale first)")  # fmt: skip
+    return arr

@@ -1,0 +1,116 @@
+"""symfruit.core.limits: every documented bound in one place, the checks, and README's table matching them."""
+
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from symfruit import FileFormatError, InputError
+from symfruit.core import limits
+from symfruit.core.limits import check_image_size, depth_metres, instance_labels
+
+README = Path(__file__).resolve().parents[2] / "README.md"
+
+
+def _limits_table() -> dict[str, str]:
+    """README's limits table: first cell -> bound cell."""
+    text = README.read_text(encoding="utf-8")
+    start = text.index("**Limits.**")
+    rows = {}
+    for line in text[start:].splitlines()[1:]:
+        if line.startswith("| ") and not line.startswith("|---") and not line.startswith("| what"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            rows[cells[0]] = cells[1]
+        elif rows and not line.startswith("|"):
+            break
+    return rows
+
+
+def _numbers(cell: str) -> list[float]:
+    """The numbers a cell states, with units: '40 megapixels' is 40e6, '256 MB' is 256 MiB, '1e6' is 1e6."""
+    out = []
+    for value, unit in re.findall(
+        r"(\d[\d,.]*(?:e\d+)?)\s*(megapixels|million|MB|kB|pixels|instances|faces|points)?", cell
+    ):
+        v = float(value.replace(",", ""))
+        out.append(v * {"megapixels": 1e6, "million": 1e6, "MB": 1 << 20, "kB": 1 << 10}.get(unit, 1))
+    return out
+
+
+def test_readme_limits_are_the_enforced_constants():
+    table = _limits_table()
+    image = _numbers(next(v for k, v in table.items() if k.startswith("an image")))
+    assert image[:3] == [limits.MAX_IMAGE_PIXELS, limits.MAX_IMAGE_SIDE, limits.MAX_FOCAL_PX]
+    window = _numbers(next(v for k, v in table.items() if "window" in k))
+    assert window == [limits.MAX_WINDOW_PIXELS]
+    cloud = _numbers(next(v for k, v in table.items() if k.startswith("a cloud file")))
+    assert cloud[:2] == [limits.MAX_CLOUD_POINTS, limits.MAX_TEXT_CLOUD_BYTES]
+    mesh = _numbers(next(v for k, v in table.items() if k.startswith("a mesh")))
+    assert mesh == [limits.MAX_FACES, limits.MAX_OBJ_BYTES]
+    files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
+    assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
+    masks = _numbers(next(v for k, v in table.items() if k.startswith("fruit per")))
+    assert (
+        masks[0] == limits.MAX_INSTANCES
+        and limits.MAX_LABEL_ID == 2**31 - 1
+        and "32 bits" in table["fruit per image (masks)"]
+    )
+
+
+def test_the_modules_use_the_one_set_of_bounds():
+    from symfruit import detect
+    from symfruit.core import camera, raster
+    from symfruit.io import bags, clouds, frames, images, intrinsics, masks, meshes
+
+    assert camera.MAX_IMAGE_SIDE is limits.MAX_IMAGE_SIDE and images.MAX_IMAGE_PIXELS == limits.MAX_IMAGE_PIXELS
+    assert bags.MAX_MESSAGE_PIXELS == frames.MAX_DEPTH_ELEMENTS == limits.MAX_IMAGE_PIXELS
+    assert raster.MAX_WINDOW_PIXELS == limits.MAX_WINDOW_PIXELS and clouds.MAX_CLOUD_POINTS == limits.MAX_CLOUD_POINTS
+    assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
+    assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
+    assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
+
+
+@pytest.mark.parametrize(("w", "h", "message"), [
+    (30000, 20, "at most 16384 pixels a side"), (20, 30000, "a side"), (8000, 6000, "at most 40,000,000 pixels"),
+    (0, 10, "must not be empty"), ("x", 3, "not whole numbers"),
+])  # fmt: skip
+def test_image_sizes_beyond_the_bounds_are_refused(w, h, message):
+    with pytest.raises(InputError, match=message):
+        check_image_size(w, h, "img")
+    assert check_image_size(16384, 2000, "img") == (16384, 2000)
+
+
+def test_label_ids_beyond_32_bits_are_refused_not_truncated():
+    labels = np.zeros((4, 4), np.int64)
+    labels[0, 0], labels[3, 3] = 1, 2**32 + 1  # truncated to int32 this would be fruit 1 again
+    with pytest.raises(InputError, match="beyond 32 bits"):
+        instance_labels(labels, "masks")
+    with pytest.raises(InputError, match="beyond 32 bits"):
+        instance_labels(labels.astype(np.uint64) + np.uint64(2**63), "masks")
+    labels[3, 3] = 2**31 - 1  # the largest id is kept as it is
+    assert instance_labels(labels, "m").dtype == np.int32 and instance_labels(labels, "m")[3, 3] == 2**31 - 1
+
+
+def test_more_than_1000_instances_and_bad_labels_are_refused():
+    many = (np.arange(40 * 40).reshape(40, 40) % 1500 + 1).astype(np.int32)
+    with pytest.raises(FileFormatError, match="1500 instances; at most 1000"):
+        instance_labels(many, "x.png", error=FileFormatError)
+    sparse = np.zeros((8, 8), np.int64)
+    sparse[0, :3] = [5, 10**9, 2**30]  # few fruit with large ids pass
+    assert instance_labels(sparse, "m").max() == 2**30
+    for bad, message in ((np.full((2, 2), -1), "negative"), (np.ones((2, 2)), "whole numbers"),
+                         (np.ones(4, int), r"\(h, w\) image")):  # fmt: skip
+        with pytest.raises(InputError, match=message):
+            instance_labels(bad, "m")
+    assert instance_labels(np.eye(3, dtype=bool), "m").tolist() == np.eye(3, dtype=int).tolist()
+
+
+def test_depth_in_raw_units_is_refused_with_a_clear_message():
+    mm = np.full((48, 64), 450, np.uint16)
+    with pytest.raises(InputError, match="uint16; depth must be float metres"):
+        depth_metres(mm, "frame")
+    with pytest.raises(InputError, match="look like millimetres"):
+        depth_metres(mm.astype(np.float32), "frame")
+    ok = np.where(np.arange(64) % 2, 0.45, np.nan).astype(np.float32)[None].repeat(48, 0)
+    assert depth_metres(ok, "frame") is ok and depth_metres(np.zeros((3, 3)), "f").shape == (3, 3)
