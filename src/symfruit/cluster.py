@@ -49,7 +49,7 @@ from .batch import (
     frame_folder_name,
 )
 from .detect import detect
-from .errors import InputError, SymfruitError
+from .errors import InputError, OutputError, SymfruitError
 from .io.frames import is_frame_folder, read_frame
 from .io.outputs import OutputFolder, reserve_record, write_record
 from .io.sources import FolderSource, FrameFolderSource, open_source
@@ -65,6 +65,8 @@ __all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "r
 EXTRA = "symfruit[cluster]"
 #: Memory limit of each worker process of a local cluster (its nanny restarts a worker above it).
 LOCAL_MEMORY_LIMIT = "2GiB"
+#: How long to try to reach a scheduler before giving up.
+CONNECT_TIMEOUT = "10s"
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
 #: scheduler's task count however long the recording.
 MAX_AHEAD = 4096
@@ -237,7 +239,7 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
     distributed = require_distributed()
     if scheduler is not None:
         try:
-            client = distributed.Client(scheduler, timeout="20s")
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
         except (OSError, TimeoutError, ValueError) as exc:
             raise InputError(f"{scheduler}: cannot reach the Dask scheduler ({exc})") from None
         with client:
@@ -307,37 +309,43 @@ def run_distributed(
               exclude=tuple(str(Path(p).absolute()) for p in [output, *exclude]), masks=masks, method=method,
               settings=settings)  # fmt: skip
     try:
-        reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
-                       entries=len(names), root=out)  # fmt: skip
         target = [output / frame_folder_name(n, reserved) for n in names]
         done_before = {i for i in range(len(names)) if resume and (target[i] / "detections.json").is_file()}
         todo = [i for i in range(len(names)) if i not in done_before]
-        with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
-            if done_before:
-                bar.update(len(done_before))
-            try:
-                with TableWriter(output, root=out) as table:
-                    _run(job, names, target, direct, todo, done_before, chunk, max_ahead, scheduler, workers, report,
-                         table, bar, out)  # fmt: skip
-            except SymfruitError as exc:
-                report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
-        how = write_record(output / "errors.json", _errors_record(report.failed, report.unprocessed, report.stopped),
-                           root=out)  # fmt: skip
-        if how and report.stopped:
-            report.stopped += f"; errors.json {how}"
-    except SymfruitError as exc:
-        if "errors.json" not in str(exc):
-            raise
-        report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
+        with contextlib.ExitStack() as stack:
+            client = stack.enter_context(_client(scheduler, workers)) if todo else None
+            if client is not None:
+                _preflight(client, job)
+            reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
+                           entries=len(names), root=out)  # fmt: skip
+            with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
+                if done_before:
+                    bar.update(len(done_before))
+                try:
+                    with TableWriter(output, root=out) as table:
+                        _run(job, client, names, target, direct, todo, done_before, chunk, max_ahead, report, table,
+                             bar, out)  # fmt: skip
+                except OutputError as exc:
+                    report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
+            if client is not None:
+                with contextlib.suppress(Exception):
+                    client.run(forget, job.run)
+        try:
+            how = write_record(output / "errors.json",
+                               _errors_record(report.failed, report.unprocessed, report.stopped), root=out)  # fmt: skip
+            if how and report.stopped:
+                report.stopped += f"; errors.json {how}"
+        except SymfruitError as exc:
+            report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
     finally:
         out.close()
     return report
 
 
 def _run(
-    job: Job, names: list[str], target: list[Path], direct: list[str] | None, todo: list[int], done_before: set[int],
-    chunk: int, max_ahead: int, scheduler: str | None, workers: int | None, report: BatchReport,
-    table: TableWriter, bar: Progress, out: OutputFolder,
+    job: Job, client: Any, names: list[str], target: list[Path], direct: list[str] | None, todo: list[int],
+    done_before: set[int], chunk: int, max_ahead: int, report: BatchReport, table: TableWriter, bar: Progress,
+    out: OutputFolder,
 ) -> None:  # fmt: skip
     """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
     and write the tables in frame order."""
@@ -361,14 +369,9 @@ def _run(
                 return  # still running
             state["flushed"] += 1
 
-    if not todo:
-        state["stopped"] = True
-        flush()
-        return
-    distributed = require_distributed()
-    parts = _parts(todo, chunk)
-    with _client(scheduler, workers) as client:
-        _preflight(client, job)
+    if client is not None:
+        distributed = require_distributed()
+        parts = _parts(todo, chunk)
         pending = distributed.as_completed()
         part_of: dict[Any, Part] = {}
 
@@ -401,8 +404,6 @@ def _run(
             bar.update(len(part.indices))
             flush()
             send()
-        with contextlib.suppress(Exception):
-            client.run(forget, job.run)
     state["stopped"] = True
     flush()
 
