@@ -57,6 +57,8 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
     p.add_argument("--method", default=None, help="with --recording: the completion method (default evidence)")
+    p.add_argument("--workers", type=int, metavar="W",
+                   help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument(
         "--segment",
         action="store_true",
@@ -309,9 +311,23 @@ def _bench(args: argparse.Namespace) -> int:
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
-        rec = bench_recording(args.recording, method=_method(args))
+        if args.workers is not None:
+            from .cluster import local_cluster, require_distributed
+
+            require_distributed()
+            if not 1 <= args.workers <= 256:
+                local_cluster(args.workers)  # refuses with the message of detect --workers
+        rec = bench_recording(args.recording, method=_method(args), workers=args.workers)
         if args.json:
             print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
+            return 0
+        if rec.workers:
+            peaks = ", ".join(f"{p:.0f}" for p in rec.worker_peak_mb)
+            print(f"symfruit bench --recording --workers {rec.workers}: {rec.frames} frames ({rec.frames_done} "
+                  f"written), method {rec.method}: {rec.seconds:.1f} s, {rec.frames / rec.seconds:.2f} frames/s "
+                  f"(cluster start {rec.startup_seconds:.1f} s not included); peak RSS per worker {peaks} MB, client "
+                  f"{rec.peak_rss_mb:.0f} MB; overhead per task {rec.task_overhead_ms:.1f} ms CPU (client, scheduler "
+                  f"and worker together), {rec.task_wall_ms:.1f} ms wall per empty task")  # fmt: skip
             return 0
         print(f"symfruit bench --recording: {rec.frames} frames ({rec.frames_done} written), method {rec.method}: "
               f"{rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "

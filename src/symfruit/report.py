@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from .core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from .errors import FileFormatError, InputError, SymfruitError
 from .table import FRAMES_NAME, TABLE_NAME
 
@@ -32,10 +33,9 @@ __all__ = ["DEFAULT_CLASSES_MM", "PLOTS", "Report", "diameters_mm", "size_classe
 
 #: Size class edges (mm) by default: the EU marketing standard's minimum diameters for strawberries.
 DEFAULT_CLASSES_MM = (18.0, 25.0)
-#: Most rows read from either table (a season of ~3 million frames of 6 fruit); a larger table is refused.
-MAX_REPORT_ROWS = 20_000_000
-#: Most bytes read from either table's columns (uncompressed, as its metadata says), checked before reading.
-MAX_REPORT_BYTES = 4 << 30
+#: Most rows read from either table, and most bytes of its columns (:mod:`symfruit.core.limits`).
+MAX_REPORT_ROWS = MAX_TABLE_ROWS
+MAX_REPORT_BYTES = MAX_TABLE_BYTES
 #: Recordings drawn one bar each; beyond, the ones with most fruit (the table lists them all).
 MAX_BARS = 60
 #: The plots, in the order report.md shows them.
