@@ -181,3 +181,27 @@ def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):
     monkeypatch.setattr(builtins, "__import__", no_distributed)
     with pytest.raises(InputError, match=r"pip install 'symfruit\[cluster\]'"):
         cluster.require_distributed()
+
+
+def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
+    """A bag travels as its path and frame indices: the worker opens it (once per run and thread), checks that
+    it lists the frame the client named, and writes what a serial run writes."""
+    from symfruit.cluster import Job, Part, detect_part, forget
+
+    from .conftest import EXAMPLES
+
+    pytest.importorskip("rosbags")
+    bag = EXAMPLES / "realsense" / "fruit.bag"
+    serial = run_batch(bag, tmp_path / "serial", method="raw", progress=False)
+    name = serial.done[0]
+    out = tmp_path / "out"
+    out.mkdir()
+    job = Job(run="bag", source=str(bag), shown=str(bag), output=str(out), recording="fruit.bag", inputs=(str(bag),),
+              input_folders=(), exclude=(), method="raw")  # fmt: skip
+    (done,) = detect_part(job, Part((0,), (name,), (str(out / name),)))
+    assert done.status == "done" and _fruits(out) == {name: _fruits(tmp_path / "serial")[name]}
+    written = json.loads((out / name / "detections.json").read_text())
+    assert written["source"] == json.loads((tmp_path / "serial" / name / "detections.json").read_text())["source"]
+    (moved,) = detect_part(job, Part((0,), ("another_00000_1",), (str(out / "x"),)))
+    assert moved.status == "failed" and "differs from the one the client listed" in moved.reason
+    assert forget("bag") == 1 and forget("bag") == 0  # the bag was opened once and is closed at the end

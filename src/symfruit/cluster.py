@@ -302,7 +302,7 @@ def run_distributed(
         src.close()  # the client decodes no frame
     out = OutputFolder(output, inputs=files, input_folders=folders).open()
     reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
-    job = Job(run=uuid.uuid4().hex, source=str(Path(source).absolute()), shown=str(source),
+    job = Job(run=uuid.uuid4().hex, source=str(Path(source).absolute()), shown=str(Path(source)),
               output=str(output.absolute()), recording=recording_name(source),
               inputs=tuple(os.path.realpath(p) for p in files),
               input_folders=tuple(os.path.realpath(p) for p in folders),
