@@ -32,6 +32,7 @@ import contextlib
 import dataclasses
 import os
 import threading
+import time
 import uuid
 from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field
@@ -68,8 +69,12 @@ LOCAL_MEMORY_LIMIT = "2GiB"
 #: How long to try to reach a scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
-#: scheduler's task count however long the recording.
+#: scheduler's task count however long the recording (with a task that takes long, the others wait at most
+#: this far ahead of it).
 MAX_AHEAD = 4096
+#: Tasks in flight per worker thread (one running, the next ones already there): enough to keep every worker
+#: busy, few enough that a worker that dies has little to hand over.
+TASKS_PER_THREAD = 3
 
 
 def require_distributed() -> Any:
@@ -374,9 +379,18 @@ def _run(
         parts = _parts(todo, chunk)
         pending = distributed.as_completed()
         part_of: dict[Any, Part] = {}
+        window = {"tasks": 0, "at": -1.0}
+
+        def room() -> bool:
+            """Whether another task may go: within the frames ahead, and within the tasks the workers can
+            take (their thread count, asked again every second as workers come and go)."""
+            if time.monotonic() - window["at"] > 1.0:
+                threads = sum(client.nthreads().values())
+                window["tasks"], window["at"] = max(TASKS_PER_THREAD * threads, 2), time.monotonic()
+            return state["sent"] - state["flushed"] < max_ahead and len(part_of) < window["tasks"]
 
         def send() -> None:
-            while not state["stopped"] and state["sent"] - state["flushed"] < max_ahead:
+            while not state["stopped"] and room():
                 indices = next(parts, None)
                 if indices is None:
                     state["sent"] = len(names)

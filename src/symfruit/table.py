@@ -61,8 +61,8 @@ TABLE_NAME = "detections.parquet"
 FRAMES_NAME = "frames.parquet"
 #: Largest ``detections.json`` read back (bytes): the bound of a ``truth.json``.
 MAX_RECORD_BYTES = MAX_TRUTH_BYTES
-#: Rows buffered before a row group is written.
-ROW_GROUP = 65_536
+#: Rows buffered before a row group is written (about 20 MB of rows in Python).
+ROW_GROUP = 16_384
 
 #: ``(name, arrow type name)`` of ``detections.parquet``, in order.
 FRUIT_COLUMNS: tuple[tuple[str, str], ...] = (
