@@ -213,7 +213,9 @@ def _plots(plt: Any, rec_f: np.ndarray, located_f: np.ndarray, per_rec: list[tup
     figs = []
     fig, ax = plt.subplots(figsize=(9, 3.5))
     x, y = _binned(located_f)
-    ax.plot(x, y, lw=1, color="tab:red")
+    ax.plot(x, y, lw=1, color="tab:red", marker="o" if len(x) <= 100 else None, ms=3)
+    ax.xaxis.get_major_locator().set_params(integer=True)
+    ax.yaxis.get_major_locator().set_params(integer=True)
     starts = [i for i in range(1, len(rec_f)) if rec_f[i] != rec_f[i - 1]]
     for s in starts[:MAX_BARS]:
         ax.axvline(s, color="grey", lw=0.5, ls=":")
@@ -231,6 +233,7 @@ def _plots(plt: Any, rec_f: np.ndarray, located_f: np.ndarray, per_rec: list[tup
                   ha="right" if len(shown) > 4 else "center", fontsize=8)  # fmt: skip
     more = f" (the {MAX_BARS} with most fruit of {len(per_rec)})" if len(per_rec) > MAX_BARS else ""
     ax.set(ylabel="fruit located", title=f"Fruit per recording{more}")
+    ax.yaxis.get_major_locator().set_params(integer=True)
     fig.tight_layout()
     figs.append(fig)
 
