@@ -66,6 +66,11 @@ __all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "r
 EXTRA = "symfruit[cluster]"
 #: Memory limit of each worker process of a local cluster (its nanny restarts a worker above it).
 LOCAL_MEMORY_LIMIT = "2GiB"
+#: Dask's statistical profiler off: it keeps a sample of the worker's stacks for every second of the last
+#: 1,000 (``distributed.admin.low-level-log-length``), which here grew a worker by about 300 kB a second (300 MB
+#: before it levels off); nobody looks at it without the dashboard. For workers you start yourself:
+#: ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
+NO_PROFILER = {"distributed.worker.profile.enabled": False}
 #: How long to try to reach a scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
@@ -226,8 +231,8 @@ def worker_peak_mb() -> float:
 
 
 def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> Any:
-    """A local Dask cluster of ``workers`` worker processes, one thread each, bound to 127.0.0.1 (no dashboard),
-    each restarted by its nanny if it dies or outgrows ``memory_limit``."""
+    """A local Dask cluster of ``workers`` worker processes, one thread each, bound to 127.0.0.1 (no dashboard,
+    no profiler: :data:`NO_PROFILER`), each restarted by its nanny if it dies or outgrows ``memory_limit``."""
     import logging
 
     require_distributed()
@@ -235,8 +240,11 @@ def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> An
 
     if not 1 <= workers <= 256:
         raise InputError(f"--workers must be between 1 and 256, got {workers}")
-    return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                        dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
+    import dask
+
+    with dask.config.set(NO_PROFILER):  # the nannies keep this config for the workers they restart
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                            dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
 
 
 @contextlib.contextmanager
