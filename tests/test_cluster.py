@@ -97,12 +97,12 @@ def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(record
 
         thread = threading.Thread(target=run)
         thread.start()
-        pid = int(_wait_for(lambda: marker.is_file() and marker.read_text(), 90, "a worker to start scene_00003"))
+        pid = int(_wait_for(lambda: marker.is_file() and marker.read_text(), 180, "a worker to start scene_00003"))
         assert pid in pids
         os.kill(pid, signal.SIGKILL)  # mid-task: scene_00002, the task's first frame, is written already
-        thread.join(timeout=120)
+        thread.join(timeout=300)
         assert not thread.is_alive() and "error" not in result, result.get("error")
-        workers = _wait_for(lambda: len(client.scheduler_info()["workers"]) == 2 and client.run(os.getpid), 60,
+        workers = _wait_for(lambda: len(client.scheduler_info()["workers"]) == 2 and client.run(os.getpid), 120,
                             "the nanny to start another worker")  # fmt: skip
         assert pid not in workers.values()
         report = result["report"]
