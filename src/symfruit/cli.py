@@ -397,16 +397,20 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
     from .io import atomic_write, write_json
     from .writers import new_results_folder
 
-    rows = evaluate_spheres(args.spheres, methods=methods, masks=args.masks or "auto", settings=settings)
+    failed: dict[str, str] = {}
+    rows = evaluate_spheres(args.spheres, methods=methods, masks=args.masks or "auto", settings=settings,
+                            failed=failed)  # fmt: skip
     table, summary = spheres_table(rows, methods)
     folder = new_results_folder(args.output, "spheres")
-    write_json(folder / "summary.json", {"source": str(args.spheres), "methods": summary,
+    write_json(folder / "summary.json", {"source": str(args.spheres), "methods": summary, "failed": failed,
                                          "settings": settings.to_dict()})  # fmt: skip
     with atomic_write(folder / "table.md", "w") as handle:
         handle.write(table)
     print(table)
+    for name, reason in failed.items():
+        print(f"skipped {name}: {reason}")
     print(f"results: {folder}")
-    return 0
+    return 0 if rows else 1
 
 
 def _evaluate_masks(args: argparse.Namespace) -> int:

@@ -53,3 +53,15 @@ def test_the_table_names_every_sphere(boxes):
     assert table.count("\n") == 5 and "sphere 4 (mm)" in table and "`paper`" in table
     assert [s["method"] for s in summary] == ["evidence", "sphere", "paper"]
     assert summary[0]["frames"] == ["lab-spheres-0", "lab-spheres-1"] and summary[0]["failed"] == 0
+
+
+def test_a_frame_that_cannot_be_read_is_skipped_and_named(tmp_path):
+    import shutil
+
+    for name in ("lab-spheres-0", "broken"):
+        shutil.copytree(FRAMES / "lab-spheres-0", tmp_path / name)
+    (tmp_path / "broken" / "depth.png").write_bytes(b"not a png")
+    failed: dict[str, str] = {}
+    rows = evaluate_spheres(tmp_path, methods=("raw",), failed=failed)
+    assert {r.frame for r in rows} == {"lab-spheres-0"} and len(rows) == 4
+    assert set(failed) == {"broken"} and "depth.png" in failed["broken"]

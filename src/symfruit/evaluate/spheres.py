@@ -50,17 +50,28 @@ class SphereBox:
 
 
 def evaluate_spheres(
-    source: str | Path, *, methods: Sequence[str], masks: str = "auto", settings: Settings | None = None
+    source: str | Path,
+    *,
+    methods: Sequence[str],
+    masks: str = "auto",
+    settings: Settings | None = None,
+    failed: dict[str, str] | None = None,
 ) -> list[SphereBox]:
-    """Every sphere of every frame of ``source`` under every method (a failed one carries its error)."""
+    """Every sphere of every frame of ``source`` under every method (a failed sphere carries its error; a
+    frame that cannot be read or detected is left out and, with ``failed``, recorded there with its reason)."""
     settings = settings or Settings()
     out: list[SphereBox] = []
     src = open_source(source)
     try:
         for index, name in enumerate(src.names()):
-            frame = src.read(index)
-            for method in methods:
-                found = detect(frame, masks=masks, method=method, settings=settings)
+            try:
+                frame = src.read(index)
+                found_by = {m: detect(frame, masks=masks, method=m, settings=settings) for m in methods}
+            except SymfruitError as exc:
+                if failed is not None:
+                    failed[name] = str(exc)
+                continue
+            for method, found in found_by.items():
                 for d in found.detections:
                     area = float(d.mask.sum())
                     if d.result is None:
@@ -71,10 +82,8 @@ def evaluate_spheres(
                     diameter = 2.0 * np.sqrt(area / np.pi) * float(box.centre[2]) / focal
                     size = tuple(float(v) * 1000.0 for v in box.size)
                     out.append(SphereBox(name, d.id, method, size, diameter * 1000.0))  # type: ignore[arg-type]
-    except SymfruitError:
+    finally:
         src.close()
-        raise
-    src.close()
     return out
 
 
