@@ -327,15 +327,16 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
 
 
 def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
-                min_accuracy: float = 0.85) -> np.ndarray:  # fmt: skip
+                min_accuracy: float = 0.85, margin: float = 0.5) -> np.ndarray:  # fmt: skip
     """``mask`` less the pixels of its outer band whose colour is the background's, not the fruit's.
 
     Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
     depth cannot tell (a time-of-flight camera returns nothing for a few pixels on both sides of an outline).
     The colour can: the pixels more than ``band_px`` inside the mask are the fruit's, a ring of the same width
     outside it the background's; both are summarised by ``centres`` colours each (a few rounds of k-means on
-    chromaticity and brightness), and a band pixel nearer a background colour than any fruit colour is
-    removed. Nothing is removed when the two do not separate (the summaries misclass more than ``1 -
+    chromaticity and brightness), and a band pixel whose squared colour distance to the background is below
+    ``margin`` times its distance to the fruit is removed (a mixed pixel on the outline, between the two,
+    stays). Nothing is removed when the two do not separate (the summaries misclass more than ``1 -
     min_accuracy`` of their own samples: a white ball before a white wall), and nothing beyond the band.
 
     Parameters
@@ -370,13 +371,14 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
 
     fc, bc = summary(fruit), summary(ring)
 
-    def is_fruit(x: np.ndarray) -> np.ndarray:
-        return ((x[:, None, :] - fc[None]) ** 2).sum(-1).min(1) <= ((x[:, None, :] - bc[None]) ** 2).sum(-1).min(1)
+    def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
+        to_fruit = ((x[:, None, :] - fc[None]) ** 2).sum(-1).min(1)
+        return margin * to_fruit <= ((x[:, None, :] - bc[None]) ** 2).sum(-1).min(1)
 
     if is_fruit(feature[fruit]).mean() < min_accuracy or (~is_fruit(feature[ring])).mean() < min_accuracy:
         return mask
     keep = mask.copy()
-    keep[band] = is_fruit(feature[band])
+    keep[band] = is_fruit(feature[band], margin)  # a mixed pixel on the outline, between the two, stays
     labels, _ = ndimage.label(keep)
     core_labels = np.unique(labels[fruit])
     return ndimage.binary_fill_holes(np.isin(labels, core_labels[core_labels > 0]))
