@@ -3,9 +3,10 @@
 Subscribes to the realsense2_camera ROS 2 wrapper's default topics (``ros2 launch realsense2_camera
 rs_launch.py align_depth.enable:=true``), paired by approximate time (:class:`~symfruit.ros.sync.ApproximateSync`):
 
-- ``color``       ``sensor_msgs/msg/Image`` rgb8/bgr8/rgba8/bgra8/mono8  (``/camera/camera/color/image_raw``)
-- ``depth``       ``sensor_msgs/msg/Image`` 16UC1 mm or 32FC1 m, aligned  (``/camera/camera/aligned_depth_to_color/image_raw``)
-- ``camera_info`` ``sensor_msgs/msg/CameraInfo``                         (``/camera/camera/color/camera_info``)
+- ``color``       ``sensor_msgs/msg/Image`` rgb8/bgr8/rgba8/bgra8/mono8 (``/camera/camera/color/image_raw``)
+- ``depth``       ``sensor_msgs/msg/Image`` 16UC1 mm or 32FC1 m, aligned to colour
+  (``/camera/camera/aligned_depth_to_color/image_raw``)
+- ``camera_info`` ``sensor_msgs/msg/CameraInfo`` (``/camera/camera/color/camera_info``)
 
 (remap either the short name, ``-r color:=/my/image``, or the default itself) and publishes, per frame and
 with the colour image's header:
@@ -30,7 +31,10 @@ SIGTERM end it cleanly (node and context destroyed). Everything but rclpy lives 
 from __future__ import annotations
 
 import array
+import os
+import signal
 import sys
+import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
@@ -100,7 +104,7 @@ def stamp_text(header: Any) -> str:
 # --------------------------------------------------------------------------------------------------
 
 
-def _pose(centre: Sequence[float]) -> Any:
+def _pose(centre: Any) -> Any:
     from geometry_msgs.msg import Point, Pose, Quaternion
 
     x, y, z = (float(v) for v in centre)
@@ -137,7 +141,9 @@ def marker_array(header: Any, fruits: Sequence[Fruit]) -> Any:
     for f in fruits:
         sx, sy, sz = (max(float(v), 1e-4) for v in f.size)
         common = {"header": header, "id": int(f.id), "action": Marker.ADD, "pose": _pose(f.centre)}
-        box = Marker(ns="symfruit/box", type=Marker.CUBE, scale=Vector3(x=sx, y=sy, z=sz), color=rgba(BOX_RGBA), **common)
+        box = Marker(
+            ns="symfruit/box", type=Marker.CUBE, scale=Vector3(x=sx, y=sy, z=sz), color=rgba(BOX_RGBA), **common
+        )
         d = CENTRE_DIAMETER
         dot = Marker(ns="symfruit/centre", type=Marker.SPHERE, scale=Vector3(x=d, y=d, z=d), color=rgba(CENTRE_RGBA),
                      **common)  # fmt: skip
@@ -150,7 +156,9 @@ def point_cloud(header: Any, fruits: Sequence[Fruit]) -> Any:
     from sensor_msgs.msg import PointCloud2, PointField
 
     data = cloud_array(fruits)
-    fields = [PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1) for i, n in enumerate(CLOUD_FIELDS)]
+    fields = [
+        PointField(name=n, offset=4 * i, datatype=PointField.FLOAT32, count=1) for i, n in enumerate(CLOUD_FIELDS)
+    ]
     step = 4 * len(CLOUD_FIELDS)
     return PointCloud2(header=header, height=1, width=len(data), fields=fields, is_bigendian=False, point_step=step,
                        row_step=step * len(data), data=array.array("B", data.tobytes()), is_dense=True)  # fmt: skip
@@ -181,7 +189,8 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
                 raise ValueError
             out[name] = kind(value)
         except (TypeError, ValueError):
-            raise SymfruitError(f"parameter {name}: expected a {kind.__name__}, got {value!r}") from None
+            what = "whole number" if kind is int else "number"
+            raise SymfruitError(f"parameter {name}: expected a {what}, got {value!r}") from None
     if not 0 <= out["slop"] <= 10:
         raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {out['slop']!r}")
     if not 1 <= out["queue_size"] <= 100:
@@ -314,9 +323,14 @@ class Ros2Node:
 
     def close(self) -> None:
         """Let the current frame finish, then destroy the subscriptions, publishers and the node."""
+        from rclpy.logging import get_logger
+
         self.worker.stop()
-        self.log.info(f"symfruit: stopped after {self.worker.handled} frames ({self.worker.dropped} dropped)")
         self.node.destroy_node()
+        # after a signal the context is gone, and with it /rosout: this line goes to the console only
+        get_logger(NODE_NAME).info(
+            f"symfruit: stopped after {self.worker.handled} frames ({self.worker.dropped} dropped)"
+        )
 
 
 USAGE = """usage: symfruit ros2 [--ros-args ...]
@@ -340,7 +354,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         return 0
     rclpy = require_rclpy()
     require_vision_msgs()
-    from rclpy.executors import ExternalShutdownException, SingleThreadedExecutor
+    from rclpy.executors import SingleThreadedExecutor
     from rclpy.signals import SignalHandlerOptions
     from rclpy.utilities import remove_ros_args
 
@@ -350,23 +364,50 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"symfruit ros2: unknown arguments {' '.join(unknown)}; ROS arguments follow --ros-args "
             "(see symfruit ros2 --help)"
         )
+    # SIGINT and SIGTERM are blocked in every thread (rclpy's and Fast DDS's inherit the mask) and taken by the main
+    # thread alone, in sigwait, while a thread spins: the shutdown below then always runs, in this order.
+    stop_signals = {signal.SIGINT, signal.SIGTERM}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, stop_signals)
     context = rclpy.Context()
-    rclpy.init(args=["symfruit", *args], context=context, signal_handler_options=SignalHandlerOptions.ALL)
+    rclpy.init(args=["symfruit", *args], context=context, signal_handler_options=SignalHandlerOptions.NO)
     executor = SingleThreadedExecutor(context=context)
+    stopping = threading.Event()
+    failed: list[BaseException] = []
     node = None
     try:
         node = Ros2Node(context)
         executor.add_node(node.node)
-        try:
-            executor.spin()
-        except (KeyboardInterrupt, ExternalShutdownException):  # SIGINT / SIGTERM: rclpy shut the context down
-            pass
+        spinner = threading.Thread(target=_spin, args=(executor, stopping, failed), name="symfruit-spin")
+        spinner.start()
+        received = signal.sigwait(stop_signals)
+        stopping.set()
+        node.log.info(f"symfruit: {signal.Signals(received).name}, shutting down")
+        executor.shutdown()
+        spinner.join()
     finally:
+        stopping.set()
         if node is not None:
-            node.close()
+            node.close()  # the worker finishes its frame first, then the node goes
         executor.shutdown()
         rclpy.try_shutdown(context=context)
+        context.destroy()  # the DDS participant with it: its shared-memory segments go
+        while stop_signals & signal.sigpending():  # a second Ctrl-C meanwhile must not kill us as we return
+            signal.sigwait(stop_signals)
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    if failed:
+        raise SymfruitError(f"symfruit ros2: the executor failed: {failed[0]!r}")
     return 0
+
+
+def _spin(executor: Any, stopping: threading.Event, failed: list[BaseException]) -> None:
+    """Spin until the main thread shuts the executor down; should it end by itself (an error), wake the main thread
+    as a signal would."""
+    try:
+        executor.spin()
+    except BaseException as exc:  # handed to the main thread, which ends the node and reports it
+        failed.append(exc)
+    if not stopping.is_set():
+        os.kill(os.getpid(), signal.SIGTERM)
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -58,11 +58,14 @@ MESSAGES = ("ObjectHypothesis", "ObjectHypothesisWithPose", "BoundingBox3D", "De
 #: REP-2011 type hashes of upstream vision_msgs 4.x (unchanged since 4.0.0), as upstream's build writes them into
 #: ``share/vision_msgs/msg/*.json``; rosbags computes the same from the shipped definitions (tests/ros/test_ros2env.py).
 UPSTREAM_TYPE_HASH = {
-    "vision_msgs/msg/Detection3DArray": "RIHS01_793f5eab9595ac1c0da07873cc859db42eae51f0ee76056db8562515d830e018",
-    "vision_msgs/msg/Detection3D": "RIHS01_ddd703be132ab0b69d33121f1bb034132bfbb3b0ac5f9fb1516005ba1c8a265b",
-    "vision_msgs/msg/BoundingBox3D": "RIHS01_bbb73a65c163d7f9bb29009c7bde9f7faa576bd2d23299c4511d19230dab4698",
-    "vision_msgs/msg/ObjectHypothesisWithPose": "RIHS01_41c12344c0396c48b81df12467c192d99b2a0eb1463c5c37194e4223251c80bc",
-    "vision_msgs/msg/ObjectHypothesis": "RIHS01_51da43cec11c01957a64d1e05a24acd18aae7745ec30b74348ad5f6d634f7f90",
+    f"vision_msgs/msg/{name}": f"RIHS01_{digest}"
+    for name, digest in [
+        ("Detection3DArray", "793f5eab9595ac1c0da07873cc859db42eae51f0ee76056db8562515d830e018"),
+        ("Detection3D", "ddd703be132ab0b69d33121f1bb034132bfbb3b0ac5f9fb1516005ba1c8a265b"),
+        ("BoundingBox3D", "bbb73a65c163d7f9bb29009c7bde9f7faa576bd2d23299c4511d19230dab4698"),
+        ("ObjectHypothesisWithPose", "41c12344c0396c48b81df12467c192d99b2a0eb1463c5c37194e4223251c80bc"),
+        ("ObjectHypothesis", "51da43cec11c01957a64d1e05a24acd18aae7745ec30b74348ad5f6d634f7f90"),
+    ]
 }
 #: Debian packages of the build tools (installed only when one is missing).
 APT_BUILD_TOOLS = ("cmake", "g++", "make")
@@ -140,7 +143,7 @@ def build_key(python_version: str = f"{sys.version_info[0]}.{sys.version_info[1]
     from importlib.metadata import PackageNotFoundError, requires
 
     try:
-        extra = sorted(r for r in (requires("symfruit") or []) if "extra == \"ros2\"" in r.replace("'", '"'))
+        extra = sorted(r for r in (requires("symfruit") or []) if 'extra == "ros2"' in r.replace("'", '"'))
     except PackageNotFoundError:
         extra = []
     h = hashlib.sha256(f"{BUILD_VERSION}\n{python_version}\n{extra}\n{PACKAGE_XML}\n{CMAKELISTS}".encode())
@@ -275,7 +278,7 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--venv", type=Path, default=Path(DEFAULT_VENV), help=f"venv to make (default {DEFAULT_VENV})")
     parser.add_argument("--project", type=Path, default=Path("."), help="project folder to install (default .)")
     parser.add_argument("--here", action="store_true",
-                        help="build into the running interpreter's venv (which has symfruit[ros2]) instead")  # fmt: skip
+                        help="build into this interpreter's venv (which has symfruit[ros2]) instead")  # fmt: skip
     parser.add_argument("--require", action="store_true", help="exit 1 instead of skipping (CI)")
     args = parser.parse_args(argv)
     venv = Path(sys.prefix) if args.here else args.venv.absolute()
