@@ -152,6 +152,7 @@ class CameraClient:
                 start_new_session=True,
             )  # fmt: skip
         self._replies: queue.Queue[str | None] = queue.Queue()
+        self._ended = False  # the process closed its output
         self._reader = threading.Thread(target=self._read, args=(self.process.stdout,), daemon=True)
         self._reader.start()
 
@@ -164,6 +165,8 @@ class CameraClient:
         """Send ``op`` with ``args``; the reply (``{"ok": ..., ...}``). Raises ``RuntimeError`` when the process
         ends or does not answer within ``deadline`` seconds (its log in the message)."""
         assert self.process.stdin is not None
+        if self._ended:
+            raise RuntimeError(f"the camera process has ended; its log:\n{self.tail()}")
         try:
             self.process.stdin.write(json.dumps({"op": op, **args}) + "\n")
             self.process.stdin.flush()
@@ -174,6 +177,7 @@ class CameraClient:
         except queue.Empty:
             raise RuntimeError(f"no answer to {op} in {deadline:.0f} s; its log:\n{self.tail()}") from None
         if line is None:
+            self._ended = True
             raise RuntimeError(f"the camera process ended during {op}; its log:\n{self.tail()}")
         return json.loads(line)
 
