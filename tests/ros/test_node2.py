@@ -132,16 +132,15 @@ def shm_left_behind(mapped: set[str]) -> set[str]:
 
 
 class World:
-    """A node, the stand-in camera and what they need, for one module or one test."""
+    """The node with its defaults, the stand-in camera and what they need, on one domain."""
 
-    def __init__(self, python: str, home: Path, domain: int, *, node_args: tuple = (), camera_args: tuple = (),
-                 node_name: str = "symfruit") -> None:  # fmt: skip
+    def __init__(self, python: str, home: Path, domain: int) -> None:
         from symfruit.ros.camera2 import CameraClient, isolated_env
 
         self.env = isolated_env(domain, home)
         self.log = home / "node.log"
-        self.node = start_node(python, self.env, self.log, *node_args)
-        self.camera = CameraClient(python, self.env, home / "camera.log", node=node_name, ros_args=camera_args)
+        self.node = start_node(python, self.env, self.log)
+        self.camera = CameraClient(python, self.env, home / "camera.log")
         self.ready()
 
     def call(self, op: str, **args) -> dict:
@@ -299,53 +298,32 @@ def test_stamps_out_of_order_and_apart(world, example_fruits):
     assert len(world.wait("detections", 10)["detections"]) == len(example_fruits)
 
 
-def test_parameters_remapping_and_sigterm(ros2_python, tmp_path):
-    """method, fruit and node name as parameters, inputs remapped by short name and by their default name: the
-    same detections as `symfruit detect --method paper`; beside it qos:=sensor_data subscribes best effort; SIGTERM
-    and SIGINT end them cleanly, nothing left in /dev/shm."""
-    from symfruit.cli import main
-    from symfruit.demo import example_frame
-    from symfruit.ros.camera2 import domain_lease
-    from symfruit.ros.node2 import DEFAULT_TOPICS
-
-    out = tmp_path / "detect"
-    with example_frame() as folder:
-        assert main(["detect", str(folder), "--output", str(out), "--method", "paper"]) == 0
-    import json
-
-    (path,) = out.glob("*/detections.json")
-    expected = [e for e in json.loads(path.read_text())["fruits"] if "error" not in e]
-    node_args = ("-p", "method:=paper", "-p", "fruit:=strawberry", "-r", "__node:=fruit_finder",
-                 "-r", "color:=/cam/rgb", "-r", "/camera/camera/color/camera_info:=/cam/rgb/info")  # fmt: skip
-    camera_args = ("--ros-args", "-r", "/camera/camera/color/image_raw:=/cam/rgb",
-                   "-r", "/camera/camera/color/camera_info:=/cam/rgb/info")  # fmt: skip
-    with domain_lease() as domain:
-        w = World(ros2_python, tmp_path, domain, node_args=node_args, camera_args=camera_args, node_name="fruit_finder")
-        # beside it, on the default topics, one with best-effort inputs (frames are not sent to it: best effort
-        # loses most of a 1.5 MB frame between processes here)
-        be = start_node(ros2_python, w.env, tmp_path / "be.log", "-r", "__node:=symfruit_be", "-p", "qos:=sensor_data")
-        try:
-            w.frame(700, 1)
-            assert_detections_equal(w.wait("detections", 700, 1), expected, 700, 1, "strawberry")
-            assert "method paper" in w.log.read_text() and "/cam/rgb, " in w.log.read_text()
-            for topic in DEFAULT_TOPICS.values():
-                got = w.call("endpoint", topic=topic, node="/symfruit_be", side="subscription", timeout=TIMEOUT)
-                assert got["ok"] and [e["reliability"] for e in got["endpoints"]] == ["best_effort"], tail(
-                    tmp_path / "be.log"
-                )
-            mapped = shm_mapped(w.node.pid) | shm_mapped(be.pid)
-            assert any("fastdds" in p for p in mapped)  # it did use shared memory
-            w.node.send_signal(signal.SIGTERM)
-            assert w.node.wait(TIMEOUT) == 0, tail(w.log)
-            be.send_signal(signal.SIGINT)
-            assert be.wait(TIMEOUT) == 0, tail(tmp_path / "be.log")
-            assert "stopped after 1 frames" in w.log.read_text()
-            assert "stopped after 0 frames" in (tmp_path / "be.log").read_text()
-            assert w.camera.close() == 0
-            assert shm_left_behind(mapped) == set()
-        finally:
-            stop_group(be, 60)
-            w.close()
+def test_parameters_remapping_qos_and_sigterm(world, ros2_python, tmp_path):
+    """A second node beside the shared one: name, method and qos as parameters, inputs remapped by short name and by
+    their default name (it hears none of the shared node's frames); best-effort subscriptions on the remapped
+    topics; SIGTERM ends it cleanly, nothing left in /dev/shm. (Frames are not sent to it: best effort loses most
+    of a 1.5 MB frame between processes here.)"""
+    log = tmp_path / "finder.log"
+    node = start_node(ros2_python, world.env, log, "-r", "__node:=fruit_finder", "-p", "method:=paper",
+                      "-p", "qos:=sensor_data", "-r", "color:=/cam/rgb", "-r", "depth:=/cam/depth",
+                      "-r", "/camera/camera/color/camera_info:=/cam/rgb/info")  # fmt: skip
+    try:
+        for topic in ("/cam/rgb", "/cam/depth", "/cam/rgb/info"):
+            got = world.call("endpoint", topic=topic, node="/fruit_finder", side="subscription", timeout=TIMEOUT)
+            assert got["ok"] and [e["reliability"] for e in got["endpoints"]] == ["best_effort"], tail(log)
+        got = world.call("endpoint", topic="/fruit_finder/detections", node="/fruit_finder", side="publisher")
+        assert got["ok"] and got["endpoints"][0]["type"] == "vision_msgs/msg/Detection3DArray"
+        assert "method paper, fruit strawberry, qos sensor_data, listening to /cam/rgb, /cam/depth, /cam/rgb/info" in (
+            log.read_text()
+        )
+        mapped = shm_mapped(node.pid)
+        assert any("fastdds" in p for p in mapped)  # it does use shared memory
+        node.send_signal(signal.SIGTERM)
+        assert node.wait(TIMEOUT) == 0, tail(log)
+        assert "SIGTERM, shutting down" in log.read_text() and "stopped after 0 frames" in log.read_text()
+        assert shm_left_behind(mapped) == set()
+    finally:
+        stop_group(node, 60)
 
 
 def test_bad_parameter_is_one_line_and_exit_2(ros2_python, tmp_path):

@@ -137,17 +137,13 @@ class CameraClient:
         Where its stderr goes.
     node : str
         Name of the node whose outputs to listen to.
-    ros_args : sequence of str
-        ``--ros-args ...`` of the stand-in (``-r /camera/camera/color/image_raw:=/cam/rgb`` moves its colour topic).
     """
 
-    def __init__(
-        self, python: str | Path, env: Mapping[str, str], log: Path, *, node: str = NODE_NAME, ros_args: tuple = ()
-    ) -> None:
+    def __init__(self, python: str | Path, env: Mapping[str, str], log: Path, *, node: str = NODE_NAME) -> None:
         self.log = Path(log)
         with open(self.log, "wb") as err:
             self.process = subprocess.Popen(
-                [str(python), "-m", "symfruit.ros.camera2", "serve", "--node", node, *ros_args],
+                [str(python), "-m", "symfruit.ros.camera2", "serve", "--node", node],
                 env=dict(env), stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=err, text=True,
                 start_new_session=True,
             )  # fmt: skip
