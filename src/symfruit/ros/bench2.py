@@ -47,7 +47,7 @@ def bench_node2(
     import rclpy
     from rclpy.executors import SingleThreadedExecutor
 
-    from .camera2 import Camera, Listener, domain_lease, frame_messages, isolated_env
+    from .camera2 import Camera, Listener, domain_lease, frame_messages, isolated_env, use_writer_profile
     from .core import FrameProcessor
 
     # 1. detect alone
@@ -72,6 +72,7 @@ def bench_node2(
         env = isolated_env(domain, Path(home))
         for key in ("ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_DOMAIN_ID", "RMW_IMPLEMENTATION"):  # this process too
             os.environ[key] = env[key]
+        use_writer_profile()  # the camera's writers repair a lost fragment in 50 ms, not 3 s (camera2)
         context = rclpy.Context()
         rclpy.init(context=context, domain_id=domain)
         node = rclpy.create_node("symfruit_bench", context=context)
