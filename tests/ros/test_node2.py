@@ -119,16 +119,21 @@ def shm_mapped(pid: int) -> set[str]:
         return {ln.split()[-1] for ln in maps if "/dev/shm/" in ln and not ln.rstrip().endswith("(deleted)")}
 
 
-def shm_left_behind(mapped: set[str]) -> set[str]:
-    """Of ``mapped``, what still exists with no live process mapping it. lttng-ust (in the ROS 2 wheels' tracing
-    library) creates one wait segment per user, shared by every traced process and by design never removed."""
+def shm_now() -> set[str]:
+    return {str(p) for p in Path("/dev/shm").iterdir()}
+
+
+def shm_left_behind(mapped: set[str], before: set[str]) -> set[str]:
+    """Of ``mapped``, what was made after ``before`` and still exists with no live process mapping it. (What was
+    there before may be a segment another process left; lttng-ust, in the ROS 2 wheels' tracing library, makes
+    one wait segment per user, shared by every traced process and by design never removed.)"""
     alive: set[str] = set()
     for maps in Path("/proc").glob("[0-9]*/maps"):
         try:
             alive |= {ln.split()[-1] for ln in maps.read_text(errors="replace").splitlines() if "/dev/shm/" in ln}
         except OSError:  # a process that ended meanwhile, or not ours to read
             continue
-    return {p for p in mapped if Path(p).exists() and p not in alive and "/lttng-ust-wait-" not in p}
+    return {p for p in mapped - before if Path(p).exists() and p not in alive and "/lttng-ust-wait-" not in p}
 
 
 class World:
@@ -139,6 +144,7 @@ class World:
 
         self.env = isolated_env(domain, home)
         self.log = home / "node.log"
+        self.shm_before = shm_now()
         self.node = start_node(python, self.env, self.log)
         self.camera = CameraClient(python, self.env, home / "camera.log")
         self.ready()
@@ -304,6 +310,7 @@ def test_parameters_remapping_qos_and_sigterm(world, ros2_python, tmp_path):
     topics; SIGTERM ends it cleanly, nothing left in /dev/shm. (Frames are not sent to it: best effort loses most
     of a 1.5 MB frame between processes here.)"""
     log = tmp_path / "finder.log"
+    before = shm_now()
     node = start_node(ros2_python, world.env, log, "-r", "__node:=fruit_finder", "-p", "method:=paper",
                       "-p", "qos:=sensor_data", "-r", "color:=/cam/rgb", "-r", "depth:=/cam/depth",
                       "-r", "/camera/camera/color/camera_info:=/cam/rgb/info")  # fmt: skip
@@ -313,15 +320,14 @@ def test_parameters_remapping_qos_and_sigterm(world, ros2_python, tmp_path):
             assert got["ok"] and [e["reliability"] for e in got["endpoints"]] == ["best_effort"], tail(log)
         got = world.call("endpoint", topic="/fruit_finder/detections", node="/fruit_finder", side="publisher")
         assert got["ok"] and got["endpoints"][0]["type"] == "vision_msgs/msg/Detection3DArray"
-        assert "method paper, fruit strawberry, qos sensor_data, listening to /cam/rgb, /cam/depth, /cam/rgb/info" in (
-            log.read_text()
-        )
+        started = "method paper, fruit strawberry, qos sensor_data, listening to /cam/rgb, /cam/depth, /cam/rgb/info"
+        wait_for_line(started, node, log)
         mapped = shm_mapped(node.pid)
         assert any("fastdds" in p for p in mapped)  # it does use shared memory
         node.send_signal(signal.SIGTERM)
         assert node.wait(TIMEOUT) == 0, tail(log)
         assert "SIGTERM, shutting down" in log.read_text() and "stopped after 0 frames" in log.read_text()
-        assert shm_left_behind(mapped) == set()
+        assert shm_left_behind(mapped, before) == set()
     finally:
         stop_group(node, 60)
 
@@ -348,4 +354,4 @@ def test_sigint_ends_the_shared_node_cleanly(world):
     assert world.node.wait(TIMEOUT) == 0, tail(world.log)
     assert "stopped after" in world.log.read_text()
     assert world.camera.close() == 0
-    assert shm_left_behind(mapped) == set()
+    assert shm_left_behind(mapped, world.shm_before) == set()

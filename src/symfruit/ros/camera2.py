@@ -125,6 +125,7 @@ def isolated_env(domain: int, log_dir: Path, base: Mapping[str, str] | None = No
         ROS_HOME=str(log_dir),
         PYTHONUNBUFFERED="1",
         RCUTILS_COLORIZED_OUTPUT="0",
+        RCUTILS_LOGGING_BUFFERED_STREAM="0",  # each log line reaches the log file at once
     )
     return env
 
