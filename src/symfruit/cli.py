@@ -164,6 +164,8 @@ def _add_ros(sub: argparse._SubParsersAction) -> None:
     # Everything after `ros` belongs to the node (name:=value, __name:=, --help): no option prefix of ours.
     p = sub.add_parser("ros", help="run the ROS 1 node (see `symfruit ros --help`)", add_help=False, prefix_chars="+")
     p.add_argument("ros_args", nargs=argparse.REMAINDER, help="ROS remappings and _param:=value")
+    p = sub.add_parser("ros2", help="run the ROS 2 node (see `symfruit ros2 --help`)", add_help=False, prefix_chars="+")
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="--ros-args -p name:=value -r from:=to")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -586,6 +588,12 @@ def _ros(args: argparse.Namespace) -> int:
     return ros_main(args.ros_args)
 
 
+def _ros2(args: argparse.Namespace) -> int:
+    from .ros.node2 import main as ros2_main
+
+    return ros2_main(args.ros_args)
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -610,6 +618,7 @@ _COMMANDS = {
     "demo": _demo,
     "scenes": _scenes,
     "ros": _ros,
+    "ros2": _ros2,
     "settings": _settings,
     "methods": _methods,
 }
