@@ -7,7 +7,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit import ConfigError
-from symfruit.extract import ExtractSettings, cluster, extract
+from symfruit.core.camera import Camera
+from symfruit.extract import ExtractSettings, cluster, extract, register, shift_labels
 
 from .conftest import SMALL_CAM, disc_frame
 
@@ -76,8 +77,10 @@ def test_a_far_cluster_is_dropped_and_the_nearest_big_one_kept():
     depth[40:42, 60:62] = 0.2
     ex = extract(mask, depth, CAM, NO_EROSION)
     assert len(ex.points) == 800 and ex.n_other_clusters == 800 and ex.points[:, 2].min() == np.float32(0.3)
-    big_leaf = extract(mask, depth, CAM, ExtractSettings(erode_px=0, cluster_share=0.001))
-    assert len(big_leaf.points) == 4 and big_leaf.points[:, 2].max() == np.float32(0.2)
+    # ... nor is a large one 10 cm in front: the fruit's depth mode is where most of the mask's depth lies
+    depth[40:50, 60:80] = 0.2
+    ex = extract(mask, depth, CAM, NO_EROSION)
+    assert len(ex.points) == 800 and ex.points[:, 2].min() == np.float32(0.3)
 
 
 def test_erosion_drops_the_border_unless_the_mask_is_small():
@@ -137,3 +140,42 @@ def test_points_closer_than_half_the_distance_share_a_cluster(seed, distance):
     labels = cluster(apart, distance)
     assert set(labels[:50].tolist()) == {labels[0]} and set(labels[50:].tolist()) == {labels[50]}
     assert labels[0] != labels[50]
+
+
+def test_shift_labels_moves_and_clips():
+    labels = np.zeros((5, 6), np.int32)
+    labels[1, 1], labels[4, 5] = 1, 2
+    moved = shift_labels(labels, 2, -1)
+    assert moved[0, 3] == 1 and moved.sum() == 1  # label 2 moved out of the image
+    assert np.array_equal(shift_labels(labels, 0, 0), labels)
+    assert not shift_labels(labels, 6, 0).any() and not shift_labels(labels, 0, -5).any()
+
+
+def test_register_moves_the_masks_onto_the_depth():
+    _, depth = disc_frame([(50, 60), (110, 60)], radius=18)
+    labels = np.zeros((120, 160), np.int32)
+    yy, xx = np.mgrid[:120, :160]
+    labels[(xx - 46) ** 2 + (yy - 63) ** 2 <= 18**2] = 1  # both drawn 4 px left and 3 px down of the depth
+    labels[(xx - 106) ** 2 + (yy - 63) ** 2 <= 18**2] = 2
+    moved, shift = register(labels, depth, CAM)
+    assert shift == (4, -3) and np.array_equal(moved, shift_labels(labels, 4, -3))
+    same, none = register(moved, depth, CAM)
+    assert none == (0, 0) and same is moved
+    assert register(labels, depth, CAM, ExtractSettings(registration_px=0))[1] == (0, 0)
+
+
+def test_a_support_under_the_fruit_is_not_its_surface():
+    """A ball on a table: the table meets the ball at its lowest point and comes nearer below it; a mask drawn
+    a few pixels too large takes in table pixels at the ball's depth, which the convexity cut leaves out."""
+    cam = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
+    yy, xx = np.mgrid[:120, :160].astype(float)
+    d2 = ((xx - 80) ** 2 + (yy - 60) ** 2) / 20.0**2
+    r_m = 20 * 0.5 / 600
+    depth = np.where(yy > 60, 0.5 + r_m - (yy - 80) * 0.002, 0.8)
+    depth = np.where(d2 <= 1, 0.5 + r_m * (1 - np.sqrt(np.clip(1 - d2, 0, None))), depth)
+    mask = d2 <= (24.0 / 20.0) ** 2
+    ex = extract(mask, depth, cam, NO_EROSION)
+    uv = cam.project(ex.points)
+    off_ball = ((uv[:, 0] - 80) ** 2 + (uv[:, 1] - 60) ** 2) > 20.5**2
+    assert off_ball.sum() <= 0.2 * (mask & (d2 > 1)).sum()
+    assert not (uv[:, 1] > 81).any()  # below the ball, where the table comes nearer

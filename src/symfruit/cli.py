@@ -107,6 +107,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
+    p.add_argument("--spheres", type=Path,
+                   help="instead of a protocol: real frames of spheres without truth (one mask per sphere, the same "
+                   "ids in every frame): how far each box is from a cube and how far the frames disagree, e.g. "
+                   "examples/real-frames")  # fmt: skip
     p.add_argument("--masks", default=None,
                    help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
@@ -185,6 +189,8 @@ def _add_ros(sub: argparse._SubParsersAction) -> None:
     # Everything after `ros` belongs to the node (name:=value, __name:=, --help): no option prefix of ours.
     p = sub.add_parser("ros", help="run the ROS 1 node (see `symfruit ros --help`)", add_help=False, prefix_chars="+")
     p.add_argument("ros_args", nargs=argparse.REMAINDER, help="ROS remappings and _param:=value")
+    p = sub.add_parser("ros2", help="run the ROS 2 node (see `symfruit ros2 --help`)", add_help=False, prefix_chars="+")
+    p.add_argument("ros_args", nargs=argparse.REMAINDER, help="--ros-args -p name:=value -r from:=to")
 
 
 def _parser() -> argparse.ArgumentParser:
@@ -385,6 +391,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
     if args.jobs is not None and not 1 <= args.jobs <= 256:
         raise InputError(f"--jobs must be between 1 and 256, got {args.jobs}")
+    if args.spheres is not None:
+        return _evaluate_spheres(args, methods, _plain_settings(args))
     if args.frames is not None:
         from .profiles import available_profiles
 
@@ -424,6 +432,27 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
         print(f"skipped {name}: {reason}")
     print(f"results: {folder}")
     return 0
+
+
+def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) -> int:
+    from .evaluate.spheres import evaluate_spheres, spheres_table
+    from .io import atomic_write, write_json
+    from .writers import new_results_folder
+
+    failed: dict[str, str] = {}
+    rows = evaluate_spheres(args.spheres, methods=methods, masks=args.masks or "auto", settings=settings,
+                            failed=failed)  # fmt: skip
+    table, summary = spheres_table(rows, methods)
+    folder = new_results_folder(args.output, "spheres")
+    write_json(folder / "summary.json", {"source": str(args.spheres), "methods": summary, "failed": failed,
+                                         "settings": settings.to_dict()})  # fmt: skip
+    with atomic_write(folder / "table.md", "w") as handle:
+        handle.write(table)
+    print(table)
+    for name, reason in failed.items():
+        print(f"skipped {name}: {reason}")
+    print(f"results: {folder}")
+    return 0 if rows else 1
 
 
 def _evaluate_masks(args: argparse.Namespace) -> int:
@@ -618,6 +647,12 @@ def _ros(args: argparse.Namespace) -> int:
     return ros_main(args.ros_args)
 
 
+def _ros2(args: argparse.Namespace) -> int:
+    from .ros.node2 import main as ros2_main
+
+    return ros2_main(args.ros_args)
+
+
 def _settings(args: argparse.Namespace) -> int:
     import yaml
 
@@ -643,6 +678,7 @@ _COMMANDS = {
     "demo": _demo,
     "scenes": _scenes,
     "ros": _ros,
+    "ros2": _ros2,
     "settings": _settings,
     "methods": _methods,
 }

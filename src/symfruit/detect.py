@@ -19,8 +19,9 @@ from .core.camera import Camera
 from .core.frame import Frame
 from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
+from .core.surface import colour_trim
 from .errors import InputError, SymfruitError
-from .extract import Extraction, extract
+from .extract import Extraction, extract, register
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .occlusion import fruit_occlusion
@@ -52,12 +53,15 @@ class Detection:
 
 @dataclass(frozen=True)
 class FrameDetections:
-    """All fruit of one frame, with the time each stage took (seconds)."""
+    """All fruit of one frame, with the time each stage took (seconds) and the shift ``(du, dv)`` (pixels) the
+    masks were moved by onto the depth image (:func:`symfruit.extract.register`; each detection's mask is the
+    moved one)."""
 
     frame: Frame
     detections: list[Detection]
     timings: dict[str, float] = field(default_factory=dict)
     mask_source: str = ""
+    registration: tuple[int, int] = (0, 0)
 
 
 Segmenter = Callable[[Frame, Settings], np.ndarray]
@@ -117,7 +121,15 @@ def detect(
             raise InputError(f"frame {frame.name}: masks hold {count} instances; at most {MAX_FRUIT_PER_FRAME} "
                              "fruit per frame are read")  # fmt: skip
         labels = (inverse.reshape(labels.shape) + int(values[0] != 0)).astype(np.int32)
-    detections, t_extract, t_complete = [], 0.0, 0.0
+    if labels.size:
+        whole = np.flatnonzero(np.bincount(labels.ravel())[1:] == labels.size)
+        if len(whole):
+            raise InputError(
+                f"frame {frame.name}: mask {int(whole[0]) + 1} covers the whole image; that is not a fruit"
+            )
+    t_register = time.perf_counter()
+    labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
+    detections, t_extract, t_complete = [], time.perf_counter() - t_register, 0.0
     from scipy import ndimage
 
     fruit_px = labels > 0
@@ -126,10 +138,9 @@ def detect(
             continue
         mask = np.zeros(labels.shape, bool)
         mask[sl] = labels[sl] == k
-        if mask.all():
-            raise InputError(f"frame {frame.name}: mask {k} covers the whole image; that is not a fruit")
         a = time.perf_counter()
         ex = _extract_window(mask, sl, frame, settings)
+        mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
         if len(ex.points) < settings.extract.min_points:
@@ -149,17 +160,24 @@ def detect(
         t_complete += time.perf_counter() - b
     total = time.perf_counter() - t0
     timings = {"segment": t1 - t0, "extract": t_extract, "complete": t_complete, "total": total}
-    return FrameDetections(frame, detections, timings, source)
+    return FrameDetections(frame, detections, timings, source, shift)
 
 
 def _extract_window(mask: np.ndarray, sl: tuple[slice, slice], frame: Frame, settings: Settings) -> Extraction:
     """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test."""
     h, w = mask.shape
-    pad = settings.extract.erode_px + 1
+    pad = max(settings.extract.erode_px, settings.extract.colour_trim_px) + 2
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
     cam = frame.camera
+    window = mask[r0:r1, c0:c1]
+    if settings.extract.colour_trim_px > 0 and frame.color is not None:
+        band = min(float(settings.extract.colour_trim_px), 0.2 * float(np.sqrt(window.sum() / np.pi)))
+        window = colour_trim(frame.color[r0:r1, c0:c1], window, band_px=band)
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
-    ex = extract(mask[r0:r1, c0:c1], frame.depth[r0:r1, c0:c1], local, settings.extract)
+    ex = extract(window, frame.depth[r0:r1, c0:c1], local, settings.extract)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
-    return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated)
+    outline = mask.copy()
+    if ex.silhouette is not None:
+        outline[r0:r1, c0:c1] = ex.silhouette
+    return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated, outline)

@@ -1,5 +1,6 @@
-"""From a fruit's mask to its 3D points: de-project, drop invalid depth and flying pixels, keep the
-fruit's own cluster (points of a leaf or of a fruit behind leak in through a mask)."""
+"""From a fruit's mask to its 3D points: the depth image registered to the masks, invalid depth dropped, the
+fruit's own surface kept (:func:`symfruit.core.surface.fruit_surface`: the background, a leaf, the support or a
+fruit behind leak in through a mask, flying pixels bridge them), de-projected."""
 
 from __future__ import annotations
 
@@ -10,9 +11,10 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
+from .core.surface import fruit_surface, registration_shift
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "cluster", "extract"]
+__all__ = ["ExtractSettings", "Extraction", "cluster", "extract", "register", "shift_labels"]
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -29,6 +31,22 @@ class ExtractSettings(Section):
     erode_px : int
         Pixels dropped along the mask's border, where flying pixels (depth mixed with the background)
         sit.
+    registration_px : int
+        How far (pixels) the depth image may sit from the masks: a real RGB-D camera's depth registered to
+        colour is often a few pixels off (the shared Azure Kinect lab frames: 8 px down). The frame's shift is
+        searched within this radius and the masks moved onto the depth before extraction
+        (:func:`~symfruit.core.surface.registration_shift`; 0: never).
+    colour_trim_px : int
+        With the frame's colour image (``detect``): a mask's outer band up to this many pixels (and a fifth of
+        its equivalent radius) loses the pixels whose colour is the background's
+        (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); 0: never.
+    slab : float
+        Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
+        fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
+    convex_tolerance : float
+        Along every image ray from the fruit's nearest point its depth may fall this many noise deviations
+        (at least 3 mm) below its running maximum before the ray has left the fruit (a convex front never
+        falls); 0 switches the test off.
     cluster_distance : float, metres
         Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
         cluster nearest the camera among those with at least ``cluster_share`` of the largest's points.
@@ -40,6 +58,10 @@ class ExtractSettings(Section):
     min_depth: float = setting(0.1, ge=0.0, le=100.0)
     max_depth: float = setting(2.0, gt=0.0, le=100.0)
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
+    registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
+    colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
+    slab: float = setting(1.3, gt=0.0, le=100.0)
+    convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
     cluster_share: float = setting(0.3, gt=0.0, le=1.0)
     min_points: int = setting(30, ge=4, le=1_000_000)
@@ -62,9 +84,12 @@ class Extraction:
     n_border : int
         Pixels dropped at the mask's border (flying pixels).
     n_other_clusters : int
-        Points dropped because they belong to another cluster.
+        Points dropped as not the fruit's own surface: another depth (the background, a leaf in front), a
+        support or stem its convex front cannot continue into, another cluster.
     truncated : bool
         The mask touches the image border: the fruit may continue outside the image.
+    silhouette : (h, w) bool, optional
+        The fruit's outline as the completion sees it (the mask).
     """
 
     points: np.ndarray
@@ -73,6 +98,7 @@ class Extraction:
     n_border: int
     n_other_clusters: int
     truncated: bool
+    silhouette: np.ndarray | None = None
 
 
 def cluster(points: np.ndarray, distance: float) -> np.ndarray:
@@ -132,15 +158,17 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     Parameters
     ----------
     mask : (h, w) bool
-    depth : (h, w) float, metres (0 or NaN = no depth)
+    depth : (h, w) float, metres (0 or NaN = no depth), registered to the mask (:func:`register`)
     camera : Camera
     settings : ExtractSettings
 
     Returns
     -------
     Extraction
-        Its points are the cluster nearest the camera among the clusters holding at least
-        ``cluster_share`` of the largest one's points.
+        Its points are the mask's pixels (the border eroded) on the fruit's own surface
+        (:func:`~symfruit.core.surface.fruit_surface`: its depth mode, a slab of ``slab`` radii behind its
+        front, the convex cap from its nearest point), then the cluster nearest the camera among the clusters
+        holding at least ``cluster_share`` of the largest one's points.
     """
     s = settings or ExtractSettings()
     area = int(mask.sum())
@@ -150,19 +178,53 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         eroded = ndimage.minimum_filter(mask.view(np.uint8), size=2 * s.erode_px + 1, mode="constant").astype(bool)
         if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
             core = eroded
-    rows, cols = np.nonzero(core)
-    z = depth[rows, cols].astype(np.float64)
-    valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth)
-    n_invalid = int((~valid).sum())
-    rows, cols, z = rows[valid], cols[valid], z[valid]
-    points = camera.deproject(np.c_[cols, rows].astype(np.float64), z)
-    dropped = 0
+    z_all = np.asarray(depth, dtype=np.float64)
+    valid = np.isfinite(z_all) & (z_all >= s.min_depth) & (z_all <= s.max_depth)
+    n_invalid = int((core & ~valid).sum())
+    usable = core & valid
+    keep, outline = usable, np.asarray(mask, dtype=bool)
+    if usable.sum() >= 10:
+        focal = float(np.sqrt(camera.fx * camera.fy))
+        found = fruit_surface(np.where(valid, z_all, 0.0), core, focal, slab=s.slab,
+                              tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf)  # fmt: skip
+        if found is not None:
+            keep = usable & found.pixels
+    rows, cols = np.nonzero(keep)
+    points = camera.deproject(np.c_[cols, rows].astype(np.float64), z_all[rows, cols])
+    dropped = int(usable.sum() - len(points))
     if len(points) >= 2:
         labels = cluster(points, s.cluster_distance)
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         near = big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
-        keep = labels == near
-        dropped = int((~keep).sum())
-        points = points[keep]
-    return Extraction(points, area, n_invalid, int(area - core.sum()), dropped, truncated)
+        keep_cluster = labels == near
+        dropped += int((~keep_cluster).sum())
+        points = points[keep_cluster]
+    return Extraction(points, area, n_invalid, int(area - core.sum()), dropped, truncated, outline)
+
+
+def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
+    """``labels`` moved by ``(du, dv)`` pixels (what lay at ``(u, v)`` lies at ``(u + du, v + dv)``; 0 enters)."""
+    out = np.zeros_like(labels)
+    h, w = labels.shape
+    if abs(du) >= w or abs(dv) >= h:
+        return out
+    out[max(dv, 0) : h + min(dv, 0), max(du, 0) : w + min(du, 0)] = labels[
+        max(-dv, 0) : h - max(dv, 0), max(-du, 0) : w - max(du, 0)
+    ]
+    return out
+
+
+def register(
+    labels: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None
+) -> tuple[np.ndarray, tuple[int, int]]:
+    """The masks moved onto the depth image, and the shift ``(du, dv)`` (pixels) they were moved by.
+
+    :func:`~symfruit.core.surface.registration_shift` within ``registration_px``; ``(0, 0)`` and the masks as they
+    are when the frame is registered well enough or the masks do not say.
+    """
+    s = settings or ExtractSettings()
+    z = np.asarray(depth, dtype=np.float64)
+    z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth), z, 0.0)
+    du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px)
+    return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

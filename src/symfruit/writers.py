@@ -141,6 +141,7 @@ def detections_record(found: FrameDetections, *, settings: Settings | None = Non
         "camera": frame.camera.to_dict(),
         "units": "metres",
         "mask_source": found.mask_source,
+        "registration_px": list(found.registration),
         "timings": found.timings,
         "fruits": [detection_record(d) for d in found.detections],
     }

@@ -51,7 +51,18 @@ def test_frames_without_truth_or_unreadable_are_reported(tmp_path):
     assert {s.frame for s in scores} == {"a"} and all(s.method == "raw" and 0 < s.iou < 1 for s in scores)
     data = summary_dict(scores, totals, failed)
     assert data["totals"] == totals and data["failed"] == failed and len(data["scores"]) == 6
-    assert set(data["scores"][0]) == {"frame", "fruit", "truth", "method", "iou", "centre_mm", "n_points", "truncated"}
+    assert set(data["scores"][0]) == {
+        "frame",
+        "fruit",
+        "truth",
+        "method",
+        "iou",
+        "centre_mm",
+        "n_points",
+        "truncated",
+        "depth_mm",
+        "lateral_mm",
+    }
 
 
 def test_the_table_is_laid_out_like_the_papers(tmp_path):

@@ -10,14 +10,16 @@ from symfruit.evaluate.report import PAPER_TABLE2, markdown_table, write_results
 from symfruit.evaluate.runner import COLUMNS, Row, summarise
 
 
-def row(method, iou, centre_mm, *, fruit="strawberry", occlusion=0.0, hidden=0.0, error="", angle_x=0.0):
+def row(method, iou, centre_mm, *, fruit="strawberry", occlusion=0.0, hidden=0.0, error="", angle_x=0.0,
+        depth_mm=float("nan"), lateral_mm=float("nan")):  # fmt: skip
     return Row(protocol="paper", fruit=fruit, kind=fruit, fruit_index=0, pose=0, angle_x=angle_x, angle_y=0.0,
                angle_z=0.0, distance_m=0.3, occlusion=occlusion, hidden=hidden, n_visible=100, method=method, iou=iou,
                centre_mm=centre_mm, chamfer_mm=1.25, f1=0.875, precision=0.9, recall=0.85, seconds=0.0015,
-               error=error)  # fmt: skip
+               error=error, depth_mm=depth_mm, lateral_mm=lateral_mm)  # fmt: skip
 
 
-ROWS = [row("raw", 0.5, 10.0, angle_x=-45.0), row("raw", 0.6, 8.0, angle_x=45.0),
+ROWS = [row("raw", 0.5, 10.0, angle_x=-45.0, depth_mm=-20.0, lateral_mm=-3.0),
+        row("raw", 0.6, 8.0, angle_x=45.0, depth_mm=-10.0, lateral_mm=1.0),
         row("paper", 0.75, 4.0, angle_x=-45.0), row("paper", float("nan"), float("nan"), error="too few")]  # fmt: skip
 
 
@@ -25,8 +27,12 @@ def test_paper_table_known_values():
     table = markdown_table(summarise(ROWS), protocol="paper", title="my run")
     lines = table.splitlines()
     assert lines[0] == "# my run" and "## paper protocol: strawberry" in lines and "2 instances." in lines
-    assert "| raw | 0.550 | 0.550 | 9.0 | 9.0 | 10.0 | 0 | 0 | 1.25 | 0.875 | 1.50 | 0 |" in lines
-    assert "| paper | 0.750 | 0.750 | 4.0 | 4.0 | 4.0 | 0 | 0 | 1.25 | 0.875 | 1.50 | 1 |" in lines
+    # size errors: mean absolute (mean signed)
+    assert (
+        "| raw | 0.550 | 0.550 | 9.0 | 9.0 | 10.0 | 0 | 0 | 15.0 (-15.0) | 2.0 (-1.0) | 1.25 | 0.875 | 1.50 | 0 |"
+        in lines
+    )
+    assert "| paper | 0.750 | 0.750 | 4.0 | 4.0 | 4.0 | 0 | 0 | - | - | 1.25 | 0.875 | 1.50 | 1 |" in lines
     (ri, rc), (pi, pc) = PAPER_TABLE2["raw"], PAPER_TABLE2["paper"]
     assert f"Ge et al. 2020, Table 2 (mean): input points {ri} / {rc} mm, completed {pi} / {pc} mm." in lines
     other = markdown_table(summarise([row("raw", 0.5, 1.0, fruit="/scans/pears")]), protocol="paper")
@@ -37,7 +43,7 @@ def test_failed_groups_print_dashes_and_camera_tables_name_the_occlusion():
     rows = [row("raw", float("nan"), float("nan"), error="x", occlusion=0.25, hidden=0.3)]
     table = markdown_table(summarise(rows), protocol="camera")
     assert "## camera protocol: strawberry, occluder target 25% (hidden 30% on average)" in table
-    assert "| raw | - | - | - | - | - | - | - | - | - | - | 1 |" in table and "Table 2" not in table
+    assert "| raw | - | - | - | - | - | - | - | - | - | - | - | - | 1 |" in table and "Table 2" not in table
 
 
 def test_confidence_lines_appear_for_methods_that_estimate_it():

@@ -75,3 +75,19 @@ def detect_json(tmp_path_factory) -> dict:
         assert main(["detect", str(folder), "--output", str(out)]) == 0
     (path,) = out.glob("*/detections.json")
     return json.loads(path.read_text())
+
+
+@pytest.fixture(scope="session")
+def ros2_python() -> str:
+    """The interpreter of the ROS 2 venv (`make ros2-env`: rclpy, Fast DDS and vision_msgs built with upstream's
+    type hash; SYMFRUIT_ROS2_VENV, default .venv-ros2 beside the sources). Skipped with the reason when it is not
+    there, failed instead when SYMFRUIT_REQUIRE_ROS=1 (CI, where `make ros2-env` built it)."""
+    from pathlib import Path
+
+    from symfruit.ros.ros2env import DEFAULT_VENV, UPSTREAM_TYPE_HASH, ros2_python, status
+
+    venv = Path(os.environ.get("SYMFRUIT_ROS2_VENV") or Path(__file__).resolve().parents[2] / DEFAULT_VENV)
+    built = status(venv).get("hash")
+    if not ros2_python(venv).exists() or built != UPSTREAM_TYPE_HASH["vision_msgs/msg/Detection3DArray"]:
+        _require_or_skip(f"no ROS 2 venv with vision_msgs at {venv} (built: {built}); `make ros2-env` makes it")
+    return str(ros2_python(venv))

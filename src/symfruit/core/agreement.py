@@ -64,6 +64,9 @@ class Observation:
     out_weights : tuple of (k,) float
         Per outside band, 1 for a ray beside a contour part of the edge, 0 beside a cut (no evidence of
         background there); None: every ray counts.
+    out_depth : tuple of (k,) float, metres, optional
+        Per outside band, the depth the camera saw at each ray's pixel where that pixel is hidden (an occluder
+        there hides the fruit only behind it: a candidate nearer than it is contradicted); NaN elsewhere.
     cone_source : {"moments", "contour"}
         Whether :attr:`cone` is the seen region's moment ellipse's or the ellipse fitted to the contour part
         of the outline (see :func:`observe`).
@@ -84,6 +87,7 @@ class Observation:
     axis: np.ndarray | None = None
     interior: np.ndarray | None = None
     out_weights: tuple[np.ndarray, ...] | None = None
+    out_depth: tuple[np.ndarray, ...] | None = None
     cone_source: str = "moments"
     extent: np.ndarray | None = None
     hidden: np.ndarray | None = None
@@ -181,16 +185,19 @@ def observe(
     contour = float(is_contour.mean()) if len(is_contour) else 1.0
     tree = cKDTree(edge_uv) if len(is_contour) else None
 
-    def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray]:
+    def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if len(rc) > n_band:
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
         uv = np.c_[rc[:, 1] + region.u0, rc[:, 0] + region.v0].astype(np.float64)
         weight = np.ones(len(rc))
+        seen = np.full(len(rc), np.nan)
         if outside and tree is not None and len(rc):
             weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
         if outside and occlusion is not None and len(rc):
-            weight = weight * ~occlusion.at(uv[:, 0], uv[:, 1])  # a hidden pixel: no evidence either
-        return camera.rays(uv[:, 0], uv[:, 1]), weight
+            hidden = occlusion.at(uv[:, 0], uv[:, 1])
+            weight = weight * ~hidden  # a hidden pixel: no evidence of background ...
+            seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
+        return camera.rays(uv[:, 0], uv[:, 1]), weight, seen
 
     ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
     outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
@@ -201,9 +208,10 @@ def observe(
         fitted = outline_cone(region, camera, cracks[is_contour[tree.query(cracks)[1]]])
         if fitted is not None:
             (cone, axis), source = fitted, "contour"
-    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(r for r, _ in ins),
-                       rays_out=tuple(r for r, _ in outs), contour=contour, cone=cone, axis=axis,
-                       interior=points[depth_px >= edge], out_weights=tuple(w for _, w in outs),
+    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(r for r, _, _ in ins),
+                       rays_out=tuple(r for r, _, _ in outs), contour=contour, cone=cone, axis=axis,
+                       interior=points[depth_px >= edge], out_weights=tuple(w for _, w, _ in outs),
+                       out_depth=None if occlusion is None else tuple(d for _, _, d in outs),
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        hidden=None if occlusion is None else occlusion.window(region, radius=2))  # fmt: skip
@@ -320,7 +328,13 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
 
 
 def explain(
-    inside: Inside, box: tuple[np.ndarray, np.ndarray], obs: Observation, *, steps: int = 24, trim: float = 0.8
+    inside: Inside,
+    box: tuple[np.ndarray, np.ndarray],
+    obs: Observation,
+    *,
+    steps: int = 24,
+    trim: float = 0.8,
+    free: float = 0.01,
 ) -> Agreement:
     """Measure one closed candidate against the observation.
 
@@ -335,6 +349,9 @@ def explain(
         March steps per ray (:func:`march`).
     trim : float in (0, 1]
         Share of the depth residuals kept (the smallest) for the robust RMS.
+    free : float, metres
+        An outside ray on a hidden pixel (:attr:`Observation.out_depth`) is wrong when the candidate meets it
+        more than this in front of what the camera saw there (it would have been seen instead).
     """
     lo, hi = box
     z0, z1 = float(lo[2]) - 1e-3, float(hi[2]) + 1e-3
@@ -346,12 +363,20 @@ def explain(
     keep = max(1, int(trim * len(res)))
     r2 = np.partition(res * res, keep - 1)[:keep]
     hits = hit_all[n:]
+    depths = depth_all[n:]
     ins, outs, k = [], [], 0
     for r in obs.rays_in:
         ins.append(1.0 - hits[k : k + len(r)].mean() if len(r) else 0.0)
         k += len(r)
     for i, r in enumerate(obs.rays_out):
         w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
-        outs.append(float((hits[k : k + len(r)] * w).sum() / w.sum()) if w.sum() > 0 else 0.0)
+        wrong = hits[k : k + len(r)] * w
+        if obs.out_depth is not None:  # free space in front of an occluder: a candidate there is contradicted
+            seen = obs.out_depth[i]
+            with np.errstate(invalid="ignore"):
+                carved = hits[k : k + len(r)] & (depths[k : k + len(r)] < seen - free)
+            w = np.where(np.isfinite(seen), 1.0, w)
+            wrong = np.where(np.isfinite(seen), carved, wrong)
+        outs.append(float(wrong.sum() / w.sum()) if w.sum() > 0 else 0.0)
         k += len(r)
     return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

@@ -45,6 +45,9 @@ class Occlusion:
     own : (h, w) bool, optional
         The fruit's own pixels in the window (its instance mask), which may reach beyond its points' pixels
         (a border dropped against flying pixels, pixels without depth).
+    depth : (h, w) float, metres, optional
+        What the camera saw at each pixel of the window (NaN: nothing): a hidden pixel hides the fruit only
+        behind that depth, so a completion there must lie behind it (:meth:`depth_at`).
     """
 
     u0: int
@@ -53,6 +56,7 @@ class Occlusion:
     width: int
     height: int
     own: np.ndarray | None = None
+    depth: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         hidden = np.asarray(self.hidden)
@@ -76,6 +80,11 @@ class Occlusion:
             if own.shape != hidden.shape or own.dtype != bool:
                 raise InputError(f"occlusion own must be a bool image of the window's {w}x{h}, got {own.dtype} "
                                  f"{own.shape}")  # fmt: skip
+        if self.depth is not None:
+            seen = np.asarray(self.depth)
+            if seen.shape != hidden.shape or seen.dtype.kind != "f":
+                raise InputError(f"occlusion depth must be a float image of the window's {w}x{h}, got {seen.dtype} "
+                                 f"{seen.shape}")  # fmt: skip
 
     def at(self, u: np.ndarray, v: np.ndarray, *, radius: int = 0) -> np.ndarray:
         """Whether pixels ``(u, v)`` are hidden, or have a hidden pixel within ``radius`` (a square).
@@ -100,6 +109,19 @@ class Occlusion:
         c, r = col - self.u0, row - self.v0
         inside = (c >= 0) & (c < w) & (r >= 0) & (r < h)
         out[inside] |= hidden[r[inside], c[inside]]
+        return out
+
+    def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """(m,) float, metres: what the camera saw at pixels ``(u, v)`` (rounded), NaN where nothing or outside
+        the window (or without :attr:`depth`)."""
+        col = np.rint(np.asarray(u, dtype=np.float64)).astype(np.intp) - self.u0
+        row = np.rint(np.asarray(v, dtype=np.float64)).astype(np.intp) - self.v0
+        out = np.full(col.shape, np.nan)
+        if self.depth is None:
+            return out
+        h, w = self.hidden.shape
+        inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
+        out[inside] = self.depth[row[inside], col[inside]]
         return out
 
     def window(self, region: Silhouette, *, radius: int = 0) -> np.ndarray:
@@ -253,7 +275,7 @@ def occlusion(
     hidden = near & ~own
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
-    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy())
+    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=d)
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:

@@ -28,7 +28,8 @@ __all__ = ["FrameScore", "evaluate_frames", "match"]
 
 @dataclass(frozen=True)
 class FrameScore:
-    """One matched fruit under one method."""
+    """One matched fruit under one method: box IoU, centre deviation and the signed size errors of the box's
+    depth side and larger lateral side (positive: too large; :class:`~symfruit.evaluate.metrics.Scores`)."""
 
     frame: str
     fruit: int
@@ -38,6 +39,8 @@ class FrameScore:
     centre_mm: float
     n_points: int
     truncated: bool
+    depth_mm: float = float("nan")
+    lateral_mm: float = float("nan")
 
 
 def match(found: Sequence[Box | None], truth: Sequence[Box], gate: float = 0.03) -> list[tuple[int, int]]:
@@ -71,7 +74,8 @@ def score_frame(
                 continue
             scores.append(FrameScore(frame.name, d.id, tid, method, box_iou(box, tbox),
                                      centre_deviation(box, tbox) * 1000, len(d.extraction.points),
-                                     d.extraction.truncated))  # fmt: skip
+                                     d.extraction.truncated, float(box.size[2] - tbox.size[2]) * 1000,
+                                     float(box.size[:2].max() - tbox.size[:2].max()) * 1000))  # fmt: skip
     counts = {"truth": len(truth), "found": len(found.detections), "matched": len(pairs),
               "missed": len(truth) - len(pairs), "false": len(found.detections) - len(pairs)}  # fmt: skip
     return scores, counts
@@ -120,8 +124,9 @@ def table3(scores: Sequence[FrameScore], totals: dict[str, int], methods: Sequen
         "# symfruit evaluation: annotated frames (cf. Ge et al. Table 3)", "",
         f"{totals['frames']} frames, {totals['truth']} true fruit, {totals['found']} found, "
         f"{totals['matched']} matched, {totals['missed']} missed, {totals['false']} false.", "",
-        "| method | IoU mean | IoU median | centre dev mean (mm) | centre dev median (mm) | fruit |",
-        "|---|---|---|---|---|---|",
+        "| method | IoU mean | IoU median | centre dev mean (mm) | centre dev median (mm) | depth side (mm) "
+        "| larger lateral side (mm) | fruit |",
+        "|---|---|---|---|---|---|---|---|",
     ]  # fmt: skip
     for m in methods:
         mine = [s for s in scores if s.method == m]
@@ -129,7 +134,10 @@ def table3(scores: Sequence[FrameScore], totals: dict[str, int], methods: Sequen
             continue
         iou = np.array([s.iou for s in mine])
         dev = np.array([s.centre_mm for s in mine])
+        dz = np.array([s.depth_mm for s in mine])
+        dl = np.array([s.lateral_mm for s in mine])
         lines.append(f"| {m} | {iou.mean():.3f} | {np.median(iou):.3f} | {dev.mean():.1f} | {np.median(dev):.1f} "
+                     f"| {np.abs(dz).mean():.1f} ({dz.mean():+.1f}) | {np.abs(dl).mean():.1f} ({dl.mean():+.1f}) "
                      f"| {len(mine)} |")  # fmt: skip
     (ri, rc), (pi, pc) = PAPER_TABLE3["raw"], PAPER_TABLE3["paper"]
     lines += [

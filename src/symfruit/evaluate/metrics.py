@@ -15,7 +15,12 @@ __all__ = ["Scores", "chamfer_f1", "score_completion"]
 
 @dataclass(frozen=True)
 class Scores:
-    """Metrics of one completed fruit (millimetres for distances)."""
+    """Metrics of one completed fruit (millimetres for distances).
+
+    ``depth_mm`` and ``lateral_mm`` are signed size errors of the box (positive: too large): its depth side
+    (along the camera's z) against the truth's, and its larger lateral side (x or y) against the truth's
+    larger lateral side, the two measures of issue 18 (a caliper's diameter against a robot's box).
+    """
 
     iou: float
     centre_mm: float
@@ -23,6 +28,8 @@ class Scores:
     f1: float
     precision: float
     recall: float
+    depth_mm: float = float("nan")
+    lateral_mm: float = float("nan")
 
 
 def chamfer_f1(
@@ -70,4 +77,6 @@ def score_completion(box: Box, completed: np.ndarray, truth_box: Box, truth_surf
         f1=f1,
         precision=precision,
         recall=recall,
+        depth_mm=float(box.size[2] - truth_box.size[2]) * 1000.0,
+        lateral_mm=float(box.size[:2].max() - truth_box.size[:2].max()) * 1000.0,
     )

@@ -30,6 +30,14 @@ def _f(value: float | None, digits: int) -> str:
     return "-" if value is None or (isinstance(value, float) and math.isnan(value)) else f"{value:.{digits}f}"
 
 
+def _size(stats: dict[str, Any], metric: str) -> str:
+    """A signed size error's cell: mean absolute (mean signed, the bias)."""
+    mean_abs, bias = stats.get(f"{metric}_abs"), stats.get(f"{metric}_bias")
+    if mean_abs is None or bias is None or math.isnan(mean_abs):
+        return "-"
+    return f"{mean_abs:.1f} ({bias:+.1f})"
+
+
 def markdown_table(summary: Sequence[dict[str, Any]], *, protocol: str, title: str = "") -> str:
     """Tables per fruit (and occlusion level): mean and median IoU and centre deviation per method."""
     lines = [f"# {title or 'symfruit evaluation'}", ""]
@@ -44,14 +52,16 @@ def markdown_table(summary: Sequence[dict[str, Any]], *, protocol: str, title: s
         lines += [heading, "", f"{n} instances.", ""]
         lines += [
             "| method | IoU mean | IoU median | centre dev mean (mm) | centre dev median (mm) | worst (mm) "
-            "| views > 10 mm | below raw | Chamfer (mm) | F1 @ 5 mm | ms / fruit | failed |",
-            "|---|---|---|---|---|---|---|---|---|---|---|---|",
+            "| views > 10 mm | below raw | depth side (mm) | larger lateral side (mm) | Chamfer (mm) | F1 @ 5 mm "
+            "| ms / fruit | failed |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|",
         ]
         for s in rows:
             lines.append(
                 f"| {s['method']} | {_f(s['iou_mean'], 3)} | {_f(s['iou_median'], 3)} "
                 f"| {_f(s['centre_mm_mean'], 1)} | {_f(s['centre_mm_median'], 1)} | {_f(s.get('centre_mm_max'), 1)} "
                 f"| {_count(s.get('over_10mm'))} | {_count(s.get('below_raw'))} "
+                f"| {_size(s, 'depth_mm')} | {_size(s, 'lateral_mm')} "
                 f"| {_f(s['chamfer_mm_mean'], 2)} | {_f(s['f1_mean'], 3)} "
                 f"| {_f(s['ms_median'], 2)} | {s['failed']} |"
             )

@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError, SymfruitError
-from ..extract import extract
+from ..extract import extract, register
 from ..methods.complete import complete
 from ..occlusion import fruit_occlusion
 from ..progress import Progress
@@ -28,7 +28,7 @@ BAD_MM = 10.0
 COLUMNS = (
     "protocol", "fruit", "kind", "fruit_index", "pose", "angle_x", "angle_y", "angle_z", "distance_m",
     "occlusion", "hidden", "n_visible", "method", "iou", "centre_mm", "chamfer_mm", "f1", "precision",
-    "recall", "seconds", "confidence", "reliable", "error",
+    "recall", "depth_mm", "lateral_mm", "seconds", "confidence", "reliable", "error",
 )  # fmt: skip
 
 
@@ -56,6 +56,8 @@ class Row:
     precision: float
     recall: float
     seconds: float
+    depth_mm: float = float("nan")
+    lateral_mm: float = float("nan")
     confidence: float = float("nan")
     reliable: bool = False
     error: str = ""
@@ -77,10 +79,14 @@ class Row:
 def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
     """Build one instance and run every method on it (runs in a worker process)."""
     inst = build(spec)
-    visible = inst.visible
+    visible, mask = inst.visible, inst.mask
     failed = ""
-    if inst.extract and inst.mask is not None and inst.depth is not None:  # as ``detect`` takes a fruit's points
-        visible = extract(inst.mask, inst.depth, inst.camera, settings.extract).points
+    if inst.extract and mask is not None and inst.depth is not None:  # as ``detect`` takes a fruit's points
+        moved, _ = register(mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
+        mask = moved > 0
+        ex = extract(mask, inst.depth, inst.camera, settings.extract)
+        visible = ex.points
+        mask = ex.silhouette if ex.silhouette is not None else mask
         if len(visible) < settings.extract.min_points:
             failed = f"only {len(visible)} points extracted (extract.min_points = {settings.extract.min_points})"
     base: dict[str, Any] = dict(
@@ -90,8 +96,8 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
     )  # fmt: skip
     rows = []
     occlusion = None
-    if inst.depth is not None and inst.mask is not None and len(visible) and not failed:
-        occlusion = fruit_occlusion(inst.depth, inst.mask, visible, inst.camera, settings.occlusion)
+    if inst.depth is not None and mask is not None and len(visible) and not failed:
+        occlusion = fruit_occlusion(inst.depth, mask, visible, inst.camera, settings.occlusion)
     for method in methods:
         try:
             if failed:
@@ -106,6 +112,7 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
         conf = float("nan") if result.confidence is None else result.confidence
         rows.append(Row(**base, method=method, iou=s.iou, centre_mm=s.centre_mm, chamfer_mm=s.chamfer_mm,
                         f1=s.f1, precision=s.precision, recall=s.recall, seconds=result.seconds,
+                        depth_mm=s.depth_mm, lateral_mm=s.lateral_mm,
                         confidence=conf, reliable=bool(result.reliable)))  # fmt: skip
     return rows
 
@@ -203,6 +210,10 @@ def summarise(rows: Sequence[Row], *, by: Sequence[str] = ("fruit", "occlusion",
             values = np.array([getattr(r, metric) for r in ok], dtype=float)
             stats[f"{metric}_mean"] = float(values.mean()) if len(values) else float("nan")
             stats[f"{metric}_median"] = float(np.median(values)) if len(values) else float("nan")
+        for metric in ("depth_mm", "lateral_mm"):  # signed size errors: mean absolute and mean (the bias)
+            values = np.array([getattr(r, metric) for r in ok], dtype=float)
+            stats[f"{metric}_abs"] = float(np.abs(values).mean()) if len(values) else float("nan")
+            stats[f"{metric}_bias"] = float(values.mean()) if len(values) else float("nan")
         centre = np.array([r.centre_mm for r in ok], dtype=float)
         stats["centre_mm_max"] = float(centre.max()) if len(centre) else float("nan")
         stats["over_10mm"] = int((centre > BAD_MM).sum()) if ok else float("nan")

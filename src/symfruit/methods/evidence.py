@@ -25,8 +25,14 @@ completion is right for every fruit, and the view itself says which ones fit. Th
    reproduce the view by construction, have fixed energies (raw: the fallback when the best closed shape
    gets about half the band rays wrong);
 5. takes the weighted median of every box face (robust to one wrong candidate, unlike a mean);
-6. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
-   own noise, the candidates' disagreement and what no candidate explains, and reports
+6. moves the back face, the one face no pixel sees, towards a prior on the fruit's depth-to-width ratio by
+   the two estimates' uncertainties (:func:`fuse_depth`): a fruit is about as deep as its silhouette is
+   wide (solids of revolution seen across their axis exactly), so on a noisy, distant or distorted view
+   the shapes' extrapolation of the front's curvature gives way to the silhouette, which a camera measures
+   well; on a clean close view the shapes keep most of their say;
+7. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
+   own noise, the candidates' disagreement, what no candidate explains and how far the prior moved the
+   back face from the shapes' (half of it, as the centre moves), and reports
    ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
@@ -39,6 +45,7 @@ from dataclasses import dataclass
 from typing import Any, Literal
 
 import numpy as np
+from scipy import ndimage
 
 from ..core.agreement import observe
 from ..core.box import Box
@@ -48,12 +55,12 @@ from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
-from ..core.raster import close_ragged, silhouette
+from ..core.raster import Silhouette, close_ragged, principal_widths, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
 
-__all__ = ["Combined", "EvidenceSettings", "clean_share", "combine"]
+__all__ = ["Combined", "EvidenceSettings", "clean_share", "combine", "fuse_depth"]
 
 
 @dataclass(frozen=True)
@@ -84,6 +91,26 @@ class EvidenceSettings(Section):
     explained_at : float
         There, when the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the
         solid of revolution is not fitted either (the ablation: the same means, half the views cheaper).
+    temperature : float
+        Weights are ``exp(-energy / temperature)``: the energies count about ``rays`` correlated ray residuals
+        as if they were independent, which makes the plain ``exp(-energy)`` far too sure of the best
+        candidate (issue 18's diagnosis; 2 keeps the ranking and lets close candidates share the box).
+    depth_ratio, depth_ratio_sd : float, float
+        The prior on the depth extent: ``depth_ratio`` times the silhouette's width (the geometric mean of its
+        widths across and along its principal axis, :func:`~symfruit.core.raster.principal_widths`, at the
+        box centre's depth), with standard deviation ``depth_ratio_sd`` times that width, divided by the
+        outline's contour share (a cut outline's width says less). Over the generated kinds' views the true
+        ratio is 0.83-1.07 by kind (round fruit 0.98-1.05, SD 0.03-0.05 within a kind; elongated fruit,
+        whose long axis lies in the image, lower); 1.0 and 0.1 are the round numbers that cover them;
+        ``depth_ratio_sd = 0`` switches the prior off.
+    shape_error, rim_error, back_inflation : float, float, float
+        The candidates' back face has standard deviation ``hypot(back_inflation * back_std, spread / 2, width *
+        (shape_error + rim_error * (1 - rim)))``: the ``cone`` fit's own back-face deviation (from ray residuals
+        that are correlated, so too small), half the candidates' weighted spread about the median back face,
+        and what a smooth shape's extrapolation of the front misses: a little on a clean view, and up to
+        ``rim_error`` widths where the seen region's rim holds no points (:func:`rim_coverage`: a
+        time-of-flight camera returns no depth at grazing angles, and the shared Azure Kinect frames' spheres
+        show caps tilted and flattened by tens of millimetres that any shape fits well).
     depth_weight, silhouette_weight : float
         Energy per unit of ``log(rms / best rms)`` (the depth misfit against the best closed candidate's)
         and per unit share of silhouette-band rays a closed candidate gets wrong (inside plus outside).
@@ -122,7 +149,8 @@ class EvidenceSettings(Section):
     mirror_energy, raw_energy : float
         Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
     misfit_scale, uncertainty_scale, reliable_uncertainty : float, float (metres), float (metres)
-        The predicted centre uncertainty ``u = hypot(back_std, spread) + misfit_scale * wrong * size``:
+        The predicted centre uncertainty ``u = hypot(hypot(back_std, spread) + misfit_scale * wrong * size,
+        moved / 2)`` (``moved``: how far :func:`fuse_depth` moved the back face):
         ``back_std`` the ``cone`` ellipsoid's back-face standard deviation from its own fit (the sensor's
         noise), ``spread`` the weighted mean distance of the candidates' centres from the result's (what
         the shapes disagree on), ``wrong`` the best closed candidate's share of silhouette-band rays
@@ -152,6 +180,12 @@ class EvidenceSettings(Section):
     revolution_coarse: int = setting(64, ge=0, le=10_000)
     covered_contour: float = setting(0.9, ge=0.0, le=1.0)
     explained_at: float = setting(0.02, ge=0.0, le=2.0)
+    temperature: float = setting(2.0, gt=0.0, le=1e6)
+    depth_ratio: float = setting(1.0, gt=0.0, le=10.0)
+    depth_ratio_sd: float = setting(0.15, ge=0.0, le=10.0)
+    shape_error: float = setting(0.02, gt=0.0, le=10.0)
+    rim_error: float = setting(1.0, ge=0.0, le=100.0)
+    back_inflation: float = setting(1.5, ge=0.0, le=1000.0)
     depth_weight: float = setting(3.0, ge=0.0, le=1e6)
     silhouette_weight: float = setting(10.0, ge=0.0, le=1e6)
     cut_energy: float = setting(10.0, ge=0.0, le=1e6)
@@ -192,6 +226,7 @@ class Combined:
     weights, energies : dict of str to float
         Per candidate.
     confidence : float in [0, 1]
+        From :attr:`uncertainty` alone (the method's result adds what :func:`fuse_depth` did).
     spread : float, metres
         Weighted mean distance of the candidates' box centres from the result's.
     explained : float in [0, 1]
@@ -199,7 +234,7 @@ class Combined:
     contour : float in [0, 1]
         The observation's contour share.
     uncertainty : float, metres
-        The predicted centre uncertainty (see :class:`EvidenceSettings`).
+        The candidates' part of the predicted centre uncertainty (see :class:`EvidenceSettings`).
     """
 
     box: Box
@@ -250,7 +285,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
         energies[c.name] = energy
     names = [c.name for c in cands]
     e = np.array([energies[n] for n in names])
-    w = np.exp(-(e - e.min()))
+    w = np.exp(-(e - e.min()) / s.temperature)
     w /= w.sum()
     faces = np.array([np.r_[c.lo, c.hi] for c in cands])
     box_faces = _weighted_median(faces, w)
@@ -265,6 +300,89 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     return Combined(box, dict(zip(names, w.tolist(), strict=True)), energies, confidence, spread,
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
+
+
+def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15) -> float:
+    """How much of the seen region's rim holds seen points, relative to its interior, in [0, 1].
+
+    The rim is the region's pixels within ``band`` equivalent radii (at least 2 px) of its edge; the share of
+    rim pixels holding a point is divided by the share of the other pixels holding one (a sparse cloud or a
+    depth image coarser than the colour image covers fewer pixels everywhere). Where the surface turns away
+    from the camera, at the rim, its depth says how deep the fruit is (a convex fruit's rim lies at about the
+    depth of its widest section); a time-of-flight camera returns nothing there (it invalidates grazing
+    pixels: the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the back face
+    must then be extrapolated from the front's curvature alone.
+    """
+    mask = region.mask
+    inner = ndimage.distance_transform_edt(mask)
+    width = max(2.0, band * float(np.sqrt(mask.sum() / np.pi)))
+    rim = mask & (inner <= width)
+    rest = mask & ~rim
+    if not rim.any() or not rest.any():
+        return 1.0
+    uv = camera.project(points)
+    col = np.rint(uv[:, 0]).astype(np.intp) - region.u0
+    row = np.rint(uv[:, 1]).astype(np.intp) - region.v0
+    ok = (col >= 0) & (col < mask.shape[1]) & (row >= 0) & (row < mask.shape[0])
+    hit = np.zeros(mask.shape, dtype=bool)
+    hit[row[ok], col[ok]] = True
+    if region.fill_radius > 0:  # a sparse cloud: a point covers its neighbourhood
+        hit = ndimage.maximum_filter(hit, size=2 * int(np.ceil(region.fill_radius)) + 1)
+    interior = (hit & rest).sum() / rest.sum()
+    if interior <= 0:
+        return 1.0
+    return float(min(1.0, (hit & rim).sum() / rim.sum() / interior))
+
+
+def fuse_depth(
+    combined: Combined,
+    cands: list[Candidate],
+    region: Silhouette,
+    camera: Camera,
+    *,
+    s: EvidenceSettings,
+    rim: float = 1.0,
+) -> tuple[Box, float, float]:
+    """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
+
+    The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
+    width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
+    standard deviation of the back face, ``width`` the silhouette's (:class:`EvidenceSettings`). The lateral
+    faces move by the prior's share of that average, times the outline's contour share squared, towards the
+    silhouette's own box at the posterior centre's depth: where the rim holds no depth (a time-of-flight
+    camera) every shape fitted to the points is as narrow as the cap it saw, and the silhouette is the
+    better measure of the fruit's width too.
+    """
+    box = combined.box
+    names = [c.name for c in cands]
+    w = np.array([combined.weights[n] for n in names])
+    backs = np.array([c.hi[2] for c in cands])
+    fit_back = float(box.max[2])
+    spread = float((w * np.abs(backs - fit_back)).sum())
+    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    minor, major = principal_widths(region.mask)
+    width = float(np.sqrt(minor * major) * box.centre[2] / np.sqrt(camera.fx * camera.fy))
+    model = width * (s.shape_error + s.rim_error * (1.0 - rim))
+    fit_sd = float(np.sqrt((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
+    if s.depth_ratio_sd <= 0 or width <= 0:
+        return box, fit_sd, width
+    front = float(box.min[2])
+    prior_sd = s.depth_ratio_sd * width / max(combined.contour, 0.25)
+    prior_back = front + s.depth_ratio * width
+    a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
+    back = max((a * fit_back + b * prior_back) / (a + b), front + 1e-4)
+    share = b / (a + b) * combined.contour**2
+    rows, cols = np.nonzero(region.mask)
+    z_mid = 0.5 * (front + back)
+    sil_lo = np.array([(cols.min() - 0.5 + region.u0 - camera.cx) / camera.fx,
+                       (rows.min() - 0.5 + region.v0 - camera.cy) / camera.fy]) * z_mid  # fmt: skip
+    sil_hi = np.array([(cols.max() + 0.5 + region.u0 - camera.cx) / camera.fx,
+                       (rows.max() + 0.5 + region.v0 - camera.cy) / camera.fy]) * z_mid  # fmt: skip
+    lo, hi = box.min.copy(), box.max.copy()
+    lo[:2] += share * (sil_lo - lo[:2])
+    hi[:2] += share * (sil_hi - hi[:2])
+    hi[2] = back
+    return Box(lo, hi), float(1.0 / np.sqrt(a + b)), width
 
 
 @register("evidence", settings=EvidenceSettings, occlusion=True)
@@ -308,11 +426,18 @@ def evidence(
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
-    box = combined.box
+    rim = rim_coverage(points, region, camera)
+    box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim)
+    moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
+    uncertainty = float(np.hypot(combined.uncertainty, moved))
+    confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
-        "confidence": combined.confidence,
-        "reliable": combined.uncertainty <= s.reliable_uncertainty,
-        "uncertainty": combined.uncertainty,
+        "confidence": confidence,
+        "reliable": uncertainty <= s.reliable_uncertainty,
+        "uncertainty": uncertainty,
+        "back_sd": back_sd,
+        "rim": rim,
+        "width": width,
         "weights": combined.weights,
         "energies": combined.energies,
         "spread": combined.spread,

@@ -201,7 +201,7 @@ def bench_node(
     return out
 
 
-def _print(res: dict) -> None:
+def _print(res: dict, title: str = "symfruit ROS node benchmark") -> None:
     rows = [
         ("detect alone (core.process)", res["process_alone_ms"]),
         ("  of which detect()", res["detect_alone_ms"]),
@@ -215,7 +215,7 @@ def _print(res: dict) -> None:
         ("end to end (publish -> detections)", res["end_to_end_ms"]),
         ("end to end - node detect() (per frame)", res["end_to_end_minus_node_detect_ms"]),
     ]
-    print(f"symfruit ROS node benchmark: example frame 640x480, method {res['method']}, {res['frames']} frames")
+    print(f"{title}: example frame 640x480, method {res['method']}, {res['frames']} frames")
     print(f"{'':<38} {'median ms':>10} {'p10':>8} {'p90':>8}")
     for name, s in rows:
         print(f"{name:<38} {s['median']:>10.1f} {s['p10']:>8.1f} {s['p90']:>8.1f}")

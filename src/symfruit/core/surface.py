@@ -1,0 +1,384 @@
+"""A fruit's own surface in a registered depth image, and the registration itself.
+
+A mask drawn on the colour image (by an annotator, a segmenter or a model) does not pick out a fruit's depth
+pixels on a real RGB-D camera: depth is registered to colour a few pixels off, a time-of-flight camera
+returns no depth where the surface turns away from it (low return at grazing angles, mixed pixels at the
+rim), flying pixels bridge the fruit and what lies behind it, the mask overshoots onto the background,
+leaves and the surface the fruit touches. Every depth pixel that is not the fruit's own enters its cloud
+and every completion then grows too large (issue 18: boxes 25-45 mm too deep on real frames).
+
+:func:`fruit_surface` keeps the pixels of one smooth convex cap, found without any model of the fruit: the
+depth mode of the mask's pixels (:func:`fruit_depth`), a slab from there to a fruit radius behind it (the
+radius from the mask's size), and, from the cap's nearest point, only what a convex surface seen from
+outside can be: along every ray in the image from its nearest point a convex fruit's depth never falls
+(:func:`monotone_region`), so a support, a stem or a leaf meeting the fruit is cut where depth turns back
+towards the camera. :func:`registration_shift` finds how far the depth image sits from the masks: the
+shift that lays the outline of every fruit's depth cap parallel to its mask's outline, a band of the
+mask's rim (the grazing pixels a time-of-flight camera invalidates) allowed between them.
+
+Numpy and scipy only; images in, images and numbers out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from .raster import principal_widths
+
+__all__ = [
+    "Surface",
+    "colour_trim",
+    "depth_noise",
+    "fruit_depth",
+    "fruit_surface",
+    "monotone_region",
+    "registration_shift",
+]
+
+
+@dataclass(frozen=True)
+class Surface:
+    """One fruit's surface pixels in an image window.
+
+    Attributes
+    ----------
+    pixels : (h, w) bool
+        The fruit's own surface.
+    front : float, metres
+        The nearest depth of the fruit's depth mode.
+    radius : float, metres
+        The mask's equivalent radius (``sqrt(area / pi)``) at ``front``.
+    noise : float, metres
+        The depth noise measured in the mask (:func:`depth_noise`).
+    apex : (int, int)
+        Row and column of the cap's nearest pixel (median-filtered depth).
+    """
+
+    pixels: np.ndarray
+    front: float
+    radius: float
+    noise: float
+    apex: tuple[int, int]
+
+
+def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -> float:
+    """Depth noise (metres) of a surface: the robust spread of the differences between horizontally
+    neighbouring depth pixels of ``mask``, divided by ``sqrt(2)``, at least ``floor``.
+
+    A registered depth image repeats a coarser depth camera's pixels, so equal neighbours are left out
+    (their difference says nothing of the noise); the fruit's own slope between neighbours is small beside
+    the noise at working distances.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres (0: none)
+    mask : (h, w) bool
+    """
+    a, b = depth[:, 1:], depth[:, :-1]
+    ok = mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)
+    diff = (a - b)[ok]
+    moved = diff[diff != 0]
+    if len(moved) >= 20:
+        diff = moved
+    if len(diff) < 10:
+        return max(floor, 0.002)
+    mad = float(np.median(np.abs(diff - np.median(diff))))
+    return max(floor, 1.4826 * mad / np.sqrt(2.0))
+
+
+def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: float = 0.001) -> tuple[float, float]:
+    """``(front, radius)``, metres: where a mask's fruit lies in depth, and how large it is there.
+
+    The depths of a mask's pixels hold the fruit and whatever the mask reaches beyond it (background,
+    leaves behind, the surface it lies on). Their histogram (bins of a third of the fruit's radius, at least
+    4 mm and two noise deviations) has one peak per surface; the fruit's is the nearest of the peaks holding
+    at least half as many pixels as the largest (a fruit behind the fruit shows through less than the
+    fruit itself; a leaf in front drawn into the mask rarely covers half of it), extended nearer over every
+    bin holding depths (a fruit's depths run without a gap from its nearest point to its rim). ``front`` is
+    the 5 % quantile of the depths of the nearest of those bins (of the peak, when that is the nearest),
+    ``radius`` the mask's equivalent radius at ``front``.
+
+    Parameters
+    ----------
+    values : (n,) float, metres
+        Depths of the mask's pixels (0 and non-finite values are ignored).
+    radius_px : float, pixels
+        The mask's equivalent radius.
+    focal : float, pixels
+    noise : float, metres
+
+    Returns
+    -------
+    front, radius : float, metres (NaN when fewer than 10 depths are valid)
+    """
+    z = np.sort(values[np.isfinite(values) & (values > 0)])
+    if len(z) < 10:
+        return float("nan"), float("nan")
+    radius = radius_px * float(np.median(z)) / focal
+    step = max(radius / 3.0, 0.004, 2.0 * noise)
+    n_bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
+    counts, edges = np.histogram(z, bins=n_bins, range=(z[0], z[0] + n_bins * step))
+    mass = np.convolve(counts, np.ones(3), mode="same")
+    peak = (mass >= np.r_[mass[1:], -1]) & (mass >= np.r_[-1, mass[:-1]]) & (mass >= 0.5 * mass.max())
+    i = int(np.flatnonzero(peak)[0])
+    # the fruit's depths run without a gap from its nearest point to its rim: walk nearer while bins are filled
+    # (an occluder in front is apart in depth; a fruit receding along its length is not)
+    first = i
+    while first > 0 and counts[first - 1] >= max(2, 0.01 * len(z)):
+        first -= 1
+    lo, hi = edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+    front = float(np.quantile(z[(z >= lo) & (z <= hi)], 0.05))
+    return front, radius_px * front / focal
+
+
+def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], tolerance: float,
+                    *, bins: int = 72) -> np.ndarray:  # fmt: skip
+    """(h, w) bool: the pixels of ``keep`` reached from ``apex`` along straight image rays on which depth
+    never falls more than ``tolerance`` below its running maximum.
+
+    The front of a convex body is a convex function of the image position, so it never falls along a ray
+    from its nearest point; where a ray's depth turns back towards the camera it has left the fruit (onto a
+    support, a stem, an occluder) and the rest of that ray is cut. Rays are ``bins`` sectors of directions;
+    pixels of ``keep`` without depth are not in it.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres
+    keep : (h, w) bool
+        The candidate pixels (with depth).
+    apex : (int, int)
+        Row and column of the ray's origin.
+    tolerance : float, metres
+    bins : int
+    """
+    rows, cols = np.nonzero(keep)
+    out = np.zeros(keep.shape, dtype=bool)
+    if not len(rows) or not np.isfinite(tolerance):
+        return keep.copy() if len(rows) else out
+    dy, dx = rows - apex[0], cols - apex[1]
+    sector = np.floor((np.arctan2(dy, dx) + np.pi) * (bins / (2.0 * np.pi))).astype(np.int64) % bins
+    order = np.lexsort((np.hypot(dy, dx), sector))
+    z, sec = depth[rows[order], cols[order]].astype(np.float64), sector[order]
+    # a running maximum per sector: offset each sector above every earlier one, accumulate, take it back off
+    offset = sec * (2.0 * (np.abs(z).max() + tolerance + 1.0))
+    running = np.maximum.accumulate(z + offset) - offset
+    fell = np.cumsum(z < running - tolerance)
+    start = np.searchsorted(sec, sec, side="left")
+    before = np.where(start > 0, fell[np.maximum(start - 1, 0)], 0)
+    ok = fell == before
+    out[rows[order][ok], cols[order][ok]] = True
+    return out
+
+
+def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
+                  tolerance: float = 3.0, interior: float = 0.35,
+                  region: np.ndarray | None = None) -> Surface | None:  # fmt: skip
+    """The pixels of one fruit's own surface under (or around) its mask.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres (0: none)
+    mask : (h, w) bool
+        The fruit's mask (its depth mode and size come from it).
+    focal : float, pixels
+    slab : float
+        Pixels farther than ``slab`` fruit radii behind the front are not the fruit (a fruit seen from any
+        side is about as deep as it is wide; its visible front lies within one radius of its nearest point);
+        the radius is the larger of the mask's equivalent radius and half its major width (an elongated fruit
+        may recede along its length).
+    tolerance : float
+        The convexity test's tolerance (:func:`monotone_region`) in noise deviations (at least 3 mm).
+    interior : float
+        Pixels more than this many half minor widths (or equivalent radii, the smaller) inside the mask are
+        kept whatever the convexity test says (supports and stems meet a fruit at its outline; a fall deep
+        inside is the fruit's own concave side).
+    region : (h, w) bool, optional
+        Where the surface may lie (default ``mask``): :func:`registration_shift` looks beyond the mask.
+
+    Returns
+    -------
+    Surface, or None when the mask holds fewer than 10 pixels with depth.
+    """
+    region = mask if region is None else region
+    valid = np.isfinite(depth) & (depth > 0)
+    depth = np.where(valid, depth, 0.0)
+    noise = depth_noise(depth, mask)
+    radius_px = float(np.sqrt(mask.sum() / np.pi))
+    front, radius = fruit_depth(depth[mask], radius_px, focal, noise=noise)
+    if not np.isfinite(front):
+        return None
+    tol = max(tolerance * noise, 0.003)
+    # an elongated fruit may lie along the line of sight as far as it is long: half its major width
+    minor_px, major_px = principal_widths(mask)
+    reach = max(radius, 0.5 * major_px * front / focal)
+    near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
+    if not near.any():
+        return None
+    smooth = ndimage.median_filter(np.where(near, depth, np.inf), size=5, mode="nearest")
+    core = ndimage.binary_erosion(mask, iterations=max(1, int(0.15 * radius_px))) & near
+    if not core.any():
+        core = near & mask if (near & mask).any() else near
+    flat = int(np.argmin(np.where(core, smooth, np.inf)))
+    apex = (flat // depth.shape[1], flat % depth.shape[1])
+    # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
+    # (a banana's inner side, a pear's neck) and is kept.
+    inner = ndimage.distance_transform_edt(mask) > interior * min(radius_px, 0.5 * minor_px)
+    return Surface(monotone_region(depth, near, apex, tol) | (near & inner), front, radius, noise, apex)
+
+
+@dataclass(frozen=True)
+class _Outline:
+    """A fruit's depth-cap outline points and its mask's signed distance map (pixels, + inside), in a window."""
+
+    rows: np.ndarray
+    cols: np.ndarray
+    inside: np.ndarray
+    band: float
+
+    def cost(self, shifts: np.ndarray, reach: int, trim: float) -> np.ndarray:
+        """(k,) trimmed mean deviation of the outline points from a band inside the mask shifted by each
+        ``(dv, du)`` of ``shifts`` (k, 2)."""
+        h, w = self.inside.shape
+        qr = self.rows[None, :] - shifts[:, :1]
+        qc = self.cols[None, :] - shifts[:, 1:]
+        ok = (qr >= 0) & (qr < h) & (qc >= 0) & (qc < w)
+        val = np.where(ok, self.inside[np.clip(qr, 0, h - 1), np.clip(qc, 0, w - 1)], -float(reach))
+        # the cap's outline lies a band inside the mask's outline (grazing pixels without depth): the band is
+        # the median distance, within 0 to 0.3 radii, and the cost the trimmed mean deviation from it
+        band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, self.band)
+        dev = np.abs(val - band)
+        keep = max(1, int(trim * dev.shape[1]))
+        return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
+
+
+def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
+    """The outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it), or None."""
+    grown = ndimage.binary_dilation(mask, iterations=reach)
+    surface = fruit_surface(depth, mask, focal, region=grown)
+    if surface is None:
+        return None
+    labels, _ = ndimage.label(surface.pixels)
+    cap = labels == labels[surface.apex]
+    rows, cols = np.nonzero(cap & ~ndimage.binary_erosion(cap))
+    if len(rows) < 12:
+        return None
+    step = max(1, len(rows) // max_points)
+    inside = ndimage.distance_transform_edt(mask) - ndimage.distance_transform_edt(~mask)
+    return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
+
+
+def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
+                       trim: float = 0.7, gain: float = 0.25) -> tuple[int, int]:  # fmt: skip
+    """``(du, dv)``, pixels: how far the depth image sits from the masks (depth pixel ``(u + du, v + dv)`` sees
+    what colour pixel ``(u, v)`` sees); ``(0, 0)`` when the masks do not say.
+
+    For every fruit of ``labels``, the outline of its depth cap (:func:`fruit_surface`, looked for up to
+    ``max_px`` beyond its mask) should run parallel to its mask's outline, a band inside it (a
+    time-of-flight camera returns no depth where the surface turns away). The cost of a shift is the trimmed
+    mean (``trim`` of the outline points: a support or a leaf bends part of any outline) of each outline
+    point's deviation from that band, averaged over the fruit; the shift of least cost is searched on a grid
+    of 2 pixels, then refined to a pixel. It is returned when it lowers the cost by more than ``gain`` pixels
+    from the unshifted masks' (moving a disc's outline by one pixel changes it by about 0.6; a frame
+    registered well enough keeps its masks).
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres (0: none)
+    labels : (h, w) int
+        Instance masks (0 none, k fruit k).
+    focal : float, pixels
+    max_px : int
+        The search radius (0: no search).
+    """
+    if max_px <= 0:
+        return 0, 0
+    depth = np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)
+    outlines = []
+    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+        if sl is None:
+            continue
+        r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
+        r1, c1 = min(sl[0].stop + max_px + 8, labels.shape[0]), min(sl[1].stop + max_px + 8, labels.shape[1])
+        mask = labels[r0:r1, c0:c1] == k
+        if mask.sum() >= 30 and (found := _outline(depth[r0:r1, c0:c1], mask, focal, max_px)) is not None:
+            outlines.append(found)
+    if not outlines:
+        return 0, 0
+
+    def cost(shifts: np.ndarray) -> np.ndarray:
+        return np.mean([o.cost(shifts, max_px, trim) for o in outlines], axis=0)
+
+    coarse = np.arange(-max_px, max_px + 1, 2)
+    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
+    first = cost(np.vstack([[[0, 0]], grid]))
+    zero = first[0]
+    dv, du = grid[int(np.argmin(first[1:]))]
+    near = np.arange(-2, 3)
+    fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
+    fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
+    refined = cost(fine)
+    best = int(np.argmin(refined))
+    if refined[best] > zero - gain:
+        return 0, 0
+    return int(fine[best, 1]), int(fine[best, 0])
+
+
+def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
+                min_accuracy: float = 0.85, margin: float = 0.5) -> np.ndarray:  # fmt: skip
+    """``mask`` less the pixels of its outer band whose colour is the background's, not the fruit's.
+
+    Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
+    depth cannot tell (a time-of-flight camera returns nothing for a few pixels on both sides of an outline).
+    The colour can: the pixels more than ``band_px`` inside the mask are the fruit's, a ring of the same width
+    outside it the background's; both are summarised by ``centres`` colours each (a few rounds of k-means on
+    chromaticity and brightness), and a band pixel whose squared colour distance to the background is below
+    ``margin`` times its distance to the fruit is removed (a mixed pixel on the outline, between the two,
+    stays). Nothing is removed when the two do not separate (the summaries misclass more than ``1 -
+    min_accuracy`` of their own samples: a white ball before a white wall), and nothing beyond the band.
+
+    Parameters
+    ----------
+    color : (h, w, 3) uint8, RGB
+    mask : (h, w) bool
+    band_px : float, pixels
+    """
+    mask = np.asarray(mask, dtype=bool)
+    if band_px <= 0 or not mask.any():
+        return mask
+    inner = ndimage.distance_transform_edt(mask)
+    outer = ndimage.distance_transform_edt(~mask)
+    fruit = inner > band_px
+    ring = (outer >= 1) & (outer <= band_px + 1)
+    band = mask & ~fruit
+    if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
+        return mask
+    rgb = np.asarray(color, dtype=np.float64)
+    total = rgb.sum(axis=2) + 1.0
+    feature = np.stack([rgb[..., 0] / total, rgb[..., 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
+    rng = np.random.default_rng(0)
+
+    def summary(where: np.ndarray) -> np.ndarray:
+        x = feature[where]
+        x = x[rng.choice(len(x), min(len(x), 400), replace=False)]
+        c = x[np.linspace(0, len(x) - 1, centres).astype(int)]
+        for _ in range(iterations):
+            label = np.argmin(((x[:, None, :] - c[None]) ** 2).sum(-1), axis=1)
+            c = np.array([x[label == k].mean(axis=0) if (label == k).any() else c[k] for k in range(len(c))])
+        return c
+
+    fc, bc = summary(fruit), summary(ring)
+
+    def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
+        to_fruit = ((x[:, None, :] - fc[None]) ** 2).sum(-1).min(1)
+        return margin * to_fruit <= ((x[:, None, :] - bc[None]) ** 2).sum(-1).min(1)
+
+    if is_fruit(feature[fruit]).mean() < min_accuracy or (~is_fruit(feature[ring])).mean() < min_accuracy:
+        return mask
+    keep = mask.copy()
+    keep[band] = is_fruit(feature[band], margin)  # a mixed pixel on the outline, between the two, stays
+    labels, _ = ndimage.label(keep)
+    core_labels = np.unique(labels[fruit])
+    return ndimage.binary_fill_holes(np.isin(labels, core_labels[core_labels > 0]))

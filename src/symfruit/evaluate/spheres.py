@@ -1,0 +1,129 @@
+"""Real RGB-D frames of spheres, whose true size is not known: a sphere's box is a cube, and two frames of
+the same spheres give the same boxes.
+
+``symfruit evaluate --spheres DIR`` runs ``detect`` on every frame of ``DIR`` (its masks: one per sphere, the
+same ids in every frame) with every method and scores each sphere's completed box by how far it is from a
+cube (the largest difference between two of its sides), how far its depth side is from the diameter the
+colour mask gives (its equivalent radius at the box centre's depth: the thin-lens estimate, a reference, not
+the truth) and how far the frames disagree (the largest difference of one side between two frames). The
+shipped Azure Kinect lab frames (``examples/real-frames``, GRAP-UdL-AT, MIT) are the real-sensor check
+of issue 18.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..detect import detect
+from ..errors import SymfruitError
+from ..io.sources import open_source
+from ..settings import Settings
+
+__all__ = ["SphereBox", "evaluate_spheres", "spheres_table"]
+
+
+@dataclass(frozen=True)
+class SphereBox:
+    """One sphere of one frame under one method; sizes in millimetres."""
+
+    frame: str
+    sphere: int
+    method: str
+    size: tuple[float, float, float]
+    diameter: float
+    error: str = ""
+
+    @property
+    def cube_mm(self) -> float:
+        """The largest difference between two of the box's sides (0 for a cube)."""
+        return float(np.ptp(self.size)) if not self.error else float("nan")
+
+    @property
+    def depth_mm(self) -> float:
+        """Depth side minus the mask's diameter."""
+        return float(self.size[2] - self.diameter) if not self.error else float("nan")
+
+
+def evaluate_spheres(
+    source: str | Path,
+    *,
+    methods: Sequence[str],
+    masks: str = "auto",
+    settings: Settings | None = None,
+    failed: dict[str, str] | None = None,
+) -> list[SphereBox]:
+    """Every sphere of every frame of ``source`` under every method (a failed sphere carries its error; a
+    frame that cannot be read or detected is left out and, with ``failed``, recorded there with its reason)."""
+    settings = settings or Settings()
+    out: list[SphereBox] = []
+    src = open_source(source)
+    try:
+        for index, name in enumerate(src.names()):
+            try:
+                frame = src.read(index)
+                found_by = {m: detect(frame, masks=masks, method=m, settings=settings) for m in methods}
+            except SymfruitError as exc:
+                if failed is not None:
+                    failed[name] = str(exc)
+                continue
+            for method, found in found_by.items():
+                for d in found.detections:
+                    area = float(d.mask.sum())
+                    if d.result is None:
+                        out.append(SphereBox(name, d.id, method, (np.nan,) * 3, np.nan, d.error or "failed"))
+                        continue
+                    box = d.result.box
+                    focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
+                    diameter = 2.0 * np.sqrt(area / np.pi) * float(box.centre[2]) / focal
+                    size = tuple(float(v) * 1000.0 for v in box.size)
+                    out.append(SphereBox(name, d.id, method, size, diameter * 1000.0))  # type: ignore[arg-type]
+    finally:
+        src.close()
+    return out
+
+
+def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[str, list[dict[str, Any]]]:
+    """A Markdown table (per method: mean cube error, depth side against the mask's diameter, the frames'
+    largest disagreement, and every sphere's box) and its rows as dictionaries."""
+    frames = sorted({r.frame for r in rows})
+    spheres = sorted({r.sphere for r in rows})
+    lines = [
+        "| method | not a cube (mm), mean / worst | depth side - mask diameter (mm), mean abs (mean) "
+        "| frames differ (mm), worst | " + " | ".join(f"sphere {k} (mm)" for k in spheres) + " |",
+        "|---|---|---|---|" + "---|" * len(spheres),
+    ]
+    summary = []
+    for m in methods:
+        mine = [r for r in rows if r.method == m]
+        ok = [r for r in mine if not r.error]
+        cube = np.array([r.cube_mm for r in ok])
+        depth = np.array([r.depth_mm for r in ok])
+        differ = [
+            float(np.max(np.abs(np.subtract(a.size, b.size))))
+            for k in spheres
+            for i, a in enumerate([r for r in ok if r.sphere == k])
+            for b in [r for r in ok if r.sphere == k][i + 1 :]
+        ]
+        cells = []
+        for k in spheres:
+            boxes = [r for r in ok if r.sphere == k]
+            cells.append(" / ".join("x".join(f"{v:.0f}" for v in r.size) for r in boxes) or "failed")
+        worst = max(differ) if differ else float("nan")
+        lines.append(
+            f"| `{m}` | {cube.mean():.1f} / {cube.max():.1f} | {np.abs(depth).mean():.1f} ({depth.mean():+.1f}) "
+            f"| {worst:.1f} | " + " | ".join(cells) + " |"
+            if len(ok)
+            else f"| `{m}` | - | - | - | " + " | ".join("failed" for _ in spheres) + " |"
+        )
+        summary.append({"method": m, "frames": frames, "failed": len(mine) - len(ok),
+                        "cube_mm_mean": float(cube.mean()) if len(ok) else None,
+                        "cube_mm_max": float(cube.max()) if len(ok) else None,
+                        "depth_mm_mean_abs": float(np.abs(depth).mean()) if len(ok) else None,
+                        "frames_differ_mm": worst if differ else None,
+                        "boxes": [r.__dict__ for r in mine]})  # fmt: skip
+    return "\n".join(lines) + "\n", summary

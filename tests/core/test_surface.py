@@ -1,0 +1,146 @@
+"""A fruit's own surface in a depth image and the depth-to-mask registration: known-answer frames of a ball
+in front of a wall, on a table, under a leaf, with the rim a time-of-flight camera invalidates, and masks
+drawn a few pixels off."""
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit.core.surface import (
+    colour_trim,
+    depth_noise,
+    fruit_depth,
+    fruit_surface,
+    monotone_region,
+    registration_shift,
+)
+
+F = 600.0  # focal length, pixels
+H, W = 120, 160
+
+
+def ball(centre=(80, 60), radius_px=20, front=0.5, *, wall=0.8, table=False, rim=0.0, noise=0.0, seed=0):
+    """``(depth (H, W), silhouette (H, W) bool)``: a ball whose silhouette is a disc of ``radius_px`` at ``centre``
+    (its front pole ``front`` metres away, orthographic within the disc), a wall at ``wall``; ``table`` adds a
+    floor meeting the ball at its lowest pixel and coming nearer below it; ``rim`` invalidates the outer share
+    of the disc's radius (a time-of-flight camera's grazing pixels)."""
+    yy, xx = np.mgrid[:H, :W].astype(np.float64)
+    r_m = radius_px * (front) / F
+    d2 = ((xx - centre[0]) ** 2 + (yy - centre[1]) ** 2) / radius_px**2
+    disc = d2 <= 1.0
+    depth = np.full((H, W), wall)
+    if table:
+        below = yy > centre[1]
+        floor = front + r_m - (yy - centre[1] - radius_px) * 0.002  # meets the ball's bottom, nearer lower down
+        depth = np.where(below, np.minimum(depth, floor), depth)
+    cap = front + r_m * (1.0 - np.sqrt(np.clip(1.0 - d2, 0.0, None)))
+    depth = np.where(disc, cap, depth)
+    if noise:
+        depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape)
+    if rim:
+        depth[disc & (d2 > (1.0 - rim) ** 2)] = 0.0
+    return depth, disc
+
+
+def grown(mask, px):
+    from scipy import ndimage
+
+    return ndimage.binary_dilation(mask, iterations=px) if px else mask
+
+
+def test_depth_noise_is_measured_on_the_mask():
+    depth, disc = ball(radius_px=30, noise=0.002)
+    assert depth_noise(depth, disc) == pytest.approx(0.002, rel=0.2)
+    flat, _ = ball(radius_px=30)
+    assert depth_noise(flat, disc) == pytest.approx(0.0005)  # the floor: a noiseless render has none
+    assert depth_noise(np.zeros((H, W)), disc) == 0.002  # no depth: a default
+
+
+def test_fruit_depth_is_the_nearest_large_mode():
+    rng = np.random.default_rng(0)
+    fruit = 0.5 + rng.uniform(0, 0.02, 1000)
+    wall = 0.8 + rng.uniform(0, 0.002, 1200)  # more wall than fruit leaks in: still behind
+    leaf = 0.45 + rng.uniform(0, 0.002, 200)  # a small leaf in front
+    front, radius = fruit_depth(np.r_[fruit, wall, leaf, np.zeros(50), np.full(5, np.nan)], 20.0, F)
+    assert front == pytest.approx(0.5, abs=0.002)
+    assert radius == pytest.approx(20.0 * front / F)
+    assert np.isnan(fruit_depth(np.zeros(5), 20.0, F)[0])
+    # a fruit receding along its length: one run of depths from its nearest point, however spread
+    ramp = np.r_[np.linspace(0.5, 0.56, 300), 0.55 + rng.uniform(0, 0.01, 900)]
+    assert fruit_depth(ramp, 20.0, F)[0] == pytest.approx(0.5, abs=0.002)
+
+
+def test_the_surface_leaves_out_wall_and_table():
+    depth, disc = ball(table=True)
+    mask = grown(disc, 4)  # an annotator's mask, 4 px too large: wall and table leak in
+    found = fruit_surface(depth, mask, F)
+    assert found is not None and found.front == pytest.approx(0.5, abs=1e-3)
+    assert (found.pixels & mask).sum() >= 0.97 * disc.sum()  # the ball, all of it
+    assert not (found.pixels & ~disc & (depth >= 0.7)).any()  # no wall
+    table = mask & ~disc
+    assert (found.pixels & table).sum() <= 0.2 * table.sum()  # the table cut where it comes nearer
+
+
+def test_the_convexity_cut_follows_rays_from_the_apex():
+    depth = np.tile(np.r_[np.linspace(0.5, 0.52, 20), np.linspace(0.52, 0.5, 20)], (5, 1))  # up, then back down
+    keep = np.ones_like(depth, bool)
+    out = monotone_region(depth, keep, (2, 0), 0.003)
+    assert out[:, :23].all() and not out[2, 30:].any()  # falls 3 mm below the running maximum at column 23
+    assert monotone_region(depth, np.zeros_like(keep), (2, 0), 0.003).sum() == 0
+    assert monotone_region(depth, keep, (2, 0), np.inf).all()
+
+
+def test_no_surface_without_depth():
+    assert fruit_surface(np.zeros((H, W)), ball()[1], F) is None
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (5, -4), (-7, 6), (3, 9)])
+@pytest.mark.parametrize("rim", [0.0, 0.13])
+def test_registration_is_found(shift, rim):
+    du, dv = shift
+    depth, _ = ball(centre=(80 + du, 60 + dv), rim=rim, noise=0.0005)
+    _, mask = ball()  # drawn where the colour camera sees the ball
+    labels = mask.astype(np.int32)
+    assert registration_shift(depth, labels, F, max_px=12) == (du, dv)
+
+
+def test_registration_pools_fruit_and_keeps_good_frames():
+    a, ma = ball(centre=(45, 60), radius_px=15, front=0.5)
+    b, mb = ball(centre=(115, 60), radius_px=18, front=0.55)
+    depth = np.minimum(a, b)
+    labels = ma.astype(np.int32) + 2 * mb
+    assert registration_shift(depth, labels, F, max_px=10) == (0, 0)
+    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    assert registration_shift(moved, labels, F, max_px=10) == (-2, 3)
+    assert registration_shift(moved, labels, F, max_px=0) == (0, 0)
+    assert registration_shift(np.zeros((H, W)), labels, F, max_px=10) == (0, 0)
+
+
+@given(st.integers(-8, 8), st.integers(-8, 8), st.integers(0, 1000))
+def test_registration_within_a_pixel(du, dv, seed):
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(14, 26))
+    depth, _ = ball(centre=(80 + du, 60 + dv), radius_px=radius, rim=float(rng.uniform(0, 0.15)), noise=0.001,
+                    seed=seed)  # fmt: skip
+    _, mask = ball(radius_px=radius)
+    found = registration_shift(depth, mask.astype(np.int32), F, max_px=10)
+    assert abs(found[0] - du) <= 1 and abs(found[1] - dv) <= 1
+
+
+def test_colour_trim_removes_an_overshoot_onto_the_background():
+    yy, xx = np.mgrid[:H, :W]
+    disc = (xx - 80) ** 2 + (yy - 60) ** 2 <= 20**2
+    color = np.zeros((H, W, 3), np.uint8)
+    color[...] = (40, 120, 50)  # leaves
+    color[disc] = (200, 30, 40)  # a red fruit
+    color[disc & (xx < 80)] = (150, 25, 30)  # shaded on one side: the same chromaticity
+    mask = (xx - 80) ** 2 + (yy - 60) ** 2 <= 23**2  # 3 px too large
+    trimmed = colour_trim(color, mask, band_px=4)
+    assert np.array_equal(trimmed, disc)
+    assert np.array_equal(colour_trim(color, disc, band_px=4), disc)  # a right mask stays
+    assert np.array_equal(colour_trim(color, mask, band_px=0), mask)
+    white = np.full((H, W, 3), 200, np.uint8)  # a white ball before a white wall: the colours do not tell
+    assert np.array_equal(colour_trim(white, mask, band_px=4), mask)
+    small = (xx - 80) ** 2 + (yy - 60) ** 2 <= 3**2  # no interior to learn from
+    assert np.array_equal(colour_trim(color, small, band_px=4), small)

@@ -1,0 +1,67 @@
+"""The real Azure Kinect frames of four white spheres (GRAP-UdL-AT ak_frame_extractor DEMO_dataset, MIT;
+examples/real-frames): each sphere's completed box is a cube and both frames agree. Their sizes were not
+recorded; the colour masks (circles fitted to the outlines) give the reference diameter at the box centre's
+depth. What they show that renders did not (issue 18): depth registered 8 px below colour, no depth over the
+outer 13 % of every sphere's radius, depth smeared where a sphere sits on the board, mask pixels on the
+background."""
+
+import numpy as np
+import pytest
+
+from symfruit.evaluate.spheres import evaluate_spheres, spheres_table
+
+from ..conftest import EXAMPLES
+
+FRAMES = EXAMPLES / "real-frames"
+
+
+@pytest.fixture(scope="module")
+def boxes():
+    return evaluate_spheres(FRAMES, methods=("evidence", "sphere", "paper"))
+
+
+def test_the_frames_ship_with_their_licence():
+    assert (FRAMES / "LICENSE-GRAP-UdL-AT.txt").read_text().startswith("MIT License")
+    assert sorted(p.name for p in FRAMES.iterdir() if p.is_dir()) == ["lab-spheres-0", "lab-spheres-1"]
+
+
+def test_the_default_makes_the_free_spheres_cubes_of_the_masks_diameter(boxes):
+    # Sphere 3 sits on the board: the board beside it is at its depth, so it may hide the sphere, and a solid
+    # of revolution reaching 4 cm behind it explains the view best (docs/ablation.md); left out here.
+    free = [b for b in boxes if b.method == "evidence" and b.sphere != 3]
+    assert len(free) == 6 and not any(b.error for b in free)
+    for b in free:
+        assert b.cube_mm <= 10.0, b
+        assert abs(b.depth_mm) <= 10.0, b
+    for k in (1, 2, 4):
+        a, c = (b.size for b in free if b.sphere == k)
+        assert np.abs(np.subtract(a, c)).max() <= 6.0  # the two frames agree
+
+
+def test_the_default_beats_the_sphere_and_the_paper_on_depth(boxes):
+    def depth_error(method):
+        return np.mean([abs(b.depth_mm) for b in boxes if b.method == method])
+
+    assert depth_error("evidence") < 8.0
+    assert depth_error("evidence") < 0.5 * depth_error("sphere") and depth_error("evidence") < 0.5 * depth_error(
+        "paper"
+    )
+
+
+def test_the_table_names_every_sphere(boxes):
+    table, summary = spheres_table(boxes, ("evidence", "sphere", "paper"))
+    assert table.count("\n") == 5 and "sphere 4 (mm)" in table and "`paper`" in table
+    assert [s["method"] for s in summary] == ["evidence", "sphere", "paper"]
+    assert summary[0]["frames"] == ["lab-spheres-0", "lab-spheres-1"] and summary[0]["failed"] == 0
+
+
+def test_a_frame_that_cannot_be_read_is_skipped_and_named(tmp_path):
+    import shutil
+
+    for name in ("lab-spheres-0", "broken"):
+        shutil.copytree(FRAMES / "lab-spheres-0", tmp_path / name)
+    (tmp_path / "broken" / "depth.png").write_bytes(b"not a png")
+    failed: dict[str, str] = {}
+    rows = evaluate_spheres(tmp_path, methods=("raw",), failed=failed)
+    assert {r.frame for r in rows} == {"lab-spheres-0"} and len(rows) == 4
+    assert set(failed) == {"broken"} and "depth.png" in failed["broken"]
