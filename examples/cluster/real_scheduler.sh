@@ -34,7 +34,8 @@ echo "started w3"
 wait "$RUN"; echo "detect exit status: $?"
 cat logs/dist.txt
 symfruit report dist
-kill "$W2" "$W3" "$SCHED"; wait 2>/dev/null
+kill "$W2" "$W3"; wait "$W2" "$W3" 2>/dev/null   # the workers first: they close while their scheduler is up
+kill "$SCHED"; wait "$SCHED" 2>/dev/null
 python - <<'PY'
 import json, pathlib
 import pyarrow.parquet as pq
