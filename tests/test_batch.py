@@ -135,7 +135,7 @@ def test_an_output_folder_inside_the_recording_is_not_a_frame(tmp_path):
     for _ in range(2):  # the second time, out/ holds frame-like folders of results
         report = run_batch(rec, out, method="raw", progress=False)
         assert report.done == ["f1", "f2"] and report.ok
-    assert sorted(p.name for p in out.iterdir()) == ["errors.json", "f1", "f2"]
+    assert sorted(p.name for p in out.iterdir()) == ["detections.parquet", "errors.json", "f1", "f2", "frames.parquet"]
 
 
 def test_a_rerun_with_fewer_fruit_leaves_no_stale_clouds(tmp_path):

@@ -34,6 +34,7 @@ from .methods import DEFAULT_METHOD
 from .progress import Progress
 from .segment import MaskSource, mask_source
 from .settings import Settings
+from .table import FRAMES_NAME, TABLE_NAME, recording_name, write_tables
 from .writers import remove_stale, write_detections
 
 __all__ = [
@@ -50,8 +51,9 @@ __all__ = [
 _NO_SPACE = {errno.ENOSPC, errno.EFBIG, errno.EDQUOT}
 
 
-#: Names a batch keeps for its own files in the output folder: a frame called so gets a hashed folder name.
-BATCH_FILES = ("errors.json", LOCK_NAME)
+#: Names a batch keeps for its own files in the output folder (its record, its lock, the fruit tables and the
+#: default folder of ``symfruit report``): a frame called so gets a hashed folder name.
+BATCH_FILES = ("errors.json", LOCK_NAME, TABLE_NAME, FRAMES_NAME, "report")
 
 
 def frame_folder_name(name: str, reserved: Sequence[str] = BATCH_FILES) -> str:
@@ -92,8 +94,16 @@ def run_batch(
     progress: bool = True,
     on_frame: Callable[[int, FrameDetections], None] | None = None,
     exclude: Sequence[str | Path] = (),
+    scheduler: str | None = None,
+    workers: int | None = None,
+    chunk: int = 4,
 ) -> BatchReport:
-    """Detect fruit in every frame of ``source`` and write each frame's results under ``output``.
+    """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
+    fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.table`).
+
+    In this process, or on a Dask cluster (``pip install 'symfruit[cluster]'``): ``scheduler`` (an existing
+    one's address, ``tcp://host:port``) or ``workers`` (a local cluster of that many worker processes),
+    ``chunk`` frames per task (:func:`symfruit.cluster.run_distributed`; ``on_frame`` is not available there).
 
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
@@ -111,8 +121,16 @@ def run_batch(
     ------
     SymfruitError
         Only when the source itself cannot be opened or the output folder cannot be used (not writable, an
-        input folder, held by another run); per-frame problems go into the report.
+        input folder, held by another run), or the cluster cannot be used; per-frame problems go into the report.
     """
+    if scheduler is not None or workers is not None:
+        from .cluster import run_distributed
+
+        if on_frame is not None:
+            raise InputError("on_frame (--ros2-bag) runs in this process: it cannot be combined with a Dask cluster")
+        return run_distributed(source, output, scheduler=scheduler, workers=workers, chunk=chunk, masks=masks,
+                               method=method, settings=settings, resume=resume, progress=progress,
+                               exclude=exclude)  # fmt: skip
     settings = settings or Settings()
     output = Path(output)
     report = BatchReport()
@@ -157,6 +175,8 @@ def run_batch(
                     report.fruits += sum(d.result is not None for d in found.detections)
                     report.failed_fruits += sum(d.result is None for d in found.detections)
                 bar.update()
+        _tables(output, [(n, output / frame_folder_name(n, reserved)) for n in names], recording_name(source), out,
+                report)  # fmt: skip
         errors = _errors_record(report.failed, report.unprocessed, report.stopped)
         try:
             how = write_record(output / "errors.json", errors, root=out)
@@ -168,6 +188,21 @@ def run_batch(
         src.close()
         out.close()
     return report
+
+
+def _tables(output: Path, frames: list[tuple[str, Path]], recording: str, out: OutputFolder, report: Any) -> None:
+    """Write the fruit tables of every frame done (:func:`symfruit.table.write_tables`) into ``report``'s
+    run: a record that cannot be read back is a failed frame, a table that cannot be written stops the run."""
+    try:
+        bad = write_tables(output, frames, recording, root=out)
+    except SymfruitError as exc:
+        report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
+        return
+    for name, reason in bad.items():
+        report.failed[name] = reason
+        for kept in (report.done, report.skipped):
+            if name in kept:
+                kept.remove(name)
 
 
 def _errors_record(failed: dict[str, str], unprocessed: list[str], stopped: str) -> dict[str, Any]:

@@ -1,5 +1,5 @@
-"""Command-line interface: ``symfruit complete | detect | segment | evaluate | bench | demo | scenes | settings |
-methods``.
+"""Command-line interface: ``symfruit complete | detect | report | segment | evaluate | bench | demo | scenes |
+settings | methods``.
 
 Thin by design: parse, import lazily, call the library, print. Errors a user can cause print one
 line (``symfruit: error: ...``) and exit with status 2; ``--debug`` shows the traceback instead.
@@ -57,6 +57,8 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
     p.add_argument("--method", default=None, help="with --recording: the completion method (default evidence)")
+    p.add_argument("--workers", type=int, metavar="W",
+                   help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument(
         "--segment",
         action="store_true",
@@ -134,6 +136,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
     _add_ros2_bag_options(p)
+    _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
     p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
     p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
@@ -160,6 +163,28 @@ def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
                    help="storage of --ros2-bag (default mcap)")  # fmt: skip
 
 
+def _add_cluster_options(p: argparse.ArgumentParser) -> None:
+    where = p.add_mutually_exclusive_group()
+    where.add_argument(
+        "--scheduler",
+        metavar="ADDRESS",
+        help="run the frames on this Dask cluster (tcp://HOST:PORT; "
+        "pip install 'symfruit[cluster]' here and on the workers, which must see the same paths)",
+    )
+    where.add_argument("--workers", type=int, metavar="N", help="run the frames on a local Dask cluster of N worker "
+                       "processes (127.0.0.1)")  # fmt: skip
+    p.add_argument("--chunk", type=int, default=4, metavar="N",
+                   help="with --scheduler or --workers: frames per task (default 4)")  # fmt: skip
+
+
+def _add_report(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="report.md and plots of what a detect run found (fruit counts, sizes)")
+    p.add_argument("run", type=Path, help="the output folder of `symfruit detect` (with detections.parquet)")
+    p.add_argument("--output", type=Path, help="folder for report.md and the plots (default RUN/report)")
+    p.add_argument("--classes", default="18,25", help="size class limits, diameters in mm (default 18,25: the EU "
+                   "strawberry classes)")  # fmt: skip
+
+
 def _add_ros(sub: argparse._SubParsersAction) -> None:
     # Everything after `ros` belongs to the node (name:=value, __name:=, --help): no option prefix of ours.
     p = sub.add_parser("ros", help="run the ROS 1 node (see `symfruit ros --help`)", add_help=False, prefix_chars="+")
@@ -182,6 +207,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_bench(sub)
     _add_evaluate(sub)
     _add_detect(sub)
+    _add_report(sub)
     _add_ros(sub)
     p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries (with truth)")
     p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
@@ -291,9 +317,23 @@ def _bench(args: argparse.Namespace) -> int:
 
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
-        rec = bench_recording(args.recording, method=_method(args))
+        if args.workers is not None:
+            from .cluster import local_cluster, require_distributed
+
+            require_distributed()
+            if not 1 <= args.workers <= 256:
+                local_cluster(args.workers)  # refuses with the message of detect --workers
+        rec = bench_recording(args.recording, method=_method(args), workers=args.workers)
         if args.json:
             print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
+            return 0
+        if rec.workers:
+            peaks = ", ".join(f"{p:.0f}" for p in rec.worker_peak_mb)
+            print(f"symfruit bench --recording --workers {rec.workers}: {rec.frames} frames ({rec.frames_done} "
+                  f"written), method {rec.method}: {rec.seconds:.1f} s, {rec.frames / rec.seconds:.2f} frames/s "
+                  f"(cluster start {rec.startup_seconds:.1f} s not included); peak RSS per worker {peaks} MB, client "
+                  f"{rec.peak_rss_mb:.0f} MB; overhead per task {rec.task_overhead_ms:.1f} ms CPU (client, scheduler "
+                  f"and worker together), {rec.task_wall_ms:.1f} ms wall per empty task")  # fmt: skip
             return 0
         print(f"symfruit bench --recording: {rec.frames} frames ({rec.frames_done} written), method {rec.method}: "
               f"{rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "
@@ -488,14 +528,19 @@ def _segment(args: argparse.Namespace) -> int:
 
 def _detect(args: argparse.Namespace) -> int:
     from .batch import run_batch
+    from .errors import InputError
     from .methods import get
 
     get(_method(args))
     settings = _settings_for(args)
+    if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
+        raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
+                         "--scheduler or --workers")  # fmt: skip
     with _ros2_bag(args) as bag:
         report = run_batch(args.input, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
-                           exclude=[] if bag is None else [args.ros2_bag])  # fmt: skip
+                           exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
+                           workers=args.workers, chunk=args.chunk)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
@@ -504,7 +549,7 @@ def _detect(args: argparse.Namespace) -> int:
         print(f"  not processed: {len(report.unprocessed)} frames (listed in errors.json)")
     if report.stopped:
         print(f"symfruit: {report.stopped}", file=sys.stderr)
-    print(f"results: {args.output}")
+    print(f"results: {args.output} (one folder per frame; every fruit in detections.parquet)")
     if bag is not None:
         print(f"ROS 2 bag: {args.ros2_bag} ({bag.count} frames on {bag.topic})")
     return 0 if report.ok else 1
@@ -582,6 +627,20 @@ def _scenes(args: argparse.Namespace) -> int:
     return 0
 
 
+def _report(args: argparse.Namespace) -> int:
+    from .errors import InputError
+    from .report import write_report
+
+    try:
+        classes = [float(x) for x in args.classes.split(",") if x.strip()]
+    except ValueError:
+        raise InputError(f"--classes {args.classes!r}: expected diameters in mm such as 18,25") from None
+    r = write_report(args.run, folder=args.output, classes=classes)
+    print(f"report: {r.recordings} recording(s), {r.frames} frames, {r.fruit} fruit seen, {r.located} located, "
+          f"{r.sized} sized; {r.folder / 'report.md'} and {len(r.written) - 1} plots")  # fmt: skip
+    return 0
+
+
 def _ros(args: argparse.Namespace) -> int:
     from .ros.node import main as ros_main
 
@@ -614,6 +673,7 @@ _COMMANDS = {
     "bench": _bench,
     "evaluate": _evaluate,
     "detect": _detect,
+    "report": _report,
     "segment": _segment,
     "demo": _demo,
     "scenes": _scenes,

@@ -50,6 +50,8 @@ def test_readme_limits_are_the_enforced_constants():
     assert mesh == [limits.MAX_FACES, limits.MAX_OBJ_BYTES]
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
+    tables = _numbers(next(v for k, v in table.items() if k.startswith("a run's fruit table")))
+    assert tables == [limits.MAX_TABLE_ROWS, limits.MAX_TABLE_BYTES]
     masks = _numbers(next(v for k, v in table.items() if k.startswith("fruit per")))
     assert (
         masks[0] == limits.MAX_INSTANCES

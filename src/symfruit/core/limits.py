@@ -29,6 +29,8 @@ __all__ = [
     "MAX_LABEL_ID",
     "MAX_OBJ_BYTES",
     "MAX_SETTINGS_BYTES",
+    "MAX_TABLE_BYTES",
+    "MAX_TABLE_ROWS",
     "MAX_TEXT_CLOUD_BYTES",
     "MAX_TRUTH_BYTES",
     "MAX_WINDOW_PIXELS",
@@ -58,6 +60,10 @@ MAX_COCO_BYTES = 256 << 20
 #: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
 MAX_INSTANCES = 1000
 MAX_LABEL_ID = 2**31 - 1
+#: A run's fruit table read by ``symfruit report``: most rows (a season of ~3 million frames of 6 fruit) and
+#: most bytes of the columns read (uncompressed, as the file's metadata states; checked before reading).
+MAX_TABLE_ROWS = 20_000_000
+MAX_TABLE_BYTES = 4096 << 20
 #: Depth handed over as metres whose typical value is beyond this is refused as "raw units, not metres"
 #: (millimetres from a 16-bit depth image are hundreds to thousands).
 MAX_DEPTH_METRES = 100.0

@@ -221,6 +221,13 @@ class RecordingRow:
     seconds: float
     peak_rss_mb: float
     frames_done: int
+    #: On a local Dask cluster (``workers``): the peak of each worker process (MB), the time to start the
+    #: cluster (not in ``seconds``), and the cost of one task round trip without work (ms).
+    workers: int = 0
+    worker_peak_mb: tuple[float, ...] = ()
+    startup_seconds: float = 0.0
+    task_overhead_ms: float = 0.0
+    task_wall_ms: float = 0.0
 
     def to_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
@@ -258,11 +265,61 @@ def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[i
     return int(data["status"]), float(data["peak_rss_mb"]), proc.stderr
 
 
+#: Run in the child of :func:`bench_recording` with ``workers``: a local Dask cluster (as ``detect --workers``
+#: starts), the cost of trivial task round trips, the detect run on it, then every process's peak memory.
+_MEASURED_CLUSTER = """
+import json, sys, time
+import distributed
+from symfruit.batch import run_batch
+from symfruit.cluster import Job, Outcome, Part, local_cluster, worker_peak_mb
+from symfruit.settings import resolve_settings
+from symfruit.table import frame_rows
+
+
+def empty_task(job, part):  # a detect task's arguments and answer (six fruit), without the work
+    fruit = {"id": 1, "centre": [0.0, 0.0, 0.4], "box": {"size": [0.03, 0.03, 0.03]}, "mask_area": 900,
+             "n_points": 800, "truncated": False, "method": "evidence", "confidence": 0.9, "reliable": True}
+    frame, fruits = frame_rows({"frame": part.names[0], "fruits": [fruit] * 6}, job.recording)
+    return [Outcome(part.indices[0], part.names[0], "done", frame=frame, fruits=fruits)]
+
+
+rec, out, method, workers = sys.argv[1], sys.argv[2], sys.argv[3], int(sys.argv[4])
+settings = resolve_settings(fruit="strawberry")
+t0 = time.perf_counter()
+with local_cluster(workers) as cluster, distributed.Client(cluster) as client:
+    client.wait_for_workers(workers)
+    client.run(lambda: __import__("symfruit.cluster"))
+    startup = time.perf_counter() - t0
+    job = Job("bench", rec, rec, out, "rec", (), (), (), "auto", method, settings)
+    n = 400
+    cpu = lambda: sum(client.run(time.process_time).values())
+    c0, w0, t1 = time.process_time(), cpu(), time.perf_counter()
+    futures = [client.submit(empty_task, job, Part((k,), (f"f{k}",), (f"{out}/f{k}",)), pure=False) for k in range(n)]
+    for future in distributed.as_completed(futures):
+        future.result()
+    wall = (time.perf_counter() - t1) / n * 1000.0
+    overhead = ((time.process_time() - c0) + (cpu() - w0)) / n * 1000.0
+    del futures
+    t2 = time.perf_counter()
+    report = run_batch(rec, out, method=method, settings=settings, progress=False, scheduler=cluster.scheduler_address)
+    seconds = time.perf_counter() - t2
+    peaks = sorted(client.run(worker_peak_mb).values())
+print(json.dumps({"seconds": seconds, "startup": startup, "overhead_ms": overhead, "wall_ms": wall,
+                  "workers": peaks, "client": worker_peak_mb(), "done": len(report.done)}))
+"""
+
+
 def bench_recording(
-    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None
+    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None, workers: int | None = None
 ) -> RecordingRow:
     """Run ``symfruit detect`` on a generated ``frames``-frame recording in a child process and report its
-    peak resident memory and wall time: memory must not grow with ``frames``."""
+    peak resident memory and wall time: memory must not grow with ``frames``. With ``workers``, on a local Dask
+    cluster of that many processes (127.0.0.1): the client's peak, each worker's, the start-up time, and the
+    overhead of one task: 400 tasks that take and return what a detect task does but do no work, their CPU
+    time (client with its scheduler, and the workers) and their wall time, per task."""
+    import json
+    import subprocess
+    import sys
     import tempfile
 
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
@@ -271,11 +328,23 @@ def bench_recording(
         rec = Path(tmp) / "rec"
         write_scenes(rec, frames, distinct=4, n_ripe=8, n_unripe=2)
         out = Path(tmp) / "out"
-        start = time.perf_counter()
-        _, peak, _ = measured_detect([str(rec), "--output", str(out), "--method", method])
-        seconds = time.perf_counter() - start
-        done = len(list(out.glob("*/detections.json")))
-    return RecordingRow(frames, method, seconds, peak, done)
+        if workers is None:
+            start = time.perf_counter()
+            _, peak, _ = measured_detect([str(rec), "--output", str(out), "--method", method])
+            seconds = time.perf_counter() - start
+            done = len(list(out.glob("*/detections.json")))
+            return RecordingRow(frames, method, seconds, peak, done)
+        proc = subprocess.run([sys.executable, "-c", _MEASURED_CLUSTER, str(rec), str(out), method, str(workers)],
+                              capture_output=True, text=True, check=False)  # fmt: skip
+        lines = proc.stdout.strip().splitlines()
+        if proc.returncode != 0 or not lines:
+            from ..errors import SymfruitError
+
+            raise SymfruitError(f"the cluster benchmark failed: {proc.stderr.strip()[-500:]}")
+        data = json.loads(lines[-1])
+    return RecordingRow(frames, method, float(data["seconds"]), float(data["client"]), int(data["done"]), workers,
+                        tuple(data["workers"]), float(data["startup"]), float(data["overhead_ms"]),
+                        float(data["wall_ms"]))  # fmt: skip
 
 
 def machine() -> dict[str, Any]:

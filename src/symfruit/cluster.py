@@ -1,0 +1,485 @@
+"""``detect`` on a Dask cluster: the frames of a recording run as tasks on ``dask.distributed`` workers, with
+the batch's guarantees (:func:`symfruit.batch.run_batch`): every frame ends done or recorded in
+``errors.json``, ``--resume`` skips finished frames, every file is written atomically, and the fruit tables
+(:mod:`symfruit.table`) hold each frame's rows exactly once. ``pip install 'symfruit[cluster]'``.
+
+Who does what:
+
+* **The client** (the ``symfruit detect`` process) lists the recording's frames (names only; it decodes
+  none), decides which to skip (``--resume``), holds the output folder's lock, and sends tasks of ``chunk``
+  frames: each names its frames by index and name, their output folders, and where to read them (a frame
+  folder's path; for a bag, the bag's path and the indices, which the worker reads itself). Nothing larger
+  than that goes through the scheduler, and no more than a bounded number of frames is ever in flight.
+  The client collects each task's small per-frame outcome (done with its table rows, failed with its
+  reason, or not reached), writes ``errors.json`` and streams the tables in frame order.
+* **A worker** reads its frames, detects, and writes each frame's folder as the serial batch does
+  (:func:`symfruit.writers.write_detections`: atomic files, ``detections.json`` last, stale files removed),
+  inside the same per-frame error boundary, through the output folder's checks (no links followed, no input
+  overwritten) but without its lock, which stays with the client.
+* **A worker that dies** (killed, out of memory) has its tasks run again elsewhere by the scheduler. Writing a
+  frame is idempotent: a second attempt writes the same files over the first attempt's (atomically; the
+  dead attempt's temporary files are removed), and the client takes exactly one outcome per task, so
+  nothing is lost or counted twice. A task whose workers die ``distributed.scheduler.allowed-failures`` times
+  (default 3: a frame that kills every worker it lands on) is recorded as failed, its frames' folders cleared.
+
+Memory per worker is one frame at a time per worker thread (the worker keeps no frame after its task); a
+local cluster (``workers=N``) runs one thread per process under a memory limit its nanny enforces.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import os
+import threading
+import time
+import uuid
+from collections.abc import Iterator, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from .batch import (
+    BATCH_FILES,
+    BatchReport,
+    _clear_frame,
+    _errors_record,
+    _first_part,
+    _guarded,
+    _source_inputs,
+    frame_folder_name,
+)
+from .detect import detect
+from .errors import InputError, OutputError, SymfruitError
+from .io.frames import is_frame_folder, read_frame
+from .io.outputs import OutputFolder, reserve_record, write_record
+from .io.sources import FolderSource, FrameFolderSource, open_source
+from .methods import DEFAULT_METHOD
+from .progress import Progress
+from .settings import Settings
+from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows, recording_name
+from .writers import detections_record, write_detections
+
+__all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "require_distributed", "run_distributed"]
+
+#: The optional dependency set that brings dask.distributed.
+EXTRA = "symfruit[cluster]"
+#: Memory limit of each worker process of a local cluster (its nanny restarts a worker above it).
+LOCAL_MEMORY_LIMIT = "2GiB"
+#: Dask's statistical profiler off: it keeps a sample of the worker's stacks for every second of the last
+#: 1,000 (``distributed.admin.low-level-log-length``), which here grew a worker by about 300 kB a second (300 MB
+#: before it levels off); nobody looks at it without the dashboard. For workers you start yourself:
+#: ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
+NO_PROFILER = {"distributed.worker.profile.enabled": False}
+#: How long to try to reach a scheduler before giving up.
+CONNECT_TIMEOUT = "10s"
+#: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
+#: scheduler's task count however long the recording (with a task that takes long, the others wait at most
+#: this far ahead of it).
+MAX_AHEAD = 4096
+#: Tasks in flight per worker thread (one running, the next ones already there): enough to keep every worker
+#: busy, few enough that a worker that dies has little to hand over.
+TASKS_PER_THREAD = 3
+
+
+def require_distributed() -> Any:
+    """The ``distributed`` module, or an :class:`~symfruit.errors.InputError` naming the extra to install."""
+    try:
+        import distributed
+    except ImportError:
+        raise InputError(f"running on a Dask cluster needs dask.distributed: pip install '{EXTRA}'") from None
+    return distributed
+
+
+@dataclass(frozen=True)
+class Job:
+    """What every task of a run shares (small: paths, names and the settings)."""
+
+    run: str
+    source: str  # absolute path of the recording
+    shown: str  # the recording's path as the user gave it (frames' ``source`` field, as a serial run writes it)
+    output: str  # absolute path of the output folder
+    recording: str
+    inputs: tuple[str, ...]  # files a worker must not write over
+    input_folders: tuple[str, ...]  # folders a worker must not write into
+    exclude: tuple[str, ...]
+    masks: str = "auto"
+    method: str = DEFAULT_METHOD
+    settings: Settings = field(default_factory=Settings)
+
+
+@dataclass(frozen=True)
+class Part:
+    """One task: frames by index and name, each frame's output folder, and (a folder of frames) the frame
+    folders to read; else the worker opens the recording and reads the indices."""
+
+    indices: tuple[int, ...]
+    names: tuple[str, ...]
+    folders: tuple[str, ...]
+    frames: tuple[str, ...] | None = None
+
+
+@dataclass(frozen=True)
+class Outcome:
+    """What became of one frame of a task: ``status`` ``done`` (with its table rows), ``failed`` (``reason``)
+    or ``unprocessed`` (its task stopped on a full disk first); ``stop``: why the batch must stop."""
+
+    index: int
+    name: str
+    status: str
+    reason: str = ""
+    stop: str = ""
+    frame: dict[str, Any] | None = None
+    fruits: list[dict[str, Any]] = field(default_factory=list)
+
+
+# --- the worker's side ---------------------------------------------------------------------------------------
+
+#: Recordings a worker has open, per (run, recording, thread): a bag is indexed once per worker thread.
+_OPEN: dict[tuple[str, str, int], tuple[Any, list[str]]] = {}
+_OPEN_LOCK = threading.Lock()
+
+
+def _opened(job: Job) -> tuple[Any, list[str]]:
+    """The recording opened by this worker thread for ``job`` (cached for the run), and its frame names."""
+    key = (job.run, job.source, threading.get_ident())
+    with _OPEN_LOCK:
+        if key in _OPEN:
+            return _OPEN[key]
+    stale = []
+    with _OPEN_LOCK:
+        for other in [k for k in _OPEN if k[0] != job.run and k[2] == key[2]]:
+            stale.append(_OPEN.pop(other)[0])
+    for src in stale:
+        with contextlib.suppress(Exception):
+            src.close()
+    src = open_source(job.source, exclude=[Path(p) for p in job.exclude])
+    entry = (src, src.names())
+    with _OPEN_LOCK:
+        _OPEN[key] = entry
+    return entry
+
+
+def forget(run: str) -> int:
+    """Close the recordings this worker opened for ``run``; the number closed (run on every worker at the end)."""
+    with _OPEN_LOCK:
+        mine = [_OPEN.pop(k)[0] for k in [k for k in _OPEN if k[0] == run]]
+    for src in mine:
+        with contextlib.suppress(Exception):
+            src.close()
+    return len(mine)
+
+
+def _read(job: Job, part: Part, k: int) -> Any:
+    """Frame ``k`` of ``part``, its ``source`` spelled as in a serial run."""
+    if part.frames is not None:
+        frame = read_frame(part.frames[k])
+    else:
+        src, names = _opened(job)
+        index = part.indices[k]
+        if index >= len(names) or names[index] != part.names[k]:
+            raise InputError(f"{job.source}: frame {index} is not {part.names[k]} on this worker: the recording "
+                             "differs from the one the client listed (workers must see the same files)")  # fmt: skip
+        frame = src.read(index)
+    if frame.source.startswith(job.source) and job.shown != job.source:
+        frame = dataclasses.replace(frame, source=job.shown + frame.source[len(job.source) :])
+    return frame
+
+
+def detect_part(job: Job, part: Part) -> list[Outcome]:
+    """The task: detect and write every frame of ``part``, each in its own error boundary; returns one
+    :class:`Outcome` per frame. Runs on a worker; never raises for a frame."""
+    outcomes: list[Outcome] = []
+    stop = ""
+    with OutputFolder(job.output, inputs=job.inputs, input_folders=job.input_folders, lock=False) as out:
+        for k, (index, name, folder) in enumerate(zip(part.indices, part.names, map(Path, part.folders), strict=True)):
+            if stop:
+                outcomes.append(Outcome(index, name, "unprocessed"))
+                continue
+            failed: dict[str, str] = {}
+
+            def one_frame(k: int = k, folder: Path = folder) -> Any:
+                found = detect(_read(job, part, k), masks=job.masks, method=job.method, settings=job.settings)
+                write_detections(folder, found, settings=job.settings)
+                return frame_rows(detections_record(found), job.recording)
+
+            def clear(folder: Path = folder) -> None:
+                _clear_frame(folder, out)
+
+            done, rows, stop = _guarded(one_frame, item=name, failed=failed, target=folder, at=f"frame {name}",
+                                        cleanup=clear)  # fmt: skip
+            if done and rows is not None:
+                outcomes.append(Outcome(index, name, "done", frame=rows[0], fruits=rows[1]))
+            else:
+                outcomes.append(Outcome(index, name, "failed", reason=failed.get(name, "failed"), stop=stop))
+    return outcomes
+
+
+def worker_peak_mb() -> float:
+    """This process's peak resident memory (MB): its ``VmHWM``, else ``ru_maxrss``."""
+    import resource
+
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+    with contextlib.suppress(OSError, ValueError):
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("VmHWM:"):
+                peak = int(line.split()[1]) / 1024.0
+    return peak
+
+
+# --- the client's side ---------------------------------------------------------------------------------------
+
+
+def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> Any:
+    """A local Dask cluster of ``workers`` worker processes, one thread each, bound to 127.0.0.1 (no dashboard,
+    no profiler: :data:`NO_PROFILER`), each restarted by its nanny if it dies or outgrows ``memory_limit``."""
+    import logging
+
+    require_distributed()
+    from distributed import LocalCluster
+
+    if not 1 <= workers <= 256:
+        raise InputError(f"--workers must be between 1 and 256, got {workers}")
+    import dask
+
+    with dask.config.set(NO_PROFILER):  # the nannies keep this config for the workers they restart
+        return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
+                            dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
+
+
+@contextlib.contextmanager
+def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
+    distributed = require_distributed()
+    if scheduler is not None:
+        try:
+            client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
+        except (OSError, TimeoutError, ValueError) as exc:
+            raise InputError(f"{scheduler}: cannot reach the Dask scheduler ({exc})") from None
+        with client:
+            yield client
+        return
+    with local_cluster(int(workers or 1)) as cluster, distributed.Client(cluster) as client:
+        yield client
+
+
+def _parts(todo: Sequence[int], chunk: int) -> Iterator[list[int]]:
+    """Runs of up to ``chunk`` frame indices, in order."""
+    for i in range(0, len(todo), chunk):
+        yield list(todo[i : i + chunk])
+
+
+def run_distributed(
+    source: str | Path,
+    output: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int | None = None,
+    chunk: int = 4,
+    masks: str = "auto",
+    method: str = DEFAULT_METHOD,
+    settings: Settings | None = None,
+    resume: bool = False,
+    progress: bool = True,
+    exclude: Sequence[str | Path] = (),
+    max_ahead: int = MAX_AHEAD,
+) -> BatchReport:
+    """:func:`symfruit.batch.run_batch` on a Dask cluster: an existing one (``scheduler``, its address) or a
+    local one of ``workers`` processes; ``chunk`` frames per task (see the module docstring).
+
+    Raises
+    ------
+    SymfruitError
+        When the recording cannot be opened, the output folder cannot be used, dask.distributed is missing
+        or the scheduler cannot be reached; per-frame problems go into the report.
+    """
+    if (scheduler is None) == (workers is None):
+        raise InputError("give either a scheduler address or a number of local workers")
+    if not 1 <= chunk <= 10_000:
+        raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {chunk}")
+    if not isinstance(masks, str):
+        raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
+    require_distributed()
+    settings = settings or Settings()
+    output = Path(output)
+    report = BatchReport()
+    src = open_source(source, exclude=[output, *map(Path, exclude)])
+    try:
+        files, folders = _source_inputs(src)
+        if is_frame_folder(output):
+            folders.append(output)
+        names = src.names()
+        direct = [str(Path(p).absolute()) for p in src.folders()] if isinstance(src, FolderSource) else None
+        if isinstance(src, FrameFolderSource):
+            direct = [str(Path(src.path).absolute())]
+    finally:
+        src.close()  # the client decodes no frame
+    out = OutputFolder(output, inputs=files, input_folders=folders).open()
+    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
+    job = Job(run=uuid.uuid4().hex, source=str(Path(source).absolute()), shown=str(Path(source)),
+              output=str(output.absolute()), recording=recording_name(source),
+              inputs=tuple(os.path.realpath(p) for p in files),
+              input_folders=tuple(os.path.realpath(p) for p in folders),
+              exclude=tuple(str(Path(p).absolute()) for p in [output, *exclude]), masks=masks, method=method,
+              settings=settings)  # fmt: skip
+    try:
+        target = [output / frame_folder_name(n, reserved) for n in names]
+        done_before = {i for i in range(len(names)) if resume and (target[i] / "detections.json").is_file()}
+        todo = [i for i in range(len(names)) if i not in done_before]
+        with contextlib.ExitStack() as stack:
+            client = stack.enter_context(_client(scheduler, workers)) if todo else None
+            if client is not None:
+                _preflight(client, job)
+            reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
+                           entries=len(names), root=out)  # fmt: skip
+            with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
+                if done_before:
+                    bar.update(len(done_before))
+                try:
+                    with TableWriter(output, root=out) as table:
+                        _run(job, client, names, target, direct, todo, done_before, chunk, max_ahead, report, table,
+                             bar, out)  # fmt: skip
+                except OutputError as exc:
+                    report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
+            if client is not None:
+                with contextlib.suppress(Exception):
+                    client.run(forget, job.run)
+        try:
+            how = write_record(output / "errors.json",
+                               _errors_record(report.failed, report.unprocessed, report.stopped), root=out)  # fmt: skip
+            if how and report.stopped:
+                report.stopped += f"; errors.json {how}"
+        except SymfruitError as exc:
+            report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
+    finally:
+        out.close()
+    return report
+
+
+def _run(
+    job: Job, client: Any, names: list[str], target: list[Path], direct: list[str] | None, todo: list[int],
+    done_before: set[int], chunk: int, max_ahead: int, report: BatchReport, table: TableWriter, bar: Progress,
+    out: OutputFolder,
+) -> None:  # fmt: skip
+    """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
+    and write the tables in frame order."""
+    results: dict[int, Outcome] = {}  # outcomes not yet in the tables, by frame index
+    state = {"flushed": 0, "sent": 0, "stopped": False}  # frames below "flushed" are in the report and tables
+
+    def flush() -> None:
+        while state["flushed"] < len(names):
+            i = state["flushed"]
+            if i in done_before:
+                try:
+                    table.add(*read_frame_rows(target[i] / "detections.json", job.recording))
+                    report.skipped.append(names[i])
+                except SymfruitError as exc:
+                    report.failed[names[i]] = f"{exc} (left out of {TABLE_NAME})"
+            elif i in results:
+                _record(results.pop(i), report, table)
+            elif i >= state["sent"] and state["stopped"]:
+                report.unprocessed.append(names[i])
+            else:
+                return  # still running
+            state["flushed"] += 1
+
+    if client is not None:
+        distributed = require_distributed()
+        parts = _parts(todo, chunk)
+        pending = distributed.as_completed()
+        part_of: dict[Any, Part] = {}
+        window = {"tasks": 0, "at": -1.0}
+
+        def room() -> bool:
+            """Whether another task may go: within the frames ahead, and within the tasks the workers can
+            take (their thread count, asked again every second as workers come and go)."""
+            if time.monotonic() - window["at"] > 1.0:
+                threads = sum(client.nthreads().values())
+                window["tasks"], window["at"] = max(TASKS_PER_THREAD * threads, 2), time.monotonic()
+            return state["sent"] - state["flushed"] < max_ahead and len(part_of) < window["tasks"]
+
+        def send() -> None:
+            while not state["stopped"] and room():
+                indices = next(parts, None)
+                if indices is None:
+                    state["sent"] = len(names)
+                    return
+                part = Part(tuple(indices), tuple(names[i] for i in indices),
+                            tuple(str(target[i].absolute()) for i in indices),
+                            None if direct is None else tuple(direct[i] for i in indices))  # fmt: skip
+                future = client.submit(detect_part, job, part, key=f"symfruit-detect-{job.run}-{indices[0]}")
+                part_of[future.key] = part
+                pending.add(future)
+                state["sent"] = indices[-1] + 1
+
+        send()
+        for future in pending:
+            part = part_of.pop(future.key)
+            outcomes, whole = _outcomes(future, part, distributed)
+            future.release()
+            for o in outcomes:
+                results[o.index] = o
+                if whole:  # the task died as a whole: what its attempts left is no result
+                    _clear_frame(target[o.index], out)
+                if o.stop and not state["stopped"]:
+                    state["stopped"] = True
+                    report.stopped = o.stop
+            bar.update(len(part.indices))
+            flush()
+            send()
+    state["stopped"] = True
+    flush()
+
+
+def _record(o: Outcome, report: BatchReport, table: TableWriter) -> None:
+    """Put one frame's outcome into the report and its rows into the tables."""
+    if o.status == "done" and o.frame is not None:
+        table.add(o.frame, o.fruits)
+        report.done.append(o.name)
+        report.fruits += sum(f["error"] is None for f in o.fruits)
+        report.failed_fruits += sum(f["error"] is not None for f in o.fruits)
+    elif o.status == "failed":
+        report.failed[o.name] = o.reason
+    else:
+        report.unprocessed.append(o.name)
+
+
+def _worker_check(source: str, output: str) -> dict[str, Any]:
+    """Run on every worker before the first task: its symfruit version and whether it sees the run's paths."""
+    from . import __version__
+
+    return {"version": __version__, "source": os.path.exists(source), "output": os.path.isdir(output)}
+
+
+def _preflight(client: Any, job: Job) -> None:
+    """Refuse a cluster whose workers cannot run this job: symfruit missing or of another version, or the
+    recording or the output folder not at the same path on a worker."""
+    from . import __version__
+
+    try:
+        checks = client.run(_worker_check, job.source, job.output)
+    except Exception as exc:  # unpickling symfruit's function fails on a worker without symfruit
+        raise InputError(f"the Dask workers cannot run symfruit ({type(exc).__name__}: {exc}); install "
+                         f"'{EXTRA}' where the workers run") from None  # fmt: skip
+    for worker, check in sorted(checks.items()):
+        if check["version"] != __version__:
+            raise InputError(f"Dask worker {worker} runs symfruit {check['version']}, this client {__version__}: "
+                             "install the same version on both")  # fmt: skip
+        for what in ("source", "output"):
+            if not check[what]:
+                path = job.source if what == "source" else job.output
+                raise InputError(
+                    f"{path}: Dask worker {worker} does not see it; workers must see the recording "
+                    "and the output folder at the same paths as this client (a shared file system)"
+                )
+
+
+def _outcomes(future: Any, part: Part, distributed: Any) -> tuple[list[Outcome], bool]:
+    """The outcomes of a finished task, and whether it failed as a whole (each of its frames failed then)."""
+    try:
+        return list(future.result()), False
+    except distributed.scheduler.KilledWorker as exc:
+        times = getattr(exc, "allowed_failures", 3) + 1
+        reason = f"the workers running this frame died {times} times (killed or out of memory)"
+    except Exception as exc:  # the task as a whole: e.g. a worker that cannot unpickle it
+        reason = f"the task failed on its worker ({type(exc).__name__}: {exc})"
+    return [Outcome(i, n, "failed", reason=reason) for i, n in zip(part.indices, part.names, strict=True)], True

@@ -1,0 +1,317 @@
+"""``symfruit report OUT``: what a ``detect`` run found, for someone who never ran it: ``report.md`` and PNG plots
+(fruit per frame and per recording, fruit diameters against the size classes fruit is sorted by, confidence).
+
+It reads the run's tables (``OUT/detections.parquet``, ``OUT/frames.parquet``: :mod:`symfruit.table`) and
+``OUT/errors.json``, each checked against a bound before it is read, and writes every file atomically into
+``OUT/report/`` (or the folder named), locked while it writes. Millimetres in the report, as in every
+printed report; the tables stay in metres.
+
+A fruit's **diameter** is the larger horizontal side of its completed box, ``max(size_x, size_z)``: the
+widest horizontal section of a fruit hanging below its stem seen by a level camera, which is what sizing
+rings and grading machines measure ("the maximum diameter of the equatorial section" of the EU marketing
+standard for strawberries, whose classes start at 18 mm, Classes I and II, and 25 mm, Extra: the default
+classes). Fruit cut by the image border (``truncated``) and fruit that could not be completed have no
+diameter here; they are counted, not sized.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from .errors import FileFormatError, InputError, SymfruitError
+from .table import FRAMES_NAME, TABLE_NAME
+
+__all__ = ["DEFAULT_CLASSES_MM", "PLOTS", "Report", "diameters_mm", "size_classes", "write_report"]
+
+#: Size class edges (mm) by default: the EU marketing standard's minimum diameters for strawberries.
+DEFAULT_CLASSES_MM = (18.0, 25.0)
+#: Most rows read from either table, and most bytes of its columns (:mod:`symfruit.core.limits`).
+MAX_REPORT_ROWS = MAX_TABLE_ROWS
+MAX_REPORT_BYTES = MAX_TABLE_BYTES
+#: Recordings drawn one bar each; beyond, the ones with most fruit (the table lists them all).
+MAX_BARS = 60
+#: The plots, in the order report.md shows them.
+PLOTS = ("fruit_per_frame.png", "fruit_per_recording.png", "diameters.png", "confidence.png")
+
+
+@dataclass
+class Report:
+    """What :func:`write_report` found and wrote."""
+
+    folder: Path
+    frames: int = 0
+    fruit: int = 0
+    located: int = 0
+    sized: int = 0
+    recordings: int = 0
+    failed_frames: int = 0
+    written: list[Path] = field(default_factory=list)
+
+
+def _read(path: Path, columns: Sequence[str]) -> Any:
+    """The ``columns`` of a Parquet table, after checking its row count and column sizes against the bounds."""
+    import pyarrow.parquet as pq
+
+    if not path.is_file():
+        raise FileFormatError(f"{path}: no such table; run `symfruit detect ... --output {path.parent}` first")
+    try:
+        meta = pq.ParquetFile(path).metadata
+        if meta.num_rows > MAX_REPORT_ROWS:
+            raise FileFormatError(f"{path}: {meta.num_rows:,} rows; a report reads at most {MAX_REPORT_ROWS:,}")
+        names = [meta.schema.column(i).name for i in range(meta.num_columns)]
+        missing = [c for c in columns if c not in names]
+        if missing:
+            raise FileFormatError(f"{path}: not a symfruit table (no column {', '.join(missing)})")
+        wanted = {names.index(c) for c in columns}
+        size = sum(meta.row_group(g).column(i).total_uncompressed_size for g in range(meta.num_row_groups)
+                   for i in wanted)  # fmt: skip
+        if size > MAX_REPORT_BYTES:
+            raise FileFormatError(f"{path}: its columns hold {size / 2**30:.1f} GB; a report reads at most "
+                                  f"{MAX_REPORT_BYTES / 2**30:.0f} GB")  # fmt: skip
+        return pq.read_table(path, columns=list(columns))
+    except SymfruitError:
+        raise
+    except Exception as exc:  # pyarrow's own errors for a corrupt or truncated file
+        raise FileFormatError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from None
+
+
+def diameters_mm(size_x: np.ndarray, size_z: np.ndarray) -> np.ndarray:
+    """Fruit diameters (mm) from box sizes (m): the larger horizontal side, ``max(size_x, size_z)``.
+
+    >>> diameters_mm(np.array([0.02, 0.03]), np.array([0.025, 0.01])).tolist()
+    [25.0, 30.0]
+    """
+    return np.round(np.maximum(np.asarray(size_x, float), np.asarray(size_z, float)) * 1000.0, 6)
+
+
+def size_classes(diameters: np.ndarray, edges: Sequence[float]) -> list[tuple[str, int]]:
+    """``(label, count)`` per size class: below the first edge, between edges, at or above the last (mm).
+
+    >>> size_classes(np.array([10.0, 18.0, 20.0, 31.0]), [18, 25])
+    [('< 18 mm', 1), ('18-25 mm', 2), ('>= 25 mm', 1)]
+    """
+    edges = [float(e) for e in edges]
+    if not edges or any(not math.isfinite(e) or e <= 0 for e in edges) or sorted(set(edges)) != edges:
+        raise InputError(f"size classes must be increasing diameters in mm, got {edges}")
+    d = np.asarray(diameters, float)
+    counts = np.histogram(d, bins=[-np.inf, *edges, np.inf])[0]
+    labels = [f"< {edges[0]:g} mm", *(f"{a:g}-{b:g} mm" for a, b in itertools.pairwise(edges)), f">= {edges[-1]:g} mm"]
+    return list(zip(labels, (int(c) for c in counts), strict=True))
+
+
+def _errors(output: Path) -> int:
+    """Frames ``errors.json`` lists as failed or not reached (0 without the file)."""
+    from .io.text import read_structured
+    from .table import MAX_RECORD_BYTES
+
+    path = output / "errors.json"
+    if not path.is_file():
+        return 0
+    data = read_structured(path, what="errors.json", max_bytes=MAX_RECORD_BYTES)
+    if not isinstance(data, dict):
+        raise FileFormatError(f"{path}: not a symfruit errors.json")
+    failed, unprocessed = data.get("failed", []), data.get("unprocessed", [])
+    return (len(failed) if isinstance(failed, list) else 0) + (len(unprocessed) if isinstance(unprocessed, list) else 0)
+
+
+def _mm(value: float) -> str:
+    return "-" if not math.isfinite(value) else f"{value:.1f}"
+
+
+def write_report(
+    output: str | Path, *, folder: str | Path | None = None, classes: Sequence[float] = DEFAULT_CLASSES_MM
+) -> Report:
+    """Write ``report.md`` and the plots (:data:`PLOTS`) of the ``detect`` output folder ``output`` into
+    ``folder`` (default ``output/report``).
+
+    Raises
+    ------
+    SymfruitError
+        When the tables are missing, too large or not symfruit's, matplotlib is missing
+        (``pip install 'symfruit[plot]'``), or the folder cannot be written.
+    """
+    try:
+        import matplotlib
+
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        raise InputError("symfruit report draws its plots with matplotlib: pip install 'symfruit[plot]'") from None
+    from .io.atomic import atomic_write
+    from .io.outputs import OutputFolder
+
+    output = Path(output)
+    folder = Path(folder) if folder is not None else output / "report"
+    size_classes(np.ones(1), classes)  # checked before anything is read
+    fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
+                                        "truncated", "error", "method"])  # fmt: skip
+    frames = _read(output / FRAMES_NAME, ["recording", "frame", "fruit", "located"])
+    failed = _errors(output)
+    col = {name: fruit.column(name).to_numpy(zero_copy_only=False) for name in fruit.column_names}
+    rec_f = frames.column("recording").to_numpy(zero_copy_only=False).astype(str)
+    located_f = frames.column("located").to_numpy(zero_copy_only=False).astype(np.int64)
+    seen_f = frames.column("fruit").to_numpy(zero_copy_only=False).astype(np.int64)
+    ok = np.array([e is None for e in col["error"]], bool)
+    size_x = np.array([np.nan if v is None else v for v in col["size_x"]], float)
+    size_z = np.array([np.nan if v is None else v for v in col["size_z"]], float)
+    truncated = np.array([bool(v) for v in col["truncated"]], bool)
+    sized = ok & ~truncated & np.isfinite(size_x) & np.isfinite(size_z)
+    diam = diameters_mm(size_x[sized], size_z[sized])
+    conf = np.array([np.nan if v is None else v for v in col["confidence"]], float)
+    reliable = np.array([v is True for v in col["reliable"]], bool)
+    methods = sorted({str(m) for m in col["method"] if m is not None})
+    recordings = list(dict.fromkeys(rec_f.tolist()))
+    report = Report(folder, frames=len(rec_f), fruit=len(ok), located=int(ok.sum()), sized=int(sized.sum()),
+                    recordings=len(recordings), failed_frames=failed)  # fmt: skip
+    rec_fruit = np.asarray(col["recording"]).astype(str)
+    per_rec = []
+    for r in recordings:
+        m, loc = rec_f == r, located_f[rec_f == r]
+        d = diameters_mm(size_x[sized & (rec_fruit == r)], size_z[sized & (rec_fruit == r)])
+        per_rec.append((r, int(m.sum()), int((loc > 0).sum()), int(seen_f[m].sum()), int(loc.sum()),
+                        float(loc.mean()) if len(loc) else math.nan, int(loc.max()) if len(loc) else 0,
+                        float(np.median(d)) if len(d) else math.nan))  # fmt: skip
+    classes_rows = size_classes(diam, classes)
+    finite_conf = np.isfinite(conf) & ok
+
+    with OutputFolder(folder, inputs=[output / TABLE_NAME, output / FRAMES_NAME, output / "errors.json"],
+                      what="report folder") as out:  # fmt: skip
+        plots = _plots(plt, rec_f, located_f, per_rec, diam, classes, conf[finite_conf], reliable[finite_conf])
+        for name, fig in zip(PLOTS, plots, strict=True):
+            with atomic_write(folder / name, "wb", root=out) as handle:
+                fig.savefig(handle, format="png", dpi=100)
+            plt.close(fig)
+            report.written.append(folder / name)
+        text = _markdown(output, report, per_rec, classes_rows, diam, conf[finite_conf], reliable[finite_conf],
+                         methods, truncated_n=int((ok & truncated).sum()))  # fmt: skip
+        with atomic_write(folder / "report.md", "w", root=out) as handle:
+            handle.write(text)
+        report.written.append(folder / "report.md")
+    return report
+
+
+def _binned(values: np.ndarray, most: int = 2000) -> tuple[np.ndarray, np.ndarray]:
+    """``(x, y)``: the values themselves, or their means over ``most`` equal runs of a long sequence."""
+    n = len(values)
+    if n <= most:
+        return np.arange(n), values.astype(float)
+    edges = np.linspace(0, n, most + 1).astype(int)
+    sums = np.add.reduceat(values.astype(float), edges[:-1])
+    return (edges[:-1] + edges[1:]) / 2.0, sums / np.diff(edges)
+
+
+def _plots(plt: Any, rec_f: np.ndarray, located_f: np.ndarray, per_rec: list[tuple], diam: np.ndarray,
+           classes: Sequence[float], conf: np.ndarray, reliable: np.ndarray) -> list[Any]:  # fmt: skip
+    figs = []
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    x, y = _binned(located_f)
+    ax.plot(x, y, lw=1, color="tab:red", marker="o" if len(x) <= 100 else None, ms=3)
+    ax.xaxis.get_major_locator().set_params(integer=True)
+    ax.yaxis.get_major_locator().set_params(integer=True)
+    starts = [i for i in range(1, len(rec_f)) if rec_f[i] != rec_f[i - 1]]
+    for s in starts[:MAX_BARS]:
+        ax.axvline(s, color="grey", lw=0.5, ls=":")
+    averaged = " (mean over runs of frames)" if len(located_f) > 2000 else ""
+    ax.set(xlabel="frame (in recording order; dotted lines: a new recording)", ylabel="fruit located",
+           title=f"Fruit per frame{averaged}")  # fmt: skip
+    ax.set_ylim(bottom=0)
+    fig.tight_layout()
+    figs.append(fig)
+
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    shown = sorted(per_rec, key=lambda r: -r[4])[:MAX_BARS] if len(per_rec) > MAX_BARS else per_rec
+    ax.bar(range(len(shown)), [r[4] for r in shown], color="tab:red")
+    ax.set_xticks(range(len(shown)), [str(r[0])[:24] for r in shown], rotation=45 if len(shown) > 4 else 0,
+                  ha="right" if len(shown) > 4 else "center", fontsize=8)  # fmt: skip
+    more = f" (the {MAX_BARS} with most fruit of {len(per_rec)})" if len(per_rec) > MAX_BARS else ""
+    ax.set(ylabel="fruit located", title=f"Fruit per recording{more}")
+    ax.yaxis.get_major_locator().set_params(integer=True)
+    fig.tight_layout()
+    figs.append(fig)
+
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    if len(diam):
+        lo, hi = math.floor(min(diam.min(), classes[0]) - 1), math.ceil(max(diam.max(), classes[-1]) + 1)
+        ax.hist(diam, bins=np.arange(lo, hi + 1, 1.0), color="tab:red", alpha=0.8)
+    for edge in classes:
+        ax.axvline(edge, color="black", ls="--", lw=1)
+    for label, count in size_classes(diam, classes):
+        ax.plot([], [], " ", label=f"{label}: {count}")
+    ax.legend(title="size class: fruit", fontsize=8, loc="upper right")
+    ax.yaxis.get_major_locator().set_params(integer=True)
+    ax.set(xlabel="diameter (mm): larger horizontal side of the completed box", ylabel="fruit",
+           title="Fruit diameters; dashed lines: size class limits")  # fmt: skip
+    fig.tight_layout()
+    figs.append(fig)
+
+    fig, ax = plt.subplots(figsize=(9, 3.5))
+    if len(conf):
+        bins = np.linspace(0, 1, 21)
+        ax.hist([conf[reliable], conf[~reliable]], bins=bins, stacked=True, color=["tab:green", "tab:orange"],
+                label=["reliable", "not reliable"])  # fmt: skip
+        ax.legend(fontsize=8)
+        ax.yaxis.get_major_locator().set_params(integer=True)
+    else:
+        ax.text(0.5, 0.5, "the method used gives no confidence", ha="center", va="center", transform=ax.transAxes)
+    ax.set(xlabel="confidence", ylabel="fruit", title="Confidence of the located fruit", xlim=(0, 1))
+    fig.tight_layout()
+    figs.append(fig)
+    return figs
+
+
+def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[tuple[str, int]], diam: np.ndarray,
+              conf: np.ndarray, reliable: np.ndarray, methods: list[str], *, truncated_n: int) -> str:  # fmt: skip
+    share = lambda n, d: f"{100.0 * n / d:.1f} %" if d else "-"  # noqa: E731
+    lines = [
+        f"# Fruit found in `{output}`",
+        "",
+        f"symfruit located fruit in RGB-D camera frames: for each fruit it completed the side the camera could not "
+        f"see and measured the fruit's box (its centre and size). This report covers {r.recordings} recording(s), "
+        f"{r.frames:,} frames and {r.fruit:,} fruit seen, of which {r.located:,} were located (completed); "
+        f"completion method: {', '.join(methods) or '-'}."
+        + (f" {r.failed_frames:,} frame(s) could not be processed (see `errors.json`)." if r.failed_frames else ""),
+        "",
+        "Sizes are in millimetres. A fruit's **diameter** is the larger horizontal side of its completed box, the "
+        "widest horizontal section of a hanging fruit, which is what sizing rings and grading machines measure. "
+        f"Fruit cut by the image border ({truncated_n:,}) and fruit that could not be completed are counted but "
+        "not sized.",
+        "",
+        "## Fruit per recording",
+        "",
+        "| recording | frames | frames with fruit | fruit seen | fruit located | located per frame (mean) | most in "
+        "one frame | median diameter (mm) |",
+        "|---|---|---|---|---|---|---|---|",
+    ]
+    for rec, n, with_fruit, seen, located, mean, most, med in per_rec:
+        lines.append(f"| {rec} | {n:,} | {with_fruit:,} | {seen:,} | {located:,} | "
+                     f"{'-' if not math.isfinite(mean) else f'{mean:.2f}'} | {most} | {_mm(med)} |")  # fmt: skip
+    lines += ["", "![fruit per frame](fruit_per_frame.png)", "", "![fruit per recording](fruit_per_recording.png)",
+              "", "## Sizes", ""]  # fmt: skip
+    if len(diam):
+        p10, p50, p90 = np.percentile(diam, [10, 50, 90])
+        lines += [f"{len(diam):,} fruit sized: median diameter {p50:.1f} mm (10 % are below {p10:.1f} mm, 10 % above "
+                  f"{p90:.1f} mm).", ""]  # fmt: skip
+    else:
+        lines += ["No fruit could be sized.", ""]
+    lines += ["| size class (diameter) | fruit | share |", "|---|---|---|"]
+    for label, count in classes_rows:
+        lines.append(f"| {label} | {count:,} | {share(count, len(diam))} |")
+    lines += ["", "![fruit diameters](diameters.png)", "", "## Confidence", ""]
+    if len(conf):
+        lines += [f"How far to trust each located fruit's box: {len(conf):,} fruit have a confidence (median "
+                  f"{np.median(conf):.2f}); {int(reliable.sum()):,} ({share(int(reliable.sum()), len(conf))}) are "
+                  "marked reliable, the others' centres may be off by more than a few millimetres.", ""]  # fmt: skip
+    else:
+        lines += ["The completion method used gives no confidence (the default method, `evidence`, does).", ""]
+    lines += ["![confidence](confidence.png)", "",
+              f"Made by `symfruit report` from `{TABLE_NAME}` (one row per fruit, metres) and `{FRAMES_NAME}` (one "
+              "row per frame) in the output folder.", ""]  # fmt: skip
+    return "\n".join(lines)

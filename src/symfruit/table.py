@@ -1,0 +1,307 @@
+"""The fruit table of a ``detect`` run: ``OUT/detections.parquet`` (one row per fruit per frame) and
+``OUT/frames.parquet`` (one row per frame, so that frames without fruit count too).
+
+Both are built from the frames' ``detections.json`` records, never from anything else: the rows of a frame
+done in this run come from the record it just wrote (:func:`frame_rows`), the rows of a frame skipped by
+``--resume`` from its file (:func:`read_frame_rows`), so a resumed run's table is the table of an
+uninterrupted one, with each frame's rows exactly once. :class:`TableWriter` streams the rows into both
+files in row groups (memory stays flat over a long recording) and renames them into place only when the
+run's table is complete (:mod:`symfruit.io.atomic`); an interrupted run leaves the previous tables.
+
+Units are metres (centre, size) and seconds (``seconds``, the frame's detection time); ``stamp`` is the
+colour image's time (UTC nanoseconds) where the recording has one (bags), else null.
+
+=============  ===========================  =====================================================
+column         type                         content
+=============  ===========================  =====================================================
+recording      string                       the recording's name (the input's file or folder name)
+frame          string                       the frame's name
+stamp          timestamp[ns, UTC], null     the colour image's time
+id             int32                        the fruit's id in the frame (1, 2, ...)
+centre_x/y/z   float64, null                the completed fruit's box centre, metres, camera frame
+size_x/y/z     float64, null                the completed fruit's box size, metres
+confidence     float64, null                in [0, 1] (null for methods without one)
+reliable       bool, null
+method         string, null                 the completion method
+mask_area      int64                        pixels of the fruit's mask
+points         int64                        visible points extracted under the mask
+truncated      bool                         the fruit touches the image border
+error          string, null                 why the fruit could not be completed (then no centre)
+=============  ===========================  =====================================================
+
+``frames.parquet``: ``recording``, ``frame``, ``stamp``, ``fruit`` (int32, every fruit of the frame),
+``located`` (int32, those completed) and ``seconds`` (float64, the frame's detection time).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+from .core.limits import MAX_TRUTH_BYTES
+from .errors import FileFormatError, SymfruitError
+
+__all__ = [
+    "FRAMES_NAME",
+    "FRAME_COLUMNS",
+    "FRUIT_COLUMNS",
+    "TABLE_NAME",
+    "TableWriter",
+    "frame_rows",
+    "read_frame_rows",
+    "recording_name",
+    "write_tables",
+]
+
+#: The files a ``detect`` run writes into its output folder besides the frame folders.
+TABLE_NAME = "detections.parquet"
+FRAMES_NAME = "frames.parquet"
+#: Largest ``detections.json`` read back (bytes): the bound of a ``truth.json``.
+MAX_RECORD_BYTES = MAX_TRUTH_BYTES
+#: Rows buffered before a row group is written (about 20 MB of rows in Python).
+ROW_GROUP = 16_384
+
+#: ``(name, arrow type name)`` of ``detections.parquet``, in order.
+FRUIT_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("recording", "string"), ("frame", "string"), ("stamp", "timestamp"), ("id", "int32"),
+    ("centre_x", "float64"), ("centre_y", "float64"), ("centre_z", "float64"),
+    ("size_x", "float64"), ("size_y", "float64"), ("size_z", "float64"),
+    ("confidence", "float64"), ("reliable", "bool"), ("method", "string"), ("mask_area", "int64"),
+    ("points", "int64"), ("truncated", "bool"), ("error", "string"),
+)  # fmt: skip
+#: ``(name, arrow type name)`` of ``frames.parquet``, in order.
+FRAME_COLUMNS: tuple[tuple[str, str], ...] = (
+    ("recording", "string"), ("frame", "string"), ("stamp", "timestamp"), ("fruit", "int32"), ("located", "int32"),
+    ("seconds", "float64"),
+)  # fmt: skip
+
+Row = dict[str, Any]
+
+
+def schema(columns: Sequence[tuple[str, str]]) -> Any:
+    """The pyarrow schema of ``columns`` (:data:`FRUIT_COLUMNS` or :data:`FRAME_COLUMNS`)."""
+    import pyarrow as pa
+
+    kinds = {"string": pa.string(), "timestamp": pa.timestamp("ns", tz="UTC"), "int32": pa.int32(),
+             "int64": pa.int64(), "float64": pa.float64(), "bool": pa.bool_()}  # fmt: skip
+    return pa.schema([(name, kinds[kind]) for name, kind in columns])
+
+
+def _number(value: Any, what: str, *, whole: bool = False) -> Any:
+    if value is None:
+        return None
+    if isinstance(value, bool) or not isinstance(value, (int, float)):
+        raise FileFormatError(f"{what} is {type(value).__name__}, not a number")
+    if whole:
+        if not isinstance(value, int) or not -(2**62) <= value <= 2**62:
+            raise FileFormatError(f"{what} is {value!r}, not a whole number")
+        return value
+    return float(value) if math.isfinite(value) else None
+
+
+def _flag(value: Any, what: str) -> bool | None:
+    if value is None or isinstance(value, bool):
+        return value
+    raise FileFormatError(f"{what} is {value!r}, not true or false")
+
+
+def _text(value: Any, what: str) -> str | None:
+    if value is None or isinstance(value, str):
+        return value
+    raise FileFormatError(f"{what} is {type(value).__name__}, not text")
+
+
+def _triple(value: Any, what: str) -> list[float | None]:
+    if value is None:
+        return [None, None, None]
+    if not isinstance(value, list) or len(value) != 3:
+        raise FileFormatError(f"{what} is not three numbers")
+    return [_number(v, what) for v in value]
+
+
+def _stamp(header: Any) -> int | None:
+    stamp = header.get("stamp") if isinstance(header, Mapping) else None
+    if stamp is None:
+        return None
+    if not isinstance(stamp, Mapping):
+        raise FileFormatError("header.stamp is not {sec, nanosec}")
+    sec = _number(stamp.get("sec"), "header.stamp.sec", whole=True)
+    nsec = _number(stamp.get("nanosec"), "header.stamp.nanosec", whole=True)
+    if sec is None or nsec is None or not 0 <= nsec < 1_000_000_000 or not 0 <= sec < 2**33:
+        raise FileFormatError(f"header.stamp {sec}.{nsec} is not a time")
+    return int(sec) * 1_000_000_000 + int(nsec)
+
+
+def frame_rows(record: Mapping[str, Any], recording: str) -> tuple[Row, list[Row]]:
+    """The ``frames.parquet`` row and the ``detections.parquet`` rows of one frame's ``detections.json``
+    record (:func:`symfruit.writers.detections_record`).
+
+    Raises
+    ------
+    FileFormatError
+        When the record is not one (a field missing or of the wrong type), saying which.
+    """
+    if not isinstance(record, Mapping) or not isinstance(record.get("fruits"), list):
+        raise FileFormatError("not a detections.json record (no list of fruits)")
+    frame = _text(record.get("frame"), "frame")
+    if frame is None:
+        raise FileFormatError("not a detections.json record (no frame name)")
+    stamp = _stamp(record.get("header"))
+    fruits: list[Row] = []
+    for k, fruit in enumerate(record["fruits"]):
+        where = f"fruits[{k}]"
+        if not isinstance(fruit, Mapping):
+            raise FileFormatError(f"{where} is not an object")
+        box = fruit.get("box")
+        size = box.get("size") if isinstance(box, Mapping) else None
+        error = _text(fruit.get("error"), f"{where}.error")
+        centre, extent = _triple(fruit.get("centre"), f"{where}.centre"), _triple(size, f"{where}.box.size")
+        fruits.append({
+            "recording": recording, "frame": frame, "stamp": stamp, "id": _number(fruit.get("id"), f"{where}.id",
+            whole=True), "centre_x": centre[0], "centre_y": centre[1], "centre_z": centre[2], "size_x": extent[0],
+            "size_y": extent[1], "size_z": extent[2], "confidence": _number(fruit.get("confidence"),
+            f"{where}.confidence"), "reliable": _flag(fruit.get("reliable"), f"{where}.reliable"),
+            "method": _text(fruit.get("method"), f"{where}.method"),
+            "mask_area": _number(fruit.get("mask_area"), f"{where}.mask_area", whole=True),
+            "points": _number(fruit.get("n_points"), f"{where}.n_points", whole=True),
+            "truncated": bool(_flag(fruit.get("truncated"), f"{where}.truncated")), "error": error,
+        })  # fmt: skip
+        if fruits[-1]["id"] is None or not -(2**31) <= fruits[-1]["id"] < 2**31:
+            raise FileFormatError(f"{where}.id is missing or out of range")
+    timings = record.get("timings")
+    seconds = _number(timings.get("total"), "timings.total") if isinstance(timings, Mapping) else None
+    located = sum(f["error"] is None and f["centre_x"] is not None for f in fruits)
+    row = {"recording": recording, "frame": frame, "stamp": stamp, "fruit": len(fruits), "located": located,
+           "seconds": seconds}  # fmt: skip
+    return row, fruits
+
+
+def read_frame_rows(path: str | Path, recording: str) -> tuple[Row, list[Row]]:
+    """:func:`frame_rows` of a ``detections.json`` file (read with a size bound).
+
+    Raises
+    ------
+    FileFormatError
+        Naming the file, when it cannot be read or is not a record.
+    """
+    from .io.text import read_structured
+
+    path = Path(path)
+    data = read_structured(path, what="detections.json", max_bytes=MAX_RECORD_BYTES)
+    try:
+        return frame_rows(data, recording)
+    except SymfruitError as exc:
+        raise FileFormatError(f"{path}: {exc}") from None
+
+
+class TableWriter:
+    """Streams rows into ``OUT/detections.parquet`` and ``OUT/frames.parquet``; both appear (atomically) when
+    the block ends without an error, and neither when it fails.
+
+    Examples
+    --------
+    >>> with TableWriter(out_folder) as table:  # doctest: +SKIP
+    ...     table.add(*frame_rows(record, "rec"))
+    """
+
+    def __init__(self, output: str | Path, *, root: Any = None) -> None:
+        self.output = Path(output)
+        self.root = root
+        self.frames = 0
+        self.fruits = 0
+        self._stack = contextlib.ExitStack()
+        self._writers: dict[str, Any] = {}
+        self._buffers: dict[str, list[Row]] = {TABLE_NAME: [], FRAMES_NAME: []}
+        self._schemas: dict[str, Any] = {}
+
+    def __enter__(self) -> TableWriter:
+        import pyarrow.parquet as pq
+
+        from .io.atomic import atomic_write
+
+        try:
+            for name, columns in ((TABLE_NAME, FRUIT_COLUMNS), (FRAMES_NAME, FRAME_COLUMNS)):
+                handle = self._stack.enter_context(atomic_write(self.output / name, "wb", root=self.root))
+                self._schemas[name] = schema(columns)
+                self._writers[name] = pq.ParquetWriter(handle, self._schemas[name])
+        except BaseException:
+            self._stack.close()
+            raise
+        return self
+
+    def add(self, frame: Row, fruits: Sequence[Row]) -> None:
+        """Add one frame's row and its fruit rows (:func:`frame_rows`)."""
+        self._buffers[FRAMES_NAME].append(frame)
+        self._buffers[TABLE_NAME].extend(fruits)
+        self.frames += 1
+        self.fruits += len(fruits)
+        for name, rows in self._buffers.items():
+            if len(rows) >= ROW_GROUP:
+                self._flush(name)
+
+    def _flush(self, name: str) -> None:
+        import pyarrow as pa
+
+        rows = self._buffers[name]
+        if rows:
+            columns = {field.name: [r[field.name] for r in rows] for field in self._schemas[name]}
+            self._writers[name].write_table(pa.table(columns, schema=self._schemas[name]))
+            rows.clear()
+
+    def __exit__(self, kind: Any, exc: Any, tb: Any) -> None:
+        if kind is not None:
+            self._abort(kind, exc, tb)
+            return
+        try:
+            for name in self._writers:
+                self._flush(name)
+            for writer in self._writers.values():
+                writer.close()  # the footer: the file is whole only now
+        except BaseException as err:
+            self._abort(type(err), err, err.__traceback__)  # an OSError comes back as an OutputError
+            raise
+        self._stack.close()  # both renamed into place
+
+    def _abort(self, kind: Any, exc: Any, tb: Any) -> None:
+        """Drop both temporary files (the tables of an earlier run stay)."""
+        for writer in self._writers.values():
+            with contextlib.suppress(Exception):
+                writer.close()
+        self._stack.__exit__(kind, exc, tb)
+
+
+def recording_name(source: str | Path) -> str:
+    """The ``recording`` column of a run on ``source``: the input's file or folder name."""
+    return Path(source).absolute().name or str(source)
+
+
+def write_tables(
+    output: str | Path, frames: Sequence[tuple[str, Path]], recording: str, *, root: Any = None
+) -> dict[str, str]:
+    """Write both tables from the ``detections.json`` of every frame ``(name, folder)`` that has one, in
+    order (the frames of the run that are done, by this run or by the one it resumed).
+
+    Returns
+    -------
+    dict
+        Frames whose ``detections.json`` could not be read into the table, with the reason (left out).
+
+    Raises
+    ------
+    OutputError
+        When a table cannot be written (then neither is replaced).
+    """
+    bad: dict[str, str] = {}
+    with TableWriter(output, root=root) as table:
+        for name, folder in frames:
+            path = Path(folder) / "detections.json"
+            if not path.is_file():
+                continue
+            try:
+                table.add(*read_frame_rows(path, recording))
+            except SymfruitError as exc:
+                bad[name] = f"{exc} (left out of {TABLE_NAME})"
+    return bad

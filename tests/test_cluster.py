@@ -1,0 +1,207 @@
+"""detect on a Dask cluster: a local cluster of two worker processes on 127.0.0.1, one of them killed while it
+works on a frame, gives the serial run's detections frame for frame and tables with each fruit once, also
+after --resume; the client refuses what the workers could not do."""
+
+import json
+import os
+import shutil
+import signal
+import threading
+import time
+from pathlib import Path
+
+import pyarrow.parquet as pq
+import pytest
+
+from symfruit import InputError
+from symfruit.batch import run_batch
+from symfruit.cli import main
+
+from .conftest import EXAMPLE_FRAME
+
+distributed = pytest.importorskip("distributed")
+
+from symfruit.cluster import local_cluster, run_distributed  # noqa: E402
+
+#: Exec'd on every worker: the first attempt at frame FRAME writes its worker's pid to MARKER (atomically, by a
+#: hard link that only one attempt can make) and waits to be killed; any later attempt goes on as usual.
+BLOCK_ONE_FRAME = """
+import os, time
+import symfruit.cluster as cluster
+
+real = cluster.detect
+
+
+def detect(frame, **kwargs):
+    if frame.name == FRAME:
+        tmp = f"{MARKER}.{os.getpid()}"
+        with open(tmp, "w") as handle:
+            handle.write(str(os.getpid()))
+        try:
+            os.link(tmp, MARKER)
+        except FileExistsError:
+            return real(frame, **kwargs)
+        time.sleep(60)  # killed long before
+    return real(frame, **kwargs)
+
+
+cluster.detect = detect
+"""
+
+
+def _fruits(folder: Path) -> dict:
+    out = {}
+    for path in sorted(folder.glob("*/detections.json")):
+        data = json.loads(path.read_text())
+        out[path.parent.name] = [{k: v for k, v in f.items() if k != "seconds"} for f in data["fruits"]]
+    return out
+
+
+def _wait_for(check, seconds: float, what: str):
+    deadline = time.monotonic() + seconds
+    while time.monotonic() < deadline:
+        value = check()
+        if value:
+            return value
+        time.sleep(0.05)
+    raise AssertionError(f"waited {seconds} s for {what}")
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """Four copies of the shipped frame (rendered by symfruit.synthetic.scenes, six ripe strawberries)."""
+    rec = tmp_path_factory.mktemp("cluster") / "rec"
+    for k in range(4):
+        shutil.copytree(EXAMPLE_FRAME, rec / f"scene_{k:05d}")
+    return rec
+
+
+def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(recording, tmp_path, capsys):
+    from symfruit.settings import resolve_settings
+
+    settings = resolve_settings(fruit="strawberry")  # what the command line's default --fruit gives
+    serial = run_batch(recording, tmp_path / "serial", method="sphere", settings=settings, progress=False)
+    assert serial.ok and serial.fruits > 0
+    marker, out = tmp_path / "started", tmp_path / "out"
+    result: dict = {}
+    with local_cluster(2) as cluster, distributed.Client(cluster) as client:
+        client.run(exec, BLOCK_ONE_FRAME, {"FRAME": "scene_00003", "MARKER": str(marker)})
+        pids = set(client.run(os.getpid).values())
+
+        def run() -> None:
+            try:
+                result["report"] = run_distributed(recording, out, scheduler=cluster.scheduler_address, chunk=2,
+                                                   method="sphere", settings=settings, progress=False)  # fmt: skip
+            except BaseException as exc:  # surfaced by the assertions below
+                result["error"] = exc
+
+        thread = threading.Thread(target=run)
+        thread.start()
+        pid = int(_wait_for(lambda: marker.is_file() and marker.read_text(), 180, "a worker to start scene_00003"))
+        assert pid in pids
+        os.kill(pid, signal.SIGKILL)  # mid-task: scene_00002, the task's first frame, is written already
+        thread.join(timeout=300)
+        assert not thread.is_alive() and "error" not in result, result.get("error")
+        workers = _wait_for(lambda: len(client.scheduler_info()["workers"]) == 2 and client.run(os.getpid), 120,
+                            "the nanny to start another worker")  # fmt: skip
+        assert pid not in workers.values()
+        report = result["report"]
+        assert report.ok and report.done == serial.done and report.fruits == serial.fruits
+        assert _fruits(out) == _fruits(tmp_path / "serial")  # frame for frame
+        assert not list(out.rglob("*.tmp"))
+        table = pq.read_table(out / "detections.parquet").to_pylist()
+        assert len(table) == serial.fruits and len({(r["frame"], r["id"]) for r in table}) == len(table)
+        assert table == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist()
+        frames = pq.read_table(out / "frames.parquet").column("frame").to_pylist()
+        assert frames == serial.done
+
+        # --resume (the command line, on the same cluster) after losing two frames, one folder and one record:
+        # only those two are detected again, and the tables are whole again with each fruit once
+        shutil.rmtree(out / "scene_00000")
+        (out / "scene_00002" / "detections.json").unlink()
+        capsys.readouterr()
+        args = ["detect", str(recording), "--output", str(out), "--method", "sphere"]
+        assert main([*args, "--resume", "--scheduler", cluster.scheduler_address, "--chunk", "1"]) == 0
+        assert "frames: 2 done, 2 skipped (resume), 0 failed" in capsys.readouterr().out
+    assert pq.read_table(out / "detections.parquet").to_pylist() == table
+    assert _fruits(out) == _fruits(tmp_path / "serial")
+
+
+def test_a_frame_that_fails_on_a_worker_is_recorded_and_the_task_goes_on(recording, tmp_path):
+    """The worker's side in this process: each frame of a task in its own error boundary."""
+    from symfruit.cluster import Job, Part, detect_part
+
+    rec = tmp_path / "rec"
+    for name in ("scene_00000", "scene_00001"):
+        shutil.copytree(recording / name, rec / name)
+    (rec / "scene_00000" / "depth.png").write_bytes(b"not a png")
+    out = tmp_path / "out"
+    out.mkdir()
+    job = Job(run="r", source=str(rec), shown="rec", output=str(out), recording="rec", inputs=(),
+              input_folders=(str(rec),), exclude=(), method="raw")  # fmt: skip
+    part = Part((0, 1), ("scene_00000", "scene_00001"), (str(out / "scene_00000"), str(out / "scene_00001")),
+                (str(rec / "scene_00000"), str(rec / "scene_00001")))  # fmt: skip
+    failed, done = detect_part(job, part)
+    assert failed.status == "failed" and "depth.png" in failed.reason and not failed.stop
+    assert done.status == "done" and done.frame is not None and len(done.fruits) == done.frame["fruit"] > 0
+    assert json.loads((out / "scene_00001" / "detections.json").read_text())["source"] == "rec/scene_00001"
+    assert not (out / "scene_00000").exists() or not list((out / "scene_00000").iterdir())
+
+
+def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, tmp_path, capsys, monkeypatch):
+    from symfruit import cluster
+
+    monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "0.5s")
+    with pytest.raises(InputError, match="either a scheduler address or a number of local workers"):
+        run_distributed(recording, tmp_path / "out")
+    with pytest.raises(InputError, match="--workers must be between 1 and 256"):
+        local_cluster(0)
+    with pytest.raises(InputError, match="frames per task"):
+        run_distributed(recording, tmp_path / "out", workers=1, chunk=0)
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "2", "--ros2-bag",
+                 str(tmp_path / "bag")]) == 2  # fmt: skip
+    assert "cannot be combined with --scheduler or --workers" in capsys.readouterr().err
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--scheduler", "tcp://127.0.0.1:1"]) == 2
+    assert "cannot reach the Dask scheduler" in capsys.readouterr().err
+    assert not (tmp_path / "o" / "errors.json").exists()
+
+
+def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):
+    import builtins
+
+    from symfruit import cluster
+
+    real = builtins.__import__
+
+    def no_distributed(name, *args, **kwargs):
+        if name == "distributed" or name.startswith("distributed."):
+            raise ImportError(name)
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_distributed)
+    with pytest.raises(InputError, match=r"pip install 'symfruit\[cluster\]'"):
+        cluster.require_distributed()
+
+
+def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
+    """A bag travels as its path and frame indices: the worker opens it (once per run and thread), checks that
+    it lists the frame the client named, and writes what a serial run writes."""
+    from symfruit.cluster import Job, Part, detect_part, forget
+
+    from .conftest import EXAMPLES
+
+    pytest.importorskip("rosbags")
+    bag = EXAMPLES / "realsense" / "fruit.bag"
+    serial = run_batch(bag, tmp_path / "serial", method="raw", progress=False)
+    name = serial.done[0]
+    out = tmp_path / "out"
+    out.mkdir()
+    job = Job(run="bag", source=str(bag), shown=str(bag), output=str(out), recording="fruit.bag", inputs=(str(bag),),
+              input_folders=(), exclude=(), method="raw")  # fmt: skip
+    (done,) = detect_part(job, Part((0,), (name,), (str(out / name),)))
+    assert done.status == "done" and _fruits(out) == {name: _fruits(tmp_path / "serial")[name]}
+    written = json.loads((out / name / "detections.json").read_text())
+    assert written["source"] == json.loads((tmp_path / "serial" / name / "detections.json").read_text())["source"]
+    (moved,) = detect_part(job, Part((0,), ("another_00000_1",), (str(out / "x"),)))
+    assert moved.status == "failed" and "differs from the one the client listed" in moved.reason
+    assert forget("bag") == 1 and forget("bag") == 0  # the bag was opened once and is closed at the end

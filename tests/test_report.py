@@ -1,0 +1,108 @@
+"""symfruit report: report.md and its plots from a run's tables, numbers a reader can check, written atomically;
+tables that are missing, too large or not symfruit's refused by name."""
+
+import numpy as np
+import pytest
+from PIL import Image
+
+from symfruit import FileFormatError, InputError
+from symfruit.cli import main
+from symfruit.report import PLOTS, diameters_mm, size_classes, write_report
+from symfruit.table import TableWriter
+
+
+def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0, failed: int = 0) -> dict:
+    fruits = [{"id": k + 1, "mask_area": 900, "n_points": 700, "truncated": k < cut, "centre": [0.0, 0.0, 0.4],
+               "box": {"size": list(s)}, "method": "evidence", "confidence": 0.9 - 0.1 * k, "reliable": k % 2 == 0}
+              for k, s in enumerate(sizes)]  # fmt: skip
+    fruits += [{"id": len(sizes) + k + 1, "mask_area": 30, "n_points": 4, "truncated": False, "error": "too few"}
+               for k in range(failed)]  # fmt: skip
+    return {"frame": frame, "header": {}, "timings": {"total": 0.1}, "fruits": fruits}
+
+
+@pytest.fixture
+def run(tmp_path):
+    """A run of two recordings: 'row1' 3 frames (one without fruit), 'row2' 1 frame; 7 fruit seen, 6 located,
+    5 sized (one cut by the border), diameters 16, 20, 24, 30 and 40 mm."""
+    from symfruit.table import frame_rows
+
+    out = tmp_path / "out"
+    out.mkdir()
+    with TableWriter(out) as table:
+        table.add(*frame_rows(_record("a", [(0.016, 0.02, 0.01), (0.02, 0.03, 0.012)], failed=1), "row1"))
+        table.add(*frame_rows(_record("b", []), "row1"))
+        table.add(*frame_rows(_record("c", [(0.05, 0.05, 0.05), (0.01, 0.02, 0.024)], cut=1), "row1"))
+        table.add(*frame_rows(_record("d", [(0.03, 0.02, 0.01), (0.02, 0.02, 0.04)]), "row2"))
+    (out / "errors.json").write_text('{"failed": [{"frame": "e", "reason": "broken"}], "stopped": ""}')
+    return out
+
+
+def test_the_report_counts_sizes_and_classes_as_a_reader_would(run):
+    report = write_report(run)
+    assert (report.frames, report.fruit, report.located, report.sized, report.recordings, report.failed_frames) == (
+        4, 7, 6, 5, 2, 1)  # fmt: skip
+    text = (run / "report" / "report.md").read_text()
+    assert "2 recording(s), 4 frames and 7 fruit seen, of which 6 were located" in text
+    assert "| row1 | 3 | 2 | 5 | 4 | 1.33 | 2 | 20.0 |" in text  # diameters 16, 20, 24 mm
+    assert "| row2 | 1 | 1 | 2 | 2 | 2.00 | 2 | 35.0 |" in text  # 30, 40 mm
+    assert "| < 18 mm | 1 | 20.0 % |" in text and "| 18-25 mm | 2 | 40.0 % |" in text
+    assert "| >= 25 mm | 2 | 40.0 % |" in text and "1 frame(s) could not be processed" in text
+    assert "5 fruit sized: median diameter 24.0 mm" in text
+    for name in PLOTS:
+        assert f"]({name})" in text
+        with Image.open(run / "report" / name) as img:
+            assert img.format == "PNG" and img.size[0] >= 600
+    assert sorted(p.name for p in (run / "report").iterdir()) == sorted([*PLOTS, "report.md"])
+
+
+def test_diameters_and_classes():
+    assert diameters_mm(np.array([0.018]), np.array([0.0175])).tolist() == [18.0]
+    assert size_classes(np.array([17.99, 18.0, 24.99, 25.0]), [18, 25]) == [("< 18 mm", 1), ("18-25 mm", 2),
+                                                                            (">= 25 mm", 1)]  # fmt: skip
+    for bad in ([], [25, 18], [0, 10], [18, float("nan")]):
+        with pytest.raises(InputError, match="increasing diameters"):
+            size_classes(np.ones(1), bad)
+
+
+def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
+    assert main(["report", str(run), "--output", str(tmp_path / "season"), "--classes", "20,30,35"]) == 0
+    assert "2 recording(s), 4 frames, 7 fruit seen, 6 located, 5 sized" in capsys.readouterr().out
+    assert "| 30-35 mm | 1 | 20.0 % |" in (tmp_path / "season" / "report.md").read_text()
+    assert main(["report", str(run), "--classes", "big"]) == 2
+    assert "--classes 'big'" in capsys.readouterr().err
+    assert main(["report", str(tmp_path / "nothing")]) == 2
+    assert "no such table; run `symfruit detect" in capsys.readouterr().err
+
+
+def test_tables_too_large_or_not_ours_are_refused(run, monkeypatch):
+    from symfruit import report as module
+
+    monkeypatch.setattr(module, "MAX_REPORT_ROWS", 3)
+    with pytest.raises(FileFormatError, match="7 rows; a report reads at most 3"):
+        write_report(run)
+    monkeypatch.undo()
+    (run / "frames.parquet").write_bytes(b"PAR1 not really")
+    with pytest.raises(FileFormatError, match=r"frames\.parquet: cannot read table"):
+        write_report(run)
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    pq.write_table(pa.table({"x": [1]}), run / "frames.parquet")
+    with pytest.raises(FileFormatError, match="not a symfruit table"):
+        write_report(run)
+    assert not (run / "report").exists()
+
+
+def test_without_matplotlib_the_message_names_the_extra(run, monkeypatch):
+    import builtins
+
+    real = builtins.__import__
+
+    def no_matplotlib(name, *args, **kwargs):
+        if name.startswith("matplotlib"):
+            raise ImportError(name)
+        return real(name, *args, **kwargs)
+
+    monkeypatch.setattr(builtins, "__import__", no_matplotlib)
+    with pytest.raises(InputError, match=r"pip install 'symfruit\[plot\]'"):
+        write_report(run)
