@@ -32,9 +32,9 @@ from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, uni
 from .io.sources import open_source
 from .methods import DEFAULT_METHOD
 from .progress import Progress
+from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_tables
 from .segment import MaskSource, mask_source
 from .settings import Settings
-from .table import FRAMES_NAME, TABLE_NAME, recording_name, write_tables
 from .writers import remove_stale, write_detections
 
 __all__ = [
@@ -99,11 +99,11 @@ def run_batch(
     chunk: int = 4,
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
-    fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.table`).
+    fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.season.table`).
 
     In this process, or on a Dask cluster (``pip install 'symfruit[cluster]'``): ``scheduler`` (an existing
     one's address, ``tcp://host:port``) or ``workers`` (a local cluster of that many worker processes),
-    ``chunk`` frames per task (:func:`symfruit.cluster.run_distributed`; ``on_frame`` is not available there).
+    ``chunk`` frames per task (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there).
 
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
@@ -124,7 +124,7 @@ def run_batch(
         input folder, held by another run), or the cluster cannot be used; per-frame problems go into the report.
     """
     if scheduler is not None or workers is not None:
-        from .cluster import run_distributed
+        from .season.cluster import run_distributed
 
         if on_frame is not None:
             raise InputError("on_frame (--ros2-bag) runs in this process: it cannot be combined with a Dask cluster")
@@ -191,7 +191,7 @@ def run_batch(
 
 
 def _tables(output: Path, frames: list[tuple[str, Path]], recording: str, out: OutputFolder, report: Any) -> None:
-    """Write the fruit tables of every frame done (:func:`symfruit.table.write_tables`) into ``report``'s
+    """Write the fruit tables of every frame done (:func:`symfruit.season.table.write_tables`) into ``report``'s
     run: a record that cannot be read back is a failed frame, a table that cannot be written stops the run."""
     try:
         bad = write_tables(output, frames, recording, root=out)

@@ -318,7 +318,7 @@ def _bench(args: argparse.Namespace) -> int:
         if not 1 <= args.recording <= 100_000:
             raise InputError("--recording must be between 1 and 100000 frames")
         if args.workers is not None:
-            from .cluster import local_cluster, require_distributed
+            from .season.cluster import local_cluster, require_distributed
 
             require_distributed()
             if not 1 <= args.workers <= 256:
@@ -629,7 +629,7 @@ def _scenes(args: argparse.Namespace) -> int:
 
 def _report(args: argparse.Namespace) -> int:
     from .errors import InputError
-    from .report import write_report
+    from .season.report import write_report
 
     try:
         classes = [float(x) for x in args.classes.split(",") if x.strip()]

@@ -271,9 +271,9 @@ _MEASURED_CLUSTER = """
 import json, sys, time
 import distributed
 from symfruit.batch import run_batch
-from symfruit.cluster import Job, Outcome, Part, local_cluster, worker_peak_mb
+from symfruit.season.cluster import Job, Outcome, Part, local_cluster, worker_peak_mb
 from symfruit.settings import resolve_settings
-from symfruit.table import frame_rows
+from symfruit.season.table import frame_rows
 
 
 def empty_task(job, part):  # a detect task's arguments and answer (six fruit), without the work
@@ -288,7 +288,7 @@ settings = resolve_settings(fruit="strawberry")
 t0 = time.perf_counter()
 with local_cluster(workers) as cluster, distributed.Client(cluster) as client:
     client.wait_for_workers(workers)
-    client.run(lambda: __import__("symfruit.cluster"))
+    client.run(lambda: __import__("symfruit.season.cluster"))
     startup = time.perf_counter() - t0
     job = Job("bench", rec, rec, out, "rec", (), (), (), "auto", method, settings)
     n = 400

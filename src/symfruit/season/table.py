@@ -41,8 +41,8 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from .core.limits import MAX_TRUTH_BYTES
-from .errors import FileFormatError, SymfruitError
+from ..core.limits import MAX_TRUTH_BYTES
+from ..errors import FileFormatError, SymfruitError
 
 __all__ = [
     "FRAMES_NAME",
@@ -187,7 +187,7 @@ def read_frame_rows(path: str | Path, recording: str) -> tuple[Row, list[Row]]:
     FileFormatError
         Naming the file, when it cannot be read or is not a record.
     """
-    from .io.text import read_structured
+    from ..io.text import read_structured
 
     path = Path(path)
     data = read_structured(path, what="detections.json", max_bytes=MAX_RECORD_BYTES)
@@ -220,7 +220,7 @@ class TableWriter:
     def __enter__(self) -> TableWriter:
         import pyarrow.parquet as pq
 
-        from .io.atomic import atomic_write
+        from ..io.atomic import atomic_write
 
         try:
             for name, columns in ((TABLE_NAME, FRUIT_COLUMNS), (FRAMES_NAME, FRAME_COLUMNS)):

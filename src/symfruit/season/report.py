@@ -1,7 +1,7 @@
 """``symfruit report OUT``: what a ``detect`` run found, for someone who never ran it: ``report.md`` and PNG plots
 (fruit per frame and per recording, fruit diameters against the size classes fruit is sorted by, confidence).
 
-It reads the run's tables (``OUT/detections.parquet``, ``OUT/frames.parquet``: :mod:`symfruit.table`) and
+It reads the run's tables (``OUT/detections.parquet``, ``OUT/frames.parquet``: :mod:`symfruit.season.table`) and
 ``OUT/errors.json``, each checked against a bound before it is read, and writes every file atomically into
 ``OUT/report/`` (or the folder named), locked while it writes. Millimetres in the report, as in every
 printed report; the tables stay in metres.
@@ -25,8 +25,8 @@ from typing import Any
 
 import numpy as np
 
-from .core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
-from .errors import FileFormatError, InputError, SymfruitError
+from ..core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from ..errors import FileFormatError, InputError, SymfruitError
 from .table import FRAMES_NAME, TABLE_NAME
 
 __all__ = ["DEFAULT_CLASSES_MM", "PLOTS", "Report", "diameters_mm", "size_classes", "write_report"]
@@ -109,7 +109,7 @@ def size_classes(diameters: np.ndarray, edges: Sequence[float]) -> list[tuple[st
 
 def _errors(output: Path) -> int:
     """Frames ``errors.json`` lists as failed or not reached (0 without the file)."""
-    from .io.text import read_structured
+    from ..io.text import read_structured
     from .table import MAX_RECORD_BYTES
 
     path = output / "errors.json"
@@ -145,8 +145,8 @@ def write_report(
         import matplotlib.pyplot as plt
     except ImportError:
         raise InputError("symfruit report draws its plots with matplotlib: pip install 'symfruit[plot]'") from None
-    from .io.atomic import atomic_write
-    from .io.outputs import OutputFolder
+    from ..io.atomic import atomic_write
+    from ..io.outputs import OutputFolder
 
     output = Path(output)
     folder = Path(folder) if folder is not None else output / "report"

@@ -9,9 +9,9 @@ import pytest
 
 from symfruit import FileFormatError
 from symfruit.batch import run_batch
-from symfruit.table import FRUIT_COLUMNS, TableWriter, frame_rows, read_frame_rows, recording_name
+from symfruit.season.table import FRUIT_COLUMNS, TableWriter, frame_rows, read_frame_rows, recording_name
 
-from .conftest import EXAMPLE_FRAME
+from ..conftest import EXAMPLE_FRAME
 
 RECORD = {
     "frame": "f1",
@@ -72,7 +72,7 @@ def test_the_tables_appear_whole_or_not_at_all(tmp_path):
 
 
 def test_row_groups_stream_and_an_empty_run_has_empty_tables(tmp_path, monkeypatch):
-    from symfruit import table as module
+    from symfruit.season import table as module
 
     monkeypatch.setattr(module, "ROW_GROUP", 3)
     with TableWriter(tmp_path) as table:

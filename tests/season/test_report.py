@@ -7,8 +7,8 @@ from PIL import Image
 
 from symfruit import FileFormatError, InputError
 from symfruit.cli import main
-from symfruit.report import PLOTS, diameters_mm, size_classes, write_report
-from symfruit.table import TableWriter
+from symfruit.season.report import PLOTS, diameters_mm, size_classes, write_report
+from symfruit.season.table import TableWriter
 
 
 def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0, failed: int = 0) -> dict:
@@ -24,7 +24,7 @@ def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0
 def run(tmp_path):
     """A run of two recordings: 'row1' 3 frames (one without fruit), 'row2' 1 frame; 7 fruit seen, 6 located,
     5 sized (one cut by the border), diameters 16, 20, 24, 30 and 40 mm."""
-    from symfruit.table import frame_rows
+    from symfruit.season.table import frame_rows
 
     out = tmp_path / "out"
     out.mkdir()
@@ -75,7 +75,7 @@ def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
 
 
 def test_tables_too_large_or_not_ours_are_refused(run, monkeypatch):
-    from symfruit import report as module
+    from symfruit.season import report as module
 
     monkeypatch.setattr(module, "MAX_REPORT_ROWS", 3)
     with pytest.raises(FileFormatError, match="7 rows; a report reads at most 3"):

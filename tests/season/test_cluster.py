@@ -17,17 +17,17 @@ from symfruit import InputError
 from symfruit.batch import run_batch
 from symfruit.cli import main
 
-from .conftest import EXAMPLE_FRAME
+from ..conftest import EXAMPLE_FRAME
 
 distributed = pytest.importorskip("distributed")
 
-from symfruit.cluster import local_cluster, run_distributed  # noqa: E402
+from symfruit.season.cluster import local_cluster, run_distributed  # noqa: E402
 
 #: Exec'd on every worker: the first attempt at frame FRAME writes its worker's pid to MARKER (atomically, by a
 #: hard link that only one attempt can make) and waits to be killed; any later attempt goes on as usual.
 BLOCK_ONE_FRAME = """
 import os, time
-import symfruit.cluster as cluster
+import symfruit.season.cluster as cluster
 
 real = cluster.detect
 
@@ -129,7 +129,7 @@ def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(record
 
 def test_a_frame_that_fails_on_a_worker_is_recorded_and_the_task_goes_on(recording, tmp_path):
     """The worker's side in this process: each frame of a task in its own error boundary."""
-    from symfruit.cluster import Job, Part, detect_part
+    from symfruit.season.cluster import Job, Part, detect_part
 
     rec = tmp_path / "rec"
     for name in ("scene_00000", "scene_00001"):
@@ -149,7 +149,7 @@ def test_a_frame_that_fails_on_a_worker_is_recorded_and_the_task_goes_on(recordi
 
 
 def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, tmp_path, capsys, monkeypatch):
-    from symfruit import cluster
+    from symfruit.season import cluster
 
     monkeypatch.setattr(cluster, "CONNECT_TIMEOUT", "0.5s")
     with pytest.raises(InputError, match="either a scheduler address or a number of local workers"):
@@ -169,7 +169,7 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
 def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):
     import builtins
 
-    from symfruit import cluster
+    from symfruit.season import cluster
 
     real = builtins.__import__
 
@@ -186,9 +186,9 @@ def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):
 def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
     """A bag travels as its path and frame indices: the worker opens it (once per run and thread), checks that
     it lists the frame the client named, and writes what a serial run writes."""
-    from symfruit.cluster import Job, Part, detect_part, forget
+    from symfruit.season.cluster import Job, Part, detect_part, forget
 
-    from .conftest import EXAMPLES
+    from ..conftest import EXAMPLES
 
     pytest.importorskip("rosbags")
     bag = EXAMPLES / "realsense" / "fruit.bag"

@@ -1,7 +1,7 @@
 """``detect`` on a Dask cluster: the frames of a recording run as tasks on ``dask.distributed`` workers, with
 the batch's guarantees (:func:`symfruit.batch.run_batch`): every frame ends done or recorded in
 ``errors.json``, ``--resume`` skips finished frames, every file is written atomically, and the fruit tables
-(:mod:`symfruit.table`) hold each frame's rows exactly once. ``pip install 'symfruit[cluster]'``.
+(:mod:`symfruit.season.table`) hold each frame's rows exactly once. ``pip install 'symfruit[cluster]'``.
 
 Who does what:
 
@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from .batch import (
+from ..batch import (
     BATCH_FILES,
     BatchReport,
     _clear_frame,
@@ -49,16 +49,16 @@ from .batch import (
     _source_inputs,
     frame_folder_name,
 )
-from .detect import detect
-from .errors import InputError, OutputError, SymfruitError
-from .io.frames import is_frame_folder, read_frame
-from .io.outputs import OutputFolder, reserve_record, write_record
-from .io.sources import FolderSource, FrameFolderSource, open_source
-from .methods import DEFAULT_METHOD
-from .progress import Progress
-from .settings import Settings
+from ..detect import detect
+from ..errors import InputError, OutputError, SymfruitError
+from ..io.frames import is_frame_folder, read_frame
+from ..io.outputs import OutputFolder, reserve_record, write_record
+from ..io.sources import FolderSource, FrameFolderSource, open_source
+from ..methods import DEFAULT_METHOD
+from ..progress import Progress
+from ..settings import Settings
+from ..writers import detections_record, write_detections
 from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows, recording_name
-from .writers import detections_record, write_detections
 
 __all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "require_distributed", "run_distributed"]
 
@@ -445,7 +445,7 @@ def _record(o: Outcome, report: BatchReport, table: TableWriter) -> None:
 
 def _worker_check(source: str, output: str) -> dict[str, Any]:
     """Run on every worker before the first task: its symfruit version and whether it sees the run's paths."""
-    from . import __version__
+    from .. import __version__
 
     return {"version": __version__, "source": os.path.exists(source), "output": os.path.isdir(output)}
 
@@ -453,7 +453,7 @@ def _worker_check(source: str, output: str) -> dict[str, Any]:
 def _preflight(client: Any, job: Job) -> None:
     """Refuse a cluster whose workers cannot run this job: symfruit missing or of another version, or the
     recording or the output folder not at the same path on a worker."""
-    from . import __version__
+    from .. import __version__
 
     try:
         checks = client.run(_worker_check, job.source, job.output)
