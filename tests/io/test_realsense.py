@@ -144,7 +144,7 @@ def test_the_alignment_is_the_sdks():
     with RealSenseBagSource(BAG) as src:
         stamps = {s: i for i, (s, _) in enumerate(src._depth_stamps)}
         compared = 0
-        for stamp, sdk in sdk_aligned(BAG):
+        for stamp, sdk in sdk_aligned(BAG, timeout_ms=60_000):  # a loaded machine may start playing late
             _, units, scale, _ = src.read_raw(stamps[stamp])
             depth = units * np.float32(scale)
             lenses = (src.depth_stream.lens, src.color_stream.lens, src.rotation, src.translation)
@@ -171,7 +171,7 @@ def test_a_distorted_colour_lens_matches_the_sdk(tmp_path):
     with RealSenseBagSource(path) as src:
         assert src.color_stream.lens.coeffs[0] == pytest.approx(0.06)
         stamps = {s: i for i, (s, _) in enumerate(src._depth_stamps)}
-        for stamp, sdk in sdk_aligned(path):
+        for stamp, sdk in sdk_aligned(path, timeout_ms=60_000):
             _, units, scale, _ = src.read_raw(stamps[stamp])
             lenses = (src.depth_stream.lens, src.color_stream.lens, src.rotation, src.translation)
             same = align_depth(units * np.float32(scale), *lenses, z="depth")

@@ -352,7 +352,9 @@ def sdk_aligned(path: str | Path, *, timeout_ms: int = 5000) -> Iterator[tuple[i
             ok, frames = pipeline.try_wait_for_frames(100)
             if not ok:  # the end of the file, or the SDK is slow: give it timeout_ms in all
                 waited += 100
-                if playback.current_status() == rs.playback_status.stopped or waited >= timeout_ms:
+                # "stopped" before the first frame can be a playback that has not started yet (a loaded machine)
+                stopped = playback.current_status() == rs.playback_status.stopped
+                if (stopped and seen) or waited >= timeout_ms:
                     return
                 continue
             waited = 0
