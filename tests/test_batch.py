@@ -107,7 +107,7 @@ def test_an_unexpected_error_in_one_frame_is_recorded_and_the_batch_goes_on(tmp_
 
 
 def test_resume_decides_before_decoding(tmp_path, monkeypatch):
-    rec = recording(tmp_path / "rec", "a", "b", "c")
+    rec = recording(tmp_path / "rec", "a", "b")
     out = tmp_path / "out"
     reads = []
     real = FolderSource.read
@@ -118,15 +118,15 @@ def test_resume_decides_before_decoding(tmp_path, monkeypatch):
 
     monkeypatch.setattr(FolderSource, "read", read)
     run_batch(rec, out, method="raw", progress=False)
-    assert reads == ["a", "b", "c"]
-    shutil.rmtree(out / "b")
+    assert reads == ["a", "b"]
+    shutil.rmtree(out / "a")
     reads.clear()
     again = run_batch(rec, out, method="raw", resume=True, progress=False)
-    assert reads == ["b"]  # finished frames are never decoded
-    assert again.skipped == ["a", "c"] and again.done == ["b"] and again.ok
+    assert reads == ["a"]  # finished frames are never decoded
+    assert again.skipped == ["b"] and again.done == ["a"] and again.ok
     reads.clear()
     run_batch(rec, out, method="raw", resume=False, progress=False)
-    assert reads == ["a", "b", "c"]  # without resume every frame is redone
+    assert reads == ["a", "b"]  # without resume every frame is redone
 
 
 def test_an_output_folder_inside_the_recording_is_not_a_frame(tmp_path):
@@ -222,17 +222,16 @@ sys.exit(main(sys.argv[2:]))
 
 
 def test_killed_batch_resumes_to_identical_results(tmp_path, capsys):
-    rec = recording(tmp_path / "rec", *(f"f{i}" for i in range(6)))
+    rec = recording(tmp_path / "rec", *(f"f{i}" for i in range(4)))
     whole, part = tmp_path / "whole", tmp_path / "part"
     cmd = ["detect", str(rec), "--method", "raw"]
     assert main([*cmd, "--output", str(whole)]) == 0
-    # Killed at a fixed moment, the worst one: frame f3's outputs written but its record still a temporary file.
-    killed = subprocess.run([sys.executable, "-c", KILLED_WHILE_WRITING, "f3", *cmd, "--output", str(part)],
+    # Killed at a fixed moment, the worst one: frame f2's outputs written but its record still a temporary file.
+    killed = subprocess.run([sys.executable, "-c", KILLED_WHILE_WRITING, "f2", *cmd, "--output", str(part)],
                             capture_output=True, text=True, timeout=300)  # fmt: skip
     assert killed.returncode == -signal.SIGKILL, killed.stderr
     done_before = len(list(part.glob("*/detections.json")))
-    assert 1 <= done_before <= 6
-    assert done_before == 3  # f0, f1, f2
+    assert done_before == 2  # f0, f1
     for path in part.glob("*/detections.json"):  # a file that exists is whole (written atomically)
         assert json.loads(path.read_text())["fruits"]
     assert [p.name.startswith(".detections.json.") for p in part.rglob("*.tmp")] == [True]  # the half-written record
@@ -269,7 +268,7 @@ def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tm
 
 @pytest.mark.parametrize(
     ("frames", "ripe", "method"),
-    [(12, 3, "sphere"), pytest.param(40, 8, "evidence", marks=pytest.mark.slow)],
+    [(8, 3, "sphere"), pytest.param(40, 8, "evidence", marks=pytest.mark.slow)],
 )
 def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     """Peak resident memory of a detect child (its own VmHWM) over a recording stays far under the bound the
@@ -278,7 +277,7 @@ def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     from symfruit.evaluate.bench import measured_detect
     from symfruit.synthetic.scenes import write_scenes
 
-    write_scenes(tmp_path / "rec", frames, distinct=3, n_ripe=ripe)
+    write_scenes(tmp_path / "rec", frames, distinct=2, n_ripe=ripe)
     args = [str(tmp_path / "rec"), "--output", str(tmp_path / "out"), "--method", method]
     status, peak_mb, err = measured_detect(args, timeout=600)
     assert status == 0, err

@@ -56,7 +56,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    help="with --frame: the frame through a real camera model, at its resolution")  # fmt: skip
     p.add_argument("--recording", type=int, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
-    p.add_argument("--method", default=None, help="with --recording: the completion method (default evidence)")
+    p.add_argument("--method", default=None,
+                   help="with --frame: only this method (default paper, fused and evidence); with --recording: the "
+                   "completion method (default evidence)")  # fmt: skip
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument(
@@ -343,7 +345,7 @@ def _bench(args: argparse.Namespace) -> int:
         from .evaluate.bench import bench_frame
 
         rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor)
-                for m in ("paper", "fused", "evidence")]  # fmt: skip
+                for m in ((args.method,) if args.method else ("paper", "fused", "evidence"))]  # fmt: skip
     else:
         rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:

@@ -60,6 +60,9 @@ __all__ = [
 OPTICAL_FRAME = "camera_color_optical_frame"
 #: Files a frame's output folder may hold; anything else matching these patterns is a previous run's.
 _FRAME_OUTPUTS = ("fruit_*.ply", "overlay.png", "detections.json")
+#: zlib level of the overlays: level 1 writes a 640x480 overlay in about 60 % of the default level's time
+#: (a sixth of a frame's wall time at level 6) for files about 13 % larger.
+FAST_PNG = 1
 
 
 def _labels(result: Result) -> np.ndarray:
@@ -173,7 +176,7 @@ def write_detections(folder: str | Path, found: FrameDetections, *, settings: Se
             write_ply(path, d.result.points, labels=_labels(d.result))
             written.append(path)
     with atomic_write(folder / "overlay.png", "wb") as handle:
-        draw_overlay(found).save(handle, format="PNG")
+        draw_overlay(found).save(handle, format="PNG", compress_level=FAST_PNG)
     written.append(folder / "overlay.png")
     remove_stale(folder, keep=[*written, folder / "detections.json"])
     write_json(folder / "detections.json", detections_record(found, settings=settings))
@@ -347,7 +350,7 @@ def write_label_overlay(path: str | Path, color: np.ndarray, labels: np.ndarray)
     path = Path(path)
     image = draw_label_overlay(color, labels)
     with atomic_write(path, "wb") as handle:
-        image.save(handle, format="PNG")
+        image.save(handle, format="PNG", compress_level=FAST_PNG)
     return path
 
 

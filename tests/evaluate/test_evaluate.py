@@ -9,6 +9,9 @@ import pytest
 
 from symfruit.evaluate import evaluate
 
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+pytestmark = pytest.mark.xdist_group("evaluate")
+
 
 @pytest.fixture(scope="module")
 def quick_paper(tmp_path_factory):

@@ -15,6 +15,10 @@ from ..conftest import EXAMPLES
 FRAMES = EXAMPLES / "real-frames"
 
 
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+pytestmark = pytest.mark.xdist_group("real-spheres")
+
+
 @pytest.fixture(scope="module")
 def boxes():
     return evaluate_spheres(FRAMES, methods=("evidence", "sphere", "paper"))

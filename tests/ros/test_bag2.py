@@ -162,7 +162,7 @@ def test_run_batch_on_frame_sees_every_frame_and_its_failures_are_the_frames(tmp
     from symfruit.batch import run_batch
     from symfruit.synthetic.scenes import write_scenes
 
-    write_scenes(tmp_path / "rec", 3, seed=0, n_ripe=2, n_unripe=0)
+    write_scenes(tmp_path / "rec", 3, distinct=1, seed=0, n_ripe=2, n_unripe=0)  # one render, three frames
     names = sorted(p.name for p in (tmp_path / "rec").iterdir())
     seen = []
 

@@ -9,7 +9,8 @@ import subprocess
 
 def test_a_short_real_run(ros2_python, tmp_path):
     out = tmp_path / "bench.json"
-    proc = subprocess.run([ros2_python, "-m", "symfruit.ros.bench2", "--frames", "1", "--json", str(out)],
+    proc = subprocess.run([ros2_python, "-m", "symfruit.ros.bench2", "--frames", "1", "--method", "raw",
+                           "--json", str(out)],
                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     res = json.loads(out.read_text())

@@ -174,6 +174,10 @@ def stop(process: subprocess.Popen) -> None:
     stop_group(process, 60)
 
 
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+pytestmark = pytest.mark.xdist_group("ros1-node")
+
+
 @pytest.fixture(scope="module")
 def ros_world(ros1, tmp_path_factory):
     """A master, this process as a rospy node, and `symfruit ros` as a subprocess, all connected."""

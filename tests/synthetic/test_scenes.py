@@ -11,16 +11,21 @@ from symfruit.synthetic.scenes import Scene, SceneFruit, make_scene, write_scene
 PERFECT = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
 
 
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+pytestmark = pytest.mark.xdist_group("scenes")
+
+
 @pytest.fixture(scope="module")
 def exact():
     return make_scene(4, noise=PERFECT)
 
 
 def test_the_same_seed_gives_the_same_scene():
-    a, b = make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1), make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1)
+    cam = Camera(fx=300, fy=300, cx=160, cy=120, width=320, height=240)  # small: rendering is most of the time
+    a, b = (make_scene(2, n_ripe=3, n_unripe=1, n_leaves=1, camera=cam) for _ in range(2))
     assert np.array_equal(a.color, b.color) and np.array_equal(a.depth, b.depth)
     assert np.array_equal(a.labels, b.labels) and a.truth() == b.truth()
-    c = make_scene(3, n_ripe=3, n_unripe=1, n_leaves=1)
+    c = make_scene(3, n_ripe=3, n_unripe=1, n_leaves=1, camera=cam)
     assert not np.array_equal(a.color, c.color) and a.truth() != c.truth()
 
 

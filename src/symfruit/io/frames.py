@@ -167,7 +167,7 @@ def write_frame(
     units = np.clip(np.rint(np.nan_to_num(depth) / depth_scale), 0, 65535).astype(np.uint16)
     for name, img in (("color.png", Image.fromarray(color)), ("depth.png", Image.fromarray(units))):
         with atomic_write(folder / name, "wb") as handle:
-            img.save(handle, format="PNG", optimize=True)
+            img.save(handle, format="PNG", compress_level=1)  # zlib level 1: 3x faster to write, ~10 % larger
     write_json(folder / "camera.json", {**camera.to_dict(), "depth_scale": depth_scale})
     if truth is not None:
         write_json(folder / "truth.json", truth)
