@@ -9,11 +9,12 @@ import pytest
 
 from symfruit.evaluate import evaluate
 
-#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup; session scope, as
+#: a worker interleaves other modules' tests and would tear a module-scoped fixture down between them)
 pytestmark = pytest.mark.xdist_group("evaluate")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def quick_paper(tmp_path_factory):
     root = tmp_path_factory.mktemp("results")
     return evaluate(protocol="paper", quick=True, output=root, jobs=2, progress=False), root

@@ -15,11 +15,12 @@ from ..conftest import EXAMPLES
 FRAMES = EXAMPLES / "real-frames"
 
 
-#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup; session scope, as
+#: a worker interleaves other modules' tests and would tear a module-scoped fixture down between them)
 pytestmark = pytest.mark.xdist_group("real-spheres")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def boxes():
     return evaluate_spheres(FRAMES, methods=("evidence", "sphere", "paper"))
 

@@ -11,11 +11,12 @@ from symfruit.synthetic.scenes import Scene, SceneFruit, make_scene, write_scene
 PERFECT = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=0.0, grazing_dropout=0.0, dropout=0.0)
 
 
-#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup)
+#: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup; session scope, as
+#: a worker interleaves other modules' tests and would tear a module-scoped fixture down between them)
 pytestmark = pytest.mark.xdist_group("scenes")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")
 def exact():
     return make_scene(4, noise=PERFECT)
 
