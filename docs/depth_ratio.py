@@ -29,7 +29,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__)
     parser.add_argument("--n", type=int, default=20)
     args = parser.parse_args()
-    sys.stdout.write("| kind | depth / minor width | depth / major width | depth / geometric mean |\n|---|---|---|---|\n")
+    sys.stdout.write("| kind | depth / minor width | depth / major width | depth / geometric mean |\n")
+    sys.stdout.write("|---|---|---|---|\n")
     rows = [(f, "hanging") for f in KINDS] + [("examples/scans", p) for p in ("hanging", "upright", "uniform")]
     for fruit, pose in rows:
         for kind, r in sorted(ratios(fruit, args.n, pose).items()):
