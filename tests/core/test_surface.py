@@ -4,7 +4,7 @@ drawn a few pixels off."""
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit.core.surface import (
@@ -144,3 +144,18 @@ def test_colour_trim_removes_an_overshoot_onto_the_background():
     assert np.array_equal(colour_trim(white, mask, band_px=4), mask)
     small = (xx - 80) ** 2 + (yy - 60) ** 2 <= 3**2  # no interior to learn from
     assert np.array_equal(colour_trim(color, small, band_px=4), small)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([3, 5]))
+def test_median_at_is_the_median_filter_at_those_pixels(seed, size):
+    from scipy import ndimage
+
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = rng.integers(1, 30, size=2)
+    image = rng.choice([0.3, 0.31, 0.5, np.inf], size=(h, w)) + rng.normal(0, 0.01, (h, w)).round(3)
+    rows, cols = np.nonzero(rng.random((h, w)) < 0.5)
+    expected = ndimage.median_filter(image, size=size, mode="nearest")[rows, cols]
+    np.testing.assert_array_equal(median_at(image, rows, cols, size=size), expected)

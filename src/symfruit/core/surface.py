@@ -173,6 +173,21 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     return out
 
 
+def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: int) -> np.ndarray:
+    """(n,) the ``size`` x ``size`` median filter of ``image`` (odd ``size``; edges repeated, as
+    ``scipy.ndimage.median_filter(..., mode="nearest")``) at the pixels ``(rows, cols)`` only.
+
+    The apex search needs it on a fruit's core alone, a fraction of the window the filter would sweep.
+    """
+    h, w = image.shape
+    off = np.arange(size) - size // 2
+    r = np.clip(rows[:, None, None] + off[None, :, None], 0, h - 1)
+    c = np.clip(cols[:, None, None] + off[None, None, :], 0, w - 1)
+    values = image[r, c].reshape(len(rows), size * size)
+    middle = size * size // 2
+    return np.partition(values, middle, axis=1)[:, middle]
+
+
 def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None) -> Surface | None:  # fmt: skip
@@ -217,12 +232,13 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
     if not near.any():
         return None
-    smooth = ndimage.median_filter(np.where(near, depth, np.inf), size=5, mode="nearest")
     core = ndimage.binary_erosion(mask, iterations=max(1, int(0.15 * radius_px))) & near
     if not core.any():
         core = near & mask if (near & mask).any() else near
-    flat = int(np.argmin(np.where(core, smooth, np.inf)))
-    apex = (flat // depth.shape[1], flat % depth.shape[1])
+    rows, cols = np.nonzero(core)
+    smooth = median_at(np.where(near, depth, np.inf), rows, cols, size=5)
+    first = int(np.argmin(smooth))
+    apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
     inner = ndimage.distance_transform_edt(mask) > interior * min(radius_px, 0.5 * minor_px)
@@ -241,14 +257,16 @@ class _Outline:
     def cost(self, shifts: np.ndarray, reach: int, trim: float) -> np.ndarray:
         """(k,) trimmed mean deviation of the outline points from a band inside the mask shifted by each
         ``(dv, du)`` of ``shifts`` (k, 2)."""
-        h, w = self.inside.shape
-        qr = self.rows[None, :] - shifts[:, :1]
-        qc = self.cols[None, :] - shifts[:, 1:]
-        ok = (qr >= 0) & (qr < h) & (qc >= 0) & (qc < w)
-        val = np.where(ok, self.inside[np.clip(qr, 0, h - 1), np.clip(qc, 0, w - 1)], -float(reach))
+        # outside the window the distance is -reach: a border that wide around the map replaces bounds tests
+        pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
+        padded = np.pad(self.inside, pad, constant_values=-float(reach))
+        val = padded[self.rows[None, :] - shifts[:, :1] + pad, self.cols[None, :] - shifts[:, 1:] + pad]
         # the cap's outline lies a band inside the mask's outline (grazing pixels without depth): the band is
         # the median distance, within 0 to 0.3 radii, and the cost the trimmed mean deviation from it
-        band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, self.band)
+        n = val.shape[1]
+        mid = np.partition(val, [(n - 1) // 2, n // 2], axis=1)  # np.median's two middle values, 5x faster
+        median = 0.5 * (mid[:, (n - 1) // 2] + mid[:, n // 2]) if n % 2 == 0 else mid[:, n // 2]
+        band = np.clip(median[:, None], 0.0, self.band)
         dev = np.abs(val - band)
         keep = max(1, int(trim * dev.shape[1]))
         return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
@@ -256,7 +274,7 @@ class _Outline:
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
     """The outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it), or None."""
-    grown = ndimage.binary_dilation(mask, iterations=reach)
+    grown = ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach  # = binary_dilation, reach times
     surface = fruit_surface(depth, mask, focal, region=grown)
     if surface is None:
         return None
