@@ -14,7 +14,8 @@ colour image's time (UTC nanoseconds) where the recording has one (bags), else n
 =============  ===========================  =====================================================
 column         type                         content
 =============  ===========================  =====================================================
-recording      string                       the recording's name (the input's file or folder name)
+recording      string                       the recording's name (the input's file or folder name; with
+                                            several inputs, its folder in the output, told apart)
 frame          string                       the frame's name
 stamp          timestamp[ns, UTC], null     the colour image's time
 id             int32                        the fruit's id in the frame (1, 2, ...)
@@ -53,6 +54,7 @@ __all__ = [
     "frame_rows",
     "read_frame_rows",
     "recording_name",
+    "write_run_tables",
     "write_tables",
 ]
 
@@ -282,7 +284,8 @@ def write_tables(
     output: str | Path, frames: Sequence[tuple[str, Path]], recording: str, *, root: Any = None
 ) -> dict[str, str]:
     """Write both tables from the ``detections.json`` of every frame ``(name, folder)`` that has one, in
-    order (the frames of the run that are done, by this run or by the one it resumed).
+    order (the frames of the run that are done, by this run or by the one it resumed): one recording's
+    :func:`write_run_tables`.
 
     Returns
     -------
@@ -294,14 +297,35 @@ def write_tables(
     OutputError
         When a table cannot be written (then neither is replaced).
     """
+    return write_run_tables(output, [(recording, frames)], root=root)
+
+
+def write_run_tables(
+    output: str | Path, recordings: Sequence[tuple[str, Sequence[tuple[str, Path]]]], *, root: Any = None
+) -> dict[str, str]:
+    """Write both tables over several recordings, each ``(recording, frames)`` with ``frames`` as in
+    :func:`write_tables` (``name`` there is how a frame is reported, e.g. ``rec/frame``); the rows keep
+    the recordings' order and each one's frame order.
+
+    Returns
+    -------
+    dict
+        Frames (by ``name``) whose ``detections.json`` could not be read into the table, with the reason.
+
+    Raises
+    ------
+    OutputError
+        When a table cannot be written (then neither is replaced).
+    """
     bad: dict[str, str] = {}
     with TableWriter(output, root=root) as table:
-        for name, folder in frames:
-            path = Path(folder) / "detections.json"
-            if not path.is_file():
-                continue
-            try:
-                table.add(*read_frame_rows(path, recording))
-            except SymfruitError as exc:
-                bad[name] = f"{exc} (left out of {TABLE_NAME})"
+        for recording, frames in recordings:
+            for name, folder in frames:
+                path = Path(folder) / "detections.json"
+                if not path.is_file():
+                    continue
+                try:
+                    table.add(*read_frame_rows(path, recording))
+                except SymfruitError as exc:
+                    bad[name] = f"{exc} (left out of {TABLE_NAME})"
     return bad
