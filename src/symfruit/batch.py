@@ -297,14 +297,20 @@ def plan_recordings(
 
 
 def list_recordings(
-    recordings: Sequence[Recording], exclude: Sequence[Path], report: BatchReport, *, keep_open: bool = False
+    recordings: Sequence[Recording],
+    exclude: Sequence[Path],
+    report: BatchReport,
+    *,
+    keep_open: bool = False,
+    inspect: Callable[[Recording, Any, list[Path], list[Path]], None] | None = None,
 ) -> tuple[list[tuple[Recording, list[str]]], list[Path], list[Path], Any]:
     """Open every recording to list its frames (names only, nothing decoded) and the files and folders the
     run must not write into: ``(listed, files, folders, held)``.
 
     With one recording, one that cannot be opened raises (as always); with several, it is recorded in
     ``report.failed_recordings`` and left out. ``keep_open``: ``held`` is the one recording still open, for
-    the run to read (else ``None``; every recording is closed again).
+    the run to read (else ``None``; every recording is closed again). ``inspect(recording, source, files,
+    folders)`` is called on each recording listed, while it is open.
     """
     listed: list[tuple[Recording, list[str]]] = []
     files: list[Path] = []
@@ -322,6 +328,8 @@ def list_recordings(
         try:
             more_files, more_folders = _source_inputs(src)
             names = src.names()
+            if inspect is not None:
+                inspect(rec, src, more_files, more_folders)
         except Exception as exc:
             src.close()
             if single:
