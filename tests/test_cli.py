@@ -445,3 +445,7 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     assert "lies inside the output folder" in capsys.readouterr().err
     assert main(["detect", *inputs[1:], "--output", str(tmp_path / "o3"), "--ros2-bag", str(tmp_path / "bag")]) == 2
     assert "give one input with it" in capsys.readouterr().err and not (tmp_path / "bag").exists()
+    pytest.importorskip("matplotlib")
+    assert main(["report", str(out)]) == 0
+    assert "report: 3 recording(s), 3 frames, 18 fruit seen" in capsys.readouterr().out
+    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in (out / "report" / "report.md").read_text()
