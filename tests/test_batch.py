@@ -404,6 +404,13 @@ def test_several_recordings_each_get_a_folder_even_when_they_share_a_name(tmp_pa
     assert len(rows) == 24 and len(set((r[0], r[1], r[2]) for r in rows)) == 24
     assert [(r[0], r[1]) for r in rows[::6]] == [(fa, "f1"), (fa, "f2"), (fb, "f1"), (fr, "row 3")]
     assert [r[2:] for r in rows if r[0] == fb] == [r[2:] for r in _rows(tmp_path / "single")]
+    import pyarrow.parquet as pq
+
+    from symfruit.season.table import recording_inputs
+
+    for table in ("detections.parquet", "frames.parquet"):  # which input each recording is, in the metadata
+        assert recording_inputs(pq.read_schema(out / table).metadata) == {fa: str(a), fb: str(b), fr: str(row)}
+    assert recording_inputs(pq.read_schema(tmp_path / "single" / "detections.parquet").metadata) == {}
 
 
 def test_one_input_in_a_list_keeps_the_layout_of_one_recording(tmp_path):

@@ -448,4 +448,8 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     pytest.importorskip("matplotlib")
     assert main(["report", str(out)]) == 0
     assert "report: 3 recording(s), 3 frames, 18 fruit seen" in capsys.readouterr().out
-    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in (out / "report" / "report.md").read_text()
+    report = (out / "report" / "report.md").read_text()
+    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in report and f"- `row2`: `{inputs[2]}`" in report
+    assert report.count("- `frames+") == 2 and f"`: `{inputs[0]}`" in report
+    for name in ("fruit_per_frame_by_recording.png", "diameters_by_recording.png"):
+        assert f"]({name})" in report and (out / "report" / name).is_file()

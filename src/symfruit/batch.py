@@ -185,7 +185,7 @@ def run_batch(
                     report.unprocessed += [r.key + n for r, later in listed[at + 1 :] for n in later]
                     break
         _tables(output, [(rec.name, [(rec.key + n, rec.folder / frame_folder_name(n, reserved)) for n in names])
-                         for rec, names in listed], out, report)  # fmt: skip
+                         for rec, names in listed], out, report, report.recordings)  # fmt: skip
         errors = _errors_record(report.failed, report.unprocessed, report.stopped, report.failed_recordings,
                                 recordings)  # fmt: skip
         try:
@@ -360,12 +360,12 @@ def _reason(exc: BaseException) -> str:
 
 
 def _tables(output: Path, recordings: list[tuple[str, list[tuple[str, Path]]]], out: OutputFolder,
-            report: Any) -> None:  # fmt: skip
+            report: Any, inputs: dict[str, str]) -> None:  # fmt: skip
     """Write the fruit tables of every frame done (:func:`symfruit.season.table.write_run_tables`; per recording
-    its name and its frames ``(key, folder)``) into ``report``'s run: a record that cannot be read back is a
-    failed frame, a table that cannot be written stops the run."""
+    its name and its frames ``(key, folder)``; ``inputs``: input path to recording name) into ``report``'s run:
+    a record that cannot be read back is a failed frame, a table that cannot be written stops the run."""
     try:
-        bad = write_run_tables(output, recordings, root=out)
+        bad = write_run_tables(output, recordings, root=out, inputs={v: k for k, v in inputs.items()})
     except SymfruitError as exc:
         report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
         return

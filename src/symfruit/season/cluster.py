@@ -362,7 +362,8 @@ def run_distributed(
                     bar.update(len(done_before))
                 frames = _Frames(jobs, bases, keys, raw, owner, target, direct)
                 try:
-                    with TableWriter(output, root=out) as table:
+                    named = {v: k for k, v in report.recordings.items()}
+                    with TableWriter(output, root=out, inputs=named) as table:
                         _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out)
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"

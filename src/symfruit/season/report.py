@@ -29,7 +29,7 @@ import numpy as np
 
 from ..core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from ..errors import FileFormatError, InputError, SymfruitError
-from .table import FRAMES_NAME, TABLE_NAME
+from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
 
 __all__ = [
     "DEFAULT_CLASSES_MM",
@@ -169,6 +169,7 @@ def write_report(
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
                                         "truncated", "error", "method"])  # fmt: skip
     frames = _read(output / FRAMES_NAME, ["recording", "frame", "fruit", "located"])
+    inputs = recording_inputs(fruit.schema.metadata)
     failed, failed_recordings = _errors(output)
     col = {name: fruit.column(name).to_numpy(zero_copy_only=False) for name in fruit.column_names}
     rec_f = frames.column("recording").to_numpy(zero_copy_only=False).astype(str)
@@ -211,7 +212,8 @@ def write_report(
             plt.close(fig)
             report.written.append(folder / name)
         text = _markdown(output, report, per_rec, classes_rows, diam, conf[finite_conf], reliable[finite_conf],
-                         methods, truncated_n=int((ok & truncated).sum()), by_rec=by_rec, classes=classes)  # fmt: skip
+                         methods, truncated_n=int((ok & truncated).sum()), by_rec=by_rec, classes=classes,
+                         inputs=inputs)  # fmt: skip
         with atomic_write(folder / "report.md", "w", root=out) as handle:
             handle.write(text)
         report.written.append(folder / "report.md")
@@ -300,7 +302,7 @@ def _recording_plots(plt: Any, by_rec: list[tuple[str, np.ndarray, np.ndarray]],
     shown = _shown(by_rec)
     more = f" (the {MAX_BARS} with most fruit of {len(by_rec)})" if len(shown) < len(by_rec) else ""
     labels = [str(r[0])[:24] for r in shown]
-    figs = []
+    figs: list[Any] = []
     for what, k in (("fruit located per frame", 1), ("diameter (mm)", 2)):
         fig, ax = plt.subplots(figsize=(9, 3.8))
         data = [np.asarray(r[k], float) for r in shown]
@@ -308,10 +310,8 @@ def _recording_plots(plt: Any, by_rec: list[tuple[str, np.ndarray, np.ndarray]],
         if filled:
             ax.boxplot([data[x] for x in filled], positions=filled, widths=0.6, showmeans=True,
                        medianprops={"color": "tab:red"})  # fmt: skip
-        for x in range(len(data)):
-            ax.annotate(f"n={len(data[x])}", (x, 0), xycoords=("data", "axes fraction"), xytext=(0, 2),
-                        textcoords="offset points", ha="center", fontsize=7, color="grey")  # fmt: skip
-        ax.set_xticks(range(len(shown)), labels, rotation=45 if len(shown) > 4 else 0,
+        ticks = [f"{label}\nn={len(x)}" for label, x in zip(labels, data, strict=True)]
+        ax.set_xticks(range(len(shown)), ticks, rotation=45 if len(shown) > 4 else 0,
                       ha="right" if len(shown) > 4 else "center", fontsize=8)  # fmt: skip
         ax.set_xlim(-0.7, len(shown) - 0.3)
         if k == 1:
@@ -330,7 +330,7 @@ def _recording_plots(plt: Any, by_rec: list[tuple[str, np.ndarray, np.ndarray]],
 def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[tuple[str, int]], diam: np.ndarray,
               conf: np.ndarray, reliable: np.ndarray, methods: list[str], *, truncated_n: int,
               by_rec: Sequence[tuple[str, np.ndarray, np.ndarray]] = (), classes: Sequence[float] = DEFAULT_CLASSES_MM,
-              ) -> str:  # fmt: skip
+              inputs: dict[str, str] | None = None) -> str:  # fmt: skip
     share = lambda n, d: f"{100.0 * n / d:.1f} %" if d else "-"  # noqa: E731
     lines = [
         f"# Fruit found in `{output}`",
@@ -360,6 +360,11 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
     for rec, n, with_fruit, seen, located, mean, most, med in per_rec:
         lines.append(f"| {rec} | {n:,} | {with_fruit:,} | {seen:,} | {located:,} | "
                      f"{'-' if not math.isfinite(mean) else f'{mean:.2f}'} | {most} | {_mm(med)} |")  # fmt: skip
+    shown = [rec for rec, *_ in per_rec if rec in (inputs or {})]
+    if shown:
+        lines += ["", "Each recording's input (a name with `+` and a hash is shared by several inputs or is not a "
+                  "plain file name):", ""]  # fmt: skip
+        lines += [f"- `{rec}`: `{(inputs or {})[rec]}`" for rec in shown]
     lines += ["", "![fruit per frame](fruit_per_frame.png)", "", "![fruit per recording](fruit_per_recording.png)", ""]
     if len(by_rec) > 1:
         lines += ["![fruit per frame, by recording](fruit_per_frame_by_recording.png)", ""]
