@@ -491,3 +491,23 @@ def test_recording_folders_never_take_the_runs_own_names(tmp_path):
     assert names[4] == "row2.bag" and plans[4].folder == tmp_path / "out" / "row2.bag"
     assert [p.key for p in plans] == [n + "/" for n in names]
     assert plan_recordings(inputs, tmp_path / "out") == plans  # the same inputs, the same names (--resume)
+
+
+def test_a_full_disk_in_one_recording_leaves_the_later_recordings_recorded_as_not_reached(tmp_path, monkeypatch):
+    from symfruit import OutputError
+
+    a = recording(tmp_path / "a", "f1", "f2", "f3")
+    b = recording(tmp_path / "b", "f1")
+    real = batch.write_detections
+
+    def write(folder, found, **kwargs):
+        if folder.parent.name == "a" and folder.name == "f2":
+            raise OutputError(f"{folder}/overlay.png: cannot write (No space left on device)", errno.ENOSPC)
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write)
+    report = run_batch([a, b], tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["a/f1"] and list(report.failed) == ["a/f2"] and report.unprocessed == ["a/f3", "b/f1"]
+    assert "stopped at frame a/f2: the output is full" in report.stopped
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    assert errors["unprocessed"] == ["a/f3", "b/f1"] and not (tmp_path / "out" / "b").exists()

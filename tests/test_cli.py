@@ -432,8 +432,9 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     out = tmp_path / "out"
     inputs = [str(tmp_path / "a" / "frames"), str(tmp_path / "b" / "frames"), str(tmp_path / "row2")]
     assert main(["detect", *inputs, "--output", str(out), "--method", "raw"]) == 0
-    text = capsys.readouterr().out
+    text, err = capsys.readouterr()
     assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 18 located, 0 failed" in text
+    assert "detect: 3/3" in err and "/1 " not in err  # one progress bar over every recording's frames
     assert text.count(" (its name is shared or not a plain file name)") == 2 and f"-> {out / 'frames+'}" in text
     assert "one folder per recording, in it one per frame" in text
     assert (out / "row2" / "f1" / "detections.json").is_file()
