@@ -369,3 +369,144 @@ def test_a_frame_that_fails_on_a_rerun_keeps_no_old_results(tmp_path):
     (rec / "f1" / "depth.png").write_bytes(b"broken")
     report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
     assert list(report.failed) == ["f1"] and sorted(p.name for p in (tmp_path / "out" / "f1").iterdir()) == []
+
+
+# --- several recordings in one run ---------------------------------------------------------------------------
+
+
+def _rows(out: Path) -> list[tuple]:
+    import pyarrow.parquet as pq
+
+    rows = pq.read_table(out / "detections.parquet").to_pylist()
+    return [(r["recording"], r["frame"], r["id"], r["centre_x"], r["size_x"]) for r in rows]
+
+
+def test_several_recordings_each_get_a_folder_even_when_they_share_a_name(tmp_path):
+    a = recording(tmp_path / "a" / "frames", "f1", "f2")
+    b = recording(tmp_path / "b" / "frames", "f1")
+    row = tmp_path / "row 3"  # one frame folder as a recording, its name not a plain file name
+    shutil.copytree(EXAMPLE_FRAME, row)
+    out = tmp_path / "out"
+    report = run_batch([a, b, row], out, method="raw", progress=False)
+    names = {str(a): "", str(b): "", str(row): ""}
+    names.update(report.recordings)
+    fa, fb, fr = names[str(a)], names[str(b)], names[str(row)]
+    assert fa.startswith("frames+") and fb.startswith("frames+") and fa != fb and fr.startswith("row_3+")
+    assert report.ok and report.done == [f"{fa}/f1", f"{fa}/f2", f"{fb}/f1", f"{fr}/row 3"] and report.fruits == 24
+    assert sorted(p.name for p in out.iterdir()) == sorted(
+        ["detections.parquet", "errors.json", "frames.parquet", fa, fb, fr])  # fmt: skip
+    assert sorted(p.name for p in (out / fa).iterdir()) == ["f1", "f2"]
+    assert sorted(p.name for p in (out / fr).iterdir()) == [frame_folder_name("row 3")]
+    single = run_batch(b, tmp_path / "single", method="raw", progress=False)  # the same frames, alone
+    assert single.done == ["f1"] and _fruits(out / fb) == _fruits(tmp_path / "single")
+    rows = _rows(out)
+    assert len(rows) == 24 and len(set((r[0], r[1], r[2]) for r in rows)) == 24
+    assert [(r[0], r[1]) for r in rows[::6]] == [(fa, "f1"), (fa, "f2"), (fb, "f1"), (fr, "row 3")]
+    assert [r[2:] for r in rows if r[0] == fb] == [r[2:] for r in _rows(tmp_path / "single")]
+    import pyarrow.parquet as pq
+
+    from symfruit.season.table import recording_inputs
+
+    for table in ("detections.parquet", "frames.parquet"):  # which input each recording is, in the metadata
+        assert recording_inputs(pq.read_schema(out / table).metadata) == {fa: str(a), fb: str(b), fr: str(row)}
+    assert recording_inputs(pq.read_schema(tmp_path / "single" / "detections.parquet").metadata) == {}
+
+
+def test_one_input_in_a_list_keeps_the_layout_of_one_recording(tmp_path):
+    rec = recording(tmp_path / "rec", "f1")
+    report = run_batch([rec], tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["f1"] and report.recordings == {} and (tmp_path / "out" / "f1" / "detections.json").is_file()
+    assert {r[0] for r in _rows(tmp_path / "out")} == {"rec"}
+
+
+def test_a_bad_recording_among_good_ones_is_recorded_and_the_run_goes_on(tmp_path):
+    good = recording(tmp_path / "good", "f1", "f2")
+    (good / "f2" / "depth.png").write_bytes(b"not a png")
+    other = recording(tmp_path / "other", "f1")
+    notes = tmp_path / "notes.txt"
+    notes.write_text("not a recording")
+    out = tmp_path / "out"
+    report = run_batch([good, notes, other], out, method="raw", progress=False)
+    assert report.done == ["good/f1", "other/f1"] and list(report.failed) == ["good/f2"] and not report.ok
+    assert list(report.failed_recordings) == [str(notes)] and "neither a frame folder" in report.failed_recordings[
+        str(notes)]  # fmt: skip
+    errors = json.loads((out / "errors.json").read_text())
+    assert [e["frame"] for e in errors["failed"]] == ["good/f2"] and "depth.png" in errors["failed"][0]["reason"]
+    assert [(e["recording"], e["input"]) for e in errors["recordings"]] == [("notes.txt", str(notes))]
+    assert {(r[0], r[1]) for r in _rows(out)} == {("good", "f1"), ("other", "f1")}
+    assert not (out / "notes.txt").exists()
+
+
+def test_resume_over_several_recordings_redoes_only_what_is_missing_and_keeps_each_fruit_once(tmp_path, monkeypatch):
+    a = recording(tmp_path / "a", "f1", "f2")
+    b = recording(tmp_path / "b", "f1")
+    out = tmp_path / "out"
+    first = run_batch([a, b], out, method="raw", progress=False)
+    whole = _rows(out)
+    assert first.ok and len(whole) == 18
+    shutil.rmtree(out / "a" / "f2")  # as a run killed before a/f2 and b/f1 would have left it, had b been done
+    reads = []
+    real = FolderSource.read
+
+    def read(self, index):
+        reads.append((self.path.name, self.names()[index]))
+        return real(self, index)
+
+    monkeypatch.setattr(FolderSource, "read", read)
+    again = run_batch([a, b], out, method="raw", resume=True, progress=False)
+    assert reads == [("a", "f2")] and again.done == ["a/f2"] and again.skipped == ["a/f1", "b/f1"] and again.ok
+    assert _rows(out) == whole  # every fruit once, in the same order
+
+
+def test_an_input_in_the_output_given_twice_or_missing_is_refused_before_anything_is_written(tmp_path):
+    from symfruit import FileFormatError, InputError, OutputError
+
+    rec = recording(tmp_path / "rec", "f1")
+    out = tmp_path / "out"
+    inside = recording(out / "old", "f1")
+    with pytest.raises(OutputError, match="this input is the output folder"):
+        run_batch([rec, out], out, method="raw", progress=False)
+    with pytest.raises(OutputError, match="this input lies inside the output folder"):
+        run_batch([rec, inside], out, method="raw", progress=False)
+    with pytest.raises(InputError, match="the same recording as"):
+        run_batch([rec, tmp_path / "." / "rec"], tmp_path / "o2", method="raw", progress=False)
+    with pytest.raises(FileFormatError, match="no such frame folder"):
+        run_batch([rec, tmp_path / "missing"], tmp_path / "o2", method="raw", progress=False)
+    with pytest.raises(InputError, match="no recording given"):
+        run_batch([], tmp_path / "o2", method="raw", progress=False)
+    assert sorted(p.name for p in out.iterdir()) == ["old"] and not (tmp_path / "o2").exists()
+
+
+def test_recording_folders_never_take_the_runs_own_names(tmp_path):
+    from symfruit.batch import plan_recordings
+
+    inputs = [tmp_path / p for p in ("data/errors.json", "data/report", "x/row1", "y/row1", "z/row2.bag")]
+    for path in inputs:
+        path.mkdir(parents=True)
+    plans = plan_recordings(inputs, tmp_path / "out")
+    names = [p.name for p in plans]
+    assert names[0].startswith("errors.json+") and names[1].startswith("report+")
+    assert names[2].startswith("row1+") and names[3].startswith("row1+") and names[2] != names[3]
+    assert names[4] == "row2.bag" and plans[4].folder == tmp_path / "out" / "row2.bag"
+    assert [p.key for p in plans] == [n + "/" for n in names]
+    assert plan_recordings(inputs, tmp_path / "out") == plans  # the same inputs, the same names (--resume)
+
+
+def test_a_full_disk_in_one_recording_leaves_the_later_recordings_recorded_as_not_reached(tmp_path, monkeypatch):
+    from symfruit import OutputError
+
+    a = recording(tmp_path / "a", "f1", "f2", "f3")
+    b = recording(tmp_path / "b", "f1")
+    real = batch.write_detections
+
+    def write(folder, found, **kwargs):
+        if folder.parent.name == "a" and folder.name == "f2":
+            raise OutputError(f"{folder}/overlay.png: cannot write (No space left on device)", errno.ENOSPC)
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write)
+    report = run_batch([a, b], tmp_path / "out", method="raw", progress=False)
+    assert report.done == ["a/f1"] and list(report.failed) == ["a/f2"] and report.unprocessed == ["a/f3", "b/f1"]
+    assert "stopped at frame a/f2: the output is full" in report.stopped
+    errors = json.loads((tmp_path / "out" / "errors.json").read_text())
+    assert errors["unprocessed"] == ["a/f3", "b/f1"] and not (tmp_path / "out" / "b").exists()

@@ -423,3 +423,34 @@ def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
     code = main(["evaluate", "--frames", str(out), "--methods", "raw,evidence", "--output", str(tmp_path / "r")])
     assert code == 0
     assert "2 true fruit" in capsys.readouterr().out
+
+
+def test_detect_takes_several_recordings(tmp_path, capsys):
+    for parent in ("a", "b"):
+        shutil.copytree(EXAMPLE_FRAME, tmp_path / parent / "frames" / "f1")
+    shutil.copytree(EXAMPLE_FRAME, tmp_path / "row2" / "f1")
+    out = tmp_path / "out"
+    inputs = [str(tmp_path / "a" / "frames"), str(tmp_path / "b" / "frames"), str(tmp_path / "row2")]
+    assert main(["detect", *inputs, "--output", str(out), "--method", "raw"]) == 0
+    text, err = capsys.readouterr()
+    assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 18 located, 0 failed" in text
+    assert "detect: 3/3" in err and "/1 " not in err  # one progress bar over every recording's frames
+    assert text.count(" (its name is shared or not a plain file name)") == 2 and f"-> {out / 'frames+'}" in text
+    assert "one folder per recording, in it one per frame" in text
+    assert (out / "row2" / "f1" / "detections.json").is_file()
+    (tmp_path / "empty").mkdir()
+    assert main(["detect", str(tmp_path / "row2"), str(tmp_path / "empty"), "--output", str(tmp_path / "o2"),
+                 "--method", "raw"]) == 1  # fmt: skip
+    assert f"recording not read {tmp_path / 'empty'}: " in capsys.readouterr().out
+    assert main(["detect", str(tmp_path / "row2"), str(out / "row2"), "--output", str(out)]) == 2
+    assert "lies inside the output folder" in capsys.readouterr().err
+    assert main(["detect", *inputs[1:], "--output", str(tmp_path / "o3"), "--ros2-bag", str(tmp_path / "bag")]) == 2
+    assert "give one input with it" in capsys.readouterr().err and not (tmp_path / "bag").exists()
+    pytest.importorskip("matplotlib")
+    assert main(["report", str(out)]) == 0
+    assert "report: 3 recording(s), 3 frames, 18 fruit seen" in capsys.readouterr().out
+    report = (out / "report" / "report.md").read_text()
+    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in report and f"- `row2`: `{inputs[2]}`" in report
+    assert report.count("- `frames+") == 2 and f"`: `{inputs[0]}`" in report
+    for name in ("fruit_per_frame_by_recording.png", "diameters_by_recording.png"):
+        assert f"]({name})" in report and (out / "report" / name).is_file()

@@ -24,7 +24,7 @@ import numpy as np
 
 from .core.limits import instance_labels
 from .detect import FrameDetections, detect
-from .errors import FileFormatError, InputError, SymfruitError
+from .errors import FileFormatError, InputError, OutputError, SymfruitError
 from .io.atomic import folder_fd
 from .io.frames import is_frame_folder
 from .io.images import image_suffixes
@@ -32,17 +32,20 @@ from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, uni
 from .io.sources import open_source
 from .methods import DEFAULT_METHOD
 from .progress import Progress
-from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_tables
+from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_run_tables
 from .segment import MaskSource, mask_source
 from .settings import Settings
 from .writers import remove_stale, write_detections
 
 __all__ = [
     "BatchReport",
+    "Recording",
     "SegmentReport",
     "SegmentedImage",
     "expand_images",
     "frame_folder_name",
+    "list_recordings",
+    "plan_recordings",
     "run_batch",
     "segment_images",
 ]
@@ -77,14 +80,18 @@ class BatchReport:
     stopped: str = ""
     #: Frames not reached because the batch stopped (a full disk): recorded in ``errors.json`` too.
     unprocessed: list[str] = field(default_factory=list)
+    #: Recordings (several inputs) that could not be opened, by input path, with the reason.
+    failed_recordings: dict[str, str] = field(default_factory=dict)
+    #: Several inputs: each input path's folder in the output (its ``recording`` in the tables).
+    recordings: dict[str, str] = field(default_factory=dict)
 
     @property
     def ok(self) -> bool:
-        return not self.failed and not self.stopped
+        return not self.failed and not self.stopped and not self.failed_recordings
 
 
 def run_batch(
-    source: str | Path,
+    source: str | Path | Sequence[str | Path],
     output: str | Path,
     *,
     masks: str = "auto",
@@ -101,6 +108,11 @@ def run_batch(
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
     fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.season.table`).
 
+    ``source`` is one recording (a frame folder, a folder of frames or a bag) or several: with one, each frame's
+    folder is ``output/<frame>``; with several, ``output/<recording>/<frame>`` (:func:`plan_recordings`), one
+    progress bar, ``errors.json`` and pair of tables over all of them, and a recording that cannot be opened is
+    recorded (``failed_recordings``, ``errors.json``) while the others go on.
+
     In this process, or on a Dask cluster (``pip install 'symfruit[cluster]'``): ``scheduler`` (an existing
     one's address, ``tcp://host:port``) or ``workers`` (a local cluster of that many worker processes),
     ``chunk`` frames per task (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there).
@@ -108,20 +120,23 @@ def run_batch(
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
     a frame whose every step succeeded; e.g. to append it to a ROS 2 bag
-    (:meth:`symfruit.ros.bag2.Ros2DetectionBag.write_frame`). Frames skipped by ``resume`` are not passed.
-    ``exclude``: further outputs of the run (a ROS 2 bag folder) that are no frames if they lie in the
-    source, and whose names no frame folder takes if they lie in ``output``.
+    (:meth:`symfruit.ros.bag2.Ros2DetectionBag.write_frame`); one recording only. Frames skipped by ``resume``
+    are not passed. ``exclude``: further outputs of the run (a ROS 2 bag folder) that are no frames if they lie
+    in the source, and whose names no frame folder takes if they lie in ``output``.
 
     The output folder is locked while the batch runs (a second batch on it is refused), is never an input
     folder, and nothing is written through a link out of it (:class:`symfruit.io.outputs.OutputFolder`).
     Every frame ends done or recorded in ``errors.json``: failed with its reason, or, after a full disk
-    stopped the batch, unprocessed.
+    stopped the batch, unprocessed. With several recordings a frame is named ``<recording>/<frame>`` in the
+    report and ``errors.json``.
 
     Raises
     ------
     SymfruitError
-        Only when the source itself cannot be opened or the output folder cannot be used (not writable, an
-        input folder, held by another run), or the cluster cannot be used; per-frame problems go into the report.
+        Only when the source itself cannot be opened (one recording; with several: an input that does not
+        exist, is given twice or lies in the output folder), the output folder cannot be used (not writable,
+        an input folder, held by another run), or the cluster cannot be used; per-frame problems go into the
+        report.
     """
     if scheduler is not None or workers is not None:
         from .season.cluster import run_distributed
@@ -134,50 +149,45 @@ def run_batch(
     settings = settings or Settings()
     output = Path(output)
     report = BatchReport()
-    src = open_source(source, exclude=[output, *map(Path, exclude)])
+    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
+    recordings = plan_recordings(source, output, reserved=reserved)
+    if len(recordings) > 1:
+        report.recordings = {str(r.source): r.name for r in recordings}
+    if on_frame is not None and len(recordings) > 1:
+        raise InputError("on_frame (--ros2-bag) takes the frames of one recording: give one input")
+    skip = [output, *map(Path, exclude)]
+    listed, files, folders, held = list_recordings(recordings, skip, report, keep_open=len(recordings) == 1)
     try:
-        files, folders = _source_inputs(src)
         if is_frame_folder(output):  # a frame left out of the recording as the output is still an input
             folders.append(output)
         out = OutputFolder(output, inputs=files, input_folders=folders).open()
     except BaseException:
-        src.close()
+        if held is not None:
+            held.close()
         raise
-    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
-    names: list[str] = []
+    keys = [rec.key + n for rec, names in listed for n in names]
     try:
-        names = src.names()
-        reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
-                       entries=len(names), root=out)  # fmt: skip
-        with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
-            for index, name in enumerate(names):
-                folder = output / frame_folder_name(name, reserved)
-                if resume and (folder / "detections.json").is_file():
-                    report.skipped.append(name)
-                    bar.update()
+        reserve_record(output / "errors.json", _errors_record({}, keys, "the batch is running (or was killed)",
+                       report.failed_recordings, recordings), entries=len(keys), root=out)  # fmt: skip
+        with Progress(len(keys), "detect", enabled=progress and len(keys) > 1) as bar:
+            for at, (rec, names) in enumerate(listed):
+                src = held if held is not None else _reopen(rec, skip, report)
+                if src is None:
+                    bar.update(len(names))
                     continue
-
-                def one_frame(index: int = index, folder: Path = folder) -> FrameDetections:
-                    found = detect(src.read(index), masks=masks, method=method, settings=settings)
-                    if on_frame is not None:
-                        on_frame(index, found)
-                    write_detections(folder, found, settings=settings)
-                    return found
-
-                clear = partial(_clear_frame, folder, out)
-                done, found, report.stopped = _guarded(one_frame, item=name, failed=report.failed, target=folder,
-                                                       at=f"frame {name}", cleanup=clear)  # fmt: skip
+                try:
+                    _run_recording(src, rec, names, masks, method, settings, resume, on_frame, reserved, report,
+                                   bar, out)  # fmt: skip
+                finally:
+                    src.close()
+                    held = None
                 if report.stopped:
-                    report.unprocessed = names[index + 1 :]
+                    report.unprocessed += [r.key + n for r, later in listed[at + 1 :] for n in later]
                     break
-                if done and found is not None:
-                    report.done.append(name)
-                    report.fruits += sum(d.result is not None for d in found.detections)
-                    report.failed_fruits += sum(d.result is None for d in found.detections)
-                bar.update()
-        _tables(output, [(n, output / frame_folder_name(n, reserved)) for n in names], recording_name(source), out,
-                report)  # fmt: skip
-        errors = _errors_record(report.failed, report.unprocessed, report.stopped)
+        _tables(output, [(rec.name, [(rec.key + n, rec.folder / frame_folder_name(n, reserved)) for n in names])
+                         for rec, names in listed], out, report, report.recordings)  # fmt: skip
+        errors = _errors_record(report.failed, report.unprocessed, report.stopped, report.failed_recordings,
+                                recordings)  # fmt: skip
         try:
             how = write_record(output / "errors.json", errors, root=out)
             if how and report.stopped:
@@ -185,16 +195,177 @@ def run_batch(
         except SymfruitError as exc:
             report.stopped = report.stopped or f"cannot write {output / 'errors.json'} ({exc})"
     finally:
-        src.close()
+        if held is not None:
+            held.close()
         out.close()
     return report
 
 
-def _tables(output: Path, frames: list[tuple[str, Path]], recording: str, out: OutputFolder, report: Any) -> None:
-    """Write the fruit tables of every frame done (:func:`symfruit.season.table.write_tables`) into ``report``'s
-    run: a record that cannot be read back is a failed frame, a table that cannot be written stops the run."""
+def _run_recording(
+    src: Any, rec: Recording, names: list[str], masks: str, method: str, settings: Settings, resume: bool,
+    on_frame: Callable[[int, FrameDetections], None] | None, reserved: Sequence[str], report: BatchReport,
+    bar: Progress, out: OutputFolder,
+) -> None:  # fmt: skip
+    """The frames ``names`` of one recording, in this process, each in its error boundary."""
+    now = src.names()
+    where = {n: i for i, n in enumerate(now)} if now != names else None  # changed since it was listed
+    for index, name in enumerate(names):
+        key = rec.key + name
+        folder = rec.folder / frame_folder_name(name, reserved)
+        if resume and (folder / "detections.json").is_file():
+            report.skipped.append(key)
+            bar.update()
+            continue
+
+        def one_frame(index: int = index, name: str = name, folder: Path = folder) -> FrameDetections:
+            if where is not None and name not in where:
+                raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
+            found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
+                           settings=settings)  # fmt: skip
+            if on_frame is not None:
+                on_frame(index, found)
+            write_detections(folder, found, settings=settings)
+            return found
+
+        clear = partial(_clear_frame, folder, out)
+        done, found, report.stopped = _guarded(one_frame, item=key, failed=report.failed, target=folder,
+                                               at=f"frame {key}", cleanup=clear)  # fmt: skip
+        if report.stopped:
+            report.unprocessed = [rec.key + n for n in names[index + 1 :]]
+            return
+        if done and found is not None:
+            report.done.append(key)
+            report.fruits += sum(d.result is not None for d in found.detections)
+            report.failed_fruits += sum(d.result is None for d in found.detections)
+        bar.update()
+
+
+@dataclass(frozen=True)
+class Recording:
+    """One input of a run and where its frames go: ``folder`` is the output folder itself with one input, else
+    ``OUT/<name>``; ``name`` fills the tables' ``recording`` column; ``key`` prefixes its frames' names in the
+    report and ``errors.json`` (``""`` with one input, else ``<name>/``)."""
+
+    source: Path
+    name: str
+    folder: Path
+    key: str = ""
+
+
+def plan_recordings(
+    sources: str | Path | Sequence[str | Path], output: str | Path, *, reserved: Sequence[str] = BATCH_FILES
+) -> list[Recording]:
+    """The recordings of a run on ``sources`` (one path or several) writing into ``output``.
+
+    One input keeps the layout of a one-recording run: frames straight under ``output``, the recording named
+    by its input (:func:`symfruit.season.table.recording_name`). Several inputs each get a folder
+    ``output/<name>``, named by :func:`symfruit.io.outputs.unique_names`: the input's file or folder name where
+    it is a safe name no other input shares (and not one of the run's own files, ``reserved``), else the
+    cleaned name, ``+`` and a hash of its full path; that name is also its ``recording`` in the tables. The
+    names depend on the inputs given, so a ``--resume`` gives the same ones.
+
+    Raises
+    ------
+    InputError
+        For no input, or an input given twice (the same file or folder).
+    FileFormatError
+        For an input that does not exist (checked before anything runs).
+    OutputError
+        For an input that is the output folder or lies inside it.
+    """
+    paths = [Path(sources)] if isinstance(sources, (str, os.PathLike)) else [Path(s) for s in sources]
+    if not paths:
+        raise InputError("no recording given: name one or more frame folders, folders of frames or bags")
+    output = Path(output)
+    if len(paths) == 1:
+        return [Recording(paths[0], recording_name(paths[0]), output)]
+    home = os.path.realpath(output)
+    seen: dict[str, Path] = {}
+    for path in paths:
+        if not os.path.lexists(path):
+            raise FileFormatError(f"{path}: no such frame folder, folder of frames or bag")
+        real = os.path.realpath(path)
+        if real == home or real.startswith(home.rstrip(os.sep) + os.sep):
+            where = "is" if real == home else "lies inside"
+            raise OutputError(f"{path}: this input {where} the output folder {output}; its frames would mix with "
+                              "the results: choose an output folder outside every input")  # fmt: skip
+        if real in seen:
+            raise InputError(f"{path}: the same recording as {seen[real]}; give each recording once")
+        seen[real] = path
+    names = unique_names([recording_name(p) for p in paths], list(seen), reserved=reserved)
+    return [Recording(p, n, output / n, n + "/") for p, n in zip(paths, names, strict=True)]
+
+
+def list_recordings(
+    recordings: Sequence[Recording],
+    exclude: Sequence[Path],
+    report: BatchReport,
+    *,
+    keep_open: bool = False,
+    inspect: Callable[[Recording, Any, list[Path], list[Path]], None] | None = None,
+) -> tuple[list[tuple[Recording, list[str]]], list[Path], list[Path], Any]:
+    """Open every recording to list its frames (names only, nothing decoded) and the files and folders the
+    run must not write into: ``(listed, files, folders, held)``.
+
+    With one recording, one that cannot be opened raises (as always); with several, it is recorded in
+    ``report.failed_recordings`` and left out. ``keep_open``: ``held`` is the one recording still open, for
+    the run to read (else ``None``; every recording is closed again). ``inspect(recording, source, files,
+    folders)`` is called on each recording listed, while it is open.
+    """
+    listed: list[tuple[Recording, list[str]]] = []
+    files: list[Path] = []
+    folders: list[Path] = []
+    held = None
+    single = len(recordings) == 1
+    for rec in recordings:
+        try:
+            src = open_source(rec.source, exclude=exclude)
+        except Exception as exc:
+            if single:
+                raise
+            report.failed_recordings[str(rec.source)] = _reason(exc)
+            continue
+        try:
+            more_files, more_folders = _source_inputs(src)
+            names = src.names()
+            if inspect is not None:
+                inspect(rec, src, more_files, more_folders)
+        except Exception as exc:
+            src.close()
+            if single:
+                raise
+            report.failed_recordings[str(rec.source)] = _reason(exc)
+            continue
+        files += more_files
+        folders += more_folders
+        listed.append((rec, names))
+        if keep_open and single:
+            held = src
+        else:
+            src.close()
+    return listed, files, folders, held
+
+
+def _reopen(rec: Recording, exclude: Sequence[Path], report: BatchReport) -> Any:
+    """A recording opened again to read its frames (``None``, recorded, when it cannot be any more)."""
     try:
-        bad = write_tables(output, frames, recording, root=out)
+        return open_source(rec.source, exclude=exclude)
+    except Exception as exc:
+        report.failed_recordings[str(rec.source)] = _reason(exc)
+        return None
+
+
+def _reason(exc: BaseException) -> str:
+    return str(exc) if isinstance(exc, SymfruitError) else f"{type(exc).__name__}: {exc}"
+
+
+def _tables(output: Path, recordings: list[tuple[str, list[tuple[str, Path]]]], out: OutputFolder,
+            report: Any, inputs: dict[str, str]) -> None:  # fmt: skip
+    """Write the fruit tables of every frame done (:func:`symfruit.season.table.write_run_tables`; per recording
+    its name and its frames ``(key, folder)``; ``inputs``: input path to recording name) into ``report``'s run:
+    a record that cannot be read back is a failed frame, a table that cannot be written stops the run."""
+    try:
+        bad = write_run_tables(output, recordings, root=out, inputs={v: k for k, v in inputs.items()})
     except SymfruitError as exc:
         report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
         return
@@ -205,12 +376,23 @@ def _tables(output: Path, frames: list[tuple[str, Path]], recording: str, out: O
                 kept.remove(name)
 
 
-def _errors_record(failed: dict[str, str], unprocessed: list[str], stopped: str) -> dict[str, Any]:
-    """``errors.json``: every failed frame with its reason, why the batch stopped, and (when it did) every
-    frame it did not reach."""
+def _errors_record(
+    failed: dict[str, str],
+    unprocessed: list[str],
+    stopped: str,
+    failed_recordings: dict[str, str] | None = None,
+    recordings: Sequence[Recording] = (),
+) -> dict[str, Any]:
+    """``errors.json``: every failed frame with its reason, why the batch stopped, (when it did) every frame
+    it did not reach, and (several inputs) every recording that could not be opened: its input and the
+    folder it would have had."""
     record: dict[str, Any] = {"failed": [{"frame": k, "reason": v} for k, v in failed.items()], "stopped": stopped}
     if unprocessed:
         record["unprocessed"] = unprocessed
+    if failed_recordings:
+        named = {str(r.source): r.name for r in recordings}
+        record["recordings"] = [{"recording": named.get(k, k), "input": k, "reason": v}
+                                for k, v in failed_recordings.items()]  # fmt: skip
     return record
 
 

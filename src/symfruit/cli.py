@@ -124,8 +124,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
 
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("detect", help="locate the fruit of RGB-D frames: a frame folder, a folder of frames or a bag")
-    p.add_argument("input", type=Path, help="frame folder (color.png, depth.png, camera.json), folder of them, or bag")
+    p = sub.add_parser("detect", help="locate the fruit of RGB-D frames: frame folders, folders of frames or bags")
+    p.add_argument("inputs", nargs="+", type=Path, metavar="INPUT",
+                   help="a recording: frame folder (color.png, depth.png, camera.json), folder of them, or bag; "
+                   "several: each recording's frames go into OUT/<recording>/")  # fmt: skip
     p.add_argument(
         "--masks",
         default="auto",
@@ -133,7 +135,8 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
         "or onnx:MODEL.onnx",
     )
     p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
-    p.add_argument("--output", type=Path, required=True, help="output folder (one sub-folder per frame)")
+    p.add_argument("--output", type=Path, required=True,
+                   help="output folder (one sub-folder per frame; with several inputs one per recording)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
@@ -538,8 +541,11 @@ def _detect(args: argparse.Namespace) -> int:
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
                          "--scheduler or --workers")  # fmt: skip
+    if len(args.inputs) > 1 and args.ros2_bag is not None:
+        raise InputError("--ros2-bag holds the frames of one recording: give one input with it")
     with _ros2_bag(args) as bag:
-        report = run_batch(args.input, args.output, masks=args.masks, method=_method(args), settings=settings,
+        source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
+        report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
                            workers=args.workers, chunk=args.chunk)  # fmt: skip
@@ -547,11 +553,17 @@ def _detect(args: argparse.Namespace) -> int:
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
         print(f"  failed {name}: {reason}")
+    renamed = {k: v for k, v in report.recordings.items() if v != Path(k).absolute().name}
+    for given, folder in renamed.items():
+        print(f"  recording {given} -> {args.output / folder} (its name is shared or not a plain file name)")
+    for name, reason in report.failed_recordings.items():
+        print(f"  recording not read {name}: {reason}")
     if report.unprocessed:
         print(f"  not processed: {len(report.unprocessed)} frames (listed in errors.json)")
     if report.stopped:
         print(f"symfruit: {report.stopped}", file=sys.stderr)
-    print(f"results: {args.output} (one folder per frame; every fruit in detections.parquet)")
+    per = "per frame" if len(args.inputs) == 1 else "per recording, in it one per frame"
+    print(f"results: {args.output} (one folder {per}; every fruit in detections.parquet)")
     if bag is not None:
         print(f"ROS 2 bag: {args.ros2_bag} ({bag.count} frames on {bag.topic})")
     return 0 if report.ok else 1

@@ -205,3 +205,31 @@ def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
     (moved,) = detect_part(job, Part((0,), ("another_00000_1",), (str(out / "x"),)))
     assert moved.status == "failed" and "differs from the one the client listed" in moved.reason
     assert forget("bag") == 1 and forget("bag") == 0  # the bag was opened once and is closed at the end
+
+
+def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(recording, tmp_path):
+    """Two recordings that share a name and one that cannot be opened: the cluster's folders, tables and
+    errors.json are the serial run's; a task never mixes recordings (three frames of one, chunk 2); --resume
+    redoes what is missing and keeps each fruit once."""
+    a, b = tmp_path / "a" / "rec", tmp_path / "b" / "rec"
+    for k in range(3):
+        shutil.copytree(recording / f"scene_{k:05d}", a / f"scene_{k:05d}")
+    shutil.copytree(recording / "scene_00003", b / "scene_00003")
+    bad = tmp_path / "bad.txt"
+    bad.write_text("no recording")
+    inputs = [a, bad, b]
+    serial = run_batch(inputs, tmp_path / "serial", method="raw", progress=False)
+    out = tmp_path / "out"
+    report = run_distributed(inputs, out, workers=2, chunk=2, method="raw", progress=False)
+    assert report.recordings == serial.recordings and report.done == serial.done and len(report.done) == 4
+    assert report.failed_recordings == serial.failed_recordings and list(report.failed_recordings) == [str(bad)]
+    for name in (report.recordings[str(a)], report.recordings[str(b)]):
+        assert name.startswith("rec+") and _fruits(out / name) == _fruits(tmp_path / "serial" / name)
+    rows = pq.read_table(out / "detections.parquet").to_pylist()
+    assert rows == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist() and len(rows) == 24
+    errors = json.loads((out / "errors.json").read_text())
+    assert errors == json.loads((tmp_path / "serial" / "errors.json").read_text()) and errors["recordings"]
+    shutil.rmtree(out / report.recordings[str(a)] / "scene_00001")
+    again = run_distributed(inputs, out, workers=1, chunk=2, method="raw", resume=True, progress=False)
+    assert again.done == [f"{report.recordings[str(a)]}/scene_00001"] and len(again.skipped) == 3
+    assert pq.read_table(out / "detections.parquet").to_pylist() == rows

@@ -7,7 +7,7 @@ from PIL import Image
 
 from symfruit import FileFormatError, InputError
 from symfruit.cli import main
-from symfruit.season.report import PLOTS, diameters_mm, size_classes, write_report
+from symfruit.season.report import PER_RECORDING_PLOTS, PLOTS, diameters_mm, size_classes, write_report
 from symfruit.season.table import TableWriter
 
 
@@ -48,11 +48,11 @@ def test_the_report_counts_sizes_and_classes_as_a_reader_would(run):
     assert "| < 18 mm | 1 | 20.0 % |" in text and "| 18-25 mm | 2 | 40.0 % |" in text
     assert "| >= 25 mm | 2 | 40.0 % |" in text and "1 frame(s) could not be processed" in text
     assert "5 fruit sized: median diameter 24.0 mm" in text
-    for name in PLOTS:
+    for name in (*PLOTS, *PER_RECORDING_PLOTS):
         assert f"]({name})" in text
         with Image.open(run / "report" / name) as img:
             assert img.format == "PNG" and img.size[0] >= 600
-    assert sorted(p.name for p in (run / "report").iterdir()) == sorted([*PLOTS, "report.md"])
+    assert sorted(p.name for p in (run / "report").iterdir()) == sorted([*PLOTS, *PER_RECORDING_PLOTS, "report.md"])
 
 
 def test_diameters_and_classes():
@@ -106,3 +106,24 @@ def test_without_matplotlib_the_message_names_the_extra(run, monkeypatch):
     monkeypatch.setattr(builtins, "__import__", no_matplotlib)
     with pytest.raises(InputError, match=r"pip install 'symfruit\[plot\]'"):
         write_report(run)
+
+
+def test_each_recording_gets_its_sizes_and_a_run_of_one_recording_no_boxes(run, tmp_path):
+    text = write_report(run).folder.joinpath("report.md").read_text()
+    assert "| recording | fruit sized | 10 % below (mm) | median (mm) | 10 % above (mm) | < 18 mm | 18-25 mm | " in text
+    assert "| row1 | 3 | 16.8 | 20.0 | 23.2 | 1 | 2 | 0 |" in text  # diameters 16, 20, 24 mm
+    assert "| row2 | 2 | 31.0 | 35.0 | 39.0 | 0 | 0 | 2 |" in text  # 30, 40 mm
+    (run / "errors.json").write_text('{"failed": [], "stopped": "", "recordings": [{"recording": "x", "input": "x", '
+                                     '"reason": "not a bag"}]}')  # fmt: skip
+    report = write_report(run, folder=tmp_path / "again")
+    assert report.failed_recordings == 1 and report.failed_frames == 0
+    assert "1 recording(s) could not be read (see `errors.json`)" in (tmp_path / "again" / "report.md").read_text()
+    from symfruit.season.table import frame_rows
+
+    one = tmp_path / "one"
+    one.mkdir()
+    with TableWriter(one) as table:
+        table.add(*frame_rows(_record("a", [(0.02, 0.02, 0.02)]), "row1"))
+    single = write_report(one)
+    assert sorted(p.name for p in single.folder.iterdir()) == sorted([*PLOTS, "report.md"])
+    assert "Sizes per recording" not in (single.folder / "report.md").read_text()

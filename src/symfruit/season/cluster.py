@@ -42,12 +42,14 @@ from typing import Any
 from ..batch import (
     BATCH_FILES,
     BatchReport,
+    Recording,
     _clear_frame,
     _errors_record,
     _first_part,
     _guarded,
-    _source_inputs,
     frame_folder_name,
+    list_recordings,
+    plan_recordings,
 )
 from ..detect import detect
 from ..errors import InputError, OutputError, SymfruitError
@@ -58,7 +60,7 @@ from ..methods import DEFAULT_METHOD
 from ..progress import Progress
 from ..settings import Settings
 from ..writers import detections_record, write_detections
-from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows, recording_name
+from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows
 
 __all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "require_distributed", "run_distributed"]
 
@@ -111,12 +113,14 @@ class Job:
 @dataclass(frozen=True)
 class Part:
     """One task: frames by index and name, each frame's output folder, and (a folder of frames) the frame
-    folders to read; else the worker opens the recording and reads the indices."""
+    folders to read; else the worker opens the recording and reads the indices. ``base``: where the
+    recording's frames start in the run's list of frames (several recordings), for the client."""
 
     indices: tuple[int, ...]
     names: tuple[str, ...]
     folders: tuple[str, ...]
     frames: tuple[str, ...] | None = None
+    base: int = 0
 
 
 @dataclass(frozen=True)
@@ -135,7 +139,8 @@ class Outcome:
 
 # --- the worker's side ---------------------------------------------------------------------------------------
 
-#: Recordings a worker has open, per (run, recording, thread): a bag is indexed once per worker thread.
+#: Recordings a worker has open, per (run, recording, thread): a bag is indexed once per worker thread (again
+#: when a thread moves on to another recording and back).
 _OPEN: dict[tuple[str, str, int], tuple[Any, list[str]]] = {}
 _OPEN_LOCK = threading.Lock()
 
@@ -147,8 +152,8 @@ def _opened(job: Job) -> tuple[Any, list[str]]:
         if key in _OPEN:
             return _OPEN[key]
     stale = []
-    with _OPEN_LOCK:
-        for other in [k for k in _OPEN if k[0] != job.run and k[2] == key[2]]:
+    with _OPEN_LOCK:  # one recording open per worker thread: a run over many bags holds few files open
+        for other in [k for k in _OPEN if k != key and k[2] == key[2]]:
             stale.append(_OPEN.pop(other)[0])
     for src in stale:
         with contextlib.suppress(Exception):
@@ -262,14 +267,8 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
         yield client
 
 
-def _parts(todo: Sequence[int], chunk: int) -> Iterator[list[int]]:
-    """Runs of up to ``chunk`` frame indices, in order."""
-    for i in range(0, len(todo), chunk):
-        yield list(todo[i : i + chunk])
-
-
 def run_distributed(
-    source: str | Path,
+    source: str | Path | Sequence[str | Path],
     output: str | Path,
     *,
     scheduler: str | None = None,
@@ -284,13 +283,16 @@ def run_distributed(
     max_ahead: int = MAX_AHEAD,
 ) -> BatchReport:
     """:func:`symfruit.batch.run_batch` on a Dask cluster: an existing one (``scheduler``, its address) or a
-    local one of ``workers`` processes; ``chunk`` frames per task (see the module docstring).
+    local one of ``workers`` processes; ``chunk`` frames per task (see the module docstring). ``source``: one
+    recording or several, laid out as :func:`symfruit.batch.run_batch` does (a task holds frames of one
+    recording).
 
     Raises
     ------
     SymfruitError
-        When the recording cannot be opened, the output folder cannot be used, dask.distributed is missing
-        or the scheduler cannot be reached; per-frame problems go into the report.
+        When the recording cannot be opened (one; several: as :func:`symfruit.batch.plan_recordings` says),
+        the output folder cannot be used, dask.distributed is missing or the scheduler cannot be reached;
+        per-frame problems go into the report.
     """
     if (scheduler is None) == (workers is None):
         raise InputError("give either a scheduler address or a number of local workers")
@@ -302,50 +304,75 @@ def run_distributed(
     settings = settings or Settings()
     output = Path(output)
     report = BatchReport()
-    src = open_source(source, exclude=[output, *map(Path, exclude)])
-    try:
-        files, folders = _source_inputs(src)
-        if is_frame_folder(output):
-            folders.append(output)
-        names = src.names()
+    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
+    recordings = plan_recordings(source, output, reserved=reserved)
+    if len(recordings) > 1:
+        report.recordings = {str(r.source): r.name for r in recordings}
+    skip = [output, *map(Path, exclude)]
+    seen: dict[str, tuple[list[str] | None, list[Path], list[Path]]] = {}
+
+    def inspect(rec: Recording, src: Any, files: list[Path], folders: list[Path]) -> None:
+        """What the workers need of a recording: its frame folders to read directly (none for a bag), and the
+        files and folders they must not write into."""
         direct = [str(Path(p).absolute()) for p in src.folders()] if isinstance(src, FolderSource) else None
         if isinstance(src, FrameFolderSource):
             direct = [str(Path(src.path).absolute())]
-    finally:
-        src.close()  # the client decodes no frame
+        seen[rec.name] = (direct, files, folders)
+
+    listed, files, folders, _ = list_recordings(recordings, skip, report, inspect=inspect)  # the client decodes none
+    if is_frame_folder(output):
+        folders.append(output)
     out = OutputFolder(output, inputs=files, input_folders=folders).open()
-    reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
-    job = Job(run=uuid.uuid4().hex, source=str(Path(source).absolute()), shown=str(Path(source)),
-              output=str(output.absolute()), recording=recording_name(source),
-              inputs=tuple(os.path.realpath(p) for p in files),
-              input_folders=tuple(os.path.realpath(p) for p in folders),
-              exclude=tuple(str(Path(p).absolute()) for p in [output, *exclude]), masks=masks, method=method,
-              settings=settings)  # fmt: skip
+    run = uuid.uuid4().hex
+    tops = [os.path.realpath(r.source) for r in recordings]
+    jobs: list[Job] = []
+    keys: list[str] = []
+    raw: list[str] = []
+    owner: list[int] = []
+    target: list[Path] = []
+    direct: list[str | None] = []
+    bases: list[int] = []
+    for rec, names in listed:
+        rec_direct, rec_files, rec_folders = seen[rec.name]
+        if is_frame_folder(output):
+            rec_folders = [*rec_folders, output]
+        jobs.append(Job(run=run, source=str(rec.source.absolute()), shown=str(rec.source),
+                        output=str(output.absolute()), recording=rec.name,
+                        inputs=tuple(dict.fromkeys([*(os.path.realpath(p) for p in rec_files), *tops])),
+                        input_folders=tuple(dict.fromkeys([*(os.path.realpath(p) for p in rec_folders), *tops])),
+                        exclude=tuple(str(Path(p).absolute()) for p in skip), masks=masks, method=method,
+                        settings=settings))  # fmt: skip
+        bases.append(len(keys))
+        keys += [rec.key + n for n in names]
+        raw += names
+        owner += [len(jobs) - 1] * len(names)
+        target += [rec.folder / frame_folder_name(n, reserved) for n in names]
+        direct += rec_direct if rec_direct is not None else [None] * len(names)
     try:
-        target = [output / frame_folder_name(n, reserved) for n in names]
-        done_before = {i for i in range(len(names)) if resume and (target[i] / "detections.json").is_file()}
-        todo = [i for i in range(len(names)) if i not in done_before]
+        done_before = {i for i in range(len(keys)) if resume and (target[i] / "detections.json").is_file()}
+        todo = [i for i in range(len(keys)) if i not in done_before]
         with contextlib.ExitStack() as stack:
             client = stack.enter_context(_client(scheduler, workers)) if todo else None
             if client is not None:
-                _preflight(client, job)
-            reserve_record(output / "errors.json", _errors_record({}, names, "the batch is running (or was killed)"),
-                           entries=len(names), root=out)  # fmt: skip
-            with Progress(len(names), "detect", enabled=progress and len(names) > 1) as bar:
+                _preflight(client, jobs)
+            reserve_record(output / "errors.json", _errors_record({}, keys, "the batch is running (or was killed)",
+                           report.failed_recordings, recordings), entries=len(keys), root=out)  # fmt: skip
+            with Progress(len(keys), "detect", enabled=progress and len(keys) > 1) as bar:
                 if done_before:
                     bar.update(len(done_before))
+                frames = _Frames(jobs, bases, keys, raw, owner, target, direct)
                 try:
-                    with TableWriter(output, root=out) as table:
-                        _run(job, client, names, target, direct, todo, done_before, chunk, max_ahead, report, table,
-                             bar, out)  # fmt: skip
+                    named = {v: k for k, v in report.recordings.items()}
+                    with TableWriter(output, root=out, inputs=named) as table:
+                        _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out)
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
             if client is not None:
                 with contextlib.suppress(Exception):
-                    client.run(forget, job.run)
+                    client.run(forget, run)
         try:
-            how = write_record(output / "errors.json",
-                               _errors_record(report.failed, report.unprocessed, report.stopped), root=out)  # fmt: skip
+            how = write_record(output / "errors.json", _errors_record(report.failed, report.unprocessed,
+                               report.stopped, report.failed_recordings, recordings), root=out)  # fmt: skip
             if how and report.stopped:
                 report.stopped += f"; errors.json {how}"
         except SymfruitError as exc:
@@ -355,36 +382,64 @@ def run_distributed(
     return report
 
 
+@dataclass(frozen=True)
+class _Frames:
+    """Every frame of a run, over its recordings in order: its key in the report (``rec/frame`` with several
+    recordings), its name in its recording, its recording's :class:`Job` (``owner``, an index into ``jobs``),
+    its output folder, and its frame folder when a worker reads it directly (else ``None``: a bag);
+    ``bases``: where each recording's frames start."""
+
+    jobs: list[Job]
+    bases: list[int]
+    keys: list[str]
+    raw: list[str]
+    owner: list[int]
+    target: list[Path]
+    direct: list[str | None]
+
+
+def _parts(todo: Sequence[int], chunk: int, owner: Sequence[int] | None = None) -> Iterator[list[int]]:
+    """Runs of up to ``chunk`` frame indices, in order, each of one recording (``owner``)."""
+    run: list[int] = []
+    for i in todo:
+        if run and (len(run) == chunk or (owner is not None and owner[i] != owner[run[0]])):
+            yield run
+            run = []
+        run.append(i)
+    if run:
+        yield run
+
+
 def _run(
-    job: Job, client: Any, names: list[str], target: list[Path], direct: list[str] | None, todo: list[int],
-    done_before: set[int], chunk: int, max_ahead: int, report: BatchReport, table: TableWriter, bar: Progress,
-    out: OutputFolder,
+    frames: _Frames, client: Any, todo: list[int], done_before: set[int], chunk: int, max_ahead: int,
+    report: BatchReport, table: TableWriter, bar: Progress, out: OutputFolder,
 ) -> None:  # fmt: skip
     """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
     and write the tables in frame order."""
-    results: dict[int, Outcome] = {}  # outcomes not yet in the tables, by frame index
+    keys, target = frames.keys, frames.target
+    results: dict[int, Outcome] = {}  # outcomes not yet in the tables, by frame index (in the run)
     state = {"flushed": 0, "sent": 0, "stopped": False}  # frames below "flushed" are in the report and tables
 
     def flush() -> None:
-        while state["flushed"] < len(names):
+        while state["flushed"] < len(keys):
             i = state["flushed"]
             if i in done_before:
                 try:
-                    table.add(*read_frame_rows(target[i] / "detections.json", job.recording))
-                    report.skipped.append(names[i])
+                    table.add(*read_frame_rows(target[i] / "detections.json", frames.jobs[frames.owner[i]].recording))
+                    report.skipped.append(keys[i])
                 except SymfruitError as exc:
-                    report.failed[names[i]] = f"{exc} (left out of {TABLE_NAME})"
+                    report.failed[keys[i]] = f"{exc} (left out of {TABLE_NAME})"
             elif i in results:
-                _record(results.pop(i), report, table)
+                _record(results.pop(i), keys[i], report, table)
             elif i >= state["sent"] and state["stopped"]:
-                report.unprocessed.append(names[i])
+                report.unprocessed.append(keys[i])
             else:
                 return  # still running
             state["flushed"] += 1
 
     if client is not None:
         distributed = require_distributed()
-        parts = _parts(todo, chunk)
+        parts = _parts(todo, chunk, frames.owner)
         pending = distributed.as_completed()
         part_of: dict[Any, Part] = {}
         window = {"tasks": 0, "at": -1.0}
@@ -401,12 +456,17 @@ def _run(
             while not state["stopped"] and room():
                 indices = next(parts, None)
                 if indices is None:
-                    state["sent"] = len(names)
+                    state["sent"] = len(keys)
                     return
-                part = Part(tuple(indices), tuple(names[i] for i in indices),
+                j = frames.owner[indices[0]]
+                base = frames.bases[j]
+                direct = frames.direct[indices[0]]
+                part = Part(tuple(i - base for i in indices), tuple(frames.raw[i] for i in indices),
                             tuple(str(target[i].absolute()) for i in indices),
-                            None if direct is None else tuple(direct[i] for i in indices))  # fmt: skip
-                future = client.submit(detect_part, job, part, key=f"symfruit-detect-{job.run}-{indices[0]}")
+                            None if direct is None else tuple(str(frames.direct[i]) for i in indices),
+                            base)  # fmt: skip
+                future = client.submit(detect_part, frames.jobs[j], part,
+                                       key=f"symfruit-detect-{frames.jobs[j].run}-{indices[0]}")  # fmt: skip
                 part_of[future.key] = part
                 pending.add(future)
                 state["sent"] = indices[-1] + 1
@@ -417,9 +477,10 @@ def _run(
             outcomes, whole = _outcomes(future, part, distributed)
             future.release()
             for o in outcomes:
-                results[o.index] = o
+                i = part.base + o.index
+                results[i] = o
                 if whole:  # the task died as a whole: what its attempts left is no result
-                    _clear_frame(target[o.index], out)
+                    _clear_frame(target[i], out)
                 if o.stop and not state["stopped"]:
                     state["stopped"] = True
                     report.stopped = o.stop
@@ -430,33 +491,33 @@ def _run(
     flush()
 
 
-def _record(o: Outcome, report: BatchReport, table: TableWriter) -> None:
-    """Put one frame's outcome into the report and its rows into the tables."""
+def _record(o: Outcome, key: str, report: BatchReport, table: TableWriter) -> None:
+    """Put one frame's outcome into the report (as ``key``) and its rows into the tables."""
     if o.status == "done" and o.frame is not None:
         table.add(o.frame, o.fruits)
-        report.done.append(o.name)
+        report.done.append(key)
         report.fruits += sum(f["error"] is None for f in o.fruits)
         report.failed_fruits += sum(f["error"] is not None for f in o.fruits)
     elif o.status == "failed":
-        report.failed[o.name] = o.reason
+        report.failed[key] = o.reason
     else:
-        report.unprocessed.append(o.name)
+        report.unprocessed.append(key)
 
 
-def _worker_check(source: str, output: str) -> dict[str, Any]:
-    """Run on every worker before the first task: its symfruit version and whether it sees the run's paths."""
+def _worker_check(sources: Sequence[str], output: str) -> dict[str, Any]:
+    """Run on every worker before the first task: its symfruit version and the run's paths it does not see."""
     from .. import __version__
 
-    return {"version": __version__, "source": os.path.exists(source), "output": os.path.isdir(output)}
+    return {"version": __version__, "missing": [p for p in [*sources, output] if not os.path.exists(p)]}
 
 
-def _preflight(client: Any, job: Job) -> None:
-    """Refuse a cluster whose workers cannot run this job: symfruit missing or of another version, or the
+def _preflight(client: Any, jobs: Sequence[Job]) -> None:
+    """Refuse a cluster whose workers cannot run these jobs: symfruit missing or of another version, or a
     recording or the output folder not at the same path on a worker."""
     from .. import __version__
 
     try:
-        checks = client.run(_worker_check, job.source, job.output)
+        checks = client.run(_worker_check, [job.source for job in jobs], jobs[0].output)
     except Exception as exc:  # unpickling symfruit's function fails on a worker without symfruit
         raise InputError(f"the Dask workers cannot run symfruit ({type(exc).__name__}: {exc}); install "
                          f"'{EXTRA}' where the workers run") from None  # fmt: skip
@@ -464,13 +525,11 @@ def _preflight(client: Any, job: Job) -> None:
         if check["version"] != __version__:
             raise InputError(f"Dask worker {worker} runs symfruit {check['version']}, this client {__version__}: "
                              "install the same version on both")  # fmt: skip
-        for what in ("source", "output"):
-            if not check[what]:
-                path = job.source if what == "source" else job.output
-                raise InputError(
-                    f"{path}: Dask worker {worker} does not see it; workers must see the recording "
-                    "and the output folder at the same paths as this client (a shared file system)"
-                )
+        for path in check["missing"][:1]:
+            raise InputError(
+                f"{path}: Dask worker {worker} does not see it; workers must see the recording "
+                "and the output folder at the same paths as this client (a shared file system)"
+            )
 
 
 def _outcomes(future: Any, part: Part, distributed: Any) -> tuple[list[Outcome], bool]:

@@ -1,5 +1,7 @@
 """``symfruit report OUT``: what a ``detect`` run found, for someone who never ran it: ``report.md`` and PNG plots
 (fruit per frame and per recording, fruit diameters against the size classes fruit is sorted by, confidence).
+A run over several recordings (``detect A B ... --output OUT``) is also reported recording by recording: fruit
+per frame and the diameters of each, with its size classes.
 
 It reads the run's tables (``OUT/detections.parquet``, ``OUT/frames.parquet``: :mod:`symfruit.season.table`) and
 ``OUT/errors.json``, each checked against a bound before it is read, and writes every file atomically into
@@ -27,9 +29,17 @@ import numpy as np
 
 from ..core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from ..errors import FileFormatError, InputError, SymfruitError
-from .table import FRAMES_NAME, TABLE_NAME
+from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
 
-__all__ = ["DEFAULT_CLASSES_MM", "PLOTS", "Report", "diameters_mm", "size_classes", "write_report"]
+__all__ = [
+    "DEFAULT_CLASSES_MM",
+    "PER_RECORDING_PLOTS",
+    "PLOTS",
+    "Report",
+    "diameters_mm",
+    "size_classes",
+    "write_report",
+]
 
 #: Size class edges (mm) by default: the EU marketing standard's minimum diameters for strawberries.
 DEFAULT_CLASSES_MM = (18.0, 25.0)
@@ -40,6 +50,8 @@ MAX_REPORT_BYTES = MAX_TABLE_BYTES
 MAX_BARS = 60
 #: The plots, in the order report.md shows them.
 PLOTS = ("fruit_per_frame.png", "fruit_per_recording.png", "diameters.png", "confidence.png")
+#: The plots added when the run holds more than one recording: one box per recording.
+PER_RECORDING_PLOTS = ("fruit_per_frame_by_recording.png", "diameters_by_recording.png")
 
 
 @dataclass
@@ -53,6 +65,8 @@ class Report:
     sized: int = 0
     recordings: int = 0
     failed_frames: int = 0
+    #: Recordings the run could not read (``errors.json``).
+    failed_recordings: int = 0
     written: list[Path] = field(default_factory=list)
 
 
@@ -107,19 +121,20 @@ def size_classes(diameters: np.ndarray, edges: Sequence[float]) -> list[tuple[st
     return list(zip(labels, (int(c) for c in counts), strict=True))
 
 
-def _errors(output: Path) -> int:
-    """Frames ``errors.json`` lists as failed or not reached (0 without the file)."""
+def _errors(output: Path) -> tuple[int, int]:
+    """Frames ``errors.json`` lists as failed or not reached, and recordings it lists as not read (0, 0 without
+    the file)."""
     from ..io.text import read_structured
     from .table import MAX_RECORD_BYTES
 
     path = output / "errors.json"
     if not path.is_file():
-        return 0
+        return 0, 0
     data = read_structured(path, what="errors.json", max_bytes=MAX_RECORD_BYTES)
     if not isinstance(data, dict):
         raise FileFormatError(f"{path}: not a symfruit errors.json")
-    failed, unprocessed = data.get("failed", []), data.get("unprocessed", [])
-    return (len(failed) if isinstance(failed, list) else 0) + (len(unprocessed) if isinstance(unprocessed, list) else 0)
+    count = lambda key: len(data[key]) if isinstance(data.get(key), list) else 0  # noqa: E731
+    return count("failed") + count("unprocessed"), count("recordings")
 
 
 def _mm(value: float) -> str:
@@ -154,7 +169,8 @@ def write_report(
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
                                         "truncated", "error", "method"])  # fmt: skip
     frames = _read(output / FRAMES_NAME, ["recording", "frame", "fruit", "located"])
-    failed = _errors(output)
+    inputs = recording_inputs(fruit.schema.metadata)
+    failed, failed_recordings = _errors(output)
     col = {name: fruit.column(name).to_numpy(zero_copy_only=False) for name in fruit.column_names}
     rec_f = frames.column("recording").to_numpy(zero_copy_only=False).astype(str)
     located_f = frames.column("located").to_numpy(zero_copy_only=False).astype(np.int64)
@@ -170,28 +186,34 @@ def write_report(
     methods = sorted({str(m) for m in col["method"] if m is not None})
     recordings = list(dict.fromkeys(rec_f.tolist()))
     report = Report(folder, frames=len(rec_f), fruit=len(ok), located=int(ok.sum()), sized=int(sized.sum()),
-                    recordings=len(recordings), failed_frames=failed)  # fmt: skip
+                    recordings=len(recordings), failed_frames=failed, failed_recordings=failed_recordings)  # fmt: skip
     rec_fruit = np.asarray(col["recording"]).astype(str)
-    per_rec = []
+    per_rec, by_rec = [], []
     for r in recordings:
         m, loc = rec_f == r, located_f[rec_f == r]
         d = diameters_mm(size_x[sized & (rec_fruit == r)], size_z[sized & (rec_fruit == r)])
         per_rec.append((r, int(m.sum()), int((loc > 0).sum()), int(seen_f[m].sum()), int(loc.sum()),
                         float(loc.mean()) if len(loc) else math.nan, int(loc.max()) if len(loc) else 0,
                         float(np.median(d)) if len(d) else math.nan))  # fmt: skip
+        by_rec.append((r, loc, d))
     classes_rows = size_classes(diam, classes)
     finite_conf = np.isfinite(conf) & ok
 
     with OutputFolder(folder, inputs=[output / TABLE_NAME, output / FRAMES_NAME, output / "errors.json"],
                       what="report folder") as out:  # fmt: skip
         plots = _plots(plt, rec_f, located_f, per_rec, diam, classes, conf[finite_conf], reliable[finite_conf])
-        for name, fig in zip(PLOTS, plots, strict=True):
+        names = list(PLOTS)
+        if len(recordings) > 1:
+            plots += _recording_plots(plt, by_rec, classes)
+            names += PER_RECORDING_PLOTS
+        for name, fig in zip(names, plots, strict=True):
             with atomic_write(folder / name, "wb", root=out) as handle:
                 fig.savefig(handle, format="png", dpi=100)
             plt.close(fig)
             report.written.append(folder / name)
         text = _markdown(output, report, per_rec, classes_rows, diam, conf[finite_conf], reliable[finite_conf],
-                         methods, truncated_n=int((ok & truncated).sum()))  # fmt: skip
+                         methods, truncated_n=int((ok & truncated).sum()), by_rec=by_rec, classes=classes,
+                         inputs=inputs)  # fmt: skip
         with atomic_write(folder / "report.md", "w", root=out) as handle:
             handle.write(text)
         report.written.append(folder / "report.md")
@@ -267,8 +289,48 @@ def _plots(plt: Any, rec_f: np.ndarray, located_f: np.ndarray, per_rec: list[tup
     return figs
 
 
+def _shown(by_rec: list[tuple[str, np.ndarray, np.ndarray]]) -> list[tuple[str, np.ndarray, np.ndarray]]:
+    """The recordings drawn one box each: all, or the :data:`MAX_BARS` with most fruit located (in run order)."""
+    if len(by_rec) <= MAX_BARS:
+        return by_rec
+    keep = set(sorted(range(len(by_rec)), key=lambda k: -int(by_rec[k][1].sum()))[:MAX_BARS])
+    return [r for k, r in enumerate(by_rec) if k in keep]
+
+
+def _recording_plots(plt: Any, by_rec: list[tuple[str, np.ndarray, np.ndarray]], classes: Sequence[float]) -> list[Any]:
+    """Fruit located per frame and fruit diameters, one box per recording (:data:`PER_RECORDING_PLOTS`)."""
+    shown = _shown(by_rec)
+    more = f" (the {MAX_BARS} with most fruit of {len(by_rec)})" if len(shown) < len(by_rec) else ""
+    labels = [str(r[0])[:24] for r in shown]
+    figs: list[Any] = []
+    for what, k in (("fruit located per frame", 1), ("diameter (mm)", 2)):
+        fig, ax = plt.subplots(figsize=(9, 3.8))
+        data = [np.asarray(r[k], float) for r in shown]
+        filled = [x for x in range(len(data)) if len(data[x])]
+        if filled:
+            ax.boxplot([data[x] for x in filled], positions=filled, widths=0.6, showmeans=True,
+                       medianprops={"color": "tab:red"})  # fmt: skip
+        ticks = [f"{label}\nn={len(x)}" for label, x in zip(labels, data, strict=True)]
+        ax.set_xticks(range(len(shown)), ticks, rotation=45 if len(shown) > 4 else 0,
+                      ha="right" if len(shown) > 4 else "center", fontsize=8)  # fmt: skip
+        ax.set_xlim(-0.7, len(shown) - 0.3)
+        if k == 1:
+            ax.yaxis.get_major_locator().set_params(integer=True)
+            ax.set_ylim(bottom=0)
+            ax.set(ylabel=what, title=f"Fruit per frame, by recording{more}; box: quartiles, triangle: mean, n: frames")
+        else:
+            for edge in classes:
+                ax.axhline(edge, color="black", ls="--", lw=1)
+            ax.set(ylabel=what, title=f"Fruit diameters, by recording{more}; dashed: size class limits, n: fruit sized")
+        fig.tight_layout()
+        figs.append(fig)
+    return figs
+
+
 def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[tuple[str, int]], diam: np.ndarray,
-              conf: np.ndarray, reliable: np.ndarray, methods: list[str], *, truncated_n: int) -> str:  # fmt: skip
+              conf: np.ndarray, reliable: np.ndarray, methods: list[str], *, truncated_n: int,
+              by_rec: Sequence[tuple[str, np.ndarray, np.ndarray]] = (), classes: Sequence[float] = DEFAULT_CLASSES_MM,
+              inputs: dict[str, str] | None = None) -> str:  # fmt: skip
     share = lambda n, d: f"{100.0 * n / d:.1f} %" if d else "-"  # noqa: E731
     lines = [
         f"# Fruit found in `{output}`",
@@ -277,7 +339,12 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
         f"see and measured the fruit's box (its centre and size). This report covers {r.recordings} recording(s), "
         f"{r.frames:,} frames and {r.fruit:,} fruit seen, of which {r.located:,} were located (completed); "
         f"completion method: {', '.join(methods) or '-'}."
-        + (f" {r.failed_frames:,} frame(s) could not be processed (see `errors.json`)." if r.failed_frames else ""),
+        + (f" {r.failed_frames:,} frame(s) could not be processed (see `errors.json`)." if r.failed_frames else "")
+        + (
+            f" {r.failed_recordings:,} recording(s) could not be read (see `errors.json`)."
+            if r.failed_recordings
+            else ""
+        ),
         "",
         "Sizes are in millimetres. A fruit's **diameter** is the larger horizontal side of its completed box, the "
         "widest horizontal section of a hanging fruit, which is what sizing rings and grading machines measure. "
@@ -293,8 +360,15 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
     for rec, n, with_fruit, seen, located, mean, most, med in per_rec:
         lines.append(f"| {rec} | {n:,} | {with_fruit:,} | {seen:,} | {located:,} | "
                      f"{'-' if not math.isfinite(mean) else f'{mean:.2f}'} | {most} | {_mm(med)} |")  # fmt: skip
-    lines += ["", "![fruit per frame](fruit_per_frame.png)", "", "![fruit per recording](fruit_per_recording.png)",
-              "", "## Sizes", ""]  # fmt: skip
+    shown = [rec for rec, *_ in per_rec if rec in (inputs or {})]
+    if shown:
+        lines += ["", "Each recording's input (a name with `+` and a hash is shared by several inputs or is not a "
+                  "plain file name):", ""]  # fmt: skip
+        lines += [f"- `{rec}`: `{(inputs or {})[rec]}`" for rec in shown]
+    lines += ["", "![fruit per frame](fruit_per_frame.png)", "", "![fruit per recording](fruit_per_recording.png)", ""]
+    if len(by_rec) > 1:
+        lines += ["![fruit per frame, by recording](fruit_per_frame_by_recording.png)", ""]
+    lines += ["## Sizes", ""]
     if len(diam):
         p10, p50, p90 = np.percentile(diam, [10, 50, 90])
         lines += [f"{len(diam):,} fruit sized: median diameter {p50:.1f} mm (10 % are below {p10:.1f} mm, 10 % above "
@@ -304,7 +378,10 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
     lines += ["| size class (diameter) | fruit | share |", "|---|---|---|"]
     for label, count in classes_rows:
         lines.append(f"| {label} | {count:,} | {share(count, len(diam))} |")
-    lines += ["", "![fruit diameters](diameters.png)", "", "## Confidence", ""]
+    lines += ["", "![fruit diameters](diameters.png)", ""]
+    if len(by_rec) > 1:
+        lines += _sizes_by_recording(by_rec, classes)
+    lines += ["## Confidence", ""]
     if len(conf):
         lines += [f"How far to trust each located fruit's box: {len(conf):,} fruit have a confidence (median "
                   f"{np.median(conf):.2f}); {int(reliable.sum()):,} ({share(int(reliable.sum()), len(conf))}) are "
@@ -315,3 +392,16 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
               f"Made by `symfruit report` from `{TABLE_NAME}` (one row per fruit, metres) and `{FRAMES_NAME}` (one "
               "row per frame) in the output folder.", ""]  # fmt: skip
     return "\n".join(lines)
+
+
+def _sizes_by_recording(by_rec: Sequence[tuple[str, np.ndarray, np.ndarray]], classes: Sequence[float]) -> list[str]:
+    """The ``report.md`` section of diameters recording by recording: percentiles and size classes."""
+    labels = [label for label, _ in size_classes(np.zeros(0), classes)]
+    lines = ["### Sizes per recording", "",
+             "| recording | fruit sized | 10 % below (mm) | median (mm) | 10 % above (mm) | "
+             + " | ".join(labels) + " |", "|---|---|---|---|---|" + "---|" * len(labels)]  # fmt: skip
+    for rec, _, d in by_rec:
+        p10, p50, p90 = np.percentile(d, [10, 50, 90]) if len(d) else (math.nan,) * 3
+        counts = " | ".join(f"{c:,}" for _, c in size_classes(d, classes))
+        lines.append(f"| {rec} | {len(d):,} | {_mm(p10)} | {_mm(p50)} | {_mm(p90)} | {counts} |")
+    return [*lines, "", "![fruit diameters, by recording](diameters_by_recording.png)", ""]

@@ -14,7 +14,8 @@ colour image's time (UTC nanoseconds) where the recording has one (bags), else n
 =============  ===========================  =====================================================
 column         type                         content
 =============  ===========================  =====================================================
-recording      string                       the recording's name (the input's file or folder name)
+recording      string                       the recording's name (the input's file or folder name; with
+                                            several inputs, its folder in the output, told apart)
 frame          string                       the frame's name
 stamp          timestamp[ns, UTC], null     the colour image's time
 id             int32                        the fruit's id in the frame (1, 2, ...)
@@ -31,11 +32,15 @@ error          string, null                 why the fruit could not be completed
 
 ``frames.parquet``: ``recording``, ``frame``, ``stamp``, ``fruit`` (int32, every fruit of the frame),
 ``located`` (int32, those completed) and ``seconds`` (float64, the frame's detection time).
+
+A run over several recordings also names each recording's input in both files' metadata, under
+``symfruit.recordings``: JSON ``{recording: input path as given}`` (:func:`recording_inputs`).
 """
 
 from __future__ import annotations
 
 import contextlib
+import json
 import math
 from collections.abc import Mapping, Sequence
 from pathlib import Path
@@ -48,17 +53,23 @@ __all__ = [
     "FRAMES_NAME",
     "FRAME_COLUMNS",
     "FRUIT_COLUMNS",
+    "INPUTS_KEY",
     "TABLE_NAME",
     "TableWriter",
     "frame_rows",
     "read_frame_rows",
+    "recording_inputs",
     "recording_name",
+    "write_run_tables",
     "write_tables",
 ]
 
 #: The files a ``detect`` run writes into its output folder besides the frame folders.
 TABLE_NAME = "detections.parquet"
 FRAMES_NAME = "frames.parquet"
+#: The key of the tables' metadata that names each recording's input (JSON ``{recording: input path}``), written
+#: by a run over several recordings.
+INPUTS_KEY = "symfruit.recordings"
 #: Largest ``detections.json`` read back (bytes): the bound of a ``truth.json``.
 MAX_RECORD_BYTES = MAX_TRUTH_BYTES
 #: Rows buffered before a row group is written (about 20 MB of rows in Python).
@@ -199,7 +210,8 @@ def read_frame_rows(path: str | Path, recording: str) -> tuple[Row, list[Row]]:
 
 class TableWriter:
     """Streams rows into ``OUT/detections.parquet`` and ``OUT/frames.parquet``; both appear (atomically) when
-    the block ends without an error, and neither when it fails.
+    the block ends without an error, and neither when it fails. ``inputs``: each recording's input path by
+    its name, kept in both files' metadata (:data:`INPUTS_KEY`; :func:`recording_inputs`).
 
     Examples
     --------
@@ -207,9 +219,10 @@ class TableWriter:
     ...     table.add(*frame_rows(record, "rec"))
     """
 
-    def __init__(self, output: str | Path, *, root: Any = None) -> None:
+    def __init__(self, output: str | Path, *, root: Any = None, inputs: Mapping[str, str] | None = None) -> None:
         self.output = Path(output)
         self.root = root
+        self.inputs = dict(inputs or {})
         self.frames = 0
         self.fruits = 0
         self._stack = contextlib.ExitStack()
@@ -226,6 +239,8 @@ class TableWriter:
             for name, columns in ((TABLE_NAME, FRUIT_COLUMNS), (FRAMES_NAME, FRAME_COLUMNS)):
                 handle = self._stack.enter_context(atomic_write(self.output / name, "wb", root=self.root))
                 self._schemas[name] = schema(columns)
+                if self.inputs:
+                    self._schemas[name] = self._schemas[name].with_metadata({INPUTS_KEY: json.dumps(self.inputs)})
                 self._writers[name] = pq.ParquetWriter(handle, self._schemas[name])
         except BaseException:
             self._stack.close()
@@ -273,6 +288,19 @@ class TableWriter:
         self._stack.__exit__(kind, exc, tb)
 
 
+def recording_inputs(metadata: Mapping[bytes, bytes] | None) -> dict[str, str]:
+    """Each recording's input path by its name, from a table's metadata (empty when it names none, as after a
+    run over one recording, or when it is not what :class:`TableWriter` writes)."""
+    raw = (metadata or {}).get(INPUTS_KEY.encode())
+    try:
+        data = json.loads(raw.decode("utf-8")) if raw else {}
+    except (UnicodeDecodeError, ValueError):
+        return {}
+    if not isinstance(data, dict):
+        return {}
+    return {str(k): str(v) for k, v in data.items() if isinstance(k, str) and isinstance(v, str)}
+
+
 def recording_name(source: str | Path) -> str:
     """The ``recording`` column of a run on ``source``: the input's file or folder name."""
     return Path(source).absolute().name or str(source)
@@ -282,7 +310,8 @@ def write_tables(
     output: str | Path, frames: Sequence[tuple[str, Path]], recording: str, *, root: Any = None
 ) -> dict[str, str]:
     """Write both tables from the ``detections.json`` of every frame ``(name, folder)`` that has one, in
-    order (the frames of the run that are done, by this run or by the one it resumed).
+    order (the frames of the run that are done, by this run or by the one it resumed): one recording's
+    :func:`write_run_tables`.
 
     Returns
     -------
@@ -294,14 +323,39 @@ def write_tables(
     OutputError
         When a table cannot be written (then neither is replaced).
     """
+    return write_run_tables(output, [(recording, frames)], root=root)
+
+
+def write_run_tables(
+    output: str | Path,
+    recordings: Sequence[tuple[str, Sequence[tuple[str, Path]]]],
+    *,
+    root: Any = None,
+    inputs: Mapping[str, str] | None = None,
+) -> dict[str, str]:
+    """Write both tables over several recordings, each ``(recording, frames)`` with ``frames`` as in
+    :func:`write_tables` (``name`` there is how a frame is reported, e.g. ``rec/frame``); the rows keep
+    the recordings' order and each one's frame order. ``inputs``: as :class:`TableWriter` takes it.
+
+    Returns
+    -------
+    dict
+        Frames (by ``name``) whose ``detections.json`` could not be read into the table, with the reason.
+
+    Raises
+    ------
+    OutputError
+        When a table cannot be written (then neither is replaced).
+    """
     bad: dict[str, str] = {}
-    with TableWriter(output, root=root) as table:
-        for name, folder in frames:
-            path = Path(folder) / "detections.json"
-            if not path.is_file():
-                continue
-            try:
-                table.add(*read_frame_rows(path, recording))
-            except SymfruitError as exc:
-                bad[name] = f"{exc} (left out of {TABLE_NAME})"
+    with TableWriter(output, root=root, inputs=inputs) as table:
+        for recording, frames in recordings:
+            for name, folder in frames:
+                path = Path(folder) / "detections.json"
+                if not path.is_file():
+                    continue
+                try:
+                    table.add(*read_frame_rows(path, recording))
+                except SymfruitError as exc:
+                    bad[name] = f"{exc} (left out of {TABLE_NAME})"
     return bad
