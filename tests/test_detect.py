@@ -172,3 +172,17 @@ def test_the_occlusion_settings_are_bounded():
         Settings().replace(occlusion={"tolerance": 5.0})
     with pytest.raises(ConfigError, match="reach_px"):
         Settings().replace(occlusion={"reach_px": -1})
+
+
+def test_masks_are_trimmed_before_they_move_onto_the_depth():
+    """Depth registered 6 px right of the colour, a mask 3 px too large: the detection's silhouette is the
+    fruit's disc moved onto the depth image (trimmed against the colour first, then moved)."""
+    color, depth = disc_frame([(70, 60)], radius=22)
+    moved = np.full_like(depth, 1.0)
+    moved[:, 6:] = depth[:, :-6]  # what colour pixel (u, v) sees lies at depth pixel (u + 6, v)
+    yy, xx = np.mgrid[:120, :160]
+    masks = ((xx - 70) ** 2 + (yy - 60) ** 2 <= 25**2).astype(np.int32)
+    found = detect(Frame("shifted", color, moved, SMALL_CAM, masks=masks), method="raw")
+    assert found.registration == (6, 0)
+    (d,) = found.detections
+    assert np.array_equal(d.mask, (xx - 76) ** 2 + (yy - 60) ** 2 <= 22**2)

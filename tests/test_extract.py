@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 
 from symfruit import ConfigError
 from symfruit.core.camera import Camera
-from symfruit.extract import ExtractSettings, cluster, extract, register, shift_labels
+from symfruit.extract import ExtractSettings, cluster, extract, register, shift_labels, trim_labels
 
 from .conftest import SMALL_CAM, disc_frame
 
@@ -179,3 +179,18 @@ def test_a_support_under_the_fruit_is_not_its_surface():
     off_ball = ((uv[:, 0] - 80) ** 2 + (uv[:, 1] - 60) ** 2) > 20.5**2
     assert off_ball.sum() <= 0.2 * (mask & (d2 > 1)).sum()
     assert not (uv[:, 1] > 81).any()  # below the ball, where the table comes nearer
+
+
+def test_masks_are_colour_trimmed_in_the_colour_cameras_pixels():
+    """Two fruit whose masks overshoot by 3 px: each is trimmed back to its own disc of colour, the other's
+    label and the background untouched; with ``colour_trim_px`` 0 nothing changes."""
+    color, _ = disc_frame([(50, 60), (115, 60)], radius=18)
+    yy, xx = np.mgrid[:120, :160]
+    labels = np.zeros((120, 160), np.int32)
+    for k, cx in ((1, 50), (2, 115)):
+        labels[(xx - cx) ** 2 + (yy - 60) ** 2 <= 21**2] = k
+    trimmed = trim_labels(color, labels)
+    for k, cx in ((1, 50), (2, 115)):
+        assert np.array_equal(trimmed == k, (xx - cx) ** 2 + (yy - 60) ** 2 <= 18**2)
+    assert trimmed is not labels and labels.max() == 2 and (labels == 1).sum() > (trimmed == 1).sum()
+    assert trim_labels(color, labels, ExtractSettings(colour_trim_px=0)) is labels

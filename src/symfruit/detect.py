@@ -19,9 +19,8 @@ from .core.camera import Camera
 from .core.frame import Frame
 from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
-from .core.surface import colour_trim
 from .errors import InputError, SymfruitError
-from .extract import Extraction, extract, register
+from .extract import Extraction, extract, register, trim_labels
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .occlusion import fruit_occlusion
@@ -128,6 +127,8 @@ def detect(
                 f"frame {frame.name}: mask {int(whole[0]) + 1} covers the whole image; that is not a fruit"
             )
     t_register = time.perf_counter()
+    if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
+        labels = trim_labels(frame.color, labels, settings.extract)
     labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
     detections, t_extract, t_complete = [], time.perf_counter() - t_register, 0.0
     from scipy import ndimage
@@ -166,14 +167,11 @@ def detect(
 def _extract_window(mask: np.ndarray, sl: tuple[slice, slice], frame: Frame, settings: Settings) -> Extraction:
     """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test."""
     h, w = mask.shape
-    pad = max(settings.extract.erode_px, settings.extract.colour_trim_px) + 2
+    pad = settings.extract.erode_px + 2
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
     cam = frame.camera
     window = mask[r0:r1, c0:c1]
-    if settings.extract.colour_trim_px > 0 and frame.color is not None:
-        band = min(float(settings.extract.colour_trim_px), 0.2 * float(np.sqrt(window.sum() / np.pi)))
-        window = colour_trim(frame.color[r0:r1, c0:c1], window, band_px=band)
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
     ex = extract(window, frame.depth[r0:r1, c0:c1], local, settings.extract)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)

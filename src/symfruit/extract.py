@@ -11,10 +11,10 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
-from .core.surface import fruit_surface, registration_shift
+from .core.surface import colour_trim, fruit_surface, registration_shift
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "cluster", "extract", "register", "shift_labels"]
+__all__ = ["ExtractSettings", "Extraction", "cluster", "extract", "register", "shift_labels", "trim_labels"]
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -212,6 +212,34 @@ def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
     out[max(dv, 0) : h + min(dv, 0), max(du, 0) : w + min(du, 0)] = labels[
         max(-dv, 0) : h - max(dv, 0), max(-du, 0) : w - max(du, 0)
     ]
+    return out
+
+
+def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None) -> np.ndarray:
+    """``labels`` with each mask's outer band trimmed where its colour is the background's
+    (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
+    equivalent radius).
+
+    Masks and colour share the colour camera's pixels, so this comes before :func:`register` moves the masks
+    onto the depth image: trimmed after the move, a mask would be compared with colours several pixels off.
+    """
+    s = settings or ExtractSettings()
+    if s.colour_trim_px <= 0:
+        return labels
+    out = labels
+    h, w = labels.shape
+    pad = s.colour_trim_px + 2
+    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+        if sl is None:
+            continue
+        r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
+        c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+        mask = labels[r0:r1, c0:c1] == k
+        band = min(float(s.colour_trim_px), 0.2 * float(np.sqrt(mask.sum() / np.pi)))
+        kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band)
+        if (dropped := mask & ~kept).any():
+            out = out.copy() if out is labels else out
+            out[r0:r1, c0:c1][dropped] = 0
     return out
 
 
