@@ -350,12 +350,13 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
 
     Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
     depth cannot tell (a time-of-flight camera returns nothing for a few pixels on both sides of an outline).
-    The colour can: the pixels more than ``band_px`` inside the mask are the fruit's, a ring of the same width
-    outside it the background's; both are summarised by ``centres`` colours each (a few rounds of k-means on
-    chromaticity and brightness), and a band pixel whose squared colour distance to the background is below
-    ``margin`` times its distance to the fruit is removed (a mixed pixel on the outline, between the two,
-    stays). Nothing is removed when the two do not separate (the summaries misclass more than ``1 -
-    min_accuracy`` of their own samples: a white ball before a white wall), and nothing beyond the band.
+    The colour can: the pixels from ``band_px`` to ``3 band_px`` inside the mask are the fruit's (near the
+    outline, its limb's shading included), a ring of ``band_px`` outside it the background's; both are
+    summarised by ``centres`` colours each (a few rounds of k-means on chromaticity and brightness), and a
+    band pixel whose squared colour distance to the background is below ``margin`` times its distance to the
+    fruit is removed (a mixed pixel on the outline, between the two, stays). Nothing is removed when the two
+    do not separate (the summaries misclass more than ``1 - min_accuracy`` of their own samples: a white ball
+    before a white wall), and nothing beyond the band.
 
     Parameters
     ----------
@@ -368,9 +369,12 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
         return mask
     inner = ndimage.distance_transform_edt(mask)
     outer = ndimage.distance_transform_edt(~mask)
-    fruit = inner > band_px
+    # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
+    # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
+    # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
+    fruit = (inner > band_px) & (inner <= 3.0 * band_px + 1)
     ring = (outer >= 1) & (outer <= band_px + 1)
-    band = mask & ~fruit
+    band = mask & (inner <= band_px)
     if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
         return mask
     rgb = np.asarray(color, dtype=np.float64)
