@@ -166,6 +166,15 @@ def test_bench_runs_and_reports(capsys):
     assert all(r["median_ms"] > 0 for r in rows)
 
 
+def test_bench_frame_times_one_method_or_profiles_it(capsys):
+    assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--json"]) == 0
+    rows = json.loads(capsys.readouterr().out)["rows"]
+    assert [r["method"] for r in rows] == ["raw"] and rows[0]["min_ms"] > 0
+    assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--profile"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("cProfile of 1 frames, method raw") and "detect" in out
+
+
 def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
     assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
     assert (tmp_path / "d" / "example_frame" / "detections.json").exists()

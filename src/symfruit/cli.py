@@ -59,6 +59,8 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", default=None,
                    help="with --frame: only this method (default paper, fused and evidence); with --recording: the "
                    "completion method (default evidence)")  # fmt: skip
+    p.add_argument("--profile", action="store_true",
+                   help="with --frame: print a cProfile of the frame instead (5 runs of --method)")  # fmt: skip
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument(
@@ -345,8 +347,11 @@ def _bench(args: argparse.Namespace) -> int:
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
     if args.frame:
-        from .evaluate.bench import bench_frame
+        from .evaluate.bench import bench_frame, profile_frame
 
+        if args.profile:
+            print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
+            return 0
         rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor)
                 for m in ((args.method,) if args.method else ("paper", "fused", "evidence"))]  # fmt: skip
     else:
@@ -359,9 +364,10 @@ def _bench(args: argparse.Namespace) -> int:
         f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process "
         f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
     )
-    print(f"{'case':<26} {'points':>6} {'planes':>6} {'median ms':>10} {'p10':>8} {'p90':>8}")
+    print(f"{'case':<26} {'points':>6} {'planes':>6} {'median ms':>10} {'min':>8} {'p10':>8} {'p90':>8}")
     for r in rows:
-        print(f"{r.case:<26} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.p10_ms:>8.2f} {r.p90_ms:>8.2f}")
+        print(f"{r.case:<26} {r.points:>6} {r.planes:>6} {r.median_ms:>10.2f} {r.min_ms:>8.2f} {r.p10_ms:>8.2f} "
+              f"{r.p90_ms:>8.2f}")  # fmt: skip
     return 0
 
 

@@ -2,8 +2,10 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from symfruit.core.agreement import explain, march, observe
+from symfruit.core.agreement import Quadric, explain, intersect_quadric, march, observe
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -24,6 +26,96 @@ def test_march_hits_a_ball_at_its_surface():
     assert depth[1] == pytest.approx((-b - np.sqrt(b * b - 4 * a * cc)) / (2 * a), abs=3e-4)
     inside, depth_inside = march(ball(c, r), rays[:1], 0.39, 0.45, steps=8)
     assert inside[0] and depth_inside[0] == 0.39  # the ray starts inside
+
+
+def test_closed_form_meets_a_ball_where_its_quadratic_says():
+    c, r = np.array([0.0, 0.0, 0.4]), 0.03
+    rays = np.array([[0.0, 0.0, 1.0], [0.05, 0.0, 1.0], [0.2, 0.0, 1.0]])
+    hit, depth = intersect_quadric(c, np.eye(3) / r**2, rays, 0.35, 0.45)
+    assert hit.tolist() == [True, True, False] and np.isnan(depth[2])
+    assert depth[0] == pytest.approx(0.37, abs=1e-12)
+    a, b, cc = 1.0025, -0.8, 0.16 - 0.0009  # |z d - c| = r along d = (0.05, 0, 1)
+    assert depth[1] == pytest.approx((-b - np.sqrt(b * b - 4 * a * cc)) / (2 * a), abs=1e-12)
+
+
+def test_closed_form_tangent_rays_miss_and_a_ray_starting_inside_enters_at_once():
+    c, r = np.array([0.0, 0.0, 0.4]), 0.03
+    # the ray through (r, 0, 0.4) tangent to the ball's silhouette: x = t z, |t z - 0|^2 + (z - 0.4)^2 = r^2 has a
+    # double root where t^2 = r^2 / (0.4^2 - r^2)
+    t = r / np.sqrt(0.4**2 - r**2)
+    hit, _ = intersect_quadric(c, np.eye(3) / r**2, np.array([[t, 0.0, 1.0], [0.999 * t, 0.0, 1.0]]), 0.3, 0.5)
+    assert hit.tolist() == [False, True]
+    hit, depth = intersect_quadric(c, np.eye(3) / r**2, np.array([[0.0, 0.0, 1.0]]), 0.39, 0.45)
+    assert hit[0] and depth[0] == 0.39  # inside at z0
+    hit, _ = intersect_quadric(c, np.eye(3) / r**2, np.array([[0.0, 0.0, 1.0]]), 0.2, 0.36)
+    assert not hit[0]  # the ball lies beyond the range
+    hit, _ = intersect_quadric(c, np.eye(3) / r**2, np.array([[0.0, 0.0, 1.0]]), 0.44, 0.5)
+    assert not hit[0]  # ... or before it
+
+
+def test_closed_form_with_the_camera_inside_the_ellipsoid():
+    # an ellipsoid around the origin (semi-axes 0.1, 0.2, 0.5): along +z from 0 the ray is inside until z = 0.5
+    shape = np.diag([1 / 0.1**2, 1 / 0.2**2, 1 / 0.5**2])
+    hit, depth = intersect_quadric(np.zeros(3), shape, np.array([[0.0, 0.0, 1.0], [0.1, 0.0, 1.0]]), 0.1, 1.0)
+    assert hit.tolist() == [True, True] and depth.tolist() == [0.1, 0.1]
+    hit, _ = intersect_quadric(np.zeros(3), shape, np.array([[0.0, 0.0, 1.0]]), 0.6, 1.0)
+    assert not hit[0]  # the exit lies before the range
+
+
+def test_closed_form_meets_a_rotated_ellipsoid_on_its_surface():
+    rng = np.random.default_rng(4)
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    shape = rot @ np.diag(1 / np.array([0.02, 0.035, 0.05]) ** 2) @ rot.T
+    c = np.array([0.01, -0.02, 0.45])
+    rays = np.c_[rng.uniform(-0.12, 0.08, 200), rng.uniform(-0.15, 0.05, 200), np.ones(200)]
+    hit, depth = intersect_quadric(c, shape, rays, 0.3, 0.6)
+    assert 20 < hit.sum() < 200
+    entry = rays[hit] * depth[hit, None]
+    q = Quadric(c, shape)
+    assert np.allclose(q(entry), 0.0, atol=1e-9)  # on the surface
+    assert np.all(q(rays[hit] * (depth[hit, None] - 1e-4)) < 0)  # and entered there, not left
+    assert np.all(q(rays[~hit, None, :] * np.linspace(0.3, 0.6, 301)[None, :, None]) <= 0)  # missed rays stay out
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.floats(0.01, 0.06),
+    st.floats(1.0, 3.0),
+)
+def test_closed_form_is_what_a_fine_march_converges_to(seed, size, elongation):
+    rng = np.random.default_rng(seed)
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    semi = size * np.array([1.0, rng.uniform(1.0, elongation), elongation])
+    shape = rot @ np.diag(1 / semi**2) @ rot.T
+    c = np.r_[rng.uniform(-0.05, 0.05, 2), rng.uniform(0.3, 0.6)]
+    rays = np.c_[rng.uniform(-0.3, 0.3, (300, 2)), np.ones(300)]
+    z0, z1 = c[2] - 1.2 * semi.max(), c[2] + 1.2 * semi.max()
+    hit, depth = intersect_quadric(c, shape, rays, z0, z1)
+    hit_m, depth_m = march(Quadric(c, shape), rays, z0, z1, steps=4000)
+    step = (z1 - z0) / 3999
+    assert np.all(hit_m <= hit)  # the march sees no hit the closed form misses
+    assert np.all(np.abs(depth[hit_m] - depth_m[hit_m]) <= step)
+    # a ray the march misses has a chord shorter than two of its steps
+    missed = hit & ~hit_m
+    if missed.any():
+        a = np.einsum("ni,ij,nj->n", rays[missed], shape, rays[missed])
+        b = rays[missed] @ shape @ c
+        chord = 2 * np.sqrt(np.maximum(b * b - a * (c @ shape @ c - 1), 0)) / a
+        assert np.all(chord <= 2 * step)
+
+
+def test_explain_uses_the_closed_form_of_a_quadric(camera):
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.0, seed=3)
+    region = silhouette(visible, camera)
+    obs = observe(visible, region, camera)
+    c, r = np.array([0.0, 0.0, 0.4]), 0.035
+    box = (c - r, c + r)
+    closed = explain(Quadric(c, np.eye(3) / r**2), box, obs, steps=16)
+    marched = explain(ball(c, r), box, obs, steps=400)
+    assert closed.depth == pytest.approx(marched.depth, abs=2e-4)
+    assert closed.inside == pytest.approx(marched.inside, abs=0.02)
+    assert closed.outside == pytest.approx(marched.outside, abs=0.02)
 
 
 def test_observation_of_a_camera_view(camera):

@@ -280,6 +280,30 @@ def test_every_cone_parameter_is_an_ellipsoid_with_that_outline(offset, tau):
                                cone / np.abs(cone).max(), atol=1e-6)  # fmt: skip
 
 
+@given(st.integers(0, 2**32 - 1))
+def test_cone_fronts_from_the_cone_are_the_ellipsoids_fronts(seed):
+    from symfruit.core.agreement import intersect_quadric
+    from symfruit.core.fits import _cone_fronts
+
+    rng = np.random.default_rng(seed)
+    centre = np.r_[rng.uniform(-0.05, 0.05, 2), rng.uniform(0.3, 0.6)]
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    cone = _tangent_cone(centre, rot @ np.diag(rng.uniform(0.015, 0.05, 3) ** 2) @ rot.T)
+    if np.linalg.eigvalsh(cone)[-1] < 0:
+        cone = -cone
+    axis = centre / centre[2]
+    params = np.c_[rng.normal(0.0, 0.02, (20, 2)), np.log(rng.uniform(0.2, 0.8, 20)), rng.uniform(-6, 6, 20)]
+    rays = np.c_[axis[0] + rng.normal(0.0, 0.08, 100), axis[1] + rng.normal(0.0, 0.08, 100), np.ones(100)]
+    fronts, valid = _cone_fronts(params, cone, axis, rays, ((rays @ cone) * rays).sum(axis=1))
+    m, shape, valid_shape = cone_ellipsoid(params, cone, axis)
+    assert np.array_equal(valid, valid_shape)
+    for k in np.flatnonzero(valid):
+        hit, depth = intersect_quadric(m[k], np.linalg.inv(shape[k]), rays, 0.0, 10.0)
+        near = np.isfinite(fronts[k]) & hit
+        np.testing.assert_allclose(fronts[k][near], depth[near], rtol=1e-6, atol=1e-9)  # nanometres
+        assert np.all(np.isfinite(fronts[k]) | ~hit)  # a ray the ellipsoid's own quadric meets has a front
+
+
 def test_cone_ellipsoid_of_a_noisy_ball_is_the_ball():
     from symfruit import DEFAULT_CAMERA
     from symfruit.core.raster import silhouette, silhouette_cone

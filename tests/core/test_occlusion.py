@@ -138,3 +138,79 @@ def test_occlusion_refuses_a_camera_of_the_wrong_type_and_raw_depth():
         occlusion(depth, disc, points, CAM.to_dict())
     with pytest.raises(InputError, match="uint16; depth must be float metres"):
         occlusion(np.rint(depth * 1000).astype(np.uint16), disc, points, CAM)
+
+
+def _uncached_at(occ: Occlusion, u: np.ndarray, v: np.ndarray, radius: int) -> np.ndarray:
+    """What :meth:`Occlusion.at` answered before its grown maps were kept: the filter run on every call."""
+    col, row = np.rint(u).astype(np.intp), np.rint(v).astype(np.intp)
+    out = (col < radius) | (col >= occ.width - radius) | (row < radius) | (row >= occ.height - radius)
+    hidden = occ.hidden
+    if radius > 0 and hidden.any():
+        hidden = ndimage.maximum_filter(hidden, size=2 * radius + 1, mode="constant", cval=False)
+    h, w = hidden.shape
+    c, r = col - occ.u0, row - occ.v0
+    inside = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+    out[inside] |= hidden[r[inside], c[inside]]
+    return out
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 5))
+def test_kept_grown_maps_answer_as_the_filter_run_every_time(seed, radius):
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 25)), int(rng.integers(1, 25))
+    u0, v0 = int(rng.integers(0, 40 - w + 1)), int(rng.integers(0, 30 - h + 1))
+    occ = Occlusion(u0, v0, rng.random((h, w)) < rng.uniform(0.0, 0.3), 40, 30)
+    u, v = rng.uniform(-3, 43, 200), rng.uniform(-3, 33, 200)
+    for _ in range(2):  # made, then kept
+        assert np.array_equal(occ.at(u, v, radius=radius), _uncached_at(occ, u, v, radius))
+    rh, rw = int(rng.integers(1, 30)), int(rng.integers(1, 40))
+    region = Silhouette(int(rng.integers(-5, 40)), int(rng.integers(-5, 30)), np.ones((rh, rw), bool), 0.0)
+    vv, uu = np.mgrid[region.v0 : region.v0 + rh, region.u0 : region.u0 + rw]
+    expected = _uncached_at(occ, uu.ravel().astype(float), vv.ravel().astype(float), radius).reshape(rh, rw)
+    assert np.array_equal(occ.window(region, radius=radius), expected)
+    assert not occ.grown(max(radius, 1)).flags.writeable or not occ.hidden.any()
+
+
+def test_filling_pixels_without_depth_is_skipped_only_when_there_are_none():
+    depth, disc, points = _disc_frame(background=0.302)  # background at the fruit's depth: hidden
+    holes = depth.copy()
+    holes[14:17, 9:11] = 0.0  # beside the disc (its left edge is at u = 14), no depth: takes a neighbour's
+    full, holed = occlusion(depth, disc, points, CAM), occlusion(holes, disc, points, CAM)
+    assert full.hidden[14 - full.v0 : 17 - full.v0, 9 - full.u0 : 11 - full.u0].all()
+    assert np.array_equal(full.hidden, holed.hidden)
+    assert np.isfinite(holed.depth[14 - holed.v0, 9 - holed.u0])
+
+
+def _allowed_whole_window(occ: Occlusion, region: Silhouette, gap: int, thin: int) -> np.ndarray:
+    """:meth:`Occlusion.allowed` as it was: both filters over the whole window, the kept labels by ``np.isin``."""
+    h, w = occ.hidden.shape
+    hidden = open_square(occ.hidden, 2 * thin + 1) if thin > 0 and occ.hidden.any() else occ.hidden
+    seen = np.zeros((h, w), dtype=bool)
+    for r in range(region.mask.shape[0]):
+        for c in range(region.mask.shape[1]):
+            rr, cc = region.v0 + r - occ.v0, region.u0 + c - occ.u0
+            if 0 <= rr < h and 0 <= cc < w:
+                seen[rr, cc] = region.mask[r, c]
+    if not seen.any():
+        return seen
+    allowed = hidden.copy()
+    if gap > 0:
+        size = 2 * gap + 1
+        grown = ndimage.maximum_filter(seen, size=size, mode="constant", cval=False)
+        allowed |= grown & ndimage.maximum_filter(hidden, size=size, mode="constant", cval=False)
+    allowed |= seen
+    labels, _ = ndimage.label(allowed, structure=np.ones((3, 3), bool))
+    keep = np.unique(labels[seen])
+    return np.isin(labels, keep[keep > 0])
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 4), st.integers(0, 3))
+def test_allowed_on_the_seen_box_is_allowed_on_the_whole_window(seed, gap, thin):
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    hidden = rng.random((h, w)) < rng.uniform(0, 0.5)
+    occ = Occlusion(int(rng.integers(0, 10)), int(rng.integers(0, 10)), hidden, 60, 60)
+    rh, rw = (int(x) for x in rng.integers(1, 20, 2))
+    mask = rng.random((rh, rw)) < rng.uniform(0.1, 1.0)
+    region = Silhouette(int(rng.integers(-5, 40)), int(rng.integers(-5, 40)), mask, 0.0)
+    assert np.array_equal(occ.allowed(region, gap=gap, thin=thin), _allowed_whole_window(occ, region, gap, thin))

@@ -1,8 +1,11 @@
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import rasterise, silhouette_coverage
+from symfruit.core.raster import inner_distance, rasterise, silhouette_coverage
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -199,3 +202,19 @@ def test_an_ellipse_is_recovered_from_part_of_its_outline(camera):
     assert outline_cone(region, camera, small + [250, 180]) is None  # would not hold the seen region
     with pytest.raises(InputError, match="shape"):
         outline_cone(region, camera, np.zeros((10, 3)))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_inner_distance_over_the_masks_box_is_the_whole_images(seed):
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 30, 2))
+    mask = np.zeros((h, w), bool)
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    mask[r0 : r0 + int(rng.integers(1, 12)), c0 : c0 + int(rng.integers(1, 12))] = True  # touching a border or not
+    mask &= rng.random((h, w)) < rng.uniform(0.6, 1.0)
+    assert np.array_equal(inner_distance(mask), ndimage.distance_transform_edt(mask))
+
+
+def test_the_inner_distance_of_an_empty_or_full_mask_is_the_whole_images():
+    for mask in (np.zeros((7, 9), bool), np.ones((7, 9), bool)):
+        np.testing.assert_array_equal(inner_distance(mask), ndimage.distance_transform_edt(mask))

@@ -159,3 +159,36 @@ def test_median_at_is_the_median_filter_at_those_pixels(seed, size):
     rows, cols = np.nonzero(rng.random((h, w)) < 0.5)
     expected = ndimage.median_filter(image, size=size, mode="nearest")[rows, cols]
     np.testing.assert_array_equal(median_at(image, rows, cols, size=size), expected)
+
+
+def test_the_registration_grows_the_mask_as_twenty_dilations_would():
+    from scipy import ndimage
+
+    mask = np.zeros((60, 70), bool)
+    mask[20:35, 25:31] = True
+    mask[30:40, 28:50] = True
+    grown = ndimage.distance_transform_cdt(~mask, metric="taxicab") <= 20
+    assert np.array_equal(grown, ndimage.binary_dilation(mask, iterations=20))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_registration_cost_reads_minus_reach_beyond_the_window(seed):
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 40, 2))
+    inside = rng.normal(0.0, 5.0, (h, w))
+    n = int(rng.integers(12, 100))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, 3.0)
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (30, 2))
+    # each shifted point's value, looked up one by one: the map inside the window, -reach outside it
+    val = np.full((30, n), -float(reach))
+    for k, (dv, du) in enumerate(shifts):
+        for i in range(n):
+            r, c = outline.rows[i] - dv, outline.cols[i] - du
+            if 0 <= r < h and 0 <= c < w:
+                val[k, i] = inside[r, c]
+    band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, 3.0)
+    dev = np.sort(np.abs(val - band), axis=1)[:, : int(0.7 * n)]
+    np.testing.assert_allclose(outline.cost(shifts, reach, 0.7), dev.mean(axis=1), rtol=1e-12)

@@ -23,3 +23,19 @@ def test_a_frame_through_a_real_camera_is_timed_at_its_resolution():
 
     row = bench_frame(repeat=1, method="raw", sensor="realsense-d405")
     assert "realsense-d405 1280x720" in row.case and row.median_ms > 0 and row.points >= 1
+
+
+@pytest.mark.slow
+def test_the_frame_profile_lists_detect_and_the_method():
+    from symfruit.evaluate.bench import profile_frame
+
+    text = profile_frame(repeat=1, method="raw", top=5)
+    assert "method raw" in text and "detect" in text and "tottime" in text
+
+
+@pytest.mark.slow
+def test_a_frame_row_has_its_fastest_run_at_most_its_median():
+    from symfruit.evaluate.bench import bench_frame
+
+    row = bench_frame(repeat=3, method="raw")
+    assert row.repeat == 3 and 0 < row.min_ms <= row.median_ms <= row.p90_ms

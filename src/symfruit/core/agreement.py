@@ -13,9 +13,10 @@ vectorised over rays and march steps:
   background there);
 * ``inside``: share of the rays just inside the silhouette that miss it (the camera saw fruit there).
 
-Rays are marched front to back in fixed steps through the candidate's depth range and the first
-crossing is refined by linear interpolation of the inside function, so any shape with an inside test is
-measured the same way (no per-shape ray casting, no loop over rays).
+A quadric candidate (sphere, ellipsoid: :class:`Quadric`) is met in closed form, the smaller root of
+one quadratic per ray (:func:`intersect_quadric`); any other shape with an inside test is marched front to
+back in fixed steps through its depth range, the first crossing refined by linear interpolation of the
+inside function (:func:`march`), vectorised over rays and steps (no loop over rays).
 """
 
 from __future__ import annotations
@@ -30,13 +31,79 @@ from scipy.spatial import cKDTree
 from .camera import Camera
 from .occlusion import Occlusion
 from .points import as_points
-from .raster import Silhouette, outline_cone, outline_cracks, silhouette_cone
+from .raster import Silhouette, inner_distance, outline_cone, outline_cracks, silhouette_cone
 
-__all__ = ["Agreement", "Inside", "Observation", "explain", "march", "observe"]
+__all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
 #: ``inside(x)`` for points ``x`` (..., 3), metres: positive inside the shape (a signed distance, or any
 #: function with the same sign), shape ``x.shape[:-1]``.
 Inside = Callable[[np.ndarray], np.ndarray]
+
+
+@dataclass(frozen=True, eq=False)
+class Quadric:
+    """The solid ellipsoid ``(x - centre)^T shape (x - centre) <= 1`` as an :data:`Inside` test
+    (``1 - (x - centre)^T shape (x - centre)``) whose rays are met in closed form (:meth:`intersect`).
+
+    Attributes
+    ----------
+    centre : (3,) float, metres
+    shape : (3, 3) float, symmetric positive definite, metres^-2 (a sphere of radius ``r``: ``I / r^2``)
+    """
+
+    centre: np.ndarray
+    shape: np.ndarray
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        d = np.asarray(x, dtype=np.float64) - self.centre
+        return 1.0 - np.einsum("...i,ij,...j->...", d, self.shape, d)
+
+    def intersect(self, rays: np.ndarray, z0: float, z1: float) -> tuple[np.ndarray, np.ndarray]:
+        """:func:`intersect_quadric` of this quadric."""
+        return intersect_quadric(self.centre, self.shape, rays, z0, z1)
+
+
+def intersect_quadric(
+    centre: np.ndarray, shape: np.ndarray, rays: np.ndarray, z0: float, z1: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """First entry into the solid ellipsoid ``(x - centre)^T shape (x - centre) <= 1`` along rays ``x = z *
+    ray`` for ``z`` in ``[z0, z1]``, in closed form: what :func:`march` approximates.
+
+    Along a ray the quadric is ``a z^2 - 2 b z + c`` with ``a = ray^T S ray``, ``b = ray^T S centre`` and
+    ``c = centre^T S centre - 1``; the ray is inside between the roots ``(b -+ sqrt(b^2 - a c)) / a``. A ray
+    that only touches the surface (``b^2 = a c``) does not enter it.
+
+    Parameters
+    ----------
+    centre : (3,) float, metres
+    shape : (3, 3) float, symmetric positive definite
+    rays : (m, 3) float, ``z = 1``
+    z0, z1 : float, metres
+
+    Returns
+    -------
+    hit : (m,) bool
+        The ray is inside the solid somewhere in ``(z0, z1)``.
+    depth : (m,) float, metres
+        The entry depth (``z0`` where the ray is inside at ``z0``; NaN where there is no hit).
+
+    Examples
+    --------
+    >>> hit, depth = intersect_quadric(np.array([0.0, 0.0, 0.5]), np.eye(3) / 0.04**2,
+    ...                                np.array([[0.0, 0.0, 1.0], [1.0, 0.0, 1.0]]), 0.3, 0.7)
+    >>> hit.tolist(), np.round(depth, 6).tolist()
+    ([True, False], [0.46, nan])
+    """
+    rays = np.asarray(rays, dtype=np.float64)
+    sc = shape @ centre
+    a = np.einsum("ni,ij,nj->n", rays, shape, rays)
+    b = rays @ sc
+    c = float(centre @ sc) - 1.0
+    disc = b * b - a * c
+    root = np.sqrt(np.maximum(disc, 0.0))
+    near, far = (b - root) / a, (b + root) / a
+    hit = (disc > 0) & (near < z1) & (far > z0)
+    return hit, np.where(hit, np.maximum(near, z0), np.nan)
 
 
 @dataclass(frozen=True)
@@ -76,6 +143,8 @@ class Observation:
     hidden : (h, w) bool, optional
         With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
         outline crossing onto one is an occluder's edge).
+    inner : (h, w) float, pixels, optional
+        The region's distance map (``ndimage.distance_transform_edt(region.mask)``), for reuse.
     """
 
     rays: np.ndarray
@@ -91,6 +160,7 @@ class Observation:
     cone_source: str = "moments"
     extent: np.ndarray | None = None
     hidden: np.ndarray | None = None
+    inner: np.ndarray | None = None
 
 
 @dataclass(frozen=True)
@@ -165,7 +235,7 @@ def observe(
     sample = points[:: max(1, len(points) // n_rays)]
     rays = sample / sample[:, 2:3]
     mask = region.mask
-    inner = ndimage.distance_transform_edt(mask)
+    inner = inner_distance(mask)
     outer = ndimage.distance_transform_edt(~mask)
 
     def spread(rc: np.ndarray) -> np.ndarray:
@@ -214,7 +284,8 @@ def observe(
                        out_depth=None if occlusion is None else tuple(d for _, _, d in outs),
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
-                       hidden=None if occlusion is None else occlusion.window(region, radius=2))  # fmt: skip
+                       hidden=None if occlusion is None else occlusion.window(region, radius=2),
+                       inner=inner)  # fmt: skip
 
 
 def _occluded_edges(
@@ -341,9 +412,10 @@ def explain(
     Parameters
     ----------
     inside : callable
-        The candidate's inside function (:data:`Inside`).
+        The candidate's inside function (:data:`Inside`); one with an ``intersect(rays, z0, z1)`` method
+        (a :class:`Quadric`) is met in closed form instead of marched.
     box : ((3,), (3,)) float, metres
-        The candidate's box: the rays are marched over its depth range (1 mm beyond on both sides).
+        The candidate's box: the rays are met over its depth range (1 mm beyond on both sides).
     obs : Observation
     steps : int
         March steps per ray (:func:`march`).
@@ -357,7 +429,11 @@ def explain(
     z0, z1 = float(lo[2]) - 1e-3, float(hi[2]) + 1e-3
     n = len(obs.rays)
     every = np.concatenate([obs.rays, *obs.rays_in, *obs.rays_out])  # one march for all rays
-    hit_all, depth_all = march(inside, every, z0, z1, steps=steps)
+    closed_form = getattr(inside, "intersect", None)
+    if callable(closed_form):
+        hit_all, depth_all = closed_form(every, z0, z1)
+    else:
+        hit_all, depth_all = march(inside, every, z0, z1, steps=steps)
     hit, depth = hit_all[:n], depth_all[:n]
     res = np.where(hit, obs.depth - np.where(hit, depth, 0.0), z1 - z0)
     keep = max(1, int(trim * len(res)))

@@ -34,7 +34,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .agreement import Agreement, Inside, Observation, explain
+from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
     ellipsoid_half_extents,
@@ -290,7 +290,7 @@ class _Shape:
 
 def _sphere(fit: _Fitting) -> Iterator[_Shape]:
     c, r = fit_sphere(fit.sample)
-    yield _Shape("sphere", c - r, c + r, lambda x: r - np.linalg.norm(x - c, axis=-1), c)
+    yield _Shape("sphere", c - r, c + r, Quadric(c, np.eye(3) / r**2), c)
 
 
 def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
@@ -298,8 +298,7 @@ def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
     with np.errstate(invalid="ignore"):
         half = ellipsoid_half_extents(shape)
     fit.axes.append(np.linalg.eigh(shape)[1].T)
-    inside = lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - ce, shape, x - ce)  # noqa: E731
-    yield _Shape("ellipsoid", ce - half, ce + half, inside, ce)
+    yield _Shape("ellipsoid", ce - half, ce + half, Quadric(ce, shape), ce)
 
 
 def _cone(fit: _Fitting) -> Iterator[_Shape]:
@@ -311,8 +310,7 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
     ch = np.sqrt(np.diag(cs))
     inv = np.linalg.inv(cs)
     fit.axes.append(np.linalg.eigh(cs)[1].T)
-    yield _Shape("cone", cc - ch, cc + ch, lambda x: 1.0 - np.einsum("...i,ij,...j->...", x - cc, inv, x - cc), cc,
-                 found.back_std)  # fmt: skip
+    yield _Shape("cone", cc - ch, cc + ch, Quadric(cc, inv), cc, found.back_std)
 
 
 def _revolution(fit: _Fitting) -> Iterator[_Shape]:

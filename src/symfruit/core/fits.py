@@ -71,13 +71,17 @@ def fit_sphere(points: np.ndarray, *, refine: bool = True, iterations: int = 10)
     c = sol[:3]
     r = float(np.sqrt(max(sol[3] + c @ c, 1e-12)))
     if refine:
+        jac = np.empty((len(q), 4))
+        jac[:, 3] = -1.0
         for _ in range(iterations):
             diff = q - c
-            dist = np.linalg.norm(diff, axis=1)
-            dist = np.maximum(dist, 1e-12)
-            jac = np.column_stack([-diff / dist[:, None], -np.ones(len(q))])
+            dist = np.maximum(np.sqrt(np.einsum("ij,ij->i", diff, diff)), 1e-12)
+            np.divide(diff, -dist[:, None], out=jac[:, :3])
             res = dist - r
-            step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
+            try:  # the 4x4 normal equations (the algebraic fit above has checked the points' rank)
+                step = np.linalg.solve(jac.T @ jac, -(jac.T @ res))
+            except np.linalg.LinAlgError:
+                step, *_ = np.linalg.lstsq(jac, -res, rcond=None)
             c = c + step[:3]
             r = float(abs(r + step[3]))
             if np.abs(step).max() < 1e-10:
@@ -641,6 +645,37 @@ def cone_ellipsoid(
     return m, shape, valid
 
 
+def _cone_fronts(params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray,
+                 ray_cone: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Front depth (k, n) along rays (n, ``z = 1``) of the ellipsoids of :func:`cone_ellipsoid` with parameters
+    (k, 4), straight from the cone (NaN where a ray misses), and which parameters are valid (k,).
+
+    With ``S = lambda C^-1 + m m^T`` and ``q = -m^T C m``, Sherman-Morrison gives ``S^-1 = C / lambda - C m m^T C
+    / (lambda (lambda - q))``, so along a ray ``r`` the quadratic ``a z^2 - 2 b z + c`` of
+    ``(z r - m)^T S^-1 (z r - m) - 1`` has ``a = r^T C r / lambda - (r^T C m)^2 / (lambda (lambda - q))``, ``b =
+    r^T C m / (lambda - q)`` and ``c = -lambda / (lambda - q)``: no 3x3 inverse per ellipsoid, no (k, n, 3)
+    product. ``ray_cone`` is ``r^T C r`` of every ray (n,).
+    """
+    p = np.atleast_2d(params)
+    m = np.empty((len(p), 3))
+    m[:, :2] = axis[:2] + p[:, :2]
+    m[:, 2] = axis[2]
+    m *= np.exp(p[:, 2:3])
+    cm = m @ cone  # (k, 3); C is symmetric
+    q = -(cm * m).sum(axis=1)
+    valid = q > 0
+    lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
+    gap = (lam - q)[:, None]  # < 0
+    rcm = cm @ rays.T  # (k, n)
+    with np.errstate(invalid="ignore"):
+        a = ray_cone[None, :] / lam[:, None] - rcm * rcm / (lam[:, None] * gap)
+        b = rcm / gap
+        c = -lam[:, None] / gap
+        disc = b * b - a * c
+        root = np.sqrt(np.maximum(disc, 0.0))
+        return np.where(disc >= 0, (b - root) / a, np.nan), valid
+
+
 def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarray:
     """Front depth (k, n) of ellipsoids (k) along rays (n, ``z = 1``); NaN where a ray misses."""
     inv = np.linalg.inv(shape)
@@ -737,12 +772,11 @@ def fit_cone_ellipsoid(
     grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 7)])
 
     cone_inv = np.linalg.inv(cone)
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
 
     def residuals(p: np.ndarray) -> np.ndarray:
-        m, shape, valid = cone_ellipsoid(p, cone, axis, cone_inv=cone_inv)
-        res = np.full((len(p), len(z)), 0.05)
-        if valid.any():
-            res[valid] = z[None, :] - _cone_front(m[valid], shape[valid], rays)
+        fronts, valid = _cone_fronts(p, cone, axis, rays, ray_cone)
+        res = np.where(valid[:, None], z[None, :] - fronts, 0.05)
         return np.where(np.isfinite(res), res, 0.02)
 
     def cost(res: np.ndarray) -> np.ndarray:

@@ -14,7 +14,7 @@ evaluation's rendered views, so both measure what a robot gets.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import ndimage
@@ -57,6 +57,8 @@ class Occlusion:
     height: int
     own: np.ndarray | None = None
     depth: np.ndarray | None = None
+    #: :attr:`hidden` grown by each radius asked for (:meth:`grown`), made once (the maps are read-only).
+    _grown: dict[int, np.ndarray] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __post_init__(self) -> None:
         hidden = np.asarray(self.hidden)
@@ -102,14 +104,24 @@ class Occlusion:
         col = np.rint(np.asarray(u, dtype=np.float64)).astype(np.intp)
         row = np.rint(np.asarray(v, dtype=np.float64)).astype(np.intp)
         out = (col < radius) | (col >= self.width - radius) | (row < radius) | (row >= self.height - radius)
-        hidden = self.hidden
-        if radius > 0 and hidden.any():
-            hidden = ndimage.maximum_filter(hidden, size=2 * radius + 1, mode="constant", cval=False)
+        hidden = self.grown(radius)
         h, w = hidden.shape
         c, r = col - self.u0, row - self.v0
         inside = (c >= 0) & (c < w) & (r >= 0) & (r < h)
         out[inside] |= hidden[r[inside], c[inside]]
         return out
+
+    def grown(self, radius: int) -> np.ndarray:
+        """(h, w) bool: the window's pixels with a hidden pixel of the window within ``radius`` (a square), made
+        once per radius (the image border is :meth:`at`'s)."""
+        if radius <= 0 or not self.hidden.any():
+            return self.hidden
+        found = self._grown.get(radius)
+        if found is None:
+            found = ndimage.maximum_filter(self.hidden, size=2 * radius + 1, mode="constant", cval=False)
+            found.flags.writeable = False
+            self._grown[radius] = found
+        return found
 
     def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """(m,) float, metres: what the camera saw at pixels ``(u, v)`` (rounded), NaN where nothing or outside
@@ -125,10 +137,23 @@ class Occlusion:
         return out
 
     def window(self, region: Silhouette, *, radius: int = 0) -> np.ndarray:
-        """(h, w) bool in ``region``'s window: :meth:`at` of every pixel."""
+        """(h, w) bool in ``region``'s window: :meth:`at` of every pixel (cut from the grown map, no per-pixel
+        look-up)."""
         h, w = region.mask.shape
-        vv, uu = np.mgrid[region.v0 : region.v0 + h, region.u0 : region.u0 + w]
-        return self.at(uu.ravel(), vv.ravel(), radius=radius).reshape(h, w)
+        u = np.arange(region.u0, region.u0 + w)
+        v = np.arange(region.v0, region.v0 + h)
+        out = ((v < radius) | (v >= self.height - radius))[:, None] | ((u < radius) | (u >= self.width - radius))[
+            None, :
+        ]
+        hidden = self.grown(radius)
+        gh, gw = hidden.shape
+        r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
+        r1, c1 = min(region.v0 + h, self.v0 + gh), min(region.u0 + w, self.u0 + gw)
+        if r1 > r0 and c1 > c0:
+            out[r0 - region.v0 : r1 - region.v0, c0 - region.u0 : c1 - region.u0] |= hidden[
+                r0 - self.v0 : r1 - self.v0, c0 - self.u0 : c1 - self.u0
+            ]
+        return out
 
     def allowed(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
         """(h, w) bool, this window: where the fruit seen as ``region`` may project.
@@ -154,13 +179,21 @@ class Occlusion:
             return seen
         allowed = hidden.copy()
         if gap > 0:
+            # both filters only matter within ``gap`` of the seen pixels: run them on the seen box grown by
+            # ``2 gap`` (their inputs there), clipped to the window as the filters' own border is
             size = 2 * gap + 1
-            grown = ndimage.maximum_filter(seen, size=size, mode="constant", cval=False)
-            allowed |= grown & ndimage.maximum_filter(hidden, size=size, mode="constant", cval=False)
+            rows, cols = np.flatnonzero(seen.any(axis=1)), np.flatnonzero(seen.any(axis=0))
+            b0, b1 = max(int(rows[0]) - 2 * gap, 0), min(int(rows[-1]) + 2 * gap + 1, h)
+            a0, a1 = max(int(cols[0]) - 2 * gap, 0), min(int(cols[-1]) + 2 * gap + 1, w)
+            grown = ndimage.maximum_filter(seen[b0:b1, a0:a1], size=size, mode="constant", cval=False)
+            near = ndimage.maximum_filter(hidden[b0:b1, a0:a1], size=size, mode="constant", cval=False)
+            allowed[b0:b1, a0:a1] |= grown & near
         allowed |= seen
-        labels, _ = ndimage.label(allowed, structure=np.ones((3, 3), bool))
-        keep = np.unique(labels[seen])
-        return np.isin(labels, keep[keep > 0])
+        labels, count = ndimage.label(allowed, structure=np.ones((3, 3), bool))
+        keep = np.zeros(count + 1, dtype=bool)
+        keep[labels[seen]] = True
+        keep[0] = False
+        return keep[labels]
 
     def extent(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
         """Where the fruit seen as ``region`` can project at most: ``(u_min, v_min, u_max, v_max)``, pixels
@@ -260,13 +293,13 @@ def occlusion(
     own_z = flat.reshape(h, w)
     seen_own = np.isfinite(own_z)
     # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
-    _, (nr, nc) = ndimage.distance_transform_edt(~seen_own, return_indices=True)
+    nr, nc = ndimage.distance_transform_edt(~seen_own, return_distances=False, return_indices=True)
     z_ref = own_z[nr, nc]
     own = mask[v0:v1, u0:u1] | seen_own
     d = np.asarray(depth[v0:v1, u0:u1], dtype=np.float64)
     valid = np.isfinite(d) & (d > 0) & ~own
     d = np.where(valid, d, np.nan)
-    if reach > 0 and valid.any():
+    if reach > 0 and valid.any() and not (valid | own).all():  # pixels without depth take a neighbour's
         dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
         d = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
     with np.errstate(invalid="ignore"):

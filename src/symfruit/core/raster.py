@@ -23,6 +23,7 @@ __all__ = [
     "Silhouette",
     "View",
     "close_ragged",
+    "inner_distance",
     "outline_cone",
     "outline_cracks",
     "principal_widths",
@@ -216,6 +217,21 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     conic[:2, 2] = conic[2, :2] = -inv @ mu
     conic[2, 2] = mu @ inv @ mu - 1.0
     return _image_cone(conic, mu, camera)
+
+
+def inner_distance(mask: np.ndarray) -> np.ndarray:
+    """(h, w) float, pixels: ``ndimage.distance_transform_edt(mask)`` (each mask pixel's distance to the nearest
+    pixel outside it), transformed over the mask's box grown by a pixel (clipped to the image) alone: a pixel on
+    that grown border in the row or column of any farther background pixel is nearer, so the distances are the
+    same, and a mask in a wide window costs its own box."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    out = np.zeros(mask.shape)
+    if not len(rows):
+        return out
+    r0, r1 = max(int(rows[0]) - 1, 0), min(int(rows[-1]) + 2, mask.shape[0])
+    c0, c1 = max(int(cols[0]) - 1, 0), min(int(cols[-1]) + 2, mask.shape[1])
+    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(mask[r0:r1, c0:c1])
+    return out
 
 
 def principal_widths(mask: np.ndarray) -> tuple[float, float]:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
-from .raster import principal_widths
+from .raster import inner_distance, principal_widths
 
 __all__ = [
     "Surface",
@@ -241,7 +241,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
-    inner = ndimage.distance_transform_edt(mask) > interior * min(radius_px, 0.5 * minor_px)
+    inner = inner_distance(mask) > interior * min(radius_px, 0.5 * minor_px)
     return Surface(monotone_region(depth, near, apex, tol) | (near & inner), front, radius, noise, apex)
 
 
@@ -284,7 +284,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
-    inside = ndimage.distance_transform_edt(mask) - ndimage.distance_transform_edt(~mask)
+    inside = inner_distance(mask) - ndimage.distance_transform_edt(~mask)
     return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
 
 
@@ -367,7 +367,7 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     mask = np.asarray(mask, dtype=bool)
     if band_px <= 0 or not mask.any():
         return mask
-    inner = ndimage.distance_transform_edt(mask)
+    inner = inner_distance(mask)
     outer = ndimage.distance_transform_edt(~mask)
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt

@@ -32,6 +32,7 @@ __all__ = [
     "bench_segment",
     "bench_view",
     "measured_detect",
+    "profile_frame",
     "run_bench",
 ]
 
@@ -58,6 +59,7 @@ class BenchRow:
     p10_ms: float
     p90_ms: float
     repeat: int
+    min_ms: float = float("nan")
 
     def to_dict(self) -> dict[str, Any]:
         return dict(self.__dict__)
@@ -72,6 +74,11 @@ def _time(fn: Any, repeat: int) -> np.ndarray:
         fn()
         times[i] = time.perf_counter() - start
     return times * 1000.0
+
+
+def _row(case: str, method: str, planes: int, points: int, ms: np.ndarray) -> BenchRow:
+    return BenchRow(case, method, planes, points, float(np.median(ms)), float(np.percentile(ms, 10)),
+                    float(np.percentile(ms, 90)), len(ms), float(ms.min()))  # fmt: skip
 
 
 def run_bench(
@@ -107,19 +114,21 @@ def run_bench(
         for name, method, settings, view in cases:
             ms = _time(lambda m=method, s=settings, v=view: complete(v, method=m, settings=s), repeat)
             planes = settings.paper.n_hypotheses if method == "paper" else 0
-            rows.append(
-                BenchRow(
-                    name,
-                    method,
-                    planes,
-                    n,
-                    float(np.median(ms)),
-                    float(np.percentile(ms, 10)),
-                    float(np.percentile(ms, 90)),
-                    repeat,
-                )
-            )
+            rows.append(_row(name, method, planes, n, ms))
     return rows
+
+
+def _bench_scene(sensor: str | None, seed: int) -> Any:
+    """The benchmark's frame (see :func:`bench_frame`)."""
+    from ..core.frame import Frame
+    from ..synthetic.scenes import make_scene
+    from ..synthetic.sensors import sensor_model
+
+    model = None if sensor is None else sensor_model(sensor)
+    scene = make_scene(seed, n_ripe=8, n_unripe=2, sensor=model)
+    # Through a camera model the annotators' masks are used (as in the real-frame measurement of issue 18):
+    # at 1-2 m the colour segmenter finds few of the 20-40 px berries, which would leave little to time.
+    return Frame("bench", scene.color, scene.depth, scene.camera, masks=scene.masks), model
 
 
 def bench_frame(
@@ -130,23 +139,40 @@ def bench_frame(
     (a key of :data:`symfruit.synthetic.sensors.SENSOR_MODELS`) the frame is rendered through that camera
     model at its colour resolution (1920x1080 or 1280x720) and its annotators' masks are used instead of the
     colour segmenter."""
-    from ..core.frame import Frame
     from ..detect import detect
-    from ..synthetic.scenes import make_scene
-    from ..synthetic.sensors import sensor_model
 
-    model = None if sensor is None else sensor_model(sensor)
-    scene = make_scene(seed, n_ripe=8, n_unripe=2, sensor=model)
-    # Through a camera model the annotators' masks are used (as in the real-frame measurement of issue 18):
-    # at 1-2 m the colour segmenter finds few of the 20-40 px berries, which would leave little to time.
-    frame = Frame("bench", scene.color, scene.depth, scene.camera, masks=scene.masks)
+    frame, model = _bench_scene(sensor, seed)
     found = detect(frame, method=method)
     ms = _time(lambda: detect(frame, method=method), repeat)
     n = sum(d.result is not None for d in found.detections)
     where = "" if model is None else f", {sensor} {model.width}x{model.height}"
-    return BenchRow(f"frame, {n} fruit, {method}{where}", method, Settings().paper.n_hypotheses, n,
-                    float(np.median(ms)), float(np.percentile(ms, 10)), float(np.percentile(ms, 90)),
-                    repeat)  # fmt: skip
+    return _row(f"frame, {n} fruit, {method}{where}", method, Settings().paper.n_hypotheses, n, ms)
+
+
+def profile_frame(
+    *, repeat: int = 5, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None, top: int = 30
+) -> str:
+    """A deterministic profile (:mod:`cProfile`) of :func:`bench_frame`'s frame, ``repeat`` runs after a
+    warm-up: the ``top`` functions by their own time and by cumulative time, as text (times per frame)."""
+    import cProfile
+    import io
+    import pstats
+
+    from ..detect import detect
+
+    frame, _ = _bench_scene(sensor, seed)
+    detect(frame, method=method)
+    profiler = cProfile.Profile()
+    profiler.enable()
+    for _ in range(repeat):
+        detect(frame, method=method)
+    profiler.disable()
+    out = io.StringIO()
+    stats = pstats.Stats(profiler, stream=out)
+    out.write(f"cProfile of {repeat} frames, method {method} (times are totals over the {repeat} frames)\n")
+    stats.sort_stats("tottime").print_stats(top)
+    stats.sort_stats("cumulative").print_stats(top)
+    return out.getvalue()
 
 
 @dataclass(frozen=True)

@@ -55,7 +55,7 @@ from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
-from ..core.raster import Silhouette, close_ragged, principal_widths, silhouette
+from ..core.raster import Silhouette, close_ragged, inner_distance, principal_widths, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -302,7 +302,8 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
 
 
-def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15) -> float:
+def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15,
+                 inner: np.ndarray | None = None) -> float:  # fmt: skip
     """How much of the seen region's rim holds seen points, relative to its interior, in [0, 1].
 
     The rim is the region's pixels within ``band`` equivalent radii (at least 2 px) of its edge; the share of
@@ -311,10 +312,12 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     from the camera, at the rim, its depth says how deep the fruit is (a convex fruit's rim lies at about the
     depth of its widest section); a time-of-flight camera returns nothing there (it invalidates grazing
     pixels: the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the back face
-    must then be extrapolated from the front's curvature alone.
+    must then be extrapolated from the front's curvature alone. ``inner``: the region's distance map when known
+    (:attr:`~symfruit.core.agreement.Observation.inner`).
     """
     mask = region.mask
-    inner = ndimage.distance_transform_edt(mask)
+    if inner is None or inner.shape != mask.shape:
+        inner = inner_distance(mask)
     width = max(2.0, band * float(np.sqrt(mask.sum() / np.pi)))
     rim = mask & (inner <= width)
     rest = mask & ~rim
@@ -426,7 +429,7 @@ def evidence(
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
-    rim = rim_coverage(points, region, camera)
+    rim = rim_coverage(points, region, camera, inner=obs.inner)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim)
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     uncertainty = float(np.hypot(combined.uncertainty, moved))
