@@ -332,6 +332,8 @@ def segment(
     h, w = c.shape[:2]
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
+    # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
+    z_typical = 0.0 if z is None else float(np.median(z[::8, ::8][z[::8, ::8] > 0])) if (z[::8, ::8] > 0).any() else 1.0
 
     # Red pixels are looked for on a coarse grid first, then at full resolution around what it found: a
     # region that no grid point falls in is far smaller than a fruit.
@@ -348,7 +350,9 @@ def segment(
         seeded[labels[strong[win]]] = True
         seeded[0] = False
         sizes = np.bincount(labels.ravel(), minlength=n + 1)
-        keep = seeded & (sizes >= 0.25 * min_area)  # fragments down to a quarter of a fruit may join one
+        # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
+        least = min_area if z is None else _least_areas(labels, n, z[win], s.min_diameter * geo.focal, z_typical)
+        keep = seeded & (sizes >= 0.25 * least)
         for k, sl in enumerate(ndimage.find_objects(labels), 1):
             if not keep[k] or sl is None:
                 continue
@@ -381,7 +385,7 @@ def segment(
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
-        if not _fruit_sized(hull, sub_z, s, geo.focal, min_area):
+        if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
         if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
             continue
@@ -896,15 +900,29 @@ def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jum
     return part | (hull & ~off)
 
 
-def _fruit_sized(mask: np.ndarray, depth: np.ndarray | None, s: SegmentSettings, focal: float, min_area: float) -> bool:
+def _fruit_sized(
+    mask: np.ndarray, depth: np.ndarray | None, s: SegmentSettings, focal: float, min_area: float, z_typical: float
+) -> bool:
+    """Whether a part is fruit-sized: without depth ``min_area`` pixels; with depth at least a disc of
+    ``min_diameter`` at its median depth (``z_typical`` when none of its pixels has depth)."""
     area = int(mask.sum())
     if depth is None:
         return area >= min_area
     z = depth[mask & (depth > 0)]
-    if len(z) == 0:
-        return False
-    diameter_px = focal * s.min_diameter / float(np.median(z))
+    diameter_px = focal * s.min_diameter / (float(np.median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
+
+
+def _least_areas(labels: np.ndarray, n: int, depth: np.ndarray, diameter_px_m: float, z_typical: float) -> np.ndarray:
+    """(n + 1,) the least fruit's area (pixels) at each labelled region's median depth (``z_typical`` for
+    regions without depth); ``diameter_px_m`` is the least diameter times the focal length."""
+    valid = (labels > 0) & (depth > 0)
+    z = np.full(n + 1, z_typical)
+    if valid.any():
+        idx = np.arange(1, n + 1)
+        med = np.asarray(ndimage.median(depth, np.where(valid, labels, 0), idx), dtype=np.float64)
+        z[1:] = np.where(np.isfinite(med) & (med > 0), med, z_typical)
+    return np.pi / 4 * (diameter_px_m / z) ** 2
 
 
 def _elongation(mask: np.ndarray) -> float:
