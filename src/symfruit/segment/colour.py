@@ -505,6 +505,7 @@ class _Piece:
     mask: np.ndarray
     source: int  # a bit set of the colour regions it came from
     hull: float = -1.0
+    serial: int = -1  # a number of its own while pieces are merged
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
@@ -527,6 +528,10 @@ def _merge(
     were kept apart on purpose and are not joined again."""
     slack = s.merge_slack
     pieces = sorted(pieces, key=lambda p: -p.area)
+    for k, piece in enumerate(pieces):
+        piece.serial = k
+    serial = len(pieces)
+    apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
     merged = True
     while merged and len(pieces) > 1:
         merged = False
@@ -534,7 +539,7 @@ def _merge(
             for j in range(i + 1, len(pieces)):
                 a, b = pieces[i], pieces[j]
                 gap = max(2, int(0.5 * np.sqrt(min(a.area, b.area))))  # an occluder narrower than the fruit
-                if (a.source & b.source) or not _near(a.window, b.window, gap=gap):
+                if (a.source & b.source) or (a.serial, b.serial) in apart or not _near(a.window, b.window, gap=gap):
                     continue
                 window, union = _union(a, b)
                 hull = _hull_area(union)
@@ -543,10 +548,12 @@ def _merge(
                 if hull <= (1.0 + slack) * (a.hull + b.hull) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
-                    pieces[i] = _Piece(window, union, a.source | b.source, hull)
+                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
+                    serial += 1
                     del pieces[j]
                     merged = True
                     break
+                apart.add((a.serial, b.serial))
             if merged:
                 break
     return pieces
