@@ -333,15 +333,101 @@ def segment(
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
     # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
-    z_typical = 0.0 if z is None else float(np.median(z[::8, ::8][z[::8, ::8] > 0])) if (z[::8, ::8] > 0).any() else 1.0
+    grid = None if z is None else z[::8, ::8]
+    z_typical = 0.0 if grid is None else float(np.median(grid[grid > 0])) if (grid > 0).any() else 1.0
 
-    # Red pixels are looked for on a coarse grid first, then at full resolution around what it found: a
-    # region that no grid point falls in is far smaller than a fruit.
+    # Red pixels are looked for on a coarse grid first (the pyramid's top). When every candidate fruit there
+    # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
+    # more across) and the fruit brought back to full resolution.
+    coarse = _coarse_regions(c, s)
+    if coarse is None:
+        return np.zeros((h, w), np.int32)
+    step = _working_step(coarse, min_area if z is None else 0.0)
+    if step == 1:
+        return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
+    o = step // 2
+    small_c = c[o::step, o::step]
+    small_z = None if z is None else z[o::step, o::step]
+    small_geo = _Geometry(geo.focal / step, (geo.cy - o) / step, (geo.cx - o) / step)
+    small = _segment_at(small_c, small_z, small_geo, s, min_area / step**2, z_typical,
+                        _red_windows(_coarse_regions(small_c, s), small_c.shape[:2]))  # fmt: skip
+    hull = s.fill == "hull" or (s.fill == "auto" and z is None)
+    return _upsample(small, step, (h, w), hull=hull)
+
+
+#: A fruit this many pixels across (or more) is segmented as well on a coarser grid: when every candidate
+#: fruit of an image is at least twice this, the image is worked on every other (third, fourth) pixel.
+WORK_DIAMETER = 128
+
+#: The coarsest working grid (every fourth pixel).
+MAX_STEP = 4
+
+
+def _working_step(coarse: tuple[np.ndarray, np.ndarray, np.ndarray], min_area: float) -> int:
+    """The pixel step to work on: the smallest seeded candidate region's equivalent diameter (on the coarse
+    grid) over :data:`WORK_DIAMETER`, 1 to :data:`MAX_STEP`. Regions too small to hold a quarter of the
+    least fruit (``min_area``, pixels; 0 with depth, where the size rule is in metres) do not count."""
+    _, sizes, seeded = coarse
+    area = sizes * COARSE_STEP**2
+    candidates = seeded & (area >= 0.25 * min_area)
+    candidates[0] = False
+    if not candidates.any():
+        return 1
+    diameter = float(np.sqrt(4.0 / np.pi * area[candidates].min()))
+    return int(np.clip(diameter // WORK_DIAMETER, 1, MAX_STEP))
+
+
+def _upsample(small: np.ndarray, step: int, shape: tuple[int, int], *, hull: bool) -> np.ndarray:
+    """Labels found on every ``step``-th pixel (sampled at ``step // 2``) brought to full resolution: each
+    fruit's blocks of pixels, or with ``hull`` the convex hull of those blocks (a polygon, not a staircase)."""
+    h, w = shape
+    out = np.zeros((h, w), np.int32)
+    corners = np.array([[0, 0], [step - 1, 0], [0, step - 1], [step - 1, step - 1]], np.float64)
+    for k, sl in enumerate(ndimage.find_objects(small), 1):
+        if sl is None:
+            continue
+        mask = small[sl] == k
+        r0, c0 = sl[0].start * step, sl[1].start * step
+        r1, c1 = min(sl[0].stop * step, h), min(sl[1].stop * step, w)
+        full = np.repeat(np.repeat(mask, step, axis=0), step, axis=1)[: r1 - r0, : c1 - c0]
+        if hull:
+            v = _hull_vertices(mask)
+            if v is not None:
+                pts = (v[:, None, :] * step + corners[None]).reshape(-1, 2)
+                full = full | _fill_polygon(_polygon(pts), (r1 - r0, c1 - c0))
+        window = out[r0:r1, c0:c1]
+        window[full & (window == 0)] = k
+    return out
+
+
+def _polygon(points: np.ndarray) -> np.ndarray:
+    """The convex hull vertices of (n, 2) points."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        return points[ConvexHull(points).vertices]
+    except QhullError:
+        return points
+
+
+def _segment_at(
+    c: np.ndarray,
+    z: np.ndarray | None,
+    geo: _Geometry,
+    s: SegmentSettings,
+    min_area: float,
+    z_typical: float,
+    windows: list[Window],
+) -> np.ndarray:
+    """:func:`segment` on one level of the pyramid, in the ``windows`` where red was found."""
+    h, w = c.shape[:2]
+    # Red pixels are looked for at full resolution around what the coarse grid found: a region that no grid
+    # point falls in is far smaller than a fruit.
     strong = np.zeros((h, w), bool)
     weak = np.zeros((h, w), bool)
     pieces: list[_Piece] = []
     sources = 0
-    for win in _red_windows(c, s):
+    for win in windows:
         strong[win], weak[win] = ripe_seeds(c[win], s)
         labels, n = ndimage.label(weak[win], structure=np.ones((3, 3), bool))
         if n == 0:
@@ -406,17 +492,28 @@ def segment(
 COARSE_STEP = 4
 
 
-def _red_windows(c: np.ndarray, s: SegmentSettings) -> list[Window]:
-    """Disjoint image windows holding every weakly red region with a grid point in it (a coarse grid of
-    step :data:`COARSE_STEP`), each with a margin of one grid step."""
-    h, w = c.shape[:2]
-    step = COARSE_STEP
-    _, weak = ripe_seeds(c[::step, ::step], s)
+def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The weakly red regions on a coarse grid of step :data:`COARSE_STEP`: their labels, sizes (grid
+    points) and whether each holds a seed (strongly red) point; None without any."""
+    strong, weak = ripe_seeds(c[::COARSE_STEP, ::COARSE_STEP], s)
     if not weak.any():
-        return []
+        return None
     lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     sizes[0] = 0
+    seeded = np.zeros(n + 1, bool)
+    seeded[lab[strong]] = True
+    return lab, sizes, seeded
+
+
+def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape: tuple[int, int]) -> list[Window]:
+    """Disjoint image windows holding every weakly red region with a grid point in it (the coarse grid of
+    :func:`_coarse_regions`), each with a margin of one grid step."""
+    if coarse is None:
+        return []
+    h, w = shape
+    step = COARSE_STEP
+    lab, sizes, _ = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
     lab, _ = ndimage.label(ndimage.binary_dilation((sizes >= 2)[lab], structure=np.ones((3, 3), bool)))
     boxes = [[max(sl[0].start * step - step, 0), min(sl[0].stop * step + step, h),
