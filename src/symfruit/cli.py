@@ -62,9 +62,11 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--segment",
         action="store_true",
-        help="instead: time the colour segmenter per 640x480 image (photos from --images, else synthetic)",
+        help="instead: time the colour segmenter per image at --size (photos from --images, else synthetic)",
     )
-    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to 640x480)")
+    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to --size)")
+    p.add_argument("--size", default="640x480", metavar="WxH",
+                   help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
@@ -302,9 +304,15 @@ def _bench(args: argparse.Namespace) -> int:
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
     if args.segment:
+        from .core.limits import check_image_size
         from .evaluate.bench import bench_segment
 
-        row = bench_segment(args.images)
+        try:
+            width, height = (int(v) for v in str(args.size).lower().split("x"))
+        except ValueError:
+            raise InputError(f"--size must be WIDTHxHEIGHT, e.g. 1920x1080, got {args.size!r}") from None
+        check_image_size(width, height, "--size")
+        row = bench_segment(args.images, size=(width, height))
         if args.json:
             print(json.dumps({"machine": machine(), "segment": row.to_dict()}, indent=2))
             return 0

@@ -317,7 +317,9 @@ def make_tree_scene(
     meshes: list[tuple[np.ndarray, np.ndarray]] = []
     colours: list[tuple[float, float, float]] = []
     fruits: list[SceneFruit] = []
-    skins: list[tuple[int, np.ndarray, float, np.ndarray, np.ndarray, float]] = []  # mesh, centre, r, base, blush, share
+    skins: list[
+        tuple[int, np.ndarray, float, np.ndarray, np.ndarray, float]
+    ] = []  # mesh, centre, r, base, blush, share
     spheres: list[tuple[np.ndarray, float]] = []
     for k in range(n_apples + n_green):
         ripe = k < n_apples
@@ -325,7 +327,9 @@ def make_tree_scene(
         radius = 0.5 * float(np.ptp(fruit.vertices, axis=0).max())
         for _ in range(200):
             z = z0 + rng.uniform(-0.05, 0.35)
-            centre = np.array([rng.uniform(-0.95, 0.95) * half_x * z / z0, rng.uniform(-0.95, 0.95) * half_y * z / z0, z])
+            centre = np.array(
+                [rng.uniform(-0.95, 0.95) * half_x * z / z0, rng.uniform(-0.95, 0.95) * half_y * z / z0, z]
+            )
             if all(np.linalg.norm(centre - c) > 1.05 * (radius + r) for c, r in spheres):
                 break
         spheres.append((centre, radius))
@@ -374,7 +378,7 @@ def make_tree_scene(
     # apple skins: blush and base colour by the direction from the apple's centre, sunlit from the upper left
     sun = np.array([-0.5, -0.7, -0.5]) / np.linalg.norm([-0.5, -0.7, -0.5])
     yy, xx = np.mgrid[: camera.height, : camera.width]
-    for index, centre, radius, base, blush, share in skins:
+    for index, centre, _radius, base, blush, share in skins:
         on = shot.ids == index
         if not on.any():
             continue
