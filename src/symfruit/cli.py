@@ -121,6 +121,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--category", type=int, default=1,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+                   help="masks protocol on rendered scenes: table-top strawberries (default) or an apple tree's "
+                   "canopy at 1.2-2 m through the Azure Kinect model (1920x1080; use with --fruit apple)")  # fmt: skip
 
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
@@ -488,9 +491,10 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
         n = args.n or 20
-        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth)
-        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth}
-        what = f"rendered scenes {args.seed}-{args.seed + n - 1} ({'colour alone' if args.no_depth else 'with depth'})"
+        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
+        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}
+        what = (f"rendered {args.scene} scenes {args.seed}-{args.seed + n - 1} "
+                f"({'colour alone' if args.no_depth else 'with depth'})")  # fmt: skip
     folder = new_results_folder(args.output, "masks")
     write_mask_report(folder, ev, meta={**meta, "mask_source": source, "settings": settings.to_dict()["segment"]})
     s = ev.summary
