@@ -121,6 +121,10 @@ class SegmentSettings(Section):
         centres farther apart than this share of the sum of their radii (touching fruit: about 1; one
         fruit cut in two: about 0); two fragments are one fruit when the smaller lies on the larger's
         sphere within this share of its radius.
+    round_fruit : bool
+        With depth: the fruit are round (apples, tomatoes, citrus), so each one's visible skin is every pixel
+        inside the outline of the sphere fitted to its red part whose depth lies on that sphere's front
+        (a bicoloured apple's yellow-green side, not the leaf in front). Off for strawberries.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -140,6 +144,7 @@ class SegmentSettings(Section):
     crease_curvature: float = setting(1500.0, gt=0.0, le=1e7)
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
+    round_fruit: bool = setting(False)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -471,6 +476,9 @@ def _segment_at(
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
+            if s.round_fruit:  # the rest of a round fruit's visible skin: on the sphere its red part lies on
+                sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, (owner == 0) | (owner == k))
+                sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
         if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
@@ -684,7 +692,7 @@ def _same_surface(
     if fit is None or len(p) < 20:
         return None
     off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
-    return bool(np.median(off) <= s.sphere_apart * fit[1])
+    return bool(np.median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
 
 
 def _near(a: Window, b: Window, *, gap: int) -> bool:
@@ -1006,6 +1014,56 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     lap = ndimage.laplace(smooth)
     z = float(np.median(depth[valid]))
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
+
+
+def _on_sphere(
+    sl: Window,
+    hull: np.ndarray,
+    red: np.ndarray,
+    depth: np.ndarray,
+    color: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    free: np.ndarray,
+) -> tuple[Window, np.ndarray]:
+    """A round fruit's whole visible skin: the sphere fitted to its red part's depth points, and every
+    pixel inside the sphere's outline whose depth lies on its front (within ``depth_jump``; without depth:
+    not green), not another fruit's (``free``, whole image). A bicoloured apple's yellow-green side joins
+    its red blush; a leaf in front or behind does not. The window grows to the sphere's outline (bounded by
+    :data:`SPHERE_GROWTH` times the part's own size); unchanged without a fruit-like fit."""
+    fit = _sphere(red, depth[sl], geo, (sl[0].start, sl[1].start))
+    if fit is None:
+        return sl, hull
+    centre, radius = fit
+    if not (centre[2] > 2 * radius and radius <= 2.0 * s.min_diameter * 2):  # in front of the camera, fruit-sized
+        return sl, hull
+    u = geo.cx + geo.focal * centre[0] / centre[2]
+    v = geo.cy + geo.focal * centre[1] / centre[2]
+    rp = geo.focal * radius / np.sqrt(centre[2] ** 2 - radius**2)  # the outline's radius, pixels
+    size = max(sl[0].stop - sl[0].start, sl[1].stop - sl[1].start)
+    if rp > SPHERE_GROWTH * size:
+        return sl, hull
+    h, w = depth.shape
+    r0, r1 = max(int(v - rp) - 1, 0), min(int(v + rp) + 2, h)
+    c0, c1 = max(int(u - rp) - 1, 0), min(int(u + rp) + 2, w)
+    big = (slice(min(r0, sl[0].start), max(r1, sl[0].stop)), slice(min(c0, sl[1].start), max(c1, sl[1].stop)))
+    yy, xx = np.mgrid[big[0], big[1]]
+    dx, dy = (xx - geo.cx) / geo.focal, (yy - geo.cy) / geo.focal
+    dc = dx * centre[0] + dy * centre[1] + centre[2]
+    dd = dx * dx + dy * dy + 1.0
+    disc = dc * dc - dd * (float(centre @ centre) - radius * radius)
+    inside = disc >= 0
+    front = (dc - np.sqrt(np.where(inside, disc, 0.0))) / dd  # depth of the sphere's front along each ray
+    z = depth[big]
+    core = (xx - u) ** 2 + (yy - v) ** 2 <= (0.9 * rp) ** 2  # registration moves depth a few pixels off colour
+    on = inside & core & (z > 0) & (np.abs(z - front) <= s.depth_jump) & ~_green(color[big]) & free[big]
+    grown = np.zeros(on.shape, bool)
+    grown[sl[0].start - big[0].start : sl[0].stop - big[0].start, sl[1].start - big[1].start : sl[1].stop - big[1].start] = hull
+    return big, grown | on
+
+
+#: The sphere of a round fruit may reach at most this many times the size of its red part's window.
+SPHERE_GROWTH = 1.5
 
 
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
