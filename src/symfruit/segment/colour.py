@@ -477,7 +477,7 @@ def _segment_at(
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
             if s.round_fruit:  # the rest of a round fruit's visible skin: on the sphere its red part lies on
-                sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, (owner == 0) | (owner == k))
+                sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, owner, k)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
@@ -682,7 +682,8 @@ def _same_surface(
     a: _Piece, b: _Piece, depth: np.ndarray, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
-    distance off it at most ``sphere_apart`` times its radius); None when there is no fit."""
+    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``); None
+    when there is no fit."""
     big, small = (a, b) if a.area >= b.area else (b, a)
     origin = (big.window[0].start, big.window[1].start)
     fit = _sphere(big.mask & weak[big.window], depth[big.window], geo, origin)
@@ -1024,11 +1025,12 @@ def _on_sphere(
     color: np.ndarray,
     geo: _Geometry,
     s: SegmentSettings,
-    free: np.ndarray,
+    owner: np.ndarray,
+    k: int,
 ) -> tuple[Window, np.ndarray]:
     """A round fruit's whole visible skin: the sphere fitted to its red part's depth points, and every
-    pixel inside the sphere's outline whose depth lies on its front (within ``depth_jump``; without depth:
-    not green), not another fruit's (``free``, whole image). A bicoloured apple's yellow-green side joins
+    pixel inside the sphere's outline whose depth lies on its front (within ``depth_jump``) and that is not
+    green, nor another fruit's (``owner``, whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow-green side joins
     its red blush; a leaf in front or behind does not. The window grows to the sphere's outline (bounded by
     :data:`SPHERE_GROWTH` times the part's own size); unchanged without a fruit-like fit."""
     fit = _sphere(red, depth[sl], geo, (sl[0].start, sl[1].start))
@@ -1056,7 +1058,8 @@ def _on_sphere(
     front = (dc - np.sqrt(np.where(inside, disc, 0.0))) / dd  # depth of the sphere's front along each ray
     z = depth[big]
     core = (xx - u) ** 2 + (yy - v) ** 2 <= (0.9 * rp) ** 2  # registration moves depth a few pixels off colour
-    on = inside & core & (z > 0) & (np.abs(z - front) <= s.depth_jump) & ~_green(color[big]) & free[big]
+    free = (owner[big] == 0) | (owner[big] == k)
+    on = inside & core & (z > 0) & (np.abs(z - front) <= s.depth_jump) & ~_green(color[big]) & free
     grown = np.zeros(on.shape, bool)
     grown[sl[0].start - big[0].start : sl[0].stop - big[0].start, sl[1].start - big[1].start : sl[1].stop - big[1].start] = hull
     return big, grown | on
@@ -1090,14 +1093,12 @@ def _fruit_sized(
 
 
 def _least_areas(labels: np.ndarray, n: int, depth: np.ndarray, diameter_px_m: float, z_typical: float) -> np.ndarray:
-    """(n + 1,) the least fruit's area (pixels) at each labelled region's median depth (``z_typical`` for
+    """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
     regions without depth); ``diameter_px_m`` is the least diameter times the focal length."""
     valid = (labels > 0) & (depth > 0)
-    z = np.full(n + 1, z_typical)
-    if valid.any():
-        idx = np.arange(1, n + 1)
-        med = np.asarray(ndimage.median(depth, np.where(valid, labels, 0), idx), dtype=np.float64)
-        z[1:] = np.where(np.isfinite(med) & (med > 0), med, z_typical)
+    count = np.bincount(labels[valid], minlength=n + 1).astype(np.float64)
+    total = np.bincount(labels[valid], weights=depth[valid], minlength=n + 1)
+    z = np.where(count > 0, total / np.maximum(count, 1.0), z_typical)  # the mean: a threshold needs no more
     return np.pi / 4 * (diameter_px_m / z) ** 2
 
 
