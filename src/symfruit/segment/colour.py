@@ -654,11 +654,17 @@ def _merge(
     merged = True
     while merged and len(pieces) > 1:
         merged = False
+        box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
+        area = np.array([p.area for p in pieces], dtype=np.float64)
         for i in range(len(pieces)):
-            for j in range(i + 1, len(pieces)):
+            # the pieces near this one (closer than an occluder narrower than the smaller fruit), in order
+            gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
+            rest = box[i + 1 :]
+            near = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
+                    & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
+            for j in (np.flatnonzero(near) + i + 1).tolist():
                 a, b = pieces[i], pieces[j]
-                gap = max(2, int(0.5 * np.sqrt(min(a.area, b.area))))  # an occluder narrower than the fruit
-                if (a.source & b.source) or (a.serial, b.serial) in apart or not _near(a.window, b.window, gap=gap):
+                if (a.source & b.source) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
                 hull = _hull_area(union)
@@ -694,11 +700,6 @@ def _same_surface(
         return None
     off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
     return bool(np.median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
-
-
-def _near(a: Window, b: Window, *, gap: int) -> bool:
-    return (a[0].start - gap < b[0].stop and b[0].start - gap < a[0].stop
-            and a[1].start - gap < b[1].stop and b[1].start - gap < a[1].stop)  # fmt: skip
 
 
 def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
@@ -1029,9 +1030,10 @@ def _on_sphere(
     k: int,
 ) -> tuple[Window, np.ndarray]:
     """A round fruit's whole visible skin: the sphere fitted to its red part's depth points, and every
-    pixel inside the sphere's outline whose depth lies on its front (within ``depth_jump``) and that is not
-    green, nor another fruit's (``owner``, whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow-green side joins
-    its red blush; a leaf in front or behind does not. The window grows to the sphere's outline (bounded by
+    pixel inside the sphere's outline (shrunk by a tenth: depth is registered a few pixels off colour) whose
+    depth lies on its front (within ``depth_jump``), that is not green, nor another fruit's (``owner``,
+    whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow-green side joins its red
+    blush; a leaf in front or behind does not. The window grows to the sphere's outline (at most
     :data:`SPHERE_GROWTH` times the part's own size); unchanged without a fruit-like fit."""
     fit = _sphere(red, depth[sl], geo, (sl[0].start, sl[1].start))
     if fit is None:
@@ -1057,11 +1059,12 @@ def _on_sphere(
     inside = disc >= 0
     front = (dc - np.sqrt(np.where(inside, disc, 0.0))) / dd  # depth of the sphere's front along each ray
     z = depth[big]
-    core = (xx - u) ** 2 + (yy - v) ** 2 <= (0.9 * rp) ** 2  # registration moves depth a few pixels off colour
+    core = (xx - u) ** 2 + (yy - v) ** 2 <= (0.9 * rp) ** 2
     free = (owner[big] == 0) | (owner[big] == k)
     on = inside & core & (z > 0) & (np.abs(z - front) <= s.depth_jump) & ~_green(color[big]) & free
     grown = np.zeros(on.shape, bool)
-    grown[sl[0].start - big[0].start : sl[0].stop - big[0].start, sl[1].start - big[1].start : sl[1].stop - big[1].start] = hull
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    grown[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
     return big, grown | on
 
 
