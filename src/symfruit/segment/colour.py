@@ -524,24 +524,22 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     lab, sizes, _ = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
     lab = np.where((sizes >= 2)[lab], lab, 0)
-    pad = 2 * step  # a grid step around the region, and one more for its pixels between the grid points
-    boxes = [[max(sl[0].start * step - pad, 0), min(sl[0].stop * step + pad, h),
-              max(sl[1].start * step - pad, 0), min(sl[1].stop * step + pad, w)]
+    pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
+    gh, gw = lab.shape
+    boxes = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, gh),
+              max(sl[1].start - pad, 0), min(sl[1].stop + pad, gw))
              for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
-    merged = True
-    while merged:  # join overlapping windows, so that each region lies in one window only
-        merged = False
-        for i in range(len(boxes)):
-            for j in range(i + 1, len(boxes)):
-                a, b = boxes[i], boxes[j]
-                if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]:
-                    boxes[i] = [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])]
-                    del boxes[j]
-                    merged = True
-                    break
-            if merged:
-                break
-    return [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in boxes]
+    while boxes:  # join overlapping (and abutting) windows on the grid, until each region lies in one window only
+        painted = np.zeros((gh, gw), bool)
+        for r0, r1, c0, c1 in boxes:
+            painted[r0:r1, c0:c1] = True
+        joined = [
+            (sl[0].start, sl[0].stop, sl[1].start, sl[1].stop) for sl in ndimage.find_objects(ndimage.label(painted)[0])
+        ]
+        if len(joined) == len(boxes):
+            break
+        boxes = joined
+    return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
 def _fill_holes(mask: np.ndarray) -> np.ndarray:
