@@ -8,7 +8,11 @@ lying over it) sits inside that body's outline. So the segmenter
    (``redness >= red_high`` and a red, not orange, hue) through weakly red ones (``redness >= red_low``):
    hysteresis. White and green (unripe) fruit, the calyx, stems, skin tones too weak to seed and the
    light background never start a region; very dark pixels (deep shadow, black borders) are never red.
-   Red is looked for on a coarse grid first and at full resolution only around what it finds.
+   Red is looked for on a coarse grid first and at full resolution only around what it finds; when
+   every candidate fruit there is large (a close-up, a 1920x1080 photo), the image is worked on every
+   2nd-4th pixel (each fruit still ``WORK_DIAMETER`` pixels across) and the fruit are brought back to full
+   resolution as polygons. With depth, a region is kept by the least fruit's size at its own depth
+   (``min_diameter``), not by a share of the image, so 40-60 px apples in a 1920x1080 frame count.
 2. splits each region where it is not one convex body. A convex body's *distance transform* (the
    distance of each pixel to the region's outline) is concave: one peak, and the points deeper than any
    radius stay connected. Two touching or overlapping fruit give two peaks joined by a *waist*. A peak
@@ -29,6 +33,8 @@ lying over it) sits inside that body's outline. So the segmenter
 4. reports each fruit as its convex hull: seeds, highlights and the calyx inside the outline are filled
    (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
    green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
+   With ``round_fruit`` (apples), the visible skin is also every pixel inside the outline of the sphere
+   fitted to the red part's depth whose depth lies on that sphere's front (a bicoloured apple's green side).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
    berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
@@ -476,7 +482,7 @@ def _segment_at(
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
-            if s.round_fruit:  # the rest of a round fruit's visible skin: on the sphere its red part lies on
+            if s.round_fruit and z is not None:  # the rest of a round fruit's visible skin: on the sphere its red part lies on
                 sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, owner, k)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
