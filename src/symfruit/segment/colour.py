@@ -482,7 +482,7 @@ def _segment_at(
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
-            if s.round_fruit and z is not None:  # the rest of a round fruit's visible skin: on the sphere its red part lies on
+            if s.round_fruit and z is not None:  # the rest of a round fruit's skin
                 sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, owner, k)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
