@@ -368,7 +368,7 @@ def segment(
 
 #: A fruit this many pixels across (or more) is segmented as well on a coarser grid: when every candidate
 #: fruit of an image is at least twice this, the image is worked on every other (third, fourth) pixel.
-WORK_DIAMETER = 160
+WORK_DIAMETER = 128
 
 #: The coarsest working grid (every fourth pixel).
 MAX_STEP = 4
