@@ -392,3 +392,19 @@ def test_fill_holes_is_scipys():
     for _ in range(20):
         mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
         assert np.array_equal(_fill_holes(mask), ndimage.binary_fill_holes(mask))
+
+
+def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
+    # an apple 60 px across at 1.5 m, its left half red and its right half yellow, a leaf 10 cm behind it
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    yellow = disc & (np.mgrid[:1080, :1920][1] > 900)
+    color[yellow] = (200, 180, 60)
+    color[500:580, 935:990] = np.where(disc[500:580, 935:990, None], color[500:580, 935:990], (150, 140, 60))
+    plain = segment(color, depth, HD_CAM)
+    assert plain.max() == 1 and (plain > 0).sum() < 0.6 * disc.sum()  # the red half only
+    labels = segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True))
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow half joined
+    assert not found[500:580, 935:990][~disc[500:580, 935:990]].any()  # the yellowish leaf behind did not

@@ -33,8 +33,8 @@ lying over it) sits inside that body's outline. So the segmenter
 4. reports each fruit as its convex hull: seeds, highlights and the calyx inside the outline are filled
    (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
    green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
-   With ``round_fruit`` (apples), the visible skin is also every pixel inside the outline of the sphere
-   fitted to the red part's depth whose depth lies on that sphere's front (a bicoloured apple's green side).
+   With ``round_fruit`` (apples), the visible skin also takes the pixels around the red part reached from
+   it without crossing a depth step (a bicoloured apple's yellow side, not the leaf behind it).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
    berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
@@ -128,9 +128,9 @@ class SegmentSettings(Section):
         fruit cut in two: about 0); two fragments are one fruit when the smaller lies on the larger's
         sphere within this share of its radius.
     round_fruit : bool
-        With depth: the fruit are round (apples, tomatoes, citrus), so each one's visible skin is every pixel
-        inside the outline of the sphere fitted to its red part whose depth lies on that sphere's front
-        (a bicoloured apple's yellow-green side, not the leaf in front). Off for strawberries.
+        With depth: the fruit are round and may be only partly red (bicoloured apples), so each one's
+        visible skin also takes the pixels around its red part (within twice its radius) reached without
+        crossing a depth step and not green: the yellow side, not the leaf behind. Off for strawberries.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -483,7 +483,7 @@ def _segment_at(
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
             if s.round_fruit and z is not None:  # the rest of a round fruit's skin
-                sl, hull = _on_sphere(sl, hull, red, z, c, geo, s, owner, k)
+                sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
@@ -1022,10 +1022,9 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
-def _on_sphere(
+def _round_skin(
     sl: Window,
     hull: np.ndarray,
-    red: np.ndarray,
     depth: np.ndarray,
     color: np.ndarray,
     geo: _Geometry,
@@ -1033,47 +1032,51 @@ def _on_sphere(
     owner: np.ndarray,
     k: int,
 ) -> tuple[Window, np.ndarray]:
-    """A round fruit's whole visible skin: the sphere fitted to its red part's depth points, and every
-    pixel inside the sphere's outline (shrunk by a tenth: depth is registered a few pixels off colour) whose
-    depth lies on its front (within ``depth_jump``), that is not green, nor another fruit's (``owner``,
-    whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow-green side joins its red
-    blush; a leaf in front or behind does not. The window grows to the sphere's outline (at most
-    :data:`SPHERE_GROWTH` times the part's own size); unchanged without a fruit-like fit."""
-    fit = _sphere(red, depth[sl], geo, (sl[0].start, sl[1].start))
-    if fit is None:
+    """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
+    within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
+    crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
+    ``depth_jump`` of its median depth, and are neither green nor another fruit's (``owner``, whole image:
+    red pixels of piece ``k`` or of none). A bicoloured apple's yellow side joins its red blush; a leaf
+    in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
+    z_part = depth[sl][hull & (depth[sl] > 0)]
+    if len(z_part) < 20:
         return sl, hull
-    centre, radius = fit
-    if not (centre[2] > 2 * radius and radius <= 2.0 * s.min_diameter * 2):  # in front of the camera, fruit-sized
-        return sl, hull
-    u = geo.cx + geo.focal * centre[0] / centre[2]
-    v = geo.cy + geo.focal * centre[1] / centre[2]
-    rp = geo.focal * radius / np.sqrt(centre[2] ** 2 - radius**2)  # the outline's radius, pixels
-    size = max(sl[0].stop - sl[0].start, sl[1].stop - sl[1].start)
-    if rp > SPHERE_GROWTH * size:
-        return sl, hull
+    rows, cols = np.nonzero(hull)
+    rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
+    own = float(np.sqrt(hull.sum() / np.pi))
+    reach = ROUND_REACH * own
     h, w = depth.shape
-    r0, r1 = max(int(v - rp) - 1, 0), min(int(v + rp) + 2, h)
-    c0, c1 = max(int(u - rp) - 1, 0), min(int(u + rp) + 2, w)
-    big = (slice(min(r0, sl[0].start), max(r1, sl[0].stop)), slice(min(c0, sl[1].start), max(c1, sl[1].stop)))
+    big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
+           slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
     yy, xx = np.mgrid[big[0], big[1]]
-    dx, dy = (xx - geo.cx) / geo.focal, (yy - geo.cy) / geo.focal
-    dc = dx * centre[0] + dy * centre[1] + centre[2]
-    dd = dx * dx + dy * dy + 1.0
-    disc = dc * dc - dd * (float(centre @ centre) - radius * radius)
-    inside = disc >= 0
-    front = (dc - np.sqrt(np.where(inside, disc, 0.0))) / dd  # depth of the sphere's front along each ray
     z = depth[big]
-    core = (xx - u) ** 2 + (yy - v) ** 2 <= (0.9 * rp) ** 2
-    free = (owner[big] == 0) | (owner[big] == k)
-    on = inside & core & (z > 0) & (np.abs(z - front) <= s.depth_jump) & ~_green(color[big]) & free
-    grown = np.zeros(on.shape, bool)
+    zm = float(np.median(z_part))
+    part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
-    grown[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
-    return big, grown | on
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    free = (owner[big] == 0) | (owner[big] == k)
+    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+    deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
+    candidate = near & (z > 0) & deep & ~_green(color[big]) & free
+    step = np.zeros(z.shape, bool)
+    for axis in (0, 1):
+        jump = np.abs(np.diff(z, axis=axis)) > 0.5 * s.depth_jump
+        if axis == 0:
+            step[:-1] |= jump
+            step[1:] |= jump
+        else:
+            step[:, :-1] |= jump
+            step[:, 1:] |= jump
+    lab, n = ndimage.label((candidate & ~step) | part)
+    reached = np.zeros(n + 1, bool)
+    reached[lab[part]] = True
+    reached[0] = False
+    return big, reached[lab] | part
 
 
-#: The sphere of a round fruit may reach at most this many times the size of its red part's window.
-SPHERE_GROWTH = 1.5
+#: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
+#: third of the visible disc has about 0.6 of its radius).
+ROUND_REACH = 2.0
 
 
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
