@@ -66,9 +66,11 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--segment",
         action="store_true",
-        help="instead: time the colour segmenter per 640x480 image (photos from --images, else synthetic)",
+        help="instead: time the colour segmenter per image at --size (photos from --images, else synthetic)",
     )
-    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to 640x480)")
+    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to --size)")
+    p.add_argument("--size", default="640x480", metavar="WxH",
+                   help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
@@ -123,6 +125,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--category", type=int, default=1,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+                   help="masks protocol on rendered scenes: table-top strawberries (default) or an apple tree's "
+                   "canopy at 1.2-2 m through the Azure Kinect model (1920x1080; use with --fruit apple)")  # fmt: skip
 
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
@@ -309,9 +314,15 @@ def _bench(args: argparse.Namespace) -> int:
     if args.repeat < 1 or any(n < 10 for n in args.points):
         raise InputError("--repeat must be >= 1 and every --points >= 10")
     if args.segment:
+        from .core.limits import check_image_size
         from .evaluate.bench import bench_segment
 
-        row = bench_segment(args.images)
+        try:
+            width, height = (int(v) for v in str(args.size).lower().split("x"))
+        except ValueError:
+            raise InputError(f"--size must be WIDTHxHEIGHT, e.g. 1920x1080, got {args.size!r}") from None
+        check_image_size(width, height, "--size")
+        row = bench_segment(args.images, size=(width, height))
         if args.json:
             print(json.dumps({"machine": machine(), "segment": row.to_dict()}, indent=2))
             return 0
@@ -491,9 +502,10 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
         n = args.n or 20
-        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth)
-        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth}
-        what = f"rendered scenes {args.seed}-{args.seed + n - 1} ({'colour alone' if args.no_depth else 'with depth'})"
+        ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
+        meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}
+        what = (f"rendered {args.scene} scenes {args.seed}-{args.seed + n - 1} "
+                f"({'colour alone' if args.no_depth else 'with depth'})")  # fmt: skip
     folder = new_results_folder(args.output, "masks")
     write_mask_report(folder, ev, meta={**meta, "mask_source": source, "settings": settings.to_dict()["segment"]})
     s = ev.summary

@@ -181,3 +181,19 @@ def test_scoring_with_crowd_regions_known_answer():
     s = score_masks(truth, labels, ignore=crowd, crowd=1)
     assert (s.matched, s.n_pred, s.false, s.ignored, s.crowd) == (1, 2, 1, 1, 1)
     assert score_masks(truth, labels).false == 2
+
+
+def test_scene_masks_on_an_apple_tree_count_the_visible_ripe_apples():
+    from symfruit.settings import resolve_settings
+    from symfruit.synthetic.scenes import make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    options = {"sensor": sensor_model("azure-kinect").at(480, 270), "n_apples": 8, "n_green": 2, "n_leaves": 300}
+    settings = resolve_settings(fruit="apple").segment
+    ev = evaluate_scene_masks([2], lambda c, **kw: segment(c, settings=settings, **kw), scene="apple-tree",
+                              keep_worst=0, **options)  # fmt: skip
+    frame = make_tree_scene(2, **options)
+    seen = {int(k) for k in np.unique(frame.labels)} & {f.id for f in frame.fruits if f.ripe}
+    assert ev.summary["true_fruit"] == len(seen) and ev.summary["images"] == 1
+    with pytest.raises(InputError, match="apple-tree"):
+        evaluate_scene_masks([2], segment, scene="orchard")

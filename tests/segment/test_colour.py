@@ -295,3 +295,116 @@ def test_nothing_red_gives_an_empty_label_image():
     color = np.full((120, 160, 3), 90, np.uint8)
     labels = segment(color, np.ones((120, 160), np.float32), SMALL_CAM)
     assert labels.shape == (120, 160) and not labels.any()
+
+
+# Full camera resolutions: a pyramid for large fruit, the size rule in metres for small fruit with depth.
+
+HD_CAM = Camera(fx=960.0, fy=960.0, cx=959.5, cy=539.5, width=1920, height=1080)
+
+
+@pytest.mark.parametrize(
+    ("shape", "radius"), [((480, 640), 60), ((480, 640), 150), ((1080, 1920), 70), ((1080, 1920), 300)]
+)
+def test_a_disc_of_known_size_is_found_with_its_area(shape, radius):
+    h, w = shape
+    color, truth = make_photo([(w * 0.45, h * 0.55, radius, RED)], shape=shape, seed=3)
+    labels = segment(color)
+    assert labels.max() == 1
+    area = np.pi * radius**2
+    assert abs(int((labels == 1).sum()) - area) < 0.02 * area + 2 * np.pi * radius  # within a pixel of outline
+    assert score_masks(truth, labels).best_iou[0] > 0.97
+
+
+def test_large_touching_fruit_are_split_on_the_coarser_grid_too():
+    # 1080p, fruit 440 px across: worked on every third pixel, still two fruit with full-resolution outlines
+    color, truth = make_photo([(700, 540, 220, RED), (1130, 560, 220, RED)], shape=(1080, 1920), seed=2)
+    labels = segment(color)
+    s = score_masks(truth, labels)
+    assert s.n_pred == 2 and s.matched == 2 and s.best_iou.min() > 0.95
+    assert labels[540, 700] != labels[560, 1130]
+
+
+def test_fruit_at_the_image_border_of_a_large_image_are_kept_whole():
+    # cut by each border, worked on a coarser grid: the windows clipped to the image, the area right
+    fruit = [(-60, 540, 250, RED), (1960, 300, 250, RED), (960, -50, 250, RED), (960, 1140, 250, RED)]
+    color, truth = make_photo(fruit, shape=(1080, 1920), seed=4)
+    s = score_masks(truth, segment(color))
+    assert s.n_pred == 4 and s.matched == 4 and s.best_iou.min() > 0.97
+
+
+def hd_disc_frame(centres, radius, z=1.5, shape=(1080, 1920)):
+    """Red spheres (``radius`` pixels) at ``z`` on grey leaves' depth 10 cm behind: colour and depth."""
+    h, w = shape
+    yy, xx = np.mgrid[:h, :w]
+    color = np.full((h, w, 3), (70, 110, 60), np.uint8)
+    depth = np.full((h, w), z + 0.1)
+    r_m = radius * z / HD_CAM.fx
+    for cx, cy in centres:
+        d2 = ((xx - cx) ** 2 + (yy - cy) ** 2) * (z / HD_CAM.fx) ** 2
+        inside = d2 < r_m * r_m
+        color[inside] = RED
+        depth[inside] = z - np.sqrt(r_m * r_m - d2[inside])
+    return color, depth
+
+
+def test_small_fruit_in_a_full_hd_frame_are_found_with_depth():
+    # 50 px across at 1.5 m (a 78 mm apple): a thousandth of the image, below the colour-only share rule,
+    # fruit-sized by the size rule in metres at their own depth; one cut by the left border
+    centres = [(300, 200), (900, 540), (1500, 800), (10, 700)]
+    color, depth = hd_disc_frame(centres, radius=25)
+    labels = segment(color, depth, HD_CAM)
+    assert labels.max() == 4
+    for cx, cy in centres[:3]:
+        k = labels[cy, cx]
+        assert k > 0 and abs(int((labels == k).sum()) - np.pi * 25**2) < 0.1 * np.pi * 25**2
+    assert labels[700, 5] > 0
+    assert segment(color).max() == 0  # colour alone: the share of the image rules them out
+
+
+def test_a_small_fruit_cut_in_two_by_a_leaf_in_front_is_found_with_depth():
+    # each half is far smaller than the colour-only rule's least fruit; with depth, the pieces are sized in
+    # metres and joined again (one sphere), the leaf left out of the visible surface
+    color, depth = hd_disc_frame([(900, 540)], radius=25)
+    color[:, 896:905] = (60, 120, 50)
+    depth[:, 896:905] = 1.4
+    labels = segment(color, depth, HD_CAM)
+    assert labels.max() == 1
+    visible = (color == RED).all(axis=2)
+    assert (labels[visible] == 1).mean() > 0.95 and not labels[:, 897:904].any()
+
+
+def test_a_fruit_outside_the_depth_cameras_view_is_sized_at_the_frames_depth():
+    color, depth = hd_disc_frame([(900, 540), (100, 540)], radius=25)
+    depth[:, :200] = 0.0  # the depth camera sees less than the colour camera
+    labels = segment(color, depth, HD_CAM)
+    assert labels.max() == 2 and labels[540, 100] > 0
+    speck, depth = hd_disc_frame([(900, 540), (100, 540)], radius=3)  # 4.5 mm at 1.5 m: no fruit
+    depth[:, :200] = 0.0
+    assert segment(speck, depth, HD_CAM).max() == 0
+
+
+def test_fill_holes_is_scipys():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _fill_holes
+
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
+        assert np.array_equal(_fill_holes(mask), ndimage.binary_fill_holes(mask))
+
+
+def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
+    # an apple 60 px across at 1.5 m, its left half red and its right half yellow, a leaf 10 cm behind it
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    yellow = disc & (np.mgrid[:1080, :1920][1] > 900)
+    color[yellow] = (200, 180, 60)
+    color[500:580, 935:990] = np.where(disc[500:580, 935:990, None], color[500:580, 935:990], (150, 140, 60))
+    plain = segment(color, depth, HD_CAM)
+    assert plain.max() == 1 and (plain > 0).sum() < 0.6 * disc.sum()  # the red half only
+    labels = segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True))
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow half joined
+    assert not found[500:580, 935:990][~disc[500:580, 935:990]].any()  # the yellowish leaf behind did not

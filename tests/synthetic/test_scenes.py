@@ -121,3 +121,46 @@ def test_a_scene_through_a_real_camera_has_its_resolution_and_the_annotators_mas
             assert (scene.masks[own] == k).mean() > 0.95 and (scene.masks == k).sum() >= own.sum()
     z = np.array([f.box.centre[2] for f in scene.fruits])
     assert 0.24 <= z.min() and z.max() <= 0.52 and np.ptp(z) <= 0.1  # one cluster within the D405 range
+
+
+@pytest.fixture(scope="module")
+def tree():
+    from symfruit.synthetic.scenes import make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    # a quarter of the Azure Kinect's 1920x1080 (the same fields of view), fewer leaves: quick to render
+    return make_tree_scene(3, sensor=sensor_model("azure-kinect").at(480, 270), n_apples=12, n_green=2, n_leaves=600)
+
+
+def test_an_apple_tree_frame_has_apples_of_their_size_at_their_depth(tree):
+    assert tree.color.shape == (270, 480, 3) and tree.depth.shape == (270, 480) and tree.labels.shape == (270, 480)
+    assert [f.kind for f in tree.fruits] == ["apple"] * 14 and sum(f.ripe for f in tree.fruits) == 12
+    for f in tree.fruits:
+        assert 0.055 <= f.box.size.max() <= 0.095  # 60-90 mm apples (their stems not in the box)
+        assert 1.1 <= f.box.centre[2] <= 2.5
+    # seen whole near the middle of the view (no perspective stretch), an apple spans about fx * diameter / z px
+    cam = tree.camera
+    middle = [f for f in tree.fruits if abs(f.box.centre[0] / f.box.centre[2] * cam.fx) < 0.25 * cam.width]
+    f = max(middle, key=lambda f: int((tree.labels == f.id).sum()))
+    rows, cols = np.nonzero(tree.labels == f.id)
+    expected = tree.camera.fx * f.box.size[:2].max() / f.box.centre[2]
+    assert 0.6 * expected <= max(np.ptp(rows), np.ptp(cols)) + 1 <= 1.2 * expected
+    # its depth is mostly the apple's front (registration and the rim let some background in)
+    z = tree.depth[rows, cols]
+    assert (
+        np.median(np.abs(z[z > 0] - f.box.centre[2])) < 0.05 and np.mean(np.abs(z[z > 0] - f.box.centre[2]) < 0.1) > 0.7
+    )
+
+
+def test_an_apple_trees_ripe_apples_are_red_its_green_ones_not(tree):
+    strong, _ = ripe_seeds(tree.color)
+    for f in tree.fruits:
+        seen = tree.labels == f.id
+        if seen.sum() >= 30:
+            share = strong[seen].mean()
+            assert share < 0.05 if not f.ripe else True, f.id
+    ripe_seen = np.isin(tree.labels, [f.id for f in tree.fruits if f.ripe])
+    assert strong[ripe_seen].mean() > 0.4  # most ripe skin is red (bicolour apples show green too)
+    leaves = (tree.labels == 0) & (tree.depth > 0)
+    assert strong[leaves].mean() < 0.02
+    assert tree.masks is not None and set(np.unique(tree.masks)) <= {0, *(f.id for f in tree.fruits if f.ripe)}

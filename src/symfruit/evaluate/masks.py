@@ -377,23 +377,31 @@ def evaluate_scene_masks(
     threshold: float = 0.5,
     keep_worst: int = 12,
     depth: bool = True,
+    scene: str = "strawberry",
     **scene_options: Any,
 ) -> MaskEvaluation:
-    """The masks protocol on rendered scenes (:func:`symfruit.synthetic.scenes.make_scene`): truth is the ripe
-    fruit's visible pixels; a region on an unripe fruit counts as false.
+    """The masks protocol on rendered scenes: truth is the ripe fruit's visible pixels; a region on an
+    unripe fruit counts as false.
 
-    With ``depth`` (default), ``segment(color, depth=..., camera=...)`` is given the scene's depth and
-    camera; without, ``segment(color)`` sees the colour alone.
+    ``scene`` is ``"strawberry"`` (:func:`symfruit.synthetic.scenes.make_scene`, table-top strawberries) or
+    ``"apple-tree"`` (:func:`symfruit.synthetic.scenes.make_tree_scene`: an apple tree's canopy at 1.2-2 m
+    through the Azure Kinect model, 1920x1080, apples 40-70 px across). With ``depth`` (default),
+    ``segment(color, depth=..., camera=...)`` is given the scene's depth and camera; without,
+    ``segment(color)`` sees the colour alone.
     """
-    from ..synthetic.scenes import make_scene
+    from ..synthetic.scenes import make_scene, make_tree_scene
+
+    if scene not in ("strawberry", "apple-tree"):
+        raise InputError(f"scene must be 'strawberry' or 'apple-tree', got {scene!r}")
+    make = make_scene if scene == "strawberry" else make_tree_scene
 
     def items() -> Iterator[Item]:
         for seed in seeds:
-            scene = make_scene(int(seed), **scene_options)
-            ripe = np.array([f.id for f in scene.fruits if f.ripe], dtype=np.int32)
-            truth = scene.labels[None] == ripe[:, None, None]
+            frame = make(int(seed), **scene_options)
+            ripe = np.array([f.id for f in frame.fruits if f.ripe], dtype=np.int32)
+            truth = frame.labels[None] == ripe[:, None, None]
             truth = truth[truth.reshape(len(ripe), -1).any(axis=1)]  # fruit hidden entirely are not truth
-            extra = {"depth": scene.depth, "camera": scene.camera} if depth else {}
-            yield f"scene-{seed}", scene.color, truth, extra
+            extra = {"depth": frame.depth, "camera": frame.camera} if depth else {}
+            yield f"scene-{seed}", frame.color, truth, extra
 
     return evaluate_mask_items(items(), segment, threshold=threshold, keep_worst=keep_worst)

@@ -8,7 +8,11 @@ lying over it) sits inside that body's outline. So the segmenter
    (``redness >= red_high`` and a red, not orange, hue) through weakly red ones (``redness >= red_low``):
    hysteresis. White and green (unripe) fruit, the calyx, stems, skin tones too weak to seed and the
    light background never start a region; very dark pixels (deep shadow, black borders) are never red.
-   Red is looked for on a coarse grid first and at full resolution only around what it finds.
+   Red is looked for on a coarse grid first and at full resolution only around what it finds; when
+   every candidate fruit there is large (a close-up, a 1920x1080 photo), the image is worked on every
+   2nd-4th pixel (each fruit still ``WORK_DIAMETER`` pixels across) and the fruit are brought back to full
+   resolution as polygons. With depth, a region is kept by the least fruit's size at its own depth
+   (``min_diameter``), not by a share of the image, so 40-60 px apples in a 1920x1080 frame count.
 2. splits each region where it is not one convex body. A convex body's *distance transform* (the
    distance of each pixel to the region's outline) is concave: one peak, and the points deeper than any
    radius stay connected. Two touching or overlapping fruit give two peaks joined by a *waist*. A peak
@@ -29,6 +33,8 @@ lying over it) sits inside that body's outline. So the segmenter
 4. reports each fruit as its convex hull: seeds, highlights and the calyx inside the outline are filled
    (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
    green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
+   With ``round_fruit`` (apples), the visible skin also takes the pixels around the red part reached from
+   it without crossing a depth step (a bicoloured apple's yellow side, not the leaf behind it).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
    berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
@@ -121,6 +127,10 @@ class SegmentSettings(Section):
         centres farther apart than this share of the sum of their radii (touching fruit: about 1; one
         fruit cut in two: about 0); two fragments are one fruit when the smaller lies on the larger's
         sphere within this share of its radius.
+    round_fruit : bool
+        With depth: the fruit are round and may be only partly red (bicoloured apples), so each one's
+        visible skin also takes the pixels around its red part (within twice its radius) reached without
+        crossing a depth step and not green: the yellow side, not the leaf behind. Off for strawberries.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -140,6 +150,7 @@ class SegmentSettings(Section):
     crease_curvature: float = setting(1500.0, gt=0.0, le=1e7)
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
+    round_fruit: bool = setting(False)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -332,14 +343,102 @@ def segment(
     h, w = c.shape[:2]
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
+    # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
+    grid = None if z is None else z[::8, ::8]
+    z_typical = 0.0 if grid is None else float(np.median(grid[grid > 0])) if (grid > 0).any() else 1.0
 
-    # Red pixels are looked for on a coarse grid first, then at full resolution around what it found: a
-    # region that no grid point falls in is far smaller than a fruit.
+    # Red pixels are looked for on a coarse grid first (the pyramid's top). When every candidate fruit there
+    # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
+    # more across) and the fruit brought back to full resolution.
+    coarse = _coarse_regions(c, s)
+    if coarse is None:
+        return np.zeros((h, w), np.int32)
+    step = _working_step(coarse, min_area if z is None else 0.0)
+    if step == 1:
+        return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
+    o = step // 2
+    small_c = c[o::step, o::step]
+    small_z = None if z is None else z[o::step, o::step]
+    small_geo = _Geometry(geo.focal / step, (geo.cy - o) / step, (geo.cx - o) / step)
+    small = _segment_at(small_c, small_z, small_geo, s, min_area / step**2, z_typical,
+                        _red_windows(_coarse_regions(small_c, s), small_c.shape[:2]))  # fmt: skip
+    hull = s.fill == "hull" or (s.fill == "auto" and z is None)
+    return _upsample(small, step, (h, w), hull=hull)
+
+
+#: A fruit this many pixels across (or more) is segmented as well on a coarser grid: when every candidate
+#: fruit of an image is at least twice this, the image is worked on every other (third, fourth) pixel.
+WORK_DIAMETER = 128
+
+#: The coarsest working grid (every fourth pixel).
+MAX_STEP = 4
+
+
+def _working_step(coarse: tuple[np.ndarray, np.ndarray, np.ndarray], min_area: float) -> int:
+    """The pixel step to work on: the smallest seeded candidate region's equivalent diameter (on the coarse
+    grid) over :data:`WORK_DIAMETER`, 1 to :data:`MAX_STEP`. Regions too small to hold a quarter of the
+    least fruit (``min_area``, pixels; 0 with depth, where the size rule is in metres) do not count."""
+    _, sizes, seeded = coarse
+    area = sizes * COARSE_STEP**2
+    candidates = seeded & (area >= 0.25 * min_area)
+    candidates[0] = False
+    if not candidates.any():
+        return 1
+    diameter = float(np.sqrt(4.0 / np.pi * area[candidates].min()))
+    return int(np.clip(diameter // WORK_DIAMETER, 1, MAX_STEP))
+
+
+def _upsample(small: np.ndarray, step: int, shape: tuple[int, int], *, hull: bool) -> np.ndarray:
+    """Labels found on every ``step``-th pixel (sampled at ``step // 2``) brought to full resolution: each
+    fruit's blocks of pixels, or with ``hull`` the convex hull of those blocks (a polygon, not a staircase)."""
+    h, w = shape
+    out = np.zeros((h, w), np.int32)
+    corners = np.array([[0, 0], [step - 1, 0], [0, step - 1], [step - 1, step - 1]], np.float64)
+    for k, sl in enumerate(ndimage.find_objects(small), 1):
+        if sl is None:
+            continue
+        mask = small[sl] == k
+        r0, c0 = sl[0].start * step, sl[1].start * step
+        r1, c1 = min(sl[0].stop * step, h), min(sl[1].stop * step, w)
+        full = np.repeat(np.repeat(mask, step, axis=0), step, axis=1)[: r1 - r0, : c1 - c0]
+        if hull:
+            v = _hull_vertices(mask)
+            if v is not None:
+                pts = (v[:, None, :] * step + corners[None]).reshape(-1, 2)
+                full = full | _fill_polygon(_polygon(pts), (r1 - r0, c1 - c0))
+        window = out[r0:r1, c0:c1]
+        window[full & (window == 0)] = k
+    return out
+
+
+def _polygon(points: np.ndarray) -> np.ndarray:
+    """The convex hull vertices of (n, 2) points."""
+    from scipy.spatial import ConvexHull, QhullError
+
+    try:
+        return points[ConvexHull(points).vertices]
+    except QhullError:
+        return points
+
+
+def _segment_at(
+    c: np.ndarray,
+    z: np.ndarray | None,
+    geo: _Geometry,
+    s: SegmentSettings,
+    min_area: float,
+    z_typical: float,
+    windows: list[Window],
+) -> np.ndarray:
+    """:func:`segment` on one level of the pyramid, in the ``windows`` where red was found."""
+    h, w = c.shape[:2]
+    # Red pixels are looked for at full resolution around what the coarse grid found: a region that no grid
+    # point falls in is far smaller than a fruit.
     strong = np.zeros((h, w), bool)
     weak = np.zeros((h, w), bool)
     pieces: list[_Piece] = []
     sources = 0
-    for win in _red_windows(c, s):
+    for win in windows:
         strong[win], weak[win] = ripe_seeds(c[win], s)
         labels, n = ndimage.label(weak[win], structure=np.ones((3, 3), bool))
         if n == 0:
@@ -348,7 +447,9 @@ def segment(
         seeded[labels[strong[win]]] = True
         seeded[0] = False
         sizes = np.bincount(labels.ravel(), minlength=n + 1)
-        keep = seeded & (sizes >= 0.25 * min_area)  # fragments down to a quarter of a fruit may join one
+        # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
+        least = min_area if z is None else _least_areas(labels, n, z[win], s.min_diameter * geo.focal, z_typical)
+        keep = seeded & (sizes >= 0.25 * least)
         for k, sl in enumerate(ndimage.find_objects(labels), 1):
             if not keep[k] or sl is None:
                 continue
@@ -381,7 +482,10 @@ def segment(
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
-        if not _fruit_sized(hull, sub_z, s, geo.focal, min_area):
+            if s.round_fruit and z is not None:  # the rest of a round fruit's skin
+                sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
+                sub_z = z[sl]
+        if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
         if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
             continue
@@ -402,36 +506,59 @@ def segment(
 COARSE_STEP = 4
 
 
-def _red_windows(c: np.ndarray, s: SegmentSettings) -> list[Window]:
-    """Disjoint image windows holding every weakly red region with a grid point in it (a coarse grid of
-    step :data:`COARSE_STEP`), each with a margin of one grid step."""
-    h, w = c.shape[:2]
-    step = COARSE_STEP
-    _, weak = ripe_seeds(c[::step, ::step], s)
+def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+    """The weakly red regions on a coarse grid of step :data:`COARSE_STEP`: their labels, sizes (grid
+    points) and whether each holds a seed (strongly red) point; None without any."""
+    strong, weak = ripe_seeds(c[::COARSE_STEP, ::COARSE_STEP], s)
     if not weak.any():
-        return []
+        return None
     lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     sizes[0] = 0
+    seeded = np.zeros(n + 1, bool)
+    seeded[lab[strong]] = True
+    return lab, sizes, seeded
+
+
+def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape: tuple[int, int]) -> list[Window]:
+    """Disjoint image windows holding every weakly red region with a grid point in it (the coarse grid of
+    :func:`_coarse_regions`), each with a margin of two grid steps."""
+    if coarse is None:
+        return []
+    h, w = shape
+    step = COARSE_STEP
+    lab, sizes, _ = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
-    lab, _ = ndimage.label(ndimage.binary_dilation((sizes >= 2)[lab], structure=np.ones((3, 3), bool)))
-    boxes = [[max(sl[0].start * step - step, 0), min(sl[0].stop * step + step, h),
-              max(sl[1].start * step - step, 0), min(sl[1].stop * step + step, w)]
+    lab = np.where((sizes >= 2)[lab], lab, 0)
+    pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
+    gh, gw = lab.shape
+    boxes = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, gh),
+              max(sl[1].start - pad, 0), min(sl[1].stop + pad, gw))
              for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
-    merged = True
-    while merged:  # join overlapping windows, so that each region lies in one window only
-        merged = False
-        for i in range(len(boxes)):
-            for j in range(i + 1, len(boxes)):
-                a, b = boxes[i], boxes[j]
-                if a[0] < b[1] and b[0] < a[1] and a[2] < b[3] and b[2] < a[3]:
-                    boxes[i] = [min(a[0], b[0]), max(a[1], b[1]), min(a[2], b[2]), max(a[3], b[3])]
-                    del boxes[j]
-                    merged = True
-                    break
-            if merged:
-                break
-    return [(slice(r0, r1), slice(c0, c1)) for r0, r1, c0, c1 in boxes]
+    while boxes:  # join overlapping (and abutting) windows on the grid, until each region lies in one window only
+        painted = np.zeros((gh, gw), bool)
+        for r0, r1, c0, c1 in boxes:
+            painted[r0:r1, c0:c1] = True
+        joined = [
+            (sl[0].start, sl[0].stop, sl[1].start, sl[1].stop) for sl in ndimage.find_objects(ndimage.label(painted)[0])
+        ]
+        if len(joined) == len(boxes):
+            break
+        boxes = joined
+    return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
+
+
+def _fill_holes(mask: np.ndarray) -> np.ndarray:
+    """The mask with its holes filled: the background pieces (4-connected) that do not reach the border
+    (as :func:`scipy.ndimage.binary_fill_holes`, by one labelling instead of repeated dilations)."""
+    lab, n = ndimage.label(~mask)
+    if n == 0:
+        return mask.copy()
+    outside = np.zeros(n + 1, bool)
+    for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
+        outside[edge] = True
+    outside[0] = False
+    return ~outside[lab]
 
 
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
@@ -501,6 +628,7 @@ class _Piece:
     mask: np.ndarray
     source: int  # a bit set of the colour regions it came from
     hull: float = -1.0
+    serial: int = -1  # a number of its own while pieces are merged
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
@@ -523,14 +651,24 @@ def _merge(
     were kept apart on purpose and are not joined again."""
     slack = s.merge_slack
     pieces = sorted(pieces, key=lambda p: -p.area)
+    for k, piece in enumerate(pieces):
+        piece.serial = k
+    serial = len(pieces)
+    apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
     merged = True
     while merged and len(pieces) > 1:
         merged = False
+        box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
+        area = np.array([p.area for p in pieces], dtype=np.float64)
         for i in range(len(pieces)):
-            for j in range(i + 1, len(pieces)):
+            # the pieces near this one (closer than an occluder narrower than the smaller fruit), in order
+            gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
+            rest = box[i + 1 :]
+            near = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
+                    & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
+            for j in (np.flatnonzero(near) + i + 1).tolist():
                 a, b = pieces[i], pieces[j]
-                gap = max(2, int(0.5 * np.sqrt(min(a.area, b.area))))  # an occluder narrower than the fruit
-                if (a.source & b.source) or not _near(a.window, b.window, gap=gap):
+                if (a.source & b.source) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
                 hull = _hull_area(union)
@@ -539,10 +677,12 @@ def _merge(
                 if hull <= (1.0 + slack) * (a.hull + b.hull) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
-                    pieces[i] = _Piece(window, union, a.source | b.source, hull)
+                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
+                    serial += 1
                     del pieces[j]
                     merged = True
                     break
+                apart.add((a.serial, b.serial))
             if merged:
                 break
     return pieces
@@ -552,7 +692,8 @@ def _same_surface(
     a: _Piece, b: _Piece, depth: np.ndarray, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
-    distance off it at most ``sphere_apart`` times its radius); None when there is no fit."""
+    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``); None
+    when there is no fit."""
     big, small = (a, b) if a.area >= b.area else (b, a)
     origin = (big.window[0].start, big.window[1].start)
     fit = _sphere(big.mask & weak[big.window], depth[big.window], geo, origin)
@@ -562,12 +703,7 @@ def _same_surface(
     if fit is None or len(p) < 20:
         return None
     off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
-    return bool(np.median(off) <= s.sphere_apart * fit[1])
-
-
-def _near(a: Window, b: Window, *, gap: int) -> bool:
-    return (a[0].start - gap < b[0].stop and b[0].start - gap < a[0].stop
-            and a[1].start - gap < b[1].stop and b[1].start - gap < a[1].stop)  # fmt: skip
+    return bool(np.median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
 
 
 def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
@@ -590,7 +726,7 @@ def _split(
 ) -> list[np.ndarray]:
     """Cut a region into fruit (see the module docstring): at waists of its distance transform (the depth
     steps and creases taken as part of its outline), keeping the cuts that evidence backs."""
-    region = ndimage.binary_fill_holes(region)
+    region = _fill_holes(region)
     if s.close_px:
         r = s.close_px
         padded = np.pad(region, r + 1)
@@ -604,7 +740,7 @@ def _split(
     least = np.sqrt(min_area / np.pi)
     if use_depth and depth is not None:
         edges = _depth_edges(region, depth, s, geo.focal)
-        carved = ndimage.binary_fill_holes(region & ~edges)
+        carved = _fill_holes(region & ~edges)
         least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
@@ -886,6 +1022,63 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
+def _round_skin(
+    sl: Window,
+    hull: np.ndarray,
+    depth: np.ndarray,
+    color: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+) -> tuple[Window, np.ndarray]:
+    """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
+    within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
+    crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
+    ``depth_jump`` of its median depth, and are neither green nor another fruit's (``owner``, whole image:
+    red pixels of piece ``k`` or of none). A bicoloured apple's yellow side joins its red blush; a leaf
+    in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
+    z_part = depth[sl][hull & (depth[sl] > 0)]
+    if len(z_part) < 20:
+        return sl, hull
+    rows, cols = np.nonzero(hull)
+    rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
+    own = float(np.sqrt(hull.sum() / np.pi))
+    reach = ROUND_REACH * own
+    h, w = depth.shape
+    big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
+           slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
+    yy, xx = np.mgrid[big[0], big[1]]
+    z = depth[big]
+    zm = float(np.median(z_part))
+    part = np.zeros(z.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    free = (owner[big] == 0) | (owner[big] == k)
+    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+    deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
+    candidate = near & (z > 0) & deep & ~_green(color[big]) & free
+    step = np.zeros(z.shape, bool)
+    for axis in (0, 1):
+        jump = np.abs(np.diff(z, axis=axis)) > 0.5 * s.depth_jump
+        if axis == 0:
+            step[:-1] |= jump
+            step[1:] |= jump
+        else:
+            step[:, :-1] |= jump
+            step[:, 1:] |= jump
+    lab, n = ndimage.label((candidate & ~step) | part)
+    reached = np.zeros(n + 1, bool)
+    reached[lab[part]] = True
+    reached[0] = False
+    return big, reached[lab] | part
+
+
+#: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
+#: third of the visible disc has about 0.6 of its radius).
+ROUND_REACH = 2.0
+
+
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
     """Drop hull pixels (outside the colour part) whose depth is far from the part's median depth."""
     z = depth[part & (depth > 0)]
@@ -896,15 +1089,27 @@ def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jum
     return part | (hull & ~off)
 
 
-def _fruit_sized(mask: np.ndarray, depth: np.ndarray | None, s: SegmentSettings, focal: float, min_area: float) -> bool:
+def _fruit_sized(
+    mask: np.ndarray, depth: np.ndarray | None, s: SegmentSettings, focal: float, min_area: float, z_typical: float
+) -> bool:
+    """Whether a part is fruit-sized: without depth ``min_area`` pixels; with depth at least a disc of
+    ``min_diameter`` at its median depth (``z_typical`` when none of its pixels has depth)."""
     area = int(mask.sum())
     if depth is None:
         return area >= min_area
     z = depth[mask & (depth > 0)]
-    if len(z) == 0:
-        return False
-    diameter_px = focal * s.min_diameter / float(np.median(z))
+    diameter_px = focal * s.min_diameter / (float(np.median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
+
+
+def _least_areas(labels: np.ndarray, n: int, depth: np.ndarray, diameter_px_m: float, z_typical: float) -> np.ndarray:
+    """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
+    regions without depth); ``diameter_px_m`` is the least diameter times the focal length."""
+    valid = (labels > 0) & (depth > 0)
+    count = np.bincount(labels[valid], minlength=n + 1).astype(np.float64)
+    total = np.bincount(labels[valid], weights=depth[valid], minlength=n + 1)
+    z = np.where(count > 0, total / np.maximum(count, 1.0), z_typical)  # the mean: a threshold needs no more
+    return np.pi / 4 * (diameter_px_m / z) ** 2
 
 
 def _elongation(mask: np.ndarray) -> float:

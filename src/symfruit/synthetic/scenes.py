@@ -23,10 +23,10 @@ from ..core.camera import DEFAULT_CAMERA, Camera
 from ..core.points import perpendicular_basis
 from ..errors import OutputError
 from .render import SensorNoise, render
-from .sensors import SensorModel, apply_sensor
-from .shapes import leaf_outline, rotation, strawberry
+from .sensors import SENSOR_MODELS, SensorModel, apply_sensor
+from .shapes import apple, leaf_outline, rotation, strawberry
 
-__all__ = ["Scene", "SceneFruit", "make_photo", "make_scene", "write_scenes"]
+__all__ = ["Scene", "SceneFruit", "make_photo", "make_scene", "make_tree_scene", "write_scenes"]
 
 
 @dataclass(frozen=True)
@@ -279,6 +279,124 @@ def _sensor_scene(seed: int, sensor: SensorModel, *, n_ripe: int, n_unripe: int,
     out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
                        amodal=amodal)  # fmt: skip
     color = _shade(shot, colours, rng)
+    return Scene(color=color, depth=out.depth, camera=camera, labels=labels, fruits=fruits, masks=out.labels)
+
+
+def make_tree_scene(
+    seed: int = 0,
+    *,
+    sensor: SensorModel | None = None,
+    n_apples: int = 30,
+    n_green: int = 4,
+    n_leaves: int = 2500,
+    distance: tuple[float, float] = (1.2, 2.0),
+) -> Scene:
+    """Render one seeded frame of an apple tree's canopy, the way an orchard robot sees it (issue 18).
+
+    Apples of 60-90 mm (:func:`~symfruit.synthetic.shapes.apple`) hang in a canopy slab whose front is
+    ``distance`` (log-uniform) from the camera, among ``n_leaves`` leaves of 5-9 cm (some in front of the
+    fruit), branches and a distant background; at 1.2-2 m a 1920x1080 camera sees them 40-70 px across.
+    Most apples are red all over, the rest yellow-green with a red blush over 40-80 % of the skin (the
+    blush faces a random side, so some show mostly green); ``n_green`` apples are green (unripe, not to be
+    found). Shading follows the surface normal with a brighter sunlit side, plus pixel noise. The frame goes
+    through ``sensor`` (default the Azure Kinect model: rim invalidation, flying pixels, registration,
+    noise, multipath; :func:`~symfruit.synthetic.sensors.apply_sensor`).
+
+    Returns
+    -------
+    Scene
+        ``labels`` holds every apple's visible pixels (the ripe ones are the truth), ``fruits`` the apples
+        (``kind`` ``"apple"``), ``masks`` the annotators' masks of the ripe ones.
+    """
+    sensor = sensor or SENSOR_MODELS["azure-kinect"]
+    rng = np.random.default_rng([seed, 19])
+    camera = sensor.camera()
+    z0 = float(np.exp(rng.uniform(np.log(distance[0]), np.log(distance[1]))))
+    half_x = 0.5 * camera.width / camera.fx * z0
+    half_y = 0.5 * camera.height / camera.fy * z0
+    meshes: list[tuple[np.ndarray, np.ndarray]] = []
+    colours: list[tuple[float, float, float]] = []
+    fruits: list[SceneFruit] = []
+    skins: list[
+        tuple[int, np.ndarray, float, np.ndarray, np.ndarray, float]
+    ] = []  # mesh, centre, r, base, blush, share
+    spheres: list[tuple[np.ndarray, float]] = []
+    for k in range(n_apples + n_green):
+        ripe = k < n_apples
+        fruit = apple(rng)
+        radius = 0.5 * float(np.ptp(fruit.vertices, axis=0).max())
+        for _ in range(200):
+            z = z0 + rng.uniform(-0.05, 0.35)
+            centre = np.array(
+                [rng.uniform(-0.95, 0.95) * half_x * z / z0, rng.uniform(-0.95, 0.95) * half_y * z / z0, z]
+            )
+            if all(np.linalg.norm(centre - c) > 1.05 * (radius + r) for c, r in spheres):
+                break
+        spheres.append((centre, radius))
+        rot = rotation(rng.uniform(-40, 40), rng.uniform(-180, 180), rng.uniform(-40, 40))
+        posed = fruit.transformed(rot, centre)
+        fruits.append(SceneFruit(k + 1, ripe, "apple", Box.from_points(posed.vertices), len(meshes)))
+        red = colorsys.hsv_to_rgb(rng.uniform(-0.03, 0.02) % 1.0, rng.uniform(0.65, 0.9), rng.uniform(0.45, 0.8))
+        yellow = colorsys.hsv_to_rgb(rng.uniform(0.12, 0.2), rng.uniform(0.45, 0.7), rng.uniform(0.55, 0.8))
+        if not ripe:
+            skins.append((len(meshes), centre, radius, np.array(yellow), np.array(yellow), 0.0))
+        elif rng.random() < 0.6:  # red all over, a paler streak side
+            skins.append((len(meshes), centre, radius, np.array(red) * 0.8 + 0.2 * np.array(yellow), np.array(red),
+                          rng.uniform(0.75, 0.95)))  # fmt: skip
+        else:  # bicolour: a red blush over part of a yellow-green skin
+            skins.append((len(meshes), centre, radius, np.array(yellow), np.array(red), rng.uniform(0.4, 0.8)))
+        meshes.append((posed.vertices, posed.faces))
+        colours.append((0.0, 0.0, 0.0))  # coloured per pixel below
+        top = centre + rot @ np.array([0.0, -radius * 0.8, 0.0])
+        meshes.append(_cylinder(top, top + np.array([rng.uniform(-0.01, 0.01), -0.025, 0.0]), 0.0015))
+        colours.append((0.08, 0.5, 0.3))
+    for _ in range(n_leaves):  # the canopy, from in front of the fruit to behind them
+        z = z0 + rng.uniform(-0.2, 0.6)
+        centre = np.array([rng.uniform(-1.1, 1.1) * half_x * z / z0, rng.uniform(-1.1, 1.1) * half_y * z / z0, z])
+        meshes.append(_leaf(centre, rng.uniform(0.06, 0.10), rng.uniform(0, 2 * np.pi),
+                            rotation(rng.uniform(-70, 70), rng.uniform(-70, 70), 0)))  # fmt: skip
+        colours.append((rng.uniform(0.2, 0.36), rng.uniform(0.4, 0.85), rng.uniform(0.15, 0.6)))
+    for _ in range(8):  # branches
+        a = np.array([rng.uniform(-1, 1) * half_x, rng.uniform(-1, 1) * half_y, z0 + rng.uniform(0.0, 0.4)])
+        b = a + rng.normal(size=3) * np.array([0.5, 0.5, 0.1]) * z0
+        meshes.append(_cylinder(a, b, rng.uniform(0.008, 0.03)))
+        colours.append((rng.uniform(0.05, 0.1), rng.uniform(0.3, 0.5), rng.uniform(0.2, 0.4)))
+    span, bz = 4.0 * z0, z0 + rng.uniform(2.0, 4.0)  # the next row, grass and sky far behind
+    back = np.array([[-span, -span, bz], [span, -span, bz], [span, span, bz], [-span, span, bz]])
+    meshes.append((back, np.array([[0, 1, 2], [0, 2, 3]])))
+    colours.append((rng.uniform(0.2, 0.3), rng.uniform(0.2, 0.4), rng.uniform(0.35, 0.55)))
+
+    shot = render(meshes, camera)
+    labels = np.zeros(shot.ids.shape, np.int32)
+    amodal = np.zeros(shot.ids.shape, np.int32)
+    for f in fruits:
+        labels[shot.ids == f.mesh_index] = f.id
+        if f.ripe:
+            vertices, faces = meshes[f.mesh_index]
+            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
+    color = _shade(shot, colours, rng).astype(np.float64) / 255.0
+    # apple skins: blush and base colour by the direction from the apple's centre, sunlit from the upper left
+    sun = np.array([-0.5, -0.7, -0.5]) / np.linalg.norm([-0.5, -0.7, -0.5])
+    yy, xx = np.mgrid[: camera.height, : camera.width]
+    for index, centre, _radius, base, blush, share in skins:
+        on = shot.ids == index
+        if not on.any():
+            continue
+        z = shot.depth[on]
+        p = np.c_[(xx[on] - camera.cx) * z / camera.fx, (yy[on] - camera.cy) * z / camera.fy, z]
+        d = (p - centre) / np.linalg.norm(p - centre, axis=1, keepdims=True)
+        axis = rng.normal(size=3)
+        axis /= np.linalg.norm(axis)
+        cut = 1.0 - 2.0 * share  # the cap d . axis > cut covers ``share`` of the sphere
+        streak = 0.12 * np.sin(40.0 * np.arctan2(d[:, 1], d[:, 0]) + rng.uniform(0, 6.3))  # striped blush
+        w = np.clip((d @ axis - cut) / 0.25 + 0.5 + streak, 0.0, 1.0) if share > 0 else np.zeros(len(d))
+        skin = base[None] * (1 - w[:, None]) + blush[None] * w[:, None]
+        light = 0.3 + 0.45 * shot.facing[on] + 0.35 * np.clip(-(d @ sun), 0, 1)
+        color[on] = skin * light[:, None] + rng.normal(scale=0.015, size=(len(d), 3))
+    color = (np.clip(color, 0, 1) * 255).astype(np.uint8)
+    ripe_labels = np.where(np.isin(labels, [f.id for f in fruits if f.ripe]), labels, 0)
+    out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
+                       amodal=amodal)  # fmt: skip
     return Scene(color=color, depth=out.depth, camera=camera, labels=labels, fruits=fruits, masks=out.labels)
 
 
