@@ -224,14 +224,20 @@ def test_detections_equal_symfruit_detect(world, detect_json, color, depth, sec)
 def test_type_hash_and_qos_on_the_graph(world):
     from symfruit.ros.ros2env import UPSTREAM_TYPE_HASH
 
+    # discovery may show an endpoint before the node that owns it ('_NODE_NAME_UNKNOWN_'): wait for the node's
+    # own endpoints first, then read the graph
+    for topic in ("/symfruit/detections", "/symfruit/markers", "/symfruit/fruit_points"):
+        assert world.call("endpoint", topic=topic, node="/symfruit", side="publisher", timeout=TIMEOUT)["ok"]
+    from symfruit.ros.node2 import DEFAULT_TOPICS
+
+    for topic in DEFAULT_TOPICS.values():
+        assert world.call("endpoint", topic=topic, node="/symfruit", side="subscription", timeout=TIMEOUT)["ok"]
     graph = world.call("graph")
     (pub,) = graph["publishers"]["/symfruit/detections"]
     assert pub == {"node": "/symfruit", "type": "vision_msgs/msg/Detection3DArray", "reliability": "reliable",
                    "hash": UPSTREAM_TYPE_HASH["vision_msgs/msg/Detection3DArray"]}  # fmt: skip
     assert [p["type"] for p in graph["publishers"]["/symfruit/markers"]] == ["visualization_msgs/msg/MarkerArray"]
     assert [p["type"] for p in graph["publishers"]["/symfruit/fruit_points"]] == ["sensor_msgs/msg/PointCloud2"]
-    from symfruit.ros.node2 import DEFAULT_TOPICS
-
     for topic in DEFAULT_TOPICS.values():  # the node listens to the RealSense topics, reliably (as they publish)
         (sub,) = [s for s in graph["subscriptions"][topic] if s["node"] == "/symfruit"]
         assert sub["reliability"] == "reliable"
