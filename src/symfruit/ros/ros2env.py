@@ -212,6 +212,13 @@ def make_venv(venv: Path, project: Path) -> None:
     res = _run([*pip, "-e", f"{project}[ros2]"])
     if res.returncode != 0:
         raise Skip(f"pip could not install the ROS 2 wheels into {venv}: {_tail(res)}")
+    # `pytest --cov` in the project's venv measures the subprocesses it starts only where coverage is importable:
+    # the ROS 2 node and stand-in camera run here, so the same coverage goes here too (the project's tests only)
+    try:
+        import coverage
+    except ImportError:
+        return
+    _run([*pip, f"coverage=={coverage.__version__}"])  # not fatal: without it only the measurement is lost
 
 
 def build_vision_msgs(venv: Path) -> None:
