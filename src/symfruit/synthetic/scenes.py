@@ -91,6 +91,21 @@ def _leaf(centre: np.ndarray, length: float, spin: float, tilt: np.ndarray) -> t
     return vertices, faces
 
 
+def _fruit_labels(
+    ids: np.ndarray, meshes: list, fruits: list[SceneFruit], camera: Camera
+) -> tuple[np.ndarray, np.ndarray]:
+    """The fruit's visible labels in a rendering (``ids``: the mesh seen at each pixel) and the ripe fruit's
+    amodal ones (each ripe fruit rendered alone; the first fruit keeps a pixel two would share)."""
+    labels = np.zeros(ids.shape, np.int32)
+    amodal = np.zeros(ids.shape, np.int32)
+    for f in fruits:
+        labels[ids == f.mesh_index] = f.id
+        if f.ripe:
+            vertices, faces = meshes[f.mesh_index]
+            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
+    return labels, amodal
+
+
 def make_scene(
     seed: int = 0,
     *,
@@ -268,13 +283,7 @@ def _sensor_scene(seed: int, sensor: SensorModel, *, n_ripe: int, n_unripe: int,
     colours.append((0.2, 0.18, 0.42))
 
     shot = render(meshes, camera)
-    labels = np.zeros(shot.ids.shape, np.int32)
-    amodal = np.zeros(shot.ids.shape, np.int32)
-    for f in fruits:
-        labels[shot.ids == f.mesh_index] = f.id
-        if f.ripe:
-            vertices, faces = meshes[f.mesh_index]
-            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
+    labels, amodal = _fruit_labels(shot.ids, meshes, fruits, camera)
     ripe_labels = np.where(np.isin(labels, [f.id for f in fruits if f.ripe]), labels, 0)
     out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
                        amodal=amodal)  # fmt: skip
@@ -367,13 +376,7 @@ def make_tree_scene(
     colours.append((rng.uniform(0.2, 0.3), rng.uniform(0.2, 0.4), rng.uniform(0.35, 0.55)))
 
     shot = render(meshes, camera)
-    labels = np.zeros(shot.ids.shape, np.int32)
-    amodal = np.zeros(shot.ids.shape, np.int32)
-    for f in fruits:
-        labels[shot.ids == f.mesh_index] = f.id
-        if f.ripe:
-            vertices, faces = meshes[f.mesh_index]
-            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
+    labels, amodal = _fruit_labels(shot.ids, meshes, fruits, camera)
     color = _shade(shot, colours, rng).astype(np.float64) / 255.0
     # apple skins: blush and base colour by the direction from the apple's centre, sunlit from the upper left
     sun = np.array([-0.5, -0.7, -0.5]) / np.linalg.norm([-0.5, -0.7, -0.5])
