@@ -76,7 +76,7 @@ def bench_node2(
         context = rclpy.Context()
         rclpy.init(context=context, domain_id=domain)
         node = rclpy.create_node("symfruit_bench", context=context)
-        camera, listener = Camera(node, images), Listener(node, points=False)
+        camera, listener = Camera(node, images), Listener(node, points=False, markers=False)
         executor = SingleThreadedExecutor(context=context)
         executor.add_node(node)
         spinner = threading.Thread(target=executor.spin, daemon=True)

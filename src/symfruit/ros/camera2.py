@@ -350,7 +350,7 @@ class Listener:
     """Subscriptions to the node's outputs; each message kept by its header stamp (markers: the first
     marker's), with the time it arrived, until :meth:`wait` hands it over."""
 
-    def __init__(self, node: Any, prefix: str = f"/{NODE_NAME}", *, points: bool = True) -> None:
+    def __init__(self, node: Any, prefix: str = f"/{NODE_NAME}", *, points: bool = True, markers: bool = True) -> None:
         from rclpy.qos import QoSProfile
         from sensor_msgs.msg import PointCloud2
         from vision_msgs.msg import Detection3DArray
@@ -363,7 +363,7 @@ class Listener:
         self.subs = [
             node.create_subscription(kinds[k], f"{prefix}/{k}", self._keeper(k), QoSProfile(depth=10))
             for k in OUTPUTS
-            if points or k != "fruit_points"
+            if (points or k != "fruit_points") and (markers or k != "markers")
         ]
 
     def _keeper(self, kind: str) -> Any:

@@ -313,7 +313,8 @@ class Ros2Node:
         header = color.header
         t_publish = time.perf_counter()
         self.pub_detections.publish(detection_array(self.vision_msgs, header, processed.fruits, self.class_id))
-        self.pub_markers.publish(marker_array(header, processed.fruits))
+        if self.pub_markers.get_subscription_count() > 0:  # built only for a viewer (rclpy would serialise for none)
+            self.pub_markers.publish(marker_array(header, processed.fruits))
         if self.pub_points.get_subscription_count() > 0:
             self.pub_points.publish(point_cloud(header, processed.fruits))
         t_end = time.perf_counter()
