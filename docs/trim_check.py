@@ -18,8 +18,7 @@ from symfruit.io.masks import read_coco
 
 
 def labels_of(instances: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    if instances.ndim == 2:
-        return instances.astype(np.int32)
+    """(h, w) labels of ``CocoSet.instances``' (n, h, w) masks; the first of two overlapping keeps a pixel."""
     out = np.zeros(shape, np.int32)
     for i, m in enumerate(instances, 1):
         out[m & (out == 0)] = i

@@ -998,16 +998,21 @@ def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, foca
     """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
     crease of the depth surface: where one fruit ends and another begins."""
     z = np.where(region & (depth > 0), depth, np.nan)
-    edge = _creases(region, depth, s, focal)
+    return (_creases(region, depth, s, focal) | _steps(z, s.depth_jump)) & region
+
+
+def _steps(z: np.ndarray, jump: float) -> np.ndarray:
+    """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step)."""
+    edge = np.zeros(z.shape, bool)
     for axis in (0, 1):
-        step = np.nan_to_num(np.abs(np.diff(z, axis=axis)), nan=0.0) > s.depth_jump
+        step = np.nan_to_num(np.abs(np.diff(z, axis=axis)), nan=0.0) > jump
         if axis == 0:
             edge[:-1] |= step
             edge[1:] |= step
         else:
             edge[:, :-1] |= step
             edge[:, 1:] |= step
-    return edge & region
+    return edge
 
 
 def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
@@ -1058,16 +1063,7 @@ def _round_skin(
     near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
     deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
     candidate = near & (z > 0) & deep & ~_green(color[big]) & free
-    step = np.zeros(z.shape, bool)
-    for axis in (0, 1):
-        jump = np.abs(np.diff(z, axis=axis)) > 0.5 * s.depth_jump
-        if axis == 0:
-            step[:-1] |= jump
-            step[1:] |= jump
-        else:
-            step[:, :-1] |= jump
-            step[:, 1:] |= jump
-    lab, n = ndimage.label((candidate & ~step) | part)
+    lab, n = ndimage.label((candidate & ~_steps(z, 0.5 * s.depth_jump)) | part)
     reached = np.zeros(n + 1, bool)
     reached[lab[part]] = True
     reached[0] = False
