@@ -408,3 +408,42 @@ def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
     found = labels == 1
     assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow half joined
     assert not found[500:580, 935:990][~disc[500:580, 935:990]].any()  # the yellowish leaf behind did not
+
+
+def test_a_bicoloured_apple_with_a_yellow_green_side_is_found_whole_but_not_the_leaf_beside_it():
+    # an apple 60 px across at 1.5 m: red left half, yellow-green right half (hue 68 degrees: green by the
+    # calyx test, not a leaf); a leaf-green strip (hue 108) at the apple's own depth touching its right side
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    xx = np.mgrid[:1080, :1920][1]
+    color[disc & (xx > 900)] = (160, 175, 60)
+    leaf = (~disc) & (xx >= 925) & (xx < 960) & (np.abs(np.mgrid[:1080, :1920][0] - 540) < 12)
+    color[leaf] = (70, 150, 50)
+    depth[leaf] = 1.5 - 0.005  # the leaf touches the fruit's rim at its depth: no depth step parts them
+    labels = segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True))
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow-green half joined
+    assert found[leaf].sum() < 0.05 * leaf.sum()  # the leaf did not
+
+
+def test_a_leaf_green_round_depth_bump_is_no_fruit():
+    # a sphere's depth bump 60 px across, leaf green all over, before leaves 10 cm behind: nothing red, nothing found
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    color[(color == RED).all(axis=2)] = (70, 150, 50)
+    assert segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True)).max() == 0
+
+
+@pytest.mark.parametrize(
+    ("rgb", "leaf"),
+    [((70, 150, 50), True), ((40, 120, 110), True), ((160, 175, 60), False), ((200, 180, 60), False),
+     ((120, 160, 60), True), ((150, 160, 60), False)],
+)  # fmt: skip
+def test_leaf_green_is_a_hue_of_80_degrees_or_more(rgb, leaf):
+    import colorsys
+
+    from symfruit.segment.colour import LEAF_HUE, _leaf
+
+    hue = 360 * colorsys.rgb_to_hsv(*(v / 255 for v in rgb))[0]
+    assert (hue >= LEAF_HUE) == leaf  # each case lies on its side of the boundary
+    assert bool(_leaf(np.array([[rgb]], np.uint8))[0, 0]) == leaf

@@ -34,7 +34,8 @@ lying over it) sits inside that body's outline. So the segmenter
    (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
    green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
    With ``round_fruit`` (apples), the visible skin also takes the pixels around the red part reached from
-   it without crossing a depth step (a bicoloured apple's yellow side, not the leaf behind it).
+   it without crossing a depth step and not leaf green (a bicoloured apple's yellow or yellow-green side, not
+   the leaf behind it).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
    berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
@@ -130,7 +131,8 @@ class SegmentSettings(Section):
     round_fruit : bool
         With depth: the fruit are round and may be only partly red (bicoloured apples), so each one's
         visible skin also takes the pixels around its red part (within twice its radius) reached without
-        crossing a depth step and not green: the yellow side, not the leaf behind. Off for strawberries.
+        crossing a depth step and not leaf green (hue :data:`LEAF_HUE` or more): the yellow or yellow-green
+        side, not the leaf behind. Off for strawberries.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -1056,7 +1058,7 @@ def _round_skin(
     """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
     within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
-    ``depth_jump`` of its median depth, and are neither green nor another fruit's (``owner``, whole image:
+    ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's (``owner``, whole image:
     red pixels of piece ``k`` or of none). A bicoloured apple's yellow side joins its red blush; a leaf
     in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
     z_part = depth[sl][hull & (depth[sl] > 0)]
