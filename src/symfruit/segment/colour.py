@@ -1058,8 +1058,9 @@ def _round_skin(
     """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
     within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
-    ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's (``owner``, whole image:
-    red pixels of piece ``k`` or of none). A bicoloured apple's yellow side joins its red blush; a leaf
+    ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
+    (``owner``, whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow or
+    yellow-green side joins its red blush; a leaf
     in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
     z_part = depth[sl][hull & (depth[sl] > 0)]
     if len(z_part) < 20:
