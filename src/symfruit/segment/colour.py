@@ -133,6 +133,11 @@ class SegmentSettings(Section):
         visible skin also takes the pixels around its red part (within twice its radius) reached without
         crossing a depth step and not leaf green (hue :data:`LEAF_HUE` or more): the yellow or yellow-green
         side, not the leaf behind. Off for strawberries.
+    round_max_diameter : float, metres
+        With depth and ``round_fruit``: the largest fruit. A weakly red region larger than a disc of this
+        diameter at its depth is a fruit joined to bark or a twig by weakly red pixels, and only its ripe-red
+        cores are kept (:func:`_ripe_cores`). Default 0.12: round fruit up to large apples and oranges
+        (about 100 mm) with a margin; the apple profile sets 0.10.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -153,6 +158,7 @@ class SegmentSettings(Section):
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
     round_fruit: bool = setting(False)
+    round_max_diameter: float = setting(0.12, gt=0.0, le=1.0)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -461,8 +467,18 @@ def _segment_at(
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
             sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
             origin = (sl[0].start, sl[1].start)
-            pieces += [_Piece(sl, part, 1 << sources) for part in _split(region, sub_z, s, geo, origin, min_area)]
-            sources += 1
+            least_area = min_area
+            if sub_z is not None and not (sub_z[region] > 0).any():
+                # with depth, but none here (outside the depth camera's view): the least fruit at the frame's
+                # typical depth, as the size rules do, not a share of the image (40-60 px apples at 1920x1080)
+                least_area = np.pi * (0.25 * geo.focal * s.min_diameter / z_typical) ** 2
+            cores = [region]
+            if s.round_fruit and sub_z is not None:
+                cores = _ripe_cores(region, c[sl], sub_z, s, geo.focal, z_typical)
+            for core in cores:
+                parts = _split(core, sub_z, s, geo, origin, least_area)
+                pieces += [_Piece(sl, part, 1 << sources) for part in parts]
+                sources += 1
     if not pieces:
         return np.zeros((h, w), np.int32)
     pieces = _merge(pieces, s, c, weak, z, geo)
@@ -1043,6 +1059,26 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     lap = ndimage.laplace(smooth)
     z = float(np.median(depth[valid]))
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
+
+
+def _ripe_cores(
+    region: np.ndarray, color: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float
+) -> list[np.ndarray]:
+    """A weakly red region larger than the largest round fruit (``round_max_diameter`` at its median depth,
+    ``z_typical`` without any) is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through
+    weakly red pixels. It is then taken as its cores, the pieces of its pixels that are as red as a ripe
+    fruit (``ripe_median``), each holding a seed and big enough for a fragment of the least fruit; the
+    fruit's skin around them is found again later (:func:`_round_skin`, the hull)."""
+    z = depth[region & (depth > 0)]
+    zr = float(np.median(z)) if len(z) else z_typical
+    if region.sum() <= np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2:
+        return [region]
+    core = region & (redness(color) >= s.ripe_median)
+    lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    keep = sizes >= 0.25 * np.pi / 4 * (focal * s.min_diameter / zr) ** 2
+    keep[0] = False
+    return [lab == k for k in np.flatnonzero(keep)]
 
 
 def _round_skin(
