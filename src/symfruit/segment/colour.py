@@ -467,16 +467,11 @@ def _segment_at(
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
             sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
             origin = (sl[0].start, sl[1].start)
-            least_area = min_area
-            if sub_z is not None and not (sub_z[region] > 0).any():
-                # with depth, but none here (outside the depth camera's view): the least fruit at the frame's
-                # typical depth, as the size rules do, not a share of the image (40-60 px apples at 1920x1080)
-                least_area = np.pi * (0.25 * geo.focal * s.min_diameter / z_typical) ** 2
             cores = [region]
             if s.round_fruit and sub_z is not None:
                 cores = _ripe_cores(region, c[sl], sub_z, s, geo.focal, z_typical)
             for core in cores:
-                parts = _split(core, sub_z, s, geo, origin, least_area)
+                parts = _split(core, sub_z, s, geo, origin, min_area)
                 pieces += [_Piece(sl, part, 1 << sources) for part in parts]
                 sources += 1
     if not pieces:
@@ -1067,7 +1062,7 @@ def _ripe_cores(
     """A weakly red region larger than the largest round fruit (``round_max_diameter`` at its median depth,
     ``z_typical`` without any) is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through
     weakly red pixels. It is then taken as its cores, the pieces of its pixels that are as red as a ripe
-    fruit (``ripe_median``), each holding a seed and big enough for a fragment of the least fruit; the
+    fruit (``ripe_median``), each holding a seed and at least the least fruit's area at its depth; the
     fruit's skin around them is found again later (:func:`_round_skin`, the hull)."""
     z = depth[region & (depth > 0)]
     zr = float(np.median(z)) if len(z) else z_typical
@@ -1076,7 +1071,7 @@ def _ripe_cores(
     core = region & (redness(color) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
-    keep = sizes >= 0.25 * np.pi / 4 * (focal * s.min_diameter / zr) ** 2
+    keep = sizes >= np.pi / 4 * (focal * s.min_diameter / zr) ** 2
     keep[0] = False
     return [lab == k for k in np.flatnonzero(keep)]
 
