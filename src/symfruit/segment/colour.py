@@ -1059,16 +1059,20 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
 def _ripe_cores(
     region: np.ndarray, color: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float
 ) -> list[np.ndarray]:
-    """A weakly red region larger than the largest round fruit (``round_max_diameter`` at its median depth,
+    """A weakly red region no larger than the largest round fruit is kept when ripe (``ripe_median``). One
+    larger than the largest round fruit (``round_max_diameter`` at its median depth,
     ``z_typical`` without any) is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through
     weakly red pixels. It is then taken as its cores, the pieces of its pixels that are as red as a ripe
-    fruit (``ripe_median``), each holding a seed and at least the least fruit's area at its depth; the
+    fruit (``ripe_median``), each at least the least fruit's area at its depth; the
     fruit's skin around them is found again later (:func:`_round_skin`, the hull)."""
     z = depth[region & (depth > 0)]
     zr = float(np.median(z)) if len(z) else z_typical
+    red = redness(color)
     if region.sum() <= np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2:
-        return [region]
-    core = region & (redness(color) >= s.ripe_median)
+        # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
+        # before the region is split and merged: a twig or bark never costs the work on a fruit)
+        return [region] if np.median(red[region]) >= s.ripe_median else []
+    core = region & (red >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     keep = sizes >= np.pi / 4 * (focal * s.min_diameter / zr) ** 2
