@@ -1072,12 +1072,18 @@ def _ripe_cores(
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
         # before the region is split and merged: a twig or bark never costs the work on a fruit)
         return [region] if np.median(red[region]) >= s.ripe_median else []
-    core = region & (red >= s.ripe_median)
+    # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
+    core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     keep = sizes >= np.pi / 4 * (focal * s.min_diameter / zr) ** 2
     keep[0] = False
     return [lab == k for k in np.flatnonzero(keep)]
+
+
+#: Width (pixels) of the box over which a ripe-red core's redness is averaged (the colour noise of one
+#: pixel: brown bark whose mean redness lies just below ``ripe_median`` has single pixels above it).
+CORE_SMOOTH_PX = 5
 
 
 def _round_skin(
