@@ -1056,6 +1056,14 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
+def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
+    """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
+    (``z_typical`` where none of its pixels has depth)."""
+    z = depth[mask & (depth > 0)]
+    zr = float(np.median(z)) if len(z) else z_typical
+    return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
+
+
 def _ripe_cores(
     region: np.ndarray, color: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float
 ) -> list[np.ndarray]:
@@ -1065,10 +1073,9 @@ def _ripe_cores(
     weakly red pixels. It is then taken as its cores, the pieces of its pixels that are as red as a ripe
     fruit (``ripe_median``), each at least the least fruit's area at its depth; the
     fruit's skin around them is found again later (:func:`_round_skin`, the hull)."""
-    z = depth[region & (depth > 0)]
-    zr = float(np.median(z)) if len(z) else z_typical
     red = redness(color)
-    if region.sum() <= np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2:
+    largest = _largest_area(region, depth, s, focal, z_typical)
+    if region.sum() <= largest:
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
         # before the region is split and merged: a twig or bark never costs the work on a fruit)
         return [region] if np.median(red[region]) >= s.ripe_median else []
@@ -1076,7 +1083,7 @@ def _ripe_cores(
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
-    keep = sizes >= np.pi / 4 * (focal * s.min_diameter / zr) ** 2
+    keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
     keep[0] = False
     return [lab == k for k in np.flatnonzero(keep)]
 
@@ -1102,7 +1109,9 @@ def _round_skin(
     ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
     (``owner``, whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow or
     yellow-green side joins its red blush; a leaf
-    in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
+    in front or behind, beyond a depth step, does not. When what is reached exceeds the largest fruit's disc
+    (``round_max_diameter``) it is not one fruit's skin (bark or a branch at the fruit's depth joined it) and
+    the part is kept as it was. Returns the grown window and mask."""
     z_part = depth[sl][hull & (depth[sl] > 0)]
     if len(z_part) < 20:
         return sl, hull
@@ -1127,7 +1136,10 @@ def _round_skin(
     reached = np.zeros(n + 1, bool)
     reached[lab[part]] = True
     reached[0] = False
-    return big, reached[lab] | part
+    skin = reached[lab] | part
+    if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
+        return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
+    return big, skin
 
 
 #: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
