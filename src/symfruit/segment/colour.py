@@ -1132,9 +1132,10 @@ def _round_skin(
     near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
     deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
     candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
-    lab, n = ndimage.label((candidate & ~_steps(z, 0.5 * s.depth_jump)) | part)
+    # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
+    lab, n = ndimage.label((candidate | part) & ~_steps(z, 0.5 * s.depth_jump))
     reached = np.zeros(n + 1, bool)
-    reached[lab[part]] = True
+    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
     reached[0] = False
     skin = reached[lab] | part
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
