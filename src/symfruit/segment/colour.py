@@ -615,12 +615,13 @@ def _depth(
     z = np.asarray(depth)
     if z.shape != shape:
         raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
-    z = np.asarray(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units
+    z = np.array(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units; a copy
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    z = np.where(np.isfinite(z) & (z > 0), z, 0.0)
-    if not (z > 0).any():
+    np.nan_to_num(z, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # in place: no full-frame temporaries
+    np.maximum(z, 0.0, out=z)
+    if not z.any():
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
