@@ -268,7 +268,7 @@ def bench_segment_trees(n: int = 6, *, seed: int = 0, repeat: int = 3) -> Segmen
         ms.append(best * 1000.0)
     t = np.array(ms)
     h, w = frames[0].color.shape[:2]
-    return SegmentRow(len(t), "rendered apple-tree frames with depth", w, h, float(np.median(t)),
+    return SegmentRow(len(t), "rendered apple-tree frames", w, h, float(np.median(t)),
                       float(np.percentile(t, 90)), float(t.max()))  # fmt: skip
 
 
