@@ -38,7 +38,10 @@ lying over it) sits inside that body's outline. So the segmenter
    the leaf behind it).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
-   berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
+   berry, or not red over most of their body (``ripe_median``; blushed white or green fruit). With
+   ``round_fruit`` and depth this is settled for each region before it is split: one no larger than the
+   largest fruit (``round_max_diameter``) and not ripe-red over most of it is dropped at once (bark, twigs),
+   and one larger (a fruit joined to bark by weakly red pixels) keeps only its ripe-red cores.
 
 Fruit cut by the image border are kept (their hull is cut by the border too).
 """
