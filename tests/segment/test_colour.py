@@ -481,3 +481,24 @@ def test_brown_bark_alone_is_no_fruit():
     color[bark] = np.c_[np.full(bark.sum(), 120), rng.integers(80, 90, bark.sum()), np.full(bark.sum(), 60)]
     depth[bark] = 1.5
     assert segment(color, depth, HD_CAM, resolve_settings(fruit="apple").segment).max() == 0
+
+
+def test_a_region_larger_than_the_largest_fruit_keeps_its_ripe_red_cores():
+    from symfruit.segment.colour import _ripe_cores
+
+    # at 1.5 m and f = 960 the largest fruit (0.10 m) is 64 px across: a red disc of 50 px joined by a
+    # brown strip (redness 0.29) to a second red disc too small to be a fruit fragment (6 px)
+    yy, xx = np.mgrid[:100, :300]
+    color = np.full((100, 300, 3), (120, 85, 60), np.uint8)
+    apple = (yy - 50) ** 2 + (xx - 50) ** 2 < 25**2
+    speck = (yy - 50) ** 2 + (xx - 250) ** 2 < 3**2
+    color[apple | speck] = RED
+    region = apple | speck | ((np.abs(yy - 50) < 8) & (xx > 60) & (xx < 260))
+    depth = np.full((100, 300), 1.5)
+    s = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    cores = _ripe_cores(region, color, depth, s, 960.0, 1.5)
+    assert len(cores) == 1 and (cores[0] ^ apple).sum() < 0.05 * apple.sum()
+    # no larger than the largest fruit: kept whole when ripe-red over most of it, else dropped
+    assert _ripe_cores(apple, color, depth, s, 960.0, 1.5)[0] is apple
+    strip = region & ~apple & ~speck
+    assert _ripe_cores(strip[:, 100:160], color[:, 100:160], depth[:, 100:160], s, 960.0, 1.5) == []
