@@ -139,8 +139,9 @@ class SegmentSettings(Section):
     round_max_diameter : float, metres
         With depth and ``round_fruit``: the largest fruit. A weakly red region larger than a disc of this
         diameter at its depth is a fruit joined to bark or a twig by weakly red pixels, and only its ripe-red
-        cores are kept (:func:`_ripe_cores`). Default 0.12: round fruit up to large apples and oranges
-        (about 100 mm) with a margin; the apple profile sets 0.10.
+        cores are kept; a smaller one not ripe-red over most of it (``ripe_median``) is dropped before it is
+        split (:func:`_ripe_cores`); a grown skin larger than that disc is not taken. Default 0.12: round
+        fruit up to large apples and oranges (about 100 mm) with a margin; the apple profile sets 0.10.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -1071,12 +1072,14 @@ def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal
 def _ripe_cores(
     region: np.ndarray, color: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float
 ) -> list[np.ndarray]:
-    """A weakly red region no larger than the largest round fruit is kept when ripe (``ripe_median``). One
-    larger than the largest round fruit (``round_max_diameter`` at its median depth,
-    ``z_typical`` without any) is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through
-    weakly red pixels. It is then taken as its cores, the pieces of its pixels that are as red as a ripe
-    fruit (``ripe_median``), each at least the least fruit's area at its depth; the
-    fruit's skin around them is found again later (:func:`_round_skin`, the hull)."""
+    """What of a weakly red region (``region`` in a window of ``color`` and ``depth``) may hold round fruit.
+
+    One no larger than the largest fruit (a disc of ``round_max_diameter`` at its median depth, at
+    ``z_typical`` without any) is kept whole when its median redness reaches ``ripe_median``, else dropped.
+    One larger is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through weakly red
+    pixels. It is taken as its cores, the pieces of its pixels whose redness averaged over
+    :data:`CORE_SMOOTH_PX` pixels reaches ``ripe_median``, each at least the least fruit's disc
+    (``min_diameter``); the fruit's skin around them is found again later (the hull, :func:`_round_skin`)."""
     red = redness(color)
     largest = _largest_area(region, depth, s, focal, z_typical)
     if region.sum() <= largest:
@@ -1111,11 +1114,12 @@ def _round_skin(
     within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
     ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
-    (``owner``, whole image: red pixels of piece ``k`` or of none). A bicoloured apple's yellow or
-    yellow-green side joins its red blush; a leaf
-    in front or behind, beyond a depth step, does not. When what is reached exceeds the largest fruit's disc
-    (``round_max_diameter``) it is not one fruit's skin (bark or a branch at the fruit's depth joined it) and
-    the part is kept as it was. Returns the grown window and mask."""
+    (``owner``, whole image: red pixels of piece ``k`` or of none). The growth starts from the part's pixels
+    within ``depth_jump`` of its median depth (its hull's rim may lie on what is behind it). A bicoloured
+    apple's yellow or yellow-green side joins its red blush; a leaf in front or behind, beyond a depth step,
+    does not. When what is reached exceeds the largest fruit's disc (``round_max_diameter``) it is not one
+    fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. Returns
+    the grown window and mask."""
     z_part = depth[sl][hull & (depth[sl] > 0)]
     if len(z_part) < 20:
         return sl, hull
