@@ -71,6 +71,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to --size)")
     p.add_argument("--size", default="640x480", metavar="WxH",
                    help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
+    p.add_argument("--scene", choices=("apple-tree",), default=None,
+                   help="with --segment: rendered apple-tree frames with depth (1920x1080, apple profile) instead "
+                   "of photos")  # fmt: skip
 
 
 def _add_evaluate(sub: argparse._SubParsersAction) -> None:
@@ -322,11 +325,17 @@ def _bench(args: argparse.Namespace) -> int:
         except ValueError:
             raise InputError(f"--size must be WIDTHxHEIGHT, e.g. 1920x1080, got {args.size!r}") from None
         check_image_size(width, height, "--size")
-        row = bench_segment(args.images, size=(width, height))
+        if args.scene is not None:
+            from .evaluate.bench import bench_segment_trees
+
+            row = bench_segment_trees()
+        else:
+            row = bench_segment(args.images, size=(width, height))
         if args.json:
             print(json.dumps({"machine": machine(), "segment": row.to_dict()}, indent=2))
             return 0
-        print(f"symfruit bench --segment: {row.images} {row.source} at {row.width}x{row.height}, colour alone, "
+        alone = "with depth" if args.scene is not None else "colour alone"
+        print(f"symfruit bench --segment: {row.images} {row.source} at {row.width}x{row.height}, {alone}, "
               f"one process: median {row.median_ms:.2f} ms, p90 {row.p90_ms:.2f} ms, max {row.max_ms:.1f} ms "
               "per image")  # fmt: skip
         return 0

@@ -18,6 +18,15 @@ def test_bench_segment_times_24_synthetic_photos():
 
 
 @pytest.mark.slow
+def test_bench_segment_times_rendered_apple_tree_frames_with_depth():
+    from symfruit.evaluate.bench import bench_segment_trees
+
+    row = bench_segment_trees(1, seed=3, repeat=1)
+    assert row.images == 1 and (row.width, row.height) == (1920, 1080) and "apple-tree" in row.source
+    assert row.median_ms > 0
+
+
+@pytest.mark.slow
 def test_a_frame_through_a_real_camera_is_timed_at_its_resolution():
     from symfruit.evaluate.bench import bench_frame
 

@@ -408,3 +408,97 @@ def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
     found = labels == 1
     assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow half joined
     assert not found[500:580, 935:990][~disc[500:580, 935:990]].any()  # the yellowish leaf behind did not
+
+
+def test_a_bicoloured_apple_with_a_yellow_green_side_is_found_whole_but_not_the_leaf_beside_it():
+    # an apple 60 px across at 1.5 m: red left half, yellow-green right half (hue 68 degrees: green by the
+    # calyx test, not a leaf); a leaf-green strip (hue 108) at the apple's own depth touching its right side
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    xx = np.mgrid[:1080, :1920][1]
+    color[disc & (xx > 900)] = (160, 175, 60)
+    leaf = (~disc) & (xx >= 925) & (xx < 960) & (np.abs(np.mgrid[:1080, :1920][0] - 540) < 12)
+    color[leaf] = (70, 150, 50)
+    depth[leaf] = 1.5 - 0.005  # the leaf touches the fruit's rim at its depth: no depth step parts them
+    labels = segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True))
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum()  # the yellow-green half joined
+    assert found[leaf].sum() < 0.05 * leaf.sum()  # the leaf did not
+
+
+def test_a_leaf_green_round_depth_bump_is_no_fruit():
+    # a sphere's depth bump 60 px across, leaf green all over, before leaves 10 cm behind: nothing red, nothing found
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    color[(color == RED).all(axis=2)] = (70, 150, 50)
+    assert segment(color, depth, HD_CAM, SegmentSettings(round_fruit=True)).max() == 0
+
+
+@pytest.mark.parametrize(
+    ("rgb", "leaf"),
+    [((70, 150, 50), True), ((40, 120, 110), True), ((160, 175, 60), False), ((200, 180, 60), False),
+     ((120, 160, 60), True), ((150, 160, 60), False)],
+)  # fmt: skip
+def test_leaf_green_is_a_hue_of_80_degrees_or_more(rgb, leaf):
+    import colorsys
+
+    from symfruit.segment.colour import LEAF_HUE, _leaf
+
+    hue = 360 * colorsys.rgb_to_hsv(*(v / 255 for v in rgb))[0]
+    assert (hue >= LEAF_HUE) == leaf  # each case lies on its side of the boundary
+    assert bool(_leaf(np.array([[rgb]], np.uint8))[0, 0]) == leaf
+
+
+def test_an_apple_joined_to_brown_bark_is_found_without_the_bark():
+    # an apple 60 px across at 1.5 m touching a branch of brown bark (redness 0.27-0.31: weakly red, some pixels
+    # strongly) 3 cm behind its rim: the branch joins the apple's red region. (Level with the rim, the skin
+    # grows over the bark: brown is not leaf green and no depth step parts them; not handled.)
+    behind = 0.03
+    from symfruit.settings import resolve_settings
+
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    yy, xx = np.mgrid[:1080, :1920]
+    bark = ~disc & (np.abs(yy - 540) < 12) & (xx > 925) & (xx < 1300)
+    rng = np.random.default_rng(4)
+    color[bark] = np.c_[np.full(bark.sum(), 120), rng.integers(83, 88, bark.sum()), np.full(bark.sum(), 60)]
+    depth[bark] = 1.5 + behind
+    s = resolve_settings(fruit="apple").segment
+    labels = segment(color, depth, HD_CAM, s)
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() / (found | disc).sum() > 0.9
+    assert found[bark].sum() < 0.02 * bark.sum()
+
+
+def test_brown_bark_alone_is_no_fruit():
+    from symfruit.settings import resolve_settings
+
+    color, depth = hd_disc_frame([], radius=30)
+    yy, xx = np.mgrid[:1080, :1920]
+    bark = (np.abs(yy - 540) < 15) & (xx > 700) & (xx < 760)  # a stub of branch the size of an apple
+    rng = np.random.default_rng(5)
+    color[bark] = np.c_[np.full(bark.sum(), 120), rng.integers(80, 90, bark.sum()), np.full(bark.sum(), 60)]
+    depth[bark] = 1.5
+    assert segment(color, depth, HD_CAM, resolve_settings(fruit="apple").segment).max() == 0
+
+
+def test_a_region_larger_than_the_largest_fruit_keeps_its_ripe_red_cores():
+    from symfruit.segment.colour import _ripe_cores
+
+    # at 1.5 m and f = 960 the largest fruit (0.10 m) is 64 px across: a red disc of 50 px joined by a
+    # brown strip (redness 0.29) to a second red disc too small to be a fruit fragment (6 px)
+    yy, xx = np.mgrid[:100, :300]
+    color = np.full((100, 300, 3), (120, 85, 60), np.uint8)
+    apple = (yy - 50) ** 2 + (xx - 50) ** 2 < 25**2
+    speck = (yy - 50) ** 2 + (xx - 250) ** 2 < 3**2
+    color[apple | speck] = RED
+    region = apple | speck | ((np.abs(yy - 50) < 8) & (xx > 60) & (xx < 260))
+    depth = np.full((100, 300), 1.5)
+    s = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    cores = _ripe_cores(region, color, depth, s, 960.0, 1.5)
+    assert len(cores) == 1 and (cores[0] ^ apple).sum() < 0.05 * apple.sum()
+    # no larger than the largest fruit: kept whole when ripe-red over most of it, else dropped
+    assert _ripe_cores(apple, color, depth, s, 960.0, 1.5)[0] is apple
+    strip = region & ~apple & ~speck
+    assert _ripe_cores(strip[:, 100:160], color[:, 100:160], depth[:, 100:160], s, 960.0, 1.5) == []

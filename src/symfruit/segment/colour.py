@@ -34,10 +34,14 @@ lying over it) sits inside that body's outline. So the segmenter
    (``fill``: without depth the whole outline, as annotators draw it; with depth the visible surface,
    green calyx, leaf and stem pixels over it left out, and pixels off the fruit's depth dropped).
    With ``round_fruit`` (apples), the visible skin also takes the pixels around the red part reached from
-   it without crossing a depth step (a bicoloured apple's yellow side, not the leaf behind it).
+   it without crossing a depth step and not leaf green (a bicoloured apple's yellow or yellow-green side, not
+   the leaf behind it).
 5. drops parts that are not ripe fruit: too small (with depth: smaller than ``min_diameter`` at their
    depth; without: than ``min_area_share`` of the image), without depth far more elongated than a
-   berry, or not red over most of their body (``ripe_median``; blushed white or green fruit).
+   berry, or not red over most of their body (``ripe_median``; blushed white or green fruit). With
+   ``round_fruit`` and depth this is settled for each region before it is split: one no larger than the
+   largest fruit (``round_max_diameter``) and not ripe-red over most of it is dropped at once (bark, twigs),
+   and one larger (a fruit joined to bark by weakly red pixels) keeps only its ripe-red cores.
 
 Fruit cut by the image border are kept (their hull is cut by the border too).
 """
@@ -130,7 +134,14 @@ class SegmentSettings(Section):
     round_fruit : bool
         With depth: the fruit are round and may be only partly red (bicoloured apples), so each one's
         visible skin also takes the pixels around its red part (within twice its radius) reached without
-        crossing a depth step and not green: the yellow side, not the leaf behind. Off for strawberries.
+        crossing a depth step and not leaf green (hue :data:`LEAF_HUE` or more): the yellow or yellow-green
+        side, not the leaf behind. Off for strawberries.
+    round_max_diameter : float, metres
+        With depth and ``round_fruit``: the largest fruit. A weakly red region larger than a disc of this
+        diameter at its depth is a fruit joined to bark or a twig by weakly red pixels, and only its ripe-red
+        cores are kept; a smaller one not ripe-red over most of it (``ripe_median``) is dropped before it is
+        split (:func:`_ripe_cores`); a grown skin larger than that disc is not taken. Default 0.12: round
+        fruit up to large apples and oranges (about 100 mm) with a margin; the apple profile sets 0.10.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -151,6 +162,7 @@ class SegmentSettings(Section):
     crease_sigma: float = setting(2.0, ge=0.0, le=MAX_RADIUS_PX)
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
     round_fruit: bool = setting(False)
+    round_max_diameter: float = setting(0.12, gt=0.0, le=1.0)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -459,8 +471,13 @@ def _segment_at(
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
             sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
             origin = (sl[0].start, sl[1].start)
-            pieces += [_Piece(sl, part, 1 << sources) for part in _split(region, sub_z, s, geo, origin, min_area)]
-            sources += 1
+            cores = [region]
+            if s.round_fruit and sub_z is not None:
+                cores = _ripe_cores(region, c[sl], sub_z, s, geo.focal, z_typical)
+            for core in cores:
+                parts = _split(core, sub_z, s, geo, origin, min_area)
+                pieces += [_Piece(sl, part, 1 << sources) for part in parts]
+                sources += 1
     if not pieces:
         return np.zeros((h, w), np.int32)
     pieces = _merge(pieces, s, c, weak, z, geo)
@@ -575,6 +592,22 @@ def _green(color: np.ndarray) -> np.ndarray:
     return (g > r) & (g >= b) & (3 * (g - np.minimum(r, b)) >= g)
 
 
+def _leaf(color: np.ndarray) -> np.ndarray:
+    """(h, w) bool: leaf-green pixels, :func:`_green` and of a hue of at least :data:`LEAF_HUE` degrees. A
+    yellow-green fruit skin (a bicoloured apple's ground colour) is green by :func:`_green` but yellower.
+    With G the largest channel, the hue is ``60 + 60 (G - R) / (G - min(R, B))`` degrees (above 120 when
+    B > R), so hue >= 80 is ``3 (G - R) >= G - min(R, B)``: integers, independent of brightness and saturation."""
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    return _green(color) & (3 * (g - r) >= g - np.minimum(r, b))
+
+
+#: The least hue (degrees) of a leaf. Leaves of apple and most fruit trees are green of hue about 85-130;
+#: the ground colour of yellow-green and bicoloured apples (Golden Delicious, Gala, Fuji, Pink Lady) yellow to
+#: yellow-green, about 45-75. Written into :func:`_leaf`'s integer test; a physical boundary between the
+#: two, not fitted (on the rendered apple trees, seeds 0-5, the recall is flat within 1 % for 75-85).
+LEAF_HUE = 80.0
+
+
 def _depth(
     depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]
 ) -> tuple[np.ndarray | None, _Geometry]:
@@ -586,12 +619,13 @@ def _depth(
     z = np.asarray(depth)
     if z.shape != shape:
         raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
-    z = np.asarray(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units
+    z = np.array(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units; a copy
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    z = np.where(np.isfinite(z) & (z > 0), z, 0.0)
-    if not (z > 0).any():
+    np.nan_to_num(z, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # in place: no full-frame temporaries
+    np.maximum(z, 0.0, out=z)
+    if not z.any():
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
@@ -1027,6 +1061,45 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
+def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
+    """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
+    (``z_typical`` where none of its pixels has depth)."""
+    z = depth[mask & (depth > 0)]
+    zr = float(np.median(z)) if len(z) else z_typical
+    return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
+
+
+def _ripe_cores(
+    region: np.ndarray, color: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float
+) -> list[np.ndarray]:
+    """What of a weakly red region (``region`` in a window of ``color`` and ``depth``) may hold round fruit.
+
+    One no larger than the largest fruit (a disc of ``round_max_diameter`` at its median depth, at
+    ``z_typical`` without any) is kept whole when its median redness reaches ``ripe_median``, else dropped.
+    One larger is not one fruit: brown bark, a twig or a shaded leaf joins a red fruit through weakly red
+    pixels. It is taken as its cores, the pieces of its pixels whose redness averaged over
+    :data:`CORE_SMOOTH_PX` pixels reaches ``ripe_median``, each at least the least fruit's disc
+    (``min_diameter``); the fruit's skin around them is found again later (the hull, :func:`_round_skin`)."""
+    red = redness(color)
+    largest = _largest_area(region, depth, s, focal, z_typical)
+    if region.sum() <= largest:
+        # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
+        # before the region is split and merged: a twig or bark never costs the work on a fruit)
+        return [region] if np.median(red[region]) >= s.ripe_median else []
+    # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
+    core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
+    lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
+    keep[0] = False
+    return [lab == k for k in np.flatnonzero(keep)]
+
+
+#: Width (pixels) of the box over which a ripe-red core's redness is averaged (the colour noise of one
+#: pixel: brown bark whose mean redness lies just below ``ripe_median`` has single pixels above it).
+CORE_SMOOTH_PX = 5
+
+
 def _round_skin(
     sl: Window,
     hull: np.ndarray,
@@ -1040,9 +1113,13 @@ def _round_skin(
     """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
     within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
-    ``depth_jump`` of its median depth, and are neither green nor another fruit's (``owner``, whole image:
-    red pixels of piece ``k`` or of none). A bicoloured apple's yellow side joins its red blush; a leaf
-    in front or behind, beyond a depth step, does not. Returns the grown window and mask."""
+    ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
+    (``owner``, whole image: red pixels of piece ``k`` or of none). The growth starts from the part's pixels
+    within ``depth_jump`` of its median depth (its hull's rim may lie on what is behind it). A bicoloured
+    apple's yellow or yellow-green side joins its red blush; a leaf in front or behind, beyond a depth step,
+    does not. When what is reached exceeds the largest fruit's disc (``round_max_diameter``) it is not one
+    fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. Returns
+    the grown window and mask."""
     z_part = depth[sl][hull & (depth[sl] > 0)]
     if len(z_part) < 20:
         return sl, hull
@@ -1062,12 +1139,16 @@ def _round_skin(
     free = (owner[big] == 0) | (owner[big] == k)
     near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
     deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    candidate = near & (z > 0) & deep & ~_green(color[big]) & free
-    lab, n = ndimage.label((candidate & ~_steps(z, 0.5 * s.depth_jump)) | part)
+    candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
+    # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
+    lab, n = ndimage.label((candidate | part) & ~_steps(z, 0.5 * s.depth_jump))
     reached = np.zeros(n + 1, bool)
-    reached[lab[part]] = True
+    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
     reached[0] = False
-    return big, reached[lab] | part
+    skin = reached[lab] | part
+    if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
+        return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
+    return big, skin
 
 
 #: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
