@@ -345,6 +345,7 @@ def fuse_depth(
     *,
     s: EvidenceSettings,
     rim: float = 1.0,
+    seen_back: float | None = None,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -374,6 +375,8 @@ def fuse_depth(
     prior_back = front + s.depth_ratio * width
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
     back = max((a * fit_back + b * prior_back) / (a + b), front + 1e-4)
+    if seen_back is not None:
+        back = max(back, seen_back)  # the fruit holds every point seen of it
     share = b / (a + b) * combined.contour**2
     rows, cols = np.nonzero(region.mask)
     z_mid = 0.5 * (front + back)
@@ -430,7 +433,8 @@ def evidence(
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner)
-    box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim)
+    box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim,
+                                     seen_back=float(points[:, 2].max()))  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     uncertainty = float(np.hypot(combined.uncertainty, moved))
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
