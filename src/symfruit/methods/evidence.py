@@ -55,7 +55,7 @@ from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
-from ..core.raster import Silhouette, close_ragged, inner_distance, principal_widths, silhouette
+from ..core.raster import Silhouette, across_sight, close_ragged, inner_distance, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -364,8 +364,8 @@ def fuse_depth(
     fit_back = float(box.max[2])
     spread = float((w * np.abs(backs - fit_back)).sum())
     back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
-    minor, major = principal_widths(region.mask)
-    width = float(np.sqrt(minor * major) * box.centre[2] / np.sqrt(camera.fx * camera.fy))
+    across = across_sight(region, camera)
+    width = float(np.sqrt(across.minor * across.major) * box.centre[2] / across.axis[2])
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
     fit_sd = float(np.sqrt((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
     if s.depth_ratio_sd <= 0 or width <= 0:
@@ -378,12 +378,12 @@ def fuse_depth(
     if seen_back is not None:
         back = max(back, seen_back)  # the fruit holds every point seen of it
     share = b / (a + b) * combined.contour**2
-    rows, cols = np.nonzero(region.mask)
-    z_mid = 0.5 * (front + back)
-    sil_lo = np.array([(cols.min() - 0.5 + region.u0 - camera.cx) / camera.fx,
-                       (rows.min() - 0.5 + region.v0 - camera.cy) / camera.fy]) * z_mid  # fmt: skip
-    sil_hi = np.array([(cols.max() + 0.5 + region.u0 - camera.cx) / camera.fx,
-                       (rows.max() + 0.5 + region.v0 - camera.cy) / camera.fy]) * z_mid  # fmt: skip
+    # The silhouette's box: its widths across the line of sight (a sphere's diameter wherever it is in the
+    # image, where the pixel box times the depth is stretched off the optical axis), about the posterior
+    # centre's point on the ray through the silhouette's centroid.
+    dist = 0.5 * (front + back) / across.axis[2]
+    sil_lo = dist * (across.axis[:2] + across.lo)
+    sil_hi = dist * (across.axis[:2] + across.hi)
     lo, hi = box.min.copy(), box.max.copy()
     lo[:2] += share * (sil_lo - lo[:2])
     hi[:2] += share * (sil_hi - hi[:2])
