@@ -55,7 +55,7 @@ from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import subsample
-from ..core.raster import Silhouette, across_sight, close_ragged, inner_distance, silhouette
+from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -195,6 +195,7 @@ class EvidenceSettings(Section):
     mirror_energy: float = setting(5.0, ge=0.0, le=1e6)
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
+    recede_scale: float = setting(0.2, ge=0.0, le=100.0)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     occluded_px: int = setting(4, ge=0, le=50)
@@ -346,6 +347,7 @@ def fuse_depth(
     s: EvidenceSettings,
     rim: float = 1.0,
     seen_back: float | None = None,
+    across: Across | None = None,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -364,7 +366,7 @@ def fuse_depth(
     fit_back = float(box.max[2])
     spread = float((w * np.abs(backs - fit_back)).sum())
     back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
-    across = across_sight(region, camera)
+    across = across_sight(region, camera) if across is None else across
     width = float(np.sqrt(across.minor * across.major) * box.centre[2] / across.axis[2])
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
     fit_sd = float(np.sqrt((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
@@ -433,10 +435,17 @@ def evidence(
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner)
-    box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim,
-                                     seen_back=float(points[:, 2].max()))  # fmt: skip
+    across = across_sight(region, camera)
+    seen_back = float(points[:, 2].max())
+    box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
+                                     across=across)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
-    uncertainty = float(np.hypot(combined.uncertainty, moved))
+    # A fruit receding along the line of sight (seen deeper than the half-width a round fruit shows in front
+    # of its rim) has a back that nothing seen mirrors; an elongated outline leaves the tilt of the fruit's
+    # long axis out of the image unseen.
+    recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width)
+    elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
+    uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2))
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
         "confidence": confidence,
