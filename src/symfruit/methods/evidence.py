@@ -440,10 +440,11 @@ def evidence(
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=across)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
-    # A fruit receding along the line of sight (seen deeper than the half-width a round fruit shows in front
-    # of its rim) has a back that nothing seen mirrors; an elongated outline leaves the tilt of the fruit's
-    # long axis out of the image unseen.
-    recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width)
+    # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
+    # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
+    # mirrors; an elongated outline leaves the tilt of the fruit's long axis out of the image unseen. (A
+    # sparse cloud's points need not end at the rim: no receding measure there.)
+    recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width) if dense else 0.0
     elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
     uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2))
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
