@@ -304,27 +304,32 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     >>> round(a.minor * 500, 3), round(a.major * 500, 3)
     (10.0, 20.0)
     """
-    mask = region.mask
-    rows, cols = np.nonzero(mask)
-    if len(rows) == 0:
+    m = region.mask.astype(np.float64)
+    col_sums, row_sums = m.sum(axis=0), m.sum(axis=1)
+    n = col_sums.sum()
+    if n == 0:
         raise InputError("the region is empty")
-    u = cols + float(region.u0)
-    v = rows + float(region.v0)
-    axis = camera.rays(np.array(u.mean()), np.array(v.mean())).reshape(3)
+    u = np.arange(m.shape[1], dtype=np.float64) + region.u0
+    v = np.arange(m.shape[0], dtype=np.float64) + region.v0
+    mu = np.array([col_sums @ u, row_sums @ v]) / n
+    du, dv = u - mu[0], v - mu[1]
+    cov = np.array([[col_sums @ (du * du), dv @ m @ du], [dv @ m @ du, row_sums @ (dv * dv)]]) / n
+    axis = camera.rays(mu[0], mu[1]).reshape(3)
     axis = axis / np.linalg.norm(axis)
     e1 = np.array([axis[2], 0.0, -axis[0]])
     e1 /= np.linalg.norm(e1)
-    e2 = np.cross(axis, e1)
-    basis = np.array([e1, e2])
+    basis = np.array([e1, np.cross(axis, e1)])
 
     def tangent(uu: np.ndarray, vv: np.ndarray) -> np.ndarray:
         r = camera.rays(uu, vv).reshape(-1, 3)
         return (r @ basis.T) / (r @ axis)[:, None]
 
-    inside = tangent(u, v)
+    # The principal axes from the pixels' covariance carried to tangent coordinates by the map's Jacobian at
+    # the centroid (the map is projective: over one fruit's pixels, linear to well under a pixel).
+    t0, tu, tv = tangent(mu[0] + np.array([0.0, 1.0, 0.0]), mu[1] + np.array([0.0, 0.0, 1.0]))
+    jac = np.c_[tu - t0, tv - t0]
+    _, vec = np.linalg.eigh(jac @ cov @ jac.T)
     edge = tangent(*outline_cracks(region).T)
-    xy = inside - inside.mean(axis=0)
-    _, vec = np.linalg.eigh(xy.T @ xy)
     p = edge @ vec
     return Across(axis, basis, edge.min(axis=0), edge.max(axis=0), float(np.ptp(p[:, 0])), float(np.ptp(p[:, 1])))
 
