@@ -239,7 +239,8 @@ def test_across_sight_measures_a_ball_off_axis_by_its_diameter():
         centre = dist * np.array([np.sin(a), 0.0, np.cos(a)])
         mask = _ball_mask(cam, centre, radius)
         rows, cols = np.nonzero(mask)
-        region = Silhouette(int(cols.min()), int(rows.min()), mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1], 0.0)
+        window = mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
+        region = Silhouette(int(cols.min()), int(rows.min()), window, 0.0)
         across = across_sight(region, cam)
         pixel = dist / cam.fx  # metres per pixel there
         assert across.minor * dist == pytest.approx(2 * radius, abs=1.5 * pixel)

@@ -19,11 +19,11 @@ from .limits import MAX_WINDOW_PIXELS
 from .points import as_points
 
 __all__ = [
-    "Across",
-    "across_sight",
     "MAX_WINDOW_PIXELS",
+    "Across",
     "Silhouette",
     "View",
+    "across_sight",
     "close_ragged",
     "inner_distance",
     "outline_cone",

@@ -27,12 +27,14 @@ completion is right for every fruit, and the view itself says which ones fit. Th
 5. takes the weighted median of every box face (robust to one wrong candidate, unlike a mean);
 6. moves the back face, the one face no pixel sees, towards a prior on the fruit's depth-to-width ratio by
    the two estimates' uncertainties (:func:`fuse_depth`): a fruit is about as deep as its silhouette is
-   wide (solids of revolution seen across their axis exactly), so on a noisy, distant or distorted view
-   the shapes' extrapolation of the front's curvature gives way to the silhouette, which a camera measures
-   well; on a clean close view the shapes keep most of their say;
+   wide across the line of sight (solids of revolution seen across their axis exactly), so on a noisy,
+   distant or distorted view the shapes' extrapolation of the front's curvature gives way to the
+   silhouette, which a camera measures well; on a clean close view the shapes keep most of their say; the
+   back face never ends in front of the deepest seen point (the fruit holds every point seen of it);
 7. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
-   own noise, the candidates' disagreement, what no candidate explains and how far the prior moved the
-   back face from the shapes' (half of it, as the centre moves), and reports
+   own noise, the candidates' disagreement, what no candidate explains, how far the prior moved the
+   back face from the shapes' (half of it, as the centre moves) and how far the fruit recedes along the
+   line of sight, all scaled by the outline's elongation, and reports
    ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
@@ -97,10 +99,11 @@ class EvidenceSettings(Section):
         candidate (issue 18's diagnosis; 2 keeps the ranking and lets close candidates share the box).
     depth_ratio, depth_ratio_sd : float, float
         The prior on the depth extent: ``depth_ratio`` times the silhouette's width (the geometric mean of its
-        widths across and along its principal axis, :func:`~symfruit.core.raster.principal_widths`, at the
-        box centre's depth), with standard deviation ``depth_ratio_sd`` times that width, divided by the
-        outline's contour share (a cut outline's width says less). Over the generated kinds' views the true
-        ratio is 0.83-1.07 by kind (round fruit 0.98-1.05, SD 0.03-0.05 within a kind; elongated fruit,
+        widths across and along its principal axis, measured across the line of sight through its centroid
+        at the box centre's distance, :func:`~symfruit.core.raster.across_sight`: a fruit off the optical axis
+        projects stretched by ``1 / cos`` of its angle), with standard deviation ``depth_ratio_sd`` times that
+        width, divided by the outline's contour share (a cut outline's width says less). Over the generated
+        kinds' views the true ratio is 0.83-1.07 by kind (round fruit 0.98-1.05, SD 0.03-0.05 within a kind; elongated fruit,
         whose long axis lies in the image, lower); 1.0 and 0.1 are the round numbers that cover them;
         ``depth_ratio_sd = 0`` switches the prior off.
     shape_error, rim_error, back_inflation : float, float, float
@@ -148,14 +151,22 @@ class EvidenceSettings(Section):
         best shape there is.
     mirror_energy, raw_energy : float
         Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
-    misfit_scale, uncertainty_scale, reliable_uncertainty : float, float (metres), float (metres)
-        The predicted centre uncertainty ``u = hypot(hypot(back_std, spread) + misfit_scale * wrong * size,
-        moved / 2)`` (``moved``: how far :func:`fuse_depth` moved the back face):
-        ``back_std`` the ``cone`` ellipsoid's back-face standard deviation from its own fit (the sensor's
-        noise), ``spread`` the weighted mean distance of the candidates' centres from the result's (what
-        the shapes disagree on), ``wrong`` the best closed candidate's share of silhouette-band rays
-        wrong and ``size`` the result's largest side (what no shape explains). ``confidence = exp(-u /
-        uncertainty_scale)``; ``reliable`` when ``u <= reliable_uncertainty``.
+    misfit_scale, recede_scale, uncertainty_scale, reliable_uncertainty : float, float, float (metres), float (metres)
+        The predicted centre uncertainty ``u = elongation * hypot(hypot(back_std, spread) + misfit_scale *
+        wrong * size, moved / 2, recede_scale * recede)``: ``back_std`` the ``cone`` ellipsoid's back-face
+        standard deviation from its own fit (the sensor's noise), ``spread`` the weighted mean distance of
+        the candidates' centres from the result's (what the shapes disagree on), ``wrong`` the best closed
+        candidate's share of silhouette-band rays wrong and ``size`` the result's largest side (what no
+        shape explains), ``moved`` how far :func:`fuse_depth` moved the back face (the prior against the
+        shapes); ``recede`` how much deeper than half the silhouette's width the points of a depth camera's
+        view reach behind the front, times the contour share (a round fruit shows about half its depth in
+        front of its rim; a fruit receding along the line of sight, a pear or banana pointing at the camera,
+        has a back that nothing seen mirrors); ``elongation`` the square root of the silhouette's major over
+        minor width (an elongated outline leaves the tilt of the long axis out of the image unseen, and
+        every error above grows with it). ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when
+        ``u <= reliable_uncertainty``. Issue 18's block jackknife of the ``cone`` fit's back face (angular
+        sectors of the seen depths, or of the outline, left out) was measured and predicts nothing on the
+        real scans (docs/ablation.md).
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
@@ -351,13 +362,17 @@ def fuse_depth(
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
+    ``seen_back``: the deepest seen point, which the back face never ends in front of (a fruit seen deeper
+    than it is wide, pointing at the camera, would otherwise be cut by the prior). ``across``: the region's
+    :func:`~symfruit.core.raster.across_sight` when known.
+
     The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
     width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
     standard deviation of the back face, ``width`` the silhouette's (:class:`EvidenceSettings`). The lateral
     faces move by the prior's share of that average, times the outline's contour share squared, towards the
-    silhouette's own box at the posterior centre's depth: where the rim holds no depth (a time-of-flight
-    camera) every shape fitted to the points is as narrow as the cap it saw, and the silhouette is the
-    better measure of the fruit's width too.
+    silhouette's own box (its extents across the line of sight about the posterior centre's point on the ray
+    through its centroid): where the rim holds no depth (a time-of-flight camera) every shape fitted to the
+    points is as narrow as the cap it saw, and the silhouette is the better measure of the fruit's width too.
     """
     box = combined.box
     names = [c.name for c in cands]
