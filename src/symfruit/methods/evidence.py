@@ -207,7 +207,7 @@ class EvidenceSettings(Section):
     mirror_energy: float = setting(5.0, ge=0.0, le=1e6)
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
-    recede_scale: float = setting(0.2, ge=0.0, le=100.0)
+    recede_scale: float = setting(0.1, ge=0.0, le=100.0)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     occluded_px: int = setting(4, ge=0, le=50)
