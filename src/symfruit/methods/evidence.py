@@ -103,7 +103,7 @@ class EvidenceSettings(Section):
         at the box centre's distance, :func:`~symfruit.core.raster.across_sight`: a fruit off the optical axis
         projects stretched by ``1 / cos`` of its angle), with standard deviation ``depth_ratio_sd`` times that
         width, divided by the outline's contour share (a cut outline's width says less). Over the generated
-        kinds' views the true ratio is 0.83-1.07 by kind (round fruit 0.98-1.05, SD 0.03-0.05 within a kind;
+        kinds' views the true ratio is 0.85-1.08 by kind (round fruit 1.00-1.08, SD 0.02-0.08 within a kind;
         elongated fruit, whose long axis lies in the image, lower); 1.0 and 0.1 are the round numbers that
         cover them;
         ``depth_ratio_sd = 0`` switches the prior off.
