@@ -468,6 +468,8 @@ def evidence(
         "confidence": confidence,
         "reliable": uncertainty <= s.reliable_uncertainty,
         "uncertainty": uncertainty,
+        "recede": recede,
+        "elongation": elongation,
         "back_sd": back_sd,
         "rim": rim,
         "width": width,
