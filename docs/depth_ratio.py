@@ -6,7 +6,7 @@ import sys
 
 import numpy as np
 
-from symfruit.core.raster import principal_widths, silhouette
+from symfruit.core.raster import across_sight, silhouette
 from symfruit.evaluate.protocols import build, specs
 
 KINDS = "apple,citrus,peach,tomato,strawberry,lopsided,lemon,pear,plum".split(",")
@@ -17,8 +17,9 @@ def ratios(fruit: str, n: int, pose: str) -> dict[str, np.ndarray]:
     for spec in specs("camera", fruit, n=n, seed=0, sensor="heldback", poses=pose):
         inst = build(spec)
         region = silhouette(inst.visible, inst.camera)
-        minor, major = principal_widths(region.mask)
-        scale = inst.truth_box.centre[2] / inst.camera.fx
+        across = across_sight(region, inst.camera)  # the widths the prior uses (tangent units)
+        minor, major = across.minor, across.major
+        scale = inst.truth_box.centre[2] / across.axis[2]
         depth = inst.truth_box.size[2]
         out.setdefault(inst.kind, []).append((depth / (minor * scale), depth / (major * scale),
                                               depth / (np.sqrt(minor * major) * scale)))  # fmt: skip

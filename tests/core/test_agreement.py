@@ -190,3 +190,21 @@ def test_an_occluders_edge_is_a_cut_with_the_occlusion_information(camera):
 def _whole_ball(camera):
     visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.01, seed=2)
     return visible[::10], silhouette(visible, camera), camera
+
+
+def test_a_view_on_the_image_border_whose_points_round_beyond_it(camera):
+    """A fruit cut by the image's last row, its points' sub-pixel projections within half a pixel of the
+    border: one that rounds to the row beyond the image is no outline neighbour (it indexed past the window,
+    an IndexError on a real pear scan's view touching the border)."""
+    rng = np.random.default_rng(2)
+    centre = np.array([0.0, (camera.height - 5 - camera.cy) / camera.fy * 0.4, 0.4])
+    d = rng.normal(size=(60000, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    pts = centre + 0.03 * d
+    pts = pts[(pts - centre)[:, 2] < 0]  # the front half
+    v = camera.project(pts)[:, 1]
+    pts = pts[v < camera.height - 0.1]  # in the image, some within half a pixel of its last row
+    assert (camera.project(pts)[:, 1] > camera.height - 0.5).any()
+    region = silhouette(pts, camera)
+    obs = observe(pts[::5], region, camera, dense=pts)
+    assert obs.contour < 1.0  # the border is a cut

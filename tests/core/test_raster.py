@@ -218,3 +218,46 @@ def test_the_inner_distance_over_the_masks_box_is_the_whole_images(seed):
 def test_the_inner_distance_of_an_empty_or_full_mask_is_the_whole_images():
     for mask in (np.zeros((7, 9), bool), np.ones((7, 9), bool)):
         np.testing.assert_array_equal(inner_distance(mask), ndimage.distance_transform_edt(mask))
+
+
+def _ball_mask(camera, centre, radius):
+    """The exact silhouette (pixel centres) of a ball: rays within its viewing cone's half-angle."""
+    v, u = np.mgrid[0 : camera.height, 0 : camera.width].astype(float)
+    d = np.stack([(u - camera.cx) / camera.fx, (v - camera.cy) / camera.fy, np.ones_like(u)], axis=-1)
+    c = np.asarray(centre, dtype=float)
+    cos = (d @ c) / (np.linalg.norm(d, axis=-1) * np.linalg.norm(c))
+    return cos >= np.sqrt(1.0 - (radius / np.linalg.norm(c)) ** 2)
+
+
+def test_across_sight_measures_a_ball_off_axis_by_its_diameter():
+    from symfruit.core.raster import Silhouette, across_sight, principal_widths
+
+    cam = Camera(fx=960.0, fy=960.0, cx=960.0, cy=540.0, width=1920, height=1080)  # the Azure Kinect's 90 deg
+    radius, dist = 0.03, 1.2
+    for angle in (0.0, 20.0, 38.0):  # degrees off the optical axis, to the right
+        a = np.radians(angle)
+        centre = dist * np.array([np.sin(a), 0.0, np.cos(a)])
+        mask = _ball_mask(cam, centre, radius)
+        rows, cols = np.nonzero(mask)
+        window = mask[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
+        region = Silhouette(int(cols.min()), int(rows.min()), window, 0.0)
+        across = across_sight(region, cam)
+        pixel = dist / cam.fx  # metres per pixel there
+        assert across.minor * dist == pytest.approx(2 * radius, abs=1.5 * pixel)
+        assert across.major * dist == pytest.approx(2 * radius, abs=1.5 * pixel)
+        np.testing.assert_allclose(across.axis, centre / dist, atol=1e-3)
+        # The silhouette's box about the ball's point on the axis is the ball's box (its x side, too).
+        x_lo, x_hi = dist * (across.axis[0] + across.lo[0]), dist * (across.axis[0] + across.hi[0])
+        assert x_lo == pytest.approx(centre[0] - radius, abs=1.5 * pixel)
+        assert x_hi == pytest.approx(centre[0] + radius, abs=1.5 * pixel)
+        # Pixel widths times depth over f are stretched by 1 / cos(angle) along the direction off the axis.
+        major_px = max(principal_widths(region.mask))
+        stretch = major_px * centre[2] / cam.fx / (2 * radius)
+        assert stretch == pytest.approx(1.0 / np.cos(a), rel=0.04)
+
+
+def test_across_sight_rejects_an_empty_region(camera):
+    from symfruit.core.raster import Silhouette, across_sight
+
+    with pytest.raises(InputError, match="empty"):
+        across_sight(Silhouette(0, 0, np.zeros((4, 4), bool), 0.0), camera)

@@ -168,3 +168,39 @@ def test_a_solid_of_revolution_running_along_a_real_banana_does_not_win():
     assert centre_deviation(r.box, inst.truth_box) < 0.01
     loose = complete(inst.visible, camera=inst.camera, settings={"evidence": {"lateral_reach": 1.0}})
     assert centre_deviation(loose.box, inst.truth_box) > 0.05
+
+
+@needs_real_scans
+def test_the_box_holds_every_point_seen_of_a_real_banana_pointing_at_the_camera():
+    """The real banana stood up (YCB 011_banana), camera view 32: it points at the camera, seen 190 mm deep
+    through a silhouette about 75 mm wide. The depth-to-width prior pulled the back face 103 mm in front of
+    the deepest seen point (54 mm off); the fruit holds every point seen of it, and the uncertainty says the
+    back is extrapolated."""
+    from symfruit.evaluate.protocols import specs
+
+    spec = next(s for s in specs("camera", str(REAL_SCANS), n=38, sensor="heldback", poses="upright") if s.pose == 32)
+    inst = build(spec)
+    assert "banana" in inst.kind
+    r = complete(inst.visible, camera=inst.camera)
+    assert r.box.max[2] >= inst.visible[:, 2].max()
+    assert centre_deviation(r.box, inst.truth_box) < 0.01
+    assert not r.reliable and r.extras["uncertainty"] > 0.01
+
+
+def test_a_fruit_pointing_at_the_camera_is_less_confident_than_one_seen_from_the_side():
+    """A tapering fruit (a cone with a round base, 105 mm long, 50 mm wide) seen tip first recedes along the line
+    of sight: what is seen reaches 80 mm behind its front through a 50 mm silhouette, and its hidden back is
+    mirrored by nothing seen. Seen from the side its outline is elongated but nothing recedes."""
+    from symfruit.synthetic.shapes import _revolve
+
+    s = np.linspace(0.0, 0.08, 60)
+    t = np.linspace(0.0, np.pi / 2, 30)[1:]
+    mesh = _revolve(np.r_[0.025 * np.sqrt(s / 0.08), 0.025 * np.cos(t)], np.r_[s, 0.08 + 0.025 * np.sin(t)] - 0.05,
+                    name="cone", n_phi=96)  # fmt: skip
+    tip, _ = rendered_view(mesh, [0.0, 0.0, 0.4], noise=0.01, rotation=rotation(90, 0, 0), seed=1)
+    side, _ = rendered_view(mesh, [0.0, 0.0, 0.4], noise=0.01, seed=1)
+    a, b = complete(tip), complete(side)
+    assert a.box.max[2] >= tip[:, 2].max()  # the box holds every seen point
+    assert a.extras["recede"] > 0.02 and b.extras["recede"] < 0.005
+    assert a.extras["elongation"] == pytest.approx(1.0, abs=0.1) and b.extras["elongation"] > 1.3
+    assert a.extras["uncertainty"] > 3 * b.extras["uncertainty"] and not a.reliable

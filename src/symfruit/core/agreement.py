@@ -323,15 +323,16 @@ def _contour_pixels(
     are the points of the ``(2 half + 1)^2`` pixels around its own (no search tree)."""
     near = np.flatnonzero(depth_px <= half + 1.5)  # every neighbour of an edge point lies this close
     points, depth_px = points[near], depth_px[near]
-    edge = np.flatnonzero(depth_px <= 1.5)
-    if len(edge) < 3:
-        return np.empty((0, 2)), np.empty(0, dtype=bool)
-    edge = edge[:: max(1, len(edge) // count)]
     h, w = region.mask.shape
     uv = camera.project(points)
     col = np.rint(uv[:, 0]).astype(np.intp) - region.u0 + half
     row = np.rint(uv[:, 1]).astype(np.intp) - region.v0 + half
     ok = (col >= half) & (col < w + half) & (row >= half) & (row < h + half)
+    # A point on the image's last row or column can round to the pixel beyond it (outside the window).
+    edge = np.flatnonzero((depth_px <= 1.5) & ok)
+    if len(edge) < 3:
+        return np.empty((0, 2)), np.empty(0, dtype=bool)
+    edge = edge[:: max(1, len(edge) // count)]
     grid = np.full((h + 2 * half, w + 2 * half, 3), np.nan)
     grid[row[ok], col[ok]] = points[ok]
     d = np.arange(-half, half + 1)
