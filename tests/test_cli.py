@@ -286,6 +286,40 @@ def test_bench_arguments_are_checked(capsys):
     assert main(["bench", "--points", "5"]) == 2
     assert main(["bench", "--recording", "0"]) == 2
     assert "--recording must be between 1 and 100000 frames" in capsys.readouterr().err
+    assert main(["bench", "--segment", "--size", "640"]) == 2
+    assert "--size must be WIDTHxHEIGHT, e.g. 1920x1080, got '640'" in capsys.readouterr().err
+    assert main(["bench", "--segment", "--size", "0x480"]) == 2  # the image size limits of every reader
+    assert "--size" in capsys.readouterr().err
+    pytest.importorskip("distributed")
+    assert main(["bench", "--recording", "1", "--workers", "0"]) == 2
+    assert "--workers must be between 1 and 256, got 0" in capsys.readouterr().err
+
+
+def test_bench_segment_times_synthetic_photos_or_a_folder_of_them(tmp_path, capsys):
+    """The segmenter's timing at a small size (the benchmark's 640x480 runs in `make test-slow`)."""
+    from PIL import Image
+
+    assert main(["bench", "--segment", "--size", "96x72"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("symfruit bench --segment: 24 synthetic photos at 96x72, colour alone, one process: median ")
+    photos = tmp_path / "photos"
+    photos.mkdir()
+    for k, size in enumerate([(200, 150), (120, 90)]):
+        Image.new("RGB", size, (40, 120, 30)).save(photos / f"p{k}.png")
+    assert main(["bench", "--segment", "--images", str(photos), "--size", "64x48", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["segment"]
+    assert row["images"] == 2 and row["source"] == str(photos) and (row["width"], row["height"]) == (64, 48)
+    assert 0 < row["median_ms"] <= row["p90_ms"] <= row["max_ms"]
+
+
+def test_bench_recording_reports_the_childs_peak_memory(capsys):
+    """One generated frame through a `symfruit detect` child (the memory bound itself is checked over a longer
+    recording in tests/test_batch.py)."""
+    assert main(["bench", "--recording", "1", "--method", "raw"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("symfruit bench --recording: 1 frames (1 written), method raw: ")
+    peak = float(out.split("peak RSS ")[1].split(" MB")[0])
+    assert 30 < peak < 400
 
 
 def test_no_command_prints_help(capsys):
