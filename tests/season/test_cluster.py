@@ -17,7 +17,7 @@ from symfruit import InputError
 from symfruit.batch import run_batch
 from symfruit.cli import main
 
-from ..conftest import EXAMPLE_FRAME
+from ..conftest import small_frame
 
 distributed = pytest.importorskip("distributed")
 
@@ -81,10 +81,10 @@ def cluster():
 
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    """Four copies of the shipped frame (rendered by symfruit.synthetic.scenes, six ripe strawberries)."""
+    """Four copies of the small frame (the shipped frame's right-hand strawberry: conftest.small_frame)."""
     rec = tmp_path_factory.mktemp("cluster") / "rec"
     for k in range(4):
-        shutil.copytree(EXAMPLE_FRAME, rec / f"scene_{k:05d}")
+        shutil.copytree(small_frame(), rec / f"scene_{k:05d}")
     return rec
 
 
@@ -239,7 +239,7 @@ def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(
     for name in (report.recordings[str(a)], report.recordings[str(b)]):
         assert name.startswith("rec+") and _fruits(out / name) == _fruits(tmp_path / "serial" / name)
     rows = pq.read_table(out / "detections.parquet").to_pylist()
-    assert rows == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist() and len(rows) == 24
+    assert rows == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist() and len(rows) == 4
     errors = json.loads((out / "errors.json").read_text())
     assert errors == json.loads((tmp_path / "serial" / "errors.json").read_text()) and errors["recordings"]
     shutil.rmtree(out / report.recordings[str(a)] / "scene_00001")
