@@ -80,6 +80,7 @@ def small_frame() -> Path:
     (folder / "truth.json").write_text(json.dumps({**truth, "fruits": inside}))
     return folder
 
+
 CENTRE = np.array([0.01, -0.02, 0.35])
 
 

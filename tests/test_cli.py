@@ -360,8 +360,8 @@ def test_inputs_claiming_huge_sizes_fail_cleanly_inside_a_memory_limit(tmp_path)
     # and what it wrote to stderr, each run's on one JSON line
     child = (
         "import contextlib, io, json, sys\nfrom symfruit.cli import main\nfor args in json.loads(sys.argv[1]):\n"
-        "    err = io.StringIO()\n    with contextlib.redirect_stderr(err):\n        status = main(['complete', *args])\n"
-        "    print(json.dumps([status, err.getvalue()]), flush=True)\n"
+        "    err = io.StringIO()\n    with contextlib.redirect_stderr(err):\n"
+        "        status = main(['complete', *args])\n    print(json.dumps([status, err.getvalue()]), flush=True)\n"
     )
     proc = subprocess.run([sys.executable, "-c", child, json.dumps(runs)], capture_output=True, text=True,
                           preexec_fn=cap, timeout=120)  # fmt: skip
@@ -476,13 +476,13 @@ def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
 
 def test_detect_takes_several_recordings(tmp_path, capsys):
     for parent in ("a", "b"):
-        shutil.copytree(EXAMPLE_FRAME, tmp_path / parent / "frames" / "f1")
-    shutil.copytree(EXAMPLE_FRAME, tmp_path / "row2" / "f1")
+        shutil.copytree(small_frame(), tmp_path / parent / "frames" / "f1")  # one fruit each
+    shutil.copytree(small_frame(), tmp_path / "row2" / "f1")
     out = tmp_path / "out"
     inputs = [str(tmp_path / "a" / "frames"), str(tmp_path / "b" / "frames"), str(tmp_path / "row2")]
     assert main(["detect", *inputs, "--output", str(out), "--method", "raw"]) == 0
     text, err = capsys.readouterr()
-    assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 18 located, 0 failed" in text
+    assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 3 located, 0 failed" in text
     assert "detect: 3/3" in err and "/1 " not in err  # one progress bar over every recording's frames
     assert text.count(" (its name is shared or not a plain file name)") == 2 and f"-> {out / 'frames+'}" in text
     assert "one folder per recording, in it one per frame" in text
@@ -497,9 +497,9 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     assert "give one input with it" in capsys.readouterr().err and not (tmp_path / "bag").exists()
     pytest.importorskip("matplotlib")
     assert main(["report", str(out)]) == 0
-    assert "report: 3 recording(s), 3 frames, 18 fruit seen" in capsys.readouterr().out
+    assert "report: 3 recording(s), 3 frames, 3 fruit seen" in capsys.readouterr().out
     report = (out / "report" / "report.md").read_text()
-    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in report and f"- `row2`: `{inputs[2]}`" in report
+    assert "| row2 | 1 | 1 | 1 | 1 | 1.00 | 1 |" in report and f"- `row2`: `{inputs[2]}`" in report
     assert report.count("- `frames+") == 2 and f"`: `{inputs[0]}`" in report
     for name in ("fruit_per_frame_by_recording.png", "diameters_by_recording.png"):
         assert f"]({name})" in report and (out / "report" / name).is_file()
