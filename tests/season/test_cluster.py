@@ -2,6 +2,7 @@
 works on a frame, gives the serial run's detections frame for frame and tables with each fruit once, also
 after --resume; the client refuses what the workers could not do."""
 
+import importlib.util
 import json
 import os
 import shutil
@@ -16,12 +17,9 @@ import pytest
 from symfruit import InputError
 from symfruit.batch import run_batch
 from symfruit.cli import main
+from symfruit.season.cluster import local_cluster, run_distributed
 
 from ..conftest import small_frame
-
-distributed = pytest.importorskip("distributed")
-
-from symfruit.season.cluster import local_cluster, run_distributed  # noqa: E402
 
 #: Exec'd on every worker: the first attempt at frame FRAME writes its worker's pid to MARKER (atomically, by a
 #: hard link that only one attempt can make) and waits to be killed; any later attempt goes on as usual.
@@ -67,8 +65,12 @@ def _wait_for(check, seconds: float, what: str):
     raise AssertionError(f"waited {seconds} s for {what}")
 
 
-#: one worker of the test run starts the module's local cluster once (pytest-xdist, --dist loadgroup)
-pytestmark = pytest.mark.xdist_group("cluster")
+#: one worker of the test run starts the module's local cluster once (pytest-xdist, --dist loadgroup), and only it
+#: imports dask.distributed (inside the tests: not at collection)
+pytestmark = [
+    pytest.mark.skipif(importlib.util.find_spec("distributed") is None, reason="needs dask.distributed"),
+    pytest.mark.xdist_group("cluster"),
+]
 
 
 @pytest.fixture(scope="module")
@@ -89,6 +91,8 @@ def recording(tmp_path_factory):
 
 
 def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(cluster, recording, tmp_path, capsys):
+    import distributed
+
     from symfruit.settings import resolve_settings
 
     settings = resolve_settings(fruit="strawberry")  # what the command line's default --fruit gives
