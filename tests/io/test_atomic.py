@@ -136,8 +136,8 @@ def test_an_activated_folder_checks_every_write_under_it(tmp_path):
     from symfruit.io.atomic import activate, active_root
 
     class Folder:  # what activate needs of an output folder: its root and its check of a path
-        root = tmp_path / "out"
-        checked: list = []
+        def __init__(self):
+            self.root, self.checked = tmp_path / "out", []
 
         def check(self, path):
             self.checked.append(path.name)
