@@ -40,9 +40,7 @@ def _fruits(folder: Path) -> dict:
 
 
 def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
-    frames = tmp_path / "rec"
-    for name in ("f1", "f2", "f3"):
-        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    frames = recording(tmp_path / "rec", "f1", "f2", "f3")
     (frames / "f2" / "depth.png").write_bytes(b"not a png")
     out = tmp_path / "out"
     report = run_batch(frames, out, method="raw", progress=False)
@@ -68,7 +66,7 @@ def test_frame_names_from_a_recording_cannot_escape_the_output(tmp_path):
 
     rec = tmp_path / "rec"
 
-    shutil.copytree(EXAMPLE_FRAME, rec / "x..y ;$(rm -rf)")
+    shutil.copytree(small_frame(), rec / "x..y ;$(rm -rf)")
     out = tmp_path / "out"
     report = run_batch(rec, out, method="raw", progress=False)
     assert report.done == ["x..y ;$(rm -rf)"] and (out / frame_folder_name("x..y ;$(rm -rf)")).is_dir()
