@@ -317,9 +317,17 @@ def test_bench_segment_times_synthetic_photos_or_a_folder_of_them(tmp_path, caps
     assert 0 < row["median_ms"] <= row["p90_ms"] <= row["max_ms"]
 
 
-def test_bench_recording_reports_the_childs_peak_memory(capsys):
-    """One generated frame through a `symfruit detect` child (the memory bound itself is checked over a longer
-    recording in tests/test_batch.py)."""
+def test_bench_recording_reports_the_childs_peak_memory(capsys, monkeypatch):
+    """One frame through a `symfruit detect` child (the memory bound itself is checked over a generated
+    recording in tests/test_batch.py); the small frame stands in for the generated one (rendering it is tested in
+    tests/synthetic)."""
+    from symfruit.synthetic import scenes
+
+    def small_recording(folder, n, **kwargs):
+        assert n == 1 and kwargs["n_ripe"] == 8  # what the benchmark asks for
+        shutil.copytree(small_frame(), folder / "scene_00000")
+
+    monkeypatch.setattr(scenes, "write_scenes", small_recording)
     assert main(["bench", "--recording", "1", "--method", "raw"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("symfruit bench --recording: 1 frames (1 written), method raw: ")
