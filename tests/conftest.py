@@ -14,6 +14,7 @@ test unless ``SYMFRUIT_FUZZ_EXAMPLES`` says otherwise.
 
 from __future__ import annotations
 
+import functools
 import os
 from pathlib import Path
 
@@ -44,6 +45,41 @@ EXAMPLES = ROOT / "examples"
 SRC = ROOT / "src" / "symfruit"
 #: The demo frame shipped as package data.
 EXAMPLE_FRAME = Path(symfruit.__file__).resolve().parent / "data" / "example_frame"
+#: The part of the example frame :func:`small_frame` keeps: (left, top, right, bottom) pixels.
+SMALL_CROP = (400, 100, 560, 260)
+
+
+@functools.cache
+def small_frame() -> Path:
+    """A frame folder holding :data:`SMALL_CROP` of the example frame: its right-hand ripe strawberry alone
+    (160x160 pixels, intrinsics shifted to the crop, the truth of that fruit alone). Tests of how frames are
+    batched, resumed, written and refused use it: it detects in a sixth of the example frame's time. Written
+    once per test process (a temporary folder removed at exit); copy it, never write into it."""
+    import atexit
+    import json
+    import shutil
+    import tempfile
+
+    from PIL import Image
+
+    folder = Path(tempfile.mkdtemp(prefix="symfruit-small-frame-")) / "small_frame"
+    folder.mkdir()
+    atexit.register(shutil.rmtree, folder.parent, True)
+    for name in ("color.png", "depth.png"):
+        with Image.open(EXAMPLE_FRAME / name) as image:
+            image.crop(SMALL_CROP).save(folder / name)
+    left, top, right, bottom = SMALL_CROP
+    cam = json.loads((EXAMPLE_FRAME / "camera.json").read_text())
+    cam.update(cx=cam["cx"] - left, cy=cam["cy"] - top, width=right - left, height=bottom - top)
+    (folder / "camera.json").write_text(json.dumps(cam))
+    truth = json.loads((EXAMPLE_FRAME / "truth.json").read_text())
+    seen = Camera(**{k: cam[k] for k in ("fx", "fy", "cx", "cy", "width", "height")})
+    u, v = seen.project(np.asarray([f["centre"] for f in truth["fruits"]])).T
+    keep = (u >= 0) & (u < seen.width) & (v >= 0) & (v < seen.height)
+    inside = [f for f, k in zip(truth["fruits"], keep, strict=True) if k]
+    (folder / "truth.json").write_text(json.dumps({**truth, "fruits": inside}))
+    return folder
+
 
 CENTRE = np.array([0.01, -0.02, 0.35])
 

@@ -21,12 +21,13 @@ from symfruit.batch import BatchReport, frame_folder_name, run_batch
 from symfruit.cli import main
 from symfruit.io.sources import FolderSource
 
-from .conftest import EXAMPLE_FRAME
+from .conftest import EXAMPLE_FRAME, small_frame
 
 
 def recording(root: Path, *names: str) -> Path:
+    """Frame folders ``names`` in ``root``, each the small frame (one strawberry: see conftest.small_frame)."""
     for name in names:
-        shutil.copytree(EXAMPLE_FRAME, root / name)
+        shutil.copytree(small_frame(), root / name)
     return root
 
 
@@ -39,9 +40,7 @@ def _fruits(folder: Path) -> dict:
 
 
 def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
-    frames = tmp_path / "rec"
-    for name in ("f1", "f2", "f3"):
-        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    frames = recording(tmp_path / "rec", "f1", "f2", "f3")
     (frames / "f2" / "depth.png").write_bytes(b"not a png")
     out = tmp_path / "out"
     report = run_batch(frames, out, method="raw", progress=False)
@@ -67,7 +66,7 @@ def test_frame_names_from_a_recording_cannot_escape_the_output(tmp_path):
 
     rec = tmp_path / "rec"
 
-    shutil.copytree(EXAMPLE_FRAME, rec / "x..y ;$(rm -rf)")
+    shutil.copytree(small_frame(), rec / "x..y ;$(rm -rf)")
     out = tmp_path / "out"
     report = run_batch(rec, out, method="raw", progress=False)
     assert report.done == ["x..y ;$(rm -rf)"] and (out / frame_folder_name("x..y ;$(rm -rf)")).is_dir()
@@ -100,7 +99,7 @@ def test_an_unexpected_error_in_one_frame_is_recorded_and_the_batch_goes_on(tmp_
     monkeypatch.setattr(batch, "detect", detect)
     report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
     assert report.done == ["f1", "f3"] and report.failed == {"f2": "RuntimeError: the segmenter fell over"}
-    assert not report.ok and report.stopped == "" and report.fruits == 12 and report.failed_fruits == 0
+    assert not report.ok and report.stopped == "" and report.fruits == 2 and report.failed_fruits == 0  # one each
     errors = json.loads((tmp_path / "out" / "errors.json").read_text())
     assert errors == {"failed": [{"frame": "f2", "reason": "RuntimeError: the segmenter fell over"}], "stopped": ""}
     assert not (tmp_path / "out" / "f2").exists()
@@ -139,7 +138,8 @@ def test_an_output_folder_inside_the_recording_is_not_a_frame(tmp_path):
 
 
 def test_a_rerun_with_fewer_fruit_leaves_no_stale_clouds(tmp_path):
-    rec = recording(tmp_path / "rec", "f1")
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "f1")  # six fruit
     out = tmp_path / "out"
     run_batch(rec, out, method="raw", progress=False)
     assert sorted(p.name for p in (out / "f1").glob("fruit_*.ply")) == [f"fruit_{k:03d}.ply" for k in range(1, 7)]
@@ -248,17 +248,23 @@ def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tm
     frames already done untouched, errors.json saying where it stopped."""
     import resource
 
-    rec = recording(tmp_path / "rec", "f1", "f2")
+    rec = tmp_path / "rec"
+    for name in ("f1", "f2"):  # the example frame: its overlay is larger than the limit, every other file smaller
+        shutil.copytree(EXAMPLE_FRAME, rec / name)
     out = tmp_path / "out"
-    cmd = [sys.executable, "-m", "symfruit", "detect", str(rec), "--output", str(out), "--method", "raw"]
-    subprocess.run(cmd, check=True, capture_output=True)
+    args = ["detect", str(rec), "--output", str(out), "--method", "raw"]
+    assert main(args) == 0  # the whole run in this process; the limited one in a child
     before = {p: p.read_bytes() for p in (out / "f1").iterdir()}
     shutil.rmtree(out / "f2")
+    # (not much less: under `pytest --cov` the child also writes its coverage data, some tens of kB)
+    size = 100_000
+    assert all((p.stat().st_size < size) == (p.name != "overlay.png") for p in (out / "f1").iterdir())
 
-    def limit() -> None:  # overlay.png alone is larger than this
-        resource.setrlimit(resource.RLIMIT_FSIZE, (100_000, 100_000))
+    def limit() -> None:
+        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
 
-    proc = subprocess.run([*cmd, "--resume"], capture_output=True, text=True, preexec_fn=limit)
+    proc = subprocess.run([sys.executable, "-m", "symfruit", *args, "--resume"], capture_output=True, text=True,
+                          preexec_fn=limit)  # fmt: skip
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert "symfruit: stopped at frame f2: the output is full (File too large)" in proc.stderr
     assert {p: p.read_bytes() for p in (out / "f1").iterdir()} == before
@@ -268,12 +274,12 @@ def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tm
 
 @pytest.mark.parametrize(
     ("frames", "ripe", "method"),
-    [(8, 3, "sphere"), pytest.param(40, 8, "evidence", marks=pytest.mark.slow)],
+    [(4, 3, "sphere"), pytest.param(40, 8, "evidence", marks=pytest.mark.slow)],
 )
 def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     """Peak resident memory of a detect child (its own VmHWM) over a recording stays far under the bound the
-    issue sets for 2,000 frames; frames are decoded one at a time. The quick case: 12 frames completed with
-    the sphere; the slow one: 40 frames of 8 fruit with the default method."""
+    issue sets for 2,000 frames; frames are decoded one at a time. The quick case: 4 frames (two scenes)
+    completed with the sphere; the slow one: 40 frames of 8 fruit with the default method."""
     from symfruit.evaluate.bench import measured_detect
     from symfruit.synthetic.scenes import write_scenes
 
@@ -392,7 +398,7 @@ def test_several_recordings_each_get_a_folder_even_when_they_share_a_name(tmp_pa
     names.update(report.recordings)
     fa, fb, fr = names[str(a)], names[str(b)], names[str(row)]
     assert fa.startswith("frames+") and fb.startswith("frames+") and fa != fb and fr.startswith("row_3+")
-    assert report.ok and report.done == [f"{fa}/f1", f"{fa}/f2", f"{fb}/f1", f"{fr}/row 3"] and report.fruits == 24
+    assert report.ok and report.done == [f"{fa}/f1", f"{fa}/f2", f"{fb}/f1", f"{fr}/row 3"] and report.fruits == 9
     assert sorted(p.name for p in out.iterdir()) == sorted(
         ["detections.parquet", "errors.json", "frames.parquet", fa, fb, fr])  # fmt: skip
     assert sorted(p.name for p in (out / fa).iterdir()) == ["f1", "f2"]
@@ -400,8 +406,8 @@ def test_several_recordings_each_get_a_folder_even_when_they_share_a_name(tmp_pa
     single = run_batch(b, tmp_path / "single", method="raw", progress=False)  # the same frames, alone
     assert single.done == ["f1"] and _fruits(out / fb) == _fruits(tmp_path / "single")
     rows = _rows(out)
-    assert len(rows) == 24 and len(set((r[0], r[1], r[2]) for r in rows)) == 24
-    assert [(r[0], r[1]) for r in rows[::6]] == [(fa, "f1"), (fa, "f2"), (fb, "f1"), (fr, "row 3")]
+    assert len(rows) == 9 and len(set((r[0], r[1], r[2]) for r in rows)) == 9  # one fruit each, six in "row 3"
+    assert [(r[0], r[1]) for r in rows] == [(fa, "f1"), (fa, "f2"), (fb, "f1"), *[(fr, "row 3")] * 6]
     assert [r[2:] for r in rows if r[0] == fb] == [r[2:] for r in _rows(tmp_path / "single")]
     import pyarrow.parquet as pq
 
@@ -443,7 +449,7 @@ def test_resume_over_several_recordings_redoes_only_what_is_missing_and_keeps_ea
     out = tmp_path / "out"
     first = run_batch([a, b], out, method="raw", progress=False)
     whole = _rows(out)
-    assert first.ok and len(whole) == 18
+    assert first.ok and len(whole) == 3
     shutil.rmtree(out / "a" / "f2")  # as a run killed before a/f2 and b/f1 would have left it, had b been done
     reads = []
     real = FolderSource.read

@@ -12,7 +12,7 @@ from symfruit import Settings, __version__
 from symfruit.cli import main
 from symfruit.io import read_cloud
 
-from .conftest import EXAMPLE_FRAME, EXAMPLES, VISIBLE, front_half, sphere_cloud, write_pcd
+from .conftest import EXAMPLE_FRAME, EXAMPLES, VISIBLE, front_half, small_frame, sphere_cloud, write_pcd
 
 
 def write(path: Path, points: np.ndarray) -> None:
@@ -166,32 +166,37 @@ def test_bench_runs_and_reports(capsys):
     assert all(r["median_ms"] > 0 for r in rows)
 
 
-def test_bench_frame_times_one_method_or_profiles_it(capsys):
+def test_bench_frame_times_one_method_or_profiles_it(capsys, monkeypatch):
+    import functools
+
+    from symfruit.evaluate import bench
+
+    # both commands render the same synthetic frame: render it once
+    monkeypatch.setattr(bench, "_bench_scene", functools.cache(bench._bench_scene))
     assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--json"]) == 0
     rows = json.loads(capsys.readouterr().out)["rows"]
     assert [r["method"] for r in rows] == ["raw"] and rows[0]["min_ms"] > 0
+    assert rows[0]["points"] >= 6 and rows[0]["median_ms"] > 0  # the fruit located in the frame of 8 ripe ones
     assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--profile"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("cProfile of 1 frames, method raw") and "detect" in out
 
 
-def test_cli_detect_demo_evaluate_frames_and_bench(tmp_path, capsys):
+def test_cli_detect_and_evaluate_frames(tmp_path, capsys):
+    """(`demo` runs as a command in tests/test_demo.py, `bench --frame` in the test above.)"""
     assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / "d"), "--method", "raw"]) == 0
     assert (tmp_path / "d" / "example_frame" / "detections.json").exists()
-    assert main(["demo", "--output", str(tmp_path / "demo")]) == 0
-    out = capsys.readouterr().out
-    assert "mean centre error: raw" in out and "overlay:" in out
     frames = str(EXAMPLE_FRAME.parent)
     assert main(["evaluate", "--frames", frames, "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
     assert "Table 3" in capsys.readouterr().out
-    assert main(["bench", "--frame", "--repeat", "1", "--method", "paper", "--json"]) == 0
-    row = json.loads(capsys.readouterr().out)["rows"][0]
-    assert row["points"] >= 6 and row["median_ms"] > 0 and row["method"] == "paper"
     assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
 
 
 def test_evaluate_command(tmp_path, capsys):
-    assert main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper"]) == 0
+    assert (
+        main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper", "--n", "1"])
+        == 0
+    )
     out = capsys.readouterr().out
     assert "| raw |" in out and "results: " in out
     assert main(["evaluate", "--fruit", "kiwi"]) == 2
@@ -248,12 +253,12 @@ def test_output_folder_that_cannot_be_written(tmp_path, capsys):
 
 def test_detect_exits_1_when_a_frame_failed_and_names_it(tmp_path, capsys):
     rec = tmp_path / "rec"
-    shutil.copytree(EXAMPLE_FRAME, rec / "good")
-    shutil.copytree(EXAMPLE_FRAME, rec / "bad")
+    shutil.copytree(small_frame(), rec / "good")  # one fruit
+    shutil.copytree(small_frame(), rec / "bad")
     (rec / "bad" / "color.png").write_bytes(b"broken")
     assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
     out = capsys.readouterr().out
-    assert "frames: 1 done, 0 skipped (resume), 1 failed; fruit: 6 located, 0 failed" in out
+    assert "frames: 1 done, 0 skipped (resume), 1 failed; fruit: 1 located, 0 failed" in out
     assert "  failed bad: " in out and "color.png" in out and f"results: {tmp_path / 'out'}" in out
     assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "nope"]) == 2
 
@@ -286,6 +291,48 @@ def test_bench_arguments_are_checked(capsys):
     assert main(["bench", "--points", "5"]) == 2
     assert main(["bench", "--recording", "0"]) == 2
     assert "--recording must be between 1 and 100000 frames" in capsys.readouterr().err
+    assert main(["bench", "--segment", "--size", "640"]) == 2
+    assert "--size must be WIDTHxHEIGHT, e.g. 1920x1080, got '640'" in capsys.readouterr().err
+    assert main(["bench", "--segment", "--size", "0x480"]) == 2  # the image size limits of every reader
+    assert "--size" in capsys.readouterr().err
+    pytest.importorskip("distributed")
+    assert main(["bench", "--recording", "1", "--workers", "0"]) == 2
+    assert "--workers must be between 1 and 256, got 0" in capsys.readouterr().err
+
+
+def test_bench_segment_times_synthetic_photos_or_a_folder_of_them(tmp_path, capsys):
+    """The segmenter's timing at a small size (the benchmark's 640x480 runs in `make test-slow`)."""
+    from PIL import Image
+
+    assert main(["bench", "--segment", "--size", "96x72"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("symfruit bench --segment: 24 synthetic photos at 96x72, colour alone, one process: median ")
+    photos = tmp_path / "photos"
+    photos.mkdir()
+    for k, size in enumerate([(200, 150), (120, 90)]):
+        Image.new("RGB", size, (40, 120, 30)).save(photos / f"p{k}.png")
+    assert main(["bench", "--segment", "--images", str(photos), "--size", "64x48", "--json"]) == 0
+    row = json.loads(capsys.readouterr().out)["segment"]
+    assert row["images"] == 2 and row["source"] == str(photos) and (row["width"], row["height"]) == (64, 48)
+    assert 0 < row["median_ms"] <= row["p90_ms"] <= row["max_ms"]
+
+
+def test_bench_recording_reports_the_childs_peak_memory(capsys, monkeypatch):
+    """One frame through a `symfruit detect` child (the memory bound itself is checked over a generated
+    recording in tests/test_batch.py); the small frame stands in for the generated one (rendering it is tested in
+    tests/synthetic)."""
+    from symfruit.synthetic import scenes
+
+    def small_recording(folder, n, **kwargs):
+        assert n == 1 and kwargs["n_ripe"] == 8  # what the benchmark asks for
+        shutil.copytree(small_frame(), folder / "scene_00000")
+
+    monkeypatch.setattr(scenes, "write_scenes", small_recording)
+    assert main(["bench", "--recording", "1", "--method", "raw"]) == 0
+    out = capsys.readouterr().out
+    assert out.startswith("symfruit bench --recording: 1 frames (1 written), method raw: ")
+    peak = float(out.split("peak RSS ")[1].split(" MB")[0])
+    assert 30 < peak < 400
 
 
 def test_no_command_prints_help(capsys):
@@ -326,11 +373,21 @@ def test_inputs_claiming_huge_sizes_fail_cleanly_inside_a_memory_limit(tmp_path)
 
     runs = [[str(path)] for path in files] + [[sample, "--camera", str(cam)]]
     messages = [*files.values(), "width is 100000 pixels"]
-    for args, message in zip(runs, messages, strict=True):
-        proc = subprocess.run([sys.executable, "-m", "symfruit", "complete", *args], capture_output=True, text=True,
-                              preexec_fn=cap, timeout=120)  # fmt: skip
-        assert proc.returncode == 2 and proc.stderr.count("\n") == 1, proc.stderr
-        assert proc.stderr.startswith("symfruit: error: ") and message in proc.stderr
+    # one child runs the command once per file (a child per file cost a second each of start-up): its status
+    # and what it wrote to stderr, each run's on one JSON line
+    child = (
+        "import contextlib, io, json, sys\nfrom symfruit.cli import main\nfor args in json.loads(sys.argv[1]):\n"
+        "    err = io.StringIO()\n    with contextlib.redirect_stderr(err):\n"
+        "        status = main(['complete', *args])\n    print(json.dumps([status, err.getvalue()]), flush=True)\n"
+    )
+    proc = subprocess.run([sys.executable, "-c", child, json.dumps(runs)], capture_output=True, text=True,
+                          preexec_fn=cap, timeout=120)  # fmt: skip
+    assert proc.returncode == 0 and not proc.stderr, proc.stderr
+    results = [json.loads(line) for line in proc.stdout.splitlines()]
+    assert len(results) == len(runs)
+    for (status, err), message in zip(results, messages, strict=True):
+        assert status == 2 and err.count("\n") == 1, err
+        assert err.startswith("symfruit: error: ") and message in err
 
 
 def _one_line_error(capsys, *needles):
@@ -378,7 +435,7 @@ def test_a_second_writer_on_one_output_folder_is_exit_2(tmp_path, capsys):
 
 def test_detect_refuses_writing_into_its_input_and_names_a_linked_frame(tmp_path, capsys):
     rec = tmp_path / "rec"
-    shutil.copytree(EXAMPLE_FRAME, rec / "f1")
+    shutil.copytree(small_frame(), rec / "f1")
     assert main(["detect", str(rec), "--output", str(rec), "--method", "raw"]) == 2
     _one_line_error(capsys, "also an input folder")
     (tmp_path / "out").mkdir()
@@ -407,7 +464,7 @@ def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
 def test_a_ros2_bag_written_inside_the_recording_is_no_failed_frame(tmp_path, capsys):
     pytest.importorskip("rosbags")
     rec = tmp_path / "rec"
-    shutil.copytree(EXAMPLE_FRAME, rec / "f1")
+    shutil.copytree(small_frame(), rec / "f1")
     args = ["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw", "--ros2-bag", str(rec / "bag")]
     assert main(args) == 0
     out = capsys.readouterr().out
@@ -436,13 +493,13 @@ def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
 
 def test_detect_takes_several_recordings(tmp_path, capsys):
     for parent in ("a", "b"):
-        shutil.copytree(EXAMPLE_FRAME, tmp_path / parent / "frames" / "f1")
-    shutil.copytree(EXAMPLE_FRAME, tmp_path / "row2" / "f1")
+        shutil.copytree(small_frame(), tmp_path / parent / "frames" / "f1")  # one fruit each
+    shutil.copytree(small_frame(), tmp_path / "row2" / "f1")
     out = tmp_path / "out"
     inputs = [str(tmp_path / "a" / "frames"), str(tmp_path / "b" / "frames"), str(tmp_path / "row2")]
     assert main(["detect", *inputs, "--output", str(out), "--method", "raw"]) == 0
     text, err = capsys.readouterr()
-    assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 18 located, 0 failed" in text
+    assert "frames: 3 done, 0 skipped (resume), 0 failed; fruit: 3 located, 0 failed" in text
     assert "detect: 3/3" in err and "/1 " not in err  # one progress bar over every recording's frames
     assert text.count(" (its name is shared or not a plain file name)") == 2 and f"-> {out / 'frames+'}" in text
     assert "one folder per recording, in it one per frame" in text
@@ -457,9 +514,9 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     assert "give one input with it" in capsys.readouterr().err and not (tmp_path / "bag").exists()
     pytest.importorskip("matplotlib")
     assert main(["report", str(out)]) == 0
-    assert "report: 3 recording(s), 3 frames, 18 fruit seen" in capsys.readouterr().out
+    assert "report: 3 recording(s), 3 frames, 3 fruit seen" in capsys.readouterr().out
     report = (out / "report" / "report.md").read_text()
-    assert "| row2 | 1 | 1 | 6 | 6 | 6.00 | 6 |" in report and f"- `row2`: `{inputs[2]}`" in report
+    assert "| row2 | 1 | 1 | 1 | 1 | 1.00 | 1 |" in report and f"- `row2`: `{inputs[2]}`" in report
     assert report.count("- `frames+") == 2 and f"`: `{inputs[0]}`" in report
     for name in ("fruit_per_frame_by_recording.png", "diameters_by_recording.png"):
         assert f"]({name})" in report and (out / "report" / name).is_file()

@@ -50,4 +50,5 @@ def test_the_demo_works_from_an_unrelated_folder(tmp_path, monkeypatch):
                           cwd=tmp_path, capture_output=True, text=True, timeout=300)  # fmt: skip
     assert done.returncode == 0, done.stderr
     assert "6 fruit found, 6 ripe fruit in the truth, method raw" in done.stdout
+    assert "mean centre error: raw" in done.stdout and "overlay:" in done.stdout
     assert (tmp_path / "cli" / "overlay.png").is_file() and (tmp_path / "cli" / "detections.json").is_file()

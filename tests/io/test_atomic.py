@@ -104,3 +104,71 @@ def test_only_a_dead_runs_temporaries_are_stale(tmp_path):
         (tmp_path / name).write_text("")
     with folder_fd(tmp_path) as fd:
         assert sorted(stale_temporaries(fd)) == sorted(names[1:3])  # this live run's one is kept
+
+
+def test_folder_fd_refuses_what_lies_outside_or_cannot_be_opened(tmp_path):
+    from symfruit import OutputError
+    from symfruit.io.atomic import folder_fd
+
+    base = tmp_path / "out"
+    base.mkdir()
+    with pytest.raises(OutputError, match=r"elsewhere: outside the output folder .*out; not written"):
+        with folder_fd(tmp_path / "elsewhere", root=base):
+            pass
+    with pytest.raises(OutputError, match=r"missing: cannot write to folder"):
+        with folder_fd(tmp_path / "missing" / "x", root=tmp_path / "missing"):  # the root itself is not there
+            pass
+    (base / "f").write_text("a file")
+    with pytest.raises(OutputError, match=r"out/f: is a file, not a folder; not overwritten"):
+        with folder_fd(base / "f" / "sub", root=base):
+            pass
+    with pytest.raises(OutputError, match=r"cannot write to folder"):
+        with folder_fd(base / ("x" * 300), root=base):  # a name longer than the file system allows
+            pass
+    with pytest.raises(OutputError, match=r"nothing: cannot write to folder"):
+        with folder_fd(tmp_path / "nothing", create=False):  # no root: a plain folder that is not there
+            pass
+    assert not (tmp_path / "nothing").exists() and sorted(p.name for p in base.iterdir()) == ["f"]
+
+
+def test_an_activated_folder_checks_every_write_under_it(tmp_path):
+    from symfruit import OutputError
+    from symfruit.io.atomic import activate, active_root
+
+    class Folder:  # what activate needs of an output folder: its root and its check of a path
+        def __init__(self):
+            self.root, self.checked = tmp_path / "out", []
+
+        def check(self, path):
+            self.checked.append(path.name)
+            if path.name == "input.png":
+                raise OutputError(f"{path}: is an input of this run; not overwritten")
+            return path
+
+    folder = Folder()
+    folder.root.mkdir()
+    with activate(folder):
+        assert active_root(folder.root / "a" / "b.json") is folder and active_root(tmp_path / "x") is None
+        write_json(folder.root / "a" / "b.json", {"k": 1})
+        with pytest.raises(OutputError, match="is an input of this run"):
+            write_json(folder.root / "input.png", {})
+        (folder.root / "link").symlink_to(tmp_path, target_is_directory=True)
+        with pytest.raises(OutputError, match="is a symbolic link"):  # under the root: no link followed
+            write_json(folder.root / "link" / "c.json", {})
+    assert active_root(folder.root / "a" / "b.json") is None
+    assert "b.json" in folder.checked and json.loads((folder.root / "a" / "b.json").read_text()) == {"k": 1}
+    assert not (tmp_path / "c.json").exists() and not (folder.root / "input.png").exists()
+
+
+def test_a_pid_no_process_can_have_is_not_alive():
+    from symfruit.io.atomic import _alive
+
+    assert _alive(os.getpid()) and _alive(1)  # this process, and the first one (init) that outlives every other
+    assert not _alive(2**70)  # os.kill overflows: no such process
+
+
+def test_a_path_without_a_file_name_is_refused(tmp_path):
+    from symfruit import OutputError
+
+    with pytest.raises(OutputError, match=r"\.\.: not a file name"):
+        write_json(tmp_path / "a" / "..", {})

@@ -1,6 +1,8 @@
 """Point clouds: each format round-trips, sizes are checked before reading, and no file, however
 broken, makes a reader fail other than with a :class:`~symfruit.errors.SymfruitError`."""
 
+import struct
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -233,3 +235,67 @@ def test_complex_npy_is_refused(tmp_path):
     np.save(tmp_path / "c.npy", POINTS.astype(np.complex128))
     with pytest.raises(FileFormatError, match="complex numbers cannot be coordinates"):
         read_cloud(tmp_path / "c.npy")
+
+
+def _pcd(fields: str, data: bytes, *, points: int = 1, mode: str = "ascii", size: str = "4 4 4", kind: str = "F F F",
+         count: str = "1 1 1") -> bytes:  # fmt: skip
+    return (f"VERSION 0.7\nFIELDS {fields}\nSIZE {size}\nTYPE {kind}\nCOUNT {count}\nWIDTH {points}\nHEIGHT 1\n"
+            f"POINTS {points}\nDATA {mode}\n").encode() + data  # fmt: skip
+
+
+PLY_XYZ = b"property float x\nproperty float y\nproperty float z\n"
+#: Files each reader refuses, and what its message says: every header field it checks, each in its own file.
+# fmt: off
+REFUSED = {
+    "ply-no-format": ("a.ply", b"ply\nelement vertex 1\n" + PLY_XYZ + b"end_header\n" + bytes(12),
+                      "PLY header lacks a format line"),
+    "ply-element-line": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex many\nend_header\n1 2 3\n",
+                         "PLY element line is not 'element NAME COUNT'"),
+    "ply-no-vertex": ("a.ply", b"ply\nformat ascii 1.0\nelement point 1\n" + PLY_XYZ + b"end_header\n1 2 3\n",
+                      "PLY has no vertex element"),
+    "ply-too-many": ("a.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 6000000\nproperty uchar x\n"
+                     b"end_header\n" + bytes(6_000_000), "PLY holds 6,000,000 vertices; at most 5,000,000 are read"),
+    "ply-no-z": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
+                 b"end_header\n1 2\n", "PLY has no no field of name z property or vertex element"),  # plyfile's words
+    "ply-corrupt": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
+                    "corrupt PLY"),
+    "pcd-no-fields": ("a.pcd", b"VERSION 0.7\nSIZE 4\nPOINTS 1\nDATA ascii\n1 2 3\n",
+                      "PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA"),
+    "pcd-type": ("a.pcd", _pcd("x y z", b"1 2 3\n", kind="F F X"), "PCD has an unsupported TYPE/SIZE pair"),
+    "pcd-ascii-short": ("a.pcd", _pcd("x y z", b"1 2 3\n", points=40), "header promises 40 points but the file is "
+                        "too short"),
+    "pcd-ascii-rows": ("a.pcd", _pcd("x y z", b"1 2 3" + b" " * 80 + b"\n", points=3),
+                       "header promises 3 points, the file holds 1"),
+    "pcd-no-size-words": ("a.pcd", _pcd("x y z", b"\x01\x00", mode="binary_compressed"),
+                          "truncated binary_compressed PCD (no size words)"),
+    "pcd-lzf-literal": ("a.pcd", _pcd("x y z", struct.pack("<II", 4, 12) + b"\x1f\x00\x00\x00",
+                                      mode="binary_compressed"), "corrupt LZF data in binary_compressed PCD"),
+    "pcd-lzf-reference": ("a.pcd", _pcd("x y z", struct.pack("<II", 4, 12) + b"\x00\x01\x40\x05",
+                                        mode="binary_compressed"), "corrupt LZF data in binary_compressed PCD"),
+    "pcd-lzf-short": ("a.pcd", _pcd("x y z", struct.pack("<II", 4, 12) + b"\x02abc", mode="binary_compressed"),
+                      "binary_compressed PCD decompressed to 3 bytes, expected 12"),
+    "text-two-columns": ("a.xyz", b"# x y\n1 2\n", "line 2 has 2 columns, need x y z"),
+    "text-ragged": ("a.xyz", b"1 2 3\n4 5\n", "rows after line 1 are not all x y z numbers"),
+    "npy-bad-header": ("a.npy", b"\x93NUMPY\x01\x00\x10\x00{'descr': <f8'}   \n", "not a valid .npy file"),
+    "npy-v2-shape": ("a.npy", None, "expected a numeric (n, 3) array, got float64 (4,)"),
+    "npy-no-z": ("a.npy", np.zeros(2, dtype=[("x", "f4"), ("y", "f4")]), "structured array lacks field 'z'"),
+    "npy-2-columns": ("a.npy", np.zeros((3, 2)), "expected a numeric (n, 3) array, got float64 (3, 2)"),
+}
+# fmt: on
+
+
+@pytest.mark.parametrize("case", REFUSED)
+def test_each_header_check_refuses_with_its_own_message(tmp_path, case):
+    name, content, message = REFUSED[case]
+    path = tmp_path / name
+    if content is None:  # a version 2.0 header
+        with path.open("wb") as handle:
+            np.lib.format.write_array_header_2_0(handle, {"descr": "<f8", "fortran_order": False, "shape": (4,)})
+            handle.write(bytes(32))
+    elif isinstance(content, np.ndarray):
+        np.save(path, content)
+    else:
+        path.write_bytes(content)
+    with pytest.raises(FileFormatError) as info:
+        read_cloud(path)
+    assert str(info.value).startswith(f"{path}: ") and message in str(info.value)

@@ -2,6 +2,7 @@
 works on a frame, gives the serial run's detections frame for frame and tables with each fruit once, also
 after --resume; the client refuses what the workers could not do."""
 
+import importlib.util
 import json
 import os
 import shutil
@@ -16,12 +17,9 @@ import pytest
 from symfruit import InputError
 from symfruit.batch import run_batch
 from symfruit.cli import main
+from symfruit.season.cluster import local_cluster, run_distributed
 
-from ..conftest import EXAMPLE_FRAME
-
-distributed = pytest.importorskip("distributed")
-
-from symfruit.season.cluster import local_cluster, run_distributed  # noqa: E402
+from ..conftest import small_frame
 
 #: Exec'd on every worker: the first attempt at frame FRAME writes its worker's pid to MARKER (atomically, by a
 #: hard link that only one attempt can make) and waits to be killed; any later attempt goes on as usual.
@@ -67,16 +65,34 @@ def _wait_for(check, seconds: float, what: str):
     raise AssertionError(f"waited {seconds} s for {what}")
 
 
+#: one worker of the test run starts the module's local cluster once (pytest-xdist, --dist loadgroup), and only it
+#: imports dask.distributed (inside the tests: not at collection)
+pytestmark = [
+    pytest.mark.skipif(importlib.util.find_spec("distributed") is None, reason="needs dask.distributed"),
+    pytest.mark.xdist_group("cluster"),
+]
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """A local cluster of two worker processes, shared by the tests that need a running one (starting one
+    costs a few seconds); each test leaves it with two workers running symfruit's own code."""
+    with local_cluster(2) as running:
+        yield running
+
+
 @pytest.fixture(scope="module")
 def recording(tmp_path_factory):
-    """Four copies of the shipped frame (rendered by symfruit.synthetic.scenes, six ripe strawberries)."""
+    """Four copies of the small frame (the shipped frame's right-hand strawberry: conftest.small_frame)."""
     rec = tmp_path_factory.mktemp("cluster") / "rec"
     for k in range(4):
-        shutil.copytree(EXAMPLE_FRAME, rec / f"scene_{k:05d}")
+        shutil.copytree(small_frame(), rec / f"scene_{k:05d}")
     return rec
 
 
-def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(recording, tmp_path, capsys):
+def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(cluster, recording, tmp_path, capsys):
+    import distributed
+
     from symfruit.settings import resolve_settings
 
     settings = resolve_settings(fruit="strawberry")  # what the command line's default --fruit gives
@@ -84,7 +100,7 @@ def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(record
     assert serial.ok and serial.fruits > 0
     marker, out = tmp_path / "started", tmp_path / "out"
     result: dict = {}
-    with local_cluster(2) as cluster, distributed.Client(cluster) as client:
+    with distributed.Client(cluster) as client:
         client.run(exec, BLOCK_ONE_FRAME, {"FRAME": "scene_00003", "MARKER": str(marker)})
         pids = set(client.run(os.getpid).values())
 
@@ -123,6 +139,7 @@ def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(record
         args = ["detect", str(recording), "--output", str(out), "--method", "sphere"]
         assert main([*args, "--resume", "--scheduler", cluster.scheduler_address, "--chunk", "1"]) == 0
         assert "frames: 2 done, 2 skipped (resume), 0 failed" in capsys.readouterr().out
+        client.run(exec, "import symfruit.detect, symfruit.season.cluster as c\nc.detect = symfruit.detect.detect")
     assert pq.read_table(out / "detections.parquet").to_pylist() == table
     assert _fruits(out) == _fruits(tmp_path / "serial")
 
@@ -207,10 +224,10 @@ def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
     assert forget("bag") == 1 and forget("bag") == 0  # the bag was opened once and is closed at the end
 
 
-def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(recording, tmp_path):
+def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(cluster, recording, tmp_path):
     """Two recordings that share a name and one that cannot be opened: the cluster's folders, tables and
     errors.json are the serial run's; a task never mixes recordings (three frames of one, chunk 2); --resume
-    redoes what is missing and keeps each fruit once."""
+    (on a local cluster of its own: ``workers=1``) redoes what is missing and keeps each fruit once."""
     a, b = tmp_path / "a" / "rec", tmp_path / "b" / "rec"
     for k in range(3):
         shutil.copytree(recording / f"scene_{k:05d}", a / f"scene_{k:05d}")
@@ -220,13 +237,13 @@ def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(
     inputs = [a, bad, b]
     serial = run_batch(inputs, tmp_path / "serial", method="raw", progress=False)
     out = tmp_path / "out"
-    report = run_distributed(inputs, out, workers=2, chunk=2, method="raw", progress=False)
+    report = run_distributed(inputs, out, scheduler=cluster.scheduler_address, chunk=2, method="raw", progress=False)
     assert report.recordings == serial.recordings and report.done == serial.done and len(report.done) == 4
     assert report.failed_recordings == serial.failed_recordings and list(report.failed_recordings) == [str(bad)]
     for name in (report.recordings[str(a)], report.recordings[str(b)]):
         assert name.startswith("rec+") and _fruits(out / name) == _fruits(tmp_path / "serial" / name)
     rows = pq.read_table(out / "detections.parquet").to_pylist()
-    assert rows == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist() and len(rows) == 24
+    assert rows == pq.read_table(tmp_path / "serial" / "detections.parquet").to_pylist() and len(rows) == 4
     errors = json.loads((out / "errors.json").read_text())
     assert errors == json.loads((tmp_path / "serial" / "errors.json").read_text()) and errors["recordings"]
     shutil.rmtree(out / report.recordings[str(a)] / "scene_00001")

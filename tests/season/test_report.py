@@ -20,13 +20,11 @@ def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0
     return {"frame": frame, "header": {}, "timings": {"total": 0.1}, "fruits": fruits}
 
 
-@pytest.fixture
-def run(tmp_path):
+def _run(out):
     """A run of two recordings: 'row1' 3 frames (one without fruit), 'row2' 1 frame; 7 fruit seen, 6 located,
     5 sized (one cut by the border), diameters 16, 20, 24, 30 and 40 mm."""
     from symfruit.season.table import frame_rows
 
-    out = tmp_path / "out"
     out.mkdir()
     with TableWriter(out) as table:
         table.add(*frame_rows(_record("a", [(0.016, 0.02, 0.01), (0.02, 0.03, 0.012)], failed=1), "row1"))
@@ -37,8 +35,22 @@ def run(tmp_path):
     return out
 
 
-def test_the_report_counts_sizes_and_classes_as_a_reader_would(run):
-    report = write_report(run)
+@pytest.fixture
+def run(tmp_path):
+    """The run of :func:`_run`, the test's own."""
+    return _run(tmp_path / "out")
+
+
+@pytest.fixture(scope="module")
+def written(tmp_path_factory):
+    """``(run, report)``: the run of :func:`_run` and its report, written once for the tests that only read it
+    (drawing the plots is most of a report's time)."""
+    out = _run(tmp_path_factory.mktemp("report") / "out")
+    return out, write_report(out)
+
+
+def test_the_report_counts_sizes_and_classes_as_a_reader_would(written):
+    run, report = written
     assert (report.frames, report.fruit, report.located, report.sized, report.recordings, report.failed_frames) == (
         4, 7, 6, 5, 2, 1)  # fmt: skip
     text = (run / "report" / "report.md").read_text()
@@ -108,8 +120,8 @@ def test_without_matplotlib_the_message_names_the_extra(run, monkeypatch):
         write_report(run)
 
 
-def test_each_recording_gets_its_sizes_and_a_run_of_one_recording_no_boxes(run, tmp_path):
-    text = write_report(run).folder.joinpath("report.md").read_text()
+def test_each_recording_gets_its_sizes_and_a_run_of_one_recording_no_boxes(written, run, tmp_path):
+    text = written[1].folder.joinpath("report.md").read_text()
     assert "| recording | fruit sized | 10 % below (mm) | median (mm) | 10 % above (mm) | < 18 mm | 18-25 mm | " in text
     assert "| row1 | 3 | 16.8 | 20.0 | 23.2 | 1 | 2 | 0 |" in text  # diameters 16, 20, 24 mm
     assert "| row2 | 2 | 31.0 | 35.0 | 39.0 | 0 | 0 | 2 |" in text  # 30, 40 mm

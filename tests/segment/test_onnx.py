@@ -1,19 +1,27 @@
 """ONNX instance-segmentation decoding (symfruit.segment.onnx) on tiny models built here: a Mask R-CNN-like
 export and a YOLO-like segmentation head, through `symfruit segment` too."""
 
+import importlib.util
+
 import numpy as np
 import pytest
 
 from symfruit import FileFormatError, SymfruitError
+from symfruit.segment.onnx import decode_yolo, letterbox, load_onnx, onnx_labels
 
-onnx = pytest.importorskip("onnx")
-pytest.importorskip("onnxruntime")
-from onnx import TensorProto, helper, numpy_helper  # noqa: E402
-
-from symfruit.segment.onnx import decode_yolo, letterbox, load_onnx, onnx_labels  # noqa: E402
+#: onnx is imported by the tests that build a model, not at collection (it takes half a second to import); the
+#: module's tests run in one xdist worker, so only that one imports it.
+pytestmark = [
+    pytest.mark.skipif(not all(importlib.util.find_spec(m) for m in ("onnx", "onnxruntime")),
+                       reason="needs onnx and onnxruntime (the extra onnx)"),
+    pytest.mark.xdist_group("onnx"),
+]  # fmt: skip
 
 
 def _save(graph, path):
+    import onnx
+    from onnx import helper
+
     model = helper.make_model(graph, opset_imports=[helper.make_opsetid("", 13)])
     model.ir_version = 7
     onnx.checker.check_model(model)
@@ -22,12 +30,16 @@ def _save(graph, path):
 
 
 def _const(name, array):
+    from onnx import helper, numpy_helper
+
     return helper.make_node("Constant", [], [name], value=numpy_helper.from_array(np.asarray(array), name + "_v"))
 
 
 def maskrcnn_model(path):
     """Input (3, H, W); instance 1 = where red > 0.5 (score 0.9, class 1), instance 2 = where green > 0.5
     (score 0.3, class 1), instance 3 = the whole image (score 0.95, class 2: not fruit)."""
+    from onnx import TensorProto, helper
+
     nodes = [
         _const("zero", np.array(0.0, np.float32)), _const("one", np.array(1.0, np.float32)),
         _const("starts", np.array([0], np.int64)), _const("ends", np.array([2], np.int64)),
@@ -60,6 +72,8 @@ def yolo_model(path):
     """Input (1, 3, 64, 64); prototypes: 0 = left half of the input, 1 = right half; anchors: a box over the
     left half (score 0.9, class 0), a near duplicate of it (0.8: suppressed), a box over the right half
     (0.7, class 1), one below the threshold (0.2)."""
+    from onnx import TensorProto, helper
+
     protos = np.full((1, 2, MH, MH), -10.0, np.float32)
     protos[0, 0, :, : MH // 2] = 10.0
     protos[0, 1, :, MH // 2 :] = 10.0
