@@ -300,8 +300,7 @@ def occlusion(
     valid = np.isfinite(d) & (d > 0) & ~own
     d = np.where(valid, d, np.nan)
     if reach > 0 and valid.any() and not (valid | own).all():  # pixels without depth take a neighbour's
-        dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
-        d = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
+        d = _fill(d, valid, own, reach)
     with np.errstate(invalid="ignore"):
         behind = d >= z_ref + tolerance  # NaN compares False: no depth is not "seen behind"
         near = d < z_ref + tolerance
@@ -309,6 +308,30 @@ def occlusion(
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
     return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=d)
+
+
+def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
+    """``d`` with each pixel that is neither ``valid`` nor ``own`` given the value of the nearest ``valid`` pixel
+    within ``reach`` pixels (as ``ndimage.distance_transform_edt(~valid, return_indices=True)`` picks it).
+
+    The transform runs on the box of those pixels grown by ``reach + 1`` alone (every valid pixel within
+    ``reach`` of them lies inside it; the same nearest pixels, checked against the whole window's transform),
+    not on the window, most of which has depth or is the fruit's own.
+    """
+    need = ~valid & ~own
+    rows, cols = np.flatnonzero(need.any(axis=1)), np.flatnonzero(need.any(axis=0))
+    h, w = d.shape
+    m = reach + 1
+    r0, r1 = max(int(rows[0]) - m, 0), min(int(rows[-1]) + m + 1, h)
+    c0, c1 = max(int(cols[0]) - m, 0), min(int(cols[-1]) + m + 1, w)
+    empty = ~valid[r0:r1, c0:c1]
+    if empty.all():  # no depth anywhere near: nothing to take
+        return d
+    dist, (vr, vc) = ndimage.distance_transform_edt(empty, return_indices=True)
+    sub = d[r0:r1, c0:c1]
+    out = d.copy()
+    out[r0:r1, c0:c1] = np.where(need[r0:r1, c0:c1] & (dist <= reach), sub[vr, vc], sub)
+    return out
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:
