@@ -327,10 +327,14 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
     empty = ~valid[r0:r1, c0:c1]
     if empty.all():  # no depth anywhere near: nothing to take
         return d
-    dist, (vr, vc) = ndimage.distance_transform_edt(empty, return_indices=True)
-    sub = d[r0:r1, c0:c1]
+    vr, vc = ndimage.distance_transform_edt(empty, return_distances=False, return_indices=True)
+    # the distance of the nearest pixel only where it is needed, in whole pixels squared (exactly as
+    # ``dist <= reach``): the transform's own distance map costs more than its feature transform
+    rr, cc = np.nonzero(need[r0:r1, c0:c1])
+    fr, fc = vr[rr, cc], vc[rr, cc]
+    near = (fr - rr) ** 2 + (fc - cc) ** 2 <= reach * reach
     out = d.copy()
-    out[r0:r1, c0:c1] = np.where(need[r0:r1, c0:c1] & (dist <= reach), sub[vr, vc], sub)
+    out[rr[near] + r0, cc[near] + c0] = d[fr[near] + r0, fc[near] + c0]
     return out
 
 
