@@ -395,30 +395,38 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     band = mask & (inner <= band_px)
     if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
         return mask
-    rgb = np.asarray(color, dtype=np.float64)
-    total = rgb.sum(axis=2) + 1.0
-    feature = np.stack([rgb[..., 0] / total, rgb[..., 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
+    color = np.asarray(color)
+
+    def feature(where: np.ndarray) -> np.ndarray:  # chromaticity and brightness of the pixels ``where``
+        rgb = color[where].astype(np.float64)
+        total = rgb[:, 0] + rgb[:, 1] + rgb[:, 2] + 1.0
+        return np.stack([rgb[:, 0] / total, rgb[:, 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
+
     rng = np.random.default_rng(0)
 
-    def summary(where: np.ndarray) -> np.ndarray:
-        x = feature[where]
+    def summary(x: np.ndarray) -> np.ndarray:
         x = x[rng.choice(len(x), min(len(x), 400), replace=False)]
         c = x[np.linspace(0, len(x) - 1, centres).astype(int)]
+        k = len(c)
         for _ in range(iterations):
             label = np.argmin(((x[:, None, :] - c[None]) ** 2).sum(-1), axis=1)
-            c = np.array([x[label == k].mean(axis=0) if (label == k).any() else c[k] for k in range(len(c))])
+            # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
+            count = np.bincount(label, minlength=k)
+            total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
+            c = np.where(count[:, None] > 0, total.reshape(k, 3) / np.maximum(count, 1)[:, None], c)
         return c
 
-    fc, bc = summary(fruit), summary(ring)
+    f_fruit, f_ring = feature(fruit), feature(ring)
+    fc, bc = summary(f_fruit), summary(f_ring)
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
         to_fruit = ((x[:, None, :] - fc[None]) ** 2).sum(-1).min(1)
         return margin * to_fruit <= ((x[:, None, :] - bc[None]) ** 2).sum(-1).min(1)
 
-    if is_fruit(feature[fruit]).mean() < min_accuracy or (~is_fruit(feature[ring])).mean() < min_accuracy:
+    if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
         return mask
     keep = mask.copy()
-    keep[band] = is_fruit(feature[band], margin)  # a mixed pixel on the outline, between the two, stays
+    keep[band] = is_fruit(feature(band), margin)  # a mixed pixel on the outline, between the two, stays
     labels, _ = ndimage.label(keep)
     core_labels = np.unique(labels[fruit])
     return ndimage.binary_fill_holes(np.isin(labels, core_labels[core_labels > 0]))
