@@ -269,8 +269,13 @@ def observe(
             seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
         return camera.rays(uv[:, 0], uv[:, 1]), weight, seen
 
-    ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
-    outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
+    def rings(dist: np.ndarray) -> list[np.ndarray]:  # each band's pixels (row-major), one pass over the map
+        rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5)) if bands else np.empty((0, 2), int)
+        at = dist[rc[:, 0], rc[:, 1]]
+        return [rc[(at > b - 0.5) & (at <= b + 0.5)] for b in bands]
+
+    ins = [band(rc, False) for rc in rings(inner)]
+    outs = [band(rc, True) for rc in rings(outer)]
     cone, axis = silhouette_cone(region, camera)
     source = "moments"
     if occlusion is not None and tree is not None and contour_cone <= contour < 1.0:
