@@ -192,3 +192,20 @@ def test_the_registration_cost_reads_minus_reach_beyond_the_window(seed):
     band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, 3.0)
     dev = np.sort(np.abs(val - band), axis=1)[:, : int(0.7 * n)]
     np.testing.assert_allclose(outline.cost(shifts, reach, 0.7), dev.mean(axis=1), rtol=1e-12)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_histogram_of_sorted_depths_is_numpys(seed):
+    from symfruit.core.surface import _sorted_histogram
+
+    rng = np.random.default_rng(seed)
+    step = float(rng.uniform(0.001, 0.02))
+    z = np.sort(rng.uniform(0.3, 0.6, int(rng.integers(10, 400))))
+    bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
+    span = (z[0], z[0] + bins * step)
+    # depths on the bins' edges as well: a registered depth image repeats values
+    z = np.sort(np.r_[z, np.linspace(*span, bins + 1)[rng.integers(0, bins + 1, 20)]])
+    counts, edges = _sorted_histogram(z, bins, span)
+    expected, expected_edges = np.histogram(z, bins=bins, range=span)
+    np.testing.assert_array_equal(counts, expected)
+    np.testing.assert_array_equal(edges, expected_edges)

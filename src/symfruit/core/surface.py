@@ -117,10 +117,12 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     z = np.sort(values[np.isfinite(values) & (values > 0)])
     if len(z) < 10:
         return float("nan"), float("nan")
-    radius = radius_px * float(np.median(z)) / focal
+    half = len(z) // 2
+    median = float(z[half]) if len(z) % 2 else float((z[half - 1] + z[half]) / 2.0)  # np.median of sorted z
+    radius = radius_px * median / focal
     step = max(radius / 3.0, 0.004, 2.0 * noise)
     n_bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
-    counts, edges = np.histogram(z, bins=n_bins, range=(z[0], z[0] + n_bins * step))
+    counts, edges = _sorted_histogram(z, n_bins, (z[0], z[0] + n_bins * step))
     mass = np.convolve(counts, np.ones(3), mode="same")
     peak = (mass >= np.r_[mass[1:], -1]) & (mass >= np.r_[-1, mass[:-1]]) & (mass >= 0.5 * mass.max())
     i = int(np.flatnonzero(peak)[0])
@@ -130,8 +132,20 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     while first > 0 and counts[first - 1] >= max(2, 0.01 * len(z)):
         first -= 1
     lo, hi = edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
-    front = float(np.quantile(z[(z >= lo) & (z <= hi)], 0.05))
+    front = float(np.quantile(z[np.searchsorted(z, lo, side="left") : np.searchsorted(z, hi, side="right")], 0.05))
     return front, radius_px * front / focal
+
+
+def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
+    """``np.histogram(z, bins=bins, range=span)`` of sorted ``z``: the counts between the same edges (each bin
+    ``[e_i, e_i+1)``, the last closed) found by bisection instead of a pass over ``z`` per bin index."""
+    lo, hi = float(span[0]), float(span[1])
+    if not lo < hi:  # numpy widens an empty range; let it
+        return np.histogram(z, bins=bins, range=(lo, hi))
+    edges = np.linspace(lo, hi, bins + 1)
+    at = np.searchsorted(z, edges, side="left")
+    at[-1] = np.searchsorted(z, hi, side="right")
+    return np.diff(at), edges
 
 
 def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], tolerance: float,
