@@ -217,7 +217,7 @@ def test_allowed_on_the_seen_box_is_allowed_on_the_whole_window(seed, gap, thin)
 
 
 @given(st.integers(0, 2**32 - 1))
-def test_the_depth_fill_on_its_box_matches_the_whole_window_transform(seed):
+def test_the_depth_fill_takes_the_pixel_the_feature_transform_picks(seed):
     from symfruit.core.occlusion import _fill
 
     rng = np.random.default_rng(seed)

@@ -312,30 +312,40 @@ def occlusion(
 
 def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
     """``d`` with each pixel that is neither ``valid`` nor ``own`` given the value of the nearest ``valid`` pixel
-    within ``reach`` pixels (as ``ndimage.distance_transform_edt(~valid, return_indices=True)`` picks it).
+    within ``reach`` pixels, the one ``ndimage.distance_transform_edt(~valid, return_indices=True)`` picks.
 
-    The transform runs on the box of those pixels grown by ``reach + 1`` alone (every valid pixel within
-    ``reach`` of them lies inside it; the same nearest pixels, checked against the whole window's transform),
-    not on the window, most of which has depth or is the fruit's own.
+    Only the pixels to fill look for it, through the offsets within ``reach`` nearest first: most dropouts have
+    depth a pixel away, and a feature transform of the window (most of which has depth) costs many times more.
+    Among equally near pixels scipy's transform picks the one of least column, then least row offset; so
+    do the offsets' order here (checked against the transform on random dropouts, ties included).
     """
-    need = ~valid & ~own
-    rows, cols = np.flatnonzero(need.any(axis=1)), np.flatnonzero(need.any(axis=0))
     h, w = d.shape
-    m = reach + 1
-    r0, r1 = max(int(rows[0]) - m, 0), min(int(rows[-1]) + m + 1, h)
-    c0, c1 = max(int(cols[0]) - m, 0), min(int(cols[-1]) + m + 1, w)
-    empty = ~valid[r0:r1, c0:c1]
-    if empty.all():  # no depth anywhere near: nothing to take
-        return d
-    vr, vc = ndimage.distance_transform_edt(empty, return_distances=False, return_indices=True)
-    # the distance of the nearest pixel only where it is needed, in whole pixels squared (exactly as
-    # ``dist <= reach``): the transform's own distance map costs more than its feature transform
-    rr, cc = np.nonzero(need[r0:r1, c0:c1])
-    fr, fc = vr[rr, cc], vc[rr, cc]
-    near = (fr - rr) ** 2 + (fc - cc) ** 2 <= reach * reach
+    rows, cols = np.nonzero(~valid & ~own)
     out = d.copy()
-    out[rr[near] + r0, cc[near] + c0] = d[fr[near] + r0, fc[near] + c0]
+    todo = np.arange(len(rows))
+    for dr, dc in _offsets(reach):
+        if not len(todo):
+            break
+        r, c = rows[todo] + dr, cols[todo] + dc
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        hit = np.zeros(len(todo), dtype=bool)
+        hit[inside] = valid[r[inside], c[inside]]
+        out[rows[todo[hit]], cols[todo[hit]]] = d[r[hit], c[hit]]
+        todo = todo[~hit]
     return out
+
+
+def _offsets(reach: int) -> list[tuple[int, int]]:
+    """``(dr, dc)`` within ``reach`` (Euclidean, not 0), by distance, then column offset, then row offset."""
+    found = _OFFSETS.get(reach)
+    if found is None:
+        found = sorted(((dr, dc) for dr in range(-reach, reach + 1) for dc in range(-reach, reach + 1)
+                        if 0 < dr * dr + dc * dc <= reach * reach), key=lambda o: (o[0] ** 2 + o[1] ** 2, o[1], o[0]))  # fmt: skip
+        _OFFSETS[reach] = found
+    return found
+
+
+_OFFSETS: dict[int, list[tuple[int, int]]] = {}
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:
