@@ -227,3 +227,12 @@ def test_the_least_median_pixel_is_the_argmin_of_every_median(seed):
         return
     first = int(np.argmin(median_at(image, rows, cols, size=5)))
     assert least_median_at(image, rows, cols, size=5) == (int(rows[first]), int(cols[first]))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_colour_distances_are_numpys_sum_bit_for_bit(seed):
+    from symfruit.core.surface import _square_distances
+
+    rng = np.random.default_rng(seed)
+    x, c = rng.random((int(rng.integers(1, 300)), 3)), rng.random((int(rng.integers(1, 5)), 3))
+    np.testing.assert_array_equal(_square_distances(x, c), ((x[:, None, :] - c[None]) ** 2).sum(-1))

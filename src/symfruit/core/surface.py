@@ -447,7 +447,7 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
         c = x[np.linspace(0, len(x) - 1, centres).astype(int)]
         k = len(c)
         for _ in range(iterations):
-            label = np.argmin(((x[:, None, :] - c[None]) ** 2).sum(-1), axis=1)
+            label = np.argmin(_square_distances(x, c), axis=1)
             # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
             count = np.bincount(label, minlength=k)
             total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
@@ -458,8 +458,8 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     fc, bc = summary(f_fruit), summary(f_ring)
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
-        to_fruit = ((x[:, None, :] - fc[None]) ** 2).sum(-1).min(1)
-        return margin * to_fruit <= ((x[:, None, :] - bc[None]) ** 2).sum(-1).min(1)
+        to_fruit = _square_distances(x, fc).min(1)
+        return margin * to_fruit <= _square_distances(x, bc).min(1)
 
     if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
         return mask
@@ -468,3 +468,13 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     labels, _ = ndimage.label(keep)
     core_labels = np.unique(labels[fruit])
     return ndimage.binary_fill_holes(np.isin(labels, core_labels[core_labels > 0]))
+
+
+def _square_distances(x: np.ndarray, c: np.ndarray) -> np.ndarray:
+    """(n, k) squared distances of rows ``x`` (n, 3) to rows ``c`` (k, 3): ``((x[:, None] - c[None]) ** 2).sum(-1)``
+    term by term (numpy sums three terms left to right: the same values), without the (n, k, 3) array's short
+    last-axis reduction."""
+    d0 = x[:, 0, None] - c[None, :, 0]
+    d1 = x[:, 1, None] - c[None, :, 1]
+    d2 = x[:, 2, None] - c[None, :, 2]
+    return d0 * d0 + d1 * d1 + d2 * d2
