@@ -212,24 +212,6 @@ def test_the_histogram_of_sorted_depths_is_numpys(seed):
 
 
 @given(st.integers(0, 2**32 - 1))
-def test_the_least_median_pixel_is_the_argmin_of_every_median(seed):
-    from symfruit.core.surface import least_median_at, median_at
-
-    rng = np.random.default_rng(seed)
-    h, w = (int(x) for x in rng.integers(3, 50, 2))
-    yy, xx = np.mgrid[:h, :w]
-    # a cap (ties on a coarse depth grid), background at inf, and noise spikes nearer than the cap
-    image = np.round(0.4 + 1e-4 * ((yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2), 3)
-    image[rng.random((h, w)) < rng.uniform(0, 0.5)] = np.inf
-    image[rng.random((h, w)) < 0.05] = 0.1
-    rows, cols = np.nonzero(rng.random((h, w)) < rng.uniform(0.05, 1.0))
-    if not len(rows):
-        return
-    first = int(np.argmin(median_at(image, rows, cols, size=5)))
-    assert least_median_at(image, rows, cols, size=5) == (int(rows[first]), int(cols[first]))
-
-
-@given(st.integers(0, 2**32 - 1))
 def test_the_colour_distances_are_numpys_sum_bit_for_bit(seed):
     from symfruit.core.surface import _square_distances
 

@@ -202,32 +202,6 @@ def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: in
     return np.partition(values, middle, axis=1)[:, middle]
 
 
-def least_median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: int,
-                    probe: int = 16) -> tuple[int, int]:  # fmt: skip
-    """``(row, col)`` of the pixel ``(rows[i], cols[i])`` of least :func:`median_at` (the first of equals), with
-    the median computed only where it can win.
-
-    A window's median is at least its minimum: the medians at the ``probe`` pixels of least window minimum
-    bound the least median from above, and a pixel whose window minimum exceeds that bound cannot reach it
-    (on a fruit's cap, most pixels lie millimetres behind its apex). Every pixel of least median keeps its
-    place in the order, so the first of equals is the same.
-    """
-    h, w = image.shape
-    half = size // 2
-    r0, r1 = max(int(rows.min()) - half, 0), min(int(rows.max()) + half + 1, h)
-    c0, c1 = max(int(cols.min()) - half, 0), min(int(cols.max()) + half + 1, w)
-    # the pixels' windows lie inside this box, so its own border (``nearest``) matters only at the image's
-    low = ndimage.minimum_filter(image[r0:r1, c0:c1], size=size, mode="nearest")[rows - r0, cols - c0]
-    if len(rows) > probe:
-        probes = np.argpartition(low, probe - 1)[:probe]
-        bound = median_at(image, rows[probes], cols[probes], size=size).min()
-        kept = np.flatnonzero(low <= bound)
-    else:
-        kept = np.arange(len(rows))
-    first = kept[int(np.argmin(median_at(image, rows[kept], cols[kept], size=size)))]
-    return int(rows[first]), int(cols[first])
-
-
 def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None) -> Surface | None:  # fmt: skip
@@ -278,7 +252,9 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     if not core.any():
         core = near & mask if (near & mask).any() else near
     rows, cols = np.nonzero(core)
-    apex = least_median_at(np.where(near, depth, np.inf), rows, cols, size=5)
+    smooth = median_at(np.where(near, depth, np.inf), rows, cols, size=5)
+    first = int(np.argmin(smooth))
+    apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
     if inner is None or inner.shape != mask.shape:
