@@ -218,3 +218,27 @@ def test_the_colour_distances_are_numpys_sum_bit_for_bit(seed):
     rng = np.random.default_rng(seed)
     x, c = rng.random((int(rng.integers(1, 300)), 3)), rng.random((int(rng.integers(1, 5)), 3))
     np.testing.assert_array_equal(_square_distances(x, c), ((x[:, None, :] - c[None]) ** 2).sum(-1))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_monotone_region_walks_every_ray_as_a_loop_does(seed):
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 30, 2))
+    depth = np.round(rng.uniform(0.4, 0.45, (h, w)), 3)  # a coarse grid: equal depths and equal distances
+    keep = rng.random((h, w)) < 0.8
+    apex = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    tol, bins = 0.0105, 72  # off the depth grid: the sector offsets round by 1e-13
+    expected = np.zeros((h, w), bool)
+    rows, cols = np.nonzero(keep)
+    sector = np.floor((np.arctan2(rows - apex[0], cols - apex[1]) + np.pi) * (bins / (2 * np.pi))).astype(int) % bins
+    for k in np.unique(sector):
+        on = np.flatnonzero(sector == k)
+        on = on[np.argsort(np.hypot(rows[on] - apex[0], cols[on] - apex[1]), kind="stable")]
+        top = -np.inf
+        for i in on:  # along the ray: cut from the first pixel that falls more than tol below the running maximum
+            z = depth[rows[i], cols[i]]
+            top = max(top, z)
+            if z < top - tol:
+                break
+            expected[rows[i], cols[i]] = True
+    np.testing.assert_array_equal(monotone_region(depth, keep, apex, tol, bins=bins), expected)

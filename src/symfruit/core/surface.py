@@ -174,7 +174,10 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
         return keep.copy() if len(rows) else out
     dy, dx = rows - apex[0], cols - apex[1]
     sector = np.floor((np.arctan2(dy, dx) + np.pi) * (bins / (2.0 * np.pi))).astype(np.int64) % bins
-    order = np.lexsort((np.hypot(dy, dx), sector))
+    # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
+    # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
+    d2 = dy * dy + dx * dx
+    order = np.argsort(sector * (int(d2.max()) + 1) + d2, kind="stable")
     z, sec = depth[rows[order], cols[order]].astype(np.float64), sector[order]
     # a running maximum per sector: offset each sector above every earlier one, accumulate, take it back off
     offset = sec * (2.0 * (np.abs(z).max() + tolerance + 1.0))
