@@ -115,7 +115,7 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
         return np.zeros(0, np.int64)
     order = np.argsort(points[:, 2], kind="stable")
     gaps = np.flatnonzero(np.diff(points[order, 2]) > distance) + 1
-    bounds = np.r_[0, gaps, n]
+    bounds = np.concatenate(([0], gaps, [n]))
     labels = np.empty(n, np.int64)
     next_label = 0
     for lo, hi in itertools.pairwise(bounds):
@@ -190,7 +190,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         if found is not None:
             keep = usable & found.pixels
     rows, cols = np.nonzero(keep)
-    points = camera.deproject(np.c_[cols, rows].astype(np.float64), z_all[rows, cols])
+    points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
     dropped = int(usable.sum() - len(points))
     if len(points) >= 2:
         labels = cluster(points, s.cluster_distance)

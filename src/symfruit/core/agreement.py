@@ -258,7 +258,7 @@ def observe(
     def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if len(rc) > n_band:
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        uv = np.c_[rc[:, 1] + region.u0, rc[:, 0] + region.v0].astype(np.float64)
+        uv = np.stack((rc[:, 1] + region.u0, rc[:, 0] + region.v0), axis=1).astype(np.float64)
         weight = np.ones(len(rc))
         seen = np.full(len(rc), np.nan)
         if outside and tree is not None and len(rc):
@@ -302,7 +302,7 @@ def _occluded_edges(
     mask = region.mask
     rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask))
     step = max(1, len(rows) // (2 * count))
-    uv = np.c_[cols[::step] + region.u0, rows[::step] + region.v0].astype(np.float64)
+    uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
     return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
 

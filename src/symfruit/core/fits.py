@@ -469,7 +469,7 @@ def fit_revolution_slices(
         best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
     t = q @ best
-    w = np.c_[q @ e1[0], q @ e2[0]]
+    w = np.stack((q @ e1[0], q @ e2[0]), axis=1)
     edges = np.linspace(t.min(), t.max(), profile_bins + 1)
     which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, profile_bins - 1)
     counts = np.bincount(which, minlength=profile_bins)
@@ -583,12 +583,12 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
     ok = np.isfinite(rev.radii)
     t, r = mid[ok], rev.radii[ok]
     if len(t) < 2:
-        return np.r_[rev.edges[0], rev.edges[-1]], np.zeros(2)
+        return np.array([rev.edges[0], rev.edges[-1]]), np.zeros(2)
     widest = int(np.argmax(r))
     if close and widest == len(t) - 1:
-        t, r = np.r_[t, 2 * t[-1] - t[:-1][::-1]], np.r_[r, r[:-1][::-1]]
+        t, r = np.concatenate((t, 2 * t[-1] - t[:-1][::-1])), np.concatenate((r, r[:-1][::-1]))
     elif close and widest == 0:
-        t, r = np.r_[2 * t[0] - t[1:][::-1], t], np.r_[r[1:][::-1], r]
+        t, r = np.concatenate((2 * t[0] - t[1:][::-1], t)), np.concatenate((r[1:][::-1], r))
     return t, r
 
 

@@ -339,8 +339,9 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
     """``(dr, dc)`` within ``reach`` (Euclidean, not 0), by distance, then column offset, then row offset."""
     found = _OFFSETS.get(reach)
     if found is None:
-        found = sorted(((dr, dc) for dr in range(-reach, reach + 1) for dc in range(-reach, reach + 1)
-                        if 0 < dr * dr + dc * dc <= reach * reach), key=lambda o: (o[0] ** 2 + o[1] ** 2, o[1], o[0]))  # fmt: skip
+        span = range(-reach, reach + 1)
+        near = [(dr, dc) for dr in span for dc in span if 0 < dr * dr + dc * dc <= reach * reach]
+        found = sorted(near, key=lambda o: (o[0] ** 2 + o[1] ** 2, o[1], o[0]))
         _OFFSETS[reach] = found
     return found
 

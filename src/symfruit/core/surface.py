@@ -124,7 +124,8 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     n_bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
     counts, edges = _sorted_histogram(z, n_bins, (z[0], z[0] + n_bins * step))
     mass = np.convolve(counts, np.ones(3), mode="same")
-    peak = (mass >= np.r_[mass[1:], -1]) & (mass >= np.r_[-1, mass[:-1]]) & (mass >= 0.5 * mass.max())
+    after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
+    peak = (mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max())
     i = int(np.flatnonzero(peak)[0])
     # the fruit's depths run without a gap from its nearest point to its rim: walk nearer while bins are filled
     # (an occluder in front is apart in depth; a fruit receding along its length is not)

@@ -287,7 +287,7 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     e = np.array([energies[n] for n in names])
     w = np.exp(-(e - e.min()) / s.temperature)
     w /= w.sum()
-    faces = np.array([np.r_[c.lo, c.hi] for c in cands])
+    faces = np.array([np.concatenate((c.lo, c.hi)) for c in cands])
     box_faces = _weighted_median(faces, w)
     box = Box(box_faces[:3], box_faces[3:])
     centres = 0.5 * (faces[:, :3] + faces[:, 3:])
