@@ -393,7 +393,7 @@ def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
     theta = np.pi * (1.0 + 5**0.5) * i
     e1, e2 = perpendicular_basis(direction[None, :])
     rot = np.stack([e1[0], e2[0], direction], axis=1)
-    out = np.vstack([direction[None, :], np.c_[r * np.cos(theta), r * np.sin(theta), z] @ rot.T])
+    out = np.vstack([direction[None, :], np.stack((r * np.cos(theta), r * np.sin(theta), z), axis=1) @ rot.T])
     return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
 
 
@@ -450,7 +450,8 @@ def fit_revolution_slices(
         On fewer than 20 finite points.
     """
     pts = as_points(points, min_count=1)
-    pts = pts[np.isfinite(pts).all(axis=1)]
+    if not np.isfinite(pts).all():  # a short last-axis reduction is slow: only when something is not finite
+        pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts) < 20:
         raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
     centre = pts.mean(axis=0)
