@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points, perpendicular_basis
+from .points import as_points, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
@@ -192,7 +192,7 @@ def surface_noise(
 def _residuals(theta, points, prior, ratio, delta, jac=True):
     centre, axes = theta[:3], np.exp(theta[3:])
     u = (points - centre) / axes
-    r = np.maximum(np.linalg.norm(u, axis=1), 1e-12)
+    r = np.maximum(row_norms(u), 1e-12)
     mean_axis = axes.mean()
     res = (r - 1.0) * mean_axis  # about the distance to the surface, metres
     w = np.sqrt(np.where(np.abs(res) <= delta, 1.0, delta / np.maximum(np.abs(res), 1e-15)))
@@ -294,7 +294,7 @@ def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -
     k = int(np.argmin(cost))
     a0, d = a[k] + c, _DIRECTIONS[k]
     t = (points - a0) @ d
-    rho = np.linalg.norm((points - a0) - t[:, None] * d, axis=1)
+    rho = row_norms((points - a0) - t[:, None] * d)
     edges = np.quantile(t, np.linspace(0.0, 1.0, bins + 1))
     which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
     lo, hi = points.min(axis=0), points.max(axis=0)
@@ -498,7 +498,7 @@ def fit_revolution_slices(
         if np.abs(step).max() < 1e-7:
             break
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
-    rho = np.linalg.norm(w - a2, axis=1)
+    rho = row_norms(w - a2)
     mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
     radii = np.where(counts >= 3, mean_r, np.nan)
     res2 = np.sort((rho - mean_r[which]) ** 2)
@@ -605,7 +605,7 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     t_prof, r_prof = closed_profile(rev, close=close)
     rel = np.asarray(x, dtype=np.float64) - rev.point
     t = rel @ rev.direction
-    rho = np.linalg.norm(rel - t[..., None] * rev.direction, axis=-1)
+    rho = row_norms(rel - t[..., None] * rev.direction)
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     return r - rho - past
