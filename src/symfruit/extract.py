@@ -11,6 +11,7 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
+from .core.points import bounds
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .settings import Section, SettingError, setting
 
@@ -134,8 +135,8 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
 
 
 def _grid_clusters(points: np.ndarray, voxel: float) -> np.ndarray:
-    cells = np.floor((points - points.min(axis=0)) / voxel).astype(np.int64)
-    shape = cells.max(axis=0) + 1
+    cells = np.floor((points - bounds(points)[0]) / voxel).astype(np.int64)
+    shape = bounds(cells)[1] + 1  # column by column: the first-axis reduction of (n, 3) is slow
     if np.prod(shape) > 2e7:  # too sparse for a dense grid: link the occupied cells through a tree
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
