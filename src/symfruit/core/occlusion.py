@@ -294,7 +294,7 @@ def occlusion(
     seen_own = np.isfinite(own_z)
     # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
     nr, nc = ndimage.distance_transform_edt(~seen_own, return_distances=False, return_indices=True)
-    z_ref = own_z[nr, nc]
+    z_ref = np.take(own_z.ravel(), nr * w + nc)  # by flat index: faster than two index arrays
     own = mask[v0:v1, u0:u1] | seen_own
     d = np.asarray(depth[v0:v1, u0:u1], dtype=np.float64)
     valid = np.isfinite(d) & (d > 0) & ~own

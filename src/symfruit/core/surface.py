@@ -201,7 +201,8 @@ def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: in
     off = np.arange(size) - size // 2
     r = np.clip(rows[:, None, None] + off[None, :, None], 0, h - 1)
     c = np.clip(cols[:, None, None] + off[None, None, :], 0, w - 1)
-    values = image[r, c].reshape(len(rows), size * size)
+    # one flat index per value: np.take is several times faster than indexing by two broadcast arrays
+    values = np.take(np.ascontiguousarray(image).ravel(), r * w + c).reshape(len(rows), size * size)
     middle = size * size // 2
     return np.partition(values, middle, axis=1)[:, middle]
 
@@ -289,7 +290,7 @@ class _Outline:
             self._padded[(pad, int(reach))] = flat
         width = self.inside.shape[1] + 2 * pad
         at = (self.rows + pad) * width + (self.cols + pad)  # one flat index per point, one offset per shift
-        return flat[at[None, :] - (shifts[:, :1] * width + shifts[:, 1:])]
+        return np.take(flat, at[None, :] - (shifts[:, :1] * width + shifts[:, 1:]))
 
     def cost(self, shifts: np.ndarray, reach: int, trim: float) -> np.ndarray:
         """(k,) trimmed mean deviation of the outline points from a band inside the mask shifted by each
