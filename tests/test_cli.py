@@ -180,6 +180,14 @@ def test_bench_frame_times_one_method_or_profiles_it(capsys, monkeypatch):
     assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--profile"]) == 0
     out = capsys.readouterr().out
     assert out.startswith("cProfile of 1 frames, method raw") and "detect" in out
+    assert main(["bench", "--frame", "--method", "raw", "--repeat", "2", "--stages", "--json"]) == 0
+    stages = json.loads(capsys.readouterr().out)["stages"]["raw"]
+    assert set(stages) == {"segment", "trim", "register", "extract", "occlusion", "complete", "total", "cpu"}
+    assert all(len(v) == 2 for v in stages.values())
+    assert all(t >= s for t, s in zip(stages["total"], stages["segment"], strict=True))
+    assert main(["bench", "--frame", "--method", "raw", "--repeat", "1", "--stages"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[1].split() == ["stage", "raw"] and [ln.split()[0] for ln in lines[2:]][-1] == "cpu"
 
 
 def test_cli_detect_and_evaluate_frames(tmp_path, capsys):

@@ -88,7 +88,9 @@ def test_each_fruit_is_numbered_boxed_and_timed():
     assert left.visible_box.centre[0] < 0 < right.visible_box.centre[0]
     assert left.mask[60, 40] and not left.mask[60, 120] and left.mask.shape == (120, 160)
     assert np.array_equal(left.result.box.min, left.extraction.points.min(axis=0))  # raw: the visible box
-    assert set(found.timings) == {"segment", "extract", "complete", "total"}
+    assert set(found.timings) == {"segment", "trim", "register", "extract", "occlusion", "complete", "total", "cpu"}
+    assert found.timings["trim"] + found.timings["register"] <= found.timings["extract"]
+    assert found.timings["occlusion"] <= found.timings["complete"]
     assert all(v >= 0 for v in found.timings.values()) and found.timings["total"] >= found.timings["segment"]
 
 

@@ -61,6 +61,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    "completion method (default evidence)")  # fmt: skip
     p.add_argument("--profile", action="store_true",
                    help="with --frame: print a cProfile of the frame instead (5 runs of --method)")  # fmt: skip
+    p.add_argument("--stages", action="store_true",
+                   help="with --frame: median and least wall time of each stage of `detect` and the thread's CPU "
+                   "time per frame (--repeat runs of each method)")  # fmt: skip
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument(
@@ -371,6 +374,26 @@ def _bench(args: argparse.Namespace) -> int:
 
         if args.profile:
             print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
+            return 0
+        if args.stages:
+            import numpy as np
+
+            from .evaluate.bench import STAGES, bench_stages
+
+            methods = (args.method,) if args.method else ("paper", "fused", "evidence")
+            found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor) for m in methods}
+            if args.json:
+                print(json.dumps({"machine": machine(), "stages": {m: {k: v.tolist() for k, v in ms.items()}
+                                                                   for m, ms in found.items()}}))  # fmt: skip
+                return 0
+            runs = len(next(iter(found.values()))["total"])
+            print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least; "
+                  "wall time per stage, CPU time of the thread ('cpu'); trim and register are part of extract, "
+                  "occlusion of complete")  # fmt: skip
+            print(f"{'stage':<10}" + "".join(f"{m:>22}" for m in methods))
+            for stage in STAGES:
+                cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
+                print(f"{stage:<10}{cells}")
             return 0
         rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor)
                 for m in ((args.method,) if args.method else ("paper", "fused", "evidence"))]  # fmt: skip

@@ -54,7 +54,11 @@ class Detection:
 class FrameDetections:
     """All fruit of one frame, with the time each stage took (seconds) and the shift ``(du, dv)`` (pixels) the
     masks were moved by onto the depth image (:func:`symfruit.extract.register`; each detection's mask is the
-    moved one)."""
+    moved one).
+
+    ``timings``: wall seconds of ``segment``, ``extract`` (of which ``trim`` and ``register``, the colour trimming
+    and registration of the whole frame's masks), ``complete`` (of which ``occlusion``, the occlusion maps) and
+    ``total``, and ``cpu``, the CPU seconds of this thread over the whole frame."""
 
     frame: Frame
     detections: list[Detection]
@@ -106,7 +110,7 @@ def detect(
     if settings is not None and not isinstance(settings, Settings):
         raise InputError(f"settings must be a Settings (symfruit.resolve_settings), got {type(settings).__name__}")
     settings = settings or Settings()
-    t0 = time.perf_counter()
+    t0, cpu0 = time.perf_counter(), time.thread_time()
     labels, source = frame_masks(frame, masks, settings)
     t1 = time.perf_counter()
     if not (frame.depth > 0).any():
@@ -129,8 +133,10 @@ def detect(
     t_register = time.perf_counter()
     if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
         labels = trim_labels(frame.color, labels, settings.extract)
+    t_trim = time.perf_counter() - t_register
     labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
-    detections, t_extract, t_complete = [], time.perf_counter() - t_register, 0.0
+    detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t_register, 0.0, 0.0
+    t_reg = t_extract - t_trim
     from scipy import ndimage
 
     fruit_px = labels > 0
@@ -154,13 +160,15 @@ def detect(
         try:
             occ = fruit_occlusion(frame.depth, mask, ex.points, frame.camera, settings.occlusion,
                                   others=fruit_px & ~mask)  # fmt: skip
+            t_occlusion += time.perf_counter() - b
             result = complete(ex.points, camera=frame.camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
         except SymfruitError as exc:
             detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
         t_complete += time.perf_counter() - b
     total = time.perf_counter() - t0
-    timings = {"segment": t1 - t0, "extract": t_extract, "complete": t_complete, "total": total}
+    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_reg, "extract": t_extract, "occlusion": t_occlusion,
+               "complete": t_complete, "total": total, "cpu": time.thread_time() - cpu0}  # fmt: skip
     return FrameDetections(frame, detections, timings, source, shift)
 
 

@@ -11,6 +11,7 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
+from .core.points import bounds
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .settings import Section, SettingError, setting
 
@@ -115,7 +116,7 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
         return np.zeros(0, np.int64)
     order = np.argsort(points[:, 2], kind="stable")
     gaps = np.flatnonzero(np.diff(points[order, 2]) > distance) + 1
-    bounds = np.r_[0, gaps, n]
+    bounds = np.concatenate(([0], gaps, [n]))
     labels = np.empty(n, np.int64)
     next_label = 0
     for lo, hi in itertools.pairwise(bounds):
@@ -134,8 +135,8 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
 
 
 def _grid_clusters(points: np.ndarray, voxel: float) -> np.ndarray:
-    cells = np.floor((points - points.min(axis=0)) / voxel).astype(np.int64)
-    shape = cells.max(axis=0) + 1
+    cells = np.floor((points - bounds(points)[0]) / voxel).astype(np.int64)
+    shape = bounds(cells)[1] + 1  # column by column: the first-axis reduction of (n, 3) is slow
     if np.prod(shape) > 2e7:  # too sparse for a dense grid: link the occupied cells through a tree
         from scipy.sparse import coo_matrix
         from scipy.sparse.csgraph import connected_components
@@ -190,7 +191,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         if found is not None:
             keep = usable & found.pixels
     rows, cols = np.nonzero(keep)
-    points = camera.deproject(np.c_[cols, rows].astype(np.float64), z_all[rows, cols])
+    points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
     dropped = int(usable.sum() - len(points))
     if len(points) >= 2:
         labels = cluster(points, s.cluster_distance)

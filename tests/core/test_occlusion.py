@@ -214,3 +214,23 @@ def test_allowed_on_the_seen_box_is_allowed_on_the_whole_window(seed, gap, thin)
     mask = rng.random((rh, rw)) < rng.uniform(0.1, 1.0)
     region = Silhouette(int(rng.integers(-5, 40)), int(rng.integers(-5, 40)), mask, 0.0)
     assert np.array_equal(occ.allowed(region, gap=gap, thin=thin), _allowed_whole_window(occ, region, gap, thin))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_depth_fill_takes_the_pixel_the_feature_transform_picks(seed):
+    from symfruit.core.occlusion import _fill
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 60, 2))
+    yy, xx = np.mgrid[:h, :w]
+    own = np.hypot(yy - rng.uniform(0, h), xx - rng.uniform(0, w)) < rng.uniform(0, 15)
+    # scattered dropout and a hole: many pixels at equal distances from several valid ones
+    valid = (rng.random((h, w)) > rng.uniform(0.0, 0.7)) & ~own
+    valid &= np.hypot(yy - rng.uniform(0, h), xx - rng.uniform(0, w)) > rng.uniform(0, 10)
+    if not valid.any() or (valid | own).all():
+        return
+    d = np.where(valid, rng.uniform(0.3, 0.6, (h, w)), np.nan)
+    reach = int(rng.integers(1, 6))
+    dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
+    expected = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
+    np.testing.assert_array_equal(_fill(d, valid, own, reach), expected)

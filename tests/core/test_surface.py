@@ -192,3 +192,53 @@ def test_the_registration_cost_reads_minus_reach_beyond_the_window(seed):
     band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, 3.0)
     dev = np.sort(np.abs(val - band), axis=1)[:, : int(0.7 * n)]
     np.testing.assert_allclose(outline.cost(shifts, reach, 0.7), dev.mean(axis=1), rtol=1e-12)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_histogram_of_sorted_depths_is_numpys(seed):
+    from symfruit.core.surface import _sorted_histogram
+
+    rng = np.random.default_rng(seed)
+    step = float(rng.uniform(0.001, 0.02))
+    z = np.sort(rng.uniform(0.3, 0.6, int(rng.integers(10, 400))))
+    bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
+    span = (z[0], z[0] + bins * step)
+    # depths on the bins' edges as well: a registered depth image repeats values
+    z = np.sort(np.r_[z, np.linspace(*span, bins + 1)[rng.integers(0, bins + 1, 20)]])
+    counts, edges = _sorted_histogram(z, bins, span)
+    expected, expected_edges = np.histogram(z, bins=bins, range=span)
+    np.testing.assert_array_equal(counts, expected)
+    np.testing.assert_array_equal(edges, expected_edges)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_colour_distances_are_numpys_sum_bit_for_bit(seed):
+    from symfruit.core.surface import _square_distances
+
+    rng = np.random.default_rng(seed)
+    x, c = rng.random((int(rng.integers(1, 300)), 3)), rng.random((int(rng.integers(1, 5)), 3))
+    np.testing.assert_array_equal(_square_distances(x, c), ((x[:, None, :] - c[None]) ** 2).sum(-1))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_monotone_region_walks_every_ray_as_a_loop_does(seed):
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 30, 2))
+    depth = np.round(rng.uniform(0.4, 0.45, (h, w)), 3)  # a coarse grid: equal depths and equal distances
+    keep = rng.random((h, w)) < 0.8
+    apex = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    tol, bins = 0.0105, 72  # off the depth grid: the sector offsets round by 1e-13
+    expected = np.zeros((h, w), bool)
+    rows, cols = np.nonzero(keep)
+    sector = np.floor((np.arctan2(rows - apex[0], cols - apex[1]) + np.pi) * (bins / (2 * np.pi))).astype(int) % bins
+    for k in np.unique(sector):
+        on = np.flatnonzero(sector == k)
+        on = on[np.argsort(np.hypot(rows[on] - apex[0], cols[on] - apex[1]), kind="stable")]
+        top = -np.inf
+        for i in on:  # along the ray: cut from the first pixel that falls more than tol below the running maximum
+            z = depth[rows[i], cols[i]]
+            top = max(top, z)
+            if z < top - tol:
+                break
+            expected[rows[i], cols[i]] = True
+    np.testing.assert_array_equal(monotone_region(depth, keep, apex, tol, bins=bins), expected)

@@ -258,7 +258,7 @@ def observe(
     def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         if len(rc) > n_band:
             rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        uv = np.c_[rc[:, 1] + region.u0, rc[:, 0] + region.v0].astype(np.float64)
+        uv = np.stack((rc[:, 1] + region.u0, rc[:, 0] + region.v0), axis=1).astype(np.float64)
         weight = np.ones(len(rc))
         seen = np.full(len(rc), np.nan)
         if outside and tree is not None and len(rc):
@@ -269,8 +269,13 @@ def observe(
             seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
         return camera.rays(uv[:, 0], uv[:, 1]), weight, seen
 
-    ins = [band(np.argwhere((inner > b - 0.5) & (inner <= b + 0.5)), False) for b in bands]
-    outs = [band(np.argwhere((outer > b - 0.5) & (outer <= b + 0.5)), True) for b in bands]
+    def rings(dist: np.ndarray) -> list[np.ndarray]:  # each band's pixels (row-major), one pass over the map
+        rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5)) if bands else np.empty((0, 2), int)
+        at = dist[rc[:, 0], rc[:, 1]]
+        return [rc[(at > b - 0.5) & (at <= b + 0.5)] for b in bands]
+
+    ins = [band(rc, False) for rc in rings(inner)]
+    outs = [band(rc, True) for rc in rings(outer)]
     cone, axis = silhouette_cone(region, camera)
     source = "moments"
     if occlusion is not None and tree is not None and contour_cone <= contour < 1.0:
@@ -297,7 +302,7 @@ def _occluded_edges(
     mask = region.mask
     rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask))
     step = max(1, len(rows) // (2 * count))
-    uv = np.c_[cols[::step] + region.u0, rows[::step] + region.v0].astype(np.float64)
+    uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
     return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
 
@@ -307,7 +312,7 @@ def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np
     uv = camera.project(points)
     col = np.clip(np.rint(uv[:, 0]).astype(np.intp) - region.u0, 0, inner.shape[1] - 1)
     row = np.clip(np.rint(uv[:, 1]).astype(np.intp) - region.v0, 0, inner.shape[0] - 1)
-    return inner[row, col]
+    return np.take(np.ascontiguousarray(inner).ravel(), row * inner.shape[1] + col)  # flat: faster than [row, col]
 
 
 def _grazing(normal: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -338,7 +343,8 @@ def _contour_pixels(
     d = np.arange(-half, half + 1)
     rr = row[edge][:, None, None] + d[None, :, None]
     cc = col[edge][:, None, None] + d[None, None, :]
-    patch = grid[rr, cc].reshape(len(edge), -1, 3)  # (m, (2 half + 1)^2, 3), NaN where no point
+    at = (rr * (w + 2 * half) + cc).ravel()  # flat pixel indices: np.take is faster than grid[rr, cc]
+    patch = np.take(grid.reshape(-1, 3), at, axis=0).reshape(len(edge), -1, 3)  # (m, (2 half + 1)^2, 3), NaN: none
     valid = np.isfinite(patch[..., 0])
     n = valid.sum(axis=1)
     patch = np.where(valid[..., None], patch, 0.0)

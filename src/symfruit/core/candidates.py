@@ -112,7 +112,7 @@ def constrain_box(
        edge is a contour; with occlusion information the box is where the fruit can project at all, and
        ``pull = 1`` brings every side back to it).
     """
-    seen_lo = np.r_[seen_lo[:2], front]
+    seen_lo = np.concatenate((seen_lo[:2], [front]))
     seen_hi = np.maximum(seen_hi, seen_lo)
     reach = REACH / max(contour, REACH_FLOOR) * (seen_hi - seen_lo)
     lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)

@@ -16,7 +16,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points, perpendicular_basis
+from .points import as_points, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
@@ -192,7 +192,7 @@ def surface_noise(
 def _residuals(theta, points, prior, ratio, delta, jac=True):
     centre, axes = theta[:3], np.exp(theta[3:])
     u = (points - centre) / axes
-    r = np.maximum(np.linalg.norm(u, axis=1), 1e-12)
+    r = np.maximum(row_norms(u), 1e-12)
     mean_axis = axes.mean()
     res = (r - 1.0) * mean_axis  # about the distance to the surface, metres
     w = np.sqrt(np.where(np.abs(res) <= delta, 1.0, delta / np.maximum(np.abs(res), 1e-15)))
@@ -294,7 +294,7 @@ def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -
     k = int(np.argmin(cost))
     a0, d = a[k] + c, _DIRECTIONS[k]
     t = (points - a0) @ d
-    rho = np.linalg.norm((points - a0) - t[:, None] * d, axis=1)
+    rho = row_norms((points - a0) - t[:, None] * d)
     edges = np.quantile(t, np.linspace(0.0, 1.0, bins + 1))
     which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
     lo, hi = points.min(axis=0), points.max(axis=0)
@@ -393,7 +393,7 @@ def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
     theta = np.pi * (1.0 + 5**0.5) * i
     e1, e2 = perpendicular_basis(direction[None, :])
     rot = np.stack([e1[0], e2[0], direction], axis=1)
-    out = np.vstack([direction[None, :], np.c_[r * np.cos(theta), r * np.sin(theta), z] @ rot.T])
+    out = np.vstack([direction[None, :], np.stack((r * np.cos(theta), r * np.sin(theta), z), axis=1) @ rot.T])
     return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
 
 
@@ -450,7 +450,8 @@ def fit_revolution_slices(
         On fewer than 20 finite points.
     """
     pts = as_points(points, min_count=1)
-    pts = pts[np.isfinite(pts).all(axis=1)]
+    if not np.isfinite(pts).all():  # a short last-axis reduction is slow: only when something is not finite
+        pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts) < 20:
         raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
     centre = pts.mean(axis=0)
@@ -469,7 +470,7 @@ def fit_revolution_slices(
         best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
     t = q @ best
-    w = np.c_[q @ e1[0], q @ e2[0]]
+    w = np.stack((q @ e1[0], q @ e2[0]), axis=1)
     edges = np.linspace(t.min(), t.max(), profile_bins + 1)
     which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, profile_bins - 1)
     counts = np.bincount(which, minlength=profile_bins)
@@ -497,7 +498,7 @@ def fit_revolution_slices(
         if np.abs(step).max() < 1e-7:
             break
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
-    rho = np.linalg.norm(w - a2, axis=1)
+    rho = row_norms(w - a2)
     mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
     radii = np.where(counts >= 3, mean_r, np.nan)
     res2 = np.sort((rho - mean_r[which]) ** 2)
@@ -583,12 +584,12 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
     ok = np.isfinite(rev.radii)
     t, r = mid[ok], rev.radii[ok]
     if len(t) < 2:
-        return np.r_[rev.edges[0], rev.edges[-1]], np.zeros(2)
+        return np.array([rev.edges[0], rev.edges[-1]]), np.zeros(2)
     widest = int(np.argmax(r))
     if close and widest == len(t) - 1:
-        t, r = np.r_[t, 2 * t[-1] - t[:-1][::-1]], np.r_[r, r[:-1][::-1]]
+        t, r = np.concatenate((t, 2 * t[-1] - t[:-1][::-1])), np.concatenate((r, r[:-1][::-1]))
     elif close and widest == 0:
-        t, r = np.r_[2 * t[0] - t[1:][::-1], t], np.r_[r[1:][::-1], r]
+        t, r = np.concatenate((2 * t[0] - t[1:][::-1], t)), np.concatenate((r[1:][::-1], r))
     return t, r
 
 
@@ -604,7 +605,7 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     t_prof, r_prof = closed_profile(rev, close=close)
     rel = np.asarray(x, dtype=np.float64) - rev.point
     t = rel @ rev.direction
-    rho = np.linalg.norm(rel - t[..., None] * rev.direction, axis=-1)
+    rho = row_norms(rel - t[..., None] * rev.direction)
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     return r - rho - past

@@ -60,4 +60,4 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
             zv = float(np.array([1.0, v[0], v[1], v[0] ** 2, v[0] * v[1], v[1] ** 2]) @ coef)
             if zv < best_z:
                 best_z, best_xy = zv, v
-    return best_z, np.r_[best_xy + seed, best_z]
+    return best_z, np.concatenate((best_xy + seed, [best_z]))

@@ -294,14 +294,13 @@ def occlusion(
     seen_own = np.isfinite(own_z)
     # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
     nr, nc = ndimage.distance_transform_edt(~seen_own, return_distances=False, return_indices=True)
-    z_ref = own_z[nr, nc]
+    z_ref = np.take(own_z.ravel(), nr * w + nc)  # by flat index: faster than two index arrays
     own = mask[v0:v1, u0:u1] | seen_own
     d = np.asarray(depth[v0:v1, u0:u1], dtype=np.float64)
     valid = np.isfinite(d) & (d > 0) & ~own
     d = np.where(valid, d, np.nan)
     if reach > 0 and valid.any() and not (valid | own).all():  # pixels without depth take a neighbour's
-        dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
-        d = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
+        d = _fill(d, valid, own, reach)
     with np.errstate(invalid="ignore"):
         behind = d >= z_ref + tolerance  # NaN compares False: no depth is not "seen behind"
         near = d < z_ref + tolerance
@@ -309,6 +308,45 @@ def occlusion(
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
     return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=d)
+
+
+def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
+    """``d`` with each pixel that is neither ``valid`` nor ``own`` given the value of the nearest ``valid`` pixel
+    within ``reach`` pixels, the one ``ndimage.distance_transform_edt(~valid, return_indices=True)`` picks.
+
+    Only the pixels to fill look for it, through the offsets within ``reach`` nearest first: most dropouts have
+    depth a pixel away, and a feature transform of the window (most of which has depth) costs many times more.
+    Among equally near pixels scipy's transform picks the one of least column, then least row offset; so
+    do the offsets' order here (checked against the transform on random dropouts, ties included).
+    """
+    h, w = d.shape
+    rows, cols = np.nonzero(~valid & ~own)
+    out = d.copy()
+    todo = np.arange(len(rows))
+    for dr, dc in _offsets(reach):
+        if not len(todo):
+            break
+        r, c = rows[todo] + dr, cols[todo] + dc
+        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
+        hit = np.zeros(len(todo), dtype=bool)
+        hit[inside] = valid[r[inside], c[inside]]
+        out[rows[todo[hit]], cols[todo[hit]]] = d[r[hit], c[hit]]
+        todo = todo[~hit]
+    return out
+
+
+def _offsets(reach: int) -> list[tuple[int, int]]:
+    """``(dr, dc)`` within ``reach`` (Euclidean, not 0), by distance, then column offset, then row offset."""
+    found = _OFFSETS.get(reach)
+    if found is None:
+        span = range(-reach, reach + 1)
+        near = [(dr, dc) for dr in span for dc in span if 0 < dr * dr + dc * dc <= reach * reach]
+        found = sorted(near, key=lambda o: (o[0] ** 2 + o[1] ** 2, o[1], o[0]))
+        _OFFSETS[reach] = found
+    return found
+
+
+_OFFSETS: dict[int, list[tuple[int, int]]] = {}
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:

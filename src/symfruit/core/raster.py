@@ -252,7 +252,7 @@ def principal_widths(mask: np.ndarray) -> tuple[float, float]:
     rows, cols = np.nonzero(mask)
     if len(rows) < 2:
         return float(len(rows)), float(len(rows))
-    xy = np.c_[cols, rows].astype(np.float64)
+    xy = np.stack((cols, rows), axis=1).astype(np.float64)
     xy -= xy.mean(axis=0)
     _, vec = np.linalg.eigh(xy.T @ xy)
     p = xy @ vec
@@ -351,7 +351,7 @@ def outline_cracks(region: Silhouette) -> np.ndarray:
     out = []
     for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
         rows, cols = np.nonzero(inner & ~m[1 + dr : m.shape[0] - 1 + dr, 1 + dc : m.shape[1] - 1 + dc])
-        out.append(np.c_[cols + 0.5 * dc + region.u0, rows + 0.5 * dr + region.v0])
+        out.append(np.stack((cols + 0.5 * dc + region.u0, rows + 0.5 * dr + region.v0), axis=1))
     return np.vstack(out).astype(np.float64)
 
 

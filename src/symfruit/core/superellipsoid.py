@@ -29,7 +29,7 @@ from scipy import sparse
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
-from .points import as_points
+from .points import as_points, row_norms
 
 __all__ = [
     "Superellipsoid",
@@ -238,7 +238,7 @@ def _evaluate(theta, pts, prior, w_c, w_s, *, jacobian):
     f = big_g + big_z
     lf = np.log(f)
     fe = np.exp(-0.5 * e1 * lf)  # f^(-e1/2)
-    rho = np.linalg.norm(q, axis=1)
+    rho = row_norms(q)
     n = len(pts)
     res = np.empty(n + 2)
     res[:n] = rho * (1.0 - fe)
@@ -482,7 +482,7 @@ def superellipsoid_fibonacci(se: Superellipsoid, *, n: int = 500) -> np.ndarray:
     for _ in range(10):  # their fixed 10 projection steps (vectorised over all points)
         ax = np.abs(p)
         f = (ax[:, 0] ** (2.0 / e2) + ax[:, 1] ** (2.0 / e2)) ** (e2 / e1) + ax[:, 2] ** (2.0 / e1)
-        to_centre = np.linalg.norm(p, axis=1)
+        to_centre = row_norms(p)
         to_surface = np.copysign(np.abs(1.0 - f ** (e1 / 2.0)), f - 1.0)
         p = p * ((to_centre - to_surface) / np.maximum(to_centre, _TINY))[:, None]
     return (p * se.axes) @ se.rotation.T + se.centre

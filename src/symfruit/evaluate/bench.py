@@ -25,6 +25,7 @@ from ..synthetic.views import bench_camera_view, bench_view
 
 __all__ = [
     "DENSE_GRID",
+    "STAGES",
     "BenchRow",
     "RecordingRow",
     "bench_camera_view",
@@ -32,6 +33,7 @@ __all__ = [
     "bench_recording",
     "bench_segment",
     "bench_segment_trees",
+    "bench_stages",
     "bench_view",
     "measured_detect",
     "profile_frame",
@@ -149,6 +151,26 @@ def bench_frame(
     n = sum(d.result is not None for d in found.detections)
     where = "" if model is None else f", {sensor} {model.width}x{model.height}"
     return _row(f"frame, {n} fruit, {method}{where}", method, Settings().paper.n_hypotheses, n, ms)
+
+
+#: The stages :func:`bench_stages` reports: ``detect``'s own timings (wall) and the thread's CPU time.
+STAGES = ("segment", "trim", "register", "extract", "occlusion", "complete", "total", "cpu")
+
+
+def bench_stages(
+    *, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None
+) -> dict[str, np.ndarray]:
+    """Milliseconds per stage of :func:`bench_frame`'s frame, ``repeat`` runs after a warm-up: each of
+    :data:`STAGES` (``detect``'s timings; ``trim`` and ``register`` are part of ``extract``, ``occlusion`` of
+    ``complete``; ``cpu`` the CPU time of the calling thread over the frame, which a busy machine disturbs
+    less than the wall time)."""
+    from ..detect import detect
+
+    frame, _ = _bench_scene(sensor, seed)
+    for _ in range(min(5, repeat)):
+        detect(frame, method=method)
+    runs = [detect(frame, method=method).timings for _ in range(repeat)]
+    return {stage: np.array([t[stage] for t in runs]) * 1000.0 for stage in STAGES}
 
 
 def profile_frame(

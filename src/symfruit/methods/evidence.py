@@ -56,7 +56,7 @@ from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
 from ..core.occlusion import Occlusion, with_own
-from ..core.points import subsample
+from ..core.points import row_norms, subsample
 from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
@@ -300,11 +300,11 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     e = np.array([energies[n] for n in names])
     w = np.exp(-(e - e.min()) / s.temperature)
     w /= w.sum()
-    faces = np.array([np.r_[c.lo, c.hi] for c in cands])
+    faces = np.array([np.concatenate((c.lo, c.hi)) for c in cands])
     box_faces = _weighted_median(faces, w)
     box = Box(box_faces[:3], box_faces[3:])
     centres = 0.5 * (faces[:, :3] + faces[:, 3:])
-    spread = float((w * np.linalg.norm(centres - box.centre, axis=1)).sum())
+    spread = float((w * row_norms(centres - box.centre)).sum())
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
     size = float(box.size.max())

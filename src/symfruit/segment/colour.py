@@ -276,7 +276,8 @@ def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
     sub = mask[rows]
     first = np.argmax(sub, axis=1)
     last = mask.shape[1] - 1 - np.argmax(sub[:, ::-1], axis=1)
-    pts = np.r_[np.c_[first, rows], np.c_[last, rows]].astype(np.float64)  # row ends span every pixel's hull
+    # row ends span every pixel's hull
+    pts = np.concatenate((np.stack((first, rows), axis=1), np.stack((last, rows), axis=1))).astype(np.float64)
     if len(rows) < 2 and np.all(first == last):
         return None
     try:

@@ -1,0 +1,81 @@
+"""Interleaved A/B timing of ``detect`` on the benchmark frame (``symfruit bench --frame``) for two source trees:
+the thread's CPU time per frame and per stage (each stage function of ``symfruit.detect`` wrapped), median and
+least over every frame, the trees alternated round by round so that a machine shared with other work disturbs
+both alike. CPU time, not wall time: a busy machine stretches the wall time far more.
+
+    python docs/speed_ab.py BEFORE/src AFTER/src [--method evidence] [--rounds 6] [--frames 10]
+
+e.g. ``python docs/speed_ab.py ../main/src src``. Each round starts a fresh process per tree (``PYTHONPATH``).
+"""
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+import numpy as np
+
+#: ``symfruit.detect`` names wrapped, and the stage each one is.
+STAGES = {"frame_masks": "segment", "trim_labels": "trim", "register": "register", "_extract_window": "extract",
+          "fruit_occlusion": "occlusion", "complete": "complete"}  # fmt: skip
+
+CHILD = """
+import json, sys, time
+import symfruit.detect as D
+from symfruit.evaluate.bench import _bench_scene
+method, frames, stages = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
+spent = {}
+def wrap(name, stage):
+    fn = getattr(D, name)
+    def timed(*a, **k):
+        start = time.thread_time()
+        try:
+            return fn(*a, **k)
+        finally:
+            spent[stage] = spent.get(stage, 0.0) + time.thread_time() - start
+    setattr(D, name, timed)
+for name, stage in stages.items():
+    wrap(name, stage)
+frame, _ = _bench_scene(None, 0)
+for _ in range(5):
+    D.detect(frame, method=method)
+rows = []
+for _ in range(frames):
+    spent.clear()
+    start = time.thread_time()
+    D.detect(frame, method=method)
+    rows.append({"cpu": time.thread_time() - start, **spent})
+print(json.dumps(rows))
+"""
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("before")
+    parser.add_argument("after")
+    parser.add_argument("--method", default="evidence")
+    parser.add_argument("--rounds", type=int, default=6)
+    parser.add_argument("--frames", type=int, default=10)
+    args = parser.parse_args()
+    trees = {"before": os.path.abspath(args.before), "after": os.path.abspath(args.after)}
+    found: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
+    for r in range(args.rounds):
+        for name in trees if r % 2 == 0 else list(trees)[::-1]:
+            out = subprocess.run(
+                [sys.executable, "-c", CHILD, args.method, str(args.frames), json.dumps(STAGES)],
+                env={**os.environ, "PYTHONPATH": trees[name]}, capture_output=True, text=True, check=True,
+            )  # fmt: skip
+            found[name] += json.loads(out.stdout)
+    sys.stdout.write(f"detect, method {args.method}: thread CPU ms per frame, {args.rounds} rounds x {args.frames} "
+                     "frames per tree, median / least\n")  # fmt: skip
+    for stage in ["cpu", *STAGES.values()]:
+        cells = []
+        for name in trees:
+            v = np.array([row.get(stage, 0.0) for row in found[name]]) * 1000.0
+            cells.append(f"{name} {np.median(v):7.1f} / {v.min():7.1f}")
+        sys.stdout.write(f"{stage:>10}   " + "   ".join(cells) + "\n")
+
+
+if __name__ == "__main__":
+    main()
