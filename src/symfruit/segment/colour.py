@@ -597,16 +597,17 @@ def _leaf(color: np.ndarray) -> np.ndarray:
     """(h, w) bool: leaf-green pixels, :func:`_green` and of a hue of at least :data:`LEAF_HUE` degrees. A
     yellow-green fruit skin (a bicoloured apple's ground colour) is green by :func:`_green` but yellower.
     With G the largest channel, the hue is ``60 + 60 (G - R) / (G - min(R, B))`` degrees (above 120 when
-    B > R), so hue >= 80 is ``3 (G - R) >= G - min(R, B)``: integers, independent of brightness and saturation."""
+    B > R), so hue >= LEAF_HUE is ``60 (G - R) >= (LEAF_HUE - 60) (G - min(R, B))``: integers, independent of
+    brightness and saturation."""
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
-    return _green(color) & (3 * (g - r) >= g - np.minimum(r, b))
+    return _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))
 
 
 #: The least hue (degrees) of a leaf. Leaves of apple and most fruit trees are green of hue about 85-130;
 #: the ground colour of yellow-green and bicoloured apples (Golden Delicious, Gala, Fuji, Pink Lady) yellow to
-#: yellow-green, about 45-75. Written into :func:`_leaf`'s integer test; a physical boundary between the
+#: yellow-green, about 45-75. Used by :func:`_leaf`'s integer test; a physical boundary between the
 #: two, not fitted (on the rendered apple trees, seeds 0-5, the recall is flat within 1 % for 75-85).
-LEAF_HUE = 80.0
+LEAF_HUE = 80
 
 
 def _depth(
