@@ -375,12 +375,12 @@ def _bench(args: argparse.Namespace) -> int:
         if args.profile:
             print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
             return 0
+        methods = (args.method,) if args.method else ("paper", "fused", "evidence")
         if args.stages:
             import numpy as np
 
             from .evaluate.bench import STAGES, bench_stages
 
-            methods = (args.method,) if args.method else ("paper", "fused", "evidence")
             found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor) for m in methods}
             if args.json:
                 print(json.dumps({"machine": machine(), "stages": {m: {k: v.tolist() for k, v in ms.items()}
@@ -395,8 +395,7 @@ def _bench(args: argparse.Namespace) -> int:
                 cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
                 print(f"{stage:<10}{cells}")
             return 0
-        rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor)
-                for m in ((args.method,) if args.method else ("paper", "fused", "evidence"))]  # fmt: skip
+        rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor) for m in methods]
     else:
         rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:

@@ -130,13 +130,13 @@ def detect(
             raise InputError(
                 f"frame {frame.name}: mask {int(whole[0]) + 1} covers the whole image; that is not a fruit"
             )
-    t_register = time.perf_counter()
+    t2 = time.perf_counter()  # trimming, registration and extraction start
     if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
         labels = trim_labels(frame.color, labels, settings.extract)
-    t_trim = time.perf_counter() - t_register
+    t_trim = time.perf_counter() - t2
     labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
-    detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t_register, 0.0, 0.0
-    t_reg = t_extract - t_trim
+    detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
+    t_register = t_extract - t_trim
     from scipy import ndimage
 
     fruit_px = labels > 0
@@ -167,8 +167,9 @@ def detect(
             detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
         t_complete += time.perf_counter() - b
     total = time.perf_counter() - t0
-    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_reg, "extract": t_extract, "occlusion": t_occlusion,
-               "complete": t_complete, "total": total, "cpu": time.thread_time() - cpu0}  # fmt: skip
+    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
+               "occlusion": t_occlusion, "complete": t_complete, "total": total,
+               "cpu": time.thread_time() - cpu0}  # fmt: skip
     return FrameDetections(frame, detections, timings, source, shift)
 
 

@@ -116,10 +116,10 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
         return np.zeros(0, np.int64)
     order = np.argsort(points[:, 2], kind="stable")
     gaps = np.flatnonzero(np.diff(points[order, 2]) > distance) + 1
-    bounds = np.concatenate(([0], gaps, [n]))
+    runs = np.concatenate(([0], gaps, [n]))
     labels = np.empty(n, np.int64)
     next_label = 0
-    for lo, hi in itertools.pairwise(bounds):
+    for lo, hi in itertools.pairwise(runs):
         idx = order[lo:hi]
         if hi - lo == 1:
             labels[idx] = next_label
