@@ -243,3 +243,37 @@ def test_stamps_out_of_order_and_odd_headers_are_carried_as_given():
         color.header = header(secs=secs, nsecs=0)
         stamps.append(message_frame(color, depth, info).stamp)
     assert stamps == [9_000_000_000, 3_000_000_000, 7_000_000_000]
+
+
+STOP_CHILD = """
+import os, signal, sys, threading, time
+from symfruit.ros.core import stop_signals
+started = threading.Event()
+def early():  # started before the mask, as numpy's BLAS threads are: SIGINT and SIGTERM are not blocked in it
+    started.set()
+    time.sleep(30)
+early_thread = threading.Thread(target=early, daemon=True)
+early_thread.start()
+started.wait()
+with stop_signals() as wait:
+    signal.pthread_kill(early_thread.ident, signal.SIGTERM)  # lands on the thread that does not block it
+    print(signal.Signals(wait()).name, flush=True)
+with stop_signals() as wait:
+    os.kill(os.getpid(), signal.SIGINT)  # process-wide, while the main thread is not waiting
+    print(signal.Signals(wait()).name, flush=True)
+    os.kill(os.getpid(), signal.SIGTERM)  # a second signal before leaving: taken, not fatal
+print("handlers", signal.getsignal(signal.SIGTERM) == signal.SIG_DFL,
+      signal.getsignal(signal.SIGINT) is signal.default_int_handler, flush=True)
+"""
+
+
+def test_stop_signals_are_never_fatal_whichever_thread_they_land_on():
+    """A node ends on SIGINT or SIGTERM by returning from ``wait()``, also when the kernel hands the signal to a
+    thread started before the mask (with the default action that killed the process with exit -15); a signal
+    arriving before ``wait()`` or while leaving is taken too, and the handlers are restored afterwards."""
+    import subprocess
+    import sys
+
+    res = subprocess.run([sys.executable, "-c", STOP_CHILD], capture_output=True, text=True, timeout=60)
+    assert res.returncode == 0, res.stderr
+    assert res.stdout.split("\n")[:3] == ["SIGTERM", "SIGINT", "handlers True True"], res.stdout + res.stderr

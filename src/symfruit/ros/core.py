@@ -17,9 +17,11 @@ ROS 1 wrapper (:mod:`symfruit.ros.node`), a ROS 2 (rclpy) wrapper and the bag wr
 
 from __future__ import annotations
 
+import contextlib
+import signal
 import threading
 import time
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -36,7 +38,7 @@ from ..segment import mask_source
 from ..settings import resolve_settings
 from ..writers import bbox_record
 
-__all__ = ["FrameProcessor", "Fruit", "LatestOnly", "Processed", "fruits_of", "message_frame"]
+__all__ = ["FrameProcessor", "Fruit", "LatestOnly", "Processed", "fruits_of", "message_frame", "stop_signals"]
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -187,6 +189,52 @@ class FrameProcessor:
         fruits = fruits_of(found)
         t3 = time.perf_counter()
         return Processed(fruits, found, {"decode": t1 - t0, "detect": t2 - t1, "collect": t3 - t2})
+
+
+# ---------------------------------------------------------------------------------------------------
+# ending on SIGINT and SIGTERM
+# ---------------------------------------------------------------------------------------------------
+
+
+@contextlib.contextmanager
+def stop_signals(signals: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SIGTERM)) -> Iterator[Callable[[], int]]:
+    """Hold ``signals`` for the main thread while a node runs; yields ``wait()``, which returns the first one's number.
+
+    Inside, the signals are blocked in the calling (main) thread, and so in every thread it starts (rclpy's
+    executor and the DDS threads inherit the mask): none of them is interrupted, and ``wait()`` takes the signal by
+    ``sigtimedwait``. Threads started before (the BLAS pool numpy starts on import) do not block them, and the kernel
+    hands a process-wide signal to such a thread whenever the main thread is not waiting for it at that instant; with
+    the default action that killed the whole process (exit -15, the DDS segments left in /dev/shm). So a Python handler
+    is installed as well: whichever thread the signal lands on, the interpreter notes it for the main thread, and
+    ``wait()`` sees it within a fifth of a second. On leaving, signals still pending are taken (a second Ctrl-C
+    meanwhile does not kill the process as it returns) and the mask and the handlers are restored
+    (``signal.signal`` runs the handlers still due first).
+    """
+    caught: list[int] = []
+
+    def note(signum: int, frame: object) -> None:
+        caught.append(signum)
+
+    handlers = {sig: signal.signal(sig, note) for sig in signals}
+    previous = signal.pthread_sigmask(signal.SIG_BLOCK, signals)
+
+    def wait() -> int:
+        while not caught:
+            info = signal.sigtimedwait(signals, 0.2)
+            if info is not None:
+                return info.si_signo
+        return caught[0]
+
+    try:
+        yield wait
+    finally:
+        # Taken without waiting: a signal sigpending() still lists may be handed to another thread a moment
+        # later (then ``note`` has it), and a blocking sigwait would wait for ever.
+        while signal.sigtimedwait(signals, 0) is not None:
+            pass
+        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+        for sig, handler in handlers.items():
+            signal.signal(sig, handler)
 
 
 # ---------------------------------------------------------------------------------------------------

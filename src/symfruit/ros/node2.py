@@ -43,7 +43,7 @@ from typing import Any
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import FrameProcessor, Fruit, LatestOnly
+from .core import FrameProcessor, Fruit, LatestOnly, stop_signals
 from .node import BOX_RGBA, CENTRE_DIAMETER, CENTRE_RGBA, CLOUD_FIELDS, cloud_array
 from .sync import ApproximateSync
 
@@ -372,36 +372,32 @@ def main(argv: Sequence[str] | None = None) -> int:
             f"symfruit ros2: unknown arguments {' '.join(unknown)}; ROS arguments follow --ros-args "
             "(see symfruit ros2 --help)"
         )
-    # SIGINT and SIGTERM are blocked in every thread (rclpy's and Fast DDS's inherit the mask) and taken by the main
-    # thread alone, in sigwait, while a thread spins: the shutdown below then always runs, in this order.
-    stop_signals = {signal.SIGINT, signal.SIGTERM}
-    previous = signal.pthread_sigmask(signal.SIG_BLOCK, stop_signals)
-    context = rclpy.Context()
-    rclpy.init(args=["symfruit", *args], context=context, signal_handler_options=SignalHandlerOptions.NO)
-    executor = SingleThreadedExecutor(context=context)
-    stopping = threading.Event()
-    failed: list[BaseException] = []
-    node = None
-    try:
-        node = Ros2Node(context)
-        executor.add_node(node.node)
-        spinner = threading.Thread(target=_spin, args=(executor, stopping, failed), name="symfruit-spin")
-        spinner.start()
-        received = signal.sigwait(stop_signals)
-        stopping.set()
-        node.log.info(f"symfruit: {signal.Signals(received).name}, shutting down")
-        executor.shutdown()
-        spinner.join()
-    finally:
-        stopping.set()
-        if node is not None:
-            node.close()  # the worker finishes its frame first, then the node goes
-        executor.shutdown()
-        rclpy.try_shutdown(context=context)
-        context.destroy()  # the DDS participant with it: its shared-memory segments go
-        while stop_signals & signal.sigpending():  # a second Ctrl-C meanwhile must not kill us as we return
-            signal.sigwait(stop_signals)
-        signal.pthread_sigmask(signal.SIG_SETMASK, previous)
+    # SIGINT and SIGTERM are held for the main thread (stop_signals), which waits for them while a thread spins:
+    # the shutdown below then always runs, in this order.
+    with stop_signals() as wait_for_stop:
+        context = rclpy.Context()
+        rclpy.init(args=["symfruit", *args], context=context, signal_handler_options=SignalHandlerOptions.NO)
+        executor = SingleThreadedExecutor(context=context)
+        stopping = threading.Event()
+        failed: list[BaseException] = []
+        node = None
+        try:
+            node = Ros2Node(context)
+            executor.add_node(node.node)
+            spinner = threading.Thread(target=_spin, args=(executor, stopping, failed), name="symfruit-spin")
+            spinner.start()
+            received = wait_for_stop()
+            stopping.set()
+            node.log.info(f"symfruit: {signal.Signals(received).name}, shutting down")
+            executor.shutdown()
+            spinner.join()
+        finally:
+            stopping.set()
+            if node is not None:
+                node.close()  # the worker finishes its frame first, then the node goes
+            executor.shutdown()
+            rclpy.try_shutdown(context=context)
+            context.destroy()  # the DDS participant with it: its shared-memory segments go
     if failed:
         raise SymfruitError(f"symfruit ros2: the executor failed: {failed[0]!r}")
     return 0
