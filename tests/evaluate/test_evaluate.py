@@ -97,7 +97,10 @@ def test_settings_given_are_used_for_every_fruit_and_nothing_is_written_without_
     assert "## paper protocol: apple" in result.table and "## paper protocol: tomato" in result.table
 
 
-def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path):
+def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path, monkeypatch):
+    from symfruit.evaluate import report
+
+    monkeypatch.setattr(report, "write_plots", lambda *a, **k: [])  # as without matplotlib (plots: tests above)
     config = tmp_path / "s.yaml"
     config.write_text("fused:\n  depth_ratio: 1.7\n")
     result = evaluate(protocol="paper", fruits=("strawberry", "apple"), n=1, methods=("raw",), config=config,
