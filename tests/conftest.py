@@ -36,6 +36,24 @@ settings.register_profile(
 )  # fmt: skip
 settings.load_profile(os.environ.get("SYMFRUIT_HYPOTHESIS", "ci"))
 
+
+@pytest.hookimpl(trylast=True)
+def pytest_collection_modifyitems(config, items) -> None:
+    """Keep ``--dist loadgroup``'s groups together: pytest-xdist names a test's ``xdist_group`` in its node id on
+    the worker, and since pytest 9.2 (structured node ids) its assignment no longer takes, so every group was
+    spread over the workers and its expensive fixture computed on each (pytest-xdist issue 1386). Done here
+    after xdist's own hook, and only where it did not take."""
+    if not getattr(config.option, "loadgroup", False):
+        return
+    for item in items:
+        names = {
+            str(m.args[0] if m.args else m.kwargs.get("name", "default")) for m in item.iter_markers("xdist_group")
+        }
+        suffix = "@" + "_".join(sorted(names))
+        if names and not item.nodeid.endswith(suffix) and hasattr(item, "_id"):
+            item._id = type(item._id).parse(item.nodeid + suffix)
+
+
 #: Examples per property test under the loaded profile (tests that are costlier run a share of it).
 FUZZ_EXAMPLES = settings.default.max_examples
 

@@ -200,7 +200,10 @@ def test_cli_detect_and_evaluate_frames(tmp_path, capsys):
     assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
 
 
-def test_evaluate_command(tmp_path, capsys):
+def test_evaluate_command(tmp_path, capsys, monkeypatch):
+    from symfruit.evaluate import report
+
+    monkeypatch.setattr(report, "write_plots", lambda *a, **k: [])  # as without matplotlib (plots: tests/evaluate)
     assert (
         main(["evaluate", "--quick", "--output", str(tmp_path), "--jobs", "1", "--methods", "raw,paper", "--n", "1"])
         == 0

@@ -10,6 +10,10 @@ from symfruit.demo import FRAME_SEED, example_frame, run_demo
 
 from .conftest import EXAMPLE_FRAME
 
+#: one worker runs the module's tests one after another and runs the demo once (pytest-xdist, --dist loadgroup: a
+#: worker that interleaved other modules' tests would tear the module-scoped fixture down between them)
+pytestmark = pytest.mark.xdist_group("demo")
+
 
 @pytest.fixture(scope="module")
 def demo(tmp_path_factory):

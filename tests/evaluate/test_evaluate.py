@@ -51,12 +51,16 @@ def test_quick_paper_run_writes_every_output(quick_paper):
     assert Image.open(folder / "strawberry-by-angle.png").size[0] > 600
 
 
-def test_camera_run_with_occlusion_and_every_fruit(tmp_path):
+def test_camera_run_with_occlusion_and_every_fruit(tmp_path, monkeypatch):
+    from symfruit.evaluate import report
+
+    plotted = []  # what the plots are drawn from (drawing them: test_report.py, by occlusion level too)
+    monkeypatch.setattr(report, "write_plots", lambda folder, rows, *, protocol: plotted.append((protocol, rows)) or [])
     result = evaluate(protocol="camera", fruits=("apple", "citrus", "tomato"), n=1, occlusions=(0.0, 0.4),
                       methods=("raw", "paper"), output=tmp_path, jobs=1, progress=False)  # fmt: skip
     assert len(result.rows) == 3 * 1 * 2 * 2
     assert not any(r.error for r in result.rows)
-    assert (result.folder / "apple-by-occlusion.png").exists()
+    assert (result.folder / "instances.csv").exists() and plotted == [("camera", result.rows)]
     assert "occluder target 40%" in result.table
 
 
@@ -97,7 +101,10 @@ def test_settings_given_are_used_for_every_fruit_and_nothing_is_written_without_
     assert "## paper protocol: apple" in result.table and "## paper protocol: tomato" in result.table
 
 
-def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path):
+def test_a_config_file_is_laid_over_each_fruits_profile(tmp_path, monkeypatch):
+    from symfruit.evaluate import report
+
+    monkeypatch.setattr(report, "write_plots", lambda *a, **k: [])  # as without matplotlib (plots: tests above)
     config = tmp_path / "s.yaml"
     config.write_text("fused:\n  depth_ratio: 1.7\n")
     result = evaluate(protocol="paper", fruits=("strawberry", "apple"), n=1, methods=("raw",), config=config,

@@ -124,15 +124,16 @@ def test_bag_frames_know_the_colour_header(tmp_path, example_images):
     assert frame.frame_id == "camera_color_optical_frame"
 
 
-@pytest.mark.parametrize("storage", ["mcap", "sqlite3"])
-def test_detect_cli_writes_a_ros2_bag_stamped_like_its_input(tmp_path, example_images, example_fruits, storage,
-                                                             capsys):  # fmt: skip
+def test_detect_cli_writes_a_ros2_bag_stamped_like_its_input(tmp_path, example_images, example_fruits, capsys):
+    """In the storage asked for (sqlite3; the default, mcap, in the next test; both writers in
+    test_write_and_read_back)."""
     stamps = [1_650_000_000_000_000_000, 1_650_000_000_033_333_333]
     write_ros1_bag(tmp_path / "in.bag", example_images, stamps, color_offset=2_000_000)
     out = tmp_path / "out"
     args = ["detect", str(tmp_path / "in.bag"), "--output", str(out), "--ros2-bag", str(out / "bag")]
-    assert main([*args, "--ros2-storage", storage]) == 0
+    assert main([*args, "--ros2-storage", "sqlite3"]) == 0
     assert f"ROS 2 bag: {out / 'bag'} (2 frames on {TOPIC})" in capsys.readouterr().out
+    assert [p.suffix for p in (out / "bag").iterdir() if p.suffix in (".db3", ".mcap")] == [".db3"]
     got = read_back(out / "bag")
     assert [t for t, _, _ in got] == [s + 2_000_000 for s in stamps]  # the colour images' header stamps
     for _, _, msg in got:
@@ -149,6 +150,7 @@ def test_detect_cli_ros2_bag_of_a_frame_folder_and_refusals(tmp_path, example_fr
         assert main(["detect", str(folder), "--output", str(tmp_path / "o"), "--ros2-bag", str(tmp_path / "b")]) == 0
         ((t, _, msg),) = read_back(tmp_path / "b")
         assert t == 0 and msg.header.frame_id == "camera_color_optical_frame"  # a folder has no time: index 0
+        assert [p.suffix for p in (tmp_path / "b").iterdir() if p.suffix in (".db3", ".mcap")] == [".mcap"]
         assert_same(msg, example_fruits, class_id="strawberry")
         resume = ["detect", str(folder), "--output", str(tmp_path / "o"), "--resume", "--ros2-bag", str(tmp_path / "c")]
         assert main(resume) == 2 and "--resume" in capsys.readouterr().err

@@ -10,6 +10,10 @@ from symfruit.cli import main
 from symfruit.season.report import PER_RECORDING_PLOTS, PLOTS, diameters_mm, size_classes, write_report
 from symfruit.season.table import TableWriter
 
+#: one worker runs the module's tests one after another and writes the shared report once (pytest-xdist, --dist
+#: loadgroup: a worker that interleaved other modules' tests would tear the module-scoped fixture down between them)
+pytestmark = pytest.mark.xdist_group("season-report")
+
 
 def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0, failed: int = 0) -> dict:
     fruits = [{"id": k + 1, "mask_area": 900, "n_points": 700, "truncated": k < cut, "centre": [0.0, 0.0, 0.4],
