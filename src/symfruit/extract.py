@@ -197,7 +197,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         labels = cluster(points, s.cluster_distance)
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
-        near = big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
+        # the nearest of the big clusters (one alone needs no medians)
+        near = big[0] if len(big) == 1 else big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]

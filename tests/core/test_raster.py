@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import inner_distance, rasterise, silhouette_coverage
+from symfruit.core.raster import fill_holes, inner_distance, rasterise, silhouette_coverage
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -261,3 +261,18 @@ def test_across_sight_rejects_an_empty_region(camera):
 
     with pytest.raises(InputError, match="empty"):
         across_sight(Silhouette(0, 0, np.zeros((4, 4), bool), 0.0), camera)
+
+
+def test_fill_holes_is_scipys():
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
+        assert np.array_equal(fill_holes(mask), ndimage.binary_fill_holes(mask))
+    ring = np.zeros((9, 9), bool)
+    ring[2:7, 2:7] = True
+    ring[4, 4] = False  # one hole: filled; an empty and a full image stay as they are
+    assert (
+        fill_holes(ring)[4, 4]
+        and not fill_holes(np.zeros((5, 5), bool)).any()
+        and fill_holes(np.ones((5, 5), bool)).all()
+    )

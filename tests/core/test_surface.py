@@ -242,3 +242,46 @@ def test_the_monotone_region_walks_every_ray_as_a_loop_does(seed):
                 break
             expected[rows[i], cols[i]] = True
     np.testing.assert_array_equal(monotone_region(depth, keep, apex, tol, bins=bins), expected)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_median_and_quantile_helpers_are_numpys_bit_for_bit(seed):
+    from symfruit.core.surface import _median, _sorted_quantile
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400))
+    x = rng.normal(0.0, 0.002, n).round(int(rng.integers(3, 17)))  # rounded: repeated values as well
+    assert _median(x) == np.median(x)
+    z = np.sort(rng.uniform(0.3, 0.6, n).round(int(rng.integers(2, 17))))
+    for q in (0.05, float(rng.random()), 0.0, 1.0):
+        assert _sorted_quantile(z, q) == np.quantile(z, q)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_fruit_surface_of_a_mask_in_a_wide_window_is_its_box_s(seed):
+    # the mask's own numbers are computed on its box: a window 30 px wider on every side gives the same surface
+    from scipy import ndimage
+
+    from symfruit.core.raster import principal_widths
+    from symfruit.core.surface import _interior
+
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(6, 30))  # the disc 3 px from the image's border: padding changes nothing else
+    depth, disc = ball(centre=(int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3))),
+                       radius_px=radius, noise=0.001, table=bool(rng.random() < 0.5),
+                       rim=float(rng.uniform(0.0, 0.2)), seed=int(rng.integers(0, 100)))  # fmt: skip
+    mask = disc & (rng.random((H, W)) < 0.97)
+    wide = np.pad(depth, 30), np.pad(mask, 30)
+    a, b = fruit_surface(depth, mask, F), fruit_surface(*wide, F)
+    assert (a is None) == (b is None)
+    if a is not None:
+        assert np.array_equal(np.pad(a.pixels, 30), b.pixels)
+        assert (a.front, a.radius, a.noise) == (b.front, b.radius, b.noise)
+        assert (a.apex[0] + 30, a.apex[1] + 30) == b.apex
+    rows, cols = np.nonzero(mask)
+    if len(rows):
+        r0, c0 = int(rows.min()), int(cols.min())
+        box = mask[r0:, c0:]
+        assert principal_widths(box, origin=(r0, c0)) == principal_widths(mask)
+    assert np.array_equal(_interior(mask), ndimage.binary_erosion(mask))
+    assert np.array_equal(_interior(np.ones((4, 5), bool)), ndimage.binary_erosion(np.ones((4, 5), bool)))

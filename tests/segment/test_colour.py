@@ -383,17 +383,6 @@ def test_a_fruit_outside_the_depth_cameras_view_is_sized_at_the_frames_depth():
     assert segment(speck, depth, HD_CAM).max() == 0
 
 
-def test_fill_holes_is_scipys():
-    from scipy import ndimage
-
-    from symfruit.segment.colour import _fill_holes
-
-    rng = np.random.default_rng(5)
-    for _ in range(20):
-        mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
-        assert np.array_equal(_fill_holes(mask), ndimage.binary_fill_holes(mask))
-
-
 def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
     # an apple 60 px across at 1.5 m, its left half red and its right half yellow, a leaf 10 cm behind it
     color, depth = hd_disc_frame([(900, 540)], radius=30)

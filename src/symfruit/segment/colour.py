@@ -56,6 +56,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.limits import check_image_size, depth_metres
+from ..core.raster import fill_holes
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -566,19 +567,6 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
-def _fill_holes(mask: np.ndarray) -> np.ndarray:
-    """The mask with its holes filled: the background pieces (4-connected) that do not reach the border
-    (as :func:`scipy.ndimage.binary_fill_holes`, by one labelling instead of repeated dilations)."""
-    lab, n = ndimage.label(~mask)
-    if n == 0:
-        return mask.copy()
-    outside = np.zeros(n + 1, bool)
-    for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
-        outside[edge] = True
-    outside[0] = False
-    return ~outside[lab]
-
-
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
     x = sl[1].start + (cols[0] + cols[-1] + 1) / 2
@@ -762,7 +750,7 @@ def _split(
 ) -> list[np.ndarray]:
     """Cut a region into fruit (see the module docstring): at waists of its distance transform (the depth
     steps and creases taken as part of its outline), keeping the cuts that evidence backs."""
-    region = _fill_holes(region)
+    region = fill_holes(region)
     if s.close_px:
         r = s.close_px
         padded = np.pad(region, r + 1)
@@ -776,7 +764,7 @@ def _split(
     least = np.sqrt(min_area / np.pi)
     if use_depth and depth is not None:
         edges = _depth_edges(region, depth, s, geo.focal)
-        carved = _fill_holes(region & ~edges)
+        carved = fill_holes(region & ~edges)
         least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
