@@ -267,8 +267,8 @@ def test_the_fruit_surface_of_a_mask_in_a_wide_window_is_its_box_s(seed):
 
     rng = np.random.default_rng(seed)
     radius = int(rng.integers(6, 30))  # the disc 3 px from the image's border: padding changes nothing else
-    depth, disc = ball(centre=(int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3))),
-                       radius_px=radius, noise=0.001, table=bool(rng.random() < 0.5),
+    centre = (int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3)))
+    depth, disc = ball(centre=centre, radius_px=radius, noise=0.001, table=bool(rng.random() < 0.5),
                        rim=float(rng.uniform(0.0, 0.2)), seed=int(rng.integers(0, 100)))  # fmt: skip
     mask = disc & (rng.random((H, W)) < 0.97)
     wide = np.pad(depth, 30), np.pad(mask, 30)
