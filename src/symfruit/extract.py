@@ -255,6 +255,6 @@ def register(
     """
     s = settings or ExtractSettings()
     z = np.asarray(depth, dtype=np.float64)
-    z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth), z, 0.0)
-    du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px)
+    du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,
+                                depth_range=(s.min_depth, s.max_depth))  # fmt: skip
     return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

@@ -285,3 +285,29 @@ def test_the_fruit_surface_of_a_mask_in_a_wide_window_is_its_box_s(seed):
         assert principal_widths(box, origin=(r0, c0)) == principal_widths(mask)
     assert np.array_equal(_interior(mask), ndimage.binary_erosion(mask))
     assert np.array_equal(_interior(np.ones((4, 5), bool)), ndimage.binary_erosion(np.ones((4, 5), bool)))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_within_a_radius_is_the_distance_transform_s(seed):
+    from scipy import ndimage
+
+    from symfruit.core.surface import within
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.0, 0.1) if rng.random() < 0.5 else rng.random((h, w)) < 0.6
+    # whole radii, square roots of whole numbers (on the disc's own rim) and any other
+    radius = float(rng.choice([rng.uniform(0, 8), float(rng.integers(0, 8)), np.sqrt(rng.integers(0, 60))]))
+    expected = ndimage.distance_transform_edt(~mask) <= radius if mask.any() else np.zeros((h, w), bool)
+    np.testing.assert_array_equal(within(mask, radius), expected)
+
+
+def test_the_registration_reads_depth_within_its_range_only():
+    depth, disc = ball(rim=0.1)
+    labels = grown(disc, 2).astype(np.int32)
+    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    assert registration_shift(moved, labels, F, max_px=10) == (-2, 3)
+    # the same depth beyond the range (a wall too near to be true over the ball) is none: the same answer
+    near = np.where(moved == 0, 0.05, moved)
+    assert registration_shift(near, labels, F, max_px=10, depth_range=(0.1, 2.0)) == (-2, 3)
+    assert registration_shift(moved, labels, F, max_px=10, depth_range=(0.9, 2.0)) == (0, 0)  # nothing in range

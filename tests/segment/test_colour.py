@@ -491,3 +491,16 @@ def test_a_region_larger_than_the_largest_fruit_keeps_its_ripe_red_cores():
     assert _ripe_cores(apple, color, depth, s, 960.0, 1.5)[0] is apple
     strip = region & ~apple & ~speck
     assert _ripe_cores(strip[:, 100:160], color[:, 100:160], depth[:, 100:160], s, 960.0, 1.5) == []
+
+
+def test_the_dilations_are_scipys():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _dilate
+
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        mask = rng.random(tuple(rng.integers(1, 30, 2))) < 0.1
+        assert np.array_equal(_dilate(mask), ndimage.binary_dilation(mask))
+        assert np.array_equal(_dilate(_dilate(mask)), ndimage.binary_dilation(mask, iterations=2))
+        assert np.array_equal(_dilate(mask, square=True), ndimage.binary_dilation(mask, structure=np.ones((3, 3))))
