@@ -26,6 +26,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy import ndimage
 
+from .points import median
 from .raster import fill_holes, inner_distance, principal_widths
 
 __all__ = [
@@ -86,19 +87,8 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -
         diff = moved
     if len(diff) < 10:
         return max(floor, 0.002)
-    mad = float(_median(np.abs(diff - _median(diff))))
+    mad = float(median(np.abs(diff - median(diff))))
     return max(floor, 1.4826 * mad / np.sqrt(2.0))
-
-
-def _median(x: np.ndarray) -> float:
-    """``np.median`` of a non-empty 1-d float array without NaN: the same two middle values of one partition,
-    averaged the same way, without np.median's general-axis and NaN machinery (several times its partition)."""
-    n = len(x)
-    h = n // 2
-    if n % 2:
-        return float(np.partition(x, h)[h])
-    part = np.partition(x, (h - 1, h))
-    return float((part[h - 1] + part[h]) / 2.0)
 
 
 def _sorted_quantile(z: np.ndarray, q: float) -> float:

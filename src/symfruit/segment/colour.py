@@ -56,6 +56,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.limits import check_image_size, depth_metres
+from ..core.points import median
 from ..core.raster import fill_holes
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
@@ -359,7 +360,7 @@ def segment(
     min_area = max(s.min_area_share * h * w, 4.0)
     # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
     grid = None if z is None else z[::8, ::8]
-    z_typical = 0.0 if grid is None else float(np.median(grid[grid > 0])) if (grid > 0).any() else 1.0
+    z_typical = 0.0 if grid is None else float(median(grid[grid > 0])) if (grid > 0).any() else 1.0
 
     # Red pixels are looked for on a coarse grid first (the pyramid's top). When every candidate fruit there
     # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
@@ -492,7 +493,7 @@ def _segment_at(
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
-        if not red.any() or np.median(redness(c[sl][red])) < s.ripe_median:
+        if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
         hull = convex_hull_mask(part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
@@ -726,7 +727,7 @@ def _same_surface(
     if fit is None or len(p) < 20:
         return None
     off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
-    return bool(np.median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+    return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
 
 
 def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
@@ -764,7 +765,7 @@ def _split(
     if use_depth and depth is not None:
         edges = _depth_edges(region, depth, s, geo.focal)
         carved = fill_holes(region & ~edges)
-        least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
+        least = 0.25 * geo.focal * s.min_diameter / float(median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
@@ -974,7 +975,7 @@ def _sphere(
         return None
     z = p[:, 2]
     spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
-    p = p[np.abs(z - np.median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+    p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
     centre, radius = np.zeros(3), 0.0
     for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
         if len(p) < 20:
@@ -984,7 +985,7 @@ def _sphere(
         centre = sol[:3]
         radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
         res = np.abs(np.linalg.norm(p - centre, axis=1) - radius)
-        p = p[res <= max(3.0 * float(np.median(res)) * 1.4826, 1e-4)]
+        p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
     if not (np.isfinite(radius) and 0.25 * spread <= radius <= 4.0 * spread):
         return None
     return centre, radius
@@ -1059,7 +1060,7 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
     smooth = ndimage.gaussian_filter(depth[ri, ci], s.crease_sigma) if s.crease_sigma > 0 else depth[ri, ci]
     lap = ndimage.laplace(smooth)
-    z = float(np.median(depth[valid]))
+    z = float(median(depth[valid]))
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
@@ -1067,7 +1068,7 @@ def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal
     """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
     (``z_typical`` where none of its pixels has depth)."""
     z = depth[mask & (depth > 0)]
-    zr = float(np.median(z)) if len(z) else z_typical
+    zr = float(median(z)) if len(z) else z_typical
     return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
 
 
@@ -1087,7 +1088,7 @@ def _ripe_cores(
     if region.sum() <= largest:
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
         # before the region is split and merged: a twig or bark never costs the work on a fruit)
-        return [region] if np.median(red[region]) >= s.ripe_median else []
+        return [region] if median(red[region]) >= s.ripe_median else []
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
@@ -1132,9 +1133,9 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    yy, xx = np.mgrid[big[0], big[1]]
+    yy, xx = np.ogrid[big[0], big[1]]  # broadcast: the same values per pixel, without two full grids
     z = depth[big]
-    zm = float(np.median(z_part))
+    zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
@@ -1163,7 +1164,7 @@ def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jum
     z = depth[part & (depth > 0)]
     if len(z) == 0:
         return hull
-    zm = float(np.median(z))
+    zm = float(median(z))
     off = (depth > 0) & (np.abs(depth - zm) > jump)
     return part | (hull & ~off)
 
@@ -1177,7 +1178,7 @@ def _fruit_sized(
     if depth is None:
         return area >= min_area
     z = depth[mask & (depth > 0)]
-    diameter_px = focal * s.min_diameter / (float(np.median(z)) if len(z) else z_typical)
+    diameter_px = focal * s.min_diameter / (float(median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
 
 
