@@ -656,8 +656,12 @@ class _Piece:
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
+
+    def hull_area(self) -> float:
+        """:func:`_hull_area` of the mask, worked out when first asked for: only pieces near another need it."""
         if self.hull < 0:
             self.hull = _hull_area(self.mask)
+        return self.hull
 
 
 def _merge(
@@ -696,9 +700,9 @@ def _merge(
                     continue
                 window, union = _union(a, b)
                 hull = _hull_area(union)
-                if hull > (1.0 + slack) * (a.hull + b.hull):
+                if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
                     hull -= float((convex_hull_mask(union) & ~union & _green(color[window])).sum())
-                if hull <= (1.0 + slack) * (a.hull + b.hull) and (
+                if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
                     pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
@@ -802,7 +806,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     if not seeds.any():
         return parts
     _, (ri, ci) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
-    grown = np.where(region, seeds[ri, ci], 0)
+    grown = np.where(region, np.take(seeds.ravel(), ri * seeds.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
 
 
@@ -1027,7 +1031,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
     _, (ri, ci) = ndimage.distance_transform_edt(cores == 0, return_indices=True)
-    cells = np.where(region, cores[ri, ci], 0)
+    cells = np.where(region, np.take(cores.ravel(), ri * cores.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
@@ -1042,7 +1046,7 @@ def _steps(z: np.ndarray, jump: float) -> np.ndarray:
     """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step)."""
     edge = np.zeros(z.shape, bool)
     for axis in (0, 1):
-        step = np.nan_to_num(np.abs(np.diff(z, axis=axis)), nan=0.0) > jump
+        step = np.abs(np.diff(z, axis=axis)) > jump  # NaN compares False: no step
         if axis == 0:
             edge[:-1] |= step
             edge[1:] |= step
@@ -1058,7 +1062,8 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
-    smooth = ndimage.gaussian_filter(depth[ri, ci], s.crease_sigma) if s.crease_sigma > 0 else depth[ri, ci]
+    filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
+    smooth = ndimage.gaussian_filter(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.laplace(smooth)
     z = float(median(depth[valid]))
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
