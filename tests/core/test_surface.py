@@ -312,3 +312,76 @@ def test_the_registration_reads_depth_within_its_range_only():
     near = np.where(moved == 0, 0.05, moved)
     assert registration_shift(near, labels, F, max_px=10, depth_range=(0.1, 2.0)) == (-2, 3)
     assert registration_shift(moved, labels, F, max_px=10, depth_range=(0.9, 2.0)) == (0, 0)  # nothing in range
+
+
+def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
+    """registration_shift as it was: every shift of the grid costed exactly, the least taken (first of ties)."""
+    from scipy import ndimage
+
+    from symfruit.core.surface import _outline
+
+    depth = np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)
+    outlines = []
+    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+        r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
+        r1, c1 = min(sl[0].stop + max_px + 8, labels.shape[0]), min(sl[1].stop + max_px + 8, labels.shape[1])
+        mask = labels[r0:r1, c0:c1] == k
+        if mask.sum() >= 30 and (found := _outline(depth[r0:r1, c0:c1], mask, focal, max_px)) is not None:
+            outlines.append(found)
+    if not outlines:
+        return 0, 0
+
+    def cost(shifts):
+        return np.mean([o.cost(shifts, max_px, trim) for o in outlines], axis=0)
+
+    coarse = np.arange(-max_px, max_px + 1, 2)
+    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
+    first = cost(np.vstack([[[0, 0]], grid]))
+    dv, du = grid[int(np.argmin(first[1:]))]
+    near = np.arange(-2, 3)
+    fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
+    fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
+    refined = cost(fine)
+    best = int(np.argmin(refined))
+    return (0, 0) if refined[best] > first[0] - gain else (int(fine[best, 1]), int(fine[best, 0]))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_registration_finds_the_shift_costing_every_shift_exactly_would(seed):
+    # the grid's shifts are costed by a sort first and only the least ones exactly: the same answer as costing
+    # them all exactly, on noiseless discs (whose mirrored shifts cost the same: ties) as on noisy ones
+    rng = np.random.default_rng(seed)
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    for k in range(1, int(rng.integers(1, 4)) + 1):
+        r = int(rng.integers(8, 18))
+        centre = (int(rng.integers(r + 2, W - r - 2)), int(rng.integers(r + 2, H - r - 2)))
+        d, disc = ball(centre=centre, radius_px=r, front=float(rng.uniform(0.4, 0.6)), rim=float(rng.uniform(0, 0.2)))
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[grown(disc, int(rng.integers(0, 3))) & (labels == 0)] = k
+    if rng.random() < 0.5:
+        depth = depth + rng.normal(0.0, 0.001, depth.shape)
+    moved = np.roll(depth, (int(rng.integers(-4, 5)), int(rng.integers(-4, 5))), axis=(0, 1))
+    max_px = int(rng.integers(2, 12))
+    assert registration_shift(moved, labels, F, max_px=max_px) == _shift_as_before(moved, labels, F, max_px)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_a_shift_s_cost_is_its_row_s_alone_and_the_sorted_sum_is_near_it(seed):
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 40, 2))
+    # a signed distance map of whole-number squares (as the transforms give), or any map
+    inside = np.sqrt(rng.integers(1, 900, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    if rng.random() < 0.3:
+        inside = rng.normal(0.0, 5.0, (h, w))
+    n = int(rng.integers(12, 300))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, 3.0)
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (40, 2))
+    full = outline.cost(shifts, reach, 0.7)
+    rows = np.sort(rng.choice(40, int(rng.integers(1, 5)), replace=False))
+    np.testing.assert_array_equal(outline.cost(shifts[rows], reach, 0.7), full[rows])
+    np.testing.assert_allclose(outline.cost(shifts, reach, 0.7, exact=False), full, rtol=1e-13, atol=1e-13)

@@ -304,35 +304,74 @@ class _Outline:
     cols: np.ndarray
     inside: np.ndarray
     band: float
-    #: ``inside`` padded by ``pad`` pixels of ``-reach`` (flattened), made once per ``(pad, reach)``.
-    _padded: dict[tuple[int, int], np.ndarray] = field(default_factory=dict, init=False, repr=False, compare=False)
+    #: ``inside`` padded by ``pad`` pixels of ``-reach`` (flattened), made once per ``(pad, reach)``; under
+    #: ``("keys", pad, reach)`` the same for its whole-number keys (:meth:`keys`), None when it has none.
+    _padded: dict[tuple, np.ndarray | None] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def values(self, shifts: np.ndarray, reach: int) -> np.ndarray:
-        """(k, n) the signed distance at each outline point moved back by each ``(dv, du)`` of ``shifts`` (k, 2);
-        ``-reach`` outside the window."""
+    def _at(self, shifts: np.ndarray, reach: int) -> tuple[np.ndarray, int]:
+        """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad."""
         # outside the window the distance is -reach: a border that wide around the map replaces bounds tests
         pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
+        width = self.inside.shape[1] + 2 * pad
+        at = (self.rows + pad) * width + (self.cols + pad)  # one flat index per point, one offset per shift
+        return at[None, :] - (shifts[:, :1] * width + shifts[:, 1:]), pad
+
+    def _flat(self, pad: int, reach: int) -> np.ndarray:
         flat = self._padded.get((pad, int(reach)))
         if flat is None:
             flat = np.pad(self.inside, pad, constant_values=-float(reach)).ravel()
             self._padded[(pad, int(reach))] = flat
-        width = self.inside.shape[1] + 2 * pad
-        at = (self.rows + pad) * width + (self.cols + pad)  # one flat index per point, one offset per shift
-        return np.take(flat, at[None, :] - (shifts[:, :1] * width + shifts[:, 1:]))
+        return flat
 
-    def cost(self, shifts: np.ndarray, reach: int, trim: float) -> np.ndarray:
+    def keys(self, pad: int, reach: int) -> np.ndarray | None:
+        """The padded map as whole numbers in the same order, ``sign * distance^2`` (int16 or int32, flattened), or
+        None when the map is not made of signed square roots of whole numbers (it is when it comes from distance
+        transforms). Sorting them instead of the distances gives the same order, several times faster."""
+        key = ("keys", pad, int(reach))
+        if key not in self._padded:
+            d = self.inside
+            whole = np.rint(d * d)
+            found = None
+            top = max(float(whole.max(initial=0.0)), float(reach) ** 2)
+            # each value must come back exactly from its key (sqrt is correctly rounded, as the transforms' is)
+            if top < 2**31 - 1 and np.array_equal(np.sqrt(whole), np.abs(d)):
+                dtype = np.int16 if top < 2**15 - 1 else np.int32
+                signed = np.where(d < 0, -whole, whole).astype(dtype)
+                found = np.pad(signed, pad, constant_values=-(int(reach) ** 2)).ravel()
+            self._padded[key] = found
+        return self._padded[key]
+
+    def values(self, shifts: np.ndarray, reach: int) -> np.ndarray:
+        """(k, n) the signed distance at each outline point moved back by each ``(dv, du)`` of ``shifts`` (k, 2);
+        ``-reach`` outside the window."""
+        at, pad = self._at(shifts, reach)
+        return np.take(self._flat(pad, reach), at)
+
+    def cost(self, shifts: np.ndarray, reach: int, trim: float, *, exact: bool = True) -> np.ndarray:
         """(k,) trimmed mean deviation of the outline points from a band inside the mask shifted by each
-        ``(dv, du)`` of ``shifts`` (k, 2)."""
-        val = self.values(shifts, reach)
+        ``(dv, du)`` of ``shifts`` (k, 2).
+
+        Each row's cost depends on that row alone. ``exact=False`` sums the same smallest deviations in ascending
+        order (one sort, 3-4x faster than the partition) instead of in the partition's order: the same number
+        to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way)."""
+        at, pad = self._at(shifts, reach)
+        val = np.take(self._flat(pad, reach), at)
         # the cap's outline lies a band inside the mask's outline (grazing pixels without depth): the band is
         # the median distance, within 0 to 0.3 radii, and the cost the trimmed mean deviation from it
         n = val.shape[1]
-        # np.median's two middle values; a sort of these short rows is 4x faster than a two-kth partition
-        mid = np.sort(val, axis=1)
-        median = 0.5 * (mid[:, (n - 1) // 2] + mid[:, n // 2]) if n % 2 == 0 else mid[:, n // 2]
+        middle = [(n - 1) // 2, n // 2]  # np.median's two middle places (one place when n is odd)
+        keys = self.keys(pad, reach)
+        if keys is not None:  # the middle keys of each row, and their distances back (the same values)
+            k = np.sort(np.take(keys, at), axis=1)[:, middle]
+            mid = np.sign(k) * np.sqrt(np.abs(k).astype(np.float64))
+        else:  # a sort of these short rows is 4x faster than a two-kth partition
+            mid = np.sort(val, axis=1)[:, middle]
+        median = 0.5 * (mid[:, 0] + mid[:, 1]) if n % 2 == 0 else mid[:, 1]
         band = np.clip(median[:, None], 0.0, self.band)
         dev = np.abs(val - band)
         keep = max(1, int(trim * dev.shape[1]))
+        if not exact:
+            return np.sort(dev, axis=1)[:, :keep].mean(axis=1)
         return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
 
 
@@ -406,20 +445,26 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     if not outlines:
         return 0, 0
 
-    def cost(shifts: np.ndarray) -> np.ndarray:
-        return np.mean([o.cost(shifts, max_px, trim) for o in outlines], axis=0)
+    def cost(shifts: np.ndarray, exact: bool = True) -> np.ndarray:
+        return np.mean([o.cost(shifts, max_px, trim, exact=exact) for o in outlines], axis=0)
+
+    def least(shifts: np.ndarray) -> int:
+        """The first shift of least exact cost. The fast costs are within ``slack`` of the exact ones, so only
+        the shifts within twice that of their least can be it; those (one, but for ties) are costed exactly."""
+        fast = cost(shifts, exact=False)
+        slack = 1e-10 * (1.0 + float(np.abs(fast).max()))  # some 10^4 times the sums' rounding
+        near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
+        return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
 
     coarse = np.arange(-max_px, max_px + 1, 2)
     grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
-    first = cost(np.vstack([[[0, 0]], grid]))
-    zero = first[0]
-    dv, du = grid[int(np.argmin(first[1:]))]
+    zero = cost(np.zeros((1, 2), np.int64))[0]
+    dv, du = grid[least(grid)]
     near = np.arange(-2, 3)
     fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
-    refined = cost(fine)
-    best = int(np.argmin(refined))
-    if refined[best] > zero - gain:
+    best = least(fine)
+    if cost(fine[best : best + 1])[0] > zero - gain:
         return 0, 0
     return int(fine[best, 1]), int(fine[best, 0])
 
