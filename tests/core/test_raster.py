@@ -276,3 +276,22 @@ def test_fill_holes_is_scipys():
         and not fill_holes(np.zeros((5, 5), bool)).any()
         and fill_holes(np.ones((5, 5), bool)).all()
     )
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_principal_widths_are_the_covariance_s_extents_bit_for_bit(seed):
+    from symfruit.core.raster import principal_widths
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 200, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    rows, cols = np.nonzero(mask)
+    if len(rows) >= 2:  # the former formulation: the coordinates' mean subtracted, numpy's own column means
+        xy = np.stack((cols, rows), axis=1).astype(np.float64)
+        xy -= xy.mean(axis=0)
+        _, vec = np.linalg.eigh(xy.T @ xy)
+        p = xy @ vec
+        assert principal_widths(mask) == (float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0))
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    if mask[r0:, c0:].sum() == mask.sum():  # a window holding the whole mask: the same widths at its origin
+        assert principal_widths(mask[r0:, c0:], origin=(r0, c0)) == principal_widths(mask)

@@ -385,3 +385,20 @@ def test_a_shift_s_cost_is_its_row_s_alone_and_the_sorted_sum_is_near_it(seed):
     rows = np.sort(rng.choice(40, int(rng.integers(1, 5)), replace=False))
     np.testing.assert_array_equal(outline.cost(shifts[rows], reach, 0.7), full[rows])
     np.testing.assert_allclose(outline.cost(shifts, reach, 0.7, exact=False), full, rtol=1e-13, atol=1e-13)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([3, 5]))
+def test_median_at_pixels_away_from_the_edges_is_the_median_filter(seed, size):
+    from scipy import ndimage
+
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(6, 30, 2))
+    image = rng.choice([0.3, 0.31, 0.5, np.inf], size=(h, w)) + rng.normal(0, 0.01, (h, w)).round(3)
+    inner = np.zeros((h, w), bool)
+    inner[size // 2 : h - size // 2, size // 2 : w - size // 2] = rng.random((h - size + 1, w - size + 1)) < 0.5
+    rows, cols = np.nonzero(inner)
+    expected = ndimage.median_filter(image, size=size, mode="nearest")[rows, cols]
+    np.testing.assert_array_equal(median_at(image, rows, cols, size=size), expected)

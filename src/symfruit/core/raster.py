@@ -275,8 +275,10 @@ def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> t
         rows, cols = rows + origin[0], cols + origin[1]
     if len(rows) < 2:
         return float(len(rows)), float(len(rows))
-    xy = np.stack((cols, rows), axis=1).astype(np.float64)
-    xy -= xy.mean(axis=0)
+    xy = np.empty((len(rows), 2))
+    xy[:, 0], xy[:, 1] = cols, rows
+    # the column means from whole-number sums (exact in any order, as numpy's are): xy.mean(axis=0) bit for bit
+    xy -= np.array([int(cols.sum()), int(rows.sum())], dtype=np.float64) / len(rows)
     _, vec = np.linalg.eigh(xy.T @ xy)
     p = xy @ vec
     return float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0)
