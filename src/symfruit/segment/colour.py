@@ -1031,7 +1031,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
     _, (ri, ci) = ndimage.distance_transform_edt(cores == 0, return_indices=True)
-    cells = np.where(region, np.take(cores.ravel(), ri * cores.shape[1] + ci), 0)  # flat: faster than 2 indices
+    cells = np.where(region, np.take(cores.ravel(), ri * region.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
