@@ -504,3 +504,37 @@ def test_the_dilations_are_scipys():
         assert np.array_equal(_dilate(mask), ndimage.binary_dilation(mask))
         assert np.array_equal(_dilate(_dilate(mask)), ndimage.binary_dilation(mask, iterations=2))
         assert np.array_equal(_dilate(mask, square=True), ndimage.binary_dilation(mask, structure=np.ones((3, 3))))
+
+
+def test_the_sphere_fit_is_the_former_one_bit_for_bit():
+    from symfruit.core.points import median
+    from symfruit.segment.colour import _Geometry, _points, _sphere
+
+    def former(mask, depth, geo, origin):  # norms and squared norms by numpy's reductions
+        p = _points(mask, depth, geo, origin, 1500)
+        z = p[:, 2]
+        spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)
+        p = p[np.abs(z - median(z)) <= 2.0 * spread]
+        for _ in range(2):
+            a = np.concatenate((2.0 * p, np.ones((len(p), 1))), axis=1)
+            sol, *_ = np.linalg.lstsq(a, (p * p).sum(axis=1), rcond=None)
+            centre = sol[:3]
+            radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
+            res = np.abs(np.linalg.norm(p - centre, axis=1) - radius)
+            p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
+        return centre, radius
+
+    rng = np.random.default_rng(3)
+    geo = _Geometry(600.0, 40.0, 50.0)
+    yy, xx = np.mgrid[:80, :100]
+    for _ in range(10):
+        r = float(rng.uniform(10, 30))
+        disc = (xx - 50) ** 2 + (yy - 40) ** 2 <= r * r
+        depth = np.where(
+            disc, 0.5 - np.sqrt(np.clip(r * r - (xx - 50) ** 2 - (yy - 40) ** 2, 0, None)) / 600 * 0.5, 0.0
+        )
+        depth = np.where(disc, depth + rng.normal(0, 0.001, depth.shape), 0.0)
+        fit = _sphere(disc, depth, geo, (0, 0))
+        assert fit is not None
+        centre, radius = former(disc, depth, geo, (0, 0))
+        assert np.array_equal(fit[0], centre) and fit[1] == radius
