@@ -402,3 +402,14 @@ def test_median_at_pixels_away_from_the_edges_is_the_median_filter(seed, size):
     rows, cols = np.nonzero(inner)
     expected = ndimage.median_filter(image, size=size, mode="nearest")[rows, cols]
     np.testing.assert_array_equal(median_at(image, rows, cols, size=size), expected)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_least_colour_distance_is_numpys_row_minimum(seed):
+    from symfruit.core.surface import _row_min
+
+    rng = np.random.default_rng(seed)
+    d = rng.random((int(rng.integers(1, 300)), int(rng.integers(1, 6)))).round(int(rng.integers(1, 6)))  # ties
+    if rng.random() < 0.2:
+        d[rng.integers(0, len(d)), rng.integers(0, d.shape[1])] = np.nan  # propagated as numpy's minimum does
+    np.testing.assert_array_equal(_row_min(d), d.min(axis=1))

@@ -535,8 +535,8 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     fc, bc = summary(f_fruit), summary(f_ring)
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
-        to_fruit = _square_distances(x, fc).min(1)
-        return margin * to_fruit <= _square_distances(x, bc).min(1)
+        to_fruit = _row_min(_square_distances(x, fc))
+        return margin * to_fruit <= _row_min(_square_distances(x, bc))
 
     if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
         return mask
@@ -572,6 +572,15 @@ def within(mask: np.ndarray, radius: float) -> np.ndarray:
     for dy, k in zip(off.tolist(), half.tolist(), strict=True):
         out |= wide[int(k)][r - dy : r - dy + h]
     return out.view(bool)
+
+
+def _row_min(d: np.ndarray) -> np.ndarray:
+    """(n,) ``d.min(axis=1)`` of a few columns ``d`` (n, k), as ``np.minimum`` of the columns (the same values: a
+    minimum is exact): numpy's reduction along so short an axis is some 20x slower."""
+    out = d[:, 0]
+    for j in range(1, d.shape[1]):
+        out = np.minimum(out, d[:, j])
+    return out
 
 
 def _square_distances(x: np.ndarray, c: np.ndarray) -> np.ndarray:
