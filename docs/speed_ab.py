@@ -6,6 +6,9 @@ both alike. CPU time, not wall time: a busy machine stretches the wall time far 
     python docs/speed_ab.py BEFORE/src AFTER/src [--method evidence] [--rounds 6] [--frames 10]
 
 e.g. ``python docs/speed_ab.py ../main/src src``. Each round starts a fresh process per tree (``PYTHONPATH``).
+With ``--trees N`` the colour segmenter alone is timed instead, on N rendered apple-tree frames (1920x1080 with
+depth, the apple profile's settings, as ``symfruit bench --segment --scene apple-tree``): the thread's CPU time
+of each frame, ``--frames`` times per round.
 """
 
 import argparse
@@ -50,6 +53,25 @@ print(json.dumps(rows))
 """
 
 
+TREES = """
+import json, sys, time
+from symfruit.segment.colour import segment
+from symfruit.settings import resolve_settings
+from symfruit.synthetic.scenes import make_tree_scene
+n, repeat = int(sys.argv[1]), int(sys.argv[2])
+settings = resolve_settings(fruit="apple").segment
+frames = [make_tree_scene(k) for k in range(n)]
+segment(frames[0].color, frames[0].depth, frames[0].camera, settings)
+rows = []
+for _ in range(repeat):
+    for f in frames:
+        start = time.thread_time()
+        segment(f.color, f.depth, f.camera, settings)
+        rows.append({"segment": time.thread_time() - start})
+print(json.dumps(rows))
+"""
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("before")
@@ -57,19 +79,27 @@ def main() -> None:
     parser.add_argument("--method", default="evidence")
     parser.add_argument("--rounds", type=int, default=6)
     parser.add_argument("--frames", type=int, default=10)
+    parser.add_argument("--trees", type=int, default=0, help="time the segmenter on this many apple-tree frames")
     args = parser.parse_args()
     trees = {"before": os.path.abspath(args.before), "after": os.path.abspath(args.after)}
     found: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
     for r in range(args.rounds):
         for name in trees if r % 2 == 0 else list(trees)[::-1]:
+            child = [CHILD, args.method, str(args.frames), json.dumps(STAGES)]
+            if args.trees:
+                child = [TREES, str(args.trees), str(args.frames)]
             out = subprocess.run(
-                [sys.executable, "-c", CHILD, args.method, str(args.frames), json.dumps(STAGES)],
+                [sys.executable, "-c", *child],
                 env={**os.environ, "PYTHONPATH": trees[name]}, capture_output=True, text=True, check=True,
             )  # fmt: skip
             found[name] += json.loads(out.stdout)
-    sys.stdout.write(f"detect, method {args.method}: thread CPU ms per frame, {args.rounds} rounds x {args.frames} "
-                     "frames per tree, median / least\n")  # fmt: skip
-    for stage in ["cpu", *STAGES.values()]:
+    if args.trees:
+        sys.stdout.write(f"colour segmenter, {args.trees} apple-tree frames: thread CPU ms per frame, {args.rounds} "
+                         f"rounds x {args.frames} per frame and tree, median / least\n")  # fmt: skip
+    else:
+        sys.stdout.write(f"detect, method {args.method}: thread CPU ms per frame, {args.rounds} rounds x "
+                         f"{args.frames} frames per tree, median / least\n")  # fmt: skip
+    for stage in ["segment"] if args.trees else ["cpu", *STAGES.values()]:
         cells = []
         for name in trees:
             v = np.array([row.get(stage, 0.0) for row in found[name]]) * 1000.0

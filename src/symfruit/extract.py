@@ -197,7 +197,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         labels = cluster(points, s.cluster_distance)
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
-        near = big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
+        # the nearest of the big clusters (one alone needs no medians)
+        near = big[0] if len(big) == 1 else big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
@@ -254,6 +255,6 @@ def register(
     """
     s = settings or ExtractSettings()
     z = np.asarray(depth, dtype=np.float64)
-    z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth), z, 0.0)
-    du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px)
+    du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,
+                                depth_range=(s.min_depth, s.max_depth))  # fmt: skip
     return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

@@ -114,3 +114,17 @@ def test_row_norms_are_numpys_bit_for_bit(seed, shape):
 
     x = np.random.default_rng(seed).normal(0.0, 10.0 ** np.random.default_rng(seed).uniform(-4, 2), shape)
     np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=-1))
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.float64, np.float32]))
+def test_median_is_numpys_bit_for_bit(seed, dtype):
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 80))
+    x = rng.normal(0.0, 1.0, n).round(int(rng.integers(0, 8))).astype(dtype)  # rounded: repeated values
+    if rng.random() < 0.2:
+        x[rng.integers(0, n)] = rng.choice([np.nan, np.inf, -np.inf])
+    got, expected = median(x), np.median(x)
+    assert type(got) is type(expected)
+    assert got == expected or (np.isnan(got) and np.isnan(expected))

@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import inner_distance, rasterise, silhouette_coverage
+from symfruit.core.raster import fill_holes, inner_distance, rasterise, silhouette_coverage
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -261,3 +261,37 @@ def test_across_sight_rejects_an_empty_region(camera):
 
     with pytest.raises(InputError, match="empty"):
         across_sight(Silhouette(0, 0, np.zeros((4, 4), bool), 0.0), camera)
+
+
+def test_fill_holes_is_scipys():
+    rng = np.random.default_rng(5)
+    for _ in range(20):
+        mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
+        assert np.array_equal(fill_holes(mask), ndimage.binary_fill_holes(mask))
+    ring = np.zeros((9, 9), bool)
+    ring[2:7, 2:7] = True
+    ring[4, 4] = False  # one hole: filled; an empty and a full image stay as they are
+    assert (
+        fill_holes(ring)[4, 4]
+        and not fill_holes(np.zeros((5, 5), bool)).any()
+        and fill_holes(np.ones((5, 5), bool)).all()
+    )
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_principal_widths_are_the_covariance_s_extents_bit_for_bit(seed):
+    from symfruit.core.raster import principal_widths
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 200, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    rows, cols = np.nonzero(mask)
+    if len(rows) >= 2:  # the former formulation: the coordinates' mean subtracted, numpy's own column means
+        xy = np.stack((cols, rows), axis=1).astype(np.float64)
+        xy -= xy.mean(axis=0)
+        _, vec = np.linalg.eigh(xy.T @ xy)
+        p = xy @ vec
+        assert principal_widths(mask) == (float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0))
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    if mask[r0:, c0:].sum() == mask.sum():  # a window holding the whole mask: the same widths at its origin
+        assert principal_widths(mask[r0:, c0:], origin=(r0, c0)) == principal_widths(mask)

@@ -242,3 +242,174 @@ def test_the_monotone_region_walks_every_ray_as_a_loop_does(seed):
                 break
             expected[rows[i], cols[i]] = True
     np.testing.assert_array_equal(monotone_region(depth, keep, apex, tol, bins=bins), expected)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_median_and_quantile_helpers_are_numpys_bit_for_bit(seed):
+    from symfruit.core.points import median
+    from symfruit.core.surface import _sorted_quantile
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400))
+    x = rng.normal(0.0, 0.002, n).round(int(rng.integers(3, 17)))  # rounded: repeated values as well
+    assert median(x) == np.median(x)
+    z = np.sort(rng.uniform(0.3, 0.6, n).round(int(rng.integers(2, 17))))
+    for q in (0.05, float(rng.random()), 0.0, 1.0):
+        assert _sorted_quantile(z, q) == np.quantile(z, q)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_fruit_surface_of_a_mask_in_a_wide_window_is_its_box_s(seed):
+    # the mask's own numbers are computed on its box: a window 30 px wider on every side gives the same surface
+    from scipy import ndimage
+
+    from symfruit.core.raster import principal_widths
+    from symfruit.core.surface import _interior
+
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(6, 30))  # the disc 3 px from the image's border: padding changes nothing else
+    centre = (int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3)))
+    depth, disc = ball(centre=centre, radius_px=radius, noise=0.001, table=bool(rng.random() < 0.5),
+                       rim=float(rng.uniform(0.0, 0.2)), seed=int(rng.integers(0, 100)))  # fmt: skip
+    mask = disc & (rng.random((H, W)) < 0.97)
+    wide = np.pad(depth, 30), np.pad(mask, 30)
+    a, b = fruit_surface(depth, mask, F), fruit_surface(*wide, F)
+    assert (a is None) == (b is None)
+    if a is not None:
+        assert np.array_equal(np.pad(a.pixels, 30), b.pixels)
+        assert (a.front, a.radius, a.noise) == (b.front, b.radius, b.noise)
+        assert (a.apex[0] + 30, a.apex[1] + 30) == b.apex
+    rows, cols = np.nonzero(mask)
+    if len(rows):
+        r0, c0 = int(rows.min()), int(cols.min())
+        box = mask[r0:, c0:]
+        assert principal_widths(box, origin=(r0, c0)) == principal_widths(mask)
+    assert np.array_equal(_interior(mask), ndimage.binary_erosion(mask))
+    assert np.array_equal(_interior(np.ones((4, 5), bool)), ndimage.binary_erosion(np.ones((4, 5), bool)))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_within_a_radius_is_the_distance_transform_s(seed):
+    from scipy import ndimage
+
+    from symfruit.core.surface import within
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.0, 0.1) if rng.random() < 0.5 else rng.random((h, w)) < 0.6
+    # whole radii, square roots of whole numbers (on the disc's own rim) and any other
+    radius = float(rng.choice([rng.uniform(0, 8), float(rng.integers(0, 8)), np.sqrt(rng.integers(0, 60))]))
+    expected = ndimage.distance_transform_edt(~mask) <= radius if mask.any() else np.zeros((h, w), bool)
+    np.testing.assert_array_equal(within(mask, radius), expected)
+
+
+def test_the_registration_reads_depth_within_its_range_only():
+    depth, disc = ball(rim=0.1)
+    labels = grown(disc, 2).astype(np.int32)
+    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    assert registration_shift(moved, labels, F, max_px=10) == (-2, 3)
+    # the same depth beyond the range (a wall too near to be true over the ball) is none: the same answer
+    near = np.where(moved == 0, 0.05, moved)
+    assert registration_shift(near, labels, F, max_px=10, depth_range=(0.1, 2.0)) == (-2, 3)
+    assert registration_shift(moved, labels, F, max_px=10, depth_range=(0.9, 2.0)) == (0, 0)  # nothing in range
+
+
+def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
+    """registration_shift as it was: every shift of the grid costed exactly, the least taken (first of ties)."""
+    from scipy import ndimage
+
+    from symfruit.core.surface import _outline
+
+    depth = np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)
+    outlines = []
+    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+        r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
+        r1, c1 = min(sl[0].stop + max_px + 8, labels.shape[0]), min(sl[1].stop + max_px + 8, labels.shape[1])
+        mask = labels[r0:r1, c0:c1] == k
+        if mask.sum() >= 30 and (found := _outline(depth[r0:r1, c0:c1], mask, focal, max_px)) is not None:
+            outlines.append(found)
+    if not outlines:
+        return 0, 0
+
+    def cost(shifts):
+        return np.mean([o.cost(shifts, max_px, trim) for o in outlines], axis=0)
+
+    coarse = np.arange(-max_px, max_px + 1, 2)
+    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
+    first = cost(np.vstack([[[0, 0]], grid]))
+    dv, du = grid[int(np.argmin(first[1:]))]
+    near = np.arange(-2, 3)
+    fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
+    fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
+    refined = cost(fine)
+    best = int(np.argmin(refined))
+    return (0, 0) if refined[best] > first[0] - gain else (int(fine[best, 1]), int(fine[best, 0]))
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_registration_finds_the_shift_costing_every_shift_exactly_would(seed):
+    # the grid's shifts are costed by a sort first and only the least ones exactly: the same answer as costing
+    # them all exactly, on noiseless discs (whose mirrored shifts cost the same: ties) as on noisy ones
+    rng = np.random.default_rng(seed)
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    for k in range(1, int(rng.integers(1, 4)) + 1):
+        r = int(rng.integers(8, 18))
+        centre = (int(rng.integers(r + 2, W - r - 2)), int(rng.integers(r + 2, H - r - 2)))
+        d, disc = ball(centre=centre, radius_px=r, front=float(rng.uniform(0.4, 0.6)), rim=float(rng.uniform(0, 0.2)))
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[grown(disc, int(rng.integers(0, 3))) & (labels == 0)] = k
+    if rng.random() < 0.5:
+        depth = depth + rng.normal(0.0, 0.001, depth.shape)
+    moved = np.roll(depth, (int(rng.integers(-4, 5)), int(rng.integers(-4, 5))), axis=(0, 1))
+    max_px = int(rng.integers(2, 12))
+    assert registration_shift(moved, labels, F, max_px=max_px) == _shift_as_before(moved, labels, F, max_px)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_a_shift_s_cost_is_its_row_s_alone_and_the_sorted_sum_is_near_it(seed):
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 40, 2))
+    # a signed distance map of whole-number squares (as the transforms give), or any map
+    inside = np.sqrt(rng.integers(1, 900, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    if rng.random() < 0.3:
+        inside = rng.normal(0.0, 5.0, (h, w))
+    n = int(rng.integers(12, 300))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, 3.0)
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (40, 2))
+    full = outline.cost(shifts, reach, 0.7)
+    rows = np.sort(rng.choice(40, int(rng.integers(1, 5)), replace=False))
+    np.testing.assert_array_equal(outline.cost(shifts[rows], reach, 0.7), full[rows])
+    np.testing.assert_allclose(outline.cost(shifts, reach, 0.7, exact=False), full, rtol=1e-13, atol=1e-13)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([3, 5]))
+def test_median_at_pixels_away_from_the_edges_is_the_median_filter(seed, size):
+    from scipy import ndimage
+
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(6, 30, 2))
+    image = rng.choice([0.3, 0.31, 0.5, np.inf], size=(h, w)) + rng.normal(0, 0.01, (h, w)).round(3)
+    inner = np.zeros((h, w), bool)
+    inner[size // 2 : h - size // 2, size // 2 : w - size // 2] = rng.random((h - size + 1, w - size + 1)) < 0.5
+    rows, cols = np.nonzero(inner)
+    expected = ndimage.median_filter(image, size=size, mode="nearest")[rows, cols]
+    np.testing.assert_array_equal(median_at(image, rows, cols, size=size), expected)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_least_colour_distance_is_numpys_row_minimum(seed):
+    from symfruit.core.surface import _row_min
+
+    rng = np.random.default_rng(seed)
+    d = rng.random((int(rng.integers(1, 300)), int(rng.integers(1, 6)))).round(int(rng.integers(1, 6)))  # ties
+    if rng.random() < 0.2:
+        d[rng.integers(0, len(d)), rng.integers(0, d.shape[1])] = np.nan  # propagated as numpy's minimum does
+    np.testing.assert_array_equal(_row_min(d), d.min(axis=1))

@@ -383,17 +383,6 @@ def test_a_fruit_outside_the_depth_cameras_view_is_sized_at_the_frames_depth():
     assert segment(speck, depth, HD_CAM).max() == 0
 
 
-def test_fill_holes_is_scipys():
-    from scipy import ndimage
-
-    from symfruit.segment.colour import _fill_holes
-
-    rng = np.random.default_rng(5)
-    for _ in range(20):
-        mask = ndimage.binary_opening(rng.random((40, 50)) < 0.55)
-        assert np.array_equal(_fill_holes(mask), ndimage.binary_fill_holes(mask))
-
-
 def test_a_bicoloured_round_fruit_is_found_whole_with_round_fruit():
     # an apple 60 px across at 1.5 m, its left half red and its right half yellow, a leaf 10 cm behind it
     color, depth = hd_disc_frame([(900, 540)], radius=30)
@@ -502,3 +491,50 @@ def test_a_region_larger_than_the_largest_fruit_keeps_its_ripe_red_cores():
     assert _ripe_cores(apple, color, depth, s, 960.0, 1.5)[0] is apple
     strip = region & ~apple & ~speck
     assert _ripe_cores(strip[:, 100:160], color[:, 100:160], depth[:, 100:160], s, 960.0, 1.5) == []
+
+
+def test_the_dilations_are_scipys():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _dilate
+
+    rng = np.random.default_rng(7)
+    for _ in range(20):
+        mask = rng.random(tuple(rng.integers(1, 30, 2))) < 0.1
+        assert np.array_equal(_dilate(mask), ndimage.binary_dilation(mask))
+        assert np.array_equal(_dilate(_dilate(mask)), ndimage.binary_dilation(mask, iterations=2))
+        assert np.array_equal(_dilate(mask, square=True), ndimage.binary_dilation(mask, structure=np.ones((3, 3))))
+
+
+def test_the_sphere_fit_is_the_former_one_bit_for_bit():
+    from symfruit.core.points import median
+    from symfruit.segment.colour import _Geometry, _points, _sphere
+
+    def former(mask, depth, geo, origin):  # norms and squared norms by numpy's reductions
+        p = _points(mask, depth, geo, origin, 1500)
+        z = p[:, 2]
+        spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)
+        p = p[np.abs(z - median(z)) <= 2.0 * spread]
+        for _ in range(2):
+            a = np.concatenate((2.0 * p, np.ones((len(p), 1))), axis=1)
+            sol, *_ = np.linalg.lstsq(a, (p * p).sum(axis=1), rcond=None)
+            centre = sol[:3]
+            radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
+            res = np.abs(np.linalg.norm(p - centre, axis=1) - radius)
+            p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
+        return centre, radius
+
+    rng = np.random.default_rng(3)
+    geo = _Geometry(600.0, 40.0, 50.0)
+    yy, xx = np.mgrid[:80, :100]
+    for _ in range(10):
+        r = float(rng.uniform(10, 30))
+        disc = (xx - 50) ** 2 + (yy - 40) ** 2 <= r * r
+        depth = np.where(
+            disc, 0.5 - np.sqrt(np.clip(r * r - (xx - 50) ** 2 - (yy - 40) ** 2, 0, None)) / 600 * 0.5, 0.0
+        )
+        depth = np.where(disc, depth + rng.normal(0, 0.001, depth.shape), 0.0)
+        fit = _sphere(disc, depth, geo, (0, 0))
+        assert fit is not None
+        centre, radius = former(disc, depth, geo, (0, 0))
+        assert np.array_equal(fit[0], centre) and fit[1] == radius

@@ -19,6 +19,7 @@ __all__ = [
     "check_cloud",
     "check_view",
     "mean_point",
+    "median",
     "perpendicular_basis",
     "row_norms",
     "subsample",
@@ -44,6 +45,23 @@ def row_norms(x: np.ndarray) -> np.ndarray:
     if x.shape[-1] == 3:
         total += x[..., 2] * x[..., 2]
     return np.sqrt(total)
+
+
+def median(values: np.ndarray) -> Any:
+    """``np.median(values)`` of a 1-d float array, the same value bit for bit: one partition at the two middle
+    places (and the last, where a NaN would sort) and the mean of the middle two in the array's own type, without
+    np.median's general-axis machinery (20-40 us a call, several times the partition on a fruit's pixels).
+    NaN when a value is NaN or there is none."""
+    x = np.asarray(values)
+    n = len(x)
+    if n == 0 or x.ndim != 1 or x.dtype.kind != "f":
+        return np.median(x)
+    h = n // 2
+    part = np.partition(x, (h - 1, h, n - 1) if n % 2 == 0 else (h, n - 1))
+    if np.isnan(part[-1]):
+        return part.dtype.type(np.nan)
+    # np.mean of the two: their sum in the array's type, halved (exact); of one: itself
+    return part[h] if n % 2 else (part[h - 1] + part[h]) / part.dtype.type(2)
 
 
 def mean_point(points: np.ndarray) -> np.ndarray:

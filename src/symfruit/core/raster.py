@@ -25,6 +25,7 @@ __all__ = [
     "View",
     "across_sight",
     "close_ragged",
+    "fill_holes",
     "inner_distance",
     "outline_cone",
     "outline_cracks",
@@ -236,7 +237,24 @@ def inner_distance(mask: np.ndarray) -> np.ndarray:
     return out
 
 
-def principal_widths(mask: np.ndarray) -> tuple[float, float]:
+def fill_holes(mask: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ``mask`` with its holes filled, the same as :func:`scipy.ndimage.binary_fill_holes`.
+
+    A hole is a 4-connected piece of the background that does not reach the image border; scipy finds them by
+    dilating the background from the border until nothing changes (one pass over the image per pixel of the
+    longest path), one labelling finds them at once.
+    """
+    lab, n = ndimage.label(~mask)
+    if n == 0:
+        return mask.copy()
+    outside = np.zeros(n + 1, bool)
+    for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
+        outside[edge] = True
+    outside[0] = False
+    return ~outside[lab]
+
+
+def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> tuple[float, float]:
     """``(minor, major)``, pixels: a region's widths across and along its principal axis.
 
     The extents of the region's pixels projected on the two eigenvectors of their covariance, each pixel
@@ -248,12 +266,19 @@ def principal_widths(mask: np.ndarray) -> tuple[float, float]:
     >>> m = np.zeros((9, 20), bool); m[2:7, 3:17] = True
     >>> principal_widths(m)
     (5.0, 14.0)
+
+    ``origin`` (row, column) is where ``mask`` lies in a larger image: the pixels are taken at that image's
+    coordinates (a window cut around a mask gives the same widths, bit for bit, as the whole image).
     """
     rows, cols = np.nonzero(mask)
+    if origin != (0, 0):
+        rows, cols = rows + origin[0], cols + origin[1]
     if len(rows) < 2:
         return float(len(rows)), float(len(rows))
-    xy = np.stack((cols, rows), axis=1).astype(np.float64)
-    xy -= xy.mean(axis=0)
+    xy = np.empty((len(rows), 2))
+    xy[:, 0], xy[:, 1] = cols, rows
+    # the column means from whole-number sums (exact in any order, as numpy's are): xy.mean(axis=0) bit for bit
+    xy -= np.array([int(cols.sum()), int(rows.sum())], dtype=np.float64) / len(rows)
     _, vec = np.linalg.eigh(xy.T @ xy)
     p = xy @ vec
     return float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0)

@@ -56,6 +56,8 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.limits import check_image_size, depth_metres
+from ..core.points import median, row_norms
+from ..core.raster import fill_holes
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -358,7 +360,7 @@ def segment(
     min_area = max(s.min_area_share * h * w, 4.0)
     # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
     grid = None if z is None else z[::8, ::8]
-    z_typical = 0.0 if grid is None else float(np.median(grid[grid > 0])) if (grid > 0).any() else 1.0
+    z_typical = 0.0 if grid is None else float(median(grid[grid > 0])) if (grid > 0).any() else 1.0
 
     # Red pixels are looked for on a coarse grid first (the pyramid's top). When every candidate fruit there
     # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
@@ -463,10 +465,9 @@ def _segment_at(
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
         least = min_area if z is None else _least_areas(labels, n, z[win], s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
-        for k, sl in enumerate(ndimage.find_objects(labels), 1):
-            if not keep[k] or sl is None:
-                continue
-            sl = _pad(sl, 1, labels.shape)
+        objects = ndimage.find_objects(labels)
+        for k in np.flatnonzero(keep).tolist():  # the kept regions alone: a window may hold thousands of specks
+            sl = _pad(objects[k - 1], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
@@ -492,7 +493,7 @@ def _segment_at(
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
-        if not red.any() or np.median(redness(c[sl][red])) < s.ripe_median:
+        if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
         hull = convex_hull_mask(part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
@@ -564,19 +565,6 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
             break
         boxes = joined
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
-
-
-def _fill_holes(mask: np.ndarray) -> np.ndarray:
-    """The mask with its holes filled: the background pieces (4-connected) that do not reach the border
-    (as :func:`scipy.ndimage.binary_fill_holes`, by one labelling instead of repeated dilations)."""
-    lab, n = ndimage.label(~mask)
-    if n == 0:
-        return mask.copy()
-    outside = np.zeros(n + 1, bool)
-    for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
-        outside[edge] = True
-    outside[0] = False
-    return ~outside[lab]
 
 
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
@@ -668,8 +656,12 @@ class _Piece:
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
+
+    def hull_area(self) -> float:
+        """:func:`_hull_area` of the mask, worked out when first asked for: only pieces near another need it."""
         if self.hull < 0:
             self.hull = _hull_area(self.mask)
+        return self.hull
 
 
 def _merge(
@@ -708,9 +700,9 @@ def _merge(
                     continue
                 window, union = _union(a, b)
                 hull = _hull_area(union)
-                if hull > (1.0 + slack) * (a.hull + b.hull):
+                if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
                     hull -= float((convex_hull_mask(union) & ~union & _green(color[window])).sum())
-                if hull <= (1.0 + slack) * (a.hull + b.hull) and (
+                if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
                     pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
@@ -738,8 +730,8 @@ def _same_surface(
     )
     if fit is None or len(p) < 20:
         return None
-    off = np.abs(np.linalg.norm(p - fit[0], axis=1) - fit[1])
-    return bool(np.median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+    off = np.abs(row_norms(p - fit[0]) - fit[1])
+    return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
 
 
 def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
@@ -762,7 +754,7 @@ def _split(
 ) -> list[np.ndarray]:
     """Cut a region into fruit (see the module docstring): at waists of its distance transform (the depth
     steps and creases taken as part of its outline), keeping the cuts that evidence backs."""
-    region = _fill_holes(region)
+    region = fill_holes(region)
     if s.close_px:
         r = s.close_px
         padded = np.pad(region, r + 1)
@@ -776,8 +768,8 @@ def _split(
     least = np.sqrt(min_area / np.pi)
     if use_depth and depth is not None:
         edges = _depth_edges(region, depth, s, geo.focal)
-        carved = _fill_holes(region & ~edges)
-        least = 0.25 * geo.focal * s.min_diameter / float(np.median(depth[region & (depth > 0)]))
+        carved = fill_holes(region & ~edges)
+        least = 0.25 * geo.focal * s.min_diameter / float(median(depth[region & (depth > 0)]))
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
@@ -814,7 +806,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     if not seeds.any():
         return parts
     _, (ri, ci) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
-    grown = np.where(region, seeds[ri, ci], 0)
+    grown = np.where(region, np.take(seeds.ravel(), ri * seeds.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
 
 
@@ -904,9 +896,9 @@ def _supported(
       ``merge_slack`` (they are not one convex body).
     """
     n = len(cells)
-    grown = [ndimage.binary_dilation(c, structure=np.ones((3, 3), bool)) for c in cells]
+    grown = [_dilate(c, square=True) for c in cells]
     hulls = [_hull_area(c) for c in cells]
-    near_edges = None if edges is None else ndimage.binary_dilation(edges, iterations=2)
+    near_edges = None if edges is None else _dilate(_dilate(edges))
     owner = list(range(n))
 
     def root(i: int) -> int:
@@ -939,6 +931,17 @@ def _supported(
     return list(groups.values())
 
 
+def _dilate(mask: np.ndarray, *, square: bool = False) -> np.ndarray:
+    """(h, w) bool: ``ndimage.binary_dilation(mask)`` by the 4-neighbourhood (``square``: the 8-neighbourhood,
+    ``structure=np.ones((3, 3))``), from shifted views of the padded mask (scipy's general structuring element
+    costs several times more on these small windows)."""
+    p = np.pad(mask, 1)
+    if square:
+        rows = p[:-2] | p[1:-1] | p[2:]
+        return rows[:, :-2] | rows[:, 1:-1] | rows[:, 2:]
+    return p[1:-1, 1:-1] | p[:-2, 1:-1] | p[2:, 1:-1] | p[1:-1, :-2] | p[1:-1, 2:]
+
+
 def _points(
     mask: np.ndarray, depth: np.ndarray, geo: _Geometry, origin: tuple[int, int], most: int = 1500
 ) -> np.ndarray:
@@ -949,7 +952,9 @@ def _points(
         pick = np.linspace(0, len(rows) - 1, most).astype(np.int64)
         rows, cols = rows[pick], cols[pick]
     z = depth[rows, cols]
-    return np.c_[(cols + origin[1] - geo.cx) * z / geo.focal, (rows + origin[0] - geo.cy) * z / geo.focal, z]
+    return np.stack(
+        ((cols + origin[1] - geo.cx) * z / geo.focal, (rows + origin[0] - geo.cy) * z / geo.focal, z), axis=1
+    )
 
 
 def _two_spheres(
@@ -974,17 +979,18 @@ def _sphere(
         return None
     z = p[:, 2]
     spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
-    p = p[np.abs(z - np.median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+    p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
     centre, radius = np.zeros(3), 0.0
     for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
         if len(p) < 20:
             return None
-        a = np.c_[2.0 * p, np.ones(len(p))]
-        sol, *_ = np.linalg.lstsq(a, (p * p).sum(axis=1), rcond=None)
+        a = np.concatenate((2.0 * p, np.ones((len(p), 1))), axis=1)  # np.c_ costs 5-10 us a call
+        # |p|^2 term by term: numpy sums a 3-long axis left to right, the same values without its slow reduction
+        sol, *_ = np.linalg.lstsq(a, p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1] + p[:, 2] * p[:, 2], rcond=None)
         centre = sol[:3]
         radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
-        res = np.abs(np.linalg.norm(p - centre, axis=1) - radius)
-        p = p[res <= max(3.0 * float(np.median(res)) * 1.4826, 1e-4)]
+        res = np.abs(row_norms(p - centre) - radius)
+        p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
     if not (np.isfinite(radius) and 0.25 * spread <= radius <= 4.0 * spread):
         return None
     return centre, radius
@@ -1026,7 +1032,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
     _, (ri, ci) = ndimage.distance_transform_edt(cores == 0, return_indices=True)
-    cells = np.where(region, cores[ri, ci], 0)
+    cells = np.where(region, np.take(cores.ravel(), ri * region.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
@@ -1041,7 +1047,7 @@ def _steps(z: np.ndarray, jump: float) -> np.ndarray:
     """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step)."""
     edge = np.zeros(z.shape, bool)
     for axis in (0, 1):
-        step = np.nan_to_num(np.abs(np.diff(z, axis=axis)), nan=0.0) > jump
+        step = np.abs(np.diff(z, axis=axis)) > jump  # NaN compares False: no step
         if axis == 0:
             edge[:-1] |= step
             edge[1:] |= step
@@ -1057,9 +1063,10 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
-    smooth = ndimage.gaussian_filter(depth[ri, ci], s.crease_sigma) if s.crease_sigma > 0 else depth[ri, ci]
+    filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
+    smooth = ndimage.gaussian_filter(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.laplace(smooth)
-    z = float(np.median(depth[valid]))
+    z = float(median(depth[valid]))
     return region & (lap < -s.crease_curvature * (z / focal) ** 2)
 
 
@@ -1067,7 +1074,7 @@ def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal
     """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
     (``z_typical`` where none of its pixels has depth)."""
     z = depth[mask & (depth > 0)]
-    zr = float(np.median(z)) if len(z) else z_typical
+    zr = float(median(z)) if len(z) else z_typical
     return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
 
 
@@ -1087,7 +1094,7 @@ def _ripe_cores(
     if region.sum() <= largest:
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
         # before the region is split and merged: a twig or bark never costs the work on a fruit)
-        return [region] if np.median(red[region]) >= s.ripe_median else []
+        return [region] if median(red[region]) >= s.ripe_median else []
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
@@ -1132,9 +1139,9 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    yy, xx = np.mgrid[big[0], big[1]]
+    yy, xx = np.ogrid[big[0], big[1]]  # broadcast: the same values per pixel, without two full grids
     z = depth[big]
-    zm = float(np.median(z_part))
+    zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
@@ -1163,7 +1170,7 @@ def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jum
     z = depth[part & (depth > 0)]
     if len(z) == 0:
         return hull
-    zm = float(np.median(z))
+    zm = float(median(z))
     off = (depth > 0) & (np.abs(depth - zm) > jump)
     return part | (hull & ~off)
 
@@ -1177,7 +1184,7 @@ def _fruit_sized(
     if depth is None:
         return area >= min_area
     z = depth[mask & (depth > 0)]
-    diameter_px = focal * s.min_diameter / (float(np.median(z)) if len(z) else z_typical)
+    diameter_px = focal * s.min_diameter / (float(median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
 
 
