@@ -378,3 +378,43 @@ def test_slice_costs_in_place_equal_the_plain_expressions(seed, k, n):
     dirs = rng.normal(size=(k, 3))
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     np.testing.assert_array_equal(_slice_costs(q, dirs, 12), _slice_costs_plain(q, dirs, 12))
+
+
+def _cone_fronts_plain(params, cone, axis, rays, ray_cone):
+    """``_cone_fronts`` as plain expressions (before its arithmetic ran in place): the reference it must equal."""
+    p = np.atleast_2d(params)
+    m = np.empty((len(p), 3))
+    m[:, :2] = axis[:2] + p[:, :2]
+    m[:, 2] = axis[2]
+    m *= np.exp(p[:, 2:3])
+    cm = m @ cone
+    q = -(cm * m).sum(axis=1)
+    valid = q > 0
+    lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
+    gap = (lam - q)[:, None]
+    rcm = cm @ rays.T
+    with np.errstate(invalid="ignore", divide="ignore"):
+        a = ray_cone[None, :] / lam[:, None] - rcm * rcm / (lam[:, None] * gap)
+        b = rcm / gap
+        c = -lam[:, None] / gap
+        disc = b * b - a * c
+        root = np.sqrt(np.maximum(disc, 0.0))
+        return np.where(disc >= 0, (b - root) / a, np.nan), valid
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 50), st.integers(1, 300))
+def test_cone_fronts_in_place_equal_the_plain_expressions(seed, k, n):
+    from symfruit.core.fits import _cone_fronts
+
+    rng = np.random.default_rng(seed)
+    half = rng.normal(size=(3, 3))
+    cone = half + half.T if seed % 2 else np.diag([1.0, 1.0, -rng.uniform(0.01, 0.1)])
+    axis = np.r_[rng.normal(0.0, 0.1, 2), 1.0]
+    params = np.c_[rng.normal(0.0, 0.05, (k, 2)), np.log(rng.uniform(0.2, 0.8, k)), rng.uniform(-60, 60, k)]
+    params[0, 3] = [0.0, -np.inf, 60.0][seed % 3]  # lambda at q / 2, at 0 (fronts of 0 / 0) and at q
+    rays = np.c_[axis[0] + rng.normal(0.0, 0.1, n), axis[1] + rng.normal(0.0, 0.1, n), np.ones(n)]
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    fronts, valid = _cone_fronts(params, cone, axis, rays, ray_cone)
+    want, want_valid = _cone_fronts_plain(params, cone, axis, rays, ray_cone)
+    np.testing.assert_array_equal(fronts, want)
+    np.testing.assert_array_equal(valid, want_valid)
