@@ -8,6 +8,7 @@ its options as keywords, and returns arrays; none knows settings objects or file
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -413,14 +414,23 @@ def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
 
 def _cap(direction: np.ndarray, spread_deg: float, n: int) -> np.ndarray:
     """``direction`` and ``n`` directions within ``spread_deg`` of it (a Fibonacci cap), unit rows, z >= 0."""
+    e1, e2 = perpendicular_basis(direction[None, :])
+    rot = np.stack([e1[0], e2[0], direction], axis=1)
+    out = np.vstack([direction[None, :], _cap_local(float(spread_deg), int(n)) @ rot.T])
+    return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
+
+
+@functools.lru_cache(maxsize=16)
+def _cap_local(spread_deg: float, n: int) -> np.ndarray:
+    """(n, 3) float, read-only: the Fibonacci cap of :func:`_cap` about ``+z`` (it depends on the spread and the
+    count alone, so it is made once per pair)."""
     i = np.arange(n) + 0.5
     z = 1.0 - (1.0 - np.cos(np.radians(spread_deg))) * i / n
     r = np.sqrt(np.clip(1.0 - z * z, 0.0, None))
     theta = np.pi * (1.0 + 5**0.5) * i
-    e1, e2 = perpendicular_basis(direction[None, :])
-    rot = np.stack([e1[0], e2[0], direction], axis=1)
-    out = np.vstack([direction[None, :], np.stack((r * np.cos(theta), r * np.sin(theta), z), axis=1) @ rot.T])
-    return out * np.where(out[:, 2:3] < 0, -1.0, 1.0)
+    local = np.stack((r * np.cos(theta), r * np.sin(theta), z), axis=1)
+    local.flags.writeable = False
+    return local
 
 
 _COARSE = _hemisphere(64)
@@ -509,13 +519,19 @@ def fit_revolution_slices(
                        axis=1)[which]  # fmt: skip
     sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
     a2 = sol + w.mean(axis=0)
+    # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
+    # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
+    which3 = np.concatenate((which, which + profile_bins, which + 2 * profile_bins))
     for _ in range(gauss_newton_steps):
         diff = w - a2
-        rho = np.maximum(np.sqrt((diff * diff).sum(axis=1)), 1e-12)
-        jac = -diff / rho[:, None]
-        res = rho - (np.bincount(which, weights=rho, minlength=profile_bins) / cnt)[which]
-        jac = jac - np.stack([np.bincount(which, weights=jac[:, i], minlength=profile_bins) / cnt
-                              for i in range(2)], axis=1)[which]  # fmt: skip
+        rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
+        np.maximum(rho, 1e-12, out=rho)
+        jac = np.negative(diff, out=diff)
+        jac /= rho[:, None]
+        means = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * profile_bins)
+        means = means.reshape(3, profile_bins) / cnt
+        res = rho - means[0][which]
+        jac -= means[1:].T[which]
         jtj = jac.T @ jac
         if abs(np.linalg.det(jtj)) < 1e-30:
             break
