@@ -701,34 +701,22 @@ def _cone_fronts(params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: n
     """
     p = np.atleast_2d(params)
     m = np.empty((len(p), 3))
-    np.add(axis[:2], p[:, :2], out=m[:, :2])
+    m[:, :2] = axis[:2] + p[:, :2]
     m[:, 2] = axis[2]
     m *= np.exp(p[:, 2:3])
     cm = m @ cone  # (k, 3); C is symmetric
-    cmm = cm * m
-    q = -(cmm[:, 0] + cmm[:, 1] + cmm[:, 2])  # = -(cm * m).sum(axis=1): numpy sums 3 terms left to right
+    q = -(cm * m).sum(axis=1)
     valid = q > 0
     lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
     gap = (lam - q)[:, None]  # < 0
     rcm = cm @ rays.T  # (k, n)
-    # The (k, n) arithmetic of a = r^T C r / lambda - (r^T C m)^2 / (lambda (lambda - q)), b = r^T C m / (lambda
-    # - q), disc = b^2 - a c, front = (b - sqrt(disc)) / a runs in place (the same operations in the same order:
-    # the same bits as the plain expressions, which the tests keep): this runs some 16 times per cone fit.
-    with np.errstate(invalid="ignore", divide="ignore"):
-        lam_col = lam[:, None]
-        a = ray_cone[None, :] / lam_col
-        buf = np.multiply(rcm, rcm)
-        buf /= lam_col * gap
-        a -= buf
-        b = np.divide(rcm, gap, out=rcm)
-        c = -lam_col / gap
-        disc = np.multiply(b, b, out=buf)
-        disc -= a * c
-        root = np.maximum(disc, 0.0)
-        np.sqrt(root, out=root)
-        front = np.subtract(b, root, out=root)
-        front /= a
-        return np.where(disc >= 0, front, np.nan), valid
+    with np.errstate(invalid="ignore"):
+        a = ray_cone[None, :] / lam[:, None] - rcm * rcm / (lam[:, None] * gap)
+        b = rcm / gap
+        c = -lam[:, None] / gap
+        disc = b * b - a * c
+        root = np.sqrt(np.maximum(disc, 0.0))
+        return np.where(disc >= 0, (b - root) / a, np.nan), valid
 
 
 def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarray:
