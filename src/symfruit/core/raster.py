@@ -212,7 +212,8 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     n = col_sums.sum()
     mu = np.array([col_sums @ u, row_sums @ v]) / n
     du, dv = u - mu[0], v - mu[1]
-    cov = np.array([[col_sums @ (du * du), dv @ m @ du], [dv @ m @ du, row_sums @ (dv * dv)]]) / n
+    cross = dv @ m @ du  # once: the same product twice was a second pass over the window
+    cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
     inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
     conic = np.zeros((3, 3))
     conic[:2, :2] = inv
@@ -313,7 +314,8 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     v = np.arange(m.shape[0], dtype=np.float64) + region.v0
     mu = np.array([col_sums @ u, row_sums @ v]) / n
     du, dv = u - mu[0], v - mu[1]
-    cov = np.array([[col_sums @ (du * du), dv @ m @ du], [dv @ m @ du, row_sums @ (dv * dv)]]) / n
+    cross = dv @ m @ du  # once: the same product twice was a second pass over the window
+    cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
     axis = camera.rays(mu[0], mu[1]).reshape(3)
     axis = axis / np.linalg.norm(axis)
     e1 = np.array([axis[2], 0.0, -axis[0]])
