@@ -357,9 +357,10 @@ def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     algebraic residual over ``2 rho`` is about the distance to the circle. The lower 80 % of the squared
     distances count (stems, calyx, flying pixels).
 
-    The (k, n) arithmetic runs in place on a few buffers: at 70 directions and 250 points every temporary is
-    above the allocator's mmap threshold, and fresh ones cost page faults as well as passes (each operation
-    is the one of the plain expression, in the same order: the same bits as the plain expressions; the tests keep them).
+    The (k, n) arithmetic runs in place on a few buffers, each operation the plain expression's in the same
+    order (the same bits; the tests keep the plain expressions): at 70 directions and 250 points every
+    temporary is larger than the allocator's mmap threshold (128 kB), and the plain expressions' fresh ones
+    took 2.4 times as long (850 against 350 us a call).
     """
     k, n = len(dirs), len(q)
     e1, e2 = perpendicular_basis(dirs)
