@@ -575,11 +575,13 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     """
     mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     c = rev.point[None, :] + mid[:, None] * rev.direction[None, :]  # (b, 3)
-    e = np.cross(rev.direction[None, :], c)
-    e /= np.maximum(np.linalg.norm(e, axis=1, keepdims=True), 1e-12)
+    d = rev.direction  # e = d x c term by term (np.cross computes the same products and differences)
+    e = np.stack((d[1] * c[:, 2] - d[2] * c[:, 1], d[2] * c[:, 0] - d[0] * c[:, 2], d[0] * c[:, 1] - d[1] * c[:, 0]),
+                 axis=1)  # fmt: skip
+    e /= np.maximum(row_norms(e), 1e-12)[:, None]
     uc = camera.project(c)
     du = camera.project(c + 1e-3 * e) - uc
-    du /= np.maximum(np.linalg.norm(du, axis=1, keepdims=True), 1e-12)
+    du /= np.maximum(row_norms(du), 1e-12)[:, None]
     h, w = mask.shape
     reach = 2.0 * max(h, w)
     s = np.arange(step, reach, step)  # (m,)

@@ -189,7 +189,9 @@ def close_ragged(region: Silhouette, *, radius: int = 3, ragged: float = 0.3) ->
     mask = region.mask
     if radius <= 0 or not mask.any():
         return region
-    closed = _closed_mask(np.pad(mask, radius), radius)[radius:-radius, radius:-radius]
+    padded = np.zeros((mask.shape[0] + 2 * radius, mask.shape[1] + 2 * radius), dtype=bool)  # np.pad is slow
+    padded[radius:-radius, radius:-radius] = mask
+    closed = _closed_mask(padded, radius)[radius:-radius, radius:-radius]
     outline = int((mask & ~ndimage.binary_erosion(mask)).sum())
     if (closed & ~mask).sum() <= ragged * max(outline, 1):
         return region
@@ -331,7 +333,7 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     # The principal axes from the pixels' covariance carried to tangent coordinates by the map's Jacobian at
     # the centroid (the map is projective: over one fruit's pixels, linear to well under a pixel).
     t0, tu, tv = tangent(mu[0] + np.array([0.0, 1.0, 0.0]), mu[1] + np.array([0.0, 0.0, 1.0]))
-    jac = np.c_[tu - t0, tv - t0]
+    jac = np.stack((tu - t0, tv - t0), axis=1)
     _, vec = np.linalg.eigh(jac @ cov @ jac.T)
     edge = tangent(*outline_cracks(region).T)
     p = edge @ vec
@@ -394,8 +396,8 @@ def outline_cone(
     mu = pts.mean(axis=0)
     scale = float(np.sqrt(((pts - mu) ** 2).sum(axis=1).mean())) or 1.0
     x, y = (pts[:, 0] - mu[0]) / scale, (pts[:, 1] - mu[1]) / scale
-    d1 = np.c_[x * x, x * y, y * y]
-    d2 = np.c_[x, y, np.ones_like(x)]
+    d1 = np.stack((x * x, x * y, y * y), axis=1)  # np.stack: the same (m, 3) arrays as np.c_, without its overhead
+    d2 = np.stack((x, y, np.ones_like(x)), axis=1)
     s1, s2, s3 = d1.T @ d1, d1.T @ d2, d2.T @ d2
     try:
         t = -np.linalg.solve(s3, s2.T)
@@ -413,7 +415,7 @@ def outline_cone(
     if not len(good):
         return None
     a1 = vecs[:, good[0]]
-    a, b, c, d, e, f = np.r_[a1, t @ a1]
+    a, b, c, d, e, f = np.concatenate((a1, t @ a1))
     # Back to pixels: x = (u - mu_u) / s, y = (v - mu_v) / s.
     q = np.array([[a, b / 2, d / 2], [b / 2, c, e / 2], [d / 2, e / 2, f]])
     tr = np.array([[1 / scale, 0, -mu[0] / scale], [0, 1 / scale, -mu[1] / scale], [0, 0, 1]])
