@@ -529,8 +529,8 @@ def fit_revolution_slices(
         np.maximum(rho, 1e-12, out=rho)
         jac = np.negative(diff, out=diff)
         jac /= rho[:, None]
-        means = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * profile_bins)
-        means = means.reshape(3, profile_bins) / cnt
+        sums = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * profile_bins)
+        means = sums.reshape(3, profile_bins) / cnt
         res = rho - means[0][which]
         jac -= np.take(means[1:].T, which, axis=0)  # rows by np.take: 5x faster than [which] here
         jtj = jac.T @ jac
