@@ -89,3 +89,22 @@ def test_absurd_intrinsics_are_refused_without_numpy_warnings(bad, message):
         warnings.simplefilter("error")  # a RuntimeWarning from numpy would fail here
         with pytest.raises(InputError, match=message):
             Camera(**args)
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(), (5,), (7, 3), (0,)]))
+def test_project_and_rays_are_the_stacked_formulas_bit_for_bit(seed, shape):
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=612.3, fy=611.9, cx=321.7, cy=239.2, width=640, height=480)
+    p = rng.normal(size=(*shape, 3))
+    p[..., 2] = rng.uniform(0.1, 2.0, shape)
+    want = np.stack([cam.fx * p[..., 0] * (1.0 / p[..., 2]) + cam.cx, cam.fy * p[..., 1] * (1.0 / p[..., 2]) + cam.cy],
+                    axis=-1)  # fmt: skip
+    np.testing.assert_array_equal(cam.project(p), want)
+    v = np.full(shape, 200.0)
+    floats = rng.normal(0.0, 300.0, shape)
+    for u in (floats, rng.integers(0, 640, shape), floats.astype(np.float32)):
+        x, y = (np.asarray(u) - cam.cx) / cam.fx, (v - cam.cy) / cam.fy
+        want = np.stack([x, y, np.ones_like(x, dtype=np.float64)], axis=-1)
+        got = cam.rays(u, v)
+        assert got.dtype == want.dtype
+        np.testing.assert_array_equal(got, want)

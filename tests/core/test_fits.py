@@ -336,3 +336,45 @@ def test_outline_radii_of_a_tilted_cylinder_like_lemon_follow_its_silhouette():
     assert np.median(np.abs(radii[ok] - rev.radii[ok])) < 0.0015
     truth = 0.5 * np.ptp((posed.vertices - posed.vertices.mean(axis=0)) @ (tilt @ [1.0, 0.0, 0.0]))
     assert np.nanmax(radii) == pytest.approx(truth, abs=0.0015)
+
+
+def _slice_costs_plain(q, dirs, bins):
+    """``_slice_costs`` as plain expressions (before its arithmetic ran in place): the reference it must equal."""
+    from symfruit.core.points import perpendicular_basis
+
+    k, n = len(dirs), len(q)
+    e1, e2 = perpendicular_basis(dirs)
+    t, u, v = dirs @ q.T, e1 @ q.T, e2 @ q.T
+    y = u * u + v * v
+    lo, hi = t.min(axis=1, keepdims=True), t.max(axis=1, keepdims=True)
+    b = np.minimum(((t - lo) / np.maximum(hi - lo, 1e-12) * bins).astype(np.int64), bins - 1)
+    idx = (b + bins * np.arange(k)[:, None]).ravel()
+    safe = np.maximum(np.bincount(idx, minlength=k * bins), 1).astype(np.float64)
+
+    def centred(x):
+        return x - (np.bincount(idx, weights=x.ravel(), minlength=k * bins) / safe)[idx].reshape(k, n)
+
+    du, dv, dy = centred(u), centred(v), centred(y)
+    a11, a12, a22 = (du * du).sum(1), (du * dv).sum(1), (dv * dv).sum(1)
+    b1, b2 = (du * dy).sum(1), (dv * dy).sum(1)
+    det = a11 * a22 - a12 * a12
+    det = np.where(np.abs(det) > 1e-30, det, 1e-30)
+    au = (0.5 * (a22 * b1 - a12 * b2) / det)[:, None]
+    av = (0.5 * (a11 * b2 - a12 * b1) / det)[:, None]
+    res = dy - 2.0 * (au * du + av * dv)
+    rho2 = (u - au) ** 2 + (v - av) ** 2
+    dist2 = res * res / (4.0 * np.maximum(rho2, 1e-12))
+    keep = max(1, int(0.8 * n))
+    return np.partition(dist2, keep - 1, axis=1)[:, :keep].mean(axis=1)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 90), st.integers(3, 300))
+def test_slice_costs_in_place_equal_the_plain_expressions(seed, k, n):
+    from symfruit.core.fits import _slice_costs
+
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    q[: n // 3] = np.round(q[: n // 3], 3)  # repeated coordinates: ties in the slices and the partition
+    dirs = rng.normal(size=(k, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    np.testing.assert_array_equal(_slice_costs(q, dirs, 12), _slice_costs_plain(q, dirs, 12))

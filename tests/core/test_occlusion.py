@@ -182,7 +182,8 @@ def test_filling_pixels_without_depth_is_skipped_only_when_there_are_none():
 
 
 def _allowed_whole_window(occ: Occlusion, region: Silhouette, gap: int, thin: int) -> np.ndarray:
-    """:meth:`Occlusion.allowed` as it was: both filters over the whole window, the kept labels by ``np.isin``."""
+    """:meth:`Occlusion.allowed` as it was: the opening, both filters and the labels over the whole window, the
+    kept labels by ``np.isin``."""
     h, w = occ.hidden.shape
     hidden = open_square(occ.hidden, 2 * thin + 1) if thin > 0 and occ.hidden.any() else occ.hidden
     seen = np.zeros((h, w), dtype=bool)
@@ -209,6 +210,10 @@ def test_allowed_on_the_seen_box_is_allowed_on_the_whole_window(seed, gap, thin)
     rng = np.random.default_rng(seed)
     h, w = (int(x) for x in rng.integers(1, 40, 2))
     hidden = rng.random((h, w)) < rng.uniform(0, 0.5)
+    if seed % 2:  # hidden pixels in part of the window only (the opening and the labels run over their box)
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        hidden[:r0] = False
+        hidden[:, c0 + int(rng.integers(1, w + 1)) :] = False
     occ = Occlusion(int(rng.integers(0, 10)), int(rng.integers(0, 10)), hidden, 60, 60)
     rh, rw = (int(x) for x in rng.integers(1, 20, 2))
     mask = rng.random((rh, rw)) < rng.uniform(0.1, 1.0)

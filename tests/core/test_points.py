@@ -108,6 +108,25 @@ def test_limits_are_keywords():
         check_cloud(VISIBLE, max_extent=0.01)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 80))
+def test_perpendicular_basis_is_the_stacked_formulation_bit_for_bit(seed, k):
+    from symfruit.core.points import perpendicular_basis
+
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(k, 3))
+    d[0] = [[1.0, 0.0, 0.0], [0.0, -0.0, 1.0], [0.95, 0.3, 0.0]][seed % 3]  # each branch, signed zeros
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    x, y, z = d[:, 0], d[:, 1], d[:, 2]  # the formulation before it was filled column by column
+    zero = np.zeros_like(x)
+    e1 = np.where((np.abs(x) < 0.9)[:, None], np.stack([zero, z, -y], axis=1), np.stack([-z, zero, x], axis=1))
+    e1 /= np.sqrt((e1 * e1).sum(axis=1))[:, None]
+    e2 = np.stack([y * e1[:, 2] - z * e1[:, 1], z * e1[:, 0] - x * e1[:, 2], x * e1[:, 1] - y * e1[:, 0]], axis=1)
+    got1, got2 = perpendicular_basis(d)
+    for got, want in ((got1, e1), (got2, e2)):
+        np.testing.assert_array_equal(got, want)
+        assert np.array_equal(np.signbit(got), np.signbit(want))
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([(50, 3), (7, 11, 3), (40, 2), (5, 4)]))
 def test_row_norms_are_numpys_bit_for_bit(seed, shape):
     from symfruit.core.points import row_norms

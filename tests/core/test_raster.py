@@ -180,6 +180,22 @@ def test_outline_cracks_are_the_pixel_squares_edges():
     assert cracks[:, 1].min() == 20 + 0.5 and cracks[:, 1].max() == 20 + 2.5
 
 
+@given(st.integers(0, 2**32 - 1))
+def test_outline_cracks_are_in_the_order_of_the_edges_then_of_the_pixels(seed):
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random(tuple(int(x) for x in rng.integers(1, 30, 2))) < rng.uniform(0.0, 1.0)
+    u0, v0 = (int(x) for x in rng.integers(0, 600, 2))
+    padded = np.pad(mask, 1)  # the plain formulation: the kept order (above, below, left, right; row-major)
+    want = []
+    for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+        shifted = padded[1 + dr : padded.shape[0] - 1 + dr, 1 + dc : padded.shape[1] - 1 + dc]
+        rows, cols = np.nonzero(mask & ~shifted)
+        want.append(np.stack((cols + 0.5 * dc + u0, rows + 0.5 * dr + v0), axis=1))
+    np.testing.assert_array_equal(outline_cracks(Silhouette(u0, v0, mask, 0.0)), np.vstack(want).astype(np.float64))
+
+
 def test_an_ellipse_is_recovered_from_part_of_its_outline(camera):
     from symfruit.core.raster import Silhouette, outline_cone, silhouette_cone
 

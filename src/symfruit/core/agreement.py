@@ -30,7 +30,7 @@ from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .occlusion import Occlusion
-from .points import as_points
+from .points import as_points, row_norms
 from .raster import Silhouette, inner_distance, outline_cone, outline_cracks, silhouette_cone
 
 __all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
@@ -317,7 +317,7 @@ def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np
 
 def _grazing(normal: np.ndarray, points: np.ndarray) -> np.ndarray:
     """(m,) bool: whether each unit ``normal`` is within 60 degrees of perpendicular to the ray to its point."""
-    ray = points / np.linalg.norm(points, axis=1, keepdims=True)
+    ray = points / row_norms(points)[:, None]
     return np.abs(np.einsum("ni,ni->n", normal, ray)) < 0.5
 
 

@@ -101,9 +101,10 @@ class Camera:
         points = np.asarray(points, dtype=np.float64)
         with np.errstate(divide="ignore", invalid="ignore"):
             inv_z = 1.0 / points[..., 2]
-        u = self.fx * points[..., 0] * inv_z + self.cx
-        v = self.fy * points[..., 1] * inv_z + self.cy
-        return np.stack([u, v], axis=-1)
+        uv = np.empty(points.shape[:-1] + (2,))  # filled in place: np.stack's overhead is most of a small call
+        uv[..., 0] = self.fx * points[..., 0] * inv_z + self.cx
+        uv[..., 1] = self.fy * points[..., 1] * inv_z + self.cy
+        return uv
 
     def rays(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Viewing rays through pixels, scaled to ``z = 1``.
@@ -123,7 +124,13 @@ class Camera:
         """
         x = (np.asarray(u) - self.cx) / self.fx
         y = (np.asarray(v) - self.cy) / self.fy
-        return np.stack([x, y, np.ones_like(x, dtype=np.float64)], axis=-1)
+        if np.shape(x) != np.shape(y):  # np.stack's error for coordinates of different shapes
+            return np.stack([x, y, np.ones_like(x, dtype=np.float64)], axis=-1)
+        out = np.empty(np.shape(x) + (3,), dtype=np.result_type(x, y, np.float64))  # as np.stack's, in place
+        out[..., 0] = x
+        out[..., 1] = y
+        out[..., 2] = 1.0
+        return out
 
     def deproject(self, uv: np.ndarray, depth: np.ndarray) -> np.ndarray:
         """Lift pixel coordinates with depth to camera-frame points.

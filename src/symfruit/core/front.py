@@ -48,7 +48,7 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     pick = np.argpartition(d2, k - 1)[:k]
     near = p[pick]
     x, y = near[:, 0] - seed[0], near[:, 1] - seed[1]
-    a = np.c_[np.ones(k), x, y, x * x, x * y, y * y]
+    a = np.stack((np.ones(k), x, y, x * x, x * y, y * y), axis=1)  # the array of np.c_, without its overhead
     coef, *_ = np.linalg.lstsq(a, near[:, 2], rcond=None)
     fitted = a @ coef
     i = int(np.argmin(fitted))

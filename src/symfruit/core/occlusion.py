@@ -165,8 +165,12 @@ class Occlusion:
         """
         h, w = self.hidden.shape
         hidden = self.hidden
-        if thin > 0 and hidden.any():
-            hidden = open_square(hidden, 2 * thin + 1)
+        if thin > 0 and (box := _box(hidden)) is not None:
+            # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
+            # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
+            (b0, b1), (a0, a1) = box
+            hidden = np.zeros_like(self.hidden)
+            hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         rh, rw = region.mask.shape
         r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
         r1, c1 = min(region.v0 + rh, self.v0 + h), min(region.u0 + rw, self.u0 + w)
@@ -189,11 +193,16 @@ class Occlusion:
             near = ndimage.maximum_filter(hidden[b0:b1, a0:a1], size=size, mode="constant", cval=False)
             allowed[b0:b1, a0:a1] |= grown & near
         allowed |= seen
-        labels, count = ndimage.label(allowed, structure=np.ones((3, 3), bool))
+        # Components are labelled over the box of the allowed pixels (none lies outside it, so no component
+        # changes), the window's rest stays outside.
+        (b0, b1), (a0, a1) = _box(allowed)  # type: ignore[misc]  # allowed holds the seen pixels
+        labels, count = ndimage.label(allowed[b0:b1, a0:a1], structure=np.ones((3, 3), bool))
         keep = np.zeros(count + 1, dtype=bool)
-        keep[labels[seen]] = True
+        keep[labels[seen[b0:b1, a0:a1]]] = True
         keep[0] = False
-        return keep[labels]
+        out = np.zeros_like(allowed)
+        out[b0:b1, a0:a1] = np.take(keep, labels)  # a table look-up: np.take is twice as fast as keep[labels]
+        return out
 
     def extent(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
         """Where the fruit seen as ``region`` can project at most: ``(u_min, v_min, u_max, v_max)``, pixels
@@ -347,6 +356,14 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 
 
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
+
+
+def _box(mask: np.ndarray) -> tuple[tuple[int, int], tuple[int, int]] | None:
+    """``((row_start, row_stop), (col_start, col_stop))`` of a bool image's true pixels; None when there are none."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if not len(rows):
+        return None
+    return (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1)
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:
