@@ -48,7 +48,7 @@ test: $(STAMP) ros-env ros2-env realsense-env  ## lint, type check and the test 
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -m "not slow" -n auto --dist loadgroup --durations=15
 
 # Coverage is its own target, not part of `make test`: measuring it (every line, and every CLI and ROS subprocess,
-# through [tool.coverage.run]) costs a fifth to a quarter more CPU than the suite itself.
+# through [tool.coverage.run]) costs about two fifths more CPU than the suite itself.
 coverage: $(STAMP) ros-env ros2-env realsense-env  ## the quick suite under coverage: the missing lines, and a failure below 95 %
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -m "not slow" -n auto --dist loadgroup --cov=symfruit --cov-report=term-missing:skip-covered \
 	  --cov-fail-under=95
