@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import fill_holes, inner_distance, rasterise, silhouette_coverage
+from symfruit.core.raster import fill_holes, inner_distance, mask_box, rasterise, silhouette_coverage
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -311,3 +311,16 @@ def test_principal_widths_are_the_covariance_s_extents_bit_for_bit(seed):
     r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
     if mask[r0:, c0:].sum() == mask.sum():  # a window holding the whole mask: the same widths at its origin
         assert principal_widths(mask[r0:, c0:], origin=(r0, c0)) == principal_widths(mask)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 12), st.integers(1, 12), st.floats(0.0, 0.3))
+def test_mask_box_is_the_extent_of_the_true_pixels(seed, h, w, fill):
+    mask = np.random.default_rng(seed).random((h, w)) < fill
+    box = mask_box(mask)
+    if not mask.any():
+        assert box is None
+        return
+    rows, cols = np.nonzero(mask)
+    assert box == (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
+    r0, r1, c0, c1 = box
+    assert mask[r0:r1, c0:c1].sum() == mask.sum() and all(isinstance(x, int) for x in box)

@@ -23,7 +23,7 @@ from ..errors import InputError
 from .camera import Camera
 from .limits import check_image_size, depth_metres
 from .points import as_points
-from .raster import Silhouette
+from .raster import Silhouette, mask_box
 
 __all__ = ["Occlusion", "occlusion", "with_own"]
 
@@ -165,10 +165,10 @@ class Occlusion:
         """
         h, w = self.hidden.shape
         hidden = self.hidden
-        if thin > 0 and (box := _box(hidden)) is not None:
+        if thin > 0 and (box := mask_box(hidden)) is not None:
             # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
             # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
-            (b0, b1), (a0, a1) = box
+            b0, b1, a0, a1 = box
             hidden = np.zeros_like(self.hidden)
             hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         rh, rw = region.mask.shape
@@ -186,16 +186,16 @@ class Occlusion:
             # both filters only matter within ``gap`` of the seen pixels: run them on the seen box grown by
             # ``2 gap`` (their inputs there), clipped to the window as the filters' own border is
             size = 2 * gap + 1
-            rows, cols = np.flatnonzero(seen.any(axis=1)), np.flatnonzero(seen.any(axis=0))
-            b0, b1 = max(int(rows[0]) - 2 * gap, 0), min(int(rows[-1]) + 2 * gap + 1, h)
-            a0, a1 = max(int(cols[0]) - 2 * gap, 0), min(int(cols[-1]) + 2 * gap + 1, w)
+            s0, s1, t0, t1 = mask_box(seen) or (0, h, 0, w)  # seen has pixels (above)
+            b0, b1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+            a0, a1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
             grown = ndimage.maximum_filter(seen[b0:b1, a0:a1], size=size, mode="constant", cval=False)
             near = ndimage.maximum_filter(hidden[b0:b1, a0:a1], size=size, mode="constant", cval=False)
             allowed[b0:b1, a0:a1] |= grown & near
         allowed |= seen
         # Components are labelled over the box of the allowed pixels (none lies outside it, so no component
         # changes), the window's rest stays outside.
-        (b0, b1), (a0, a1) = _box(allowed)  # type: ignore[misc]  # allowed holds the seen pixels
+        b0, b1, a0, a1 = mask_box(allowed) or (0, h, 0, w)  # allowed holds the seen pixels
         labels, count = ndimage.label(allowed[b0:b1, a0:a1], structure=np.ones((3, 3), bool))
         keep = np.zeros(count + 1, dtype=bool)
         keep[labels[seen[b0:b1, a0:a1]]] = True
@@ -208,16 +208,15 @@ class Occlusion:
         """Where the fruit seen as ``region`` can project at most: ``(u_min, v_min, u_max, v_max)``, pixels
         (pixel edges): the box of :meth:`allowed`; a side where it reaches the image's border is unbounded
         (``-inf`` / ``+inf``), one where it reaches the window's edge ends there."""
-        part = self.allowed(region, gap=gap, thin=thin)
-        if not part.any():
+        found = mask_box(self.allowed(region, gap=gap, thin=thin))
+        if found is None:
             return np.array([-np.inf, -np.inf, np.inf, np.inf])
-        rows, cols = np.nonzero(part.any(axis=1))[0], np.nonzero(part.any(axis=0))[0]
-        box = np.array([cols[0] + self.u0 - 0.5, rows[0] + self.v0 - 0.5, cols[-1] + self.u0 + 0.5,
-                        rows[-1] + self.v0 + 0.5])  # fmt: skip
-        box[0] = -np.inf if cols[0] + self.u0 == 0 else box[0]
-        box[1] = -np.inf if rows[0] + self.v0 == 0 else box[1]
-        box[2] = np.inf if cols[-1] + self.u0 == self.width - 1 else box[2]
-        box[3] = np.inf if rows[-1] + self.v0 == self.height - 1 else box[3]
+        r0, r1, c0, c1 = found  # pixel edges: the first row's top, the last row's bottom (r1 - 1 + 0.5)
+        box = np.array([c0 + self.u0 - 0.5, r0 + self.v0 - 0.5, c1 + self.u0 - 0.5, r1 + self.v0 - 0.5])
+        box[0] = -np.inf if c0 + self.u0 == 0 else box[0]
+        box[1] = -np.inf if r0 + self.v0 == 0 else box[1]
+        box[2] = np.inf if c1 + self.u0 == self.width else box[2]
+        box[3] = np.inf if r1 + self.v0 == self.height else box[3]
         return box
 
     def share(self) -> float:
@@ -358,14 +357,6 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
 
 
-def _box(mask: np.ndarray) -> tuple[tuple[int, int], tuple[int, int]] | None:
-    """``((row_start, row_stop), (col_start, col_stop))`` of a bool image's true pixels; None when there are none."""
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if not len(rows):
-        return None
-    return (int(rows[0]), int(rows[-1]) + 1), (int(cols[0]), int(cols[-1]) + 1)
-
-
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:
     """``scipy.ndimage.binary_opening`` of a bool image by a ``size x size`` square (odd ``size``; outside
     the image is background), as separable minimum and maximum filters: the same pixels in a sixth of the
@@ -376,12 +367,12 @@ def open_square(mask: np.ndarray, size: int) -> np.ndarray:
 
 def with_own(region: Silhouette, occ: Occlusion) -> Silhouette:
     """``region`` joined with the fruit's own pixels (:attr:`Occlusion.own`), in a window holding both."""
-    if occ.own is None or not occ.own.any():
+    if occ.own is None or (own_box := mask_box(occ.own)) is None:
         return region
-    rows, cols = np.nonzero(occ.own.any(axis=1))[0], np.nonzero(occ.own.any(axis=0))[0]
+    b0, b1, a0, a1 = own_box
     h, w = region.mask.shape
-    u0, v0 = min(region.u0, occ.u0 + int(cols[0])), min(region.v0, occ.v0 + int(rows[0]))
-    u1, v1 = max(region.u0 + w, occ.u0 + int(cols[-1]) + 1), max(region.v0 + h, occ.v0 + int(rows[-1]) + 1)
+    u0, v0 = min(region.u0, occ.u0 + a0), min(region.v0, occ.v0 + b0)
+    u1, v1 = max(region.u0 + w, occ.u0 + a1), max(region.v0 + h, occ.v0 + b1)
     mask = np.zeros((v1 - v0, u1 - u0), dtype=bool)
     mask[region.v0 - v0 : region.v0 - v0 + h, region.u0 - u0 : region.u0 - u0 + w] = region.mask
     oh, ow = occ.own.shape

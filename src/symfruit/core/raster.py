@@ -27,6 +27,7 @@ __all__ = [
     "close_ragged",
     "fill_holes",
     "inner_distance",
+    "mask_box",
     "outline_cone",
     "outline_cracks",
     "principal_widths",
@@ -225,17 +226,30 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     return _image_cone(conic, mu, camera)
 
 
+def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
+    """``(row_start, row_stop, col_start, col_stop)`` of a bool image's true pixels (stops exclusive, as slices
+    take them); None when there are none. Two reductions along the axes, not the coordinates of every pixel.
+
+    >>> m = np.zeros((6, 8), bool); m[1:3, 2:7] = True
+    >>> mask_box(m)
+    (1, 3, 2, 7)
+    """
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    if not len(rows):
+        return None
+    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+
+
 def inner_distance(mask: np.ndarray) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(mask)`` (each mask pixel's distance to the nearest
     pixel outside it), transformed over the mask's box grown by a pixel (clipped to the image) alone: a pixel on
     that grown border in the row or column of any farther background pixel is nearer, so the distances are the
     same, and a mask in a wide window costs its own box."""
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
     out = np.zeros(mask.shape)
-    if not len(rows):
+    if (box := mask_box(mask)) is None:
         return out
-    r0, r1 = max(int(rows[0]) - 1, 0), min(int(rows[-1]) + 2, mask.shape[0])
-    c0, c1 = max(int(cols[0]) - 1, 0), min(int(cols[-1]) + 2, mask.shape[1])
+    r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
+    c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
     out[r0:r1, c0:c1] = ndimage.distance_transform_edt(mask[r0:r1, c0:c1])
     return out
 

@@ -27,7 +27,7 @@ import numpy as np
 from scipy import ndimage
 
 from .points import median
-from .raster import fill_holes, inner_distance, principal_widths
+from .raster import fill_holes, inner_distance, mask_box, principal_widths
 
 __all__ = [
     "Surface",
@@ -266,11 +266,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     depth = np.where(valid, depth, 0.0)
     # What depends on the mask alone is worked out on the mask's box (the same values: pixels outside it are not
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
-    rows_in, cols_in = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    if not len(rows_in):
+    if (found := mask_box(mask)) is None:
         return None  # no depth in an empty mask
-    r0, c0 = int(rows_in[0]), int(cols_in[0])
-    box = (slice(r0, int(rows_in[-1]) + 1), slice(c0, int(cols_in[-1]) + 1))
+    r0, r1, c0, c1 = found
+    box = (slice(r0, r1), slice(c0, c1))
     own, own_depth = mask[box], depth[box]
     noise = depth_noise(own_depth, own)
     radius_px = float(np.sqrt(own.sum() / np.pi))

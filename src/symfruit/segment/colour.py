@@ -57,7 +57,7 @@ from scipy import ndimage
 
 from ..core.limits import check_image_size, depth_metres
 from ..core.points import median, row_norms
-from ..core.raster import fill_holes
+from ..core.raster import fill_holes, mask_box
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -568,9 +568,9 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
 
 
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    x = sl[1].start + (cols[0] + cols[-1] + 1) / 2
-    y = sl[0].start + (rows[0] + rows[-1] + 1) / 2
+    r0, r1, c0, c1 = mask_box(mask) or (0, 0, 0, 0)  # a found piece is never empty
+    x = sl[1].start + (c0 + c1) / 2
+    y = sl[0].start + (r0 + r1) / 2
     return round(x / 20), y
 
 
