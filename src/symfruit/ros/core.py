@@ -219,10 +219,15 @@ def stop_signals(signals: tuple[signal.Signals, ...] = (signal.SIGINT, signal.SI
     previous = signal.pthread_sigmask(signal.SIG_BLOCK, signals)
 
     def wait() -> int:
+        me = threading.get_ident()
         while not caught:
             info = signal.sigtimedwait(signals, 0.2)
             if info is not None:
                 return info.si_signo
+            # A signal another thread took is marked for the main thread, but the interpreter may not get round to
+            # ``note`` by itself (since Python 3.12 a thread that cannot run handlers does not flag the main one):
+            # signal 0 to this thread sends nothing, and pthread_kill then runs the handlers due.
+            signal.pthread_kill(me, 0)
         return caught[0]
 
     try:
