@@ -147,3 +147,18 @@ def test_median_is_numpys_bit_for_bit(seed, dtype):
     got, expected = median(x), np.median(x)
     assert type(got) is type(expected)
     assert got == expected or (np.isnan(got) and np.isnan(expected))
+
+
+SHAPE_PAIRS = [((3,), (3,)), ((3,), (9, 3)), ((9, 3), (9, 3)), ((4, 1, 3), (5, 3))]
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from(SHAPE_PAIRS))
+def test_cross_rows_is_numpys_cross_bit_for_bit(seed, shapes):
+    from symfruit.core.points import cross_rows
+
+    rng = np.random.default_rng(seed)
+    a, b = rng.normal(size=shapes[0]), rng.normal(size=shapes[1])
+    got = cross_rows(a, b)
+    np.testing.assert_array_equal(got, np.cross(a, b))
+    assert got.shape == np.broadcast_shapes(a.shape, b.shape) and got.dtype == np.float64
+    assert cross_rows(a.astype(np.float32), b.astype(np.float32)).dtype == np.float32

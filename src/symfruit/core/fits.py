@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points, perpendicular_basis, row_norms
+from .points import as_points, cross_rows, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
@@ -575,9 +575,7 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     """
     mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     c = rev.point[None, :] + mid[:, None] * rev.direction[None, :]  # (b, 3)
-    d = rev.direction  # e = d x c term by term (np.cross computes the same products and differences)
-    e = np.stack((d[1] * c[:, 2] - d[2] * c[:, 1], d[2] * c[:, 0] - d[0] * c[:, 2], d[0] * c[:, 1] - d[1] * c[:, 0]),
-                 axis=1)  # fmt: skip
+    e = cross_rows(rev.direction, c)
     e /= np.maximum(row_norms(e), 1e-12)[:, None]
     uc = camera.project(c)
     du = camera.project(c + 1e-3 * e) - uc

@@ -18,6 +18,7 @@ __all__ = [
     "bounds",
     "check_cloud",
     "check_view",
+    "cross_rows",
     "mean_point",
     "median",
     "perpendicular_basis",
@@ -45,6 +46,18 @@ def row_norms(x: np.ndarray) -> np.ndarray:
     if x.shape[-1] == 3:
         total += x[..., 2] * x[..., 2]
     return np.sqrt(total)
+
+
+def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """``np.cross(a, b)`` of 3-vectors along the last axis (broadcast), term by term into one array: the same
+    products and differences, so the same values, without np.cross's overhead (some 20 us a call, several times
+    the arithmetic on the few vectors the fits and rays cross)."""
+    a, b = np.asarray(a), np.asarray(b)
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape), dtype=np.result_type(a, b, 0.0))
+    out[..., 0] = a[..., 1] * b[..., 2] - a[..., 2] * b[..., 1]
+    out[..., 1] = a[..., 2] * b[..., 0] - a[..., 0] * b[..., 2]
+    out[..., 2] = a[..., 0] * b[..., 1] - a[..., 1] * b[..., 0]
+    return out
 
 
 def median(values: np.ndarray) -> Any:
@@ -223,8 +236,4 @@ def perpendicular_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e1[:, 1] = np.where(use_x, z, 0.0)
     e1[:, 2] = np.where(use_x, -y, x)
     e1 /= row_norms(e1)[:, None]
-    e2 = np.empty_like(e1)
-    e2[:, 0] = y * e1[:, 2] - z * e1[:, 1]
-    e2[:, 1] = z * e1[:, 0] - x * e1[:, 2]
-    e2[:, 2] = x * e1[:, 1] - y * e1[:, 0]
-    return e1, e2
+    return e1, cross_rows(d, e1)
