@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import functools
 import os
+import signal
 from pathlib import Path
 
 import numpy as np
@@ -35,6 +36,14 @@ settings.register_profile(
     max_examples=int(os.environ.get("SYMFRUIT_FUZZ_EXAMPLES", "1000")),
 )  # fmt: skip
 settings.load_profile(os.environ.get("SYMFRUIT_HYPOTHESIS", "ci"))
+
+# A shell that starts a job in the background without job control (``make test &`` in a script, ``nohup``) starts
+# it with SIGINT ignored, and an ignored signal stays ignored in every process started from it: the nodes, masters
+# and children these tests stop with SIGINT would then take their kill timeouts instead (30 s, and the restored
+# handler a test compares with is SIG_IGN). Each process of the suite (xdist's workers load this file too) takes
+# SIGINT back, so what its children inherit does not depend on how the suite was started.
+if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+    signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.hookimpl(trylast=True)
