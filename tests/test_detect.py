@@ -188,3 +188,29 @@ def test_masks_are_trimmed_before_they_move_onto_the_depth():
     assert found.registration == (6, 0)
     (d,) = found.detections
     assert np.array_equal(d.mask, (xx - 76) ** 2 + (yy - 60) ** 2 <= 22**2)
+
+
+def test_a_fruit_on_depth_registered_off_the_colour_is_where_the_colour_camera_sees_it():
+    """Depth registered 6 px right and 4 px below the colour: once the masks are moved onto it, the points
+    deproject to where the colour camera (whose frame the intrinsics are) sees them, the same as on the
+    well-registered frame, not 6 px x depth / f to the side (what deprojecting with the colour camera's own
+    principal point gave)."""
+    color, depth = disc_frame([(70, 60)], radius=22)
+    moved = np.full_like(depth, 1.0)
+    moved[4:, 6:] = depth[:-4, :-6]  # what colour pixel (u, v) sees lies at depth pixel (u + 6, v + 4)
+    straight = detect(Frame("straight", color, depth, SMALL_CAM), method="raw")
+    shifted = detect(Frame("shifted", color, moved, SMALL_CAM, masks=straight_masks(straight)), method="raw")
+    assert straight.registration == (0, 0) and shifted.registration == (6, 4)
+    (a,), (b,) = straight.detections, shifted.detections
+    assert len(a.extraction.points) == len(b.extraction.points) > 500
+    order = np.lexsort(a.extraction.points.T), np.lexsort(b.extraction.points.T)
+    np.testing.assert_allclose(b.extraction.points[order[1]], a.extraction.points[order[0]], atol=1e-12)
+    np.testing.assert_allclose(b.result.box.centre, a.result.box.centre, atol=1e-9)
+
+
+def straight_masks(found) -> np.ndarray:
+    """The label image of a frame's detections (each detection's mask, numbered by its id)."""
+    labels = np.zeros(found.detections[0].mask.shape, np.int32)
+    for d in found.detections:
+        labels[d.mask] = d.id
+    return labels

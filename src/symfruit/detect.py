@@ -66,6 +66,14 @@ class FrameDetections:
     mask_source: str = ""
     registration: tuple[int, int] = (0, 0)
 
+    @property
+    def camera(self) -> Camera:
+        """The camera of the detections' masks, points and occlusion maps: the frame's, its principal point moved
+        by :attr:`registration` (:meth:`~symfruit.core.camera.Camera.shifted`; the points are in the frame
+        camera's frame). Complete a detection's points again with this one."""
+        cam = self.frame.camera
+        return cam.shifted(*self.registration) if self.registration != (0, 0) else cam
+
 
 Segmenter = Callable[[Frame, Settings], np.ndarray]
 
@@ -135,6 +143,10 @@ def detect(
         labels = trim_labels(frame.color, labels, settings.extract)
     t_trim = time.perf_counter() - t2
     labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
+    # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
+    # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
+    # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
+    camera = FrameDetections(frame, [], registration=shift).camera
     detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
     from scipy import ndimage
@@ -146,7 +158,7 @@ def detect(
         mask = np.zeros(labels.shape, bool)
         mask[sl] = labels[sl] == k
         a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame, settings)
+        ex = _extract_window(mask, sl, frame.depth, camera, settings)
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
@@ -158,10 +170,10 @@ def detect(
             continue
         occ = None
         try:
-            occ = fruit_occlusion(frame.depth, mask, ex.points, frame.camera, settings.occlusion,
+            occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
                                   others=fruit_px & ~mask)  # fmt: skip
             t_occlusion += time.perf_counter() - b
-            result = complete(ex.points, camera=frame.camera, method=method, settings=settings, occlusion=occ)
+            result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
         except SymfruitError as exc:
             detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
@@ -173,16 +185,17 @@ def detect(
     return FrameDetections(frame, detections, timings, source, shift)
 
 
-def _extract_window(mask: np.ndarray, sl: tuple[slice, slice], frame: Frame, settings: Settings) -> Extraction:
+def _extract_window(
+    mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings
+) -> Extraction:
     """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test."""
     h, w = mask.shape
     pad = settings.extract.erode_px + 2
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-    cam = frame.camera
     window = mask[r0:r1, c0:c1]
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
-    ex = extract(window, frame.depth[r0:r1, c0:c1], local, settings.extract)
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     outline = mask.copy()
     if ex.silhouette is not None:

@@ -108,3 +108,14 @@ def test_project_and_rays_are_the_stacked_formulas_bit_for_bit(seed, shape):
         got = cam.rays(u, v)
         assert got.dtype == want.dtype
         np.testing.assert_array_equal(got, want)
+
+
+@given(st.floats(-20, 20), st.floats(-20, 20), st.floats(-0.3, 0.3), st.floats(-0.2, 0.2), st.floats(0.2, 3.0))
+def test_a_shifted_camera_sees_every_point_shifted_and_deprojects_it_back(du, dv, x, y, z):
+    cam = Camera(fx=600.0, fy=590.0, cx=320.0, cy=240.0, width=640, height=480)
+    moved = cam.shifted(du, dv)
+    p = np.array([[x, y, z]])
+    np.testing.assert_allclose(moved.project(p), cam.project(p) + [du, dv], atol=1e-9)
+    np.testing.assert_allclose(moved.deproject(moved.project(p), [z]), p, atol=1e-12)
+    assert (moved.fx, moved.fy, moved.width, moved.height) == (cam.fx, cam.fy, cam.width, cam.height)
+    assert cam.shifted(0, 0) == cam

@@ -6,7 +6,7 @@ Pixel ``(u, v)`` has its centre at integer coordinates: a point projects to
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
@@ -80,6 +80,20 @@ class Camera:
     def matrix(self) -> np.ndarray:
         """(3, 3) float: the intrinsic matrix K."""
         return np.array([[self.fx, 0.0, self.cx], [0.0, self.fy, self.cy], [0.0, 0.0, 1.0]])
+
+    def shifted(self, du: float, dv: float) -> Camera:
+        """The camera of an image whose content sits ``(du, dv)`` pixels from this camera's: what this camera sees at
+        pixel ``(u, v)`` lies at ``(u + du, v + dv)`` there (a depth image registered a few pixels off the colour
+        image, :func:`symfruit.extract.register`). Its principal point moves by the shift, so a pixel of that
+        image deprojects to the point this camera sees there: the point is in this camera's frame.
+
+        Examples
+        --------
+        >>> cam = Camera(fx=600.0, fy=600.0, cx=320.0, cy=240.0, width=640, height=480)
+        >>> cam.shifted(6, -2).project(cam.deproject([[100.0, 50.0]], [1.0]))
+        array([[106.,  48.]])
+        """
+        return replace(self, cx=self.cx + float(du), cy=self.cy + float(dv))
 
     def to_dict(self) -> dict[str, float | int]:
         """The six intrinsics as a plain dict (the layout :func:`symfruit.io.load_camera` reads)."""

@@ -68,7 +68,7 @@ def score_frame(
         tid, tbox = truth[j]
         for method in methods:
             try:
-                box = complete(d.extraction.points, camera=frame.camera, method=method, settings=settings,
+                box = complete(d.extraction.points, camera=found.camera, method=method, settings=settings,
                                occlusion=d.occlusion).box  # fmt: skip
             except SymfruitError:
                 continue

@@ -81,10 +81,12 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
     inst = build(spec)
     visible, mask = inst.visible, inst.mask
     failed = ""
+    camera = inst.camera
     if inst.extract and mask is not None and inst.depth is not None:  # as ``detect`` takes a fruit's points
-        moved, _ = register(mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
+        moved, shift = register(mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
         mask = moved > 0
-        ex = extract(mask, inst.depth, inst.camera, settings.extract)
+        camera = inst.camera.shifted(*shift) if shift != (0, 0) else inst.camera
+        ex = extract(mask, inst.depth, camera, settings.extract)
         visible = ex.points
         mask = ex.silhouette if ex.silhouette is not None else mask
         if len(visible) < settings.extract.min_points:
@@ -97,12 +99,12 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
     rows = []
     occlusion = None
     if inst.depth is not None and mask is not None and len(visible) and not failed:
-        occlusion = fruit_occlusion(inst.depth, mask, visible, inst.camera, settings.occlusion)
+        occlusion = fruit_occlusion(inst.depth, mask, visible, camera, settings.occlusion)
     for method in methods:
         try:
             if failed:
                 raise InputError(failed)
-            result = complete(visible, camera=inst.camera, method=method, settings=settings, occlusion=occlusion)
+            result = complete(visible, camera=camera, method=method, settings=settings, occlusion=occlusion)
         except SymfruitError as exc:
             nan = float("nan")
             rows.append(Row(**base, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan,
