@@ -214,3 +214,23 @@ def test_reading_a_large_photo_and_drawing_its_overlay_stays_within_a_few_bytes_
                          text=True, timeout=600)  # fmt: skip
     assert run.returncode == 0, run.stderr
     assert float(run.stdout) < 20.0
+
+
+def test_the_overlay_tints_each_fruit_where_the_colour_image_shows_it():
+    """Depth registered 6 px right of the colour: the masks move onto the depth image, and the overlay moves them
+    back onto the colour image's pixels (tinted 6 px to the right of the fruit before)."""
+    from symfruit.core.frame import Frame
+    from symfruit.detect import detect
+
+    from .conftest import SMALL_CAM, disc_frame
+
+    color, depth = disc_frame([(70, 60)], radius=22)
+    moved = np.full_like(depth, 1.0)
+    moved[:, 6:] = depth[:, :-6]
+    yy, xx = np.mgrid[:120, :160]
+    masks = ((xx - 70) ** 2 + (yy - 60) ** 2 <= 22**2).astype(np.int32)
+    found = detect(Frame("shifted", color, moved, SMALL_CAM, masks=masks), method="raw")
+    assert found.registration == (6, 0)
+    tinted = np.any(np.asarray(draw_overlay(found)) != color, axis=2)
+    assert tinted[60, 50] and tinted[60, 89]  # the disc's left and right ends in the colour image
+    assert not tinted[60, 95]  # beside the disc, where the moved mask reached (it ends at column 98)

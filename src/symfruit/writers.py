@@ -34,6 +34,7 @@ import numpy as np
 from .core.box import Box
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError, OutputError
+from .extract import shift_labels
 from .io.atomic import atomic_write, folder_fd, stale_temporaries, write_json
 from .io.clouds import write_ply
 from .io.images import BAND_PIXELS
@@ -249,10 +250,13 @@ def draw_overlay(found: FrameDetections) -> Any:
     from PIL import Image, ImageDraw
 
     frame = found.frame
+    du, dv = found.registration
     image = frame.color.copy()  # tinted fruit by fruit (their masks are disjoint): no full-size float copy
     for i, d in enumerate(found.detections):
-        tinted = 0.55 * image[d.mask].astype(np.float32) + 0.45 * _PALETTE[i % len(_PALETTE)].astype(np.float32)
-        image[d.mask] = np.clip(tinted, 0, 255).astype(np.uint8)
+        # the masks lie on the depth image: moved back by the registration shift onto the colour image's pixels
+        mask = shift_labels(d.mask, -du, -dv) if (du, dv) != (0, 0) else d.mask
+        tinted = 0.55 * image[mask].astype(np.float32) + 0.45 * _PALETTE[i % len(_PALETTE)].astype(np.float32)
+        image[mask] = np.clip(tinted, 0, 255).astype(np.uint8)
     img = Image.fromarray(image)
     del image
     draw = ImageDraw.Draw(img)
@@ -267,7 +271,7 @@ def draw_overlay(found: FrameDetections) -> Any:
             for a, b in _EDGES:
                 draw.line([tuple(uv[a]), tuple(uv[b])], fill=colour, width=1)
         rows, cols = np.nonzero(d.mask)
-        label_at = (int(cols.min()), max(int(rows.min()) - 12, 0))
+        label_at = (min(max(int(cols.min()) - du, 0), frame.camera.width - 1), max(int(rows.min()) - dv - 12, 0))
         if d.result is not None:
             u, v = cam.project(d.result.centre[None])[0]
             draw.line([(u - 4, v), (u + 4, v)], fill=COMPLETED_COLOUR, width=2)
