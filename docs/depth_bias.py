@@ -51,15 +51,16 @@ def main() -> None:
                 for spec in specs("camera", fruit, n=args.n, sensor=args.sensor, seed=0):
                     inst = build(spec)
                     assert inst.mask is not None and inst.depth is not None
-                    moved, _ = register(inst.mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
-                    ex = extract(moved > 0, inst.depth, inst.camera, settings.extract)
+                    moved, shift = register(inst.mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
+                    camera = inst.camera.shifted(*shift)  # as detect: the points in the colour camera's frame
+                    ex = extract(moved > 0, inst.depth, camera, settings.extract)
                     if len(ex.points) < settings.extract.min_points:
                         continue
                     mask = ex.silhouette if ex.silhouette is not None else moved > 0
-                    occ = fruit_occlusion(inst.depth, mask, ex.points, inst.camera, settings.occlusion)
+                    occ = fruit_occlusion(inst.depth, mask, ex.points, camera, settings.occlusion)
                     t = inst.truth_box
                     for m in methods:
-                        r = complete(ex.points, camera=inst.camera, method=m, settings=settings, occlusion=occ)
+                        r = complete(ex.points, camera=camera, method=m, settings=settings, occlusion=occ)
                         b = r.box
                         s = score_completion(b, r.points, t, inst.truth_surface)
                         d = 1000 * np.r_[b.centre[2] - t.centre[2], b.min[2] - t.min[2], b.max[2] - t.max[2],

@@ -37,7 +37,7 @@ def main() -> None:
             for i, j in match([d.visible_box for d in ok], [b for _, b in truth]):
                 d, t = ok[i], truth[j][1]
                 for m in methods:
-                    b = complete(d.extraction.points, camera=frame.camera, method=m, settings=settings,
+                    b = complete(d.extraction.points, camera=found.camera, method=m, settings=settings,
                                  occlusion=d.occlusion).box  # fmt: skip
                     rows[m].append([1000 * (b.centre[2] - t.centre[2]), 1000 * (b.min[2] - t.min[2]),
                                     1000 * (b.max[2] - t.max[2])])  # fmt: skip
