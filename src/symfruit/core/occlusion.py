@@ -104,11 +104,15 @@ class Occlusion:
         col = np.rint(np.asarray(u, dtype=np.float64)).astype(np.intp)
         row = np.rint(np.asarray(v, dtype=np.float64)).astype(np.intp)
         out = (col < radius) | (col >= self.width - radius) | (row < radius) | (row >= self.height - radius)
-        hidden = self.grown(radius)
-        h, w = hidden.shape
+        h, w = self.hidden.shape
         c, r = col - self.u0, row - self.v0
         inside = (c >= 0) & (c < w) & (r >= 0) & (r < h)
-        out[inside] |= hidden[r[inside], c[inside]]
+        if radius <= 0 or not inside.any():
+            out[inside] |= self.hidden[r[inside], c[inside]]
+            return out
+        r, c = r[inside], c[inside]  # the grown map over these pixels' box alone (:meth:`grown_part`)
+        r0, c0 = int(r.min()), int(c.min())
+        out[inside] |= self.grown_part(radius, r0, int(r.max()) + 1, c0, int(c.max()) + 1)[r - r0, c - c0]
         return out
 
     def grown(self, radius: int) -> np.ndarray:
@@ -122,6 +126,24 @@ class Occlusion:
             found.flags.writeable = False
             self._grown[radius] = found
         return found
+
+    def grown_part(self, radius: int, r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        """(r1 - r0, c1 - c0) bool: rows ``r0:r1`` and columns ``c0:c1`` of :meth:`grown` (window pixels, inside
+        the window), the same values, filtered over that box grown by ``radius`` alone (the filter's square
+        reaches no farther; beyond the window it reads nothing hidden either way). A fruit's outline or seen
+        region is a small part of its occlusion window (which reaches to where the fruit could project), and
+        filtering the whole window cost more than the rest of :func:`~symfruit.core.agreement.observe`'s
+        occlusion look-ups; a map :meth:`grown` has already made is cut instead."""
+        found = self._grown.get(radius)
+        if radius <= 0 or found is not None:
+            return (self.hidden if radius <= 0 else found)[r0:r1, c0:c1]
+        h, w = self.hidden.shape
+        g0, g1, f0, f1 = max(r0 - radius, 0), min(r1 + radius, h), max(c0 - radius, 0), min(c1 + radius, w)
+        part = self.hidden[g0:g1, f0:f1]
+        if not part.any():
+            return part[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
+        grown = ndimage.maximum_filter(part, size=2 * radius + 1, mode="constant", cval=False)
+        return grown[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
 
     def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
         """(m,) float, metres: what the camera saw at pixels ``(u, v)`` (rounded), NaN where nothing or outside
@@ -145,14 +167,13 @@ class Occlusion:
         out = ((v < radius) | (v >= self.height - radius))[:, None] | ((u < radius) | (u >= self.width - radius))[
             None, :
         ]
-        hidden = self.grown(radius)
-        gh, gw = hidden.shape
+        gh, gw = self.hidden.shape
         r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
         r1, c1 = min(region.v0 + h, self.v0 + gh), min(region.u0 + w, self.u0 + gw)
         if r1 > r0 and c1 > c0:
-            out[r0 - region.v0 : r1 - region.v0, c0 - region.u0 : c1 - region.u0] |= hidden[
-                r0 - self.v0 : r1 - self.v0, c0 - self.u0 : c1 - self.u0
-            ]
+            out[r0 - region.v0 : r1 - region.v0, c0 - region.u0 : c1 - region.u0] |= self.grown_part(
+                radius, r0 - self.v0, r1 - self.v0, c0 - self.u0, c1 - self.u0
+            )
         return out
 
     def allowed(self, region: Silhouette, *, gap: int = 2, thin: int = 0) -> np.ndarray:
