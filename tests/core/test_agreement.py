@@ -209,3 +209,22 @@ def test_a_view_on_the_image_border_whose_points_round_beyond_it(camera):
     region = silhouette(pts, camera)
     obs = observe(pts[::5], region, camera, dense=pts)
     assert obs.contour < 1.0  # the border is a cut
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(2, 40))
+def test_march_samples_every_ray_at_every_depth_as_broadcasting_did(seed, steps):
+    """The march's points are made as tiled rows, the same products as ``rays[:, None] * zs[None, :, None]``."""
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(1, 60))
+    rays = np.c_[rng.normal(0.0, 0.2, (m, 2)), np.ones(m)]
+    seen = []
+
+    def inside(x):
+        seen.append(x.copy())
+        return np.ones(x.shape[:-1])
+
+    z0, z1 = sorted(rng.uniform(0.1, 2.0, 2))
+    march(inside, rays, z0, z1, steps=steps)
+    zs = np.linspace(z0, z1, steps)
+    assert seen[0].shape == (len(rays), steps, 3)
+    assert np.array_equal(seen[0], rays[:, None, :] * zs[None, :, None])

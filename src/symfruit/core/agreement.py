@@ -392,7 +392,11 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
     depth : (m,) float, metres (NaN where there is no hit; ``z0`` where the ray starts inside)
     """
     zs = np.linspace(z0, z1, steps)
-    f = inside(rays[:, None, :] * zs[None, :, None])  # (m, steps)
+    # (m, steps, 3): every ray times every depth, made as rows of ``steps`` copies of the ray times each depth
+    # repeated per component (the same products; broadcasting over a last axis of 3 ran numpy's inner loop once
+    # per point, several times the arithmetic)
+    points = (np.tile(rays, steps) * np.repeat(zs, 3)).reshape(len(rays), steps, 3)
+    f = inside(points)  # (m, steps)
     pos = f > 0
     hit = np.asarray(pos.any(axis=1))
     first = np.argmax(pos, axis=1)

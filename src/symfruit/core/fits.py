@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points, cross_rows, perpendicular_basis, row_norms
+from .points import as_points, cross_rows, median, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
@@ -180,10 +180,11 @@ def surface_noise(
     k = min(small, k_large)
     near = hood[:, :k] - hood[:, :k].mean(axis=1, keepdims=True)
     values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near) / k)
-    small_res, normals = np.sqrt(max(float(np.median(values[:, 0])), 0.0)), vectors[:, :, 0]
+    # medians by core.points.median: np.median's values, without its general-axis machinery
+    small_res, normals = np.sqrt(max(float(median(values[:, 0])), 0.0)), vectors[:, :, 0]
     wide = hood - hood.mean(axis=1, keepdims=True)
     large_res = np.sqrt(
-        max(float(np.median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
+        max(float(median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
     )
     flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
     normals[flip] *= -1.0
@@ -646,12 +647,23 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     """Signed inside measure of points ``x`` (..., 3): the profile's radius minus the distance to the axis,
     metres (positive inside; beyond the profile's ends, minus the distance past the end as well)."""
     t_prof, r_prof = closed_profile(rev, close=close)
-    rel = np.asarray(x, dtype=np.float64) - rev.point
+    x = np.asarray(x, dtype=np.float64)
+    shape = x.shape[:-1]
+    flat = x.reshape(-1, 3)
+    # Component by component: ``x - point`` and ``rel - t direction`` broadcast over a last axis of 3 ran numpy's
+    # inner loop once per point (a march's 6,000 points: several times the arithmetic); these are the same
+    # subtractions and products, one strided pass per component, and ``rel @ direction`` the same product.
+    rel = np.empty_like(flat)
+    for c in range(3):  # three components, not a loop over points
+        np.subtract(flat[:, c], rev.point[c], out=rel[:, c])
     t = rel @ rev.direction
-    rho = row_norms(rel - t[..., None] * rev.direction)
+    off = [rel[:, c] - t * rev.direction[c] for c in range(3)]
+    total = off[0] * off[0] + off[1] * off[1]  # as row_norms: numpy sums the three squares left to right
+    total += off[2] * off[2]
+    rho = np.sqrt(total)
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
-    return r - rho - past
+    return (r - rho - past).reshape(shape)
 
 
 # --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------

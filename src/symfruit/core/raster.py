@@ -7,7 +7,8 @@ falling outside it with an upper bound of their distance to the mask).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -141,6 +142,9 @@ class Silhouette:
     v0: int
     mask: np.ndarray
     fill_radius: float
+    #: What :func:`silhouette_cone`, :func:`across_sight` and :func:`outline_cracks` work out of the mask alone,
+    #: made once per region and read-only (no code changes a region's mask in place once the region holds it).
+    _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius: float | None = None) -> Silhouette:
@@ -208,6 +212,22 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     image coordinates ``x = ((u - cx) / fx, (v - cy) / fy, 1)`` the cone is ``x^T C x = 0``, negative
     inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
     """
+    _, mu, cov = _moments(region)
+    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
+    conic = np.zeros((3, 3))
+    conic[:2, :2] = inv
+    conic[:2, 2] = conic[2, :2] = -inv @ mu
+    conic[2, 2] = mu @ inv @ mu - 1.0
+    return _image_cone(conic, mu, camera)
+
+
+def _moments(region: Silhouette) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(n, centroid (2,), covariance (2, 2))`` of a region's pixels (image coordinates ``u, v``; the covariance
+    of the pixel centres), made once per region: :func:`silhouette_cone` and :func:`across_sight` both read them
+    (kept read-only; an empty region's are NaN, not kept)."""
+    found = region._made.get("moments")
+    if found is not None:
+        return found  # type: ignore[no-any-return]
     m = region.mask.astype(np.float64)
     h, w = m.shape
     u = np.arange(w, dtype=np.float64) + region.u0
@@ -218,12 +238,10 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     du, dv = u - mu[0], v - mu[1]
     cross = dv @ m @ du  # once: the same product twice was a second pass over the window
     cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
-    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
-    conic = np.zeros((3, 3))
-    conic[:2, :2] = inv
-    conic[:2, 2] = conic[2, :2] = -inv @ mu
-    conic[2, 2] = mu @ inv @ mu - 1.0
-    return _image_cone(conic, mu, camera)
+    if n > 0:
+        mu.flags.writeable = cov.flags.writeable = False
+        region._made["moments"] = (float(n), mu, cov)
+    return float(n), mu, cov
 
 
 def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
@@ -234,7 +252,8 @@ def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     >>> mask_box(m)
     (1, 3, 2, 7)
     """
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    # the ufunc's reduction and nonzero() directly: the method and np.flatnonzero add their wrappers' calls
+    rows, cols = np.logical_or.reduce(mask, axis=1).nonzero()[0], np.logical_or.reduce(mask, axis=0).nonzero()[0]
     if not len(rows):
         return None
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
@@ -346,17 +365,9 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     >>> round(a.minor * 500, 3), round(a.major * 500, 3)
     (10.0, 20.0)
     """
-    m = region.mask.astype(np.float64)
-    col_sums, row_sums = m.sum(axis=0), m.sum(axis=1)
-    n = col_sums.sum()
-    if n == 0:
+    if not region.mask.any():
         raise InputError("the region is empty")
-    u = np.arange(m.shape[1], dtype=np.float64) + region.u0
-    v = np.arange(m.shape[0], dtype=np.float64) + region.v0
-    mu = np.array([col_sums @ u, row_sums @ v]) / n
-    du, dv = u - mu[0], v - mu[1]
-    cross = dv @ m @ du  # once: the same product twice was a second pass over the window
-    cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
+    _, mu, cov = _moments(region)
     axis = camera.rays(mu[0], mu[1]).reshape(3)
     axis = axis / np.linalg.norm(axis)
     e1 = np.array([axis[2], 0.0, -axis[0]])
@@ -388,7 +399,11 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
     """(m, 2) float, pixels: the region's outline as the midpoints of the pixel edges between a region pixel
-    and a 4-neighbour outside it (image coordinates: the exact boundary of the pixel squares)."""
+    and a 4-neighbour outside it (image coordinates: the exact boundary of the pixel squares). Made once per region
+    (:func:`~symfruit.core.agreement.observe` and :func:`across_sight` both read it), read-only."""
+    found = region._made.get("cracks")
+    if found is not None:
+        return found  # type: ignore[no-any-return]
     mask = region.mask
     h, w = mask.shape
     m = np.zeros((h + 2, w + 2), dtype=bool)  # padded by hand: np.pad's overhead was a fifth of the call
@@ -400,7 +415,10 @@ def outline_cracks(region: Silhouette) -> np.ndarray:
         np.add(cols, 0.5 * dc + region.u0, out=uv[:, 0])
         np.add(rows, 0.5 * dr + region.v0, out=uv[:, 1])
         out.append(uv)
-    return np.concatenate(out)
+    cracks = np.concatenate(out)
+    cracks.flags.writeable = False
+    region._made["cracks"] = cracks
+    return cracks
 
 
 def outline_cone(
