@@ -347,20 +347,38 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
     depth a pixel away, and a feature transform of the window (most of which has depth) costs many times more.
     Among equally near pixels scipy's transform picks the one of least column, then least row offset; so
     do the offsets' order here (checked against the transform on random dropouts, ties included).
+
+    The pixels to fill read their offsets by flat index into the valid map padded by ``reach`` (nothing valid in
+    the pad), all of them the four offsets a pixel away at once, then those still without depth (a third on the
+    benchmark frame) the rest at once, each taking its first valid one: a loop over the offsets cost some ten
+    numpy calls each.
     """
     h, w = d.shape
-    rows, cols = np.nonzero(~valid & ~own)
+    rows, cols = np.nonzero(~(valid | own))
     out = d.copy()
-    todo = np.arange(len(rows))
-    for dr, dc in _offsets(reach):
-        if not len(todo):
+    if not len(rows):
+        return out
+    pw = w + 2 * reach
+    padded = np.zeros((h + 2 * reach, pw), dtype=bool)
+    padded[reach : reach + h, reach : reach + w] = valid
+    offsets = _offsets(reach)
+    steps = np.array([dr * pw + dc for dr, dc in offsets], dtype=np.intp)
+    todo = (rows + reach) * pw + (cols + reach)  # padded flat index of each pixel to fill
+    dst, src = [], []
+    for group in (steps[:4], steps[4:]):  # the offsets a pixel away (every reach has four), then the rest
+        if not len(todo) or not len(group):
             break
-        r, c = rows[todo] + dr, cols[todo] + dc
-        inside = (r >= 0) & (r < h) & (c >= 0) & (c < w)
-        hit = np.zeros(len(todo), dtype=bool)
-        hit[inside] = valid[r[inside], c[inside]]
-        out[rows[todo[hit]], cols[todo[hit]]] = d[r[hit], c[hit]]
-        todo = todo[~hit]
+        at = todo[:, None] + group[None, :]  # (m, offsets), nearest first
+        ok = np.take(padded.ravel(), at)
+        first = ok.argmax(axis=1)
+        pick = np.arange(len(todo))
+        found = ok[pick, first]
+        dst.append(todo[found])
+        src.append(at[pick, first][found])
+        todo = todo[~found]
+    dst_i, src_i = np.concatenate(dst), np.concatenate(src)
+    # padded flat indices back to the window's
+    out.ravel()[(dst_i // pw - reach) * w + dst_i % pw - reach] = np.take(d.ravel(), (src_i // pw - reach) * w + src_i % pw - reach)
     return out
 
 
