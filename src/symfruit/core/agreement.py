@@ -31,7 +31,7 @@ from scipy.spatial import cKDTree
 from .camera import Camera
 from .occlusion import Occlusion
 from .points import as_points, row_norms
-from .raster import Silhouette, inner_distance, outline_cone, outline_cracks, silhouette_cone
+from .raster import Silhouette, inner_distance, interior, outline_cone, outline_cracks, silhouette_cone
 
 __all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
@@ -300,7 +300,7 @@ def _occluded_edges(
     where the normal of the nearest edge point (``edge_uv``, ``is_contour``; none: every one) says so and
     no hidden pixel lies within ``radius`` pixels."""
     mask = region.mask
-    rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask))
+    rows, cols = np.nonzero(mask & ~interior(mask))
     step = max(1, len(rows) // (2 * count))
     uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)

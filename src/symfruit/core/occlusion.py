@@ -134,9 +134,11 @@ class Occlusion:
         region is a small part of its occlusion window (which reaches to where the fruit could project), and
         filtering the whole window cost more than the rest of :func:`~symfruit.core.agreement.observe`'s
         occlusion look-ups; a map :meth:`grown` has already made is cut instead."""
+        if radius <= 0:
+            return self.hidden[r0:r1, c0:c1]
         found = self._grown.get(radius)
-        if radius <= 0 or found is not None:
-            return (self.hidden if radius <= 0 else found)[r0:r1, c0:c1]
+        if found is not None:
+            return found[r0:r1, c0:c1]
         h, w = self.hidden.shape
         g0, g1, f0, f1 = max(r0 - radius, 0), min(r1 + radius, h), max(c0 - radius, 0), min(c1 + radius, w)
         part = self.hidden[g0:g1, f0:f1]
@@ -378,7 +380,8 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
         todo = todo[~found]
     dst_i, src_i = np.concatenate(dst), np.concatenate(src)
     # padded flat indices back to the window's
-    out.ravel()[(dst_i // pw - reach) * w + dst_i % pw - reach] = np.take(d.ravel(), (src_i // pw - reach) * w + src_i % pw - reach)
+    src_w = (src_i // pw - reach) * w + src_i % pw - reach
+    out.ravel()[(dst_i // pw - reach) * w + dst_i % pw - reach] = np.take(d.ravel(), src_w)
     return out
 
 

@@ -8,7 +8,6 @@ an error from deep inside numpy.
 from __future__ import annotations
 
 import math
-
 from typing import Any
 
 import numpy as np

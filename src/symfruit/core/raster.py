@@ -28,6 +28,7 @@ __all__ = [
     "close_ragged",
     "fill_holes",
     "inner_distance",
+    "interior",
     "mask_box",
     "outline_cone",
     "outline_cracks",
@@ -118,12 +119,7 @@ def _closed_mask(hit: np.ndarray, half: int) -> np.ndarray:
         closed = ndimage.uniform_filter(dilated, size=size, mode="nearest") > 1.0 - 1e-3
         closed |= hit
     # Fill holes: background components (4-connected) not touching the window's edge.
-    labels, _ = ndimage.label(~closed)
-    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
-    background = np.zeros(labels.max() + 1, dtype=bool)
-    background[edge] = True
-    background[0] = False
-    return ~np.take(background, labels)  # a table look-up: np.take is twice as fast as background[labels]
+    return fill_holes(closed)
 
 
 @dataclass(frozen=True)
@@ -198,7 +194,7 @@ def close_ragged(region: Silhouette, *, radius: int = 3, ragged: float = 0.3) ->
     padded = np.zeros((mask.shape[0] + 2 * radius, mask.shape[1] + 2 * radius), dtype=bool)  # np.pad is slow
     padded[radius:-radius, radius:-radius] = mask
     closed = _closed_mask(padded, radius)[radius:-radius, radius:-radius]
-    outline = int((mask & ~ndimage.binary_erosion(mask)).sum())
+    outline = int((mask & ~interior(mask)).sum())
     if (closed & ~mask).sum() <= ragged * max(outline, 1):
         return region
     return Silhouette(region.u0, region.v0, closed, max(region.fill_radius, float(radius)))
@@ -227,7 +223,7 @@ def _moments(region: Silhouette) -> tuple[float, np.ndarray, np.ndarray]:
     (kept read-only; an empty region's are NaN, not kept)."""
     found = region._made.get("moments")
     if found is not None:
-        return found  # type: ignore[no-any-return]
+        return found
     m = region.mask.astype(np.float64)
     h, w = m.shape
     u = np.arange(w, dtype=np.float64) + region.u0
@@ -273,21 +269,42 @@ def inner_distance(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def interior(mask: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ``ndimage.binary_erosion(mask)`` (the pixels whose 4 neighbours are in the mask; pixels beyond
+    the array are not), by five shifted views of the padded mask instead of scipy's general structuring element
+    (3x faster); ``mask & ~interior(mask)`` is its outline."""
+    p = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)  # padded by hand: np.pad is slow
+    p[1:-1, 1:-1] = mask
+    return p[1:-1, 1:-1] & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
+
+
 def fill_holes(mask: np.ndarray) -> np.ndarray:
     """(h, w) bool: ``mask`` with its holes filled, the same as :func:`scipy.ndimage.binary_fill_holes`.
 
     A hole is a 4-connected piece of the background that does not reach the image border; scipy finds them by
     dilating the background from the border until nothing changes (one pass over the image per pixel of the
     longest path), one labelling finds them at once.
+
+    The labelling covers the mask's box grown by a pixel (clipped to the image) alone: every background pixel
+    outside the box reaches the border along its row or column, so a piece of the background inside the grown
+    box is a hole exactly when it does not reach the grown box's edge (whose pixels beyond the mask's box are
+    background that reaches the border), and a silhouette's window is often twice its box.
     """
-    lab, n = ndimage.label(~mask)
+    mask = np.asarray(mask, dtype=bool)
+    out = mask.copy()
+    if (box := mask_box(mask)) is None:
+        return out
+    r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
+    c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
+    lab, n = ndimage.label(~mask[r0:r1, c0:c1])
     if n == 0:
-        return mask.copy()
+        return out
     outside = np.zeros(n + 1, bool)
     for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
         outside[edge] = True
-    outside[0] = False
-    return ~outside[lab]
+    outside[0] = True  # the mask's own pixels: kept as they are
+    out[r0:r1, c0:c1] |= ~np.take(outside, lab)  # a table look-up: np.take is twice as fast as outside[lab]
+    return out
 
 
 def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> tuple[float, float]:
@@ -403,7 +420,7 @@ def outline_cracks(region: Silhouette) -> np.ndarray:
     (:func:`~symfruit.core.agreement.observe` and :func:`across_sight` both read it), read-only."""
     found = region._made.get("cracks")
     if found is not None:
-        return found  # type: ignore[no-any-return]
+        return found
     mask = region.mask
     h, w = mask.shape
     m = np.zeros((h + 2, w + 2), dtype=bool)  # padded by hand: np.pad's overhead was a fifth of the call
