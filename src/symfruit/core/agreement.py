@@ -22,7 +22,8 @@ inside function (:func:`march`), vectorised over rays and steps (no loop over ra
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -161,6 +162,8 @@ class Observation:
     extent: np.ndarray | None = None
     hidden: np.ndarray | None = None
     inner: np.ndarray | None = None
+    #: What :func:`explain` reads of every candidate's rays alike (:func:`_bands`), made once per observation.
+    _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -291,6 +294,57 @@ def observe(
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        hidden=None if occlusion is None else occlusion.window(region, radius=2),
                        inner=inner)  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _Bands:
+    """An observation's rays packed for :func:`explain`: every ray (depth, inside bands, outside bands) in one
+    array, and per band where its rays start in the band part and how many; the outside bands' weights and
+    seen depths in one array each (``finite``: where a depth was seen, the weight is 1 there). ``*_ok``: the
+    bands that count (an inside band with rays, an outside band of positive weight), ``out_rays`` the outside
+    bands with rays."""
+
+    rays: np.ndarray
+    n_in: int
+    in_starts: np.ndarray
+    in_sizes: np.ndarray
+    in_ok: np.ndarray
+    out_starts: np.ndarray
+    out_w: np.ndarray
+    out_wsum: np.ndarray
+    out_rays: np.ndarray
+    out_ok: np.ndarray
+    seen: np.ndarray | None
+    finite: np.ndarray | None
+
+
+def _bands(obs: Observation) -> _Bands:
+    """The observation's :class:`_Bands`, made once (every candidate is measured on the same rays)."""
+    found = obs._made.get("bands")
+    if found is not None:
+        return found
+    in_sizes = np.array([len(r) for r in obs.rays_in], dtype=np.intp)
+    out_sizes = np.array([len(r) for r in obs.rays_out], dtype=np.intp)
+    in_starts = np.concatenate(([0], np.cumsum(in_sizes)[:-1])).astype(np.intp)
+    out_starts = np.concatenate(([0], np.cumsum(out_sizes)[:-1])).astype(np.intp)
+    weights = [np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i] for i, r in enumerate(obs.rays_out)]
+    out_w = np.concatenate(weights) if weights else np.zeros(0)
+    seen = finite = None
+    counted = out_w
+    if obs.out_depth is not None:
+        seen = np.concatenate(obs.out_depth) if len(obs.out_depth) else np.zeros(0)
+        finite = np.isfinite(seen)
+        counted = np.where(finite, 1.0, out_w)
+    # each band's weight: its own sum (whole numbers; the per-band sum of before)
+    out_wsum = np.array([counted[s : s + k].sum() for s, k in zip(out_starts, out_sizes, strict=True)])
+    found = _Bands(
+        rays=np.concatenate([obs.rays, *obs.rays_in, *obs.rays_out]), n_in=int(in_sizes.sum()),
+        in_starts=in_starts, in_sizes=in_sizes, in_ok=in_sizes > 0, out_starts=out_starts, out_w=out_w,
+        out_wsum=out_wsum, out_rays=out_sizes > 0, out_ok=(out_sizes > 0) & (out_wsum > 0), seen=seen,
+        finite=finite,
+    )  # fmt: skip
+    obs._made["bands"] = found
+    return found
 
 
 def _occluded_edges(
@@ -440,7 +494,7 @@ def explain(
     lo, hi = box
     z0, z1 = float(lo[2]) - 1e-3, float(hi[2]) + 1e-3
     n = len(obs.rays)
-    every = np.concatenate([obs.rays, *obs.rays_in, *obs.rays_out])  # one march for all rays
+    every = _bands(obs).rays  # one march for all rays
     closed_form = getattr(inside, "intersect", None)
     if callable(closed_form):
         hit_all, depth_all = closed_form(every, z0, z1)
@@ -451,20 +505,23 @@ def explain(
     keep = max(1, int(trim * len(res)))
     r2 = np.partition(res * res, keep - 1)[:keep]
     hits = hit_all[n:]
-    depths = depth_all[n:]
-    ins, outs, k = [], [], 0
-    for r in obs.rays_in:
-        ins.append(1.0 - hits[k : k + len(r)].mean() if len(r) else 0.0)
-        k += len(r)
-    for i, r in enumerate(obs.rays_out):
-        w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
-        wrong = hits[k : k + len(r)] * w
-        if obs.out_depth is not None:  # free space in front of an occluder: a candidate there is contradicted
-            seen = obs.out_depth[i]
+    bands = _bands(obs)
+    # every band's share of rays wrong from whole-number counts (sums of 0 and 1: exact in any order, so the
+    # same shares as a mean and a sum per band), the bands' order and empty bands (0) kept
+    # (np.add.reduceat sums from each given start to the next: the starts of the bands with rays alone)
+    ins = np.zeros(len(obs.rays_in))
+    if bands.in_ok.any():
+        counts = np.add.reduceat(hits[: bands.n_in], bands.in_starts[bands.in_ok], dtype=np.int64)
+        ins[bands.in_ok] = 1.0 - counts / bands.in_sizes[bands.in_ok]
+    outs = np.zeros(len(obs.rays_out))
+    if bands.out_ok.any():
+        hits_out = hits[bands.n_in :]
+        wrong = hits_out * bands.out_w
+        if bands.seen is not None and bands.finite is not None:
+            # free space in front of an occluder: a candidate there is contradicted
             with np.errstate(invalid="ignore"):
-                carved = hits[k : k + len(r)] & (depths[k : k + len(r)] < seen - free)
-            w = np.where(np.isfinite(seen), 1.0, w)
-            wrong = np.where(np.isfinite(seen), carved, wrong)
-        outs.append(float(wrong.sum() / w.sum()) if w.sum() > 0 else 0.0)
-        k += len(r)
+                carved = hits_out & (depth_all[n + bands.n_in :] < bands.seen - free)
+            wrong = np.where(bands.finite, carved, wrong)
+        sums = np.add.reduceat(wrong, bands.out_starts[bands.out_rays])  # every band with rays
+        outs[bands.out_ok] = sums[bands.out_ok[bands.out_rays]] / bands.out_wsum[bands.out_ok]
     return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))
