@@ -158,8 +158,9 @@ def detect(
             continue
         occ = None
         try:
+            # the frame checked its depth's units when it was made
             occ = fruit_occlusion(frame.depth, mask, ex.points, frame.camera, settings.occlusion,
-                                  others=fruit_px & ~mask)  # fmt: skip
+                                  others=fruit_px & ~mask, checked=True)  # fmt: skip
             t_occlusion += time.perf_counter() - b
             result = complete(ex.points, camera=frame.camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
