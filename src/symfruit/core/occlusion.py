@@ -281,7 +281,7 @@ def occlusion(
     camera : Camera
         Its image is ``W x H``; every pixel outside it is hidden (:meth:`Occlusion.at`).
     others : (H, W) bool, optional
-        Other fruit's masks.
+        Other fruit's masks (this fruit's own pixels may be marked too: they are never hidden).
     tolerance : float, metres
         How far behind the fruit's nearest depth something must lie to count as seen behind it.
     reach : int, pixels
