@@ -241,11 +241,6 @@ def observe(
     inner = inner_distance(mask)
     outer = ndimage.distance_transform_edt(~mask)
 
-    def spread(rc: np.ndarray) -> np.ndarray:
-        if len(rc) > n_band:
-            rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        return camera.rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0)
-
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
     edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner)
