@@ -170,8 +170,10 @@ def detect(
             continue
         occ = None
         try:
+            # the frame checked its depth's units when it was made; every fruit's pixels are the others' (this
+            # fruit's own are never hidden: the same occlusion without two whole-image operations per fruit)
             occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
-                                  others=fruit_px & ~mask)  # fmt: skip
+                                  others=fruit_px, checked=True)  # fmt: skip
             t_occlusion += time.perf_counter() - b
             result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))

@@ -47,10 +47,13 @@ def fruit_occlusion(
     camera: Camera,
     settings: OcclusionSettings,
     others: np.ndarray | None = None,
+    *,
+    checked: bool = False,
 ) -> Occlusion | None:
     """:func:`~symfruit.core.occlusion.occlusion` with the section's values, or None when it is disabled (the one
-    place both ``detect`` and the evaluation's rendered views make it)."""
+    place both ``detect`` and the evaluation's rendered views make it). ``checked``: ``depth`` is a
+    :class:`~symfruit.core.frame.Frame`'s, its units checked already."""
     if not settings.enabled:
         return None
     return occlusion(depth, mask, points, camera, others=others, tolerance=settings.tolerance,
-                     reach=settings.reach_px)  # fmt: skip
+                     reach=settings.reach_px, checked=checked)  # fmt: skip

@@ -209,3 +209,85 @@ def test_a_view_on_the_image_border_whose_points_round_beyond_it(camera):
     region = silhouette(pts, camera)
     obs = observe(pts[::5], region, camera, dense=pts)
     assert obs.contour < 1.0  # the border is a cut
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(2, 40))
+def test_march_samples_every_ray_at_every_depth_as_broadcasting_did(seed, steps):
+    """The march's points are made as tiled rows, the same products as ``rays[:, None] * zs[None, :, None]``."""
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(1, 60))
+    rays = np.c_[rng.normal(0.0, 0.2, (m, 2)), np.ones(m)]
+    seen = []
+
+    def inside(x):
+        seen.append(x.copy())
+        return np.ones(x.shape[:-1])
+
+    z0, z1 = sorted(rng.uniform(0.1, 2.0, 2))
+    march(inside, rays, z0, z1, steps=steps)
+    zs = np.linspace(z0, z1, steps)
+    assert seen[0].shape == (len(rays), steps, 3)
+    assert np.array_equal(seen[0], rays[:, None, :] * zs[None, :, None])
+
+
+def _former_bands(hit_all, depth_all, obs, free=0.01):
+    """explain()'s band shares as they were computed before the bands were packed (issue 19): band by band."""
+    n = len(obs.rays)
+    hits, depths = hit_all[n:], depth_all[n:]
+    ins, outs, k = [], [], 0
+    for r in obs.rays_in:
+        ins.append(1.0 - hits[k : k + len(r)].mean() if len(r) else 0.0)
+        k += len(r)
+    for i, r in enumerate(obs.rays_out):
+        w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
+        wrong = hits[k : k + len(r)] * w
+        if obs.out_depth is not None:
+            seen = obs.out_depth[i]
+            with np.errstate(invalid="ignore"):
+                carved = hits[k : k + len(r)] & (depths[k : k + len(r)] < seen - free)
+            w = np.where(np.isfinite(seen), 1.0, w)
+            wrong = np.where(np.isfinite(seen), carved, wrong)
+        outs.append(float(wrong.sum() / w.sum()) if w.sum() > 0 else 0.0)
+        k += len(r)
+    return float(np.mean(ins)), float(np.mean(outs))
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_packed_bands_give_the_band_by_band_shares(seed):
+    """The bands packed once per observation (empty bands, bands of zero weight, no weights, seen depths or
+    not): the same shares, to the bit, as band by band."""
+    from symfruit.core.agreement import Observation
+
+    rng = np.random.default_rng(seed)
+
+    def rays(k):
+        return np.c_[rng.normal(0.0, 0.1, (k, 2)), np.ones(k)]
+
+    sizes_in = [int(rng.integers(0, 30)) * int(rng.random() < 0.8) for _ in range(int(rng.integers(1, 4)))]
+    sizes_out = [int(rng.integers(0, 30)) * int(rng.random() < 0.8) for _ in range(int(rng.integers(1, 4)))]
+    weights = (
+        None if rng.random() < 0.3 else tuple((rng.random(k) < rng.uniform(0, 1)).astype(float) for k in sizes_out)
+    )
+    seen = None if rng.random() < 0.3 else tuple(np.where(rng.random(k) < 0.4, rng.uniform(0.3, 0.6, k), np.nan)
+                                                 for k in sizes_out)  # fmt: skip
+    obs = Observation(rays=rays(40), depth=rng.uniform(0.3, 0.6, 40), rays_in=tuple(rays(k) for k in sizes_in),
+                      rays_out=tuple(rays(k) for k in sizes_out), out_weights=weights, out_depth=seen)  # fmt: skip
+    total = 40 + sum(sizes_in) + sum(sizes_out)
+    for _ in range(3):  # the packing is made once and read again
+        hit_all = rng.random(total) < rng.uniform(0, 1)
+        depth_all = np.where(hit_all, rng.uniform(0.3, 0.6, total), np.nan)
+
+        class Fixed:
+            def __init__(self, hit_all, depth_all):
+                self.found = hit_all, depth_all
+
+            def __call__(self, x):
+                raise AssertionError("not marched")
+
+            def intersect(self, every, z0, z1):
+                assert len(every) == total
+                return self.found
+
+        got = explain(Fixed(hit_all, depth_all), (np.array([0, 0, 0.3]), np.array([0, 0, 0.6])), obs)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            assert (got.inside, got.outside) == _former_bands(hit_all, depth_all, obs)

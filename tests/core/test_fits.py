@@ -378,3 +378,132 @@ def test_slice_costs_in_place_equal_the_plain_expressions(seed, k, n):
     dirs = rng.normal(size=(k, 3))
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     np.testing.assert_array_equal(_slice_costs(q, dirs, 12), _slice_costs_plain(q, dirs, 12))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 6))
+def test_cone_fronts_split_keeps_each_groups_own_values(seed, split):
+    """``split`` evaluates two groups of parameters in one call with each group's values, to the bit, those of
+    a call with that group alone (a one-row product rounds differently from a many-row one)."""
+    from symfruit.core.fits import _cone_fronts
+
+    rng = np.random.default_rng(seed)
+    centre = np.r_[rng.uniform(-0.05, 0.05, 2), rng.uniform(0.3, 0.6)]
+    cone = _tangent_cone(centre, np.diag(rng.uniform(0.015, 0.05, 3) ** 2))
+    if np.linalg.eigvalsh(cone)[-1] < 0:
+        cone = -cone
+    axis = centre / centre[2]
+    k = split + int(rng.integers(1, 6))
+    params = np.c_[rng.normal(0.0, 0.02, (k, 2)), np.log(rng.uniform(0.2, 0.8, k)), rng.uniform(-6, 6, k)]
+    rays = np.c_[axis[0] + rng.normal(0.0, 0.08, 250), axis[1] + rng.normal(0.0, 0.08, 250), np.ones(250)]
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    both, valid = _cone_fronts(params, cone, axis, rays, ray_cone, split=split)
+    first, valid_first = _cone_fronts(params[:split], cone, axis, rays, ray_cone)
+    rest, valid_rest = _cone_fronts(params[split:], cone, axis, rays, ray_cone)
+    assert np.array_equal(both, np.vstack((first, rest)), equal_nan=True)
+    assert np.array_equal(valid, np.concatenate((valid_first, valid_rest)))
+
+
+@given(st.floats(0.1, 3.0), st.floats(0.005, 0.5))
+def test_cone_grid_is_the_former_nested_list(front, extent):
+    from symfruit.core.fits import _cone_grid
+
+    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 7)
+    former = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 7)])
+    assert np.array_equal(_cone_grid(front, extent), former)
+
+
+def _former_fit_cone_ellipsoid(points, *, cone, axis, front, extent, huber=0.003, iterations=10, tolerance=1e-4):
+    """fit_cone_ellipsoid as it was before its trial steps and Jacobians were evaluated together (issue 19)."""
+    from symfruit.core.fits import _cone_fronts
+
+    points = points[:: max(1, -(-len(points) // 300))]
+    rays = points / points[:, 2:3]
+    z = points[:, 2]
+    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 7)
+    grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 7)])
+    cone_inv = np.linalg.inv(cone)
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+
+    def residuals(p):
+        fronts, valid = _cone_fronts(p, cone, axis, rays, ray_cone)
+        res = np.where(valid[:, None], z[None, :] - fronts, 0.05)
+        return np.where(np.isfinite(res), res, 0.02)
+
+    def cost(res):
+        a = np.abs(res)
+        return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
+
+    p = grid[int(np.argmin(cost(residuals(grid))))]
+    r = residuals(p[None])[0]
+    current, mu = float(cost(r)), 1e-2
+    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
+    for _ in range(iterations):
+        done = False
+        jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]
+        a = np.abs(r)
+        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        jtj = (jac * w) @ jac.T
+        g = (jac * w) @ r
+        improved = False
+        while mu < 1e6:
+            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
+            trial = p + delta
+            r_new = residuals(trial[None])[0]
+            new = float(cost(r_new))
+            if new < current:
+                p, r, mu, improved = trial, r_new, max(mu / 3.0, 1e-7), True
+                done = current - new < tolerance * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
+    m, shape, _ = cone_ellipsoid(p[None], cone, axis)
+    a = np.abs(r)
+    w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+    sigma2 = float((w * r * r).sum() / max(w.sum() - 4.0, 1.0))
+    jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]
+    cov = sigma2 * np.linalg.inv((jac * w) @ jac.T + 1e-18 * np.eye(4))
+    mb, sb, vb = cone_ellipsoid(p[None] + np.diag(step), cone, axis, cone_inv=cone_inv)
+    back = m[0, 2] + np.sqrt(shape[0, 2, 2])
+    grad = (mb[:, 2] + np.sqrt(sb[:, 2, 2]) - back) / step
+    back_std = float(np.sqrt(max(grad @ cov @ grad, 0.0))) if vb.all() else float("nan")
+    return m[0], shape[0], back_std, float(np.sqrt(sigma2))
+
+
+@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3)])
+def test_cone_fit_is_the_former_fit_to_the_bit(kind, seed):
+    """The trial step and the Jacobian about it evaluated in one call change no value of the fit."""
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.03 * seed], noise=0.01,
+                               rotation=rotation(10 * seed, 20, 30 * seed), seed=seed)  # fmt: skip
+    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    front, extent = float(visible[:, 2].min()), float(np.ptp(visible, axis=0).max())
+    fit = fit_cone_ellipsoid(visible, cone=cone, axis=axis, front=front, extent=extent)
+    centre, shape, back_std, rms = _former_fit_cone_ellipsoid(visible, cone=cone, axis=axis, front=front,
+                                                              extent=extent)  # fmt: skip
+    assert np.array_equal(fit.centre, centre) and np.array_equal(fit.shape, shape)
+    assert fit.back_std == back_std and fit.rms == rms
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(50,), (7, 11), (1,), (3, 4, 5)]))
+def test_revolution_inside_is_the_broadcast_formulation_bit_for_bit(seed, shape):
+    """Component by component, the same values as the former broadcast over the last axis."""
+    from symfruit.core.points import row_norms
+
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=3)
+    rev = Revolution(rng.normal(0.0, 0.1, 3), d / np.linalg.norm(d), np.linspace(-0.03, 0.03, 9),
+                     np.where(rng.random(8) < 0.2, np.nan, rng.uniform(0.005, 0.03, 8)), 0.0)  # fmt: skip
+    x = rng.normal(0.0, 0.05, (*shape, 3)) + rev.point
+    t_prof, r_prof = closed_profile(rev)
+    rel = x - rev.point
+    t = rel @ rev.direction
+    rho = row_norms(rel - t[..., None] * rev.direction)
+    want = np.interp(t, t_prof, r_prof, left=0.0, right=0.0) - rho
+    want -= np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
+    got = revolution_inside(rev, x)
+    assert got.shape == shape and np.array_equal(got, want)

@@ -239,3 +239,40 @@ def test_the_depth_fill_takes_the_pixel_the_feature_transform_picks(seed):
     dist, (vr, vc) = ndimage.distance_transform_edt(~valid, return_indices=True)
     expected = np.where(~valid & ~own & (dist <= reach), d[vr, vc], d)
     np.testing.assert_array_equal(_fill(d, valid, own, reach), expected)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 6))
+def test_grown_part_is_the_grown_map_cut_to_its_box(seed, radius):
+    """The filter run over a box grown by the radius alone gives the whole window's filter's values there."""
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+    occ = Occlusion(0, 0, rng.random((h, w)) < rng.uniform(0.0, 0.2), 60, 50)
+    full = occ.hidden
+    if radius:
+        full = ndimage.maximum_filter(occ.hidden, size=2 * radius + 1, mode="constant", cval=False)
+    for _ in range(3):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+        assert np.array_equal(occ.grown_part(radius, r0, r1, c0, c1), full[r0:r1, c0:c1])
+    occ.grown(radius)  # kept: then cut from it
+    assert np.array_equal(occ.grown_part(radius, 0, h, 0, w), full)
+
+
+def test_a_checked_depth_gives_the_same_occlusion_and_only_an_unchecked_one_is_sampled():
+    depth, disc, points = _disc_frame()
+    a, b = occlusion(depth, disc, points, CAM), occlusion(depth, disc, points, CAM, checked=True)
+    assert (a.u0, a.v0) == (b.u0, b.v0) and np.array_equal(a.hidden, b.hidden)
+    assert np.array_equal(a.depth, b.depth, equal_nan=True) and np.array_equal(a.own, b.own)
+    with pytest.raises(InputError, match="millimetres"):
+        occlusion(depth * 1000.0, disc, points, CAM)
+    with pytest.raises(InputError, match="depth and mask images"):  # the shapes are checked either way
+        occlusion(depth[:-1], disc, points, CAM, checked=True)
+
+
+def test_the_fruits_own_pixels_among_the_others_change_nothing():
+    depth, disc, points = _disc_frame(background=0.302)
+    others = np.zeros_like(disc)
+    others[10:30, 5:12] = True  # another fruit beside it
+    a = occlusion(depth, disc, points, CAM, others=others)
+    b = occlusion(depth, disc, points, CAM, others=others | disc)
+    assert a.hidden.any() and np.array_equal(a.hidden, b.hidden)

@@ -162,3 +162,22 @@ def test_cross_rows_is_numpys_cross_bit_for_bit(seed, shapes):
     np.testing.assert_array_equal(got, np.cross(a, b))
     assert got.shape == np.broadcast_shapes(a.shape, b.shape) and got.dtype == np.float64
     assert cross_rows(a.astype(np.float32), b.astype(np.float32)).dtype == np.float32
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_perpendicular_basis_of_one_row_is_that_row_of_many(seed):
+    """One float64 row goes through Python floats: the same values as the array path's, signed zeros included."""
+    from symfruit.core.points import perpendicular_basis
+
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(40, 3)) * 10.0 ** rng.uniform(-3, 3, (40, 1))
+    d[:20] /= np.linalg.norm(d[:20], axis=1, keepdims=True)
+    d[:4] = [[1.0, 0.0, 0.0], [0.0, -0.0, 1.0], [0.95, 0.3, 0.0], [-0.9, 0.0, -0.0]]
+    e1, e2 = perpendicular_basis(d)
+    for i in range(len(d)):
+        o1, o2 = perpendicular_basis(d[i : i + 1])
+        assert o1.shape == o2.shape == (1, 3)
+        for got, want in ((o1[0], e1[i]), (o2[0], e2[i])):
+            assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
+    with np.errstate(invalid="ignore"):  # a zero row: numpy's NaN, not a Python ZeroDivisionError
+        assert np.isnan(perpendicular_basis(np.zeros((1, 3)))[0]).all()

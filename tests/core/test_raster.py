@@ -324,3 +324,50 @@ def test_mask_box_is_the_extent_of_the_true_pixels(seed, h, w, fill):
     assert box == (rows.min(), rows.max() + 1, cols.min(), cols.max() + 1)
     r0, r1, c0, c1 = box
     assert mask[r0:r1, c0:c1].sum() == mask.sum() and all(isinstance(x, int) for x in box)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_what_a_region_keeps_is_what_a_fresh_region_works_out(seed):
+    """Moments and outline are made once per region: the cone, the widths across the line of sight and the
+    outline of a region asked again are those of a fresh copy, and what is kept is read-only."""
+    from symfruit.core.raster import Silhouette, across_sight, outline_cracks, silhouette_cone
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=600.0, fy=600.0, cx=320.0, cy=240.0, width=640, height=480)
+    mask = ndimage.binary_opening(rng.random((30, 40)) < 0.7)
+    if not mask.any():
+        mask[5:9, 5:12] = True
+    u0, v0 = int(rng.integers(0, 600)), int(rng.integers(0, 450))
+    kept = Silhouette(u0, v0, mask, 0.0)
+    for _ in range(2):
+        fresh = Silhouette(u0, v0, mask.copy(), 0.0)
+        for a, b in zip(silhouette_cone(kept, cam), silhouette_cone(fresh, cam), strict=True):
+            assert np.array_equal(a, b)
+        a, b = across_sight(kept, cam), across_sight(fresh, cam)
+        assert np.array_equal(a.lo, b.lo) and np.array_equal(a.hi, b.hi) and (a.minor, a.major) == (b.minor, b.major)
+        assert np.array_equal(outline_cracks(kept), outline_cracks(fresh))
+    assert not outline_cracks(kept).flags.writeable
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_fill_holes_over_the_masks_box_is_scipys(seed, h, w):
+    """Labelled over the mask's box grown by a pixel: the same holes wherever the mask lies in the image (its box
+    at the border, in a corner, a pixel wide, or a mask with rings inside rings)."""
+    rng = np.random.default_rng(seed)
+    mask = np.zeros((h, w), bool)
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+    mask[r0:r1, c0:c1] = rng.random((r1 - r0, c1 - c0)) < rng.uniform(0.3, 0.9)
+    yy, xx = np.mgrid[:h, :w]
+    for radius in rng.uniform(1, 12, int(rng.integers(0, 4))):  # rings: holes with islands with holes
+        mask ^= np.abs(np.hypot(yy - rng.uniform(0, h), xx - rng.uniform(0, w)) - radius) < 0.8
+    assert np.array_equal(fill_holes(mask), ndimage.binary_fill_holes(mask))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30))
+def test_interior_is_scipys_erosion(seed, h, w):
+    from symfruit.core.raster import interior
+
+    mask = np.random.default_rng(seed).random((h, w)) < np.random.default_rng(seed + 1).uniform(0.2, 1.0)
+    assert np.array_equal(interior(mask), ndimage.binary_erosion(mask))
+    assert np.array_equal(interior(np.ones((h, w), bool)), ndimage.binary_erosion(np.ones((h, w), bool)))

@@ -204,3 +204,11 @@ def test_a_fruit_pointing_at_the_camera_is_less_confident_than_one_seen_from_the
     assert a.extras["recede"] > 0.02 and b.extras["recede"] < 0.005
     assert a.extras["elongation"] == pytest.approx(1.0, abs=0.1) and b.extras["elongation"] > 1.3
     assert a.extras["uncertainty"] > 3 * b.extras["uncertainty"] and not a.reliable
+
+
+def test_completed_points_are_the_seen_and_their_mirror_images_through_the_box_centre():
+    """Written column by column: the same values as ``np.vstack([points, 2 centre - points])``, to the bit."""
+    visible, _ = rendered_view(ball_mesh(0.03), [0.02, -0.01, 0.4], noise=0.01, seed=4)
+    result = complete(visible, camera=DEFAULT_CAMERA, method="evidence")
+    want = np.vstack([visible, 2.0 * result.box.centre - visible])
+    assert result.points.shape == want.shape and np.array_equal(result.points, want)

@@ -22,7 +22,8 @@ inside function (:func:`march`), vectorised over rays and steps (no loop over ra
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -31,7 +32,7 @@ from scipy.spatial import cKDTree
 from .camera import Camera
 from .occlusion import Occlusion
 from .points import as_points, row_norms
-from .raster import Silhouette, inner_distance, outline_cone, outline_cracks, silhouette_cone
+from .raster import Silhouette, inner_distance, interior, outline_cone, outline_cracks, silhouette_cone
 
 __all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
@@ -161,6 +162,8 @@ class Observation:
     extent: np.ndarray | None = None
     hidden: np.ndarray | None = None
     inner: np.ndarray | None = None
+    #: What :func:`explain` reads of every candidate's rays alike (:func:`_bands`), made once per observation.
+    _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 @dataclass(frozen=True)
@@ -238,11 +241,6 @@ def observe(
     inner = inner_distance(mask)
     outer = ndimage.distance_transform_edt(~mask)
 
-    def spread(rc: np.ndarray) -> np.ndarray:
-        if len(rc) > n_band:
-            rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        return camera.rays(rc[:, 1] + region.u0, rc[:, 0] + region.v0)
-
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
     edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner)
@@ -255,27 +253,34 @@ def observe(
     contour = float(is_contour.mean()) if len(is_contour) else 1.0
     tree = cKDTree(edge_uv) if len(is_contour) else None
 
-    def band(rc: np.ndarray, outside: bool) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        if len(rc) > n_band:
-            rc = rc[np.linspace(0, len(rc) - 1, n_band).astype(int)]
-        uv = np.stack((rc[:, 1] + region.u0, rc[:, 0] + region.v0), axis=1).astype(np.float64)
+    def bands_of(dist: np.ndarray, outside: bool) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
+        """Each band's rays, weights and seen depths; the bands' pixels looked up together (every look-up is
+        pixel by pixel: the same values as band by band, in a quarter of the calls)."""
+        rcs = [rc[np.linspace(0, len(rc) - 1, n_band).astype(int)] if len(rc) > n_band else rc for rc in rings(dist)]
+        if not rcs:  # no bands asked for
+            return []
+        rc = np.concatenate(rcs)
+        u = (rc[:, 1] + region.u0).astype(np.float64)
+        v = (rc[:, 0] + region.v0).astype(np.float64)
         weight = np.ones(len(rc))
         seen = np.full(len(rc), np.nan)
         if outside and tree is not None and len(rc):
-            weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge: no evidence
+            weight = is_contour[tree.query(np.stack((u, v), axis=1))[1]].astype(np.float64)  # beyond a cut edge
         if outside and occlusion is not None and len(rc):
-            hidden = occlusion.at(uv[:, 0], uv[:, 1])
+            hidden = occlusion.at(u, v)
             weight = weight * ~hidden  # a hidden pixel: no evidence of background ...
-            seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
-        return camera.rays(uv[:, 0], uv[:, 1]), weight, seen
+            seen = np.where(hidden, occlusion.depth_at(u, v), np.nan)  # ... but of free space
+        rays = camera.rays(u, v)
+        cuts = np.cumsum([len(r) for r in rcs])[:-1]
+        return list(zip(np.split(rays, cuts), np.split(weight, cuts), np.split(seen, cuts), strict=True))
 
     def rings(dist: np.ndarray) -> list[np.ndarray]:  # each band's pixels (row-major), one pass over the map
         rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5)) if bands else np.empty((0, 2), int)
         at = dist[rc[:, 0], rc[:, 1]]
         return [rc[(at > b - 0.5) & (at <= b + 0.5)] for b in bands]
 
-    ins = [band(rc, False) for rc in rings(inner)]
-    outs = [band(rc, True) for rc in rings(outer)]
+    ins = bands_of(inner, False)
+    outs = bands_of(outer, True)
     cone, axis = silhouette_cone(region, camera)
     source = "moments"
     if occlusion is not None and tree is not None and contour_cone <= contour < 1.0:
@@ -293,6 +298,57 @@ def observe(
                        inner=inner)  # fmt: skip
 
 
+@dataclass(frozen=True)
+class _Bands:
+    """An observation's rays packed for :func:`explain`: every ray (depth, inside bands, outside bands) in one
+    array, and per band where its rays start in the band part and how many; the outside bands' weights and
+    seen depths in one array each (``finite``: where a depth was seen, the weight is 1 there). ``*_ok``: the
+    bands that count (an inside band with rays, an outside band of positive weight), ``out_rays`` the outside
+    bands with rays."""
+
+    rays: np.ndarray
+    n_in: int
+    in_starts: np.ndarray
+    in_sizes: np.ndarray
+    in_ok: np.ndarray
+    out_starts: np.ndarray
+    out_w: np.ndarray
+    out_wsum: np.ndarray
+    out_rays: np.ndarray
+    out_ok: np.ndarray
+    seen: np.ndarray | None
+    finite: np.ndarray | None
+
+
+def _bands(obs: Observation) -> _Bands:
+    """The observation's :class:`_Bands`, made once (every candidate is measured on the same rays)."""
+    found = obs._made.get("bands")
+    if found is not None:
+        return found
+    in_sizes = np.array([len(r) for r in obs.rays_in], dtype=np.intp)
+    out_sizes = np.array([len(r) for r in obs.rays_out], dtype=np.intp)
+    in_starts = np.concatenate(([0], np.cumsum(in_sizes)[:-1])).astype(np.intp)
+    out_starts = np.concatenate(([0], np.cumsum(out_sizes)[:-1])).astype(np.intp)
+    weights = [np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i] for i, r in enumerate(obs.rays_out)]
+    out_w = np.concatenate(weights) if weights else np.zeros(0)
+    seen = finite = None
+    counted = out_w
+    if obs.out_depth is not None:
+        seen = np.concatenate(obs.out_depth) if len(obs.out_depth) else np.zeros(0)
+        finite = np.isfinite(seen)
+        counted = np.where(finite, 1.0, out_w)
+    # each band's weight: its own sum (whole numbers; the per-band sum of before)
+    out_wsum = np.array([counted[s : s + k].sum() for s, k in zip(out_starts, out_sizes, strict=True)])
+    found = _Bands(
+        rays=np.concatenate([obs.rays, *obs.rays_in, *obs.rays_out]), n_in=int(in_sizes.sum()),
+        in_starts=in_starts, in_sizes=in_sizes, in_ok=in_sizes > 0, out_starts=out_starts, out_w=out_w,
+        out_wsum=out_wsum, out_rays=out_sizes > 0, out_ok=(out_sizes > 0) & (out_wsum > 0), seen=seen,
+        finite=finite,
+    )  # fmt: skip
+    obs._made["bands"] = found
+    return found
+
+
 def _occluded_edges(
     region: Silhouette, occlusion: Occlusion, edge_uv: np.ndarray, is_contour: np.ndarray, count: int, radius: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -300,7 +356,7 @@ def _occluded_edges(
     where the normal of the nearest edge point (``edge_uv``, ``is_contour``; none: every one) says so and
     no hidden pixel lies within ``radius`` pixels."""
     mask = region.mask
-    rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask))
+    rows, cols = np.nonzero(mask & ~interior(mask))
     step = max(1, len(rows) // (2 * count))
     uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
@@ -339,7 +395,8 @@ def _contour_pixels(
         return np.empty((0, 2)), np.empty(0, dtype=bool)
     edge = edge[:: max(1, len(edge) // count)]
     grid = np.full((h + 2 * half, w + 2 * half, 3), np.nan)
-    grid[row[ok], col[ok]] = points[ok]
+    # by flat pixel index (twice as fast as two index arrays; a pixel met twice keeps the later point either way)
+    grid.reshape(-1, 3)[row[ok] * (w + 2 * half) + col[ok]] = points[ok]
     d = np.arange(-half, half + 1)
     rr = row[edge][:, None, None] + d[None, :, None]
     cc = col[edge][:, None, None] + d[None, None, :]
@@ -392,7 +449,11 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
     depth : (m,) float, metres (NaN where there is no hit; ``z0`` where the ray starts inside)
     """
     zs = np.linspace(z0, z1, steps)
-    f = inside(rays[:, None, :] * zs[None, :, None])  # (m, steps)
+    # (m, steps, 3): every ray times every depth, made as rows of ``steps`` copies of the ray times each depth
+    # repeated per component (the same products; broadcasting over a last axis of 3 ran numpy's inner loop once
+    # per point, several times the arithmetic)
+    points = (np.tile(rays, steps) * np.repeat(zs, 3)).reshape(len(rays), steps, 3)
+    f = inside(points)  # (m, steps)
     pos = f > 0
     hit = np.asarray(pos.any(axis=1))
     first = np.argmax(pos, axis=1)
@@ -435,7 +496,7 @@ def explain(
     lo, hi = box
     z0, z1 = float(lo[2]) - 1e-3, float(hi[2]) + 1e-3
     n = len(obs.rays)
-    every = np.concatenate([obs.rays, *obs.rays_in, *obs.rays_out])  # one march for all rays
+    every = _bands(obs).rays  # one march for all rays
     closed_form = getattr(inside, "intersect", None)
     if callable(closed_form):
         hit_all, depth_all = closed_form(every, z0, z1)
@@ -446,20 +507,23 @@ def explain(
     keep = max(1, int(trim * len(res)))
     r2 = np.partition(res * res, keep - 1)[:keep]
     hits = hit_all[n:]
-    depths = depth_all[n:]
-    ins, outs, k = [], [], 0
-    for r in obs.rays_in:
-        ins.append(1.0 - hits[k : k + len(r)].mean() if len(r) else 0.0)
-        k += len(r)
-    for i, r in enumerate(obs.rays_out):
-        w = np.ones(len(r)) if obs.out_weights is None else obs.out_weights[i]
-        wrong = hits[k : k + len(r)] * w
-        if obs.out_depth is not None:  # free space in front of an occluder: a candidate there is contradicted
-            seen = obs.out_depth[i]
+    bands = _bands(obs)
+    # every band's share of rays wrong from whole-number counts (sums of 0 and 1: exact in any order, so the
+    # same shares as a mean and a sum per band), the bands' order and empty bands (0) kept
+    # (np.add.reduceat sums from each given start to the next: the starts of the bands with rays alone)
+    ins = np.zeros(len(obs.rays_in))
+    if bands.in_ok.any():
+        counts = np.add.reduceat(hits[: bands.n_in], bands.in_starts[bands.in_ok], dtype=np.int64)
+        ins[bands.in_ok] = 1.0 - counts / bands.in_sizes[bands.in_ok]
+    outs = np.zeros(len(obs.rays_out))
+    if bands.out_ok.any():
+        hits_out = hits[bands.n_in :]
+        wrong = hits_out * bands.out_w
+        if bands.seen is not None and bands.finite is not None:
+            # free space in front of an occluder: a candidate there is contradicted
             with np.errstate(invalid="ignore"):
-                carved = hits[k : k + len(r)] & (depths[k : k + len(r)] < seen - free)
-            w = np.where(np.isfinite(seen), 1.0, w)
-            wrong = np.where(np.isfinite(seen), carved, wrong)
-        outs.append(float(wrong.sum() / w.sum()) if w.sum() > 0 else 0.0)
-        k += len(r)
+                carved = hits_out & (depth_all[n + bands.n_in :] < bands.seen - free)
+            wrong = np.where(bands.finite, carved, wrong)
+        sums = np.add.reduceat(wrong, bands.out_starts[bands.out_rays])  # every band with rays
+        outs[bands.out_ok] = sums[bands.out_ok[bands.out_rays]] / bands.out_wsum[bands.out_ok]
     return Agreement(depth=float(np.sqrt(r2.mean())), inside=float(np.mean(ins)), outside=float(np.mean(outs)))

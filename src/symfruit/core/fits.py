@@ -17,7 +17,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
-from .points import as_points, cross_rows, perpendicular_basis, row_norms
+from .points import as_points, cross_rows, median, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
@@ -180,10 +180,11 @@ def surface_noise(
     k = min(small, k_large)
     near = hood[:, :k] - hood[:, :k].mean(axis=1, keepdims=True)
     values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near) / k)
-    small_res, normals = np.sqrt(max(float(np.median(values[:, 0])), 0.0)), vectors[:, :, 0]
+    # medians by core.points.median: np.median's values, without its general-axis machinery
+    small_res, normals = np.sqrt(max(float(median(values[:, 0])), 0.0)), vectors[:, :, 0]
     wide = hood - hood.mean(axis=1, keepdims=True)
     large_res = np.sqrt(
-        max(float(np.median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
+        max(float(median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
     )
     flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
     normals[flip] *= -1.0
@@ -646,12 +647,23 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     """Signed inside measure of points ``x`` (..., 3): the profile's radius minus the distance to the axis,
     metres (positive inside; beyond the profile's ends, minus the distance past the end as well)."""
     t_prof, r_prof = closed_profile(rev, close=close)
-    rel = np.asarray(x, dtype=np.float64) - rev.point
+    x = np.asarray(x, dtype=np.float64)
+    shape = x.shape[:-1]
+    flat = x.reshape(-1, 3)
+    # Component by component: ``x - point`` and ``rel - t direction`` broadcast over a last axis of 3 ran numpy's
+    # inner loop once per point (a march's 6,000 points: several times the arithmetic); these are the same
+    # subtractions and products, one strided pass per component, and ``rel @ direction`` the same product.
+    rel = np.empty_like(flat)
+    for c in range(3):  # three components, not a loop over points
+        np.subtract(flat[:, c], rev.point[c], out=rel[:, c])
     t = rel @ rev.direction
-    rho = row_norms(rel - t[..., None] * rev.direction)
+    off = [rel[:, c] - t * rev.direction[c] for c in range(3)]
+    total = off[0] * off[0] + off[1] * off[1]  # as row_norms: numpy sums the three squares left to right
+    total += off[2] * off[2]
+    rho = np.sqrt(total)
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
-    return r - rho - past
+    return (r - rho - past).reshape(shape)
 
 
 # --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------
@@ -690,9 +702,14 @@ def cone_ellipsoid(
 
 
 def _cone_fronts(params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray,
-                 ray_cone: np.ndarray) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+                 ray_cone: np.ndarray, *, split: int = 0) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Front depth (k, n) along rays (n, ``z = 1``) of the ellipsoids of :func:`cone_ellipsoid` with parameters
     (k, 4), straight from the cone (NaN where a ray misses), and which parameters are valid (k,).
+
+    ``split``: the parameter rows before it and from it on go through separate matrix products, so that each
+    group's values are, to the bit, those of a call with that group alone (OpenBLAS rounds a one-row product,
+    a matrix-vector kernel, differently from the same row of a many-row product; every other operation here
+    is row by row). :func:`fit_cone_ellipsoid` evaluates a trial step and the Jacobian about it in one call.
 
     With ``S = lambda C^-1 + m m^T`` and ``q = -m^T C m``, Sherman-Morrison gives ``S^-1 = C / lambda - C m m^T C
     / (lambda (lambda - q))``, so along a ray ``r`` the quadratic ``a z^2 - 2 b z + c`` of
@@ -705,12 +722,19 @@ def _cone_fronts(params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: n
     m[:, :2] = axis[:2] + p[:, :2]
     m[:, 2] = axis[2]
     m *= np.exp(p[:, 2:3])
-    cm = m @ cone  # (k, 3); C is symmetric
+    if 0 < split < len(p):
+        cm = np.empty_like(m)
+        rcm = np.empty((len(p), len(rays)))
+        for group in (slice(0, split), slice(split, None)):  # two groups, not a loop over hypotheses
+            np.matmul(m[group], cone, out=cm[group])
+            np.matmul(cm[group], rays.T, out=rcm[group])
+    else:
+        cm = m @ cone  # (k, 3); C is symmetric
+        rcm = cm @ rays.T  # (k, n)
     q = -(cm * m).sum(axis=1)
     valid = q > 0
     lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
     gap = (lam - q)[:, None]  # < 0
-    rcm = cm @ rays.T  # (k, n)
     with np.errstate(invalid="ignore"):
         a = ray_cone[None, :] / lam[:, None] - rcm * rcm / (lam[:, None] * gap)
         b = rcm / gap
@@ -730,6 +754,16 @@ def _cone_front(m: np.ndarray, shape: np.ndarray, rays: np.ndarray) -> np.ndarra
     disc = b * b - a * c[:, None]
     root = np.sqrt(np.maximum(disc, 0.0))
     return np.where(disc >= 0, (b - root) / a, np.nan)
+
+
+def _cone_grid(front: float, extent: float) -> np.ndarray:
+    """(49, 4): :func:`fit_cone_ellipsoid`'s starting grid, every centre depth ``front + (0.15 .. 1) extent`` (7)
+    with every ``tau`` in ``-4 .. 4`` (7), the depth the slower index, no lateral offset (built by whole
+    columns: a nested list of 49 rows cost more than the fit's first evaluation)."""
+    grid = np.zeros((49, 4))
+    grid[:, 2] = np.repeat(np.log(front + 0.5 * extent * np.linspace(0.3, 2.0, 7)), 7)
+    grid[:, 3] = np.tile(np.linspace(-4.0, 4.0, 7), 7)
+    return grid
 
 
 @dataclass(frozen=True)
@@ -812,16 +846,27 @@ def fit_cone_ellipsoid(
     axis = np.asarray(axis, dtype=np.float64)
     rays = points / points[:, 2:3]
     z = points[:, 2]
-    depths = front + 0.5 * extent * np.linspace(0.3, 2.0, 7)
-    grid = np.array([[0.0, 0.0, np.log(d), tau] for d in depths for tau in np.linspace(-4.0, 4.0, 7)])
+    grid = _cone_grid(front, extent)
 
     cone_inv = np.linalg.inv(cone)
     ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
+    steps = np.diag(step)
+    at = np.empty((5, 4))
 
-    def residuals(p: np.ndarray) -> np.ndarray:
-        fronts, valid = _cone_fronts(p, cone, axis, rays, ray_cone)
+    def residuals(p: np.ndarray, split: int = 0) -> np.ndarray:
+        fronts, valid = _cone_fronts(p, cone, axis, rays, ray_cone, split=split)
         res = np.where(valid[:, None], z[None, :] - fronts, 0.05)
         return np.where(np.isfinite(res), res, 0.02)
+
+    def with_steps(p: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The residuals at ``p`` (n,) and at ``p`` plus each finite-difference step (4, n), in one evaluation
+        (a trial step that is taken needs both; one that is not wastes the four rows, cheaper than a second
+        call), each group's values those of its own call (``split``)."""
+        at[0] = p
+        np.add(p[None], steps, out=at[1:])
+        both = residuals(at, split=1)
+        return both[0], both[1:]
 
     def cost(res: np.ndarray) -> np.ndarray:
         a = np.abs(res)
@@ -831,12 +876,11 @@ def fit_cone_ellipsoid(
     if not np.isfinite(costs).any():
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
     p = grid[int(np.argmin(costs))]
-    r = residuals(p[None])[0]
+    r, r_steps = with_steps(p)
     current, mu = float(cost(r)), 1e-2
-    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
     for _ in range(iterations):
         done = False
-        jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]  # (4, n), forward differences
+        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
         a = np.abs(r)
         w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
         jtj = (jac * w) @ jac.T
@@ -845,10 +889,10 @@ def fit_cone_ellipsoid(
         while mu < 1e6:
             delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
             trial = p + delta
-            r_new = residuals(trial[None])[0]
+            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
             new = float(cost(r_new))
             if new < current:
-                p, r, mu, improved = trial, r_new, max(mu / 3.0, 1e-7), True
+                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
                 done = current - new < tolerance * current
                 current = new
                 break
@@ -863,7 +907,7 @@ def fit_cone_ellipsoid(
     a = np.abs(r)
     w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
     sigma2 = float((w * r * r).sum() / max(w.sum() - 4.0, 1.0))
-    jac = (residuals(p[None] + np.diag(step)) - r[None]) / step[:, None]
+    jac = (r_steps - r[None]) / step[:, None]
     try:
         cov = sigma2 * np.linalg.inv((jac * w) @ jac.T + 1e-18 * np.eye(4))
     except np.linalg.LinAlgError:

@@ -7,6 +7,7 @@ an error from deep inside numpy.
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -227,6 +228,8 @@ def subsample(points: np.ndarray, n: int | None, *, seed: int = 0) -> np.ndarray
 def perpendicular_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Two unit vectors completing each unit row of ``d`` (k, 3) to an orthonormal basis: ``e1, e2`` (k, 3),
     ``e2 = d x e1``."""
+    if d.shape == (1, 3) and d.dtype == np.float64 and (one := _perpendicular_one(d)) is not None:
+        return one
     x, y, z = d[:, 0], d[:, 1], d[:, 2]
     use_x = np.abs(x) < 0.9  # cross with (1, 0, 0) where d is not near x, else with (0, 1, 0)
     # Filled column by column (np.stack and a where over stacked rows cost more calls than the arithmetic): the
@@ -237,3 +240,22 @@ def perpendicular_basis(d: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     e1[:, 2] = np.where(use_x, -y, x)
     e1 /= row_norms(e1)[:, None]
     return e1, cross_rows(d, e1)
+
+
+def _perpendicular_one(d: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
+    """:func:`perpendicular_basis` of one float64 row (1, 3) in Python floats: the same operations in the same
+    order (IEEE double arithmetic, a correctly rounded square root), so the same values, in a tenth of the time
+    of some fifteen numpy calls on three numbers (the solid of revolution's fit asks for about six a fruit).
+    None for a zero row (numpy divides by zero where Python would raise)."""
+    x, y, z = (float(c) for c in d[0])
+    if abs(x) < 0.9:
+        a, b, c = 0.0, z, -y
+    else:
+        a, b, c = -z, 0.0, x
+    norm = math.sqrt(a * a + b * b + c * c)
+    if norm == 0.0:
+        return None
+    a, b, c = a / norm, b / norm, c / norm
+    e1 = np.array([[a, b, c]])
+    e2 = np.array([[y * c - z * b, z * a - x * c, x * b - y * a]])
+    return e1, e2

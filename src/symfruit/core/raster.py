@@ -7,7 +7,8 @@ falling outside it with an upper bound of their distance to the mask).
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -27,6 +28,7 @@ __all__ = [
     "close_ragged",
     "fill_holes",
     "inner_distance",
+    "interior",
     "mask_box",
     "outline_cone",
     "outline_cracks",
@@ -117,12 +119,7 @@ def _closed_mask(hit: np.ndarray, half: int) -> np.ndarray:
         closed = ndimage.uniform_filter(dilated, size=size, mode="nearest") > 1.0 - 1e-3
         closed |= hit
     # Fill holes: background components (4-connected) not touching the window's edge.
-    labels, _ = ndimage.label(~closed)
-    edge = np.unique(np.concatenate([labels[0], labels[-1], labels[:, 0], labels[:, -1]]))
-    background = np.zeros(labels.max() + 1, dtype=bool)
-    background[edge] = True
-    background[0] = False
-    return ~np.take(background, labels)  # a table look-up: np.take is twice as fast as background[labels]
+    return fill_holes(closed)
 
 
 @dataclass(frozen=True)
@@ -141,6 +138,9 @@ class Silhouette:
     v0: int
     mask: np.ndarray
     fill_radius: float
+    #: What :func:`silhouette_cone`, :func:`across_sight` and :func:`outline_cracks` work out of the mask alone,
+    #: made once per region and read-only (no code changes a region's mask in place once the region holds it).
+    _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
 def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius: float | None = None) -> Silhouette:
@@ -169,7 +169,7 @@ def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius:
     half = int(np.ceil(fill_radius))
     u0, v0, h, w = _window(col, row, camera, pad + half + 2)
     hit = np.zeros((h, w), dtype=bool)
-    hit[row - v0, col - u0] = True
+    hit.ravel()[(row - v0) * w + (col - u0)] = True  # by flat index: twice as fast as two index arrays
     return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
 
 
@@ -194,7 +194,7 @@ def close_ragged(region: Silhouette, *, radius: int = 3, ragged: float = 0.3) ->
     padded = np.zeros((mask.shape[0] + 2 * radius, mask.shape[1] + 2 * radius), dtype=bool)  # np.pad is slow
     padded[radius:-radius, radius:-radius] = mask
     closed = _closed_mask(padded, radius)[radius:-radius, radius:-radius]
-    outline = int((mask & ~ndimage.binary_erosion(mask)).sum())
+    outline = int((mask & ~interior(mask)).sum())
     if (closed & ~mask).sum() <= ragged * max(outline, 1):
         return region
     return Silhouette(region.u0, region.v0, closed, max(region.fill_radius, float(radius)))
@@ -208,6 +208,22 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     image coordinates ``x = ((u - cx) / fx, (v - cy) / fy, 1)`` the cone is ``x^T C x = 0``, negative
     inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
     """
+    _, mu, cov = _moments(region)
+    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
+    conic = np.zeros((3, 3))
+    conic[:2, :2] = inv
+    conic[:2, 2] = conic[2, :2] = -inv @ mu
+    conic[2, 2] = mu @ inv @ mu - 1.0
+    return _image_cone(conic, mu, camera)
+
+
+def _moments(region: Silhouette) -> tuple[float, np.ndarray, np.ndarray]:
+    """``(n, centroid (2,), covariance (2, 2))`` of a region's pixels (image coordinates ``u, v``; the covariance
+    of the pixel centres), made once per region: :func:`silhouette_cone` and :func:`across_sight` both read them
+    (kept read-only; an empty region's are NaN, not kept)."""
+    found = region._made.get("moments")
+    if found is not None:
+        return found
     m = region.mask.astype(np.float64)
     h, w = m.shape
     u = np.arange(w, dtype=np.float64) + region.u0
@@ -218,12 +234,10 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     du, dv = u - mu[0], v - mu[1]
     cross = dv @ m @ du  # once: the same product twice was a second pass over the window
     cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
-    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
-    conic = np.zeros((3, 3))
-    conic[:2, :2] = inv
-    conic[:2, 2] = conic[2, :2] = -inv @ mu
-    conic[2, 2] = mu @ inv @ mu - 1.0
-    return _image_cone(conic, mu, camera)
+    if n > 0:
+        mu.flags.writeable = cov.flags.writeable = False
+        region._made["moments"] = (float(n), mu, cov)
+    return float(n), mu, cov
 
 
 def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
@@ -234,7 +248,8 @@ def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     >>> mask_box(m)
     (1, 3, 2, 7)
     """
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    # the ufunc's reduction and nonzero() directly: the method and np.flatnonzero add their wrappers' calls
+    rows, cols = np.logical_or.reduce(mask, axis=1).nonzero()[0], np.logical_or.reduce(mask, axis=0).nonzero()[0]
     if not len(rows):
         return None
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
@@ -254,21 +269,42 @@ def inner_distance(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def interior(mask: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ``ndimage.binary_erosion(mask)`` (the pixels whose 4 neighbours are in the mask; pixels beyond
+    the array are not), by five shifted views of the padded mask instead of scipy's general structuring element
+    (3x faster); ``mask & ~interior(mask)`` is its outline."""
+    p = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), dtype=bool)  # padded by hand: np.pad is slow
+    p[1:-1, 1:-1] = mask
+    return p[1:-1, 1:-1] & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
+
+
 def fill_holes(mask: np.ndarray) -> np.ndarray:
     """(h, w) bool: ``mask`` with its holes filled, the same as :func:`scipy.ndimage.binary_fill_holes`.
 
     A hole is a 4-connected piece of the background that does not reach the image border; scipy finds them by
     dilating the background from the border until nothing changes (one pass over the image per pixel of the
     longest path), one labelling finds them at once.
+
+    The labelling covers the mask's box grown by a pixel (clipped to the image) alone: every background pixel
+    outside the box reaches the border along its row or column, so a piece of the background inside the grown
+    box is a hole exactly when it does not reach the grown box's edge (whose pixels beyond the mask's box are
+    background that reaches the border), and a silhouette's window is often twice its box.
     """
-    lab, n = ndimage.label(~mask)
+    mask = np.asarray(mask, dtype=bool)
+    out = mask.copy()
+    if (box := mask_box(mask)) is None:
+        return out
+    r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
+    c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
+    lab, n = ndimage.label(~mask[r0:r1, c0:c1])
     if n == 0:
-        return mask.copy()
+        return out
     outside = np.zeros(n + 1, bool)
     for edge in (lab[0], lab[-1], lab[:, 0], lab[:, -1]):
         outside[edge] = True
-    outside[0] = False
-    return ~outside[lab]
+    outside[0] = True  # the mask's own pixels: kept as they are
+    out[r0:r1, c0:c1] |= ~np.take(outside, lab)  # a table look-up: np.take is twice as fast as outside[lab]
+    return out
 
 
 def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> tuple[float, float]:
@@ -346,17 +382,9 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     >>> round(a.minor * 500, 3), round(a.major * 500, 3)
     (10.0, 20.0)
     """
-    m = region.mask.astype(np.float64)
-    col_sums, row_sums = m.sum(axis=0), m.sum(axis=1)
-    n = col_sums.sum()
-    if n == 0:
+    if not region.mask.any():
         raise InputError("the region is empty")
-    u = np.arange(m.shape[1], dtype=np.float64) + region.u0
-    v = np.arange(m.shape[0], dtype=np.float64) + region.v0
-    mu = np.array([col_sums @ u, row_sums @ v]) / n
-    du, dv = u - mu[0], v - mu[1]
-    cross = dv @ m @ du  # once: the same product twice was a second pass over the window
-    cov = np.array([[col_sums @ (du * du), cross], [cross, row_sums @ (dv * dv)]]) / n
+    _, mu, cov = _moments(region)
     axis = camera.rays(mu[0], mu[1]).reshape(3)
     axis = axis / np.linalg.norm(axis)
     e1 = np.array([axis[2], 0.0, -axis[0]])
@@ -388,7 +416,11 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
     """(m, 2) float, pixels: the region's outline as the midpoints of the pixel edges between a region pixel
-    and a 4-neighbour outside it (image coordinates: the exact boundary of the pixel squares)."""
+    and a 4-neighbour outside it (image coordinates: the exact boundary of the pixel squares). Made once per region
+    (:func:`~symfruit.core.agreement.observe` and :func:`across_sight` both read it), read-only."""
+    found = region._made.get("cracks")
+    if found is not None:
+        return found
     mask = region.mask
     h, w = mask.shape
     m = np.zeros((h + 2, w + 2), dtype=bool)  # padded by hand: np.pad's overhead was a fifth of the call
@@ -400,7 +432,10 @@ def outline_cracks(region: Silhouette) -> np.ndarray:
         np.add(cols, 0.5 * dc + region.u0, out=uv[:, 0])
         np.add(rows, 0.5 * dr + region.v0, out=uv[:, 1])
         out.append(uv)
-    return np.concatenate(out)
+    cracks = np.concatenate(out)
+    cracks.flags.writeable = False
+    region._made["cracks"] = cracks
+    return cracks
 
 
 def outline_cone(

@@ -27,7 +27,7 @@ import numpy as np
 from scipy import ndimage
 
 from .points import median
-from .raster import fill_holes, inner_distance, mask_box, principal_widths
+from .raster import fill_holes, inner_distance, interior, mask_box, principal_widths
 
 __all__ = [
     "Surface",
@@ -389,19 +389,12 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
         return None
     labels, _ = ndimage.label(surface.pixels)
     cap = labels == labels[surface.apex]
-    rows, cols = np.nonzero(cap & ~_interior(cap))
+    rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
     inside = inner - ndimage.distance_transform_edt(~mask)
     return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
-
-
-def _interior(mask: np.ndarray) -> np.ndarray:
-    """(h, w) bool: ``ndimage.binary_erosion(mask)`` (its 4 neighbours in the mask; pixels beyond the array are
-    not), by five shifted views of the padded mask instead of scipy's general structuring element (3x faster)."""
-    p = np.pad(mask, 1)
-    return p[1:-1, 1:-1] & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
 
 
 def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
