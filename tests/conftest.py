@@ -19,6 +19,13 @@ import os
 import signal
 from pathlib import Path
 
+# One BLAS thread per process, set before numpy loads OpenBLAS (numpy's and scipy's both read it): the suite runs
+# one pytest-xdist worker per core, and each worker's OpenBLAS would otherwise start a thread per core too and
+# spin-wait on it, so on this 2-core machine the workers and their CLI and ROS children (they inherit it) fought
+# over the cores: 10-15 % more CPU for the same tests, and more wall time still when other work shares the host.
+# A value already set (a run that wants to test threaded BLAS) is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
