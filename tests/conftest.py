@@ -19,12 +19,40 @@ import os
 import signal
 from pathlib import Path
 
+# One BLAS thread per process, set before numpy loads OpenBLAS (numpy's and scipy's both read it): the suite runs
+# one pytest-xdist worker per core, and each worker's OpenBLAS would otherwise start a thread per core too and
+# spin-wait on it, so on this 2-core machine the workers and their CLI and ROS children (they inherit it) fought
+# over the cores: 10-15 % more CPU for the same tests, and more wall time still when other work shares the host.
+# A value already set (a run that wants to test threaded BLAS) is kept.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, settings
 
 import symfruit
 from symfruit import Camera
+
+
+def _ram_temp_root(folder: Path = Path("/dev/shm"), needed: int = 2 << 30) -> str | None:
+    """``folder`` when it is a writable RAM disk with ``needed`` bytes free, else None."""
+    import shutil
+
+    try:
+        ok = folder.is_dir() and os.access(folder, os.W_OK) and shutil.disk_usage(folder).free >= needed
+    except OSError:
+        return None
+    return str(folder) if ok else None
+
+
+# pytest's temporary folders (tmp_path, tmp_path_factory; PYTEST_DEBUG_TEMPROOT is pytest's own setting) on the
+# RAM disk where there is one: every output is written atomically, fsync included, and on this host's disk the
+# suite's ~700 fsyncs held the workers up for seconds of wall time that nothing here measures (durability across
+# a power cut is not something a test can check). Only pytest's folders: the lock files of the ROS 2 domain
+# leases stay in the system's temporary folder, shared with every other process on the machine.
+if "PYTEST_DEBUG_TEMPROOT" not in os.environ and (_ram := _ram_temp_root()) is not None:
+    os.environ["PYTEST_DEBUG_TEMPROOT"] = _ram
+
 
 _QUIET = [HealthCheck.too_slow, HealthCheck.function_scoped_fixture, HealthCheck.data_too_large]
 settings.register_profile(

@@ -297,6 +297,9 @@ def test_complete_refuses_an_output_folder_and_prints_a_table(tmp_path, capsys):
     assert f"written    {tmp_path / 'o.ply'} and {tmp_path / 'o.json'}" in out
 
 
+# with the Dask cluster's tests (tests/season/test_cluster.py): the refusal of --workers 0 imports dask.distributed,
+# half a second of CPU on a worker that would otherwise never import it (pytest-xdist, --dist loadgroup)
+@pytest.mark.xdist_group("cluster")
 def test_bench_arguments_are_checked(capsys):
     assert main(["bench", "--repeat", "0"]) == 2
     assert main(["bench", "--points", "5"]) == 2

@@ -18,6 +18,10 @@ def row(method, iou, centre_mm, *, fruit="strawberry", occlusion=0.0, hidden=0.0
                error=error, depth_mm=depth_mm, lateral_mm=lateral_mm)  # fmt: skip
 
 
+#: Tests that draw plots run on the worker of tests/evaluate/test_evaluate.py's group, which draws them too: one
+#: worker imports matplotlib, not both (pytest-xdist, --dist loadgroup)
+PLOTS = pytest.mark.xdist_group("evaluate")
+
 ROWS = [row("raw", 0.5, 10.0, angle_x=-45.0, depth_mm=-20.0, lateral_mm=-3.0),
         row("raw", 0.6, 8.0, angle_x=45.0, depth_mm=-10.0, lateral_mm=1.0),
         row("paper", 0.75, 4.0, angle_x=-45.0), row("paper", float("nan"), float("nan"), error="too few")]  # fmt: skip
@@ -52,6 +56,7 @@ def test_confidence_lines_appear_for_methods_that_estimate_it():
     assert "Confidence of `fused`: Spearman -1.00 against the centre deviation" in table
 
 
+@PLOTS
 def test_every_file_is_written(tmp_path):
     summary = summarise(ROWS)
     written = write_results(tmp_path / "out", ROWS, summary, protocol="paper", meta={"title": "t", "seed": 3})
@@ -73,6 +78,7 @@ def test_every_file_is_written(tmp_path):
     assert (tmp_path / "given" / "table.md").read_text() == "# mine\n"
 
 
+@PLOTS
 def test_camera_runs_plot_by_occlusion_when_there_are_levels(tmp_path):
     pytest.importorskip("matplotlib")
     rows = [row(m, 0.5, 2.0, occlusion=o, hidden=o) for m in ("raw", "paper") for o in (0.0, 0.5)]

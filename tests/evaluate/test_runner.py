@@ -6,11 +6,13 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from symfruit import InputError, Settings
 from symfruit.evaluate.metrics import score_completion
 from symfruit.evaluate.protocols import Spec, build
-from symfruit.evaluate.runner import COLUMNS, Row, run, summarise
+from symfruit.evaluate.runner import COLUMNS, Row, average_ranks, run, spearman, summarise
 from symfruit.methods import register
 
 SPECS = [Spec("paper", "strawberry", 0, 9), Spec("paper", "strawberry", 1, 0)]
@@ -90,6 +92,37 @@ def test_confidence_statistics():
     assert s["reliable_share"] == pytest.approx(0.6)
     flat = [replace(r, confidence=0.5) for r in rows]
     assert math.isnan(summarise(flat)[0]["spearman"])  # no spread in confidence: no correlation
+
+
+def test_spearman_known_answers_with_ties():
+    assert average_ranks(np.array([10.0, 30.0, 20.0, 30.0, 10.0, 10.0])).tolist() == [2.0, 5.5, 4.0, 5.5, 2.0, 2.0]
+    assert spearman(np.array([1.0, 2.0, 3.0, 4.0]), np.array([8.0, 6.0, 4.0, 2.0])) == pytest.approx(-1.0)
+    # ranks (1.5, 1.5, 3, 4) and (1, 3, 2, 4), both about 2.5: Pearson 3 / sqrt(4.5 * 5)
+    got = spearman(np.array([5.0, 5.0, 7.0, 9.0]), np.array([1.0, 3.0, 2.0, 4.0]))
+    assert got == pytest.approx(3.0 / math.sqrt(4.5 * 5.0))
+    constant, nan = ([1.0, 1.0, 1.0], [1.0, 2.0, 3.0]), ([1.0, math.nan, 3.0], [1.0, 2.0, 3.0])
+    for x, y in (constant, constant[::-1], nan, nan[::-1]):
+        assert math.isnan(spearman(np.array(x), np.array(y)))  # a constant or a NaN: no correlation
+
+
+def _defined_ranks(v: np.ndarray) -> np.ndarray:
+    """Ranks as the definition counts them: 1 + the values below + half the others equal."""
+    return np.array([1 + np.sum(v < e) + (np.sum(v == e) - 1) / 2 for e in v])
+
+
+@given(st.lists(st.tuples(st.integers(0, 6), st.floats(-1e3, 1e3)), min_size=3, max_size=40))
+def test_spearman_is_pearson_of_the_ranks_by_their_definition(pairs):
+    """Ties drawn often (x takes seven values); y any finite numbers."""
+    x = np.array([float(a) for a, _ in pairs])
+    y = np.array([b for _, b in pairs])
+    rx, ry = _defined_ranks(x), _defined_ranks(y)
+    np.testing.assert_array_equal(average_ranks(x), rx)
+    np.testing.assert_array_equal(average_ranks(y), ry)
+    if np.ptp(x) > 0 and np.ptp(y) > 0:
+        dx, dy = rx - rx.mean(), ry - ry.mean()
+        assert spearman(x, y) == pytest.approx(np.sum(dx * dy) / math.sqrt(np.sum(dx**2) * np.sum(dy**2)), abs=1e-12)
+    else:
+        assert math.isnan(spearman(x, y))
 
 
 def test_worst_case_statistics():

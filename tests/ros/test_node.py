@@ -28,6 +28,10 @@ REPO = Path(__file__).resolve().parents[2]
 TIMEOUT = float(os.environ.get("SYMFRUIT_ROS_TIMEOUT", "120"))
 NODE = "/symfruit_under_test"
 FRAME_ID = "camera_color_optical_frame"
+#: The node's log line once its synchroniser has its callback. Its inputs are subscribed a moment before, so a
+#: publisher sees them connected while a frame sent then would still be dropped (and a test wait its whole deadline
+#: for it): frames are sent after this line.
+LISTENING = ", listening to "
 
 
 # --------------------------------------------------------------------------------------------------
@@ -215,6 +219,7 @@ def ros_world(ros1, tmp_path_factory):
         node = start(cmd, env, log)
         wait_until(lambda: all(p.get_num_connections() > 0 for p in pubs), "the node to subscribe", node, log)
         wait_until(lambda: all(s.get_num_connections() > 0 for s in subs), "the node's topics", node, log)
+        wait_until(lambda: LISTENING in log.read_text(errors="replace"), "the node to listen", node, log)
         yield {"rospy": rospy, "vm": vm, "pubs": pubs, "inbox": inbox, "process": node, "log": log, "master": master}
     finally:
         if node is not None:
@@ -332,6 +337,7 @@ def test_launch_file_runs_the_node_with_remapped_inputs(ros_world, example_image
     try:
         ready = lambda: all(p.get_num_connections() > 0 for p in pubs) and sub.get_num_connections() > 0  # noqa: E731
         wait_until(ready, "the launched node to connect", launcher, log)
+        wait_until(lambda: LISTENING in log.read_text(errors="replace"), "the launched node to listen", launcher, log)
         stamp = rospy.Time(500, 0)
         play(ros_world, example_images, stamp, pubs=pubs)
         got = inbox.wait(stamp, "detections from the launched node", {"process": launcher, "log": log})

@@ -11,8 +11,9 @@ from symfruit.season.report import PER_RECORDING_PLOTS, PLOTS, diameters_mm, siz
 from symfruit.season.table import TableWriter
 
 #: one worker runs the module's tests one after another and writes the shared report once (pytest-xdist, --dist
-#: loadgroup: a worker that interleaved other modules' tests would tear the module-scoped fixture down between them)
-pytestmark = pytest.mark.xdist_group("season-report")
+#: loadgroup: a worker that interleaved other modules' tests would tear the module-scoped fixture down between them);
+#: the group of tests/evaluate/test_evaluate.py, whose run draws plots too: one worker imports matplotlib, not both
+pytestmark = pytest.mark.xdist_group("evaluate")
 
 
 def _record(frame: str, sizes: list[tuple[float, float, float]], *, cut: int = 0, failed: int = 0) -> dict:
