@@ -29,6 +29,7 @@ from __future__ import annotations
 import bisect
 import re
 import struct
+import time
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
@@ -325,14 +326,32 @@ def _require_pyrealsense2() -> Any:
     return rs
 
 
-def sdk_aligned(path: str | Path, *, timeout_ms: int = 5000) -> Iterator[tuple[int, np.ndarray]]:
+def sdk_aligned(path: str | Path, *, timeout_ms: int = 5000, attempts: int = 10) -> Iterator[tuple[int, np.ndarray]]:
     """Play a recording with the RealSense SDK (pyrealsense2, extra ``realsense``) and align its depth to
-    colour with ``rs.align``: ``(depth stamp in ns, (h, w) float32 metres)`` per depth frame, in order,
-    each depth frame once. No camera is needed.
+    colour with ``rs.align``: ``(depth stamp in ns, (h, w) float32 metres)`` per depth frame the SDK's pipeline
+    delivers, in order, each once. No camera is needed.
 
-    The stamps are the depth images' header stamps, as :class:`RealSenseBagSource` names its frames.
+    The stamps are the depth images' header stamps, as :class:`RealSenseBagSource` names its frames. The SDK's
+    pipeline pairs depth with colour and may leave frames out (one of the two of ``examples/realsense/fruit.bag``).
+    A playback starts in real time until it is switched off, a moment after the pipeline starts: on a loaded
+    machine it can run to its end before a frame is taken (about 1 start in 150 with both cores busy), and it
+    then says "stopped", as a playback that has not started yet does. One that stays stopped for a second
+    without a frame is started again, up to ``attempts`` times, within ``timeout_ms`` in all.
     """
     rs = _require_pyrealsense2()
+    seen: set[int] = set()
+    deadline = time.monotonic() + timeout_ms / 1000.0
+    for _ in range(max(1, attempts)):
+        yield from _sdk_playback(rs, path, deadline, seen)
+        if seen or time.monotonic() >= deadline:
+            return
+
+
+def _sdk_playback(
+    rs: Any, path: str | Path, deadline: float, seen: set[int], *, stopped_ms: int = 1000
+) -> Iterator[tuple[int, np.ndarray]]:
+    """One playback of :func:`sdk_aligned` until it ends, stays stopped ``stopped_ms`` without a frame or the
+    ``deadline`` (``time.monotonic()``) passes; the stamps yielded are added to ``seen`` (and not yielded again)."""
     config = rs.config()
     config.enable_device_from_file(str(path), repeat_playback=False)
     pipeline = rs.pipeline()
@@ -346,18 +365,17 @@ def sdk_aligned(path: str | Path, *, timeout_ms: int = 5000) -> Iterator[tuple[i
         playback.set_real_time(False)
         scale = device.first_depth_sensor().get_depth_scale()
         align = rs.align(rs.stream.color)
-        seen: set[int] = set()
-        waited = 0
+        taken = 0
+        stopped_for = 0
         while True:
             ok, frames = pipeline.try_wait_for_frames(100)
-            if not ok:  # the end of the file, or the SDK is slow: give it timeout_ms in all
-                waited += 100
-                # "stopped" before the first frame can be a playback that has not started yet (a loaded machine)
+            if not ok:  # the end of the file, a playback not started yet or one that ran out unseen
                 stopped = playback.current_status() == rs.playback_status.stopped
-                if (stopped and seen) or waited >= timeout_ms:
+                stopped_for = stopped_for + 100 if stopped else 0
+                if (stopped and taken) or stopped_for >= stopped_ms or time.monotonic() >= deadline:
                     return
                 continue
-            waited = 0
+            taken += 1
             aligned = align.process(frames)
             depth = aligned.get_depth_frame()
             if not depth:
