@@ -195,15 +195,16 @@ class SymfruitNode:
         self.pub_points = rospy.Publisher("~fruit_points", PointCloud2, queue_size=2)
         self.topics = {name: input_topic(rospy, name) for name in DEFAULT_TOPICS}
         big = 1 << 26  # rospy's 64 kB default receive buffer makes large images lag far behind
+        # Everything the synchroniser needs is read (two round trips to the master) and the worker started before
+        # the first subscription: a frame completed between subscribing and registering the callback was dropped.
+        queue_size, slop = int(param("~queue_size", 5)), float(param("~slop", 0.05))
+        self.worker = LatestOnly(self._handle, on_error=self._on_error).start()
         subs = [
             message_filters.Subscriber(self.topics["color"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
             message_filters.Subscriber(self.topics["depth"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
             message_filters.Subscriber(self.topics["camera_info"], CameraInfo, queue_size=1, tcp_nodelay=True),
         ]
-        self.sync = message_filters.ApproximateTimeSynchronizer(
-            subs, queue_size=int(param("~queue_size", 5)), slop=float(param("~slop", 0.05))
-        )
-        self.worker = LatestOnly(self._handle, on_error=self._on_error).start()
+        self.sync = message_filters.ApproximateTimeSynchronizer(subs, queue_size=queue_size, slop=slop)
         self.sync.registerCallback(self._on_frame)
         rospy.on_shutdown(self.worker.stop)
         rospy.loginfo("symfruit: method %s, listening to %s, %s, %s", self.core.method, *self.topics.values())
