@@ -71,8 +71,7 @@ class FrameDetections:
         """The camera of the detections' masks, points and occlusion maps: the frame's, its principal point moved
         by :attr:`registration` (:meth:`~symfruit.core.camera.Camera.shifted`; the points are in the frame
         camera's frame). Complete a detection's points again with this one."""
-        cam = self.frame.camera
-        return cam.shifted(*self.registration) if self.registration != (0, 0) else cam
+        return self.frame.camera.shifted(*self.registration)
 
 
 Segmenter = Callable[[Frame, Settings], np.ndarray]
@@ -146,7 +145,7 @@ def detect(
     # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
     # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
     # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
-    camera = FrameDetections(frame, [], registration=shift).camera
+    camera = frame.camera.shifted(*shift)
     detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
     from scipy import ndimage

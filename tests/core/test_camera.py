@@ -118,4 +118,4 @@ def test_a_shifted_camera_sees_every_point_shifted_and_deprojects_it_back(du, dv
     np.testing.assert_allclose(moved.project(p), cam.project(p) + [du, dv], atol=1e-9)
     np.testing.assert_allclose(moved.deproject(moved.project(p), [z]), p, atol=1e-12)
     assert (moved.fx, moved.fy, moved.width, moved.height) == (cam.fx, cam.fy, cam.width, cam.height)
-    assert cam.shifted(0, 0) == cam
+    assert cam.shifted(0, 0) is cam

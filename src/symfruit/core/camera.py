@@ -93,6 +93,8 @@ class Camera:
         >>> cam.shifted(6, -2).project(cam.deproject([[100.0, 50.0]], [1.0]))
         array([[106.,  48.]])
         """
+        if du == 0 and dv == 0:  # a well-registered frame: this camera itself
+            return self
         return replace(self, cx=self.cx + float(du), cy=self.cy + float(dv))
 
     def to_dict(self) -> dict[str, float | int]:

@@ -85,7 +85,7 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
     if inst.extract and mask is not None and inst.depth is not None:  # as ``detect`` takes a fruit's points
         moved, shift = register(mask.astype(np.int32), inst.depth, inst.camera, settings.extract)
         mask = moved > 0
-        camera = inst.camera.shifted(*shift) if shift != (0, 0) else inst.camera
+        camera = inst.camera.shifted(*shift)
         ex = extract(mask, inst.depth, camera, settings.extract)
         visible = ex.points
         mask = ex.silhouette if ex.silhouette is not None else mask
