@@ -111,6 +111,12 @@ def test_mask_sources_in_order_of_preference(tmp_path):
     assert source == "my_masks" and got.dtype == np.int32 and np.array_equal(got, labels)
     found = detect(frame, method="raw")
     assert [d.id for d in found.detections] == [7] and found.mask_source == "frame masks file"
+    # the labels themselves (a segmenter of the user's own): the same fruit, named as such
+    got, source = frame_masks(frame, labels.astype(np.uint16))
+    assert source == "label array" and got.dtype == np.int32 and np.array_equal(got, labels)
+    by_array = detect(frame, masks=labels, method="raw")
+    assert by_array.mask_source == "label array"
+    assert np.array_equal(by_array.detections[0].extraction.points, found.detections[0].extraction.points)
 
 
 def test_masks_that_do_not_fit_the_frame_are_refused():
@@ -121,6 +127,14 @@ def test_masks_that_do_not_fit_the_frame_are_refused():
     negative[0, 0] = -1
     with pytest.raises(InputError, match="masks hold negative labels"):
         detect(frame, masks=lambda f, s: negative)
+    with pytest.raises(InputError, match="masks hold negative labels"):
+        detect(frame, masks=negative)
+    with pytest.raises(InputError, match=r"frame small: masks \(label array\): instance labels must be whole"):
+        detect(frame, masks=np.zeros((120, 160)))
+    with pytest.raises(InputError, match=r"frame small: masks are \(10, 10\), the image \(160, 120\)"):
+        detect(frame, masks=np.zeros((10, 10), bool))
+    with pytest.raises(InputError, match=r"masks must be a spec .* got int"):
+        detect(frame, masks=3)  # type: ignore[arg-type]
 
 
 def test_sparse_instance_ids_are_kept_and_too_many_instances_refused():

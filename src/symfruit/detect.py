@@ -78,18 +78,24 @@ Segmenter = Callable[[Frame, Settings], np.ndarray]
 
 
 def frame_masks(
-    frame: Frame, masks: str | Path | MaskSource | Segmenter = "auto", settings: Settings | None = None
+    frame: Frame, masks: str | Path | MaskSource | Segmenter | np.ndarray = "auto", settings: Settings | None = None
 ) -> tuple[np.ndarray, str]:
     """Instance labels for a frame, and a word on where they came from.
 
     ``masks`` is a spec of :func:`symfruit.segment.mask_source` (``"auto"``: the frame's own masks file if it
     has one, else the colour segmenter; ``"color"``; a label PNG or COCO JSON path; ``"maskrcnn:CHECKPOINT"``;
-    ``"onnx:MODEL"``), a :class:`~symfruit.segment.MaskSource` made from one, or a callable
-    ``(frame, settings) -> labels``.
+    ``"onnx:MODEL"``), a :class:`~symfruit.segment.MaskSource` made from one, a callable
+    ``(frame, settings) -> labels``, or the labels themselves: an ``(h, w)`` integer array of the frame's size
+    (0 = background, k = fruit k).
     """
     settings = settings or Settings()
     shape = frame.depth.shape
-    if callable(masks) and not isinstance(masks, MaskSource):
+    if isinstance(masks, np.ndarray):  # checked below: its size, whole numbers, how many fruit
+        labels, source = masks, "label array"
+    elif not isinstance(masks, str | Path | MaskSource) and not callable(masks):
+        raise InputError(f"frame {frame.name}: masks must be a spec (str or path), a MaskSource, a callable or a "
+                         f"label array, got {type(masks).__name__}")  # fmt: skip
+    elif callable(masks) and not isinstance(masks, MaskSource):
         labels, source = np.asarray(masks(frame, settings)), getattr(masks, "__name__", "callable")
     else:
         source_of = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings)
@@ -103,7 +109,7 @@ def frame_masks(
 def detect(
     frame: Frame,
     *,
-    masks: str | Path | MaskSource | Segmenter = "auto",
+    masks: str | Path | MaskSource | Segmenter | np.ndarray = "auto",
     method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
 ) -> FrameDetections:
