@@ -494,6 +494,33 @@ def test_the_cli_names_every_real_camera_model():
     assert REAL_SENSORS == tuple(SENSOR_MODELS)
 
 
+def test_scenes_of_an_apple_tree_go_through_the_azure_kinect_by_default(tmp_path, capsys, monkeypatch):
+    """The arguments alone (rendering a 1920x1080 canopy is tested in tests/synthetic)."""
+    from symfruit.synthetic import scenes
+
+    calls = []
+
+    def fake(folder, n, **kwargs):
+        sensor = kwargs["sensor"]
+        calls.append((n, kwargs["seed"], kwargs["n_ripe"], kwargs["n_unripe"], sensor and sensor.name, kwargs["tree"]))
+        return [folder / f"scene_{i:05d}" for i in range(n)]
+
+    monkeypatch.setattr(scenes, "write_scenes", fake)
+    assert main(["scenes", str(tmp_path / "t"), "--scene", "apple-tree", "--n", "2", "--seed", "6"]) == 0
+    assert main(["scenes", str(tmp_path / "u"), "--scene", "apple-tree", "--n", "1", "--ripe", "3",
+                 "--sensor", "realsense-l515"]) == 0  # fmt: skip
+    assert main(["scenes", str(tmp_path / "v"), "--n", "1"]) == 0
+    assert calls == [
+        (2, 6, 30, 4, "azure-kinect", True),
+        (1, 0, 3, 4, "realsense-l515", True),
+        (1, 0, 6, 2, None, False),
+    ]
+    out = capsys.readouterr().out
+    assert "wrote 2 apple-tree frames to" in out and "(seeds 6-7, azure-kinect at 1920x1080 with masks.png)" in out
+    with pytest.raises(SystemExit):
+        main(["scenes", str(tmp_path / "w"), "--scene", "pear-tree"])
+
+
 @pytest.mark.slow
 def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
     out = tmp_path / "frames"

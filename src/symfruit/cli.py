@@ -227,16 +227,22 @@ def _parser() -> argparse.ArgumentParser:
     _add_detect(sub)
     _add_report(sub)
     _add_ros(sub)
-    p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries (with truth)")
+    p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries or of an "
+                       "apple tree (with truth)")  # fmt: skip
     p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
-    p.add_argument("--ripe", type=int, default=6, help="ripe fruit per frame (default 6)")
-    p.add_argument("--unripe", type=int, default=2, help="unripe (white or green) fruit per frame (default 2)")
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+                   help="hanging strawberries (default) or an apple tree's canopy at 1.2-2 m through a real camera "
+                   "model (the Azure Kinect unless --sensor), with the annotators' masks.png")  # fmt: skip
+    p.add_argument("--ripe", type=int, default=None,
+                   help="ripe fruit per frame (default 6 strawberries, 30 apples)")  # fmt: skip
+    p.add_argument("--unripe", type=int, default=None,
+                   help="unripe (white or green) fruit per frame (default 2 strawberries, 4 apples)")  # fmt: skip
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
                    help="through a real camera model (symfruit.synthetic.sensors) at its resolution, fruit at "
                    "its working distances within 0.25-2 m, with the annotators' masks.png (default: the 640x480 "
-                   "D435-like frames)")  # fmt: skip
+                   "D435-like frames; apple trees: the Azure Kinect)")  # fmt: skip
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
@@ -677,16 +683,20 @@ def _scenes(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .synthetic.scenes import write_scenes
 
-    if not 1 <= args.n <= 100_000 or not 0 <= args.ripe <= 50 or not 0 <= args.unripe <= 50 or args.seed < 0:
+    tree = args.scene == "apple-tree"
+    ripe = (30 if tree else 6) if args.ripe is None else args.ripe
+    unripe = (4 if tree else 2) if args.unripe is None else args.unripe
+    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50 or args.seed < 0:
         raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")
     sensor = None
-    if args.sensor is not None:
+    if args.sensor is not None or tree:
         from .synthetic.sensors import sensor_model
 
-        sensor = sensor_model(args.sensor)
-    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=args.ripe, n_unripe=args.unripe, sensor=sensor)
-    through = f", {args.sensor} at {sensor.width}x{sensor.height} with masks.png" if sensor is not None else ""
-    print(f"wrote {len(folders)} frames to {args.output} (seeds {args.seed}-{args.seed + args.n - 1}{through})")
+        sensor = sensor_model(args.sensor or "azure-kinect")
+    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor, tree=tree)
+    what = "apple-tree frames" if tree else "frames"
+    through = f", {sensor.name} at {sensor.width}x{sensor.height} with masks.png" if sensor is not None else ""
+    print(f"wrote {len(folders)} {what} to {args.output} (seeds {args.seed}-{args.seed + args.n - 1}{through})")
     return 0
 
 

@@ -1,12 +1,13 @@
 """Table 3 on annotated frames: matching found fruit to the truth, scoring every method, the table."""
 
+import json
 import shutil
 
 import numpy as np
 import pytest
 
-from symfruit import Box
-from symfruit.evaluate.frames import evaluate_frames, match, summary_dict, table3
+from symfruit import Box, Camera
+from symfruit.evaluate.frames import FrameScore, evaluate_frames, match, summary_dict, table3, thin_lens
 
 from ..conftest import EXAMPLE_FRAME
 
@@ -62,7 +63,14 @@ def test_frames_without_truth_or_unreadable_are_reported(tmp_path):
         "truncated",
         "depth_mm",
         "lateral_mm",
+        "visible",
+        "thin_depth_mm",
+        "thin_lateral_mm",
     }
+    # the example frame's truth records no visible share: null in summary.json (JSON has no NaN), no table of them
+    assert all(row["visible"] is None for row in data["scores"])
+    json.dumps(data, allow_nan=False)
+    assert all(np.isnan(s.visible) for s in scores) and "how much of each fruit" not in table3(scores, totals, ["raw"])
 
 
 def test_the_table_is_laid_out_like_the_papers(tmp_path):
@@ -84,3 +92,47 @@ def test_a_tight_gate_matches_nothing(tmp_path, gate):
     shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
     scores, totals, _ = evaluate_frames(tmp_path, methods=("raw",), gate=gate)
     assert scores == [] and totals["matched"] == 0 and totals["missed"] == 6 and totals["false"] == 6
+
+
+def test_the_thin_lens_estimate_is_the_masks_larger_extent_at_the_median_depth():
+    cam = Camera(fx=500.0, fy=400.0, cx=50.0, cy=50.0, width=100, height=100)
+    mask = np.zeros((100, 100), bool)
+    mask[40:60, 30:80] = True  # 50 px wide, 20 px tall
+    points = np.array([[0.0, 0.0, 0.9], [0.0, 0.0, 1.0], [0.0, 0.0, 1.5]])
+    assert thin_lens(mask, points, cam) == pytest.approx(50 / 500.0 * 1.0)
+    mask[:] = False
+    mask[10:90, 45:50] = True  # 80 px tall over fy 400 beats 5 px wide over fx 500
+    assert thin_lens(mask, points, cam) == pytest.approx(80 / 400.0 * 1.0)
+    assert np.isnan(thin_lens(np.zeros((100, 100), bool), points, cam))
+
+
+def test_sizes_by_how_much_of_each_fruit_is_seen(tmp_path):
+    shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
+    truth = tmp_path / "a" / "truth.json"
+    data = json.loads(truth.read_text())
+    ripe = [f for f in data["fruits"] if f.get("ripe", True)]
+    for f, seen in zip(ripe, [1.0, 0.95, 0.7, 0.5, 0.2, 0.9], strict=True):
+        f["visible"] = seen
+    truth.write_text(json.dumps(data))
+    scores, totals, _ = evaluate_frames(tmp_path, methods=("raw", "sphere"))
+    assert sorted({s.visible for s in scores}) == [0.2, 0.5, 0.7, 0.9, 0.95, 1.0]
+    raw = [s for s in scores if s.method == "raw"]
+    table = table3(scores, totals, ("raw", "sphere")).splitlines()
+    head = table.index("| method | visible (>= 90 % seen) | partly hidden (60-90 %) | mostly hidden (< 60 %) |")
+
+    def cell(group, depth, lateral):
+        dz, dl = np.array([getattr(s, depth) for s in group]), np.array([getattr(s, lateral) for s in group])
+        return f"{np.abs(dz).mean():.1f} ({dz.mean():+.1f}) / {np.abs(dl).mean():.1f} ({dl.mean():+.1f}) (n {len(dz)})"
+
+    groups = [[s for s in raw if s.visible >= 0.9], [s for s in raw if 0.6 <= s.visible < 0.9],
+              [s for s in raw if s.visible < 0.6]]  # fmt: skip
+    assert [len(g) for g in groups] == [3, 1, 2]
+    assert table[head + 2] == "| thin-lens (reference) | " + " | ".join(
+        cell(g, "thin_depth_mm", "thin_lateral_mm") for g in groups) + " |"  # fmt: skip
+    assert table[head + 3] == "| raw | " + " | ".join(cell(g, "depth_mm", "lateral_mm") for g in groups) + " |"
+    assert table[head + 4].startswith("| sphere | ")
+    # the thin-lens reference is the same for every method of a fruit, and near the truth on this frame
+    by_fruit = {(s.frame, s.fruit): s.thin_lateral_mm for s in raw}
+    assert all(s.thin_lateral_mm == by_fruit[(s.frame, s.fruit)] for s in scores)
+    assert all(abs(s.thin_lateral_mm) < 10 for s in raw)
+    assert isinstance(raw[0], FrameScore)

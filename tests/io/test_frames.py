@@ -158,10 +158,25 @@ def test_truth_keeps_the_ripe_fruit_with_their_ids(tmp_path):
         ({"fruits": {"a": 1}}, "'fruits' is not a list"),
         ({"fruits": [3]}, "fruit 1 is not an object"),
         ({"fruits": [{"min": [0, 0, 0]}]}, "'max'"),
+        ({"fruits": [{"min": [0, 0, 0], "max": [1, 1, 1], "visible": 1.5}]}, "visible must be a share in"),
+        ({"fruits": [{"min": [0, 0, 0], "max": [1, 1, 1], "visible": True}]}, "visible must be a share in"),
+        ({"fruits": [{"min": [0, 0, 0], "max": [1, 1, 1], "visible": "all"}]}, "visible must be a share in"),
     ]:
         path.write_text(json.dumps(bad))
         with pytest.raises(FileFormatError, match=rf"truth\.json: expected .*{message}"):
             read_truth(path)
+
+
+def test_a_frame_knows_how_much_of_each_true_fruit_is_seen(tmp_path):
+    color, depth = disc_frame([(40, 60)])
+    fruits = [{"id": 4, "min": [0, 0, 0.3], "max": [0.02, 0.03, 0.33], "visible": 0.25},
+              {"id": 9, "min": [0, 0, 0.3], "max": [0.02, 0.03, 0.33]},
+              {"id": 5, "ripe": False, "min": [0, 0, 0.3], "max": [0.02, 0.03, 0.33], "visible": 1}]  # fmt: skip
+    write_frame(tmp_path / "f", color, depth, CAM, truth={"fruits": fruits})
+    frame = read_frame(tmp_path / "f")
+    assert [fid for fid, _ in frame.truth] == [4, 9] and frame.visible == {4: 0.25}  # no share, no target: none
+    write_frame(tmp_path / "g", color, depth, CAM)
+    assert read_frame(tmp_path / "g").visible == {}
 
 
 def test_masks_written_with_the_frame_come_back(tmp_path):

@@ -164,3 +164,36 @@ def test_an_apple_trees_ripe_apples_are_red_its_green_ones_not(tree):
     leaves = (tree.labels == 0) & (tree.depth > 0)
     assert strong[leaves].mean() < 0.02
     assert tree.masks is not None and set(np.unique(tree.masks)) <= {0, *(f.id for f in tree.fruits if f.ripe)}
+
+
+def test_an_apple_trees_ripe_apples_say_how_much_of_them_is_seen(tree):
+    """``visible``: the apple's seen pixels over its pixels rendered alone (truth.json's ``visible``)."""
+    ripe = [f for f in tree.fruits if f.ripe]
+    assert all(f.visible is not None and 0.0 <= f.visible <= 1.0 for f in ripe)
+    assert all(f.visible is None for f in tree.fruits if not f.ripe)  # no target, not measured
+    for f in ripe:
+        seen = int((tree.labels == f.id).sum())
+        assert (seen == 0) == (f.visible == 0.0)
+        assert f.to_dict()["visible"] == pytest.approx(f.visible, abs=1e-4)
+    # an apple with nothing in front of it is seen whole; some of the canopy's apples are hidden in part
+    shares = sorted(f.visible for f in ripe)
+    assert shares[-1] > 0.97 and shares[0] < 0.8
+
+
+def test_a_written_apple_tree_frame_carries_its_truth_and_masks(tmp_path, monkeypatch):
+    from symfruit.io.frames import read_frame
+    from symfruit.synthetic import scenes
+    from symfruit.synthetic.sensors import sensor_model
+
+    calls, make = [], scenes.make_tree_scene
+
+    def small_tree(seed, *, sensor=None, n_apples=30, n_green=4):
+        calls.append((seed, sensor.name, n_apples, n_green))
+        return make(seed, sensor=sensor.at(320, 180), n_apples=n_apples, n_green=n_green, n_leaves=200)
+
+    monkeypatch.setattr(scenes, "make_tree_scene", small_tree)
+    [folder] = write_scenes(tmp_path / "t", 1, seed=5, n_ripe=4, n_unripe=1, sensor=sensor_model("azure-kinect"),
+                            tree=True)  # fmt: skip
+    assert calls == [(5, "azure-kinect", 4, 1)]
+    frame = read_frame(folder)
+    assert frame.masks is not None and len(frame.truth) == 4 and set(frame.visible) == {fid for fid, _ in frame.truth}

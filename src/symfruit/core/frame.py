@@ -39,6 +39,8 @@ class Frame:
         The colour image's coordinate frame (a ROS header's ``frame_id``); detections are in it.
         None: ``camera_color_optical_frame``.
     extras : dict
+    visible : dict of int to float
+        For truth fruit whose ``truth.json`` records it: the share of the fruit's silhouette the camera sees.
     """
 
     name: str
@@ -51,6 +53,7 @@ class Frame:
     stamp: int | None = None
     frame_id: str | None = None
     extras: dict[str, Any] = field(default_factory=dict)
+    visible: dict[int, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         if not isinstance(self.camera, Camera):

@@ -16,6 +16,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from ..core.box import Box, box_iou, centre_deviation
+from ..core.camera import Camera
 from ..core.frame import Frame
 from ..detect import FrameDetections, detect
 from ..errors import SymfruitError
@@ -23,13 +24,17 @@ from ..io.sources import open_source
 from ..methods.complete import complete
 from ..settings import Settings
 
-__all__ = ["FrameScore", "evaluate_frames", "match"]
+__all__ = ["VISIBILITY_GROUPS", "FrameScore", "evaluate_frames", "match", "thin_lens"]
 
 
 @dataclass(frozen=True)
 class FrameScore:
     """One matched fruit under one method: box IoU, centre deviation and the signed size errors of the box's
-    depth side and larger lateral side (positive: too large; :class:`~symfruit.evaluate.metrics.Scores`)."""
+    depth side and larger lateral side (positive: too large; :class:`~symfruit.evaluate.metrics.Scores`).
+
+    ``visible``: the share of the fruit's silhouette the camera sees, where ``truth.json`` records it (NaN
+    otherwise). ``thin_depth_mm``, ``thin_lateral_mm``: the same two errors of the 2-D thin-lens estimate, a
+    reference that knows no 3-D shape (:func:`thin_lens`; the same for every method of one fruit)."""
 
     frame: str
     fruit: int
@@ -41,6 +46,19 @@ class FrameScore:
     truncated: bool
     depth_mm: float = float("nan")
     lateral_mm: float = float("nan")
+    visible: float = float("nan")
+    thin_depth_mm: float = float("nan")
+    thin_lateral_mm: float = float("nan")
+
+
+def thin_lens(mask: np.ndarray, points: np.ndarray, camera: Camera) -> float:
+    """The 2-D thin-lens estimate of a fruit's diameter (metres): the mask's larger extent in pixels times the
+    median depth of its points over the focal length (issue 18's reference for a box's lateral sides)."""
+    rows, cols = np.nonzero(mask)
+    if not len(rows) or not len(points):
+        return float("nan")
+    z = float(np.median(points[:, 2]))
+    return max((np.ptp(cols) + 1) / camera.fx, (np.ptp(rows) + 1) / camera.fy) * z
 
 
 def match(found: Sequence[Box | None], truth: Sequence[Box], gate: float = 0.03) -> list[tuple[int, int]]:
@@ -66,6 +84,10 @@ def score_frame(
     for i, j in pairs:
         d = ok[i]
         tid, tbox = truth[j]
+        thin = thin_lens(d.mask, d.extraction.points, found.camera)
+        reference = {"visible": frame.visible.get(tid, float("nan")),
+                     "thin_depth_mm": (thin - float(tbox.size[2])) * 1000,
+                     "thin_lateral_mm": (thin - float(tbox.size[:2].max())) * 1000}  # fmt: skip
         for method in methods:
             try:
                 box = complete(d.extraction.points, camera=found.camera, method=method, settings=settings,
@@ -75,7 +97,8 @@ def score_frame(
             scores.append(FrameScore(frame.name, d.id, tid, method, box_iou(box, tbox),
                                      centre_deviation(box, tbox) * 1000, len(d.extraction.points),
                                      d.extraction.truncated, float(box.size[2] - tbox.size[2]) * 1000,
-                                     float(box.size[:2].max() - tbox.size[:2].max()) * 1000))  # fmt: skip
+                                     float(box.size[:2].max() - tbox.size[:2].max()) * 1000,
+                                     **reference))  # fmt: skip
     counts = {"truth": len(truth), "found": len(found.detections), "matched": len(pairs),
               "missed": len(truth) - len(pairs), "false": len(found.detections) - len(pairs)}  # fmt: skip
     return scores, counts
@@ -145,8 +168,53 @@ def table3(scores: Sequence[FrameScore], totals: dict[str, int], methods: Sequen
         f"Ge et al. 2020, Table 3 (D435, mean): input points {ri} / {rc} mm, completed {pi} / {pc} mm.",
         "",
     ]
+    lines += sizes_by_visibility(scores, methods)
     return "\n".join(lines)
 
 
+#: Groups of truth fruit by the share of their silhouette the camera sees: (label, least share, below share).
+VISIBILITY_GROUPS = (("visible (>= 90 % seen)", 0.9, 2.0), ("partly hidden (60-90 %)", 0.6, 0.9),
+                     ("mostly hidden (< 60 %)", -1.0, 0.6))  # fmt: skip
+
+
+def sizes_by_visibility(scores: Sequence[FrameScore], methods: Sequence[str]) -> list[str]:
+    """Markdown lines: the box's depth side and larger lateral side against the truth per visibility group
+    (``truth.json``'s ``visible``; none when no fruit records one), the thin-lens estimate as a reference row."""
+    if not any(np.isfinite(s.visible) for s in scores):
+        return []
+    head = [label for label, _, _ in VISIBILITY_GROUPS]
+    lines = ["Box sides by how much of each fruit the camera sees (mean absolute error in mm, the mean signed error "
+             "in brackets: depth side / larger lateral side; the thin-lens row is the mask's larger extent times "
+             "the median depth over f, for both):", "",
+             "| method | " + " | ".join(head) + " |", "|---|" + "---|" * len(head)]  # fmt: skip
+
+    def cell(dz: np.ndarray, dl: np.ndarray) -> str:
+        if not len(dz):
+            return "-"
+        return (f"{np.abs(dz).mean():.1f} ({dz.mean():+.1f}) / {np.abs(dl).mean():.1f} ({dl.mean():+.1f}) "
+                f"(n {len(dz)})")  # fmt: skip
+
+    def groups(mine: Sequence[FrameScore], depth: str, lateral: str) -> list[str]:
+        out = []
+        for _, lo, hi in VISIBILITY_GROUPS:
+            got = [s for s in mine if lo <= s.visible < hi]
+            out.append(cell(np.array([getattr(s, depth) for s in got]), np.array([getattr(s, lateral) for s in got])))
+        return out
+
+    first = [s for s in scores if s.method == next((m for m in methods if any(x.method == m for x in scores)), "")]
+    lines.append("| thin-lens (reference) | " + " | ".join(groups(first, "thin_depth_mm", "thin_lateral_mm")) + " |")
+    for m in methods:
+        mine = [s for s in scores if s.method == m]
+        if mine:
+            lines.append(f"| {m} | " + " | ".join(groups(mine, "depth_mm", "lateral_mm")) + " |")
+    return [*lines, ""]
+
+
 def summary_dict(scores: Sequence[FrameScore], totals: dict[str, int], failed: dict[str, str]) -> dict[str, Any]:
-    return {"totals": totals, "failed": failed, "scores": [s.__dict__ for s in scores]}
+    """What ``summary.json`` holds (a value not measured, NaN, is ``null``: JSON has no NaN)."""
+
+    def plain(value: Any) -> Any:
+        return None if isinstance(value, float) and not np.isfinite(value) else value
+
+    return {"totals": totals, "failed": failed,
+            "scores": [{k: plain(v) for k, v in s.__dict__.items()} for s in scores]}  # fmt: skip

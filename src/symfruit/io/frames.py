@@ -9,7 +9,7 @@ A frame folder holds::
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
     masks.json                optional: COCO-style annotations (polygons or RLE)
-    truth.json                optional: {"fruits": [{"id", "min", "max", ...}]}, true boxes in metres
+    truth.json                optional: {"fruits": [{"id", "min", "max", "visible", ...}]}, true boxes in metres
 
 A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
@@ -93,8 +93,8 @@ def read_frame(folder: str | Path) -> Frame:
     else:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
-    truth = read_truth(folder / "truth.json") if (folder / "truth.json").is_file() else None
-    return Frame(folder.name, color, depth, camera, masks, truth, str(folder))
+    truth, visible = _truth(folder / "truth.json") if (folder / "truth.json").is_file() else (None, {})
+    return Frame(folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
 
 
 def read_depth_npy(path: Path) -> np.ndarray:
@@ -130,12 +130,18 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
 
 def read_truth(path: Path) -> list[tuple[int, Box]]:
     """The ripe fruit of a ``truth.json``: ``[(id, Box)]`` (unripe fruit, ``"ripe": false``, are no targets)."""
+    return _truth(path)[0]
+
+
+def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
+    """:func:`read_truth`, and the share of each fruit's silhouette the camera sees where a fruit records one
+    (``"visible"``, in [0, 1])."""
     data = read_structured(path, what="truth file", max_bytes=MAX_TRUTH_BYTES)
     try:
         fruits = data["fruits"] if isinstance(data, dict) else data
         if not isinstance(fruits, list):
             raise TypeError("'fruits' is not a list")
-        out = []
+        out, visible = [], {}
         for k, item in enumerate(fruits, 1):
             if not isinstance(item, dict):
                 raise TypeError(f"fruit {k} is not an object")
@@ -148,7 +154,12 @@ def read_truth(path: Path) -> list[tuple[int, Box]]:
             if isinstance(fid, bool) or not isinstance(fid, int):
                 raise ValueError(f"fruit {k}: id must be a whole number")
             out.append((fid, Box(lo, hi)))
-        return out
+            if "visible" in item:
+                seen = item["visible"]
+                if isinstance(seen, bool) or not isinstance(seen, int | float) or not 0.0 <= seen <= 1.0:
+                    raise ValueError(f"fruit {k}: visible must be a share in [0, 1]")
+                visible[fid] = float(seen)
+        return out, visible
     except (ValueError, KeyError, TypeError) as exc:
         raise FileFormatError(
             f"{path}: expected {{'fruits': [{{'min': [x, y, z], 'max': [x, y, z]}}]}} ({exc})"

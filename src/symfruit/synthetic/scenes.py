@@ -13,7 +13,7 @@ import colorsys
 import os
 import shutil
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -31,17 +31,20 @@ __all__ = ["Scene", "SceneFruit", "make_photo", "make_scene", "make_tree_scene",
 
 @dataclass(frozen=True)
 class SceneFruit:
-    """One strawberry of a scene and its truth."""
+    """One fruit of a scene and its truth; ``visible``: the share of its silhouette the camera sees (its visible
+    pixels over those of the fruit rendered alone), for the ripe fruit of scenes through a real camera model."""
 
     id: int
     ripe: bool
     kind: str
     box: Box
     mesh_index: int
+    visible: float | None = None
 
     def to_dict(self) -> dict:
+        seen = {} if self.visible is None else {"visible": round(self.visible, 4)}
         return {"id": self.id, "ripe": self.ripe, "kind": self.kind, "centre": self.box.centre.tolist(),
-                **self.box.to_dict()}  # fmt: skip
+                **self.box.to_dict(), **seen}  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -93,17 +96,23 @@ def _leaf(centre: np.ndarray, length: float, spin: float, tilt: np.ndarray) -> t
 
 def _fruit_labels(
     ids: np.ndarray, meshes: list, fruits: list[SceneFruit], camera: Camera
-) -> tuple[np.ndarray, np.ndarray]:
-    """The fruit's visible labels in a rendering (``ids``: the mesh seen at each pixel) and the ripe fruit's
-    amodal ones (each ripe fruit rendered alone; the first fruit keeps a pixel two would share)."""
+) -> tuple[np.ndarray, np.ndarray, list[SceneFruit]]:
+    """The fruit's visible labels in a rendering (``ids``: the mesh seen at each pixel), the ripe fruit's
+    amodal ones (each ripe fruit rendered alone; the first fruit keeps a pixel two would share), and the fruit
+    with the ripe ones' visible share (:attr:`SceneFruit.visible`)."""
     labels = np.zeros(ids.shape, np.int32)
     amodal = np.zeros(ids.shape, np.int32)
+    out = []
     for f in fruits:
-        labels[ids == f.mesh_index] = f.id
+        seen = ids == f.mesh_index
+        labels[seen] = f.id
         if f.ripe:
             vertices, faces = meshes[f.mesh_index]
-            amodal[(render([(vertices, faces)], camera).ids == 0) & (amodal == 0)] = f.id
-    return labels, amodal
+            alone = render([(vertices, faces)], camera).ids == 0
+            amodal[alone & (amodal == 0)] = f.id
+            f = replace(f, visible=float(np.count_nonzero(seen)) / max(1, int(np.count_nonzero(alone))))
+        out.append(f)
+    return labels, amodal, out
 
 
 def make_scene(
@@ -283,7 +292,7 @@ def _sensor_scene(seed: int, sensor: SensorModel, *, n_ripe: int, n_unripe: int,
     colours.append((0.2, 0.18, 0.42))
 
     shot = render(meshes, camera)
-    labels, amodal = _fruit_labels(shot.ids, meshes, fruits, camera)
+    labels, amodal, fruits = _fruit_labels(shot.ids, meshes, fruits, camera)
     ripe_labels = np.where(np.isin(labels, [f.id for f in fruits if f.ripe]), labels, 0)
     out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
                        amodal=amodal)  # fmt: skip
@@ -376,7 +385,7 @@ def make_tree_scene(
     colours.append((rng.uniform(0.2, 0.3), rng.uniform(0.2, 0.4), rng.uniform(0.35, 0.55)))
 
     shot = render(meshes, camera)
-    labels, amodal = _fruit_labels(shot.ids, meshes, fruits, camera)
+    labels, amodal, fruits = _fruit_labels(shot.ids, meshes, fruits, camera)
     color = _shade(shot, colours, rng).astype(np.float64) / 255.0
     # apple skins: blush and base colour by the direction from the apple's centre, sunlit from the upper left
     sun = np.array([-0.5, -0.7, -0.5]) / np.linalg.norm([-0.5, -0.7, -0.5])
@@ -417,13 +426,15 @@ def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Gener
 
 def write_scenes(
     folder: str | Path, n: int, *, seed: int = 0, distinct: int | None = None, n_ripe: int = 6, n_unripe: int = 2,
-    n_leaves: int = 3, sensor: SensorModel | None = None,
+    n_leaves: int = 3, sensor: SensorModel | None = None, tree: bool = False,
 ) -> list[Path]:  # fmt: skip
     """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
     ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
     (copies where links are impossible), so a long recording costs little time and disk. Through a real
     camera model (``sensor``) each folder also gets the annotators' ``masks.png`` (which ``detect`` and
-    ``evaluate --frames`` then use instead of the colour segmenter).
+    ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
+    (:func:`make_tree_scene`, ``n_ripe`` apples and ``n_unripe`` green ones a frame, through ``sensor`` or the
+    Azure Kinect model; ``n_leaves`` is not used).
 
     Returns
     -------
@@ -434,12 +445,12 @@ def write_scenes(
 
     folder = Path(folder)
     with OutputFolder(folder):  # locked while written; no link inside it followed
-        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor)
+        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor, tree)
 
 
 def _write_scenes(
     folder: Path, n: int, seed: int, distinct: int | None, n_ripe: int, n_unripe: int, n_leaves: int,
-    sensor: SensorModel | None,
+    sensor: SensorModel | None, tree: bool,
 ) -> list[Path]:  # fmt: skip
     from ..io.frames import write_frame
 
@@ -448,7 +459,10 @@ def _write_scenes(
     for i in range(n):
         target = folder / f"scene_{i:05d}"
         if i < unique:
-            scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves, sensor=sensor)
+            if tree:
+                scene = make_tree_scene(seed + i, sensor=sensor, n_apples=n_ripe, n_green=n_unripe)
+            else:
+                scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves, sensor=sensor)
             written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth(),
                                        masks=scene.masks))  # fmt: skip
             continue
