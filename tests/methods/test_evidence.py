@@ -139,6 +139,66 @@ def test_the_frames_occlusion_information_completes_an_occluded_fruit():
                           complete(visible, method="sphere").box.min)  # fmt: skip
 
 
+def test_a_time_of_flight_view_without_its_rim_is_still_a_depth_cameras_view():
+    """A 70 mm ball whose outer third of the radius holds no depth (a time-of-flight camera returns none where
+    the surface turns away), its mask the whole disc: under half a point per mask pixel, still one point per
+    pixel of what was seen (the ``cone`` ellipsoid is fitted), and the silhouette, 70 mm wide, bounds how deep
+    a candidate may plausibly reach (the seen cap is 47 mm wide; the ball's back lies 58 mm behind its deepest
+    seen point). Without both only the raw box was left."""
+    from symfruit import Box
+    from symfruit.core.occlusion import occlusion
+    from symfruit.synthetic.render import render
+
+    cam = DEFAULT_CAMERA
+    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
+    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
+    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+    mask = shot.ids == 0
+    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    rows, cols = np.nonzero(mask)
+    yy, xx = np.mgrid[: depth.shape[0], : depth.shape[1]]
+    rim = mask & (np.hypot(yy - rows.mean(), xx - cols.mean()) > 0.68 * np.sqrt(mask.sum() / np.pi))
+    depth[rim] = 0.0
+    r2, c2 = np.nonzero(mask & ~rim)
+    points = cam.deproject(np.c_[c2, r2].astype(float), depth[r2, c2])
+    assert len(points) < 0.5 * mask.sum()
+    truth = Box(ball.vertices.min(axis=0), ball.vertices.max(axis=0))
+    r = complete(points, camera=cam, occlusion=occlusion(depth, mask, points, cam))
+    assert "cone" in r.extras["candidates"]
+    assert box_iou(r.box, truth) > 0.92 and centre_deviation(r.box, truth) < 0.002  # raw box alone: 0.899, 2.6 mm
+
+
+def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_contour_part():
+    """``fuse_depth``'s lateral faces: a box narrower than the silhouette grows to it by the prior's share
+    whatever the outline's contour share (the fruit covers at least what was seen of it, a cut edge or not); a
+    box wider than the silhouette shrinks by that share times the contour share squared (beyond a cut edge the
+    fruit may reach)."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    mask = np.zeros((60, 60), bool)
+    yy, xx = np.mgrid[:60, :60]
+    mask[np.hypot(yy - 29.5, xx - 29.5) <= 20] = True  # a disc 40 px across near the image centre
+    region = Silhouette(int(cam.cx) - 30, int(cam.cy) - 30, mask, 0.0)
+    across = across_sight(region, cam)
+    s = EvidenceSettings()
+    for contour in (1.0, 0.3):
+        for half in (0.01, 0.08):  # a box far narrower, and one far wider, than the silhouette
+            box = Box(np.array([-half, -half, 0.5]), np.array([half, half, 0.5 + 2 * half]))
+            cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+            combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
+            got, _, width = fuse_depth(combined, [cand], region, cam, s=s, across=across)
+            fit_sd = np.hypot(s.back_inflation * 0.002, width * s.shape_error)
+            prior_sd = s.depth_ratio_sd * width / max(contour, 0.25)
+            prior = prior_sd**-2 / (fit_sd**-2 + prior_sd**-2)  # the prior's share of the back face
+            dist = 0.5 * (got.min[2] + got.max[2]) / across.axis[2]
+            sil_hi = dist * (across.axis[0] + across.hi[0])
+            share = prior if half < sil_hi else prior * contour**2
+            assert got.max[0] == pytest.approx(box.max[0] + share * (sil_hi - box.max[0]), rel=1e-9)
+
+
 def test_a_runaway_fit_does_not_win():
     """The paper protocol's generated banana of seed 1 whose solid of revolution and sphere ran away (245 mm)."""
     inst = build(Spec("paper", "banana", 2, 1, seed=1))

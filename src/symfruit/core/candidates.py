@@ -131,12 +131,13 @@ def constrain_box(
 
 
 def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray,
-               reach: tuple[float, float], *, lateral: bool = True) -> bool:  # fmt: skip
+               reach: tuple[float, float], *, lateral: bool = True, width: float = 0.0) -> bool:  # fmt: skip
     """Whether a box could be the fruit's: its hidden depth beyond the deepest seen point at most
-    ``reach[1]`` times the seen box's largest lateral side, and (``lateral``) no lateral face beyond the seen
-    box by more than ``reach[0]`` times the seen extent along that axis."""
+    ``reach[1]`` times the seen box's largest lateral side (or ``width``, the silhouette's, when larger), and
+    (``lateral``) no lateral face beyond the seen box by more than ``reach[0]`` times the seen extent along that
+    axis."""
     seen = seen_hi - seen_lo
-    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1]):
+    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1], width):
         return False
     if lateral:
         over = np.maximum(seen_lo[:2] - lo[:2], hi[:2] - seen_hi[:2])
@@ -161,6 +162,7 @@ def candidates(
     region: Silhouette | None = None,
     outline_profile: str = "off",
     plausible: tuple[float, float] | None = None,
+    width: float = 0.0,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -198,6 +200,10 @@ def candidates(
         ``lateral`` seen extents on a lateral side (not checked when ``obs.extent`` bounds where the fruit can
         project), or whose back lies more than ``depth`` times the seen box's largest lateral side behind
         the deepest seen point, is left out: implausible for what was seen (a runaway fit).
+    width : float, metres
+        The silhouette's larger width across the line of sight, when it is known to be wider than the seen
+        points (a fruit's mask whose rim holds no depth, or whose part behind a leaf the mask covers): the
+        hidden depth is measured against it where it is larger than the seen box's largest lateral side.
     explained : float, optional
         When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
         explained and the solid of revolution is not fitted (no other shape can explain the outline better).
@@ -230,7 +236,7 @@ def candidates(
                 if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
                     continue  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
                 if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible,
-                                                            lateral=obs.extent is None):  # fmt: skip
+                                                            lateral=obs.extent is None, width=width):  # fmt: skip
                     continue
                 ev = explain(shape.inside, (lo, hi), obs, steps=steps)
                 box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, pull=pull)

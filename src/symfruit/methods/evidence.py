@@ -402,9 +402,13 @@ def fuse_depth(
     dist = 0.5 * (front + back) / across.axis[2]
     sil_lo = dist * (across.axis[:2] + across.lo)
     sil_hi = dist * (across.axis[:2] + across.hi)
+    # Outwards by the prior's share alone: the fruit covers at least what it was seen to cover, cut or not
+    # (the contour share only says how far beyond a cut edge it may reach, which pulls inwards).
+    grow = b / (a + b)
     lo, hi = box.min.copy(), box.max.copy()
-    lo[:2] += share * (sil_lo - lo[:2])
-    hi[:2] += share * (sil_hi - hi[:2])
+    d_lo, d_hi = sil_lo - lo[:2], sil_hi - hi[:2]
+    lo[:2] += np.where(d_lo < 0.0, grow, share) * d_lo
+    hi[:2] += np.where(d_hi > 0.0, grow, share) * d_hi
     hi[2] = back
     return Box(lo, hi), float(1.0 / np.sqrt(a + b)), width
 
@@ -417,6 +421,9 @@ def evidence(
     s = settings
     sample = subsample(points, s.fit_points)
     region = close_ragged(silhouette(points, camera), radius=s.ragged_close_px, ragged=s.ragged_at)
+    # about a point per pixel of the points' own region: a depth camera's view (the fruit's mask, joined below,
+    # also holds the pixels a time-of-flight camera returns no depth for: its rim, a leaf's mixed edge)
+    dense = len(points) >= 0.5 * region.mask.sum()
     if occlusion is not None:
         region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
@@ -427,7 +434,6 @@ def evidence(
     shapes: tuple[str, ...] = SHAPES
     explained: float | None = None
     clean = 0.0
-    dense = len(points) >= 0.5 * region.mask.sum()  # about a point per pixel: a depth camera's view
     if not dense:
         # The cone ellipsoid's fit reads each point as the nearest surface along its ray, as a depth camera
         # sees it; a sparse cloud (a scan's points, possibly on both sides of the fruit) is not that.
@@ -442,8 +448,10 @@ def evidence(
     else:
         ratio, _, _ = surface_noise(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
+    across = across_sight(region, camera)
     cands = candidates(
         points, sample=sample, obs=obs, camera=camera, front=front,
+        width=across.major * front / float(across.axis[2]) if occlusion is not None else 0.0,
         mirror=s.mirror.options() if s.mirror_candidate else None, revolution_points=s.revolution_points,
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
         region=region, plausible=(s.lateral_reach, s.depth_reach),
@@ -451,7 +459,6 @@ def evidence(
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner)
-    across = across_sight(region, camera)
     seen_back = float(points[:, 2].max())
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=across)  # fmt: skip
