@@ -133,6 +133,8 @@ def test_masks_that_do_not_fit_the_frame_are_refused():
         detect(frame, masks=np.zeros((120, 160)))
     with pytest.raises(InputError, match=r"frame small: masks are \(10, 10\), the image \(160, 120\)"):
         detect(frame, masks=np.zeros((10, 10), bool))
+    with pytest.raises(InputError, match=r"unknown method 'nope'; available: .*evidence"):
+        detect(frame, masks=negative, method="nope")  # refused before the masks are read
     with pytest.raises(InputError, match=r"masks must be a spec .* got int"):
         detect(frame, masks=3)  # type: ignore[arg-type]
 

@@ -23,6 +23,7 @@ from .errors import InputError, SymfruitError
 from .extract import Extraction, extract, register, trim_labels
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
+from .methods.registry import get as get_method
 from .occlusion import fruit_occlusion
 from .segment import MaskSource, mask_source
 from .settings import Settings
@@ -123,6 +124,7 @@ def detect(
     if settings is not None and not isinstance(settings, Settings):
         raise InputError(f"settings must be a Settings (symfruit.resolve_settings), got {type(settings).__name__}")
     settings = settings or Settings()
+    get_method(method)  # an unknown method is refused before any work, not reported once per fruit
     t0, cpu0 = time.perf_counter(), time.thread_time()
     labels, source = frame_masks(frame, masks, settings)
     t1 = time.perf_counter()
