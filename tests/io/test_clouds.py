@@ -256,7 +256,7 @@ REFUSED = {
     "ply-too-many": ("a.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 6000000\nproperty uchar x\n"
                      b"end_header\n" + bytes(6_000_000), "PLY holds 6,000,000 vertices; at most 5,000,000 are read"),
     "ply-no-z": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
-                 b"end_header\n1 2\n", "PLY has no no field of name z property or vertex element"),  # plyfile's words
+                 b"end_header\n1 2\n", "PLY vertices lack the z property (they have x, y)"),
     "ply-corrupt": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
                     "corrupt PLY"),
     "pcd-no-fields": ("a.pcd", b"VERSION 0.7\nSIZE 4\nPOINTS 1\nDATA ascii\n1 2 3\n",

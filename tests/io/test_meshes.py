@@ -91,3 +91,20 @@ def test_mesh_readers_survive_random_bytes(tmp_path, data, suffix):
         read_mesh(path)
     except SymfruitError:
         pass
+
+
+@pytest.mark.parametrize(
+    "body, message",
+    [
+        (b"element point 1\nproperty float x\nend_header\n1\n", "PLY has no vertex element"),
+        (b"element vertex 1\nproperty float x\nproperty float y\nend_header\n1 2\n",
+         r"PLY vertices lack the z property \(they have x, y\)"),
+        (b"element vertex 1\nproperty float a\nend_header\n1\n",
+         r"PLY vertices lack the x, y, z properties \(they have a\)"),
+    ],
+)  # fmt: skip
+def test_a_ply_mesh_without_xyz_vertices_is_refused_naming_what_it_lacks(tmp_path, body, message):
+    path = tmp_path / "m.ply"
+    path.write_bytes(b"ply\nformat ascii 1.0\n" + body)
+    with pytest.raises(FileFormatError, match=rf"m\.ply: {message}"):
+        read_mesh(path)

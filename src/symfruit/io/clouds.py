@@ -12,6 +12,7 @@ import re
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -126,13 +127,29 @@ def read_ply(path: Path) -> np.ndarray:
     if counts["vertex"] > MAX_CLOUD_POINTS:
         raise FileFormatError(f"{path}: PLY holds {counts['vertex']:,} vertices; at most {MAX_CLOUD_POINTS:,} are read")
     try:
-        data = PlyData.read(str(path))
-        element = data["vertex"]
+        element = PlyData.read(str(path))["vertex"]
+    except PlyParseError as exc:
+        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
+    except (KeyError, ValueError) as exc:
+        raise FileFormatError(f"{path}: unreadable PLY ({exc})") from None
+    _xyz_properties(path, element)
+    try:
         return np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
-        raise FileFormatError(f"{path}: PLY has no {exc} property or vertex element") from None
+        raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
+
+
+def _xyz_properties(path: Path, element: Any) -> None:
+    """Refuse a PLY vertex element without ``x``, ``y`` and ``z``, naming what it lacks and what it has."""
+    names = [p.name for p in element.properties]
+    missing = [c for c in ("x", "y", "z") if c not in names]
+    if missing:
+        raise FileFormatError(
+            f"{path}: PLY vertices lack the {', '.join(missing)} propert"
+            f"{'y' if len(missing) == 1 else 'ies'} (they have {', '.join(names) or 'none'})"
+        )
 
 
 _PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4",

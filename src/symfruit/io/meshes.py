@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.limits import MAX_FACES, MAX_OBJ_BYTES  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
-from .clouds import MAX_CLOUD_POINTS, ply_elements
+from .clouds import MAX_CLOUD_POINTS, _xyz_properties, ply_elements
 from .text import read_limited
 
 __all__ = ["read_mesh"]
@@ -32,17 +32,25 @@ def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
         raise FileFormatError(f"{path}: no such file")
     _, elements = ply_elements(path)  # every element's count checked against the file size first
     counts = dict(elements)
+    if "vertex" not in counts:
+        raise FileFormatError(f"{path}: PLY has no vertex element")
     if counts.get("vertex", 0) > MAX_CLOUD_POINTS or counts.get("face", 0) > MAX_FACES:
         raise FileFormatError(f"{path}: mesh of {counts.get('vertex', 0):,} vertices and {counts.get('face', 0):,} "
                               f"faces; at most {MAX_CLOUD_POINTS:,} and {MAX_FACES:,} are read")  # fmt: skip
     try:
         data = PlyData.read(str(path))
         vertex = data["vertex"]
+    except PlyParseError as exc:
+        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
+    except (KeyError, ValueError) as exc:
+        raise FileFormatError(f"{path}: unreadable PLY ({exc})") from None
+    _xyz_properties(path, vertex)
+    try:
         vertices = np.column_stack([np.asarray(vertex[c], dtype=np.float64) for c in ("x", "y", "z")])
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
-        raise FileFormatError(f"{path}: PLY has no {exc} property or vertex element") from None
+        raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
     if "face" not in data:
         return vertices, None
     face = data["face"]
