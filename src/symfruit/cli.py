@@ -320,11 +320,13 @@ def _check_output_file(path: Path, suffix: str) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
+    from .core.limits import MAX_CLOUD_POINTS
     from .errors import InputError
     from .evaluate.bench import machine, run_bench
 
-    if args.repeat < 1 or any(n < 10 for n in args.points):
-        raise InputError("--repeat must be >= 1 and every --points >= 10")
+    if not 1 <= args.repeat <= 100_000 or any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
+        raise InputError(f"--repeat must be 1-100000 and every --points 10-{MAX_CLOUD_POINTS} (the most a cloud file "
+                         "may hold)")  # fmt: skip
     if args.segment:
         from .core.limits import check_image_size
         from .evaluate.bench import bench_segment
