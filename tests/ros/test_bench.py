@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 from symfruit.ros.bench import _LINE, _stats
 
@@ -53,3 +54,13 @@ def test_a_short_real_run(ros1, tmp_path):
     assert 0.0 <= res["node_overhead_ms"]["median"] < res["node_total_ms"]["median"]
     assert 1 <= res["open_loop"]["delivered"] <= 2  # the last frame is never dropped
     assert "node: overhead" in proc.stdout
+
+
+def test_bad_counts_and_rates_are_refused_before_anything_starts(capsys):
+    from symfruit.ros.bench import main
+
+    for args in (["--rate", "0"], ["--frames", "-5"], ["--frames", "1000000"], ["--rate", "1e9"]):
+        with pytest.raises(SystemExit) as stop:
+            main(args)
+        assert stop.value.code == 2
+        assert "--frames must be 1-100000 and --rate in (0, 1000] Hz" in capsys.readouterr().err

@@ -20,3 +20,9 @@ def test_a_short_real_run(ros2_python, tmp_path):
     assert res["end_to_end_ms"]["median"] > res["node_detect_ms"]["median"] > 0
     assert res["open_loop"]["delivered"] == 1  # the last frame is never dropped
     assert proc.stdout.startswith("symfruit ROS 2 node benchmark") and "node: overhead" in proc.stdout
+
+
+def test_a_rate_of_zero_is_refused_before_anything_starts(ros2_python):
+    proc = subprocess.run([ros2_python, "-m", "symfruit.ros.bench2", "--rate", "0"], capture_output=True, text=True,
+                          timeout=120)  # fmt: skip
+    assert proc.returncode == 2 and "--rate in (0, 1000] Hz, got 30 and 0" in proc.stderr

@@ -175,6 +175,8 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
         local_cluster(0)
     with pytest.raises(InputError, match="frames per task"):
         run_distributed(recording, tmp_path / "out", workers=1, chunk=0)
+    with pytest.raises(InputError, match="--workers must be between 1 and 256, got 0"):  # not taken as one
+        run_distributed(recording, tmp_path / "out", workers=0)
     assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "2", "--ros2-bag",
                  str(tmp_path / "bag")]) == 2  # fmt: skip
     assert "cannot be combined with --scheduler or --workers" in capsys.readouterr().err

@@ -234,6 +234,8 @@ def main(argv=None) -> int:
     parser.add_argument("--method", default=DEFAULT_METHOD)
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
     args = parser.parse_args(argv)
+    if not 1 <= args.frames <= 100_000 or not 0 < args.rate <= 1000:
+        parser.error(f"--frames must be 1-100000 and --rate in (0, 1000] Hz, got {args.frames} and {args.rate:g}")
     res = bench_node(args.frames, rate=args.rate, method=args.method)
     _print(res)
     if args.json:

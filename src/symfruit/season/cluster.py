@@ -298,6 +298,8 @@ def run_distributed(
         raise InputError("give either a scheduler address or a number of local workers")
     if not 1 <= chunk <= 10_000:
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {chunk}")
+    if workers is not None and not 1 <= workers <= 256:  # refused before the inputs are read, not taken as 1
+        raise InputError(f"--workers must be between 1 and 256, got {workers}")
     if not isinstance(masks, str):
         raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
     require_distributed()
