@@ -594,6 +594,8 @@ def _detect(args: argparse.Namespace) -> int:
     from .methods import get
 
     get(_method(args))
+    if not 1 <= args.chunk <= 10_000:  # refused whether or not a cluster uses it
+        raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {args.chunk}")
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
