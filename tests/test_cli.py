@@ -116,6 +116,7 @@ def test_embedded_sample(capsys):
         (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
         (["detect", "{sample}", "--output", "o", "--chunk", "0"], "--chunk must be between 1 and 10000"),
+        (["evaluate", "--frames", "f", "--match", "id", "--masks", "color"], "--match id needs the frames' own masks"),
         (["bench", "--points", "999999999"], "every --points 10-5000000"),  # refused before 30 GB are asked for
         (["bench", "--repeat", "0"], "--repeat must be 1-100000"),
     ],

@@ -119,6 +119,11 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
     p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
+    p.add_argument("--match", choices=("centre", "id"), default="centre",
+                   help="--frames: match found fruit to the truth by their seen points' box centre within 3 cm "
+                   "(default, Table 3's protocol) or by mask label = truth id (the frames' own masks drawn for the "
+                   "truth, as those of `symfruit scenes --sensor`/`--scene apple-tree`: every completed fruit "
+                   "scored)")  # fmt: skip
     p.add_argument("--spheres", type=Path,
                    help="instead of a protocol: real frames of spheres without truth (one mask per sphere, the same "
                    "ids in every frame): how far each box is from a cube and how far the frames disagree, e.g. "
@@ -477,12 +482,16 @@ def _plain_settings(args: argparse.Namespace):
 
 
 def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> int:
+    from .errors import InputError
     from .evaluate.frames import evaluate_frames, summary_dict, table3
     from .io import atomic_write, write_json
     from .writers import new_results_folder
 
     masks = args.masks or "auto"
-    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=masks, settings=settings)
+    by_id = args.match == "id"
+    if by_id and masks != "auto":
+        raise InputError("--match id needs the frames' own masks (their labels are the truth's ids): leave --masks out")
+    scores, totals, failed = evaluate_frames(args.frames, methods=methods, masks=masks, settings=settings, by_id=by_id)
     table = table3(scores, totals, methods)
     folder = new_results_folder(args.output, "frames")
     write_json(folder / "summary.json", {**summary_dict(scores, totals, failed), "settings": settings.to_dict()})

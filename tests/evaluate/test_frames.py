@@ -7,7 +7,18 @@ import numpy as np
 import pytest
 
 from symfruit import Box, Camera
-from symfruit.evaluate.frames import FrameScore, evaluate_frames, match, summary_dict, table3, thin_lens
+from symfruit.detect import detect, frame_masks
+from symfruit.evaluate.frames import (
+    FrameScore,
+    evaluate_frames,
+    match,
+    score_frame,
+    summary_dict,
+    table3,
+    thin_lens,
+)
+from symfruit.io import read_frame
+from symfruit.settings import Settings
 
 from ..conftest import EXAMPLE_FRAME
 
@@ -136,3 +147,25 @@ def test_sizes_by_how_much_of_each_fruit_is_seen(tmp_path):
     assert all(s.thin_lateral_mm == by_fruit[(s.frame, s.fruit)] for s in scores)
     assert all(abs(s.thin_lateral_mm) < 10 for s in raw)
     assert isinstance(raw[0], FrameScore)
+
+
+def test_found_fruit_can_be_matched_to_the_truth_by_their_masks_label(tmp_path):
+    """``by_id``: the frame's own masks carry the truth's ids; every completed fruit is scored, however far its
+    seen points' box lies from the truth (here every true box is moved 10 cm: nothing within the centre gate)."""
+    shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
+    truth = tmp_path / "a" / "truth.json"
+    data = json.loads(truth.read_text())
+    for f in data["fruits"]:
+        f["min"][0] += 0.1
+        f["max"][0] += 0.1
+    truth.write_text(json.dumps(data))
+    frame = read_frame(tmp_path / "a")
+    labels, _ = frame_masks(frame, "color")
+    ids = [tid for tid, _ in frame.truth]
+    found = detect(frame, masks=np.where(labels > 0, np.asarray(ids)[np.clip(labels - 1, 0, len(ids) - 1)], 0))
+    assert sorted(d.id for d in found.detections) == sorted(ids)
+    scores, counts = score_frame(frame, found, ["raw"], Settings())
+    assert scores == [] and counts["matched"] == 0  # by centre: all beyond the gate
+    scores, counts = score_frame(frame, found, ["raw"], Settings(), by_id=True)
+    assert counts["matched"] == 6 and sorted(s.truth for s in scores) == sorted(ids)
+    assert all(s.fruit == s.truth and s.centre_mm > 50 for s in scores)
