@@ -5,7 +5,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
-from symfruit import InputError, Settings
+from symfruit import InputError, Settings, resolve_settings
 from symfruit.core.frame import Frame
 from symfruit.detect import MAX_FRUIT_PER_FRAME, Detection, FrameDetections, detect, frame_masks
 from symfruit.evaluate.frames import match
@@ -230,3 +230,23 @@ def straight_masks(found) -> np.ndarray:
     for d in found.detections:
         labels[d.mask] = d.id
     return labels
+
+
+def test_a_leaf_in_front_that_the_mask_covers_is_not_taken_for_the_fruit():
+    """An annotator draws a fruit's whole outline over the leaf in front of it: the leaf, flat and nearer, holds
+    most of the mask's depth pixels; its green tells it from the red fruit behind, whose points are extracted."""
+    color, depth = disc_frame([(80, 60)], radius=25, z=0.45)
+    yy, xx = np.mgrid[:120, :160]
+    leaf = (xx >= 45) & (xx < 88) & (yy >= 25) & (yy < 95)  # most of the fruit, and beyond it
+    color[leaf], depth[leaf] = (40, 140, 50), 0.3
+    outline = (xx - 80) ** 2 + (yy - 60) ** 2 <= 25**2
+    registered = resolve_settings(overrides={"extract": {"registration_px": 0}})  # registered as drawn
+    found = detect(Frame("leaf", color, depth, SMALL_CAM), masks=outline.astype(np.int32), method="raw",
+                   settings=registered)  # fmt: skip
+    points = found.detections[0].extraction.points
+    assert len(points) >= 30 and points[:, 2].min() > 0.42  # the fruit's front, 0.43 m; the leaf is at 0.3 m
+    # colour-blind (no colour to tell them apart: a grey leaf), the leaf is taken, as before
+    color[leaf] = (90, 90, 90)
+    grey = detect(Frame("grey", color, depth, SMALL_CAM), masks=outline.astype(np.int32), method="raw",
+                  settings=registered)  # fmt: skip
+    assert grey.detections[0].extraction.points[:, 2].max() < 0.31

@@ -20,12 +20,13 @@ from .core.frame import Frame
 from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .errors import InputError, SymfruitError
-from .extract import Extraction, extract, register, trim_labels
+from .extract import Extraction, extract, register, shift_labels, trim_labels
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .methods.registry import get as get_method
 from .occlusion import fruit_occlusion
 from .segment import MaskSource, mask_source
+from .segment.colour import _leaf as leaf_green
 from .settings import Settings
 
 __all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
@@ -159,13 +160,15 @@ def detect(
     from scipy import ndimage
 
     fruit_px = labels > 0
+    # leaf-green pixels where the depth image sees them (depth pixel (u + du, v + dv) sees colour pixel (u, v))
+    leafy = None if frame.color is None else shift_labels(leaf_green(frame.color), *shift)
     for k, sl in enumerate(ndimage.find_objects(labels), 1):
         if sl is None:
             continue
         mask = np.zeros(labels.shape, bool)
         mask[sl] = labels[sl] == k
         a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame.depth, camera, settings)
+        ex = _extract_window(mask, sl, frame.depth, camera, settings, leafy=leafy)
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
@@ -195,8 +198,9 @@ def detect(
 
 
 def _extract_window(
-    mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings
-) -> Extraction:
+    mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings,
+    *, leafy: np.ndarray | None = None,
+) -> Extraction:  # fmt: skip
     """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test."""
     h, w = mask.shape
     pad = settings.extract.erode_px + 2
@@ -204,7 +208,8 @@ def _extract_window(
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
     window = mask[r0:r1, c0:c1]
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
-    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract)
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract,
+                 leafy=None if leafy is None else leafy[r0:r1, c0:c1])  # fmt: skip
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     outline = mask.copy()
     if ex.silhouette is not None:

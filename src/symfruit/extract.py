@@ -155,7 +155,8 @@ def _grid_clusters(points: np.ndarray, voxel: float) -> np.ndarray:
     return np.take(lab.ravel(), flat) - 1
 
 
-def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None) -> Extraction:
+def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None,
+            *, leafy: np.ndarray | None = None) -> Extraction:  # fmt: skip
     """The 3D points of the fruit under ``mask``.
 
     Parameters
@@ -189,7 +190,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     if usable.sum() >= 10:
         focal = float(np.sqrt(camera.fx * camera.fy))
         found = fruit_surface(np.where(valid, z_all, 0.0), core, focal, slab=s.slab,
-                              tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf)  # fmt: skip
+                              tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
+                              leafy=leafy)  # fmt: skip
         if found is not None:
             keep = usable & found.pixels
     rows, cols = np.nonzero(keep)

@@ -71,6 +71,33 @@ def test_fruit_depth_is_the_nearest_large_mode():
     assert fruit_depth(ramp, 20.0, F)[0] == pytest.approx(0.5, abs=0.002)
 
 
+def test_a_leaf_in_front_drawn_into_the_mask_is_passed_over_for_the_fruit_behind_it():
+    """An annotator's mask drawn over the leaf in front of a fruit: the flat leaf puts more pixels in one depth bin
+    than the curved fruit does in any, so it is the nearest large peak; told which pixels are leaf green, the
+    fruit is the nearest peak behind that is not (a tenth of the largest's pixels is enough)."""
+    rng = np.random.default_rng(1)
+    leaf = 1.50 + rng.uniform(0, 0.003, 900)  # flat, nearer
+    fruit = 1.90 + rng.uniform(0, 0.03, 300)  # curved, behind
+    sky = np.full(40, 5.0)
+    values = np.r_[leaf, fruit, sky]
+    green = np.r_[np.ones(900, bool), rng.uniform(size=300) < 0.1, np.zeros(40, bool)]  # a few leafy fruit pixels
+    assert fruit_depth(values, 20.0, F)[0] == pytest.approx(1.5, abs=0.002)  # colour-blind: the leaf
+    assert fruit_depth(values, 20.0, F, leafy=green)[0] == pytest.approx(1.90, abs=0.003)
+    # the same order of pixels given in any order: the leafy flags follow their depths
+    order = rng.permutation(len(values))
+    assert fruit_depth(values[order], 20.0, F, leafy=green[order])[0] == pytest.approx(1.90, abs=0.003)
+    # a leaf with nothing but leaf behind it, and a fruit in front of a leaf, stay as they were
+    both = np.r_[leaf, 1.9 + rng.uniform(0, 0.03, 300)]
+    assert fruit_depth(both, 20.0, F, leafy=np.ones(1200, bool))[0] == pytest.approx(1.5, abs=0.002)
+    red_front = np.r_[1.5 + rng.uniform(0, 0.02, 900), 1.9 + rng.uniform(0, 0.003, 300)]
+    flags = np.r_[np.zeros(900, bool), np.ones(300, bool)]
+    assert fruit_depth(red_front, 20.0, F, leafy=flags)[0] == pytest.approx(1.5, abs=0.002)
+    # a fruit behind showing too few pixels to be one (under a tenth of the leaf's peak) is not taken
+    hidden = np.r_[leaf, 1.9 + rng.uniform(0, 0.003, 20)]
+    assert fruit_depth(hidden, 20.0, F, leafy=np.r_[np.ones(900, bool), np.zeros(20, bool)])[0] == pytest.approx(
+        1.5, abs=0.002)  # fmt: skip
+
+
 def test_the_surface_leaves_out_wall_and_table():
     depth, disc = ball(table=True)
     mask = grown(disc, 4)  # an annotator's mask, 4 px too large: wall and table leak in

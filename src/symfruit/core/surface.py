@@ -54,6 +54,10 @@ class Surface:
     radius : float, metres
         The mask's equivalent radius (``sqrt(area / pi)``) at ``front``.
     noise : float, metres
+    leafy : (n,) bool, optional
+        Which pixels are leaf green, aligned with ``values``: a peak most of whose pixels are (a leaf in front drawn
+        into the mask) is passed over for the nearest peak behind it that holds a tenth of the largest's pixels
+        and is mostly not (:data:`LEAFY`).
         The depth noise measured in the mask (:func:`depth_noise`).
     apex : (int, int)
         Row and column of the cap's nearest pixel (median-filtered depth).
@@ -105,7 +109,8 @@ def _sorted_quantile(z: np.ndarray, q: float) -> float:
     return b - (b - a) * (1.0 - t) if t >= 0.5 else a + (b - a) * t
 
 
-def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: float = 0.001) -> tuple[float, float]:
+def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: float = 0.001,
+                leafy: np.ndarray | None = None) -> tuple[float, float]:  # fmt: skip
     """``(front, radius)``, metres: where a mask's fruit lies in depth, and how large it is there.
 
     The depths of a mask's pixels hold the fruit and whatever the mask reaches beyond it (background,
@@ -130,7 +135,8 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     -------
     front, radius : float, metres (NaN when fewer than 10 depths are valid)
     """
-    z = np.sort(values[np.isfinite(values) & (values > 0)])
+    ok = np.isfinite(values) & (values > 0)
+    z = np.sort(values[ok])
     if len(z) < 10:
         return float("nan"), float("nan")
     half = len(z) // 2
@@ -143,6 +149,17 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
     peak = (mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max())
     i = int(np.flatnonzero(peak)[0])
+    if leafy is not None:
+        green = np.asarray(leafy, dtype=bool)[ok][np.argsort(values[ok], kind="stable")]  # sorted with z
+
+        def leaf_share(k: int) -> float:
+            a, b = np.searchsorted(z, edges[max(k - 1, 0)]), np.searchsorted(z, edges[min(k + 2, n_bins)], "right")
+            return float(green[a:b].mean()) if b - a >= 10 else 0.0
+
+        if leaf_share(i) >= LEAFY[0]:
+            local = (mass >= after) & (mass >= before) & (mass >= 0.1 * mass.max())
+            behind = [int(k) for k in np.flatnonzero(local) if i < k < len(counts)]
+            i = next((k for k in behind if leaf_share(k) < LEAFY[1] and mass[k] >= 10), i)
     # the fruit's depths run without a gap from its nearest point to its rim: walk nearer while bins are filled
     # (an occluder in front is apart in depth; a fruit receding along its length is not)
     first = i
@@ -151,6 +168,11 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     lo, hi = edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
     front = _sorted_quantile(z[np.searchsorted(z, lo, side="left") : np.searchsorted(z, hi, side="right")], 0.05)
     return front, radius_px * front / focal
+
+
+#: (a leaf, not a leaf): a depth peak at least this share of whose pixels are leaf green is a leaf, one below the
+#: second share is not (:func:`fruit_depth`).
+LEAFY = (0.5, 0.3)
 
 
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
@@ -232,7 +254,8 @@ def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: in
 
 def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
                   tolerance: float = 3.0, interior: float = 0.35,
-                  region: np.ndarray | None = None, inner: np.ndarray | None = None) -> Surface | None:  # fmt: skip
+                  region: np.ndarray | None = None, inner: np.ndarray | None = None,
+                  leafy: np.ndarray | None = None) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -256,6 +279,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         Where the surface may lie (default ``mask``): :func:`registration_shift` looks beyond the mask.
     inner : (h, w) float, optional
         ``mask``'s distance map (:func:`~symfruit.core.raster.inner_distance`) when the caller has it.
+    leafy : (h, w) bool, optional
+        The leaf-green pixels (:func:`fruit_depth`).
 
     Returns
     -------
@@ -273,7 +298,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     own, own_depth = mask[box], depth[box]
     noise = depth_noise(own_depth, own)
     radius_px = float(np.sqrt(own.sum() / np.pi))
-    front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise)
+    front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                leafy=None if leafy is None else leafy[box][own])  # fmt: skip
     if not np.isfinite(front):
         return None
     tol = max(tolerance * noise, 0.003)
