@@ -57,12 +57,12 @@ def test_invalid_depth_is_dropped_and_counted():
     mask[50:60, 70:80] = True  # 100 pixels
     depth = np.full((120, 160), 0.4, np.float32)
     depth[50, 70:74] = [0.0, np.nan, np.inf, -0.4]  # no depth, NaN, infinite, negative
-    depth[51, 70:72] = [0.05, 2.5]  # nearer than min_depth, farther than max_depth
+    depth[51, 70:72] = [0.05, 3.5]  # nearer than min_depth, farther than max_depth
     depth[59, 79] = 0.1  # exactly min_depth: valid
     ex = extract(mask, depth, CAM, NO_EROSION)
     assert ex.n_invalid == 6 and len(ex.points) == 94 - 1 and ex.n_other_clusters == 1
     assert np.isfinite(ex.points).all() and ex.points[:, 2].max() == pytest.approx(0.4)
-    kept = extract(mask, depth, CAM, ExtractSettings(erode_px=0, min_depth=0.01, max_depth=3.0))
+    kept = extract(mask, depth, CAM, ExtractSettings(erode_px=0, min_depth=0.01, max_depth=4.0))
     assert kept.n_invalid == 4  # the range is a setting
 
 

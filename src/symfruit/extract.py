@@ -28,7 +28,9 @@ class ExtractSettings(Section):
     Attributes
     ----------
     min_depth, max_depth : float, metres
-        Depth outside this range is invalid (the D435 reads from about 0.1 m).
+        Depth outside this range is invalid (the D435 reads from about 0.1 m; an orchard robot's camera at 1.2-2 m
+        from a canopy sees apples up to 2.4 m away, which a 2 m bound left with the depth of the leaf in front of
+        them only; the Azure Kinect's narrow mode reads to 3.86 m).
     erode_px : int
         Pixels dropped along the mask's border, where flying pixels (depth mixed with the background)
         sit.
@@ -57,7 +59,7 @@ class ExtractSettings(Section):
     """
 
     min_depth: float = setting(0.1, ge=0.0, le=100.0)
-    max_depth: float = setting(2.0, gt=0.0, le=100.0)
+    max_depth: float = setting(3.0, gt=0.0, le=100.0)
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)

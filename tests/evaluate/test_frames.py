@@ -169,3 +169,6 @@ def test_found_fruit_can_be_matched_to_the_truth_by_their_masks_label(tmp_path):
     scores, counts = score_frame(frame, found, ["raw"], Settings(), by_id=True)
     assert counts["matched"] == 6 and sorted(s.truth for s in scores) == sorted(ids)
     assert all(s.fruit == s.truth and s.centre_mm > 50 for s in scores)
+    # a frame without its own masks file: the colour segmenter's labels are no truth ids, the frame is not scored
+    scores, totals, failed = evaluate_frames(tmp_path, methods=("raw",), by_id=True)
+    assert scores == [] and totals["frames"] == 0 and "no masks file to match the truth by label" in failed["a"]

@@ -140,6 +140,9 @@ def evaluate_frames(
             except SymfruitError as exc:
                 failed[name] = str(exc)
                 continue
+            if by_id and found.mask_source != "frame masks file":  # a segmenter's labels are not the truth's ids
+                failed[name] = f"no masks file to match the truth by label (the masks: {found.mask_source})"
+                continue
             s, counts = score_frame(frame, found, methods, settings, gate, by_id=by_id)
             scores += s
             totals["frames"] += 1
