@@ -222,23 +222,32 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
     """
     s = settings or SegmentSettings()
     c = _color(color)
-    r, g, b = c[:, :, 0], c[:, :, 1], c[:, :, 2]
-    mgb = np.maximum(g, b)
     # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
     levels = np.arange(256, dtype=np.float64)
     low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
     high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
     low[: s.dark + 1] = -1  # dark pixels are never red
     high[: s.dark + 1] = -1
-    weak = mgb <= low[r]
-    strong = mgb <= high[r]
+    # a weakly red pixel has R above max(G, B) (low[R] < R as red_low > 0): the tables are read for those
+    # pixels alone (a look-up over the whole image converts every pixel's index to 64 bits first), and the
+    # strong table for the weak ones alone (high <= low, as red_high >= red_low); on a contiguous copy (numpy's
+    # loops over a window's strided channels are several times slower)
+    c = np.ascontiguousarray(c)
+    r = c[:, :, 0]
+    at = np.flatnonzero(r > np.maximum(c[:, :, 1], c[:, :, 2]))
+    rgb = c.reshape(-1, 3).take(at, axis=0).astype(np.int16)
+    rw, mw = rgb[:, 0], np.maximum(rgb[:, 1], rgb[:, 2])
+    keep = np.flatnonzero(mw <= low.take(rw))
+    at, rgb, rw, mw = at.take(keep), rgb.take(keep, axis=0), rw.take(keep), mw.take(keep)
+    weak = np.zeros(r.shape, bool)
+    weak.ravel()[at] = True
+    keep = np.flatnonzero(mw <= high.take(rw))
     # hue < hue_max  <=>  sqrt(3) (G - B) < tan(hue_max) (2R - G - B)  (2R - G - B > 0 on red pixels);
     # tested on the strongly red pixels only
-    idx = np.flatnonzero(strong)
-    rs, gs, bs = (ch.ravel()[idx].astype(np.int16) for ch in (r, g, b))
-    ok = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
+    rs, gs, bs = rw.take(keep), rgb[:, 1].take(keep), rgb[:, 2].take(keep)
+    hue = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
     strong = np.zeros(r.shape, bool)
-    strong.ravel()[idx[ok]] = True
+    strong.ravel()[at.take(keep)[hue]] = True
     return strong, weak
 
 
@@ -613,8 +622,7 @@ def _depth(
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    np.nan_to_num(z, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # in place: no full-frame temporaries
-    np.maximum(z, 0.0, out=z)
+    _no_depth_zero(z)
     if not z.any():
         return None, none
     if camera is None:
@@ -628,6 +636,15 @@ def _depth(
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
     return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+
+
+def _no_depth_zero(z: np.ndarray) -> None:
+    """Set NaN, infinite and negative depths to 0, in place: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)``
+    then ``np.maximum(z, 0)`` to the bit (-0.0 stays -0.0), in two comparisons of the image instead of
+    numpy's six passes."""
+    keep = np.greater_equal(z, 0.0)  # False for NaN and the negatives
+    keep &= np.less(z, np.inf)
+    np.copyto(z, 0.0, where=~keep)
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
