@@ -220,8 +220,17 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
     -------
     strong, weak : (h, w) bool
     """
-    s = settings or SegmentSettings()
     c = _color(color)
+    weak_at, strong_at = _red_pixels(c, settings or SegmentSettings())
+    strong = np.zeros(c.shape[:2], bool)
+    strong.ravel()[strong_at] = True
+    weak = np.zeros(c.shape[:2], bool)
+    weak.ravel()[weak_at] = True
+    return strong, weak
+
+
+def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices (ascending) of :func:`ripe_seeds`' weak and strong pixels of a checked colour image."""
     # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
     levels = np.arange(256, dtype=np.float64)
     low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
@@ -233,22 +242,17 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
     # strong table for the weak ones alone (high <= low, as red_high >= red_low); on a contiguous copy (numpy's
     # loops over a window's strided channels are several times slower)
     c = np.ascontiguousarray(c)
-    r = c[:, :, 0]
-    at = np.flatnonzero(r > np.maximum(c[:, :, 1], c[:, :, 2]))
+    at = np.flatnonzero(c[:, :, 0] > np.maximum(c[:, :, 1], c[:, :, 2]))
     rgb = c.reshape(-1, 3).take(at, axis=0).astype(np.int16)
     rw, mw = rgb[:, 0], np.maximum(rgb[:, 1], rgb[:, 2])
     keep = np.flatnonzero(mw <= low.take(rw))
     at, rgb, rw, mw = at.take(keep), rgb.take(keep, axis=0), rw.take(keep), mw.take(keep)
-    weak = np.zeros(r.shape, bool)
-    weak.ravel()[at] = True
     keep = np.flatnonzero(mw <= high.take(rw))
     # hue < hue_max  <=>  sqrt(3) (G - B) < tan(hue_max) (2R - G - B)  (2R - G - B > 0 on red pixels);
     # tested on the strongly red pixels only
     rs, gs, bs = rw.take(keep), rgb[:, 1].take(keep), rgb[:, 2].take(keep)
     hue = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
-    strong = np.zeros(r.shape, bool)
-    strong.ravel()[at.take(keep)[hue]] = True
-    return strong, weak
+    return at, at.take(keep)[hue]
 
 
 def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
@@ -458,25 +462,37 @@ def _segment_at(
     h, w = c.shape[:2]
     # Red pixels are looked for at full resolution around what the coarse grid found: a region that no grid
     # point falls in is far smaller than a fruit.
-    strong = np.zeros((h, w), bool)
     weak = np.zeros((h, w), bool)
     pieces: list[_Piece] = []
     sources = 0
     for win in windows:
-        strong[win], weak[win] = ripe_seeds(c[win], s)
-        labels, n = ndimage.label(weak[win], structure=np.ones((3, 3), bool))
-        if n == 0:
+        # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
+        # the weak pixels alone, not off every pixel of a window that may span most of the image
+        weak_at, strong_at = _red_pixels(c[win], s)
+        if len(weak_at) == 0:
             continue
+        shape = (win[0].stop - win[0].start, win[1].stop - win[1].start)
+        weak_w = np.zeros(shape, bool)
+        weak_w.ravel()[weak_at] = True
+        weak[win] = weak_w
+        labels, n = ndimage.label(weak_w, structure=np.ones((3, 3), bool))
+        flat = labels.ravel()
         seeded = np.zeros(n + 1, bool)
-        seeded[labels[strong[win]]] = True
+        seeded[flat.take(strong_at)] = True
         seeded[0] = False
-        sizes = np.bincount(labels.ravel(), minlength=n + 1)
+        lab = flat.take(weak_at)
+        sizes = np.bincount(lab, minlength=n + 1)
+        rows, cols = np.divmod(weak_at, shape[1])
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
-        least = min_area if z is None else _least_areas(labels, n, z[win], s.min_diameter * geo.focal, z_typical)
+        if z is None:
+            least: float | np.ndarray = min_area
+        else:
+            zw = z.ravel().take((rows + win[0].start) * w + (cols + win[1].start))
+            least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
-        objects = ndimage.find_objects(labels)
+        objects = _boxes(lab, rows, cols, keep)
         for k in np.flatnonzero(keep).tolist():  # the kept regions alone: a window may hold thousands of specks
-            sl = _pad(objects[k - 1], 1, labels.shape)
+            sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
@@ -557,23 +573,57 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     step = COARSE_STEP
     lab, sizes, _ = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
-    lab = np.where((sizes >= 2)[lab], lab, 0)
+    big = sizes >= 2
+    big[0] = False
     pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
     gh, gw = lab.shape
+    at = np.flatnonzero(lab)
+    rows, cols = np.divmod(at, gw)
     boxes = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, gh),
               max(sl[1].start - pad, 0), min(sl[1].stop + pad, gw))
-             for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
-    while boxes:  # join overlapping (and abutting) windows on the grid, until each region lies in one window only
-        painted = np.zeros((gh, gw), bool)
-        for r0, r1, c0, c1 in boxes:
-            painted[r0:r1, c0:c1] = True
-        joined = [
-            (sl[0].start, sl[0].stop, sl[1].start, sl[1].stop) for sl in ndimage.find_objects(ndimage.label(painted)[0])
-        ]
-        if len(joined) == len(boxes):
-            break
-        boxes = joined
+             for sl in _boxes(lab.ravel().take(at), rows, cols, big).values()]  # fmt: skip
+    boxes = _join_boxes(boxes)
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
+
+
+def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int, int]]:
+    """Boxes ``(r0, r1, c0, c1)`` joined until none overlaps or abuts another: each time, the boxes whose
+    painted pixels are 4-connected become their bounding box, ordered by its first pixel in raster order, as
+    the labels of the painted image number them (``ndimage.label`` and ``find_objects``, worked out on the
+    boxes instead of the grid); unchanged (in their own order) once no two join."""
+    while boxes:
+        b = np.array(boxes, np.int64)
+        r0, r1, c0, c1 = b[:, 0], b[:, 1], b[:, 2], b[:, 3]
+        rows_over = (r0[:, None] < r1[None]) & (r0[None] < r1[:, None])
+        rows_touch = (r0[:, None] <= r1[None]) & (r0[None] <= r1[:, None])
+        cols_over = (c0[:, None] < c1[None]) & (c0[None] < c1[:, None])
+        cols_touch = (c0[:, None] <= c1[None]) & (c0[None] <= c1[:, None])
+        i, j = np.nonzero(np.triu((rows_over & cols_touch) | (rows_touch & cols_over), 1))
+        owner = list(range(len(boxes)))
+
+        def root(k: int) -> int:
+            while owner[k] != k:
+                owner[k] = owner[owner[k]]
+                k = owner[k]
+            return k
+
+        for p, q in zip(i.tolist(), j.tolist(), strict=True):
+            rp, rq = root(p), root(q)
+            if rp != rq:
+                owner[max(rp, rq)] = min(rp, rq)
+        groups: dict[int, list[int]] = {}
+        for k in range(len(boxes)):
+            groups.setdefault(root(k), []).append(k)
+        if len(groups) == len(boxes):
+            break
+        joined = []
+        for members in groups.values():
+            m = b[members]
+            top = int(m[:, 0].min())
+            first = (top, int(m[m[:, 0] == top, 2].min()))  # the component's first pixel in raster order
+            joined.append((first, (top, int(m[:, 1].max()), int(m[:, 2].min()), int(m[:, 3].max()))))
+        boxes = [box for _, box in sorted(joined)]
+    return boxes
 
 
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
@@ -639,10 +689,10 @@ def _depth(
 
 
 def _no_depth_zero(z: np.ndarray) -> None:
-    """Set NaN, infinite and negative depths to 0, in place: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)``
-    then ``np.maximum(z, 0)`` to the bit (-0.0 stays -0.0), in two comparisons of the image instead of
-    numpy's six passes."""
-    keep = np.greater_equal(z, 0.0)  # False for NaN and the negatives
+    """Set NaN, infinite and non-positive depths to 0, in place: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)``
+    then ``np.maximum(z, 0)`` to the bit (-0.0 becomes 0.0 there too), in two comparisons of the image instead
+    of numpy's six passes."""
+    keep = np.greater(z, 0.0)  # False for NaN
     keep &= np.less(z, np.inf)
     np.copyto(z, 0.0, where=~keep)
 
@@ -1205,14 +1255,33 @@ def _fruit_sized(
     return area >= np.pi / 4 * diameter_px**2
 
 
-def _least_areas(labels: np.ndarray, n: int, depth: np.ndarray, diameter_px_m: float, z_typical: float) -> np.ndarray:
+def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
     """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
-    regions without depth); ``diameter_px_m`` is the least diameter times the focal length."""
-    valid = (labels > 0) & (depth > 0)
-    count = np.bincount(labels[valid], minlength=n + 1).astype(np.float64)
-    total = np.bincount(labels[valid], weights=depth[valid], minlength=n + 1)
+    regions without depth), from the labels ``1..n`` of a window's region pixels and their depths (in the
+    window's raster order: each mean sums its depths in that order); ``diameter_px_m`` is the least diameter
+    times the focal length."""
+    valid = depth > 0
+    lab = labels[valid]
+    count = np.bincount(lab, minlength=n + 1).astype(np.float64)
+    total = np.bincount(lab, weights=depth[valid], minlength=n + 1)
     z = np.where(count > 0, total / np.maximum(count, 1.0), z_typical)  # the mean: a threshold needs no more
     return np.pi / 4 * (diameter_px_m / z) ** 2
+
+
+def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndarray) -> dict[int, Window]:
+    """The boxes of the labels that ``keep`` marks, as ``ndimage.find_objects`` gives them, from the labels,
+    rows and columns of a window's labelled pixels (scipy's makes a box for every label of the window)."""
+    at = np.flatnonzero(keep.take(labels))
+    if len(at) == 0:
+        return {}
+    lab = labels.take(at)
+    order = np.argsort(lab, kind="stable")
+    lab = lab.take(order)
+    r, c = rows.take(at).take(order), cols.take(at).take(order)
+    first = np.flatnonzero(np.concatenate(([True], lab[1:] != lab[:-1])))
+    r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
+    c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
+    return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)}
 
 
 def _elongation(mask: np.ndarray) -> float:
