@@ -586,6 +586,14 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
+def _root(owner: list[int], k: int) -> int:
+    """The root of ``k`` in a union-find forest (paths halved on the way)."""
+    while owner[k] != k:
+        owner[k] = owner[owner[k]]
+        k = owner[k]
+    return k
+
+
 def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int, int]]:
     """Boxes ``(r0, r1, c0, c1)`` joined until none overlaps or abuts another: each time, the boxes whose
     painted pixels are 4-connected become their bounding box, ordered by its first pixel in raster order, as
@@ -600,20 +608,13 @@ def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, 
         cols_touch = (c0[:, None] <= c1[None]) & (c0[None] <= c1[:, None])
         i, j = np.nonzero(np.triu((rows_over & cols_touch) | (rows_touch & cols_over), 1))
         owner = list(range(len(boxes)))
-
-        def root(k: int) -> int:
-            while owner[k] != k:
-                owner[k] = owner[owner[k]]
-                k = owner[k]
-            return k
-
         for p, q in zip(i.tolist(), j.tolist(), strict=True):
-            rp, rq = root(p), root(q)
+            rp, rq = _root(owner, p), _root(owner, q)
             if rp != rq:
                 owner[max(rp, rq)] = min(rp, rq)
         groups: dict[int, list[int]] = {}
         for k in range(len(boxes)):
-            groups.setdefault(root(k), []).append(k)
+            groups.setdefault(_root(owner, k), []).append(k)
         if len(groups) == len(boxes):
             break
         joined = []
@@ -1281,7 +1282,8 @@ def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndar
     first = np.flatnonzero(np.concatenate(([True], lab[1:] != lab[:-1])))
     r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
     c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
-    return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)}
+    cells = zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)
+    return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in cells}
 
 
 def _elongation(mask: np.ndarray) -> float:
