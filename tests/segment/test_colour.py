@@ -583,7 +583,7 @@ def test_ripe_seeds_are_the_former_look_ups():
 
 
 def test_depth_cleaning_is_nan_to_num_then_maximum_bit_for_bit():
-    from symfruit.segment.colour import _no_depth_zero
+    from symfruit.segment.colour import _valid_depth
 
     rng = np.random.default_rng(5)
     z = rng.normal(0.5, 1.0, 2000)
@@ -594,9 +594,13 @@ def test_depth_cleaning_is_nan_to_num_then_maximum_bit_for_bit():
     z[rng.integers(0, 2000, 50)] = 0.0
     want = np.nan_to_num(z, nan=0.0, posinf=0.0, neginf=0.0)
     np.maximum(want, 0.0, out=want)
-    got = z.copy()
-    _no_depth_zero(got)
+    got, valid = _valid_depth(z)
+    assert got.dtype == np.float64 and np.array_equal(valid, want != 0)
     assert np.array_equal(got.view(np.int64), want.view(np.int64))  # the bits, the sign of -0.0 included
+    z32 = z.astype(np.float32)
+    want = np.maximum(np.nan_to_num(z32.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
+    got, valid = _valid_depth(z32)
+    assert np.array_equal(got.view(np.int64), want.view(np.int64)) and np.array_equal(valid, want != 0)
 
 
 def test_the_red_windows_and_region_boxes_are_the_former_ones():

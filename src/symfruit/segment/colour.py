@@ -669,12 +669,12 @@ def _depth(
     z = np.asarray(depth)
     if z.shape != shape:
         raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
-    z = np.array(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units; a copy
+    given = depth_metres(z, "segment: depth")  # float metres, not raw units
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    _no_depth_zero(z)
-    if not z.any():
+    z, valid = _valid_depth(given)
+    if not valid.any():
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
@@ -689,13 +689,16 @@ def _depth(
     return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
 
 
-def _no_depth_zero(z: np.ndarray) -> None:
-    """Set NaN, infinite and non-positive depths to 0, in place: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)``
-    then ``np.maximum(z, 0)`` to the bit (-0.0 becomes 0.0 there too), in two comparisons of the image instead
-    of numpy's six passes."""
-    keep = np.greater(z, 0.0)  # False for NaN
-    keep &= np.less(z, np.inf)
-    np.copyto(z, 0.0, where=~keep)
+def _valid_depth(depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """A float64 copy of a float depth image with NaN, infinite and non-positive depths set to 0, and where it
+    is not 0: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)`` then ``np.maximum(z, 0)`` to the bit (-0.0
+    becomes 0.0 there too), by two comparisons on the image as given (float32 compares as its float64 copy)
+    instead of numpy's six passes over the copy."""
+    valid = np.greater(depth, 0.0)  # False for NaN
+    valid &= np.less(depth, np.inf)
+    z = np.array(depth, dtype=np.float64)
+    np.copyto(z, 0.0, where=~valid)
+    return z, valid
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
