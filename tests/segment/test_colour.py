@@ -651,3 +651,22 @@ def test_the_red_windows_and_region_boxes_are_the_former_ones():
         want = np.pi / 4 * (600.0 * 0.02 / np.where(count > 0, total / np.maximum(count, 1.0), 1.1)) ** 2
         got = _least_areas(lab.ravel()[at], depth.ravel()[at], n, 600.0 * 0.02, 1.1)
         assert np.array_equal(got, want)
+
+
+def test_the_hull_area_is_the_former_one_bit_for_bit():
+    from symfruit.segment.colour import _hull_area, _hull_vertices
+
+    def former(mask):  # successors by np.roll and np.diff
+        v = _hull_vertices(mask)
+        if v is None:
+            return float(mask.sum())
+        x, y = v[:, 0], v[:, 1]
+        area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+        return area + 0.5 * perimeter + 1.0
+
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        shape = tuple(rng.integers(1, 80, 2))
+        mask = rng.random(shape) < rng.uniform(0.001, 0.3)
+        assert _hull_area(mask) == former(mask)

@@ -275,7 +275,11 @@ def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
     mask = np.asarray(mask, dtype=bool)
     if mask.ndim != 2:
         raise InputError(f"mask must be (h, w), got shape {mask.shape}")
-    vertices = _hull_vertices(mask)
+    return _hull_mask(_hull_vertices(mask), mask)
+
+
+def _hull_mask(vertices: np.ndarray | None, mask: np.ndarray) -> np.ndarray:
+    """:func:`convex_hull_mask` from the mask's :func:`_hull_vertices`."""
     if vertices is None:
         return mask.copy()
     return _fill_polygon(vertices, mask.shape) | mask
@@ -312,12 +316,18 @@ def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 def _hull_area(mask: np.ndarray) -> float:
     """Area of the hull polygon of the mask's pixel centres, plus its half-perimeter (the pixels' own area
     beyond the centres): the filled hull's pixel count, without drawing it."""
-    v = _hull_vertices(mask)
+    return _hull_area_of(_hull_vertices(mask), mask)
+
+
+def _hull_area_of(v: np.ndarray | None, mask: np.ndarray) -> float:
+    """:func:`_hull_area` from the mask's :func:`_hull_vertices` (each vertex's successor by one concatenation:
+    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead)."""
     if v is None:
         return float(mask.sum())
     x, y = v[:, 0], v[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-    perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+    xn, yn = np.concatenate((x[1:], x[:1])), np.concatenate((y[1:], y[:1]))
+    area = 0.5 * abs(float(np.dot(x, yn) - np.dot(y, xn)))
+    perimeter = float(np.hypot(xn - x, yn - y).sum())
     return area + 0.5 * perimeter + 1.0
 
 
@@ -520,7 +530,7 @@ def _segment_at(
         red = part & weak[sl]
         if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
-        hull = convex_hull_mask(part) & ((owner[sl] == 0) | (owner[sl] == k))
+        hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
         if s.fill == "surface" or (s.fill == "auto" and sub_z is not None):
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
@@ -724,14 +734,21 @@ class _Piece:
     source: int  # a bit set of the colour regions it came from
     hull: float = -1.0
     serial: int = -1  # a number of its own while pieces are merged
+    vertices: tuple[np.ndarray | None] | None = None  # its hull's vertices, once worked out
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
 
+    def hull_vertices(self) -> np.ndarray | None:
+        """:func:`_hull_vertices` of the mask, worked out once (a merge test, then the reported hull)."""
+        if self.vertices is None:
+            self.vertices = (_hull_vertices(self.mask),)
+        return self.vertices[0]
+
     def hull_area(self) -> float:
         """:func:`_hull_area` of the mask, worked out when first asked for: only pieces near another need it."""
         if self.hull < 0:
-            self.hull = _hull_area(self.mask)
+            self.hull = _hull_area_of(self.hull_vertices(), self.mask)
         return self.hull
 
 
@@ -770,13 +787,14 @@ def _merge(
                 if (a.source & b.source) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
-                hull = _hull_area(union)
+                vertices = _hull_vertices(union)
+                hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    hull -= float((convex_hull_mask(union) & ~union & _green(color[window])).sum())
+                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
-                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
+                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial, (vertices,))
                     serial += 1
                     del pieces[j]
                     merged = True
