@@ -670,3 +670,13 @@ def test_the_hull_area_is_the_former_one_bit_for_bit():
         shape = tuple(rng.integers(1, 80, 2))
         mask = rng.random(shape) < rng.uniform(0.001, 0.3)
         assert _hull_area(mask) == former(mask)
+
+
+def test_the_leaf_test_is_the_former_one():
+    from symfruit.segment.colour import LEAF_HUE, _green, _leaf
+
+    rng = np.random.default_rng(8)
+    color = rng.integers(0, 256, (300, 400, 3), dtype=np.uint8)
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    want = _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))  # _green's casts made twice
+    assert np.array_equal(_leaf(color), want) and np.array_equal(_leaf(color[5:90:2, 7:]), want[5:90:2, 7:])

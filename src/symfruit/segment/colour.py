@@ -658,7 +658,9 @@ def _leaf(color: np.ndarray) -> np.ndarray:
     B > R), so hue >= LEAF_HUE is ``60 (G - R) >= (LEAF_HUE - 60) (G - min(R, B))``: integers, independent of
     brightness and saturation."""
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
-    return _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))
+    over = g - np.minimum(r, b)  # the channels cast once for both tests (as _green casts them)
+    green = (g > r) & (g >= b) & (3 * over >= g)
+    return green & (60 * (g - r) >= (LEAF_HUE - 60) * over)
 
 
 #: The least hue (degrees) of a leaf. Leaves of apple and most fruit trees are green of hue about 85-130;
@@ -1178,12 +1180,13 @@ def _ripe_cores(
     pixels. It is taken as its cores, the pieces of its pixels whose redness averaged over
     :data:`CORE_SMOOTH_PX` pixels reaches ``ripe_median``, each at least the least fruit's disc
     (``min_diameter``); the fruit's skin around them is found again later (the hull, :func:`_round_skin`)."""
-    red = redness(color)
     largest = _largest_area(region, depth, s, focal, z_typical)
     if region.sum() <= largest:
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
-        # before the region is split and merged: a twig or bark never costs the work on a fruit)
-        return [region] if median(red[region]) >= s.ripe_median else []
+        # before the region is split and merged: a twig or bark never costs the work on a fruit); the redness
+        # of its own pixels alone (per pixel, in the same order: the values of the window's at them)
+        return [region] if median(redness(color[region])) >= s.ripe_median else []
+    red = redness(color)
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
