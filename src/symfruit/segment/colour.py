@@ -704,12 +704,17 @@ def _depth(
 def _valid_depth(depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """A float64 copy of a float depth image with NaN, infinite and non-positive depths set to 0, and where it
     is not 0: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)`` then ``np.maximum(z, 0)`` to the bit (-0.0
-    becomes 0.0 there too), by two comparisons on the image as given (float32 compares as its float64 copy)
-    instead of numpy's six passes over the copy."""
+    becomes 0.0 there too), by comparisons on the image as given (float32 compares as its float64 copy); only
+    the pixels that are not +0.0 already are written (numpy's masked copy over the whole image costs more than
+    the comparisons, and "no depth" is mostly stored as 0)."""
     valid = np.greater(depth, 0.0)  # False for NaN
     valid &= np.less(depth, np.inf)
     z = np.array(depth, dtype=np.float64)
-    np.copyto(z, 0.0, where=~valid)
+    fix = np.not_equal(depth, 0.0)  # NaN, infinities, negatives ...
+    fix |= np.signbit(depth)  # ... and -0.0
+    fix &= ~valid
+    if fix.any():
+        np.copyto(z, 0.0, where=fix)
     return z, valid
 
 
