@@ -582,25 +582,26 @@ def test_ripe_seeds_are_the_former_look_ups():
             assert np.array_equal(strong_at, np.flatnonzero(want[0]))
 
 
-def test_depth_cleaning_is_nan_to_num_then_maximum_bit_for_bit():
-    from symfruit.segment.colour import _valid_depth
+def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
+    from symfruit.segment.colour import _Depth
 
     rng = np.random.default_rng(5)
-    z = rng.normal(0.5, 1.0, 2000)
-    z[rng.integers(0, 2000, 300)] = np.nan
-    z[rng.integers(0, 2000, 50)] = np.inf
-    z[rng.integers(0, 2000, 50)] = -np.inf
-    z[rng.integers(0, 2000, 50)] = -0.0
-    z[rng.integers(0, 2000, 50)] = 0.0
-    want = np.nan_to_num(z, nan=0.0, posinf=0.0, neginf=0.0)
-    np.maximum(want, 0.0, out=want)
-    got, valid = _valid_depth(z)
-    assert got.dtype == np.float64 and np.array_equal(valid, want != 0)
-    assert np.array_equal(got.view(np.int64), want.view(np.int64))  # the bits, the sign of -0.0 included
-    z32 = z.astype(np.float32)
-    want = np.maximum(np.nan_to_num(z32.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
-    got, valid = _valid_depth(z32)
-    assert np.array_equal(got.view(np.int64), want.view(np.int64)) and np.array_equal(valid, want != 0)
+    z = rng.normal(0.5, 1.0, (40, 50))
+    for value, count in ((np.nan, 300), (np.inf, 50), (-np.inf, 50), (-0.0, 50), (0.0, 50)):
+        z.ravel()[rng.integers(0, z.size, count)] = value
+    for image in (z, z.astype(np.float32), z[::2, 3:]):
+        whole = np.maximum(np.nan_to_num(image.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
+        valid = np.greater(image, 0.0) & np.less(image, np.inf)
+        depth = _Depth(image, valid)
+        assert np.array_equal(valid, whole != 0) and depth.shape == image.shape
+        for window in ((slice(None), slice(None)), (slice(3, 17), slice(5, 21)), (slice(1, None, 3), slice(0, 9, 2))):
+            got = depth[window]
+            assert got.dtype == np.float64 and got.flags.writeable
+            assert np.array_equal(got.view(np.int64), whole[window].view(np.int64))  # the bits, -0.0's sign included
+        flat = rng.integers(0, image.size, 200)
+        assert np.array_equal(depth.take(flat).view(np.int64), whole.ravel()[flat].view(np.int64))
+        clean = _Depth.of(whole)
+        assert np.array_equal(clean[(slice(2, 9), slice(None))].view(np.int64), whole[2:9].view(np.int64))
 
 
 def test_the_red_windows_and_region_boxes_are_the_former_ones():

@@ -396,7 +396,7 @@ def segment(
         return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
     o = step // 2
     small_c = c[o::step, o::step]
-    small_z = None if z is None else z[o::step, o::step]
+    small_z = None if z is None else _Depth.of(z[o::step, o::step])
     small_geo = _Geometry(geo.focal / step, (geo.cy - o) / step, (geo.cx - o) / step)
     small = _segment_at(small_c, small_z, small_geo, s, min_area / step**2, z_typical,
                         _red_windows(_coarse_regions(small_c, s), small_c.shape[:2]))  # fmt: skip
@@ -461,7 +461,7 @@ def _polygon(points: np.ndarray) -> np.ndarray:
 
 def _segment_at(
     c: np.ndarray,
-    z: np.ndarray | None,
+    z: _Depth | None,
     geo: _Geometry,
     s: SegmentSettings,
     min_area: float,
@@ -497,7 +497,7 @@ def _segment_at(
         if z is None:
             least: float | np.ndarray = min_area
         else:
-            zw = z.ravel().take((rows + win[0].start) * w + (cols + win[1].start))
+            zw = z.take((rows + win[0].start) * w + (cols + win[1].start))
             least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
         objects = _boxes(lab, rows, cols, keep)
@@ -670,11 +670,9 @@ def _leaf(color: np.ndarray) -> np.ndarray:
 LEAF_HUE = 80
 
 
-def _depth(
-    depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]
-) -> tuple[np.ndarray | None, _Geometry]:
-    """The depth (0 where invalid) and the camera geometry (the principal point defaults to the image
-    centre), or ``(None, ...)`` without usable depth."""
+def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]) -> tuple[_Depth | None, _Geometry]:
+    """The depth (:class:`_Depth`: float64 metres, 0 where invalid, window by window) and the camera geometry (the
+    principal point defaults to the image centre), or ``(None, ...)`` without usable depth."""
     none = _Geometry(0.0, shape[0] / 2, shape[1] / 2)
     if depth is None:
         return None, none
@@ -685,7 +683,8 @@ def _depth(
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    z, valid = _valid_depth(given)
+    valid = np.greater(given, 0.0)  # False for NaN
+    valid &= np.less(given, np.inf)
     if not valid.any():
         return None, none
     if camera is None:
@@ -698,24 +697,36 @@ def _depth(
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
-    return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+    return _Depth(given, valid), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
 
 
-def _valid_depth(depth: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """A float64 copy of a float depth image with NaN, infinite and non-positive depths set to 0, and where it
-    is not 0: ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)`` then ``np.maximum(z, 0)`` to the bit (-0.0
-    becomes 0.0 there too), by comparisons on the image as given (float32 compares as its float64 copy); only
-    the pixels that are not +0.0 already are written (numpy's masked copy over the whole image costs more than
-    the comparisons, and "no depth" is mostly stored as 0)."""
-    valid = np.greater(depth, 0.0)  # False for NaN
-    valid &= np.less(depth, np.inf)
-    z = np.array(depth, dtype=np.float64)
-    fix = np.not_equal(depth, 0.0)  # NaN, infinities, negatives ...
-    fix |= np.signbit(depth)  # ... and -0.0
-    fix &= ~valid
-    if fix.any():
-        np.copyto(z, 0.0, where=fix)
-    return z, valid
+class _Depth:
+    """A depth image as float64 metres with NaN, infinite and non-positive depths 0, converted window by window
+    when read (``depth[window]``, a copy; ``take(flat)``): the values of ``np.nan_to_num(z, nan=0, posinf=0,
+    neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole image, to the bit (-0.0 becomes 0.0
+    there too). The segmenter reads some 250 small windows of a frame: a float64 copy of a 1920x1080 image, 16 MB
+    of fresh pages, cost more than all of them."""
+
+    def __init__(self, given: np.ndarray, valid: np.ndarray) -> None:
+        self.given = given  # float, as handed over
+        self.valid = valid  # (h, w) bool: positive and finite
+        self.shape: tuple[int, int] = (int(given.shape[0]), int(given.shape[1]))
+
+    @classmethod
+    def of(cls, z: np.ndarray) -> _Depth:
+        """A float64 depth already cleaned (0 where invalid)."""
+        return cls(z, z > 0)
+
+    def __getitem__(self, window: tuple[slice, slice]) -> np.ndarray:
+        z = np.array(self.given[window], dtype=np.float64)
+        np.copyto(z, 0.0, where=~self.valid[window])
+        return z
+
+    def take(self, flat: np.ndarray) -> np.ndarray:
+        """The depths at flat (row-major) pixel indices."""
+        z = np.asarray(self.given).ravel().take(flat).astype(np.float64)
+        np.copyto(z, 0.0, where=~self.valid.ravel().take(flat))
+        return z
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
@@ -764,7 +775,7 @@ def _merge(
     s: SegmentSettings,
     color: np.ndarray,
     weak: np.ndarray,
-    depth: np.ndarray | None,
+    depth: _Depth | None,
     geo: _Geometry,
 ) -> list[_Piece]:
     """Join pieces of one convex body (greedy, largest first): the hull of their union, less the green
@@ -813,7 +824,7 @@ def _merge(
 
 
 def _same_surface(
-    a: _Piece, b: _Piece, depth: np.ndarray, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
+    a: _Piece, b: _Piece, depth: _Depth, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
     distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``); None
@@ -1209,7 +1220,7 @@ CORE_SMOOTH_PX = 5
 def _round_skin(
     sl: Window,
     hull: np.ndarray,
-    depth: np.ndarray,
+    depth: _Depth,
     color: np.ndarray,
     geo: _Geometry,
     s: SegmentSettings,
@@ -1226,7 +1237,8 @@ def _round_skin(
     does not. When what is reached exceeds the largest fruit's disc (``round_max_diameter``) it is not one
     fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. Returns
     the grown window and mask."""
-    z_part = depth[sl][hull & (depth[sl] > 0)]
+    z_sl = depth[sl]
+    z_part = z_sl[hull & (z_sl > 0)]
     if len(z_part) < 20:
         return sl, hull
     rows, cols = np.nonzero(hull)
