@@ -681,3 +681,22 @@ def test_the_leaf_test_is_the_former_one():
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     want = _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))  # _green's casts made twice
     assert np.array_equal(_leaf(color), want) and np.array_equal(_leaf(color[5:90:2, 7:]), want[5:90:2, 7:])
+
+
+def test_the_depth_steps_are_the_former_ones():
+    from symfruit.segment.colour import _steps
+
+    rng = np.random.default_rng(9)
+    for _ in range(20):
+        z = rng.uniform(0.3, 0.6, tuple(rng.integers(1, 40, 2)))
+        z[rng.random(z.shape) < 0.2] = np.nan
+        want = np.zeros(z.shape, bool)
+        for axis in (0, 1):  # the former: np.diff along each axis
+            step = np.abs(np.diff(z, axis=axis)) > 0.05
+            if axis == 0:
+                want[:-1] |= step
+                want[1:] |= step
+            else:
+                want[:, :-1] |= step
+                want[:, 1:] |= step
+        assert np.array_equal(_steps(z, 0.05), want)

@@ -1151,16 +1151,15 @@ def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, foca
 
 
 def _steps(z: np.ndarray, jump: float) -> np.ndarray:
-    """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step)."""
+    """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step). The
+    neighbours' differences by slices (``np.diff``'s values, without its call's overhead)."""
     edge = np.zeros(z.shape, bool)
-    for axis in (0, 1):
-        step = np.abs(np.diff(z, axis=axis)) > jump  # NaN compares False: no step
-        if axis == 0:
-            edge[:-1] |= step
-            edge[1:] |= step
-        else:
-            edge[:, :-1] |= step
-            edge[:, 1:] |= step
+    step = np.abs(z[1:] - z[:-1]) > jump  # NaN compares False: no step
+    edge[:-1] |= step
+    edge[1:] |= step
+    step = np.abs(z[:, 1:] - z[:, :-1]) > jump
+    edge[:, :-1] |= step
+    edge[:, 1:] |= step
     return edge
 
 
