@@ -700,3 +700,12 @@ def test_the_depth_steps_are_the_former_ones():
                 want[:, :-1] |= step
                 want[:, 1:] |= step
         assert np.array_equal(_steps(z, 0.05), want)
+
+
+def test_the_padding_is_numpys():
+    from symfruit.segment.colour import _pad1
+
+    rng = np.random.default_rng(10)
+    for shape in ((1, 1), (3, 7), (20, 11)):
+        mask = rng.random(shape) < 0.5
+        assert np.array_equal(_pad1(mask), np.pad(mask, 1)) and _pad1(mask).dtype == bool

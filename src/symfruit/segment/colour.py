@@ -942,7 +942,7 @@ def _centres(
         step = 2
         found = _centres(region[::step, ::step], least / step, waist, loose, coarse=False)
         return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
-    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
     if float(edt.max()) < least:
         return []
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
@@ -1042,11 +1042,19 @@ def _dilate(mask: np.ndarray, *, square: bool = False) -> np.ndarray:
     """(h, w) bool: ``ndimage.binary_dilation(mask)`` by the 4-neighbourhood (``square``: the 8-neighbourhood,
     ``structure=np.ones((3, 3))``), from shifted views of the padded mask (scipy's general structuring element
     costs several times more on these small windows)."""
-    p = np.pad(mask, 1)
+    p = _pad1(mask)
     if square:
         rows = p[:-2] | p[1:-1] | p[2:]
         return rows[:, :-2] | rows[:, 1:-1] | rows[:, 2:]
     return p[1:-1, 1:-1] | p[:-2, 1:-1] | p[2:, 1:-1] | p[1:-1, :-2] | p[1:-1, 2:]
+
+
+def _pad1(mask: np.ndarray) -> np.ndarray:
+    """``np.pad(mask, 1)`` of a bool image, written out (np.pad's own work costs more than the copy on these small
+    windows)."""
+    p = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), bool)
+    p[1:-1, 1:-1] = mask
+    return p
 
 
 def _points(
@@ -1127,7 +1135,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
     times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
     touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
-    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
     cen = np.array(centres, dtype=np.float64)
     deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
     rows, cols = np.nonzero(deep)
