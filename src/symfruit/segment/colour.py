@@ -683,6 +683,7 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
+    given = np.ascontiguousarray(given)  # read by flat index window by window (a copy only if strided)
     valid = np.greater(given, 0.0)  # False for NaN
     valid &= np.less(given, np.inf)
     if not valid.any():
