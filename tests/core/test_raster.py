@@ -5,7 +5,7 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import fill_holes, inner_distance, mask_box, rasterise, silhouette_coverage
+from symfruit.core.raster import fill_holes, inner_distance, mask_box, outer_distance, rasterise, silhouette_coverage
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -229,6 +229,22 @@ def test_the_inner_distance_over_the_masks_box_is_the_whole_images(seed):
     mask[r0 : r0 + int(rng.integers(1, 12)), c0 : c0 + int(rng.integers(1, 12))] = True  # touching a border or not
     mask &= rng.random((h, w)) < rng.uniform(0.6, 1.0)
     assert np.array_equal(inner_distance(mask), ndimage.distance_transform_edt(mask))
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 12.0))
+def test_the_outer_distance_within_reach_is_the_whole_images(seed, reach):
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = np.zeros((h, w), bool)
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    mask[r0 : r0 + int(rng.integers(1, 12)), c0 : c0 + int(rng.integers(1, 12))] = True
+    mask &= rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    want = ndimage.distance_transform_edt(~mask)
+    got = outer_distance(mask, reach)
+    near = want <= reach
+    assert np.array_equal(got[near], want[near]) and np.all(got[~near] > reach)
+    if not mask.any():
+        assert np.array_equal(got, want)
 
 
 def test_the_inner_distance_of_an_empty_or_full_mask_is_the_whole_images():

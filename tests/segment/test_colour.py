@@ -538,3 +538,174 @@ def test_the_sphere_fit_is_the_former_one_bit_for_bit():
         assert fit is not None
         centre, radius = former(disc, depth, geo, (0, 0))
         assert np.array_equal(fit[0], centre) and fit[1] == radius
+
+
+def test_ripe_seeds_are_the_former_look_ups():
+    from symfruit.segment.colour import _red_pixels
+
+    def former(c, s):  # both look-up tables read for every pixel, the hue for the strong ones
+        r, g, b = c[:, :, 0], c[:, :, 1], c[:, :, 2]
+        mgb = np.maximum(g, b)
+        levels = np.arange(256, dtype=np.float64)
+        low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
+        high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
+        low[: s.dark + 1] = -1
+        high[: s.dark + 1] = -1
+        weak = mgb <= low[r]
+        strong = mgb <= high[r]
+        idx = np.flatnonzero(strong)
+        rs, gs, bs = (ch.ravel()[idx].astype(np.int16) for ch in (r, g, b))
+        ok = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
+        strong = np.zeros(r.shape, bool)
+        strong.ravel()[idx[ok]] = True
+        return strong, weak
+
+    rng = np.random.default_rng(11)
+    every = np.stack(np.meshgrid(np.arange(256), np.arange(256), indexing="ij"), -1).reshape(-1, 2)
+    for settings in (SegmentSettings(), SegmentSettings(red_low=0.3, red_high=0.3, dark=0, hue_max=10.0),
+                     SegmentSettings(red_low=0.01, red_high=0.9, dark=254)):  # fmt: skip
+        # every (R, max(G, B)) pair, with the other channel random, and a strided window of a random image
+        c = np.zeros((256, 256, 3), np.uint8)
+        c[..., 0] = every[:, 0].reshape(256, 256)
+        c[..., 1] = every[:, 1].reshape(256, 256)
+        c[..., 2] = rng.integers(0, 256, (256, 256))
+        swap = rng.random((256, 256)) < 0.5
+        c[swap, 1], c[swap, 2] = c[swap, 2], c[swap, 1].copy()
+        image = rng.integers(0, 256, (60, 90, 4), dtype=np.uint8)
+        image[..., 0] = np.maximum(image[..., 0], image[..., 1])
+        for case in (c, image[5:50, 7:80, :3], image[::3, ::2]):
+            strong, weak = ripe_seeds(case, settings)
+            want = former(case[:, :, :3], settings)
+            assert np.array_equal(strong, want[0]) and np.array_equal(weak, want[1])
+            weak_at, strong_at = _red_pixels(case[:, :, :3], settings)
+            assert np.array_equal(weak_at, np.flatnonzero(want[1]))
+            assert np.array_equal(strong_at, np.flatnonzero(want[0]))
+
+
+def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
+    from symfruit.segment.colour import _Depth
+
+    rng = np.random.default_rng(5)
+    z = rng.normal(0.5, 1.0, (40, 50))
+    for value, count in ((np.nan, 300), (np.inf, 50), (-np.inf, 50), (-0.0, 50), (0.0, 50)):
+        z.ravel()[rng.integers(0, z.size, count)] = value
+    for image in (z, z.astype(np.float32), z[::2, 3:]):
+        whole = np.maximum(np.nan_to_num(image.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
+        valid = np.greater(image, 0.0) & np.less(image, np.inf)
+        depth = _Depth(image, valid)
+        assert np.array_equal(valid, whole != 0) and depth.shape == image.shape
+        for window in ((slice(None), slice(None)), (slice(3, 17), slice(5, 21)), (slice(1, None, 3), slice(0, 9, 2))):
+            got = depth[window]
+            assert got.dtype == np.float64 and got.flags.writeable
+            assert np.array_equal(got.view(np.int64), whole[window].view(np.int64))  # the bits, -0.0's sign included
+        flat = rng.integers(0, image.size, 200)
+        assert np.array_equal(depth.take(flat).view(np.int64), whole.ravel()[flat].view(np.int64))
+        clean = _Depth.of(whole)
+        assert np.array_equal(clean[(slice(2, 9), slice(None))].view(np.int64), whole[2:9].view(np.int64))
+
+
+def test_the_red_windows_and_region_boxes_are_the_former_ones():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import COARSE_STEP, _boxes, _least_areas, _red_windows
+
+    def former(coarse, shape):  # the boxes painted on the grid and labelled until none join
+        h, w = shape
+        lab, sizes, _ = coarse
+        lab = np.where((sizes >= 2)[lab], lab, 0)
+        gh, gw = lab.shape
+        boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
+                 for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
+        while boxes:
+            painted = np.zeros((gh, gw), bool)
+            for r0, r1, c0, c1 in boxes:
+                painted[r0:r1, c0:c1] = True
+            joined = [(a.start, a.stop, b.start, b.stop) for a, b in ndimage.find_objects(ndimage.label(painted)[0])]
+            if len(joined) == len(boxes):
+                break
+            boxes = joined
+        step = COARSE_STEP
+        return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
+
+    rng = np.random.default_rng(2)
+    for trial in range(60):
+        gh, gw = (int(v) for v in rng.integers(3, 60, 2))
+        weak = ndimage.binary_opening(rng.random((gh, gw)) < rng.uniform(0.05, 0.5)) | (rng.random((gh, gw)) < 0.03)
+        lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+        sizes = np.bincount(lab.ravel(), minlength=n + 1)
+        sizes[0] = 0
+        coarse = (lab, sizes, np.ones(n + 1, bool))
+        shape = (gh * COARSE_STEP - int(rng.integers(0, 4)), gw * COARSE_STEP - int(rng.integers(0, 4)))
+        assert _red_windows(coarse, shape) == former(coarse, shape), trial
+        # the kept regions' boxes, and the least areas from the region pixels alone
+        keep = rng.random(n + 1) < 0.5
+        keep[0] = False
+        at = np.flatnonzero(lab)
+        rows, cols = np.divmod(at, gw)
+        boxes = _boxes(lab.ravel()[at], rows, cols, keep)
+        objects = ndimage.find_objects(lab)
+        assert boxes == {k: objects[k - 1] for k in np.flatnonzero(keep).tolist()}
+        depth = np.where(rng.random((gh, gw)) < 0.8, rng.uniform(0.3, 2.0, (gh, gw)), 0.0)
+        valid = (lab > 0) & (depth > 0)
+        count = np.bincount(lab[valid], minlength=n + 1).astype(np.float64)
+        total = np.bincount(lab[valid], weights=depth[valid], minlength=n + 1)
+        want = np.pi / 4 * (600.0 * 0.02 / np.where(count > 0, total / np.maximum(count, 1.0), 1.1)) ** 2
+        got = _least_areas(lab.ravel()[at], depth.ravel()[at], n, 600.0 * 0.02, 1.1)
+        assert np.array_equal(got, want)
+
+
+def test_the_hull_area_is_the_former_one_bit_for_bit():
+    from symfruit.segment.colour import _hull_area, _hull_vertices
+
+    def former(mask):  # successors by np.roll and np.diff
+        v = _hull_vertices(mask)
+        if v is None:
+            return float(mask.sum())
+        x, y = v[:, 0], v[:, 1]
+        area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
+        perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+        return area + 0.5 * perimeter + 1.0
+
+    rng = np.random.default_rng(4)
+    for _ in range(200):
+        shape = tuple(rng.integers(1, 80, 2))
+        mask = rng.random(shape) < rng.uniform(0.001, 0.3)
+        assert _hull_area(mask) == former(mask)
+
+
+def test_the_leaf_test_is_the_former_one():
+    from symfruit.segment.colour import LEAF_HUE, _green, _leaf
+
+    rng = np.random.default_rng(8)
+    color = rng.integers(0, 256, (300, 400, 3), dtype=np.uint8)
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    want = _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))  # _green's casts made twice
+    assert np.array_equal(_leaf(color), want) and np.array_equal(_leaf(color[5:90:2, 7:]), want[5:90:2, 7:])
+
+
+def test_the_depth_steps_are_the_former_ones():
+    from symfruit.segment.colour import _steps
+
+    rng = np.random.default_rng(9)
+    for _ in range(20):
+        z = rng.uniform(0.3, 0.6, tuple(rng.integers(1, 40, 2)))
+        z[rng.random(z.shape) < 0.2] = np.nan
+        want = np.zeros(z.shape, bool)
+        for axis in (0, 1):  # the former: np.diff along each axis
+            step = np.abs(np.diff(z, axis=axis)) > 0.05
+            if axis == 0:
+                want[:-1] |= step
+                want[1:] |= step
+            else:
+                want[:, :-1] |= step
+                want[:, 1:] |= step
+        assert np.array_equal(_steps(z, 0.05), want)
+
+
+def test_the_padding_is_numpys():
+    from symfruit.segment.colour import _pad1
+
+    rng = np.random.default_rng(10)
+    for shape in ((1, 1), (3, 7), (20, 11)):
+        mask = rng.random(shape) < 0.5
+        assert np.array_equal(_pad1(mask), np.pad(mask, 1)) and _pad1(mask).dtype == bool

@@ -26,13 +26,12 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .occlusion import Occlusion
 from .points import as_points, row_norms
-from .raster import Silhouette, inner_distance, interior, outline_cone, outline_cracks, silhouette_cone
+from .raster import Silhouette, inner_distance, interior, outer_distance, outline_cone, outline_cracks, silhouette_cone
 
 __all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
@@ -239,7 +238,8 @@ def observe(
     rays = sample / sample[:, 2:3]
     mask = region.mask
     inner = inner_distance(mask)
-    outer = ndimage.distance_transform_edt(~mask)
+    # the outside bands read the map out to the widest band alone
+    outer = outer_distance(mask, max(bands, default=0.0) + 0.5)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")

@@ -269,6 +269,21 @@ def inner_distance(mask: np.ndarray) -> np.ndarray:
     return out
 
 
+def outer_distance(mask: np.ndarray, reach: float) -> np.ndarray:
+    """(h, w) float, pixels: ``ndimage.distance_transform_edt(~mask)`` (each pixel's distance to the nearest mask
+    pixel) wherever that is at most ``reach``, transformed over the mask's box grown by ``ceil(reach) + 1`` pixels
+    (clipped to the image) alone: every mask pixel lies in that box, so its distances are the same, and a pixel
+    beyond it is farther than ``reach`` from every mask pixel (+inf here). An empty mask: scipy's map."""
+    if (box := mask_box(mask)) is None:
+        return ndimage.distance_transform_edt(~mask)
+    m = int(np.ceil(reach)) + 1
+    out = np.full(mask.shape, np.inf)
+    r0, r1 = max(box[0] - m, 0), min(box[1] + m, mask.shape[0])
+    c0, c1 = max(box[2] - m, 0), min(box[3] + m, mask.shape[1])
+    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(~mask[r0:r1, c0:c1])
+    return out
+
+
 def interior(mask: np.ndarray) -> np.ndarray:
     """(h, w) bool: ``ndimage.binary_erosion(mask)`` (the pixels whose 4 neighbours are in the mask; pixels beyond
     the array are not), by five shifted views of the padded mask instead of scipy's general structuring element

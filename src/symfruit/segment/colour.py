@@ -220,26 +220,39 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
     -------
     strong, weak : (h, w) bool
     """
-    s = settings or SegmentSettings()
     c = _color(color)
-    r, g, b = c[:, :, 0], c[:, :, 1], c[:, :, 2]
-    mgb = np.maximum(g, b)
+    weak_at, strong_at = _red_pixels(c, settings or SegmentSettings())
+    strong = np.zeros(c.shape[:2], bool)
+    strong.ravel()[strong_at] = True
+    weak = np.zeros(c.shape[:2], bool)
+    weak.ravel()[weak_at] = True
+    return strong, weak
+
+
+def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray]:
+    """The flat indices (ascending) of :func:`ripe_seeds`' weak and strong pixels of a checked colour image."""
     # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
     levels = np.arange(256, dtype=np.float64)
     low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
     high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
     low[: s.dark + 1] = -1  # dark pixels are never red
     high[: s.dark + 1] = -1
-    weak = mgb <= low[r]
-    strong = mgb <= high[r]
+    # a weakly red pixel has R above max(G, B) (low[R] < R as red_low > 0): the tables are read for those
+    # pixels alone (a look-up over the whole image converts every pixel's index to 64 bits first), and the
+    # strong table for the weak ones alone (high <= low, as red_high >= red_low); on a contiguous copy (numpy's
+    # loops over a window's strided channels are several times slower)
+    c = np.ascontiguousarray(c)
+    at = np.flatnonzero(c[:, :, 0] > np.maximum(c[:, :, 1], c[:, :, 2]))
+    rgb = c.reshape(-1, 3).take(at, axis=0).astype(np.int16)
+    rw, mw = rgb[:, 0], np.maximum(rgb[:, 1], rgb[:, 2])
+    keep = np.flatnonzero(mw <= low.take(rw))
+    at, rgb, rw, mw = at.take(keep), rgb.take(keep, axis=0), rw.take(keep), mw.take(keep)
+    keep = np.flatnonzero(mw <= high.take(rw))
     # hue < hue_max  <=>  sqrt(3) (G - B) < tan(hue_max) (2R - G - B)  (2R - G - B > 0 on red pixels);
     # tested on the strongly red pixels only
-    idx = np.flatnonzero(strong)
-    rs, gs, bs = (ch.ravel()[idx].astype(np.int16) for ch in (r, g, b))
-    ok = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
-    strong = np.zeros(r.shape, bool)
-    strong.ravel()[idx[ok]] = True
-    return strong, weak
+    rs, gs, bs = rw.take(keep), rgb[:, 1].take(keep), rgb[:, 2].take(keep)
+    hue = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
+    return at, at.take(keep)[hue]
 
 
 def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
@@ -262,7 +275,11 @@ def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
     mask = np.asarray(mask, dtype=bool)
     if mask.ndim != 2:
         raise InputError(f"mask must be (h, w), got shape {mask.shape}")
-    vertices = _hull_vertices(mask)
+    return _hull_mask(_hull_vertices(mask), mask)
+
+
+def _hull_mask(vertices: np.ndarray | None, mask: np.ndarray) -> np.ndarray:
+    """:func:`convex_hull_mask` from the mask's :func:`_hull_vertices`."""
     if vertices is None:
         return mask.copy()
     return _fill_polygon(vertices, mask.shape) | mask
@@ -299,12 +316,18 @@ def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 def _hull_area(mask: np.ndarray) -> float:
     """Area of the hull polygon of the mask's pixel centres, plus its half-perimeter (the pixels' own area
     beyond the centres): the filled hull's pixel count, without drawing it."""
-    v = _hull_vertices(mask)
+    return _hull_area_of(_hull_vertices(mask), mask)
+
+
+def _hull_area_of(v: np.ndarray | None, mask: np.ndarray) -> float:
+    """:func:`_hull_area` from the mask's :func:`_hull_vertices` (each vertex's successor by one concatenation:
+    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead)."""
     if v is None:
         return float(mask.sum())
     x, y = v[:, 0], v[:, 1]
-    area = 0.5 * abs(float(np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1))))
-    perimeter = float(np.hypot(np.diff(x, append=x[0]), np.diff(y, append=y[0])).sum())
+    xn, yn = np.concatenate((x[1:], x[:1])), np.concatenate((y[1:], y[:1]))
+    area = 0.5 * abs(float(np.dot(x, yn) - np.dot(y, xn)))
+    perimeter = float(np.hypot(xn - x, yn - y).sum())
     return area + 0.5 * perimeter + 1.0
 
 
@@ -373,7 +396,7 @@ def segment(
         return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
     o = step // 2
     small_c = c[o::step, o::step]
-    small_z = None if z is None else z[o::step, o::step]
+    small_z = None if z is None else _Depth.of(z[o::step, o::step])
     small_geo = _Geometry(geo.focal / step, (geo.cy - o) / step, (geo.cx - o) / step)
     small = _segment_at(small_c, small_z, small_geo, s, min_area / step**2, z_typical,
                         _red_windows(_coarse_regions(small_c, s), small_c.shape[:2]))  # fmt: skip
@@ -438,7 +461,7 @@ def _polygon(points: np.ndarray) -> np.ndarray:
 
 def _segment_at(
     c: np.ndarray,
-    z: np.ndarray | None,
+    z: _Depth | None,
     geo: _Geometry,
     s: SegmentSettings,
     min_area: float,
@@ -449,25 +472,37 @@ def _segment_at(
     h, w = c.shape[:2]
     # Red pixels are looked for at full resolution around what the coarse grid found: a region that no grid
     # point falls in is far smaller than a fruit.
-    strong = np.zeros((h, w), bool)
     weak = np.zeros((h, w), bool)
     pieces: list[_Piece] = []
     sources = 0
     for win in windows:
-        strong[win], weak[win] = ripe_seeds(c[win], s)
-        labels, n = ndimage.label(weak[win], structure=np.ones((3, 3), bool))
-        if n == 0:
+        # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
+        # the weak pixels alone, not off every pixel of a window that may span most of the image
+        weak_at, strong_at = _red_pixels(c[win], s)
+        if len(weak_at) == 0:
             continue
+        shape = (win[0].stop - win[0].start, win[1].stop - win[1].start)
+        weak_w = np.zeros(shape, bool)
+        weak_w.ravel()[weak_at] = True
+        weak[win] = weak_w
+        labels, n = ndimage.label(weak_w, structure=np.ones((3, 3), bool))
+        flat = labels.ravel()
         seeded = np.zeros(n + 1, bool)
-        seeded[labels[strong[win]]] = True
+        seeded[flat.take(strong_at)] = True
         seeded[0] = False
-        sizes = np.bincount(labels.ravel(), minlength=n + 1)
+        lab = flat.take(weak_at)
+        sizes = np.bincount(lab, minlength=n + 1)
+        rows, cols = np.divmod(weak_at, shape[1])
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
-        least = min_area if z is None else _least_areas(labels, n, z[win], s.min_diameter * geo.focal, z_typical)
+        if z is None:
+            least: float | np.ndarray = min_area
+        else:
+            zw = z.take((rows + win[0].start) * w + (cols + win[1].start))
+            least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
-        objects = ndimage.find_objects(labels)
+        objects = _boxes(lab, rows, cols, keep)
         for k in np.flatnonzero(keep).tolist():  # the kept regions alone: a window may hold thousands of specks
-            sl = _pad(objects[k - 1], 1, labels.shape)
+            sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
                   slice(sl[1].start + win[1].start, sl[1].stop + win[1].start))  # fmt: skip
@@ -495,7 +530,7 @@ def _segment_at(
         red = part & weak[sl]
         if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
-        hull = convex_hull_mask(part) & ((owner[sl] == 0) | (owner[sl] == k))
+        hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
         if s.fill == "surface" or (s.fill == "auto" and sub_z is not None):
             hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
@@ -548,23 +583,58 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     step = COARSE_STEP
     lab, sizes, _ = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
-    lab = np.where((sizes >= 2)[lab], lab, 0)
+    big = sizes >= 2
+    big[0] = False
     pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
     gh, gw = lab.shape
+    at = np.flatnonzero(lab)
+    rows, cols = np.divmod(at, gw)
     boxes = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, gh),
               max(sl[1].start - pad, 0), min(sl[1].stop + pad, gw))
-             for sl in ndimage.find_objects(lab) if sl is not None]  # fmt: skip
-    while boxes:  # join overlapping (and abutting) windows on the grid, until each region lies in one window only
-        painted = np.zeros((gh, gw), bool)
-        for r0, r1, c0, c1 in boxes:
-            painted[r0:r1, c0:c1] = True
-        joined = [
-            (sl[0].start, sl[0].stop, sl[1].start, sl[1].stop) for sl in ndimage.find_objects(ndimage.label(painted)[0])
-        ]
-        if len(joined) == len(boxes):
-            break
-        boxes = joined
+             for sl in _boxes(lab.ravel().take(at), rows, cols, big).values()]  # fmt: skip
+    boxes = _join_boxes(boxes)
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
+
+
+def _root(owner: list[int], k: int) -> int:
+    """The root of ``k`` in a union-find forest (paths halved on the way)."""
+    while owner[k] != k:
+        owner[k] = owner[owner[k]]
+        k = owner[k]
+    return k
+
+
+def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int, int]]:
+    """Boxes ``(r0, r1, c0, c1)`` joined until none overlaps or abuts another: each time, the boxes whose
+    painted pixels are 4-connected become their bounding box, ordered by its first pixel in raster order, as
+    the labels of the painted image number them (``ndimage.label`` and ``find_objects``, worked out on the
+    boxes instead of the grid); unchanged (in their own order) once no two join."""
+    while boxes:
+        b = np.array(boxes, np.int64)
+        r0, r1, c0, c1 = b[:, 0], b[:, 1], b[:, 2], b[:, 3]
+        rows_over = (r0[:, None] < r1[None]) & (r0[None] < r1[:, None])
+        rows_touch = (r0[:, None] <= r1[None]) & (r0[None] <= r1[:, None])
+        cols_over = (c0[:, None] < c1[None]) & (c0[None] < c1[:, None])
+        cols_touch = (c0[:, None] <= c1[None]) & (c0[None] <= c1[:, None])
+        i, j = np.nonzero(np.triu((rows_over & cols_touch) | (rows_touch & cols_over), 1))
+        owner = list(range(len(boxes)))
+        for p, q in zip(i.tolist(), j.tolist(), strict=True):
+            rp, rq = _root(owner, p), _root(owner, q)
+            if rp != rq:
+                owner[max(rp, rq)] = min(rp, rq)
+        groups: dict[int, list[int]] = {}
+        for k in range(len(boxes)):
+            groups.setdefault(_root(owner, k), []).append(k)
+        if len(groups) == len(boxes):
+            break
+        joined = []
+        for members in groups.values():
+            m = b[members]
+            top = int(m[:, 0].min())
+            first = (top, int(m[m[:, 0] == top, 2].min()))  # the component's first pixel in raster order
+            joined.append((first, (top, int(m[:, 1].max()), int(m[:, 2].min()), int(m[:, 3].max()))))
+        boxes = [box for _, box in sorted(joined)]
+    return boxes
 
 
 def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
@@ -588,7 +658,9 @@ def _leaf(color: np.ndarray) -> np.ndarray:
     B > R), so hue >= LEAF_HUE is ``60 (G - R) >= (LEAF_HUE - 60) (G - min(R, B))``: integers, independent of
     brightness and saturation."""
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
-    return _green(color) & (60 * (g - r) >= (LEAF_HUE - 60) * (g - np.minimum(r, b)))
+    over = g - np.minimum(r, b)  # the channels cast once for both tests (as _green casts them)
+    green = (g > r) & (g >= b) & (3 * over >= g)
+    return green & (60 * (g - r) >= (LEAF_HUE - 60) * over)
 
 
 #: The least hue (degrees) of a leaf. Leaves of apple and most fruit trees are green of hue about 85-130;
@@ -598,24 +670,23 @@ def _leaf(color: np.ndarray) -> np.ndarray:
 LEAF_HUE = 80
 
 
-def _depth(
-    depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]
-) -> tuple[np.ndarray | None, _Geometry]:
-    """The depth (0 where invalid) and the camera geometry (the principal point defaults to the image
-    centre), or ``(None, ...)`` without usable depth."""
+def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, int]) -> tuple[_Depth | None, _Geometry]:
+    """The depth (:class:`_Depth`: float64 metres, 0 where invalid, window by window) and the camera geometry (the
+    principal point defaults to the image centre), or ``(None, ...)`` without usable depth."""
     none = _Geometry(0.0, shape[0] / 2, shape[1] / 2)
     if depth is None:
         return None, none
     z = np.asarray(depth)
     if z.shape != shape:
         raise InputError(f"depth is {z.shape[1::-1] if z.ndim >= 2 else z.shape}, the colour image {shape[::-1]}")
-    z = np.array(depth_metres(z, "segment: depth"), dtype=np.float64)  # float metres, not raw units; a copy
+    given = depth_metres(z, "segment: depth")  # float metres, not raw units
     size = (getattr(camera, "width", None), getattr(camera, "height", None))
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
-    np.nan_to_num(z, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # in place: no full-frame temporaries
-    np.maximum(z, 0.0, out=z)
-    if not z.any():
+    given = np.ascontiguousarray(given)  # read by flat index window by window (a copy only if strided)
+    valid = np.greater(given, 0.0)  # False for NaN
+    valid &= np.less(given, np.inf)
+    if not valid.any():
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
@@ -627,7 +698,36 @@ def _depth(
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
-    return z, _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+    return _Depth(given, valid), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+
+
+class _Depth:
+    """A depth image as float64 metres with NaN, infinite and non-positive depths 0, converted window by window
+    when read (``depth[window]``, a copy; ``take(flat)``): the values of ``np.nan_to_num(z, nan=0, posinf=0,
+    neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole image, to the bit (-0.0 becomes 0.0
+    there too). The segmenter reads some 250 small windows of a frame: a float64 copy of a 1920x1080 image, 16 MB
+    of fresh pages, cost more than all of them."""
+
+    def __init__(self, given: np.ndarray, valid: np.ndarray) -> None:
+        self.given = given  # float, as handed over
+        self.valid = valid  # (h, w) bool: positive and finite
+        self.shape: tuple[int, int] = (int(given.shape[0]), int(given.shape[1]))
+
+    @classmethod
+    def of(cls, z: np.ndarray) -> _Depth:
+        """A float64 depth already cleaned (0 where invalid)."""
+        return cls(z, z > 0)
+
+    def __getitem__(self, window: tuple[slice, slice]) -> np.ndarray:
+        z = np.array(self.given[window], dtype=np.float64)
+        np.copyto(z, 0.0, where=~self.valid[window])
+        return z
+
+    def take(self, flat: np.ndarray) -> np.ndarray:
+        """The depths at flat (row-major) pixel indices."""
+        z = np.asarray(self.given).ravel().take(flat).astype(np.float64)
+        np.copyto(z, 0.0, where=~self.valid.ravel().take(flat))
+        return z
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
@@ -653,14 +753,21 @@ class _Piece:
     source: int  # a bit set of the colour regions it came from
     hull: float = -1.0
     serial: int = -1  # a number of its own while pieces are merged
+    vertices: tuple[np.ndarray | None] | None = None  # its hull's vertices, once worked out
 
     def __post_init__(self) -> None:
         self.area = int(self.mask.sum())
 
+    def hull_vertices(self) -> np.ndarray | None:
+        """:func:`_hull_vertices` of the mask, worked out once (a merge test, then the reported hull)."""
+        if self.vertices is None:
+            self.vertices = (_hull_vertices(self.mask),)
+        return self.vertices[0]
+
     def hull_area(self) -> float:
         """:func:`_hull_area` of the mask, worked out when first asked for: only pieces near another need it."""
         if self.hull < 0:
-            self.hull = _hull_area(self.mask)
+            self.hull = _hull_area_of(self.hull_vertices(), self.mask)
         return self.hull
 
 
@@ -669,7 +776,7 @@ def _merge(
     s: SegmentSettings,
     color: np.ndarray,
     weak: np.ndarray,
-    depth: np.ndarray | None,
+    depth: _Depth | None,
     geo: _Geometry,
 ) -> list[_Piece]:
     """Join pieces of one convex body (greedy, largest first): the hull of their union, less the green
@@ -699,13 +806,14 @@ def _merge(
                 if (a.source & b.source) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
-                hull = _hull_area(union)
+                vertices = _hull_vertices(union)
+                hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    hull -= float((convex_hull_mask(union) & ~union & _green(color[window])).sum())
+                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
                 ):
-                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial)
+                    pieces[i] = _Piece(window, union, a.source | b.source, hull, serial, (vertices,))
                     serial += 1
                     del pieces[j]
                     merged = True
@@ -717,7 +825,7 @@ def _merge(
 
 
 def _same_surface(
-    a: _Piece, b: _Piece, depth: np.ndarray, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
+    a: _Piece, b: _Piece, depth: _Depth, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
     distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``); None
@@ -805,7 +913,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     seeds[(pieces == 0) | ~region] = 0  # edge pixels and the outside: to the nearest piece
     if not seeds.any():
         return parts
-    _, (ri, ci) = ndimage.distance_transform_edt(seeds == 0, return_indices=True)
+    ri, ci = ndimage.distance_transform_edt(seeds == 0, return_distances=False, return_indices=True)
     grown = np.where(region, np.take(seeds.ravel(), ri * seeds.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
 
@@ -835,7 +943,7 @@ def _centres(
         step = 2
         found = _centres(region[::step, ::step], least / step, waist, loose, coarse=False)
         return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
-    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
     if float(edt.max()) < least:
         return []
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
@@ -935,11 +1043,19 @@ def _dilate(mask: np.ndarray, *, square: bool = False) -> np.ndarray:
     """(h, w) bool: ``ndimage.binary_dilation(mask)`` by the 4-neighbourhood (``square``: the 8-neighbourhood,
     ``structure=np.ones((3, 3))``), from shifted views of the padded mask (scipy's general structuring element
     costs several times more on these small windows)."""
-    p = np.pad(mask, 1)
+    p = _pad1(mask)
     if square:
         rows = p[:-2] | p[1:-1] | p[2:]
         return rows[:, :-2] | rows[:, 1:-1] | rows[:, 2:]
     return p[1:-1, 1:-1] | p[:-2, 1:-1] | p[2:, 1:-1] | p[1:-1, :-2] | p[1:-1, 2:]
+
+
+def _pad1(mask: np.ndarray) -> np.ndarray:
+    """``np.pad(mask, 1)`` of a bool image, written out (np.pad's own work costs more than the copy on these small
+    windows)."""
+    p = np.zeros((mask.shape[0] + 2, mask.shape[1] + 2), bool)
+    p[1:-1, 1:-1] = mask
+    return p
 
 
 def _points(
@@ -1020,7 +1136,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
     times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
     touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
-    edt = ndimage.distance_transform_edt(np.pad(region, 1))[1:-1, 1:-1]
+    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
     cen = np.array(centres, dtype=np.float64)
     deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
     rows, cols = np.nonzero(deep)
@@ -1031,7 +1147,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores = np.zeros(region.shape, np.int32)
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
-    _, (ri, ci) = ndimage.distance_transform_edt(cores == 0, return_indices=True)
+    ri, ci = ndimage.distance_transform_edt(cores == 0, return_distances=False, return_indices=True)
     cells = np.where(region, np.take(cores.ravel(), ri * region.shape[1] + ci), 0)  # flat: faster than 2 indices
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
@@ -1044,16 +1160,15 @@ def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, foca
 
 
 def _steps(z: np.ndarray, jump: float) -> np.ndarray:
-    """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step)."""
+    """(h, w) bool: pixels whose depth differs from a 4-neighbour's by more than ``jump`` (NaN: no step). The
+    neighbours' differences by slices (``np.diff``'s values, without its call's overhead)."""
     edge = np.zeros(z.shape, bool)
-    for axis in (0, 1):
-        step = np.abs(np.diff(z, axis=axis)) > jump  # NaN compares False: no step
-        if axis == 0:
-            edge[:-1] |= step
-            edge[1:] |= step
-        else:
-            edge[:, :-1] |= step
-            edge[:, 1:] |= step
+    step = np.abs(z[1:] - z[:-1]) > jump  # NaN compares False: no step
+    edge[:-1] |= step
+    edge[1:] |= step
+    step = np.abs(z[:, 1:] - z[:, :-1]) > jump
+    edge[:, :-1] |= step
+    edge[:, 1:] |= step
     return edge
 
 
@@ -1062,7 +1177,7 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
     valid = region & (depth > 0)
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
-    _, (ri, ci) = ndimage.distance_transform_edt(~valid, return_indices=True)
+    ri, ci = ndimage.distance_transform_edt(~valid, return_distances=False, return_indices=True)
     filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
     smooth = ndimage.gaussian_filter(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.laplace(smooth)
@@ -1089,12 +1204,13 @@ def _ripe_cores(
     pixels. It is taken as its cores, the pieces of its pixels whose redness averaged over
     :data:`CORE_SMOOTH_PX` pixels reaches ``ripe_median``, each at least the least fruit's disc
     (``min_diameter``); the fruit's skin around them is found again later (the hull, :func:`_round_skin`)."""
-    red = redness(color)
     largest = _largest_area(region, depth, s, focal, z_typical)
     if region.sum() <= largest:
         # one fruit at most: ripe when red over most of it (the test every fruit passes at the end, made
-        # before the region is split and merged: a twig or bark never costs the work on a fruit)
-        return [region] if median(red[region]) >= s.ripe_median else []
+        # before the region is split and merged: a twig or bark never costs the work on a fruit); the redness
+        # of its own pixels alone (per pixel, in the same order: the values of the window's at them)
+        return [region] if median(redness(color[region])) >= s.ripe_median else []
+    red = redness(color)
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
@@ -1112,7 +1228,7 @@ CORE_SMOOTH_PX = 5
 def _round_skin(
     sl: Window,
     hull: np.ndarray,
-    depth: np.ndarray,
+    depth: _Depth,
     color: np.ndarray,
     geo: _Geometry,
     s: SegmentSettings,
@@ -1129,7 +1245,8 @@ def _round_skin(
     does not. When what is reached exceeds the largest fruit's disc (``round_max_diameter``) it is not one
     fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. Returns
     the grown window and mask."""
-    z_part = depth[sl][hull & (depth[sl] > 0)]
+    z_sl = depth[sl]
+    z_part = z_sl[hull & (z_sl > 0)]
     if len(z_part) < 20:
         return sl, hull
     rows, cols = np.nonzero(hull)
@@ -1188,14 +1305,34 @@ def _fruit_sized(
     return area >= np.pi / 4 * diameter_px**2
 
 
-def _least_areas(labels: np.ndarray, n: int, depth: np.ndarray, diameter_px_m: float, z_typical: float) -> np.ndarray:
+def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
     """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
-    regions without depth); ``diameter_px_m`` is the least diameter times the focal length."""
-    valid = (labels > 0) & (depth > 0)
-    count = np.bincount(labels[valid], minlength=n + 1).astype(np.float64)
-    total = np.bincount(labels[valid], weights=depth[valid], minlength=n + 1)
+    regions without depth), from the labels ``1..n`` of a window's region pixels and their depths (in the
+    window's raster order: each mean sums its depths in that order); ``diameter_px_m`` is the least diameter
+    times the focal length."""
+    valid = depth > 0
+    lab = labels[valid]
+    count = np.bincount(lab, minlength=n + 1).astype(np.float64)
+    total = np.bincount(lab, weights=depth[valid], minlength=n + 1)
     z = np.where(count > 0, total / np.maximum(count, 1.0), z_typical)  # the mean: a threshold needs no more
     return np.pi / 4 * (diameter_px_m / z) ** 2
+
+
+def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndarray) -> dict[int, Window]:
+    """The boxes of the labels that ``keep`` marks, as ``ndimage.find_objects`` gives them, from the labels,
+    rows and columns of a window's labelled pixels (scipy's makes a box for every label of the window)."""
+    at = np.flatnonzero(keep.take(labels))
+    if len(at) == 0:
+        return {}
+    lab = labels.take(at)
+    order = np.argsort(lab, kind="stable")
+    lab = lab.take(order)
+    r, c = rows.take(at).take(order), cols.take(at).take(order)
+    first = np.flatnonzero(np.concatenate(([True], lab[1:] != lab[:-1])))
+    r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
+    c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
+    cells = zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)
+    return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in cells}
 
 
 def _elongation(mask: np.ndarray) -> float:
