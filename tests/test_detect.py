@@ -250,3 +250,17 @@ def test_a_leaf_in_front_that_the_mask_covers_is_not_taken_for_the_fruit():
     grey = detect(Frame("grey", color, depth, SMALL_CAM), masks=outline.astype(np.int32), method="raw",
                   settings=registered)  # fmt: skip
     assert grey.detections[0].extraction.points[:, 2].max() < 0.31
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (3, -2), (-7, 5), (200, 0), (0, -150)])
+def test_the_leaf_pixels_of_a_window_are_the_whole_images_moved_and_cut(shift):
+    from symfruit.detect import _leafy
+    from symfruit.extract import shift_labels
+    from symfruit.segment.colour import _leaf
+
+    rng = np.random.default_rng(4)
+    color = rng.integers(0, 256, (120, 160, 3), dtype=np.uint8)
+    whole = shift_labels(_leaf(color), *shift)
+    for window in [(0, 120, 0, 160), (10, 50, 20, 90), (100, 120, 150, 160), (0, 5, 0, 5)]:
+        r0, r1, c0, c1 = window
+        assert np.array_equal(_leafy(color, shift, window), whole[r0:r1, c0:c1])

@@ -20,7 +20,7 @@ from .core.frame import Frame
 from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .errors import InputError, SymfruitError
-from .extract import Extraction, extract, register, shift_labels, trim_labels
+from .extract import Extraction, extract, register, trim_labels
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .methods.registry import get as get_method
@@ -160,15 +160,13 @@ def detect(
     from scipy import ndimage
 
     fruit_px = labels > 0
-    # leaf-green pixels where the depth image sees them (depth pixel (u + du, v + dv) sees colour pixel (u, v))
-    leafy = None if frame.color is None else shift_labels(leaf_green(frame.color), *shift)
     for k, sl in enumerate(ndimage.find_objects(labels), 1):
         if sl is None:
             continue
         mask = np.zeros(labels.shape, bool)
         mask[sl] = labels[sl] == k
         a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame.depth, camera, settings, leafy=leafy)
+        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=shift)
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
@@ -197,9 +195,24 @@ def detect(
     return FrameDetections(frame, detections, timings, source, shift)
 
 
+def _leafy(color: np.ndarray, shift: tuple[int, int], window: tuple[int, int, int, int]) -> np.ndarray:
+    """(r1 - r0, c1 - c0) bool: the leaf-green pixels of the colour image where the depth image's ``window`` sees
+    them (depth pixel ``(u + du, v + dv)`` sees colour pixel ``(u, v)``; none beyond the colour image), worked out
+    on that window alone (the leaf test is per pixel: the same as the whole image's, moved and cut)."""
+    du, dv = shift
+    r0, r1, c0, c1 = window
+    h, w = color.shape[:2]
+    out = np.zeros((r1 - r0, c1 - c0), dtype=bool)
+    a0, a1 = max(r0 - dv, 0), min(r1 - dv, h)
+    b0, b1 = max(c0 - du, 0), min(c1 - du, w)
+    if a0 < a1 and b0 < b1:
+        out[a0 + dv - r0 : a1 + dv - r0, b0 + du - c0 : b1 + du - c0] = leaf_green(color[a0:a1, b0:b1])
+    return out
+
+
 def _extract_window(
     mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings,
-    *, leafy: np.ndarray | None = None,
+    *, color: np.ndarray | None = None, shift: tuple[int, int] = (0, 0),
 ) -> Extraction:  # fmt: skip
     """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test."""
     h, w = mask.shape
@@ -208,8 +221,8 @@ def _extract_window(
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
     window = mask[r0:r1, c0:c1]
     local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
-    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract,
-                 leafy=None if leafy is None else leafy[r0:r1, c0:c1])  # fmt: skip
+    leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     outline = mask.copy()
     if ex.silhouette is not None:
