@@ -136,7 +136,12 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     front, radius : float, metres (NaN when fewer than 10 depths are valid)
     """
     ok = np.isfinite(values) & (values > 0)
-    z = np.sort(values[ok])
+    green = None
+    if leafy is None:
+        z = np.sort(values[ok])
+    else:  # one sort for both: the depths in order and their pixels' leaf flags with them
+        order = np.argsort(values[ok], kind="stable")
+        z, green = values[ok][order], np.asarray(leafy, dtype=bool)[ok][order]
     if len(z) < 10:
         return float("nan"), float("nan")
     half = len(z) // 2
@@ -149,12 +154,12 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
     peak = (mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max())
     i = int(np.flatnonzero(peak)[0])
-    if leafy is not None:
-        green = np.asarray(leafy, dtype=bool)[ok][np.argsort(values[ok], kind="stable")]  # sorted with z
+    if green is not None:
+        leaf = green
 
         def leaf_share(k: int) -> float:
             a, b = np.searchsorted(z, edges[max(k - 1, 0)]), np.searchsorted(z, edges[min(k + 2, n_bins)], "right")
-            return float(green[a:b].mean()) if b - a >= 10 else 0.0
+            return float(leaf[a:b].mean()) if b - a >= 10 else 0.0
 
         if leaf_share(i) >= LEAFY[0]:
             local = (mass >= after) & (mass >= before) & (mass >= 0.1 * mass.max())
