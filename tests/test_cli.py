@@ -518,6 +518,9 @@ def test_scenes_through_a_real_camera_then_table_3_on_them(tmp_path, capsys):
     assert "2 true fruit" in capsys.readouterr().out
 
 
+# with the tests that draw plots (tests/evaluate, tests/season/test_report.py): its `symfruit report` imports
+# matplotlib, half a second of CPU on a worker that would otherwise never import it (pytest-xdist, --dist loadgroup)
+@pytest.mark.xdist_group("evaluate")
 def test_detect_takes_several_recordings(tmp_path, capsys):
     for parent in ("a", "b"):
         shutil.copytree(small_frame(), tmp_path / parent / "frames" / "f1")  # one fruit each
