@@ -288,7 +288,7 @@ def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     status, peak_mb, err = measured_detect(args, timeout=600)
     assert status == 0, err
     assert len(list((tmp_path / "out").glob("*/detections.json"))) == frames
-    assert peak_mb < 400  # measured: about 105 MB for 1 to 500 frames
+    assert 30 < peak_mb < 400  # measured: about 105 MB for 1 to 500 frames
 
 
 def test_a_frame_folder_that_links_out_of_the_output_is_refused_and_recorded(tmp_path):

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from symfruit import Camera
-from symfruit.evaluate.sensorcheck import measure_sphere, model_frame, real_frames, table
+from symfruit.evaluate.sensorcheck import _best_shift, measure_sphere, model_frame, real_frames, table
 
 #: The shared real frames: ``../shared`` beside the clone (CI), or beside the folder of worktrees.
 _ROOT = Path(__file__).resolve().parents[2]
@@ -32,6 +32,33 @@ def test_a_shifted_sphere_with_a_hole_ring_is_measured_as_built():
     assert m["band_px"] == pytest.approx(3.0, abs=1.0)
     assert m["flying"] == 0.0 and m["noise_mm"] < 0.5 and m["mask_no_depth"] < 0.2
     assert "| 1 |" in table([{"frame": "x", "sphere": 1, **m}])
+
+
+def test_the_best_shift_is_the_one_a_loop_over_every_shift_finds():
+    """Every shift's overlap at once (by FFT) against its definition: each shift rolled and counted, the first
+    of equal IoUs kept (dv, then du, from -search), on random masks, shifted copies and empty images."""
+
+    def by_loop(mask, silhouette, search):
+        best = (-1.0, 0, 0)
+        for dv in range(-search, search + 1):
+            for du in range(-search, search + 1):
+                shifted = np.roll(np.roll(mask, dv, axis=0), du, axis=1)
+                iou = float((shifted & silhouette).sum() / max((shifted | silhouette).sum(), 1))
+                if iou > best[0]:
+                    best = (iou, du, dv)
+        return best
+
+    rng = np.random.default_rng(7)
+    for k in range(24):
+        h, w = rng.integers(3, 30, size=2) if k % 3 else rng.integers(2, 8, size=2)
+        mask = rng.random((h, w)) < rng.random()
+        silhouette = rng.random((h, w)) < rng.random()
+        if k % 2:  # a shifted, thinned copy: one clear best shift
+            silhouette = np.roll(mask, (rng.integers(-4, 5), rng.integers(-4, 5)), axis=(0, 1)) & silhouette
+        search = int(rng.integers(0, 7)) if k % 3 else int(max(h, w)) + 1  # beyond the image: rolls wrap round
+        assert _best_shift(mask, silhouette, search) == by_loop(mask, silhouette, search)
+    empty = np.zeros((6, 9), bool)
+    assert _best_shift(empty, empty, 3) == by_loop(empty, empty, 3) == (0.0, -3, -3)
 
 
 @pytest.mark.slow

@@ -224,9 +224,22 @@ def ros_world(ros1, tmp_path_factory):
     finally:
         if node is not None:
             stop(node)
-        rospy.signal_shutdown("tests done")
+        shutdown_rospy(rospy, "tests done")
         master.close()
         mp.undo()
+
+
+def shutdown_rospy(rospy: Any, reason: str) -> None:
+    """``rospy.signal_shutdown``, and the end of its XML-RPC server's thread: rospy closes the server's socket but
+    leaves ``serve_forever`` running, which then polls the closed socket without pause, half a core or more for as
+    long as this process lives (the pytest-xdist worker: the rest of the run)."""
+    from rosgraph.xmlrpc import XmlRpcNode
+
+    nodes = [getattr(h, "__self__", None) for h in rospy.core._shutdown_hooks]
+    servers = [n.server for n in nodes if isinstance(n, XmlRpcNode) and n.server is not None]
+    rospy.signal_shutdown(reason)
+    for server in servers:
+        server.shutdown()  # serve_forever returns at its next poll; rospy's loop around it sees its own shutdown
 
 
 def example_messages(images, stamp, *, color_encoding="rgb8", depth_encoding="16UC1", corrupt=False):

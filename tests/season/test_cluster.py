@@ -226,10 +226,17 @@ def test_a_bag_is_read_by_the_worker_from_its_path_and_indices(tmp_path):
     assert forget("bag") == 1 and forget("bag") == 0  # the bag was opened once and is closed at the end
 
 
-def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(cluster, recording, tmp_path):
+def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(cluster, recording, tmp_path,
+                                                                                 monkeypatch):  # fmt: skip
     """Two recordings that share a name and one that cannot be opened: the cluster's folders, tables and
     errors.json are the serial run's; a task never mixes recordings (three frames of one, chunk 2); --resume
-    (on a local cluster of its own: ``workers=1``) redoes what is missing and keeps each fruit once."""
+    (with ``workers=1``: a local cluster of that many workers, here the module's running one standing in for it,
+    as starting another costs a scheduler and a worker process; ``local_cluster`` itself starts the module's)
+    redoes what is missing and keeps each fruit once."""
+    import contextlib
+
+    from symfruit.season import cluster as cluster_module
+
     a, b = tmp_path / "a" / "rec", tmp_path / "b" / "rec"
     for k in range(3):
         shutil.copytree(recording / f"scene_{k:05d}", a / f"scene_{k:05d}")
@@ -249,6 +256,9 @@ def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(
     errors = json.loads((out / "errors.json").read_text())
     assert errors == json.loads((tmp_path / "serial" / "errors.json").read_text()) and errors["recordings"]
     shutil.rmtree(out / report.recordings[str(a)] / "scene_00001")
+    asked: list[int] = []
+    monkeypatch.setattr(cluster_module, "local_cluster", lambda n: asked.append(n) or contextlib.nullcontext(cluster))
     again = run_distributed(inputs, out, workers=1, chunk=2, method="raw", resume=True, progress=False)
+    assert asked == [1]
     assert again.done == [f"{report.recordings[str(a)]}/scene_00001"] and len(again.skipped) == 3
     assert pq.read_table(out / "detections.parquet").to_pylist() == rows

@@ -46,15 +46,7 @@ def measure_sphere(depth: np.ndarray, mask: np.ndarray, camera: Camera, *, searc
     z_front = float(np.percentile(inside, 5)) if len(inside) else 0.0
     r_m = r_px * z_front / camera.fx
     silhouette = (d > 0) & (d > z_front - 0.02) & (d < z_front + 1.2 * r_m)
-    best = (-1.0, 0, 0)
-    for dv in range(-search, search + 1):
-        shifted_v = np.roll(m, dv, axis=0)
-        for du in range(-search, search + 1):
-            shifted = np.roll(shifted_v, du, axis=1)
-            iou = float((shifted & silhouette).sum() / max((shifted | silhouette).sum(), 1))
-            if iou > best[0]:
-                best = (iou, du, dv)
-    iou, du, dv = best
+    iou, du, dv = _best_shift(m, silhouette, search)
     reg = np.roll(np.roll(m, dv, axis=0), du, axis=1)
     sd = np.where(reg, ndimage.distance_transform_edt(reg), -ndimage.distance_transform_edt(~reg))
     zero = d == 0
@@ -86,6 +78,22 @@ def measure_sphere(depth: np.ndarray, mask: np.ndarray, camera: Camera, *, searc
         "mask_no_depth": float((in_mask == 0).mean()),
         "mask_background": float((in_mask > z_front + 2 * r_m + 0.02).mean()),
     }  # fmt: skip
+
+
+def _best_shift(mask: np.ndarray, silhouette: np.ndarray, search: int) -> tuple[float, int, int]:
+    """``(IoU, du, dv)``: the shift of ``mask`` (``np.roll`` by ``dv`` rows, then ``du`` columns; each within
+    ``search`` pixels) that overlaps ``silhouette`` best, the first of equals in the order dv, then du, from
+    ``-search``. Every shift's overlap at once: a circular cross-correlation of the two (h, w) bool images by FFT,
+    its counts rounded back to the integers they are (below 2**31, far within float64's exact range)."""
+    h, w = mask.shape
+    spectrum = np.fft.rfft2(silhouette.astype(np.float64)) * np.conj(np.fft.rfft2(mask.astype(np.float64)))
+    overlap = np.rint(np.fft.irfft2(spectrum, s=(h, w))).astype(np.int64)  # [dv % h, du % w]
+    shifts = np.arange(-search, search + 1)
+    inter = overlap[np.ix_(shifts % h, shifts % w)]  # (dv, du)
+    union = int(mask.sum()) + int(silhouette.sum()) - inter  # a shift moves the mask's pixels, never drops one
+    iou = inter / np.maximum(union, 1)
+    k = int(np.argmax(iou))  # the first of equals, as a loop over dv, then du, keeping only a larger IoU would
+    return float(iou.flat[k]), int(shifts[k % len(shifts)]), int(shifts[k // len(shifts)])
 
 
 def real_frames(folder: str | Path) -> list[dict[str, Any]]:

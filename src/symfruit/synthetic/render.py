@@ -104,27 +104,32 @@ def render(meshes: list[tuple[np.ndarray, np.ndarray]], camera: Camera, *, max_c
 
 
 def _candidates(idx, side, lo, size, uv, normal, offset, camera, w, cand_pix, cand_z, cand_t) -> None:
-    """Pixels covered by triangles ``idx`` (boxes up to ``side`` pixels) and their exact depths."""
-    du, dv = np.meshgrid(np.arange(side), np.arange(side))
-    du, dv = du.ravel()[None, :], dv.ravel()[None, :]
-    pu = lo[idx, 0, None] + du
-    pv = lo[idx, 1, None] + dv
-    inside = (du < size[idx, 0, None]) & (dv < size[idx, 1, None])
+    """Pixels covered by triangles ``idx`` (boxes up to ``side`` pixels) and their exact depths.
+
+    Each triangle's candidates are the ``side x side`` pixels from its box's corner, ``(t, dv, du)``. An edge
+    function ``(q - p) x (pixel - p)`` is a product depending on the row alone minus one depending on the column
+    alone: each is computed once per row or column and the two broadcast, the same floating-point operations on
+    the same numbers as per pixel."""
+    n, step = len(idx), np.arange(side)
+    pu = lo[idx, 0, None] + step  # (n, side): the columns of each box
+    pv = lo[idx, 1, None] + step  # (n, side): the rows
     a, b, c = uv[idx, 0], uv[idx, 1], uv[idx, 2]
 
     def edge(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-        return (q[:, 0, None] - p[:, 0, None]) * (pv - p[:, 1, None]) - (q[:, 1, None] - p[:, 1, None]) * (
-            pu - p[:, 0, None]
-        )
+        rows = (q[:, 0, None] - p[:, 0, None]) * (pv - p[:, 1, None])
+        cols = (q[:, 1, None] - p[:, 1, None]) * (pu - p[:, 0, None])
+        return (rows[:, :, None] - cols[:, None, :]).reshape(n, side * side)
 
     e0, e1, e2 = edge(a, b), edge(b, c), edge(c, a)
-    # A small tolerance so that pixels exactly on an edge shared by two triangles are not lost.
+    inside = ((step < size[idx, 1, None])[:, :, None] & (step < size[idx, 0, None])[:, None, :]).reshape(n, -1)
+    # Inside: all three edge functions >= 0 or all <= 0, with a small tolerance so that pixels exactly on an edge
+    # shared by two triangles are not lost (the least >= -eps or the largest <= eps; NaN is neither, as before).
     eps = 1e-6
-    inside &= ((e0 >= -eps) & (e1 >= -eps) & (e2 >= -eps)) | ((e0 <= eps) & (e1 <= eps) & (e2 <= eps))
+    inside &= (np.minimum(np.minimum(e0, e1), e2) >= -eps) | (np.maximum(np.maximum(e0, e1), e2) <= eps)
     t_i, k = np.nonzero(inside)
     if len(t_i) == 0:
         return
-    u, v = pu[t_i, k], pv[t_i, k]
+    u, v = pu[t_i, k % side], pv[t_i, k // side]
     tt = idx[t_i]
     ray = camera.rays(u, v)
     denom = np.einsum("ti,ti->t", normal[tt], ray)
