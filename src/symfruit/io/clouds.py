@@ -118,31 +118,28 @@ def _rows(name: str, count: int) -> str:
 
 def read_ply(path: Path) -> np.ndarray:
     """PLY (ascii or binary) through ``plyfile``; every element's row count is checked against the file first."""
-    from plyfile import PlyData, PlyParseError
-
     _, elements = ply_elements(path)
     counts = dict(elements)
     if "vertex" not in counts:
         raise FileFormatError(f"{path}: PLY has no vertex element")
     if counts["vertex"] > MAX_CLOUD_POINTS:
         raise FileFormatError(f"{path}: PLY holds {counts['vertex']:,} vertices; at most {MAX_CLOUD_POINTS:,} are read")
+    return ply_vertices(path)[1]
+
+
+def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
+    """``(PlyData, vertices (n, 3) float64)`` of a PLY file whose element counts were checked against its size
+    (:func:`ply_elements`); a vertex element without ``x``, ``y`` and ``z`` is refused naming what it lacks and what
+    it has."""
+    from plyfile import PlyData, PlyParseError
+
     try:
-        element = PlyData.read(str(path))["vertex"]
+        data = PlyData.read(str(path))
+        element = data["vertex"]
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
         raise FileFormatError(f"{path}: unreadable PLY ({exc})") from None
-    _xyz_properties(path, element)
-    try:
-        return np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
-    except PlyParseError as exc:
-        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
-    except (KeyError, ValueError) as exc:
-        raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
-
-
-def _xyz_properties(path: Path, element: Any) -> None:
-    """Refuse a PLY vertex element without ``x``, ``y`` and ``z``, naming what it lacks and what it has."""
     names = [p.name for p in element.properties]
     missing = [c for c in ("x", "y", "z") if c not in names]
     if missing:
@@ -150,6 +147,12 @@ def _xyz_properties(path: Path, element: Any) -> None:
             f"{path}: PLY vertices lack the {', '.join(missing)} propert"
             f"{'y' if len(missing) == 1 else 'ies'} (they have {', '.join(names) or 'none'})"
         )
+    try:
+        return data, np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
+    except PlyParseError as exc:
+        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
+    except (KeyError, ValueError) as exc:
+        raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
 
 
 _PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4",

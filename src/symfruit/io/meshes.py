@@ -8,7 +8,7 @@ import numpy as np
 
 from ..core.limits import MAX_FACES, MAX_OBJ_BYTES  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
-from .clouds import MAX_CLOUD_POINTS, _xyz_properties, ply_elements
+from .clouds import MAX_CLOUD_POINTS, ply_elements, ply_vertices
 from .text import read_limited
 
 __all__ = ["read_mesh"]
@@ -26,8 +26,6 @@ def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    from plyfile import PlyData, PlyParseError
-
     if not path.is_file():
         raise FileFormatError(f"{path}: no such file")
     _, elements = ply_elements(path)  # every element's count checked against the file size first
@@ -37,20 +35,7 @@ def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     if counts.get("vertex", 0) > MAX_CLOUD_POINTS or counts.get("face", 0) > MAX_FACES:
         raise FileFormatError(f"{path}: mesh of {counts.get('vertex', 0):,} vertices and {counts.get('face', 0):,} "
                               f"faces; at most {MAX_CLOUD_POINTS:,} and {MAX_FACES:,} are read")  # fmt: skip
-    try:
-        data = PlyData.read(str(path))
-        vertex = data["vertex"]
-    except PlyParseError as exc:
-        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
-    except (KeyError, ValueError) as exc:
-        raise FileFormatError(f"{path}: unreadable PLY ({exc})") from None
-    _xyz_properties(path, vertex)
-    try:
-        vertices = np.column_stack([np.asarray(vertex[c], dtype=np.float64) for c in ("x", "y", "z")])
-    except PlyParseError as exc:
-        raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
-    except (KeyError, ValueError) as exc:
-        raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
+    data, vertices = ply_vertices(path)
     if "face" not in data:
         return vertices, None
     face = data["face"]
