@@ -54,10 +54,6 @@ class Surface:
     radius : float, metres
         The mask's equivalent radius (``sqrt(area / pi)``) at ``front``.
     noise : float, metres
-    leafy : (n,) bool, optional
-        Which pixels are leaf green, aligned with ``values``: a peak most of whose pixels are (a leaf in front drawn
-        into the mask) is passed over for the nearest peak behind it that holds a tenth of the largest's pixels
-        and is mostly not (:data:`LEAFY`).
         The depth noise measured in the mask (:func:`depth_noise`).
     apex : (int, int)
         Row and column of the cap's nearest pixel (median-filtered depth).
@@ -130,6 +126,10 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
         The mask's equivalent radius.
     focal : float, pixels
     noise : float, metres
+    leafy : (n,) bool, optional
+        Which pixels are leaf green, aligned with ``values``: a peak most of whose pixels are (a leaf in front drawn
+        into the mask) is passed over for the nearest peak behind it that holds a tenth of the largest's pixels
+        and is mostly not (:data:`LEAFY`).
 
     Returns
     -------

@@ -18,6 +18,7 @@ from scipy.optimize import linear_sum_assignment
 from ..core.box import Box, box_iou, centre_deviation
 from ..core.camera import Camera
 from ..core.frame import Frame
+from ..core.raster import mask_box
 from ..detect import FrameDetections, detect
 from ..errors import SymfruitError
 from ..io.sources import open_source
@@ -54,11 +55,11 @@ class FrameScore:
 def thin_lens(mask: np.ndarray, points: np.ndarray, camera: Camera) -> float:
     """The 2-D thin-lens estimate of a fruit's diameter (metres): the mask's larger extent in pixels times the
     median depth of its points over the focal length (issue 18's reference for a box's lateral sides)."""
-    rows, cols = np.nonzero(mask)
-    if not len(rows) or not len(points):
+    box = mask_box(mask)
+    if box is None or not len(points):
         return float("nan")
-    z = float(np.median(points[:, 2]))
-    return max((np.ptp(cols) + 1) / camera.fx, (np.ptp(rows) + 1) / camera.fy) * z
+    r0, r1, c0, c1 = box
+    return max((c1 - c0) / camera.fx, (r1 - r0) / camera.fy) * float(np.median(points[:, 2]))
 
 
 def match(found: Sequence[Box | None], truth: Sequence[Box], gate: float = 0.03) -> list[tuple[int, int]]:
