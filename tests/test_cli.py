@@ -315,6 +315,17 @@ def test_complete_refuses_an_output_folder_and_prints_a_table(tmp_path, capsys):
     assert f"written    {tmp_path / 'o.ply'} and {tmp_path / 'o.json'}" in out
 
 
+def test_complete_names_the_file_of_a_cloud_it_cannot_use(tmp_path, capsys):
+    rng = np.random.default_rng(0)
+    flat = np.c_[rng.uniform(-0.03, 0.03, (200, 2)), np.full(200, 0.5)]
+    np.save(tmp_path / "flat.npy", flat)
+    np.save(tmp_path / "behind.npy", VISIBLE * [1.0, 1.0, -1.0])
+    assert main(["complete", str(tmp_path / "flat.npy")]) == 2
+    assert f"{tmp_path / 'flat.npy'}: all points lie on a plane" in capsys.readouterr().err
+    assert main(["complete", str(tmp_path / "behind.npy")]) == 2
+    assert f"{tmp_path / 'behind.npy'}: " in capsys.readouterr().err
+
+
 # with the Dask cluster's tests (tests/season/test_cluster.py): the refusal of --workers 0 imports dask.distributed,
 # half a second of CPU on a worker that would otherwise never import it (pytest-xdist, --dist loadgroup)
 @pytest.mark.xdist_group("cluster")

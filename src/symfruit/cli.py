@@ -276,6 +276,7 @@ def _settings_for(args: argparse.Namespace, fruit: str | None = None):
 
 def _complete(args: argparse.Namespace) -> int:
     from .core.camera import DEFAULT_CAMERA
+    from .errors import InputError
     from .io import load_camera, read_cloud
     from .methods.complete import complete
     from .writers import write_result
@@ -287,7 +288,10 @@ def _complete(args: argparse.Namespace) -> int:
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
-    result = complete(points, camera=camera, method=_method(args), settings=settings)
+    try:
+        result = complete(points, camera=camera, method=_method(args), settings=settings)
+    except InputError as exc:  # the cloud's own fault (too few points, flat, behind the camera): name the file
+        raise InputError(f"{args.cloud}: {exc}") from None
     written = None
     if args.output is not None:
         meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}

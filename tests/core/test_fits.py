@@ -280,6 +280,25 @@ def test_every_cone_parameter_is_an_ellipsoid_with_that_outline(offset, tau):
                                cone / np.abs(cone).max(), atol=1e-6)  # fmt: skip
 
 
+def test_cone_fronts_of_a_saturated_shape_parameter_warn_nothing():
+    """A shape parameter beyond about 37 saturates the logistic (lambda = q): those rows have no front, and the
+    fit's trial steps reach it (a square mask in a frame did), so no divide-by-zero warning may leak."""
+    import warnings
+
+    from symfruit.core.fits import _cone_fronts
+
+    centre = np.array([0.0, 0.0, 0.5])
+    cone = -_tangent_cone(centre, np.diag([0.03, 0.03, 0.03]) ** 2)  # signature (+, +, -), negative inside
+    axis = centre / centre[2]
+    rays = np.c_[np.linspace(-0.04, 0.04, 9), np.zeros(9), np.ones(9)]
+    params = np.array([[0.0, 0.0, np.log(0.5), 0.0], [0.0, 0.0, np.log(0.5), 60.0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        fronts, valid = _cone_fronts(params, cone, axis, rays, ((rays @ cone) * rays).sum(axis=1))
+    assert valid.all() and np.isfinite(fronts[0]).any()
+    assert not np.isfinite(fronts[1]).any()
+
+
 @given(st.integers(0, 2**32 - 1))
 def test_cone_fronts_from_the_cone_are_the_ellipsoids_fronts(seed):
     from symfruit.core.agreement import intersect_quadric

@@ -734,8 +734,8 @@ def _cone_fronts(params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: n
     q = -(cm * m).sum(axis=1)
     valid = q > 0
     lam = np.where(valid, q, np.nan) / (1.0 + np.exp(-np.clip(p[:, 3], -50.0, 50.0)))
-    gap = (lam - q)[:, None]  # < 0
-    with np.errstate(invalid="ignore"):
+    gap = (lam - q)[:, None]  # < 0; 0 once the logistic saturates (p[3] above about 37): no front, NaN rows
+    with np.errstate(invalid="ignore", divide="ignore"):
         a = ray_cone[None, :] / lam[:, None] - rcm * rcm / (lam[:, None] * gap)
         b = rcm / gap
         c = -lam[:, None] / gap
