@@ -239,6 +239,13 @@ def test_evaluate_command(tmp_path, capsys, monkeypatch):
     capsys.readouterr()
     assert main(["evaluate", "--pose", "uniform"]) == 2  # the paper protocol has its own poses
     assert "camera protocol" in capsys.readouterr().err
+    assert main(["evaluate", "--views", "3"]) == 2  # the paper protocol's fruit have their own 19 views
+    assert main(["evaluate", "--protocol", "camera", "--views", "0"]) == 2
+    assert "--views must be 1-100000, and more than 1 only with --protocol camera" in capsys.readouterr().err
+    assert main(["evaluate", "--protocol", "camera", "--sensor", "heldback", "--n", "2", "--views", "2", "--methods",
+                 "raw", "--output", str(tmp_path), "--jobs", "1", "--fruit", "plum"]) == 0  # fmt: skip
+    rows = (tmp_path / "latest" / "instances.csv").read_text().splitlines()
+    assert [r.split(",")[3] for r in rows[1:]] == ["0", "0"]  # fruit_index: both views of fruit 0
 
 
 def test_cli_fruit_profile(tmp_path, capsys):

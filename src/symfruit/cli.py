@@ -109,6 +109,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--pose", choices=("hanging", "upright", "uniform"), default="hanging",
                    help="pose distribution: hanging (stem up; scans as in their file), upright (scans stood up "
                    "first), uniform (any orientation; camera protocol)")  # fmt: skip
+    p.add_argument("--views", type=int, default=1,
+                   help="camera protocol, generated kinds: views of each fruit (default 1: every view a new fruit; "
+                   "more rank confidence among one fruit's views, as the scans' views are)")  # fmt: skip
     p.add_argument("--output", type=Path, default=Path("results"), help="results root (default results/)")
     p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
@@ -457,6 +460,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         raise InputError("--n must be between 1 and 100000")
     if args.protocol == "paper" and args.pose == "uniform":
         raise InputError("--pose uniform is for the camera protocol (the paper protocol has its own 19 poses)")
+    if not 1 <= args.views <= 100_000 or (args.views > 1 and args.protocol != "camera"):
+        raise InputError("--views must be 1-100000, and more than 1 only with --protocol camera")
     if not 0 <= args.seed < 2**63:
         raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
     if args.jobs is not None and not 1 <= args.jobs <= 256:
@@ -470,8 +475,9 @@ def _evaluate(args: argparse.Namespace) -> int:
         return _evaluate_frames(args, methods, _settings_for(args, fruit))
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
-        occlusions=occlusions, sensor=args.sensor, poses=args.pose, quick=args.quick, config=args.config,
-        output=args.output, jobs=args.jobs, settings=_plain_settings(args) if args.no_profile else None,
+        occlusions=occlusions, sensor=args.sensor, poses=args.pose, views=args.views, quick=args.quick,
+        config=args.config, output=args.output, jobs=args.jobs,
+        settings=_plain_settings(args) if args.no_profile else None,
     )  # fmt: skip
     print(result.table)
     print(f"results: {result.folder}")

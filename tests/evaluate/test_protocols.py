@@ -49,6 +49,20 @@ def test_specs_enumerate_fruits_poses_and_occlusions():
         specs("lab", "apple", n=1)
 
 
+def test_views_of_one_generated_fruit():
+    camera = specs("camera", "pear", n=6, views=3, sensor="heldback")
+    assert [(s.index, s.pose) for s in camera] == [(0, 0), (0, 1), (0, 2), (1, 3), (1, 4), (1, 5)]
+    a, b, c = (build(s) for s in camera[:2] + camera[3:4])
+    # the same fruit (one shape, its truth surface the same up to pose and place) seen from two views
+    assert a.kind == b.kind and len(a.truth_surface) == len(b.truth_surface)
+    extent = [np.sort(np.linalg.svd(i.truth_surface - i.truth_surface.mean(0), compute_uv=False)) for i in (a, b, c)]
+    assert np.allclose(extent[0], extent[1], rtol=1e-9) and not np.allclose(extent[0], extent[2], rtol=1e-3)
+    assert not np.array_equal(a.visible, b.visible)
+    assert specs("camera", "pear", n=4) == specs("camera", "pear", n=4, views=1)
+    with pytest.raises(ValueError, match="views must be 1-100000"):
+        specs("camera", "pear", n=4, views=0)
+
+
 def test_instances_are_built_from_their_spec_alone():
     spec = Spec("camera", "citrus", 1, 4, 0.0, seed=7)
     a, b = build(spec), build(Spec("camera", "citrus", 1, 4, 0.0, seed=7))

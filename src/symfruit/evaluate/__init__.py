@@ -42,6 +42,7 @@ def evaluate(
     occlusions: Sequence[float] = (0.0,),
     sensor: str = "d435",
     poses: str = "hanging",
+    views: int = 1,
     quick: bool = False,
     settings: Settings | None = None,
     config: Path | None = None,
@@ -55,7 +56,8 @@ def evaluate(
     views per occlusion level (``camera``; default 100). ``sensor`` and ``poses`` choose the camera
     protocol's sensor model and pose distribution (:data:`~symfruit.evaluate.protocols.SENSORS`,
     :data:`~symfruit.evaluate.protocols.POSES`; ``poses="upright"`` also stands scans up in the paper
-    protocol). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
+    protocol); ``views`` how many of a generated fruit's camera views are of one fruit (default 1: every
+    view a fruit of its own). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
     ``output=None`` writes nothing. Tables have a row per fruit kind, and per scan of a scan folder.
 
     Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
@@ -75,7 +77,7 @@ def evaluate(
     rows, all_specs, used = [], [], {}
     for fruit in fruits:
         these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions), sensor=sensor,
-                      poses=poses)  # fmt: skip
+                      poses=poses, views=views)  # fmt: skip
         used[fruit] = settings_for(fruit)
         rows += run(these, methods, used[fruit], jobs=jobs, progress=progress)
         all_specs += these
@@ -107,7 +109,7 @@ def evaluate(
         meta = {
             "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
             "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "sensor": sensor,
-            "poses": poses, "quick": quick,
+            "poses": poses, "views": views, "quick": quick,
             "instances": len(all_specs), "settings": {f: s.to_dict() for f, s in used.items()},
         }  # fmt: skip
         from ..io import write_json

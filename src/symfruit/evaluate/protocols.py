@@ -153,11 +153,15 @@ class Instance:
 
 def specs(
     protocol: str, fruit: str, *, n: int, seed: int = 0, angles: tuple[int, ...] = PAPER_ANGLES,
-    occlusions: tuple[float, ...] = (0.0,), sensor: str = "d435", poses: str = "hanging",
+    occlusions: tuple[float, ...] = (0.0,), sensor: str = "d435", poses: str = "hanging", views: int = 1,
 ) -> list[Spec]:  # fmt: skip
     """All instance specs of a protocol: ``n`` fruits x the 19 poses (paper) or ``n`` views per
-    occlusion level (camera; the views of a scan folder go round its scans); for a scan folder, the
-    paper protocol's ``n`` is capped by the number of scans."""
+    occlusion level (camera; the views of a scan folder go round its scans, and a generated kind's go
+    ``views`` to a fruit: ``n // views`` fruits, each seen from ``views`` poses and distances, so that
+    confidence can be ranked among one fruit's views as on the scans); for a scan folder, the paper
+    protocol's ``n`` is capped by the number of scans."""
+    if not 1 <= views <= 100_000:
+        raise ValueError(f"views must be 1-100000 views a fruit, got {views}")
     if protocol == "paper":
         if fruit not in FRUITS:
             n = min(n, len(_scans(fruit)))
@@ -165,8 +169,8 @@ def specs(
                 for a in angles]  # fmt: skip
     if protocol == "camera":
         count = len(_scans(fruit)) if fruit not in FRUITS else None
-        return [Spec("camera", fruit, i % count if count else i, i, occ, seed, sensor, poses) for occ in occlusions
-                for i in range(n)]  # fmt: skip
+        return [Spec("camera", fruit, i % count if count else i // views, i, occ, seed, sensor, poses)
+                for occ in occlusions for i in range(n)]  # fmt: skip
     raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
 
 
