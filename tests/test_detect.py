@@ -52,6 +52,13 @@ def test_a_mask_over_the_whole_image_and_empty_depth_are_refused(example):
     empty = replace(example, depth=np.zeros_like(example.depth))
     with pytest.raises(InputError, match="no valid depth"):
         detect(empty)
+    # a depth_scale of 0.02 for millimetres: every depth 20 times too far, refused before the segmenter sees it
+    far = replace(example, depth=example.depth * 20.0)
+    median = float(np.median(far.depth[far.depth > 0]))
+    with pytest.raises(
+        InputError, match=rf"no depth within extraction's range 0.1-3 m .* median depth is {median:.3g} m"
+    ):
+        detect(far)
 
 
 def test_a_fruit_without_depth_is_reported_not_fatal(example):

@@ -108,6 +108,19 @@ def frame_masks(
     return instance_labels(labels, f"frame {frame.name}: masks ({source})"), source
 
 
+def _check_depth_range(frame: Frame, near: float, far: float) -> None:
+    """Refuse a frame whose depth holds nothing extraction could use: no depth at all, or none within its range
+    (a wrong ``depth_scale`` puts a whole frame 10 or 1000 times too far or too near)."""
+    depth = frame.depth
+    if not (depth > 0).any():
+        raise InputError(f"frame {frame.name}: the depth image holds no valid depth")
+    if not ((depth >= near) & (depth <= far)).any():
+        median = float(np.median(depth[depth > 0]))
+        raise InputError(f"frame {frame.name}: no depth within extraction's range {near:g}-{far:g} m "
+                         f"(extract.min_depth, extract.max_depth; the image's median depth is {median:.3g} m): is the "
+                         "frame's depth_scale right (metres per unit: 0.001 for millimetres)?")  # fmt: skip
+
+
 def detect(
     frame: Frame,
     *,
@@ -127,10 +140,9 @@ def detect(
     settings = settings or Settings()
     get_method(method)  # an unknown method is refused before any work, not reported once per fruit
     t0, cpu0 = time.perf_counter(), time.thread_time()
+    _check_depth_range(frame, settings.extract.min_depth, settings.extract.max_depth)
     labels, source = frame_masks(frame, masks, settings)
     t1 = time.perf_counter()
-    if not (frame.depth > 0).any():
-        raise InputError(f"frame {frame.name}: the depth image holds no valid depth")
     if labels.size and labels.min() < 0:
         raise InputError(f"frame {frame.name}: masks hold negative labels")
     if labels.size and int(labels.max()) > MAX_FRUIT_PER_FRAME:  # sparse ids: number them 1..k first
