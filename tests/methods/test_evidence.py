@@ -266,26 +266,6 @@ def test_a_fruit_pointing_at_the_camera_is_less_confident_than_one_seen_from_the
     assert a.extras["uncertainty"] > 3 * b.extras["uncertainty"] and not a.reliable
 
 
-def test_the_elongation_along_the_line_of_sight_scales_the_uncertainty():
-    """A ball shows half its width in depth (the factor stays 1); the tapering fruit seen tip first shows its
-    80 mm of seen depth through a 50 mm silhouette (about 3); seen from the side, no more than a ball."""
-    from symfruit.synthetic.shapes import _revolve
-
-    s = np.linspace(0.0, 0.08, 60)
-    t = np.linspace(0.0, np.pi / 2, 30)[1:]
-    mesh = _revolve(np.r_[0.025 * np.sqrt(s / 0.08), 0.025 * np.cos(t)], np.r_[s, 0.08 + 0.025 * np.sin(t)] - 0.05,
-                    name="cone", n_phi=96)  # fmt: skip
-    tip, _ = rendered_view(mesh, [0.0, 0.0, 0.4], noise=0.01, rotation=rotation(90, 0, 0), seed=1)
-    side, _ = rendered_view(mesh, [0.0, 0.0, 0.4], noise=0.01, seed=1)
-    ball, _ = rendered_view(ball_mesh(0.03), [0.02, -0.01, 0.4], noise=0.01, seed=4)
-    off = Settings().replace(evidence={"sight_elongation": False})
-    for view, low, high in ((ball, 1.0, 1.0), (side, 1.0, 1.0), (tip, 2.5, 3.5)):
-        on, without = complete(view), complete(view, settings=off)
-        assert low <= on.extras["sight_elongation"] <= high and without.extras["sight_elongation"] == 1.0
-        assert on.extras["uncertainty"] == pytest.approx(without.extras["uncertainty"] * on.extras["sight_elongation"])
-        assert np.array_equal(on.box.min, without.box.min) and np.array_equal(on.box.max, without.box.max)
-
-
 def test_completed_points_are_the_seen_and_their_mirror_images_through_the_box_centre():
     """Written column by column: the same values as ``np.vstack([points, 2 centre - points])``, to the bit."""
     visible, _ = rendered_view(ball_mesh(0.03), [0.02, -0.01, 0.4], noise=0.01, seed=4)

@@ -34,8 +34,7 @@ completion is right for every fruit, and the view itself says which ones fit. Th
 7. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
    own noise, the candidates' disagreement, what no candidate explains, how far the prior moved the
    back face from the shapes' (half of it, as the centre moves) and how far the fruit recedes along the
-   line of sight, all scaled by the fruit's elongation in the image (the outline's) and along the line of
-   sight (how much deeper than a round fruit's the seen depth runs), and reports
+   line of sight, all scaled by the outline's elongation, and reports
    ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
@@ -62,11 +61,6 @@ from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
-
-#: The share of a view's depths left out at each end when the seen depth range is measured for the elongation
-#: along the line of sight (noise puts a few points millimetres beyond the surface; the 2nd-98th percentiles of
-#: a round fruit's view span about half its width, as the fruit's front does).
-SIGHT_TRIM = 0.02
 
 __all__ = ["Combined", "EvidenceSettings", "clean_share", "combine", "fuse_depth"]
 
@@ -170,19 +164,10 @@ class EvidenceSettings(Section):
         front of its rim; a fruit receding along the line of sight, a pear or banana pointing at the camera,
         has a back that nothing seen mirrors); ``elongation`` the square root of the silhouette's major over
         minor width (an elongated outline leaves the tilt of the long axis out of the image unseen, and
-        every error above grows with it); with ``sight_elongation``, on a depth camera's view ``u`` is also
-        multiplied by the fruit's elongation along the line of sight, ``max(1, 2 d / width)``: ``d`` the seen
-        depth range (its 2nd to 98th percentile, :data:`SIGHT_TRIM`, so that a few noisy points do not set it)
-        and ``width`` the silhouette's, as the prior measures it (a round fruit shows about half its width in
-        depth: over the generated kinds' heldback views the median of ``2 d / width`` is 0.94-0.99; a fruit
-        pointing at the camera shows more, and the back that nothing seen mirrors is the less certain).
-        ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when
+        every error above grows with it). ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when
         ``u <= reliable_uncertainty``. Issue 18's block jackknife of the ``cone`` fit's back face (angular
         sectors of the seen depths, or of the outline, left out) was measured and predicts nothing on the
         real scans (docs/ablation.md).
-    sight_elongation : bool
-        Scale ``u`` by the elongation along the line of sight (above; docs/ablation.md, "Confidence among one
-        fruit's views").
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
@@ -223,7 +208,6 @@ class EvidenceSettings(Section):
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
     recede_scale: float = setting(0.1, ge=0.0, le=100.0)
-    sight_elongation: bool = setting(True)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     occluded_px: int = setting(4, ge=0, le=50)
@@ -485,12 +469,7 @@ def evidence(
     # sparse cloud's points need not end at the rim: no receding measure there.)
     recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width) if dense else 0.0
     elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
-    sight = 1.0
-    if s.sight_elongation and dense and width > 0:  # a sparse cloud's points need not end at the rim either
-        near, far = np.quantile(points[:, 2], (SIGHT_TRIM, 1.0 - SIGHT_TRIM))
-        sight = max(1.0, 2.0 * float(far - near) / width)
-    core = float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2))
-    uncertainty = elongation * sight * core
+    uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2))
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
         "confidence": confidence,
@@ -498,7 +477,6 @@ def evidence(
         "uncertainty": uncertainty,
         "recede": recede,
         "elongation": elongation,
-        "sight_elongation": sight,
         "back_sd": back_sd,
         "rim": rim,
         "width": width,
