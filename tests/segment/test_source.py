@@ -60,6 +60,36 @@ def test_a_coco_file_gives_each_image_its_annotations_by_name(photo, tmp_path):
     assert labels.max() == 1 and labels[25, 25] == 1 and labels[60, 60] == 0
 
 
+def test_a_coco_file_of_a_recording_gives_each_frame_its_own_image(photo, tmp_path):
+    """One COCO file for several frames: each frame its own image's masks, by the frame folder's name (the image's
+    file name or folder); a frame it holds no image of is refused, never given another frame's masks."""
+    from symfruit import FileFormatError
+
+    color, _ = photo
+    h, w = color.shape[:2]
+    square = [[10, 10, 40, 10, 40, 40, 10, 40]]
+    coco = {"images": [{"id": 1, "file_name": "capture_1/color.png", "width": w, "height": h},
+                       {"id": 2, "file_name": "capture_2.png", "width": w, "height": h}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1, "segmentation": square},
+                            {"id": 2, "image_id": 2, "category_id": 1, "segmentation": [[60, 60, 90, 60, 90, 90]]},
+                            {"id": 3, "image_id": 2, "category_id": 1, "segmentation": square}]}  # fmt: skip
+    (tmp_path / "all.json").write_text(json.dumps(coco))
+    source = mask_source(tmp_path / "all.json")
+    first, word = source(color, name="capture_1")
+    assert word == str(tmp_path / "all.json") and first.max() == 1 and first[25, 25] == 1 and first[65, 80] == 0
+    second, _ = source(color, name="capture_2")
+    assert second.max() == 2 and second[25, 25] == 2 and second[65, 80] == 1
+    with pytest.raises(FileFormatError, match=r"no image for frame 'capture_3' among its 2 images"):
+        source(color, name="capture_3")
+    coco["images"][1]["file_name"] = "capture_1.png"  # two images would fit frame capture_1
+    (tmp_path / "two.json").write_text(json.dumps(coco))
+    with pytest.raises(FileFormatError, match=r"2 images \('capture_1.png', 'capture_1/color.png'\) for frame"):
+        mask_source(tmp_path / "two.json")(color, name="capture_1")
+    coco["images"], coco["annotations"] = coco["images"][:1], coco["annotations"][:1]  # one image: any frame's
+    (tmp_path / "one.json").write_text(json.dumps(coco))
+    assert mask_source(tmp_path / "one.json")(color, name="elsewhere")[0][25, 25] == 1
+
+
 def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):
     with pytest.raises(InputError, match="expected color, maskrcnn:CHECKPOINT"):
         mask_source("auto", images=[tmp_path / "a.jpg"])  # `auto` is a frame's word only

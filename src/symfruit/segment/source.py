@@ -7,7 +7,10 @@ torchvision Mask R-CNN, extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segme
 ``onnx``), or files:
 
 * for a frame: a label PNG or COCO JSON holding that frame's masks, or a frame folder with ``masks.png`` /
-  ``masks.json`` (:func:`symfruit.io.masks.read_masks`, read for every frame);
+  ``masks.json`` (:func:`symfruit.io.masks.read_masks`, read for every frame); a COCO JSON of several images
+  (one file for a recording's frames) gives each frame the image whose file name, or whose folder, is the
+  frame's name (``frame_0007.png`` or ``frame_0007/color.png`` for the frame folder ``frame_0007``), read once
+  and refused for a frame it holds no image of, never another frame's masks;
 * for a set of image files (``images`` given): a COCO JSON (each image's annotations, by file name), a
   folder of label PNGs (``<stem>.png``), or one label PNG for one image; ``auto`` is a frame's word only.
   Files are checked here, before any image.
@@ -97,8 +100,50 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
     if images is None:
         from ..io.masks import read_masks
 
+        several = _coco_of_several_images(Path(text))
+        if several is not None:
+            return several
         return MaskSource(text, lambda color, depth, camera, name, own: (read_masks(spec, color.shape[:2]), text))
     return _image_files(text, images)
+
+
+def _coco_of_several_images(path: Path) -> MaskSource | None:
+    """For frames: a COCO JSON whose ``images`` list names more than one image, as a source that finds each
+    frame's image by the frame's name (None for any other file: one image, or annotations without images)."""
+    if path.suffix.lower() != ".json" or not path.is_file():
+        return None
+    from ..core.limits import MAX_COCO_BYTES
+    from ..io.masks import read_coco
+    from ..io.text import read_structured
+
+    try:
+        data = read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES)
+    except FileFormatError:
+        return None  # read_masks says what is wrong with it, for the first frame
+    if not (isinstance(data, dict) and isinstance(data.get("images"), list) and len(data["images"]) > 1):
+        return None
+    coco = read_coco(path)
+    by_frame: dict[str, list[str]] = {}
+    for entry in coco.entries():
+        file_name = str(entry["file_name"]).replace("\\", "/")
+        stem, folder = Path(file_name).stem, Path(file_name).parent.name
+        for key in {stem, folder} - {""}:
+            by_frame.setdefault(key, []).append(entry["file_name"])
+
+    def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+        found = by_frame.get(Path(name).stem, []) if name else []
+        if len(found) != 1:
+            some = ", ".join(repr(e["file_name"]) for e in coco.entries()[:3])
+            why = "no image" if not found else f"{len(found)} images ({', '.join(map(repr, found[:3]))})"
+            raise FileFormatError(f"{path}: {why} for frame {name!r} among its {len(coco.entries())} images (an "
+                                  "image's file name or folder is matched to the frame's name; they are "
+                                  f"{some}, ...)")  # fmt: skip
+        labels = np.zeros(color.shape[:2], np.int32)
+        for k, m in enumerate(coco.instances(found[0], color.shape[:2], category=None), 1):
+            labels[m] = k
+        return labels, str(path)
+
+    return MaskSource(str(path), from_coco)
 
 
 def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
