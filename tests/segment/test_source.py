@@ -90,6 +90,25 @@ def test_a_coco_file_of_a_recording_gives_each_frame_its_own_image(photo, tmp_pa
     assert mask_source(tmp_path / "one.json")(color, name="elsewhere")[0][25, 25] == 1
 
 
+def test_a_folder_of_each_frames_masks(photo, tmp_path):
+    from symfruit import FileFormatError
+
+    color, _ = photo
+    labels = np.zeros(color.shape[:2], np.uint16)
+    labels[5:50, 5:50] = 3
+    Image.fromarray(labels).save(tmp_path / "frame_1.png")
+    (tmp_path / "frame_2").mkdir()
+    Image.fromarray(labels * 2).save(tmp_path / "frame_2" / "masks.png")
+    source = mask_source(tmp_path)
+    got, word = source(color, name="frame_1")
+    assert np.array_equal(got, labels) and word == str(tmp_path / "frame_1.png")
+    assert np.array_equal(source(color, name="frame_2")[0], labels * 2)
+    with pytest.raises(FileFormatError, match=r"no masks for frame 'frame_3' \(frame_3.png, or frame_3/masks.png"):
+        source(color, name="frame_3")
+    Image.fromarray(labels).save(tmp_path / "masks.png")  # a frame folder's own masks file: every frame's
+    assert np.array_equal(mask_source(tmp_path)(color, name="frame_2")[0], labels)
+
+
 def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):
     with pytest.raises(InputError, match="expected color, maskrcnn:CHECKPOINT"):
         mask_source("auto", images=[tmp_path / "a.jpg"])  # `auto` is a frame's word only

@@ -10,7 +10,8 @@ torchvision Mask R-CNN, extra ``seg``), ``"onnx:MODEL"`` (an ONNX instance-segme
   ``masks.json`` (:func:`symfruit.io.masks.read_masks`, read for every frame); a COCO JSON of several images
   (one file for a recording's frames) gives each frame the image whose file name, or whose folder, is the
   frame's name (``frame_0007.png`` or ``frame_0007/color.png`` for the frame folder ``frame_0007``), read once
-  and refused for a frame it holds no image of, never another frame's masks;
+  and refused for a frame it holds no image of, never another frame's masks; a folder without masks files of
+  its own holds each frame's as ``<frame>.png`` or ``<frame>/masks.png`` (or ``.json``);
 * for a set of image files (``images`` given): a COCO JSON (each image's annotations, by file name), a
   folder of label PNGs (``<stem>.png``), or one label PNG for one image; ``auto`` is a frame's word only.
   Files are checked here, before any image.
@@ -100,7 +101,7 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
     if images is None:
         from ..io.masks import read_masks
 
-        several = _coco_of_several_images(Path(text))
+        several = _coco_of_several_images(Path(text)) or _frames_folder(Path(text))
         if several is not None:
             return several
         return MaskSource(text, lambda color, depth, camera, name, own: (read_masks(spec, color.shape[:2]), text))
@@ -144,6 +145,24 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
         return labels, str(path)
 
     return MaskSource(str(path), from_coco)
+
+
+def _frames_folder(folder: Path) -> MaskSource | None:
+    """For frames: a folder without ``masks.png`` / ``masks.json`` of its own, holding each frame's masks as
+    ``<frame>.png`` or ``<frame>/masks.png`` / ``masks.json`` (None for anything else)."""
+    if not folder.is_dir() or (folder / "masks.png").is_file() or (folder / "masks.json").is_file():
+        return None
+    from ..io.masks import read_masks
+
+    def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+        stem = Path(name).stem
+        for path in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json"):
+            if stem and path.is_file():
+                return read_masks(path, color.shape[:2]), str(path)
+        raise FileFormatError(f"{folder}: no masks for frame {name!r} ({stem}.png, or {stem}/masks.png or "
+                              f"{stem}/masks.json)")  # fmt: skip
+
+    return MaskSource(str(folder), per_frame)
 
 
 def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
