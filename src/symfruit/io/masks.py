@@ -26,7 +26,7 @@ MAX_INSTANCES_PER_IMAGE = MAX_INSTANCES
 MAX_POLYGON_POINTS = 100_000
 MAX_RLE_RUNS = 10_000_000
 
-__all__ = ["CocoSet", "coco_masks", "read_coco", "read_masks", "rle_decode"]
+__all__ = ["CocoSet", "coco_from_data", "coco_masks", "read_coco", "read_masks", "rle_decode"]
 
 
 def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
@@ -253,7 +253,11 @@ def read_coco(path: str | Path) -> CocoSet:
         When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists.
     """
     path = Path(path)
-    data = read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES)
+    return coco_from_data(path, read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES))
+
+
+def coco_from_data(path: Path, data: Any) -> CocoSet:
+    """:func:`read_coco` of a file already parsed (``data``); errors name ``path``."""
     if (
         not isinstance(data, dict)
         or not isinstance(data.get("images"), list)

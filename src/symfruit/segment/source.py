@@ -114,7 +114,7 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
     if path.suffix.lower() != ".json" or not path.is_file():
         return None
     from ..core.limits import MAX_COCO_BYTES
-    from ..io.masks import read_coco
+    from ..io.masks import coco_from_data
     from ..io.text import read_structured
 
     try:
@@ -123,7 +123,7 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
         return None  # read_masks says what is wrong with it, for the first frame
     if not (isinstance(data, dict) and isinstance(data.get("images"), list) and len(data["images"]) > 1):
         return None
-    coco = read_coco(path)
+    coco = coco_from_data(path, data)
     by_frame: dict[str, list[str]] = {}
     for entry in coco.entries():
         file_name = str(entry["file_name"]).replace("\\", "/")
