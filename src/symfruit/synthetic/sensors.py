@@ -380,7 +380,8 @@ def apply_sensor(
         far = np.where(valid, out, np.inf)
         if model.fatten_px > 0:
             near = ndimage.minimum_filter(far, size=2 * model.fatten_px + 1, mode="nearest")
-            spread = np.isfinite(near) & (far - near > model.edge_step)
+            with np.errstate(invalid="ignore"):  # inf - inf where neither nor a neighbour has depth: no spread
+                spread = np.isfinite(near) & (far - near > model.edge_step)
             out[spread] = near[spread]
             valid |= spread
         valid &= ~_shadow(np.where(valid, out, 0.0), f_d * model.baseline)
