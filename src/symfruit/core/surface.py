@@ -341,7 +341,8 @@ class _Outline:
     inside: np.ndarray
     band: float
     #: ``inside`` padded by ``pad`` pixels of ``-reach`` (flattened), made once per ``(pad, reach)``; under
-    #: ``("keys", pad, reach)`` the same for its whole-number keys (:meth:`keys`), None when it has none.
+    #: ``("keys", pad, reach)`` the same for its whole-number keys (:meth:`keys`), None when it has none; under
+    #: ``("table", pad, reach)`` the value of each key (:meth:`_table`)
     _padded: dict[tuple, np.ndarray | None] = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def _at(self, shifts: np.ndarray, reach: int) -> tuple[np.ndarray, int]:
@@ -391,12 +392,14 @@ class _Outline:
         order (one sort, 3-4x faster than the partition) instead of in the partition's order: the same number
         to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way)."""
         at, pad = self._at(shifts, reach)
+        keys = self.keys(pad, reach)
+        if not exact and keys is not None:
+            return self._nearest_mean(np.sort(np.take(keys, at), axis=1), pad, reach, trim)
         val = np.take(self._flat(pad, reach), at)
         # the cap's outline lies a band inside the mask's outline (grazing pixels without depth): the band is
         # the median distance, within 0 to 0.3 radii, and the cost the trimmed mean deviation from it
         n = val.shape[1]
         middle = [(n - 1) // 2, n // 2]  # np.median's two middle places (one place when n is odd)
-        keys = self.keys(pad, reach)
         if keys is not None:  # the middle keys of each row, and their distances back (the same values)
             k = np.sort(np.take(keys, at), axis=1)[:, middle]
             mid = np.sign(k) * np.sqrt(np.abs(k).astype(np.float64))
@@ -409,6 +412,45 @@ class _Outline:
         if not exact:
             return np.sort(dev, axis=1)[:, :keep].mean(axis=1)
         return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
+
+    def _nearest_mean(self, ordered: np.ndarray, pad: int, reach: int, trim: float) -> np.ndarray:
+        """:meth:`cost`'s ``exact=False`` from each row's keys in ascending order (:meth:`keys`), without the
+        distances' sort: the same deviations, summed in another order.
+
+        The keys in order are the values in order (each value comes back exactly from its key, by a table). The
+        ``keep`` values nearest the band (the smallest deviations) are a run of them: it starts at the number of
+        places ``i`` where the run ``[i, i + keep)`` comes nearer by dropping value ``i`` for value ``i + keep``
+        (``b - v[i] > v[i + keep] - b``; those places are a prefix, the differences being monotone in ``v``
+        as rounded too), the run the usual search for the ``keep`` values nearest ``b`` ends in. Ties swap
+        equal deviations: the run's deviations are the ``keep`` smallest, as a multiset."""
+        v = np.take(self._table(pad, reach), ordered, mode="wrap")  # a negative key wraps to the table's end
+        k, n = v.shape
+        mid = v[:, [(n - 1) // 2, n // 2]]  # np.median's two middle places, as in cost()
+        median = 0.5 * (mid[:, 0] + mid[:, 1]) if n % 2 == 0 else mid[:, 1]
+        band = np.clip(median[:, None], 0.0, self.band)
+        keep = max(1, int(trim * n))
+        if keep < n:
+            start = np.count_nonzero(np.subtract(band, v[:, : n - keep]) > np.subtract(v[:, keep:], band), axis=1)
+        else:
+            start = np.zeros(k, dtype=np.intp)
+        run = np.take(v.ravel(), (np.arange(k) * n + start)[:, None] + np.arange(keep)[None, :])
+        return np.abs(np.subtract(run, band, out=run), out=run).mean(axis=1)
+
+    def _table(self, pad: int, reach: int) -> np.ndarray:
+        """The value of every key of :meth:`keys` (``sign * sqrt(|key|)``), indexed by the key itself, negative keys
+        from the end (``np.take(..., mode="wrap")``)."""
+        key = ("table", pad, int(reach))
+        found = self._padded.get(key)
+        if found is None:
+            keys = self.keys(pad, reach)
+            assert keys is not None  # only called when the map has keys
+            top, low = max(int(keys.max()), 0), min(int(keys.min()), 0)
+            found = np.empty(top + 1 - low)
+            found[: top + 1] = np.sqrt(np.arange(top + 1, dtype=np.float64))
+            if low < 0:
+                found[top + 1 :] = -np.sqrt(-np.arange(low, 0, dtype=np.float64))
+            self._padded[key] = found
+        return found
 
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
