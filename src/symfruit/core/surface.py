@@ -27,7 +27,7 @@ import numpy as np
 from scipy import ndimage
 
 from .points import median
-from .raster import fill_holes, inner_distance, interior, mask_box, principal_widths
+from .raster import eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
 
 __all__ = [
     "Surface",
@@ -315,7 +315,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     if not near.any():
         return None
     # the erosion treats pixels beyond the array as background, as the window's pixels beyond the box are
-    core = ndimage.binary_erosion(own, iterations=max(1, int(0.15 * radius_px))) & near[box]
+    core = eroded(own, max(1, int(0.15 * radius_px))) & near[box]
     if core.any():
         rows, cols = np.nonzero(core)
         rows, cols = rows + r0, cols + c0
