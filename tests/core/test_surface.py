@@ -455,3 +455,13 @@ def test_the_fast_cost_sums_the_deviations_the_sort_would_keep(seed, top, trim):
     band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, outline.band)
     former = np.sort(np.abs(val - band), axis=1)[:, : max(1, int(trim * n))].mean(axis=1)
     np.testing.assert_allclose(outline.cost(shifts, reach, trim, exact=False), former, rtol=1e-13, atol=0.0)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 6000), st.sampled_from([1, 3, 72, 10**6]))
+def test_the_stable_order_is_numpys_stable_argsort(seed, n, span):
+    # distinct keys made of the key and the position, sorted as values: the same permutation, ties in order
+    from symfruit.core.surface import _stable_order
+
+    rng = np.random.default_rng(seed)
+    key = rng.integers(0, span, n) * 5001 + rng.integers(0, rng.integers(1, 5000), n)
+    np.testing.assert_array_equal(_stable_order(key), np.argsort(key, kind="stable"))

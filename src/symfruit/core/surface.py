@@ -221,7 +221,7 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
     # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
     d2 = dy * dy + dx * dx
-    order = np.argsort(sector * (int(d2.max()) + 1) + d2, kind="stable")
+    order = _stable_order(sector * (int(d2.max()) + 1) + d2)
     at = (rows * keep.shape[1] + cols)[order]  # flat indices: np.take is faster than two index arrays
     z, sec = np.take(np.ascontiguousarray(depth).ravel(), at).astype(np.float64), sector[order]
     # a running maximum per sector: offset each sector above every earlier one, accumulate, take it back off
@@ -233,6 +233,17 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     ok = fell == before
     out.ravel()[at[ok]] = True
     return out
+
+
+def _stable_order(key: np.ndarray) -> np.ndarray:
+    """``np.argsort(key, kind="stable")`` of non-negative whole numbers (int64): the keys made distinct as ``key * n +
+    position`` (ties in their positions' order), sorted as values and the positions read back, when that fits in
+    64 bits and there are enough of them: numpy sorts int64 values faster than it sorts them stably by index
+    (a fruit's 2,000-7,000 pixels: 20-25 % less; 20,000 random keys: a tenth), not below a thousand."""
+    n = len(key)
+    if n < 1024 or int(key.max()) >= (2**62 - n) // n:
+        return np.argsort(key, kind="stable")
+    return np.sort(key * n + np.arange(n)) % n
 
 
 def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: int) -> np.ndarray:
