@@ -483,7 +483,8 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
 
 def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
                        trim: float = 0.7, gain: float = 0.25,
-                       depth_range: tuple[float, float] = (0.0, np.inf)) -> tuple[int, int]:  # fmt: skip
+                       depth_range: tuple[float, float] = (0.0, np.inf),
+                       boxes: list[tuple[slice, slice] | None] | None = None) -> tuple[int, int]:  # fmt: skip
     """``(du, dv)``, pixels: how far the depth image sits from the masks (depth pixel ``(u + du, v + dv)`` sees
     what colour pixel ``(u, v)`` sees); ``(0, 0)`` when the masks do not say.
 
@@ -506,12 +507,14 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
         The search radius (0: no search).
     depth_range : (float, float), metres
         Depth outside it is none.
+    boxes : list of (slice, slice) or None, optional
+        ``ndimage.find_objects(labels)`` when the caller has it.
     """
     if max_px <= 0:
         return 0, 0
     lo, hi = depth_range
     outlines = []
-    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+    for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
         if sl is None:
             continue
         r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
