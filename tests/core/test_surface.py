@@ -465,3 +465,51 @@ def test_the_stable_order_is_numpys_stable_argsort(seed, n, span):
     rng = np.random.default_rng(seed)
     key = rng.integers(0, span, n) * 5001 + rng.integers(0, rng.integers(1, 5000), n)
     np.testing.assert_array_equal(_stable_order(key), np.argsort(key, kind="stable"))
+
+
+def _fruit_depth_as_before(values, radius_px, focal, *, noise=0.001, leafy=None):
+    """fruit_depth as it was: the leaf flags carried through a stable argsort of the depths."""
+    from symfruit.core.surface import LEAFY, _sorted_histogram, _sorted_quantile
+
+    ok = np.isfinite(values) & (values > 0)
+    order = np.argsort(values[ok], kind="stable")
+    z, leaf = values[ok][order], np.asarray(leafy, dtype=bool)[ok][order]
+    if len(z) < 10:
+        return float("nan"), float("nan")
+    half = len(z) // 2
+    median = float(z[half]) if len(z) % 2 else float((z[half - 1] + z[half]) / 2.0)
+    step = max(radius_px * median / focal / 3.0, 0.004, 2.0 * noise)
+    n_bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
+    counts, edges = _sorted_histogram(z, n_bins, (z[0], z[0] + n_bins * step))
+    mass = np.convolve(counts, np.ones(3), mode="same")
+    after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
+    i = int(np.flatnonzero((mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max()))[0])
+
+    def leaf_share(k):
+        a, b = np.searchsorted(z, edges[max(k - 1, 0)]), np.searchsorted(z, edges[min(k + 2, n_bins)], "right")
+        return float(leaf[a:b].mean()) if b - a >= 10 else 0.0
+
+    if leaf_share(i) >= LEAFY[0]:
+        local = (mass >= after) & (mass >= before) & (mass >= 0.1 * mass.max())
+        behind = [int(k) for k in np.flatnonzero(local) if i < k < len(counts)]
+        i = next((k for k in behind if leaf_share(k) < LEAFY[1] and mass[k] >= 10), i)
+    first = i
+    while first > 0 and counts[first - 1] >= max(2, 0.01 * len(z)):
+        first -= 1
+    lo, hi = edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+    front = _sorted_quantile(z[np.searchsorted(z, lo, side="left") : np.searchsorted(z, hi, side="right")], 0.05)
+    return front, radius_px * front / focal
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.001]))
+def test_the_leaf_shares_counted_unsorted_decide_as_the_sorted_flags_did(seed, quantum):
+    # a leaf in front, the fruit and a background, depths quantised (ties) or not, leaf flags partly wrong
+    rng = np.random.default_rng(seed)
+    parts = [rng.normal(mu, sd, int(rng.integers(0, 400))) for mu, sd in ((1.2, 0.01), (1.5, 0.02), (1.9, 0.03))]
+    values = np.concatenate(parts)
+    if quantum:
+        values = np.round(values / quantum) * quantum
+    green = np.concatenate([rng.random(len(p)) < share for p, share in zip(parts, rng.uniform(0, 1, 3), strict=True)])
+    values[rng.random(len(values)) < 0.05] = rng.choice([0.0, np.nan])
+    expected = _fruit_depth_as_before(values, 20.0, F, leafy=green)
+    np.testing.assert_array_equal(fruit_depth(values, 20.0, F, leafy=green), expected)

@@ -136,12 +136,8 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     front, radius : float, metres (NaN when fewer than 10 depths are valid)
     """
     ok = np.isfinite(values) & (values > 0)
-    green = None
-    if leafy is None:
-        z = np.sort(values[ok])
-    else:  # one sort for both: the depths in order and their pixels' leaf flags with them
-        order = np.argsort(values[ok], kind="stable")
-        z, green = values[ok][order], np.asarray(leafy, dtype=bool)[ok][order]
+    kept = values[ok]
+    z = np.sort(kept)
     if len(z) < 10:
         return float("nan"), float("nan")
     half = len(z) // 2
@@ -154,12 +150,15 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
     peak = (mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max())
     i = int(np.flatnonzero(peak)[0])
-    if green is not None:
-        leaf = green
+    if leafy is not None:
+        leaf = np.asarray(leafy, dtype=bool)[ok]
 
         def leaf_share(k: int) -> float:
-            a, b = np.searchsorted(z, edges[max(k - 1, 0)]), np.searchsorted(z, edges[min(k + 2, n_bins)], "right")
-            return float(leaf[a:b].mean()) if b - a >= 10 else 0.0
+            """The leaf-green share of the depths from edge ``k - 1`` to edge ``k + 2`` (both included): counted on
+            the depths as they are, not carried through the sort (a whole number of pixels either way)."""
+            lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
+            a, b = np.searchsorted(z, lo), np.searchsorted(z, hi, "right")
+            return int(np.count_nonzero(leaf & (kept >= lo) & (kept <= hi))) / (b - a) if b - a >= 10 else 0.0
 
         if leaf_share(i) >= LEAFY[0]:
             local = (mass >= after) & (mass >= before) & (mass >= 0.1 * mass.max())
