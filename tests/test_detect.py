@@ -4,6 +4,8 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from symfruit import InputError, Settings, resolve_settings
 from symfruit.core.frame import Frame
@@ -271,3 +273,19 @@ def test_the_leaf_pixels_of_a_window_are_the_whole_images_moved_and_cut(shift):
     for window in [(0, 120, 0, 160), (10, 50, 20, 90), (100, 120, 150, 160), (0, 5, 0, 5)]:
         r0, r1, c0, c1 = window
         assert np.array_equal(_leafy(color, shift, window), whole[r0:r1, c0:c1])
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_a_box_looked_for_within_the_old_one_is_find_objects(seed):
+    # detect carries the masks' boxes through trimming (pixels taken away) instead of finding them again
+    from scipy import ndimage
+
+    from symfruit.detect import _box_within
+
+    rng = np.random.default_rng(seed)
+    labels = rng.integers(0, 5, (30, 40)) * (rng.random((30, 40)) < 0.3)
+    before = ndimage.find_objects(labels)
+    trimmed = np.where(rng.random(labels.shape) < rng.uniform(0.0, 1.0), labels, 0)
+    after = ndimage.find_objects(trimmed)
+    after += [None] * (len(before) - len(after))  # labels gone from the end
+    assert [_box_within(trimmed, k, sl) for k, sl in enumerate(before, 1)] == after

@@ -19,6 +19,7 @@ from .core.camera import Camera
 from .core.frame import Frame
 from .core.limits import MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
+from .core.raster import mask_box
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract, register, trim_labels
 from .methods import DEFAULT_METHOD
@@ -159,20 +160,29 @@ def detect(
                 f"frame {frame.name}: mask {int(whole[0]) + 1} covers the whole image; that is not a fruit"
             )
     t2 = time.perf_counter()  # trimming, registration and extraction start
+    from scipy import ndimage
+
+    # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
+    # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
+    boxes = ndimage.find_objects(labels)
     if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
-        labels = trim_labels(frame.color, labels, settings.extract)
+        trimmed = trim_labels(frame.color, labels, settings.extract, boxes=boxes)
+        if trimmed is not labels:
+            boxes = [_box_within(trimmed, k, sl) for k, sl in enumerate(boxes, 1)]
+        labels = trimmed
     t_trim = time.perf_counter() - t2
-    labels, shift = register(labels, frame.depth, frame.camera, settings.extract)
+    moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
+    if moved is not labels:
+        boxes = ndimage.find_objects(moved)
+    labels = moved
     # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
     # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
     # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
     camera = frame.camera.shifted(*shift)
     detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
-    from scipy import ndimage
-
     fruit_px = labels > 0
-    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+    for k, sl in enumerate(boxes, 1):
         if sl is None:
             continue
         mask = np.zeros(labels.shape, bool)
@@ -205,6 +215,15 @@ def detect(
                "occlusion": t_occlusion, "complete": t_complete, "total": total,
                "cpu": time.thread_time() - cpu0}  # fmt: skip
     return FrameDetections(frame, detections, timings, source, shift)
+
+
+def _box_within(labels: np.ndarray, k: int, sl: tuple[slice, slice] | None) -> tuple[slice, slice] | None:
+    """``ndimage.find_objects(labels)[k - 1]`` when label ``k`` lies within ``sl`` (its box before pixels were taken
+    away; None: it had none): the box of its pixels there, None when none is left."""
+    if sl is None or (box := mask_box(labels[sl] == k)) is None:
+        return None
+    r0, c0 = sl[0].start, sl[1].start
+    return slice(r0 + box[0], r0 + box[1], None), slice(c0 + box[2], c0 + box[3], None)
 
 
 def _leafy(color: np.ndarray, shift: tuple[int, int], window: tuple[int, int, int, int]) -> np.ndarray:

@@ -223,13 +223,16 @@ def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
     return out
 
 
-def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None) -> np.ndarray:
+def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None,
+                *, boxes: list[tuple[slice, slice] | None] | None = None) -> np.ndarray:  # fmt: skip
     """``labels`` with each mask's outer band trimmed where its colour is the background's
     (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
     equivalent radius).
 
     Masks and colour share the colour camera's pixels, so this comes before :func:`register` moves the masks
     onto the depth image: trimmed after the move, a mask would be compared with colours several pixels off.
+    ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
+    is trimmed.
     """
     s = settings or ExtractSettings()
     if s.colour_trim_px <= 0:
@@ -237,7 +240,7 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     out = labels
     h, w = labels.shape
     pad = s.colour_trim_px + 2
-    for k, sl in enumerate(ndimage.find_objects(labels), 1):
+    for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
         if sl is None:
             continue
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
@@ -252,15 +255,17 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
 
 
 def register(
-    labels: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None
-) -> tuple[np.ndarray, tuple[int, int]]:
+    labels: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None,
+    *, boxes: list[tuple[slice, slice] | None] | None = None,
+) -> tuple[np.ndarray, tuple[int, int]]:  # fmt: skip
     """The masks moved onto the depth image, and the shift ``(du, dv)`` (pixels) they were moved by.
 
     :func:`~symfruit.core.surface.registration_shift` within ``registration_px``; ``(0, 0)`` and the masks as they
-    are when the frame is registered well enough or the masks do not say.
+    are when the frame is registered well enough or the masks do not say. ``boxes``: ``ndimage.find_objects(labels)``
+    when the caller has it.
     """
     s = settings or ExtractSettings()
     z = np.asarray(depth, dtype=np.float64)
     du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,
-                                depth_range=(s.min_depth, s.max_depth))  # fmt: skip
+                                depth_range=(s.min_depth, s.max_depth), boxes=boxes)  # fmt: skip
     return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

@@ -387,3 +387,17 @@ def test_interior_is_scipys_erosion(seed, h, w):
     mask = np.random.default_rng(seed).random((h, w)) < np.random.default_rng(seed + 1).uniform(0.2, 1.0)
     assert np.array_equal(interior(mask), ndimage.binary_erosion(mask))
     assert np.array_equal(interior(np.ones((h, w), bool)), ndimage.binary_erosion(np.ones((h, w), bool)))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(1, 7))
+def test_eroded_is_scipys_iterated_erosion(seed, h, w, iterations):
+    from symfruit.core.raster import eroded
+
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:h, :w]
+    # a blob (what a fruit's mask is) or speckle
+    if rng.random() < 0.5:
+        mask = np.hypot(yy - rng.uniform(0, h), xx - rng.uniform(0, w)) < rng.uniform(1, 25)
+    else:
+        mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
+    assert np.array_equal(eroded(mask, iterations), ndimage.binary_erosion(mask, iterations=iterations))

@@ -436,3 +436,80 @@ def test_the_least_colour_distance_is_numpys_row_minimum(seed):
     if rng.random() < 0.2:
         d[rng.integers(0, len(d)), rng.integers(0, d.shape[1])] = np.nan  # propagated as numpy's minimum does
     np.testing.assert_array_equal(_row_min(d), d.min(axis=1))
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900]), st.sampled_from([0.7, 0.5, 1.0, 0.01]))
+def test_the_fast_cost_sums_the_deviations_the_sort_would_keep(seed, top, trim):
+    # exact=False takes the run of sorted values nearest the band instead of sorting the deviations: the same
+    # deviations (ties included: few distinct values), so the same mean but for the order of the sum
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 40, 2))
+    inside = np.sqrt(rng.integers(1, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    n = int(rng.integers(2, 320))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, float(rng.uniform(0.0, 6.0)))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (40, 2))
+    val = outline.values(shifts, reach)
+    band = np.clip(np.median(val, axis=1, keepdims=True), 0.0, outline.band)
+    former = np.sort(np.abs(val - band), axis=1)[:, : max(1, int(trim * n))].mean(axis=1)
+    np.testing.assert_allclose(outline.cost(shifts, reach, trim, exact=False), former, rtol=1e-13, atol=0.0)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 6000), st.sampled_from([1, 3, 72, 10**6]))
+def test_the_stable_order_is_numpys_stable_argsort(seed, n, span):
+    # distinct keys made of the key and the position, sorted as values: the same permutation, ties in order
+    from symfruit.core.surface import _stable_order
+
+    rng = np.random.default_rng(seed)
+    key = rng.integers(0, span, n) * 5001 + rng.integers(0, rng.integers(1, 5000), n)
+    np.testing.assert_array_equal(_stable_order(key), np.argsort(key, kind="stable"))
+
+
+def _fruit_depth_as_before(values, radius_px, focal, *, noise=0.001, leafy=None):
+    """fruit_depth as it was: the leaf flags carried through a stable argsort of the depths."""
+    from symfruit.core.surface import LEAFY, _sorted_histogram, _sorted_quantile
+
+    ok = np.isfinite(values) & (values > 0)
+    order = np.argsort(values[ok], kind="stable")
+    z, leaf = values[ok][order], np.asarray(leafy, dtype=bool)[ok][order]
+    if len(z) < 10:
+        return float("nan"), float("nan")
+    half = len(z) // 2
+    median = float(z[half]) if len(z) % 2 else float((z[half - 1] + z[half]) / 2.0)
+    step = max(radius_px * median / focal / 3.0, 0.004, 2.0 * noise)
+    n_bins = int(min(max(np.ceil((z[-1] - z[0]) / step), 1), 4096))
+    counts, edges = _sorted_histogram(z, n_bins, (z[0], z[0] + n_bins * step))
+    mass = np.convolve(counts, np.ones(3), mode="same")
+    after, before = np.concatenate((mass[1:], [-1.0])), np.concatenate(([-1.0], mass[:-1]))
+    i = int(np.flatnonzero((mass >= after) & (mass >= before) & (mass >= 0.5 * mass.max()))[0])
+
+    def leaf_share(k):
+        a, b = np.searchsorted(z, edges[max(k - 1, 0)]), np.searchsorted(z, edges[min(k + 2, n_bins)], "right")
+        return float(leaf[a:b].mean()) if b - a >= 10 else 0.0
+
+    if leaf_share(i) >= LEAFY[0]:
+        local = (mass >= after) & (mass >= before) & (mass >= 0.1 * mass.max())
+        behind = [int(k) for k in np.flatnonzero(local) if i < k < len(counts)]
+        i = next((k for k in behind if leaf_share(k) < LEAFY[1] and mass[k] >= 10), i)
+    first = i
+    while first > 0 and counts[first - 1] >= max(2, 0.01 * len(z)):
+        first -= 1
+    lo, hi = edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+    front = _sorted_quantile(z[np.searchsorted(z, lo, side="left") : np.searchsorted(z, hi, side="right")], 0.05)
+    return front, radius_px * front / focal
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.001]))
+def test_the_leaf_shares_counted_unsorted_decide_as_the_sorted_flags_did(seed, quantum):
+    # a leaf in front, the fruit and a background, depths quantised (ties) or not, leaf flags partly wrong
+    rng = np.random.default_rng(seed)
+    parts = [rng.normal(mu, sd, int(rng.integers(0, 400))) for mu, sd in ((1.2, 0.01), (1.5, 0.02), (1.9, 0.03))]
+    values = np.concatenate(parts)
+    if quantum:
+        values = np.round(values / quantum) * quantum
+    green = np.concatenate([rng.random(len(p)) < share for p, share in zip(parts, rng.uniform(0, 1, 3), strict=True)])
+    values[rng.random(len(values)) < 0.05] = rng.choice([0.0, np.nan])
+    expected = _fruit_depth_as_before(values, 20.0, F, leafy=green)
+    np.testing.assert_array_equal(fruit_depth(values, 20.0, F, leafy=green), expected)

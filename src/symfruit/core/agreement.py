@@ -271,8 +271,8 @@ def observe(
             weight = weight * ~hidden  # a hidden pixel: no evidence of background ...
             seen = np.where(hidden, occlusion.depth_at(u, v), np.nan)  # ... but of free space
         rays = camera.rays(u, v)
-        cuts = np.cumsum([len(r) for r in rcs])[:-1]
-        return list(zip(np.split(rays, cuts), np.split(weight, cuts), np.split(seen, cuts), strict=True))
+        ends = np.cumsum([len(r) for r in rcs]).tolist()  # each band's rows, sliced (np.split's views, its calls)
+        return [(rays[a:b], weight[a:b], seen[a:b]) for a, b in zip([0, *ends[:-1]], ends, strict=True)]
 
     def rings(dist: np.ndarray) -> list[np.ndarray]:  # each band's pixels (row-major), one pass over the map
         rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5)) if bands else np.empty((0, 2), int)

@@ -293,6 +293,18 @@ def interior(mask: np.ndarray) -> np.ndarray:
     return p[1:-1, 1:-1] & p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:]
 
 
+def eroded(mask: np.ndarray, iterations: int) -> np.ndarray:
+    """(h, w) bool: ``ndimage.binary_erosion(mask, iterations=iterations)`` (``iterations >= 1``; the cross, pixels
+    beyond the array not in the mask): :func:`interior` that many times while that is faster (a few erosions of a
+    fruit's box, each some 5 us against scipy's 30 us a call), scipy's iterated erosion beyond."""
+    if iterations > 4:
+        return np.asarray(ndimage.binary_erosion(mask, iterations=iterations))
+    out = np.asarray(mask, dtype=bool)
+    for _ in range(iterations):
+        out = interior(out)
+    return out
+
+
 def fill_holes(mask: np.ndarray) -> np.ndarray:
     """(h, w) bool: ``mask`` with its holes filled, the same as :func:`scipy.ndimage.binary_fill_holes`.
 
