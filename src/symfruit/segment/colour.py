@@ -144,6 +144,13 @@ class SegmentSettings(Section):
         cores are kept; a smaller one not ripe-red over most of it (``ripe_median``) is dropped before it is
         split (:func:`_ripe_cores`); a grown skin larger than that disc is not taken. Default 0.12: round
         fruit up to large apples and oranges (about 100 mm) with a margin; the apple profile sets 0.10.
+    ground_colour : bool
+        With depth and ``round_fruit``: a fruit turned with its ground colour (yellow to yellow-green, hue
+        :data:`GROUND_HUE` to :data:`LEAF_HUE` degrees) to the camera, no red to seed it, is found when its
+        depth shows a round body of fruit size (:func:`_round_body`: a sphere of radius ``min_diameter / 2``
+        to ``0.6 round_max_diameter`` fits its surface far better than a plane, convex towards the camera, its
+        outline convex and no wider than the sphere). Unripe fruit of the same colour are found too: colour
+        cannot tell them apart. Off by default; the apple profile sets it.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -165,6 +172,7 @@ class SegmentSettings(Section):
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
     round_fruit: bool = setting(False)
     round_max_diameter: float = setting(0.12, gt=0.0, le=1.0)
+    ground_colour: bool = setting(False)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -389,9 +397,9 @@ def segment(
     # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
     # more across) and the fruit brought back to full resolution.
     coarse = _coarse_regions(c, s)
-    if coarse is None:
+    if coarse is None and not (s.ground_colour and s.round_fruit and z is not None):
         return np.zeros((h, w), np.int32)
-    step = _working_step(coarse, min_area if z is None else 0.0)
+    step = 1 if coarse is None else _working_step(coarse, min_area if z is None else 0.0)
     if step == 1:
         return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
     o = step // 2
@@ -515,7 +523,8 @@ def _segment_at(
                 parts = _split(core, sub_z, s, geo, origin, min_area)
                 pieces += [_Piece(sl, part, 1 << sources) for part in parts]
                 sources += 1
-    if not pieces:
+    ground = s.ground_colour and s.round_fruit and z is not None
+    if not pieces and not ground:
         return np.zeros((h, w), np.int32)
     pieces = _merge(pieces, s, c, weak, z, geo)
 
@@ -548,6 +557,8 @@ def _segment_at(
             continue
         out[sl][free] = -1
         found.append((sl, free))
+    if ground and z is not None:  # fruit showing their ground colour, no red to seed them
+        found += _ground_fruit(c, z, geo, s, out, owner, min_area, z_typical)
     # number the fruit left to right (then top to bottom) by their box centres, for stable ids
     order = sorted(range(len(found)), key=lambda i: _box_centre(*found[i]))
     for new, i in enumerate(order, 1):
@@ -1280,6 +1291,160 @@ def _round_skin(
 #: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
 #: third of the visible disc has about 0.6 of its radius).
 ROUND_REACH = 2.0
+
+
+def _ground(color: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ground-colour pixels, yellow to yellow-green: saturated as :func:`_green` (the largest channel
+    a third above the smallest), blue the smallest, of a hue from :data:`GROUND_HUE` up to (not including)
+    :data:`LEAF_HUE` degrees, and not dark (the largest channel above :data:`GROUND_DARK`). Integer tests: with
+    R the largest the hue is ``60 (G - B) / (R - B)``, with G the largest ``60 + 60 (G - R) / (G - B)``."""
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    top = np.maximum(r, g)
+    gb, rb = g - b, r - b
+    out = (b <= np.minimum(r, g)) & (3 * (top - b) >= top) & (top > GROUND_DARK)
+    out &= 60 * gb >= GROUND_HUE * rb  # hue >= GROUND_HUE (where G > R it is above 60 anyway)
+    out &= (r >= g) | (60 * (g - r) < (LEAF_HUE - 60) * gb)  # hue < LEAF_HUE
+    return out
+
+
+#: The least hue (degrees) of a fruit's ground colour: yellow-orange. Below it lie the red blush and its orange
+#: stripes (found from red) and brown bark and twigs (hue about 20-35).
+GROUND_HUE = 40
+
+#: Ground-colour pixels need a largest channel above this (0-255): in deep shadow the hue is noise.
+GROUND_DARK = 40
+
+
+def _ground_fruit(
+    c: np.ndarray,
+    z: _Depth,
+    geo: _Geometry,
+    s: SegmentSettings,
+    out: np.ndarray,
+    owner: np.ndarray,
+    min_area: float,
+    z_typical: float,
+) -> list[tuple[Window, np.ndarray]]:
+    """Round fruit showing only their ground colour (no red seed): the pieces of ground-colour pixels
+    (:func:`_ground`) with depth and no depth step inside, fruit-sized (a disc of ``min_diameter`` to one of
+    ``round_max_diameter`` at their depth), whose depth is a round body (:func:`_round_body`). Each one's mask
+    is its hull less leaf green and the pixels off its depth, grown over the rest of its skin
+    (:func:`_round_skin`); pixels of fruit found already (``out`` nonzero, ``owner``: red pixels) are not taken.
+    Looked for on the coarse grid first (:data:`COARSE_STEP`), at full resolution only around what it finds."""
+    h, w = c.shape[:2]
+    g = COARSE_STEP
+    focal = geo.focal
+    zc = z[(slice(None, None, g), slice(None, None, g))]
+    cand = _ground(c[::g, ::g]) & (zc > 0) & (out[::g, ::g] == 0)
+    cand &= ~_steps(np.where(zc > 0, zc, np.nan), 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
+    lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+    if n == 0:
+        return []
+    flat = lab.ravel()
+    at = np.flatnonzero(flat)
+    la = flat.take(at)
+    count = np.bincount(la, minlength=n + 1).astype(np.float64)
+    zmean = np.bincount(la, weights=zc.ravel().take(at), minlength=n + 1) / np.maximum(count, 1.0)
+    disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2  # a 1 m disc's area (pixels) at each depth
+    area = count * g * g
+    keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
+    keep[0] = False
+    if not keep.any():
+        return []
+    rows, cols = np.divmod(at, lab.shape[1])
+    gh, gw = lab.shape
+    boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
+             for sl in _boxes(la, rows, cols, keep).values()]  # fmt: skip
+    found: list[tuple[Window, np.ndarray]] = []
+    for r0, r1, c0, c1 in _join_boxes(boxes):
+        win = (slice(r0 * g, min(r1 * g, h)), slice(c0 * g, min(c1 * g, w)))
+        zw = z[win]
+        cand = _ground(c[win]) & (zw > 0) & (out[win] == 0) & (owner[win] == 0)
+        cand &= ~_steps(np.where(zw > 0, zw, np.nan), 0.5 * s.depth_jump)
+        lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+        if n == 0:
+            continue
+        flat = lab.ravel()
+        at = np.flatnonzero(flat)
+        la = flat.take(at)
+        count = np.bincount(la, minlength=n + 1).astype(np.float64)
+        zmean = np.bincount(la, weights=zw.ravel().take(at), minlength=n + 1) / np.maximum(count, 1.0)
+        disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
+        keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
+        keep[0] = False
+        rows, cols = np.divmod(at, lab.shape[1])
+        for k, box in _boxes(la, rows, cols, keep).items():
+            box = _pad(box, 1, lab.shape)
+            part = fill_holes(lab[box] == k)
+            sl = (slice(box[0].start + win[0].start, box[0].stop + win[0].start),
+                  slice(box[1].start + win[1].start, box[1].stop + win[1].start))  # fmt: skip
+            origin = (sl[0].start, sl[1].start)
+            vertices = _hull_vertices(part)
+            if float(part.sum()) < GROUND_SOLIDITY * _hull_area_of(vertices, part):
+                continue  # not one convex outline: leaves, or fruit and leaves
+            sub_z = z[sl]
+            if not _round_body(part, sub_z, geo, s, origin):
+                continue
+            hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl]))
+            hull = _depth_consistent(hull, part, sub_z, s.depth_jump)
+            sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, -1)
+            if not _fruit_sized(hull, z[sl], s, focal, min_area, z_typical):
+                continue
+            free = hull & (out[sl] == 0)
+            if free.sum() < 0.5 * hull.sum():
+                continue
+            out[sl][free] = -1
+            found.append((sl, free))
+    return found
+
+
+def _round_body(part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]) -> bool:
+    """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``) is a round fruit's visible
+    surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
+    ``round_max_diameter`` fits it, convex towards the camera (its centre at least :data:`GROUND_BEHIND` of its
+    radius behind the surface's median depth), at least twice as closely as a plane (median distances: a leaf
+    or the background seen through a gap is flat), and the piece is no wider than the sphere (its area at most
+    that of a disc of :data:`GROUND_WIDER` times its radius)."""
+    z = depth[part & (depth > 0)]
+    if len(z) < 20:
+        return False
+    part = part & (np.abs(depth - float(median(z))) <= s.round_max_diameter)  # not a hole's far background
+    fit = _sphere(part, depth, geo, origin)
+    if fit is None:
+        return False
+    centre, radius = fit
+    if not 0.5 * s.min_diameter <= radius <= GROUND_RADIUS * s.round_max_diameter:
+        return False
+    p = _points(part, depth, geo, origin)
+    zm = float(median(p[:, 2]))
+    if centre[2] - zm < GROUND_BEHIND * radius:
+        return False
+    if np.sqrt(part.sum() / np.pi) * zm / geo.focal > GROUND_WIDER * radius:
+        return False
+    a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
+    coef, *_ = np.linalg.lstsq(a, p[:, 2], rcond=None)
+    plane = float(median(np.abs(a @ coef - p[:, 2])))
+    sphere = float(median(np.abs(row_norms(p - centre) - radius)))
+    return sphere <= GROUND_PLANE * plane
+
+
+#: A ground-colour piece is one fruit's outline when it fills at least this share of its convex hull.
+GROUND_SOLIDITY = 0.75
+
+#: The largest sphere a ground-colour piece may fit, as a share of ``round_max_diameter`` (its radius, 0.5,
+#: with a margin for the fit's noise on a partial cap).
+GROUND_RADIUS = 0.6
+
+#: A sphere's centre lies about a radius behind its visible cap (the cap's median depth at least half a radius
+#: in front of the centre: a fruit's surface is convex towards the camera).
+GROUND_BEHIND = 0.5
+
+#: A fruit's visible outline is no wider than the sphere it lies on: the piece's equivalent radius at most this
+#: many times the fitted radius.
+GROUND_WIDER = 1.2
+
+#: A round surface: the sphere's median distance from the points at most this share of the plane's.
+GROUND_PLANE = 0.5
 
 
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
