@@ -532,6 +532,12 @@ def _segment_at(
     owner = np.zeros((h, w), np.int32)  # which piece each red pixel is part of: no hull takes another's
     for k, piece in enumerate(pieces, 1):
         owner[piece.window][piece.mask] = k
+    # fruit showing their ground colour: joined to the red fruit whose skin reaches them, else fruit of their own
+    bodies = _ground_bodies(c, z, geo, s, owner) if ground and z is not None else []
+    body_map = np.zeros((h, w), np.int32) if bodies else None
+    for i, body in enumerate(bodies, 1):
+        body_map[body.window][body.mask] = i  # type: ignore[index]
+    taken = np.zeros(len(bodies) + 1, bool)
     out = np.zeros((h, w), np.int32)
     found: list[tuple[Window, np.ndarray]] = []
     for k, piece in enumerate(pieces, 1):
@@ -547,6 +553,8 @@ def _segment_at(
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
             if s.round_fruit and z is not None:  # the rest of a round fruit's skin
                 sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
+                if body_map is not None:
+                    sl, hull = _join_bodies(sl, hull, bodies, body_map, taken, z, geo, s)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
@@ -557,8 +565,17 @@ def _segment_at(
             continue
         out[sl][free] = -1
         found.append((sl, free))
-    if ground and z is not None:  # fruit showing their ground colour, no red to seed them
-        found += _ground_fruit(c, z, geo, s, out, owner, min_area, z_typical)
+    for i, body in enumerate(bodies, 1):  # the rest: fruit with no red to seed them
+        if taken[i] or z is None:
+            continue
+        sl, hull = _round_skin(body.window, body.mask, z, c, geo, s, owner, -1)
+        if not _fruit_sized(hull, z[sl], s, geo.focal, min_area, z_typical):
+            continue
+        free = hull & (out[sl] == 0)
+        if free.sum() < 0.5 * hull.sum():
+            continue
+        out[sl][free] = -1
+        found.append((sl, free))
     # number the fruit left to right (then top to bottom) by their box centres, for stable ids
     order = sorted(range(len(found)), key=lambda i: _box_centre(*found[i]))
     for new, i in enumerate(order, 1):
@@ -1315,28 +1332,32 @@ GROUND_HUE = 40
 GROUND_DARK = 40
 
 
-def _ground_fruit(
-    c: np.ndarray,
-    z: _Depth,
-    geo: _Geometry,
-    s: SegmentSettings,
-    out: np.ndarray,
-    owner: np.ndarray,
-    min_area: float,
-    z_typical: float,
-) -> list[tuple[Window, np.ndarray]]:
-    """Round fruit showing only their ground colour (no red seed): the pieces of ground-colour pixels
-    (:func:`_ground`) with depth and no depth step inside, fruit-sized (a disc of ``min_diameter`` to one of
-    ``round_max_diameter`` at their depth), whose depth is a round body (:func:`_round_body`). Each one's mask
-    is its hull less leaf green and the pixels off its depth, grown over the rest of its skin
-    (:func:`_round_skin`); pixels of fruit found already (``out`` nonzero, ``owner``: red pixels) are not taken.
-    Looked for on the coarse grid first (:data:`COARSE_STEP`), at full resolution only around what it finds."""
+@dataclass
+class _Body:
+    """A round body of ground colour (:func:`_ground_bodies`): its mask in an image window and the sphere its
+    depth fits (centre in the camera frame and radius, metres)."""
+
+    window: Window
+    mask: np.ndarray
+    centre: np.ndarray
+    radius: float
+
+
+def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings, owner: np.ndarray) -> list[_Body]:
+    """Round fruit showing their ground colour: the pieces of ground-colour pixels (:func:`_ground`) with depth
+    and no depth step inside, not red pixels of a candidate fruit (``owner``), fruit-sized (a disc of
+    ``min_diameter`` to one of ``round_max_diameter`` at their depth), convex in outline
+    (:data:`GROUND_SOLIDITY`), whose depth is a round body (:func:`_round_body`). Each one's mask is its hull
+    less leaf green and the pixels off its depth. Looked for on the coarse grid first (:data:`COARSE_STEP`), at
+    full resolution only around what it finds."""
     h, w = c.shape[:2]
     g = COARSE_STEP
     focal = geo.focal
     zc = z[(slice(None, None, g), slice(None, None, g))]
-    cand = _ground(c[::g, ::g]) & (zc > 0) & (out[::g, ::g] == 0)
-    cand &= ~_steps(np.where(zc > 0, zc, np.nan), 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
+    if not (zc > 0).any():
+        return []
+    zc = _nearest_filled(zc)
+    cand = _ground(c[::g, ::g]) & ~_steps(zc, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
     lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
     if n == 0:
         return []
@@ -1355,12 +1376,14 @@ def _ground_fruit(
     gh, gw = lab.shape
     boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
              for sl in _boxes(la, rows, cols, keep).values()]  # fmt: skip
-    found: list[tuple[Window, np.ndarray]] = []
+    bodies: list[_Body] = []
     for r0, r1, c0, c1 in _join_boxes(boxes):
         win = (slice(r0 * g, min(r1 * g, h)), slice(c0 * g, min(c1 * g, w)))
         zw = z[win]
-        cand = _ground(c[win]) & (zw > 0) & (out[win] == 0) & (owner[win] == 0)
-        cand &= ~_steps(np.where(zw > 0, zw, np.nan), 0.5 * s.depth_jump)
+        if not (zw > 0).any():
+            continue
+        filled = _nearest_filled(zw)
+        cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(filled, s.depth_jump)
         lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
         if n == 0:
             continue
@@ -1368,7 +1391,7 @@ def _ground_fruit(
         at = np.flatnonzero(flat)
         la = flat.take(at)
         count = np.bincount(la, minlength=n + 1).astype(np.float64)
-        zmean = np.bincount(la, weights=zw.ravel().take(at), minlength=n + 1) / np.maximum(count, 1.0)
+        zmean = np.bincount(la, weights=filled.ravel().take(at), minlength=n + 1) / np.maximum(count, 1.0)
         disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
         keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
         keep[0] = False
@@ -1378,54 +1401,89 @@ def _ground_fruit(
             part = fill_holes(lab[box] == k)
             sl = (slice(box[0].start + win[0].start, box[0].stop + win[0].start),
                   slice(box[1].start + win[1].start, box[1].stop + win[1].start))  # fmt: skip
-            origin = (sl[0].start, sl[1].start)
             vertices = _hull_vertices(part)
             if float(part.sum()) < GROUND_SOLIDITY * _hull_area_of(vertices, part):
                 continue  # not one convex outline: leaves, or fruit and leaves
             sub_z = z[sl]
-            if not _round_body(part, sub_z, geo, s, origin):
+            fit = _round_body(part, sub_z, geo, s, (sl[0].start, sl[1].start))
+            if fit is None:
                 continue
-            hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl]))
-            hull = _depth_consistent(hull, part, sub_z, s.depth_jump)
-            sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, -1)
-            if not _fruit_sized(hull, z[sl], s, focal, min_area, z_typical):
-                continue
-            free = hull & (out[sl] == 0)
-            if free.sum() < 0.5 * hull.sum():
-                continue
-            out[sl][free] = -1
-            found.append((sl, free))
-    return found
+            hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl])) & ((owner[sl] == 0) | part)
+            bodies.append(_Body(sl, _depth_consistent(hull, part, sub_z, s.depth_jump), *fit))
+    return bodies
 
 
-def _round_body(part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]) -> bool:
+def _nearest_filled(depth: np.ndarray) -> np.ndarray:
+    """A depth image (0: none) with every pixel without depth given its nearest valid pixel's: a step between
+    two surfaces then lies in the band of missing depth between them (a time-of-flight camera's invalid rim)."""
+    ri, ci = ndimage.distance_transform_edt(depth <= 0, return_distances=False, return_indices=True)
+    return np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)
+
+
+def _join_bodies(
+    sl: Window,
+    hull: np.ndarray,
+    bodies: list[_Body],
+    body_map: np.ndarray,
+    taken: np.ndarray,
+    depth: _Depth,
+    geo: _Geometry,
+    s: SegmentSettings,
+) -> tuple[Window, np.ndarray]:
+    """A red fruit's skin (``hull`` in window ``sl``) joined with the ground-colour bodies it reaches (overlaps,
+    or touches) whose sphere its depth lies on (the median distance of its points off the body's sphere at most
+    ``sphere_apart`` of its radius and ``depth_jump``), while the whole stays within the largest fruit's disc
+    (``round_max_diameter``). The bodies joined are marked ``taken``."""
+    grown = _dilate(hull, square=True)
+    ids = np.unique(body_map[sl][grown])
+    for i in ids[ids > 0].tolist():
+        if taken[i]:
+            continue
+        body = bodies[i - 1]
+        p = _points(hull, depth[sl], geo, (sl[0].start, sl[1].start))
+        if len(p) < 20:
+            continue
+        off = float(median(np.abs(row_norms(p - body.centre) - body.radius)))
+        if off > min(s.sphere_apart * body.radius, s.depth_jump):
+            continue
+        window, union = _union(_Piece(sl, hull, 0), _Piece(body.window, body.mask, 0))
+        if union.sum() > _largest_area(union, depth[window], s, geo.focal, 1.0):
+            continue
+        taken[i] = True
+        sl, hull = window, union
+    return sl, hull
+
+
+def _round_body(
+    part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]
+) -> tuple[np.ndarray, float] | None:
     """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``) is a round fruit's visible
     surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
     ``round_max_diameter`` fits it, convex towards the camera (its centre at least :data:`GROUND_BEHIND` of its
     radius behind the surface's median depth), at least twice as closely as a plane (median distances: a leaf
     or the background seen through a gap is flat), and the piece is no wider than the sphere (its area at most
-    that of a disc of :data:`GROUND_WIDER` times its radius)."""
+    that of a disc of :data:`GROUND_WIDER` times its radius). Returns the sphere (centre, radius), or None."""
     z = depth[part & (depth > 0)]
     if len(z) < 20:
-        return False
+        return None
     part = part & (np.abs(depth - float(median(z))) <= s.round_max_diameter)  # not a hole's far background
     fit = _sphere(part, depth, geo, origin)
     if fit is None:
-        return False
+        return None
     centre, radius = fit
     if not 0.5 * s.min_diameter <= radius <= GROUND_RADIUS * s.round_max_diameter:
-        return False
+        return None
     p = _points(part, depth, geo, origin)
     zm = float(median(p[:, 2]))
     if centre[2] - zm < GROUND_BEHIND * radius:
-        return False
+        return None
     if np.sqrt(part.sum() / np.pi) * zm / geo.focal > GROUND_WIDER * radius:
-        return False
+        return None
     a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
     coef, *_ = np.linalg.lstsq(a, p[:, 2], rcond=None)
     plane = float(median(np.abs(a @ coef - p[:, 2])))
     sphere = float(median(np.abs(row_norms(p - centre) - radius)))
-    return sphere <= GROUND_PLANE * plane
+    return (centre, radius) if sphere <= GROUND_PLANE * plane else None
 
 
 #: A ground-colour piece is one fruit's outline when it fills at least this share of its convex hull.
