@@ -1371,10 +1371,13 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
     keep[0] = False
-    sized = np.flatnonzero(keep.take(la))  # the fruit-sized pieces' points alone
+    sized = np.flatnonzero(keep.take(la))  # the fruit-sized pieces' points alone, numbered 0..m-1 for the test
     at, la = at.take(sized), la.take(sized)
     rows, cols = np.divmod(at, lab.shape[1])
-    keep &= _bulging(la, rows * g, cols * g, z_grid.ravel().take(at), n, geo, s)
+    ids = np.flatnonzero(keep)
+    index = np.zeros(n + 1, np.int64)
+    index[ids] = np.arange(len(ids))
+    keep[ids] = _bulging(index.take(la), rows * g, cols * g, z_grid.ravel().take(at), len(ids) - 1, geo, s)
     if not keep.any():
         return []
     gh, gw = lab.shape
@@ -1428,7 +1431,7 @@ GAP_PX = 7
 def _bulging(
     labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, depth: np.ndarray, n: int, geo: _Geometry, s: SegmentSettings
 ) -> np.ndarray:
-    """(n + 1,) bool: which labelled pieces (``labels`` 1..n of pixels at ``rows``, ``cols`` with ``depth``, 0 where
+    """(n + 1,) bool: which labelled pieces (``labels`` 0..n of pixels at ``rows``, ``cols`` with ``depth``, 0 where
     none) may be a round fruit's visible surface, all at once: the paraboloid ``z = a + b x + c y + d (x^2 + y^2)``
     (camera-frame metres, about each piece's mean) fitted to its points with depth by least squares bulges
     towards the camera (``d > 0``) with a curvature radius ``1 / (2 d)`` within 4x of the fruit's radii
@@ -1468,13 +1471,7 @@ def _gap_filled(depth: np.ndarray, size: int) -> np.ndarray:
     """A depth image (0: none) with each pixel without depth given the farthest depth within a ``size`` box, NaN
     where there is none (no step is seen there): a step between two surfaces then lies at the nearer one's edge,
     not across the band of missing depth between them (a time-of-flight camera's invalid rim)."""
-    if size == 3:  # the 3x3 maximum from shifted views (scipy's filter costs several times more)
-        p = np.zeros((depth.shape[0] + 2, depth.shape[1] + 2))
-        p[1:-1, 1:-1] = depth
-        rows = np.maximum(np.maximum(p[:-2], p[1:-1]), p[2:])
-        near = np.maximum(np.maximum(rows[:, :-2], rows[:, 1:-1]), rows[:, 2:])
-    else:
-        near = ndimage.maximum_filter(depth, size)
+    near = ndimage.maximum_filter(depth, size)
     filled = np.where(depth > 0, depth, near)
     return np.where(filled > 0, filled, np.nan)
 
@@ -1493,6 +1490,10 @@ def _join_bodies(
     or touches) whose sphere its depth lies on (the median distance of its points off the body's sphere at most
     ``sphere_apart`` of its radius and ``depth_jump``), while the whole stays within the largest fruit's disc
     (``round_max_diameter``). The bodies joined are marked ``taken``."""
+    near = [b.window for b in bodies if b.window[0].start <= sl[0].stop and sl[0].start <= b.window[0].stop
+            and b.window[1].start <= sl[1].stop and sl[1].start <= b.window[1].stop]  # fmt: skip
+    if not near:
+        return sl, hull
     grown = _dilate(hull, square=True)
     ids = np.unique(body_map[sl][grown])
     for i in ids[ids > 0].tolist():
