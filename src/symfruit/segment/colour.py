@@ -148,9 +148,9 @@ class SegmentSettings(Section):
         With depth and ``round_fruit``: a fruit turned with its ground colour (yellow to yellow-green, hue
         :data:`GROUND_HUE` to :data:`LEAF_HUE` degrees) to the camera, no red to seed it, is found when its
         depth shows a round body of fruit size (:func:`_round_body`: a sphere of radius ``min_diameter / 2``
-        to ``0.6 round_max_diameter`` fits its surface far better than a plane, convex towards the camera, its
-        outline convex and no wider than the sphere). Unripe fruit of the same colour are found too: colour
-        cannot tell them apart. Off by default; the apple profile sets it.
+        to ``0.6 round_max_diameter`` fits its surface far better than a plane, convex towards the camera; its
+        outline convex). Unripe fruit of the same colour are found too: colour cannot tell them apart. Off by
+        default; the apple profile sets it.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -1520,9 +1520,9 @@ def _round_body(
     """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``) is a round fruit's visible
     surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
     ``round_max_diameter`` fits it, convex towards the camera (its centre at least :data:`GROUND_BEHIND` of its
-    radius behind the surface's median depth), at least twice as closely as a plane (median distances: a leaf
-    or the background seen through a gap is flat), and the piece is no wider than the sphere (its area at most
-    that of a disc of :data:`GROUND_WIDER` times its radius). Returns the sphere (centre, radius), or None."""
+    radius behind the surface's median depth), and at least twice as closely as a plane (:data:`GROUND_PLANE`,
+    median distances: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits
+    neither well). Returns the sphere (centre, radius), or None."""
     z = depth[part & (depth > 0)]
     if len(z) < 20:
         return None
@@ -1536,8 +1536,6 @@ def _round_body(
     p = _points(part, depth, geo, origin)
     zm = float(median(p[:, 2]))
     if centre[2] - zm < GROUND_BEHIND * radius:
-        return None
-    if np.sqrt(part.sum() / np.pi) * zm / geo.focal > GROUND_WIDER * radius:
         return None
     a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
     coef, *_ = np.linalg.lstsq(a, p[:, 2], rcond=None)
@@ -1556,10 +1554,6 @@ GROUND_RADIUS = 0.6
 #: A sphere's centre lies about a radius behind its visible cap (the cap's median depth at least half a radius
 #: in front of the centre: a fruit's surface is convex towards the camera).
 GROUND_BEHIND = 0.5
-
-#: A fruit's visible outline is no wider than the sphere it lies on: the piece's equivalent radius at most this
-#: many times the fitted radius.
-GROUND_WIDER = 1.2
 
 #: A round surface: the sphere's median distance from the points at most this share of the plane's.
 GROUND_PLANE = 0.5
