@@ -1529,16 +1529,21 @@ def _join_bodies(
 def _round_body(
     part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]
 ) -> tuple[np.ndarray, float] | None:
-    """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``) is a round fruit's visible
-    surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
+    """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``; its largest surface without a
+    step of ``depth_jump``) is a round fruit's visible surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
     ``round_max_diameter`` fits it, convex towards the camera (its centre at least :data:`GROUND_BEHIND` of its
     radius behind the surface's median depth), and at least twice as closely as a plane (:data:`GROUND_PLANE`,
     median distances: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits
     neither well). Returns the sphere (centre, radius), or None."""
-    z = depth[part & (depth > 0)]
-    if len(z) < 20:
+    seen = part & (depth > 0)
+    if seen.sum() < 20:
         return None
-    part = part & (np.abs(depth - float(median(z))) <= s.round_max_diameter)  # not a hole's far background
+    # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
+    # (4-connected: the steps are looked for between 4-neighbours)
+    lab, n = ndimage.label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
+    if n == 0:
+        return None
+    part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
     fit = _sphere(part, depth, geo, origin)
     if fit is None:
         return None
@@ -1550,8 +1555,12 @@ def _round_body(
     if centre[2] - zm < GROUND_BEHIND * radius:
         return None
     a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
-    coef, *_ = np.linalg.lstsq(a, p[:, 2], rcond=None)
-    plane = float(median(np.abs(a @ coef - p[:, 2])))
+    keep = np.ones(len(p), bool)
+    for _ in range(2):  # fit, drop the points far off the plane (a leaf's mixed rim pixels), fit again: as the sphere
+        coef, *_ = np.linalg.lstsq(a[keep], p[keep, 2], rcond=None)
+        off = np.abs(a @ coef - p[:, 2])
+        keep = off <= max(3.0 * float(median(off)) * 1.4826, 1e-4)
+    plane = float(median(off))
     sphere = float(median(np.abs(row_norms(p - centre) - radius)))
     return (centre, radius) if sphere <= GROUND_PLANE * plane else None
 
