@@ -842,3 +842,17 @@ def test_the_gap_fill_is_scipys_maximum_filter_where_depth_is_missing():
             depth[rng.random(depth.shape) < 0.6] = 0.0
             near = np.where(depth > 0, depth, ndimage.maximum_filter(depth, size))
             assert np.array_equal(_gap_filled(depth, size), np.where(near > 0, near, np.nan), equal_nan=True)
+
+
+def test_two_flat_pieces_joined_where_depth_is_missing_are_no_round_body():
+    # an apple-sized yellow-green patch: two flat leaves 6 cm apart in depth, a band without depth between them
+    # (a time-of-flight camera's invalid rim): no step is seen between them, yet a sphere fits their points
+    from symfruit.segment.colour import _Geometry, _round_body
+
+    _, patch, depth = patch_depth("flat disc")
+    yy = np.mgrid[:1080, :1920][0]
+    depth[patch & (yy > 545)] = 1.56 + 0.0002 * (yy[patch & (yy > 545)] - 545)
+    depth[patch & (np.abs(yy - 541) <= 3)] = 0.0
+    rng = np.random.default_rng(2)
+    depth[depth > 0] += rng.normal(0, 0.0015, int((depth > 0).sum()))
+    assert _round_body(patch, depth, _Geometry(HD_CAM.fx, HD_CAM.cy, HD_CAM.cx), APPLE, (0, 0)) is None
