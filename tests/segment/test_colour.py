@@ -711,7 +711,9 @@ def test_the_padding_is_numpys():
         assert np.array_equal(_pad1(mask), np.pad(mask, 1)) and _pad1(mask).dtype == bool
 
 
-APPLE = SegmentSettings(round_fruit=True, ground_colour=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+APPLE = SegmentSettings(
+    round_fruit=True, ground_colour=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10
+)
 YELLOW_GREEN = (160, 175, 60)  # hue 68 degrees: a bicoloured apple's ground colour, not leaf green
 
 

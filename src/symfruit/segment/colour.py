@@ -1431,14 +1431,21 @@ GAP_PX = 7
 
 
 def _bulging(
-    labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, depth: np.ndarray, n: int, geo: _Geometry, s: SegmentSettings
+    labels: np.ndarray,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    depth: np.ndarray,
+    n: int,
+    geo: _Geometry,
+    s: SegmentSettings,
 ) -> np.ndarray:
     """(n + 1,) bool: which labelled pieces (``labels`` 0..n of pixels at ``rows``, ``cols`` with ``depth``, 0 where
     none) may be a round fruit's visible surface, all at once: the paraboloid ``z = a + b x + c y + d (x^2 + y^2)``
-    (camera-frame metres, about each piece's mean) fitted to its points with depth by least squares bulges
-    towards the camera (``d > 0``) with a curvature radius ``1 / (2 d)`` within 4x of the fruit's radii
-    (``min_diameter / 2`` to ``round_max_diameter / 2``), and fits them at least twice as closely as a plane (the
-    residual sums of squares: four times smaller). A quick test before :func:`_round_body`, looser than it."""
+    (camera-frame metres, about each piece's mean) fitted to its points with depth (10 or more) by least squares
+    bulges towards the camera (``d > 0``) with a curvature radius ``1 / (2 d)`` from a quarter of the least fruit's
+    radius to twice the largest's (``min_diameter``, ``round_max_diameter``), and fits them more closely than a
+    plane (a residual sum of squares at most :data:`BULGE_RSS` of the plane's). A quick test on the coarse grid
+    before :func:`_round_body`, looser than it: a paraboloid follows a cap's steep rim less well than a sphere."""
     ok = depth > 0
     lab = labels[ok]
     z = depth[ok]
@@ -1464,9 +1471,14 @@ def _bulging(
     rss3 = zz - np.einsum("ij,ij->i", sol3, rhs[:, :3])
     d = sol4[:, 3]
     radius = 0.5 / np.maximum(d, 1e-9)
-    return enough & (d > 0) & (radius >= 0.125 * s.min_diameter) & (radius <= s.round_max_diameter) & (
-        rss4 <= 0.6 * rss3
-    )
+    bounded = (radius >= 0.125 * s.min_diameter) & (radius <= s.round_max_diameter)
+    return enough & (d > 0) & bounded & (rss4 <= BULGE_RSS * rss3)
+
+
+#: A coarse piece bulges when its paraboloid's residual sum of squares is at most this share of the plane's: a
+#: loose bound (chosen on seeds 0-5 of the rendered trees: 0.25 lost six apples there; whole visible apples give
+#: 0.3-0.45, their rims and the depth's offset from the colour included).
+BULGE_RSS = 0.6
 
 
 def _gap_filled(depth: np.ndarray, size: int) -> np.ndarray:
@@ -1530,11 +1542,12 @@ def _round_body(
     part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]
 ) -> tuple[np.ndarray, float] | None:
     """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``; its largest surface without a
-    step of ``depth_jump``) is a round fruit's visible surface: a sphere (:func:`_sphere`) of radius ``min_diameter / 2`` to :data:`GROUND_RADIUS` times
-    ``round_max_diameter`` fits it, convex towards the camera (its centre at least :data:`GROUND_BEHIND` of its
-    radius behind the surface's median depth), and at least twice as closely as a plane (:data:`GROUND_PLANE`,
-    median distances: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits
-    neither well). Returns the sphere (centre, radius), or None."""
+    step of ``depth_jump``) is a round fruit's visible surface: a sphere (:func:`_sphere`) of radius
+    ``min_diameter / 2`` to :data:`GROUND_RADIUS` times ``round_max_diameter`` fits it, convex towards the camera
+    (its centre at least :data:`GROUND_BEHIND` of its radius behind the surface's median depth), and at least
+    twice as closely as a plane (:data:`GROUND_PLANE`, median distances, each fit once more without the points far
+    off it: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits neither
+    well). Returns the sphere (centre, radius), or None."""
     seen = part & (depth > 0)
     if seen.sum() < 20:
         return None
