@@ -1391,9 +1391,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         zw = z[win]
         if not (zw > 0).any():
             continue
-        filled = _gap_filled(zw, GAP_PX)
-        cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(filled, s.depth_jump)
-        filled = np.nan_to_num(filled)
+        cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(_gap_filled(zw, GAP_PX), s.depth_jump)
         lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
         if n == 0:
             continue
