@@ -709,3 +709,152 @@ def test_the_padding_is_numpys():
     for shape in ((1, 1), (3, 7), (20, 11)):
         mask = rng.random(shape) < 0.5
         assert np.array_equal(_pad1(mask), np.pad(mask, 1)) and _pad1(mask).dtype == bool
+
+
+APPLE = SegmentSettings(
+    round_fruit=True, ground_colour=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10
+)
+YELLOW_GREEN = (160, 175, 60)  # hue 68 degrees: a bicoloured apple's ground colour, not leaf green
+
+
+def shaded(color, disc, rgb, depth, z):
+    """Paint ``rgb`` over ``disc`` shaded by the sphere's depth (brighter where it faces the camera)."""
+    light = np.clip(1.0 - 8.0 * (depth - depth[disc].min()), 0.55, 1.0)
+    color[disc] = (np.array(rgb)[None] * light[disc][:, None]).astype(np.uint8)
+
+
+def test_an_apple_showing_only_its_yellow_green_side_is_found_by_its_round_depth():
+    # a 78 mm apple at 1.5 m (52 px across) turned with its ground colour to the camera: no red to seed it
+    color, depth = hd_disc_frame([(900, 540)], radius=26)
+    disc = (color == RED).all(axis=2)
+    shaded(color, disc, YELLOW_GREEN, depth, 1.5)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum() and (found & ~disc).sum() < 0.05 * disc.sum()
+    off = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    assert segment(color, depth, HD_CAM, off).max() == 0  # without ground_colour: nothing red, nothing found
+    depth[:, :1000] = 0.0  # outside the depth camera's view: no depth to confirm it, not found
+    assert segment(color, depth, HD_CAM, APPLE).max() == 0
+
+
+def test_an_apple_with_a_small_blush_is_found_whole():
+    # the red blush a thin crescent on the left (too little to grow the yellow-green side from it), the rest of
+    # the apple ground colour: the red fruit and the round body are one apple
+    color, depth = hd_disc_frame([(900, 540)], radius=26)
+    disc = (color == RED).all(axis=2)
+    xx = np.mgrid[:1080, :1920][1]
+    shaded(color, disc & (xx > 882), YELLOW_GREEN, depth, 1.5)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    assert ((labels == 1) & disc).sum() > 0.9 * disc.sum()
+
+
+def patch_depth(shape):
+    """An apple-sized patch at 1.5 m before leaves 10 cm behind, its mask and depth: an apple (a 39 mm sphere's
+    cap), a flat disc facing the camera, a tilted flat leaf (an ellipse 90 x 45 mm), a leaf curled as tightly as
+    an apple but in one direction only, a dome far flatter than an
+    apple (a 0.1 m sphere's cap), a concave bowl."""
+    color, depth = hd_disc_frame([], radius=26)
+    yy, xx = np.mgrid[:1080, :1920]
+    f = HD_CAM.fx / 1.5  # pixels per metre at 1.5 m
+    if shape == "curled leaf":  # a 30 mm cylinder's front, 54 x 60 mm, its axis upright
+        patch = (np.abs(xx - 900) <= 0.027 * f) & (np.abs(yy - 540) <= 0.03 * f)
+        depth[patch] = 1.5 + 0.03 - np.sqrt(0.03**2 - ((xx[patch] - 900) / f) ** 2)
+    elif shape == "tilted leaf":
+        patch = ((xx - 900) / (0.045 * f)) ** 2 + ((yy - 540) / (0.0225 * f)) ** 2 <= 1
+        depth[patch] = 1.5 + 0.5 * (xx[patch] - 900) / f  # tilted 27 degrees
+    else:
+        rho2 = ((xx - 900) ** 2 + (yy - 540) ** 2) / f**2
+        patch = rho2 <= 0.039**2
+        rho2 = rho2[patch]
+        radius = {"apple": 0.039, "flat disc": np.inf, "large dome": 0.1, "bowl": -0.04}[shape]  # negative: concave
+        sag = 0.0 * rho2 if np.isinf(radius) else np.sign(radius) * (abs(radius) - np.sqrt(radius**2 - rho2))
+        depth[patch] = 1.5 + sag
+    shaded(color, patch, YELLOW_GREEN, depth, 1.5)
+    return color, patch, depth
+
+
+@pytest.mark.parametrize("shape", ["flat disc", "tilted leaf", "curled leaf", "large dome", "bowl"])
+def test_a_yellow_green_patch_that_is_not_a_round_body_is_no_fruit(shape):
+    # sunlit leaves can approach an apple's ground colour; their depth is not an apple's
+    color, _, depth = patch_depth(shape)
+    assert segment(color, depth, HD_CAM, APPLE).max() == 0
+
+
+@pytest.mark.parametrize("shape", ["apple", "flat disc", "tilted leaf", "curled leaf", "large dome", "bowl"])
+def test_a_round_body_is_a_fruit_sized_sphere_convex_towards_the_camera(shape):
+    from symfruit.segment.colour import _Geometry, _round_body
+
+    _, patch, depth = patch_depth(shape)
+    rng = np.random.default_rng(5)
+    depth = depth + rng.normal(0, 0.0015, depth.shape)  # the Azure Kinect's noise at 1.5 m
+    fit = _round_body(patch, depth, _Geometry(HD_CAM.fx, HD_CAM.cy, HD_CAM.cx), APPLE, (0, 0))
+    assert (fit is not None) == (shape == "apple")
+    if fit is not None:
+        assert abs(fit[1] - 0.039) < 0.006 and abs(fit[0][2] - (1.5 + 0.039)) < 0.006
+
+
+@pytest.mark.parametrize(
+    ("rgb", "ground"),
+    [((160, 175, 60), True), ((200, 180, 60), True), ((200, 160, 60), True), ((200, 150, 60), False),
+     ((120, 160, 60), False), ((70, 150, 50), False), ((140, 140, 120), False), ((30, 33, 10), False),
+     ((150, 160, 60), True)],
+)  # fmt: skip
+def test_ground_colour_is_a_saturated_hue_from_40_to_80_degrees(rgb, ground):
+    import colorsys
+
+    from symfruit.segment.colour import GROUND_HUE, LEAF_HUE, _ground
+
+    hue, sat, value = colorsys.rgb_to_hsv(*(v / 255 for v in rgb))
+    expected = GROUND_HUE <= 360 * hue < LEAF_HUE and sat >= 1 / 3 and 255 * value > 40
+    assert expected == ground  # each case lies on its side of the boundaries
+    assert bool(_ground(np.array([[rgb]], np.uint8))[0, 0]) == ground
+
+
+def test_the_bulging_test_fits_each_pieces_paraboloid():
+    from symfruit.segment.colour import _bulging, _Geometry
+
+    geo = _Geometry(1000.0, 0.0, 0.0)
+    rng = np.random.default_rng(3)
+    rows, cols, labels, depth = [], [], [], []
+    # piece 0: a 35 mm sphere's cap at 1.5 m; piece 1: a tilted plane; piece 2: a 35 mm bowl; piece 3: too few points
+    for k, (r0, c0) in enumerate([(100, 100), (300, 100), (500, 100), (700, 100)]):
+        rr, cc = np.mgrid[-12:13, -12:13]
+        keep = rr**2 + cc**2 <= 144 if k < 3 else (rr == 0) & (np.abs(cc) < 3)
+        rr, cc = rr[keep], cc[keep]
+        rho2 = (rr**2 + cc**2) * (1.5 / geo.focal) ** 2
+        cap = 0.035 - np.sqrt(0.035**2 - rho2)
+        z = 1.5 + [cap, 0.3 * cc * 1.5 / geo.focal, -cap, cap][k] + rng.normal(0, 2e-4, len(rr))
+        rows.append(rr + r0), cols.append(cc + c0), labels.append(np.full(len(rr), k)), depth.append(z)
+    s = SegmentSettings(min_diameter=0.03, round_max_diameter=0.10)
+    ok = _bulging(*(np.concatenate(v) for v in (labels, rows, cols, depth)), 3, geo, s)
+    assert ok.tolist() == [True, False, False, False]
+
+
+def test_the_gap_fill_is_scipys_maximum_filter_where_depth_is_missing():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _gap_filled
+
+    rng = np.random.default_rng(11)
+    for size in (3, 7):
+        for _ in range(20):
+            depth = rng.uniform(0.5, 3.0, tuple(rng.integers(1, 40, 2)))
+            depth[rng.random(depth.shape) < 0.6] = 0.0
+            near = np.where(depth > 0, depth, ndimage.maximum_filter(depth, size))
+            assert np.array_equal(_gap_filled(depth, size), np.where(near > 0, near, np.nan), equal_nan=True)
+
+
+def test_two_flat_pieces_joined_where_depth_is_missing_are_no_round_body():
+    # an apple-sized yellow-green patch: two flat leaves 6 cm apart in depth, a band without depth between them
+    # (a time-of-flight camera's invalid rim): no step is seen between them, yet a sphere fits their points
+    from symfruit.segment.colour import _Geometry, _round_body
+
+    _, patch, depth = patch_depth("flat disc")
+    yy = np.mgrid[:1080, :1920][0]
+    depth[patch & (yy > 545)] = 1.56 + 0.0002 * (yy[patch & (yy > 545)] - 545)
+    depth[patch & (np.abs(yy - 541) <= 3)] = 0.0
+    rng = np.random.default_rng(2)
+    depth[depth > 0] += rng.normal(0, 0.0015, int((depth > 0).sum()))
+    assert _round_body(patch, depth, _Geometry(HD_CAM.fx, HD_CAM.cy, HD_CAM.cx), APPLE, (0, 0)) is None

@@ -144,6 +144,13 @@ class SegmentSettings(Section):
         cores are kept; a smaller one not ripe-red over most of it (``ripe_median``) is dropped before it is
         split (:func:`_ripe_cores`); a grown skin larger than that disc is not taken. Default 0.12: round
         fruit up to large apples and oranges (about 100 mm) with a margin; the apple profile sets 0.10.
+    ground_colour : bool
+        With depth and ``round_fruit``: a fruit turned with its ground colour (yellow to yellow-green, hue
+        :data:`GROUND_HUE` to :data:`LEAF_HUE` degrees) to the camera, no red to seed it, is found when its
+        depth shows a round body of fruit size (:func:`_round_body`: a sphere of radius ``min_diameter / 2``
+        to ``0.6 round_max_diameter`` fits its surface far better than a plane, convex towards the camera; its
+        outline convex). Unripe fruit of the same colour are found too: colour cannot tell them apart. Off by
+        default; the apple profile sets it.
     """
 
     red_high: float = setting(0.30, gt=0.0, lt=1.0)
@@ -165,6 +172,7 @@ class SegmentSettings(Section):
     sphere_apart: float = setting(0.5, gt=0.0, le=10.0)
     round_fruit: bool = setting(False)
     round_max_diameter: float = setting(0.12, gt=0.0, le=1.0)
+    ground_colour: bool = setting(False)
 
     def check(self) -> None:
         if self.red_low > self.red_high:
@@ -389,9 +397,9 @@ def segment(
     # is large, the image is worked on every ``step``-th pixel (each fruit still WORK_DIAMETER pixels or
     # more across) and the fruit brought back to full resolution.
     coarse = _coarse_regions(c, s)
-    if coarse is None:
+    if coarse is None and not (s.ground_colour and s.round_fruit and z is not None):
         return np.zeros((h, w), np.int32)
-    step = _working_step(coarse, min_area if z is None else 0.0)
+    step = 1 if coarse is None else _working_step(coarse, min_area if z is None else 0.0)
     if step == 1:
         return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
     o = step // 2
@@ -515,7 +523,8 @@ def _segment_at(
                 parts = _split(core, sub_z, s, geo, origin, min_area)
                 pieces += [_Piece(sl, part, 1 << sources) for part in parts]
                 sources += 1
-    if not pieces:
+    ground = s.ground_colour and s.round_fruit and z is not None
+    if not pieces and not ground:
         return np.zeros((h, w), np.int32)
     pieces = _merge(pieces, s, c, weak, z, geo)
 
@@ -523,6 +532,12 @@ def _segment_at(
     owner = np.zeros((h, w), np.int32)  # which piece each red pixel is part of: no hull takes another's
     for k, piece in enumerate(pieces, 1):
         owner[piece.window][piece.mask] = k
+    # fruit showing their ground colour: joined to the red fruit whose skin reaches them, else fruit of their own
+    bodies = _ground_bodies(c, z, geo, s, owner) if ground and z is not None else []
+    body_map = np.zeros((h, w), np.int32) if bodies else None
+    for i, body in enumerate(bodies, 1):
+        body_map[body.window][body.mask] = i  # type: ignore[index]
+    taken = np.zeros(len(bodies) + 1, bool)
     out = np.zeros((h, w), np.int32)
     found: list[tuple[Window, np.ndarray]] = []
     for k, piece in enumerate(pieces, 1):
@@ -538,6 +553,8 @@ def _segment_at(
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
             if s.round_fruit and z is not None:  # the rest of a round fruit's skin
                 sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
+                if body_map is not None:
+                    sl, hull = _join_bodies(sl, hull, bodies, body_map, taken, z, geo, s)
                 sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
@@ -545,6 +562,17 @@ def _segment_at(
             continue
         free = hull & (out[sl] == 0)
         if free.sum() < 0.5 * hull.sum():  # mostly inside a larger fruit: a piece of it, not a fruit
+            continue
+        out[sl][free] = -1
+        found.append((sl, free))
+    for i, body in enumerate(bodies, 1):  # the rest: fruit with no red to seed them
+        if taken[i] or z is None:
+            continue
+        sl, hull = _round_skin(body.window, body.mask, z, c, geo, s, owner, -1)
+        if not _fruit_sized(hull, z[sl], s, geo.focal, min_area, z_typical):
+            continue
+        free = hull & (out[sl] == 0)
+        if free.sum() < 0.5 * hull.sum():
             continue
         out[sl][free] = -1
         found.append((sl, free))
@@ -1280,6 +1308,287 @@ def _round_skin(
 #: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
 #: third of the visible disc has about 0.6 of its radius).
 ROUND_REACH = 2.0
+
+
+def _ground(color: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ground-colour pixels, yellow to yellow-green: saturated as :func:`_green` (the largest channel
+    a third above the smallest), blue the smallest, of a hue from :data:`GROUND_HUE` up to (not including)
+    :data:`LEAF_HUE` degrees, and not dark (the largest channel above :data:`GROUND_DARK`). Integer tests: with
+    R the largest the hue is ``60 (G - B) / (R - B)``, with G the largest ``60 + 60 (G - R) / (G - B)``."""
+    r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
+    top = np.maximum(r, g)
+    gb, rb = g - b, r - b
+    out = (b <= np.minimum(r, g)) & (3 * (top - b) >= top) & (top > GROUND_DARK)
+    out &= 60 * gb >= GROUND_HUE * rb  # hue >= GROUND_HUE (where G > R it is above 60 anyway)
+    out &= (r >= g) | (60 * (g - r) < (LEAF_HUE - 60) * gb)  # hue < LEAF_HUE
+    return out
+
+
+#: The least hue (degrees) of a fruit's ground colour: yellow-orange. Below it lie the red blush and its orange
+#: stripes (found from red) and brown bark and twigs (hue about 20-35).
+GROUND_HUE = 40
+
+#: Ground-colour pixels need a largest channel above this (0-255): in deep shadow the hue is noise.
+GROUND_DARK = 40
+
+
+@dataclass
+class _Body:
+    """A round body of ground colour (:func:`_ground_bodies`): its mask in an image window and the sphere its
+    depth fits (centre in the camera frame and radius, metres)."""
+
+    window: Window
+    mask: np.ndarray
+    centre: np.ndarray
+    radius: float
+
+
+def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings, owner: np.ndarray) -> list[_Body]:
+    """Round fruit showing their ground colour: the pieces of ground-colour pixels (:func:`_ground`) with depth
+    and no depth step inside, not red pixels of a candidate fruit (``owner``), fruit-sized (a disc of
+    ``min_diameter`` to one of ``round_max_diameter`` at their depth), convex in outline
+    (:data:`GROUND_SOLIDITY`), whose depth is a round body (:func:`_round_body`). Each one's mask is its hull
+    less leaf green and the pixels off its depth. Looked for on the coarse grid first (:data:`COARSE_STEP`), at
+    full resolution only around what it finds."""
+    h, w = c.shape[:2]
+    g = COARSE_STEP
+    focal = geo.focal
+    zc = z[(slice(None, None, g), slice(None, None, g))]
+    if not (zc > 0).any():
+        return []
+    z_grid, zc = zc, _gap_filled(zc, 3)
+    cand = _ground(c[::g, ::g]) & ~_steps(zc, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
+    lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+    if n == 0:
+        return []
+    flat = lab.ravel()
+    at = np.flatnonzero(flat)
+    la = flat.take(at)
+    count = np.bincount(la, minlength=n + 1).astype(np.float64)
+    zsum = np.bincount(la, weights=z_grid.ravel().take(at), minlength=n + 1)
+    zmean = zsum / np.maximum(np.bincount(la, weights=z_grid.ravel().take(at) > 0, minlength=n + 1), 1.0)
+    disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2  # a 1 m disc's area (pixels) at each depth
+    area = count * g * g
+    keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
+    keep[0] = False
+    if not keep.any():
+        return []
+    sized = np.flatnonzero(keep.take(la))  # the fruit-sized pieces' points alone, numbered 0..m-1 for the test
+    at, la = at.take(sized), la.take(sized)
+    rows, cols = np.divmod(at, lab.shape[1])
+    ids = np.flatnonzero(keep)
+    index = np.zeros(n + 1, np.int64)
+    index[ids] = np.arange(len(ids))
+    keep[ids] = _bulging(index.take(la), rows * g, cols * g, z_grid.ravel().take(at), len(ids) - 1, geo, s)
+    if not keep.any():
+        return []
+    gh, gw = lab.shape
+    boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
+             for sl in _boxes(la, rows, cols, keep).values()]  # fmt: skip
+    bodies: list[_Body] = []
+    for r0, r1, c0, c1 in _join_boxes(boxes):
+        win = (slice(r0 * g, min(r1 * g, h)), slice(c0 * g, min(c1 * g, w)))
+        zw = z[win]
+        if not (zw > 0).any():
+            continue
+        cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(_gap_filled(zw, GAP_PX), s.depth_jump)
+        lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+        if n == 0:
+            continue
+        flat = lab.ravel()
+        at = np.flatnonzero(flat)
+        la = flat.take(at)
+        count = np.bincount(la, minlength=n + 1).astype(np.float64)
+        zmean = np.bincount(la, weights=zw.ravel().take(at), minlength=n + 1) / np.maximum(
+            np.bincount(la, weights=zw.ravel().take(at) > 0, minlength=n + 1), 1.0
+        )
+        disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
+        keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
+        keep[0] = False
+        rows, cols = np.divmod(at, lab.shape[1])
+        for k, box in _boxes(la, rows, cols, keep).items():
+            box = _pad(box, 1, lab.shape)
+            part = fill_holes(lab[box] == k)
+            sl = (slice(box[0].start + win[0].start, box[0].stop + win[0].start),
+                  slice(box[1].start + win[1].start, box[1].stop + win[1].start))  # fmt: skip
+            vertices = _hull_vertices(part)
+            if float(part.sum()) < GROUND_SOLIDITY * _hull_area_of(vertices, part):
+                continue  # not one convex outline: leaves, or fruit and leaves
+            sub_z = z[sl]
+            fit = _round_body(part, sub_z, geo, s, (sl[0].start, sl[1].start))
+            if fit is None:
+                continue
+            hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl])) & ((owner[sl] == 0) | part)
+            bodies.append(_Body(sl, _depth_consistent(hull, part, sub_z, s.depth_jump), *fit))
+    return bodies
+
+
+#: Width (pixels) of the box over which a pixel without depth takes the farthest depth near it
+#: (:func:`_gap_filled`): a time-of-flight camera's invalid rim is 1-2 depth pixels, 3-6 colour pixels at 1920x1080.
+GAP_PX = 7
+
+
+def _bulging(
+    labels: np.ndarray,
+    rows: np.ndarray,
+    cols: np.ndarray,
+    depth: np.ndarray,
+    n: int,
+    geo: _Geometry,
+    s: SegmentSettings,
+) -> np.ndarray:
+    """(n + 1,) bool: which labelled pieces (``labels`` 0..n of pixels at ``rows``, ``cols`` with ``depth``, 0 where
+    none) may be a round fruit's visible surface, all at once: the paraboloid ``z = a + b x + c y + d (x^2 + y^2)``
+    (camera-frame metres, about each piece's mean) fitted to its points with depth (10 or more) by least squares
+    bulges towards the camera (``d > 0``) with a curvature radius ``1 / (2 d)`` from a quarter of the least fruit's
+    radius to twice the largest's (``min_diameter``, ``round_max_diameter``), and fits them more closely than a
+    plane (a residual sum of squares at most :data:`BULGE_RSS` of the plane's). A quick test on the coarse grid
+    before :func:`_round_body`, looser than it: a paraboloid follows a cap's steep rim less well than a sphere."""
+    ok = depth > 0
+    lab = labels[ok]
+    z = depth[ok]
+    x = (cols[ok] - geo.cx) * z / geo.focal
+    y = (rows[ok] - geo.cy) * z / geo.focal
+    count = np.bincount(lab, minlength=n + 1).astype(np.float64)
+    safe = np.maximum(count, 1.0)
+    x = x - (np.bincount(lab, weights=x, minlength=n + 1) / safe)[lab]
+    y = y - (np.bincount(lab, weights=y, minlength=n + 1) / safe)[lab]
+    cols_ = (np.ones_like(x), x, y, x * x + y * y)
+    m = np.empty((n + 1, 4, 4))
+    for i in range(4):
+        for j in range(i, 4):
+            m[:, i, j] = m[:, j, i] = np.bincount(lab, weights=cols_[i] * cols_[j], minlength=n + 1)
+    rhs = np.stack([np.bincount(lab, weights=v * z, minlength=n + 1) for v in cols_], axis=1)
+    zz = np.bincount(lab, weights=z * z, minlength=n + 1)
+    enough = count >= 10
+    m[~enough] = np.eye(4)  # a placeholder: those pieces are not tested
+    m += 1e-12 * np.eye(4)
+    sol4 = np.linalg.solve(m, rhs[:, :, None])[:, :, 0]
+    sol3 = np.linalg.solve(m[:, :3, :3], rhs[:, :3, None])[:, :, 0]
+    rss4 = zz - np.einsum("ij,ij->i", sol4, rhs)
+    rss3 = zz - np.einsum("ij,ij->i", sol3, rhs[:, :3])
+    d = sol4[:, 3]
+    radius = 0.5 / np.maximum(d, 1e-9)
+    bounded = (radius >= 0.125 * s.min_diameter) & (radius <= s.round_max_diameter)
+    return enough & (d > 0) & bounded & (rss4 <= BULGE_RSS * rss3)
+
+
+#: A coarse piece bulges when its paraboloid's residual sum of squares is at most this share of the plane's: a
+#: loose bound (chosen on seeds 0-5 of the rendered trees: 0.25 lost six apples there; whole visible apples give
+#: 0.3-0.45, their rims and the depth's offset from the colour included).
+BULGE_RSS = 0.6
+
+
+def _gap_filled(depth: np.ndarray, size: int) -> np.ndarray:
+    """A depth image (0: none) with each pixel without depth given the farthest depth within a ``size`` box, NaN
+    where there is none (no step is seen there): a step between two surfaces then lies at the nearer one's edge,
+    not across the band of missing depth between them (a time-of-flight camera's invalid rim). The box's maximum
+    from shifted views, rows then columns: ``ndimage.maximum_filter(depth, size)``'s values, at a third of its
+    cost."""
+    near = depth.copy()
+    for axis in (0, 1):
+        src = near.copy()
+        for k in range(1, size // 2 + 1):
+            lead = (slice(k, None), slice(None)) if axis == 0 else (slice(None), slice(k, None))
+            lag = (slice(None, -k), slice(None)) if axis == 0 else (slice(None), slice(None, -k))
+            np.maximum(near[lead], src[lag], out=near[lead])
+            np.maximum(near[lag], src[lead], out=near[lag])
+    np.copyto(near, depth, where=depth > 0)
+    near[near <= 0] = np.nan
+    return near
+
+
+def _join_bodies(
+    sl: Window,
+    hull: np.ndarray,
+    bodies: list[_Body],
+    body_map: np.ndarray,
+    taken: np.ndarray,
+    depth: _Depth,
+    geo: _Geometry,
+    s: SegmentSettings,
+) -> tuple[Window, np.ndarray]:
+    """A red fruit's skin (``hull`` in window ``sl``) joined with the ground-colour bodies it reaches (overlaps,
+    or touches) whose sphere its depth lies on (the median distance of its points off the body's sphere at most
+    ``sphere_apart`` of its radius and ``depth_jump``), while the whole stays within the largest fruit's disc
+    (``round_max_diameter``). The bodies joined are marked ``taken``."""
+    near = [b.window for b in bodies if b.window[0].start <= sl[0].stop and sl[0].start <= b.window[0].stop
+            and b.window[1].start <= sl[1].stop and sl[1].start <= b.window[1].stop]  # fmt: skip
+    if not near:
+        return sl, hull
+    grown = _dilate(hull, square=True)
+    ids = np.unique(body_map[sl][grown])
+    for i in ids[ids > 0].tolist():
+        if taken[i]:
+            continue
+        body = bodies[i - 1]
+        p = _points(hull, depth[sl], geo, (sl[0].start, sl[1].start))
+        if len(p) < 20:
+            continue
+        off = float(median(np.abs(row_norms(p - body.centre) - body.radius)))
+        if off > min(s.sphere_apart * body.radius, s.depth_jump):
+            continue
+        window, union = _union(_Piece(sl, hull, 0), _Piece(body.window, body.mask, 0))
+        if union.sum() > _largest_area(union, depth[window], s, geo.focal, 1.0):
+            continue
+        taken[i] = True
+        sl, hull = window, union
+    return sl, hull
+
+
+def _round_body(
+    part: np.ndarray, depth: np.ndarray, geo: _Geometry, s: SegmentSettings, origin: tuple[int, int]
+) -> tuple[np.ndarray, float] | None:
+    """Whether the depth of a piece (``part`` in the window at ``origin`` of ``depth``; its largest surface without a
+    step of ``depth_jump``) is a round fruit's visible surface: a sphere (:func:`_sphere`) of radius
+    ``min_diameter / 2`` to :data:`GROUND_RADIUS` times ``round_max_diameter`` fits it, convex towards the camera
+    (its centre at least :data:`GROUND_BEHIND` of its radius behind the surface's median depth), and at least
+    twice as closely as a plane (:data:`GROUND_PLANE`, median distances, each fit once more without the points far
+    off it: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits neither
+    well). Returns the sphere (centre, radius), or None."""
+    seen = part & (depth > 0)
+    if seen.sum() < 20:
+        return None
+    # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
+    # (4-connected: the steps are looked for between 4-neighbours)
+    lab, n = ndimage.label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
+    if n == 0:
+        return None
+    part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
+    fit = _sphere(part, depth, geo, origin)
+    if fit is None:
+        return None
+    centre, radius = fit
+    if not 0.5 * s.min_diameter <= radius <= GROUND_RADIUS * s.round_max_diameter:
+        return None
+    p = _points(part, depth, geo, origin)
+    zm = float(median(p[:, 2]))
+    if centre[2] - zm < GROUND_BEHIND * radius:
+        return None
+    a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
+    keep = np.ones(len(p), bool)
+    for _ in range(2):  # fit, drop the points far off the plane (a leaf's mixed rim pixels), fit again: as the sphere
+        coef, *_ = np.linalg.lstsq(a[keep], p[keep, 2], rcond=None)
+        off = np.abs(a @ coef - p[:, 2])
+        keep = off <= max(3.0 * float(median(off)) * 1.4826, 1e-4)
+    plane = float(median(off))
+    sphere = float(median(np.abs(row_norms(p - centre) - radius)))
+    return (centre, radius) if sphere <= GROUND_PLANE * plane else None
+
+
+#: A ground-colour piece is one fruit's outline when it fills at least this share of its convex hull.
+GROUND_SOLIDITY = 0.75
+
+#: The largest sphere a ground-colour piece may fit, as a share of ``round_max_diameter`` (its radius, 0.5,
+#: with a margin for the fit's noise on a partial cap).
+GROUND_RADIUS = 0.6
+
+#: A sphere's centre lies about a radius behind its visible cap (the cap's median depth at least half a radius
+#: in front of the centre: a fruit's surface is convex towards the camera).
+GROUND_BEHIND = 0.5
+
+#: A round surface: the sphere's median distance from the points at most this share of the plane's.
+GROUND_PLANE = 0.5
 
 
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
