@@ -858,3 +858,23 @@ def test_two_flat_pieces_joined_where_depth_is_missing_are_no_round_body():
     rng = np.random.default_rng(2)
     depth[depth > 0] += rng.normal(0, 0.0015, int((depth > 0).sum()))
     assert _round_body(patch, depth, _Geometry(HD_CAM.fx, HD_CAM.cy, HD_CAM.cx), APPLE, (0, 0)) is None
+
+
+def test_two_pieces_a_fruit_apart_in_depth_are_not_one_fruit_without_a_sphere():
+    """Two red pieces, one in front of the other: where no sphere fits the larger (flat here, as a ragged or
+    mixed-pixel cap can be), their median depths tell them apart when they lie further apart than the largest
+    fruit is across; nearer, nothing is told (None), as before."""
+    from symfruit.segment.colour import _Depth, _Geometry, _Piece, _same_surface
+
+    s = SegmentSettings(round_max_diameter=0.10)
+    geo = _Geometry(900.0, 100.0, 100.0)
+    depth = np.zeros((200, 200))
+    weak = np.zeros((200, 200), bool)
+    a, b = np.zeros((200, 200), bool), np.zeros((200, 200), bool)
+    a[20:90, 20:90], b[100:150, 100:150] = True, True
+    weak[a | b] = True
+    for far, told in ((1.40, False), (1.29, None), (1.22, None)):
+        depth[a], depth[b] = 1.20, far  # flat: no sphere fits either
+        whole = (slice(0, 200), slice(0, 200))
+        pa, pb = _Piece(whole, a.copy(), 1), _Piece(whole, b.copy(), 2)
+        assert _same_surface(pa, pb, _Depth.of(depth), weak, geo, s) is told, far

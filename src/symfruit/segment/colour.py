@@ -856,8 +856,9 @@ def _same_surface(
     a: _Piece, b: _Piece, depth: _Depth, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
-    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``); None
-    when there is no fit."""
+    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``). Without
+    a fit: not when the two pieces' median depths lie further apart than the largest fruit is across
+    (``round_max_diameter``: two fruit, one behind the other), else None (nothing to tell)."""
     big, small = (a, b) if a.area >= b.area else (b, a)
     origin = (big.window[0].start, big.window[1].start)
     fit = _sphere(big.mask & weak[big.window], depth[big.window], geo, origin)
@@ -865,9 +866,17 @@ def _same_surface(
         small.mask & weak[small.window], depth[small.window], geo, (small.window[0].start, small.window[1].start)
     )
     if fit is None or len(p) < 20:
+        zs = [depth[x.window][x.mask & weak[x.window]] for x in (big, small)]
+        zs = [z[z > 0] for z in zs]
+        if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
+            return False
         return None
     off = np.abs(row_norms(p - fit[0]) - fit[1])
     return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+
+
+#: Depth points each piece needs for :func:`_same_surface` to compare their median depths without a sphere.
+SAME_SURFACE_POINTS = 10
 
 
 def _union(a: _Piece, b: _Piece) -> tuple[Window, np.ndarray]:
