@@ -91,10 +91,8 @@ class EvidenceSettings(Section):
         much an occluding contour, the sphere and the unconstrained ellipsoid are not fitted: the ``cone``
         ellipsoid covers both.
     explained_at : float
-        In a depth camera's view, when the ``cone`` ellipsoid gets at most this share of the silhouette-band
-        rays wrong (the rays beyond a cut edge do not count), the solid of revolution is not fitted (the
-        ablation: the same means, half the views cheaper; issue 19's seventh round extended it from the views
-        of ``covered_contour`` to every depth camera's view: the same boxes).
+        There, when the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the
+        solid of revolution is not fitted either (the ablation: the same means, half the views cheaper).
     temperature : float
         Weights are ``exp(-energy / temperature)``: the energies count about ``rays`` correlated ray residuals
         as if they were independent, which makes the plain ``exp(-energy)`` far too sure of the best
@@ -434,10 +432,7 @@ def evidence(
     apex, _ = apex_depth(sample)
     front = max(float(points[:, 2].min()), apex)
     shapes: tuple[str, ...] = SHAPES
-    # A depth camera's view that the cone ellipsoid explains (at most ``explained_at`` of the band rays wrong,
-    # those beyond a cut edge not counted) needs no solid of revolution: no other shape can explain the outline
-    # better (issue 19, seventh round: on a cut outline too; the same boxes on every evaluation instance).
-    explained: float | None = s.explained_at if dense else None
+    explained: float | None = None
     clean = 0.0
     if not dense:
         # The cone ellipsoid's fit reads each point as the nearest surface along its ray, as a depth camera
@@ -449,6 +444,7 @@ def evidence(
         # unconstrained ellipsoid (which noise thins), so they cannot win and are not fitted (the ablation:
         # the same boxes, a millisecond less), and whether the data is noisy need not be measured.
         shapes = tuple(name for name in SHAPES if name not in ("sphere", "ellipsoid"))
+        explained = s.explained_at
     else:
         ratio, _, _ = surface_noise(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
