@@ -255,17 +255,25 @@ def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
 
 
-def inner_distance(mask: np.ndarray) -> np.ndarray:
+def inner_distance(mask: np.ndarray, reach: float | None = None) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(mask)`` (each mask pixel's distance to the nearest
     pixel outside it), transformed over the mask's box grown by a pixel (clipped to the image) alone: a pixel on
     that grown border in the row or column of any farther background pixel is nearer, so the distances are the
-    same, and a mask in a wide window costs its own box."""
+    same, and a mask in a wide window costs its own box.
+
+    ``reach`` (pixels, >= 0): only the distances up to it are wanted; they are the same, to the bit, and farther
+    ones are +inf (:func:`_near_distance`'s shifts instead of scipy's transform: 0.24 against 0.40 ms for a disc
+    134 px across at 10.5 px; issue 19, seventh round)."""
     out = np.zeros(mask.shape)
     if (box := mask_box(mask)) is None:
         return out
     r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
     c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
-    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(mask[r0:r1, c0:c1])
+    part = mask[r0:r1, c0:c1]
+    if reach is None or part.all():  # no pixel outside the mask in reach of the shifts: scipy's map
+        out[r0:r1, c0:c1] = ndimage.distance_transform_edt(part)
+    else:
+        out[r0:r1, c0:c1] = _near_distance(~part, reach)
     return out
 
 
