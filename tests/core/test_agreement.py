@@ -291,3 +291,26 @@ def test_packed_bands_give_the_band_by_band_shares(seed):
         got = explain(Fixed(hit_all, depth_all), (np.array([0, 0, 0.3]), np.array([0, 0, 0.6])), obs)
         with np.errstate(invalid="ignore", divide="ignore"):
             assert (got.inside, got.outside) == _former_bands(hit_all, depth_all, obs)
+
+
+@pytest.mark.parametrize("noise, rim", [(0.0, 2.0), (0.01, 2.0), (0.01, 30.0)])
+def test_an_observation_with_its_inner_map_cut_at_a_reach_is_the_same(noise, rim):
+    """Issue 19's seventh round: with ``inner_reach`` the region's inner distance map is exact only up to what is
+    read of it (+inf beyond), and the observation is the same, ray for ray, as with the whole map."""
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import inner_distance
+
+    visible, _ = rendered_view(ball_mesh(), [0.01, -0.02, 0.4], noise=noise, seed=5)
+    region = silhouette(visible, DEFAULT_CAMERA)
+    full = observe(visible[::5], region, DEFAULT_CAMERA, dense=visible)
+    cut = observe(visible[::5], region, DEFAULT_CAMERA, dense=visible, inner_reach=rim)
+    assert cut.inner_reach == max(rim, 8.0) and full.inner_reach == np.inf
+    for name in ("rays", "depth", "interior", "cone", "axis"):
+        np.testing.assert_array_equal(getattr(cut, name), getattr(full, name))
+    assert cut.contour == full.contour
+    for a, b in zip(cut.rays_in + cut.rays_out, full.rays_in + full.rays_out, strict=True):
+        np.testing.assert_array_equal(a, b)
+    within = full.inner <= cut.inner_reach
+    np.testing.assert_array_equal(cut.inner[within], full.inner[within])
+    assert np.all(np.isinf(cut.inner[~within])) and (~within).any()
+    np.testing.assert_array_equal(full.inner, inner_distance(region.mask))

@@ -5,7 +5,15 @@ from hypothesis import strategies as st
 from scipy import ndimage
 
 from symfruit import Box, Camera, InputError
-from symfruit.core.raster import fill_holes, inner_distance, mask_box, outer_distance, rasterise, silhouette_coverage
+from symfruit.core.raster import (
+    _near_distance,
+    fill_holes,
+    inner_distance,
+    mask_box,
+    outer_distance,
+    rasterise,
+    silhouette_coverage,
+)
 
 from ..conftest import CENTRE, front_half, sphere_cloud
 
@@ -245,6 +253,41 @@ def test_the_outer_distance_within_reach_is_the_whole_images(seed, reach):
     assert np.array_equal(got[near], want[near]) and np.all(got[~near] > reach)
     if not mask.any():
         assert np.array_equal(got, want)
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 200.0), st.floats(0.0, 1.0))
+def test_the_near_distance_is_scipys_within_reach_to_the_bit(seed, reach, density):
+    """Issue 19's seventh round: the distance to the nearest true pixel by row and column shifts up to the reach
+    is scipy's Euclidean distance transform wherever that is within reach (scattered pixels, any density, a
+    reach below a pixel to beyond the window; int16 and, past about 127 px, int64 arithmetic), +inf beyond."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    mask = rng.random((h, w)) < density * density
+    if not mask.any():
+        mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True
+    want = ndimage.distance_transform_edt(~mask)
+    got = _near_distance(mask, reach)
+    near = want <= reach
+    assert np.array_equal(got[near], want[near]) and np.all(np.isinf(got[~near]))
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 30.0))
+def test_the_inner_distance_within_a_reach_is_the_whole_images(seed, reach):
+    """``inner_distance(mask, reach)``: scipy's values, to the bit, where they are at most ``reach``; +inf beyond;
+    0 outside the mask (masks touching the window's border or not, with holes, full)."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = np.zeros((h, w), bool)
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    mask[r0 : r0 + int(rng.integers(1, 30)), c0 : c0 + int(rng.integers(1, 30))] = True
+    mask &= rng.random((h, w)) < rng.uniform(0.6, 1.0)
+    want = ndimage.distance_transform_edt(mask)
+    got = inner_distance(mask, reach)
+    near = want <= reach
+    assert np.array_equal(got[near], want[near]) and np.all(np.isinf(got[~near]) | (got[~near] == want[~near]))
+    assert np.all(got[~near] > reach)
+    full = np.ones((h, w), bool)
+    assert np.array_equal(inner_distance(full, reach), ndimage.distance_transform_edt(full))
 
 
 def test_the_inner_distance_of_an_empty_or_full_mask_is_the_whole_images():

@@ -272,3 +272,27 @@ def test_completed_points_are_the_seen_and_their_mirror_images_through_the_box_c
     result = complete(visible, camera=DEFAULT_CAMERA, method="evidence")
     want = np.vstack([visible, 2.0 * result.box.centre - visible])
     assert result.points.shape == want.shape and np.array_equal(result.points, want)
+
+
+def test_the_rim_coverage_takes_a_cut_inner_map_only_as_far_as_it_reaches():
+    """Issue 19's seventh round: ``observe`` may hand on an inner distance map exact only up to a reach (+inf
+    beyond); the rim coverage reads it when that reach covers the rim's width and makes the whole map otherwise,
+    with the same share either way."""
+    from symfruit.core.raster import inner_distance, silhouette
+    from symfruit.methods.evidence import rim_coverage, rim_width
+
+    visible, _ = rendered_view(ball_mesh(), [0.0, 0.01, 0.4], noise=0.01, seed=2)
+    region = silhouette(visible, DEFAULT_CAMERA)
+    lateral = np.hypot(*(visible[:, :2] - visible[:, :2].mean(axis=0)).T)
+    points = visible[lateral < 0.9 * lateral.max()]  # the rim without depth, as a time-of-flight camera sees it
+    width = rim_width(region.mask)
+    assert 2.0 < width < 20.0
+    want = rim_coverage(points, region, DEFAULT_CAMERA)
+    assert 0.0 < want < 0.9
+    for reach in (width, width + 3.0, 1.0):  # covering the rim, or short of it (then made again)
+        cut = inner_distance(region.mask, reach)
+        got = rim_coverage(points, region, DEFAULT_CAMERA, inner=cut, inner_reach=reach)
+        assert got == want
+    # a short map taken at its word would see a rim 1 px wide: the check is what keeps the share
+    short = inner_distance(region.mask, 1.0)
+    assert rim_coverage(points, region, DEFAULT_CAMERA, inner=short, inner_reach=np.inf) != want

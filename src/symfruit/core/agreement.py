@@ -144,7 +144,9 @@ class Observation:
         With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
         outline crossing onto one is an occluder's edge).
     inner : (h, w) float, pixels, optional
-        The region's distance map (``ndimage.distance_transform_edt(region.mask)``), for reuse.
+        The region's distance map (``ndimage.distance_transform_edt(region.mask)``), for reuse: exact up to
+        ``inner_reach`` pixels, +inf beyond.
+    inner_reach : float, pixels
     """
 
     rays: np.ndarray
@@ -161,6 +163,7 @@ class Observation:
     extent: np.ndarray | None = None
     hidden: np.ndarray | None = None
     inner: np.ndarray | None = None
+    inner_reach: float = float("inf")
     #: What :func:`explain` reads of every candidate's rays alike (:func:`_bands`), made once per observation.
     _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -197,6 +200,7 @@ def observe(
     occluded_px: int = 4,
     contour_cone: float = 0.3,
     thin_px: int = 3,
+    inner_reach: float | None = None,
 ) -> Observation:
     """Reduce a view to sample rays and silhouette-band rays.
 
@@ -232,12 +236,18 @@ def observe(
         narrower than ``2 thin_px + 1`` pixels (stems) left out.
     occluded_px, thin_px : int, pixels
     contour_cone : float in [0, 1]
+    inner_reach : float, pixels, optional
+        How far inside the edge :attr:`Observation.inner` must be exact for its caller (e.g. a rim band); it is
+        then exact up to the larger of that and what this function reads of it (the bands, ``edge``, the 8 px
+        of the edge points' neighbourhoods) and +inf beyond, instead of the whole map (None).
     """
     points = as_points(points, min_count=3)
     sample = points[:: max(1, len(points) // n_rays)]
     rays = sample / sample[:, 2:3]
     mask = region.mask
-    inner = inner_distance(mask)
+    # every read of the map below compares it with at most this (the bands, ``edge``, _contour_points' 8 px)
+    reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
+    inner = inner_distance(mask, reach)
     # the outside bands read the map out to the widest band alone
     outer = outer_distance(mask, max(bands, default=0.0) + 0.5)
 
@@ -295,7 +305,7 @@ def observe(
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        hidden=None if occlusion is None else occlusion.window(region, radius=2),
-                       inner=inner)  # fmt: skip
+                       inner=inner, inner_reach=float("inf") if reach is None else reach)  # fmt: skip
 
 
 @dataclass(frozen=True)

@@ -255,32 +255,73 @@ def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
 
 
-def inner_distance(mask: np.ndarray) -> np.ndarray:
+def inner_distance(mask: np.ndarray, reach: float | None = None) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(mask)`` (each mask pixel's distance to the nearest
     pixel outside it), transformed over the mask's box grown by a pixel (clipped to the image) alone: a pixel on
     that grown border in the row or column of any farther background pixel is nearer, so the distances are the
-    same, and a mask in a wide window costs its own box."""
+    same, and a mask in a wide window costs its own box.
+
+    ``reach`` (pixels, >= 0): only the distances up to it are wanted; they are the same, to the bit, and farther
+    ones are +inf (:func:`_near_distance`'s shifts instead of scipy's transform: 0.24 against 0.40 ms for a disc
+    134 px across at 10.5 px; issue 19, seventh round)."""
     out = np.zeros(mask.shape)
     if (box := mask_box(mask)) is None:
         return out
     r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
     c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
-    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(mask[r0:r1, c0:c1])
+    part = mask[r0:r1, c0:c1]
+    if reach is None or part.all():  # no pixel outside the mask in reach of the shifts: scipy's map
+        out[r0:r1, c0:c1] = ndimage.distance_transform_edt(part)
+    else:
+        out[r0:r1, c0:c1] = _near_distance(~part, reach)
     return out
 
 
 def outer_distance(mask: np.ndarray, reach: float) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(~mask)`` (each pixel's distance to the nearest mask
-    pixel) wherever that is at most ``reach``, transformed over the mask's box grown by ``ceil(reach) + 1`` pixels
-    (clipped to the image) alone: every mask pixel lies in that box, so its distances are the same, and a pixel
-    beyond it is farther than ``reach`` from every mask pixel (+inf here). An empty mask: scipy's map."""
+    pixel) wherever that is at most ``reach``, +inf wherever it is farther. An empty mask: scipy's map.
+
+    Worked out over the mask's box grown by ``ceil(reach) + 1`` pixels (clipped to the image) by
+    :func:`_near_distance`, not by scipy's whole transform (issue 19, seventh round: 0.25 against 0.73 ms for a
+    150 px window at the bands' reach of 5.5 px; the same values within reach, to the bit)."""
     if (box := mask_box(mask)) is None:
         return ndimage.distance_transform_edt(~mask)
     m = int(np.ceil(reach)) + 1
     out = np.full(mask.shape, np.inf)
     r0, r1 = max(box[0] - m, 0), min(box[1] + m, mask.shape[0])
     c0, c1 = max(box[2] - m, 0), min(box[3] + m, mask.shape[1])
-    out[r0:r1, c0:c1] = ndimage.distance_transform_edt(~mask[r0:r1, c0:c1])
+    out[r0:r1, c0:c1] = _near_distance(mask[r0:r1, c0:c1], reach)
+    return out
+
+
+def _near_distance(mask: np.ndarray, reach: float) -> np.ndarray:
+    """(h, w) float: each pixel's Euclidean distance to the nearest true pixel of ``mask`` where that is at most
+    ``reach`` (``reach >= 0``), +inf elsewhere.
+
+    A true pixel within ``reach`` lies at most ``k = floor(reach)`` rows and columns away, so: each pixel's
+    distance along its column to the nearest true pixel, ``g``, by ``k`` shifts up and down (capped at ``k +
+    1``: farther is beyond reach), then ``min over |t| <= k of g(c + t)^2 + t^2`` by ``k`` shifts left and right.
+    Every term is the squared distance to a true pixel or at least ``(k + 1)^2 > reach^2``, and the nearest
+    true pixel's term is among them when it is within reach: the squared distance, a whole number, is exact
+    there, and its square root is scipy's (which takes the root of the same whole number). 4k + 2 passes over
+    small integers instead of scipy's feature transform (a few hundred instructions a pixel).
+    """
+    h, w = mask.shape
+    k = int(np.floor(reach))
+    cap = k + 1
+    kind = np.int16 if cap * cap + k * k < np.iinfo(np.int16).max else np.int64
+    base = np.where(mask, 0, cap).astype(kind)  # 0 on the mask, beyond reach elsewhere
+    g = base.copy()
+    for s in range(1, min(cap, h)):  # row offsets up to the reach, not a loop over pixels
+        np.minimum(g[s:], base[:-s] + kind(s), out=g[s:])
+        np.minimum(g[:-s], base[s:] + kind(s), out=g[:-s])
+    g2 = g * g
+    d2 = g2.copy()
+    for t in range(1, min(k, w - 1) + 1):  # column offsets up to the reach
+        np.minimum(d2[:, t:], g2[:, :-t] + kind(t * t), out=d2[:, t:])
+        np.minimum(d2[:, :-t], g2[:, t:] + kind(t * t), out=d2[:, :-t])
+    out = np.sqrt(d2, dtype=np.float64)
+    out[d2 > reach * reach] = np.inf
     return out
 
 

@@ -315,8 +315,13 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
 
 
+def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
+    """:func:`rim_coverage`'s rim width, pixels: ``band`` equivalent radii of the region ``mask``, at least 2."""
+    return max(2.0, band * float(np.sqrt(mask.sum() / np.pi)))
+
+
 def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15,
-                 inner: np.ndarray | None = None) -> float:  # fmt: skip
+                 inner: np.ndarray | None = None, inner_reach: float = np.inf) -> float:  # fmt: skip
     """How much of the seen region's rim holds seen points, relative to its interior, in [0, 1].
 
     The rim is the region's pixels within ``band`` equivalent radii (at least 2 px) of its edge; the share of
@@ -326,12 +331,13 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     depth of its widest section); a time-of-flight camera returns nothing there (it invalidates grazing
     pixels: the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the back face
     must then be extrapolated from the front's curvature alone. ``inner``: the region's distance map when known
-    (:attr:`~symfruit.core.agreement.Observation.inner`).
+    (:attr:`~symfruit.core.agreement.Observation.inner`), exact up to ``inner_reach`` pixels (it is made again
+    when that is short of the rim's width).
     """
     mask = region.mask
-    if inner is None or inner.shape != mask.shape:
+    width = rim_width(mask, band)
+    if inner is None or inner.shape != mask.shape or inner_reach < width:
         inner = inner_distance(mask)
-    width = max(2.0, band * float(np.sqrt(mask.sum() / np.pi)))
     rim = mask & (inner <= width)
     rest = mask & ~rim
     if not rim.any() or not rest.any():
@@ -428,7 +434,7 @@ def evidence(
         region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
-                  thin_px=s.thin_px)  # fmt: skip
+                  thin_px=s.thin_px, inner_reach=rim_width(region.mask))  # fmt: skip
     apex, _ = apex_depth(sample)
     front = max(float(points[:, 2].min()), apex)
     shapes: tuple[str, ...] = SHAPES
@@ -458,7 +464,7 @@ def evidence(
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
-    rim = rim_coverage(points, region, camera, inner=obs.inner)
+    rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach)
     seen_back = float(points[:, 2].max())
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=across)  # fmt: skip
