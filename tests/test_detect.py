@@ -54,6 +54,8 @@ def test_a_mask_over_the_whole_image_and_empty_depth_are_refused(example):
     empty = replace(example, depth=np.zeros_like(example.depth))
     with pytest.raises(InputError, match="no valid depth"):
         detect(empty)
+    with pytest.raises(InputError, match="no valid depth"):  # a range from 0 m does not take 0 (no depth) for depth
+        detect(empty, settings=Settings().replace(extract={"min_depth": 0.0}))
     # a depth_scale of 0.02 for millimetres: every depth 20 times too far, refused before the segmenter sees it
     far = replace(example, depth=example.depth * 20.0)
     median = float(np.median(far.depth[far.depth > 0]))

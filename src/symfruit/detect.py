@@ -113,13 +113,14 @@ def _check_depth_range(frame: Frame, near: float, far: float) -> None:
     """Refuse a frame whose depth holds nothing extraction could use: no depth at all, or none within its range
     (a wrong ``depth_scale`` puts a whole frame 10 or 1000 times too far or too near)."""
     depth = frame.depth
+    if ((depth >= max(near, 1e-9)) & (depth <= far)).any():  # one pass over the image on every usable frame
+        return
     if not (depth > 0).any():
         raise InputError(f"frame {frame.name}: the depth image holds no valid depth")
-    if not ((depth >= near) & (depth <= far)).any():
-        median = float(np.median(depth[depth > 0]))
-        raise InputError(f"frame {frame.name}: no depth within extraction's range {near:g}-{far:g} m "
-                         f"(extract.min_depth, extract.max_depth; the image's median depth is {median:.3g} m): is the "
-                         "frame's depth_scale right (metres per unit: 0.001 for millimetres)?")  # fmt: skip
+    median = float(np.median(depth[depth > 0]))
+    raise InputError(f"frame {frame.name}: no depth within extraction's range {near:g}-{far:g} m "
+                     f"(extract.min_depth, extract.max_depth; the image's median depth is {median:.3g} m): is the "
+                     "frame's depth_scale right (metres per unit: 0.001 for millimetres)?")  # fmt: skip
 
 
 def detect(
