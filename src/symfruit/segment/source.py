@@ -139,12 +139,18 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
             raise FileFormatError(f"{path}: {why} for frame {name!r} among its {len(coco.entries())} images (an "
                                   "image's file name or folder is matched to the frame's name; they are "
                                   f"{some}, ...)")  # fmt: skip
-        labels = np.zeros(color.shape[:2], np.int32)
-        for k, m in enumerate(coco.instances(found[0], color.shape[:2], category=None), 1):
-            labels[m] = k
-        return labels, str(path)
+        return _coco_labels(coco, found[0], color.shape[:2]), str(path)
 
     return MaskSource(str(path), from_coco)
+
+
+def _coco_labels(coco: Any, name: str, shape: tuple[int, int]) -> np.ndarray:
+    """One image's annotations of a :class:`~symfruit.io.masks.CocoSet` (every category) as instance labels, later
+    annotations over earlier ones."""
+    labels = np.zeros(shape, np.int32)
+    for k, m in enumerate(coco.instances(name, shape, category=None), 1):
+        labels[m] = k
+    return labels
 
 
 def _frames_folder(folder: Path) -> MaskSource | None:
@@ -175,10 +181,7 @@ def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
         coco = read_coco(source)
 
         def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
-            labels = np.zeros(color.shape[:2], np.int32)
-            for k, m in enumerate(coco.instances(name, color.shape[:2], category=None), 1):
-                labels[m] = k
-            return labels, where
+            return _coco_labels(coco, name, color.shape[:2]), where
 
         return MaskSource(where, from_coco)
     if source.is_dir():
