@@ -1373,10 +1373,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     flat = lab.ravel()
     at = np.flatnonzero(flat)
     la = flat.take(at)
-    count = np.bincount(la, minlength=n + 1).astype(np.float64)
-    zsum = np.bincount(la, weights=z_grid.ravel().take(at), minlength=n + 1)
-    zmean = zsum / np.maximum(np.bincount(la, weights=z_grid.ravel().take(at) > 0, minlength=n + 1), 1.0)
-    disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2  # a 1 m disc's area (pixels) at each depth
+    count, disc = _piece_discs(la, z_grid.ravel().take(at), n, focal)
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
     keep[0] = False
@@ -1407,11 +1404,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         flat = lab.ravel()
         at = np.flatnonzero(flat)
         la = flat.take(at)
-        count = np.bincount(la, minlength=n + 1).astype(np.float64)
-        zmean = np.bincount(la, weights=zw.ravel().take(at), minlength=n + 1) / np.maximum(
-            np.bincount(la, weights=zw.ravel().take(at) > 0, minlength=n + 1), 1.0
-        )
-        disc = np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
+        count, disc = _piece_discs(la, zw.ravel().take(at), n, focal)
         keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
         keep[0] = False
         rows, cols = np.divmod(at, lab.shape[1])
@@ -1430,6 +1423,16 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
             hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl])) & ((owner[sl] == 0) | part)
             bodies.append(_Body(sl, _depth_consistent(hull, part, sub_z, s.depth_jump), *fit))
     return bodies
+
+
+def _piece_discs(labels: np.ndarray, depth: np.ndarray, n: int, focal: float) -> tuple[np.ndarray, np.ndarray]:
+    """For pieces ``0..n`` (``labels`` of pixels with ``depth``, 0 where none): each one's pixel count, and the area
+    (pixels) a disc 1 m across would cover at its mean depth (over its pixels with depth)."""
+    count = np.bincount(labels, minlength=n + 1).astype(np.float64)
+    zmean = np.bincount(labels, weights=depth, minlength=n + 1) / np.maximum(
+        np.bincount(labels, weights=depth > 0, minlength=n + 1), 1.0
+    )
+    return count, np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
 
 
 #: Width (pixels) of the box over which a pixel without depth takes the farthest depth near it
