@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from symfruit import FileFormatError
-from symfruit.io.bags import image_array
+from symfruit.io.bags import color_image, image_array
 from symfruit.io.sources import open_source
 
 from ..conftest import SMALL_CAM, disc_frame
@@ -126,6 +126,30 @@ def test_colour_encodings_come_back_rgb():
     assert np.array_equal(image_array(message(mono, "mono8"), "sensor_msgs/msg/Image"), mono)
     padded = message(RGB, "rgb8", step=16)  # rows padded to 16 bytes
     assert np.array_equal(image_array(padded, "sensor_msgs/msg/Image"), RGB)
+
+
+@pytest.mark.parametrize(
+    "pixels, encoding",
+    [
+        (np.array([[40000, 300]], np.uint16), "16UC1"),
+        (np.array([[40000, 300]], np.uint16), "mono16"),
+        (np.array([[0.5, 1.0]], np.float32), "32FC1"),
+    ],
+)
+def test_a_colour_message_of_wider_pixels_is_refused_not_cut_to_8_bits(pixels, encoding):
+    with pytest.raises(FileFormatError, match=rf"colour image encoding '{encoding}' is not 8-bit colour \(use one of "
+                       r"rgb8, bgr8, rgba8, bgra8, mono8, 8uc1, 8uc3\)"):  # fmt: skip
+        color_image(message(pixels, encoding))
+
+
+def test_a_bag_whose_colour_topic_holds_16_bit_images_is_refused_by_name(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    wide = np.ascontiguousarray(color[:, :, 0]).astype(np.uint16) * 257  # what the 8-bit cut would have hidden
+    path = write_ros2_bag(tmp_path / "wide", wide.view(np.uint8).reshape(120, 320), (depth * 1000).astype(np.uint16),
+                          encoding="mono16")  # fmt: skip
+    with open_source(path) as src, pytest.raises(FileFormatError, match=r"wide: colour image encoding 'mono16'"):
+        src.read(0)
 
 
 def test_depth_encodings_keep_their_type():

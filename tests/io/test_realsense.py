@@ -223,10 +223,12 @@ def edited(field, value, topic_end):
     return edit
 
 
-def patch_encoding(new: bytes):
+def patch_encoding(new: bytes, old: bytes = b"mono16", topic_end: str = "Depth_0/image/data"):
     def edit(topic, raw):
-        if topic.endswith("Depth_0/image/data"):
-            return raw.replace(b"\x06\x00\x00\x00mono16", struct.pack("<I", len(new)) + new, 1)
+        if topic.endswith(topic_end):
+            key = struct.pack("<I", len(old)) + old
+            assert key in raw
+            return raw.replace(key, struct.pack("<I", len(new)) + new, 1)
         return raw
 
     return edit
@@ -237,6 +239,9 @@ def patch_encoding(new: bytes):
     [
         (patch_encoding(b"32FC1"), r"depth image encoding '32FC1': expected mono16", "read"),
         (patch_encoding(b"yuv422"), r"depth image encoding 'yuv422'", "read"),
+        # 16-bit "colour" is refused, never cut to its low 8 bits
+        (patch_encoding(b"mono16", b"rgb8", "Color_0/image/data"), r"colour image encoding 'mono16' is not 8-bit",
+         "read"),
         (edited("distortion_model", "Kannala Brandt4", "Color_0/info/camera_info"),
          r"lens model 'Kannala Brandt4' is not supported", "open"),
         (edited("width", 100_000, "Color_0/info/camera_info"), r"invalid intrinsics .*100000 pixels", "open"),

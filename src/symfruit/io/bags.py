@@ -103,8 +103,18 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
 
 
 def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray:
-    """(h, w, 3) uint8 RGB of a colour image message (:func:`image_array`; ``mono8`` repeated to grey RGB)."""
+    """(h, w, 3) uint8 RGB of a colour image message (:func:`image_array`; ``mono8`` repeated to grey RGB).
+
+    Raises
+    ------
+    FileFormatError
+        For anything :func:`image_array` refuses, or a 16-bit or float encoding (depth, not colour: it is
+        refused, never cut to 8 bits).
+    """
     img = image_array(msg, typename)
+    if img.dtype != np.uint8:
+        raise FileFormatError(f"colour image encoding {msg.encoding!r} is not 8-bit colour (use one of "
+                              f"{', '.join(e for e, (t, _) in _ENCODINGS.items() if t is np.uint8)})")  # fmt: skip
     if img.ndim == 2:
         img = np.repeat(img[:, :, None], 3, axis=2)
     return np.ascontiguousarray(img, dtype=np.uint8)
