@@ -1,12 +1,13 @@
 """Frames from ROS bags (optional extra ``bag``): a tiny ROS 2 bag end to end, image messages decoded
 by encoding, and broken bags named."""
 
+import re
 from types import SimpleNamespace
 
 import numpy as np
 import pytest
 
-from symfruit import FileFormatError
+from symfruit import FileFormatError, InputError
 from symfruit.io.bags import color_image, image_array
 from symfruit.io.sources import open_source
 
@@ -15,7 +16,18 @@ from ..conftest import SMALL_CAM, disc_frame
 CAM = SMALL_CAM
 
 
-def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_topic=True, k=None, encoding="rgb8"):
+def write_ros2_bag(
+    path,
+    color,
+    depth_mm,
+    *,
+    frames=2,
+    camera_info=True,
+    colour_topic=True,
+    k=None,
+    encoding="rgb8",
+    info_size=(160, 120),
+):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
@@ -31,7 +43,8 @@ def write_ros2_bag(path, color, depth_mm, *, frames=2, camera_info=True, colour_
         for i in range(frames):
             t = 1_000_000_000 * (i + 1)
             head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="camera_color_optical_frame")
-            info = Info(header=head, height=120, width=160, distortion_model="plumb_bob", d=np.zeros(5),
+            info = Info(header=head, height=info_size[1], width=info_size[0], distortion_model="plumb_bob",
+                        d=np.zeros(5),
                         k=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]) if k is None else np.asarray(k, float),
                         r=np.eye(3).ravel(),
                         p=np.array([600.0, 0, 80, 0, 0, 600, 60, 0, 0, 0, 1, 0]), binning_x=0, binning_y=0,
@@ -149,6 +162,21 @@ def test_a_bag_whose_colour_topic_holds_16_bit_images_is_refused_by_name(tmp_pat
     path = write_ros2_bag(tmp_path / "wide", wide.view(np.uint8).reshape(120, 320), (depth * 1000).astype(np.uint16),
                           encoding="mono16")  # fmt: skip
     with open_source(path) as src, pytest.raises(FileFormatError, match=r"wide: colour image encoding 'mono16'"):
+        src.read(0)
+
+
+def test_a_frame_whose_images_disagree_names_the_bag_and_stamp(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "small", color, (depth * 1000).astype(np.uint16), frames=1,
+                          k=[600.0, 0, 80, 0, 600, 60, 0, 0, 1], info_size=(320, 240))  # fmt: skip
+    with (
+        open_source(path) as src,
+        pytest.raises(
+            InputError,
+            match=rf"^{re.escape(str(path))}@1000001000: intrinsics are for 320x240 but the images are 160x120",
+        ),
+    ):
         src.read(0)
 
 

@@ -26,6 +26,7 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
+from .frames import named_frame
 
 __all__ = [
     "BagSource",
@@ -278,8 +279,8 @@ class BagSource:
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
             raise FileFormatError(named) from None
         # stamped like the colour image: the detections are in its frame (ROS outputs copy its header)
-        return Frame(name, color, depth, camera, source=f"{self.path}@{stamp}", stamp=_stamp(cmsg, cstamp),
-                     frame_id=header_frame_id(cmsg))  # fmt: skip
+        return named_frame(f"{self.path}@{stamp}", name, color, depth, camera, source=f"{self.path}@{stamp}",
+                           stamp=_stamp(cmsg, cstamp), frame_id=header_frame_id(cmsg))  # fmt: skip
 
     def close(self) -> None:
         """Close the bag."""

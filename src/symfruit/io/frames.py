@@ -35,6 +35,7 @@ __all__ = [
     "COLOR_NAMES",
     "DEFAULT_DEPTH_SCALE",
     "is_frame_folder",
+    "named_frame",
     "read_depth_npy",
     "read_frame",
     "read_truth",
@@ -94,7 +95,17 @@ def read_frame(folder: str | Path) -> Frame:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if (folder / "truth.json").is_file() else (None, {})
-    return Frame(folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
+    return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
+
+
+def named_frame(where: str, name: str, *args: Any, **kwargs: Any) -> Frame:
+    """``Frame(name, *args, **kwargs)`` for a reader: a frame it refuses (colour, depth and intrinsics of
+    different sizes, depth in millimetres...) is refused naming ``where`` (the folder, the bag and stamp)
+    instead of the frame's name alone."""
+    try:
+        return Frame(name, *args, **kwargs)
+    except InputError as exc:
+        raise InputError(f"{where}: {str(exc).removeprefix(f'frame {name}: ')}") from None
 
 
 def read_depth_npy(path: Path) -> np.ndarray:

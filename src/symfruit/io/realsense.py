@@ -42,6 +42,7 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
+from .frames import named_frame
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -284,9 +285,9 @@ class RealSenseBagSource:
         depth = np.multiply(units, np.float32(scale), dtype=np.float32)
         aligned = align_depth(depth, self.depth_stream.lens, self.color_stream.lens, self.rotation, self.translation)
         depth_stamp = self._depth_stamps[index][0]
-        return Frame(f"{self.path.stem}_{index:05d}_{depth_stamp}", color, aligned, self.color_stream.lens.camera,
-                     source=f"{self.path}@{depth_stamp}", stamp=stamp,
-                     extras={"depth_units": scale, "aligned_by": "symfruit"})  # fmt: skip
+        return named_frame(f"{self.path}@{depth_stamp}", f"{self.path.stem}_{index:05d}_{depth_stamp}", color, aligned,
+                           self.color_stream.lens.camera, source=f"{self.path}@{depth_stamp}", stamp=stamp,
+                           extras={"depth_units": scale, "aligned_by": "symfruit"})  # fmt: skip
 
     def close(self) -> None:
         """Close the bag."""
