@@ -72,6 +72,10 @@ def test_depth_from_a_folder_is_used_and_needs_a_camera(tmp_path):
     assert "depth is" in next(iter(bad.failed.values()))
     with pytest.raises(InputError, match="camera"):
         segment_images([folder], output=tmp_path / "out", depth=depth)
+    Image.fromarray(np.full((240, 320), 200, np.uint8)).save(depth / "p0.png")  # an 8-bit depth picture
+    (depth / "p0.npy").unlink()
+    eight = segment_images([folder], output=tmp_path / "o4", depth=depth, camera=cam)
+    assert "p0.png: depth PNG is 8-bit" in next(iter(eight.failed.values()))  # recorded, the batch went on
 
 
 def test_coco_and_label_folders_as_mask_sources(tmp_path):

@@ -495,7 +495,7 @@ def _read_depth(path: Path, scale: float, shape: tuple[int, int]) -> np.ndarray:
     if path.suffix.lower() == ".npy":
         depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
     else:
-        depth = read_depth_units(path).astype(np.float64) * scale
+        depth = read_depth_units(path, scale=scale).astype(np.float64) * scale
     if depth.shape != shape:
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth

@@ -69,6 +69,16 @@ def test_colour_and_depth_of_different_sizes(tmp_path):
         read_frame(tmp_path / "f")  # the folder named, not the frame's name alone
 
 
+def test_an_8_bit_depth_picture_is_refused_not_read_as_millimetres(tmp_path):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    Image.fromarray(np.clip(depth / depth.max() * 255, 0, 255).astype(np.uint8)).save(tmp_path / "f" / "depth.png")
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(tmp_path / 'f' / 'depth.png'))}: depth PNG is 8-bit"):
+        read_frame(tmp_path / "f")
+    (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), "depth_units": "cm"}))
+    assert read_frame(tmp_path / "f").depth.max() == pytest.approx(2.55)  # centimetres reach 2.55 m: depth
+
+
 @pytest.mark.parametrize("name", ["color.png", "depth.png", "camera.json", "truth.json"])
 def test_truncated_frame_files(tmp_path, name):
 

@@ -143,6 +143,13 @@ def test_depth_units(tmp_path):
     assert eight.dtype == np.uint16 and np.array_equal(eight, units.astype(np.uint8))
     with pytest.raises(FileFormatError, match=r"c\.png: depth PNG must be single-channel 16-bit, got mode 'RGB'"):
         read_depth_units(save(Image.new("RGB", (2, 2)), tmp_path / "c.png"))
+    # 8-bit depth is read where its units can reach real depth (centimetres: 2.55 m), and refused where they
+    # cannot (millimetres: 0.255 m; a depth picture normalised for viewing)
+    assert np.array_equal(read_depth_units(tmp_path / "d8.png", scale=0.01), units.astype(np.uint8))
+    with pytest.raises(FileFormatError, match=r"d8\.png: depth PNG is 8-bit: at 0\.001 m per unit it reaches only "
+                       r"0\.255 m, so it is a picture of depth"):  # fmt: skip
+        read_depth_units(tmp_path / "d8.png", scale=0.001)
+    assert np.array_equal(read_depth_units(tmp_path / "d.png", scale=0.001), units)  # 16-bit: any scale
 
 
 def test_labels_from_grey_palette_and_colour_images(tmp_path):

@@ -88,7 +88,7 @@ def read_frame(folder: str | Path) -> Frame:
     color = read_color(color_path)
     depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
     if depth_png.is_file():
-        depth = read_depth_units(depth_png).astype(np.float32) * np.float32(scale)
+        depth = read_depth_units(depth_png, scale=scale).astype(np.float32) * np.float32(scale)
     elif depth_npy.is_file():
         depth = read_depth_npy(depth_npy)
     else:

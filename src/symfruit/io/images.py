@@ -7,7 +7,8 @@ use            accepted modes -> result
 colour         ``RGB`` as is; ``RGBA``/``RGBX``/``RGBa``, ``P``/``PA`` (palette), ``L``/``LA``/``La``,
                ``1``, ``CMYK``, ``YCbCr``, ``LAB``, ``HSV`` converted to RGB; 16-bit grey
                (``I;16*``) and 32-bit ``I`` scaled to 8 bits -> ``(h, w, 3) uint8``
-depth          single channel ``I;16*``, ``I`` (0-65535) or ``L`` -> ``(h, w) uint16`` units
+depth          single channel ``I;16*``, ``I`` (0-65535) or ``L`` -> ``(h, w) uint16`` units (``L`` only
+               where 255 units reach 1 m: :data:`MIN_8BIT_DEPTH_REACH`)
 labels         ``1``, ``L``, ``P`` (palette indices are the labels), ``I;16*``, ``I`` -> ``(h, w)
                int32``; ``RGB``/``RGBA`` -> one label per distinct colour, black = background
 =============  ==============================================================================
@@ -133,13 +134,27 @@ def decode_color(data: bytes, label: str) -> np.ndarray:
         return _to_rgb(_decode(img, label), label)
 
 
-def read_depth_units(path: str | Path) -> np.ndarray:
-    """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each)."""
+#: Depth an 8-bit depth image must reach (255 units times the depth scale, metres) to be read as depth: one
+#: that reaches less (0.255 m at millimetre units) is a picture of depth (normalised to 0-255 for viewing),
+#: not a measurement, and would give every pixel a wrong depth.
+MIN_8BIT_DEPTH_REACH = 1.0
+
+
+def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndarray:
+    """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each).
+
+    With ``scale`` (metres per unit), an 8-bit image is refused when 255 units reach less than
+    :data:`MIN_8BIT_DEPTH_REACH`.
+    """
     path = Path(path)
     with _open(path, str(path)) as img:
         img = _decode(img, str(path))
         if img.mode not in _WIDE_GREY and img.mode != "L":
             raise FileFormatError(f"{path}: depth PNG must be single-channel 16-bit, got mode {img.mode!r}")
+        if img.mode == "L" and scale is not None and 255 * scale < MIN_8BIT_DEPTH_REACH:
+            raise FileFormatError(f"{path}: depth PNG is 8-bit: at {scale:g} m per unit it reaches only "
+                                  f"{255 * scale:.3g} m, so it is a picture of depth, not depth; write 16-bit units "
+                                  "(or give the depth scale that its 8-bit units stand for)")  # fmt: skip
         raw = np.asarray(img)
     if raw.ndim != 2:
         raise FileFormatError(f"{path}: depth PNG must be single-channel, got shape {raw.shape}")
