@@ -1,6 +1,8 @@
 """Depth registered to colour: librealsense's lens models (against the SDK's own functions when pyrealsense2
 imports), and known-answer alignments of a plane and a sphere seen by a depth camera with known extrinsics."""
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -136,3 +138,20 @@ def test_bad_inputs_are_refused():
     with pytest.raises(InputError, match="z must be"):
         align_depth(np.ones((120, 160)), Lens(DEPTH), Lens(COLOR), np.eye(3), np.zeros(3), z="both")
     assert not align_depth(np.zeros((120, 160)), Lens(DEPTH), Lens(COLOR), np.eye(3), np.zeros(3)).any()
+
+
+@pytest.mark.parametrize(
+    "color_lens, translation",
+    [
+        (Lens(COLOR, "brown_conrady", (1e30,) * 5), np.zeros(3)),  # a recorded lens model gone wild
+        (Lens(COLOR), np.array([1e12, 0.0, 0.0])),  # everything lands far off the image
+    ],
+)
+def test_depth_landing_far_off_the_colour_image_is_dropped_without_overflow(color_lens, translation):
+    depth = np.full((DEPTH.height, DEPTH.width), 0.5)
+    with np.errstate(all="raise"), warnings.catch_warnings():
+        warnings.simplefilter("error")  # no "invalid value encountered in cast" from far-off pixel indices
+        out = align_depth(depth, Lens(DEPTH), color_lens, np.eye(3), translation)
+    assert out.shape == (COLOR.height, COLOR.width) and np.isfinite(out).all()
+    if translation[0]:
+        assert not out.any()

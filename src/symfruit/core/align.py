@@ -231,6 +231,9 @@ def align_depth(
         zc = centre[:, 2] if z == "color" else zd
         ok = np.isfinite(x0) & np.isfinite(y0) & np.isfinite(x1) & np.isfinite(y1) & (centre[:, 2] > 0)
         ok &= (x1 - x0 < MAX_FOOTPRINT) & (y1 - y0 < MAX_FOOTPRINT)
+        # footprints wholly outside the colour image cover no pixel (the spans below would be empty); left out
+        # here so that far-off ones (a wild lens model's) are never cast to pixel indices
+        ok &= (x1 >= 0) & (y1 >= 0) & (x0 <= ccam.width - 1) & (y0 <= ccam.height - 1)
         x0, y0 = np.maximum(x0[ok], 0), np.maximum(y0[ok], 0)
         x1, y1 = np.minimum(x1[ok], ccam.width - 1), np.minimum(y1[ok], ccam.height - 1)
         zc = zc[ok]
