@@ -2,11 +2,13 @@
 
 import json
 import os
+from pathlib import Path
 
+import numpy as np
 import pytest
 
-from symfruit import ConfigError, FileFormatError, load_settings
-from symfruit.io.text import read_limited, read_structured
+from symfruit import ConfigError, FileFormatError, InputError, load_settings
+from symfruit.io.text import as_path, read_limited, read_structured
 
 
 def test_json_and_yaml_by_extension(tmp_path):
@@ -91,3 +93,21 @@ def test_other_problems_name_the_file(tmp_path):
         read_structured(tmp_path / "folder.json", what="camera file", max_bytes=100)
     with pytest.raises(ConfigError, match="no such thing"):
         read_structured(tmp_path / "missing.yaml", what="thing", max_bytes=100, error=ConfigError)
+
+
+def test_as_path_takes_paths_and_refuses_anything_else_by_name(tmp_path):
+    assert as_path("a/b.png", "x") == as_path(b"a/b.png", "x") == as_path(Path("a/b.png"), "x") == Path("a/b.png")
+    for value, kind in ((None, "NoneType"), (3, "int"), (["a"], "list"), (np.zeros(3), "ndarray")):
+        with pytest.raises(InputError, match=rf"^the image must be a path \(str or os\.PathLike\), got {kind}$"):
+            as_path(value, "the image")
+
+
+@pytest.mark.parametrize(
+    "reader", ["load_camera", "open_source", "read_cloud", "read_color", "read_depth_units", "read_frame",
+               "read_labels", "read_mesh"],
+)  # fmt: skip
+def test_every_reader_refuses_what_is_not_a_path_by_name(reader):
+    import symfruit.io
+
+    with pytest.raises(InputError, match=rf"^{reader}: the .* must be a path \(str or os\.PathLike\), got NoneType"):
+        getattr(symfruit.io, reader)(None)

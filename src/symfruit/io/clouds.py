@@ -19,6 +19,7 @@ import numpy as np
 from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
 from ..errors import FileFormatError
 from .atomic import atomic_write
+from .text import as_path
 
 __all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
 
@@ -36,7 +37,7 @@ def read_cloud(path: str | Path) -> np.ndarray:
     -------
     (n, 3) float64
     """
-    path = Path(path)
+    path = as_path(path, "read_cloud: the cloud file")
     reader = CLOUD_READERS.get(path.suffix.lower())
     if reader is None:
         known = ", ".join(sorted(CLOUD_READERS))

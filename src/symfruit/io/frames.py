@@ -29,7 +29,7 @@ from ..core.limits import MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
-from .text import read_structured
+from .text import as_path, read_structured
 
 __all__ = [
     "COLOR_NAMES",
@@ -73,7 +73,7 @@ def read_frame(folder: str | Path) -> Frame:
     from .intrinsics import camera_from_file_data, read_mapping
     from .masks import read_masks
 
-    folder = Path(folder)
+    folder = as_path(folder, "read_frame: the frame folder")
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such frame folder")
     color_path = _first(folder, *COLOR_NAMES)

@@ -28,6 +28,7 @@ import numpy as np
 
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  # checked before decoding
 from ..errors import FileFormatError
+from .text import as_path
 
 __all__ = ["MAX_IMAGE_PIXELS", "decode_color", "image_suffixes", "read_color", "read_depth_units", "read_labels"]
 
@@ -123,7 +124,7 @@ def _to_rgb(img: Any, label: str) -> np.ndarray:
 
 def read_color(path: str | Path) -> np.ndarray:
     """A colour image as ``(h, w, 3) uint8`` RGB, from any mode listed in the module docstring."""
-    path = Path(path)
+    path = as_path(path, "read_color: the image")
     with _open(path, str(path)) as img:
         return _to_rgb(_decode(img, str(path)), str(path))
 
@@ -146,7 +147,7 @@ def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndar
     With ``scale`` (metres per unit), an 8-bit image is refused when 255 units reach less than
     :data:`MIN_8BIT_DEPTH_REACH`.
     """
-    path = Path(path)
+    path = as_path(path, "read_depth_units: the depth image")
     with _open(path, str(path)) as img:
         img = _decode(img, str(path))
         if img.mode not in _WIDE_GREY and img.mode != "L":
@@ -167,7 +168,7 @@ def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndar
 
 def read_labels(path: str | Path) -> np.ndarray:
     """An instance label image as ``(h, w) int32`` (0 background); RGB label images get one label per colour."""
-    path = Path(path)
+    path = as_path(path, "read_labels: the label image")
     with _open(path, str(path)) as img:
         img = _decode(img, str(path))
         mode = img.mode

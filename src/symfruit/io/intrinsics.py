@@ -24,7 +24,7 @@ from typing import Any
 from ..core.camera import Camera
 from ..core.limits import MAX_SETTINGS_BYTES
 from ..errors import FileFormatError, InputError
-from .text import read_structured
+from .text import as_path, read_structured
 
 __all__ = ["camera_from_dict", "load_camera"]
 
@@ -36,7 +36,7 @@ _NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
 
 def load_camera(path: str | Path) -> Camera:
     """Read intrinsics from a ``.json``, ``.yaml`` or ``.yml`` file in any layout above."""
-    path = Path(path)
+    path = as_path(path, "load_camera: the intrinsics file")
     return camera_from_file_data(path, read_mapping(path))
 
 

@@ -9,14 +9,14 @@ import numpy as np
 from ..core.limits import MAX_FACES, MAX_OBJ_BYTES  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
 from .clouds import MAX_CLOUD_POINTS, ply_elements, ply_vertices
-from .text import read_limited
+from .text import as_path, read_limited
 
 __all__ = ["read_mesh"]
 
 
 def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
     """Read ``(vertices (v, 3) float, faces (f, 3) int or None)``; polygons are split into fans."""
-    path = Path(path)
+    path = as_path(path, "read_mesh: the mesh file")
     suffix = path.suffix.lower()
     if suffix == ".obj":
         return _read_obj(path)

@@ -28,6 +28,7 @@ from typing import Protocol, runtime_checkable
 from ..core.frame import Frame
 from ..errors import FileFormatError
 from .frames import is_frame_folder, read_frame
+from .text import as_path
 
 __all__ = ["FolderSource", "FrameFolderSource", "FrameSource", "open_source", "register_source", "source_kinds"]
 
@@ -154,7 +155,7 @@ def open_source(path: str | Path, *, exclude: Sequence[Path] = ()) -> FrameSourc
     FileFormatError
         When ``path`` is none of the registered kinds.
     """
-    path = Path(path)
+    path = as_path(path, "open_source: the recording")
     for kind in _KINDS:
         if kind.probe(path):
             return kind.open(path, exclude)

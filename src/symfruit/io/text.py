@@ -11,12 +11,24 @@ safely, errors naming the file.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import Any
 
-from ..errors import FileFormatError, SymfruitError
+from ..errors import FileFormatError, InputError, SymfruitError
 
-__all__ = ["read_limited", "read_structured"]
+__all__ = ["as_path", "read_limited", "read_structured"]
+
+
+def as_path(value: Any, what: str) -> Path:
+    """``value`` (``str``, ``bytes`` or ``os.PathLike``) as a :class:`~pathlib.Path`; anything else (None, a
+    number, an array handed to a reader) is refused naming ``what``, not a ``TypeError`` from pathlib."""
+    if isinstance(value, (str, bytes, os.PathLike)):
+        try:
+            return Path(os.fsdecode(value))
+        except TypeError:  # an os.PathLike whose __fspath__ returns neither str nor bytes
+            pass
+    raise InputError(f"{what} must be a path (str or os.PathLike), got {type(value).__name__}")
 
 
 def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError) -> bytes:
