@@ -514,6 +514,19 @@ def test_evaluate_masks_with_a_category_no_annotation_has_is_exit_2(tmp_path, ca
     _one_line_error(capsys, "no annotation has category 77")
 
 
+@pytest.mark.parametrize("protocol", ["paper", "camera", "masks"])
+def test_evaluate_refuses_a_results_root_that_is_a_file_before_it_evaluates(tmp_path, capsys, monkeypatch, protocol):
+    import symfruit.evaluate
+
+    def no_work(**kwargs):
+        raise AssertionError("evaluated before the results root was checked")
+
+    monkeypatch.setattr(symfruit.evaluate, "evaluate", no_work)
+    (tmp_path / "results").write_text("")
+    assert main(["evaluate", "--protocol", protocol, "--quick", "--output", str(tmp_path / "results")]) == 2
+    _one_line_error(capsys, "results: cannot create a results folder (the results root is a file)")
+
+
 def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
     (tmp_path / "big.yaml").write_text("a: [" + "1, " * 400_000 + "1]\n")
     assert main(["settings", "--config", str(tmp_path / "big.yaml")]) == 2

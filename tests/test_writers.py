@@ -16,6 +16,7 @@ from symfruit import FileFormatError, complete
 from symfruit.detect import FrameDetections
 from symfruit.writers import (
     OPTICAL_FRAME,
+    check_results_root,
     detections_record,
     draw_overlay,
     new_results_folder,
@@ -234,3 +235,14 @@ def test_the_overlay_tints_each_fruit_where_the_colour_image_shows_it():
     tinted = np.any(np.asarray(draw_overlay(found)) != color, axis=2)
     assert tinted[60, 50] and tinted[60, 89]  # the disc's left and right ends in the colour image
     assert not tinted[60, 95]  # beside the disc, where the moved mask reached (it ends at column 98)
+
+
+def test_a_results_root_that_cannot_hold_a_results_folder_is_refused_before_anything_is_made(tmp_path):
+    (tmp_path / "file").write_text("")
+    with pytest.raises(FileFormatError, match=r"file: cannot create a results folder \(the results root is a file\)"):
+        check_results_root(tmp_path / "file")
+    with pytest.raises(FileFormatError, match=r"file/a/b: .*lies below .*file, which is a file"):
+        check_results_root(tmp_path / "file" / "a" / "b")
+    check_results_root(tmp_path / "new" / "deeper")  # to be made: fine, and nothing made yet
+    check_results_root(tmp_path)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]

@@ -438,7 +438,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .evaluate import evaluate
     from .methods import get
     from .synthetic.shapes import FRUITS
+    from .writers import check_results_root
 
+    check_results_root(args.output)  # before the work, not after it
     if args.protocol == "masks":
         return _evaluate_masks(args)
     fruits = [f.strip() for f in args.fruit.split(",") if f.strip()]

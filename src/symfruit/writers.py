@@ -201,6 +201,27 @@ def remove_stale(folder: Path, *, keep: list[Path]) -> None:
                 os.unlink(name, dir_fd=fd)
 
 
+def check_results_root(root: str | Path) -> None:
+    """Refuse, before any work is done, a results root :func:`new_results_folder` could not write into: a
+    file, a path below a file, or a folder (or the nearest existing one above a root still to be made) that
+    is not writable. Nothing is created.
+
+    Raises
+    ------
+    FileFormatError
+        Naming ``root`` and the problem.
+    """
+    root = Path(root)
+    probe = root
+    while not probe.exists() and probe != probe.parent:  # the nearest existing folder, where mkdir would start
+        probe = probe.parent
+    if not probe.is_dir():
+        where = "is a file" if probe == root else f"lies below {probe}, which is a file"
+        raise FileFormatError(f"{root}: cannot create a results folder (the results root {where})")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise FileFormatError(f"{root}: cannot create a results folder ({probe} is not writable)")
+
+
 def new_results_folder(root: str | Path, tag: str) -> Path:
     """A new folder ``root/<YYYYmmdd-HHMMSS>-<tag>`` (``-2``, ``-3``... if taken) and a ``latest`` link to it.
 
