@@ -237,3 +237,71 @@ def test_a_mono8_colour_topic_gives_grey_rgb_frames(tmp_path):
     src = open_source(write_ros2_bag(tmp_path / "mono", grey, (depth * 1000).astype(np.uint16), encoding="mono8"))
     frame = src.read(0)
     assert frame.color.shape == (120, 160, 3) and np.array_equal(frame.color[:, :, 1], grey)
+
+
+def write_topics(path, topics, color, depth_mm):
+    """A ROS 2 bag of two frames on ``topics`` (``name -> kind``: colour, grey, depth, shifted depth or a
+    camera info of focal length ``fx``), written in the order given, 1 us apart."""
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    Image, Info = ts.types["sensor_msgs/msg/Image"], ts.types["sensor_msgs/msg/CameraInfo"]
+    Header, Time = ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
+    with Writer(path, version=9) as writer:
+        conns = {t: writer.add_connection(t, f"sensor_msgs/msg/{'CameraInfo' if isinstance(k, float) else 'Image'}",
+                                          typestore=ts) for t, k in topics.items()}  # fmt: skip
+        for i in range(2):
+            head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="x")
+            for j, (topic, kind) in enumerate(topics.items()):
+                if isinstance(kind, float):
+                    msg = Info(header=head, height=120, width=160, distortion_model="plumb_bob", d=np.zeros(5),
+                               k=np.array([kind, 0, 80, 0, kind, 60, 0, 0, 1]), r=np.eye(3).ravel(), p=np.zeros(12),
+                               binning_x=0, binning_y=0, roi=RoI(x_offset=0, y_offset=0, height=0, width=0,
+                                                                 do_rectify=False))  # fmt: skip
+                    typ = "sensor_msgs/msg/CameraInfo"
+                else:
+                    pixels = {"colour": color, "grey": np.full((120, 160), 90, np.uint8), "depth": depth_mm,
+                              "shifted": np.roll(depth_mm, 12, axis=1)}[kind]  # fmt: skip
+                    enc = {"colour": "rgb8", "grey": "mono8"}.get(kind, "16UC1")
+                    msg = Image(header=head, height=120, width=160, encoding=enc, is_bigendian=0,
+                                step=pixels.nbytes // 120, data=pixels.view(np.uint8).ravel())  # fmt: skip
+                    typ = "sensor_msgs/msg/Image"
+                writer.write(conns[topic], 1_000_000_000 * (i + 1) + 1000 * j, ts.serialize_cdr(msg, typ))
+    return path
+
+
+def test_a_realsense_ros_recording_is_read_from_its_aligned_depth_colour_and_colour_intrinsics(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    mm = (depth * 1000).astype(np.uint16)
+    ns = "/camera/camera/"
+    # as the realsense-ros launch file advertises them: raw depth and infrared before the aligned depth
+    topics = {ns + "infra1/image_rect_raw": "grey", ns + "infra1/camera_info": 420.0,
+              ns + "depth/image_rect_raw": "shifted", ns + "depth/camera_info": 420.0,
+              ns + "color/image_raw": "colour", ns + "color/camera_info": 600.0,
+              ns + "aligned_depth_to_color/image_raw": "depth",
+              ns + "aligned_depth_to_color/camera_info": 600.0}  # fmt: skip
+    with open_source(write_topics(tmp_path / "rs", topics, color, mm)) as src:
+        for i in range(2):
+            frame = src.read(i)
+            assert np.array_equal(frame.color, color) and np.allclose(frame.depth, mm / 1000.0)  # not infra, not raw
+            assert frame.camera == CAM  # the colour camera's intrinsics, never the depth camera's (fx 420)
+    # the colour camera's info missing: the aligned depth's is the colour camera's
+    del topics[ns + "color/camera_info"]
+    with open_source(write_topics(tmp_path / "rs2", topics, color, mm)) as src:
+        assert src.read(1).camera == CAM
+
+
+def test_a_bag_whose_colour_intrinsics_cannot_be_told_apart_is_refused_by_name(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    topics = {"/rgb/image": "colour", "/d/depth": "depth", "/a/camera_info": 600.0, "/b/camera_info": 420.0}
+    path = write_topics(tmp_path / "two", topics, color, (depth * 1000).astype(np.uint16))
+    with pytest.raises(FileFormatError, match=r"two: bag has several CameraInfo topics \(/a/camera_info, "
+                       r"/b/camera_info\) and none beside the colour topic /rgb/image"):  # fmt: skip
+        open_source(path)
+    del topics["/b/camera_info"]  # one camera info: it is the colour camera's
+    with open_source(write_topics(tmp_path / "one", topics, color, (depth * 1000).astype(np.uint16))) as src:
+        assert src.read(0).camera == CAM

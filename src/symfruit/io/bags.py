@@ -2,7 +2,8 @@
 
 Colour (``sensor_msgs/Image`` rgb8/bgr8/rgba8/bgra8/mono8, or ``CompressedImage``), depth (``Image``
 16UC1 in millimetres or 32FC1 in metres) and ``CameraInfo`` topics are found by type and name (a topic
-whose name contains "depth" is depth). Each depth image is one frame, paired with the colour image nearest
+whose name contains "depth" is depth; of several, the aligned depth, the ``color`` topic and the camera
+info beside it: :func:`_pick_topics`). Each depth image is one frame, paired with the colour image nearest
 in time (within ``max_skew``) and the latest camera info at or before it.
 
 The bag is indexed once (timestamps only; the raw message bytes pass through without being kept or
@@ -185,6 +186,41 @@ def _stamp(msg: Any, fallback: int) -> int:
     return value if value else fallback
 
 
+def _namespace(topic: str) -> str:
+    return topic.rsplit("/", 1)[0]
+
+
+def _pick_topics(depth: list[Any], color: list[Any], info: list[Any]) -> tuple[Any, Any, Any]:
+    """The depth, colour and CameraInfo connections a frame is read from, when a bag holds several (a
+    realsense-ros recording has ``depth/image_rect_raw`` beside ``aligned_depth_to_color/image_raw``,
+    ``infra1`` beside ``color``, and a camera info for each).
+
+    Depth aligned to colour (``aligned`` or ``registered`` in its name) comes first; colour is a topic named
+    ``color``/``colour``/``rgb`` before any other, and never an infrared one while there is another; the camera
+    info is the one beside the colour topic (same namespace), else beside the aligned depth (whose intrinsics
+    are the colour camera's), else the only one. Several camera infos and none of those is refused: taking
+    one at random could give the colour image the depth camera's intrinsics.
+    """
+
+    def has(conn: Any, *words: str) -> bool:
+        return any(w in conn.topic.lower() for w in words)
+
+    d = sorted(depth, key=lambda c: not has(c, "aligned", "registered"))[0]
+    named = [c for c in color if has(c, "color", "colour", "rgb")]
+    plain = [c for c in color if not has(c, "infra", "/ir/", "/ir_")]
+    c = (named or plain or color)[0]
+    beside = [i for i in info if _namespace(i.topic) == _namespace(c.topic)]
+    if not beside and has(d, "aligned", "registered"):
+        beside = [i for i in info if _namespace(i.topic) == _namespace(d.topic)]
+    if not beside and len(info) == 1:
+        beside = info
+    if not beside:
+        topics = ", ".join(i.topic for i in info)
+        raise FileFormatError(f"bag has several CameraInfo topics ({topics}) and none beside the colour topic "
+                              f"{c.topic}: which are the colour camera's intrinsics?")  # fmt: skip
+    return d, c, beside[0]
+
+
 class BagSource:
     """A bag as a recording: one frame per depth image (see the module docstring)."""
 
@@ -217,12 +253,12 @@ class BagSource:
                                   f"{', '.join(c.topic for c in conns) or 'none'})")  # fmt: skip
         if not info:
             raise FileFormatError("bag has no CameraInfo topic")
-        self._depth, self._color = depth[0], color[0]
+        self._depth, self._color, self._info = _pick_topics(depth, color, info)
         self._depth_stamps: list[int] = []
         self._color_stamps: list[int] = []
         self._cameras: list[tuple[int, Camera | str]] = []  # (stamp, camera or why it is invalid), on change
         last: Any = None
-        for conn, stamp, raw in self._reader.messages(connections=[*info, self._depth, self._color]):
+        for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
             if conn == self._depth:
                 self._depth_stamps.append(stamp)
             elif conn == self._color:
@@ -237,7 +273,7 @@ class BagSource:
         if not self._color_stamps:
             raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
         if not self._cameras:
-            raise FileFormatError(f"CameraInfo topic {info[0].topic} holds no messages")
+            raise FileFormatError(f"CameraInfo topic {self._info.topic} holds no messages")
         self._camera_stamps = [s for s, _ in self._cameras]
 
     def __len__(self) -> int:
