@@ -50,6 +50,7 @@ def test_readme_limits_are_the_enforced_constants():
     assert mesh == [limits.MAX_FACES, limits.MAX_OBJ_BYTES]
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
+    assert limits.MAX_BAG_METADATA_BYTES == limits.MAX_TRUTH_BYTES  # stated beside the truth file's
     tables = _numbers(next(v for k, v in table.items() if k.startswith("a run's fruit table")))
     assert tables == [limits.MAX_TABLE_ROWS, limits.MAX_TABLE_BYTES]
     masks = _numbers(next(v for k, v in table.items() if k.startswith("fruit per")))
@@ -71,6 +72,7 @@ def test_the_modules_use_the_one_set_of_bounds():
     assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
     assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
     assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
+    assert bags.MAX_BAG_METADATA_BYTES is limits.MAX_BAG_METADATA_BYTES
 
 
 @pytest.mark.parametrize(("w", "h", "message"), [

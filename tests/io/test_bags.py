@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from symfruit import FileFormatError, InputError
+from symfruit.core.limits import MAX_BAG_METADATA_BYTES
 from symfruit.io.bags import color_image, image_array
 from symfruit.io.sources import open_source
 
@@ -305,3 +306,20 @@ def test_a_bag_whose_colour_intrinsics_cannot_be_told_apart_is_refused_by_name(t
     del topics["/b/camera_info"]  # one camera info: it is the colour camera's
     with open_source(write_topics(tmp_path / "one", topics, color, (depth * 1000).astype(np.uint16))) as src:
         assert src.read(0).camera == CAM
+
+
+def test_a_ros2_bag_metadata_file_that_is_huge_or_not_a_file_is_refused_before_rosbags_reads_it(tmp_path):
+    pytest.importorskip("rosbags")
+    from symfruit.io.bags import BagSource
+
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "meta", color, (depth * 1000).astype(np.uint16), frames=1)
+    meta = path / "metadata.yaml"
+    with meta.open("a") as handle:  # rosbags would read all of it before parsing a byte
+        handle.truncate(MAX_BAG_METADATA_BYTES + 1)
+    with pytest.raises(FileFormatError, match=r"metadata\.yaml: bag metadata is 16,777,217 bytes; at most 16 MB"):
+        BagSource(path)
+    meta.unlink()
+    meta.symlink_to("/dev/zero")  # read_text() would never end
+    with pytest.raises(FileFormatError, match=r"metadata\.yaml: bag metadata is missing or not a regular file"):
+        BagSource(path)

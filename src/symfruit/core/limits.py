@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import InputError, SymfruitError
 
 __all__ = [
+    "MAX_BAG_METADATA_BYTES",
     "MAX_CLOUD_POINTS",
     "MAX_COCO_BYTES",
     "MAX_DEPTH_METRES",
@@ -57,6 +58,9 @@ MAX_OBJ_BYTES = 64 << 20
 MAX_SETTINGS_BYTES = 1 << 20
 MAX_TRUTH_BYTES = 16 << 20
 MAX_COCO_BYTES = 256 << 20
+#: Largest ``metadata.yaml`` of a ROS 2 bag folder (bytes), checked before rosbags reads it whole: a few kB per
+#: topic and split file; as large as a truth file may be.
+MAX_BAG_METADATA_BYTES = MAX_TRUTH_BYTES
 #: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
 MAX_INSTANCES = 1000
 MAX_LABEL_ID = 2**31 - 1

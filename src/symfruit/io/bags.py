@@ -25,7 +25,7 @@ import numpy as np
 
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_IMAGE_PIXELS, check_image_size
+from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
 
@@ -186,6 +186,20 @@ def _stamp(msg: Any, fallback: int) -> int:
     return value if value else fallback
 
 
+def _check_metadata(path: Path) -> None:
+    """Refuse a ROS 2 bag's ``metadata.yaml`` that rosbags would read without end or bound: not a regular
+    file (a link to ``/dev/zero``, a pipe) or larger than :data:`~symfruit.core.limits.MAX_BAG_METADATA_BYTES`."""
+    try:
+        size = path.stat().st_size if path.is_file() else None
+    except OSError as exc:
+        raise FileFormatError(f"{path}: cannot read bag metadata ({exc.strerror or exc})") from None
+    if size is None:
+        raise FileFormatError(f"{path}: bag metadata is missing or not a regular file")
+    if size > MAX_BAG_METADATA_BYTES:
+        raise FileFormatError(f"{path}: bag metadata is {size:,} bytes; at most {MAX_BAG_METADATA_BYTES >> 20} MB "
+                              "are read (a rosbag2 metadata.yaml takes a few kB)")  # fmt: skip
+
+
 def _namespace(topic: str) -> str:
     return topic.rsplit("/", 1)[0]
 
@@ -228,6 +242,8 @@ class BagSource:
         self.path = Path(path)
         self.max_skew = max_skew
         reader_cls = _require_rosbags()
+        if self.path.is_dir():
+            _check_metadata(self.path / "metadata.yaml")
         try:
             self._reader = reader_cls([self.path])
             self._reader.open()
