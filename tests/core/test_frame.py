@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from symfruit import Box, InputError
-from symfruit.core.frame import Frame
+from symfruit.core.frame import MAX_STAMP_NS, Frame
 
 from ..conftest import SMALL_CAM, disc_frame
 
@@ -17,6 +17,8 @@ def test_a_consistent_frame_keeps_what_it_is_given():
     frame = Frame("f", COLOR, DEPTH, SMALL_CAM, masks=masks, truth=truth, source="here", stamp=5)
     assert frame.color is COLOR and frame.depth is DEPTH and frame.masks is masks and frame.truth == truth
     assert (frame.source, frame.stamp, frame.extras) == ("here", 5, {})
+    stamped = Frame("f", COLOR, DEPTH, SMALL_CAM, stamp=np.int64(MAX_STAMP_NS - 1))  # the last time there is
+    assert type(stamped.stamp) is int and stamped.stamp == MAX_STAMP_NS - 1
     bare = Frame("g", COLOR, DEPTH, SMALL_CAM)
     assert bare.masks is None and bare.truth is None and bare.source == "" and bare.stamp is None
 
@@ -48,6 +50,10 @@ def test_inconsistent_frames_are_refused_by_name(change, message):
         ({"depth": DEPTH * 1000}, "look like millimetres"),
         ({"masks": np.where(DEPTH > 0, 2**40, 0)}, "beyond 32 bits"),
         ({"masks": np.zeros((120, 160))}, "whole numbers"),
+        ({"stamp": -5}, r"stamp -5 ns is not a time \(0 to 2\*\*33 s after 1970\)"),
+        ({"stamp": MAX_STAMP_NS}, "is not a time"),
+        ({"stamp": 1.5e9}, "stamp must be whole nanoseconds since the epoch, got float"),
+        ({"stamp": True}, "got bool"),
     ],
 )
 def test_api_inputs_of_the_wrong_kind_or_units_are_refused(change, message):

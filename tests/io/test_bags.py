@@ -240,9 +240,10 @@ def test_a_mono8_colour_topic_gives_grey_rgb_frames(tmp_path):
     assert frame.color.shape == (120, 160, 3) and np.array_equal(frame.color[:, :, 1], grey)
 
 
-def write_topics(path, topics, color, depth_mm):
+def write_topics(path, topics, color, depth_mm, *, sec=None):
     """A ROS 2 bag of two frames on ``topics`` (``name -> kind``: colour, grey, depth, shifted depth or a
-    camera info of focal length ``fx``), written in the order given, 1 us apart."""
+    camera info of focal length ``fx``), written in the order given, 1 us apart (headers stamped ``sec``
+    when given, else with the frame's second)."""
     from rosbags.rosbag2 import Writer
     from rosbags.typesys import Stores, get_typestore
 
@@ -254,7 +255,7 @@ def write_topics(path, topics, color, depth_mm):
         conns = {t: writer.add_connection(t, f"sensor_msgs/msg/{'CameraInfo' if isinstance(k, float) else 'Image'}",
                                           typestore=ts) for t, k in topics.items()}  # fmt: skip
         for i in range(2):
-            head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="x")
+            head = Header(stamp=Time(sec=i + 1 if sec is None else sec, nanosec=0), frame_id="x")
             for j, (topic, kind) in enumerate(topics.items()):
                 if isinstance(kind, float):
                     msg = Info(header=head, height=120, width=160, distortion_model="plumb_bob", d=np.zeros(5),
@@ -323,3 +324,24 @@ def test_a_ros2_bag_metadata_file_that_is_huge_or_not_a_file_is_refused_before_r
     meta.symlink_to("/dev/zero")  # read_text() would never end
     with pytest.raises(FileFormatError, match=r"metadata\.yaml: bag metadata is missing or not a regular file"):
         BagSource(path)
+
+
+def test_a_stamp_that_is_not_a_time_is_no_stamp():
+    from symfruit.core.frame import MAX_STAMP_NS
+    from symfruit.io.bags import header_stamp
+
+    def msg(sec, nanosec=0):
+        return SimpleNamespace(header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec)))
+
+    assert header_stamp(msg(3, 5)) == 3_000_000_005 and header_stamp(msg(1, 4_000_000_000)) == 5_000_000_000
+    assert header_stamp(msg(-5)) is None and header_stamp(msg(MAX_STAMP_NS // 1_000_000_000)) is None
+    assert header_stamp(SimpleNamespace()) is None
+
+
+def test_a_colour_image_stamped_before_1970_is_stamped_with_the_bags_time(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    topics = {"/rgb/image": "colour", "/d/depth": "depth", "/rgb/camera_info": 600.0}
+    path = write_topics(tmp_path / "neg", topics, color, (depth * 1000).astype(np.uint16), sec=-5)
+    with open_source(path) as src:
+        assert src.read(1).stamp == 2_000_000_000  # the colour message's time in the bag, not -5 s

@@ -12,7 +12,11 @@ from .box import Box
 from .camera import Camera
 from .limits import depth_metres, instance_labels
 
-__all__ = ["Frame"]
+__all__ = ["MAX_STAMP_NS", "Frame"]
+
+#: Stamps are nanoseconds since the epoch in [0, MAX_STAMP_NS): 2**33 s, the year 2242 (the range a run's
+#: fruit table reads back, :mod:`symfruit.season.table`).
+MAX_STAMP_NS = 2**33 * 1_000_000_000
 
 
 @dataclass(frozen=True)
@@ -83,3 +87,10 @@ class Frame:
         if self.masks is not None and self.masks.shape != (h, w):
             raise InputError(f"frame {self.name}: masks are {self.masks.shape[1]}x{self.masks.shape[0]}, "
                              f"the image {w}x{h}")  # fmt: skip
+        if self.stamp is not None:
+            if isinstance(self.stamp, bool) or not isinstance(self.stamp, (int, np.integer)):
+                raise InputError(f"frame {self.name}: stamp must be whole nanoseconds since the epoch, got "
+                                 f"{type(self.stamp).__name__}")  # fmt: skip
+            if not 0 <= self.stamp < MAX_STAMP_NS:
+                raise InputError(f"frame {self.name}: stamp {self.stamp} ns is not a time (0 to 2**33 s after 1970)")
+            object.__setattr__(self, "stamp", int(self.stamp))

@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..core.camera import Camera
-from ..core.frame import Frame
+from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
@@ -166,13 +166,15 @@ def camera_from_info(msg: Any, *, width: int | None = None, height: int | None =
 
 
 def header_stamp(msg: Any) -> int | None:
-    """A message's header stamp in nanoseconds (``sec``/``nanosec`` or ``secs``/``nsecs``); None without one."""
+    """A message's header stamp in nanoseconds (``sec``/``nanosec`` or ``secs``/``nsecs``); None without one,
+    or for one that is not a time (before 1970 or from 2242 on: :data:`~symfruit.core.frame.MAX_STAMP_NS`)."""
     stamp = getattr(getattr(msg, "header", None), "stamp", None)
     if stamp is None:
         return None
     sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
     nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
-    return int(sec) * 1_000_000_000 + int(nsec)
+    value = int(sec) * 1_000_000_000 + int(nsec)
+    return value if 0 <= value < MAX_STAMP_NS else None
 
 
 def header_frame_id(msg: Any) -> str:
@@ -181,7 +183,7 @@ def header_frame_id(msg: Any) -> str:
 
 
 def _stamp(msg: Any, fallback: int) -> int:
-    """The header stamp in nanoseconds, else ``fallback`` (also for a zero stamp)."""
+    """The header stamp in nanoseconds, else ``fallback`` (also for a zero stamp or one that is not a time)."""
     value = header_stamp(msg)
     return value if value else fallback
 
