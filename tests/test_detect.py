@@ -132,7 +132,7 @@ def test_mask_sources_in_order_of_preference(tmp_path):
 
 def test_masks_that_do_not_fit_the_frame_are_refused():
     frame = small_frame()
-    with pytest.raises(InputError, match=r"frame small: masks are \(10, 10\), the image \(160, 120\)"):
+    with pytest.raises(InputError, match=r"frame small: masks are 10x10, the image 160x120"):
         frame_masks(frame, lambda f, s: np.zeros((10, 10), np.int32))
     negative = np.zeros((120, 160), np.int32)
     negative[0, 0] = -1
@@ -142,8 +142,12 @@ def test_masks_that_do_not_fit_the_frame_are_refused():
         detect(frame, masks=negative)
     with pytest.raises(InputError, match=r"frame small: masks \(label array\): instance labels must be whole"):
         detect(frame, masks=np.zeros((120, 160)))
-    with pytest.raises(InputError, match=r"frame small: masks are \(10, 10\), the image \(160, 120\)"):
+    with pytest.raises(InputError, match=r"frame small: masks are 10x10, the image 160x120"):
         detect(frame, masks=np.zeros((10, 10), bool))
+    with pytest.raises(
+        InputError, match=r"frame small: masks must be an \(h, w\) label image, got shape \(120, 160, 3\)"
+    ):
+        detect(frame, masks=np.zeros((120, 160, 3), np.int32))  # an RGB label picture: not read as labels
     with pytest.raises(InputError, match=r"unknown method 'nope'; available: .*evidence"):
         detect(frame, masks=negative, method="nope")  # refused before the masks are read
     with pytest.raises(InputError, match=r"masks must be a spec .* got int"):

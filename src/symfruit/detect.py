@@ -103,8 +103,11 @@ def frame_masks(
     else:
         source_of = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings)
         labels, source = source_of(frame.color, frame.depth, frame.camera, name=frame.name, own=frame.masks)
+    if labels.ndim != 2:
+        raise InputError(f"frame {frame.name}: masks must be an (h, w) label image, got shape {labels.shape}")
     if labels.shape != shape:
-        raise InputError(f"frame {frame.name}: masks are {labels.shape[::-1]}, the image {shape[::-1]}")
+        raise InputError(f"frame {frame.name}: masks are {labels.shape[1]}x{labels.shape[0]}, the image "
+                         f"{shape[1]}x{shape[0]}")  # fmt: skip
     # whole numbers, at most MAX_INSTANCES fruit; ids beyond 32 bits refused, never truncated into others
     return instance_labels(labels, f"frame {frame.name}: masks ({source})"), source
 
