@@ -97,7 +97,8 @@ def test_a_header_claiming_too_many_pixels_is_refused_before_decoding(tmp_path, 
     with pytest.raises(FileFormatError, match=rf"wide\.png: image is {side}x{side} pixels; at most 40,000,000"):
         read_color(tmp_path / "wide.png")
     (tmp_path / "bomb.png").write_bytes(png_header(100_000, 100_000))  # over Pillow's bound as well
-    with pytest.raises(FileFormatError, match=r"bomb\.png: image (too large|is 100000x100000)"):
+    with pytest.raises(FileFormatError, match=r"bomb\.png: image of 10,000,000,000 pixels; at most 40,000,000 pixels "
+                       "are read$"):  # Pillow's own bound (and its number) tripped first: ours is stated  # fmt: skip
         read_color(tmp_path / "bomb.png")
     with pytest.raises(FileFormatError, match="at most"):
         read_depth_units(tmp_path / "wide.png")

@@ -20,6 +20,7 @@ errors, including its decompression-bomb error, never escape.
 from __future__ import annotations
 
 import io
+import re
 import warnings
 from pathlib import Path
 from typing import Any
@@ -60,7 +61,10 @@ def _open(source: Path | bytes, label: str) -> Any:
     except FileNotFoundError:
         raise FileFormatError(f"{label}: no such image") from None
     except (Image.DecompressionBombError, Image.DecompressionBombWarning) as exc:
-        raise FileFormatError(f"{label}: image too large ({exc})") from None
+        # Pillow's own, looser bound tripped first (its message names its bound, not ours): say ours
+        claimed = re.search(r"\((\d+) pixels\)", str(exc))
+        size = f"image of {int(claimed.group(1)):,} pixels" if claimed else "image too large"
+        raise FileFormatError(f"{label}: {size}; at most {MAX_IMAGE_PIXELS:,} pixels are read") from None
     except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
         raise FileFormatError(f"{label}: cannot read image ({exc})") from None
     try:
