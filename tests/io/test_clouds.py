@@ -1,6 +1,7 @@
 """Point clouds: each format round-trips, sizes are checked before reading, and no file, however
 broken, makes a reader fail other than with a :class:`~symfruit.errors.SymfruitError`."""
 
+import os
 import struct
 
 import numpy as np
@@ -191,6 +192,14 @@ def test_a_huge_npy_header_and_an_npz_named_npy_are_refused(tmp_path):
     (tmp_path / "points.npz").rename(npz)
     with pytest.raises(FileFormatError, match=r"points\.npy: is an \.npz archive"):
         read_cloud(npz)
+
+
+def test_a_pipe_named_as_an_npy_array_is_refused_without_waiting_for_a_writer(tmp_path):
+    from symfruit.io.clouds import npy_header  # also how depth.npy and segment --depth .npy are read
+
+    os.mkfifo(tmp_path / "depth.npy")
+    with pytest.raises(FileFormatError, match=r"depth\.npy: is a pipe or a socket; the \.npy array must be a regular"):
+        npy_header(tmp_path / "depth.npy")
 
 
 def test_text_clouds_are_bounded_in_rows_and_bytes(tmp_path, monkeypatch):

@@ -2,6 +2,7 @@
 checked from the header before any pixel is decoded."""
 
 import io
+import os
 import struct
 import zlib
 
@@ -201,3 +202,10 @@ def test_image_readers_survive_corrupted_pngs(tmp_path, where, byte, cut):
             reader(path)
         except SymfruitError:
             pass
+
+
+def test_a_pipe_named_as_an_image_is_refused_without_waiting_for_a_writer(tmp_path):
+    os.mkfifo(tmp_path / "depth.png")  # opening it to read would block until something writes to it
+    for reader in (read_color, read_depth_units, read_labels):
+        with pytest.raises(FileFormatError, match=r"depth\.png: is a pipe or a socket; the image must be a regular"):
+            reader(tmp_path / "depth.png")

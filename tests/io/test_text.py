@@ -40,6 +40,17 @@ def test_a_symlink_to_an_endless_file_is_refused_after_the_bound(tmp_path):
         read_limited(link, what="file", max_bytes=10)
 
 
+def test_a_pipe_is_refused_without_waiting_for_a_writer(tmp_path):
+    pipe = tmp_path / "settings.yaml"
+    os.mkfifo(pipe)  # opening it to read would block until something writes to it
+    with pytest.raises(
+        ConfigError, match=r"settings\.yaml: is a pipe or a socket; the settings file must be a regular file"
+    ):
+        load_settings(pipe)
+    with pytest.raises(FileFormatError, match=r"settings\.yaml: is a pipe or a socket; the file must be"):
+        read_structured(pipe, what="file", max_bytes=10)
+
+
 def test_yaml_aliases_are_refused(tmp_path):
     bomb = tmp_path / "bomb.yaml"
     bomb.write_text('a: &a ["x", "x"]\nb: &b [*a, *a]\nc: &c [*b, *b]\n')

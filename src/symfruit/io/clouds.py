@@ -19,7 +19,7 @@ import numpy as np
 from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
 from ..errors import FileFormatError
 from .atomic import atomic_write
-from .text import as_path
+from .text import as_path, refuse_pipe
 
 __all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
 
@@ -335,6 +335,7 @@ def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
         For a file that is not ``.npy`` (an ``.npz`` archive is named as such), a header numpy cannot
         parse, an object (pickled) dtype, or data shorter than the header promises.
     """
+    refuse_pipe(path, ".npy array")
     try:
         with open(path, "rb") as handle:
             magic = handle.read(6)

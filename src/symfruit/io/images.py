@@ -29,7 +29,7 @@ import numpy as np
 
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  # checked before decoding
 from ..errors import FileFormatError
-from .text import as_path
+from .text import as_path, refuse_pipe
 
 __all__ = ["MAX_IMAGE_PIXELS", "decode_color", "image_suffixes", "read_color", "read_depth_units", "read_labels"]
 
@@ -54,6 +54,8 @@ def _open(source: Path | bytes, label: str) -> Any:
     """The opened (not yet decoded) Pillow image, size-checked; ``label`` names it in errors."""
     from PIL import Image, UnidentifiedImageError
 
+    if not isinstance(source, bytes):
+        refuse_pipe(source, "image")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)

@@ -12,12 +12,13 @@ from __future__ import annotations
 
 import json
 import os
+import stat
 from pathlib import Path
 from typing import Any
 
 from ..errors import FileFormatError, InputError, SymfruitError
 
-__all__ = ["as_path", "read_limited", "read_structured"]
+__all__ = ["as_path", "read_limited", "read_structured", "refuse_pipe"]
 
 
 def as_path(value: Any, what: str) -> Path:
@@ -31,8 +32,21 @@ def as_path(value: Any, what: str) -> Path:
     raise InputError(f"{what} must be a path (str or os.PathLike), got {type(value).__name__}")
 
 
+def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileFormatError) -> None:
+    """Refuse a pipe or a socket named as a file (opening one to read waits for a writer that may never
+    come); anything else, a missing file included, is left to the open that follows to name."""
+    try:
+        mode = os.stat(path).st_mode
+    except (OSError, ValueError):
+        return
+    if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
+        raise error(f"{path}: is a pipe or a socket; the {what} must be a regular file")
+
+
 def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError) -> bytes:
-    """The bytes of ``path``, refusing anything over ``max_bytes`` (read is bounded, not trusted to stat)."""
+    """The bytes of ``path``, refusing anything over ``max_bytes`` (read is bounded, not trusted to stat), and a
+    pipe or socket (opening one waits for a writer that may never come)."""
+    refuse_pipe(path, what, error=error)
     try:
         with open(path, "rb") as handle:
             data = handle.read(max_bytes + 1)
