@@ -527,6 +527,18 @@ def test_evaluate_refuses_a_results_root_that_is_a_file_before_it_evaluates(tmp_
     _one_line_error(capsys, "results: cannot create a results folder (the results root is a file)")
 
 
+def test_a_frame_folder_named_with_bytes_that_are_not_utf8_is_run_and_reported(tmp_path, capsys):
+    rec = tmp_path / "rec"
+    shutil.copytree(EXAMPLE_FRAME, rec / "good")
+    bad = rec / os.fsdecode(b"bad\xff")
+    bad.mkdir()
+    (bad / "color.png").write_bytes(b"")  # fails: its name is printed and written into the tables
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
+    out = capsys.readouterr().out  # pytest's capture is strict UTF-8, as a terminal in a UTF-8 locale is
+    assert "failed bad\\udcff: " in out and "frames: 1 done" in out
+    assert (tmp_path / "out" / "frames.parquet").is_file()
+
+
 def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
     (tmp_path / "big.yaml").write_text("a: [" + "1, " * 400_000 + "1]\n")
     assert main(["settings", "--config", str(tmp_path / "big.yaml")]) == 2

@@ -782,8 +782,18 @@ _COMMANDS = {
 }
 
 
+def _printable_names() -> None:
+    """Let names that are not valid UTF-8 (a folder named with other bytes, which Python keeps as lone
+    surrogates) be printed as backslash escapes where the terminal's encoding would refuse them (a UTF-8
+    locale other than C), instead of a traceback after the work is done."""
+    for stream in (sys.stdout, sys.stderr):
+        if getattr(stream, "errors", None) == "strict" and hasattr(stream, "reconfigure"):
+            stream.reconfigure(errors="backslashreplace")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symfruit`` console script; returns the exit status."""
+    _printable_names()
     parser = _parser()
     args = parser.parse_args(argv)
     if args.command is None:

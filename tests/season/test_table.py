@@ -2,6 +2,7 @@
 --resume with each fruit once, and a record that is not one refused by name."""
 
 import json
+import os
 import shutil
 
 import pyarrow.parquet as pq
@@ -69,6 +70,14 @@ def test_the_tables_appear_whole_or_not_at_all(tmp_path):
         raise RuntimeError("the run dies")
     assert pq.read_table(tmp_path / "detections.parquet").equals(before)  # the earlier table stays
     assert sorted(p.name for p in tmp_path.iterdir()) == ["detections.parquet", "frames.parquet"]
+
+
+def test_names_that_are_not_utf8_go_into_the_tables_escaped(tmp_path):
+    name = os.fsdecode(b"row\xff")  # a folder named with bytes that are not UTF-8: Python keeps "row\udcff"
+    with TableWriter(tmp_path) as table:
+        table.add(*frame_rows({**RECORD, "frame": name}, name))
+    rows = pq.read_table(tmp_path / "frames.parquet", columns=["recording", "frame"]).to_pylist()
+    assert rows == [{"recording": "row\\udcff", "frame": "row\\udcff"}]
 
 
 def test_row_groups_stream_and_an_empty_run_has_empty_tables(tmp_path, monkeypatch):

@@ -121,8 +121,20 @@ def _flag(value: Any, what: str) -> bool | None:
 
 def _text(value: Any, what: str) -> str | None:
     if value is None or isinstance(value, str):
-        return value
+        return _utf8(value)
     raise FileFormatError(f"{what} is {type(value).__name__}, not text")
+
+
+def _utf8(value: str | None) -> str | None:
+    """``value`` as Parquet can hold it: a name that is not valid UTF-8 (a folder named with other bytes,
+    kept by Python as lone surrogates) with those characters written as backslash escapes."""
+    if value is None:
+        return None
+    try:
+        value.encode("utf-8")
+    except UnicodeEncodeError:
+        return value.encode("utf-8", "backslashreplace").decode("utf-8")
+    return value
 
 
 def _triple(value: Any, what: str) -> list[float | None]:
@@ -158,6 +170,7 @@ def frame_rows(record: Mapping[str, Any], recording: str) -> tuple[Row, list[Row
     if not isinstance(record, Mapping) or not isinstance(record.get("fruits"), list):
         raise FileFormatError("not a detections.json record (no list of fruits)")
     frame = _text(record.get("frame"), "frame")
+    recording = _utf8(recording) or ""
     if frame is None:
         raise FileFormatError("not a detections.json record (no frame name)")
     stamp = _stamp(record.get("header"))
