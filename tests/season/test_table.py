@@ -80,6 +80,15 @@ def test_names_that_are_not_utf8_go_into_the_tables_escaped(tmp_path):
     assert rows == [{"recording": "row\\udcff", "frame": "row\\udcff"}]
 
 
+def test_recording_inputs_named_with_bytes_that_are_not_utf8_come_back_as_the_column_holds_them():
+    from symfruit.season.table import INPUTS_KEY, recording_inputs
+
+    name = os.fsdecode(b"row\xfe")
+    metadata = {INPUTS_KEY.encode(): json.dumps({name: f"/data/{name}"}).encode()}
+    assert recording_inputs(metadata) == {"row\\udcfe": "/data/row\\udcfe"}  # printable, and keys match rows
+    assert frame_rows(RECORD, name)[0]["recording"] == "row\\udcfe"
+
+
 def test_row_groups_stream_and_an_empty_run_has_empty_tables(tmp_path, monkeypatch):
     from symfruit.season import table as module
 

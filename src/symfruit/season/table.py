@@ -311,7 +311,8 @@ def recording_inputs(metadata: Mapping[bytes, bytes] | None) -> dict[str, str]:
         return {}
     if not isinstance(data, dict):
         return {}
-    return {str(k): str(v) for k, v in data.items() if isinstance(k, str) and isinstance(v, str)}
+    # names and paths that are not UTF-8 come back escaped, as the tables' recording column holds them
+    return {str(_utf8(k)): str(_utf8(v)) for k, v in data.items() if isinstance(k, str) and isinstance(v, str)}
 
 
 def recording_name(source: str | Path) -> str:
