@@ -345,3 +345,12 @@ def test_a_colour_image_stamped_before_1970_is_stamped_with_the_bags_time(tmp_pa
     path = write_topics(tmp_path / "neg", topics, color, (depth * 1000).astype(np.uint16), sec=-5)
     with open_source(path) as src:
         assert src.read(1).stamp == 2_000_000_000  # the colour message's time in the bag, not -5 s
+
+
+def test_the_index_keeps_the_intrinsics_once_not_once_per_message(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    src = open_source(write_ros2_bag(tmp_path / "long", color, (depth * 1000).astype(np.uint16), frames=40))
+    with src:
+        assert len(src) == 40 and len(src._cameras) == 1  # every info message is stamped anew: kept on change
+        assert src.read(39).camera == CAM

@@ -287,7 +287,8 @@ class BagSource:
                     camera: Camera | str = camera_from_info(self._reader.deserialize(raw, conn.msgtype))
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
-                self._cameras.append((stamp, camera))
+                if not self._cameras or self._cameras[-1][1] != camera:  # kept on change: each message is
+                    self._cameras.append((stamp, camera))  # stamped anew, the intrinsics seldom change
         if not self._color_stamps:
             raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
         if not self._cameras:
