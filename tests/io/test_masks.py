@@ -167,8 +167,11 @@ def test_instances_from_polygons_and_rle_by_base_name(tmp_path):
 
 def test_sizes_in_the_file_are_checked_against_the_image(tmp_path):
     c = read_coco(_write(tmp_path, _coco([[0, 0, 5, 0, 5, 5]])))
-    with pytest.raises(FileFormatError, match="30x20 in the file but 40x20 on disk"):
+    with pytest.raises(FileFormatError, match=r"30x20 in the file but 40x20 on disk$"):
         c.instances("a.jpg", (20, 40))
+    # a phone photo annotated as shown (its EXIF orientation applied) but read as stored: the cause is said
+    with pytest.raises(FileFormatError, match=r"30x20 in the file but 20x30 on disk \(turned a quarter: .*EXIF"):
+        c.instances("a.jpg", (30, 20))
     huge = _coco({"size": [100000, 100000], "counts": [10**10]})  # would allocate 10 GB if trusted
     c = read_coco(_write(tmp_path, huge, "huge.json"))
     with pytest.raises(FileFormatError, match="RLE size"):
