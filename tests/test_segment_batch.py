@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -235,3 +236,17 @@ def test_a_full_disk_records_every_image(tmp_path, monkeypatch):
     assert len(report.failed) == 1 and len(report.unprocessed) == 2 and "output is full" in report.stopped
     record = json.loads((tmp_path / "out" / "segment.json").read_text())
     assert len(record["failed"]) + len(record["unprocessed"]) == 3
+
+
+def test_an_entry_named_as_an_image_that_is_no_file_is_reported_not_left_out(tmp_path):
+    import os
+
+    folder = _photos(tmp_path / "in", n=1)
+    (folder / "gone.png").symlink_to(tmp_path / "nowhere.png")  # a dangling link
+    (folder / "loop.png").symlink_to("loop.png")  # a link to itself
+    os.mkfifo(folder / "pipe.png")  # reading it would wait for a writer
+    (folder / "sub.png").mkdir()  # a folder: not an image, left out
+    report = segment_images([folder], output=tmp_path / "out")
+    assert [d.path.name for d in report.done] == ["p0.jpg"]
+    assert sorted(Path(k).name for k in report.failed) == ["gone.png", "loop.png", "pipe.png"]
+    assert "pipe.png: is a pipe or a socket" in report.failed[str(folder / "pipe.png")]

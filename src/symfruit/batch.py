@@ -466,7 +466,9 @@ class SegmentReport:
 
 def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     """Image files from files and folders (a folder's images in name order, not recursive: every file in a
-    format that is read when named, :data:`IMAGE_SUFFIXES`; hidden files are left out).
+    format that is read when named, :data:`IMAGE_SUFFIXES`; hidden files are left out). An entry with an
+    image's name that is no regular file (a dangling link, a link loop, a pipe) is listed too, so that the
+    batch reports it as failed instead of leaving it out unsaid; a sub-folder is not an image.
 
     Raises
     ------
@@ -477,7 +479,7 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     for p in map(Path, paths):
         if p.is_dir():
             listed = [q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES and not q.name.startswith(".")]
-            out += sorted(q for q in listed if q.is_file())
+            out += sorted(q for q in listed if not q.is_dir())
         elif p.is_file():
             out.append(p)
         else:
