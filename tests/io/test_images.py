@@ -209,3 +209,6 @@ def test_a_pipe_named_as_an_image_is_refused_without_waiting_for_a_writer(tmp_pa
     for reader in (read_color, read_depth_units, read_labels):
         with pytest.raises(FileFormatError, match=r"depth\.png: is a pipe or a socket; the image must be a regular"):
             reader(tmp_path / "depth.png")
+    (tmp_path / "tty.png").symlink_to("/dev/null")  # a device: /dev/tty would wait for typing
+    with pytest.raises(FileFormatError, match=r"tty\.png: is a device; the image must be a regular file"):
+        read_color(tmp_path / "tty.png")

@@ -55,7 +55,7 @@ def _open(source: Path | bytes, label: str) -> Any:
     from PIL import Image, UnidentifiedImageError
 
     if not isinstance(source, bytes):
-        refuse_pipe(source, "image")
+        refuse_pipe(source, "image", devices=True)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)

@@ -32,15 +32,18 @@ def as_path(value: Any, what: str) -> Path:
     raise InputError(f"{what} must be a path (str or os.PathLike), got {type(value).__name__}")
 
 
-def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileFormatError) -> None:
+def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileFormatError, devices: bool = False) -> None:
     """Refuse a pipe or a socket named as a file (opening one to read waits for a writer that may never
-    come); anything else, a missing file included, is left to the open that follows to name."""
+    come), and with ``devices`` a device too (an image is never one; ``/dev/tty`` would wait for typing);
+    anything else, a missing file included, is left to the open that follows to name."""
     try:
         mode = os.stat(path).st_mode
     except (OSError, ValueError):
         return
     if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
         raise error(f"{path}: is a pipe or a socket; the {what} must be a regular file")
+    if devices and (stat.S_ISCHR(mode) or stat.S_ISBLK(mode)):
+        raise error(f"{path}: is a device; the {what} must be a regular file")
 
 
 def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError) -> bytes:
