@@ -207,6 +207,15 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ({"fruits": [5]}, "fruit 1 is not an object"),
         ({"fruits": "none"}, "'fruits' is not a list"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": "one"}]}, "id must be a whole number"),
+        (
+            {"fruits": [{"min": [0.1, 0, 0.3], "max": [0.0, 0.1, 0.4]}]},
+            r"fruit 1: min \[0\.1, 0\.0, 0\.3\] lies beyond max",
+        ),
+        (
+            {"fruits": [{"min": [10, 20, 300], "max": [40, 50, 340]}]},
+            "more than 100 m from the camera; boxes are in metres",
+        ),
+        ({"fruits": [{"min": [-1e308] * 3, "max": [1e308] * 3}]}, "more than 100 m from the camera"),
     ],
 )
 def test_malformed_truth_names_the_file(tmp_path, truth, message):

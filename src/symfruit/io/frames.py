@@ -25,7 +25,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
+from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
@@ -161,6 +161,11 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
             if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
                 raise ValueError(f"fruit {k}: min and max need three finite numbers each")
+            if (lo > hi).any():
+                raise ValueError(f"fruit {k}: min {lo.tolist()} lies beyond max {hi.tolist()}")
+            if max(np.abs(lo).max(), np.abs(hi).max()) > MAX_DEPTH_METRES:
+                raise ValueError(f"fruit {k}: a box more than {MAX_DEPTH_METRES:g} m from the camera; boxes are in "
+                                 "metres (these look like millimetres)")  # fmt: skip
             fid = item.get("id", k)
             if isinstance(fid, bool) or not isinstance(fid, int):
                 raise ValueError(f"fruit {k}: id must be a whole number")
