@@ -308,3 +308,16 @@ def test_each_header_check_refuses_with_its_own_message(tmp_path, case):
     with pytest.raises(FileFormatError) as info:
         read_cloud(path)
     assert str(info.value).startswith(f"{path}: ") and message in str(info.value)
+
+
+def test_a_signalling_nan_in_a_binary_cloud_is_a_missing_point_not_a_warning(tmp_path):
+    import warnings
+
+    points = POINTS.astype(np.float32)
+    raw = points.view(np.uint32).copy()
+    raw[3, 0] = 0x7F800001  # float32 signalling NaN: casting it to float64 raises numpy's "invalid value" flag
+    write_pcd(tmp_path / "snan.pcd", raw.view(np.float32), "binary")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        out = read_cloud(tmp_path / "snan.pcd")
+    assert np.isnan(out[3, 0]) and np.isfinite(np.delete(out, 3, axis=0)).all()

@@ -30,7 +30,9 @@ def test_obj_without_faces_and_broken_objs(tmp_path):
         ("none.obj", "# nothing\n", "OBJ has no vertices"),
         ("bad.obj", "v 0 0 0\nv 0 x 0\n", "line 2 is not a valid OBJ vertex or face"),
         ("far.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 9\n", "a face refers to a vertex that does not exist"),
-        ("short.obj", "v 0 0\n", "OBJ vertices need x y z"),
+        ("short.obj", "v 0 0\n", "line 1: OBJ vertices need x y z"),
+        ("mixed.obj", "v 0 0 0\nv 1 0\n", "line 2: OBJ vertices need x y z"),  # was numpy's ragged-array error
+        ("nan.obj", "v 0 0 0\nv nan 0 inf\n", "OBJ vertices must be finite numbers"),
     ]:
         (tmp_path / name).write_text(text)
         with pytest.raises(FileFormatError, match=rf"{name.replace('.', '[.]')}: {message}"):

@@ -47,14 +47,16 @@ def read_cloud(path: str | Path) -> np.ndarray:
     if not path.is_file():
         raise FileFormatError(f"{path}: not a regular file (a folder or a device)")
     try:
-        points = reader(path)
+        with np.errstate(invalid="ignore", over="ignore"):  # a signalling NaN or a huge float64 stored as float32:
+            points = reader(path)  # non-finite points, dropped with the rest (never a warning from the cast)
     except FileFormatError:
         raise
     except (ValueError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError) as exc:
         raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({exc})") from None
     if points.ndim != 2 or points.shape[1] != 3:
         raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")
-    return np.ascontiguousarray(points, dtype=np.float64)
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.ascontiguousarray(points, dtype=np.float64)
 
 
 def _header(path: Path, kind: str, magic: bytes, end: re.Pattern[bytes]) -> tuple[bytes, int, int]:

@@ -55,6 +55,8 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
         parts = line.split()
         if not parts:
             continue
+        if parts[0] == "v" and len(parts) < 4:
+            raise FileFormatError(f"{path}: line {number}: OBJ vertices need x y z")
         try:
             if parts[0] == "v":
                 vertices.append([float(p) for p in parts[1:4]])
@@ -65,8 +67,8 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     if not vertices:
         raise FileFormatError(f"{path}: OBJ has no vertices")
     v = np.asarray(vertices, dtype=np.float64)
-    if v.shape[1] != 3:
-        raise FileFormatError(f"{path}: OBJ vertices need x y z")
+    if not np.isfinite(v).all():
+        raise FileFormatError(f"{path}: OBJ vertices must be finite numbers")
     # OBJ indices are 1-based; negative ones count back from the last vertex read.
     polygons = [[i - 1 if i > 0 else len(v) + i for i in poly] for poly in polygons]
     return v, (_fans(polygons, len(v), path) if polygons else None)
