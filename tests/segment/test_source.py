@@ -114,3 +114,6 @@ def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):
         mask_source("auto", images=[tmp_path / "a.jpg"])  # `auto` is a frame's word only
     with pytest.raises(InputError, match=r"one label \.png for one image"):
         mask_source(tmp_path / "nothing.txt", images=[tmp_path / "a.jpg"])
+    for images in (None, [tmp_path / "a.jpg"]):  # an empty spec is not the working folder's label PNGs
+        with pytest.raises(InputError, match=r"^--masks '': expected color"):
+            mask_source("", images=images)

@@ -81,6 +81,9 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
 
     settings = settings or Settings()
     text = str(spec)
+    if not text.strip():  # Path("") is the working folder: never taken for a folder of label PNGs unsaid
+        raise InputError("--masks '': expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, a folder of "
+                         "label PNGs, or one label .png")  # fmt: skip
     colour = "colour segmenter"
 
     def by_colour(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
