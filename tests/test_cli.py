@@ -539,6 +539,19 @@ def test_a_frame_folder_named_with_bytes_that_are_not_utf8_is_run_and_reported(t
     assert (tmp_path / "out" / "frames.parquet").is_file()
 
 
+@pytest.mark.parametrize(
+    "args",
+    [["detect", "", "--output", "out"], ["detect", "rec", "--output", ""], ["segment", "a.png", "--output", ""],
+     ["scenes", ""], ["evaluate", "--quick", "--output", ""], ["complete", "a.ply", "--config", " "]],
+)  # fmt: skip
+def test_an_empty_path_is_refused_not_read_as_the_working_folder(tmp_path, capsys, monkeypatch, args):
+    monkeypatch.chdir(tmp_path)  # `--output "$OUT"` with OUT unset would write here
+    with pytest.raises(SystemExit) as stop:
+        main(args)
+    assert stop.value.code == 2 and "an empty path (an unset shell variable?)" in capsys.readouterr().err
+    assert not list(tmp_path.iterdir())
+
+
 def test_settings_and_bench_refuse_bad_input_in_one_line(tmp_path, capsys):
     (tmp_path / "big.yaml").write_text("a: [" + "1, " * 400_000 + "1]\n")
     assert main(["settings", "--config", str(tmp_path / "big.yaml")]) == 2

@@ -26,21 +26,29 @@ if TYPE_CHECKING:
 __all__ = ["main"]
 
 
+def _path(text: str) -> Path:
+    """A path argument; an empty one (an unset shell variable: ``--output "$OUT"``) is refused, not read as the
+    working folder."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("an empty path (an unset shell variable?)")
+    return Path(text)
+
+
 def _add_complete(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("complete", help="complete one fruit's partial cloud and box it")
-    p.add_argument("cloud", type=Path, help="PLY, PCD, XYZ/TXT/CSV or NPY file of the visible points")
+    p.add_argument("cloud", type=_path, help="PLY, PCD, XYZ/TXT/CSV or NPY file of the visible points")
     p.add_argument(
         "--camera",
-        type=Path,
+        type=_path,
         help="intrinsics (JSON/YAML: plain, RealSense, Open3D, ROS); default: Intel D435 colour 640x480",
     )
     p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON; see `symfruit settings`), over the profile")
+    p.add_argument("--config", type=_path, help="settings file (YAML/JSON; see `symfruit settings`), over the profile")
     p.add_argument("--units", choices=("m", "mm"), default="m", help="units of the input cloud")
     p.add_argument(
         "--output",
-        type=Path,
+        type=_path,
         help="write the completed cloud to OUT.ply and the result with the effective settings to OUT.json",
     )
     p.add_argument("--json", action="store_true", help="print the result as JSON")
@@ -71,7 +79,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="instead: time the colour segmenter per image at --size (photos from --images, else synthetic)",
     )
-    p.add_argument("--images", type=Path, help="with --segment: a folder of photographs (resized to --size)")
+    p.add_argument("--images", type=_path, help="with --segment: a folder of photographs (resized to --size)")
     p.add_argument("--size", default="640x480", metavar="WxH",
                    help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
     p.add_argument("--scene", choices=("apple-tree",), default=None,
@@ -112,30 +120,30 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--views", type=int, default=1,
                    help="camera protocol, generated kinds: views of each fruit (default 1: every view a new fruit; "
                    "more rank confidence among one fruit's views, as the scans' views are)")  # fmt: skip
-    p.add_argument("--output", type=Path, default=Path("results"), help="results root (default results/)")
+    p.add_argument("--output", type=_path, default=Path("results"), help="results root (default results/)")
     p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
     p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
-    p.add_argument("--config", type=Path, help="settings file for the methods")
+    p.add_argument("--config", type=_path, help="settings file for the methods")
     p.add_argument(
         "--no-profile",
         action="store_true",
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
-    p.add_argument("--frames", type=Path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
+    p.add_argument("--frames", type=_path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
     p.add_argument("--match", choices=("centre", "id"), default="centre",
                    help="--frames: match found fruit to the truth by their seen points' box centre within 3 cm "
                    "(default, Table 3's protocol) or by mask label = truth id (the frames' own masks drawn for the "
                    "truth, as those of `symfruit scenes --sensor`/`--scene apple-tree`: every completed fruit "
                    "scored)")  # fmt: skip
-    p.add_argument("--spheres", type=Path,
+    p.add_argument("--spheres", type=_path,
                    help="instead of a protocol: real frames of spheres without truth (one mask per sphere, the same "
                    "ids in every frame): how far each box is from a cube and how far the frames disagree, e.g. "
                    "examples/real-frames")  # fmt: skip
     p.add_argument("--masks", default=None,
                    help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
-    p.add_argument("--images", type=Path, help="masks protocol: folder of photographs")
-    p.add_argument("--truth", type=Path, help="masks protocol: COCO JSON of the photographs' instance masks")
+    p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
+    p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
     p.add_argument("--category", type=int, default=1,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
@@ -146,7 +154,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
 
 def _add_detect(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("detect", help="locate the fruit of RGB-D frames: frame folders, folders of frames or bags")
-    p.add_argument("inputs", nargs="+", type=Path, metavar="INPUT",
+    p.add_argument("inputs", nargs="+", type=_path, metavar="INPUT",
                    help="a recording: frame folder (color.png, depth.png, camera.json), folder of them, or bag; "
                    "several: each recording's frames go into OUT/<recording>/")  # fmt: skip
     p.add_argument(
@@ -156,33 +164,33 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
         "or onnx:MODEL.onnx",
     )
     p.add_argument("--method", default=None, help="completion method (see `symfruit methods`; default evidence)")
-    p.add_argument("--output", type=Path, required=True,
+    p.add_argument("--output", type=_path, required=True,
                    help="output folder (one sub-folder per frame; with several inputs one per recording)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+    p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
     _add_ros2_bag_options(p)
     _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
-    p.add_argument("inputs", nargs="+", type=Path, help="images or folders of images")
-    p.add_argument("--output", type=Path, required=True, help="folder for <stem>.png (16-bit labels) and "
+    p.add_argument("inputs", nargs="+", type=_path, help="images or folders of images")
+    p.add_argument("--output", type=_path, required=True, help="folder for <stem>.png (16-bit labels) and "
                    "<stem>_overlay.png")  # fmt: skip
     p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
                    ".json or a folder of label PNGs")  # fmt: skip
-    p.add_argument("--depth", type=Path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
-    p.add_argument("--camera", type=Path, help="intrinsics file (needed with --depth)")
+    p.add_argument("--depth", type=_path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
+    p.add_argument("--camera", type=_path, help="intrinsics file (needed with --depth)")
     p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+    p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
-    p.add_argument("--output", type=Path, default=Path("out/demo"), help="output folder (default out/demo)")
+    p.add_argument("--output", type=_path, default=Path("out/demo"), help="output folder (default out/demo)")
     p.add_argument("--method", default=None, help="completion method (default evidence)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+    p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
 
 
 def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--ros2-bag", type=Path, metavar="BAG",
+    p.add_argument("--ros2-bag", type=_path, metavar="BAG",
                    help="also write the detections into this new ROS 2 bag folder (vision_msgs/msg/Detection3DArray "
                    "on /symfruit/detections, stamped like the input frames)")  # fmt: skip
     p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default="mcap",
@@ -205,8 +213,8 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
 
 def _add_report(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("report", help="report.md and plots of what a detect run found (fruit counts, sizes)")
-    p.add_argument("run", type=Path, help="the output folder of `symfruit detect` (with detections.parquet)")
-    p.add_argument("--output", type=Path, help="folder for report.md and the plots (default RUN/report)")
+    p.add_argument("run", type=_path, help="the output folder of `symfruit detect` (with detections.parquet)")
+    p.add_argument("--output", type=_path, help="folder for report.md and the plots (default RUN/report)")
     p.add_argument("--classes", default="18,25", help="size class limits, diameters in mm (default 18,25: the EU "
                    "strawberry classes)")  # fmt: skip
 
@@ -237,7 +245,7 @@ def _parser() -> argparse.ArgumentParser:
     _add_ros(sub)
     p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries or of an "
                        "apple tree (with truth)")  # fmt: skip
-    p.add_argument("output", type=Path, help="folder to write scene_00000, scene_00001, ... into")
+    p.add_argument("output", type=_path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
     p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
@@ -253,7 +261,7 @@ def _parser() -> argparse.ArgumentParser:
                    "D435-like frames; apple trees: the Azure Kinect)")  # fmt: skip
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
-    p.add_argument("--config", type=Path, help="settings file (YAML/JSON), over the profile")
+    p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     sub.add_parser("methods", help="list the completion methods")
     return parser
 
