@@ -52,6 +52,15 @@ def test_ply_with_and_without_faces(tmp_path):
     write_ply(tmp_path / "cloud.ply", CUBE)
     vertices, faces = read_mesh(tmp_path / "cloud.ply")
     assert np.allclose(vertices, CUBE) and faces is None
+    import warnings
+
+    raw = vertex.view(np.uint32).reshape(len(CUBE), 3).copy()
+    raw[2, 1] = 0x7F800001  # a float32 signalling NaN: refused as not finite, without numpy's cast warning
+    bad = raw.view(vertex.dtype).ravel()
+    PlyData([PlyElement.describe(bad, "vertex"), PlyElement.describe(face, "face")]).write(str(tmp_path / "nan.ply"))
+    with warnings.catch_warnings(), pytest.raises(FileFormatError, match=r"nan\.ply: PLY mesh vertices must be finite"):
+        warnings.simplefilter("error")
+        read_mesh(tmp_path / "nan.ply")
 
 
 def test_other_extensions_are_refused(tmp_path):

@@ -151,7 +151,8 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
             f"{'y' if len(missing) == 1 else 'ies'} (they have {', '.join(names) or 'none'})"
         )
     try:
-        return data, np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
+        with np.errstate(invalid="ignore", over="ignore"):  # a signalling NaN cast: a missing point, no warning
+            return data, np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:

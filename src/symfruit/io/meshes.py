@@ -36,6 +36,8 @@ def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
         raise FileFormatError(f"{path}: mesh of {counts.get('vertex', 0):,} vertices and {counts.get('face', 0):,} "
                               f"faces; at most {MAX_CLOUD_POINTS:,} and {MAX_FACES:,} are read")  # fmt: skip
     data, vertices = ply_vertices(path)
+    if not np.isfinite(vertices).all():
+        raise FileFormatError(f"{path}: PLY mesh vertices must be finite numbers")
     if "face" not in data:
         return vertices, None
     face = data["face"]
