@@ -152,6 +152,10 @@ def test_depth_landing_far_off_the_colour_image_is_dropped_without_overflow(colo
     with np.errstate(all="raise"), warnings.catch_warnings():
         warnings.simplefilter("error")  # no "invalid value encountered in cast" from far-off pixel indices
         out = align_depth(depth, Lens(DEPTH), color_lens, np.eye(3), translation)
+        # a wide depth lens whose distortion denominator 1 + k1 r^2 passes 0 (k1 = -1): divides by zero
+        wide = Camera(fx=60.0, fy=60.0, cx=79.5, cy=59.5, width=160, height=120)
+        wild = Lens(wide, "brown_conrady", (-1.0, 0, 0, 0, 0))
+        assert np.isfinite(align_depth(depth, wild, color_lens, np.eye(3), translation)).all()
     assert out.shape == (COLOR.height, COLOR.width) and np.isfinite(out).all()
     if translation[0]:
         assert not out.any()

@@ -218,22 +218,24 @@ def align_depth(
         def corner(offset: float) -> tuple[np.ndarray, np.ndarray]:
             pts = transform(deproject(depth_lens, np.c_[u + offset, v + offset], zd), rotation, translation)
             px = project(color_lens, pts)
-            with np.errstate(invalid="ignore"):
-                return np.floor(px[:, 0] + 0.5), np.floor(px[:, 1] + 0.5)
+            return np.floor(px[:, 0] + 0.5), np.floor(px[:, 1] + 0.5)
 
-        if _denser(dcam, ccam):  # one colour pixel per depth pixel: the one its centre lands in
-            x0, y0 = corner(0.0)
-            x1, y1 = x0, y0
-        else:
-            x0, y0 = corner(-0.5)
-            x1, y1 = corner(0.5)
-        centre = transform(deproject(depth_lens, np.c_[u, v], zd), rotation, translation)
-        zc = centre[:, 2] if z == "color" else zd
-        ok = np.isfinite(x0) & np.isfinite(y0) & np.isfinite(x1) & np.isfinite(y1) & (centre[:, 2] > 0)
-        ok &= (x1 - x0 < MAX_FOOTPRINT) & (y1 - y0 < MAX_FOOTPRINT)
-        # footprints wholly outside the colour image cover no pixel (the spans below would be empty); left out
-        # here so that far-off ones (a wild lens model's) are never cast to pixel indices
-        ok &= (x1 >= 0) & (y1 >= 0) & (x0 <= ccam.width - 1) & (y0 <= ccam.height - 1)
+        # a wild recorded lens model (a distortion denominator of 0, coefficients of 1e9) sends some pixels to
+        # inf or NaN: they are dropped below (``ok``), without numpy's floating-point warnings on the way
+        with np.errstate(divide="ignore", over="ignore", invalid="ignore"):
+            if _denser(dcam, ccam):  # one colour pixel per depth pixel: the one its centre lands in
+                x0, y0 = corner(0.0)
+                x1, y1 = x0, y0
+            else:
+                x0, y0 = corner(-0.5)
+                x1, y1 = corner(0.5)
+            centre = transform(deproject(depth_lens, np.c_[u, v], zd), rotation, translation)
+            zc = centre[:, 2] if z == "color" else zd
+            ok = np.isfinite(x0) & np.isfinite(y0) & np.isfinite(x1) & np.isfinite(y1) & (centre[:, 2] > 0)
+            ok &= (x1 - x0 < MAX_FOOTPRINT) & (y1 - y0 < MAX_FOOTPRINT)
+            # footprints wholly outside the colour image cover no pixel (the spans below would be empty); left
+            # out here so that far-off ones (a wild lens model's) are never cast to pixel indices
+            ok &= (x1 >= 0) & (y1 >= 0) & (x0 <= ccam.width - 1) & (y0 <= ccam.height - 1)
         x0, y0 = np.maximum(x0[ok], 0), np.maximum(y0[ok], 0)
         x1, y1 = np.minimum(x1[ok], ccam.width - 1), np.minimum(y1[ok], ccam.height - 1)
         zc = zc[ok]
