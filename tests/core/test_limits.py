@@ -72,6 +72,9 @@ def test_the_modules_use_the_one_set_of_bounds():
     assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
     assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
     assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
+    from symfruit.segment import colour
+
+    assert colour.MAX_PIECES is limits.MAX_PIECES == limits.MAX_INSTANCES  # README: "at most 1000 candidate pieces"
     assert bags.MAX_BAG_METADATA_BYTES is limits.MAX_BAG_METADATA_BYTES
 
 

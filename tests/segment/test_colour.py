@@ -173,6 +173,28 @@ def test_bad_colour_input_is_refused():
     assert segment(np.zeros((1, 1, 3), np.uint8)).shape == (1, 1)
 
 
+def test_a_picture_of_colour_noise_is_refused_in_a_moment_not_joined_for_minutes():
+    # uniform colour noise over real depth: ~1,600 red pieces, whose pairwise joining took about 10 minutes
+    frame = read_frame(EXAMPLE_FRAME)
+    noise = (np.random.default_rng(0).random(frame.color.shape) * 255).astype(np.uint8)
+    with pytest.raises(InputError, match=r"the colour segmenter found 1,\d{3} red pieces; at most 1,000 are joined"):
+        segment(noise, frame.depth, frame.camera)
+    assert segment(frame.color, frame.depth, frame.camera).max() == 6  # a real frame's few pieces: as before
+
+
+def test_joining_pieces_keeps_each_piece_s_surface_once_with_the_same_answers(monkeypatch):
+    # _merge works each piece's sphere fit and points out once, not once per pair: the labels are the ones the
+    # per-pair work gives (the surfaces cache left out)
+    import symfruit.segment.colour as colour
+
+    frame = read_frame(EXAMPLE_FRAME)
+    cached = segment(frame.color, frame.depth, frame.camera)
+    plain = colour._same_surface
+    monkeypatch.setattr(colour, "_same_surface", lambda a, b, depth, weak, geo, s, surfaces=None: plain(
+        a, b, depth, weak, geo, s))  # fmt: skip
+    assert np.array_equal(segment(frame.color, frame.depth, frame.camera), cached)
+
+
 def test_redness_and_seeds_known_answers():
     px = np.array([[[200, 50, 40], [100, 25, 20], [90, 90, 90], [30, 5, 5], [210, 120, 40]]], np.uint8)
     assert np.allclose(redness(px)[0, :3], [0.75, 0.75, 0.0])

@@ -29,6 +29,7 @@ __all__ = [
     "MAX_INSTANCES",
     "MAX_LABEL_ID",
     "MAX_OBJ_BYTES",
+    "MAX_PIECES",
     "MAX_SETTINGS_BYTES",
     "MAX_TABLE_BYTES",
     "MAX_TABLE_ROWS",
@@ -64,6 +65,10 @@ MAX_BAG_METADATA_BYTES = MAX_TRUTH_BYTES
 #: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
 MAX_INSTANCES = 1000
 MAX_LABEL_ID = 2**31 - 1
+#: Most candidate pieces (red regions and their parts) the colour segmenter joins into fruit in one image: as
+#: many as fruit. Joining tests nearby pairs, so the cost grows with their square: a frame of colour noise gives
+#: ~1,600 pieces (minutes); real frames give at most a few hundred (an apple tree at 1920x1080: 225).
+MAX_PIECES = MAX_INSTANCES
 #: A run's fruit table read by ``symfruit report``: most rows (a season of ~3 million frames of 6 fruit) and
 #: most bytes of the columns read (uncompressed, as the file's metadata states; checked before reading).
 MAX_TABLE_ROWS = 20_000_000

@@ -55,7 +55,7 @@ from typing import Literal, Protocol
 import numpy as np
 from scipy import ndimage
 
-from ..core.limits import check_image_size, depth_metres
+from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
 from ..core.raster import fill_holes, mask_box
 from ..errors import InputError
@@ -526,6 +526,9 @@ def _segment_at(
     ground = s.ground_colour and s.round_fruit and z is not None
     if not pieces and not ground:
         return np.zeros((h, w), np.int32)
+    if len(pieces) > MAX_PIECES:
+        raise InputError(f"the colour segmenter found {len(pieces):,} red pieces; at most {MAX_PIECES:,} are joined "
+                         "into fruit (a picture of noise, or a red backdrop?)")  # fmt: skip
     pieces = _merge(pieces, s, c, weak, z, geo)
 
     pieces = sorted(pieces, key=lambda p: -p.area)
@@ -818,6 +821,8 @@ def _merge(
         piece.serial = k
     serial = len(pieces)
     apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
+    surfaces: dict[int, _Surface] = {}  # each piece's sphere fit and points, worked out once per piece, not per pair
+    green: np.ndarray | None = None  # _green of the image, once (pixel by pixel: the same as of each window)
     merged = True
     while merged and len(pieces) > 1:
         merged = False
@@ -837,9 +842,10 @@ def _merge(
                 vertices = _hull_vertices(union)
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
+                    green = _green(color) if green is None else green
+                    hull -= float((_hull_mask(vertices, union) & ~union & green[window]).sum())
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
-                    depth is None or _same_surface(a, b, depth, weak, geo, s) is not False
+                    depth is None or _same_surface(a, b, depth, weak, geo, s, surfaces) is not False
                 ):
                     pieces[i] = _Piece(window, union, a.source | b.source, hull, serial, (vertices,))
                     serial += 1
@@ -852,22 +858,64 @@ def _merge(
     return pieces
 
 
+@dataclass
+class _Surface:
+    """What :func:`_same_surface` needs of one piece, worked out when first asked for: its sphere fit (as the
+    larger piece), its points (as the smaller one) and its depths."""
+
+    piece: _Piece
+    depth: _Depth
+    weak: np.ndarray
+    geo: _Geometry
+    fit: tuple[tuple[np.ndarray, float] | None] | None = None
+    points: np.ndarray | None = None
+    depths: np.ndarray | None = None
+
+    def origin(self) -> tuple[int, int]:
+        return (self.piece.window[0].start, self.piece.window[1].start)
+
+    def sphere(self) -> tuple[np.ndarray, float] | None:
+        if self.fit is None:
+            w = self.piece.window
+            self.fit = (_sphere(self.piece.mask & self.weak[w], self.depth[w], self.geo, self.origin()),)
+        return self.fit[0]
+
+    def cloud(self) -> np.ndarray:
+        if self.points is None:
+            w = self.piece.window
+            self.points = _points(self.piece.mask & self.weak[w], self.depth[w], self.geo, self.origin())
+        return self.points
+
+    def z(self) -> np.ndarray:
+        if self.depths is None:
+            w = self.piece.window
+            z = self.depth[w][self.piece.mask & self.weak[w]]
+            self.depths = z[z > 0]
+        return self.depths
+
+
 def _same_surface(
-    a: _Piece, b: _Piece, depth: _Depth, weak: np.ndarray, geo: _Geometry, s: SegmentSettings
+    a: _Piece,
+    b: _Piece,
+    depth: _Depth,
+    weak: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    surfaces: dict[int, _Surface] | None = None,
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
     distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``). Without
     a fit: not when the two pieces' median depths lie further apart than the largest fruit is across
     (``round_max_diameter``: two fruit, one behind the other), else None (nothing to tell)."""
     big, small = (a, b) if a.area >= b.area else (b, a)
-    origin = (big.window[0].start, big.window[1].start)
-    fit = _sphere(big.mask & weak[big.window], depth[big.window], geo, origin)
-    p = _points(
-        small.mask & weak[small.window], depth[small.window], geo, (small.window[0].start, small.window[1].start)
-    )
+    if surfaces is None:
+        big_s, small_s = _Surface(big, depth, weak, geo), _Surface(small, depth, weak, geo)
+    else:  # by serial: one merge's pieces, one depth, one weak mask
+        big_s, small_s = (surfaces.setdefault(x.serial, _Surface(x, depth, weak, geo)) for x in (big, small))
+    fit = big_s.sphere()
+    p = small_s.cloud()
     if fit is None or len(p) < 20:
-        zs = [depth[x.window][x.mask & weak[x.window]] for x in (big, small)]
-        zs = [z[z > 0] for z in zs]
+        zs = [big_s.z(), small_s.z()]
         if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
             return False
         return None
