@@ -259,8 +259,13 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
     if hint is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise ConfigError(f"{where}: expected a number, got {value!r}")
-        if not math.isfinite(value):
-            raise ConfigError(f"{where}: expected a finite number, got {value!r}")
+        try:
+            finite = math.isfinite(value)
+        except OverflowError:  # a whole number of hundreds of digits: beyond any float
+            finite = False
+        if not finite:
+            shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:20]}..."
+            raise ConfigError(f"{where}: expected a finite number, got {shown}")
         return float(value)
     if hint is str:
         if not isinstance(value, str):

@@ -44,6 +44,7 @@ def test_matrix_and_dict(camera):
         ({"height": 2.5}, "height"),
         ({"cx": float("nan")}, "finite"),
         ({"fx": "a"}, "number"),
+        ({"cy": 10**400}, r"camera cy must be a number, got 10{19}\.\.\.$"),  # beyond float: not OverflowError
     ],
 )
 def test_invalid_intrinsics_are_refused(bad, message):

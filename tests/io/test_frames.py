@@ -216,6 +216,8 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
             "more than 100 m from the camera; boxes are in metres",
         ),
         ({"fruits": [{"min": [-1e308] * 3, "max": [1e308] * 3}]}, "more than 100 m from the camera"),
+        ({"fruits": [{"min": [10**400, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, "int too large to convert to float"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2**40}]}, "id must be a whole number in 0-"),
     ],
 )
 def test_malformed_truth_names_the_file(tmp_path, truth, message):

@@ -51,6 +51,11 @@ def test_intrinsics_layouts(tmp_path, name):
         ('{"fx": 0, "fy": 615, "cx": 320, "cy": 240, "width": 640, "height": 480}', "positive"),
         ('{"fx": 615, "fy": 615, "cx": 320, "cy": 240}', "width and height"),
         ('{"K": [1, 2, 3], "width": 640, "height": 480}', "9 numbers"),
+        (
+            '{"fx": 1' + "0" * 400 + ', "fy": 615, "cx": 320, "cy": 240, "width": 640, "height": 480}',
+            r"'fx' must be a number, got 10{19}\.\.\. \(401 characters\)",
+        ),  # JSON's whole number beyond float
+        ('{"K": [1' + "0" * 400 + ', 0, 320, 0, 615, 240, 0, 0, 1], "width": 640, "height": 480}', "9 numbers"),
         ('{"foo": 1}', "not recognised"),
         ("[1, 2]", "mapping"),
         ("{not json", "not valid JSON"),

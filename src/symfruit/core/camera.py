@@ -50,8 +50,9 @@ class Camera:
             value = getattr(self, name)
             try:
                 value = float(value)
-            except (TypeError, ValueError):
-                raise InputError(f"camera {name} must be a number, got {value!r}") from None
+            except (TypeError, ValueError, OverflowError):  # OverflowError: a whole number beyond float's range
+                shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:20]}..."
+                raise InputError(f"camera {name} must be a number, got {shown}") from None
             if not np.isfinite(value):
                 raise InputError(f"camera {name} must be finite, got {value!r}")
             object.__setattr__(self, name, value)

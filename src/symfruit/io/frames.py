@@ -25,7 +25,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_TRUTH_BYTES, check_image_size
+from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units
@@ -167,8 +167,8 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
                 raise ValueError(f"fruit {k}: a box more than {MAX_DEPTH_METRES:g} m from the camera; boxes are in "
                                  "metres (these look like millimetres)")  # fmt: skip
             fid = item.get("id", k)
-            if isinstance(fid, bool) or not isinstance(fid, int):
-                raise ValueError(f"fruit {k}: id must be a whole number")
+            if isinstance(fid, bool) or not isinstance(fid, int) or not 0 <= fid <= MAX_LABEL_ID:
+                raise ValueError(f"fruit {k}: id must be a whole number in 0-{MAX_LABEL_ID} (a label id)")
             out.append((fid, Box(lo, hi)))
             if "visible" in item:
                 seen = item["visible"]
@@ -176,7 +176,7 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
                     raise ValueError(f"fruit {k}: visible must be a share in [0, 1]")
                 visible[fid] = float(seen)
         return out, visible
-    except (ValueError, KeyError, TypeError) as exc:
+    except (ValueError, KeyError, TypeError, OverflowError) as exc:  # OverflowError: a 400-digit whole number
         raise FileFormatError(
             f"{path}: expected {{'fruits': [{{'min': [x, y, z], 'max': [x, y, z]}}]}} ({exc})"
         ) from None

@@ -58,9 +58,24 @@ def read_mapping(path: Path) -> Any:
 
 def _number(data: dict[str, Any], key: str) -> float:
     value = data[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise InputError(f"intrinsics field {key!r} must be a number, got {value!r}")
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not _fits_float(value):
+        raise InputError(f"intrinsics field {key!r} must be a number, got {_short(value)}")
     return float(value)
+
+
+def _fits_float(value: int | float) -> bool:
+    """Whether a number read from a file converts to float (JSON and YAML read a 400-digit whole number as an
+    int, which float() refuses with OverflowError)."""
+    try:
+        float(value)
+    except OverflowError:
+        return False
+    return True
+
+
+def _short(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def _matrix(values: Any, name: str) -> list[float]:
@@ -69,7 +84,7 @@ def _matrix(values: Any, name: str) -> list[float]:
     if (
         not isinstance(values, list)
         or len(values) != 9
-        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and _fits_float(v) for v in values)
     ):
         raise InputError(f"intrinsics field {name!r} must hold 9 numbers")
     return [float(v) for v in values]
