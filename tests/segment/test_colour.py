@@ -583,7 +583,7 @@ def test_ripe_seeds_are_the_former_look_ups():
 
 
 def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
-    from symfruit.segment.colour import _Depth
+    from symfruit.segment.colour import _Depth, _usable
 
     rng = np.random.default_rng(5)
     z = rng.normal(0.5, 1.0, (40, 50))
@@ -591,9 +591,8 @@ def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
         z.ravel()[rng.integers(0, z.size, count)] = value
     for image in (z, z.astype(np.float32), z[::2, 3:]):
         whole = np.maximum(np.nan_to_num(image.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
-        valid = np.greater(image, 0.0) & np.less(image, np.inf)
-        depth = _Depth(image, valid)
-        assert np.array_equal(valid, whole != 0) and depth.shape == image.shape
+        depth = _Depth(image)
+        assert np.array_equal(_usable(image), whole != 0) and depth.shape == image.shape
         for window in ((slice(None), slice(None)), (slice(3, 17), slice(5, 21)), (slice(1, None, 3), slice(0, 9, 2))):
             got = depth[window]
             assert got.dtype == np.float64 and got.flags.writeable

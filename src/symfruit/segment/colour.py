@@ -508,8 +508,21 @@ def _segment_at(
             zw = z.take((rows + win[0].start) * w + (cols + win[1].start))
             least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
-        objects = _boxes(lab, rows, cols, keep)
-        for k in np.flatnonzero(keep).tolist():  # the kept regions alone: a window may hold thousands of specks
+        ids, grouped, first = _grouped(lab, keep)  # the kept regions alone: a window may hold thousands of specks
+        objects = _group_boxes(ids, grouped, first, rows, cols)
+        ripe_test = s.round_fruit and z is not None and len(ids) > 0
+        if ripe_test:  # each region's depths and rednesses, read off its pixels at once
+            zs = zw.take(grouped)  # type: ignore[union-attr]
+            reds = redness(c[rows.take(grouped) + win[0].start, cols.take(grouped) + win[1].start])
+        for i, k in enumerate(ids.tolist()):
+            if ripe_test:
+                run = slice(int(first[i]), int(first[i + 1]))
+                zk = zs[run]
+                if sizes[k] <= _largest_disc(zk[zk > 0], s, geo.focal, z_typical):
+                    # one fruit at most, not ripe-red over most of it: dropped before its masks are made
+                    # (:func:`_ripe_cores`' test on the region's own pixels, without the region's window)
+                    if median(reds[run]) < s.ripe_median:
+                        continue
             sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
@@ -712,9 +725,8 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
     given = np.ascontiguousarray(given)  # read by flat index window by window (a copy only if strided)
-    valid = np.greater(given, 0.0)  # False for NaN
-    valid &= np.less(given, np.inf)
-    if not valid.any():
+    # usable depth anywhere: looked for on every 8th pixel first, over the whole image only when none is there
+    if not (_usable(given[::8, ::8]).any() or _usable(given).any()):
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
@@ -726,7 +738,14 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
-    return _Depth(given, valid), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+    return _Depth(given), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+
+
+def _usable(z: np.ndarray) -> np.ndarray:
+    """(h, w) bool: depths positive and finite (False for NaN)."""
+    valid = np.greater(z, 0.0)
+    valid &= np.less(z, np.inf)
+    return valid
 
 
 class _Depth:
@@ -734,27 +753,28 @@ class _Depth:
     when read (``depth[window]``, a copy; ``take(flat)``): the values of ``np.nan_to_num(z, nan=0, posinf=0,
     neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole image, to the bit (-0.0 becomes 0.0
     there too). The segmenter reads some 250 small windows of a frame: a float64 copy of a 1920x1080 image, 16 MB
-    of fresh pages, cost more than all of them."""
+    of fresh pages, cost more than all of them, and so did the validity of every pixel (two passes over the
+    image, 2 ms at 1920x1080): each window's is worked out when it is read (a float64 copy keeps the order of a
+    float32 depth against 0 and infinity)."""
 
-    def __init__(self, given: np.ndarray, valid: np.ndarray) -> None:
+    def __init__(self, given: np.ndarray) -> None:
         self.given = given  # float, as handed over
-        self.valid = valid  # (h, w) bool: positive and finite
         self.shape: tuple[int, int] = (int(given.shape[0]), int(given.shape[1]))
 
     @classmethod
     def of(cls, z: np.ndarray) -> _Depth:
         """A float64 depth already cleaned (0 where invalid)."""
-        return cls(z, z > 0)
+        return cls(z)
 
     def __getitem__(self, window: tuple[slice, slice]) -> np.ndarray:
         z = np.array(self.given[window], dtype=np.float64)
-        np.copyto(z, 0.0, where=~self.valid[window])
+        np.copyto(z, 0.0, where=~_usable(z))
         return z
 
     def take(self, flat: np.ndarray) -> np.ndarray:
         """The depths at flat (row-major) pixel indices."""
         z = np.asarray(self.given).ravel().take(flat).astype(np.float64)
-        np.copyto(z, 0.0, where=~self.valid.ravel().take(flat))
+        np.copyto(z, 0.0, where=~_usable(z))
         return z
 
 
@@ -1225,7 +1245,11 @@ def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: f
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
     """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
     (``z_typical`` where none of its pixels has depth)."""
-    z = depth[mask & (depth > 0)]
+    return _largest_disc(depth[mask & (depth > 0)], s, focal, z_typical)
+
+
+def _largest_disc(z: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
+    """:func:`_largest_area` at the median of the depths ``z`` (all positive; ``z_typical`` when there are none)."""
     zr = float(median(z)) if len(z) else z_typical
     return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
 
@@ -1642,17 +1666,29 @@ def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: f
 def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndarray) -> dict[int, Window]:
     """The boxes of the labels that ``keep`` marks, as ``ndimage.find_objects`` gives them, from the labels,
     rows and columns of a window's labelled pixels (scipy's makes a box for every label of the window)."""
+    return _group_boxes(*_grouped(labels, keep), rows, cols)
+
+
+def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pixels of the labels that ``keep`` marks, grouped by label: their labels in ascending order, the
+    pixels' indices (into ``labels``) label by label (each label's in their own order), and where each label's
+    run starts in them (one more at the end: their number)."""
     at = np.flatnonzero(keep.take(labels))
-    if len(at) == 0:
-        return {}
     lab = labels.take(at)
     order = np.argsort(lab, kind="stable")
-    lab = lab.take(order)
-    r, c = rows.take(at).take(order), cols.take(at).take(order)
-    first = np.flatnonzero(np.concatenate(([True], lab[1:] != lab[:-1])))
+    lab, at = lab.take(order), at.take(order)
+    first = np.flatnonzero(np.concatenate(([len(lab) > 0], lab[1:] != lab[:-1])))
+    return lab.take(first), at, np.append(first, len(lab))
+
+
+def _group_boxes(ids: np.ndarray, at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> dict[int, Window]:
+    """:func:`_boxes` of the groups of :func:`_grouped`."""
+    if len(at) == 0:
+        return {}
+    r, c, first = rows.take(at), cols.take(at), first[:-1]
     r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
     c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
-    cells = zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)
+    cells = zip(*(v.tolist() for v in (ids, r0, r1, c0, c1)), strict=True)
     return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in cells}
 
 
