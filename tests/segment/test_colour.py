@@ -595,8 +595,11 @@ def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
         assert np.array_equal(_usable(image), whole != 0) and depth.shape == image.shape
         for window in ((slice(None), slice(None)), (slice(3, 17), slice(5, 21)), (slice(1, None, 3), slice(0, 9, 2))):
             got = depth[window]
-            assert got.dtype == np.float64 and got.flags.writeable
+            assert got.dtype == np.float64 and not got.flags.writeable  # read once: one array for every reader
             assert np.array_equal(got.view(np.int64), whole[window].view(np.int64))  # the bits, -0.0's sign included
+            assert depth[window] is got
+            with pytest.raises(ValueError):
+                got[0] = 1.0
         flat = rng.integers(0, image.size, 200)
         assert np.array_equal(depth.take(flat).view(np.int64), whole.ravel()[flat].view(np.int64))
         clean = _Depth.of(whole)
