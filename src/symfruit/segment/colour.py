@@ -48,6 +48,7 @@ Fruit cut by the image border are kept (their hull is cut by the border too).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
@@ -932,17 +933,19 @@ def _split(
         r = s.close_px
         padded = np.pad(region, r + 1)
         region = ndimage.binary_closing(padded, structure=_disc(r))[r + 1 : -r - 1, r + 1 : -r - 1] | region
-    use_depth = depth is not None and s.split in ("depth", "both") and int((depth[region] > 0).sum()) >= 20
+    seen = None if depth is None else region & (depth > 0)  # the region's pixels with depth
+    use_depth = seen is not None and s.split in ("depth", "both") and int(seen.sum()) >= 20
     if s.split == "none" or (s.split == "depth" and not use_depth):
         return [region]
     carved, edges = region, None
     # the smallest fruit worth cutting off: fruit-sized (with depth: at its depth, and half of it may be
     # hidden behind the fruit in front or a leaf)
     least = np.sqrt(min_area / np.pi)
-    if use_depth and depth is not None:
-        edges = _depth_edges(region, depth, s, geo.focal)
+    if use_depth and depth is not None and seen is not None:
+        zm = float(median(depth[seen]))
+        edges = _depth_edges(region, depth, seen, zm, s, geo.focal)
         carved = fill_holes(region & ~edges)
-        least = 0.25 * geo.focal * s.min_diameter / float(median(depth[region & (depth > 0)]))
+        least = 0.25 * geo.focal * s.min_diameter / zm
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
@@ -1217,11 +1220,14 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
-def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
+def _depth_edges(
+    region: np.ndarray, depth: np.ndarray, seen: np.ndarray, zm: float, s: SegmentSettings, focal: float
+) -> np.ndarray:
     """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
-    crease of the depth surface: where one fruit ends and another begins."""
-    z = np.where(region & (depth > 0), depth, np.nan)
-    return (_creases(region, depth, s, focal) | _steps(z, s.depth_jump)) & region
+    crease of the depth surface: where one fruit ends and another begins. ``seen``: the region's pixels with depth
+    (``region & (depth > 0)``), ``zm`` their median depth."""
+    z = np.where(seen, depth, np.nan)
+    return (_creases(region, depth, seen, zm, s, focal) | _steps(z, s.depth_jump)) & region
 
 
 def _steps(z: np.ndarray, jump: float) -> np.ndarray:
@@ -1237,17 +1243,44 @@ def _steps(z: np.ndarray, jump: float) -> np.ndarray:
     return edge
 
 
-def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
-    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam."""
-    valid = region & (depth > 0)
+def _creases(
+    region: np.ndarray, depth: np.ndarray, valid: np.ndarray, zm: float, s: SegmentSettings, focal: float
+) -> np.ndarray:
+    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam. ``valid``:
+    the region's pixels with depth, ``zm`` their median depth."""
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     ri, ci = ndimage.distance_transform_edt(~valid, return_distances=False, return_indices=True)
     filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
-    smooth = ndimage.gaussian_filter(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
-    lap = ndimage.laplace(smooth)
-    z = float(median(depth[valid]))
-    return region & (lap < -s.crease_curvature * (z / focal) ** 2)
+    smooth = _gaussian(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
+    lap = ndimage.correlate1d(smooth, _SECOND, 0)  # ndimage.laplace's sum, without its call's overhead
+    lap += ndimage.correlate1d(smooth, _SECOND, 1)
+    return region & (lap < -s.crease_curvature * (zm / focal) ** 2)
+
+
+#: The second difference that :func:`scipy.ndimage.laplace` takes along each axis.
+_SECOND = np.array([1.0, -2.0, 1.0])
+
+
+def _gaussian(image: np.ndarray, sigma: float) -> np.ndarray:
+    """``ndimage.gaussian_filter(image, sigma)`` of a float64 image, the same values: its weights worked out once per
+    ``sigma`` (:func:`_gaussian_weights`), not on every call (a polynomial's set-up and evaluation, some 40 us a call
+    on these small windows), then the two passes it makes, rows then columns, the second in place."""
+    weights = _gaussian_weights(float(sigma))
+    out = ndimage.correlate1d(image, weights, 0)
+    return ndimage.correlate1d(out, weights, 1, output=out)
+
+
+@functools.lru_cache(maxsize=8)
+def _gaussian_weights(sigma: float) -> np.ndarray:
+    """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
+    (each weight times 1, plus zeros: exact; the kernel is symmetric)."""
+    radius = int(4.0 * sigma + 0.5)
+    impulse = np.zeros(2 * radius + 1)
+    impulse[radius] = 1.0
+    weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
+    weights.flags.writeable = False
+    return weights
 
 
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
