@@ -1358,7 +1358,8 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    yy, xx = np.ogrid[big[0], big[1]]  # broadcast: the same values per pixel, without two full grids
+    # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
+    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     z = depth[big]
     zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
