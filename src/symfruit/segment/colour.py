@@ -512,21 +512,14 @@ def _segment_at(
         keep = seeded & (sizes >= 0.25 * least)
         ids, grouped, first = _grouped(lab, keep)  # the kept regions alone: a window may hold thousands of specks
         objects = _group_boxes(ids, grouped, first, rows, cols)
-        ripe_test = s.round_fruit and z is not None and len(ids) > 0
-        if ripe_test:  # each region's depths and rednesses, read off its pixels at once
-            zs = zw.take(grouped)
+        one = ripe = np.zeros(len(ids), bool)
+        if s.round_fruit and z is not None and len(ids) > 0:
+            # a region no larger than one fruit and not ripe-red is dropped before its masks are made: its pixels'
+            # depths and colours read off at once
             at = image_at.take(grouped)
             rgb = c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w]
-            reds = redness(rgb)
-        for i, k in enumerate(ids.tolist()):
-            if ripe_test:
-                run = slice(int(first[i]), int(first[i + 1]))
-                zk = zs[run]
-                if sizes[k] <= _largest_disc(zk[zk > 0], s, geo.focal, z_typical):
-                    # one fruit at most, not ripe-red over most of it: dropped before its masks are made
-                    # (:func:`_ripe_cores`' test on the region's own pixels, without the region's window)
-                    if median(reds[run]) < s.ripe_median:
-                        continue
+            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), redness(rgb), s, geo.focal, z_typical)
+        for k, whole in zip(ids[ripe | ~one].tolist(), one[ripe | ~one].tolist(), strict=True):
             sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
@@ -534,7 +527,7 @@ def _segment_at(
             sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
             origin = (sl[0].start, sl[1].start)
             cores = [region]
-            if s.round_fruit and sub_z is not None:
+            if s.round_fruit and sub_z is not None and not whole:
                 cores = _ripe_cores(region, c[sl], sub_z, s, geo.focal, z_typical)
             for core in cores:
                 parts = _split(core, sub_z, s, geo, origin, min_area)
@@ -1322,6 +1315,29 @@ def _ripe_cores(
     return [lab == k for k in np.flatnonzero(keep)]
 
 
+def _one_fruit(
+    first: np.ndarray,
+    sizes: np.ndarray,
+    depth: np.ndarray,
+    red: np.ndarray,
+    s: SegmentSettings,
+    focal: float,
+    z_typical: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_ripe_cores`' first test on regions, from their pixels alone (no window, no mask): which are no larger
+    than the largest fruit's disc at their median depth (one fruit at most), and of those which are ripe (their median
+    redness reaches ``ripe_median``; :func:`_ripe_cores` keeps them whole and drops the rest). ``depth`` and ``red``:
+    the regions' pixels' depths (0: none) and rednesses, region by region, region ``i``'s from ``first[i]`` to
+    ``first[i + 1]``; ``sizes``: their pixel counts. Returns two (n,) bool."""
+    one, ripe = np.zeros(len(sizes), bool), np.zeros(len(sizes), bool)
+    for i, size in enumerate(sizes.tolist()):
+        z = depth[first[i] : first[i + 1]]
+        if size <= _largest_disc(z[z > 0], s, focal, z_typical):
+            one[i] = True
+            ripe[i] = median(red[first[i] : first[i + 1]]) >= s.ripe_median
+    return one, ripe
+
+
 #: Width (pixels) of the box over which a ripe-red core's redness is averaged (the colour noise of one
 #: pixel: brown bark whose mean redness lies just below ``ripe_median`` has single pixels above it).
 CORE_SMOOTH_PX = 5
@@ -1723,7 +1739,9 @@ def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarr
     return lab.take(first), at, np.append(first, len(lab))
 
 
-def _group_boxes(ids: np.ndarray, at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> dict[int, Window]:
+def _group_boxes(
+    ids: np.ndarray, at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray
+) -> dict[int, Window]:
     """:func:`_boxes` of the groups of :func:`_grouped`."""
     if len(at) == 0:
         return {}
