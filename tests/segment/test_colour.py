@@ -988,3 +988,12 @@ def test_the_early_ripe_test_is_ripe_cores_first_one():
             cores = _ripe_cores(region, color, np.where(region, depth, 0.0), s, 300.0, 1.4)
             if one[i]:
                 assert cores == [] if not ripe[i] else len(cores) == 1 and np.array_equal(cores[0], region), trial
+
+
+def test_the_id_maps_hold_every_id():
+    from symfruit.segment.colour import _id_type
+
+    for n in (0, 1, 255, 32766, 32767, 100_000):
+        info = np.iinfo(_id_type(n))
+        assert info.min <= -1 and n <= info.max
+    assert _id_type(30) == np.int16
