@@ -782,9 +782,8 @@ class _Depth:
 
     def take(self, flat: np.ndarray) -> np.ndarray:
         """The depths at flat (row-major) pixel indices."""
-        z = np.asarray(self.given).ravel().take(flat).astype(np.float64)
-        np.copyto(z, 0.0, where=~_usable(z))
-        return z
+        z = np.asarray(self.given).ravel().take(flat)
+        return np.where(_usable(z), z.astype(np.float64), 0.0)
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
