@@ -750,12 +750,12 @@ def _usable(z: np.ndarray) -> np.ndarray:
 
 class _Depth:
     """A depth image as float64 metres with NaN, infinite and non-positive depths 0, converted window by window
-    when read (``depth[window]``, read-only and converted once per window; ``take(flat)``, a copy): the values of ``np.nan_to_num(z, nan=0, posinf=0,
-    neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole image, to the bit (-0.0 becomes 0.0
-    there too). The segmenter reads some 250 small windows of a frame: a float64 copy of a 1920x1080 image, 16 MB
-    of fresh pages, cost more than all of them, and so did the validity of every pixel (two passes over the
-    image, 2 ms at 1920x1080): each window's is worked out when it is read (a float64 copy keeps the order of a
-    float32 depth against 0 and infinity)."""
+    when read (``depth[window]``, read-only and converted once per window; ``take(flat)``, a copy): the values of
+    ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole
+    image, to the bit (-0.0 becomes 0.0 there too). The segmenter reads some 170 small windows of a frame: a float64
+    copy of a 1920x1080 image, 16 MB of fresh pages, cost more than all of them, and so did the validity of every
+    pixel (two passes over the image, 2 ms at 1920x1080): each window's is worked out when it is read (the depth's
+    own type keeps its order against 0 and infinity)."""
 
     def __init__(self, given: np.ndarray) -> None:
         self.given = given  # float, as handed over
