@@ -5,9 +5,11 @@ count of 3 passes less that of 1, halved, is one pass without the start-up (impo
         .venv/bin/python docs/callgrind_passes.py WHAT $n; done
     # then (summary of cg.3 - summary of cg.1) / 2: `grep -m1 ^summary: cg.N`
 
-WHAT: ``dense`` (five completions of ``symfruit bench``'s dense camera view, ``evidence``) or ``frames`` (the
+WHAT: ``dense`` (five completions of ``symfruit bench``'s dense camera view, ``evidence``), ``frames`` (the
 ``evidence`` completions of the benchmark frames of seeds 0 and 1, their inputs taken from ``detect`` once and
-replayed). Run with ``PYTHONPATH=TREE/src`` to count another tree. (numpy cannot use AVX-512 under valgrind, so its
+replayed) or ``trees`` (the colour segmenter with depth on the rendered apple-tree frames of seeds 0-2, 1920x1080,
+the apple profile's settings, as ``symfruit bench --segment --scene apple-tree``; divide by 3 for one frame).
+Run with ``PYTHONPATH=TREE/src`` to count another tree. (numpy cannot use AVX-512 under valgrind, so its
 sorts count more than they cost natively: check a change that trades sorts for other work in CPU time too,
 ``docs/speed_ab.py``.)
 """
@@ -40,8 +42,19 @@ def frame_inputs() -> list[tuple]:
 
 if __name__ == "__main__":
     what, n = sys.argv[1], int(sys.argv[2])
-    if what not in ("dense", "frames"):
-        sys.exit("WHAT is dense or frames")
+    if what not in ("dense", "frames", "trees"):
+        sys.exit("WHAT is dense, frames or trees")
+    if what == "trees":
+        from symfruit.segment.colour import segment
+        from symfruit.settings import resolve_settings
+        from symfruit.synthetic.scenes import make_tree_scene
+
+        settings = resolve_settings(fruit="apple").segment
+        trees = [make_tree_scene(seed) for seed in range(3)]
+        for _ in range(n):
+            for f in trees:
+                segment(f.color, f.depth, f.camera, settings)
+        sys.exit(0)
     work = frame_inputs() if what == "frames" else [(bench_camera_view(), {})] * 5
     for _ in range(n):
         for points, kwargs in work:

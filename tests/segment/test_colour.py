@@ -605,7 +605,7 @@ def test_ripe_seeds_are_the_former_look_ups():
 
 
 def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
-    from symfruit.segment.colour import _Depth
+    from symfruit.segment.colour import _Depth, _usable
 
     rng = np.random.default_rng(5)
     z = rng.normal(0.5, 1.0, (40, 50))
@@ -613,13 +613,15 @@ def test_the_depth_windows_are_nan_to_num_then_maximum_bit_for_bit():
         z.ravel()[rng.integers(0, z.size, count)] = value
     for image in (z, z.astype(np.float32), z[::2, 3:]):
         whole = np.maximum(np.nan_to_num(image.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0), 0.0)
-        valid = np.greater(image, 0.0) & np.less(image, np.inf)
-        depth = _Depth(image, valid)
-        assert np.array_equal(valid, whole != 0) and depth.shape == image.shape
+        depth = _Depth(image)
+        assert np.array_equal(_usable(image), whole != 0) and depth.shape == image.shape
         for window in ((slice(None), slice(None)), (slice(3, 17), slice(5, 21)), (slice(1, None, 3), slice(0, 9, 2))):
             got = depth[window]
-            assert got.dtype == np.float64 and got.flags.writeable
+            assert got.dtype == np.float64 and not got.flags.writeable  # read once: one array for every reader
             assert np.array_equal(got.view(np.int64), whole[window].view(np.int64))  # the bits, -0.0's sign included
+            assert depth[window] is got
+            with pytest.raises(ValueError):
+                got[0] = 1.0
         flat = rng.integers(0, image.size, 200)
         assert np.array_equal(depth.take(flat).view(np.int64), whole.ravel()[flat].view(np.int64))
         clean = _Depth.of(whole)
@@ -900,3 +902,120 @@ def test_two_pieces_a_fruit_apart_in_depth_are_not_one_fruit_without_a_sphere():
         whole = (slice(0, 200), slice(0, 200))
         pa, pb = _Piece(whole, a.copy(), 1), _Piece(whole, b.copy(), 2)
         assert _same_surface(pa, pb, _Depth.of(depth), weak, geo, s) is told, far
+
+
+def test_depth_off_the_sampling_grid_is_still_used():
+    """The depth's validity is looked for on every 8th pixel first, and over the whole image only when none is there:
+    depth on pixels off that grid alone is depth all the same (the same labels as with it made explicit)."""
+    from symfruit.segment.colour import _depth
+
+    depth = np.zeros((H, W))
+    depth[3::8, 5::8] = 0.6  # no pixel of the 8-grid
+    z, geo = _depth(depth, CAM, (H, W))
+    assert z is not None and geo.focal == 600.0
+    assert np.array_equal(z[(slice(None), slice(None))], depth)
+    assert _depth(np.where(depth > 0, np.nan, 0.0), CAM, (H, W))[0] is None  # NaN is no depth
+
+
+@given(n=st.integers(0, 12), size=st.integers(1, 300), seed=st.integers(0, 2**32 - 1), share=st.floats(0.0, 1.0))
+def test_the_grouped_pixels_are_each_kept_label_s_in_order(n, size, seed, share):
+    """_grouped: every kept label's pixels, in their own order, label after label ascending; its boxes are _boxes'."""
+    from symfruit.segment.colour import _boxes, _group_boxes, _grouped
+
+    rng = np.random.default_rng(seed)
+    labels = rng.integers(0, n + 1, size)
+    keep = rng.random(n + 1) < share
+    rows, cols = rng.integers(0, 50, size), rng.integers(0, 70, size)
+    ids, at, first = _grouped(labels, keep)
+    want = [k for k in range(n + 1) if keep[k] and (labels == k).any()]
+    assert ids.tolist() == want and len(first) == len(ids) + 1 and first[-1] == len(at)
+    for i, k in enumerate(want):
+        assert np.array_equal(at[first[i] : first[i + 1]], np.flatnonzero(labels == k))
+    assert _group_boxes(ids, at, first, rows, cols) == _boxes(labels, rows, cols, keep)
+
+
+@given(st.lists(st.tuples(st.integers(0, 40), st.integers(1, 12), st.integers(0, 40), st.integers(1, 12)), max_size=25))
+def test_the_joined_boxes_neither_touch_nor_lose_a_box(raw):
+    """_join_boxes: no two boxes it returns overlap or abut (4-connected), each box given lies in one of them, and each
+    returned box is the bounding box of the boxes in it; boxes that touch none come back unchanged."""
+    from symfruit.segment.colour import _join_boxes
+
+    boxes = [(r0, r0 + dr, c0, c0 + dc) for r0, dr, c0, dc in raw]
+    out = _join_boxes(list(boxes))
+    painted = np.zeros((60, 60), bool)
+    for r0, r1, c0, c1 in out:
+        assert not painted[r0:r1, c0:c1].any()  # no overlap
+        painted[r0:r1, c0:c1] = True
+    for a, (r0, r1, c0, c1) in enumerate(out):
+        for b, (s0, s1, d0, d1) in enumerate(out):
+            if a != b:  # no abutting either: a shared edge would join their pixels
+                assert not (
+                    (r0 < s1 and s0 < r1 and (c1 == d0 or d1 == c0)) or (c0 < d1 and d0 < c1 and (r1 == s0 or s1 == r0))
+                )
+        inside = [box for box in boxes if r0 <= box[0] and box[1] <= r1 and c0 <= box[2] and box[3] <= c1]
+        assert inside and (min(x[0] for x in inside), max(x[1] for x in inside), min(x[2] for x in inside),
+                           max(x[3] for x in inside)) == (r0, r1, c0, c1)  # fmt: skip
+    assert all(any(r0 <= b[0] and b[1] <= r1 and c0 <= b[2] and b[3] <= c1 for r0, r1, c0, c1 in out) for b in boxes)
+    if len(out) == len(boxes):
+        assert out == boxes
+
+
+def test_the_crease_smoothing_is_scipy_s_bit_for_bit():
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _SECOND, _gaussian
+
+    rng = np.random.default_rng(11)
+    for shape in ((1, 1), (3, 40), (57, 83), (120, 9)):
+        image = rng.normal(1.0, 0.3, shape)
+        for sigma in (0.5, 2.0, 3.3):
+            smooth = _gaussian(image, sigma)
+            assert np.array_equal(smooth.view(np.int64), ndimage.gaussian_filter(image, sigma).view(np.int64))
+            lap = ndimage.correlate1d(smooth, _SECOND, 0)
+            lap += ndimage.correlate1d(smooth, _SECOND, 1)
+            assert np.array_equal(lap.view(np.int64), ndimage.laplace(smooth).view(np.int64))
+
+
+def test_the_early_ripe_test_is_ripe_cores_first_one():
+    """_one_fruit tells from a region's pixels alone what _ripe_cores does with it at once: a region no larger than
+    the largest fruit's disc is kept whole when ripe, dropped when not; a larger one is left to _ripe_cores."""
+    from symfruit.segment.colour import _grouped, _one_fruit, _ripe_cores
+
+    s = SegmentSettings(round_fruit=True, round_max_diameter=0.10)
+    rng = np.random.default_rng(6)
+    for trial in range(40):
+        color = rng.integers(30, 256, (60, 80, 3), dtype=np.uint8)
+        color[..., 0] = np.maximum(color[..., 0], rng.integers(0, 256, (60, 80)).astype(np.uint8))
+        labels = np.zeros((60, 80), np.int64)
+        for k in range(1, 6):
+            r, c, rad = rng.integers(0, 60), rng.integers(0, 80), rng.integers(2, 25)
+            labels[(YY[:60, :80] - r) ** 2 + (XX[:60, :80] - c) ** 2 <= rad * rad] = k
+        red = np.stack(
+            [rng.integers(150, 256, (60, 80)), rng.integers(0, 120, (60, 80)), rng.integers(0, 120, (60, 80))], -1
+        )
+        color = np.where((labels % 2 == 1)[..., None], red, color).astype(np.uint8)  # odd regions mostly ripe-red
+        depth = np.where(rng.random((60, 80)) < 0.8, rng.uniform(0.5, 3.0, (60, 80)), 0.0)
+        if trial % 5 == 0:
+            depth[:] = 0.0  # no depth at all: sized at the typical depth
+        at = np.flatnonzero(labels)
+        lab = labels.ravel()[at]
+        keep = np.ones(6, bool)
+        ids, grouped, first = _grouped(lab, keep)
+        sizes = np.bincount(lab, minlength=6).take(ids)
+        pixels = at.take(grouped)
+        one, ripe = _one_fruit(first, sizes, depth.ravel().take(pixels), redness(color.reshape(-1, 3)[pixels]), s,
+                               300.0, 1.4)  # fmt: skip
+        for i, k in enumerate(ids.tolist()):
+            region = labels == k
+            cores = _ripe_cores(region, color, np.where(region, depth, 0.0), s, 300.0, 1.4)
+            if one[i]:
+                assert cores == [] if not ripe[i] else len(cores) == 1 and np.array_equal(cores[0], region), trial
+
+
+def test_the_id_maps_hold_every_id():
+    from symfruit.segment.colour import _id_type
+
+    for n in (0, 1, 255, 32766, 32767, 100_000):
+        info = np.iinfo(_id_type(n))
+        assert info.min <= -1 and n <= info.max
+    assert _id_type(30) == np.int16

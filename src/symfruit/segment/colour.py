@@ -48,6 +48,7 @@ Fruit cut by the image border are kept (their hull is cut by the border too).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Literal, Protocol
@@ -505,11 +506,20 @@ def _segment_at(
         if z is None:
             least: float | np.ndarray = min_area
         else:
-            zw = z.take((rows + win[0].start) * w + (cols + win[1].start))
+            image_at = (rows + win[0].start) * w + (cols + win[1].start)  # the pixels' flat indices in the image
+            zw = z.take(image_at)
             least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
         keep = seeded & (sizes >= 0.25 * least)
-        objects = _boxes(lab, rows, cols, keep)
-        for k in np.flatnonzero(keep).tolist():  # the kept regions alone: a window may hold thousands of specks
+        ids, grouped, first = _grouped(lab, keep)  # the kept regions alone: a window may hold thousands of specks
+        objects = _group_boxes(ids, grouped, first, rows, cols)
+        one = ripe = np.zeros(len(ids), bool)
+        if s.round_fruit and z is not None and len(ids) > 0:
+            # a region no larger than one fruit and not ripe-red is dropped before its masks are made: its pixels'
+            # depths and colours read off at once
+            at = image_at.take(grouped)
+            rgb = c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w]
+            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), redness(rgb), s, geo.focal, z_typical)
+        for k, whole in zip(ids[ripe | ~one].tolist(), one[ripe | ~one].tolist(), strict=True):
             sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
             sl = (slice(sl[0].start + win[0].start, sl[0].stop + win[0].start),
@@ -517,7 +527,7 @@ def _segment_at(
             sub_z = None if z is None else np.where(weak[sl], z[sl], 0.0)  # depth on red pixels only
             origin = (sl[0].start, sl[1].start)
             cores = [region]
-            if s.round_fruit and sub_z is not None:
+            if s.round_fruit and sub_z is not None and not whole:
                 cores = _ripe_cores(region, c[sl], sub_z, s, geo.focal, z_typical)
             for core in cores:
                 parts = _split(core, sub_z, s, geo, origin, min_area)
@@ -532,12 +542,15 @@ def _segment_at(
     pieces = _merge(pieces, s, c, weak, z, geo)
 
     pieces = sorted(pieces, key=lambda p: -p.area)
-    owner = np.zeros((h, w), np.int32)  # which piece each red pixel is part of: no hull takes another's
+    # which piece each red pixel is part of (no hull takes another's), and below which ground-colour body each pixel
+    # is: whole-image maps, in the narrowest integer type that numbers them (an 8 MB int32 image is 0.5-1 ms of
+    # zeroing alone)
+    owner = np.zeros((h, w), _id_type(len(pieces)))
     for k, piece in enumerate(pieces, 1):
         owner[piece.window][piece.mask] = k
     # fruit showing their ground colour: joined to the red fruit whose skin reaches them, else fruit of their own
     bodies = _ground_bodies(c, z, geo, s, owner) if ground and z is not None else []
-    body_map = np.zeros((h, w), np.int32) if bodies else None
+    body_map = np.zeros((h, w), _id_type(len(bodies))) if bodies else None
     for i, body in enumerate(bodies, 1):
         body_map[body.window][body.mask] = i  # type: ignore[index]
     taken = np.zeros(len(bodies) + 1, bool)
@@ -587,6 +600,11 @@ def _segment_at(
     return out
 
 
+def _id_type(n: int) -> type[np.signedinteger]:
+    """The signed integer type of a map numbering ``n`` things (-1 and 0 free for none)."""
+    return np.int16 if n < np.iinfo(np.int16).max else np.int32
+
+
 #: Grid step of the first, coarse look for red pixels (pixels).
 COARSE_STEP = 4
 
@@ -627,19 +645,15 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
-def _root(owner: list[int], k: int) -> int:
-    """The root of ``k`` in a union-find forest (paths halved on the way)."""
-    while owner[k] != k:
-        owner[k] = owner[owner[k]]
-        k = owner[k]
-    return k
-
-
 def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, int, int]]:
     """Boxes ``(r0, r1, c0, c1)`` joined until none overlaps or abuts another: each time, the boxes whose
     painted pixels are 4-connected become their bounding box, ordered by its first pixel in raster order, as
     the labels of the painted image number them (``ndimage.label`` and ``find_objects``, worked out on the
-    boxes instead of the grid); unchanged (in their own order) once no two join."""
+    boxes instead of the grid); unchanged (in their own order) once no two join. The groups are the connected
+    components of the graph of touching boxes (scipy's, not a union-find in Python over the pairs)."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
     while boxes:
         b = np.array(boxes, np.int64)
         r0, r1, c0, c1 = b[:, 0], b[:, 1], b[:, 2], b[:, 3]
@@ -648,23 +662,22 @@ def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, 
         cols_over = (c0[:, None] < c1[None]) & (c0[None] < c1[:, None])
         cols_touch = (c0[:, None] <= c1[None]) & (c0[None] <= c1[:, None])
         i, j = np.nonzero(np.triu((rows_over & cols_touch) | (rows_touch & cols_over), 1))
-        owner = list(range(len(boxes)))
-        for p, q in zip(i.tolist(), j.tolist(), strict=True):
-            rp, rq = _root(owner, p), _root(owner, q)
-            if rp != rq:
-                owner[max(rp, rq)] = min(rp, rq)
-        groups: dict[int, list[int]] = {}
-        for k in range(len(boxes)):
-            groups.setdefault(_root(owner, k), []).append(k)
-        if len(groups) == len(boxes):
+        n = len(boxes)
+        if len(i) == 0:
             break
-        joined = []
-        for members in groups.values():
-            m = b[members]
-            top = int(m[:, 0].min())
-            first = (top, int(m[m[:, 0] == top, 2].min()))  # the component's first pixel in raster order
-            joined.append((first, (top, int(m[:, 1].max()), int(m[:, 2].min()), int(m[:, 3].max()))))
-        boxes = [box for _, box in sorted(joined)]
+        m, group = connected_components(coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n)), directed=False)
+        top = np.full(m, np.iinfo(np.int64).max)
+        np.minimum.at(top, group, r0)
+        first = np.full(m, np.iinfo(np.int64).max)  # the component's first pixel in raster order: its top row's
+        at_top = r0 == top[group]
+        np.minimum.at(first, group[at_top], c0[at_top])
+        left = np.full(m, np.iinfo(np.int64).max)
+        np.minimum.at(left, group, c0)
+        bottom, right = np.zeros(m, np.int64), np.zeros(m, np.int64)
+        np.maximum.at(bottom, group, r1)
+        np.maximum.at(right, group, c1)
+        order = np.lexsort((first, top))  # no two components share their first pixel
+        boxes = list(zip(*(v.take(order).tolist() for v in (top, bottom, left, right)), strict=True))
     return boxes
 
 
@@ -715,9 +728,8 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     if None not in size and (int(size[0]), int(size[1])) != (shape[1], shape[0]):  # type: ignore[arg-type]
         raise InputError(f"segment: the camera is for {size[0]}x{size[1]} images, the image is {shape[1]}x{shape[0]}")
     given = np.ascontiguousarray(given)  # read by flat index window by window (a copy only if strided)
-    valid = np.greater(given, 0.0)  # False for NaN
-    valid &= np.less(given, np.inf)
-    if not valid.any():
+    # usable depth anywhere: looked for on every 8th pixel first, over the whole image only when none is there
+    if not (_usable(given[::8, ::8]).any() or _usable(given).any()):
         return None, none
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
@@ -729,36 +741,52 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)
-    return _Depth(given, valid), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+    return _Depth(given), _Geometry(float(np.sqrt(fx * fy)), cy, cx)
+
+
+def _usable(z: np.ndarray) -> np.ndarray:
+    """(h, w) bool: depths positive and finite (False for NaN)."""
+    valid = np.greater(z, 0.0)
+    valid &= np.less(z, np.inf)
+    return valid
 
 
 class _Depth:
     """A depth image as float64 metres with NaN, infinite and non-positive depths 0, converted window by window
-    when read (``depth[window]``, a copy; ``take(flat)``): the values of ``np.nan_to_num(z, nan=0, posinf=0,
-    neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole image, to the bit (-0.0 becomes 0.0
-    there too). The segmenter reads some 250 small windows of a frame: a float64 copy of a 1920x1080 image, 16 MB
-    of fresh pages, cost more than all of them."""
+    when read (``depth[window]``, read-only and converted once per window; ``take(flat)``, a copy): the values of
+    ``np.nan_to_num(z, nan=0, posinf=0, neginf=0)`` then ``np.maximum(z, 0)`` over a float64 copy of the whole
+    image, to the bit (-0.0 becomes 0.0 there too). The segmenter reads some 170 small windows of a frame: a float64
+    copy of a 1920x1080 image, 16 MB of fresh pages, cost more than all of them, and so did the validity of every
+    pixel (two passes over the image, 2 ms at 1920x1080): each window's is worked out when it is read (the depth's
+    own type keeps its order against 0 and infinity)."""
 
-    def __init__(self, given: np.ndarray, valid: np.ndarray) -> None:
+    def __init__(self, given: np.ndarray) -> None:
         self.given = given  # float, as handed over
-        self.valid = valid  # (h, w) bool: positive and finite
         self.shape: tuple[int, int] = (int(given.shape[0]), int(given.shape[1]))
+        self.read: dict[tuple[int | None, ...], np.ndarray] = {}  # the windows read so far, by their slices
 
     @classmethod
     def of(cls, z: np.ndarray) -> _Depth:
         """A float64 depth already cleaned (0 where invalid)."""
-        return cls(z, z > 0)
+        return cls(z)
 
     def __getitem__(self, window: tuple[slice, slice]) -> np.ndarray:
-        z = np.array(self.given[window], dtype=np.float64)
-        np.copyto(z, 0.0, where=~self.valid[window])
+        """The window's depths, read-only: a window read again (a region's window is read by its split, its merge
+        tests, its hull and its skin; some 170 reads of 70 windows a 1920x1080 tree frame) is converted once."""
+        a, b = window
+        key = (a.start, a.stop, a.step, b.start, b.stop, b.step)
+        z = self.read.get(key)
+        if z is None:
+            given = self.given[window]
+            z = np.where(_usable(given), given.astype(np.float64), 0.0)  # a select: faster than a masked copy
+            z.flags.writeable = False
+            self.read[key] = z
         return z
 
     def take(self, flat: np.ndarray) -> np.ndarray:
         """The depths at flat (row-major) pixel indices."""
-        z = np.asarray(self.given).ravel().take(flat).astype(np.float64)
-        np.copyto(z, 0.0, where=~self.valid.ravel().take(flat))
-        return z
+        z = np.asarray(self.given).ravel().take(flat)
+        return np.where(_usable(z), z.astype(np.float64), 0.0)
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
@@ -952,17 +980,19 @@ def _split(
         r = s.close_px
         padded = np.pad(region, r + 1)
         region = ndimage.binary_closing(padded, structure=_disc(r))[r + 1 : -r - 1, r + 1 : -r - 1] | region
-    use_depth = depth is not None and s.split in ("depth", "both") and int((depth[region] > 0).sum()) >= 20
+    seen = None if depth is None else region & (depth > 0)  # the region's pixels with depth
+    use_depth = seen is not None and s.split in ("depth", "both") and int(seen.sum()) >= 20
     if s.split == "none" or (s.split == "depth" and not use_depth):
         return [region]
     carved, edges = region, None
     # the smallest fruit worth cutting off: fruit-sized (with depth: at its depth, and half of it may be
     # hidden behind the fruit in front or a leaf)
     least = np.sqrt(min_area / np.pi)
-    if use_depth and depth is not None:
-        edges = _depth_edges(region, depth, s, geo.focal)
+    if use_depth and depth is not None and seen is not None:
+        zm = float(median(depth[seen]))
+        edges = _depth_edges(region, depth, seen, zm, s, geo.focal)
         carved = fill_holes(region & ~edges)
-        least = 0.25 * geo.focal * s.min_diameter / float(median(depth[region & (depth > 0)]))
+        least = 0.25 * geo.focal * s.min_diameter / zm
     # with depth, every saddle of the distance transform is tried: the depth surface decides
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
@@ -1237,11 +1267,14 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
-def _depth_edges(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
+def _depth_edges(
+    region: np.ndarray, depth: np.ndarray, seen: np.ndarray, zm: float, s: SegmentSettings, focal: float
+) -> np.ndarray:
     """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
-    crease of the depth surface: where one fruit ends and another begins."""
-    z = np.where(region & (depth > 0), depth, np.nan)
-    return (_creases(region, depth, s, focal) | _steps(z, s.depth_jump)) & region
+    crease of the depth surface: where one fruit ends and another begins. ``seen``: the region's pixels with depth
+    (``region & (depth > 0)``), ``zm`` their median depth."""
+    z = np.where(seen, depth, np.nan)
+    return (_creases(region, depth, seen, zm, s, focal) | _steps(z, s.depth_jump)) & region
 
 
 def _steps(z: np.ndarray, jump: float) -> np.ndarray:
@@ -1257,23 +1290,54 @@ def _steps(z: np.ndarray, jump: float) -> np.ndarray:
     return edge
 
 
-def _creases(region: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float) -> np.ndarray:
-    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam."""
-    valid = region & (depth > 0)
+def _creases(
+    region: np.ndarray, depth: np.ndarray, valid: np.ndarray, zm: float, s: SegmentSettings, focal: float
+) -> np.ndarray:
+    """Concave creases of the depth surface: where two convex fruit meet, depth peaks across the seam. ``valid``:
+    the region's pixels with depth, ``zm`` their median depth."""
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     ri, ci = ndimage.distance_transform_edt(~valid, return_distances=False, return_indices=True)
     filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
-    smooth = ndimage.gaussian_filter(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
-    lap = ndimage.laplace(smooth)
-    z = float(median(depth[valid]))
-    return region & (lap < -s.crease_curvature * (z / focal) ** 2)
+    smooth = _gaussian(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
+    lap = ndimage.correlate1d(smooth, _SECOND, 0)  # ndimage.laplace's sum, without its call's overhead
+    lap += ndimage.correlate1d(smooth, _SECOND, 1)
+    return region & (lap < -s.crease_curvature * (zm / focal) ** 2)
+
+
+#: The second difference that :func:`scipy.ndimage.laplace` takes along each axis.
+_SECOND = np.array([1.0, -2.0, 1.0])
+
+
+def _gaussian(image: np.ndarray, sigma: float) -> np.ndarray:
+    """``ndimage.gaussian_filter(image, sigma)`` of a float64 image, the same values: its weights worked out once per
+    ``sigma`` (:func:`_gaussian_weights`), not on every call (a polynomial's set-up and evaluation, some 40 us a call
+    on these small windows), then the two passes it makes, rows then columns, the second in place."""
+    weights = _gaussian_weights(float(sigma))
+    out = ndimage.correlate1d(image, weights, 0)
+    return ndimage.correlate1d(out, weights, 1, output=out)
+
+
+@functools.lru_cache(maxsize=8)
+def _gaussian_weights(sigma: float) -> np.ndarray:
+    """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
+    (each weight times 1, plus zeros: exact; the kernel is symmetric)."""
+    radius = int(4.0 * sigma + 0.5)
+    impulse = np.zeros(2 * radius + 1)
+    impulse[radius] = 1.0
+    weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
+    weights.flags.writeable = False
+    return weights
 
 
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
     """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
     (``z_typical`` where none of its pixels has depth)."""
-    z = depth[mask & (depth > 0)]
+    return _largest_disc(depth[mask & (depth > 0)], s, focal, z_typical)
+
+
+def _largest_disc(z: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
+    """:func:`_largest_area` at the median of the depths ``z`` (all positive; ``z_typical`` when there are none)."""
     zr = float(median(z)) if len(z) else z_typical
     return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
 
@@ -1303,6 +1367,29 @@ def _ripe_cores(
     keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
     keep[0] = False
     return [lab == k for k in np.flatnonzero(keep)]
+
+
+def _one_fruit(
+    first: np.ndarray,
+    sizes: np.ndarray,
+    depth: np.ndarray,
+    red: np.ndarray,
+    s: SegmentSettings,
+    focal: float,
+    z_typical: float,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_ripe_cores`' first test on regions, from their pixels alone (no window, no mask): which are no larger
+    than the largest fruit's disc at their median depth (one fruit at most), and of those which are ripe (their median
+    redness reaches ``ripe_median``; :func:`_ripe_cores` keeps them whole and drops the rest). ``depth`` and ``red``:
+    the regions' pixels' depths (0: none) and rednesses, region by region, region ``i``'s from ``first[i]`` to
+    ``first[i + 1]``; ``sizes``: their pixel counts. Returns two (n,) bool."""
+    one, ripe = np.zeros(len(sizes), bool), np.zeros(len(sizes), bool)
+    for i, size in enumerate(sizes.tolist()):
+        z = depth[first[i] : first[i + 1]]
+        if size <= _largest_disc(z[z > 0], s, focal, z_typical):
+            one[i] = True
+            ripe[i] = median(red[first[i] : first[i + 1]]) >= s.ripe_median
+    return one, ripe
 
 
 #: Width (pixels) of the box over which a ripe-red core's redness is averaged (the colour noise of one
@@ -1341,7 +1428,8 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    yy, xx = np.ogrid[big[0], big[1]]  # broadcast: the same values per pixel, without two full grids
+    # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
+    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     z = depth[big]
     zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
@@ -1553,9 +1641,8 @@ def _gap_filled(depth: np.ndarray, size: int) -> np.ndarray:
             lag = (slice(None, -k), slice(None)) if axis == 0 else (slice(None), slice(None, -k))
             np.maximum(near[lead], src[lag], out=near[lead])
             np.maximum(near[lag], src[lead], out=near[lag])
-    np.copyto(near, depth, where=depth > 0)
-    near[near <= 0] = np.nan
-    return near
+    near = np.where(depth > 0, depth, near)  # a select: several times a masked copy's speed
+    return np.where(near > 0, near, np.nan)  # no NaN in a cleaned depth: not positive is 0
 
 
 def _join_bodies(
@@ -1690,17 +1777,31 @@ def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: f
 def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndarray) -> dict[int, Window]:
     """The boxes of the labels that ``keep`` marks, as ``ndimage.find_objects`` gives them, from the labels,
     rows and columns of a window's labelled pixels (scipy's makes a box for every label of the window)."""
+    return _group_boxes(*_grouped(labels, keep), rows, cols)
+
+
+def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The pixels of the labels that ``keep`` marks, grouped by label: their labels in ascending order, the
+    pixels' indices (into ``labels``) label by label (each label's in their own order), and where each label's
+    run starts in them (one more at the end: their number)."""
     at = np.flatnonzero(keep.take(labels))
-    if len(at) == 0:
-        return {}
     lab = labels.take(at)
     order = np.argsort(lab, kind="stable")
-    lab = lab.take(order)
-    r, c = rows.take(at).take(order), cols.take(at).take(order)
-    first = np.flatnonzero(np.concatenate(([True], lab[1:] != lab[:-1])))
+    lab, at = lab.take(order), at.take(order)
+    first = np.flatnonzero(np.concatenate(([len(lab) > 0], lab[1:] != lab[:-1])))
+    return lab.take(first), at, np.append(first, len(lab))
+
+
+def _group_boxes(
+    ids: np.ndarray, at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray
+) -> dict[int, Window]:
+    """:func:`_boxes` of the groups of :func:`_grouped`."""
+    if len(at) == 0:
+        return {}
+    r, c, first = rows.take(at), cols.take(at), first[:-1]
     r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
     c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
-    cells = zip(*(v.tolist() for v in (lab[first], r0, r1, c0, c1)), strict=True)
+    cells = zip(*(v.tolist() for v in (ids, r0, r1, c0, c1)), strict=True)
     return {k: (slice(a, b), slice(d, e)) for k, a, b, d, e in cells}
 
 
