@@ -9,6 +9,7 @@ its options as keywords, and returns arrays; none knows settings objects or file
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -17,6 +18,7 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
+from .kernels import compiled
 from .points import as_points, cross_rows, median, perpendicular_basis, row_norms
 
 __all__ = [
@@ -81,6 +83,11 @@ def fit_sphere(
         raise InputError("cannot fit a sphere: the points are (nearly) coplanar or collinear")
     c = sol[:3]
     r = float(np.sqrt(max(sol[3] + c @ c, 1e-12)))
+    if refine and (jit := compiled()) is not None:  # the compiled twin of the loop below
+        c_jit = np.array(c)
+        r_jit, ok = jit.sphere_steps(q, c_jit, r, iterations, tolerance, scale)
+        if ok:
+            return c_jit * scale + mean, r_jit * scale
     if refine:
         jac = np.empty((len(q), 4))
         jac[:, 3] = -1.0
@@ -512,10 +519,15 @@ def fit_revolution_slices(
         dirs = np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
     if not len(dirs):
         raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
-    best = dirs[int(np.argmin(_slice_costs(qs, dirs, bins)))]
+    jit = compiled()
+    if jit is not None:  # the compiled twin of _slice_costs
+        qs = np.ascontiguousarray(qs)
+        dirs = np.ascontiguousarray(dirs)
+    slice_costs = _slice_costs if jit is None else jit.slice_costs
+    best = dirs[int(np.argmin(slice_costs(qs, dirs, bins)))]
     for spread in refine_deg:
         cand = _cap(best, spread, refine_n)
-        best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
+        best = cand[int(np.argmin(slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
     t = q @ best
     w = np.stack((q @ e1[0], q @ e2[0]), axis=1)
@@ -799,6 +811,40 @@ class ConeFit:
     rms: float
 
 
+def _cone_steps(
+    p: np.ndarray, with_steps: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
+    cost: Callable[[np.ndarray], np.ndarray], huber: float, iterations: int, tolerance: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`fit_cone_ellipsoid`'s Levenberg-Marquardt from the grid's best ``p`` (4,): the parameters, the
+    residuals at them (n,) and at each finite-difference step (4, n) (the numpy twin of
+    :func:`symfruit.core._jit.cone_fit`)."""
+    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
+    r, r_steps = with_steps(p)
+    current, mu = float(cost(r)), 1e-2
+    for _ in range(iterations):
+        done = False
+        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
+        a = np.abs(r)
+        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        jtj = (jac * w) @ jac.T
+        g = (jac * w) @ r
+        improved = False
+        while mu < 1e6:
+            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
+            trial = p + delta
+            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
+            new = float(cost(r_new))
+            if new < current:
+                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
+                done = current - new < tolerance * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
+    return p, r, r_steps
+
+
 def fit_cone_ellipsoid(
     points: np.ndarray,
     *,
@@ -882,33 +928,18 @@ def fit_cone_ellipsoid(
         a = np.abs(res)
         return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
 
-    costs = cost(residuals(grid))
-    if not np.isfinite(costs).any():
+    status = -1
+    if (jit := compiled()) is not None:  # the compiled twin of the grid search and the loop below
+        z = np.ascontiguousarray(z)
+        p, both, status = jit.cone_fit(
+            grid, np.ascontiguousarray(cone), np.ascontiguousarray(axis), rays, ray_cone, z, step, huber, iterations,
+            tolerance,
+        )  # fmt: skip
+        r, r_steps = both[0], both[1:]
+    if status == 1 or status != 0 and not np.isfinite(costs := cost(residuals(grid))).any():
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
-    p = grid[int(np.argmin(costs))]
-    r, r_steps = with_steps(p)
-    current, mu = float(cost(r)), 1e-2
-    for _ in range(iterations):
-        done = False
-        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
-        a = np.abs(r)
-        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
-        jtj = (jac * w) @ jac.T
-        g = (jac * w) @ r
-        improved = False
-        while mu < 1e6:
-            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
-            trial = p + delta
-            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
-            new = float(cost(r_new))
-            if new < current:
-                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
-                done = current - new < tolerance * current
-                current = new
-                break
-            mu *= 4.0
-        if not improved or done:
-            break
+    if status != 0:
+        p, r, r_steps = _cone_steps(grid[int(np.argmin(costs))], with_steps, cost, huber, iterations, tolerance)
     m, shape, valid = cone_ellipsoid(p[None], cone, axis)
     if not valid[0]:
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")

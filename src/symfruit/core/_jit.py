@@ -1,0 +1,352 @@
+"""The compiled kernels behind :mod:`symfruit.core.kernels` (numba; imported only when a kernel is first asked for).
+
+Each kernel is a whole loop of :mod:`symfruit.core.fits` written out element by element, with its numpy twin
+there (the tests compare the two). ``error_model="numpy"``: a division by zero gives inf or NaN as numpy's
+does, where the twin's ``np.errstate`` lets it, instead of raising. No ``fastmath``: IEEE arithmetic, though
+sums run in another order than numpy's pairwise ones (results agree to rounding, not to the bit).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any, Callable
+
+import numba
+import numpy as np
+
+
+def _njit(func: Callable[..., Any]) -> Any:
+    """``numba.njit`` with the compiled code cached on disk (beside this file, or in the user's cache directory
+    when that is not writable, e.g. a read-only site-packages); without the cache when numba finds no writable
+    directory at all (it raises then), so a kernel is never what fails."""
+    try:
+        return numba.njit(cache=True, error_model="numpy", nogil=True)(func)
+    except RuntimeError:
+        return numba.njit(error_model="numpy", nogil=True)(func)
+
+
+@_njit
+def solve(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
+    """Solve ``a x = b`` for a small square ``a`` by Gaussian elimination with partial pivoting (``a`` and ``b``
+    are overwritten); False, ``x`` untouched, when a pivot is exactly zero (numpy's ``solve`` raises there)."""
+    n = a.shape[0]
+    for col in range(n):
+        piv = col
+        best = abs(a[col, col])
+        for row in range(col + 1, n):
+            if abs(a[row, col]) > best:
+                piv, best = row, abs(a[row, col])
+        if best == 0.0:
+            return False
+        if piv != col:
+            for j in range(n):
+                a[col, j], a[piv, j] = a[piv, j], a[col, j]
+            b[col], b[piv] = b[piv], b[col]
+        for row in range(col + 1, n):
+            f = a[row, col] / a[col, col]
+            if f != 0.0:
+                for j in range(col, n):
+                    a[row, j] -= f * a[col, j]
+                b[row] -= f * b[col]
+    for row in range(n - 1, -1, -1):
+        s = b[row]
+        for j in range(row + 1, n):
+            s -= a[row, j] * x[j]
+        x[row] = s / a[row, row]
+    return True
+
+
+@_njit
+def select(x: np.ndarray, kth: int) -> None:
+    """Reorder ``x`` (n,) in place so that ``x[kth]`` is its ``kth`` smallest value, none larger before it and none
+    smaller after (quickselect, median-of-three pivots: a partition without ``np.partition``'s copy, half its
+    time on a few hundred values)."""
+    lo, hi = 0, x.shape[0] - 1
+    while hi > lo:
+        mid = (lo + hi) >> 1
+        a, b, c = x[lo], x[mid], x[hi]
+        if a > b:
+            a, b = b, a
+        if b > c:
+            b = c
+            if a > b:
+                b = a
+        i, j = lo, hi
+        while i <= j:
+            while x[i] < b:
+                i += 1
+            while x[j] > b:
+                j -= 1
+            if i <= j:
+                x[i], x[j] = x[j], x[i]
+                i += 1
+                j -= 1
+        if kth <= j:
+            hi = j
+        elif kth >= i:
+            lo = i
+        else:
+            return
+
+
+@_njit
+def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
+    """:func:`symfruit.core.fits._slice_costs`: the robust slice-circle cost (k,) of every direction (k, 3) for
+    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused)."""
+    k, n = dirs.shape[0], q.shape[0]
+    out = np.empty(k)
+    t = np.empty(n)
+    u = np.empty(n)
+    v = np.empty(n)
+    idx = np.empty(n, np.int64)
+    dist2 = np.empty(n)
+    cnt = np.empty(bins)
+    su = np.empty(bins)
+    sv = np.empty(bins)
+    sy = np.empty(bins)
+    keep = max(1, int(0.8 * n))
+    for j in range(k):
+        x, y, z = dirs[j, 0], dirs[j, 1], dirs[j, 2]
+        if abs(x) < 0.9:  # the basis of core.points.perpendicular_basis
+            a, b, c = 0.0, z, -y
+        else:
+            a, b, c = -z, 0.0, x
+        norm = math.sqrt(a * a + b * b + c * c)
+        a, b, c = a / norm, b / norm, c / norm
+        f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
+        lo, hi = np.inf, -np.inf
+        for i in range(n):
+            p0, p1, p2 = q[i, 0], q[i, 1], q[i, 2]
+            ti = x * p0 + y * p1 + z * p2
+            t[i] = ti
+            u[i] = a * p0 + b * p1 + c * p2
+            v[i] = f * p0 + g * p1 + h * p2
+            lo = min(lo, ti)
+            hi = max(hi, ti)
+        span = max(hi - lo, 1e-12)
+        cnt[:] = 0.0
+        su[:] = 0.0
+        sv[:] = 0.0
+        sy[:] = 0.0
+        for i in range(n):
+            s = int((t[i] - lo) / span * bins)
+            s = min(s, bins - 1)
+            idx[i] = s
+            cnt[s] += 1.0
+            su[s] += u[i]
+            sv[s] += v[i]
+            sy[s] += u[i] * u[i] + v[i] * v[i]
+        for s in range(bins):
+            d = max(cnt[s], 1.0)
+            su[s] /= d
+            sv[s] /= d
+            sy[s] /= d
+        a11 = a12 = a22 = b1 = b2 = 0.0
+        for i in range(n):
+            s = idx[i]
+            du = u[i] - su[s]
+            dv = v[i] - sv[s]
+            dy = u[i] * u[i] + v[i] * v[i] - sy[s]
+            a11 += du * du
+            a12 += du * dv
+            a22 += dv * dv
+            b1 += du * dy
+            b2 += dv * dy
+        det = a11 * a22 - a12 * a12
+        if not abs(det) > 1e-30:
+            det = 1e-30
+        au = 0.5 * (a22 * b1 - a12 * b2) / det
+        av = 0.5 * (a11 * b2 - a12 * b1) / det
+        for i in range(n):
+            s = idx[i]
+            du = u[i] - su[s]
+            dv = v[i] - sv[s]
+            dy = u[i] * u[i] + v[i] * v[i] - sy[s]
+            res = dy - 2.0 * (au * du + av * dv)
+            ru = u[i] - au
+            rv = v[i] - av
+            rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
+            dist2[i] = res * res / rho2
+        select(dist2, keep - 1)
+        total = 0.0
+        for i in range(keep):
+            total += dist2[i]
+        out[j] = total / keep
+    return out
+
+
+@_njit
+def sphere_steps(
+    q: np.ndarray, c: np.ndarray, r: float, iterations: int, tolerance: float, scale: float
+) -> tuple[float, bool]:
+    """:func:`symfruit.core.fits.fit_sphere`'s Gauss-Newton on the residuals ``|q - c| - r`` (``c`` (3,) updated in
+    place; it stops once a step times ``scale`` is under ``tolerance``): the radius and True, or False where the 4x4 normal equations are
+    singular (the twin then takes a least-squares step, so the caller runs the twin)."""
+    n = q.shape[0]
+    jtj = np.empty((4, 4))
+    g = np.empty(4)
+    step = np.empty(4)
+    for _ in range(iterations):
+        jtj[:] = 0.0
+        g[:] = 0.0
+        for i in range(n):
+            d0, d1, d2 = q[i, 0] - c[0], q[i, 1] - c[1], q[i, 2] - c[2]
+            dist = max(math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), 1e-12)
+            j0, j1, j2 = -d0 / dist, -d1 / dist, -d2 / dist
+            res = dist - r
+            jtj[0, 0] += j0 * j0
+            jtj[0, 1] += j0 * j1
+            jtj[0, 2] += j0 * j2
+            jtj[0, 3] -= j0
+            jtj[1, 1] += j1 * j1
+            jtj[1, 2] += j1 * j2
+            jtj[1, 3] -= j1
+            jtj[2, 2] += j2 * j2
+            jtj[2, 3] -= j2
+            g[0] -= j0 * res
+            g[1] -= j1 * res
+            g[2] -= j2 * res
+            g[3] += res
+        jtj[3, 3] = float(n)
+        for a in range(4):
+            for b in range(a):
+                jtj[a, b] = jtj[b, a]
+        if not solve(jtj, g, step):
+            return r, False
+        c[0] += step[0]
+        c[1] += step[1]
+        c[2] += step[2]
+        r = abs(r + step[3])
+        largest = 0.0
+        for a in range(4):
+            largest = max(largest, abs(step[a]))
+        if largest * scale < tolerance:
+            break
+    return r, True
+
+
+@_njit
+def cone_residuals(
+    params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
+    out: np.ndarray,
+) -> None:  # fmt: skip
+    """The depth residuals (k, n) into ``out`` of :func:`symfruit.core.fits.fit_cone_ellipsoid`: ``z`` less the front
+    of each ellipsoid of :func:`symfruit.core.fits._cone_fronts` (parameters (k, 4)) along each ray, 0.05 for an
+    invalid ellipsoid's row, 0.02 where a ray misses."""
+    k, n = params.shape[0], rays.shape[0]
+    for j in range(k):
+        e = math.exp(params[j, 2])
+        m0 = (axis[0] + params[j, 0]) * e
+        m1 = (axis[1] + params[j, 1]) * e
+        m2 = axis[2] * e
+        c0 = m0 * cone[0, 0] + m1 * cone[1, 0] + m2 * cone[2, 0]
+        c1 = m0 * cone[0, 1] + m1 * cone[1, 1] + m2 * cone[2, 1]
+        c2 = m0 * cone[0, 2] + m1 * cone[1, 2] + m2 * cone[2, 2]
+        qq = -(c0 * m0 + c1 * m1 + c2 * m2)
+        if not qq > 0:
+            out[j, :] = 0.05
+            continue
+        lam = qq / (1.0 + math.exp(-min(max(params[j, 3], -50.0), 50.0)))
+        gap = lam - qq
+        for i in range(n):
+            rcm = c0 * rays[i, 0] + c1 * rays[i, 1] + c2 * rays[i, 2]
+            a = ray_cone[i] / lam - rcm * rcm / (lam * gap)
+            b = rcm / gap
+            c = -lam / gap
+            disc = b * b - a * c
+            res = z[i] - (b - math.sqrt(disc)) / a if disc >= 0 else np.nan
+            out[j, i] = res if math.isfinite(res) else 0.02
+
+
+@_njit
+def huber_cost(res: np.ndarray, huber: float) -> float:
+    """The Huber cost of one row of residuals (``fit_cone_ellipsoid``'s ``cost``)."""
+    total = 0.0
+    for i in range(res.shape[0]):
+        a = abs(res[i])
+        total += 0.5 * res[i] * res[i] if a <= huber else huber * (a - 0.5 * huber)
+    return total
+
+
+@_njit
+def cone_fit(
+    grid: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
+    step: np.ndarray, huber: float, iterations: int, tolerance: float,
+) -> tuple[np.ndarray, np.ndarray, int]:  # fmt: skip
+    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s grid search and Levenberg-Marquardt: the parameters (4,),
+    the residuals at them and at each finite-difference step (5, n), and a status: 0 done, 1 no finite cost on
+    the grid, 2 a singular damped system (numpy's ``solve`` raises there; the caller runs the twin)."""
+    n = rays.shape[0]
+    k = grid.shape[0]
+    res = np.empty((k, n))
+    cone_residuals(grid, cone, axis, rays, ray_cone, z, res)
+    best, current = -1, np.inf
+    for j in range(k):
+        cj = huber_cost(res[j], huber)
+        if cj < current:  # the first least, as np.argmin
+            best, current = j, cj
+    at = np.empty((5, 4))
+    both = np.empty((5, n))
+    if best < 0:
+        return at[0], both, 1
+    p = grid[best].copy()
+    for a in range(5):
+        for b in range(4):
+            at[a, b] = p[b] + (step[b] if a == b + 1 else 0.0)
+    cone_residuals(at, cone, axis, rays, ray_cone, z, both)
+    trial_at = np.empty((5, 4))
+    trial_both = np.empty((5, n))
+    current = huber_cost(both[0], huber)
+    mu = 1e-2
+    jac = np.empty((4, n))
+    w = np.empty(n)
+    jtj = np.empty((4, 4))
+    g = np.empty(4)
+    lhs = np.empty((4, 4))
+    rhs = np.empty(4)
+    delta = np.empty(4)
+    for _ in range(iterations):
+        done = False
+        for i in range(n):
+            ri = both[0, i]
+            a = abs(ri)
+            w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
+            for b in range(4):
+                jac[b, i] = (both[b + 1, i] - ri) / step[b]
+        for a in range(4):
+            s = 0.0
+            for i in range(n):
+                s += jac[a, i] * w[i] * both[0, i]
+            g[a] = s
+            for b in range(a, 4):
+                s = 0.0
+                for i in range(n):
+                    s += jac[a, i] * w[i] * jac[b, i]
+                jtj[a, b] = s
+                jtj[b, a] = s
+        improved = False
+        while mu < 1e6:
+            for a in range(4):
+                for b in range(4):
+                    lhs[a, b] = jtj[a, b]
+                lhs[a, a] += mu * (jtj[a, a] + 1e-12)
+                rhs[a] = g[a]
+            if not solve(lhs, rhs, delta):
+                return p, both, 2
+            for a in range(5):
+                for b in range(4):
+                    trial_at[a, b] = p[b] - delta[b] + (step[b] if a == b + 1 else 0.0)
+            cone_residuals(trial_at, cone, axis, rays, ray_cone, z, trial_both)
+            new = huber_cost(trial_both[0], huber)
+            if new < current:
+                p = trial_at[0].copy()
+                both, trial_both = trial_both, both
+                mu = max(mu / 3.0, 1e-7)
+                improved = True
+                done = current - new < tolerance * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
+    return p, both, 0
