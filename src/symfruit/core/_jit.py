@@ -98,6 +98,8 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     t = np.empty(n)
     u = np.empty(n)
     v = np.empty(n)
+    cu = np.empty(n)
+    cv = np.empty(n)
     idx = np.empty(n, np.int64)
     dist2 = np.empty(n)
     cnt = np.empty(bins)
@@ -128,10 +130,10 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
         su[:] = 0.0
         sv[:] = 0.0
         sy[:] = 0.0
+        for i in range(n):  # apart from the sums below, so that it runs on vectors
+            idx[i] = min(int((t[i] - lo) / span * bins), bins - 1)
         for i in range(n):
-            s = int((t[i] - lo) / span * bins)
-            s = min(s, bins - 1)
-            idx[i] = s
+            s = idx[i]
             cnt[s] += 1.0
             su[s] += u[i]
             sv[s] += v[i]
@@ -142,11 +144,12 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
             sv[s] /= d
             sy[s] /= d
         a11 = a12 = a22 = b1 = b2 = 0.0
-        for i in range(n):
+        for i in range(n):  # the slices' centred values, kept for the residuals
             s = idx[i]
             du = u[i] - su[s]
             dv = v[i] - sv[s]
             dy = u[i] * u[i] + v[i] * v[i] - sy[s]
+            cu[i], cv[i], t[i] = du, dv, dy
             a11 += du * du
             a12 += du * dv
             a22 += dv * dv
@@ -158,11 +161,7 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
         au = 0.5 * (a22 * b1 - a12 * b2) / det
         av = 0.5 * (a11 * b2 - a12 * b1) / det
         for i in range(n):
-            s = idx[i]
-            du = u[i] - su[s]
-            dv = v[i] - sv[s]
-            dy = u[i] * u[i] + v[i] * v[i] - sy[s]
-            res = dy - 2.0 * (au * du + av * dv)
+            res = t[i] - 2.0 * (au * cu[i] + av * cv[i])
             ru = u[i] - au
             rv = v[i] - av
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
@@ -350,3 +349,53 @@ def cone_fit(
         if not improved or done:
             break
     return p, both, 0
+
+
+@_njit
+def revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.ndarray, steps: int) -> None:
+    """:func:`symfruit.core.fits.fit_revolution_slices`' Gauss-Newton on the axis position ``a2`` (2,), updated in
+    place: the points' plane coordinates ``w`` (n, 2) about the axis at ``a2`` less their slice's mean distance
+    (slice ``which`` (n,), ``cnt`` (b,) its points, at least 1)."""
+    n, b = w.shape[0], cnt.shape[0]
+    rho = np.empty(n)
+    j0 = np.empty(n)
+    j1 = np.empty(n)
+    sums = np.empty((3, b))
+    jtj = np.empty((2, 2))
+    g = np.empty(2)
+    step = np.empty(2)
+    for _ in range(steps):
+        sums[:] = 0.0
+        for i in range(n):
+            d0, d1 = w[i, 0] - a2[0], w[i, 1] - a2[1]
+            r = max(math.sqrt(d0 * d0 + d1 * d1), 1e-12)
+            rho[i], j0[i], j1[i] = r, -d0 / r, -d1 / r
+            s = which[i]
+            sums[0, s] += r
+            sums[1, s] += j0[i]
+            sums[2, s] += j1[i]
+        for s in range(b):
+            sums[0, s] /= cnt[s]
+            sums[1, s] /= cnt[s]
+            sums[2, s] /= cnt[s]
+        a11 = a12 = a22 = g0 = g1 = 0.0
+        for i in range(n):
+            s = which[i]
+            res = rho[i] - sums[0, s]
+            x0 = j0[i] - sums[1, s]
+            x1 = j1[i] - sums[2, s]
+            a11 += x0 * x0
+            a12 += x0 * x1
+            a22 += x1 * x1
+            g0 -= x0 * res
+            g1 -= x1 * res
+        if abs(a11 * a22 - a12 * a12) < 1e-30:
+            break
+        jtj[0, 0], jtj[0, 1], jtj[1, 0], jtj[1, 1] = a11, a12, a12, a22
+        g[0], g[1] = g0, g1
+        if not solve(jtj, g, step):
+            break
+        a2[0] += step[0]
+        a2[1] += step[1]
+        if max(abs(step[0]), abs(step[1])) < 1e-7:
+            break

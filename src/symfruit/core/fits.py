@@ -545,8 +545,11 @@ def fit_revolution_slices(
     a2 = sol + w.mean(axis=0)
     # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
     # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
+    if jit is not None:  # the compiled twin of the loop below
+        a2 = np.array(a2)
+        jit.revolution_steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, gauss_newton_steps)
     which3 = np.concatenate((which, which + profile_bins, which + 2 * profile_bins))
-    for _ in range(gauss_newton_steps):
+    for _ in range(gauss_newton_steps if jit is None else 0):
         diff = w - a2
         rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
         np.maximum(rho, 1e-12, out=rho)
