@@ -1,0 +1,227 @@
+"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``, seeded and
+property-tested; the switch to the twins (``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
+
+The kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
+iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm).
+"""
+
+import subprocess
+import sys
+import types
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit.core import kernels
+from symfruit.core.fits import _slice_costs, fit_cone_ellipsoid, fit_revolution_slices, fit_sphere
+from symfruit.synthetic.shapes import FRUITS, rotation
+
+from ..conftest import CENTRE, random_sphere, rendered_view, revolution_cloud
+
+numba = pytest.importorskip("numba")
+from symfruit.core import _jit  # noqa: E402  (numba is there: the module may be imported)
+
+
+def _both(monkeypatch, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)`` with the kernels, then with the numpy twins."""
+    compiled = fn(*args, **kwargs)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    twin = fn(*args, **kwargs)
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    return compiled, twin
+
+
+# --- the switch -------------------------------------------------------------------------------------------
+
+
+def test_the_environment_switches_to_the_numpy_twins(monkeypatch):
+    assert kernels.compiled() is _jit
+    for value in ("numpy", "NumPy"):
+        monkeypatch.setenv("SYMFRUIT_KERNELS", value)
+        assert kernels.compiled() is None
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "")
+    assert kernels.compiled() is _jit
+
+
+def test_without_numba_the_twins_run(monkeypatch):
+    """numba missing (or unusable with this numpy): no kernels, and every fit still works (its twin)."""
+    import symfruit.core
+
+    monkeypatch.setattr(kernels, "_STATE", {})
+    monkeypatch.delattr(symfruit.core, "_jit")
+    monkeypatch.setitem(sys.modules, "symfruit.core._jit", None)  # `from . import _jit` raises ImportError
+    assert kernels.compiled() is None
+    centre, radius = fit_sphere(random_sphere(200, seed=1))
+    assert np.allclose(centre, CENTRE) and radius == pytest.approx(0.03)
+
+
+def test_importing_symfruit_compiles_nothing():
+    code = "import sys, symfruit, symfruit.core.fits, symfruit.detect; print('numba' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_no_writable_cache_directory_compiles_without_a_cache(monkeypatch):
+    """numba raises when it finds no directory to cache in (a read-only install and home): the kernel is then
+    compiled without the cache instead of failing."""
+    calls = []
+
+    def njit(**options):
+        calls.append(options)
+        if options.get("cache"):
+            raise RuntimeError("cannot cache function: no locator available")
+        return lambda func: ("compiled", func)
+
+    monkeypatch.setattr(_jit, "numba", types.SimpleNamespace(njit=njit))
+    assert _jit._njit(len) == ("compiled", len)
+    assert [c.get("cache", False) for c in calls] == [True, False]
+
+
+# --- small helpers ----------------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.booleans())
+def test_select_partitions_in_place(seed, n, ties):
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=n)
+    if ties:
+        x = np.round(x * 2.0)
+    kth = int(rng.integers(n))
+    y = x.copy()
+    _jit.select(y, kth)
+    assert np.array_equal(np.sort(y), np.sort(x))  # a permutation
+    assert y[kth] == np.sort(x)[kth]
+    assert (y[:kth] <= y[kth]).all() and (y[kth + 1 :] >= y[kth]).all()
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_solve_is_numpys_solve(seed, n):
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(n, n)) + n * np.eye(n) * rng.choice([-1.0, 1.0])
+    b = rng.normal(size=n)
+    x = np.empty(n)
+    assert _jit.solve(a.copy(), b.copy(), x)
+    np.testing.assert_allclose(x, np.linalg.solve(a, b), rtol=1e-9, atol=1e-12)
+
+
+def test_solve_refuses_a_singular_matrix():
+    x = np.full(3, 7.0)
+    assert not _jit.solve(np.array([[1.0, 2.0, 0.0], [2.0, 4.0, 0.0], [0.0, 0.0, 1.0]]), np.ones(3), x)
+    assert (x == 7.0).all()
+
+
+# --- the solid of revolution ------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 90), st.integers(60, 300))
+def test_slice_costs_are_the_twins(seed, k, n):
+    """At five points a slice or more, as the fit's 240 in 12 (with a point or two per slice the 2x2 system is
+    singular and both costs are rounding noise amplified by the determinant's floor)."""
+    rng = np.random.default_rng(seed)
+    scale = rng.uniform(0.001, 0.1)
+    q = rng.normal(size=(n, 3)) * scale
+    q[: n // 3] = np.round(q[: n // 3], 3)  # repeated coordinates: ties in the slices and the partition
+    dirs = rng.normal(size=(k, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    fast, twin = _jit.slice_costs(q, dirs, 12), _slice_costs(q, dirs, 12)
+    np.testing.assert_allclose(fast, twin, rtol=1e-7, atol=1e-12 * scale**2)
+
+
+@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("citrus", 4)])
+def test_revolution_fit_is_the_twins(monkeypatch, kind, seed):
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.02 * seed], noise=0.002 * (seed % 3),
+                               rotation=rotation(10 * seed, 20, 30 * seed), seed=seed)  # fmt: skip
+    fast, twin = _both(monkeypatch, fit_revolution_slices, visible)
+    np.testing.assert_allclose(fast.direction, twin.direction, atol=1e-12)
+    np.testing.assert_allclose(fast.point, twin.point, atol=1e-9)  # a nanometre
+    np.testing.assert_allclose(fast.radii, twin.radii, atol=1e-9)
+    np.testing.assert_allclose(fast.edges, twin.edges, atol=1e-9)
+
+
+# --- the sphere -------------------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.01, 0.06), st.floats(0.0, 0.002), st.floats(20.0, 90.0))
+def test_sphere_fit_is_the_twins(seed, radius, noise, cap_deg):
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(400, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = d[d[:, 2] < -np.cos(np.radians(cap_deg))]
+    if len(d) < 20:
+        return
+    pts = radius * d + CENTRE + rng.normal(scale=noise, size=d.shape)
+    with pytest.MonkeyPatch.context() as mp:
+        (c, r), (c_twin, r_twin) = _both(mp, fit_sphere, pts)
+    assert np.linalg.norm(c - c_twin) < 1e-9 and abs(r - r_twin) < 1e-9
+
+
+def test_sphere_steps_of_an_exact_sphere_stay_on_it():
+    pts = random_sphere(300, radius=0.04, seed=2) - CENTRE
+    c = np.array([0.003, -0.002, 0.001])
+    r, ok = _jit.sphere_steps(pts, c, 0.035, 20, 1e-12, 1.0)
+    assert ok and r == pytest.approx(0.04, abs=1e-12)
+    np.testing.assert_allclose(c, 0.0, atol=1e-12)
+
+
+def test_sphere_steps_report_a_singular_system():
+    """Every point at the centre: the Jacobian's direction columns are zero, the normal equations singular."""
+    c = np.zeros(3)
+    _, ok = _jit.sphere_steps(np.zeros((10, 3)), c, 1.0, 5, 1e-7, 1.0)
+    assert not ok
+
+
+# --- the cone ellipsoid -----------------------------------------------------------------------------------
+
+
+def _cone_view(kind: str, seed: int, noise: float = 0.01):
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.03 * seed], noise=noise,
+                               rotation=rotation(10 * seed, 20, 30 * seed), seed=seed)  # fmt: skip
+    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    return visible, cone, axis, float(visible[:, 2].min()), float(np.ptp(visible, axis=0).max())
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_cone_residuals_are_the_twins(seed):
+    """Shape parameters within the fit's reach (its grid spans -4..4): beyond about 20 the logistic's gap
+    ``lambda - q`` has lost its digits and a ray near tangency may hit in one path and miss in the other."""
+    from symfruit.core.fits import _cone_fronts
+
+    visible, cone, axis, front, extent = _cone_view("apple", 1)
+    rng = np.random.default_rng(seed)
+    pts = visible[rng.choice(len(visible), 50, replace=False)]
+    rays, z = pts / pts[:, 2:3], np.ascontiguousarray(pts[:, 2])
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    params = np.c_[rng.normal(0.0, 0.02, (30, 2)), np.log(rng.uniform(0.2, 0.8, 30)), rng.uniform(-10, 10, 30)]
+    params[0, 3] = 60.0  # a saturated logistic: no front on any ray (the twin's NaN rows)
+    fronts, valid = _cone_fronts(params, cone, axis, rays, ray_cone)
+    twin = np.where(valid[:, None], z[None, :] - fronts, 0.05)
+    twin = np.where(np.isfinite(twin), twin, 0.02)
+    out = np.empty_like(twin)
+    _jit.cone_residuals(params, cone, axis, rays, ray_cone, z, out)
+    np.testing.assert_allclose(out, twin, atol=1e-8)  # 10 nm: the front's root cancels a few digits
+    assert (out[0] == 0.02).all()
+
+
+@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("plum", 4)])
+def test_cone_fit_is_the_twins(monkeypatch, kind, seed):
+    visible, cone, axis, front, extent = _cone_view(kind, seed)
+    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, visible, cone=cone, axis=axis, front=front, extent=extent)
+    np.testing.assert_allclose(fast.centre, twin.centre, atol=1e-9)
+    np.testing.assert_allclose(fast.shape, twin.shape, atol=1e-12)  # metres squared: 1e-12 is 1e-9 m at 1 mm
+    assert fast.back_std == pytest.approx(twin.back_std, rel=1e-6) and fast.rms == pytest.approx(twin.rms, rel=1e-6)
+
+
+def test_cone_fit_without_a_meeting_ellipsoid_raises_as_the_twin(monkeypatch):
+    """Rays that no ellipsoid of the cone meets: every row's cost is the misses' constant, finite, so the fit
+    goes on; both paths agree on the result."""
+    visible, cone, axis, front, extent = _cone_view("apple", 1, noise=0.0)
+    far = visible + np.array([0.5, 0.0, 0.0])  # the points' rays outside the cone
+    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, far, cone=cone, axis=axis, front=front, extent=extent)
+    np.testing.assert_allclose(fast.centre, twin.centre, atol=1e-9)
