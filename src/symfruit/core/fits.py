@@ -455,6 +455,34 @@ def _cap_local(spread_deg: float, n: int) -> np.ndarray:
 _COARSE = _hemisphere(64)
 
 
+def _revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.ndarray, steps: int) -> None:
+    """:func:`fit_revolution_slices`' Gauss-Newton on the axis position ``a2`` (2,), refined in place: the points'
+    distances from the axis in the plane (coordinates ``w`` (n, 2)) less their slice's mean distance (slice
+    ``which`` (n,) of ``b``, ``cnt`` (b,) its points, at least 1), at most ``steps`` steps (the numpy twin of
+    :func:`symfruit.core._jit.revolution_steps`)."""
+    b = len(cnt)
+    # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
+    # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
+    which3 = np.concatenate((which, which + b, which + 2 * b))
+    for _ in range(steps):
+        diff = w - a2
+        rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
+        np.maximum(rho, 1e-12, out=rho)
+        jac = np.negative(diff, out=diff)
+        jac /= rho[:, None]
+        sums = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * b)
+        means = sums.reshape(3, b) / cnt
+        res = rho - means[0][which]
+        jac -= np.take(means[1:].T, which, axis=0)  # rows by np.take: 5x faster than [which] here
+        jtj = jac.T @ jac
+        if abs(np.linalg.det(jtj)) < 1e-30:
+            break
+        step = np.linalg.solve(jtj, -(jac.T @ res))  # the normal equations of the 2-unknown step
+        a2 += step
+        if np.abs(step).max() < 1e-7:
+            break
+
+
 def fit_revolution_slices(
     points: np.ndarray,
     *,
@@ -543,29 +571,9 @@ def fit_revolution_slices(
                                 for i in range(2)], axis=1), which, axis=0)  # fmt: skip
     sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
     a2 = sol + w.mean(axis=0)
-    # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
-    # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
-    if jit is not None:  # the compiled twin of the loop below
-        a2 = np.array(a2)
-        jit.revolution_steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, gauss_newton_steps)
-    which3 = np.concatenate((which, which + profile_bins, which + 2 * profile_bins))
-    for _ in range(gauss_newton_steps if jit is None else 0):
-        diff = w - a2
-        rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
-        np.maximum(rho, 1e-12, out=rho)
-        jac = np.negative(diff, out=diff)
-        jac /= rho[:, None]
-        sums = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * profile_bins)
-        means = sums.reshape(3, profile_bins) / cnt
-        res = rho - means[0][which]
-        jac -= np.take(means[1:].T, which, axis=0)  # rows by np.take: 5x faster than [which] here
-        jtj = jac.T @ jac
-        if abs(np.linalg.det(jtj)) < 1e-30:
-            break
-        step = np.linalg.solve(jtj, -(jac.T @ res))  # the normal equations of the 2-unknown step
-        a2 = a2 + step
-        if np.abs(step).max() < 1e-7:
-            break
+    a2 = np.array(a2)  # refined in place
+    steps = _revolution_steps if jit is None else jit.revolution_steps
+    steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, gauss_newton_steps)
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
     rho = row_norms(w - a2)
     mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
