@@ -18,7 +18,7 @@ from symfruit.core import kernels
 from symfruit.core.fits import _slice_costs, fit_cone_ellipsoid, fit_revolution_slices, fit_sphere
 from symfruit.synthetic.shapes import FRUITS, rotation
 
-from ..conftest import CENTRE, random_sphere, rendered_view, revolution_cloud
+from ..conftest import CENTRE, random_sphere, rendered_view
 
 numba = pytest.importorskip("numba")
 from symfruit.core import _jit  # noqa: E402  (numba is there: the module may be imported)
@@ -193,7 +193,7 @@ def test_cone_residuals_are_the_twins(seed):
     ``lambda - q`` has lost its digits and a ray near tangency may hit in one path and miss in the other."""
     from symfruit.core.fits import _cone_fronts
 
-    visible, cone, axis, front, extent = _cone_view("apple", 1)
+    visible, cone, axis, _, _ = _cone_view("apple", 1)
     rng = np.random.default_rng(seed)
     pts = visible[rng.choice(len(visible), 50, replace=False)]
     rays, z = pts / pts[:, 2:3], np.ascontiguousarray(pts[:, 2])
@@ -218,9 +218,9 @@ def test_cone_fit_is_the_twins(monkeypatch, kind, seed):
     assert fast.back_std == pytest.approx(twin.back_std, rel=1e-6) and fast.rms == pytest.approx(twin.rms, rel=1e-6)
 
 
-def test_cone_fit_without_a_meeting_ellipsoid_raises_as_the_twin(monkeypatch):
-    """Rays that no ellipsoid of the cone meets: every row's cost is the misses' constant, finite, so the fit
-    goes on; both paths agree on the result."""
+def test_cone_fit_of_points_outside_the_cone_is_the_twins(monkeypatch):
+    """Points whose rays no ellipsoid of the cone meets: every residual is the misses' constant, so the costs
+    stay finite and the fit goes on; both paths end where they start, the grid's first best."""
     visible, cone, axis, front, extent = _cone_view("apple", 1, noise=0.0)
     far = visible + np.array([0.5, 0.0, 0.0])  # the points' rays outside the cone
     fast, twin = _both(monkeypatch, fit_cone_ellipsoid, far, cone=cone, axis=axis, front=front, extent=extent)

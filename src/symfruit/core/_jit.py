@@ -9,7 +9,8 @@ sums run in another order than numpy's pairwise ones (results agree to rounding,
 from __future__ import annotations
 
 import math
-from typing import Any, Callable
+from collections.abc import Callable
+from typing import Any
 
 import numba
 import numpy as np
@@ -179,8 +180,8 @@ def sphere_steps(
     q: np.ndarray, c: np.ndarray, r: float, iterations: int, tolerance: float, scale: float
 ) -> tuple[float, bool]:
     """:func:`symfruit.core.fits.fit_sphere`'s Gauss-Newton on the residuals ``|q - c| - r`` (``c`` (3,) updated in
-    place; it stops once a step times ``scale`` is under ``tolerance``): the radius and True, or False where the 4x4 normal equations are
-    singular (the twin then takes a least-squares step, so the caller runs the twin)."""
+    place; it stops once a step times ``scale`` is under ``tolerance``): the radius and True, or False where the
+    4x4 normal equations are singular (the twin then takes a least-squares step, so the caller runs the twin)."""
     n = q.shape[0]
     jtj = np.empty((4, 4))
     g = np.empty(4)

@@ -947,9 +947,10 @@ def fit_cone_ellipsoid(
             tolerance,
         )  # fmt: skip
         r, r_steps = both[0], both[1:]
-    if status == 1 or status != 0 and not np.isfinite(costs := cost(residuals(grid))).any():
-        raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
-    if status != 0:
+    if status != 0:  # no kernel, no finite cost (1) or a singular damped system in it (2): the numpy twin
+        costs = cost(residuals(grid))
+        if not np.isfinite(costs).any():
+            raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
         p, r, r_steps = _cone_steps(grid[int(np.argmin(costs))], with_steps, cost, huber, iterations, tolerance)
     m, shape, valid = cone_ellipsoid(p[None], cone, axis)
     if not valid[0]:
