@@ -139,6 +139,45 @@ def test_revolution_fit_is_the_twins(monkeypatch, kind, seed):
     np.testing.assert_allclose(fast.point, twin.point, atol=1e-9)  # a nanometre
     np.testing.assert_allclose(fast.radii, twin.radii, atol=1e-9)
     np.testing.assert_allclose(fast.edges, twin.edges, atol=1e-9)
+    assert fast.cost == pytest.approx(twin.cost, rel=1e-6)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(20, 400), st.floats(0.0, 0.003))
+def test_revolution_profile_is_the_twins(seed, n, noise):
+    """The profile about a given direction (its algebraic start, Gauss-Newton, slices and cost) of a noisy
+    circular cylinder's visible side, tilted at random."""
+    from symfruit.core.fits import _revolution_profile
+    from symfruit.core.points import perpendicular_basis
+
+    rng = np.random.default_rng(seed)
+    phi, h = rng.uniform(-1.2, 1.2, n), rng.uniform(-0.03, 0.03, n)
+    radius = rng.uniform(0.01, 0.04)
+    local = np.c_[radius * np.sin(phi), h, -radius * np.cos(phi)] + rng.normal(scale=noise, size=(n, 3))
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = local @ rot.T
+    q -= q.mean(axis=0)
+    best = rot[:, 1] + rng.normal(scale=0.02, size=3)  # about the axis, as the search leaves it
+    best /= np.linalg.norm(best)
+    e1, e2 = perpendicular_basis(best[None, :])
+    fast = _jit.revolution_profile(q, best, e1[0], e2[0], 16, 5)
+    twin = _revolution_profile(q, best, e1[0], e2[0], 16, 5)
+    assert fast[4] and twin[4]
+    np.testing.assert_allclose(fast[0], twin[0], atol=1e-10)
+    np.testing.assert_allclose(fast[1], twin[1], atol=1e-15)
+    np.testing.assert_allclose(fast[2], twin[2], atol=1e-10)
+    assert fast[3] == pytest.approx(twin[3], rel=1e-6, abs=1e-18)
+
+
+def test_revolution_profile_of_points_on_a_line_leaves_it_to_the_twin():
+    """Every point on the axis: the algebraic start's 2x2 system is singular; the kernel says so (the twin's
+    least squares takes its minimum-norm solution) and fit_revolution_slices runs the twin."""
+    from symfruit.core.fits import _revolution_profile
+
+    q = np.c_[np.zeros(30), np.linspace(-0.02, 0.02, 30), np.zeros(30)]
+    best, e1, e2 = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    assert not _jit.revolution_profile(q, best, e1, e2, 16, 5)[4]
+    a2, _, radii, cost, _ = _revolution_profile(q, best, e1, e2, 16, 5)
+    assert np.allclose(a2, 0.0) and np.allclose(radii[np.isfinite(radii)], 0.0) and cost == pytest.approx(0.0)
 
 
 # --- the sphere -------------------------------------------------------------------------------------------

@@ -400,3 +400,83 @@ def revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.n
         a2[1] += step[1]
         if max(abs(step[0]), abs(step[1])) < 1e-7:
             break
+
+
+@_njit
+def revolution_profile(
+    q: np.ndarray, best: np.ndarray, e1: np.ndarray, e2: np.ndarray, bins: int, steps: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, bool]:
+    """:func:`symfruit.core.fits._revolution_profile`: for centred points ``q`` (n, 3) about the axis direction
+    ``best`` (plane basis ``e1``, ``e2``), the axis position in the plane (2,), the slice borders (b + 1,), the
+    slices' radii (b,) and the robust cost, and True; False where the algebraic start's 2x2 system is singular
+    (the twin's least squares then takes the minimum-norm solution, so the caller runs the twin)."""
+    n = q.shape[0]
+    t = np.empty(n)
+    w = np.empty((n, 2))
+    m0 = m1 = 0.0
+    for i in range(n):
+        p0, p1, p2 = q[i, 0], q[i, 1], q[i, 2]
+        t[i] = p0 * best[0] + p1 * best[1] + p2 * best[2]
+        w[i, 0] = p0 * e1[0] + p1 * e1[1] + p2 * e1[2]
+        w[i, 1] = p0 * e2[0] + p1 * e2[1] + p2 * e2[2]
+        m0 += w[i, 0]
+        m1 += w[i, 1]
+    m0 /= n
+    m1 /= n
+    edges = np.linspace(t.min(), t.max(), bins + 1)
+    which = np.searchsorted(edges, t, side="right") - 1
+    counts = np.zeros(bins)
+    sums = np.zeros((3, bins))
+    for i in range(n):
+        s = min(max(which[i], 0), bins - 1)
+        which[i] = s
+        counts[s] += 1.0
+        x0, x1 = w[i, 0] - m0, w[i, 1] - m1
+        sums[0, s] += x0 * x0 + x1 * x1
+        sums[1, s] += x0
+        sums[2, s] += x1
+    cnt = np.maximum(counts, 1.0)
+    for s in range(bins):
+        sums[0, s] /= cnt[s]
+        sums[1, s] /= cnt[s]
+        sums[2, s] /= cnt[s]
+    # the algebraic start: least squares of 2 dw . a = dy by its normal equations
+    a11 = a12 = a22 = g0 = g1 = 0.0
+    for i in range(n):
+        s = which[i]
+        x0, x1 = w[i, 0] - m0, w[i, 1] - m1
+        dy = x0 * x0 + x1 * x1 - sums[0, s]
+        d0, d1 = 2.0 * (x0 - sums[1, s]), 2.0 * (x1 - sums[2, s])
+        a11 += d0 * d0
+        a12 += d0 * d1
+        a22 += d1 * d1
+        g0 += d0 * dy
+        g1 += d1 * dy
+    lhs = np.array([[a11, a12], [a12, a22]])
+    rhs = np.array([g0, g1])
+    a2 = np.empty(2)
+    radii = np.empty(bins)
+    # nearly singular (the normal equations' condition past 1e10): the twin's least squares decides
+    if not a11 * a22 - a12 * a12 > 1e-20 * (a11 + a22) ** 2 or not solve(lhs, rhs, a2):
+        return a2, edges, radii, 0.0, False
+    a2[0] += m0
+    a2[1] += m1
+    revolution_steps(w, which, cnt, a2, steps)
+    rho = np.empty(n)
+    mean_r = np.zeros(bins)
+    for i in range(n):
+        d0, d1 = w[i, 0] - a2[0], w[i, 1] - a2[1]
+        rho[i] = math.sqrt(d0 * d0 + d1 * d1)
+        mean_r[which[i]] += rho[i]
+    for s in range(bins):
+        mean_r[s] /= cnt[s]
+        radii[s] = mean_r[s] if counts[s] >= 3 else np.nan
+    for i in range(n):
+        d = rho[i] - mean_r[which[i]]
+        rho[i] = d * d
+    keep = max(1, int(0.8 * n))
+    select(rho, keep - 1)
+    total = 0.0
+    for i in range(keep):
+        total += rho[i]
+    return a2, edges, radii, total / keep, True

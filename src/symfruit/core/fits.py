@@ -483,6 +483,35 @@ def _revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.
             break
 
 
+def _revolution_profile(
+    q: np.ndarray, best: np.ndarray, e1: np.ndarray, e2: np.ndarray, bins: int, steps: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, bool]:
+    """:func:`fit_revolution_slices` about the chosen direction ``best`` (3,) for centred points ``q`` (n, 3)
+    (``e1``, ``e2`` (3,) the plane's basis): the axis position in the plane (2,), the profile's ``bins`` slice
+    borders along the axis (b + 1,), their radii (b,), the robust cost, and True (the numpy twin of
+    :func:`symfruit.core._jit.revolution_profile`)."""
+    t = q @ best
+    w = np.stack((q @ e1, q @ e2), axis=1)
+    edges = np.linspace(t.min(), t.max(), bins + 1)
+    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
+    counts = np.bincount(which, minlength=bins)
+    cnt = np.maximum(counts, 1)
+    # Start: the algebraic axis offset on the profile slices, then Gauss-Newton on rho_i - mean_slice(rho).
+    ww = w - w.mean(axis=0)
+    y = (ww * ww).sum(axis=1)
+    dy = y - (np.bincount(which, weights=y, minlength=bins) / cnt)[which]
+    dw = ww - np.take(np.stack([np.bincount(which, weights=ww[:, i], minlength=bins) / cnt
+                                for i in range(2)], axis=1), which, axis=0)  # fmt: skip
+    sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
+    a2 = sol + w.mean(axis=0)  # refined in place
+    _revolution_steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, steps)
+    rho = row_norms(w - a2)
+    mean_r = np.bincount(which, weights=rho, minlength=bins) / cnt
+    radii = np.where(counts >= 3, mean_r, np.nan)
+    res2 = np.sort((rho - mean_r[which]) ** 2)
+    return a2, edges, radii, float(res2[: max(1, int(0.8 * len(res2)))].mean()), True
+
+
 def fit_revolution_slices(
     points: np.ndarray,
     *,
@@ -557,29 +586,11 @@ def fit_revolution_slices(
         cand = _cap(best, spread, refine_n)
         best = cand[int(np.argmin(slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
-    t = q @ best
-    w = np.stack((q @ e1[0], q @ e2[0]), axis=1)
-    edges = np.linspace(t.min(), t.max(), profile_bins + 1)
-    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, profile_bins - 1)
-    counts = np.bincount(which, minlength=profile_bins)
-    cnt = np.maximum(counts, 1)
-    # Start: the algebraic axis offset on the profile slices, then Gauss-Newton on rho_i - mean_slice(rho).
-    ww = w - w.mean(axis=0)
-    y = (ww * ww).sum(axis=1)
-    dy = y - (np.bincount(which, weights=y, minlength=profile_bins) / cnt)[which]
-    dw = ww - np.take(np.stack([np.bincount(which, weights=ww[:, i], minlength=profile_bins) / cnt
-                                for i in range(2)], axis=1), which, axis=0)  # fmt: skip
-    sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
-    a2 = sol + w.mean(axis=0)
-    a2 = np.array(a2)  # refined in place
-    steps = _revolution_steps if jit is None else jit.revolution_steps
-    steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, gauss_newton_steps)
+    found = None if jit is None else jit.revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
+    if found is None or not found[4]:  # no kernel, or a singular start (the twin's least squares copes)
+        found = _revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
+    a2, edges, radii, cost = found[0], found[1], found[2], float(found[3])
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
-    rho = row_norms(w - a2)
-    mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
-    radii = np.where(counts >= 3, mean_r, np.nan)
-    res2 = np.sort((rho - mean_r[which]) ** 2)
-    cost = float(res2[: max(1, int(0.8 * len(res2)))].mean())
     edges = edges + float(centre @ best - axis_point @ best)
     return Revolution(axis_point, best, edges, radii, cost)
 
