@@ -26,6 +26,7 @@ from symfruit.core import _jit  # noqa: E402  (numba is there: the module may be
 
 def _both(monkeypatch, fn, *args, **kwargs):
     """``fn(*args, **kwargs)`` with the kernels, then with the numpy twins."""
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # a run with the twins throughout still compares
     compiled = fn(*args, **kwargs)
     monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
     twin = fn(*args, **kwargs)
@@ -37,6 +38,7 @@ def _both(monkeypatch, fn, *args, **kwargs):
 
 
 def test_the_environment_switches_to_the_numpy_twins(monkeypatch):
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
     assert kernels.compiled() is _jit
     for value in ("numpy", "NumPy"):
         monkeypatch.setenv("SYMFRUIT_KERNELS", value)
