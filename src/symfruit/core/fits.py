@@ -4,6 +4,10 @@ measure that tells clean scans from depth-camera views.
 
 Every function takes ``points : (n, 3) float, metres`` first and normalises it (:func:`as_points`), takes
 its options as keywords, and returns arrays; none knows settings objects or files.
+
+The loops of the sphere's, the solid of revolution's and the cone ellipsoid's fits run as compiled kernels
+where numba (the extra ``fast``) is installed (:mod:`symfruit.core.kernels`); the numpy code here is their twin,
+run without numba or with ``SYMFRUIT_KERNELS=numpy``, and gives the same results within rounding.
 """
 
 from __future__ import annotations
