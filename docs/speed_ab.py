@@ -7,8 +7,10 @@ both alike. CPU time, not wall time: a busy machine stretches the wall time far 
 
 e.g. ``python docs/speed_ab.py ../main/src src``. Each round starts a fresh process per tree (``PYTHONPATH``).
 ``--fits`` adds the completion's three iterative fits as stages (the solid of revolution's, the cone ellipsoid's
-and the sphere's, all of their calls in a frame). With ``--dense`` the dense camera view of ``symfruit bench``
-(about 14,000 points) is timed instead: the thread's CPU time of each ``complete``, ``--frames`` per round.
+and the sphere's, all of their calls in a frame), ``--wrap MODULE:NAME ...`` any other function as a stage (where
+the caller looks it up, e.g. ``symfruit.methods.evidence:observe``). With ``--dense`` the dense camera view of
+``symfruit bench`` (about 14,000 points) is timed instead: the thread's CPU time of each ``complete``, ``--frames``
+per round.
 With ``--trees N`` the colour segmenter alone is timed instead, on N rendered apple-tree frames (1920x1080 with
 depth, the apple profile's settings, as ``symfruit bench --segment --scene apple-tree``): the thread's CPU time
 of each frame, ``--frames`` times per round.
@@ -107,8 +109,10 @@ def main() -> None:
     parser.add_argument("--trees", type=int, default=0, help="time the segmenter on this many apple-tree frames")
     parser.add_argument("--fits", action="store_true", help="the completion's fits as stages too")
     parser.add_argument("--dense", action="store_true", help="time the dense camera view's completion instead")
+    parser.add_argument("--wrap", nargs="*", default=[], help="MODULE:NAME functions timed as stages too")
     args = parser.parse_args()
-    stages = {**STAGES, **FITS} if args.fits else STAGES
+    stages = {**STAGES, **FITS} if args.fits else dict(STAGES)
+    stages.update({name: name.rpartition(":")[2] for name in args.wrap})
     trees = {"before": os.path.abspath(args.before), "after": os.path.abspath(args.after)}
     found: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
     for r in range(args.rounds):
