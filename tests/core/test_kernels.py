@@ -266,3 +266,46 @@ def test_cone_fit_of_points_outside_the_cone_is_the_twins(monkeypatch):
     far = visible + np.array([0.5, 0.0, 0.0])  # the points' rays outside the cone
     fast, twin = _both(monkeypatch, fit_cone_ellipsoid, far, cone=cone, axis=axis, front=front, extent=extent)
     np.testing.assert_allclose(fast.centre, twin.centre, atol=1e-9)
+
+
+# --- marching a solid of revolution -----------------------------------------------------------------------
+
+
+def _lemon_revolution(seed: int):
+    rng = np.random.default_rng(seed)
+    fruit = FRUITS["lemon"](rng)
+    visible, _ = rendered_view(fruit, [0.01, -0.01, 0.35], noise=0.001, rotation=rotation(10 * seed, 40, 30 * seed),
+                               seed=seed)  # fmt: skip
+    return fit_revolution_slices(visible), visible
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(12, 40), st.booleans())
+def test_revolution_march_is_the_twins(seed, steps, close):
+    from symfruit.core.agreement import march
+    from symfruit.core.fits import RevolutionInside, closed_profile
+
+    rev, visible = _lemon_revolution(seed % 4)
+    rng = np.random.default_rng(seed)
+    centre = visible.mean(axis=0)
+    rays = np.c_[centre[:2] / centre[2] + rng.normal(0.0, 0.08, (200, 2)), np.ones(200)]  # hits and misses
+    z0, z1 = float(visible[:, 2].min()) - 0.03, float(visible[:, 2].max()) + 0.05
+    inside = RevolutionInside(rev, close=close)
+    t, r = closed_profile(rev, close=close)
+    hit, depth = _jit.revolution_march(rev.point, rev.direction, t, r, rays, z0, z1, steps)
+    hit_twin, depth_twin = march(inside, rays, z0, z1, steps=steps)
+    assert np.array_equal(hit, hit_twin) and hit.any() and not hit.all()
+    np.testing.assert_allclose(depth[hit], depth_twin[hit], atol=1e-12)
+    assert np.isnan(depth[~hit]).all()
+
+
+def test_revolution_inside_marches_its_rays_only_with_the_kernels(monkeypatch):
+    from symfruit.core.fits import RevolutionInside, revolution_inside
+
+    rev, visible = _lemon_revolution(1)
+    inside = RevolutionInside(rev)
+    assert np.array_equal(inside(visible), revolution_inside(rev, visible))
+    rays = visible[::50] / visible[::50, 2:3]
+    hit, depth = inside.march(rays, 0.2, 0.5, 24)
+    assert hit.shape == depth.shape == (len(rays),) and hit.mean() > 0.8  # most rays through seen points meet it
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    assert inside.march(rays, 0.2, 0.5, 24) is None  # explain() then marches with core.agreement.march

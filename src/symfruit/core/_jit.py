@@ -480,3 +480,51 @@ def revolution_profile(
     for i in range(keep):
         total += rho[i]
     return a2, edges, radii, total / keep, True
+
+
+@_njit
+def _revolution_at(x0: float, x1: float, x2: float, point: np.ndarray, direction: np.ndarray, t_prof: np.ndarray,
+                   r_prof: np.ndarray) -> float:  # fmt: skip
+    """:func:`symfruit.core.fits.revolution_inside` of one point (``np.interp``'s rule: 0 outside the profile)."""
+    r0, r1, r2 = x0 - point[0], x1 - point[1], x2 - point[2]
+    t = r0 * direction[0] + r1 * direction[1] + r2 * direction[2]
+    o0, o1, o2 = r0 - t * direction[0], r1 - t * direction[1], r2 - t * direction[2]
+    rho = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+    m = t_prof.shape[0]
+    if t < t_prof[0] or t > t_prof[m - 1] or math.isnan(t):
+        r = 0.0
+    elif t == t_prof[m - 1]:
+        r = r_prof[m - 1]
+    else:
+        j = np.searchsorted(t_prof, t, side="right") - 1
+        r = r_prof[j] + (r_prof[j + 1] - r_prof[j]) / (t_prof[j + 1] - t_prof[j]) * (t - t_prof[j])
+    return r - rho - (max(t_prof[0] - t, 0.0) + max(t - t_prof[m - 1], 0.0))
+
+
+@_njit
+def revolution_march(
+    point: np.ndarray, direction: np.ndarray, t_prof: np.ndarray, r_prof: np.ndarray, rays: np.ndarray, z0: float,
+    z1: float, steps: int,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement.march` into a solid of revolution (axis ``point``, ``direction``; closed profile
+    ``t_prof``, ``r_prof``) along rays (m, 3), each ray stopped at its first step inside: ``(hit (m,), depth (m,))``."""
+    m = rays.shape[0]
+    zs = np.linspace(z0, z1, steps)
+    hit = np.zeros(m, np.bool_)
+    depth = np.full(m, np.nan)
+    for i in range(m):
+        a, b, c = rays[i, 0], rays[i, 1], rays[i, 2]
+        before = 0.0
+        for s in range(steps):
+            z = zs[s]
+            f = _revolution_at(a * z, b * z, c * z, point, direction, t_prof, r_prof)
+            if f > 0:
+                hit[i] = True
+                if s == 0:
+                    depth[i] = zs[0]
+                else:
+                    frac = -before / (f - before) if f != before else 0.0
+                    depth[i] = zs[s - 1] + min(max(frac, 0.0), 1.0) * (zs[s] - zs[s - 1])
+                break
+            before = f
+    return hit, depth

@@ -28,6 +28,7 @@ from .points import as_points, cross_rows, median, perpendicular_basis, row_norm
 __all__ = [
     "ConeFit",
     "Revolution",
+    "RevolutionInside",
     "closed_profile",
     "cone_ellipsoid",
     "ellipsoid_half_extents",
@@ -712,6 +713,32 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     return (r - rho - past).reshape(shape)
+
+
+@dataclass(frozen=True, eq=False)
+class RevolutionInside:
+    """:func:`revolution_inside` of a fitted solid as an inside test (:data:`symfruit.core.agreement.Inside`) whose
+    rays are marched by a compiled kernel where numba is installed (:meth:`march`; its twin is
+    :func:`symfruit.core.agreement.march` of this test)."""
+
+    rev: Revolution
+    close: bool = True
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        return revolution_inside(self.rev, x, close=self.close)
+
+    def march(self, rays: np.ndarray, z0: float, z1: float, steps: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(hit (m,), depth (m,))`` of :func:`symfruit.core.agreement.march` along rays (m, 3) by the compiled
+        kernel (each ray stopped at its first step inside), or None without it."""
+        jit = compiled()
+        if jit is None:
+            return None
+        t, r = closed_profile(self.rev, close=self.close)
+        return jit.revolution_march(
+            np.ascontiguousarray(self.rev.point, dtype=np.float64), np.ascontiguousarray(self.rev.direction,
+            dtype=np.float64), np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(r, dtype=np.float64),
+            np.ascontiguousarray(rays, dtype=np.float64), float(z0), float(z1), int(steps),
+        )  # fmt: skip
 
 
 # --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------
