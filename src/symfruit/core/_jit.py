@@ -483,41 +483,41 @@ def revolution_profile(
 
 
 @_njit
-def _revolution_at(x0: float, x1: float, x2: float, point: np.ndarray, direction: np.ndarray, t_prof: np.ndarray,
-                   r_prof: np.ndarray) -> float:  # fmt: skip
-    """:func:`symfruit.core.fits.revolution_inside` of one point (``np.interp``'s rule: 0 outside the profile)."""
-    r0, r1, r2 = x0 - point[0], x1 - point[1], x2 - point[2]
-    t = r0 * direction[0] + r1 * direction[1] + r2 * direction[2]
-    o0, o1, o2 = r0 - t * direction[0], r1 - t * direction[1], r2 - t * direction[2]
-    rho = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
-    m = t_prof.shape[0]
-    if t < t_prof[0] or t > t_prof[m - 1] or math.isnan(t):
-        r = 0.0
-    elif t == t_prof[m - 1]:
-        r = r_prof[m - 1]
-    else:
-        j = np.searchsorted(t_prof, t, side="right") - 1
-        r = r_prof[j] + (r_prof[j + 1] - r_prof[j]) / (t_prof[j + 1] - t_prof[j]) * (t - t_prof[j])
-    return r - rho - (max(t_prof[0] - t, 0.0) + max(t - t_prof[m - 1], 0.0))
-
-
-@_njit
 def revolution_march(
     point: np.ndarray, direction: np.ndarray, t_prof: np.ndarray, r_prof: np.ndarray, rays: np.ndarray, z0: float,
     z1: float, steps: int,
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`symfruit.core.agreement.march` into a solid of revolution (axis ``point``, ``direction``; closed profile
     ``t_prof``, ``r_prof``) along rays (m, 3), each ray stopped at its first step inside: ``(hit (m,), depth (m,))``."""
-    m = rays.shape[0]
+    m, k = rays.shape[0], t_prof.shape[0]
     zs = np.linspace(z0, z1, steps)
     hit = np.zeros(m, np.bool_)
     depth = np.full(m, np.nan)
+    p0, p1, p2 = point[0], point[1], point[2]
+    d0, d1, d2 = direction[0], direction[1], direction[2]
+    first, last = t_prof[0], t_prof[k - 1]
     for i in range(m):
         a, b, c = rays[i, 0], rays[i, 1], rays[i, 2]
         before = 0.0
+        j = 0  # the slice of the last step (the steps walk along the axis monotonically: a short walk each)
         for s in range(steps):
             z = zs[s]
-            f = _revolution_at(a * z, b * z, c * z, point, direction, t_prof, r_prof)
+            # core.fits.revolution_inside of the point z * ray (np.interp's rule: 0 outside the profile)
+            r0, r1, r2 = a * z - p0, b * z - p1, c * z - p2
+            t = r0 * d0 + r1 * d1 + r2 * d2
+            o0, o1, o2 = r0 - t * d0, r1 - t * d1, r2 - t * d2
+            rho = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+            if t < first or t > last or math.isnan(t):
+                r = 0.0
+            elif t == last:
+                r = r_prof[k - 1]
+            else:  # the last j with t_prof[j] <= t (np.searchsorted(side="right") - 1)
+                while j > 0 and t_prof[j] > t:
+                    j -= 1
+                while j < k - 2 and t_prof[j + 1] <= t:
+                    j += 1
+                r = r_prof[j] + (r_prof[j + 1] - r_prof[j]) / (t_prof[j + 1] - t_prof[j]) * (t - t_prof[j])
+            f = r - rho - (max(first - t, 0.0) + max(t - last, 0.0))
             if f > 0:
                 hit[i] = True
                 if s == 0:
