@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
-from symfruit.core.fits import _slice_costs, fit_cone_ellipsoid, fit_revolution_slices, fit_sphere
+from symfruit.core.fits import _slice_costs, fit_revolution_slices, fit_sphere
 from symfruit.synthetic.shapes import FRUITS, rotation
 
 from ..conftest import CENTRE, random_sphere, rendered_view
@@ -212,60 +212,6 @@ def test_sphere_steps_report_a_singular_system():
     c = np.zeros(3)
     _, ok = _jit.sphere_steps(np.zeros((10, 3)), c, 1.0, 5, 1e-7, 1.0)
     assert not ok
-
-
-# --- the cone ellipsoid -----------------------------------------------------------------------------------
-
-
-def _cone_view(kind: str, seed: int, noise: float = 0.01):
-    from symfruit import DEFAULT_CAMERA
-    from symfruit.core.raster import silhouette, silhouette_cone
-
-    fruit = FRUITS[kind](np.random.default_rng(seed))
-    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.03 * seed], noise=noise,
-                               rotation=rotation(10 * seed, 20, 30 * seed), seed=seed)  # fmt: skip
-    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
-    return visible, cone, axis, float(visible[:, 2].min()), float(np.ptp(visible, axis=0).max())
-
-
-@given(st.integers(0, 2**32 - 1))
-def test_cone_residuals_are_the_twins(seed):
-    """Shape parameters within the fit's reach (its grid spans -4..4): beyond about 20 the logistic's gap
-    ``lambda - q`` has lost its digits and a ray near tangency may hit in one path and miss in the other."""
-    from symfruit.core.fits import _cone_fronts
-
-    visible, cone, axis, _, _ = _cone_view("apple", 1)
-    rng = np.random.default_rng(seed)
-    pts = visible[rng.choice(len(visible), 50, replace=False)]
-    rays, z = pts / pts[:, 2:3], np.ascontiguousarray(pts[:, 2])
-    ray_cone = ((rays @ cone) * rays).sum(axis=1)
-    params = np.c_[rng.normal(0.0, 0.02, (30, 2)), np.log(rng.uniform(0.2, 0.8, 30)), rng.uniform(-10, 10, 30)]
-    params[0, 3] = 60.0  # a saturated logistic: no front on any ray (the twin's NaN rows)
-    fronts, valid = _cone_fronts(params, cone, axis, rays, ray_cone)
-    twin = np.where(valid[:, None], z[None, :] - fronts, 0.05)
-    twin = np.where(np.isfinite(twin), twin, 0.02)
-    out = np.empty_like(twin)
-    _jit.cone_residuals(params, cone, axis, rays, ray_cone, z, out)
-    np.testing.assert_allclose(out, twin, atol=1e-8)  # 10 nm: the front's root cancels a few digits
-    assert (out[0] == 0.02).all()
-
-
-@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("plum", 4)])
-def test_cone_fit_is_the_twins(monkeypatch, kind, seed):
-    visible, cone, axis, front, extent = _cone_view(kind, seed)
-    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, visible, cone=cone, axis=axis, front=front, extent=extent)
-    np.testing.assert_allclose(fast.centre, twin.centre, atol=1e-9)
-    np.testing.assert_allclose(fast.shape, twin.shape, atol=1e-12)  # metres squared: 1e-12 is 1e-9 m at 1 mm
-    assert fast.back_std == pytest.approx(twin.back_std, rel=1e-6) and fast.rms == pytest.approx(twin.rms, rel=1e-6)
-
-
-def test_cone_fit_of_points_outside_the_cone_is_the_twins(monkeypatch):
-    """Points whose rays no ellipsoid of the cone meets: every residual is the misses' constant, so the costs
-    stay finite and the fit goes on; both paths end where they start, the grid's first best."""
-    visible, cone, axis, front, extent = _cone_view("apple", 1, noise=0.0)
-    far = visible + np.array([0.5, 0.0, 0.0])  # the points' rays outside the cone
-    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, far, cone=cone, axis=axis, front=front, extent=extent)
-    np.testing.assert_allclose(fast.centre, twin.centre, atol=1e-9)
 
 
 # --- marching a solid of revolution -----------------------------------------------------------------------

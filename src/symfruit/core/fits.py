@@ -5,15 +5,14 @@ measure that tells clean scans from depth-camera views.
 Every function takes ``points : (n, 3) float, metres`` first and normalises it (:func:`as_points`), takes
 its options as keywords, and returns arrays; none knows settings objects or files.
 
-The loops of the sphere's, the solid of revolution's and the cone ellipsoid's fits run as compiled kernels
-where numba (the extra ``fast``) is installed (:mod:`symfruit.core.kernels`); the numpy code here is their twin,
-run without numba or with ``SYMFRUIT_KERNELS=numpy``, and gives the same results within rounding.
+The loops of the sphere's and the solid of revolution's fits (and the marching of the latter) run as compiled
+kernels where numba (the extra ``fast``) is installed (:mod:`symfruit.core.kernels`); the numpy code here is their
+twin, run without numba or with ``SYMFRUIT_KERNELS=numpy``, and gives the same results within rounding.
 """
 
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -864,40 +863,6 @@ class ConeFit:
     rms: float
 
 
-def _cone_steps(
-    p: np.ndarray, with_steps: Callable[[np.ndarray], tuple[np.ndarray, np.ndarray]],
-    cost: Callable[[np.ndarray], np.ndarray], huber: float, iterations: int, tolerance: float,
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`fit_cone_ellipsoid`'s Levenberg-Marquardt from the grid's best ``p`` (4,): the parameters, the
-    residuals at them (n,) and at each finite-difference step (4, n) (the numpy twin of
-    :func:`symfruit.core._jit.cone_fit`)."""
-    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
-    r, r_steps = with_steps(p)
-    current, mu = float(cost(r)), 1e-2
-    for _ in range(iterations):
-        done = False
-        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
-        a = np.abs(r)
-        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
-        jtj = (jac * w) @ jac.T
-        g = (jac * w) @ r
-        improved = False
-        while mu < 1e6:
-            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
-            trial = p + delta
-            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
-            new = float(cost(r_new))
-            if new < current:
-                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
-                done = current - new < tolerance * current
-                current = new
-                break
-            mu *= 4.0
-        if not improved or done:
-            break
-    return p, r, r_steps
-
-
 def fit_cone_ellipsoid(
     points: np.ndarray,
     *,
@@ -981,19 +946,33 @@ def fit_cone_ellipsoid(
         a = np.abs(res)
         return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
 
-    status = -1
-    if (jit := compiled()) is not None:  # the compiled twin of the grid search and the loop below
-        z = np.ascontiguousarray(z)
-        p, both, status = jit.cone_fit(
-            grid, np.ascontiguousarray(cone), np.ascontiguousarray(axis), rays, ray_cone, z, step, huber, iterations,
-            tolerance,
-        )  # fmt: skip
-        r, r_steps = both[0], both[1:]
-    if status != 0:  # no kernel, no finite cost (1) or a singular damped system in it (2): the numpy twin
-        costs = cost(residuals(grid))
-        if not np.isfinite(costs).any():
-            raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
-        p, r, r_steps = _cone_steps(grid[int(np.argmin(costs))], with_steps, cost, huber, iterations, tolerance)
+    costs = cost(residuals(grid))
+    if not np.isfinite(costs).any():
+        raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
+    p = grid[int(np.argmin(costs))]
+    r, r_steps = with_steps(p)
+    current, mu = float(cost(r)), 1e-2
+    for _ in range(iterations):
+        done = False
+        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
+        a = np.abs(r)
+        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        jtj = (jac * w) @ jac.T
+        g = (jac * w) @ r
+        improved = False
+        while mu < 1e6:
+            delta = -np.linalg.solve(jtj + mu * np.diag(np.diag(jtj) + 1e-12), g)
+            trial = p + delta
+            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
+            new = float(cost(r_new))
+            if new < current:
+                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
+                done = current - new < tolerance * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
     m, shape, valid = cone_ellipsoid(p[None], cone, axis)
     if not valid[0]:
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")

@@ -2,7 +2,7 @@
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed,
 or when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
-:func:`~symfruit.core.fits.fit_cone_ellipsoid`, :func:`~symfruit.core.fits.fit_revolution_slices`) then run their
+:func:`~symfruit.core.fits.fit_revolution_slices`, :class:`~symfruit.core.fits.RevolutionInside`) then run their
 numpy twins, the code the kernels were written from, which stays tested and gives the same results within
 rounding (the kernels sum in another order than numpy). Nothing compiles when symfruit is imported: numba is
 imported by the first fit that asks for a kernel (about half a second), and each kernel is compiled on its first
