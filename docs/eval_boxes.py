@@ -3,7 +3,7 @@ instance by instance: how many boxes moved by more than a tolerance (issue 19's 
 may move results: every instance within 0.1 mm, box faces and centre).
 
     python docs/eval_boxes.py run BOXES.csv evaluate --protocol camera --sensor heldback --fruit all --n 30 ...
-    python docs/eval_boxes.py compare BEFORE.csv AFTER.csv [--tolerance-mm 0.1]
+    python docs/eval_boxes.py compare BEFORE.csv AFTER.csv [--tolerance-mm 0.1] [--list]
 
 ``run`` takes ``symfruit evaluate``'s own arguments (``--jobs`` included: each worker appends its rows); the
 box rows are ``key, min x/y/z, max x/y/z`` in metres, the key the instance (kind, fruit, pose, occlusion) and the
@@ -52,10 +52,11 @@ def load(path: str) -> dict[str, np.ndarray]:
         return {row[0]: np.array([float(v) for v in row[1:]]) for row in csv.reader(f)}
 
 
-def compare(before: str, after: str, tolerance_mm: float) -> int:
+def compare(before: str, after: str, tolerance_mm: float, listed: bool = False) -> int:
     a, b = load(before), load(after)
     keys = sorted(set(a) & set(b))
     moved, worst = 0, 0.0
+    lines = []
     for k in keys:
         if np.isnan(a[k]).all() and np.isnan(b[k]).all():
             continue
@@ -64,10 +65,13 @@ def compare(before: str, after: str, tolerance_mm: float) -> int:
         d = float(max(np.nanmax(faces) if np.isfinite(faces).any() else np.inf, centre))
         worst = max(worst, d)
         moved += int(not d <= tolerance_mm)
+        if listed and not d <= tolerance_mm:
+            lines.append(f"  {k}: {d:.3f} mm\n")
     sys.stdout.write(
         f"{len(keys)} instances in both ({len(a)} before, {len(b)} after); {moved} moved by more than "
         f"{tolerance_mm:g} mm (a box face or the centre); the largest move {worst:.4g} mm\n"
     )
+    sys.stdout.write("".join(lines))
     return 0
 
 
@@ -81,7 +85,8 @@ if __name__ == "__main__":
     c.add_argument("before")
     c.add_argument("after")
     c.add_argument("--tolerance-mm", type=float, default=0.1)
+    c.add_argument("--list", action="store_true", help="every instance moved beyond the tolerance, and how far")
     args = parser.parse_args()
     if args.cmd == "run":
         sys.exit(run(args.boxes, args.evaluate))
-    sys.exit(compare(args.before, args.after, args.tolerance_mm))
+    sys.exit(compare(args.before, args.after, args.tolerance_mm, args.list))

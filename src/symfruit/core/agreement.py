@@ -491,7 +491,8 @@ def explain(
     ----------
     inside : callable
         The candidate's inside function (:data:`Inside`); one with an ``intersect(rays, z0, z1)`` method
-        (a :class:`Quadric`) is met in closed form instead of marched.
+        (a :class:`Quadric`) is met in closed form instead of marched, one with a ``march(rays, z0, z1, steps)``
+        method (:class:`symfruit.core.fits.RevolutionInside`) marches its own rays where it can (None: not).
     box : ((3,), (3,)) float, metres
         The candidate's box: the rays are met over its depth range (1 mm beyond on both sides).
     obs : Observation
@@ -508,10 +509,13 @@ def explain(
     n = len(obs.rays)
     every = _bands(obs).rays  # one march for all rays
     closed_form = getattr(inside, "intersect", None)
+    marcher = getattr(inside, "march", None)  # a compiled march (core.fits.RevolutionInside), None without numba
     if callable(closed_form):
         hit_all, depth_all = closed_form(every, z0, z1)
-    else:
+    elif not callable(marcher) or (marched := marcher(every, z0, z1, steps)) is None:
         hit_all, depth_all = march(inside, every, z0, z1, steps=steps)
+    else:
+        hit_all, depth_all = marched
     hit, depth = hit_all[:n], depth_all[:n]
     res = np.where(hit, obs.depth - np.where(hit, depth, 0.0), z1 - z0)
     keep = max(1, int(trim * len(res)))

@@ -37,6 +37,7 @@ from ..errors import InputError
 from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
+    RevolutionInside,
     ellipsoid_half_extents,
     fit_cone_ellipsoid,
     fit_ellipsoid,
@@ -44,7 +45,6 @@ from .fits import (
     fit_sphere,
     outline_radii,
     revolution_box,
-    revolution_inside,
 )
 from .points import as_points, bounds
 from .raster import Silhouette, View
@@ -331,9 +331,9 @@ def _revolution(fit: _Fitting) -> Iterator[_Shape]:
             rev = shaped
         else:
             olo, ohi = revolution_box(shaped)
-            yield _Shape("outline", olo, ohi, lambda x: revolution_inside(shaped, x), 0.5 * (olo + ohi))
+            yield _Shape("outline", olo, ohi, RevolutionInside(shaped), 0.5 * (olo + ohi))
     lo, hi = revolution_box(rev)
-    yield _Shape("revolution", lo, hi, lambda x: revolution_inside(rev, x), 0.5 * (lo + hi))
+    yield _Shape("revolution", lo, hi, RevolutionInside(rev), 0.5 * (lo + hi))
 
 
 _Fitter = Callable[[_Fitting], Iterator[_Shape]]

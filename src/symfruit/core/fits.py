@@ -4,6 +4,10 @@ measure that tells clean scans from depth-camera views.
 
 Every function takes ``points : (n, 3) float, metres`` first and normalises it (:func:`as_points`), takes
 its options as keywords, and returns arrays; none knows settings objects or files.
+
+The loops of the sphere's and the solid of revolution's fits (and the marching of the latter) run as compiled
+kernels where numba (the extra ``fast``) is installed (:mod:`symfruit.core.kernels`); the numpy code here is their
+twin, run without numba or with ``SYMFRUIT_KERNELS=numpy``, and gives the same results within rounding.
 """
 
 from __future__ import annotations
@@ -17,11 +21,13 @@ from scipy.spatial import cKDTree
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
+from .kernels import compiled
 from .points import as_points, cross_rows, median, perpendicular_basis, row_norms
 
 __all__ = [
     "ConeFit",
     "Revolution",
+    "RevolutionInside",
     "closed_profile",
     "cone_ellipsoid",
     "ellipsoid_half_extents",
@@ -81,6 +87,11 @@ def fit_sphere(
         raise InputError("cannot fit a sphere: the points are (nearly) coplanar or collinear")
     c = sol[:3]
     r = float(np.sqrt(max(sol[3] + c @ c, 1e-12)))
+    if refine and (jit := compiled()) is not None:  # the compiled twin of the loop below
+        c_jit = np.array(c)
+        r_jit, ok = jit.sphere_steps(q, c_jit, r, iterations, tolerance, scale)
+        if ok:
+            return c_jit * scale + mean, r_jit * scale
     if refine:
         jac = np.empty((len(q), 4))
         jac[:, 3] = -1.0
@@ -448,6 +459,63 @@ def _cap_local(spread_deg: float, n: int) -> np.ndarray:
 _COARSE = _hemisphere(64)
 
 
+def _revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.ndarray, steps: int) -> None:
+    """:func:`fit_revolution_slices`' Gauss-Newton on the axis position ``a2`` (2,), refined in place: the points'
+    distances from the axis in the plane (coordinates ``w`` (n, 2)) less their slice's mean distance (slice
+    ``which`` (n,) of ``b``, ``cnt`` (b,) its points, at least 1), at most ``steps`` steps (the numpy twin of
+    :func:`symfruit.core._jit.revolution_steps`)."""
+    b = len(cnt)
+    # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
+    # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
+    which3 = np.concatenate((which, which + b, which + 2 * b))
+    for _ in range(steps):
+        diff = w - a2
+        rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
+        np.maximum(rho, 1e-12, out=rho)
+        jac = np.negative(diff, out=diff)
+        jac /= rho[:, None]
+        sums = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * b)
+        means = sums.reshape(3, b) / cnt
+        res = rho - means[0][which]
+        jac -= np.take(means[1:].T, which, axis=0)  # rows by np.take: 5x faster than [which] here
+        jtj = jac.T @ jac
+        if abs(np.linalg.det(jtj)) < 1e-30:
+            break
+        step = np.linalg.solve(jtj, -(jac.T @ res))  # the normal equations of the 2-unknown step
+        a2 += step
+        if np.abs(step).max() < 1e-7:
+            break
+
+
+def _revolution_profile(
+    q: np.ndarray, best: np.ndarray, e1: np.ndarray, e2: np.ndarray, bins: int, steps: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, bool]:
+    """:func:`fit_revolution_slices` about the chosen direction ``best`` (3,) for centred points ``q`` (n, 3)
+    (``e1``, ``e2`` (3,) the plane's basis): the axis position in the plane (2,), the profile's ``bins`` slice
+    borders along the axis (b + 1,), their radii (b,), the robust cost, and True (the numpy twin of
+    :func:`symfruit.core._jit.revolution_profile`)."""
+    t = q @ best
+    w = np.stack((q @ e1, q @ e2), axis=1)
+    edges = np.linspace(t.min(), t.max(), bins + 1)
+    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, bins - 1)
+    counts = np.bincount(which, minlength=bins)
+    cnt = np.maximum(counts, 1)
+    # Start: the algebraic axis offset on the profile slices, then Gauss-Newton on rho_i - mean_slice(rho).
+    ww = w - w.mean(axis=0)
+    y = (ww * ww).sum(axis=1)
+    dy = y - (np.bincount(which, weights=y, minlength=bins) / cnt)[which]
+    dw = ww - np.take(np.stack([np.bincount(which, weights=ww[:, i], minlength=bins) / cnt
+                                for i in range(2)], axis=1), which, axis=0)  # fmt: skip
+    sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
+    a2 = sol + w.mean(axis=0)  # refined in place
+    _revolution_steps(np.ascontiguousarray(w), which, cnt.astype(np.float64), a2, steps)
+    rho = row_norms(w - a2)
+    mean_r = np.bincount(which, weights=rho, minlength=bins) / cnt
+    radii = np.where(counts >= 3, mean_r, np.nan)
+    res2 = np.sort((rho - mean_r[which]) ** 2)
+    return a2, edges, radii, float(res2[: max(1, int(0.8 * len(res2)))].mean()), True
+
+
 def fit_revolution_slices(
     points: np.ndarray,
     *,
@@ -512,51 +580,21 @@ def fit_revolution_slices(
         dirs = np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
     if not len(dirs):
         raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
-    best = dirs[int(np.argmin(_slice_costs(qs, dirs, bins)))]
+    jit = compiled()
+    if jit is not None:  # the compiled twin of _slice_costs
+        qs = np.ascontiguousarray(qs)
+        dirs = np.ascontiguousarray(dirs)
+    slice_costs = _slice_costs if jit is None else jit.slice_costs
+    best = dirs[int(np.argmin(slice_costs(qs, dirs, bins)))]
     for spread in refine_deg:
         cand = _cap(best, spread, refine_n)
-        best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
+        best = cand[int(np.argmin(slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
-    t = q @ best
-    w = np.stack((q @ e1[0], q @ e2[0]), axis=1)
-    edges = np.linspace(t.min(), t.max(), profile_bins + 1)
-    which = np.clip(np.searchsorted(edges, t, side="right") - 1, 0, profile_bins - 1)
-    counts = np.bincount(which, minlength=profile_bins)
-    cnt = np.maximum(counts, 1)
-    # Start: the algebraic axis offset on the profile slices, then Gauss-Newton on rho_i - mean_slice(rho).
-    ww = w - w.mean(axis=0)
-    y = (ww * ww).sum(axis=1)
-    dy = y - (np.bincount(which, weights=y, minlength=profile_bins) / cnt)[which]
-    dw = ww - np.take(np.stack([np.bincount(which, weights=ww[:, i], minlength=profile_bins) / cnt
-                                for i in range(2)], axis=1), which, axis=0)  # fmt: skip
-    sol, *_ = np.linalg.lstsq(2.0 * dw, dy, rcond=None)
-    a2 = sol + w.mean(axis=0)
-    # Each step's three slice means (of rho and of the two Jacobian columns) come from one bincount over the
-    # three stacked (each bin adds its values in the same order as a bincount of its own: the same sums).
-    which3 = np.concatenate((which, which + profile_bins, which + 2 * profile_bins))
-    for _ in range(gauss_newton_steps):
-        diff = w - a2
-        rho = np.sqrt(diff[:, 0] * diff[:, 0] + diff[:, 1] * diff[:, 1])  # numpy sums 2 terms left to right
-        np.maximum(rho, 1e-12, out=rho)
-        jac = np.negative(diff, out=diff)
-        jac /= rho[:, None]
-        sums = np.bincount(which3, weights=np.concatenate((rho, jac[:, 0], jac[:, 1])), minlength=3 * profile_bins)
-        means = sums.reshape(3, profile_bins) / cnt
-        res = rho - means[0][which]
-        jac -= np.take(means[1:].T, which, axis=0)  # rows by np.take: 5x faster than [which] here
-        jtj = jac.T @ jac
-        if abs(np.linalg.det(jtj)) < 1e-30:
-            break
-        step = np.linalg.solve(jtj, -(jac.T @ res))  # the normal equations of the 2-unknown step
-        a2 = a2 + step
-        if np.abs(step).max() < 1e-7:
-            break
+    found = None if jit is None else jit.revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
+    if found is None or not found[4]:  # no kernel, or a singular start (the twin's least squares copes)
+        found = _revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
+    a2, edges, radii, cost = found[0], found[1], found[2], float(found[3])
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
-    rho = row_norms(w - a2)
-    mean_r = np.bincount(which, weights=rho, minlength=profile_bins) / cnt
-    radii = np.where(counts >= 3, mean_r, np.nan)
-    res2 = np.sort((rho - mean_r[which]) ** 2)
-    cost = float(res2[: max(1, int(0.8 * len(res2)))].mean())
     edges = edges + float(centre @ best - axis_point @ best)
     return Revolution(axis_point, best, edges, radii, cost)
 
@@ -674,6 +712,32 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     r = np.interp(t, t_prof, r_prof, left=0.0, right=0.0)
     past = np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     return (r - rho - past).reshape(shape)
+
+
+@dataclass(frozen=True, eq=False)
+class RevolutionInside:
+    """:func:`revolution_inside` of a fitted solid as an inside test (:data:`symfruit.core.agreement.Inside`) whose
+    rays are marched by a compiled kernel where numba is installed (:meth:`march`; its twin is
+    :func:`symfruit.core.agreement.march` of this test)."""
+
+    rev: Revolution
+    close: bool = True
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        return revolution_inside(self.rev, x, close=self.close)
+
+    def march(self, rays: np.ndarray, z0: float, z1: float, steps: int) -> tuple[np.ndarray, np.ndarray] | None:
+        """``(hit (m,), depth (m,))`` of :func:`symfruit.core.agreement.march` along rays (m, 3) by the compiled
+        kernel (each ray stopped at its first step inside), or None without it."""
+        jit = compiled()
+        if jit is None:
+            return None
+        t, r = closed_profile(self.rev, close=self.close)
+        return jit.revolution_march(
+            np.ascontiguousarray(self.rev.point, dtype=np.float64), np.ascontiguousarray(self.rev.direction,
+            dtype=np.float64), np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(r, dtype=np.float64),
+            np.ascontiguousarray(rays, dtype=np.float64), float(z0), float(z1), int(steps),
+        )  # fmt: skip
 
 
 # --- ellipsoid tangent to the silhouette's viewing cone ----------------------------------------------------

@@ -1,0 +1,403 @@
+"""The compiled kernels behind :mod:`symfruit.core.kernels` (numba; imported only when a kernel is first asked for).
+
+Each kernel is a whole loop of :mod:`symfruit.core.fits` written out element by element, with its numpy twin
+there (the tests compare the two). ``error_model="numpy"``: a division by zero gives inf or NaN as numpy's
+does, where the twin's ``np.errstate`` lets it, instead of raising. No ``fastmath``: IEEE arithmetic, though
+sums run in another order than numpy's pairwise ones (results agree to rounding, not to the bit).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from typing import Any
+
+import numba
+import numpy as np
+
+
+def _njit(func: Callable[..., Any]) -> Any:
+    """``numba.njit`` with the compiled code cached on disk (beside this file, or in the user's cache directory
+    when that is not writable, e.g. a read-only site-packages); without the cache when numba finds no writable
+    directory at all (it raises then), so a kernel is never what fails."""
+    try:
+        return numba.njit(cache=True, error_model="numpy", nogil=True)(func)
+    except RuntimeError:
+        return numba.njit(error_model="numpy", nogil=True)(func)
+
+
+@_njit
+def solve(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
+    """Solve ``a x = b`` for a small square ``a`` by Gaussian elimination with partial pivoting (``a`` and ``b``
+    are overwritten); False, ``x`` untouched, when a pivot is exactly zero (numpy's ``solve`` raises there)."""
+    n = a.shape[0]
+    for col in range(n):
+        piv = col
+        best = abs(a[col, col])
+        for row in range(col + 1, n):
+            if abs(a[row, col]) > best:
+                piv, best = row, abs(a[row, col])
+        if best == 0.0:
+            return False
+        if piv != col:
+            for j in range(n):
+                a[col, j], a[piv, j] = a[piv, j], a[col, j]
+            b[col], b[piv] = b[piv], b[col]
+        for row in range(col + 1, n):
+            f = a[row, col] / a[col, col]
+            if f != 0.0:
+                for j in range(col, n):
+                    a[row, j] -= f * a[col, j]
+                b[row] -= f * b[col]
+    for row in range(n - 1, -1, -1):
+        s = b[row]
+        for j in range(row + 1, n):
+            s -= a[row, j] * x[j]
+        x[row] = s / a[row, row]
+    return True
+
+
+@_njit
+def select(x: np.ndarray, kth: int) -> None:
+    """Reorder ``x`` (n,) in place so that ``x[kth]`` is its ``kth`` smallest value, none larger before it and none
+    smaller after (quickselect, median-of-three pivots: a partition without ``np.partition``'s copy, half its
+    time on a few hundred values)."""
+    lo, hi = 0, x.shape[0] - 1
+    while hi > lo:
+        mid = (lo + hi) >> 1
+        a, b, c = x[lo], x[mid], x[hi]
+        if a > b:
+            a, b = b, a
+        if b > c:
+            b = c
+            if a > b:
+                b = a
+        i, j = lo, hi
+        while i <= j:
+            while x[i] < b:
+                i += 1
+            while x[j] > b:
+                j -= 1
+            if i <= j:
+                x[i], x[j] = x[j], x[i]
+                i += 1
+                j -= 1
+        if kth <= j:
+            hi = j
+        elif kth >= i:
+            lo = i
+        else:
+            return
+
+
+@_njit
+def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
+    """:func:`symfruit.core.fits._slice_costs`: the robust slice-circle cost (k,) of every direction (k, 3) for
+    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused)."""
+    k, n = dirs.shape[0], q.shape[0]
+    out = np.empty(k)
+    t = np.empty(n)
+    u = np.empty(n)
+    v = np.empty(n)
+    cu = np.empty(n)
+    cv = np.empty(n)
+    idx = np.empty(n, np.int64)
+    dist2 = np.empty(n)
+    cnt = np.empty(bins)
+    su = np.empty(bins)
+    sv = np.empty(bins)
+    sy = np.empty(bins)
+    keep = max(1, int(0.8 * n))
+    for j in range(k):
+        x, y, z = dirs[j, 0], dirs[j, 1], dirs[j, 2]
+        if abs(x) < 0.9:  # the basis of core.points.perpendicular_basis
+            a, b, c = 0.0, z, -y
+        else:
+            a, b, c = -z, 0.0, x
+        norm = math.sqrt(a * a + b * b + c * c)
+        a, b, c = a / norm, b / norm, c / norm
+        f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
+        lo, hi = np.inf, -np.inf
+        for i in range(n):
+            p0, p1, p2 = q[i, 0], q[i, 1], q[i, 2]
+            ti = x * p0 + y * p1 + z * p2
+            t[i] = ti
+            u[i] = a * p0 + b * p1 + c * p2
+            v[i] = f * p0 + g * p1 + h * p2
+            lo = min(lo, ti)
+            hi = max(hi, ti)
+        span = max(hi - lo, 1e-12)
+        cnt[:] = 0.0
+        su[:] = 0.0
+        sv[:] = 0.0
+        sy[:] = 0.0
+        for i in range(n):  # apart from the sums below, so that it runs on vectors
+            idx[i] = min(int((t[i] - lo) / span * bins), bins - 1)
+        for i in range(n):
+            s = idx[i]
+            cnt[s] += 1.0
+            su[s] += u[i]
+            sv[s] += v[i]
+            sy[s] += u[i] * u[i] + v[i] * v[i]
+        for s in range(bins):
+            d = max(cnt[s], 1.0)
+            su[s] /= d
+            sv[s] /= d
+            sy[s] /= d
+        a11 = a12 = a22 = b1 = b2 = 0.0
+        for i in range(n):  # the slices' centred values, kept for the residuals
+            s = idx[i]
+            du = u[i] - su[s]
+            dv = v[i] - sv[s]
+            dy = u[i] * u[i] + v[i] * v[i] - sy[s]
+            cu[i], cv[i], t[i] = du, dv, dy
+            a11 += du * du
+            a12 += du * dv
+            a22 += dv * dv
+            b1 += du * dy
+            b2 += dv * dy
+        det = a11 * a22 - a12 * a12
+        if not abs(det) > 1e-30:
+            det = 1e-30
+        au = 0.5 * (a22 * b1 - a12 * b2) / det
+        av = 0.5 * (a11 * b2 - a12 * b1) / det
+        for i in range(n):
+            res = t[i] - 2.0 * (au * cu[i] + av * cv[i])
+            ru = u[i] - au
+            rv = v[i] - av
+            rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
+            dist2[i] = res * res / rho2
+        select(dist2, keep - 1)
+        total = 0.0
+        for i in range(keep):
+            total += dist2[i]
+        out[j] = total / keep
+    return out
+
+
+@_njit
+def sphere_steps(
+    q: np.ndarray, c: np.ndarray, r: float, iterations: int, tolerance: float, scale: float
+) -> tuple[float, bool]:
+    """:func:`symfruit.core.fits.fit_sphere`'s Gauss-Newton on the residuals ``|q - c| - r`` (``c`` (3,) updated in
+    place; it stops once a step times ``scale`` is under ``tolerance``): the radius and True, or False where the
+    4x4 normal equations are singular (the twin then takes a least-squares step, so the caller runs the twin)."""
+    n = q.shape[0]
+    jtj = np.empty((4, 4))
+    g = np.empty(4)
+    step = np.empty(4)
+    for _ in range(iterations):
+        jtj[:] = 0.0
+        g[:] = 0.0
+        for i in range(n):
+            d0, d1, d2 = q[i, 0] - c[0], q[i, 1] - c[1], q[i, 2] - c[2]
+            dist = max(math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), 1e-12)
+            j0, j1, j2 = -d0 / dist, -d1 / dist, -d2 / dist
+            res = dist - r
+            jtj[0, 0] += j0 * j0
+            jtj[0, 1] += j0 * j1
+            jtj[0, 2] += j0 * j2
+            jtj[0, 3] -= j0
+            jtj[1, 1] += j1 * j1
+            jtj[1, 2] += j1 * j2
+            jtj[1, 3] -= j1
+            jtj[2, 2] += j2 * j2
+            jtj[2, 3] -= j2
+            g[0] -= j0 * res
+            g[1] -= j1 * res
+            g[2] -= j2 * res
+            g[3] += res
+        jtj[3, 3] = float(n)
+        for a in range(4):
+            for b in range(a):
+                jtj[a, b] = jtj[b, a]
+        if not solve(jtj, g, step):
+            return r, False
+        c[0] += step[0]
+        c[1] += step[1]
+        c[2] += step[2]
+        r = abs(r + step[3])
+        largest = 0.0
+        for a in range(4):
+            largest = max(largest, abs(step[a]))
+        if largest * scale < tolerance:
+            break
+    return r, True
+
+
+@_njit
+def revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.ndarray, steps: int) -> None:
+    """:func:`symfruit.core.fits.fit_revolution_slices`' Gauss-Newton on the axis position ``a2`` (2,), updated in
+    place: the points' plane coordinates ``w`` (n, 2) about the axis at ``a2`` less their slice's mean distance
+    (slice ``which`` (n,), ``cnt`` (b,) its points, at least 1)."""
+    n, b = w.shape[0], cnt.shape[0]
+    rho = np.empty(n)
+    j0 = np.empty(n)
+    j1 = np.empty(n)
+    sums = np.empty((3, b))
+    jtj = np.empty((2, 2))
+    g = np.empty(2)
+    step = np.empty(2)
+    for _ in range(steps):
+        sums[:] = 0.0
+        for i in range(n):
+            d0, d1 = w[i, 0] - a2[0], w[i, 1] - a2[1]
+            r = max(math.sqrt(d0 * d0 + d1 * d1), 1e-12)
+            rho[i], j0[i], j1[i] = r, -d0 / r, -d1 / r
+            s = which[i]
+            sums[0, s] += r
+            sums[1, s] += j0[i]
+            sums[2, s] += j1[i]
+        for s in range(b):
+            sums[0, s] /= cnt[s]
+            sums[1, s] /= cnt[s]
+            sums[2, s] /= cnt[s]
+        a11 = a12 = a22 = g0 = g1 = 0.0
+        for i in range(n):
+            s = which[i]
+            res = rho[i] - sums[0, s]
+            x0 = j0[i] - sums[1, s]
+            x1 = j1[i] - sums[2, s]
+            a11 += x0 * x0
+            a12 += x0 * x1
+            a22 += x1 * x1
+            g0 -= x0 * res
+            g1 -= x1 * res
+        if abs(a11 * a22 - a12 * a12) < 1e-30:
+            break
+        jtj[0, 0], jtj[0, 1], jtj[1, 0], jtj[1, 1] = a11, a12, a12, a22
+        g[0], g[1] = g0, g1
+        if not solve(jtj, g, step):
+            break
+        a2[0] += step[0]
+        a2[1] += step[1]
+        if max(abs(step[0]), abs(step[1])) < 1e-7:
+            break
+
+
+@_njit
+def revolution_profile(
+    q: np.ndarray, best: np.ndarray, e1: np.ndarray, e2: np.ndarray, bins: int, steps: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, float, bool]:
+    """:func:`symfruit.core.fits._revolution_profile`: for centred points ``q`` (n, 3) about the axis direction
+    ``best`` (plane basis ``e1``, ``e2``), the axis position in the plane (2,), the slice borders (b + 1,), the
+    slices' radii (b,) and the robust cost, and True; False where the algebraic start's 2x2 system is singular
+    (the twin's least squares then takes the minimum-norm solution, so the caller runs the twin)."""
+    n = q.shape[0]
+    t = np.empty(n)
+    w = np.empty((n, 2))
+    m0 = m1 = 0.0
+    for i in range(n):
+        p0, p1, p2 = q[i, 0], q[i, 1], q[i, 2]
+        t[i] = p0 * best[0] + p1 * best[1] + p2 * best[2]
+        w[i, 0] = p0 * e1[0] + p1 * e1[1] + p2 * e1[2]
+        w[i, 1] = p0 * e2[0] + p1 * e2[1] + p2 * e2[2]
+        m0 += w[i, 0]
+        m1 += w[i, 1]
+    m0 /= n
+    m1 /= n
+    edges = np.linspace(t.min(), t.max(), bins + 1)
+    which = np.searchsorted(edges, t, side="right") - 1
+    counts = np.zeros(bins)
+    sums = np.zeros((3, bins))
+    for i in range(n):
+        s = min(max(which[i], 0), bins - 1)
+        which[i] = s
+        counts[s] += 1.0
+        x0, x1 = w[i, 0] - m0, w[i, 1] - m1
+        sums[0, s] += x0 * x0 + x1 * x1
+        sums[1, s] += x0
+        sums[2, s] += x1
+    cnt = np.maximum(counts, 1.0)
+    for s in range(bins):
+        sums[0, s] /= cnt[s]
+        sums[1, s] /= cnt[s]
+        sums[2, s] /= cnt[s]
+    # the algebraic start: least squares of 2 dw . a = dy by its normal equations
+    a11 = a12 = a22 = g0 = g1 = 0.0
+    for i in range(n):
+        s = which[i]
+        x0, x1 = w[i, 0] - m0, w[i, 1] - m1
+        dy = x0 * x0 + x1 * x1 - sums[0, s]
+        d0, d1 = 2.0 * (x0 - sums[1, s]), 2.0 * (x1 - sums[2, s])
+        a11 += d0 * d0
+        a12 += d0 * d1
+        a22 += d1 * d1
+        g0 += d0 * dy
+        g1 += d1 * dy
+    lhs = np.array([[a11, a12], [a12, a22]])
+    rhs = np.array([g0, g1])
+    a2 = np.empty(2)
+    radii = np.empty(bins)
+    # nearly singular (the normal equations' condition past 1e10): the twin's least squares decides
+    if not a11 * a22 - a12 * a12 > 1e-20 * (a11 + a22) ** 2 or not solve(lhs, rhs, a2):
+        return a2, edges, radii, 0.0, False
+    a2[0] += m0
+    a2[1] += m1
+    revolution_steps(w, which, cnt, a2, steps)
+    rho = np.empty(n)
+    mean_r = np.zeros(bins)
+    for i in range(n):
+        d0, d1 = w[i, 0] - a2[0], w[i, 1] - a2[1]
+        rho[i] = math.sqrt(d0 * d0 + d1 * d1)
+        mean_r[which[i]] += rho[i]
+    for s in range(bins):
+        mean_r[s] /= cnt[s]
+        radii[s] = mean_r[s] if counts[s] >= 3 else np.nan
+    for i in range(n):
+        d = rho[i] - mean_r[which[i]]
+        rho[i] = d * d
+    keep = max(1, int(0.8 * n))
+    select(rho, keep - 1)
+    total = 0.0
+    for i in range(keep):
+        total += rho[i]
+    return a2, edges, radii, total / keep, True
+
+
+@_njit
+def revolution_march(
+    point: np.ndarray, direction: np.ndarray, t_prof: np.ndarray, r_prof: np.ndarray, rays: np.ndarray, z0: float,
+    z1: float, steps: int,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement.march` into a solid of revolution (axis ``point``, ``direction``; closed profile
+    ``t_prof``, ``r_prof``) along rays (m, 3), each ray stopped at its first step inside: ``(hit (m,), depth (m,))``."""
+    m, k = rays.shape[0], t_prof.shape[0]
+    zs = np.linspace(z0, z1, steps)
+    hit = np.zeros(m, np.bool_)
+    depth = np.full(m, np.nan)
+    p0, p1, p2 = point[0], point[1], point[2]
+    d0, d1, d2 = direction[0], direction[1], direction[2]
+    first, last = t_prof[0], t_prof[k - 1]
+    for i in range(m):
+        a, b, c = rays[i, 0], rays[i, 1], rays[i, 2]
+        before = 0.0
+        j = 0  # the slice of the last step (the steps walk along the axis monotonically: a short walk each)
+        for s in range(steps):
+            z = zs[s]
+            # core.fits.revolution_inside of the point z * ray (np.interp's rule: 0 outside the profile)
+            r0, r1, r2 = a * z - p0, b * z - p1, c * z - p2
+            t = r0 * d0 + r1 * d1 + r2 * d2
+            o0, o1, o2 = r0 - t * d0, r1 - t * d1, r2 - t * d2
+            rho = math.sqrt(o0 * o0 + o1 * o1 + o2 * o2)
+            if t < first or t > last or math.isnan(t):
+                r = 0.0
+            elif t == last:
+                r = r_prof[k - 1]
+            else:  # the last j with t_prof[j] <= t (np.searchsorted(side="right") - 1)
+                while j > 0 and t_prof[j] > t:
+                    j -= 1
+                while j < k - 2 and t_prof[j + 1] <= t:
+                    j += 1
+                r = r_prof[j] + (r_prof[j + 1] - r_prof[j]) / (t_prof[j + 1] - t_prof[j]) * (t - t_prof[j])
+            f = r - rho - (max(first - t, 0.0) + max(t - last, 0.0))
+            if f > 0:
+                hit[i] = True
+                if s == 0:
+                    depth[i] = zs[0]
+                else:
+                    frac = -before / (f - before) if f != before else 0.0
+                    depth[i] = zs[s - 1] + min(max(frac, 0.0), 1.0) * (zs[s] - zs[s - 1])
+                break
+            before = f
+    return hit, depth

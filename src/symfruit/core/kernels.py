@@ -1,0 +1,38 @@
+"""Compiled kernels for the fits' loops (issue 19, eighth round), with numba from the optional extra ``fast``.
+
+:func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed,
+or when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
+:func:`~symfruit.core.fits.fit_revolution_slices`, :class:`~symfruit.core.fits.RevolutionInside`) then run their
+numpy twins, the code the kernels were written from, which stays tested and gives the same results within
+rounding (the kernels sum in another order than numpy). Nothing compiles when symfruit is imported: numba is
+imported by the first fit that asks for a kernel (about half a second), and each kernel is compiled on its first
+call (a few seconds in all) or loaded from numba's on-disk cache (beside the module, or the user's cache
+directory where that is read-only; without a cache where neither is writable).
+
+>>> compiled() is None or callable(compiled().slice_costs)
+True
+"""
+
+from __future__ import annotations
+
+import os
+from types import ModuleType
+
+__all__ = ["compiled"]
+
+_STATE: dict[str, ModuleType | None] = {}
+
+
+def compiled() -> ModuleType | None:
+    """The compiled kernels' module, or None where the numpy twins are to run (no numba, or
+    ``SYMFRUIT_KERNELS=numpy``)."""
+    if os.environ.get("SYMFRUIT_KERNELS", "").lower() == "numpy":
+        return None
+    if "jit" not in _STATE:
+        try:
+            from . import _jit
+        except ImportError:  # numba (the extra `fast`) is not installed, or not for this numpy
+            _STATE["jit"] = None
+        else:
+            _STATE["jit"] = _jit
+    return _STATE["jit"]

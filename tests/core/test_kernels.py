@@ -1,0 +1,257 @@
+"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``, seeded and
+property-tested; the switch to the twins (``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
+
+The kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
+iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm).
+"""
+
+import subprocess
+import sys
+import types
+
+import numpy as np
+import pytest
+from hypothesis import given
+from hypothesis import strategies as st
+
+from symfruit.core import kernels
+from symfruit.core.fits import _slice_costs, fit_revolution_slices, fit_sphere
+from symfruit.synthetic.shapes import FRUITS, rotation
+
+from ..conftest import CENTRE, random_sphere, rendered_view
+
+numba = pytest.importorskip("numba")
+from symfruit.core import _jit  # noqa: E402  (numba is there: the module may be imported)
+
+
+def _both(monkeypatch, fn, *args, **kwargs):
+    """``fn(*args, **kwargs)`` with the kernels, then with the numpy twins."""
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # a run with the twins throughout still compares
+    compiled = fn(*args, **kwargs)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    twin = fn(*args, **kwargs)
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    return compiled, twin
+
+
+# --- the switch -------------------------------------------------------------------------------------------
+
+
+def test_the_environment_switches_to_the_numpy_twins(monkeypatch):
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+    assert kernels.compiled() is _jit
+    for value in ("numpy", "NumPy"):
+        monkeypatch.setenv("SYMFRUIT_KERNELS", value)
+        assert kernels.compiled() is None
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "")
+    assert kernels.compiled() is _jit
+
+
+def test_without_numba_the_twins_run(monkeypatch):
+    """numba missing (or unusable with this numpy): no kernels, and every fit still works (its twin)."""
+    import symfruit.core
+
+    monkeypatch.setattr(kernels, "_STATE", {})
+    monkeypatch.delattr(symfruit.core, "_jit")
+    monkeypatch.setitem(sys.modules, "symfruit.core._jit", None)  # `from . import _jit` raises ImportError
+    assert kernels.compiled() is None
+    centre, radius = fit_sphere(random_sphere(200, seed=1))
+    assert np.allclose(centre, CENTRE) and radius == pytest.approx(0.03)
+
+
+def test_importing_symfruit_compiles_nothing():
+    code = "import sys, symfruit, symfruit.core.fits, symfruit.detect; print('numba' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
+
+
+def test_no_writable_cache_directory_compiles_without_a_cache(monkeypatch):
+    """numba raises when it finds no directory to cache in (a read-only install and home): the kernel is then
+    compiled without the cache instead of failing."""
+    calls = []
+
+    def njit(**options):
+        calls.append(options)
+        if options.get("cache"):
+            raise RuntimeError("cannot cache function: no locator available")
+        return lambda func: ("compiled", func)
+
+    monkeypatch.setattr(_jit, "numba", types.SimpleNamespace(njit=njit))
+    assert _jit._njit(len) == ("compiled", len)
+    assert [c.get("cache", False) for c in calls] == [True, False]
+
+
+# --- small helpers ----------------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.booleans())
+def test_select_partitions_in_place(seed, n, ties):
+    rng = np.random.default_rng(seed)
+    x = rng.normal(size=n)
+    if ties:
+        x = np.round(x * 2.0)
+    kth = int(rng.integers(n))
+    y = x.copy()
+    _jit.select(y, kth)
+    assert np.array_equal(np.sort(y), np.sort(x))  # a permutation
+    assert y[kth] == np.sort(x)[kth]
+    assert (y[:kth] <= y[kth]).all() and (y[kth + 1 :] >= y[kth]).all()
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_solve_is_numpys_solve(seed, n):
+    rng = np.random.default_rng(seed)
+    a = rng.normal(size=(n, n)) + n * np.eye(n) * rng.choice([-1.0, 1.0])
+    b = rng.normal(size=n)
+    x = np.empty(n)
+    assert _jit.solve(a.copy(), b.copy(), x)
+    np.testing.assert_allclose(x, np.linalg.solve(a, b), rtol=1e-9, atol=1e-12)
+
+
+def test_solve_refuses_a_singular_matrix():
+    x = np.full(3, 7.0)
+    assert not _jit.solve(np.array([[1.0, 2.0, 0.0], [2.0, 4.0, 0.0], [0.0, 0.0, 1.0]]), np.ones(3), x)
+    assert (x == 7.0).all()
+
+
+# --- the solid of revolution ------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 90), st.integers(60, 300))
+def test_slice_costs_are_the_twins(seed, k, n):
+    """At five points a slice or more, as the fit's 240 in 12 (with a point or two per slice the 2x2 system is
+    singular and both costs are rounding noise amplified by the determinant's floor)."""
+    rng = np.random.default_rng(seed)
+    scale = rng.uniform(0.001, 0.1)
+    q = rng.normal(size=(n, 3)) * scale
+    q[: n // 3] = np.round(q[: n // 3], 3)  # repeated coordinates: ties in the slices and the partition
+    dirs = rng.normal(size=(k, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    fast, twin = _jit.slice_costs(q, dirs, 12), _slice_costs(q, dirs, 12)
+    np.testing.assert_allclose(fast, twin, rtol=1e-7, atol=1e-12 * scale**2)
+
+
+@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("citrus", 4)])
+def test_revolution_fit_is_the_twins(monkeypatch, kind, seed):
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.02 * seed], noise=0.002 * (seed % 3),
+                               rotation=rotation(10 * seed, 20, 30 * seed), seed=seed)  # fmt: skip
+    fast, twin = _both(monkeypatch, fit_revolution_slices, visible)
+    np.testing.assert_allclose(fast.direction, twin.direction, atol=1e-12)
+    np.testing.assert_allclose(fast.point, twin.point, atol=1e-9)  # a nanometre
+    np.testing.assert_allclose(fast.radii, twin.radii, atol=1e-9)
+    np.testing.assert_allclose(fast.edges, twin.edges, atol=1e-9)
+    assert fast.cost == pytest.approx(twin.cost, rel=1e-6)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(20, 400), st.floats(0.0, 0.003))
+def test_revolution_profile_is_the_twins(seed, n, noise):
+    """The profile about a given direction (its algebraic start, Gauss-Newton, slices and cost) of a noisy
+    circular cylinder's visible side, tilted at random."""
+    from symfruit.core.fits import _revolution_profile
+    from symfruit.core.points import perpendicular_basis
+
+    rng = np.random.default_rng(seed)
+    phi, h = rng.uniform(-1.2, 1.2, n), rng.uniform(-0.03, 0.03, n)
+    radius = rng.uniform(0.01, 0.04)
+    local = np.c_[radius * np.sin(phi), h, -radius * np.cos(phi)] + rng.normal(scale=noise, size=(n, 3))
+    rot, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    q = local @ rot.T
+    q -= q.mean(axis=0)
+    best = rot[:, 1] + rng.normal(scale=0.02, size=3)  # about the axis, as the search leaves it
+    best /= np.linalg.norm(best)
+    e1, e2 = perpendicular_basis(best[None, :])
+    fast = _jit.revolution_profile(q, best, e1[0], e2[0], 16, 5)
+    twin = _revolution_profile(q, best, e1[0], e2[0], 16, 5)
+    assert fast[4] and twin[4]
+    np.testing.assert_allclose(fast[0], twin[0], atol=1e-10)
+    np.testing.assert_allclose(fast[1], twin[1], atol=1e-15)
+    np.testing.assert_allclose(fast[2], twin[2], atol=1e-10)
+    assert fast[3] == pytest.approx(twin[3], rel=1e-6, abs=1e-18)
+
+
+def test_revolution_profile_of_points_on_a_line_leaves_it_to_the_twin():
+    """Every point on the axis: the algebraic start's 2x2 system is singular; the kernel says so (the twin's
+    least squares takes its minimum-norm solution) and fit_revolution_slices runs the twin."""
+    from symfruit.core.fits import _revolution_profile
+
+    q = np.c_[np.zeros(30), np.linspace(-0.02, 0.02, 30), np.zeros(30)]
+    best, e1, e2 = np.array([0.0, 1.0, 0.0]), np.array([0.0, 0.0, 1.0]), np.array([1.0, 0.0, 0.0])
+    assert not _jit.revolution_profile(q, best, e1, e2, 16, 5)[4]
+    a2, _, radii, cost, _ = _revolution_profile(q, best, e1, e2, 16, 5)
+    assert np.allclose(a2, 0.0) and np.allclose(radii[np.isfinite(radii)], 0.0) and cost == pytest.approx(0.0)
+
+
+# --- the sphere -------------------------------------------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(0.01, 0.06), st.floats(0.0, 0.002), st.floats(20.0, 90.0))
+def test_sphere_fit_is_the_twins(seed, radius, noise, cap_deg):
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(400, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = d[d[:, 2] < -np.cos(np.radians(cap_deg))]
+    if len(d) < 20:
+        return
+    pts = radius * d + CENTRE + rng.normal(scale=noise, size=d.shape)
+    with pytest.MonkeyPatch.context() as mp:
+        (c, r), (c_twin, r_twin) = _both(mp, fit_sphere, pts)
+    assert np.linalg.norm(c - c_twin) < 1e-9 and abs(r - r_twin) < 1e-9
+
+
+def test_sphere_steps_of_an_exact_sphere_stay_on_it():
+    pts = random_sphere(300, radius=0.04, seed=2) - CENTRE
+    c = np.array([0.003, -0.002, 0.001])
+    r, ok = _jit.sphere_steps(pts, c, 0.035, 20, 1e-12, 1.0)
+    assert ok and r == pytest.approx(0.04, abs=1e-12)
+    np.testing.assert_allclose(c, 0.0, atol=1e-12)
+
+
+def test_sphere_steps_report_a_singular_system():
+    """Every point at the centre: the Jacobian's direction columns are zero, the normal equations singular."""
+    c = np.zeros(3)
+    _, ok = _jit.sphere_steps(np.zeros((10, 3)), c, 1.0, 5, 1e-7, 1.0)
+    assert not ok
+
+
+# --- marching a solid of revolution -----------------------------------------------------------------------
+
+
+def _lemon_revolution(seed: int):
+    rng = np.random.default_rng(seed)
+    fruit = FRUITS["lemon"](rng)
+    visible, _ = rendered_view(fruit, [0.01, -0.01, 0.35], noise=0.001, rotation=rotation(10 * seed, 40, 30 * seed),
+                               seed=seed)  # fmt: skip
+    return fit_revolution_slices(visible), visible
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(12, 40), st.booleans())
+def test_revolution_march_is_the_twins(seed, steps, close):
+    from symfruit.core.agreement import march
+    from symfruit.core.fits import RevolutionInside, closed_profile
+
+    rev, visible = _lemon_revolution(seed % 4)
+    rng = np.random.default_rng(seed)
+    centre = visible.mean(axis=0)
+    rays = np.c_[centre[:2] / centre[2] + rng.normal(0.0, 0.08, (200, 2)), np.ones(200)]  # hits and misses
+    z0, z1 = float(visible[:, 2].min()) - 0.03, float(visible[:, 2].max()) + 0.05
+    inside = RevolutionInside(rev, close=close)
+    t, r = closed_profile(rev, close=close)
+    hit, depth = _jit.revolution_march(rev.point, rev.direction, t, r, rays, z0, z1, steps)
+    hit_twin, depth_twin = march(inside, rays, z0, z1, steps=steps)
+    assert np.array_equal(hit, hit_twin) and hit.any() and not hit.all()
+    np.testing.assert_allclose(depth[hit], depth_twin[hit], atol=1e-12)
+    assert np.isnan(depth[~hit]).all()
+
+
+def test_revolution_inside_marches_its_rays_only_with_the_kernels(monkeypatch):
+    from symfruit.core.fits import RevolutionInside, revolution_inside
+
+    rev, visible = _lemon_revolution(1)
+    inside = RevolutionInside(rev)
+    assert np.array_equal(inside(visible), revolution_inside(rev, visible))
+    rays = visible[::50] / visible[::50, 2:3]
+    hit, depth = inside.march(rays, 0.2, 0.5, 24)
+    assert hit.shape == depth.shape == (len(rays),) and hit.mean() > 0.8  # most rays through seen points meet it
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    assert inside.march(rays, 0.2, 0.5, 24) is None  # explain() then marches with core.agreement.march
