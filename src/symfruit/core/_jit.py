@@ -226,6 +226,15 @@ def sphere_steps(
 
 
 @_njit
+def _per_slice(sums: np.ndarray, cnt: np.ndarray) -> None:
+    """Each slice's sums (3, b) divided by its count (b,), in place: the slice means."""
+    for s in range(cnt.shape[0]):
+        sums[0, s] /= cnt[s]
+        sums[1, s] /= cnt[s]
+        sums[2, s] /= cnt[s]
+
+
+@_njit
 def revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.ndarray, steps: int) -> None:
     """:func:`symfruit.core.fits.fit_revolution_slices`' Gauss-Newton on the axis position ``a2`` (2,), updated in
     place: the points' plane coordinates ``w`` (n, 2) about the axis at ``a2`` less their slice's mean distance
@@ -248,10 +257,7 @@ def revolution_steps(w: np.ndarray, which: np.ndarray, cnt: np.ndarray, a2: np.n
             sums[0, s] += r
             sums[1, s] += j0[i]
             sums[2, s] += j1[i]
-        for s in range(b):
-            sums[0, s] /= cnt[s]
-            sums[1, s] /= cnt[s]
-            sums[2, s] /= cnt[s]
+        _per_slice(sums, cnt)
         a11 = a12 = a22 = g0 = g1 = 0.0
         for i in range(n):
             s = which[i]
@@ -309,10 +315,7 @@ def revolution_profile(
         sums[1, s] += x0
         sums[2, s] += x1
     cnt = np.maximum(counts, 1.0)
-    for s in range(bins):
-        sums[0, s] /= cnt[s]
-        sums[1, s] /= cnt[s]
-        sums[2, s] /= cnt[s]
+    _per_slice(sums, cnt)
     # the algebraic start: least squares of 2 dw . a = dy by its normal equations
     a11 = a12 = a22 = g0 = g1 = 0.0
     for i in range(n):
