@@ -342,6 +342,47 @@ def test_cone_fronts_from_the_cone_are_the_ellipsoids_fronts(seed):
         assert np.all(np.isfinite(fronts[k]) | ~hit)  # a ray the ellipsoid's own quadric meets has a front
 
 
+@pytest.mark.parametrize("t,thickness", [(0.07, 0.25), (0.02, 0.25), (0.07, 0.5), (0.3, 1.0)])
+def test_cone_thickness_bound_is_the_ratio_on_the_axis(t, thickness):
+    """Known answer: a cone about the optical axis with half-angle tangent ``t``, its centre on the axis, at the
+    bound the ellipsoid is ``thickness`` times its width deep; any positive scale of the cone, the same bound."""
+    from symfruit.core.fits import cone_thickness_bound
+
+    cone = np.diag([1.0, 1.0, -t * t])
+    tau = cone_thickness_bound(cone, thickness)
+    assert tau == pytest.approx(-2.0 * np.log(thickness * t))
+    assert cone_thickness_bound(7.0 * cone, thickness) == pytest.approx(tau)
+    _, shape, valid = cone_ellipsoid(np.array([[0.0, 0.0, np.log(0.5), tau]]), cone, np.array([0.0, 0.0, 1.0]))
+    assert valid[0]
+    assert np.sqrt(shape[0, 2, 2] / shape[0, 0, 0]) == pytest.approx(thickness, rel=1e-9)
+    assert cone_thickness_bound(cone, 0.0) == np.inf
+
+
+def test_cone_fit_of_a_banana_from_the_side_is_no_disc_and_no_matter_of_rounding():
+    """A banana whose front the fit matched best by a flat tilted disc (the shape parameter ran to about 30,
+    the logistic saturated): without the bound the fit is a disc; with it the ellipsoid keeps a thickness, and
+    moving every point by one unit in the last place moves the fit by nanometres at most, its back face's
+    uncertainty a fruit's, not 0.03 mm."""
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    fruit = FRUITS["banana"](np.random.default_rng(3))
+    visible, _ = rendered_view(fruit, [0.0, -0.01, 0.35], noise=0.01, rotation=rotation(30, 60, 20), seed=3)
+    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    front, extent = float(visible[:, 2].min()), float(np.ptp(visible, axis=0).max())
+    disc = fit_cone_ellipsoid(visible, cone=cone, axis=axis, front=front, extent=extent, min_thickness=0.0)
+    assert np.sqrt(max(np.linalg.eigvalsh(disc.shape)[0], 0.0)) < 5e-4  # a disc: under half a millimetre thick
+    fit = fit_cone_ellipsoid(visible, cone=cone, axis=axis, front=front, extent=extent)
+    assert np.sqrt(np.linalg.eigvalsh(fit.shape)[0]) > 2e-3
+    assert fit.back_std > 5e-4
+    rng = np.random.default_rng(1)
+    for _ in range(3):
+        moved = visible * (1.0 + rng.choice([-1.0, 1.0], visible.shape) * 2.2e-16)
+        other = fit_cone_ellipsoid(moved, cone=cone, axis=axis, front=front, extent=extent)
+        np.testing.assert_allclose(other.centre, fit.centre, rtol=0, atol=1e-9)
+        np.testing.assert_allclose(other.shape, fit.shape, rtol=0, atol=1e-12)
+
+
 def test_cone_ellipsoid_of_a_noisy_ball_is_the_ball():
     from symfruit import DEFAULT_CAMERA
     from symfruit.core.raster import silhouette, silhouette_cone
