@@ -404,3 +404,137 @@ def revolution_march(
                 break
             before = f
     return hit, depth
+
+
+@_njit
+def cone_residuals(
+    params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
+    out: np.ndarray,
+) -> None:  # fmt: skip
+    """The depth residuals (k, n) into ``out`` of :func:`symfruit.core.fits.fit_cone_ellipsoid`: ``z`` less the front
+    of each ellipsoid of :func:`symfruit.core.fits._cone_fronts` (parameters (k, 4)) along each ray, 0.05 for an
+    invalid ellipsoid's row, 0.02 where a ray misses (or the logistic has saturated: ``gap`` 0, no front)."""
+    k, n = params.shape[0], rays.shape[0]
+    for j in range(k):
+        e = math.exp(params[j, 2])
+        m0 = (axis[0] + params[j, 0]) * e
+        m1 = (axis[1] + params[j, 1]) * e
+        m2 = axis[2] * e
+        c0 = m0 * cone[0, 0] + m1 * cone[1, 0] + m2 * cone[2, 0]
+        c1 = m0 * cone[0, 1] + m1 * cone[1, 1] + m2 * cone[2, 1]
+        c2 = m0 * cone[0, 2] + m1 * cone[1, 2] + m2 * cone[2, 2]
+        qq = -(c0 * m0 + c1 * m1 + c2 * m2)
+        if not qq > 0:
+            out[j, :] = 0.05
+            continue
+        lam = qq / (1.0 + math.exp(-min(max(params[j, 3], -50.0), 50.0)))
+        gap = lam - qq
+        for i in range(n):
+            rcm = c0 * rays[i, 0] + c1 * rays[i, 1] + c2 * rays[i, 2]
+            a = ray_cone[i] / lam - rcm * rcm / (lam * gap)
+            b = rcm / gap
+            c = -lam / gap
+            disc = b * b - a * c
+            res = z[i] - (b - math.sqrt(disc)) / a if disc >= 0 else np.nan
+            out[j, i] = res if math.isfinite(res) else 0.02
+
+
+@_njit
+def huber_cost(res: np.ndarray, huber: float) -> float:
+    """The Huber cost of one row of residuals (``fit_cone_ellipsoid``'s ``cost``)."""
+    total = 0.0
+    for i in range(res.shape[0]):
+        a = abs(res[i])
+        total += 0.5 * res[i] * res[i] if a <= huber else huber * (a - 0.5 * huber)
+    return total
+
+
+@_njit
+def cone_fit(
+    grid: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
+    step: np.ndarray, huber: float, iterations: int, tolerance: float, tau_max: float,
+) -> tuple[np.ndarray, np.ndarray, int]:  # fmt: skip
+    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s grid search and Levenberg-Marquardt (its twin
+    :func:`symfruit.core.fits._cone_steps`), the shape parameter bounded by ``tau_max`` (an active set of one
+    bound): the parameters (4,), the residuals at them and at each finite-difference step (5, n), and a status:
+    0 done, 1 no finite cost on the grid, 2 a singular damped system (numpy's ``solve`` raises there; the caller
+    runs the twin)."""
+    n, k = rays.shape[0], grid.shape[0]
+    res = np.empty((k, n))
+    cone_residuals(grid, cone, axis, rays, ray_cone, z, res)
+    best, current = -1, np.inf
+    for j in range(k):
+        cj = huber_cost(res[j], huber)
+        if cj < current:  # the first least, as np.argmin
+            best, current = j, cj
+    at = np.empty((5, 4))
+    both = np.empty((5, n))
+    if best < 0:
+        return at[0], both, 1
+    p = grid[best].copy()
+    for a in range(5):
+        for b in range(4):
+            at[a, b] = p[b] + step[b] if a == b + 1 else p[b]
+    cone_residuals(at, cone, axis, rays, ray_cone, z, both)
+    trial_both = np.empty((5, n))
+    current = huber_cost(both[0], huber)
+    mu = 1e-2
+    jac = np.empty((4, n))
+    w = np.empty(n)
+    jtj = np.empty((4, 4))
+    g = np.empty(4)
+    lhs4, rhs4, x4 = np.empty((4, 4)), np.empty(4), np.empty(4)
+    lhs3, rhs3, x3 = np.empty((3, 3)), np.empty(3), np.empty(3)
+    trial = np.empty(4)
+    for _ in range(iterations):
+        done = False
+        for i in range(n):
+            ri = both[0, i]
+            a = abs(ri)
+            w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
+            for b in range(4):
+                jac[b, i] = (both[b + 1, i] - ri) / step[b]
+        for a in range(4):
+            s = 0.0
+            for i in range(n):
+                s += jac[a, i] * w[i] * both[0, i]
+            g[a] = s
+            for b in range(a, 4):
+                s = 0.0
+                for i in range(n):
+                    s += jac[a, i] * w[i] * jac[b, i]
+                jtj[a, b] = s
+                jtj[b, a] = s
+        improved = False
+        # at the bound with the cost falling beyond it, tau stays there and the other three are solved for alone
+        free = 3 if p[3] >= tau_max and g[3] < 0 else 4
+        lhs, rhs, x = (lhs3, rhs3, x3) if free == 3 else (lhs4, rhs4, x4)
+        while mu < 1e6:
+            for a in range(free):
+                for b in range(free):
+                    lhs[a, b] = jtj[a, b]
+                lhs[a, a] += mu * (jtj[a, a] + 1e-12)
+                rhs[a] = g[a]
+            if not solve(lhs, rhs, x):
+                return p, both, 2
+            for b in range(4):
+                trial[b] = p[b] - x[b] if b < free else p[b]
+            if trial[3] > tau_max:
+                trial[3] = tau_max
+            for a in range(5):
+                for b in range(4):
+                    at[a, b] = trial[b] + step[b] if a == b + 1 else trial[b]
+            cone_residuals(at, cone, axis, rays, ray_cone, z, trial_both)
+            new = huber_cost(trial_both[0], huber)
+            if new < current:
+                p = trial.copy()
+                both, trial_both = trial_both, both
+                mu = max(mu / 3.0, 1e-7)
+                improved = True
+                done = current - new < tolerance * current
+                current = new
+                break
+            mu *= 4.0
+        if not improved or done:
+            break
+    return p, both, 0
