@@ -344,6 +344,13 @@ def write_pcd(path, points, mode, extra_field=False):
 
 
 @pytest.fixture
+def numpy_twins(monkeypatch):
+    """The numpy twins of the compiled kernels (:mod:`symfruit.core.kernels`) for the test: for tests that pin the
+    numpy formulation's values bit for bit (the kernels agree with them to rounding)."""
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+
+
+@pytest.fixture
 def camera() -> symfruit.Camera:
     return symfruit.DEFAULT_CAMERA
 

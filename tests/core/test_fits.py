@@ -551,8 +551,9 @@ def _former_fit_cone_ellipsoid(points, *, cone, axis, front, extent, huber=0.003
 
 
 @pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3)])
-def test_cone_fit_is_the_former_fit_to_the_bit(kind, seed):
-    """The trial step and the Jacobian about it evaluated in one call change no value of the fit."""
+def test_cone_fit_is_the_former_fit_to_the_bit(kind, seed, numpy_twins):
+    """The trial step and the Jacobian about it evaluated in one call change no value of the fit (the numpy twin
+    of the compiled kernel: tests/core/test_kernels.py compares the two)."""
     from symfruit import DEFAULT_CAMERA
     from symfruit.core.raster import silhouette, silhouette_cone
 

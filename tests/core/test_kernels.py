@@ -15,7 +15,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
-from symfruit.core.fits import _slice_costs, fit_revolution_slices, fit_sphere
+from symfruit.core.fits import _slice_costs, fit_cone_ellipsoid, fit_revolution_slices, fit_sphere
 from symfruit.synthetic.shapes import FRUITS, rotation
 
 from ..conftest import CENTRE, random_sphere, rendered_view
@@ -212,6 +212,104 @@ def test_sphere_steps_report_a_singular_system():
     c = np.zeros(3)
     _, ok = _jit.sphere_steps(np.zeros((10, 3)), c, 1.0, 5, 1e-7, 1.0)
     assert not ok
+
+
+# --- the cone ellipsoid -----------------------------------------------------------------------------------
+
+
+def _cone_view(kind: str, seed: int, noise: float = 0.01, turn: tuple[float, float, float] | None = None):
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.raster import silhouette, silhouette_cone
+
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    turn = (10 * seed, 20, 30 * seed) if turn is None else turn
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35 + 0.03 * seed], noise=noise, rotation=rotation(*turn),
+                               seed=seed)  # fmt: skip
+    cone, axis = silhouette_cone(silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    return visible, cone, axis, float(visible[:, 2].min()), float(np.ptp(visible, axis=0).max())
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_cone_residuals_are_the_twins(seed):
+    """Shape parameters within the fit's reach (its grid spans -4..4): beyond about 20 the logistic's gap
+    ``lambda - q`` has lost its digits and a ray near tangency may hit in one path and miss in the other."""
+    from symfruit.core.fits import _cone_fronts
+
+    visible, cone, axis, _, _ = _cone_view("apple", 1)
+    rng = np.random.default_rng(seed)
+    pts = visible[rng.choice(len(visible), 50, replace=False)]
+    rays, z = pts / pts[:, 2:3], np.ascontiguousarray(pts[:, 2])
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    params = np.c_[rng.normal(0.0, 0.02, (30, 2)), np.log(rng.uniform(0.2, 0.8, 30)), rng.uniform(-10, 10, 30)]
+    params[0, 3] = 60.0  # a saturated logistic: no front on any ray (the twin's NaN rows)
+    params[1, :2] = 1.0  # a centre outside the cone: no ellipsoid (the twin's invalid rows)
+    fronts, valid = _cone_fronts(params, cone, axis, rays, ray_cone)
+    twin = np.where(valid[:, None], z[None, :] - fronts, 0.05)
+    twin = np.where(np.isfinite(twin), twin, 0.02)
+    out = np.empty_like(twin)
+    _jit.cone_residuals(params, cone, axis, rays, ray_cone, z, out)
+    np.testing.assert_allclose(out, twin, atol=1e-8)  # 10 nm: the front's root cancels a few digits
+    assert (out[0] == 0.02).all() and (out[1] == 0.05).all()
+    assert _jit.huber_cost(out[2], 0.003) == pytest.approx(
+        np.where(np.abs(out[2]) <= 0.003, 0.5 * out[2] ** 2, 0.003 * (np.abs(out[2]) - 0.0015)).sum(), rel=1e-12
+    )
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_cone_shape_is_cone_ellipsoid(seed):
+    from symfruit.core.fits import cone_ellipsoid
+
+    _, cone, axis, _, _ = _cone_view("pear", 2)
+    rng = np.random.default_rng(seed)
+    p = np.array([*rng.normal(0.0, 0.05, 2), np.log(rng.uniform(0.2, 0.8)), rng.uniform(-60, 60)])
+    m, shape, valid = cone_ellipsoid(p[None], cone, axis)
+    got_m, got_shape = np.empty(3), np.empty((3, 3))
+    assert _jit._cone_shape(p, cone, axis, np.linalg.inv(cone), got_m, got_shape) == valid[0]
+    np.testing.assert_allclose(got_m, m[0], rtol=1e-14)
+    np.testing.assert_allclose(got_shape, shape[0], rtol=1e-9, atol=1e-15)  # NaN where invalid, in both
+
+
+_CONE_VIEWS = [(kind, seed) for kind in ("strawberry", "apple", "pear", "lemon", "plum", "banana") for seed in range(3)]
+
+
+@pytest.mark.parametrize("kind,seed", _CONE_VIEWS)
+def test_cone_fit_is_the_twins(monkeypatch, kind, seed):
+    visible, cone, axis, front, extent = _cone_view(kind, seed, turn=(10 * seed + 7, 20 + 13 * seed, 30 * seed))
+    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, visible, cone=cone, axis=axis, front=front, extent=extent)
+    np.testing.assert_allclose(fast.centre, twin.centre, rtol=0, atol=1e-9)  # a nanometre (measured: under 4e-12)
+    np.testing.assert_allclose(np.sqrt(np.diag(fast.shape)), np.sqrt(np.diag(twin.shape)), rtol=0, atol=1e-9)
+    assert fast.back_std == pytest.approx(twin.back_std, rel=1e-6) and fast.rms == pytest.approx(twin.rms, rel=1e-6)
+
+
+def test_cone_fit_at_the_thickness_bound_is_the_twins(monkeypatch):
+    """The banana whose unbounded fit is a flat disc (tests/core/test_fits.py): the kernel's fit stops at the
+    bound, tau held there by the active set as in the twin, and both agree to a nanometre."""
+    from symfruit.core.fits import _cone_grid, cone_thickness_bound
+
+    visible, cone, axis, front, extent = _cone_view("banana", 3, turn=(30, 60, 20))
+    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, visible, cone=cone, axis=axis, front=front, extent=extent)
+    np.testing.assert_allclose(fast.centre, twin.centre, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(np.sqrt(np.diag(fast.shape)), np.sqrt(np.diag(twin.shape)), rtol=0, atol=1e-9)
+    pts = visible[:: -(-len(visible) // 300)]
+    rays, z = pts / pts[:, 2:3], np.ascontiguousarray(pts[:, 2])
+    tau_max = cone_thickness_bound(cone, 0.25)
+    grid = _cone_grid(front, extent)
+    np.minimum(grid[:, 3], tau_max, out=grid[:, 3])
+    step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
+    args = (grid, cone, axis, rays, ((rays @ cone) * rays).sum(axis=1), z, step, 0.003, 10, 1e-4)
+    p, _, status = _jit.cone_fit(*args, tau_max)
+    assert status == 0 and p[3] == tau_max  # held at the bound
+    p_free, _, _ = _jit.cone_fit(*args, np.inf)
+    assert p_free[3] > tau_max + 10.0  # unbounded, it runs on into the disc
+
+
+def test_cone_fit_of_points_outside_the_cone_is_the_twins(monkeypatch):
+    """Points whose rays no ellipsoid of the cone meets: every residual is the misses' constant, so the costs
+    stay finite and the fit goes on; both paths end where they start, the grid's first best."""
+    visible, cone, axis, front, extent = _cone_view("apple", 1, noise=0.0)
+    far = visible + np.array([0.5, 0.0, 0.0])  # the points' rays outside the cone
+    fast, twin = _both(monkeypatch, fit_cone_ellipsoid, far, cone=cone, axis=axis, front=front, extent=extent)
+    np.testing.assert_allclose(fast.centre, twin.centre, rtol=0, atol=1e-9)
 
 
 # --- marching a solid of revolution -----------------------------------------------------------------------

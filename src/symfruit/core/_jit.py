@@ -538,3 +538,96 @@ def cone_fit(
         if not improved or done:
             break
     return p, both, 0
+
+
+@_njit
+def _cone_shape(
+    p: np.ndarray, cone: np.ndarray, axis: np.ndarray, cone_inv: np.ndarray, m: np.ndarray, shape: np.ndarray
+) -> bool:
+    """:func:`symfruit.core.fits.cone_ellipsoid` of one parameter vector ``p`` (4,): its centre into ``m`` (3,) and
+    its shape into ``shape`` (3, 3) (NaN where the centre falls outside the cone), and whether it is valid."""
+    e = math.exp(p[2])
+    m[0] = e * (axis[0] + p[0])
+    m[1] = e * (axis[1] + p[1])
+    m[2] = e * (axis[2] + 0.0)
+    q = 0.0
+    for j in range(3):
+        q += (m[0] * cone[0, j] + m[1] * cone[1, j] + m[2] * cone[2, j]) * m[j]
+    q = -q
+    valid = q > 0
+    lam = (q if valid else np.nan) / (1.0 + math.exp(-min(max(p[3], -50.0), 50.0)))
+    for a in range(3):
+        for b in range(3):
+            shape[a, b] = lam * cone_inv[a, b] + m[a] * m[b]
+    return valid
+
+
+@_njit
+def cone_result(
+    p: np.ndarray, both: np.ndarray, step: np.ndarray, huber: float, cone: np.ndarray, axis: np.ndarray,
+    cone_inv: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, bool, float, float]:  # fmt: skip
+    """The end of :func:`symfruit.core.fits.fit_cone_ellipsoid` after :func:`cone_fit`, from its parameters ``p`` (4,)
+    and residuals ``both`` (5, n): the centre (3,), the shape (3, 3), whether it is valid, the back face's standard
+    deviation (the parameters' covariance ``sigma^2 (J^T W J)^-1`` carried to ``z_c + sqrt(S_zz)`` by finite
+    differences; NaN where the 4x4 matrix is singular, as the twin's where numpy's ``inv`` raises) and the rms."""
+    n = both.shape[1]
+    m = np.empty(3)
+    shape = np.empty((3, 3))
+    valid = _cone_shape(p, cone, axis, cone_inv, m, shape)
+    if not valid:
+        return m, shape, False, np.nan, np.nan
+    w = np.empty(n)
+    jac = np.empty((4, n))
+    top = bottom = 0.0
+    for i in range(n):
+        ri = both[0, i]
+        a = abs(ri)
+        w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
+        top += w[i] * ri * ri
+        bottom += w[i]
+        for b in range(4):
+            jac[b, i] = (both[b + 1, i] - ri) / step[b]
+    sigma2 = top / max(bottom - 4.0, 1.0)
+    jtj = np.empty((4, 4))
+    for a in range(4):
+        for b in range(a, 4):
+            s = 0.0
+            for i in range(n):
+                s += jac[a, i] * w[i] * jac[b, i]
+            jtj[a, b] = s
+            jtj[b, a] = s
+        jtj[a, a] += 1e-18
+    cov = np.empty((4, 4))
+    lhs = np.empty((4, 4))
+    unit = np.empty(4)
+    col = np.empty(4)
+    for b in range(4):  # the inverse, column by column
+        lhs[:] = jtj
+        unit[:] = 0.0
+        unit[b] = 1.0
+        if not solve(lhs, unit, col):
+            cov[:] = np.nan
+            break
+        for a in range(4):
+            cov[a, b] = sigma2 * col[a]
+    back = m[2] + math.sqrt(shape[2, 2])
+    grad = np.empty(4)
+    mb = np.empty(3)
+    sb = np.empty((3, 3))
+    pb = np.empty(4)
+    all_valid = True
+    for b in range(4):
+        pb[:] = p
+        pb[b] += step[b]
+        all_valid &= _cone_shape(pb, cone, axis, cone_inv, mb, sb)
+        grad[b] = (mb[2] + math.sqrt(sb[2, 2]) - back) / step[b]
+    var = 0.0
+    for b in range(4):
+        s = 0.0
+        for a in range(4):
+            s += grad[a] * cov[a, b]
+        var += s * grad[b]
+    if var < 0.0:
+        var = 0.0
+    return m, shape, True, math.sqrt(var) if all_valid else np.nan, math.sqrt(sigma2)

@@ -980,47 +980,49 @@ def fit_cone_ellipsoid(
         a = np.abs(res)
         return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
 
-    status = -1
-    if (jit := compiled()) is not None:  # the compiled twin of the grid search and the loop below
+    if (jit := compiled()) is not None:  # the compiled twin of the grid search, the loop and the back face below
+        cone_c, axis_c = np.ascontiguousarray(cone), np.ascontiguousarray(axis)
         p, both, status = jit.cone_fit(
-            grid, np.ascontiguousarray(cone), np.ascontiguousarray(axis), np.ascontiguousarray(rays), ray_cone,
-            np.ascontiguousarray(z), step, huber, iterations, tolerance, tau_max,
-        )  # fmt: skip
-        r, r_steps = both[0], both[1:]
-    if status != 0:  # no kernel, no finite cost (1) or a singular damped system in it (2): the numpy twin
-        costs = cost(residuals(grid))
-        if not np.isfinite(costs).any():
-            raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
-        p = grid[int(np.argmin(costs))]
-        r, r_steps = with_steps(p)
-        current, mu = float(cost(r)), 1e-2
-        for _ in range(iterations):
-            done = False
-            jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
-            a = np.abs(r)
-            w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
-            jtj = (jac * w) @ jac.T
-            g = (jac * w) @ r
-            improved = False
-            # At the thickness bound with the cost falling beyond it, ``tau`` stays there and the other three
-            # parameters are solved for alone (an active set of one bound).
-            free = slice(0, 3) if p[3] >= tau_max and g[3] < 0 else slice(0, 4)
-            while mu < 1e6:
-                delta = np.zeros(4)
-                sub = jtj[free, free]
-                delta[free] = -np.linalg.solve(sub + mu * np.diag(np.diag(sub) + 1e-12), g[free])
-                trial = p + delta
-                trial[3] = min(trial[3], tau_max)
-                r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
-                new = float(cost(r_new))
-                if new < current:
-                    p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
-                    done = current - new < tolerance * current
-                    current = new
-                    break
-                mu *= 4.0
-            if not improved or done:
+            grid, cone_c, axis_c, rays, ray_cone, np.ascontiguousarray(z), step, huber, iterations, tolerance, tau_max
+        )
+        if status == 0:  # else no finite cost (1) or a singular damped system (2): the twin decides
+            centre, shape, valid, back_std, rms = jit.cone_result(p, both, step, huber, cone_c, axis_c, cone_inv)
+            if not valid:
+                raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
+            return ConeFit(centre, shape, back_std, rms)
+    costs = cost(residuals(grid))
+    if not np.isfinite(costs).any():
+        raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
+    p = grid[int(np.argmin(costs))]
+    r, r_steps = with_steps(p)
+    current, mu = float(cost(r)), 1e-2
+    for _ in range(iterations):
+        done = False
+        jac = (r_steps - r[None]) / step[:, None]  # (4, n), forward differences
+        a = np.abs(r)
+        w = np.where(a <= huber, 1.0, huber / np.maximum(a, 1e-12))
+        jtj = (jac * w) @ jac.T
+        g = (jac * w) @ r
+        improved = False
+        # At the thickness bound with the cost falling beyond it, ``tau`` stays there and the other three
+        # parameters are solved for alone (an active set of one bound).
+        free = slice(0, 3) if p[3] >= tau_max and g[3] < 0 else slice(0, 4)
+        while mu < 1e6:
+            delta = np.zeros(4)
+            sub = jtj[free, free]
+            delta[free] = -np.linalg.solve(sub + mu * np.diag(np.diag(sub) + 1e-12), g[free])
+            trial = p + delta
+            trial[3] = min(trial[3], tau_max)
+            r_new, r_new_steps = with_steps(trial)  # the next Jacobian's evaluations too, should it be taken
+            new = float(cost(r_new))
+            if new < current:
+                p, r, r_steps, mu, improved = trial, r_new, r_new_steps, max(mu / 3.0, 1e-7), True
+                done = current - new < tolerance * current
+                current = new
                 break
+            mu *= 4.0
+        if not improved or done:
+            break
     m, shape, valid = cone_ellipsoid(p[None], cone, axis)
     if not valid[0]:
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
