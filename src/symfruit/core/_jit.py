@@ -425,7 +425,8 @@ def cone_residuals(
         c2 = m0 * cone[0, 2] + m1 * cone[1, 2] + m2 * cone[2, 2]
         qq = -(c0 * m0 + c1 * m1 + c2 * m2)
         if not qq > 0:
-            out[j, :] = 0.05
+            for i in range(n):
+                out[j, i] = 0.05
             continue
         lam = qq / (1.0 + math.exp(-min(max(params[j, 3], -50.0), 50.0)))
         gap = lam - qq
@@ -602,15 +603,21 @@ def cone_result(
     lhs = np.empty((4, 4))
     unit = np.empty(4)
     col = np.empty(4)
-    for b in range(4):  # the inverse, column by column
-        lhs[:] = jtj
-        unit[:] = 0.0
-        unit[b] = 1.0
+    singular = False
+    for b in range(4):  # the inverse, column by column (element loops: slice copies cost seconds to compile)
+        for a in range(4):
+            for c in range(4):
+                lhs[a, c] = jtj[a, c]
+            unit[a] = 1.0 if a == b else 0.0
         if not solve(lhs, unit, col):
-            cov[:] = np.nan
+            singular = True
             break
         for a in range(4):
             cov[a, b] = sigma2 * col[a]
+    if singular:  # numpy's inv raises: the twin's covariance is NaN
+        for a in range(4):
+            for c in range(4):
+                cov[a, c] = np.nan
     back = m[2] + math.sqrt(shape[2, 2])
     grad = np.empty(4)
     mb = np.empty(3)
@@ -618,9 +625,9 @@ def cone_result(
     pb = np.empty(4)
     all_valid = True
     for b in range(4):
-        pb[:] = p
-        pb[b] += step[b]
-        all_valid &= _cone_shape(pb, cone, axis, cone_inv, mb, sb)
+        for a in range(4):
+            pb[a] = p[a] + step[a] if a == b else p[a]
+        all_valid = _cone_shape(pb, cone, axis, cone_inv, mb, sb) and all_valid
         grad[b] = (mb[2] + math.sqrt(sb[2, 2]) - back) / step[b]
     var = 0.0
     for b in range(4):
