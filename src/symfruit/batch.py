@@ -489,16 +489,18 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     return out
 
 
-def _read_depth(path: Path, scale: float, shape: tuple[int, int]) -> np.ndarray:
-    """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape``."""
+def _read_depth(path: Path, scale: float, shape: tuple[int, int], image: Path) -> np.ndarray:
+    """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape`` (that
+    of ``image``, as read)."""
     from .io.frames import read_depth_npy
-    from .io.images import read_depth_units
+    from .io.images import read_depth_units, turned_mismatch
 
     if path.suffix.lower() == ".npy":
         depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
     else:
         depth = read_depth_units(path, scale=scale).astype(np.float64) * scale
     if depth.shape != shape:
+        turned_mismatch(image, shape, {str(path): depth.shape})
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth
 
@@ -616,7 +618,7 @@ def segment_images(
         Only for the batch as a whole: no images, depth without a camera, an unusable mask source or
         output folder.
     """
-    from .io.images import read_color
+    from .io.images import read_color, turned_mismatch
     from .writers import write_label_overlay, write_labels
 
     images = expand_images(paths)
@@ -649,13 +651,14 @@ def segment_images(
                 def one_image(path: Path = path, targets: tuple[Path, Path] = targets) -> SegmentedImage:
                     color = read_color(path)
                     dfile = _depth_file(path, depth_path, len(images))
-                    z = _read_depth(dfile, depth_scale, color.shape[:2]) if dfile is not None else None
+                    z = _read_depth(dfile, depth_scale, color.shape[:2], path) if dfile is not None else None
                     if z is not None:
                         _check_camera(camera, color.shape[:2], path)
                     t0 = time.perf_counter()
                     labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
                     ms = (time.perf_counter() - t0) * 1000.0
                     if labels.shape != color.shape[:2]:
+                        turned_mismatch(path, color.shape, {"the mask source's labels": labels.shape})
                         raise InputError(f"{path.name}: the mask source gave labels {labels.dtype} {labels.shape}, "
                                          f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
                     labels = instance_labels(labels, f"{path.name}: the mask source's labels")
@@ -696,6 +699,9 @@ def _check_camera(camera: Any, shape: tuple[int, ...], path: Path) -> None:
     """Intrinsics with a size must be for this image's size (as ``detect`` refuses them for a frame)."""
     w, h = getattr(camera, "width", None), getattr(camera, "height", None)
     if w is not None and h is not None and (int(w), int(h)) != (shape[1], shape[0]):
+        from .io.images import turned_mismatch
+
+        turned_mismatch(path, shape, {"the intrinsics (--camera)": (int(h), int(w))})
         raise InputError(f"{path}: the intrinsics (--camera) are for {w}x{h} but the image is {shape[1]}x{shape[0]}; "
                          "give the intrinsics of this resolution")  # fmt: skip
 

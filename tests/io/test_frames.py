@@ -286,3 +286,26 @@ def test_truth_survives_any_json(tmp_path, data):
     except SymfruitError:
         return
     assert all(isinstance(k, int) and box.min.shape == (3,) for k, box in truth)
+
+
+def test_a_phone_photo_turned_by_its_exif_orientation_must_agree_with_depth_and_intrinsics(tmp_path):
+    cam = Camera(fx=50, fy=50, cx=20, cy=15, width=40, height=30)
+    yy, xx = np.mgrid[0:30, 0:40]
+    color = np.stack([xx * 6, yy * 8, np.full_like(xx, 128)], axis=2).astype(np.uint8)  # smooth: JPEG keeps it
+    write_frame(tmp_path / "f", color, np.full((30, 40), 0.5, np.float32), cam)
+    (tmp_path / "f" / "color.png").unlink()
+    exif = Image.Exif()
+    exif[0x0112] = 6  # shown turned a quarter clockwise: 30x40
+    Image.fromarray(color).save(tmp_path / "f" / "color.jpg", exif=exif, quality=95)
+    with pytest.raises(FileFormatError, match=r"color\.jpg: its EXIF orientation 6 turns it a quarter on reading .*"
+                       r"40x30 stored, 30x40 shown\), but depth\.png and the intrinsics \(camera\.json\) are for the "
+                       r"stored 40x30 pixels"):  # fmt: skip
+        read_frame(tmp_path / "f")
+    # depth and intrinsics for the image as displayed: read as displayed
+    turned = Camera(fx=50, fy=50, cx=15, cy=20, width=30, height=40)
+    write_frame(tmp_path / "g", np.rot90(color, -1), np.full((40, 30), 0.5, np.float32), turned)
+    (tmp_path / "g" / "color.png").unlink()
+    shutil.copy(tmp_path / "f" / "color.jpg", tmp_path / "g" / "color.jpg")
+    frame = read_frame(tmp_path / "g")
+    assert frame.color.shape == (40, 30, 3)
+    assert np.abs(frame.color.astype(int) - np.rot90(color, -1)).max() <= 8  # JPEG: close, not equal

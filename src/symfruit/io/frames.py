@@ -2,7 +2,7 @@
 
 A frame folder holds::
 
-    color.png | color.jpg     colour image, 8-bit RGB
+    color.png | color.jpg     colour image, 8-bit RGB, read as displayed (an EXIF orientation applied)
     depth.png                 depth aligned to colour, 16-bit, times depth_scale metres per unit
     depth.npy                 ... or depth as float metres (0 or NaN: no depth)
     camera.json | .yaml       intrinsics in any layout symfruit reads; an optional "depth_scale"
@@ -28,7 +28,7 @@ from ..core.frame import Frame
 from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
-from .images import read_color, read_depth_units
+from .images import read_color, read_depth_units, turned_mismatch
 from .text import as_path, read_structured
 
 __all__ = [
@@ -93,6 +93,9 @@ def read_frame(folder: str | Path) -> Frame:
         depth = read_depth_npy(depth_npy)
     else:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
+    depth_name = depth_png.name if depth_png.is_file() else depth_npy.name
+    sizes = {depth_name: depth.shape[:2], f"the intrinsics ({cam_path.name})": (camera.height, camera.width)}
+    turned_mismatch(color_path, color.shape, sizes)  # depth and intrinsics for the stored pixels: said so
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if (folder / "truth.json").is_file() else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)

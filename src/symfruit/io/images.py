@@ -13,6 +13,11 @@ labels         ``1``, ``L``, ``P`` (palette indices are the labels), ``I;16*``, 
                int32``; ``RGB``/``RGBA`` -> one label per distinct colour, black = background
 =============  ==============================================================================
 
+Images are read as displayed: an EXIF orientation (phone photos: 6 and 8 turn them a quarter) is applied
+to every image read, colour, depth and labels alike (:func:`exif_orientation`). Where a colour image is
+turned a quarter and its depth or intrinsics are for its stored size, readers refuse the pair naming the
+file and its orientation (:func:`turned_mismatch`), never pair turned colour with unturned depth.
+
 Every error names the file and the problem (:class:`~symfruit.errors.FileFormatError`); Pillow's own
 errors, including its decompression-bomb error, never escape.
 """
@@ -31,7 +36,16 @@ from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  #
 from ..errors import FileFormatError
 from .text import as_path, refuse_pipe
 
-__all__ = ["MAX_IMAGE_PIXELS", "decode_color", "image_suffixes", "read_color", "read_depth_units", "read_labels"]
+__all__ = [
+    "MAX_IMAGE_PIXELS",
+    "decode_color",
+    "exif_orientation",
+    "image_suffixes",
+    "read_color",
+    "read_depth_units",
+    "read_labels",
+    "turned_mismatch",
+]
 
 #: Suffixes Pillow opens that symfruit reads as something else (``.pcd``: a point cloud, not a Kodak PhotoCD).
 _NOT_IMAGES = {".pcd"}
@@ -80,6 +94,7 @@ def _open(source: Path | bytes, label: str) -> Any:
 
 
 def _decode(img: Any, label: str) -> Any:
+    """The decoded image, turned as its EXIF orientation says (a new image where it is not 1)."""
     from PIL import Image
 
     try:
@@ -88,7 +103,55 @@ def _decode(img: Any, label: str) -> Any:
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
-    return img
+    turn = _TRANSPOSE.get(_orientation(img))
+    return img if turn is None else img.transpose(Image.Transpose[turn])
+
+
+#: EXIF orientation -> the ``Image.Transpose`` that shows the image as displayed (2-8; 1 is as stored): as
+#: ``PIL.ImageOps.exif_transpose``, which also rewrites the metadata (not needed: pixels are all that is read).
+_TRANSPOSE = {2: "FLIP_LEFT_RIGHT", 3: "ROTATE_180", 4: "FLIP_TOP_BOTTOM", 5: "TRANSPOSE", 6: "ROTATE_270",
+              7: "TRANSVERSE", 8: "ROTATE_90"}  # fmt: skip
+#: Orientations that turn an image a quarter: its width and height swap on reading.
+QUARTER_TURNS = frozenset({5, 6, 7, 8})
+
+
+def _orientation(img: Any) -> int:
+    """The EXIF orientation of an opened image, 1 where it has none or an unreadable one (viewers show such
+    an image as stored too)."""
+    try:
+        value = img.getexif().get(0x0112, 1)
+    except Exception:  # Pillow's EXIF parser raises many types on a damaged block
+        return 1
+    return value if isinstance(value, int) and value in _TRANSPOSE else 1  # 1 and nonsense: as stored
+
+
+def exif_orientation(path: str | Path) -> int:
+    """The EXIF orientation (1-8) of an image file, read from its header; 1 where it has none."""
+    path = as_path(path, "exif_orientation: the image")
+    with _open(path, str(path)) as img:
+        return _orientation(img)
+
+
+def turned_mismatch(color_path: Path, shape: tuple[int, ...], others: dict[str, tuple[int, ...]]) -> None:
+    """Refuse a colour image that its EXIF orientation turned a quarter on reading (``shape``, as read)
+    while ``others`` (what -> its ``(h, w)``: the depth image, the intrinsics) are for its stored size.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the colour file, its orientation and what has the stored size.
+    """
+    h, w = shape[:2]
+    stored = [what for what, size in others.items() if tuple(size[:2]) == (w, h) and w != h]
+    if not stored:
+        return
+    orientation = exif_orientation(color_path)
+    if orientation not in QUARTER_TURNS:
+        return
+    raise FileFormatError(f"{color_path}: its EXIF orientation {orientation} turns it a quarter on reading (images "
+                          f"are read as displayed: {h}x{w} stored, {w}x{h} shown), but {' and '.join(stored)} "
+                          f"{'are' if len(stored) > 1 else 'is'} for the stored {h}x{w} pixels; save the colour "
+                          "image turned as displayed (or without its orientation tag) so that all agree")  # fmt: skip
 
 
 #: Pixels converted at a time: a decoded image is copied out of Pillow in bands of rows, so reading one costs
