@@ -218,13 +218,24 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ({"fruits": [{"min": [-1e308] * 3, "max": [1e308] * 3}]}, "more than 100 m from the camera"),
         ({"fruits": [{"min": [10**400, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, "int too large to convert to float"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2**40}]}, "id must be a whole number in 0-"),
+        # a misspelt key was dropped: "rip": false counted an unripe fruit as a target
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "rip": False}]}, r"unknown key 'rip'; did you "
+         "mean 'ripe'"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "Visible": 0.5}]}, "did you mean 'visible'"),
     ],
-)
+)  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):
     path = tmp_path / "truth.json"
     path.write_text(json.dumps(truth))
     with pytest.raises(FileFormatError, match=rf"truth\.json: expected .*{message}"):
         read_truth(path)
+
+
+def test_truth_keys_other_tools_write_beside_the_read_ones_are_left_alone(tmp_path):
+    fruit = {"id": 3, "ripe": True, "kind": "strawberry", "centre": [0.05, 0.05, 0.35], "size": [0.1] * 3,
+             "min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "visible_box": {}, "mask_area": 10, "score": 0.5}  # fmt: skip
+    (tmp_path / "truth.json").write_text(json.dumps({"fruits": [fruit]}))
+    assert [i for i, _ in read_truth(tmp_path / "truth.json")] == [3]
 
 
 def test_an_unreadable_truth_file_is_named(tmp_path, monkeypatch):

@@ -9,7 +9,8 @@ A frame folder holds::
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
     masks.json                optional: COCO-style annotations (polygons or RLE)
-    truth.json                optional: {"fruits": [{"id", "min", "max", "visible", ...}]}, true boxes in metres
+    truth.json                optional: {"fruits": [{"id", "min", "max", "visible", "ripe", ...}]}, true boxes in
+                              metres (other keys left alone, one a letter or two from these refused)
 
 A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
@@ -159,6 +160,7 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         for k, item in enumerate(fruits, 1):
             if not isinstance(item, dict):
                 raise TypeError(f"fruit {k} is not an object")
+            _misspelt_truth_key(item, k)
             if item.get("ripe", True) is False:
                 continue
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
@@ -183,6 +185,24 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         raise FileFormatError(
             f"{path}: expected {{'fruits': [{{'min': [x, y, z], 'max': [x, y, z]}}]}} ({exc})"
         ) from None
+
+
+#: The keys of a truth fruit that are read; other keys (a scene's ``kind``, ``centre``, ``size``, a detection's
+#: fields) are kept out of the way, but one a letter or two from these is a misspelling that would be dropped.
+TRUTH_KEYS = ("id", "min", "max", "ripe", "visible")
+
+
+def _misspelt_truth_key(item: dict[str, Any], k: int) -> None:
+    import difflib
+
+    for key in item:
+        if not isinstance(key, str) or key in TRUTH_KEYS:
+            continue
+        close = difflib.get_close_matches(key.lower(), TRUTH_KEYS, n=1, cutoff=0.75)
+        # a letter or two off ("rip": false would count an unripe fruit as a target), not a longer name that
+        # holds one ("visible_box" of a detection)
+        if close and abs(len(key) - len(close[0])) <= 2 and close[0] not in item:
+            raise ValueError(f"fruit {k}: unknown key {key!r}; did you mean {close[0]!r}?")
 
 
 def write_frame(
