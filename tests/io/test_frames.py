@@ -320,3 +320,20 @@ def test_a_phone_photo_turned_by_its_exif_orientation_must_agree_with_depth_and_
     frame = read_frame(tmp_path / "g")
     assert frame.color.shape == (40, 30, 3)
     assert np.abs(frame.color.astype(int) - np.rot90(color, -1)).max() <= 8  # JPEG: close, not equal
+
+
+@pytest.mark.parametrize("name", ["color.png", "depth.png", "camera.json", "masks.png", "truth.json"])
+@pytest.mark.parametrize("kind", ["directory", "link loop", "dangling link"])
+def test_a_frame_file_that_is_no_file_is_refused_by_name_not_taken_as_missing(tmp_path, name, kind):
+    # a masks.png or truth.json folder was "no masks" / "no truth" (colour segmenter, no scores), in silence
+    frame = tmp_path / "f"
+    color, depth = disc_frame([(80, 60)])
+    write_frame(frame, color, depth, CAM, truth={"fruits": []}, masks=np.zeros((120, 160), np.int32))
+    (frame / name).unlink()
+    if kind == "directory":
+        (frame / name).mkdir()
+    else:
+        (frame / name).symlink_to(name if kind == "link loop" else "gone.png")
+    why = "a directory, not a file" if kind == "directory" else "a link that leads to no file"
+    with pytest.raises(FileFormatError, match=rf"f/{re.escape(name)}: {why}"):
+        read_frame(frame)

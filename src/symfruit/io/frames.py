@@ -18,6 +18,7 @@ ROS 2 bag folder (:mod:`.bags`).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -52,14 +53,32 @@ MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
 
 def _first(folder: Path, *names: str) -> Path | None:
     for name in names:
-        if (folder / name).is_file():
+        if _holds(folder / name):
             return folder / name
     return None
 
 
+def _holds(path: Path) -> bool:
+    """Whether a frame folder holds the file ``path``. An entry of that name that is no file (a directory, a
+    link whose target is missing or that links in a loop, a pipe) is refused by name: it is never read as
+    "no such file" (a ``masks.png`` folder would quietly mean no masks)."""
+    if path.is_file():
+        return True
+    if not os.path.lexists(path):
+        return False
+    if path.is_dir():
+        why = "a directory, not a file"
+    elif path.is_symlink():
+        why = "a link that leads to no file (its target is missing, or the links loop)"
+    else:
+        why = "not a regular file"
+    raise FileFormatError(f"{path}: {why}")
+
+
 def is_frame_folder(folder: Path) -> bool:
-    """Whether ``folder`` holds a colour image under one of :data:`COLOR_NAMES`."""
-    return folder.is_dir() and _first(folder, *COLOR_NAMES) is not None
+    """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
+    that name is then refused by name when the frame is read)."""
+    return folder.is_dir() and any(os.path.lexists(folder / name) for name in COLOR_NAMES)
 
 
 def read_frame(folder: str | Path) -> Frame:
@@ -88,17 +107,18 @@ def read_frame(folder: str | Path) -> Frame:
     scale = _depth_scale(cam_path, cam_data)
     color = read_color(color_path)
     depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
-    if depth_png.is_file():
-        depth = read_depth_units(depth_png, scale=scale).astype(np.float32) * np.float32(scale)
-    elif depth_npy.is_file():
-        depth = read_depth_npy(depth_npy)
-    else:
+    depth_file = _first(folder, "depth.png", "depth.npy")
+    if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
-    depth_name = depth_png.name if depth_png.is_file() else depth_npy.name
+    if depth_file == depth_png:
+        depth = read_depth_units(depth_png, scale=scale).astype(np.float32) * np.float32(scale)
+    else:
+        depth = read_depth_npy(depth_npy)
+    depth_name = depth_file.name
     sizes = {depth_name: depth.shape[:2], f"the intrinsics ({cam_path.name})": (camera.height, camera.width)}
     turned_mismatch(color_path, color.shape, sizes)  # depth and intrinsics for the stored pixels: said so
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
-    truth, visible = _truth(folder / "truth.json") if (folder / "truth.json").is_file() else (None, {})
+    truth, visible = _truth(folder / "truth.json") if _holds(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
 
 
