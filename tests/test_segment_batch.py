@@ -78,6 +78,19 @@ def test_a_photo_turned_by_its_exif_orientation_is_segmented_as_displayed_and_st
                      r"stored 320x240 pixels", next(iter(bad.failed.values())))  # fmt: skip
 
 
+def test_a_depth_entry_that_is_no_file_is_refused_not_passed_over_for_colour_alone(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    (depth / "p0.png").mkdir()  # was "no depth for p0": segmented on colour alone, in silence
+    cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
+    report = segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert not report.done and re.search(r"depth/p0\.png: a directory, not a file", next(iter(report.failed.values())))
+    (folder / "loop.jpg").symlink_to("loop.jpg")
+    with pytest.raises(FileFormatError, match=r"loop\.jpg: a link that leads to no file"):
+        segment_images([folder / "loop.jpg"], output=tmp_path / "o2")
+
+
 def test_depth_from_a_folder_is_used_and_needs_a_camera(tmp_path):
     folder = _photos(tmp_path / "in", n=1)
     depth = tmp_path / "depth"

@@ -30,6 +30,7 @@ from .io.frames import is_frame_folder
 from .io.images import image_suffixes
 from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, unique_names, write_record
 from .io.sources import open_source
+from .io.text import holds_file
 from .methods import DEFAULT_METHOD
 from .progress import Progress
 from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_run_tables
@@ -480,7 +481,7 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
         if p.is_dir():
             listed = [q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES and not q.name.startswith(".")]
             out += sorted(q for q in listed if not q.is_dir())
-        elif p.is_file():
+        elif holds_file(p):  # a dangling or looping link is said to be one
             out.append(p)
         else:
             raise FileFormatError(f"{p}: no such image or folder")
@@ -511,7 +512,7 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
     if depth.is_dir():
         for name in (image.stem, image.stem + "_depth"):
             for suffix in (".png", ".npy"):
-                if (depth / (name + suffix)).is_file():
+                if holds_file(depth / (name + suffix)):  # one that is no file is refused, not passed over
                     return depth / (name + suffix)
         return None
     if n_images != 1:

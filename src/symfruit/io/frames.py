@@ -31,7 +31,7 @@ from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import read_color, read_depth_units, turned_mismatch
-from .text import as_path, read_structured
+from .text import as_path, holds_file, read_structured
 
 __all__ = [
     "COLOR_NAMES",
@@ -53,26 +53,9 @@ MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
 
 def _first(folder: Path, *names: str) -> Path | None:
     for name in names:
-        if _holds(folder / name):
+        if holds_file(folder / name):
             return folder / name
     return None
-
-
-def _holds(path: Path) -> bool:
-    """Whether a frame folder holds the file ``path``. An entry of that name that is no file (a directory, a
-    link whose target is missing or that links in a loop, a pipe) is refused by name: it is never read as
-    "no such file" (a ``masks.png`` folder would quietly mean no masks)."""
-    if path.is_file():
-        return True
-    if not os.path.lexists(path):
-        return False
-    if path.is_dir():
-        why = "a directory, not a file"
-    elif path.is_symlink():
-        why = "a link that leads to no file (its target is missing, or the links loop)"
-    else:
-        why = "not a regular file"
-    raise FileFormatError(f"{path}: {why}")
 
 
 def is_frame_folder(folder: Path) -> bool:
@@ -118,7 +101,7 @@ def read_frame(folder: str | Path) -> Frame:
     sizes = {depth_name: depth.shape[:2], f"the intrinsics ({cam_path.name})": (camera.height, camera.width)}
     turned_mismatch(color_path, color.shape, sizes)  # depth and intrinsics for the stored pixels: said so
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
-    truth, visible = _truth(folder / "truth.json") if _holds(folder / "truth.json") else (None, {})
+    truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
 
 
