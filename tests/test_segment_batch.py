@@ -74,8 +74,8 @@ def test_a_photo_turned_by_its_exif_orientation_is_segmented_as_displayed_and_st
     Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "p0.png")  # for the stored pixels
     cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
     bad = segment_images([tmp_path / "in"], output=tmp_path / "o2", depth=depth, camera=cam)
-    assert re.search(r"p0\.jpg: its EXIF orientation 8 turns it a quarter on reading .*, but .*p0\.png is for the "
-                     r"stored 320x240 pixels", next(iter(bad.failed.values())))  # fmt: skip
+    assert re.search(r"p0\.jpg: its EXIF orientation 8 \(turned a quarter anticlockwise\) is applied on reading "
+                     r".*, but p0\.png has 1 \(as stored\)", next(iter(bad.failed.values())))  # fmt: skip
 
 
 def test_a_depth_entry_that_is_no_file_is_refused_not_passed_over_for_colour_alone(tmp_path):

@@ -490,18 +490,20 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     return out
 
 
-def _read_depth(path: Path, scale: float, shape: tuple[int, int], image: Path) -> np.ndarray:
+def _read_depth(path: Path, scale: float, shape: tuple[int, int], image: Path, orientation: int) -> np.ndarray:
     """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape`` (that
-    of ``image``, as read)."""
+    of ``image`` as read, its EXIF ``orientation`` applied: the depth's must be the same)."""
     from .io.frames import read_depth_npy
-    from .io.images import read_depth_units, turned_mismatch
+    from .io.images import orientation_mismatch, read_depth_units_oriented
 
+    depth_orientation = 1  # a .npy array has none
     if path.suffix.lower() == ".npy":
         depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
     else:
-        depth = read_depth_units(path, scale=scale).astype(np.float64) * scale
+        units, depth_orientation = read_depth_units_oriented(path, scale=scale)
+        depth = units.astype(np.float64) * scale
+    orientation_mismatch(image, orientation, path, depth_orientation)
     if depth.shape != shape:
-        turned_mismatch(image, shape, {str(path): depth.shape})
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth
 
@@ -619,7 +621,7 @@ def segment_images(
         Only for the batch as a whole: no images, depth without a camera, an unusable mask source or
         output folder.
     """
-    from .io.images import read_color, turned_mismatch
+    from .io.images import read_color_oriented, turned_mismatch
     from .writers import write_label_overlay, write_labels
 
     images = expand_images(paths)
@@ -650,9 +652,9 @@ def segment_images(
                 targets = (output / f"{stem}.png", output / f"{stem}_overlay.png")
 
                 def one_image(path: Path = path, targets: tuple[Path, Path] = targets) -> SegmentedImage:
-                    color = read_color(path)
+                    color, turned = read_color_oriented(path)
                     dfile = _depth_file(path, depth_path, len(images))
-                    z = _read_depth(dfile, depth_scale, color.shape[:2], path) if dfile is not None else None
+                    z = _read_depth(dfile, depth_scale, color.shape[:2], path, turned) if dfile is not None else None
                     if z is not None:
                         _check_camera(camera, color.shape[:2], path)
                     t0 = time.perf_counter()

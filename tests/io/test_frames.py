@@ -303,22 +303,34 @@ def test_a_phone_photo_turned_by_its_exif_orientation_must_agree_with_depth_and_
     cam = Camera(fx=50, fy=50, cx=20, cy=15, width=40, height=30)
     yy, xx = np.mgrid[0:30, 0:40]
     color = np.stack([xx * 6, yy * 8, np.full_like(xx, 128)], axis=2).astype(np.uint8)  # smooth: JPEG keeps it
-    write_frame(tmp_path / "f", color, np.full((30, 40), 0.5, np.float32), cam)
-    (tmp_path / "f" / "color.png").unlink()
-    exif = Image.Exif()
-    exif[0x0112] = 6  # shown turned a quarter clockwise: 30x40
-    Image.fromarray(color).save(tmp_path / "f" / "color.jpg", exif=exif, quality=95)
-    with pytest.raises(FileFormatError, match=r"color\.jpg: its EXIF orientation 6 turns it a quarter on reading .*"
-                       r"40x30 stored, 30x40 shown\), but depth\.png and the intrinsics \(camera\.json\) are for the "
-                       r"stored 40x30 pixels"):  # fmt: skip
-        read_frame(tmp_path / "f")
-    # depth and intrinsics for the image as displayed: read as displayed
-    turned = Camera(fx=50, fy=50, cx=15, cy=20, width=30, height=40)
-    write_frame(tmp_path / "g", np.rot90(color, -1), np.full((40, 30), 0.5, np.float32), turned)
-    (tmp_path / "g" / "color.png").unlink()
-    shutil.copy(tmp_path / "f" / "color.jpg", tmp_path / "g" / "color.jpg")
-    frame = read_frame(tmp_path / "g")
-    assert frame.color.shape == (40, 30, 3)
+    depth = np.full((30, 40), 0.5, np.float32)
+
+    def tagged(img, path, orientation):
+        exif = Image.Exif()
+        exif[0x0112] = orientation
+        img.save(path, exif=exif, quality=95)
+
+    for orientation, does in ((6, "turned a quarter clockwise"), (3, "turned half around")):  # 3: sizes agree
+        folder = tmp_path / f"o{orientation}"
+        write_frame(folder, color, depth, cam)
+        (folder / "color.png").unlink()
+        tagged(Image.fromarray(color), folder / "color.jpg", orientation)
+        said = (rf"o{orientation}/color\.jpg: its EXIF orientation {orientation} \({does}\) is applied on reading "
+                r"\(images are read as displayed\), but depth\.png has 1 \(as stored\): depth registered to the "
+                r"stored pixels would meet other pixels")  # fmt: skip
+        with pytest.raises(FileFormatError, match=said):
+            read_frame(folder)
+    # depth tagged alike: both read as displayed; intrinsics for the stored pixels are then said to be so
+    folder = tmp_path / "o6"
+    with Image.open(folder / "depth.png") as img:
+        tagged(img.copy(), folder / "depth.png", 6)
+    said = (r"color\.jpg: its EXIF orientation 6 turns it a quarter on reading .*40x30 stored, 30x40 shown\), but "
+            r"the intrinsics \(camera\.json\) is for the stored 40x30")  # fmt: skip
+    with pytest.raises(FileFormatError, match=said):
+        read_frame(folder)
+    (folder / "camera.json").write_text(json.dumps(Camera(fx=50, fy=50, cx=15, cy=20, width=30, height=40).to_dict()))
+    frame = read_frame(folder)
+    assert frame.color.shape == (40, 30, 3) and frame.depth.shape == (40, 30)
     assert np.abs(frame.color.astype(int) - np.rot90(color, -1)).max() <= 8  # JPEG: close, not equal
 
 

@@ -30,7 +30,7 @@ from ..core.frame import Frame
 from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
-from .images import read_color, read_depth_units, turned_mismatch
+from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
 from .text import as_path, holds_file, read_structured
 
 __all__ = [
@@ -88,18 +88,20 @@ def read_frame(folder: str | Path) -> Frame:
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
-    color = read_color(color_path)
+    color, color_orientation = read_color_oriented(color_path)
     depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
     depth_file = _first(folder, "depth.png", "depth.npy")
     if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
+    depth_orientation = 1  # a .npy array has none
     if depth_file == depth_png:
-        depth = read_depth_units(depth_png, scale=scale).astype(np.float32) * np.float32(scale)
+        units, depth_orientation = read_depth_units_oriented(depth_png, scale=scale)
+        depth = units.astype(np.float32) * np.float32(scale)
     else:
         depth = read_depth_npy(depth_npy)
-    depth_name = depth_file.name
-    sizes = {depth_name: depth.shape[:2], f"the intrinsics ({cam_path.name})": (camera.height, camera.width)}
-    turned_mismatch(color_path, color.shape, sizes)  # depth and intrinsics for the stored pixels: said so
+    # depth registered to a phone photo's stored pixels, or intrinsics for them: said so, never paired turned
+    orientation_mismatch(color_path, color_orientation, depth_file, depth_orientation)
+    turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
