@@ -17,7 +17,8 @@ Images are read as displayed: an EXIF orientation (phone photos: 6 and 8 turn th
 to every image read, colour, depth and labels alike (:func:`exif_orientation`). Where colour and depth
 carry different orientations (:func:`orientation_mismatch`), or a colour image is turned a quarter beside
 intrinsics for its stored size (:func:`turned_mismatch`), readers refuse them naming the file and its
-orientation, never pair turned colour with unturned depth.
+orientation, never pair turned colour with unturned depth (:func:`decode_color`, a message's image beside
+raw depth, refuses a tag).
 
 Every error names the file and the problem (:class:`~symfruit.errors.FileFormatError`); Pillow's own
 errors, including its decompression-bomb error, never escape.
@@ -236,9 +237,15 @@ def read_color_oriented(path: str | Path) -> tuple[np.ndarray, int]:
 
 
 def decode_color(data: bytes, label: str) -> np.ndarray:
-    """:func:`read_color` for encoded bytes (a ``CompressedImage``'s JPEG or PNG)."""
+    """:func:`read_color` for encoded bytes (a ``CompressedImage``'s JPEG or PNG). One that carries an EXIF
+    orientation is refused: a message's depth beside it is raw pixels, registered to the stored ones."""
     with _open(bytes(data), label) as img:
-        return _to_rgb(_decode(img, label)[0], label)
+        shown, orientation = _decode(img, label)
+        if orientation != 1:
+            raise FileFormatError(f"{label}: carries EXIF orientation {orientation} ({ORIENTATION_NAMES[orientation]} "
+                                  "on reading), but depth beside it is raw, registered to the stored pixels; "
+                                  "encode the image without an orientation tag")  # fmt: skip
+        return _to_rgb(shown, label)
 
 
 #: Depth an 8-bit depth image must reach (255 units times the depth scale, metres) to be read as depth: one
