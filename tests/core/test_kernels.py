@@ -1,8 +1,10 @@
-"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``, seeded and
-property-tested; the switch to the twins (``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
+"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``,
+``symfruit.core.raster`` and ``symfruit.core.occlusion``, seeded and property-tested; the switch to the twins
+(``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
 
-The kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
-iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm).
+The fits' kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
+iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm). The pixel maps'
+kernels (whole numbers, booleans) are compared to the bit.
 """
 
 import subprocess
@@ -255,3 +257,63 @@ def test_revolution_inside_marches_its_rays_only_with_the_kernels(monkeypatch):
     assert hit.shape == depth.shape == (len(rays),) and hit.mean() > 0.8  # most rays through seen points meet it
     monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
     assert inside.march(rays, 0.2, 0.5, 24) is None  # explain() then marches with core.agreement.march
+
+
+# --- the observation's pixel maps (core.raster, core.occlusion) ---------------------------------------------
+
+
+def _blobs(rng: np.random.Generator, h: int, w: int, share: float) -> np.ndarray:
+    """(h, w) bool: random pixels grown into blobs of a few pixels (edges, holes, thin parts and isolated pixels)."""
+    from scipy import ndimage
+
+    seeds = rng.random((h, w)) < share
+    return ndimage.binary_dilation(seeds, iterations=int(rng.integers(0, 4))) if seeds.any() else seeds
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 12.0), st.booleans())
+def test_near_distance_is_the_twins_to_the_bit(seed, h, w, reach, want):
+    from symfruit.core.raster import _near_distance
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.1))
+    out = np.full((h, w), -1.0)
+    _jit.near_distance(mask, reach, want, out)
+    assert np.array_equal(out, _near_distance(mask == want, reach))
+
+
+def test_the_distance_maps_are_the_twins_to_the_bit(monkeypatch):
+    """inner_distance and outer_distance, with the kernel and with the numpy twin: the same maps, to the bit, and
+    within reach scipy's transform's."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance, outer_distance
+
+    rng = np.random.default_rng(5)
+    mask = np.zeros((70, 90), bool)
+    mask[10:60, 15:80] = _blobs(rng, 50, 65, 0.3)
+    for reach in (2.5, 5.5, 10.7):
+        inner, inner_twin = _both(monkeypatch, inner_distance, mask, reach)
+        outer, outer_twin = _both(monkeypatch, outer_distance, mask, reach)
+        assert np.array_equal(inner, inner_twin) and np.array_equal(outer, outer_twin)
+        near = outer <= reach
+        assert near.any() and np.array_equal(outer[near], ndimage.distance_transform_edt(~mask)[near])
+        assert np.array_equal(inner[inner <= reach], ndimage.distance_transform_edt(mask)[inner <= reach])
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.integers(0, 4))
+def test_allowed_pixels_are_the_twins(seed, gap, thin):
+    """Occlusion.allowed (and so extent) with the kernel and with the numpy twin: the same pixels, on random hidden
+    blobs and seen regions reaching out of the window."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 60, 2))
+    occ = Occlusion(3, 4, _blobs(rng, h, w, rng.uniform(0.0, 0.15)), 100, 90)
+    rh, rw = (int(x) for x in rng.integers(3, 30, 2))
+    region = Silhouette(int(rng.integers(0, 50)), int(rng.integers(0, 50)), _blobs(rng, rh, rw, 0.2), 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occ.allowed, region, gap=gap, thin=thin)
+        assert np.array_equal(fast, twin)
+        box, box_twin = _both(mp, occ.extent, region, gap=gap, thin=thin)
+    assert np.array_equal(box, box_twin)

@@ -404,3 +404,148 @@ def revolution_march(
                 break
             before = f
     return hit, depth
+
+
+@_njit
+def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -> None:
+    """:func:`symfruit.core.raster._near_distance` of the pixels of ``mask`` (h, w) equal to ``want`` (the twin's
+    true pixels), written into ``out`` (h, w): each pixel's distance to the nearest such pixel where that is at most
+    ``reach``, +inf elsewhere. The same whole-number squared distances as the twin's shifts (each column's distance
+    to its nearest pixel, capped past the reach, by two sweeps; then the nearest over ``2 floor(reach) + 1``
+    columns), and the same square roots: the twin's values to the bit."""
+    h, w = mask.shape
+    k = math.floor(reach)
+    cap = k + 1
+    g2 = np.empty((h, w), np.int64)
+    for c in range(w):
+        last = -cap  # the row of the last wanted pixel above, or far enough to be beyond reach
+        for r in range(h):
+            if mask[r, c] == want:
+                last = r
+            g2[r, c] = min(r - last, cap)
+        last = h - 1 + cap
+        for r in range(h - 1, -1, -1):
+            if mask[r, c] == want:
+                last = r
+            g2[r, c] = min(g2[r, c], last - r)
+    for r in range(h):
+        for c in range(w):
+            g2[r, c] *= g2[r, c]
+    limit = reach * reach
+    for r in range(h):
+        for c in range(w):
+            best = g2[r, c]
+            for t in range(1, k + 1):
+                tt = t * t
+                if tt >= best:  # farther columns cannot be nearer
+                    break
+                if c - t >= 0 and g2[r, c - t] + tt < best:
+                    best = g2[r, c - t] + tt
+                if c + t < w and g2[r, c + t] + tt < best:
+                    best = g2[r, c + t] + tt
+            out[r, c] = math.sqrt(float(best)) if best <= limit else np.inf
+
+
+@_njit
+def _square_filter(src: np.ndarray, radius: int, every: bool, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the minimum (``every``: all of the square true) or maximum (any true) of ``src`` (h, w)
+    over the ``2 radius + 1`` square about each pixel, outside the array false (``ndimage.minimum_filter`` /
+    ``maximum_filter`` with ``mode="constant", cval=False``), by running counts along the rows, then down the
+    columns (row by row, in memory order)."""
+    h, w = src.shape
+    size = 2 * radius + 1
+    rows = np.empty((h, w), np.bool_)
+    count = np.empty(w + 1, np.int64)
+    for r in range(h):
+        count[0] = 0
+        for c in range(w):
+            count[c + 1] = count[c] + src[r, c]
+        if every:
+            for c in range(w):
+                rows[r, c] = c >= radius and c + radius < w and count[c + radius + 1] - count[c - radius] == size
+        else:
+            for c in range(w):
+                rows[r, c] = count[min(c + radius + 1, w)] - count[max(c - radius, 0)] > 0
+    cols = np.zeros((h + 1, w), np.int64)  # cols[r, c]: true pixels of rows[:r, c]
+    for r in range(h):
+        for c in range(w):
+            cols[r + 1, c] = cols[r, c] + rows[r, c]
+    for r in range(h):
+        if every:
+            if r < radius or r + radius >= h:
+                out[r, :] = False
+                continue
+            for c in range(w):
+                out[r, c] = cols[r + radius + 1, c] - cols[r - radius, c] == size
+        else:
+            a, b = max(r - radius, 0), min(r + radius + 1, h)
+            for c in range(w):
+                out[r, c] = cols[b, c] - cols[a, c] > 0
+
+
+@_njit
+def _box(mask: np.ndarray) -> tuple[int, int, int, int]:
+    """``(r0, r1, c0, c1)`` of a bool image's true pixels (stops exclusive), ``(0, 0, 0, 0)`` when none."""
+    h, w = mask.shape
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                r0, r1 = min(r0, r), r + 1
+                c0, c1 = min(c0, c), max(c1, c + 1)
+    return (r0, r1, c0, c1) if r1 > 0 else (0, 0, 0, 0)
+
+
+@_njit
+def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.ndarray:
+    """:meth:`symfruit.core.occlusion.Occlusion.allowed` of a window's ``hidden`` and ``seen`` pixels (h, w) bool
+    (``seen`` not empty): the 8-connected parts of ``hidden`` (opened by a ``2 thin + 1`` square when ``thin >
+    0``, over the hidden pixels' box), ``seen`` and their joins across ``gap`` (over the seen pixels' box grown
+    by ``2 gap``, as the twin's filters) that hold a seen pixel, by a flood fill from the seen pixels; the twin's
+    pixels exactly (booleans)."""
+    h, w = hidden.shape
+    join = hidden.copy()
+    if thin > 0:
+        b0, b1, a0, a1 = _box(hidden)
+        if b1 > b0:
+            part = hidden[b0:b1, a0:a1]
+            eroded = np.empty(part.shape, np.bool_)
+            _square_filter(part, thin, True, eroded)
+            _square_filter(eroded, thin, False, join[b0:b1, a0:a1])
+    if gap > 0:
+        s0, s1, t0, t1 = _box(seen)
+        b0, b1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+        a0, a1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
+        grown = np.empty((b1 - b0, a1 - a0), np.bool_)
+        _square_filter(seen[b0:b1, a0:a1], gap, False, grown)
+        near = np.empty((b1 - b0, a1 - a0), np.bool_)
+        _square_filter(join[b0:b1, a0:a1], gap, False, near)
+        for r in range(b1 - b0):
+            for c in range(a1 - a0):
+                if grown[r, c] and near[r, c]:
+                    join[b0 + r, a0 + c] = True
+    out = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            if seen[r, c]:
+                out[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        for dr in range(-1, 2):
+            rr = r + dr
+            if rr < 0 or rr >= h:
+                continue
+            for dc in range(-1, 2):
+                cc = c + dc
+                if cc < 0 or cc >= w or out[rr, cc]:
+                    continue
+                if join[rr, cc] or seen[rr, cc]:
+                    out[rr, cc] = True
+                    stack[top] = rr * w + cc
+                    top += 1
+    return out

@@ -21,6 +21,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from .camera import Camera
+from .kernels import compiled
 from .limits import check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box
@@ -187,13 +188,6 @@ class Occlusion:
         + 1`` pixels (a stem) are left out first: a fruit cannot hide behind them.
         """
         h, w = self.hidden.shape
-        hidden = self.hidden
-        if thin > 0 and (box := mask_box(hidden)) is not None:
-            # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
-            # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
-            b0, b1, a0, a1 = box
-            hidden = np.zeros_like(self.hidden)
-            hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         rh, rw = region.mask.shape
         r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
         r1, c1 = min(region.v0 + rh, self.v0 + h), min(region.u0 + rw, self.u0 + w)
@@ -204,6 +198,15 @@ class Occlusion:
             ]
         if not seen.any():
             return seen
+        if (jit := compiled()) is not None:  # the compiled twin of what follows (the same pixels)
+            return jit.allowed(self.hidden, seen, gap, thin)
+        hidden = self.hidden
+        if thin > 0 and (box := mask_box(hidden)) is not None:
+            # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
+            # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
+            b0, b1, a0, a1 = box
+            hidden = np.zeros_like(self.hidden)
+            hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         allowed = hidden.copy()
         if gap > 0:
             # both filters only matter within ``gap`` of the seen pixels: run them on the seen box grown by
