@@ -317,3 +317,48 @@ def test_allowed_pixels_are_the_twins(seed, gap, thin):
         assert np.array_equal(fast, twin)
         box, box_twin = _both(mp, occ.extent, region, gap=gap, thin=thin)
     assert np.array_equal(box, box_twin)
+
+
+# --- the surface's noise (core.fits.surface_noise) ----------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(3, 400), st.integers(1, 60), st.integers(1, 12), st.integers(0, 40))
+def test_neighbour_covariances_are_the_twins(seed, n, step, small, extra):
+    """Random points (a tenth of them repeated: ties at distance 0, as a duplicated point gives): the same
+    neighbourhoods' covariances as the search tree's, within rounding."""
+    from symfruit.core.fits import _neighbour_covariances
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    pts[: n // 10] = pts[n // 10 : 2 * (n // 10)]
+    large = max(min(small + extra, n), 2)  # as surface_noise's (a search for one neighbour returns a flat array)
+    small = min(small, large)
+    fast = _jit.neighbour_covariances(pts, step, small, large)
+    twin = _neighbour_covariances(pts, step, small, large)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.shape == b.shape == (len(pts[::step]), 3, 3)
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
+
+
+@pytest.mark.parametrize("kind,noise,queries", [("apple", 0.0, 120), ("pear", 0.002, 40), ("banana", 0.001, 7)])
+def test_surface_noise_is_the_twins(monkeypatch, kind, noise, queries):
+    from symfruit.core.fits import surface_noise
+
+    fruit = FRUITS[kind](np.random.default_rng(3))
+    visible, _ = rendered_view(fruit, [0.01, -0.01, 0.4], noise=noise, rotation=rotation(10, 20, 30), seed=3)
+    (ratio, res, normals), (ratio_twin, res_twin, normals_twin) = _both(monkeypatch, surface_noise, visible,
+                                                                       queries=queries)  # fmt: skip
+    assert ratio == pytest.approx(ratio_twin, rel=1e-12) and res == pytest.approx(res_twin, rel=1e-12)
+    np.testing.assert_allclose(normals, normals_twin, atol=1e-9)
+
+
+def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
+    """Past _BRUTE_NEIGHBOURS distances the twin's search tree runs even with the kernels (the same results)."""
+    from symfruit.core import fits
+
+    pts = random_sphere(300, seed=4)
+    monkeypatch.setattr(fits, "_neighbour_covariances", lambda *a: (_ for _ in ()).throw(AssertionError("tree")))
+    fits.surface_noise(pts, queries=30)  # 300 x 30 distances: the kernel
+    monkeypatch.setattr(fits, "_BRUTE_NEIGHBOURS", 300 * 30 - 1)
+    with pytest.raises(AssertionError, match="tree"):
+        fits.surface_noise(pts, queries=30)

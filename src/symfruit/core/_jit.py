@@ -549,3 +549,59 @@ def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.nda
                     stack[top] = rr * w + cc
                     top += 1
     return out
+
+
+@_njit
+def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits._neighbour_covariances`: for each query point ``points[::step]``, the covariances
+    (3, 3) of its ``small`` and its ``large`` nearest points (itself among them; ``small <= large <= n``), each
+    about its own mean: ``(m, 3, 3), (m, 3, 3)``. The nearest by brute force (every squared distance, the
+    nearest ``large`` kept in order, ties by index: the same points as the twin's search tree but where a tie
+    straddles the last place), not a search tree: a few thousand points are fewer operations than building one."""
+    n = points.shape[0]
+    m = (n + step - 1) // step
+    out_small = np.empty((m, 3, 3))
+    out_large = np.empty((m, 3, 3))
+    best_d = np.empty(large)
+    best_i = np.empty(large, np.int64)
+    for q in range(m):
+        x, y, z = points[q * step, 0], points[q * step, 1], points[q * step, 2]
+        count = 0
+        for j in range(n):
+            dx, dy, dz = points[j, 0] - x, points[j, 1] - y, points[j, 2] - z
+            d = dx * dx + dy * dy + dz * dz
+            if count == large:
+                if not d < best_d[large - 1]:
+                    continue
+                slot = large - 1
+            else:
+                slot = count
+                count += 1
+            while slot > 0 and best_d[slot - 1] > d:  # insertion: the kept ones stay sorted, ties in index order
+                best_d[slot] = best_d[slot - 1]
+                best_i[slot] = best_i[slot - 1]
+                slot -= 1
+            best_d[slot] = d
+            best_i[slot] = j
+        for kk, out in ((small, out_small), (large, out_large)):
+            m0 = m1 = m2 = 0.0
+            for a in range(kk):
+                j = best_i[a]
+                m0 += points[j, 0]
+                m1 += points[j, 1]
+                m2 += points[j, 2]
+            m0, m1, m2 = m0 / kk, m1 / kk, m2 / kk
+            c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+            for a in range(kk):
+                j = best_i[a]
+                e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
+                c00 += e0 * e0
+                c01 += e0 * e1
+                c02 += e0 * e2
+                c11 += e1 * e1
+                c12 += e1 * e2
+                c22 += e2 * e2
+            out[q, 0, 0], out[q, 0, 1], out[q, 0, 2] = c00 / kk, c01 / kk, c02 / kk
+            out[q, 1, 0], out[q, 1, 1], out[q, 1, 2] = c01 / kk, c11 / kk, c12 / kk
+            out[q, 2, 0], out[q, 2, 1], out[q, 2, 2] = c02 / kk, c12 / kk, c22 / kk
+    return out_small, out_large

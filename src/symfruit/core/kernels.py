@@ -4,6 +4,7 @@ with numba from the optional extra ``fast``.
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed,
 or when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
 :func:`~symfruit.core.fits.fit_revolution_slices`, :class:`~symfruit.core.fits.RevolutionInside`,
+:func:`~symfruit.core.fits.surface_noise`,
 :func:`symfruit.core.raster.inner_distance` and :func:`~symfruit.core.raster.outer_distance`,
 :meth:`symfruit.core.occlusion.Occlusion.allowed`) then run their numpy twins, the code the kernels were written
 from, which stays tested and gives the same results within rounding (the fits' kernels sum in another order than
