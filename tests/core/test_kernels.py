@@ -300,6 +300,35 @@ def test_the_distance_maps_are_the_twins_to_the_bit(monkeypatch):
         assert np.array_equal(inner[inner <= reach], ndimage.distance_transform_edt(mask)[inner <= reach])
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 6), st.booleans())
+def test_square_filter_is_scipys(seed, h, w, radius, every):
+    from scipy import ndimage
+
+    mask = _blobs(np.random.default_rng(seed), h, w, 0.3)
+    out = np.empty((h, w), bool)
+    _jit.square_filter(mask, radius, every, out)
+    scipys = ndimage.minimum_filter if every else ndimage.maximum_filter
+    assert np.array_equal(out, scipys(mask, size=2 * radius + 1, mode="constant", cval=False))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_grown_occlusion_is_the_twins(seed, radius):
+    """Occlusion.at with a radius and Occlusion.window (their grown maps, filtered by the kernel or by scipy)."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 60, 2))
+    occ = Occlusion(3, 4, _blobs(rng, h, w, rng.uniform(0.0, 0.15)), 100, 90)
+    u, v = rng.uniform(-5, 105, 200), rng.uniform(-5, 95, 200)
+    region = Silhouette(int(rng.integers(0, 50)), int(rng.integers(0, 50)), np.ones((20, 30), bool), 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        at, at_twin = _both(mp, occ.at, u, v, radius=radius)
+        window, window_twin = _both(mp, occ.window, region, radius=radius)
+        grown, grown_twin = _both(mp, lambda r: Occlusion(3, 4, occ.hidden, 100, 90).grown(r), radius)  # not cached
+    assert np.array_equal(at, at_twin) and np.array_equal(window, window_twin) and np.array_equal(grown, grown_twin)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.integers(0, 4))
 def test_allowed_pixels_are_the_twins(seed, gap, thin):
     """Occlusion.allowed (and so extent) with the kernel and with the numpy twin: the same pixels, on random hidden

@@ -447,7 +447,7 @@ def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -
 
 
 @_njit
-def _square_filter(src: np.ndarray, radius: int, every: bool, out: np.ndarray) -> None:
+def square_filter(src: np.ndarray, radius: int, every: bool, out: np.ndarray) -> None:
     """``out`` (h, w) bool: the minimum (``every``: all of the square true) or maximum (any true) of ``src`` (h, w)
     over the ``2 radius + 1`` square about each pixel, outside the array false (``ndimage.minimum_filter`` /
     ``maximum_filter`` with ``mode="constant", cval=False``), by running counts along the rows, then down the
@@ -510,16 +510,16 @@ def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.nda
         if b1 > b0:
             part = hidden[b0:b1, a0:a1]
             eroded = np.empty(part.shape, np.bool_)
-            _square_filter(part, thin, True, eroded)
-            _square_filter(eroded, thin, False, join[b0:b1, a0:a1])
+            square_filter(part, thin, True, eroded)
+            square_filter(eroded, thin, False, join[b0:b1, a0:a1])
     if gap > 0:
         s0, s1, t0, t1 = _box(seen)
         b0, b1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
         a0, a1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
         grown = np.empty((b1 - b0, a1 - a0), np.bool_)
-        _square_filter(seen[b0:b1, a0:a1], gap, False, grown)
+        square_filter(seen[b0:b1, a0:a1], gap, False, grown)
         near = np.empty((b1 - b0, a1 - a0), np.bool_)
-        _square_filter(join[b0:b1, a0:a1], gap, False, near)
+        square_filter(join[b0:b1, a0:a1], gap, False, near)
         for r in range(b1 - b0):
             for c in range(a1 - a0):
                 if grown[r, c] and near[r, c]:

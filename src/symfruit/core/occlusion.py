@@ -123,7 +123,7 @@ class Occlusion:
             return self.hidden
         found = self._grown.get(radius)
         if found is None:
-            found = ndimage.maximum_filter(self.hidden, size=2 * radius + 1, mode="constant", cval=False)
+            found = _grow(self.hidden, radius)
             found.flags.writeable = False
             self._grown[radius] = found
         return found
@@ -145,7 +145,7 @@ class Occlusion:
         part = self.hidden[g0:g1, f0:f1]
         if not part.any():
             return part[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
-        grown = ndimage.maximum_filter(part, size=2 * radius + 1, mode="constant", cval=False)
+        grown = _grow(part, radius)
         return grown[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
 
     def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -406,6 +406,17 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 
 
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
+
+
+def _grow(mask: np.ndarray, radius: int) -> np.ndarray:
+    """(h, w) bool: the pixels of ``mask`` (h, w) bool with a true pixel within ``radius`` (a square; outside the
+    image is background): ``ndimage.maximum_filter``, or its compiled twin (:func:`symfruit.core._jit.square_filter`,
+    the same pixels) where numba is installed."""
+    if (jit := compiled()) is not None:
+        out = np.empty(mask.shape, dtype=bool)
+        jit.square_filter(mask, radius, False, out)
+        return out
+    return ndimage.maximum_filter(mask, size=2 * radius + 1, mode="constant", cval=False)
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:
