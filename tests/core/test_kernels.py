@@ -348,6 +348,30 @@ def test_allowed_pixels_are_the_twins(seed, gap, thin):
     assert np.array_equal(box, box_twin)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(0, 300))
+def test_inside_px_is_the_twins_to_the_bit(seed, n):
+    """Points in the window, beyond it, on pixel centres' half-way marks (rounded half to even), and ones whose
+    pixel numpy's integers cannot hold (NaN, infinite, z = 0, past 2^63)."""
+    from symfruit.core.agreement import _inside_px
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=500.0, fy=480.0, cx=64.0, cy=48.0, width=128, height=96)
+    inner = rng.random((40, 50)) * 10.0
+    region = Silhouette(int(rng.integers(0, 80)), int(rng.integers(0, 60)), inner > 1.0, 0.0)
+    uv = np.c_[rng.uniform(-20, 150, n), rng.uniform(-20, 120, n)]
+    uv[: n // 4] = np.round(uv[: n // 4]) + 0.5  # half-way: numpy's rint rounds to even
+    z = rng.uniform(0.2, 1.0, n)
+    pts = np.c_[(uv[:, 0] - 64.0) / 500.0 * z, (uv[:, 1] - 48.0) / 480.0 * z, z]
+    odd = [np.nan, np.inf, -np.inf, 0.0, 1e300, -1e300, 1e-300]
+    for i in range(min(n, 2 * len(odd))):
+        pts[i, i % 3] = odd[i % len(odd)]
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        fast, twin = _both(mp, _inside_px, pts, region, cam, inner)
+    assert np.array_equal(fast, twin)
+
+
 # --- the surface's noise (core.fits.surface_noise) ----------------------------------------------------------
 
 

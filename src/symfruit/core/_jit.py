@@ -605,3 +605,27 @@ def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int)
             out[q, 1, 0], out[q, 1, 1], out[q, 1, 2] = c01 / kk, c11 / kk, c12 / kk
             out[q, 2, 0], out[q, 2, 1], out[q, 2, 2] = c02 / kk, c12 / kk, c22 / kk
     return out_small, out_large
+
+
+@_njit
+def inside_px(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, inner: np.ndarray
+) -> np.ndarray:
+    """:func:`symfruit.core.agreement._inside_px`: the distance map ``inner`` (h, w) at each point's (n, 3) pixel
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, less the window's corner
+    ``u0``, ``v0``, clipped to the window): the twin's values to the bit. A coordinate numpy's integer conversion
+    cannot hold (NaN, infinite, past 2^63) becomes its smallest integer there, and so here, the corner's
+    subtraction wrapping around as numpy's does."""
+    h, w = inner.shape
+    n = points.shape[0]
+    out = np.empty(n)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        iu = np.int64(u) if -big <= u < big else least
+        iv = np.int64(v) if -big <= v < big else least
+        out[i] = inner[min(max(iv - np.int64(v0), 0), h - 1), min(max(iu - np.int64(u0), 0), w - 1)]
+    return out
