@@ -409,6 +409,7 @@ def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
     """Past _BRUTE_NEIGHBOURS distances the twin's search tree runs even with the kernels (the same results)."""
     from symfruit.core import fits
 
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # the kernels are there (numba is, above)
     pts = random_sphere(300, seed=4)
     monkeypatch.setattr(fits, "_neighbour_covariances", lambda *a: (_ for _ in ()).throw(AssertionError("tree")))
     fits.surface_noise(pts, queries=30)  # 300 x 30 distances: the kernel
