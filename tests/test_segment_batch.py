@@ -2,6 +2,7 @@
 
 import importlib.util
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -55,6 +56,39 @@ def test_a_mask_source_that_raises_is_contained(tmp_path):
 
     report = segment_images([_photos(tmp_path / "in")], output=tmp_path / "out", masks=flaky)
     assert len(report.failed) == 2 and all("RuntimeError: boom" in v for v in report.failed.values())
+
+
+def test_a_photo_turned_by_its_exif_orientation_is_segmented_as_displayed_and_stored_depth_refused(tmp_path):
+    color, _ = make_photo([(80, 120, 40, RED)], seed=0)  # 320x240, the fruit left of centre
+    exif = Image.Exif()
+    exif[0x0112] = 8  # shown turned a quarter anticlockwise: 240x320, the fruit below the middle
+    (tmp_path / "in").mkdir()
+    Image.fromarray(color).save(tmp_path / "in" / "p0.jpg", exif=exif, quality=95)
+    report = segment_images([tmp_path / "in"], output=tmp_path / "out")
+    with Image.open(tmp_path / "out" / "p0.png") as img:
+        labels = np.asarray(img)
+    rows = np.nonzero(labels)[0]
+    assert report.done[0].fruit == 1 and labels.shape == (320, 240) and rows.mean() > 160 + 60
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "p0.png")  # for the stored pixels
+    cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
+    bad = segment_images([tmp_path / "in"], output=tmp_path / "o2", depth=depth, camera=cam)
+    assert re.search(r"p0\.jpg: its EXIF orientation 8 \(turned a quarter anticlockwise\) is applied on reading "
+                     r".*, but p0\.png has 1 \(as stored\)", next(iter(bad.failed.values())))  # fmt: skip
+
+
+def test_a_depth_entry_that_is_no_file_is_refused_not_passed_over_for_colour_alone(tmp_path):
+    folder = _photos(tmp_path / "in", n=1)
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    (depth / "p0.png").mkdir()  # was "no depth for p0": segmented on colour alone, in silence
+    cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
+    report = segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert not report.done and re.search(r"depth/p0\.png: a directory, not a file", next(iter(report.failed.values())))
+    (folder / "loop.jpg").symlink_to("loop.jpg")
+    with pytest.raises(FileFormatError, match=r"loop\.jpg: a link that leads to no file"):
+        segment_images([folder / "loop.jpg"], output=tmp_path / "o2")
 
 
 def test_depth_from_a_folder_is_used_and_needs_a_camera(tmp_path):

@@ -30,6 +30,7 @@ from .io.frames import is_frame_folder
 from .io.images import image_suffixes
 from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, unique_names, write_record
 from .io.sources import open_source
+from .io.text import holds_file
 from .methods import DEFAULT_METHOD
 from .progress import Progress
 from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_run_tables
@@ -480,7 +481,7 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
         if p.is_dir():
             listed = [q for q in p.iterdir() if q.suffix.lower() in IMAGE_SUFFIXES and not q.name.startswith(".")]
             out += sorted(q for q in listed if not q.is_dir())
-        elif p.is_file():
+        elif holds_file(p):  # a dangling or looping link is said to be one
             out.append(p)
         else:
             raise FileFormatError(f"{p}: no such image or folder")
@@ -489,15 +490,19 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
     return out
 
 
-def _read_depth(path: Path, scale: float, shape: tuple[int, int]) -> np.ndarray:
-    """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape``."""
+def _read_depth(path: Path, scale: float, shape: tuple[int, int], image: Path, orientation: int) -> np.ndarray:
+    """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape`` (that
+    of ``image`` as read, its EXIF ``orientation`` applied: the depth's must be the same)."""
     from .io.frames import read_depth_npy
-    from .io.images import read_depth_units
+    from .io.images import orientation_mismatch, read_depth_units_oriented
 
+    depth_orientation = 1  # a .npy array has none
     if path.suffix.lower() == ".npy":
         depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
     else:
-        depth = read_depth_units(path, scale=scale).astype(np.float64) * scale
+        units, depth_orientation = read_depth_units_oriented(path, scale=scale)
+        depth = units.astype(np.float64) * scale
+    orientation_mismatch(image, orientation, path, depth_orientation)
     if depth.shape != shape:
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth
@@ -509,7 +514,7 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
     if depth.is_dir():
         for name in (image.stem, image.stem + "_depth"):
             for suffix in (".png", ".npy"):
-                if (depth / (name + suffix)).is_file():
+                if holds_file(depth / (name + suffix)):  # one that is no file is refused, not passed over
                     return depth / (name + suffix)
         return None
     if n_images != 1:
@@ -616,7 +621,7 @@ def segment_images(
         Only for the batch as a whole: no images, depth without a camera, an unusable mask source or
         output folder.
     """
-    from .io.images import read_color
+    from .io.images import read_color_oriented, turned_mismatch
     from .writers import write_label_overlay, write_labels
 
     images = expand_images(paths)
@@ -647,15 +652,16 @@ def segment_images(
                 targets = (output / f"{stem}.png", output / f"{stem}_overlay.png")
 
                 def one_image(path: Path = path, targets: tuple[Path, Path] = targets) -> SegmentedImage:
-                    color = read_color(path)
+                    color, turned = read_color_oriented(path)
                     dfile = _depth_file(path, depth_path, len(images))
-                    z = _read_depth(dfile, depth_scale, color.shape[:2]) if dfile is not None else None
+                    z = _read_depth(dfile, depth_scale, color.shape[:2], path, turned) if dfile is not None else None
                     if z is not None:
                         _check_camera(camera, color.shape[:2], path)
                     t0 = time.perf_counter()
                     labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
                     ms = (time.perf_counter() - t0) * 1000.0
                     if labels.shape != color.shape[:2]:
+                        turned_mismatch(path, color.shape, {"the mask source's labels": labels.shape})
                         raise InputError(f"{path.name}: the mask source gave labels {labels.dtype} {labels.shape}, "
                                          f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
                     labels = instance_labels(labels, f"{path.name}: the mask source's labels")
@@ -696,6 +702,9 @@ def _check_camera(camera: Any, shape: tuple[int, ...], path: Path) -> None:
     """Intrinsics with a size must be for this image's size (as ``detect`` refuses them for a frame)."""
     w, h = getattr(camera, "width", None), getattr(camera, "height", None)
     if w is not None and h is not None and (int(w), int(h)) != (shape[1], shape[0]):
+        from .io.images import turned_mismatch
+
+        turned_mismatch(path, shape, {"the intrinsics (--camera)": (int(h), int(w))})
         raise InputError(f"{path}: the intrinsics (--camera) are for {w}x{h} but the image is {shape[1]}x{shape[0]}; "
                          "give the intrinsics of this resolution")  # fmt: skip
 

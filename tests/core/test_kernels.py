@@ -1,8 +1,10 @@
-"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``, seeded and
-property-tested; the switch to the twins (``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
+"""The compiled kernels (numba, the extra ``fast``) against their numpy twins in ``symfruit.core.fits``,
+``symfruit.core.raster`` and ``symfruit.core.occlusion``, seeded and property-tested; the switch to the twins
+(``SYMFRUIT_KERNELS=numpy``, no numba); no compilation at import.
 
-The kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
-iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm).
+The fits' kernels sum in another order than numpy, so they agree with the twins to rounding, not to the bit; a fit
+iterates on its sums, so whole fits are compared to a nanometre (the evaluation's rule is 0.1 mm). The pixel maps'
+kernels (whole numbers, booleans) are compared to the bit.
 """
 
 import subprocess
@@ -345,6 +347,7 @@ def test_revolution_march_is_the_twins(seed, steps, close):
 def test_revolution_inside_marches_its_rays_only_with_the_kernels(monkeypatch):
     from symfruit.core.fits import RevolutionInside, revolution_inside
 
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # a run with the twins throughout still has the kernels here
     rev, visible = _lemon_revolution(1)
     inside = RevolutionInside(rev)
     assert np.array_equal(inside(visible), revolution_inside(rev, visible))
@@ -353,3 +356,162 @@ def test_revolution_inside_marches_its_rays_only_with_the_kernels(monkeypatch):
     assert hit.shape == depth.shape == (len(rays),) and hit.mean() > 0.8  # most rays through seen points meet it
     monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
     assert inside.march(rays, 0.2, 0.5, 24) is None  # explain() then marches with core.agreement.march
+
+
+# --- the observation's pixel maps (core.raster, core.occlusion) ---------------------------------------------
+
+
+def _blobs(rng: np.random.Generator, h: int, w: int, share: float) -> np.ndarray:
+    """(h, w) bool: random pixels grown into blobs of a few pixels (edges, holes, thin parts and isolated pixels)."""
+    from scipy import ndimage
+
+    seeds = rng.random((h, w)) < share
+    return ndimage.binary_dilation(seeds, iterations=int(rng.integers(0, 4))) if seeds.any() else seeds
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 12.0), st.booleans())
+def test_near_distance_is_the_twins_to_the_bit(seed, h, w, reach, want):
+    from symfruit.core.raster import _near_distance
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.1))
+    out = np.full((h, w), -1.0)
+    _jit.near_distance(mask, reach, want, out)
+    assert np.array_equal(out, _near_distance(mask == want, reach))
+
+
+def test_the_distance_maps_are_the_twins_to_the_bit(monkeypatch):
+    """inner_distance and outer_distance, with the kernel and with the numpy twin: the same maps, to the bit, and
+    within reach scipy's transform's."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance, outer_distance
+
+    rng = np.random.default_rng(5)
+    mask = np.zeros((70, 90), bool)
+    mask[10:60, 15:80] = _blobs(rng, 50, 65, 0.3)
+    for reach in (2.5, 5.5, 10.7):
+        inner, inner_twin = _both(monkeypatch, inner_distance, mask, reach)
+        outer, outer_twin = _both(monkeypatch, outer_distance, mask, reach)
+        assert np.array_equal(inner, inner_twin) and np.array_equal(outer, outer_twin)
+        near = outer <= reach
+        assert near.any() and np.array_equal(outer[near], ndimage.distance_transform_edt(~mask)[near])
+        assert np.array_equal(inner[inner <= reach], ndimage.distance_transform_edt(mask)[inner <= reach])
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 6), st.booleans())
+def test_square_filter_is_scipys(seed, h, w, radius, every):
+    from scipy import ndimage
+
+    mask = _blobs(np.random.default_rng(seed), h, w, 0.3)
+    out = np.empty((h, w), bool)
+    _jit.square_filter(mask, radius, every, out)
+    scipys = ndimage.minimum_filter if every else ndimage.maximum_filter
+    assert np.array_equal(out, scipys(mask, size=2 * radius + 1, mode="constant", cval=False))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_grown_occlusion_is_the_twins(seed, radius):
+    """Occlusion.at with a radius and Occlusion.window (their grown maps, filtered by the kernel or by scipy)."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 60, 2))
+    occ = Occlusion(3, 4, _blobs(rng, h, w, rng.uniform(0.0, 0.15)), 100, 90)
+    u, v = rng.uniform(-5, 105, 200), rng.uniform(-5, 95, 200)
+    region = Silhouette(int(rng.integers(0, 50)), int(rng.integers(0, 50)), np.ones((20, 30), bool), 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        at, at_twin = _both(mp, occ.at, u, v, radius=radius)
+        window, window_twin = _both(mp, occ.window, region, radius=radius)
+        grown, grown_twin = _both(mp, lambda r: Occlusion(3, 4, occ.hidden, 100, 90).grown(r), radius)  # not cached
+    assert np.array_equal(at, at_twin) and np.array_equal(window, window_twin) and np.array_equal(grown, grown_twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.integers(0, 4))
+def test_allowed_pixels_are_the_twins(seed, gap, thin):
+    """Occlusion.allowed (and so extent) with the kernel and with the numpy twin: the same pixels, on random hidden
+    blobs and seen regions reaching out of the window."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 60, 2))
+    occ = Occlusion(3, 4, _blobs(rng, h, w, rng.uniform(0.0, 0.15)), 100, 90)
+    rh, rw = (int(x) for x in rng.integers(3, 30, 2))
+    region = Silhouette(int(rng.integers(0, 50)), int(rng.integers(0, 50)), _blobs(rng, rh, rw, 0.2), 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occ.allowed, region, gap=gap, thin=thin)
+        assert np.array_equal(fast, twin)
+        box, box_twin = _both(mp, occ.extent, region, gap=gap, thin=thin)
+    assert np.array_equal(box, box_twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 300))
+def test_inside_px_is_the_twins_to_the_bit(seed, n):
+    """Points in the window, beyond it, on pixel centres' half-way marks (rounded half to even), and ones whose
+    pixel numpy's integers cannot hold (NaN, infinite, z = 0, past 2^63)."""
+    from symfruit.core.agreement import _inside_px
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=500.0, fy=480.0, cx=64.0, cy=48.0, width=128, height=96)
+    inner = rng.random((40, 50)) * 10.0
+    region = Silhouette(int(rng.integers(0, 80)), int(rng.integers(0, 60)), inner > 1.0, 0.0)
+    uv = np.c_[rng.uniform(-20, 150, n), rng.uniform(-20, 120, n)]
+    uv[: n // 4] = np.round(uv[: n // 4]) + 0.5  # half-way: numpy's rint rounds to even
+    z = rng.uniform(0.2, 1.0, n)
+    pts = np.c_[(uv[:, 0] - 64.0) / 500.0 * z, (uv[:, 1] - 48.0) / 480.0 * z, z]
+    odd = [np.nan, np.inf, -np.inf, 0.0, 1e300, -1e300, 1e-300]
+    for i in range(min(n, 2 * len(odd))):
+        pts[i, i % 3] = odd[i % len(odd)]
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        fast, twin = _both(mp, _inside_px, pts, region, cam, inner)
+    assert np.array_equal(fast, twin)
+
+
+# --- the surface's noise (core.fits.surface_noise) ----------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(3, 400), st.integers(1, 60), st.integers(1, 12), st.integers(0, 40))
+def test_neighbour_covariances_are_the_twins(seed, n, step, small, extra):
+    """Random points (a tenth of them repeated: ties at distance 0, as a duplicated point gives): the same
+    neighbourhoods' covariances as the search tree's, within rounding."""
+    from symfruit.core.fits import _neighbour_covariances
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    pts[: n // 10] = pts[n // 10 : 2 * (n // 10)]
+    large = max(min(small + extra, n), 2)  # as surface_noise's (a search for one neighbour returns a flat array)
+    small = min(small, large)
+    fast = _jit.neighbour_covariances(pts, step, small, large)
+    twin = _neighbour_covariances(pts, step, small, large)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.shape == b.shape == (len(pts[::step]), 3, 3)
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
+
+
+@pytest.mark.parametrize("kind,noise,queries", [("apple", 0.0, 120), ("pear", 0.002, 40), ("banana", 0.001, 7)])
+def test_surface_noise_is_the_twins(monkeypatch, kind, noise, queries):
+    from symfruit.core.fits import surface_noise
+
+    fruit = FRUITS[kind](np.random.default_rng(3))
+    visible, _ = rendered_view(fruit, [0.01, -0.01, 0.4], noise=noise, rotation=rotation(10, 20, 30), seed=3)
+    (ratio, res, normals), (ratio_twin, res_twin, normals_twin) = _both(monkeypatch, surface_noise, visible,
+                                                                       queries=queries)  # fmt: skip
+    assert ratio == pytest.approx(ratio_twin, rel=1e-12) and res == pytest.approx(res_twin, rel=1e-12)
+    np.testing.assert_allclose(normals, normals_twin, atol=1e-9)
+
+
+def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
+    """Past _BRUTE_NEIGHBOURS distances the twin's search tree runs even with the kernels (the same results)."""
+    from symfruit.core import fits
+
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # the kernels are there (numba is, above)
+    pts = random_sphere(300, seed=4)
+    monkeypatch.setattr(fits, "_neighbour_covariances", lambda *a: (_ for _ in ()).throw(AssertionError("tree")))
+    fits.surface_noise(pts, queries=30)  # 300 x 30 distances: the kernel
+    monkeypatch.setattr(fits, "_BRUTE_NEIGHBOURS", 300 * 30 - 1)
+    with pytest.raises(AssertionError, match="tree"):
+        fits.surface_noise(pts, queries=30)

@@ -5,10 +5,12 @@ depth. What they show that renders did not (issue 18): depth registered 8 px bel
 outer 13 % of every sphere's radius, depth smeared where a sphere sits on the board, mask pixels on the
 background."""
 
+import json
+
 import numpy as np
 import pytest
 
-from symfruit.evaluate.spheres import evaluate_spheres, spheres_table
+from symfruit.evaluate.spheres import SphereBox, evaluate_spheres, spheres_table
 
 from ..conftest import EXAMPLES
 
@@ -70,3 +72,14 @@ def test_a_frame_that_cannot_be_read_is_skipped_and_named(tmp_path):
     rows = evaluate_spheres(tmp_path, methods=("raw",), failed=failed)
     assert {r.frame for r in rows} == {"lab-spheres-0"} and len(rows) == 4
     assert set(failed) == {"broken"} and "depth.png" in failed["broken"]
+
+
+def test_a_failed_sphere_and_a_single_frame_give_a_summary_that_is_json_and_no_nan_in_the_table():
+    # a sphere that failed under a method carried NaN sizes into summary.json: `evaluate --spheres` died in
+    # json.dump (allow_nan=False) with a traceback after the whole run; one frame printed "nan" as its disagreement
+    rows = [SphereBox("f1", 1, "raw", (40.0, 40.0, 30.0), 38.0),
+            SphereBox("f1", 2, "raw", (np.nan,) * 3, np.nan, "only 2 points with valid depth")]  # fmt: skip
+    table, summary = spheres_table(rows, ("raw",))
+    assert "| `raw` | 10.0 / 10.0 | 8.0 (-8.0) | - | 40x40x30 | failed |" in table and "nan" not in table
+    boxes = json.loads(json.dumps(summary, allow_nan=False))[0]["boxes"]
+    assert boxes[0]["size"] == [40.0, 40.0, 30.0] and boxes[1]["size"] is None and boxes[1]["diameter"] is None

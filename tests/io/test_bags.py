@@ -142,6 +142,35 @@ def test_colour_encodings_come_back_rgb():
     assert np.array_equal(image_array(padded, "sensor_msgs/msg/Image"), RGB)
 
 
+def _yuy2_reference(y0, u, y1, v):
+    """librealsense's portable unpack_yuy2, one pair of pixels at a time in plain Python."""
+
+    def clamp(x):
+        return 255 if x > 255 else 0 if x < 0 else x
+
+    out = []
+    for y in (y0, y1):
+        c, d, e = y - 16, u - 128, v - 128
+        out.append((clamp((298 * c + 409 * e + 128) >> 8), clamp((298 * c - 100 * d - 208 * e + 128) >> 8),
+                    clamp((298 * c + 516 * d + 128) >> 8)))  # fmt: skip
+    return out
+
+
+def test_yuyv_and_uyvy_colour_comes_back_rgb_as_librealsense_converts_it():
+    # known answers: BT.601 limited-range black, white and red (Y 81, U 90, V 240)
+    pairs = np.array([[[16, 128, 16, 128], [235, 128, 235, 128], [81, 90, 81, 240]]], np.uint8)  # Y0 U Y1 V
+    want = np.array([[[0, 0, 0]] * 2 + [[255, 255, 255]] * 2 + [[255, 0, 0]] * 2], np.uint8)
+    yuyv = pairs.reshape(1, 6, 2)
+    assert np.array_equal(color_image(message(yuyv, "YUYV")), want)
+    uyvy = pairs[:, :, [1, 0, 3, 2]].reshape(1, 6, 2)
+    assert np.array_equal(color_image(message(uyvy, "yuv422", step=16)), want)  # ROS's yuv422 is UYVY; padded rows
+    # every byte value, against the C code's formula pixel by pixel
+    quads = np.random.default_rng(0).integers(0, 256, (8, 16, 4), dtype=np.uint8)
+    got = image_array(message(quads.reshape(8, 32, 2), "yuv422_yuy2"), "sensor_msgs/msg/Image")
+    ref = np.array([[px for q in row.tolist() for px in _yuy2_reference(*q)] for row in quads], np.uint8)
+    assert got.shape == (8, 32, 3) and np.array_equal(got, ref)
+
+
 @pytest.mark.parametrize(
     "pixels, encoding",
     [
@@ -152,7 +181,8 @@ def test_colour_encodings_come_back_rgb():
 )
 def test_a_colour_message_of_wider_pixels_is_refused_not_cut_to_8_bits(pixels, encoding):
     with pytest.raises(FileFormatError, match=rf"colour image encoding '{encoding}' is not 8-bit colour \(use one of "
-                       r"rgb8, bgr8, rgba8, bgra8, mono8, 8uc1, 8uc3\)"):  # fmt: skip
+                       r"rgb8, bgr8, rgba8, bgra8, mono8, 8uc1, 8uc3, yuyv, yuy2, yuv422_yuy2, uyvy, "
+                       r"yuv422\)"):  # fmt: skip
         color_image(message(pixels, encoding))
 
 
@@ -208,7 +238,11 @@ def test_compressed_images(tmp_path):
 @pytest.mark.parametrize(
     "msg, error",
     [
-        (message(RGB, "yuv422"), "unsupported image encoding 'yuv422'"),
+        (message(RGB, "yuv420"), "unsupported image encoding 'yuv420'"),
+        (message(np.zeros((2, 3, 2), np.uint8), "YUYV"), "YUYV image of odd width 3: two pixels share each U and V"),
+        (message(np.zeros((2, 4, 2), np.uint8), "yuv422", step=6), "image step 6 is shorter than a row of 4 yuv422"),
+        (SimpleNamespace(height=2, width=4, step=8, encoding="YUYV", is_bigendian=0, data=bytes(15)),
+         "image data holds 15 bytes, 2 rows of 8 need 16"),
         (message(RGB, "rgb8", step=4), "image step 4 is shorter than a row of 3 rgb8 pixels"),
         (SimpleNamespace(height=0, width=3, step=9, encoding="rgb8", is_bigendian=0, data=b""), "empty or larger"),
         (SimpleNamespace(height=10**5, width=10**5, step=3 * 10**5, encoding="rgb8", is_bigendian=0, data=b""),

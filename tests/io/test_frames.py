@@ -218,13 +218,24 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ({"fruits": [{"min": [-1e308] * 3, "max": [1e308] * 3}]}, "more than 100 m from the camera"),
         ({"fruits": [{"min": [10**400, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, "int too large to convert to float"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2**40}]}, "id must be a whole number in 0-"),
+        # a misspelt key was dropped: "rip": false counted an unripe fruit as a target
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "rip": False}]}, r"unknown key 'rip'; did you "
+         "mean 'ripe'"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "Visible": 0.5}]}, "did you mean 'visible'"),
     ],
-)
+)  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):
     path = tmp_path / "truth.json"
     path.write_text(json.dumps(truth))
     with pytest.raises(FileFormatError, match=rf"truth\.json: expected .*{message}"):
         read_truth(path)
+
+
+def test_truth_keys_other_tools_write_beside_the_read_ones_are_left_alone(tmp_path):
+    fruit = {"id": 3, "ripe": True, "kind": "strawberry", "centre": [0.05, 0.05, 0.35], "size": [0.1] * 3,
+             "min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "visible_box": {}, "mask_area": 10, "score": 0.5}  # fmt: skip
+    (tmp_path / "truth.json").write_text(json.dumps({"fruits": [fruit]}))
+    assert [i for i, _ in read_truth(tmp_path / "truth.json")] == [3]
 
 
 def test_an_unreadable_truth_file_is_named(tmp_path, monkeypatch):
@@ -286,3 +297,55 @@ def test_truth_survives_any_json(tmp_path, data):
     except SymfruitError:
         return
     assert all(isinstance(k, int) and box.min.shape == (3,) for k, box in truth)
+
+
+def test_a_phone_photo_turned_by_its_exif_orientation_must_agree_with_depth_and_intrinsics(tmp_path):
+    cam = Camera(fx=50, fy=50, cx=20, cy=15, width=40, height=30)
+    yy, xx = np.mgrid[0:30, 0:40]
+    color = np.stack([xx * 6, yy * 8, np.full_like(xx, 128)], axis=2).astype(np.uint8)  # smooth: JPEG keeps it
+    depth = np.full((30, 40), 0.5, np.float32)
+
+    def tagged(img, path, orientation):
+        exif = Image.Exif()
+        exif[0x0112] = orientation
+        img.save(path, exif=exif, quality=95)
+
+    for orientation, does in ((6, "turned a quarter clockwise"), (3, "turned half around")):  # 3: sizes agree
+        folder = tmp_path / f"o{orientation}"
+        write_frame(folder, color, depth, cam)
+        (folder / "color.png").unlink()
+        tagged(Image.fromarray(color), folder / "color.jpg", orientation)
+        said = (rf"o{orientation}/color\.jpg: its EXIF orientation {orientation} \({does}\) is applied on reading "
+                r"\(images are read as displayed\), but depth\.png has 1 \(as stored\): depth registered to the "
+                r"stored pixels would meet other pixels")  # fmt: skip
+        with pytest.raises(FileFormatError, match=said):
+            read_frame(folder)
+    # depth tagged alike: both read as displayed; intrinsics for the stored pixels are then said to be so
+    folder = tmp_path / "o6"
+    with Image.open(folder / "depth.png") as img:
+        tagged(img.copy(), folder / "depth.png", 6)
+    said = (r"color\.jpg: its EXIF orientation 6 turns it a quarter on reading .*40x30 stored, 30x40 shown\), but "
+            r"the intrinsics \(camera\.json\) is for the stored 40x30")  # fmt: skip
+    with pytest.raises(FileFormatError, match=said):
+        read_frame(folder)
+    (folder / "camera.json").write_text(json.dumps(Camera(fx=50, fy=50, cx=15, cy=20, width=30, height=40).to_dict()))
+    frame = read_frame(folder)
+    assert frame.color.shape == (40, 30, 3) and frame.depth.shape == (40, 30)
+    assert np.abs(frame.color.astype(int) - np.rot90(color, -1)).max() <= 8  # JPEG: close, not equal
+
+
+@pytest.mark.parametrize("name", ["color.png", "depth.png", "camera.json", "masks.png", "truth.json"])
+@pytest.mark.parametrize("kind", ["directory", "link loop", "dangling link"])
+def test_a_frame_file_that_is_no_file_is_refused_by_name_not_taken_as_missing(tmp_path, name, kind):
+    # a masks.png or truth.json folder was "no masks" / "no truth" (colour segmenter, no scores), in silence
+    frame = tmp_path / "f"
+    color, depth = disc_frame([(80, 60)])
+    write_frame(frame, color, depth, CAM, truth={"fruits": []}, masks=np.zeros((120, 160), np.int32))
+    (frame / name).unlink()
+    if kind == "directory":
+        (frame / name).mkdir()
+    else:
+        (frame / name).symlink_to(name if kind == "link loop" else "gone.png")
+    why = "a directory, not a file" if kind == "directory" else "a link that leads to no file"
+    with pytest.raises(FileFormatError, match=rf"f/{re.escape(name)}: {why}"):
+        read_frame(frame)

@@ -212,3 +212,52 @@ def test_a_pipe_named_as_an_image_is_refused_without_waiting_for_a_writer(tmp_pa
     (tmp_path / "tty.png").symlink_to("/dev/null")  # a device: /dev/tty would wait for typing
     with pytest.raises(FileFormatError, match=r"tty\.png: is a device; the image must be a regular file"):
         read_color(tmp_path / "tty.png")
+
+
+def _with_orientation(img: Image.Image, path, orientation: int, **save) -> None:
+    exif = Image.Exif()
+    exif[0x0112] = orientation
+    img.save(path, exif=exif, **save)
+
+
+@pytest.mark.parametrize("orientation", range(1, 9))
+def test_an_exif_orientation_is_applied_as_viewers_show_the_image(tmp_path, orientation):
+    from PIL import ImageOps
+
+    stored = np.arange(2 * 3 * 3, dtype=np.uint8).reshape(2, 3, 3) * 10  # 3x2, every pixel its own colour
+    _with_orientation(Image.fromarray(stored), tmp_path / "c.png", orientation)
+    with Image.open(tmp_path / "c.png") as img:
+        shown = np.asarray(ImageOps.exif_transpose(img))
+    got = read_color(tmp_path / "c.png")
+    assert np.array_equal(got, shown) and images.exif_orientation(tmp_path / "c.png") == orientation
+    assert got.shape == ((3, 2, 3) if orientation >= 5 else (2, 3, 3))
+    if orientation == 6:  # known answer: turned a quarter clockwise, the stored bottom-left pixel on top
+        assert np.array_equal(got[0, 0], stored[1, 0]) and np.array_equal(got[0, 1], stored[0, 0])
+    buf = io.BytesIO()  # a message's compressed image: depth beside it is raw, so a tag is refused, not applied
+    _with_orientation(Image.fromarray(stored), buf, orientation, format="PNG")
+    if orientation == 1:
+        assert np.array_equal(decode_color(buf.getvalue(), "message"), stored)
+    else:
+        with pytest.raises(FileFormatError, match=rf"message: carries EXIF orientation {orientation} \(.* on "
+                           r"reading\), but depth beside it is raw"):  # fmt: skip
+            decode_color(buf.getvalue(), "message")
+
+
+def test_depth_and_labels_are_turned_by_their_own_orientation_too(tmp_path):
+    units = np.array([[1, 2, 3], [4, 5, 6]], np.uint16)
+    _with_orientation(Image.fromarray(units), tmp_path / "d.png", 8)
+    assert np.array_equal(read_depth_units(tmp_path / "d.png"), np.rot90(units))  # 8: a quarter anticlockwise
+    _with_orientation(Image.fromarray(units.astype(np.uint8)), tmp_path / "l.png", 3)
+    assert np.array_equal(read_labels(tmp_path / "l.png"), units[::-1, ::-1])
+
+
+def test_a_quarter_turned_colour_image_whose_partners_are_for_its_stored_pixels_is_refused_by_name(tmp_path):
+    _with_orientation(Image.new("RGB", (4, 2)), tmp_path / "c.jpg", 6)
+    shown = read_color(tmp_path / "c.jpg").shape
+    assert shown == (4, 2, 3)
+    images.turned_mismatch(tmp_path / "c.jpg", shown, {"depth.png": (4, 2)})  # agrees: nothing said
+    said = r"c\.jpg: its EXIF orientation 6 turns it a quarter on reading \(images are read as displayed: 4x2 stored, "
+    with pytest.raises(FileFormatError, match=said + r"2x4 shown\), but depth\.png is for the stored 4x2"):
+        images.turned_mismatch(tmp_path / "c.jpg", shown, {"depth.png": (2, 4)})
+    Image.new("RGB", (2, 4)).save(tmp_path / "plain.jpg")  # no orientation: a size mismatch of another kind
+    images.turned_mismatch(tmp_path / "plain.jpg", (4, 2, 3), {"depth.png": (2, 4)})

@@ -117,3 +117,41 @@ def test_a_sensor_of_100000_pixels_a_side_is_refused_naming_the_file(tmp_path):
     path.write_text('{"fx": 615, "fy": 615, "cx": 320, "cy": 240, "width": 100000, "height": 100000}')
     with pytest.raises(FileFormatError, match=r"cam\.json: camera width is 100000 pixels"):
         load_camera(path)
+
+
+@pytest.mark.parametrize(
+    "data, message",
+    [
+        ({"depth_scal": 0.0001}, r"unknown key 'depth_scal' .*did you mean 'depth_scale'\?"),
+        ({"ppxx": 321.0}, r"unknown key 'ppxx' .*did you mean 'ppx'\?"),
+        ({"serial": "123"}, r"unknown key 'serial' .*known keys: D, K, "),
+        ({"colour": {"fx": 615.0, "fxx": 1.0}}, r"unknown key 'colour\.fxx' .*did you mean 'fx'\?"),
+        ({"color": {"depth_scale": 0.0001}}, r"'depth_scale' under 'color' is not read: write it at the top level"),
+    ],
+)
+def test_a_key_no_layout_has_is_refused_naming_the_file_the_key_and_the_closest(tmp_path, data, message):
+    plain = {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}
+    nest = next(iter(data.values())) if isinstance(next(iter(data.values())), dict) else None
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps({k: {**plain, **v} for k, v in data.items()} if nest is not None else {**plain, **data}))
+    with pytest.raises(FileFormatError, match=rf"cam\.json: {message}"):
+        load_camera(path)
+    with pytest.raises(FileFormatError, match=r"cam\.json: unknown key 'ppxx' .*did you mean 'ppx'\?"):
+        load_camera(_written(tmp_path / "cam.json", {k: v for k, v in plain.items() if k != "cx"} | {"ppxx": 1.0}))
+
+
+def test_every_layout_key_and_the_depth_keys_beside_them_are_read(tmp_path):
+    ros = {"header": {"frame_id": "c"}, "height": 480, "width": 640, "distortion_model": "plumb_bob", "D": [0] * 5,
+           "K": [615.0, 0.0, 321.0, 0.0, 616.0, 239.0, 0.0, 0.0, 1.0], "R": [1, 0, 0, 0, 1, 0, 0, 0, 1],
+           "P": [615.0, 0, 321.0, 0, 0, 616.0, 239.0, 0, 0, 0, 1, 0], "binning_x": 0, "binning_y": 0, "roi": {},
+           "depth_scale": 0.001}  # fmt: skip
+    nested = {"color": {"fx": 615.0, "fy": 616.0, "ppx": 321.0, "ppy": 239.0, "width": 640, "height": 480,
+                        "model": "Brown Conrady", "coeffs": [0] * 5}, "depth": {}, "depth_units": "mm"}  # fmt: skip
+    expected = Camera(fx=615.0, fy=616.0, cx=321.0, cy=239.0, width=640, height=480)
+    assert load_camera(_written(tmp_path / "ros.json", ros)) == expected
+    assert load_camera(_written(tmp_path / "rs.json", nested)) == expected
+
+
+def _written(path, data):
+    path.write_text(json.dumps(data))
+    return path

@@ -264,6 +264,29 @@ def test_a_broken_recording_is_refused_by_name(tmp_path, edit, error, when):
     assert str(info.value).startswith(str(path)) and "\n" not in str(info.value)
 
 
+def test_a_yuyv_colour_stream_is_read_as_librealsense_converts_it(tmp_path):
+    # librealsense records a YUYV (YUY2) colour stream as encoding "YUYV", two bytes a pixel
+    from symfruit.io.bags import yuv422_rgb
+
+    def as_yuyv(topic, raw):
+        if not topic.endswith("Color_0/image/data"):
+            return raw
+        at = 12 + 4 + struct.unpack_from("<I", raw, 12)[0]  # seq, stamp, frame_id
+        h, w, n = *struct.unpack_from("<II", raw, at), struct.unpack_from("<I", raw, at + 8)[0]
+        rest = at + 12 + n  # after the encoding: is_bigendian, step, data, and librealsense's float
+        trailer = raw[rest + 1 + 4 + 4 + struct.unpack_from("<I", raw, rest + 5)[0] :]
+        packed = np.random.default_rng(0).integers(0, 256, h * w * 2, dtype=np.uint8).tobytes()
+        seen.append(np.frombuffer(packed, np.uint8).reshape(h, 2 * w))
+        return (raw[:at] + struct.pack("<II", h, w) + struct.pack("<I", 4) + b"YUYV" + b"\0"
+                + struct.pack("<II", 2 * w, len(packed)) + packed + trailer)  # fmt: skip
+
+    seen: list[np.ndarray] = []
+    path = rewrite(tmp_path / "yuyv.bag", edit=as_yuyv)
+    with RealSenseBagSource(path) as src:
+        frame = src.read(0)
+    assert frame.color.shape == (240, 320, 3) and np.array_equal(frame.color, yuv422_rgb(seen[0], (0, 1, 2, 3)))
+
+
 def test_a_bad_extrinsic_rotation_is_refused(tmp_path):
     def edit(topic, msg):
         if topic.endswith("Color_0/tf/1"):

@@ -122,3 +122,18 @@ def test_every_reader_refuses_what_is_not_a_path_by_name(reader):
 
     with pytest.raises(InputError, match=rf"^{reader}: the .* must be a path \(str or os\.PathLike\), got NoneType"):
         getattr(symfruit.io, reader)(None)
+
+
+def test_holds_file_says_what_an_entry_that_is_no_file_is(tmp_path):
+    from symfruit.io.text import holds_file
+
+    (tmp_path / "f.png").write_bytes(b"x")
+    (tmp_path / "d.png").mkdir()
+    (tmp_path / "loop.png").symlink_to("loop.png")
+    (tmp_path / "gone.png").symlink_to("nowhere.png")
+    os.mkfifo(tmp_path / "pipe.png")
+    assert holds_file(tmp_path / "f.png") and not holds_file(tmp_path / "missing.png")
+    for name, why in [("d.png", "a directory, not a file"), ("loop.png", "a link that leads to no file"),
+                      ("gone.png", "a link that leads to no file"), ("pipe.png", "not a regular file")]:  # fmt: skip
+        with pytest.raises(FileFormatError, match=rf"{name}: {why}"):
+            holds_file(tmp_path / name)

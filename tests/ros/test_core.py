@@ -91,7 +91,7 @@ def test_frame_carries_the_colour_header():
 
 @pytest.mark.parametrize(
     ("change", "match"),
-    [({"encoding": "yuv422"}, "encoding"), ({"data": b"\x00" * 10}, "image data holds 10 bytes"),
+    [({"encoding": "yuv420"}, "encoding"), ({"data": b"\x00" * 10}, "image data holds 10 bytes"),
      ({"step": 2}, "step"), ({"height": 0}, "empty")],
 )  # fmt: skip
 def test_bad_images_raise_symfruit_errors(change, match):

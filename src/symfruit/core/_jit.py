@@ -407,6 +407,231 @@ def revolution_march(
 
 
 @_njit
+def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -> None:
+    """:func:`symfruit.core.raster._near_distance` of the pixels of ``mask`` (h, w) equal to ``want`` (the twin's
+    true pixels), written into ``out`` (h, w): each pixel's distance to the nearest such pixel where that is at most
+    ``reach``, +inf elsewhere. The same whole-number squared distances as the twin's shifts (each column's distance
+    to its nearest pixel, capped past the reach, by two sweeps; then the nearest over ``2 floor(reach) + 1``
+    columns), and the same square roots: the twin's values to the bit."""
+    h, w = mask.shape
+    k = math.floor(reach)
+    cap = k + 1
+    g2 = np.empty((h, w), np.int64)
+    for c in range(w):
+        last = -cap  # the row of the last wanted pixel above, or far enough to be beyond reach
+        for r in range(h):
+            if mask[r, c] == want:
+                last = r
+            g2[r, c] = min(r - last, cap)
+        last = h - 1 + cap
+        for r in range(h - 1, -1, -1):
+            if mask[r, c] == want:
+                last = r
+            g2[r, c] = min(g2[r, c], last - r)
+    for r in range(h):
+        for c in range(w):
+            g2[r, c] *= g2[r, c]
+    limit = reach * reach
+    for r in range(h):
+        for c in range(w):
+            best = g2[r, c]
+            for t in range(1, k + 1):
+                tt = t * t
+                if tt >= best:  # farther columns cannot be nearer
+                    break
+                if c - t >= 0 and g2[r, c - t] + tt < best:
+                    best = g2[r, c - t] + tt
+                if c + t < w and g2[r, c + t] + tt < best:
+                    best = g2[r, c + t] + tt
+            out[r, c] = math.sqrt(float(best)) if best <= limit else np.inf
+
+
+@_njit
+def square_filter(src: np.ndarray, radius: int, every: bool, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the minimum (``every``: all of the square true) or maximum (any true) of ``src`` (h, w)
+    over the ``2 radius + 1`` square about each pixel, outside the array false (``ndimage.minimum_filter`` /
+    ``maximum_filter`` with ``mode="constant", cval=False``), by running counts along the rows, then down the
+    columns (row by row, in memory order)."""
+    h, w = src.shape
+    size = 2 * radius + 1
+    rows = np.empty((h, w), np.bool_)
+    count = np.empty(w + 1, np.int64)
+    for r in range(h):
+        count[0] = 0
+        for c in range(w):
+            count[c + 1] = count[c] + src[r, c]
+        if every:
+            for c in range(w):
+                rows[r, c] = c >= radius and c + radius < w and count[c + radius + 1] - count[c - radius] == size
+        else:
+            for c in range(w):
+                rows[r, c] = count[min(c + radius + 1, w)] - count[max(c - radius, 0)] > 0
+    cols = np.zeros((h + 1, w), np.int64)  # cols[r, c]: true pixels of rows[:r, c]
+    for r in range(h):
+        for c in range(w):
+            cols[r + 1, c] = cols[r, c] + rows[r, c]
+    for r in range(h):
+        if every:
+            if r < radius or r + radius >= h:
+                out[r, :] = False
+                continue
+            for c in range(w):
+                out[r, c] = cols[r + radius + 1, c] - cols[r - radius, c] == size
+        else:
+            a, b = max(r - radius, 0), min(r + radius + 1, h)
+            for c in range(w):
+                out[r, c] = cols[b, c] - cols[a, c] > 0
+
+
+@_njit
+def _box(mask: np.ndarray) -> tuple[int, int, int, int]:
+    """``(r0, r1, c0, c1)`` of a bool image's true pixels (stops exclusive), ``(0, 0, 0, 0)`` when none."""
+    h, w = mask.shape
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                r0, r1 = min(r0, r), r + 1
+                c0, c1 = min(c0, c), max(c1, c + 1)
+    return (r0, r1, c0, c1) if r1 > 0 else (0, 0, 0, 0)
+
+
+@_njit
+def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.ndarray:
+    """:meth:`symfruit.core.occlusion.Occlusion.allowed` of a window's ``hidden`` and ``seen`` pixels (h, w) bool
+    (``seen`` not empty): the 8-connected parts of ``hidden`` (opened by a ``2 thin + 1`` square when ``thin >
+    0``, over the hidden pixels' box), ``seen`` and their joins across ``gap`` (over the seen pixels' box grown
+    by ``2 gap``, as the twin's filters) that hold a seen pixel, by a flood fill from the seen pixels; the twin's
+    pixels exactly (booleans)."""
+    h, w = hidden.shape
+    join = hidden.copy()
+    if thin > 0:
+        b0, b1, a0, a1 = _box(hidden)
+        if b1 > b0:
+            part = hidden[b0:b1, a0:a1]
+            eroded = np.empty(part.shape, np.bool_)
+            square_filter(part, thin, True, eroded)
+            square_filter(eroded, thin, False, join[b0:b1, a0:a1])
+    if gap > 0:
+        s0, s1, t0, t1 = _box(seen)
+        b0, b1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+        a0, a1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
+        grown = np.empty((b1 - b0, a1 - a0), np.bool_)
+        square_filter(seen[b0:b1, a0:a1], gap, False, grown)
+        near = np.empty((b1 - b0, a1 - a0), np.bool_)
+        square_filter(join[b0:b1, a0:a1], gap, False, near)
+        for r in range(b1 - b0):
+            for c in range(a1 - a0):
+                if grown[r, c] and near[r, c]:
+                    join[b0 + r, a0 + c] = True
+    out = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            if seen[r, c]:
+                out[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        for dr in range(-1, 2):
+            rr = r + dr
+            if rr < 0 or rr >= h:
+                continue
+            for dc in range(-1, 2):
+                cc = c + dc
+                if cc < 0 or cc >= w or out[rr, cc]:
+                    continue
+                if join[rr, cc] or seen[rr, cc]:
+                    out[rr, cc] = True
+                    stack[top] = rr * w + cc
+                    top += 1
+    return out
+
+
+@_njit
+def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits._neighbour_covariances`: for each query point ``points[::step]``, the covariances
+    (3, 3) of its ``small`` and its ``large`` nearest points (itself among them; ``small <= large <= n``), each
+    about its own mean: ``(m, 3, 3), (m, 3, 3)``. The nearest by brute force (every squared distance, the
+    nearest ``large`` kept in order, ties by index: the same points as the twin's search tree but where a tie
+    straddles the last place), not a search tree: a few thousand points are fewer operations than building one."""
+    n = points.shape[0]
+    m = (n + step - 1) // step
+    out_small = np.empty((m, 3, 3))
+    out_large = np.empty((m, 3, 3))
+    best_d = np.empty(large)
+    best_i = np.empty(large, np.int64)
+    for q in range(m):
+        x, y, z = points[q * step, 0], points[q * step, 1], points[q * step, 2]
+        count = 0
+        for j in range(n):
+            dx, dy, dz = points[j, 0] - x, points[j, 1] - y, points[j, 2] - z
+            d = dx * dx + dy * dy + dz * dz
+            if count == large:
+                if not d < best_d[large - 1]:
+                    continue
+                slot = large - 1
+            else:
+                slot = count
+                count += 1
+            while slot > 0 and best_d[slot - 1] > d:  # insertion: the kept ones stay sorted, ties in index order
+                best_d[slot] = best_d[slot - 1]
+                best_i[slot] = best_i[slot - 1]
+                slot -= 1
+            best_d[slot] = d
+            best_i[slot] = j
+        for kk, out in ((small, out_small), (large, out_large)):
+            m0 = m1 = m2 = 0.0
+            for a in range(kk):
+                j = best_i[a]
+                m0 += points[j, 0]
+                m1 += points[j, 1]
+                m2 += points[j, 2]
+            m0, m1, m2 = m0 / kk, m1 / kk, m2 / kk
+            c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+            for a in range(kk):
+                j = best_i[a]
+                e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
+                c00 += e0 * e0
+                c01 += e0 * e1
+                c02 += e0 * e2
+                c11 += e1 * e1
+                c12 += e1 * e2
+                c22 += e2 * e2
+            out[q, 0, 0], out[q, 0, 1], out[q, 0, 2] = c00 / kk, c01 / kk, c02 / kk
+            out[q, 1, 0], out[q, 1, 1], out[q, 1, 2] = c01 / kk, c11 / kk, c12 / kk
+            out[q, 2, 0], out[q, 2, 1], out[q, 2, 2] = c02 / kk, c12 / kk, c22 / kk
+    return out_small, out_large
+
+
+@_njit
+def inside_px(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, inner: np.ndarray
+) -> np.ndarray:
+    """:func:`symfruit.core.agreement._inside_px`: the distance map ``inner`` (h, w) at each point's (n, 3) pixel
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, less the window's corner
+    ``u0``, ``v0``, clipped to the window): the twin's values to the bit. A coordinate numpy's integer conversion
+    cannot hold (NaN, infinite, past 2^63) becomes its smallest integer there, and so here, the corner's
+    subtraction wrapping around as numpy's does."""
+    h, w = inner.shape
+    n = points.shape[0]
+    out = np.empty(n)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        iu = np.int64(u) if -big <= u < big else least
+        iv = np.int64(v) if -big <= v < big else least
+        out[i] = inner[min(max(iv - np.int64(v0), 0), h - 1), min(max(iu - np.int64(u0), 0), w - 1)]
+    return out
+
+
+@_njit
 def cone_residuals(
     params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
     out: np.ndarray,
@@ -455,8 +680,8 @@ def cone_fit(
     grid: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
     step: np.ndarray, huber: float, iterations: int, tolerance: float, tau_max: float,
 ) -> tuple[np.ndarray, np.ndarray, int]:  # fmt: skip
-    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s grid search and Levenberg-Marquardt (its twin
-    :func:`symfruit.core.fits._cone_steps`), the shape parameter bounded by ``tau_max`` (an active set of one
+    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s grid search and Levenberg-Marquardt (its twin the numpy loop
+    there), the shape parameter bounded by ``tau_max`` (an active set of one
     bound): the parameters (4,), the residuals at them and at each finite-difference step (5, n), and a status:
     0 done, 1 no finite cost on the grid, 2 a singular damped system (numpy's ``solve`` raises there; the caller
     runs the twin)."""

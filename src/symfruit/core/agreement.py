@@ -29,6 +29,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from .camera import Camera
+from .kernels import compiled
 from .occlusion import Occlusion
 from .points import as_points, row_norms
 from .raster import Silhouette, inner_distance, interior, outer_distance, outline_cone, outline_cracks, silhouette_cone
@@ -374,7 +375,10 @@ def _occluded_edges(
 
 
 def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:
-    """(n,) float: how far inside the region's edge each point's pixel lies (``inner``: its distance map)."""
+    """(n,) float: how far inside the region's edge each point's pixel lies (``inner``: its distance map); by the
+    compiled twin :func:`symfruit.core._jit.inside_px` where numba is installed (the same values)."""
+    if (jit := compiled()) is not None:
+        return jit.inside_px(points, camera.fx, camera.fy, camera.cx, camera.cy, region.u0, region.v0, inner)
     uv = camera.project(points)
     col = np.clip(np.rint(uv[:, 0]).astype(np.intp) - region.u0, 0, inner.shape[1] - 1)
     row = np.clip(np.rint(uv[:, 1]).astype(np.intp) - region.v0, 0, inner.shape[0] - 1)

@@ -6,9 +6,9 @@ Every function takes ``points : (n, 3) float, metres`` first and normalises it (
 its options as keywords, and returns arrays; none knows settings objects or files.
 
 The loops of the sphere's, the solid of revolution's and the cone ellipsoid's fits (and the marching of the solid
-of revolution) run as compiled kernels where numba (the extra ``fast``) is installed (:mod:`symfruit.core.kernels`);
-the numpy code here is their twin, run without numba or with ``SYMFRUIT_KERNELS=numpy``, and gives the same results
-within rounding.
+of revolution) and the neighbourhoods of :func:`surface_noise` run as compiled kernels where numba (the extra
+``fast``) is installed (:mod:`symfruit.core.kernels`); the numpy code here is their twin, run without numba or with
+``SYMFRUIT_KERNELS=numpy``, and gives the same results within rounding.
 """
 
 from __future__ import annotations
@@ -198,20 +198,35 @@ def surface_noise(
     points = as_points(points, min_count=3)
     k_large = min(large, len(points))
     step = max(1, len(points) // queries)
-    _, idx = cKDTree(points).query(points[::step], k=k_large)
-    hood = points[idx]
     k = min(small, k_large)
-    near = hood[:, :k] - hood[:, :k].mean(axis=1, keepdims=True)
-    values, vectors = np.linalg.eigh(np.einsum("nki,nkj->nij", near, near) / k)
+    jit = compiled()
+    if jit is not None and len(points) * len(range(0, len(points), step)) <= _BRUTE_NEIGHBOURS:
+        cov_small, cov_large = jit.neighbour_covariances(points, step, k, k_large)  # the compiled twin
+    else:
+        cov_small, cov_large = _neighbour_covariances(points, step, k, k_large)
+    values, vectors = np.linalg.eigh(cov_small)
     # medians by core.points.median: np.median's values, without its general-axis machinery
     small_res, normals = np.sqrt(max(float(median(values[:, 0])), 0.0)), vectors[:, :, 0]
-    wide = hood - hood.mean(axis=1, keepdims=True)
-    large_res = np.sqrt(
-        max(float(median(np.linalg.eigvalsh(np.einsum("nki,nkj->nij", wide, wide) / k_large)[:, 0])), 0.0)
-    )
+    large_res = np.sqrt(max(float(median(np.linalg.eigvalsh(cov_large)[:, 0])), 0.0))
     flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
     normals[flip] *= -1.0
     return large_res / max(small_res, 1e-15), small_res, normals
+
+
+#: :func:`surface_noise` finds neighbours by the kernel's brute force up to this many distances (points times
+#: queries: 40,000 in the default method's call on 1,000 points), by a search tree beyond.
+_BRUTE_NEIGHBOURS = 5_000_000
+
+
+def _neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(m, 3, 3), (m, 3, 3)``: for each query point ``points[::step]``, the covariance of its ``small`` and its
+    ``large`` nearest points (itself among them), each about its own mean (:func:`surface_noise`; its compiled
+    twin is :func:`symfruit.core._jit.neighbour_covariances`)."""
+    _, idx = cKDTree(points).query(points[::step], k=large)
+    hood = points[idx]
+    near = hood[:, :small] - hood[:, :small].mean(axis=1, keepdims=True)
+    wide = hood - hood.mean(axis=1, keepdims=True)
+    return np.einsum("nki,nkj->nij", near, near) / small, np.einsum("nki,nkj->nij", wide, wide) / large
 
 
 def _residuals(theta, points, prior, ratio, delta, jac=True):

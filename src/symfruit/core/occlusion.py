@@ -21,6 +21,7 @@ from scipy import ndimage
 
 from ..errors import InputError
 from .camera import Camera
+from .kernels import compiled
 from .limits import check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box
@@ -122,7 +123,7 @@ class Occlusion:
             return self.hidden
         found = self._grown.get(radius)
         if found is None:
-            found = ndimage.maximum_filter(self.hidden, size=2 * radius + 1, mode="constant", cval=False)
+            found = _grow(self.hidden, radius)
             found.flags.writeable = False
             self._grown[radius] = found
         return found
@@ -144,7 +145,7 @@ class Occlusion:
         part = self.hidden[g0:g1, f0:f1]
         if not part.any():
             return part[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
-        grown = ndimage.maximum_filter(part, size=2 * radius + 1, mode="constant", cval=False)
+        grown = _grow(part, radius)
         return grown[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
 
     def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -187,13 +188,6 @@ class Occlusion:
         + 1`` pixels (a stem) are left out first: a fruit cannot hide behind them.
         """
         h, w = self.hidden.shape
-        hidden = self.hidden
-        if thin > 0 and (box := mask_box(hidden)) is not None:
-            # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
-            # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
-            b0, b1, a0, a1 = box
-            hidden = np.zeros_like(self.hidden)
-            hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         rh, rw = region.mask.shape
         r0, c0 = max(region.v0, self.v0), max(region.u0, self.u0)
         r1, c1 = min(region.v0 + rh, self.v0 + h), min(region.u0 + rw, self.u0 + w)
@@ -204,6 +198,15 @@ class Occlusion:
             ]
         if not seen.any():
             return seen
+        if (jit := compiled()) is not None:  # the compiled twin of what follows (the same pixels)
+            return jit.allowed(self.hidden, seen, gap, thin)
+        hidden = self.hidden
+        if thin > 0 and (box := mask_box(hidden)) is not None:
+            # An opening keeps a subset of its input, so it is made over the hidden pixels' box alone (outside
+            # it, as outside the window, there is nothing): the same pixels, a window often several times larger.
+            b0, b1, a0, a1 = box
+            hidden = np.zeros_like(self.hidden)
+            hidden[b0:b1, a0:a1] = open_square(self.hidden[b0:b1, a0:a1], 2 * thin + 1)
         allowed = hidden.copy()
         if gap > 0:
             # both filters only matter within ``gap`` of the seen pixels: run them on the seen box grown by
@@ -403,6 +406,17 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 
 
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
+
+
+def _grow(mask: np.ndarray, radius: int) -> np.ndarray:
+    """(h, w) bool: the pixels of ``mask`` (h, w) bool with a true pixel within ``radius`` (a square; outside the
+    image is background): ``ndimage.maximum_filter``, or its compiled twin (:func:`symfruit.core._jit.square_filter`,
+    the same pixels) where numba is installed."""
+    if (jit := compiled()) is not None:
+        out = np.empty(mask.shape, dtype=bool)
+        jit.square_filter(mask, radius, False, out)
+        return out
+    return ndimage.maximum_filter(mask, size=2 * radius + 1, mode="constant", cval=False)
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:

@@ -116,7 +116,7 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
         worst = max(differ) if differ else float("nan")
         lines.append(
             f"| `{m}` | {cube.mean():.1f} / {cube.max():.1f} | {np.abs(depth).mean():.1f} ({depth.mean():+.1f}) "
-            f"| {worst:.1f} | " + " | ".join(cells) + " |"
+            f"| {f'{worst:.1f}' if differ else '-'} | " + " | ".join(cells) + " |"
             if len(ok)
             else f"| `{m}` | - | - | - | " + " | ".join("failed" for _ in spheres) + " |"
         )
@@ -125,5 +125,13 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
                         "cube_mm_max": float(cube.max()) if len(ok) else None,
                         "depth_mm_mean_abs": float(np.abs(depth).mean()) if len(ok) else None,
                         "frames_differ_mm": worst if differ else None,
-                        "boxes": [r.__dict__ for r in mine]})  # fmt: skip
+                        "boxes": [_box_record(r) for r in mine]})  # fmt: skip
     return "\n".join(lines) + "\n", summary
+
+
+def _box_record(r: SphereBox) -> dict[str, Any]:
+    """One sphere box for summary.json: a failed one has no size and no diameter (null, never NaN, which is
+    not JSON)."""
+    if r.error:
+        return {**r.__dict__, "size": None, "diameter": None}
+    return {**r.__dict__, "size": list(r.size)}

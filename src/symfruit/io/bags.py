@@ -1,6 +1,7 @@
 """Frames from ROS 1 / ROS 2 bags, through the pure-Python ``rosbags`` package (optional extra ``bag``).
 
-Colour (``sensor_msgs/Image`` rgb8/bgr8/rgba8/bgra8/mono8, or ``CompressedImage``), depth (``Image``
+Colour (``sensor_msgs/Image`` rgb8/bgr8/rgba8/bgra8/mono8, packed 4:2:2 YUYV/UYVY (:func:`yuv422_rgb`), or
+``CompressedImage``), depth (``Image``
 16UC1 in millimetres or 32FC1 in metres) and ``CameraInfo`` topics are found by type and name (a topic
 whose name contains "depth" is depth; of several, the aligned depth, the ``color`` topic and the camera
 info beside it: :func:`_pick_topics`). Each depth image is one frame, paired with the colour image nearest
@@ -37,6 +38,7 @@ __all__ = [
     "header_frame_id",
     "header_stamp",
     "image_array",
+    "yuv422_rgb",
 ]
 
 _ENCODINGS: dict[str, tuple[type, int]] = {
@@ -44,6 +46,11 @@ _ENCODINGS: dict[str, tuple[type, int]] = {
     "mono8": (np.uint8, 1), "8uc1": (np.uint8, 1), "8uc3": (np.uint8, 3), "16uc1": (np.uint16, 1),
     "mono16": (np.uint16, 1), "32fc1": (np.float32, 1),
 }  # fmt: skip
+#: Packed 4:2:2 encodings (two bytes a pixel, each U and V shared by two pixels), decoded to RGB: the offsets
+#: of Y0, U, Y1, V in each 4-byte pair. librealsense records its YUYV (YUY2) colour as ``YUYV`` and its UYVY as
+#: ``yuv422``, which is UYVY in ROS too (``yuv422_yuy2``: YUYV).
+_YUV422 = {"yuyv": (0, 1, 2, 3), "yuy2": (0, 1, 2, 3), "yuv422_yuy2": (0, 1, 2, 3), "uyvy": (1, 0, 3, 2),
+           "yuv422": (1, 0, 3, 2)}  # fmt: skip
 #: Largest image a message may claim (pixels), checked before its data is touched (with the largest side:
 #: :func:`symfruit.core.limits.check_image_size`).
 MAX_MESSAGE_PIXELS = MAX_IMAGE_PIXELS
@@ -62,8 +69,8 @@ def _require_rosbags() -> Any:
 def image_array(msg: Any, typename: str) -> np.ndarray:
     """The pixels of a ``sensor_msgs/Image`` or ``CompressedImage``: ``(h, w)`` or ``(h, w, 3)``.
 
-    Colour comes back RGB (``bgr*`` reordered, alpha dropped, ``mono8`` stays one channel); depth keeps
-    its dtype (uint16 units or float32 metres).
+    Colour comes back RGB (``bgr*`` reordered, alpha dropped, YUYV/UYVY converted, ``mono8`` stays one
+    channel); depth keeps its dtype (uint16 units or float32 metres).
 
     Raises
     ------
@@ -79,9 +86,10 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
 
         return decode_color(bytes(msg.data), "compressed image")
     enc = str(msg.encoding).lower()
-    if enc not in _ENCODINGS:
-        raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of {', '.join(_ENCODINGS)})")
-    dtype, channels = _ENCODINGS[enc]
+    if enc not in _ENCODINGS and enc not in _YUV422:
+        raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of "
+                              f"{', '.join([*_ENCODINGS, *_YUV422])})")  # fmt: skip
+    dtype, channels = _ENCODINGS.get(enc, (np.uint8, 2))
     try:
         h, w, step = int(msg.height), int(msg.width), int(msg.step)
     except (TypeError, ValueError, OverflowError, AttributeError):
@@ -90,6 +98,8 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
         raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
+    if enc in _YUV422 and w % 2:
+        raise FileFormatError(f"{msg.encoding} image of odd width {w}: two pixels share each U and V")
     dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
     row_bytes = w * channels * dt.itemsize
     if step < row_bytes:
@@ -98,10 +108,30 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if len(data) < h * step:
         raise FileFormatError(f"image data holds {len(data)} bytes, {h} rows of {step} need {h * step}")
     rows = data[: h * step].reshape(h, step)
+    if enc in _YUV422:
+        return yuv422_rgb(rows[:, :row_bytes], _YUV422[enc])
     img = rows[:, :row_bytes].copy().view(dt).reshape(h, w, channels).astype(dtype, copy=False)
     if enc.startswith("bgr"):
         img = img[:, :, [2, 1, 0]]
     return img[:, :, 0] if channels == 1 else img[:, :, :3]
+
+
+def yuv422_rgb(rows: np.ndarray, order: tuple[int, int, int, int]) -> np.ndarray:
+    """``(h, w, 3) uint8`` RGB of packed 4:2:2 rows (``(h, 2 w)`` bytes), BT.601 limited range in integers
+    exactly as librealsense's ``unpack_yuy2`` (its portable code): ``c = Y - 16, d = U - 128, e = V - 128``,
+    ``R = (298 c + 409 e + 128) >> 8``, ``G = (298 c - 100 d - 208 e + 128) >> 8``, ``B = (298 c + 516 d + 128)
+    >> 8``, clipped to 0-255. ``order`` gives the offsets of Y0, U, Y1 and V in each 4 bytes."""
+    h = rows.shape[0]
+    quads = rows.reshape(h, -1, 4).astype(np.int32)
+    y0, u, y1, v = (quads[:, :, k] for k in order)
+    c = np.stack([y0, y1], axis=2).reshape(h, -1) - 16  # pixel by pixel: Y0 Y1 of each pair
+    d = np.repeat(u - 128, 2, axis=1)
+    e = np.repeat(v - 128, 2, axis=1)
+    out = np.empty((*c.shape, 3), np.uint8)
+    out[:, :, 0] = np.clip((298 * c + 409 * e + 128) >> 8, 0, 255)
+    out[:, :, 1] = np.clip((298 * c - 100 * d - 208 * e + 128) >> 8, 0, 255)
+    out[:, :, 2] = np.clip((298 * c + 516 * d + 128) >> 8, 0, 255)
+    return out
 
 
 def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray:
@@ -115,8 +145,9 @@ def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray
     """
     img = image_array(msg, typename)
     if img.dtype != np.uint8:
+        eight = [e for e, (t, _) in _ENCODINGS.items() if t is np.uint8]
         raise FileFormatError(f"colour image encoding {msg.encoding!r} is not 8-bit colour (use one of "
-                              f"{', '.join(e for e, (t, _) in _ENCODINGS.items() if t is np.uint8)})")  # fmt: skip
+                              f"{', '.join([*eight, *_YUV422])})")  # fmt: skip
     if img.ndim == 2:
         img = np.repeat(img[:, :, None], 3, axis=2)
     return np.ascontiguousarray(img, dtype=np.uint8)

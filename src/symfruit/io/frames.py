@@ -2,14 +2,15 @@
 
 A frame folder holds::
 
-    color.png | color.jpg     colour image, 8-bit RGB
+    color.png | color.jpg     colour image, 8-bit RGB, read as displayed (an EXIF orientation applied)
     depth.png                 depth aligned to colour, 16-bit, times depth_scale metres per unit
     depth.npy                 ... or depth as float metres (0 or NaN: no depth)
     camera.json | .yaml       intrinsics in any layout symfruit reads; an optional "depth_scale"
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
     masks.json                optional: COCO-style annotations (polygons or RLE)
-    truth.json                optional: {"fruits": [{"id", "min", "max", "visible", ...}]}, true boxes in metres
+    truth.json                optional: {"fruits": [{"id", "min", "max", "visible", "ripe", ...}]}, true boxes in
+                              metres (other keys left alone, one a letter or two from these refused)
 
 A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
@@ -17,6 +18,7 @@ ROS 2 bag folder (:mod:`.bags`).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 from typing import Any
 
@@ -28,8 +30,8 @@ from ..core.frame import Frame
 from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
-from .images import read_color, read_depth_units
-from .text import as_path, read_structured
+from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
+from .text import as_path, holds_file, read_structured
 
 __all__ = [
     "COLOR_NAMES",
@@ -51,14 +53,15 @@ MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
 
 def _first(folder: Path, *names: str) -> Path | None:
     for name in names:
-        if (folder / name).is_file():
+        if holds_file(folder / name):
             return folder / name
     return None
 
 
 def is_frame_folder(folder: Path) -> bool:
-    """Whether ``folder`` holds a colour image under one of :data:`COLOR_NAMES`."""
-    return folder.is_dir() and _first(folder, *COLOR_NAMES) is not None
+    """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
+    that name is then refused by name when the frame is read)."""
+    return folder.is_dir() and any(os.path.lexists(folder / name) for name in COLOR_NAMES)
 
 
 def read_frame(folder: str | Path) -> Frame:
@@ -85,16 +88,22 @@ def read_frame(folder: str | Path) -> Frame:
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
-    color = read_color(color_path)
+    color, color_orientation = read_color_oriented(color_path)
     depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
-    if depth_png.is_file():
-        depth = read_depth_units(depth_png, scale=scale).astype(np.float32) * np.float32(scale)
-    elif depth_npy.is_file():
-        depth = read_depth_npy(depth_npy)
-    else:
+    depth_file = _first(folder, "depth.png", "depth.npy")
+    if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
+    depth_orientation = 1  # a .npy array has none
+    if depth_file == depth_png:
+        units, depth_orientation = read_depth_units_oriented(depth_png, scale=scale)
+        depth = units.astype(np.float32) * np.float32(scale)
+    else:
+        depth = read_depth_npy(depth_npy)
+    # depth registered to a phone photo's stored pixels, or intrinsics for them: said so, never paired turned
+    orientation_mismatch(color_path, color_orientation, depth_file, depth_orientation)
+    turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
-    truth, visible = _truth(folder / "truth.json") if (folder / "truth.json").is_file() else (None, {})
+    truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
 
 
@@ -156,6 +165,7 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         for k, item in enumerate(fruits, 1):
             if not isinstance(item, dict):
                 raise TypeError(f"fruit {k} is not an object")
+            _misspelt_truth_key(item, k)
             if item.get("ripe", True) is False:
                 continue
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
@@ -180,6 +190,24 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         raise FileFormatError(
             f"{path}: expected {{'fruits': [{{'min': [x, y, z], 'max': [x, y, z]}}]}} ({exc})"
         ) from None
+
+
+#: The keys of a truth fruit that are read; other keys (a scene's ``kind``, ``centre``, ``size``, a detection's
+#: fields) are kept out of the way, but one a letter or two from these is a misspelling that would be dropped.
+TRUTH_KEYS = ("id", "min", "max", "ripe", "visible")
+
+
+def _misspelt_truth_key(item: dict[str, Any], k: int) -> None:
+    import difflib
+
+    for key in item:
+        if not isinstance(key, str) or key in TRUTH_KEYS:
+            continue
+        close = difflib.get_close_matches(key.lower(), TRUTH_KEYS, n=1, cutoff=0.75)
+        # a letter or two off ("rip": false would count an unripe fruit as a target), not a longer name that
+        # holds one ("visible_box" of a detection)
+        if close and abs(len(key) - len(close[0])) <= 2 and close[0] not in item:
+            raise ValueError(f"fruit {k}: unknown key {key!r}; did you mean {close[0]!r}?")
 
 
 def write_frame(

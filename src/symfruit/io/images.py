@@ -13,6 +13,13 @@ labels         ``1``, ``L``, ``P`` (palette indices are the labels), ``I;16*``, 
                int32``; ``RGB``/``RGBA`` -> one label per distinct colour, black = background
 =============  ==============================================================================
 
+Images are read as displayed: an EXIF orientation (phone photos: 6 and 8 turn them a quarter) is applied
+to every image read, colour, depth and labels alike (:func:`exif_orientation`). Where colour and depth
+carry different orientations (:func:`orientation_mismatch`), or a colour image is turned a quarter beside
+intrinsics for its stored size (:func:`turned_mismatch`), readers refuse them naming the file and its
+orientation, never pair turned colour with unturned depth (:func:`decode_color`, a message's image beside
+raw depth, refuses a tag).
+
 Every error names the file and the problem (:class:`~symfruit.errors.FileFormatError`); Pillow's own
 errors, including its decompression-bomb error, never escape.
 """
@@ -31,7 +38,19 @@ from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  #
 from ..errors import FileFormatError
 from .text import as_path, refuse_pipe
 
-__all__ = ["MAX_IMAGE_PIXELS", "decode_color", "image_suffixes", "read_color", "read_depth_units", "read_labels"]
+__all__ = [
+    "MAX_IMAGE_PIXELS",
+    "decode_color",
+    "exif_orientation",
+    "image_suffixes",
+    "orientation_mismatch",
+    "read_color",
+    "read_color_oriented",
+    "read_depth_units",
+    "read_depth_units_oriented",
+    "read_labels",
+    "turned_mismatch",
+]
 
 #: Suffixes Pillow opens that symfruit reads as something else (``.pcd``: a point cloud, not a Kodak PhotoCD).
 _NOT_IMAGES = {".pcd"}
@@ -79,7 +98,9 @@ def _open(source: Path | bytes, label: str) -> Any:
     return img
 
 
-def _decode(img: Any, label: str) -> Any:
+def _decode(img: Any, label: str) -> tuple[Any, int]:
+    """The decoded image, turned as its EXIF orientation says (a new image where it is not 1), and that
+    orientation (1-8)."""
     from PIL import Image
 
     try:
@@ -88,7 +109,81 @@ def _decode(img: Any, label: str) -> Any:
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
-    return img
+    orientation = _orientation(img)
+    turn = _TRANSPOSE.get(orientation)
+    return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
+
+
+#: EXIF orientation -> the ``Image.Transpose`` that shows the image as displayed (2-8; 1 is as stored): as
+#: ``PIL.ImageOps.exif_transpose``, which also rewrites the metadata (not needed: pixels are all that is read).
+_TRANSPOSE = {2: "FLIP_LEFT_RIGHT", 3: "ROTATE_180", 4: "FLIP_TOP_BOTTOM", 5: "TRANSPOSE", 6: "ROTATE_270",
+              7: "TRANSVERSE", 8: "ROTATE_90"}  # fmt: skip
+#: Orientations that turn an image a quarter: its width and height swap on reading.
+QUARTER_TURNS = frozenset({5, 6, 7, 8})
+
+
+def _orientation(img: Any) -> int:
+    """The EXIF orientation of an opened image, 1 where it has none or an unreadable one (viewers show such
+    an image as stored too)."""
+    try:
+        value = img.getexif().get(0x0112, 1)
+    except Exception:  # Pillow's EXIF parser raises many types on a damaged block
+        return 1
+    return value if isinstance(value, int) and value in _TRANSPOSE else 1  # 1 and nonsense: as stored
+
+
+def exif_orientation(path: str | Path) -> int:
+    """The EXIF orientation (1-8) of an image file, read from its header; 1 where it has none."""
+    path = as_path(path, "exif_orientation: the image")
+    with _open(path, str(path)) as img:
+        return _orientation(img)
+
+
+#: What each EXIF orientation does to the stored pixels on reading.
+ORIENTATION_NAMES = {1: "as stored", 2: "mirrored left-right", 3: "turned half around", 4: "mirrored top-bottom",
+                     5: "mirrored and turned a quarter", 6: "turned a quarter clockwise", 7: "mirrored and turned "
+                     "a quarter", 8: "turned a quarter anticlockwise"}  # fmt: skip
+
+
+def orientation_mismatch(color_path: Path, orientation: int, depth_path: Path, depth_orientation: int) -> None:
+    """Refuse colour and depth that their EXIF orientations turn differently on reading (a phone photo's tag
+    beside a depth image registered to its stored pixels): even where the sizes agree (half a turn, a
+    mirror), depth would meet the wrong pixels.
+
+    Raises
+    ------
+    FileFormatError
+        Naming both files and their orientations.
+    """
+    if orientation == depth_orientation:
+        return
+    raise FileFormatError(f"{color_path}: its EXIF orientation {orientation} ({ORIENTATION_NAMES[orientation]}) is "
+                          f"applied on reading (images are read as displayed), but {depth_path.name} has "
+                          f"{depth_orientation} ({ORIENTATION_NAMES[depth_orientation]}): depth registered to the "
+                          "stored pixels would meet other pixels; save the colour image as displayed without its "
+                          "orientation tag, or give both the same")  # fmt: skip
+
+
+def turned_mismatch(color_path: Path, shape: tuple[int, ...], others: dict[str, tuple[int, ...]]) -> None:
+    """Refuse a colour image that its EXIF orientation turned a quarter on reading (``shape``, as read)
+    while ``others`` (what -> its ``(h, w)``: the depth image, the intrinsics) are for its stored size.
+
+    Raises
+    ------
+    FileFormatError
+        Naming the colour file, its orientation and what has the stored size.
+    """
+    h, w = shape[:2]
+    stored = [what for what, size in others.items() if tuple(size[:2]) == (w, h) and w != h]
+    if not stored:
+        return
+    orientation = exif_orientation(color_path)
+    if orientation not in QUARTER_TURNS:
+        return
+    raise FileFormatError(f"{color_path}: its EXIF orientation {orientation} turns it a quarter on reading (images "
+                          f"are read as displayed: {h}x{w} stored, {w}x{h} shown), but {' and '.join(stored)} "
+                          f"{'are' if len(stored) > 1 else 'is'} for the stored {h}x{w} pixels; save the colour "
+                          "image turned as displayed (or without its orientation tag) so that all agree")  # fmt: skip
 
 
 #: Pixels converted at a time: a decoded image is copied out of Pillow in bands of rows, so reading one costs
@@ -129,16 +224,28 @@ def _to_rgb(img: Any, label: str) -> np.ndarray:
 
 
 def read_color(path: str | Path) -> np.ndarray:
-    """A colour image as ``(h, w, 3) uint8`` RGB, from any mode listed in the module docstring."""
+    """A colour image as ``(h, w, 3) uint8`` RGB, from any mode listed in the module docstring, as displayed."""
+    return read_color_oriented(path)[0]
+
+
+def read_color_oriented(path: str | Path) -> tuple[np.ndarray, int]:
+    """:func:`read_color`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_color: the image")
     with _open(path, str(path)) as img:
-        return _to_rgb(_decode(img, str(path)), str(path))
+        shown, orientation = _decode(img, str(path))
+        return _to_rgb(shown, str(path)), orientation
 
 
 def decode_color(data: bytes, label: str) -> np.ndarray:
-    """:func:`read_color` for encoded bytes (a ``CompressedImage``'s JPEG or PNG)."""
+    """:func:`read_color` for encoded bytes (a ``CompressedImage``'s JPEG or PNG). One that carries an EXIF
+    orientation is refused: a message's depth beside it is raw pixels, registered to the stored ones."""
     with _open(bytes(data), label) as img:
-        return _to_rgb(_decode(img, label), label)
+        shown, orientation = _decode(img, label)
+        if orientation != 1:
+            raise FileFormatError(f"{label}: carries EXIF orientation {orientation} ({ORIENTATION_NAMES[orientation]} "
+                                  "on reading), but depth beside it is raw, registered to the stored pixels; "
+                                  "encode the image without an orientation tag")  # fmt: skip
+        return _to_rgb(shown, label)
 
 
 #: Depth an 8-bit depth image must reach (255 units times the depth scale, metres) to be read as depth: one
@@ -148,14 +255,19 @@ MIN_8BIT_DEPTH_REACH = 1.0
 
 
 def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndarray:
-    """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each).
+    """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each), as displayed.
 
     With ``scale`` (metres per unit), an 8-bit image is refused when 255 units reach less than
     :data:`MIN_8BIT_DEPTH_REACH`.
     """
+    return read_depth_units_oriented(path, scale=scale)[0]
+
+
+def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -> tuple[np.ndarray, int]:
+    """:func:`read_depth_units`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_depth_units: the depth image")
     with _open(path, str(path)) as img:
-        img = _decode(img, str(path))
+        img, orientation = _decode(img, str(path))
         if img.mode not in _WIDE_GREY and img.mode != "L":
             raise FileFormatError(f"{path}: depth PNG must be single-channel 16-bit, got mode {img.mode!r}")
         if img.mode == "L" and scale is not None and 255 * scale < MIN_8BIT_DEPTH_REACH:
@@ -169,14 +281,14 @@ def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndar
         raise FileFormatError(f"{path}: depth PNG must hold integer units, got {raw.dtype}")
     if raw.size and (raw.min() < 0 or raw.max() > 65535):
         raise FileFormatError(f"{path}: depth units outside 0-65535")
-    return raw.astype(np.uint16)
+    return raw.astype(np.uint16), orientation
 
 
 def read_labels(path: str | Path) -> np.ndarray:
     """An instance label image as ``(h, w) int32`` (0 background); RGB label images get one label per colour."""
     path = as_path(path, "read_labels: the label image")
     with _open(path, str(path)) as img:
-        img = _decode(img, str(path))
+        img = _decode(img, str(path))[0]
         mode = img.mode
         if mode in ("RGB", "RGBA", "RGBX"):
             rgb = np.asarray(img)[:, :, :3].astype(np.int64)

@@ -13,11 +13,15 @@ ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with
                        (``camera_calibration_parsers`` YAML)
 =====================  ==================================================================
 
-JSON or YAML by extension (YAML through ``yaml.safe_load`` only).
+JSON or YAML by extension (YAML through ``yaml.safe_load`` only). A file's keys are checked: a key that none of
+these layouts has (nor ``depth_scale``/``depth_units``, read beside them by :func:`symfruit.io.read_frame`) is
+refused naming the file, the key and the closest known key, so a misspelt ``depth_scal`` is not a default
+depth scale in disguise. :func:`camera_from_dict` (a mapping handed to the API) does not check them.
 """
 
 from __future__ import annotations
 
+import difflib
 from pathlib import Path
 from typing import Any
 
@@ -33,6 +37,21 @@ MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
 
 _NESTS = ("intrinsics", "intrinsic", "color", "colour", "camera", "camera_info")
 
+#: Every key of the layouts above: symfruit's own, ``rs2_intrinsics``, Open3D, ROS 1 and 2 ``CameraInfo`` and
+#: ``camera_calibration_parsers`` YAML.
+LAYOUT_KEYS = frozenset(
+    {"fx", "fy", "cx", "cy", "width", "height"}
+    | {"ppx", "ppy", "model", "coeffs"}
+    | {"intrinsic_matrix"}
+    | {"header", "distortion_model", "D", "K", "R", "P", "d", "k", "r", "p", "binning_x", "binning_y", "roi"}
+    | {"image_width", "image_height", "camera_name", "camera_matrix", "distortion_coefficients",
+       "rectification_matrix", "projection_matrix"}
+)  # fmt: skip
+#: Keys a frame folder's camera file holds beside the intrinsics (:func:`symfruit.io.read_frame`).
+DEPTH_KEYS = frozenset({"depth_scale", "depth_units"})
+#: Keys beside a nested layout (``{"color": {...}, "depth": {...}}`` as RealSense tools write it).
+_BESIDE_NESTS = frozenset({*_NESTS, "depth", "extrinsics"})
+
 
 def load_camera(path: str | Path) -> Camera:
     """Read intrinsics from a ``.json``, ``.yaml`` or ``.yml`` file in any layout above."""
@@ -41,11 +60,46 @@ def load_camera(path: str | Path) -> Camera:
 
 
 def camera_from_file_data(path: Path, data: Any) -> Camera:
-    """:func:`camera_from_dict` with errors naming the file the data came from."""
+    """:func:`camera_from_dict` with errors naming the file the data came from, and the file's keys checked
+    (a key no layout has is refused naming the closest known one)."""
     try:
-        return camera_from_dict(data)
+        camera = camera_from_dict(data)
     except InputError as exc:
+        unknown = _unknown_key(data, "")
+        if unknown is not None and unknown[2] is not None:  # a misspelt key explains the failure better
+            raise FileFormatError(f"{path}: {_unknown_message(*unknown)}") from None
         raise FileFormatError(f"{path}: {exc}") from None
+    unknown = _unknown_key(data, "")
+    if unknown is not None:
+        raise FileFormatError(f"{path}: {_unknown_message(*unknown)}")
+    return camera
+
+
+def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
+    """The first key of the intrinsics mapping ``data`` (following the nests :func:`camera_from_dict`
+    follows) that no layout has: ``(key, where, closest known key or None)``, or None."""
+    if not isinstance(data, dict):
+        return None
+    nested = not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)) and any(
+        isinstance(data.get(key), dict) for key in _NESTS
+    )
+    known = (_BESIDE_NESTS if nested else LAYOUT_KEYS) | (DEPTH_KEYS if not where else frozenset())
+    for key in data:
+        if not isinstance(key, str) or key not in known:
+            name = str(key)
+            close = difflib.get_close_matches(name, sorted(known | DEPTH_KEYS), n=1, cutoff=0.6)
+            return name, where, close[0] if close else None
+    if nested:
+        key = next(k for k in _NESTS if isinstance(data.get(k), dict))
+        return _unknown_key(data[key], f"{where}{key}.")
+    return None
+
+
+def _unknown_message(key: str, where: str, close: str | None) -> str:
+    if where and key in DEPTH_KEYS:
+        return f"{key!r} under {where[:-1]!r} is not read: write it at the top level of the file"
+    hint = f"; did you mean {close!r}?" if close else f"; known keys: {', '.join(sorted(LAYOUT_KEYS | DEPTH_KEYS))}"
+    return f"unknown key {where + key!r} (not a key of any intrinsics layout symfruit reads){hint}"
 
 
 def read_mapping(path: Path) -> Any:

@@ -231,8 +231,8 @@ class CocoSet:
             except (KeyError, TypeError, ValueError, OverflowError):
                 raise FileFormatError(f"{label}: height/width are not whole numbers") from None
             if stated != (h, w):
-                turned = (" (turned a quarter: images are read as their pixels are stored, an EXIF orientation is "
-                          "not applied; annotate the stored pixels, or save the photos turned)")  # fmt: skip
+                turned = (" (turned a quarter: images are read as displayed, an EXIF orientation applied; annotate "
+                          "each image as it is displayed, not its stored pixels)")  # fmt: skip
                 raise FileFormatError(f"{label} is {stated[1]}x{stated[0]} in the file but {w}x{h} on disk"
                                       f"{turned if stated == (w, h) else ''}")  # fmt: skip
         return entry, (h, w)

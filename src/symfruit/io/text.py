@@ -18,7 +18,7 @@ from typing import Any
 
 from ..errors import FileFormatError, InputError, SymfruitError
 
-__all__ = ["as_path", "read_limited", "read_structured", "refuse_pipe"]
+__all__ = ["as_path", "holds_file", "read_limited", "read_structured", "refuse_pipe"]
 
 
 def as_path(value: Any, what: str) -> Path:
@@ -30,6 +30,29 @@ def as_path(value: Any, what: str) -> Path:
         except TypeError:  # an os.PathLike whose __fspath__ returns neither str nor bytes
             pass
     raise InputError(f"{what} must be a path (str or os.PathLike), got {type(value).__name__}")
+
+
+def holds_file(path: Path) -> bool:
+    """Whether ``path`` is a file: False where nothing has that name. An entry of that name that is no file
+    (a directory, a link whose target is missing or that links in a loop, a pipe) is refused by name, never
+    read as "no such file" (a frame's ``masks.png`` folder would quietly mean no masks).
+
+    Raises
+    ------
+    FileFormatError
+        Naming the path and what it is.
+    """
+    if path.is_file():
+        return True
+    if not os.path.lexists(path):
+        return False
+    if path.is_dir():
+        why = "a directory, not a file"
+    elif path.is_symlink():
+        why = "a link that leads to no file (its target is missing, or the links loop)"
+    else:
+        why = "not a regular file"
+    raise FileFormatError(f"{path}: {why}")
 
 
 def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileFormatError, devices: bool = False) -> None:
