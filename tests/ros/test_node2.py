@@ -265,7 +265,7 @@ def test_markers_and_points_arrive(world, example_fruits):
 SPOILT = [  # (spoil, what the node's log line says)
     ("truncated_color", "image data holds 460800 bytes, 480 rows of 1920 need 921600"),
     ("truncated_depth", "image data holds 307200 bytes, 480 rows of 1280 need 614400"),
-    ("color_encoding", "unsupported image encoding 'yuv422'"),
+    ("color_encoding", "unsupported image encoding 'yuv420'"),
     ("depth_encoding", "depth image has 3 channels, expected 1"),
     ("short_step", "image step 640 is shorter than a row of 640 rgb8 pixels"),
     ("huge_claim", "image of 16384x16384 pixels is empty or larger than 40,000,000 pixels"),

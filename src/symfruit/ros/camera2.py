@@ -68,7 +68,7 @@ OUTPUTS = ("detections", "markers", "fruit_points")
 SPOILS = (
     "truncated_color",  # half of the colour image's data
     "truncated_depth",  # half of the depth image's data
-    "color_encoding",  # colour claims yuv422
+    "color_encoding",  # colour claims yuv420 (a layout no reader decodes)
     "depth_encoding",  # depth claims rgb8 (a colour image on the depth topic)
     "short_step",  # colour step shorter than a row
     "huge_claim",  # colour claims 16384 x 16384 pixels, with the data of 640 x 480
@@ -256,7 +256,7 @@ def frame_messages(
     elif spoil == "truncated_depth":
         ddata = ddata[: len(ddata) // 2]
     elif spoil == "color_encoding":
-        color = "yuv422"
+        color = "yuv420"
     elif spoil == "depth_encoding":
         depth, ddata, dstep = "rgb8", cdata, cstep
     elif spoil == "short_step":
