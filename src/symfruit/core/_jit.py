@@ -676,6 +676,28 @@ def huber_cost(res: np.ndarray, huber: float) -> float:
 
 
 @_njit
+def _weighted_normal(
+    both: np.ndarray, huber: float, step: np.ndarray, w: np.ndarray, jac: np.ndarray, jtj: np.ndarray
+) -> None:
+    """The Huber weights ``w`` (n,) of the residuals ``both[0]``, the forward-difference Jacobian ``jac`` (4, n) from
+    the residuals at each step ``both[1:]``, and ``J^T W J`` into ``jtj`` (4, 4), as the twin forms them."""
+    n = both.shape[1]
+    for i in range(n):
+        ri = both[0, i]
+        a = abs(ri)
+        w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
+        for b in range(4):
+            jac[b, i] = (both[b + 1, i] - ri) / step[b]
+    for a in range(4):
+        for b in range(a, 4):
+            s = 0.0
+            for i in range(n):
+                s += jac[a, i] * w[i] * jac[b, i]
+            jtj[a, b] = s
+            jtj[b, a] = s
+
+
+@_njit
 def cone_fit(
     grid: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
     step: np.ndarray, huber: float, iterations: int, tolerance: float, tau_max: float,
@@ -714,23 +736,12 @@ def cone_fit(
     trial = np.empty(4)
     for _ in range(iterations):
         done = False
-        for i in range(n):
-            ri = both[0, i]
-            a = abs(ri)
-            w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
-            for b in range(4):
-                jac[b, i] = (both[b + 1, i] - ri) / step[b]
+        _weighted_normal(both, huber, step, w, jac, jtj)
         for a in range(4):
             s = 0.0
             for i in range(n):
                 s += jac[a, i] * w[i] * both[0, i]
             g[a] = s
-            for b in range(a, 4):
-                s = 0.0
-                for i in range(n):
-                    s += jac[a, i] * w[i] * jac[b, i]
-                jtj[a, b] = s
-                jtj[b, a] = s
         improved = False
         # at the bound with the cost falling beyond it, tau stays there and the other three are solved for alone
         free = 3 if p[3] >= tau_max and g[3] < 0 else 4
@@ -805,24 +816,14 @@ def cone_result(
         return m, shape, False, np.nan, np.nan
     w = np.empty(n)
     jac = np.empty((4, n))
+    jtj = np.empty((4, 4))
+    _weighted_normal(both, huber, step, w, jac, jtj)
     top = bottom = 0.0
     for i in range(n):
-        ri = both[0, i]
-        a = abs(ri)
-        w[i] = 1.0 if a <= huber else huber / max(a, 1e-12)
-        top += w[i] * ri * ri
+        top += w[i] * both[0, i] * both[0, i]
         bottom += w[i]
-        for b in range(4):
-            jac[b, i] = (both[b + 1, i] - ri) / step[b]
     sigma2 = top / max(bottom - 4.0, 1.0)
-    jtj = np.empty((4, 4))
     for a in range(4):
-        for b in range(a, 4):
-            s = 0.0
-            for i in range(n):
-                s += jac[a, i] * w[i] * jac[b, i]
-            jtj[a, b] = s
-            jtj[b, a] = s
         jtj[a, a] += 1e-18
     cov = np.empty((4, 4))
     lhs = np.empty((4, 4))
