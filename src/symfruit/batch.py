@@ -524,17 +524,22 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
 
 def _labeller(
     masks: str | Path | MaskSource | Masker, settings: Settings | None, images: Sequence[Path]
-) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any], np.ndarray], str]:
-    """What :func:`segment_images` runs on each image ``(path, color, depth, camera) -> labels``, and a word on
+) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any, int], np.ndarray], str]:
+    """What :func:`segment_images` runs on each image ``(path, color, depth, camera, orientation) -> labels``
+    (``orientation``: the image's EXIF orientation, which a label file read for it must carry too), and a word on
     it: a callable ``(color, depth=, camera=) -> labels`` as it is, anything else through
     :func:`symfruit.segment.mask_source` (checked here, before any image)."""
     if callable(masks) and not isinstance(masks, MaskSource):
         fn = masks
-        return (lambda path, color, depth, camera: np.asarray(fn(color, depth=depth, camera=camera))), getattr(
-            masks, "__name__", "callable"
-        )
+        return (
+            lambda path, color, depth, camera, turned=1: np.asarray(fn(color, depth=depth, camera=camera))
+        ), getattr(masks, "__name__", "callable")
     source = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings, images=images)
-    return (lambda path, color, depth, camera: source(color, depth, camera, name=path.name)[0]), source.name
+    return (
+        lambda path, color, depth, camera, turned=1: source(
+            color, depth, camera, name=path.name, color_file=(path, turned)
+        )[0]
+    ), source.name
 
 
 T = TypeVar("T")
@@ -658,7 +663,7 @@ def segment_images(
                     if z is not None:
                         _check_camera(camera, color.shape[:2], path)
                     t0 = time.perf_counter()
-                    labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
+                    labels = np.asarray(labeller(path, color, z, camera if z is not None else None, turned))
                     ms = (time.perf_counter() - t0) * 1000.0
                     if labels.shape != color.shape[:2]:
                         turned_mismatch(path, color.shape, {"the mask source's labels": labels.shape})
