@@ -360,8 +360,10 @@ def test_a_frames_masks_png_must_carry_the_colour_images_exif_orientation(tmp_pa
     exif = Image.Exif()
     exif[0x0112] = 2  # mirrored left-right on reading
     Image.fromarray(labels).save(folder / "masks.png", exif=exif)
-    said = (r"f/color\.png: its EXIF orientation 1 \(as stored\) is applied on reading \(images are read as "
-            r"displayed\), but masks\.png has 2 \(mirrored left-right\): labels registered to the stored pixels")
+    said = (
+        r"f/color\.png: its EXIF orientation 1 \(as stored\) is applied on reading \(images are read as "
+        r"displayed\), but masks\.png has 2 \(mirrored left-right\): labels registered to the stored pixels"
+    )
     with pytest.raises(FileFormatError, match=said):
         read_frame(folder)
     exif[0x0112] = 1
