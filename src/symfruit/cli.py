@@ -140,7 +140,8 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "ids in every frame): how far each box is from a cube and how far the frames disagree, e.g. "
                    "examples/real-frames")  # fmt: skip
     p.add_argument("--masks", default=None,
-                   help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
+                   help="with --frames: mask source (see `symfruit detect`; default auto); with --spheres: mask files "
+                   "only (default auto: each frame's own; a frame without one is skipped); with --protocol masks: "
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
