@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .limits import MAX_DEPTH_METRES
 
 __all__ = [
     "as_points",
@@ -107,6 +108,8 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     """
     if isinstance(points, np.ndarray) and np.iscomplexobj(points):
         raise InputError(f"{name} must be real numbers, got a complex array")
+    if isinstance(points, np.ndarray) and points.dtype.kind == "b":  # True/False would read as 1 m / 0 m
+        raise InputError(f"{name} must be x, y, z in metres, got a boolean array (a mask?)")
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -131,8 +134,9 @@ def check_cloud(
 
     Non-finite rows are dropped (and counted); clouds over ``max_points`` are down-sampled with a
     fixed seed. Raises :class:`InputError` for anything a fruit cannot be: wrong shape, too few
-    points, points at or behind the camera, all points identical or on a line or a plane, or a cloud
-    wider than ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
+    points, points at or behind the camera or beyond any depth camera's reach (:data:`MAX_DEPTH_METRES`), all
+    points identical or on a line or a plane, or a cloud wider than ``max_extent`` (most often a cloud in
+    millimetres) or narrower than ``min_extent``.
 
     Parameters
     ----------
@@ -165,6 +169,12 @@ def check_cloud(
         raise InputError(
             f"the cloud is {extent:.3g} m across, too large for one fruit ({key}max_extent = {max_extent} m); "
             "if it is in millimetres, use --units mm (or divide by 1000)"
+        )
+    reach = float(np.abs(np.concatenate([lo, hi])).max())
+    if reach > MAX_DEPTH_METRES:  # a fruit-sized cloud a kilometre off: beyond any depth camera, a wrong origin
+        raise InputError(
+            f"the points lie up to {reach:.3g} m from the camera, beyond any depth camera's reach "
+            f"({MAX_DEPTH_METRES:g} m); points must be in the camera optical frame, in metres"
         )
     if extent < min_extent:
         if extent == 0:
