@@ -213,7 +213,7 @@ def _run_recording(
     for index, name in enumerate(names):
         key = rec.key + name
         folder = rec.folder / frame_folder_name(name, reserved)
-        if resume and (folder / "detections.json").is_file():
+        if resume and frame_done(folder):
             report.skipped.append(key)
             bar.update()
             continue
@@ -239,6 +239,21 @@ def _run_recording(
             report.fruits += sum(d.result is not None for d in found.detections)
             report.failed_fruits += sum(d.result is None for d in found.detections)
         bar.update()
+
+
+def frame_done(folder: Path) -> bool:
+    """Whether a frame's output ``folder`` holds a whole ``detections.json`` record (``--resume`` skips it): one
+    that cannot be read back into the tables (truncated by a copy, a crash outside symfruit's atomic writes,
+    another tool) means the frame is run again, not skipped and then left out of the tables."""
+    from .season.table import read_frame_rows
+
+    if not (folder / "detections.json").is_file():
+        return False
+    try:
+        read_frame_rows(folder / "detections.json", "")
+    except SymfruitError:
+        return False
+    return True
 
 
 @dataclass(frozen=True)

@@ -169,7 +169,9 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
                    help="output folder (one sub-folder per frame; with several inputs one per recording)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
-    p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
+    p.add_argument("--resume", action="store_true",
+                   help="skip frames whose detections.json is a whole record (one that cannot be read back, "
+                   "truncated by a copy, is run again)")  # fmt: skip
     _add_ros2_bag_options(p)
     _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
