@@ -140,7 +140,7 @@ def _check_sizes(path: Path, *sizes: np.ndarray) -> None:
         bad = np.flatnonzero(np.isfinite(size) & ((size < 0) | (size > MAX_SIZE_M)) | np.isinf(size))
         if len(bad):
             raise FileFormatError(f"{path}: row {int(bad[0]) + 1} has {name} {size[bad[0]]:g} m; box sides are "
-                                  f"metres in [0, {MAX_SIZE_M:g}] (not a symfruit table, or a damaged one)")  # fmt: skip
+                                  f"metres in [0, {MAX_SIZE_M:g}] (not a symfruit table, or damaged)")  # fmt: skip
 
 
 def _errors(output: Path) -> tuple[int, int]:
