@@ -108,6 +108,10 @@ def test_tables_too_large_or_not_ours_are_refused(run, monkeypatch):
     with pytest.raises(FileFormatError, match="not a symfruit table"):
         write_report(run)
     assert not (run / "report").exists()
+    (run / "frames.parquet").unlink()
+    (run / "frames.parquet").mkdir()  # was "no such table; run `symfruit detect` first"
+    with pytest.raises(FileFormatError, match=r"frames\.parquet: a directory, not a file"):
+        write_report(run)
 
 
 def test_box_sides_no_completion_writes_and_unbounded_classes_are_refused(tmp_path):

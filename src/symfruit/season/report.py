@@ -81,7 +81,9 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
     """The ``columns`` of a Parquet table, after checking its row count and column sizes against the bounds."""
     import pyarrow.parquet as pq
 
-    if not path.is_file():
+    from ..io.text import holds_file
+
+    if not holds_file(path):  # a directory or broken link of that name says so, not "no such table"
         raise FileFormatError(f"{path}: no such table; run `symfruit detect ... --output {path.parent}` first")
     try:
         meta = pq.ParquetFile(path).metadata
