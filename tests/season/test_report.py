@@ -133,6 +133,16 @@ def test_box_sides_no_completion_writes_and_unbounded_classes_are_refused(tmp_pa
         size_classes(np.ones(1), list(range(1, 52)))
 
 
+def test_an_errors_json_that_is_not_ours_is_refused_not_counted_as_no_failures(run):
+    (run / "errors.json").write_text('{"failed": 5}')  # counted no failed frame
+    with pytest.raises(FileFormatError, match=r"errors\.json: not a symfruit errors\.json \('failed' is not a list\)"):
+        write_report(run)
+    (run / "errors.json").unlink()
+    (run / "errors.json").mkdir()
+    with pytest.raises(FileFormatError, match=r"errors\.json: a directory, not a file"):
+        write_report(run)
+
+
 def test_without_matplotlib_the_message_names_the_extra(run, monkeypatch):
     import builtins
 

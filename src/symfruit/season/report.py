@@ -148,16 +148,19 @@ def _check_sizes(path: Path, *sizes: np.ndarray) -> None:
 def _errors(output: Path) -> tuple[int, int]:
     """Frames ``errors.json`` lists as failed or not reached, and recordings it lists as not read (0, 0 without
     the file)."""
-    from ..io.text import read_structured
+    from ..io.text import holds_file, read_structured
     from .table import MAX_RECORD_BYTES
 
     path = output / "errors.json"
-    if not path.is_file():
+    if not holds_file(path):  # a directory or broken link of that name is said, not taken for "no failures"
         return 0, 0
     data = read_structured(path, what="errors.json", max_bytes=MAX_RECORD_BYTES)
     if not isinstance(data, dict):
         raise FileFormatError(f"{path}: not a symfruit errors.json")
-    count = lambda key: len(data[key]) if isinstance(data.get(key), list) else 0  # noqa: E731
+    for key in ("failed", "unprocessed", "recordings"):  # {"failed": 5} counted no failed frame
+        if key in data and not isinstance(data[key], list):
+            raise FileFormatError(f"{path}: not a symfruit errors.json ({key!r} is not a list)")
+    count = lambda key: len(data.get(key, []))  # noqa: E731
     return count("failed") + count("unprocessed"), count("recordings")
 
 
