@@ -193,5 +193,8 @@ def test_a_cloud_beyond_any_depth_cameras_reach_or_of_booleans_is_refused():
             match=r"the points lie up to 1[0-9.e+]+ m from the camera, beyond any depth camera's reach \(100 m\)",
         ):
             check_cloud(front + offset)
+    for z in (1e-9, 5e-324):  # one stray point at 5e-324 m ended 'evidence' in numpy's "data must be finite"
+        with pytest.raises(InputError, match=r"1 of \d+ points are nearer the camera than 1 mm \(z as small as"):
+            check_cloud(np.vstack([front, [[0.01, 0.01, z]]]))
     with pytest.raises(InputError, match=r"points must be x, y, z in metres, got a boolean array"):
         check_cloud(front > 0.01)

@@ -13,7 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
-from .limits import MAX_DEPTH_METRES
+from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES
 
 __all__ = [
     "as_points",
@@ -134,9 +134,9 @@ def check_cloud(
 
     Non-finite rows are dropped (and counted); clouds over ``max_points`` are down-sampled with a
     fixed seed. Raises :class:`InputError` for anything a fruit cannot be: wrong shape, too few
-    points, points at or behind the camera or beyond any depth camera's reach (:data:`MAX_DEPTH_METRES`), all
-    points identical or on a line or a plane, or a cloud wider than ``max_extent`` (most often a cloud in
-    millimetres) or narrower than ``min_extent``.
+    points, points at or behind the camera, nearer than :data:`MIN_DEPTH_METRES` or beyond any depth camera's
+    reach (:data:`MAX_DEPTH_METRES`), all points identical or on a line or a plane, or a cloud wider than
+    ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
 
     Parameters
     ----------
@@ -162,6 +162,12 @@ def check_cloud(
         raise InputError(
             f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
             "the camera optical frame (x right, y down, z forward), in metres"
+        )
+    if arr[:, 2].min() < MIN_DEPTH_METRES:
+        near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
+        raise InputError(
+            f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
+            f"{arr[:, 2].min():.3g} m), which no depth camera measures; drop them (stray or flying pixels)"
         )
     lo, hi = bounds(arr)
     extent = float((hi - lo).max())
