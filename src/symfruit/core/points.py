@@ -163,12 +163,6 @@ def check_cloud(
             f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
             "the camera optical frame (x right, y down, z forward), in metres"
         )
-    if arr[:, 2].min() < MIN_DEPTH_METRES:
-        near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
-        raise InputError(
-            f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
-            f"{arr[:, 2].min():.3g} m), which no depth camera measures; drop them (stray or flying pixels)"
-        )
     lo, hi = bounds(arr)
     extent = float((hi - lo).max())
     if extent > max_extent:
@@ -188,6 +182,13 @@ def check_cloud(
         raise InputError(
             f"the cloud is only {extent * 1000:.3g} mm across, too small for a fruit ({key}min_extent = "
             f"{min_extent * 1000:g} mm); check the units (--units m for metres)"
+        )
+    # after the extents: a cloud in metres read as millimetres (--units mm) is told its units, not its depth
+    if arr[:, 2].min() < MIN_DEPTH_METRES:
+        near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
+        raise InputError(
+            f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
+            f"{arr[:, 2].min():.3g} m), which no depth camera measures; drop them (stray or flying pixels)"
         )
     centred = arr - mean_point(arr)
     spread = np.linalg.eigvalsh(centred.T @ centred)  # ascending variances (times n)
