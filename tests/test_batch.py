@@ -52,6 +52,21 @@ def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
     assert again.skipped == ["f1", "f3"] and (out / "f1" / "detections.json").read_bytes() == before
 
 
+def test_resume_runs_again_a_frame_whose_record_cannot_be_read_back(tmp_path):
+    # a detections.json truncated by a copy was trusted: the frame was skipped, then left out of the tables
+    frames = recording(tmp_path / "rec", "f1", "f2")
+    out = tmp_path / "out"
+    run_batch(frames, out, method="raw", progress=False)
+    before = _fruits(out)
+    (out / "f2" / "detections.json").write_bytes((out / "f2" / "detections.json").read_bytes()[:300])
+    (out / "f1" / "detections.json").write_text('{"frame": "f1"}')  # JSON, but no record
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == [] and again.done == ["f1", "f2"] and again.ok
+    assert _fruits(out) == before
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == ["f1", "f2"] and again.ok
+
+
 def test_frame_folder_names_stay_in_their_folder_and_never_collide():
     assert frame_folder_name("f1") == "f1"
     assert frame_folder_name("../../etc/passwd").startswith("etc_passwd+")

@@ -295,3 +295,20 @@ def test_a_box_looked_for_within_the_old_one_is_find_objects(seed):
     after = ndimage.find_objects(trimmed)
     after += [None] * (len(before) - len(after))  # labels gone from the end
     assert [_box_within(trimmed, k, sl) for k, sl in enumerate(before, 1)] == after
+
+
+def test_a_label_file_for_a_frame_must_carry_its_colour_images_exif_orientation(tmp_path):
+    from PIL import Image
+
+    from symfruit.errors import FileFormatError
+
+    frame = small_frame()
+    labels = np.zeros((120, 160), np.uint8)
+    labels[40:80, 60:100] = 1
+    exif = Image.Exif()
+    exif[0x0112] = 3  # half a turn on reading: the size agrees with the frame
+    Image.fromarray(labels).save(tmp_path / "m.png", exif=exif)
+    with pytest.raises(FileFormatError, match=r"frame small's colour image: its EXIF orientation 1 .* m\.png has 3"):
+        frame_masks(frame, str(tmp_path / "m.png"))
+    tagged = replace(frame, extras={"color_file": ("f/color.jpg", 3)})  # a frame folder's colour, turned alike
+    assert np.array_equal(frame_masks(tagged, str(tmp_path / "m.png"))[0], labels[::-1, ::-1])

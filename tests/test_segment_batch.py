@@ -78,6 +78,25 @@ def test_a_photo_turned_by_its_exif_orientation_is_segmented_as_displayed_and_st
                      r".*, but p0\.png has 1 \(as stored\)", next(iter(bad.failed.values())))  # fmt: skip
 
 
+def test_a_label_png_for_a_photo_must_carry_its_exif_orientation(tmp_path):
+    # half a turn keeps the size: the labels were paired with the other end of the photo in silence
+    color, _ = make_photo([(80, 120, 40, RED)], seed=0)
+    exif = Image.Exif()
+    exif[0x0112] = 3
+    for folder in ("in", "labels"):
+        (tmp_path / folder).mkdir()
+    Image.fromarray(color).save(tmp_path / "in" / "p0.jpg", exif=exif, quality=95)
+    labels = np.zeros(color.shape[:2], np.uint8)
+    labels[80:160, 40:120] = 1
+    Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
+    bad = segment_images([tmp_path / "in"], output=tmp_path / "o1", masks=tmp_path / "labels")
+    assert not bad.done and re.search(r"p0\.jpg: its EXIF orientation 3 \(turned half around\) .* but p0\.png has 1 "
+                                      r"\(as stored\): labels registered", next(iter(bad.failed.values())))  # fmt: skip
+    Image.fromarray(labels).save(tmp_path / "labels" / "p0.png", exif=exif)  # turned alike: read as displayed
+    good = segment_images([tmp_path / "in"], output=tmp_path / "o2", masks=tmp_path / "labels")
+    assert good.done[0].fruit == 1 and not good.failed
+
+
 def test_a_depth_entry_that_is_no_file_is_refused_not_passed_over_for_colour_alone(tmp_path):
     folder = _photos(tmp_path / "in", n=1)
     depth = tmp_path / "depth"

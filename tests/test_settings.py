@@ -36,8 +36,9 @@ def test_round_trip():
     "data, message",
     [
         ({"paper": {"rotations_x": "eleven"}}, r"paper.rotations_x: expected a whole number"),
-        ({"paper": {"rotatons_x": 3}}, r"unknown setting paper.rotatons_x"),
-        ({"papr": {}}, r"unknown setting papr"),
+        ({"paper": {"rotatons_x": 3}}, r"unknown setting paper.rotatons_x \(did you mean 'rotations_x'\?\); known"),
+        ({"papr": {}}, r"unknown setting papr \(did you mean 'paper'\?\); known sections"),
+        ({"paper": {"Translations": 3}}, r"paper.Translations \(did you mean 'translations'\?\)"),
         ({"paper": {"scoring": "smooth"}}, r"paper.scoring: expected one of"),
         ({"paper": {"j2": 1.5}}, r"paper.j2: must be smaller than j3"),
         ({"paper": {"translations": 0}}, r"paper.translations: must be >= 1, got 0"),
@@ -134,7 +135,7 @@ def test_errors_name_the_layer_and_the_dotted_key(tmp_path):
         resolve_settings(fruit=profile)
     config = tmp_path / "run.yaml"
     config.write_text("fused:\n  mirror:\n    nope: 1\n")
-    with pytest.raises(ConfigError, match=r"run\.yaml: unknown setting fused\.mirror\.nope; known: "):
+    with pytest.raises(ConfigError, match=r"run\.yaml: unknown setting fused\.mirror\.nope; known: "):  # none close
         resolve_settings(config=config)
     with pytest.raises(ConfigError, match=r"^fused\.mirror\.j3: must be <= 10, got 11"):
         resolve_settings(overrides={"fused": {"mirror": {"j3": 11}}})
@@ -249,7 +250,9 @@ def test_settings_are_immutable_and_name_unknown_sections():
         s.paper = PaperSettings()
     with pytest.raises(AttributeError, match="Settings has no section 'papr'"):
         _ = s.papr
-    with pytest.raises(ConfigError, match=r"unknown settings section 'papr'; known: .*paper"):
+    with pytest.raises(
+        ConfigError, match=r"unknown settings section 'papr' \(did you mean 'paper'\?\); known: .*paper"
+    ):
         s.section("papr")
     with pytest.raises(ConfigError, match="unknown settings section 'papr'"):
         Settings(papr=PaperSettings())

@@ -213,7 +213,7 @@ def _run_recording(
     for index, name in enumerate(names):
         key = rec.key + name
         folder = rec.folder / frame_folder_name(name, reserved)
-        if resume and (folder / "detections.json").is_file():
+        if resume and frame_done(folder):
             report.skipped.append(key)
             bar.update()
             continue
@@ -239,6 +239,21 @@ def _run_recording(
             report.fruits += sum(d.result is not None for d in found.detections)
             report.failed_fruits += sum(d.result is None for d in found.detections)
         bar.update()
+
+
+def frame_done(folder: Path) -> bool:
+    """Whether a frame's output ``folder`` holds a whole ``detections.json`` record (``--resume`` skips it): one
+    that cannot be read back into the tables (truncated by a copy, a crash outside symfruit's atomic writes,
+    another tool) means the frame is run again, not skipped and then left out of the tables."""
+    from .season.table import read_frame_rows
+
+    if not (folder / "detections.json").is_file():
+        return False
+    try:
+        read_frame_rows(folder / "detections.json", "")
+    except SymfruitError:
+        return False
+    return True
 
 
 @dataclass(frozen=True)
@@ -524,17 +539,22 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
 
 def _labeller(
     masks: str | Path | MaskSource | Masker, settings: Settings | None, images: Sequence[Path]
-) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any], np.ndarray], str]:
-    """What :func:`segment_images` runs on each image ``(path, color, depth, camera) -> labels``, and a word on
+) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any, int], np.ndarray], str]:
+    """What :func:`segment_images` runs on each image ``(path, color, depth, camera, orientation) -> labels``
+    (``orientation``: the image's EXIF orientation, which a label file read for it must carry too), and a word on
     it: a callable ``(color, depth=, camera=) -> labels`` as it is, anything else through
     :func:`symfruit.segment.mask_source` (checked here, before any image)."""
     if callable(masks) and not isinstance(masks, MaskSource):
         fn = masks
-        return (lambda path, color, depth, camera: np.asarray(fn(color, depth=depth, camera=camera))), getattr(
-            masks, "__name__", "callable"
-        )
+        return (
+            lambda path, color, depth, camera, turned=1: np.asarray(fn(color, depth=depth, camera=camera))
+        ), getattr(masks, "__name__", "callable")
     source = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings, images=images)
-    return (lambda path, color, depth, camera: source(color, depth, camera, name=path.name)[0]), source.name
+    return (
+        lambda path, color, depth, camera, turned=1: source(
+            color, depth, camera, name=path.name, color_file=(path, turned)
+        )[0]
+    ), source.name
 
 
 T = TypeVar("T")
@@ -658,7 +678,7 @@ def segment_images(
                     if z is not None:
                         _check_camera(camera, color.shape[:2], path)
                     t0 = time.perf_counter()
-                    labels = np.asarray(labeller(path, color, z, camera if z is not None else None))
+                    labels = np.asarray(labeller(path, color, z, camera if z is not None else None, turned))
                     ms = (time.perf_counter() - t0) * 1000.0
                     if labels.shape != color.shape[:2]:
                         turned_mismatch(path, color.shape, {"the mask source's labels": labels.shape})

@@ -140,7 +140,8 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "ids in every frame): how far each box is from a cube and how far the frames disagree, e.g. "
                    "examples/real-frames")  # fmt: skip
     p.add_argument("--masks", default=None,
-                   help="with --frames: mask source (see `symfruit detect`; default auto); with --protocol masks: "
+                   help="with --frames: mask source (see `symfruit detect`; default auto); with --spheres: mask files "
+                   "only (default auto: each frame's own; a frame without one is skipped); with --protocol masks: "
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
@@ -168,7 +169,9 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
                    help="output folder (one sub-folder per frame; with several inputs one per recording)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
-    p.add_argument("--resume", action="store_true", help="skip frames whose detections.json exists")  # fmt: skip
+    p.add_argument("--resume", action="store_true",
+                   help="skip frames whose detections.json is a whole record (one that cannot be read back, "
+                   "truncated by a copy, is run again)")  # fmt: skip
     _add_ros2_bag_options(p)
     _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")

@@ -22,6 +22,7 @@ from .core.occlusion import Occlusion
 from .core.raster import mask_box
 from .errors import InputError, SymfruitError
 from .extract import Extraction, extract, register, trim_labels
+from .io.frames import COLOR_FILE
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
 from .methods.registry import get as get_method
@@ -102,7 +103,10 @@ def frame_masks(
         labels, source = np.asarray(masks(frame, settings)), getattr(masks, "__name__", "callable")
     else:
         source_of = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings)
-        labels, source = source_of(frame.color, frame.depth, frame.camera, name=frame.name, own=frame.masks)
+        # a label file must turn on reading as the frame's colour did (pixels as stored where it was no file)
+        color_file = frame.extras.get(COLOR_FILE) or (f"frame {frame.name}'s colour image", 1)
+        labels, source = source_of(frame.color, frame.depth, frame.camera, name=frame.name, own=frame.masks,
+                                   color_file=color_file)  # fmt: skip
     if labels.ndim != 2:
         raise InputError(f"frame {frame.name}: masks must be an (h, w) label image, got shape {labels.shape}")
     if labels.shape != shape:

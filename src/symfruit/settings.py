@@ -28,7 +28,7 @@ import dataclasses
 import math
 import types
 import typing
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar
 
@@ -159,7 +159,8 @@ class Settings:
         known = _sections()
         unknown = sorted(set(sections) - set(known))
         if unknown:
-            raise ConfigError(f"unknown settings section {unknown[0]!r}; known: {', '.join(known)}")
+            raise ConfigError(f"unknown settings section {unknown[0]!r}{_closest(unknown[0], known)}; known: "
+                              f"{', '.join(known)}")  # fmt: skip
         values = {}
         for name, cls in known.items():
             value = sections.get(name)
@@ -175,7 +176,8 @@ class Settings:
         try:
             return self._sections[name]
         except KeyError:
-            raise ConfigError(f"unknown settings section {name!r}; known: {', '.join(self._sections)}") from None
+            raise ConfigError(f"unknown settings section {name!r}{_closest(name, self._sections)}; known: "
+                              f"{', '.join(self._sections)}") from None  # fmt: skip
 
     def __getattr__(self, name: str) -> Any:
         try:
@@ -283,7 +285,8 @@ def _build(cls: type, data: Mapping[str, Any], where: str) -> Any:
         raise ConfigError(f"{where or 'settings'}: setting names must be text, got {bad[0]!r}")
     unknown = sorted(set(data) - set(fields))
     if unknown:
-        raise ConfigError(f"unknown setting {prefix}{unknown[0]}; known: {', '.join(sorted(fields))}")
+        raise ConfigError(f"unknown setting {prefix}{unknown[0]}{_closest(unknown[0], fields)}; known: "
+                          f"{', '.join(sorted(fields))}")  # fmt: skip
     kwargs = {name: _coerce(value, hints[name], prefix + name) for name, value in data.items()}
     try:
         return cls(**kwargs)
@@ -301,9 +304,18 @@ def from_dict(data: Any) -> Settings:
     known = _sections()
     unknown = sorted(set(data) - set(known))
     if unknown:
-        raise ConfigError(f"unknown setting {unknown[0]}; known sections: {', '.join(known)}")
+        raise ConfigError(f"unknown setting {unknown[0]}{_closest(unknown[0], known)}; known sections: "
+                          f"{', '.join(known)}")  # fmt: skip
     return Settings(**{name: _build(known[name], value, name) if isinstance(value, Mapping) else
                        _not_a_mapping(name, value) for name, value in data.items()})  # fmt: skip
+
+
+def _closest(key: str, known: Iterable[str]) -> str:
+    """`` (did you mean 'x'?)`` for the known name closest to a misspelt ``key`` (difflib), else ``""``."""
+    import difflib
+
+    close = difflib.get_close_matches(key.lower(), list(known), n=1, cutoff=0.6)
+    return f" (did you mean {close[0]!r}?)" if close else ""
 
 
 def _not_a_mapping(name: str, value: Any) -> Any:

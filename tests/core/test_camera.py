@@ -44,6 +44,10 @@ def test_matrix_and_dict(camera):
         ({"height": 2.5}, "height"),
         ({"cx": float("nan")}, "finite"),
         ({"fx": "a"}, "number"),
+        ({"fx": "600"}, r"camera fx must be a number, got '600'"),  # float() read text and True in silence
+        ({"cy": True}, r"camera cy must be a number, got True"),
+        ({"fy": 1e-300}, r"at least 1 pixel, got fx=600, fy=1e-300 \(focal lengths are in pixels"),
+        ({"fx": 0.00193}, r"at least 1 pixel"),  # a 1.93 mm lens in metres
         ({"cy": 10**400}, r"camera cy must be a number, got 10{19}\.\.\.$"),  # beyond float: not OverflowError
     ],
 )

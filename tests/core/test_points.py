@@ -181,3 +181,20 @@ def test_perpendicular_basis_of_one_row_is_that_row_of_many(seed):
             assert np.array_equal(got, want) and np.array_equal(np.signbit(got), np.signbit(want))
     with np.errstate(invalid="ignore"):  # a zero row: numpy's NaN, not a Python ZeroDivisionError
         assert np.isnan(perpendicular_basis(np.zeros((1, 3)))[0]).all()
+
+
+def test_a_cloud_beyond_any_depth_cameras_reach_or_of_booleans_is_refused():
+    # a fruit-sized cloud 1e6 m off was called "a streak along the line of sight"; a boolean mask read as 1 m / 0 m
+    front = np.asarray(VISIBLE)
+    assert check_cloud(front)[0].shape == front.shape
+    for offset in ([1e6, 0, 0], [0, 0, 1e6], [0, -150, 0]):
+        with pytest.raises(
+            InputError,
+            match=r"the points lie up to 1[0-9.e+]+ m from the camera, beyond any depth camera's reach \(100 m\)",
+        ):
+            check_cloud(front + offset)
+    for z in (1e-9, 5e-324):  # one stray point at 5e-324 m ended 'evidence' in numpy's "data must be finite"
+        with pytest.raises(InputError, match=r"1 of \d+ points are nearer the camera than 1 mm \(z as small as"):
+            check_cloud(np.vstack([front, [[0.01, 0.01, z]]]))
+    with pytest.raises(InputError, match=r"points must be x, y, z in metres, got a boolean array"):
+        check_cloud(front > 0.01)

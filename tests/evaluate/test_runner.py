@@ -54,6 +54,35 @@ def test_a_failing_method_is_recorded_and_the_others_go_on(isolated_registry):
     assert rows[1].error == "" and 0 < rows[1].iou < 1
 
 
+def test_a_bad_instance_or_a_method_fault_in_a_worker_pool_is_recorded_and_the_run_goes_on(isolated_registry,
+                                                                                        monkeypatch):  # fmt: skip
+    # with --jobs N one exception in a worker (an instance that could not be built, a method's fault that is no
+    # refusal) ended the whole evaluation through pool.map, every finished instance lost
+    from symfruit.evaluate import runner
+
+    @register("test-fault")
+    def fault(points, camera, settings):
+        """Fails like a bug on the second instance."""
+        if len(points) == len(build(SPECS[1]).visible):
+            raise ValueError("a fault")
+        raise InputError("refused")
+
+    real = runner.build
+
+    def build_or_fail(spec, *args):
+        if spec.index == 2:
+            raise OSError("scan unreadable")
+        return real(spec, *args)
+
+    monkeypatch.setattr(runner, "build", build_or_fail)  # workers are forked: they see it
+    specs = [*SPECS, Spec("paper", "strawberry", 2, 0)]
+    rows = run(specs, ("test-fault", "raw"), jobs=2, progress=False)
+    assert [(r.fruit_index, r.method) for r in rows] == [(i, m) for i in (0, 1, 2) for m in ("test-fault", "raw")]
+    lost = "the instance: internal error (OSError: scan unreadable)"
+    assert [r.error for r in rows] == ["refused", "", "internal error (ValueError: a fault)", "", lost, lost]
+    assert 0 < rows[1].iou < 1 and 0 < rows[3].iou < 1 and math.isnan(rows[4].iou)
+
+
 def row(method="raw", iou=0.5, centre_mm=2.0, confidence=float("nan"), error="", occlusion=0.0, **kw):
     base = dict(protocol="paper", fruit="apple", kind="apple", fruit_index=0, pose=0, angle_x=0.0, angle_y=0.0,
                 angle_z=0.0, distance_m=0.3, occlusion=occlusion, hidden=0.1, n_visible=100, method=method, iou=iou,

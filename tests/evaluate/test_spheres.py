@@ -83,3 +83,22 @@ def test_a_failed_sphere_and_a_single_frame_give_a_summary_that_is_json_and_no_n
     assert "| `raw` | 10.0 / 10.0 | 8.0 (-8.0) | - | 40x40x30 | failed |" in table and "nan" not in table
     boxes = json.loads(json.dumps(summary, allow_nan=False))[0]["boxes"]
     assert boxes[0]["size"] == [40.0, 40.0, 30.0] and boxes[1]["size"] is None and boxes[1]["diameter"] is None
+
+
+def test_frames_without_masks_files_are_left_out_and_a_segmenter_refused(tmp_path):
+    # the colour segmenter numbers what it finds anew in each frame: its sphere 2 of one frame was compared with
+    # another frame's sphere 2 in silence
+    import shutil
+
+    from symfruit.errors import InputError
+
+    for name in ("lab-spheres-0", "no-masks"):
+        shutil.copytree(FRAMES / "lab-spheres-0", tmp_path / name)
+    (tmp_path / "no-masks" / "masks.png").unlink()
+    failed: dict[str, str] = {}
+    rows = evaluate_spheres(tmp_path, methods=("raw",), failed=failed)
+    assert {r.frame for r in rows} == {"lab-spheres-0"} and len(rows) == 4
+    assert set(failed) == {"no-masks"} and "no-masks: no masks file (masks.png or masks.json)" in failed["no-masks"]
+    for spec in ("color", "onnx:model.onnx"):
+        with pytest.raises(InputError, match=rf"--masks {spec}: spheres are matched across frames by their mask ids"):
+            evaluate_spheres(tmp_path, methods=("raw",), masks=spec)

@@ -349,3 +349,25 @@ def test_a_frame_file_that_is_no_file_is_refused_by_name_not_taken_as_missing(tm
     why = "a directory, not a file" if kind == "directory" else "a link that leads to no file"
     with pytest.raises(FileFormatError, match=rf"f/{re.escape(name)}: {why}"):
         read_frame(frame)
+
+
+def test_a_frames_masks_png_must_carry_the_colour_images_exif_orientation(tmp_path):
+    # a mirrored or half-turned mask keeps the size: the size check alone paired it with the wrong pixels
+    color, depth = disc_frame([(80, 60)])
+    labels = np.zeros((120, 160), np.uint8)
+    labels[40:80, 60:100] = 1
+    folder = write_frame(tmp_path / "f", color, depth, CAM, masks=labels)
+    exif = Image.Exif()
+    exif[0x0112] = 2  # mirrored left-right on reading
+    Image.fromarray(labels).save(folder / "masks.png", exif=exif)
+    said = (
+        r"f/color\.png: its EXIF orientation 1 \(as stored\) is applied on reading \(images are read as "
+        r"displayed\), but masks\.png has 2 \(mirrored left-right\): labels registered to the stored pixels"
+    )
+    with pytest.raises(FileFormatError, match=said):
+        read_frame(folder)
+    exif[0x0112] = 1
+    Image.fromarray(labels).save(folder / "masks.png", exif=exif)
+    frame = read_frame(folder)
+    assert np.array_equal(frame.masks, labels)
+    assert frame.extras["color_file"] == (str(folder / "color.png"), 1)

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symfruit import Camera, FileFormatError, SymfruitError
+from symfruit import Camera, FileFormatError, InputError, SymfruitError
 from symfruit.io import camera_from_dict, load_camera
 
 LAYOUTS = {
@@ -79,11 +79,23 @@ def test_readers_survive_random_bytes(tmp_path, data, suffix):
         pass
 
 
+def test_a_mapping_handed_to_the_api_is_checked_as_files_are():
+    # camera_from_dict (symfruit.complete's camera=) took unknown keys: a misspelt 'ppy' read as missing 'cy'
+    plain = {"fx": 615.0, "fy": 616.0, "ppx": 321.0, "ppy": 239.0, "width": 640, "height": 480}
+    with pytest.raises(InputError, match=r"unknown key 'ppyy' .*; did you mean 'ppy'\?"):
+        camera_from_dict({**{k: v for k, v in plain.items() if k != "ppy"}, "ppyy": 239.0})
+    with pytest.raises(InputError, match=r"unknown key 'colour\.hieght' .*; did you mean 'height'\?"):
+        camera_from_dict({"colour": {**plain, "hieght": 480}})
+    with pytest.raises(InputError, match=r"unknown key 'other' .*; known keys: "):
+        camera_from_dict({"intrinsics": plain, "other": 1})
+    assert camera_from_dict({**plain, "depth_scale": 0.001, "model": "brown_conrady", "coeffs": [0] * 5}).cx == 321.0
+
+
 def test_nested_layouts_and_wrong_extensions(tmp_path):
     plain = {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}
     expected = Camera(fx=615.0, fy=616.0, cx=321.0, cy=239.0, width=640, height=480)
     for key in ("intrinsics", "colour", "camera_info"):
-        assert camera_from_dict({key: plain, "other": 1}) == expected
+        assert camera_from_dict({key: plain, "depth": {"fx": 1}}) == expected
     assert camera_from_dict({**plain, "width": 640.0}) == expected  # a whole float is a size
     path = tmp_path / "cam.txt"
     path.write_text(json.dumps(plain))

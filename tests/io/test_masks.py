@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from PIL import Image
 
 from symfruit import FileFormatError
 from symfruit.io import masks as io_masks
@@ -289,3 +290,16 @@ def test_crowd_regions_are_no_instances_and_a_missing_category_is_named(tmp_path
         coco.check_category(2)
     coco.check_category(None)
     coco.check_category(1)
+
+
+def test_a_label_png_must_carry_the_orientation_of_the_colour_image_it_is_for(tmp_path):
+    labels = np.zeros((12, 16), np.uint8)
+    labels[2:5, 3:9] = 1
+    exif = Image.Exif()
+    exif[0x0112] = 3  # half a turn: the size agrees
+    Image.fromarray(labels).save(tmp_path / "m.png", exif=exif)
+    with pytest.raises(FileFormatError, match=r"c\.jpg: its EXIF orientation 1 .* but m\.png has 3 \(turned half"):
+        read_masks(tmp_path / "m.png", (12, 16), color=(tmp_path / "c.jpg", 1))
+    # both turned alike: read as displayed; no colour given: read as displayed, unchecked
+    assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16), color=("c.jpg", 3)), labels[::-1, ::-1])
+    assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16)), labels[::-1, ::-1])

@@ -137,3 +137,20 @@ def test_holds_file_says_what_an_entry_that_is_no_file_is(tmp_path):
                       ("gone.png", "a link that leads to no file"), ("pipe.png", "not a regular file")]:  # fmt: skip
         with pytest.raises(FileFormatError, match=rf"{name}: {why}"):
             holds_file(tmp_path / name)
+
+
+def test_a_key_repeated_in_one_mapping_is_refused_naming_it(tmp_path):
+    # the parsers keep the last in silence: 'translations: 3' above 'translations: 5' was dropped unsaid
+    config = tmp_path / "run.yaml"
+    config.write_text("paper:\n  translations: 3\n  j1: 1\n  translations: 5\n")
+    with pytest.raises(ConfigError, match=r"run\.yaml: not valid YAML: duplicate key 'translations' .* line 4"):
+        load_settings(config)
+    (tmp_path / "cam.json").write_text('{"color": {"fx": 600}, "depth": {}, "color": {"fx": 615}}')
+    with pytest.raises(FileFormatError, match=r"cam\.json: not valid JSON: duplicate key 'color'"):
+        read_structured(tmp_path / "cam.json", what="intrinsics file", max_bytes=1000)
+    # the same key in different mappings, and distinct keys, are fine
+    (tmp_path / "ok.yaml").write_text("a: {x: 1}\nb: {x: 2}\n1: one\n'1': text\n")
+    assert read_structured(tmp_path / "ok.yaml", what="file", max_bytes=1000) == {
+        "a": {"x": 1}, "b": {"x": 2}, 1: "one", "1": "text"}  # fmt: skip
+    (tmp_path / "ok.json").write_text('[{"x": 1}, {"x": 2}]')
+    assert read_structured(tmp_path / "ok.json", what="file", max_bytes=1000) == [{"x": 1}, {"x": 2}]

@@ -108,6 +108,39 @@ def test_tables_too_large_or_not_ours_are_refused(run, monkeypatch):
     with pytest.raises(FileFormatError, match="not a symfruit table"):
         write_report(run)
     assert not (run / "report").exists()
+    (run / "frames.parquet").unlink()
+    (run / "frames.parquet").mkdir()  # was "no such table; run `symfruit detect` first"
+    with pytest.raises(FileFormatError, match=r"frames\.parquet: a directory, not a file"):
+        write_report(run)
+
+
+def test_box_sides_no_completion_writes_and_unbounded_classes_are_refused(tmp_path):
+    # a side of 1e300 m ended the report in an OverflowError (the histogram's bins), 1e6 m asked for a billion
+    # bins, a negative one was counted as a sized fruit; --classes 18,1e9 asked for a billion bins too
+    from symfruit.season.table import frame_rows
+
+    for side, shown in ((1e300, r"1e\+300"), (-0.02, "-0.02"), (2e3, "2000")):
+        out = tmp_path / f"out{side:g}"
+        out.mkdir()
+        with TableWriter(out) as table:
+            table.add(*frame_rows(_record("a", [(0.02, 0.02, 0.02), (side, 0.02, 0.02)]), "row1"))
+        with pytest.raises(FileFormatError, match=rf"detections\.parquet: row 2 has size_x {shown} m; box sides"):
+            write_report(out)
+        assert not (out / "report").exists()
+    with pytest.raises(InputError, match=r"a limit of 1e\+09 mm; diameters are in mm, at most 10000"):
+        size_classes(np.ones(1), [18, 1e9])
+    with pytest.raises(InputError, match=r"size classes: 51 limits; at most 50"):
+        size_classes(np.ones(1), list(range(1, 52)))
+
+
+def test_an_errors_json_that_is_not_ours_is_refused_not_counted_as_no_failures(run):
+    (run / "errors.json").write_text('{"failed": 5}')  # counted no failed frame
+    with pytest.raises(FileFormatError, match=r"errors\.json: not a symfruit errors\.json \('failed' is not a list\)"):
+        write_report(run)
+    (run / "errors.json").unlink()
+    (run / "errors.json").mkdir()
+    with pytest.raises(FileFormatError, match=r"errors\.json: a directory, not a file"):
+        write_report(run)
 
 
 def test_without_matplotlib_the_message_names_the_extra(run, monkeypatch):

@@ -117,3 +117,17 @@ def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):
     for images in (None, [tmp_path / "a.jpg"]):  # an empty spec is not the working folder's label PNGs
         with pytest.raises(InputError, match=r"^--masks '': expected color"):
             mask_source("", images=images)
+
+
+def test_a_label_png_must_turn_on_reading_as_its_colour_image_did(photo, tmp_path):
+    color, _ = photo
+    labels = np.zeros(color.shape[:2], np.uint8)
+    labels[5:50, 5:50] = 1
+    exif = Image.Exif()
+    exif[0x0112] = 4  # mirrored top-bottom: the size agrees
+    Image.fromarray(labels).save(tmp_path / "p0.png", exif=exif)
+    for source, name in ((mask_source(tmp_path / "p0.png"), ""), (mask_source(tmp_path, images=[]), "p0.jpg")):
+        with pytest.raises(Exception, match=r"p0\.jpg: its EXIF orientation 1 .* but p0\.png has 4 \(mirrored"):
+            source(color, name=name, color_file=(tmp_path / "p0.jpg", 1))
+        got = source(color, name=name, color_file=(tmp_path / "p0.jpg", 4))[0]
+        assert np.array_equal(got, labels[::-1])

@@ -48,6 +48,8 @@ class Camera:
     def __post_init__(self) -> None:
         for name in ("fx", "fy", "cx", "cy"):
             value = getattr(self, name)
+            if isinstance(value, bool | str | bytes):  # float() reads True as 1 and "600" as 600 in silence
+                raise InputError(f"camera {name} must be a number, got {value!r}")
             try:
                 value = float(value)
             except (TypeError, ValueError, OverflowError):  # OverflowError: a whole number beyond float's range
@@ -69,6 +71,9 @@ class Camera:
             raise InputError(f"camera image of {self.width}x{self.height} pixels exceeds {MAX_IMAGE_PIXELS:,} pixels")
         if self.fx <= 0 or self.fy <= 0:
             raise InputError(f"camera focal lengths must be positive, got fx={self.fx}, fy={self.fy}")
+        if self.fx < 1.0 or self.fy < 1.0:  # under a pixel per radian: no camera (a focal length in metres)
+            raise InputError(f"camera focal lengths must be at least 1 pixel, got fx={self.fx:g}, fy={self.fy:g} "
+                             "(focal lengths are in pixels, not millimetres or metres)")  # fmt: skip
         if self.fx > MAX_FOCAL_PX or self.fy > MAX_FOCAL_PX:
             raise InputError(f"camera focal lengths must be at most {MAX_FOCAL_PX:g} pixels, got fx={self.fx:g}, "
                              f"fy={self.fy:g}")  # fmt: skip

@@ -36,6 +36,7 @@ __all__ = [
     "MAX_TEXT_CLOUD_BYTES",
     "MAX_TRUTH_BYTES",
     "MAX_WINDOW_PIXELS",
+    "MIN_DEPTH_METRES",
     "check_image_size",
     "depth_metres",
     "instance_labels",
@@ -76,6 +77,9 @@ MAX_TABLE_BYTES = 4096 << 20
 #: Depth handed over as metres whose typical value is beyond this is refused as "raw units, not metres"
 #: (millimetres from a 16-bit depth image are hundreds to thousands).
 MAX_DEPTH_METRES = 100.0
+#: Points nearer the camera than this (metres) are refused: no depth camera measures them, and one at 1e-300 m
+#: projects beyond any float (a method's numpy error, or a fruit sized by one stray point).
+MIN_DEPTH_METRES = 0.001
 
 
 def check_image_size(

@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES
 
 __all__ = [
     "as_points",
@@ -107,6 +108,8 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     """
     if isinstance(points, np.ndarray) and np.iscomplexobj(points):
         raise InputError(f"{name} must be real numbers, got a complex array")
+    if isinstance(points, np.ndarray) and points.dtype.kind == "b":  # True/False would read as 1 m / 0 m
+        raise InputError(f"{name} must be x, y, z in metres, got a boolean array (a mask?)")
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -131,8 +134,9 @@ def check_cloud(
 
     Non-finite rows are dropped (and counted); clouds over ``max_points`` are down-sampled with a
     fixed seed. Raises :class:`InputError` for anything a fruit cannot be: wrong shape, too few
-    points, points at or behind the camera, all points identical or on a line or a plane, or a cloud
-    wider than ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
+    points, points at or behind the camera, nearer than :data:`MIN_DEPTH_METRES` or beyond any depth camera's
+    reach (:data:`MAX_DEPTH_METRES`), all points identical or on a line or a plane, or a cloud wider than
+    ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
 
     Parameters
     ----------
@@ -166,12 +170,25 @@ def check_cloud(
             f"the cloud is {extent:.3g} m across, too large for one fruit ({key}max_extent = {max_extent} m); "
             "if it is in millimetres, use --units mm (or divide by 1000)"
         )
+    reach = float(np.abs(np.concatenate([lo, hi])).max())
+    if reach > MAX_DEPTH_METRES:  # a fruit-sized cloud a kilometre off: beyond any depth camera, a wrong origin
+        raise InputError(
+            f"the points lie up to {reach:.3g} m from the camera, beyond any depth camera's reach "
+            f"({MAX_DEPTH_METRES:g} m); points must be in the camera optical frame, in metres"
+        )
     if extent < min_extent:
         if extent == 0:
             raise InputError("all points are identical; a fruit needs points spread over its surface")
         raise InputError(
             f"the cloud is only {extent * 1000:.3g} mm across, too small for a fruit ({key}min_extent = "
             f"{min_extent * 1000:g} mm); check the units (--units m for metres)"
+        )
+    # after the extents: a cloud in metres read as millimetres (--units mm) is told its units, not its depth
+    if arr[:, 2].min() < MIN_DEPTH_METRES:
+        near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
+        raise InputError(
+            f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
+            f"{arr[:, 2].min():.3g} m), which no depth camera measures; drop them (stray or flying pixels)"
         )
     centred = arr - mean_point(arr)
     spread = np.linalg.eigvalsh(centred.T @ centred)  # ascending variances (times n)

@@ -77,7 +77,25 @@ class Row:
 
 
 def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
-    """Build one instance and run every method on it (runs in a worker process)."""
+    """Build one instance and run every method on it (runs in a worker process). An instance that cannot be
+    built or prepared, and a method that fails in any way, give rows carrying the error: the run goes on
+    (in a worker pool one exception ended the whole evaluation, every finished instance lost)."""
+    try:
+        return _evaluate_instance(spec, methods, settings)
+    except Exception as exc:  # the instance itself: every method's row says why
+        nan = float("nan")
+        return [Row(protocol=spec.protocol, fruit=spec.fruit, kind="", fruit_index=spec.index, pose=spec.pose,
+                    angle_x=nan, angle_y=nan, angle_z=nan, distance_m=nan, occlusion=spec.occlusion, hidden=nan,
+                    n_visible=0, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan, precision=nan,
+                    recall=nan, seconds=nan, error=f"the instance: {_reason(exc)}") for method in methods]  # fmt: skip
+
+
+def _reason(exc: BaseException) -> str:
+    """An error's message; for anything but a refusal of the input, its type too (a fault, not the data)."""
+    return str(exc) if isinstance(exc, SymfruitError) else f"internal error ({type(exc).__name__}: {exc})"
+
+
+def _evaluate_instance(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Row]:
     inst = build(spec)
     visible, mask = inst.visible, inst.mask
     failed = ""
@@ -105,12 +123,12 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
             if failed:
                 raise InputError(failed)
             result = complete(visible, camera=camera, method=method, settings=settings, occlusion=occlusion)
-        except SymfruitError as exc:
+            s = score_completion(result.box, result.points, inst.truth_box, inst.truth_surface)
+        except Exception as exc:  # one method's failure, whatever it is, is its row's; the others go on
             nan = float("nan")
             rows.append(Row(**base, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan,
-                            precision=nan, recall=nan, seconds=nan, error=str(exc)))  # fmt: skip
+                            precision=nan, recall=nan, seconds=nan, error=_reason(exc)))  # fmt: skip
             continue
-        s = score_completion(result.box, result.points, inst.truth_box, inst.truth_surface)
         conf = float("nan") if result.confidence is None else result.confidence
         rows.append(Row(**base, method=method, iou=s.iou, centre_mm=s.centre_mm, chamfer_mm=s.chamfer_mm,
                         f1=s.f1, precision=s.precision, recall=s.recall, seconds=result.seconds,

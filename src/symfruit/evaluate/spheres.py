@@ -20,11 +20,14 @@ from typing import Any
 import numpy as np
 
 from ..detect import detect
-from ..errors import SymfruitError
+from ..errors import InputError, SymfruitError
 from ..io.sources import open_source
 from ..settings import Settings
 
 __all__ = ["SphereBox", "evaluate_spheres", "spheres_table"]
+
+#: Mask specs of segmenters, whose ids are not the same from frame to frame (besides ``color``).
+_SEGMENTERS = ("maskrcnn:", "onnx:")
 
 
 @dataclass(frozen=True)
@@ -58,7 +61,23 @@ def evaluate_spheres(
     failed: dict[str, str] | None = None,
 ) -> list[SphereBox]:
     """Every sphere of every frame of ``source`` under every method (a failed sphere carries its error; a
-    frame that cannot be read or detected is left out and, with ``failed``, recorded there with its reason)."""
+    frame that cannot be read or detected is left out and, with ``failed``, recorded there with its reason).
+
+    Spheres are matched across frames by their mask ids, so ``masks`` must give the same ids in every frame:
+    mask files (``auto``: each frame's own). A segmenter (``color``, ``maskrcnn:``, ``onnx:``) numbers what
+    it finds anew in each frame and is refused; under ``auto`` a frame without a masks file is left out and
+    recorded, never segmented by colour (its ids would be scored against other spheres' boxes).
+
+    Raises
+    ------
+    InputError
+        ``masks`` names a segmenter.
+    """
+    spec = str(masks)
+    if spec == "color" or spec.startswith(_SEGMENTERS):
+        raise InputError(f"--masks {spec}: spheres are matched across frames by their mask ids, which a segmenter "
+                         "numbers anew in every frame; give mask files with the same id for a sphere in every "
+                         "frame (auto: each frame's masks.png or masks.json)")  # fmt: skip
     settings = settings or Settings()
     out: list[SphereBox] = []
     src = open_source(source)
@@ -66,6 +85,10 @@ def evaluate_spheres(
         for index, name in enumerate(src.names()):
             try:
                 frame = src.read(index)
+                if spec == "auto" and frame.masks is None:
+                    raise InputError(f"{frame.source or name}: no masks file (masks.png or masks.json); spheres are "
+                                     "matched across frames by their mask ids, which the colour segmenter does not "
+                                     "keep from frame to frame")  # fmt: skip
                 found_by = {m: detect(frame, masks=masks, method=m, settings=settings) for m in methods}
             except SymfruitError as exc:
                 if failed is not None:

@@ -34,6 +34,7 @@ from .images import orientation_mismatch, read_color_oriented, read_depth_units_
 from .text import as_path, holds_file, read_structured
 
 __all__ = [
+    "COLOR_FILE",
     "COLOR_NAMES",
     "DEFAULT_DEPTH_SCALE",
     "is_frame_folder",
@@ -45,6 +46,10 @@ __all__ = [
 ]
 
 DEFAULT_DEPTH_SCALE = 0.001
+#: ``Frame.extras`` key of a frame read from a folder: its colour file and the EXIF orientation applied to it on
+#: reading, which mask files given for the frame (``--masks``) must carry too. Frames without it (bags, arrays)
+#: hold pixels as stored: orientation 1.
+COLOR_FILE = "color_file"
 #: Colour image names a frame folder may use, in order of preference.
 COLOR_NAMES = ("color.png", "color.jpg", "color.jpeg")
 #: Largest truth.json read (bytes), and largest depth.npy (elements): :mod:`symfruit.core.limits`.
@@ -102,9 +107,12 @@ def read_frame(folder: str | Path) -> Frame:
     # depth registered to a phone photo's stored pixels, or intrinsics for them: said so, never paired turned
     orientation_mismatch(color_path, color_orientation, depth_file, depth_orientation)
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
-    masks = read_masks(folder, color.shape[:2]) if _first(folder, "masks.png", "masks.json") else None
+    # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
+    oriented = (str(color_path), color_orientation)
+    masks = read_masks(folder, color.shape[:2], color=oriented) if _first(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
-    return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible)
+    return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible,
+                       extras={COLOR_FILE: oriented})  # fmt: skip
 
 
 def named_frame(where: str, name: str, *args: Any, **kwargs: Any) -> Frame:

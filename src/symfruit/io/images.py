@@ -14,8 +14,8 @@ labels         ``1``, ``L``, ``P`` (palette indices are the labels), ``I;16*``, 
 =============  ==============================================================================
 
 Images are read as displayed: an EXIF orientation (phone photos: 6 and 8 turn them a quarter) is applied
-to every image read, colour, depth and labels alike (:func:`exif_orientation`). Where colour and depth
-carry different orientations (:func:`orientation_mismatch`), or a colour image is turned a quarter beside
+to every image read, colour, depth and labels alike (:func:`exif_orientation`). Where colour and depth (or
+a label image) carry different orientations (:func:`orientation_mismatch`), or a colour image is turned a quarter beside
 intrinsics for its stored size (:func:`turned_mismatch`), readers refuse them naming the file and its
 orientation, never pair turned colour with unturned depth (:func:`decode_color`, a message's image beside
 raw depth, refuses a tag).
@@ -49,6 +49,7 @@ __all__ = [
     "read_depth_units",
     "read_depth_units_oriented",
     "read_labels",
+    "read_labels_oriented",
     "turned_mismatch",
 ]
 
@@ -145,10 +146,11 @@ ORIENTATION_NAMES = {1: "as stored", 2: "mirrored left-right", 3: "turned half a
                      "a quarter", 8: "turned a quarter anticlockwise"}  # fmt: skip
 
 
-def orientation_mismatch(color_path: Path, orientation: int, depth_path: Path, depth_orientation: int) -> None:
-    """Refuse colour and depth that their EXIF orientations turn differently on reading (a phone photo's tag
-    beside a depth image registered to its stored pixels): even where the sizes agree (half a turn, a
-    mirror), depth would meet the wrong pixels.
+def orientation_mismatch(color_path: Path | str, orientation: int, depth_path: Path, depth_orientation: int, *,
+                         what: str = "depth") -> None:  # fmt: skip
+    """Refuse colour and depth (or instance labels, ``what``) that their EXIF orientations turn differently on
+    reading (a phone photo's tag beside a depth image registered to its stored pixels): even where the sizes
+    agree (half a turn, a mirror), depth or labels would meet the wrong pixels.
 
     Raises
     ------
@@ -158,8 +160,8 @@ def orientation_mismatch(color_path: Path, orientation: int, depth_path: Path, d
     if orientation == depth_orientation:
         return
     raise FileFormatError(f"{color_path}: its EXIF orientation {orientation} ({ORIENTATION_NAMES[orientation]}) is "
-                          f"applied on reading (images are read as displayed), but {depth_path.name} has "
-                          f"{depth_orientation} ({ORIENTATION_NAMES[depth_orientation]}): depth registered to the "
+                          f"applied on reading (images are read as displayed), but {Path(depth_path).name} has "
+                          f"{depth_orientation} ({ORIENTATION_NAMES[depth_orientation]}): {what} registered to the "
                           "stored pixels would meet other pixels; save the colour image as displayed without its "
                           "orientation tag, or give both the same")  # fmt: skip
 
@@ -286,16 +288,22 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
 
 def read_labels(path: str | Path) -> np.ndarray:
     """An instance label image as ``(h, w) int32`` (0 background); RGB label images get one label per colour."""
+    return read_labels_oriented(path)[0]
+
+
+def read_labels_oriented(path: str | Path) -> tuple[np.ndarray, int]:
+    """:func:`read_labels`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_labels: the label image")
     with _open(path, str(path)) as img:
-        img = _decode(img, str(path))[0]
+        img, orientation = _decode(img, str(path))
         mode = img.mode
         if mode in ("RGB", "RGBA", "RGBX"):
             rgb = np.asarray(img)[:, :, :3].astype(np.int64)
             keys = rgb[:, :, 0] << 16 | rgb[:, :, 1] << 8 | rgb[:, :, 2]
             _, inverse = np.unique(keys.ravel(), return_inverse=True)
             labels = inverse.reshape(keys.shape).astype(np.int32)  # black (key 0) sorts first: label 0
-            return instance_labels(labels if keys.min() == 0 else labels + 1, str(path), error=FileFormatError)
+            labels = labels if keys.min() == 0 else labels + 1
+            return instance_labels(labels, str(path), error=FileFormatError), orientation
         if mode in ("1", "L", "P") or mode in _WIDE_GREY:
             w, h = img.size
             # every single-channel mode Pillow reads holds 32-bit signed values at most
@@ -305,4 +313,4 @@ def read_labels(path: str | Path) -> np.ndarray:
                                   "single-channel 8- or 16-bit PNG, or RGB with one colour per fruit)")  # fmt: skip
     if labels.size and labels.min() < 0:
         raise FileFormatError(f"{path}: negative labels")
-    return instance_labels(labels, str(path), error=FileFormatError)
+    return instance_labels(labels, str(path), error=FileFormatError), orientation

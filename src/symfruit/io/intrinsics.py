@@ -16,7 +16,9 @@ ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with
 JSON or YAML by extension (YAML through ``yaml.safe_load`` only). A file's keys are checked: a key that none of
 these layouts has (nor ``depth_scale``/``depth_units``, read beside them by :func:`symfruit.io.read_frame`) is
 refused naming the file, the key and the closest known key, so a misspelt ``depth_scal`` is not a default
-depth scale in disguise. :func:`camera_from_dict` (a mapping handed to the API) does not check them.
+depth scale in disguise. :func:`camera_from_dict` (a mapping handed to the API, ``symfruit.complete(camera=...)``)
+checks them alike (``depth_scale``/``depth_units`` allowed at the top level), so a misspelt ``ppy`` is refused
+by name, not read as a missing field or ignored.
 """
 
 from __future__ import annotations
@@ -60,19 +62,11 @@ def load_camera(path: str | Path) -> Camera:
 
 
 def camera_from_file_data(path: Path, data: Any) -> Camera:
-    """:func:`camera_from_dict` with errors naming the file the data came from, and the file's keys checked
-    (a key no layout has is refused naming the closest known one)."""
+    """:func:`camera_from_dict` with errors naming the file the data came from."""
     try:
-        camera = camera_from_dict(data)
+        return camera_from_dict(data)
     except InputError as exc:
-        unknown = _unknown_key(data, "")
-        if unknown is not None and unknown[2] is not None:  # a misspelt key explains the failure better
-            raise FileFormatError(f"{path}: {_unknown_message(*unknown)}") from None
         raise FileFormatError(f"{path}: {exc}") from None
-    unknown = _unknown_key(data, "")
-    if unknown is not None:
-        raise FileFormatError(f"{path}: {_unknown_message(*unknown)}")
-    return camera
 
 
 def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
@@ -158,14 +152,29 @@ def camera_from_dict(data: Any) -> Camera:
     Raises
     ------
     InputError
-        Naming the missing or invalid field.
+        Naming the missing or invalid field, or a key no layout has (with the closest known key).
     """
+    try:
+        camera = _camera_of(data)
+    except InputError:
+        unknown = _unknown_key(data, "")
+        if unknown is not None and unknown[2] is not None:  # a misspelt key explains the failure better
+            raise InputError(_unknown_message(*unknown)) from None
+        raise
+    unknown = _unknown_key(data, "")
+    if unknown is not None:
+        raise InputError(_unknown_message(*unknown))
+    return camera
+
+
+def _camera_of(data: Any) -> Camera:
+    """:func:`camera_from_dict` without the check of the keys."""
     if not isinstance(data, dict):
         raise InputError(f"intrinsics must be a mapping, got {type(data).__name__}")
     if not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)):
         for key in _NESTS:
             if isinstance(data.get(key), dict):
-                return camera_from_dict(data[key])
+                return _camera_of(data[key])
     if "intrinsic_matrix" in data:  # Open3D, column-major
         m = _matrix(data["intrinsic_matrix"], "intrinsic_matrix")
         fx, fy, cx, cy = m[0], m[4], m[6], m[7]

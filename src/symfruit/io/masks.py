@@ -16,7 +16,7 @@ import numpy as np
 
 from ..core.limits import MAX_COCO_BYTES, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_INSTANCES, check_image_size
 from ..errors import FileFormatError, InputError
-from .images import read_labels
+from .images import orientation_mismatch, read_labels_oriented
 from .text import read_structured
 
 #: Largest COCO annotation file read (bytes) and most annotations of one image that are rasterised (a fruit
@@ -29,16 +29,21 @@ MAX_RLE_RUNS = 10_000_000
 __all__ = ["CocoSet", "coco_from_data", "coco_masks", "read_coco", "read_masks", "rle_decode"]
 
 
-def read_masks(path: str | Path, shape: tuple[int, int]) -> np.ndarray:
+def read_masks(path: str | Path, shape: tuple[int, int], *, color: tuple[str | Path, int] | None = None) -> np.ndarray:
     """Instance labels ``(h, w)`` int32 (0 background, k fruit k) from a label PNG or COCO JSON.
 
-    ``path`` may be a frame folder (its ``masks.png`` or ``masks.json``) or the file itself.
+    ``path`` may be a frame folder (its ``masks.png`` or ``masks.json``) or the file itself. ``color``: the
+    colour image the labels are for and the EXIF orientation applied to it on reading (1 for pixels that
+    carried none); a label PNG must carry the same (:func:`~symfruit.io.images.orientation_mismatch`), so a
+    mirrored or half-turned mask, which the size check alone lets through, is refused by name.
     """
     path = Path(path)
     if path.is_dir():
         path = path / "masks.png" if (path / "masks.png").is_file() else path / "masks.json"
     if path.suffix.lower() == ".png":
-        labels = read_labels(path)
+        labels, orientation = read_labels_oriented(path)
+        if color is not None:
+            orientation_mismatch(color[0], color[1], path, orientation, what="labels")
     elif path.suffix.lower() == ".json":
         labels = coco_masks(path, shape)
     else:

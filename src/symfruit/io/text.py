@@ -6,6 +6,8 @@ safely, errors naming the file.
 * YAML goes through a safe loader that also refuses aliases (``*name``): an alias refers to a shared node,
   and a few lines of nested aliases expand into billions of values as soon as anything walks them.
 * Nesting deeper than Python's recursion allows is refused, not a traceback.
+* A key repeated in one mapping (JSON object or YAML mapping) is refused naming it: parsers keep the last in
+  silence, so ``translations: 3`` above ``translations: 5`` would be dropped unsaid.
 """
 
 from __future__ import annotations
@@ -99,7 +101,34 @@ def _yaml_loader() -> type:
                 )
             return super().compose_node(parent, index)
 
+        def construct_mapping(self, node: Any, deep: bool = False) -> Any:
+            seen: set[Any] = set()
+            for key_node, _ in node.value:
+                key = self.construct_object(key_node, deep=deep)
+                try:
+                    duplicate = key in seen
+                except TypeError:  # an unhashable key: the SafeLoader says so
+                    continue
+                if duplicate:
+                    raise yaml.constructor.ConstructorError(
+                        None, None, f"duplicate key {key!r} (which one is meant?)", key_node.start_mark
+                    )
+                seen.add(key)
+            return super().construct_mapping(node, deep=deep)
+
     return _NoAliasLoader
+
+
+def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:
+    """A JSON object, refused where a key repeats (the last would win in silence)."""
+    out = dict(pairs)
+    if len(out) != len(pairs):
+        seen: set[str] = set()
+        for key, _ in pairs:
+            if key in seen:
+                raise ValueError(f"duplicate key {key!r} (which one is meant?)")
+            seen.add(key)
+    return out
 
 
 def read_structured(
@@ -110,7 +139,8 @@ def read_structured(
     Raises
     ------
     error
-        Naming the file: unreadable, too large, not UTF-8, not valid JSON/YAML, aliases, nesting too deep.
+        Naming the file: unreadable, too large, not UTF-8, not valid JSON/YAML, aliases, nesting too deep, a
+        key repeated in one mapping.
     """
     path = Path(path)
     raw = read_limited(path, what=what, max_bytes=max_bytes, error=error)
@@ -122,7 +152,7 @@ def read_structured(
     kind = "JSON" if suffix == ".json" else "YAML"
     try:
         if kind == "JSON":
-            return json.loads(text)
+            return json.loads(text, object_pairs_hook=_unique_keys)
         loader = _yaml_loader()(text)  # a SafeLoader that also refuses aliases
         try:
             return loader.get_single_data()

@@ -47,6 +47,7 @@ from ..batch import (
     _errors_record,
     _first_part,
     _guarded,
+    frame_done,
     frame_folder_name,
     list_recordings,
     plan_recordings,
@@ -351,7 +352,7 @@ def run_distributed(
         target += [rec.folder / frame_folder_name(n, reserved) for n in names]
         direct += rec_direct if rec_direct is not None else [None] * len(names)
     try:
-        done_before = {i for i in range(len(keys)) if resume and (target[i] / "detections.json").is_file()}
+        done_before = {i for i in range(len(keys)) if resume and frame_done(target[i])}
         todo = [i for i in range(len(keys)) if i not in done_before]
         with contextlib.ExitStack() as stack:
             client = stack.enter_context(_client(scheduler, workers)) if todo else None

@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from ..core.limits import MAX_DEPTH_METRES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from ..errors import FileFormatError, InputError, SymfruitError
 from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
 
@@ -48,6 +48,13 @@ MAX_REPORT_ROWS = MAX_TABLE_ROWS
 MAX_REPORT_BYTES = MAX_TABLE_BYTES
 #: Recordings drawn one bar each; beyond, the ones with most fruit (the table lists them all).
 MAX_BARS = 60
+#: Size class edges: at most this many, each at most :data:`MAX_CLASS_MM` (a 10 m fruit); the diameter
+#: histogram has at most :data:`MAX_HIST_BINS` bins (1 mm wide where that suffices), however wide the sizes.
+MAX_CLASSES = 50
+MAX_CLASS_MM = 10_000.0
+MAX_HIST_BINS = 400
+#: Largest box side (m) a fruit row of the table may hold: one beyond (or negative) is no symfruit box.
+MAX_SIZE_M = MAX_DEPTH_METRES
 #: The plots, in the order report.md shows them.
 PLOTS = ("fruit_per_frame.png", "fruit_per_recording.png", "diameters.png", "confidence.png")
 #: The plots added when the run holds more than one recording: one box per recording.
@@ -74,7 +81,9 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
     """The ``columns`` of a Parquet table, after checking its row count and column sizes against the bounds."""
     import pyarrow.parquet as pq
 
-    if not path.is_file():
+    from ..io.text import holds_file
+
+    if not holds_file(path):  # a directory or broken link of that name says so, not "no such table"
         raise FileFormatError(f"{path}: no such table; run `symfruit detect ... --output {path.parent}` first")
     try:
         meta = pq.ParquetFile(path).metadata
@@ -112,28 +121,46 @@ def size_classes(diameters: np.ndarray, edges: Sequence[float]) -> list[tuple[st
     >>> size_classes(np.array([10.0, 18.0, 20.0, 31.0]), [18, 25])
     [('< 18 mm', 1), ('18-25 mm', 2), ('>= 25 mm', 1)]
     """
+    if len(edges) > MAX_CLASSES:
+        raise InputError(f"size classes: {len(edges)} limits; at most {MAX_CLASSES}")
     edges = [float(e) for e in edges]
     if not edges or any(not math.isfinite(e) or e <= 0 for e in edges) or sorted(set(edges)) != edges:
         raise InputError(f"size classes must be increasing diameters in mm, got {edges}")
+    if edges[-1] > MAX_CLASS_MM:
+        raise InputError(f"size classes: a limit of {edges[-1]:g} mm; diameters are in mm, at most "
+                         f"{MAX_CLASS_MM:g}")  # fmt: skip
     d = np.asarray(diameters, float)
     counts = np.histogram(d, bins=[-np.inf, *edges, np.inf])[0]
     labels = [f"< {edges[0]:g} mm", *(f"{a:g}-{b:g} mm" for a, b in itertools.pairwise(edges)), f">= {edges[-1]:g} mm"]
     return list(zip(labels, (int(c) for c in counts), strict=True))
 
 
+def _check_sizes(path: Path, *sizes: np.ndarray) -> None:
+    """Refuse a table whose box sides are negative or beyond :data:`MAX_SIZE_M` (NaN: not sized): no completion
+    writes them, and a side of 1e300 m made the diameter histogram's bins overflow (1e6 m: a billion bins)."""
+    for name, size in zip(("size_x", "size_z"), sizes, strict=True):
+        bad = np.flatnonzero(np.isfinite(size) & ((size < 0) | (size > MAX_SIZE_M)) | np.isinf(size))
+        if len(bad):
+            raise FileFormatError(f"{path}: row {int(bad[0]) + 1} has {name} {size[bad[0]]:g} m; box sides are "
+                                  f"metres in [0, {MAX_SIZE_M:g}] (not a symfruit table, or damaged)")  # fmt: skip
+
+
 def _errors(output: Path) -> tuple[int, int]:
     """Frames ``errors.json`` lists as failed or not reached, and recordings it lists as not read (0, 0 without
     the file)."""
-    from ..io.text import read_structured
+    from ..io.text import holds_file, read_structured
     from .table import MAX_RECORD_BYTES
 
     path = output / "errors.json"
-    if not path.is_file():
+    if not holds_file(path):  # a directory or broken link of that name is said, not taken for "no failures"
         return 0, 0
     data = read_structured(path, what="errors.json", max_bytes=MAX_RECORD_BYTES)
     if not isinstance(data, dict):
         raise FileFormatError(f"{path}: not a symfruit errors.json")
-    count = lambda key: len(data[key]) if isinstance(data.get(key), list) else 0  # noqa: E731
+    for key in ("failed", "unprocessed", "recordings"):  # {"failed": 5} counted no failed frame
+        if key in data and not isinstance(data[key], list):
+            raise FileFormatError(f"{path}: not a symfruit errors.json ({key!r} is not a list)")
+    count = lambda key: len(data.get(key, []))  # noqa: E731
     return count("failed") + count("unprocessed"), count("recordings")
 
 
@@ -179,6 +206,7 @@ def write_report(
     size_x = np.array([np.nan if v is None else v for v in col["size_x"]], float)
     size_z = np.array([np.nan if v is None else v for v in col["size_z"]], float)
     truncated = np.array([bool(v) for v in col["truncated"]], bool)
+    _check_sizes(output / TABLE_NAME, size_x, size_z)
     sized = ok & ~truncated & np.isfinite(size_x) & np.isfinite(size_z)
     diam = diameters_mm(size_x[sized], size_z[sized])
     conf = np.array([np.nan if v is None else v for v in col["confidence"]], float)
@@ -262,7 +290,8 @@ def _plots(plt: Any, rec_f: np.ndarray, located_f: np.ndarray, per_rec: list[tup
     fig, ax = plt.subplots(figsize=(9, 3.5))
     if len(diam):
         lo, hi = math.floor(min(diam.min(), classes[0]) - 1), math.ceil(max(diam.max(), classes[-1]) + 1)
-        ax.hist(diam, bins=np.arange(lo, hi + 1, 1.0), color="tab:red", alpha=0.8)
+        width = max(1, math.ceil((hi - lo) / MAX_HIST_BINS))  # 1 mm bins where at most MAX_HIST_BINS suffice
+        ax.hist(diam, bins=np.arange(lo, hi + width, width, dtype=float), color="tab:red", alpha=0.8)
     for edge in classes:
         ax.axvline(edge, color="black", ls="--", lw=1)
     for label, count in size_classes(diam, classes):

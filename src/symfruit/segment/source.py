@@ -33,8 +33,8 @@ from ..settings import Settings
 
 __all__ = ["MaskSource", "mask_source"]
 
-#: ``(color, depth, camera, name, own) -> (labels, word)``: see :class:`MaskSource`.
-Labeller = Callable[[np.ndarray, Any, Any, str, Any], tuple[np.ndarray, str]]
+#: ``(color, depth, camera, name, own, color_file) -> (labels, word)``: see :class:`MaskSource`.
+Labeller = Callable[[np.ndarray, Any, Any, str, Any, Any], tuple[np.ndarray, str]]
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,8 @@ class MaskSource:
     _labeller: Labeller
 
     def __call__(self, color: np.ndarray, depth: np.ndarray | None = None, camera: Any = None, *, name: str = "",
-                 own: np.ndarray | None = None) -> tuple[np.ndarray, str]:  # fmt: skip
+                 own: np.ndarray | None = None,
+                 color_file: tuple[str | Path, int] | None = None) -> tuple[np.ndarray, str]:  # fmt: skip
         """Labels for one image and the word on where they came from (``frame masks file`` for a frame's own).
 
         Parameters
@@ -64,13 +65,16 @@ class MaskSource:
             The image's file name (a COCO JSON's images are found by it; a folder's label PNGs by its stem).
         own : (h, w) int, optional
             The frame's own masks (``auto``).
+        color_file : (path, int), optional
+            The colour image's file and the EXIF orientation applied to it on reading; a label PNG read for
+            it must carry the same (None: not checked).
 
         Returns
         -------
         labels : (h, w) int array (not yet checked)
         word : str
         """
-        return self._labeller(color, depth, camera, name, own)
+        return self._labeller(color, depth, camera, name, own, color_file)
 
 
 def mask_source(spec: str | Path, *, settings: Settings | None = None,
@@ -86,13 +90,13 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
                          "label PNGs, or one label .png")  # fmt: skip
     colour = "colour segmenter"
 
-    def by_colour(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+    def by_colour(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         return segment(color, depth, camera, settings.segment), colour
 
     if images is None and text == "auto":
 
-        def auto(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
-            return (own, "frame masks file") if own is not None else by_colour(color, depth, camera, name, own)
+        def auto(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
+            return (own, "frame masks file") if own is not None else by_colour(color, depth, camera, name, own, cf)
 
         return MaskSource("auto", auto)
     if text == "color":
@@ -100,14 +104,16 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
     learned = learned_masks(text)  # a missing extra or a bad model fails once, here
     if learned is not None:
         model = learned
-        return MaskSource(text, lambda color, depth, camera, name, own: (model(color), text))
+        return MaskSource(text, lambda color, depth, camera, name, own, cf: (model(color), text))
     if images is None:
         from ..io.masks import read_masks
 
         several = _coco_of_several_images(Path(text)) or _frames_folder(Path(text))
         if several is not None:
             return several
-        return MaskSource(text, lambda color, depth, camera, name, own: (read_masks(spec, color.shape[:2]), text))
+        return MaskSource(
+            text, lambda color, depth, camera, name, own, cf: (read_masks(spec, color.shape[:2], color=cf), text)
+        )
     return _image_files(text, images)
 
 
@@ -134,7 +140,7 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
         for key in {stem, folder} - {""}:
             by_frame.setdefault(key, []).append(entry["file_name"])
 
-    def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+    def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         found = by_frame.get(Path(name).stem, []) if name else []
         if len(found) != 1:
             some = ", ".join(repr(e["file_name"]) for e in coco.entries()[:3])
@@ -163,15 +169,25 @@ def _frames_folder(folder: Path) -> MaskSource | None:
         return None
     from ..io.masks import read_masks
 
-    def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+    def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         stem = Path(name).stem
         for path in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json"):
             if stem and path.is_file():
-                return read_masks(path, color.shape[:2]), str(path)
+                return read_masks(path, color.shape[:2], color=cf), str(path)
         raise FileFormatError(f"{folder}: no masks for frame {name!r} ({stem}.png, or {stem}/masks.png or "
                               f"{stem}/masks.json)")  # fmt: skip
 
     return MaskSource(str(folder), per_frame)
+
+
+def _labels(path: Path, color_file: tuple[str | Path, int] | None) -> np.ndarray:
+    """A label PNG for a colour image that must carry the colour's EXIF orientation (None: not checked)."""
+    from ..io.images import orientation_mismatch, read_labels_oriented
+
+    labels, orientation = read_labels_oriented(path)
+    if color_file is not None:
+        orientation_mismatch(color_file[0], color_file[1], path, orientation, what="labels")
+    return labels
 
 
 def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
@@ -183,23 +199,24 @@ def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
 
         coco = read_coco(source)
 
-        def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+        def from_coco(
+            color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any
+        ) -> tuple[np.ndarray, str]:
             return _coco_labels(coco, name, color.shape[:2]), where
 
         return MaskSource(where, from_coco)
     if source.is_dir():
-        from ..io.images import read_labels
 
-        def from_folder(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any) -> tuple[np.ndarray, str]:
+        def from_folder(
+            color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any
+        ) -> tuple[np.ndarray, str]:
             label_path = source / f"{Path(name).stem}.png"
             if not label_path.is_file():
                 raise FileFormatError(f"{label_path}: no label image for {name}")
-            return read_labels(label_path), where
+            return _labels(label_path, cf), where
 
         return MaskSource(where, from_folder)
     if source.suffix.lower() == ".png" and source.is_file() and len(images) == 1:
-        from ..io.images import read_labels
-
-        return MaskSource(where, lambda color, depth, camera, name, own: (read_labels(source), where))
+        return MaskSource(where, lambda color, depth, camera, name, own, cf: (_labels(source, cf), where))
     raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
                      "a folder of label PNGs, or one label .png for one image")  # fmt: skip
