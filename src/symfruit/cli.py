@@ -802,6 +802,24 @@ def _printable_names() -> None:
             stream.reconfigure(errors="backslashreplace")
 
 
+def _show_warnings(category: type[Warning]) -> None:
+    """Print symfruit's own warnings as one line, ``symfruit: warning: ...``, not Python's file:line form."""
+    import warnings
+
+    shown = warnings.showwarning
+    if getattr(shown, "symfruit", False):  # main() called again in one process
+        return
+
+    def show(message, kind, filename, lineno, file=None, line=None):  # type: ignore[no-untyped-def]
+        if issubclass(kind, category):
+            print(f"symfruit: warning: {message}".replace("\n", " "), file=file or sys.stderr)
+        else:
+            shown(message, kind, filename, lineno, file, line)
+
+    show.symfruit = True  # type: ignore[attr-defined]
+    warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symfruit`` console script; returns the exit status."""
     _printable_names()
@@ -810,8 +828,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    from .errors import SymfruitError
+    from .errors import SymfruitError, SymfruitWarning
 
+    _show_warnings(SymfruitWarning)
     try:
         return _COMMANDS[args.command](args)
     except SymfruitError as exc:
