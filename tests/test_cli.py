@@ -333,6 +333,16 @@ def test_complete_names_the_file_of_a_cloud_it_cannot_use(tmp_path, capsys):
     assert f"{tmp_path / 'behind.npy'}: " in capsys.readouterr().err
 
 
+def test_complete_prints_a_symfruit_warning_as_one_line(tmp_path, capsys):
+    np.save(tmp_path / "c.npy", VISIBLE)
+    camera = json.loads((EXAMPLES / "camera.json").read_text())
+    (tmp_path / "cam.json").write_text(json.dumps(camera | {"coeffs": [0.06, -0.1, 0.001, -0.0008, 0.02]}))
+    assert main(["complete", str(tmp_path / "c.npy"), "--camera", str(tmp_path / "cam.json")]) == 0
+    err = capsys.readouterr().err
+    assert err.startswith(f"symfruit: warning: {tmp_path / 'cam.json'}: non-zero distortion coefficients 'coeffs'")
+    assert err.count("\n") == 1 and "SymfruitWarning" not in err
+
+
 # with the Dask cluster's tests (tests/season/test_cluster.py): the refusal of --workers 0 imports dask.distributed,
 # half a second of CPU on a worker that would otherwise never import it (pytest-xdist, --dist loadgroup)
 @pytest.mark.xdist_group("cluster")

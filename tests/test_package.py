@@ -18,7 +18,8 @@ PACKAGE = Path(symfruit.__file__).resolve().parent
 
 PUBLIC = {
     "DEFAULT_CAMERA", "Box", "Camera", "ConfigError", "FileFormatError", "InputError", "OutputError", "Plane", "Result",
-    "Settings", "SymfruitError", "__version__", "available_methods", "box_iou", "centre_deviation", "complete",
+    "Settings", "SymfruitError", "SymfruitWarning", "__version__", "available_methods", "box_iou", "centre_deviation",
+    "complete",
     "load_settings",
     "resolve_settings",
 }  # fmt: skip

@@ -13,7 +13,7 @@ from importlib.metadata import PackageNotFoundError, version
 from .core.box import Box, box_iou, centre_deviation
 from .core.camera import DEFAULT_CAMERA, Camera
 from .core.planes import Plane
-from .errors import ConfigError, FileFormatError, InputError, OutputError, SymfruitError
+from .errors import ConfigError, FileFormatError, InputError, OutputError, SymfruitError, SymfruitWarning
 from .methods import available as available_methods
 from .methods.complete import Result, complete
 from .settings import Settings, load_settings, resolve_settings
@@ -35,6 +35,7 @@ __all__ = [
     "Result",
     "Settings",
     "SymfruitError",
+    "SymfruitWarning",
     "__version__",
     "available_methods",
     "box_iou",

@@ -14,7 +14,7 @@ import shutil
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TextIO
 
 #: The real camera models of ``--sensor`` (the keys of :data:`symfruit.synthetic.sensors.SENSOR_MODELS`, named here so
 #: that building the parser imports nothing heavy; a test checks they agree).
@@ -802,6 +802,31 @@ def _printable_names() -> None:
             stream.reconfigure(errors="backslashreplace")
 
 
+def _show_warnings(own: type[Warning]) -> None:
+    """Print symfruit's own warnings as one line, ``symfruit: warning: ...``, not Python's file:line form."""
+    import warnings
+
+    shown = warnings.showwarning
+    if getattr(shown, "symfruit", False):  # main() called again in one process
+        return
+
+    def show(
+        message: Warning | str,
+        category: type[Warning],
+        filename: str,
+        lineno: int,
+        file: TextIO | None = None,
+        line: str | None = None,
+    ) -> None:
+        if issubclass(category, own):
+            print(f"symfruit: warning: {message}".replace("\n", " "), file=file or sys.stderr)
+        else:
+            shown(message, category, filename, lineno, file, line)
+
+    show.symfruit = True  # type: ignore[attr-defined]
+    warnings.showwarning = show
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symfruit`` console script; returns the exit status."""
     _printable_names()
@@ -810,8 +835,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if args.command is None:
         parser.print_help()
         return 2
-    from .errors import SymfruitError
+    from .errors import SymfruitError, SymfruitWarning
 
+    _show_warnings(SymfruitWarning)
     try:
         return _COMMANDS[args.command](args)
     except SymfruitError as exc:

@@ -6,7 +6,7 @@ Every error a user can cause derives from :class:`SymfruitError`, which is also 
 
 from __future__ import annotations
 
-__all__ = ["ConfigError", "FileFormatError", "InputError", "OutputError", "SymfruitError"]
+__all__ = ["ConfigError", "FileFormatError", "InputError", "OutputError", "SymfruitError", "SymfruitWarning"]
 
 
 class SymfruitError(ValueError):
@@ -36,3 +36,8 @@ class OutputError(FileFormatError):
     def __init__(self, message: str, errno: int | None = None) -> None:
         super().__init__(message)
         self.errno = errno
+
+
+class SymfruitWarning(UserWarning):
+    """Input symfruit uses but cannot honour in full (intrinsics with lens distortion it does not apply); the
+    command line prints it as ``symfruit: warning: ...``."""

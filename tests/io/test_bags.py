@@ -265,6 +265,23 @@ def test_a_camera_info_with_k_all_zero_names_the_bag(tmp_path):
         src.read(0)
 
 
+@pytest.mark.parametrize("size", [(0, 0), (160, 0), (0, 120)])
+def test_a_camera_info_of_size_0_takes_the_images_as_the_live_node_does(tmp_path, size):
+    pytest.importorskip("rosbags")
+    from symfruit.ros.core import message_frame
+
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "sizeless", color, (depth * 1000).astype(np.uint16), frames=3, info_size=size)
+    with open_source(path) as src:
+        assert [src.read(i).camera for i in range(3)] == [CAM] * 3 and len(src._cameras) == 1
+        info = src._reader.deserialize(next(raw for c, _, raw in src._reader.messages() if c == src._info),
+                                       src._info.msgtype)  # fmt: skip
+        assert info.width == size[0] and info.height == size[1]
+        live = message_frame(src._message(src._color, src._color_stamps[0]),
+                                   src._message(src._depth, src._depth_stamps[0]), info, name="x")  # fmt: skip
+        assert live.camera == CAM
+
+
 def test_a_mono8_colour_topic_gives_grey_rgb_frames(tmp_path):
     pytest.importorskip("rosbags")
     color, depth = disc_frame([(80, 60)])

@@ -268,6 +268,15 @@ REFUSED = {
                  b"end_header\n1 2\n", "PLY vertices lack the z property (they have x, y)"),
     "ply-corrupt": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
                     "corrupt PLY"),
+    "ply-more-rows": ("a.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n"
+                      + np.ones((3, 3), "<f4").tobytes(), "24 bytes of data after the header's 1 vertices"),
+    "ply-more-lines": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n4 5 6\n",
+                       "2 data lines after the header but it declares 1 vertices"),
+    "pcd-points-wh": ("a.pcd", _pcd("x y z", b"1 2 3\n4 5 6\n", points=2).replace(b"WIDTH 2", b"WIDTH 1"),
+                      "PCD header's POINTS 2 disagrees with WIDTH x HEIGHT 1 x 1 = 1"),
+    "pcd-ascii-more": ("a.pcd", _pcd("x y z", b"1 2 3\n4 5 6\n"), "header promises 1 points but more rows follow"),
+    "pcd-binary-more": ("a.pcd", _pcd("x y z", np.ones((3, 3), "<f4").tobytes(), mode="binary"),
+                        "header promises 1 points (12 bytes) but the file holds 36: 2 more whole points"),
     "pcd-no-fields": ("a.pcd", b"VERSION 0.7\nSIZE 4\nPOINTS 1\nDATA ascii\n1 2 3\n",
                       "PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA"),
     "pcd-type": ("a.pcd", _pcd("x y z", b"1 2 3\n", kind="F F X"), "PCD has an unsupported TYPE/SIZE pair"),
@@ -308,6 +317,18 @@ def test_each_header_check_refuses_with_its_own_message(tmp_path, case):
     with pytest.raises(FileFormatError) as info:
         read_cloud(path)
     assert str(info.value).startswith(f"{path}: ") and message in str(info.value)
+
+
+def test_trailing_padding_and_blank_lines_after_the_declared_rows_are_not_more_rows(tmp_path):
+    ply = tmp_path / "pad.ply"
+    ply.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n"
+                    + np.ones(3, "<f4").tobytes() + b"\n\0\0")  # fmt: skip
+    text = tmp_path / "blank.ply"
+    text.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n\n  \n")
+    pcd = tmp_path / "pad.pcd"
+    pcd.write_bytes(_pcd("x y z", np.ones(3, "<f4").tobytes() + b"\n", mode="binary"))
+    for path in (ply, text, pcd):
+        assert read_cloud(path).shape == (1, 3)
 
 
 def test_a_signalling_nan_in_a_binary_cloud_is_a_missing_point_not_a_warning(tmp_path):

@@ -6,7 +6,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symfruit import Camera, FileFormatError, InputError, SymfruitError
+from symfruit import Camera, FileFormatError, InputError, SymfruitError, SymfruitWarning
 from symfruit.io import camera_from_dict, load_camera
 
 LAYOUTS = {
@@ -162,6 +162,44 @@ def test_every_layout_key_and_the_depth_keys_beside_them_are_read(tmp_path):
     expected = Camera(fx=615.0, fy=616.0, cx=321.0, cy=239.0, width=640, height=480)
     assert load_camera(_written(tmp_path / "ros.json", ros)) == expected
     assert load_camera(_written(tmp_path / "rs.json", nested)) == expected
+
+
+PLAIN = {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640, "height": 480}
+
+
+@pytest.mark.parametrize(
+    "extra, key, largest",
+    [
+        ({"model": "Brown Conrady", "coeffs": [0.06, -0.1, 0.001, -0.0008, 0.02]}, "coeffs", "-0.1"),
+        ({"distortion_model": "rational_polynomial", "D": [0.5, -2.7, 0, 0, 1.5, 0.4, -2.5, 1.4]}, "D", "-2.7"),
+        ({"distortion_coefficients": {"rows": 1, "cols": 5, "data": [0, 0, 0, 0.003, 0]}}, "distortion_coefficients",
+         "0.003"),
+    ],
+)  # fmt: skip
+def test_non_zero_distortion_is_named_in_a_warning_not_ignored_in_silence(tmp_path, extra, key, largest):
+    path = _written(tmp_path / "cam.json", PLAIN | extra)
+    with pytest.warns(
+        SymfruitWarning, match=rf"cam\.json: non-zero distortion coefficients '{key}' \(largest {largest}\)"
+    ):
+        assert load_camera(path) == Camera(**PLAIN)
+    with pytest.warns(SymfruitWarning, match=rf"^intrinsics: non-zero distortion coefficients '{key}'"):
+        camera_from_dict({"color": PLAIN | extra})
+
+
+def test_zero_or_absent_distortion_warns_nothing_and_garbled_coefficients_are_refused(tmp_path):
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        for extra in ({}, {"coeffs": [0] * 5}, {"D": []}, {"d": [0.0] * 8}):
+            assert camera_from_dict(PLAIN | extra) == Camera(**PLAIN)
+    for bad in ([float("nan"), 0, 0, 0, 0], ["0.1"], [True], 0.1, [1e400]):
+        with pytest.raises(InputError, match="intrinsics field 'coeffs' must hold at most 16 finite numbers"):
+            camera_from_dict(PLAIN | {"coeffs": bad})
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps(PLAIN)[:-1] + ', "D": [NaN, 0, 0, 0, 0]}')
+    with pytest.raises(FileFormatError, match=r"cam\.json: intrinsics field 'D' must hold at most 16 finite numbers"):
+        load_camera(path)
 
 
 def _written(path, data):

@@ -102,6 +102,18 @@ def test_an_unwritable_output_folder_is_one_clear_error(tmp_path):
             OutputFolder(ro).open()
 
 
+def test_an_output_folder_that_is_a_dangling_or_looping_link_is_named_as_one_not_as_a_file(tmp_path):
+    (tmp_path / "gone").symlink_to(tmp_path / "nowhere")
+    (tmp_path / "a").symlink_to("b")
+    (tmp_path / "b").symlink_to("a")
+    for name, target in (("gone", str(tmp_path / "nowhere")), ("a", "b")):
+        with pytest.raises(OutputError) as info:
+            OutputFolder(tmp_path / name).open()
+        assert str(info.value) == (f"{tmp_path / name}: cannot write to folder (the output folder is a dangling or "
+                                   f"looping link, to {target}; make that folder or choose another)")  # fmt: skip
+    assert not (tmp_path / "nowhere").exists()
+
+
 def test_the_final_record_is_written_over_its_reserved_space_on_a_full_disk(tmp_path, monkeypatch):
     path = tmp_path / "errors.json"
     reserve_record(path, {"failed": [], "unprocessed": ["f1", "f2"], "stopped": "running"}, entries=2)

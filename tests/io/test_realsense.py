@@ -307,6 +307,26 @@ def test_a_truncated_recording_is_refused_by_name(tmp_path):
         assert "\n" not in str(info.value)
 
 
+def test_one_torn_image_fails_its_frame_not_the_recording(tmp_path):
+    torn: list[bytes] = []
+
+    def tear(topic, raw):
+        if topic.endswith("Depth_0/image/data"):
+            torn.append(raw)
+            if len(torn) == 3:
+                return raw[:200]  # the third depth image cut short (its header and stamp kept)
+        return raw
+
+    path = rewrite(tmp_path / "torn.bag", edit=tear, frames=5)
+    with RealSenseBagSource(path) as src:
+        secs, nsecs = struct.unpack_from("<II", torn[2], 4)
+        assert len(src) == 5 and src.names()[2] == f"torn_00002_{secs * 1_000_000_000 + nsecs}"
+        for i in (0, 1, 3, 4):
+            assert src.read(i).depth.shape == (240, 320)
+        with pytest.raises(FileFormatError, match=r"torn\.bag: corrupt sensor_msgs/msg/Image message on .*Depth_0"):
+            src.read(2)
+
+
 def test_memory_stays_flat_over_a_long_recording(tmp_path):
     path = rewrite(tmp_path / "long.bag", frames=30)
     with RealSenseBagSource(path) as src:

@@ -51,6 +51,17 @@ def test_folder_order_is_by_name_hidden_folders_and_exclusions_skipped(tmp_path)
     assert "out" not in open_source(tmp_path, exclude=[tmp_path / "a" / ".." / "out"]).names()
 
 
+@pytest.mark.parametrize("left", ["errors.json", "detections.parquet", "frames.parquet", ".symfruit.lock"])
+def test_an_earlier_runs_output_inside_the_recording_is_no_frame(tmp_path, left):
+    make_frames(tmp_path, "a", "b")
+    (tmp_path / "out" / "a").mkdir(parents=True)  # detect rec --output rec/out, then --output rec/out2
+    (tmp_path / "out" / left).write_text("{}")
+    assert open_source(tmp_path).names() == ["a", "b"]
+    (tmp_path / "b" / left).write_text("{}")  # a frame folder holding such a file is still a frame
+    (tmp_path / "odd").mkdir()  # and a folder with neither is still a frame that fails, by name
+    assert open_source(tmp_path).names() == ["a", "b", "odd"]
+
+
 def test_a_frame_folder_is_a_one_frame_recording(tmp_path):
     src = open_source(EXAMPLE_FRAME)
     assert isinstance(src, FrameFolderSource) and isinstance(src, FrameSource)

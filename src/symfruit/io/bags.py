@@ -19,6 +19,7 @@ on top of it, and :func:`camera_from_info`): the live ROS node (:mod:`symfruit.r
 from __future__ import annotations
 
 import bisect
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -305,7 +306,8 @@ class BagSource:
         self._depth, self._color, self._info = _pick_topics(depth, color, info)
         self._depth_stamps: list[int] = []
         self._color_stamps: list[int] = []
-        self._cameras: list[tuple[int, Camera | str]] = []  # (stamp, camera or why it is invalid), on change
+        # (stamp, camera or why it is invalid, whether its width/height were 0: the image's then), on change
+        self._cameras: list[tuple[int, Camera | str, tuple[bool, bool]]] = []
         last: Any = None
         for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
             if conn == self._depth:
@@ -314,17 +316,20 @@ class BagSource:
                 self._color_stamps.append(stamp)
             elif bytes(raw) != last:
                 last = bytes(raw)
+                sizeless = (False, False)
                 try:
-                    camera: Camera | str = camera_from_info(self._reader.deserialize(raw, conn.msgtype))
+                    msg = self._reader.deserialize(raw, conn.msgtype)
+                    sizeless = (not int(msg.width), not int(msg.height))  # as the live node: the image's size
+                    camera: Camera | str = camera_from_info(msg, width=1, height=1)
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
-                if not self._cameras or self._cameras[-1][1] != camera:  # kept on change: each message is
-                    self._cameras.append((stamp, camera))  # stamped anew, the intrinsics seldom change
+                if not self._cameras or self._cameras[-1][1:] != (camera, sizeless):  # kept on change: each
+                    self._cameras.append((stamp, camera, sizeless))  # is stamped anew, the intrinsics seldom change
         if not self._color_stamps:
             raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
         if not self._cameras:
             raise FileFormatError(f"CameraInfo topic {self._info.topic} holds no messages")
-        self._camera_stamps = [s for s, _ in self._cameras]
+        self._camera_stamps = [s for s, _, _ in self._cameras]
 
     def __len__(self) -> int:
         return len(self._depth_stamps)
@@ -351,7 +356,7 @@ class BagSource:
         if abs(self._color_stamps[near] - stamp) > self.max_skew * 1e9:
             raise FileFormatError(f"{self.path}: no colour image within {self.max_skew} s of depth at {stamp}")
         c = max(bisect.bisect_right(self._camera_stamps, stamp) - 1, 0)
-        camera = self._cameras[c][1]
+        _, camera, sizeless = self._cameras[c]
         if isinstance(camera, str):
             raise FileFormatError(f"{self.path}: {camera}")
         try:
@@ -360,6 +365,9 @@ class BagSource:
             cmsg = self._message(self._color, cstamp)
             color = color_image(cmsg, self._color.msgtype)
             depth = depth_image(dmsg, self._depth.msgtype)
+            if any(sizeless):  # a camera info of width or height 0 is for the images' size (the live node's rule)
+                camera = replace(camera, width=depth.shape[1] if sizeless[0] else camera.width,
+                                 height=depth.shape[0] if sizeless[1] else camera.height)  # fmt: skip
         except FileFormatError as exc:
             message = str(exc)
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"

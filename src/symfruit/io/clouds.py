@@ -137,12 +137,15 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
     from plyfile import PlyData, PlyParseError
 
     try:
-        data = PlyData.read(str(path))
+        with path.open("rb") as handle:
+            data = PlyData.read(handle)
+            end = None if data.text else handle.tell()
         element = data["vertex"]
     except PlyParseError as exc:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
         raise FileFormatError(f"{path}: unreadable PLY ({exc})") from None
+    _check_ply_rest(path, data, end)
     names = [p.name for p in element.properties]
     missing = [c for c in ("x", "y", "z") if c not in names]
     if missing:
@@ -157,6 +160,36 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
         raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
+
+
+def _check_ply_rest(path: Path, data: Any, end: int | None) -> None:
+    """Refuse data left after the header's last element: a vertex count smaller than the rows written (a file
+    appended to, or a header edited by hand) read the first rows in silence. Trailing whitespace or NUL padding
+    is allowed; in ASCII every row is one line, so the lines after the header are counted."""
+    counts = ", ".join(_rows(e.name, e.count) for e in data.elements)
+    if end is not None:  # binary: plyfile stops right after the last element
+        with path.open("rb") as handle:
+            handle.seek(end)
+            rest = handle.read(1 << 16)
+            extra = path.stat().st_size - end
+        if rest.strip(b" \t\r\n\0"):
+            raise FileFormatError(
+                f"{path}: {extra} bytes of data after the header's {counts} (the header's counts disagree with the "
+                "data: truncated header count or a file appended to)"
+            )
+        return
+    _, start, _ = _header(path, "PLY", b"ply", re.compile(rb"end_header\r?\n"))
+    lines = 0
+    with path.open("rb") as handle:
+        handle.seek(start)
+        for line in handle:
+            lines += bool(line.strip())
+    rows = sum(e.count for e in data.elements)
+    if lines > rows:
+        raise FileFormatError(
+            f"{path}: {lines} data lines after the header but it declares {counts} ({rows} rows): the header's "
+            "counts disagree with the data"
+        )
 
 
 _PCD_TYPES = {("F", 4): "f4", ("F", 8): "f8", ("I", 1): "i1", ("I", 2): "i2", ("I", 4): "i4",
@@ -182,6 +215,15 @@ def read_pcd(path: Path) -> np.ndarray:
         raise FileFormatError(f"{path}: PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA") from None
     if not (len(names) == len(sizes) == len(types) == len(counts)) or n < 0 or min(counts, default=1) < 1:
         raise FileFormatError(f"{path}: PCD header's FIELDS, SIZE, TYPE and COUNT disagree")
+    if "POINTS" in fields and "WIDTH" in fields and "HEIGHT" in fields:
+        try:
+            width, height = int(fields["WIDTH"][0]), int(fields["HEIGHT"][0])
+        except (ValueError, IndexError):
+            raise FileFormatError(f"{path}: PCD header garbles WIDTH/HEIGHT") from None
+        if width * height != n:
+            raise FileFormatError(
+                f"{path}: PCD header's POINTS {n} disagrees with WIDTH x HEIGHT {width} x {height} = {width * height}"
+            )
     if n > MAX_CLOUD_POINTS:
         raise FileFormatError(f"{path}: PCD holds {n:,} points; at most {MAX_CLOUD_POINTS:,} are read")
     missing = [c for c in ("x", "y", "z") if c not in names]
@@ -202,12 +244,23 @@ def read_pcd(path: Path) -> np.ndarray:
             values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
             if len(values) < n:
                 raise FileFormatError(f"{path}: header promises {n} points, the file holds {len(values)}")
+            if any(line.strip() for line in text):
+                raise FileFormatError(
+                    f"{path}: header promises {n} points but more rows follow them (the header's POINTS disagrees "
+                    "with the data)"
+                )
             columns = np.cumsum([0, *counts])
             return np.column_stack([values[:n, columns[names.index(c)]] for c in ("x", "y", "z")])
         if mode == "binary":
             if n * row > body_size:
                 raise FileFormatError(
                     f"{path}: header promises {n} points ({n * row} bytes) but the file holds {body_size}"
+                )
+            if body_size - n * row >= max(row, 1):
+                raise FileFormatError(
+                    f"{path}: header promises {n} points ({n * row} bytes) but the file holds {body_size}: "
+                    f"{(body_size - n * row) // max(row, 1)} more whole points (the header's POINTS disagrees with "
+                    "the data)"
                 )
             dtype = np.dtype([(f"f{i}", d, (c,)) for i, (d, c) in enumerate(zip(dtypes, counts, strict=True))])
             rec = np.frombuffer(handle.read(n * row), dtype=dtype, count=n)

@@ -13,6 +13,11 @@ ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with
                        (``camera_calibration_parsers`` YAML)
 =====================  ==================================================================
 
+Distortion coefficients (RealSense ``coeffs``, ROS ``D``/``d``, ``distortion_coefficients``) are checked to be
+finite numbers but never applied: symfruit's pipeline is pinhole. Non-zero ones raise a
+:class:`~symfruit.errors.SymfruitWarning` naming the file and the largest coefficient (undistort the images, or
+give the rectified camera's intrinsics, ROS ``P``); they are not ignored in silence.
+
 JSON or YAML by extension (YAML through ``yaml.safe_load`` only). A file's keys are checked: a key that none of
 these layouts has (nor ``depth_scale``/``depth_units``, read beside them by :func:`symfruit.io.read_frame`) is
 refused naming the file, the key and the closest known key, so a misspelt ``depth_scal`` is not a default
@@ -24,12 +29,14 @@ by name, not read as a missing field or ignored.
 from __future__ import annotations
 
 import difflib
+import math
+import warnings
 from pathlib import Path
 from typing import Any
 
 from ..core.camera import Camera
 from ..core.limits import MAX_SETTINGS_BYTES
-from ..errors import FileFormatError, InputError
+from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
 __all__ = ["camera_from_dict", "load_camera"]
@@ -64,9 +71,59 @@ def load_camera(path: str | Path) -> Camera:
 def camera_from_file_data(path: Path, data: Any) -> Camera:
     """:func:`camera_from_dict` with errors naming the file the data came from."""
     try:
-        return camera_from_dict(data)
+        return _checked(data, str(path))
     except InputError as exc:
         raise FileFormatError(f"{path}: {exc}") from None
+
+
+#: Distortion keys of the layouts: RealSense, ROS 1, ROS 2, camera_calibration_parsers.
+_DISTORTION_KEYS = ("coeffs", "D", "d", "distortion_coefficients")
+
+
+def _distortion(data: Any) -> tuple[str, list[float]] | None:
+    """``(key, coefficients)`` of the intrinsics mapping's distortion (following the nests :func:`_camera_of`
+    follows), or None; coefficients that are not finite numbers are refused naming the key."""
+    if not isinstance(data, dict):
+        return None
+    if not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)):
+        for nest in _NESTS:
+            if isinstance(data.get(nest), dict):
+                return _distortion(data[nest])
+    key = next((k for k in _DISTORTION_KEYS if k in data), None)
+    if key is None:
+        return None
+    values = data[key]
+    if isinstance(values, dict) and "data" in values:
+        values = values["data"]
+    if values is None:
+        return None
+    if (
+        not isinstance(values, list)
+        or len(values) > 16
+        or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and _fits_float(v) for v in values)
+        or not all(math.isfinite(float(v)) for v in values)
+    ):
+        raise InputError(f"intrinsics field {key!r} must hold at most 16 finite numbers, got {_short(values)}")
+    return key, [float(v) for v in values]
+
+
+def _checked(data: Any, source: str) -> Camera:
+    """:func:`camera_from_dict`, warning (:class:`SymfruitWarning`) about non-zero distortion it does not apply;
+    ``source`` names where the intrinsics came from."""
+    camera = _camera_with_keys_checked(data)
+    distortion = _distortion(data)
+    if distortion is not None and any(distortion[1]):
+        key, values = distortion
+        largest = max(values, key=abs)
+        warnings.warn(
+            SymfruitWarning(
+                f"{source}: non-zero distortion coefficients {key!r} (largest {largest:.4g}) are not applied: "
+                "symfruit treats the image as pinhole; undistort it first (or use the rectified camera's "
+                "intrinsics, ROS P), else points far from the centre are misplaced"
+            ),
+            stacklevel=3,
+        )
+    return camera
 
 
 def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
@@ -153,7 +210,17 @@ def camera_from_dict(data: Any) -> Camera:
     ------
     InputError
         Naming the missing or invalid field, or a key no layout has (with the closest known key).
+
+    Warns
+    -----
+    SymfruitWarning
+        When the mapping holds non-zero distortion coefficients, which are not applied.
     """
+    return _checked(data, "intrinsics")
+
+
+def _camera_with_keys_checked(data: Any) -> Camera:
+    """:func:`camera_from_dict` without the distortion warning."""
     try:
         camera = _camera_of(data)
     except InputError:

@@ -154,6 +154,12 @@ class OutputFolder:
             self.root.mkdir(parents=True, exist_ok=True)
             self._fd = os.open(self.root, os.O_RDONLY | getattr(os, "O_DIRECTORY", 0))
         except FileExistsError:
+            if os.path.islink(self.root) and not os.path.exists(self.root):
+                target = os.readlink(self.root)
+                raise OutputError(
+                    f"{self.root}: cannot write to folder (the {self.what} is a dangling or looping link, to {target}; "
+                    "make that folder or choose another)"
+                ) from None
             raise OutputError(f"{self.root}: cannot write to folder (the {self.what} is a file)") from None
         except OSError as exc:
             raise OutputError(f"{self.root}: cannot write to folder ({exc.strerror or exc})", exc.errno) from None

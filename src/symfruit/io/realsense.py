@@ -219,8 +219,10 @@ class RealSenseBagSource:
         self._depth_stamps: list[tuple[int, int]] = []  # (header stamp or bag time, bag time)
         self._color_stamps: list[tuple[int, int]] = []
         for conn, bag_time, raw in self._reader.messages(connections=[self._depth, self._color]):
-            msg, _ = self._deserialize(raw, conn)
-            stamp = _header_ns(msg) or bag_time
+            try:
+                stamp = _header_ns(self._deserialize(raw, conn)[0]) or bag_time
+            except FileFormatError:  # one torn image: its frame fails when read, naming it, not the recording
+                stamp = _raw_header_ns(raw) or bag_time
             (self._depth_stamps if conn == self._depth else self._color_stamps).append((stamp, bag_time))
         if not self._depth_stamps:
             raise FileFormatError(f"depth topic {self._depth.topic} holds no images")
@@ -315,6 +317,15 @@ def _check_units(value: float, what: str) -> float:
 def _header_ns(msg: Any) -> int:
     stamp = msg.header.stamp
     return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+def _raw_header_ns(raw: Any) -> int:
+    """The header stamp of a ROS 1 message whose body cannot be deserialised (``seq``, then ``secs`` and ``nsecs``
+    as little-endian uint32); 0 when not even those 12 bytes are there."""
+    if len(raw) < 12:
+        return 0
+    secs, nsecs = struct.unpack_from("<II", bytes(raw[:12]), 4)
+    return secs * 1_000_000_000 + nsecs
 
 
 def _require_pyrealsense2() -> Any:

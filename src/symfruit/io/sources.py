@@ -28,6 +28,7 @@ from typing import Protocol, runtime_checkable
 from ..core.frame import Frame
 from ..errors import FileFormatError
 from .frames import is_frame_folder, read_frame
+from .outputs import LOCK_NAME
 from .text import as_path
 
 __all__ = ["FolderSource", "FrameFolderSource", "FrameSource", "open_source", "register_source", "source_kinds"]
@@ -95,7 +96,11 @@ class FolderSource(_Closing):
         self._folders = sorted(
             p
             for p in path.iterdir()
-            if p.is_dir() and not p.name.startswith(".") and p.resolve() not in skip and not _is_bag_output(p)
+            if p.is_dir()
+            and not p.name.startswith(".")
+            and p.resolve() not in skip
+            and not _is_bag_output(p)
+            and not _is_run_output(p)
         )
 
     def __len__(self) -> int:
@@ -186,6 +191,16 @@ def _is_bag_output(folder: Path) -> bool:
     """A ROS 2 bag folder (``metadata.yaml``, no colour image) inside a recording of frame folders, e.g. the
     ``--ros2-bag`` an earlier run wrote there: not a frame (a frame folder missing its files still is one)."""
     return (folder / "metadata.yaml").is_file() and not is_frame_folder(folder)
+
+
+#: Files a ``detect`` run writes at the top of its output folder (:mod:`symfruit.batch`), never in a frame folder.
+RUN_FILES = ("errors.json", "detections.parquet", "frames.parquet", LOCK_NAME)
+
+
+def _is_run_output(folder: Path) -> bool:
+    """An earlier ``detect`` run's output folder inside a recording of frame folders (``--output rec/out``, then
+    ``--output rec/out2``): not a frame (it was counted as one that failed, 'no color.png or color.jpg')."""
+    return any((folder / name).is_file() for name in RUN_FILES) and not is_frame_folder(folder)
 
 
 register_source("bag", _is_bag, _open_bag)
