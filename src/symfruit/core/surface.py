@@ -404,14 +404,14 @@ class _Outline:
         at, pad = self._at(shifts, reach)
         keys = self.keys(pad, reach)
         if not exact and keys is not None:
-            return self._nearest_mean(np.sort(np.take(keys, at), axis=1), pad, reach, trim)
+            return self._nearest_mean(_sort_rows(np.take(keys, at)), pad, reach, trim)
         val = np.take(self._flat(pad, reach), at)
         # the cap's outline lies a band inside the mask's outline (grazing pixels without depth): the band is
         # the median distance, within 0 to 0.3 radii, and the cost the trimmed mean deviation from it
         n = val.shape[1]
         middle = [(n - 1) // 2, n // 2]  # np.median's two middle places (one place when n is odd)
         if keys is not None:  # the middle keys of each row, and their distances back (the same values)
-            k = np.sort(np.take(keys, at), axis=1)[:, middle]
+            k = _sort_rows(np.take(keys, at))[:, middle]
             mid = np.sign(k) * np.sqrt(np.abs(k).astype(np.float64))
         else:  # a sort of these short rows is 4x faster than a two-kth partition
             mid = np.sort(val, axis=1)[:, middle]
@@ -433,7 +433,8 @@ class _Outline:
         (``b - v[i] > v[i + keep] - b``; those places are a prefix, the differences being monotone in ``v``
         as rounded too), the run the usual search for the ``keep`` values nearest ``b`` ends in. Ties swap
         equal deviations: the run's deviations are the ``keep`` smallest, as a multiset."""
-        v = np.take(self._table(pad, reach), ordered, mode="wrap")  # a negative key wraps to the table's end
+        # a negative key counts from the table's end; indexing, not np.take (whose int16 indices cost 6x more)
+        v = self._table(pad, reach)[ordered]
         k, n = v.shape
         mid = v[:, [(n - 1) // 2, n // 2]]  # np.median's two middle places, as in cost()
         median = 0.5 * (mid[:, 0] + mid[:, 1]) if n % 2 == 0 else mid[:, 1]
@@ -448,7 +449,7 @@ class _Outline:
 
     def _table(self, pad: int, reach: int) -> np.ndarray:
         """The value of every key of :meth:`keys` (``sign * sqrt(|key|)``), indexed by the key itself, negative keys
-        from the end (``np.take(..., mode="wrap")``)."""
+        from the end (as Python indexes)."""
         key = ("table", pad, int(reach))
         found = self._padded.get(key)
         if found is None:
@@ -461,6 +462,12 @@ class _Outline:
                 found[top + 1 :] = -np.sqrt(-np.arange(low, 0, dtype=np.float64))
             self._padded[key] = found
         return found
+
+
+def _sort_rows(keys: np.ndarray) -> np.ndarray:
+    """``np.sort(keys, axis=1)``: whole numbers in order are the same whatever the sort, and numpy's stable sort of
+    16-bit ones is a radix sort (2.4x faster on the registration's rows than the default introsort)."""
+    return np.sort(keys, axis=1, kind="stable" if keys.dtype.itemsize <= 2 else None)
 
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
