@@ -342,6 +342,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     return Surface(monotone_region(depth, near, apex, tol) | (near & deep), front, radius, noise, apex)
 
 
+#: :meth:`_Outline.cost`'s block: about this many outline values at a time (256 KB of float64)
+_BLOCK = 2**15
+
+
 @dataclass(frozen=True)
 class _Outline:
     """A fruit's depth-cap outline points and its mask's signed distance map (pixels, + inside), in a window."""
@@ -355,10 +359,11 @@ class _Outline:
     #: ``("table", pad, reach)`` the value of each key (:meth:`_table`)
     _padded: dict[tuple, np.ndarray | None] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    def _at(self, shifts: np.ndarray, reach: int) -> tuple[np.ndarray, int]:
-        """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad."""
+    def _at(self, shifts: np.ndarray, reach: int, pad: int = 0) -> tuple[np.ndarray, int]:
+        """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad (at
+        least ``pad``)."""
         # outside the window the distance is -reach: a border that wide around the map replaces bounds tests
-        pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
+        pad = max(int(reach), int(np.abs(shifts).max(initial=0)), pad)
         width = self.inside.shape[1] + 2 * pad
         at = (self.rows + pad) * width + (self.cols + pad)  # one flat index per point, one offset per shift
         return at[None, :] - (shifts[:, :1] * width + shifts[:, 1:]), pad
@@ -400,8 +405,21 @@ class _Outline:
 
         Each row's cost depends on that row alone. ``exact=False`` sums the same smallest deviations in ascending
         order (one sort, 3-4x faster than the partition) instead of in the partition's order: the same number
-        to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way)."""
-        at, pad = self._at(shifts, reach)
+        to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way).
+
+        Many shifts are costed a block of rows at a time (:data:`_BLOCK` values): the same rows, each block's arrays
+        staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame)."""
+        rows = max(1, _BLOCK // max(1, len(self.rows)))
+        if len(shifts) > rows:
+            pad = max(int(reach), int(np.abs(shifts).max(initial=0)))  # one pad for all blocks: one padded map
+            return np.concatenate(
+                [self._cost(shifts[i : i + rows], reach, trim, exact, pad) for i in range(0, len(shifts), rows)]
+            )
+        return self._cost(shifts, reach, trim, exact)
+
+    def _cost(self, shifts: np.ndarray, reach: int, trim: float, exact: bool, pad: int = 0) -> np.ndarray:
+        """:meth:`cost` of one block of shifts, the padded maps at least ``pad`` wide."""
+        at, pad = self._at(shifts, reach, pad)
         keys = self.keys(pad, reach)
         if not exact and keys is not None:
             return self._nearest_mean(_sort_rows(np.take(keys, at)), pad, reach, trim)
