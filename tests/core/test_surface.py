@@ -457,6 +457,82 @@ def test_the_fast_cost_sums_the_deviations_the_sort_would_keep(seed, top, trim):
     np.testing.assert_allclose(outline.cost(shifts, reach, trim, exact=False), former, rtol=1e-13, atol=0.0)
 
 
+@given(
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([np.int16, np.int32, np.float64]),
+    st.sampled_from([3, 400, 32000]),
+    st.sampled_from(["stable", None]),
+)
+def test_the_rows_sorted_for_the_registration_are_numpys_sort(seed, dtype, span, kind):
+    # whichever sort the CPU's features choose for 16-bit keys
+    from unittest import mock
+
+    from symfruit.core import surface
+
+    rng = np.random.default_rng(seed)
+    keys = rng.integers(-span, span + 1, (int(rng.integers(1, 60)), int(rng.integers(1, 330)))).astype(dtype)
+    with mock.patch.object(surface, "_KIND16", kind):
+        np.testing.assert_array_equal(surface._sort_rows(keys), np.sort(keys, axis=1))
+
+
+def _costs_as_before(outline, shifts, reach, trim):
+    """The fast and exact costs of ``outline`` as the tenth round computed them (default sort, np.take wrapping)."""
+    at, pad = outline._at(shifts, reach)
+    keys, val = outline.keys(pad, reach), np.take(outline._flat(pad, reach), at)
+    k, n = val.shape
+    middle, keep = [(n - 1) // 2, n // 2], max(1, int(trim * n))
+
+    def band_of(mid):
+        return np.clip((0.5 * (mid[:, 0] + mid[:, 1]) if n % 2 == 0 else mid[:, 1])[:, None], 0.0, outline.band)
+
+    fast = None
+    if keys is not None:
+        v = np.take(outline._table(pad, reach), np.sort(np.take(keys, at), axis=1), mode="wrap")
+        band = band_of(v[:, middle])
+        start = np.zeros(k, dtype=np.intp)
+        if keep < n:
+            start = np.count_nonzero(np.subtract(band, v[:, : n - keep]) > np.subtract(v[:, keep:], band), axis=1)
+        run = np.take(v.ravel(), (np.arange(k) * n + start)[:, None] + np.arange(keep)[None, :])
+        fast = np.abs(np.subtract(run, band, out=run), out=run).mean(axis=1)
+        mk = np.sort(np.take(keys, at), axis=1)[:, middle]
+        mid = np.sign(mk) * np.sqrt(np.abs(mk).astype(np.float64))
+    else:
+        mid = np.sort(val, axis=1)[:, middle]
+    exact = np.partition(np.abs(val - band_of(mid)), keep - 1, axis=1)[:, :keep].mean(axis=1)
+    return fast, exact
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.sampled_from([4, 30, 900, 40000]),
+    st.sampled_from([0.7, 0.5, 1.0, 0.01]),
+    st.sampled_from([None, 1, 97, 1000]),
+)
+def test_the_costs_are_the_tenth_round_s_bit_for_bit(seed, top, trim, block):
+    # the radix sort of the keys, the table read by indexing and the shifts costed in blocks of rows give the very
+    # same costs, fast and exact (int16 keys, int32 keys past 2**15, and maps without keys)
+    from unittest import mock
+
+    from symfruit.core import surface
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 60, 2))
+    inside = np.sqrt(rng.integers(1, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    if rng.random() < 0.2:
+        inside = rng.normal(0.0, 5.0, (h, w))
+    n = int(rng.integers(2, 320))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, float(rng.uniform(0.0, 6.0)))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (int(rng.integers(1, 60)), 2))
+    fast, exact = _costs_as_before(outline, shifts, reach, trim)
+    with mock.patch.object(surface, "_BLOCK", block or surface._BLOCK):
+        np.testing.assert_array_equal(outline.cost(shifts, reach, trim), exact)
+        if fast is not None:
+            np.testing.assert_array_equal(outline.cost(shifts, reach, trim, exact=False), fast)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(0, 6000), st.sampled_from([1, 3, 72, 10**6]))
 def test_the_stable_order_is_numpys_stable_argsort(seed, n, span):
     # distinct keys made of the key and the position, sorted as values: the same permutation, ties in order
