@@ -60,6 +60,16 @@ LAYOUT_KEYS = frozenset(
 DEPTH_KEYS = frozenset({"depth_scale", "depth_units"})
 #: Keys beside a nested layout (``{"color": {...}, "depth": {...}}`` as RealSense tools write it).
 _BESIDE_NESTS = frozenset({*_NESTS, "depth", "extrinsics"})
+#: Keys that make a mapping a layout of its own (its nests, if any, are not followed).
+_LAYOUT_MARKS = frozenset({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"})
+
+
+def _nest(data: dict) -> str | None:
+    """The nest (:data:`_NESTS`) whose mapping holds the intrinsics of ``data``, the first there is, or None where
+    ``data`` is a layout itself or has no nest."""
+    if _LAYOUT_MARKS & set(data):
+        return None
+    return next((key for key in _NESTS if isinstance(data.get(key), dict)), None)
 
 
 def load_camera(path: str | Path) -> Camera:
@@ -85,10 +95,8 @@ def _distortion(data: Any) -> tuple[str, list[float]] | None:
     follows), or None; coefficients that are not finite numbers are refused naming the key."""
     if not isinstance(data, dict):
         return None
-    if not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)):
-        for nest in _NESTS:
-            if isinstance(data.get(nest), dict):
-                return _distortion(data[nest])
+    if (nest := _nest(data)) is not None:
+        return _distortion(data[nest])
     key = next((k for k in _DISTORTION_KEYS if k in data), None)
     if key is None:
         return None
@@ -131,18 +139,15 @@ def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
     follows) that no layout has: ``(key, where, closest known key or None)``, or None."""
     if not isinstance(data, dict):
         return None
-    nested = not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)) and any(
-        isinstance(data.get(key), dict) for key in _NESTS
-    )
-    known = (_BESIDE_NESTS if nested else LAYOUT_KEYS) | (DEPTH_KEYS if not where else frozenset())
+    nest = _nest(data)
+    known = (_BESIDE_NESTS if nest is not None else LAYOUT_KEYS) | (DEPTH_KEYS if not where else frozenset())
     for key in data:
         if not isinstance(key, str) or key not in known:
             name = str(key)
             close = difflib.get_close_matches(name, sorted(known | DEPTH_KEYS), n=1, cutoff=0.6)
             return name, where, close[0] if close else None
-    if nested:
-        key = next(k for k in _NESTS if isinstance(data.get(k), dict))
-        return _unknown_key(data[key], f"{where}{key}.")
+    if nest is not None:
+        return _unknown_key(data[nest], f"{where}{nest}.")
     return None
 
 
@@ -238,10 +243,8 @@ def _camera_of(data: Any) -> Camera:
     """:func:`camera_from_dict` without the check of the keys."""
     if not isinstance(data, dict):
         raise InputError(f"intrinsics must be a mapping, got {type(data).__name__}")
-    if not ({"fx", "intrinsic_matrix", "K", "k", "camera_matrix"} & set(data)):
-        for key in _NESTS:
-            if isinstance(data.get(key), dict):
-                return _camera_of(data[key])
+    if (nest := _nest(data)) is not None:
+        return _camera_of(data[nest])
     if "intrinsic_matrix" in data:  # Open3D, column-major
         m = _matrix(data["intrinsic_matrix"], "intrinsic_matrix")
         fx, fy, cx, cy = m[0], m[4], m[6], m[7]
