@@ -26,7 +26,7 @@ MAX_INSTANCES_PER_IMAGE = MAX_INSTANCES
 MAX_POLYGON_POINTS = 100_000
 MAX_RLE_RUNS = 10_000_000
 
-__all__ = ["CocoSet", "coco_from_data", "coco_masks", "read_coco", "read_masks", "rle_decode"]
+__all__ = ["CocoSet", "coco_from_data", "coco_masks", "read_coco", "read_label_png", "read_masks", "rle_decode"]
 
 
 def read_masks(path: str | Path, shape: tuple[int, int], *, color: tuple[str | Path, int] | None = None) -> np.ndarray:
@@ -41,15 +41,23 @@ def read_masks(path: str | Path, shape: tuple[int, int], *, color: tuple[str | P
     if path.is_dir():
         path = path / "masks.png" if (path / "masks.png").is_file() else path / "masks.json"
     if path.suffix.lower() == ".png":
-        labels, orientation = read_labels_oriented(path)
-        if color is not None:
-            orientation_mismatch(color[0], color[1], path, orientation, what="labels")
+        labels = read_label_png(path, color=color)
     elif path.suffix.lower() == ".json":
         labels = coco_masks(path, shape)
     else:
         raise FileFormatError(f"{path}: masks must be a label .png or a COCO .json")
     if labels.shape != tuple(shape):
         raise FileFormatError(f"{path}: masks are {labels.shape[1]}x{labels.shape[0]}, the image {shape[1]}x{shape[0]}")
+    return labels
+
+
+def read_label_png(path: Path, *, color: tuple[str | Path, int] | None = None) -> np.ndarray:
+    """Instance labels from a label PNG (:func:`~symfruit.io.images.read_labels`), as displayed; ``color`` as in
+    :func:`read_masks`: the colour image they are for and its EXIF orientation, which the PNG must carry too
+    (None: not checked)."""
+    labels, orientation = read_labels_oriented(path)
+    if color is not None:
+        orientation_mismatch(color[0], color[1], path, orientation, what="labels")
     return labels
 
 

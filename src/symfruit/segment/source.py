@@ -180,16 +180,6 @@ def _frames_folder(folder: Path) -> MaskSource | None:
     return MaskSource(str(folder), per_frame)
 
 
-def _labels(path: Path, color_file: tuple[str | Path, int] | None) -> np.ndarray:
-    """A label PNG for a colour image that must carry the colour's EXIF orientation (None: not checked)."""
-    from ..io.images import orientation_mismatch, read_labels_oriented
-
-    labels, orientation = read_labels_oriented(path)
-    if color_file is not None:
-        orientation_mismatch(color_file[0], color_file[1], path, orientation, what="labels")
-    return labels
-
-
 def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
     """Masks of a set of image files from files: a COCO JSON, a folder of label PNGs, one label PNG."""
     source = Path(text)
@@ -213,10 +203,14 @@ def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
             label_path = source / f"{Path(name).stem}.png"
             if not label_path.is_file():
                 raise FileFormatError(f"{label_path}: no label image for {name}")
-            return _labels(label_path, cf), where
+            from ..io.masks import read_label_png
+
+            return read_label_png(label_path, color=cf), where
 
         return MaskSource(where, from_folder)
     if source.suffix.lower() == ".png" and source.is_file() and len(images) == 1:
-        return MaskSource(where, lambda color, depth, camera, name, own, cf: (_labels(source, cf), where))
+        from ..io.masks import read_label_png
+
+        return MaskSource(where, lambda color, depth, camera, name, own, cf: (read_label_png(source, color=cf), where))
     raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
                      "a folder of label PNGs, or one label .png for one image")  # fmt: skip
