@@ -10,7 +10,7 @@ import sys
 import numpy as np
 import pytest
 
-from symfruit.ros.bench import _LINE, _stats
+from symfruit.ros.bench import _LINE, _stats, _summarise
 
 
 def test_stats_known_answer():
@@ -27,6 +27,24 @@ def test_the_node_log_line_is_read():
     assert m is not None
     assert m.groups() == ("1003", "500000000", "89.2", "88.2", "0.9", "0.1", "0.2", "0.0", "0.5")
     assert _LINE.search(line.replace("6 fruit", "1 fruit (2 failed)")) is not None
+
+
+def test_the_summary_reads_closed_loop_frames_only_and_counts_the_open_loop():
+    def line(stamp, total, detect, node):
+        return (f"symfruit: frame {stamp}.000000000: 2 fruit in {total} ms (detect {detect} ms, node {node} ms: "
+                "wait 0.1, decode 0.2, collect 0.3, publish 0.4), 0 dropped so far")  # fmt: skip
+
+    log = "\n".join([line(1000, 9, 9, 9), line(1001, 50.0, 40.0, 2.0), line(1002, 60.0, 44.0, 4.0),
+                      line(5000, 99, 99, 99), "an unrelated line"])  # fmt: skip
+    out = _summarise({"process_alone_ms": {"median": 30.0}}, log, {1001: 70.0, 1002: 80.0, 1003: 90.0},
+                     frames=4, delivered=[0.0, 0.1, 0.3], span=0.5)  # fmt: skip
+    assert out["node_total_ms"]["n"] == 2 and out["node_total_ms"]["median"] == 55.0  # warm-up and open loop left out
+    assert out["node_overhead_each_ms"] == [2.0, 4.0]
+    assert out["node_publish_ms"]["median"] == 0.4
+    assert out["end_to_end_ms"]["median"] == 80.0
+    assert out["end_to_end_minus_node_detect_ms"]["median"] == 33.0  # (70 - 40, 80 - 44); frame 1003 has no log line
+    assert out["end_to_end_minus_detect_alone_ms"] == 50.0
+    assert out["open_loop"] == {"sent": 4, "delivered": 3, "dropped": 1, "fps": 4.0}
 
 
 def test_example_images_are_what_a_camera_driver_publishes(example_images):

@@ -180,7 +180,15 @@ def bench_node(
         finally:
             stop_group(node, 30)
             rospy.signal_shutdown("bench done")
-        lines = [m.groups() for m in map(_LINE.search, log.read_text(errors="replace").splitlines()) if m]
+        log_text = log.read_text(errors="replace")
+    return _summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span)
+
+
+def _summarise(out: dict, log_text: str, e2e: dict[int, float], *, frames: int, delivered: list[float],
+               span: float) -> dict:  # fmt: skip
+    """The node's per-frame timings (its log lines of the closed-loop frames), end to end and the open loop's
+    delivery, added to ``out`` (the ROS 1 and ROS 2 benchmarks report alike)."""
+    lines = [m.groups() for m in map(_LINE.search, log_text.splitlines()) if m]
     closed = {int(g[0]): tuple(map(float, g[2:])) for g in lines if 1001 <= int(g[0]) < 5000}
     out["node_total_ms"] = _stats([c[0] for c in closed.values()])
     out["node_detect_ms"] = _stats([c[1] for c in closed.values()])

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 from ..methods import DEFAULT_METHOD
-from .bench import _LINE, _PARTS, _print, _stats, example_images
+from .bench import _print, _stats, _summarise, example_images
 from .master import stop_group
 
 __all__ = ["bench_node2", "main"]
@@ -120,24 +120,8 @@ def bench_node2(
             spinner.join(10)
             rclpy.try_shutdown(context=context)
             context.destroy()
-        lines = [m.groups() for m in map(_LINE.search, log.read_text(errors="replace").splitlines()) if m]
-    closed = {int(g[0]): tuple(map(float, g[2:])) for g in lines if 1001 <= int(g[0]) < 5000}
-    out["node_total_ms"] = _stats([c[0] for c in closed.values()])
-    out["node_detect_ms"] = _stats([c[1] for c in closed.values()])
-    out["node_overhead_ms"] = _stats([c[2] for c in closed.values()])
-    out["node_overhead_each_ms"] = [c[2] for _, c in sorted(closed.items())]
-    for k, part in enumerate(_PARTS, 3):
-        out[f"node_{part}_ms"] = _stats([c[k] for c in closed.values()])
-    out["end_to_end_ms"] = _stats(list(e2e.values()))
-    out["end_to_end_minus_node_detect_ms"] = _stats([e2e[k] - closed[k][1] for k in e2e if k in closed])
-    out["end_to_end_minus_detect_alone_ms"] = out["end_to_end_ms"]["median"] - out["process_alone_ms"]["median"]
-    out["open_loop"] = {
-        "sent": frames,
-        "delivered": len(delivered),
-        "dropped": frames - len(delivered),
-        "fps": (len(delivered) - 1) / span if len(delivered) > 1 else float("nan"),
-    }
-    return out
+        log_text = log.read_text(errors="replace")
+    return _summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span)
 
 
 def main(argv: list[str] | None = None) -> int:
