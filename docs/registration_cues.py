@@ -173,7 +173,8 @@ def model(name, n):
                 if got is not None:
                     errors[cue][axis].append(abs(got - true))
             row.append(f"{cue} ({_px(du)}, {_px(dv)})")
-        say(f"seed {seed}: true ({tu:+.1f}, {tv:+.1f}); " + "; ".join(row) + "\n")
+        sides = ", ".join(f"{k} {_px(v[0])}" for k, v in whole.sides.items())
+        say(f"seed {seed}: true ({tu:+.1f}, {tv:+.1f}); " + "; ".join(row) + f"; edge sides: {sides}\n")
     for cue in cues:
         eu, ev = (np.array(e) for e in errors[cue])
         say(
