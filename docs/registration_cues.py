@@ -10,8 +10,15 @@ alone; the same with the outline points left out where the depth cap runs on int
 support) or ends at the search border; the image offset from the mask's centroid of the centre of a sphere fitted
 to the depth pixels within 0.6 of the mask's equivalent radius of that centroid; and of the nearest depth point
 (a paraboloid fitted to the median-filtered depth there). A sphere's nearest point and centre lie on one ray, so
-on a well-registered frame the last two are near (0, 0) for spheres. ``--model``: rendered frames through a camera
-model, the true shift of each against what ``symfruit.extract.register`` finds.
+on a well-registered frame the last two are near (0, 0) for spheres. Per frame, the frame-wide edge cue
+(``symfruit.core.edges.edge_shift``: the depth's outlines laid on the colour's edges, independent of the fruit's
+outline cue): its best shift over the whole frame and with the fruit's masks (grown by the search radius) left
+out, how sharp it is (the cost 2 px off the optimum along u and v, less the optimum's, and the shifts along each
+axis within 0.1 px of the optimum's cost), and the shift each side of the outlines says (left/right: du, top/bottom:
+dv; their difference is the time-of-flight band). ``--model``: rendered frames through a camera model, the true
+shift of each against what ``symfruit.extract.register`` (the fruit-outline cue) and the edge cue find; the edge
+cue also on the render's colour given texture and blur (the render's own colour is flat-shaded: its only edges
+are the silhouettes, cleaner than a real camera's).
 """
 
 import argparse
@@ -20,7 +27,7 @@ import sys
 import numpy as np
 from scipy import ndimage
 
-from symfruit.core import surface
+from symfruit.core import edges, surface
 from symfruit.core.raster import inner_distance
 from symfruit.extract import ExtractSettings, register
 
@@ -72,6 +79,30 @@ def sphere_and_apex(depth, mask, camera):
     return centre - (cx, cy), apex - (cx, cy)
 
 
+def edge_cue(depth, color, masks, max_px):
+    """The edge cue over the whole frame and with the fruit left out; one line each."""
+    grown = ndimage.distance_transform_cdt(masks == 0, metric="taxicab") <= max_px
+    lines = []
+    for label, exclude in (("whole frame", None), ("fruit left out", grown)):
+        r = edges.edge_shift(depth, color, max_px=max_px, exclude=exclude)
+        m = max_px
+        iu, iv = r.shift[0] + m, r.shift[1] + m
+        along_u, along_v = r.cost[iv, :], r.cost[:, iu]
+        span_u = np.flatnonzero(along_u <= along_u.min() + 0.1) - m
+        span_v = np.flatnonzero(along_v <= along_v.min() + 0.1) - m
+        sides = ", ".join(
+            f"{k} {v[0]} ({v[1]} px, rise {v[2]:.2f})" if v[0] is not None else f"{k} - ({v[1]} px)"
+            for k, v in r.sides.items()
+        )
+        bu, bv = r.balanced
+        lines.append(
+            f"  edge cue, {label}: (du, dv) = {r.shift} on {r.n_outline} outline px; rise at 2 px u {r.rise[0]:.2f}, "
+            f"v {r.rise[1]:.2f} px; within 0.1 px of the optimum du {span_u.min()}..{span_u.max()}, dv "
+            f"{span_v.min()}..{span_v.max()}; sides: {sides}; band {r.band}; sides balanced ({bu}, {bv})\n"
+        )
+    return r, lines
+
+
 def real(folder):
     from symfruit.io.sources import open_source
 
@@ -83,6 +114,8 @@ def real(folder):
         focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
         _, whole = register(frame.masks, frame.depth, frame.camera)
         say(f"{name}: registration of the frame (du, dv) = {whole}\n")
+        for line in edge_cue(frame.depth, frame.color, frame.masks, max_px)[1]:
+            say(line)
         for k, sl in enumerate(ndimage.find_objects(frame.masks), 1):
             if sl is None:
                 continue
@@ -98,6 +131,17 @@ def real(folder):
             )
 
 
+def textured(color, seed):
+    """``color`` with a random blotch texture (+-20 % brightness, edges of its own) and a 1 px blur: edges that
+    are not silhouettes, and soft ones, as a real camera's."""
+    rng = np.random.default_rng(seed)
+    h, w = color.shape[:2]
+    blotch = ndimage.gaussian_filter(rng.normal(size=(h, w)), 6.0) > 0
+    out = color.astype(np.float64) * np.where(blotch, 1.2, 0.8)[..., None]
+    out = ndimage.gaussian_filter(out, (1.0, 1.0, 0))
+    return np.clip(out, 0, 255).astype(np.uint8)
+
+
 def model(name, n):
     from symfruit.synthetic import scenes, sensors
 
@@ -110,14 +154,37 @@ def model(name, n):
         return out
 
     scenes.apply_sensor = keep
-    errors = []
+    max_px = ExtractSettings().registration_px
+    cues = ("fruit outline", "edge, 2D optimum", "edge, sides balanced", "edge, fruit left out, sides balanced",
+            "edge, textured colour, sides balanced")  # fmt: skip
+    errors = {c: ([], []) for c in cues}
     for seed in range(n):
         scene = scenes._sensor_scene(seed, sensors.sensor_model(name), n_ripe=6, n_unripe=2, n_leaves=2)
-        _, (du, dv) = register(scene.masks, scene.depth, scene.camera)
+        _, found = register(scene.masks, scene.depth, scene.camera)
+        grown = ndimage.distance_transform_cdt(scene.masks == 0, metric="taxicab") <= max_px
+        whole = edges.edge_shift(scene.depth, scene.color, max_px=max_px)
+        alone = edges.edge_shift(scene.depth, scene.color, max_px=max_px, exclude=grown)
+        tex = edges.edge_shift(scene.depth, textured(scene.color, seed), max_px=max_px)
         tu, tv = shifts[-1]
-        errors.append(np.hypot(du - tu, dv - tv))
-        say(f"seed {seed}: true ({tu:+.1f}, {tv:+.1f}), found ({du:+d}, {dv:+d})\n")
-    say(f"mean distance of the found shift from the true one: {np.mean(errors):.2f} px\n")
+        row = []
+        answers = (found, whole.shift, whole.balanced, alone.balanced, tex.balanced)
+        for cue, (du, dv) in zip(cues, answers, strict=True):
+            for axis, (got, true) in enumerate(((du, tu), (dv, tv))):
+                if got is not None:
+                    errors[cue][axis].append(abs(got - true))
+            row.append(f"{cue} ({_px(du)}, {_px(dv)})")
+        sides = ", ".join(f"{k} {_px(v[0])}" for k, v in whole.sides.items())
+        say(f"seed {seed}: true ({tu:+.1f}, {tv:+.1f}); " + "; ".join(row) + f"; edge sides: {sides}\n")
+    for cue in cues:
+        eu, ev = (np.array(e) for e in errors[cue])
+        say(
+            f"{cue}: mean absolute error u {eu.mean():.2f} px ({len(eu)} of {n} frames answer), v {ev.mean():.2f} px "
+            f"({len(ev)} of {n}); answers off by more than 2 px: u {int((eu > 2).sum())}, v {int((ev > 2).sum())}\n"
+        )
+
+
+def _px(value):
+    return "-" if value is None else f"{value:+g}"
 
 
 def main(argv=None):

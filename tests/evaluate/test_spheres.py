@@ -62,6 +62,23 @@ def test_the_table_names_every_sphere(boxes):
     assert summary[0]["frames"] == ["lab-spheres-0", "lab-spheres-1"] and summary[0]["failed"] == 0
 
 
+def test_the_lateral_column_is_the_larger_lateral_side_against_the_masks_diameter():
+    # issue 18 compares lateral sides with the 2D thin-lens estimate: the larger of x and y, not the depth side
+    rows = [SphereBox("f1", 1, "raw", (40.0, 46.0, 30.0), 42.0), SphereBox("f2", 1, "raw", (36.0, 30.0, 50.0), 40.0),
+            SphereBox("f1", 2, "raw", (np.nan,) * 3, np.nan, "failed")]  # fmt: skip
+    assert [rows[0].lateral_mm, rows[1].lateral_mm] == [4.0, -4.0] and np.isnan(rows[2].lateral_mm)
+    table, summary = spheres_table(rows, ("raw",))
+    head = table.splitlines()[0].split(" | ")
+    assert head[2:5] == [
+        "depth side - mask diameter (mm), mean abs (mean)",
+        "larger lateral side - mask diameter (mm), mean abs (mean)",
+        "frames differ (mm), worst",
+    ]
+    assert table.splitlines()[2].split(" | ")[2:5] == ["11.0 (-1.0)", "4.0 (+0.0)", "20.0"]
+    assert summary[0]["lateral_mm_mean_abs"] == 4.0
+    assert spheres_table(rows[2:], ("raw",))[0].splitlines()[2] == "| `raw` | - | - | - | - | failed |"
+
+
 def test_a_frame_that_cannot_be_read_is_skipped_and_named(tmp_path):
     import shutil
 
@@ -80,7 +97,7 @@ def test_a_failed_sphere_and_a_single_frame_give_a_summary_that_is_json_and_no_n
     rows = [SphereBox("f1", 1, "raw", (40.0, 40.0, 30.0), 38.0),
             SphereBox("f1", 2, "raw", (np.nan,) * 3, np.nan, "only 2 points with valid depth")]  # fmt: skip
     table, summary = spheres_table(rows, ("raw",))
-    assert "| `raw` | 10.0 / 10.0 | 8.0 (-8.0) | - | 40x40x30 | failed |" in table and "nan" not in table
+    assert "| `raw` | 10.0 / 10.0 | 8.0 (-8.0) | 2.0 (+2.0) | - | 40x40x30 | failed |" in table and "nan" not in table
     boxes = json.loads(json.dumps(summary, allow_nan=False))[0]["boxes"]
     assert boxes[0]["size"] == [40.0, 40.0, 30.0] and boxes[1]["size"] is None and boxes[1]["diameter"] is None
 

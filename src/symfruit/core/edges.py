@@ -1,0 +1,267 @@
+"""How far a depth image sits from its colour image, from the whole frame's edges (not the fruit's).
+
+The standard targetless idea for calibrating a range sensor against a camera (depth discontinuities should lie
+on image edges; Levinson and Thrun, "Automatic online calibration of cameras and lasers", RSS 2013): the near
+side of every depth discontinuity is an object's outline, which the colour image sees as an edge. The shift that
+lays the depth's outlines on the colour's edges is the registration offset.
+
+- :func:`depth_outline`: the near side of every depth discontinuity, whether the far side holds depth (a jump)
+  or not (a time-of-flight camera invalidates the mixed pixels between, and the depth camera's parallax shadow
+  lies behind it). The far side of an invalid band (the shadow's edge), the edge of the depth camera's field
+  of view and a band of invalid pixels between two surfaces at about one depth (where two surfaces meet, or a
+  dark patch) are no outline: no surface within ``reach`` pixels lies farther by ``jump`` of the depth.
+- :func:`colour_edges`: the colour image's edges (gradient maxima along the gradient, the strongest channel's
+  gradient, a threshold a multiple of the frame's median gradient), with their orientation.
+- :func:`edge_shift`: an oriented, truncated chamfer score (each outline pixel's distance to the nearest colour
+  edge of about its orientation, capped, the worst share dropped) at every integer shift within ``max_px``. The
+  colour's texture (a printed board, handles, shading) only adds edges, which a distance from the depth's
+  outline to the colour's edges tolerates. The outline pixels are also split by the side their background lies
+  on: a time-of-flight camera loses the outermost pixels of every foreground object (mixed pixels), which moves
+  each outline a band ``b`` towards its object; left and right outlines then give ``du + b`` and ``du - b``, top
+  and bottom ones ``dv + b`` and ``dv - b``, so the band cancels where both sides are seen and can be told apart.
+
+Convention as :func:`symfruit.core.surface.registration_shift`: the depth pixel ``(u + du, v + dv)`` sees what
+the colour pixel ``(u, v)`` sees. Numpy and scipy only; images in, numbers out.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+__all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift"]
+
+#: Orientation bins of the oriented chamfer score (edge normals modulo 180 degrees); a depth outline pixel is
+#: matched to colour edges in its own bin and the two beside it (within 45 degrees).
+N_BINS = 6
+
+
+@dataclass(frozen=True)
+class EdgeShift:
+    """What :func:`edge_shift` found.
+
+    Attributes
+    ----------
+    shift : (int, int)
+        ``(du, dv)``, pixels: the shift of least cost over all outline pixels.
+    cost : (2 m + 1, 2 m + 1) float
+        The trimmed mean capped distance (pixels) at every shift, ``cost[dv + m, du + m]``.
+    n_outline : int
+        Outline pixels scored (after thinning to at most ``max_points``).
+    sides : dict
+        For ``"left"``, ``"right"``, ``"top"``, ``"bottom"`` (where the outline's background lies), the best shift
+        along the axis that side constrains (``du`` for left and right, ``dv`` for top and bottom; the other
+        coordinate free), how many outline pixels it rests on and how sharp its optimum is (the cost 2 px either
+        side less the optimum's, pixels): ``(shift, n, rise)``, shift and rise None under ``min_side`` pixels.
+    band : float or None
+        Half the difference of the left and right sides' ``du`` (pixels): how far a time-of-flight camera's lost
+        rim moves an outline towards its object (None without both sides).
+    rise : (float, float)
+        How sharp the optimum is: the cost 2 px away along ``u`` and along ``v`` (the mean of both directions),
+        less the cost at the optimum, pixels.
+    """
+
+    shift: tuple[int, int]
+    cost: np.ndarray
+    n_outline: int
+    sides: dict[str, tuple[int | None, int, float | None]]
+    band: float | None
+    rise: tuple[float, float]
+
+    @property
+    def balanced(self) -> tuple[float | None, float | None]:
+        """``(du, dv)`` from the sides, the band cancelled: the mean of left and right (of top and bottom), each side
+        weighted alike however many pixels it has. None for an axis one of whose sides does not say (the band
+        need not be the same across and along: a side alone says the shift plus or minus its band)."""
+        out: list[float | None] = []
+        for lo, hi in (("left", "right"), ("top", "bottom")):
+            a, b = self.sides[lo][0], self.sides[hi][0]
+            out.append(None if a is None or b is None else (a + b) / 2.0)
+        return out[0], out[1]
+
+
+def _orientation_bin(gx: np.ndarray, gy: np.ndarray) -> np.ndarray:
+    angle = np.mod(np.arctan2(gy, gx), np.pi)
+    return (np.floor(angle / (np.pi / N_BINS) + 0.5).astype(np.int64)) % N_BINS
+
+
+def depth_outline(
+    depth: np.ndarray, *, jump: float = 0.1, reach: int = 30
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The near side of the depth image's discontinuities.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres; 0 or NaN where invalid
+    jump : float
+        A surface at least this share of the pixel's depth (and 2 cm) farther, within ``reach`` pixels, makes a
+        valid pixel at the image of an outline (beside an invalid or a farther pixel) the near side of a
+        discontinuity.
+    reach : int, pixels
+        How far across an invalid band the farther surface is looked for. Pixels within ``reach`` of the depth
+        camera's field of view (the valid region closed over gaps of ``2 reach`` and its holes filled) are no
+        outline: the field's edge is no object's.
+
+    Returns
+    -------
+    outline : (h, w) bool
+    gx, gy : (h, w) float
+        The outline's normal, pointing from the object to its background (the gradient of the depth with invalid
+        pixels filled by the farthest depth within ``reach``: across an invalid band, its far side).
+    """
+    z = np.asarray(depth, dtype=np.float64)
+    valid = np.isfinite(z) & (z > 0)
+    z = np.where(valid, z, 0.0)
+    far = ndimage.maximum_filter(z, size=2 * reach + 1)
+    step = np.maximum(jump * z, 0.02)
+    neighbours = np.full(z.shape, 0.0)
+    for dv, du in ((0, 1), (0, -1), (1, 0), (-1, 0)):
+        other = np.roll(np.where(valid, z, np.inf), (dv, du), axis=(0, 1))
+        neighbours = np.maximum(neighbours, np.where(np.isfinite(other), other - z, np.inf))
+    outline = valid & (neighbours > step) & (far - z > step)
+    # The invalid band's side: keep only pixels that are the near side locally (nothing nearer by a step beside them).
+    near = ndimage.minimum_filter(np.where(valid, z, np.inf), size=5)
+    outline &= z - near < step
+    closed = ndimage.binary_closing(valid, iterations=reach, border_value=0)
+    field = ndimage.binary_fill_holes(closed | valid)
+    outline &= ndimage.binary_erosion(field, iterations=reach, border_value=0)
+    filled = ndimage.gaussian_filter(np.where(valid, z, far), 1.0)
+    gx = ndimage.sobel(filled, axis=1)
+    gy = ndimage.sobel(filled, axis=0)
+    return outline, gx, gy
+
+
+def colour_edges(color: np.ndarray, *, sigma: float = 1.0, ratio: float = 4.0) -> tuple[np.ndarray, np.ndarray]:
+    """The colour image's edges: pixels whose gradient (the strongest of the three channels after a Gaussian of
+    ``sigma``) is a maximum along its own direction and at least ``ratio`` times the frame's median gradient.
+
+    Returns
+    -------
+    edges : (h, w) bool
+    bins : (h, w) int
+        Each pixel's gradient orientation bin (``N_BINS`` bins over 180 degrees).
+    """
+    img = np.asarray(color, dtype=np.float64)
+    if img.ndim == 2:
+        img = img[..., None]
+    gx = np.zeros(img.shape[:2])
+    gy = np.zeros(img.shape[:2])
+    mag = np.zeros(img.shape[:2])
+    for c in range(img.shape[2]):
+        ch = ndimage.gaussian_filter(img[..., c], sigma)
+        cx, cy = ndimage.sobel(ch, axis=1), ndimage.sobel(ch, axis=0)
+        m = np.hypot(cx, cy)
+        take = m > mag
+        gx, gy, mag = np.where(take, cx, gx), np.where(take, cy, gy), np.where(take, m, mag)
+    # Non-maximum suppression along the gradient, quantised to 4 directions.
+    angle = np.mod(np.arctan2(gy, gx), np.pi)
+    q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
+    offsets = ((0, 1), (1, 1), (1, 0), (1, -1))  # (dv, du) along 0, 45, 90, 135 degrees
+    peak = np.zeros(mag.shape, bool)
+    for k, (dv, du) in enumerate(offsets):
+        a = np.roll(mag, (dv, du), axis=(0, 1))
+        b = np.roll(mag, (-dv, -du), axis=(0, 1))
+        peak |= (q == k) & (mag >= a) & (mag >= b)
+    med = float(np.median(mag))
+    edges = peak & (mag > ratio * max(med, 1e-9))
+    edges[[0, -1], :] = False
+    edges[:, [0, -1]] = False
+    return edges, _orientation_bin(gx, gy)
+
+
+def edge_shift(
+    depth: np.ndarray, color: np.ndarray, *, max_px: int = 20, cap: float = 6.0, keep: float = 0.7,
+    max_points: int = 8000, min_side: int = 100, jump: float = 0.1, reach: int = 30,
+    exclude: np.ndarray | None = None,
+) -> EdgeShift:  # fmt: skip
+    """The integer shift ``(du, dv)`` within ``max_px`` that lays the depth's outlines (:func:`depth_outline`) on
+    the colour's edges (:func:`colour_edges`).
+
+    Each outline pixel costs its distance to the nearest colour edge within 45 degrees of its orientation, capped
+    at ``cap`` pixels (a pixel off the image costs ``cap``); a shift costs the mean of its ``keep`` share of
+    cheapest pixels (an outline without a colour edge, a colour edge the depth does not see). At most
+    ``max_points`` outline pixels are scored, evenly thinned. ``exclude``: (h, w) bool, pixels whose outline is
+    not scored (the fruit's masks grown by ``max_px``, for a cue independent of the fruit).
+
+    Raises
+    ------
+    ValueError
+        When depth and colour differ in size.
+    """
+    z = np.asarray(depth, dtype=np.float64)
+    if np.asarray(color).shape[:2] != z.shape:
+        raise ValueError(f"depth {z.shape} and colour {np.asarray(color).shape[:2]} differ in size")
+    h, w = z.shape
+    outline, ogx, ogy = depth_outline(z, jump=jump, reach=reach)
+    if exclude is not None:
+        outline &= ~np.asarray(exclude, dtype=bool)
+    edges, ebins = colour_edges(color)
+    rows, cols = np.nonzero(outline)
+    m = int(max_px)
+    # Every point's cost at every shift is kept (for the sides): at most about 2e7 of them.
+    max_points = max(1, min(max_points, 20_000_000 // (2 * m + 1) ** 2))
+    step = max(1, -(-len(rows) // max_points))
+    rows, cols = rows[::step], cols[::step]
+    nx, ny = ogx[rows, cols], ogy[rows, cols]
+    bins = _orientation_bin(nx, ny)
+    # One distance map a bin: distance to colour edges within one bin of it, capped.
+    dist = np.empty((N_BINS, h, w), np.float32)
+    for b in range(N_BINS):
+        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
+        dist[b] = np.minimum(ndimage.distance_transform_edt(~near_bin), cap) if near_bin.any() else cap
+    shifts = np.arange(-m, m + 1)
+    n = len(rows)
+
+    def costs(sel: np.ndarray) -> np.ndarray:
+        """Per-point capped distances at every shift: (2m+1, 2m+1, n) over (dv, du)."""
+        r, c, bb = rows[sel], cols[sel], bins[sel]
+        out = np.full((2 * m + 1, 2 * m + 1, len(r)), cap, np.float32)
+        for i, dv in enumerate(shifts):
+            rr = r - dv
+            ok_r = (rr >= 0) & (rr < h)
+            for j, du in enumerate(shifts):
+                cc = c - du
+                ok = ok_r & (cc >= 0) & (cc < w)
+                out[i, j, ok] = dist[bb[ok], rr[ok], cc[ok]]
+        return out
+
+    def trimmed(values: np.ndarray) -> np.ndarray:
+        k = max(1, round(keep * values.shape[-1]))
+        return np.sort(values, axis=-1)[..., :k].mean(axis=-1)
+
+    every = costs(np.ones(n, bool)) if n else np.full((2 * m + 1, 2 * m + 1, 0), cap, np.float32)
+    cost = trimmed(every) if n else np.full((2 * m + 1, 2 * m + 1), cap)
+    iv, iu = (int(i) for i in np.unravel_index(int(np.argmin(cost)), cost.shape))
+    shift = (int(shifts[iu]), int(shifts[iv]))
+
+    def rise_along(axis: int) -> float:
+        i0 = (iv, iu)
+        vals = []
+        for d in (-2, 2):
+            idx = list(i0)
+            idx[axis] = min(max(idx[axis] + d, 0), 2 * m)
+            vals.append(cost[tuple(idx)])
+        return float(np.mean(vals) - cost[iv, iu])
+
+    # Sides: background to the left has a normal pointing -u (the depth rises towards the background).
+    horizontal = np.abs(nx) > 2.0 * np.abs(ny)
+    vertical = np.abs(ny) > 2.0 * np.abs(nx)
+    side_sel = {"left": horizontal & (nx < 0), "right": horizontal & (nx > 0),
+                "top": vertical & (ny < 0), "bottom": vertical & (ny > 0)}  # fmt: skip
+    sides: dict[str, tuple[int | None, int, float | None]] = {}
+    for name, sel in side_sel.items():
+        count = int(sel.sum())
+        if count < min_side:
+            sides[name] = (None, count, None)
+            continue
+        # The axis the side constrains: the other is free (its best for every value of this one).
+        per = trimmed(every[:, :, sel])
+        profile = per.min(axis=0) if name in ("left", "right") else per.min(axis=1)
+        best = int(np.argmin(profile))
+        around = float(np.mean(profile[[max(best - 2, 0), min(best + 2, 2 * m)]]) - profile[best])
+        sides[name] = (int(shifts[best]), count, around)
+    left, right = sides["left"][0], sides["right"][0]
+    band = None if left is None or right is None else (left - right) / 2.0
+    return EdgeShift(shift, cost, n, sides, band, (rise_along(1), rise_along(0)))

@@ -1,0 +1,107 @@
+"""The frame-wide edge cue of depth-to-colour registration: a scene of boxes and a disc before a wall, colour with
+texture of its own, depth moved by a known shift and its objects' outermost pixels lost (a time-of-flight band)."""
+
+import numpy as np
+import pytest
+
+from symfruit.core.edges import colour_edges, depth_outline, edge_shift
+
+H, W = 240, 320
+
+
+def scene(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """Depth (metres) and an object id per pixel: a wall at 2 m, two boxes and a disc at 1-1.3 m."""
+    vv, uu = np.mgrid[:H, :W]
+    ids = np.zeros((H, W), np.int32)
+    ids[60:180, 40:120] = 1
+    ids[30:110, 190:290] = 2
+    ids[np.hypot(uu - 230, vv - 180) < 35] = 3
+    depth = np.choose(ids, [2.0, 1.0, 1.3, 1.15]) + rng.normal(0, 0.001, (H, W))
+    return depth, ids
+
+
+def colour(ids: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Each object its own grey, a checkerboard printed on the wall (texture, no depth edge), noise."""
+    vv, uu = np.mgrid[:H, :W]
+    grey = np.choose(ids, [120.0, 60.0, 180.0, 90.0])
+    board = ((uu // 12 + vv // 12) % 2 == 0) & (ids == 0) & (uu < 160) & (vv > 150)
+    grey = grey + 40.0 * board + rng.normal(0, 2.0, (H, W))
+    return np.clip(np.repeat(grey[..., None], 3, axis=2), 0, 255).astype(np.uint8)
+
+
+def registered(depth: np.ndarray, ids: np.ndarray, du: int, dv: int, band: int) -> np.ndarray:
+    """Depth as the colour camera's pixels get it: what colour pixel (u, v) sees lands at depth pixel
+    (u + du, v + dv); every object loses its outermost ``band`` pixels (invalid), and no depth outside a
+    field of view 8 px inside the image."""
+    from scipy import ndimage
+
+    out = depth.copy()
+    objects = ids > 0
+    rim = objects & ~ndimage.binary_erosion(objects, iterations=band) if band else np.zeros_like(objects)
+    out[rim] = 0.0
+    moved = np.zeros_like(out)
+    moved[max(dv, 0) : H + min(dv, 0), max(du, 0) : W + min(du, 0)] = out[
+        max(-dv, 0) : H - max(dv, 0), max(-du, 0) : W - max(du, 0)
+    ]
+    moved[:8], moved[-8:], moved[:, :8], moved[:, -8:] = 0.0, 0.0, 0.0, 0.0
+    return moved
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (5, -3), (-7, 6)])
+def test_the_sides_find_a_known_shift_with_the_band_cancelled(shift):
+    rng = np.random.default_rng(3)
+    depth, ids = scene(rng)
+    found = edge_shift(registered(depth, ids, *shift, band=2), colour(ids, rng), max_px=12)
+    assert found.balanced == (float(shift[0]), float(shift[1]))
+    assert found.band == 2.0  # left and right outlines each sit 2 px inside their object
+    # a side alone says the shift plus or minus the band, to the pixel on which the colour edge is marked
+    assert abs(found.sides["top"][0] - (shift[1] + 2)) <= 1 and abs(found.sides["bottom"][0] - (shift[1] - 2)) <= 1
+    assert found.sides["left"][0] - found.sides["right"][0] == 4
+    assert all(rise > 0.3 for _, _, rise in found.sides.values())  # sharp: 2 px off costs a third of a pixel
+
+
+def test_without_a_band_the_whole_frame_optimum_is_the_shift():
+    rng = np.random.default_rng(4)
+    depth, ids = scene(rng)
+    found = edge_shift(registered(depth, ids, 4, 3, band=0), colour(ids, rng), max_px=12)
+    assert found.shift == (4, 3) and found.band == 0.0 and min(found.rise) > 0.3
+    assert found.cost.shape == (25, 25) and found.cost[3 + 12, 4 + 12] == found.cost.min()
+
+
+def test_the_outline_is_the_near_side_only():
+    rng = np.random.default_rng(5)
+    depth, ids = scene(rng)
+    z = registered(depth, ids, 0, 0, band=3)
+    outline, gx, gy = depth_outline(z)
+    # box 1 (rows 60-179, columns 40-119) lost 3 px: its outline is the first valid pixel inside
+    assert outline[120, 43] and outline[120, 116] and outline[63, 80] and outline[176, 80]
+    assert gx[120, 43] < 0 < gx[120, 116] and gy[63, 80] < 0 < gy[176, 80]  # normals point to the background
+    # the wall beside the band (its far side) and along the field of view's edge is no outline
+    assert not outline[120, 39] and not outline[120, 121] and not outline[120, 8] and not outline[8, 60]
+    assert not outline[ids == 0].any()
+
+
+def test_a_surface_continuing_across_an_invalid_band_is_no_outline():
+    # a dark stripe across the wall (no depth) between two parts of one surface: no farther surface beyond it
+    z = np.full((H, W), 2.0) + np.linspace(0, 0.05, H)[:, None]
+    z[100:110] = 0.0
+    assert not depth_outline(z)[0].any()
+
+
+def test_texture_alone_gives_colour_edges_the_depth_lacks_and_they_are_tolerated():
+    rng = np.random.default_rng(6)
+    depth, ids = scene(rng)
+    image = colour(ids, rng)
+    edges, _ = colour_edges(image)
+    assert edges[150:, :150][(ids[150:, :150] == 0)].sum() > 300  # the printed board's edges
+    found = edge_shift(registered(depth, ids, -3, 2, band=1), image, max_px=12)
+    du, dv = found.balanced
+    assert abs(du + 3.0) <= 0.5 and abs(dv - 2.0) <= 0.5  # an odd band: half a pixel, the colour edge's marked pixel
+
+
+def test_a_frame_without_outlines_says_nothing_and_sizes_must_agree():
+    flat = np.full((H, W), 1.5)
+    found = edge_shift(flat, np.zeros((H, W, 3), np.uint8), max_px=4)
+    assert found.n_outline == 0 and found.balanced == (None, None) and found.band is None
+    with pytest.raises(ValueError, match=r"depth \(240, 320\) and colour \(10, 10\) differ in size"):
+        edge_shift(flat, np.zeros((10, 10, 3), np.uint8))
