@@ -43,6 +43,7 @@ from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
 from .frames import named_frame
+from .intrinsics import warn_distortion
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -202,6 +203,10 @@ class RealSenseBagSource:
         color_prefix = self._color.topic[1 : -len("/image/data")]
         self.depth_stream = self._stream(depth_prefix, tfs)
         self.color_stream = self._stream(color_prefix, tfs)
+        # the colour lens's distortion registers depth to the colour pixels (align_depth) but the frames' camera is
+        # its pinhole part: said so, as for any camera; the depth lens's is applied in full
+        warn_distortion(f"{self.path}: colour camera info /{color_prefix}/info/camera_info", "D",
+                        self.color_stream.lens.coeffs, stacklevel=4)  # fmt: skip
         d, c = self.depth_stream, self.color_stream
         if d.group != c.group:
             raise FileFormatError(f"depth and colour extrinsics are relative to different references "
