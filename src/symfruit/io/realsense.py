@@ -5,7 +5,8 @@ librealsense's layout (``src/media/ros/ros_file_format.h``, file version 3 and 4
 
     /file_version                                               std_msgs/UInt32
     /device_0/sensor_<s>/<Stream>_<i>/image/data                sensor_msgs/Image (Depth: mono16 units)
-    /device_0/sensor_<s>/<Stream>_<i>/info/camera_info          sensor_msgs/CameraInfo (K, D, distortion_model)
+    /device_0/sensor_<s>/<Stream>_<i>/info/camera_info          sensor_msgs/CameraInfo (K, D, distortion_model;
+                                                                D: rs2_intrinsics' five coeffs, no more)
     /device_0/sensor_<s>/<Stream>_<i>/tf/<group>                geometry_msgs/Transform: group reference -> stream
     /device_0/sensor_<s>/option/Depth Units/value               std_msgs/Float32, metres per unit
                                                                 (``Depth_Units`` in SDK 2.5x)
@@ -157,9 +158,12 @@ class RealSenseBagSource:
         if model not in LENS_MODELS:
             raise FileFormatError(f"{prefix}: lens model {model!r} is not supported (known: {', '.join(LENS_MODELS)})")
         k = [float(v) for v in info.K]
-        coeffs = [float(v) for v in info.D][:5]
+        # librealsense writes D from rs2_intrinsics::coeffs, a float[5] (ros_writer.cpp), and reads five back: every
+        # model's coefficients are those five, so a D of any other length is not its recording; refused, never cut
+        coeffs = [float(v) for v in info.D]
         if len(k) != 9 or len(coeffs) not in (0, 5):
-            raise FileFormatError(f"{prefix}: camera info K has {len(k)} values and D {len(info.D)}; expected 9 and 5")
+            raise FileFormatError(f"{prefix}: camera info K has {len(k)} values and D {len(coeffs)}; expected 9 and "
+                                  "5 (librealsense records five lens coefficients, rs2_intrinsics coeffs)")  # fmt: skip
         try:
             camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(info.width), height=int(info.height))
             lens = Lens(camera, LENS_MODELS[model], tuple(coeffs or [0.0] * 5))
