@@ -131,6 +131,31 @@ def test_rle_counts_must_cover_the_image():
         rle_decode({"size": [7, 5], "counts": [5]})
 
 
+@pytest.mark.parametrize(
+    "counts, message",
+    [
+        ([36, -1], r"whole numbers 0-35, got 36"),  # adds up to 35: a negative run never cancels a longer one
+        ([-1, 36], r"whole numbers 0-35, got -1"),
+        ([1.5, 33.5], r"whole numbers 0-35, got 1\.5"),  # never cut to 1
+        ([True, 34], r"whole numbers 0-35, got True"),
+        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 characters\)"),
+        (None, r"a list of run lengths or a compressed string, got NoneType"),
+        ({"a": 1}, r"got dict"),
+        ("\u00e9", r"only ASCII"),
+    ],
+)  # fmt: skip
+def test_rle_counts_that_are_no_run_lengths_are_refused_by_what_they_are(counts, message):
+    with pytest.raises(ValueError, match=message):
+        rle_decode({"size": [7, 5], "counts": counts})
+    assert rle_decode({"size": [7, 5], "counts": np.array([1, 34])}).sum() == 34  # the API's arrays too
+
+
+def test_a_broken_rle_in_a_masks_file_names_the_file_and_annotation(tmp_path):
+    (tmp_path / "m.json").write_text(json.dumps({"annotations": [{"segmentation": {"size": [7, 5], "counts": None}}]}))
+    with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(RLE counts must be"):
+        read_masks(tmp_path / "m.json", (7, 5))
+
+
 def test_other_extensions_are_refused(tmp_path):
     with pytest.raises(FileFormatError, match=r"m\.npy: masks must be a label \.png or a COCO \.json"):
         read_masks(tmp_path / "m.npy", (10, 10))

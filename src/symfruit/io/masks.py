@@ -321,10 +321,22 @@ def rle_decode(rle: dict[str, Any]) -> np.ndarray:
         if len(counts) > 8 * MAX_RLE_RUNS:
             raise ValueError("RLE string too long")
         counts = _rle_string_counts(counts)
+    if isinstance(counts, (tuple, np.ndarray)) and np.ndim(counts) == 1:  # handed over by the API
+        counts = [c.item() if isinstance(c, np.generic) else c for c in counts]
+    if not isinstance(counts, list):
+        raise ValueError(
+            f"RLE counts must be a list of run lengths or a compressed string, got {type(counts).__name__}"
+        )
     if len(counts) > MAX_RLE_RUNS:
         raise ValueError("RLE has too many runs")
+    # whole numbers 0 to the image's pixels, each: a float is not cut, a negative run does not cancel a longer
+    # one (the sum alone let [19300, -100] through as "adds up to 19200"), a 400-digit one is not an overflow
+    bad = next((c for c in counts if isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= h * w), None)
+    if bad is not None:
+        shown = repr(bad) if len(repr(bad)) <= 20 else f"{repr(bad)[:12]}... ({len(repr(bad))} characters)"
+        raise ValueError(f"RLE counts must be run lengths, whole numbers 0-{h * w}, got {shown}")
     counts = np.asarray(counts, dtype=np.int64)
-    if counts.ndim != 1 or (counts < 0).any() or counts.sum() != h * w:
+    if counts.sum() != h * w:
         raise ValueError(f"RLE counts add up to {counts.sum()}, expected {h * w}")
     values = np.zeros(len(counts), bool)
     values[1::2] = True
@@ -336,6 +348,8 @@ def _rle_string_counts(s: str) -> list[int]:
     """The LEB128-like string encoding of COCO's ``maskApi.c`` (``rleFrString``)."""
     counts: list[int] = []
     p = 0
+    if not s.isascii():
+        raise ValueError("a compressed RLE string holds only ASCII characters")
     data = s.encode("ascii")
     while p < len(data):
         x, k, more = 0, 0, True
