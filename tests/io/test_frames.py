@@ -391,3 +391,20 @@ def test_read_depth_is_the_one_depth_reader_of_frames_and_segment(tmp_path):
         read_depth(tmp_path / "d.png", 0.001, color=(tmp_path / "c.png", 6))
     with pytest.raises(FileFormatError, match=r"d\.png: depth is 4x3, the image 3x4"):
         _read_depth(tmp_path / "d.png", 0.001, (4, 3), tmp_path / "c.png", 1)
+
+
+def test_depth_units_that_are_not_text_and_float64_depth_beyond_float32_are_no_python_errors(tmp_path):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    cam = json.loads((tmp_path / "f" / "camera.json").read_text())
+    for units in (["m"], {"m": 1}):
+        (tmp_path / "f" / "camera.json").write_text(json.dumps({**cam, "depth_units": units}))
+        with pytest.raises(InputError, match=r"camera\.json: unknown depth_units \[?\{?'m'"):  # not "unhashable"
+            read_frame(tmp_path / "f")
+    (tmp_path / "f" / "camera.json").write_text(json.dumps(cam))
+    (tmp_path / "f" / "depth.png").unlink()
+    huge = depth.astype(np.float64)
+    huge[:10] = 1e300  # beyond float32: no depth there, never a RuntimeWarning (an error under pytest)
+    np.save(tmp_path / "f" / "depth.npy", huge)
+    got = read_frame(tmp_path / "f").depth
+    assert not got[:10].any() and np.array_equal(got[10:], depth[10:])

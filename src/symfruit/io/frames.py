@@ -148,7 +148,8 @@ def read_depth_npy(path: Path) -> np.ndarray:
         depth = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
         raise FileFormatError(f"{path}: cannot read ({exc})") from None
-    return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # float64 beyond float32 (1e300 m): inf, then no depth
+        return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
 
 
 def _depth_scale(cam_path: Path, data: Any) -> float:
@@ -157,7 +158,7 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
     units = data.get("depth_units") if isinstance(data, dict) else None
     if units is not None:
         known = {"m": 1.0, "mm": 0.001, "0.1mm": 0.0001, "cm": 0.01}
-        if units not in known:
+        if not isinstance(units, str) or units not in known:  # a list or mapping is no unit (nor hashable)
             raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
         scale = known[units]
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:
