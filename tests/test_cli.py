@@ -112,6 +112,7 @@ def test_embedded_sample(capsys):
         (["complete", "{sample}", "--camera", "nocam.json"], "nocam.json: no such intrinsics file"),
         (["evaluate", "--quick", "--jobs", "-1"], "--jobs must be between 1 and 256, got -1"),
         (["evaluate", "--quick", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
+        (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
         (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),

@@ -574,6 +574,8 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     else:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
+        if not 0 <= args.seed < 2**63:
+            raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
         n = args.n or 20
         ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
         meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}
