@@ -177,3 +177,14 @@ def test_each_recording_gets_its_sizes_and_a_run_of_one_recording_no_boxes(writt
     single = write_report(one)
     assert sorted(p.name for p in single.folder.iterdir()) == sorted([*PLOTS, "report.md"])
     assert "Sizes per recording" not in (single.folder / "report.md").read_text()
+
+
+def test_a_report_folder_that_links_out_of_the_run_is_refused_not_written_through(run, tmp_path, capsys):
+    (tmp_path / "elsewhere").mkdir()
+    (run / "report").symlink_to(tmp_path / "elsewhere")
+    assert main(["report", str(run)]) == 2
+    err = capsys.readouterr().err
+    assert f"{run / 'report'}: is a symbolic link (to {tmp_path / 'elsewhere'}); symfruit does not write" in err
+    assert not list((tmp_path / "elsewhere").iterdir())
+    assert main(["report", str(run), "--output", str(run / "report")]) == 0  # named: the user's own choice
+    assert (tmp_path / "elsewhere" / "report.md").is_file()

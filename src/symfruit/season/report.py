@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from ..core.limits import MAX_DEPTH_METRES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
-from ..errors import FileFormatError, InputError, SymfruitError
+from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
 
 __all__ = [
@@ -191,6 +192,10 @@ def write_report(
     from ..io.outputs import OutputFolder
 
     output = Path(output)
+    if folder is None and (output / "report").is_symlink():  # the default is the run's own: never a link out of it
+        link = output / "report"
+        raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
+                          f"links inside {output}: remove it, or name a folder (--output)")  # fmt: skip
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
