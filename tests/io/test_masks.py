@@ -328,3 +328,12 @@ def test_a_label_png_must_carry_the_orientation_of_the_colour_image_it_is_for(tm
     # both turned alike: read as displayed; no colour given: read as displayed, unchecked
     assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16), color=("c.jpg", 3)), labels[::-1, ::-1])
     assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16)), labels[::-1, ::-1])
+
+
+def test_a_category_id_that_is_no_id_is_refused_by_annotation(tmp_path):
+    data = {"images": [{"id": 1, "file_name": "a.png"}], "annotations": [
+        {"id": 1, "image_id": 1, "category_id": 1, "segmentation": []},
+        {"id": 2, "image_id": 1, "category_id": [1], "segmentation": []}]}  # fmt: skip
+    (tmp_path / "c.json").write_text(json.dumps(data))
+    with pytest.raises(FileFormatError, match=r"c\.json: annotation 2 has category_id \[1\]; a category id is a whole"):
+        read_coco(tmp_path / "c.json")  # before: "TypeError: unhashable type: 'list'" out of check_category

@@ -339,11 +339,14 @@ def coco_items(
         raise FileFormatError(f"{coco.path}: no images to evaluate")
     for entry in entries:
         name = str(entry["file_name"])
-        path = folder / name
+        # inside the folder only: an absolute name or one climbing out ("../../x.png") is looked up by its base name
+        inside = not Path(name).is_absolute() and ".." not in Path(name).parts
+        path = folder / name if inside else folder / Path(name).name
         if not path.is_file():
             path = folder / Path(name).name
         if not path.is_file():
-            raise FileFormatError(f"{folder / name}: listed in {coco.path.name} but not in {folder}")
+            raise FileFormatError(f"{folder / Path(name).name if not inside else folder / name}: listed in "
+                                  f"{coco.path.name} as {name!r} but not in {folder}")  # fmt: skip
         color, orientation = read_color_oriented(path)
         crowd = coco.crowd(name, color.shape[:2], category=category)
         extra = {"name": name, "color_file": (path, orientation)} if files else {}

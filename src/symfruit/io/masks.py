@@ -296,9 +296,13 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         images[name] = entry
         images.setdefault(Path(name).name, entry)
     annotations: dict[Any, list[dict[str, Any]]] = {}
-    for ann in data["annotations"]:
+    for k, ann in enumerate(data["annotations"], 1):
         if not isinstance(ann, dict):
             raise FileFormatError(f"{path}: an 'annotations' entry is not an object")
+        category = ann.get("category_id")
+        if isinstance(category, bool) or not isinstance(category, (int, str, type(None))):
+            raise FileFormatError(f"{path}: annotation {k} has category_id {_shown(category)}; a category id is a "
+                                  "whole number")  # fmt: skip
         annotations.setdefault(_key(ann.get("image_id")), []).append(ann)
     categories: dict[int, str] = {}
     raw = data.get("categories", [])
@@ -306,6 +310,11 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         if isinstance(c, dict) and isinstance(c.get("id"), int) and not isinstance(c.get("id"), bool):
             categories[c["id"]] = str(c.get("name", c["id"]))
     return CocoSet(path, images, annotations, categories)
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def rle_decode(rle: dict[str, Any]) -> np.ndarray:
