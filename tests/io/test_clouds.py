@@ -362,3 +362,11 @@ def test_a_ply_header_naming_the_other_byte_order_than_its_data_is_refused_sayin
     zeros = head + "end_header\n"  # nothing to tell the orders apart by: read as declared
     (tmp_path / "c.ply").write_bytes(zeros.encode() + np.zeros((300, 3), written).tobytes())
     assert not read_cloud(tmp_path / "c.ply").any()
+
+
+def test_a_ragged_ascii_pcd_is_refused_in_its_own_words(tmp_path):
+    head = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n"
+    (tmp_path / "a.pcd").write_text(head + "0 0\n1 0 0.5\n0 0 0.5\n")
+    with pytest.raises(FileFormatError, match=r"a\.pcd: ascii PCD rows are not all 3 numbers \(the number of columns "
+                       r"changed from 2 to 3 at row 2\)$"):  # fmt: skip
+        read_cloud(tmp_path / "a.pcd")  # before: numpy's "; use `usecols` to select a subset and avoid this error"

@@ -306,7 +306,13 @@ def read_pcd(path: Path) -> np.ndarray:
             if n * 2 * len(names) > body_size + 1:
                 raise FileFormatError(f"{path}: header promises {n} points but the file is too short")
             text = io.TextIOWrapper(handle, encoding="ascii", errors="replace")
-            values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
+            try:
+                values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
+            except ValueError as exc:  # numpy's own words on a ragged or wordy row, without its API advice
+                why = str(exc).split("; use `usecols`")[0].replace("\n", " ")
+                raise FileFormatError(
+                    f"{path}: ascii PCD rows are not all {int(sum(counts))} numbers ({why})"
+                ) from None
             if len(values) < n:
                 raise FileFormatError(f"{path}: header promises {n} points, the file holds {len(values)}")
             if any(line.strip() for line in text):
