@@ -337,3 +337,18 @@ def test_a_category_id_that_is_no_id_is_refused_by_annotation(tmp_path):
     (tmp_path / "c.json").write_text(json.dumps(data))
     with pytest.raises(FileFormatError, match=r"c\.json: annotation 2 has category_id \[1\]; a category id is a whole"):
         read_coco(tmp_path / "c.json")  # before: "TypeError: unhashable type: 'list'" out of check_category
+
+
+@pytest.mark.parametrize(
+    "images, image_id, message",
+    [
+        ([{"file_name": "a.png"}], 1, r"c\.json: the 'images' entry 'a\.png' has no id"),
+        ([{"id": 1, "file_name": "a.png"}], 2, r"c\.json: annotation 1 is for image id 2, which no 'images' entry has"),
+        ([{"id": 1, "file_name": "a.png"}], None, r"annotation 1 is for image id None"),
+    ],
+)  # fmt: skip
+def test_annotations_that_no_image_would_claim_are_refused_not_dropped(tmp_path, images, image_id, message):
+    ann = {"id": 1, "category_id": 1, "segmentation": [], **({} if image_id is None else {"image_id": image_id})}
+    (tmp_path / "c.json").write_text(json.dumps({"images": images, "annotations": [ann]}))
+    with pytest.raises(FileFormatError, match=message):
+        read_coco(tmp_path / "c.json")  # before: read, and the image scored as holding no fruit

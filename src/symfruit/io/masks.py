@@ -266,7 +266,9 @@ def read_coco(path: str | Path) -> CocoSet:
     Raises
     ------
     FileFormatError
-        When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists.
+        When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists; for an image
+        without an id, two images of one name or id, an annotation for an image id no image has (its fruit would
+        be lost from the truth unsaid) or whose ``category_id`` is no id.
     """
     path = Path(path)
     return coco_from_data(path, read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES))
@@ -288,6 +290,8 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         name = entry["file_name"]
         if name in images and images[name].get("file_name") == name:
             raise FileFormatError(f"{path}: two 'images' entries are named {name!r}")
+        if entry.get("id") is None:  # its annotations could never be found: the image would be scored fruitless
+            raise FileFormatError(f"{path}: the 'images' entry {name!r} has no id")
         key = _key(entry.get("id"))
         if key in ids:  # both would be scored against the same annotations
             raise FileFormatError(f"{path}: {ids[key]!r} and {name!r} share the image id {entry.get('id')!r}; "
@@ -303,7 +307,11 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         if isinstance(category, bool) or not isinstance(category, (int, str, type(None))):
             raise FileFormatError(f"{path}: annotation {k} has category_id {_shown(category)}; a category id is a "
                                   "whole number")  # fmt: skip
-        annotations.setdefault(_key(ann.get("image_id")), []).append(ann)
+        image = _key(ann.get("image_id"))
+        if image not in ids:  # a misspelt or missing image_id: that fruit would be lost from the truth unsaid
+            raise FileFormatError(f"{path}: annotation {k} is for image id {_shown(ann.get('image_id'))}, which no "
+                                  "'images' entry has")  # fmt: skip
+        annotations.setdefault(image, []).append(ann)
     categories: dict[int, str] = {}
     raw = data.get("categories", [])
     for c in raw if isinstance(raw, list) else []:
