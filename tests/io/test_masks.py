@@ -2,6 +2,7 @@
 read safely: sizes in the file checked against the image before anything is allocated."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -352,3 +353,15 @@ def test_annotations_that_no_image_would_claim_are_refused_not_dropped(tmp_path,
     (tmp_path / "c.json").write_text(json.dumps({"images": images, "annotations": [ann]}))
     with pytest.raises(FileFormatError, match=message):
         read_coco(tmp_path / "c.json")  # before: read, and the image scored as holding no fruit
+
+
+@pytest.mark.parametrize("crowd", ["0", "no", 2])
+def test_an_iscrowd_that_is_not_0_or_1_is_refused_not_read_as_a_crowd(tmp_path, crowd):
+    ann = {"id": 1, "image_id": 1, "category_id": 1, "segmentation": [], "iscrowd": crowd}
+    (tmp_path / "c.json").write_text(json.dumps({"images": [{"id": 1, "file_name": "a.png"}], "annotations": [ann]}))
+    with pytest.raises(
+        FileFormatError, match=rf"c\.json: annotation 1 has iscrowd {re.escape(repr(crowd))}; it is 0 or 1"
+    ):
+        read_coco(tmp_path / "c.json")  # before: "0" (text) was truthy, the fruit ignored as a crowd region
+    with pytest.raises(FileFormatError, match=r"c\.json: annotation 1 has iscrowd"):
+        read_masks(tmp_path / "c.json", (4, 4))  # a frame's masks.json alike

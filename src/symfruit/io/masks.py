@@ -114,6 +114,8 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     for k, ann in enumerate(anns, 1):
         if not isinstance(ann, dict):  # never dropped quietly: that would read as a frame without fruit
             raise FileFormatError(f"{path}: annotation {k} is a {type(ann).__name__}, not an object")
+        if ann.get("iscrowd") not in (None, 0, 1):  # "0" as text is truthy: the fruit would be dropped as a crowd
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
     images = data.get("images") if isinstance(data, dict) else None
     if images is not None:
         if not isinstance(images, list) or not all(isinstance(e, dict) for e in images):
@@ -307,6 +309,8 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         if isinstance(category, bool) or not isinstance(category, (int, str, type(None))):
             raise FileFormatError(f"{path}: annotation {k} has category_id {_shown(category)}; a category id is a "
                                   "whole number")  # fmt: skip
+        if ann.get("iscrowd") not in (None, 0, 1):  # "0" or "no" as text is truthy: a fruit counted as a crowd
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
         image = _key(ann.get("image_id"))
         if image not in ids:  # a misspelt or missing image_id: that fruit would be lost from the truth unsaid
             raise FileFormatError(f"{path}: annotation {k} is for image id {_shown(ann.get('image_id'))}, which no "
