@@ -112,6 +112,7 @@ def test_embedded_sample(capsys):
         (["complete", "{sample}", "--camera", "nocam.json"], "nocam.json: no such intrinsics file"),
         (["evaluate", "--quick", "--jobs", "-1"], "--jobs must be between 1 and 256, got -1"),
         (["evaluate", "--quick", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
+        (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
         (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
@@ -659,3 +660,35 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
     assert report.count("- `frames+") == 2 and f"`: `{inputs[0]}`" in report
     for name in ("fruit_per_frame_by_recording.png", "diameters_by_recording.png"):
         assert f"]({name})" in report and (out / "report" / name).is_file()
+
+
+def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_and_size(tmp_path, capsys):
+    from PIL import Image
+
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "labels").mkdir()
+    color = np.zeros((24, 32, 3), np.uint8)
+    color[6:14, 2:12] = (200, 20, 20)
+    labels = np.zeros((24, 32), np.uint8)
+    labels[6:14, 2:12] = 1
+    Image.fromarray(color).save(tmp_path / "photos" / "p0.png")
+    Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
+    box = [[2, 6, 11, 6, 11, 13, 2, 13]]
+    coco = {"images": [{"id": 1, "file_name": "p0.png", "height": 24, "width": 32}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1, "segmentation": box}]}  # fmt: skip
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    photos, truth, found = str(tmp_path / "photos"), str(tmp_path / "t.json"), str(tmp_path / "labels")
+    args = ["evaluate", "--protocol", "masks", "--images", photos, "--truth", truth, "--masks", found,
+            "--output", str(tmp_path / "res")]  # fmt: skip
+    assert main(args) == 0  # found by the photograph's name (before: "labels/.png: no label image for")
+    assert "1 true fruit, 1 found" in capsys.readouterr().out
+    turned = Image.fromarray(color)
+    exif = turned.getexif()
+    exif[0x0112] = 3  # half a turn: the sizes agree, the pixels do not
+    turned.save(tmp_path / "photos" / "p0.png", exif=exif)
+    assert main(args) == 2
+    _one_line_error(capsys, "photos/p0.png: its EXIF orientation 3 (turned half around)", "but p0.png has 1")
+    Image.fromarray(color).save(tmp_path / "photos" / "p0.png")
+    Image.fromarray(labels[:, :30]).save(tmp_path / "labels" / "p0.png")
+    assert main(args) == 2
+    _one_line_error(capsys, "labels/p0.png: labels are 30x24, the image 32x24")

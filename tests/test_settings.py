@@ -303,3 +303,29 @@ def test_every_section_survives_random_values(name, data):
     for key, value in layer.items():  # what was accepted is what is there (numbers as floats where floats)
         got = getattr(section, key)
         assert got == value or (isinstance(got, float) and got == float(value)) or dataclasses.is_dataclass(got)
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        # YAML 1.1 reads an unquoted off as False: refused (never coerced back), saying why and how to write it
+        ("evidence:\n  outline_profile: off\n", r"x\.yaml: evidence\.outline_profile: expected one of 'off', 'add', "
+         r"'replace', got False \(YAML reads an unquoted yes, no, on, off, true or false as a boolean: quote text, "
+         r"e\.g\. 'off'\)$"),
+        ("paper:\n  rotations_x: on\n", r"paper\.rotations_x: expected a whole number, got True \(YAML reads an "
+         r"unquoted yes, .* as a boolean: write a number\)$"),
+        ("sphere:\n  refine: \"yes\"\n", r"sphere\.refine: expected true or false, got 'yes' \(text, as quoted: write "
+         r"true or false without quotes\)$"),
+        ("sphere:\n  refine: \"maybe\"\n", r"sphere\.refine: expected true or false, got 'maybe'$"),
+    ],
+)  # fmt: skip
+def test_yaml_booleans_where_text_or_numbers_are_expected_are_refused_saying_why(tmp_path, text, message):
+    (tmp_path / "x.yaml").write_text(text)
+    with pytest.raises(ConfigError, match=message):
+        load_settings(tmp_path / "x.yaml")
+    assert load_settings_text(tmp_path, "sphere:\n  refine: yes\n").sphere.refine is True  # a boolean: YAML's own
+
+
+def load_settings_text(tmp_path, text):
+    (tmp_path / "y.yaml").write_text(text)
+    return load_settings(tmp_path / "y.yaml")

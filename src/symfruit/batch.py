@@ -506,18 +506,12 @@ def expand_images(paths: Sequence[str | Path]) -> list[Path]:
 
 
 def _read_depth(path: Path, scale: float, shape: tuple[int, int], image: Path, orientation: int) -> np.ndarray:
-    """Depth in metres from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape`` (that
-    of ``image`` as read, its EXIF ``orientation`` applied: the depth's must be the same)."""
-    from .io.frames import read_depth_npy
-    from .io.images import orientation_mismatch, read_depth_units_oriented
+    """Depth in metres (float64) from ``.npy`` (metres) or a 16-bit PNG (``scale`` metres per unit), of ``shape`` (that
+    of ``image`` as read, its EXIF ``orientation`` applied: the depth's must be the same;
+    :func:`symfruit.io.frames.read_depth`)."""
+    from .io.frames import read_depth
 
-    depth_orientation = 1  # a .npy array has none
-    if path.suffix.lower() == ".npy":
-        depth = read_depth_npy(path).astype(np.float64)  # sizes checked from the header; never unpickled
-    else:
-        units, depth_orientation = read_depth_units_oriented(path, scale=scale)
-        depth = units.astype(np.float64) * scale
-    orientation_mismatch(image, orientation, path, depth_orientation)
+    depth = read_depth(path, scale, color=(image, orientation), dtype=np.float64)
     if depth.shape != shape:
         raise FileFormatError(f"{path}: depth is {depth.shape[1]}x{depth.shape[0]}, the image {shape[1]}x{shape[0]}")
     return depth

@@ -559,19 +559,23 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     labeller = mask_source(args.masks or "color", settings=settings, images=())
     source = labeller.name
 
-    def run(color: np.ndarray, depth: np.ndarray | None = None, camera: object = None) -> np.ndarray:
-        return labeller(color, depth, camera)[0]
+    def run(color: np.ndarray, depth: np.ndarray | None = None, camera: object = None, name: str = "",
+            color_file: tuple[str, int] | None = None) -> np.ndarray:  # fmt: skip
+        return labeller(color, depth, camera, name=name, color_file=color_file)[0]
 
     if args.images is not None or args.truth is not None:
         if args.images is None or args.truth is None:
             raise InputError("--protocol masks needs both --images DIR and --truth COCO.json")
         category = None if args.category < 0 else args.category
-        ev = evaluate_masks(args.images, args.truth, run, category=category)
+        # each photograph's name and orientation: --masks label PNGs are found by name and must turn as it does
+        ev = evaluate_masks(args.images, args.truth, run, category=category, files=True)
         meta = {"images": str(args.images), "truth": str(args.truth), "category": category, "depth": False}
         what = f"{args.images}"
     else:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
+        if not 0 <= args.seed < 2**63:
+            raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
         n = args.n or 20
         ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
         meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}

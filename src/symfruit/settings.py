@@ -14,7 +14,10 @@ with ``settings=``) is added with :func:`register_section` and follows the built
 
 Values read from a mapping (a file, a profile, overrides) are validated: unknown keys, wrong types and
 non-finite numbers raise :class:`~symfruit.errors.ConfigError` with the dotted path of the key, e.g.
-``paper.rotations_x: expected a whole number, got 'eleven'``. Every section checks its fields' declared
+``paper.rotations_x: expected a whole number, got 'eleven'``. Nothing is coerced: YAML 1.1 reads an unquoted
+``yes``/``no``/``on``/``off`` as a boolean, so a boolean where text or a number is expected says so and how to
+quote it (``evidence.outline_profile: off`` is ``False``, refused, not the choice ``'off'``), and quoted ``"yes"``
+for a boolean is refused as text. Every section checks its fields' declared
 bounds (``setting(..., ge=1)``) and its cross-field rules (:meth:`Section.check`) when it is made, from a
 file or from Python; a failure names the field, and the path is added when it came from a mapping.
 
@@ -233,12 +236,28 @@ def merge(base: Mapping[str, Any], over: Mapping[str, Any]) -> dict[str, Any]:
     return out
 
 
+#: Words YAML 1.1 (PyYAML's safe loader) reads as a boolean when unquoted, in any of its three cases.
+YAML_BOOLEAN_WORDS = ("y", "yes", "n", "no", "true", "false", "on", "off")
+
+
+def _as_read(value: Any, choices: tuple[Any, ...] = (), *, number: bool = False) -> str:
+    """``value`` as the error shows it: a boolean where text or a ``number`` is expected is said to be what YAML
+    makes of an unquoted ``yes``/``no``/``on``/``off`` (the value written, ``'off'``, cannot be told from the
+    boolean), naming the choice that is such a word when there is one; anything else as its repr."""
+    if not isinstance(value, bool):
+        return repr(value)
+    words = [c for c in choices if isinstance(c, str) and c.lower() in YAML_BOOLEAN_WORDS]
+    fix = "write a number" if number else f"quote text, e.g. {words[0] if words else 'yes'!r}"
+    return f"{value!r} (YAML reads an unquoted yes, no, on, off, true or false as a boolean: {fix})"
+
+
 def _coerce(value: Any, hint: Any, where: str) -> Any:
     origin = typing.get_origin(hint)
     if origin is Literal:
         choices = typing.get_args(hint)
         if not isinstance(value, str) or value not in choices:
-            raise ConfigError(f"{where}: expected one of {', '.join(repr(a) for a in choices)}, got {value!r}")
+            raise ConfigError(f"{where}: expected one of {', '.join(repr(a) for a in choices)}, got "
+                              f"{_as_read(value, choices)}")  # fmt: skip
         return value
     if origin in (typing.Union, types.UnionType):
         args = typing.get_args(hint)
@@ -252,15 +271,17 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         return _build(typing.cast(type, hint), value, where)
     if hint is bool:
         if not isinstance(value, bool):
-            raise ConfigError(f"{where}: expected true or false, got {value!r}")
+            quoted = isinstance(value, str) and value.strip().lower() in YAML_BOOLEAN_WORDS
+            why = " (text, as quoted: write true or false without quotes)" if quoted else ""
+            raise ConfigError(f"{where}: expected true or false, got {value!r}{why}")
         return value
     if hint is int:
         if isinstance(value, bool) or not isinstance(value, int):
-            raise ConfigError(f"{where}: expected a whole number, got {value!r}")
+            raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}")
         return value
     if hint is float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
-            raise ConfigError(f"{where}: expected a number, got {value!r}")
+            raise ConfigError(f"{where}: expected a number, got {_as_read(value, number=True)}")
         try:
             finite = math.isfinite(value)
         except OverflowError:  # a whole number of hundreds of digits: beyond any float
@@ -271,7 +292,7 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         return float(value)
     if hint is str:
         if not isinstance(value, str):
-            raise ConfigError(f"{where}: expected text, got {value!r}")
+            raise ConfigError(f"{where}: expected text, got {_as_read(value)}")
         return value
     raise ConfigError(f"{where}: unsupported setting type {hint!r}")  # pragma: no cover
 

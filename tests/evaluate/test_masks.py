@@ -197,3 +197,18 @@ def test_scene_masks_on_an_apple_tree_count_the_visible_ripe_apples():
     assert ev.summary["true_fruit"] == len(seen) and ev.summary["images"] == 1
     with pytest.raises(InputError, match="apple-tree"):
         evaluate_scene_masks([2], segment, scene="orchard")
+
+
+@pytest.mark.parametrize("outside", ["../elsewhere/a.png", "/{tmp}/elsewhere/a.png"])
+def test_an_image_named_outside_the_folder_is_looked_up_inside_it_only(tmp_path, outside):
+    folder = tmp_path / "photos"
+    folder.mkdir()
+    truth = _coco_folder(folder)
+    (tmp_path / "elsewhere").mkdir()
+    (folder / "a.png").rename(tmp_path / "elsewhere" / "a.png")  # reachable only by climbing out of the folder
+    data = json.loads(Path(truth).read_text())
+    name = outside.replace("/{tmp}", str(tmp_path))
+    data["images"][0]["file_name"] = name
+    Path(truth).write_text(json.dumps(data))
+    with pytest.raises(FileFormatError, match=rf"photos/a\.png: listed in .* as '{name}' but not in "):
+        evaluate_masks(folder, truth, segment)

@@ -28,6 +28,7 @@ def write_ros2_bag(
     k=None,
     encoding="rgb8",
     info_size=(160, 120),
+    d=None,
 ):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
@@ -45,7 +46,7 @@ def write_ros2_bag(
             t = 1_000_000_000 * (i + 1)
             head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="camera_color_optical_frame")
             info = Info(header=head, height=info_size[1], width=info_size[0], distortion_model="plumb_bob",
-                        d=np.zeros(5),
+                        d=np.zeros(5) if d is None else np.asarray(d, float),
                         k=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]) if k is None else np.asarray(k, float),
                         r=np.eye(3).ravel(),
                         p=np.array([600.0, 0, 80, 0, 0, 600, 60, 0, 0, 0, 1, 0]), binning_x=0, binning_y=0,
@@ -405,3 +406,34 @@ def test_the_index_keeps_the_intrinsics_once_not_once_per_message(tmp_path):
     with src:
         assert len(src) == 40 and len(src._cameras) == 1  # every info message is stamped anew: kept on change
         assert src.read(39).camera == CAM
+
+
+def test_a_camera_info_with_distortion_is_warned_about_once_per_bag_and_a_non_finite_one_refused(tmp_path):
+    pytest.importorskip("rosbags")
+    import warnings
+
+    from symfruit import SymfruitWarning
+
+    color, depth = disc_frame([(80, 60)])
+    mm = (depth * 1000).astype(np.uint16)
+    path = write_ros2_bag(tmp_path / "dist", color, mm, frames=3, d=[-0.05, 0.1, 0, 0, 0])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with open_source(path) as src:
+            assert [src.read(i).camera for i in range(3)] == [CAM] * 3  # used as pinhole, said once
+    said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
+    assert len(said) == 1 and said[0].startswith(
+        f"{path}: CameraInfo on /camera/color/camera_info: non-zero "
+        "distortion coefficients 'd' (largest 0.1) are not applied"
+    )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SymfruitWarning)  # zeros: nothing to say
+        open_source(write_ros2_bag(tmp_path / "zero", color, mm)).close()
+        src = open_source(write_ros2_bag(tmp_path / "nan", color, mm, d=[0.1, float("nan"), 0, 0, 0]))
+    with pytest.raises(
+        FileFormatError,
+        match=r"nan: invalid CameraInfo on /camera/color/camera_info \(CameraInfo "
+        r"d must hold at most 16 finite numbers, got \[0\.1, nan",
+    ):
+        src.read(0)
+    src.close()

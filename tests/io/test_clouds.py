@@ -342,3 +342,31 @@ def test_a_signalling_nan_in_a_binary_cloud_is_a_missing_point_not_a_warning(tmp
         warnings.simplefilter("error")
         out = read_cloud(tmp_path / "snan.pcd")
     assert np.isnan(out[3, 0]) and np.isfinite(np.delete(out, 3, axis=0)).all()
+
+
+@pytest.mark.parametrize(("written", "said"), [("<f4", "binary_big_endian"), (">f8", "binary_little_endian")])
+def test_a_ply_header_naming_the_other_byte_order_than_its_data_is_refused_saying_so(tmp_path, written, said):
+    rng = np.random.default_rng(5)
+    pts = rng.normal(size=(300, 3)) * 0.02 + [0.0, 0.0, 0.5]
+    kind = "float" if written.endswith("4") else "double"
+    head = f"ply\nformat {said} 1.0\nelement vertex 300\n" + "".join(f"property {kind} {c}\n" for c in "xyz")
+    (tmp_path / "a.ply").write_bytes((head + "end_header\n").encode() + pts.astype(written).tobytes())
+    other = "binary_little_endian" if said == "binary_big_endian" else "binary_big_endian"
+    with pytest.raises(FileFormatError, match=rf"a\.ply: the header says {said} but the data look {other}: read as "
+                       rf"declared, \d+% of the first 300 vertices' coordinates are implausible .* write 'format "
+                       rf"{other} 1\.0' in the header"):  # fmt: skip
+        read_cloud(tmp_path / "a.ply")
+    right = head.replace(said, other) + "end_header\n"  # the same bytes under the right header read as written
+    (tmp_path / "b.ply").write_bytes(right.encode() + pts.astype(written).tobytes())
+    assert np.allclose(read_cloud(tmp_path / "b.ply"), pts, atol=1e-6)
+    zeros = head + "end_header\n"  # nothing to tell the orders apart by: read as declared
+    (tmp_path / "c.ply").write_bytes(zeros.encode() + np.zeros((300, 3), written).tobytes())
+    assert not read_cloud(tmp_path / "c.ply").any()
+
+
+def test_a_ragged_ascii_pcd_is_refused_in_its_own_words(tmp_path):
+    head = "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 3\nHEIGHT 1\nPOINTS 3\nDATA ascii\n"
+    (tmp_path / "a.pcd").write_text(head + "0 0\n1 0 0.5\n0 0 0.5\n")
+    with pytest.raises(FileFormatError, match=r"a\.pcd: ascii PCD rows are not all 3 numbers \(the number of columns "
+                       r"changed from 2 to 3 at row 2\)$"):  # fmt: skip
+        read_cloud(tmp_path / "a.pcd")  # before: numpy's "; use `usecols` to select a subset and avoid this error"

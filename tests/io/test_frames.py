@@ -371,3 +371,40 @@ def test_a_frames_masks_png_must_carry_the_colour_images_exif_orientation(tmp_pa
     frame = read_frame(folder)
     assert np.array_equal(frame.masks, labels)
     assert frame.extras["color_file"] == (str(folder / "color.png"), 1)
+
+
+def test_read_depth_is_the_one_depth_reader_of_frames_and_segment(tmp_path):
+    from symfruit.batch import _read_depth
+    from symfruit.io.frames import read_depth
+
+    units = np.arange(12, dtype=np.uint16).reshape(3, 4) * 1000
+    Image.fromarray(units).save(tmp_path / "d.png")
+    color = (tmp_path / "c.png", 1)
+    d32 = read_depth(tmp_path / "d.png", 0.001, color=color)
+    d64 = read_depth(tmp_path / "d.png", 0.001, color=color, dtype=np.float64)
+    assert d32.dtype == np.float32 and np.array_equal(d32, units.astype(np.float32) * np.float32(0.001))
+    assert d64.dtype == np.float64 and np.array_equal(d64, units * 0.001)
+    assert np.array_equal(_read_depth(tmp_path / "d.png", 0.001, (3, 4), tmp_path / "c.png", 1), d64)
+    np.save(tmp_path / "d.npy", np.full((3, 4), 0.5, np.float32))
+    assert read_depth(tmp_path / "d.npy", 0.001, color=color, dtype=np.float64).dtype == np.float64
+    with pytest.raises(FileFormatError, match=r"c\.png: its EXIF orientation 6 .* but d\.png has 1"):
+        read_depth(tmp_path / "d.png", 0.001, color=(tmp_path / "c.png", 6))
+    with pytest.raises(FileFormatError, match=r"d\.png: depth is 4x3, the image 3x4"):
+        _read_depth(tmp_path / "d.png", 0.001, (4, 3), tmp_path / "c.png", 1)
+
+
+def test_depth_units_that_are_not_text_and_float64_depth_beyond_float32_are_no_python_errors(tmp_path):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    cam = json.loads((tmp_path / "f" / "camera.json").read_text())
+    for units in (["m"], {"m": 1}):
+        (tmp_path / "f" / "camera.json").write_text(json.dumps({**cam, "depth_units": units}))
+        with pytest.raises(InputError, match=r"camera\.json: unknown depth_units \[?\{?'m'"):  # not "unhashable"
+            read_frame(tmp_path / "f")
+    (tmp_path / "f" / "camera.json").write_text(json.dumps(cam))
+    (tmp_path / "f" / "depth.png").unlink()
+    huge = depth.astype(np.float64)
+    huge[:10] = 1e300  # beyond float32: no depth there, never a RuntimeWarning (an error under pytest)
+    np.save(tmp_path / "f" / "depth.npy", huge)
+    got = read_frame(tmp_path / "f").depth
+    assert not got[:10].any() and np.array_equal(got[10:], depth[10:])

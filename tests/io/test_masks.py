@@ -2,6 +2,7 @@
 read safely: sizes in the file checked against the image before anything is allocated."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -129,6 +130,31 @@ def test_bad_coco_files_name_the_file_and_annotation(tmp_path, data, message):
 def test_rle_counts_must_cover_the_image():
     with pytest.raises(ValueError, match="add up to 5, expected 35"):
         rle_decode({"size": [7, 5], "counts": [5]})
+
+
+@pytest.mark.parametrize(
+    "counts, message",
+    [
+        ([36, -1], r"whole numbers 0-35, got 36"),  # adds up to 35: a negative run never cancels a longer one
+        ([-1, 36], r"whole numbers 0-35, got -1"),
+        ([1.5, 33.5], r"whole numbers 0-35, got 1\.5"),  # never cut to 1
+        ([True, 34], r"whole numbers 0-35, got True"),
+        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 characters\)"),
+        (None, r"a list of run lengths or a compressed string, got NoneType"),
+        ({"a": 1}, r"got dict"),
+        ("\u00e9", r"only ASCII"),
+    ],
+)  # fmt: skip
+def test_rle_counts_that_are_no_run_lengths_are_refused_by_what_they_are(counts, message):
+    with pytest.raises(ValueError, match=message):
+        rle_decode({"size": [7, 5], "counts": counts})
+    assert rle_decode({"size": [7, 5], "counts": np.array([1, 34])}).sum() == 34  # the API's arrays too
+
+
+def test_a_broken_rle_in_a_masks_file_names_the_file_and_annotation(tmp_path):
+    (tmp_path / "m.json").write_text(json.dumps({"annotations": [{"segmentation": {"size": [7, 5], "counts": None}}]}))
+    with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(RLE counts must be"):
+        read_masks(tmp_path / "m.json", (7, 5))
 
 
 def test_other_extensions_are_refused(tmp_path):
@@ -303,3 +329,39 @@ def test_a_label_png_must_carry_the_orientation_of_the_colour_image_it_is_for(tm
     # both turned alike: read as displayed; no colour given: read as displayed, unchecked
     assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16), color=("c.jpg", 3)), labels[::-1, ::-1])
     assert np.array_equal(read_masks(tmp_path / "m.png", (12, 16)), labels[::-1, ::-1])
+
+
+def test_a_category_id_that_is_no_id_is_refused_by_annotation(tmp_path):
+    data = {"images": [{"id": 1, "file_name": "a.png"}], "annotations": [
+        {"id": 1, "image_id": 1, "category_id": 1, "segmentation": []},
+        {"id": 2, "image_id": 1, "category_id": [1], "segmentation": []}]}  # fmt: skip
+    (tmp_path / "c.json").write_text(json.dumps(data))
+    with pytest.raises(FileFormatError, match=r"c\.json: annotation 2 has category_id \[1\]; a category id is a whole"):
+        read_coco(tmp_path / "c.json")  # before: "TypeError: unhashable type: 'list'" out of check_category
+
+
+@pytest.mark.parametrize(
+    "images, image_id, message",
+    [
+        ([{"file_name": "a.png"}], 1, r"c\.json: the 'images' entry 'a\.png' has no id"),
+        ([{"id": 1, "file_name": "a.png"}], 2, r"c\.json: annotation 1 is for image id 2, which no 'images' entry has"),
+        ([{"id": 1, "file_name": "a.png"}], None, r"annotation 1 is for image id None"),
+    ],
+)  # fmt: skip
+def test_annotations_that_no_image_would_claim_are_refused_not_dropped(tmp_path, images, image_id, message):
+    ann = {"id": 1, "category_id": 1, "segmentation": [], **({} if image_id is None else {"image_id": image_id})}
+    (tmp_path / "c.json").write_text(json.dumps({"images": images, "annotations": [ann]}))
+    with pytest.raises(FileFormatError, match=message):
+        read_coco(tmp_path / "c.json")  # before: read, and the image scored as holding no fruit
+
+
+@pytest.mark.parametrize("crowd", ["0", "no", 2])
+def test_an_iscrowd_that_is_not_0_or_1_is_refused_not_read_as_a_crowd(tmp_path, crowd):
+    ann = {"id": 1, "image_id": 1, "category_id": 1, "segmentation": [], "iscrowd": crowd}
+    (tmp_path / "c.json").write_text(json.dumps({"images": [{"id": 1, "file_name": "a.png"}], "annotations": [ann]}))
+    with pytest.raises(
+        FileFormatError, match=rf"c\.json: annotation 1 has iscrowd {re.escape(repr(crowd))}; it is 0 or 1"
+    ):
+        read_coco(tmp_path / "c.json")  # before: "0" (text) was truthy, the fruit ignored as a crowd region
+    with pytest.raises(FileFormatError, match=r"c\.json: annotation 1 has iscrowd"):
+        read_masks(tmp_path / "c.json", (4, 4))  # a frame's masks.json alike

@@ -2,6 +2,7 @@
 read, aligned and detected on, compared with the SDK's ``rs.align`` when pyrealsense2 imports, and copies
 of it broken in every way a file can be (rewritten with rosbags) refused by name."""
 
+import re
 import struct
 import tracemalloc
 
@@ -157,6 +158,7 @@ def test_the_alignment_is_the_sdks():
         assert compared >= 1
 
 
+@pytest.mark.filterwarnings("ignore::symfruit.SymfruitWarning")  # said: test below
 def test_a_distorted_colour_lens_matches_the_sdk(tmp_path):
     pytest.importorskip("pyrealsense2")
     from symfruit.core.align import align_depth
@@ -245,6 +247,10 @@ def patch_encoding(new: bytes, old: bytes = b"mono16", topic_end: str = "Depth_0
         (edited("distortion_model", "Kannala Brandt4", "Color_0/info/camera_info"),
          r"lens model 'Kannala Brandt4' is not supported", "open"),
         (edited("width", 100_000, "Color_0/info/camera_info"), r"invalid intrinsics .*100000 pixels", "open"),
+        # librealsense records five coefficients: eight (a rational model's) are refused, never cut to five
+        (edited("D", np.array([0.0] * 5 + [0.3, 0.0, 0.0]), "Color_0/info/camera_info"),
+         r"Color_0: camera info K has 9 values and D 8; expected 9 and 5 \(librealsense records five", "open"),
+        (edited("D", np.array([0.1, 0.0]), "Depth_0/info/camera_info"), r"Depth_0: .* D 2; expected 9 and 5", "open"),
         (edited("width", 640, "Color_0/info/camera_info"), r"colour image is 320x240 but its camera info says 640x240",
          "read"),
         (edited("data", 2, "/file_version"), r"RealSense file version 2 is not supported", "open"),
@@ -434,3 +440,22 @@ def test_a_playback_that_ran_out_unseen_is_started_again(monkeypatch):
     starts.clear()  # a playback that never delivers: started again until the attempts or the time run out
     monkeypatch.setattr(Pipeline, "try_wait_for_frames", lambda self, ms: (time.sleep(ms / 1e5), (False, None))[1])
     assert list(realsense.sdk_aligned(BAG, timeout_ms=60_000, attempts=3)) == [] and len(starts) == 3
+
+
+def test_a_distorted_colour_lens_is_warned_about_as_any_camera_is(tmp_path):
+    import warnings
+
+    from symfruit import SymfruitWarning
+
+    path = rewrite(tmp_path / "distorted.bag", edit=edited("D", np.array([0.06, -0.1, 0.001, -0.0008, 0.02]),
+                                                           "Color_0/info/camera_info"))  # fmt: skip
+    with pytest.warns(
+        SymfruitWarning,
+        match=rf"^{re.escape(str(path))}: colour camera info "
+        r"/device_0/sensor_1/Color_0/info/camera_info: non-zero distortion coefficients 'D' "
+        r"\(largest -0\.1\) are not applied",
+    ):
+        RealSenseBagSource(path).close()
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SymfruitWarning)  # the example's lenses are undistorted
+        RealSenseBagSource(BAG).close()

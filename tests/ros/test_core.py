@@ -29,9 +29,10 @@ def image_msg(array: np.ndarray, encoding: str, *, pad: int = 0, bigendian: bool
                            data=rows.tobytes(), header=header())  # fmt: skip
 
 
-def info_msg(fx=615.0, fy=615.0, cx=320.0, cy=240.0, width=640, height=480, key="K") -> SimpleNamespace:
+def info_msg(fx=615.0, fy=615.0, cx=320.0, cy=240.0, width=640, height=480, key="K", d=None) -> SimpleNamespace:
+    extra = {} if d is None else {"D" if key == "K" else "d": d}
     return SimpleNamespace(width=width, height=height, header=header(),
-                           **{key: [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]})  # fmt: skip
+                           **{key: [fx, 0.0, cx, 0.0, fy, cy, 0.0, 0.0, 1.0]}, **extra)  # fmt: skip
 
 
 def example_messages(images, color_encoding="rgb8", depth_encoding="16UC1"):
@@ -278,3 +279,35 @@ def test_stop_signals_are_never_fatal_whichever_thread_they_land_on():
     res = subprocess.run([sys.executable, "-c", STOP_CHILD], capture_output=True, text=True, timeout=60)
     assert res.returncode == 0, res.stderr
     assert res.stdout.split("\n")[:3] == ["SIGTERM", "SIGINT", "handlers True True"], res.stdout + res.stderr
+
+
+def test_live_camera_info_distortion_is_warned_about_once_and_a_non_finite_one_refused(example_images):
+    import warnings
+
+    from symfruit import SymfruitWarning
+
+    color, depth = image_msg(np.zeros((48, 64, 3), np.uint8), "rgb8"), image_msg(np.zeros((48, 64), np.uint16), "16UC1")
+    for key in ("K", "k"):
+        with pytest.warns(
+            SymfruitWarning,
+            match=r"^ros: CameraInfo: non-zero distortion coefficients "
+            rf"'{key.replace('K', 'D').replace('k', 'd')}' \(largest -0\.2\) are not applied",
+        ):
+            frame_of(color, depth, info_msg(width=64, height=48, key=key, d=[-0.2, 0.05, 0, 0, 0]))
+    with pytest.raises(InputError, match=r"CameraInfo D must hold at most 16 finite numbers, got \[inf"):
+        frame_of(color, depth, info_msg(width=64, height=48, d=[float("inf"), 0, 0, 0, 0]))
+    with pytest.raises(InputError, match=r"CameraInfo D holds something that is not a number"):
+        frame_of(color, depth, info_msg(width=64, height=48, d=["x"]))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", SymfruitWarning)
+        frame_of(color, depth, info_msg(width=64, height=48, d=[0.0] * 5))  # zeros, or none: nothing to say
+        frame_of(color, depth, info_msg(width=64, height=48))
+    core = FrameProcessor(fruit="strawberry")
+    color, depth, info = example_messages(example_images)
+    info.D = [0.1, 0, 0, 0, 0]
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for k in range(2):
+            core.frame(color, depth, info, source=f"ros:/c@{k}")
+    said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
+    assert len(said) == 1 and said[0].startswith("ros:/c@0: CameraInfo: non-zero distortion coefficients 'D'")

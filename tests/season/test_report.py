@@ -177,3 +177,38 @@ def test_each_recording_gets_its_sizes_and_a_run_of_one_recording_no_boxes(writt
     single = write_report(one)
     assert sorted(p.name for p in single.folder.iterdir()) == sorted([*PLOTS, "report.md"])
     assert "Sizes per recording" not in (single.folder / "report.md").read_text()
+
+
+def test_a_report_folder_that_links_out_of_the_run_is_refused_not_written_through(run, tmp_path, capsys):
+    (tmp_path / "elsewhere").mkdir()
+    (run / "report").symlink_to(tmp_path / "elsewhere")
+    assert main(["report", str(run)]) == 2
+    err = capsys.readouterr().err
+    assert f"{run / 'report'}: is a symbolic link (to {tmp_path / 'elsewhere'}); symfruit does not write" in err
+    assert not list((tmp_path / "elsewhere").iterdir())
+    assert main(["report", str(run), "--output", str(run / "report")]) == 0  # named: the user's own choice
+    assert (tmp_path / "elsewhere" / "report.md").is_file()
+
+
+@pytest.mark.parametrize(
+    "table, column, value, message",
+    [
+        ("detections.parquet", "confidence", 1e300, r"detections\.parquet: row 1 has confidence 1e\+300; a confidence "
+         r"is in \[0, 1\]"),
+        ("detections.parquet", "confidence", -0.5, r"row 1 has confidence -0\.5"),
+        ("frames.parquet", "located", -5, r"frames\.parquet: row 1 has -5 of 3 fruit located; a frame holds 0-1000 "
+         r"fruit, located 0 to them \(not a symfruit table, or damaged\)"),
+        ("frames.parquet", "fruit", 2**31 - 1, r"row 1 has 2 of 2147483647 fruit located"),
+    ],
+)  # fmt: skip
+def test_counts_and_confidences_no_run_writes_are_refused_not_reported(run, table, column, value, message):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    t = pq.read_table(run / table)
+    k = t.schema.get_field_index(column)
+    t = t.set_column(k, t.schema.field(k), pa.array([value] * t.num_rows, type=t.schema.field(k).type))
+    pq.write_table(t, run / table)
+    with pytest.raises(FileFormatError, match=message):
+        write_report(run)
+    assert not (run / "report").exists()

@@ -197,3 +197,11 @@ def test_a_written_apple_tree_frame_carries_its_truth_and_masks(tmp_path, monkey
     assert calls == [(5, "azure-kinect", 4, 1)]
     frame = read_frame(folder)
     assert frame.masks is not None and len(frame.truth) == 4 and set(frame.visible) == {fid for fid, _ in frame.truth}
+
+
+def test_a_scene_without_ripe_fruit_or_without_any_fruit_is_made_not_a_numpy_error():
+    small = Camera(fx=300, fy=300, cx=160, cy=120, width=320, height=240)
+    unripe_only = make_scene(2, n_ripe=0, n_unripe=2, n_leaves=2, camera=small)
+    assert [f.ripe for f in unripe_only.fruits] == [False, False] and unripe_only.labels.any()
+    empty = make_scene(2, n_ripe=0, n_unripe=0, n_leaves=2, camera=small)  # leaves hang in front of fruit: none
+    assert empty.fruits == [] and not empty.labels.any()

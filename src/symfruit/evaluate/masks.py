@@ -302,10 +302,18 @@ def evaluate_mask_items(
 
 
 def coco_items(
-    images: str | Path, truth: str | Path, *, category: int | None = 1, names: Sequence[str] | None = None
+    images: str | Path,
+    truth: str | Path,
+    *,
+    category: int | None = 1,
+    names: Sequence[str] | None = None,
+    files: bool = False,
 ) -> Iterator[Item]:
     """``(file name, colour, true masks, {}, (crowd mask, crowd count))`` for every image of a COCO file found
     in ``images``, by name. Crowd regions (``iscrowd: 1``) are no true fruit; predictions in them are ignored.
+    With ``files``, the keyword arguments are ``name`` (the file name) and ``color_file`` (the image's path and
+    the EXIF orientation applied to it on reading), which a :class:`~symfruit.segment.MaskSource` reading label
+    files needs: to find an image's labels, and to refuse a label PNG that turns otherwise than the photograph.
 
     Raises
     ------
@@ -315,7 +323,7 @@ def coco_items(
     InputError
         When no annotation has ``category``.
     """
-    from ..io.images import read_color
+    from ..io.images import read_color_oriented
     from ..io.masks import read_coco
 
     folder = Path(images)
@@ -331,14 +339,18 @@ def coco_items(
         raise FileFormatError(f"{coco.path}: no images to evaluate")
     for entry in entries:
         name = str(entry["file_name"])
-        path = folder / name
+        # inside the folder only: an absolute name or one climbing out ("../../x.png") is looked up by its base name
+        inside = not Path(name).is_absolute() and ".." not in Path(name).parts
+        path = folder / name if inside else folder / Path(name).name
         if not path.is_file():
             path = folder / Path(name).name
         if not path.is_file():
-            raise FileFormatError(f"{folder / name}: listed in {coco.path.name} but not in {folder}")
-        color = read_color(path)
+            raise FileFormatError(f"{folder / Path(name).name if not inside else folder / name}: listed in "
+                                  f"{coco.path.name} as {name!r} but not in {folder}")  # fmt: skip
+        color, orientation = read_color_oriented(path)
         crowd = coco.crowd(name, color.shape[:2], category=category)
-        yield name, color, coco.instances(name, color.shape[:2], category=category), {}, crowd
+        extra = {"name": name, "color_file": (path, orientation)} if files else {}
+        yield name, color, coco.instances(name, color.shape[:2], category=category), extra, crowd
 
 
 def evaluate_masks(
@@ -350,6 +362,7 @@ def evaluate_masks(
     threshold: float = 0.5,
     keep_worst: int = 12,
     names: Sequence[str] | None = None,
+    files: bool = False,
 ) -> MaskEvaluation:
     """The masks protocol on a folder of photographs with COCO truth.
 
@@ -365,8 +378,10 @@ def evaluate_masks(
         on them is false); ``None`` takes every annotation as fruit.
     names : sequence of str, optional
         Evaluate only these file names (e.g. one half of a split).
+    files : bool
+        Call ``segment(color, name=..., color_file=...)`` (:func:`coco_items`): for a mask source of label files.
     """
-    items = coco_items(images, truth, category=category, names=names)
+    items = coco_items(images, truth, category=category, names=names, files=files)
     return evaluate_mask_items(items, segment, threshold=threshold, keep_worst=keep_worst)
 
 

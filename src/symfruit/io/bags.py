@@ -13,12 +13,14 @@ frame's ``stamp`` and ``frame_id`` are its colour image's header's (the detectio
 camera's frame; ROS outputs and detections.json copy them).
 
 :func:`image_array` is the one decoder of ``sensor_msgs/Image`` (:func:`color_image`, :func:`depth_image`
-on top of it, and :func:`camera_from_info`): the live ROS node (:mod:`symfruit.ros.core`) uses them too.
+on top of it, and :func:`camera_from_info`, which checks a camera info's distortion as an intrinsics file's is:
+non-finite refused, non-zero warned about once per bag): the live ROS node (:mod:`symfruit.ros.core`) uses them too.
 """
 
 from __future__ import annotations
 
 import bisect
+import math
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -30,6 +32,7 @@ from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
+from .intrinsics import MAX_DISTORTION_COEFFS, warn_distortion
 
 __all__ = [
     "BagSource",
@@ -39,6 +42,7 @@ __all__ = [
     "header_frame_id",
     "header_stamp",
     "image_array",
+    "info_distortion",
     "yuv422_rgb",
 ]
 
@@ -173,16 +177,21 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
     return np.nan_to_num(raw, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # image_array's own copy
 
 
-def camera_from_info(msg: Any, *, width: int | None = None, height: int | None = None) -> Camera:
+def camera_from_info(
+    msg: Any, *, width: int | None = None, height: int | None = None, source: str | None = None
+) -> Camera:
     """Pinhole intrinsics of a ``sensor_msgs/CameraInfo`` (``K`` in ROS 1, ``k`` in ROS 2).
 
     A camera info whose width or height is 0 takes ``width`` / ``height`` (the image's) when given.
-    Distortion is ignored: symfruit works on rectified or near-distortion-free colour images.
+    Distortion (``D``/``d``) is not applied: symfruit works on rectified or near-distortion-free colour images.
+    It is checked as an intrinsics file's is (:func:`info_distortion`: non-finite refused) and, with ``source``
+    (what names the camera in the warning), non-zero coefficients raise a
+    :class:`~symfruit.errors.SymfruitWarning` (:func:`symfruit.io.intrinsics.warn_distortion`).
 
     Raises
     ------
     InputError
-        When there is no 3x3 ``K`` or the intrinsics are invalid.
+        When there is no 3x3 ``K``, the intrinsics are invalid or the distortion is not finite numbers.
     """
     k = getattr(msg, "k", None)
     if k is None:
@@ -193,8 +202,35 @@ def camera_from_info(msg: Any, *, width: int | None = None, height: int | None =
         raise InputError("CameraInfo K holds something that is not a number") from None
     if len(k) != 9:
         raise InputError("CameraInfo has no 3x3 K matrix")
+    key, coeffs = info_distortion(msg)
     w, h = int(msg.width) or (width or 0), int(msg.height) or (height or 0)
-    return Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
+    camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
+    if source is not None:
+        warn_distortion(source, key, coeffs, stacklevel=3)
+    return camera
+
+
+def info_distortion(msg: Any) -> tuple[str, list[float]]:
+    """``(field, coefficients)`` of a ``CameraInfo``'s distortion (``D`` in ROS 1, ``d`` in ROS 2; none: empty),
+    checked as an intrinsics file's: at most :data:`~symfruit.io.intrinsics.MAX_DISTORTION_COEFFS` finite numbers.
+
+    Raises
+    ------
+    InputError
+        Naming the field, for values that are not finite numbers or too many of them.
+    """
+    key = "d" if getattr(msg, "d", None) is not None else "D"
+    values = getattr(msg, key, None)
+    if values is None:
+        return key, []
+    try:
+        coeffs = [float(v) for v in values]
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(f"CameraInfo {key} holds something that is not a number") from None
+    if len(coeffs) > MAX_DISTORTION_COEFFS or not all(math.isfinite(c) for c in coeffs):
+        shown = coeffs if len(coeffs) <= 8 else f"{len(coeffs)} values"
+        raise InputError(f"CameraInfo {key} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got {shown}")
+    return key, coeffs
 
 
 def header_stamp(msg: Any) -> int | None:
@@ -309,6 +345,7 @@ class BagSource:
         # (stamp, camera or why it is invalid, whether its width/height were 0: the image's then), on change
         self._cameras: list[tuple[int, Camera | str, tuple[bool, bool]]] = []
         last: Any = None
+        distorted: tuple[str, list[float]] | None = None  # the first non-zero distortion: warned about once
         for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
             if conn == self._depth:
                 self._depth_stamps.append(stamp)
@@ -321,6 +358,8 @@ class BagSource:
                     msg = self._reader.deserialize(raw, conn.msgtype)
                     sizeless = (not int(msg.width), not int(msg.height))  # as the live node: the image's size
                     camera: Camera | str = camera_from_info(msg, width=1, height=1)
+                    if distorted is None and any((coeffs := info_distortion(msg))[1]):
+                        distorted = coeffs
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
                 if not self._cameras or self._cameras[-1][1:] != (camera, sizeless):  # kept on change: each
@@ -330,6 +369,8 @@ class BagSource:
         if not self._cameras:
             raise FileFormatError(f"CameraInfo topic {self._info.topic} holds no messages")
         self._camera_stamps = [s for s, _, _ in self._cameras]
+        if distorted is not None:
+            warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4)
 
     def __len__(self) -> int:
         return len(self._depth_stamps)

@@ -136,6 +136,7 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
     it has."""
     from plyfile import PlyData, PlyParseError
 
+    _check_ply_byte_order(path)
     try:
         with path.open("rb") as handle:
             data = PlyData.read(handle)
@@ -160,6 +161,70 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
         raise FileFormatError(f"{path}: corrupt PLY ({exc})") from None
     except (KeyError, ValueError) as exc:
         raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
+
+
+#: numpy codes of the PLY scalar types.
+_PLY_CODES = {
+    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2", "ushort": "u2",
+    "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4",
+    "double": "f8", "float64": "f8",
+}  # fmt: skip
+#: Vertices a binary PLY's byte order is judged on (the first rows).
+_BYTE_ORDER_ROWS = 1000
+
+
+def _plausible(values: np.ndarray) -> float:
+    """Share of coordinates that look like a measurement in any unit: 0, or finite with magnitude 1e-6 to 1e6
+    (bytes read in the wrong order give exponents all over the range: ~13 % of float32 fall there by chance)."""
+    with np.errstate(invalid="ignore", over="ignore"):
+        a = np.abs(values.astype(np.float64))
+        ok = (a == 0) | ((a >= 1e-6) & (a <= 1e6))
+    return float(ok.mean()) if len(a) else 1.0
+
+
+def _check_ply_byte_order(path: Path) -> None:
+    """Refuse a binary PLY whose header names the other byte order than its data's (a ``binary_big_endian``
+    header written over little-endian floats, or the reverse): read as declared, the first vertices' float x, y, z
+    are mostly no coordinates (1e25, 1e-39, NaN), read swapped they are. Judged only where it can be told: the
+    vertex element first, of fixed-size properties, with float or double x, y, z."""
+    header, start, size = _header(path, "PLY", b"ply", re.compile(rb"end_header\r?\n"))
+    text = header.decode("ascii", errors="replace")
+    fmt = re.search(r"^format\s+(\S+)", text, re.M)
+    orders = {"binary_little_endian": "<", "binary_big_endian": ">"}
+    if fmt is None or fmt.group(1) not in orders:
+        return
+    blocks = re.split(r"^element\s+", text, flags=re.M)[1:]
+    head = blocks[0].split(None, 2) if blocks else []
+    if len(head) < 2 or head[0] != "vertex" or not head[1].isdigit():
+        return
+    props = re.findall(r"^property\s+(\S+)\s+(\S+)", blocks[0], re.M)
+    if not props or any(kind not in _PLY_CODES for kind, _ in props):  # a list property: rows of varying size
+        return
+    coords = [name for kind, name in props if name in ("x", "y", "z") and _PLY_CODES[kind].startswith("f")]
+    if len(coords) != 3 or len({name for _, name in props}) != len(props):
+        return
+    declared = orders[fmt.group(1)]
+    other = "<" if declared == ">" else ">"
+    fields = [(name, _PLY_CODES[kind]) for kind, name in props]
+    row = np.dtype([(name, declared + code) for name, code in fields])
+    n = min(int(head[1]), _BYTE_ORDER_ROWS, (size - start) // row.itemsize)
+    if n <= 0:
+        return
+    with path.open("rb") as handle:
+        handle.seek(start)
+        raw = handle.read(n * row.itemsize)
+    as_declared = np.frombuffer(raw, row, count=n)
+    swapped = np.frombuffer(raw, np.dtype([(name, other + code) for name, code in fields]), count=n)
+    ours = _plausible(np.concatenate([as_declared[c] for c in coords]))
+    theirs = _plausible(np.concatenate([swapped[c] for c in coords]))
+    if ours < 0.5 and theirs > 0.9:
+        named = {v: k for k, v in orders.items()}
+        example = ", ".join(f"{float(as_declared[c][0]):.3g}" for c in coords)
+        raise FileFormatError(
+            f"{path}: the header says {fmt.group(1)} but the data look {named[other]}: read as declared, "
+            f"{1 - ours:.0%} of the first {n} vertices' coordinates are implausible (the first: {example}), read "
+            f"in the other byte order {theirs:.0%} are plausible; write 'format {named[other]} 1.0' in the header"
+        )
 
 
 def _check_ply_rest(path: Path, data: Any, end: int | None) -> None:
@@ -241,7 +306,13 @@ def read_pcd(path: Path) -> np.ndarray:
             if n * 2 * len(names) > body_size + 1:
                 raise FileFormatError(f"{path}: header promises {n} points but the file is too short")
             text = io.TextIOWrapper(handle, encoding="ascii", errors="replace")
-            values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
+            try:
+                values = np.loadtxt(text, ndmin=2, dtype=np.float64, max_rows=n)
+            except ValueError as exc:  # numpy's own words on a ragged or wordy row, without its API advice
+                why = str(exc).split("; use `usecols`")[0].replace("\n", " ")
+                raise FileFormatError(
+                    f"{path}: ascii PCD rows are not all {int(sum(counts))} numbers ({why})"
+                ) from None
             if len(values) < n:
                 raise FileFormatError(f"{path}: header promises {n} points, the file holds {len(values)}")
             if any(line.strip() for line in text):

@@ -39,6 +39,7 @@ __all__ = [
     "DEFAULT_DEPTH_SCALE",
     "is_frame_folder",
     "named_frame",
+    "read_depth",
     "read_depth_npy",
     "read_frame",
     "read_truth",
@@ -94,18 +95,10 @@ def read_frame(folder: str | Path) -> Frame:
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
     color, color_orientation = read_color_oriented(color_path)
-    depth_png, depth_npy = folder / "depth.png", folder / "depth.npy"
     depth_file = _first(folder, "depth.png", "depth.npy")
     if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
-    depth_orientation = 1  # a .npy array has none
-    if depth_file == depth_png:
-        units, depth_orientation = read_depth_units_oriented(depth_png, scale=scale)
-        depth = units.astype(np.float32) * np.float32(scale)
-    else:
-        depth = read_depth_npy(depth_npy)
-    # depth registered to a phone photo's stored pixels, or intrinsics for them: said so, never paired turned
-    orientation_mismatch(color_path, color_orientation, depth_file, depth_orientation)
+    depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
     oriented = (str(color_path), color_orientation)
@@ -125,6 +118,22 @@ def named_frame(where: str, name: str, *args: Any, **kwargs: Any) -> Frame:
         raise InputError(f"{where}: {str(exc).removeprefix(f'frame {name}: ')}") from None
 
 
+def read_depth(path: Path, scale: float, *, color: tuple[str | Path, int], dtype: Any = np.float32) -> np.ndarray:
+    """Depth in metres (``dtype``) from ``.npy`` (float metres: :func:`read_depth_npy`) or a depth image (16-bit
+    units, ``scale`` metres each: :func:`~symfruit.io.images.read_depth_units`), for the colour image ``color``:
+    its file and the EXIF orientation applied to it on reading, which the depth image must carry too (depth
+    registered to a phone photo's stored pixels is refused naming both files, never paired turned). The one
+    reader of a depth file beside a colour image: frame folders and ``symfruit segment --depth``."""
+    depth_orientation = 1  # a .npy array has none
+    if path.suffix.lower() == ".npy":
+        depth = read_depth_npy(path).astype(dtype, copy=False)  # sizes checked from the header; never unpickled
+    else:
+        units, depth_orientation = read_depth_units_oriented(path, scale=scale)
+        depth = units.astype(dtype) * np.dtype(dtype).type(scale)
+    orientation_mismatch(color[0], color[1], path, depth_orientation)
+    return depth
+
+
 def read_depth_npy(path: Path) -> np.ndarray:
     """A float depth image in metres from ``.npy`` (never unpickled; size checked from the header)."""
     from .clouds import npy_header
@@ -139,7 +148,8 @@ def read_depth_npy(path: Path) -> np.ndarray:
         depth = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
         raise FileFormatError(f"{path}: cannot read ({exc})") from None
-    return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    with np.errstate(over="ignore", invalid="ignore"):  # float64 beyond float32 (1e300 m): inf, then no depth
+        return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
 
 
 def _depth_scale(cam_path: Path, data: Any) -> float:
@@ -148,7 +158,7 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
     units = data.get("depth_units") if isinstance(data, dict) else None
     if units is not None:
         known = {"m": 1.0, "mm": 0.001, "0.1mm": 0.0001, "cm": 0.01}
-        if units not in known:
+        if not isinstance(units, str) or units not in known:  # a list or mapping is no unit (nor hashable)
             raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
         scale = known[units]
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:

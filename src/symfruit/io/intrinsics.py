@@ -31,6 +31,7 @@ from __future__ import annotations
 import difflib
 import math
 import warnings
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +40,7 @@ from ..core.limits import MAX_SETTINGS_BYTES
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
-__all__ = ["camera_from_dict", "load_camera"]
+__all__ = ["camera_from_dict", "load_camera", "warn_distortion"]
 
 #: Largest intrinsics file read (bytes): that of a settings file (:mod:`symfruit.core.limits`).
 MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
@@ -86,6 +87,8 @@ def camera_from_file_data(path: Path, data: Any) -> Camera:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
+#: Most distortion coefficients read (OpenCV's largest model has 14; ROS ``rational_polynomial`` 8).
+MAX_DISTORTION_COEFFS = 16
 #: Distortion keys of the layouts: RealSense, ROS 1, ROS 2, camera_calibration_parsers.
 _DISTORTION_KEYS = ("coeffs", "D", "d", "distortion_coefficients")
 
@@ -107,11 +110,12 @@ def _distortion(data: Any) -> tuple[str, list[float]] | None:
         return None
     if (
         not isinstance(values, list)
-        or len(values) > 16
+        or len(values) > MAX_DISTORTION_COEFFS
         or not all(isinstance(v, (int, float)) and not isinstance(v, bool) and _fits_float(v) for v in values)
         or not all(math.isfinite(float(v)) for v in values)
     ):
-        raise InputError(f"intrinsics field {key!r} must hold at most 16 finite numbers, got {_short(values)}")
+        raise InputError(f"intrinsics field {key!r} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got "
+                         f"{_short(values)}")  # fmt: skip
     return key, [float(v) for v in values]
 
 
@@ -120,18 +124,27 @@ def _checked(data: Any, source: str) -> Camera:
     ``source`` names where the intrinsics came from."""
     camera = _camera_with_keys_checked(data)
     distortion = _distortion(data)
-    if distortion is not None and any(distortion[1]):
-        key, values = distortion
-        largest = max(values, key=abs)
-        warnings.warn(
-            SymfruitWarning(
-                f"{source}: non-zero distortion coefficients {key!r} (largest {largest:.4g}) are not applied: "
-                "symfruit treats the image as pinhole; undistort it first (or use the rectified camera's "
-                "intrinsics, ROS P), else points far from the centre are misplaced"
-            ),
-            stacklevel=3,
-        )
+    if distortion is not None:
+        warn_distortion(source, *distortion, stacklevel=4)
     return camera
+
+
+def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2) -> bool:
+    """Warn (:class:`SymfruitWarning`) that the distortion coefficients ``values`` (field ``key``) of the camera
+    ``source`` names are not applied, when one is non-zero; whether it warned. The one rule for intrinsics files,
+    bags' and live ``CameraInfo`` messages and RealSense recordings' colour lens."""
+    if not any(values):
+        return False
+    largest = max(values, key=abs)
+    warnings.warn(
+        SymfruitWarning(
+            f"{source}: non-zero distortion coefficients {key!r} (largest {largest:.4g}) are not applied: "
+            "symfruit treats the image as pinhole; undistort it first (or use the rectified camera's "
+            "intrinsics, ROS P), else points far from the centre are misplaced"
+        ),
+        stacklevel=stacklevel,
+    )
+    return True
 
 
 def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:

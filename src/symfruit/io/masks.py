@@ -114,6 +114,8 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     for k, ann in enumerate(anns, 1):
         if not isinstance(ann, dict):  # never dropped quietly: that would read as a frame without fruit
             raise FileFormatError(f"{path}: annotation {k} is a {type(ann).__name__}, not an object")
+        if ann.get("iscrowd") not in (None, 0, 1):  # "0" as text is truthy: the fruit would be dropped as a crowd
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
     images = data.get("images") if isinstance(data, dict) else None
     if images is not None:
         if not isinstance(images, list) or not all(isinstance(e, dict) for e in images):
@@ -266,7 +268,9 @@ def read_coco(path: str | Path) -> CocoSet:
     Raises
     ------
     FileFormatError
-        When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists.
+        When the file is too large, not JSON, or lacks the ``images`` / ``annotations`` lists; for an image
+        without an id, two images of one name or id, an annotation for an image id no image has (its fruit would
+        be lost from the truth unsaid) or whose ``category_id`` is no id.
     """
     path = Path(path)
     return coco_from_data(path, read_structured(path, what="COCO annotation file", max_bytes=MAX_COCO_BYTES))
@@ -288,6 +292,8 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         name = entry["file_name"]
         if name in images and images[name].get("file_name") == name:
             raise FileFormatError(f"{path}: two 'images' entries are named {name!r}")
+        if entry.get("id") is None:  # its annotations could never be found: the image would be scored fruitless
+            raise FileFormatError(f"{path}: the 'images' entry {name!r} has no id")
         key = _key(entry.get("id"))
         if key in ids:  # both would be scored against the same annotations
             raise FileFormatError(f"{path}: {ids[key]!r} and {name!r} share the image id {entry.get('id')!r}; "
@@ -296,16 +302,31 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         images[name] = entry
         images.setdefault(Path(name).name, entry)
     annotations: dict[Any, list[dict[str, Any]]] = {}
-    for ann in data["annotations"]:
+    for k, ann in enumerate(data["annotations"], 1):
         if not isinstance(ann, dict):
             raise FileFormatError(f"{path}: an 'annotations' entry is not an object")
-        annotations.setdefault(_key(ann.get("image_id")), []).append(ann)
+        category = ann.get("category_id")
+        if isinstance(category, bool) or not isinstance(category, (int, str, type(None))):
+            raise FileFormatError(f"{path}: annotation {k} has category_id {_shown(category)}; a category id is a "
+                                  "whole number")  # fmt: skip
+        if ann.get("iscrowd") not in (None, 0, 1):  # "0" or "no" as text is truthy: a fruit counted as a crowd
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
+        image = _key(ann.get("image_id"))
+        if image not in ids:  # a misspelt or missing image_id: that fruit would be lost from the truth unsaid
+            raise FileFormatError(f"{path}: annotation {k} is for image id {_shown(ann.get('image_id'))}, which no "
+                                  "'images' entry has")  # fmt: skip
+        annotations.setdefault(image, []).append(ann)
     categories: dict[int, str] = {}
     raw = data.get("categories", [])
     for c in raw if isinstance(raw, list) else []:
         if isinstance(c, dict) and isinstance(c.get("id"), int) and not isinstance(c.get("id"), bool):
             categories[c["id"]] = str(c.get("name", c["id"]))
     return CocoSet(path, images, annotations, categories)
+
+
+def _shown(value: Any) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def rle_decode(rle: dict[str, Any]) -> np.ndarray:
@@ -321,10 +342,22 @@ def rle_decode(rle: dict[str, Any]) -> np.ndarray:
         if len(counts) > 8 * MAX_RLE_RUNS:
             raise ValueError("RLE string too long")
         counts = _rle_string_counts(counts)
+    if isinstance(counts, (tuple, np.ndarray)) and np.ndim(counts) == 1:  # handed over by the API
+        counts = [c.item() if isinstance(c, np.generic) else c for c in counts]
+    if not isinstance(counts, list):
+        raise ValueError(
+            f"RLE counts must be a list of run lengths or a compressed string, got {type(counts).__name__}"
+        )
     if len(counts) > MAX_RLE_RUNS:
         raise ValueError("RLE has too many runs")
+    # whole numbers 0 to the image's pixels, each: a float is not cut, a negative run does not cancel a longer
+    # one (the sum alone let [19300, -100] through as "adds up to 19200"), a 400-digit one is not an overflow
+    bad = next((c for c in counts if isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= h * w), None)
+    if bad is not None:
+        shown = repr(bad) if len(repr(bad)) <= 20 else f"{repr(bad)[:12]}... ({len(repr(bad))} characters)"
+        raise ValueError(f"RLE counts must be run lengths, whole numbers 0-{h * w}, got {shown}")
     counts = np.asarray(counts, dtype=np.int64)
-    if counts.ndim != 1 or (counts < 0).any() or counts.sum() != h * w:
+    if counts.sum() != h * w:
         raise ValueError(f"RLE counts add up to {counts.sum()}, expected {h * w}")
     values = np.zeros(len(counts), bool)
     values[1::2] = True
@@ -336,6 +369,8 @@ def _rle_string_counts(s: str) -> list[int]:
     """The LEB128-like string encoding of COCO's ``maskApi.c`` (``rleFrString``)."""
     counts: list[int] = []
     p = 0
+    if not s.isascii():
+        raise ValueError("a compressed RLE string holds only ASCII characters")
     data = s.encode("ascii")
     while p < len(data):
         x, k, more = 0, 0, True

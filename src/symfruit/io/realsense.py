@@ -5,7 +5,8 @@ librealsense's layout (``src/media/ros/ros_file_format.h``, file version 3 and 4
 
     /file_version                                               std_msgs/UInt32
     /device_0/sensor_<s>/<Stream>_<i>/image/data                sensor_msgs/Image (Depth: mono16 units)
-    /device_0/sensor_<s>/<Stream>_<i>/info/camera_info          sensor_msgs/CameraInfo (K, D, distortion_model)
+    /device_0/sensor_<s>/<Stream>_<i>/info/camera_info          sensor_msgs/CameraInfo (K, D, distortion_model;
+                                                                D: rs2_intrinsics' five coeffs, no more)
     /device_0/sensor_<s>/<Stream>_<i>/tf/<group>                geometry_msgs/Transform: group reference -> stream
     /device_0/sensor_<s>/option/Depth Units/value               std_msgs/Float32, metres per unit
                                                                 (``Depth_Units`` in SDK 2.5x)
@@ -43,6 +44,7 @@ from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
 from .frames import named_frame
+from .intrinsics import warn_distortion
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -156,9 +158,12 @@ class RealSenseBagSource:
         if model not in LENS_MODELS:
             raise FileFormatError(f"{prefix}: lens model {model!r} is not supported (known: {', '.join(LENS_MODELS)})")
         k = [float(v) for v in info.K]
-        coeffs = [float(v) for v in info.D][:5]
+        # librealsense writes D from rs2_intrinsics::coeffs, a float[5] (ros_writer.cpp), and reads five back: every
+        # model's coefficients are those five, so a D of any other length is not its recording; refused, never cut
+        coeffs = [float(v) for v in info.D]
         if len(k) != 9 or len(coeffs) not in (0, 5):
-            raise FileFormatError(f"{prefix}: camera info K has {len(k)} values and D {len(info.D)}; expected 9 and 5")
+            raise FileFormatError(f"{prefix}: camera info K has {len(k)} values and D {len(coeffs)}; expected 9 and "
+                                  "5 (librealsense records five lens coefficients, rs2_intrinsics coeffs)")  # fmt: skip
         try:
             camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(info.width), height=int(info.height))
             lens = Lens(camera, LENS_MODELS[model], tuple(coeffs or [0.0] * 5))
@@ -202,6 +207,10 @@ class RealSenseBagSource:
         color_prefix = self._color.topic[1 : -len("/image/data")]
         self.depth_stream = self._stream(depth_prefix, tfs)
         self.color_stream = self._stream(color_prefix, tfs)
+        # the colour lens's distortion registers depth to the colour pixels (align_depth) but the frames' camera is
+        # its pinhole part: said so, as for any camera; the depth lens's is applied in full
+        warn_distortion(f"{self.path}: colour camera info /{color_prefix}/info/camera_info", "D",
+                        self.color_stream.lens.coeffs, stacklevel=4)  # fmt: skip
         d, c = self.depth_stream, self.color_stream
         if d.group != c.group:
             raise FileFormatError(f"depth and colour extrinsics are relative to different references "

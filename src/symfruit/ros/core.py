@@ -31,7 +31,7 @@ import numpy as np
 from ..core.frame import Frame
 from ..detect import FrameDetections, detect
 from ..errors import InputError
-from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
+from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp, info_distortion
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
 from ..segment import mask_source
@@ -105,9 +105,12 @@ def message_frame(
     depth_scale: float = 0.001,
     name: str = "frame",
     source: str = "ros",
+    warn: bool = True,
 ) -> Frame:
     """A :class:`~symfruit.core.frame.Frame` of a colour image, the depth image aligned to it and the colour
-    camera's info; stamped with the colour header (``stamp``, ``frame_id``).
+    camera's info; stamped with the colour header (``stamp``, ``frame_id``). Non-zero distortion in the camera
+    info is not applied: with ``warn``, a :class:`~symfruit.errors.SymfruitWarning` says so
+    (:func:`~symfruit.io.bags.camera_from_info`).
 
     Raises
     ------
@@ -118,7 +121,7 @@ def message_frame(
     rgb = color_image(color)
     metres = depth_image(depth, depth_scale=depth_scale)
     h, w = metres.shape
-    camera = camera_from_info(info, width=w, height=h)
+    camera = camera_from_info(info, width=w, height=h, source=f"{source}: CameraInfo" if warn else None)
     return Frame(name, rgb, metres, camera, source=source, stamp=header_stamp(color), frame_id=header_frame_id(color))
 
 
@@ -174,10 +177,16 @@ class FrameProcessor:
         self.method, self.masks, self.depth_scale = method, masks, float(depth_scale)
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
         self.mask_source = mask_source(masks, settings=self.settings)  # a bad model fails here, once
+        self._warned_distortion = False
 
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
-        """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`)."""
-        return message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source)
+        """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`); the first camera
+        info with non-zero distortion is warned about, once per processor (not on every frame)."""
+        warn = not self._warned_distortion
+        frame = message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source, warn=warn)
+        if warn and any(info_distortion(info)[1]):
+            self._warned_distortion = True
+        return frame
 
     def process(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Processed:
         """Decode, detect, and list the located fruit. Raises ``SymfruitError`` for a bad frame."""

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,8 +28,8 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import MAX_DEPTH_METRES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
-from ..errors import FileFormatError, InputError, SymfruitError
+from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
 
 __all__ = [
@@ -145,6 +146,25 @@ def _check_sizes(path: Path, *sizes: np.ndarray) -> None:
                                   f"metres in [0, {MAX_SIZE_M:g}] (not a symfruit table, or damaged)")  # fmt: skip
 
 
+def _check_counts(path: Path, fruit: np.ndarray, located: np.ndarray) -> None:
+    """Refuse a frames table whose counts no run writes: a frame's fruit 0-:data:`MAX_INSTANCES`, located 0 to its
+    fruit (a negative count made "-5 located per frame", a huge one a billion-bin histogram)."""
+    bad = np.flatnonzero((fruit < 0) | (fruit > MAX_INSTANCES) | (located < 0) | (located > fruit))
+    if len(bad):
+        k = int(bad[0])
+        raise FileFormatError(f"{path}: row {k + 1} has {int(located[k])} of {int(fruit[k])} fruit located; a "
+                              f"frame holds 0-{MAX_INSTANCES} fruit, located 0 to them (not a symfruit table, or "
+                              "damaged)")  # fmt: skip
+
+
+def _check_confidence(path: Path, conf: np.ndarray) -> None:
+    """Refuse a detections table whose confidence is outside [0, 1] (NaN: none)."""
+    bad = np.flatnonzero(~np.isnan(conf) & ~((conf >= 0) & (conf <= 1)))
+    if len(bad):
+        raise FileFormatError(f"{path}: row {int(bad[0]) + 1} has confidence {conf[bad[0]]:.4g}; a confidence is in "
+                              "[0, 1] (not a symfruit table, or damaged)")  # fmt: skip
+
+
 def _errors(output: Path) -> tuple[int, int]:
     """Frames ``errors.json`` lists as failed or not reached, and recordings it lists as not read (0, 0 without
     the file)."""
@@ -191,6 +211,10 @@ def write_report(
     from ..io.outputs import OutputFolder
 
     output = Path(output)
+    if folder is None and (output / "report").is_symlink():  # the default is the run's own: never a link out of it
+        link = output / "report"
+        raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
+                          f"links inside {output}: remove it, or name a folder (--output)")  # fmt: skip
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
@@ -210,6 +234,8 @@ def write_report(
     sized = ok & ~truncated & np.isfinite(size_x) & np.isfinite(size_z)
     diam = diameters_mm(size_x[sized], size_z[sized])
     conf = np.array([np.nan if v is None else v for v in col["confidence"]], float)
+    _check_confidence(output / TABLE_NAME, conf)
+    _check_counts(output / FRAMES_NAME, seen_f, located_f)
     reliable = np.array([v is True for v in col["reliable"]], bool)
     methods = sorted({str(m) for m in col["method"] if m is not None})
     recordings = list(dict.fromkeys(rec_f.tolist()))

@@ -205,12 +205,23 @@ def _image_files(text: str, images: Sequence[Path]) -> MaskSource:
                 raise FileFormatError(f"{label_path}: no label image for {name}")
             from ..io.masks import read_label_png
 
-            return read_label_png(label_path, color=cf), where
+            return _sized(read_label_png(label_path, color=cf), color, label_path), where
 
         return MaskSource(where, from_folder)
     if source.suffix.lower() == ".png" and source.is_file() and len(images) == 1:
         from ..io.masks import read_label_png
 
-        return MaskSource(where, lambda color, depth, camera, name, own, cf: (read_label_png(source, color=cf), where))
+        def one_png(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
+            return _sized(read_label_png(source, color=cf), color, source), where
+
+        return MaskSource(where, one_png)
     raise InputError(f"--masks {text!r}: expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, "
                      "a folder of label PNGs, or one label .png for one image")  # fmt: skip
+
+
+def _sized(labels: np.ndarray, color: np.ndarray, path: Path) -> np.ndarray:
+    """A label PNG's labels, refused naming the file when they are not the size of the image they are for."""
+    if labels.shape != color.shape[:2]:
+        raise FileFormatError(f"{path}: labels are {labels.shape[1]}x{labels.shape[0]}, the image "
+                              f"{color.shape[1]}x{color.shape[0]}")  # fmt: skip
+    return labels

@@ -198,8 +198,9 @@ def make_scene(
         stem_top = np.array([top[0] + rng.uniform(-0.01, 0.01), gutter_y * top[2] / 0.4, top[2]])
         meshes.append(_cylinder(top, stem_top, 0.0012))
         colours.append((0.25, 0.55, 0.5))
-    ripe_boxes = [f.box for f in fruits if f.ripe]
-    for _ in range(n_leaves):
+    # leaves hang in front of ripe fruit; of a scene without any, in front of the unripe; without fruit, none
+    ripe_boxes = [f.box for f in fruits if f.ripe] or [f.box for f in fruits]
+    for _ in range(n_leaves if ripe_boxes else 0):
         target = ripe_boxes[int(rng.integers(len(ripe_boxes)))]
         centre = target.centre + np.array([rng.uniform(-1, 1) * target.size[0], rng.uniform(-1, 1) * target.size[1],
                                            -target.size[2] / 2 - rng.uniform(0.01, 0.04)])  # fmt: skip
