@@ -16,7 +16,8 @@ towards the camera. :func:`registration_shift` finds how far the depth image sit
 shift that lays the outline of every fruit's depth cap parallel to its mask's outline, a band of the
 mask's rim (the grazing pixels a time-of-flight camera invalidates) allowed between them.
 
-Numpy and scipy only; images in, images and numbers out.
+Numpy and scipy only (or their compiled twins, :mod:`symfruit.core.kernels`, where numba is); images in, images and
+numbers out.
 """
 
 from __future__ import annotations
@@ -28,8 +29,9 @@ from typing import Literal
 import numpy as np
 from scipy import ndimage
 
+from .kernels import compiled
 from .points import median
-from .raster import eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
+from .raster import distance_transform, eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
 
 __all__ = [
     "Surface",
@@ -222,6 +224,9 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
     # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
     d2 = dy * dy + dx * dx
+    if (jit := compiled()) is not None:  # the compiled twin of what follows (the same pixels)
+        jit.monotone(depth, rows, cols, sector, d2, bins, float(tolerance), out)
+        return out
     order = _stable_order(sector * (int(d2.max()) + 1) + d2)
     at = (rows * keep.shape[1] + cols)[order]  # flat indices: np.take is faster than two index arrays
     z, sec = np.take(np.ascontiguousarray(depth).ravel(), at).astype(np.float64), sector[order]
@@ -333,8 +338,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         rows, cols = rows + r0, cols + c0
     else:
         rows, cols = np.nonzero(near & mask if (near & mask).any() else near)
-    smooth = median_at(np.where(near, depth, np.inf), rows, cols, size=5)
-    first = int(np.argmin(smooth))
+    if (jit := compiled()) is not None:  # the compiled twin of np.argmin(median_at(...)): the same pixel
+        first = int(jit.least_median(np.where(near, depth, np.inf), rows, cols, 5))
+    else:
+        first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
     apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
@@ -506,7 +513,7 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
     """The outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it), or None."""
-    grown = ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach  # = binary_dilation, reach times
+    grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     inner = inner_distance(mask)
     surface = fruit_surface(depth, mask, focal, region=grown, inner=inner)
     if surface is None:
@@ -517,8 +524,19 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
-    inside = inner - ndimage.distance_transform_edt(~mask)
+    inside = inner - distance_transform(~mask)
     return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
+
+
+def _taxicab_within(mask: np.ndarray, reach: int) -> np.ndarray:
+    """(h, w) bool: the pixels at most ``reach`` steps along rows and columns from a pixel of ``mask`` (not empty),
+    ``ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach``, or its compiled twin's
+    (:func:`symfruit.core._jit.taxicab_within`: the chamfer's two sweeps, the same pixels)."""
+    if (jit := compiled()) is not None and mask.any():
+        out = np.empty(mask.shape, bool)
+        jit.taxicab_within(mask, int(reach), out)
+        return out
+    return ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach
 
 
 def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
@@ -627,45 +645,62 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
         return mask
     color = np.asarray(color)
-
-    def feature(where: np.ndarray) -> np.ndarray:  # chromaticity and brightness of the pixels ``where``
-        rgb = color[where].astype(np.float64)
-        total = rgb[:, 0] + rgb[:, 1] + rgb[:, 2] + 1.0
-        return np.stack([rgb[:, 0] / total, rgb[:, 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
-
+    # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
+    jit = compiled() if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
+    feature = _colour_features if jit is None else jit.colour_features
+    kmeans = _kmeans if jit is None else jit.kmeans
     rng = np.random.default_rng(0)
 
     def summary(x: np.ndarray) -> np.ndarray:
         x = x[rng.choice(len(x), min(len(x), 400), replace=False)]
-        c = x[np.linspace(0, len(x) - 1, centres).astype(int)]
-        k, last = len(c), None
-        for _ in range(iterations):
-            label = np.argmin(_square_distances(x, c), axis=1)
-            if last is not None and np.array_equal(label, last):
-                break  # the same labels give the same centres, bit for bit, in every round left
-            last = label
-            # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
-            count = np.bincount(label, minlength=k)
-            total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
-            c = np.where(count[:, None] > 0, total.reshape(k, 3) / np.maximum(count, 1)[:, None], c)
-        return c
+        return kmeans(x, x[np.linspace(0, len(x) - 1, centres).astype(int)], iterations)
 
-    f_fruit, f_ring = feature(fruit), feature(ring)
+    f_fruit, f_ring = feature(color, fruit), feature(color, ring)
     fc, bc = summary(f_fruit), summary(f_ring)
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
-        to_fruit = _row_min(_square_distances(x, fc))
-        return margin * to_fruit <= _row_min(_square_distances(x, bc))
+        return (_nearer_fruit if jit is None else jit.nearer_fruit)(x, fc, bc, float(margin))
 
     if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
         return mask
     keep = mask.copy()
-    keep[band] = is_fruit(feature(band), margin)  # a mixed pixel on the outline, between the two, stays
+    keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     labels, n = ndimage.label(keep)
     reached = np.zeros(n + 1, bool)  # the pieces holding fruit pixels, looked up by label (np.isin sorts)
     reached[labels[fruit]] = True
     reached[0] = False
     return fill_holes(reached[labels])
+
+
+def _colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """(n, 3) :func:`colour_trim`'s features of the pixels ``where`` (h, w) bool of ``color`` (h, w, 3), in their
+    order: chromaticity and brightness. The compiled twin: :func:`symfruit.core._jit.colour_features`."""
+    rgb = color[where].astype(np.float64)
+    total = rgb[:, 0] + rgb[:, 1] + rgb[:, 2] + 1.0
+    return np.stack([rgb[:, 0] / total, rgb[:, 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
+
+
+def _kmeans(x: np.ndarray, c: np.ndarray, iterations: int) -> np.ndarray:
+    """(k, 3) the centres after up to ``iterations`` rounds of k-means of the rows ``x`` (n, 3) from the centres ``c``
+    (k, 3), stopped when the labels repeat (the same labels give the same centres, bit for bit, in every round
+    left). The compiled twin: :func:`symfruit.core._jit.kmeans`."""
+    k, last = len(c), None
+    for _ in range(iterations):
+        label = np.argmin(_square_distances(x, c), axis=1)
+        if last is not None and np.array_equal(label, last):
+            break
+        last = label
+        # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
+        count = np.bincount(label, minlength=k)
+        total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
+        c = np.where(count[:, None] > 0, total.reshape(k, 3) / np.maximum(count, 1)[:, None], c)
+    return c
+
+
+def _nearer_fruit(x: np.ndarray, fruit: np.ndarray, ground: np.ndarray, margin: float) -> np.ndarray:
+    """(n,) bool: ``margin`` times each row of ``x``'s (n, 3) least squared distance to the centres ``fruit`` is at
+    most its least to the centres ``ground``. The compiled twin: :func:`symfruit.core._jit.nearer_fruit`."""
+    return margin * _row_min(_square_distances(x, fruit)) <= _row_min(_square_distances(x, ground))
 
 
 def within(mask: np.ndarray, radius: float) -> np.ndarray:
@@ -681,6 +716,10 @@ def within(mask: np.ndarray, radius: float) -> np.ndarray:
     r = int(np.floor(radius)) if radius >= 0 else -1
     if r < 0 or not mask.any():
         return np.zeros(mask.shape, bool)
+    if (jit := compiled()) is not None:  # the distances within reach, compiled (the same roots, compared alike)
+        near = np.empty(mask.shape)
+        jit.near_distance(mask, float(radius), True, near)
+        return near <= radius
     off = np.arange(-r, r + 1)
     disc = np.sqrt((off[:, None] ** 2 + off[None, :] ** 2).astype(np.float64)) <= radius
     half = (disc.sum(axis=1) - 1) // 2  # each row of the disc: the run -half..half about its centre
