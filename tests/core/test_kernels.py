@@ -13,7 +13,7 @@ import types
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
@@ -662,3 +662,78 @@ def test_the_surface_outline_and_colour_trim_are_the_twins(monkeypatch, seed):
     for radius in (0.0, 2.5, 5.0):
         fast, twin = _both(monkeypatch, within, mask, radius)
         assert np.array_equal(fast, twin)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900, 20000]), st.sampled_from([0.7, 0.5, 1.0, 0.01]))
+def test_the_outlines_fast_costs_are_the_twins_within_their_sums_rounding(seed, top, trim):
+    """The registration's fast costs (exact=False) of random maps of whole-number squares (int16 keys; ties) with
+    the kernel and with the numpy twin: the same run of values summed in another order, so within rounding (the
+    shift is then chosen by the exact costs, which the kernel leaves to numpy: the same shift)."""
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 60, 2))
+    inside = np.sqrt(rng.integers(1, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    n = int(rng.integers(1, 320))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, float(rng.uniform(0.0, 6.0)))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (int(rng.integers(1, 60)), 2))
+    keys = outline.keys(reach, reach)
+    assert keys is not None and keys.dtype == np.int16  # the kernel's case
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, outline.cost, shifts, reach, trim, exact=False)
+    np.testing.assert_allclose(fast, twin, rtol=1e-13, atol=0.0)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_registration_shift_is_the_twins(monkeypatch, seed):
+    """Balls apart, their depth a few pixels off their masks (noisy or not, rims without depth): the same shift."""
+    from symfruit.core.surface import registration_shift
+
+    from .test_surface import ball
+
+    rng = np.random.default_rng(seed)
+    depth = np.full((120, 160), 0.8)
+    labels = np.zeros((120, 160), np.int32)
+    for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
+        d, disc = ball(centre=centre, radius_px=int(rng.integers(10, 20)), front=float(rng.uniform(0.4, 0.6)),
+                       rim=float(rng.uniform(0.0, 0.2)))  # fmt: skip
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[disc] = k + 1
+    if seed % 2:
+        depth = depth + rng.normal(0.0, 0.001, depth.shape)
+    shift = (int(rng.integers(-4, 5)), int(rng.integers(-4, 5)))
+    moved = np.roll(depth, shift, axis=(0, 1))
+    fast, twin = _both(monkeypatch, registration_shift, moved, labels, 600.0, max_px=10)
+    assert fast == twin == (shift[1], shift[0])
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_filled_and_connected_are_the_labellings(seed, h, w):
+    """Random blobs and speckle (pieces touching the edge, holes, pieces meeting at a corner only: apart, as the
+    4-connected labelling has them)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import fill_holes
+    from symfruit.core.surface import _connected
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.3)) if rng.random() < 0.5 else rng.random((h, w)) < rng.random()
+    out = np.empty((h, w), bool)
+    _jit.filled(mask, out)
+    assert np.array_equal(out, ndimage.binary_fill_holes(mask))
+    seeds = rng.random((h, w)) < rng.uniform(0.0, 0.05)
+    labels, _ = ndimage.label(mask)
+    expected = np.isin(labels, np.unique(labels[seeds & mask]))
+    _jit.connected(mask, seeds, out)
+    assert np.array_equal(out, expected)
+    at = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    with pytest.MonkeyPatch.context() as mp:
+        for fast, twin in (
+            _both(mp, fill_holes, mask),
+            _both(mp, _connected, mask, seeds),
+            _both(mp, _connected, mask, at),
+        ):
+            assert np.array_equal(fast, twin)
+    assert np.array_equal(_connected(mask, at), labels == labels[at])

@@ -1116,3 +1116,109 @@ def monotone(
             fallen = True
         if not fallen:
             out[rows[i], cols[i]] = True
+
+
+@_njit
+def outline_costs(
+    keys: np.ndarray, table: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, keep: int, band: float
+) -> np.ndarray:  # fmt: skip
+    """(k,) :meth:`symfruit.core.surface._Outline.cost` with ``exact=False`` of each shift (k, 2) ``(dv, du)``: the
+    outline points' flat indices ``at`` (n,) into the padded map's whole-number keys ``keys`` moved back by the
+    shift, put in order by counting them (the keys span a few hundred whole numbers a row), their values read from
+    ``table`` (a negative key from its end), the median's band (clipped to 0 .. ``band``) and the mean deviation of
+    the run of ``keep`` values nearest it (:meth:`~symfruit.core.surface._Outline._nearest_mean`'s search). The
+    twin's values, medians, bands and runs; the run's deviations summed in another order: within ``keep`` units in
+    the last place of the twin's fast costs, as those are of the exact ones."""
+    k, n = shifts.shape[0], at.shape[0]
+    size = table.shape[0]
+    out = np.empty(k)
+    row = np.empty(n, np.int64)
+    v = np.empty(n)
+    count = np.zeros(1, np.int64)
+    for s in range(k):
+        offset = shifts[s, 0] * width + shifts[s, 1]
+        low, top = np.int64(2**62), -np.int64(2**62)
+        for j in range(n):
+            key = np.int64(keys[at[j] - offset])
+            row[j] = key
+            low, top = min(low, key), max(top, key)
+        span = top - low + 1
+        if count.shape[0] < span:
+            count = np.zeros(span, np.int64)
+        for j in range(n):
+            count[row[j] - low] += 1
+        i = 0
+        for b in range(span):  # the keys in order, each bin emptied as it is read
+            c = count[b]
+            if c:
+                key = low + b
+                value = table[key if key >= 0 else size + key]
+                for _ in range(c):
+                    v[i] = value
+                    i += 1
+                count[b] = 0
+        median = 0.5 * (v[(n - 1) // 2] + v[n // 2]) if n % 2 == 0 else v[n // 2]
+        middle = min(max(median, 0.0), band)
+        start = 0  # the places where the run comes nearer by dropping its first value for the next (a prefix)
+        for j in range(n - keep):
+            start += middle - v[j] > v[j + keep] - middle
+        total = 0.0
+        for j in range(start, start + keep):
+            total += abs(v[j] - middle)
+        out[s] = total / keep
+    return out
+
+
+@_njit
+def _flood(image: np.ndarray, out: np.ndarray, stack: np.ndarray, top: int) -> None:
+    """Mark in ``out`` every pixel of ``image`` 4-connected through ``image`` to the marked pixels on ``stack`` (the
+    first ``top`` of it, flat indices)."""
+    h, w = image.shape
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
+            if 0 <= rr < h and 0 <= cc < w and image[rr, cc] and not out[rr, cc]:
+                out[rr, cc] = True
+                stack[top] = rr * w + cc
+                top += 1
+
+
+@_njit
+def connected(image: np.ndarray, seeds: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the pixels of the pieces of ``image`` (h, w) bool (4-connected, as ``ndimage.label``'s
+    default) holding a pixel of ``seeds`` (h, w) bool, by a flood fill: the twins' ``label`` and look-up, the same
+    pixels."""
+    h, w = image.shape
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = image[r, c] and seeds[r, c]
+            if out[r, c]:
+                stack[top] = r * w + c
+                top += 1
+    _flood(image, out, stack, top)
+
+
+@_njit
+def filled(mask: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: ``mask`` (h, w) bool with its holes filled (the 4-connected pieces of its background not
+    reaching the array's edge, :func:`symfruit.core.raster.fill_holes`' labelling), by a flood fill of the
+    background from the edge: the same pixels."""
+    h, w = mask.shape
+    background = np.empty((h, w), np.bool_)
+    reached = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            background[r, c] = not mask[r, c]
+            if background[r, c] and (r == 0 or c == 0 or r == h - 1 or c == w - 1):
+                reached[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    _flood(background, reached, stack, top)
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = not reached[r, c]

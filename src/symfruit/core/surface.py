@@ -417,7 +417,17 @@ class _Outline:
         to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way).
 
         Many shifts are costed a block of rows at a time (:data:`_BLOCK` values): the same rows, each block's arrays
-        staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame)."""
+        staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame). Where numba
+        is, the fast costs of a map with 16-bit keys come from the compiled twin of :meth:`_cost`
+        (:func:`symfruit.core._jit.outline_costs`: each row's keys put in order by counting, the same run of values,
+        summed in another order; 1.5x faster on the benchmark frame's coarse grid, issue 19's twelfth round)."""
+        if not exact and (jit := compiled()) is not None:  # the compiled twin of the fast costs, all rows at once
+            pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
+            if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:  # a row's keys: < 2**16 apart
+                width = self.inside.shape[1] + 2 * pad
+                at = (self.rows + pad) * width + (self.cols + pad)
+                keep = max(1, int(trim * len(self.rows)))
+                return jit.outline_costs(keys, self._table(pad, reach), at, shifts, width, keep, self.band)
         rows = max(1, _BLOCK // max(1, len(self.rows)))
         if len(shifts) > rows:
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))  # one pad for all blocks: one padded map
@@ -518,8 +528,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     surface = fruit_surface(depth, mask, focal, region=grown, inner=inner)
     if surface is None:
         return None
-    labels, _ = ndimage.label(surface.pixels)
-    cap = labels == labels[surface.apex]
+    cap = _connected(surface.pixels, surface.apex)
     rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
@@ -665,11 +674,29 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
         return mask
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
-    labels, n = ndimage.label(keep)
-    reached = np.zeros(n + 1, bool)  # the pieces holding fruit pixels, looked up by label (np.isin sorts)
-    reached[labels[fruit]] = True
+    return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.ndarray:
+    """(h, w) bool: the pieces of ``image`` (4-connected, ``ndimage.label``'s default) holding a pixel of ``seeds``
+    ((h, w) bool, or one pixel's row and column; a pixel outside ``image`` gives the background, label 0's pixels),
+    by labelling them, or by the compiled twin's flood fill (:func:`symfruit.core._jit.connected`: the same
+    pixels)."""
+    image = np.asarray(image, dtype=bool)
+    if (jit := compiled()) is not None and (not isinstance(seeds, tuple) or image[seeds]):
+        if isinstance(seeds, tuple):
+            at, seeds = seeds, np.zeros(image.shape, bool)
+            seeds[at] = True
+        out = np.empty(image.shape, bool)
+        jit.connected(image, seeds, out)
+        return out
+    labels, n = ndimage.label(image)
+    if isinstance(seeds, tuple):
+        return labels == labels[seeds]
+    reached = np.zeros(n + 1, bool)  # looked up by label (np.isin sorts)
+    reached[labels[seeds]] = True
     reached[0] = False
-    return fill_holes(reached[labels])
+    return reached[labels]
 
 
 def _colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
