@@ -13,7 +13,7 @@ import types
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
@@ -515,3 +515,225 @@ def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
     monkeypatch.setattr(fits, "_BRUTE_NEIGHBOURS", 300 * 30 - 1)
     with pytest.raises(AssertionError, match="tree"):
         fits.surface_noise(pts, queries=30)
+
+
+# --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.booleans())
+def test_distance_is_scipys_transform_to_the_bit(seed, h, w, want):
+    """Random blobs (whole rows and columns without a pixel of the kind, single pixels, thin parts)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.2))
+    if rng.random() < 0.2:
+        mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    if not (mask == want).any():
+        mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = want
+    out = np.full((h, w), -1.0)
+    _jit.distance(mask, want, out)
+    assert np.array_equal(out, ndimage.distance_transform_edt(mask != want))
+
+
+def test_distance_transform_is_scipys_with_and_without_the_kernel(monkeypatch):
+    """raster.distance_transform (and so inner_distance without a reach) on both paths: scipy's map to the bit; an
+    image without a false pixel, and an empty one, are left to scipy."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import distance_transform, inner_distance
+
+    rng = np.random.default_rng(11)
+    for image in (_blobs(rng, 90, 70, 0.3), np.ones((5, 7), bool), np.zeros((4, 3), bool), np.zeros((0, 3), bool)):
+        fast, twin = _both(monkeypatch, distance_transform, image)
+        assert np.array_equal(fast, twin) and np.array_equal(fast, ndimage.distance_transform_edt(image))
+    mask = np.zeros((60, 80), bool)
+    mask[5:50, 10:75] = _blobs(rng, 45, 65, 0.4)
+    fast, twin = _both(monkeypatch, inner_distance, mask)
+    assert np.array_equal(fast, twin) and np.array_equal(fast, ndimage.distance_transform_edt(mask))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 30))
+def test_taxicab_within_is_scipys(seed, h, w, reach):
+    from scipy import ndimage
+
+    from symfruit.core.surface import _taxicab_within
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.1))
+    mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True
+    out = np.empty((h, w), bool)
+    _jit.taxicab_within(mask, reach, out)
+    expected = ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach
+    assert np.array_equal(out, expected)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _taxicab_within, mask, reach)
+    assert np.array_equal(fast, expected) and np.array_equal(twin, expected)
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1, 3, 5]))
+def test_least_median_is_the_twins_first_least_median(seed, size):
+    """Coarse values (many equal medians: the first least is the one), +inf (pixels outside the slab), windows over
+    the image's edges."""
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 30, 2))
+    image = rng.choice([0.3, 0.31, 0.32, np.inf], size=(h, w), p=[0.2, 0.3, 0.3, 0.2])
+    if rng.random() < 0.5:
+        image = image + rng.normal(0, 0.01, (h, w)).round(2)
+    rows, cols = np.nonzero(rng.random((h, w)) < 0.5)
+    if not len(rows):
+        rows, cols = np.array([h // 2]), np.array([w // 2])
+    expected = int(np.argmin(median_at(image, rows, cols, size=size)))
+    assert _jit.least_median(image, rows, cols, size) == expected
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.float64, np.float32]), st.sampled_from([8, 72]))
+def test_monotone_region_is_the_twins(seed, dtype, bins):
+    """Coarse depths (equal depths, equal distances from the apex), holes in the kept pixels, the apex anywhere."""
+    from symfruit.core.surface import monotone_region
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    depth = np.round(rng.uniform(0.4, 0.45, (h, w)), int(rng.integers(2, 5))).astype(dtype)
+    keep = rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    apex = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    tol = float(rng.choice([0.0, 0.003, 0.0105, 0.02]))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, monotone_region, depth, keep, apex, tol, bins=bins)
+    assert np.array_equal(fast, twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.integers(1, 4), st.integers(1, 6))
+def test_colour_trims_features_k_means_and_test_are_the_twins_to_the_bit(seed, n, k, iterations):
+    """Colours on a coarse grid (equal features, rows as near two centres: the first is taken) and centres that
+    lose every row (kept)."""
+    from symfruit.core.surface import _colour_features, _kmeans, _nearer_fruit
+
+    rng = np.random.default_rng(seed)
+    color = rng.choice(np.arange(0, 256, 51), size=(int(rng.integers(1, 30)), int(rng.integers(1, 30)), 3))
+    color = color.astype(np.uint8)
+    where = rng.random(color.shape[:2]) < 0.5
+    assert np.array_equal(_jit.colour_features(color, where), _colour_features(color, where))
+    x = _colour_features(rng.choice(np.arange(0, 256, 51), size=(n, 1, 3)).astype(np.uint8), np.ones((n, 1), bool))
+    c = np.concatenate([x[rng.integers(0, n, k)], [[5.0, 5.0, 5.0]]])  # the last centre far from every row
+    assert np.array_equal(_jit.kmeans(x, c, iterations), _kmeans(x, c, iterations))
+    fruit, ground = x[rng.integers(0, n, k)], x[rng.integers(0, n, k)] + rng.choice([0.0, 0.01])
+    for margin in (1.0, 0.5):
+        assert np.array_equal(_jit.nearer_fruit(x, fruit, ground, margin), _nearer_fruit(x, fruit, ground, margin))
+
+
+def _ball_frame(seed: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(depth, mask, colour) of a noisy red ball on a table before a green wall, its mask drawn a pixel off
+    and overshooting by two (a 160 x 120 frame)."""
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:120, :160].astype(np.float64)
+    cu, cv, r = 80 + rng.uniform(-10, 10), 60 + rng.uniform(-8, 8), rng.uniform(14, 30)
+    d2 = ((xx - cu) ** 2 + (yy - cv) ** 2) / r**2
+    disc = d2 <= 1.0
+    depth = np.where(yy > cv, np.minimum(0.8, 0.5 + r * 0.5 / 600 - (yy - cv - r) * 0.002), 0.8)
+    depth = np.where(disc, 0.5 + r * 0.5 / 600 * (1.0 - np.sqrt(np.clip(1.0 - d2, 0.0, None))), depth)
+    depth = depth + rng.normal(0.0, 0.001, depth.shape)
+    depth[disc & (d2 > 0.85**2)] = 0.0  # the rim a time-of-flight camera invalidates
+    colour = np.where(disc[..., None], [200, 30, 30], [40, 160, 60]) + rng.integers(0, 30, (120, 160, 3))
+    du, dv = (int(x) for x in rng.integers(-1, 2, 2))
+    mask = np.roll(((xx - cu) ** 2 + (yy - cv) ** 2) <= (r + 2) ** 2, (dv, du), axis=(0, 1))
+    return depth, mask, colour.astype(np.uint8)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_surface_outline_and_colour_trim_are_the_twins(monkeypatch, seed):
+    """fruit_surface, the registration's outline and colour_trim with the kernels and with the numpy twins: the same
+    pixels, numbers and maps, to the bit."""
+    from symfruit.core.surface import _outline, colour_trim, fruit_surface, within
+
+    depth, mask, colour = _ball_frame(seed)
+    surface, surface_twin = _both(monkeypatch, fruit_surface, depth, mask, 600.0)
+    assert np.array_equal(surface.pixels, surface_twin.pixels)
+    assert (surface.front, surface.radius, surface.noise, surface.apex) == (
+        surface_twin.front, surface_twin.radius, surface_twin.noise, surface_twin.apex)  # fmt: skip
+    outline, outline_twin = _both(monkeypatch, _outline, depth, mask, 600.0, 20)
+    for a, b in ((outline.rows, outline_twin.rows), (outline.cols, outline_twin.cols),
+                 (outline.inside, outline_twin.inside)):  # fmt: skip
+        assert np.array_equal(a, b)
+    trimmed, trimmed_twin = _both(monkeypatch, colour_trim, colour, mask, band_px=4.0)
+    assert np.array_equal(trimmed, trimmed_twin) and not np.array_equal(trimmed, mask)
+    for radius in (0.0, 2.5, 5.0):
+        fast, twin = _both(monkeypatch, within, mask, radius)
+        assert np.array_equal(fast, twin)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900, 20000]), st.sampled_from([0.7, 0.5, 1.0, 0.01]))
+def test_the_outlines_fast_costs_are_the_twins_within_their_sums_rounding(seed, top, trim):
+    """The registration's fast costs (exact=False) of random maps of whole-number squares (int16 keys; ties) with
+    the kernel and with the numpy twin: the same run of values summed in another order, so within rounding (the
+    shift is then chosen by the exact costs, which the kernel leaves to numpy: the same shift)."""
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 60, 2))
+    inside = np.sqrt(rng.integers(1, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    n = int(rng.integers(1, 320))
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, float(rng.uniform(0.0, 6.0)))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach, reach + 1, (int(rng.integers(1, 60)), 2))
+    keys = outline.keys(reach, reach)
+    assert keys is not None and keys.dtype == np.int16  # the kernel's case
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, outline.cost, shifts, reach, trim, exact=False)
+    np.testing.assert_allclose(fast, twin, rtol=1e-13, atol=0.0)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_registration_shift_is_the_twins(monkeypatch, seed):
+    """Balls apart, their depth a few pixels off their masks (noisy or not, rims without depth): the same shift."""
+    from symfruit.core.surface import registration_shift
+
+    from .test_surface import ball
+
+    rng = np.random.default_rng(seed)
+    depth = np.full((120, 160), 0.8)
+    labels = np.zeros((120, 160), np.int32)
+    for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
+        d, disc = ball(centre=centre, radius_px=int(rng.integers(10, 20)), front=float(rng.uniform(0.4, 0.6)),
+                       rim=float(rng.uniform(0.0, 0.2)))  # fmt: skip
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[disc] = k + 1
+    if seed % 2:
+        depth = depth + rng.normal(0.0, 0.001, depth.shape)
+    shift = (int(rng.integers(-4, 5)), int(rng.integers(-4, 5)))
+    moved = np.roll(depth, shift, axis=(0, 1))
+    fast, twin = _both(monkeypatch, registration_shift, moved, labels, 600.0, max_px=10)
+    assert fast == twin == (shift[1], shift[0])
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_filled_and_connected_are_the_labellings(seed, h, w):
+    """Random blobs and speckle (pieces touching the edge, holes, pieces meeting at a corner only: apart, as the
+    4-connected labelling has them)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import fill_holes
+    from symfruit.core.surface import _connected
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.3)) if rng.random() < 0.5 else rng.random((h, w)) < rng.random()
+    out = np.empty((h, w), bool)
+    _jit.filled(mask, out)
+    assert np.array_equal(out, ndimage.binary_fill_holes(mask))
+    seeds = rng.random((h, w)) < rng.uniform(0.0, 0.05)
+    labels, _ = ndimage.label(mask)
+    expected = np.isin(labels, np.unique(labels[seeds & mask]))
+    _jit.connected(mask, seeds, out)
+    assert np.array_equal(out, expected)
+    at = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    with pytest.MonkeyPatch.context() as mp:
+        for fast, twin in (
+            _both(mp, fill_holes, mask),
+            _both(mp, _connected, mask, seeds),
+            _both(mp, _connected, mask, at),
+        ):
+            assert np.array_equal(fast, twin)
+    assert np.array_equal(_connected(mask, at), labels == labels[at])

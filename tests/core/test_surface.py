@@ -527,7 +527,8 @@ def test_the_costs_are_the_tenth_round_s_bit_for_bit(seed, top, trim, block):
     reach = int(rng.integers(1, 25))
     shifts = rng.integers(-reach, reach + 1, (int(rng.integers(1, 60)), 2))
     fast, exact = _costs_as_before(outline, shifts, reach, trim)
-    with mock.patch.object(surface, "_BLOCK", block or surface._BLOCK):
+    with mock.patch.object(surface, "_BLOCK", block or surface._BLOCK), pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")  # the numpy code (the compiled fast costs: tests/core/test_kernels.py)
         np.testing.assert_array_equal(outline.cost(shifts, reach, trim), exact)
         if fast is not None:
             np.testing.assert_array_equal(outline.cost(shifts, reach, trim, exact=False), fast)

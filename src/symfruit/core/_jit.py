@@ -864,3 +864,361 @@ def cone_result(
     if var < 0.0:
         var = 0.0
     return m, shape, True, math.sqrt(var) if all_valid else np.nan, math.sqrt(sigma2)
+
+
+@_njit
+def distance(mask: np.ndarray, want: bool, out: np.ndarray) -> None:
+    """``ndimage.distance_transform_edt`` of the pixels of ``mask`` (h, w) not equal to ``want`` (the twin's input:
+    each pixel's distance to the nearest pixel equal to ``want``, 0 on those), written into ``out`` (h, w); ``mask``
+    must hold such a pixel. Meijster's exact transform in whole numbers: each column's distance to its nearest such
+    pixel by two sweeps down the rows, then each row's lower envelope of the parabolas ``(u - i)^2 + g(i)^2``; the
+    same squared distances as scipy's exact feature transform, and the same square roots: its values to the bit."""
+    h, w = mask.shape
+    big = h + w  # farther than any pixel of the image: a column without such a pixel
+    g = np.empty((h, w), np.int64)
+    for c in range(w):
+        g[0, c] = 0 if mask[0, c] == want else big
+    for r in range(1, h):
+        for c in range(w):
+            g[r, c] = 0 if mask[r, c] == want else g[r - 1, c] + 1
+    for r in range(h - 2, -1, -1):
+        for c in range(w):
+            if g[r + 1, c] + 1 < g[r, c]:
+                g[r, c] = g[r + 1, c] + 1
+    f = np.empty(w, np.int64)
+    s = np.empty(w, np.int64)  # the envelope's parabolas (their columns), left to right
+    t = np.empty(w, np.int64)  # where each of them starts to be the least
+    for r in range(h):
+        for c in range(w):
+            f[c] = g[r, c] * g[r, c]
+        q = 0
+        s[0] = 0
+        t[0] = 0
+        for u in range(1, w):
+            while q >= 0:
+                a, b = t[q] - s[q], t[q] - u
+                if a * a + f[s[q]] <= b * b + f[u]:
+                    break
+                q -= 1
+            if q < 0:
+                q = 0
+                s[0] = u
+            else:
+                i = s[q]
+                start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
+                if start < w:
+                    q += 1
+                    s[q] = u
+                    t[q] = start
+        for u in range(w - 1, -1, -1):
+            a = u - s[q]
+            out[r, u] = math.sqrt(float(a * a + f[s[q]]))
+            if u == t[q]:
+                q -= 1
+
+
+@_njit
+def taxicab_within(mask: np.ndarray, reach: int, out: np.ndarray) -> None:
+    """``ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach`` (``mask`` (h, w) not empty) into ``out``
+    (h, w) bool: the pixels at most ``reach`` steps along rows and columns from a pixel of ``mask``, by the two
+    sweeps of the city-block chamfer (exact for this metric), in whole numbers."""
+    h, w = mask.shape
+    big = h + w
+    d = np.empty((h, w), np.int64)
+    for r in range(h):
+        for c in range(w):
+            v = 0 if mask[r, c] else big
+            if r > 0 and d[r - 1, c] + 1 < v:
+                v = d[r - 1, c] + 1
+            if c > 0 and d[r, c - 1] + 1 < v:
+                v = d[r, c - 1] + 1
+            d[r, c] = v
+    for r in range(h - 1, -1, -1):
+        for c in range(w - 1, -1, -1):
+            v = d[r, c]
+            if r + 1 < h and d[r + 1, c] + 1 < v:
+                v = d[r + 1, c] + 1
+            if c + 1 < w and d[r, c + 1] + 1 < v:
+                v = d[r, c + 1] + 1
+            d[r, c] = v
+            out[r, c] = v <= reach
+
+
+@_njit
+def colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.surface.colour_trim`'s features (n, 3) of the pixels ``where`` (h, w) bool of ``color``
+    (h, w, 3) uint8, in the pixels' order: chromaticity ``r / t``, ``g / t`` and brightness ``0.25 t / 765`` with
+    ``t = r + g + b + 1``, each operation the twin's in its order (the same values to the bit)."""
+    h, w = where.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += where[r, c]
+    out = np.empty((n, 3))
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if where[r, c]:
+                red, green, blue = float(color[r, c, 0]), float(color[r, c, 1]), float(color[r, c, 2])
+                total = red + green + blue + 1.0
+                out[i, 0] = red / total
+                out[i, 1] = green / total
+                out[i, 2] = 0.25 * total / (3 * 255.0)
+                i += 1
+    return out
+
+
+@_njit
+def _nearest_centre(x: np.ndarray, i: int, c: np.ndarray) -> tuple[int, float]:
+    """The first centre of ``c`` (k, 3) nearest row ``i`` of ``x``, and its squared distance (the twin's terms in
+    their order)."""
+    best, least = 0, np.inf
+    for j in range(c.shape[0]):
+        d0, d1, d2 = x[i, 0] - c[j, 0], x[i, 1] - c[j, 1], x[i, 2] - c[j, 2]
+        d = d0 * d0 + d1 * d1 + d2 * d2
+        if d < least or j == 0:
+            best, least = j, d
+    return best, least
+
+
+@_njit
+def kmeans(x: np.ndarray, c: np.ndarray, iterations: int) -> np.ndarray:
+    """:func:`symfruit.core.surface.colour_trim`'s summary: up to ``iterations`` rounds of k-means of the rows of
+    ``x`` (n, 3) from the centres ``c`` (k, 3), stopped when the labels repeat; the new centres (k, 3). Each row's
+    label the first nearest centre (``np.argmin``), each centre the mean of its rows added in order (the twin's
+    ``bincount``), a centre without rows kept: the twin's values to the bit."""
+    n, k = x.shape[0], c.shape[0]
+    c = c.copy()
+    label = np.empty(n, np.int64)
+    last = np.empty(n, np.int64)
+    count = np.empty(k, np.int64)
+    total = np.empty((k, 3))
+    for it in range(iterations):
+        same = it > 0
+        for i in range(n):
+            label[i] = _nearest_centre(x, i, c)[0]
+            same = same and label[i] == last[i]
+        if same:
+            break
+        last[:] = label
+        count[:] = 0
+        total[:] = 0.0
+        for i in range(n):
+            count[label[i]] += 1
+            for a in range(3):
+                total[label[i], a] += x[i, a]
+        for j in range(k):
+            if count[j] > 0:
+                for a in range(3):
+                    c[j, a] = total[j, a] / count[j]
+    return c
+
+
+@_njit
+def nearer_fruit(x: np.ndarray, fruit: np.ndarray, ground: np.ndarray, margin: float) -> np.ndarray:
+    """(n,) bool: ``margin`` times each row of ``x``'s (n, 3) least squared distance to the centres ``fruit`` is at
+    most its least to the centres ``ground`` (:func:`symfruit.core.surface.colour_trim`'s test; the same values)."""
+    n = x.shape[0]
+    out = np.empty(n, np.bool_)
+    for i in range(n):
+        out[i] = margin * _nearest_centre(x, i, fruit)[1] <= _nearest_centre(x, i, ground)[1]
+    return out
+
+
+@_njit
+def least_median(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, size: int) -> int:
+    """``np.argmin(median_at(image, rows, cols, size=size))`` (:func:`symfruit.core.surface.median_at`; ``image``
+    (h, w) without NaN, at least one pixel): the first of the pixels ``(rows, cols)`` whose ``size`` x ``size``
+    median (odd ``size``, edges repeated) is least. A pixel is passed over without its median when fewer than half
+    of its window's values lie below the least median so far (its median is then no less: not the first least);
+    the others' medians by an insertion sort, the same order statistic as the twin's partition."""
+    h, w = image.shape
+    half = size // 2
+    middle = size * size // 2
+    window = np.empty(size * size)
+    best, least = -1, np.inf
+    for i in range(rows.shape[0]):
+        r, c = rows[i], cols[i]
+        n = 0
+        below = 0
+        for dr in range(-half, half + 1):
+            rr = min(max(r + dr, 0), h - 1)
+            for dc in range(-half, half + 1):
+                v = image[rr, min(max(c + dc, 0), w - 1)]
+                window[n] = v
+                n += 1
+                below += v < least
+        if best >= 0 and below <= middle:
+            continue  # at most ``middle`` values below the least: the median is not below it
+        for a in range(1, n):
+            v = window[a]
+            b = a
+            while b > 0 and window[b - 1] > v:
+                window[b] = window[b - 1]
+                b -= 1
+            window[b] = v
+        if best < 0 or window[middle] < least:
+            best, least = i, window[middle]
+    return best
+
+
+@_njit
+def monotone(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, sector: np.ndarray, d2: np.ndarray, bins: int,
+    tolerance: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.surface.monotone_region` after its sectors: the pixels ``(rows, cols)`` (n,) of ``depth``
+    (h, w), in sectors ``sector`` (n,) of ``bins`` at squared distances ``d2`` (n,) from the apex, marked in ``out``
+    (h, w) bool where their sector's depth has not yet fallen more than ``tolerance`` below its running maximum.
+    The twin's order (by sector, then distance, then position: two stable counting sorts) and its arithmetic (the
+    running maximum of ``z + offset`` less the offset, each sector offset above the ones before): its pixels."""
+    n = rows.shape[0]
+    top = 0
+    for i in range(n):
+        top = max(top, d2[i])
+    count = np.zeros(top + 2, np.int64)
+    for i in range(n):
+        count[d2[i] + 1] += 1
+    for v in range(top + 1):
+        count[v + 1] += count[v]
+    by_d2 = np.empty(n, np.int64)
+    for i in range(n):
+        by_d2[count[d2[i]]] = i
+        count[d2[i]] += 1
+    start = np.zeros(bins + 1, np.int64)
+    for i in range(n):
+        start[sector[i] + 1] += 1
+    for s in range(bins):
+        start[s + 1] += start[s]
+    order = np.empty(n, np.int64)
+    for j in range(n):
+        i = by_d2[j]
+        order[start[sector[i]]] = i
+        start[sector[i]] += 1
+    z = np.empty(n)
+    biggest = 0.0
+    for j in range(n):
+        i = order[j]
+        z[j] = float(depth[rows[i], cols[i]])
+        biggest = max(biggest, abs(z[j]))
+    scale = 2.0 * (biggest + tolerance + 1.0)
+    running = -np.inf
+    last = -1
+    fallen = False
+    for j in range(n):
+        i = order[j]
+        s = sector[i]
+        if s != last:
+            last, fallen = s, False
+        offset = s * scale
+        running = max(running, z[j] + offset)
+        if z[j] < (running - offset) - tolerance:
+            fallen = True
+        if not fallen:
+            out[rows[i], cols[i]] = True
+
+
+@_njit
+def outline_costs(
+    keys: np.ndarray, table: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, keep: int, band: float
+) -> np.ndarray:  # fmt: skip
+    """(k,) :meth:`symfruit.core.surface._Outline.cost` with ``exact=False`` of each shift (k, 2) ``(dv, du)``: the
+    outline points' flat indices ``at`` (n,) into the padded map's whole-number keys ``keys`` moved back by the
+    shift, put in order by counting them (the keys span a few hundred whole numbers a row), their values read from
+    ``table`` (a negative key from its end), the median's band (clipped to 0 .. ``band``) and the mean deviation of
+    the run of ``keep`` values nearest it (:meth:`~symfruit.core.surface._Outline._nearest_mean`'s search). The
+    twin's values, medians, bands and runs; the run's deviations summed in another order: within ``keep`` units in
+    the last place of the twin's fast costs, as those are of the exact ones."""
+    k, n = shifts.shape[0], at.shape[0]
+    size = table.shape[0]
+    out = np.empty(k)
+    row = np.empty(n, np.int64)
+    v = np.empty(n)
+    count = np.zeros(1, np.int64)
+    for s in range(k):
+        offset = shifts[s, 0] * width + shifts[s, 1]
+        low, top = np.int64(2**62), -np.int64(2**62)
+        for j in range(n):
+            key = np.int64(keys[at[j] - offset])
+            row[j] = key
+            low, top = min(low, key), max(top, key)
+        span = top - low + 1
+        if count.shape[0] < span:
+            count = np.zeros(span, np.int64)
+        for j in range(n):
+            count[row[j] - low] += 1
+        i = 0
+        for b in range(span):  # the keys in order, each bin emptied as it is read
+            c = count[b]
+            if c:
+                key = low + b
+                value = table[key if key >= 0 else size + key]
+                for _ in range(c):
+                    v[i] = value
+                    i += 1
+                count[b] = 0
+        median = 0.5 * (v[(n - 1) // 2] + v[n // 2]) if n % 2 == 0 else v[n // 2]
+        middle = min(max(median, 0.0), band)
+        start = 0  # the places where the run comes nearer by dropping its first value for the next (a prefix)
+        for j in range(n - keep):
+            start += middle - v[j] > v[j + keep] - middle
+        total = 0.0
+        for j in range(start, start + keep):
+            total += abs(v[j] - middle)
+        out[s] = total / keep
+    return out
+
+
+@_njit
+def _flood(image: np.ndarray, out: np.ndarray, stack: np.ndarray, top: int) -> None:
+    """Mark in ``out`` every pixel of ``image`` 4-connected through ``image`` to the marked pixels on ``stack`` (the
+    first ``top`` of it, flat indices)."""
+    h, w = image.shape
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        for rr, cc in ((r - 1, c), (r + 1, c), (r, c - 1), (r, c + 1)):
+            if 0 <= rr < h and 0 <= cc < w and image[rr, cc] and not out[rr, cc]:
+                out[rr, cc] = True
+                stack[top] = rr * w + cc
+                top += 1
+
+
+@_njit
+def connected(image: np.ndarray, seeds: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the pixels of the pieces of ``image`` (h, w) bool (4-connected, as ``ndimage.label``'s
+    default) holding a pixel of ``seeds`` (h, w) bool, by a flood fill: the twins' ``label`` and look-up, the same
+    pixels."""
+    h, w = image.shape
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = image[r, c] and seeds[r, c]
+            if out[r, c]:
+                stack[top] = r * w + c
+                top += 1
+    _flood(image, out, stack, top)
+
+
+@_njit
+def filled(mask: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: ``mask`` (h, w) bool with its holes filled (the 4-connected pieces of its background not
+    reaching the array's edge, :func:`symfruit.core.raster.fill_holes`' labelling), by a flood fill of the
+    background from the edge: the same pixels."""
+    h, w = mask.shape
+    background = np.empty((h, w), np.bool_)
+    reached = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            background[r, c] = not mask[r, c]
+            if background[r, c] and (r == 0 or c == 0 or r == h - 1 or c == w - 1):
+                reached[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    _flood(background, reached, stack, top)
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = not reached[r, c]

@@ -16,7 +16,8 @@ towards the camera. :func:`registration_shift` finds how far the depth image sit
 shift that lays the outline of every fruit's depth cap parallel to its mask's outline, a band of the
 mask's rim (the grazing pixels a time-of-flight camera invalidates) allowed between them.
 
-Numpy and scipy only; images in, images and numbers out.
+Numpy and scipy only (or their compiled twins, :mod:`symfruit.core.kernels`, where numba is); images in, images and
+numbers out.
 """
 
 from __future__ import annotations
@@ -28,8 +29,9 @@ from typing import Literal
 import numpy as np
 from scipy import ndimage
 
+from .kernels import compiled
 from .points import median
-from .raster import eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
+from .raster import distance_transform, eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
 
 __all__ = [
     "Surface",
@@ -222,6 +224,9 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
     # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
     d2 = dy * dy + dx * dx
+    if (jit := compiled()) is not None:  # the compiled twin of what follows (the same pixels)
+        jit.monotone(depth, rows, cols, sector, d2, bins, float(tolerance), out)
+        return out
     order = _stable_order(sector * (int(d2.max()) + 1) + d2)
     at = (rows * keep.shape[1] + cols)[order]  # flat indices: np.take is faster than two index arrays
     z, sec = np.take(np.ascontiguousarray(depth).ravel(), at).astype(np.float64), sector[order]
@@ -333,8 +338,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         rows, cols = rows + r0, cols + c0
     else:
         rows, cols = np.nonzero(near & mask if (near & mask).any() else near)
-    smooth = median_at(np.where(near, depth, np.inf), rows, cols, size=5)
-    first = int(np.argmin(smooth))
+    if (jit := compiled()) is not None:  # the compiled twin of np.argmin(median_at(...)): the same pixel
+        first = int(jit.least_median(np.where(near, depth, np.inf), rows, cols, 5))
+    else:
+        first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
     apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
@@ -410,7 +417,17 @@ class _Outline:
         to within a few units in the last place (``(keep - 1) * 2**-53`` of it, relatively, each way).
 
         Many shifts are costed a block of rows at a time (:data:`_BLOCK` values): the same rows, each block's arrays
-        staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame)."""
+        staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame). Where numba
+        is, the fast costs of a map with 16-bit keys come from the compiled twin of :meth:`_cost`
+        (:func:`symfruit.core._jit.outline_costs`: each row's keys put in order by counting, the same run of values,
+        summed in another order; 1.5x faster on the benchmark frame's coarse grid, issue 19's twelfth round)."""
+        if not exact and (jit := compiled()) is not None:  # the compiled twin of the fast costs, all rows at once
+            pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
+            if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:  # a row's keys: < 2**16 apart
+                width = self.inside.shape[1] + 2 * pad
+                at = (self.rows + pad) * width + (self.cols + pad)
+                keep = max(1, int(trim * len(self.rows)))
+                return jit.outline_costs(keys, self._table(pad, reach), at, shifts, width, keep, self.band)
         rows = max(1, _BLOCK // max(1, len(self.rows)))
         if len(shifts) > rows:
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))  # one pad for all blocks: one padded map
@@ -506,19 +523,29 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
     """The outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it), or None."""
-    grown = ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach  # = binary_dilation, reach times
+    grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     inner = inner_distance(mask)
     surface = fruit_surface(depth, mask, focal, region=grown, inner=inner)
     if surface is None:
         return None
-    labels, _ = ndimage.label(surface.pixels)
-    cap = labels == labels[surface.apex]
+    cap = _connected(surface.pixels, surface.apex)
     rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
-    inside = inner - ndimage.distance_transform_edt(~mask)
+    inside = inner - distance_transform(~mask)
     return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
+
+
+def _taxicab_within(mask: np.ndarray, reach: int) -> np.ndarray:
+    """(h, w) bool: the pixels at most ``reach`` steps along rows and columns from a pixel of ``mask`` (not empty),
+    ``ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach``, or its compiled twin's
+    (:func:`symfruit.core._jit.taxicab_within`: the chamfer's two sweeps, the same pixels)."""
+    if (jit := compiled()) is not None and mask.any():
+        out = np.empty(mask.shape, bool)
+        jit.taxicab_within(mask, int(reach), out)
+        return out
+    return ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach
 
 
 def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
@@ -627,45 +654,80 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
         return mask
     color = np.asarray(color)
-
-    def feature(where: np.ndarray) -> np.ndarray:  # chromaticity and brightness of the pixels ``where``
-        rgb = color[where].astype(np.float64)
-        total = rgb[:, 0] + rgb[:, 1] + rgb[:, 2] + 1.0
-        return np.stack([rgb[:, 0] / total, rgb[:, 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
-
+    # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
+    jit = compiled() if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
+    feature = _colour_features if jit is None else jit.colour_features
+    kmeans = _kmeans if jit is None else jit.kmeans
     rng = np.random.default_rng(0)
 
     def summary(x: np.ndarray) -> np.ndarray:
         x = x[rng.choice(len(x), min(len(x), 400), replace=False)]
-        c = x[np.linspace(0, len(x) - 1, centres).astype(int)]
-        k, last = len(c), None
-        for _ in range(iterations):
-            label = np.argmin(_square_distances(x, c), axis=1)
-            if last is not None and np.array_equal(label, last):
-                break  # the same labels give the same centres, bit for bit, in every round left
-            last = label
-            # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
-            count = np.bincount(label, minlength=k)
-            total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
-            c = np.where(count[:, None] > 0, total.reshape(k, 3) / np.maximum(count, 1)[:, None], c)
-        return c
+        return kmeans(x, x[np.linspace(0, len(x) - 1, centres).astype(int)], iterations)
 
-    f_fruit, f_ring = feature(fruit), feature(ring)
+    f_fruit, f_ring = feature(color, fruit), feature(color, ring)
     fc, bc = summary(f_fruit), summary(f_ring)
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
-        to_fruit = _row_min(_square_distances(x, fc))
-        return margin * to_fruit <= _row_min(_square_distances(x, bc))
+        return (_nearer_fruit if jit is None else jit.nearer_fruit)(x, fc, bc, float(margin))
 
     if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
         return mask
     keep = mask.copy()
-    keep[band] = is_fruit(feature(band), margin)  # a mixed pixel on the outline, between the two, stays
-    labels, n = ndimage.label(keep)
-    reached = np.zeros(n + 1, bool)  # the pieces holding fruit pixels, looked up by label (np.isin sorts)
-    reached[labels[fruit]] = True
+    keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
+    return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.ndarray:
+    """(h, w) bool: the pieces of ``image`` (4-connected, ``ndimage.label``'s default) holding a pixel of ``seeds``
+    ((h, w) bool, or one pixel's row and column; a pixel outside ``image`` gives the background, label 0's pixels),
+    by labelling them, or by the compiled twin's flood fill (:func:`symfruit.core._jit.connected`: the same
+    pixels)."""
+    image = np.asarray(image, dtype=bool)
+    if (jit := compiled()) is not None and (not isinstance(seeds, tuple) or image[seeds]):
+        if isinstance(seeds, tuple):
+            at, seeds = seeds, np.zeros(image.shape, bool)
+            seeds[at] = True
+        out = np.empty(image.shape, bool)
+        jit.connected(image, seeds, out)
+        return out
+    labels, n = ndimage.label(image)
+    if isinstance(seeds, tuple):
+        return labels == labels[seeds]
+    reached = np.zeros(n + 1, bool)  # looked up by label (np.isin sorts)
+    reached[labels[seeds]] = True
     reached[0] = False
-    return fill_holes(reached[labels])
+    return reached[labels]
+
+
+def _colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
+    """(n, 3) :func:`colour_trim`'s features of the pixels ``where`` (h, w) bool of ``color`` (h, w, 3), in their
+    order: chromaticity and brightness. The compiled twin: :func:`symfruit.core._jit.colour_features`."""
+    rgb = color[where].astype(np.float64)
+    total = rgb[:, 0] + rgb[:, 1] + rgb[:, 2] + 1.0
+    return np.stack([rgb[:, 0] / total, rgb[:, 1] / total, 0.25 * total / (3 * 255.0)], axis=-1)
+
+
+def _kmeans(x: np.ndarray, c: np.ndarray, iterations: int) -> np.ndarray:
+    """(k, 3) the centres after up to ``iterations`` rounds of k-means of the rows ``x`` (n, 3) from the centres ``c``
+    (k, 3), stopped when the labels repeat (the same labels give the same centres, bit for bit, in every round
+    left). The compiled twin: :func:`symfruit.core._jit.kmeans`."""
+    k, last = len(c), None
+    for _ in range(iterations):
+        label = np.argmin(_square_distances(x, c), axis=1)
+        if last is not None and np.array_equal(label, last):
+            break
+        last = label
+        # each centre's mean by one bincount: the rows added in order, as x[label == k].mean(axis=0) does
+        count = np.bincount(label, minlength=k)
+        total = np.bincount((label[:, None] * 3 + np.arange(3)).ravel(), weights=x.ravel(), minlength=3 * k)
+        c = np.where(count[:, None] > 0, total.reshape(k, 3) / np.maximum(count, 1)[:, None], c)
+    return c
+
+
+def _nearer_fruit(x: np.ndarray, fruit: np.ndarray, ground: np.ndarray, margin: float) -> np.ndarray:
+    """(n,) bool: ``margin`` times each row of ``x``'s (n, 3) least squared distance to the centres ``fruit`` is at
+    most its least to the centres ``ground``. The compiled twin: :func:`symfruit.core._jit.nearer_fruit`."""
+    return margin * _row_min(_square_distances(x, fruit)) <= _row_min(_square_distances(x, ground))
 
 
 def within(mask: np.ndarray, radius: float) -> np.ndarray:
@@ -681,6 +743,10 @@ def within(mask: np.ndarray, radius: float) -> np.ndarray:
     r = int(np.floor(radius)) if radius >= 0 else -1
     if r < 0 or not mask.any():
         return np.zeros(mask.shape, bool)
+    if (jit := compiled()) is not None:  # the distances within reach, compiled (the same roots, compared alike)
+        near = np.empty(mask.shape)
+        jit.near_distance(mask, float(radius), True, near)
+        return near <= radius
     off = np.arange(-r, r + 1)
     disc = np.sqrt((off[:, None] ** 2 + off[None, :] ** 2).astype(np.float64)) <= radius
     half = (disc.sum(axis=1) - 1) // 2  # each row of the disc: the run -half..half about its centre

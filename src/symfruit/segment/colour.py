@@ -58,7 +58,7 @@ from scipy import ndimage
 
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
-from ..core.raster import fill_holes, mask_box
+from ..core.raster import distance_transform, fill_holes, mask_box
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -1062,7 +1062,7 @@ def _centres(
         step = 2
         found = _centres(region[::step, ::step], least / step, waist, loose, coarse=False)
         return [(a * step, b * step, r * step, f) for a, b, r, f in found if region[a * step, b * step]]
-    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
+    edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     if float(edt.max()) < least:
         return []
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
@@ -1255,7 +1255,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
     times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
     touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
-    edt = ndimage.distance_transform_edt(_pad1(region))[1:-1, 1:-1]
+    edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
     deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
     rows, cols = np.nonzero(deep)
