@@ -692,3 +692,35 @@ def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_an
     Image.fromarray(labels[:, :30]).save(tmp_path / "labels" / "p0.png")
     assert main(args) == 2
     _one_line_error(capsys, "labels/p0.png: labels are 30x24, the image 32x24")
+
+
+def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, capsys):
+    from PIL import Image
+
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "labels").mkdir()
+    color = np.zeros((24, 32, 3), np.uint8)
+    color[6:14, 2:12] = (200, 20, 20)
+    labels = np.zeros((24, 32), np.uint8)
+    labels[6:14, 2:12] = 1
+    for name in ("p0", "p1"):
+        Image.fromarray(color).save(tmp_path / "photos" / f"{name}.png")
+    Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
+    Image.fromarray(labels[:, :30]).save(tmp_path / "labels" / "p1.png")  # not the photograph's size
+    (tmp_path / "photos" / "p2.png").write_bytes(b"not a png")
+    box = [[2, 6, 11, 6, 11, 13, 2, 13]]
+    coco = {
+        "images": [{"id": k, "file_name": f"p{k}.png"} for k in range(3)],
+        "annotations": [{"id": k + 1, "image_id": k, "category_id": 1, "segmentation": box} for k in range(3)],
+    }
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    photos, truth, found = str(tmp_path / "photos"), str(tmp_path / "t.json"), str(tmp_path / "labels")
+    args = ["evaluate", "--protocol", "masks", "--images", photos, "--truth", truth, "--masks", found,
+            "--output", str(tmp_path / "res")]  # fmt: skip
+    assert main(args) == 1  # before: exit 2 at p1.png, nothing scored
+    out = capsys.readouterr().out
+    assert "1 images (2 skipped, below), 1 true fruit, 1 found" in out
+    assert "skipped p1.png: " in out and "labels/p1.png: labels are 30x24, the image 32x24" in out
+    assert "skipped p2.png: " in out and "photos/p2.png" in out
+    summary = json.loads(next((tmp_path / "res").glob("*/summary.json")).read_text())
+    assert sorted(summary["failed"]) == ["p1.png", "p2.png"] and summary["summary"]["skipped_images"] == 2

@@ -587,14 +587,17 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     iou = "-" if s["mean_best_iou"] is None else f"{s['mean_best_iou']:.3f}"
     share = "-" if s["matched_share"] is None else f"{s['matched_share']:.1%}"
     ms = "" if s["ms_median"] is None else f"; {s['ms_median']:.1f} ms per image (median), {s['ms_p90']:.1f} (p90)"
-    print(f"masks ({source}) on {what}: {s['images']} images, {s['true_fruit']} true fruit, {s['detections']} "
+    skipped = f" ({s['skipped_images']} skipped, below)" if s.get("skipped_images") else ""
+    print(f"masks ({source}) on {what}: {s['images']} images{skipped}, {s['true_fruit']} true fruit, {s['detections']} "
           f"found; mean best-match IoU {iou}; matched {s['matched']} ({share}), missed {s['missed']}, false "
           f"{s['false']} ({s['false_share']:.1%} of found){ms}")  # fmt: skip
     if s.get("crowd_regions"):
         print(f"{s['crowd_regions']} crowd regions (iscrowd) ignored as COCO does: not counted as fruit, and "
               f"{s['ignored_in_crowd']} regions found in them counted neither matched nor false")  # fmt: skip
+    for name, reason in ev.failed.items():
+        print(f"skipped {name}: {reason}")
     print(f"results: {folder} (masks.csv, summary.json, worst.png)")
-    return 0
+    return 1 if ev.failed else 0
 
 
 def _segment(args: argparse.Namespace) -> int:

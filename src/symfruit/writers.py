@@ -417,7 +417,8 @@ def draw_contact_sheet(entries: Any, *, tile: int = 256, columns: int = 4, thres
 
 def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, Any] | None = None) -> list[Path]:
     """Write a masks evaluation (:class:`symfruit.evaluate.masks.MaskEvaluation`) into ``folder``:
-    ``masks.csv`` (one row per image), ``summary.json`` (``meta`` and the summary) and ``worst.png``."""
+    ``masks.csv`` (one row per image scored), ``summary.json`` (``meta``, the summary and ``failed``: the images
+    skipped, name -> reason) and ``worst.png``."""
     import csv
     import io
     import math
@@ -437,7 +438,8 @@ def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, An
     with atomic_write(folder / "masks.csv", "w") as handle:
         handle.write(buf.getvalue())
     clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in evaluation.summary.items()}
-    write_json(folder / "summary.json", {**(meta or {}), "protocol": "masks", "summary": clean})
+    failed = dict(getattr(evaluation, "failed", {}))
+    write_json(folder / "summary.json", {**(meta or {}), "protocol": "masks", "summary": clean, "failed": failed})
     with atomic_write(folder / "worst.png", "wb") as handle:
         draw_contact_sheet(evaluation.worst).save(handle, format="PNG")
     return [folder / "masks.csv", folder / "summary.json", folder / "worst.png"]
