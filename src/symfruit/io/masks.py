@@ -89,8 +89,10 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
             xy = np.asarray(poly, dtype=np.float64)
             if xy.ndim != 1 or not np.isfinite(xy).all():
                 raise ValueError("polygon coordinates must be finite numbers")
+            if len(xy) % 2:  # one coordinate lost or one too many: which is unknown, so the outline is too
+                raise ValueError(f"a polygon has {len(xy)} coordinates, an odd number; it is x, y pairs")
             # far-off vertices are clipped (the drawn mask is the same inside the image)
-            xy = np.clip(xy[: len(xy) // 2 * 2].reshape(-1, 2), -4.0 * max(h, w), 5.0 * max(h, w))
+            xy = np.clip(xy.reshape(-1, 2), -4.0 * max(h, w), 5.0 * max(h, w))
             if len(xy) >= 3:
                 draw.polygon([tuple(p) for p in xy.tolist()], fill=1, outline=1)
         return np.asarray(img, dtype=bool)
