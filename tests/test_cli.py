@@ -724,3 +724,30 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
     assert "skipped p2.png: " in out and "photos/p2.png" in out
     summary = json.loads(next((tmp_path / "res").glob("*/summary.json")).read_text())
     assert sorted(summary["failed"]) == ["p1.png", "p2.png"] and summary["summary"]["skipped_images"] == 2
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [(["bench", "--workers", "2"], "bench --workers is for --recording; here it would be ignored"),
+     (["bench", "--frame", "--recording", "3"], "--recording and --frame are two kinds of bench; give one"),
+     (["bench", "--sensor", "azure-kinect"], "bench --sensor is for --frame"),
+     (["bench", "--segment", "--method", "raw"], "bench --method is for --frame or --recording"),
+     (["bench", "--recording", "2", "--repeat", "3"], "bench --repeat is for the cloud bench"),
+     (["bench", "--frame", "--points", "100"], "bench --points is for the cloud bench"),
+     (["bench", "--images", "x"], "bench --images is for --segment"),
+     (["bench", "--frame", "--profile", "--stages"], "--profile and --stages do not go together"),
+     (["bench", "--frame", "--profile", "--json"], "--profile and --json do not go together"),
+     (["bench", "--segment", "--scene", "apple-tree", "--size", "64x48"], "--scene and --size do not go together"),
+     (["evaluate", "--match", "id"], "evaluate --match is for --frames"),
+     (["evaluate", "--frames", "x", "--spheres", "y"], "--frames and --spheres are two evaluations"),
+     (["evaluate", "--frames", "x", "--protocol", "masks"], "--frames and --protocol masks are two evaluations"),
+     (["evaluate", "--truth", "t.json"], "evaluate --truth is for --protocol masks"),
+     (["evaluate", "--masks", "color"], "evaluate --masks is for --frames, --spheres or --protocol masks"),
+     (["evaluate", "--protocol", "masks", "--category", "2"], "--category is for --protocol masks with --images"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--no-depth"], "--no-depth is for")],
+)  # fmt: skip
+def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)
+    assert main([*args, "--output", "res"] if args[0] == "evaluate" else args) == 2
+    _one_line_error(capsys, message)
+    assert not list(tmp_path.iterdir())

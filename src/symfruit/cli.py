@@ -56,8 +56,8 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
 
 def _add_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="time `complete` on a fixed partial strawberry (the project benchmark)")
-    p.add_argument("--repeat", type=int, default=200, help="timed runs per case (default 200)")
-    p.add_argument("--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)")
+    p.add_argument("--repeat", type=int, default=None, help="timed runs per case (default 200)")
+    p.add_argument("--points", type=int, nargs="+", default=None, help="cloud sizes (default 600 3000)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
@@ -80,7 +80,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         help="instead: time the colour segmenter per image at --size (photos from --images, else synthetic)",
     )
     p.add_argument("--images", type=_path, help="with --segment: a folder of photographs (resized to --size)")
-    p.add_argument("--size", default="640x480", metavar="WxH",
+    p.add_argument("--size", default=None, metavar="WxH",
                    help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
     p.add_argument("--scene", choices=("apple-tree",), default=None,
                    help="with --segment: rendered apple-tree frames with depth (1920x1080, apple profile) instead "
@@ -92,7 +92,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--protocol",
         choices=("paper", "camera", "masks"),
-        default="paper",
+        default=None,
         help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views; masks: mask "
         "quality of a segmenter on photographs (--images, --truth) or on rendered scenes (--n, --seed)",
     )
@@ -130,7 +130,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
     p.add_argument("--frames", type=_path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
-    p.add_argument("--match", choices=("centre", "id"), default="centre",
+    p.add_argument("--match", choices=("centre", "id"), default=None,
                    help="--frames: match found fruit to the truth by their seen points' box centre within 3 cm "
                    "(default, Table 3's protocol) or by mask label = truth id (the frames' own masks drawn for the "
                    "truth, as those of `symfruit scenes --sensor`/`--scene apple-tree`: every completed fruit "
@@ -145,10 +145,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
-    p.add_argument("--category", type=int, default=1,
+    p.add_argument("--category", type=int, default=None,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
-    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
                    help="masks protocol on rendered scenes: table-top strawberries (default) or an apple tree's "
                    "canopy at 1.2-2 m through the Azure Kinect model (1920x1080; use with --fruit apple)")  # fmt: skip
 
@@ -251,7 +251,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("output", type=_path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
-    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
                    help="hanging strawberries (default) or an apple tree's canopy at 1.2-2 m through a real camera "
                    "model (the Azure Kinect unless --sensor), with the annotators' masks.png")  # fmt: skip
     p.add_argument("--ripe", type=int, default=None,
@@ -342,11 +342,48 @@ def _check_output_file(path: Path, suffix: str) -> None:
         raise FileFormatError(f"{path}: --output is a folder; give a file name ending in {suffix}")
 
 
+def _check_bench_options(args: argparse.Namespace) -> None:
+    """Refuse options the chosen kind of bench would ignore, and two kinds at once (one took over, unsaid)."""
+    from .errors import InputError
+
+    kinds = [k for k, on in (("--segment", args.segment), ("--recording", args.recording is not None),
+                             ("--frame", args.frame)) if on]  # fmt: skip
+    if len(kinds) > 1:
+        raise InputError(f"bench: {' and '.join(kinds)} are two kinds of bench; give one")
+    kind = kinds[0] if kinds else None
+    rules = (  # option, given, the kinds of bench it is for (None: the cloud bench)
+        ("--points", args.points is not None, (None,)),
+        ("--repeat", args.repeat is not None, (None, "--frame")),
+        ("--sensor", args.sensor is not None, ("--frame",)),
+        ("--method", args.method is not None, ("--frame", "--recording")),
+        ("--profile", args.profile, ("--frame",)),
+        ("--stages", args.stages, ("--frame",)),
+        ("--workers", args.workers is not None, ("--recording",)),
+        ("--images", args.images is not None, ("--segment",)),
+        ("--size", args.size is not None, ("--segment",)),
+        ("--scene", args.scene is not None, ("--segment",)),
+    )
+    for option, given, kinds_for in rules:
+        if given and kind not in kinds_for:
+            need = " or ".join(k or "the cloud bench (no --frame, --recording or --segment)" for k in kinds_for)
+            raise InputError(f"bench {option} is for {need}; here it would be ignored")
+    for a, b, on in (("--profile", "--stages", args.profile and args.stages),
+                     ("--profile", "--json", args.profile and args.json),
+                     ("--scene", "--images", args.scene is not None and args.images is not None),
+                     ("--scene", "--size", args.scene is not None and args.size is not None)):  # fmt: skip
+        if on:
+            raise InputError(f"bench {a} and {b} do not go together ({a} would take over, {b} ignored)")
+
+
 def _bench(args: argparse.Namespace) -> int:
     from .core.limits import MAX_CLOUD_POINTS
     from .errors import InputError
     from .evaluate.bench import machine, run_bench
 
+    _check_bench_options(args)
+    args.repeat = 200 if args.repeat is None else args.repeat
+    args.points = [600, 3000] if args.points is None else args.points
+    args.size = "640x480" if args.size is None else args.size
     if not 1 <= args.repeat <= 100_000 or any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
         raise InputError(f"--repeat must be 1-100000 and every --points 10-{MAX_CLOUD_POINTS} (the most a cloud file "
                          "may hold)")  # fmt: skip
@@ -444,6 +481,35 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_evaluate_options(args: argparse.Namespace) -> None:
+    """Refuse options the chosen evaluation would ignore (``--frames`` and ``--spheres`` together, or either with
+    a ``--protocol``: one took over, unsaid), then fill in the defaults."""
+    from .errors import InputError
+
+    kinds = [k for k, on in (("--frames", args.frames is not None), ("--spheres", args.spheres is not None),
+                             (f"--protocol {args.protocol}", args.protocol is not None)) if on]  # fmt: skip
+    if len(kinds) > 1:
+        raise InputError(f"evaluate: {' and '.join(kinds)} are two evaluations; give one")
+    masks, photos = args.protocol == "masks", args.images is not None or args.truth is not None
+    rules = (  # option, given, where it counts, what that is
+        ("--match", args.match is not None, args.frames is not None, "--frames"),
+        ("--masks", args.masks is not None, masks or args.frames is not None or args.spheres is not None,
+         "--frames, --spheres or --protocol masks"),
+        ("--images", args.images is not None, masks, "--protocol masks"),
+        ("--truth", args.truth is not None, masks, "--protocol masks"),
+        ("--category", args.category is not None, masks and photos, "--protocol masks with --images and --truth"),
+        ("--no-depth", args.no_depth, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
+        ("--scene", args.scene is not None, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
+    )  # fmt: skip
+    for option, given, counts, need in rules:
+        if given and not counts:
+            raise InputError(f"evaluate {option} is for {need}; here it would be ignored")
+    args.protocol = args.protocol or "paper"
+    args.match = args.match or "centre"
+    args.category = 1 if args.category is None else args.category
+    args.scene = args.scene or "strawberry"
+
+
 def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
@@ -451,6 +517,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .synthetic.shapes import FRUITS
     from .writers import check_results_root
 
+    _check_evaluate_options(args)
     check_results_root(args.output)  # before the work, not after it
     if args.protocol == "masks":
         return _evaluate_masks(args)
