@@ -8,7 +8,7 @@ import pytest
 
 from symfruit import FileFormatError, InputError
 from symfruit.core import limits
-from symfruit.core.limits import check_image_size, depth_metres, instance_labels
+from symfruit.core.limits import check_image_size, depth_metres, instance_labels, shown
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -121,3 +121,16 @@ def test_depth_in_raw_units_is_refused_with_a_clear_message():
         depth_metres(mm.astype(np.float32), "frame")
     ok = np.where(np.arange(64) % 2, 0.45, np.nan).astype(np.float32)[None].repeat(48, 0)
     assert depth_metres(ok, "frame") is ok and depth_metres(np.zeros((3, 3)), "f").shape == (3, 3)
+
+
+def test_a_long_bad_value_is_shown_shortened_in_messages():
+    assert shown(640) == "640" and shown(np.int64(7)) == "7" and shown(-(10**50)) == "-10000000000... (51 digits)"
+    assert shown("x" * 50) == "'xxxxxxxxxxxxxxxxxxx... (52 characters)" and shown(2.5) == "2.5"
+    assert shown(10**5000) == "a whole number of about 5001 digits"  # repr() itself refuses beyond 4300 digits
+    for width, height, message in (
+        (10**400, 480, r"^w: image is 10{11}\.\.\. \(401 digits\)x480 pixels; at most 16384 pixels a side are read$"),
+        (-(10**400), 480, r"^w: image is -10{10}\.\.\. \(401 digits\)x480 pixels; it must not be empty$"),
+        ("x" * 400, 480, r"^w: image size 'x{19}\.\.\. \(402 characters\)x480 is not whole numbers"),
+    ):  # before: every digit printed
+        with pytest.raises(InputError, match=message):
+            check_image_size(width, height, "w")

@@ -139,7 +139,7 @@ def test_rle_counts_must_cover_the_image():
         ([-1, 36], r"whole numbers 0-35, got -1"),
         ([1.5, 33.5], r"whole numbers 0-35, got 1\.5"),  # never cut to 1
         ([True, 34], r"whole numbers 0-35, got True"),
-        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 characters\)"),
+        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 digits\)"),
         (None, r"a list of run lengths or a compressed string, got NoneType"),
         ({"a": 1}, r"got dict"),
         ("\u00e9", r"only ASCII"),
