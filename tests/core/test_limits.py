@@ -41,7 +41,13 @@ def _numbers(cell: str) -> list[float]:
 def test_readme_limits_are_the_enforced_constants():
     table = _limits_table()
     image = _numbers(next(v for k, v in table.items() if k.startswith("an image")))
-    assert image[:3] == [limits.MAX_IMAGE_PIXELS, limits.MAX_IMAGE_SIDE, limits.MAX_FOCAL_PX]
+    assert image[:4] == [
+        limits.MAX_IMAGE_PIXELS,
+        limits.MAX_IMAGE_SIDE,
+        limits.MAX_FOCAL_PX,
+        limits.MAX_DISTORTION_COEFFS,
+    ]
+    assert "16 lens distortion coefficients" in next(v for k, v in table.items() if k.startswith("an image"))
     window = _numbers(next(v for k, v in table.items() if "window" in k))
     assert window == [limits.MAX_WINDOW_PIXELS]
     cloud = _numbers(next(v for k, v in table.items() if k.startswith("a cloud file")))
@@ -72,6 +78,7 @@ def test_the_modules_use_the_one_set_of_bounds():
     assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
     assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
     assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
+    assert intrinsics.MAX_DISTORTION_COEFFS is limits.MAX_DISTORTION_COEFFS
     from symfruit.segment import colour
 
     assert colour.MAX_PIECES is limits.MAX_PIECES == limits.MAX_INSTANCES  # README: "at most 1000 candidate pieces"

@@ -22,6 +22,7 @@ __all__ = [
     "MAX_CLOUD_POINTS",
     "MAX_COCO_BYTES",
     "MAX_DEPTH_METRES",
+    "MAX_DISTORTION_COEFFS",
     "MAX_FACES",
     "MAX_FOCAL_PX",
     "MAX_IMAGE_PIXELS",
@@ -49,6 +50,9 @@ MAX_IMAGE_SIDE = 16384
 MAX_IMAGE_PIXELS = 40_000_000
 #: Largest focal length and principal-point offset (pixels): a 16K sensor behind a 60x telephoto fits.
 MAX_FOCAL_PX = 1e6
+#: Most lens distortion coefficients read with a camera's intrinsics (OpenCV's largest model has 14; ROS
+#: ``rational_polynomial`` 8).
+MAX_DISTORTION_COEFFS = 16
 #: One fruit's window in the image (the rating's raster), pixels.
 MAX_WINDOW_PIXELS = 4_000_000
 #: Largest cloud read from a file (points), and largest text cloud (bytes).

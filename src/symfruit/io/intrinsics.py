@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.camera import Camera
-from ..core.limits import MAX_SETTINGS_BYTES, shown
+from ..core.limits import MAX_DISTORTION_COEFFS, MAX_SETTINGS_BYTES, shown
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
@@ -87,8 +87,7 @@ def camera_from_file_data(path: Path, data: Any) -> Camera:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
-#: Most distortion coefficients read (OpenCV's largest model has 14; ROS ``rational_polynomial`` 8).
-MAX_DISTORTION_COEFFS = 16
+#: Most distortion coefficients read: :data:`symfruit.core.limits.MAX_DISTORTION_COEFFS`.
 #: Distortion keys of the layouts: RealSense, ROS 1, ROS 2, camera_calibration_parsers.
 _DISTORTION_KEYS = ("coeffs", "D", "d", "distortion_coefficients")
 
