@@ -210,7 +210,7 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
     )
     where.add_argument("--workers", type=int, metavar="N", help="run the frames on a local Dask cluster of N worker "
                        "processes (127.0.0.1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=4, metavar="N",
+    p.add_argument("--chunk", type=int, default=None, metavar="N",
                    help="with --scheduler or --workers: frames per task (default 4)")  # fmt: skip
 
 
@@ -700,8 +700,10 @@ def _detect(args: argparse.Namespace) -> int:
     from .methods import get
 
     get(_method(args))
-    if not 1 <= args.chunk <= 10_000:  # refused whether or not a cluster uses it
+    if args.chunk is not None and not 1 <= args.chunk <= 10_000:  # refused whether or not a cluster uses it
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {args.chunk}")
+    if args.chunk is not None and not args.scheduler and args.workers is None:
+        raise InputError("--chunk (frames per Dask task) is for --scheduler or --workers; here it would be ignored")
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
@@ -713,7 +715,7 @@ def _detect(args: argparse.Namespace) -> int:
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
-                           workers=args.workers, chunk=args.chunk)  # fmt: skip
+                           workers=args.workers, chunk=args.chunk or 4)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
