@@ -115,6 +115,11 @@ def test_embedded_sample(capsys):
         (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
         (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
+        (
+            ["scenes", "out", "--seed", "1" + "0" * 400],
+            r"--seed must be a whole number >= 0 with --seed \+ --n at most 2\*\*63, got 10{11}\.\.\. \(401 digits\)$",
+        ),  # before: written, the seed printed whole
+        (["scenes", "out", "--seed", str(2**63 - 1), "--n", "2"], r"with --seed \+ --n at most 2\*\*63"),
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
         (["detect", "{sample}", "--output", "o", "--chunk", "0"], "--chunk must be between 1 and 10000"),
         (["evaluate", "--frames", "f", "--match", "id", "--masks", "color"], "--match id needs the frames' own masks"),

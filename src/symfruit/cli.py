@@ -798,8 +798,12 @@ def _scenes(args: argparse.Namespace) -> int:
     tree = args.scene == "apple-tree"
     ripe = (30 if tree else 6) if args.ripe is None else args.ripe
     unripe = (4 if tree else 2) if args.unripe is None else args.unripe
-    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50 or args.seed < 0:
-        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")
+    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50:
+        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50")
+    if not 0 <= args.seed <= 2**63 - args.n:  # as evaluate's seeds: every frame's seed below 2**63
+        from .core.limits import shown
+
+        raise InputError(f"--seed must be a whole number >= 0 with --seed + --n at most 2**63, got {shown(args.seed)}")
     sensor = None
     if args.sensor is not None or tree:
         from .synthetic.sensors import sensor_model
