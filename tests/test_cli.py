@@ -749,7 +749,10 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--truth", "t.json"], "evaluate --truth is for --protocol masks"),
      (["evaluate", "--masks", "color"], "evaluate --masks is for --frames, --spheres or --protocol masks"),
      (["evaluate", "--protocol", "masks", "--category", "2"], "--category is for --protocol masks with --images"),
-     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--no-depth"], "--no-depth is for")],
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--no-depth"], "--no-depth is for"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--n", "3"], "evaluate --n is for the"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--seed", "3"], "--seed is for the paper"),
+     (["evaluate", "--frames", "f", "--n", "3"], "--n is for the paper and camera protocols and --protocol masks")],
 )  # fmt: skip
 def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)

@@ -107,7 +107,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=None, help="first seed (default 0)")
     p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
     p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS), default="d435",
                    help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m), heldback (issue 11's measurement: "
@@ -491,6 +491,7 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
     if len(kinds) > 1:
         raise InputError(f"evaluate: {' and '.join(kinds)} are two evaluations; give one")
     masks, photos = args.protocol == "masks", args.images is not None or args.truth is not None
+    generated = not (masks and photos) and args.frames is None and args.spheres is None  # what --n and --seed make
     rules = (  # option, given, where it counts, what that is
         ("--match", args.match is not None, args.frames is not None, "--frames"),
         ("--masks", args.masks is not None, masks or args.frames is not None or args.spheres is not None,
@@ -500,6 +501,8 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         ("--category", args.category is not None, masks and photos, "--protocol masks with --images and --truth"),
         ("--no-depth", args.no_depth, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
         ("--scene", args.scene is not None, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
+        ("--n", args.n is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
+        ("--seed", args.seed is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
     )  # fmt: skip
     for option, given, counts, need in rules:
         if given and not counts:
@@ -508,6 +511,7 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
     args.match = args.match or "centre"
     args.category = 1 if args.category is None else args.category
     args.scene = args.scene or "strawberry"
+    args.seed = 0 if args.seed is None else args.seed
 
 
 def _evaluate(args: argparse.Namespace) -> int:
@@ -543,7 +547,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     if not 1 <= args.views <= 100_000 or (args.views > 1 and args.protocol != "camera"):
         raise InputError("--views must be 1-100000, and more than 1 only with --protocol camera")
     if not 0 <= args.seed < 2**63:
-        raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
+        from .core.limits import shown
+
+        raise InputError(f"--seed must be a whole number >= 0, got {shown(args.seed)}")
     if args.jobs is not None and not 1 <= args.jobs <= 256:
         raise InputError(f"--jobs must be between 1 and 256, got {args.jobs}")
     if args.spheres is not None:
@@ -642,7 +648,9 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
         if not 0 <= args.seed < 2**63:
-            raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
+            from .core.limits import shown
+
+            raise InputError(f"--seed must be a whole number >= 0, got {shown(args.seed)}")
         n = args.n or 20
         ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
         meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}
