@@ -115,6 +115,11 @@ def test_embedded_sample(capsys):
         (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
         (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
+        (
+            ["scenes", "out", "--seed", "1" + "0" * 400],
+            r"--seed must be a whole number >= 0 with --seed \+ --n at most 2\*\*63, got 10{11}\.\.\. \(401 digits\)$",
+        ),  # before: written, the seed printed whole
+        (["scenes", "out", "--seed", str(2**63 - 1), "--n", "2"], r"with --seed \+ --n at most 2\*\*63"),
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
         (["detect", "{sample}", "--output", "o", "--chunk", "0"], "--chunk must be between 1 and 10000"),
         (["evaluate", "--frames", "f", "--match", "id", "--masks", "color"], "--match id needs the frames' own masks"),
@@ -692,3 +697,65 @@ def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_an
     Image.fromarray(labels[:, :30]).save(tmp_path / "labels" / "p0.png")
     assert main(args) == 2
     _one_line_error(capsys, "labels/p0.png: labels are 30x24, the image 32x24")
+
+
+def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, capsys):
+    from PIL import Image
+
+    (tmp_path / "photos").mkdir()
+    (tmp_path / "labels").mkdir()
+    color = np.zeros((24, 32, 3), np.uint8)
+    color[6:14, 2:12] = (200, 20, 20)
+    labels = np.zeros((24, 32), np.uint8)
+    labels[6:14, 2:12] = 1
+    for name in ("p0", "p1"):
+        Image.fromarray(color).save(tmp_path / "photos" / f"{name}.png")
+    Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
+    Image.fromarray(labels[:, :30]).save(tmp_path / "labels" / "p1.png")  # not the photograph's size
+    (tmp_path / "photos" / "p2.png").write_bytes(b"not a png")
+    box = [[2, 6, 11, 6, 11, 13, 2, 13]]
+    coco = {
+        "images": [{"id": k, "file_name": f"p{k}.png"} for k in range(3)],
+        "annotations": [{"id": k + 1, "image_id": k, "category_id": 1, "segmentation": box} for k in range(3)],
+    }
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    photos, truth, found = str(tmp_path / "photos"), str(tmp_path / "t.json"), str(tmp_path / "labels")
+    args = ["evaluate", "--protocol", "masks", "--images", photos, "--truth", truth, "--masks", found,
+            "--output", str(tmp_path / "res")]  # fmt: skip
+    assert main(args) == 1  # before: exit 2 at p1.png, nothing scored
+    out = capsys.readouterr().out
+    assert "1 images (2 skipped, below), 1 true fruit, 1 found" in out
+    assert "skipped p1.png: " in out and "labels/p1.png: labels are 30x24, the image 32x24" in out
+    assert "skipped p2.png: " in out and "photos/p2.png" in out
+    summary = json.loads(next((tmp_path / "res").glob("*/summary.json")).read_text())
+    assert sorted(summary["failed"]) == ["p1.png", "p2.png"] and summary["summary"]["skipped_images"] == 2
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [(["bench", "--workers", "2"], "bench --workers is for --recording; here it would be ignored"),
+     (["bench", "--frame", "--recording", "3"], "--recording and --frame are two kinds of bench; give one"),
+     (["bench", "--sensor", "azure-kinect"], "bench --sensor is for --frame"),
+     (["bench", "--segment", "--method", "raw"], "bench --method is for --frame or --recording"),
+     (["bench", "--recording", "2", "--repeat", "3"], "bench --repeat is for the cloud bench"),
+     (["bench", "--frame", "--points", "100"], "bench --points is for the cloud bench"),
+     (["bench", "--images", "x"], "bench --images is for --segment"),
+     (["bench", "--frame", "--profile", "--stages"], "--profile and --stages do not go together"),
+     (["bench", "--frame", "--profile", "--json"], "--profile and --json do not go together"),
+     (["bench", "--segment", "--scene", "apple-tree", "--size", "64x48"], "--scene and --size do not go together"),
+     (["evaluate", "--match", "id"], "evaluate --match is for --frames"),
+     (["evaluate", "--frames", "x", "--spheres", "y"], "--frames and --spheres are two evaluations"),
+     (["evaluate", "--frames", "x", "--protocol", "masks"], "--frames and --protocol masks are two evaluations"),
+     (["evaluate", "--truth", "t.json"], "evaluate --truth is for --protocol masks"),
+     (["evaluate", "--masks", "color"], "evaluate --masks is for --frames, --spheres or --protocol masks"),
+     (["evaluate", "--protocol", "masks", "--category", "2"], "--category is for --protocol masks with --images"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--no-depth"], "--no-depth is for"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--n", "3"], "evaluate --n is for the"),
+     (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--seed", "3"], "--seed is for the paper"),
+     (["evaluate", "--frames", "f", "--n", "3"], "--n is for the paper and camera protocols and --protocol masks")],
+)  # fmt: skip
+def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
+    monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)
+    assert main([*args, "--output", "res"] if args[0] == "evaluate" else args) == 2
+    _one_line_error(capsys, message)
+    assert not list(tmp_path.iterdir())

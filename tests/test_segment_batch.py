@@ -58,6 +58,25 @@ def test_a_mask_source_that_raises_is_contained(tmp_path):
     assert len(report.failed) == 2 and all("RuntimeError: boom" in v for v in report.failed.values())
 
 
+def test_label_ids_beyond_16_bits_are_refused_naming_the_image_and_the_limit(tmp_path):
+    ids = [70000, 65535]  # p0.jpg, p1.jpg
+
+    def wide(color, depth=None, camera=None):
+        labels = np.zeros(color.shape[:2], np.int32)
+        labels[:4, :4] = ids.pop(0)
+        return labels
+
+    folder = _photos(tmp_path / "in")
+    report = segment_images([folder], output=tmp_path / "out", masks=wide)
+    assert [d.path.name for d in report.done] == ["p1.jpg"]  # 65535 fits
+    failed = report.failed[str(folder / "p0.jpg")]  # before: "out/p0.png: labels must be 0-65535 ..."
+    assert failed == (
+        f"{folder / 'p0.jpg'}: the mask source (wide) gave label id 70000; a 16-bit label PNG holds "
+        "ids up to 65535: number the fruit 1..k"
+    )
+    assert not (tmp_path / "out" / "p0.png").exists()
+
+
 def test_a_photo_turned_by_its_exif_orientation_is_segmented_as_displayed_and_stored_depth_refused(tmp_path):
     color, _ = make_photo([(80, 120, 40, RED)], seed=0)  # 320x240, the fruit left of centre
     exif = Image.Exif()

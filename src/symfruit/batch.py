@@ -636,7 +636,7 @@ def segment_images(
         output folder.
     """
     from .io.images import read_color_oriented, turned_mismatch
-    from .writers import write_label_overlay, write_labels
+    from .writers import MAX_LABEL_PNG_ID, write_label_overlay, write_labels
 
     images = expand_images(paths)
     depth_path = Path(depth) if depth is not None else None
@@ -679,6 +679,10 @@ def segment_images(
                         raise InputError(f"{path.name}: the mask source gave labels {labels.dtype} {labels.shape}, "
                                          f"the image is {color.shape[1]}x{color.shape[0]}")  # fmt: skip
                     labels = instance_labels(labels, f"{path.name}: the mask source's labels")
+                    top = int(labels.max()) if labels.size else 0
+                    if top > MAX_LABEL_PNG_ID:  # refused, not renumbered: a label's id is what masks match by
+                        raise InputError(f"{path}: the mask source ({source}) gave label id {top}; a 16-bit label "
+                                         f"PNG holds ids up to {MAX_LABEL_PNG_ID}: number the fruit 1..k")  # fmt: skip
                     written = (write_labels(targets[0], labels),
                                write_label_overlay(targets[1], color, labels))  # fmt: skip
                     used = z is not None and bool((z > 0).any())

@@ -56,8 +56,8 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
 
 def _add_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="time `complete` on a fixed partial strawberry (the project benchmark)")
-    p.add_argument("--repeat", type=int, default=200, help="timed runs per case (default 200)")
-    p.add_argument("--points", type=int, nargs="+", default=[600, 3000], help="cloud sizes (default 600 3000)")
+    p.add_argument("--repeat", type=int, default=None, help="timed runs per case (default 200)")
+    p.add_argument("--points", type=int, nargs="+", default=None, help="cloud sizes (default 600 3000)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
@@ -80,7 +80,7 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
         help="instead: time the colour segmenter per image at --size (photos from --images, else synthetic)",
     )
     p.add_argument("--images", type=_path, help="with --segment: a folder of photographs (resized to --size)")
-    p.add_argument("--size", default="640x480", metavar="WxH",
+    p.add_argument("--size", default=None, metavar="WxH",
                    help="with --segment: the image size timed (default 640x480; e.g. 1920x1080)")  # fmt: skip
     p.add_argument("--scene", choices=("apple-tree",), default=None,
                    help="with --segment: rendered apple-tree frames with depth (1920x1080, apple profile) instead "
@@ -92,7 +92,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--protocol",
         choices=("paper", "camera", "masks"),
-        default="paper",
+        default=None,
         help="paper: Ge et al. Algorithm 2 (19 poses about x); camera: rendered D435-like views; masks: mask "
         "quality of a segmenter on photographs (--images, --truth) or on rendered scenes (--n, --seed)",
     )
@@ -107,7 +107,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=None, help="first seed (default 0)")
     p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
     p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS), default="d435",
                    help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m), heldback (issue 11's measurement: "
@@ -130,7 +130,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="every method's defaults for every fruit (as complete() without settings), no fruit profile",
     )
     p.add_argument("--frames", type=_path, help="instead of a protocol: Table 3 on a folder of frames with truth.json")
-    p.add_argument("--match", choices=("centre", "id"), default="centre",
+    p.add_argument("--match", choices=("centre", "id"), default=None,
                    help="--frames: match found fruit to the truth by their seen points' box centre within 3 cm "
                    "(default, Table 3's protocol) or by mask label = truth id (the frames' own masks drawn for the "
                    "truth, as those of `symfruit scenes --sensor`/`--scene apple-tree`: every completed fruit "
@@ -145,10 +145,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
-    p.add_argument("--category", type=int, default=1,
+    p.add_argument("--category", type=int, default=None,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
-    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
                    help="masks protocol on rendered scenes: table-top strawberries (default) or an apple tree's "
                    "canopy at 1.2-2 m through the Azure Kinect model (1920x1080; use with --fruit apple)")  # fmt: skip
 
@@ -210,7 +210,7 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
     )
     where.add_argument("--workers", type=int, metavar="N", help="run the frames on a local Dask cluster of N worker "
                        "processes (127.0.0.1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=4, metavar="N",
+    p.add_argument("--chunk", type=int, default=None, metavar="N",
                    help="with --scheduler or --workers: frames per task (default 4)")  # fmt: skip
 
 
@@ -251,7 +251,7 @@ def _parser() -> argparse.ArgumentParser:
     p.add_argument("output", type=_path, help="folder to write scene_00000, scene_00001, ... into")
     p.add_argument("--n", type=int, default=12, help="frames (default 12)")
     p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
-    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default="strawberry",
+    p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
                    help="hanging strawberries (default) or an apple tree's canopy at 1.2-2 m through a real camera "
                    "model (the Azure Kinect unless --sensor), with the annotators' masks.png")  # fmt: skip
     p.add_argument("--ripe", type=int, default=None,
@@ -342,11 +342,48 @@ def _check_output_file(path: Path, suffix: str) -> None:
         raise FileFormatError(f"{path}: --output is a folder; give a file name ending in {suffix}")
 
 
+def _check_bench_options(args: argparse.Namespace) -> None:
+    """Refuse options the chosen kind of bench would ignore, and two kinds at once (one took over, unsaid)."""
+    from .errors import InputError
+
+    kinds = [k for k, on in (("--segment", args.segment), ("--recording", args.recording is not None),
+                             ("--frame", args.frame)) if on]  # fmt: skip
+    if len(kinds) > 1:
+        raise InputError(f"bench: {' and '.join(kinds)} are two kinds of bench; give one")
+    kind = kinds[0] if kinds else None
+    rules = (  # option, given, the kinds of bench it is for (None: the cloud bench)
+        ("--points", args.points is not None, (None,)),
+        ("--repeat", args.repeat is not None, (None, "--frame")),
+        ("--sensor", args.sensor is not None, ("--frame",)),
+        ("--method", args.method is not None, ("--frame", "--recording")),
+        ("--profile", args.profile, ("--frame",)),
+        ("--stages", args.stages, ("--frame",)),
+        ("--workers", args.workers is not None, ("--recording",)),
+        ("--images", args.images is not None, ("--segment",)),
+        ("--size", args.size is not None, ("--segment",)),
+        ("--scene", args.scene is not None, ("--segment",)),
+    )
+    for option, given, kinds_for in rules:
+        if given and kind not in kinds_for:
+            need = " or ".join(k or "the cloud bench (no --frame, --recording or --segment)" for k in kinds_for)
+            raise InputError(f"bench {option} is for {need}; here it would be ignored")
+    for a, b, on in (("--profile", "--stages", args.profile and args.stages),
+                     ("--profile", "--json", args.profile and args.json),
+                     ("--scene", "--images", args.scene is not None and args.images is not None),
+                     ("--scene", "--size", args.scene is not None and args.size is not None)):  # fmt: skip
+        if on:
+            raise InputError(f"bench {a} and {b} do not go together ({a} would take over, {b} ignored)")
+
+
 def _bench(args: argparse.Namespace) -> int:
     from .core.limits import MAX_CLOUD_POINTS
     from .errors import InputError
     from .evaluate.bench import machine, run_bench
 
+    _check_bench_options(args)
+    args.repeat = 200 if args.repeat is None else args.repeat
+    args.points = [600, 3000] if args.points is None else args.points
+    args.size = "640x480" if args.size is None else args.size
     if not 1 <= args.repeat <= 100_000 or any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
         raise InputError(f"--repeat must be 1-100000 and every --points 10-{MAX_CLOUD_POINTS} (the most a cloud file "
                          "may hold)")  # fmt: skip
@@ -444,6 +481,39 @@ def _bench(args: argparse.Namespace) -> int:
     return 0
 
 
+def _check_evaluate_options(args: argparse.Namespace) -> None:
+    """Refuse options the chosen evaluation would ignore (``--frames`` and ``--spheres`` together, or either with
+    a ``--protocol``: one took over, unsaid), then fill in the defaults."""
+    from .errors import InputError
+
+    kinds = [k for k, on in (("--frames", args.frames is not None), ("--spheres", args.spheres is not None),
+                             (f"--protocol {args.protocol}", args.protocol is not None)) if on]  # fmt: skip
+    if len(kinds) > 1:
+        raise InputError(f"evaluate: {' and '.join(kinds)} are two evaluations; give one")
+    masks, photos = args.protocol == "masks", args.images is not None or args.truth is not None
+    generated = not (masks and photos) and args.frames is None and args.spheres is None  # what --n and --seed make
+    rules = (  # option, given, where it counts, what that is
+        ("--match", args.match is not None, args.frames is not None, "--frames"),
+        ("--masks", args.masks is not None, masks or args.frames is not None or args.spheres is not None,
+         "--frames, --spheres or --protocol masks"),
+        ("--images", args.images is not None, masks, "--protocol masks"),
+        ("--truth", args.truth is not None, masks, "--protocol masks"),
+        ("--category", args.category is not None, masks and photos, "--protocol masks with --images and --truth"),
+        ("--no-depth", args.no_depth, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
+        ("--scene", args.scene is not None, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
+        ("--n", args.n is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
+        ("--seed", args.seed is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
+    )  # fmt: skip
+    for option, given, counts, need in rules:
+        if given and not counts:
+            raise InputError(f"evaluate {option} is for {need}; here it would be ignored")
+    args.protocol = args.protocol or "paper"
+    args.match = args.match or "centre"
+    args.category = 1 if args.category is None else args.category
+    args.scene = args.scene or "strawberry"
+    args.seed = 0 if args.seed is None else args.seed
+
+
 def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
@@ -451,6 +521,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .synthetic.shapes import FRUITS
     from .writers import check_results_root
 
+    _check_evaluate_options(args)
     check_results_root(args.output)  # before the work, not after it
     if args.protocol == "masks":
         return _evaluate_masks(args)
@@ -476,7 +547,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     if not 1 <= args.views <= 100_000 or (args.views > 1 and args.protocol != "camera"):
         raise InputError("--views must be 1-100000, and more than 1 only with --protocol camera")
     if not 0 <= args.seed < 2**63:
-        raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
+        from .core.limits import shown
+
+        raise InputError(f"--seed must be a whole number >= 0, got {shown(args.seed)}")
     if args.jobs is not None and not 1 <= args.jobs <= 256:
         raise InputError(f"--jobs must be between 1 and 256, got {args.jobs}")
     if args.spheres is not None:
@@ -575,7 +648,9 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         if args.n is not None and not 1 <= args.n <= 10_000:
             raise InputError("--n must be 1-10000 scenes")
         if not 0 <= args.seed < 2**63:
-            raise InputError(f"--seed must be a whole number >= 0, got {args.seed}")
+            from .core.limits import shown
+
+            raise InputError(f"--seed must be a whole number >= 0, got {shown(args.seed)}")
         n = args.n or 20
         ev = evaluate_scene_masks(range(args.seed, args.seed + n), run, depth=not args.no_depth, scene=args.scene)
         meta = {"scenes": n, "seed": args.seed, "depth": not args.no_depth, "scene": args.scene}
@@ -587,14 +662,17 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     iou = "-" if s["mean_best_iou"] is None else f"{s['mean_best_iou']:.3f}"
     share = "-" if s["matched_share"] is None else f"{s['matched_share']:.1%}"
     ms = "" if s["ms_median"] is None else f"; {s['ms_median']:.1f} ms per image (median), {s['ms_p90']:.1f} (p90)"
-    print(f"masks ({source}) on {what}: {s['images']} images, {s['true_fruit']} true fruit, {s['detections']} "
+    skipped = f" ({s['skipped_images']} skipped, below)" if s.get("skipped_images") else ""
+    print(f"masks ({source}) on {what}: {s['images']} images{skipped}, {s['true_fruit']} true fruit, {s['detections']} "
           f"found; mean best-match IoU {iou}; matched {s['matched']} ({share}), missed {s['missed']}, false "
           f"{s['false']} ({s['false_share']:.1%} of found){ms}")  # fmt: skip
     if s.get("crowd_regions"):
         print(f"{s['crowd_regions']} crowd regions (iscrowd) ignored as COCO does: not counted as fruit, and "
               f"{s['ignored_in_crowd']} regions found in them counted neither matched nor false")  # fmt: skip
+    for name, reason in ev.failed.items():
+        print(f"skipped {name}: {reason}")
     print(f"results: {folder} (masks.csv, summary.json, worst.png)")
-    return 0
+    return 1 if ev.failed else 0
 
 
 def _segment(args: argparse.Namespace) -> int:
@@ -630,8 +708,10 @@ def _detect(args: argparse.Namespace) -> int:
     from .methods import get
 
     get(_method(args))
-    if not 1 <= args.chunk <= 10_000:  # refused whether or not a cluster uses it
+    if args.chunk is not None and not 1 <= args.chunk <= 10_000:  # refused whether or not a cluster uses it
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {args.chunk}")
+    if args.chunk is not None and not args.scheduler and args.workers is None:
+        raise InputError("--chunk (frames per Dask task) is for --scheduler or --workers; here it would be ignored")
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
@@ -643,7 +723,7 @@ def _detect(args: argparse.Namespace) -> int:
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
-                           workers=args.workers, chunk=args.chunk)  # fmt: skip
+                           workers=args.workers, chunk=args.chunk or 4)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
@@ -726,8 +806,12 @@ def _scenes(args: argparse.Namespace) -> int:
     tree = args.scene == "apple-tree"
     ripe = (30 if tree else 6) if args.ripe is None else args.ripe
     unripe = (4 if tree else 2) if args.unripe is None else args.unripe
-    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50 or args.seed < 0:
-        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50, --seed >= 0")
+    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50:
+        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50")
+    if not 0 <= args.seed <= 2**63 - args.n:  # as evaluate's seeds: every frame's seed below 2**63
+        from .core.limits import shown
+
+        raise InputError(f"--seed must be a whole number >= 0 with --seed + --n at most 2**63, got {shown(args.seed)}")
     sensor = None
     if args.sensor is not None or tree:
         from .synthetic.sensors import sensor_model

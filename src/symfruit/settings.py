@@ -287,8 +287,9 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         except OverflowError:  # a whole number of hundreds of digits: beyond any float
             finite = False
         if not finite:
-            shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:20]}..."
-            raise ConfigError(f"{where}: expected a finite number, got {shown}")
+            from .core.limits import shown
+
+            raise ConfigError(f"{where}: expected a finite number, got {shown(value)}")
         return float(value)
     if hint is str:
         if not isinstance(value, str):

@@ -347,6 +347,10 @@ def draw_label_overlay(color: np.ndarray, labels: np.ndarray, *, alpha: float = 
     return out
 
 
+#: Largest label id a 16-bit label PNG holds.
+MAX_LABEL_PNG_ID = 65535
+
+
 def write_labels(path: str | Path, labels: np.ndarray) -> Path:
     """Write instance labels as a 16-bit greyscale PNG (0 background, 1..k fruit).
 
@@ -363,8 +367,8 @@ def write_labels(path: str | Path, labels: np.ndarray) -> Path:
         raise FileFormatError(f"{path}: instance labels are written as .png")
     if labels.ndim != 2 or not np.issubdtype(labels.dtype, np.integer):
         raise FileFormatError(f"{path}: labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
-    if labels.size and (labels.min() < 0 or labels.max() > 65535):
-        raise FileFormatError(f"{path}: labels must be 0-65535 to fit a 16-bit PNG")
+    if labels.size and (labels.min() < 0 or labels.max() > MAX_LABEL_PNG_ID):
+        raise FileFormatError(f"{path}: labels must be 0-{MAX_LABEL_PNG_ID} to fit a 16-bit PNG")
     with atomic_write(path, "wb") as handle:
         Image.fromarray(labels.astype(np.uint16)).save(handle, format="PNG")
     return path
@@ -417,7 +421,8 @@ def draw_contact_sheet(entries: Any, *, tile: int = 256, columns: int = 4, thres
 
 def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, Any] | None = None) -> list[Path]:
     """Write a masks evaluation (:class:`symfruit.evaluate.masks.MaskEvaluation`) into ``folder``:
-    ``masks.csv`` (one row per image), ``summary.json`` (``meta`` and the summary) and ``worst.png``."""
+    ``masks.csv`` (one row per image scored), ``summary.json`` (``meta``, the summary and ``failed``: the images
+    skipped, name -> reason) and ``worst.png``."""
     import csv
     import io
     import math
@@ -437,7 +442,8 @@ def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, An
     with atomic_write(folder / "masks.csv", "w") as handle:
         handle.write(buf.getvalue())
     clean = {k: (None if isinstance(v, float) and not math.isfinite(v) else v) for k, v in evaluation.summary.items()}
-    write_json(folder / "summary.json", {**(meta or {}), "protocol": "masks", "summary": clean})
+    failed = dict(getattr(evaluation, "failed", {}))
+    write_json(folder / "summary.json", {**(meta or {}), "protocol": "masks", "summary": clean, "failed": failed})
     with atomic_write(folder / "worst.png", "wb") as handle:
         draw_contact_sheet(evaluation.worst).save(handle, format="PNG")
     return [folder / "masks.csv", folder / "summary.json", folder / "worst.png"]

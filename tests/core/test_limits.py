@@ -8,7 +8,7 @@ import pytest
 
 from symfruit import FileFormatError, InputError
 from symfruit.core import limits
-from symfruit.core.limits import check_image_size, depth_metres, instance_labels
+from symfruit.core.limits import check_image_size, depth_metres, instance_labels, shown
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -41,7 +41,13 @@ def _numbers(cell: str) -> list[float]:
 def test_readme_limits_are_the_enforced_constants():
     table = _limits_table()
     image = _numbers(next(v for k, v in table.items() if k.startswith("an image")))
-    assert image[:3] == [limits.MAX_IMAGE_PIXELS, limits.MAX_IMAGE_SIDE, limits.MAX_FOCAL_PX]
+    assert image[:4] == [
+        limits.MAX_IMAGE_PIXELS,
+        limits.MAX_IMAGE_SIDE,
+        limits.MAX_FOCAL_PX,
+        limits.MAX_DISTORTION_COEFFS,
+    ]
+    assert "16 lens distortion coefficients" in next(v for k, v in table.items() if k.startswith("an image"))
     window = _numbers(next(v for k, v in table.items() if "window" in k))
     assert window == [limits.MAX_WINDOW_PIXELS]
     cloud = _numbers(next(v for k, v in table.items() if k.startswith("a cloud file")))
@@ -72,6 +78,7 @@ def test_the_modules_use_the_one_set_of_bounds():
     assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
     assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
     assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
+    assert intrinsics.MAX_DISTORTION_COEFFS is limits.MAX_DISTORTION_COEFFS
     from symfruit.segment import colour
 
     assert colour.MAX_PIECES is limits.MAX_PIECES == limits.MAX_INSTANCES  # README: "at most 1000 candidate pieces"
@@ -121,3 +128,16 @@ def test_depth_in_raw_units_is_refused_with_a_clear_message():
         depth_metres(mm.astype(np.float32), "frame")
     ok = np.where(np.arange(64) % 2, 0.45, np.nan).astype(np.float32)[None].repeat(48, 0)
     assert depth_metres(ok, "frame") is ok and depth_metres(np.zeros((3, 3)), "f").shape == (3, 3)
+
+
+def test_a_long_bad_value_is_shown_shortened_in_messages():
+    assert shown(640) == "640" and shown(np.int64(7)) == "7" and shown(-(10**50)) == "-10000000000... (51 digits)"
+    assert shown("x" * 50) == "'xxxxxxxxxxxxxxxxxxx... (52 characters)" and shown(2.5) == "2.5"
+    assert shown(10**5000) == "a whole number of about 5001 digits"  # repr() itself refuses beyond 4300 digits
+    for width, height, message in (
+        (10**400, 480, r"^w: image is 10{11}\.\.\. \(401 digits\)x480 pixels; at most 16384 pixels a side are read$"),
+        (-(10**400), 480, r"^w: image is -10{10}\.\.\. \(401 digits\)x480 pixels; it must not be empty$"),
+        ("x" * 400, 480, r"^w: image size 'x{19}\.\.\. \(402 characters\)x480 is not whole numbers"),
+    ):  # before: every digit printed
+        with pytest.raises(InputError, match=message):
+            check_image_size(width, height, "w")

@@ -1,6 +1,7 @@
 """The masks protocol (symfruit.evaluate.masks): IoU, one-to-one matching, summaries, COCO photos, scenes."""
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -108,15 +109,49 @@ def test_masks_protocol_on_a_tiny_coco_set_and_its_report(tmp_path):
     assert rows[0].startswith("image,n_true,n_pred,matched") and len(rows) == 3
 
 
-def test_masks_protocol_refuses_a_missing_image_or_folder(tmp_path):
+def test_masks_protocol_refuses_a_missing_folder_or_no_images(tmp_path):
     truth = _coco_folder(tmp_path)
-    (tmp_path / "a.png").unlink()
-    with pytest.raises(FileFormatError, match="not in"):
-        evaluate_masks(tmp_path, truth, segment)
     with pytest.raises(FileFormatError, match="not a folder"):
         evaluate_masks(tmp_path / "nope", truth, segment)
     with pytest.raises(FileFormatError, match="no images"):
         evaluate_masks(tmp_path, truth, segment, names=["zzz.png"])
+
+
+def test_a_bad_photograph_is_skipped_and_named_the_others_scored(tmp_path):
+    truth = _coco_folder(tmp_path)
+    data = json.loads(truth.read_text())
+    for k, name in enumerate(["c.png", "d.png", "e.png", "f.png"], 10):
+        data["images"].append({"id": k, "file_name": name})
+    data["images"][-3].update(width=321, height=240)  # d.png: its COCO entry fails
+    data["annotations"].append({"id": 20, "image_id": 13, "category_id": 1, "segmentation": {"size": 1}})
+    truth.write_text(json.dumps(data))
+    (tmp_path / "c.png").write_bytes(b"\x89PNG\r\n\x1a\n broken")  # unreadable; e.png is missing
+    for name in ("d.png", "f.png"):
+        Image.open(tmp_path / "a.png").save(tmp_path / name)  # f.png: an RLE that is no RLE
+
+    def refusing(color, name="", color_file=None):  # a label file not the photograph's
+        if name == "b.jpg":
+            raise FileFormatError("labels/b.png: labels are 30x24, the image 320x240")
+        return segment(color)
+
+    ev = evaluate_masks(tmp_path, truth, refusing, files=True)
+    assert sorted(ev.failed) == ["b.jpg", "c.png", "d.png", "e.png", "f.png"]
+    assert "c.png" in ev.failed["c.png"] and "labels are 30x24" in ev.failed["b.jpg"]
+    assert "d.png" in ev.failed["d.png"] and "321x240 in the file but 320x240 on disk" in ev.failed["d.png"]
+    assert "e.png: listed in c.json as 'e.png' but not in" in ev.failed["e.png"]
+    assert "c.json: annotation 20: RLE size 1 is not the image" in ev.failed["f.png"]
+    s = ev.summary
+    assert (s["images"], s["skipped_images"], s["true_fruit"], s["matched"]) == (1, 5, 2, 2)
+    assert [x.image for x in ev.scores] == ["a.png"]
+    written = write_mask_report(tmp_path / "out", ev)
+    summary = json.loads(written[1].read_text())
+    assert summary["failed"] == ev.failed and summary["summary"]["skipped_images"] == 5
+    (tmp_path / "a.png").write_bytes(b"")
+    with pytest.raises(FileFormatError, match=r"none of the 6 images of c\.json could be scored; a\.png: "):
+        evaluate_masks(tmp_path, truth, refusing, files=True)
+    truth.write_text('{"images": [], "annotations": 3}')  # the truth file itself broken: nothing can be scored
+    with pytest.raises(FileFormatError, match=r"c\.json: expected a COCO object"):
+        evaluate_masks(tmp_path, truth, segment)
 
 
 def test_the_worst_images_are_kept_for_the_contact_sheet():
@@ -210,5 +245,6 @@ def test_an_image_named_outside_the_folder_is_looked_up_inside_it_only(tmp_path,
     name = outside.replace("/{tmp}", str(tmp_path))
     data["images"][0]["file_name"] = name
     Path(truth).write_text(json.dumps(data))
-    with pytest.raises(FileFormatError, match=rf"photos/a\.png: listed in .* as '{name}' but not in "):
-        evaluate_masks(folder, truth, segment)
+    ev = evaluate_masks(folder, truth, segment)  # skipped, named; b.jpg scored
+    assert [s.image for s in ev.scores] == ["b.jpg"] and list(ev.failed) == [name]
+    assert re.search(rf"photos/a\.png: listed in .* as '{name}' but not in ", ev.failed[name])

@@ -53,9 +53,13 @@ def test_intrinsics_layouts(tmp_path, name):
         ('{"K": [1, 2, 3], "width": 640, "height": 480}', "9 numbers"),
         (
             '{"fx": 1' + "0" * 400 + ', "fy": 615, "cx": 320, "cy": 240, "width": 640, "height": 480}',
-            r"'fx' must be a number, got 10{19}\.\.\. \(401 characters\)",
+            r"'fx' must be a number, got 10{11}\.\.\. \(401 digits\)",
         ),  # JSON's whole number beyond float
         ('{"K": [1' + "0" * 400 + ', 0, 320, 0, 615, 240, 0, 0, 1], "width": 640, "height": 480}', "9 numbers"),
+        (
+            '{"fx": 615, "fy": 615, "cx": 320, "cy": 240, "width": ' + "9" * 400 + ', "height": 480}',
+            r"camera width is 9{12}\.\.\. \(400 digits\) pixels; at most 16384 are supported$",
+        ),  # before: all 400 digits printed
         ('{"foo": 1}', "not recognised"),
         ("[1, 2]", "mapping"),
         ("{not json", "not valid JSON"),

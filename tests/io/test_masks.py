@@ -139,7 +139,7 @@ def test_rle_counts_must_cover_the_image():
         ([-1, 36], r"whole numbers 0-35, got -1"),
         ([1.5, 33.5], r"whole numbers 0-35, got 1\.5"),  # never cut to 1
         ([True, 34], r"whole numbers 0-35, got True"),
-        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 characters\)"),
+        ([int("9" * 400)], r"got 999999999999\.\.\. \(400 digits\)"),
         (None, r"a list of run lengths or a compressed string, got NoneType"),
         ({"a": 1}, r"got dict"),
         ("\u00e9", r"only ASCII"),
@@ -365,3 +365,13 @@ def test_an_iscrowd_that_is_not_0_or_1_is_refused_not_read_as_a_crowd(tmp_path, 
         read_coco(tmp_path / "c.json")  # before: "0" (text) was truthy, the fruit ignored as a crowd region
     with pytest.raises(FileFormatError, match=r"c\.json: annotation 1 has iscrowd"):
         read_masks(tmp_path / "c.json", (4, 4))  # a frame's masks.json alike
+
+
+def test_a_polygon_of_an_odd_number_of_coordinates_is_refused_naming_the_annotation(tmp_path):
+    odd = [[3, 5, 11, 5, 11, 9, 3, 9, 3]]  # before: the last coordinate dropped, the rest drawn
+    c = read_coco(_write(tmp_path, _coco(odd)))
+    message = r"c\.json: annotation 5 has no valid segmentation \(a polygon has 9 coordinates, an odd number"
+    with pytest.raises(FileFormatError, match=message):
+        c.instances("a.jpg", (20, 30))
+    with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(a polygon has 9"):
+        read_masks(_write(tmp_path, {"annotations": [{"segmentation": odd}]}, "m.json"), (20, 30))  # a frame's masks

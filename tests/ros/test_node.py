@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 import pytest
 
+from symfruit.errors import SymfruitError
 from symfruit.ros.core import Fruit
 from symfruit.ros.master import stop_group
 
@@ -363,3 +364,22 @@ def test_launch_file_runs_the_node_with_remapped_inputs(ros_world, example_image
         sub.unregister()
         for p in pubs:
             p.unregister()
+
+
+def test_private_parameters_are_checked_as_the_ros2_nodes_are():
+    from symfruit.ros.node import private_parameters
+
+    def get_param(values):
+        return lambda name, default: values.get(name, default)
+
+    p = private_parameters(get_param({"~slop": 1, "~queue_size": 3.0, "~fruit": "apple"}))
+    assert (p["slop"], p["queue_size"], p["fruit"], p["masks"]) == (1.0, 3, "apple", "auto")
+    for values, message in [  # before: int("abc") a ValueError's traceback; 0, -1 or 1e9 handed to message_filters
+        ({"~queue_size": "abc"}, "parameter queue_size: expected a whole number, got 'abc'"),
+        ({"~queue_size": 0}, "parameter queue_size: expected 1 to 100, got 0"),
+        ({"~queue_size": 10**400}, r"parameter queue_size: expected 1 to 100, got 10{11}\.\.\. \(401 digits\)"),
+        ({"~slop": -1.0}, r"parameter slop: expected seconds in \[0, 10\], got -1\.0"),
+        ({"~depth_scale": "mm"}, "parameter depth_scale: expected a number, got 'mm'"),
+    ]:
+        with pytest.raises(SymfruitError, match="^" + message):
+            private_parameters(get_param(values))

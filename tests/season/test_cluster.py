@@ -183,6 +183,16 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
     assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--scheduler", "tcp://127.0.0.1:1"]) == 2
     assert "cannot reach the Dask scheduler" in capsys.readouterr().err
     assert not (tmp_path / "o" / "errors.json").exists()
+    for address, message in (
+        ("", "an empty address"),
+        ("tcp://127.0.0.1:99999", "the port 1-65535"),
+        ("127.0.0.1", "not a scheduler address"),
+    ):  # before: tried for 10 s, or ": cannot reach"
+        assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--scheduler", address]) == 2
+        assert message in capsys.readouterr().err
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--chunk", "8"]) == 2  # before: ignored
+    assert "--chunk (frames per Dask task) is for --scheduler or --workers" in capsys.readouterr().err
+    assert not (tmp_path / "o" / "errors.json").exists()
 
 
 def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):

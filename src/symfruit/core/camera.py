@@ -11,7 +11,7 @@ from dataclasses import asdict, dataclass, replace
 import numpy as np
 
 from ..errors import InputError
-from .limits import MAX_FOCAL_PX, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE
+from .limits import MAX_FOCAL_PX, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, shown
 
 __all__ = ["DEFAULT_CAMERA", "MAX_FOCAL_PX", "MAX_IMAGE_PIXELS", "MAX_IMAGE_SIDE", "Camera"]
 
@@ -49,12 +49,11 @@ class Camera:
         for name in ("fx", "fy", "cx", "cy"):
             value = getattr(self, name)
             if isinstance(value, bool | str | bytes):  # float() reads True as 1 and "600" as 600 in silence
-                raise InputError(f"camera {name} must be a number, got {value!r}")
+                raise InputError(f"camera {name} must be a number, got {shown(value)}")
             try:
                 value = float(value)
             except (TypeError, ValueError, OverflowError):  # OverflowError: a whole number beyond float's range
-                shown = repr(value) if len(repr(value)) <= 40 else f"{repr(value)[:20]}..."
-                raise InputError(f"camera {name} must be a number, got {shown}") from None
+                raise InputError(f"camera {name} must be a number, got {shown(value)}") from None
             if not np.isfinite(value):
                 raise InputError(f"camera {name} must be finite, got {value!r}")
             object.__setattr__(self, name, value)
@@ -63,9 +62,9 @@ class Camera:
             if isinstance(value, float) and value.is_integer():
                 value = int(value)
             if isinstance(value, bool) or not isinstance(value, (int, np.integer)) or value <= 0:
-                raise InputError(f"camera {name} must be a positive whole number of pixels, got {value!r}")
+                raise InputError(f"camera {name} must be a positive whole number of pixels, got {shown(value)}")
             if value > MAX_IMAGE_SIDE:
-                raise InputError(f"camera {name} is {value} pixels; at most {MAX_IMAGE_SIDE} are supported")
+                raise InputError(f"camera {name} is {shown(value)} pixels; at most {MAX_IMAGE_SIDE} are supported")
             object.__setattr__(self, name, int(value))
         if self.width * self.height > MAX_IMAGE_PIXELS:
             raise InputError(f"camera image of {self.width}x{self.height} pixels exceeds {MAX_IMAGE_PIXELS:,} pixels")

@@ -22,6 +22,7 @@ __all__ = [
     "MAX_CLOUD_POINTS",
     "MAX_COCO_BYTES",
     "MAX_DEPTH_METRES",
+    "MAX_DISTORTION_COEFFS",
     "MAX_FACES",
     "MAX_FOCAL_PX",
     "MAX_IMAGE_PIXELS",
@@ -40,6 +41,7 @@ __all__ = [
     "check_image_size",
     "depth_metres",
     "instance_labels",
+    "shown",
 ]
 
 #: Largest image side (pixels) and largest image (pixels), for every image (colour, depth, labels, a bag or
@@ -48,6 +50,9 @@ MAX_IMAGE_SIDE = 16384
 MAX_IMAGE_PIXELS = 40_000_000
 #: Largest focal length and principal-point offset (pixels): a 16K sensor behind a 60x telephoto fits.
 MAX_FOCAL_PX = 1e6
+#: Most lens distortion coefficients read with a camera's intrinsics (OpenCV's largest model has 14; ROS
+#: ``rational_polynomial`` 8).
+MAX_DISTORTION_COEFFS = 16
 #: One fruit's window in the image (the rating's raster), pixels.
 MAX_WINDOW_PIXELS = 4_000_000
 #: Largest cloud read from a file (points), and largest text cloud (bytes).
@@ -82,6 +87,28 @@ MAX_DEPTH_METRES = 100.0
 MIN_DEPTH_METRES = 0.001
 
 
+def shown(value: Any, limit: int = 40) -> str:
+    """A bad value as an error message shows it: its ``repr``, or, beyond ``limit`` characters, its start and
+    how long it is (a 400-digit width read from a file is not printed whole: ``99999999999... (400 digits)``).
+
+    Examples
+    --------
+    >>> shown(640), shown(10**400 - 1), shown("x" * 50)
+    ('640', '999999999999... (400 digits)', "'xxxxxxxxxxxxxxxxxxx... (52 characters)")
+    """
+    if isinstance(value, np.generic):
+        value = value.item()
+    try:
+        text = repr(value)
+    except ValueError:  # a whole number beyond Python's 4300-digit conversion limit
+        return f"a whole number of about {int(abs(value).bit_length() * 0.30103) + 1} digits"
+    if len(text) <= limit:
+        return text
+    if isinstance(value, int) and not isinstance(value, bool):
+        return f"{text[:12]}... ({len(text.lstrip('-'))} digits)"
+    return f"{text[:20]}... ({len(text)} characters)"
+
+
 def check_image_size(
     width: Any,
     height: Any,
@@ -99,13 +126,14 @@ def check_image_size(
     try:
         w, h = int(width), int(height)
     except (TypeError, ValueError, OverflowError):
-        raise error(f"{what}: image size {width!r}x{height!r} is not whole numbers of pixels") from None
+        raise error(f"{what}: image size {shown(width)}x{shown(height)} is not whole numbers of pixels") from None
+    size = f"{shown(w)}x{shown(h)}"
     if w <= 0 or h <= 0:
-        raise error(f"{what}: image is {w}x{h} pixels; it must not be empty")
+        raise error(f"{what}: image is {size} pixels; it must not be empty")
     if w > max_side or h > max_side:
-        raise error(f"{what}: image is {w}x{h} pixels; at most {max_side} pixels a side are read")
+        raise error(f"{what}: image is {size} pixels; at most {max_side} pixels a side are read")
     if w * h > max_pixels:
-        raise error(f"{what}: image is {w}x{h} pixels; at most {max_pixels:,} pixels are read")
+        raise error(f"{what}: image is {size} pixels; at most {max_pixels:,} pixels are read")
     return w, h
 
 
@@ -133,9 +161,9 @@ def instance_labels(labels: Any, what: str, *, error: type[SymfruitError] = Inpu
         return arr.astype(np.int32)
     lo, hi = int(arr.min()), int(arr.max())
     if lo < 0:
-        raise error(f"{what}: masks hold negative labels (got {lo}); 0 is background, 1..k the fruit")
+        raise error(f"{what}: masks hold negative labels (got {shown(lo)}); 0 is background, 1..k the fruit")
     if hi > MAX_LABEL_ID:
-        raise error(f"{what}: label id {hi} is beyond 32 bits (at most {MAX_LABEL_ID}); number the fruit 1..k")
+        raise error(f"{what}: label id {shown(hi)} is beyond 32 bits (at most {MAX_LABEL_ID}); number the fruit 1..k")
     if hi > MAX_INSTANCES:  # more ids than fruit allowed may still be few fruit: count them
         if hi <= 1 << 22:
             count = int(np.count_nonzero(np.bincount(arr.ravel(), minlength=hi + 1)[1:]))

@@ -21,12 +21,13 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import FileFormatError, InputError
+from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 
 __all__ = [
     "CSV_COLUMNS",
     "ImageScore",
     "MaskEvaluation",
+    "Skipped",
     "coco_items",
     "evaluate_mask_items",
     "evaluate_masks",
@@ -49,6 +50,15 @@ Item = (
     | tuple[str, np.ndarray, np.ndarray, dict[str, Any]]
     | tuple[str, np.ndarray, np.ndarray, dict[str, Any], tuple[np.ndarray, int]]
 )
+
+
+@dataclass(frozen=True)
+class Skipped:
+    """An item that could not be made (its photograph unreadable or missing, its COCO entry failing): it is
+    reported by name with the reason, and the evaluation goes on with the others."""
+
+    name: str
+    reason: str
 
 
 def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
@@ -229,8 +239,9 @@ def score_masks(
     return ImageScore(image, best, int(ious.shape[1]) - ignored, len(pairs), float(ms), int(crowd), ignored)
 
 
-def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
-    """Totals over images: mean best-match IoU over true fruit, matched / missed / false, shares, time."""
+def summarise_masks(scores: Sequence[ImageScore], skipped: int = 0) -> dict[str, Any]:
+    """Totals over images: mean best-match IoU over true fruit, matched / missed / false, shares, time;
+    ``skipped``: how many images could not be scored (not in the totals)."""
     best = np.concatenate([s.best_iou for s in scores]) if scores else np.zeros(0)
     n_true = int(sum(s.n_true for s in scores))
     n_pred = int(sum(s.n_pred for s in scores))
@@ -239,6 +250,7 @@ def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
     ms = ms[np.isfinite(ms)]
     return {
         "images": len(scores),
+        "skipped_images": int(skipped),
         "true_fruit": n_true,
         "detections": n_pred,
         "matched": matched,
@@ -258,22 +270,27 @@ def summarise_masks(scores: Sequence[ImageScore]) -> dict[str, Any]:
 
 @dataclass(frozen=True)
 class MaskEvaluation:
-    """What the masks protocol returns: per-image scores, the summary, and the worst images kept for
-    the contact sheet as ``(name, color, truth masks, labels)``."""
+    """What the masks protocol returns: per-image scores, the summary, the worst images kept for
+    the contact sheet as ``(name, color, truth masks, labels)``, and the images skipped (name -> reason)."""
 
     scores: list[ImageScore]
     summary: dict[str, Any]
     worst: list[tuple[str, np.ndarray, np.ndarray, np.ndarray]] = field(default_factory=list)
+    failed: dict[str, str] = field(default_factory=dict)
 
 
 def evaluate_mask_items(
-    items: Iterable[Item], segment: Segmenter, *, threshold: float = 0.5, keep_worst: int = 12
+    items: Iterable[Item | Skipped], segment: Segmenter, *, threshold: float = 0.5, keep_worst: int = 12
 ) -> MaskEvaluation:
     """Run ``segment(color, **extra) -> labels`` on each ``(name, color, truth[, extra])`` and score it.
 
+    An image that cannot be scored (a :class:`Skipped` item, or ``segment`` or the scoring raising a
+    :class:`~symfruit.errors.SymfruitError`, e.g. a label file that is not the photograph's) is recorded in
+    ``failed`` with the reason and left out of the totals; the others are scored.
+
     Parameters
     ----------
-    items : iterable of (str, (h, w, 3) uint8, (n, h, w) bool or (h, w) int[, dict])
+    items : iterable of (str, (h, w, 3) uint8, (n, h, w) bool or (h, w) int[, dict]) or Skipped
         The optional dict holds keyword arguments for ``segment`` (e.g. ``depth`` and ``camera``).
     segment : callable
         Colour image to instance labels; timed per image (the segmentation alone, no file reading).
@@ -282,23 +299,33 @@ def evaluate_mask_items(
         How many of the worst images to keep (with their pixels) for the contact sheet.
     """
     scores: list[ImageScore] = []
+    failed: dict[str, str] = {}
     worst: list[tuple[float, int, tuple[str, np.ndarray, np.ndarray, np.ndarray]]] = []
     for k, item in enumerate(items):
+        if isinstance(item, Skipped):
+            failed[item.name] = item.reason
+            continue
         name, color, truth = item[0], item[1], item[2]
         extra: dict[str, Any] = item[3] if len(item) > 3 else {}
         ignore, crowd = item[4] if len(item) > 4 else (None, 0)
-        t0 = time.perf_counter()
-        labels = np.asarray(segment(color, **extra))
-        ms = (time.perf_counter() - t0) * 1000.0
-        truth = truth_stack(truth, labels.shape)
-        score = score_masks(truth, labels, threshold=threshold, image=name, ms=ms, ignore=ignore, crowd=crowd)
+        try:
+            t0 = time.perf_counter()
+            labels = np.asarray(segment(color, **extra))
+            ms = (time.perf_counter() - t0) * 1000.0
+            truth = truth_stack(truth, labels.shape)
+            score = score_masks(truth, labels, threshold=threshold, image=name, ms=ms, ignore=ignore, crowd=crowd)
+        except OutputError:
+            raise
+        except SymfruitError as exc:
+            failed[name] = str(exc)
+            continue
         scores.append(score)
         if keep_worst > 0:
             worst.append((score.badness(), k, (name, color, truth, labels)))
             worst.sort(key=lambda w: (-w[0], w[1]))
             del worst[keep_worst:]
     kept = [w[2] for w in worst if w[0] > 0]
-    return MaskEvaluation(scores, summarise_masks(scores), kept)
+    return MaskEvaluation(scores, summarise_masks(scores, len(failed)), kept, failed)
 
 
 def coco_items(
@@ -308,9 +335,11 @@ def coco_items(
     category: int | None = 1,
     names: Sequence[str] | None = None,
     files: bool = False,
-) -> Iterator[Item]:
+) -> Iterator[Item | Skipped]:
     """``(file name, colour, true masks, {}, (crowd mask, crowd count))`` for every image of a COCO file found
-    in ``images``, by name. Crowd regions (``iscrowd: 1``) are no true fruit; predictions in them are ignored.
+    in ``images``, by name; a :class:`Skipped` (name and reason) for one that cannot be read, is missing from
+    the folder, or whose COCO entry or annotations fail (the file as a whole is checked first). Crowd regions
+    (``iscrowd: 1``) are no true fruit; predictions in them are ignored.
     With ``files``, the keyword arguments are ``name`` (the file name) and ``color_file`` (the image's path and
     the EXIF orientation applied to it on reading), which a :class:`~symfruit.segment.MaskSource` reading label
     files needs: to find an image's labels, and to refuse a label PNG that turns otherwise than the photograph.
@@ -318,12 +347,10 @@ def coco_items(
     Raises
     ------
     FileFormatError
-        When ``images`` is not a folder, no image is left to evaluate, or an image listed in the file
-        (and wanted) is missing from the folder.
+        When ``images`` is not a folder, the COCO file cannot be read, or no image is left to evaluate.
     InputError
         When no annotation has ``category``.
     """
-    from ..io.images import read_color_oriented
     from ..io.masks import read_coco
 
     folder = Path(images)
@@ -339,18 +366,32 @@ def coco_items(
         raise FileFormatError(f"{coco.path}: no images to evaluate")
     for entry in entries:
         name = str(entry["file_name"])
-        # inside the folder only: an absolute name or one climbing out ("../../x.png") is looked up by its base name
-        inside = not Path(name).is_absolute() and ".." not in Path(name).parts
-        path = folder / name if inside else folder / Path(name).name
-        if not path.is_file():
-            path = folder / Path(name).name
-        if not path.is_file():
-            raise FileFormatError(f"{folder / Path(name).name if not inside else folder / name}: listed in "
-                                  f"{coco.path.name} as {name!r} but not in {folder}")  # fmt: skip
-        color, orientation = read_color_oriented(path)
-        crowd = coco.crowd(name, color.shape[:2], category=category)
-        extra = {"name": name, "color_file": (path, orientation)} if files else {}
-        yield name, color, coco.instances(name, color.shape[:2], category=category), extra, crowd
+        try:
+            item = _coco_item(folder, coco, name, category, files)
+        except OutputError:
+            raise
+        except SymfruitError as exc:  # this photograph alone: reported by name, the others scored
+            yield Skipped(name, str(exc))
+            continue
+        yield item
+
+
+def _coco_item(folder: Path, coco: Any, name: str, category: int | None, files: bool) -> Item:
+    """One photograph of :func:`coco_items`: read, its truth and crowd regions drawn."""
+    from ..io.images import read_color_oriented
+
+    # inside the folder only: an absolute name or one climbing out ("../../x.png") is looked up by its base name
+    inside = not Path(name).is_absolute() and ".." not in Path(name).parts
+    path = folder / name if inside else folder / Path(name).name
+    if not path.is_file():
+        path = folder / Path(name).name
+    if not path.is_file():
+        raise FileFormatError(f"{folder / Path(name).name if not inside else folder / name}: listed in "
+                              f"{coco.path.name} as {name!r} but not in {folder}")  # fmt: skip
+    color, orientation = read_color_oriented(path)
+    crowd = coco.crowd(name, color.shape[:2], category=category)
+    extra = {"name": name, "color_file": (path, orientation)} if files else {}
+    return name, color, coco.instances(name, color.shape[:2], category=category), extra, crowd
 
 
 def evaluate_masks(
@@ -370,7 +411,9 @@ def evaluate_masks(
     ----------
     images : folder
         The photographs; every image of the COCO file is evaluated (images in the folder without an
-        entry are skipped; an image listed but missing from the folder is an error).
+        entry are left out). An image listed but missing from the folder or unreadable, one whose COCO entry
+        or annotations fail, or one ``segment`` refuses (a label file not the photograph's) is skipped and
+        named in ``failed`` with the reason; when none can be scored, that is an error.
     truth : COCO JSON path
     segment : callable ``(h, w, 3) uint8 -> (h, w) int labels``
     category : int or None
@@ -382,7 +425,14 @@ def evaluate_masks(
         Call ``segment(color, name=..., color_file=...)`` (:func:`coco_items`): for a mask source of label files.
     """
     items = coco_items(images, truth, category=category, names=names, files=files)
-    return evaluate_mask_items(items, segment, threshold=threshold, keep_worst=keep_worst)
+    ev = evaluate_mask_items(items, segment, threshold=threshold, keep_worst=keep_worst)
+    if not ev.scores and ev.failed:
+        first, reason = next(iter(ev.failed.items()))
+        n = len(ev.failed)
+        which = f"none of the {n} images" if n > 1 else "the one image"
+        more = f" (and {n - 1} more)" if n > 1 else ""
+        raise FileFormatError(f"{images}: {which} of {Path(truth).name} could be scored; {first}: {reason}{more}")
+    return ev
 
 
 def evaluate_scene_masks(

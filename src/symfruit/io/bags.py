@@ -29,10 +29,10 @@ import numpy as np
 
 from ..core.camera import Camera
 from ..core.frame import MAX_STAMP_NS, Frame
-from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_IMAGE_PIXELS, check_image_size
+from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
-from .intrinsics import MAX_DISTORTION_COEFFS, warn_distortion
+from .intrinsics import warn_distortion
 
 __all__ = [
     "BagSource",
@@ -212,7 +212,7 @@ def camera_from_info(
 
 def info_distortion(msg: Any) -> tuple[str, list[float]]:
     """``(field, coefficients)`` of a ``CameraInfo``'s distortion (``D`` in ROS 1, ``d`` in ROS 2; none: empty),
-    checked as an intrinsics file's: at most :data:`~symfruit.io.intrinsics.MAX_DISTORTION_COEFFS` finite numbers.
+    checked as an intrinsics file's: at most :data:`~symfruit.core.limits.MAX_DISTORTION_COEFFS` finite numbers.
 
     Raises
     ------

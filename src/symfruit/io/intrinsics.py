@@ -36,7 +36,7 @@ from pathlib import Path
 from typing import Any
 
 from ..core.camera import Camera
-from ..core.limits import MAX_SETTINGS_BYTES
+from ..core.limits import MAX_DISTORTION_COEFFS, MAX_SETTINGS_BYTES, shown
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
@@ -87,8 +87,7 @@ def camera_from_file_data(path: Path, data: Any) -> Camera:
         raise FileFormatError(f"{path}: {exc}") from None
 
 
-#: Most distortion coefficients read (OpenCV's largest model has 14; ROS ``rational_polynomial`` 8).
-MAX_DISTORTION_COEFFS = 16
+#: Most distortion coefficients read: :data:`symfruit.core.limits.MAX_DISTORTION_COEFFS`.
 #: Distortion keys of the layouts: RealSense, ROS 1, ROS 2, camera_calibration_parsers.
 _DISTORTION_KEYS = ("coeffs", "D", "d", "distortion_coefficients")
 
@@ -115,7 +114,7 @@ def _distortion(data: Any) -> tuple[str, list[float]] | None:
         or not all(math.isfinite(float(v)) for v in values)
     ):
         raise InputError(f"intrinsics field {key!r} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got "
-                         f"{_short(values)}")  # fmt: skip
+                         f"{shown(values)}")  # fmt: skip
     return key, [float(v) for v in values]
 
 
@@ -182,7 +181,7 @@ def read_mapping(path: Path) -> Any:
 def _number(data: dict[str, Any], key: str) -> float:
     value = data[key]
     if isinstance(value, bool) or not isinstance(value, (int, float)) or not _fits_float(value):
-        raise InputError(f"intrinsics field {key!r} must be a number, got {_short(value)}")
+        raise InputError(f"intrinsics field {key!r} must be a number, got {shown(value)}")
     return float(value)
 
 
@@ -194,11 +193,6 @@ def _fits_float(value: int | float) -> bool:
     except OverflowError:
         return False
     return True
-
-
-def _short(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def _matrix(values: Any, name: str) -> list[float]:

@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import MAX_COCO_BYTES, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_INSTANCES, check_image_size
+from ..core.limits import MAX_COCO_BYTES, MAX_IMAGE_PIXELS, MAX_IMAGE_SIDE, MAX_INSTANCES, check_image_size, shown
 from ..errors import FileFormatError, InputError
 from .images import orientation_mismatch, read_labels_oriented
 from .text import read_structured
@@ -89,8 +89,10 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
             xy = np.asarray(poly, dtype=np.float64)
             if xy.ndim != 1 or not np.isfinite(xy).all():
                 raise ValueError("polygon coordinates must be finite numbers")
+            if len(xy) % 2:  # one coordinate lost or one too many: which is unknown, so the outline is too
+                raise ValueError(f"a polygon has {len(xy)} coordinates, an odd number; it is x, y pairs")
             # far-off vertices are clipped (the drawn mask is the same inside the image)
-            xy = np.clip(xy[: len(xy) // 2 * 2].reshape(-1, 2), -4.0 * max(h, w), 5.0 * max(h, w))
+            xy = np.clip(xy.reshape(-1, 2), -4.0 * max(h, w), 5.0 * max(h, w))
             if len(xy) >= 3:
                 draw.polygon([tuple(p) for p in xy.tolist()], fill=1, outline=1)
         return np.asarray(img, dtype=bool)
@@ -115,7 +117,7 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
         if not isinstance(ann, dict):  # never dropped quietly: that would read as a frame without fruit
             raise FileFormatError(f"{path}: annotation {k} is a {type(ann).__name__}, not an object")
         if ann.get("iscrowd") not in (None, 0, 1):  # "0" as text is truthy: the fruit would be dropped as a crowd
-            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {shown(ann.get('iscrowd'))}; it is 0 or 1")
     images = data.get("images") if isinstance(data, dict) else None
     if images is not None:
         if not isinstance(images, list) or not all(isinstance(e, dict) for e in images):
@@ -307,13 +309,13 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
             raise FileFormatError(f"{path}: an 'annotations' entry is not an object")
         category = ann.get("category_id")
         if isinstance(category, bool) or not isinstance(category, (int, str, type(None))):
-            raise FileFormatError(f"{path}: annotation {k} has category_id {_shown(category)}; a category id is a "
+            raise FileFormatError(f"{path}: annotation {k} has category_id {shown(category)}; a category id is a "
                                   "whole number")  # fmt: skip
         if ann.get("iscrowd") not in (None, 0, 1):  # "0" or "no" as text is truthy: a fruit counted as a crowd
-            raise FileFormatError(f"{path}: annotation {k} has iscrowd {_shown(ann.get('iscrowd'))}; it is 0 or 1")
+            raise FileFormatError(f"{path}: annotation {k} has iscrowd {shown(ann.get('iscrowd'))}; it is 0 or 1")
         image = _key(ann.get("image_id"))
         if image not in ids:  # a misspelt or missing image_id: that fruit would be lost from the truth unsaid
-            raise FileFormatError(f"{path}: annotation {k} is for image id {_shown(ann.get('image_id'))}, which no "
+            raise FileFormatError(f"{path}: annotation {k} is for image id {shown(ann.get('image_id'))}, which no "
                                   "'images' entry has")  # fmt: skip
         annotations.setdefault(image, []).append(ann)
     categories: dict[int, str] = {}
@@ -322,11 +324,6 @@ def coco_from_data(path: Path, data: Any) -> CocoSet:
         if isinstance(c, dict) and isinstance(c.get("id"), int) and not isinstance(c.get("id"), bool):
             categories[c["id"]] = str(c.get("name", c["id"]))
     return CocoSet(path, images, annotations, categories)
-
-
-def _shown(value: Any) -> str:
-    text = repr(value)
-    return text if len(text) <= 40 else f"{text[:20]}... ({len(text)} characters)"
 
 
 def rle_decode(rle: dict[str, Any]) -> np.ndarray:
@@ -354,8 +351,7 @@ def rle_decode(rle: dict[str, Any]) -> np.ndarray:
     # one (the sum alone let [19300, -100] through as "adds up to 19200"), a 400-digit one is not an overflow
     bad = next((c for c in counts if isinstance(c, bool) or not isinstance(c, int) or not 0 <= c <= h * w), None)
     if bad is not None:
-        shown = repr(bad) if len(repr(bad)) <= 20 else f"{repr(bad)[:12]}... ({len(repr(bad))} characters)"
-        raise ValueError(f"RLE counts must be run lengths, whole numbers 0-{h * w}, got {shown}")
+        raise ValueError(f"RLE counts must be run lengths, whole numbers 0-{h * w}, got {shown(bad, 20)}")
     counts = np.asarray(counts, dtype=np.int64)
     if counts.sum() != h * w:
         raise ValueError(f"RLE counts add up to {counts.sum()}, expected {h * w}")

@@ -29,8 +29,9 @@ from typing import Any
 import numpy as np
 
 from ..core.frame import Frame
+from ..core.limits import shown
 from ..detect import FrameDetections, detect
-from ..errors import InputError
+from ..errors import InputError, SymfruitError
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp, info_distortion
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
@@ -38,7 +39,68 @@ from ..segment import mask_source
 from ..settings import resolve_settings
 from ..writers import bbox_record
 
-__all__ = ["FrameProcessor", "Fruit", "LatestOnly", "Processed", "fruits_of", "message_frame", "stop_signals"]
+__all__ = [
+    "PARAMETERS",
+    "QOS_CHOICES",
+    "FrameProcessor",
+    "Fruit",
+    "LatestOnly",
+    "Processed",
+    "checked_parameters",
+    "fruits_of",
+    "message_frame",
+    "stop_signals",
+]
+
+
+# ---------------------------------------------------------------------------------------------------
+# parameters (both nodes)
+# ---------------------------------------------------------------------------------------------------
+
+#: name: (default, description); every parameter is read once, at start.
+PARAMETERS: dict[str, tuple[Any, str]] = {
+    "method": (DEFAULT_METHOD, "completion method (symfruit methods)"),
+    "fruit": ("strawberry", "fruit profile name or profile file; also each detection's class_id"),
+    "config": ("", "settings file (YAML/JSON) over the profile; empty for none"),
+    "masks": ("auto", "mask source as symfruit detect --masks"),
+    "depth_scale": (0.001, "metres per unit of 16UC1 depth images"),
+    "slop": (0.05, "largest stamp difference of a synchronised colour, depth and camera info, seconds"),
+    "queue_size": (5, "messages kept per input topic for the synchroniser"),
+    "qos": ("reliable", "input QoS: reliable (as the RealSense wrapper publishes) or sensor_data (best effort)"),
+}
+QOS_CHOICES = ("reliable", "sensor_data")
+
+
+def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
+    """The node's parameters from what ROS handed over (any types): strings as strings, numbers checked; the
+    one check of the ROS 2 node's parameters and the ROS 1 node's private ones (which have no ``qos``).
+
+    Raises
+    ------
+    SymfruitError
+        One line naming the parameter, for a number that is not one or is out of range, or an unknown ``qos``.
+    """
+    out: dict[str, Any] = {}
+    for name, (default, _) in PARAMETERS.items():
+        value = values.get(name, default)
+        if isinstance(default, str):
+            out[name] = "" if value is None else str(value)
+            continue
+        kind = int if isinstance(default, int) else float
+        try:
+            if isinstance(value, bool) or (kind is int and isinstance(value, float) and not value.is_integer()):
+                raise ValueError
+            out[name] = kind(value)
+        except (TypeError, ValueError, OverflowError):  # OverflowError: int() of an infinite float
+            what = "whole number" if kind is int else "number"
+            raise SymfruitError(f"parameter {name}: expected a {what}, got {shown(value)}") from None
+    if not 0 <= out["slop"] <= 10:
+        raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {shown(out['slop'])}")
+    if not 1 <= out["queue_size"] <= 100:
+        raise SymfruitError(f"parameter queue_size: expected 1 to 100, got {shown(out['queue_size'])}")
+    if out["qos"] not in QOS_CHOICES:
+        raise SymfruitError(f"parameter qos: expected one of {', '.join(QOS_CHOICES)}, got {shown(out['qos'])}")
+    return out
 
 
 # ---------------------------------------------------------------------------------------------------

@@ -19,7 +19,8 @@ itself) and publishes, per frame and with the colour image's header:
 
 Private parameters: ``~method`` (fused), ``~fruit`` (strawberry), ``~config`` (settings file, ""),
 ``~masks`` (auto), resolved by :func:`symfruit.settings.resolve_settings` as on the command line;
-``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5). A frame that cannot be
+``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5), checked at start
+(:func:`private_parameters`). A frame that cannot be
 used is logged and skipped; frames arriving while one is processed are dropped (only the newest waits).
 Each frame logs its latency. Everything but rospy lives in :mod:`symfruit.ros.core`.
 """
@@ -35,7 +36,7 @@ import numpy as np
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import FrameProcessor, Fruit, LatestOnly
+from .core import PARAMETERS, FrameProcessor, Fruit, LatestOnly, checked_parameters
 
 __all__ = ["DEFAULT_TOPICS", "SymfruitNode", "main"]
 
@@ -182,14 +183,11 @@ class SymfruitNode:
 
         self.rospy = rospy
         self.vision_msgs = load_vision_msgs()
-        param = rospy.get_param
+        p = private_parameters(rospy.get_param)
         self.core = FrameProcessor(
-            method=str(param("~method", "")) or DEFAULT_METHOD,
-            fruit=str(param("~fruit", "strawberry")) or None,
-            config=str(param("~config", "")) or None,
-            masks=str(param("~masks", "auto")),
-            depth_scale=float(param("~depth_scale", 0.001)),
-        )
+            method=p["method"] or DEFAULT_METHOD, fruit=p["fruit"] or None, config=p["config"] or None,
+            masks=p["masks"], depth_scale=p["depth_scale"],
+        )  # fmt: skip
         self.pub_detections = rospy.Publisher("~detections", self.vision_msgs.Detection3DArray, queue_size=2)
         self.pub_markers = rospy.Publisher("~markers", MarkerArray, queue_size=2)
         self.pub_points = rospy.Publisher("~fruit_points", PointCloud2, queue_size=2)
@@ -197,7 +195,7 @@ class SymfruitNode:
         big = 1 << 26  # rospy's 64 kB default receive buffer makes large images lag far behind
         # Everything the synchroniser needs is read (two round trips to the master) and the worker started before
         # the first subscription: a frame completed between subscribing and registering the callback was dropped.
-        queue_size, slop = int(param("~queue_size", 5)), float(param("~slop", 0.05))
+        queue_size, slop = p["queue_size"], p["slop"]
         self.worker = LatestOnly(self._handle, on_error=self._on_error).start()
         subs = [
             message_filters.Subscriber(self.topics["color"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
@@ -264,6 +262,14 @@ Run the symfruit ROS 1 node (ROS_MASTER_URI from the environment). ROS arguments
   _method:=fused _fruit:=strawberry _config:=settings.yaml _masks:=auto      private parameters
   __name:=symfruit __ns:=/robot                                               node name, namespace
 """
+
+
+def private_parameters(get_param: Any) -> dict[str, Any]:
+    """The node's private parameters (``~method`` ... ``~queue_size``; ROS 1 has no ``qos``) through ``get_param``
+    (``rospy.get_param``), checked as the ROS 2 node's are (:func:`~symfruit.ros.core.checked_parameters`): a
+    ``~queue_size`` that is no whole number, or a ``~slop`` out of [0, 10] s, is one line naming it."""
+    return checked_parameters({name: get_param(f"~{name}", default) for name, (default, _) in PARAMETERS.items()
+                               if name != "qos"})  # fmt: skip
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -43,7 +43,7 @@ from typing import Any
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import FrameProcessor, Fruit, LatestOnly, stop_signals
+from .core import PARAMETERS, QOS_CHOICES, FrameProcessor, Fruit, LatestOnly, checked_parameters, stop_signals
 from .node import BOX_RGBA, CENTRE_DIAMETER, CENTRE_RGBA, CLOUD_FIELDS, cloud_array
 from .sync import ApproximateSync
 
@@ -55,18 +55,6 @@ DEFAULT_TOPICS = {
     "depth": "/camera/camera/aligned_depth_to_color/image_raw",
     "camera_info": "/camera/camera/color/camera_info",
 }
-#: name: (default, description); every parameter is read once, at start.
-PARAMETERS: dict[str, tuple[Any, str]] = {
-    "method": (DEFAULT_METHOD, "completion method (symfruit methods)"),
-    "fruit": ("strawberry", "fruit profile name or profile file; also each detection's class_id"),
-    "config": ("", "settings file (YAML/JSON) over the profile; empty for none"),
-    "masks": ("auto", "mask source as symfruit detect --masks"),
-    "depth_scale": (0.001, "metres per unit of 16UC1 depth images"),
-    "slop": (0.05, "largest stamp difference of a synchronised colour, depth and camera info, seconds"),
-    "queue_size": (5, "messages kept per input topic for the synchroniser"),
-    "qos": ("reliable", "input QoS: reliable (as the RealSense wrapper publishes) or sensor_data (best effort)"),
-}
-QOS_CHOICES = ("reliable", "sensor_data")
 
 
 def require_rclpy() -> Any:
@@ -173,37 +161,6 @@ def point_cloud(header: Any, fruits: Sequence[Fruit]) -> Any:
 # --------------------------------------------------------------------------------------------------
 # parameters
 # --------------------------------------------------------------------------------------------------
-
-
-def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
-    """The node's parameters from what ROS handed over (any types): strings as strings, numbers checked.
-
-    Raises
-    ------
-    SymfruitError
-        One line naming the parameter, for a number that is not one or is out of range, or an unknown ``qos``.
-    """
-    out: dict[str, Any] = {}
-    for name, (default, _) in PARAMETERS.items():
-        value = values.get(name, default)
-        if isinstance(default, str):
-            out[name] = "" if value is None else str(value)
-            continue
-        kind = int if isinstance(default, int) else float
-        try:
-            if isinstance(value, bool) or (kind is int and isinstance(value, float) and not value.is_integer()):
-                raise ValueError
-            out[name] = kind(value)
-        except (TypeError, ValueError):
-            what = "whole number" if kind is int else "number"
-            raise SymfruitError(f"parameter {name}: expected a {what}, got {value!r}") from None
-    if not 0 <= out["slop"] <= 10:
-        raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {out['slop']!r}")
-    if not 1 <= out["queue_size"] <= 100:
-        raise SymfruitError(f"parameter queue_size: expected 1 to 100, got {out['queue_size']!r}")
-    if out["qos"] not in QOS_CHOICES:
-        raise SymfruitError(f"parameter qos: expected one of {', '.join(QOS_CHOICES)}, got {out['qos']!r}")
-    return out
 
 
 def class_id_of(fruit: str) -> str:

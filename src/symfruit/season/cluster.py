@@ -52,6 +52,7 @@ from ..batch import (
     list_recordings,
     plan_recordings,
 )
+from ..core.limits import shown
 from ..detect import detect
 from ..errors import InputError, OutputError, SymfruitError
 from ..io.frames import is_frame_folder, read_frame
@@ -253,6 +254,19 @@ def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> An
                             dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
 
 
+def check_address(scheduler: Any) -> None:
+    """Refuse a scheduler address that cannot be one before trying it for :data:`CONNECT_TIMEOUT`: empty (an
+    unset shell variable), or a port that is not 1-65535 (``tcp://HOST:PORT``; ``inproc://`` is not checked)."""
+    text = str(scheduler).strip()
+    if not text:
+        raise InputError("--scheduler '': an empty address (an unset shell variable?); give tcp://HOST:PORT")
+    if text.startswith("inproc://"):
+        return
+    port = text.rpartition(":")[2]
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise InputError(f"--scheduler {shown(text)}: not a scheduler address; give tcp://HOST:PORT, the port 1-65535")
+
+
 @contextlib.contextmanager
 def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
     distributed = require_distributed()
@@ -297,6 +311,8 @@ def run_distributed(
     """
     if (scheduler is None) == (workers is None):
         raise InputError("give either a scheduler address or a number of local workers")
+    if scheduler is not None:
+        check_address(scheduler)
     if not 1 <= chunk <= 10_000:
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {chunk}")
     if workers is not None and not 1 <= workers <= 256:  # refused before the inputs are read, not taken as 1
