@@ -224,6 +224,17 @@ def test_cli_detect_and_evaluate_frames(tmp_path, capsys):
     assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
 
 
+def test_evaluate_frames_goes_on_past_a_bad_frame_and_exits_1(tmp_path, capsys):
+    frames = tmp_path / "frames"
+    shutil.copytree(EXAMPLE_FRAME, frames / "good")
+    shutil.copytree(EXAMPLE_FRAME, frames / "torn")
+    (frames / "torn" / "depth.png").write_bytes(b"\x89PNG\r\n\x1a\n torn off")
+    code = main(["evaluate", "--frames", str(frames), "--methods", "raw", "--output", str(tmp_path / "r")])
+    out = capsys.readouterr().out
+    assert code == 1  # as detect: the table is of the good frame, the torn one is named
+    assert "skipped torn" in out and "Table 3" in out
+
+
 def test_evaluate_command(tmp_path, capsys, monkeypatch):
     from symfruit.evaluate import report
 

@@ -597,7 +597,7 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
     for name, reason in failed.items():
         print(f"skipped {name}: {reason}")
     print(f"results: {folder}")
-    return 0
+    return 1 if failed else 0  # as detect: the batch went on past a bad frame, and says so
 
 
 def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) -> int:
@@ -618,7 +618,7 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
     for name, reason in failed.items():
         print(f"skipped {name}: {reason}")
     print(f"results: {folder}")
-    return 0 if rows else 1
+    return 1 if failed or not rows else 0
 
 
 def _evaluate_masks(args: argparse.Namespace) -> int:

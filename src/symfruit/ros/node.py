@@ -17,7 +17,7 @@ itself) and publishes, per frame and with the colour image's header:
 - ``~fruit_points`` ``sensor_msgs/PointCloud2`` (x, y, z, fruit, completed) of the completed clouds,
   built only while someone subscribes.
 
-Private parameters: ``~method`` (fused), ``~fruit`` (strawberry), ``~config`` (settings file, ""),
+Private parameters: ``~method`` (the default method, ``evidence``), ``~fruit`` (strawberry), ``~config`` (settings file, ""),
 ``~masks`` (auto), resolved by :func:`symfruit.settings.resolve_settings` as on the command line;
 ``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5), checked at start
 (:func:`private_parameters`). A frame that cannot be
@@ -259,7 +259,7 @@ USAGE = """usage: symfruit ros [ROS arguments]
 
 Run the symfruit ROS 1 node (ROS_MASTER_URI from the environment). ROS arguments, e.g.:
   color:=/my/color/image_raw depth:=/my/depth camera_info:=/my/camera_info   remap the inputs
-  _method:=fused _fruit:=strawberry _config:=settings.yaml _masks:=auto      private parameters
+  _method:=evidence _fruit:=strawberry _config:=settings.yaml _masks:=auto   private parameters
   __name:=symfruit __ns:=/robot                                               node name, namespace
 """
 
