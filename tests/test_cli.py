@@ -550,7 +550,8 @@ def test_evaluate_refuses_a_results_root_that_is_a_file_before_it_evaluates(tmp_
 
     monkeypatch.setattr(symfruit.evaluate, "evaluate", no_work)
     (tmp_path / "results").write_text("")
-    assert main(["evaluate", "--protocol", protocol, "--quick", "--output", str(tmp_path / "results")]) == 2
+    quick = ["--quick"] if protocol != "masks" else []  # (--protocol masks has no --quick)
+    assert main(["evaluate", "--protocol", protocol, *quick, "--output", str(tmp_path / "results")]) == 2
     _one_line_error(capsys, "results: cannot create a results folder (the results root is a file)")
 
 
@@ -763,7 +764,14 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--no-depth"], "--no-depth is for"),
      (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--n", "3"], "evaluate --n is for the"),
      (["evaluate", "--protocol", "masks", "--images", "a", "--truth", "b", "--seed", "3"], "--seed is for the paper"),
-     (["evaluate", "--frames", "f", "--n", "3"], "--n is for the paper and camera protocols and --protocol masks")],
+     (["evaluate", "--frames", "f", "--n", "3"], "--n is for the paper and camera protocols and --protocol masks"),
+     (["evaluate", "--protocol", "masks", "--methods", "raw"], "evaluate --methods is for --frames, --spheres and"),
+     (["evaluate", "--protocol", "masks", "--quick"], "evaluate --quick is for the paper and camera protocols"),
+     (["evaluate", "--spheres", "s", "--jobs", "2"], "evaluate --jobs is for the paper and camera protocols"),
+     (["evaluate", "--frames", "f", "--pose", "upright"], "evaluate --pose is for the paper and camera protocols"),
+     (["evaluate", "--occlusion", "0.25"], "evaluate --occlusion is for --protocol camera"),
+     (["evaluate", "--protocol", "paper", "--sensor", "heldback"], "evaluate --sensor is for --protocol camera"),
+     (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera")],
 )  # fmt: skip
 def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)

@@ -26,6 +26,10 @@ if TYPE_CHECKING:
 __all__ = ["main"]
 
 
+#: The methods `evaluate` compares unless --methods says otherwise.
+_EVALUATED = "raw,sphere,ellipsoid,superellipsoid,paper,fused,evidence"
+
+
 def _path(text: str) -> Path:
     """A path argument; an empty one (an unset shell variable: ``--output "$OUT"``) is refused, not read as the
     working folder."""
@@ -102,27 +106,27 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
         help="a generated kind (strawberry, apple, citrus, tomato, pear, lemon, peach, plum, banana, lopsided), "
         "all, or a folder of complete scans (one table row per scan); comma-separated",
     )
-    p.add_argument("--methods", default="raw,sphere,ellipsoid,superellipsoid,paper,fused,evidence",
-                   help="comma-separated methods")  # fmt: skip
+    p.add_argument("--methods", help="comma-separated methods (default: " + _EVALUATED + ")")
     p.add_argument(
         "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
     p.add_argument("--seed", type=int, default=None, help="first seed (default 0)")
-    p.add_argument("--occlusion", default="0", help="camera protocol: occluder levels, e.g. 0,0.25,0.5")
-    p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS), default="d435",
+    p.add_argument("--occlusion", help="camera protocol: occluder levels, e.g. 0,0.25,0.5 (default 0)")
+    p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS),
                    help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m), heldback (issue 11's measurement: "
                    "0.01 z^2 noise, no dropout, 0.3-0.5 m), or a real camera model (symfruit.synthetic.sensors: rim "
                    "invalidation or edge fattening, flying pixels, registration, masks that overshoot, clutter; "
-                   "1920x1080 or 1280x720, 0.25-2 m)")  # fmt: skip
-    p.add_argument("--pose", choices=("hanging", "upright", "uniform"), default="hanging",
+                   "1920x1080 or 1280x720, 0.25-2 m; default d435)")  # fmt: skip
+    p.add_argument("--pose", choices=("hanging", "upright", "uniform"),
                    help="pose distribution: hanging (stem up; scans as in their file), upright (scans stood up "
-                   "first), uniform (any orientation; camera protocol)")  # fmt: skip
-    p.add_argument("--views", type=int, default=1,
+                   "first), uniform (any orientation; camera protocol); default hanging")  # fmt: skip
+    p.add_argument("--views", type=int,
                    help="camera protocol, generated kinds: views of each fruit (default 1: every view a new fruit; "
                    "more rank confidence among one fruit's views, as the scans' views are)")  # fmt: skip
     p.add_argument("--output", type=_path, default=Path("results"), help="results root (default results/)")
-    p.add_argument("--quick", action="store_true", help="a handful of instances, well under a minute")
-    p.add_argument("--jobs", type=int, help="worker processes (default: all CPUs)")
+    p.add_argument("--quick", action="store_true", help="paper and camera protocols: a handful of instances, well "
+                   "under a minute")  # fmt: skip
+    p.add_argument("--jobs", type=int, help="paper and camera protocols: worker processes (default: all CPUs)")
     p.add_argument("--config", type=_path, help="settings file for the methods")
     p.add_argument(
         "--no-profile",
@@ -492,6 +496,8 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         raise InputError(f"evaluate: {' and '.join(kinds)} are two evaluations; give one")
     masks, photos = args.protocol == "masks", args.images is not None or args.truth is not None
     generated = not (masks and photos) and args.frames is None and args.spheres is None  # what --n and --seed make
+    protocols = not masks and args.frames is None and args.spheres is None  # the paper and camera protocols
+    camera = protocols and args.protocol == "camera"
     rules = (  # option, given, where it counts, what that is
         ("--match", args.match is not None, args.frames is not None, "--frames"),
         ("--masks", args.masks is not None, masks or args.frames is not None or args.spheres is not None,
@@ -503,6 +509,13 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         ("--scene", args.scene is not None, masks and not photos, "--protocol masks on rendered scenes (no --images)"),
         ("--n", args.n is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
         ("--seed", args.seed is not None, generated, "the paper and camera protocols and --protocol masks on scenes"),
+        ("--methods", args.methods is not None, not masks, "--frames, --spheres and the paper and camera protocols"),
+        ("--quick", args.quick, protocols, "the paper and camera protocols"),
+        ("--jobs", args.jobs is not None, protocols, "the paper and camera protocols"),
+        ("--pose", args.pose is not None, protocols, "the paper and camera protocols"),
+        ("--occlusion", args.occlusion is not None, camera, "--protocol camera"),
+        ("--sensor", args.sensor is not None, camera, "--protocol camera"),
+        ("--views", args.views is not None, camera, "--protocol camera"),
     )  # fmt: skip
     for option, given, counts, need in rules:
         if given and not counts:
@@ -512,6 +525,11 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
     args.category = 1 if args.category is None else args.category
     args.scene = args.scene or "strawberry"
     args.seed = 0 if args.seed is None else args.seed
+    args.methods = _EVALUATED if args.methods is None else args.methods
+    args.occlusion = "0" if args.occlusion is None else args.occlusion
+    args.sensor = args.sensor or "d435"
+    args.pose = args.pose or "hanging"
+    args.views = 1 if args.views is None else args.views
 
 
 def _evaluate(args: argparse.Namespace) -> int:
