@@ -532,6 +532,19 @@ def test_band_pixels_are_the_twins_to_the_bit(seed, bands, n_band):
     assert rc.dtype == rc_twin.dtype and np.array_equal(rc, rc_twin) and np.array_equal(sizes, sizes_twin)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 7), st.floats(0.0, 1.0))
+def test_closed_masks_are_the_twins_to_the_bit(seed, half, share):
+    """Random masks (empty to full, some narrower than the square, pixels on the array's edge): the same closing
+    and filled holes as the twin's two box means."""
+    from symfruit.core.raster import _closed_mask
+
+    rng = np.random.default_rng(seed)
+    hit = rng.random((int(rng.integers(1, 50)), int(rng.integers(1, 50)))) < share
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _closed_mask, hit, half)
+    assert fast.dtype == twin.dtype == bool and np.array_equal(fast, twin)
+
+
 @given(st.integers(0, 2**32 - 1), st.floats(1e-9, 1.0))
 def test_least_vector_is_eighs(seed, gap):
     """Random symmetric matrices, the least two eigenvalues ``gap`` apart relative to the largest: the least

@@ -1399,3 +1399,31 @@ def band_pixels(dist: np.ndarray, bands: np.ndarray, n_band: int) -> tuple[np.nd
             m += 1
         sizes[b] = take
     return out[:m], sizes
+
+
+@_njit
+def close_square(hit: np.ndarray, half: int, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: ``hit`` (h, w) bool closed by the ``2 half + 1`` square, as
+    :func:`symfruit.core.raster._closed_mask`'s two box means (a dilation, outside the array false, then an erosion
+    with the array's edge pixels repeated beyond it: all of the square's pixels within the array), ``hit`` kept: the
+    same pixels. Each by running counts along the rows, then down the columns."""
+    h, w = hit.shape
+    dilated = np.empty((h, w), np.bool_)
+    square_filter(hit, half, False, dilated)
+    rows = np.empty((h, w), np.bool_)
+    count = np.empty(w + 1, np.int64)
+    for r in range(h):
+        count[0] = 0
+        for c in range(w):
+            count[c + 1] = count[c] + dilated[r, c]
+        for c in range(w):
+            a, b = max(c - half, 0), min(c + half + 1, w)
+            rows[r, c] = count[b] - count[a] == b - a
+    cols = np.zeros((h + 1, w), np.int64)  # cols[r, c]: true pixels of rows[:r, c]
+    for r in range(h):
+        for c in range(w):
+            cols[r + 1, c] = cols[r, c] + rows[r, c]
+    for r in range(h):
+        a, b = max(r - half, 0), min(r + half + 1, h)
+        for c in range(w):
+            out[r, c] = cols[b, c] - cols[a, c] == b - a or hit[r, c]
