@@ -471,6 +471,100 @@ def test_inside_px_is_the_twins_to_the_bit(seed, n):
     assert np.array_equal(fast, twin)
 
 
+@pytest.mark.parametrize("name", ["apple", "banana", "strawberry"])
+@pytest.mark.parametrize("noise", [0.0, 0.004])
+def test_contour_pixels_are_the_twins(name, noise):
+    """A depth camera's view of a tilted fruit (a point per pixel, noisy or not): the same edge pixels and the
+    same contour labels as the twin's ``eigh``."""
+    from symfruit import DEFAULT_CAMERA as cam
+    from symfruit.core.agreement import _contour_pixels, _inside_px
+    from symfruit.core.raster import inner_distance, silhouette
+
+    fruit = FRUITS[name](np.random.default_rng(1))
+    pts, _ = rendered_view(fruit, CENTRE, noise=noise, rotation=rotation(0.3, 1.0, 0.2), seed=3)
+    region = silhouette(pts, cam)
+    depth_px = _inside_px(pts, region, cam, inner_distance(region.mask))
+    with pytest.MonkeyPatch.context() as mp:
+        (uv, contour), (uv_twin, contour_twin) = _both(mp, _contour_pixels, pts, depth_px, region, cam, 150)
+    assert len(uv) > 50 and contour.any()
+    assert np.array_equal(uv, uv_twin) and np.array_equal(contour, contour_twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 2500), st.integers(1, 60), st.integers(1, 3))
+@settings(deadline=None)
+def test_contour_pixels_are_the_twins_on_random_clouds(seed, n, count, half):
+    """Points on a random bumpy surface, some pixels met twice (the later point keeps it), some beyond the
+    window, random distances inside the edge: the same pixels and labels as the twin's."""
+    from symfruit.core.agreement import _contour_pixels
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=500.0, fy=480.0, cx=64.0, cy=48.0, width=128, height=96)
+    u0, v0 = (int(x) for x in rng.integers(0, 30, 2))
+    region = Silhouette(u0, v0, np.ones((40, 50), bool), 0.0)
+    uv = np.c_[rng.integers(u0 - 3, u0 + 53, n), rng.integers(v0 - 3, v0 + 43, n)] + rng.uniform(-0.45, 0.45, (n, 2))
+    uv[: n // 5] = uv[n // 5 : 2 * (n // 5)] + 0.1  # the same pixels again
+    z = 0.5 + 0.02 * np.sin(uv[:, 0] / rng.uniform(2, 20)) + rng.normal(0.0, 1e-3, n)
+    pts = np.c_[(uv[:, 0] - 64.0) / 500.0 * z, (uv[:, 1] - 48.0) / 480.0 * z, z]
+    depth_px = rng.choice([0.0, 1.0, 1.5, 2.0, 3.0, 6.0], n)
+    with pytest.MonkeyPatch.context() as mp:
+        (uv_f, contour), (uv_twin, contour_twin) = _both(mp, _contour_pixels, pts, depth_px, region, cam, count, half)
+    assert np.array_equal(uv_f, uv_twin) and np.array_equal(contour, contour_twin)
+
+
+@given(
+    st.integers(0, 2**32 - 1),
+    st.lists(st.sampled_from([0.5, 1.0, 2.0, 2.3, 5.0, 8.0]), min_size=1, max_size=4),
+    st.integers(0, 100),
+)
+def test_band_pixels_are_the_twins_to_the_bit(seed, bands, n_band):
+    """Distance maps of whole and half pixels (on the bands' half-way marks), +inf and NaN pixels, bands that
+    overlap or repeat, more and fewer pixels than ``n_band``: the same pixels in the same order."""
+    from symfruit.core.agreement import _band_pixels
+
+    rng = np.random.default_rng(seed)
+    dist = rng.integers(0, 20, (int(rng.integers(1, 60)), int(rng.integers(1, 60)))) * 0.5
+    dist[rng.random(dist.shape) < 0.1] = np.inf
+    dist[rng.random(dist.shape) < 0.05] = np.nan
+    with pytest.MonkeyPatch.context() as mp:
+        (rc, sizes), (rc_twin, sizes_twin) = _both(mp, _band_pixels, dist, tuple(bands), n_band)
+    assert rc.dtype == rc_twin.dtype and np.array_equal(rc, rc_twin) and np.array_equal(sizes, sizes_twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 7), st.floats(0.0, 1.0))
+def test_closed_masks_are_the_twins_to_the_bit(seed, half, share):
+    """Random masks (empty to full, some narrower than the square, pixels on the array's edge): the same closing
+    and filled holes as the twin's two box means."""
+    from symfruit.core.raster import _closed_mask
+
+    rng = np.random.default_rng(seed)
+    hit = rng.random((int(rng.integers(1, 50)), int(rng.integers(1, 50)))) < share
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _closed_mask, hit, half)
+    assert fast.dtype == twin.dtype == bool and np.array_equal(fast, twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(1e-9, 1.0))
+def test_least_vector_is_eighs(seed, gap):
+    """Random symmetric matrices, the least two eigenvalues ``gap`` apart relative to the largest: the least
+    eigenvalue and (where the gap leaves it defined) its eigenvector as LAPACK's, to rounding."""
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    lam = np.array([1.0, 1.0 + gap, 2.0 + rng.random()]) * 10.0 ** rng.uniform(-8, 2)
+    a = (q * lam) @ q.T
+    a = 0.5 * (a + a.T)
+    w, vec = np.linalg.eigh(a)
+    work, v = a.copy(), np.empty((3, 3))
+    least = _jit._least_vector(work, v)
+    scale = lam.max()
+    assert abs(work[least, least] - w[0]) <= 1e-12 * scale
+    assert np.linalg.norm(a @ v[:, least] - w[0] * v[:, least]) <= 1e-12 * scale
+    assert np.allclose(v.T @ v, np.eye(3), atol=1e-13)
+    if gap > 1e-3:
+        assert abs(abs(v[:, least] @ vec[:, 0]) - 1.0) <= 1e-9 / gap
+
+
 # --- the surface's noise (core.fits.surface_noise) ----------------------------------------------------------
 
 

@@ -1222,3 +1222,208 @@ def filled(mask: np.ndarray, out: np.ndarray) -> None:
     for r in range(h):
         for c in range(w):
             out[r, c] = not reached[r, c]
+
+
+@_njit
+def _least_vector(a: np.ndarray, v: np.ndarray) -> int:
+    """The eigenvectors of the symmetric ``a`` (3, 3) into the columns of ``v`` (3, 3) by cyclic Jacobi rotations
+    (``a`` left diagonal, its eigenvalues there); returns the column of the least eigenvalue. Orthogonal to
+    rounding however close the eigenvalues, as LAPACK's are (a closed form is not)."""
+    for i in range(3):
+        for j in range(3):
+            v[i, j] = 1.0 if i == j else 0.0
+    for _ in range(32):
+        off = a[0, 1] * a[0, 1] + a[0, 2] * a[0, 2] + a[1, 2] * a[1, 2]
+        if off <= 1e-36 * (a[0, 0] * a[0, 0] + a[1, 1] * a[1, 1] + a[2, 2] * a[2, 2]):
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = a[p, q]
+            if apq == 0.0:
+                continue
+            theta = (a[q, q] - a[p, p]) / (2.0 * apq)
+            t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+            if theta < 0.0:
+                t = -t
+            c = 1.0 / math.sqrt(t * t + 1.0)
+            s = t * c
+            for k in range(3):  # a J
+                akp, akq = a[k, p], a[k, q]
+                a[k, p] = c * akp - s * akq
+                a[k, q] = s * akp + c * akq
+            for k in range(3):  # J^T a
+                apk, aqk = a[p, k], a[q, k]
+                a[p, k] = c * apk - s * aqk
+                a[q, k] = s * apk + c * aqk
+            for k in range(3):  # v J
+                vkp, vkq = v[k, p], v[k, q]
+                v[k, p] = c * vkp - s * vkq
+                v[k, q] = s * vkp + c * vkq
+    least = 0
+    if a[1, 1] < a[least, least]:
+        least = 1
+    if a[2, 2] < a[least, least]:
+        least = 2
+    return least
+
+
+@_njit
+def contour_pixels(
+    points: np.ndarray, depth_px: np.ndarray, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, h: int,
+    w: int, count: int, half: int,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._contour_pixels`: ``(uv (m, 2), contour (m,) bool)`` of up to ``count`` edge
+    points (within 1.5 px of the region's edge, ``depth_px``) of a cloud with about a point per pixel: whether the
+    plane of the points on the ``(2 half + 1)^2`` pixels around each (at least 6 of them; a pixel met twice holds
+    the later point) is within 60 degrees of containing its ray. The same points and pixels as the twin (the
+    projection's arithmetic, rounded half to even); the covariances summed in another order and their least
+    eigenvector by Jacobi rotations instead of LAPACK's ``eigh``, so a normal agrees to rounding, not to the bit."""
+    n = points.shape[0]
+    near = np.empty(n, np.int64)
+    m = 0
+    for i in range(n):
+        if depth_px[i] <= half + 1.5:
+            near[m] = i
+            m += 1
+    big = 9.223372036854775808e18  # 2^63: numpy's integer conversion as in inside_px
+    least = np.int64(-9223372036854775808)
+    us = np.empty(m)
+    vs = np.empty(m)
+    rows = np.empty(m, np.int64)
+    cols = np.empty(m, np.int64)
+    ok = np.empty(m, np.bool_)
+    edge = np.empty(m, np.int64)
+    n_edge = 0
+    for k in range(m):
+        i = near[k]
+        inv_z = 1.0 / points[i, 2]
+        u = fx * points[i, 0] * inv_z + cx
+        v = fy * points[i, 1] * inv_z + cy
+        us[k], vs[k] = u, v
+        ru, rv = np.rint(u), np.rint(v)
+        col = (np.int64(ru) if -big <= ru < big else least) - np.int64(u0) + half
+        row = (np.int64(rv) if -big <= rv < big else least) - np.int64(v0) + half
+        cols[k], rows[k] = col, row
+        ok[k] = half <= col < w + half and half <= row < h + half
+        if depth_px[i] <= 1.5 and ok[k]:
+            edge[n_edge] = k
+            n_edge += 1
+    if n_edge < 3:
+        return np.empty((0, 2)), np.empty(0, np.bool_)
+    step = max(1, n_edge // count)
+    width = w + 2 * half
+    grid = np.full((h + 2 * half) * width, -1, np.int64)
+    for k in range(m):
+        if ok[k]:
+            grid[rows[k] * width + cols[k]] = near[k]  # the later point keeps the pixel, as the twin's assignment
+    n_out = (n_edge + step - 1) // step
+    uv = np.empty((n_out, 2))
+    contour = np.empty(n_out, np.bool_)
+    nb = np.empty((2 * half + 1) * (2 * half + 1), np.int64)
+    a = np.empty((3, 3))
+    vec = np.empty((3, 3))
+    kept = 0
+    for e in range(0, n_edge, step):
+        k = edge[e]
+        cnt = 0
+        s0 = s1 = s2 = 0.0
+        for dr in range(-half, half + 1):
+            for dc in range(-half, half + 1):
+                j = grid[(rows[k] + dr) * width + cols[k] + dc]
+                if j >= 0:
+                    nb[cnt] = j
+                    cnt += 1
+                    s0 += points[j, 0]
+                    s1 += points[j, 1]
+                    s2 += points[j, 2]
+        if cnt < 6:
+            continue
+        m0, m1, m2 = s0 / cnt, s1 / cnt, s2 / cnt
+        c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+        for t in range(cnt):
+            j = nb[t]
+            e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
+            c00 += e0 * e0
+            c01 += e0 * e1
+            c02 += e0 * e2
+            c11 += e1 * e1
+            c12 += e1 * e2
+            c22 += e2 * e2
+        a[0, 0], a[0, 1], a[0, 2] = c00, c01, c02
+        a[1, 0], a[1, 1], a[1, 2] = c01, c11, c12
+        a[2, 0], a[2, 1], a[2, 2] = c02, c12, c22
+        col = _least_vector(a, vec)
+        i = near[k]
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        r = math.sqrt(x * x + y * y + z * z)
+        uv[kept, 0], uv[kept, 1] = us[k], vs[k]
+        contour[kept] = abs(vec[0, col] * (x / r) + vec[1, col] * (y / r) + vec[2, col] * (z / r)) < 0.5
+        kept += 1
+    return uv[:kept], contour[:kept]
+
+
+@_njit
+def band_pixels(dist: np.ndarray, bands: np.ndarray, n_band: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.agreement._band_pixels`: ``(rc (m, 2), sizes (k,))``, each band's pixels of ``dist``
+    (h, w) within half a pixel of ``bands[i]`` in row-major order, more than ``n_band`` of them thinned to the twin's
+    ``np.linspace(0, count - 1, n_band)`` picks (its arithmetic: ``i * step``, the last the last pixel, truncated):
+    the same pixels."""
+    h, w = dist.shape
+    k = bands.shape[0]
+    found = np.empty(h * w, np.int64)
+    out = np.empty((k * min(h * w, max(n_band, 0)), 2), np.int64)
+    sizes = np.zeros(k, np.int64)
+    m = 0
+    for b in range(k):
+        lo, hi = bands[b] - 0.5, bands[b] + 0.5
+        count = 0
+        for r in range(h):
+            for c in range(w):
+                d = dist[r, c]
+                if d > lo and d <= hi:
+                    found[count] = r * w + c
+                    count += 1
+        take = count if count <= n_band else n_band
+        if count > n_band and n_band > 1:
+            step = (count - 1) / (n_band - 1)
+        for i in range(take):
+            if count <= n_band:
+                j = i
+            elif i == n_band - 1 and n_band > 1:
+                j = count - 1  # linspace's endpoint is ``stop`` itself
+            elif n_band == 1:
+                j = 0
+            else:
+                j = np.int64(i * step)
+            out[m, 0] = found[j] // w
+            out[m, 1] = found[j] % w
+            m += 1
+        sizes[b] = take
+    return out[:m], sizes
+
+
+@_njit
+def close_square(hit: np.ndarray, half: int, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: ``hit`` (h, w) bool closed by the ``2 half + 1`` square, as
+    :func:`symfruit.core.raster._closed_mask`'s two box means (a dilation, outside the array false, then an erosion
+    with the array's edge pixels repeated beyond it: all of the square's pixels within the array), ``hit`` kept: the
+    same pixels. Each by running counts along the rows, then down the columns."""
+    h, w = hit.shape
+    dilated = np.empty((h, w), np.bool_)
+    square_filter(hit, half, False, dilated)
+    rows = np.empty((h, w), np.bool_)
+    count = np.empty(w + 1, np.int64)
+    for r in range(h):
+        count[0] = 0
+        for c in range(w):
+            count[c + 1] = count[c] + dilated[r, c]
+        for c in range(w):
+            a, b = max(c - half, 0), min(c + half + 1, w)
+            rows[r, c] = count[b] - count[a] == b - a
+    cols = np.zeros((h + 1, w), np.int64)  # cols[r, c]: true pixels of rows[:r, c]
+    for r in range(h):
+        for c in range(w):
+            cols[r + 1, c] = cols[r, c] + rows[r, c]
+    for r in range(h):
+        a, b = max(r - half, 0), min(r + half + 1, h)
+        for c in range(w):
+            out[r, c] = cols[b, c] - cols[a, c] == b - a or hit[r, c]

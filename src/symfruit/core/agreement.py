@@ -267,10 +267,9 @@ def observe(
     def bands_of(dist: np.ndarray, outside: bool) -> list[tuple[np.ndarray, np.ndarray, np.ndarray]]:
         """Each band's rays, weights and seen depths; the bands' pixels looked up together (every look-up is
         pixel by pixel: the same values as band by band, in a quarter of the calls)."""
-        rcs = [rc[np.linspace(0, len(rc) - 1, n_band).astype(int)] if len(rc) > n_band else rc for rc in rings(dist)]
-        if not rcs:  # no bands asked for
+        if not bands:  # no bands asked for
             return []
-        rc = np.concatenate(rcs)
+        rc, sizes = _band_pixels(dist, bands, n_band)
         u = (rc[:, 1] + region.u0).astype(np.float64)
         v = (rc[:, 0] + region.v0).astype(np.float64)
         weight = np.ones(len(rc))
@@ -282,13 +281,8 @@ def observe(
             weight = weight * ~hidden  # a hidden pixel: no evidence of background ...
             seen = np.where(hidden, occlusion.depth_at(u, v), np.nan)  # ... but of free space
         rays = camera.rays(u, v)
-        ends = np.cumsum([len(r) for r in rcs]).tolist()  # each band's rows, sliced (np.split's views, its calls)
+        ends = np.cumsum(sizes).tolist()  # each band's rows, sliced (np.split's views, its calls)
         return [(rays[a:b], weight[a:b], seen[a:b]) for a, b in zip([0, *ends[:-1]], ends, strict=True)]
-
-    def rings(dist: np.ndarray) -> list[np.ndarray]:  # each band's pixels (row-major), one pass over the map
-        rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5)) if bands else np.empty((0, 2), int)
-        at = dist[rc[:, 0], rc[:, 1]]
-        return [rc[(at > b - 0.5) & (at <= b + 0.5)] for b in bands]
 
     ins = bands_of(inner, False)
     outs = bands_of(outer, True)
@@ -360,6 +354,21 @@ def _bands(obs: Observation) -> _Bands:
     return found
 
 
+def _band_pixels(dist: np.ndarray, bands: tuple[float, ...], n_band: int) -> tuple[np.ndarray, np.ndarray]:
+    """``(rc (m, 2) int, sizes (k,) int)``: each band's pixels of the distance map ``dist`` (those within half a
+    pixel of its distance ``bands[i]``), row-major, at most ``n_band`` of them evenly spread (``np.linspace``'s
+    picks), the bands one after the other. By the compiled twin :func:`symfruit.core._jit.band_pixels` where numba
+    is installed (the same pixels)."""
+    if (jit := compiled()) is not None:
+        return jit.band_pixels(dist, np.asarray(bands, dtype=np.float64), n_band)
+    # every band's pixels in one pass over the map
+    rc = np.argwhere((dist > min(bands) - 0.5) & (dist <= max(bands) + 0.5))
+    at = dist[rc[:, 0], rc[:, 1]]
+    rings = [rc[(at > b - 0.5) & (at <= b + 0.5)] for b in bands]
+    rcs = [r[np.linspace(0, len(r) - 1, n_band).astype(int)] if len(r) > n_band else r for r in rings]
+    return np.concatenate(rcs), np.array([len(r) for r in rcs], dtype=np.intp)
+
+
 def _occluded_edges(
     region: Silhouette, occlusion: Occlusion, edge_uv: np.ndarray, is_contour: np.ndarray, count: int, radius: int
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -395,7 +404,11 @@ def _contour_pixels(
     points: np.ndarray, depth_px: np.ndarray, region: Silhouette, camera: Camera, count: int, half: int = 3
 ) -> tuple[np.ndarray, np.ndarray]:
     """As :func:`_contour_points` for a cloud with about one point per pixel: each edge point's neighbours
-    are the points of the ``(2 half + 1)^2`` pixels around its own (no search tree)."""
+    are the points of the ``(2 half + 1)^2`` pixels around its own (no search tree). By the compiled twin
+    :func:`symfruit.core._jit.contour_pixels` where numba is installed (the same points; the normals to rounding)."""
+    if (jit := compiled()) is not None:
+        return jit.contour_pixels(points, depth_px, camera.fx, camera.fy, camera.cx, camera.cy, region.u0, region.v0,
+                                  *region.mask.shape, count, half)  # fmt: skip
     near = np.flatnonzero(depth_px <= half + 1.5)  # every neighbour of an edge point lies this close
     points, depth_px = points[near], depth_px[near]
     h, w = region.mask.shape

@@ -110,9 +110,13 @@ def _default_fill(col: np.ndarray, row: np.ndarray) -> float:
 
 
 def _closed_mask(hit: np.ndarray, half: int) -> np.ndarray:
-    """The marked pixels closed by a square of half-width ``half`` (0: as they are), holes filled."""
+    """The marked pixels closed by a square of half-width ``half`` (0: as they are), holes filled; the closing by
+    the compiled twin :func:`symfruit.core._jit.close_square` where numba is installed (the same pixels)."""
     closed = hit
-    if half > 0:
+    if half > 0 and hit.ndim == 2 and hit.dtype == bool and (jit := compiled()) is not None:
+        closed = np.empty(hit.shape, dtype=bool)
+        jit.close_square(hit, half, closed)
+    elif half > 0:
         # Closing by a square, as box means: dilation = any hit in the square, erosion = all dilated.
         # "nearest" keeps a silhouette that the image edge cuts from being eroded there.
         size = 2 * half + 1
