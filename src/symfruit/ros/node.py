@@ -17,8 +17,8 @@ itself) and publishes, per frame and with the colour image's header:
 - ``~fruit_points`` ``sensor_msgs/PointCloud2`` (x, y, z, fruit, completed) of the completed clouds,
   built only while someone subscribes.
 
-Private parameters: ``~method`` (the default method, ``evidence``), ``~fruit`` (strawberry), ``~config`` (settings file, ""),
-``~masks`` (auto), resolved by :func:`symfruit.settings.resolve_settings` as on the command line;
+Private parameters: ``~method`` (the default method, ``evidence``), ``~fruit`` (strawberry), ``~config``
+(settings file, ""), ``~masks`` (auto), resolved by :func:`symfruit.settings.resolve_settings` as on the command line;
 ``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5), checked at start
 (:func:`private_parameters`). A frame that cannot be
 used is logged and skipped; frames arriving while one is processed are dropped (only the newest waits).
