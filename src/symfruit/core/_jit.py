@@ -552,6 +552,32 @@ def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.nda
 
 
 @_njit
+def _scatter(points: np.ndarray, idx: np.ndarray, n: int, out: np.ndarray) -> None:
+    """The scatter matrix (3, 3) of ``points[idx[:n]]`` about their mean (the sum of the outer products of their
+    deviations, not divided by ``n``), into ``out``: summed in ``idx``'s order."""
+    m0 = m1 = m2 = 0.0
+    for t in range(n):
+        j = idx[t]
+        m0 += points[j, 0]
+        m1 += points[j, 1]
+        m2 += points[j, 2]
+    m0, m1, m2 = m0 / n, m1 / n, m2 / n
+    c00 = c01 = c02 = c11 = c12 = c22 = 0.0
+    for t in range(n):
+        j = idx[t]
+        e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
+        c00 += e0 * e0
+        c01 += e0 * e1
+        c02 += e0 * e2
+        c11 += e1 * e1
+        c12 += e1 * e2
+        c22 += e2 * e2
+    out[0, 0], out[0, 1], out[0, 2] = c00, c01, c02
+    out[1, 0], out[1, 1], out[1, 2] = c01, c11, c12
+    out[2, 0], out[2, 1], out[2, 2] = c02, c12, c22
+
+
+@_njit
 def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`symfruit.core.fits._neighbour_covariances`: for each query point ``points[::step]``, the covariances
     (3, 3) of its ``small`` and its ``large`` nearest points (itself among them; ``small <= large <= n``), each
@@ -564,6 +590,7 @@ def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int)
     out_large = np.empty((m, 3, 3))
     best_d = np.empty(large)
     best_i = np.empty(large, np.int64)
+    scatter = np.empty((3, 3))
     for q in range(m):
         x, y, z = points[q * step, 0], points[q * step, 1], points[q * step, 2]
         count = 0
@@ -584,26 +611,10 @@ def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int)
             best_d[slot] = d
             best_i[slot] = j
         for kk, out in ((small, out_small), (large, out_large)):
-            m0 = m1 = m2 = 0.0
-            for a in range(kk):
-                j = best_i[a]
-                m0 += points[j, 0]
-                m1 += points[j, 1]
-                m2 += points[j, 2]
-            m0, m1, m2 = m0 / kk, m1 / kk, m2 / kk
-            c00 = c01 = c02 = c11 = c12 = c22 = 0.0
-            for a in range(kk):
-                j = best_i[a]
-                e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
-                c00 += e0 * e0
-                c01 += e0 * e1
-                c02 += e0 * e2
-                c11 += e1 * e1
-                c12 += e1 * e2
-                c22 += e2 * e2
-            out[q, 0, 0], out[q, 0, 1], out[q, 0, 2] = c00 / kk, c01 / kk, c02 / kk
-            out[q, 1, 0], out[q, 1, 1], out[q, 1, 2] = c01 / kk, c11 / kk, c12 / kk
-            out[q, 2, 0], out[q, 2, 1], out[q, 2, 2] = c02 / kk, c12 / kk, c22 / kk
+            _scatter(points, best_i, kk, scatter)
+            for r in range(3):
+                for c in range(3):
+                    out[q, r, c] = scatter[r, c] / kk
     return out_small, out_large
 
 
@@ -1325,32 +1336,15 @@ def contour_pixels(
     for e in range(0, n_edge, step):
         k = edge[e]
         cnt = 0
-        s0 = s1 = s2 = 0.0
         for dr in range(-half, half + 1):
             for dc in range(-half, half + 1):
                 j = grid[(rows[k] + dr) * width + cols[k] + dc]
                 if j >= 0:
                     nb[cnt] = j
                     cnt += 1
-                    s0 += points[j, 0]
-                    s1 += points[j, 1]
-                    s2 += points[j, 2]
         if cnt < 6:
             continue
-        m0, m1, m2 = s0 / cnt, s1 / cnt, s2 / cnt
-        c00 = c01 = c02 = c11 = c12 = c22 = 0.0
-        for t in range(cnt):
-            j = nb[t]
-            e0, e1, e2 = points[j, 0] - m0, points[j, 1] - m1, points[j, 2] - m2
-            c00 += e0 * e0
-            c01 += e0 * e1
-            c02 += e0 * e2
-            c11 += e1 * e1
-            c12 += e1 * e2
-            c22 += e2 * e2
-        a[0, 0], a[0, 1], a[0, 2] = c00, c01, c02
-        a[1, 0], a[1, 1], a[1, 2] = c01, c11, c12
-        a[2, 0], a[2, 1], a[2, 2] = c02, c12, c22
+        _scatter(points, nb, cnt, a)
         col = _least_vector(a, vec)
         i = near[k]
         x, y, z = points[i, 0], points[i, 1], points[i, 2]
