@@ -679,15 +679,21 @@ def test_detect_takes_several_recordings(tmp_path, capsys):
         assert f"]({name})" in report and (out / "report" / name).is_file()
 
 
-def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_and_size(tmp_path, capsys):
-    from PIL import Image
-
+def _red_photo(tmp_path):
+    """A 32x24 photograph with one red fruit and its labels; the folders photos/ and labels/ made."""
     (tmp_path / "photos").mkdir()
     (tmp_path / "labels").mkdir()
     color = np.zeros((24, 32, 3), np.uint8)
     color[6:14, 2:12] = (200, 20, 20)
     labels = np.zeros((24, 32), np.uint8)
     labels[6:14, 2:12] = 1
+    return color, labels
+
+
+def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_and_size(tmp_path, capsys):
+    from PIL import Image
+
+    color, labels = _red_photo(tmp_path)
     Image.fromarray(color).save(tmp_path / "photos" / "p0.png")
     Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
     box = [[2, 6, 11, 6, 11, 13, 2, 13]]
@@ -714,12 +720,7 @@ def test_evaluate_masks_reads_label_pngs_by_name_and_checks_their_orientation_an
 def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, capsys):
     from PIL import Image
 
-    (tmp_path / "photos").mkdir()
-    (tmp_path / "labels").mkdir()
-    color = np.zeros((24, 32, 3), np.uint8)
-    color[6:14, 2:12] = (200, 20, 20)
-    labels = np.zeros((24, 32), np.uint8)
-    labels[6:14, 2:12] = 1
+    color, labels = _red_photo(tmp_path)
     for name in ("p0", "p1"):
         Image.fromarray(color).save(tmp_path / "photos" / f"{name}.png")
     Image.fromarray(labels).save(tmp_path / "labels" / "p0.png")
