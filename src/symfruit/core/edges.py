@@ -31,6 +31,8 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .raster import distance_transform
+
 __all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift"]
 
 #: Orientation bins of the oriented chamfer score (edge normals modulo 180 degrees); a depth outline pixel is
@@ -210,7 +212,7 @@ def edge_shift(
     dist = np.empty((N_BINS, h, w), np.float32)
     for b in range(N_BINS):
         near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
-        dist[b] = np.minimum(ndimage.distance_transform_edt(~near_bin), cap) if near_bin.any() else cap
+        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
     shifts = np.arange(-m, m + 1)
     n = len(rows)
 
