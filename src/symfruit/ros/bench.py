@@ -96,24 +96,9 @@ def bench_node(
     from sensor_msgs.msg import CameraInfo, Image
 
     # 1. detect alone
-    core = FrameProcessor(method=method, fruit=fruit)
     images = example_images()
-    msgs = _example_messages(rospy.Time(1, 0), images)
-    core.process(*msgs)
-    alone, alone_detect = [], []
-    for _ in range(frames):
-        t0 = time.perf_counter()
-        p = core.process(*msgs)
-        alone.append((time.perf_counter() - t0) * 1e3)
-        alone_detect.append(p.found.timings["total"] * 1e3)
-
-    out: dict = {
-        "frames": frames,
-        "rate_hz": rate,
-        "method": method,
-        "process_alone_ms": _stats(alone),
-        "detect_alone_ms": _stats(alone_detect),
-    }
+    out = _alone(FrameProcessor(method=method, fruit=fruit), _example_messages(rospy.Time(1, 0), images),
+                 frames=frames, rate=rate, method=method)  # fmt: skip
     with RosMaster() as master:
         for key in ("ROS_MASTER_URI", "ROS_HOSTNAME", "ROS_HOME", "ROS_LOG_DIR"):
             os.environ[key] = master.env[key]
@@ -182,6 +167,25 @@ def bench_node(
             rospy.signal_shutdown("bench done")
         log_text = log.read_text(errors="replace")
     return _summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span)
+
+
+def _alone(core, msgs, *, frames: int, rate: float, method: str) -> dict:
+    """The benchmark's first part, shared by both nodes' benchmarks: ``core`` (a ``FrameProcessor``) on the
+    same messages ``frames`` times after one warm-up, without a node: wall time per call and ``detect``'s own."""
+    core.process(*msgs)
+    alone, alone_detect = [], []
+    for _ in range(frames):
+        t0 = time.perf_counter()
+        p = core.process(*msgs)
+        alone.append((time.perf_counter() - t0) * 1e3)
+        alone_detect.append(p.found.timings["total"] * 1e3)
+    return {
+        "frames": frames,
+        "rate_hz": rate,
+        "method": method,
+        "process_alone_ms": _stats(alone),
+        "detect_alone_ms": _stats(alone_detect),
+    }
 
 
 def _summarise(out: dict, log_text: str, e2e: dict[int, float], *, frames: int, delivered: list[float],

@@ -28,7 +28,7 @@ import time
 from pathlib import Path
 
 from ..methods import DEFAULT_METHOD
-from .bench import _print, _stats, _summarise, example_images
+from .bench import _alone, _print, _summarise, example_images
 from .master import stop_group
 
 __all__ = ["bench_node2", "main"]
@@ -51,23 +51,10 @@ def bench_node2(
     from .core import FrameProcessor
 
     # 1. detect alone
-    core = FrameProcessor(method=method, fruit=fruit)
     images = example_images()
-    msgs = frame_messages(images, 1)  # rclpy's messages, as the node receives them
-    core.process(*msgs)
-    alone, alone_detect = [], []
-    for _ in range(frames):
-        t0 = time.perf_counter()
-        p = core.process(*msgs)
-        alone.append((time.perf_counter() - t0) * 1e3)
-        alone_detect.append(p.found.timings["total"] * 1e3)
-    out: dict = {
-        "frames": frames,
-        "rate_hz": rate,
-        "method": method,
-        "process_alone_ms": _stats(alone),
-        "detect_alone_ms": _stats(alone_detect),
-    }
+    # rclpy's messages, as the node receives them
+    out = _alone(FrameProcessor(method=method, fruit=fruit), frame_messages(images, 1), frames=frames, rate=rate,
+                 method=method)  # fmt: skip
     with domain_lease() as domain, tempfile.TemporaryDirectory(prefix="symfruit-ros2-bench-") as home:
         env = isolated_env(domain, Path(home))
         for key in ("ROS_AUTOMATIC_DISCOVERY_RANGE", "ROS_DOMAIN_ID", "RMW_IMPLEMENTATION"):  # this process too
