@@ -228,12 +228,7 @@ def _camera(spec: Spec, camera: Camera) -> Instance:
     noise = sensor.noise
     rng = np.random.default_rng([spec.seed, 2000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
                                  round(spec.occlusion * 1000)])  # fmt: skip
-    if spec.poses == "uniform":
-        rot = _uniform_rotation(rng)
-        angles = (float("nan"),) * 3
-    else:
-        angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
-        rot = rotation(*angles)
+    rot, angles = _pose(spec, rng)
     distance = float(rng.uniform(*sensor.distance))
     radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
     # Anywhere in the image where the whole fruit stays in view (a 10-pixel margin).
@@ -267,6 +262,14 @@ def _camera(spec: Spec, camera: Camera) -> Instance:
     )  # fmt: skip
 
 
+def _pose(spec: Spec, rng: np.random.Generator) -> tuple[np.ndarray, tuple[float, float, float]]:
+    """A view's rotation and its hanging-pose angles (degrees; NaN for ``poses == "uniform"``), drawn from ``rng``."""
+    if spec.poses == "uniform":
+        return _uniform_rotation(rng), (float("nan"),) * 3
+    angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
+    return rotation(*angles), angles
+
+
 def _real_camera(spec: Spec, model: SensorModel) -> Instance:
     """A view through a real camera model: the fruit, an optional occluding leaf, clutter behind and beside,
     rendered in a window of the camera's colour image around the fruit."""
@@ -274,12 +277,7 @@ def _real_camera(spec: Spec, model: SensorModel) -> Instance:
     full = model.camera()
     rng = np.random.default_rng([spec.seed, 4000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
                                  round(spec.occlusion * 1000), list(SENSOR_MODELS).index(model.name)])  # fmt: skip
-    if spec.poses == "uniform":
-        rot = _uniform_rotation(rng)
-        angles = (float("nan"),) * 3
-    else:
-        angles = (float(rng.uniform(-45, 45)), float(rng.uniform(-180, 180)), float(rng.uniform(-45, 45)))
-        rot = rotation(*angles)
+    rot, angles = _pose(spec, rng)
     distance = float(rng.uniform(*model.distance))
     radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
     # Anywhere the whole fruit is in both cameras' view (the Azure Kinect's depth is narrower than its colour).
