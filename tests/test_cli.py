@@ -772,10 +772,34 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--frames", "f", "--pose", "upright"], "evaluate --pose is for the paper and camera protocols"),
      (["evaluate", "--occlusion", "0.25"], "evaluate --occlusion is for --protocol camera"),
      (["evaluate", "--protocol", "paper", "--sensor", "heldback"], "evaluate --sensor is for --protocol camera"),
-     (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera")],
+     (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera"),
+     (["evaluate", "--spheres", "s", "--no-profile"], "evaluate --no-profile is for the protocols and --frames"),
+     (["evaluate", "--spheres", "s", "--fruit", "apple"], "evaluate --fruit is for the protocols and --frames"),
+     (["evaluate", "--frames", "f", "--fruit", "apple,pear"], "--fruit 'apple,pear': give one fruit kind"),
+     (["evaluate", "--frames", "f", "--fruit", "all"], "--fruit 'all': give one fruit kind")],
 )  # fmt: skip
 def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)
     assert main([*args, "--output", "res"] if args[0] == "evaluate" else args) == 2
     _one_line_error(capsys, message)
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("extra, profile", [([], True), (["--no-profile"], False)])
+def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra, profile):
+    import symfruit.evaluate.frames as frames
+    from symfruit.settings import resolve_settings
+
+    seen = []
+
+    def fake(folder, methods, masks, settings, by_id):
+        seen.append(settings)
+        return {}, {}, {}
+
+    monkeypatch.setattr(frames, "evaluate_frames", fake)
+    monkeypatch.setattr(frames, "table3", lambda *a: "table")
+    monkeypatch.setattr(frames, "summary_dict", lambda *a: {})
+    main(["evaluate", "--frames", str(tmp_path), "--fruit", "apple", *extra, "--output", str(tmp_path / "r")])
+    # before: --no-profile was accepted and the apple profile used all the same
+    assert (seen[0].to_dict() == resolve_settings(fruit="apple").to_dict()) is profile
+    assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile

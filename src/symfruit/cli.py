@@ -102,9 +102,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--fruit",
-        default="strawberry",
+        default=None,
         help="a generated kind (strawberry, apple, citrus, tomato, pear, lemon, peach, plum, banana, lopsided), "
-        "all, or a folder of complete scans (one table row per scan); comma-separated",
+        "all, or a folder of complete scans (one table row per scan); comma-separated; with --frames: the one "
+        "fruit profile of the frames (default strawberry)",
     )
     p.add_argument("--methods", help="comma-separated methods (default: " + _EVALUATED + ")")
     p.add_argument(
@@ -516,10 +517,21 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         ("--occlusion", args.occlusion is not None, camera, "--protocol camera"),
         ("--sensor", args.sensor is not None, camera, "--protocol camera"),
         ("--views", args.views is not None, camera, "--protocol camera"),
+        ("--fruit", args.fruit is not None, args.spheres is None,
+         "the protocols and --frames (--spheres use no profile)"),
+        ("--no-profile", args.no_profile, args.spheres is None,
+         "the protocols and --frames (--spheres use no profile)"),
     )  # fmt: skip
     for option, given, counts, need in rules:
         if given and not counts:
             raise InputError(f"evaluate {option} is for {need}; here it would be ignored")
+    if args.frames is not None and args.fruit is not None:
+        from .synthetic.shapes import FRUITS
+
+        if args.fruit.strip() not in FRUITS:  # a list, all or a folder of scans: the frames have one profile
+            raise InputError(f"evaluate --frames --fruit {args.fruit!r}: give one fruit kind (its profile is the "
+                             "frames')")  # fmt: skip
+    args.fruit = args.fruit or "strawberry"
     args.protocol = args.protocol or "paper"
     args.match = args.match or "centre"
     args.category = 1 if args.category is None else args.category
@@ -576,7 +588,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         from .profiles import available_profiles
 
         fruit = fruits[0] if len(fruits) == 1 and fruits[0] in available_profiles() else None
-        return _evaluate_frames(args, methods, _settings_for(args, fruit))
+        settings = _plain_settings(args) if args.no_profile else _settings_for(args, fruit)
+        return _evaluate_frames(args, methods, settings)
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, sensor=args.sensor, poses=args.pose, views=args.views, quick=args.quick,
@@ -644,7 +657,10 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     from .evaluate.masks import evaluate_masks, evaluate_scene_masks
     from .writers import new_results_folder, write_mask_report
 
-    settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
+    if args.no_profile:
+        settings = _plain_settings(args)
+    else:
+        settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
     from .segment import mask_source
 
     labeller = mask_source(args.masks or "color", settings=settings, images=())

@@ -190,6 +190,17 @@ def test_a_report_folder_that_links_out_of_the_run_is_refused_not_written_throug
     assert (tmp_path / "elsewhere" / "report.md").is_file()
 
 
+@pytest.mark.parametrize("inside", [".", "row1", "row1/a", "row1/../row2/d"])
+def test_a_report_folder_inside_the_run_other_than_its_own_is_refused(run, capsys, inside):
+    (run / "row1" / "a").mkdir(parents=True)
+    (run / "row2" / "d").mkdir(parents=True)
+    before = sorted(str(p.relative_to(run)) for p in run.rglob("*"))
+    assert main(["report", str(run), "--output", str(run / inside)]) == 2  # before: written into the frame's folder
+    err = capsys.readouterr().err
+    assert f"{run / inside}: is inside the run {run} (its own folder, a recording's or a frame's" in err
+    assert sorted(str(p.relative_to(run)) for p in run.rglob("*")) == before
+
+
 @pytest.mark.parametrize(
     "table, column, value, message",
     [

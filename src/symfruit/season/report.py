@@ -188,6 +188,18 @@ def _mm(value: float) -> str:
     return "-" if not math.isfinite(value) else f"{value:.1f}"
 
 
+def _check_folder(output: Path, folder: Path) -> None:
+    """Refuse a report folder inside the run other than its own ``report`` (the run's root, a recording's or a
+    frame's folder: the report's files would mix with the run's, whose next detect run owns that folder)."""
+    run, real = os.path.realpath(output), os.path.realpath(folder)
+    own = os.path.realpath(output / "report")
+    inside = os.path.commonpath([run, real]) == run
+    if inside and os.path.commonpath([own, real]) != own:
+        raise OutputError(f"{folder}: is inside the run {output} (its own folder, a recording's or a frame's, which "
+                          f"a detect run writes); write the report to {output / 'report'} (the default) or outside "
+                          "the run")  # fmt: skip
+
+
 def write_report(
     output: str | Path, *, folder: str | Path | None = None, classes: Sequence[float] = DEFAULT_CLASSES_MM
 ) -> Report:
@@ -215,6 +227,8 @@ def write_report(
         link = output / "report"
         raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
                           f"links inside {output}: remove it, or name a folder (--output)")  # fmt: skip
+    if folder is not None:
+        _check_folder(output, Path(folder))
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
