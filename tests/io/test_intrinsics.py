@@ -209,3 +209,17 @@ def test_zero_or_absent_distortion_warns_nothing_and_garbled_coefficients_are_re
 def _written(path, data):
     path.write_text(json.dumps(data))
     return path
+
+
+@pytest.mark.parametrize("centre", [{"cx": 700.0}, {"cy": -3.0}, {"cy": 600.0}])
+def test_a_principal_point_outside_the_image_is_named_in_a_warning(tmp_path, centre):
+    import warnings
+
+    path = _written(tmp_path / "cam.json", PLAIN | centre)
+    with pytest.warns(SymfruitWarning, match=r"cam\.json: the principal point \(cx .*\) lies outside the 640x480 "
+                      r"image: are these the intrinsics of this resolution"):  # fmt: skip
+        assert load_camera(path) == Camera(**(PLAIN | centre))  # used as given (a cropped image's may be so)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the image's edges (pixel centres at whole numbers) are inside
+        for cx, cy in ((-0.5, -0.5), (639.5, 479.5)):
+            load_camera(_written(tmp_path / "edge.json", PLAIN | {"cx": cx, "cy": cy}))

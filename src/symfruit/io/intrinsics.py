@@ -16,7 +16,9 @@ ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with
 Distortion coefficients (RealSense ``coeffs``, ROS ``D``/``d``, ``distortion_coefficients``) are checked to be
 finite numbers but never applied: symfruit's pipeline is pinhole. Non-zero ones raise a
 :class:`~symfruit.errors.SymfruitWarning` naming the file and the largest coefficient (undistort the images, or
-give the rectified camera's intrinsics, ROS ``P``); they are not ignored in silence.
+give the rectified camera's intrinsics, ROS ``P``); they are not ignored in silence. A principal point
+(``cx, cy``) outside the image is warned about alike (:func:`warn_principal_point`): intrinsics of another
+resolution, or swapped width and height, more often than a cropped image's.
 
 JSON or YAML by extension (YAML through ``yaml.safe_load`` only). A file's keys are checked: a key that none of
 these layouts has (nor ``depth_scale``/``depth_units``, read beside them by :func:`symfruit.io.read_frame`) is
@@ -40,7 +42,7 @@ from ..core.limits import MAX_DISTORTION_COEFFS, MAX_SETTINGS_BYTES, shown
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
-__all__ = ["camera_from_dict", "load_camera", "warn_distortion"]
+__all__ = ["camera_from_dict", "load_camera", "warn_distortion", "warn_principal_point"]
 
 #: Largest intrinsics file read (bytes): that of a settings file (:mod:`symfruit.core.limits`).
 MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
@@ -125,7 +127,27 @@ def _checked(data: Any, source: str) -> Camera:
     distortion = _distortion(data)
     if distortion is not None:
         warn_distortion(source, *distortion, stacklevel=4)
+    warn_principal_point(source, camera, stacklevel=4)
     return camera
+
+
+def warn_principal_point(source: str, camera: Camera, *, stacklevel: int = 2) -> bool:
+    """Warn (:class:`SymfruitWarning`) that the principal point of the camera ``source`` names lies outside its
+    image (pixel centres at whole numbers: the image spans -0.5 to width - 0.5); whether it warned. Not refused:
+    a cropped image's camera may have it there, but intrinsics of another resolution or with width and height
+    swapped are likelier, and misplace every point. The one rule for intrinsics files, bags' and live
+    ``CameraInfo`` messages and RealSense recordings' colour camera, as :func:`warn_distortion` is."""
+    if -0.5 <= camera.cx <= camera.width - 0.5 and -0.5 <= camera.cy <= camera.height - 0.5:
+        return False
+    warnings.warn(
+        SymfruitWarning(
+            f"{source}: the principal point (cx {camera.cx:g}, cy {camera.cy:g}) lies outside the "
+            f"{camera.width}x{camera.height} image: are these the intrinsics of this resolution (width and height "
+            "not swapped)? They are used as given"
+        ),
+        stacklevel=stacklevel,
+    )
+    return True
 
 
 def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2) -> bool:
