@@ -803,3 +803,21 @@ def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra
     # before: --no-profile was accepted and the apple profile used all the same
     assert (seen[0].to_dict() == resolve_settings(fruit="apple").to_dict()) is profile
     assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
+
+
+@pytest.mark.parametrize("target", ["cloud", "camera", "config", "link"])
+def test_complete_never_writes_its_result_over_an_input(tmp_path, capsys, target):
+    from symfruit.core.camera import DEFAULT_CAMERA
+    from symfruit.io.clouds import write_ply
+
+    write_ply(tmp_path / "a.ply", VISIBLE)
+    (tmp_path / "cam.json").write_text(json.dumps(DEFAULT_CAMERA.to_dict()))
+    (tmp_path / "s.json").write_text('{"fused": {"mirror_weight": 0.3}}')
+    (tmp_path / "link.ply").symlink_to(tmp_path / "a.ply")
+    output = {"cloud": "a.ply", "camera": "cam.ply", "config": "s.ply", "link": "link.ply"}[target]
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    args = ["complete", str(tmp_path / "a.ply"), "--camera", str(tmp_path / "cam.json"), "--config",
+            str(tmp_path / "s.json"), "--output", str(tmp_path / output)]  # fmt: skip
+    assert main(args) == 2  # before: exit 0, the cloud (or the intrinsics, the settings) written over
+    _one_line_error(capsys, "is an input of this run", "choose another output name")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before

@@ -298,12 +298,15 @@ def _complete(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .io import load_camera, read_cloud
     from .methods.complete import complete
-    from .writers import write_result
+    from .writers import check_result_paths, write_result
 
     settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
+    profile = Path(args.fruit) if args.fruit and Path(args.fruit).is_file() else None  # a profile file
+    inputs = [args.cloud, args.camera, args.config, profile]
     if args.output is not None:
         _check_output_file(args.output, ".ply")
+        check_result_paths(args.output, inputs)  # before the work: never over the cloud, intrinsics or settings
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
@@ -314,7 +317,7 @@ def _complete(args: argparse.Namespace) -> int:
     written = None
     if args.output is not None:
         meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}
-        written = write_result(args.output, result, meta=meta)
+        written = write_result(args.output, result, meta=meta, inputs=inputs)
     if args.json:
         print(json.dumps(result.to_dict(), indent=2))
         return 0
