@@ -776,9 +776,13 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--spheres", "s", "--no-profile"], "evaluate --no-profile is for the protocols and --frames"),
      (["evaluate", "--spheres", "s", "--fruit", "apple"], "evaluate --fruit is for the protocols and --frames"),
      (["evaluate", "--frames", "f", "--fruit", "apple,pear"], "--fruit 'apple,pear': give one fruit kind"),
-     (["evaluate", "--frames", "f", "--fruit", "all"], "--fruit 'all': give one fruit kind")],
+     (["evaluate", "--frames", "f", "--fruit", "all"], "--fruit 'all': give one fruit kind"),
+     (["segment", "a.png", "--output", "o", "--camera", "c.json"], "segment --camera is for --depth; here it would"),
+     (["segment", "a.png", "--output", "o", "--depth-scale", "0.0001"], "segment --depth-scale is for --depth"),
+     (["segment", "a.png", "--output", "o", "--depth", "d.png", "--camera", "c.json", "--masks", "labels"],
+      "segment --depth is for --masks color (the colour segmenter; --masks labels does not use depth)")],
 )  # fmt: skip
-def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
+def test_options_the_chosen_run_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)
     assert main([*args, "--output", "res"] if args[0] == "evaluate" else args) == 2
     _one_line_error(capsys, message)

@@ -186,8 +186,9 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
                    ".json or a folder of label PNGs")  # fmt: skip
     p.add_argument("--depth", type=_path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
-    p.add_argument("--camera", type=_path, help="intrinsics file (needed with --depth)")
-    p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
+    p.add_argument("--camera", type=_path, help="with --depth: intrinsics file (needed)")
+    p.add_argument("--depth-scale", type=float, default=None, help="with --depth: metres per unit of 16-bit depth "
+                   "(default 0.001)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
@@ -714,11 +715,21 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
 
 def _segment(args: argparse.Namespace) -> int:
     from .batch import segment_images
+    from .errors import InputError
     from .io import load_camera
 
+    # depth is the colour segmenter's alone: a model or mask files label the colour image without it
+    rules = (("--camera", args.camera is not None, args.depth is not None, "--depth"),
+             ("--depth-scale", args.depth_scale is not None, args.depth is not None, "--depth"),
+             ("--depth", args.depth is not None, args.masks == "color", "--masks color (the colour segmenter; "
+              f"--masks {args.masks} does not use depth)"))  # fmt: skip
+    for option, given, counts, need in rules:
+        if given and not counts:
+            raise InputError(f"segment {option} is for {need}; here it would be ignored")
     camera = load_camera(args.camera) if args.camera else None
+    depth_scale = 0.001 if args.depth_scale is None else args.depth_scale
     report = segment_images(args.inputs, output=args.output, masks=args.masks, depth=args.depth, camera=camera,
-                            depth_scale=args.depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
+                            depth_scale=depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
     if len(report.done) <= 20:
         for d in report.done:
             print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
