@@ -780,7 +780,10 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["segment", "a.png", "--output", "o", "--camera", "c.json"], "segment --camera is for --depth; here it would"),
      (["segment", "a.png", "--output", "o", "--depth-scale", "0.0001"], "segment --depth-scale is for --depth"),
      (["segment", "a.png", "--output", "o", "--depth", "d.png", "--camera", "c.json", "--masks", "labels"],
-      "segment --depth is for --masks color (the colour segmenter; --masks labels does not use depth)")],
+      "segment --depth is for --masks color (the colour segmenter; --masks labels does not use depth)"),
+     (["detect", "rec", "--output", "o", "--ros2-storage", "sqlite3"], "--ros2-storage (the storage of --ros2-bag) is"),
+     (["detect", "rec", "--output", "o", "--ros2-bag", "o"], "--ros2-bag o holds --output o: the bag's files and"),
+     (["detect", "rec", "--output", "b/o", "--ros2-bag", "b"], "--ros2-bag b holds --output b/o")],
 )  # fmt: skip
 def test_options_the_chosen_run_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)

@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import os
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
@@ -202,7 +203,7 @@ def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ros2-bag", type=_path, metavar="BAG",
                    help="also write the detections into this new ROS 2 bag folder (vision_msgs/msg/Detection3DArray "
                    "on /symfruit/detections, stamped like the input frames)")  # fmt: skip
-    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default="mcap",
+    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default=None,
                    help="storage of --ros2-bag (default mcap)")  # fmt: skip
 
 
@@ -766,6 +767,13 @@ def _detect(args: argparse.Namespace) -> int:
                          "--scheduler or --workers")  # fmt: skip
     if len(args.inputs) > 1 and args.ros2_bag is not None:
         raise InputError("--ros2-bag holds the frames of one recording: give one input with it")
+    if args.ros2_storage is not None and args.ros2_bag is None:
+        raise InputError("--ros2-storage (the storage of --ros2-bag) is for --ros2-bag; here it would be ignored")
+    if args.ros2_bag is not None:
+        bag_at, out_at = os.path.realpath(args.ros2_bag), os.path.realpath(args.output)
+        if os.path.commonpath([bag_at, out_at]) == bag_at:  # the bag's folder would hold the run's files
+            raise InputError(f"--ros2-bag {args.ros2_bag} holds --output {args.output}: the bag's files and the "
+                             "run's would share a folder; give the bag a folder of its own (e.g. OUT/bag)")  # fmt: skip
     with _ros2_bag(args) as bag:
         source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
@@ -804,7 +812,7 @@ def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
 
     if args.resume:
         raise InputError("--ros2-bag writes every frame into a new bag; it cannot be combined with --resume")
-    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage, class_id=Path(args.fruit).stem).open()
+    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage or "mcap", class_id=Path(args.fruit).stem).open()
     try:
         yield bag
     except BaseException:
