@@ -223,3 +223,24 @@ def test_counts_and_confidences_no_run_writes_are_refused_not_reported(run, tabl
     with pytest.raises(FileFormatError, match=message):
         write_report(run)
     assert not (run / "report").exists()
+
+
+@pytest.mark.parametrize(
+    "table, column, values, message",
+    [("detections.parquet", "size_x", "a", r"column size_x holds string, not float64"),  # before: ValueError
+     ("detections.parquet", "reliable", "yes", r"column reliable holds string, not bool"),  # before: all unreliable
+     ("frames.parquet", "fruit", 1.5, r"column fruit holds double, not int32"),  # before: read as 1
+     ("frames.parquet", "located", None, r"column located has 4 empty rows; every frame has its count")],
+)  # fmt: skip
+def test_columns_of_another_type_are_refused_by_name(run, table, column, values, message):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    t = pq.read_table(run / table)
+    k = t.schema.get_field_index(column)
+    kind = pa.int32() if values is None else None
+    t = t.set_column(k, column, pa.array([values] * t.num_rows, type=kind))
+    pq.write_table(t, run / table)
+    with pytest.raises(FileFormatError, match=rf"{table}: {message} \(not a symfruit table, or damaged\)$"):
+        write_report(run)
+    assert not (run / "report").exists()
