@@ -478,3 +478,14 @@ def test_a_camera_info_whose_principal_point_is_off_the_image_is_warned_about_on
     sized = write_ros2_bag(tmp_path / "sizeless", color, mm, info_size=(0, 0), k=[600.0, 0, 80, 0, 600, 160, 0, 0, 1])
     with pytest.warns(SymfruitWarning, match=r"cy 160\) lies outside the 160x120 image"), open_source(sized) as src:
         src.read(0)
+
+
+def test_a_camera_info_whose_k_is_transposed_fails_its_frames_by_name(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(
+        tmp_path / "t", color, (depth * 1000).astype(np.uint16), k=[600.0, 0, 0, 0, 600, 0, 80, 60, 1]
+    )
+    message = r"t: invalid CameraInfo on /camera/color/camera_info \(CameraInfo K \[600, 0, 0, 0, 600, 0, 80, 60, 1\]"
+    with open_source(path) as src, pytest.raises(FileFormatError, match=message + " is not a pinhole"):
+        src.read(0)  # before: read as cx = cy = 0, the fruit placed far off

@@ -332,3 +332,11 @@ def test_live_camera_info_principal_point_off_the_image_is_warned_about_once(exa
     said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
     assert len(said) == 2 and said[0].startswith("ros:/c@0: CameraInfo: non-zero distortion coefficients 'D'")
     assert said[1].startswith("ros:/c@0: CameraInfo: the principal point (cx -40, cy")
+
+
+def test_live_camera_info_with_a_transposed_k_is_refused():
+    color = image_msg(np.zeros((48, 64, 3), np.uint8), "rgb8")
+    depth = image_msg(np.zeros((48, 64), np.uint16), "16UC1")
+    info = SimpleNamespace(width=64, height=48, header=header(), K=[600.0, 0, 0, 0, 600, 0, 32, 24, 1])
+    with pytest.raises(InputError, match=r"CameraInfo K \[600, 0, 0, 0, 600, 0, 32, 24, 1\] is not a pinhole"):
+        frame_of(color, depth, info)  # before: a frame of cx = cy = 0

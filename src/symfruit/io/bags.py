@@ -32,7 +32,7 @@ from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
-from .intrinsics import warn_distortion, warn_principal_point
+from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = [
     "BagSource",
@@ -212,6 +212,7 @@ def camera_from_info(
     key, coeffs = info_distortion(msg)
     w, h = int(msg.width) or (width or 0), int(msg.height) or (height or 0)
     camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
+    check_pinhole_matrix(k, "CameraInfo K")  # row-major; a transposed one would read cx = cy = 0
     if source is not None:
         said = warned if warned is not None else set()
         if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3):

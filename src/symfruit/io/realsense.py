@@ -44,7 +44,7 @@ from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
 from .frames import named_frame
-from .intrinsics import warn_distortion, warn_principal_point
+from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -168,6 +168,7 @@ class RealSenseBagSource:
         try:
             camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(info.width), height=int(info.height))
             lens = Lens(camera, LENS_MODELS[model], tuple(coeffs or [0.0] * 5))
+            check_pinhole_matrix(k, "camera info K")
         except InputError as exc:
             raise FileFormatError(f"{prefix}: invalid intrinsics ({exc})") from None
         if prefix not in tfs:
