@@ -222,6 +222,16 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "rip": False}]}, r"unknown key 'rip'; did you "
          "mean 'ripe'"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "Visible": 0.5}]}, "did you mean 'visible'"),
+        # before: "false" or 0 is not False, so an unripe fruit counted as a target
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "ripe": "false"}]}, r"fruit 1: ripe must be true "
+         "or false, got 'false'"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "ripe": 0}]}, r"ripe must be true or false, got 0"),
+        # before: two fruits of one id (one mask label), one of them matched by --match id and the other missed
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 3},
+                     {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 3, "ripe": False}]},
+         r"fruit 2: id 3 is fruit 1's too; each fruit has its own id"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2},
+                     {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, r"fruit 2: id 2 is fruit 1's too"),  # its number
     ],
 )  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):

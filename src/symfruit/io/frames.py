@@ -10,7 +10,8 @@ A frame folder holds::
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
     masks.json                optional: COCO-style annotations (polygons or RLE)
     truth.json                optional: {"fruits": [{"id", "min", "max", "visible", "ripe", ...}]}, true boxes in
-                              metres (other keys left alone, one a letter or two from these refused)
+                              metres (other keys left alone, one a letter or two from these refused; ids
+                              unique, ripe true or false)
 
 A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
@@ -27,7 +28,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
+from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size, shown
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
@@ -180,11 +181,21 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         if not isinstance(fruits, list):
             raise TypeError("'fruits' is not a list")
         out, visible = [], {}
+        seen_ids: dict[int, int] = {}  # every fruit's id (unripe ones' too: a label is one fruit's) -> its number
         for k, item in enumerate(fruits, 1):
             if not isinstance(item, dict):
                 raise TypeError(f"fruit {k} is not an object")
             _misspelt_truth_key(item, k)
-            if item.get("ripe", True) is False:
+            ripe = item.get("ripe", True)
+            if not isinstance(ripe, bool):  # "false" or 0 is not False: it would count an unripe fruit as a target
+                raise ValueError(f"fruit {k}: ripe must be true or false, got {shown(ripe)}")
+            fid = item.get("id", k)
+            if isinstance(fid, int) and not isinstance(fid, bool):  # other ids are refused below, if ripe
+                if fid in seen_ids:
+                    raise ValueError(f"fruit {k}: id {fid} is fruit {seen_ids[fid]}'s too; each fruit has its own "
+                                     "id (its mask label)")  # fmt: skip
+                seen_ids[fid] = k
+            if not ripe:
                 continue
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
             if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
@@ -194,7 +205,6 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
             if max(np.abs(lo).max(), np.abs(hi).max()) > MAX_DEPTH_METRES:
                 raise ValueError(f"fruit {k}: a box more than {MAX_DEPTH_METRES:g} m from the camera; boxes are in "
                                  "metres (these look like millimetres)")  # fmt: skip
-            fid = item.get("id", k)
             if isinstance(fid, bool) or not isinstance(fid, int) or not 0 <= fid <= MAX_LABEL_ID:
                 raise ValueError(f"fruit {k}: id must be a whole number in 0-{MAX_LABEL_ID} (a label id)")
             out.append((fid, Box(lo, hi)))
