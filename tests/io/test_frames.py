@@ -418,3 +418,24 @@ def test_depth_units_that_are_not_text_and_float64_depth_beyond_float32_are_no_p
     np.save(tmp_path / "f" / "depth.npy", huge)
     got = read_frame(tmp_path / "f").depth
     assert not got[:10].any() and np.array_equal(got[10:], depth[10:])
+
+
+@pytest.mark.parametrize(
+    "extra, first, second",
+    [("depth.npy", "depth.png", "depth.npy"), ("camera.yaml", "camera.json", "camera.yaml"),
+     ("masks.json", "masks.png", "masks.json")],
+)  # fmt: skip
+def test_a_frame_holding_two_depth_intrinsics_or_mask_files_is_refused(tmp_path, extra, first, second):
+    frame = tmp_path / "f"
+    shutil.copytree(EXAMPLE_FRAME, frame)
+    Image.fromarray(np.zeros((480, 640), np.uint8)).save(frame / "masks.png")
+    if extra == "depth.npy":  # depth that disagrees with depth.png: which one is meant?
+        np.save(frame / extra, np.full((480, 640), 0.5))
+    elif extra == "camera.yaml":
+        (frame / extra).write_text("fx: 600\nfy: 600\ncx: 320\ncy: 240\nwidth: 640\nheight: 480\n")
+    else:
+        (frame / extra).write_text('{"annotations": []}')
+    with pytest.raises(FileFormatError, match=rf"f: holds both {first} and {second}; which one is meant\? Keep one"):
+        read_frame(frame)  # before: the first read, the other ignored in silence
+    (frame / extra).unlink()
+    assert read_frame(frame).camera.fx == 615.0

@@ -8,12 +8,14 @@ A frame folder holds::
     camera.json | .yaml       intrinsics in any layout symfruit reads; an optional "depth_scale"
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
-    masks.json                optional: COCO-style annotations (polygons or RLE)
+    masks.json                ... or COCO-style annotations (polygons or RLE)
     truth.json                optional: {"fruits": [{"id", "min", "max", "visible", "ripe", ...}]}, true boxes in
                               metres (other keys left alone, one a letter or two from these refused; ids
                               unique, ripe true or false)
 
-A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
+Of the depth, intrinsics and mask files a frame holds one each: two (``depth.png`` and ``depth.npy``,
+``camera.json`` and ``camera.yaml``, ``masks.png`` and ``masks.json``) are refused by name, never one taken in
+silence. A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
 """
 
@@ -65,6 +67,16 @@ def _first(folder: Path, *names: str) -> Path | None:
     return None
 
 
+def _only(folder: Path, *names: str) -> Path | None:
+    """The one file of ``names`` the frame folder holds, or None; two of them are refused: two depth images or
+    intrinsics or mask files that may disagree, one of them taken in silence, would not be the one meant."""
+    given = [folder / n for n in names if holds_file(folder / n)]
+    if len(given) > 1:
+        raise FileFormatError(f"{folder}: holds both {given[0].name} and {given[1].name}; which one is meant? Keep "
+                              "one")  # fmt: skip
+    return given[0] if given else None
+
+
 def is_frame_folder(folder: Path) -> bool:
     """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
     that name is then refused by name when the frame is read)."""
@@ -89,21 +101,21 @@ def read_frame(folder: str | Path) -> Frame:
     color_path = _first(folder, *COLOR_NAMES)
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")
-    cam_path = _first(folder, "camera.json", "camera.yaml", "camera.yml")
+    cam_path = _only(folder, "camera.json", "camera.yaml", "camera.yml")
     if cam_path is None:
         raise FileFormatError(f"{folder}: no camera.json (intrinsics)")
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
     color, color_orientation = read_color_oriented(color_path)
-    depth_file = _first(folder, "depth.png", "depth.npy")
+    depth_file = _only(folder, "depth.png", "depth.npy")
     if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
     oriented = (str(color_path), color_orientation)
-    masks = read_masks(folder, color.shape[:2], color=oriented) if _first(folder, "masks.png", "masks.json") else None
+    masks = read_masks(folder, color.shape[:2], color=oriented) if _only(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible,
                        extras={COLOR_FILE: oriented})  # fmt: skip
