@@ -128,6 +128,18 @@ def test_depth_units_and_scale(tmp_path, units, scale):
         assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
     (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 0.0002}))
     assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(0.0002))
+    # both, agreeing: read; disagreeing (before: depth_units taken, depth_scale ignored in silence): refused
+    (tmp_path / "f" / "camera.json").write_text(
+        json.dumps({**CAM.to_dict(), "depth_scale": scale, "depth_units": units})
+    )
+    if units != "m":
+        assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
+    (tmp_path / "f" / "camera.json").write_text(
+        json.dumps({**CAM.to_dict(), "depth_scale": 0.0002, "depth_units": units})
+    )
+    message = rf"camera\.json: depth_scale 0\.0002 and depth_units '{units}' \({scale:g} m\) disagree; which one"
+    with pytest.raises(InputError, match=message):
+        read_frame(tmp_path / "f")
 
 
 @pytest.mark.parametrize("scale", [0, 1.5, -0.001, True, "0.001"])
