@@ -828,3 +828,37 @@ def test_complete_never_writes_its_result_over_an_input(tmp_path, capsys, target
     assert main(args) == 2  # before: exit 0, the cloud (or the intrinsics, the settings) written over
     _one_line_error(capsys, "is an input of this run", "choose another output name")
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+@pytest.mark.parametrize(
+    "stated, given, used",
+    [({"depth_scale": 0.0001}, None, 0.0001), ({"depth_units": "cm"}, None, 0.01), ({}, None, 0.001),
+     ({}, "0.0002", 0.0002), ({"depth_units": "mm"}, "0.001", 0.001), ({"depth_scale": 0.0001}, "0.001", None)],
+)  # fmt: skip
+def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, monkeypatch, stated, given, used):
+    import symfruit.batch
+    from symfruit.core.camera import DEFAULT_CAMERA
+
+    seen = []
+
+    class Report:
+        done, failed, fruit, stopped, ok, mask_source = [], {}, 0, None, True, "colour segmenter"
+
+    monkeypatch.setattr(symfruit.batch, "segment_images", lambda *a, **k: seen.append(k["depth_scale"]) or Report)
+    (tmp_path / "cam.json").write_text(json.dumps({**DEFAULT_CAMERA.to_dict(), **stated}))
+    args = [
+        "segment",
+        "a.png",
+        "--output",
+        str(tmp_path / "o"),
+        "--depth",
+        "d.png",
+        "--camera",
+        str(tmp_path / "cam.json"),
+    ]
+    code = main([*args, *(["--depth-scale", given] if given else [])])
+    if used is None:  # two depth scales that disagree: which one is meant?
+        assert code == 2 and not seen
+        _one_line_error(capsys, "segment --depth-scale 0.001 and", "cam.json's depth scale 0.0001 disagree")
+    else:  # before: the camera file's depth_scale ignored, 0.001 used whatever it said
+        assert code == 0 and seen == [used]

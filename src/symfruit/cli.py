@@ -189,7 +189,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--depth", type=_path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
     p.add_argument("--camera", type=_path, help="with --depth: intrinsics file (needed)")
     p.add_argument("--depth-scale", type=float, default=None, help="with --depth: metres per unit of 16-bit depth "
-                   "(default 0.001)")  # fmt: skip
+                   "(default: the --camera file's depth_scale or depth_units, else 0.001)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
@@ -728,7 +728,13 @@ def _segment(args: argparse.Namespace) -> int:
         if given and not counts:
             raise InputError(f"segment {option} is for {need}; here it would be ignored")
     camera = load_camera(args.camera) if args.camera else None
-    depth_scale = 0.001 if args.depth_scale is None else args.depth_scale
+    from .io.frames import file_depth_scale
+
+    stated = file_depth_scale(args.camera) if args.camera else None  # as a frame's camera.json: read, not ignored
+    if stated is not None and args.depth_scale is not None and stated != args.depth_scale:
+        raise InputError(f"segment --depth-scale {args.depth_scale:g} and {args.camera}'s depth scale {stated:g} "
+                         "disagree; which one is meant? Give one")  # fmt: skip
+    depth_scale = args.depth_scale if args.depth_scale is not None else stated if stated is not None else 0.001
     report = segment_images(args.inputs, output=args.output, masks=args.masks, depth=args.depth, camera=camera,
                             depth_scale=depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
     if len(report.done) <= 20:

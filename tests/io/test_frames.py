@@ -451,3 +451,14 @@ def test_a_frame_holding_two_depth_intrinsics_or_mask_files_is_refused(tmp_path,
         read_frame(frame)  # before: the first read, the other ignored in silence
     (frame / extra).unlink()
     assert read_frame(frame).camera.fx == 615.0
+
+
+def test_the_depth_scale_an_intrinsics_file_states(tmp_path):
+    from symfruit.io.frames import file_depth_scale
+
+    for stated, scale in (({"depth_scale": 0.0001}, 0.0001), ({"depth_units": "cm"}, 0.01), ({}, None)):
+        (tmp_path / "cam.json").write_text(json.dumps({**CAM.to_dict(), **stated}))
+        assert file_depth_scale(tmp_path / "cam.json") == scale
+    (tmp_path / "cam.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 7}))
+    with pytest.raises(InputError, match=r"cam\.json: depth_scale must be metres per unit in \(0, 1\], got 7"):
+        file_depth_scale(tmp_path / "cam.json")

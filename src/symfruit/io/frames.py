@@ -40,6 +40,7 @@ __all__ = [
     "COLOR_FILE",
     "COLOR_NAMES",
     "DEFAULT_DEPTH_SCALE",
+    "file_depth_scale",
     "is_frame_folder",
     "named_frame",
     "read_depth",
@@ -163,6 +164,19 @@ def read_depth_npy(path: Path) -> np.ndarray:
         raise FileFormatError(f"{path}: cannot read ({exc})") from None
     with np.errstate(over="ignore", invalid="ignore"):  # float64 beyond float32 (1e300 m): inf, then no depth
         return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+
+
+def file_depth_scale(path: str | Path) -> float | None:
+    """The depth scale (metres per unit) an intrinsics file states (``depth_scale`` or ``depth_units``, as a
+    frame's ``camera.json`` does), or None where it states none: what ``segment --depth`` with ``--camera``
+    reads 16-bit depth by."""
+    from .intrinsics import read_mapping
+
+    path = as_path(path, "file_depth_scale: the intrinsics file")
+    data = read_mapping(path)
+    if not isinstance(data, dict) or ("depth_scale" not in data and "depth_units" not in data):
+        return None
+    return _depth_scale(path, data)
 
 
 def _depth_scale(cam_path: Path, data: Any) -> float:
