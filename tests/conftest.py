@@ -75,6 +75,13 @@ if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
 
 
 @pytest.hookimpl(trylast=True)
+def pytest_configure(config) -> None:
+    # small_frame() is a crop of the example frame whose principal point lies left of it (cx -80): the cropped
+    # image a warning allows for (symfruit.io.intrinsics.warn_principal_point), read by dozens of batch tests.
+    # Its warning is tested where it is said (pytest.warns records whatever the filters say).
+    config.addinivalue_line("filterwarnings", r"ignore:.*the principal point \(cx -80, cy 140\) lies outside")
+
+
 def pytest_collection_modifyitems(config, items) -> None:
     """Keep ``--dist loadgroup``'s groups together: pytest-xdist names a test's ``xdist_group`` in its node id on
     the worker, and since pytest 9.2 (structured node ids) its assignment no longer takes, so every group was

@@ -772,10 +772,93 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--frames", "f", "--pose", "upright"], "evaluate --pose is for the paper and camera protocols"),
      (["evaluate", "--occlusion", "0.25"], "evaluate --occlusion is for --protocol camera"),
      (["evaluate", "--protocol", "paper", "--sensor", "heldback"], "evaluate --sensor is for --protocol camera"),
-     (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera")],
+     (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera"),
+     (["evaluate", "--spheres", "s", "--no-profile"], "evaluate --no-profile is for the protocols and --frames"),
+     (["evaluate", "--spheres", "s", "--fruit", "apple"], "evaluate --fruit is for the protocols and --frames"),
+     (["evaluate", "--frames", "f", "--fruit", "apple,pear"], "--fruit 'apple,pear': give one fruit kind"),
+     (["evaluate", "--frames", "f", "--fruit", "all"], "--fruit 'all': give one fruit kind"),
+     (["segment", "a.png", "--output", "o", "--camera", "c.json"], "segment --camera is for --depth; here it would"),
+     (["segment", "a.png", "--output", "o", "--depth-scale", "0.0001"], "segment --depth-scale is for --depth"),
+     (["segment", "a.png", "--output", "o", "--depth", "d.png", "--camera", "c.json", "--masks", "labels"],
+      "segment --depth is for --masks color (the colour segmenter; --masks labels does not use depth)"),
+     (["detect", "rec", "--output", "o", "--ros2-storage", "sqlite3"], "--ros2-storage (the storage of --ros2-bag) is"),
+     (["detect", "rec", "--output", "o", "--ros2-bag", "o"], "--ros2-bag o holds --output o: the bag's files and"),
+     (["detect", "rec", "--output", "b/o", "--ros2-bag", "b"], "--ros2-bag b holds --output b/o")],
 )  # fmt: skip
-def test_options_the_chosen_bench_or_evaluation_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
+def test_options_the_chosen_run_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)
     assert main([*args, "--output", "res"] if args[0] == "evaluate" else args) == 2
     _one_line_error(capsys, message)
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("extra, profile", [([], True), (["--no-profile"], False)])
+def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra, profile):
+    import symfruit.evaluate.frames as frames
+    from symfruit.settings import resolve_settings
+
+    seen = []
+
+    def fake(folder, methods, masks, settings, by_id):
+        seen.append(settings)
+        return {}, {}, {}
+
+    monkeypatch.setattr(frames, "evaluate_frames", fake)
+    monkeypatch.setattr(frames, "table3", lambda *a: "table")
+    monkeypatch.setattr(frames, "summary_dict", lambda *a: {})
+    main(["evaluate", "--frames", str(tmp_path), "--fruit", "apple", *extra, "--output", str(tmp_path / "r")])
+    # before: --no-profile was accepted and the apple profile used all the same
+    assert (seen[0].to_dict() == resolve_settings(fruit="apple").to_dict()) is profile
+    assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
+
+
+@pytest.mark.parametrize("target", ["cloud", "camera", "config", "link"])
+def test_complete_never_writes_its_result_over_an_input(tmp_path, capsys, target):
+    from symfruit.core.camera import DEFAULT_CAMERA
+    from symfruit.io.clouds import write_ply
+
+    write_ply(tmp_path / "a.ply", VISIBLE)
+    (tmp_path / "cam.json").write_text(json.dumps(DEFAULT_CAMERA.to_dict()))
+    (tmp_path / "s.json").write_text('{"fused": {"mirror_weight": 0.3}}')
+    (tmp_path / "link.ply").symlink_to(tmp_path / "a.ply")
+    output = {"cloud": "a.ply", "camera": "cam.ply", "config": "s.ply", "link": "link.ply"}[target]
+    before = {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()}
+    args = ["complete", str(tmp_path / "a.ply"), "--camera", str(tmp_path / "cam.json"), "--config",
+            str(tmp_path / "s.json"), "--output", str(tmp_path / output)]  # fmt: skip
+    assert main(args) == 2  # before: exit 0, the cloud (or the intrinsics, the settings) written over
+    _one_line_error(capsys, "is an input of this run", "choose another output name")
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir() if p.is_file()} == before
+
+
+@pytest.mark.parametrize(
+    "stated, given, used",
+    [({"depth_scale": 0.0001}, None, 0.0001), ({"depth_units": "cm"}, None, 0.01), ({}, None, 0.001),
+     ({}, "0.0002", 0.0002), ({"depth_units": "mm"}, "0.001", 0.001), ({"depth_scale": 0.0001}, "0.001", None)],
+)  # fmt: skip
+def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, monkeypatch, stated, given, used):
+    import symfruit.batch
+    from symfruit.core.camera import DEFAULT_CAMERA
+
+    seen = []
+
+    class Report:
+        done, failed, fruit, stopped, ok, mask_source = [], {}, 0, None, True, "colour segmenter"
+
+    monkeypatch.setattr(symfruit.batch, "segment_images", lambda *a, **k: seen.append(k["depth_scale"]) or Report)
+    (tmp_path / "cam.json").write_text(json.dumps({**DEFAULT_CAMERA.to_dict(), **stated}))
+    args = [
+        "segment",
+        "a.png",
+        "--output",
+        str(tmp_path / "o"),
+        "--depth",
+        "d.png",
+        "--camera",
+        str(tmp_path / "cam.json"),
+    ]
+    code = main([*args, *(["--depth-scale", given] if given else [])])
+    if used is None:  # two depth scales that disagree: which one is meant?
+        assert code == 2 and not seen
+        _one_line_error(capsys, "segment --depth-scale 0.001 and", "cam.json's depth scale 0.0001 disagree")
+    else:  # before: the camera file's depth_scale ignored, 0.001 used whatever it said
+        assert code == 0 and seen == [used]

@@ -59,3 +59,19 @@ def test_the_demo_works_from_an_unrelated_folder(tmp_path, monkeypatch, capsys):
     assert (folder / "overlay.png").is_file() and (folder / "detections.json").is_file()
     fruits = json.loads((folder / "detections.json").read_text())["fruits"]
     assert len(fruits) == 6 and not any("error" in f for f in fruits)
+
+
+def test_the_demo_never_writes_into_its_own_frame_folder(tmp_path, monkeypatch):
+    import contextlib
+    import shutil
+
+    from symfruit import demo
+    from symfruit.errors import OutputError
+
+    copy = tmp_path / "example_frame"  # a copy stands in for the package data, which a failure would write into
+    shutil.copytree(EXAMPLE_FRAME, copy)
+    monkeypatch.setattr(demo, "example_frame", lambda: contextlib.nullcontext(copy))
+    before = sorted(p.name for p in copy.iterdir())
+    with pytest.raises(OutputError, match=r"example_frame: the output folder is also an input folder"):
+        run_demo(copy, method="raw")  # before: fruit_00k.ply, overlay.png, detections.json written beside its images
+    assert sorted(p.name for p in copy.iterdir()) == before

@@ -246,3 +246,17 @@ def test_a_results_root_that_cannot_hold_a_results_folder_is_refused_before_anyt
     check_results_root(tmp_path / "new" / "deeper")  # to be made: fine, and nothing made yet
     check_results_root(tmp_path)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["file"]
+
+
+def test_a_result_is_never_written_over_an_input(tmp_path):
+    from symfruit.errors import OutputError
+    from symfruit.writers import check_result_paths
+
+    (tmp_path / "cloud.ply").write_text("ply")
+    (tmp_path / "cam.json").write_text("{}")
+    inputs = [tmp_path / "cloud.ply", tmp_path / "cam.json", None]
+    for output in ("cloud.ply", "cam.ply", "sub/../cloud.ply"):  # the cloud, or its .json the intrinsics
+        with pytest.raises(OutputError, match=r"is an input of this run .*choose another output name"):
+            check_result_paths(tmp_path / output, inputs)
+    assert check_result_paths(tmp_path / "out.ply", inputs) == (tmp_path / "out.ply", tmp_path / "out.json")
+    assert [p.read_text() for p in inputs[:2]] == ["ply", "{}"]

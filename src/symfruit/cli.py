@@ -10,6 +10,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import os
 import shutil
 import sys
 from collections.abc import Iterator, Sequence
@@ -102,9 +103,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--fruit",
-        default="strawberry",
+        default=None,
         help="a generated kind (strawberry, apple, citrus, tomato, pear, lemon, peach, plum, banana, lopsided), "
-        "all, or a folder of complete scans (one table row per scan); comma-separated",
+        "all, or a folder of complete scans (one table row per scan); comma-separated; with --frames: the one "
+        "fruit profile of the frames (default strawberry)",
     )
     p.add_argument("--methods", help="comma-separated methods (default: " + _EVALUATED + ")")
     p.add_argument(
@@ -185,8 +187,9 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--masks", default="color", help="color (default), maskrcnn:CHECKPOINT.pth, onnx:MODEL.onnx, a COCO "
                    ".json or a folder of label PNGs")  # fmt: skip
     p.add_argument("--depth", type=_path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
-    p.add_argument("--camera", type=_path, help="intrinsics file (needed with --depth)")
-    p.add_argument("--depth-scale", type=float, default=0.001, help="metres per unit of 16-bit depth (0.001)")
+    p.add_argument("--camera", type=_path, help="with --depth: intrinsics file (needed)")
+    p.add_argument("--depth-scale", type=float, default=None, help="with --depth: metres per unit of 16-bit depth "
+                   "(default: the --camera file's depth_scale or depth_units, else 0.001)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
     p = sub.add_parser("demo", help="detect the fruit of the shipped example frame and compare with its truth")
@@ -200,7 +203,7 @@ def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--ros2-bag", type=_path, metavar="BAG",
                    help="also write the detections into this new ROS 2 bag folder (vision_msgs/msg/Detection3DArray "
                    "on /symfruit/detections, stamped like the input frames)")  # fmt: skip
-    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default="mcap",
+    p.add_argument("--ros2-storage", choices=("mcap", "sqlite3"), default=None,
                    help="storage of --ros2-bag (default mcap)")  # fmt: skip
 
 
@@ -297,12 +300,15 @@ def _complete(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .io import load_camera, read_cloud
     from .methods.complete import complete
-    from .writers import write_result
+    from .writers import check_result_paths, write_result
 
     settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
+    profile = Path(args.fruit) if args.fruit and Path(args.fruit).is_file() else None  # a profile file
+    inputs = [args.cloud, args.camera, args.config, profile]
     if args.output is not None:
         _check_output_file(args.output, ".ply")
+        check_result_paths(args.output, inputs)  # before the work: never over the cloud, intrinsics or settings
     points = read_cloud(args.cloud)
     if args.units == "mm":
         points = points / 1000.0
@@ -313,7 +319,7 @@ def _complete(args: argparse.Namespace) -> int:
     written = None
     if args.output is not None:
         meta = {"input": str(args.cloud), "units": args.units, "camera": camera.to_dict()}
-        written = write_result(args.output, result, meta=meta)
+        written = write_result(args.output, result, meta=meta, inputs=inputs)
     if args.json:
         print(json.dumps(result.to_dict(), indent=2))
         return 0
@@ -516,10 +522,21 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         ("--occlusion", args.occlusion is not None, camera, "--protocol camera"),
         ("--sensor", args.sensor is not None, camera, "--protocol camera"),
         ("--views", args.views is not None, camera, "--protocol camera"),
+        ("--fruit", args.fruit is not None, args.spheres is None,
+         "the protocols and --frames (--spheres use no profile)"),
+        ("--no-profile", args.no_profile, args.spheres is None,
+         "the protocols and --frames (--spheres use no profile)"),
     )  # fmt: skip
     for option, given, counts, need in rules:
         if given and not counts:
             raise InputError(f"evaluate {option} is for {need}; here it would be ignored")
+    if args.frames is not None and args.fruit is not None:
+        from .synthetic.shapes import FRUITS
+
+        if args.fruit.strip() not in FRUITS:  # a list, all or a folder of scans: the frames have one profile
+            raise InputError(f"evaluate --frames --fruit {args.fruit!r}: give one fruit kind (its profile is the "
+                             "frames')")  # fmt: skip
+    args.fruit = args.fruit or "strawberry"
     args.protocol = args.protocol or "paper"
     args.match = args.match or "centre"
     args.category = 1 if args.category is None else args.category
@@ -576,7 +593,8 @@ def _evaluate(args: argparse.Namespace) -> int:
         from .profiles import available_profiles
 
         fruit = fruits[0] if len(fruits) == 1 and fruits[0] in available_profiles() else None
-        return _evaluate_frames(args, methods, _settings_for(args, fruit))
+        settings = _plain_settings(args) if args.no_profile else _settings_for(args, fruit)
+        return _evaluate_frames(args, methods, settings)
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, sensor=args.sensor, poses=args.pose, views=args.views, quick=args.quick,
@@ -644,7 +662,10 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
     from .evaluate.masks import evaluate_masks, evaluate_scene_masks
     from .writers import new_results_folder, write_mask_report
 
-    settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
+    if args.no_profile:
+        settings = _plain_settings(args)
+    else:
+        settings = _settings_for(args, "strawberry" if args.fruit == "strawberry" else None)
     from .segment import mask_source
 
     labeller = mask_source(args.masks or "color", settings=settings, images=())
@@ -695,11 +716,27 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
 
 def _segment(args: argparse.Namespace) -> int:
     from .batch import segment_images
+    from .errors import InputError
     from .io import load_camera
 
+    # depth is the colour segmenter's alone: a model or mask files label the colour image without it
+    rules = (("--camera", args.camera is not None, args.depth is not None, "--depth"),
+             ("--depth-scale", args.depth_scale is not None, args.depth is not None, "--depth"),
+             ("--depth", args.depth is not None, args.masks == "color", "--masks color (the colour segmenter; "
+              f"--masks {args.masks} does not use depth)"))  # fmt: skip
+    for option, given, counts, need in rules:
+        if given and not counts:
+            raise InputError(f"segment {option} is for {need}; here it would be ignored")
     camera = load_camera(args.camera) if args.camera else None
+    from .io.frames import file_depth_scale
+
+    stated = file_depth_scale(args.camera) if args.camera else None  # as a frame's camera.json: read, not ignored
+    if stated is not None and args.depth_scale is not None and stated != args.depth_scale:
+        raise InputError(f"segment --depth-scale {args.depth_scale:g} and {args.camera}'s depth scale {stated:g} "
+                         "disagree; which one is meant? Give one")  # fmt: skip
+    depth_scale = args.depth_scale if args.depth_scale is not None else stated if stated is not None else 0.001
     report = segment_images(args.inputs, output=args.output, masks=args.masks, depth=args.depth, camera=camera,
-                            depth_scale=args.depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
+                            depth_scale=depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
     if len(report.done) <= 20:
         for d in report.done:
             print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
@@ -736,6 +773,13 @@ def _detect(args: argparse.Namespace) -> int:
                          "--scheduler or --workers")  # fmt: skip
     if len(args.inputs) > 1 and args.ros2_bag is not None:
         raise InputError("--ros2-bag holds the frames of one recording: give one input with it")
+    if args.ros2_storage is not None and args.ros2_bag is None:
+        raise InputError("--ros2-storage (the storage of --ros2-bag) is for --ros2-bag; here it would be ignored")
+    if args.ros2_bag is not None:
+        bag_at, out_at = os.path.realpath(args.ros2_bag), os.path.realpath(args.output)
+        if os.path.commonpath([bag_at, out_at]) == bag_at:  # the bag's folder would hold the run's files
+            raise InputError(f"--ros2-bag {args.ros2_bag} holds --output {args.output}: the bag's files and the "
+                             "run's would share a folder; give the bag a folder of its own (e.g. OUT/bag)")  # fmt: skip
     with _ros2_bag(args) as bag:
         source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
@@ -774,7 +818,7 @@ def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
 
     if args.resume:
         raise InputError("--ros2-bag writes every frame into a new bag; it cannot be combined with --resume")
-    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage, class_id=Path(args.fruit).stem).open()
+    bag = Ros2DetectionBag(args.ros2_bag, storage=args.ros2_storage or "mcap", class_id=Path(args.fruit).stem).open()
     try:
         yield bag
     except BaseException:

@@ -61,9 +61,11 @@ def run_demo(output: str | Path, *, method: str = DEFAULT_METHOD, settings: Sett
     output = Path(output)
     with example_frame() as folder:
         frame = read_frame(folder)
+        source = Path(folder)  # the frame's folder, an input: never written into (--output it is refused)
+        inputs = [p for p in source.iterdir() if p.is_file()]
     settings = settings or Settings()
-    found = detect(frame, method=method, settings=settings)
-    with OutputFolder(output):  # locked while written; no link inside it followed
+    with OutputFolder(output, inputs=inputs, input_folders=[source]):  # checked before the work; locked, no link
+        found = detect(frame, method=method, settings=settings)
         write_detections(output, found, settings=settings)
     truth = frame.truth or []
     ok = [d for d in found.detections if d.result is not None]

@@ -26,6 +26,7 @@ import contextlib
 import datetime as _dt
 import fnmatch
 import os
+from collections.abc import Iterable
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,7 @@ from .settings import Settings
 __all__ = [
     "OPTICAL_FRAME",
     "bbox_record",
+    "check_result_paths",
     "detection_record",
     "detections_record",
     "draw_contact_sheet",
@@ -72,22 +74,47 @@ def _labels(result: Result) -> np.ndarray:
     return np.r_[np.zeros(n_vis, np.uint8), np.ones(len(result.points) - n_vis, np.uint8)]
 
 
-def write_result(path: str | Path, result: Result, *, meta: dict[str, Any] | None = None) -> tuple[Path, Path]:
-    """Write ``path`` (``.ply``: the completed cloud) and the same name ``.json`` (record, extras, settings).
+def check_result_paths(path: str | Path, inputs: Iterable[str | Path | None] = ()) -> tuple[Path, Path]:
+    """``(ply, json)``: the two files :func:`write_result` writes for ``path``, checked before any work is
+    done: ``path`` ends in ``.ply``, neither is a folder nor one of the run's ``inputs`` (the cloud, the
+    intrinsics, the settings file: ``complete a.ply --output a.ply`` would write over the cloud it read).
 
     Raises
     ------
     FileFormatError
-        When ``path`` does not end in ``.ply`` or is a folder.
+        When ``path`` does not end in ``.ply``.
+    OutputError
+        When either file is a folder or an input.
     """
     path = Path(path)
     if path.suffix.lower() != ".ply":
         raise FileFormatError(f"{path}: the output must end in .ply")
     json_path = path.with_suffix(".json")
+    read = {os.path.realpath(p): Path(p) for p in inputs if p is not None}
     for target in (path, json_path):  # both checked before either is written
         if target.is_dir():
             raise OutputError(f"{target}: is a folder; give a file name ending in .ply (the result goes to "
                               f"{path.name} and {json_path.name})")  # fmt: skip
+        if (given := read.get(os.path.realpath(target))) is not None:
+            raise OutputError(f"{target}: is an input of this run ({given}); the result ({path.name} and "
+                              f"{json_path.name}) would write over it: choose another output name")  # fmt: skip
+    return path, json_path
+
+
+def write_result(
+    path: str | Path, result: Result, *, meta: dict[str, Any] | None = None, inputs: Iterable[str | Path | None] = ()
+) -> tuple[Path, Path]:
+    """Write ``path`` (``.ply``: the completed cloud) and the same name ``.json`` (record, extras, settings);
+    ``inputs``: the files the result was made from, never written over (:func:`check_result_paths`).
+
+    Raises
+    ------
+    FileFormatError
+        When ``path`` does not end in ``.ply``.
+    OutputError
+        When ``path`` or its ``.json`` is a folder or one of ``inputs``.
+    """
+    path, json_path = check_result_paths(path, inputs)
     record = {**result.to_dict(), **(meta or {}), "extras": result.extras,
               "settings": result.settings.to_dict()}  # fmt: skip
     write_ply(path, result.points, labels=_labels(result))

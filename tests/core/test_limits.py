@@ -53,7 +53,7 @@ def test_readme_limits_are_the_enforced_constants():
     cloud = _numbers(next(v for k, v in table.items() if k.startswith("a cloud file")))
     assert cloud[:2] == [limits.MAX_CLOUD_POINTS, limits.MAX_TEXT_CLOUD_BYTES]
     mesh = _numbers(next(v for k, v in table.items() if k.startswith("a mesh")))
-    assert mesh == [limits.MAX_FACES, limits.MAX_OBJ_BYTES]
+    assert mesh == [limits.MAX_CLOUD_POINTS, limits.MAX_FACES, limits.MAX_OBJ_BYTES]
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
     assert limits.MAX_BAG_METADATA_BYTES == limits.MAX_TRUTH_BYTES  # stated beside the truth file's
@@ -76,6 +76,7 @@ def test_the_modules_use_the_one_set_of_bounds():
     assert bags.MAX_MESSAGE_PIXELS == frames.MAX_DEPTH_ELEMENTS == limits.MAX_IMAGE_PIXELS
     assert raster.MAX_WINDOW_PIXELS == limits.MAX_WINDOW_PIXELS and clouds.MAX_CLOUD_POINTS == limits.MAX_CLOUD_POINTS
     assert meshes.MAX_FACES == limits.MAX_FACES and masks.MAX_COCO_BYTES == limits.MAX_COCO_BYTES
+    assert meshes.MAX_CLOUD_POINTS == limits.MAX_CLOUD_POINTS
     assert detect.MAX_FRUIT_PER_FRAME == masks.MAX_INSTANCES_PER_IMAGE == limits.MAX_INSTANCES
     assert intrinsics.MAX_INTRINSICS_BYTES == limits.MAX_SETTINGS_BYTES
     assert intrinsics.MAX_DISTORTION_COEFFS is limits.MAX_DISTORTION_COEFFS

@@ -590,3 +590,31 @@ def test_the_leaf_shares_counted_unsorted_decide_as_the_sorted_flags_did(seed, q
     values[rng.random(len(values)) < 0.05] = rng.choice([0.0, np.nan])
     expected = _fruit_depth_as_before(values, 20.0, F, leafy=green)
     np.testing.assert_array_equal(fruit_depth(values, 20.0, F, leafy=green), expected)
+
+
+@pytest.mark.parametrize("found", ["gone", "renamed", "not a dict", "odd value"])
+def test_the_sort_choice_survives_numpy_moving_its_private_cpu_features(monkeypatch, found):
+    import importlib
+    import types
+
+    from symfruit.core import surface
+
+    real = importlib.import_module
+
+    def fake(name, *args):
+        if not name.endswith("._multiarray_umath"):
+            return real(name, *args)
+        if found == "gone":
+            raise ImportError(name)  # before: ImportError out of the module's import
+        module = types.ModuleType(name)
+        if found == "not a dict":
+            module.__cpu_features__ = ("AVX512_ICL",)  # before: AttributeError (no .get)
+        elif found == "odd value":
+            module.__cpu_features__ = {"AVX512_ICL": "yes"}
+        return module
+
+    monkeypatch.setattr(importlib, "import_module", fake)
+    assert surface._simd_sort16() is False  # the radix sort: the same rows in order
+    keys = np.random.default_rng(0).integers(-300, 300, (50, 40)).astype(np.int16)
+    monkeypatch.setattr(surface, "_KIND16", "stable")
+    assert np.array_equal(surface._sort_rows(keys), np.sort(keys, axis=1))

@@ -437,3 +437,55 @@ def test_a_camera_info_with_distortion_is_warned_about_once_per_bag_and_a_non_fi
     ):
         src.read(0)
     src.close()
+
+
+class _Unconverted:
+    """A coefficient that fails the test if it is ever converted."""
+
+    def __float__(self):
+        raise AssertionError("a coefficient was converted before the count was checked")
+
+
+@pytest.mark.parametrize("key", ["D", "d"])
+def test_a_camera_info_distortion_is_counted_before_any_value_is_converted(key):
+    from symfruit.io.bags import info_distortion
+
+    msg = SimpleNamespace(**{key: [_Unconverted()] * 1000})  # before: every value converted, then counted
+    with pytest.raises(InputError, match=rf"^CameraInfo {key} must hold at most 16 finite numbers, got 1000 values$"):
+        info_distortion(msg)
+    with pytest.raises(InputError, match=rf"^CameraInfo {key} is not a list of numbers$"):
+        info_distortion(SimpleNamespace(**{key: 3.0}))
+
+
+def test_a_camera_info_whose_principal_point_is_off_the_image_is_warned_about_once_per_bag(tmp_path):
+    pytest.importorskip("rosbags")
+    import warnings
+
+    from symfruit import SymfruitWarning
+
+    color, depth = disc_frame([(80, 60)])
+    mm = (depth * 1000).astype(np.uint16)
+    path = write_ros2_bag(tmp_path / "off", color, mm, frames=3, k=[600.0, 0, 80, 0, 600, 160, 0, 0, 1])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        with open_source(path) as src:
+            assert [src.read(i).camera.cy for i in range(3)] == [160.0] * 3  # used as given, said once
+    said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
+    assert said == [f"{path}: CameraInfo on /camera/color/camera_info: the principal point (cx 80, cy 160) lies "
+                    "outside the 160x120 image: are these the intrinsics of this resolution (width and height not "
+                    "swapped)? They are used as given"]  # fmt: skip
+    # a camera info of size 0 takes the images' size first: checked against that
+    sized = write_ros2_bag(tmp_path / "sizeless", color, mm, info_size=(0, 0), k=[600.0, 0, 80, 0, 600, 160, 0, 0, 1])
+    with pytest.warns(SymfruitWarning, match=r"cy 160\) lies outside the 160x120 image"), open_source(sized) as src:
+        src.read(0)
+
+
+def test_a_camera_info_whose_k_is_transposed_fails_its_frames_by_name(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(
+        tmp_path / "t", color, (depth * 1000).astype(np.uint16), k=[600.0, 0, 0, 0, 600, 0, 80, 60, 1]
+    )
+    message = r"t: invalid CameraInfo on /camera/color/camera_info \(CameraInfo K \[600, 0, 0, 0, 600, 0, 80, 60, 1\]"
+    with open_source(path) as src, pytest.raises(FileFormatError, match=message + " is not a pinhole"):
+        src.read(0)  # before: read as cx = cy = 0, the fruit placed far off

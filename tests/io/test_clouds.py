@@ -370,3 +370,14 @@ def test_a_ragged_ascii_pcd_is_refused_in_its_own_words(tmp_path):
     with pytest.raises(FileFormatError, match=r"a\.pcd: ascii PCD rows are not all 3 numbers \(the number of columns "
                        r"changed from 2 to 3 at row 2\)$"):  # fmt: skip
         read_cloud(tmp_path / "a.pcd")  # before: numpy's "; use `usecols` to select a subset and avoid this error"
+
+
+@pytest.mark.parametrize("shape", ["WIDTH -2\nHEIGHT -1\nPOINTS 2\n", "WIDTH -2\nHEIGHT -1\n", "WIDTH 2\nHEIGHT 1\n"])
+def test_a_pcd_of_negative_width_and_height_is_refused(tmp_path, shape):
+    head = f"VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n{shape}DATA ascii\n"
+    (tmp_path / "a.pcd").write_text(head + "0 0 0.5\n0.01 0 0.5\n")
+    if "-" not in shape:  # no POINTS: the shape's product
+        assert read_cloud(tmp_path / "a.pcd").shape == (2, 3)
+        return
+    with pytest.raises(FileFormatError, match=r"a\.pcd: PCD header garbles WIDTH/HEIGHT \(-2 x -1; counts are >= 0\)"):
+        read_cloud(tmp_path / "a.pcd")  # before: -2 x -1 = 2 points read

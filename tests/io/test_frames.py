@@ -128,6 +128,18 @@ def test_depth_units_and_scale(tmp_path, units, scale):
         assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
     (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 0.0002}))
     assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(0.0002))
+    # both, agreeing: read; disagreeing (before: depth_units taken, depth_scale ignored in silence): refused
+    (tmp_path / "f" / "camera.json").write_text(
+        json.dumps({**CAM.to_dict(), "depth_scale": scale, "depth_units": units})
+    )
+    if units != "m":
+        assert np.array_equal(read_frame(tmp_path / "f").depth, raw * np.float32(scale))
+    (tmp_path / "f" / "camera.json").write_text(
+        json.dumps({**CAM.to_dict(), "depth_scale": 0.0002, "depth_units": units})
+    )
+    message = rf"camera\.json: depth_scale 0\.0002 and depth_units '{units}' \({scale:g} m\) disagree; which one"
+    with pytest.raises(InputError, match=message):
+        read_frame(tmp_path / "f")
 
 
 @pytest.mark.parametrize("scale", [0, 1.5, -0.001, True, "0.001"])
@@ -222,6 +234,16 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "rip": False}]}, r"unknown key 'rip'; did you "
          "mean 'ripe'"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "Visible": 0.5}]}, "did you mean 'visible'"),
+        # before: "false" or 0 is not False, so an unripe fruit counted as a target
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "ripe": "false"}]}, r"fruit 1: ripe must be true "
+         "or false, got 'false'"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "ripe": 0}]}, r"ripe must be true or false, got 0"),
+        # before: two fruits of one id (one mask label), one of them matched by --match id and the other missed
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 3},
+                     {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 3, "ripe": False}]},
+         r"fruit 2: id 3 is fruit 1's too; each fruit has its own id"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2},
+                     {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, r"fruit 2: id 2 is fruit 1's too"),  # its number
     ],
 )  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):
@@ -408,3 +430,35 @@ def test_depth_units_that_are_not_text_and_float64_depth_beyond_float32_are_no_p
     np.save(tmp_path / "f" / "depth.npy", huge)
     got = read_frame(tmp_path / "f").depth
     assert not got[:10].any() and np.array_equal(got[10:], depth[10:])
+
+
+@pytest.mark.parametrize(
+    "extra, first, second",
+    [("depth.npy", "depth.png", "depth.npy"), ("camera.yaml", "camera.json", "camera.yaml"),
+     ("masks.json", "masks.png", "masks.json")],
+)  # fmt: skip
+def test_a_frame_holding_two_depth_intrinsics_or_mask_files_is_refused(tmp_path, extra, first, second):
+    frame = tmp_path / "f"
+    shutil.copytree(EXAMPLE_FRAME, frame)
+    Image.fromarray(np.zeros((480, 640), np.uint8)).save(frame / "masks.png")
+    if extra == "depth.npy":  # depth that disagrees with depth.png: which one is meant?
+        np.save(frame / extra, np.full((480, 640), 0.5))
+    elif extra == "camera.yaml":
+        (frame / extra).write_text("fx: 600\nfy: 600\ncx: 320\ncy: 240\nwidth: 640\nheight: 480\n")
+    else:
+        (frame / extra).write_text('{"annotations": []}')
+    with pytest.raises(FileFormatError, match=rf"f: holds both {first} and {second}; which one is meant\? Keep one"):
+        read_frame(frame)  # before: the first read, the other ignored in silence
+    (frame / extra).unlink()
+    assert read_frame(frame).camera.fx == 615.0
+
+
+def test_the_depth_scale_an_intrinsics_file_states(tmp_path):
+    from symfruit.io.frames import file_depth_scale
+
+    for stated, scale in (({"depth_scale": 0.0001}, 0.0001), ({"depth_units": "cm"}, 0.01), ({}, None)):
+        (tmp_path / "cam.json").write_text(json.dumps({**CAM.to_dict(), **stated}))
+        assert file_depth_scale(tmp_path / "cam.json") == scale
+    (tmp_path / "cam.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 7}))
+    with pytest.raises(InputError, match=r"cam\.json: depth_scale must be metres per unit in \(0, 1\], got 7"):
+        file_depth_scale(tmp_path / "cam.json")

@@ -261,3 +261,18 @@ def test_a_quarter_turned_colour_image_whose_partners_are_for_its_stored_pixels_
         images.turned_mismatch(tmp_path / "c.jpg", shown, {"depth.png": (2, 4)})
     Image.new("RGB", (2, 4)).save(tmp_path / "plain.jpg")  # no orientation: a size mismatch of another kind
     images.turned_mismatch(tmp_path / "plain.jpg", (4, 2, 3), {"depth.png": (2, 4)})
+
+
+@pytest.mark.parametrize("suffix, mode", [(".png", "I;16"), (".tif", "I;16"), (".png", "L"), (".gif", "L")])
+def test_depth_and_labels_of_several_images_in_one_file_are_refused(tmp_path, suffix, mode):
+    first = Image.fromarray(np.full((8, 10), 500 if mode != "L" else 5, np.uint16 if mode != "L" else np.uint8))
+    second = Image.fromarray(np.asarray(first) * 2)
+    path = tmp_path / f"stack{suffix}"
+    first.save(path, save_all=True, append_images=[second])
+    read = read_labels if mode == "L" else read_depth_units
+    what = "a label image" if mode == "L" else "a depth image"
+    with pytest.raises(FileFormatError, match=rf"stack\{suffix}: holds 2 images \(an animation or a multi-page "
+                       rf"file\); {what} is one image"):  # fmt: skip
+        read(path)  # before: the first one read in silence
+    first.save(path)  # one image: read
+    assert read(path).shape == (8, 10)

@@ -209,3 +209,40 @@ def test_zero_or_absent_distortion_warns_nothing_and_garbled_coefficients_are_re
 def _written(path, data):
     path.write_text(json.dumps(data))
     return path
+
+
+@pytest.mark.parametrize("centre", [{"cx": 700.0}, {"cy": -3.0}, {"cy": 600.0}])
+def test_a_principal_point_outside_the_image_is_named_in_a_warning(tmp_path, centre):
+    import warnings
+
+    path = _written(tmp_path / "cam.json", PLAIN | centre)
+    with pytest.warns(SymfruitWarning, match=r"cam\.json: the principal point \(cx .*\) lies outside the 640x480 "
+                      r"image: are these the intrinsics of this resolution"):  # fmt: skip
+        assert load_camera(path) == Camera(**(PLAIN | centre))  # used as given (a cropped image's may be so)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the image's edges (pixel centres at whole numbers) are inside
+        for cx, cy in ((-0.5, -0.5), (639.5, 479.5)):
+            load_camera(_written(tmp_path / "edge.json", PLAIN | {"cx": cx, "cy": cy}))
+
+
+@pytest.mark.parametrize(
+    "data, message",
+    [({"intrinsic_matrix": [615, 0, 320, 0, 615, 240, 0, 0, 1]}, r"'intrinsic_matrix' \[615, 0, 320, 0, 615, 240, 0, "
+      r"0, 1\] is not a pinhole intrinsic matrix .* column-major, as Open3D writes it"),  # before: cx = cy = 0
+     ({"K": [615, 0, 0, 0, 615, 0, 320, 240, 1]}, r"'K' \[615, 0, 0, 0, 615, 0, 320, 240, 1\] is not .* row-major"),
+     ({"k": [615, 0, 320, 0, 615, 240, 0, 0, 2]}, r"'k' .* its entries below the diagonal must be 0 and the last 1"),
+     ({"K": [615, 0, 320, 0, 615, 240, 0, 0, 1], "k": [1, 0, 3, 0, 1, 2, 0, 0, 1]},
+      r"give the focal lengths twice, as 'K' and 'k': which one is meant"),  # before: K read, k left unsaid
+     ({"fx": 615, "fy": 615, "cx": 320, "cy": 240, "K": [1, 0, 3, 0, 1, 2, 0, 0, 1]}, r"as 'K' and 'fx'"),
+     ({"fx": 615, "fy": 615, "cx": 320, "ppx": 300, "cy": 240}, r"the principal point's x twice, as 'cx' and 'ppx'"),
+     ({"fx": 615, "fy": 615, "cx": 320, "cy": 240, "image_height": 480}, r"the height twice, as 'height' and "
+      r"'image_height'")],
+)  # fmt: skip
+def test_a_transposed_or_scaled_matrix_and_a_value_given_twice_are_refused(tmp_path, data, message):
+    base = {"width": 640, "height": 480}
+    with pytest.raises(InputError, match=message):
+        camera_from_dict(base | data)
+    with pytest.raises(FileFormatError, match=r"cam\.json: intrinsics "):
+        load_camera(_written(tmp_path / "cam.json", base | data))
+    right = {"K": [615, 0, 320, 0, 615, 240, 0, 0, 1]}, {"intrinsic_matrix": [615, 0, 0, 0, 615, 0, 320, 240, 1]}
+    assert {camera_from_dict(base | r) for r in right} == {Camera(615, 615, 320, 240, 640, 480)}

@@ -119,3 +119,33 @@ def test_a_ply_mesh_without_xyz_vertices_is_refused_naming_what_it_lacks(tmp_pat
     path.write_bytes(b"ply\nformat ascii 1.0\n" + body)
     with pytest.raises(FileFormatError, match=rf"m\.ply: {message}"):
         read_mesh(path)
+
+
+@pytest.mark.parametrize(
+    "body, line",
+    [("v 0 0 0\n" * 11, 11),  # one vertex over the bound
+     ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf " + "1 2 3 " * 3 + "\n", 4)],  # one polygon of 9 corners: 7 triangles
+)  # fmt: skip
+def test_an_obj_over_the_vertex_or_face_bound_is_refused_while_read(tmp_path, monkeypatch, body, line):
+    from symfruit.io import meshes
+
+    monkeypatch.setattr(meshes, "MAX_CLOUD_POINTS", 10)  # bounds as a PLY mesh's (before: an OBJ had none)
+    monkeypatch.setattr(meshes, "MAX_FACES", 5)
+    (tmp_path / "m.obj").write_text(body)
+    with pytest.raises(FileFormatError, match=rf"m\.obj: line {line}: OBJ mesh of more than 10 vertices or 5 faces"):
+        read_mesh(tmp_path / "m.obj")
+
+
+def test_a_ply_polygon_of_many_corners_is_bounded_by_the_triangles_it_makes(tmp_path, monkeypatch):
+    from symfruit.io import meshes
+
+    path = tmp_path / "m.ply"
+    path.write_bytes(
+        b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+        b"element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 1\n1 0 1\n0 1 1\n"
+        b"9 0 1 2 0 1 2 0 1 2\n"
+    )
+    assert read_mesh(path)[1].shape == (7, 3)
+    monkeypatch.setattr(meshes, "MAX_FACES", 5)  # one face within the bound, its fan of 7 triangles over it
+    with pytest.raises(FileFormatError, match=r"m\.ply: its polygons make 7 triangles; at most 5 faces are read"):
+        read_mesh(path)

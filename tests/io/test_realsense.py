@@ -459,3 +459,23 @@ def test_a_distorted_colour_lens_is_warned_about_as_any_camera_is(tmp_path):
     with warnings.catch_warnings():
         warnings.simplefilter("error", SymfruitWarning)  # the example's lenses are undistorted
         RealSenseBagSource(BAG).close()
+
+
+def test_a_camera_info_distortion_is_counted_before_any_value_is_converted(monkeypatch):
+    from symfruit.io import realsense
+
+    class Unconverted:
+        def __float__(self):
+            raise AssertionError("a coefficient was converted before the count was checked")
+
+    only = realsense.RealSenseBagSource._only
+
+    def poisoned(self, topic):
+        msg = only(self, topic)
+        if topic.endswith("Color_0/info/camera_info"):
+            msg.D = [Unconverted()] * 100_000  # before: every value converted, then counted
+        return msg
+
+    monkeypatch.setattr(realsense.RealSenseBagSource, "_only", poisoned)
+    with pytest.raises(FileFormatError, match=r"Color_0: camera info K has 9 values and D 100000; expected 9 and 5"):
+        RealSenseBagSource(BAG)

@@ -51,7 +51,8 @@ def test_folder_order_is_by_name_hidden_folders_and_exclusions_skipped(tmp_path)
     assert "out" not in open_source(tmp_path, exclude=[tmp_path / "a" / ".." / "out"]).names()
 
 
-@pytest.mark.parametrize("left", ["errors.json", "detections.parquet", "frames.parquet", ".symfruit.lock"])
+@pytest.mark.parametrize("left", ["errors.json", "detections.parquet", "frames.parquet", ".symfruit.lock",
+                                  "summary.json"])  # fmt: skip
 def test_an_earlier_runs_output_inside_the_recording_is_no_frame(tmp_path, left):
     make_frames(tmp_path, "a", "b")
     (tmp_path / "out" / "a").mkdir(parents=True)  # detect rec --output rec/out, then --output rec/out2
@@ -132,3 +133,13 @@ def test_the_registry_of_kinds(tmp_path, isolated_registry):
     (tmp_path / "rec.list").write_text(f"{tmp_path / 'x'}\n")
     src = open_source(tmp_path / "rec.list")
     assert isinstance(src, FrameSource) and src.names() == ["x"] and src.read(0).color.shape == (480, 640, 3)
+
+
+def test_evaluate_results_written_into_the_frames_folder_are_no_frames_of_it(tmp_path):
+    from symfruit.writers import new_results_folder
+
+    make_frames(tmp_path, "a", "b")
+    for tag in ("frames", "spheres"):  # evaluate --frames rec --output rec: rec/<stamp>-frames and rec/latest
+        (new_results_folder(tmp_path, tag) / "summary.json").write_text("{}")
+    # before: each results folder and the latest link counted as a frame, and failed ('no color.png')
+    assert open_source(tmp_path).names() == ["a", "b"]

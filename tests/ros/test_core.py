@@ -116,7 +116,7 @@ def test_camera_info_ros1_and_ros2_names_and_image_size():
     for key in ("K", "k"):
         cam = frame_of(color, depth, info_msg(fx=600, fy=601, cx=30, cy=20, width=64, height=48, key=key)).camera
         assert (cam.fx, cam.fy, cam.cx, cam.cy, cam.width, cam.height) == (600, 601, 30, 20, 64, 48)
-    cam = frame_of(color, depth, info_msg(width=0, height=0)).camera  # an unset size is the image's
+    cam = frame_of(color, depth, info_msg(width=0, height=0, cx=32, cy=24)).camera  # an unset size is the image's
     assert (cam.width, cam.height) == (64, 48)
     with pytest.raises(InputError, match="focal"):
         frame_of(color, depth, info_msg(fx=0.0, width=64, height=48))
@@ -293,15 +293,15 @@ def test_live_camera_info_distortion_is_warned_about_once_and_a_non_finite_one_r
             match=r"^ros: CameraInfo: non-zero distortion coefficients "
             rf"'{key.replace('K', 'D').replace('k', 'd')}' \(largest -0\.2\) are not applied",
         ):
-            frame_of(color, depth, info_msg(width=64, height=48, key=key, d=[-0.2, 0.05, 0, 0, 0]))
+            frame_of(color, depth, info_msg(width=64, height=48, cx=32, cy=24, key=key, d=[-0.2, 0.05, 0, 0, 0]))
     with pytest.raises(InputError, match=r"CameraInfo D must hold at most 16 finite numbers, got \[inf"):
-        frame_of(color, depth, info_msg(width=64, height=48, d=[float("inf"), 0, 0, 0, 0]))
+        frame_of(color, depth, info_msg(width=64, height=48, cx=32, cy=24, d=[float("inf"), 0, 0, 0, 0]))
     with pytest.raises(InputError, match=r"CameraInfo D holds something that is not a number"):
-        frame_of(color, depth, info_msg(width=64, height=48, d=["x"]))
+        frame_of(color, depth, info_msg(width=64, height=48, cx=32, cy=24, d=["x"]))
     with warnings.catch_warnings():
         warnings.simplefilter("error", SymfruitWarning)
-        frame_of(color, depth, info_msg(width=64, height=48, d=[0.0] * 5))  # zeros, or none: nothing to say
-        frame_of(color, depth, info_msg(width=64, height=48))
+        frame_of(color, depth, info_msg(width=64, height=48, cx=32, cy=24, d=[0.0] * 5))  # zeros or none: silent
+        frame_of(color, depth, info_msg(width=64, height=48, cx=32, cy=24))
     core = FrameProcessor(fruit="strawberry")
     color, depth, info = example_messages(example_images)
     info.D = [0.1, 0, 0, 0, 0]
@@ -311,3 +311,32 @@ def test_live_camera_info_distortion_is_warned_about_once_and_a_non_finite_one_r
             core.frame(color, depth, info, source=f"ros:/c@{k}")
     said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
     assert len(said) == 1 and said[0].startswith("ros:/c@0: CameraInfo: non-zero distortion coefficients 'D'")
+
+
+def test_live_camera_info_principal_point_off_the_image_is_warned_about_once(example_images):
+    import warnings
+
+    from symfruit import SymfruitWarning
+
+    color, depth = image_msg(np.zeros((48, 64, 3), np.uint8), "rgb8"), image_msg(np.zeros((48, 64), np.uint16), "16UC1")
+    with pytest.warns(SymfruitWarning, match=r"^ros: CameraInfo: the principal point \(cx 320, cy 240\) lies outside "
+                      r"the 64x48 image"):  # fmt: skip
+        frame_of(color, depth, info_msg(width=0, height=0))  # the intrinsics of 640x480 on 64x48 images
+    core = FrameProcessor(fruit="strawberry")
+    color, depth, info = example_messages(example_images)
+    info.D, info.K[2] = [0.1, 0, 0, 0, 0], -40.0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for k in range(3):
+            core.frame(color, depth, info, source=f"ros:/c@{k}")
+    said = [str(w.message) for w in caught if issubclass(w.category, SymfruitWarning)]
+    assert len(said) == 2 and said[0].startswith("ros:/c@0: CameraInfo: non-zero distortion coefficients 'D'")
+    assert said[1].startswith("ros:/c@0: CameraInfo: the principal point (cx -40, cy")
+
+
+def test_live_camera_info_with_a_transposed_k_is_refused():
+    color = image_msg(np.zeros((48, 64, 3), np.uint8), "rgb8")
+    depth = image_msg(np.zeros((48, 64), np.uint16), "16UC1")
+    info = SimpleNamespace(width=64, height=48, header=header(), K=[600.0, 0, 0, 0, 600, 0, 32, 24, 1])
+    with pytest.raises(InputError, match=r"CameraInfo K \[600, 0, 0, 0, 600, 0, 32, 24, 1\] is not a pinhole"):
+        frame_of(color, depth, info)  # before: a frame of cx = cy = 0

@@ -190,6 +190,17 @@ def test_a_report_folder_that_links_out_of_the_run_is_refused_not_written_throug
     assert (tmp_path / "elsewhere" / "report.md").is_file()
 
 
+@pytest.mark.parametrize("inside", [".", "row1", "row1/a", "row1/../row2/d"])
+def test_a_report_folder_inside_the_run_other_than_its_own_is_refused(run, capsys, inside):
+    (run / "row1" / "a").mkdir(parents=True)
+    (run / "row2" / "d").mkdir(parents=True)
+    before = sorted(str(p.relative_to(run)) for p in run.rglob("*"))
+    assert main(["report", str(run), "--output", str(run / inside)]) == 2  # before: written into the frame's folder
+    err = capsys.readouterr().err
+    assert f"{run / inside}: is inside the run {run} (its own folder, a recording's or a frame's" in err
+    assert sorted(str(p.relative_to(run)) for p in run.rglob("*")) == before
+
+
 @pytest.mark.parametrize(
     "table, column, value, message",
     [
@@ -210,5 +221,26 @@ def test_counts_and_confidences_no_run_writes_are_refused_not_reported(run, tabl
     t = t.set_column(k, t.schema.field(k), pa.array([value] * t.num_rows, type=t.schema.field(k).type))
     pq.write_table(t, run / table)
     with pytest.raises(FileFormatError, match=message):
+        write_report(run)
+    assert not (run / "report").exists()
+
+
+@pytest.mark.parametrize(
+    "table, column, values, message",
+    [("detections.parquet", "size_x", "a", r"column size_x holds string, not float64"),  # before: ValueError
+     ("detections.parquet", "reliable", "yes", r"column reliable holds string, not bool"),  # before: all unreliable
+     ("frames.parquet", "fruit", 1.5, r"column fruit holds double, not int32"),  # before: read as 1
+     ("frames.parquet", "located", None, r"column located has 4 empty rows; every frame has its count")],
+)  # fmt: skip
+def test_columns_of_another_type_are_refused_by_name(run, table, column, values, message):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    t = pq.read_table(run / table)
+    k = t.schema.get_field_index(column)
+    kind = pa.int32() if values is None else None
+    t = t.set_column(k, column, pa.array([values] * t.num_rows, type=kind))
+    pq.write_table(t, run / table)
+    with pytest.raises(FileFormatError, match=rf"{table}: {message} \(not a symfruit table, or damaged\)$"):
         write_report(run)
     assert not (run / "report").exists()

@@ -502,12 +502,17 @@ class _Outline:
 
 
 def _simd_sort16() -> bool:
-    """Whether numpy's default sort of 16-bit integers is its AVX-512 (ICL) one, which beats its radix sort."""
-    try:
-        umath = importlib.import_module("numpy._core._multiarray_umath")  # numpy 2
-    except ImportError:  # pragma: no cover - numpy 1
-        umath = importlib.import_module("numpy.core._multiarray_umath")
-    return bool(getattr(umath, "__cpu_features__", {}).get("AVX512_ICL", False))
+    """Whether numpy's default sort of 16-bit integers is its AVX-512 (ICL) one, which beats its radix sort. Read
+    from numpy's private ``__cpu_features__``: where numpy moves or renames it, False (the radix sort: the same
+    sorted rows, at worst slower than AVX-512's), never an error."""
+    for name in ("numpy._core._multiarray_umath", "numpy.core._multiarray_umath"):  # numpy 2, numpy 1
+        try:
+            features = getattr(importlib.import_module(name), "__cpu_features__", None)
+        except Exception:  # gone, or numpy 1's deprecated path warned as an error
+            continue
+        if isinstance(features, dict):
+            return features.get("AVX512_ICL") is True
+    return False
 
 
 #: the sort of :func:`_sort_rows` for 16-bit keys: numpy's radix sort ("stable") but where the default is AVX-512's

@@ -26,9 +26,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
 
 from ..core.camera import Camera
+from ..core.raster import distance_transform
 
 __all__ = ["measure_sphere", "model_frame", "real_frames", "table"]
 
@@ -48,7 +48,7 @@ def measure_sphere(depth: np.ndarray, mask: np.ndarray, camera: Camera, *, searc
     silhouette = (d > 0) & (d > z_front - 0.02) & (d < z_front + 1.2 * r_m)
     iou, du, dv = _best_shift(m, silhouette, search)
     reg = np.roll(np.roll(m, dv, axis=0), du, axis=1)
-    sd = np.where(reg, ndimage.distance_transform_edt(reg), -ndimage.distance_transform_edt(~reg))
+    sd = np.where(reg, distance_transform(reg), -distance_transform(~reg))
     zero = d == 0
     base_in = float(zero[(sd > 8) & (sd < 8 + r_px)].mean()) if ((sd > 8) & (sd < 8 + r_px)).any() else 0.0
     base_out = float(zero[(sd < -10) & (sd > -24)].mean())

@@ -32,7 +32,7 @@ from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
-from .intrinsics import warn_distortion
+from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = [
     "BagSource",
@@ -178,7 +178,12 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
 
 
 def camera_from_info(
-    msg: Any, *, width: int | None = None, height: int | None = None, source: str | None = None
+    msg: Any,
+    *,
+    width: int | None = None,
+    height: int | None = None,
+    source: str | None = None,
+    warned: set[str] | None = None,
 ) -> Camera:
     """Pinhole intrinsics of a ``sensor_msgs/CameraInfo`` (``K`` in ROS 1, ``k`` in ROS 2).
 
@@ -186,7 +191,9 @@ def camera_from_info(
     Distortion (``D``/``d``) is not applied: symfruit works on rectified or near-distortion-free colour images.
     It is checked as an intrinsics file's is (:func:`info_distortion`: non-finite refused) and, with ``source``
     (what names the camera in the warning), non-zero coefficients raise a
-    :class:`~symfruit.errors.SymfruitWarning` (:func:`symfruit.io.intrinsics.warn_distortion`).
+    :class:`~symfruit.errors.SymfruitWarning` (:func:`symfruit.io.intrinsics.warn_distortion`), as does a
+    principal point outside the image (:func:`symfruit.io.intrinsics.warn_principal_point`). ``warned``: the
+    kinds (``"distortion"``, ``"principal point"``) already said, not said again; those said are added.
 
     Raises
     ------
@@ -205,8 +212,13 @@ def camera_from_info(
     key, coeffs = info_distortion(msg)
     w, h = int(msg.width) or (width or 0), int(msg.height) or (height or 0)
     camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
+    check_pinhole_matrix(k, "CameraInfo K")  # row-major; a transposed one would read cx = cy = 0
     if source is not None:
-        warn_distortion(source, key, coeffs, stacklevel=3)
+        said = warned if warned is not None else set()
+        if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3):
+            said.add("distortion")
+        if "principal point" not in said and warn_principal_point(source, camera, stacklevel=3):
+            said.add("principal point")
     return camera
 
 
@@ -224,12 +236,18 @@ def info_distortion(msg: Any) -> tuple[str, list[float]]:
     if values is None:
         return key, []
     try:
+        count = len(values)  # counted before any is converted: a field of millions is refused as it stands
+    except TypeError:
+        raise InputError(f"CameraInfo {key} is not a list of numbers") from None
+    if count > MAX_DISTORTION_COEFFS:
+        raise InputError(f"CameraInfo {key} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got {count} "
+                         "values")  # fmt: skip
+    try:
         coeffs = [float(v) for v in values]
     except (TypeError, ValueError, OverflowError):
         raise InputError(f"CameraInfo {key} holds something that is not a number") from None
-    if len(coeffs) > MAX_DISTORTION_COEFFS or not all(math.isfinite(c) for c in coeffs):
-        shown = coeffs if len(coeffs) <= 8 else f"{len(coeffs)} values"
-        raise InputError(f"CameraInfo {key} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got {shown}")
+    if not all(math.isfinite(c) for c in coeffs):
+        raise InputError(f"CameraInfo {key} must hold at most {MAX_DISTORTION_COEFFS} finite numbers, got {coeffs}")
     return key, coeffs
 
 
@@ -369,6 +387,7 @@ class BagSource:
         if not self._cameras:
             raise FileFormatError(f"CameraInfo topic {self._info.topic} holds no messages")
         self._camera_stamps = [s for s, _, _ in self._cameras]
+        self._off_centre_said = False  # a principal point outside the image: warned about at the first frame
         if distorted is not None:
             warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4)
 
@@ -413,6 +432,9 @@ class BagSource:
             message = str(exc)
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"
             raise FileFormatError(named) from None
+        if not self._off_centre_said:  # once per bag, as its distortion: the camera is whole only here
+            self._off_centre_said = warn_principal_point(f"{self.path}: CameraInfo on {self._info.topic}", camera,
+                                                         stacklevel=3)  # fmt: skip
         # stamped like the colour image: the detections are in its frame (ROS outputs copy its header)
         return named_frame(f"{self.path}@{stamp}", name, color, depth, camera, source=f"{self.path}@{stamp}",
                            stamp=_stamp(cmsg, cstamp), frame_id=header_frame_id(cmsg))  # fmt: skip

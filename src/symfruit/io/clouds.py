@@ -274,7 +274,9 @@ def read_pcd(path: Path) -> np.ndarray:
         sizes = [int(s) for s in fields["SIZE"]]
         types = fields["TYPE"]
         counts = [int(c) for c in fields.get("COUNT", ["1"] * len(names))]
-        n = int(fields["POINTS"][0]) if "POINTS" in fields else int(fields["WIDTH"][0]) * int(fields["HEIGHT"][0])
+        if "POINTS" not in fields:  # the shape's product, of counts that are no counts below 0
+            fields["POINTS"] = [str(int(fields["WIDTH"][0]) * int(fields["HEIGHT"][0]))]
+        n = int(fields["POINTS"][0])
         mode = fields["DATA"][0].lower()
     except (KeyError, ValueError, IndexError):
         raise FileFormatError(f"{path}: PCD header lacks or garbles FIELDS/SIZE/TYPE/POINTS/DATA") from None
@@ -285,6 +287,8 @@ def read_pcd(path: Path) -> np.ndarray:
             width, height = int(fields["WIDTH"][0]), int(fields["HEIGHT"][0])
         except (ValueError, IndexError):
             raise FileFormatError(f"{path}: PCD header garbles WIDTH/HEIGHT") from None
+        if width < 0 or height < 0:  # -2 x -1 is 2, but no cloud's shape
+            raise FileFormatError(f"{path}: PCD header garbles WIDTH/HEIGHT ({width} x {height}; counts are >= 0)")
         if width * height != n:
             raise FileFormatError(
                 f"{path}: PCD header's POINTS {n} disagrees with WIDTH x HEIGHT {width} x {height} = {width * height}"

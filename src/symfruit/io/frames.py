@@ -8,11 +8,14 @@ A frame folder holds::
     camera.json | .yaml       intrinsics in any layout symfruit reads; an optional "depth_scale"
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
-    masks.json                optional: COCO-style annotations (polygons or RLE)
+    masks.json                ... or COCO-style annotations (polygons or RLE)
     truth.json                optional: {"fruits": [{"id", "min", "max", "visible", "ripe", ...}]}, true boxes in
-                              metres (other keys left alone, one a letter or two from these refused)
+                              metres (other keys left alone, one a letter or two from these refused; ids
+                              unique, ripe true or false)
 
-A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
+Of the depth, intrinsics and mask files a frame holds one each: two (``depth.png`` and ``depth.npy``,
+``camera.json`` and ``camera.yaml``, ``masks.png`` and ``masks.json``) are refused by name, never one taken in
+silence. A folder whose sub-folders are frame folders is a recording (:mod:`.sources`); so is a ROS 1 ``.bag`` or
 ROS 2 bag folder (:mod:`.bags`).
 """
 
@@ -27,7 +30,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size
+from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size, shown
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
@@ -37,6 +40,7 @@ __all__ = [
     "COLOR_FILE",
     "COLOR_NAMES",
     "DEFAULT_DEPTH_SCALE",
+    "file_depth_scale",
     "is_frame_folder",
     "named_frame",
     "read_depth",
@@ -64,6 +68,16 @@ def _first(folder: Path, *names: str) -> Path | None:
     return None
 
 
+def _only(folder: Path, *names: str) -> Path | None:
+    """The one file of ``names`` the frame folder holds, or None; two of them are refused: two depth images or
+    intrinsics or mask files that may disagree, one of them taken in silence, would not be the one meant."""
+    given = [folder / n for n in names if holds_file(folder / n)]
+    if len(given) > 1:
+        raise FileFormatError(f"{folder}: holds both {given[0].name} and {given[1].name}; which one is meant? Keep "
+                              "one")  # fmt: skip
+    return given[0] if given else None
+
+
 def is_frame_folder(folder: Path) -> bool:
     """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
     that name is then refused by name when the frame is read)."""
@@ -88,21 +102,21 @@ def read_frame(folder: str | Path) -> Frame:
     color_path = _first(folder, *COLOR_NAMES)
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")
-    cam_path = _first(folder, "camera.json", "camera.yaml", "camera.yml")
+    cam_path = _only(folder, "camera.json", "camera.yaml", "camera.yml")
     if cam_path is None:
         raise FileFormatError(f"{folder}: no camera.json (intrinsics)")
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
     color, color_orientation = read_color_oriented(color_path)
-    depth_file = _first(folder, "depth.png", "depth.npy")
+    depth_file = _only(folder, "depth.png", "depth.npy")
     if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy")
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
     oriented = (str(color_path), color_orientation)
-    masks = read_masks(folder, color.shape[:2], color=oriented) if _first(folder, "masks.png", "masks.json") else None
+    masks = read_masks(folder, color.shape[:2], color=oriented) if _only(folder, "masks.png", "masks.json") else None
     truth, visible = _truth(folder / "truth.json") if holds_file(folder / "truth.json") else (None, {})
     return named_frame(str(folder), folder.name, color, depth, camera, masks, truth, str(folder), visible=visible,
                        extras={COLOR_FILE: oriented})  # fmt: skip
@@ -152,6 +166,19 @@ def read_depth_npy(path: Path) -> np.ndarray:
         return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
 
 
+def file_depth_scale(path: str | Path) -> float | None:
+    """The depth scale (metres per unit) an intrinsics file states (``depth_scale`` or ``depth_units``, as a
+    frame's ``camera.json`` does), or None where it states none: what ``segment --depth`` with ``--camera``
+    reads 16-bit depth by."""
+    from .intrinsics import read_mapping
+
+    path = as_path(path, "file_depth_scale: the intrinsics file")
+    data = read_mapping(path)
+    if not isinstance(data, dict) or ("depth_scale" not in data and "depth_units" not in data):
+        return None
+    return _depth_scale(path, data)
+
+
 def _depth_scale(cam_path: Path, data: Any) -> float:
     """Metres per depth unit from the parsed camera file (``depth_scale`` or ``depth_units``)."""
     scale = data.get("depth_scale", DEFAULT_DEPTH_SCALE) if isinstance(data, dict) else DEFAULT_DEPTH_SCALE
@@ -160,6 +187,9 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
         known = {"m": 1.0, "mm": 0.001, "0.1mm": 0.0001, "cm": 0.01}
         if not isinstance(units, str) or units not in known:  # a list or mapping is no unit (nor hashable)
             raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
+        if isinstance(data, dict) and "depth_scale" in data and data["depth_scale"] != known[units]:
+            raise InputError(f"{cam_path}: depth_scale {shown(data['depth_scale'])} and depth_units {units!r} "
+                             f"({known[units]:g} m) disagree; which one is meant? Keep one")  # fmt: skip
         scale = known[units]
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:
         raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {scale!r}")
@@ -180,11 +210,21 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
         if not isinstance(fruits, list):
             raise TypeError("'fruits' is not a list")
         out, visible = [], {}
+        seen_ids: dict[int, int] = {}  # every fruit's id (unripe ones' too: a label is one fruit's) -> its number
         for k, item in enumerate(fruits, 1):
             if not isinstance(item, dict):
                 raise TypeError(f"fruit {k} is not an object")
             _misspelt_truth_key(item, k)
-            if item.get("ripe", True) is False:
+            ripe = item.get("ripe", True)
+            if not isinstance(ripe, bool):  # "false" or 0 is not False: it would count an unripe fruit as a target
+                raise ValueError(f"fruit {k}: ripe must be true or false, got {shown(ripe)}")
+            fid = item.get("id", k)
+            if isinstance(fid, int) and not isinstance(fid, bool):  # other ids are refused below, if ripe
+                if fid in seen_ids:
+                    raise ValueError(f"fruit {k}: id {fid} is fruit {seen_ids[fid]}'s too; each fruit has its own "
+                                     "id (its mask label)")  # fmt: skip
+                seen_ids[fid] = k
+            if not ripe:
                 continue
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
             if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
@@ -194,7 +234,6 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
             if max(np.abs(lo).max(), np.abs(hi).max()) > MAX_DEPTH_METRES:
                 raise ValueError(f"fruit {k}: a box more than {MAX_DEPTH_METRES:g} m from the camera; boxes are in "
                                  "metres (these look like millimetres)")  # fmt: skip
-            fid = item.get("id", k)
             if isinstance(fid, bool) or not isinstance(fid, int) or not 0 <= fid <= MAX_LABEL_ID:
                 raise ValueError(f"fruit {k}: id must be a whole number in 0-{MAX_LABEL_ID} (a label id)")
             out.append((fid, Box(lo, hi)))

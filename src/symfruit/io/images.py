@@ -20,6 +20,9 @@ intrinsics for its stored size (:func:`turned_mismatch`), readers refuse them na
 orientation, never pair turned colour with unturned depth (:func:`decode_color`, a message's image beside
 raw depth, refuses a tag).
 
+A depth or label image file that holds several images (an animated PNG or GIF, a multi-page TIFF) is refused: its
+first is not necessarily the one meant.
+
 Every error names the file and the problem (:class:`~symfruit.errors.FileFormatError`); Pillow's own
 errors, including its decompression-bomb error, never escape.
 """
@@ -97,6 +100,18 @@ def _open(source: Path | bytes, label: str) -> Any:
         img.close()
         raise
     return img
+
+
+def _single(img: Any, label: str, what: str) -> None:
+    """Refuse an image file holding several images (an animated PNG or GIF, a multi-page TIFF) where one is
+    read by value (depth, labels): Pillow would give its first in silence, which may not be the one meant."""
+    try:
+        frames = int(getattr(img, "n_frames", 1))
+    except Exception:  # a damaged frame index: decoding the image says what is wrong
+        return
+    if frames > 1:
+        raise FileFormatError(f"{label}: holds {frames} images (an animation or a multi-page file); {what} is one "
+                              "image: save the one meant on its own")  # fmt: skip
 
 
 def _decode(img: Any, label: str) -> tuple[Any, int]:
@@ -269,6 +284,7 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
     """:func:`read_depth_units`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_depth_units: the depth image")
     with _open(path, str(path)) as img:
+        _single(img, str(path), "a depth image")
         img, orientation = _decode(img, str(path))
         if img.mode not in _WIDE_GREY and img.mode != "L":
             raise FileFormatError(f"{path}: depth PNG must be single-channel 16-bit, got mode {img.mode!r}")
@@ -295,6 +311,7 @@ def read_labels_oriented(path: str | Path) -> tuple[np.ndarray, int]:
     """:func:`read_labels`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_labels: the label image")
     with _open(path, str(path)) as img:
+        _single(img, str(path), "a label image")
         img, orientation = _decode(img, str(path))
         mode = img.mode
         if mode in ("RGB", "RGBA", "RGBX"):

@@ -16,7 +16,9 @@ ROS CameraInfo         ``K`` (ROS 1) or ``k`` (ROS 2), 9 numbers row-major, with
 Distortion coefficients (RealSense ``coeffs``, ROS ``D``/``d``, ``distortion_coefficients``) are checked to be
 finite numbers but never applied: symfruit's pipeline is pinhole. Non-zero ones raise a
 :class:`~symfruit.errors.SymfruitWarning` naming the file and the largest coefficient (undistort the images, or
-give the rectified camera's intrinsics, ROS ``P``); they are not ignored in silence.
+give the rectified camera's intrinsics, ROS ``P``); they are not ignored in silence. A principal point
+(``cx, cy``) outside the image is warned about alike (:func:`warn_principal_point`): intrinsics of another
+resolution, or swapped width and height, more often than a cropped image's.
 
 JSON or YAML by extension (YAML through ``yaml.safe_load`` only). A file's keys are checked: a key that none of
 these layouts has (nor ``depth_scale``/``depth_units``, read beside them by :func:`symfruit.io.read_frame`) is
@@ -40,7 +42,7 @@ from ..core.limits import MAX_DISTORTION_COEFFS, MAX_SETTINGS_BYTES, shown
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
-__all__ = ["camera_from_dict", "load_camera", "warn_distortion"]
+__all__ = ["camera_from_dict", "check_pinhole_matrix", "load_camera", "warn_distortion", "warn_principal_point"]
 
 #: Largest intrinsics file read (bytes): that of a settings file (:mod:`symfruit.core.limits`).
 MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
@@ -125,7 +127,27 @@ def _checked(data: Any, source: str) -> Camera:
     distortion = _distortion(data)
     if distortion is not None:
         warn_distortion(source, *distortion, stacklevel=4)
+    warn_principal_point(source, camera, stacklevel=4)
     return camera
+
+
+def warn_principal_point(source: str, camera: Camera, *, stacklevel: int = 2) -> bool:
+    """Warn (:class:`SymfruitWarning`) that the principal point of the camera ``source`` names lies outside its
+    image (pixel centres at whole numbers: the image spans -0.5 to width - 0.5); whether it warned. Not refused:
+    a cropped image's camera may have it there, but intrinsics of another resolution or with width and height
+    swapped are likelier, and misplace every point. The one rule for intrinsics files, bags' and live
+    ``CameraInfo`` messages and RealSense recordings' colour camera, as :func:`warn_distortion` is."""
+    if -0.5 <= camera.cx <= camera.width - 0.5 and -0.5 <= camera.cy <= camera.height - 0.5:
+        return False
+    warnings.warn(
+        SymfruitWarning(
+            f"{source}: the principal point (cx {camera.cx:g}, cy {camera.cy:g}) lies outside the "
+            f"{camera.width}x{camera.height} image: are these the intrinsics of this resolution (width and height "
+            "not swapped)? They are used as given"
+        ),
+        stacklevel=stacklevel,
+    )
+    return True
 
 
 def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2) -> bool:
@@ -207,7 +229,37 @@ def _matrix(values: Any, name: str) -> list[float]:
     return [float(v) for v in values]
 
 
+def check_pinhole_matrix(m: Sequence[float], name: str, *, column_major: bool = False) -> None:
+    """Refuse 9 numbers that are not a pinhole intrinsic matrix ``[[fx, s, cx], [0, fy, cy], [0, 0, 1]]`` in
+    their order (ROS ``K``: row-major; Open3D ``intrinsic_matrix``: column-major): a matrix given in the other
+    order puts the principal point in the bottom row and reads ``cx = cy = 0`` in silence, and one scaled by a
+    last entry other than 1 halves or doubles the focal lengths.
+
+    Raises
+    ------
+    InputError
+        Naming the field and what is wrong.
+    """
+    below = (m[1], m[2], m[5]) if column_major else (m[3], m[6], m[7])  # the three entries below the diagonal
+    if any(below) or m[-1] != 1.0:
+        order = "column-major, as Open3D writes it" if column_major else "row-major, as ROS writes it"
+        given = ", ".join(f"{float(v):g}" for v in m)
+        raise InputError(f"{name} [{given}] is not a pinhole intrinsic matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]] "
+                         f"{order}: its entries below the diagonal must be 0 and the last 1 (given in the other "
+                         "order?)")  # fmt: skip
+
+
+def _one(data: dict[str, Any], keys: Sequence[str], what: str) -> None:
+    """Refuse a mapping that gives ``what`` twice, under two of ``keys``: which one is meant?"""
+    given = [k for k in keys if k in data]
+    if len(given) > 1:
+        raise InputError(f"intrinsics give {what} twice, as {' and '.join(repr(k) for k in given)}: which one is "
+                         "meant? Keep one")  # fmt: skip
+
+
 def _size(data: dict[str, Any]) -> tuple[Any, Any]:
+    _one(data, ("width", "image_width"), "the width")
+    _one(data, ("height", "image_height"), "the height")
     width = data.get("width", data.get("image_width"))
     height = data.get("height", data.get("image_height"))
     if width is None or height is None:
@@ -252,14 +304,20 @@ def _camera_of(data: Any) -> Camera:
         raise InputError(f"intrinsics must be a mapping, got {type(data).__name__}")
     if (nest := _nest(data)) is not None:
         return _camera_of(data[nest])
+    _one(data, ("intrinsic_matrix", "K", "k", "camera_matrix", "fx"), "the focal lengths")
+    matrix: tuple[list[float], str, bool] | None = None
     if "intrinsic_matrix" in data:  # Open3D, column-major
         m = _matrix(data["intrinsic_matrix"], "intrinsic_matrix")
         fx, fy, cx, cy = m[0], m[4], m[6], m[7]
+        matrix = (m, "intrinsics field 'intrinsic_matrix'", True)
     elif any(k in data for k in ("K", "k", "camera_matrix")):  # ROS, row-major
         key = next(k for k in ("K", "k", "camera_matrix") if k in data)
         m = _matrix(data[key], key)
         fx, fy, cx, cy = m[0], m[4], m[2], m[5]
+        matrix = (m, f"intrinsics field {key!r}", False)
     elif "fx" in data:
+        _one(data, ("cx", "ppx"), "the principal point's x")
+        _one(data, ("cy", "ppy"), "the principal point's y")
         if "fy" not in data:
             raise InputError("intrinsics lack field 'fy'")
         for key, alias in (("cx", "ppx"), ("cy", "ppy")):
@@ -274,4 +332,7 @@ def _camera_of(data: Any) -> Camera:
             "Open3D intrinsic_matrix or ROS K/k, each with width and height"
         )
     width, height = _size(data)
-    return Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=width, height=height)
+    camera = Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=width, height=height)
+    if matrix is not None:  # after the camera's own checks: an all-zero matrix is 'focal lengths must be positive'
+        check_pinhole_matrix(matrix[0], matrix[1], column_major=matrix[2])
+    return camera

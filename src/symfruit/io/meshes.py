@@ -53,6 +53,7 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
         text = read_limited(path, what="OBJ mesh", max_bytes=MAX_OBJ_BYTES).decode("utf-8-sig")
     except UnicodeDecodeError as exc:
         raise FileFormatError(f"{path}: cannot read OBJ ({exc})") from None
+    triangles = 0  # the faces the polygons make as fans: bounded as a PLY's faces are, while they are read
     for number, line in enumerate(text.splitlines(), 1):
         parts = line.split()
         if not parts:
@@ -64,8 +65,13 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
                 vertices.append([float(p) for p in parts[1:4]])
             elif parts[0] == "f":
                 polygons.append([int(p.split("/")[0]) for p in parts[1:]])
+                triangles += max(len(parts) - 3, 0)
         except ValueError:
             raise FileFormatError(f"{path}: line {number} is not a valid OBJ vertex or face") from None
+        if len(vertices) > MAX_CLOUD_POINTS or triangles > MAX_FACES:
+            raise FileFormatError(f"{path}: line {number}: OBJ mesh of more than {MAX_CLOUD_POINTS:,} vertices or "
+                                  f"{MAX_FACES:,} faces (polygons counted as the triangles they make); no more "
+                                  "are read")  # fmt: skip
     if not vertices:
         raise FileFormatError(f"{path}: OBJ has no vertices")
     v = np.asarray(vertices, dtype=np.float64)
@@ -78,6 +84,8 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 def _fans(polygons: list, n_vertices: int, path: Path) -> np.ndarray:
     lengths = np.fromiter(map(len, polygons), dtype=np.int64, count=len(polygons))
+    if (made := int(np.maximum(lengths - 2, 0).sum())) > MAX_FACES:  # a PLY face of a million corners: 999,998
+        raise FileFormatError(f"{path}: its polygons make {made:,} triangles; at most {MAX_FACES:,} faces are read")
     if len(polygons) and (lengths == 3).all():  # a triangle mesh: no fans to make
         arr = np.asarray(np.stack([np.asarray(p, dtype=np.int64) for p in polygons]), dtype=np.int64)
         if arr.min() < 0 or arr.max() >= n_vertices:

@@ -44,7 +44,7 @@ from ..core.frame import Frame
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
 from .frames import named_frame
-from .intrinsics import warn_distortion
+from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -157,16 +157,18 @@ class RealSenseBagSource:
         model = str(info.distortion_model)
         if model not in LENS_MODELS:
             raise FileFormatError(f"{prefix}: lens model {model!r} is not supported (known: {', '.join(LENS_MODELS)})")
-        k = [float(v) for v in info.K]
         # librealsense writes D from rs2_intrinsics::coeffs, a float[5] (ros_writer.cpp), and reads five back: every
         # model's coefficients are those five, so a D of any other length is not its recording; refused, never cut
-        coeffs = [float(v) for v in info.D]
-        if len(k) != 9 or len(coeffs) not in (0, 5):
-            raise FileFormatError(f"{prefix}: camera info K has {len(k)} values and D {len(coeffs)}; expected 9 and "
-                                  "5 (librealsense records five lens coefficients, rs2_intrinsics coeffs)")  # fmt: skip
+        # (counted before any value is converted: a D of millions is refused as it stands)
+        if len(info.K) != 9 or len(info.D) not in (0, 5):
+            raise FileFormatError(f"{prefix}: camera info K has {len(info.K)} values and D {len(info.D)}; expected "
+                                  "9 and 5 (librealsense records five lens coefficients, rs2_intrinsics "
+                                  "coeffs)")  # fmt: skip
+        k, coeffs = [float(v) for v in info.K], [float(v) for v in info.D]
         try:
             camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(info.width), height=int(info.height))
             lens = Lens(camera, LENS_MODELS[model], tuple(coeffs or [0.0] * 5))
+            check_pinhole_matrix(k, "camera info K")
         except InputError as exc:
             raise FileFormatError(f"{prefix}: invalid intrinsics ({exc})") from None
         if prefix not in tfs:
@@ -211,6 +213,8 @@ class RealSenseBagSource:
         # its pinhole part: said so, as for any camera; the depth lens's is applied in full
         warn_distortion(f"{self.path}: colour camera info /{color_prefix}/info/camera_info", "D",
                         self.color_stream.lens.coeffs, stacklevel=4)  # fmt: skip
+        warn_principal_point(f"{self.path}: colour camera info /{color_prefix}/info/camera_info",
+                             self.color_stream.lens.camera, stacklevel=4)  # fmt: skip
         d, c = self.depth_stream, self.color_stream
         if d.group != c.group:
             raise FileFormatError(f"depth and colour extrinsics are relative to different references "

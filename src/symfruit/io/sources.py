@@ -193,13 +193,15 @@ def _is_bag_output(folder: Path) -> bool:
     return (folder / "metadata.yaml").is_file() and not is_frame_folder(folder)
 
 
-#: Files a ``detect`` run writes at the top of its output folder (:mod:`symfruit.batch`), never in a frame folder.
-RUN_FILES = ("errors.json", "detections.parquet", "frames.parquet", LOCK_NAME)
+#: Files a ``detect`` run writes at the top of its output folder (:mod:`symfruit.batch`), and the summary every
+#: ``evaluate`` results folder holds (:func:`symfruit.writers.new_results_folder`), never in a frame folder.
+RUN_FILES = ("errors.json", "detections.parquet", "frames.parquet", LOCK_NAME, "summary.json")
 
 
 def _is_run_output(folder: Path) -> bool:
     """An earlier ``detect`` run's output folder inside a recording of frame folders (``--output rec/out``, then
-    ``--output rec/out2``): not a frame (it was counted as one that failed, 'no color.png or color.jpg')."""
+    ``--output rec/out2``), or an ``evaluate`` results folder there (``evaluate --frames rec --output rec``, and
+    its ``latest`` link): not a frame (it was counted as one that failed, 'no color.png or color.jpg')."""
     return any((folder / name).is_file() for name in RUN_FILES) and not is_frame_folder(folder)
 
 

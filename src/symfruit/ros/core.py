@@ -32,7 +32,7 @@ from ..core.frame import Frame
 from ..core.limits import shown
 from ..detect import FrameDetections, detect
 from ..errors import InputError, SymfruitError
-from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp, info_distortion
+from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
 from ..segment import mask_source
@@ -168,11 +168,12 @@ def message_frame(
     name: str = "frame",
     source: str = "ros",
     warn: bool = True,
+    warned: set[str] | None = None,
 ) -> Frame:
     """A :class:`~symfruit.core.frame.Frame` of a colour image, the depth image aligned to it and the colour
     camera's info; stamped with the colour header (``stamp``, ``frame_id``). Non-zero distortion in the camera
-    info is not applied: with ``warn``, a :class:`~symfruit.errors.SymfruitWarning` says so
-    (:func:`~symfruit.io.bags.camera_from_info`).
+    info is not applied: with ``warn``, a :class:`~symfruit.errors.SymfruitWarning` says so, as of a principal
+    point outside the image (:func:`~symfruit.io.bags.camera_from_info`; ``warned``: the kinds already said).
 
     Raises
     ------
@@ -183,7 +184,8 @@ def message_frame(
     rgb = color_image(color)
     metres = depth_image(depth, depth_scale=depth_scale)
     h, w = metres.shape
-    camera = camera_from_info(info, width=w, height=h, source=f"{source}: CameraInfo" if warn else None)
+    camera = camera_from_info(info, width=w, height=h, source=f"{source}: CameraInfo" if warn else None,
+                              warned=warned)  # fmt: skip
     return Frame(name, rgb, metres, camera, source=source, stamp=header_stamp(color), frame_id=header_frame_id(color))
 
 
@@ -239,16 +241,14 @@ class FrameProcessor:
         self.method, self.masks, self.depth_scale = method, masks, float(depth_scale)
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
         self.mask_source = mask_source(masks, settings=self.settings)  # a bad model fails here, once
-        self._warned_distortion = False
+        self._warned: set[str] = set()  # what was said of the camera infos ("distortion", "principal point")
 
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
         """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`); the first camera
-        info with non-zero distortion is warned about, once per processor (not on every frame)."""
-        warn = not self._warned_distortion
-        frame = message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source, warn=warn)
-        if warn and any(info_distortion(info)[1]):
-            self._warned_distortion = True
-        return frame
+        info with non-zero distortion is warned about, once per processor (not on every frame), and so is the
+        first with its principal point outside the image."""
+        return message_frame(color, depth, info, depth_scale=self.depth_scale, name=name, source=source,
+                             warned=self._warned)  # fmt: skip
 
     def process(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Processed:
         """Decode, detect, and list the located fruit. Raises ``SymfruitError`` for a bad frame."""

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
-from .table import FRAMES_NAME, TABLE_NAME, recording_inputs
+from .table import FRAME_COLUMNS, FRAMES_NAME, FRUIT_COLUMNS, TABLE_NAME, recording_inputs
 
 __all__ = [
     "DEFAULT_CLASSES_MM",
@@ -100,11 +100,33 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
         if size > MAX_REPORT_BYTES:
             raise FileFormatError(f"{path}: its columns hold {size / 2**30:.1f} GB; a report reads at most "
                                   f"{MAX_REPORT_BYTES / 2**30:.0f} GB")  # fmt: skip
-        return pq.read_table(path, columns=list(columns))
+        table = pq.read_table(path, columns=list(columns))
     except SymfruitError:
         raise
     except Exception as exc:  # pyarrow's own errors for a corrupt or truncated file
         raise FileFormatError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from None
+    _check_types(path, table)
+    return table
+
+
+def _check_types(path: Path, table: Any) -> None:
+    """Refuse a column whose type is not its kind in a symfruit table (:data:`FRUIT_COLUMNS`,
+    :data:`FRAME_COLUMNS`: text, a number, a whole number, true/false), and a frame count left empty, by name:
+    not numpy's or Python's words later, on a value turned into a number it is not."""
+    import pyarrow.types as pt
+
+    fits = {"string": lambda t: pt.is_string(t) or pt.is_large_string(t), "bool": pt.is_boolean,
+            "float64": lambda t: pt.is_floating(t) or pt.is_integer(t), "int32": pt.is_integer,
+            "int64": pt.is_integer, "timestamp": pt.is_timestamp}  # fmt: skip
+    kinds = dict(FRAME_COLUMNS if path.name == FRAMES_NAME else FRUIT_COLUMNS)
+    for name, column in zip(table.column_names, table.columns, strict=True):
+        kind = kinds.get(name)
+        if kind is not None and not fits[kind](column.type):
+            raise FileFormatError(f"{path}: column {name} holds {column.type}, not {kind} (not a symfruit table, or "
+                                  "damaged)")  # fmt: skip
+        if path.name == FRAMES_NAME and name in ("fruit", "located") and column.null_count:
+            raise FileFormatError(f"{path}: column {name} has {column.null_count} empty rows; every frame has its "
+                                  "count (not a symfruit table, or damaged)")  # fmt: skip
 
 
 def diameters_mm(size_x: np.ndarray, size_z: np.ndarray) -> np.ndarray:
@@ -188,6 +210,18 @@ def _mm(value: float) -> str:
     return "-" if not math.isfinite(value) else f"{value:.1f}"
 
 
+def _check_folder(output: Path, folder: Path) -> None:
+    """Refuse a report folder inside the run other than its own ``report`` (the run's root, a recording's or a
+    frame's folder: the report's files would mix with the run's, whose next detect run owns that folder)."""
+    run, real = os.path.realpath(output), os.path.realpath(folder)
+    own = os.path.realpath(output / "report")
+    inside = os.path.commonpath([run, real]) == run
+    if inside and os.path.commonpath([own, real]) != own:
+        raise OutputError(f"{folder}: is inside the run {output} (its own folder, a recording's or a frame's, which "
+                          f"a detect run writes); write the report to {output / 'report'} (the default) or outside "
+                          "the run")  # fmt: skip
+
+
 def write_report(
     output: str | Path, *, folder: str | Path | None = None, classes: Sequence[float] = DEFAULT_CLASSES_MM
 ) -> Report:
@@ -215,6 +249,8 @@ def write_report(
         link = output / "report"
         raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
                           f"links inside {output}: remove it, or name a folder (--output)")  # fmt: skip
+    if folder is not None:
+        _check_folder(output, Path(folder))
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
     fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",

@@ -45,6 +45,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.camera import Camera
+from ..core.raster import distance_transform
 
 __all__ = ["SENSOR_MODELS", "SensorFrame", "SensorModel", "apply_sensor", "sensor_model"]
 
@@ -422,7 +423,7 @@ def _multipath(z: np.ndarray, sid: np.ndarray, model: SensorModel, focal: float)
         junction[tuple(b)] |= meet
     if not junction.any():
         return np.zeros_like(z)
-    d_px = ndimage.distance_transform_edt(~junction)
+    d_px = distance_transform(~junction)
     lateral = d_px * z / focal
     return np.where(z > 0, model.multipath_bias * np.exp(-lateral / model.multipath_range), 0.0)
 
@@ -480,6 +481,6 @@ def annotate(
             c0, c1 = max(cols.min() - pad, 0), min(cols.max() + pad + 1, labels.shape[1])
             window = region[r0:r1, c0:c1]
             region = np.zeros_like(region)
-            region[r0:r1, c0:c1] = ndimage.distance_transform_edt(~window) <= grow
+            region[r0:r1, c0:c1] = distance_transform(~window) <= grow
         out[region & ((labels == 0) | (labels == k))] = k
     return out
