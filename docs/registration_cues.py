@@ -9,7 +9,9 @@ For every fruit of every frame (its label in the frame's masks): the shift ``(du
 alone; the same with the outline points left out where the depth cap runs on into a surface beside the mask (a
 support) or ends at the search border; the image offset from the mask's centroid of the centre of a sphere fitted
 to the depth pixels within 0.6 of the mask's equivalent radius of that centroid; and of the nearest depth point
-(a paraboloid fitted to the median-filtered depth there). A sphere's nearest point and centre lie on one ray, so
+(a paraboloid fitted to the median-filtered depth there); and of its outline's rim points on each side, how many
+are free (a silhouette, not a junction with a support) and which axes the fruit tells (``core.surface._outline``).
+A sphere's nearest point and centre lie on one ray, so
 on a well-registered frame the last two are near (0, 0) for spheres. Per frame, the frame-wide edge cue
 (``symfruit.core.edges.edge_shift``: the depth's outlines laid on the colour's edges, independent of the fruit's
 outline cue): its best shift over the whole frame and with the fruit's masks (grown by the search radius) left
@@ -125,9 +127,16 @@ def real(folder):
             a = fruit_shift(depth[win], mask, focal, max_px, drop_supports=False)
             b = fruit_shift(depth[win], mask, focal, max_px, drop_supports=True)
             centre, apex = sphere_and_apex(depth, frame.masks == k, frame.camera)
+            found = surface._outline(depth[win], mask, focal, max_px)
+            free, told = "-", "-"
+            if found is not None and found.sides is not None:
+                names = ("top", "bottom", "left", "right")
+                free = " ".join(f"{s} {f}/{n}" for s, (f, n) in zip(names, found.sides.tolist(), strict=True))
+                told = "".join(a for a, t in zip("vu", found.axes, strict=True) if t) or "none"
             say(
                 f"  fruit {k}: registration alone {a}, without support and border points {b}; sphere centre "
-                f"({centre[0]:+.1f}, {centre[1]:+.1f}) px, nearest point ({apex[0]:+.1f}, {apex[1]:+.1f}) px\n"
+                f"({centre[0]:+.1f}, {centre[1]:+.1f}) px, nearest point ({apex[0]:+.1f}, {apex[1]:+.1f}) px; "
+                f"free outline points {free}, axes told {told}\n"
             )
 
 

@@ -144,6 +144,46 @@ def test_registration_pools_fruit_and_keeps_good_frames():
     assert registration_shift(np.zeros((H, W)), labels, F, max_px=10) == (0, 0)
 
 
+def on_support(shift=(0, 0), *, support=True, radius_px=20, front=0.5, top=0.25, side=0.1):
+    """Depth (H, W) of a ball whose silhouette is a disc of ``radius_px`` at ``(80, 60) + shift`` before a wall at
+    0.8 m, standing on a support that comes into view below ``0.4 radius_px`` under its centre at the ball's rim
+    depth and nearer lower down (a board seen from above: at the fruit's own depth, running on from its outline),
+    as a time-of-flight camera sees it: the outer ``top`` of the radius lost over the upper half (mixed pixels
+    against the far wall), ``side`` elsewhere, nothing where the support meets the ball; 0.5 mm noise."""
+    du, dv = shift
+    cx, cy = 80 + du, 60 + dv
+    yy, xx = np.mgrid[:H, :W].astype(np.float64)
+    r_m = radius_px * front / F
+    d2 = ((xx - cx) ** 2 + (yy - cy) ** 2) / radius_px**2
+    disc = d2 <= 1.0
+    depth = np.full((H, W), 0.8)
+    below = yy > cy + 0.4 * radius_px
+    if support:
+        depth = np.where(below, front + r_m - 0.001 * (yy - cy - 0.4 * radius_px), depth)
+    depth = np.where(disc, front + r_m * (1.0 - np.sqrt(np.clip(1.0 - d2, 0.0, None))), depth)
+    depth = depth + np.random.default_rng(0).normal(scale=0.0005, size=depth.shape)
+    lost = disc & (np.sqrt(d2) > 1.0 - np.where(yy < cy, top, side))
+    depth[lost & ~(below & support)] = 0.0
+    return depth
+
+
+@pytest.mark.parametrize("top", [0.25, 0.1])
+def test_a_fruit_on_a_support_at_its_own_depth_tells_no_shift_down(top):
+    """The real frames' sphere 3: a board at the ball's depth below it (no band at the bottom), a wide band at the
+    top. A shift down and a wider band at the top are one and the same there (the estimator as it was found 3 px
+    down on the registered frame); across, the left and right outlines are free and tell it."""
+    _, disc = ball(radius_px=20)
+    labels = disc.astype(np.int32)
+    for du in (0, 3, -4):
+        found = registration_shift(on_support((du, 0), top=top), labels, F, max_px=12)
+        assert found[1] == 0 and abs(found[0] - du) <= 1
+    # a true shift down is not guessed either: 0, not the band's answer
+    assert registration_shift(on_support((-4, 5), top=top), labels, F, max_px=12)[1] == 0
+    # the same ball hanging before the wall, its band even: free all round, the shift found
+    for shift in ((2, 5), (-4, -3), (0, 0)):
+        assert registration_shift(on_support(shift, support=False, top=0.1), labels, F, max_px=12) == shift
+
+
 @given(st.integers(-8, 8), st.integers(-8, 8), st.integers(0, 1000))
 def test_registration_within_a_pixel(du, dv, seed):
     rng = np.random.default_rng(seed)
@@ -338,10 +378,11 @@ def test_the_registration_reads_depth_within_its_range_only():
 
 
 def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
-    """registration_shift as it was: every shift of the grid costed exactly, the least taken (first of ties)."""
+    """registration_shift as it was: every shift of the grid costed exactly, the least taken (first of ties); along
+    the axes the outlines tell (:func:`symfruit.core.surface._told_axes`)."""
     from scipy import ndimage
 
-    from symfruit.core.surface import _outline
+    from symfruit.core.surface import _outline, _told_axes
 
     depth = np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)
     outlines = []
@@ -349,20 +390,27 @@ def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
         r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
         r1, c1 = min(sl[0].stop + max_px + 8, labels.shape[0]), min(sl[1].stop + max_px + 8, labels.shape[1])
         mask = labels[r0:r1, c0:c1] == k
-        if mask.sum() >= 30 and (found := _outline(depth[r0:r1, c0:c1], mask, focal, max_px)) is not None:
+        found = _outline(depth[r0:r1, c0:c1], mask, focal, max_px) if mask.sum() >= 30 else None
+        if found is not None and any(found.axes):
             outlines.append(found)
     if not outlines:
         return 0, 0
 
-    def cost(shifts):
-        return np.mean([o.cost(shifts, max_px, trim) for o in outlines], axis=0)
+    pooled = _told_axes(np.sum([o.sides for o in outlines], axis=0))
+    tell = [pooled[i] and any(o.axes[i] for o in outlines) for i in (0, 1)]
+    if not any(tell):
+        return 0, 0
+
+    def cost(shifts):  # an axis a fruit does not tell costs it nothing: that shift's part along it taken as 0
+        return np.mean([o.cost(shifts * np.array(o.axes), max_px, trim) for o in outlines], axis=0)
 
     coarse = np.arange(-max_px, max_px + 1, 2)
-    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
+    steps = [coarse if t else np.zeros(1, int) for t in tell]
+    grid = np.stack(np.meshgrid(*steps, indexing="ij"), axis=-1).reshape(-1, 2)
     first = cost(np.vstack([[[0, 0]], grid]))
     dv, du = grid[int(np.argmin(first[1:]))]
-    near = np.arange(-2, 3)
-    fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
+    near = [np.arange(-2, 3) if t else np.zeros(1, int) for t in tell]
+    fine = np.stack(np.meshgrid(dv + near[0], du + near[1], indexing="ij"), axis=-1).reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     refined = cost(fine)
     best = int(np.argmin(refined))

@@ -14,7 +14,8 @@ outside can be: along every ray in the image from its nearest point a convex fru
 (:func:`monotone_region`), so a support, a stem or a leaf meeting the fruit is cut where depth turns back
 towards the camera. :func:`registration_shift` finds how far the depth image sits from the masks: the
 shift that lays the outline of every fruit's depth cap parallel to its mask's outline, a band of the
-mask's rim (the grazing pixels a time-of-flight camera invalidates) allowed between them.
+mask's rim (the grazing pixels a time-of-flight camera invalidates) allowed between them, along the axes whose
+both sides show a silhouette rather than a support running on.
 
 Numpy and scipy only (or their compiled twins, :mod:`symfruit.core.kernels`, where numba is); images in, images and
 numbers out.
@@ -363,10 +364,19 @@ class _Outline:
     cols: np.ndarray
     inside: np.ndarray
     band: float
+    #: (4, 2) int: of the outline's points on its top, bottom, left and right side, how many are free and how many
+    #: there are (:func:`_free_points`; counted before ``rows`` and ``cols`` kept the free ones); None: all free
+    sides: np.ndarray | None = None
     #: ``inside`` padded by ``pad`` pixels of ``-reach`` (flattened), made once per ``(pad, reach)``; under
     #: ``("keys", pad, reach)`` the same for its whole-number keys (:meth:`keys`), None when it has none; under
     #: ``("table", pad, reach)`` the value of each key (:meth:`_table`)
     _padded: dict[tuple, np.ndarray | None] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    @property
+    def axes(self) -> tuple[bool, bool]:
+        """``(v, u)``: whether the outline tells a shift down the image (``dv``: its top and its bottom side free)
+        and across it (``du``: its left and its right side free)."""
+        return (True, True) if self.sides is None else _told_axes(self.sides)
 
     def _at(self, shifts: np.ndarray, reach: int, pad: int = 0) -> tuple[np.ndarray, int]:
         """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad (at
@@ -527,7 +537,8 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
 
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
-    """The outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it), or None."""
+    """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
+    and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points)."""
     grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     inner = inner_distance(mask)
     surface = fruit_surface(depth, mask, focal, region=grown, inner=inner)
@@ -537,9 +548,76 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
+    free, sides = _free_points(depth, cap, rows, cols, surface)
+    rows, cols = rows[free], cols[free]  # where the depth runs on, no band lies to be measured
+    if len(rows) < 12:
+        return None
     step = max(1, len(rows) // max_points)
     inside = inner - distance_transform(~mask)
-    return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)))
+    return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)), sides)
+
+
+def _rim(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """Indices (ascending) of the outline points (``rows``, ``cols``) farthest from their centroid in each direction
+    from it: the cap's outer rim, without the sides of the cracks the convexity test cuts into a noisy cap (rays
+    whose depth fell by noise: neither silhouette nor junction). As many directions as a circle of the outline's
+    mean radius has pixels around it."""
+    dv, du = rows - rows.mean(), cols - cols.mean()
+    radius = np.hypot(dv, du)
+    bins = max(8, int(2.0 * np.pi * radius.mean()))
+    at = np.minimum(((np.arctan2(dv, du) + np.pi) * (bins / (2.0 * np.pi))).astype(np.intp), bins - 1)
+    order = np.lexsort((-radius, at))  # by direction, the farthest first
+    first = order[np.r_[True, at[order][1:] != at[order][:-1]]]
+    return np.sort(first)
+
+
+#: :func:`_free_points`: an outline point is free when a pixel outside the cap within this many pixels holds no
+#: depth or depth behind the fruit's rim. A time-of-flight camera's lost band lies right beside a silhouette, and
+#: an active-stereo camera's fattened edge (about 3 depth pixels: 4-5 colour pixels, ``synthetic.sensors``'
+#: ``fatten_px`` times its footprint) ends about this far out; a support or a neighbour at the fruit's own depth
+#: runs on farther.
+_FREE_PX = 4.0
+
+#: :func:`_told_axes`: a side of an outline (or of all a frame's outlines) is free when more than this share of
+#: its points is: the band its points lie at is then what its free points say (their median), not its junctions.
+_FREE_SHARE = 0.5
+
+
+def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray,
+                 surface: Surface) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """Which points of a depth cap's outline (``rows``, ``cols``) are *free*: a true silhouette, whose band inside
+    the mask (:func:`registration_shift`) is there to be measured; and of the points on its top, bottom, left
+    and right side, how many are free and how many there are: ``((n,) bool, (4, 2) int)``.
+
+    An outline point is free when a pixel outside the cap within :data:`_FREE_PX` of it holds no depth (the band
+    a time-of-flight camera loses where the surface turns away, or mixed pixels against what is behind) or depth
+    behind the fruit's rim (its front plus its radius, plus the convexity test's tolerance: what a fruit hides
+    lies behind its rim). Where the depth runs on at the fruit's own depth or nearer, into a support, a
+    neighbour or a leaf in front, the outline is the junction, not the silhouette, and no band lies there.
+    The sides are counted on the outline's rim (:func:`_rim`); a point belongs to the side its direction from the
+    outline's centroid points to most."""
+    tol = max(3.0 * surface.noise, 0.003)
+    # on the outline's box grown by the reach alone (the same answers: no farther pixel is within reach)
+    r = int(_FREE_PX) + 1
+    r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
+    box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
+    gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
+    free = within(gap, _FREE_PX)[rows - r0, cols - c0]
+    outer = _rim(rows, cols)
+    dv, du = rows[outer] - rows.mean(), cols[outer] - cols.mean()
+    along_v = np.abs(dv) >= np.abs(du)
+    sides = (along_v & (dv < 0), along_v & (dv > 0), ~along_v & (du < 0), ~along_v & (du > 0))
+    return free, np.array([(np.count_nonzero(free[outer] & side), np.count_nonzero(side)) for side in sides])
+
+
+def _told_axes(sides: np.ndarray) -> tuple[bool, bool]:
+    """``(v, u)`` from the free and all points of the top, bottom, left and right sides ((4, 2), :func:`_free_points`):
+    an axis is told when both its sides are free (more than :data:`_FREE_SHARE` of their points). A shift along an
+    axis is told apart from the band only by both sides of that axis: with the bottom side missing, moving the
+    masks down and widening the band at the top are one and the same (a fruit on a board: no band at the bottom,
+    where the board runs on; a wide band at the top, mixed pixels against the far background)."""
+    free = sides[:, 0] > _FREE_SHARE * sides[:, 1]
+    return bool(free[0] and free[1]), bool(free[2] and free[3])
 
 
 def _taxicab_within(mask: np.ndarray, reach: int) -> np.ndarray:
@@ -569,6 +647,14 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     from the unshifted masks' (moving a disc's outline by one pixel changes it by about 0.6; a frame
     registered well enough keeps its masks).
 
+    Only an outline's *free* points, where what lies beyond it has no depth or lies behind the fruit, are a
+    silhouette with a band to measure; where the depth runs on into a support, a neighbour or a leaf in front,
+    the outline is a junction and is left out (:func:`_free_points`). Along an axis, a shift is told apart from
+    the band only when both sides of it are free (top and bottom for ``dv``, left and right for ``du``): a fruit
+    on a board has no band at its bottom, and there a shift down and a wider band at its top are the same
+    (:func:`_told_axes`). A fruit costs each shift as far as it tells it (along an axis it does not tell, as if
+    the shift had no part along it), and an axis that the frame's outlines, pooled, do not tell keeps 0.
+
     Parameters
     ----------
     depth : (h, w) float, metres (0: none)
@@ -597,13 +683,13 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
         # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds)
         z = depth[r0:r1, c0:c1]
         z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
-        if (found := _outline(z, mask, focal, max_px)) is not None:
+        if (found := _outline(z, mask, focal, max_px)) is not None and any(found.axes):
             outlines.append(found)
     if not outlines:
         return 0, 0
 
     def cost(shifts: np.ndarray, exact: bool = True) -> np.ndarray:
-        return np.mean([o.cost(shifts, max_px, trim, exact=exact) for o in outlines], axis=0)
+        return np.mean([_told(o, shifts, max_px, trim, exact) for o in outlines], axis=0)
 
     def least(shifts: np.ndarray) -> int:
         """The first shift of least exact cost. The fast costs are within ``slack`` of the exact ones, so only
@@ -613,17 +699,36 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
         near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
         return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
 
+    # an axis is searched when the frame's outlines, pooled, tell it (a fruit whose side is free by a few points
+    # does not outvote the others) and a fruit tells it; otherwise it keeps 0
+    counted = [o.sides for o in outlines if o.sides is not None]
+    pooled = _told_axes(np.sum(counted, axis=0)) if counted else (True, True)
+    tell_v, tell_u = (pooled[i] and any(o.axes[i] for o in outlines) for i in (0, 1))
+    if not (tell_v or tell_u):
+        return 0, 0
     coarse = np.arange(-max_px, max_px + 1, 2)
-    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), axis=-1).reshape(-1, 2)
+    grid = np.stack(np.meshgrid(coarse if tell_v else [0], coarse if tell_u else [0], indexing="ij"), axis=-1)
+    grid = grid.reshape(-1, 2)
     zero = cost(np.zeros((1, 2), np.int64))[0]
     dv, du = grid[least(grid)]
     near = np.arange(-2, 3)
-    fine = np.stack(np.meshgrid(dv + near, du + near, indexing="ij"), axis=-1).reshape(-1, 2)
+    fine = np.stack(np.meshgrid(dv + (near if tell_v else 0), du + (near if tell_u else 0), indexing="ij"), axis=-1)
+    fine = fine.reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     best = least(fine)
     if cost(fine[best : best + 1])[0] > zero - gain:
         return 0, 0
     return int(fine[best, 1]), int(fine[best, 0])
+
+
+def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact: bool) -> np.ndarray:
+    """(k,) :meth:`_Outline.cost` of each ``(dv, du)`` of ``shifts`` (k, 2) as far as the outline tells it: along
+    an axis it does not tell (:attr:`_Outline.axes`) every shift costs what none does, so that fruit neither pulls
+    the shift along it nor weighs against it; each distinct shift costed once."""
+    if all(outline.axes):
+        return outline.cost(shifts, reach, trim, exact=exact)
+    seen, back = np.unique(shifts * np.array(outline.axes, dtype=shifts.dtype), axis=0, return_inverse=True)
+    return outline.cost(seen, reach, trim, exact=exact)[back.reshape(-1)]
 
 
 def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
