@@ -647,6 +647,46 @@ def test_distance_transform_is_scipys_with_and_without_the_kernel(monkeypatch):
     assert np.array_equal(fast, twin) and np.array_equal(fast, ndimage.distance_transform_edt(mask))
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 3))
+def test_nearest_is_scipys_feature_transform_to_the_pixel(seed, h, w, kind):
+    """Blobs, speckle, a few lone pixels and lattices of pixels (equally near pixels everywhere: the tie rule)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    if kind == 0:
+        image = ~_blobs(rng, h, w, rng.uniform(0.0, 0.2))
+    elif kind == 1:
+        image = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    else:
+        image = np.ones((h, w), bool)
+        step = int(rng.integers(1, 7))
+        if kind == 2:
+            image[rng.integers(0, h, 3), rng.integers(0, w, 3)] = False
+        else:
+            image[::step, ::step] = rng.random(image[::step, ::step].shape) < 0.4
+    if image.all():
+        image[int(rng.integers(0, h)), int(rng.integers(0, w))] = False
+    out = np.full((h, w), -2, np.int64)
+    _jit.nearest(image, out)
+    rows, cols = ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)
+    assert np.array_equal(out, rows * w + cols)
+    _jit.nearest(np.ones((h, w), bool), out)  # nothing to point to
+    assert (out == -1).all()
+
+
+def test_nearest_index_is_scipys_with_and_without_the_kernel(monkeypatch):
+    """raster.nearest_index on both paths: scipy's picks."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import nearest_index
+
+    rng = np.random.default_rng(5)
+    for image in (~_blobs(rng, 120, 90, 0.02), rng.random((31, 17)) < 0.9, np.array([[True, False]])):
+        fast, twin = _both(monkeypatch, nearest_index, image)
+        rows, cols = ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)
+        assert np.array_equal(fast, twin) and np.array_equal(fast, rows * image.shape[1] + cols)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 30))
 def test_taxicab_within_is_scipys(seed, h, w, reach):
     from scipy import ndimage

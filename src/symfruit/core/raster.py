@@ -32,6 +32,7 @@ __all__ = [
     "inner_distance",
     "interior",
     "mask_box",
+    "nearest_index",
     "outline_cone",
     "outline_cracks",
     "principal_widths",
@@ -296,6 +297,21 @@ def distance_transform(image: np.ndarray) -> np.ndarray:
         jit.distance(image, False, out)
         return out
     return np.asarray(ndimage.distance_transform_edt(image))
+
+
+def nearest_index(image: np.ndarray) -> np.ndarray:
+    """(h, w) int: each pixel's flat index (``row * w + col``) of the false pixel of a 2-D ``image`` nearest to it,
+    the one ``ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)`` picks (``image``
+    must hold a false pixel). By its compiled twin where there is one (:func:`symfruit.core._jit.nearest`: scipy's
+    feature transform written out, its choices among equally near pixels included, so the same pixels; 0.44
+    against 1.0 ms on a 230 px occlusion window; issue 19, fourteenth round), else by scipy's."""
+    image = np.asarray(image, dtype=bool)
+    if image.ndim == 2 and image.size and (jit := compiled()) is not None:
+        out = np.empty(image.shape, np.int64)
+        jit.nearest(image, out)
+        return out
+    ri, ci = ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)
+    return ri * image.shape[1] + ci
 
 
 def outer_distance(mask: np.ndarray, reach: float) -> np.ndarray:
