@@ -611,6 +611,44 @@ def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
         fits.surface_noise(pts, queries=30)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
+    """Spheres and rotated ellipsoids about the truth, beside it, around the camera, missing every ray and reaching
+    in front of the leaf, against views with and without the frame's depth beside the fruit (outside rays on an
+    occluder: free space); the depth RMS within rounding (its sums' order; grazing rays' roots), the band shares
+    from whole counts: equal."""
+    from symfruit.core.agreement import Quadric, explain, observe
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.occlusion import occlusion
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, occluded_view
+
+    rng = np.random.default_rng(seed)
+    centre = np.array([0.01 * seed, -0.005, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
+                                            seed=seed)  # fmt: skip
+    region = silhouette(visible, camera)
+    occ = occlusion(depth, mask, visible, camera)
+    views = [observe(visible[::10], region, camera, dense=visible, occlusion=o) for o in (None, occ)]
+    for obs in views:
+        for k in range(16):
+            r = rng.uniform(0.02, 0.05) if k < 12 else rng.uniform(0.055, 0.085)  # the last: fronts about the leaf's
+            c = centre + rng.normal(0.0, 0.01, 3) * (k % 4 != 0)
+            if k == 10:
+                c = np.array([0.0, 0.0, 0.05])  # the camera inside
+            if k == 11:
+                c = centre + [0.5, 0.0, 0.0]  # no ray meets it
+            axes = rng.uniform(0.6, 1.6, 3) * r
+            turn = rotation(*rng.uniform(0.0, 180.0, 3))
+            shape = turn @ np.diag(1.0 / axes**2) @ turn.T if k % 2 else np.eye(3) / r**2
+            quadric = Quadric(c, shape)
+            box = (c - axes.max(), c + axes.max())
+            fast, twin = _both(monkeypatch, explain, quadric, box, obs)
+            assert fast.depth == pytest.approx(twin.depth, rel=1e-9, abs=1e-15)
+            assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
+
+
 # --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------
 
 

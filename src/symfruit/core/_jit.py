@@ -1488,3 +1488,90 @@ def close_square(hit: np.ndarray, half: int, out: np.ndarray) -> None:
         a, b = max(r - half, 0), min(r + half + 1, h)
         for c in range(w):
             out[r, c] = cols[b, c] - cols[a, c] == b - a or hit[r, c]
+
+
+@_njit
+def explain_quadric(
+    centre: np.ndarray,
+    shape: np.ndarray,
+    rays: np.ndarray,
+    z0: float,
+    z1: float,
+    depth: np.ndarray,
+    keep: int,
+    in_starts: np.ndarray,
+    in_sizes: np.ndarray,
+    out_starts: np.ndarray,
+    out_w: np.ndarray,
+    out_wsum: np.ndarray,
+    seen: np.ndarray,
+    free: float,
+) -> tuple[float, float, float]:
+    """:func:`symfruit.core.agreement.explain` of a :class:`~symfruit.core.agreement.Quadric` (``centre`` (3,),
+    ``shape`` (3, 3)): ``(depth RMS, inside, outside)``, each ray met in closed form (``intersect_quadric``'s
+    roots) in one pass. ``rays`` (m, 3): the depth rays (``depth`` (n,), their seen depths), the inside bands' and
+    the outside bands' rays one after the other (:class:`~symfruit.core.agreement._Bands`); ``keep`` the trimmed
+    RMS's count (at least 1, at most n); each band's first ray and size (``in_starts``, ``in_sizes``; the outside
+    bands' sizes from their starts), the outside rays' weights, each outside band's weight and the outside rays'
+    seen depths (``seen``: NaN where none; empty without). The twin's arithmetic but for the order of the trimmed RMS's
+    sum and of the products making each ray's quadratic (numpy's ``einsum`` and BLAS there): the depth RMS within
+    rounding of the twin's (grazing rays' roots the most), the band shares, counts of whole numbers (the outside
+    weights are 0 or 1), equal."""
+    n = depth.shape[0]
+    m = rays.shape[0]
+    s = np.empty(3)
+    for i in range(3):
+        s[i] = shape[i, 0] * centre[0] + shape[i, 1] * centre[1] + shape[i, 2] * centre[2]
+    c = centre[0] * s[0] + centre[1] * s[1] + centre[2] * s[2] - 1.0
+    hit = np.empty(m, np.bool_)
+    at = np.empty(m)
+    for k in range(m):
+        x, y, z = rays[k, 0], rays[k, 1], rays[k, 2]
+        a = 0.0
+        for i in range(3):
+            for j in range(3):
+                a += rays[k, i] * shape[i, j] * rays[k, j]
+        b = x * s[0] + y * s[1] + z * s[2]
+        disc = b * b - a * c
+        root = math.sqrt(disc) if disc > 0.0 else 0.0
+        near, far = (b - root) / a, (b + root) / a
+        hit[k] = disc > 0.0 and near < z1 and far > z0
+        at[k] = max(near, z0) if hit[k] else np.nan
+    r2 = np.empty(n)
+    for k in range(n):
+        r = depth[k] - at[k] if hit[k] else z1 - z0
+        r2[k] = r * r
+    select(r2, keep - 1)
+    total = 0.0
+    for k in range(keep):
+        total += r2[k]
+    rms = math.sqrt(total / keep)
+    n_bands = in_starts.shape[0]
+    inside = 0.0
+    for j in range(n_bands):
+        size = in_sizes[j]
+        if size > 0:
+            count = 0
+            for k in range(n + in_starts[j], n + in_starts[j] + size):
+                count += hit[k]
+            inside += 1.0 - count / size
+    inside = inside / n_bands if n_bands else np.nan
+    base = n
+    for j in range(n_bands):
+        base += in_sizes[j]
+    n_out = m - base
+    k_bands = out_starts.shape[0]
+    outside = 0.0
+    for j in range(k_bands):
+        start = out_starts[j]
+        stop = out_starts[j + 1] if j + 1 < k_bands else n_out
+        if stop > start and out_wsum[j] > 0:
+            wrong = 0.0
+            for k in range(start, stop):
+                if seen.shape[0] and math.isfinite(seen[k]):  # free space in front of an occluder
+                    wrong += 1.0 if hit[base + k] and at[base + k] < seen[k] - free else 0.0
+                elif hit[base + k]:
+                    wrong += out_w[k]
+            outside += wrong / out_wsum[j]
+    outside = outside / k_bands if k_bands else np.nan
+    return rms, inside, outside
