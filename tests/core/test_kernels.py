@@ -725,6 +725,61 @@ def test_nearest_index_is_scipys_with_and_without_the_kernel(monkeypatch):
         assert np.array_equal(fast, twin) and np.array_equal(fast, rows * image.shape[1] + cols)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_outline_cracks_are_the_twins_to_the_bit(seed, h, w):
+    """Blobs and speckle touching the window's edges, at random window origins: the same points in the same order."""
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.3)) if rng.random() < 0.5 else rng.random((h, w)) < rng.random()
+    u0, v0 = (int(x) for x in rng.integers(0, 600, 2))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: outline_cracks(Silhouette(u0, v0, mask, 0.0)))
+    assert fast.shape == twin.shape and fast.tobytes() == twin.tobytes()
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000))
+def test_cloud_spread_is_the_bounds_and_the_twins_scatter(seed, n):
+    """Random clouds far from the origin (the mean's rounding matters most there): numpy's bounds exactly, the
+    scatter within rounding of the centred product."""
+    from symfruit.core.points import bounds, mean_point
+
+    rng = np.random.default_rng(seed)
+    points = rng.normal(0.0, rng.uniform(1e-4, 0.05), (n, 3)) * rng.uniform(0.1, 1.0, 3) + [0.1, -0.2, 0.6]
+    lo, hi, scatter = _jit.cloud_spread(points)
+    want_lo, want_hi = bounds(points)
+    centred = points - mean_point(points)
+    twin = centred.T @ centred
+    assert np.array_equal(lo, want_lo) and np.array_equal(hi, want_hi)
+    assert np.allclose(scatter, twin, rtol=1e-9, atol=1e-12 * np.abs(twin).max())
+
+
+def test_check_cloud_is_the_twins(monkeypatch):
+    """The same clean points, and the same refusals of clouds on a plane, on a line, of one point, and behind or
+    too near the camera, with and without the kernel."""
+    from symfruit.core.limits import MIN_DEPTH_METRES
+    from symfruit.core.points import check_cloud
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(2)
+    cloud = rng.normal(0.0, 0.02, (500, 3)) + [0.0, 0.0, 0.5]
+    cloud[::7] = np.nan
+    fast, twin = _both(monkeypatch, check_cloud, cloud)
+    assert fast[1] == twin[1] == 72 and np.array_equal(fast[0], twin[0])
+    flat = cloud[1:200].copy()
+    flat[:, 2] = 0.5
+    line = np.outer(np.linspace(0.0, 1.0, 50), [0.01, 0.02, 0.03]) + [0.0, 0.0, 0.5]
+    same = np.tile([0.0, 0.0, 0.5], (20, 1))
+    behind, near = cloud[1:200] - [0.0, 0.0, 0.49], cloud[1:200].copy()
+    near[:, 2] = MIN_DEPTH_METRES / 2 + np.abs(near[:, 2] - 0.5) * 0.05  # in front, some nearer than a camera reads
+    for bad, said in ((flat, "plane"), (line, "line"), (same, "identical"), (behind, "behind"), (near, "nearer")):
+        for env in ("", "numpy"):
+            monkeypatch.setenv("SYMFRUIT_KERNELS", env)
+            with pytest.raises(InputError, match=said):
+                check_cloud(bad[np.isfinite(bad).all(axis=1)])
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 30))
 def test_taxicab_within_is_scipys(seed, h, w, reach):
     from scipy import ndimage

@@ -1575,3 +1575,76 @@ def explain_quadric(
             outside += wrong / out_wsum[j]
     outside = outside / k_bands if k_bands else np.nan
     return rms, inside, outside
+
+
+@_njit
+def outline_cracks(mask: np.ndarray, u0: int, v0: int) -> np.ndarray:
+    """:func:`symfruit.core.raster.outline_cracks` of the region ``mask`` (h, w) bool whose top-left pixel is ``(u0,
+    v0)``: (m, 2) the midpoints of the pixel edges between a region pixel and a 4-neighbour outside it (beyond the
+    window: outside), those above their pixel, then below, left and right, each row-major, as the twin's four
+    ``np.nonzero`` passes give them; half-integers, the same values. Two passes: the counts, then the points."""
+    h, w = mask.shape
+    count = np.zeros(4, np.int64)
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                count[0] += r == 0 or not mask[r - 1, c]
+                count[1] += r == h - 1 or not mask[r + 1, c]
+                count[2] += c == 0 or not mask[r, c - 1]
+                count[3] += c == w - 1 or not mask[r, c + 1]
+    at = np.empty(4, np.int64)
+    at[0] = 0
+    for d in range(1, 4):
+        at[d] = at[d - 1] + count[d - 1]
+    out = np.empty((at[3] + count[3], 2))
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                if r == 0 or not mask[r - 1, c]:
+                    out[at[0], 0], out[at[0], 1] = c + (0.0 + u0), r + (-0.5 + v0)
+                    at[0] += 1
+                if r == h - 1 or not mask[r + 1, c]:
+                    out[at[1], 0], out[at[1], 1] = c + (0.0 + u0), r + (0.5 + v0)
+                    at[1] += 1
+                if c == 0 or not mask[r, c - 1]:
+                    out[at[2], 0], out[at[2], 1] = c + (-0.5 + u0), r + (0.0 + v0)
+                    at[2] += 1
+                if c == w - 1 or not mask[r, c + 1]:
+                    out[at[3], 0], out[at[3], 1] = c + (0.5 + u0), r + (0.0 + v0)
+                    at[3] += 1
+    return out
+
+
+@_njit
+def cloud_spread(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(min (3,), max (3,), scatter (3, 3))`` of the rows of ``points`` (n, 3), ``n >= 1``: the columns' least and
+    greatest values (exactly :func:`symfruit.core.points.bounds`'s) and the sums of the products of the rows'
+    deviations from their mean (the twin's ``centred.T @ centred``, within rounding: these sums run row by row, the
+    mean's too), in two passes over the points without the centred copy."""
+    n = points.shape[0]
+    lo = np.empty(3)
+    hi = np.empty(3)
+    mean = np.zeros(3)
+    for j in range(3):
+        lo[j] = hi[j] = points[0, j]
+    for i in range(n):
+        for j in range(3):
+            x = points[i, j]
+            mean[j] += x
+            if x < lo[j]:
+                lo[j] = x
+            if x > hi[j]:
+                hi[j] = x
+    for j in range(3):
+        mean[j] /= n
+    s = np.zeros((3, 3))
+    for i in range(n):
+        a, b, c = points[i, 0] - mean[0], points[i, 1] - mean[1], points[i, 2] - mean[2]
+        s[0, 0] += a * a
+        s[0, 1] += a * b
+        s[0, 2] += a * c
+        s[1, 1] += b * b
+        s[1, 2] += b * c
+        s[2, 2] += c * c
+    s[1, 0], s[2, 0], s[2, 1] = s[0, 1], s[0, 2], s[1, 2]
+    return lo, hi, s
