@@ -428,6 +428,39 @@ def test_grown_occlusion_is_the_twins(seed, radius):
     assert np.array_equal(at, at_twin) and np.array_equal(window, window_twin) and np.array_equal(grown, grown_twin)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(0, 4), st.booleans(), st.booleans())
+def test_occlusion_maps_are_the_twins_to_the_bit(seed, reach, single, with_others):
+    """core.occlusion.occlusion with the kernels and with the numpy twins: the same hidden pixels and seen depths,
+    bit for bit, on random depth images (a background, surfaces in front of and behind the fruit, dropouts as 0
+    and NaN, float32 and float64), the fruit's mask larger than its points' pixels, other fruit or none, points
+    on the image's edges."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=300.0, fy=300.0, cx=40.0, cy=30.0, width=80, height=60)
+    depth = np.where(_blobs(rng, 60, 80, 0.02), rng.uniform(0.3, 0.45), 1.0) + rng.normal(0.0, 0.01, (60, 80))
+    depth[rng.random((60, 80)) < rng.uniform(0.0, 0.4)] = 0.0
+    depth[rng.random((60, 80)) < 0.05] = np.nan
+    depth = depth.astype(np.float32 if single else np.float64)
+    u = rng.uniform(-0.4, 79.4, 300) if rng.random() < 0.2 else rng.normal(rng.uniform(10, 70), 6.0, 300)
+    v = rng.normal(rng.uniform(10, 50), 5.0, 300)
+    z = rng.uniform(0.38, 0.42, 300)
+    points = np.column_stack(((u - 40.0) * z / 300.0, (v - 30.0) * z / 300.0, z))
+    ok = (np.rint(u) >= 0) & (np.rint(u) < 80) & (np.rint(v) >= 0) & (np.rint(v) < 60)
+    if not ok.any():
+        return
+    mask = np.zeros((60, 80), bool)
+    mask[np.rint(v[ok]).astype(int), np.rint(u[ok]).astype(int)] = True
+    mask &= rng.random((60, 80)) < 0.9
+    mask |= _blobs(rng, 60, 80, 0.01) & (rng.random() < 0.5)
+    others = _blobs(rng, 60, 80, 0.03) if with_others else None
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occlusion, depth, mask, points, camera, others=others, reach=reach)
+    assert (fast.u0, fast.v0) == (twin.u0, twin.v0) and np.array_equal(fast.hidden, twin.hidden)
+    assert np.array_equal(fast.own, twin.own) and fast.depth.tobytes() == twin.depth.tobytes()
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.integers(0, 4))
 def test_allowed_pixels_are_the_twins(seed, gap, thin):
     """Occlusion.allowed (and so extent) with the kernel and with the numpy twin: the same pixels, on random hidden

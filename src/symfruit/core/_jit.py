@@ -1648,3 +1648,55 @@ def cloud_spread(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
         s[2, 2] += c * c
     s[1, 0], s[2, 0], s[2, 1] = s[0, 1], s[0, 2], s[1, 2]
     return lo, hi, s
+
+
+@_njit
+def occlusion_maps(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    own_z: np.ndarray,
+    nearest: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+    hidden: np.ndarray,
+    seen: np.ndarray,
+) -> None:
+    """:func:`symfruit.core.occlusion.occlusion`'s maps of one window, into ``hidden`` (h, w) bool and ``seen`` (h,
+    w) float (what the camera saw, NaN: nothing): ``depth`` (h, w) the frame's depth there (metres; 0 or not
+    finite: none), ``mask`` (h, w) the fruit's own pixels, ``own_z`` (h, w) its points' least depth per pixel (+inf:
+    none), ``nearest`` (h, w) each pixel's flat index of its nearest point pixel (:func:`nearest`), ``others`` (h,
+    w) other fruit's pixels ((0, 0): none), ``steps`` (k, 2) the offsets ``(dr, dc)`` a pixel without depth looks
+    through, nearest first (``_offsets``; none: no fill). A pixel without depth, not the fruit's, takes the depth
+    of its first offset with depth in the window (the twin's ``_fill``: depths as read, not as filled); a pixel is
+    hidden when what was seen is nearer than the fruit's depth at its nearest point pixel plus ``tolerance``, or it
+    is another fruit's and not clearly behind, never when it is the fruit's own. The twin's comparisons on the same
+    values: the same maps, bit for bit."""
+    h, w = mask.shape
+    valid = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            x = np.float64(depth[r, c])
+            own = mask[r, c] or math.isfinite(own_z[r, c])
+            ok = math.isfinite(x) and x > 0.0 and not own
+            valid[r, c] = ok
+            seen[r, c] = x if ok else np.nan
+    k = steps.shape[0]
+    flat_z = own_z.ravel()
+    with_others = others.shape[0] > 0
+    for r in range(h):
+        for c in range(w):
+            own = mask[r, c] or math.isfinite(own_z[r, c])
+            x = seen[r, c]
+            if not own and not valid[r, c]:
+                for j in range(k):
+                    rr, cc = r + steps[j, 0], c + steps[j, 1]
+                    if 0 <= rr < h and 0 <= cc < w and valid[rr, cc]:
+                        x = seen[rr, cc]  # a valid pixel's depth is never a filled one
+                        seen[r, c] = x
+                        break
+            ref = flat_z[nearest[r, c]] + tolerance
+            hide = False
+            if not own:
+                hide = x < ref or (with_others and others[r, c] and not x >= ref)
+            hidden[r, c] = hide
