@@ -428,6 +428,39 @@ def test_grown_occlusion_is_the_twins(seed, radius):
     assert np.array_equal(at, at_twin) and np.array_equal(window, window_twin) and np.array_equal(grown, grown_twin)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(0, 4), st.booleans(), st.booleans())
+def test_occlusion_maps_are_the_twins_to_the_bit(seed, reach, single, with_others):
+    """core.occlusion.occlusion with the kernels and with the numpy twins: the same hidden pixels and seen depths,
+    bit for bit, on random depth images (a background, surfaces in front of and behind the fruit, dropouts as 0
+    and NaN, float32 and float64), the fruit's mask larger than its points' pixels, other fruit or none, points
+    on the image's edges."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=300.0, fy=300.0, cx=40.0, cy=30.0, width=80, height=60)
+    depth = np.where(_blobs(rng, 60, 80, 0.02), rng.uniform(0.3, 0.45), 1.0) + rng.normal(0.0, 0.01, (60, 80))
+    depth[rng.random((60, 80)) < rng.uniform(0.0, 0.4)] = 0.0
+    depth[rng.random((60, 80)) < 0.05] = np.nan
+    depth = depth.astype(np.float32 if single else np.float64)
+    u = rng.uniform(-0.4, 79.4, 300) if rng.random() < 0.2 else rng.normal(rng.uniform(10, 70), 6.0, 300)
+    v = rng.normal(rng.uniform(10, 50), 5.0, 300)
+    z = rng.uniform(0.38, 0.42, 300)
+    points = np.column_stack(((u - 40.0) * z / 300.0, (v - 30.0) * z / 300.0, z))
+    ok = (np.rint(u) >= 0) & (np.rint(u) < 80) & (np.rint(v) >= 0) & (np.rint(v) < 60)
+    if not ok.any():
+        return
+    mask = np.zeros((60, 80), bool)
+    mask[np.rint(v[ok]).astype(int), np.rint(u[ok]).astype(int)] = True
+    mask &= rng.random((60, 80)) < 0.9
+    mask |= _blobs(rng, 60, 80, 0.01) & (rng.random() < 0.5)
+    others = _blobs(rng, 60, 80, 0.03) if with_others else None
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occlusion, depth, mask, points, camera, others=others, reach=reach)
+    assert (fast.u0, fast.v0) == (twin.u0, twin.v0) and np.array_equal(fast.hidden, twin.hidden)
+    assert np.array_equal(fast.own, twin.own) and fast.depth.tobytes() == twin.depth.tobytes()
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.integers(0, 4))
 def test_allowed_pixels_are_the_twins(seed, gap, thin):
     """Occlusion.allowed (and so extent) with the kernel and with the numpy twin: the same pixels, on random hidden
@@ -611,6 +644,44 @@ def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
         fits.surface_noise(pts, queries=30)
 
 
+@pytest.mark.parametrize("seed", range(4))
+def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
+    """Spheres and rotated ellipsoids about the truth, beside it, around the camera, missing every ray and reaching
+    in front of the leaf, against views with and without the frame's depth beside the fruit (outside rays on an
+    occluder: free space); the depth RMS within rounding (its sums' order; grazing rays' roots), the band shares
+    from whole counts: equal."""
+    from symfruit.core.agreement import Quadric, explain, observe
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.occlusion import occlusion
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, occluded_view
+
+    rng = np.random.default_rng(seed)
+    centre = np.array([0.01 * seed, -0.005, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
+                                            seed=seed)  # fmt: skip
+    region = silhouette(visible, camera)
+    occ = occlusion(depth, mask, visible, camera)
+    views = [observe(visible[::10], region, camera, dense=visible, occlusion=o) for o in (None, occ)]
+    for obs in views:
+        for k in range(16):
+            r = rng.uniform(0.02, 0.05) if k < 12 else rng.uniform(0.055, 0.085)  # the last: fronts about the leaf's
+            c = centre + rng.normal(0.0, 0.01, 3) * (k % 4 != 0)
+            if k == 10:
+                c = np.array([0.0, 0.0, 0.05])  # the camera inside
+            if k == 11:
+                c = centre + [0.5, 0.0, 0.0]  # no ray meets it
+            axes = rng.uniform(0.6, 1.6, 3) * r
+            turn = rotation(*rng.uniform(0.0, 180.0, 3))
+            shape = turn @ np.diag(1.0 / axes**2) @ turn.T if k % 2 else np.eye(3) / r**2
+            quadric = Quadric(c, shape)
+            box = (c - axes.max(), c + axes.max())
+            fast, twin = _both(monkeypatch, explain, quadric, box, obs)
+            assert fast.depth == pytest.approx(twin.depth, rel=1e-9, abs=1e-15)
+            assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
+
+
 # --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------
 
 
@@ -645,6 +716,101 @@ def test_distance_transform_is_scipys_with_and_without_the_kernel(monkeypatch):
     mask[5:50, 10:75] = _blobs(rng, 45, 65, 0.4)
     fast, twin = _both(monkeypatch, inner_distance, mask)
     assert np.array_equal(fast, twin) and np.array_equal(fast, ndimage.distance_transform_edt(mask))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 3))
+def test_nearest_is_scipys_feature_transform_to_the_pixel(seed, h, w, kind):
+    """Blobs, speckle, a few lone pixels and lattices of pixels (equally near pixels everywhere: the tie rule)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    if kind == 0:
+        image = ~_blobs(rng, h, w, rng.uniform(0.0, 0.2))
+    elif kind == 1:
+        image = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    else:
+        image = np.ones((h, w), bool)
+        step = int(rng.integers(1, 7))
+        if kind == 2:
+            image[rng.integers(0, h, 3), rng.integers(0, w, 3)] = False
+        else:
+            image[::step, ::step] = rng.random(image[::step, ::step].shape) < 0.4
+    if image.all():
+        image[int(rng.integers(0, h)), int(rng.integers(0, w))] = False
+    out = np.full((h, w), -2, np.int64)
+    _jit.nearest(image, out)
+    rows, cols = ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)
+    assert np.array_equal(out, rows * w + cols)
+    _jit.nearest(np.ones((h, w), bool), out)  # nothing to point to
+    assert (out == -1).all()
+
+
+def test_nearest_index_is_scipys_with_and_without_the_kernel(monkeypatch):
+    """raster.nearest_index on both paths: scipy's picks."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import nearest_index
+
+    rng = np.random.default_rng(5)
+    for image in (~_blobs(rng, 120, 90, 0.02), rng.random((31, 17)) < 0.9, np.array([[True, False]])):
+        fast, twin = _both(monkeypatch, nearest_index, image)
+        rows, cols = ndimage.distance_transform_edt(image, return_distances=False, return_indices=True)
+        assert np.array_equal(fast, twin) and np.array_equal(fast, rows * image.shape[1] + cols)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_outline_cracks_are_the_twins_to_the_bit(seed, h, w):
+    """Blobs and speckle touching the window's edges, at random window origins: the same points in the same order."""
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.0, 0.3)) if rng.random() < 0.5 else rng.random((h, w)) < rng.random()
+    u0, v0 = (int(x) for x in rng.integers(0, 600, 2))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: outline_cracks(Silhouette(u0, v0, mask, 0.0)))
+    assert fast.shape == twin.shape and fast.tobytes() == twin.tobytes()
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000))
+def test_cloud_spread_is_the_bounds_and_the_twins_scatter(seed, n):
+    """Random clouds far from the origin (the mean's rounding matters most there): numpy's bounds exactly, the
+    scatter within rounding of the centred product."""
+    from symfruit.core.points import bounds, mean_point
+
+    rng = np.random.default_rng(seed)
+    points = rng.normal(0.0, rng.uniform(1e-4, 0.05), (n, 3)) * rng.uniform(0.1, 1.0, 3) + [0.1, -0.2, 0.6]
+    lo, hi, scatter = _jit.cloud_spread(points)
+    want_lo, want_hi = bounds(points)
+    centred = points - mean_point(points)
+    twin = centred.T @ centred
+    assert np.array_equal(lo, want_lo) and np.array_equal(hi, want_hi)
+    assert np.allclose(scatter, twin, rtol=1e-9, atol=1e-12 * np.abs(twin).max())
+
+
+def test_check_cloud_is_the_twins(monkeypatch):
+    """The same clean points, and the same refusals of clouds on a plane, on a line, of one point, and behind or
+    too near the camera, with and without the kernel."""
+    from symfruit.core.limits import MIN_DEPTH_METRES
+    from symfruit.core.points import check_cloud
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(2)
+    cloud = rng.normal(0.0, 0.02, (500, 3)) + [0.0, 0.0, 0.5]
+    cloud[::7] = np.nan
+    fast, twin = _both(monkeypatch, check_cloud, cloud)
+    assert fast[1] == twin[1] == 72 and np.array_equal(fast[0], twin[0])
+    flat = cloud[1:200].copy()
+    flat[:, 2] = 0.5
+    line = np.outer(np.linspace(0.0, 1.0, 50), [0.01, 0.02, 0.03]) + [0.0, 0.0, 0.5]
+    same = np.tile([0.0, 0.0, 0.5], (20, 1))
+    behind, near = cloud[1:200] - [0.0, 0.0, 0.49], cloud[1:200].copy()
+    near[:, 2] = MIN_DEPTH_METRES / 2 + np.abs(near[:, 2] - 0.5) * 0.05  # in front, some nearer than a camera reads
+    for bad, said in ((flat, "plane"), (line, "line"), (same, "identical"), (behind, "behind"), (near, "nearer")):
+        for env in ("", "numpy"):
+            monkeypatch.setenv("SYMFRUIT_KERNELS", env)
+            with pytest.raises(InputError, match=said):
+                check_cloud(bad[np.isfinite(bad).all(axis=1)])
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
 
 
 @given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 30))

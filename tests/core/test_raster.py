@@ -10,6 +10,7 @@ from symfruit.core.raster import (
     fill_holes,
     inner_distance,
     mask_box,
+    nearest_index,
     outer_distance,
     rasterise,
     silhouette_coverage,
@@ -226,6 +227,14 @@ def test_an_ellipse_is_recovered_from_part_of_its_outline(camera):
     assert outline_cone(region, camera, small + [250, 180]) is None  # would not hold the seen region
     with pytest.raises(InputError, match="shape"):
         outline_cone(region, camera, np.zeros((10, 3)))
+
+
+def test_nearest_index_takes_scipys_pick_among_equally_near_pixels():
+    """The upper of two in a column, the left of two in a row, the least column first otherwise (flat indices)."""
+    assert nearest_index(np.array([[0, 1, 1, 1, 0]], bool)).tolist() == [[0, 0, 0, 4, 4]]
+    assert nearest_index(np.array([[0], [1], [1], [1], [0]], bool)).ravel().tolist() == [0, 0, 0, 4, 4]
+    corners = np.array([[1, 1, 0], [1, 1, 1], [0, 1, 1]], bool)
+    assert nearest_index(corners).tolist() == [[6, 2, 2], [6, 6, 2], [6, 6, 6]]
 
 
 @given(st.integers(0, 2**32 - 1))

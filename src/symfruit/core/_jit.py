@@ -929,6 +929,73 @@ def distance(mask: np.ndarray, want: bool, out: np.ndarray) -> None:
 
 
 @_njit
+def nearest(image: np.ndarray, out: np.ndarray) -> None:
+    """Each pixel's flat index (``row * w + col``) of the false pixel of ``image`` (h, w) bool nearest to it, the
+    one ``ndimage.distance_transform_edt(image, return_indices=True)`` picks, into ``out`` (h, w) int64 (-1
+    everywhere when ``image`` holds no false pixel).
+
+    scipy's exact feature transform (Maurer, Qi and Raghavan) in two passes, with its choices among equally near
+    pixels: each column's nearest false pixel, the upper of two as near (here by a sweep down the rows and one up,
+    row by row); then each row's lower envelope of the parabolas ``(u - c)^2 + (r - row(c))^2`` of its columns, a
+    parabola dropped when its predecessor and successor leave it nowhere least (scipy's test, in whole numbers: its
+    doubles of whole numbers are exact), and each pixel's the envelope's first parabola no farther than the next.
+    Property-tested against scipy, ties included."""
+    h, w = image.shape
+    near = np.empty((h, w), np.int64)  # the nearest false pixel's row in each pixel's column, -1: none
+    for c in range(w):
+        near[0, c] = -1 if image[0, c] else 0
+    for r in range(1, h):
+        for c in range(w):
+            near[r, c] = near[r - 1, c] if image[r, c] else r
+    below = np.full(w, -1, np.int64)  # the nearest false pixel at or below, row by row from the bottom
+    for r in range(h - 1, -1, -1):
+        for c in range(w):
+            if not image[r, c]:
+                below[c] = r
+            b = below[c]
+            if b >= 0:
+                a = near[r, c]
+                if a < 0 or b - r < r - a:  # as near: the upper one stays
+                    near[r, c] = b
+    env = np.empty(w, np.int64)  # the envelope's columns, left to right
+    for r in range(h):
+        top = -1
+        for u in range(w):
+            if near[r, u] < 0:
+                continue
+            dw = near[r, u] - r
+            wr = dw * dw
+            while top >= 1:
+                i1, i0 = env[top], env[top - 1]
+                a, b = i1 - i0, u - i1
+                c = a + b
+                d0, d1 = near[r, i0] - r, near[r, i1] - r
+                if c * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * c <= 0:
+                    break
+                top -= 1
+            top += 1
+            env[top] = u
+        if top < 0:  # no false pixel in the image: nothing to point to
+            out[r, :] = -1
+            continue
+        k = 0
+        for u in range(w):
+            i = env[k]
+            dr, dc = near[r, i] - r, i - u
+            best = dr * dr + dc * dc
+            while k < top:
+                i = env[k + 1]
+                dr, dc = near[r, i] - r, i - u
+                d = dr * dr + dc * dc
+                if best <= d:
+                    break
+                best = d
+                k += 1
+            i = env[k]
+            out[r, u] = near[r, i] * w + i
+
+
+@_njit
 def taxicab_within(mask: np.ndarray, reach: int, out: np.ndarray) -> None:
     """``ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach`` (``mask`` (h, w) not empty) into ``out``
     (h, w) bool: the pixels at most ``reach`` steps along rows and columns from a pixel of ``mask``, by the two
@@ -1421,3 +1488,215 @@ def close_square(hit: np.ndarray, half: int, out: np.ndarray) -> None:
         a, b = max(r - half, 0), min(r + half + 1, h)
         for c in range(w):
             out[r, c] = cols[b, c] - cols[a, c] == b - a or hit[r, c]
+
+
+@_njit
+def explain_quadric(
+    centre: np.ndarray,
+    shape: np.ndarray,
+    rays: np.ndarray,
+    z0: float,
+    z1: float,
+    depth: np.ndarray,
+    keep: int,
+    in_starts: np.ndarray,
+    in_sizes: np.ndarray,
+    out_starts: np.ndarray,
+    out_w: np.ndarray,
+    out_wsum: np.ndarray,
+    seen: np.ndarray,
+    free: float,
+) -> tuple[float, float, float]:
+    """:func:`symfruit.core.agreement.explain` of a :class:`~symfruit.core.agreement.Quadric` (``centre`` (3,),
+    ``shape`` (3, 3)): ``(depth RMS, inside, outside)``, each ray met in closed form (``intersect_quadric``'s
+    roots) in one pass. ``rays`` (m, 3): the depth rays (``depth`` (n,), their seen depths), the inside bands' and
+    the outside bands' rays one after the other (:class:`~symfruit.core.agreement._Bands`); ``keep`` the trimmed
+    RMS's count (at least 1, at most n); each band's first ray and size (``in_starts``, ``in_sizes``; the outside
+    bands' sizes from their starts), the outside rays' weights, each outside band's weight and the outside rays'
+    seen depths (``seen``: NaN where none; empty without). The twin's arithmetic but for the order of the trimmed RMS's
+    sum and of the products making each ray's quadratic (numpy's ``einsum`` and BLAS there): the depth RMS within
+    rounding of the twin's (grazing rays' roots the most), the band shares, counts of whole numbers (the outside
+    weights are 0 or 1), equal."""
+    n = depth.shape[0]
+    m = rays.shape[0]
+    s = np.empty(3)
+    for i in range(3):
+        s[i] = shape[i, 0] * centre[0] + shape[i, 1] * centre[1] + shape[i, 2] * centre[2]
+    c = centre[0] * s[0] + centre[1] * s[1] + centre[2] * s[2] - 1.0
+    hit = np.empty(m, np.bool_)
+    at = np.empty(m)
+    for k in range(m):
+        x, y, z = rays[k, 0], rays[k, 1], rays[k, 2]
+        a = 0.0
+        for i in range(3):
+            for j in range(3):
+                a += rays[k, i] * shape[i, j] * rays[k, j]
+        b = x * s[0] + y * s[1] + z * s[2]
+        disc = b * b - a * c
+        root = math.sqrt(disc) if disc > 0.0 else 0.0
+        near, far = (b - root) / a, (b + root) / a
+        hit[k] = disc > 0.0 and near < z1 and far > z0
+        at[k] = max(near, z0) if hit[k] else np.nan
+    r2 = np.empty(n)
+    for k in range(n):
+        r = depth[k] - at[k] if hit[k] else z1 - z0
+        r2[k] = r * r
+    select(r2, keep - 1)
+    total = 0.0
+    for k in range(keep):
+        total += r2[k]
+    rms = math.sqrt(total / keep)
+    n_bands = in_starts.shape[0]
+    inside = 0.0
+    for j in range(n_bands):
+        size = in_sizes[j]
+        if size > 0:
+            count = 0
+            for k in range(n + in_starts[j], n + in_starts[j] + size):
+                count += hit[k]
+            inside += 1.0 - count / size
+    inside = inside / n_bands if n_bands else np.nan
+    base = n
+    for j in range(n_bands):
+        base += in_sizes[j]
+    n_out = m - base
+    k_bands = out_starts.shape[0]
+    outside = 0.0
+    for j in range(k_bands):
+        start = out_starts[j]
+        stop = out_starts[j + 1] if j + 1 < k_bands else n_out
+        if stop > start and out_wsum[j] > 0:
+            wrong = 0.0
+            for k in range(start, stop):
+                if seen.shape[0] and math.isfinite(seen[k]):  # free space in front of an occluder
+                    wrong += 1.0 if hit[base + k] and at[base + k] < seen[k] - free else 0.0
+                elif hit[base + k]:
+                    wrong += out_w[k]
+            outside += wrong / out_wsum[j]
+    outside = outside / k_bands if k_bands else np.nan
+    return rms, inside, outside
+
+
+@_njit
+def outline_cracks(mask: np.ndarray, u0: int, v0: int) -> np.ndarray:
+    """:func:`symfruit.core.raster.outline_cracks` of the region ``mask`` (h, w) bool whose top-left pixel is ``(u0,
+    v0)``: (m, 2) the midpoints of the pixel edges between a region pixel and a 4-neighbour outside it (beyond the
+    window: outside), those above their pixel, then below, left and right, each row-major, as the twin's four
+    ``np.nonzero`` passes give them; half-integers, the same values. Two passes: the counts, then the points."""
+    h, w = mask.shape
+    count = np.zeros(4, np.int64)
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                count[0] += r == 0 or not mask[r - 1, c]
+                count[1] += r == h - 1 or not mask[r + 1, c]
+                count[2] += c == 0 or not mask[r, c - 1]
+                count[3] += c == w - 1 or not mask[r, c + 1]
+    at = np.empty(4, np.int64)
+    at[0] = 0
+    for d in range(1, 4):
+        at[d] = at[d - 1] + count[d - 1]
+    out = np.empty((at[3] + count[3], 2))
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                if r == 0 or not mask[r - 1, c]:
+                    out[at[0], 0], out[at[0], 1] = c + (0.0 + u0), r + (-0.5 + v0)
+                    at[0] += 1
+                if r == h - 1 or not mask[r + 1, c]:
+                    out[at[1], 0], out[at[1], 1] = c + (0.0 + u0), r + (0.5 + v0)
+                    at[1] += 1
+                if c == 0 or not mask[r, c - 1]:
+                    out[at[2], 0], out[at[2], 1] = c + (-0.5 + u0), r + (0.0 + v0)
+                    at[2] += 1
+                if c == w - 1 or not mask[r, c + 1]:
+                    out[at[3], 0], out[at[3], 1] = c + (0.5 + u0), r + (0.0 + v0)
+                    at[3] += 1
+    return out
+
+
+@_njit
+def cloud_spread(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(min (3,), max (3,), scatter (3, 3))`` of the rows of ``points`` (n, 3), ``n >= 1``: the columns' least and
+    greatest values (exactly :func:`symfruit.core.points.bounds`'s) and the sums of the products of the rows'
+    deviations from their mean (the twin's ``centred.T @ centred``, within rounding: these sums run row by row, the
+    mean's too), in two passes over the points without the centred copy."""
+    n = points.shape[0]
+    lo = np.empty(3)
+    hi = np.empty(3)
+    mean = np.zeros(3)
+    for j in range(3):
+        lo[j] = hi[j] = points[0, j]
+    for i in range(n):
+        for j in range(3):
+            x = points[i, j]
+            mean[j] += x
+            if x < lo[j]:
+                lo[j] = x
+            if x > hi[j]:
+                hi[j] = x
+    for j in range(3):
+        mean[j] /= n
+    s = np.zeros((3, 3))
+    for i in range(n):
+        a, b, c = points[i, 0] - mean[0], points[i, 1] - mean[1], points[i, 2] - mean[2]
+        s[0, 0] += a * a
+        s[0, 1] += a * b
+        s[0, 2] += a * c
+        s[1, 1] += b * b
+        s[1, 2] += b * c
+        s[2, 2] += c * c
+    s[1, 0], s[2, 0], s[2, 1] = s[0, 1], s[0, 2], s[1, 2]
+    return lo, hi, s
+
+
+@_njit
+def occlusion_maps(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    own_z: np.ndarray,
+    nearest: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+    hidden: np.ndarray,
+    seen: np.ndarray,
+) -> None:
+    """:func:`symfruit.core.occlusion.occlusion`'s maps of one window, into ``hidden`` (h, w) bool and ``seen`` (h,
+    w) float (what the camera saw, NaN: nothing): ``depth`` (h, w) the frame's depth there (metres; 0 or not
+    finite: none), ``mask`` (h, w) the fruit's own pixels, ``own_z`` (h, w) its points' least depth per pixel (+inf:
+    none), ``nearest`` (h, w) each pixel's flat index of its nearest point pixel (:func:`nearest`), ``others`` (h,
+    w) other fruit's pixels ((0, 0): none), ``steps`` (k, 2) the offsets ``(dr, dc)`` a pixel without depth looks
+    through, nearest first (``_offsets``; none: no fill). A pixel without depth, not the fruit's, takes the depth
+    of its first offset with depth in the window (the twin's ``_fill``: depths as read, not as filled); a pixel is
+    hidden when what was seen is nearer than the fruit's depth at its nearest point pixel plus ``tolerance``, or it
+    is another fruit's and not clearly behind, never when it is the fruit's own. The twin's comparisons on the same
+    values: the same maps, bit for bit."""
+    h, w = mask.shape
+    valid = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            x = np.float64(depth[r, c])
+            own = mask[r, c] or math.isfinite(own_z[r, c])
+            ok = math.isfinite(x) and x > 0.0 and not own
+            valid[r, c] = ok
+            seen[r, c] = x if ok else np.nan
+    k = steps.shape[0]
+    flat_z = own_z.ravel()
+    with_others = others.shape[0] > 0
+    for r in range(h):
+        for c in range(w):
+            own = mask[r, c] or math.isfinite(own_z[r, c])
+            x = seen[r, c]
+            if not own and not valid[r, c]:
+                for j in range(k):
+                    rr, cc = r + steps[j, 0], c + steps[j, 1]
+                    if 0 <= rr < h and 0 <= cc < w and valid[rr, cc]:
+                        x = seen[rr, cc]  # a valid pixel's depth is never a filled one
+                        seen[r, c] = x
+                        break
+            ref = flat_z[nearest[r, c]] + tolerance
+            hide = False
+            if not own:
+                hide = x < ref or (with_others and others[r, c] and not x >= ref)
+            hidden[r, c] = hide

@@ -509,7 +509,9 @@ def explain(
     inside : callable
         The candidate's inside function (:data:`Inside`); one with an ``intersect(rays, z0, z1)`` method
         (a :class:`Quadric`) is met in closed form instead of marched, one with a ``march(rays, z0, z1, steps)``
-        method (:class:`symfruit.core.fits.RevolutionInside`) marches its own rays where it can (None: not).
+        method (:class:`symfruit.core.fits.RevolutionInside`) marches its own rays where it can (None: not). A
+        :class:`Quadric` is measured by the compiled twin :func:`symfruit.core._jit.explain_quadric` where numba
+        is installed (one pass over the rays: 9 against 120 us; the depth RMS within rounding, the same shares).
     box : ((3,), (3,)) float, metres
         The candidate's box: the rays are met over its depth range (1 mm beyond on both sides).
     obs : Observation
@@ -524,6 +526,13 @@ def explain(
     lo, hi = box
     z0, z1 = float(lo[2]) - 1e-3, float(hi[2]) + 1e-3
     n = len(obs.rays)
+    if isinstance(inside, Quadric) and n and (jit := compiled()) is not None:  # one pass over the rays, compiled
+        b = _bands(obs)
+        seen = np.empty(0) if b.seen is None else b.seen
+        rms, ins, outs = jit.explain_quadric(inside.centre, inside.shape, b.rays, z0, z1, obs.depth,
+                                             max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
+                                             b.out_wsum, seen, free)  # fmt: skip
+        return Agreement(depth=rms, inside=ins, outside=outs)
     every = _bands(obs).rays  # one march for all rays
     closed_form = getattr(inside, "intersect", None)
     marcher = getattr(inside, "march", None)  # a compiled march (core.fits.RevolutionInside), None without numba

@@ -1,10 +1,10 @@
-"""Compiled kernels for the fits' loops (issue 19, eighth round; the cone ellipsoid's in the tenth), the
-observation's pixel maps (ninth round), a fruit's surface, outline and colour trimming (twelfth round) and the
-observation's edge normals and silhouette bands and the silhouette's closing (thirteenth round), with numba from the
-optional extra ``fast``.
+"""Compiled kernels for the fits' loops (issue 19, eighth round; the cone ellipsoid's in the tenth), the observation's
+pixel maps (ninth round), a fruit's surface, outline and colour trimming (twelfth round), the observation's edge
+normals and silhouette bands and the silhouette's closing (thirteenth round), and scipy's feature transform and the
+quadric candidates' agreement (fourteenth round), with numba from the optional extra ``fast``.
 
-:func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed,
-or when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
+:func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
+when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
 :func:`~symfruit.core.fits.fit_revolution_slices`, :class:`~symfruit.core.fits.RevolutionInside`,
 :func:`~symfruit.core.fits.fit_cone_ellipsoid`, :func:`~symfruit.core.fits.surface_noise`,
 :func:`symfruit.core.raster.inner_distance` and :func:`~symfruit.core.raster.outer_distance`,
@@ -12,13 +12,14 @@ or when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`sym
 :func:`symfruit.core.raster.distance_transform`, :func:`symfruit.core.surface.fruit_surface`,
 :func:`~symfruit.core.surface.monotone_region`, :func:`~symfruit.core.surface.colour_trim` and
 :func:`~symfruit.core.surface.within`; the thirteenth round's :func:`symfruit.core.agreement.observe` and
-:func:`symfruit.core.raster.close_ragged`) then run their numpy twins, the code the kernels were written from, which
+:func:`symfruit.core.raster.close_ragged`; the fourteenth round's :func:`symfruit.core.raster.nearest_index` and
+:func:`symfruit.core.agreement.explain`) then run their numpy twins, the code the kernels were written from, which
 stays tested and gives the same results within rounding (the fits' kernels sum in another order than numpy; the
-pixel maps' and the surface's are the twins' to the bit; the observation's edge normals come from Jacobi
-rotations instead of LAPACK, so they agree to rounding). Nothing compiles when symfruit is imported: numba is
-imported by the first fit that asks for a kernel (about half a second), and each kernel is compiled on its first
-call (a few seconds in all) or loaded from numba's on-disk cache (beside the module, or the user's cache
-directory where that is read-only; without a cache where neither is writable).
+pixel maps', the surface's and the feature transform's are the twins' to the bit; the observation's edge normals
+come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics' depth RMS does). Nothing
+compiles when symfruit is imported: numba is imported by the first fit that asks for a kernel (about half a second),
+and each kernel is compiled on its first call (a few seconds in all) or loaded from numba's on-disk cache (beside
+the module, or the user's cache directory where that is read-only; without a cache where neither is writable).
 
 >>> compiled() is None or callable(compiled().slice_costs)
 True

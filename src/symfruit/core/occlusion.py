@@ -24,7 +24,7 @@ from .camera import Camera
 from .kernels import compiled
 from .limits import check_image_size, depth_metres
 from .points import as_points
-from .raster import Silhouette, mask_box
+from .raster import Silhouette, mask_box, nearest_index
 
 __all__ = ["Occlusion", "occlusion", "with_own"]
 
@@ -273,6 +273,10 @@ def occlusion(
     hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
     pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden.
 
+    Where numba is installed the maps are made in one compiled pass over the window
+    (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
+    maps, bit for bit; the benchmark frame's 9 windows 4.9 against 9.1 ms; issue 19, fourteenth round).
+
     Parameters
     ----------
     depth : (H, W) float, metres
@@ -332,9 +336,18 @@ def occlusion(
     np.minimum.at(flat, (row - v0) * w + (col - u0), z)
     own_z = flat.reshape(h, w)
     seen_own = np.isfinite(own_z)
+    if (jit := compiled()) is not None:  # the maps below in one compiled pass, the same bits
+        window = depth[v0:v1, u0:u1]
+        if window.dtype not in (np.float32, np.float64):
+            window = np.asarray(window, dtype=np.float64)
+        near_to = others[v0:v1, u0:u1] if others is not None else np.zeros((0, 0), bool)
+        steps = np.array(_offsets(reach) if reach > 0 else [], dtype=np.int64).reshape(-1, 2)
+        hidden, seen = np.empty((h, w), bool), np.empty((h, w))
+        jit.occlusion_maps(window, mask[v0:v1, u0:u1], own_z, nearest_index(~seen_own),
+                           np.asarray(near_to, dtype=bool), tolerance, steps, hidden, seen)  # fmt: skip
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=seen)
     # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
-    nr, nc = ndimage.distance_transform_edt(~seen_own, return_distances=False, return_indices=True)
-    z_ref = np.take(own_z.ravel(), nr * w + nc)  # by flat index: faster than two index arrays
+    z_ref = np.take(own_z.ravel(), nearest_index(~seen_own))  # the nearest point pixel's
     own = mask[v0:v1, u0:u1] | seen_own
     d = np.asarray(depth[v0:v1, u0:u1], dtype=np.float64)
     valid = np.isfinite(d) & (d > 0) & ~own

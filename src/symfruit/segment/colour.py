@@ -58,7 +58,7 @@ from scipy import ndimage
 
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
-from ..core.raster import distance_transform, fill_holes, mask_box
+from ..core.raster import distance_transform, fill_holes, mask_box, nearest_index
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -1032,8 +1032,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     seeds[(pieces == 0) | ~region] = 0  # edge pixels and the outside: to the nearest piece
     if not seeds.any():
         return parts
-    ri, ci = ndimage.distance_transform_edt(seeds == 0, return_distances=False, return_indices=True)
-    grown = np.where(region, np.take(seeds.ravel(), ri * seeds.shape[1] + ci), 0)  # flat: faster than 2 indices
+    grown = np.where(region, np.take(seeds.ravel(), nearest_index(seeds == 0)), 0)
     return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
 
 
@@ -1266,8 +1265,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores = np.zeros(region.shape, np.int32)
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
-    ri, ci = ndimage.distance_transform_edt(cores == 0, return_distances=False, return_indices=True)
-    cells = np.where(region, np.take(cores.ravel(), ri * region.shape[1] + ci), 0)  # flat: faster than 2 indices
+    cells = np.where(region, np.take(cores.ravel(), nearest_index(cores == 0)), 0)
     return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
 
 
@@ -1301,8 +1299,7 @@ def _creases(
     the region's pixels with depth, ``zm`` their median depth."""
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
-    ri, ci = ndimage.distance_transform_edt(~valid, return_distances=False, return_indices=True)
-    filled = np.take(np.ascontiguousarray(depth).ravel(), ri * depth.shape[1] + ci)  # flat: faster than 2 indices
+    filled = np.take(np.ascontiguousarray(depth).ravel(), nearest_index(~valid))
     smooth = _gaussian(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.correlate1d(smooth, _SECOND, 0)  # ndimage.laplace's sum, without its call's overhead
     lap += ndimage.correlate1d(smooth, _SECOND, 1)
