@@ -36,9 +36,10 @@ class ExtractSettings(Section):
         sit.
     registration_px : int
         How far (pixels) the depth image may sit from the masks: a real RGB-D camera's depth registered to
-        colour is often a few pixels off (the shared Azure Kinect lab frames: 8 px down). The frame's shift is
-        searched within this radius and the masks moved onto the depth before extraction
-        (:func:`~symfruit.core.surface.registration_shift`; 0: never).
+        colour is often a few pixels off. The frame's shift is searched within this radius and the masks moved
+        onto the depth before extraction (:func:`~symfruit.core.surface.registration_shift`; 0: never); a least
+        cost at the radius itself is no minimum found and moves nothing, so the radius must exceed the largest
+        shift expected.
     colour_trim_px : int
         With the frame's colour image (``detect``): a mask's outer band up to this many pixels (and a fifth of
         its equivalent radius) loses the pixels whose colour is the background's

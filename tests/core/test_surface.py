@@ -184,6 +184,19 @@ def test_a_fruit_on_a_support_at_its_own_depth_tells_no_shift_down(top):
         assert registration_shift(on_support(shift, support=False, top=0.1), labels, F, max_px=12) == shift
 
 
+def test_a_least_cost_at_the_search_border_is_no_registration():
+    """A shift beyond the search (or a cost that keeps falling, as an elongated fruit's outline sliding along its own
+    length does) has its least cost at ``max_px``: no minimum was found there, and the masks are kept (a banana
+    through the D435 model answered (+20, +19), its true shift within 2 px)."""
+    _, mask = ball()
+    labels = mask.astype(np.int32)
+    depth, _ = ball(centre=(80 + 7, 60 - 2), rim=0.13, noise=0.0005)
+    assert registration_shift(depth, labels, F, max_px=12) == (7, -2)  # inside the search: found
+    assert registration_shift(depth, labels, F, max_px=5) == (0, 0)  # beyond it: not (5, -2)
+    assert registration_shift(depth, labels, F, max_px=7) == (0, 0)  # at its border: no minimum seen
+    assert registration_shift(depth, labels, F, max_px=8) == (7, -2)
+
+
 @given(st.integers(-8, 8), st.integers(-8, 8), st.integers(0, 1000))
 def test_registration_within_a_pixel(du, dv, seed):
     rng = np.random.default_rng(seed)
@@ -379,7 +392,7 @@ def test_the_registration_reads_depth_within_its_range_only():
 
 def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
     """registration_shift as it was: every shift of the grid costed exactly, the least taken (first of ties); along
-    the axes the outlines tell (:func:`symfruit.core.surface._told_axes`)."""
+    the axes the outlines tell (:func:`symfruit.core.surface._told_axes`); none at the search's border."""
     from scipy import ndimage
 
     from symfruit.core.surface import _outline, _told_axes
@@ -414,7 +427,9 @@ def _shift_as_before(depth, labels, focal, max_px, trim=0.7, gain=0.25):
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     refined = cost(fine)
     best = int(np.argmin(refined))
-    return (0, 0) if refined[best] > first[0] - gain else (int(fine[best, 1]), int(fine[best, 0]))
+    if refined[best] > first[0] - gain or (np.abs(fine[best]) >= max_px).any():  # no gain, or at the border
+        return 0, 0
+    return int(fine[best, 1]), int(fine[best, 0])
 
 
 @settings(max_examples=25, deadline=None)

@@ -645,7 +645,9 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     point's deviation from that band, averaged over the fruit; the shift of least cost is searched on a grid
     of 2 pixels, then refined to a pixel. It is returned when it lowers the cost by more than ``gain`` pixels
     from the unshifted masks' (moving a disc's outline by one pixel changes it by about 0.6; a frame
-    registered well enough keeps its masks).
+    registered well enough keeps its masks), and when it lies inside the search: a least cost at ``max_px``
+    along an axis is a cost still falling beyond the search, no minimum found (an elongated fruit's outline
+    slides along its own length; a cap that runs on into the background), and the masks are kept.
 
     Only an outline's *free* points, where what lies beyond it has no depth or lies behind the fruit, are a
     silhouette with a band to measure; where the depth runs on into a support, a neighbour or a leaf in front,
@@ -716,8 +718,8 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     fine = fine.reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     best = least(fine)
-    if cost(fine[best : best + 1])[0] > zero - gain:
-        return 0, 0
+    if cost(fine[best : best + 1])[0] > zero - gain or (np.abs(fine[best]) >= max_px).any():
+        return 0, 0  # no gain; or a least cost at the search's border, still falling beyond it: no minimum found
     return int(fine[best, 1]), int(fine[best, 0])
 
 
