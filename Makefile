@@ -42,8 +42,8 @@ realsense-env: $(STAMP)  ## make pyrealsense2 importable (libusb-1.0 from apt) f
 # pytest keeps its assertion-rewritten test modules in __pycache__ even where PYTHONDONTWRITEBYTECODE is set:
 # rewriting the ~90 test modules again costs each xdist worker about 3.5 s of CPU on every run.
 test: $(STAMP) ros-env ros2-env realsense-env  ## lint, type check and the test suite (slow evaluation runs excluded)
-	$(BIN)/ruff check src tests examples
-	$(BIN)/ruff format --check src tests examples
+	$(BIN)/ruff check src tests examples docs
+	$(BIN)/ruff format --check src tests examples docs
 	$(BIN)/mypy
 	PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest -m "not slow" -n auto --dist loadgroup --durations=15
 
@@ -69,11 +69,11 @@ ros2-bench: ros2-env  ## latency of the ROS 2 node on the example frame (node su
 	$(VENV2)/bin/python -m symfruit.ros.bench2
 
 lint: $(STAMP)
-	$(BIN)/ruff check src tests examples
+	$(BIN)/ruff check src tests examples docs
 
 format: $(STAMP)
-	$(BIN)/ruff format src tests examples
-	$(BIN)/ruff check --fix src tests examples
+	$(BIN)/ruff format src tests examples docs
+	$(BIN)/ruff check --fix src tests examples docs
 
 clean:
 	rm -rf $(VENV) $(VENV2) out .pytest_cache .ruff_cache

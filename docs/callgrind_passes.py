@@ -14,6 +14,7 @@ sorts count more than they cost natively: check a change that trades sorts for o
 ``docs/speed_ab.py``.)
 """
 
+import argparse
 import sys
 
 import symfruit.detect as detect_module
@@ -41,9 +42,13 @@ def frame_inputs() -> list[tuple]:
 
 
 if __name__ == "__main__":
-    what, n = sys.argv[1], int(sys.argv[2])
-    if what not in ("dense", "frames", "trees"):
-        sys.exit("WHAT is dense, frames or trees")
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("what", choices=("dense", "frames", "trees"), help="the work (above)")
+    parser.add_argument("n", type=int, help="how many passes of it (1 or more)")
+    args = parser.parse_args()
+    what, n = args.what, args.n
+    if n < 1:
+        parser.error(f"n must be 1 or more, got {n}")
     if what == "trees":
         from symfruit.segment.colour import segment
         from symfruit.settings import resolve_settings
