@@ -105,6 +105,13 @@ def test_a_folder_of_each_frames_masks(photo, tmp_path):
     assert np.array_equal(source(color, name="frame_2")[0], labels * 2)
     with pytest.raises(FileFormatError, match=r"no masks for frame 'frame_3' \(frame_3.png, or frame_3/masks.png"):
         source(color, name="frame_3")
+    Image.fromarray(labels).save(tmp_path / "frame_2.png")  # and <frame>.png besides <frame>/masks.png: which?
+    with pytest.raises(FileFormatError, match=r"holds both .*frame_2\.png and .*frame_2/masks\.png for frame"):
+        source(color, name="frame_2")
+    (tmp_path / "frame_2.png").unlink()
+    (tmp_path / "frame_2" / "masks.json").write_text("{}")
+    with pytest.raises(FileFormatError, match=r"holds both .*frame_2/masks\.png and .*frame_2/masks\.json"):
+        source(color, name="frame_2")
     Image.fromarray(labels).save(tmp_path / "masks.png")  # a frame folder's own masks file: every frame's
     assert np.array_equal(mask_source(tmp_path)(color, name="frame_2")[0], labels)
 

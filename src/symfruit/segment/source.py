@@ -171,9 +171,13 @@ def _frames_folder(folder: Path) -> MaskSource | None:
 
     def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         stem = Path(name).stem
-        for path in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json"):
-            if stem and path.is_file():
-                return read_masks(path, color.shape[:2], color=cf), str(path)
+        given = [p for p in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json")
+                 if stem and p.is_file()]  # fmt: skip
+        if len(given) > 1:  # two mask files that may disagree: taking one in silence would not be the one meant
+            raise FileFormatError(f"{folder}: holds both {given[0]} and {given[1]} for frame {name!r}; which one is "
+                                  "meant? Keep one")  # fmt: skip
+        if given:
+            return read_masks(given[0], color.shape[:2], color=cf), str(given[0])
         raise FileFormatError(f"{folder}: no masks for frame {name!r} ({stem}.png, or {stem}/masks.png or "
                               f"{stem}/masks.json)")  # fmt: skip
 
