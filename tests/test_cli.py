@@ -123,8 +123,9 @@ def test_embedded_sample(capsys):
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
         (["detect", "{sample}", "--output", "o", "--chunk", "0"], "--chunk must be between 1 and 10000"),
         (["evaluate", "--frames", "f", "--match", "id", "--masks", "color"], "--match id needs the frames' own masks"),
-        (["bench", "--points", "999999999"], "every --points 10-5000000"),  # refused before 30 GB are asked for
-        (["bench", "--repeat", "0"], "--repeat must be 1-100000"),
+        (["bench", "--points", "999999999"], "every --points must be 10-5000000"),  # refused before 30 GB asked for
+        (["bench", "--repeat", "0"], "--repeat must be 1-100000, got 0$"),
+        (["bench", "--frame", "--repeat", "0"], "--repeat must be 1-100000, got 0$"),  # not: "and every --points"
     ],
 )
 def test_errors_are_one_line_with_status_2(capsys, args, message):
@@ -809,6 +810,27 @@ def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra
     main(["evaluate", "--frames", str(tmp_path), "--fruit", "apple", *extra, "--output", str(tmp_path / "r")])
     # before: --no-profile was accepted and the apple profile used all the same
     assert (seen[0].to_dict() == resolve_settings(fruit="apple").to_dict()) is profile
+    assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
+
+
+@pytest.mark.parametrize("extra, profile", [([], True), (["--no-profile"], False)])
+def test_evaluate_masks_honours_no_profile(tmp_path, monkeypatch, extra, profile):
+    import symfruit.segment as segment
+    from symfruit.settings import resolve_settings
+
+    seen = []
+
+    class Seen(Exception):
+        pass
+
+    def fake(spec, settings=None, **kwargs):
+        seen.append(settings)
+        raise Seen  # the segmenter's settings are all this test needs: no scene is rendered
+
+    monkeypatch.setattr(segment, "mask_source", fake)
+    with pytest.raises(Seen):
+        main(["evaluate", "--protocol", "masks", "--n", "1", *extra, "--output", str(tmp_path / "r")])
+    assert (seen[0].to_dict() == resolve_settings(fruit="strawberry").to_dict()) is profile
     assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
 
 

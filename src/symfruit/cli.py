@@ -386,7 +386,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from .core.limits import MAX_CLOUD_POINTS
+    from .core.limits import MAX_CLOUD_POINTS, shown
     from .errors import InputError
     from .evaluate.bench import machine, run_bench
 
@@ -394,9 +394,10 @@ def _bench(args: argparse.Namespace) -> int:
     args.repeat = 200 if args.repeat is None else args.repeat
     args.points = [600, 3000] if args.points is None else args.points
     args.size = "640x480" if args.size is None else args.size
-    if not 1 <= args.repeat <= 100_000 or any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
-        raise InputError(f"--repeat must be 1-100000 and every --points 10-{MAX_CLOUD_POINTS} (the most a cloud file "
-                         "may hold)")  # fmt: skip
+    if not 1 <= args.repeat <= 100_000:  # --points is the cloud bench's alone: not named to --frame's runs
+        raise InputError(f"--repeat must be 1-100000, got {shown(args.repeat)}")
+    if any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
+        raise InputError(f"every --points must be 10-{MAX_CLOUD_POINTS} (the most a cloud file may hold)")
     if args.segment:
         from .core.limits import check_image_size
         from .evaluate.bench import bench_segment
