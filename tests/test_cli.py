@@ -813,6 +813,19 @@ def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra
     assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
 
 
+def test_evaluate_goes_on_past_a_bad_scan_names_it_and_exits_1(tmp_path, capsys):
+    from symfruit.io import write_ply
+
+    scans = tmp_path / "scans"
+    write_ply(scans / "a.ply", sphere_cloud())
+    (scans / "b.xyz").write_text("1 2\n")  # not x y z
+    args = ["evaluate", "--fruit", str(scans), "--methods", "raw", "--n", "1", "--quick", "--jobs", "1"]
+    assert main([*args, "--output", str(tmp_path / "r")]) == 1  # before: 2, the whole evaluation refused
+    out = capsys.readouterr().out
+    assert "## paper protocol: a\n\n7 instances." in out and "protocol: b" not in out  # a's 7 --quick poses
+    assert f"skipped {scans / 'b.xyz'}: {scans / 'b.xyz'}" in out
+
+
 @pytest.mark.parametrize("extra, profile", [([], True), (["--no-profile"], False)])
 def test_evaluate_masks_honours_no_profile(tmp_path, monkeypatch, extra, profile):
     import symfruit.segment as segment

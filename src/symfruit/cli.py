@@ -603,8 +603,10 @@ def _evaluate(args: argparse.Namespace) -> int:
         settings=_plain_settings(args) if args.no_profile else None,
     )  # fmt: skip
     print(result.table)
+    for name, reason in result.skipped.items():
+        print(f"skipped {name}: {reason}")
     print(f"results: {result.folder}")
-    return 0
+    return 1 if result.skipped else 0  # as detect: the evaluation went on past a bad scan, and says so
 
 
 def _plain_settings(args: argparse.Namespace):
