@@ -114,7 +114,9 @@ def test_embedded_sample(capsys):
         (["evaluate", "--quick", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
-        (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
+        (["scenes", "out", "--n", "0"], "--n must be 1-100000, got 0$"),
+        (["scenes", "out", "--ripe", "100000"], "--ripe must be 0-50, got 100000$"),  # before: "--n must be ..."
+        (["scenes", "out", "--unripe", "-1"], "--unripe must be 0-50, got -1$"),
         (
             ["scenes", "out", "--seed", "1" + "0" * 400],
             r"--seed must be a whole number >= 0 with --seed \+ --n at most 2\*\*63, got 10{11}\.\.\. \(401 digits\)$",

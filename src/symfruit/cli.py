@@ -865,17 +865,17 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _scenes(args: argparse.Namespace) -> int:
+    from .core.limits import shown
     from .errors import InputError
     from .synthetic.scenes import write_scenes
 
     tree = args.scene == "apple-tree"
     ripe = (30 if tree else 6) if args.ripe is None else args.ripe
     unripe = (4 if tree else 2) if args.unripe is None else args.unripe
-    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50:
-        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50")
+    for option, value, low, high in (("--n", args.n, 1, 100_000), ("--ripe", ripe, 0, 50), ("--unripe", unripe, 0, 50)):
+        if not low <= value <= high:  # the option given named, not all three
+            raise InputError(f"{option} must be {low}-{high}, got {shown(value)}")
     if not 0 <= args.seed <= 2**63 - args.n:  # as evaluate's seeds: every frame's seed below 2**63
-        from .core.limits import shown
-
         raise InputError(f"--seed must be a whole number >= 0 with --seed + --n at most 2**63, got {shown(args.seed)}")
     sensor = None
     if args.sensor is not None or tree:
