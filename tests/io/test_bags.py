@@ -25,6 +25,7 @@ def write_ros2_bag(
     frames=2,
     camera_info=True,
     colour_topic=True,
+    depth_topic=True,
     k=None,
     encoding="rgb8",
     info_size=(160, 120),
@@ -60,7 +61,8 @@ def write_ros2_bag(
                 writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
             dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=0, step=320,
                         data=depth_mm.view(np.uint8).ravel())  # fmt: skip
-            writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
+            if depth_topic:
+                writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
     return path
 
 
@@ -100,6 +102,24 @@ def test_a_bag_whose_colour_topic_is_empty_is_named(tmp_path):
     path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), colour_topic=False)
     with pytest.raises(FileFormatError, match=r"bad: colour topic /camera/color/image_raw holds no messages"):
         open_source(path)
+
+
+def test_a_bag_whose_depth_topic_is_empty_is_named_not_read_as_no_frames(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), depth_topic=False)
+    match = r"bad: depth topic /camera/aligned_depth_to_color/image_raw holds no messages"
+    with pytest.raises(FileFormatError, match=match):  # before: a recording of 0 frames, done without a word
+        open_source(path)
+
+
+def test_a_refused_image_names_its_topic_and_stamp(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "yuv", color, (depth * 1000).astype(np.uint16), frames=1, encoding="nv12")
+    with open_source(path) as src, pytest.raises(FileFormatError, match=r"yuv: /camera/color/image_raw at "
+                                                 r"1000000000: unsupported image encoding 'nv12'"):  # fmt: skip
+        src.read(0)
 
 
 def test_a_bag_whose_camera_info_topic_is_empty_is_named(tmp_path):
@@ -193,7 +213,12 @@ def test_a_bag_whose_colour_topic_holds_16_bit_images_is_refused_by_name(tmp_pat
     wide = np.ascontiguousarray(color[:, :, 0]).astype(np.uint16) * 257  # what the 8-bit cut would have hidden
     path = write_ros2_bag(tmp_path / "wide", wide.view(np.uint8).reshape(120, 320), (depth * 1000).astype(np.uint16),
                           encoding="mono16")  # fmt: skip
-    with open_source(path) as src, pytest.raises(FileFormatError, match=r"wide: colour image encoding 'mono16'"):
+    with (
+        open_source(path) as src,
+        pytest.raises(
+            FileFormatError, match=r"wide: /camera/color/image_raw at 1000000000: colour image encoding 'mono16'"
+        ),
+    ):
         src.read(0)
 
 
