@@ -408,8 +408,12 @@ class BagSource:
     def names(self) -> list[str]:
         return [f"{self.path.stem}_{i:05d}_{s}" for i, s in enumerate(self._depth_stamps)]
 
-    def _message(self, conn: Any, stamp: int) -> Any:
-        for _, _, raw in self._reader.messages(connections=[conn], start=stamp, stop=stamp + 1):
+    def _message(self, conn: Any, stamp: int, nth: int = 0) -> Any:
+        """The ``nth`` message of ``conn`` at bag time ``stamp`` (two may share one: a bag rewritten with header
+        stamps as its times; each is its own frame, never the first read twice)."""
+        for k, (_, _, raw) in enumerate(self._reader.messages(connections=[conn], start=stamp, stop=stamp + 1)):
+            if k < nth:
+                continue
             try:
                 return self._reader.deserialize(raw, conn.msgtype)
             except Exception as exc:
@@ -431,9 +435,9 @@ class BagSource:
         if isinstance(camera, str):
             raise FileFormatError(f"{self.path}: {camera}")
         try:
-            dmsg = self._message(self._depth, stamp)
+            dmsg = self._message(self._depth, stamp, index - bisect.bisect_left(self._depth_stamps, stamp))
             cstamp = self._color_stamps[near]
-            cmsg = self._message(self._color, cstamp)
+            cmsg = self._message(self._color, cstamp, near - bisect.bisect_left(self._color_stamps, cstamp))
             color = _on_topic(self._color.topic, cstamp, color_image, cmsg, self._color.msgtype)
             depth = _on_topic(self._depth.topic, stamp, depth_image, dmsg, self._depth.msgtype)
             if any(sizeless):  # a camera info of width or height 0 is for the images' size (the live node's rule)
