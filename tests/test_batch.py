@@ -531,3 +531,36 @@ def test_a_full_disk_in_one_recording_leaves_the_later_recordings_recorded_as_no
     assert "stopped at frame a/f2: the output is full" in report.stopped
     errors = json.loads((tmp_path / "out" / "errors.json").read_text())
     assert errors["unprocessed"] == ["a/f3", "b/f1"] and not (tmp_path / "out" / "b").exists()
+
+
+def test_a_frame_named_as_the_bag_the_run_writes_in_the_output_gets_a_folder_of_its_own(tmp_path):
+    rec = recording(tmp_path / "rec", "f1", "bag")
+    out = tmp_path / "out"
+    (out / "bag").mkdir(parents=True)
+    (out / "bag" / "metadata.yaml").write_text("rosbag2_bagfile_information: {}\n")  # the bag's own file
+    report = run_batch(rec, out, method="raw", progress=False, exclude=[out / "bag"])
+    assert report.ok and report.done == ["bag", "f1"]
+    (renamed,) = [p for p in out.iterdir() if p.name.startswith("bag+")]
+    assert (renamed / "detections.json").is_file() and sorted(p.name for p in (out / "bag").iterdir()) == [
+        "metadata.yaml"
+    ]
+
+
+def test_a_masks_folder_in_the_output_is_an_input_no_frame_writes_into(tmp_path):
+    from symfruit.io.frames import read_frame
+    from symfruit.segment import segment
+
+    rec = recording(tmp_path / "rec", "f1", "masks", "overlay")
+    out = tmp_path / "out"
+    (out / "masks").mkdir(parents=True)
+    labels = segment(read_frame(rec / "f1").color).astype(np.uint16)
+    for name in ("f1", "masks", "overlay"):
+        Image.fromarray(labels).save(out / "masks" / f"{name}.png")
+    before = {p.name: p.read_bytes() for p in (out / "masks").iterdir()}
+    report = run_batch(rec, out, masks=str(out / "masks"), method="raw", progress=False)
+    assert report.ok and report.done == ["f1", "masks", "overlay"]
+    # before: frame "masks" wrote its detections.json, fruit PLYs and overlay.png into the masks folder, its
+    # overlay.png over frame "overlay"'s label image
+    assert {p.name: p.read_bytes() for p in (out / "masks").iterdir()} == before
+    (renamed,) = [p for p in out.iterdir() if p.name.startswith("masks+")]
+    assert (renamed / "detections.json").is_file()

@@ -114,7 +114,9 @@ def test_embedded_sample(capsys):
         (["evaluate", "--quick", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--protocol", "masks", "--n", "1", "--seed", "-1"], "--seed must be a whole number >= 0, got -1"),
         (["evaluate", "--quick", "--n", "0"], "--n must be between 1 and 100000"),
-        (["scenes", "out", "--n", "0"], "--n must be 1-100000"),
+        (["scenes", "out", "--n", "0"], "--n must be 1-100000, got 0$"),
+        (["scenes", "out", "--ripe", "100000"], "--ripe must be 0-50, got 100000$"),  # before: "--n must be ..."
+        (["scenes", "out", "--unripe", "-1"], "--unripe must be 0-50, got -1$"),
         (
             ["scenes", "out", "--seed", "1" + "0" * 400],
             r"--seed must be a whole number >= 0 with --seed \+ --n at most 2\*\*63, got 10{11}\.\.\. \(401 digits\)$",
@@ -123,8 +125,9 @@ def test_embedded_sample(capsys):
         (["bench", "--recording", "0"], "--recording must be between 1 and 100000"),
         (["detect", "{sample}", "--output", "o", "--chunk", "0"], "--chunk must be between 1 and 10000"),
         (["evaluate", "--frames", "f", "--match", "id", "--masks", "color"], "--match id needs the frames' own masks"),
-        (["bench", "--points", "999999999"], "every --points 10-5000000"),  # refused before 30 GB are asked for
-        (["bench", "--repeat", "0"], "--repeat must be 1-100000"),
+        (["bench", "--points", "999999999"], "every --points must be 10-5000000"),  # refused before 30 GB asked for
+        (["bench", "--repeat", "0"], "--repeat must be 1-100000, got 0$"),
+        (["bench", "--frame", "--repeat", "0"], "--repeat must be 1-100000, got 0$"),  # not: "and every --points"
     ],
 )
 def test_errors_are_one_line_with_status_2(capsys, args, message):
@@ -809,6 +812,40 @@ def test_evaluate_frames_honours_no_profile(tmp_path, capsys, monkeypatch, extra
     main(["evaluate", "--frames", str(tmp_path), "--fruit", "apple", *extra, "--output", str(tmp_path / "r")])
     # before: --no-profile was accepted and the apple profile used all the same
     assert (seen[0].to_dict() == resolve_settings(fruit="apple").to_dict()) is profile
+    assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
+
+
+def test_evaluate_goes_on_past_a_bad_scan_names_it_and_exits_1(tmp_path, capsys):
+    from symfruit.io import write_ply
+
+    scans = tmp_path / "scans"
+    write_ply(scans / "a.ply", sphere_cloud())
+    (scans / "b.xyz").write_text("1 2\n")  # not x y z
+    args = ["evaluate", "--fruit", str(scans), "--methods", "raw", "--n", "1", "--quick", "--jobs", "1"]
+    assert main([*args, "--output", str(tmp_path / "r")]) == 1  # before: 2, the whole evaluation refused
+    out = capsys.readouterr().out
+    assert "## paper protocol: a\n\n7 instances." in out and "protocol: b" not in out  # a's 7 --quick poses
+    assert f"skipped {scans / 'b.xyz'}: {scans / 'b.xyz'}" in out
+
+
+@pytest.mark.parametrize("extra, profile", [([], True), (["--no-profile"], False)])
+def test_evaluate_masks_honours_no_profile(tmp_path, monkeypatch, extra, profile):
+    import symfruit.segment as segment
+    from symfruit.settings import resolve_settings
+
+    seen = []
+
+    class Seen(Exception):
+        pass
+
+    def fake(spec, settings=None, **kwargs):
+        seen.append(settings)
+        raise Seen  # the segmenter's settings are all this test needs: no scene is rendered
+
+    monkeypatch.setattr(segment, "mask_source", fake)
+    with pytest.raises(Seen):
+        main(["evaluate", "--protocol", "masks", "--n", "1", *extra, "--output", str(tmp_path / "r")])
+    assert (seen[0].to_dict() == resolve_settings(fruit="strawberry").to_dict()) is profile
     assert (seen[0].to_dict() == resolve_settings().to_dict()) is not profile
 
 

@@ -123,7 +123,8 @@ def run_batch(
     a frame whose every step succeeded; e.g. to append it to a ROS 2 bag
     (:meth:`symfruit.ros.bag2.Ros2DetectionBag.write_frame`); one recording only. Frames skipped by ``resume``
     are not passed. ``exclude``: further outputs of the run (a ROS 2 bag folder) that are no frames if they lie
-    in the source, and whose names no frame folder takes if they lie in ``output``.
+    in the source, and whose names no frame folder takes if they lie in ``output``; a ``masks`` file or folder
+    given as a path is treated so too, and nothing is written into it.
 
     The output folder is locked while the batch runs (a second batch on it is refused), is never an input
     folder, and nothing is written through a link out of it (:class:`symfruit.io.outputs.OutputFolder`).
@@ -139,6 +140,8 @@ def run_batch(
         an input folder, held by another run), or the cluster cannot be used; per-frame problems go into the
         report.
     """
+    given_masks = _mask_paths(masks)  # read by the run: no frame folder takes their name, nothing is written there
+    exclude = [*exclude, *given_masks]
     if scheduler is not None or workers is not None:
         from .season.cluster import run_distributed
 
@@ -161,7 +164,8 @@ def run_batch(
     try:
         if is_frame_folder(output):  # a frame left out of the recording as the output is still an input
             folders.append(output)
-        out = OutputFolder(output, inputs=files, input_folders=folders).open()
+        out = OutputFolder(output, inputs=[*files, *(p for p in given_masks if p.is_file())],
+                           input_folders=[*folders, *(p for p in given_masks if p.is_dir())]).open()  # fmt: skip
     except BaseException:
         if held is not None:
             held.close()
@@ -417,6 +421,17 @@ def _source_inputs(src: Any) -> tuple[list[Path], list[Path]]:
     path = Path(src.path)
     folders = list(src.folders()) if hasattr(src, "folders") else []
     return ([], [path, *folders]) if path.is_dir() else ([path], folders)
+
+
+def _mask_paths(masks: Any) -> list[Path]:
+    """The file or folder a ``masks`` spec reads (a label PNG, a COCO JSON, a folder of each frame's masks),
+    or nothing (``auto``, ``color``, a model, a :class:`MaskSource`)."""
+    if not isinstance(masks, str | Path):
+        return []
+    if str(masks) in ("auto", "color") or str(masks).startswith(("maskrcnn:", "onnx:")):
+        return []
+    path = Path(masks)
+    return [path] if path.exists() else []
 
 
 def _first_part(path: Path, output: Path) -> str:

@@ -386,7 +386,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
 
 
 def _bench(args: argparse.Namespace) -> int:
-    from .core.limits import MAX_CLOUD_POINTS
+    from .core.limits import MAX_CLOUD_POINTS, shown
     from .errors import InputError
     from .evaluate.bench import machine, run_bench
 
@@ -394,9 +394,10 @@ def _bench(args: argparse.Namespace) -> int:
     args.repeat = 200 if args.repeat is None else args.repeat
     args.points = [600, 3000] if args.points is None else args.points
     args.size = "640x480" if args.size is None else args.size
-    if not 1 <= args.repeat <= 100_000 or any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
-        raise InputError(f"--repeat must be 1-100000 and every --points 10-{MAX_CLOUD_POINTS} (the most a cloud file "
-                         "may hold)")  # fmt: skip
+    if not 1 <= args.repeat <= 100_000:  # --points is the cloud bench's alone: not named to --frame's runs
+        raise InputError(f"--repeat must be 1-100000, got {shown(args.repeat)}")
+    if any(not 10 <= n <= MAX_CLOUD_POINTS for n in args.points):
+        raise InputError(f"every --points must be 10-{MAX_CLOUD_POINTS} (the most a cloud file may hold)")
     if args.segment:
         from .core.limits import check_image_size
         from .evaluate.bench import bench_segment
@@ -602,8 +603,10 @@ def _evaluate(args: argparse.Namespace) -> int:
         settings=_plain_settings(args) if args.no_profile else None,
     )  # fmt: skip
     print(result.table)
+    for name, reason in result.skipped.items():
+        print(f"skipped {name}: {reason}")
     print(f"results: {result.folder}")
-    return 0
+    return 1 if result.skipped else 0  # as detect: the evaluation went on past a bad scan, and says so
 
 
 def _plain_settings(args: argparse.Namespace):
@@ -862,17 +865,17 @@ def _demo(args: argparse.Namespace) -> int:
 
 
 def _scenes(args: argparse.Namespace) -> int:
+    from .core.limits import shown
     from .errors import InputError
     from .synthetic.scenes import write_scenes
 
     tree = args.scene == "apple-tree"
     ripe = (30 if tree else 6) if args.ripe is None else args.ripe
     unripe = (4 if tree else 2) if args.unripe is None else args.unripe
-    if not 1 <= args.n <= 100_000 or not 0 <= ripe <= 50 or not 0 <= unripe <= 50:
-        raise InputError("--n must be 1-100000, --ripe and --unripe 0-50")
+    for option, value, low, high in (("--n", args.n, 1, 100_000), ("--ripe", ripe, 0, 50), ("--unripe", unripe, 0, 50)):
+        if not low <= value <= high:  # the option given named, not all three
+            raise InputError(f"{option} must be {low}-{high}, got {shown(value)}")
     if not 0 <= args.seed <= 2**63 - args.n:  # as evaluate's seeds: every frame's seed below 2**63
-        from .core.limits import shown
-
         raise InputError(f"--seed must be a whole number >= 0 with --seed + --n at most 2**63, got {shown(args.seed)}")
     sensor = None
     if args.sensor is not None or tree:

@@ -80,6 +80,23 @@ def test_scan_folder_runs_both_protocols(tmp_path):
     assert len(camera.rows) == 3 and all(r.n_visible > 50 for r in camera.rows)
 
 
+def test_a_bad_scan_is_left_out_and_named_the_others_evaluated(tmp_path):
+    from symfruit.io import write_ply
+    from symfruit.synthetic.shapes import FRUITS
+
+    scans = tmp_path / "scans"
+    berry = FRUITS["strawberry"](np.random.default_rng(0))
+    write_ply(scans / "berry0.ply", berry.sample(3000, np.random.default_rng(0)))
+    (scans / "berry1.ply").write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 9\n")  # torn
+    result = evaluate(protocol="paper", fruits=(str(scans),), n=5, methods=("raw",), output=tmp_path / "r",
+                      jobs=1, progress=False)  # fmt: skip
+    # before: the whole evaluation refused for berry1.ply
+    assert len(result.rows) == 19 and {r.kind for r in result.rows} == {"scan/berry0"}
+    bad = str(scans / "berry1.ply")
+    assert list(result.skipped) == [bad] and result.skipped[bad].startswith(bad)
+    assert json.loads((result.folder / "settings.json").read_text())["skipped_scans"] == result.skipped
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("fruit", ["strawberry", "apple", "citrus", "tomato"])
 def test_full_paper_protocol(fruit):

@@ -43,8 +43,10 @@ def test_text_mode_writes_utf8(tmp_path):
 def test_a_folder_that_cannot_be_made_is_named(tmp_path):
     blocker = tmp_path / "file"
     blocker.write_text("not a folder")
-    with pytest.raises(FileFormatError, match=r"out\.json: cannot write to folder .*file"):
-        write_json(blocker / "out.json", {})
+    with pytest.raises(FileFormatError, match=r"out\.json: cannot write to folder .*file \(.*file is a file, not a f"):
+        write_json(blocker / "out.json", {})  # before: "(Not a directory)" or "(File exists)"
+    with pytest.raises(FileFormatError, match=r"sub/out\.json: cannot write to folder .*sub \(.*/file is a file, not"):
+        write_json(blocker / "sub" / "out.json", {})
 
 
 def test_json_is_indented_ends_with_a_newline_and_refuses_nan(tmp_path):

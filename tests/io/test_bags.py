@@ -25,6 +25,9 @@ def write_ros2_bag(
     frames=2,
     camera_info=True,
     colour_topic=True,
+    depth_topic=True,
+    times=None,
+    depth_step=0,
     k=None,
     encoding="rgb8",
     info_size=(160, 120),
@@ -43,7 +46,7 @@ def write_ros2_bag(
         c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
         c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
         for i in range(frames):
-            t = 1_000_000_000 * (i + 1)
+            t = 1_000_000_000 * (i + 1) if times is None else times[i]
             head = Header(stamp=Time(sec=i + 1, nanosec=0), frame_id="camera_color_optical_frame")
             info = Info(header=head, height=info_size[1], width=info_size[0], distortion_model="plumb_bob",
                         d=np.zeros(5) if d is None else np.asarray(d, float),
@@ -59,8 +62,9 @@ def write_ros2_bag(
             if colour_topic:
                 writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
             dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=0, step=320,
-                        data=depth_mm.view(np.uint8).ravel())  # fmt: skip
-            writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
+                        data=(depth_mm + np.uint16(i * depth_step)).view(np.uint8).ravel())  # fmt: skip
+            if depth_topic:
+                writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
     return path
 
 
@@ -100,6 +104,36 @@ def test_a_bag_whose_colour_topic_is_empty_is_named(tmp_path):
     path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), colour_topic=False)
     with pytest.raises(FileFormatError, match=r"bad: colour topic /camera/color/image_raw holds no messages"):
         open_source(path)
+
+
+def test_a_bag_whose_depth_topic_is_empty_is_named_not_read_as_no_frames(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "bad", color, (depth * 1000).astype(np.uint16), depth_topic=False)
+    match = r"bad: depth topic /camera/aligned_depth_to_color/image_raw holds no messages"
+    with pytest.raises(FileFormatError, match=match):  # before: a recording of 0 frames, done without a word
+        open_source(path)
+
+
+def test_messages_that_share_a_bag_time_are_each_their_own_frame(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    mm = (depth * 1000).astype(np.uint16)
+    path = write_ros2_bag(tmp_path / "same", color, mm, frames=3, times=[10**9] * 3, depth_step=7)
+    with open_source(path) as src:
+        assert len(src) == 3
+        got = [src.read(i).depth for i in range(3)]
+    for i in range(3):  # before: the first message at that time, three times
+        assert np.allclose(got[i], np.where(mm > 0, mm + 7 * i, 7 * i) / 1000.0)
+
+
+def test_a_refused_image_names_its_topic_and_stamp(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "yuv", color, (depth * 1000).astype(np.uint16), frames=1, encoding="nv12")
+    with open_source(path) as src, pytest.raises(FileFormatError, match=r"yuv: /camera/color/image_raw at "
+                                                 r"1000000000: unsupported image encoding 'nv12'"):  # fmt: skip
+        src.read(0)
 
 
 def test_a_bag_whose_camera_info_topic_is_empty_is_named(tmp_path):
@@ -193,7 +227,12 @@ def test_a_bag_whose_colour_topic_holds_16_bit_images_is_refused_by_name(tmp_pat
     wide = np.ascontiguousarray(color[:, :, 0]).astype(np.uint16) * 257  # what the 8-bit cut would have hidden
     path = write_ros2_bag(tmp_path / "wide", wide.view(np.uint8).reshape(120, 320), (depth * 1000).astype(np.uint16),
                           encoding="mono16")  # fmt: skip
-    with open_source(path) as src, pytest.raises(FileFormatError, match=r"wide: colour image encoding 'mono16'"):
+    with (
+        open_source(path) as src,
+        pytest.raises(
+            FileFormatError, match=r"wide: /camera/color/image_raw at 1000000000: colour image encoding 'mono16'"
+        ),
+    ):
         src.read(0)
 
 

@@ -114,6 +114,17 @@ def test_an_output_folder_that_is_a_dangling_or_looping_link_is_named_as_one_not
     assert not (tmp_path / "nowhere").exists()
 
 
+def test_an_output_folder_under_a_file_names_the_file(tmp_path):
+    (tmp_path / "afile").write_text("x")
+    with pytest.raises(OutputError) as info:
+        OutputFolder(tmp_path / "afile" / "out" / "deeper").open()
+    # before: "(Not a directory)"
+    assert str(info.value) == (f"{tmp_path / 'afile' / 'out' / 'deeper'}: cannot write to folder "
+                               f"({tmp_path / 'afile'} is a file, not a folder)")  # fmt: skip
+    with pytest.raises(OutputError, match=r"afile: cannot write to folder \(the output folder is a file\)"):
+        OutputFolder(tmp_path / "afile").open()
+
+
 def test_the_final_record_is_written_over_its_reserved_space_on_a_full_disk(tmp_path, monkeypatch):
     path = tmp_path / "errors.json"
     reserve_record(path, {"failed": [], "unprocessed": ["f1", "f2"], "stopped": "running"}, entries=2)

@@ -251,6 +251,11 @@ def patch_encoding(new: bytes, old: bytes = b"mono16", topic_end: str = "Depth_0
         (edited("D", np.array([0.0] * 5 + [0.3, 0.0, 0.0]), "Color_0/info/camera_info"),
          r"Color_0: camera info K has 9 values and D 8; expected 9 and 5 \(librealsense records five", "open"),
         (edited("D", np.array([0.1, 0.0]), "Depth_0/info/camera_info"), r"Depth_0: .* D 2; expected 9 and 5", "open"),
+        # a lens no camera has (applied in the alignment): refused by name, never projected
+        (edited("D", np.array([1e30, 0.0, 0.0, 0.0, 0.0]), "Depth_0/info/camera_info"),
+         r"Depth_0: lens coefficients \[1e\+30, 0.0, 0.0, 0.0, 0.0\] are not plausible \(each at most 10", "open"),
+        (edited("D", np.array([0.0, 0.0, 0.0, 0.0, np.nan]), "Color_0/info/camera_info"), r"Color_0: lens coeff",
+         "open"),
         (edited("width", 640, "Color_0/info/camera_info"), r"colour image is 320x240 but its camera info says 640x240",
          "read"),
         (edited("data", 2, "/file_version"), r"RealSense file version 2 is not supported", "open"),

@@ -103,6 +103,18 @@ def test_bad_images_raise_symfruit_errors(change, match):
         frame_of(msg, image_msg(np.ones((4, 4), np.uint16), "16UC1"), info_msg(width=4, height=4, cx=2, cy=2))
 
 
+def test_an_error_names_the_message_it_is_about():
+    color, depth = image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8"), image_msg(np.ones((4, 4), np.uint16), "16UC1")
+    info = info_msg(width=4, height=4, cx=2, cy=2)
+    for spoilt, what in ((color, "colour image"), (depth, "depth image")):  # one fault, either image
+        data, spoilt.data = spoilt.data, b"\x00" * 10
+        with pytest.raises(SymfruitError, match=rf"^{what}: image data holds 10 bytes"):  # before: which image?
+            frame_of(color, depth, info)
+        spoilt.data = data
+    with pytest.raises(InputError, match=r"^CameraInfo: camera focal lengths must be positive"):
+        frame_of(color, depth, info_msg(fx=0.0, width=4, height=4))
+
+
 def test_depth_rejects_colour_encodings():
     color = image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8")
     for bad in (image_msg(np.zeros((2, 2, 3), np.uint8), "rgb8"), image_msg(np.zeros((2, 2), np.uint8), "mono8")):

@@ -263,14 +263,14 @@ def test_markers_and_points_arrive(world, example_fruits):
 
 
 SPOILT = [  # (spoil, what the node's log line says)
-    ("truncated_color", "image data holds 460800 bytes, 480 rows of 1920 need 921600"),
-    ("truncated_depth", "image data holds 307200 bytes, 480 rows of 1280 need 614400"),
-    ("color_encoding", "unsupported image encoding 'yuv420'"),
+    ("truncated_color", "colour image: image data holds 460800 bytes, 480 rows of 1920 need 921600"),
+    ("truncated_depth", "depth image: image data holds 307200 bytes, 480 rows of 1280 need 614400"),
+    ("color_encoding", "colour image: unsupported image encoding 'yuv420'"),
     ("depth_encoding", "depth image has 3 channels, expected 1"),
-    ("short_step", "image step 640 is shorter than a row of 640 rgb8 pixels"),
-    ("huge_claim", "image of 16384x16384 pixels is empty or larger than 40,000,000 pixels"),
+    ("short_step", "colour image: image step 640 is shorter than a row of 640 rgb8 pixels"),
+    ("huge_claim", "colour image: image of 16384x16384 pixels is empty or larger than 40,000,000 pixels"),
     ("size_mismatch", "colour is 640x480 but depth is 320x480; depth must be aligned to the colour image"),
-    ("zero_k", "camera focal lengths must be positive, got fx=0.0, fy=0.0"),
+    ("zero_k", "CameraInfo: camera focal lengths must be positive, got fx=0.0, fy=0.0"),
     ("nan_depth", "the depth image holds no valid depth"),
 ]
 

@@ -187,6 +187,8 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
         ("", "an empty address"),
         ("tcp://127.0.0.1:99999", "the port 1-65535"),
         ("127.0.0.1", "not a scheduler address"),
+        ("tcp://127.0.0.1:\uff11\uff12", "not a scheduler address"),  # full-width digits: int() reads them
+        ("8786", "not a scheduler address"),  # a port without a host
     ):  # before: tried for 10 s, or ": cannot reach"
         assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--scheduler", address]) == 2
         assert message in capsys.readouterr().err

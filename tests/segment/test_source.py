@@ -105,8 +105,37 @@ def test_a_folder_of_each_frames_masks(photo, tmp_path):
     assert np.array_equal(source(color, name="frame_2")[0], labels * 2)
     with pytest.raises(FileFormatError, match=r"no masks for frame 'frame_3' \(frame_3.png, or frame_3/masks.png"):
         source(color, name="frame_3")
+    Image.fromarray(labels).save(tmp_path / "frame_2.png")  # and <frame>.png besides <frame>/masks.png: which?
+    with pytest.raises(FileFormatError, match=r"holds both .*frame_2\.png and .*frame_2/masks\.png for frame"):
+        source(color, name="frame_2")
+    (tmp_path / "frame_2.png").unlink()
+    (tmp_path / "frame_2" / "masks.json").write_text("{}")
+    with pytest.raises(FileFormatError, match=r"holds both .*frame_2/masks\.png and .*frame_2/masks\.json"):
+        source(color, name="frame_2")
     Image.fromarray(labels).save(tmp_path / "masks.png")  # a frame folder's own masks file: every frame's
     assert np.array_equal(mask_source(tmp_path)(color, name="frame_2")[0], labels)
+
+
+def test_a_frame_whose_name_holds_dots_takes_its_own_masks(photo, tmp_path):
+    color, _ = photo
+    labels = np.zeros(color.shape[:2], np.uint16)
+    labels[5:50, 5:50] = 1
+    Image.fromarray(labels).save(tmp_path / "day.1.png")
+    Image.fromarray(labels * 2).save(tmp_path / "day.2.png")
+    Image.fromarray(labels * 3).save(tmp_path / "day.png")
+    source = mask_source(tmp_path)
+    for name, k in (("day.1", 1), ("day.2", 2), ("day", 3)):  # before: "day.png" for all three
+        got, word = source(color, name=name)
+        assert got[25, 25] == k and word == str(tmp_path / f"{name}.png")
+    h, w = color.shape[:2]
+    square, triangle = [[10, 10, 40, 10, 40, 40, 10, 40]], [[60, 60, 90, 60, 90, 90]]
+    coco = {"images": [{"id": 1, "file_name": "day/color.png", "width": w, "height": h},
+                       {"id": 2, "file_name": "day.2/color.png", "width": w, "height": h}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1, "segmentation": square},
+                            {"id": 2, "image_id": 2, "category_id": 1, "segmentation": triangle}]}  # fmt: skip
+    (tmp_path / "all.json").write_text(json.dumps(coco))
+    got = mask_source(tmp_path / "all.json")(color, name="day.2")[0]  # before: frame "day"'s image
+    assert got[25, 25] == 0 and got[65, 80] == 1
 
 
 def test_an_unknown_spec_for_images_names_what_is_accepted(tmp_path):

@@ -104,3 +104,11 @@ def test_load_scans_errors(tmp_path):
     np.save(tmp_path / "tiny.npy", np.random.default_rng(0).random((20, 3)))
     with pytest.raises(FileFormatError, match=r"tiny\.npy: a complete scan needs at least 100 points"):
         load_scans(tmp_path)
+    failed = {}  # asked to go on: the bad scan is recorded, the folder refused only for holding none readable
+    with pytest.raises(FileFormatError, match=r"no fruit scans found .*1 not readable, the first: .*tiny\.npy: a comp"):
+        load_scans(tmp_path, failed=failed)
+    assert list(failed) == [str(tmp_path / "tiny.npy")]
+    np.save(tmp_path / "whole.npy", FRUITS["apple"](np.random.default_rng(0)).sample(500, np.random.default_rng(1)))
+    failed = {}
+    assert [s.kind for s in load_scans(tmp_path, failed=failed)] == ["scan/whole"]
+    assert "at least 100 points, got 20" in failed[str(tmp_path / "tiny.npy")]

@@ -7,12 +7,13 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from ..settings import Settings
-from .protocols import PAPER_ANGLES, Spec, build, specs
+from ..synthetic.shapes import FRUITS
+from .protocols import PAPER_ANGLES, Spec, build, skipped_scans, specs
 from .report import markdown_table, write_results
 from .runner import Row, run, summarise
 
@@ -30,6 +31,8 @@ class Evaluation:
     rows: list[Row]
     summary: list[dict[str, Any]]
     table: str
+    #: Scans of a scan folder left out as unreadable (path: reason); the others were evaluated.
+    skipped: dict[str, str] = field(default_factory=dict)
 
 
 def evaluate(
@@ -58,7 +61,8 @@ def evaluate(
     :data:`~symfruit.evaluate.protocols.POSES`; ``poses="upright"`` also stands scans up in the paper
     protocol); ``views`` how many of a generated fruit's camera views are of one fruit (default 1: every
     view a fruit of its own). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
-    ``output=None`` writes nothing. Tables have a row per fruit kind, and per scan of a scan folder.
+    ``output=None`` writes nothing. Tables have a row per fruit kind, and per scan of a scan folder; a scan that
+    cannot be read is left out, the others evaluated, and named in ``skipped`` (and ``settings.json``).
 
     Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
     (:mod:`symfruit.profiles`), with the settings file ``config`` laid over it.
@@ -74,10 +78,11 @@ def evaluate(
     angles = tuple(QUICK["paper"]["angles"]) if quick and protocol == "paper" else PAPER_ANGLES
     if n is None:
         n = QUICK[protocol]["n"] if quick else (10 if protocol == "paper" else 100)
-    rows, all_specs, used = [], [], {}
+    rows, all_specs, used, skipped = [], [], {}, {}
     for fruit in fruits:
         these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions), sensor=sensor,
                       poses=poses, views=views)  # fmt: skip
+        skipped.update(skipped_scans(fruit) if fruit not in FRUITS else {})
         used[fruit] = settings_for(fruit)
         rows += run(these, methods, used[fruit], jobs=jobs, progress=progress)
         all_specs += these
@@ -111,9 +116,10 @@ def evaluate(
             "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "sensor": sensor,
             "poses": poses, "views": views, "quick": quick,
             "instances": len(all_specs), "settings": {f: s.to_dict() for f, s in used.items()},
+            "skipped_scans": skipped,
         }  # fmt: skip
         from ..io import write_json
 
         write_json(folder / "settings.json", meta)
         write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled}, table=table)
-    return Evaluation(folder=folder, rows=rows, summary=summary, table=table)
+    return Evaluation(folder=folder, rows=rows, summary=summary, table=table, skipped=skipped)

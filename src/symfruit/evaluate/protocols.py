@@ -174,9 +174,21 @@ def specs(
     raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
 
 
-@functools.lru_cache(maxsize=4)
 def _scans(folder: str) -> tuple[Fruit, ...]:
-    return tuple(load_scans(folder))
+    return _read_scans(folder)[0]
+
+
+def skipped_scans(folder: str) -> dict[str, str]:
+    """The scans of the scan folder ``folder`` left out of its evaluation as unreadable (path: reason); the
+    others are evaluated, so one broken file does not stop a folder's evaluation (as a bad frame does not stop
+    ``detect``)."""
+    return dict(_read_scans(folder)[1])
+
+
+@functools.lru_cache(maxsize=4)
+def _read_scans(folder: str) -> tuple[tuple[Fruit, ...], tuple[tuple[str, str], ...]]:
+    failed: dict[str, str] = {}
+    return tuple(load_scans(folder, failed=failed)), tuple(failed.items())
 
 
 def _fruit(spec: Spec) -> Fruit:

@@ -94,12 +94,14 @@ def folder_fd(folder: str | Path, *, root: Path | OutputFolder | None = None, cr
         try:
             if create:
                 folder.mkdir(parents=True, exist_ok=True)
-        except OSError as exc:
-            raise _error(folder, exc, "cannot create output folder") from None
-        try:
             fd = os.open(folder, os.O_RDONLY | _DIRECTORY | _CLOEXEC)
         except OSError as exc:
-            raise _error(folder, exc, "cannot write to folder") from None
+            err = _error(folder, exc, "cannot create output folder" if create else "cannot write to folder")
+            file = next((p for p in (folder, *folder.parents) if p.exists() and not p.is_dir()), None)
+            if file is not None:  # said as it is, not as the system's "File exists" / "Not a directory"
+                err = OutputError(f"{folder}: {file} is a file, not a folder; not overwritten", exc.errno)
+                err.plain, err.reason = True, f"{file} is a file, not a folder"  # type: ignore[attr-defined]
+            raise err from None
     else:
         if not _inside(folder, base):
             raise OutputError(f"{folder}: outside the output folder {base}; not written")
@@ -171,9 +173,8 @@ def atomic_write(path: str | Path, mode: str = "wb", *, root: Path | OutputFolde
     except OutputError as exc:
         if not getattr(exc, "plain", False) or exc.errno is None:
             raise
-        raise OutputError(
-            f"{path}: cannot write to folder {path.parent} ({os.strerror(exc.errno)})", exc.errno
-        ) from None
+        reason = getattr(exc, "reason", None) or os.strerror(exc.errno)
+        raise OutputError(f"{path}: cannot write to folder {path.parent} ({reason})", exc.errno) from None
     with stack:
         with contextlib.suppress(FileNotFoundError):
             st = os.stat(name, dir_fd=dfd, follow_symlinks=False)

@@ -323,6 +323,15 @@ def _pick_topics(depth: list[Any], color: list[Any], info: list[Any]) -> tuple[A
     return d, c, beside[0]
 
 
+def _on_topic(topic: str, stamp: int, read: Any, *args: Any) -> np.ndarray:
+    """``read(*args)`` (an image of a message), its refusal naming the topic and stamp of the message (a colour
+    and a depth image may be refused alike: ``image data holds ...`` would not say which)."""
+    try:
+        return read(*args)
+    except FileFormatError as exc:
+        raise FileFormatError(f"{topic} at {stamp}: {exc}") from None
+
+
 class BagSource:
     """A bag as a recording: one frame per depth image (see the module docstring)."""
 
@@ -382,6 +391,8 @@ class BagSource:
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
                 if not self._cameras or self._cameras[-1][1:] != (camera, sizeless):  # kept on change: each
                     self._cameras.append((stamp, camera, sizeless))  # is stamped anew, the intrinsics seldom change
+        if not self._depth_stamps:  # a frame per depth image: a recording of none would be "0 frames", unsaid
+            raise FileFormatError(f"depth topic {self._depth.topic} holds no messages")
         if not self._color_stamps:
             raise FileFormatError(f"colour topic {self._color.topic} holds no messages")
         if not self._cameras:
@@ -397,8 +408,12 @@ class BagSource:
     def names(self) -> list[str]:
         return [f"{self.path.stem}_{i:05d}_{s}" for i, s in enumerate(self._depth_stamps)]
 
-    def _message(self, conn: Any, stamp: int) -> Any:
-        for _, _, raw in self._reader.messages(connections=[conn], start=stamp, stop=stamp + 1):
+    def _message(self, conn: Any, stamp: int, nth: int = 0) -> Any:
+        """The ``nth`` message of ``conn`` at bag time ``stamp`` (two may share one: a bag rewritten with header
+        stamps as its times; each is its own frame, never the first read twice)."""
+        for k, (_, _, raw) in enumerate(self._reader.messages(connections=[conn], start=stamp, stop=stamp + 1)):
+            if k < nth:
+                continue
             try:
                 return self._reader.deserialize(raw, conn.msgtype)
             except Exception as exc:
@@ -420,11 +435,11 @@ class BagSource:
         if isinstance(camera, str):
             raise FileFormatError(f"{self.path}: {camera}")
         try:
-            dmsg = self._message(self._depth, stamp)
+            dmsg = self._message(self._depth, stamp, index - bisect.bisect_left(self._depth_stamps, stamp))
             cstamp = self._color_stamps[near]
-            cmsg = self._message(self._color, cstamp)
-            color = color_image(cmsg, self._color.msgtype)
-            depth = depth_image(dmsg, self._depth.msgtype)
+            cmsg = self._message(self._color, cstamp, near - bisect.bisect_left(self._color_stamps, cstamp))
+            color = _on_topic(self._color.topic, cstamp, color_image, cmsg, self._color.msgtype)
+            depth = _on_topic(self._depth.topic, stamp, depth_image, dmsg, self._depth.msgtype)
             if any(sizeless):  # a camera info of width or height 0 is for the images' size (the live node's rule)
                 camera = replace(camera, width=depth.shape[1] if sizeless[0] else camera.width,
                                  height=depth.shape[0] if sizeless[1] else camera.height)  # fmt: skip

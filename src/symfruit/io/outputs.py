@@ -162,7 +162,9 @@ class OutputFolder:
                 ) from None
             raise OutputError(f"{self.root}: cannot write to folder (the {self.what} is a file)") from None
         except OSError as exc:
-            raise OutputError(f"{self.root}: cannot write to folder ({exc.strerror or exc})", exc.errno) from None
+            file = next((p for p in self.root.parents if p.exists() and not p.is_dir()), None)
+            why = f"{file} is a file, not a folder" if file is not None else exc.strerror or exc  # not "Not a dir..."
+            raise OutputError(f"{self.root}: cannot write to folder ({why})", exc.errno) from None
         if self._lock:
             try:
                 self._take_lock()

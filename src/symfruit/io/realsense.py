@@ -41,6 +41,7 @@ import numpy as np
 from ..core.align import LENS_MODELS, Lens, align_depth
 from ..core.camera import Camera
 from ..core.frame import Frame
+from ..core.limits import shown
 from ..errors import FileFormatError, InputError, SymfruitError
 from .bags import _require_rosbags, color_image, image_array
 from .frames import named_frame
@@ -54,6 +55,11 @@ _TF = re.compile(r"^/(device_\d+/sensor_\d+/(?:Depth|Color)_\d+)/tf/(\d+)$")
 #: File versions of librealsense's ROS 1 layout read here (2 and below are the pre-2.10 "legacy" layout).
 FILE_VERSIONS = (3, 4)
 _DEPTH_ENCODINGS = ("mono16", "16uc1")
+#: Largest lens coefficient (any of ``k1, k2, p1, p2, k3``) of a recorded stream: the depth lens's are applied in
+#: the alignment (and the colour lens's), and the SDK's cameras record well under 1 (D400 colour ``|k| < 0.6``,
+#: tangential ``< 0.01``, depth lenses 0); at 10 a point at the image corner (``r^2 ~ 0.5``) would move by five
+#: times its distance from the centre: no lens, a recording gone wrong (1e30 overflows the projection).
+MAX_LENS_COEFF = 10.0
 
 
 def is_realsense(path: Path) -> bool:
@@ -165,6 +171,9 @@ class RealSenseBagSource:
                                   "9 and 5 (librealsense records five lens coefficients, rs2_intrinsics "
                                   "coeffs)")  # fmt: skip
         k, coeffs = [float(v) for v in info.K], [float(v) for v in info.D]
+        if not all(abs(c) <= MAX_LENS_COEFF for c in coeffs):  # NaN too
+            raise FileFormatError(f"{prefix}: lens coefficients {shown(coeffs)} are not plausible (each at most "
+                                  f"{MAX_LENS_COEFF:g} in size; real lenses record well under 1)")  # fmt: skip
         try:
             camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=int(info.width), height=int(info.height))
             lens = Lens(camera, LENS_MODELS[model], tuple(coeffs or [0.0] * 5))

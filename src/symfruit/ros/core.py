@@ -181,12 +181,28 @@ def message_frame(
         (``FileFormatError``, ``InputError``) for an unknown encoding, truncated data, invalid intrinsics,
         or sizes that disagree.
     """
-    rgb = color_image(color)
-    metres = depth_image(depth, depth_scale=depth_scale)
+    with _named("colour image"):
+        rgb = color_image(color)
+    with _named("depth image"):
+        metres = depth_image(depth, depth_scale=depth_scale)
     h, w = metres.shape
-    camera = camera_from_info(info, width=w, height=h, source=f"{source}: CameraInfo" if warn else None,
-                              warned=warned)  # fmt: skip
+    with _named("CameraInfo"):
+        camera = camera_from_info(info, width=w, height=h, source=f"{source}: CameraInfo" if warn else None,
+                                  warned=warned)  # fmt: skip
     return Frame(name, rgb, metres, camera, source=source, stamp=header_stamp(color), frame_id=header_frame_id(color))
+
+
+@contextlib.contextmanager
+def _named(what: str) -> Iterator[None]:
+    """Errors of one message said with the message they are about (``colour image: image data holds ...``): the
+    node's log line for a skipped frame tells which topic to look at."""
+    try:
+        yield
+    except SymfruitError as exc:
+        text = str(exc)
+        if text.startswith(what):
+            raise
+        raise type(exc)(f"{what}: {text}") from None
 
 
 @dataclass(frozen=True)

@@ -262,8 +262,11 @@ def check_address(scheduler: Any) -> None:
         raise InputError("--scheduler '': an empty address (an unset shell variable?); give tcp://HOST:PORT")
     if text.startswith("inproc://"):
         return
-    port = text.rpartition(":")[2]
-    if not port.isdigit() or not 1 <= int(port) <= 65535:
+    rest = text.split("://", 1)[1] if "://" in text else text
+    _, colon, port = rest.rpartition(":")
+    # ASCII digits only: str.isdigit() takes full-width and other scripts' digits and int() reads them, so a
+    # mistyped port passed as another; ``8786`` alone has no port (distributed: "missing port number")
+    if not colon or not (port.isascii() and port.isdigit()) or not 1 <= int(port) <= 65535:
         raise InputError(f"--scheduler {shown(text)}: not a scheduler address; give tcp://HOST:PORT, the port 1-65535")
 
 

@@ -141,7 +141,7 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
             by_frame.setdefault(key, []).append(entry["file_name"])
 
     def from_coco(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
-        found = by_frame.get(Path(name).stem, []) if name else []
+        found = by_frame.get(_frame_key(name), []) if name else []
         if len(found) != 1:
             some = ", ".join(repr(e["file_name"]) for e in coco.entries()[:3])
             why = "no image" if not found else f"{len(found)} images ({', '.join(map(repr, found[:3]))})"
@@ -151,6 +151,13 @@ def _coco_of_several_images(path: Path) -> MaskSource | None:
         return _coco_labels(coco, found[0], color.shape[:2]), str(path)
 
     return MaskSource(str(path), from_coco)
+
+
+def _frame_key(name: str) -> str:
+    """What a frame's masks are found by: its whole name (a frame folder ``day.1`` is not ``day``: its masks are
+    ``day.1.png``, never ``day.png``), an image file's name without its extension (``capture_1.png``)."""
+    path = Path(name)
+    return path.stem if path.suffix.lower() in (".png", ".jpg", ".jpeg") else path.name
 
 
 def _coco_labels(coco: Any, name: str, shape: tuple[int, int]) -> np.ndarray:
@@ -170,10 +177,14 @@ def _frames_folder(folder: Path) -> MaskSource | None:
     from ..io.masks import read_masks
 
     def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
-        stem = Path(name).stem
-        for path in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json"):
-            if stem and path.is_file():
-                return read_masks(path, color.shape[:2], color=cf), str(path)
+        stem = _frame_key(name)
+        given = [p for p in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json")
+                 if stem and p.is_file()]  # fmt: skip
+        if len(given) > 1:  # two mask files that may disagree: taking one in silence would not be the one meant
+            raise FileFormatError(f"{folder}: holds both {given[0]} and {given[1]} for frame {name!r}; which one is "
+                                  "meant? Keep one")  # fmt: skip
+        if given:
+            return read_masks(given[0], color.shape[:2], color=cf), str(given[0])
         raise FileFormatError(f"{folder}: no masks for frame {name!r} ({stem}.png, or {stem}/masks.png or "
                               f"{stem}/masks.json)")  # fmt: skip
 

@@ -40,7 +40,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ..errors import FileFormatError
+from ..errors import FileFormatError, SymfruitError
 
 __all__ = [
     "FRUITS",
@@ -413,7 +413,7 @@ def make_fruit(kind: str, rng: np.random.Generator) -> Fruit:
         raise ValueError(f"unknown fruit kind {kind!r}; known: {', '.join(FRUITS)}") from None
 
 
-def load_scans(folder: str | Path) -> list[Fruit]:
+def load_scans(folder: str | Path, *, failed: dict[str, str] | None = None) -> list[Fruit]:
     """Load complete fruit scans from a folder as an evaluation set.
 
     Every ``.ply``, ``.pcd``, ``.xyz``, ``.txt``, ``.csv``, ``.npy`` (point clouds) and ``.obj`` or
@@ -422,13 +422,14 @@ def load_scans(folder: str | Path) -> list[Fruit]:
     protocol) through its convex hull, which suits fruit, being nearly convex; its own points are
     what is sampled (``paper`` protocol) and what the truth is measured on.
 
+    ``failed``: when given, a scan that cannot be read (a broken file, too few points, flat) is left out and
+    recorded there (its path: the reason), and the others are loaded; without it the first bad scan is raised.
+
     Raises
     ------
     FileFormatError
         When the folder is missing or holds no readable scan; a bad file names itself.
     """
-    from ..io import read_cloud, read_mesh
-
     folder = Path(folder)
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such folder of fruit scans")
@@ -437,25 +438,37 @@ def load_scans(folder: str | Path) -> list[Fruit]:
         suffix = path.suffix.lower()
         if suffix not in (".ply", ".pcd", ".xyz", ".txt", ".csv", ".npy", ".obj"):
             continue
-        vertices, faces = read_mesh(path) if suffix in (".obj", ".ply") else (read_cloud(path), None)
-        if len(vertices) < 100:
-            raise FileFormatError(f"{path}: a complete scan needs at least 100 points, got {len(vertices)}")
-        centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
-        vertices = vertices - centre
-        kind = f"scan/{path.stem}"
-        if faces is None or len(faces) == 0:
-            from scipy.spatial import ConvexHull, QhullError
-
-            try:
-                hull = ConvexHull(vertices)
-            except QhullError:
-                raise FileFormatError(f"{path}: the scan's points are flat or degenerate") from None
-            fruits.append(Fruit(vertices, hull.simplices.astype(np.int64), kind, points=vertices))
-        else:
-            fruits.append(Fruit(vertices, faces, kind))
+        try:
+            fruits.append(_load_scan(path, suffix))
+        except SymfruitError as exc:
+            if failed is None:
+                raise
+            failed[str(path)] = str(exc)
     if not fruits:
-        raise FileFormatError(f"{folder}: no fruit scans found (.ply, .pcd, .xyz, .txt, .csv, .npy, .obj)")
+        bad = f"; {len(failed)} not readable, the first: {next(iter(failed.values()))}" if failed else ""
+        raise FileFormatError(f"{folder}: no fruit scans found (.ply, .pcd, .xyz, .txt, .csv, .npy, .obj){bad}")
     return fruits
+
+
+def _load_scan(path: Path, suffix: str) -> Fruit:
+    """One scan of :func:`load_scans`, centred on its box centre; a bad one raises naming ``path``."""
+    from ..io import read_cloud, read_mesh
+
+    vertices, faces = read_mesh(path) if suffix in (".obj", ".ply") else (read_cloud(path), None)
+    if len(vertices) < 100:
+        raise FileFormatError(f"{path}: a complete scan needs at least 100 points, got {len(vertices)}")
+    centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
+    vertices = vertices - centre
+    kind = f"scan/{path.stem}"
+    if faces is None or len(faces) == 0:
+        from scipy.spatial import ConvexHull, QhullError
+
+        try:
+            hull = ConvexHull(vertices)
+        except QhullError:
+            raise FileFormatError(f"{path}: the scan's points are flat or degenerate") from None
+        return Fruit(vertices, hull.simplices.astype(np.int64), kind, points=vertices)
+    return Fruit(vertices, faces, kind)
 
 
 def rotation_x(degrees: float) -> np.ndarray:
