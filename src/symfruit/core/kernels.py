@@ -35,10 +35,22 @@ __all__ = ["compiled"]
 _STATE: dict[str, ModuleType | None] = {}
 
 
+def _setting() -> str:
+    """``SYMFRUIT_KERNELS`` as the environment holds it now ("" unset). Read on every call (a test or a caller may
+    set it at any time), from ``os.environ``'s own dictionary of encoded names where it has one (CPython on POSIX):
+    ``os.environ.get`` of an unset name costs a caught KeyError, about 3 us, and :func:`compiled` is called some
+    300 times a frame (issue 19, fifteenth round); elsewhere by ``os.environ.get``."""
+    data = getattr(os.environ, "_data", None)
+    if os.name == "posix" and isinstance(data, dict):
+        raw = data.get(b"SYMFRUIT_KERNELS")
+        return "" if raw is None else os.fsdecode(raw)
+    return os.environ.get("SYMFRUIT_KERNELS", "")
+
+
 def compiled() -> ModuleType | None:
     """The compiled kernels' module, or None where the numpy twins are to run (no numba, or
     ``SYMFRUIT_KERNELS=numpy``)."""
-    if os.environ.get("SYMFRUIT_KERNELS", "").lower() == "numpy":
+    if _setting().lower() == "numpy":
         return None
     if "jit" not in _STATE:
         try:
