@@ -501,23 +501,25 @@ class _Outline:
 
     def ranks(self, pad: int, reach: int) -> tuple[np.ndarray, np.ndarray]:
         """The padded map's whole-number keys (:meth:`keys`, which it must have) as their places among its distinct
-        keys (int16 or int32, flattened), and the value of each place ((m,) ascending): the same order, a few times
-        fewer places for a row of keys to span than the keys' own values (the squared distances that a map holds
-        are sums of two squares; issue 19, fifteenth round)."""
+        keys (int32, flattened), and the value of each place ((m,) ascending, :meth:`_table`'s bit for bit): the same
+        order, a few times fewer places for a row of keys to span than the keys' own values (the squared distances
+        that a map holds are sums of two squares; issue 19, fifteenth round). Where numba is, counted by its
+        compiled twin (:func:`symfruit.core._jit.key_ranks`: the same places and values)."""
         found = self._ranks.get((pad, int(reach)))
         if found is None:
             keys = self.keys(pad, reach)
             assert keys is not None  # only called when the map has keys
-            low = int(keys.min())
-            shifted = keys.astype(np.int32) - low
-            present = np.zeros(int(shifted.max()) + 1, bool)
-            present[shifted] = True
-            place = np.cumsum(present) - 1
-            count = int(place[-1]) + 1
-            ranks = place.astype(np.int16 if count <= 2**15 else np.int32)[shifted]
-            whole = (np.flatnonzero(present) + low).astype(np.float64)
-            values = np.sign(whole) * np.sqrt(np.abs(whole))  # the values of :meth:`_table`, bit for bit
-            found = self._ranks[(pad, int(reach))] = (ranks, values)
+            if (jit := compiled()) is not None:
+                found = jit.key_ranks(keys)
+            else:
+                low = int(keys.min(initial=0))
+                shifted = keys.astype(np.int64) - low
+                present = np.zeros(int(shifted.max(initial=0)) + 1, bool)
+                present[shifted] = True
+                ranks = (np.cumsum(present) - 1).astype(np.int32)[shifted]
+                whole = (np.flatnonzero(present) + low).astype(np.float64)
+                found = (ranks, np.sign(whole) * np.sqrt(np.abs(whole)))
+            self._ranks[(pad, int(reach))] = found
         return found
 
     def _table(self, pad: int, reach: int) -> np.ndarray:
