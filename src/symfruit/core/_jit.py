@@ -1298,6 +1298,57 @@ def key_ranks(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @_njit
+def _median_of(x: np.ndarray) -> float:
+    """np.median of ``x`` (n >= 1, no NaN), reordering it: :func:`select` at the middle place, the place below it
+    (even ``n``) the largest before it, their sum halved (:func:`symfruit.core.points.median`'s value bit for bit)."""
+    n = x.shape[0]
+    h = n // 2
+    select(x, h)
+    if n % 2:
+        return x[h]
+    below = x[0]
+    for i in range(1, h):
+        below = max(below, x[i])
+    return (below + x[h]) / 2.0
+
+
+@_njit
+def depth_noise(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float]:
+    """:func:`symfruit.core.surface.depth_noise`'s differences and their median absolute deviation: how many
+    differences it takes (``n``) and the deviation (NaN when ``n < 10`` or a difference is NaN). The twin's
+    differences (the same subtractions, the moved ones where at least 20 are) and its medians (order statistics, the
+    middle two's sum halved): its deviation bit for bit."""
+    h, w = depth.shape
+    diff = np.empty(max(h * (w - 1), 0))
+    n = 0
+    moved = 0
+    for r in range(h):
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            if mask[r, c + 1] and mask[r, c] and a > 0 and b > 0:
+                diff[n] = a - b
+                moved += diff[n] != 0
+                n += 1
+    if moved >= 20:
+        kept = 0
+        for i in range(n):
+            if diff[i] != 0:
+                diff[kept] = diff[i]
+                kept += 1
+        n = kept
+    if n < 10:
+        return n, np.nan
+    x = diff[:n]
+    for i in range(n):
+        if np.isnan(x[i]):
+            return n, np.nan
+    middle = _median_of(x)
+    for i in range(n):
+        x[i] = abs(x[i] - middle)
+    return n, _median_of(x)
+
+
+@_njit
 def _flood(image: np.ndarray, out: np.ndarray, stack: np.ndarray, top: int) -> None:
     """Mark in ``out`` every pixel of ``image`` 4-connected through ``image`` to the marked pixels on ``stack`` (the
     first ``top`` of it, flat indices)."""
