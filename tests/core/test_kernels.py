@@ -946,6 +946,47 @@ def test_the_outlines_fast_costs_are_the_twins_within_their_sums_rounding(seed, 
     np.testing.assert_allclose(fast, twin, rtol=1e-13, atol=0.0)
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900, 40000]), st.integers(1, 25))
+def test_the_outlines_ranks_are_the_twins(seed, top, reach):
+    """The places of a padded map's distinct keys and their values (int16 and int32 keys, the pad's key among
+    them): the same arrays bit for bit; and a map with its keys made again gives the same fast costs."""
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    inside = np.sqrt(rng.integers(0, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    with pytest.MonkeyPatch.context() as mp:
+        (ranks, values), (ranks_twin, values_twin) = _both(
+            mp, lambda: _Outline(np.zeros(1, int), np.zeros(1, int), inside, 3.0).ranks(reach, reach)
+        )
+    assert ranks.dtype == ranks_twin.dtype == np.int32
+    np.testing.assert_array_equal(ranks, ranks_twin)
+    np.testing.assert_array_equal(values, values_twin)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.3, 0.9, 0.995]), st.sampled_from([0.0, 0.5, 0.97]))
+def test_the_depth_noise_is_the_twins(seed, repeated, holes):
+    """Depth with repeated neighbours (few moved differences), pixels without depth, few pixels, an infinite depth
+    (NaN differences), a window of the image (not contiguous): the same noise bit for bit."""
+    from symfruit.core.surface import depth_noise
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    depth = np.round(0.6 + rng.normal(0.0, 0.002, (h, w)), int(rng.integers(3, 7)))
+    depth[rng.random((h, w)) < repeated] = 0.6
+    depth[rng.random((h, w)) < holes] = 0.0
+    if rng.random() < 0.2:
+        depth[rng.integers(0, h), rng.integers(0, w)] = np.inf
+    mask = rng.random((h, w)) < 0.9
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    with pytest.MonkeyPatch.context() as mp:
+        for d, m in ((depth, mask), (depth[r0:, c0:], mask[r0:, c0:])):
+            noise, twin = _both(mp, depth_noise, d, m, floor=float(rng.choice([0.0, 0.0005])))
+            assert noise == twin or (np.isnan(noise) and np.isnan(twin))
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_the_registration_shift_is_the_twins(monkeypatch, seed):
     """Balls apart, their depth a few pixels off their masks (noisy or not, rims without depth): the same shift."""

@@ -520,6 +520,24 @@ def test_the_fast_cost_sums_the_deviations_the_sort_would_keep(seed, top, trim):
     np.testing.assert_allclose(outline.cost(shifts, reach, trim, exact=False), former, rtol=1e-13, atol=0.0)
 
 
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900, 40000]), st.integers(1, 25))
+def test_the_ranks_order_the_keys_and_read_back_their_values(seed, top, reach):
+    # the compiled fast costs count a row's ranks: the places of the map's distinct keys, in the keys' order, each
+    # place's value the table's value of its key bit for bit (int32 ranks where keys are int32)
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    inside = np.sqrt(rng.integers(0, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+    outline = _Outline(np.zeros(1, int), np.zeros(1, int), inside, 3.0)
+    keys = outline.keys(reach, reach)
+    ranks, values = outline.ranks(reach, reach)
+    assert ranks.shape == keys.shape and len(values) == len(np.unique(keys)) and np.all(np.diff(values) > 0)
+    np.testing.assert_array_equal(np.unique(keys)[ranks], keys)  # the places of the keys, in order
+    np.testing.assert_array_equal(values[ranks], np.take(outline._table(reach, reach), keys, mode="wrap"))
+    assert outline.ranks(reach, reach)[0] is ranks  # made once
+
+
 @given(
     st.integers(0, 2**32 - 1),
     st.sampled_from([np.int16, np.int32, np.float64]),

@@ -1198,53 +1198,154 @@ def monotone(
 
 @_njit
 def outline_costs(
-    keys: np.ndarray, table: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, keep: int, band: float
+    ranks: np.ndarray, values: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, keep: int, band: float
 ) -> np.ndarray:  # fmt: skip
     """(k,) :meth:`symfruit.core.surface._Outline.cost` with ``exact=False`` of each shift (k, 2) ``(dv, du)``: the
-    outline points' flat indices ``at`` (n,) into the padded map's whole-number keys ``keys`` moved back by the
-    shift, put in order by counting them (the keys span a few hundred whole numbers a row), their values read from
-    ``table`` (a negative key from its end), the median's band (clipped to 0 .. ``band``) and the mean deviation of
-    the run of ``keep`` values nearest it (:meth:`~symfruit.core.surface._Outline._nearest_mean`'s search). The
-    twin's values, medians, bands and runs; the run's deviations summed in another order: within ``keep`` units in
-    the last place of the twin's fast costs, as those are of the exact ones."""
+    outline points' flat indices ``at`` (n,) into the padded map's ranks ``ranks`` (each distance's place among the
+    map's distinct distances, :meth:`~symfruit.core.surface._Outline.ranks`) moved back by the shift, counted per
+    rank (a row's ranks span a few hundred places); the median (np.median's two middle places, walked to on the
+    counts) of their values ``values`` (ascending, one per rank), its band (clipped to 0 .. ``band``) and the
+    mean of the ``keep`` deviations from it nearest the band, taken a rank at a time from the band outward, the
+    nearer side first (:meth:`~symfruit.core.surface._Outline._nearest_mean`'s run of sorted values, whose
+    deviations are the ``keep`` smallest). The twin's medians and bands and the same deviations, summed as count
+    times deviation per rank: within ``keep`` units in the last place of the twin's fast costs, as those are of
+    the exact ones (issue 19, fifteenth round; the twelfth round's kernel sorted each row's keys by counting and
+    summed the run value by value, 1.5-2x slower)."""
     k, n = shifts.shape[0], at.shape[0]
-    size = table.shape[0]
+    size = values.shape[0]
     out = np.empty(k)
-    row = np.empty(n, np.int64)
-    v = np.empty(n)
-    count = np.zeros(1, np.int64)
+    count = np.zeros(size, np.int64)
+    lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
     for s in range(k):
         offset = shifts[s, 0] * width + shifts[s, 1]
-        low, top = np.int64(2**62), -np.int64(2**62)
+        low, top = size, -1
         for j in range(n):
-            key = np.int64(keys[at[j] - offset])
-            row[j] = key
-            low, top = min(low, key), max(top, key)
-        span = top - low + 1
-        if count.shape[0] < span:
-            count = np.zeros(span, np.int64)
-        for j in range(n):
-            count[row[j] - low] += 1
-        i = 0
-        for b in range(span):  # the keys in order, each bin emptied as it is read
-            c = count[b]
-            if c:
-                key = low + b
-                value = table[key if key >= 0 else size + key]
-                for _ in range(c):
-                    v[i] = value
-                    i += 1
-                count[b] = 0
-        median = 0.5 * (v[(n - 1) // 2] + v[n // 2]) if n % 2 == 0 else v[n // 2]
+            r = np.int64(ranks[at[j] - offset])
+            count[r] += 1
+            low, top = min(low, r), max(top, r)
+        b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
+        while seen <= lower:
+            b += 1
+            seen += count[b]
+        first = float(values[b])
+        if seen <= upper:  # place `upper` is in the next rank that holds any
+            b += 1
+            while count[b] == 0:
+                b += 1
+            second = float(values[b])
+        else:
+            second = first
+        median = 0.5 * (first + second) if n % 2 == 0 else second
         middle = min(max(median, 0.0), band)
-        start = 0  # the places where the run comes nearer by dropping its first value for the next (a prefix)
-        for j in range(n - keep):
-            start += middle - v[j] > v[j + keep] - middle
+        right = low  # the first rank at or above the band, the one below it: the nearer one taken first
+        while right <= top and values[right] < middle:
+            right += 1
+        left = right - 1
+        need = keep
         total = 0.0
-        for j in range(start, start + keep):
-            total += abs(v[j] - middle)
+        while need > 0:
+            while left >= low and count[left] == 0:
+                left -= 1
+            while right <= top and count[right] == 0:
+                right += 1
+            below = middle - float(values[left]) if left >= low else np.inf
+            above = float(values[right]) - middle if right <= top else np.inf
+            if below < above:
+                take = min(int(count[left]), need)
+                total += take * below
+                left -= 1
+            else:
+                take = min(int(count[right]), need)
+                total += take * above
+                right += 1
+            need -= take
+        for r in range(low, top + 1):
+            count[r] = 0
         out[s] = total / keep
     return out
+
+
+@_njit
+def key_ranks(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The places of whole-number ``keys`` (n,) among their distinct values (int32) and the value of each place,
+    ``sign * sqrt(|key|)`` ascending: :meth:`symfruit.core.surface._Outline.ranks`' twin, marking the keys present
+    and counting them up in two passes (the same places and values)."""
+    n = keys.shape[0]
+    low, top = np.int64(0), np.int64(0)
+    if n:
+        low, top = np.int64(keys[0]), np.int64(keys[0])
+    for i in range(n):
+        low, top = min(low, np.int64(keys[i])), max(top, np.int64(keys[i]))
+    place = np.zeros(top - low + 1, np.int64)
+    for i in range(n):
+        place[np.int64(keys[i]) - low] = 1
+    m = 0
+    for v in range(top - low + 1):
+        if place[v]:
+            place[v] = m
+            m += 1
+        else:
+            place[v] = -1
+    values = np.empty(m)
+    ranks = np.empty(n, np.int32)
+    for v in range(top - low + 1):
+        if place[v] >= 0:
+            whole = float(v + low)
+            values[place[v]] = np.sign(whole) * np.sqrt(abs(whole))
+    for i in range(n):
+        ranks[i] = place[np.int64(keys[i]) - low]
+    return ranks, values
+
+
+@_njit
+def _median_of(x: np.ndarray) -> float:
+    """np.median of ``x`` (n >= 1, no NaN), reordering it: :func:`select` at the middle place, the place below it
+    (even ``n``) the largest before it, their sum halved (:func:`symfruit.core.points.median`'s value bit for bit)."""
+    n = x.shape[0]
+    h = n // 2
+    select(x, h)
+    if n % 2:
+        return x[h]
+    below = x[0]
+    for i in range(1, h):
+        below = max(below, x[i])
+    return (below + x[h]) / 2.0
+
+
+@_njit
+def depth_noise(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float]:
+    """:func:`symfruit.core.surface.depth_noise`'s differences and their median absolute deviation: how many
+    differences it takes (``n``) and the deviation (NaN when ``n < 10`` or a difference is NaN). The twin's
+    differences (the same subtractions, the moved ones where at least 20 are) and its medians (order statistics, the
+    middle two's sum halved): its deviation bit for bit."""
+    h, w = depth.shape
+    diff = np.empty(max(h * (w - 1), 0))
+    n = 0
+    moved = 0
+    for r in range(h):
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            if mask[r, c + 1] and mask[r, c] and a > 0 and b > 0:
+                diff[n] = a - b
+                moved += diff[n] != 0
+                n += 1
+    if moved >= 20:
+        kept = 0
+        for i in range(n):
+            if diff[i] != 0:
+                diff[kept] = diff[i]
+                kept += 1
+        n = kept
+    if n < 10:
+        return n, np.nan
+    x = diff[:n]
+    for i in range(n):
+        if np.isnan(x[i]):
+            return n, np.nan
+    middle = _median_of(x)
+    for i in range(n):
+        x[i] = abs(x[i] - middle)
+    return n, _median_of(x)
 
 
 @_njit

@@ -1,7 +1,8 @@
 """Compiled kernels for the fits' loops (issue 19, eighth round; the cone ellipsoid's in the tenth), the observation's
 pixel maps (ninth round), a fruit's surface, outline and colour trimming (twelfth round), the observation's edge
-normals and silhouette bands and the silhouette's closing (thirteenth round), and scipy's feature transform and the
-quadric candidates' agreement (fourteenth round), with numba from the optional extra ``fast``.
+normals and silhouette bands and the silhouette's closing (thirteenth round), scipy's feature transform and the
+quadric candidates' agreement (fourteenth round) and the registration's key ranks and a fruit's depth noise
+(fifteenth round), with numba from the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -13,7 +14,8 @@ when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfru
 :func:`~symfruit.core.surface.monotone_region`, :func:`~symfruit.core.surface.colour_trim` and
 :func:`~symfruit.core.surface.within`; the thirteenth round's :func:`symfruit.core.agreement.observe` and
 :func:`symfruit.core.raster.close_ragged`; the fourteenth round's :func:`symfruit.core.raster.nearest_index` and
-:func:`symfruit.core.agreement.explain`) then run their numpy twins, the code the kernels were written from, which
+:func:`symfruit.core.agreement.explain`; the fifteenth round's :meth:`symfruit.core.surface._Outline.ranks` and
+:func:`symfruit.core.surface.depth_noise`) then run their numpy twins, the code the kernels were written from, which
 stays tested and gives the same results within rounding (the fits' kernels sum in another order than numpy; the
 pixel maps', the surface's and the feature transform's are the twins' to the bit; the observation's edge normals
 come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics' depth RMS does). Nothing
@@ -35,10 +37,22 @@ __all__ = ["compiled"]
 _STATE: dict[str, ModuleType | None] = {}
 
 
+def _setting() -> str:
+    """``SYMFRUIT_KERNELS`` as the environment holds it now ("" unset). Read on every call (a test or a caller may
+    set it at any time), from ``os.environ``'s own dictionary of encoded names where it has one (CPython on POSIX):
+    ``os.environ.get`` of an unset name costs a caught KeyError, about 3 us, and :func:`compiled` is called some
+    300 times a frame (issue 19, fifteenth round); elsewhere by ``os.environ.get``."""
+    data = getattr(os.environ, "_data", None)
+    if os.name == "posix" and isinstance(data, dict):
+        raw = data.get(b"SYMFRUIT_KERNELS")
+        return "" if raw is None else os.fsdecode(raw)
+    return os.environ.get("SYMFRUIT_KERNELS", "")
+
+
 def compiled() -> ModuleType | None:
     """The compiled kernels' module, or None where the numpy twins are to run (no numba, or
     ``SYMFRUIT_KERNELS=numpy``)."""
-    if os.environ.get("SYMFRUIT_KERNELS", "").lower() == "numpy":
+    if _setting().lower() == "numpy":
         return None
     if "jit" not in _STATE:
         try:

@@ -83,7 +83,13 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -
     ----------
     depth : (h, w) float, metres (0: none)
     mask : (h, w) bool
+
+    Where numba is, its compiled twin finds the differences and their medians (:func:`symfruit.core._jit.depth_noise`:
+    the same differences and order statistics, the same value; issue 19, fifteenth round).
     """
+    if (jit := compiled()) is not None and depth.ndim == 2 and depth.dtype == np.float64 and mask.shape == depth.shape:
+        n, mad = jit.depth_noise(depth, np.asarray(mask, dtype=bool))
+        return max(floor, 0.002) if n < 10 else max(floor, 1.4826 * float(mad) / np.sqrt(2.0))
     a, b = depth[:, 1:], depth[:, :-1]
     ok = mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)
     diff = (a - b)[ok]
@@ -371,6 +377,10 @@ class _Outline:
     #: ``("keys", pad, reach)`` the same for its whole-number keys (:meth:`keys`), None when it has none; under
     #: ``("table", pad, reach)`` the value of each key (:meth:`_table`)
     _padded: dict[tuple, np.ndarray | None] = field(default_factory=dict, init=False, repr=False, compare=False)
+    #: :meth:`ranks` per ``(pad, reach)``
+    _ranks: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     @property
     def axes(self) -> tuple[bool, bool]:
@@ -429,15 +439,16 @@ class _Outline:
         Many shifts are costed a block of rows at a time (:data:`_BLOCK` values): the same rows, each block's arrays
         staying in a core's cache (the whole coarse grid's do not; 1.6x faster on the benchmark frame). Where numba
         is, the fast costs of a map with 16-bit keys come from the compiled twin of :meth:`_cost`
-        (:func:`symfruit.core._jit.outline_costs`: each row's keys put in order by counting, the same run of values,
-        summed in another order; 1.5x faster on the benchmark frame's coarse grid, issue 19's twelfth round)."""
+        (:func:`symfruit.core._jit.outline_costs`: each row's ranks of its keys (:meth:`ranks`) counted, the median
+        and the same deviations read off the counts, summed in another order; issue 19's twelfth round, made about
+        half as costly again by the fifteenth)."""
         if not exact and (jit := compiled()) is not None:  # the compiled twin of the fast costs, all rows at once
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
             if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:  # a row's keys: < 2**16 apart
                 width = self.inside.shape[1] + 2 * pad
                 at = (self.rows + pad) * width + (self.cols + pad)
                 keep = max(1, int(trim * len(self.rows)))
-                return jit.outline_costs(keys, self._table(pad, reach), at, shifts, width, keep, self.band)
+                return jit.outline_costs(*self.ranks(pad, reach), at, shifts, width, keep, self.band)
         rows = max(1, _BLOCK // max(1, len(self.rows)))
         if len(shifts) > rows:
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))  # one pad for all blocks: one padded map
@@ -493,6 +504,29 @@ class _Outline:
             start = np.zeros(k, dtype=np.intp)
         run = np.take(v.ravel(), (np.arange(k) * n + start)[:, None] + np.arange(keep)[None, :])
         return np.abs(np.subtract(run, band, out=run), out=run).mean(axis=1)
+
+    def ranks(self, pad: int, reach: int) -> tuple[np.ndarray, np.ndarray]:
+        """The padded map's whole-number keys (:meth:`keys`, which it must have) as their places among its distinct
+        keys (int32, flattened), and the value of each place ((m,) ascending, :meth:`_table`'s bit for bit): the same
+        order, a few times fewer places for a row of keys to span than the keys' own values (the squared distances
+        that a map holds are sums of two squares; issue 19, fifteenth round). Where numba is, counted by its
+        compiled twin (:func:`symfruit.core._jit.key_ranks`: the same places and values)."""
+        found = self._ranks.get((pad, int(reach)))
+        if found is None:
+            keys = self.keys(pad, reach)
+            assert keys is not None  # only called when the map has keys
+            if (jit := compiled()) is not None:
+                found = jit.key_ranks(keys)
+            else:
+                low = int(keys.min(initial=0))
+                shifted = keys.astype(np.int64) - low
+                present = np.zeros(int(shifted.max(initial=0)) + 1, bool)
+                present[shifted] = True
+                ranks = (np.cumsum(present) - 1).astype(np.int32)[shifted]
+                whole = (np.flatnonzero(present) + low).astype(np.float64)
+                found = (ranks, np.sign(whole) * np.sqrt(np.abs(whole)))
+            self._ranks[(pad, int(reach))] = found
+        return found
 
     def _table(self, pad: int, reach: int) -> np.ndarray:
         """The value of every key of :meth:`keys` (``sign * sqrt(|key|)``), indexed by the key itself, negative keys
