@@ -61,7 +61,7 @@ def compare(before: str, after: str, tolerance_mm: float, listed: bool = False) 
         if np.isnan(a[k]).all() and np.isnan(b[k]).all():
             continue
         faces = np.abs(b[k] - a[k]) * 1000.0
-        centre = np.linalg.norm((b[k][:3] + b[k][3:] - a[k][:3] - a[k][3:]) / 2.0) * 1000.0
+        centre = np.linalg.norm(((b[k][:3] - a[k][:3]) + (b[k][3:] - a[k][3:])) / 2.0) * 1000.0  # 0 when equal
         d = float(max(np.nanmax(faces) if np.isfinite(faces).any() else np.inf, centre))
         worst = max(worst, d)
         moved += int(not d <= tolerance_mm)
