@@ -49,8 +49,8 @@ class ExtractSettings(Section):
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
     convex_tolerance : float
         Along every image ray from the fruit's nearest point its depth may fall this many noise deviations
-        (at least 3 mm) below its running maximum before the ray has left the fruit (a convex front never
-        falls); 0 switches the test off.
+        (at least 3 mm), plus the depth's unit, below its running maximum before the ray has left the fruit (a
+        convex front never falls); 0 switches the test off.
     cluster_distance : float, metres
         Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
         cluster nearest the camera among those with at least ``cluster_share`` of the largest's points.

@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from symfruit.core.surface import (
     colour_trim,
     depth_noise,
+    depth_step,
     fruit_depth,
     fruit_surface,
     monotone_region,
@@ -116,6 +117,35 @@ def test_the_convexity_cut_follows_rays_from_the_apex():
     assert out[:, :23].all() and not out[2, 30:].any()  # falls 3 mm below the running maximum at column 23
     assert monotone_region(depth, np.zeros_like(keep), (2, 0), 0.003).sum() == 0
     assert monotone_region(depth, keep, (2, 0), np.inf).all()
+
+
+def test_the_depth_step_is_the_smallest_difference_of_neighbours():
+    depth, disc = ball(radius_px=30, noise=0.002)
+    assert depth_step(np.round(depth / 0.001) * 0.001, disc) == pytest.approx(0.001)  # whole millimetres
+    assert depth_step(np.round(depth / 0.0001) * 0.0001, disc) == pytest.approx(0.0001)
+    assert depth_step(depth, disc) < 1e-5  # continuous depth: no step to speak of
+    assert depth_step(np.full((H, W), 0.5), disc) == 0.0 and depth_step(np.zeros((H, W)), disc) == 0.0
+
+
+def test_a_fall_of_the_tolerance_in_whole_millimetres_is_rounding_not_a_cut():
+    # A near fruit through a stereo camera (issue 18, the D405 model's peach at 0.27 m): millimetre depth units,
+    # noise of half a millimetre. Its flat front at 266 mm, its nearest pixels 265 mm at the centre; one pixel
+    # 2 mm up and one 1 mm down farther along the same ray, both the noise, 3 mm apart: no support turns back
+    # there, yet float32's 0.268 - 0.265 is a hair above the 3 mm tolerance, and without the depth's own unit
+    # in the tolerance everything beyond the low pixel on its ray was cut.
+    yy, xx = np.mgrid[:H, :W]
+    disc = (xx - 80) ** 2 + (yy - 60) ** 2 <= 40**2
+    depth = np.where(disc, 0.266, 0.6)
+    depth[58:63, 78:83] = 0.265
+    depth[58, 100], depth[58, 110] = 0.268, 0.265
+    depth = depth.astype(np.float32)
+    found = fruit_surface(depth, disc, F)
+    assert found is not None and found.apex == (58, 80) and depth_noise(depth, disc) == 0.0005  # a 3 mm tolerance
+    assert (found.pixels & disc).sum() == disc.sum()  # the whole front
+    walls = np.where(disc, depth, 0.6).astype(np.float32)
+    walls[58, 112:121] = 0.262  # a support turning back 6 mm towards the camera at the rim: still cut
+    found = fruit_surface(walls, disc, F)
+    assert found is not None and not found.pixels[58, 112:121].any()
 
 
 def test_no_surface_without_depth():

@@ -38,6 +38,7 @@ __all__ = [
     "Surface",
     "colour_trim",
     "depth_noise",
+    "depth_step",
     "fruit_depth",
     "fruit_surface",
     "monotone_region",
@@ -100,6 +101,26 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -
         return max(floor, 0.002)
     mad = float(median(np.abs(diff - median(diff))))
     return max(floor, 1.4826 * mad / np.sqrt(2.0))
+
+
+def depth_step(depth: np.ndarray, mask: np.ndarray) -> float:
+    """The depth's quantisation step (metres): the smallest non-zero difference between horizontally
+    neighbouring depth pixels of ``mask``, 0 with none.
+
+    Depth cameras store whole depth units (a millimetre on the RealSense and Azure Kinect images and in their
+    16-bit PNGs); a continuous depth (a render) has no step worth the name, and its smallest difference is
+    negligible beside any tolerance.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres (0: none)
+    mask : (h, w) bool
+    """
+    a, b = depth[:, 1:], depth[:, :-1]
+    ok = mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)
+    diff = np.abs(a - b)[ok]
+    diff = diff[diff > 0]
+    return float(diff.min()) if len(diff) else 0.0
 
 
 def _sorted_quantile(z: np.ndarray, q: float) -> float:
@@ -284,7 +305,7 @@ def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: in
 def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
-                  leafy: np.ndarray | None = None) -> Surface | None:  # fmt: skip
+                  leafy: np.ndarray | None = None, step: float | None = None) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -299,7 +320,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         the radius is the larger of the mask's equivalent radius and half its major width (an elongated fruit
         may recede along its length).
     tolerance : float
-        The convexity test's tolerance (:func:`monotone_region`) in noise deviations (at least 3 mm).
+        The convexity test's tolerance (:func:`monotone_region`) in noise deviations (at least 3 mm), plus the
+        depth's quantisation step (:func:`depth_step`).
     interior : float
         Pixels more than this many half minor widths (or equivalent radii, the smaller) inside the mask are
         kept whatever the convexity test says (supports and stems meet a fruit at its outline; a fall deep
@@ -310,6 +332,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         ``mask``'s distance map (:func:`~symfruit.core.raster.inner_distance`) when the caller has it.
     leafy : (h, w) bool, optional
         The leaf-green pixels (:func:`fruit_depth`).
+    step : float, metres, optional
+        The depth's quantisation step added to the tolerance (default: measured in the mask, :func:`depth_step`).
 
     Returns
     -------
@@ -331,7 +355,11 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
                                 leafy=None if leafy is None else leafy[box][own])  # fmt: skip
     if not np.isfinite(front):
         return None
-    tol = max(tolerance * noise, 0.003)
+    # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
+    # known to a unit: without it a 3 mm tolerance on millimetre depth cuts every 3 mm fall that float32 rounding
+    # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
+    # camera's near fruit lost a third of its cap, issue 18)
+    tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
@@ -575,7 +603,10 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points)."""
     grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     inner = inner_distance(mask)
-    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner)
+    # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
+    # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
+    # (0, 17) px to (18, 0) and (-15, 15) (docs/ablation.md, "A fall of whole depth units")
+    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0)
     if surface is None:
         return None
     cap = _connected(surface.pixels, surface.apex)
