@@ -91,9 +91,7 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -
     if (jit := compiled()) is not None and depth.ndim == 2 and depth.dtype == np.float64 and mask.shape == depth.shape:
         n, mad = jit.depth_noise(depth, np.asarray(mask, dtype=bool))
         return max(floor, 0.002) if n < 10 else max(floor, 1.4826 * float(mad) / np.sqrt(2.0))
-    a, b = depth[:, 1:], depth[:, :-1]
-    ok = mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)
-    diff = (a - b)[ok]
+    diff = _neighbour_differences(depth, mask)
     moved = diff[diff != 0]
     if len(moved) >= 20:
         diff = moved
@@ -116,11 +114,16 @@ def depth_step(depth: np.ndarray, mask: np.ndarray) -> float:
     depth : (h, w) float, metres (0: none)
     mask : (h, w) bool
     """
-    a, b = depth[:, 1:], depth[:, :-1]
-    ok = mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)
-    diff = np.abs(a - b)[ok]
+    diff = np.abs(_neighbour_differences(depth, mask))
     diff = diff[diff > 0]
     return float(diff.min()) if len(diff) else 0.0
+
+
+def _neighbour_differences(depth: np.ndarray, mask: np.ndarray) -> np.ndarray:
+    """(n,) the differences, right less left, between horizontally neighbouring pixels of ``mask`` that both hold
+    depth (:func:`depth_noise`'s spread and :func:`depth_step`'s unit are read off them)."""
+    a, b = depth[:, 1:], depth[:, :-1]
+    return (a - b)[mask[:, 1:] & mask[:, :-1] & (a > 0) & (b > 0)]
 
 
 def _sorted_quantile(z: np.ndarray, q: float) -> float:
