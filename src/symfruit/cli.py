@@ -537,7 +537,7 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         if args.fruit.strip() not in FRUITS:  # a list, all or a folder of scans: the frames have one profile
             raise InputError(f"evaluate --frames --fruit {args.fruit!r}: give one fruit kind (its profile is the "
                              "frames')")  # fmt: skip
-    args.fruit = args.fruit or "strawberry"
+    args.fruit = "strawberry" if args.fruit is None else args.fruit  # an empty --fruit is refused, not the default
     args.protocol = args.protocol or "paper"
     args.match = args.match or "centre"
     args.category = 1 if args.category is None else args.category
@@ -570,6 +570,12 @@ def _evaluate(args: argparse.Namespace) -> int:
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     for method in methods:
         get(method)
+    for option, names in (("--fruit", fruits), ("--methods", methods)):  # nothing to evaluate: an empty table
+        if not names:
+            raise InputError(f"{option} {getattr(args, option[2:])!r} names nothing; give at least one")
+        if len(set(names)) < len(names):
+            twice = next(name for name in names if names.count(name) > 1)
+            raise InputError(f"{option} names {twice!r} twice")
     try:
         occlusions = [float(x) for x in args.occlusion.split(",")]
     except ValueError:
