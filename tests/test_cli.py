@@ -915,3 +915,11 @@ def test_evaluate_refuses_an_option_naming_no_fruit_or_method_or_one_twice(tmp_p
     assert main(["evaluate", "--quick", option, value, "--output", str(tmp_path / "r")]) == 2
     _one_line_error(capsys, message)
     assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("command", [["complete", "cloud.ply"], ["detect", "rec", "--output", "out"], ["demo"]])
+def test_an_empty_method_is_refused_not_read_as_the_default(tmp_path, monkeypatch, capsys, command):
+    monkeypatch.chdir(tmp_path)
+    assert main([*command, "--method", ""]) == 2  # before: the default method ran, exit 0
+    assert "unknown method ''" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

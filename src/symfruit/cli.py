@@ -281,10 +281,11 @@ def _fmt(values: Sequence[float] | np.ndarray, scale: float = 1000.0) -> str:
 
 
 def _method(args: argparse.Namespace) -> str:
-    """``--method``, or the default method when it is not given."""
+    """``--method``, or the default method when it is not given (an empty ``--method ''`` is given: refused by the
+    method registry as an unknown method, never read as the default)."""
     from .methods import DEFAULT_METHOD
 
-    return str(args.method or DEFAULT_METHOD)
+    return str(DEFAULT_METHOD if args.method is None else args.method)
 
 
 def _settings_for(args: argparse.Namespace, fruit: str | None = None):
@@ -299,9 +300,11 @@ def _complete(args: argparse.Namespace) -> int:
     from .core.camera import DEFAULT_CAMERA
     from .errors import InputError
     from .io import load_camera, read_cloud
+    from .methods import get
     from .methods.complete import complete
     from .writers import check_result_paths, write_result
 
+    get(_method(args))  # an unknown method refused before the work, not blamed on the cloud file
     settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
     profile = Path(args.fruit) if args.fruit and Path(args.fruit).is_file() else None  # a profile file
@@ -454,7 +457,7 @@ def _bench(args: argparse.Namespace) -> int:
         if args.profile:
             print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
             return 0
-        methods = (args.method,) if args.method else ("paper", "fused", "evidence")
+        methods = (_method(args),) if args.method is not None else ("paper", "fused", "evidence")
         if args.stages:
             import numpy as np
 
