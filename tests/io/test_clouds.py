@@ -381,3 +381,17 @@ def test_a_pcd_of_negative_width_and_height_is_refused(tmp_path, shape):
         return
     with pytest.raises(FileFormatError, match=r"a\.pcd: PCD header garbles WIDTH/HEIGHT \(-2 x -1; counts are >= 0\)"):
         read_cloud(tmp_path / "a.pcd")  # before: -2 x -1 = 2 points read
+
+
+def test_a_npy_of_times_or_a_structured_npy_of_other_fields_than_numbers_is_refused(tmp_path):
+    np.save(tmp_path / "times.npy", np.ones((20, 3)).astype("timedelta64[ms]"))  # numpy counts it an integer
+    with pytest.raises(FileFormatError, match=r"expected a numeric \(n, 3\) array, got timedelta64\[ms\]"):
+        read_cloud(tmp_path / "times.npy")  # before: read as counts of milliseconds, 'the cloud is 28 m across'
+    fields = np.zeros(20, dtype=[("x", "f4"), ("y", "f4"), ("z", "?")])
+    np.save(tmp_path / "flags.npy", fields)
+    with pytest.raises(FileFormatError, match="structured array field 'z' is bool, not a number"):
+        read_cloud(tmp_path / "flags.npy")  # before: True/False read as 1 m / 0 m
+    fields = np.zeros(20, dtype=[("x", "f4"), ("y", "f4"), ("z", "i2")])
+    fields["z"] = 3
+    np.save(tmp_path / "ints.npy", fields)
+    assert read_cloud(tmp_path / "ints.npy")[:, 2].tolist() == [3.0] * 20

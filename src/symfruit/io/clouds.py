@@ -508,8 +508,12 @@ def read_npy(path: Path) -> np.ndarray:
         missing = [c for c in ("x", "y", "z") if c not in arr.dtype.names]
         if missing:
             raise FileFormatError(f"{path}: structured array lacks field {missing[0]!r}")
+        for c in ("x", "y", "z"):  # numbers only: a bool, a time or text would be read as metres by the cast
+            if arr.dtype[c].kind not in "iuf":
+                raise FileFormatError(f"{path}: structured array field {c!r} is {arr.dtype[c]}, not a number")
         return np.column_stack([np.asarray(arr[c], dtype=np.float64) for c in ("x", "y", "z")])
-    if arr.ndim != 2 or arr.shape[1] < 3 or not np.issubdtype(arr.dtype, np.number):
+    # numpy counts timedelta64 among its integers: a time is no coordinate (read as a count of its units)
+    if arr.ndim != 2 or arr.shape[1] < 3 or arr.dtype.kind not in "iufc":
         raise FileFormatError(f"{path}: expected a numeric (n, 3) array, got {arr.dtype} {arr.shape}")
     if np.iscomplexobj(arr):
         raise FileFormatError(f"{path}: complex numbers cannot be coordinates")
