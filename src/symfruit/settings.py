@@ -148,7 +148,7 @@ def _field_value(value: Any, hint: Any, name: str) -> Any:
     kind = type(value)
     if (kind is hint and kind in (int, bool, str)) or (kind is float and hint is float and math.isfinite(value)):
         return value
-    if dataclasses.is_dataclass(hint) and isinstance(value, typing.cast(type, hint)):
+    if dataclasses.is_dataclass(hint):  # a nested section: its owner's check() names what else it was given
         return value
     return _coerce(value, hint, name)
 
