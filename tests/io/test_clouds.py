@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symfruit import FileFormatError, SymfruitError
+from symfruit import FileFormatError, InputError, SymfruitError
 from symfruit.io import read_cloud, write_ply
 
 from ..conftest import POINTS, lzf_compress, write_pcd
@@ -395,3 +395,21 @@ def test_a_npy_of_times_or_a_structured_npy_of_other_fields_than_numbers_is_refu
     fields["z"] = 3
     np.save(tmp_path / "ints.npy", fields)
     assert read_cloud(tmp_path / "ints.npy")[:, 2].tolist() == [3.0] * 20
+
+
+@pytest.mark.parametrize(
+    ("points", "labels", "message"),
+    [
+        (np.zeros((4, 3)), np.array([0, 1, 255, 256]), r"labels must be 0-255 to fit the PLY's uchar, got 0 to 256"),
+        (np.zeros((4, 3)), np.array([-1, 0, 0, 0]), r"labels must be 0-255"),  # before: -1 written as 255
+        (np.zeros((4, 3)), np.zeros(3, np.uint8), r"labels must be 4 whole numbers, one a point"),  # ValueError
+        (np.zeros((4, 2)), None, r"points must have shape \(n, 3\), got \(4, 2\)"),  # before: IndexError
+        (np.full((4, 3), 1e300), None, r"beyond a 32-bit float's range"),  # before: written as infinity
+    ],
+)
+def test_write_ply_refuses_points_or_labels_it_would_write_as_something_else(tmp_path, points, labels, message):
+    with pytest.raises(InputError, match=message):
+        write_ply(tmp_path / "c.ply", points, labels=labels)
+    assert not (tmp_path / "c.ply").exists()
+    write_ply(tmp_path / "ok.ply", [[0.0, 0.0, 0.3]] * 4, labels=[0, 1, 1, 255])  # lists are read as arrays
+    assert read_cloud(tmp_path / "ok.ply").tolist() == [[0.0, 0.0, 0.30000001192092896]] * 4
