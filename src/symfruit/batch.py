@@ -667,6 +667,11 @@ def segment_images(
             raise InputError("segment: depth needs a camera (--camera: fx, fy) to turn metres into pixels")
         if not depth_path.exists():
             raise FileFormatError(f"{depth_path}: no such depth image or folder")
+        if not depth_path.is_dir():
+            holds_file(depth_path)  # a pipe or device named as the depth image is refused by name, here
+            if len(images) != 1:  # before: refused once per image, each image failed with it
+                raise InputError(f"--depth {depth_path} is one file but there are {len(images)} images: give a "
+                                 "folder of depth images")  # fmt: skip
     if not (np.isfinite(depth_scale) and 0 < depth_scale <= 1.0):
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
     labeller, source = _labeller(masks, settings, images)
