@@ -364,3 +364,18 @@ def test_numpy_numbers_are_read_as_the_python_ones_from_python_and_from_override
     assert (over.input.min_points, over.input.max_points) == (12, 900)
     with pytest.raises(ConfigError, match=r"expected a whole number, got np\.True_"):
         Settings().replace(input={"min_points": np.bool_(True)})
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: resolve_settings(fruit=5), "fruit must be a profile name or a path, got int"),  # before: TypeError
+        (lambda: resolve_settings(config=["a.yaml"]), "config must be a profile name or a path, got list"),
+        (lambda: resolve_settings(base="apple"), "base must be a Settings, got str"),  # before: AttributeError
+        (lambda: load_settings(None), "load_settings needs a settings file path, got None"),  # before: the defaults
+        (lambda: Settings().section(5), "a settings section is named by text, got int"),  # before: AttributeError
+    ],
+)
+def test_resolve_settings_refuses_arguments_of_another_type_by_name(call, message):
+    with pytest.raises(ConfigError, match=message):
+        call()

@@ -30,6 +30,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import numbers
+import os
 import types
 import typing
 from collections.abc import Iterable, Mapping
@@ -209,7 +210,9 @@ class Settings:
         """The section ``name``; raises :class:`ConfigError` listing the known ones."""
         try:
             return self._sections[name]
-        except KeyError:
+        except (KeyError, TypeError):  # TypeError: an unhashable name
+            if not isinstance(name, str):
+                raise ConfigError(f"a settings section is named by text, got {type(name).__name__}") from None
             raise ConfigError(f"unknown settings section {name!r}{_closest(name, self._sections)}; known: "
                               f"{', '.join(self._sections)}") from None  # fmt: skip
 
@@ -396,6 +399,8 @@ def read_settings_file(path: str | Path) -> dict[str, Any]:
 
 def load_settings(path: str | Path, base: Settings | None = None) -> Settings:
     """Settings from a file laid over ``base`` (default: the defaults); errors name the file."""
+    if path is None:  # resolve_settings' "no file": here it would be the defaults, with no file read, unsaid
+        raise ConfigError("load_settings needs a settings file path, got None (the defaults are Settings())")
     return resolve_settings(config=path, base=base)
 
 
@@ -425,6 +430,15 @@ def resolve_settings(
     ConfigError
         Naming the profile or file and the key.
     """
+    for name, value in (("fruit", fruit), ("config", config)):  # a number or list is no name or path (TypeError)
+        if value is not None and not isinstance(value, str | bytes | os.PathLike):
+            raise ConfigError(f"{name} must be a profile name or a path, got {type(value).__name__}")
+    if isinstance(config, bytes):
+        config = os.fsdecode(config)
+    if isinstance(fruit, bytes):
+        fruit = os.fsdecode(fruit)
+    if base is not None and not isinstance(base, Settings):
+        raise ConfigError(f"base must be a Settings, got {type(base).__name__}")
     data = (base or Settings()).to_dict()
     if fruit is not None:
         from .profiles import profile_data
