@@ -16,6 +16,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
+import symfruit
 from symfruit import batch
 from symfruit.batch import BatchReport, frame_folder_name, run_batch
 from symfruit.cli import main
@@ -564,3 +565,19 @@ def test_a_masks_folder_in_the_output_is_an_input_no_frame_writes_into(tmp_path)
     assert {p.name: p.read_bytes() for p in (out / "masks").iterdir()} == before
     (renamed,) = [p for p in out.iterdir() if p.name.startswith("masks+")]
     assert (renamed / "detections.json").is_file()
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"masks": ""}, "--masks ''"),
+        ({"masks": "missing.png"}, "no such file or folder"),
+        ({"masks": "onnx:missing.onnx"}, "missing.onnx"),
+        ({"method": "nope"}, "unknown method 'nope'"),
+    ],
+)
+def test_a_masks_spec_or_method_no_frame_can_use_is_refused_before_any_frame(tmp_path, monkeypatch, kwargs, message):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(symfruit.SymfruitError, match=re.escape(message)):  # before: each frame failed with it
+        run_batch(EXAMPLE_FRAME, tmp_path / "out", progress=False, **kwargs)
+    assert not (tmp_path / "out").exists()

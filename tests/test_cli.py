@@ -899,3 +899,27 @@ def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, m
         _one_line_error(capsys, "segment --depth-scale 0.001 and", "cam.json's depth scale 0.0001 disagree")
     else:  # before: the camera file's depth_scale ignored, 0.001 used whatever it said
         assert code == 0 and seen == [used]
+
+
+@pytest.mark.parametrize(
+    ("option", "value", "message"),
+    [
+        ("--methods", "", "--methods '' names nothing"),  # before: an evaluation of no method, exit 0
+        ("--methods", ",,", "--methods ',,' names nothing"),
+        ("--fruit", ",", "--fruit ',' names nothing"),  # before: an evaluation of no fruit, exit 0
+        ("--fruit", "", "--fruit '' names nothing"),  # before: taken as the default, strawberry
+        ("--methods", "raw,raw", "--methods names 'raw' twice"),
+    ],
+)
+def test_evaluate_refuses_an_option_naming_no_fruit_or_method_or_one_twice(tmp_path, capsys, option, value, message):
+    assert main(["evaluate", "--quick", option, value, "--output", str(tmp_path / "r")]) == 2
+    _one_line_error(capsys, message)
+    assert not (tmp_path / "r").exists()
+
+
+@pytest.mark.parametrize("command", [["complete", "cloud.ply"], ["detect", "rec", "--output", "out"], ["demo"]])
+def test_an_empty_method_is_refused_not_read_as_the_default(tmp_path, monkeypatch, capsys, command):
+    monkeypatch.chdir(tmp_path)
+    assert main([*command, "--method", ""]) == 2  # before: the default method ran, exit 0
+    assert "unknown method ''" in capsys.readouterr().err
+    assert not (tmp_path / "out").exists()

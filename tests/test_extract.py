@@ -1,16 +1,19 @@
 """From a fruit's mask to its points: exact de-projection, invalid depth dropped and counted, the border
 eroded, the fruit's own cluster kept."""
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from symfruit import ConfigError
+from symfruit import ConfigError, InputError
 from symfruit.core.camera import Camera
 from symfruit.extract import ExtractSettings, cluster, extract, register, shift_labels, trim_labels
+from symfruit.io import read_frame
 
-from .conftest import SMALL_CAM, disc_frame
+from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
 
 CAM = SMALL_CAM
 NO_EROSION = ExtractSettings(erode_px=0)
@@ -208,3 +211,29 @@ def test_good_masks_of_real_shaded_spheres_are_not_trimmed(name):
     frame = read_frame(EXAMPLES / "real-frames" / name)
     labels = frame.masks.astype(np.int32)
     assert np.array_equal(trim_labels(frame.color, labels), labels)
+
+
+def test_extract_register_and_trim_labels_refuse_inputs_that_do_not_fit_by_name():
+    frame = read_frame(EXAMPLE_FRAME)
+    h, w = frame.depth.shape
+    mask = np.zeros((h, w), bool)
+    mask[200:260, 300:360] = True
+    ok = extract(mask, frame.depth, frame.camera)
+    # an integer mask is read as its non-zero pixels (before: an int64 mask viewed as 8 bytes a pixel, other points)
+    assert np.array_equal(extract(mask.astype(np.int64) * 5, frame.depth, frame.camera).points, ok.points)
+    cases = [
+        (lambda: extract(mask.T, frame.depth, frame.camera), "mask must be an (h, w) image of the depth's shape"),
+        (lambda: extract(mask * 0.5, frame.depth, frame.camera), "mask must be bool, got float64"),
+        (lambda: extract(mask, (frame.depth * 1000).astype(np.uint16), frame.camera), "depth must be float metres"),
+        (lambda: extract(mask, frame.depth, "camera.json"), "camera must be a symfruit Camera, got str"),
+        (lambda: extract(mask, frame.depth, Camera(fx=600, fy=600, cx=50, cy=50, width=100, height=100)),
+         "the camera is for 100x100 images, the depth is 640x480"),
+        (lambda: extract(mask, frame.depth, frame.camera, leafy=np.zeros((3, 3), bool)), "leafy must be an (h, w)"),
+        (lambda: register(mask.T.astype(np.int32), frame.depth, frame.camera), "labels must be an (h, w) image"),
+        (lambda: register(mask + 0.5, frame.depth, frame.camera), "labels must be whole numbers, got float64"),
+        (lambda: trim_labels(frame.color[..., 0], mask.astype(np.int32)), "colour must be (h, w, 3) uint8 RGB"),
+        (lambda: trim_labels(frame.color, mask.T.astype(np.int32)), "labels must be an (h, w) image of the colour"),
+    ]  # fmt: skip
+    for call, message in cases:  # before: numpy broadcast/index errors, AttributeError, or silently no points
+        with pytest.raises(InputError, match=re.escape(message)):
+            call()

@@ -322,3 +322,16 @@ def test_an_entry_named_as_an_image_that_is_no_file_is_reported_not_left_out(tmp
     assert [d.path.name for d in report.done] == ["p0.jpg"]
     assert sorted(Path(k).name for k in report.failed) == ["gone.png", "loop.png", "pipe.png"]
     assert "pipe.png: is a pipe or a socket" in report.failed[str(folder / "pipe.png")]
+
+
+def test_one_depth_file_for_several_images_or_a_device_as_depth_is_refused_before_any_image(tmp_path):
+    camera = Camera(fx=100, fy=100, cx=20, cy=15, width=40, height=30)
+    for name in ("a.png", "b.png"):
+        Image.fromarray(np.zeros((30, 40, 3), np.uint8)).save(tmp_path / name)
+    Image.fromarray(np.full((30, 40), 500, np.uint16)).save(tmp_path / "depth.png")
+    images = [tmp_path / "a.png", tmp_path / "b.png"]
+    with pytest.raises(InputError, match="is one file but there are 2 images"):  # before: each image failed so
+        segment_images(images, output=tmp_path / "out", depth=tmp_path / "depth.png", camera=camera, progress=False)
+    with pytest.raises(FileFormatError, match="/dev/zero: not a regular file"):  # before: the image failed
+        segment_images(images[:1], output=tmp_path / "out", depth="/dev/zero", camera=camera, progress=False)
+    assert not (tmp_path / "out").exists()

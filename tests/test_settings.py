@@ -3,8 +3,10 @@
 
 import json
 import pickle
+import re
 from dataclasses import dataclass
 
+import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
@@ -332,3 +334,48 @@ def test_yaml_booleans_where_text_or_numbers_are_expected_are_refused_saying_why
 def load_settings_text(tmp_path, text):
     (tmp_path / "y.yaml").write_text(text)
     return load_settings(tmp_path / "y.yaml")
+
+
+@pytest.mark.parametrize(
+    ("field", "value", "message"),
+    [
+        ("min_points", np.int64(-5), "min_points: must be >= 4, got -5"),  # before: numpy's int skipped the bounds
+        ("max_extent", np.float32("nan"), "max_extent: expected a finite number, got nan"),  # before: taken
+        ("min_points", "5", "min_points: expected a whole number, got '5'"),  # before: TypeError from check()
+        ("max_extent", "1", "max_extent: expected a number, got '1'"),
+        ("min_points", 5.0, "min_points: expected a whole number, got 5.0"),
+    ],
+)
+def test_a_section_made_in_python_is_checked_as_one_read_from_a_file(field, value, message):
+    from symfruit.methods.complete import InputSettings
+
+    with pytest.raises(ConfigError, match=re.escape(message)):
+        InputSettings(**{field: value})
+
+
+def test_numpy_numbers_are_read_as_the_python_ones_from_python_and_from_overrides():
+    from symfruit.methods.complete import InputSettings
+
+    made = InputSettings(min_points=np.int64(12), max_extent=np.float32(0.5))
+    assert (made.min_points, made.max_extent) == (12, 0.5) and type(made.min_points) is int
+    assert type(made.max_extent) is float and made == InputSettings(min_points=12, max_extent=0.5)
+    # before: 'input.min_points: expected a whole number, got np.int64(12)'
+    over = Settings().replace(input={"min_points": np.int64(12), "max_points": np.uint16(900)})
+    assert (over.input.min_points, over.input.max_points) == (12, 900)
+    with pytest.raises(ConfigError, match=r"expected a whole number, got np\.True_"):
+        Settings().replace(input={"min_points": np.bool_(True)})
+
+
+@pytest.mark.parametrize(
+    ("call", "message"),
+    [
+        (lambda: resolve_settings(fruit=5), "fruit must be a profile name or a path, got int"),  # before: TypeError
+        (lambda: resolve_settings(config=["a.yaml"]), "config must be a profile name or a path, got list"),
+        (lambda: resolve_settings(base="apple"), "base must be a Settings, got str"),  # before: AttributeError
+        (lambda: load_settings(None), "load_settings needs a settings file path, got None"),  # before: the defaults
+        (lambda: Settings().section(5), "a settings section is named by text, got int"),  # before: AttributeError
+    ],
+)
+def test_resolve_settings_refuses_arguments_of_another_type_by_name(call, message):
+    with pytest.raises(ConfigError, match=message):
+        call()

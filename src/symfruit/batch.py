@@ -32,6 +32,7 @@ from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, uni
 from .io.sources import open_source
 from .io.text import holds_file
 from .methods import DEFAULT_METHOD
+from .methods.registry import get as get_method
 from .progress import Progress
 from .season.table import FRAMES_NAME, TABLE_NAME, recording_name, write_run_tables
 from .segment import MaskSource, mask_source
@@ -137,9 +138,15 @@ def run_batch(
     SymfruitError
         Only when the source itself cannot be opened (one recording; with several: an input that does not
         exist, is given twice or lies in the output folder), the output folder cannot be used (not writable,
-        an input folder, held by another run), or the cluster cannot be used; per-frame problems go into the
-        report.
+        an input folder, held by another run), the cluster cannot be used, or ``method`` or ``masks`` cannot be
+        used by any frame (an unknown method; an empty spec, a masks file or folder that does not exist, a model
+        or its extra missing); per-frame problems go into the report.
     """
+    get_method(method)  # an unknown method or a masks spec no frame can use: refused before any frame, never
+    if isinstance(masks, str | Path) and not (  # reported once per frame of a recording
+        (scheduler is not None or workers is not None) and str(masks).startswith(("maskrcnn:", "onnx:"))
+    ):  # a model is loaded (once: cached) where it runs; on a cluster, by the workers
+        mask_source(masks, settings=settings)
     given_masks = _mask_paths(masks)  # read by the run: no frame folder takes their name, nothing is written there
     exclude = [*exclude, *given_masks]
     if scheduler is not None or workers is not None:
@@ -660,6 +667,11 @@ def segment_images(
             raise InputError("segment: depth needs a camera (--camera: fx, fy) to turn metres into pixels")
         if not depth_path.exists():
             raise FileFormatError(f"{depth_path}: no such depth image or folder")
+        if not depth_path.is_dir():
+            holds_file(depth_path)  # a pipe or device named as the depth image is refused by name, here
+            if len(images) != 1:  # before: refused once per image, each image failed with it
+                raise InputError(f"--depth {depth_path} is one file but there are {len(images)} images: give a "
+                                 "folder of depth images")  # fmt: skip
     if not (np.isfinite(depth_scale) and 0 < depth_scale <= 1.0):
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
     labeller, source = _labeller(masks, settings, images)

@@ -281,10 +281,11 @@ def _fmt(values: Sequence[float] | np.ndarray, scale: float = 1000.0) -> str:
 
 
 def _method(args: argparse.Namespace) -> str:
-    """``--method``, or the default method when it is not given."""
+    """``--method``, or the default method when it is not given (an empty ``--method ''`` is given: refused by the
+    method registry as an unknown method, never read as the default)."""
     from .methods import DEFAULT_METHOD
 
-    return str(args.method or DEFAULT_METHOD)
+    return str(DEFAULT_METHOD if args.method is None else args.method)
 
 
 def _settings_for(args: argparse.Namespace, fruit: str | None = None):
@@ -299,9 +300,11 @@ def _complete(args: argparse.Namespace) -> int:
     from .core.camera import DEFAULT_CAMERA
     from .errors import InputError
     from .io import load_camera, read_cloud
+    from .methods import get
     from .methods.complete import complete
     from .writers import check_result_paths, write_result
 
+    get(_method(args))  # an unknown method refused before the work, not blamed on the cloud file
     settings = _settings_for(args)
     camera = load_camera(args.camera) if args.camera else DEFAULT_CAMERA
     profile = Path(args.fruit) if args.fruit and Path(args.fruit).is_file() else None  # a profile file
@@ -454,7 +457,7 @@ def _bench(args: argparse.Namespace) -> int:
         if args.profile:
             print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
             return 0
-        methods = (args.method,) if args.method else ("paper", "fused", "evidence")
+        methods = (_method(args),) if args.method is not None else ("paper", "fused", "evidence")
         if args.stages:
             import numpy as np
 
@@ -537,7 +540,7 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         if args.fruit.strip() not in FRUITS:  # a list, all or a folder of scans: the frames have one profile
             raise InputError(f"evaluate --frames --fruit {args.fruit!r}: give one fruit kind (its profile is the "
                              "frames')")  # fmt: skip
-    args.fruit = args.fruit or "strawberry"
+    args.fruit = "strawberry" if args.fruit is None else args.fruit  # an empty --fruit is refused, not the default
     args.protocol = args.protocol or "paper"
     args.match = args.match or "centre"
     args.category = 1 if args.category is None else args.category
@@ -570,6 +573,12 @@ def _evaluate(args: argparse.Namespace) -> int:
     methods = [m.strip() for m in args.methods.split(",") if m.strip()]
     for method in methods:
         get(method)
+    for option, names in (("--fruit", fruits), ("--methods", methods)):  # nothing to evaluate: an empty table
+        if not names:
+            raise InputError(f"{option} {getattr(args, option[2:])!r} names nothing; give at least one")
+        if len(set(names)) < len(names):
+            twice = next(name for name in names if names.count(name) > 1)
+            raise InputError(f"{option} names {twice!r} twice")
     try:
         occlusions = [float(x) for x in args.occlusion.split(",")]
     except ValueError:

@@ -58,6 +58,9 @@ class DemoReport:
 
 def run_demo(output: str | Path, *, method: str = DEFAULT_METHOD, settings: Settings | None = None) -> DemoReport:
     """Detect the example frame's fruit, write the outputs to ``output``, score them against the truth."""
+    from .methods.registry import get
+
+    get(method)  # an unknown method refused before the output folder is made
     output = Path(output)
     with example_frame() as folder:
         frame = read_frame(folder)

@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import itertools
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -14,6 +15,7 @@ from .core.camera import Camera
 from .core.kernels import compiled
 from .core.points import bounds
 from .core.surface import colour_trim, fruit_surface, registration_shift
+from .errors import InputError
 from .settings import Section, SettingError, setting
 
 __all__ = ["ExtractSettings", "Extraction", "cluster", "extract", "register", "shift_labels", "trim_labels"]
@@ -167,6 +169,34 @@ def _grid_clusters(points: np.ndarray, voxel: float) -> np.ndarray:
     return np.take(lab.ravel(), flat) - 1
 
 
+def _checked(image: Any, beside: Any, camera: Any, settings: Any, what: str, name: str) -> np.ndarray:
+    """A mask (``name`` "mask": bool, an integer mask read as non-zero) or instance labels (integers) checked at an
+    entry point in O(1): a 2-D image of ``beside``'s shape (the depth: float metres; or the colour), ``camera`` a
+    :class:`Camera` of that size, ``settings`` an :class:`ExtractSettings`. Before: numpy's broadcast errors, an
+    int64 mask viewed as 8 bytes a pixel, 16-bit depth read as metres (no point within range), AttributeErrors."""
+    arr = np.asarray(image)
+    size = np.shape(beside)
+    if arr.ndim != 2 or arr.shape != size:
+        raise InputError(f"{what}: {name} must be an (h, w) image of the {'colour' if camera is None else 'depth'}"
+                         f"'s shape {size}, got {arr.shape}")  # fmt: skip
+    if arr.dtype != bool and arr.dtype.kind not in "iu":
+        raise InputError(f"{what}: {name} must be {'bool' if name == 'mask' else 'whole numbers'}, got {arr.dtype}")
+    if camera is not None:
+        depth = np.asarray(beside)
+        if depth.dtype.kind != "f":
+            raise InputError(f"{what}: depth must be float metres, got {depth.dtype} (raw units: multiply by the "
+                             "depth scale first)")  # fmt: skip
+        if not isinstance(camera, Camera):
+            raise InputError(f"{what}: camera must be a symfruit Camera, got {type(camera).__name__}")
+        if (camera.width, camera.height) != (size[1], size[0]):
+            raise InputError(f"{what}: the camera is for {camera.width}x{camera.height} images, the depth is "
+                             f"{size[1]}x{size[0]}")  # fmt: skip
+    if settings is not None and not isinstance(settings, ExtractSettings):
+        raise InputError(f"{what}: settings must be an ExtractSettings (Settings().extract), got "
+                         f"{type(settings).__name__}")  # fmt: skip
+    return (arr != 0) if name == "mask" and arr.dtype != bool else arr
+
+
 def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None,
             *, leafy: np.ndarray | None = None) -> Extraction:  # fmt: skip
     """The 3D points of the fruit under ``mask``.
@@ -186,6 +216,10 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         front, the convex cap from its nearest point), then the cluster nearest the camera among the clusters
         holding at least ``cluster_share`` of the largest one's points.
     """
+    mask = _checked(mask, depth, camera, settings, "extract", "mask")
+    if leafy is not None and (np.shape(leafy) != mask.shape or np.asarray(leafy).dtype != bool):
+        raise InputError(f"extract: leafy must be an (h, w) bool image of the mask's shape {mask.shape}, got "
+                         f"{np.asarray(leafy).dtype} {np.shape(leafy)}")  # fmt: skip
     s = settings or ExtractSettings()
     area = int(mask.sum())
     truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
@@ -248,6 +282,10 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
     is trimmed.
     """
+    color = np.asarray(color)
+    if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
+        raise InputError(f"trim_labels: colour must be (h, w, 3) uint8 RGB, got {color.dtype} {color.shape}")
+    labels = _checked(labels, color[:, :, 0], None, settings, "trim_labels", "labels")
     s = settings or ExtractSettings()
     if s.colour_trim_px <= 0:
         return labels
@@ -278,6 +316,7 @@ def register(
     are when the frame is registered well enough or the masks do not say. ``boxes``: ``ndimage.find_objects(labels)``
     when the caller has it.
     """
+    labels = _checked(labels, depth, camera, settings, "register", "labels")
     s = settings or ExtractSettings()
     z = np.asarray(depth, dtype=np.float64)
     du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,

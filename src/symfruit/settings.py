@@ -29,11 +29,15 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
+import os
 import types
 import typing
 from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any, Literal, TypeVar
+
+import numpy as np
 
 from .core.limits import MAX_SETTINGS_BYTES  # settings are a few kB; anything larger is not settings
 from .errors import ConfigError
@@ -107,8 +111,15 @@ class Section:
     """Base of every settings section: checks the declared bounds of its fields, then :meth:`check`."""
 
     def __post_init__(self) -> None:
+        hints = _field_hints(type(self))
         for f in dataclasses.fields(self):  # type: ignore[arg-type]
             value = getattr(self, f.name)
+            # made in Python as from a file: of its declared type (a numpy number as the Python one), never text
+            # for a number (a TypeError in check()) nor np.int64(-5) past the bounds below, which test int and float
+            checked = _field_value(value, hints[f.name], f.name)
+            if checked is not value:
+                object.__setattr__(self, f.name, checked)
+                value = checked
             bounds = f.metadata.get("bounds", {})
             if bounds and isinstance(value, (int, float)) and not isinstance(value, bool):
                 for op, limit in bounds.items():
@@ -120,6 +131,27 @@ class Section:
 
     def check(self) -> None:
         """Cross-field rules; raise :class:`SettingError` naming the field."""
+
+
+_HINTS: dict[type, dict[str, Any]] = {}  # each section class's resolved field types, worked out once
+
+
+def _field_hints(cls: type) -> dict[str, Any]:
+    hints = _HINTS.get(cls)
+    if hints is None:
+        hints = _HINTS[cls] = typing.get_type_hints(cls)
+    return hints
+
+
+def _field_value(value: Any, hint: Any, name: str) -> Any:
+    """A section field's value as :func:`_coerce` reads it from a mapping (the same types and finiteness), for a
+    section made in Python; a value already of its type is returned as it is, without the general check."""
+    kind = type(value)
+    if (kind is hint and kind in (int, bool, str)) or (kind is float and hint is float and math.isfinite(value)):
+        return value
+    if dataclasses.is_dataclass(hint):  # a nested section: its owner's check() names what else it was given
+        return value
+    return _coerce(value, hint, name)
 
 
 def register_section(name: str, cls: type[T]) -> type[T]:
@@ -178,7 +210,9 @@ class Settings:
         """The section ``name``; raises :class:`ConfigError` listing the known ones."""
         try:
             return self._sections[name]
-        except KeyError:
+        except (KeyError, TypeError):  # TypeError: an unhashable name
+            if not isinstance(name, str):
+                raise ConfigError(f"a settings section is named by text, got {type(name).__name__}") from None
             raise ConfigError(f"unknown settings section {name!r}{_closest(name, self._sections)}; known: "
                               f"{', '.join(self._sections)}") from None  # fmt: skip
 
@@ -270,17 +304,19 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
             raise ConfigError(f"{where}: expected a mapping of settings, got {type(value).__name__}")
         return _build(typing.cast(type, hint), value, where)
     if hint is bool:
+        if isinstance(value, np.bool_):
+            value = bool(value)
         if not isinstance(value, bool):
             quoted = isinstance(value, str) and value.strip().lower() in YAML_BOOLEAN_WORDS
             why = " (text, as quoted: write true or false without quotes)" if quoted else ""
             raise ConfigError(f"{where}: expected true or false, got {value!r}{why}")
         return value
-    if hint is int:
-        if isinstance(value, bool) or not isinstance(value, int):
+    if hint is int:  # a numpy whole number (overrides handed over from arrays) as the Python one
+        if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
             raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}")
-        return value
+        return int(value)
     if hint is float:
-        if isinstance(value, bool) or not isinstance(value, (int, float)):
+        if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
             raise ConfigError(f"{where}: expected a number, got {_as_read(value, number=True)}")
         try:
             finite = math.isfinite(value)
@@ -363,6 +399,8 @@ def read_settings_file(path: str | Path) -> dict[str, Any]:
 
 def load_settings(path: str | Path, base: Settings | None = None) -> Settings:
     """Settings from a file laid over ``base`` (default: the defaults); errors name the file."""
+    if path is None:  # resolve_settings' "no file": here it would be the defaults, with no file read, unsaid
+        raise ConfigError("load_settings needs a settings file path, got None (the defaults are Settings())")
     return resolve_settings(config=path, base=base)
 
 
@@ -392,6 +430,15 @@ def resolve_settings(
     ConfigError
         Naming the profile or file and the key.
     """
+    for name, value in (("fruit", fruit), ("config", config)):  # a number or list is no name or path (TypeError)
+        if value is not None and not isinstance(value, str | bytes | os.PathLike):
+            raise ConfigError(f"{name} must be a profile name or a path, got {type(value).__name__}")
+    if isinstance(config, bytes):
+        config = os.fsdecode(config)
+    if isinstance(fruit, bytes):
+        fruit = os.fsdecode(fruit)
+    if base is not None and not isinstance(base, Settings):
+        raise ConfigError(f"base must be a Settings, got {type(base).__name__}")
     data = (base or Settings()).to_dict()
     if fruit is not None:
         from .profiles import profile_data

@@ -113,3 +113,15 @@ def test_the_box_of_points_is_the_tightest_that_contains_them(points):
     assert box.contains(points)
     # Every face of the box touches a point.
     assert np.array_equal(box.min, points.min(axis=0)) and np.array_equal(box.max, points.max(axis=0))
+
+
+def test_box_from_points_refuses_non_finite_points_and_box_functions_refuse_what_is_no_box():
+    with pytest.raises(InputError, match="hold NaN or infinite coordinates"):
+        Box.from_points([[0.0, 0.0, 0.3], [0.01, 0.01, np.nan]])  # before: a box of NaN corners
+    with pytest.raises(InputError, match="a box needs min and max of 3 numbers"):
+        Box("a", "b")  # before: ValueError from numpy
+    unit = Box(np.zeros(3), np.ones(3))
+    with pytest.raises(InputError, match="box_iou needs two Box"):
+        box_iou(unit, np.ones((2, 3)))  # before: TypeError comparing ndarray.max with ndarray.min
+    with pytest.raises(InputError, match="centre_deviation needs two Box"):
+        centre_deviation(np.zeros(3), unit)  # before: AttributeError

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from symfruit import Box, InputError
+from symfruit import Box, Camera, InputError
 from symfruit.core.frame import MAX_STAMP_NS, Frame
 
 from ..conftest import SMALL_CAM, disc_frame
@@ -60,3 +60,10 @@ def test_api_inputs_of_the_wrong_kind_or_units_are_refused(change, message):
     args = {"name": "f", "color": COLOR, "depth": DEPTH, "camera": SMALL_CAM, **change}
     with pytest.raises(InputError, match=message):
         Frame(**args)
+
+
+@pytest.mark.parametrize("name", [None, 5, b"frame"])
+def test_a_frame_name_that_is_no_text_is_refused(name):
+    cam = Camera(fx=50, fy=50, cx=4, cy=3, width=8, height=6)
+    with pytest.raises(InputError, match="a frame's name must be text"):  # before: taken, then the run's table
+        Frame(name, np.zeros((6, 8, 3), np.uint8), np.zeros((6, 8), np.float32), cam)  # refused the frame's record

@@ -142,3 +142,19 @@ def test_a_long_bad_value_is_shown_shortened_in_messages():
     ):  # before: every digit printed
         with pytest.raises(InputError, match=message):
             check_image_size(width, height, "w")
+
+
+def test_a_masked_arrays_masked_pixels_are_no_depth_and_background_not_the_values_under_the_mask():
+    from symfruit.core.limits import depth_metres, instance_labels, unmasked
+
+    depth = np.ma.masked_array(np.full((4, 5), 0.5, np.float32), mask=np.zeros((4, 5), bool))
+    depth.mask[1, 2] = True
+    got = depth_metres(depth, "frame f")
+    assert type(got) is np.ndarray and got[1, 2] == 0 and (got > 0).sum() == 19  # before: 0.5 m, as if measured
+    labels = np.ma.masked_array(np.arange(20).reshape(4, 5) % 3, mask=np.arange(20).reshape(4, 5) % 3 == 2)
+    got = instance_labels(labels, "frame f: masks")
+    assert set(np.unique(got).tolist()) == {0, 1}  # before: label 2 read from under its mask
+    assert unmasked(np.ma.masked_array([1, 2], mask=[False, True]), np.nan).tolist()[0] == 1.0
+    assert np.isnan(unmasked(np.ma.masked_array([1, 2], mask=[False, True]), np.nan)[1])
+    plain = np.ones(3)
+    assert unmasked(plain, 0) is plain and unmasked(np.ma.masked_array(plain), 0).tolist() == [1.0, 1.0, 1.0]

@@ -1,5 +1,7 @@
 """Point arrays at the core's boundary: normalisation (:func:`as_points`) and the fruit checks (:func:`check_cloud`)."""
 
+import re
+
 import numpy as np
 import pytest
 from hypothesis import given
@@ -198,3 +200,22 @@ def test_a_cloud_beyond_any_depth_cameras_reach_or_of_booleans_is_refused():
             check_cloud(np.vstack([front, [[0.01, 0.01, z]]]))
     with pytest.raises(InputError, match=r"points must be x, y, z in metres, got a boolean array"):
         check_cloud(front > 0.01)
+
+
+def test_a_masked_coordinate_is_none_and_its_row_dropped_not_the_value_under_the_mask():
+    rng = np.random.default_rng(3)
+    d = rng.normal(size=(600, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    front = 0.015 * d[d[:, 2] < 0] + [0.0, 0.0, 0.3]
+    pts = np.vstack([front, np.tile([0.5, 0.5, 2.0], (20, 1))])  # 20 stray points, their z masked
+    mask = np.zeros(pts.shape, bool)
+    mask[len(front) :, 2] = True
+    clean, dropped = check_cloud(np.ma.masked_array(pts, mask=mask))
+    assert dropped == 20 and len(clean) == len(front)  # before: the strays read, 'the cloud is 1.71 m across'
+    assert np.isnan(as_points(np.ma.masked_array(pts, mask=mask))[-1, 2])
+
+
+@pytest.mark.parametrize("dtype", ["datetime64[s]", "timedelta64[ms]"])
+def test_times_are_refused_as_points(dtype):
+    with pytest.raises(InputError, match=f"points must be x, y, z in metres, got {re.escape(dtype)} times"):
+        as_points(np.ones((20, 3)).astype(dtype))  # before: read as counts of seconds, 'behind the camera'

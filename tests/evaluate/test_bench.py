@@ -48,3 +48,14 @@ def test_a_frame_row_has_its_fastest_run_at_most_its_median():
 
     row = bench_frame(repeat=3, method="raw")
     assert row.repeat == 3 and 0 < row.min_ms <= row.median_ms <= row.p90_ms
+
+
+def test_bench_recording_refuses_an_unknown_method_and_a_detect_run_that_failed(tmp_path, monkeypatch):
+    from symfruit.errors import InputError, SymfruitError
+    from symfruit.evaluate import bench
+
+    with pytest.raises(InputError, match="unknown method 'nope'"):  # before: every frame failed, measured
+        bench.bench_recording(1, method="nope", workdir=tmp_path)
+    monkeypatch.setattr(bench, "measured_detect", lambda args: (2, float("nan"), "symfruit: error: boom\n"))
+    with pytest.raises(SymfruitError, match="detect exited with status 2: symfruit: error: boom"):
+        bench.bench_recording(1, workdir=tmp_path)  # before: '1 frames (0 written), peak RSS nan MB', exit 0

@@ -3,10 +3,12 @@ the camera protocol with occlusion, scan folders, and the full paper protocol (s
 
 import csv
 import json
+import re
 
 import numpy as np
 import pytest
 
+from symfruit.errors import InputError
 from symfruit.evaluate import evaluate
 
 #: one worker computes the module's expensive fixture once (pytest-xdist, --dist loadgroup; session scope, as
@@ -153,3 +155,36 @@ def test_camera_run_through_each_real_camera_on_the_proxies(sensor):
     assert sum(bool(r.error) for r in rows) <= 2
     raw = np.mean([r.iou for r in ev.rows if r.method == "raw" and not r.error])
     assert raw < np.mean([r.iou for r in rows if not r.error])
+
+
+@pytest.mark.parametrize(
+    ("kwargs", "message"),
+    [
+        ({"methods": ()}, "methods is empty"),
+        ({"fruits": []}, "fruits is empty"),
+        ({"methods": "sphere"}, "methods must be a list of names, got str"),  # before: six unknown methods s, p, h...
+        ({"fruits": "apple"}, "fruits must be a list of names, got str"),
+        ({"methods": ("raw", "raw")}, "methods lists 'raw' twice"),
+        ({"fruits": ("apple", "apple")}, "fruits lists 'apple' twice"),
+        ({"methods": ("nope",)}, "unknown method 'nope'"),  # before: a table row of errors
+        ({"protocol": "masks"}, "unknown protocol 'masks'"),  # before: ValueError
+        ({"n": 0}, "n must be a whole number 1-100000, got 0"),  # before: an empty table
+        ({"n": -1}, "n must be a whole number 1-100000, got -1"),
+        ({"n": 10**9}, "n must be a whole number 1-100000"),  # before: a billion instances
+        ({"n": 1.5}, "n must be a whole number"),  # before: TypeError from range()
+        ({"views": 0}, "views must be a whole number"),  # before: ValueError
+        ({"seed": -1}, "seed must be a whole number 0-"),
+        ({"jobs": 10**6}, "jobs must be a whole number 1-256"),
+        ({"occlusions": ()}, "occlusions must be a non-empty list"),
+        ({"occlusions": (float("nan"),)}, "occlusion levels must be numbers in [0, 1), got nan"),
+        ({"occlusions": (1.5,)}, "occlusion levels must be numbers in [0, 1), got 1.5"),
+        ({"sensor": "nope"}, "unknown sensor 'nope'"),  # before: ValueError
+        ({"poses": "uniform"}, "poses must be one of"),  # the paper protocol's own poses; before: ValueError
+        ({"settings": "apple"}, "settings must be a Settings"),  # before: every row an error
+    ],
+)
+def test_evaluate_refuses_arguments_it_cannot_run_with_before_any_work(kwargs, message, tmp_path):
+    args = {"protocol": "paper", "quick": True, "methods": ("raw",), "output": tmp_path / "r", "progress": False}
+    with pytest.raises(InputError, match=re.escape(message)):
+        evaluate(**{**args, **kwargs})
+    assert not (tmp_path / "r").exists()  # refused before a results folder was made

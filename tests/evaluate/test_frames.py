@@ -172,3 +172,13 @@ def test_found_fruit_can_be_matched_to_the_truth_by_their_masks_label(tmp_path):
     # a frame without its own masks file: the colour segmenter's labels are no truth ids, the frame is not scored
     scores, totals, failed = evaluate_frames(tmp_path, methods=("raw",), by_id=True)
     assert scores == [] and totals["frames"] == 0 and "no masks file to match the truth by label" in failed["a"]
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [({"masks": "missing.png"}, "no such file or folder"),
+                                                 ({"methods": ("raw", "nope")}, "unknown method 'nope'")])  # fmt: skip
+def test_evaluate_frames_refuses_masks_or_a_method_no_frame_can_use_before_any_frame(tmp_path, kwargs, message):
+    from symfruit import SymfruitError
+
+    shutil.copytree(EXAMPLE_FRAME, tmp_path / "a")
+    with pytest.raises(SymfruitError, match=message):  # before: every frame skipped with the reason, or errors
+        evaluate_frames(tmp_path, **kwargs)

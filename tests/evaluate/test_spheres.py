@@ -120,3 +120,10 @@ def test_frames_without_masks_files_are_left_out_and_a_segmenter_refused(tmp_pat
     for spec in ("color", "onnx:model.onnx"):
         with pytest.raises(InputError, match=rf"--masks {spec}: spheres are matched across frames by their mask ids"):
             evaluate_spheres(tmp_path, methods=("raw",), masks=spec)
+
+
+def test_evaluate_spheres_refuses_a_masks_path_that_does_not_exist_before_any_frame(tmp_path):
+    from symfruit import SymfruitError
+
+    with pytest.raises(SymfruitError, match="no such file or folder"):  # before: every frame skipped with it
+        evaluate_spheres(EXAMPLES / "real-frames", methods=("raw",), masks=str(tmp_path / "missing.png"))

@@ -528,3 +528,42 @@ def test_a_camera_info_whose_k_is_transposed_fails_its_frames_by_name(tmp_path):
     message = r"t: invalid CameraInfo on /camera/color/camera_info \(CameraInfo K \[600, 0, 0, 0, 600, 0, 80, 60, 1\]"
     with open_source(path) as src, pytest.raises(FileFormatError, match=message + " is not a pinhole"):
         src.read(0)  # before: read as cx = cy = 0, the fruit placed far off
+
+
+@pytest.mark.parametrize(
+    ("changes", "error"),
+    [
+        ({"height": 2.5}, "height, width and step must be whole numbers, got 2.5, 3, 9"),  # before: read as 2 rows
+        ({"width": "3"}, "height, width and step must be whole numbers, got 2, '3', 9"),  # before: text read as 3
+        ({"step": None}, "height, width and step must be whole numbers, got 2, 3, None"),
+        ({"data": None}, "image data must be bytes"),  # before: TypeError from bytes()
+        ({"data": "abcdefghijklmnopqr"}, "image data must be bytes"),  # before: TypeError
+        ({"data": [300] * 18}, "image data must be bytes"),  # before: ValueError 'bytes must be in range(0, 256)'
+        ({"data": 10**12}, "image data must be bytes"),  # before: bytes(10**12), a terabyte of zeros allocated
+    ],
+)
+def test_a_hand_made_message_of_sizes_or_data_of_other_types_is_refused_by_name(changes, error):
+    fields = {"height": 2, "width": 3, "step": 9, "encoding": "rgb8", "is_bigendian": 0, "data": bytes(18)}
+    with pytest.raises(FileFormatError, match=re.escape(error)):
+        image_array(SimpleNamespace(**{**fields, **changes}), "sensor_msgs/msg/Image")
+    rclpy_like = SimpleNamespace(**{**fields, "data": list(range(18))})  # rclpy's data: a list of 0-255 is read
+    assert image_array(rclpy_like, "sensor_msgs/msg/Image").shape == (2, 3, 3)
+
+
+@pytest.mark.parametrize("scale", [0, -0.001, float("nan"), float("inf"), 2.0, "0.001", None])
+def test_depth_image_refuses_a_depth_scale_that_is_no_metres_per_unit(scale):
+    from symfruit.io.bags import depth_image
+
+    msg = SimpleNamespace(height=1, width=2, step=4, encoding="16UC1", is_bigendian=0, data=bytes([232, 3, 0, 0]))
+    with pytest.raises(InputError, match=r"depth_scale must be metres per unit in \(0, 1\]"):  # before: NaN or
+        depth_image(msg, depth_scale=scale)  # negative metres, or no depth at all (0), or a TypeError (text)
+    assert depth_image(msg, depth_scale=0.001).tolist() == [[1.0, 0.0]]
+
+
+@pytest.mark.parametrize("size", [{"width": None}, {"height": "480"}, {"width": 640.5}])
+def test_camera_info_of_a_size_that_is_no_whole_number_is_refused_by_name(size):
+    from symfruit.io.bags import camera_from_info
+
+    info = SimpleNamespace(**{"width": 640, "height": 480, "K": [600.0, 0, 320, 0, 600, 240, 0, 0, 1], **size})
+    with pytest.raises(InputError, match="CameraInfo width and height must be whole numbers"):
+        camera_from_info(info)  # before: TypeError / ValueError from int(), or 640.5 read as 640

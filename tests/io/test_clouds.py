@@ -9,7 +9,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symfruit import FileFormatError, SymfruitError
+from symfruit import FileFormatError, InputError, SymfruitError
 from symfruit.io import read_cloud, write_ply
 
 from ..conftest import POINTS, lzf_compress, write_pcd
@@ -381,3 +381,35 @@ def test_a_pcd_of_negative_width_and_height_is_refused(tmp_path, shape):
         return
     with pytest.raises(FileFormatError, match=r"a\.pcd: PCD header garbles WIDTH/HEIGHT \(-2 x -1; counts are >= 0\)"):
         read_cloud(tmp_path / "a.pcd")  # before: -2 x -1 = 2 points read
+
+
+def test_a_npy_of_times_or_a_structured_npy_of_other_fields_than_numbers_is_refused(tmp_path):
+    np.save(tmp_path / "times.npy", np.ones((20, 3)).astype("timedelta64[ms]"))  # numpy counts it an integer
+    with pytest.raises(FileFormatError, match=r"expected a numeric \(n, 3\) array, got timedelta64\[ms\]"):
+        read_cloud(tmp_path / "times.npy")  # before: read as counts of milliseconds, 'the cloud is 28 m across'
+    fields = np.zeros(20, dtype=[("x", "f4"), ("y", "f4"), ("z", "?")])
+    np.save(tmp_path / "flags.npy", fields)
+    with pytest.raises(FileFormatError, match="structured array field 'z' is bool, not a number"):
+        read_cloud(tmp_path / "flags.npy")  # before: True/False read as 1 m / 0 m
+    fields = np.zeros(20, dtype=[("x", "f4"), ("y", "f4"), ("z", "i2")])
+    fields["z"] = 3
+    np.save(tmp_path / "ints.npy", fields)
+    assert read_cloud(tmp_path / "ints.npy")[:, 2].tolist() == [3.0] * 20
+
+
+@pytest.mark.parametrize(
+    ("points", "labels", "message"),
+    [
+        (np.zeros((4, 3)), np.array([0, 1, 255, 256]), r"labels must be 0-255 to fit the PLY's uchar, got 0 to 256"),
+        (np.zeros((4, 3)), np.array([-1, 0, 0, 0]), r"labels must be 0-255"),  # before: -1 written as 255
+        (np.zeros((4, 3)), np.zeros(3, np.uint8), r"labels must be 4 whole numbers, one a point"),  # ValueError
+        (np.zeros((4, 2)), None, r"points must have shape \(n, 3\), got \(4, 2\)"),  # before: IndexError
+        (np.full((4, 3), 1e300), None, r"beyond a 32-bit float's range"),  # before: written as infinity
+    ],
+)
+def test_write_ply_refuses_points_or_labels_it_would_write_as_something_else(tmp_path, points, labels, message):
+    with pytest.raises(InputError, match=message):
+        write_ply(tmp_path / "c.ply", points, labels=labels)
+    assert not (tmp_path / "c.ply").exists()
+    write_ply(tmp_path / "ok.ply", [[0.0, 0.0, 0.3]] * 4, labels=[0, 1, 1, 255])  # lists are read as arrays
+    assert read_cloud(tmp_path / "ok.ply").tolist() == [[0.0, 0.0, 0.30000001192092896]] * 4

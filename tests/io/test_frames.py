@@ -462,3 +462,24 @@ def test_the_depth_scale_an_intrinsics_file_states(tmp_path):
     (tmp_path / "cam.json").write_text(json.dumps({**CAM.to_dict(), "depth_scale": 7}))
     with pytest.raises(InputError, match=r"cam\.json: depth_scale must be metres per unit in \(0, 1\], got 7"):
         file_depth_scale(tmp_path / "cam.json")
+
+
+@pytest.mark.parametrize(
+    ("changes", "message"),
+    [
+        ({"depth_scale": 0}, r"depth_scale must be metres per unit in \(0, 1\], got 0"),  # before: 65535s written
+        ({"depth_scale": float("nan")}, r"depth_scale must be metres per unit in \(0, 1\], got nan"),
+        ({"depth": np.full((4, 5), 70.0, np.float32)}, "depth reaches 70 m, beyond 65535 units of 0.001 m"),
+        ({"depth": np.full((4, 5), 500, np.uint16)}, "depth is uint16; depth must be float metres"),
+        ({"color": np.zeros((4, 5, 3))}, r"colour must be \(h, w, 3\) uint8 RGB, got float64"),
+        ({"masks": np.full((4, 5), 70000)}, "masks hold label 70000; a 16-bit masks.png holds 0-65535"),  # wrapped
+        ({"masks": np.full((4, 5), -1)}, "masks hold negative labels"),  # before: written as 65535
+    ],
+)
+def test_write_frame_refuses_what_the_folder_would_read_back_as_something_else(tmp_path, changes, message):
+    camera = Camera(fx=100, fy=100, cx=2.5, cy=2, width=5, height=4)
+    args = {"color": np.zeros((4, 5, 3), np.uint8), "depth": np.full((4, 5), 0.5, np.float32), **changes}
+    kwargs = {k: args.pop(k) for k in ("depth_scale", "masks") if k in args}
+    with pytest.raises(InputError, match=message):
+        write_frame(tmp_path / "f", args["color"], args["depth"], camera, **kwargs)
+    assert not (tmp_path / "f").exists()  # refused before anything was written

@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 from pathlib import Path
 
 import numpy as np
@@ -154,3 +155,18 @@ def test_a_key_repeated_in_one_mapping_is_refused_naming_it(tmp_path):
         "a": {"x": 1}, "b": {"x": 2}, 1: "one", "1": "text"}  # fmt: skip
     (tmp_path / "ok.json").write_text('[{"x": 1}, {"x": 2}]')
     assert read_structured(tmp_path / "ok.json", what="file", max_bytes=1000) == [{"x": 1}, {"x": 2}]
+
+
+@pytest.mark.parametrize(
+    ("value", "form", "read"),
+    [("010", "octal (a leading 0)", "8"), ("1:30", "base 60 (colons)", "90"), ("-1:30.5", "base 60", "-90.5")],
+)
+def test_yaml_octal_and_base_60_numbers_are_refused_not_read_as_another_number(tmp_path, value, form, read):
+    path = tmp_path / "settings.yaml"
+    path.write_text(f"input:\n  min_points: {value}\n")
+    with pytest.raises(FileFormatError, match=re.escape(f"{value} is a YAML 1.1 {form}") + ".*" + f"read as {read}"):
+        read_structured(path, what="settings file", max_bytes=1 << 20)  # before: 8, 90 or -90.5 in silence
+    path.write_text("a: 10\nb: 0\nc: 0x10\nd: 1_000\ne: 0.5\nf: '010'\ng: -7\n")
+    assert read_structured(path, what="settings file", max_bytes=1 << 20) == {
+        "a": 10, "b": 0, "c": 16, "d": 1000, "e": 0.5, "f": "010", "g": -7
+    }  # fmt: skip

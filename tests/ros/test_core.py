@@ -352,3 +352,13 @@ def test_live_camera_info_with_a_transposed_k_is_refused():
     info = SimpleNamespace(width=64, height=48, header=header(), K=[600.0, 0, 0, 0, 600, 0, 32, 24, 1])
     with pytest.raises(InputError, match=r"CameraInfo K \[600, 0, 0, 0, 600, 0, 32, 24, 1\] is not a pinhole"):
         frame_of(color, depth, info)  # before: a frame of cx = cy = 0
+
+
+@pytest.mark.parametrize("scale", [0, -0.001, float("nan"), float("inf"), 10])
+def test_a_depth_scale_parameter_that_is_no_metres_per_unit_is_refused_at_start(scale):
+    from symfruit.ros.core import checked_parameters
+
+    # before: taken, and every frame's depth read as none (0, negative, NaN) or thousands of metres, each logged
+    with pytest.raises(SymfruitError, match=r"parameter depth_scale: expected metres per unit in \(0, 1\]"):
+        checked_parameters({"depth_scale": scale})
+    assert checked_parameters({"depth_scale": 0.0001})["depth_scale"] == 0.0001

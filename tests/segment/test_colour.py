@@ -1036,3 +1036,32 @@ def test_the_id_maps_hold_every_id():
         info = np.iinfo(_id_type(n))
         assert info.min <= -1 and n <= info.max
     assert _id_type(30) == np.int16
+
+
+@pytest.mark.parametrize(
+    ("scale", "dtype", "message"),
+    [
+        (257, np.uint16, r"color must be 8-bit \(0-255\), got values 0 to 65535 \(uint16; 16-bit colour"),
+        (1 / 255, np.float64, r"got float64 0 to 1 \(a float image in \[0, 1\]: multiply by 255"),
+        (0.5 / 255, np.float32, r"got float32 0 to 0.5 \(a float image in \[0, 1\]"),
+        (-1, np.int16, r"color must be 8-bit \(0-255\), got values -255 to 0"),
+    ],
+)
+def test_colour_of_other_values_than_8_bit_is_refused_not_cut_into_0_255(scale, dtype, message):
+    img = np.zeros((40, 50, 3), np.float64)
+    img[..., 0] = 255
+    img[10:20, 10:20] = (0, 255, 0)
+    with pytest.raises(InputError, match=message):  # before: clipped, 16-bit read as white, [0, 1] as black
+        segment((img * scale).astype(dtype))
+    # 8-bit values in another type are read as they are (a list, int64, whole floats): the same labels
+    as_uint8 = segment(img.astype(np.uint8))
+    assert np.array_equal(segment(img.astype(np.int64)), as_uint8) and np.array_equal(segment(img), as_uint8)
+
+
+def test_segment_refuses_a_camera_or_settings_of_another_type_by_name():
+    img = np.zeros((40, 50, 3), np.uint8)
+    depth = np.full((40, 50), 0.5, np.float32)
+    with pytest.raises(InputError, match="segment: camera must be a Camera with numbers fx, fy"):
+        segment(img, depth, "camera.json")  # before: AttributeError: 'str' object has no attribute 'fx'
+    with pytest.raises(InputError, match="segment: settings must be a SegmentSettings"):
+        segment(img, settings={"dark": 10})  # before: AttributeError

@@ -160,3 +160,18 @@ def test_a_label_png_must_turn_on_reading_as_its_colour_image_did(photo, tmp_pat
             source(color, name=name, color_file=(tmp_path / "p0.jpg", 1))
         got = source(color, name=name, color_file=(tmp_path / "p0.jpg", 4))[0]
         assert np.array_equal(got, labels[::-1])
+
+
+@pytest.mark.parametrize("spec", ["missing.png", "foo:bar", "maskrcnn:", "nowhere/"])
+def test_a_masks_spec_naming_no_file_or_folder_is_refused_when_the_source_is_made(tmp_path, spec):
+    # before: a source made, then every frame failed with 'no such image'
+    with pytest.raises(InputError, match="no such file or folder"):
+        mask_source(str(tmp_path / spec) if "/" in spec or "." in spec else spec)
+
+
+def test_a_masks_file_that_is_no_png_or_json_is_refused_when_the_source_is_made(tmp_path):
+    from symfruit import FileFormatError
+
+    (tmp_path / "labels.tif").write_bytes(b"")
+    with pytest.raises(FileFormatError, match=r"labels\.tif: masks must be a label \.png or a COCO \.json"):
+        mask_source(tmp_path / "labels.tif")

@@ -25,7 +25,11 @@ class Box:
     max: np.ndarray
 
     def __post_init__(self) -> None:
-        lo, hi = (np.asarray(v, dtype=np.float64) for v in (self.min, self.max))
+        try:
+            lo, hi = (np.asarray(v, dtype=np.float64) for v in (self.min, self.max))
+        except (TypeError, ValueError):
+            given = f"{self.min!r:.40} and {self.max!r:.40}"
+            raise InputError(f"a box needs min and max of 3 numbers, got {given}") from None
         if lo.shape != (3,) or hi.shape != (3,):
             raise InputError(f"a box needs min and max of shape (3,), got {lo.shape} and {hi.shape}")
         object.__setattr__(self, "min", lo)
@@ -38,10 +42,14 @@ class Box:
         Raises
         ------
         InputError
-            When ``points`` is not an ``(n, 3)`` array with at least one row.
+            When ``points`` is not an ``(n, 3)`` array with at least one row, or holds NaN or infinity (no box
+            bounds them: drop those rows first).
         """
         points = as_points(points, min_count=1)
-        return cls(*bounds(points))
+        lo, hi = bounds(points)
+        if not (np.isfinite(lo).all() and np.isfinite(hi).all()):  # NaN would make a box of NaN corners unsaid
+            raise InputError("points to box hold NaN or infinite coordinates; drop those rows first")
+        return cls(lo, hi)
 
     @property
     def centre(self) -> np.ndarray:
@@ -85,6 +93,7 @@ def box_iou(a: Box, b: Box) -> float:
     >>> box_iou(unit, Box(np.array([0.5, 0, 0]), np.array([1.5, 1, 1])))
     0.3333333333333333
     """
+    _boxes(a, b, "box_iou")
     overlap = np.clip(np.minimum(a.max, b.max) - np.maximum(a.min, b.min), 0.0, None)
     inter = float(np.prod(overlap))
     union = a.volume + b.volume - inter
@@ -93,4 +102,12 @@ def box_iou(a: Box, b: Box) -> float:
 
 def centre_deviation(a: Box, b: Box) -> float:
     """Euclidean distance between the two box centres, metres."""
+    _boxes(a, b, "centre_deviation")
     return float(np.linalg.norm(a.centre - b.centre))
+
+
+def _boxes(a: object, b: object, what: str) -> None:
+    """Refuse anything but two :class:`Box` (arrays have ``max`` and ``min`` methods, not corners)."""
+    for box in (a, b):
+        if not isinstance(box, Box):
+            raise InputError(f"{what} needs two Box (symfruit.Box or Box.from_points), got {type(box).__name__}")

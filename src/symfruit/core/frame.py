@@ -60,6 +60,8 @@ class Frame:
     visible: dict[int, float] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
+        if not isinstance(self.name, str):  # written into detections.json and the run's tables as text
+            raise InputError(f"a frame's name must be text, got {type(self.name).__name__} {self.name!r:.40}")
         if not isinstance(self.camera, Camera):
             raise InputError(f"frame {self.name}: camera must be a symfruit Camera (symfruit.Camera or "
                              f"symfruit.io.camera_from_dict), got {type(self.camera).__name__}")  # fmt: skip

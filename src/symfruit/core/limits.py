@@ -42,6 +42,7 @@ __all__ = [
     "depth_metres",
     "instance_labels",
     "shown",
+    "unmasked",
 ]
 
 #: Largest image side (pixels) and largest image (pixels), for every image (colour, depth, labels, a bag or
@@ -137,19 +138,38 @@ def check_image_size(
     return w, h
 
 
+def unmasked(values: Any, fill: Any) -> np.ndarray:
+    """``values`` as an array, the masked entries of a :class:`numpy.ma.MaskedArray` set to ``fill`` (no
+    measurement: no depth, background, a point to drop); ``np.asarray`` alone would hand over the values the mask
+    hides, as if measured. Anything else is ``np.asarray(values)``.
+
+    Examples
+    --------
+    >>> unmasked(np.ma.masked_array([1.0, 2.0], mask=[False, True]), 0.0).tolist()
+    [1.0, 0.0]
+    """
+    if isinstance(values, np.ma.MaskedArray):
+        if np.ma.getmask(values) is np.ma.nomask:
+            return np.asarray(values.data)
+        if values.dtype.kind in "iub" and isinstance(fill, float) and not fill.is_integer():
+            values = values.astype(np.float64)  # NaN for an integer array's masked entries
+        return np.asarray(values.filled(fill))
+    return np.asarray(values)
+
+
 def instance_labels(labels: Any, what: str, *, error: type[SymfruitError] = InputError) -> np.ndarray:
     """Instance labels as ``(h, w) int32`` (0 background), checked: a 2-D image of whole numbers in
     0-:data:`MAX_LABEL_ID` holding at most :data:`MAX_INSTANCES` fruit, within the image bounds.
 
     Ids beyond 32 bits are refused, never truncated (truncation would merge two fruit or drop one); bool
-    masks are one fruit.
+    masks are one fruit; a masked pixel of a :class:`numpy.ma.MaskedArray` is background.
 
     Raises
     ------
     error
         Naming ``what`` and the problem.
     """
-    arr = np.asarray(labels)
+    arr = unmasked(labels, 0)  # a masked pixel (numpy.ma) is background, not its hidden label
     if arr.ndim != 2:
         raise error(f"{what}: instance labels must be an (h, w) image, got shape {arr.shape}")
     check_image_size(arr.shape[1], arr.shape[0], what, error=error)
@@ -178,14 +198,15 @@ def instance_labels(labels: Any, what: str, *, error: type[SymfruitError] = Inpu
 def depth_metres(depth: Any, what: str, *, error: type[SymfruitError] = InputError) -> np.ndarray:
     """A depth image handed over as metres, checked: ``(h, w)`` floating point within the image bounds, and
     not raw sensor units (integer images, or typical values beyond :data:`MAX_DEPTH_METRES`, are millimetres
-    or another unit: multiply by the depth scale first). 0 or NaN is "no depth".
+    or another unit: multiply by the depth scale first). 0 or NaN is "no depth", as is a masked pixel of a
+    :class:`numpy.ma.MaskedArray`.
 
     Raises
     ------
     error
         Naming ``what`` and the problem.
     """
-    arr = np.asarray(depth)
+    arr = unmasked(depth, 0)  # a masked pixel (numpy.ma) is no depth, not the value hidden under the mask
     if arr.ndim != 2:
         raise error(f"{what}: depth must be a 2-D image, got shape {arr.shape}")
     check_image_size(arr.shape[1], arr.shape[0], what, error=error)

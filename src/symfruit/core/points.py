@@ -14,7 +14,7 @@ import numpy as np
 
 from ..errors import InputError
 from .kernels import compiled
-from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES
+from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES, unmasked
 
 __all__ = [
     "as_points",
@@ -102,6 +102,9 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     InputError
         When ``points`` is not numeric, not real, not ``(n, 3)``, or has fewer than ``min_count`` rows.
 
+    A masked coordinate of a :class:`numpy.ma.MaskedArray` is NaN (no measurement: :func:`check_cloud` drops its
+    row and counts it), never the value the mask hides.
+
     Examples
     --------
     >>> as_points([[0, 0, 1]]).dtype
@@ -111,6 +114,10 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
         raise InputError(f"{name} must be real numbers, got a complex array")
     if isinstance(points, np.ndarray) and points.dtype.kind == "b":  # True/False would read as 1 m / 0 m
         raise InputError(f"{name} must be x, y, z in metres, got a boolean array (a mask?)")
+    if isinstance(points, np.ndarray) and points.dtype.kind in "mM":  # numpy reads them as counts of time units
+        raise InputError(f"{name} must be x, y, z in metres, got {points.dtype} times")
+    if isinstance(points, np.ma.MaskedArray) and points.dtype.kind in "iuf":
+        points = unmasked(points, np.nan)  # a masked coordinate is none: its row dropped as non-finite
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):

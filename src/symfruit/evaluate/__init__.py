@@ -6,14 +6,20 @@
 
 from __future__ import annotations
 
+import os
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
+from ..core.limits import shown
+from ..errors import InputError
 from ..settings import Settings
+from ..synthetic.sensors import SENSOR_MODELS
 from ..synthetic.shapes import FRUITS
-from .protocols import PAPER_ANGLES, Spec, build, skipped_scans, specs
+from .protocols import PAPER_ANGLES, POSES, SENSORS, Spec, build, skipped_scans, specs
 from .report import markdown_table, write_results
 from .runner import Row, run, summarise
 
@@ -66,9 +72,20 @@ def evaluate(
 
     Settings: ``settings`` for every fruit if given; otherwise each fruit kind's shipped profile
     (:mod:`symfruit.profiles`), with the settings file ``config`` laid over it.
+
+    Raises
+    ------
+    InputError
+        Before any work, for an argument the evaluation cannot run with (as ``symfruit evaluate`` checks its
+        options): an unknown protocol, method, sensor or poses; ``fruits`` or ``methods`` empty, repeating a name
+        or given as one string; ``n`` or ``views`` not 1-100000; ``jobs`` not 1-256; ``seed`` not 0 to 2**63 - 1;
+        an occlusion level outside [0, 1).
     """
     from ..profiles import available_profiles
     from ..settings import resolve_settings
+
+    fruits, methods, occlusions = _check_arguments(protocol, fruits, methods, n, seed, occlusions, sensor, poses, views,
+                                                   jobs, settings)  # fmt: skip
 
     def settings_for(fruit: str) -> Settings:
         if settings is not None:
@@ -123,3 +140,84 @@ def evaluate(
         write_json(folder / "settings.json", meta)
         write_results(folder, rows, summary, protocol=protocol, meta={**meta, "confidence": pooled}, table=table)
     return Evaluation(folder=folder, rows=rows, summary=summary, table=table, skipped=skipped)
+
+
+#: Most fruits (views) :func:`evaluate` generates per kind and occlusion level, and most views of a fruit: the
+#: bounds ``symfruit evaluate --n`` and ``--views`` check; and most worker processes (``--jobs``).
+MAX_N = 100_000
+MAX_JOBS = 256
+
+
+def _names(values: Any, what: str) -> list[str]:
+    """``values`` as a non-empty list of distinct texts (a path for a fruit is taken as its text); a bare string
+    is refused (it would be read a character at a time), as are an empty list and repeats."""
+    if isinstance(values, str | bytes) or not isinstance(values, Sequence):
+        raise InputError(f"evaluate: {what} must be a list of names, got {type(values).__name__} "
+                         f"{shown(values)}")  # fmt: skip
+    out = []
+    for value in values:
+        if isinstance(value, os.PathLike) and what == "fruits":
+            value = os.fspath(value)
+        if not isinstance(value, str) or not value.strip():
+            raise InputError(f"evaluate: {what} must be names, got {shown(value)}")
+        if value in out:
+            raise InputError(f"evaluate: {what} lists {value!r} twice")
+        out.append(value)
+    if not out:
+        raise InputError(f"evaluate: {what} is empty; name at least one")
+    return out
+
+
+def _whole(value: Any, what: str, low: int, high: int) -> None:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or not low <= value <= high:
+        raise InputError(f"evaluate: {what} must be a whole number {low}-{high}, got {shown(value)}")
+
+
+def _check_arguments(
+    protocol: Any, fruits: Any, methods: Any, n: Any, seed: Any, occlusions: Any, sensor: Any, poses: Any, views: Any,
+    jobs: Any, settings: Any,
+) -> tuple[list[str], list[str], list[float]]:  # fmt: skip
+    """The arguments of :func:`evaluate` checked before any work, as ``symfruit evaluate`` checks its options:
+    ``(fruits, methods, occlusions)`` as lists. An empty list of fruits or methods, or ``n`` of 0, would evaluate
+    nothing and write an empty table; an unknown method, a row of errors per instance.
+
+    Raises
+    ------
+    InputError
+        Naming the argument and the value.
+    """
+    from ..methods import get
+
+    if protocol not in ("paper", "camera"):
+        raise InputError(f"evaluate: unknown protocol {shown(protocol)}; use paper or camera (the masks protocol: "
+                         "symfruit.evaluate.masks)")  # fmt: skip
+    fruits = _names(fruits, "fruits")
+    methods = _names(methods, "methods")
+    for method in methods:
+        get(method)  # an unknown one refused by name, with the registered ones
+    if n is not None:
+        _whole(n, "n", 1, MAX_N)
+    _whole(views, "views", 1, MAX_N)
+    if jobs is not None:
+        _whole(jobs, "jobs", 1, MAX_JOBS)
+    if not isinstance(sensor, str) or (sensor not in SENSORS and sensor not in SENSOR_MODELS):
+        raise InputError(f"evaluate: unknown sensor {shown(sensor)}; known: {', '.join([*SENSORS, *SENSOR_MODELS])}")
+    if poses not in POSES or (protocol == "paper" and poses == "uniform"):
+        raise InputError(f"evaluate: poses must be one of {', '.join(POSES)} (uniform: the camera protocol's), got "
+                         f"{shown(poses)}")  # fmt: skip
+    _whole(seed, "seed", 0, 2**63 - 1)
+    if isinstance(occlusions, str | bytes) or not isinstance(occlusions, Sequence | np.ndarray) or not len(occlusions):
+        raise InputError(f"evaluate: occlusions must be a non-empty list of levels in [0, 1), got {shown(occlusions)}")
+    levels = []
+    for level in occlusions:
+        if (
+            isinstance(level, bool)
+            or not isinstance(level, int | float | np.integer | np.floating)
+            or not (0.0 <= level < 1.0)
+        ):
+            raise InputError(f"evaluate: occlusion levels must be numbers in [0, 1), got {shown(level)}")
+        levels.append(float(level))
+    if settings is not None and not isinstance(settings, Settings):
+        raise InputError(f"evaluate: settings must be a Settings (symfruit.resolve_settings) or None, got "
+                         f"{type(settings).__name__}")  # fmt: skip
+    return fruits, methods, levels

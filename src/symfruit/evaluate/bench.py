@@ -404,6 +404,10 @@ def bench_recording(
     import sys
     import tempfile
 
+    from ..errors import SymfruitError
+    from ..methods import get
+
+    get(method)  # an unknown method refused before the recording is made, not measured as frames that all fail
     with tempfile.TemporaryDirectory(dir=workdir) as tmp:
         from ..synthetic.scenes import write_scenes
 
@@ -412,16 +416,17 @@ def bench_recording(
         out = Path(tmp) / "out"
         if workers is None:
             start = time.perf_counter()
-            _, peak, _ = measured_detect([str(rec), "--output", str(out), "--method", method])
+            status, peak, err = measured_detect([str(rec), "--output", str(out), "--method", method])
             seconds = time.perf_counter() - start
+            if status != 0:  # a run that failed is no measurement: before, '0 written, peak RSS nan MB', exit 0
+                said = err.strip().splitlines()[-1:] or ["(nothing on stderr)"]
+                raise SymfruitError(f"bench --recording: detect exited with status {status}: {said[0]}")
             done = len(list(out.glob("*/detections.json")))
             return RecordingRow(frames, method, seconds, peak, done)
         proc = subprocess.run([sys.executable, "-c", _MEASURED_CLUSTER, str(rec), str(out), method, str(workers)],
                               capture_output=True, text=True, check=False)  # fmt: skip
         lines = proc.stdout.strip().splitlines()
         if proc.returncode != 0 or not lines:
-            from ..errors import SymfruitError
-
             raise SymfruitError(f"the cluster benchmark failed: {proc.stderr.strip()[-500:]}")
         data = json.loads(lines[-1])
     return RecordingRow(frames, method, float(data["seconds"]), float(data["client"]), int(data["done"]), workers,

@@ -126,6 +126,7 @@ def evaluate_frames(
     """Table 3 on a recording: scores, summed detection counts, and frames that failed (with reasons); ``gate``
     and ``by_id``: how found fruit are matched to the truth (:func:`score_frame`)."""
     settings = settings or Settings()
+    _check_run(methods, masks, settings)
     scores: list[FrameScore] = []
     totals = {"frames": 0, "truth": 0, "found": 0, "matched": 0, "missed": 0, "false": 0}
     failed: dict[str, str] = {}
@@ -233,3 +234,15 @@ def summary_dict(scores: Sequence[FrameScore], totals: dict[str, int], failed: d
 
     return {"totals": totals, "failed": failed,
             "scores": [{k: plain(v) for k, v in s.__dict__.items()} for s in scores]}  # fmt: skip
+
+
+def _check_run(methods: Sequence[str], masks: Any, settings: Settings) -> None:
+    """Refuse, before any frame, an unknown method or a masks spec no frame can use (an empty one, a file or folder
+    that does not exist, a model or its extra missing): otherwise every frame is skipped with the same reason."""
+    from ..methods.registry import get
+    from ..segment import mask_source
+
+    for method in methods:
+        get(method)
+    if isinstance(masks, str | Path):
+        mask_source(masks, settings=settings)

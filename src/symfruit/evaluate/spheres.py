@@ -23,6 +23,7 @@ from ..detect import detect
 from ..errors import InputError, SymfruitError
 from ..io.sources import open_source
 from ..settings import Settings
+from .frames import _check_run
 
 __all__ = ["SphereBox", "evaluate_spheres", "spheres_table"]
 
@@ -84,6 +85,7 @@ def evaluate_spheres(
                          "numbers anew in every frame; give mask files with the same id for a sphere in every "
                          "frame (auto: each frame's masks.png or masks.json)")  # fmt: skip
     settings = settings or Settings()
+    _check_run(methods, masks, settings)  # before any frame: not every frame skipped with the same reason
     out: list[SphereBox] = []
     src = open_source(source)
     try:

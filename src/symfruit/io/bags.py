@@ -29,7 +29,7 @@ import numpy as np
 
 from ..core.camera import Camera
 from ..core.frame import MAX_STAMP_NS, Frame
-from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size
+from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size, shown
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
@@ -95,11 +95,11 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
         raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of "
                               f"{', '.join([*_ENCODINGS, *_YUV422])})")  # fmt: skip
     dtype, channels = _ENCODINGS.get(enc, (np.uint8, 2))
-    try:
-        h, w, step = int(msg.height), int(msg.width), int(msg.step)
-    except (TypeError, ValueError, OverflowError, AttributeError):
-        sizes = ", ".join(repr(getattr(msg, k, None)) for k in ("height", "width", "step"))
-        raise FileFormatError(f"image height, width and step must be whole numbers, got {sizes}") from None
+    sizes = [getattr(msg, k, None) for k in ("height", "width", "step")]
+    h, w, step = (_whole(v) for v in sizes)
+    if h is None or w is None or step is None:  # a fraction is not cut to its whole part, nor text read as a number
+        raise FileFormatError(f"image height, width and step must be whole numbers, got "
+                              f"{', '.join(shown(v) for v in sizes)}")  # fmt: skip
     if h <= 0 or w <= 0 or h * w > MAX_MESSAGE_PIXELS:
         raise FileFormatError(f"image of {w}x{h} pixels is empty or larger than {MAX_MESSAGE_PIXELS:,} pixels")
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
@@ -109,7 +109,7 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     row_bytes = w * channels * dt.itemsize
     if step < row_bytes:
         raise FileFormatError(f"image step {step} is shorter than a row of {w} {enc} pixels ({row_bytes} bytes)")
-    data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
+    data = np.frombuffer(_message_bytes(getattr(msg, "data", None)), dtype=np.uint8)
     if len(data) < h * step:
         raise FileFormatError(f"image data holds {len(data)} bytes, {h} rows of {step} need {h * step}")
     rows = data[: h * step].reshape(h, step)
@@ -119,6 +119,30 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if enc.startswith("bgr"):
         img = img[:, :, [2, 1, 0]]
     return img[:, :, 0] if channels == 1 else img[:, :, :3]
+
+
+def _whole(value: Any) -> int | None:
+    """A message's size field as an int: whole numbers only (uint32 in every ROS message; a hand-made message's
+    48.5, "48" or None is no size). None for anything else."""
+    if isinstance(value, bool) or not isinstance(value, int | np.integer | float | np.floating):
+        return None
+    if isinstance(value, float | np.floating) and not float(value).is_integer():
+        return None
+    return int(value)
+
+
+def _message_bytes(data: Any) -> bytes:
+    """A message's ``data`` as bytes (``bytes`` in rospy and rosbags, ``array('B')`` or a list of 0-255 in
+    rclpy); anything else refused, not a ``TypeError`` from ``bytes`` (None, text, values beyond a byte), nor a
+    whole number taken as a count of zero bytes to allocate (``bytes(10**12)``)."""
+    if isinstance(data, bytes):
+        return data
+    if not isinstance(data, int | np.integer | str):
+        try:
+            return bytes(data)
+        except (TypeError, ValueError):
+            pass
+    raise FileFormatError(f"image data must be bytes (uint8[]), got {type(data).__name__}")
 
 
 def yuv422_rgb(rows: np.ndarray, order: tuple[int, int, int, int]) -> np.ndarray:
@@ -166,7 +190,15 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
     ------
     FileFormatError
         For anything :func:`image_array` refuses, or an image that is not one-channel depth.
+    InputError
+        For a ``depth_scale`` that is not metres per unit in (0, 1].
     """
+    if (
+        isinstance(depth_scale, bool)
+        or not isinstance(depth_scale, int | float | np.integer | np.floating)
+        or not (0 < depth_scale <= 1)
+    ):  # a frame's camera.json's rule: 0, a negative or NaN scale would read every pixel as no depth
+        raise InputError(f"depth_scale must be metres per unit in (0, 1], got {shown(depth_scale)}")
     raw = image_array(msg, typename)
     if raw.ndim != 2:
         raise FileFormatError(f"depth image has {raw.shape[2]} channels, expected 1")
@@ -210,7 +242,11 @@ def camera_from_info(
     if len(k) != 9:
         raise InputError("CameraInfo has no 3x3 K matrix")
     key, coeffs = info_distortion(msg)
-    w, h = int(msg.width) or (width or 0), int(msg.height) or (height or 0)
+    sizes = (getattr(msg, "width", None), getattr(msg, "height", None))
+    w, h = (_whole(v) for v in sizes)
+    if w is None or h is None:  # uint32 in the message; a hand-made one's None or "640" is no size, 2.5 not 2
+        raise InputError(f"CameraInfo width and height must be whole numbers, got {', '.join(shown(v) for v in sizes)}")
+    w, h = w or (width or 0), h or (height or 0)
     camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
     check_pinhole_matrix(k, "CameraInfo K")  # row-major; a transposed one would read cx = cy = 0
     if source is not None:

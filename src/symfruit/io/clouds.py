@@ -17,7 +17,7 @@ from typing import Any
 import numpy as np
 
 from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
-from ..errors import FileFormatError
+from ..errors import FileFormatError, InputError
 from .atomic import atomic_write
 from .text import as_path, refuse_pipe
 
@@ -508,8 +508,12 @@ def read_npy(path: Path) -> np.ndarray:
         missing = [c for c in ("x", "y", "z") if c not in arr.dtype.names]
         if missing:
             raise FileFormatError(f"{path}: structured array lacks field {missing[0]!r}")
+        for c in ("x", "y", "z"):  # numbers only: a bool, a time or text would be read as metres by the cast
+            if arr.dtype[c].kind not in "iuf":
+                raise FileFormatError(f"{path}: structured array field {c!r} is {arr.dtype[c]}, not a number")
         return np.column_stack([np.asarray(arr[c], dtype=np.float64) for c in ("x", "y", "z")])
-    if arr.ndim != 2 or arr.shape[1] < 3 or not np.issubdtype(arr.dtype, np.number):
+    # numpy counts timedelta64 among its integers: a time is no coordinate (read as a count of its units)
+    if arr.ndim != 2 or arr.shape[1] < 3 or arr.dtype.kind not in "iufc":
         raise FileFormatError(f"{path}: expected a numeric (n, 3) array, got {arr.dtype} {arr.shape}")
     if np.iscomplexobj(arr):
         raise FileFormatError(f"{path}: complex numbers cannot be coordinates")
@@ -533,8 +537,30 @@ def write_ply(path: str | Path, points: np.ndarray, *, labels: np.ndarray | None
 
     ``labels`` : (n,) int, optional, is stored as a ``uchar`` property ``label`` (symfruit writes 0 for
     visible and 1 for completed points) and is ignored by viewers that do not know it.
+
+    Raises
+    ------
+    InputError
+        Before anything is written: ``points`` not ``(n, 3)`` numbers, or beyond a 32-bit float's range (written as
+        infinity); ``labels`` not ``n`` whole numbers in 0-255 (a ``uchar`` would wrap 256 to 0 and -1 to 255).
     """
     from plyfile import PlyData, PlyElement
+
+    from ..core.points import as_points
+
+    points = as_points(points, min_count=0, name=f"{path}: points")
+    with np.errstate(invalid="ignore"):
+        if (np.abs(points) > np.finfo(np.float32).max).any():
+            raise InputError(f"{path}: points beyond a 32-bit float's range ({np.abs(points).max():g}) cannot be "
+                             "written to a float PLY")  # fmt: skip
+    if labels is not None:
+        labels = np.asarray(labels)
+        if labels.shape != (len(points),) or labels.dtype.kind not in "biu":
+            raise InputError(f"{path}: labels must be {len(points)} whole numbers, one a point, got {labels.dtype} "
+                             f"{labels.shape}")  # fmt: skip
+        if labels.size and (int(labels.min()) < 0 or int(labels.max()) > 255):
+            raise InputError(f"{path}: labels must be 0-255 to fit the PLY's uchar, got {int(labels.min())} to "
+                             f"{int(labels.max())}")  # fmt: skip
 
     fields = [("x", "f4"), ("y", "f4"), ("z", "f4")]
     if labels is not None:

@@ -30,7 +30,16 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.frame import Frame
-from ..core.limits import MAX_DEPTH_METRES, MAX_IMAGE_PIXELS, MAX_LABEL_ID, MAX_TRUTH_BYTES, check_image_size, shown
+from ..core.limits import (
+    MAX_DEPTH_METRES,
+    MAX_IMAGE_PIXELS,
+    MAX_LABEL_ID,
+    MAX_TRUTH_BYTES,
+    check_image_size,
+    depth_metres,
+    instance_labels,
+    shown,
+)
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
@@ -271,10 +280,39 @@ def write_frame(
     folder: str | Path, color: np.ndarray, depth: np.ndarray, camera: Camera, *, truth: dict | None = None,
     masks: np.ndarray | None = None, depth_scale: float = DEFAULT_DEPTH_SCALE,
 ) -> Path:  # fmt: skip
-    """Write a frame folder: colour PNG, 16-bit depth PNG, camera.json (with depth_scale), truth, masks."""
+    """Write a frame folder: colour PNG, 16-bit depth PNG, camera.json (with depth_scale), truth, masks.
+
+    Raises
+    ------
+    InputError
+        Before anything is written, for what the folder could not hold as given (it would be read back as something
+        else): a ``depth_scale`` that is not metres per unit in (0, 1] (as :func:`read_frame` requires), depth that
+        is not float metres or reaches beyond 65535 units of it, colour that is not ``(h, w, 3)`` uint8, masks that
+        are no instance labels or hold an id beyond 65535 (a 16-bit PNG's).
+    """
     from PIL import Image
 
     folder = Path(folder)
+    what = f"write_frame {folder}"
+    if (
+        isinstance(depth_scale, bool)
+        or not isinstance(depth_scale, int | float | np.integer | np.floating)
+        or not (0 < depth_scale <= 1)
+    ):  # before: 0 wrote a depth image of 65535s and a camera.json read_frame refuses, NaN garbage units
+        raise InputError(f"{what}: depth_scale must be metres per unit in (0, 1], got {shown(depth_scale)}")
+    color = np.asarray(color)
+    if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
+        raise InputError(f"{what}: colour must be (h, w, 3) uint8 RGB, got {color.dtype} {color.shape}")
+    depth = depth_metres(depth, what)
+    with np.errstate(invalid="ignore"):
+        far = float(np.nanmax(np.where(np.isfinite(depth), depth, np.nan), initial=0.0))
+    if far / depth_scale > 65535.5:  # clipped before: the far depth written as 65535 units in silence
+        raise InputError(f"{what}: depth reaches {far:g} m, beyond 65535 units of {depth_scale:g} m; use a larger "
+                         "depth_scale")  # fmt: skip
+    if masks is not None:
+        masks = instance_labels(masks, f"{what}: masks")
+        if masks.size and int(masks.max()) > 65535:  # before: wrapped into another fruit's id by astype(uint16)
+            raise InputError(f"{what}: masks hold label {int(masks.max())}; a 16-bit masks.png holds 0-65535")
     folder.mkdir(parents=True, exist_ok=True)
     units = np.clip(np.rint(np.nan_to_num(depth) / depth_scale), 0, 65535).astype(np.uint16)
     for name, img in (("color.png", Image.fromarray(color)), ("depth.png", Image.fromarray(units))):

@@ -8,6 +8,7 @@ safely, errors naming the file.
 * Nesting deeper than Python's recursion allows is refused, not a traceback.
 * A key repeated in one mapping (JSON object or YAML mapping) is refused naming it: parsers keep the last in
   silence, so ``translations: 3`` above ``translations: 5`` would be dropped unsaid.
+* YAML 1.1's octal and base-60 numbers are refused: ``010`` would be read as 8 and ``1:30`` as 90 in silence.
 """
 
 from __future__ import annotations
@@ -116,6 +117,29 @@ def _yaml_loader() -> type:
                 seen.add(key)
             return super().construct_mapping(node, deep=deep)
 
+    def decimal_only(kind: str) -> Any:
+        """YAML 1.1's number of ``kind`` (int or float), refusing its forms a reader takes for another number:
+        a leading 0 is octal (``010`` is 8) and colons are base 60 (``1:30`` is 90); hexadecimal and binary
+        (``0x``, ``0b``) say what they are and are read."""
+        base = getattr(yaml.SafeLoader, f"construct_yaml_{kind}")
+
+        def construct(loader: Any, node: Any) -> Any:
+            text = str(loader.construct_scalar(node))
+            body = text.replace("_", "").lstrip("+-")
+            octal = kind == "int" and len(body) > 1 and body[0] == "0" and body[1].isdigit()
+            if ":" in body or octal:
+                read = base(loader, node)
+                form = "octal (a leading 0)" if octal else "base 60 (colons)"
+                raise yaml.constructor.ConstructorError(
+                    None, None, f"{text} is a YAML 1.1 {form} number, read as {read!r}: write the number in decimal "
+                    "(or quote text)", node.start_mark,
+                )  # fmt: skip
+            return base(loader, node)
+
+        return construct
+
+    _NoAliasLoader.add_constructor("tag:yaml.org,2002:int", decimal_only("int"))
+    _NoAliasLoader.add_constructor("tag:yaml.org,2002:float", decimal_only("float"))
     return _NoAliasLoader
 
 

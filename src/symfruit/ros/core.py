@@ -78,7 +78,8 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
     Raises
     ------
     SymfruitError
-        One line naming the parameter, for a number that is not one or is out of range, or an unknown ``qos``.
+        One line naming the parameter, for a number that is not one or is out of range (``depth_scale`` (0, 1] metres
+        per unit, ``slop`` 0-10 s, ``queue_size`` 1-100), or an unknown ``qos``.
     """
     out: dict[str, Any] = {}
     for name, (default, _) in PARAMETERS.items():
@@ -94,6 +95,9 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
         except (TypeError, ValueError, OverflowError):  # OverflowError: int() of an infinite float
             what = "whole number" if kind is int else "number"
             raise SymfruitError(f"parameter {name}: expected a {what}, got {shown(value)}") from None
+    if not 0 < out["depth_scale"] <= 1:  # as a frame's camera.json: 0, negative or NaN would give no frame depth
+        scale = shown(out["depth_scale"])
+        raise SymfruitError(f"parameter depth_scale: expected metres per unit in (0, 1], got {scale}")
     if not 0 <= out["slop"] <= 10:
         raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {shown(out['slop'])}")
     if not 1 <= out["queue_size"] <= 100:

@@ -186,9 +186,18 @@ def _color(color: np.ndarray) -> np.ndarray:
     if c.ndim != 3 or c.shape[2] not in (3, 4) or c.shape[0] < 1 or c.shape[1] < 1:
         raise InputError(f"color must be an (h, w, 3) image, got shape {c.shape}")
     if c.dtype != np.uint8:
-        if not np.issubdtype(c.dtype, np.number) or not np.isfinite(c).all():
+        if c.dtype.kind not in "iuf" or not np.isfinite(c).all():
             raise InputError("color must be a finite uint8 image (0-255)")
-        c = np.clip(c, 0, 255).astype(np.uint8)
+        # 8-bit values in another type (a list, int64) are read as they are; anything else is no 8-bit colour and
+        # was cut into 0-255 unsaid: 16-bit colour read as white, a float image in [0, 1] as black (no fruit)
+        lo, hi = float(c.min()), float(c.max())
+        if lo < 0 or hi > 255:
+            raise InputError(f"color must be 8-bit (0-255), got values {lo:g} to {hi:g} ({c.dtype}; 16-bit colour: "
+                             "divide by 257 first)")  # fmt: skip
+        if c.dtype.kind == "f" and (0 < hi <= 1 or not np.array_equal(c, np.round(c))):  # [0, 1]: not 8-bit
+            raise InputError(f"color must be 8-bit whole numbers (0-255), got {c.dtype} {lo:g} to {hi:g} (a float "
+                             "image in [0, 1]: multiply by 255 first)")  # fmt: skip
+        c = c.astype(np.uint8)
     return c[:, :, :3]
 
 
@@ -390,6 +399,9 @@ def segment(
     -------
     (h, w) int32: 0 background, 1..k the fruit, numbered left to right.
     """
+    if settings is not None and not isinstance(settings, SegmentSettings):
+        raise InputError(f"segment: settings must be a SegmentSettings (Settings().segment), got "
+                         f"{type(settings).__name__}")  # fmt: skip
     s = settings or SegmentSettings()
     c = _color(color)
     check_image_size(c.shape[1], c.shape[0], "segment: colour image")  # the bounds of every entry point
@@ -751,8 +763,9 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     try:
         fx, fy = float(camera.fx), float(camera.fy)
         cx, cy = float(getattr(camera, "cx", shape[1] / 2)), float(getattr(camera, "cy", shape[0] / 2))
-    except (TypeError, ValueError):
-        raise InputError("segment: camera fx, fy (cx, cy) must be numbers") from None
+    except (TypeError, ValueError, AttributeError):  # AttributeError: no camera at all (a path, a mapping)
+        raise InputError(f"segment: camera must be a Camera with numbers fx, fy (cx, cy), got "
+                         f"{type(camera).__name__}") from None  # fmt: skip
     if not (np.isfinite(fx) and np.isfinite(fy) and fx > 0 and fy > 0):
         raise InputError("segment: camera fx, fy must be positive")
     cx, cy = (cx if np.isfinite(cx) else shape[1] / 2), (cy if np.isfinite(cy) else shape[0] / 2)

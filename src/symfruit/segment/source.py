@@ -108,6 +108,12 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
     if images is None:
         from ..io.masks import read_masks
 
+        path = Path(text)  # a file or folder read for every frame: checked once, here, not failed by each frame
+        if not path.exists():
+            raise InputError(f"--masks {text!r}: no such file or folder (expected auto, color, maskrcnn:CHECKPOINT, "
+                             "onnx:MODEL, a COCO .json, a folder of frames' masks, or one label .png)")  # fmt: skip
+        if not path.is_dir() and path.suffix.lower() not in (".png", ".json"):
+            raise FileFormatError(f"{path}: masks must be a label .png or a COCO .json")
         several = _coco_of_several_images(Path(text)) or _frames_folder(Path(text))
         if several is not None:
             return several
