@@ -100,6 +100,30 @@ def test_select_partitions_in_place(seed, n, ties):
     assert (y[:kth] <= y[kth]).all() and (y[kth + 1 :] >= y[kth]).all()
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 700), st.sampled_from(["normal", "ties", "sorted", "reversed",
+                                                                        "equal", "heavy"]))  # fmt: skip
+def test_kth_smallest_is_the_partitions(seed, n, kind):
+    rng = np.random.default_rng(seed)
+    x = {"normal": rng.normal(size=n), "ties": rng.integers(0, 4, n).astype(float), "sorted": np.sort(rng.random(n)),
+         "reversed": np.sort(rng.random(n))[::-1].copy(), "equal": np.full(n, 0.25),
+         "heavy": rng.standard_exponential(n) ** 4}[kind]  # fmt: skip
+    before = x.copy()
+    for kth in {0, n - 1, int(rng.integers(n)), max(0, int(0.8 * n) - 1)}:
+        assert _jit.kth_smallest(x, kth, np.empty(n), np.empty(n)) == np.partition(x, kth)[kth]
+    assert np.array_equal(x, before)  # left as it was
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 600), st.booleans())
+def test_smallest_mean_is_the_mean_of_a_partitions_first_places(seed, n, ties):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_exponential(n) ** 2
+    if ties:
+        x = np.round(x, 1)
+    keep = int(rng.integers(1, n + 1))
+    want = np.partition(x, keep - 1)[:keep].mean()
+    assert _jit.smallest_mean(x, keep, np.empty(n), np.empty(n)) == pytest.approx(want, rel=1e-13, abs=1e-300)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 5))
 def test_solve_is_numpys_solve(seed, n):
     rng = np.random.default_rng(seed)
@@ -131,6 +155,28 @@ def test_slice_costs_are_the_twins(seed, k, n):
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     fast, twin = _jit.slice_costs(q, dirs, 12), _slice_costs(q, dirs, 12)
     np.testing.assert_allclose(fast, twin, rtol=1e-7, atol=1e-12 * scale**2)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(30, 400), st.integers(0, 6), st.integers(0, 2))
+def test_revolution_search_is_the_searchs_steps(seed, n, extra, refine):
+    """The search in one call: the coarse directions' least cost, then each cap's about the best so far, as the
+    twin's loop takes them (each cap's rows within rounding: BLAS may sum the twin's product otherwise)."""
+    from symfruit.core.fits import _COARSE, _cap, _cap_locals
+
+    rng = np.random.default_rng(seed)
+    points = FRUITS["pear"](rng).sample(2 * n, rng) @ rotation(*rng.uniform(0.0, 360.0, 3)).T
+    q = points[points[:, 2] <= np.median(points[:, 2])]  # the half nearer a camera looking along +z
+    q = np.ascontiguousarray(q - q.mean(axis=0))
+    more = rng.normal(size=(extra, 3))
+    more /= np.linalg.norm(more, axis=1, keepdims=True)
+    dirs = np.ascontiguousarray(np.vstack([_COARSE, more * np.where(more[:, 2:3] < 0, -1.0, 1.0)]))
+    spreads = (12.0, 4.0, 1.5)[:refine]
+    best = dirs[int(np.argmin(_jit.slice_costs(q, dirs, 12)))]
+    for spread in spreads:
+        cand = _cap(best, spread, 16)
+        best = cand[int(np.argmin(_jit.slice_costs(q, cand, 12)))]
+    found = _jit.revolution_search(q, dirs, 12, _cap_locals(spreads, 16))
+    np.testing.assert_allclose(found, best, atol=1e-14)
 
 
 @pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("citrus", 4)])

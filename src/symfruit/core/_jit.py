@@ -91,9 +91,100 @@ def select(x: np.ndarray, kth: int) -> None:
 
 
 @_njit
+def _sorted_sample(src: np.ndarray, lo: int, size: int, count: int, out: np.ndarray) -> None:
+    """``out[:count]``: ``count`` evenly spaced values of ``src[lo:lo + size]`` (the first and the last among them),
+    sorted by insertion."""
+    for i in range(count):
+        v = src[lo + (i * (size - 1)) // (count - 1)]
+        j = i
+        while j > 0 and out[j - 1] > v:
+            out[j] = out[j - 1]
+            j -= 1
+        out[j] = v
+
+
+@_njit
+def kth_smallest(x: np.ndarray, kth: int, a: np.ndarray, b: np.ndarray) -> float:
+    """The ``kth`` smallest value of ``x`` (n,) (``np.partition(x, kth)[kth]``), ``x`` left as it is; ``a`` and
+    ``b`` (n,) scratch. Quickselect without its branches (issue 19, sixteenth round): :func:`select`'s
+    comparisons go either way at random, and their mispredictions were most of its time. Each round takes 15
+    evenly spaced values as a sample, brackets ``kth``'s share of them by the sample's values two places either
+    side, and in one pass counts the values below the bracket and copies those within it to a scratch array
+    (every value written, the count advanced by the comparison); when ``kth`` falls outside the bracket (or the
+    bracket keeps everything), a three-way pass about one sampled value (the lower values to the front, the
+    higher to the back, the rest equal to it) takes its place. Both passes keep at least one value fewer, or
+    end; the last 32 values or fewer are sorted by insertion. The values compared are ``x``'s, so the result is
+    exactly the ``kth`` smallest (NaN, which no comparison orders, counts as equal to the pivots there)."""
+    size = x.shape[0]
+    src, dst, other = x, a, b
+    lo = 0
+    sample = np.empty(32)
+    while size > 32:
+        _sorted_sample(src, lo, size, 15, sample)
+        r = (kth * 14 + (size - 1) // 2) // (size - 1)  # kth's place among the 15
+        p = sample[r]
+        below = sample[r - 2] if r >= 2 else -np.inf
+        above = sample[r + 2] if r <= 12 else np.inf
+        if below < above:
+            n_lo = 0
+            m = 0
+            for i in range(lo, lo + size):
+                v = src[i]
+                dst[m] = v
+                m += (v >= below) & (v <= above)
+                n_lo += v < below
+            if n_lo <= kth < n_lo + m and m < size:
+                kth -= n_lo
+                lo, size = 0, m
+                src, dst, other = dst, other, dst
+                continue
+            p = below if kth < n_lo else above if kth >= n_lo + m else p
+        n_lo = 0
+        n_hi = 0
+        top = size - 1
+        for i in range(lo, lo + size):  # three ways about p, into dst's front and back
+            v = src[i]
+            dst[n_lo] = v
+            n_lo += v < p
+            dst[top - n_hi] = v
+            n_hi += v > p
+        if kth < n_lo:
+            lo, size = 0, n_lo
+        elif kth < size - n_hi:
+            return p
+        else:
+            kth -= size - n_hi
+            lo, size = size - n_hi, n_hi
+        src, dst, other = dst, other, dst
+    if size == 1:
+        return src[lo]
+    _sorted_sample(src, lo, size, size, sample)
+    return sample[kth]
+
+
+@_njit
+def smallest_mean(x: np.ndarray, keep: int, a: np.ndarray, b: np.ndarray) -> float:
+    """The mean of the ``keep`` smallest values of ``x`` (n,), ``1 <= keep <= n`` (``x`` left as it is; ``a``, ``b``
+    (n,) scratch): those below the ``keep``-th smallest (:func:`kth_smallest`) added in ``x``'s order, then that
+    value times the places left (its ties), over ``keep``. The same values as the mean of a partition's first
+    ``keep``, added in another order."""
+    thr = kth_smallest(x, keep - 1, a, b)
+    total = 0.0
+    count = 0
+    for i in range(x.shape[0]):
+        v = x[i]
+        lt = v < thr
+        total += v if lt else 0.0  # no branch: which values lie below is as unpredictable as in the selection
+        count += lt
+    return (total + (keep - count) * thr) / keep
+
+
+@_njit
 def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     """:func:`symfruit.core.fits._slice_costs`: the robust slice-circle cost (k,) of every direction (k, 3) for
-    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused)."""
+    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused), each
+    direction's lower 80 % of the squared distances averaged by :func:`smallest_mean` (issue 19, sixteenth round;
+    :func:`select` and a sum of its first places before: the same values, added in another order)."""
     k, n = dirs.shape[0], q.shape[0]
     out = np.empty(k)
     t = np.empty(n)
@@ -103,6 +194,8 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     cv = np.empty(n)
     idx = np.empty(n, np.int64)
     dist2 = np.empty(n)
+    scratch_a = np.empty(n)
+    scratch_b = np.empty(n)
     cnt = np.empty(bins)
     su = np.empty(bins)
     sv = np.empty(bins)
@@ -167,12 +260,55 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
             rv = v[i] - av
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
             dist2[i] = res * res / rho2
-        select(dist2, keep - 1)
-        total = 0.0
-        for i in range(keep):
-            total += dist2[i]
-        out[j] = total / keep
+        out[j] = smallest_mean(dist2, keep, scratch_a, scratch_b)
     return out
+
+
+@_njit
+def _least(costs: np.ndarray) -> int:
+    """``np.argmin(costs)``: the first NaN, else the first least value."""
+    best = 0
+    for i in range(costs.shape[0]):
+        if math.isnan(costs[i]):
+            return i
+        if costs[i] < costs[best]:
+            best = i
+    return best
+
+
+@_njit
+def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.fits.fit_revolution_slices`' direction search in one call (issue 19, sixteenth round):
+    the least :func:`slice_costs` of the coarse directions ``dirs`` (k, 3), then for each of the refining caps
+    ``caps`` (r, m, 3) (:func:`symfruit.core.fits._cap_local`'s, about ``+z``) the least of the best direction so
+    far and the cap turned about it (:func:`symfruit.core.fits._cap`: the basis of
+    :func:`~symfruit.core.points.perpendicular_basis`, each row ``l0 e1 + l1 e2 + l2 d`` summed left to right, where
+    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,)."""
+    best = dirs[_least(slice_costs(q, dirs, bins))].copy()
+    m = caps.shape[1]
+    cand = np.empty((m + 1, 3))
+    for r in range(caps.shape[0]):
+        x, y, z = best[0], best[1], best[2]
+        if abs(x) < 0.9:  # the basis of core.points.perpendicular_basis
+            a, b, c = 0.0, z, -y
+        else:
+            a, b, c = -z, 0.0, x
+        norm = math.sqrt(a * a + b * b + c * c)
+        a, b, c = a / norm, b / norm, c / norm
+        f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
+        cand[0, 0], cand[0, 1], cand[0, 2] = x, y, z
+        for i in range(m):
+            l0, l1, l2 = caps[r, i, 0], caps[r, i, 1], caps[r, i, 2]
+            c0 = l0 * a + l1 * f + l2 * x
+            c1 = l0 * b + l1 * g + l2 * y
+            c2 = l0 * c + l1 * h + l2 * z
+            if c2 < 0:
+                c0, c1, c2 = -c0, -c1, -c2
+            cand[i + 1, 0], cand[i + 1, 1], cand[i + 1, 2] = c0, c1, c2
+        if cand[0, 2] < 0:
+            cand[0, 0], cand[0, 1], cand[0, 2] = -x, -y, -z
+        best = cand[_least(slice_costs(q, cand, bins))].copy()
+    return best
 
 
 @_njit
