@@ -665,6 +665,29 @@ def test_neighbour_covariances_are_the_twins(seed, n, step, small, extra):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(2, 300), st.integers(1, 40), st.integers(1, 30), st.booleans())
+def test_neighbour_covariances_keep_the_nearest_in_order_ties_by_index(seed, n, step, large, nan):
+    """The nearest ``large`` of each query in the order of a stable sort of the distances (ties by index), their
+    scatter summed in that order: bit for bit, on a lattice's whole-number coordinates (ties everywhere); with a
+    NaN coordinate the kernel falls back to offering every point in turn (checked here only to run)."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, 4, size=(n, 3)).astype(np.float64) * 0.001
+    large = min(large, n)
+    small = int(rng.integers(1, large + 1))
+    if nan:
+        pts[int(rng.integers(n)), int(rng.integers(3))] = np.nan
+    fast_small, fast_large = _jit.neighbour_covariances(pts, step, small, large)
+    scatter = np.empty((3, 3))
+    for row, q in enumerate(range(0, n, step)):
+        d = ((pts - pts[q]) ** 2).sum(axis=1)
+        order = np.argsort(d, kind="stable")  # NaN last
+        if nan and np.isnan(d).any():
+            continue  # the insertion's own handling of NaN (the former kernel's), not a sort's
+        for kk, fast in ((small, fast_small), (large, fast_large)):
+            _jit._scatter(pts, order, kk, scatter)
+            assert np.array_equal(fast[row], scatter / kk)
+
+
 @pytest.mark.parametrize("kind,noise,queries", [("apple", 0.0, 120), ("pear", 0.002, 40), ("banana", 0.001, 7)])
 def test_surface_noise_is_the_twins(monkeypatch, kind, noise, queries):
     from symfruit.core.fits import surface_noise
