@@ -751,6 +751,44 @@ def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
             assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
 
 
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_explain_of_a_solid_of_revolution_is_the_twins(monkeypatch, seed):
+    """The measures of marched rays (:func:`symfruit.core._jit.agreement`) against the twin's numpy ones, the rays
+    met alike (the march kernel's hits are the twin's): solids of revolution fitted to the view and moved about
+    it, with and without the frame's depth beside the fruit; the depth RMS within rounding, the shares equal."""
+    from dataclasses import replace
+
+    from symfruit.core import agreement
+    from symfruit.core.agreement import explain, observe
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.fits import RevolutionInside, revolution_box
+    from symfruit.core.occlusion import occlusion
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, occluded_view
+
+    rng = np.random.default_rng(seed)
+    centre = np.array([0.01 * seed, -0.005, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
+                                            seed=seed)  # fmt: skip
+    region = silhouette(visible, camera)
+    occ = occlusion(depth, mask, visible, camera)
+    rev = fit_revolution_slices(visible[::3])
+    for o in (None, occ):
+        obs = observe(visible[::10], region, camera, dense=visible, occlusion=o)
+        for k in range(6):
+            moved = replace(rev, point=rev.point + rng.normal(0.0, 0.006, 3) * (k > 0), radii=rev.radii * (1 + 0.1 * k))
+            inside = RevolutionInside(moved)
+            box = revolution_box(moved)
+            marched = inside.march(agreement._bands(obs).rays, float(box[0][2]) - 1e-3, float(box[1][2]) + 1e-3, 24)
+            assert marched is not None
+            monkeypatch.setattr(RevolutionInside, "march", lambda self, *a, hits=marched: hits)  # the same hits
+            fast, twin = _both(monkeypatch, explain, inside, box, obs)
+            monkeypatch.undo()
+            assert fast.depth == pytest.approx(twin.depth, rel=1e-9, abs=1e-15)
+            assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
+
+
 # --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------
 
 

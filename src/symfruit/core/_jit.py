@@ -1780,7 +1780,6 @@ def explain_quadric(
     sum and of the products making each ray's quadratic (numpy's ``einsum`` and BLAS there): the depth RMS within
     rounding of the twin's (grazing rays' roots the most), the band shares, counts of whole numbers (the outside
     weights are 0 or 1), equal."""
-    n = depth.shape[0]
     m = rays.shape[0]
     s = np.empty(3)
     for i in range(3):
@@ -1800,15 +1799,37 @@ def explain_quadric(
         near, far = (b - root) / a, (b + root) / a
         hit[k] = disc > 0.0 and near < z1 and far > z0
         at[k] = max(near, z0) if hit[k] else np.nan
+    return agreement(hit, at, z0, z1, depth, keep, in_starts, in_sizes, out_starts, out_w, out_wsum, seen, free)
+
+
+@_njit
+def agreement(
+    hit: np.ndarray,
+    at: np.ndarray,
+    z0: float,
+    z1: float,
+    depth: np.ndarray,
+    keep: int,
+    in_starts: np.ndarray,
+    in_sizes: np.ndarray,
+    out_starts: np.ndarray,
+    out_w: np.ndarray,
+    out_wsum: np.ndarray,
+    seen: np.ndarray,
+    free: float,
+) -> tuple[float, float, float]:
+    """:func:`symfruit.core.agreement.explain`'s measures from where each ray meets the candidate (``hit`` (m,)
+    bool, ``at`` (m,) its entry depth): ``(depth RMS, inside, outside)``, the rays and bands as
+    :func:`explain_quadric`'s (which ends here; the solids of revolution's marched rays since issue 19's
+    sixteenth round). The trimmed RMS by :func:`smallest_mean` (within rounding of the twin's partition and
+    mean), the band shares from counts of whole numbers (the outside weights are 0 or 1): the twin's."""
+    n = depth.shape[0]
+    m = hit.shape[0]
     r2 = np.empty(n)
     for k in range(n):
         r = depth[k] - at[k] if hit[k] else z1 - z0
         r2[k] = r * r
-    select(r2, keep - 1)
-    total = 0.0
-    for k in range(keep):
-        total += r2[k]
-    rms = math.sqrt(total / keep)
+    rms = math.sqrt(smallest_mean(r2, keep, np.empty(n), np.empty(n)))
     n_bands = in_starts.shape[0]
     inside = 0.0
     for j in range(n_bands):
