@@ -456,6 +456,28 @@ def test_square_filter_is_scipys(seed, h, w, radius, every):
     assert np.array_equal(out, scipys(mask, size=2 * radius + 1, mode="constant", cval=False))
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(0, 5), st.booleans())
+def test_occluded_at_is_the_twins(seed, radius, cached):
+    """Occlusion.at by the kernel (each pixel's square looked through) against the twin (the grown map over the
+    pixels' box, or the whole window's when made before): pixels inside and outside the window and the image,
+    on its border, half-way between two, and NaN or infinite ones."""
+    from symfruit.core.occlusion import Occlusion
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    hidden = _blobs(rng, h, w, rng.uniform(0.0, 0.2))
+    occ = Occlusion(int(rng.integers(0, 20)), int(rng.integers(0, 20)), hidden, 80, 75)
+    u, v = rng.uniform(-5, 85, 300), rng.uniform(-5, 80, 300)
+    u[::7], v[::5] = np.round(u[::7]) + 0.5, np.round(v[::5])  # ties of the rounding, whole pixels
+    u[:4], v[4:8] = [np.nan, np.inf, -np.inf, 1e30], [np.nan, -np.inf, np.inf, -1e30]
+    if cached:
+        occ.grown(radius)
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):
+        fast, twin = _both(mp, occ.at, u, v, radius=radius)
+        one, one_twin = _both(mp, occ.at, u[10:11], v[10:11], radius=radius)
+    assert fast.dtype == twin.dtype == bool and np.array_equal(fast, twin) and np.array_equal(one, one_twin)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 5))
 def test_grown_occlusion_is_the_twins(seed, radius):
     """Occlusion.at with a radius and Occlusion.window (their grown maps, filtered by the kernel or by scipy)."""

@@ -805,6 +805,42 @@ def inside_px(
 
 
 @_njit
+def occluded_at(
+    u: np.ndarray, v: np.ndarray, hidden: np.ndarray, u0: int, v0: int, width: int, height: int, radius: int
+) -> np.ndarray:
+    """:meth:`symfruit.core.occlusion.Occlusion.at`: whether each pixel ``(u, v)`` (m,) (rounded half to even) lies
+    within ``radius`` of the image's border or has a hidden pixel of the window ``hidden`` (h, w) at ``(u0, v0)``
+    within ``radius`` (a square; the window's own pixels alone), by looking through the square (issue 19,
+    sixteenth round; the twin filters the hidden pixels' map over the pixels' box): the twin's booleans. A
+    coordinate numpy's integer conversion cannot hold (NaN, infinite, past 2^63) becomes its smallest integer
+    there, and so here, as :func:`inside_px` does."""
+    h, w = hidden.shape
+    n = u.shape[0]
+    out = np.empty(n, np.bool_)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        fu, fv = np.rint(u[i]), np.rint(v[i])
+        col = np.int64(fu) if -big <= fu < big else least
+        row = np.int64(fv) if -big <= fv < big else least
+        o = col < radius or col >= width - radius or row < radius or row >= height - radius
+        c, r = col - np.int64(u0), row - np.int64(v0)
+        if not o and 0 <= c < w and 0 <= r < h:
+            if radius <= 0:
+                o = hidden[r, c]
+            else:
+                for rr in range(max(r - radius, 0), min(r + radius + 1, h)):
+                    for cc in range(max(c - radius, 0), min(c + radius + 1, w)):
+                        if hidden[rr, cc]:
+                            o = True
+                            break
+                    if o:
+                        break
+        out[i] = o
+    return out
+
+
+@_njit
 def cone_residuals(
     params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
     out: np.ndarray,
