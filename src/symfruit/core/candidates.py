@@ -120,24 +120,24 @@ def constrain_box(
     s_hi = [_greater(a, b) for a, b in zip(np.asarray(seen_hi, dtype=np.float64).tolist(), s_lo, strict=True)]
     scale = REACH / max(contour, REACH_FLOOR)
     reach = [scale * (a - b) for a, b in zip(s_hi, s_lo, strict=True)]
-    lo = [_lesser(_greater(a, h - r), s) for a, h, r, s in
-          zip(np.asarray(lo, dtype=np.float64).tolist(), s_hi, reach, s_lo, strict=True)]  # fmt: skip
-    hi = [_greater(_lesser(a, s + r), h) for a, s, r, h in
-          zip(np.asarray(hi, dtype=np.float64).tolist(), s_lo, reach, s_hi, strict=True)]  # fmt: skip
-    lo[2] = float(front)
-    hi[2] = float(max(hi[2], front + 1e-4))
+    out_lo = [_lesser(_greater(a, h - r), s) for a, h, r, s in
+              zip(np.asarray(lo, dtype=np.float64).tolist(), s_hi, reach, s_lo, strict=True)]  # fmt: skip
+    out_hi = [_greater(_lesser(a, s + r), h) for a, s, r, h in
+              zip(np.asarray(hi, dtype=np.float64).tolist(), s_lo, reach, s_hi, strict=True)]  # fmt: skip
+    out_lo[2] = float(front)
+    out_hi[2] = float(max(out_hi[2], front + 1e-4))
     if cone is not None:
         (u_lo, v_lo, u_hi, v_hi), camera = cone
-        z0, z1 = lo[2], hi[2]
+        z0, z1 = out_lo[2], out_hi[2]
         a, b = (u_lo - camera.cx) / camera.fx, (v_lo - camera.cy) / camera.fy
         bound_lo = (_lesser(a * z0, a * z1), _lesser(b * z0, b * z1))  # each row's .min() of the two depths
         a, b = (u_hi - camera.cx) / camera.fx, (v_hi - camera.cy) / camera.fy
         bound_hi = (_greater(a * z0, a * z1), _greater(b * z0, b * z1))
         share = contour if pull is None else pull
         for i in range(2):
-            lo[i] = float(_lesser(s_lo[i], lo[i] + share * _greater(bound_lo[i] - lo[i], 0.0)))
-            hi[i] = float(_greater(s_hi[i], hi[i] - share * _greater(hi[i] - bound_hi[i], 0.0)))
-    return np.array(lo), np.array(hi)
+            out_lo[i] = float(_lesser(s_lo[i], out_lo[i] + share * _greater(bound_lo[i] - out_lo[i], 0.0)))
+            out_hi[i] = float(_greater(s_hi[i], out_hi[i] - share * _greater(out_hi[i] - bound_hi[i], 0.0)))
+    return np.array(out_lo), np.array(out_hi)
 
 
 def _lesser(a: float, b: float) -> float:
