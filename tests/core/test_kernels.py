@@ -811,6 +811,31 @@ def test_explain_of_a_solid_of_revolution_is_the_twins(monkeypatch, seed):
             assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.sampled_from([0.0, 0.5, 1.0, 3.0]),
+       st.booleans())  # fmt: skip
+def test_rim_coverage_is_the_twins_to_the_bit(seed, h, w, fill_radius, given_map):
+    """evidence.rim_coverage by the kernel against the twin: random regions (blobs: empty rims or interiors too),
+    points on pixels inside and outside the window and on rounding ties, one at NaN, sparse clouds' filled points
+    (the twin's maximum filter with its reflected border) and dense ones, with the distance map given or made."""
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.raster import Silhouette, inner_distance
+    from symfruit.methods.evidence import rim_coverage
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.05, 0.6))
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 400)), mask, fill_radius)
+    n = int(rng.integers(1, 2 * h * w + 2))
+    u = region.u0 + rng.integers(-3, w + 3, n) + rng.choice([0.0, 0.5, -0.5, 0.3], n)
+    v = region.v0 + rng.integers(-3, h + 3, n) + rng.choice([0.0, 0.5, -0.4], n)
+    z = rng.uniform(0.3, 0.6, n)
+    points = np.stack(((u - camera.cx) * z / camera.fx, (v - camera.cy) * z / camera.fy, z), axis=1)
+    points[0, 0] = np.nan
+    inner = inner_distance(mask) if given_map else None
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):
+        fast, twin = _both(mp, rim_coverage, points, region, camera, inner=inner)
+    assert fast == twin and type(fast) is type(twin) is float
+
+
 # --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------
 
 

@@ -841,6 +841,62 @@ def occluded_at(
 
 
 @_njit
+def rim_coverage(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, mask: np.ndarray,
+    inner: np.ndarray, width: float, fill: int,
+) -> float:  # fmt: skip
+    """:func:`symfruit.methods.evidence.rim_coverage` once its rim width and distance map are known: the share of the
+    region's (``mask`` (h, w) at ``(u0, v0)``) rim pixels (``inner <= width``) holding a point's pixel
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, as :func:`inside_px`; a point
+    off the window holds none), over the share of its other pixels, at most 1 (1 where either part is empty or no
+    other pixel holds a point); with ``fill > 0`` a point holds the ``2 fill + 1`` square about its pixel (the
+    twin's maximum filter: its reflected border repeats pixels already within the square, as the window's edge
+    cut here). Counts of whole numbers and the twin's two divisions: its value to the bit (issue 19, sixteenth
+    round)."""
+    h, w = mask.shape
+    rim = np.zeros((h, w), np.bool_)
+    n_rim = n_rest = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                if inner[r, c] <= width:
+                    rim[r, c] = True
+                    n_rim += 1
+                else:
+                    n_rest += 1
+    if n_rim == 0 or n_rest == 0:
+        return 1.0
+    hit = np.zeros((h, w), np.bool_)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(points.shape[0]):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        col = (np.int64(u) if -big <= u < big else least) - np.int64(u0)
+        row = (np.int64(v) if -big <= v < big else least) - np.int64(v0)
+        if 0 <= col < w and 0 <= row < h:
+            hit[row, col] = True
+    if fill > 0:
+        grown = np.empty((h, w), np.bool_)
+        square_filter(hit, fill, False, grown)
+        hit = grown
+    hit_rim = hit_rest = 0
+    for r in range(h):
+        for c in range(w):
+            if hit[r, c] and mask[r, c]:
+                if rim[r, c]:
+                    hit_rim += 1
+                else:
+                    hit_rest += 1
+    interior = hit_rest / n_rest
+    if interior <= 0:
+        return 1.0
+    share = hit_rim / n_rim / interior
+    return share if share < 1.0 else 1.0
+
+
+@_njit
 def cone_residuals(
     params: np.ndarray, cone: np.ndarray, axis: np.ndarray, rays: np.ndarray, ray_cone: np.ndarray, z: np.ndarray,
     out: np.ndarray,
