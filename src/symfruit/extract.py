@@ -11,6 +11,7 @@ import numpy as np
 from scipy import ndimage
 
 from .core.camera import Camera
+from .core.kernels import compiled
 from .core.points import bounds
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .settings import Section, SettingError, setting
@@ -113,10 +114,18 @@ def cluster(points: np.ndarray, distance: float) -> np.ndarray:
     ``distance / 2`` and occupied cubes that touch (26-neighbourhood) form a cluster. Two points of
     different clusters are at least ``distance / 2`` apart, and points up to ``distance / 2`` apart
     always share one.
+
+    Where numba is, its compiled twin does the same steps (:func:`symfruit.core._jit.clusters`: the same labels; issue
+    19, sixteenth round), but for a slab too sparse for a dense grid.
     """
     n = len(points)
     if n == 0:
         return np.zeros(0, np.int64)
+    p = np.asarray(points)
+    if p.dtype == np.float64 and p.ndim == 2 and p.shape[1] == 3 and (jit := compiled()) is not None:
+        labels, done = jit.clusters(np.ascontiguousarray(p), float(distance))
+        if done:
+            return labels
     order = np.argsort(points[:, 2], kind="stable")
     gaps = np.flatnonzero(np.diff(points[order, 2]) > distance) + 1
     runs = np.concatenate(([0], gaps, [n]))
@@ -182,7 +191,11 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
     core = mask
     if s.erode_px:
-        eroded = ndimage.minimum_filter(mask.view(np.uint8), size=2 * s.erode_px + 1, mode="constant").astype(bool)
+        if (jit := compiled()) is not None and mask.dtype == bool and mask.ndim == 2:  # the same pixels, compiled
+            eroded = np.empty(mask.shape, bool)
+            jit.square_filter(mask, s.erode_px, True, eroded)
+        else:
+            eroded = ndimage.minimum_filter(mask.view(np.uint8), size=2 * s.erode_px + 1, mode="constant").astype(bool)
         if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
             core = eroded
     z_all = np.asarray(depth, dtype=np.float64)

@@ -1193,3 +1193,212 @@ def test_filled_and_connected_are_the_labellings(seed, h, w):
         ):
             assert np.array_equal(fast, twin)
     assert np.array_equal(_connected(mask, at), labels == labels[at])
+
+
+# --- issue 19, sixteenth round: clustering, a fruit's depth mode and apex, the segmenter's red pixels, windows and
+# sphere points
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.002, 0.006, 0.02]), st.booleans())
+def test_clusters_are_the_twins(seed, distance, rounded):
+    """Clouds of one to four blobs, depth slabs apart or not, lone points, coordinates on a millimetre grid (ties in
+    depth and cubes): the same labels, the largest cluster 0."""
+    from symfruit.extract import cluster
+
+    rng = np.random.default_rng(seed)
+    parts = [rng.normal(rng.uniform(-0.05, 0.05, 3) + [0, 0, 0.8], rng.choice([0.001, 0.005, 0.02]),
+                        (int(rng.integers(1, 400)), 3)) for _ in range(int(rng.integers(1, 5)))]  # fmt: skip
+    points = np.concatenate(parts)
+    if rounded:
+        points = np.round(points, 3)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, cluster, points, distance)
+    assert fast.dtype == twin.dtype == np.int64
+    np.testing.assert_array_equal(fast, twin)
+    labels, done = _jit.clusters(points, distance)
+    assert done and np.array_equal(labels, twin)
+
+
+def test_clusters_leave_a_sparse_slab_and_non_finite_points_to_the_twin():
+    """A slab whose grid of cubes would pass 2e7 cells (the twin links those through a tree): the kernel declines,
+    and ``cluster`` gives the twin's labels; a coordinate that is not finite: the kernel declines too."""
+    from symfruit.extract import cluster
+
+    rng = np.random.default_rng(0)
+    far = np.concatenate([rng.normal(0.0, 0.002, (50, 3)), rng.normal(0.0, 0.002, (50, 3)) + [30.0, 30.0, 0.001]])
+    assert not _jit.clusters(far, 0.006)[1]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, cluster, far, 0.006)
+    np.testing.assert_array_equal(fast, twin)
+    assert set(fast.tolist()) == {0, 1}
+    for bad in (np.nan, np.inf):
+        points = rng.normal(0.0, 0.01, (40, 3))
+        points[3, 1] = bad
+        assert not _jit.clusters(points, 0.006)[1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([5, 10, 11, 30, 400, 3000]), st.integers(0, 3),
+       st.sampled_from([0.0005, 0.002, 0.1]))  # fmt: skip
+def test_fruit_depth_is_the_twins_to_the_bit(seed, n, kind, noise):
+    """Depths of one to three surfaces, spread wide (up to the 4096 bins' bound) or over fewer than three bins
+    (numpy's masses then run past the bins), on a millimetre grid or not, with pixels without depth, with and
+    without the leaf test: the same front and radius, bit for bit."""
+    from symfruit.core.surface import fruit_depth
+
+    rng = np.random.default_rng(seed)
+    if kind == 0:
+        values = rng.uniform(0.1, float(rng.choice([0.2, 3.0, 60.0])), n)
+    elif kind == 1:
+        values = 0.8 + rng.integers(0, 3, n) * 0.001
+    else:
+        values = np.concatenate([rng.normal(rng.uniform(0.3, 2.0), rng.choice([0.0005, 0.003, 0.03]), n)
+                                 for _ in range(kind)])  # fmt: skip
+    if rng.random() < 0.5:
+        values = np.round(values, 3)
+    values[rng.random(len(values)) < 0.1] = rng.choice([0.0, np.nan, -1.0])
+    leafy = None if rng.random() < 0.3 else (rng.random(len(values)) < rng.random()) | (values < np.nanmedian(values))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, fruit_depth, values, float(rng.uniform(1.0, 80.0)), float(rng.uniform(300.0, 1500.0)),
+                           noise=noise, leafy=leafy)  # fmt: skip
+    assert np.array_equal(np.array(fast), np.array(twin), equal_nan=True)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_fruit_surfaces_apex_is_the_twins(seed):
+    """Noisy caps (flat ties on a millimetre grid), scattered masks, pixels without depth, masks wide enough to be
+    eroded more than four times, looked for beyond the mask or not: the same surface, apex and numbers."""
+    from symfruit.core.surface import fruit_surface
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 90, 2))
+    yy, xx = np.mgrid[:h, :w]
+    cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(3.0, 45.0)
+    inside = np.maximum(r * r - (yy - cy) ** 2 - (xx - cx) ** 2, 0.0)
+    mask = (inside > 0) | (rng.random((h, w)) < rng.choice([0.0, 0.1]))
+    z0 = rng.uniform(0.4, 2.0)
+    depth = z0 - 0.001 * np.sqrt(inside) + rng.normal(0.0, rng.choice([0.0, 0.0005, 0.003]), (h, w))
+    if rng.random() < 0.5:
+        depth = np.round(depth, 3)
+    depth[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5])] = 0.0
+    region = None if rng.random() < 0.5 else np.ones((h, w), bool)
+    leafy = None if rng.random() < 0.5 else rng.random((h, w)) < 0.3
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, fruit_surface, depth, mask, 600.0, region=region, leafy=leafy,
+                           tolerance=float(rng.choice([3.0, 0.5, np.inf])))  # fmt: skip
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert np.array_equal(fast.pixels, twin.pixels)
+        assert (fast.front, fast.radius, fast.noise, fast.apex) == (twin.front, twin.radius, twin.noise, twin.apex)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_depth_step_is_the_twins(seed, single):
+    """Depth rounded to 1-5 decimals with pixels without depth and an infinite one (NaN differences, left out),
+    float64 or float32, a window of it (strided): the same least step, bit for bit."""
+    from symfruit.core.surface import depth_step
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    depth = np.round(0.8 + rng.normal(0.0, 0.003, (h, w)), int(rng.integers(1, 6)))
+    depth[rng.random((h, w)) < 0.2] = 0.0
+    if rng.random() < 0.3:
+        depth[rng.integers(0, h), rng.integers(0, w)] = np.inf
+    if single:
+        depth = depth.astype(np.float32)
+    mask = rng.random((h, w)) < 0.8
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # inf - inf in the twin
+        for d, m in ((depth, mask), (depth[:, 1:], mask[:, 1:])):
+            fast, twin = _both(mp, depth_step, d, m)
+            assert fast == twin and type(fast) is type(twin) is float
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 40))
+def test_joined_boxes_are_the_twins(seed, n):
+    """Random boxes on small and large grids (chains that join over several rounds, boxes that only touch at a
+    corner, none): the same boxes in the same order, as Python ints."""
+    from symfruit.segment.colour import _join_boxes
+
+    rng = np.random.default_rng(seed)
+    size = int(rng.choice([10, 30, 100]))
+    boxes = [(int(a), int(a + rng.integers(1, 8)), int(c), int(c + rng.integers(1, 8)))
+             for a, c in zip(rng.integers(0, size, n), rng.integers(0, size, n), strict=True)]  # fmt: skip
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _join_boxes, list(boxes))
+    assert fast == twin
+    assert all(type(x) is int for box in fast for x in box)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
+def test_red_pixels_are_the_twins(seed, window, own_settings):
+    """Random colours (many of them reddish), a window of an image (strided) or a whole one, the default settings
+    or others: the same weak and strong pixels."""
+    from symfruit.segment.colour import SegmentSettings, _red_pixels
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    image = rng.integers(0, 256, (h + 6, w + 6, 3), dtype=np.uint8)
+    image[..., 0] = np.maximum(image[..., 0], rng.integers(0, 256, (h + 6, w + 6)).astype(np.uint8))
+    c = image[3 : 3 + h, 2 : 2 + w] if window else image
+    s = SegmentSettings()
+    if own_settings:
+        s = SegmentSettings(red_low=float(rng.uniform(0.05, 0.4)), red_high=float(rng.uniform(0.4, 0.7)),
+                            hue_max=float(rng.uniform(5.0, 40.0)), dark=int(rng.integers(0, 60)))  # fmt: skip
+    with pytest.MonkeyPatch.context() as mp:
+        (weak, strong), (weak_twin, strong_twin) = _both(mp, _red_pixels, c, s)
+    assert weak.dtype == weak_twin.dtype and strong.dtype == strong_twin.dtype
+    np.testing.assert_array_equal(weak, weak_twin)
+    np.testing.assert_array_equal(strong, strong_twin)
+    assert len(strong) > 0
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1500, 300, 50]), st.booleans())
+def test_the_segmenters_sphere_points_and_fit_are_the_twins(seed, most, single):
+    """A noisy cap with speckle and pixels without depth, float64 or float32 depth, more pixels than ``most`` or
+    fewer: the same points and the same sphere, bit for bit."""
+    from symfruit.segment.colour import _Geometry, _points, _sphere
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 120, 2))
+    yy, xx = np.mgrid[:h, :w]
+    cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(3.0, 60.0)
+    inside = np.maximum(r * r - (yy - cy) ** 2 - (xx - cx) ** 2, 0.0)
+    mask = (inside > 0) | (rng.random((h, w)) < 0.05)
+    depth = rng.uniform(0.4, 2.0) - 0.001 * np.sqrt(inside) + rng.normal(0.0, 0.002, (h, w))
+    depth[rng.random((h, w)) < 0.2] = 0.0
+    if single:
+        depth = depth.astype(np.float32)
+    geo = _Geometry(float(rng.uniform(300, 1500)), float(rng.uniform(0, 480)), float(rng.uniform(0, 640)))
+    origin = (int(rng.integers(0, 400)), int(rng.integers(0, 600)))
+    with pytest.MonkeyPatch.context() as mp:
+        points, points_twin = _both(mp, _points, mask, depth, geo, origin, most)
+        fit, fit_twin = _both(mp, _sphere, mask, depth, geo, origin, most)
+    assert points.dtype == points_twin.dtype == np.float64
+    np.testing.assert_array_equal(points, points_twin)
+    assert (fit is None) == (fit_twin is None)
+    if fit is not None:
+        np.testing.assert_array_equal(fit[0], fit_twin[0])
+        assert fit[1] == fit_twin[1]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_extraction_is_the_twins(monkeypatch, seed):
+    """A ball's extraction (the border's erosion, the surface, the clusters) with the kernels and with the numpy
+    twins: the same points and counts."""
+    from symfruit.core.camera import Camera
+    from symfruit.extract import extract
+
+    depth, mask, _ = _ball_frame(seed)
+    h, w = mask.shape
+    camera = Camera(fx=600.0, fy=600.0, cx=w / 2.0, cy=h / 2.0, width=w, height=h)
+    fast, twin = _both(monkeypatch, extract, mask, depth, camera)
+    np.testing.assert_array_equal(fast.points, twin.points)
+    assert (fast.n_invalid, fast.n_border, fast.n_other_clusters) == (twin.n_invalid, twin.n_border,
+                                                                       twin.n_other_clusters)  # fmt: skip
+    assert len(fast.points) > 100

@@ -2076,3 +2076,493 @@ def occlusion_maps(
             if not own:
                 hide = x < ref or (with_others and others[r, c] and not x >= ref)
             hidden[r, c] = hide
+
+
+# --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
+
+
+@_njit
+def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
+    """:func:`symfruit.extract.cluster` of ``points`` (n, 3) float64: each point's cluster, 0 the largest, and True;
+    or an empty array and False where the twin is to run instead (a depth slab's grid of cubes over 2e7 cells,
+    whose clusters the twin links through a tree and numbers otherwise, or a coordinate that is not finite).
+
+    The twin's steps on the same values: the points in a stable order of their depths, cut into slabs where
+    consecutive depths differ by more than ``distance``; in each slab the cubes of side ``distance / 2`` from the
+    slab's least corner (the same subtraction, division and floor), the occupied cubes numbered as
+    ``ndimage.label`` numbers them with the 26-neighbourhood (by the first cube of each cluster in the grid's raster
+    order: a flood fill from each unnumbered occupied cube met in that order); the clusters ranked by a stable sort
+    of their sizes, largest first. The same labels."""
+    n = points.shape[0]
+    empty = np.zeros(0, np.int64)
+    for i in range(n):
+        for j in range(3):
+            if not math.isfinite(points[i, j]):
+                return empty, False
+    voxel = distance / 2.0
+    order = np.argsort(points[:, 2], kind="mergesort")
+    labels = np.empty(n, np.int64)
+    next_label = 0
+    lo = 0
+    while lo < n:
+        hi = lo + 1
+        while hi < n and not (points[order[hi], 2] - points[order[hi - 1], 2] > distance):
+            hi += 1
+        if hi - lo == 1:
+            labels[order[lo]] = next_label
+            next_label += 1
+            lo = hi
+            continue
+        least = np.empty(3)
+        for j in range(3):
+            least[j] = points[order[lo], j]
+        for k in range(lo + 1, hi):
+            for j in range(3):
+                least[j] = min(least[j], points[order[k], j])
+        cells = np.empty((hi - lo, 3), np.int64)
+        top = np.zeros(3, np.int64)
+        for k in range(lo, hi):
+            for j in range(3):
+                c = np.int64(math.floor((points[order[k], j] - least[j]) / voxel))
+                cells[k - lo, j] = c
+                top[j] = max(top[j], c)
+        a, b, d = top[0] + 1, top[1] + 1, top[2] + 1
+        if float(a) * float(b) * float(d) > 2e7:
+            return empty, False
+        grid = np.zeros(a * b * d, np.int64)  # 0: empty, -1: occupied, k > 0: cluster k
+        for k in range(hi - lo):
+            grid[(cells[k, 0] * b + cells[k, 1]) * d + cells[k, 2]] = -1
+        stack = np.empty(hi - lo, np.int64)  # each occupied cube is pushed once
+        count = 0
+        for f in range(a * b * d):
+            if grid[f] != -1:
+                continue
+            count += 1
+            grid[f] = count
+            stack[0] = f
+            size = 1
+            while size > 0:
+                size -= 1
+                g = stack[size]
+                x, rest = g // (b * d), g % (b * d)
+                y, z = rest // d, rest % d
+                for dx in range(-1, 2):
+                    xx = x + dx
+                    if xx < 0 or xx >= a:
+                        continue
+                    for dy in range(-1, 2):
+                        yy = y + dy
+                        if yy < 0 or yy >= b:
+                            continue
+                        for dz in range(-1, 2):
+                            zz = z + dz
+                            if zz < 0 or zz >= d:
+                                continue
+                            h = (xx * b + yy) * d + zz
+                            if grid[h] == -1:
+                                grid[h] = count
+                                stack[size] = h
+                                size += 1
+        for k in range(hi - lo):
+            labels[order[lo + k]] = grid[(cells[k, 0] * b + cells[k, 1]) * d + cells[k, 2]] - 1 + next_label
+        next_label += count
+        lo = hi
+    counts = np.zeros(next_label, np.int64)
+    for i in range(n):
+        counts[labels[i]] += 1
+    rank = np.empty(next_label, np.int64)
+    by_size = np.argsort(-counts, kind="mergesort")
+    for r in range(next_label):
+        rank[by_size[r]] = r
+    out = np.empty(n, np.int64)
+    for i in range(n):
+        out[i] = rank[labels[i]]
+    return out, True
+
+
+@_njit
+def _count_below(z: np.ndarray, x: float, right: bool) -> int:
+    """``np.searchsorted(z, x, side)`` of sorted ``z`` without NaN: how many values are below ``x`` (``right``: at
+    most ``x``), by bisection."""
+    lo, hi = 0, z.shape[0]
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if z[mid] < x or (right and z[mid] == x):
+            lo = mid + 1
+        else:
+            hi = mid
+    return lo
+
+
+@_njit
+def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
+    """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient."""
+    lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
+    a, b = _count_below(z, lo, False), _count_below(z, hi, True)
+    if b - a < 10:
+        return 0.0
+    count = 0
+    for j in range(kept.shape[0]):
+        if leaf[j] and kept[j] >= lo and kept[j] <= hi:
+            count += 1
+    return count / (b - a)
+
+
+@_njit
+def fruit_depth(
+    z: np.ndarray, kept: np.ndarray, radius_px: float, focal: float, noise: float, leaf: np.ndarray, with_leafy: bool,
+    leafy_shares: tuple[float, float],
+) -> tuple[float, float, bool]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_depth` from its valid depths ``kept`` (n,) float64 as they are and sorted
+    (``z``; numpy's sort is the faster), ``leaf`` (n,) bool aligned with ``kept`` where ``with_leafy``
+    (``leafy_shares``: its :data:`~symfruit.core.surface.LEAFY`): ``(front, radius, True)``, or ``(nan, nan, False)``
+    where the twin is to run instead (a histogram range numpy widens; no depth between the front bin's edges). The
+    twin's steps on the same values: the median, the bin width (Python's ``max`` and ``min``: the same choices), the
+    edges as ``np.linspace`` makes them (``i * step + lo``, the last one ``hi``), the counts between them by
+    bisection, the three-bin masses (``np.convolve``'s ``"same"`` window of sums of whole numbers: exact), the
+    peaks, the leaf test's shares (the same counts and quotients), the walk nearer and the 5 % quantile's
+    interpolation: the same numbers, bit for bit."""
+    n = z.shape[0]
+    if n < 10:
+        return np.nan, np.nan, True
+    half = n // 2
+    median = z[half] if n % 2 else (z[half - 1] + z[half]) / 2.0
+    radius = radius_px * median / focal
+    step = radius / 3.0
+    if 0.004 > step:
+        step = 0.004
+    if 2.0 * noise > step:
+        step = 2.0 * noise
+    c = np.ceil((z[n - 1] - z[0]) / step)
+    if not math.isfinite(c):  # the twin's int() refuses it
+        return np.nan, np.nan, False
+    if 1 > c:
+        c = 1.0
+    if 4096 < c:
+        c = 4096.0
+    n_bins = int(c)
+    lo, hi = z[0], z[0] + n_bins * step
+    if not lo < hi:
+        return np.nan, np.nan, False
+    delta = hi - lo
+    width = delta / n_bins
+    edges = np.empty(n_bins + 1)
+    for k in range(n_bins + 1):
+        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
+    edges[n_bins] = hi
+    at = np.empty(n_bins + 1, np.int64)
+    for k in range(n_bins):
+        at[k] = _count_below(z, edges[k], False)
+    at[n_bins] = _count_below(z, hi, True)
+    counts = np.empty(n_bins, np.int64)
+    for k in range(n_bins):
+        counts[k] = at[k + 1] - at[k]
+    # np.convolve(counts, np.ones(3), mode="same"): max(n_bins, 3) values of the full convolution from the shorter
+    # array's half length on (with fewer than 3 bins the ones are the longer array, and the masses run past the bins)
+    size = max(n_bins, 3)
+    offset = 1 if n_bins >= 3 else 0
+    mass = np.zeros(size)
+    for k in range(size):
+        j = k + offset  # the full convolution's place: the bins j - 2 .. j
+        s = 0.0
+        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
+            s += counts[q]
+        mass[k] = s
+    top = mass.max()
+    i = -1
+    for k in range(size):
+        after = mass[k + 1] if k + 1 < size else -1.0
+        before = mass[k - 1] if k > 0 else -1.0
+        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * top:
+            i = k
+            break
+    if i < 0 or i >= n_bins:  # not met (the twin's masses run past the bins by two at most, its peak never)
+        return np.nan, np.nan, False
+    if with_leafy and _leaf_share(z, kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
+        for k in range(i + 1, n_bins):
+            after = mass[k + 1] if k + 1 < size else -1.0
+            before = mass[k - 1] if k > 0 else -1.0
+            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * top):
+                continue
+            if _leaf_share(z, kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
+                i = k
+                break
+    least = 0.01 * n
+    if 2 > least:
+        least = 2.0
+    first = i
+    while first > 0 and counts[first - 1] >= least:
+        first -= 1
+    a_edge = edges[first]
+    b_edge = edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+    a, b = _count_below(z, a_edge, False), _count_below(z, b_edge, True)
+    size = b - a
+    if size < 1:
+        return np.nan, np.nan, False
+    if size == 1:
+        front = z[a]
+    else:
+        where = (size - 1) * 0.05
+        below = np.int64(np.floor(where))
+        t = where - below
+        za, zb = z[a + below], z[a + below + 1]
+        front = zb - (zb - za) * (1.0 - t) if t >= 0.5 else za + (zb - za) * t
+    return front, radius_px * front / focal, True
+
+
+@_njit
+def surface_apex(
+    own: np.ndarray, iterations: int, near: np.ndarray, depth: np.ndarray, mask: np.ndarray, r0: int, c0: int,
+    size: int,
+) -> tuple[int, int]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface`'s apex: row and column (in the window) of the first least ``size``
+    x ``size`` median (edges repeated) of the window's depth where ``near`` (+inf elsewhere) among the core pixels:
+    the mask's box ``own`` (at ``r0``, ``c0`` in the window) eroded ``iterations`` times by the cross (beyond the box
+    not in it: :func:`symfruit.core.raster.eroded`) and ``near``; without any, the pixels of ``near`` and ``mask``,
+    or of ``near``. The twin's pixels in its (raster) order and :func:`least_median`'s pass: the same pixel."""
+    bh, bw = own.shape
+    core = own.copy()
+    nxt = np.empty((bh, bw), np.bool_)
+    for _ in range(iterations):
+        for r in range(bh):
+            for c in range(bw):
+                nxt[r, c] = (core[r, c] and r > 0 and r < bh - 1 and c > 0 and c < bw - 1
+                             and core[r - 1, c] and core[r + 1, c] and core[r, c - 1] and core[r, c + 1])  # fmt: skip
+        core, nxt = nxt, core
+    h, w = near.shape
+    n = 0
+    rows = np.empty(h * w, np.int64)
+    cols = np.empty(h * w, np.int64)
+    for r in range(bh):
+        for c in range(bw):
+            if core[r, c] and near[r + r0, c + c0]:
+                rows[n], cols[n] = r + r0, c + c0
+                n += 1
+    if n == 0:
+        both = False
+        for r in range(h):
+            for c in range(w):
+                both = both or (near[r, c] and mask[r, c])
+        for r in range(h):
+            for c in range(w):
+                if near[r, c] and (mask[r, c] or not both):
+                    rows[n], cols[n] = r, c
+                    n += 1
+    half = size // 2
+    middle = size * size // 2
+    window = np.empty(size * size)
+    best, least = -1, np.inf
+    for i in range(n):
+        r, c = rows[i], cols[i]
+        k = 0
+        below = 0
+        for dr in range(-half, half + 1):
+            rr = min(max(r + dr, 0), h - 1)
+            for dc in range(-half, half + 1):
+                cc = min(max(c + dc, 0), w - 1)
+                v = depth[rr, cc] if near[rr, cc] else np.inf
+                window[k] = v
+                k += 1
+                below += v < least
+        if best >= 0 and below <= middle:
+            continue  # at most ``middle`` values below the least: the median is not below it
+        for a in range(1, k):
+            v = window[a]
+            b = a
+            while b > 0 and window[b - 1] > v:
+                window[b] = window[b - 1]
+                b -= 1
+            window[b] = v
+        if best < 0 or window[middle] < least:
+            best, least = i, window[middle]
+    return rows[best], cols[best]
+
+
+@_njit
+def depth_step(depth: np.ndarray, mask: np.ndarray) -> float:
+    """:func:`symfruit.core.surface.depth_step`: the least non-zero ``|right - left|`` of horizontally neighbouring
+    pixels of ``mask`` that both hold depth (``> 0``), 0 with none. The twin's differences (NaN ones left out, as its
+    ``> 0`` leaves them): the same least, bit for bit."""
+    h, w = depth.shape
+    best = np.inf
+    found = False
+    for r in range(h):
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            if mask[r, c + 1] and mask[r, c] and a > 0 and b > 0:
+                d = abs(a - b)
+                if d > 0 and (not found or d < best):
+                    best, found = d, True
+    return float(best) if found else 0.0
+
+
+@_njit
+def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, out: np.ndarray) -> bool:
+    """``out`` (h, w) bool: :func:`symfruit.core.surface.fruit_surface`'s pixels of ``region`` with depth (``depth``
+    made 0 where it has none) within ``low`` .. ``high``, the twin's comparisons; whether there is any."""
+    h, w = depth.shape
+    some = False
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            hit = region[r, c] and z > 0 and z >= low and z <= high
+            out[r, c] = hit
+            some = some or hit
+    return some
+
+
+# --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
+
+
+@_njit
+def _root(parent: np.ndarray, i: int) -> int:
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@_njit
+def join_boxes(boxes: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.segment.colour._join_boxes` of ``boxes`` (n, 4) int64 rows ``(r0, r1, c0, c1)``: (m, 4). The
+    twin's rounds: the boxes that overlap along one axis and overlap or abut along the other joined (the same
+    connected groups, found by union-find instead of scipy's graph), each group's bounding box, ordered by its top row
+    and then by the least left column of its boxes on that row (no two groups share both); the boxes as they are
+    once no two join. Whole numbers: the same boxes in the same order."""
+    b = boxes.copy()
+    while b.shape[0] > 0:
+        n = b.shape[0]
+        parent = np.arange(n)
+        joined = False
+        for i in range(n):
+            for j in range(i + 1, n):
+                rows_over = b[i, 0] < b[j, 1] and b[j, 0] < b[i, 1]
+                rows_touch = b[i, 0] <= b[j, 1] and b[j, 0] <= b[i, 1]
+                cols_over = b[i, 2] < b[j, 3] and b[j, 2] < b[i, 3]
+                cols_touch = b[i, 2] <= b[j, 3] and b[j, 2] <= b[i, 3]
+                if (rows_over and cols_touch) or (rows_touch and cols_over):
+                    joined = True
+                    ri, rj = _root(parent, i), _root(parent, j)
+                    if ri != rj:
+                        parent[max(ri, rj)] = min(ri, rj)
+        if not joined:
+            break
+        group = np.empty(n, np.int64)
+        slot = np.full(n, -1, np.int64)
+        m = 0
+        for i in range(n):
+            r = _root(parent, i)
+            if slot[r] < 0:
+                slot[r] = m
+                m += 1
+            group[i] = slot[r]
+        big = np.iinfo(np.int64).max
+        top = np.full(m, big, np.int64)
+        left = np.full(m, big, np.int64)
+        first = np.full(m, big, np.int64)
+        bottom = np.zeros(m, np.int64)
+        right = np.zeros(m, np.int64)
+        for i in range(n):
+            g = group[i]
+            top[g] = min(top[g], b[i, 0])
+            left[g] = min(left[g], b[i, 2])
+            bottom[g] = max(bottom[g], b[i, 1])
+            right[g] = max(right[g], b[i, 3])
+        for i in range(n):
+            g = group[i]
+            if b[i, 0] == top[g]:
+                first[g] = min(first[g], b[i, 2])
+        by_first = np.argsort(first, kind="mergesort")
+        order = by_first[np.argsort(top[by_first], kind="mergesort")]
+        out = np.empty((m, 4), np.int64)
+        for k in range(m):
+            g = order[k]
+            out[k, 0], out[k, 1], out[k, 2], out[k, 3] = top[g], bottom[g], left[g], right[g]
+        b = out
+    return b
+
+
+@_njit
+def red_pixels(
+    c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.segment.colour._red_pixels` of ``c`` (h, w, 3) uint8 (a window of an image, any strides) with
+    its tables ``low``, ``high`` (256,) int16 and the hue test's ``sqrt(3)`` and ``tan(hue_max)``: the flat indices
+    (ascending, in the window) of the weakly and the strongly red pixels. Pixel by pixel, the twin's tests on the same
+    whole numbers and products: the same pixels."""
+    h, w = c.shape[0], c.shape[1]
+    weak = np.empty(h * w, np.int64)
+    strong = np.empty(h * w, np.int64)
+    n_weak = n_strong = 0
+    for r in range(h):
+        for q in range(w):
+            red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+            most = max(green, blue)
+            if red <= most or most > low[red]:
+                continue
+            weak[n_weak] = r * w + q
+            n_weak += 1
+            if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+                strong[n_strong] = r * w + q
+                n_strong += 1
+    return weak[:n_weak].copy(), strong[:n_strong].copy()
+
+
+@_njit
+def window_points(
+    mask: np.ndarray, depth: np.ndarray, r0: int, c0: int, cx: float, cy: float, focal: float, most: int
+) -> np.ndarray:  # fmt: skip
+    """:func:`symfruit.segment.colour._points`: (n, 3) the camera-frame points of the pixels of ``mask`` with depth
+    (``depth > 0``) in a window at ``(r0, c0)``, in raster order; at most ``most`` of them, picked as the twin's
+    ``np.linspace(0, n - 1, most)`` truncated (``k * step``, the last ``n - 1``). The same products and quotients:
+    the same points."""
+    h, w = mask.shape
+    rows = np.empty(h * w, np.int64)
+    cols = np.empty(h * w, np.int64)
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c] and depth[r, c] > 0:
+                rows[n], cols[n] = r, c
+                n += 1
+    m = n
+    if n > most:
+        m = most
+        step = float(n - 1) / (most - 1)
+        for k in range(most):
+            at = n - 1 if k == most - 1 else np.int64(k * step + 0.0)
+            rows[k], cols[k] = rows[at], cols[at]
+    out = np.empty((m, 3))
+    for k in range(m):
+        z = depth[rows[k], cols[k]]
+        out[k, 0] = float(cols[k] + c0) - cx
+        out[k, 0] = out[k, 0] * z / focal
+        out[k, 1] = float(rows[k] + r0) - cy
+        out[k, 1] = out[k, 1] * z / focal
+        out[k, 2] = z
+    return out
+
+
+@_njit
+def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._sphere`'s points ``p`` (n, 3; n >= 1, finite) kept after a fit: those whose
+    distance off the sphere (``|row_norm(p - centre) - radius|``, the twin's terms in its order) is at most 3 x
+    1.4826 times the median distance (:func:`_median_of`: np.median's value), or 1e-4. The same points."""
+    n = p.shape[0]
+    res = np.empty(n)
+    for i in range(n):
+        a, b, c = p[i, 0] - centre[0], p[i, 1] - centre[1], p[i, 2] - centre[2]
+        res[i] = abs(math.sqrt(a * a + b * b + c * c) - radius)
+    limit = 3.0 * _median_of(res.copy()) * 1.4826
+    if 1e-4 > limit:
+        limit = 1e-4
+    keep = 0
+    for i in range(n):
+        keep += res[i] <= limit
+    out = np.empty((keep, 3))
+    k = 0
+    for i in range(n):
+        if res[i] <= limit:
+            out[k, 0], out[k, 1], out[k, 2] = p[i, 0], p[i, 1], p[i, 2]
+            k += 1
+    return out

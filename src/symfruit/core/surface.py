@@ -114,6 +114,14 @@ def depth_step(depth: np.ndarray, mask: np.ndarray) -> float:
     depth : (h, w) float, metres (0: none)
     mask : (h, w) bool
     """
+    depth = np.asarray(depth)
+    if (
+        (jit := compiled()) is not None
+        and depth.ndim == 2
+        and depth.dtype.kind == "f"
+        and np.shape(mask) == depth.shape
+    ):
+        return jit.depth_step(depth, np.asarray(mask, dtype=bool))
     diff = np.abs(_neighbour_differences(depth, mask))
     diff = diff[diff > 0]
     return float(diff.min()) if len(diff) else 0.0
@@ -169,10 +177,21 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     Returns
     -------
     front, radius : float, metres (NaN when fewer than 10 depths are valid)
+
+    Where numba is, its compiled twin does the same steps (:func:`symfruit.core._jit.fruit_depth`: the same numbers,
+    bit for bit; issue 19, sixteenth round).
     """
     ok = np.isfinite(values) & (values > 0)
     kept = values[ok]
     z = np.sort(kept)
+    if (jit := compiled()) is not None and z.dtype == np.float64 and kept.ndim == 1 and (
+        leafy is None or np.shape(leafy) == np.shape(values)
+    ):  # fmt: skip
+        leaf = np.zeros(0, bool) if leafy is None else np.asarray(leafy, dtype=bool)[ok]
+        front, radius, done = jit.fruit_depth(z, kept, float(radius_px), float(focal), float(noise), leaf,
+                                              leafy is not None, (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        if done:
+            return float(front), float(radius)
     if len(z) < 10:
         return float("nan"), float("nan")
     half = len(z) // 2
@@ -366,10 +385,20 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
-    near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
-    if not near.any():
-        return None
+    if (jit := compiled()) is not None and depth.dtype == np.float64 and np.shape(region) == depth.shape:
+        near = np.empty(depth.shape, bool)  # the compiled twin of the comparisons below: the same pixels
+        if not jit.near_pixels(depth, np.asarray(region, dtype=bool), front - tol, front + slab * reach, near):
+            return None
+    else:
+        near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
+        if not near.any():
+            return None
     # the erosion treats pixels beyond the array as background, as the window's pixels beyond the box are
+    if (jit := compiled()) is not None:  # the compiled twin of what follows to the apex: the same pixel
+        whole = np.asarray(mask, dtype=bool)
+        apex = jit.surface_apex(whole[box], max(1, int(0.15 * radius_px)), near, depth, whole, r0, c0, 5)
+        return _surface(depth, mask, near, (int(apex[0]), int(apex[1])), tol, front, radius, noise, inner,
+                        interior * min(radius_px, 0.5 * minor_px))  # fmt: skip
     core = eroded(own, max(1, int(0.15 * radius_px))) & near[box]
     if core.any():
         rows, cols = np.nonzero(core)
@@ -383,9 +412,17 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     apex = (int(rows[first]), int(cols[first]))
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
+    deep_px = interior * min(radius_px, 0.5 * minor_px)
+    return _surface(depth, mask, near, apex, tol, front, radius, noise, inner, deep_px)
+
+
+def _surface(depth: np.ndarray, mask: np.ndarray, near: np.ndarray, apex: tuple[int, int], tol: float, front: float,
+             radius: float, noise: float, inner: np.ndarray | None, deep_px: float) -> Surface:  # fmt: skip
+    """:func:`fruit_surface` from its apex on: the convex cap from the apex, and every pixel of ``near`` deeper than
+    ``deep_px`` inside the mask (``inner``: the mask's distance map, when the caller has it)."""
     if inner is None or inner.shape != mask.shape:
         inner = inner_distance(mask)
-    deep = inner > interior * min(radius_px, 0.5 * minor_px)
+    deep = inner > deep_px
     return Surface(monotone_region(depth, near, apex, tol) | (near & deep), front, radius, noise, apex)
 
 

@@ -56,6 +56,7 @@ from typing import Literal, Protocol
 import numpy as np
 from scipy import ndimage
 
+from ..core.kernels import compiled
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
 from ..core.raster import distance_transform, fill_holes, mask_box, nearest_index
@@ -246,6 +247,11 @@ def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarr
     high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
     low[: s.dark + 1] = -1  # dark pixels are never red
     high[: s.dark + 1] = -1
+    if (jit := compiled()) is not None and c.dtype == np.uint8 and c.ndim == 3 and c.shape[2] == 3:
+        # the compiled twin of what follows (:func:`symfruit.core._jit.red_pixels`: the same pixels; issue 19, sixteenth
+        # round), on the window as it is
+        weak, strong = jit.red_pixels(c, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
+        return weak, strong
     # a weakly red pixel has R above max(G, B) (low[R] < R as red_low > 0): the tables are read for those
     # pixels alone (a look-up over the whole image converts every pixel's index to 64 bits first), and the
     # strong table for the weak ones alone (high <= low, as red_high >= red_low); on a contiguous copy (numpy's
@@ -654,7 +660,12 @@ def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, 
     painted pixels are 4-connected become their bounding box, ordered by its first pixel in raster order, as
     the labels of the painted image number them (``ndimage.label`` and ``find_objects``, worked out on the
     boxes instead of the grid); unchanged (in their own order) once no two join. The groups are the connected
-    components of the graph of touching boxes (scipy's, not a union-find in Python over the pairs)."""
+    components of the graph of touching boxes (scipy's, not a union-find in Python over the pairs). Where numba is,
+    its compiled twin does the same rounds (:func:`symfruit.core._jit.join_boxes`: the same boxes in the same order;
+    issue 19, sixteenth round)."""
+    if boxes and (jit := compiled()) is not None:
+        joined = jit.join_boxes(np.array(boxes, np.int64)).tolist()
+        return [(r0, r1, c0, c1) for r0, r1, c0, c1 in joined]
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
 
@@ -1181,6 +1192,9 @@ def _points(
 ) -> np.ndarray:
     """(n, 3) camera-frame points (metres) of the mask's pixels with depth, in a window at ``origin``; at
     most ``most`` of them, evenly picked."""
+    if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:  # the same points
+        return jit.window_points(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
+                                 float(geo.focal), int(most))  # fmt: skip
     rows, cols = np.nonzero(mask & (depth > 0))
     if len(rows) > most:
         pick = np.linspace(0, len(rows) - 1, most).astype(np.int64)
@@ -1223,6 +1237,9 @@ def _sphere(
         sol, *_ = np.linalg.lstsq(a, p[:, 0] * p[:, 0] + p[:, 1] * p[:, 1] + p[:, 2] * p[:, 2], rcond=None)
         centre = sol[:3]
         radius = float(np.sqrt(max(float(sol[3] + centre @ centre), 0.0)))
+        if (jit := compiled()) is not None and np.isfinite(centre).all() and np.isfinite(radius):  # the same points
+            p = jit.sphere_inliers(p, np.ascontiguousarray(centre), radius)
+            continue
         res = np.abs(row_norms(p - centre) - radius)
         p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
     if not (np.isfinite(radius) and 0.25 * spread <= radius <= 4.0 * spread):
