@@ -31,6 +31,49 @@ def test_constrained_boxes_hold_the_seen_box_behind_the_front(values, contour):
     assert np.all(out_lo >= np.minimum(far - reach, near) - 1e-12)
 
 
+def _former_constrain_box(lo, hi, seen_lo, seen_hi, front, *, cone=None, contour=1.0, pull=None):
+    """constrain_box as numpy arrays made it before issue 19's sixteenth round (Python floats since)."""
+    seen_lo = np.concatenate((seen_lo[:2], [front]))
+    seen_hi = np.maximum(seen_hi, seen_lo)
+    reach = REACH / max(contour, 0.5) * (seen_hi - seen_lo)
+    lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)
+    hi = np.maximum(np.minimum(np.asarray(hi, dtype=np.float64), seen_lo + reach), seen_hi)
+    lo[2] = front
+    hi[2] = max(hi[2], front + 1e-4)
+    if cone is not None:
+        (u_lo, v_lo, u_hi, v_hi), camera = cone
+        zs = np.array([lo[2], hi[2]])
+        bound_lo = np.array([((u_lo - camera.cx) / camera.fx * zs).min(), ((v_lo - camera.cy) / camera.fy * zs).min()])
+        bound_hi = np.array([((u_hi - camera.cx) / camera.fx * zs).max(), ((v_hi - camera.cy) / camera.fy * zs).max()])
+        share = contour if pull is None else pull
+        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + share * np.maximum(bound_lo - lo[:2], 0.0))
+        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - share * np.maximum(hi[:2] - bound_hi, 0.0))
+    return lo, hi
+
+
+edge = st.one_of(st.floats(-0.06, 0.06), st.sampled_from([0.0, -0.0, 0.4, np.inf, -np.inf, np.nan]))
+
+
+@given(st.lists(edge, min_size=12, max_size=12), st.floats(0.3, 0.5), st.sampled_from([0.0, 0.3, 1.0, np.float64(0.7)]),
+       st.one_of(st.none(), st.lists(st.one_of(st.floats(-50.0, 700.0), st.sampled_from([-np.inf, np.inf, 320.0])),
+                                     min_size=4, max_size=4)), st.sampled_from([None, 1.0, 0.5]))  # fmt: skip
+def test_constrain_box_is_the_former_array_arithmetic_to_the_bit(values, front, contour, pixels, pull):
+    """Any box, seen box, front, contour, pixel bounds (unbounded sides included) and pull, NaN and signed zeros
+    included: the same numbers as the former numpy arrays gave, bit for bit (a NaN where it gave NaN, whatever its
+    sign and payload)."""
+    v = np.array(values)
+    cone = None if pixels is None else (tuple(pixels), DEFAULT_CAMERA)
+    args = (v[:3], v[3:6], v[6:9] + [0, 0, 0.4], v[9:] + [0, 0, 0.4], front)
+    with np.errstate(invalid="ignore", over="ignore"):
+        got = constrain_box(*args, cone=cone, contour=contour, pull=pull)
+        want = _former_constrain_box(*args, cone=cone, contour=contour, pull=pull)
+    for a, b in zip(got, want, strict=True):
+        assert a.dtype == b.dtype == np.float64 and a.shape == b.shape == (3,)
+        assert np.array_equal(np.isnan(a), np.isnan(b))
+        ok = ~np.isnan(a)
+        assert a[ok].tobytes() == b[ok].tobytes()  # signed zeros too
+
+
 def test_a_box_wider_than_the_silhouette_cone_is_pulled_back():
     seen_lo, seen_hi = np.array([-0.01, -0.01, 0.39]), np.array([0.01, 0.01, 0.40])
     uv_lo = DEFAULT_CAMERA.project(np.array([[-0.01, -0.01, 0.40]]))[0]

@@ -100,6 +100,30 @@ def test_select_partitions_in_place(seed, n, ties):
     assert (y[:kth] <= y[kth]).all() and (y[kth + 1 :] >= y[kth]).all()
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(1, 700), st.sampled_from(["normal", "ties", "sorted", "reversed",
+                                                                        "equal", "heavy"]))  # fmt: skip
+def test_kth_smallest_is_the_partitions(seed, n, kind):
+    rng = np.random.default_rng(seed)
+    x = {"normal": rng.normal(size=n), "ties": rng.integers(0, 4, n).astype(float), "sorted": np.sort(rng.random(n)),
+         "reversed": np.sort(rng.random(n))[::-1].copy(), "equal": np.full(n, 0.25),
+         "heavy": rng.standard_exponential(n) ** 4}[kind]  # fmt: skip
+    before = x.copy()
+    for kth in {0, n - 1, int(rng.integers(n)), max(0, int(0.8 * n) - 1)}:
+        assert _jit.kth_smallest(x, kth, np.empty(n), np.empty(n)) == np.partition(x, kth)[kth]
+    assert np.array_equal(x, before)  # left as it was
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 600), st.booleans())
+def test_smallest_mean_is_the_mean_of_a_partitions_first_places(seed, n, ties):
+    rng = np.random.default_rng(seed)
+    x = rng.standard_exponential(n) ** 2
+    if ties:
+        x = np.round(x, 1)
+    keep = int(rng.integers(1, n + 1))
+    want = np.partition(x, keep - 1)[:keep].mean()
+    assert _jit.smallest_mean(x, keep, np.empty(n), np.empty(n)) == pytest.approx(want, rel=1e-13, abs=1e-300)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 5))
 def test_solve_is_numpys_solve(seed, n):
     rng = np.random.default_rng(seed)
@@ -131,6 +155,28 @@ def test_slice_costs_are_the_twins(seed, k, n):
     dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
     fast, twin = _jit.slice_costs(q, dirs, 12), _slice_costs(q, dirs, 12)
     np.testing.assert_allclose(fast, twin, rtol=1e-7, atol=1e-12 * scale**2)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(30, 400), st.integers(0, 6), st.integers(0, 2))
+def test_revolution_search_is_the_searchs_steps(seed, n, extra, refine):
+    """The search in one call: the coarse directions' least cost, then each cap's about the best so far, as the
+    twin's loop takes them (each cap's rows within rounding: BLAS may sum the twin's product otherwise)."""
+    from symfruit.core.fits import _COARSE, _cap, _cap_locals
+
+    rng = np.random.default_rng(seed)
+    points = FRUITS["pear"](rng).sample(2 * n, rng) @ rotation(*rng.uniform(0.0, 360.0, 3)).T
+    q = points[points[:, 2] <= np.median(points[:, 2])]  # the half nearer a camera looking along +z
+    q = np.ascontiguousarray(q - q.mean(axis=0))
+    more = rng.normal(size=(extra, 3))
+    more /= np.linalg.norm(more, axis=1, keepdims=True)
+    dirs = np.ascontiguousarray(np.vstack([_COARSE, more * np.where(more[:, 2:3] < 0, -1.0, 1.0)]))
+    spreads = (12.0, 4.0, 1.5)[:refine]
+    best = dirs[int(np.argmin(_jit.slice_costs(q, dirs, 12)))]
+    for spread in spreads:
+        cand = _cap(best, spread, 16)
+        best = cand[int(np.argmin(_jit.slice_costs(q, cand, 12)))]
+    found = _jit.revolution_search(q, dirs, 12, _cap_locals(spreads, 16))
+    np.testing.assert_allclose(found, best, atol=1e-14)
 
 
 @pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3), ("citrus", 4)])
@@ -410,6 +456,28 @@ def test_square_filter_is_scipys(seed, h, w, radius, every):
     assert np.array_equal(out, scipys(mask, size=2 * radius + 1, mode="constant", cval=False))
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(0, 5), st.booleans())
+def test_occluded_at_is_the_twins(seed, radius, cached):
+    """Occlusion.at by the kernel (each pixel's square looked through) against the twin (the grown map over the
+    pixels' box, or the whole window's when made before): pixels inside and outside the window and the image,
+    on its border, half-way between two, and NaN or infinite ones."""
+    from symfruit.core.occlusion import Occlusion
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    hidden = _blobs(rng, h, w, rng.uniform(0.0, 0.2))
+    occ = Occlusion(int(rng.integers(0, 20)), int(rng.integers(0, 20)), hidden, 80, 75)
+    u, v = rng.uniform(-5, 85, 300), rng.uniform(-5, 80, 300)
+    u[::7], v[::5] = np.round(u[::7]) + 0.5, np.round(v[::5])  # ties of the rounding, whole pixels
+    u[:4], v[4:8] = [np.nan, np.inf, -np.inf, 1e30], [np.nan, -np.inf, np.inf, -1e30]
+    if cached:
+        occ.grown(radius)
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):
+        fast, twin = _both(mp, occ.at, u, v, radius=radius)
+        one, one_twin = _both(mp, occ.at, u[10:11], v[10:11], radius=radius)
+    assert fast.dtype == twin.dtype == bool and np.array_equal(fast, twin) and np.array_equal(one, one_twin)
+
+
 @given(st.integers(0, 2**32 - 1), st.integers(1, 5))
 def test_grown_occlusion_is_the_twins(seed, radius):
     """Occlusion.at with a radius and Occlusion.window (their grown maps, filtered by the kernel or by scipy)."""
@@ -619,6 +687,29 @@ def test_neighbour_covariances_are_the_twins(seed, n, step, small, extra):
         np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
 
 
+@given(st.integers(0, 2**32 - 1), st.integers(2, 300), st.integers(1, 40), st.integers(1, 30), st.booleans())
+def test_neighbour_covariances_keep_the_nearest_in_order_ties_by_index(seed, n, step, large, nan):
+    """The nearest ``large`` of each query in the order of a stable sort of the distances (ties by index), their
+    scatter summed in that order: bit for bit, on a lattice's whole-number coordinates (ties everywhere); with a
+    NaN coordinate the kernel falls back to offering every point in turn (checked here only to run)."""
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, 4, size=(n, 3)).astype(np.float64) * 0.001
+    large = min(large, n)
+    small = int(rng.integers(1, large + 1))
+    if nan:
+        pts[int(rng.integers(n)), int(rng.integers(3))] = np.nan
+    fast_small, fast_large = _jit.neighbour_covariances(pts, step, small, large)
+    scatter = np.empty((3, 3))
+    for row, q in enumerate(range(0, n, step)):
+        d = ((pts - pts[q]) ** 2).sum(axis=1)
+        order = np.argsort(d, kind="stable")  # NaN last
+        if nan and np.isnan(d).any():
+            continue  # the insertion's own handling of NaN (the former kernel's), not a sort's
+        for kk, fast in ((small, fast_small), (large, fast_large)):
+            _jit._scatter(pts, order, kk, scatter)
+            assert np.array_equal(fast[row], scatter / kk)
+
+
 @pytest.mark.parametrize("kind,noise,queries", [("apple", 0.0, 120), ("pear", 0.002, 40), ("banana", 0.001, 7)])
 def test_surface_noise_is_the_twins(monkeypatch, kind, noise, queries):
     from symfruit.core.fits import surface_noise
@@ -680,6 +771,70 @@ def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
             fast, twin = _both(monkeypatch, explain, quadric, box, obs)
             assert fast.depth == pytest.approx(twin.depth, rel=1e-9, abs=1e-15)
             assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_explain_of_a_solid_of_revolution_is_the_twins(monkeypatch, seed):
+    """The measures of marched rays (:func:`symfruit.core._jit.agreement`) against the twin's numpy ones, the rays
+    met alike (the march kernel's hits are the twin's): solids of revolution fitted to the view and moved about
+    it, with and without the frame's depth beside the fruit; the depth RMS within rounding, the shares equal."""
+    from dataclasses import replace
+
+    from symfruit.core import agreement
+    from symfruit.core.agreement import explain, observe
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.fits import RevolutionInside, revolution_box
+    from symfruit.core.occlusion import occlusion
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, occluded_view
+
+    rng = np.random.default_rng(seed)
+    centre = np.array([0.01 * seed, -0.005, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
+                                            seed=seed)  # fmt: skip
+    region = silhouette(visible, camera)
+    occ = occlusion(depth, mask, visible, camera)
+    rev = fit_revolution_slices(visible[::3])
+    for o in (None, occ):
+        obs = observe(visible[::10], region, camera, dense=visible, occlusion=o)
+        for k in range(6):
+            moved = replace(rev, point=rev.point + rng.normal(0.0, 0.006, 3) * (k > 0), radii=rev.radii * (1 + 0.1 * k))
+            inside = RevolutionInside(moved)
+            box = revolution_box(moved)
+            monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)  # the kernel's march, whatever the run's setting
+            marched = inside.march(agreement._bands(obs).rays, float(box[0][2]) - 1e-3, float(box[1][2]) + 1e-3, 24)
+            assert marched is not None
+            monkeypatch.setattr(RevolutionInside, "march", lambda self, *a, hits=marched: hits)  # the same hits
+            fast, twin = _both(monkeypatch, explain, inside, box, obs)
+            monkeypatch.undo()
+            assert fast.depth == pytest.approx(twin.depth, rel=1e-9, abs=1e-15)
+            assert (fast.inside, fast.outside) == (twin.inside, twin.outside)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.sampled_from([0.0, 0.5, 1.0, 3.0]),
+       st.booleans())  # fmt: skip
+def test_rim_coverage_is_the_twins_to_the_bit(seed, h, w, fill_radius, given_map):
+    """evidence.rim_coverage by the kernel against the twin: random regions (blobs: empty rims or interiors too),
+    points on pixels inside and outside the window and on rounding ties, one at NaN, sparse clouds' filled points
+    (the twin's maximum filter with its reflected border) and dense ones, with the distance map given or made."""
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.raster import Silhouette, inner_distance
+    from symfruit.methods.evidence import rim_coverage
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.05, 0.6))
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 400)), mask, fill_radius)
+    n = int(rng.integers(1, 2 * h * w + 2))
+    u = region.u0 + rng.integers(-3, w + 3, n) + rng.choice([0.0, 0.5, -0.5, 0.3], n)
+    v = region.v0 + rng.integers(-3, h + 3, n) + rng.choice([0.0, 0.5, -0.4], n)
+    z = rng.uniform(0.3, 0.6, n)
+    points = np.stack(((u - camera.cx) * z / camera.fx, (v - camera.cy) * z / camera.fy, z), axis=1)
+    points[0, 0] = np.nan
+    inner = inner_distance(mask) if given_map else None
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):
+        fast, twin = _both(mp, rim_coverage, points, region, camera, inner=inner)
+    assert fast == twin and type(fast) is type(twin) is float
 
 
 # --- the fruit's surface, the registration's outlines and colour trimming (core.surface, core.raster) -------

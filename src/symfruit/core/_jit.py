@@ -91,9 +91,100 @@ def select(x: np.ndarray, kth: int) -> None:
 
 
 @_njit
+def _sorted_sample(src: np.ndarray, lo: int, size: int, count: int, out: np.ndarray) -> None:
+    """``out[:count]``: ``count`` evenly spaced values of ``src[lo:lo + size]`` (the first and the last among them),
+    sorted by insertion."""
+    for i in range(count):
+        v = src[lo + (i * (size - 1)) // (count - 1)]
+        j = i
+        while j > 0 and out[j - 1] > v:
+            out[j] = out[j - 1]
+            j -= 1
+        out[j] = v
+
+
+@_njit
+def kth_smallest(x: np.ndarray, kth: int, a: np.ndarray, b: np.ndarray) -> float:
+    """The ``kth`` smallest value of ``x`` (n,) (``np.partition(x, kth)[kth]``), ``x`` left as it is; ``a`` and
+    ``b`` (n,) scratch. Quickselect without its branches (issue 19, sixteenth round): :func:`select`'s
+    comparisons go either way at random, and their mispredictions were most of its time. Each round takes 15
+    evenly spaced values as a sample, brackets ``kth``'s share of them by the sample's values two places either
+    side, and in one pass counts the values below the bracket and copies those within it to a scratch array
+    (every value written, the count advanced by the comparison); when ``kth`` falls outside the bracket (or the
+    bracket keeps everything), a three-way pass about one sampled value (the lower values to the front, the
+    higher to the back, the rest equal to it) takes its place. Both passes keep at least one value fewer, or
+    end; the last 32 values or fewer are sorted by insertion. The values compared are ``x``'s, so the result is
+    exactly the ``kth`` smallest (NaN, which no comparison orders, counts as equal to the pivots there)."""
+    size = x.shape[0]
+    src, dst, other = x, a, b
+    lo = 0
+    sample = np.empty(32)
+    while size > 32:
+        _sorted_sample(src, lo, size, 15, sample)
+        r = (kth * 14 + (size - 1) // 2) // (size - 1)  # kth's place among the 15
+        p = sample[r]
+        below = sample[r - 2] if r >= 2 else -np.inf
+        above = sample[r + 2] if r <= 12 else np.inf
+        if below < above:
+            n_lo = 0
+            m = 0
+            for i in range(lo, lo + size):
+                v = src[i]
+                dst[m] = v
+                m += (v >= below) & (v <= above)
+                n_lo += v < below
+            if n_lo <= kth < n_lo + m and m < size:
+                kth -= n_lo
+                lo, size = 0, m
+                src, dst, other = dst, other, dst
+                continue
+            p = below if kth < n_lo else above if kth >= n_lo + m else p
+        n_lo = 0
+        n_hi = 0
+        top = size - 1
+        for i in range(lo, lo + size):  # three ways about p, into dst's front and back
+            v = src[i]
+            dst[n_lo] = v
+            n_lo += v < p
+            dst[top - n_hi] = v
+            n_hi += v > p
+        if kth < n_lo:
+            lo, size = 0, n_lo
+        elif kth < size - n_hi:
+            return p
+        else:
+            kth -= size - n_hi
+            lo, size = size - n_hi, n_hi
+        src, dst, other = dst, other, dst
+    if size == 1:
+        return src[lo]
+    _sorted_sample(src, lo, size, size, sample)
+    return sample[kth]
+
+
+@_njit
+def smallest_mean(x: np.ndarray, keep: int, a: np.ndarray, b: np.ndarray) -> float:
+    """The mean of the ``keep`` smallest values of ``x`` (n,), ``1 <= keep <= n`` (``x`` left as it is; ``a``, ``b``
+    (n,) scratch): those below the ``keep``-th smallest (:func:`kth_smallest`) added in ``x``'s order, then that
+    value times the places left (its ties), over ``keep``. The same values as the mean of a partition's first
+    ``keep``, added in another order."""
+    thr = kth_smallest(x, keep - 1, a, b)
+    total = 0.0
+    count = 0
+    for i in range(x.shape[0]):
+        v = x[i]
+        lt = v < thr
+        total += v if lt else 0.0  # no branch: which values lie below is as unpredictable as in the selection
+        count += lt
+    return (total + (keep - count) * thr) / keep
+
+
+@_njit
 def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     """:func:`symfruit.core.fits._slice_costs`: the robust slice-circle cost (k,) of every direction (k, 3) for
-    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused)."""
+    centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused), each
+    direction's lower 80 % of the squared distances averaged by :func:`smallest_mean` (issue 19, sixteenth round;
+    :func:`select` and a sum of its first places before: the same values, added in another order)."""
     k, n = dirs.shape[0], q.shape[0]
     out = np.empty(k)
     t = np.empty(n)
@@ -103,6 +194,8 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     cv = np.empty(n)
     idx = np.empty(n, np.int64)
     dist2 = np.empty(n)
+    scratch_a = np.empty(n)
+    scratch_b = np.empty(n)
     cnt = np.empty(bins)
     su = np.empty(bins)
     sv = np.empty(bins)
@@ -167,12 +260,55 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
             rv = v[i] - av
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
             dist2[i] = res * res / rho2
-        select(dist2, keep - 1)
-        total = 0.0
-        for i in range(keep):
-            total += dist2[i]
-        out[j] = total / keep
+        out[j] = smallest_mean(dist2, keep, scratch_a, scratch_b)
     return out
+
+
+@_njit
+def _least(costs: np.ndarray) -> int:
+    """``np.argmin(costs)``: the first NaN, else the first least value."""
+    best = 0
+    for i in range(costs.shape[0]):
+        if math.isnan(costs[i]):
+            return i
+        if costs[i] < costs[best]:
+            best = i
+    return best
+
+
+@_njit
+def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.fits.fit_revolution_slices`' direction search in one call (issue 19, sixteenth round):
+    the least :func:`slice_costs` of the coarse directions ``dirs`` (k, 3), then for each of the refining caps
+    ``caps`` (r, m, 3) (:func:`symfruit.core.fits._cap_local`'s, about ``+z``) the least of the best direction so
+    far and the cap turned about it (:func:`symfruit.core.fits._cap`: the basis of
+    :func:`~symfruit.core.points.perpendicular_basis`, each row ``l0 e1 + l1 e2 + l2 d`` summed left to right, where
+    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,)."""
+    best = dirs[_least(slice_costs(q, dirs, bins))].copy()
+    m = caps.shape[1]
+    cand = np.empty((m + 1, 3))
+    for r in range(caps.shape[0]):
+        x, y, z = best[0], best[1], best[2]
+        if abs(x) < 0.9:  # the basis of core.points.perpendicular_basis
+            a, b, c = 0.0, z, -y
+        else:
+            a, b, c = -z, 0.0, x
+        norm = math.sqrt(a * a + b * b + c * c)
+        a, b, c = a / norm, b / norm, c / norm
+        f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
+        cand[0, 0], cand[0, 1], cand[0, 2] = x, y, z
+        for i in range(m):
+            l0, l1, l2 = caps[r, i, 0], caps[r, i, 1], caps[r, i, 2]
+            c0 = l0 * a + l1 * f + l2 * x
+            c1 = l0 * b + l1 * g + l2 * y
+            c2 = l0 * c + l1 * h + l2 * z
+            if c2 < 0:
+                c0, c1, c2 = -c0, -c1, -c2
+            cand[i + 1, 0], cand[i + 1, 1], cand[i + 1, 2] = c0, c1, c2
+        if cand[0, 2] < 0:
+            cand[0, 0], cand[0, 1], cand[0, 2] = -x, -y, -z
+        best = cand[_least(slice_costs(q, cand, bins))].copy()
+    return best
 
 
 @_njit
@@ -583,33 +719,59 @@ def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int)
     (3, 3) of its ``small`` and its ``large`` nearest points (itself among them; ``small <= large <= n``), each
     about its own mean: ``(m, 3, 3), (m, 3, 3)``. The nearest by brute force (every squared distance, the
     nearest ``large`` kept in order, ties by index: the same points as the twin's search tree but where a tie
-    straddles the last place), not a search tree: a few thousand points are fewer operations than building one."""
+    straddles the last place), not a search tree: a few thousand points are fewer operations than building one.
+    Since the sixteenth round of issue 19 the ``large``-th least distance is found first (:func:`kth_smallest`)
+    and only the points no farther are put in order (by insertion, ties by index): the same points in the same
+    order as inserting every point into the ``large`` kept (which it does where a distance is NaN), in about
+    half the time."""
     n = points.shape[0]
     m = (n + step - 1) // step
     out_small = np.empty((m, 3, 3))
     out_large = np.empty((m, 3, 3))
-    best_d = np.empty(large)
-    best_i = np.empty(large, np.int64)
+    best_d = np.empty(n)
+    best_i = np.empty(n, np.int64)
+    dist = np.empty(n)
+    scratch_a = np.empty(n)
+    scratch_b = np.empty(n)
     scatter = np.empty((3, 3))
     for q in range(m):
         x, y, z = points[q * step, 0], points[q * step, 1], points[q * step, 2]
-        count = 0
+        finite = True
         for j in range(n):
             dx, dy, dz = points[j, 0] - x, points[j, 1] - y, points[j, 2] - z
-            d = dx * dx + dy * dy + dz * dz
-            if count == large:
-                if not d < best_d[large - 1]:
-                    continue
-                slot = large - 1
-            else:
-                slot = count
-                count += 1
-            while slot > 0 and best_d[slot - 1] > d:  # insertion: the kept ones stay sorted, ties in index order
-                best_d[slot] = best_d[slot - 1]
-                best_i[slot] = best_i[slot - 1]
-                slot -= 1
-            best_d[slot] = d
-            best_i[slot] = j
+            dist[j] = dx * dx + dy * dy + dz * dz
+            finite &= not math.isnan(dist[j])
+        if finite:  # the points within the large-th distance, in order (ties by index)
+            limit = kth_smallest(dist, large - 1, scratch_a, scratch_b)
+            count = 0
+            for j in range(n):
+                d = dist[j]
+                if d <= limit:
+                    slot = count
+                    count += 1
+                    while slot > 0 and best_d[slot - 1] > d:
+                        best_d[slot] = best_d[slot - 1]
+                        best_i[slot] = best_i[slot - 1]
+                        slot -= 1
+                    best_d[slot] = d
+                    best_i[slot] = j
+        else:  # every point offered to the large kept in order
+            count = 0
+            for j in range(n):
+                d = dist[j]
+                if count == large:
+                    if not d < best_d[large - 1]:
+                        continue
+                    slot = large - 1
+                else:
+                    slot = count
+                    count += 1
+                while slot > 0 and best_d[slot - 1] > d:  # insertion: the kept ones stay sorted, ties in index order
+                    best_d[slot] = best_d[slot - 1]
+                    best_i[slot] = best_i[slot - 1]
+                    slot -= 1
+                best_d[slot] = d
+                best_i[slot] = j
         for kk, out in ((small, out_small), (large, out_large)):
             _scatter(points, best_i, kk, scatter)
             for r in range(3):
@@ -640,6 +802,98 @@ def inside_px(
         iv = np.int64(v) if -big <= v < big else least
         out[i] = inner[min(max(iv - np.int64(v0), 0), h - 1), min(max(iu - np.int64(u0), 0), w - 1)]
     return out
+
+
+@_njit
+def occluded_at(
+    u: np.ndarray, v: np.ndarray, hidden: np.ndarray, u0: int, v0: int, width: int, height: int, radius: int
+) -> np.ndarray:
+    """:meth:`symfruit.core.occlusion.Occlusion.at`: whether each pixel ``(u, v)`` (m,) (rounded half to even) lies
+    within ``radius`` of the image's border or has a hidden pixel of the window ``hidden`` (h, w) at ``(u0, v0)``
+    within ``radius`` (a square; the window's own pixels alone), by looking through the square (issue 19,
+    sixteenth round; the twin filters the hidden pixels' map over the pixels' box): the twin's booleans. A
+    coordinate numpy's integer conversion cannot hold (NaN, infinite, past 2^63) becomes its smallest integer
+    there, and so here, as :func:`inside_px` does."""
+    h, w = hidden.shape
+    n = u.shape[0]
+    out = np.empty(n, np.bool_)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        fu, fv = np.rint(u[i]), np.rint(v[i])
+        col = np.int64(fu) if -big <= fu < big else least
+        row = np.int64(fv) if -big <= fv < big else least
+        o = col < radius or col >= width - radius or row < radius or row >= height - radius
+        c, r = col - np.int64(u0), row - np.int64(v0)
+        if not o and 0 <= c < w and 0 <= r < h:
+            if radius <= 0:
+                o = hidden[r, c]
+            else:
+                for rr in range(max(r - radius, 0), min(r + radius + 1, h)):
+                    for cc in range(max(c - radius, 0), min(c + radius + 1, w)):
+                        if hidden[rr, cc]:
+                            o = True
+                            break
+                    if o:
+                        break
+        out[i] = o
+    return out
+
+
+@_njit
+def rim_coverage(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, mask: np.ndarray,
+    inner: np.ndarray, width: float, fill: int,
+) -> float:  # fmt: skip
+    """:func:`symfruit.methods.evidence.rim_coverage` once its rim width and distance map are known: the share of the
+    region's (``mask`` (h, w) at ``(u0, v0)``) rim pixels (``inner <= width``) holding a point's pixel
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, as :func:`inside_px`; a point
+    off the window holds none), over the share of its other pixels, at most 1 (1 where either part is empty or no
+    other pixel holds a point); with ``fill > 0`` a point holds the ``2 fill + 1`` square about its pixel (the
+    twin's maximum filter: its reflected border repeats pixels already within the square, as the window's edge
+    cut here). Counts of whole numbers and the twin's two divisions: its value to the bit (issue 19, sixteenth
+    round)."""
+    h, w = mask.shape
+    rim = np.zeros((h, w), np.bool_)
+    n_rim = n_rest = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                if inner[r, c] <= width:
+                    rim[r, c] = True
+                    n_rim += 1
+                else:
+                    n_rest += 1
+    if n_rim == 0 or n_rest == 0:
+        return 1.0
+    hit = np.zeros((h, w), np.bool_)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(points.shape[0]):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        col = (np.int64(u) if -big <= u < big else least) - np.int64(u0)
+        row = (np.int64(v) if -big <= v < big else least) - np.int64(v0)
+        if 0 <= col < w and 0 <= row < h:
+            hit[row, col] = True
+    if fill > 0:
+        grown = np.empty((h, w), np.bool_)
+        square_filter(hit, fill, False, grown)
+        hit = grown
+    hit_rim = hit_rest = 0
+    for r in range(h):
+        for c in range(w):
+            if hit[r, c] and mask[r, c]:
+                if rim[r, c]:
+                    hit_rim += 1
+                else:
+                    hit_rest += 1
+    interior = hit_rest / n_rest
+    if interior <= 0:
+        return 1.0
+    share = hit_rim / n_rim / interior
+    return share if share < 1.0 else 1.0
 
 
 @_njit
@@ -1618,7 +1872,6 @@ def explain_quadric(
     sum and of the products making each ray's quadratic (numpy's ``einsum`` and BLAS there): the depth RMS within
     rounding of the twin's (grazing rays' roots the most), the band shares, counts of whole numbers (the outside
     weights are 0 or 1), equal."""
-    n = depth.shape[0]
     m = rays.shape[0]
     s = np.empty(3)
     for i in range(3):
@@ -1638,15 +1891,37 @@ def explain_quadric(
         near, far = (b - root) / a, (b + root) / a
         hit[k] = disc > 0.0 and near < z1 and far > z0
         at[k] = max(near, z0) if hit[k] else np.nan
+    return agreement(hit, at, z0, z1, depth, keep, in_starts, in_sizes, out_starts, out_w, out_wsum, seen, free)
+
+
+@_njit
+def agreement(
+    hit: np.ndarray,
+    at: np.ndarray,
+    z0: float,
+    z1: float,
+    depth: np.ndarray,
+    keep: int,
+    in_starts: np.ndarray,
+    in_sizes: np.ndarray,
+    out_starts: np.ndarray,
+    out_w: np.ndarray,
+    out_wsum: np.ndarray,
+    seen: np.ndarray,
+    free: float,
+) -> tuple[float, float, float]:
+    """:func:`symfruit.core.agreement.explain`'s measures from where each ray meets the candidate (``hit`` (m,)
+    bool, ``at`` (m,) its entry depth): ``(depth RMS, inside, outside)``, the rays and bands as
+    :func:`explain_quadric`'s (which ends here; the solids of revolution's marched rays since issue 19's
+    sixteenth round). The trimmed RMS by :func:`smallest_mean` (within rounding of the twin's partition and
+    mean), the band shares from counts of whole numbers (the outside weights are 0 or 1): the twin's."""
+    n = depth.shape[0]
+    m = hit.shape[0]
     r2 = np.empty(n)
     for k in range(n):
         r = depth[k] - at[k] if hit[k] else z1 - z0
         r2[k] = r * r
-    select(r2, keep - 1)
-    total = 0.0
-    for k in range(keep):
-        total += r2[k]
-    rms = math.sqrt(total / keep)
+    rms = math.sqrt(smallest_mean(r2, keep, np.empty(n), np.empty(n)))
     n_bands = in_starts.shape[0]
     inside = 0.0
     for j in range(n_bands):

@@ -511,7 +511,8 @@ def explain(
         (a :class:`Quadric`) is met in closed form instead of marched, one with a ``march(rays, z0, z1, steps)``
         method (:class:`symfruit.core.fits.RevolutionInside`) marches its own rays where it can (None: not). A
         :class:`Quadric` is measured by the compiled twin :func:`symfruit.core._jit.explain_quadric` where numba
-        is installed (one pass over the rays: 9 against 120 us; the depth RMS within rounding, the same shares).
+        is installed (one pass over the rays: 9 against 120 us; the depth RMS within rounding, the same shares),
+        any other shape's rays, once met, by its last step, :func:`symfruit.core._jit.agreement`.
     box : ((3,), (3,)) float, metres
         The candidate's box: the rays are met over its depth range (1 mm beyond on both sides).
     obs : Observation
@@ -542,6 +543,13 @@ def explain(
         hit_all, depth_all = march(inside, every, z0, z1, steps=steps)
     else:
         hit_all, depth_all = marched
+    if n and (jit := compiled()) is not None:  # the measures below, compiled (explain_quadric's own)
+        b = _bands(obs)
+        rms, ins, outs = jit.agreement(np.ascontiguousarray(hit_all, dtype=bool),
+                                       np.ascontiguousarray(depth_all, dtype=np.float64), z0, z1, obs.depth,
+                                       max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
+                                       b.out_wsum, np.empty(0) if b.seen is None else b.seen, free)  # fmt: skip
+        return Agreement(depth=rms, inside=ins, outside=outs)
     hit, depth = hit_all[:n], depth_all[:n]
     res = np.where(hit, obs.depth - np.where(hit, depth, 0.0), z1 - z0)
     keep = max(1, int(trim * len(res)))

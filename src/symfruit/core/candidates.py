@@ -112,22 +112,42 @@ def constrain_box(
        edge is a contour; with occlusion information the box is where the fruit can project at all, and
        ``pull = 1`` brings every side back to it).
     """
-    seen_lo = np.concatenate((seen_lo[:2], [front]))
-    seen_hi = np.maximum(seen_hi, seen_lo)
-    reach = REACH / max(contour, REACH_FLOOR) * (seen_hi - seen_lo)
-    lo = np.minimum(np.maximum(np.asarray(lo, dtype=np.float64), seen_hi - reach), seen_lo)
-    hi = np.maximum(np.minimum(np.asarray(hi, dtype=np.float64), seen_lo + reach), seen_hi)
-    lo[2] = front
-    hi[2] = max(hi[2], front + 1e-4)
+    # Component by component in Python floats (issue 19, sixteenth round): the arithmetic of numpy's (3,) arrays
+    # (np.minimum / np.maximum as _lesser / _greater: NaN carried, the second of equals), without some 40 numpy
+    # calls' overhead on three numbers (about 40 calls a frame).
+    s_lo = np.asarray(seen_lo, dtype=np.float64).tolist()
+    s_lo[2] = float(front)
+    s_hi = [_greater(a, b) for a, b in zip(np.asarray(seen_hi, dtype=np.float64).tolist(), s_lo, strict=True)]
+    scale = REACH / max(contour, REACH_FLOOR)
+    reach = [scale * (a - b) for a, b in zip(s_hi, s_lo, strict=True)]
+    out_lo = [_lesser(_greater(a, h - r), s) for a, h, r, s in
+              zip(np.asarray(lo, dtype=np.float64).tolist(), s_hi, reach, s_lo, strict=True)]  # fmt: skip
+    out_hi = [_greater(_lesser(a, s + r), h) for a, s, r, h in
+              zip(np.asarray(hi, dtype=np.float64).tolist(), s_lo, reach, s_hi, strict=True)]  # fmt: skip
+    out_lo[2] = float(front)
+    out_hi[2] = float(max(out_hi[2], front + 1e-4))
     if cone is not None:
         (u_lo, v_lo, u_hi, v_hi), camera = cone
-        zs = np.array([lo[2], hi[2]])
-        bound_lo = np.array([((u_lo - camera.cx) / camera.fx * zs).min(), ((v_lo - camera.cy) / camera.fy * zs).min()])
-        bound_hi = np.array([((u_hi - camera.cx) / camera.fx * zs).max(), ((v_hi - camera.cy) / camera.fy * zs).max()])
+        z0, z1 = out_lo[2], out_hi[2]
+        a, b = (u_lo - camera.cx) / camera.fx, (v_lo - camera.cy) / camera.fy
+        bound_lo = (_lesser(a * z0, a * z1), _lesser(b * z0, b * z1))  # each row's .min() of the two depths
+        a, b = (u_hi - camera.cx) / camera.fx, (v_hi - camera.cy) / camera.fy
+        bound_hi = (_greater(a * z0, a * z1), _greater(b * z0, b * z1))
         share = contour if pull is None else pull
-        lo[:2] = np.minimum(seen_lo[:2], lo[:2] + share * np.maximum(bound_lo - lo[:2], 0.0))
-        hi[:2] = np.maximum(seen_hi[:2], hi[:2] - share * np.maximum(hi[:2] - bound_hi, 0.0))
-    return lo, hi
+        for i in range(2):
+            out_lo[i] = float(_lesser(s_lo[i], out_lo[i] + share * _greater(bound_lo[i] - out_lo[i], 0.0)))
+            out_hi[i] = float(_greater(s_hi[i], out_hi[i] - share * _greater(out_hi[i] - bound_hi[i], 0.0)))
+    return np.array(out_lo), np.array(out_hi)
+
+
+def _lesser(a: float, b: float) -> float:
+    """``np.minimum`` of two numbers: NaN where either is, ``b`` where they are equal (as for signed zeros)."""
+    return a if a < b or a != a else b
+
+
+def _greater(a: float, b: float) -> float:
+    """``np.maximum`` of two numbers: NaN where either is, ``b`` where they are equal."""
+    return a if a > b or a != a else b
 
 
 def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray,

@@ -473,6 +473,15 @@ def _cap_local(spread_deg: float, n: int) -> np.ndarray:
     return local
 
 
+@functools.lru_cache(maxsize=16)
+def _cap_locals(spreads: tuple[float, ...], n: int) -> np.ndarray:
+    """(len(spreads), n, 3) float, read-only: :func:`_cap_local` of each spread, for the compiled search
+    (:func:`symfruit.core._jit.revolution_search`)."""
+    out = np.stack([_cap_local(spread, n) for spread in spreads]) if spreads else np.empty((0, n, 3))
+    out.flags.writeable = False
+    return out
+
+
 _COARSE = _hemisphere(64)
 
 
@@ -598,14 +607,14 @@ def fit_revolution_slices(
     if not len(dirs):
         raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
     jit = compiled()
-    if jit is not None:  # the compiled twin of _slice_costs
-        qs = np.ascontiguousarray(qs)
-        dirs = np.ascontiguousarray(dirs)
-    slice_costs = _slice_costs if jit is None else jit.slice_costs
-    best = dirs[int(np.argmin(slice_costs(qs, dirs, bins)))]
-    for spread in refine_deg:
-        cand = _cap(best, spread, refine_n)
-        best = cand[int(np.argmin(slice_costs(qs, cand, bins)))]
+    if jit is not None:  # the compiled twin of the search below, coarse and fine in one call
+        caps = _cap_locals(tuple(float(d) for d in refine_deg), int(refine_n))
+        best = jit.revolution_search(np.ascontiguousarray(qs), np.ascontiguousarray(dirs), bins, caps)
+    else:
+        best = dirs[int(np.argmin(_slice_costs(qs, dirs, bins)))]
+        for spread in refine_deg:
+            cand = _cap(best, spread, refine_n)
+            best = cand[int(np.argmin(_slice_costs(qs, cand, bins)))]
     e1, e2 = perpendicular_basis(best[None, :])
     found = None if jit is None else jit.revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
     if found is None or not found[4]:  # no kernel, or a singular start (the twin's least squares copes)

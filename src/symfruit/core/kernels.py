@@ -1,8 +1,9 @@
 """Compiled kernels for the fits' loops (issue 19, eighth round; the cone ellipsoid's in the tenth), the observation's
 pixel maps (ninth round), a fruit's surface, outline and colour trimming (twelfth round), the observation's edge
 normals and silhouette bands and the silhouette's closing (thirteenth round), scipy's feature transform and the
-quadric candidates' agreement (fourteenth round) and the registration's key ranks and a fruit's depth noise
-(fifteenth round), with numba from the optional extra ``fast``.
+quadric candidates' agreement (fourteenth round), the registration's key ranks and a fruit's depth noise
+(fifteenth round), and the solid of revolution's direction search, a marched candidate's agreement and the
+occlusion's pixel look-ups (sixteenth round), with numba from the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -15,10 +16,12 @@ when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfru
 :func:`~symfruit.core.surface.within`; the thirteenth round's :func:`symfruit.core.agreement.observe` and
 :func:`symfruit.core.raster.close_ragged`; the fourteenth round's :func:`symfruit.core.raster.nearest_index` and
 :func:`symfruit.core.agreement.explain`; the fifteenth round's :meth:`symfruit.core.surface._Outline.ranks` and
-:func:`symfruit.core.surface.depth_noise`) then run their numpy twins, the code the kernels were written from, which
-stays tested and gives the same results within rounding (the fits' kernels sum in another order than numpy; the
-pixel maps', the surface's and the feature transform's are the twins' to the bit; the observation's edge normals
-come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics' depth RMS does). Nothing
+:func:`symfruit.core.surface.depth_noise`; the sixteenth round's :func:`symfruit.core.agreement.explain` of a
+marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`) then run their numpy twins, the code the kernels
+were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
+order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
+observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
+depth RMS does). Nothing
 compiles when symfruit is imported: numba is imported by the first fit that asks for a kernel (about half a second),
 and each kernel is compiled on its first call (a few seconds in all) or loaded from numba's on-disk cache (beside
 the module, or the user's cache directory where that is read-only; without a cache where neither is writable).

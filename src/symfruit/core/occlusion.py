@@ -102,8 +102,12 @@ class Occlusion:
         -------
         (m,) bool
         """
-        col = np.rint(np.asarray(u, dtype=np.float64)).astype(np.intp)
-        row = np.rint(np.asarray(v, dtype=np.float64)).astype(np.intp)
+        u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+        if u.ndim == 1 and u.shape == v.shape and (jit := compiled()) is not None:  # the compiled twin of what follows
+            return jit.occluded_at(np.ascontiguousarray(u), np.ascontiguousarray(v), self.hidden, self.u0, self.v0,
+                                   self.width, self.height, int(radius))  # fmt: skip
+        col = np.rint(u).astype(np.intp)
+        row = np.rint(v).astype(np.intp)
         out = (col < radius) | (col >= self.width - radius) | (row < radius) | (row >= self.height - radius)
         h, w = self.hidden.shape
         c, r = col - self.u0, row - self.v0

@@ -55,6 +55,7 @@ from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.fits import surface_noise
 from ..core.front import apex_depth
+from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import row_norms, subsample
 from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, silhouette
@@ -338,6 +339,11 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     width = rim_width(mask, band)
     if inner is None or inner.shape != mask.shape or inner_reach < width:
         inner = inner_distance(mask)
+    if (jit := compiled()) is not None:  # the compiled twin of what follows (its value to the bit)
+        fill = int(np.ceil(region.fill_radius)) if region.fill_radius > 0 else 0
+        return float(jit.rim_coverage(np.ascontiguousarray(points, dtype=np.float64), camera.fx, camera.fy, camera.cx,
+                                      camera.cy, int(region.u0), int(region.v0), mask, inner, float(width),
+                                      fill))  # fmt: skip
     rim = mask & (inner <= width)
     rest = mask & ~rim
     if not rim.any() or not rest.any():
