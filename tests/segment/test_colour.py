@@ -1065,3 +1065,52 @@ def test_segment_refuses_a_camera_or_settings_of_another_type_by_name():
         segment(img, depth, "camera.json")  # before: AttributeError: 'str' object has no attribute 'fx'
     with pytest.raises(InputError, match="segment: settings must be a SegmentSettings"):
         segment(img, settings={"dark": 10})  # before: AttributeError
+
+
+def _apples_outside_the_depth_view(apart, leaf=0):
+    """An apple (28 px) with a dark rim at (300, 540) and, ``apart`` px to its right, one (26 px) partly behind it;
+    with ``leaf``, a leaf band ``2 leaf + 1`` px high across the front one instead. The depth camera sees x >= 600
+    only (outside its view, no depth: nothing to tell two surfaces apart)."""
+    yy, xx = np.mgrid[:1080, :1920]
+    color = np.full((1080, 1920, 3), (70, 110, 60), np.uint8)
+    depth = np.full((1080, 1920), 1.6)
+    depth[:, :600] = 0.0
+    front = (xx - 300) ** 2 + (yy - 540) ** 2 <= 28**2
+    if apart:
+        behind = (xx - 300 - apart) ** 2 + (yy - 540) ** 2 <= 26**2
+        color[behind] = (180, 25, 35)
+        color[(xx - 300) ** 2 + (yy - 540) ** 2 <= 30**2] = (40, 20, 20)
+    color[front] = RED
+    if leaf:
+        band = np.abs(yy - 540) <= leaf
+        color[band & front] = (60, 120, 50)
+    return color, depth, front & (color == RED).all(axis=2), (color == (180, 25, 35)).all(axis=2)
+
+
+@pytest.mark.parametrize("apart", [40, 50, 60])
+def test_two_round_fruit_side_by_side_without_depth_are_two(apart):
+    """Two apples side by side outside the depth camera's view, one partly hiding the other: their union is
+    convex enough for the merge's hull test, but reaches half as far again as either apple alone, which no two
+    pieces of one round fruit do (``_two_extents``): two fruit with ``round_fruit``."""
+    color, depth, front, behind = _apples_outside_the_depth_view(apart)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 2
+    a, b = np.bincount(labels[front]).argmax(), np.bincount(labels[behind]).argmax()
+    assert a > 0 and b > 0 and a != b
+    assert (labels[front] == a).mean() > 0.95 and (labels[behind] == b).mean() > 0.95
+
+
+def test_a_round_fruit_cut_by_a_leaf_without_depth_is_one():
+    """The pieces of one apple either side of a leaf reach no further than the apple: joined as before."""
+    color, depth, front, _ = _apples_outside_the_depth_view(0, leaf=5)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1 and (labels[front] == 1).all()
+
+
+def test_the_extent_of_a_disc_is_its_diameter():
+    from symfruit.segment.colour import _extent, _hull_vertices
+
+    yy, xx = np.mgrid[:101, :101]
+    disc = (xx - 50) ** 2 + (yy - 50) ** 2 <= 40**2
+    assert abs(_extent(_hull_vertices(disc), disc) - 81) <= 1.0
+    assert _extent(None, np.ones((3, 3), bool)) == 3.0

@@ -896,6 +896,9 @@ def _merge(
                     continue
                 window, union = _union(a, b)
                 vertices = _hull_vertices(union)
+                if s.round_fruit and _two_extents(a, b, vertices):
+                    apart.add((a.serial, b.serial))
+                    continue
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
                     green = _green(color) if green is None else green
@@ -912,6 +915,31 @@ def _merge(
             if merged:
                 break
     return pieces
+
+
+#: Round fruit: two pieces whose union reaches further than this times the larger piece alone are two fruit.
+ROUND_EXTENT = 1.35
+
+
+def _extent(vertices: np.ndarray | None, mask: np.ndarray) -> float:
+    """The largest distance across a mask (between its hull's vertices, plus a pixel), in pixels."""
+    if vertices is None:
+        return float(np.sqrt(mask.sum()))
+    d = vertices[:, None, :] - vertices[None, :, :]
+    return float(np.sqrt((d * d).sum(axis=2).max())) + 1.0
+
+
+def _two_extents(a: _Piece, b: _Piece, union: np.ndarray | None) -> bool:
+    """Whether two pieces of round fruit are two fruit by their extents: every piece of one round fruit lies
+    within its outline, so the union reaches no further than the fruit is across, and the larger piece of a
+    fruit seen past a leaf spans most of that; two whole fruit side by side reach as far as both together.
+    The union reaching more than :data:`ROUND_EXTENT` times the larger piece's extent is two fruit (with
+    depth or without: two apples beside each other outside the depth camera's view, where the convexity
+    test alone joins them when one partly hides the other)."""
+    if union is None:
+        return False
+    ea, eb = _extent(a.hull_vertices(), a.mask), _extent(b.hull_vertices(), b.mask)
+    return _extent(union, a.mask) > ROUND_EXTENT * max(ea, eb)
 
 
 @dataclass
