@@ -1364,25 +1364,35 @@ def least_median(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, size: in
     median (odd ``size``, edges repeated) is least. A pixel is passed over without its median when fewer than half
     of its window's values lie below the least median so far (its median is then no less: not the first least);
     the others' medians by an insertion sort, the same order statistic as the twin's partition."""
+    return _least_median_of(image, np.ones((1, 1), np.bool_), False, rows, cols, rows.shape[0], size)
+
+
+@_njit
+def _least_median_of(
+    image: np.ndarray, near: np.ndarray, masked: bool, rows: np.ndarray, cols: np.ndarray, n: int, size: int,
+) -> int:  # fmt: skip
+    """:func:`least_median`'s pass over the first ``n`` pixels ``(rows, cols)``; with ``masked``, a window's pixel
+    outside ``near`` ((h, w) bool) counts as +inf (:func:`surface_apex`'s depth where near)."""
     h, w = image.shape
     half = size // 2
     middle = size * size // 2
     window = np.empty(size * size)
     best, least = -1, np.inf
-    for i in range(rows.shape[0]):
+    for i in range(n):
         r, c = rows[i], cols[i]
-        n = 0
+        k = 0
         below = 0
         for dr in range(-half, half + 1):
             rr = min(max(r + dr, 0), h - 1)
             for dc in range(-half, half + 1):
-                v = image[rr, min(max(c + dc, 0), w - 1)]
-                window[n] = v
-                n += 1
+                cc = min(max(c + dc, 0), w - 1)
+                v = image[rr, cc] if not masked or near[rr, cc] else np.inf
+                window[k] = v
+                k += 1
                 below += v < least
         if best >= 0 and below <= middle:
             continue  # at most ``middle`` values below the least: the median is not below it
-        for a in range(1, n):
+        for a in range(1, k):
             v = window[a]
             b = a
             while b > 0 and window[b - 1] > v:
@@ -2348,33 +2358,7 @@ def surface_apex(
                 if near[r, c] and (mask[r, c] or not both):
                     rows[n], cols[n] = r, c
                     n += 1
-    half = size // 2
-    middle = size * size // 2
-    window = np.empty(size * size)
-    best, least = -1, np.inf
-    for i in range(n):
-        r, c = rows[i], cols[i]
-        k = 0
-        below = 0
-        for dr in range(-half, half + 1):
-            rr = min(max(r + dr, 0), h - 1)
-            for dc in range(-half, half + 1):
-                cc = min(max(c + dc, 0), w - 1)
-                v = depth[rr, cc] if near[rr, cc] else np.inf
-                window[k] = v
-                k += 1
-                below += v < least
-        if best >= 0 and below <= middle:
-            continue  # at most ``middle`` values below the least: the median is not below it
-        for a in range(1, k):
-            v = window[a]
-            b = a
-            while b > 0 and window[b - 1] > v:
-                window[b] = window[b - 1]
-                b -= 1
-            window[b] = v
-        if best < 0 or window[middle] < least:
-            best, least = i, window[middle]
+    best = _least_median_of(depth, near, True, rows, cols, n, size)
     return rows[best], cols[best]
 
 
