@@ -14,6 +14,7 @@ from scipy import ndimage
 from .core.camera import Camera
 from .core.kernels import compiled
 from .core.points import bounds
+from .core.raster import square_filter
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
@@ -225,11 +226,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
     core = mask
     if s.erode_px:
-        if (jit := compiled()) is not None and mask.dtype == bool and mask.ndim == 2:  # the same pixels, compiled
-            eroded = np.empty(mask.shape, bool)
-            jit.square_filter(mask, s.erode_px, True, eroded)
-        else:
-            eroded = ndimage.minimum_filter(mask.view(np.uint8), size=2 * s.erode_px + 1, mode="constant").astype(bool)
+        eroded = square_filter(mask, s.erode_px, every=True)
         if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
             core = eroded
     z_all = np.asarray(depth, dtype=np.float64)

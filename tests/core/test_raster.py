@@ -453,3 +453,31 @@ def test_eroded_is_scipys_iterated_erosion(seed, h, w, iterations):
     else:
         mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
     assert np.array_equal(eroded(mask, iterations), ndimage.binary_erosion(mask, iterations=iterations))
+
+
+@pytest.mark.parametrize("kernels", ["", "numpy"])
+@pytest.mark.parametrize("every", [False, True])
+@given(seed=st.integers(0, 2**32 - 1))
+def test_the_square_filter_is_scipys_minimum_or_maximum_filter(kernels, every, seed):
+    """:func:`square_filter` with the compiled kernel and with its numpy twin: scipy's filter of the square, outside
+    the image false (a square touching the border is not all true), on masks of any density and size."""
+    import os
+
+    from symfruit.core.raster import square_filter
+
+    rng = np.random.default_rng(seed)
+    h, w = rng.integers(1, 40, 2)
+    mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    radius = int(rng.integers(0, 6))
+    filt = ndimage.minimum_filter if every else ndimage.maximum_filter
+    want = filt(mask, size=2 * radius + 1, mode="constant", cval=False)
+    before = os.environ.pop("SYMFRUIT_KERNELS", None)
+    try:
+        if kernels:
+            os.environ["SYMFRUIT_KERNELS"] = kernels
+        got = square_filter(mask, radius, every=every)
+    finally:
+        os.environ.pop("SYMFRUIT_KERNELS", None)
+        if before is not None:
+            os.environ["SYMFRUIT_KERNELS"] = before
+    assert got.dtype == bool and np.array_equal(got, want)

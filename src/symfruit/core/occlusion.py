@@ -24,7 +24,7 @@ from .camera import Camera
 from .kernels import compiled
 from .limits import check_image_size, depth_metres
 from .points import as_points
-from .raster import Silhouette, mask_box, nearest_index
+from .raster import Silhouette, mask_box, nearest_index, square_filter
 
 __all__ = ["Occlusion", "occlusion", "with_own"]
 
@@ -127,7 +127,7 @@ class Occlusion:
             return self.hidden
         found = self._grown.get(radius)
         if found is None:
-            found = _grow(self.hidden, radius)
+            found = square_filter(self.hidden, radius)
             found.flags.writeable = False
             self._grown[radius] = found
         return found
@@ -149,7 +149,7 @@ class Occlusion:
         part = self.hidden[g0:g1, f0:f1]
         if not part.any():
             return part[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
-        grown = _grow(part, radius)
+        grown = square_filter(part, radius)
         return grown[r0 - g0 : r1 - g0, c0 - f0 : c1 - f0]
 
     def depth_at(self, u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -423,17 +423,6 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 
 
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
-
-
-def _grow(mask: np.ndarray, radius: int) -> np.ndarray:
-    """(h, w) bool: the pixels of ``mask`` (h, w) bool with a true pixel within ``radius`` (a square; outside the
-    image is background): ``ndimage.maximum_filter``, or its compiled twin (:func:`symfruit.core._jit.square_filter`,
-    the same pixels) where numba is installed."""
-    if (jit := compiled()) is not None:
-        out = np.empty(mask.shape, dtype=bool)
-        jit.square_filter(mask, radius, False, out)
-        return out
-    return ndimage.maximum_filter(mask, size=2 * radius + 1, mode="constant", cval=False)
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:

@@ -388,6 +388,19 @@ def eroded(mask: np.ndarray, iterations: int) -> np.ndarray:
     return out
 
 
+def square_filter(mask: np.ndarray, radius: int, *, every: bool = False) -> np.ndarray:
+    """(h, w) bool: the pixels of ``mask`` (h, w) bool with a true pixel within the ``2 radius + 1`` square about
+    them (``every``: with the whole square true), outside the image false: ``ndimage.maximum_filter`` (or
+    ``minimum_filter``) with ``mode="constant"``, or its compiled twin (:func:`symfruit.core._jit.square_filter`, the
+    same pixels) where numba is installed."""
+    if (jit := compiled()) is not None:
+        out = np.empty(mask.shape, dtype=bool)
+        jit.square_filter(mask, radius, every, out)
+        return out
+    filt = ndimage.minimum_filter if every else ndimage.maximum_filter
+    return np.asarray(filt(mask, size=2 * radius + 1, mode="constant", cval=False))
+
+
 def fill_holes(mask: np.ndarray) -> np.ndarray:
     """(h, w) bool: ``mask`` with its holes filled, the same as :func:`scipy.ndimage.binary_fill_holes`.
 
