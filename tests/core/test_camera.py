@@ -127,3 +127,15 @@ def test_a_shifted_camera_sees_every_point_shifted_and_deprojects_it_back(du, dv
     np.testing.assert_allclose(moved.deproject(moved.project(p), [z]), p, atol=1e-12)
     assert (moved.fx, moved.fy, moved.width, moved.height) == (cam.fx, cam.fy, cam.width, cam.height)
     assert cam.shifted(0, 0) is cam
+
+
+@pytest.mark.parametrize(
+    ("du", "dv", "what"),
+    [("a", 0, "du must be a number"), (0, "6", "dv must be a number"), (True, 0, "du must be a number"),
+     (None, 0, "du must be a number"), (0, float("nan"), "dv must be finite"), (float("inf"), 0, "du must be finite")],
+)  # fmt: skip
+def test_a_shift_that_is_no_finite_number_is_refused_by_name(du, dv, what):
+    cam = Camera(fx=600.0, fy=590.0, cx=320.0, cy=240.0, width=640, height=480)
+    with pytest.raises(InputError, match=f"camera shift {what}"):
+        cam.shifted(du, dv)
+    assert cam.shifted(np.int64(6), np.float32(-2.0)).cx == 326.0 and cam.shifted(np.int64(0), 0.0) is cam

@@ -4,7 +4,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from symfruit.core.planes import PlaneGrid, hypothesis_planes, mirror
+from symfruit.core.planes import Plane, PlaneGrid, hypothesis_planes, mirror
+from symfruit.errors import InputError
 
 coords = arrays(np.float64, (12, 3), elements=st.floats(-1.0, 1.0))
 unit = arrays(np.float64, 3, elements=st.floats(-1.0, 1.0)).filter(lambda v: np.linalg.norm(v) > 0.1)
@@ -118,3 +119,22 @@ def test_mirror_refuses_wrong_shapes():
 
     with pytest.raises(InputError, match="shape"):
         mirror(np.zeros((5, 2)), [0.0, 0.0, 0.0], [0.0, 0.0, 1.0])
+
+
+@pytest.mark.parametrize(
+    ("point", "normal", "what"),
+    [
+        ([0.0, 0.0, 0.3], [0.0, 0.0, 0.0], "normal must not be zero"),
+        ([0.0, 0.0, 0.3], [0.0, float("nan"), 1.0], "normal must be 3 finite"),
+        ([0.0, 0.0, 0.3], [0.0, 1.0], "normal must be 3 finite"),
+        ([0.0, float("inf"), 0.3], [0.0, 0.0, 1.0], "point must be 3 finite"),
+        ("abc", [0.0, 0.0, 1.0], "point must be 3 numbers"),
+    ],
+)
+def test_a_plane_without_a_direction_or_place_is_refused_at_construction(point, normal, what):
+    with pytest.raises(InputError, match=what):
+        Plane(point=np.array(point), normal=np.array(normal))
+
+
+def test_a_plane_with_a_direction_is_kept_as_given():
+    assert Plane(point=np.zeros(3), normal=np.array([0.0, 0.0, 2.0])).to_dict()["normal"] == [0.0, 0.0, 2.0]

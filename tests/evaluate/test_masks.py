@@ -248,3 +248,22 @@ def test_an_image_named_outside_the_folder_is_looked_up_inside_it_only(tmp_path,
     ev = evaluate_masks(folder, truth, segment)  # skipped, named; b.jpg scored
     assert [s.image for s in ev.scores] == ["b.jpg"] and list(ev.failed) == [name]
     assert re.search(rf"photos/a\.png: listed in .* as '{name}' but not in ", ev.failed[name])
+
+
+@pytest.mark.parametrize("threshold", ["0.5", None, True, float("nan")])
+def test_a_threshold_that_is_no_number_in_range_is_refused_by_name(threshold):
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    with pytest.raises(InputError, match="threshold"):
+        score_masks(labels, labels, threshold=threshold)
+
+
+@pytest.mark.parametrize("fill", [0.5, float("nan")])
+def test_float_truth_masks_are_refused_not_read_as_fruit(fill):
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    truth = np.zeros((1, 6, 6))
+    truth[0, :3] = fill
+    with pytest.raises(InputError, match="truth"):
+        score_masks(truth, labels)
+    assert score_masks(truth != 0, labels).best_iou.tolist() == [1.0]

@@ -98,9 +98,20 @@ class Camera:
         >>> cam.shifted(6, -2).project(cam.deproject([[100.0, 50.0]], [1.0]))
         array([[106.,  48.]])
         """
-        if du == 0 and dv == 0:  # a well-registered frame: this camera itself
+        shift = []
+        for name, value in (("du", du), ("dv", dv)):  # once per frame, not per pixel
+            if isinstance(value, bool | str | bytes):  # float() reads True as 1 and "6" as 6 in silence
+                raise InputError(f"camera shift {name} must be a number of pixels, got {shown(value)}")
+            try:
+                value = float(value)
+            except (TypeError, ValueError, OverflowError):
+                raise InputError(f"camera shift {name} must be a number of pixels, got {shown(value)}") from None
+            if not np.isfinite(value):
+                raise InputError(f"camera shift {name} must be finite, got {value!r}")
+            shift.append(value)
+        if shift[0] == 0 and shift[1] == 0:  # a well-registered frame: this camera itself
             return self
-        return replace(self, cx=self.cx + float(du), cy=self.cy + float(dv))
+        return replace(self, cx=self.cx + shift[0], cy=self.cy + shift[1])
 
     def to_dict(self) -> dict[str, float | int]:
         """The six intrinsics as a plain dict (the layout :func:`symfruit.io.load_camera` reads)."""

@@ -26,6 +26,17 @@ class Plane:
     point: np.ndarray
     normal: np.ndarray
 
+    def __post_init__(self) -> None:  # one Plane per completion (the chosen one); the hypotheses are Planes
+        for name in ("point", "normal"):
+            try:
+                value = np.asarray(getattr(self, name), dtype=np.float64)
+            except (TypeError, ValueError):
+                raise InputError(f"plane {name} must be 3 numbers, got {getattr(self, name)!r}") from None
+            if value.shape != (3,) or not np.isfinite(value).all():
+                raise InputError(f"plane {name} must be 3 finite numbers, got {value.tolist()}")
+        if not np.any(np.asarray(self.normal, dtype=np.float64)):
+            raise InputError("plane normal must not be zero: it has no direction")
+
     def to_dict(self) -> dict[str, list[float]]:
         return {"point": self.point.tolist(), "normal": self.normal.tolist()}
 

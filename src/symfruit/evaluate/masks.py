@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from ..core.limits import shown
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 
 __all__ = [
@@ -64,6 +65,8 @@ class Skipped:
 def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
     """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none)."""
     t = np.asarray(truth)
+    if t.dtype != bool and not np.issubdtype(t.dtype, np.integer):  # 0.5 or NaN would count as fruit in silence
+        raise InputError(f"truth must be bool masks or integer labels, got {t.dtype}")
     if t.ndim == 2:
         ids = np.unique(t[t > 0])
         t = t[None] == ids[:, None, None]
@@ -138,7 +141,9 @@ def match_masks(ious: np.ndarray, *, threshold: float = 0.5) -> np.ndarray:
     ious = np.asarray(ious, dtype=np.float64)
     if ious.ndim != 2:
         raise InputError(f"ious must be (n, k), got shape {ious.shape}")
-    if not 0 < threshold <= 1:
+    if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)):
+        raise InputError(f"threshold must be a number in (0, 1], got {shown(threshold)}")
+    if not 0 < threshold <= 1:  # NaN fails this too
         raise InputError(f"threshold must be in (0, 1], got {threshold}")
     if ious.size == 0:
         return np.zeros((0, 2), np.int64)
