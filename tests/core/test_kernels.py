@@ -735,6 +735,21 @@ def test_surface_noise_searches_a_tree_past_the_brute_forces_bound(monkeypatch):
         fits.surface_noise(pts, queries=30)
 
 
+def _ball_behind_a_leaf(seed: int):
+    """A ball's view partly behind a leaf (seeded): its centre, the visible points, their silhouette and the frame's
+    occlusion maps (the marched and the closed-form agreement tests' view)."""
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.occlusion import occlusion
+    from symfruit.core.raster import silhouette
+
+    from ..conftest import ball_mesh, occluded_view
+
+    centre = np.array([0.01 * seed, -0.005, 0.4])
+    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
+                                            seed=seed)  # fmt: skip
+    return centre, visible, silhouette(visible, camera), occlusion(depth, mask, visible, camera)
+
+
 @pytest.mark.parametrize("seed", range(4))
 def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
     """Spheres and rotated ellipsoids about the truth, beside it, around the camera, missing every ray and reaching
@@ -743,17 +758,9 @@ def test_explain_of_a_quadric_is_the_twins(monkeypatch, seed):
     from whole counts: equal."""
     from symfruit.core.agreement import Quadric, explain, observe
     from symfruit.core.camera import DEFAULT_CAMERA as camera
-    from symfruit.core.occlusion import occlusion
-    from symfruit.core.raster import silhouette
-
-    from ..conftest import ball_mesh, occluded_view
 
     rng = np.random.default_rng(seed)
-    centre = np.array([0.01 * seed, -0.005, 0.4])
-    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
-                                            seed=seed)  # fmt: skip
-    region = silhouette(visible, camera)
-    occ = occlusion(depth, mask, visible, camera)
+    centre, visible, region, occ = _ball_behind_a_leaf(seed)
     views = [observe(visible[::10], region, camera, dense=visible, occlusion=o) for o in (None, occ)]
     for obs in views:
         for k in range(16):
@@ -784,17 +791,9 @@ def test_explain_of_a_solid_of_revolution_is_the_twins(monkeypatch, seed):
     from symfruit.core.agreement import explain, observe
     from symfruit.core.camera import DEFAULT_CAMERA as camera
     from symfruit.core.fits import RevolutionInside, revolution_box
-    from symfruit.core.occlusion import occlusion
-    from symfruit.core.raster import silhouette
-
-    from ..conftest import ball_mesh, occluded_view
 
     rng = np.random.default_rng(seed)
-    centre = np.array([0.01 * seed, -0.005, 0.4])
-    visible, depth, mask, _ = occluded_view(ball_mesh(), centre, below=250 + 5 * seed, occluder_z=0.33, noise=0.01,
-                                            seed=seed)  # fmt: skip
-    region = silhouette(visible, camera)
-    occ = occlusion(depth, mask, visible, camera)
+    _, visible, region, occ = _ball_behind_a_leaf(seed)
     rev = fit_revolution_slices(visible[::3])
     for o in (None, occ):
         obs = observe(visible[::10], region, camera, dense=visible, occlusion=o)
