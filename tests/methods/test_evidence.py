@@ -266,6 +266,34 @@ def test_a_fruit_pointing_at_the_camera_is_less_confident_than_one_seen_from_the
     assert a.extras["uncertainty"] > 3 * b.extras["uncertainty"] and not a.reliable
 
 
+def test_a_front_no_shape_explains_makes_the_back_uncertain():
+    """Two fruit with the same round outline, seen along their axis: a ball, whose seen cap the ellipsoid fits to
+    within the sensor's noise (its back is the extrapolation of a front it explains), and the same ball with five
+    ribs 3.5 mm deep, whose front no closed shape explains (its back is extrapolated from a fit that misses the
+    front by millimetres). Only the second has a depth misfit beyond twice the noise, and it is the less
+    confident; with ``unexplained_scale = 0`` the term is gone."""
+    from symfruit.synthetic.shapes import _revolve
+
+    t = np.linspace(0.0, np.pi, 90)
+    ribbed = _revolve(0.035 * np.sin(t), -0.035 * np.cos(t), name="ribbed", n_phi=96, ribs=(5, 0.1))
+    ball, _ = rendered_view(ball_mesh(), [0.0, 0.01, 0.4], noise=0.01, seed=4)
+    ribs, _ = rendered_view(ribbed, [0.0, 0.01, 0.4], noise=0.01, seed=4)
+    a, b = complete(ball), complete(ribs)
+    assert a.extras["unexplained"] == 0.0 and a.reliable
+    assert 0.0015 < b.extras["unexplained"] < 0.003 and not b.reliable
+    assert b.confidence < a.confidence
+    off = complete(ribs, settings=Settings().replace(evidence={"unexplained_scale": 0.0}))
+    assert off.extras["unexplained"] == 0.0
+    assert off.extras["uncertainty"] < b.extras["uncertainty"] - 0.0005
+    np.testing.assert_array_equal(off.box.min, b.box.min)  # the confidence never moves the box
+    np.testing.assert_array_equal(off.box.max, b.box.max)
+    # the noise floor: twice the points' small-scale residual (a misfit within it is the sensor's, not the shape's)
+    floor = complete(ribs, settings=Settings().replace(evidence={"misfit_noise": 100.0}))
+    assert floor.extras["unexplained"] == 0.0
+    # a scan's sparse points need not be the nearest surface on their rays: no depth misfit term there
+    assert complete(build(Spec("paper", "citrus", 0, 13)).visible).extras["unexplained"] == 0.0
+
+
 def test_completed_points_are_the_seen_and_their_mirror_images_through_the_box_centre():
     """Written column by column: the same values as ``np.vstack([points, 2 centre - points])``, to the bit."""
     visible, _ = rendered_view(ball_mesh(0.03), [0.02, -0.01, 0.4], noise=0.01, seed=4)

@@ -32,9 +32,10 @@ completion is right for every fruit, and the view itself says which ones fit. Th
    silhouette, which a camera measures well; on a clean close view the shapes keep most of their say; the
    back face never ends in front of the deepest seen point (the fruit holds every point seen of it);
 7. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
-   own noise, the candidates' disagreement, what no candidate explains, how far the prior moved the
-   back face from the shapes' (half of it, as the centre moves) and how far the fruit recedes along the
-   line of sight, all scaled by the outline's elongation, and reports
+   own noise, the candidates' disagreement, what no candidate explains (of the outline, and of the seen
+   depths beyond the sensor's noise), how far the prior moved the back face from the shapes' (half of it,
+   as the centre moves) and how far the fruit recedes along the line of sight, all scaled by the outline's
+   elongation, and reports
    ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
@@ -153,22 +154,25 @@ class EvidenceSettings(Section):
         best shape there is.
     mirror_energy, raw_energy : float
         Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
-    misfit_scale, recede_scale, uncertainty_scale, reliable_uncertainty : float, float, float (metres), float (metres)
-        The predicted centre uncertainty ``u = elongation * hypot(hypot(back_std, spread) + misfit_scale *
-        wrong * size, moved / 2, recede_scale * recede)``: ``back_std`` the ``cone`` ellipsoid's back-face
-        standard deviation from its own fit (the sensor's noise), ``spread`` the weighted mean distance of
-        the candidates' centres from the result's (what the shapes disagree on), ``wrong`` the best closed
-        candidate's share of silhouette-band rays wrong and ``size`` the result's largest side (what no
-        shape explains), ``moved`` how far :func:`fuse_depth` moved the back face (the prior against the
-        shapes); ``recede`` how much deeper than half the silhouette's width the points of a depth camera's
-        view reach behind the front, times the contour share (a round fruit shows about half its depth in
-        front of its rim; a fruit receding along the line of sight, a pear or banana pointing at the camera,
-        has a back that nothing seen mirrors); ``elongation`` the square root of the silhouette's major over
-        minor width (an elongated outline leaves the tilt of the long axis out of the image unseen, and
-        every error above grows with it). ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when
-        ``u <= reliable_uncertainty``. Issue 18's block jackknife of the ``cone`` fit's back face (angular
-        sectors of the seen depths, or of the outline, left out) was measured and predicts nothing on the
-        real scans (docs/ablation.md).
+    misfit_scale, recede_scale, unexplained_scale, misfit_noise : float
+    uncertainty_scale, reliable_uncertainty : float (metres), float (metres)
+        The predicted centre uncertainty ``u = elongation * hypot(hypot(back_std, spread) + misfit_scale * wrong * size,
+        moved / 2, recede_scale * recede, unexplained_scale * unexplained)``: ``back_std`` the ``cone`` ellipsoid's
+        back-face standard deviation from its own fit (the sensor's noise), ``spread`` the weighted mean distance of the
+        candidates' centres from the result's (what the shapes disagree on), ``wrong`` the best closed candidate's share
+        of silhouette-band rays wrong and ``size`` the result's largest side (what no shape explains), ``moved`` how far
+        :func:`fuse_depth` moved the back face (the prior against the shapes); ``recede`` how much deeper than half the
+        silhouette's width the points of a depth camera's view reach behind the front, times the contour share (a round
+        fruit shows about half its depth in front of its rim; a fruit receding along the line of sight, a pear or banana
+        pointing at the camera, has a back that nothing seen mirrors); ``unexplained`` the seen depths' misfit that no
+        closed shape explains, ``sqrt(max(0, rms**2 - (misfit_noise * noise)**2))``, ``rms`` the best closed candidate's
+        robust RMS depth misfit and ``noise`` the points' small-scale plane residual
+        (:func:`~symfruit.core.fits.surface_noise`; a shape that does not explain the front it was fitted to does not
+        predict the back it extrapolates; 0 for a sparse cloud); ``elongation`` the square root of the silhouette's
+        major over minor width (an elongated outline leaves the tilt of the long axis out of the image unseen, and every
+        error above grows with it). ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when ``u <=
+        reliable_uncertainty``. Issue 18's block jackknife of the ``cone`` fit's back face (angular sectors of the seen
+        depths, or of the outline, left out) was measured and predicts nothing on the real scans (docs/ablation.md).
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
@@ -209,6 +213,8 @@ class EvidenceSettings(Section):
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
     recede_scale: float = setting(0.1, ge=0.0, le=100.0)
+    unexplained_scale: float = setting(1.0, ge=0.0, le=100.0)
+    misfit_noise: float = setting(2.0, ge=0.0, le=100.0)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
     reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
     occluded_px: int = setting(4, ge=0, le=50)
@@ -446,6 +452,7 @@ def evidence(
     shapes: tuple[str, ...] = SHAPES
     explained: float | None = None
     clean = 0.0
+    noise: float | None = None
     if not dense:
         # The cone ellipsoid's fit reads each point as the nearest surface along its ray, as a depth camera
         # sees it; a sparse cloud (a scan's points, possibly on both sides of the fruit) is not that.
@@ -458,7 +465,7 @@ def evidence(
         shapes = tuple(name for name in SHAPES if name not in ("sphere", "ellipsoid"))
         explained = s.explained_at
     else:
-        ratio, _, _ = surface_noise(sample, queries=s.noise_queries)
+        ratio, noise, _ = surface_noise(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
     across = across_sight(region, camera)
     cands = candidates(
@@ -481,13 +488,24 @@ def evidence(
     # sparse cloud's points need not end at the rim: no receding measure there.)
     recede = obs.contour * max(0.0, seen_back - float(box.min[2]) - 0.5 * width) if dense else 0.0
     elongation = float(np.sqrt(across.major / max(across.minor, 1e-12)))
-    uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2))
+    # What no closed shape explains of the seen depths beyond the sensor's noise: a shape that misses the front
+    # it was fitted to does not predict the back it extrapolates (the outline's part is in ``combined``). Not for
+    # a sparse cloud, whose points need not be the nearest surface on their rays.
+    best_rms = min((c.agreement.depth for c in cands if c.agreement is not None), default=None)
+    unexplained = 0.0
+    if dense and best_rms is not None and s.unexplained_scale > 0:
+        if noise is None:
+            _, noise, _ = surface_noise(sample, queries=s.noise_queries)
+        unexplained = float(np.sqrt(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
+    uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2
+                                             + (s.unexplained_scale * unexplained) ** 2))  # fmt: skip
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
         "confidence": confidence,
         "reliable": uncertainty <= s.reliable_uncertainty,
         "uncertainty": uncertainty,
         "recede": recede,
+        "unexplained": unexplained,
         "elongation": elongation,
         "back_sd": back_sd,
         "rim": rim,
