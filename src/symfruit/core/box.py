@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,8 @@ class Box:
     Attributes
     ----------
     min, max : (3,) float, metres
+        Finite, ``min <= max`` on every axis (a flat box, ``min == max``, is a box); anything else is
+        refused with :class:`~symfruit.errors.InputError`.
     """
 
     min: np.ndarray
@@ -32,6 +35,12 @@ class Box:
             raise InputError(f"a box needs min and max of 3 numbers, got {given}") from None
         if lo.shape != (3,) or hi.shape != (3,):
             raise InputError(f"a box needs min and max of shape (3,), got {lo.shape} and {hi.shape}")
+        lo_list, hi_list = lo.tolist(), hi.tolist()  # six floats: checked in Python, a fifth of numpy's cost
+        if not all(map(math.isfinite, lo_list + hi_list)):  # a NaN box has no size, centre or overlap
+            raise InputError(f"a box needs finite corners, got min {lo_list} and max {hi_list}")
+        for axis, a, b in zip("xyz", lo_list, hi_list, strict=True):
+            if a > b:  # its size would be negative, its volume and IoU garbage
+                raise InputError(f"a box's min lies beyond its max along {axis}: min {lo_list}, max {hi_list}")
         object.__setattr__(self, "min", lo)
         object.__setattr__(self, "max", hi)
 
