@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import shown
+from ..core.limits import MAX_INSTANCES, instance_labels, shown, unmasked
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 
 __all__ = [
@@ -63,15 +63,32 @@ class Skipped:
 
 
 def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
-    """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none)."""
-    t = np.asarray(truth)
+    """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none).
+
+    Integer masks hold 0 and one other value each (1 or 255: a mask image); a mask of several values (a label
+    image put in the stack) or of negative ones is refused, as are labels that :func:`instance_labels` refuses
+    (negative, beyond 32 bits, more than :data:`MAX_INSTANCES` fruit). A masked entry of a
+    :class:`numpy.ma.MaskedArray` is background.
+    """
+    t = unmasked(truth, 0)
     if t.dtype != bool and not np.issubdtype(t.dtype, np.integer):  # 0.5 or NaN would count as fruit in silence
         raise InputError(f"truth must be bool masks or integer labels, got {t.dtype}")
-    if t.ndim == 2:
+    if t.ndim == 2:  # -1 was background in silence; 10^6 ids made an (ids, h, w) stack of terabytes
+        t = instance_labels(t, "truth")
         ids = np.unique(t[t > 0])
         t = t[None] == ids[:, None, None]
     if t.ndim != 3:
         raise InputError(f"truth must be (n, h, w) masks or (h, w) labels, got shape {t.shape}")
+    if len(t) > MAX_INSTANCES:
+        raise InputError(f"truth holds {len(t)} masks; at most {MAX_INSTANCES} fruit per image are read")
+    if t.dtype != bool and t.size:  # before: any non-zero was fruit (-1, or label 2 of a label image in the stack)
+        top = t.reshape(len(t), -1).max(axis=1)
+        bad = (t.reshape(len(t), -1).min(axis=1) < 0) | ((t != 0) & (t != top[:, None, None])).any(axis=(1, 2))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            held = np.unique(t[k])
+            raise InputError(f"truth mask {k} holds the values {shown(held.tolist())}: an integer mask is 0 and one "
+                             "value (1 or 255); labels are one (h, w) image, not a stack")  # fmt: skip
     if shape is not None and t.shape[1:] != tuple(shape):
         raise InputError(f"truth masks are {t.shape[2]}x{t.shape[1]}, the labels {shape[1]}x{shape[0]}")
     return t.astype(bool, copy=False)
@@ -106,6 +123,7 @@ def mask_ious(truth: np.ndarray, labels: np.ndarray) -> tuple[np.ndarray, np.nda
         raise InputError(f"labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
     if labels.size and labels.min() < 0:
         raise InputError("labels must not be negative")
+    instance_labels(labels, "labels")  # at most MAX_INSTANCES regions: the (n, k) IoU table stays small
     truth = truth_stack(truth, labels.shape)
     ids, inverse = np.unique(labels, return_inverse=True)
     inverse = inverse.reshape(labels.shape)
