@@ -923,3 +923,20 @@ def test_an_empty_method_is_refused_not_read_as_the_default(tmp_path, monkeypatc
     assert main([*command, "--method", ""]) == 2  # before: the default method ran, exit 0
     assert "unknown method ''" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("classes", "what"),
+    [
+        ("18,,25", "an empty entry"),  # before: read as 18,25 in silence
+        ("18,25,", "an empty entry"),
+        ("١٨,25", "'١٨' is no number"),  # before: Arabic-Indic digits read as 18
+        ("1_8,25", "'1_8' is no number"),  # before: read as 18
+        ("nan", "'nan' is no number"),
+    ],
+)
+def test_report_classes_refuse_an_empty_entry_or_what_is_no_plain_number(tmp_path, capsys, classes, what):
+    assert main(["report", str(tmp_path / "run"), f"--classes={classes}"]) == 2
+    assert f"--classes {classes!r}: {what}; expected diameters in mm" in capsys.readouterr().err
+    assert main(["report", str(tmp_path / "run"), "--classes", " 18, 2.5e1 "]) == 2  # read: on to the missing run
+    assert "detections.parquet: no such table" in capsys.readouterr().err

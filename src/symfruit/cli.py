@@ -899,13 +899,17 @@ def _scenes(args: argparse.Namespace) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
+    import re
+
     from .errors import InputError
     from .season.report import write_report
 
-    try:
-        classes = [float(x) for x in args.classes.split(",") if x.strip()]
-    except ValueError:
-        raise InputError(f"--classes {args.classes!r}: expected diameters in mm such as 18,25") from None
+    entries = [x.strip() for x in args.classes.split(",")]
+    for entry in entries:  # 18,,25 was read as 18,25 and '١٨' (Arabic-Indic digits) or 1_8 as 18, unsaid
+        if not re.fullmatch(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?", entry, flags=re.ASCII):
+            what = "an empty entry" if not entry else f"{entry!r} is no number"
+            raise InputError(f"--classes {args.classes!r}: {what}; expected diameters in mm such as 18,25")
+    classes = [float(x) for x in entries]
     r = write_report(args.run, folder=args.output, classes=classes)
     print(f"report: {r.recordings} recording(s), {r.frames} frames, {r.fruit} fruit seen, {r.located} located, "
           f"{r.sized} sized; {r.folder / 'report.md'} and {len(r.written) - 1} plots")  # fmt: skip
