@@ -77,10 +77,14 @@ class Box:
 
     def union(self, other: Box) -> Box:
         """The smallest box containing both."""
+        _boxes(self, other, "Box.union")
         return Box(min=np.minimum(self.min, other.min), max=np.maximum(self.max, other.max))
 
     def contains(self, points: np.ndarray, *, tol: float = 0.0) -> bool:
         """Whether every point of ``points`` : (n, 3) lies in the box (within ``tol`` metres)."""
+        number = isinstance(tol, int | float | np.integer | np.floating) and not isinstance(tol, bool)
+        if not (number and math.isfinite(tol)):  # NaN made every point 'outside', text a UFuncTypeError
+            raise InputError(f"Box.contains: tol must be a finite number of metres, got {tol!r:.40}")
         points = as_points(points, min_count=0)
         return bool(np.all(points >= self.min - tol) and np.all(points <= self.max + tol))
 
