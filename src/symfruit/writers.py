@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from .core.box import Box
+from .core.limits import instance_labels, shown
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError, OutputError
 from .extract import shift_labels
@@ -353,9 +354,18 @@ def draw_label_overlay(color: np.ndarray, labels: np.ndarray, *, alpha: float = 
     """
     from PIL import Image
 
-    color, labels = np.asarray(color), np.asarray(labels)
+    color = np.asarray(color)
+    labels = instance_labels(labels, "labels", error=FileFormatError)  # before: -1 and 2.5 drawn as what they cast to
     if color.ndim != 3 or color.shape[:2] != labels.shape:
         raise FileFormatError(f"labels are {labels.shape[::-1]}, the image {color.shape[1::-1]}")
+    if color.shape[2] not in (3, 4):  # two channels were numpy's broadcast error
+        raise FileFormatError(f"the image must be RGB (h, w, 3), got {color.shape[2]} channels")
+    if color.dtype != np.uint8 and color.size:  # a float image in [0, 1] was drawn black, 0-1000 clipped, unsaid
+        values = color[:, :, :3]
+        if color.dtype.kind not in "iuf" or values.min() < 0 or values.max() > 255 or (values % 1).any():
+            raise FileFormatError(f"the image must be 8-bit colour (whole numbers 0-255), got {color.dtype}")
+    if isinstance(alpha, bool) or not isinstance(alpha, int | float | np.integer | np.floating) or not 0 <= alpha <= 1:
+        raise FileFormatError(f"alpha must be a tint strength in [0, 1], got {shown(alpha)}")
     h, w = labels.shape
     out = Image.new("RGB", (w, h))
     rows = max(1, BAND_PIXELS // max(w, 1))
@@ -394,7 +404,9 @@ def write_labels(path: str | Path, labels: np.ndarray) -> Path:
         raise FileFormatError(f"{path}: instance labels are written as .png")
     if labels.ndim != 2 or not np.issubdtype(labels.dtype, np.integer):
         raise FileFormatError(f"{path}: labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
-    if labels.size and (labels.min() < 0 or labels.max() > MAX_LABEL_PNG_ID):
+    if labels.size == 0:  # Pillow's 'cannot write empty image'
+        raise FileFormatError(f"{path}: labels are a {labels.shape[1]}x{labels.shape[0]} image; no PNG is empty")
+    if labels.min() < 0 or labels.max() > MAX_LABEL_PNG_ID:
         raise FileFormatError(f"{path}: labels must be 0-{MAX_LABEL_PNG_ID} to fit a 16-bit PNG")
     with atomic_write(path, "wb") as handle:
         Image.fromarray(labels.astype(np.uint16)).save(handle, format="PNG")
