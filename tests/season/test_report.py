@@ -79,6 +79,13 @@ def test_diameters_and_classes():
     for bad in ([], [25, 18], [0, 10], [18, float("nan")]):
         with pytest.raises(InputError, match="increasing diameters"):
             size_classes(np.ones(1), bad)
+    for bad in ("18", None, 18):  # before: "18" read a character at a time as classes 1 and 8 mm; TypeErrors
+        with pytest.raises(InputError, match=r"size classes must be a list of diameters in mm such as \[18, 25\]"):
+            size_classes(np.ones(1), bad)
+    for bad in ([True, 25], [[18], [25]], ["18", "25"]):  # before: True read as 1 mm, float()'s TypeError, "18" taken
+        with pytest.raises(InputError, match="size classes must be diameters in mm, got"):
+            size_classes(np.ones(1), bad)
+    assert size_classes(np.array([20.0]), np.array([18, 25])) == size_classes(np.array([20.0]), (18.0, 25))
 
 
 def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
