@@ -304,3 +304,17 @@ def test_truth_labels_negative_or_too_many_are_refused_and_masked_pixels_are_bac
     hidden = np.ma.masked_array(labels, mask=np.zeros((6, 6), bool))
     hidden.mask[:3, :3] = True  # the masked half of the fruit is background, not label 1
     assert score_masks(hidden, labels).best_iou.tolist() == [0.5]
+
+
+@pytest.mark.parametrize(
+    ("ious", "message"),
+    [
+        ("x", "ious must be an \\(n, k\\) array of IoUs in \\[0, 1\\], got 'x'"),  # before: numpy's ValueError
+        (np.full((2, 2), np.nan), "ious must be IoUs in \\[0, 1\\], got values from nan"),  # before: no match, unsaid
+        (np.array([[1.5]]), "from 1.5 to 1.5"),  # before: matched as an IoU of 1.5
+        (np.array([[0.9, -0.1]]), "from -0.1 to 0.9"),
+    ],
+)
+def test_match_masks_refuses_what_is_no_iou(ious, message):
+    with pytest.raises(InputError, match=message):
+        match_masks(ious)

@@ -156,9 +156,14 @@ def match_masks(ious: np.ndarray, *, threshold: float = 0.5) -> np.ndarray:
     """
     from scipy.optimize import linear_sum_assignment
 
-    ious = np.asarray(ious, dtype=np.float64)
+    try:
+        ious = np.asarray(ious, dtype=np.float64)
+    except (TypeError, ValueError):  # numpy's 'could not convert string to float'
+        raise InputError(f"ious must be an (n, k) array of IoUs in [0, 1], got {shown(ious)}") from None
     if ious.ndim != 2:
         raise InputError(f"ious must be (n, k), got shape {ious.shape}")
+    if ious.size and not (ious.min() >= 0.0 and ious.max() <= 1.0):  # NaN never matched, 1.5 matched, unsaid
+        raise InputError(f"ious must be IoUs in [0, 1], got values from {ious.min()} to {ious.max()}")
     if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)):
         raise InputError(f"threshold must be a number in (0, 1], got {shown(threshold)}")
     if not 0 < threshold <= 1:  # NaN fails this too
