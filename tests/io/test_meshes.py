@@ -169,3 +169,14 @@ def test_a_ply_face_of_float_indices_is_refused_not_cut_to_whole_numbers(tmp_pat
         read_mesh(path)
     path.write_text(head + "property list uchar uint vertex_indices\n" + body.replace("1.7 2.9", "1 2"))
     assert read_mesh(path)[1].tolist() == [[0, 1, 2]]
+
+
+def test_a_ply_mesh_that_is_a_folder_or_a_looping_link_is_named_as_such(tmp_path):
+    (tmp_path / "m.ply").mkdir()
+    with pytest.raises(FileFormatError, match=r"m\.ply: a directory, not a file"):  # before: 'no such file'
+        read_mesh(tmp_path / "m.ply")
+    (tmp_path / "loop.ply").symlink_to(tmp_path / "loop.ply")
+    with pytest.raises(FileFormatError, match=r"loop\.ply: a link that leads to no file"):  # before: 'no such file'
+        read_mesh(tmp_path / "loop.ply")
+    with pytest.raises(FileFormatError, match=r"none\.ply: no such file"):
+        read_mesh(tmp_path / "none.ply")

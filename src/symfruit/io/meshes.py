@@ -9,7 +9,7 @@ import numpy as np
 from ..core.limits import MAX_FACES, MAX_OBJ_BYTES, shown  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
 from .clouds import MAX_CLOUD_POINTS, ply_elements, ply_vertices
-from .text import as_path, read_limited
+from .text import as_path, holds_file, read_limited
 
 __all__ = ["read_mesh"]
 
@@ -26,7 +26,7 @@ def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    if not path.is_file():
+    if not holds_file(path):  # a folder or a looping link was 'no such file'; now named for what it is
         raise FileFormatError(f"{path}: no such file")
     _, elements = ply_elements(path)  # every element's count checked against the file size first
     counts = dict(elements)
