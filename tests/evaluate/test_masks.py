@@ -318,3 +318,23 @@ def test_truth_labels_negative_or_too_many_are_refused_and_masked_pixels_are_bac
 def test_match_masks_refuses_what_is_no_iou(ious, message):
     with pytest.raises(InputError, match=message):
         match_masks(ious)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ({"image": 5}, "image must be the image's name"),  # before: 5 kept as the image's name
+        ({"ms": "x"}, "ms must be milliseconds >= 0"),  # before: numpy's ValueError from float()
+        ({"ms": -1.0}, "ms must be milliseconds >= 0"),
+        ({"crowd": -1}, "crowd must be a count of crowd regions >= 0, got -1"),  # before: summed as -1
+        ({"crowd": "a"}, "crowd must be a count"),  # before: ValueError from int()
+        ({"ignore": np.full((6, 6), 0.5)}, "ignore must be a bool .* got float64"),  # before: 0.5 read as crowd
+    ],
+)
+def test_score_masks_refuses_a_name_time_crowd_count_or_crowd_mask_of_another_kind(extra, message):
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    with pytest.raises(InputError, match=message):
+        score_masks(labels, labels, **extra)
+    kept = score_masks(labels, labels, image="a.png", ms=np.float32(2), crowd=np.int64(1), ignore=np.zeros((6, 6), int))
+    assert (kept.image, kept.ms, kept.crowd, kept.matched) == ("a.png", 2.0, 1, 1)

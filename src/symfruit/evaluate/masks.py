@@ -249,6 +249,16 @@ def score_masks(
         Crowd regions (``crowd`` of them): an unmatched prediction with at least ``threshold`` of its area
         in them is ignored, neither matched nor false (COCO's rule for ``iscrowd`` annotations).
     """
+    if not isinstance(image, str):  # an image's name, written into the report's tables as text
+        raise InputError(f"image must be the image's name (text), got {shown(image)}")
+    if isinstance(ms, bool) or not isinstance(ms, int | float | np.integer | np.floating) or ms < 0:
+        raise InputError(f"ms must be milliseconds >= 0 (or NaN: not timed), got {shown(ms)}")  # 'x' a ValueError
+    if isinstance(crowd, bool) or not isinstance(crowd, int | np.integer) or crowd < 0:
+        raise InputError(f"crowd must be a count of crowd regions >= 0, got {shown(crowd)}")  # -1 summed as is
+    if ignore is not None:
+        ignore = np.asarray(ignore)
+        if ignore.dtype != bool and not (np.issubdtype(ignore.dtype, np.integer) and np.isin(ignore, (0, 1)).all()):
+            raise InputError(f"ignore must be a bool (h, w) mask of crowd regions, got {ignore.dtype}")  # 0.5: crowd
     ious, ids = mask_ious(truth, labels)
     best = ious.max(axis=1) if ious.shape[1] else np.zeros(ious.shape[0])
     pairs = match_masks(ious, threshold=threshold)
