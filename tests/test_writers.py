@@ -285,3 +285,19 @@ def test_the_label_overlay_and_label_png_refuse_what_they_would_draw_or_write_wr
     with pytest.raises(FileFormatError, match="labels are a 0x0 image; no PNG is empty"):
         write_labels(tmp_path / "l.png", np.zeros((0, 0), np.int32))  # before: Pillow's 'cannot write empty image'
     assert not list(tmp_path.iterdir())
+
+
+def test_an_empty_output_path_is_refused_not_read_as_the_working_folder(tmp_path, monkeypatch):
+    from symfruit import InputError
+    from symfruit.writers import check_results_root, new_results_folder, write_detections, write_result
+
+    monkeypatch.chdir(tmp_path)
+    for call, what in [
+        (lambda: write_detections("", None), "write_detections: the frame folder"),  # before: into the working folder
+        (lambda: check_results_root(""), "the results root"),
+        (lambda: new_results_folder("", "paper"), "new_results_folder: the results root"),
+        (lambda: write_result("", None), "write_result: the output file"),
+    ]:
+        with pytest.raises(InputError, match=f"{what} is an empty path"):
+            call()
+    assert not list(tmp_path.iterdir())

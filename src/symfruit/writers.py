@@ -40,6 +40,7 @@ from .extract import shift_labels
 from .io.atomic import atomic_write, folder_fd, stale_temporaries, write_json
 from .io.clouds import write_ply
 from .io.images import BAND_PIXELS
+from .io.text import as_path
 from .methods.complete import Result
 from .settings import Settings
 
@@ -87,7 +88,7 @@ def check_result_paths(path: str | Path, inputs: Iterable[str | Path | None] = (
     OutputError
         When either file is a folder or an input.
     """
-    path = Path(path)
+    path = as_path(path, "write_result: the output file")  # '' was the working folder
     if path.suffix.lower() != ".ply":
         raise FileFormatError(f"{path}: the output must end in .ply")
     json_path = path.with_suffix(".json")
@@ -195,7 +196,7 @@ def write_detections(folder: str | Path, found: FrameDetections, *, settings: Se
     OutputError
         When a file cannot be written (``errno`` set for a full disk); the frame is then not done.
     """
-    folder = Path(folder)
+    folder = as_path(folder, "write_detections: the frame folder")  # '' was the working folder
     with folder_fd(folder) as fd, contextlib.suppress(FileNotFoundError, IsADirectoryError):
         os.unlink("detections.json", dir_fd=fd)  # the frame is not done until its new record is written
     written = []
@@ -239,7 +240,7 @@ def check_results_root(root: str | Path) -> None:
     FileFormatError
         Naming ``root`` and the problem.
     """
-    root = Path(root)
+    root = as_path(root, "the results root")  # '' was the working folder
     probe = root
     while not probe.exists() and probe != probe.parent:  # the nearest existing folder, where mkdir would start
         probe = probe.parent
@@ -258,7 +259,7 @@ def new_results_folder(root: str | Path, tag: str) -> Path:
     FileFormatError
         When ``root`` cannot be written.
     """
-    root = Path(root)
+    root = as_path(root, "new_results_folder: the results root")  # '' was the working folder
     stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     k = 1
     while True:
@@ -468,7 +469,7 @@ def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, An
 
     from .evaluate.masks import CSV_COLUMNS
 
-    folder = Path(folder)
+    folder = as_path(folder, "write_mask_report: the output folder")  # '' was the working folder
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

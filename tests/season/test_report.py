@@ -251,3 +251,9 @@ def test_columns_of_another_type_are_refused_by_name(run, table, column, values,
     with pytest.raises(FileFormatError, match=rf"{table}: {message} \(not a symfruit table, or damaged\)$"):
         write_report(run)
     assert not (run / "report").exists()
+
+
+def test_write_report_refuses_an_empty_run_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match="write_report: the run folder is an empty path"):
+        write_report("")  # before: the working folder read as the run ('./detections.parquet: no such table')

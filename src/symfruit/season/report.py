@@ -30,6 +30,7 @@ import numpy as np
 
 from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TABLE_BYTES, MAX_TABLE_ROWS, shown
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
+from ..io.text import as_path
 from .table import FRAME_COLUMNS, FRAMES_NAME, FRUIT_COLUMNS, TABLE_NAME, recording_inputs
 
 __all__ = [
@@ -250,7 +251,7 @@ def write_report(
     from ..io.atomic import atomic_write
     from ..io.outputs import OutputFolder
 
-    output = Path(output)
+    output = as_path(output, "write_report: the run folder")  # '' was the working folder
     if folder is None and (output / "report").is_symlink():  # the default is the run's own: never a link out of it
         link = output / "report"
         raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
