@@ -581,3 +581,20 @@ def test_a_masks_spec_or_method_no_frame_can_use_is_refused_before_any_frame(tmp
     with pytest.raises(symfruit.SymfruitError, match=re.escape(message)):  # before: each frame failed with it
         run_batch(EXAMPLE_FRAME, tmp_path / "out", progress=False, **kwargs)
     assert not (tmp_path / "out").exists()
+
+
+def test_an_empty_recording_or_output_path_is_refused_not_read_as_the_working_folder(tmp_path, monkeypatch):
+    from symfruit import InputError
+    from symfruit.batch import segment_images
+
+    monkeypatch.chdir(tmp_path)
+    shutil.copytree(small_frame(), tmp_path / "f1")
+    with pytest.raises(InputError, match="run_batch: the output folder is an empty path"):
+        run_batch("f1", "", method="raw", progress=False)  # before: the results written into the working folder
+    for source in ("", ["f1", ""]):  # before: '.: neither a frame folder ...', the working folder as a recording
+        with pytest.raises(InputError, match="the recording is an empty path"):
+            run_batch(source, "out", method="raw", progress=False)
+    with pytest.raises(InputError, match="segment_images: the output folder is an empty path"):
+        segment_images(["f1/color.png"], output="")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["f1"]  # nothing written
+    assert run_batch(b"f1", "out", method="raw", progress=False).done == ["f1"]  # a bytes path is one recording

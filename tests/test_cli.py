@@ -909,6 +909,8 @@ def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, m
         ("--fruit", ",", "--fruit ',' names nothing"),  # before: an evaluation of no fruit, exit 0
         ("--fruit", "", "--fruit '' names nothing"),  # before: taken as the default, strawberry
         ("--methods", "raw,raw", "--methods names 'raw' twice"),
+        ("--methods", "raw,,paper", "--methods 'raw,,paper': an empty entry"),  # before: raw and paper, unsaid
+        ("--fruit", "strawberry,", "--fruit 'strawberry,': an empty entry"),  # before: strawberry, unsaid
     ],
 )
 def test_evaluate_refuses_an_option_naming_no_fruit_or_method_or_one_twice(tmp_path, capsys, option, value, message):
@@ -923,3 +925,31 @@ def test_an_empty_method_is_refused_not_read_as_the_default(tmp_path, monkeypatc
     assert main([*command, "--method", ""]) == 2  # before: the default method ran, exit 0
     assert "unknown method ''" in capsys.readouterr().err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize(
+    ("classes", "what"),
+    [
+        ("18,,25", "an empty entry"),  # before: read as 18,25 in silence
+        ("18,25,", "an empty entry"),
+        ("١٨,25", "'١٨' is no number"),  # before: Arabic-Indic digits read as 18
+        ("1_8,25", "'1_8' is no number"),  # before: read as 18
+        ("nan", "'nan' is no number"),
+    ],
+)
+def test_report_classes_refuse_an_empty_entry_or_what_is_no_plain_number(tmp_path, capsys, classes, what):
+    assert main(["report", str(tmp_path / "run"), f"--classes={classes}"]) == 2
+    assert f"--classes {classes!r}: {what}; expected diameters in mm" in capsys.readouterr().err
+    assert main(["report", str(tmp_path / "run"), "--classes", " 18, 2.5e1 "]) == 2  # read: on to the missing run
+    assert "detections.parquet: no such table" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("value", "what"),
+    [("0,٠.٥", "'٠.٥' is no number"), ("0,0.5_0", "'0.5_0' is no number"), ("0,,0.5", "an empty entry")],
+)
+def test_evaluate_occlusion_levels_are_plain_numbers(tmp_path, capsys, value, what):
+    # before: Arabic-Indic digits and 0.5_0 were read as 0.5 by float(); an empty entry was 'expected numbers'
+    assert main(["evaluate", "--protocol", "camera", "--occlusion", value, "--output", str(tmp_path / "r")]) == 2
+    _one_line_error(capsys, f"--occlusion {value!r}: {what}; expected numbers such as 0,0.25,0.5")
+    assert not (tmp_path / "r").exists()

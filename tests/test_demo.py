@@ -75,3 +75,12 @@ def test_the_demo_never_writes_into_its_own_frame_folder(tmp_path, monkeypatch):
     with pytest.raises(OutputError, match=r"example_frame: the output folder is also an input folder"):
         run_demo(copy, method="raw")  # before: fruit_00k.ply, overlay.png, detections.json written beside its images
     assert sorted(p.name for p in copy.iterdir()) == before
+
+
+def test_the_demo_refuses_an_empty_output_path(tmp_path, monkeypatch):
+    from symfruit import InputError
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match="demo: the output folder is an empty path"):
+        run_demo("")  # before: detections, clouds and overlay written into the working folder
+    assert not list(tmp_path.iterdir())

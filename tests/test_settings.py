@@ -379,3 +379,11 @@ def test_numpy_numbers_are_read_as_the_python_ones_from_python_and_from_override
 def test_resolve_settings_refuses_arguments_of_another_type_by_name(call, message):
     with pytest.raises(ConfigError, match=message):
         call()
+
+
+@pytest.mark.parametrize("config", ["", "  ", b""])
+def test_an_empty_config_path_is_refused_as_such(config):
+    with pytest.raises(ConfigError, match=r"config is an empty path \(an unset variable\?\)"):
+        resolve_settings(fruit="apple", config=config)  # before: '.: settings file must end in .yaml, .yml or .json'
+    with pytest.raises(ConfigError, match="config is an empty path"):
+        load_settings(config)

@@ -260,3 +260,44 @@ def test_a_result_is_never_written_over_an_input(tmp_path):
             check_result_paths(tmp_path / output, inputs)
     assert check_result_paths(tmp_path / "out.ply", inputs) == (tmp_path / "out.ply", tmp_path / "out.json")
     assert [p.read_text() for p in inputs[:2]] == ["ply", "{}"]
+
+
+def test_the_label_overlay_and_label_png_refuse_what_they_would_draw_or_write_wrong(tmp_path):
+    from symfruit.writers import draw_label_overlay, write_labels
+
+    color, labels = np.zeros((4, 5, 3), np.uint8), np.zeros((4, 5), np.int32)
+    labels[1, 1] = 2
+    cases = [
+        ((color, labels.astype(float) + 0.5), {}, "instance labels must be whole numbers"),  # before: drawn as 2
+        ((color, labels - 5), {}, "masks hold negative labels"),  # before: -5 drawn as background
+        ((color[..., :2], labels), {}, "must be RGB"),  # before: numpy's broadcast ValueError
+        ((np.full((4, 5, 3), 0.5), labels), {}, r"8-bit colour \(whole numbers 0-255\), got float64"),  # was black
+        ((np.full((4, 5, 3), 1000), labels), {}, "8-bit colour"),  # before: clipped to white in silence
+        ((color, labels), {"alpha": float("nan")}, "alpha must be a tint strength in"),  # before: drawn anyway
+        ((color, labels), {"alpha": "a"}, "alpha must be a tint strength"),  # before: TypeError
+        ((np.zeros((0, 0, 3), np.uint8), np.zeros((0, 0), np.int32)), {}, "must not be empty"),  # was IndexError
+    ]
+    for args, kwargs, message in cases:
+        with pytest.raises(FileFormatError, match=message):
+            draw_label_overlay(*args, **kwargs)
+    whole = np.asarray(draw_label_overlay(color.astype(np.int64) + 100, labels > 0))  # 8-bit values, one fruit
+    assert whole.shape == (4, 5, 3) and whole[0, 0].tolist() == [100, 100, 100]
+    with pytest.raises(FileFormatError, match="labels are a 0x0 image; no PNG is empty"):
+        write_labels(tmp_path / "l.png", np.zeros((0, 0), np.int32))  # before: Pillow's 'cannot write empty image'
+    assert not list(tmp_path.iterdir())
+
+
+def test_an_empty_output_path_is_refused_not_read_as_the_working_folder(tmp_path, monkeypatch):
+    from symfruit import InputError
+    from symfruit.writers import check_results_root, new_results_folder, write_detections, write_result
+
+    monkeypatch.chdir(tmp_path)
+    for call, what in [
+        (lambda: write_detections("", None), "write_detections: the frame folder"),  # before: into the working folder
+        (lambda: check_results_root(""), "the results root"),
+        (lambda: new_results_folder("", "paper"), "new_results_folder: the results root"),
+        (lambda: write_result("", None), "write_result: the output file"),
+    ]:
+        with pytest.raises(InputError, match=f"{what} is an empty path"):
+            call()
+    assert not list(tmp_path.iterdir())

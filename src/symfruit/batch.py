@@ -30,7 +30,7 @@ from .io.frames import is_frame_folder
 from .io.images import image_suffixes
 from .io.outputs import LOCK_NAME, OutputFolder, entry_name, reserve_record, unique_names, write_record
 from .io.sources import open_source
-from .io.text import holds_file
+from .io.text import as_path, holds_file
 from .methods import DEFAULT_METHOD
 from .methods.registry import get as get_method
 from .progress import Progress
@@ -158,7 +158,7 @@ def run_batch(
                                method=method, settings=settings, resume=resume, progress=progress,
                                exclude=exclude)  # fmt: skip
     settings = settings or Settings()
-    output = Path(output)
+    output = as_path(output, "run_batch: the output folder")  # '' was the working folder
     report = BatchReport()
     reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
     recordings = plan_recordings(source, output, reserved=reserved)
@@ -300,10 +300,11 @@ def plan_recordings(
     OutputError
         For an input that is the output folder or lies inside it.
     """
-    paths = [Path(sources)] if isinstance(sources, (str, os.PathLike)) else [Path(s) for s in sources]
+    given: Sequence[Any] = [sources] if isinstance(sources, (str, bytes, os.PathLike)) else sources  # bytes: one
+    paths = [as_path(s, "the recording") for s in given]  # '' was the working folder
     if not paths:
         raise InputError("no recording given: name one or more frame folders, folders of frames or bags")
-    output = Path(output)
+    output = as_path(output, "plan_recordings: the output folder")  # '' was the working folder
     if len(paths) == 1:
         return [Recording(paths[0], recording_name(paths[0]), output)]
     home = os.path.realpath(output)
@@ -675,7 +676,7 @@ def segment_images(
     if not (np.isfinite(depth_scale) and 0 < depth_scale <= 1.0):
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
     labeller, source = _labeller(masks, settings, images)
-    output = Path(output)
+    output = as_path(output, "segment_images: the output folder")  # '' was the working folder
     inputs: list[Path] = list(images)
     folders: list[Path] = sorted({p.parent for p in images})
     for extra in (depth_path, None if callable(masks) else Path(str(masks))):

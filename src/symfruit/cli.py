@@ -39,6 +39,28 @@ def _path(text: str) -> Path:
     return Path(text)
 
 
+#: A plain number as an option's list gives it: ASCII digits (float() also reads '١٨' and 1_8 as 18).
+_NUMBER = r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
+
+
+def _entries(option: str, text: str, example: str, *, numbers: bool = False) -> list[str]:
+    """The comma-separated entries of ``option``, stripped; an empty entry beside others (``a,,b``, a trailing
+    comma) and, with ``numbers``, an entry that is no plain number are refused by name (they were dropped or
+    misread). No entry at all (``''``, ``,,``) is ``[]``: the caller says what that leaves."""
+    import re
+
+    from .errors import InputError
+
+    entries = [x.strip() for x in text.split(",")]
+    if not any(entries):
+        return []
+    for entry in entries:
+        if not entry or (numbers and not re.fullmatch(_NUMBER, entry, flags=re.ASCII)):
+            what = "an empty entry" if not entry else f"{entry!r} is no number"
+            raise InputError(f"{option} {text!r}: {what}; expected {example}")
+    return entries
+
+
 def _add_complete(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("complete", help="complete one fruit's partial cloud and box it")
     p.add_argument("cloud", type=_path, help="PLY, PCD, XYZ/TXT/CSV or NPY file of the visible points")
@@ -564,13 +586,13 @@ def _evaluate(args: argparse.Namespace) -> int:
     check_results_root(args.output)  # before the work, not after it
     if args.protocol == "masks":
         return _evaluate_masks(args)
-    fruits = [f.strip() for f in args.fruit.split(",") if f.strip()]
+    fruits = _entries("--fruit", args.fruit, "fruit kinds or folders such as strawberry,apple")  # a,,b: refused
     if fruits == ["all"]:
         fruits = list(FRUITS)
     for fruit in fruits:
         if fruit not in FRUITS and not Path(fruit).is_dir():
             raise InputError(f"--fruit {fruit!r}: not a fruit kind ({', '.join(FRUITS)}, all) nor a folder of scans")
-    methods = [m.strip() for m in args.methods.split(",") if m.strip()]
+    methods = _entries("--methods", args.methods, "method names such as raw,paper")  # raw,,paper: refused
     for method in methods:
         get(method)
     for option, names in (("--fruit", fruits), ("--methods", methods)):  # nothing to evaluate: an empty table
@@ -579,10 +601,7 @@ def _evaluate(args: argparse.Namespace) -> int:
         if len(set(names)) < len(names):
             twice = next(name for name in names if names.count(name) > 1)
             raise InputError(f"{option} names {twice!r} twice")
-    try:
-        occlusions = [float(x) for x in args.occlusion.split(",")]
-    except ValueError:
-        raise InputError(f"--occlusion {args.occlusion!r}: expected numbers such as 0,0.25,0.5") from None
+    occlusions = [float(x) for x in _entries("--occlusion", args.occlusion, "numbers such as 0,0.25,0.5", numbers=True)]
     if any(not 0.0 <= x < 1.0 for x in occlusions):
         raise InputError("--occlusion levels must be in [0, 1)")
     if args.n is not None and not 1 <= args.n <= 100_000:
@@ -602,8 +621,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     if args.frames is not None:
         from .profiles import available_profiles
 
-        fruit = fruits[0] if len(fruits) == 1 and fruits[0] in available_profiles() else None
-        settings = _plain_settings(args) if args.no_profile else _settings_for(args, fruit)
+        profile = fruits[0] if len(fruits) == 1 and fruits[0] in available_profiles() else None
+        settings = _plain_settings(args) if args.no_profile else _settings_for(args, profile)
         return _evaluate_frames(args, methods, settings)
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
@@ -899,13 +918,10 @@ def _scenes(args: argparse.Namespace) -> int:
 
 
 def _report(args: argparse.Namespace) -> int:
-    from .errors import InputError
     from .season.report import write_report
 
-    try:
-        classes = [float(x) for x in args.classes.split(",") if x.strip()]
-    except ValueError:
-        raise InputError(f"--classes {args.classes!r}: expected diameters in mm such as 18,25") from None
+    # 18,,25 was read as 18,25 and '١٨' (Arabic-Indic digits) or 1_8 as 18, unsaid
+    classes = [float(x) for x in _entries("--classes", args.classes, "diameters in mm such as 18,25", numbers=True)]
     r = write_report(args.run, folder=args.output, classes=classes)
     print(f"report: {r.recordings} recording(s), {r.frames} frames, {r.fruit} fruit seen, {r.located} located, "
           f"{r.sized} sized; {r.folder / 'report.md'} and {len(r.written) - 1} plots")  # fmt: skip

@@ -19,6 +19,7 @@ from .detect import Detection, FrameDetections, detect
 from .evaluate.frames import match
 from .io.frames import read_frame
 from .io.outputs import OutputFolder
+from .io.text import as_path
 from .methods import DEFAULT_METHOD
 from .settings import Settings
 from .writers import write_detections
@@ -61,7 +62,7 @@ def run_demo(output: str | Path, *, method: str = DEFAULT_METHOD, settings: Sett
     from .methods.registry import get
 
     get(method)  # an unknown method refused before the output folder is made
-    output = Path(output)
+    output = as_path(output, "demo: the output folder")  # '' was the working folder
     with example_frame() as folder:
         frame = read_frame(folder)
         source = Path(folder)  # the frame's folder, an input: never written into (--output it is refused)

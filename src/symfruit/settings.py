@@ -437,6 +437,8 @@ def resolve_settings(
         config = os.fsdecode(config)
     if isinstance(fruit, bytes):
         fruit = os.fsdecode(fruit)
+    if config is not None and not str(config).strip():  # '' was read as the folder '.': ".: must end in .yaml"
+        raise ConfigError("config is an empty path (an unset variable?); give a settings file, or None for none")
     if base is not None and not isinstance(base, Settings):
         raise ConfigError(f"base must be a Settings, got {type(base).__name__}")
     data = (base or Settings()).to_dict()

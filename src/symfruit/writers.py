@@ -33,12 +33,14 @@ from typing import Any
 import numpy as np
 
 from .core.box import Box
+from .core.limits import instance_labels, shown
 from .detect import Detection, FrameDetections
 from .errors import FileFormatError, OutputError
 from .extract import shift_labels
 from .io.atomic import atomic_write, folder_fd, stale_temporaries, write_json
 from .io.clouds import write_ply
 from .io.images import BAND_PIXELS
+from .io.text import as_path
 from .methods.complete import Result
 from .settings import Settings
 
@@ -86,7 +88,7 @@ def check_result_paths(path: str | Path, inputs: Iterable[str | Path | None] = (
     OutputError
         When either file is a folder or an input.
     """
-    path = Path(path)
+    path = as_path(path, "write_result: the output file")  # '' was the working folder
     if path.suffix.lower() != ".ply":
         raise FileFormatError(f"{path}: the output must end in .ply")
     json_path = path.with_suffix(".json")
@@ -194,7 +196,7 @@ def write_detections(folder: str | Path, found: FrameDetections, *, settings: Se
     OutputError
         When a file cannot be written (``errno`` set for a full disk); the frame is then not done.
     """
-    folder = Path(folder)
+    folder = as_path(folder, "write_detections: the frame folder")  # '' was the working folder
     with folder_fd(folder) as fd, contextlib.suppress(FileNotFoundError, IsADirectoryError):
         os.unlink("detections.json", dir_fd=fd)  # the frame is not done until its new record is written
     written = []
@@ -238,7 +240,7 @@ def check_results_root(root: str | Path) -> None:
     FileFormatError
         Naming ``root`` and the problem.
     """
-    root = Path(root)
+    root = as_path(root, "the results root")  # '' was the working folder
     probe = root
     while not probe.exists() and probe != probe.parent:  # the nearest existing folder, where mkdir would start
         probe = probe.parent
@@ -257,7 +259,7 @@ def new_results_folder(root: str | Path, tag: str) -> Path:
     FileFormatError
         When ``root`` cannot be written.
     """
-    root = Path(root)
+    root = as_path(root, "new_results_folder: the results root")  # '' was the working folder
     stamp = _dt.datetime.now().strftime("%Y%m%d-%H%M%S")
     k = 1
     while True:
@@ -353,9 +355,18 @@ def draw_label_overlay(color: np.ndarray, labels: np.ndarray, *, alpha: float = 
     """
     from PIL import Image
 
-    color, labels = np.asarray(color), np.asarray(labels)
+    color = np.asarray(color)
+    labels = instance_labels(labels, "labels", error=FileFormatError)  # before: -1 and 2.5 drawn as what they cast to
     if color.ndim != 3 or color.shape[:2] != labels.shape:
         raise FileFormatError(f"labels are {labels.shape[::-1]}, the image {color.shape[1::-1]}")
+    if color.shape[2] not in (3, 4):  # two channels were numpy's broadcast error
+        raise FileFormatError(f"the image must be RGB (h, w, 3), got {color.shape[2]} channels")
+    if color.dtype != np.uint8 and color.size:  # a float image in [0, 1] was drawn black, 0-1000 clipped, unsaid
+        values = color[:, :, :3]
+        if color.dtype.kind not in "iuf" or values.min() < 0 or values.max() > 255 or (values % 1).any():
+            raise FileFormatError(f"the image must be 8-bit colour (whole numbers 0-255), got {color.dtype}")
+    if isinstance(alpha, bool) or not isinstance(alpha, int | float | np.integer | np.floating) or not 0 <= alpha <= 1:
+        raise FileFormatError(f"alpha must be a tint strength in [0, 1], got {shown(alpha)}")
     h, w = labels.shape
     out = Image.new("RGB", (w, h))
     rows = max(1, BAND_PIXELS // max(w, 1))
@@ -394,7 +405,9 @@ def write_labels(path: str | Path, labels: np.ndarray) -> Path:
         raise FileFormatError(f"{path}: instance labels are written as .png")
     if labels.ndim != 2 or not np.issubdtype(labels.dtype, np.integer):
         raise FileFormatError(f"{path}: labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
-    if labels.size and (labels.min() < 0 or labels.max() > MAX_LABEL_PNG_ID):
+    if labels.size == 0:  # Pillow's 'cannot write empty image'
+        raise FileFormatError(f"{path}: labels are a {labels.shape[1]}x{labels.shape[0]} image; no PNG is empty")
+    if labels.min() < 0 or labels.max() > MAX_LABEL_PNG_ID:
         raise FileFormatError(f"{path}: labels must be 0-{MAX_LABEL_PNG_ID} to fit a 16-bit PNG")
     with atomic_write(path, "wb") as handle:
         Image.fromarray(labels.astype(np.uint16)).save(handle, format="PNG")
@@ -456,7 +469,7 @@ def write_mask_report(folder: str | Path, evaluation: Any, *, meta: dict[str, An
 
     from .evaluate.masks import CSV_COLUMNS
 
-    folder = Path(folder)
+    folder = as_path(folder, "write_mask_report: the output folder")  # '' was the working folder
     try:
         folder.mkdir(parents=True, exist_ok=True)
     except OSError as exc:

@@ -125,3 +125,32 @@ def test_box_from_points_refuses_non_finite_points_and_box_functions_refuse_what
         box_iou(unit, np.ones((2, 3)))  # before: TypeError comparing ndarray.max with ndarray.min
     with pytest.raises(InputError, match="centre_deviation needs two Box"):
         centre_deviation(np.zeros(3), unit)  # before: AttributeError
+
+
+@pytest.mark.parametrize(
+    "lo, hi, message",
+    [
+        ([0.0, 0.0, 1.0], [1.0, 1.0, 0.5], "min lies beyond its max along z"),  # before: size -0.5, volume negative
+        ([2.0, 0.0, 0.0], [1.0, 1.0, 1.0], "along x"),
+        ([0.0, np.nan, 0.0], [1.0, 1.0, 1.0], "finite corners"),  # before: a box of NaN centre and IoU 0
+        ([0.0, 0.0, 0.0], [1.0, np.inf, 1.0], "finite corners"),
+        ([-np.inf, 0.0, 0.0], [1.0, 1.0, 1.0], "finite corners"),
+    ],
+)
+def test_a_box_with_its_min_beyond_its_max_or_a_corner_not_finite_is_refused(lo, hi, message):
+    with pytest.raises(InputError, match=message):
+        Box(np.array(lo), np.array(hi))
+
+
+def test_a_flat_or_point_box_is_still_a_box():
+    assert Box(np.ones(3), np.ones(3)).volume == 0.0
+    assert Box([0.0, 0.0, 0.3], [0.0, 0.1, 0.3]).size.tolist() == [0.0, 0.1, 0.0]
+
+
+def test_union_needs_a_box_and_contains_a_finite_tolerance():
+    with pytest.raises(InputError, match=r"Box\.union needs two Box"):
+        UNIT.union(np.ones((2, 3)))  # before: TypeError comparing a float with ndarray.min, a method
+    for tol in ("a", np.nan, True, None):  # before: a UFuncTypeError, False for NaN (every point 'outside'), True
+        with pytest.raises(InputError, match=r"Box\.contains: tol must be a finite number of metres"):
+            UNIT.contains([[0.5, 0.5, 0.5]], tol=tol)
+    assert UNIT.contains([[1.05, 0.5, 0.5]], tol=np.float32(0.1)) and not UNIT.contains([[0.95, 0.5, 0.5]], tol=-0.1)

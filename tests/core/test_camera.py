@@ -139,3 +139,14 @@ def test_a_shift_that_is_no_finite_number_is_refused_by_name(du, dv, what):
     with pytest.raises(InputError, match=f"camera shift {what}"):
         cam.shifted(du, dv)
     assert cam.shifted(np.int64(6), np.float32(-2.0)).cx == 326.0 and cam.shifted(np.int64(0), 0.0) is cam
+
+
+def test_project_and_deproject_refuse_coordinates_of_another_shape_by_name(camera):
+    with pytest.raises(InputError, match=r"project needs points of shape \(\.\.\., 3\) in metres, got \(2, 2\)"):
+        camera.project([[0.0, 0.4], [0.01, 0.4]])  # before: IndexError from numpy
+    with pytest.raises(InputError, match=r"deproject needs pixel coordinates of shape \(\.\.\., 2\), got \(1, 3\)"):
+        camera.deproject([[320.0, 240.0, 0.4]], [0.4])  # before: the third column dropped in silence
+    with pytest.raises(InputError, match=r"deproject needs one depth per pixel: \(3,\) pixels, depth \(2,\)"):
+        camera.deproject(np.zeros((3, 2)), [0.4, 0.5])  # before: numpy's broadcast ValueError
+    with pytest.raises(InputError, match=r"one depth per pixel: \(3,\) pixels, depth \(\)"):
+        camera.deproject(np.zeros((3, 2)), 0.4)  # before: numpy's 'all input arrays must have the same shape'

@@ -67,3 +67,26 @@ def test_a_frame_name_that_is_no_text_is_refused(name):
     cam = Camera(fx=50, fy=50, cx=4, cy=3, width=8, height=6)
     with pytest.raises(InputError, match="a frame's name must be text"):  # before: taken, then the run's table
         Frame(name, np.zeros((6, 8, 3), np.uint8), np.zeros((6, 8), np.float32), cam)  # refused the frame's record
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        ({"frame_id": 5}, "frame_id must be text .* got int"),  # before: written as 5 into detections.json
+        ({"truth": [(1, "box")]}, r"truth must be a list of \(id, Box\) pairs"),  # before: AttributeError when scored
+        ({"truth": "x"}, "truth must be a list"),
+        ({"truth": [(True, Box(np.zeros(3), np.ones(3)))]}, "truth must be a list"),
+        ({"truth": [(1.5, Box(np.zeros(3), np.ones(3)))]}, "truth must be a list"),
+        ({"visible": {1: 5.0}}, r"visible must map fruit ids to shares in \[0, 1\]"),  # before: a share of 500 %
+        ({"visible": {1: float("nan")}}, "visible must map"),
+        ({"visible": "x"}, "visible must map"),
+        ({"extras": None}, "extras must be a dict, got NoneType"),
+    ],
+)
+def test_truth_visible_shares_frame_id_and_extras_of_another_kind_are_refused(change, message):
+    args = {"name": "f", "color": COLOR, "depth": DEPTH, "camera": SMALL_CAM, **change}
+    with pytest.raises(InputError, match=message):
+        Frame(**args)
+    kept = Frame("f", COLOR, DEPTH, SMALL_CAM, truth=[(np.int64(2), Box(np.zeros(3), np.ones(3)))],
+                 visible={2: 0.5, np.int64(3): 1}, frame_id="camera_color_optical_frame")  # fmt: skip
+    assert kept.visible == {2: 0.5, 3: 1} and kept.frame_id == "camera_color_optical_frame"

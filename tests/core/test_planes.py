@@ -136,5 +136,27 @@ def test_a_plane_without_a_direction_or_place_is_refused_at_construction(point, 
         Plane(point=np.array(point), normal=np.array(normal))
 
 
-def test_a_plane_with_a_direction_is_kept_as_given():
-    assert Plane(point=np.zeros(3), normal=np.array([0.0, 0.0, 2.0])).to_dict()["normal"] == [0.0, 0.0, 2.0]
+def test_a_plane_with_a_unit_normal_is_kept_as_given():
+    normal = np.array([0.0, 0.6, 0.8])
+    plane = Plane(point=np.zeros(3), normal=normal)
+    assert plane.normal is normal and plane.to_dict()["normal"] == [0.0, 0.6, 0.8]
+
+
+@pytest.mark.parametrize(
+    ("normal", "unit"),
+    [
+        ([0.0, 0.0, 2.0], [0.0, 0.0, 1.0]),  # before: kept as [0, 0, 2], read as a unit normal by to_dict's readers
+        ([0.0, -3.0, 4.0], [0.0, -0.6, 0.8]),
+        ([0.0, 1e-300, 0.0], [0.0, 1.0, 0.0]),  # its squared length underflows to 0
+        ([1e300, 0.0, 1e300], [2**-0.5, 0.0, 2**-0.5]),  # its squared length overflows to inf
+    ],
+)
+def test_a_plane_normal_of_another_length_is_made_unit_the_same_plane(normal, unit):
+    plane = Plane(point=[0.0, 0.0, 0.3], normal=normal)
+    assert np.allclose(plane.normal, unit, rtol=0, atol=1e-15) and np.linalg.norm(plane.normal) == pytest.approx(1.0)
+
+
+def test_a_plane_given_lists_holds_arrays():
+    plane = Plane(point=[0, 0, 1], normal=(0.0, 0.0, 1.0))  # before: AttributeError 'list' object has no 'tolist'
+    assert plane.to_dict() == {"point": [0.0, 0.0, 1.0], "normal": [0.0, 0.0, 1.0]}
+    assert plane.point.dtype == np.float64 and plane.normal.dtype == np.float64

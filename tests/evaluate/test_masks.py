@@ -267,3 +267,74 @@ def test_float_truth_masks_are_refused_not_read_as_fruit(fill):
     with pytest.raises(InputError, match="truth"):
         score_masks(truth, labels)
     assert score_masks(truth != 0, labels).best_iou.tolist() == [1.0]
+
+
+@pytest.mark.parametrize(
+    ("value", "other"),
+    [
+        (1, 2),  # a label image of two fruit put in the stack: before, both read as one mask
+        (255, -1),  # before: -1 read as fruit (non-zero)
+        (255, 7),
+    ],
+)
+def test_integer_truth_masks_hold_zero_and_one_value_each(value, other):
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    truth = np.zeros((1, 6, 6), np.int16)
+    truth[0, :2] = value
+    truth[0, 2] = other
+    with pytest.raises(InputError, match=r"truth mask 0 holds the values .*an integer mask is 0 and one value"):
+        score_masks(truth, labels)
+    truth[0, 2] = value
+    assert score_masks(truth, labels).best_iou.tolist() == [1.0]  # 0/1 and 0/255 masks read as before
+
+
+def test_truth_labels_negative_or_too_many_are_refused_and_masked_pixels_are_background():
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    negative = labels.copy()
+    negative[3:] = -1  # before: background in silence
+    with pytest.raises(InputError, match="truth: masks hold negative labels"):
+        score_masks(negative, labels)
+    many = np.arange(1, 1 + 40 * 40, dtype=np.int32).reshape(40, 40)  # before: a (1600, 40, 40) stack, unbounded
+    with pytest.raises(InputError, match="truth: masks hold 1600 instances; at most 1000"):
+        score_masks(many, np.zeros((40, 40), np.int32))
+    with pytest.raises(InputError, match="labels: masks hold 1600 instances"):
+        mask_ious(np.zeros((40, 40), np.int32), many)
+    hidden = np.ma.masked_array(labels, mask=np.zeros((6, 6), bool))
+    hidden.mask[:3, :3] = True  # the masked half of the fruit is background, not label 1
+    assert score_masks(hidden, labels).best_iou.tolist() == [0.5]
+
+
+@pytest.mark.parametrize(
+    ("ious", "message"),
+    [
+        ("x", "ious must be an \\(n, k\\) array of IoUs in \\[0, 1\\], got 'x'"),  # before: numpy's ValueError
+        (np.full((2, 2), np.nan), "ious must be IoUs in \\[0, 1\\], got values from nan"),  # before: no match, unsaid
+        (np.array([[1.5]]), "from 1.5 to 1.5"),  # before: matched as an IoU of 1.5
+        (np.array([[0.9, -0.1]]), "from -0.1 to 0.9"),
+    ],
+)
+def test_match_masks_refuses_what_is_no_iou(ious, message):
+    with pytest.raises(InputError, match=message):
+        match_masks(ious)
+
+
+@pytest.mark.parametrize(
+    ("extra", "message"),
+    [
+        ({"image": 5}, "image must be the image's name"),  # before: 5 kept as the image's name
+        ({"ms": "x"}, "ms must be milliseconds >= 0"),  # before: numpy's ValueError from float()
+        ({"ms": -1.0}, "ms must be milliseconds >= 0"),
+        ({"crowd": -1}, "crowd must be a count of crowd regions >= 0, got -1"),  # before: summed as -1
+        ({"crowd": "a"}, "crowd must be a count"),  # before: ValueError from int()
+        ({"ignore": np.full((6, 6), 0.5)}, "ignore must be a bool .* got float64"),  # before: 0.5 read as crowd
+    ],
+)
+def test_score_masks_refuses_a_name_time_crowd_count_or_crowd_mask_of_another_kind(extra, message):
+    labels = np.zeros((6, 6), np.int32)
+    labels[:3] = 1
+    with pytest.raises(InputError, match=message):
+        score_masks(labels, labels, **extra)
+    kept = score_masks(labels, labels, image="a.png", ms=np.float32(2), crowd=np.int64(1), ignore=np.zeros((6, 6), int))
+    assert (kept.image, kept.ms, kept.crowd, kept.matched) == ("a.png", 2.0, 1, 1)

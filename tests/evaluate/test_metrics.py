@@ -43,3 +43,22 @@ def test_chamfer_is_the_mean_of_both_directions_and_the_threshold_is_a_keyword()
     cube = Box(np.zeros(3), np.full(3, 0.004))
     s = score_completion(cube, a, cube, b)
     assert isinstance(s, Scores) and s.iou == 1.0 and s.centre_mm == 0.0 and s.chamfer_mm == pytest.approx(1.0)
+
+
+def test_chamfer_refuses_empty_non_finite_or_misshapen_clouds_and_a_threshold_that_is_no_length():
+    from symfruit import InputError
+
+    p = np.random.default_rng(0).random((50, 3))
+    cases = [
+        ((np.zeros((0, 3)), p), {}, "completed must hold at least 1 points"),  # before: NaN chamfer, a warning
+        ((p, np.zeros((0, 3))), {}, "truth must hold at least 1 points"),
+        ((p, p[:, :2]), {}, r"truth must have shape \(n, 3\)"),  # before: scipy's ValueError
+        ((np.r_[p, [[np.nan, 0, 0]]], p), {}, "completed points hold NaN"),  # before: scipy's 'x must be finite'
+        ((p, np.r_[p, [[np.inf, 0, 0]]]), {}, "truth points hold NaN or infinite"),
+        ((p, p), {"threshold": float("nan")}, "threshold must be metres > 0, got nan"),  # before: F1 0
+        ((p, p), {"threshold": -1.0}, "threshold must be metres > 0"),  # before: F1 0
+        ((p, p), {"threshold": "a"}, "threshold must be metres, got 'a'"),  # before: UFuncTypeError
+    ]
+    for args, kwargs, message in cases:
+        with pytest.raises(InputError, match=message):
+            chamfer_f1(*args, **kwargs)

@@ -413,3 +413,14 @@ def test_write_ply_refuses_points_or_labels_it_would_write_as_something_else(tmp
     assert not (tmp_path / "c.ply").exists()
     write_ply(tmp_path / "ok.ply", [[0.0, 0.0, 0.3]] * 4, labels=[0, 1, 1, 255])  # lists are read as arrays
     assert read_cloud(tmp_path / "ok.ply").tolist() == [[0.0, 0.0, 0.30000001192092896]] * 4
+
+
+@pytest.mark.parametrize("target", ["loop.ply", "missing.ply"])
+def test_a_link_that_leads_to_no_file_is_named_as_such_not_no_such_file(tmp_path, target):
+    (tmp_path / "loop.ply").symlink_to(tmp_path / "loop.ply")  # a link to itself: the links loop
+    link = tmp_path / "cloud.ply"
+    link.symlink_to(tmp_path / target)
+    with pytest.raises(FileFormatError, match=r"cloud\.ply: a link that leads to no file \(its target is missing"):
+        read_cloud(link)  # before: 'no such file', though cloud.ply is there
+    with pytest.raises(FileFormatError, match=r"nothing\.ply: no such file"):
+        read_cloud(tmp_path / "nothing.ply")

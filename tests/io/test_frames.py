@@ -483,3 +483,11 @@ def test_write_frame_refuses_what_the_folder_would_read_back_as_something_else(t
     with pytest.raises(InputError, match=message):
         write_frame(tmp_path / "f", args["color"], args["depth"], camera, **kwargs)
     assert not (tmp_path / "f").exists()  # refused before anything was written
+
+
+def test_write_frame_refuses_an_empty_folder_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    color, depth = disc_frame([(80, 60)])
+    with pytest.raises(InputError, match="write_frame: the frame folder is an empty path"):
+        write_frame("", color, depth, SMALL_CAM)  # before: color.png, depth.png, camera.json into the working folder
+    assert not list(tmp_path.iterdir())

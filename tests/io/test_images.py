@@ -276,3 +276,14 @@ def test_depth_and_labels_of_several_images_in_one_file_are_refused(tmp_path, su
         read(path)  # before: the first one read in silence
     first.save(path)  # one image: read
     assert read(path).shape == (8, 10)
+
+
+def test_a_transparent_pixel_of_an_rgba_label_image_is_background(tmp_path):
+    rgba = np.zeros((2, 3, 4), np.uint8)
+    rgba[:, :, :3] = 255  # a white background, transparent (an editor's mask layer)
+    rgba[0, 1] = rgba[1, 2] = (255, 0, 0, 255)
+    rgba[1, 0] = (0, 0, 9, 255)
+    out = read_labels(save(Image.fromarray(rgba, "RGBA"), tmp_path / "rgba.png"))
+    assert out.tolist() == [[0, 2, 0], [1, 0, 2]]  # before: [[3, 2, 3], [1, 3, 2]], the background fruit 3
+    rgba[:, :, 3] = 255  # opaque white: a colour like any other (no black in the image: every colour a fruit)
+    assert read_labels(save(Image.fromarray(rgba, "RGBA"), tmp_path / "opaque.png")).tolist() == [[3, 2, 3], [1, 3, 2]]

@@ -10,7 +10,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 from PIL import Image
 
-from symfruit import FileFormatError
+from symfruit import FileFormatError, InputError
 from symfruit.io import masks as io_masks
 from symfruit.io.masks import coco_masks, read_coco, read_masks, rle_decode
 
@@ -375,3 +375,20 @@ def test_a_polygon_of_an_odd_number_of_coordinates_is_refused_naming_the_annotat
         c.instances("a.jpg", (20, 30))
     with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(a polygon has 9"):
         read_masks(_write(tmp_path, {"annotations": [{"segmentation": odd}]}, "m.json"), (20, 30))  # a frame's masks
+
+
+@pytest.mark.parametrize(
+    ("rle", "message"),
+    [
+        (None, r"an RLE is \{'size': \[h, w\], 'counts': \.\.\.\}, got None"),  # before: TypeError (subscript)
+        ({"size": [7, 5]}, "an RLE is"),  # before: KeyError 'counts'
+        ({"size": [7, 5, 1], "counts": [35]}, "an RLE is"),  # before: ValueError 'too many values to unpack'
+        ({"size": [7.5, 5], "counts": [35]}, r"RLE size must be two whole numbers \[h, w\], got \[7.5, 5\]"),  # was 7
+        ({"size": ["7", 5], "counts": [35]}, "RLE size must be two whole numbers"),  # before: read as 7
+        ({"size": [True, 35], "counts": [35]}, "RLE size must be two whole numbers"),  # before: read as 1
+    ],
+)
+def test_an_rle_that_is_no_mapping_of_whole_size_and_counts_is_refused_by_name(rle, message):
+    with pytest.raises(InputError, match=message):
+        rle_decode(rle)
+    assert rle_decode({"size": (np.int64(7), 5), "counts": [35]}).shape == (7, 5)

@@ -149,3 +149,34 @@ def test_a_ply_polygon_of_many_corners_is_bounded_by_the_triangles_it_makes(tmp_
     monkeypatch.setattr(meshes, "MAX_FACES", 5)  # one face within the bound, its fan of 7 triangles over it
     with pytest.raises(FileFormatError, match=r"m\.ply: its polygons make 7 triangles; at most 5 faces are read"):
         read_mesh(path)
+
+
+@pytest.mark.parametrize("index", ["99999999999999999999", "-99999999999999999999", "0"])
+def test_an_obj_face_index_zero_or_beyond_any_mesh_is_refused_naming_its_line(tmp_path, index):
+    path = tmp_path / "m.obj"
+    path.write_text(f"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3 {index}\n")  # before: OverflowError from numpy
+    with pytest.raises(FileFormatError, match=r"line 5: OBJ face \[1, 2, 3, .*\] holds an index that is 0 or beyond"):
+        read_mesh(path)
+
+
+def test_a_ply_face_of_float_indices_is_refused_not_cut_to_whole_numbers(tmp_path):
+    path = tmp_path / "m.ply"
+    xyz = "".join(f"property float {c}\n" for c in "xyz")
+    head = f"ply\nformat ascii 1.0\nelement vertex 3\n{xyz}element face 1\n"
+    body = "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1.7 2.9\n"
+    path.write_text(head + "property list uchar float vertex_indices\n" + body)  # before: face [0, 1, 2]
+    with pytest.raises(FileFormatError, match="PLY face vertex_indices are float32; vertex indices are whole"):
+        read_mesh(path)
+    path.write_text(head + "property list uchar uint vertex_indices\n" + body.replace("1.7 2.9", "1 2"))
+    assert read_mesh(path)[1].tolist() == [[0, 1, 2]]
+
+
+def test_a_ply_mesh_that_is_a_folder_or_a_looping_link_is_named_as_such(tmp_path):
+    (tmp_path / "m.ply").mkdir()
+    with pytest.raises(FileFormatError, match=r"m\.ply: a directory, not a file"):  # before: 'no such file'
+        read_mesh(tmp_path / "m.ply")
+    (tmp_path / "loop.ply").symlink_to(tmp_path / "loop.ply")
+    with pytest.raises(FileFormatError, match=r"loop\.ply: a link that leads to no file"):  # before: 'no such file'
+        read_mesh(tmp_path / "loop.ply")
+    with pytest.raises(FileFormatError, match=r"none\.ply: no such file"):
+        read_mesh(tmp_path / "none.ply")

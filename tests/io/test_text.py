@@ -123,6 +123,9 @@ def test_every_reader_refuses_what_is_not_a_path_by_name(reader):
 
     with pytest.raises(InputError, match=rf"^{reader}: the .* must be a path \(str or os\.PathLike\), got NoneType"):
         getattr(symfruit.io, reader)(None)
+    for empty in ("", b""):  # before: the working folder '.' (open_source opened it as a recording)
+        with pytest.raises(InputError, match=rf"^{reader}: the .* is an empty path \(an unset variable\?\)$"):
+            getattr(symfruit.io, reader)(empty)
 
 
 def test_holds_file_says_what_an_entry_that_is_no_file_is(tmp_path):

@@ -274,3 +274,10 @@ def test_several_recordings_on_the_cluster_equal_a_serial_run_also_after_resume(
     assert asked == [1]
     assert again.done == [f"{report.recordings[str(a)]}/scene_00001"] and len(again.skipped) == 3
     assert pq.read_table(out / "detections.parquet").to_pylist() == rows
+
+
+def test_run_distributed_refuses_an_empty_output_path_before_any_cluster(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match="run_distributed: the output folder is an empty path"):
+        run_distributed(str(small_frame()), "", workers=1)  # before: the results written into the working folder
+    assert not list(tmp_path.iterdir())

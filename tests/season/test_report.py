@@ -79,6 +79,13 @@ def test_diameters_and_classes():
     for bad in ([], [25, 18], [0, 10], [18, float("nan")]):
         with pytest.raises(InputError, match="increasing diameters"):
             size_classes(np.ones(1), bad)
+    for bad in ("18", None, 18):  # before: "18" read a character at a time as classes 1 and 8 mm; TypeErrors
+        with pytest.raises(InputError, match=r"size classes must be a list of diameters in mm such as \[18, 25\]"):
+            size_classes(np.ones(1), bad)
+    for bad in ([True, 25], [[18], [25]], ["18", "25"]):  # before: True read as 1 mm, float()'s TypeError, "18" taken
+        with pytest.raises(InputError, match="size classes must be diameters in mm, got"):
+            size_classes(np.ones(1), bad)
+    assert size_classes(np.array([20.0]), np.array([18, 25])) == size_classes(np.array([20.0]), (18.0, 25))
 
 
 def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
@@ -244,3 +251,9 @@ def test_columns_of_another_type_are_refused_by_name(run, table, column, values,
     with pytest.raises(FileFormatError, match=rf"{table}: {message} \(not a symfruit table, or damaged\)$"):
         write_report(run)
     assert not (run / "report").exists()
+
+
+def test_write_report_refuses_an_empty_run_path(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match="write_report: the run folder is an empty path"):
+        write_report("")  # before: the working folder read as the run ('./detections.parquet: no such table')

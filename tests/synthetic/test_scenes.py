@@ -205,3 +205,12 @@ def test_a_scene_without_ripe_fruit_or_without_any_fruit_is_made_not_a_numpy_err
     assert [f.ripe for f in unripe_only.fruits] == [False, False] and unripe_only.labels.any()
     empty = make_scene(2, n_ripe=0, n_unripe=0, n_leaves=2, camera=small)  # leaves hang in front of fruit: none
     assert empty.fruits == [] and not empty.labels.any()
+
+
+def test_write_scenes_refuses_an_empty_output_path(tmp_path, monkeypatch):
+    from symfruit import InputError
+
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(InputError, match="write_scenes: the output folder is an empty path"):
+        write_scenes("", 1)  # before: scene_00000 written into the working folder
+    assert not list(tmp_path.iterdir())

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -19,6 +20,8 @@ class Box:
     Attributes
     ----------
     min, max : (3,) float, metres
+        Finite, ``min <= max`` on every axis (a flat box, ``min == max``, is a box); anything else is
+        refused with :class:`~symfruit.errors.InputError`.
     """
 
     min: np.ndarray
@@ -32,6 +35,12 @@ class Box:
             raise InputError(f"a box needs min and max of 3 numbers, got {given}") from None
         if lo.shape != (3,) or hi.shape != (3,):
             raise InputError(f"a box needs min and max of shape (3,), got {lo.shape} and {hi.shape}")
+        lo_list, hi_list = lo.tolist(), hi.tolist()  # six floats: checked in Python, a fifth of numpy's cost
+        if not all(map(math.isfinite, lo_list + hi_list)):  # a NaN box has no size, centre or overlap
+            raise InputError(f"a box needs finite corners, got min {lo_list} and max {hi_list}")
+        for axis, a, b in zip("xyz", lo_list, hi_list, strict=True):
+            if a > b:  # its size would be negative, its volume and IoU garbage
+                raise InputError(f"a box's min lies beyond its max along {axis}: min {lo_list}, max {hi_list}")
         object.__setattr__(self, "min", lo)
         object.__setattr__(self, "max", hi)
 
@@ -68,10 +77,14 @@ class Box:
 
     def union(self, other: Box) -> Box:
         """The smallest box containing both."""
+        _boxes(self, other, "Box.union")
         return Box(min=np.minimum(self.min, other.min), max=np.maximum(self.max, other.max))
 
     def contains(self, points: np.ndarray, *, tol: float = 0.0) -> bool:
         """Whether every point of ``points`` : (n, 3) lies in the box (within ``tol`` metres)."""
+        number = isinstance(tol, int | float | np.integer | np.floating) and not isinstance(tol, bool)
+        if not (number and math.isfinite(tol)):  # NaN made every point 'outside', text a UFuncTypeError
+            raise InputError(f"Box.contains: tol must be a finite number of metres, got {tol!r:.40}")
         points = as_points(points, min_count=0)
         return bool(np.all(points >= self.min - tol) and np.all(points <= self.max + tol))
 

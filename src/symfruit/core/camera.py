@@ -131,6 +131,8 @@ class Camera:
             ``(u, v)`` per point.
         """
         points = np.asarray(points, dtype=np.float64)
+        if points.shape[-1:] != (3,):  # (n, 2) was an IndexError from numpy
+            raise InputError(f"project needs points of shape (..., 3) in metres, got {points.shape}")
         with np.errstate(divide="ignore", invalid="ignore"):
             inv_z = 1.0 / points[..., 2]
         uv = np.empty(points.shape[:-1] + (2,))  # filled in place: np.stack's overhead is most of a small call
@@ -178,6 +180,10 @@ class Camera:
         """
         uv = np.asarray(uv, dtype=np.float64)
         depth = np.asarray(depth, dtype=np.float64)
+        if uv.shape[-1:] != (2,):  # (n, 3) was taken as (u, v) and its third column dropped, (n, 1) an IndexError
+            raise InputError(f"deproject needs pixel coordinates of shape (..., 2), got {uv.shape}")
+        if uv.shape[:-1] != depth.shape:  # was numpy's 'all input arrays must have the same shape' (np.stack)
+            raise InputError(f"deproject needs one depth per pixel: {uv.shape[:-1]} pixels, depth {depth.shape}")
         x = (uv[..., 0] - self.cx) / self.fx * depth
         y = (uv[..., 1] - self.cy) / self.fy * depth
         return np.stack([x, y, depth], axis=-1)

@@ -96,3 +96,33 @@ class Frame:
             if not 0 <= self.stamp < MAX_STAMP_NS:
                 raise InputError(f"frame {self.name}: stamp {self.stamp} ns is not a time (0 to 2**33 s after 1970)")
             object.__setattr__(self, "stamp", int(self.stamp))
+        # the rest is written into detections.json and ROS headers, or scored: before, frame_id 5, truth
+        # [(1, "box")] or visible {1: 5.0} were taken and failed (or were written) far from here
+        if self.frame_id is not None and not isinstance(self.frame_id, str):
+            raise InputError(f"frame {self.name}: frame_id must be text (a coordinate frame's name), got "
+                             f"{type(self.frame_id).__name__}")  # fmt: skip
+        if self.truth is not None and (
+            not isinstance(self.truth, list | tuple) or not all(_truth_pair(t) for t in self.truth)
+        ):
+            raise InputError(f"frame {self.name}: truth must be a list of (id, Box) pairs, ids whole numbers, got "
+                             f"{self.truth!r:.60}")  # fmt: skip
+        if not isinstance(self.visible, dict) or not all(_share(k, v) for k, v in self.visible.items()):
+            raise InputError(f"frame {self.name}: visible must map fruit ids to shares in [0, 1], got "
+                             f"{self.visible!r:.60}")  # fmt: skip
+        if not isinstance(self.extras, dict):
+            raise InputError(f"frame {self.name}: extras must be a dict, got {type(self.extras).__name__}")
+
+
+def _whole(value: Any) -> bool:
+    return isinstance(value, int | np.integer) and not isinstance(value, bool)
+
+
+def _truth_pair(item: Any) -> bool:
+    """Whether ``item`` is one ``(id, Box)`` of a frame's truth."""
+    return isinstance(item, tuple | list) and len(item) == 2 and _whole(item[0]) and isinstance(item[1], Box)
+
+
+def _share(key: Any, value: Any) -> bool:
+    """Whether ``key: value`` is a fruit id and a share of its silhouette seen, in [0, 1]."""
+    number = isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool)
+    return _whole(key) and number and 0.0 <= value <= 1.0

@@ -21,6 +21,7 @@ class Plane:
     ----------
     point : (3,) float, metres
     normal : (3,) float, unit length
+        A normal of another length is divided by its length (the same plane); a zero one is refused.
     """
 
     point: np.ndarray
@@ -34,8 +35,14 @@ class Plane:
                 raise InputError(f"plane {name} must be 3 numbers, got {getattr(self, name)!r}") from None
             if value.shape != (3,) or not np.isfinite(value).all():
                 raise InputError(f"plane {name} must be 3 finite numbers, got {value.tolist()}")
-        if not np.any(np.asarray(self.normal, dtype=np.float64)):
+            object.__setattr__(self, name, value)  # lists kept as lists had no to_dict (AttributeError 'tolist')
+        normal = self.normal
+        if not np.any(normal):
             raise InputError("plane normal must not be zero: it has no direction")
+        length2 = sum(x * x for x in normal.tolist())  # Python floats: 1e300 squared is inf, no warning
+        if abs(length2 - 1.0) > 1e-9:  # unit as documented: readers of to_dict() take it as one
+            normal = normal / np.abs(normal).max()  # scaled first: 1e-300 or 1e300 would under/overflow the norm
+            object.__setattr__(self, "normal", normal / np.sqrt(normal @ normal))
 
     def to_dict(self) -> dict[str, list[float]]:
         return {"point": self.point.tolist(), "normal": self.normal.tolist()}

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import shown
+from ..core.limits import MAX_INSTANCES, instance_labels, shown, unmasked
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
 
 __all__ = [
@@ -63,15 +63,32 @@ class Skipped:
 
 
 def truth_stack(truth: np.ndarray, shape: tuple[int, int] | None = None) -> np.ndarray:
-    """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none)."""
-    t = np.asarray(truth)
+    """``(n, h, w)`` bool true masks from masks or from ``(h, w)`` instance labels (0 = none).
+
+    Integer masks hold 0 and one other value each (1 or 255: a mask image); a mask of several values (a label
+    image put in the stack) or of negative ones is refused, as are labels that :func:`instance_labels` refuses
+    (negative, beyond 32 bits, more than :data:`MAX_INSTANCES` fruit). A masked entry of a
+    :class:`numpy.ma.MaskedArray` is background.
+    """
+    t = unmasked(truth, 0)
     if t.dtype != bool and not np.issubdtype(t.dtype, np.integer):  # 0.5 or NaN would count as fruit in silence
         raise InputError(f"truth must be bool masks or integer labels, got {t.dtype}")
-    if t.ndim == 2:
+    if t.ndim == 2:  # -1 was background in silence; 10^6 ids made an (ids, h, w) stack of terabytes
+        t = instance_labels(t, "truth")
         ids = np.unique(t[t > 0])
         t = t[None] == ids[:, None, None]
     if t.ndim != 3:
         raise InputError(f"truth must be (n, h, w) masks or (h, w) labels, got shape {t.shape}")
+    if len(t) > MAX_INSTANCES:
+        raise InputError(f"truth holds {len(t)} masks; at most {MAX_INSTANCES} fruit per image are read")
+    if t.dtype != bool and t.size:  # before: any non-zero was fruit (-1, or label 2 of a label image in the stack)
+        top = t.reshape(len(t), -1).max(axis=1)
+        bad = (t.reshape(len(t), -1).min(axis=1) < 0) | ((t != 0) & (t != top[:, None, None])).any(axis=(1, 2))
+        if bad.any():
+            k = int(np.flatnonzero(bad)[0])
+            held = np.unique(t[k])
+            raise InputError(f"truth mask {k} holds the values {shown(held.tolist())}: an integer mask is 0 and one "
+                             "value (1 or 255); labels are one (h, w) image, not a stack")  # fmt: skip
     if shape is not None and t.shape[1:] != tuple(shape):
         raise InputError(f"truth masks are {t.shape[2]}x{t.shape[1]}, the labels {shape[1]}x{shape[0]}")
     return t.astype(bool, copy=False)
@@ -106,6 +123,7 @@ def mask_ious(truth: np.ndarray, labels: np.ndarray) -> tuple[np.ndarray, np.nda
         raise InputError(f"labels must be an (h, w) integer image, got {labels.dtype} {labels.shape}")
     if labels.size and labels.min() < 0:
         raise InputError("labels must not be negative")
+    instance_labels(labels, "labels")  # at most MAX_INSTANCES regions: the (n, k) IoU table stays small
     truth = truth_stack(truth, labels.shape)
     ids, inverse = np.unique(labels, return_inverse=True)
     inverse = inverse.reshape(labels.shape)
@@ -138,9 +156,14 @@ def match_masks(ious: np.ndarray, *, threshold: float = 0.5) -> np.ndarray:
     """
     from scipy.optimize import linear_sum_assignment
 
-    ious = np.asarray(ious, dtype=np.float64)
+    try:
+        ious = np.asarray(ious, dtype=np.float64)
+    except (TypeError, ValueError):  # numpy's 'could not convert string to float'
+        raise InputError(f"ious must be an (n, k) array of IoUs in [0, 1], got {shown(ious)}") from None
     if ious.ndim != 2:
         raise InputError(f"ious must be (n, k), got shape {ious.shape}")
+    if ious.size and not (ious.min() >= 0.0 and ious.max() <= 1.0):  # NaN never matched, 1.5 matched, unsaid
+        raise InputError(f"ious must be IoUs in [0, 1], got values from {ious.min()} to {ious.max()}")
     if isinstance(threshold, bool) or not isinstance(threshold, (int, float, np.integer, np.floating)):
         raise InputError(f"threshold must be a number in (0, 1], got {shown(threshold)}")
     if not 0 < threshold <= 1:  # NaN fails this too
@@ -226,6 +249,16 @@ def score_masks(
         Crowd regions (``crowd`` of them): an unmatched prediction with at least ``threshold`` of its area
         in them is ignored, neither matched nor false (COCO's rule for ``iscrowd`` annotations).
     """
+    if not isinstance(image, str):  # an image's name, written into the report's tables as text
+        raise InputError(f"image must be the image's name (text), got {shown(image)}")
+    if isinstance(ms, bool) or not isinstance(ms, int | float | np.integer | np.floating) or ms < 0:
+        raise InputError(f"ms must be milliseconds >= 0 (or NaN: not timed), got {shown(ms)}")  # 'x' a ValueError
+    if isinstance(crowd, bool) or not isinstance(crowd, int | np.integer) or crowd < 0:
+        raise InputError(f"crowd must be a count of crowd regions >= 0, got {shown(crowd)}")  # -1 summed as is
+    if ignore is not None:
+        ignore = np.asarray(ignore)
+        if ignore.dtype != bool and not (np.issubdtype(ignore.dtype, np.integer) and np.isin(ignore, (0, 1)).all()):
+            raise InputError(f"ignore must be a bool (h, w) mask of crowd regions, got {ignore.dtype}")  # 0.5: crowd
     ious, ids = mask_ious(truth, labels)
     best = ious.max(axis=1) if ious.shape[1] else np.zeros(ious.shape[0])
     pairs = match_masks(ious, threshold=threshold)

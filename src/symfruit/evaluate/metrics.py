@@ -9,6 +9,9 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..core.box import Box, box_iou, centre_deviation
+from ..core.limits import shown
+from ..core.points import as_points
+from ..errors import InputError
 
 __all__ = ["Scores", "chamfer_f1", "score_completion"]
 
@@ -45,7 +48,8 @@ def chamfer_f1(
     Parameters
     ----------
     completed, truth : (n, 3), (m, 3) float, metres
-    threshold : float, metres
+        At least one finite point each (else :class:`~symfruit.errors.InputError`).
+    threshold : float, metres, > 0
 
     Returns
     -------
@@ -58,6 +62,14 @@ def chamfer_f1(
     >>> chamfer_f1(pts, pts)
     (0.0, 1.0, 1.0, 1.0)
     """
+    completed, truth = as_points(completed, name="completed"), as_points(truth, name="truth")  # >= 1 point each
+    for name, cloud in (("completed", completed), ("truth", truth)):  # scipy's 'x must be finite' before
+        if not np.isfinite(cloud).all():
+            raise InputError(f"chamfer_f1: {name} points hold NaN or infinite coordinates; drop those rows first")
+    if isinstance(threshold, bool) or not isinstance(threshold, int | float | np.integer | np.floating):
+        raise InputError(f"chamfer_f1: threshold must be metres, got {shown(threshold)}")
+    if not 0.0 < threshold < np.inf:  # NaN: F1 0 in silence
+        raise InputError(f"chamfer_f1: threshold must be metres > 0, got {threshold!r}")
     d_ct, _ = cKDTree(truth).query(completed)
     d_tc, _ = cKDTree(completed).query(truth)
     chamfer = float((d_ct.mean() + d_tc.mean()) / 2.0)

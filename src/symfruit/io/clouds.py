@@ -8,6 +8,7 @@ checked against the file's length before anything is allocated.
 from __future__ import annotations
 
 import io
+import os
 import re
 import warnings
 from collections.abc import Callable
@@ -43,6 +44,8 @@ def read_cloud(path: str | Path) -> np.ndarray:
         known = ", ".join(sorted(CLOUD_READERS))
         raise FileFormatError(f"{path}: unknown cloud extension {path.suffix!r}; use one of {known}")
     if not path.exists():
+        if os.path.lexists(path):  # the link is there: it was 'no such file', as if nothing had that name
+            raise FileFormatError(f"{path}: a link that leads to no file (its target is missing, or the links loop)")
         raise FileFormatError(f"{path}: no such file")
     if not path.is_file():
         raise FileFormatError(f"{path}: not a regular file (a folder or a device)")

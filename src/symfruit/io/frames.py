@@ -292,7 +292,7 @@ def write_frame(
     """
     from PIL import Image
 
-    folder = Path(folder)
+    folder = as_path(folder, "write_frame: the frame folder")  # '' was the working folder
     what = f"write_frame {folder}"
     if (
         isinstance(depth_scale, bool)

@@ -10,7 +10,8 @@ colour         ``RGB`` as is; ``RGBA``/``RGBX``/``RGBa``, ``P``/``PA`` (palette)
 depth          single channel ``I;16*``, ``I`` (0-65535) or ``L`` -> ``(h, w) uint16`` units (``L`` only
                where 255 units reach 1 m: :data:`MIN_8BIT_DEPTH_REACH`)
 labels         ``1``, ``L``, ``P`` (palette indices are the labels), ``I;16*``, ``I`` -> ``(h, w)
-               int32``; ``RGB``/``RGBA`` -> one label per distinct colour, black = background
+               int32``; ``RGB``/``RGBA`` -> one label per distinct colour, black (and an RGBA pixel of alpha 0) =
+               background
 =============  ==============================================================================
 
 Images are read as displayed: an EXIF orientation (phone photos: 6 and 8 turn them a quarter) is applied
@@ -303,7 +304,8 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
 
 
 def read_labels(path: str | Path) -> np.ndarray:
-    """An instance label image as ``(h, w) int32`` (0 background); RGB label images get one label per colour."""
+    """An instance label image as ``(h, w) int32`` (0 background); RGB label images get one label per colour
+    (black, and in RGBA a fully transparent pixel, is background)."""
     return read_labels_oriented(path)[0]
 
 
@@ -315,8 +317,11 @@ def read_labels_oriented(path: str | Path) -> tuple[np.ndarray, int]:
         img, orientation = _decode(img, str(path))
         mode = img.mode
         if mode in ("RGB", "RGBA", "RGBX"):
-            rgb = np.asarray(img)[:, :, :3].astype(np.int64)
+            pixels = np.asarray(img)
+            rgb = pixels[:, :, :3].astype(np.int64)
             keys = rgb[:, :, 0] << 16 | rgb[:, :, 1] << 8 | rgb[:, :, 2]
+            if mode == "RGBA":  # a transparent pixel is background, whatever colour it hides (RGBX: X is padding)
+                keys[pixels[:, :, 3] == 0] = 0  # before: a transparent white background was one big fruit
             _, inverse = np.unique(keys.ravel(), return_inverse=True)
             labels = inverse.reshape(keys.shape).astype(np.int32)  # black (key 0) sorts first: label 0
             labels = labels if keys.min() == 0 else labels + 1

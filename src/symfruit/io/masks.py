@@ -331,7 +331,12 @@ def rle_decode(rle: dict[str, Any]) -> np.ndarray:
 
     The same result as ``pycocotools``; sizes are bounded (:data:`MAX_IMAGE_PIXELS`) before decoding.
     """
-    h, w = (int(v) for v in rle["size"])
+    size = rle.get("size") if isinstance(rle, dict) else None
+    if not isinstance(size, list | tuple) or len(size) != 2 or "counts" not in rle:  # was TypeError, KeyError
+        raise InputError(f"an RLE is {{'size': [h, w], 'counts': ...}}, got {shown(rle)}")
+    if any(isinstance(v, bool) or not isinstance(v, int | np.integer) for v in size):  # 7.5 was cut to 7
+        raise InputError(f"RLE size must be two whole numbers [h, w], got {shown(size)}")
+    h, w = (int(v) for v in size)
     if not (0 < h <= MAX_IMAGE_SIDE and 0 < w <= MAX_IMAGE_SIDE and h * w <= MAX_IMAGE_PIXELS):
         raise ValueError(f"RLE size {w}x{h} is out of range")
     counts = rle["counts"]

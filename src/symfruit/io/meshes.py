@@ -6,10 +6,10 @@ from pathlib import Path
 
 import numpy as np
 
-from ..core.limits import MAX_FACES, MAX_OBJ_BYTES  # most faces a mesh holds, largest OBJ file (bytes)
+from ..core.limits import MAX_FACES, MAX_OBJ_BYTES, shown  # most faces a mesh holds, largest OBJ file (bytes)
 from ..errors import FileFormatError
 from .clouds import MAX_CLOUD_POINTS, ply_elements, ply_vertices
-from .text import as_path, read_limited
+from .text import as_path, holds_file, read_limited
 
 __all__ = ["read_mesh"]
 
@@ -26,7 +26,7 @@ def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
 
 
 def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
-    if not path.is_file():
+    if not holds_file(path):  # a folder or a looping link was 'no such file'; now named for what it is
         raise FileFormatError(f"{path}: no such file")
     _, elements = ply_elements(path)  # every element's count checked against the file size first
     counts = dict(elements)
@@ -44,6 +44,9 @@ def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     name = next((n for n in ("vertex_indices", "vertex_index") if n in face.data.dtype.names), None)
     if name is None:
         return vertices, None
+    kind = next(p for p in face.properties if p.name == name).val_dtype
+    if np.dtype(kind).kind not in "iu":  # float indices were cut to whole numbers in silence (1.7 -> vertex 1)
+        raise FileFormatError(f"{path}: PLY face {name} are {np.dtype(kind).name}; vertex indices are whole numbers")
     return vertices, _fans(list(face.data[name]), len(vertices), path)
 
 
@@ -68,6 +71,9 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
                 triangles += max(len(parts) - 3, 0)
         except ValueError:
             raise FileFormatError(f"{path}: line {number} is not a valid OBJ vertex or face") from None
+        if parts[0] == "f" and any(not 0 < abs(i) <= MAX_CLOUD_POINTS for i in polygons[-1]):
+            raise FileFormatError(f"{path}: line {number}: OBJ face {shown(polygons[-1])} holds an index that is 0 or "
+                                  f"beyond the {MAX_CLOUD_POINTS:,} vertices a mesh may hold")  # fmt: skip
         if len(vertices) > MAX_CLOUD_POINTS or triangles > MAX_FACES:
             raise FileFormatError(f"{path}: line {number}: OBJ mesh of more than {MAX_CLOUD_POINTS:,} vertices or "
                                   f"{MAX_FACES:,} faces (polygons counted as the triangles they make); no more "

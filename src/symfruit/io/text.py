@@ -26,7 +26,10 @@ __all__ = ["as_path", "holds_file", "read_limited", "read_structured", "refuse_p
 
 def as_path(value: Any, what: str) -> Path:
     """``value`` (``str``, ``bytes`` or ``os.PathLike``) as a :class:`~pathlib.Path`; anything else (None, a
-    number, an array handed to a reader) is refused naming ``what``, not a ``TypeError`` from pathlib."""
+    number, an array handed to a reader) is refused naming ``what``, not a ``TypeError`` from pathlib, and so is an
+    empty one, which pathlib reads as the working folder."""
+    if isinstance(value, (str, bytes)) and not value:  # '' is no file; Path('') would be the folder '.'
+        raise InputError(f"{what} is an empty path (an unset variable?)")
     if isinstance(value, (str, bytes, os.PathLike)):
         try:
             return Path(os.fsdecode(value))

@@ -58,6 +58,7 @@ from ..errors import InputError, OutputError, SymfruitError
 from ..io.frames import is_frame_folder, read_frame
 from ..io.outputs import OutputFolder, reserve_record, write_record
 from ..io.sources import FolderSource, FrameFolderSource, open_source
+from ..io.text import as_path
 from ..methods import DEFAULT_METHOD
 from ..progress import Progress
 from ..settings import Settings
@@ -324,7 +325,7 @@ def run_distributed(
         raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
     require_distributed()
     settings = settings or Settings()
-    output = Path(output)
+    output = as_path(output, "run_distributed: the output folder")  # '' was the working folder
     report = BatchReport()
     reserved = [*BATCH_FILES, *(_first_part(Path(p), output) for p in exclude)]
     recordings = plan_recordings(source, output, reserved=reserved)

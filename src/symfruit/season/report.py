@@ -28,8 +28,9 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TABLE_BYTES, MAX_TABLE_ROWS
+from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TABLE_BYTES, MAX_TABLE_ROWS, shown
 from ..errors import FileFormatError, InputError, OutputError, SymfruitError
+from ..io.text import as_path
 from .table import FRAME_COLUMNS, FRAMES_NAME, FRUIT_COLUMNS, TABLE_NAME, recording_inputs
 
 __all__ = [
@@ -144,8 +145,14 @@ def size_classes(diameters: np.ndarray, edges: Sequence[float]) -> list[tuple[st
     >>> size_classes(np.array([10.0, 18.0, 20.0, 31.0]), [18, 25])
     [('< 18 mm', 1), ('18-25 mm', 2), ('>= 25 mm', 1)]
     """
+    if isinstance(edges, str | bytes) or not isinstance(edges, Sequence | np.ndarray):  # "18" was [1, 8] mm
+        raise InputError(f"size classes must be a list of diameters in mm such as [18, 25], got {shown(edges)}")
     if len(edges) > MAX_CLASSES:
         raise InputError(f"size classes: {len(edges)} limits; at most {MAX_CLASSES}")
+    bad = next((e for e in edges if isinstance(e, bool) or not isinstance(e, int | float | np.integer | np.floating)),
+               None)  # fmt: skip
+    if bad is not None:  # True was 1 mm, [18] a TypeError from float()
+        raise InputError(f"size classes must be diameters in mm, got {shown(bad)} in {shown(list(edges))}")
     edges = [float(e) for e in edges]
     if not edges or any(not math.isfinite(e) or e <= 0 for e in edges) or sorted(set(edges)) != edges:
         raise InputError(f"size classes must be increasing diameters in mm, got {edges}")
@@ -244,7 +251,7 @@ def write_report(
     from ..io.atomic import atomic_write
     from ..io.outputs import OutputFolder
 
-    output = Path(output)
+    output = as_path(output, "write_report: the run folder")  # '' was the working folder
     if folder is None and (output / "report").is_symlink():  # the default is the run's own: never a link out of it
         link = output / "report"
         raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "

@@ -22,6 +22,7 @@ from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
 from ..core.points import perpendicular_basis
 from ..errors import OutputError
+from ..io.text import as_path
 from .render import SensorNoise, render
 from .sensors import SENSOR_MODELS, SensorModel, apply_sensor
 from .shapes import apple, leaf_outline, rotation, strawberry
@@ -444,7 +445,7 @@ def write_scenes(
     """
     from ..io.outputs import OutputFolder
 
-    folder = Path(folder)
+    folder = as_path(folder, "write_scenes: the output folder")  # '' was the working folder
     with OutputFolder(folder):  # locked while written; no link inside it followed
         return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor, tree)
 
