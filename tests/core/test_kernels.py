@@ -1315,6 +1315,135 @@ def test_depth_step_is_the_twins(seed, single):
             assert fast == twin and type(fast) is type(twin) is float
 
 
+# --- issue 19, seventeenth round: registration, trimming, extraction, occlusion
+
+
+def _whole_map(rng: np.random.Generator, h: int, w: int, top: int) -> np.ndarray:
+    """(h, w) signed square roots of whole numbers below ``top`` (a map of distance transforms' values; zeros, ties)."""
+    return np.sqrt(rng.integers(0, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 900, 40000, 2**31]), st.integers(0, 3))
+def test_the_outlines_keys_are_the_twins(seed, top, spoil):
+    """Maps of whole-number squares (int16 and int32 keys), beyond int32 (no keys), with a value that is no square
+    root of a whole number, NaN or inf (no keys), empty: the same padded keys or None, bit for bit."""
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(0, 50, 2))
+    inside = _whole_map(rng, h, w, top)
+    if spoil and inside.size:
+        inside[rng.integers(0, h), rng.integers(0, w)] = (np.sqrt(2.5), np.nan, -np.inf)[spoil - 1]
+    reach, pad = int(rng.integers(1, 30)), int(rng.integers(0, 40))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: _Outline(np.zeros(1, int), np.zeros(1, int), inside, 3.0).keys(pad, reach))
+    assert (fast is None) == (twin is None)
+    if twin is not None:
+        assert fast.dtype == twin.dtype
+        np.testing.assert_array_equal(fast, twin)
+    if spoil and inside.size:  # a value that does not come back from its key: no keys
+        assert twin is None
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900]), st.sampled_from([0.7, 0.5, 1.0, 0.01]))
+def test_the_outlines_exact_costs_are_the_twins_to_the_bit(seed, top, trim):
+    """The registration's exact costs of random maps of whole-number squares (16-bit keys; zeros of both signs, ties,
+    odd and even point counts, one point, shifts beyond the window) with the deviations from the kernel and from
+    the padded map: the same costs, bit for bit, in one block or several."""
+    from symfruit.core import surface
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    inside = _whole_map(rng, h, w, top)
+    n = int(rng.integers(1, 320))
+    rows, cols, band = rng.integers(0, h, n), rng.integers(0, w, n), float(rng.choice([0.0, rng.uniform(0.0, 6.0)]))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach - 3, reach + 4, (int(rng.integers(1, 60)), 2))
+    with pytest.MonkeyPatch.context() as mp:
+        if rng.random() < 0.3:
+            mp.setattr(surface, "_BLOCK", int(rng.integers(1, 2000)))
+        fast, twin = _both(mp, lambda: _Outline(rows, cols, inside, band).cost(shifts, reach, trim))
+    assert _Outline(rows, cols, inside, band).keys(reach + 3, reach).dtype == np.int16  # the kernel's case
+    np.testing.assert_array_equal(fast.view(np.int64), twin.view(np.int64))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
+def test_told_costs_each_shift_as_its_told_axes_have_it(seed, tell_v, exact):
+    """``_told`` of an outline that tells one axis or none: each shift costs what it costs with its untold part
+    zeroed (each row's cost depends on that row alone), with and without the kernels."""
+    from symfruit.core.surface import _Outline, _told
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 50, 2))
+    inside, n = _whole_map(rng, h, w, 900), int(rng.integers(1, 200))
+    sides = np.array([[3, 4], [3, 4], [3, 4], [3, 4]])
+    sides[int(rng.integers(0, 2)) + (0 if tell_v else 2), 0] = 0  # one side of the other axis not free
+    if rng.random() < 0.3:
+        sides[int(rng.integers(0, 2)) + (2 if tell_v else 0), 0] = 0  # neither axis told
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, 2.5, sides)
+    shifts = rng.integers(-6, 7, (int(rng.integers(0, 50)), 2))
+    zeroed = shifts * np.array(outline.axes, dtype=shifts.dtype)
+    with pytest.MonkeyPatch.context() as mp:
+        for kernels in ("", "numpy"):
+            mp.setenv("SYMFRUIT_KERNELS", kernels)
+            found = _told(outline, shifts, 6, 0.7, exact)
+            expected = outline.cost(zeroed, 6, 0.7, exact=exact) if len(shifts) else np.zeros(0)
+            np.testing.assert_array_equal(found, expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_free_points_and_sides_are_the_twins(seed):
+    """Random outlines (a noisy ring, points in a line, repeated points: ties in distance and direction) about a
+    cap: the same free points and the same counts of each side's free and all rim points."""
+    from symfruit.core.surface import Surface, _free_points
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(20, 90, 2))
+    n = int(rng.integers(12, 300))
+    if rng.random() < 0.2:
+        rows, cols = np.full(n, h // 2), rng.integers(0, w, n)
+    else:
+        t = rng.uniform(0, 2 * np.pi, n)
+        r = rng.uniform(3.0, min(h, w) / 2 - 1) + rng.integers(-2, 3, n) * rng.choice([0.0, 1.0])
+        rows = np.clip(np.rint(h / 2 + r * np.sin(t)), 0, h - 1).astype(np.intp)
+        cols = np.clip(np.rint(w / 2 + r * np.cos(t)), 0, w - 1).astype(np.intp)
+    cap = np.zeros((h, w), bool)
+    cap[rows, cols] = True
+    depth = np.where(rng.random((h, w)) < 0.5, 0.0, rng.choice([0.5, 0.9], (h, w)))
+    surface = Surface(cap, 0.6, 0.03, 0.001, (h // 2, w // 2))
+    with pytest.MonkeyPatch.context() as mp:
+        (free, sides), (free_twin, sides_twin) = _both(mp, _free_points, depth, cap, rows, cols, surface)
+    np.testing.assert_array_equal(free, free_twin)
+    assert sides.dtype == sides_twin.dtype and sides.shape == (4, 2)
+    np.testing.assert_array_equal(sides, sides_twin)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 200), st.sampled_from([8, 12, 40]))
+def test_rim_sides_take_the_first_of_equally_far_points(seed, n, bins):
+    """Offsets on a small grid (many equally far points in one direction, on both sides of a diagonal, on an axis):
+    the kernel's sides are those of the twin's rim (:func:`symfruit.core.surface._rim`'s lexsort: the first of the
+    farthest) counted side by side."""
+    rng = np.random.default_rng(seed)
+    dv, du = (rng.integers(-4, 5, n).astype(float) for _ in range(2))
+    free = rng.random(n) < 0.5
+    radius = np.hypot(dv, du)
+    angle = np.arctan2(dv, du)
+    at = np.minimum(((angle + np.pi) * (bins / (2.0 * np.pi))).astype(np.intp), bins - 1)
+    order = np.lexsort((-radius, at))
+    outer = np.sort(order[np.r_[True, at[order][1:] != at[order][:-1]]])
+    along_v = np.abs(dv[outer]) >= np.abs(du[outer])
+    a, b = dv[outer], du[outer]
+    sides = (along_v & (a < 0), along_v & (a > 0), ~along_v & (b < 0), ~along_v & (b > 0))
+    expected = np.array([(np.count_nonzero(free[outer] & side), np.count_nonzero(side)) for side in sides])
+    np.testing.assert_array_equal(_jit.rim_sides(dv, du, radius, angle, bins, bins / (2.0 * np.pi), free), expected)
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

@@ -2395,6 +2395,132 @@ def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, 
     return some
 
 
+# --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
+
+
+@_njit
+def signed_keys(inside: np.ndarray, pad: int, reach: int) -> tuple[np.ndarray, bool, float]:
+    """:meth:`symfruit.core.surface._Outline.keys`' twin in one pass: the map ``inside`` (h, w) as whole numbers
+    ``sign * rint(d * d)`` padded by ``pad`` pixels of ``-reach**2`` (int32, flattened); whether every value comes
+    back exactly from its key (``sqrt(key) == |d|``, each key below ``2**31 - 1``; else the keys are no use and the
+    twin's answer is None), and the largest key (at least ``reach**2``). The same keys, whole numbers."""
+    h, w = inside.shape
+    width = w + 2 * pad
+    out = np.empty((h + 2 * pad) * width, np.int32)
+    floor = -(reach * reach)
+    top = float(reach * reach)
+    if top >= 2147483647.0:
+        return out, False, top
+    for i in range(out.shape[0]):
+        out[i] = floor
+    for r in range(h):
+        base = (r + pad) * width + pad
+        for c in range(w):
+            d = inside[r, c]
+            whole = np.rint(d * d)
+            if not whole < 2147483647.0 or math.sqrt(whole) != abs(d):
+                return out, False, top
+            top = max(top, whole)
+            out[base + c] = -np.int32(whole) if d < 0 else np.int32(whole)
+    return out, True, top
+
+
+@_njit
+def outline_deviations(
+    ranks: np.ndarray, values: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, band: float
+) -> np.ndarray:  # fmt: skip
+    """(k, n) each outline point's deviation from the band of each shift (k, 2) ``(dv, du)``, as
+    :meth:`symfruit.core.surface._Outline._cost` has it before its exact trimmed mean: the points' flat indices
+    ``at`` (n,) into the padded map's ranks ``ranks`` (:meth:`~symfruit.core.surface._Outline.ranks`) moved back by
+    the shift, their values ``values[rank]`` (the map's values bit for bit), the median of the row (np.median's
+    two middle places, walked to on the counts of the ranks, as :func:`outline_costs` does; the values of the
+    twin's middle keys), the band (the median clipped to 0 .. ``band``) and ``|value - band|``: the twin's
+    deviations, bit for bit, whose partition and mean numpy then takes as the twin does."""
+    k, n = shifts.shape[0], at.shape[0]
+    size = values.shape[0]
+    out = np.empty((k, n))
+    count = np.zeros(size, np.int64)
+    row = np.empty(n, np.int64)
+    lower, upper = (n - 1) // 2, n // 2
+    for s in range(k):
+        offset = shifts[s, 0] * width + shifts[s, 1]
+        low = size
+        for j in range(n):
+            r = np.int64(ranks[at[j] - offset])
+            row[j] = r
+            count[r] += 1
+            low = min(low, r)
+        b, seen = low, count[low]
+        while seen <= lower:
+            b += 1
+            seen += count[b]
+        first = values[b]
+        if seen <= upper:
+            b += 1
+            while count[b] == 0:
+                b += 1
+            second = values[b]
+        else:
+            second = first
+        median = 0.5 * (first + second) if n % 2 == 0 else second
+        middle = min(max(median, 0.0), band)
+        for j in range(n):
+            out[s, j] = abs(values[row[j]] - middle)
+            count[row[j]] = 0
+    return out
+
+
+@_njit
+def monotone_rays(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, angle: np.ndarray, dy: np.ndarray, dx: np.ndarray,
+    bins: int, per_radian: float, tolerance: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.surface.monotone_region` from the directions ``angle`` (n,) (numpy's ``arctan2(dy, dx)``
+    of the pixels' offsets ``dy``, ``dx`` from the apex) on: each pixel's sector ``floor((angle + pi) *
+    per_radian) % bins`` (``per_radian = bins / (2 pi)``) and squared distance ``dy^2 + dx^2``, as the twin works
+    them out, then :func:`monotone`. The same pixels."""
+    n = rows.shape[0]
+    sector = np.empty(n, np.int64)
+    d2 = np.empty(n, np.int64)
+    for i in range(n):
+        sector[i] = np.int64(math.floor((angle[i] + np.pi) * per_radian)) % bins
+        d2[i] = np.int64(dy[i]) * np.int64(dy[i]) + np.int64(dx[i]) * np.int64(dx[i])
+    monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+
+
+@_njit
+def rim_sides(
+    dv: np.ndarray, du: np.ndarray, radius: np.ndarray, angle: np.ndarray, bins: int, per_radian: float,
+    free: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """(4, 2) int: :func:`symfruit.core.surface._free_points`' sides from the outline points' offsets ``dv``, ``du``
+    (n,) from their centroid, their distances ``radius`` (numpy's ``hypot``) and directions ``angle`` (numpy's
+    ``arctan2(dv, du)``): the rim (:func:`~symfruit.core.surface._rim`: in each of ``bins`` directions, bin
+    ``min(int((angle + pi) * per_radian), bins - 1)``, the farthest point, the first of equally far ones), and of
+    its points on the top, bottom, left and right side how many are ``free`` and how many there are. The twin's
+    points and counts."""
+    n = dv.shape[0]
+    best = np.full(bins, -1, np.int64)
+    for i in range(n):
+        b = min(np.int64((angle[i] + np.pi) * per_radian), bins - 1)
+        if best[b] < 0 or radius[i] > radius[best[b]]:
+            best[b] = i
+    sides = np.zeros((4, 2), np.int64)
+    for b in range(bins):
+        i = best[b]
+        if i < 0:
+            continue
+        if abs(dv[i]) >= abs(du[i]):
+            side = 0 if dv[i] < 0 else 1 if dv[i] > 0 else -1
+        else:
+            side = 2 if du[i] < 0 else 3 if du[i] > 0 else -1
+        if side >= 0:
+            sides[side, 1] += 1
+            if free[i]:
+                sides[side, 0] += 1
+    return sides
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 
