@@ -1444,6 +1444,39 @@ def test_rim_sides_take_the_first_of_equally_far_points(seed, n, bins):
     np.testing.assert_array_equal(_jit.rim_sides(dv, du, radius, angle, bins, bins / (2.0 * np.pi), free), expected)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([0, 1, 3]))
+def test_extractions_depth_tests_and_points_are_the_twins(seed, single, erode):
+    """Depth with NaN, inf, 0, pixels nearer and farther than the range, float32 or float64, masks of a few pixels
+    (no surface looked for) or many, a camera off the window's centre: the same points, bit for bit, and counts."""
+    from symfruit.core.camera import Camera
+    from symfruit.extract import ExtractSettings, extract
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 60, 2))
+    depth = rng.uniform(0.05, 3.5, (h, w))
+    depth[rng.random((h, w)) < 0.1] = rng.choice([0.0, np.nan, np.inf, -np.inf])
+    if single:
+        depth = depth.astype(np.float32)
+    mask = rng.random((h, w)) < rng.choice([0.05, 0.9])
+    camera = Camera(fx=float(rng.uniform(300, 900)), fy=float(rng.uniform(300, 900)), cx=float(rng.uniform(-5, w)),
+                    cy=float(rng.uniform(-5, h)), width=w, height=h)  # fmt: skip
+    s = ExtractSettings(erode_px=erode, min_points=4)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, extract, mask, depth, camera, s)
+    assert fast.points.dtype == twin.points.dtype and fast.points.shape == twin.points.shape
+    np.testing.assert_array_equal(fast.points.view(np.int64), twin.points.view(np.int64))
+    assert (fast.mask_area, fast.n_invalid, fast.n_border, fast.n_other_clusters) == (
+        twin.mask_area, twin.n_invalid, twin.n_border, twin.n_other_clusters)  # fmt: skip
+    z = np.asarray(depth, dtype=np.float64)
+    valid, usable = np.empty((h, w)), np.empty((h, w), bool)
+    n_invalid, n_usable = _jit.valid_depth(z, mask, 0.1, 3.0, valid, usable)
+    ok = np.isfinite(z) & (z >= 0.1) & (z <= 3.0)
+    assert (n_invalid, n_usable) == (int((mask & ~ok).sum()), int((mask & ok).sum()))
+    np.testing.assert_array_equal(valid, np.where(ok, z, 0.0))
+    np.testing.assert_array_equal(usable, mask & ok)
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

@@ -2521,6 +2521,55 @@ def rim_sides(
     return sides
 
 
+@_njit
+def valid_depth(
+    depth: np.ndarray, core: np.ndarray, low: float, high: float, valid_depth: np.ndarray, usable: np.ndarray
+) -> tuple[int, int]:  # fmt: skip
+    """:func:`symfruit.extract.extract`'s depth tests in one pass: ``valid_depth`` (h, w) the depth where it is finite
+    and within ``low`` .. ``high`` (0 elsewhere), ``usable`` (h, w) the pixels of ``core`` with such depth; how many
+    of ``core``'s pixels have none, and how many are usable. The twin's comparisons: the same maps and counts."""
+    h, w = depth.shape
+    n_invalid = n_usable = 0
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            ok = np.isfinite(z) and z >= low and z <= high
+            valid_depth[r, c] = z if ok else 0.0
+            usable[r, c] = core[r, c] and ok
+            if core[r, c]:
+                if ok:
+                    n_usable += 1
+                else:
+                    n_invalid += 1
+    return n_invalid, n_usable
+
+
+@_njit
+def pixel_points(
+    keep: np.ndarray, also: np.ndarray, depth: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> np.ndarray:  # fmt: skip
+    """(n, 3) :meth:`symfruit.core.camera.Camera.deproject` of the pixels of ``keep & also`` (h, w) bool in raster
+    order (``np.nonzero``'s) at their ``depth``: ``x = (u - cx) / fx * z``, ``y = (v - cy) / fy * z``, the same
+    arithmetic, bit for bit."""
+    h, w = keep.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c] and also[r, c]:
+                n += 1
+    out = np.empty((n, 3))
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c] and also[r, c]:
+                z = float(depth[r, c])
+                out[i, 0] = (float(c) - cx) / fx * z
+                out[i, 1] = (float(r) - cy) / fy * z
+                out[i, 2] = z
+                i += 1
+    return out
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 
