@@ -1477,6 +1477,34 @@ def test_extractions_depth_tests_and_points_are_the_twins(seed, single, erode):
     np.testing.assert_array_equal(usable, mask & ok)
 
 
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.5, 1.0, 2.6, 4.0]))
+def test_colour_trims_regions_are_the_twins(seed, band_px):
+    """Random blobs (holes, thin parts, pieces at the edge, too few pixels for a ring or a fruit) on random colours
+    with a red disc: colour_trim with the kernels and with the twins gives the same pixels, and the regions' kernel
+    numpy's comparisons."""
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import colour_trim, within
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(3, 70, 2))
+    mask = _blobs(rng, h, w, float(rng.uniform(0.01, 0.2)))
+    yy, xx = np.mgrid[:h, :w]
+    disc = (yy - h / 2) ** 2 + (xx - w / 2) ** 2 < (min(h, w) / 3) ** 2
+    colour = np.where(disc[..., None], [200, 30, 30], [40, 160, 60]) + rng.integers(0, 40, (h, w, 3))
+    with pytest.MonkeyPatch.context() as mp:
+        trimmed, twin = _both(mp, colour_trim, colour.astype(np.uint8), mask | disc, band_px=band_px)
+    np.testing.assert_array_equal(trimmed, twin)
+    inner = inner_distance(mask)
+    regions = [np.empty((h, w), bool) for _ in range(3)]
+    counts = _jit.trim_regions(inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0, *regions)
+    expected = ((inner > band_px) & (inner <= 3.0 * band_px + 1), ~mask & within(mask, band_px + 1),
+                mask & (inner <= band_px))  # fmt: skip
+    for found, want in zip(regions, expected, strict=True):
+        np.testing.assert_array_equal(found, want)
+    assert counts == tuple(int(x.sum()) for x in expected)
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

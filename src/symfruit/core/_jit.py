@@ -2570,6 +2570,33 @@ def pixel_points(
     return out
 
 
+@_njit
+def trim_regions(
+    inner: np.ndarray, mask: np.ndarray, band_px: float, deep: float, ring_px: float, fruit: np.ndarray,
+    ring: np.ndarray, band: np.ndarray,
+) -> tuple[int, int, int]:  # fmt: skip
+    """:func:`symfruit.core.surface.colour_trim`'s three regions from the mask's distance map ``inner`` (h, w): the
+    fruit ``band_px < inner <= deep``, the ring of pixels outside ``mask`` at most ``ring_px`` from it
+    (:func:`near_distance`'s distances, :func:`symfruit.core.surface.within`'s test) and the band ``inner <=
+    band_px`` of the mask, written into ``fruit``, ``ring`` and ``band`` (h, w) bool; how many pixels each holds.
+    The twin's comparisons: the same pixels."""
+    h, w = mask.shape
+    near = np.empty((h, w))
+    near_distance(mask, ring_px, True, near)
+    n_fruit = n_ring = n_band = 0
+    for r in range(h):
+        for c in range(w):
+            d = inner[r, c]
+            f = d > band_px and d <= deep
+            g = (not mask[r, c]) and near[r, c] <= ring_px
+            b = mask[r, c] and d <= band_px
+            fruit[r, c], ring[r, c], band[r, c] = f, g, b
+            n_fruit += f
+            n_ring += g
+            n_band += b
+    return n_fruit, n_ring, n_band
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 

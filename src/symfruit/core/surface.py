@@ -896,14 +896,20 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
-    fruit = (inner > band_px) & (inner <= 3.0 * band_px + 1)
-    ring = ~mask & within(mask, band_px + 1)  # 1 to band_px + 1 from the mask
-    band = mask & (inner <= band_px)
-    if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
+    if (jit := compiled()) is not None:  # the three regions and their sizes in one pass (the same pixels)
+        fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
+        n_fruit, n_ring, n_band = jit.trim_regions(inner, mask, float(band_px), 3.0 * band_px + 1,
+                                                   float(band_px + 1), fruit, ring, band)  # fmt: skip
+    else:
+        fruit = (inner > band_px) & (inner <= 3.0 * band_px + 1)
+        ring = ~mask & within(mask, band_px + 1)  # 1 to band_px + 1 from the mask
+        band = mask & (inner <= band_px)
+        n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
+    if n_fruit < 20 or n_ring < 20 or not n_band:
         return mask
     color = np.asarray(color)
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
-    jit = compiled() if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
+    jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
     feature = _colour_features if jit is None else jit.colour_features
     kmeans = _kmeans if jit is None else jit.kmeans
     rng = np.random.default_rng(0)
