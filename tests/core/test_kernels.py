@@ -1505,6 +1505,52 @@ def test_colour_trims_regions_are_the_twins(seed, band_px):
     assert counts == tuple(int(x.sum()) for x in expected)
 
 
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.sampled_from([0, 5, 16]))
+def test_the_occlusion_window_and_own_depths_are_the_twins(seed, reach, pad):
+    """Points projecting onto pixel centres and halfway between them (np.rint's ties to even), several on one pixel
+    (the least depth), off the image, with infinite or NaN coordinates, none in the image: the same window and maps
+    bit for bit, or the same error."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=200.0, fy=200.0, cx=30.0, cy=20.0, width=60, height=40)
+    n = int(rng.integers(1, 200))
+    u = rng.integers(-3, 63, n) + rng.choice([0.0, 0.5, -0.5, 0.25], n)
+    v = rng.integers(-3, 43, n) + rng.choice([0.0, 0.5, -0.5], n)
+    z = np.round(rng.uniform(0.3, 0.5, n), int(rng.integers(2, 6)))
+    points = np.column_stack(((u - 30.0) * z / 200.0, (v - 20.0) * z / 200.0, z))
+    if rng.random() < 0.3:
+        points[rng.integers(0, n), int(rng.integers(0, 3))] = rng.choice([np.inf, -np.inf, np.nan])
+    if rng.random() < 0.1:
+        points[:, 0] = 50.0  # every point far off the image
+    depth = rng.uniform(0.2, 1.0, (40, 60))
+    depth[rng.random((40, 60)) < 0.2] = 0.0
+    mask = rng.random((40, 60)) < 0.1
+    results = []
+    with pytest.MonkeyPatch.context() as mp:
+        for kernels in ("", "numpy"):
+            mp.setenv("SYMFRUIT_KERNELS", kernels)
+            try:
+                with np.errstate(invalid="ignore", over="ignore"):
+                    results.append(occlusion(depth, mask, points, camera, reach=reach, pad=pad))
+            except InputError as exc:
+                results.append(str(exc))
+    fast, twin = results
+    if isinstance(twin, str):
+        assert fast == twin
+        return
+    assert (fast.u0, fast.v0) == (twin.u0, twin.v0) and fast.hidden.shape == twin.hidden.shape
+    assert np.array_equal(fast.hidden, twin.hidden) and fast.depth.tobytes() == twin.depth.tobytes()
+    with np.errstate(invalid="ignore", over="ignore"):
+        uv = camera.project(points)
+    found, u0, v0, u1, v1, own, unseen = _jit.own_depths(uv, points, 60, 40, pad)
+    assert found and (u0, v0, u1 - u0, v1 - v0) == (twin.u0, twin.v0, twin.hidden.shape[1], twin.hidden.shape[0])
+    np.testing.assert_array_equal(unseen, ~np.isfinite(own))
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

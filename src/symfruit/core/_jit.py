@@ -2597,6 +2597,42 @@ def trim_regions(
     return n_fruit, n_ring, n_band
 
 
+@_njit
+def own_depths(
+    uv: np.ndarray, points: np.ndarray, width: int, height: int, pad: int
+) -> tuple[bool, int, int, int, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.occlusion.occlusion`'s window and the fruit's own depths in it: each point's pixel (its
+    projection ``uv`` (n, 2) rounded half to even, as ``np.rint``; those within the ``width`` x ``height`` image),
+    the window (the pixels' box grown by its own size plus ``pad``, clipped to the image) and, per window pixel, the
+    least depth (``points[:, 2]``) of the points on it (+inf on none; a least is exact in any order) and whether it
+    has none. ``(False, ...)`` when no point falls in the image. The twin's window and maps, bit for bit."""
+    n = uv.shape[0]
+    cmin, cmax, rmin, rmax = width, -1, height, -1
+    for i in range(n):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            c, r = int(u), int(v)
+            cmin, cmax, rmin, rmax = min(cmin, c), max(cmax, c), min(rmin, r), max(rmax, r)
+    if cmax < 0:
+        return False, 0, 0, 0, 0, np.empty((0, 0)), np.empty((0, 0), np.bool_)
+    span_u, span_v = cmax - cmin + pad, rmax - rmin + pad
+    u0, v0 = max(cmin - span_u, 0), max(rmin - span_v, 0)
+    u1, v1 = min(cmax + span_u + 1, width), min(rmax + span_v + 1, height)
+    own = np.full((v1 - v0, u1 - u0), np.inf)
+    for i in range(n):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            r, c = int(v) - v0, int(u) - u0
+            z = points[i, 2]
+            if z < own[r, c]:
+                own[r, c] = z
+    unseen = np.empty(own.shape, np.bool_)
+    for r in range(own.shape[0]):
+        for c in range(own.shape[1]):
+            unseen[r, c] = not np.isfinite(own[r, c])
+    return True, u0, v0, u1, v1, own, unseen
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 
