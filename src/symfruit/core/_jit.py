@@ -1479,12 +1479,14 @@ def outline_costs(
     size = values.shape[0]
     out = np.empty(k)
     count = np.zeros(size, np.int64)
+    row = np.empty(n, np.int64)  # the row's ranks, to clear their counts (not the whole span of ranks) after it
     lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
     for s in range(k):
         offset = shifts[s, 0] * width + shifts[s, 1]
         low, top = size, -1
         for j in range(n):
             r = np.int64(ranks[at[j] - offset])
+            row[j] = r
             count[r] += 1
             low, top = min(low, r), max(top, r)
         b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
@@ -1501,9 +1503,8 @@ def outline_costs(
             second = first
         median = 0.5 * (first + second) if n % 2 == 0 else second
         middle = min(max(median, 0.0), band)
-        right = low  # the first rank at or above the band, the one below it: the nearer one taken first
-        while right <= top and values[right] < middle:
-            right += 1
+        # the first rank at or above the band (bisected: values ascend), the one below it: the nearer one taken first
+        right = low + np.searchsorted(values[low : top + 1], middle)
         left = right - 1
         need = keep
         total = 0.0
@@ -1523,8 +1524,8 @@ def outline_costs(
                 total += take * above
                 right += 1
             need -= take
-        for r in range(low, top + 1):
-            count[r] = 0
+        for j in range(n):
+            count[row[j]] = 0
         out[s] = total / keep
     return out
 
