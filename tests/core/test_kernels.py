@@ -1566,6 +1566,29 @@ def test_the_registrations_valid_depth_is_the_twins(seed, low, high):
     assert valid.tobytes() == twin.tobytes()
 
 
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60))
+def test_principal_widths_are_the_twins_to_the_bit(seed, h, w):
+    """Random blobs and speckle (none, one or two pixels, a line), at the origin or placed in a larger image: the
+    same widths bit for bit, and the kernel's centred coordinates numpy's."""
+    from symfruit.core.raster import principal_widths
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, float(rng.uniform(0.0, 0.2))) if rng.random() < 0.7 else rng.random((h, w)) < 0.02
+    if rng.random() < 0.1:
+        mask = np.zeros((h, w), bool)
+        mask[rng.integers(0, h), :] = True
+    origin = (0, 0) if rng.random() < 0.3 else (int(rng.integers(0, 900)), int(rng.integers(0, 1500)))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, principal_widths, mask, origin=origin)
+    assert fast == twin and all(type(x) is float for x in fast)
+    if mask.sum() >= 2:
+        rows, cols = np.nonzero(mask)
+        xy = np.column_stack((cols + origin[1], rows + origin[0])).astype(np.float64)
+        xy -= np.array([int(xy[:, 0].sum()), int(xy[:, 1].sum())], dtype=np.float64) / len(rows)
+        assert _jit.centred_pixels(mask, origin[0], origin[1]).tobytes() == xy.tobytes()
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

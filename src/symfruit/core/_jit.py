@@ -2634,6 +2634,32 @@ def own_depths(
     return True, u0, v0, u1, v1, own, unseen
 
 
+@_njit
+def centred_pixels(mask: np.ndarray, r0: int, c0: int) -> np.ndarray:
+    """(n, 2) :func:`symfruit.core.raster.principal_widths`' centred coordinates: the column and row (at ``r0``,
+    ``c0`` in a larger image) of each pixel of ``mask`` (h, w) bool in raster order, less their means (the whole-number
+    sums divided by the count, as the twin has them): the twin's array, bit for bit (at least two pixels)."""
+    h, w = mask.shape
+    n = 0
+    su = sv = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                n += 1
+                su += c + c0
+                sv += r + r0
+    mu, mv = float(su) / n, float(sv) / n
+    out = np.empty((n, 2))
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                out[i, 0] = float(c + c0) - mu
+                out[i, 1] = float(r + r0) - mv
+                i += 1
+    return out
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 
