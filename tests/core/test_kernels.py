@@ -1554,7 +1554,8 @@ def test_the_occlusion_window_and_own_depths_are_the_twins(seed, reach, pad):
 @given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.1, 0.5]), st.sampled_from([0.8, 3.0, np.inf]))
 def test_the_registrations_valid_depth_is_the_twins(seed, low, high):
     """The registration's window depth by the extraction's kernel with ``z > 0 and z >= low`` as ``z >= max(low, the
-    least positive double)``: subnormal, zero, negative, NaN and infinite depths, the twin's map bit for bit."""
+    least positive double)``, and fruit_surface's depth above 0: subnormal, zero, negative, NaN and infinite depths,
+    the twins' maps bit for bit."""
     rng = np.random.default_rng(seed)
     h, w = (int(x) for x in rng.integers(1, 40, 2))
     z = rng.uniform(-0.2, 4.0, (h, w))
@@ -1563,7 +1564,10 @@ def test_the_registrations_valid_depth_is_the_twins(seed, low, high):
     _jit.valid_depth(z, rng.random((h, w)) < 0.5, max(low, 5e-324), high, valid, np.empty((h, w), bool))
     with np.errstate(invalid="ignore"):
         twin = np.where(np.isfinite(z) & (z > 0) & (z >= low) & (z <= high), z, 0.0)
+        positive = np.where(np.isfinite(z) & (z > 0), z, 0.0)
     assert valid.tobytes() == twin.tobytes()
+    _jit.positive_depth(z, valid)  # fruit_surface's depth: the same values
+    assert valid.tobytes() == positive.tobytes()
 
 
 @settings(max_examples=80, deadline=None)

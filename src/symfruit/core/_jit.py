@@ -2660,6 +2660,17 @@ def centred_pixels(mask: np.ndarray, r0: int, c0: int) -> np.ndarray:
     return out
 
 
+@_njit
+def positive_depth(depth: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w): ``depth`` where it is finite and above 0, 0 elsewhere (:func:`symfruit.core.surface.
+    fruit_surface`'s ``np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)``, the same values)."""
+    h, w = depth.shape
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            out[r, c] = z if np.isfinite(z) and z > 0 else 0.0
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 

@@ -363,8 +363,15 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     Surface, or None when the mask holds fewer than 10 pixels with depth.
     """
     region = mask if region is None else region
-    valid = np.isfinite(depth) & (depth > 0)
-    depth = np.where(valid, depth, 0.0)
+    valid: np.ndarray | None = None  # with depth cleaned, its pixels above 0 (made only where wanted)
+    jit = compiled() if isinstance(depth, np.ndarray) and depth.dtype == np.float64 and depth.ndim == 2 else None
+    if jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
+        clean = np.empty(depth.shape)
+        jit.positive_depth(depth, clean)
+        depth = clean
+    else:
+        valid = np.isfinite(depth) & (depth > 0)
+        depth = np.where(valid, depth, 0.0)
     # What depends on the mask alone is worked out on the mask's box (the same values: pixels outside it are not
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
     if (found := mask_box(mask)) is None:
@@ -391,6 +398,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         if not jit.near_pixels(depth, np.asarray(region, dtype=bool), front - tol, front + slab * reach, near):
             return None
     else:
+        valid = depth > 0 if valid is None else valid
         near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
         if not near.any():
             return None
