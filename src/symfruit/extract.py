@@ -230,20 +230,32 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
             core = eroded
     z_all = np.asarray(depth, dtype=np.float64)
-    valid = np.isfinite(z_all) & (z_all >= s.min_depth) & (z_all <= s.max_depth)
-    n_invalid = int((core & ~valid).sum())
-    usable = core & valid
-    keep, outline = usable, np.asarray(mask, dtype=bool)
-    if usable.sum() >= 10:
+    # the depth tests and the points' deprojection by compiled twins where numba is (issue 19, seventeenth round:
+    # the same maps, counts and points, bit for bit)
+    jit = compiled() if z_all.ndim == 2 and core.dtype == bool else None
+    if jit is not None:
+        z_valid, usable = np.empty(z_all.shape), np.empty(z_all.shape, bool)
+        n_invalid, n_usable = jit.valid_depth(z_all, core, float(s.min_depth), float(s.max_depth), z_valid, usable)
+    else:
+        valid = np.isfinite(z_all) & (z_all >= s.min_depth) & (z_all <= s.max_depth)
+        n_invalid = int((core & ~valid).sum())
+        usable = core & valid
+        n_usable = int(usable.sum())
+        z_valid = np.where(valid, z_all, 0.0) if n_usable >= 10 else z_all
+    outline = np.asarray(mask, dtype=bool)
+    surface = None
+    if n_usable >= 10:
         focal = float(np.sqrt(camera.fx * camera.fy))
-        found = fruit_surface(np.where(valid, z_all, 0.0), core, focal, slab=s.slab,
-                              tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
-                              leafy=leafy)  # fmt: skip
-        if found is not None:
-            keep = usable & found.pixels
-    rows, cols = np.nonzero(keep)
-    points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
-    dropped = int(usable.sum() - len(points))
+        surface = fruit_surface(z_valid, core, focal, slab=s.slab,
+                                tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
+                                leafy=leafy)  # fmt: skip
+    if jit is not None:
+        points = jit.pixel_points(usable, usable if surface is None else surface.pixels, z_all, float(camera.cx),
+                                  float(camera.cy), float(camera.fx), float(camera.fy))  # fmt: skip
+    else:
+        rows, cols = np.nonzero(usable if surface is None else usable & surface.pixels)
+        points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
+    dropped = int(n_usable - len(points))
     if len(points) >= 2:
         labels = cluster(points, s.cluster_distance)
         counts = np.bincount(labels)

@@ -1315,6 +1315,284 @@ def test_depth_step_is_the_twins(seed, single):
             assert fast == twin and type(fast) is type(twin) is float
 
 
+# --- issue 19, seventeenth round: registration, trimming, extraction, occlusion
+
+
+def _whole_map(rng: np.random.Generator, h: int, w: int, top: int) -> np.ndarray:
+    """(h, w) signed square roots of whole numbers below ``top`` (a map of distance transforms' values; zeros, ties)."""
+    return np.sqrt(rng.integers(0, top, (h, w)).astype(float)) * rng.choice([-1.0, 1.0], (h, w))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 900, 40000, 2**31]), st.integers(0, 3))
+def test_the_outlines_keys_are_the_twins(seed, top, spoil):
+    """Maps of whole-number squares (int16 and int32 keys), beyond int32 (no keys), with a value that is no square
+    root of a whole number, NaN or inf (no keys), empty: the same padded keys or None, bit for bit."""
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(0, 50, 2))
+    inside = _whole_map(rng, h, w, top)
+    if spoil and inside.size:
+        inside[rng.integers(0, h), rng.integers(0, w)] = (np.sqrt(2.5), np.nan, -np.inf)[spoil - 1]
+    reach, pad = int(rng.integers(1, 30)), int(rng.integers(0, 40))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: _Outline(np.zeros(1, int), np.zeros(1, int), inside, 3.0).keys(pad, reach))
+    assert (fast is None) == (twin is None)
+    if twin is not None:
+        assert fast.dtype == twin.dtype
+        np.testing.assert_array_equal(fast, twin)
+    if spoil and inside.size:  # a value that does not come back from its key: no keys
+        assert twin is None
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([4, 30, 900]), st.sampled_from([0.7, 0.5, 1.0, 0.01]))
+def test_the_outlines_exact_costs_are_the_twins_to_the_bit(seed, top, trim):
+    """The registration's exact costs of random maps of whole-number squares (16-bit keys; zeros of both signs, ties,
+    odd and even point counts, one point, shifts beyond the window) with the deviations from the kernel and from
+    the padded map: the same costs, bit for bit, in one block or several."""
+    from symfruit.core import surface
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    inside = _whole_map(rng, h, w, top)
+    n = int(rng.integers(1, 320))
+    rows, cols, band = rng.integers(0, h, n), rng.integers(0, w, n), float(rng.choice([0.0, rng.uniform(0.0, 6.0)]))
+    reach = int(rng.integers(1, 25))
+    shifts = rng.integers(-reach - 3, reach + 4, (int(rng.integers(1, 60)), 2))
+    with pytest.MonkeyPatch.context() as mp:
+        if rng.random() < 0.3:
+            mp.setattr(surface, "_BLOCK", int(rng.integers(1, 2000)))
+        fast, twin = _both(mp, lambda: _Outline(rows, cols, inside, band).cost(shifts, reach, trim))
+    assert _Outline(rows, cols, inside, band).keys(reach + 3, reach).dtype == np.int16  # the kernel's case
+    np.testing.assert_array_equal(fast.view(np.int64), twin.view(np.int64))
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
+def test_told_costs_each_shift_as_its_told_axes_have_it(seed, tell_v, exact):
+    """``_told`` of an outline that tells one axis or none: each shift costs what it costs with its untold part
+    zeroed (each row's cost depends on that row alone), with and without the kernels."""
+    from symfruit.core.surface import _Outline, _told
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(5, 50, 2))
+    inside, n = _whole_map(rng, h, w, 900), int(rng.integers(1, 200))
+    sides = np.array([[3, 4], [3, 4], [3, 4], [3, 4]])
+    sides[int(rng.integers(0, 2)) + (0 if tell_v else 2), 0] = 0  # one side of the other axis not free
+    if rng.random() < 0.3:
+        sides[int(rng.integers(0, 2)) + (2 if tell_v else 0), 0] = 0  # neither axis told
+    outline = _Outline(rng.integers(0, h, n), rng.integers(0, w, n), inside, 2.5, sides)
+    shifts = rng.integers(-6, 7, (int(rng.integers(0, 50)), 2))
+    zeroed = shifts * np.array(outline.axes, dtype=shifts.dtype)
+    with pytest.MonkeyPatch.context() as mp:
+        for kernels in ("", "numpy"):
+            mp.setenv("SYMFRUIT_KERNELS", kernels)
+            found = _told(outline, shifts, 6, 0.7, exact)
+            expected = outline.cost(zeroed, 6, 0.7, exact=exact) if len(shifts) else np.zeros(0)
+            np.testing.assert_array_equal(found, expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_free_points_and_sides_are_the_twins(seed):
+    """Random outlines (a noisy ring, points in a line, repeated points: ties in distance and direction) about a
+    cap: the same free points and the same counts of each side's free and all rim points."""
+    from symfruit.core.surface import Surface, _free_points
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(20, 90, 2))
+    n = int(rng.integers(12, 300))
+    if rng.random() < 0.2:
+        rows, cols = np.full(n, h // 2), rng.integers(0, w, n)
+    else:
+        t = rng.uniform(0, 2 * np.pi, n)
+        r = rng.uniform(3.0, min(h, w) / 2 - 1) + rng.integers(-2, 3, n) * rng.choice([0.0, 1.0])
+        rows = np.clip(np.rint(h / 2 + r * np.sin(t)), 0, h - 1).astype(np.intp)
+        cols = np.clip(np.rint(w / 2 + r * np.cos(t)), 0, w - 1).astype(np.intp)
+    cap = np.zeros((h, w), bool)
+    cap[rows, cols] = True
+    depth = np.where(rng.random((h, w)) < 0.5, 0.0, rng.choice([0.5, 0.9], (h, w)))
+    surface = Surface(cap, 0.6, 0.03, 0.001, (h // 2, w // 2))
+    with pytest.MonkeyPatch.context() as mp:
+        (free, sides), (free_twin, sides_twin) = _both(mp, _free_points, depth, cap, rows, cols, surface)
+    np.testing.assert_array_equal(free, free_twin)
+    assert sides.dtype == sides_twin.dtype and sides.shape == (4, 2)
+    np.testing.assert_array_equal(sides, sides_twin)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 200), st.sampled_from([8, 12, 40]))
+def test_rim_sides_take_the_first_of_equally_far_points(seed, n, bins):
+    """Offsets on a small grid (many equally far points in one direction, on both sides of a diagonal, on an axis):
+    the kernel's sides are those of the twin's rim (:func:`symfruit.core.surface._rim`'s lexsort: the first of the
+    farthest) counted side by side."""
+    rng = np.random.default_rng(seed)
+    dv, du = (rng.integers(-4, 5, n).astype(float) for _ in range(2))
+    free = rng.random(n) < 0.5
+    radius = np.hypot(dv, du)
+    angle = np.arctan2(dv, du)
+    at = np.minimum(((angle + np.pi) * (bins / (2.0 * np.pi))).astype(np.intp), bins - 1)
+    order = np.lexsort((-radius, at))
+    outer = np.sort(order[np.r_[True, at[order][1:] != at[order][:-1]]])
+    along_v = np.abs(dv[outer]) >= np.abs(du[outer])
+    a, b = dv[outer], du[outer]
+    sides = (along_v & (a < 0), along_v & (a > 0), ~along_v & (b < 0), ~along_v & (b > 0))
+    expected = np.array([(np.count_nonzero(free[outer] & side), np.count_nonzero(side)) for side in sides])
+    np.testing.assert_array_equal(_jit.rim_sides(dv, du, radius, angle, bins, bins / (2.0 * np.pi), free), expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([0, 1, 3]))
+def test_extractions_depth_tests_and_points_are_the_twins(seed, single, erode):
+    """Depth with NaN, inf, 0, pixels nearer and farther than the range, float32 or float64, masks of a few pixels
+    (no surface looked for) or many, a camera off the window's centre: the same points, bit for bit, and counts."""
+    from symfruit.core.camera import Camera
+    from symfruit.extract import ExtractSettings, extract
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 60, 2))
+    depth = rng.uniform(0.05, 3.5, (h, w))
+    depth[rng.random((h, w)) < 0.1] = rng.choice([0.0, np.nan, np.inf, -np.inf])
+    if single:
+        depth = depth.astype(np.float32)
+    mask = rng.random((h, w)) < rng.choice([0.05, 0.9])
+    camera = Camera(fx=float(rng.uniform(300, 900)), fy=float(rng.uniform(300, 900)), cx=float(rng.uniform(-5, w)),
+                    cy=float(rng.uniform(-5, h)), width=w, height=h)  # fmt: skip
+    s = ExtractSettings(erode_px=erode, min_points=4)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, extract, mask, depth, camera, s)
+    assert fast.points.dtype == twin.points.dtype and fast.points.shape == twin.points.shape
+    np.testing.assert_array_equal(fast.points.view(np.int64), twin.points.view(np.int64))
+    assert (fast.mask_area, fast.n_invalid, fast.n_border, fast.n_other_clusters) == (
+        twin.mask_area, twin.n_invalid, twin.n_border, twin.n_other_clusters)  # fmt: skip
+    z = np.asarray(depth, dtype=np.float64)
+    valid, usable = np.empty((h, w)), np.empty((h, w), bool)
+    n_invalid, n_usable = _jit.valid_depth(z, mask, 0.1, 3.0, valid, usable)
+    ok = np.isfinite(z) & (z >= 0.1) & (z <= 3.0)
+    assert (n_invalid, n_usable) == (int((mask & ~ok).sum()), int((mask & ok).sum()))
+    np.testing.assert_array_equal(valid, np.where(ok, z, 0.0))
+    np.testing.assert_array_equal(usable, mask & ok)
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.5, 1.0, 2.6, 4.0]))
+def test_colour_trims_regions_are_the_twins(seed, band_px):
+    """Random blobs (holes, thin parts, pieces at the edge, too few pixels for a ring or a fruit) on random colours
+    with a red disc: colour_trim with the kernels and with the twins gives the same pixels, and the regions' kernel
+    numpy's comparisons."""
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import colour_trim, within
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(3, 70, 2))
+    mask = _blobs(rng, h, w, float(rng.uniform(0.01, 0.2)))
+    yy, xx = np.mgrid[:h, :w]
+    disc = (yy - h / 2) ** 2 + (xx - w / 2) ** 2 < (min(h, w) / 3) ** 2
+    colour = np.where(disc[..., None], [200, 30, 30], [40, 160, 60]) + rng.integers(0, 40, (h, w, 3))
+    with pytest.MonkeyPatch.context() as mp:
+        trimmed, twin = _both(mp, colour_trim, colour.astype(np.uint8), mask | disc, band_px=band_px)
+    np.testing.assert_array_equal(trimmed, twin)
+    inner = inner_distance(mask)
+    regions = [np.empty((h, w), bool) for _ in range(3)]
+    counts = _jit.trim_regions(inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0, *regions)
+    expected = ((inner > band_px) & (inner <= 3.0 * band_px + 1), ~mask & within(mask, band_px + 1),
+                mask & (inner <= band_px))  # fmt: skip
+    for found, want in zip(regions, expected, strict=True):
+        np.testing.assert_array_equal(found, want)
+    assert counts == tuple(int(x.sum()) for x in expected)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 3), st.sampled_from([0, 5, 16]))
+def test_the_occlusion_window_and_own_depths_are_the_twins(seed, reach, pad):
+    """Points projecting onto pixel centres and halfway between them (np.rint's ties to even), several on one pixel
+    (the least depth), off the image, with infinite or NaN coordinates, none in the image: the same window and maps
+    bit for bit, or the same error."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=200.0, fy=200.0, cx=30.0, cy=20.0, width=60, height=40)
+    n = int(rng.integers(1, 200))
+    u = rng.integers(-3, 63, n) + rng.choice([0.0, 0.5, -0.5, 0.25], n)
+    v = rng.integers(-3, 43, n) + rng.choice([0.0, 0.5, -0.5], n)
+    z = np.round(rng.uniform(0.3, 0.5, n), int(rng.integers(2, 6)))
+    points = np.column_stack(((u - 30.0) * z / 200.0, (v - 20.0) * z / 200.0, z))
+    if rng.random() < 0.3:
+        points[rng.integers(0, n), int(rng.integers(0, 3))] = rng.choice([np.inf, -np.inf, np.nan])
+    if rng.random() < 0.1:
+        points[:, 0] = 50.0  # every point far off the image
+    depth = rng.uniform(0.2, 1.0, (40, 60))
+    depth[rng.random((40, 60)) < 0.2] = 0.0
+    mask = rng.random((40, 60)) < 0.1
+    results = []
+    with pytest.MonkeyPatch.context() as mp:
+        for kernels in ("", "numpy"):
+            mp.setenv("SYMFRUIT_KERNELS", kernels)
+            try:
+                with np.errstate(invalid="ignore", over="ignore"):
+                    results.append(occlusion(depth, mask, points, camera, reach=reach, pad=pad))
+            except InputError as exc:
+                results.append(str(exc))
+    fast, twin = results
+    if isinstance(twin, str):
+        assert fast == twin
+        return
+    assert (fast.u0, fast.v0) == (twin.u0, twin.v0) and fast.hidden.shape == twin.hidden.shape
+    assert np.array_equal(fast.hidden, twin.hidden) and fast.depth.tobytes() == twin.depth.tobytes()
+    with np.errstate(invalid="ignore", over="ignore"):
+        uv = camera.project(points)
+    found, u0, v0, u1, v1, own, unseen = _jit.own_depths(uv, points, 60, 40, pad)
+    assert found and (u0, v0, u1 - u0, v1 - v0) == (twin.u0, twin.v0, twin.hidden.shape[1], twin.hidden.shape[0])
+    np.testing.assert_array_equal(unseen, ~np.isfinite(own))
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.1, 0.5]), st.sampled_from([0.8, 3.0, np.inf]))
+def test_the_registrations_valid_depth_is_the_twins(seed, low, high):
+    """The registration's window depth by the extraction's kernel with ``z > 0 and z >= low`` as ``z >= max(low, the
+    least positive double)``, and fruit_surface's depth above 0: subnormal, zero, negative, NaN and infinite depths,
+    the twins' maps bit for bit."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    z = rng.uniform(-0.2, 4.0, (h, w))
+    z[rng.random((h, w)) < 0.3] = rng.choice([0.0, -0.0, 5e-324, 1e-310, -5e-324, np.nan, np.inf, -np.inf])
+    valid = np.empty((h, w))
+    _jit.valid_depth(z, rng.random((h, w)) < 0.5, max(low, 5e-324), high, valid, np.empty((h, w), bool))
+    with np.errstate(invalid="ignore"):
+        twin = np.where(np.isfinite(z) & (z > 0) & (z >= low) & (z <= high), z, 0.0)
+        positive = np.where(np.isfinite(z) & (z > 0), z, 0.0)
+    assert valid.tobytes() == twin.tobytes()
+    _jit.positive_depth(z, valid)  # fruit_surface's depth: the same values
+    assert valid.tobytes() == positive.tobytes()
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60))
+def test_principal_widths_are_the_twins_to_the_bit(seed, h, w):
+    """Random blobs and speckle (none, one or two pixels, a line), at the origin or placed in a larger image: the
+    same widths bit for bit, and the kernel's centred coordinates numpy's."""
+    from symfruit.core.raster import principal_widths
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, float(rng.uniform(0.0, 0.2))) if rng.random() < 0.7 else rng.random((h, w)) < 0.02
+    if rng.random() < 0.1:
+        mask = np.zeros((h, w), bool)
+        mask[rng.integers(0, h), :] = True
+    origin = (0, 0) if rng.random() < 0.3 else (int(rng.integers(0, 900)), int(rng.integers(0, 1500)))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, principal_widths, mask, origin=origin)
+    assert fast == twin and all(type(x) is float for x in fast)
+    if mask.sum() >= 2:
+        rows, cols = np.nonzero(mask)
+        xy = np.column_stack((cols + origin[1], rows + origin[0])).astype(np.float64)
+        xy -= np.array([int(xy[:, 0].sum()), int(xy[:, 1].sum())], dtype=np.float64) / len(rows)
+        assert _jit.centred_pixels(mask, origin[0], origin[1]).tobytes() == xy.tobytes()
+
+
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(0, 40))
 def test_joined_boxes_are_the_twins(seed, n):

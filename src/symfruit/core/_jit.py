@@ -1479,12 +1479,14 @@ def outline_costs(
     size = values.shape[0]
     out = np.empty(k)
     count = np.zeros(size, np.int64)
+    row = np.empty(n, np.int64)  # the row's ranks, to clear their counts (not the whole span of ranks) after it
     lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
     for s in range(k):
         offset = shifts[s, 0] * width + shifts[s, 1]
         low, top = size, -1
         for j in range(n):
             r = np.int64(ranks[at[j] - offset])
+            row[j] = r
             count[r] += 1
             low, top = min(low, r), max(top, r)
         b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
@@ -1501,9 +1503,8 @@ def outline_costs(
             second = first
         median = 0.5 * (first + second) if n % 2 == 0 else second
         middle = min(max(median, 0.0), band)
-        right = low  # the first rank at or above the band, the one below it: the nearer one taken first
-        while right <= top and values[right] < middle:
-            right += 1
+        # the first rank at or above the band (bisected: values ascend), the one below it: the nearer one taken first
+        right = low + np.searchsorted(values[low : top + 1], middle)
         left = right - 1
         need = keep
         total = 0.0
@@ -1523,8 +1524,8 @@ def outline_costs(
                 total += take * above
                 right += 1
             need -= take
-        for r in range(low, top + 1):
-            count[r] = 0
+        for j in range(n):
+            count[row[j]] = 0
         out[s] = total / keep
     return out
 
@@ -2393,6 +2394,281 @@ def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, 
             out[r, c] = hit
             some = some or hit
     return some
+
+
+# --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
+
+
+@_njit
+def signed_keys(inside: np.ndarray, pad: int, reach: int) -> tuple[np.ndarray, bool, float]:
+    """:meth:`symfruit.core.surface._Outline.keys`' twin in one pass: the map ``inside`` (h, w) as whole numbers
+    ``sign * rint(d * d)`` padded by ``pad`` pixels of ``-reach**2`` (int32, flattened); whether every value comes
+    back exactly from its key (``sqrt(key) == |d|``, each key below ``2**31 - 1``; else the keys are no use and the
+    twin's answer is None), and the largest key (at least ``reach**2``). The same keys, whole numbers."""
+    h, w = inside.shape
+    width = w + 2 * pad
+    out = np.empty((h + 2 * pad) * width, np.int32)
+    floor = -(reach * reach)
+    top = float(reach * reach)
+    if top >= 2147483647.0:
+        return out, False, top
+    for i in range(out.shape[0]):
+        out[i] = floor
+    for r in range(h):
+        base = (r + pad) * width + pad
+        for c in range(w):
+            d = inside[r, c]
+            whole = np.rint(d * d)
+            if not whole < 2147483647.0 or math.sqrt(whole) != abs(d):
+                return out, False, top
+            top = max(top, whole)
+            out[base + c] = -np.int32(whole) if d < 0 else np.int32(whole)
+    return out, True, top
+
+
+@_njit
+def outline_deviations(
+    ranks: np.ndarray, values: np.ndarray, at: np.ndarray, shifts: np.ndarray, width: int, band: float
+) -> np.ndarray:  # fmt: skip
+    """(k, n) each outline point's deviation from the band of each shift (k, 2) ``(dv, du)``, as
+    :meth:`symfruit.core.surface._Outline._cost` has it before its exact trimmed mean: the points' flat indices
+    ``at`` (n,) into the padded map's ranks ``ranks`` (:meth:`~symfruit.core.surface._Outline.ranks`) moved back by
+    the shift, their values ``values[rank]`` (the map's values bit for bit), the median of the row (np.median's
+    two middle places, walked to on the counts of the ranks, as :func:`outline_costs` does; the values of the
+    twin's middle keys), the band (the median clipped to 0 .. ``band``) and ``|value - band|``: the twin's
+    deviations, bit for bit, whose partition and mean numpy then takes as the twin does."""
+    k, n = shifts.shape[0], at.shape[0]
+    size = values.shape[0]
+    out = np.empty((k, n))
+    count = np.zeros(size, np.int64)
+    row = np.empty(n, np.int64)
+    lower, upper = (n - 1) // 2, n // 2
+    for s in range(k):
+        offset = shifts[s, 0] * width + shifts[s, 1]
+        low = size
+        for j in range(n):
+            r = np.int64(ranks[at[j] - offset])
+            row[j] = r
+            count[r] += 1
+            low = min(low, r)
+        b, seen = low, count[low]
+        while seen <= lower:
+            b += 1
+            seen += count[b]
+        first = values[b]
+        if seen <= upper:
+            b += 1
+            while count[b] == 0:
+                b += 1
+            second = values[b]
+        else:
+            second = first
+        median = 0.5 * (first + second) if n % 2 == 0 else second
+        middle = min(max(median, 0.0), band)
+        for j in range(n):
+            out[s, j] = abs(values[row[j]] - middle)
+            count[row[j]] = 0
+    return out
+
+
+@_njit
+def monotone_rays(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, angle: np.ndarray, dy: np.ndarray, dx: np.ndarray,
+    bins: int, per_radian: float, tolerance: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.surface.monotone_region` from the directions ``angle`` (n,) (numpy's ``arctan2(dy, dx)``
+    of the pixels' offsets ``dy``, ``dx`` from the apex) on: each pixel's sector ``floor((angle + pi) *
+    per_radian) % bins`` (``per_radian = bins / (2 pi)``) and squared distance ``dy^2 + dx^2``, as the twin works
+    them out, then :func:`monotone`. The same pixels."""
+    n = rows.shape[0]
+    sector = np.empty(n, np.int64)
+    d2 = np.empty(n, np.int64)
+    for i in range(n):
+        sector[i] = np.int64(math.floor((angle[i] + np.pi) * per_radian)) % bins
+        d2[i] = np.int64(dy[i]) * np.int64(dy[i]) + np.int64(dx[i]) * np.int64(dx[i])
+    monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+
+
+@_njit
+def rim_sides(
+    dv: np.ndarray, du: np.ndarray, radius: np.ndarray, angle: np.ndarray, bins: int, per_radian: float,
+    free: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """(4, 2) int: :func:`symfruit.core.surface._free_points`' sides from the outline points' offsets ``dv``, ``du``
+    (n,) from their centroid, their distances ``radius`` (numpy's ``hypot``) and directions ``angle`` (numpy's
+    ``arctan2(dv, du)``): the rim (:func:`~symfruit.core.surface._rim`: in each of ``bins`` directions, bin
+    ``min(int((angle + pi) * per_radian), bins - 1)``, the farthest point, the first of equally far ones), and of
+    its points on the top, bottom, left and right side how many are ``free`` and how many there are. The twin's
+    points and counts."""
+    n = dv.shape[0]
+    best = np.full(bins, -1, np.int64)
+    for i in range(n):
+        b = min(np.int64((angle[i] + np.pi) * per_radian), bins - 1)
+        if best[b] < 0 or radius[i] > radius[best[b]]:
+            best[b] = i
+    sides = np.zeros((4, 2), np.int64)
+    for b in range(bins):
+        i = best[b]
+        if i < 0:
+            continue
+        if abs(dv[i]) >= abs(du[i]):
+            side = 0 if dv[i] < 0 else 1 if dv[i] > 0 else -1
+        else:
+            side = 2 if du[i] < 0 else 3 if du[i] > 0 else -1
+        if side >= 0:
+            sides[side, 1] += 1
+            if free[i]:
+                sides[side, 0] += 1
+    return sides
+
+
+@_njit
+def valid_depth(
+    depth: np.ndarray, core: np.ndarray, low: float, high: float, valid_depth: np.ndarray, usable: np.ndarray
+) -> tuple[int, int]:  # fmt: skip
+    """:func:`symfruit.extract.extract`'s depth tests in one pass: ``valid_depth`` (h, w) the depth where it is finite
+    and within ``low`` .. ``high`` (0 elsewhere), ``usable`` (h, w) the pixels of ``core`` with such depth; how many
+    of ``core``'s pixels have none, and how many are usable. The twin's comparisons: the same maps and counts."""
+    h, w = depth.shape
+    n_invalid = n_usable = 0
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            ok = np.isfinite(z) and z >= low and z <= high
+            valid_depth[r, c] = z if ok else 0.0
+            usable[r, c] = core[r, c] and ok
+            if core[r, c]:
+                if ok:
+                    n_usable += 1
+                else:
+                    n_invalid += 1
+    return n_invalid, n_usable
+
+
+@_njit
+def pixel_points(
+    keep: np.ndarray, also: np.ndarray, depth: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> np.ndarray:  # fmt: skip
+    """(n, 3) :meth:`symfruit.core.camera.Camera.deproject` of the pixels of ``keep & also`` (h, w) bool in raster
+    order (``np.nonzero``'s) at their ``depth``: ``x = (u - cx) / fx * z``, ``y = (v - cy) / fy * z``, the same
+    arithmetic, bit for bit."""
+    h, w = keep.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c] and also[r, c]:
+                n += 1
+    out = np.empty((n, 3))
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c] and also[r, c]:
+                z = float(depth[r, c])
+                out[i, 0] = (float(c) - cx) / fx * z
+                out[i, 1] = (float(r) - cy) / fy * z
+                out[i, 2] = z
+                i += 1
+    return out
+
+
+@_njit
+def trim_regions(
+    inner: np.ndarray, mask: np.ndarray, band_px: float, deep: float, ring_px: float, fruit: np.ndarray,
+    ring: np.ndarray, band: np.ndarray,
+) -> tuple[int, int, int]:  # fmt: skip
+    """:func:`symfruit.core.surface.colour_trim`'s three regions from the mask's distance map ``inner`` (h, w): the
+    fruit ``band_px < inner <= deep``, the ring of pixels outside ``mask`` at most ``ring_px`` from it
+    (:func:`near_distance`'s distances, :func:`symfruit.core.surface.within`'s test) and the band ``inner <=
+    band_px`` of the mask, written into ``fruit``, ``ring`` and ``band`` (h, w) bool; how many pixels each holds.
+    The twin's comparisons: the same pixels."""
+    h, w = mask.shape
+    near = np.empty((h, w))
+    near_distance(mask, ring_px, True, near)
+    n_fruit = n_ring = n_band = 0
+    for r in range(h):
+        for c in range(w):
+            d = inner[r, c]
+            f = d > band_px and d <= deep
+            g = (not mask[r, c]) and near[r, c] <= ring_px
+            b = mask[r, c] and d <= band_px
+            fruit[r, c], ring[r, c], band[r, c] = f, g, b
+            n_fruit += f
+            n_ring += g
+            n_band += b
+    return n_fruit, n_ring, n_band
+
+
+@_njit
+def own_depths(
+    uv: np.ndarray, points: np.ndarray, width: int, height: int, pad: int
+) -> tuple[bool, int, int, int, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.occlusion.occlusion`'s window and the fruit's own depths in it: each point's pixel (its
+    projection ``uv`` (n, 2) rounded half to even, as ``np.rint``; those within the ``width`` x ``height`` image),
+    the window (the pixels' box grown by its own size plus ``pad``, clipped to the image) and, per window pixel, the
+    least depth (``points[:, 2]``) of the points on it (+inf on none; a least is exact in any order) and whether it
+    has none. ``(False, ...)`` when no point falls in the image. The twin's window and maps, bit for bit."""
+    n = uv.shape[0]
+    cmin, cmax, rmin, rmax = width, -1, height, -1
+    for i in range(n):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            c, r = int(u), int(v)
+            cmin, cmax, rmin, rmax = min(cmin, c), max(cmax, c), min(rmin, r), max(rmax, r)
+    if cmax < 0:
+        return False, 0, 0, 0, 0, np.empty((0, 0)), np.empty((0, 0), np.bool_)
+    span_u, span_v = cmax - cmin + pad, rmax - rmin + pad
+    u0, v0 = max(cmin - span_u, 0), max(rmin - span_v, 0)
+    u1, v1 = min(cmax + span_u + 1, width), min(rmax + span_v + 1, height)
+    own = np.full((v1 - v0, u1 - u0), np.inf)
+    for i in range(n):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            r, c = int(v) - v0, int(u) - u0
+            z = points[i, 2]
+            if z < own[r, c]:
+                own[r, c] = z
+    unseen = np.empty(own.shape, np.bool_)
+    for r in range(own.shape[0]):
+        for c in range(own.shape[1]):
+            unseen[r, c] = not np.isfinite(own[r, c])
+    return True, u0, v0, u1, v1, own, unseen
+
+
+@_njit
+def centred_pixels(mask: np.ndarray, r0: int, c0: int) -> np.ndarray:
+    """(n, 2) :func:`symfruit.core.raster.principal_widths`' centred coordinates: the column and row (at ``r0``,
+    ``c0`` in a larger image) of each pixel of ``mask`` (h, w) bool in raster order, less their means (the whole-number
+    sums divided by the count, as the twin has them): the twin's array, bit for bit (at least two pixels)."""
+    h, w = mask.shape
+    n = 0
+    su = sv = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                n += 1
+                su += c + c0
+                sv += r + r0
+    mu, mv = float(su) / n, float(sv) / n
+    out = np.empty((n, 2))
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                out[i, 0] = float(c + c0) - mu
+                out[i, 1] = float(r + r0) - mv
+                i += 1
+    return out
+
+
+@_njit
+def positive_depth(depth: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w): ``depth`` where it is finite and above 0, 0 elsewhere (:func:`symfruit.core.surface.
+    fruit_surface`'s ``np.where(np.isfinite(depth) & (depth > 0), depth, 0.0)``, the same values)."""
+    h, w = depth.shape
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            out[r, c] = z if np.isfinite(z) and z > 0 else 0.0
 
 
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------

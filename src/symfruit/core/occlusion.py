@@ -326,6 +326,21 @@ def occlusion(
         raise InputError(f"occlusion others must be a {shape[1]}x{shape[0]} image, got {np.shape(others)[::-1]}")
     points = as_points(points, min_count=1)
     uv = camera.project(points)
+    if (jit := compiled()) is not None:  # as_points gives contiguous float64
+        # the window, the fruit's own depths and the maps below by compiled twins (the same bits; issue 19,
+        # seventeenth round: the window and own depths in one pass, not some fifteen numpy calls)
+        found, u0, v0, u1, v1, own_z, unseen = jit.own_depths(uv, points, camera.width, camera.height, pad)
+        if not found:
+            raise InputError("occlusion: no point of the fruit projects into the image")
+        h, w = v1 - v0, u1 - u0
+        window = depth[v0:v1, u0:u1]
+        if window.dtype not in (np.float32, np.float64):
+            window = np.asarray(window, dtype=np.float64)
+        near_to = others[v0:v1, u0:u1] if others is not None else np.zeros((0, 0), bool)
+        hidden, seen = np.empty((h, w), bool), np.empty((h, w))
+        jit.occlusion_maps(window, mask[v0:v1, u0:u1], own_z, nearest_index(unseen), np.asarray(near_to, dtype=bool),
+                           tolerance, _steps(reach), hidden, seen)  # fmt: skip
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=seen)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -340,16 +355,6 @@ def occlusion(
     np.minimum.at(flat, (row - v0) * w + (col - u0), z)
     own_z = flat.reshape(h, w)
     seen_own = np.isfinite(own_z)
-    if (jit := compiled()) is not None:  # the maps below in one compiled pass, the same bits
-        window = depth[v0:v1, u0:u1]
-        if window.dtype not in (np.float32, np.float64):
-            window = np.asarray(window, dtype=np.float64)
-        near_to = others[v0:v1, u0:u1] if others is not None else np.zeros((0, 0), bool)
-        steps = np.array(_offsets(reach) if reach > 0 else [], dtype=np.int64).reshape(-1, 2)
-        hidden, seen = np.empty((h, w), bool), np.empty((h, w))
-        jit.occlusion_maps(window, mask[v0:v1, u0:u1], own_z, nearest_index(~seen_own),
-                           np.asarray(near_to, dtype=bool), tolerance, steps, hidden, seen)  # fmt: skip
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=seen)
     # The fruit's depth beside every pixel: that of the nearest of its points' pixels.
     z_ref = np.take(own_z.ravel(), nearest_index(~seen_own))  # the nearest point pixel's
     own = mask[v0:v1, u0:u1] | seen_own
@@ -423,6 +428,19 @@ def _offsets(reach: int) -> list[tuple[int, int]]:
 
 
 _OFFSETS: dict[int, list[tuple[int, int]]] = {}
+
+
+def _steps(reach: int) -> np.ndarray:
+    """(k, 2) int64 :func:`_offsets` of ``reach`` as an array (none for 0), made once per reach (the kernel reads it,
+    never writes it)."""
+    found = _STEPS.get(reach)
+    if found is None:
+        found = np.array(_offsets(reach) if reach > 0 else [], dtype=np.int64).reshape(-1, 2)
+        _STEPS[reach] = found
+    return found
+
+
+_STEPS: dict[int, np.ndarray] = {}
 
 
 def open_square(mask: np.ndarray, size: int) -> np.ndarray:

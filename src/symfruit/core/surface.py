@@ -270,13 +270,14 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     if not len(rows) or not np.isfinite(tolerance):
         return keep.copy() if len(rows) else out
     dy, dx = rows - apex[0], cols - apex[1]
+    if (jit := compiled()) is not None:  # the compiled twin of what follows from the directions on (the same pixels)
+        jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi),
+                          float(tolerance), out)  # fmt: skip
+        return out
     sector = np.floor((np.arctan2(dy, dx) + np.pi) * (bins / (2.0 * np.pi))).astype(np.int64) % bins
     # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
     # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
     d2 = dy * dy + dx * dx
-    if (jit := compiled()) is not None:  # the compiled twin of what follows (the same pixels)
-        jit.monotone(depth, rows, cols, sector, d2, bins, float(tolerance), out)
-        return out
     order = _stable_order(sector * (int(d2.max()) + 1) + d2)
     at = (rows * keep.shape[1] + cols)[order]  # flat indices: np.take is faster than two index arrays
     z, sec = np.take(np.ascontiguousarray(depth).ravel(), at).astype(np.float64), sector[order]
@@ -362,8 +363,15 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     Surface, or None when the mask holds fewer than 10 pixels with depth.
     """
     region = mask if region is None else region
-    valid = np.isfinite(depth) & (depth > 0)
-    depth = np.where(valid, depth, 0.0)
+    valid: np.ndarray | None = None  # with depth cleaned, its pixels above 0 (made only where wanted)
+    jit = compiled() if isinstance(depth, np.ndarray) and depth.dtype == np.float64 and depth.ndim == 2 else None
+    if jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
+        clean = np.empty(depth.shape)
+        jit.positive_depth(depth, clean)
+        depth = clean
+    else:
+        valid = np.isfinite(depth) & (depth > 0)
+        depth = np.where(valid, depth, 0.0)
     # What depends on the mask alone is worked out on the mask's box (the same values: pixels outside it are not
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
     if (found := mask_box(mask)) is None:
@@ -390,6 +398,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         if not jit.near_pixels(depth, np.asarray(region, dtype=bool), front - tol, front + slab * reach, near):
             return None
     else:
+        valid = depth > 0 if valid is None else valid
         near = region & valid & (depth >= front - tol) & (depth <= front + slab * reach)
         if not near.any():
             return None
@@ -477,6 +486,10 @@ class _Outline:
         None when the map is not made of signed square roots of whole numbers (it is when it comes from distance
         transforms). Sorting them instead of the distances gives the same order, several times faster."""
         key = ("keys", pad, int(reach))
+        if key not in self._padded and (jit := compiled()) is not None and self.inside.dtype == np.float64:
+            # the compiled twin of what follows, in one pass (issue 19, seventeenth round: the same keys)
+            flat, ok, top = jit.signed_keys(self.inside, int(pad), int(reach))
+            self._padded[key] = None if not ok else flat.astype(np.int16) if top < 2**15 - 1 else flat
         if key not in self._padded:
             d = self.inside
             whole = np.rint(d * d)
@@ -526,7 +539,18 @@ class _Outline:
         return self._cost(shifts, reach, trim, exact)
 
     def _cost(self, shifts: np.ndarray, reach: int, trim: float, exact: bool, pad: int = 0) -> np.ndarray:
-        """:meth:`cost` of one block of shifts, the padded maps at least ``pad`` wide."""
+        """:meth:`cost` of one block of shifts, the padded maps at least ``pad`` wide. Where numba is, the exact costs
+        of a map with 16-bit keys take their deviations from a compiled twin (:func:`symfruit.core._jit.
+        outline_deviations`: the same deviations, bit for bit, read off the map's ranks instead of a padded copy of
+        its distances; issue 19, seventeenth round), their partition and mean from numpy as here."""
+        if exact and len(self.rows) and (jit := compiled()) is not None:
+            pad = max(int(reach), int(np.abs(shifts).max(initial=0)), pad)
+            if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:
+                width = self.inside.shape[1] + 2 * pad
+                at = (self.rows + pad) * width + (self.cols + pad)
+                dev = jit.outline_deviations(*self.ranks(pad, reach), at, shifts, width, self.band)
+                keep = max(1, int(trim * dev.shape[1]))
+                return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
         at, pad = self._at(shifts, reach, pad)
         keys = self.keys(pad, reach)
         if not exact and keys is not None:
@@ -708,6 +732,11 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
     box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
     gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
     free = within(gap, _FREE_PX)[rows - r0, cols - c0]
+    if (jit := compiled()) is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
+        dv, du = rows - rows.mean(), cols - cols.mean()
+        radius = np.hypot(dv, du)
+        bins = max(8, int(2.0 * np.pi * radius.mean()))
+        return free, jit.rim_sides(dv, du, radius, np.arctan2(dv, du), bins, bins / (2.0 * np.pi), free)
     outer = _rim(rows, cols)
     dv, du = rows[outer] - rows.mean(), cols[outer] - cols.mean()
     along_v = np.abs(dv) >= np.abs(du)
@@ -789,7 +818,12 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
             continue
         # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds)
         z = depth[r0:r1, c0:c1]
-        z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
+        if (jit := compiled()) is not None and z.dtype == np.float64:  # the same map by the extraction's kernel:
+            valid = np.empty(z.shape)  # z > 0 and z >= lo is z >= the larger of lo and the least positive double
+            jit.valid_depth(z, mask, max(float(lo), 5e-324), float(hi), valid, np.empty(z.shape, bool))
+            z = valid
+        else:
+            z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
         if (found := _outline(z, mask, focal, max_px)) is not None and any(found.axes):
             outlines.append(found)
     if not outlines:
@@ -831,10 +865,20 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
 def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact: bool) -> np.ndarray:
     """(k,) :meth:`_Outline.cost` of each ``(dv, du)`` of ``shifts`` (k, 2) as far as the outline tells it: along
     an axis it does not tell (:attr:`_Outline.axes`) every shift costs what none does, so that fruit neither pulls
-    the shift along it nor weighs against it; each distinct shift costed once."""
-    if all(outline.axes):
+    the shift along it nor weighs against it; each distinct shift costed once.
+
+    The distinct shifts are those of the told axis' column alone (``np.unique(..., axis=0)`` of the shifts with the
+    other column zeroed, in the same order, without its rows' structured view and sort: a few times faster)."""
+    axes = outline.axes
+    if all(axes):
         return outline.cost(shifts, reach, trim, exact=exact)
-    seen, back = np.unique(shifts * np.array(outline.axes, dtype=shifts.dtype), axis=0, return_inverse=True)
+    seen = np.zeros((min(len(shifts), 1), 2), dtype=shifts.dtype)
+    back = np.zeros(len(shifts), dtype=np.intp)
+    if any(axes):
+        told = 0 if axes[0] else 1
+        values, back = np.unique(shifts[:, told], return_inverse=True)
+        seen = np.zeros((len(values), 2), dtype=shifts.dtype)
+        seen[:, told] = values
     return outline.cost(seen, reach, trim, exact=exact)[back.reshape(-1)]
 
 
@@ -865,14 +909,20 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
-    fruit = (inner > band_px) & (inner <= 3.0 * band_px + 1)
-    ring = ~mask & within(mask, band_px + 1)  # 1 to band_px + 1 from the mask
-    band = mask & (inner <= band_px)
-    if fruit.sum() < 20 or ring.sum() < 20 or not band.any():
+    if (jit := compiled()) is not None:  # the three regions and their sizes in one pass (the same pixels)
+        fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
+        n_fruit, n_ring, n_band = jit.trim_regions(inner, mask, float(band_px), 3.0 * band_px + 1,
+                                                   float(band_px + 1), fruit, ring, band)  # fmt: skip
+    else:
+        fruit = (inner > band_px) & (inner <= 3.0 * band_px + 1)
+        ring = ~mask & within(mask, band_px + 1)  # 1 to band_px + 1 from the mask
+        band = mask & (inner <= band_px)
+        n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
+    if n_fruit < 20 or n_ring < 20 or not n_band:
         return mask
     color = np.asarray(color)
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
-    jit = compiled() if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
+    jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
     feature = _colour_features if jit is None else jit.colour_features
     kmeans = _kmeans if jit is None else jit.kmeans
     rng = np.random.default_rng(0)
