@@ -1401,3 +1401,62 @@ def test_extraction_is_the_twins(monkeypatch, seed):
     assert (fast.n_invalid, fast.n_border, fast.n_other_clusters) == (twin.n_invalid, twin.n_border,
                                                                        twin.n_other_clusters)  # fmt: skip
     assert len(fast.points) > 100
+
+
+# --- issue 19, seventeenth round: the colour segmenter --------------------------------------------------------------
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["speckle", "disc", "line", "pixel", "strided"]))
+def test_the_segmenters_hull_vertices_are_the_twins(seed, kind):
+    """Speckle of any density, a disc, a line (no hull), one pixel, a strided view: the monotone chain's vertices are
+    Qhull's, counter-clockwise from the least (y, x), and so is the filled hull, bit for bit."""
+    from symfruit.segment.colour import _hull_area, _hull_vertices, convex_hull_mask
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.001, 0.9)
+    if kind == "disc":
+        yy, xx = np.mgrid[:h, :w]
+        mask = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= rng.uniform(0.5, 40.0) ** 2
+    elif kind in ("line", "pixel"):
+        mask = np.zeros((h, w), bool)
+        mask[rng.integers(0, h), : rng.integers(1, w + 1) if kind == "line" else 1] = True
+        mask = mask.T.copy() if rng.random() < 0.5 else mask
+    elif kind == "strided":
+        mask = mask[:: int(rng.integers(1, 3)), :: int(rng.integers(2, 4))]
+    with pytest.MonkeyPatch.context() as mp:
+        v, v_twin = _both(mp, _hull_vertices, mask)
+        hull, hull_twin = _both(mp, convex_hull_mask, mask)
+        area, area_twin = _both(mp, _hull_area, mask)
+    assert (v is None) == (v_twin is None)
+    if kind in ("line", "pixel"):
+        assert v is None
+    if v is not None:
+        assert v.dtype == v_twin.dtype == np.float64
+        np.testing.assert_array_equal(v, v_twin)
+        assert (v[0, 1], v[0, 0]) == min((y, x) for x, y in v.tolist())  # the start: the least (y, x)
+        x, y = v[:, 0], v[:, 1]
+        assert np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)) > 0  # counter-clockwise in (x, y)
+    np.testing.assert_array_equal(hull, hull_twin)
+    assert area == area_twin
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_segmenters_green_and_leaf_pixels_are_the_twins(seed, window):
+    """Random colours with green the largest channel as often as not, whole or a strided window: the same green and
+    leaf-green pixels, and some of each."""
+    from symfruit.segment.colour import _green, _leaf
+
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (70, 90, 3), dtype=np.uint8)
+    image[..., 1] = np.maximum(image[..., 1], rng.integers(0, 256, (70, 90)).astype(np.uint8))
+    c = image[3:60, 2:80:2] if window else image
+    with pytest.MonkeyPatch.context() as mp:
+        green, green_twin = _both(mp, _green, c)
+        leaf, leaf_twin = _both(mp, _leaf, c)
+    assert green.dtype == green_twin.dtype == leaf.dtype == leaf_twin.dtype == np.bool_
+    np.testing.assert_array_equal(green, green_twin)
+    np.testing.assert_array_equal(leaf, leaf_twin)
+    assert 0 < leaf.sum() < green.sum() < green.size

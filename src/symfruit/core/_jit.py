@@ -2550,3 +2550,81 @@ def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarr
             out[k, 0], out[k, 1], out[k, 2] = p[i, 0], p[i, 1], p[i, 2]
             k += 1
     return out
+
+
+# --- issue 19, seventeenth round: the colour segmenter ------------------------------------------------------------
+
+
+@_njit
+def hull_vertices(mask: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.segment.colour._hull_vertices` of a 2-d bool ``mask``: (m, 2) float64 ``(x, y)`` vertices of
+    the convex hull of its rows' end pixels (every pixel's hull), counter-clockwise in ``(x, y)`` and starting at the
+    least ``(y, x)`` (the first row's first pixel), without vertices in the middle of an edge: the vertices that the
+    twin's Qhull gives, rolled to that start. Andrew's monotone chain on the row ends, which come sorted by ``(y, x)``;
+    its cross products in whole numbers. A (0, 2) array where the hull is degenerate (fewer than three vertices:
+    the twin's None)."""
+    h, w = mask.shape
+    pts = np.empty((2 * h, 2), np.int64)  # (y, x) of the row ends, sorted
+    n = 0
+    for r in range(h):
+        first = -1
+        for c in range(w):
+            if mask[r, c]:
+                first = c
+                break
+        if first < 0:
+            continue
+        last = first
+        for c in range(w - 1, first, -1):
+            if mask[r, c]:
+                last = c
+                break
+        pts[n, 0], pts[n, 1] = r, first
+        n += 1
+        if last != first:
+            pts[n, 0], pts[n, 1] = r, last
+            n += 1
+    if n < 3:
+        return np.empty((0, 2))
+    chain = np.empty((2 * n + 1, 2), np.int64)
+    k = 0
+    for i in range(n):  # one side, then the other (counter-clockwise in (y, x): clockwise in (x, y))
+        while k >= 2 and ((chain[k - 1, 0] - chain[k - 2, 0]) * (pts[i, 1] - chain[k - 2, 1])
+                          - (chain[k - 1, 1] - chain[k - 2, 1]) * (pts[i, 0] - chain[k - 2, 0])) <= 0:  # fmt: skip
+            k -= 1
+        chain[k, 0], chain[k, 1] = pts[i, 0], pts[i, 1]
+        k += 1
+    lower = k + 1
+    for i in range(n - 2, -1, -1):
+        while k >= lower and ((chain[k - 1, 0] - chain[k - 2, 0]) * (pts[i, 1] - chain[k - 2, 1])
+                              - (chain[k - 1, 1] - chain[k - 2, 1]) * (pts[i, 0] - chain[k - 2, 0])) <= 0:  # fmt: skip
+            k -= 1
+        chain[k, 0], chain[k, 1] = pts[i, 0], pts[i, 1]
+        k += 1
+    m = k - 1  # the chain ends where it began
+    if m < 3:
+        return np.empty((0, 2))
+    out = np.empty((m, 2))
+    out[0, 0], out[0, 1] = float(chain[0, 1]), float(chain[0, 0])
+    for j in range(1, m):  # reversed, from the same start: counter-clockwise in (x, y)
+        out[j, 0], out[j, 1] = float(chain[m - j, 1]), float(chain[m - j, 0])
+    return out
+
+
+@_njit
+def green_pixels(c: np.ndarray, leaf_hue: int) -> np.ndarray:
+    """:func:`symfruit.segment.colour._green` of ``c`` (h, w, 3) uint8 (a window of an image, any strides): (h, w) bool,
+    green the largest channel and a third above the smallest; with ``leaf_hue`` >= 0 also of a hue of at least that
+    many degrees (:func:`symfruit.segment.colour._leaf`: ``60 (G - R) >= (leaf_hue - 60) (G - min(R, B))``). The
+    twin's tests on the same whole numbers: the same pixels."""
+    h, w = c.shape[0], c.shape[1]
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for q in range(w):
+            red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+            if green <= red or green < blue:
+                continue
+            over = green - min(red, blue)
+            if 3 * over >= green and (leaf_hue < 0 or 60 * (green - red) >= (leaf_hue - 60) * over):
+                out[r, q] = True
+    return out

@@ -310,7 +310,15 @@ def _hull_mask(vertices: np.ndarray | None, mask: np.ndarray) -> np.ndarray:
 
 
 def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
-    """(m, 2) float (x, y) vertices of the convex hull of the mask's pixels; None when degenerate."""
+    """(m, 2) float (x, y) vertices of the convex hull of the mask's pixels, counter-clockwise from the least
+    ``(y, x)``; None when degenerate. Where numba is, its compiled twin gives the same vertices
+    (:func:`symfruit.core._jit.hull_vertices`, a monotone chain on the row ends: no Qhull call, some 0.2 ms each;
+    issue 19, seventeenth round). Qhull's vertices are rolled to that start (it starts anywhere): the reported
+    hull is the same polygon from any start, and a hull's area (:func:`_hull_area_of`) sums its perimeter in
+    this order."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        v = jit.hull_vertices(mask)
+        return v if len(v) else None
     from scipy.spatial import ConvexHull, QhullError
 
     rows = np.flatnonzero(mask.any(axis=1))
@@ -324,9 +332,11 @@ def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
     if len(rows) < 2 and np.all(first == last):
         return None
     try:
-        return pts[ConvexHull(pts).vertices]
+        v = pts[ConvexHull(pts).vertices]  # counter-clockwise in (x, y), from any vertex
     except QhullError:  # all on a line
         return None
+    start = int(np.lexsort((v[:, 0], v[:, 1]))[0])
+    return np.concatenate((v[start:], v[:start]))
 
 
 def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
@@ -717,7 +727,10 @@ def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
 
 def _green(color: np.ndarray) -> np.ndarray:
     """(h, w) bool: green pixels (calyx, leaves, stems): green the largest channel, and saturated (a third
-    above the smallest; a grey-green backdrop is not)."""
+    above the smallest; a grey-green backdrop is not). Where numba is, its compiled twin gives the same pixels
+    (:func:`symfruit.core._jit.green_pixels`; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return jit.green_pixels(color, -1)
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     return (g > r) & (g >= b) & (3 * (g - np.minimum(r, b)) >= g)
 
@@ -727,7 +740,10 @@ def _leaf(color: np.ndarray) -> np.ndarray:
     yellow-green fruit skin (a bicoloured apple's ground colour) is green by :func:`_green` but yellower.
     With G the largest channel, the hue is ``60 + 60 (G - R) / (G - min(R, B))`` degrees (above 120 when
     B > R), so hue >= LEAF_HUE is ``60 (G - R) >= (LEAF_HUE - 60) (G - min(R, B))``: integers, independent of
-    brightness and saturation."""
+    brightness and saturation. Where numba is, its compiled twin gives the same pixels
+    (:func:`symfruit.core._jit.green_pixels`; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return jit.green_pixels(color, LEAF_HUE)
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     over = g - np.minimum(r, b)  # the channels cast once for both tests (as _green casts them)
     green = (g > r) & (g >= b) & (3 * over >= g)
