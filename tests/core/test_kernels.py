@@ -1460,3 +1460,60 @@ def test_the_segmenters_green_and_leaf_pixels_are_the_twins(seed, window):
     np.testing.assert_array_equal(green, green_twin)
     np.testing.assert_array_equal(leaf, leaf_twin)
     assert 0 < leaf.sum() < green.sum() < green.size
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.2, 0.8), st.floats(0.0, 0.05))
+def test_the_flood_is_the_labelling_of_the_seeds_components(seed, density, seeded):
+    """Random pixels allowed (clusters of every size) and seeds (some outside the allowed pixels): the flood is the
+    union of ``ndimage.label``'s components (4-connected) that hold a seed, bit for bit, and holds no seed outside."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    allowed = rng.random((h, w)) < density
+    seeds = rng.random((h, w)) < seeded
+    lab, n = ndimage.label(allowed)
+    held = np.zeros(n + 1, bool)
+    held[lab[seeds]] = True
+    held[0] = False
+    got = _jit.flood(allowed, seeds)
+    assert got.dtype == np.bool_
+    np.testing.assert_array_equal(got, held[lab])
+    assert not (got & ~allowed).any()
+
+
+def test_the_round_skin_and_the_waist_test_are_the_twins(monkeypatch):
+    """A red cap on a yellow apple, a leaf across it (the skin's flood stops there), and two discs joined by a
+    neck (the waist test's flood, below and above the neck's depth): the same skin and answers with the kernels and
+    with the twins, and the known ones."""
+    from symfruit.core.raster import distance_transform
+    from symfruit.segment.colour import SegmentSettings, _Depth, _Geometry, _round_skin, _separate
+
+    h, w = 120, 160
+    yy, xx = np.mgrid[:h, :w]
+    disc = (yy - 60) ** 2 + (xx - 70) ** 2 <= 40**2
+    depth = np.where(disc, 0.8 - 0.0004 * np.sqrt(np.maximum(40**2 - (yy - 60) ** 2 - (xx - 70) ** 2, 0)), 1.5)
+    color = np.zeros((h, w, 3), np.uint8)
+    color[disc] = (200, 180, 40)  # yellow skin
+    color[(yy - 60) ** 2 + (xx - 60) ** 2 <= 15**2] = (200, 30, 30)  # the red part
+    color[:, 82:86] = (40, 150, 40)  # a leaf over the skin
+    red = (yy - 60) ** 2 + (xx - 60) ** 2 <= 15**2
+    s = SegmentSettings(round_fruit=True)
+    geo = _Geometry(600.0, 60.0, 80.0)
+    owner = np.zeros((h, w), np.int16)
+    sl = (slice(40, 80), slice(40, 80))
+    fast, twin = _both(monkeypatch, _round_skin, sl, red[sl], _Depth(depth), color, geo, s, owner, 1)
+    assert fast[0] == twin[0]
+    np.testing.assert_array_equal(fast[1], twin[1])
+    grown = np.zeros((h, w), bool)
+    grown[fast[0]] = fast[1]
+    assert grown[60, 35] and grown[60, 79] and not grown[60, 84] and not grown[60, 88]  # not past the leaf
+    assert grown.sum() > 2 * red.sum()
+    two = ((yy - 60) ** 2 + (xx - 40) ** 2 <= 30**2) | ((yy - 60) ** 2 + (xx - 115) ** 2 <= 25**2)
+    two |= (abs(yy - 60) <= 4) & (xx > 40) & (xx < 115)  # a neck 9 pixels wide
+    edt = distance_transform(two)
+    centres = [(60, 40, float(edt[60, 40]), True)]
+    for t, want in ((6.0, True), (3.0, False), (27.0, True)):  # above the neck, below it, above the smaller peak
+        got = _both(monkeypatch, _separate, edt, (60, 115), centres, t, [5])
+        assert got == (want, want)

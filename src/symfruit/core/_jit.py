@@ -2628,3 +2628,41 @@ def green_pixels(c: np.ndarray, leaf_hue: int) -> np.ndarray:
             if 3 * over >= green and (leaf_hue < 0 or 60 * (green - red) >= (leaf_hue - 60) * over):
                 out[r, q] = True
     return out
+
+
+@_njit
+def flood(allowed: np.ndarray, seeds: np.ndarray) -> np.ndarray:
+    """(h, w) bool: the pixels of ``allowed`` (h, w) bool 4-connected (through ``allowed``) to a pixel of ``seeds``
+    (h, w) bool that is itself allowed: the union of the components of ``ndimage.label(allowed)`` that hold a seed
+    (the segmenter's twins label the window and read the seeds' labels). A depth-first walk over those components
+    alone, each pixel pushed once."""
+    h, w = allowed.shape
+    out = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            if seeds[r, c] and allowed[r, c] and not out[r, c]:
+                out[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        if r > 0 and allowed[r - 1, c] and not out[r - 1, c]:
+            out[r - 1, c] = True
+            stack[top] = (r - 1) * w + c
+            top += 1
+        if r + 1 < h and allowed[r + 1, c] and not out[r + 1, c]:
+            out[r + 1, c] = True
+            stack[top] = (r + 1) * w + c
+            top += 1
+        if c > 0 and allowed[r, c - 1] and not out[r, c - 1]:
+            out[r, c - 1] = True
+            stack[top] = r * w + c - 1
+            top += 1
+        if c + 1 < w and allowed[r, c + 1] and not out[r, c + 1]:
+            out[r, c + 1] = True
+            stack[top] = r * w + c + 1
+            top += 1
+    return out

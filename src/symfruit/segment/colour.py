@@ -894,7 +894,6 @@ def _merge(
     serial = len(pieces)
     apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
     surfaces: dict[int, _Surface] = {}  # each piece's sphere fit and points, worked out once per piece, not per pair
-    green: np.ndarray | None = None  # _green of the image, once (pixel by pixel: the same as of each window)
     merged = True
     while merged and len(pieces) > 1:
         merged = False
@@ -917,8 +916,7 @@ def _merge(
                     continue
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    green = _green(color) if green is None else green
-                    hull -= float((_hull_mask(vertices, union) & ~union & green[window]).sum())
+                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s, surfaces) is not False
                 ):
@@ -1320,7 +1318,15 @@ def _separate(
     if budget[0] <= 0:
         return False
     budget[0] -= 1
-    deep = ndimage.label(edt > t)[0]
+    above = edt > t
+    if (jit := compiled()) is not None:  # p's component alone, walked (:func:`symfruit.core._jit.flood`)
+        if not above[p]:  # labelled 0 below: another component than every centre above t
+            return all(bool(above[a, b]) for a, b, _, _ in centres)
+        seed = np.zeros(above.shape, bool)
+        seed[p] = True
+        reached = jit.flood(above, seed)
+        return not any(reached[a, b] for a, b, _, _ in centres)
+    deep = ndimage.label(above)[0]
     return all(deep[a, b] != deep[p] for a, b, _, _ in centres)
 
 
@@ -1515,11 +1521,16 @@ def _round_skin(
     deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
     candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
     # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
-    lab, n = ndimage.label((candidate | part) & ~_steps(z, 0.5 * s.depth_jump))
-    reached = np.zeros(n + 1, bool)
-    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
-    reached[0] = False
-    skin = reached[lab] | part
+    allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
+    seeds = part & (np.abs(z - zm) <= s.depth_jump)
+    if (jit := compiled()) is not None:  # the seeds' components alone, walked (:func:`symfruit.core._jit.flood`)
+        skin = jit.flood(allowed, seeds) | part
+    else:
+        lab, n = ndimage.label(allowed)
+        reached = np.zeros(n + 1, bool)
+        reached[lab[seeds]] = True
+        reached[0] = False
+        skin = reached[lab] | part
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
