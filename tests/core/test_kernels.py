@@ -1517,3 +1517,49 @@ def test_the_round_skin_and_the_waist_test_are_the_twins(monkeypatch):
     for t, want in ((6.0, True), (3.0, False), (27.0, True)):  # above the neck, below it, above the smaller peak
         got = _both(monkeypatch, _separate, edt, (60, 115), centres, t, [5])
         assert got == (want, want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000))
+def test_numpys_sum_and_variance_are_the_twins_bit_for_bit(seed, n):
+    """numpy's pairwise sum and variance of a strided column, every length from one lane to several blocks: the
+    same values bit for bit (the segmenter's sphere spread rests on them)."""
+    rng = np.random.default_rng(seed)
+    col = (rng.normal(size=(n, 3)) * rng.uniform(1e-3, 10.0) + rng.uniform(-5.0, 5.0))[:, int(rng.integers(0, 3))]
+    assert _jit._pairwise_sum(col, 0, n) + 0.0 == np.sum(col)
+    assert _jit._variance(col) == np.var(col)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 12), st.booleans())
+def test_the_segmenters_peaks_are_scipys(seed, radius, ties):
+    """A map of random depths (whole numbers: ties) on images smaller and larger than the square: the peaks are the
+    pixels at least ``least`` deep that ``ndimage.maximum_filter`` (mode "reflect") leaves as they are."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    edt = rng.uniform(0.0, 30.0, (h + 2, w + 2))
+    edt = np.floor(edt / 3.0) if ties else edt
+    edt = edt[1:-1, 1:-1]  # a view, as the segmenter's
+    least = float(rng.uniform(0.0, 6.0))
+    want = (edt >= ndimage.maximum_filter(edt, size=2 * radius + 1)) & (edt >= least)
+    np.testing.assert_array_equal(_jit.peaks(edt, radius, least), want)
+    assert want.any() or edt.max() < least
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_segmenters_centres_are_the_twins(monkeypatch, seed):
+    """Three to five overlapping discs of random sizes: the same centres with the kernels and with the twins, coarse
+    or not; and at least two."""
+    from symfruit.segment.colour import _centres
+
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:140, :200]
+    region = np.zeros((140, 200), bool)
+    for _ in range(int(rng.integers(3, 6))):
+        region |= (yy - rng.uniform(30, 110)) ** 2 + (xx - rng.uniform(30, 170)) ** 2 <= rng.uniform(12, 35) ** 2
+    for coarse, least in ((True, 10.0), (False, 4.0)):
+        fast, twin = _both(monkeypatch, _centres, region, least, 0.6, 0.9, coarse=coarse)
+        assert fast == twin
+        assert len(fast) >= 2

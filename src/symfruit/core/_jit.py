@@ -2666,3 +2666,136 @@ def flood(allowed: np.ndarray, seeds: np.ndarray) -> np.ndarray:
             stack[top] = r * w + c + 1
             top += 1
     return out
+
+
+@_njit
+def _pairwise_block(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's ``pairwise_sum`` of one block ``a[lo:lo + n]`` (n <= 128): below 8 values one by one from 0, else
+    in eight lanes, the lanes summed pairwise, then the rest one by one."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@_njit
+def _pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's sum of ``a[lo:lo + n]`` (float64, any stride) in its order: blocks of at most 128
+    (:func:`_pairwise_block`), a longer run split at half its length rounded down to a multiple of 8 and the two
+    halves' sums added (numpy's recursive ``pairwise_sum``, walked here with a stack: numba's cache does not keep a
+    recursive function); ``np.sum`` of a 1-d float64 array starts from 0 and adds this. The same value bit for bit."""
+    if n <= 128:
+        return _pairwise_block(a, lo, n)
+    los = np.empty(64, np.int64)
+    ns = np.empty(64, np.int64)
+    state = np.zeros(64, np.int64)
+    vals = np.empty(64)
+    top, nv = 0, 0
+    los[0], ns[0], state[0] = lo, n, 0
+    top = 1
+    while top > 0:
+        k = top - 1
+        m = ns[k]
+        if m <= 128:
+            vals[nv] = _pairwise_block(a, los[k], m)
+            nv += 1
+            top -= 1
+            continue
+        half = m // 2
+        half -= half % 8
+        if state[k] == 0:  # the left half first
+            state[k] = 1
+            los[top], ns[top], state[top] = los[k], half, 0
+            top += 1
+        elif state[k] == 1:  # then the right
+            state[k] = 2
+            los[top], ns[top], state[top] = los[k] + half, m - half, 0
+            top += 1
+        else:  # both summed: left + right
+            vals[nv - 2] = vals[nv - 2] + vals[nv - 1]
+            nv -= 1
+            top -= 1
+    return vals[0]
+
+
+@_njit
+def _variance(a: np.ndarray) -> float:
+    """``np.var(a)`` of a 1-d float64 array (n >= 1): the mean by numpy's sum over n, the squared deviations summed
+    as numpy sums them, over n. The same value bit for bit."""
+    n = a.shape[0]
+    mean = (0.0 + _pairwise_sum(a, 0, n)) / n
+    dev = np.empty(n)
+    for i in range(n):
+        d = a[i] - mean
+        dev[i] = d * d
+    return (0.0 + _pairwise_sum(dev, 0, n)) / n
+
+
+@_njit
+def sphere_points(
+    mask: np.ndarray, depth: np.ndarray, r0: int, c0: int, cx: float, cy: float, focal: float, most: int
+) -> tuple[np.ndarray, float]:  # fmt: skip
+    """:func:`symfruit.segment.colour._sphere` up to its first fit: the points of :func:`window_points` and their
+    spread (``sqrt(2 (var x + var y))``, numpy's variances), the points within twice the spread of their median depth
+    kept; none (and spread 0) with fewer than 20 points. The same points and spread, bit for bit."""
+    p = window_points(mask, depth, r0, c0, cx, cy, focal, most)
+    n = p.shape[0]
+    if n < 20:
+        return np.empty((0, 3)), 0.0
+    spread = math.sqrt(_variance(p[:, 0]) + _variance(p[:, 1])) * math.sqrt(2.0)
+    zm = _median_of(p[:, 2].copy())
+    keep = 0
+    for i in range(n):
+        keep += abs(p[i, 2] - zm) <= 2.0 * spread
+    out = np.empty((keep, 3))
+    k = 0
+    for i in range(n):
+        if abs(p[i, 2] - zm) <= 2.0 * spread:
+            out[k, 0], out[k, 1], out[k, 2] = p[i, 0], p[i, 1], p[i, 2]
+            k += 1
+    return out, spread
+
+
+@_njit
+def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._centres`' peaks of a distance map ``edt`` (h, w) float64: (h, w) bool, the
+    pixels at least ``least`` deep and as deep as every pixel of the ``2 radius + 1`` square about them, the square
+    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). The largest
+    of each row's stretch, then of each column's: maxima are exact, the same pixels."""
+    h, w = edt.shape
+    rows = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            best = edt[r, max(c - radius, 0)]
+            for q in range(max(c - radius, 0) + 1, min(c + radius, w - 1) + 1):
+                best = max(best, edt[r, q])
+            rows[r, c] = best
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if edt[r, c] < least:
+                continue
+            best = rows[max(r - radius, 0), c]
+            for q in range(max(r - radius, 0) + 1, min(r + radius, h - 1) + 1):
+                best = max(best, rows[q, c])
+            out[r, c] = edt[r, c] >= best
+    return out

@@ -250,12 +250,7 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
 
 def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray]:
     """The flat indices (ascending) of :func:`ripe_seeds`' weak and strong pixels of a checked colour image."""
-    # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
-    levels = np.arange(256, dtype=np.float64)
-    low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
-    high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
-    low[: s.dark + 1] = -1  # dark pixels are never red
-    high[: s.dark + 1] = -1
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
     if (jit := compiled()) is not None and c.dtype == np.uint8 and c.ndim == 3 and c.shape[2] == 3:
         # the compiled twin of what follows (:func:`symfruit.core._jit.red_pixels`: the same pixels; issue 19, sixteenth
         # round), on the window as it is
@@ -277,6 +272,20 @@ def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarr
     rs, gs, bs = rw.take(keep), rgb[:, 1].take(keep), rgb[:, 2].take(keep)
     hue = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
     return at, at.take(keep)[hue]
+
+
+@functools.lru_cache(maxsize=16)
+def _red_tables(red_low: float, red_high: float, dark: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_red_pixels`' look-up tables, (256,) int16 each, read-only: redness >= t  <=>  max(G, B) <= (1 - t) R,
+    compared against per-R tables (integers only); worked out once per setting, not for each of a frame's windows."""
+    levels = np.arange(256, dtype=np.float64)
+    low = np.floor((1.0 - red_low) * levels + 1e-9).astype(np.int16)
+    high = np.floor((1.0 - red_high) * levels + 1e-9).astype(np.int16)
+    low[: dark + 1] = -1  # dark pixels are never red
+    high[: dark + 1] = -1
+    low.flags.writeable = False
+    high.flags.writeable = False
+    return low, high
 
 
 def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
@@ -1131,7 +1140,10 @@ def _centres(
     if float(edt.max()) < least:
         return []
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
-    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.peaks`; seventeenth round)
+        peaks = jit.peaks(edt, int(least), float(least))
+    else:
+        peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
     pr, pc = np.nonzero(peaks)
     order = np.argsort(-edt[pr, pc], kind="stable")
     centres: list[tuple[int, int, float, bool]] = []
@@ -1277,12 +1289,17 @@ def _sphere(
     the window at ``origin`` (algebraic least squares, once more without the points far off it); None
     with fewer than 20 points or when the fit is not a fruit-like cap (its radius off the points' own
     spread by more than 4x either way)."""
-    p = _points(mask, depth, geo, origin, most)
-    if len(p) < 20:
-        return None
-    z = p[:, 2]
-    spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
-    p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+    if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
+        # the same points and spread (:func:`symfruit.core._jit.sphere_points`; issue 19, seventeenth round)
+        p, spread = jit.sphere_points(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
+                                      float(geo.focal), int(most))  # fmt: skip
+    else:
+        p = _points(mask, depth, geo, origin, most)
+        if len(p) < 20:
+            return None
+        z = p[:, 2]
+        spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
+        p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
     centre, radius = np.zeros(3), 0.0
     for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
         if len(p) < 20:
