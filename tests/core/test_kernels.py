@@ -1563,3 +1563,27 @@ def test_the_segmenters_centres_are_the_twins(monkeypatch, seed):
         fast, twin = _both(monkeypatch, _centres, region, least, 0.6, 0.9, coarse=coarse)
         assert fast == twin
         assert len(fast) >= 2
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.02, 0.9), st.booleans(), st.booleans())
+def test_the_labelling_is_scipys(seed, density, eight, strided):
+    """Random masks of every density, whole or a strided view, 4- or 8-connected: ``ndimage.label``'s labels (the
+    same numbers: by the first pixel in raster order) and count, int32."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _label
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    mask = rng.random((h, w)) < density
+    mask = mask[::2, 1::3] if strided else mask
+    want, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
+    got, m = _jit.label(mask, eight)
+    assert got.dtype == want.dtype == np.int32
+    np.testing.assert_array_equal(got, want)
+    assert m == n
+    with pytest.MonkeyPatch.context() as mp:
+        (fast, k), (twin, k_twin) = _both(mp, _label, mask, eight=eight)
+    np.testing.assert_array_equal(fast, twin)
+    assert k == k_twin == n

@@ -2799,3 +2799,73 @@ def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
                 best = max(best, rows[q, c])
             out[r, c] = edt[r, c] >= best
     return out
+
+
+@_njit
+def _find(parent: np.ndarray, i: int) -> int:
+    """The root of ``i`` in a union-find forest, the path halved on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@_njit
+def _union(parent: np.ndarray, a: int, b: int) -> int:
+    """Join the trees of ``a`` and ``b`` under the smaller root; that root."""
+    a, b = _find(parent, a), _find(parent, b)
+    if a == b:
+        return a
+    if b < a:
+        a, b = b, a
+    parent[b] = a
+    return a
+
+
+@_njit
+def label(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int]:
+    """``ndimage.label(mask)`` of a 2-d bool ``mask`` (``eight``: ``structure=np.ones((3, 3))``, else the
+    4-neighbourhood): (h, w) int32 labels 1..n numbered by their first pixel in raster order, as scipy numbers them,
+    and n. One raster pass joining each pixel with its labelled neighbours above and to the left (union-find; with
+    eight neighbours the one above joins all three of the others already, else the left and upper-left ones are
+    joined and the upper-right one may join them), one numbering the roots in the order their first pixels come."""
+    h, w = mask.shape
+    out = np.zeros((h, w), np.int32)
+    parent = np.empty(h * w + 1, np.int64)
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if not mask[r, c]:
+                continue
+            up = out[r - 1, c] if r > 0 else 0
+            left = out[r, c - 1] if c > 0 else 0
+            own = 0
+            if eight:
+                if up:
+                    own = up
+                else:
+                    own = left if left else (out[r - 1, c - 1] if r > 0 and c > 0 else 0)
+                    right = out[r - 1, c + 1] if r > 0 and c + 1 < w else 0
+                    if right:
+                        own = _union(parent, own, right) if own else right
+            elif up and left:
+                own = _union(parent, up, left) if up != left else up
+            else:
+                own = up if up else left
+            if own == 0:
+                n += 1
+                parent[n] = n
+                own = n
+            out[r, c] = own
+    final = np.zeros(n + 1, np.int32)
+    m = 0
+    for r in range(h):
+        for c in range(w):
+            if out[r, c] == 0:
+                continue
+            root = _find(parent, out[r, c])
+            if final[root] == 0:
+                m += 1
+                final[root] = m
+            out[r, c] = final[root]
+    return out, m

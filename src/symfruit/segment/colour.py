@@ -531,7 +531,7 @@ def _segment_at(
         weak_w = np.zeros(shape, bool)
         weak_w.ravel()[weak_at] = True
         weak[win] = weak_w
-        labels, n = ndimage.label(weak_w, structure=np.ones((3, 3), bool))
+        labels, n = _label(weak_w, eight=True)
         flat = labels.ravel()
         seeded = np.zeros(n + 1, bool)
         seeded[flat.take(strong_at)] = True
@@ -636,6 +636,18 @@ def _segment_at(
     return out
 
 
+def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
+    """``ndimage.label(mask)`` of a 2-d bool mask (``eight``: with ``structure=np.ones((3, 3))``): int32 labels
+    numbered by their first pixels in raster order, and their number. Where numba is, its compiled twin gives the
+    same labels (:func:`symfruit.core._jit.label`, union-find; issue 19, seventeenth round): scipy's call costs more
+    than the labelling on the segmenter's small windows."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        labels, n = jit.label(mask, eight)
+        return labels, int(n)
+    labels, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
+    return labels, int(n)
+
+
 def _too_many_pieces() -> InputError:
     return InputError(f"the colour segmenter found more than {MAX_PIECES:,} red pieces; at most {MAX_PIECES:,} are "
                       "joined into fruit (a picture of noise, or a red backdrop?)")  # fmt: skip
@@ -656,7 +668,7 @@ def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.n
     strong, weak = ripe_seeds(c[::COARSE_STEP, ::COARSE_STEP], s)
     if not weak.any():
         return None
-    lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    lab, n = _label(weak, eight=True)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     sizes[0] = 0
     seeded = np.zeros(n + 1, bool)
@@ -1092,7 +1104,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     that the edges enclose goes whole to the fruit holding most of it (when one holds at least
     :data:`EDGE_PURITY` of it), and the edge pixels to the nearest piece. A front fruit's rim, not a straight
     line through the one behind, then separates them."""
-    pieces, n = ndimage.label(region & ~edges)
+    pieces, n = _label(region & ~edges)
     if n < 2:
         return parts
     owner = np.zeros(region.shape, np.int64)
@@ -1353,7 +1365,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
-    deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
+    deep, _ = _label(edt > loose * float(cen[:, 2].min()))
     rows, cols = np.nonzero(deep)
     power = (rows[:, None] - cen[None, :, 0]) ** 2 + (cols[:, None] - cen[None, :, 1]) ** 2 - cen[None, :, 2] ** 2
     near = np.argmin(power, axis=1)
@@ -1460,7 +1472,7 @@ def _ripe_cores(
     red = redness(color)
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
-    lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
+    lab, n = _label(core, eight=True)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
     keep[0] = False
@@ -1606,7 +1618,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         return []
     z_grid, zc = zc, _gap_filled(zc, 3)
     cand = _ground(c[::g, ::g]) & ~_steps(zc, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
-    lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+    lab, n = _label(cand, eight=True)
     if n == 0:
         return []
     flat = lab.ravel()
@@ -1637,7 +1649,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         if not (zw > 0).any():
             continue
         cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(_gap_filled(zw, GAP_PX), s.depth_jump)
-        lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+        lab, n = _label(cand, eight=True)
         if n == 0:
             continue
         flat = lab.ravel()
@@ -1801,7 +1813,7 @@ def _round_body(
         return None
     # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
     # (4-connected: the steps are looked for between 4-neighbours)
-    lab, n = ndimage.label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
+    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
     if n == 0:
         return None
     part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
