@@ -1587,3 +1587,33 @@ def test_the_labelling_is_scipys(seed, density, eight, strided):
         (fast, k), (twin, k_twin) = _both(mp, _label, mask, eight=eight)
     np.testing.assert_array_equal(fast, twin)
     assert k == k_twin == n
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.sampled_from([0.0, 0.7, 2.0, 3.3]))
+def test_the_correlation_and_the_creases_are_scipys(seed, n, sigma):
+    """scipy's ``correlate1d`` (mode "reflect") of lines shorter and longer than the weights, symmetric or not: the
+    same values bit for bit; and a noisy depth of two touching caps: the same creases with the kernel and the
+    twin (the Gaussian's smoothing, then the Laplacian), some of them along the seam."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import SegmentSettings, _creases, _gaussian_weights
+
+    rng = np.random.default_rng(seed)
+    line = rng.normal(size=n) * rng.uniform(0.01, 3.0)
+    for weights, symmetric in (_gaussian_weights(max(sigma, 0.5)), (rng.normal(size=int(rng.integers(1, 9))), False)):
+        out = np.empty(n)
+        _jit._correlate_line(line, weights, symmetric, out)
+        np.testing.assert_array_equal(out, ndimage.correlate1d(line, weights, mode="reflect"))
+    h, w = 50, 80
+    yy, xx = np.mgrid[:h, :w]
+    caps = np.minimum(np.hypot(yy - 25, xx - 22), np.hypot(yy - 25, xx - 58))
+    depth = 0.5 + 0.0003 * caps**2 + rng.normal(0.0, 0.0003, (h, w))
+    region = caps < 22
+    valid = region & (rng.random((h, w)) > 0.1)
+    s = SegmentSettings(crease_sigma=sigma)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _creases, region, depth, valid, 0.5, s, 600.0)
+    np.testing.assert_array_equal(fast, twin)
+    if sigma >= 2.0:
+        assert fast[20:30, 38:42].any() and not fast[17:33, 14:30].any()  # the seam, not a cap's middle

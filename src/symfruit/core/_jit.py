@@ -2869,3 +2869,72 @@ def label(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int]:
                 final[root] = m
             out[r, c] = final[root]
     return out, m
+
+
+@_njit
+def _reflected(i: int, n: int) -> int:
+    """The index that ``i`` reads in a line of ``n`` values extended by scipy's "reflect" mode (d c b a | a b c d |
+    d c b a: the edge value repeated)."""
+    if n == 1:
+        return 0
+    i %= 2 * n
+    return i if i < n else 2 * n - 1 - i
+
+
+@_njit
+def _correlate_line(line: np.ndarray, weights: np.ndarray, symmetric: bool, out: np.ndarray) -> None:
+    """``ndimage.correlate1d`` of one line (mode "reflect", origin 0) into ``out``, in scipy's order: the line
+    extended by reflection into a buffer, then for symmetric weights (of odd length) the middle product, then each
+    pair of values the same distance either side added and times their weight, outermost first; else the last
+    product, then each product from the first on."""
+    n = line.shape[0]
+    size = weights.shape[0]
+    half = size // 2
+    last = size - half - 1
+    ext = np.empty(n + half + last)
+    for i in range(-half, n + last):
+        ext[i + half] = line[_reflected(i, n)]
+    for k in range(n):
+        at = k + half
+        if symmetric:
+            acc = ext[at] * weights[half]
+            for j in range(-half, 0):
+                acc += (ext[at + j] + ext[at - j]) * weights[half + j]
+        else:
+            acc = ext[at + last] * weights[half + last]
+            for j in range(-half, last):
+                acc += ext[at + j] * weights[half + j]
+        out[k] = acc
+
+
+@_njit
+def creases(filled: np.ndarray, weights: np.ndarray, symmetric: bool, region: np.ndarray, limit: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._creases` from the gap-filled depth ``filled`` (h, w) float64: the pixels of
+    ``region`` where the Laplacian (``ndimage.laplace``'s second differences, rows' plus columns') of the depth
+    smoothed by ``weights`` (:func:`~symfruit.segment.colour._gaussian`'s, along the rows then the columns;
+    ``symmetric`` as scipy finds them) lies below ``limit``. scipy's correlations in scipy's order (mode "reflect"):
+    the same values and pixels, the Laplacian worked out on the region's pixels alone."""
+    h, w = filled.shape
+    across = np.empty((h, w))
+    line = np.empty(h)
+    done = np.empty(h)
+    for c in range(w):  # along axis 0
+        for r in range(h):
+            line[r] = filled[r, c]
+        _correlate_line(line, weights, symmetric, done)
+        for r in range(h):
+            across[r, c] = done[r]
+    smooth = np.empty((h, w))
+    for r in range(h):  # along axis 1
+        _correlate_line(across[r], weights, symmetric, smooth[r])
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if not region[r, c]:
+                continue
+            down = smooth[r, c] * -2.0
+            down += (smooth[_reflected(r - 1, h), c] + smooth[_reflected(r + 1, h), c]) * 1.0
+            side = smooth[r, c] * -2.0
+            side += (smooth[r, _reflected(c - 1, w)] + smooth[r, _reflected(c + 1, w)]) * 1.0
+            out[r, c] = down + side < limit
+    return out

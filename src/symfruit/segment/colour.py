@@ -1409,6 +1409,9 @@ def _creases(
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     filled = np.take(np.ascontiguousarray(depth).ravel(), nearest_index(~valid))
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.creases`; seventeenth round)
+        weights, symmetric = _gaussian_weights(float(s.crease_sigma)) if s.crease_sigma > 0 else _IDENTITY
+        return jit.creases(filled, weights, symmetric, region, -s.crease_curvature * (zm / focal) ** 2)
     smooth = _gaussian(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.correlate1d(smooth, _SECOND, 0)  # ndimage.laplace's sum, without its call's overhead
     lap += ndimage.correlate1d(smooth, _SECOND, 1)
@@ -1423,21 +1426,27 @@ def _gaussian(image: np.ndarray, sigma: float) -> np.ndarray:
     """``ndimage.gaussian_filter(image, sigma)`` of a float64 image, the same values: its weights worked out once per
     ``sigma`` (:func:`_gaussian_weights`), not on every call (a polynomial's set-up and evaluation, some 40 us a call
     on these small windows), then the two passes it makes, rows then columns, the second in place."""
-    weights = _gaussian_weights(float(sigma))
+    weights = _gaussian_weights(float(sigma))[0]
     out = ndimage.correlate1d(image, weights, 0)
     return ndimage.correlate1d(out, weights, 1, output=out)
 
 
 @functools.lru_cache(maxsize=8)
-def _gaussian_weights(sigma: float) -> np.ndarray:
+def _gaussian_weights(sigma: float) -> tuple[np.ndarray, bool]:
     """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
-    (each weight times 1, plus zeros: exact; the kernel is symmetric)."""
+    (each weight times 1, plus zeros: exact; the kernel is symmetric), and whether ``ndimage.correlate1d`` takes them
+    as symmetric (each pair within the float64 epsilon: it then adds each pair before multiplying)."""
     radius = int(4.0 * sigma + 0.5)
     impulse = np.zeros(2 * radius + 1)
     impulse[radius] = 1.0
     weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
     weights.flags.writeable = False
-    return weights
+    eps = float(np.finfo(np.float64).eps)
+    return weights, bool(np.all(np.abs(weights[radius + 1 :] - weights[:radius][::-1]) <= eps))
+
+
+#: Weights that leave a line as it is (``crease_sigma`` 0: no smoothing), symmetric.
+_IDENTITY = (np.ones(1), True)
 
 
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
