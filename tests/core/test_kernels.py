@@ -1502,6 +1502,8 @@ def test_the_round_skin_and_the_waist_test_are_the_twins(monkeypatch):
     s = SegmentSettings(round_fruit=True)
     geo = _Geometry(600.0, 60.0, 80.0)
     owner = np.zeros((h, w), np.int16)
+    owner[20:30, 50:70] = 2  # another fruit's red pixels
+    depth[85:95, 50:70] -= 0.05  # a step in front
     sl = (slice(40, 80), slice(40, 80))
     fast, twin = _both(monkeypatch, _round_skin, sl, red[sl], _Depth(depth), color, geo, s, owner, 1)
     assert fast[0] == twin[0]
@@ -1509,7 +1511,7 @@ def test_the_round_skin_and_the_waist_test_are_the_twins(monkeypatch):
     grown = np.zeros((h, w), bool)
     grown[fast[0]] = fast[1]
     assert grown[60, 35] and grown[60, 79] and not grown[60, 84] and not grown[60, 88]  # not past the leaf
-    assert grown.sum() > 2 * red.sum()
+    assert grown.sum() > 2 * red.sum() and not grown[20:30, 50:70].any() and not grown[85:95, 50:70].any()
     two = ((yy - 60) ** 2 + (xx - 40) ** 2 <= 30**2) | ((yy - 60) ** 2 + (xx - 115) ** 2 <= 25**2)
     two |= (abs(yy - 60) <= 4) & (xx > 40) & (xx < 115)  # a neck 9 pixels wide
     edt = distance_transform(two)

@@ -2938,3 +2938,64 @@ def creases(filled: np.ndarray, weights: np.ndarray, symmetric: bool, region: np
             side += (smooth[r, _reflected(c - 1, w)] + smooth[r, _reflected(c + 1, w)]) * 1.0
             out[r, c] = down + side < limit
     return out
+
+
+@_njit
+def round_skin(
+    z: np.ndarray,
+    color: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    part: np.ndarray,
+    r0: int,
+    c0: int,
+    rc: float,
+    cc: float,
+    reach2: float,
+    deep_limit: float,
+    zm: float,
+    step: float,
+    jump: float,
+    leaf_hue: int,
+) -> np.ndarray:
+    """:func:`symfruit.segment.colour._round_skin`'s grown skin in its window at ``(r0, c0)`` (``z`` depth, ``color``
+    uint8, ``owner`` ids, ``part`` the red part, all (h, w)): the pixels 4-connected to the part's pixels within
+    ``jump`` of ``zm`` through pixels that are the part's or candidates (within ``reach2`` squared pixels of
+    ``(rc, cc)``, with depth within ``deep_limit`` of ``zm``, not leaf green, of no fruit but ``k``), none of them on
+    a step larger than ``step`` to a 4-neighbour; and the part. The twin's tests pixel by pixel (its squared
+    distances, differences and whole-number colour tests): the same pixels."""
+    h, w = z.shape
+    allowed = np.zeros((h, w), np.bool_)
+    seeds = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            zc = z[r, c]
+            if r > 0 and abs(z[r - 1, c] - zc) > step:
+                continue
+            if r + 1 < h and abs(z[r + 1, c] - zc) > step:
+                continue
+            if c > 0 and abs(z[r, c - 1] - zc) > step:
+                continue
+            if c + 1 < w and abs(z[r, c + 1] - zc) > step:
+                continue
+            if part[r, c]:
+                allowed[r, c] = True
+                seeds[r, c] = abs(zc - zm) <= jump
+                continue
+            if not (zc > 0 and abs(zc - zm) <= deep_limit and (owner[r, c] == 0 or owner[r, c] == k)):
+                continue
+            dy, dx = float(r + r0) - rc, float(c + c0) - cc
+            if dy * dy + dx * dx > reach2:
+                continue
+            red, green, blue = np.int64(color[r, c, 0]), np.int64(color[r, c, 1]), np.int64(color[r, c, 2])
+            if green > red and green >= blue:
+                over = green - min(red, blue)
+                if 3 * over >= green and 60 * (green - red) >= (leaf_hue - 60) * over:
+                    continue  # leaf green
+            allowed[r, c] = True
+    skin = flood(allowed, seeds)
+    for r in range(h):
+        for c in range(w):
+            if part[r, c]:
+                skin[r, c] = True
+    return skin

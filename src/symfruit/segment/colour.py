@@ -1547,23 +1547,27 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
-    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     z = depth[big]
     zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
-    free = (owner[big] == 0) | (owner[big] == k)
-    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
-    deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
-    # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
-    allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
-    seeds = part & (np.abs(z - zm) <= s.depth_jump)
-    if (jit := compiled()) is not None:  # the seeds' components alone, walked (:func:`symfruit.core._jit.flood`)
-        skin = jit.flood(allowed, seeds) | part
+    deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the seeds'
+        # components alone; issue 19, seventeenth round)
+        skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
+                              float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
+                              LEAF_HUE)  # fmt: skip
     else:
+        # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
+        yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
+        free = (owner[big] == 0) | (owner[big] == k)
+        near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+        deep = np.abs(z - zm) <= deep_limit
+        candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
+        # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
+        allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
+        seeds = part & (np.abs(z - zm) <= s.depth_jump)
         lab, n = ndimage.label(allowed)
         reached = np.zeros(n + 1, bool)
         reached[lab[seeds]] = True
