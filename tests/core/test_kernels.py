@@ -1619,3 +1619,27 @@ def test_the_correlation_and_the_creases_are_scipys(seed, n, sigma):
     np.testing.assert_array_equal(fast, twin)
     if sigma >= 2.0:
         assert fast[20:30, 38:42].any() and not fast[17:33, 14:30].any()  # the seam, not a cap's middle
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_segmenters_red_regions_are_the_twins(seed, window):
+    """Blobs of red over random colours, whole or a strided window: the same weak mask, labels, region sizes, seeds,
+    rows and columns (values and types) with the kernel and with the twins; several regions, some seeded."""
+    from symfruit.segment.colour import SegmentSettings, _red_regions
+
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (90, 120, 3), dtype=np.uint8)
+    yy, xx = np.mgrid[:90, :120]
+    for _ in range(6):
+        blob = (yy - rng.uniform(0, 90)) ** 2 + (xx - rng.uniform(0, 120)) ** 2 <= rng.uniform(3, 15) ** 2
+        image[blob] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), int(rng.integers(0, 90)))
+    c = image[5:80, 3:110:2] if window else image
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _red_regions, c, SegmentSettings())
+    assert fast is not None and twin is not None
+    assert fast[2] == twin[2] > 3 and fast[4].sum() >= 2
+    for a, b in zip(fast, twin, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)

@@ -2999,3 +2999,32 @@ def round_skin(
             if part[r, c]:
                 skin[r, c] = True
     return skin
+
+
+@_njit
+def red_regions(
+    c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
+    """:func:`symfruit.segment.colour._red_regions` of a window ``c`` (h, w, 3) uint8: its weak pixels' mask (h, w)
+    bool, their regions' labels (8-connected, :func:`label`) and count n, the weak and strong pixels' flat indices
+    (:func:`red_pixels`), the weak pixels' labels (int32), which regions hold a strong pixel and how many pixels each
+    has ((n + 1,), 0 the background's: none), and the weak pixels' rows and columns. The twin's values."""
+    h, w = c.shape[0], c.shape[1]
+    weak_at, strong_at = red_pixels(c, low, high, sqrt3, tan_hue)
+    mask = np.zeros((h, w), np.bool_)
+    for i in range(weak_at.shape[0]):
+        mask[weak_at[i] // w, weak_at[i] % w] = True
+    labels, n = label(mask, True)
+    lab = np.empty(weak_at.shape[0], np.int32)
+    rows = np.empty(weak_at.shape[0], np.int64)
+    cols = np.empty(weak_at.shape[0], np.int64)
+    sizes = np.zeros(n + 1, np.int64)
+    for i in range(weak_at.shape[0]):
+        rows[i], cols[i] = weak_at[i] // w, weak_at[i] % w
+        lab[i] = labels[rows[i], cols[i]]
+        sizes[lab[i]] += 1
+    seeded = np.zeros(n + 1, np.bool_)
+    for i in range(strong_at.shape[0]):
+        seeded[labels[strong_at[i] // w, strong_at[i] % w]] = True
+    seeded[0] = False
+    return mask, labels, n, weak_at, strong_at, lab, seeded, sizes, rows, cols

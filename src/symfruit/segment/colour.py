@@ -524,21 +524,11 @@ def _segment_at(
     for win in windows:
         # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
         # the weak pixels alone, not off every pixel of a window that may span most of the image
-        weak_at, strong_at = _red_pixels(c[win], s)
-        if len(weak_at) == 0:
+        found = _red_regions(c[win], s)
+        if found is None:
             continue
-        shape = (win[0].stop - win[0].start, win[1].stop - win[1].start)
-        weak_w = np.zeros(shape, bool)
-        weak_w.ravel()[weak_at] = True
+        weak_w, labels, n, lab, seeded, sizes, rows, cols = found
         weak[win] = weak_w
-        labels, n = _label(weak_w, eight=True)
-        flat = labels.ravel()
-        seeded = np.zeros(n + 1, bool)
-        seeded[flat.take(strong_at)] = True
-        seeded[0] = False
-        lab = flat.take(weak_at)
-        sizes = np.bincount(lab, minlength=n + 1)
-        rows, cols = np.divmod(weak_at, shape[1])
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
         if z is None:
             least: float | np.ndarray = min_area
@@ -646,6 +636,37 @@ def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
         return labels, int(n)
     labels, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
     return labels, int(n)
+
+
+def _red_regions(
+    cw: np.ndarray, s: SegmentSettings
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """A window's weakly red regions (8-connected): its weak pixels' mask (:func:`_red_pixels`), their labels and count
+    n, the weak pixels' labels (in raster order), which regions hold a strong pixel, each one's size ((n + 1,), the
+    background's 0 and unseeded), the weak pixels' rows and columns; None without a weak pixel. Where numba is, its
+    compiled twin gives the same (:func:`symfruit.core._jit.red_regions`: one call, not a dozen numpy ones on each of
+    a frame's windows; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3:
+        low, high = _red_tables(s.red_low, s.red_high, s.dark)
+        weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions(
+            cw, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
+        )
+        return None if len(weak_at) == 0 else (weak_w, labels, int(n), lab, seeded, sizes, rows, cols)
+    weak_at, strong_at = _red_pixels(cw, s)
+    if len(weak_at) == 0:
+        return None
+    shape = cw.shape[:2]
+    weak_w = np.zeros(shape, bool)
+    weak_w.ravel()[weak_at] = True
+    labels, n = _label(weak_w, eight=True)
+    flat = labels.ravel()
+    seeded = np.zeros(n + 1, bool)
+    seeded[flat.take(strong_at)] = True
+    seeded[0] = False
+    lab = flat.take(weak_at)
+    sizes = np.bincount(lab, minlength=n + 1)
+    rows, cols = np.divmod(weak_at, shape[1])
+    return weak_w, labels, n, lab, seeded, sizes, rows, cols
 
 
 def _too_many_pieces() -> InputError:
