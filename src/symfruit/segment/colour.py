@@ -524,10 +524,10 @@ def _segment_at(
     for win in windows:
         # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
         # the weak pixels alone, not off every pixel of a window that may span most of the image
-        found = _red_regions(c[win], s)
-        if found is None:
+        regions = _red_regions(c[win], s)
+        if regions is None:
             continue
-        weak_w, labels, n, lab, seeded, sizes, rows, cols = found
+        weak_w, labels, n, lab, seeded, sizes, rows, cols = regions
         weak[win] = weak_w
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
         if z is None:
