@@ -1679,3 +1679,245 @@ def test_extraction_is_the_twins(monkeypatch, seed):
     assert (fast.n_invalid, fast.n_border, fast.n_other_clusters) == (twin.n_invalid, twin.n_border,
                                                                        twin.n_other_clusters)  # fmt: skip
     assert len(fast.points) > 100
+
+
+# --- issue 19, seventeenth round: the colour segmenter --------------------------------------------------------------
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["speckle", "disc", "line", "pixel", "strided"]))
+def test_the_segmenters_hull_vertices_are_the_twins(seed, kind):
+    """Speckle of any density, a disc, a line (no hull), one pixel, a strided view: the monotone chain's vertices are
+    Qhull's, counter-clockwise from the least (y, x), and so is the filled hull, bit for bit."""
+    from symfruit.segment.colour import _hull_area, _hull_vertices, convex_hull_mask
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.001, 0.9)
+    if kind == "disc":
+        yy, xx = np.mgrid[:h, :w]
+        mask = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= rng.uniform(0.5, 40.0) ** 2
+    elif kind in ("line", "pixel"):
+        mask = np.zeros((h, w), bool)
+        mask[rng.integers(0, h), : rng.integers(1, w + 1) if kind == "line" else 1] = True
+        mask = mask.T.copy() if rng.random() < 0.5 else mask
+    elif kind == "strided":
+        mask = mask[:: int(rng.integers(1, 3)), :: int(rng.integers(2, 4))]
+    with pytest.MonkeyPatch.context() as mp:
+        v, v_twin = _both(mp, _hull_vertices, mask)
+        hull, hull_twin = _both(mp, convex_hull_mask, mask)
+        area, area_twin = _both(mp, _hull_area, mask)
+    assert (v is None) == (v_twin is None)
+    if kind in ("line", "pixel"):
+        assert v is None
+    if v is not None:
+        assert v.dtype == v_twin.dtype == np.float64
+        np.testing.assert_array_equal(v, v_twin)
+        assert (v[0, 1], v[0, 0]) == min((y, x) for x, y in v.tolist())  # the start: the least (y, x)
+        x, y = v[:, 0], v[:, 1]
+        assert np.dot(x, np.roll(y, -1)) - np.dot(y, np.roll(x, -1)) > 0  # counter-clockwise in (x, y)
+    np.testing.assert_array_equal(hull, hull_twin)
+    assert area == area_twin
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_segmenters_green_and_leaf_pixels_are_the_twins(seed, window):
+    """Random colours with green the largest channel as often as not, whole or a strided window: the same green and
+    leaf-green pixels, and some of each."""
+    from symfruit.segment.colour import _green, _leaf
+
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (70, 90, 3), dtype=np.uint8)
+    image[..., 1] = np.maximum(image[..., 1], rng.integers(0, 256, (70, 90)).astype(np.uint8))
+    c = image[3:60, 2:80:2] if window else image
+    with pytest.MonkeyPatch.context() as mp:
+        green, green_twin = _both(mp, _green, c)
+        leaf, leaf_twin = _both(mp, _leaf, c)
+    assert green.dtype == green_twin.dtype == leaf.dtype == leaf_twin.dtype == np.bool_
+    np.testing.assert_array_equal(green, green_twin)
+    np.testing.assert_array_equal(leaf, leaf_twin)
+    assert 0 < leaf.sum() < green.sum() < green.size
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.2, 0.8), st.floats(0.0, 0.05))
+def test_the_flood_is_the_labelling_of_the_seeds_components(seed, density, seeded):
+    """Random pixels allowed (clusters of every size) and seeds (some outside the allowed pixels): the flood is the
+    union of ``ndimage.label``'s components (4-connected) that hold a seed, bit for bit, and holds no seed outside."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    allowed = rng.random((h, w)) < density
+    seeds = rng.random((h, w)) < seeded
+    lab, n = ndimage.label(allowed)
+    held = np.zeros(n + 1, bool)
+    held[lab[seeds]] = True
+    held[0] = False
+    got = _jit.flood(allowed, seeds)
+    assert got.dtype == np.bool_
+    np.testing.assert_array_equal(got, held[lab])
+    assert not (got & ~allowed).any()
+
+
+def test_the_round_skin_and_the_waist_test_are_the_twins(monkeypatch):
+    """A red cap on a yellow apple, a leaf across it (the skin's flood stops there), and two discs joined by a
+    neck (the waist test's flood, below and above the neck's depth): the same skin and answers with the kernels and
+    with the twins, and the known ones."""
+    from symfruit.core.raster import distance_transform
+    from symfruit.segment.colour import SegmentSettings, _Depth, _Geometry, _round_skin, _separate
+
+    h, w = 120, 160
+    yy, xx = np.mgrid[:h, :w]
+    disc = (yy - 60) ** 2 + (xx - 70) ** 2 <= 40**2
+    depth = np.where(disc, 0.8 - 0.0004 * np.sqrt(np.maximum(40**2 - (yy - 60) ** 2 - (xx - 70) ** 2, 0)), 1.5)
+    color = np.zeros((h, w, 3), np.uint8)
+    color[disc] = (200, 180, 40)  # yellow skin
+    color[(yy - 60) ** 2 + (xx - 60) ** 2 <= 15**2] = (200, 30, 30)  # the red part
+    color[:, 82:86] = (40, 150, 40)  # a leaf over the skin
+    red = (yy - 60) ** 2 + (xx - 60) ** 2 <= 15**2
+    s = SegmentSettings(round_fruit=True)
+    geo = _Geometry(600.0, 60.0, 80.0)
+    owner = np.zeros((h, w), np.int16)
+    owner[20:30, 50:70] = 2  # another fruit's red pixels
+    depth[85:95, 50:70] -= 0.05  # a step in front
+    sl = (slice(40, 80), slice(40, 80))
+    fast, twin = _both(monkeypatch, _round_skin, sl, red[sl], _Depth(depth), color, geo, s, owner, 1)
+    assert fast[0] == twin[0]
+    np.testing.assert_array_equal(fast[1], twin[1])
+    grown = np.zeros((h, w), bool)
+    grown[fast[0]] = fast[1]
+    assert grown[60, 35] and grown[60, 79] and not grown[60, 84] and not grown[60, 88]  # not past the leaf
+    assert grown.sum() > 2 * red.sum() and not grown[20:30, 50:70].any() and not grown[85:95, 50:70].any()
+    two = ((yy - 60) ** 2 + (xx - 40) ** 2 <= 30**2) | ((yy - 60) ** 2 + (xx - 115) ** 2 <= 25**2)
+    two |= (abs(yy - 60) <= 4) & (xx > 40) & (xx < 115)  # a neck 9 pixels wide
+    edt = distance_transform(two)
+    centres = [(60, 40, float(edt[60, 40]), True)]
+    for t, want in ((6.0, True), (3.0, False), (27.0, True)):  # above the neck, below it, above the smaller peak
+        got = _both(monkeypatch, _separate, edt, (60, 115), centres, t, [5])
+        assert got == (want, want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000))
+def test_numpys_sum_and_variance_are_the_twins_bit_for_bit(seed, n):
+    """numpy's pairwise sum and variance of a strided column, every length from one lane to several blocks: the
+    same values bit for bit (the segmenter's sphere spread rests on them)."""
+    rng = np.random.default_rng(seed)
+    col = (rng.normal(size=(n, 3)) * rng.uniform(1e-3, 10.0) + rng.uniform(-5.0, 5.0))[:, int(rng.integers(0, 3))]
+    assert _jit._pairwise_sum(col, 0, n) + 0.0 == np.sum(col)
+    assert _jit._variance(col) == np.var(col)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 12), st.booleans())
+def test_the_segmenters_peaks_are_scipys(seed, radius, ties):
+    """A map of random depths (whole numbers: ties) on images smaller and larger than the square: the peaks are the
+    pixels at least ``least`` deep that ``ndimage.maximum_filter`` (mode "reflect") leaves as they are."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    edt = rng.uniform(0.0, 30.0, (h + 2, w + 2))
+    edt = np.floor(edt / 3.0) if ties else edt
+    edt = edt[1:-1, 1:-1]  # a view, as the segmenter's
+    least = float(rng.uniform(0.0, 6.0))
+    want = (edt >= ndimage.maximum_filter(edt, size=2 * radius + 1)) & (edt >= least)
+    np.testing.assert_array_equal(_jit.peaks(edt, radius, least), want)
+    assert want.any() or edt.max() < least
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_segmenters_centres_are_the_twins(monkeypatch, seed):
+    """Three to five overlapping discs of random sizes: the same centres with the kernels and with the twins, coarse
+    or not; and at least two."""
+    from symfruit.segment.colour import _centres
+
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:140, :200]
+    region = np.zeros((140, 200), bool)
+    for _ in range(int(rng.integers(3, 6))):
+        region |= (yy - rng.uniform(30, 110)) ** 2 + (xx - rng.uniform(30, 170)) ** 2 <= rng.uniform(12, 35) ** 2
+    for coarse, least in ((True, 10.0), (False, 4.0)):
+        fast, twin = _both(monkeypatch, _centres, region, least, 0.6, 0.9, coarse=coarse)
+        assert fast == twin
+        assert len(fast) >= 2
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.02, 0.9), st.booleans(), st.booleans())
+def test_the_labelling_is_scipys(seed, density, eight, strided):
+    """Random masks of every density, whole or a strided view, 4- or 8-connected: ``ndimage.label``'s labels (the
+    same numbers: by the first pixel in raster order) and count, int32."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _label
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    mask = rng.random((h, w)) < density
+    mask = mask[::2, 1::3] if strided else mask
+    want, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
+    got, m = _jit.label(mask, eight)
+    assert got.dtype == want.dtype == np.int32
+    np.testing.assert_array_equal(got, want)
+    assert m == n
+    with pytest.MonkeyPatch.context() as mp:
+        (fast, k), (twin, k_twin) = _both(mp, _label, mask, eight=eight)
+    np.testing.assert_array_equal(fast, twin)
+    assert k == k_twin == n
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.sampled_from([0.0, 0.7, 2.0, 3.3]))
+def test_the_correlation_and_the_creases_are_scipys(seed, n, sigma):
+    """scipy's ``correlate1d`` (mode "reflect") of lines shorter and longer than the weights, symmetric or not: the
+    same values bit for bit; and a noisy depth of two touching caps: the same creases with the kernel and the
+    twin (the Gaussian's smoothing, then the Laplacian), some of them along the seam."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import SegmentSettings, _creases, _gaussian_weights
+
+    rng = np.random.default_rng(seed)
+    line = rng.normal(size=n) * rng.uniform(0.01, 3.0)
+    for weights, symmetric in (_gaussian_weights(max(sigma, 0.5)), (rng.normal(size=int(rng.integers(1, 9))), False)):
+        out = np.empty(n)
+        _jit._correlate_line(line, weights, symmetric, out)
+        np.testing.assert_array_equal(out, ndimage.correlate1d(line, weights, mode="reflect"))
+    h, w = 50, 80
+    yy, xx = np.mgrid[:h, :w]
+    caps = np.minimum(np.hypot(yy - 25, xx - 22), np.hypot(yy - 25, xx - 58))
+    depth = 0.5 + 0.0003 * caps**2 + rng.normal(0.0, 0.0003, (h, w))
+    region = caps < 22
+    valid = region & (rng.random((h, w)) > 0.1)
+    s = SegmentSettings(crease_sigma=sigma)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _creases, region, depth, valid, 0.5, s, 600.0)
+    np.testing.assert_array_equal(fast, twin)
+    if sigma >= 2.0:
+        assert fast[20:30, 38:42].any() and not fast[17:33, 14:30].any()  # the seam, not a cap's middle
+
+
+@pytest.mark.parametrize("seed", range(4))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_segmenters_red_regions_are_the_twins(seed, window):
+    """Blobs of red over random colours, whole or a strided window: the same weak mask, labels, region sizes, seeds,
+    rows and columns (values and types) with the kernel and with the twins; several regions, some seeded."""
+    from symfruit.segment.colour import SegmentSettings, _red_regions
+
+    rng = np.random.default_rng(seed)
+    image = rng.integers(0, 256, (90, 120, 3), dtype=np.uint8)
+    yy, xx = np.mgrid[:90, :120]
+    for _ in range(6):
+        blob = (yy - rng.uniform(0, 90)) ** 2 + (xx - rng.uniform(0, 120)) ** 2 <= rng.uniform(3, 15) ** 2
+        image[blob] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), int(rng.integers(0, 90)))
+    c = image[5:80, 3:110:2] if window else image
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _red_regions, c, SegmentSettings())
+    assert fast is not None and twin is not None
+    assert fast[2] == twin[2] > 3 and fast[4].sum() >= 2
+    for a, b in zip(fast, twin, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)

@@ -2826,3 +2826,481 @@ def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarr
             out[k, 0], out[k, 1], out[k, 2] = p[i, 0], p[i, 1], p[i, 2]
             k += 1
     return out
+
+
+# --- issue 19, seventeenth round: the colour segmenter ------------------------------------------------------------
+
+
+@_njit
+def hull_vertices(mask: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.segment.colour._hull_vertices` of a 2-d bool ``mask``: (m, 2) float64 ``(x, y)`` vertices of
+    the convex hull of its rows' end pixels (every pixel's hull), counter-clockwise in ``(x, y)`` and starting at the
+    least ``(y, x)`` (the first row's first pixel), without vertices in the middle of an edge: the vertices that the
+    twin's Qhull gives, rolled to that start. Andrew's monotone chain on the row ends, which come sorted by ``(y, x)``;
+    its cross products in whole numbers. A (0, 2) array where the hull is degenerate (fewer than three vertices:
+    the twin's None)."""
+    h, w = mask.shape
+    pts = np.empty((2 * h, 2), np.int64)  # (y, x) of the row ends, sorted
+    n = 0
+    for r in range(h):
+        first = -1
+        for c in range(w):
+            if mask[r, c]:
+                first = c
+                break
+        if first < 0:
+            continue
+        last = first
+        for c in range(w - 1, first, -1):
+            if mask[r, c]:
+                last = c
+                break
+        pts[n, 0], pts[n, 1] = r, first
+        n += 1
+        if last != first:
+            pts[n, 0], pts[n, 1] = r, last
+            n += 1
+    if n < 3:
+        return np.empty((0, 2))
+    chain = np.empty((2 * n + 1, 2), np.int64)
+    k = 0
+    for i in range(n):  # one side, then the other (counter-clockwise in (y, x): clockwise in (x, y))
+        while k >= 2 and ((chain[k - 1, 0] - chain[k - 2, 0]) * (pts[i, 1] - chain[k - 2, 1])
+                          - (chain[k - 1, 1] - chain[k - 2, 1]) * (pts[i, 0] - chain[k - 2, 0])) <= 0:  # fmt: skip
+            k -= 1
+        chain[k, 0], chain[k, 1] = pts[i, 0], pts[i, 1]
+        k += 1
+    lower = k + 1
+    for i in range(n - 2, -1, -1):
+        while k >= lower and ((chain[k - 1, 0] - chain[k - 2, 0]) * (pts[i, 1] - chain[k - 2, 1])
+                              - (chain[k - 1, 1] - chain[k - 2, 1]) * (pts[i, 0] - chain[k - 2, 0])) <= 0:  # fmt: skip
+            k -= 1
+        chain[k, 0], chain[k, 1] = pts[i, 0], pts[i, 1]
+        k += 1
+    m = k - 1  # the chain ends where it began
+    if m < 3:
+        return np.empty((0, 2))
+    out = np.empty((m, 2))
+    out[0, 0], out[0, 1] = float(chain[0, 1]), float(chain[0, 0])
+    for j in range(1, m):  # reversed, from the same start: counter-clockwise in (x, y)
+        out[j, 0], out[j, 1] = float(chain[m - j, 1]), float(chain[m - j, 0])
+    return out
+
+
+@_njit
+def green_pixels(c: np.ndarray, leaf_hue: int) -> np.ndarray:
+    """:func:`symfruit.segment.colour._green` of ``c`` (h, w, 3) uint8 (a window of an image, any strides): (h, w) bool,
+    green the largest channel and a third above the smallest; with ``leaf_hue`` >= 0 also of a hue of at least that
+    many degrees (:func:`symfruit.segment.colour._leaf`: ``60 (G - R) >= (leaf_hue - 60) (G - min(R, B))``). The
+    twin's tests on the same whole numbers: the same pixels."""
+    h, w = c.shape[0], c.shape[1]
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for q in range(w):
+            red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+            if green <= red or green < blue:
+                continue
+            over = green - min(red, blue)
+            if 3 * over >= green and (leaf_hue < 0 or 60 * (green - red) >= (leaf_hue - 60) * over):
+                out[r, q] = True
+    return out
+
+
+@_njit
+def flood(allowed: np.ndarray, seeds: np.ndarray) -> np.ndarray:
+    """(h, w) bool: the pixels of ``allowed`` (h, w) bool 4-connected (through ``allowed``) to a pixel of ``seeds``
+    (h, w) bool that is itself allowed: the union of the components of ``ndimage.label(allowed)`` that hold a seed
+    (the segmenter's twins label the window and read the seeds' labels). A depth-first walk over those components
+    alone, each pixel pushed once."""
+    h, w = allowed.shape
+    out = np.zeros((h, w), np.bool_)
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(h):
+        for c in range(w):
+            if seeds[r, c] and allowed[r, c] and not out[r, c]:
+                out[r, c] = True
+                stack[top] = r * w + c
+                top += 1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        if r > 0 and allowed[r - 1, c] and not out[r - 1, c]:
+            out[r - 1, c] = True
+            stack[top] = (r - 1) * w + c
+            top += 1
+        if r + 1 < h and allowed[r + 1, c] and not out[r + 1, c]:
+            out[r + 1, c] = True
+            stack[top] = (r + 1) * w + c
+            top += 1
+        if c > 0 and allowed[r, c - 1] and not out[r, c - 1]:
+            out[r, c - 1] = True
+            stack[top] = r * w + c - 1
+            top += 1
+        if c + 1 < w and allowed[r, c + 1] and not out[r, c + 1]:
+            out[r, c + 1] = True
+            stack[top] = r * w + c + 1
+            top += 1
+    return out
+
+
+@_njit
+def _pairwise_block(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's ``pairwise_sum`` of one block ``a[lo:lo + n]`` (n <= 128): below 8 values one by one from 0, else
+    in eight lanes, the lanes summed pairwise, then the rest one by one."""
+    if n < 8:
+        res = 0.0
+        for i in range(n):
+            res += a[lo + i]
+        return res
+    r0, r1, r2, r3 = a[lo], a[lo + 1], a[lo + 2], a[lo + 3]
+    r4, r5, r6, r7 = a[lo + 4], a[lo + 5], a[lo + 6], a[lo + 7]
+    i = 8
+    while i < n - (n % 8):
+        r0 += a[lo + i]
+        r1 += a[lo + i + 1]
+        r2 += a[lo + i + 2]
+        r3 += a[lo + i + 3]
+        r4 += a[lo + i + 4]
+        r5 += a[lo + i + 5]
+        r6 += a[lo + i + 6]
+        r7 += a[lo + i + 7]
+        i += 8
+    res = ((r0 + r1) + (r2 + r3)) + ((r4 + r5) + (r6 + r7))
+    while i < n:
+        res += a[lo + i]
+        i += 1
+    return res
+
+
+@_njit
+def _pairwise_sum(a: np.ndarray, lo: int, n: int) -> float:
+    """numpy's sum of ``a[lo:lo + n]`` (float64, any stride) in its order: blocks of at most 128
+    (:func:`_pairwise_block`), a longer run split at half its length rounded down to a multiple of 8 and the two
+    halves' sums added (numpy's recursive ``pairwise_sum``, walked here with a stack: numba's cache does not keep a
+    recursive function); ``np.sum`` of a 1-d float64 array starts from 0 and adds this. The same value bit for bit."""
+    if n <= 128:
+        return _pairwise_block(a, lo, n)
+    los = np.empty(64, np.int64)
+    ns = np.empty(64, np.int64)
+    state = np.zeros(64, np.int64)
+    vals = np.empty(64)
+    top, nv = 0, 0
+    los[0], ns[0], state[0] = lo, n, 0
+    top = 1
+    while top > 0:
+        k = top - 1
+        m = ns[k]
+        if m <= 128:
+            vals[nv] = _pairwise_block(a, los[k], m)
+            nv += 1
+            top -= 1
+            continue
+        half = m // 2
+        half -= half % 8
+        if state[k] == 0:  # the left half first
+            state[k] = 1
+            los[top], ns[top], state[top] = los[k], half, 0
+            top += 1
+        elif state[k] == 1:  # then the right
+            state[k] = 2
+            los[top], ns[top], state[top] = los[k] + half, m - half, 0
+            top += 1
+        else:  # both summed: left + right
+            vals[nv - 2] = vals[nv - 2] + vals[nv - 1]
+            nv -= 1
+            top -= 1
+    return vals[0]
+
+
+@_njit
+def _variance(a: np.ndarray) -> float:
+    """``np.var(a)`` of a 1-d float64 array (n >= 1): the mean by numpy's sum over n, the squared deviations summed
+    as numpy sums them, over n. The same value bit for bit."""
+    n = a.shape[0]
+    mean = (0.0 + _pairwise_sum(a, 0, n)) / n
+    dev = np.empty(n)
+    for i in range(n):
+        d = a[i] - mean
+        dev[i] = d * d
+    return (0.0 + _pairwise_sum(dev, 0, n)) / n
+
+
+@_njit
+def sphere_points(
+    mask: np.ndarray, depth: np.ndarray, r0: int, c0: int, cx: float, cy: float, focal: float, most: int
+) -> tuple[np.ndarray, float]:  # fmt: skip
+    """:func:`symfruit.segment.colour._sphere` up to its first fit: the points of :func:`window_points` and their
+    spread (``sqrt(2 (var x + var y))``, numpy's variances), the points within twice the spread of their median depth
+    kept; none (and spread 0) with fewer than 20 points. The same points and spread, bit for bit."""
+    p = window_points(mask, depth, r0, c0, cx, cy, focal, most)
+    n = p.shape[0]
+    if n < 20:
+        return np.empty((0, 3)), 0.0
+    spread = math.sqrt(_variance(p[:, 0]) + _variance(p[:, 1])) * math.sqrt(2.0)
+    zm = _median_of(p[:, 2].copy())
+    keep = 0
+    for i in range(n):
+        keep += abs(p[i, 2] - zm) <= 2.0 * spread
+    out = np.empty((keep, 3))
+    k = 0
+    for i in range(n):
+        if abs(p[i, 2] - zm) <= 2.0 * spread:
+            out[k, 0], out[k, 1], out[k, 2] = p[i, 0], p[i, 1], p[i, 2]
+            k += 1
+    return out, spread
+
+
+@_njit
+def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._centres`' peaks of a distance map ``edt`` (h, w) float64: (h, w) bool, the
+    pixels at least ``least`` deep and as deep as every pixel of the ``2 radius + 1`` square about them, the square
+    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). The largest
+    of each row's stretch, then of each column's: maxima are exact, the same pixels."""
+    h, w = edt.shape
+    rows = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            best = edt[r, max(c - radius, 0)]
+            for q in range(max(c - radius, 0) + 1, min(c + radius, w - 1) + 1):
+                best = max(best, edt[r, q])
+            rows[r, c] = best
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if edt[r, c] < least:
+                continue
+            best = rows[max(r - radius, 0), c]
+            for q in range(max(r - radius, 0) + 1, min(r + radius, h - 1) + 1):
+                best = max(best, rows[q, c])
+            out[r, c] = edt[r, c] >= best
+    return out
+
+
+@_njit
+def _find(parent: np.ndarray, i: int) -> int:
+    """The root of ``i`` in a union-find forest, the path halved on the way."""
+    while parent[i] != i:
+        parent[i] = parent[parent[i]]
+        i = parent[i]
+    return i
+
+
+@_njit
+def _union(parent: np.ndarray, a: int, b: int) -> int:
+    """Join the trees of ``a`` and ``b`` under the smaller root; that root."""
+    a, b = _find(parent, a), _find(parent, b)
+    if a == b:
+        return a
+    if b < a:
+        a, b = b, a
+    parent[b] = a
+    return a
+
+
+@_njit
+def label(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int]:
+    """``ndimage.label(mask)`` of a 2-d bool ``mask`` (``eight``: ``structure=np.ones((3, 3))``, else the
+    4-neighbourhood): (h, w) int32 labels 1..n numbered by their first pixel in raster order, as scipy numbers them,
+    and n. One raster pass joining each pixel with its labelled neighbours above and to the left (union-find; with
+    eight neighbours the one above joins all three of the others already, else the left and upper-left ones are
+    joined and the upper-right one may join them), one numbering the roots in the order their first pixels come."""
+    h, w = mask.shape
+    out = np.zeros((h, w), np.int32)
+    parent = np.empty(h * w + 1, np.int64)
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if not mask[r, c]:
+                continue
+            up = out[r - 1, c] if r > 0 else 0
+            left = out[r, c - 1] if c > 0 else 0
+            own = 0
+            if eight:
+                if up:
+                    own = up
+                else:
+                    own = left if left else (out[r - 1, c - 1] if r > 0 and c > 0 else 0)
+                    right = out[r - 1, c + 1] if r > 0 and c + 1 < w else 0
+                    if right:
+                        own = _union(parent, own, right) if own else right
+            elif up and left:
+                own = _union(parent, up, left) if up != left else up
+            else:
+                own = up if up else left
+            if own == 0:
+                n += 1
+                parent[n] = n
+                own = n
+            out[r, c] = own
+    final = np.zeros(n + 1, np.int32)
+    m = 0
+    for r in range(h):
+        for c in range(w):
+            if out[r, c] == 0:
+                continue
+            root = _find(parent, out[r, c])
+            if final[root] == 0:
+                m += 1
+                final[root] = m
+            out[r, c] = final[root]
+    return out, m
+
+
+@_njit
+def _reflected(i: int, n: int) -> int:
+    """The index that ``i`` reads in a line of ``n`` values extended by scipy's "reflect" mode (d c b a | a b c d |
+    d c b a: the edge value repeated)."""
+    if n == 1:
+        return 0
+    i %= 2 * n
+    return i if i < n else 2 * n - 1 - i
+
+
+@_njit
+def _correlate_line(line: np.ndarray, weights: np.ndarray, symmetric: bool, out: np.ndarray) -> None:
+    """``ndimage.correlate1d`` of one line (mode "reflect", origin 0) into ``out``, in scipy's order: the line
+    extended by reflection into a buffer, then for symmetric weights (of odd length) the middle product, then each
+    pair of values the same distance either side added and times their weight, outermost first; else the last
+    product, then each product from the first on."""
+    n = line.shape[0]
+    size = weights.shape[0]
+    half = size // 2
+    last = size - half - 1
+    ext = np.empty(n + half + last)
+    for i in range(-half, n + last):
+        ext[i + half] = line[_reflected(i, n)]
+    for k in range(n):
+        at = k + half
+        if symmetric:
+            acc = ext[at] * weights[half]
+            for j in range(-half, 0):
+                acc += (ext[at + j] + ext[at - j]) * weights[half + j]
+        else:
+            acc = ext[at + last] * weights[half + last]
+            for j in range(-half, last):
+                acc += ext[at + j] * weights[half + j]
+        out[k] = acc
+
+
+@_njit
+def creases(filled: np.ndarray, weights: np.ndarray, symmetric: bool, region: np.ndarray, limit: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._creases` from the gap-filled depth ``filled`` (h, w) float64: the pixels of
+    ``region`` where the Laplacian (``ndimage.laplace``'s second differences, rows' plus columns') of the depth
+    smoothed by ``weights`` (:func:`~symfruit.segment.colour._gaussian`'s, along the rows then the columns;
+    ``symmetric`` as scipy finds them) lies below ``limit``. scipy's correlations in scipy's order (mode "reflect"):
+    the same values and pixels, the Laplacian worked out on the region's pixels alone."""
+    h, w = filled.shape
+    across = np.empty((h, w))
+    line = np.empty(h)
+    done = np.empty(h)
+    for c in range(w):  # along axis 0
+        for r in range(h):
+            line[r] = filled[r, c]
+        _correlate_line(line, weights, symmetric, done)
+        for r in range(h):
+            across[r, c] = done[r]
+    smooth = np.empty((h, w))
+    for r in range(h):  # along axis 1
+        _correlate_line(across[r], weights, symmetric, smooth[r])
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if not region[r, c]:
+                continue
+            down = smooth[r, c] * -2.0
+            down += (smooth[_reflected(r - 1, h), c] + smooth[_reflected(r + 1, h), c]) * 1.0
+            side = smooth[r, c] * -2.0
+            side += (smooth[r, _reflected(c - 1, w)] + smooth[r, _reflected(c + 1, w)]) * 1.0
+            out[r, c] = down + side < limit
+    return out
+
+
+@_njit
+def round_skin(
+    z: np.ndarray,
+    color: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    part: np.ndarray,
+    r0: int,
+    c0: int,
+    rc: float,
+    cc: float,
+    reach2: float,
+    deep_limit: float,
+    zm: float,
+    step: float,
+    jump: float,
+    leaf_hue: int,
+) -> np.ndarray:
+    """:func:`symfruit.segment.colour._round_skin`'s grown skin in its window at ``(r0, c0)`` (``z`` depth, ``color``
+    uint8, ``owner`` ids, ``part`` the red part, all (h, w)): the pixels 4-connected to the part's pixels within
+    ``jump`` of ``zm`` through pixels that are the part's or candidates (within ``reach2`` squared pixels of
+    ``(rc, cc)``, with depth within ``deep_limit`` of ``zm``, not leaf green, of no fruit but ``k``), none of them on
+    a step larger than ``step`` to a 4-neighbour; and the part. The twin's tests pixel by pixel (its squared
+    distances, differences and whole-number colour tests): the same pixels."""
+    h, w = z.shape
+    allowed = np.zeros((h, w), np.bool_)
+    seeds = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            zc = z[r, c]
+            if r > 0 and abs(z[r - 1, c] - zc) > step:
+                continue
+            if r + 1 < h and abs(z[r + 1, c] - zc) > step:
+                continue
+            if c > 0 and abs(z[r, c - 1] - zc) > step:
+                continue
+            if c + 1 < w and abs(z[r, c + 1] - zc) > step:
+                continue
+            if part[r, c]:
+                allowed[r, c] = True
+                seeds[r, c] = abs(zc - zm) <= jump
+                continue
+            if not (zc > 0 and abs(zc - zm) <= deep_limit and (owner[r, c] == 0 or owner[r, c] == k)):
+                continue
+            dy, dx = float(r + r0) - rc, float(c + c0) - cc
+            if dy * dy + dx * dx > reach2:
+                continue
+            red, green, blue = np.int64(color[r, c, 0]), np.int64(color[r, c, 1]), np.int64(color[r, c, 2])
+            if green > red and green >= blue:
+                over = green - min(red, blue)
+                if 3 * over >= green and 60 * (green - red) >= (leaf_hue - 60) * over:
+                    continue  # leaf green
+            allowed[r, c] = True
+    skin = flood(allowed, seeds)
+    for r in range(h):
+        for c in range(w):
+            if part[r, c]:
+                skin[r, c] = True
+    return skin
+
+
+@_njit
+def red_regions(
+    c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
+    """:func:`symfruit.segment.colour._red_regions` of a window ``c`` (h, w, 3) uint8: its weak pixels' mask (h, w)
+    bool, their regions' labels (8-connected, :func:`label`) and count n, the weak and strong pixels' flat indices
+    (:func:`red_pixels`), the weak pixels' labels (int32), which regions hold a strong pixel and how many pixels each
+    has ((n + 1,), 0 the background's: none), and the weak pixels' rows and columns. The twin's values."""
+    h, w = c.shape[0], c.shape[1]
+    weak_at, strong_at = red_pixels(c, low, high, sqrt3, tan_hue)
+    mask = np.zeros((h, w), np.bool_)
+    for i in range(weak_at.shape[0]):
+        mask[weak_at[i] // w, weak_at[i] % w] = True
+    labels, n = label(mask, True)
+    lab = np.empty(weak_at.shape[0], np.int32)
+    rows = np.empty(weak_at.shape[0], np.int64)
+    cols = np.empty(weak_at.shape[0], np.int64)
+    sizes = np.zeros(n + 1, np.int64)
+    for i in range(weak_at.shape[0]):
+        rows[i], cols[i] = weak_at[i] // w, weak_at[i] % w
+        lab[i] = labels[rows[i], cols[i]]
+        sizes[lab[i]] += 1
+    seeded = np.zeros(n + 1, np.bool_)
+    for i in range(strong_at.shape[0]):
+        seeded[labels[strong_at[i] // w, strong_at[i] % w]] = True
+    seeded[0] = False
+    return mask, labels, n, weak_at, strong_at, lab, seeded, sizes, rows, cols

@@ -250,12 +250,7 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
 
 def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray]:
     """The flat indices (ascending) of :func:`ripe_seeds`' weak and strong pixels of a checked colour image."""
-    # redness >= t  <=>  max(G, B) <= (1 - t) R: compare against per-R look-up tables (integers only)
-    levels = np.arange(256, dtype=np.float64)
-    low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
-    high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
-    low[: s.dark + 1] = -1  # dark pixels are never red
-    high[: s.dark + 1] = -1
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
     if (jit := compiled()) is not None and c.dtype == np.uint8 and c.ndim == 3 and c.shape[2] == 3:
         # the compiled twin of what follows (:func:`symfruit.core._jit.red_pixels`: the same pixels; issue 19, sixteenth
         # round), on the window as it is
@@ -277,6 +272,20 @@ def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarr
     rs, gs, bs = rw.take(keep), rgb[:, 1].take(keep), rgb[:, 2].take(keep)
     hue = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
     return at, at.take(keep)[hue]
+
+
+@functools.lru_cache(maxsize=16)
+def _red_tables(red_low: float, red_high: float, dark: int) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_red_pixels`' look-up tables, (256,) int16 each, read-only: redness >= t  <=>  max(G, B) <= (1 - t) R,
+    compared against per-R tables (integers only); worked out once per setting, not for each of a frame's windows."""
+    levels = np.arange(256, dtype=np.float64)
+    low = np.floor((1.0 - red_low) * levels + 1e-9).astype(np.int16)
+    high = np.floor((1.0 - red_high) * levels + 1e-9).astype(np.int16)
+    low[: dark + 1] = -1  # dark pixels are never red
+    high[: dark + 1] = -1
+    low.flags.writeable = False
+    high.flags.writeable = False
+    return low, high
 
 
 def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
@@ -310,7 +319,15 @@ def _hull_mask(vertices: np.ndarray | None, mask: np.ndarray) -> np.ndarray:
 
 
 def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
-    """(m, 2) float (x, y) vertices of the convex hull of the mask's pixels; None when degenerate."""
+    """(m, 2) float (x, y) vertices of the convex hull of the mask's pixels, counter-clockwise from the least
+    ``(y, x)``; None when degenerate. Where numba is, its compiled twin gives the same vertices
+    (:func:`symfruit.core._jit.hull_vertices`, a monotone chain on the row ends: no Qhull call, some 0.2 ms each;
+    issue 19, seventeenth round). Qhull's vertices are rolled to that start (it starts anywhere): the reported
+    hull is the same polygon from any start, and a hull's area (:func:`_hull_area_of`) sums its perimeter in
+    this order."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        v = jit.hull_vertices(mask)
+        return v if len(v) else None
     from scipy.spatial import ConvexHull, QhullError
 
     rows = np.flatnonzero(mask.any(axis=1))
@@ -324,9 +341,11 @@ def _hull_vertices(mask: np.ndarray) -> np.ndarray | None:
     if len(rows) < 2 and np.all(first == last):
         return None
     try:
-        return pts[ConvexHull(pts).vertices]
+        v = pts[ConvexHull(pts).vertices]  # counter-clockwise in (x, y), from any vertex
     except QhullError:  # all on a line
         return None
+    start = int(np.lexsort((v[:, 0], v[:, 1]))[0])
+    return np.concatenate((v[start:], v[:start]))
 
 
 def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
@@ -505,21 +524,11 @@ def _segment_at(
     for win in windows:
         # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
         # the weak pixels alone, not off every pixel of a window that may span most of the image
-        weak_at, strong_at = _red_pixels(c[win], s)
-        if len(weak_at) == 0:
+        regions = _red_regions(c[win], s)
+        if regions is None:
             continue
-        shape = (win[0].stop - win[0].start, win[1].stop - win[1].start)
-        weak_w = np.zeros(shape, bool)
-        weak_w.ravel()[weak_at] = True
+        weak_w, labels, n, lab, seeded, sizes, rows, cols = regions
         weak[win] = weak_w
-        labels, n = ndimage.label(weak_w, structure=np.ones((3, 3), bool))
-        flat = labels.ravel()
-        seeded = np.zeros(n + 1, bool)
-        seeded[flat.take(strong_at)] = True
-        seeded[0] = False
-        lab = flat.take(weak_at)
-        sizes = np.bincount(lab, minlength=n + 1)
-        rows, cols = np.divmod(weak_at, shape[1])
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
         if z is None:
             least: float | np.ndarray = min_area
@@ -617,6 +626,49 @@ def _segment_at(
     return out
 
 
+def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
+    """``ndimage.label(mask)`` of a 2-d bool mask (``eight``: with ``structure=np.ones((3, 3))``): int32 labels
+    numbered by their first pixels in raster order, and their number. Where numba is, its compiled twin gives the
+    same labels (:func:`symfruit.core._jit.label`, union-find; issue 19, seventeenth round): scipy's call costs more
+    than the labelling on the segmenter's small windows."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        labels, n = jit.label(mask, eight)
+        return labels, int(n)
+    labels, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
+    return labels, int(n)
+
+
+def _red_regions(
+    cw: np.ndarray, s: SegmentSettings
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
+    """A window's weakly red regions (8-connected): its weak pixels' mask (:func:`_red_pixels`), their labels and count
+    n, the weak pixels' labels (in raster order), which regions hold a strong pixel, each one's size ((n + 1,), the
+    background's 0 and unseeded), the weak pixels' rows and columns; None without a weak pixel. Where numba is, its
+    compiled twin gives the same (:func:`symfruit.core._jit.red_regions`: one call, not a dozen numpy ones on each of
+    a frame's windows; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3:
+        low, high = _red_tables(s.red_low, s.red_high, s.dark)
+        weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions(
+            cw, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
+        )
+        return None if len(weak_at) == 0 else (weak_w, labels, int(n), lab, seeded, sizes, rows, cols)
+    weak_at, strong_at = _red_pixels(cw, s)
+    if len(weak_at) == 0:
+        return None
+    shape = cw.shape[:2]
+    weak_w = np.zeros(shape, bool)
+    weak_w.ravel()[weak_at] = True
+    labels, n = _label(weak_w, eight=True)
+    flat = labels.ravel()
+    seeded = np.zeros(n + 1, bool)
+    seeded[flat.take(strong_at)] = True
+    seeded[0] = False
+    lab = flat.take(weak_at)
+    sizes = np.bincount(lab, minlength=n + 1)
+    rows, cols = np.divmod(weak_at, shape[1])
+    return weak_w, labels, n, lab, seeded, sizes, rows, cols
+
+
 def _too_many_pieces() -> InputError:
     return InputError(f"the colour segmenter found more than {MAX_PIECES:,} red pieces; at most {MAX_PIECES:,} are "
                       "joined into fruit (a picture of noise, or a red backdrop?)")  # fmt: skip
@@ -637,7 +689,7 @@ def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.n
     strong, weak = ripe_seeds(c[::COARSE_STEP, ::COARSE_STEP], s)
     if not weak.any():
         return None
-    lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    lab, n = _label(weak, eight=True)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     sizes[0] = 0
     seeded = np.zeros(n + 1, bool)
@@ -717,7 +769,10 @@ def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
 
 def _green(color: np.ndarray) -> np.ndarray:
     """(h, w) bool: green pixels (calyx, leaves, stems): green the largest channel, and saturated (a third
-    above the smallest; a grey-green backdrop is not)."""
+    above the smallest; a grey-green backdrop is not). Where numba is, its compiled twin gives the same pixels
+    (:func:`symfruit.core._jit.green_pixels`; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return jit.green_pixels(color, -1)
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     return (g > r) & (g >= b) & (3 * (g - np.minimum(r, b)) >= g)
 
@@ -727,7 +782,10 @@ def _leaf(color: np.ndarray) -> np.ndarray:
     yellow-green fruit skin (a bicoloured apple's ground colour) is green by :func:`_green` but yellower.
     With G the largest channel, the hue is ``60 + 60 (G - R) / (G - min(R, B))`` degrees (above 120 when
     B > R), so hue >= LEAF_HUE is ``60 (G - R) >= (LEAF_HUE - 60) (G - min(R, B))``: integers, independent of
-    brightness and saturation."""
+    brightness and saturation. Where numba is, its compiled twin gives the same pixels
+    (:func:`symfruit.core._jit.green_pixels`; issue 19, seventeenth round)."""
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return jit.green_pixels(color, LEAF_HUE)
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     over = g - np.minimum(r, b)  # the channels cast once for both tests (as _green casts them)
     green = (g > r) & (g >= b) & (3 * over >= g)
@@ -878,7 +936,6 @@ def _merge(
     serial = len(pieces)
     apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
     surfaces: dict[int, _Surface] = {}  # each piece's sphere fit and points, worked out once per piece, not per pair
-    green: np.ndarray | None = None  # _green of the image, once (pixel by pixel: the same as of each window)
     merged = True
     while merged and len(pieces) > 1:
         merged = False
@@ -901,8 +958,7 @@ def _merge(
                     continue
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    green = _green(color) if green is None else green
-                    hull -= float((_hull_mask(vertices, union) & ~union & green[window]).sum())
+                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s, surfaces) is not False
                 ):
@@ -1069,7 +1125,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     that the edges enclose goes whole to the fruit holding most of it (when one holds at least
     :data:`EDGE_PURITY` of it), and the edge pixels to the nearest piece. A front fruit's rim, not a straight
     line through the one behind, then separates them."""
-    pieces, n = ndimage.label(region & ~edges)
+    pieces, n = _label(region & ~edges)
     if n < 2:
         return parts
     owner = np.zeros(region.shape, np.int64)
@@ -1117,7 +1173,10 @@ def _centres(
     if float(edt.max()) < least:
         return []
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
-    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.peaks`; seventeenth round)
+        peaks = jit.peaks(edt, int(least), float(least))
+    else:
+        peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
     pr, pc = np.nonzero(peaks)
     order = np.argsort(-edt[pr, pc], kind="stable")
     centres: list[tuple[int, int, float, bool]] = []
@@ -1263,12 +1322,17 @@ def _sphere(
     the window at ``origin`` (algebraic least squares, once more without the points far off it); None
     with fewer than 20 points or when the fit is not a fruit-like cap (its radius off the points' own
     spread by more than 4x either way)."""
-    p = _points(mask, depth, geo, origin, most)
-    if len(p) < 20:
-        return None
-    z = p[:, 2]
-    spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
-    p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+    if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
+        # the same points and spread (:func:`symfruit.core._jit.sphere_points`; issue 19, seventeenth round)
+        p, spread = jit.sphere_points(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
+                                      float(geo.focal), int(most))  # fmt: skip
+    else:
+        p = _points(mask, depth, geo, origin, most)
+        if len(p) < 20:
+            return None
+        z = p[:, 2]
+        spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
+        p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
     centre, radius = np.zeros(3), 0.0
     for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
         if len(p) < 20:
@@ -1304,7 +1368,15 @@ def _separate(
     if budget[0] <= 0:
         return False
     budget[0] -= 1
-    deep = ndimage.label(edt > t)[0]
+    above = edt > t
+    if (jit := compiled()) is not None:  # p's component alone, walked (:func:`symfruit.core._jit.flood`)
+        if not above[p]:  # labelled 0 below: another component than every centre above t
+            return all(bool(above[a, b]) for a, b, _, _ in centres)
+        seed = np.zeros(above.shape, bool)
+        seed[p] = True
+        reached = jit.flood(above, seed)
+        return not any(reached[a, b] for a, b, _, _ in centres)
+    deep = ndimage.label(above)[0]
     return all(deep[a, b] != deep[p] for a, b, _, _ in centres)
 
 
@@ -1314,7 +1386,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
-    deep, _ = ndimage.label(edt > loose * float(cen[:, 2].min()))
+    deep, _ = _label(edt > loose * float(cen[:, 2].min()))
     rows, cols = np.nonzero(deep)
     power = (rows[:, None] - cen[None, :, 0]) ** 2 + (cols[:, None] - cen[None, :, 1]) ** 2 - cen[None, :, 2] ** 2
     near = np.argmin(power, axis=1)
@@ -1358,6 +1430,9 @@ def _creases(
     if valid.sum() < 20:
         return np.zeros(region.shape, bool)
     filled = np.take(np.ascontiguousarray(depth).ravel(), nearest_index(~valid))
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.creases`; seventeenth round)
+        weights, symmetric = _gaussian_weights(float(s.crease_sigma)) if s.crease_sigma > 0 else _IDENTITY
+        return jit.creases(filled, weights, symmetric, region, -s.crease_curvature * (zm / focal) ** 2)
     smooth = _gaussian(filled, s.crease_sigma) if s.crease_sigma > 0 else filled
     lap = ndimage.correlate1d(smooth, _SECOND, 0)  # ndimage.laplace's sum, without its call's overhead
     lap += ndimage.correlate1d(smooth, _SECOND, 1)
@@ -1372,21 +1447,27 @@ def _gaussian(image: np.ndarray, sigma: float) -> np.ndarray:
     """``ndimage.gaussian_filter(image, sigma)`` of a float64 image, the same values: its weights worked out once per
     ``sigma`` (:func:`_gaussian_weights`), not on every call (a polynomial's set-up and evaluation, some 40 us a call
     on these small windows), then the two passes it makes, rows then columns, the second in place."""
-    weights = _gaussian_weights(float(sigma))
+    weights = _gaussian_weights(float(sigma))[0]
     out = ndimage.correlate1d(image, weights, 0)
     return ndimage.correlate1d(out, weights, 1, output=out)
 
 
 @functools.lru_cache(maxsize=8)
-def _gaussian_weights(sigma: float) -> np.ndarray:
+def _gaussian_weights(sigma: float) -> tuple[np.ndarray, bool]:
     """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
-    (each weight times 1, plus zeros: exact; the kernel is symmetric)."""
+    (each weight times 1, plus zeros: exact; the kernel is symmetric), and whether ``ndimage.correlate1d`` takes them
+    as symmetric (each pair within the float64 epsilon: it then adds each pair before multiplying)."""
     radius = int(4.0 * sigma + 0.5)
     impulse = np.zeros(2 * radius + 1)
     impulse[radius] = 1.0
     weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
     weights.flags.writeable = False
-    return weights
+    eps = float(np.finfo(np.float64).eps)
+    return weights, bool(np.all(np.abs(weights[radius + 1 :] - weights[:radius][::-1]) <= eps))
+
+
+#: Weights that leave a line as it is (``crease_sigma`` 0: no smoothing), symmetric.
+_IDENTITY = (np.ones(1), True)
 
 
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
@@ -1421,7 +1502,7 @@ def _ripe_cores(
     red = redness(color)
     # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
     core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
-    lab, n = ndimage.label(core, structure=np.ones((3, 3), bool))
+    lab, n = _label(core, eight=True)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
     keep[0] = False
@@ -1487,23 +1568,32 @@ def _round_skin(
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
-    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     z = depth[big]
     zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
-    free = (owner[big] == 0) | (owner[big] == k)
-    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
-    deep = np.abs(z - zm) <= ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
-    # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
-    lab, n = ndimage.label((candidate | part) & ~_steps(z, 0.5 * s.depth_jump))
-    reached = np.zeros(n + 1, bool)
-    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
-    reached[0] = False
-    skin = reached[lab] | part
+    deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the seeds'
+        # components alone; issue 19, seventeenth round)
+        skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
+                              float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
+                              LEAF_HUE)  # fmt: skip
+    else:
+        # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
+        yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
+        free = (owner[big] == 0) | (owner[big] == k)
+        near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+        deep = np.abs(z - zm) <= deep_limit
+        candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
+        # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
+        allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
+        seeds = part & (np.abs(z - zm) <= s.depth_jump)
+        lab, n = ndimage.label(allowed)
+        reached = np.zeros(n + 1, bool)
+        reached[lab[seeds]] = True
+        reached[0] = False
+        skin = reached[lab] | part
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
@@ -1562,7 +1652,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         return []
     z_grid, zc = zc, _gap_filled(zc, 3)
     cand = _ground(c[::g, ::g]) & ~_steps(zc, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
-    lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+    lab, n = _label(cand, eight=True)
     if n == 0:
         return []
     flat = lab.ravel()
@@ -1593,7 +1683,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         if not (zw > 0).any():
             continue
         cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(_gap_filled(zw, GAP_PX), s.depth_jump)
-        lab, n = ndimage.label(cand, structure=np.ones((3, 3), bool))
+        lab, n = _label(cand, eight=True)
         if n == 0:
             continue
         flat = lab.ravel()
@@ -1757,7 +1847,7 @@ def _round_body(
         return None
     # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
     # (4-connected: the steps are looked for between 4-neighbours)
-    lab, n = ndimage.label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
+    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
     if n == 0:
         return None
     part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
