@@ -39,6 +39,7 @@ __all__ = [
     "fit_revolution",
     "fit_revolution_slices",
     "fit_sphere",
+    "noise_ratio",
     "outline_radii",
     "revolution_box",
     "revolution_inside",
@@ -211,6 +212,20 @@ def surface_noise(
     flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
     normals[flip] *= -1.0
     return large_res / max(small_res, 1e-15), small_res, normals
+
+
+def noise_ratio(points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120) -> float:
+    """:func:`surface_noise`'s ``ratio`` alone (the default method reads nothing else): by the compiled twin
+    :func:`symfruit.core._jit.noise_ratio` where numba is installed and the brute force's bound allows (one call
+    for the neighbourhoods, their least eigenvalues and medians: the same value to rounding, the eigenvalues
+    LAPACK's there; issue 19, seventeenth round), else ``surface_noise(...)[0]``."""
+    points = as_points(points, min_count=3)
+    k_large = min(large, len(points))
+    step = max(1, len(points) // queries)
+    jit = compiled()
+    if jit is not None and len(points) * len(range(0, len(points), step)) <= _BRUTE_NEIGHBOURS:
+        return float(jit.noise_ratio(points, step, min(small, k_large), k_large))
+    return float(surface_noise(points, small, large, queries)[0])
 
 
 #: :func:`surface_noise` finds neighbours by the kernel's brute force up to this many distances (points times

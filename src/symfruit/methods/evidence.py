@@ -53,7 +53,7 @@ from ..core.agreement import observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
-from ..core.fits import surface_noise
+from ..core.fits import noise_ratio
 from ..core.front import apex_depth
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
@@ -458,7 +458,7 @@ def evidence(
         shapes = tuple(name for name in SHAPES if name not in ("sphere", "ellipsoid"))
         explained = s.explained_at
     else:
-        ratio, _, _ = surface_noise(sample, queries=s.noise_queries)
+        ratio = noise_ratio(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
     across = across_sight(region, camera)
     cands = candidates(
