@@ -1465,3 +1465,32 @@ def test_noise_ratio_is_the_twins(monkeypatch, kind, noise, queries):
     monkeypatch.delenv("SYMFRUIT_KERNELS")
     monkeypatch.setattr(fits, "_BRUTE_NEIGHBOURS", 0)
     assert fits.noise_ratio(visible, queries=queries) == fits.surface_noise(visible, queries=queries)[0]
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 1.0), st.integers(1, 200))
+def test_outline_pixels_are_the_twins_to_the_bit(seed, h, w, share, count):
+    """Random masks (empty to full, touching the array's edges, one pixel wide), thinned to ``2 count`` or not: the
+    same outline pixels, in the same order, at the same image coordinates."""
+    from symfruit.core.agreement import _outline_uv
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    region = Silhouette(int(rng.integers(0, 600)), int(rng.integers(0, 400)), rng.random((h, w)) < share, 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _outline_uv, region, count)
+    assert fast.dtype == twin.dtype == np.float64 and fast.shape == twin.shape and np.array_equal(fast, twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000), st.integers(1, 4), st.booleans())
+def test_column_means_are_numpys_to_the_bit(seed, n, k, strided):
+    """Rows of points far from the origin and near it, one row, a strided view (left to numpy): ``mean(axis=0)``'s
+    values, bit for bit, with the kernels and without."""
+    from symfruit.core.points import column_means
+
+    rng = np.random.default_rng(seed)
+    p = rng.normal(0.0, 10.0 ** rng.uniform(-4, 1), (n, k)) + rng.uniform(-1, 1, k)
+    if strided:
+        p = np.repeat(p, 2, axis=0)[::2]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, column_means, p)
+    assert np.array_equal(fast, p.mean(axis=0)) and np.array_equal(twin, p.mean(axis=0))

@@ -137,6 +137,17 @@ def test_row_norms_are_numpys_bit_for_bit(seed, shape):
     np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=-1))
 
 
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(50, 3), (1000, 3), (40, 2), (1, 3), (0, 3), (5, 4), (4, 1)]),
+       st.sampled_from([np.float64, np.float32]))  # fmt: skip
+def test_squared_norms_are_numpys_bit_for_bit(seed, shape, dtype):
+    from symfruit.core.points import squared_norms
+
+    rng = np.random.default_rng(seed)
+    x = (rng.normal(0.0, 10.0 ** rng.uniform(-4, 2), shape) + rng.uniform(-1, 1)).astype(dtype)
+    got, want = squared_norms(x), (x**2).sum(axis=1)
+    assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([np.float64, np.float32]))
 def test_median_is_numpys_bit_for_bit(seed, dtype):
     from symfruit.core.points import median

@@ -2185,6 +2185,47 @@ def noise_ratio(points: np.ndarray, step: int, small: int, large: int) -> float:
     return large_res / (1e-15 if 1e-15 > small_res else small_res)
 
 
+@_njit
+def outline_uv(mask: np.ndarray, count: int, u0: int, v0: int) -> np.ndarray:
+    """:func:`symfruit.core.agreement._outline_uv`: the image coordinates (m, 2) of every ``max(1, k // (2 count))``-th
+    of the ``k`` outline pixels of ``mask`` (h, w) bool (a mask pixel with a 4-neighbour outside it or beyond the
+    array: ``mask & ~interior(mask)``), row-major from the first, at ``(col + u0, row + v0)``: the same pixels."""
+    h, w = mask.shape
+    rows = np.empty(h * w, np.int64)
+    cols = np.empty(h * w, np.int64)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c] and not (
+                r > 0 and r < h - 1 and c > 0 and c < w - 1
+                and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
+            ):  # fmt: skip
+                rows[k], cols[k] = r, c
+                k += 1
+    step = max(1, k // (2 * count))
+    m = (k + step - 1) // step
+    uv = np.empty((m, 2))
+    for i in range(m):
+        uv[i, 0] = float(cols[i * step] + u0)
+        uv[i, 1] = float(rows[i * step] + v0)
+    return uv
+
+
+@_njit
+def column_means(p: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.points.column_means`: ``p.mean(axis=0)`` of a C-ordered (n, k) array, ``k`` of 2 or more
+    (numpy adds such an array's rows one after the other, its columns side by side, then divides by ``n``: the same
+    sums; a single column it sums pairwise, not so)."""
+    n, k = p.shape
+    out = np.zeros(k)
+    for i in range(n):
+        for j in range(k):
+            out[j] += p[i, j]
+    for j in range(k):
+        out[j] /= n
+    return out
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 

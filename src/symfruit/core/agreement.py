@@ -404,12 +404,21 @@ def _occluded_edges(
     """``(uv (m, 2), contour (m,) bool)`` of up to ``2 count`` of the region's own outline pixels: a contour
     where the normal of the nearest edge point (``edge_uv``, ``is_contour``; none: every one) says so and
     no hidden pixel lies within ``radius`` pixels."""
-    mask = region.mask
-    rows, cols = np.nonzero(mask & ~interior(mask))
-    step = max(1, len(rows) // (2 * count))
-    uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
+    uv = _outline_uv(region, count)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
     return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
+
+
+def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
+    """(m, 2) float, pixels: every ``max(1, k // (2 count))``-th of the region's ``k`` outline pixels (``mask &
+    ~interior(mask)``), row-major, in image coordinates. By the compiled twin :func:`symfruit.core._jit.outline_uv`
+    where numba is installed (the same pixels)."""
+    mask = region.mask
+    if count >= 1 and (jit := compiled()) is not None:
+        return jit.outline_uv(np.ascontiguousarray(mask, dtype=bool), count, int(region.u0), int(region.v0))
+    rows, cols = np.nonzero(mask & ~interior(mask))
+    step = max(1, len(rows) // (2 * count))
+    return np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
 
 
 def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:
