@@ -137,6 +137,9 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     >>> as_points([[0, 0, 1]]).dtype
     dtype('float64')
     """
+    if (type(points) is np.ndarray and points.dtype == np.float64 and points.ndim == 2 and points.shape[1] == 3
+            and points.flags.c_contiguous and len(points) >= min_count):  # fmt: skip
+        return points  # already what the steps below make of it (the same array): a fruit's completion asks ~12 times
     if isinstance(points, np.ndarray) and np.iscomplexobj(points):
         raise InputError(f"{name} must be real numbers, got a complex array")
     if isinstance(points, np.ndarray) and points.dtype.kind == "b":  # True/False would read as 1 m / 0 m
