@@ -142,14 +142,9 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     d = np.column_stack([x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)])
     s = d.T @ d
     s11, s12, s22 = s[:6, :6], s[:6, 6:], s[6:, 6:]
-    k = 4.0
-    c1 = np.zeros((6, 6))
-    c1[:3, :3] = k / 2.0 - 1.0
-    np.fill_diagonal(c1[:3, :3], -1.0)
-    c1[3:, 3:] = -k * np.eye(3)
     try:
         s22_inv_s21 = np.linalg.solve(s22, s12.T)
-        m = np.linalg.solve(c1, s11 - s12 @ s22_inv_s21)
+        m = np.linalg.solve(_LI_GRIFFITHS, s11 - s12 @ s22_inv_s21)
         values, vectors = np.linalg.eig(m)
     except np.linalg.LinAlgError:
         raise InputError("cannot fit an ellipsoid: the points are degenerate") from None
@@ -173,6 +168,19 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if not np.all(np.linalg.eigvalsh(shape) > 0):
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
+
+
+def _li_griffiths_constraint(k: float = 4.0) -> np.ndarray:
+    """(6, 6), read-only: the constraint matrix ``C1`` of Li and Griffiths' fit (:func:`fit_ellipsoid`), made once."""
+    c1 = np.zeros((6, 6))
+    c1[:3, :3] = k / 2.0 - 1.0
+    np.fill_diagonal(c1[:3, :3], -1.0)
+    c1[3:, 3:] = -k * np.eye(3)
+    c1.flags.writeable = False
+    return c1
+
+
+_LI_GRIFFITHS = _li_griffiths_constraint()
 
 
 def ellipsoid_half_extents(shape: np.ndarray) -> np.ndarray:
@@ -876,9 +884,16 @@ def _cone_grid(front: float, extent: float) -> np.ndarray:
     with every ``tau`` in ``-4 .. 4`` (7), the depth the slower index, no lateral offset (built by whole
     columns: a nested list of 49 rows cost more than the fit's first evaluation)."""
     grid = np.zeros((49, 4))
-    grid[:, 2] = np.repeat(np.log(front + 0.5 * extent * np.linspace(0.3, 2.0, 7)), 7)
-    grid[:, 3] = np.tile(np.linspace(-4.0, 4.0, 7), 7)
+    grid[:, 2] = np.repeat(np.log(front + 0.5 * extent * _GRID_DEPTHS), 7)
+    grid[:, 3] = _GRID_TAUS
     return grid
+
+
+#: :func:`_cone_grid`'s depth multiples and its ``tau`` column, made once (the same values; their three numpy calls
+#: were a tenth of the cone fit's call outside its kernel).
+_GRID_DEPTHS = np.linspace(0.3, 2.0, 7)
+_GRID_TAUS = np.tile(np.linspace(-4.0, 4.0, 7), 7)
+_GRID_DEPTHS.flags.writeable = _GRID_TAUS.flags.writeable = False
 
 
 def cone_thickness_bound(cone: np.ndarray, min_thickness: float) -> float:

@@ -312,7 +312,7 @@ def _perpendicular_one(d: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     order (IEEE double arithmetic, a correctly rounded square root), so the same values, in a tenth of the time
     of some fifteen numpy calls on three numbers (the solid of revolution's fit asks for about six a fruit).
     None for a zero row (numpy divides by zero where Python would raise)."""
-    x, y, z = (float(c) for c in d[0])
+    x, y, z = d[0].tolist()  # Python floats, the same values (a generator of float() on numpy scalars cost more)
     if abs(x) < 0.9:
         a, b, c = 0.0, z, -y
     else:
