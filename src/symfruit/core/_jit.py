@@ -2142,15 +2142,15 @@ def least_eigenvalue(m: np.ndarray, a: np.ndarray) -> float:
                     t = -t
             if not math.isfinite(t):  # NaN in the matrix
                 return math.nan
-            c = 1.0 / math.sqrt(t * t + 1.0)
-            sn = t * c
+            cs = 1.0 / math.sqrt(t * t + 1.0)
+            sn = t * cs
             a[p, p] = app - t * apq
             a[q, q] = aqq + t * apq
             a[p, q] = a[q, p] = 0.0
             r = 3 - p - q  # the third index
             arp, arq = a[r, p], a[r, q]
-            a[r, p] = a[p, r] = c * arp - sn * arq
-            a[r, q] = a[q, r] = sn * arp + c * arq
+            a[r, p] = a[p, r] = cs * arp - sn * arq
+            a[r, q] = a[q, r] = sn * arp + cs * arq
     return min(a[0, 0], a[1, 1], a[2, 2])
 
 
