@@ -5,7 +5,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from symfruit.core.agreement import Quadric, explain, intersect_quadric, march, observe
+from symfruit.core.agreement import Observation, Quadric, explain, intersect_quadric, march, observe
 from symfruit.core.raster import silhouette
 
 from ..conftest import ball_mesh, rendered_view
@@ -186,6 +186,27 @@ def test_an_occluders_edge_is_a_cut_with_the_occlusion_information(camera):
     assert seen.extent is not None and seen.extent[1] == pytest.approx(rows[0] - 0.5)  # the ball's own top
     assert seen.extent[3] > rows[-1] + 40  # below, the ball may reach as far as the leaf (the window) goes
     assert silhouette_cone(region, camera)[0] == pytest.approx(blind.cone)
+
+
+def test_the_hidden_map_is_made_when_first_read(camera):
+    """Issue 19's seventeenth round: an observation with occlusion information makes its window's hidden map (each
+    pixel with a hidden pixel within 2 px) on first read, once; without it there is none, and one given is kept."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    visible, depth, mask, _ = occluded_view(ball_mesh(), np.array([0.0, 0.0, 0.4]), below=255, occluder_z=0.33,
+                                            noise=0.01, seed=2)  # fmt: skip
+    region = silhouette(visible, camera)
+    occ = occlusion(depth, mask, visible, camera)
+    seen = observe(visible[::10], region, camera, dense=visible, occlusion=occ)
+    assert seen.hidden is None
+    made = seen.hidden_map()
+    np.testing.assert_array_equal(made, occ.window(region, radius=2))
+    assert made.any() and not made.all() and seen.hidden_map() is made
+    assert observe(visible[::10], region, camera, dense=visible).hidden_map() is None
+    given = np.zeros_like(made)
+    assert Observation(rays=seen.rays, depth=seen.depth, rays_in=(), rays_out=(), hidden=given).hidden_map() is given
 
 
 def _whole_ball(camera):

@@ -1921,3 +1921,97 @@ def test_the_segmenters_red_regions_are_the_twins(seed, window):
         if isinstance(a, np.ndarray):
             assert a.dtype == b.dtype
             np.testing.assert_array_equal(a, b)
+
+
+# --- issue 19, seventeenth round: the completion -------------------------------------------------------------------
+
+
+@given(
+    st.integers(0, 2**32 - 1),
+    st.lists(st.sampled_from([0.5, 1.0, 2.0, 2.3, 5.0, 8.0]), min_size=1, max_size=4),
+    st.integers(0, 100),
+)
+def test_band_rays_are_the_twins_to_the_bit(seed, bands, n_band):
+    """The band pixels' image coordinates and viewing rays (a window anywhere in the image, a camera of unequal
+    focal lengths and a fractional principal point): the same values, in the same order, as the twin's."""
+    from symfruit.core.agreement import _band_rays
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    dist = rng.integers(0, 20, (int(rng.integers(1, 60)), int(rng.integers(1, 60)))) * 0.5
+    dist[rng.random(dist.shape) < 0.1] = np.inf
+    dist[rng.random(dist.shape) < 0.05] = np.nan
+    cam = Camera(fx=float(rng.uniform(300, 900)), fy=float(rng.uniform(300, 900)), cx=float(rng.uniform(200, 400)),
+                 cy=float(rng.uniform(150, 300)), width=640, height=480)  # fmt: skip
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 400)), np.ones(dist.shape, bool), 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _band_rays, dist, tuple(bands), n_band, region, cam)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype and a.shape == b.shape and np.array_equal(a, b)
+    assert len(fast[0]) == fast[2].sum() and (len(fast[0]) == 0 or np.all(fast[1][:, 2] == 1.0))
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(-12.0, 0.0), st.booleans())
+def test_least_eigenvalue_is_eigvalshs(seed, log_small, repeated):
+    """Symmetric 3x3 matrices, positive semi-definite as covariances are, with a least eigenvalue down to 1e-12 of
+    the largest (a clean scan's flat neighbourhood), a repeated one, diagonal ones: LAPACK's least eigenvalue within
+    its own rounding (a few units of the largest one's last place)."""
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    values = np.array([10.0**log_small, 0.5 if not repeated else 10.0**log_small, 1.0]) * rng.uniform(1e-8, 1e-4)
+    m = (q * values) @ q.T
+    m = 0.5 * (m + m.T)
+    for mat in (m, np.diag(values[::-1])):
+        got = _jit.least_eigenvalue(mat, np.empty((3, 3)))
+        assert got == pytest.approx(np.linalg.eigvalsh(mat)[0], abs=64 * np.finfo(float).eps * values.max())
+    assert np.isnan(_jit.least_eigenvalue(np.full((3, 3), np.nan), np.empty((3, 3))))
+
+
+@pytest.mark.parametrize("kind,noise,queries", [("apple", 0.0, 120), ("pear", 0.002, 40), ("banana", 0.001, 7),
+                                                 ("apple", 0.0005, 40)])  # fmt: skip
+def test_noise_measures_are_the_twins(monkeypatch, kind, noise, queries):
+    """The surface-noise ratio and noise in one compiled call: surface_noise's to rounding (the least eigenvalues of
+    clean scans' flat neighbourhoods are LAPACK's to its absolute precision), and the twin itself under
+    ``SYMFRUIT_KERNELS=numpy``; a cloud past the brute force's bound goes to the twin."""
+    from symfruit.core import fits
+
+    fruit = FRUITS[kind](np.random.default_rng(3))
+    visible, _ = rendered_view(fruit, [0.01, -0.01, 0.4], noise=noise, rotation=rotation(10, 20, 30), seed=3)
+    (ratio, level), (ratio_twin, level_twin) = _both(monkeypatch, fits.noise_measures, visible, queries=queries)
+    assert isinstance(ratio, float) and ratio == pytest.approx(ratio_twin, rel=1e-11)
+    assert isinstance(level, float) and level > 0 and level == pytest.approx(level_twin, rel=1e-9, abs=1e-12)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    assert (ratio_twin, level_twin) == fits.surface_noise(visible, queries=queries)[:2]
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    monkeypatch.setattr(fits, "_BRUTE_NEIGHBOURS", 0)
+    assert fits.noise_measures(visible, queries=queries) == fits.surface_noise(visible, queries=queries)[:2]
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 1.0), st.integers(1, 200))
+def test_outline_pixels_are_the_twins_to_the_bit(seed, h, w, share, count):
+    """Random masks (empty to full, touching the array's edges, one pixel wide), thinned to ``2 count`` or not: the
+    same outline pixels, in the same order, at the same image coordinates."""
+    from symfruit.core.agreement import _outline_uv
+    from symfruit.core.raster import Silhouette
+
+    rng = np.random.default_rng(seed)
+    region = Silhouette(int(rng.integers(0, 600)), int(rng.integers(0, 400)), rng.random((h, w)) < share, 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _outline_uv, region, count)
+    assert fast.dtype == twin.dtype == np.float64 and fast.shape == twin.shape and np.array_equal(fast, twin)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 3000), st.integers(1, 4), st.booleans())
+def test_column_means_are_numpys_to_the_bit(seed, n, k, strided):
+    """Rows of points far from the origin and near it, one row, a strided view (left to numpy): ``mean(axis=0)``'s
+    values, bit for bit, with the kernels and without."""
+    from symfruit.core.points import column_means
+
+    rng = np.random.default_rng(seed)
+    p = rng.normal(0.0, 10.0 ** rng.uniform(-4, 1), (n, k)) + rng.uniform(-1, 1, k)
+    if strided:
+        p = np.repeat(p, 2, axis=0)[::2]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, column_means, p)
+    assert np.array_equal(fast, p.mean(axis=0)) and np.array_equal(twin, p.mean(axis=0))

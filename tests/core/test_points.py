@@ -137,6 +137,17 @@ def test_row_norms_are_numpys_bit_for_bit(seed, shape):
     np.testing.assert_array_equal(row_norms(x), np.linalg.norm(x, axis=-1))
 
 
+@given(st.integers(0, 2**32 - 1), st.sampled_from([(50, 3), (1000, 3), (40, 2), (1, 3), (0, 3), (5, 4), (4, 1)]),
+       st.sampled_from([np.float64, np.float32]))  # fmt: skip
+def test_squared_norms_are_numpys_bit_for_bit(seed, shape, dtype):
+    from symfruit.core.points import squared_norms
+
+    rng = np.random.default_rng(seed)
+    x = (rng.normal(0.0, 10.0 ** rng.uniform(-4, 2), shape) + rng.uniform(-1, 1)).astype(dtype)
+    got, want = squared_norms(x), (x**2).sum(axis=1)
+    assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
 @given(st.integers(0, 2**32 - 1), st.sampled_from([np.float64, np.float32]))
 def test_median_is_numpys_bit_for_bit(seed, dtype):
     from symfruit.core.points import median
@@ -219,3 +230,16 @@ def test_a_masked_coordinate_is_none_and_its_row_dropped_not_the_value_under_the
 def test_times_are_refused_as_points(dtype):
     with pytest.raises(InputError, match=f"points must be x, y, z in metres, got {re.escape(dtype)} times"):
         as_points(np.ones((20, 3)).astype(dtype))  # before: read as counts of seconds, 'behind the camera'
+
+
+def test_as_points_hands_back_an_array_that_is_already_points():
+    """A C-ordered float64 (n, 3) array is returned as it is (what the checks made of it before: the same array);
+    too few rows are still refused, and a view, another dtype or a masked array still go through the checks."""
+    p = np.random.default_rng(0).normal(size=(5, 3))
+    assert as_points(p) is p
+    with pytest.raises(InputError, match="at least 6"):
+        as_points(p, min_count=6)
+    assert as_points(p[::2]).flags.c_contiguous and np.array_equal(as_points(p[::2]), p[::2])
+    assert as_points(p.astype(np.float32)).dtype == np.float64
+    masked = np.ma.masked_array(p, mask=np.eye(5, 3, dtype=bool))
+    assert np.isnan(as_points(masked)[0, 0]) and type(as_points(masked)) is np.ndarray

@@ -2089,6 +2089,145 @@ def occlusion_maps(
             hidden[r, c] = hide
 
 
+# --- issue 19, seventeenth round: the completion ---
+
+
+@_njit
+def band_rays(
+    dist: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int, fx: float, fy: float, cx: float, cy: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.agreement._band_rays`: :func:`band_pixels`' pixels of ``dist`` (a window at ``u0, v0``)
+    as image coordinates ``uv`` (m, 2) and their viewing rays (m, 3) ``((u - cx) / fx, (v - cy) / fy, 1)``, and the
+    bands' sizes (k,): the same operations on each pixel as the twin's, so the same values."""
+    rc, sizes = band_pixels(dist, bands, n_band)
+    m = rc.shape[0]
+    uv = np.empty((m, 2))
+    rays = np.empty((m, 3))
+    for i in range(m):
+        u = float(rc[i, 1] + u0)
+        v = float(rc[i, 0] + v0)
+        uv[i, 0], uv[i, 1] = u, v
+        rays[i, 0] = (u - cx) / fx
+        rays[i, 1] = (v - cy) / fy
+        rays[i, 2] = 1.0
+    return uv, rays, sizes
+
+
+@_njit
+def least_eigenvalue(m: np.ndarray, a: np.ndarray) -> float:
+    """The least eigenvalue of the symmetric ``m`` (3, 3) (``np.linalg.eigvalsh(m)[0]`` to rounding: LAPACK's and
+    this one's differ in the last bits), by cyclic Jacobi rotations on the scratch ``a`` (3, 3) until no
+    off-diagonal element is left that would change a diagonal one (Numerical Recipes' ``jacobi``: each eigenvalue
+    to its own relative precision, where LAPACK's is absolute; NaN in, NaN out)."""
+    for r in range(3):
+        for c in range(3):
+            a[r, c] = m[r, c]
+    for _ in range(50):
+        if a[0, 1] == 0.0 and a[0, 2] == 0.0 and a[1, 2] == 0.0:
+            break
+        for p, q in ((0, 1), (0, 2), (1, 2)):
+            apq = a[p, q]
+            if apq == 0.0:
+                continue
+            app, aqq = a[p, p], a[q, q]
+            g = 100.0 * abs(apq)
+            if abs(app) + g == abs(app) and abs(aqq) + g == abs(aqq):  # below both diagonal elements' last bit
+                a[p, q] = a[q, p] = 0.0
+                continue
+            theta = 0.5 * (aqq - app) / apq
+            if abs(theta) > 1e150:
+                t = 0.5 / theta
+            else:
+                t = 1.0 / (abs(theta) + math.sqrt(theta * theta + 1.0))
+                if theta < 0.0:
+                    t = -t
+            if not math.isfinite(t):  # NaN in the matrix
+                return math.nan
+            cs = 1.0 / math.sqrt(t * t + 1.0)
+            sn = t * cs
+            a[p, p] = app - t * apq
+            a[q, q] = aqq + t * apq
+            a[p, q] = a[q, p] = 0.0
+            r = 3 - p - q  # the third index
+            arp, arq = a[r, p], a[r, q]
+            a[r, p] = a[p, r] = cs * arp - sn * arq
+            a[r, q] = a[q, r] = sn * arp + cs * arq
+    return min(a[0, 0], a[1, 1], a[2, 2])
+
+
+@_njit
+def noise_measures(points: np.ndarray, step: int, small: int, large: int) -> tuple[float, float]:
+    """:func:`symfruit.core.fits.noise_measures`: :func:`symfruit.core.fits.surface_noise`'s ``ratio`` and ``noise``
+    in one call,
+    the neighbourhoods' covariances of :func:`neighbour_covariances`, their least eigenvalues by
+    :func:`least_eigenvalue` (the twin's ``eigh`` and ``eigvalsh``: to rounding) and the medians of those (the
+    twin's :func:`~symfruit.core.points.median`: the middle value, or the mean of the middle two; NaN where one
+    is NaN)."""
+    cov_small, cov_large = neighbour_covariances(points, step, small, large)
+    m = cov_small.shape[0]
+    scratch = np.empty((3, 3))
+    least_small = np.empty(m)
+    least_large = np.empty(m)
+    for q in range(m):
+        least_small[q] = least_eigenvalue(cov_small[q], scratch)
+        least_large[q] = least_eigenvalue(cov_large[q], scratch)
+    res = np.empty(2)
+    for i, values in enumerate((least_small, least_large)):
+        x = np.sort(values)  # NaN last, as numpy sorts
+        h = m // 2
+        if m == 0 or math.isnan(x[m - 1]):
+            res[i] = math.nan
+        elif m % 2:
+            res[i] = x[h]
+        else:
+            res[i] = (x[h - 1] + x[h]) / 2.0
+    # the twin's Python max(x, 0.0) and max(small, 1e-15): the first argument unless the second is greater (NaN kept)
+    small_res = 0.0 if 0.0 > res[0] else math.sqrt(res[0])
+    large_res = 0.0 if 0.0 > res[1] else math.sqrt(res[1])
+    return large_res / (1e-15 if 1e-15 > small_res else small_res), small_res
+
+
+@_njit
+def outline_uv(mask: np.ndarray, count: int, u0: int, v0: int) -> np.ndarray:
+    """:func:`symfruit.core.agreement._outline_uv`: the image coordinates (m, 2) of every ``max(1, k // (2 count))``-th
+    of the ``k`` outline pixels of ``mask`` (h, w) bool (a mask pixel with a 4-neighbour outside it or beyond the
+    array: ``mask & ~interior(mask)``), row-major from the first, at ``(col + u0, row + v0)``: the same pixels."""
+    h, w = mask.shape
+    rows = np.empty(h * w, np.int64)
+    cols = np.empty(h * w, np.int64)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c] and not (
+                r > 0 and r < h - 1 and c > 0 and c < w - 1
+                and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
+            ):  # fmt: skip
+                rows[k], cols[k] = r, c
+                k += 1
+    step = max(1, k // (2 * count))
+    m = (k + step - 1) // step
+    uv = np.empty((m, 2))
+    for i in range(m):
+        uv[i, 0] = float(cols[i * step] + u0)
+        uv[i, 1] = float(rows[i * step] + v0)
+    return uv
+
+
+@_njit
+def column_means(p: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.points.column_means`: ``p.mean(axis=0)`` of a C-ordered (n, k) array, ``k`` of 2 or more
+    (numpy adds such an array's rows one after the other, its columns side by side, then divides by ``n``: the same
+    sums; a single column it sums pairwise, not so)."""
+    n, k = p.shape
+    out = np.zeros(k)
+    for i in range(n):
+        for j in range(k):
+            out[j] += p[i, j]
+    for j in range(k):
+        out[j] /= n
+    return out
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 

@@ -142,8 +142,9 @@ class Observation:
         With occlusion information: the pixel box the fruit can project into at most (``u_min, v_min, u_max,
         v_max``; :meth:`~symfruit.core.occlusion.Occlusion.extent`).
     hidden : (h, w) bool, optional
-        With occlusion information: the pixels of the region's window with a hidden pixel within 2 px (an
-        outline crossing onto one is an occluder's edge).
+        The pixels of the region's window with a hidden pixel within 2 px (an outline crossing onto one is an
+        occluder's edge), when given; :func:`observe` leaves it to :meth:`hidden_map`, which makes it from the
+        occlusion information on first call (most views never read it).
     inner : (h, w) float, pixels, optional
         The region's distance map (``ndimage.distance_transform_edt(region.mask)``), for reuse: exact up to
         ``inner_reach`` pixels, +inf beyond.
@@ -167,6 +168,20 @@ class Observation:
     inner_reach: float = float("inf")
     #: What :func:`explain` reads of every candidate's rays alike (:func:`_bands`), made once per observation.
     _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
+    #: ``(occlusion, region)`` that :meth:`hidden_map` makes :attr:`hidden` of, when not given.
+    _hidden_of: tuple[Occlusion, Silhouette] | None = field(default=None, repr=False, compare=False)
+
+    def hidden_map(self) -> np.ndarray | None:
+        """:attr:`hidden`, or where :func:`observe` had occlusion information, the region's window pixels with a
+        hidden pixel within 2 px (:meth:`~symfruit.core.occlusion.Occlusion.window`), made on first call (issue 19,
+        seventeenth round: one view in nine read it, every view made it); None without either."""
+        if self.hidden is not None or self._hidden_of is None:
+            return self.hidden
+        found = self._made.get("hidden")
+        if found is None:
+            occlusion, region = self._hidden_of
+            found = self._made["hidden"] = occlusion.window(region, radius=2)
+        return found
 
 
 @dataclass(frozen=True)
@@ -269,38 +284,36 @@ def observe(
         pixel by pixel: the same values as band by band, in a quarter of the calls)."""
         if not bands:  # no bands asked for
             return []
-        rc, sizes = _band_pixels(dist, bands, n_band)
-        u = (rc[:, 1] + region.u0).astype(np.float64)
-        v = (rc[:, 0] + region.v0).astype(np.float64)
-        weight = np.ones(len(rc))
-        seen = np.full(len(rc), np.nan)
-        if outside and tree is not None and len(rc):
-            weight = is_contour[tree.query(np.stack((u, v), axis=1))[1]].astype(np.float64)  # beyond a cut edge
-        if outside and occlusion is not None and len(rc):
+        uv, rays, sizes = _band_rays(dist, bands, n_band, region, camera)
+        m = len(uv)
+        weight = np.ones(m)
+        seen = np.full(m, np.nan)
+        if outside and tree is not None and m:
+            weight = is_contour[tree.query(uv)[1]].astype(np.float64)  # beyond a cut edge
+        if outside and occlusion is not None and m:
+            u, v = uv[:, 0], uv[:, 1]
             hidden = occlusion.at(u, v)
             weight = weight * ~hidden  # a hidden pixel: no evidence of background ...
             seen = np.where(hidden, occlusion.depth_at(u, v), np.nan)  # ... but of free space
-        rays = camera.rays(u, v)
         ends = np.cumsum(sizes).tolist()  # each band's rows, sliced (np.split's views, its calls)
         return [(rays[a:b], weight[a:b], seen[a:b]) for a, b in zip([0, *ends[:-1]], ends, strict=True)]
 
     ins = bands_of(inner, False)
     outs = bands_of(outer, True)
-    cone, axis = silhouette_cone(region, camera)
-    source = "moments"
+    fitted = None
     if occlusion is not None and tree is not None and contour_cone <= contour < 1.0:
         cracks = outline_cracks(region)
         fitted = outline_cone(region, camera, cracks[is_contour[tree.query(cracks)[1]]])
-        if fitted is not None:
-            (cone, axis), source = fitted, "contour"
+    # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
+    (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(r for r, _, _ in ins),
                        rays_out=tuple(r for r, _, _ in outs), contour=contour, cone=cone, axis=axis,
                        interior=points[depth_px >= edge], out_weights=tuple(w for _, w, _ in outs),
                        out_depth=None if occlusion is None else tuple(d for _, _, d in outs),
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
-                       hidden=None if occlusion is None else occlusion.window(region, radius=2),
-                       inner=inner, inner_reach=float("inf") if reach is None else reach)  # fmt: skip
+                       inner=inner, inner_reach=float("inf") if reach is None else reach,
+                       _hidden_of=None if occlusion is None else (occlusion, region))  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -369,18 +382,43 @@ def _band_pixels(dist: np.ndarray, bands: tuple[float, ...], n_band: int) -> tup
     return np.concatenate(rcs), np.array([len(r) for r in rcs], dtype=np.intp)
 
 
+def _band_rays(dist: np.ndarray, bands: tuple[float, ...], n_band: int, region: Silhouette,
+               camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """``(uv (m, 2) float, rays (m, 3) float, sizes (k,) int)``: :func:`_band_pixels`' pixels as image coordinates
+    (the region's window at ``region.u0, region.v0``) and their viewing rays (:meth:`~symfruit.core.camera.Camera.
+    rays`). By the compiled twin :func:`symfruit.core._jit.band_rays` where numba is installed (the same values:
+    the same operations on each pixel)."""
+    if (jit := compiled()) is not None:
+        return jit.band_rays(dist, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
+                             float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy))  # fmt: skip
+    rc, sizes = _band_pixels(dist, bands, n_band)
+    uv = np.empty((len(rc), 2))
+    uv[:, 0] = rc[:, 1] + region.u0
+    uv[:, 1] = rc[:, 0] + region.v0
+    return uv, camera.rays(uv[:, 0], uv[:, 1]), sizes
+
+
 def _occluded_edges(
     region: Silhouette, occlusion: Occlusion, edge_uv: np.ndarray, is_contour: np.ndarray, count: int, radius: int
 ) -> tuple[np.ndarray, np.ndarray]:
     """``(uv (m, 2), contour (m,) bool)`` of up to ``2 count`` of the region's own outline pixels: a contour
     where the normal of the nearest edge point (``edge_uv``, ``is_contour``; none: every one) says so and
     no hidden pixel lies within ``radius`` pixels."""
-    mask = region.mask
-    rows, cols = np.nonzero(mask & ~interior(mask))
-    step = max(1, len(rows) // (2 * count))
-    uv = np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
+    uv = _outline_uv(region, count)
     labels = is_contour[cKDTree(edge_uv).query(uv)[1]] if len(is_contour) else np.ones(len(uv), dtype=bool)
     return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
+
+
+def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
+    """(m, 2) float, pixels: every ``max(1, k // (2 count))``-th of the region's ``k`` outline pixels (``mask &
+    ~interior(mask)``), row-major, in image coordinates. By the compiled twin :func:`symfruit.core._jit.outline_uv`
+    where numba is installed (the same pixels)."""
+    mask = region.mask
+    if count >= 1 and (jit := compiled()) is not None:
+        return jit.outline_uv(np.ascontiguousarray(mask, dtype=bool), count, int(region.u0), int(region.v0))
+    rows, cols = np.nonzero(mask & ~interior(mask))
+    step = max(1, len(rows) // (2 * count))
+    return np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
 
 
 def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:

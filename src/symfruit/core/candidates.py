@@ -237,13 +237,14 @@ def candidates(
     sample = as_points(sample, min_count=4, name="sample")
     seen_lo, seen_hi = bounds(points)
     extent = float((seen_hi - seen_lo).max())
-    uv = camera.project(points[:: max(1, len(points) // 4000)])
-    cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
     pull: float | None = None
     if obs.extent is not None:
         # With occlusion information: as far as the fruit can project (the seen region and what may hide it).
         u_lo, v_lo, u_hi, v_hi = (float(x) for x in obs.extent)
         cone, pull = ((u_lo, v_lo, u_hi, v_hi), camera), 1.0
+    else:  # the seen points' pixel box
+        uv = camera.project(points[:: max(1, len(points) // 4000)])
+        cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
     fit = _Fitting(sample, obs, camera, front, extent, region, outline_profile, revolution_points,
                    revolution_coarse)  # fmt: skip
     out: list[Candidate] = []
@@ -345,7 +346,7 @@ def _revolution(fit: _Fitting) -> Iterator[_Shape]:
                                 coarse=fit.revolution_coarse)  # fmt: skip
     if fit.region is not None and fit.outline_profile != "off":
         region = fit.region
-        r_out = outline_radii(rev, region.mask, (region.u0, region.v0), fit.camera, hidden=fit.obs.hidden)
+        r_out = outline_radii(rev, region.mask, (region.u0, region.v0), fit.camera, hidden=fit.obs.hidden_map())
         shaped = replace(rev, radii=np.where(np.isfinite(r_out) & np.isfinite(rev.radii), r_out, rev.radii))
         if fit.outline_profile == "replace":
             rev = shaped

@@ -23,7 +23,7 @@ from ..errors import InputError
 from .box import Box
 from .camera import Camera
 from .kernels import compiled
-from .points import as_points, cross_rows, median, perpendicular_basis, row_norms
+from .points import as_points, column_means, cross_rows, median, perpendicular_basis, row_norms, squared_norms
 
 __all__ = [
     "ConeFit",
@@ -39,6 +39,7 @@ __all__ = [
     "fit_revolution",
     "fit_revolution_slices",
     "fit_sphere",
+    "noise_measures",
     "outline_radii",
     "revolution_box",
     "revolution_inside",
@@ -78,12 +79,12 @@ def fit_sphere(
         When the points are (nearly) coplanar or collinear, so no unique sphere exists.
     """
     points = as_points(points, min_count=4)
-    mean = points.mean(axis=0)
+    mean = column_means(points)  # points.mean(axis=0), ((q**2).sum(axis=1)): the same values in fewer calls
     q = points - mean
-    scale = float(np.sqrt((q**2).sum(axis=1).mean())) or 1.0
+    scale = float(np.sqrt(squared_norms(q).mean())) or 1.0
     q = q / scale
     a = np.column_stack([2.0 * q, np.ones(len(q))])
-    b = (q**2).sum(axis=1)
+    b = squared_norms(q)
     sol, _, rank, sv = np.linalg.lstsq(a, b, rcond=None)
     if rank < 4 or sv[-1] < 1e-6 * sv[0]:
         raise InputError("cannot fit a sphere: the points are (nearly) coplanar or collinear")
@@ -135,20 +136,15 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         When no ellipsoid fits (degenerate or planar points).
     """
     points = as_points(points, min_count=10)
-    mean = points.mean(axis=0)
-    scale = float(np.sqrt(((points - mean) ** 2).sum(axis=1).mean())) or 1.0
+    mean = column_means(points)
+    scale = float(np.sqrt(squared_norms(points - mean).mean())) or 1.0
     x, y, z = ((points - mean) / scale).T
     d = np.column_stack([x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)])
     s = d.T @ d
     s11, s12, s22 = s[:6, :6], s[:6, 6:], s[6:, 6:]
-    k = 4.0
-    c1 = np.zeros((6, 6))
-    c1[:3, :3] = k / 2.0 - 1.0
-    np.fill_diagonal(c1[:3, :3], -1.0)
-    c1[3:, 3:] = -k * np.eye(3)
     try:
         s22_inv_s21 = np.linalg.solve(s22, s12.T)
-        m = np.linalg.solve(c1, s11 - s12 @ s22_inv_s21)
+        m = np.linalg.solve(_LI_GRIFFITHS, s11 - s12 @ s22_inv_s21)
         values, vectors = np.linalg.eig(m)
     except np.linalg.LinAlgError:
         raise InputError("cannot fit an ellipsoid: the points are degenerate") from None
@@ -172,6 +168,19 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     if not np.all(np.linalg.eigvalsh(shape) > 0):
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
+
+
+def _li_griffiths_constraint(k: float = 4.0) -> np.ndarray:
+    """(6, 6), read-only: the constraint matrix ``C1`` of Li and Griffiths' fit (:func:`fit_ellipsoid`), made once."""
+    c1 = np.zeros((6, 6))
+    c1[:3, :3] = k / 2.0 - 1.0
+    np.fill_diagonal(c1[:3, :3], -1.0)
+    c1[3:, 3:] = -k * np.eye(3)
+    c1.flags.writeable = False
+    return c1
+
+
+_LI_GRIFFITHS = _li_griffiths_constraint()
 
 
 def ellipsoid_half_extents(shape: np.ndarray) -> np.ndarray:
@@ -211,6 +220,22 @@ def surface_noise(
     flip = np.einsum("ni,ni->n", normals, points[::step]) > 0
     normals[flip] *= -1.0
     return large_res / max(small_res, 1e-15), small_res, normals
+
+
+def noise_measures(points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120) -> tuple[float, float]:
+    """:func:`surface_noise`'s ``(ratio, noise)`` without its normals (the default method reads nothing else): by
+    the compiled twin :func:`symfruit.core._jit.noise_measures` where numba is installed and the brute force's bound
+    allows (one call for the neighbourhoods, their least eigenvalues and medians: the same values to rounding, the
+    eigenvalues LAPACK's there; issue 19, seventeenth round), else ``surface_noise(...)[:2]``."""
+    points = as_points(points, min_count=3)
+    k_large = min(large, len(points))
+    step = max(1, len(points) // queries)
+    jit = compiled()
+    if jit is not None and len(points) * len(range(0, len(points), step)) <= _BRUTE_NEIGHBOURS:
+        ratio, noise = jit.noise_measures(points, step, min(small, k_large), k_large)
+        return float(ratio), float(noise)
+    ratio, noise, _ = surface_noise(points, small, large, queries)
+    return ratio, noise
 
 
 #: :func:`surface_noise` finds neighbours by the kernel's brute force up to this many distances (points times
@@ -596,7 +621,7 @@ def fit_revolution_slices(
         pts = pts[np.isfinite(pts).all(axis=1)]
     if len(pts) < 20:
         raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
-    centre = pts.mean(axis=0)
+    centre = column_means(pts)
     q = pts - centre
     qs = q[:: max(1, len(q) // search_points)]
     dirs = _COARSE if coarse == 64 else _hemisphere(coarse) if coarse > 0 else np.empty((0, 3))
@@ -861,9 +886,16 @@ def _cone_grid(front: float, extent: float) -> np.ndarray:
     with every ``tau`` in ``-4 .. 4`` (7), the depth the slower index, no lateral offset (built by whole
     columns: a nested list of 49 rows cost more than the fit's first evaluation)."""
     grid = np.zeros((49, 4))
-    grid[:, 2] = np.repeat(np.log(front + 0.5 * extent * np.linspace(0.3, 2.0, 7)), 7)
-    grid[:, 3] = np.tile(np.linspace(-4.0, 4.0, 7), 7)
+    grid[:, 2] = np.repeat(np.log(front + 0.5 * extent * _GRID_DEPTHS), 7)
+    grid[:, 3] = _GRID_TAUS
     return grid
+
+
+#: :func:`_cone_grid`'s depth multiples and its ``tau`` column, made once (the same values; their three numpy calls
+#: were a tenth of the cone fit's call outside its kernel).
+_GRID_DEPTHS = np.linspace(0.3, 2.0, 7)
+_GRID_TAUS = np.tile(np.linspace(-4.0, 4.0, 7), 7)
+_GRID_DEPTHS.flags.writeable = _GRID_TAUS.flags.writeable = False
 
 
 def cone_thickness_bound(cone: np.ndarray, min_thickness: float) -> float:

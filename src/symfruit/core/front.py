@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from .points import as_points
+from .points import as_points, column_means, squared_norms
 
 __all__ = ["apex_depth"]
 
@@ -42,9 +42,9 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     n = len(p)
     z = p[:, 2]
     front = max(1, int(0.02 * n))
-    seed = p[np.argpartition(z, front - 1)[:front], :2].mean(axis=0)
+    seed = column_means(p[np.argpartition(z, front - 1)[:front], :2])  # .mean(axis=0), the same values
     k = min(n, max(min_points, int(share * n)))
-    d2 = ((p[:, :2] - seed) ** 2).sum(axis=1)
+    d2 = squared_norms(p[:, :2] - seed)  # ((...) ** 2).sum(axis=1), the same values
     pick = np.argpartition(d2, k - 1)[:k]
     near = p[pick]
     x, y = near[:, 0] - seed[0], near[:, 1] - seed[1]

@@ -21,11 +21,13 @@ __all__ = [
     "bounds",
     "check_cloud",
     "check_view",
+    "column_means",
     "cross_rows",
     "mean_point",
     "median",
     "perpendicular_basis",
     "row_norms",
+    "squared_norms",
     "subsample",
 ]
 
@@ -80,6 +82,31 @@ def median(values: np.ndarray) -> Any:
     return part[h] if n % 2 else (part[h - 1] + part[h]) / part.dtype.type(2)
 
 
+def column_means(points: np.ndarray) -> np.ndarray:
+    """(k,) float: ``points.mean(axis=0)`` of a float64 (n, k) array, the same value bit for bit: by the compiled twin
+    :func:`symfruit.core._jit.column_means` where numba is installed, the array is C-ordered and ``k`` is 2 or 3
+    (numpy's own reduction of such an array adds its rows in order; its call costs some 20 us on a few hundred
+    points, 1 us compiled; one column it sums pairwise), else by numpy (issue 19, seventeenth round)."""
+    p = np.asarray(points)
+    if (p.ndim == 2 and len(p) and p.shape[1] in (2, 3) and p.dtype == np.float64 and p.flags.c_contiguous
+            and (jit := compiled()) is not None):  # fmt: skip
+        return jit.column_means(p)
+    return p.mean(axis=0)
+
+
+def squared_norms(x: np.ndarray) -> np.ndarray:
+    """``(x**2).sum(axis=1)`` of rows of 2 or 3 float components, term by term (numpy sums so short an axis left to
+    right: the same values, in a quarter of the time of its short-axis reduction)."""
+    x = np.asarray(x)
+    if x.ndim != 2 or x.shape[1] not in (2, 3) or x.dtype.kind != "f":
+        return (x**2).sum(axis=1)
+    total = x[:, 0] * x[:, 0]
+    total += x[:, 1] * x[:, 1]
+    if x.shape[1] == 3:
+        total += x[:, 2] * x[:, 2]
+    return total
+
+
 def mean_point(points: np.ndarray) -> np.ndarray:
     """(k,) float: the mean of the rows of ``points`` (n, k), as a matrix-vector product (see :func:`bounds`)."""
     p = np.asarray(points, dtype=np.float64)
@@ -110,6 +137,9 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     >>> as_points([[0, 0, 1]]).dtype
     dtype('float64')
     """
+    if (type(points) is np.ndarray and points.dtype == np.float64 and points.ndim == 2 and points.shape[1] == 3
+            and points.flags.c_contiguous and len(points) >= min_count):  # fmt: skip
+        return points  # already what the steps below make of it (the same array): a fruit's completion asks ~12 times
     if isinstance(points, np.ndarray) and np.iscomplexobj(points):
         raise InputError(f"{name} must be real numbers, got a complex array")
     if isinstance(points, np.ndarray) and points.dtype.kind == "b":  # True/False would read as 1 m / 0 m
@@ -282,7 +312,7 @@ def _perpendicular_one(d: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
     order (IEEE double arithmetic, a correctly rounded square root), so the same values, in a tenth of the time
     of some fifteen numpy calls on three numbers (the solid of revolution's fit asks for about six a fruit).
     None for a zero row (numpy divides by zero where Python would raise)."""
-    x, y, z = (float(c) for c in d[0])
+    x, y, z = d[0].tolist()  # Python floats, the same values (a generator of float() on numpy scalars cost more)
     if abs(x) < 0.9:
         a, b, c = 0.0, z, -y
     else:

@@ -54,7 +54,7 @@ from ..core.agreement import observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
-from ..core.fits import surface_noise
+from ..core.fits import noise_measures
 from ..core.front import apex_depth
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
@@ -465,7 +465,7 @@ def evidence(
         shapes = tuple(name for name in SHAPES if name not in ("sphere", "ellipsoid"))
         explained = s.explained_at
     else:
-        ratio, noise, _ = surface_noise(sample, queries=s.noise_queries)
+        ratio, noise = noise_measures(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
     across = across_sight(region, camera)
     cands = candidates(
@@ -495,7 +495,7 @@ def evidence(
     unexplained = 0.0
     if dense and best_rms is not None and s.unexplained_scale > 0:
         if noise is None:
-            _, noise, _ = surface_noise(sample, queries=s.noise_queries)
+            _, noise = noise_measures(sample, queries=s.noise_queries)
         unexplained = float(np.sqrt(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
     uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2
                                              + (s.unexplained_scale * unexplained) ** 2))  # fmt: skip
