@@ -587,3 +587,21 @@ def test_revolution_inside_is_the_broadcast_formulation_bit_for_bit(seed, shape)
     want -= np.maximum(t_prof[0] - t, 0.0) + np.maximum(t - t_prof[-1], 0.0)
     got = revolution_inside(rev, x)
     assert got.shape == shape and np.array_equal(got, want)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(3, 300), st.integers(1, 30), st.integers(2, 40), st.booleans())
+def test_the_nearest_are_in_a_stable_order_of_the_distances(seed, n, step, large, lattice):
+    """surface_noise's neighbours without numba are the kernel's: each query's ``large`` nearest in the order of a
+    stable sort of every squared distance (ties by index), also on a lattice's grid of whole steps (ties
+    everywhere, as a depth camera's pixels give), where a search tree's own order breaks ties otherwise."""
+    from symfruit.core.fits import _nearest_in_order, _squared_distances
+
+    rng = np.random.default_rng(seed)
+    pts = rng.integers(0, 4, size=(n, 3)) * 0.001 if lattice else rng.normal(size=(n, 3)) * 0.01
+    large = min(large, n)
+    queries = pts[::step]
+    got = _nearest_in_order(pts, queries, large)
+    want = np.argsort(_squared_distances(pts, queries), axis=1, kind="stable")[:, :large]
+    np.testing.assert_array_equal(got, want)
+    d = ((pts[None, :, :] - queries[:, None, :]) ** 2).sum(axis=2)  # the same sums, another way
+    np.testing.assert_array_equal(_squared_distances(pts, queries), d)

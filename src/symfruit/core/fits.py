@@ -246,12 +246,53 @@ _BRUTE_NEIGHBOURS = 5_000_000
 def _neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
     """``(m, 3, 3), (m, 3, 3)``: for each query point ``points[::step]``, the covariance of its ``small`` and its
     ``large`` nearest points (itself among them), each about its own mean (:func:`surface_noise`; its compiled
-    twin is :func:`symfruit.core._jit.neighbour_covariances`)."""
-    _, idx = cKDTree(points).query(points[::step], k=large)
+    twin is :func:`symfruit.core._jit.neighbour_covariances`). Up to ``_BRUTE_NEIGHBOURS`` distances the nearest
+    are the kernel's: a search tree's ``large + 8`` nearest, their squared distances summed as the kernel sums
+    them and put in a stable order (ties by index), every distance worked out where a tie may reach past those
+    (:func:`_nearest_in_order`), so that a tie straddling the ``small``-th or ``large``-th place (a depth camera's
+    points lie on a pixel grid) is broken alike with and without numba; beyond, the search tree's order."""
+    queries = points[::step]
+    if len(points) * len(queries) <= _BRUTE_NEIGHBOURS:
+        idx = _nearest_in_order(points, queries, large)
+    else:
+        _, idx = cKDTree(points).query(queries, k=large)
     hood = points[idx]
     near = hood[:, :small] - hood[:, :small].mean(axis=1, keepdims=True)
     wide = hood - hood.mean(axis=1, keepdims=True)
     return np.einsum("nki,nkj->nij", near, near) / small, np.einsum("nki,nkj->nij", wide, wide) / large
+
+
+def _squared_distances(points: np.ndarray, queries: np.ndarray, idx: np.ndarray | None = None) -> np.ndarray:
+    """Squared distances of ``points`` (n, 3) (or of ``points[idx]``, idx (m, k)) from each of ``queries`` (m, 3),
+    summed ``dx * dx + dy * dy + dz * dz`` left to right, as :func:`symfruit.core._jit.neighbour_covariances` does."""
+    d: np.ndarray | None = None
+    for axis in range(3):
+        e = (points[:, axis][None, :] if idx is None else points[idx, axis]) - queries[:, axis][:, None]
+        e *= e
+        d = e if d is None else d + e
+    assert d is not None
+    return d
+
+
+def _nearest_in_order(points: np.ndarray, queries: np.ndarray, large: int) -> np.ndarray:
+    """``(m, large)``: the indices of each query's ``large`` nearest ``points`` in the order of a stable sort of
+    :func:`_squared_distances` (ties by index), the kernel's. A search tree offers ``large + 8`` candidates; a row
+    whose last candidate is not farther than its ``large``-th (a tie that may reach past the candidates, beyond
+    rounding) is sorted over every point."""
+    n = len(points)
+    offered = min(large + 8, n)
+    _, cand = cKDTree(points).query(queries, k=offered)
+    cand = cand.reshape(len(queries), offered)
+    d = _squared_distances(points, queries, cand)
+    order = np.lexsort((cand, d), axis=-1)
+    cand, d = np.take_along_axis(cand, order, axis=1), np.take_along_axis(d, order, axis=1)
+    idx = np.ascontiguousarray(cand[:, :large])
+    if offered < n:
+        loose = ~(d[:, -1] > d[:, large - 1] * (1.0 + 1e-9) + 1e-300)
+        for row in np.flatnonzero(loose):  # rare: a tie (or a cluster of duplicates) as wide as the offer
+            full = _squared_distances(points, queries[row : row + 1])[0]
+            idx[row] = np.argsort(full, kind="stable")[:large]
+    return idx
 
 
 def _residuals(theta, points, prior, ratio, delta, jac=True):

@@ -2,8 +2,11 @@
 pixel maps (ninth round), a fruit's surface, outline and colour trimming (twelfth round), the observation's edge
 normals and silhouette bands and the silhouette's closing (thirteenth round), scipy's feature transform and the
 quadric candidates' agreement (fourteenth round), the registration's key ranks and a fruit's depth noise
-(fifteenth round), and the solid of revolution's direction search, a marched candidate's agreement and the
-occlusion's pixel look-ups (sixteenth round), with numba from the optional extra ``fast``.
+(fifteenth round), the solid of revolution's direction search, a marched candidate's agreement and the
+occlusion's pixel look-ups (sixteenth round), and the registration's exact costs and keys, extraction's depth tests,
+colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
+observation's band rays and outline pixels and the surface noise's measures (seventeenth round), with numba from
+the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -17,7 +20,13 @@ when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfru
 :func:`symfruit.core.raster.close_ragged`; the fourteenth round's :func:`symfruit.core.raster.nearest_index` and
 :func:`symfruit.core.agreement.explain`; the fifteenth round's :meth:`symfruit.core.surface._Outline.ranks` and
 :func:`symfruit.core.surface.depth_noise`; the sixteenth round's :func:`symfruit.core.agreement.explain` of a
-marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`) then run their numpy twins, the code the kernels
+marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventeenth round's
+:meth:`symfruit.core.surface._Outline.keys`, :func:`~symfruit.core.surface.registration_shift`,
+:func:`~symfruit.core.surface.monotone_region`, :func:`symfruit.extract.extract`,
+:func:`symfruit.core.occlusion.occlusion`, :func:`symfruit.core.raster.principal_widths`,
+:func:`symfruit.segment.colour.segment`'s hulls, labellings, floods, creases and sphere points,
+:func:`symfruit.core.agreement.observe`'s bands and outline, :func:`symfruit.core.fits.noise_measures` and
+:func:`symfruit.core.points.column_means`) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
