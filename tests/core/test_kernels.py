@@ -2015,3 +2015,28 @@ def test_column_means_are_numpys_to_the_bit(seed, n, k, strided):
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, column_means, p)
     assert np.array_equal(fast, p.mean(axis=0)) and np.array_equal(twin, p.mean(axis=0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([3, 7]), st.booleans())
+def test_the_ground_colour_candidates_are_the_twins(seed, size, strided):
+    """Random colours (yellow to leaf green and others) over a depth of two surfaces with holes and a band without
+    depth between them, whole or a strided view of the colour: the same ground-colour pixels off the depth steps with
+    the kernel and with the twins (``_ground``, ``_gap_filled``, ``_steps``); some kept, some dropped on a step."""
+    from symfruit.segment.colour import _ground, _ground_steps
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    image = rng.integers(0, 256, (2 * h, 3 * w, 3), dtype=np.uint8)
+    image[rng.random(image.shape[:2]) < 0.5] = (200, 190, 40)  # a yellow ground colour
+    c = image[::2, 1::3] if strided else image[:h, :w]
+    depth = np.where(np.arange(w) < w // 2, 0.8, 1.1) + rng.normal(0.0, 0.004, (h, w))
+    depth[rng.random((h, w)) < 0.2] = 0.0
+    depth[:, w // 2 : w // 2 + int(rng.integers(0, 3))] = 0.0  # filled over: a step at its nearer edge
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _ground_steps, c, depth, size, 0.02)
+    np.testing.assert_array_equal(fast, twin)
+    assert fast.dtype == bool and fast.shape == (h, w)
+    assert not (fast & ~_ground(c)).any()
+    if h >= 8 and w >= 8:
+        assert fast.any() and (_ground(c) & ~fast).any()

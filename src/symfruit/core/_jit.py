@@ -3443,3 +3443,57 @@ def red_regions(
         seeded[labels[strong_at[i] // w, strong_at[i] % w]] = True
     seeded[0] = False
     return mask, labels, n, weak_at, strong_at, lab, seeded, sizes, rows, cols
+
+
+# --- issue 19, eighteenth round: the colour segmenter's ground-colour candidates ----------------------------------
+
+
+@_njit
+def ground_steps(ground: np.ndarray, depth: np.ndarray, size: int, jump: float) -> np.ndarray:
+    """``ground & ~_steps(_gap_filled(depth, size), jump)`` of :mod:`symfruit.segment.colour`: (h, w) bool, the
+    pixels of ``ground`` (h, w) bool not on a depth step. ``depth`` (h, w) float64, 0 where none (never NaN nor
+    negative): a pixel without depth takes the largest depth of the ``size`` box about it (clipped at the border),
+    none where that is 0 too (the twin's NaN: no step); a step is a 4-neighbour's depth more than ``jump`` away, both
+    with depth. Maxima and differences of the same numbers: the twin's pixels. Row by row, the box's column maxima
+    then its row maxima, each inner loop along a row (numba vectorises those, not a loop over the box)."""
+    h, w = depth.shape
+    half = size // 2
+    filled = np.empty((h, w))
+    col = np.empty(w)
+    for r in range(h):
+        for q in range(w):
+            col[q] = depth[r, q]
+        for k in range(max(r - half, 0), min(r + half + 1, h)):
+            for q in range(w):
+                u = depth[k, q]
+                col[q] = u if u > col[q] else col[q]
+        for q in range(w):
+            filled[r, q] = col[q]
+        for d in range(1, min(half, w - 1) + 1):
+            for q in range(w - d):
+                u = col[q + d]
+                filled[r, q] = u if u > filled[r, q] else filled[r, q]
+            for q in range(d, w):
+                u = col[q - d]
+                filled[r, q] = u if u > filled[r, q] else filled[r, q]
+        for q in range(w):
+            v = depth[r, q]
+            filled[r, q] = v if v > 0.0 else filled[r, q]
+    edge = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        if r + 1 < h:
+            for q in range(w):
+                a, b = filled[r, q], filled[r + 1, q]
+                step = (a > 0.0) & (b > 0.0) & (abs(b - a) > jump)
+                edge[r, q] |= step
+                edge[r + 1, q] |= step
+        for q in range(w - 1):
+            a, b = filled[r, q], filled[r, q + 1]
+            step = (a > 0.0) & (b > 0.0) & (abs(b - a) > jump)
+            edge[r, q] |= step
+            edge[r, q + 1] |= step
+    out = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for q in range(w):
+            out[r, q] = ground[r, q] and not edge[r, q]
+    return out

@@ -1647,11 +1647,10 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     h, w = c.shape[:2]
     g = COARSE_STEP
     focal = geo.focal
-    zc = z[(slice(None, None, g), slice(None, None, g))]
-    if not (zc > 0).any():
+    z_grid = z[(slice(None, None, g), slice(None, None, g))]
+    if not (z_grid > 0).any():
         return []
-    z_grid, zc = zc, _gap_filled(zc, 3)
-    cand = _ground(c[::g, ::g]) & ~_steps(zc, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
+    cand = _ground_steps(c[::g, ::g], z_grid, 3, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
     lab, n = _label(cand, eight=True)
     if n == 0:
         return []
@@ -1682,7 +1681,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         zw = z[win]
         if not (zw > 0).any():
             continue
-        cand = _ground(c[win]) & (owner[win] == 0) & ~_steps(_gap_filled(zw, GAP_PX), s.depth_jump)
+        cand = _ground_steps(c[win], zw, GAP_PX, s.depth_jump) & (owner[win] == 0)
         lab, n = _label(cand, eight=True)
         if n == 0:
             continue
@@ -1708,6 +1707,17 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
             hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl])) & ((owner[sl] == 0) | part)
             bodies.append(_Body(sl, _depth_consistent(hull, part, sub_z, s.depth_jump), *fit))
     return bodies
+
+
+def _ground_steps(color: np.ndarray, depth: np.ndarray, size: int, jump: float) -> np.ndarray:
+    """(h, w) bool: ground-colour pixels (:func:`_ground`) not on a depth step (:func:`_steps`, larger than ``jump``)
+    of the ``depth`` (0: none) with its gaps filled over a ``size`` box (:func:`_gap_filled`). Where numba is, its
+    compiled twin finds the same steps in one call (:func:`symfruit.core._jit.ground_steps`; issue 19, eighteenth
+    round: numpy's dozen calls on each window cost twice as much)."""
+    ground = _ground(color)
+    if (jit := compiled()) is not None and depth.ndim == 2 and depth.dtype == np.float64:
+        return jit.ground_steps(ground, depth, size, jump)
+    return ground & ~_steps(_gap_filled(depth, size), jump)
 
 
 def _piece_discs(labels: np.ndarray, depth: np.ndarray, n: int, focal: float) -> tuple[np.ndarray, np.ndarray]:
