@@ -2815,6 +2815,7 @@ def positive_depth(depth: np.ndarray, out: np.ndarray) -> None:
 
 @_njit
 def _root(parent: np.ndarray, i: int) -> int:
+    """The root of ``i`` in a union-find forest, the path halved on the way (:func:`join_boxes`, :func:`_union`)."""
     while parent[i] != i:
         parent[i] = parent[parent[i]]
         i = parent[i]
@@ -3217,18 +3218,9 @@ def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
 
 
 @_njit
-def _find(parent: np.ndarray, i: int) -> int:
-    """The root of ``i`` in a union-find forest, the path halved on the way."""
-    while parent[i] != i:
-        parent[i] = parent[parent[i]]
-        i = parent[i]
-    return i
-
-
-@_njit
 def _union(parent: np.ndarray, a: int, b: int) -> int:
     """Join the trees of ``a`` and ``b`` under the smaller root; that root."""
-    a, b = _find(parent, a), _find(parent, b)
+    a, b = _root(parent, a), _root(parent, b)
     if a == b:
         return a
     if b < a:
@@ -3278,7 +3270,7 @@ def label(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int]:
         for c in range(w):
             if out[r, c] == 0:
                 continue
-            root = _find(parent, out[r, c])
+            root = _root(parent, out[r, c])
             if final[root] == 0:
                 m += 1
                 final[root] = m
