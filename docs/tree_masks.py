@@ -20,6 +20,27 @@ from symfruit.settings import resolve_settings
 from symfruit.synthetic.scenes import make_tree_scene
 
 
+def match(truth: np.ndarray, labels: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """``(ious, ids, found, matched)``: the truth masks (k, h, w) against the segmenter's regions as ``symfruit
+    evaluate --protocol masks`` matches them (IoU 0.5, one to one), which truth masks were found and which
+    regions matched one (also docs/tree_misses.py's)."""
+    ious, ids = mask_ious(truth, labels)
+    pairs = match_masks(ious)
+    found = np.zeros(len(truth), bool)
+    found[pairs[:, 0]] = True
+    matched = np.zeros(len(ids), bool)
+    matched[pairs[:, 1]] = True
+    return ious, ids, found, matched
+
+
+def false_kind(under: np.ndarray, ripe: np.ndarray, unripe: np.ndarray) -> str:
+    """Where a false region lies (``under``: the true labels of its pixels): mostly (over 30 %) on a ripe apple,
+    else mostly on an unripe one, else on neither."""
+    if np.isin(under, ripe).mean() > 0.3:
+        return "on_apple"
+    return "on_unripe" if np.isin(under, unripe).mean() > 0.3 else "other"
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--seed", type=int, default=0)
@@ -42,12 +63,7 @@ def main() -> None:
             labels = segment(frame.color, frame.depth, frame.camera, settings)
             best = min(best, time.process_time() - start)
         cpu.append(1000 * best)
-        ious, ids = mask_ious(truth, labels)
-        pairs = match_masks(ious)
-        found = np.zeros(len(truth), bool)
-        found[pairs[:, 0]] = True
-        matched = np.zeros(len(ids), bool)
-        matched[pairs[:, 1]] = True
+        _, ids, found, matched = match(truth, labels)
         red = redness(frame.color) >= 0.25
         for mask, hit in zip(truth, found, strict=True):
             kind = "red" if red[mask].mean() >= 0.5 else "yellow"
@@ -55,15 +71,7 @@ def main() -> None:
             count[kind + "_found"] += int(hit)
         count["regions"] += len(ids)
         for k in ids[~matched]:
-            under = frame.labels[labels == k]
-            key = (
-                "on_apple"
-                if np.isin(under, ripe).mean() > 0.3
-                else "on_unripe"
-                if np.isin(under, unripe).mean() > 0.3
-                else "other"
-            )
-            count[key] += 1
+            count[false_kind(frame.labels[labels == k], ripe, unripe)] += 1
     total, hits = count["red"] + count["yellow"], count["red_found"] + count["yellow_found"]
     false = count["on_apple"] + count["on_unripe"] + count["other"]
     sys.stdout.write(

@@ -23,8 +23,8 @@ import colorsys
 import sys
 
 import numpy as np
+from tree_masks import false_kind, match  # docs/tree_masks.py, beside this script
 
-from symfruit.evaluate.masks import mask_ious, match_masks
 from symfruit.segment.colour import redness, segment
 from symfruit.settings import resolve_settings
 from symfruit.synthetic.scenes import make_tree_scene
@@ -72,12 +72,7 @@ def main() -> None:
         truth = frame.labels[None] == ids[:, None, None]
         total += len(ripe)
         labels = segment(frame.color, frame.depth, frame.camera, settings)
-        ious, rids = mask_ious(truth, labels)
-        pairs = match_masks(ious)
-        found = np.zeros(len(truth), bool)
-        found[pairs[:, 0]] = True
-        matched = np.zeros(len(rids), bool)
-        matched[pairs[:, 1]] = True
+        ious, rids, found, matched = match(truth, labels)
         red = redness(frame.color) >= 0.25
         sizes = np.array([(labels == k).sum() for k in rids])
         on_fruit = np.array([((labels == k) & (frame.labels > 0)).sum() for k in rids])
@@ -95,11 +90,7 @@ def main() -> None:
             rows.append((kind, seed, f.id, area, float(f.box.centre[2]), f.visible or 1.0,
                          float(red[mask].mean()), 360 * hue, sat, val, best, seen))  # fmt: skip
         for k, size in zip(rids[~matched], sizes[~matched], strict=True):
-            under = frame.labels[labels == k]
-            key = "on_apple" if np.isin(under, ids).mean() > 0.3 else "other"
-            if key == "other" and np.isin(under, unripe).mean() > 0.3:
-                key = "on_unripe"
-            false[key].append(int(size))
+            false[false_kind(frame.labels[labels == k], ids, unripe)].append(int(size))
     out = sys.stdout
     out.write(f"seeds {args.seed}-{args.seed + args.n - 1}: {len(rows)} of {total} apples missed\n")
     out.write("class   n  pixels(med)  z(m)  visible  red   hue  sat  value  bestIoU  depth\n")
