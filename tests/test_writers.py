@@ -184,8 +184,11 @@ def test_write_result_refuses_a_pipe_and_a_link_to_nowhere_without_replacing_it(
         (tmp_path / "out.ply").symlink_to(tmp_path / "pipe")
     else:
         (tmp_path / "out.ply").symlink_to(tmp_path / "gone" / "fruit.ply")
-    why = {"fifo": r"out\.ply: is a pipe, not a file", "link to a fifo": r"out\.ply: is a pipe \(through the link",
-           "link into a missing folder": r"out\.ply: is a link to .*gone/fruit\.ply, whose folder .* does not exist"}
+    why = {
+        "fifo": r"out\.ply: is a pipe, not a file",
+        "link to a fifo": r"out\.ply: is a pipe \(through the link",
+        "link into a missing folder": r"out\.ply: is a link to .*gone/fruit\.ply, whose folder .* does not exist",
+    }
     before = sorted((p.name, p.is_symlink(), stat.S_IFMT(p.lstat().st_mode)) for p in tmp_path.iterdir())
     with pytest.raises(OutputError, match=why[how]):  # before: replaced by a regular file (a dangling link: ok)
         write_result(tmp_path / "out.ply", complete(VISIBLE, method="raw"))

@@ -436,8 +436,8 @@ def write_scenes(
     """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
     ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
     (copies where links are impossible; either put in place atomically), so a long recording costs little time
-    and disk. Through a real camera model (``sensor``) each folder also gets the annotators' ``masks.png`` (which ``detect`` and
-    ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
+    and disk. Through a real camera model (``sensor``) each folder also gets the annotators' ``masks.png``
+    (which ``detect`` and ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
     (:func:`make_tree_scene`, ``n_ripe`` apples and ``n_unripe`` green ones a frame, through ``sensor`` or the
     Azure Kinect model; ``n_leaves`` is not used).
 
