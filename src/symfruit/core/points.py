@@ -127,7 +127,8 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     Raises
     ------
     InputError
-        When ``points`` is not numeric, not real, not ``(n, 3)``, or has fewer than ``min_count`` rows.
+        When ``points`` is not numeric (text is refused, even text of numbers: numpy would parse it), not real,
+        not ``(n, 3)``, or has fewer than ``min_count`` rows.
 
     A masked coordinate of a :class:`numpy.ma.MaskedArray` is NaN (no measurement: :func:`check_cloud` drops its
     row and counts it), never the value the mask hides.
@@ -148,6 +149,8 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
         raise InputError(f"{name} must be x, y, z in metres, got {points.dtype} times")
     if isinstance(points, np.ma.MaskedArray) and points.dtype.kind in "iuf":
         points = unmasked(points, np.nan)  # a masked coordinate is none: its row dropped as non-finite
+    if _holds_text(points):  # numpy parses '0.3' (and b'0.3') as a number: the API takes numbers only
+        raise InputError(f"{name} must be a numeric (n, 3) array of x, y, z in metres, got text (parse it first)")
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -157,6 +160,22 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     if len(arr) < min_count:
         raise InputError(f"{name} must hold at least {min_count} points, got {len(arr)}")
     return np.ascontiguousarray(arr)
+
+
+def _holds_text(points: Any) -> bool:
+    """Whether ``points`` (an array or nested sequences) holds a ``str`` or ``bytes`` anywhere."""
+    if isinstance(points, (str, bytes)):
+        return True
+    if not isinstance(points, np.ndarray):
+        try:
+            points = np.asarray(points)
+        except (TypeError, ValueError):  # ragged or worse: the conversion below names it
+            return False
+    if points.dtype.kind in "SU":
+        return True
+    if points.dtype.kind == "O":  # e.g. numbers and text mixed in an object array
+        return any(isinstance(v, (str, bytes)) for v in points.ravel())
+    return False
 
 
 def check_cloud(
