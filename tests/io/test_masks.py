@@ -108,6 +108,21 @@ def test_coco_uses_the_first_image_and_ids_or_order(tmp_path):
     assert (coco_masks(bare, (10, 10)) == 1).sum() == 16
 
 
+
+@pytest.mark.parametrize(
+    "ids, message",
+    [((7, 7), "annotations 1 and 2 would both be fruit 7"), ((None, 1), "annotations 1 and 2 would both be fruit 1"),
+     ((2, None), "annotations 1 and 2 would both be fruit 2")],
+)  # fmt: skip
+def test_two_annotations_that_would_be_one_fruit_are_refused_not_merged(tmp_path, ids, message):
+    anns = [{"segmentation": [[x, 0, x + 3, 0, x + 3, 3, x, 3]]} for x in (0, 5)]
+    for ann, ident in zip(anns, ids, strict=True):
+        if ident is not None:
+            ann["id"] = ident
+    (tmp_path / "a.json").write_text(json.dumps({"annotations": anns}))
+    with pytest.raises(FileFormatError, match=re.escape(message) + r" \(an id given twice, or .*its own id$"):
+        coco_masks(tmp_path / "a.json", (10, 10))  # before: both drawn with one label, read as one fruit
+
 @pytest.mark.parametrize(
     "data, message",
     [
