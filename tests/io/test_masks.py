@@ -108,7 +108,6 @@ def test_coco_uses_the_first_image_and_ids_or_order(tmp_path):
     assert (coco_masks(bare, (10, 10)) == 1).sum() == 16
 
 
-
 @pytest.mark.parametrize(
     "ids, message",
     [((7, 7), "annotations 1 and 2 would both be fruit 7"), ((None, 1), "annotations 1 and 2 would both be fruit 1"),
@@ -122,6 +121,7 @@ def test_two_annotations_that_would_be_one_fruit_are_refused_not_merged(tmp_path
     (tmp_path / "a.json").write_text(json.dumps({"annotations": anns}))
     with pytest.raises(FileFormatError, match=re.escape(message) + r" \(an id given twice, or .*its own id$"):
         coco_masks(tmp_path / "a.json", (10, 10))  # before: both drawn with one label, read as one fruit
+
 
 @pytest.mark.parametrize(
     "data, message",
