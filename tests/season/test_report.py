@@ -257,3 +257,11 @@ def test_write_report_refuses_an_empty_run_path(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(InputError, match="write_report: the run folder is an empty path"):
         write_report("")  # before: the working folder read as the run ('./detections.parquet: no such table')
+
+
+def test_rows_are_grouped_by_recording_in_one_sort_keeping_their_order():
+    from symfruit.season.report import _groups
+
+    keys = np.array(["b", "a", "b", "c", "a", "b"])
+    assert [g.tolist() for g in _groups(keys, ["a", "b"])] == [[1, 4], [0, 2, 5]]  # "c": in no group
+    assert [g.tolist() for g in _groups(keys[:0], ["a"])] == [[]]
