@@ -151,6 +151,20 @@ def test_bad_depth_scales_are_refused(tmp_path, scale):
         read_frame(tmp_path / "f")
 
 
+@pytest.mark.parametrize(
+    "stated, said",
+    [({"depth_scale": 10**400}, r"depth_scale must be .* got 100000000000\.\.\. \(401 digits\)$"),
+     ({"depth_units": ["mm"] * 100_000}, r"unknown depth_units \['mm', .*\(700000 characters\); use one of")],
+)  # fmt: skip
+def test_a_huge_depth_scale_or_units_is_refused_in_a_message_of_bounded_length(tmp_path, stated, said):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), **stated}))
+    with pytest.raises(InputError, match=said) as caught:
+        read_frame(tmp_path / "f")
+    assert len(str(caught.value)) < 400  # before: the 401 digits, or the whole list of 600,000 characters
+
+
 def test_depth_npy_is_checked_and_cleaned(tmp_path):
     color, depth = disc_frame([(80, 60)])
     write_frame(tmp_path / "f", color, depth, CAM)

@@ -195,13 +195,14 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
     if units is not None:
         known = {"m": 1.0, "mm": 0.001, "0.1mm": 0.0001, "cm": 0.01}
         if not isinstance(units, str) or units not in known:  # a list or mapping is no unit (nor hashable)
-            raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
+            raise InputError(f"{cam_path}: unknown depth_units {shown(units)}; use one of {', '.join(known)} or "
+                             "depth_scale")  # fmt: skip
         if isinstance(data, dict) and "depth_scale" in data and data["depth_scale"] != known[units]:
             raise InputError(f"{cam_path}: depth_scale {shown(data['depth_scale'])} and depth_units {units!r} "
                              f"({known[units]:g} m) disagree; which one is meant? Keep one")  # fmt: skip
         scale = known[units]
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:
-        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {scale!r}")
+        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {shown(scale)}")
     return float(scale)
 
 
