@@ -121,8 +121,8 @@ def _named_target(target: Path) -> Path:
             raise OutputError(f"{target}: is a link to {where}, whose folder {where.parent} does not exist; "
                               "not written") from None  # fmt: skip
         return where
-    except OSError as exc:
-        raise OutputError(f"{target}: cannot write ({exc.strerror or exc})", exc.errno) from None
+    except OSError:  # a file where a folder is, a loop of links: the write names it as for any path
+        return where
     if not stat.S_ISREG(mode):
         what = "a pipe" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
         via = f" (through the link to {where})" if where is not target else ""
