@@ -258,6 +258,10 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
          r"fruit 2: id 3 is fruit 1's too; each fruit has its own id"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2},
                      {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, r"fruit 2: id 2 is fruit 1's too"),  # its number
+        # before: numpy read the text "0.3" as 0.3 and true as 1 (metre)
+        ({"fruits": [{"min": [0, 0, "0.3"], "max": [0.1, 0.1, 0.4]}]}, r"fruit 1: min must be three numbers, got "
+         r"\[0, 0, '0\.3'\]"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, True]}]}, r"fruit 1: max must be three numbers"),
     ],
 )  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):

@@ -392,6 +392,16 @@ def test_a_polygon_of_an_odd_number_of_coordinates_is_refused_naming_the_annotat
         read_masks(_write(tmp_path, {"annotations": [{"segmentation": odd}]}, "m.json"), (20, 30))  # a frame's masks
 
 
+@pytest.mark.parametrize("text", ["5", True])
+def test_polygon_coordinates_that_are_text_or_booleans_are_refused_not_read_as_numbers(tmp_path, text):
+    poly = [[3, 5, 11, 5, 11, 9, 3, 9]]
+    poly[0][2] = text
+    path = _write(tmp_path, {"annotations": [{"segmentation": poly}]}, "m.json")
+    with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(polygon "
+                       r"coordinates must be numbers, got (True|'5')\)"):  # fmt: skip
+        read_masks(path, (20, 30))  # before: '5' read as 5 and true as 1
+
+
 @pytest.mark.parametrize(
     ("rle", "message"),
     [

@@ -236,6 +236,10 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
                 seen_ids[fid] = k
             if not ripe:
                 continue
+            for key in ("min", "max"):  # numpy reads "0.3" as 0.3 and true as 1: a corner is numbers
+                corner = item[key]
+                if isinstance(corner, list) and any(isinstance(v, bool | str | bytes) for v in corner):
+                    raise ValueError(f"fruit {k}: {key} must be three numbers, got {shown(corner)}")
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
             if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
                 raise ValueError(f"fruit {k}: min and max need three finite numbers each")

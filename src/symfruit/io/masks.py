@@ -86,6 +86,9 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
         for poly in seg:
             if not isinstance(poly, list) or len(poly) > 2 * MAX_POLYGON_POINTS:
                 raise ValueError("a polygon must be a list of at most 100,000 x, y pairs")
+            text = next((v for v in poly if isinstance(v, bool | str | bytes)), None)
+            if text is not None:  # numpy reads '5' as 5 and true as 1: a coordinate is a number
+                raise ValueError(f"polygon coordinates must be numbers, got {shown(text)}")
             xy = np.asarray(poly, dtype=np.float64)
             if xy.ndim != 1 or not np.isfinite(xy).all():
                 raise ValueError("polygon coordinates must be finite numbers")
