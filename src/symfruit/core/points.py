@@ -149,8 +149,7 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
         raise InputError(f"{name} must be x, y, z in metres, got {points.dtype} times")
     if isinstance(points, np.ma.MaskedArray) and points.dtype.kind in "iuf":
         points = unmasked(points, np.nan)  # a masked coordinate is none: its row dropped as non-finite
-    if _holds_text(points):  # numpy parses '0.3' (and b'0.3') as a number: the API takes numbers only
-        raise InputError(f"{name} must be a numeric (n, 3) array of x, y, z in metres, got text (parse it first)")
+    points = _refuse_text(points, name)  # numpy parses '0.3' (and b'0.3') as a number: the API takes numbers only
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -162,20 +161,21 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     return np.ascontiguousarray(arr)
 
 
-def _holds_text(points: Any) -> bool:
-    """Whether ``points`` (an array or nested sequences) holds a ``str`` or ``bytes`` anywhere."""
-    if isinstance(points, (str, bytes)):
-        return True
-    if not isinstance(points, np.ndarray):
+def _refuse_text(points: Any, name: str) -> Any:
+    """``points`` (as an array where it was nested sequences, so they are converted once), refused where it holds
+    a ``str`` or ``bytes`` anywhere."""
+    if not isinstance(points, (str, bytes, np.ndarray)):
         try:
             points = np.asarray(points)
-        except (TypeError, ValueError):  # ragged or worse: the conversion below names it
-            return False
-    if points.dtype.kind in "SU":
-        return True
-    if points.dtype.kind == "O":  # e.g. numbers and text mixed in an object array
-        return any(isinstance(v, (str, bytes)) for v in points.ravel())
-    return False
+        except (TypeError, ValueError):  # ragged or worse: the conversion that follows names it
+            return points
+    if (
+        isinstance(points, (str, bytes))
+        or points.dtype.kind in "SU"
+        or (points.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in points.ravel()))
+    ):  # an object array: numbers and text mixed
+        raise InputError(f"{name} must be a numeric (n, 3) array of x, y, z in metres, got text (parse it first)")
+    return points
 
 
 def check_cloud(
