@@ -314,7 +314,9 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         return value
     if hint is int:  # a numpy whole number (overrides handed over from arrays) as the Python one
         if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-            raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}")
+            whole = isinstance(value, float) and value.is_integer() and abs(value) < 1e18
+            why = f" (a number with a point or an exponent is a fraction: write {int(value)})" if whole else ""
+            raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}{why}")
         return int(value)
     if hint is float:
         if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
