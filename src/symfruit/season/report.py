@@ -213,6 +213,12 @@ def _errors(output: Path) -> tuple[int, int]:
     return count("failed") + count("unprocessed"), count("recordings")
 
 
+def _cell(text: str) -> str:
+    """``text`` as one Markdown table cell: a ``|`` escaped (it would start another cell: a recording named
+    ``row|1`` shifted its row's numbers one column on), a line break as a space (it would end the row)."""
+    return " ".join(str(text).replace("|", "\\|").split())
+
+
 def _mm(value: float) -> str:
     return "-" if not math.isfinite(value) else f"{value:.1f}"
 
@@ -473,7 +479,7 @@ def _markdown(output: Path, r: Report, per_rec: list[tuple], classes_rows: list[
         "|---|---|---|---|---|---|---|---|",
     ]
     for rec, n, with_fruit, seen, located, mean, most, med in per_rec:
-        lines.append(f"| {rec} | {n:,} | {with_fruit:,} | {seen:,} | {located:,} | "
+        lines.append(f"| {_cell(rec)} | {n:,} | {with_fruit:,} | {seen:,} | {located:,} | "
                      f"{'-' if not math.isfinite(mean) else f'{mean:.2f}'} | {most} | {_mm(med)} |")  # fmt: skip
     shown = [rec for rec, *_ in per_rec if rec in (inputs or {})]
     if shown:
@@ -518,5 +524,5 @@ def _sizes_by_recording(by_rec: Sequence[tuple[str, np.ndarray, np.ndarray]], cl
     for rec, _, d in by_rec:
         p10, p50, p90 = np.percentile(d, [10, 50, 90]) if len(d) else (math.nan,) * 3
         counts = " | ".join(f"{c:,}" for _, c in size_classes(d, classes))
-        lines.append(f"| {rec} | {len(d):,} | {_mm(p10)} | {_mm(p50)} | {_mm(p90)} | {counts} |")
+        lines.append(f"| {_cell(rec)} | {len(d):,} | {_mm(p10)} | {_mm(p50)} | {_mm(p90)} | {counts} |")
     return [*lines, "", "![fruit diameters, by recording](diameters_by_recording.png)", ""]
