@@ -7,7 +7,8 @@ may move results: every instance within 0.1 mm, box faces and centre).
 
 ``run`` takes ``symfruit evaluate``'s own arguments (``--jobs`` included: each worker appends its rows); the
 box rows are ``key, min x/y/z, max x/y/z`` in metres, the key the instance (kind, fruit, pose, occlusion) and the
-method. Run it with ``PYTHONPATH=TREE/src`` to measure another tree.
+method; with ``evaluate --frames FOLDER`` the key is ``frames``, the frame, the fruit's id and the method (every
+fruit matched to the truth). Run it with ``PYTHONPATH=TREE/src`` to measure another tree.
 """
 
 import argparse
@@ -44,7 +45,34 @@ def run(boxes: str, argv: list[str]) -> int:
 
     runner.score_completion = keep_box
     runner._evaluate = evaluate_with_boxes
+    _record_frames(boxes)
     return main(argv)
+
+
+def _record_frames(boxes: str) -> None:
+    """``evaluate --frames``: one row per scored fruit and method, keyed ``frames|frame|fruit id|method`` (the box
+    each score is made of: score_frame scores a box by box_iou once, in the order of its scores)."""
+    import symfruit.evaluate.frames as frames
+
+    iou, score_frame = frames.box_iou, frames.score_frame
+    seen: list = []
+
+    def keep_box(box, truth):
+        seen.append(box)
+        return iou(box, truth)
+
+    def score_with_boxes(*args, **kwargs):
+        seen.clear()
+        scores, counts = score_frame(*args, **kwargs)
+        with open(boxes, "a", newline="") as out:
+            rows = csv.writer(out)  # a frame's name may hold a comma: quoted, as load's csv.reader reads it
+            for s, box in zip(scores, seen, strict=True):
+                values = (repr(float(v)) for v in (*box.min, *box.max))
+                rows.writerow([f"frames|{s.frame}|{s.fruit}|{s.method}", *values])
+        return scores, counts
+
+    frames.box_iou = keep_box
+    frames.score_frame = score_with_boxes
 
 
 def load(path: str) -> dict[str, np.ndarray]:

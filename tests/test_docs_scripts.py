@@ -26,3 +26,37 @@ def test_a_docs_script_imports_and_prints_its_usage(script, tmp_path):
     assert done.returncode == 0, done.stderr[-2000:]
     assert done.stdout.startswith("usage:") and not done.stderr
     assert not any(tmp_path.iterdir())  # --help writes nothing
+
+
+def test_eval_boxes_records_a_box_per_scored_fruit_of_evaluate_frames(tmp_path, monkeypatch):
+    """``eval_boxes.py run ... evaluate --frames``: one row per fruit and method, keyed by frame, fruit id and
+    method (before: no row at all, so a change could not be compared box by box on frames)."""
+    import importlib.util
+
+    import numpy as np
+
+    import symfruit.evaluate.frames as frames
+    from symfruit.core.box import Box
+
+    spec = importlib.util.spec_from_file_location("eval_boxes", DOCS / "eval_boxes.py")
+    eval_boxes = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(eval_boxes)
+    truth = Box(np.array([0.0, 0.0, 0.3]), np.array([0.03, 0.03, 0.33]))
+    boxes = [Box(np.array([0.001 * k, 0.0, 0.3]), np.array([0.03, 0.03, 0.33])) for k in range(3)]
+
+    def score_frame(frame, found, methods, settings, gate=0.03, *, by_id=False):  # as frames.score_frame scores
+        out = []
+        for (name, fruit, method), box in zip(found, boxes, strict=True):
+            out.append(frames.FrameScore(name, fruit, 0, method, frames.box_iou(box, truth), 0.0, 10, False))
+        return out, {}
+
+    monkeypatch.setattr(frames, "score_frame", score_frame)
+    monkeypatch.setattr(frames, "box_iou", frames.box_iou)  # both put back after the test
+    eval_boxes._record_frames(str(tmp_path / "b.csv"))
+    found = [("a,1", 4, "raw"), ("a,1", 4, "sphere"), ("b", 7, "raw")]
+    scores, _ = frames.score_frame(None, found, ["raw", "sphere"], None)
+    assert scores[0].iou == 1.0
+    rows = eval_boxes.load(str(tmp_path / "b.csv"))
+    assert list(rows) == ["frames|a,1|4|raw", "frames|a,1|4|sphere", "frames|b|7|raw"]
+    for values, box in zip(rows.values(), boxes, strict=True):
+        assert np.array_equal(values, np.r_[box.min, box.max])

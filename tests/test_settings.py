@@ -331,6 +331,16 @@ def test_yaml_booleans_where_text_or_numbers_are_expected_are_refused_saying_why
     assert load_settings_text(tmp_path, "sphere:\n  refine: yes\n").sphere.refine is True  # a boolean: YAML's own
 
 
+def test_a_yaml_number_with_an_exponent_is_a_number_where_one_is_expected(tmp_path):
+    s = load_settings_text(tmp_path, "paper:\n  k1: 1e3\ninput:\n  max_extent: 5e-1\n")
+    assert s.paper.k1 == 1000.0 and s.input.max_extent == 0.5  # before: "expected a number, got '1e3'"
+    with pytest.raises(ConfigError, match=r"paper\.k1: must be <= 1e\+06, got 10000000\.0"):
+        load_settings_text(tmp_path, "paper:\n  k1: 1e7\n")  # read as a number, so its bounds apply
+    with pytest.raises(ConfigError, match=r"input\.max_points: expected a whole number, got 20000\.0 \(a number "
+                       r"with a point or an exponent is a fraction: write 20000\)$"):  # fmt: skip
+        load_settings_text(tmp_path, "input:\n  max_points: 2e4\n")
+
+
 def load_settings_text(tmp_path, text):
     (tmp_path / "y.yaml").write_text(text)
     return load_settings(tmp_path / "y.yaml")

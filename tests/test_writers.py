@@ -4,6 +4,7 @@
 import datetime
 import json
 import os
+import stat
 import subprocess
 import sys
 from dataclasses import replace
@@ -155,6 +156,43 @@ def test_write_result_refuses_a_folder(tmp_path):
     with pytest.raises(FileFormatError, match=r"taken\.ply: is a folder; give a file name ending in \.ply"):
         write_result(tmp_path / "taken.ply", complete(VISIBLE, method="raw"))
     assert write_result(tmp_path / "UPPER.PLY", complete(VISIBLE, method="raw"))[1].name == "UPPER.json"
+
+
+def test_write_result_follows_a_link_the_user_named_and_writes_its_target_atomically(tmp_path):
+    elsewhere = tmp_path / "store"
+    elsewhere.mkdir()
+    (elsewhere / "fruit.ply").write_text("old")
+    (tmp_path / "out.ply").symlink_to(elsewhere / "fruit.ply")
+    (tmp_path / "out.json").symlink_to(elsewhere / "record.json")  # a link to a file not yet there
+    ply, record = write_result(tmp_path / "out.ply", complete(VISIBLE, method="raw"))
+    # before: both links replaced by regular files, the targets left as they were
+    assert (tmp_path / "out.ply").is_symlink() and (tmp_path / "out.json").is_symlink()
+    assert (ply, record) == (elsewhere / "fruit.ply", elsewhere / "record.json")
+    assert PlyData.read(str(tmp_path / "out.ply"))["vertex"].count == len(VISIBLE)
+    assert json.loads((tmp_path / "out.json").read_text())["method"] == "raw"
+    assert sorted(p.name for p in elsewhere.iterdir()) == ["fruit.ply", "record.json"]  # no temporary left
+
+
+@pytest.mark.parametrize("how", ["fifo", "link to a fifo", "link into a missing folder"])
+def test_write_result_refuses_a_pipe_and_a_link_to_nowhere_without_replacing_it(tmp_path, how):
+    from symfruit import OutputError
+
+    if how == "fifo":
+        os.mkfifo(tmp_path / "out.ply")
+    elif how == "link to a fifo":
+        os.mkfifo(tmp_path / "pipe")
+        (tmp_path / "out.ply").symlink_to(tmp_path / "pipe")
+    else:
+        (tmp_path / "out.ply").symlink_to(tmp_path / "gone" / "fruit.ply")
+    why = {
+        "fifo": r"out\.ply: is a pipe, not a file",
+        "link to a fifo": r"out\.ply: is a pipe \(through the link",
+        "link into a missing folder": r"out\.ply: is a link to .*gone/fruit\.ply, whose folder .* does not exist",
+    }
+    before = sorted((p.name, p.is_symlink(), stat.S_IFMT(p.lstat().st_mode)) for p in tmp_path.iterdir())
+    with pytest.raises(OutputError, match=why[how]):  # before: replaced by a regular file (a dangling link: ok)
+        write_result(tmp_path / "out.ply", complete(VISIBLE, method="raw"))
+    assert sorted((p.name, p.is_symlink(), stat.S_IFMT(p.lstat().st_mode)) for p in tmp_path.iterdir()) == before
 
 
 class FixedClock(datetime.datetime):

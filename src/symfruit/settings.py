@@ -17,7 +17,8 @@ non-finite numbers raise :class:`~symfruit.errors.ConfigError` with the dotted p
 ``paper.rotations_x: expected a whole number, got 'eleven'``. Nothing is coerced: YAML 1.1 reads an unquoted
 ``yes``/``no``/``on``/``off`` as a boolean, so a boolean where text or a number is expected says so and how to
 quote it (``evidence.outline_profile: off`` is ``False``, refused, not the choice ``'off'``), and quoted ``"yes"``
-for a boolean is refused as text. Every section checks its fields' declared
+for a boolean is refused as text. A number with an exponent (``1e6``) is a number, as in YAML 1.2 and JSON
+(:mod:`symfruit.io.text` reads it so; YAML 1.1 would make it text). Every section checks its fields' declared
 bounds (``setting(..., ge=1)``) and its cross-field rules (:meth:`Section.check`) when it is made, from a
 file or from Python; a failure names the field, and the path is added when it came from a mapping.
 
@@ -313,7 +314,9 @@ def _coerce(value: Any, hint: Any, where: str) -> Any:
         return value
     if hint is int:  # a numpy whole number (overrides handed over from arrays) as the Python one
         if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Integral):
-            raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}")
+            whole = isinstance(value, float) and value.is_integer() and abs(value) < 1e18
+            why = f" (a number with a point or an exponent is a fraction: write {int(value)})" if whole else ""
+            raise ConfigError(f"{where}: expected a whole number, got {_as_read(value, number=True)}{why}")
         return int(value)
     if hint is float:
         if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):

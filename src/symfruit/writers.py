@@ -80,19 +80,22 @@ def check_result_paths(path: str | Path, inputs: Iterable[str | Path | None] = (
     """``(ply, json)``: the two files :func:`write_result` writes for ``path``, checked before any work is
     done: ``path`` ends in ``.ply``, neither is a folder nor one of the run's ``inputs`` (the cloud, the
     intrinsics, the settings file: ``complete a.ply --output a.ply`` would write over the cloud it read).
+    A symbolic link at either name is followed: the file returned is its target, written over atomically.
 
     Raises
     ------
     FileFormatError
         When ``path`` does not end in ``.ply``.
     OutputError
-        When either file is a folder or an input.
+        When either file is a folder, an input, a pipe, socket or device (or a link to one), or a link into a
+        folder that does not exist.
     """
     path = as_path(path, "write_result: the output file")  # '' was the working folder
     if path.suffix.lower() != ".ply":
         raise FileFormatError(f"{path}: the output must end in .ply")
     json_path = path.with_suffix(".json")
     read = {os.path.realpath(p): Path(p) for p in inputs if p is not None}
+    out = []
     for target in (path, json_path):  # both checked before either is written
         if target.is_dir():
             raise OutputError(f"{target}: is a folder; give a file name ending in .ply (the result goes to "
@@ -100,7 +103,32 @@ def check_result_paths(path: str | Path, inputs: Iterable[str | Path | None] = (
         if (given := read.get(os.path.realpath(target))) is not None:
             raise OutputError(f"{target}: is an input of this run ({given}); the result ({path.name} and "
                               f"{json_path.name}) would write over it: choose another output name")  # fmt: skip
-    return path, json_path
+        out.append(_named_target(target))
+    return out[0], out[1]
+
+
+def _named_target(target: Path) -> Path:
+    """Where a file the user names is written: a link there is followed to its target (written atomically
+    beside the target, as the user set the link up), never replaced by a file; a pipe, socket or device (its
+    own or the link's target) is refused, never replaced either."""
+    import stat
+
+    where = Path(os.path.realpath(target)) if target.is_symlink() else target
+    try:
+        mode = os.stat(where).st_mode
+    except FileNotFoundError:
+        if where is not target and not where.parent.is_dir():
+            raise OutputError(f"{target}: is a link to {where}, whose folder {where.parent} does not exist; "
+                              "not written") from None  # fmt: skip
+        return where
+    except OSError:  # a file where a folder is, a loop of links: the write names it as for any path
+        return where
+    if not stat.S_ISREG(mode):
+        what = "a pipe" if stat.S_ISFIFO(mode) else "a socket" if stat.S_ISSOCK(mode) else "a device"
+        via = f" (through the link to {where})" if where is not target else ""
+        raise OutputError(f"{target}: is {what}{via}, not a file; the result is written to regular files only: "
+                          "choose another output name")  # fmt: skip
+    return where
 
 
 def write_result(

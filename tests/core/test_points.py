@@ -243,3 +243,20 @@ def test_as_points_hands_back_an_array_that_is_already_points():
     assert as_points(p.astype(np.float32)).dtype == np.float64
     masked = np.ma.masked_array(p, mask=np.eye(5, 3, dtype=bool))
     assert np.isnan(as_points(masked)[0, 0]) and type(as_points(masked)) is np.ndarray
+
+
+@pytest.mark.parametrize(
+    "points",
+    [
+        [["0.01", "0.0", "0.3"]] * 20,
+        np.array([["0.01", "0.0", "0.3"]] * 20),
+        np.array([[b"0.01", b"0.0", b"0.3"]] * 20),
+        np.array([[0.01, "0.0", 0.3]] * 20, dtype=object),
+        "0.01 0.0 0.3",
+    ],
+    ids=["list of text", "str array", "bytes array", "object array with text", "one string"],
+)
+def test_text_is_refused_not_parsed_as_numbers(points):
+    with pytest.raises(InputError, match=r"^points must be a numeric \(n, 3\) array of x, y, z in metres, got text"):
+        as_points(points)  # before: numpy parsed '0.3' as 0.3 (the one string: 'must be a numeric (n, 3) array')
+    assert as_points(np.array([[0.01, 0.0, 0.3]], dtype=object)).dtype == np.float64  # numbers in objects: fine

@@ -127,3 +127,15 @@ def test_evaluate_spheres_refuses_a_masks_path_that_does_not_exist_before_any_fr
 
     with pytest.raises(SymfruitError, match="no such file or folder"):  # before: every frame skipped with it
         evaluate_spheres(EXAMPLES / "real-frames", methods=("raw",), masks=str(tmp_path / "missing.png"))
+
+
+def test_the_frames_disagreement_is_the_largest_difference_of_one_side_over_every_pair_of_frames():
+    import itertools
+
+    rng = np.random.default_rng(3)
+    sizes = rng.uniform(30.0, 50.0, size=(30, 3, 3))  # frame, sphere, side
+    rows = [SphereBox(f"f{i}", k + 1, "raw", tuple(sizes[i, k]), 40.0) for i in range(30) for k in range(3)]
+    rows += [SphereBox("g", 9, "raw", (1.0, 2.0, 99.0), 2.0), SphereBox("f0", 1, "raw", (0, 0, 0), 0, "failed")]
+    pairs = [np.abs(sizes[i, k] - sizes[j, k]).max() for k in range(3) for i, j in itertools.combinations(range(30), 2)]
+    _, summary = spheres_table(rows, ["raw"])  # one frame of sphere 9 and a failed box: in no pair
+    assert summary[0]["frames_differ_mm"] == max(pairs)  # now one pass over the frames, not every pair of them

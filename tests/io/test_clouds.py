@@ -383,6 +383,20 @@ def test_a_pcd_of_negative_width_and_height_is_refused(tmp_path, shape):
         read_cloud(tmp_path / "a.pcd")  # before: -2 x -1 = 2 points read
 
 
+def test_a_pcd_header_that_repeats_a_field_or_a_line_says_so_not_that_a_field_is_missing(tmp_path):
+    rows = "0 0 0.5 1\n0.01 0 0.5 1\n"
+    head = "VERSION .7\nFIELDS x x z _\nSIZE 4 4 4 4\nTYPE F F F F\nCOUNT 1 1 1 1\nWIDTH 2\nHEIGHT 1\nDATA ascii\n"
+    (tmp_path / "a.pcd").write_text(head + rows)
+    with pytest.raises(FileFormatError, match=r"a\.pcd: PCD header names field 'x' 2 times \(fields: x x z _\)"):
+        read_cloud(tmp_path / "a.pcd")  # before: "PCD has no field 'y'"
+    (tmp_path / "b.pcd").write_text(head.replace("FIELDS x x z _", "FIELDS x y z\nFIELDS x z y _") + rows)
+    with pytest.raises(FileFormatError, match=r"b\.pcd: PCD header has two FIELDS lines$"):
+        read_cloud(tmp_path / "b.pcd")  # before: the last one read, y and z swapped in silence
+    padded = head.replace("x x z _", "x y z _ _").replace("F F F F", "F F F F F").replace("4 4 4 4", "4 4 4 4 4")
+    (tmp_path / "c.pcd").write_text(padded.replace("1 1 1 1", "1 1 1 1 1") + rows.replace(" 1\n", " 1 1\n"))
+    assert read_cloud(tmp_path / "c.pcd").shape == (2, 3)  # PCL's padding field '_' may repeat: it is not read
+
+
 def test_a_npy_of_times_or_a_structured_npy_of_other_fields_than_numbers_is_refused(tmp_path):
     np.save(tmp_path / "times.npy", np.ones((20, 3)).astype("timedelta64[ms]"))  # numpy counts it an integer
     with pytest.raises(FileFormatError, match=r"expected a numeric \(n, 3\) array, got timedelta64\[ms\]"):

@@ -151,6 +151,20 @@ def test_bad_depth_scales_are_refused(tmp_path, scale):
         read_frame(tmp_path / "f")
 
 
+@pytest.mark.parametrize(
+    "stated, said",
+    [({"depth_scale": 10**400}, r"depth_scale must be .* got 100000000000\.\.\. \(401 digits\)$"),
+     ({"depth_units": ["mm"] * 100_000}, r"unknown depth_units \['mm', .*\(600000 characters\); use one of")],
+)  # fmt: skip
+def test_a_huge_depth_scale_or_units_is_refused_in_a_message_of_bounded_length(tmp_path, stated, said):
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    (tmp_path / "f" / "camera.json").write_text(json.dumps({**CAM.to_dict(), **stated}))
+    with pytest.raises(InputError, match=said) as caught:
+        read_frame(tmp_path / "f")
+    assert len(str(caught.value)) < 400  # before: the 401 digits, or the whole list of 600,000 characters
+
+
 def test_depth_npy_is_checked_and_cleaned(tmp_path):
     color, depth = disc_frame([(80, 60)])
     write_frame(tmp_path / "f", color, depth, CAM)
@@ -244,6 +258,10 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
          r"fruit 2: id 3 is fruit 1's too; each fruit has its own id"),
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2},
                      {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, r"fruit 2: id 2 is fruit 1's too"),  # its number
+        # before: numpy read the text "0.3" as 0.3 and true as 1 (metre)
+        ({"fruits": [{"min": [0, 0, "0.3"], "max": [0.1, 0.1, 0.4]}]}, r"fruit 1: min must be three numbers, got "
+         r"\[0, 0, '0\.3'\]"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, True]}]}, r"fruit 1: max must be three numbers"),
     ],
 )  # fmt: skip
 def test_malformed_truth_names_the_file(tmp_path, truth, message):

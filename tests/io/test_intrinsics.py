@@ -246,3 +246,15 @@ def test_a_transposed_or_scaled_matrix_and_a_value_given_twice_are_refused(tmp_p
         load_camera(_written(tmp_path / "cam.json", base | data))
     right = {"K": [615, 0, 320, 0, 615, 240, 0, 0, 1]}, {"intrinsic_matrix": [615, 0, 0, 0, 615, 0, 320, 240, 1]}
     assert {camera_from_dict(base | r) for r in right} == {Camera(615, 615, 320, 240, 640, 480)}
+
+
+def test_intrinsics_given_twice_under_two_nests_that_differ_are_refused_not_one_taken(tmp_path):
+    colour = {"fx": 615, "fy": 615, "cx": 320, "cy": 240, "width": 640, "height": 480}
+    depth = {"fx": 380, "fy": 380, "cx": 212, "cy": 120, "width": 424, "height": 240}
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps({"intrinsics": depth, "color": colour}))
+    with pytest.raises(FileFormatError, match=r"cam\.json: intrinsics are given twice, under 'intrinsics' and "
+                       r"'color', and they differ: which one is meant\? Keep one$"):  # fmt: skip
+        load_camera(path)  # before: 'intrinsics' read, the colour camera's left unsaid
+    path.write_text(json.dumps({"color": colour, "colour": colour, "depth": depth}))  # the same twice: no doubt
+    assert load_camera(path).fx == 615

@@ -109,6 +109,21 @@ def test_coco_uses_the_first_image_and_ids_or_order(tmp_path):
 
 
 @pytest.mark.parametrize(
+    "ids, message",
+    [((7, 7), "annotations 1 and 2 would both be fruit 7"), ((None, 1), "annotations 1 and 2 would both be fruit 1"),
+     ((2, None), "annotations 1 and 2 would both be fruit 2")],
+)  # fmt: skip
+def test_two_annotations_that_would_be_one_fruit_are_refused_not_merged(tmp_path, ids, message):
+    anns = [{"segmentation": [[x, 0, x + 3, 0, x + 3, 3, x, 3]]} for x in (0, 5)]
+    for ann, ident in zip(anns, ids, strict=True):
+        if ident is not None:
+            ann["id"] = ident
+    (tmp_path / "a.json").write_text(json.dumps({"annotations": anns}))
+    with pytest.raises(FileFormatError, match=re.escape(message) + r" \(an id given twice, or .*its own id$"):
+        coco_masks(tmp_path / "a.json", (10, 10))  # before: both drawn with one label, read as one fruit
+
+
+@pytest.mark.parametrize(
     "data, message",
     [
         ({"annotations": {"a": 1}}, "expected a COCO 'annotations' list"),
@@ -375,6 +390,16 @@ def test_a_polygon_of_an_odd_number_of_coordinates_is_refused_naming_the_annotat
         c.instances("a.jpg", (20, 30))
     with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(a polygon has 9"):
         read_masks(_write(tmp_path, {"annotations": [{"segmentation": odd}]}, "m.json"), (20, 30))  # a frame's masks
+
+
+@pytest.mark.parametrize("text", ["5", True])
+def test_polygon_coordinates_that_are_text_or_booleans_are_refused_not_read_as_numbers(tmp_path, text):
+    poly = [[3, 5, 11, 5, 11, 9, 3, 9]]
+    poly[0][2] = text
+    path = _write(tmp_path, {"annotations": [{"segmentation": poly}]}, "m.json")
+    with pytest.raises(FileFormatError, match=r"m\.json: annotation 1 has no valid segmentation \(polygon "
+                       r"coordinates must be numbers, got (True|'5')\)"):  # fmt: skip
+        read_masks(path, (20, 30))  # before: '5' read as 5 and true as 1
 
 
 @pytest.mark.parametrize(

@@ -173,3 +173,15 @@ def test_yaml_octal_and_base_60_numbers_are_refused_not_read_as_another_number(t
     assert read_structured(path, what="settings file", max_bytes=1 << 20) == {
         "a": 10, "b": 0, "c": 16, "d": 1000, "e": 0.5, "f": "010", "g": -7
     }  # fmt: skip
+
+
+def test_yaml_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2(tmp_path):
+    path = tmp_path / "settings.yaml"
+    path.write_text("a: 1e6\nb: -2.5E-3\nc: .5e3\nd: 1.0e6\ne: 1.0e+6\nf: '1e6'\ng: 1e\nh: e6\ni: [1E2, +1e-2]\n")
+    # before: 'a', 'b', 'c', 'd' and 'i' were text (YAML 1.1 wants a dot and a signed exponent)
+    assert read_structured(path, what="settings file", max_bytes=1 << 20) == {
+        "a": 1e6, "b": -2.5e-3, "c": 500.0, "d": 1e6, "e": 1e6, "f": "1e6", "g": "1e", "h": "e6", "i": [100.0, 0.01]
+    }  # fmt: skip
+    import yaml
+
+    assert yaml.safe_load("1e6") == "1e6"  # PyYAML's own loader is left as it is

@@ -257,3 +257,27 @@ def test_write_report_refuses_an_empty_run_path(tmp_path, monkeypatch):
     monkeypatch.chdir(tmp_path)
     with pytest.raises(InputError, match="write_report: the run folder is an empty path"):
         write_report("")  # before: the working folder read as the run ('./detections.parquet: no such table')
+
+
+def test_rows_are_grouped_by_recording_in_one_sort_keeping_their_order():
+    from symfruit.season.report import _groups
+
+    keys = np.array(["b", "a", "b", "c", "a", "b"])
+    assert [g.tolist() for g in _groups(keys, ["a", "b"])] == [[1, 4], [0, 2, 5]]  # "c": in no group
+    assert [g.tolist() for g in _groups(keys[:0], ["a"])] == [[]]
+
+
+def test_a_recording_name_holding_a_bar_or_a_line_break_stays_in_its_table_cell(tmp_path):
+    from symfruit.season.table import frame_rows
+
+    out = tmp_path / "out"
+    out.mkdir()
+    with TableWriter(out) as table:
+        table.add(*frame_rows(_record("a", [(0.02, 0.03, 0.012)]), "row|1"))
+        table.add(*frame_rows(_record("b", [(0.03, 0.02, 0.01)]), "row\n2"))
+    write_report(out)
+    rows = [line for line in (out / "report" / "report.md").read_text().splitlines() if line.startswith("| row")]
+    # before: "| row|1 | 1 | ..." (its numbers one column on) and a row cut in two by the line break
+    assert rows[0].startswith("| row\\|1 | 1 | 1 | 1 | 1 |") and rows[1].startswith("| row 2 | 1 | 1 | 1 | 1 |")
+    assert len(rows) == 4 and all(row.replace("\\|", "").count("|") == rows[0].replace("\\|", "").count("|")
+                                  for row in rows[:2])  # fmt: skip

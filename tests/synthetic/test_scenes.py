@@ -214,3 +214,28 @@ def test_write_scenes_refuses_an_empty_output_path(tmp_path, monkeypatch):
     with pytest.raises(InputError, match="write_scenes: the output folder is an empty path"):
         write_scenes("", 1)  # before: scene_00000 written into the working folder
     assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("links", [True, False])
+def test_repeated_frames_are_put_in_place_atomically_never_written_into(tmp_path, monkeypatch, links):
+    import os
+
+    out = tmp_path / "out"
+    write_scenes(out, 2, distinct=1, n_ripe=1, n_unripe=0, n_leaves=0)
+    keep = tmp_path / "keep.png"  # a file outside the output folder that an earlier frame file is a link to
+    keep.write_bytes(b"not to be touched")
+    (out / "scene_00001" / "color.png").unlink()
+    os.link(keep, out / "scene_00001" / "color.png")
+    if not links:  # a file system without hard links: the copies must be atomic too
+
+        def no_link(*args, **kwargs):
+            raise OSError(1, "Operation not permitted")
+
+        monkeypatch.setattr(os, "link", no_link)
+    write_scenes(out, 2, distinct=1, n_ripe=1, n_unripe=0, n_leaves=0)
+    assert keep.read_bytes() == b"not to be touched"  # before: the copy was written into the linked file
+    first, second = (sorted(p.name for p in (out / f"scene_0000{i}").iterdir()) for i in (0, 1))
+    assert first == second  # no temporary left
+    for name in first:
+        a, b = out / "scene_00000" / name, out / "scene_00001" / name
+        assert a.read_bytes() == b.read_bytes() and os.path.samefile(a, b) is links

@@ -127,7 +127,8 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     Raises
     ------
     InputError
-        When ``points`` is not numeric, not real, not ``(n, 3)``, or has fewer than ``min_count`` rows.
+        When ``points`` is not numeric (text is refused, even text of numbers: numpy would parse it), not real,
+        not ``(n, 3)``, or has fewer than ``min_count`` rows.
 
     A masked coordinate of a :class:`numpy.ma.MaskedArray` is NaN (no measurement: :func:`check_cloud` drops its
     row and counts it), never the value the mask hides.
@@ -148,6 +149,7 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
         raise InputError(f"{name} must be x, y, z in metres, got {points.dtype} times")
     if isinstance(points, np.ma.MaskedArray) and points.dtype.kind in "iuf":
         points = unmasked(points, np.nan)  # a masked coordinate is none: its row dropped as non-finite
+    points = _refuse_text(points, name)  # numpy parses '0.3' (and b'0.3') as a number: the API takes numbers only
     try:
         arr = np.asarray(points, dtype=np.float64)
     except (TypeError, ValueError):
@@ -157,6 +159,23 @@ def as_points(points: Any, *, min_count: int = 1, name: str = "points") -> np.nd
     if len(arr) < min_count:
         raise InputError(f"{name} must hold at least {min_count} points, got {len(arr)}")
     return np.ascontiguousarray(arr)
+
+
+def _refuse_text(points: Any, name: str) -> Any:
+    """``points`` (as an array where it was nested sequences, so they are converted once), refused where it holds
+    a ``str`` or ``bytes`` anywhere."""
+    if not isinstance(points, (str, bytes, np.ndarray)):
+        try:
+            points = np.asarray(points)
+        except (TypeError, ValueError):  # ragged or worse: the conversion that follows names it
+            return points
+    if (
+        isinstance(points, (str, bytes))
+        or points.dtype.kind in "SU"
+        or (points.dtype.kind == "O" and any(isinstance(v, (str, bytes)) for v in points.ravel()))
+    ):  # an object array: numbers and text mixed
+        raise InputError(f"{name} must be a numeric (n, 3) array of x, y, z in metres, got text (parse it first)")
+    return points
 
 
 def check_cloud(

@@ -135,15 +135,16 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
         cube = np.array([r.cube_mm for r in ok])
         depth = np.array([r.depth_mm for r in ok])
         lateral = np.array([r.lateral_mm for r in ok])
-        differ = [
-            float(np.max(np.abs(np.subtract(a.size, b.size))))
-            for k in spheres
-            for i, a in enumerate([r for r in ok if r.sphere == k])
-            for b in [r for r in ok if r.sphere == k][i + 1 :]
-        ]
+        by_sphere: dict[int, list[SphereBox]] = {k: [] for k in spheres}
+        for r in ok:
+            by_sphere[r.sphere].append(r)
+        # the largest difference of one side between two frames: of each side, its largest less its least (the
+        # same as over every pair of frames, without the pairs: a recording of n frames has n^2 / 2)
+        differ = [float(np.ptp([r.size for r in boxes], axis=0).max()) for boxes in by_sphere.values()
+                  if len(boxes) > 1]  # fmt: skip
         cells = []
         for k in spheres:
-            boxes = [r for r in ok if r.sphere == k]
+            boxes = by_sphere[k]
             cells.append(" / ".join("x".join(f"{v:.0f}" for v in r.size) for r in boxes) or "failed")
         worst = max(differ) if differ else float("nan")
         lines.append(

@@ -7,8 +7,9 @@ folders from the output folder down to the file are opened one at a time without
 descriptor: a sub-folder that is a symbolic link (to a folder elsewhere) is refused by name, never followed,
 so nothing is written outside the output folder, even when a link is swapped in while the run goes on; and
 the output folder refuses a path that is one of the run's inputs. A path the user names directly
-(``--output`` of ``complete``) is theirs: links in it are followed as the user set them up; only the
-temporary file is created without following one.
+(``--output`` of ``complete``) is theirs: links in its folders are followed as the user set them up, and
+:func:`symfruit.writers.write_result` follows a link at the file itself to its target (this module replaces a
+link at the file name, never writes through it); only the temporary file is created without following one.
 """
 
 from __future__ import annotations

@@ -271,6 +271,8 @@ def read_pcd(path: Path) -> np.ndarray:
     for line in header.decode("ascii", errors="replace").splitlines():
         parts = line.split()
         if parts and not parts[0].startswith("#"):
+            if parts[0].upper() in fields:  # the last would win in silence: which one is meant?
+                raise FileFormatError(f"{path}: PCD header has two {parts[0].upper()} lines")
             fields[parts[0].upper()] = parts[1:]
     try:
         names = fields["FIELDS"]
@@ -298,6 +300,10 @@ def read_pcd(path: Path) -> np.ndarray:
             )
     if n > MAX_CLOUD_POINTS:
         raise FileFormatError(f"{path}: PCD holds {n:,} points; at most {MAX_CLOUD_POINTS:,} are read")
+    twice = [c for c in ("x", "y", "z") if names.count(c) > 1]  # PCL's padding fields '_' may repeat
+    if twice:
+        raise FileFormatError(f"{path}: PCD header names field {twice[0]!r} {names.count(twice[0])} times "
+                              f"(fields: {' '.join(names)}); which one is meant?")  # fmt: skip
     missing = [c for c in ("x", "y", "z") if c not in names]
     if missing:
         raise FileFormatError(f"{path}: PCD has no field {missing[0]!r} (fields: {' '.join(names)})")

@@ -195,13 +195,14 @@ def _depth_scale(cam_path: Path, data: Any) -> float:
     if units is not None:
         known = {"m": 1.0, "mm": 0.001, "0.1mm": 0.0001, "cm": 0.01}
         if not isinstance(units, str) or units not in known:  # a list or mapping is no unit (nor hashable)
-            raise InputError(f"{cam_path}: unknown depth_units {units!r}; use one of {', '.join(known)} or depth_scale")
+            raise InputError(f"{cam_path}: unknown depth_units {shown(units)}; use one of {', '.join(known)} or "
+                             "depth_scale")  # fmt: skip
         if isinstance(data, dict) and "depth_scale" in data and data["depth_scale"] != known[units]:
             raise InputError(f"{cam_path}: depth_scale {shown(data['depth_scale'])} and depth_units {units!r} "
                              f"({known[units]:g} m) disagree; which one is meant? Keep one")  # fmt: skip
         scale = known[units]
     if isinstance(scale, bool) or not isinstance(scale, (int, float)) or not 0 < scale <= 1:
-        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {scale!r}")
+        raise InputError(f"{cam_path}: depth_scale must be metres per unit in (0, 1], got {shown(scale)}")
     return float(scale)
 
 
@@ -235,6 +236,10 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
                 seen_ids[fid] = k
             if not ripe:
                 continue
+            for key in ("min", "max"):  # numpy reads "0.3" as 0.3 and true as 1: a corner is numbers
+                corner = item[key]
+                if isinstance(corner, list) and any(isinstance(v, bool | str | bytes) for v in corner):
+                    raise ValueError(f"fruit {k}: {key} must be three numbers, got {shown(corner)}")
             lo, hi = np.array(item["min"], dtype=np.float64), np.array(item["max"], dtype=np.float64)
             if lo.shape != (3,) or hi.shape != (3,) or not (np.isfinite(lo).all() and np.isfinite(hi).all()):
                 raise ValueError(f"fruit {k}: min and max need three finite numbers each")

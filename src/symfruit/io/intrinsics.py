@@ -72,7 +72,12 @@ def _nest(data: dict) -> str | None:
     ``data`` is a layout itself or has no nest."""
     if _LAYOUT_MARKS & set(data):
         return None
-    return next((key for key in _NESTS if isinstance(data.get(key), dict)), None)
+    nests = [key for key in _NESTS if isinstance(data.get(key), dict)]
+    holding = [key for key in nests if _LAYOUT_MARKS & set(data[key]) or _nest(data[key]) is not None]
+    if any(data[key] != data[holding[0]] for key in holding[1:]):  # taking the first would be a guess
+        raise InputError(f"intrinsics are given twice, under {' and '.join(repr(k) for k in holding)}, and they "
+                         "differ: which one is meant? Keep one")  # fmt: skip
+    return nests[0] if nests else None
 
 
 def load_camera(path: str | Path) -> Camera:

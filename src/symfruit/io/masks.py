@@ -86,6 +86,9 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
         for poly in seg:
             if not isinstance(poly, list) or len(poly) > 2 * MAX_POLYGON_POINTS:
                 raise ValueError("a polygon must be a list of at most 100,000 x, y pairs")
+            text = next((v for v in poly if isinstance(v, bool | str | bytes)), None)
+            if text is not None:  # numpy reads '5' as 5 and true as 1: a coordinate is a number
+                raise ValueError(f"polygon coordinates must be numbers, got {shown(text)}")
             xy = np.asarray(poly, dtype=np.float64)
             if xy.ndim != 1 or not np.isfinite(xy).all():
                 raise ValueError("polygon coordinates must be finite numbers")
@@ -129,13 +132,18 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     if len(anns) > MAX_INSTANCES_PER_IMAGE:
         raise FileFormatError(f"{path}: {len(anns)} annotations for one image; at most {MAX_INSTANCES_PER_IMAGE}")
     h, w = _check_shape(shape, str(path))
-    labels = np.zeros((h, w), np.int32)
+    idents: dict[int, int] = {}  # label -> the annotation drawn with it: two fruit drawn as one label are one fruit
     for k, ann in enumerate(anns, 1):
-        if not isinstance(ann, dict):
-            raise FileFormatError(f"{path}: annotation {k} is not an object")
-        mask = annotation_mask(ann, (h, w), f"{path}: annotation {k}")
         ident = ann.get("id")
-        labels[mask] = ident if isinstance(ident, int) and not isinstance(ident, bool) and 0 < ident < 2**31 else k
+        label = ident if isinstance(ident, int) and not isinstance(ident, bool) and 0 < ident < 2**31 else k
+        if label in idents:
+            raise FileFormatError(f"{path}: annotations {idents[label]} and {k} would both be fruit {label} (an id "
+                                  "given twice, or an annotation without an id numbered by its place); each fruit "
+                                  "needs its own id")  # fmt: skip
+        idents[label] = k
+    labels = np.zeros((h, w), np.int32)
+    for k, (ann, label) in enumerate(zip(anns, idents, strict=True), 1):
+        labels[annotation_mask(ann, (h, w), f"{path}: annotation {k}")] = label
     return labels
 
 

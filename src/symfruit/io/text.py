@@ -9,12 +9,15 @@ safely, errors naming the file.
 * A key repeated in one mapping (JSON object or YAML mapping) is refused naming it: parsers keep the last in
   silence, so ``translations: 3`` above ``translations: 5`` would be dropped unsaid.
 * YAML 1.1's octal and base-60 numbers are refused: ``010`` would be read as 8 and ``1:30`` as 90 in silence.
+* A number with an exponent is a number, as in YAML 1.2 and JSON: ``1e6`` is 1000000.0, not the text YAML 1.1
+  makes of it (1.1 wants a dot and a signed exponent, ``1.0e+6``).
 """
 
 from __future__ import annotations
 
 import json
 import os
+import re
 import stat
 from pathlib import Path
 from typing import Any
@@ -143,7 +146,13 @@ def _yaml_loader() -> type:
 
     _NoAliasLoader.add_constructor("tag:yaml.org,2002:int", decimal_only("int"))
     _NoAliasLoader.add_constructor("tag:yaml.org,2002:float", decimal_only("float"))
+    # YAML 1.2's (and JSON's) exponent forms YAML 1.1 reads as text: 1e6, 2.5E-3, .5e3, 1.0e6 (no dot or no sign)
+    _NoAliasLoader.add_implicit_resolver("tag:yaml.org,2002:float", _EXPONENT, list("-+0123456789."))
     return _NoAliasLoader
+
+
+#: A decimal number with an exponent in YAML 1.2's core schema that YAML 1.1 does not read as a number.
+_EXPONENT = re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9][0-9_]*)[eE][-+]?[0-9]+$")
 
 
 def _unique_keys(pairs: list[tuple[str, Any]]) -> dict[str, Any]:

@@ -10,7 +10,9 @@ z-buffer of :mod:`symfruit.synthetic.render`, shaded, and given the D435-like de
 from __future__ import annotations
 
 import colorsys
+import contextlib
 import os
+import secrets
 import shutil
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
@@ -22,6 +24,7 @@ from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
 from ..core.points import perpendicular_basis
 from ..errors import OutputError
+from ..io.atomic import atomic_write, folder_fd
 from ..io.text import as_path
 from .render import SensorNoise, render
 from .sensors import SENSOR_MODELS, SensorModel, apply_sensor
@@ -432,9 +435,9 @@ def write_scenes(
 ) -> list[Path]:  # fmt: skip
     """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
     ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
-    (copies where links are impossible), so a long recording costs little time and disk. Through a real
-    camera model (``sensor``) each folder also gets the annotators' ``masks.png`` (which ``detect`` and
-    ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
+    (copies where links are impossible; either put in place atomically), so a long recording costs little time
+    and disk. Through a real camera model (``sensor``) each folder also gets the annotators' ``masks.png``
+    (which ``detect`` and ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
     (:func:`make_tree_scene`, ``n_ripe`` apples and ``n_unripe`` green ones a frame, through ``sensor`` or the
     Azure Kinect model; ``n_leaves`` is not used).
 
@@ -470,14 +473,30 @@ def _write_scenes(
             continue
         if target.is_symlink():
             raise OutputError(f"{target}: is a symbolic link; symfruit does not write through links inside {folder}")
-        target.mkdir(parents=True, exist_ok=True)
-        for path in written[i % unique].iterdir():
-            try:
-                os.link(path, target / path.name)
-            except OSError:
-                shutil.copy2(path, target / path.name)
+        with folder_fd(target) as fd:  # made where missing; inside the output folder no link is followed
+            for path in written[i % unique].iterdir():
+                _repeat(path, target / path.name, fd)
         written.append(target)
     return written
+
+
+def _repeat(source: Path, target: Path, fd: int) -> None:
+    """Put ``target`` (in the folder open as ``fd``) in place as a hard link to ``source``, or where links are
+    impossible as a copy, either one atomically: made under a temporary name and renamed over ``target``, so a
+    file that is there (an earlier run's, maybe a link to a file elsewhere) is replaced, never written into."""
+    tmp = f".{target.name[:200]}.{os.getpid()}-{secrets.token_hex(4)}.tmp"  # the name io.atomic gives its own
+    try:
+        os.link(source, tmp, dst_dir_fd=fd)
+    except OSError:  # another file system, or none that links: a copy, written atomically
+        with atomic_write(target, "wb") as out, open(source, "rb") as src:
+            shutil.copyfileobj(src, out)
+        return
+    try:
+        os.replace(tmp, target.name, src_dir_fd=fd, dst_dir_fd=fd)
+    except OSError as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp, dir_fd=fd)
+        raise OutputError(f"{target}: cannot write ({exc.strerror or exc})", exc.errno) from None
 
 
 def make_photo(
