@@ -199,6 +199,38 @@ def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_
             assert got.max[0] == pytest.approx(box.max[0] + share * (sil_hi - box.max[0]), rel=1e-9)
 
 
+def test_a_cut_outlines_prior_width_moves_towards_its_larger_width():
+    """``fuse_depth``'s width for the depth prior: a whole outline's is the geometric mean of its widths; a half
+    disc (a leaf across a ball of 40 px, the half below hidden) is a diameter wide and a radius high, and the
+    more of its outline is a cut, the nearer its width to the diameter (the geometric mean's 0.71 of it), never
+    beyond; ``cut_width = 0`` keeps the geometric mean."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth, prior_width
+
+    cam = DEFAULT_CAMERA
+    mask = np.zeros((60, 60), bool)
+    yy, xx = np.mgrid[:60, :60]
+    mask[(np.hypot(yy - 39.5, xx - 29.5) <= 20) & (yy < 40)] = True  # the upper half of a disc 40 px across
+    region = Silhouette(int(cam.cx) - 30, int(cam.cy) - 40, mask, 0.0)
+    across = across_sight(region, cam)
+    geo, big = np.sqrt(across.minor * across.major), max(across.minor, across.major)
+    assert big * cam.fx == pytest.approx(40.0, abs=1.0) and geo / big == pytest.approx(np.sqrt(0.5), abs=0.02)
+    box = Box(np.array([-0.02, -0.02, 0.5]), np.array([0.02, 0.0, 0.52]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+    widths = []
+    for contour in (1.0, 0.6, 0.3, 0.0):
+        combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
+        _, _, width = fuse_depth(combined, [cand], region, cam, s=EvidenceSettings(), across=across)
+        widths.append(width / (box.centre[2] / across.axis[2]))
+        assert widths[-1] == pytest.approx(prior_width(across, contour), rel=1e-12)
+        off = EvidenceSettings(cut_width=0.0)
+        assert fuse_depth(combined, [cand], region, cam, s=off, across=across)[2] == pytest.approx(
+            geo * box.centre[2] / across.axis[2], rel=1e-12)  # fmt: skip
+    assert widths[0] == pytest.approx(geo, rel=1e-12) and widths[-1] == pytest.approx(big, rel=1e-12)
+    assert np.all(np.diff(widths) > 0)
+
+
 def test_a_runaway_fit_does_not_win():
     """The paper protocol's generated banana of seed 1 whose solid of revolution and sphere ran away (245 mm)."""
     inst = build(Spec("paper", "banana", 2, 1, seed=1))
