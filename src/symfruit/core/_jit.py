@@ -2870,40 +2870,51 @@ def occlusion_window(
             elif not x >= hi:
                 pending[r, c] = True
                 rows[r] = True
-    # nearest()'s column pass: each pixel's nearest point pixel in its column, the upper of two as near
-    near = np.empty((h, w), np.int64)
-    for c in range(w):
-        near[0, c] = 0 if math.isfinite(own_z[0, c]) else -1
-    for r in range(1, h):
+    # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
+    # the rows looked at alone: the nearest at or above by a sweep down, the nearest below by a sweep up
+    place = np.full(h, -1, np.int64)
+    count = 0
+    for r in range(h):
+        if rows[r]:
+            place[r] = count
+            count += 1
+    near = np.empty((count, w), np.int64)
+    run = np.full(w, -1, np.int64)
+    for r in range(h):
         for c in range(w):
-            near[r, c] = r if math.isfinite(own_z[r, c]) else near[r - 1, c]
-    below = np.full(w, -1, np.int64)
+            if math.isfinite(own_z[r, c]):
+                run[c] = r
+        if place[r] >= 0:
+            near[place[r], :] = run
+    run[:] = -1
     for r in range(h - 1, -1, -1):
         for c in range(w):
             if math.isfinite(own_z[r, c]):
-                below[c] = r
-            b = below[c]
-            if b >= 0:
-                a = near[r, c]
-                if a < 0 or b - r < r - a:
-                    near[r, c] = b
+                run[c] = r
+        kr = place[r]
+        if kr >= 0:
+            for c in range(w):
+                a, b = near[kr, c], run[c]
+                if b >= 0 and (a < 0 or b - r < r - a):
+                    near[kr, c] = b
     env = np.empty(w, np.int64)
     done = 0
     for r in range(h):
         if not rows[r]:
             continue
         done += 1
+        kr = place[r]
         top = -1  # nearest()'s row pass, the same envelope and the same walk along it
         for u in range(w):
-            if near[r, u] < 0:
+            if near[kr, u] < 0:
                 continue
-            dw = near[r, u] - r
+            dw = near[kr, u] - r
             wr = dw * dw
             while top >= 1:
                 i1, i0 = env[top], env[top - 1]
                 a, b = i1 - i0, u - i1
                 cs = a + b
-                d0, d1 = near[r, i0] - r, near[r, i1] - r
+                d0, d1 = near[kr, i0] - r, near[kr, i1] - r
                 if cs * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * cs <= 0:
                     break
                 top -= 1
@@ -2912,11 +2923,11 @@ def occlusion_window(
         q = 0
         for u in range(w):
             i = env[q]
-            dr, dc = near[r, i] - r, i - u
+            dr, dc = near[kr, i] - r, i - u
             best = dr * dr + dc * dc
             while q < top:
                 i = env[q + 1]
-                dr, dc = near[r, i] - r, i - u
+                dr, dc = near[kr, i] - r, i - u
                 d = dr * dr + dc * dc
                 if best <= d:
                     break
@@ -2924,7 +2935,7 @@ def occlusion_window(
                 q += 1
             if pending[r, u]:
                 i = env[q]
-                ref = own_z[near[r, i], i] + tolerance
+                ref = own_z[near[kr, i], i] + tolerance
                 x = seen[r, u]
                 hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
     return done
