@@ -288,7 +288,9 @@ def occlusion(
 
     Where numba is installed the maps are made in one compiled pass over the window
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
-    maps, bit for bit; the benchmark frame's 9 windows 4.9 against 9.1 ms; issue 19, fourteenth round).
+    maps, bit for bit; the benchmark frame's 9 windows 4.9 against 9.1 ms; issue 19, fourteenth round), the
+    nearest point pixels looked for only where they decide, on the rows holding such pixels
+    (:func:`symfruit.core._jit.occlusion_window`: the same maps; 2.0 against 3.0 ms; eighteenth round).
 
     Parameters
     ----------
