@@ -312,3 +312,22 @@ def test_a_label_file_for_a_frame_must_carry_its_colour_images_exif_orientation(
         frame_masks(frame, str(tmp_path / "m.png"))
     tagged = replace(frame, extras={"color_file": ("f/color.jpg", 3)})  # a frame folder's colour, turned alike
     assert np.array_equal(frame_masks(tagged, str(tmp_path / "m.png"))[0], labels[::-1, ::-1])
+
+
+def test_a_windows_camera_is_the_constructors():
+    """_window_camera: the camera Camera(...) makes of a window, field for field (types too), equal and hashed alike;
+    a principal point moved beyond the bound is refused as the constructor refuses it."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.limits import MAX_FOCAL_PX
+    from symfruit.detect import _window_camera
+    from symfruit.errors import InputError
+
+    cam = Camera(fx=600.0, fy=610.0, cx=320.5, cy=240.0, width=640, height=480)
+    for r0, r1, c0, c1 in ((0, 480, 0, 640), (10, 60, 300, 420), (479, 480, 639, 640)):
+        local = _window_camera(cam, r0, r1, c0, c1)
+        want = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
+        assert local == want and hash(local) == hash(want) and vars(local) == vars(want)
+        assert [type(v) for v in vars(local).values()] == [type(v) for v in vars(want).values()]
+    far = Camera(fx=600.0, fy=600.0, cx=MAX_FOCAL_PX, cy=240.0, width=640, height=480)
+    with pytest.raises(InputError, match="implausible"):
+        _window_camera(far, 0, 10, -5, 10)

@@ -17,7 +17,7 @@ import numpy as np
 from .core.box import Box
 from .core.camera import Camera
 from .core.frame import Frame
-from .core.limits import MAX_INSTANCES, instance_labels
+from .core.limits import MAX_FOCAL_PX, MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .core.raster import mask_box
 from .errors import InputError, SymfruitError
@@ -249,6 +249,20 @@ def _leafy(color: np.ndarray, shift: tuple[int, int], window: tuple[int, int, in
     return out
 
 
+def _window_camera(cam: Camera, r0: int, r1: int, c0: int, c1: int) -> Camera:
+    """``Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)``, the camera of
+    rows ``r0:r1`` and columns ``c0:c1`` (a window within the image) of ``cam``'s image, made without the checks a
+    window of a valid camera passes but for its principal point's bound (which it may fail: the constructor then
+    raises as it would): its focal lengths are the camera's, its size whole numbers within the image's. The checks
+    cost 16 us a fruit (issue 19, eighteenth round)."""
+    cx, cy = cam.cx - c0, cam.cy - r0
+    if abs(cx) > MAX_FOCAL_PX or abs(cy) > MAX_FOCAL_PX:
+        return Camera(fx=cam.fx, fy=cam.fy, cx=cx, cy=cy, width=c1 - c0, height=r1 - r0)
+    local = object.__new__(Camera)
+    local.__dict__.update(fx=cam.fx, fy=cam.fy, cx=cx, cy=cy, width=int(c1 - c0), height=int(r1 - r0))
+    return local
+
+
 def _extract_window(
     mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings,
     *, color: np.ndarray | None = None, shift: tuple[int, int] = (0, 0),
@@ -259,7 +273,7 @@ def _extract_window(
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
     c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
     window = mask[r0:r1, c0:c1]
-    local = Camera(fx=cam.fx, fy=cam.fy, cx=cam.cx - c0, cy=cam.cy - r0, width=c1 - c0, height=r1 - r0)
+    local = _window_camera(cam, r0, r1, c0, c1)
     leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
     ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)

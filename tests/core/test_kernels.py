@@ -2040,3 +2040,102 @@ def test_the_ground_colour_candidates_are_the_twins(seed, size, strided):
     assert not (fast & ~_ground(c)).any()
     if h >= 8 and w >= 8:
         assert fast.any() and (_ground(c) & ~fast).any()
+
+
+# --- issue 19, eighteenth round (stop 38): registration, extraction, occlusion -------------------------------------
+
+
+def _steps_within(reach: int) -> np.ndarray:
+    """core.occlusion's offsets within ``reach``, nearest first, as the kernels read them."""
+    from symfruit.core.occlusion import _steps
+
+    return _steps(reach)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(0, 3), st.booleans(),
+       st.booleans(), st.sampled_from([0.0, 0.005, -0.005]), st.floats(0.0, 0.05))  # fmt: skip
+def test_the_occlusion_window_is_the_maps_after_the_nearest_pixels(seed, h, w, reach, single, with_others, tol, spread):
+    """occlusion_window against occlusion_maps after nearest of the points' pixels: the same hidden pixels and seen
+    depths, bit for bit, on windows whose depths and point depths come from a few values (ties between equally near
+    point pixels of different depths, depths on the bounds), dropouts as 0 and NaN, float32 and float64, with other
+    fruit or without, bounds at the points' least and greatest depth or wider; and some rows looked at, not all."""
+    rng = np.random.default_rng(seed)
+    own_z = np.full((h, w), np.inf)
+    n = int(rng.integers(1, max(2, h * w // 3)))
+    own_z[rng.integers(0, h, n), rng.integers(0, w, n)] = rng.choice([0.5, 0.51, 0.52, 0.53], n)
+    depth = rng.choice([0.0, np.nan, 0.49, 0.5, 0.505, 0.51, 0.515, 0.52, 0.525, 0.53, 0.535, 0.6], (h, w))
+    depth = depth.astype(np.float32 if single else np.float64)
+    mask = rng.random((h, w)) < 0.2
+    others = rng.random((h, w)) < 0.3 if with_others else np.zeros((0, 0), bool)
+    steps = _steps_within(reach)
+    near = np.empty((h, w), np.int64)
+    _jit.nearest(~np.isfinite(own_z), near)
+    hidden, seen = np.empty((h, w), bool), np.empty((h, w))
+    _jit.occlusion_maps(depth, mask, own_z, near, others, tol, steps, hidden, seen)
+    finite = own_z[np.isfinite(own_z)]
+    hid, sn = np.empty((h, w), bool), np.empty((h, w))
+    rows = _jit.occlusion_window(depth, mask, own_z, others, tol, steps, float(finite.min()) - spread,
+                                 float(finite.max()) + spread, hid, sn)  # fmt: skip
+    assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
+    assert 0 <= rows <= h
+
+
+def test_the_occlusion_window_skips_rows_that_do_not_need_the_nearest_pixels():
+    """A window whose only pixel between the bounds (plus the tolerance) sits on one row: that row alone is looked
+    at; a pixel nearer than them is hidden without it, the background behind them is not."""
+    own_z = np.full((20, 30), np.inf)
+    own_z[8:12, 10:15] = 0.5
+    depth = np.full((20, 30), 1.0)
+    depth[3, 20] = 0.51  # behind the fruit's 0.5 + 0.005: not hidden, once its nearest point pixel is known
+    depth[5, 2] = 0.502  # nearer than the least bound plus the tolerance
+    hidden, seen = np.empty((20, 30), bool), np.empty((20, 30))
+    none = np.zeros((0, 0), bool)
+    assert _jit.occlusion_window(depth, np.zeros((20, 30), bool), own_z, none, 0.005, _steps_within(3), 0.5, 0.52,
+                                 hidden, seen) == 1  # fmt: skip
+    assert hidden.sum() == 1 and hidden[5, 2]
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 4), st.integers(0, 4))
+def test_the_allowed_box_is_the_box_of_the_allowed_pixels(seed, h, w, gap, thin):
+    """allowed_box against the box of allowed's pixels (mask_box; not found for no seen pixel in the window), on
+    random hidden pixels and seen regions placed partly or wholly outside the window; and _square_extreme's filters
+    against square_filter's, pixel for pixel."""
+    from symfruit.core.raster import mask_box
+
+    rng = np.random.default_rng(seed)
+    hidden = rng.random((h, w)) < rng.choice([0.1, 0.4, 0.7, 0.9])
+    rh, rw = (int(x) for x in rng.integers(1, 25, 2))
+    region = rng.random((rh, rw)) < rng.choice([0.05, 0.5, 0.9])
+    dr, dc = int(rng.integers(-rh - 2, h + 2)), int(rng.integers(-rw - 2, w + 2))
+    for every in (True, False):
+        want, got = np.empty((h, w), bool), np.empty((h, w), bool)
+        _jit.square_filter(hidden, thin, every, want)
+        _jit._square_extreme(hidden, thin, every, got)
+        assert np.array_equal(got, want)
+    seen = np.zeros((h, w), bool)
+    a0, a1, b0, b1 = max(dr, 0), min(dr + rh, h), max(dc, 0), min(dc + rw, w)
+    if a1 > a0 and b1 > b0:
+        seen[a0:a1, b0:b1] = region[a0 - dr : a1 - dr, b0 - dc : b1 - dc]
+    found = _jit.allowed_box(hidden, region, dr, dc, gap, thin)
+    if not seen.any():
+        assert not found[0]
+        return
+    assert found[0] and tuple(found[1:]) == mask_box(_jit.allowed(hidden, seen, gap, thin))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.lists(st.one_of(st.integers(1, 500), st.integers(9990, 20010), st.integers(20, 40000)), min_size=1,
+                max_size=3), st.sampled_from([400, 30]))  # fmt: skip
+def test_the_seeded_choices_are_numpys(sizes, cap):
+    """seeded_choices against one np.random.default_rng(0) drawing choice(n, min(n, cap), replace=False) for each n
+    in turn: the same indices (Floyd's sampling and its shuffle, the tail shuffle of more than 10,000, a sample of
+    all); and refused, not wrong, when its draws run out."""
+    from symfruit.core.surface import _first_draws
+
+    rng = np.random.default_rng(0)
+    want = np.concatenate([rng.choice(n, min(n, cap), replace=False) for n in sizes])
+    found, ok = _jit.seeded_choices(np.array(sizes, np.int64), cap, _first_draws())
+    assert ok and np.array_equal(found, want)
+    assert not _jit.seeded_choices(np.array([*sizes, 5000], np.int64), cap, _first_draws()[:5])[1]

@@ -729,3 +729,89 @@ def test_the_sort_choice_survives_numpy_moving_its_private_cpu_features(monkeypa
     keys = np.random.default_rng(0).integers(-300, 300, (50, 40)).astype(np.int16)
     monkeypatch.setattr(surface, "_KIND16", "stable")
     assert np.array_equal(surface._sort_rows(keys), np.sort(keys, axis=1))
+
+
+# --- issue 19, eighteenth round: the registration's search fruit by fruit, the trimming's generator -------------
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_pruned_search_finds_the_full_searchs_shift(seed):
+    """Four to six balls, their depth a few pixels off their masks (noise, rims without depth, one on a table): the
+    coarse grid's least by :func:`_least_pruned` is the full search's (every outline at every shift, the least fast
+    cost's shifts costed exactly), index for index, on the grid and on a grid of ties (a shift along one axis
+    only); and it costs the later outlines at fewer shifts than the first."""
+    from symfruit.core import surface
+
+    rng = np.random.default_rng(seed)
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    centres = [(25, 25), (80, 27), (135, 24), (26, 92), (82, 90), (134, 93)][: int(rng.integers(4, 7))]
+    for k, centre in enumerate(centres):
+        d, disc = ball(centre=centre, radius_px=int(rng.integers(9, 15)), front=float(rng.uniform(0.4, 0.6)),
+                       rim=float(rng.uniform(0.0, 0.2)), table=k == 1)  # fmt: skip
+        depth = np.where(disc | ((k == 1) & (d < depth)), d, depth)
+        labels[disc] = k + 1
+    depth = depth + rng.normal(0.0, 0.001 * (seed % 2), depth.shape)
+    moved = np.roll(depth, (int(rng.integers(-5, 6)), int(rng.integers(-5, 6))), axis=(0, 1))
+    outlines = []
+    for k in range(1, len(centres) + 1):
+        rows, cols = np.nonzero(labels == k)
+        r0, r1, c0, c1 = max(rows.min() - 18, 0), rows.max() + 19, max(cols.min() - 18, 0), cols.max() + 19
+        if (found := surface._outline(moved[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, F, 10)) is not None:
+            outlines.append(found)
+    assert len(outlines) >= 3
+    seen = []
+
+    def cost(shifts, exact=True):
+        return np.mean([surface._told(o, shifts, 10, 0.7, exact) for o in outlines], axis=0)
+
+    def told(o, shifts, *args):
+        seen.append(len(shifts))
+        return real_told(o, shifts, *args)
+
+    coarse = np.arange(-10, 11, 2)
+    for grid in (np.stack(np.meshgrid(coarse, coarse, indexing="ij"), -1).reshape(-1, 2),
+                 np.stack(np.meshgrid(coarse, [0], indexing="ij"), -1).reshape(-1, 2)):  # fmt: skip
+        fast = cost(grid, exact=False)
+        near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
+        full = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
+        real_told, seen = surface._told, []
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(surface, "_told", told)
+            assert surface._least_pruned(outlines, grid, 10, 0.7, cost) == full
+        assert seen[0] == len(grid)
+        if len(grid) == 121:  # the whole grid: the later outlines costed at fewer shifts
+            assert min(seen[1:]) < len(grid)
+
+
+def test_registration_is_the_same_with_and_without_the_pruned_search(monkeypatch):
+    """A frame of three balls moved against their masks: the same shift whether the coarse grid is searched fruit by
+    fruit or whole."""
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
+        d, disc = ball(centre=centre, radius_px=14, front=0.45 + 0.05 * k, rim=0.1)
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[disc] = k + 1
+    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    found = registration_shift(moved, labels, F, max_px=10)
+    monkeypatch.setattr("symfruit.core.surface._PRUNE_FROM", 10**9)
+    assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)
+
+
+def test_the_trimmings_generator_draws_as_a_fresh_one():
+    """_seeded() after earlier draws, and in another thread: the draws of np.random.default_rng(0)."""
+    import threading
+
+    from symfruit.core.surface import _seeded
+
+    want = [np.random.default_rng(0).choice(n, min(n, 400), replace=False) for n in (12, 400, 3000, 15000)]
+    for n, expected in zip((12, 400, 3000, 15000), want, strict=True):
+        rng = _seeded()
+        rng.normal(size=7)  # drawn from in between: set back at the next call
+        assert np.array_equal(_seeded().choice(n, min(n, 400), replace=False), expected)
+    found = []
+    thread = threading.Thread(target=lambda: found.append(_seeded().choice(3000, 400, replace=False)))
+    thread.start()
+    thread.join()
+    assert np.array_equal(found[0], want[2]) and _seeded() is not None

@@ -2810,6 +2810,323 @@ def positive_depth(depth: np.ndarray, out: np.ndarray) -> None:
             out[r, c] = z if np.isfinite(z) and z > 0 else 0.0
 
 
+# --- issue 19, eighteenth round (stop 38): registration, extraction, occlusion ---------------------------------------
+
+
+@_njit
+def occlusion_window(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    own_z: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+    low: float,
+    high: float,
+    hidden: np.ndarray,
+    seen: np.ndarray,
+) -> int:
+    """:func:`occlusion_maps` after :func:`nearest` of ``~isfinite(own_z)`` (which must hold a finite pixel), in one
+    kernel that looks for a pixel's nearest point pixel only where it decides (issue 19, eighteenth round): the
+    same ``hidden`` and ``seen``, bit for bit. ``low`` and ``high`` bound every finite ``own_z`` from below and
+    above (the points' least and greatest depth). Returns the number of rows whose nearest point pixels were
+    looked for.
+
+    A pixel's reference is its nearest point pixel's depth plus ``tolerance``, so it lies between ``low`` and
+    ``high`` plus ``tolerance`` (``lo``, ``hi``; rounding is monotone): a pixel that is the fruit's, without depth
+    (it is hidden when another fruit's), nearer than ``lo`` (hidden) or at least ``hi`` (not hidden, not even
+    another fruit's) is decided without it. The rest (a few per cent of a window: a leaf, a support or a neighbour
+    at the fruit's depth) take it from :func:`nearest`'s two passes, its column pass over the window and its row
+    pass (each row's lower envelope) on the rows holding such a pixel alone. A pixel without depth takes that of
+    its first offset with depth (:func:`occlusion_maps`' fill; whether a pixel has depth is worked out where it is
+    looked at)."""
+    h, w = mask.shape
+    lo, hi = low + tolerance, high + tolerance
+    k = steps.shape[0]
+    with_others = others.shape[0] > 0
+    pending = np.zeros((h, w), np.bool_)
+    rows = np.zeros(h, np.bool_)
+    for r in range(h):
+        for c in range(w):
+            hidden[r, c] = False
+            x = np.float64(depth[r, c])
+            if mask[r, c] or math.isfinite(own_z[r, c]):
+                seen[r, c] = np.nan
+                continue
+            if not (math.isfinite(x) and x > 0.0):
+                x = np.nan
+                for j in range(k):
+                    rr, cc = r + steps[j, 0], c + steps[j, 1]
+                    if 0 <= rr < h and 0 <= cc < w and not (mask[rr, cc] or math.isfinite(own_z[rr, cc])):
+                        y = np.float64(depth[rr, cc])
+                        if math.isfinite(y) and y > 0.0:  # a pixel with depth: its own, never a filled one
+                            x = y
+                            break
+            seen[r, c] = x
+            if not math.isfinite(x):  # NaN: never nearer, never behind
+                hidden[r, c] = with_others and others[r, c]
+            elif x < lo:
+                hidden[r, c] = True
+            elif not x >= hi:
+                pending[r, c] = True
+                rows[r] = True
+    # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
+    # the rows looked at alone: the nearest at or above by a sweep down, the nearest below by a sweep up
+    place = np.full(h, -1, np.int64)
+    count = 0
+    for r in range(h):
+        if rows[r]:
+            place[r] = count
+            count += 1
+    near = np.empty((count, w), np.int64)
+    run = np.full(w, -1, np.int64)
+    for r in range(h):
+        for c in range(w):
+            if math.isfinite(own_z[r, c]):
+                run[c] = r
+        if place[r] >= 0:
+            near[place[r], :] = run
+    run[:] = -1
+    for r in range(h - 1, -1, -1):
+        for c in range(w):
+            if math.isfinite(own_z[r, c]):
+                run[c] = r
+        kr = place[r]
+        if kr >= 0:
+            for c in range(w):
+                a, b = near[kr, c], run[c]
+                if b >= 0 and (a < 0 or b - r < r - a):
+                    near[kr, c] = b
+    env = np.empty(w, np.int64)
+    done = 0
+    for r in range(h):
+        if not rows[r]:
+            continue
+        done += 1
+        kr = place[r]
+        top = -1  # nearest()'s row pass, the same envelope and the same walk along it
+        for u in range(w):
+            if near[kr, u] < 0:
+                continue
+            dw = near[kr, u] - r
+            wr = dw * dw
+            while top >= 1:
+                i1, i0 = env[top], env[top - 1]
+                a, b = i1 - i0, u - i1
+                cs = a + b
+                d0, d1 = near[kr, i0] - r, near[kr, i1] - r
+                if cs * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * cs <= 0:
+                    break
+                top -= 1
+            top += 1
+            env[top] = u
+        q = 0
+        for u in range(w):
+            i = env[q]
+            dr, dc = near[kr, i] - r, i - u
+            best = dr * dr + dc * dc
+            while q < top:
+                i = env[q + 1]
+                dr, dc = near[kr, i] - r, i - u
+                d = dr * dr + dc * dc
+                if best <= d:
+                    break
+                best = d
+                q += 1
+            if pending[r, u]:
+                i = env[q]
+                ref = own_z[near[kr, i], i] + tolerance
+                x = seen[r, u]
+                hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
+    return done
+
+
+@_njit
+def _square_extreme(src: np.ndarray, radius: int, every: bool, out: np.ndarray) -> None:
+    """:func:`square_filter`'s ``out``, the same pixels, from the index of the last pixel that decides along each row
+    and then down each column (the last false one for ``every``, the last true one else; beyond the array is
+    false), with a row of indices where :func:`square_filter` keeps two (h, w) arrays of counts."""
+    h, w = src.shape
+    t = radius
+    horiz = np.empty((h, w), np.bool_)
+    for r in range(h):
+        last = -1 if every else -(2 * t + 2)
+        for c in range(w + t):
+            if c < w and src[r, c] != every:
+                last = c
+            p = c - t
+            if p >= 0:
+                horiz[r, p] = (last < p - t and c < w) if every else last >= p - t
+    last_row = np.full(w, -1 if every else -(2 * t + 2), np.int64)
+    for rr in range(h + t):
+        if rr < h:
+            for c in range(w):
+                if horiz[rr, c] != every:
+                    last_row[c] = rr
+        p = rr - t
+        if p >= 0:
+            for c in range(w):
+                out[p, c] = (last_row[c] < p - t and rr < h) if every else last_row[c] >= p - t
+
+
+@_njit
+def allowed_box(
+    hidden: np.ndarray, region: np.ndarray, dr: int, dc: int, gap: int, thin: int
+) -> tuple[bool, int, int, int, int]:  # fmt: skip
+    """:meth:`symfruit.core.occlusion.Occlusion.extent`'s box of :func:`allowed` (issue 19, eighteenth round): the
+    seen pixels are ``region`` (rh, rw) bool placed at row ``dr`` and column ``dc`` of the window (clipped to it),
+    the opening and the joins are :func:`allowed`'s (by :func:`_square_extreme`, the same pixels) and the flood fill
+    keeps the box of what it reaches, not an image of it. ``(found, r0, r1, c0, c1)``: the box of the allowed
+    pixels (stops exclusive), or found False when no seen pixel lies in the window."""
+    h, w = hidden.shape
+    rh, rw = region.shape
+    a0, a1 = max(dr, 0), min(dr + rh, h)
+    b0, b1 = max(dc, 0), min(dc + rw, w)
+    s0, s1, t0, t1 = h, 0, w, 0  # the seen pixels' box
+    for r in range(a0, a1):
+        for c in range(b0, b1):
+            if region[r - dr, c - dc]:
+                s0, s1 = min(s0, r), r + 1
+                t0, t1 = min(t0, c), max(t1, c + 1)
+    if s1 == 0:
+        return False, 0, 0, 0, 0
+    join = hidden.copy()
+    if thin > 0:
+        h0, h1, g0, g1 = _box(hidden)
+        if h1 > h0:
+            part = hidden[h0:h1, g0:g1]
+            eroded = np.empty(part.shape, np.bool_)
+            _square_extreme(part, thin, True, eroded)
+            _square_extreme(eroded, thin, False, join[h0:h1, g0:g1])
+    seen = np.zeros((h, w), np.bool_)
+    for r in range(s0, s1):
+        for c in range(t0, t1):
+            seen[r, c] = region[r - dr, c - dc]
+    if gap > 0:
+        e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+        f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
+        grown = np.empty((e1 - e0, f1 - f0), np.bool_)
+        _square_extreme(seen[e0:e1, f0:f1], gap, False, grown)
+        near = np.empty((e1 - e0, f1 - f0), np.bool_)
+        _square_extreme(join[e0:e1, f0:f1], gap, False, near)
+        for r in range(e1 - e0):
+            for c in range(f1 - f0):
+                if grown[r, c] and near[r, c]:
+                    join[e0 + r, f0 + c] = True
+    reached = seen.copy()
+    stack = np.empty(h * w, np.int64)
+    top = 0
+    for r in range(s0, s1):
+        for c in range(t0, t1):
+            if seen[r, c]:
+                stack[top] = r * w + c
+                top += 1
+    r0, r1, c0, c1 = s0, s1, t0, t1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        for ddr in range(-1, 2):
+            rr = r + ddr
+            if rr < 0 or rr >= h:
+                continue
+            for ddc in range(-1, 2):
+                cc = c + ddc
+                if cc < 0 or cc >= w or reached[rr, cc]:
+                    continue
+                if join[rr, cc]:
+                    reached[rr, cc] = True
+                    r0, r1 = min(r0, rr), max(r1, rr + 1)
+                    c0, c1 = min(c0, cc), max(c1, cc + 1)
+                    stack[top] = rr * w + cc
+                    top += 1
+    return True, r0, r1, c0, c1
+
+
+@_njit
+def _next32(raw: np.ndarray, state: np.ndarray) -> np.int64:
+    """The next 32-bit draw of numpy's PCG64 from its 64-bit outputs ``raw`` (the low half of a word first, then its
+    high half, as ``next_uint32`` buffers it); ``state`` (2,) int64: the next word and the high half buffered (-1:
+    none). -1 when ``raw`` is used up."""
+    if state[1] >= 0:
+        u = state[1]
+        state[1] = -1
+        return u
+    if state[0] >= raw.shape[0]:
+        return np.int64(-1)
+    r = raw[state[0]]
+    state[0] += 1
+    state[1] = np.int64(r >> np.uint64(32))
+    return np.int64(r & np.uint64(0xFFFFFFFF))
+
+
+@_njit
+def _bounded(raw: np.ndarray, state: np.ndarray, top: int) -> np.int64:
+    """numpy's ``random_bounded_uint64(0, top)`` for ``0 <= top < 2**32 - 1`` (Lemire's multiply and reject, no draw
+    for 0), from :func:`_next32`'s draws; -1 when they are used up."""
+    if top == 0:
+        return np.int64(0)
+    excl = np.uint64(top + 1)
+    u = _next32(raw, state)
+    if u < 0:
+        return np.int64(-1)
+    m = np.uint64(u) * excl
+    left = m & np.uint64(0xFFFFFFFF)
+    if left < excl:
+        threshold = (np.uint64(0xFFFFFFFF) - np.uint64(top)) % excl
+        while left < threshold:
+            u = _next32(raw, state)
+            if u < 0:
+                return np.int64(-1)
+            m = np.uint64(u) * excl
+            left = m & np.uint64(0xFFFFFFFF)
+    return np.int64(m >> np.uint64(32))
+
+
+@_njit
+def seeded_choices(sizes: np.ndarray, cap: int, raw: np.ndarray) -> tuple[np.ndarray, bool]:
+    """``np.random.default_rng(0).choice(n, min(n, cap), replace=False)`` for each ``n`` of ``sizes`` in turn, from one
+    generator, concatenated (int64), from ``raw``, that generator's first 64-bit outputs (``PCG64(0).random_raw``);
+    and False when ``raw`` runs out first (the caller then asks numpy). numpy's own steps (Generator.choice without
+    replacement: Floyd's sampling, then a shuffle from the second element on; for more than 10,000 with more than a
+    fiftieth wanted, a shuffle of the tail of all of them), each bounded draw Lemire's: the same indices, as the
+    tests check against numpy's (:func:`symfruit.core.surface.colour_trim`'s two samples; issue 19, eighteenth round:
+    20 against 115 us a fruit with the generator made afresh)."""
+    total = 0
+    for n in sizes:
+        total += min(n, cap)
+    out = np.empty(total, np.int64)
+    state = np.array([0, -1], np.int64)
+    at = 0
+    for n in sizes:
+        size = min(n, cap)
+        idx = out[at : at + size]
+        if n > 10000 and size > n // 50:  # the tail shuffle of all n
+            every = np.arange(n)
+            for i in range(n - 1, max(n - size, 1) - 1, -1):
+                j = _bounded(raw, state, i)
+                if j < 0:
+                    return out, False
+                every[i], every[j] = every[j], every[i]
+            idx[:] = every[n - size :]
+        else:
+            taken = np.zeros(n, np.bool_)  # Floyd's set: what matters is whether a value is in it
+            for j in range(n - size, n):
+                val = _bounded(raw, state, j)
+                if val < 0:
+                    return out, False
+                if taken[val]:
+                    val = j
+                taken[val] = True
+                idx[j - n + size] = val
+            for i in range(size - 1, 0, -1):
+                j = _bounded(raw, state, i)
+                if j < 0:
+                    return out, False
+                idx[i], idx[j] = idx[j], idx[i]
+        at += size
+    return out, True
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 

@@ -24,6 +24,8 @@ numbers out.
 from __future__ import annotations
 
 import importlib
+import threading
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Literal
 
@@ -835,6 +837,8 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     def least(shifts: np.ndarray) -> int:
         """The first shift of least exact cost. The fast costs are within ``slack`` of the exact ones, so only
         the shifts within twice that of their least can be it; those (one, but for ties) are costed exactly."""
+        if len(outlines) > 1 and len(shifts) > _PRUNE_FROM:
+            return _least_pruned(outlines, shifts, max_px, trim, cost)
         fast = cost(shifts, exact=False)
         slack = 1e-10 * (1.0 + float(np.abs(fast).max()))  # some 10^4 times the sums' rounding
         near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
@@ -860,6 +864,50 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     if cost(fine[best : best + 1])[0] > zero - gain or (np.abs(fine[best]) >= max_px).any():
         return 0, 0  # no gain; or a least cost at the search's border, still falling beyond it: no minimum found
     return int(fine[best, 1]), int(fine[best, 0])
+
+
+#: :func:`registration_shift`'s search costs a set of more shifts than this fruit by fruit (:func:`_least_pruned`)
+_PRUNE_FROM = 30
+
+
+def _least_pruned(outlines: list[_Outline], shifts: np.ndarray, reach: int, trim: float,
+                  cost: Callable[..., np.ndarray]) -> int:  # fmt: skip
+    """:func:`registration_shift`'s ``least(shifts)``, the same index, without the fast cost of every outline at
+    every shift (issue 19, eighteenth round: the coarse grid's 441 shifts of 9 fruit were most of the registration).
+
+    A shift's cost is the mean of the outlines' costs, each at least 0, so the outlines' costs summed so far,
+    divided by their number, are a lower bound of it. The first outline is costed at every shift and the frame's
+    cost at that outline's least shift (the same number the search computes there) bounds the least one from
+    above; each further outline is costed only at the shifts whose lower bound is not above that by more than the
+    margin, which is more than twice ``least``'s slack (made with a bound of the largest cost an outline can have:
+    its window's diagonal plus the reach and its band) and more than the sums' rounding. A shift left out cannot
+    be among those within twice the slack of the least fast cost; those left in have every outline's fast cost,
+    each row's the same numbers the search has (a row's cost depends on that row alone), their mean taken as the
+    search does. The shifts within twice the larger slack of the least are costed exactly, the first least
+    returned: any taken beyond the search's own lie more than the slack above its least fast cost, so above the
+    least exact one, and are never it."""
+    first = _told(outlines[0], shifts, reach, trim, False)
+    count = len(outlines)
+    best = int(np.argmin(first))
+    upper = float(cost(shifts[best : best + 1], exact=False)[0])
+    # no distance in a window exceeds its diagonal (beyond it the map reads -reach): no fast cost exceeds ``top``
+    top = max(float(np.hypot(*o.inside.shape)) + float(reach) + o.band for o in outlines)
+    slack = 1e-10 * (1.0 + top)  # at least the search's
+    limit = (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
+    alive = np.flatnonzero(first <= limit)
+    summed = first[alive]
+    rows = [first[alive]]
+    for o in outlines[1:]:
+        part = _told(o, shifts[alive], reach, trim, False)
+        summed = summed + part
+        keep = summed <= limit
+        if not keep.all():
+            alive, summed, part = alive[keep], summed[keep], part[keep]
+            rows = [r[keep] for r in rows]
+        rows.append(part)
+    fast = np.mean(rows, axis=0)
+    near = alive[fast <= fast.min() + 2.0 * slack]
+    return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
 
 
 def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact: bool) -> np.ndarray:
@@ -925,14 +973,23 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
     feature = _colour_features if jit is None else jit.colour_features
     kmeans = _kmeans if jit is None else jit.kmeans
-    rng = np.random.default_rng(0)
 
-    def summary(x: np.ndarray) -> np.ndarray:
-        x = x[rng.choice(len(x), min(len(x), 400), replace=False)]
+    def summary(x: np.ndarray, pick: np.ndarray) -> np.ndarray:
+        x = x[pick]
         return kmeans(x, x[np.linspace(0, len(x) - 1, centres).astype(int)], iterations)
 
     f_fruit, f_ring = feature(color, fruit), feature(color, ring)
-    fc, bc = summary(f_fruit), summary(f_ring)
+    # each summary from a sample of at most _SAMPLE pixels, drawn by np.random.default_rng(0) (both from one
+    # generator); where numba is, the same draws by a compiled twin of numpy's (issue 19, eighteenth round)
+    picks: list[np.ndarray] = []
+    if jit is not None:
+        drawn, ok = jit.seeded_choices(np.array([len(f_fruit), len(f_ring)], np.int64), _SAMPLE, _first_draws())
+        if ok:
+            picks = [drawn[: min(len(f_fruit), _SAMPLE)], drawn[min(len(f_fruit), _SAMPLE) :]]
+    if not picks:
+        rng = _seeded()
+        picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
+    fc, bc = summary(f_fruit, picks[0]), summary(f_ring, picks[1])
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
         return (_nearer_fruit if jit is None else jit.nearer_fruit)(x, fc, bc, float(margin))
@@ -942,6 +999,41 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _seeded() -> np.random.Generator:
+    """``np.random.default_rng(0)`` as made afresh: this thread's own generator, made once, with the state a fresh one
+    starts from set back into it (the same draws; 5 instead of 30 us, and :func:`colour_trim` wants it for every
+    fruit of a frame; issue 19, eighteenth round). Not to be held across another call of this function."""
+    found = getattr(_SEEDED, "rng", None)
+    if found is None:
+        found = np.random.default_rng(0)
+        _SEEDED.rng, _SEEDED.state = found, found.bit_generator.state
+    else:
+        found.bit_generator.state = _SEEDED.state
+    return found
+
+
+#: :func:`_seeded`'s generator and its starting state, per thread (a frame's fruit may be trimmed on several)
+_SEEDED = threading.local()
+
+#: :func:`colour_trim`'s samples: at most this many pixels of each region
+_SAMPLE = 400
+
+
+def _first_draws() -> np.ndarray:
+    """(2048,) uint64: the first outputs of ``np.random.PCG64(0)``, :func:`colour_trim`'s generator's (made once; the
+    compiled twin of its draws reads them, :func:`symfruit.core._jit.seeded_choices`, and asks numpy when they run
+    out)."""
+    found = _FIRST_DRAWS.get("raw")
+    if found is None:
+        found = np.random.PCG64(0).random_raw(2048)
+        found.flags.writeable = False
+        _FIRST_DRAWS["raw"] = found
+    return found
+
+
+_FIRST_DRAWS: dict[str, np.ndarray] = {}
 
 
 def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.ndarray:
