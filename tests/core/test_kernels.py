@@ -2123,19 +2123,3 @@ def test_the_allowed_box_is_the_box_of_the_allowed_pixels(seed, h, w, gap, thin)
         assert not found[0]
         return
     assert found[0] and tuple(found[1:]) == mask_box(_jit.allowed(hidden, seen, gap, thin))
-
-
-@settings(max_examples=200, deadline=None)
-@given(st.lists(st.one_of(st.integers(1, 500), st.integers(9990, 20010), st.integers(20, 40000)), min_size=1,
-                max_size=3), st.sampled_from([400, 30]))  # fmt: skip
-def test_the_seeded_choices_are_numpys(sizes, cap):
-    """seeded_choices against one np.random.default_rng(0) drawing choice(n, min(n, cap), replace=False) for each n
-    in turn: the same indices (Floyd's sampling and its shuffle, the tail shuffle of more than 10,000, a sample of
-    all); and refused, not wrong, when its draws run out."""
-    from symfruit.core.surface import _first_draws
-
-    rng = np.random.default_rng(0)
-    want = np.concatenate([rng.choice(n, min(n, cap), replace=False) for n in sizes])
-    found, ok = _jit.seeded_choices(np.array(sizes, np.int64), cap, _first_draws())
-    assert ok and np.array_equal(found, want)
-    assert not _jit.seeded_choices(np.array([*sizes, 5000], np.int64), cap, _first_draws()[:5])[1]

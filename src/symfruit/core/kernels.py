@@ -30,8 +30,7 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 :func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.core.occlusion.occlusion`
 (:func:`symfruit.core._jit.occlusion_window`, the maps of ``occlusion_maps`` after ``nearest``) and
 :meth:`symfruit.core.occlusion.Occlusion.extent` (:func:`symfruit.core._jit.allowed_box`, the box of ``allowed``'s
-pixels), :func:`symfruit.core.surface.colour_trim`'s samples (:func:`symfruit.core._jit.seeded_choices`, numpy's
-``default_rng(0).choice`` from the generator's first outputs)) then run their numpy twins, the code the kernels
+pixels)) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'

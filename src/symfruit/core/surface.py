@@ -980,15 +980,9 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
 
     f_fruit, f_ring = feature(color, fruit), feature(color, ring)
     # each summary from a sample of at most _SAMPLE pixels, drawn by np.random.default_rng(0) (both from one
-    # generator); where numba is, the same draws by a compiled twin of numpy's (issue 19, eighteenth round)
-    picks: list[np.ndarray] = []
-    if jit is not None:
-        drawn, ok = jit.seeded_choices(np.array([len(f_fruit), len(f_ring)], np.int64), _SAMPLE, _first_draws())
-        if ok:
-            picks = [drawn[: min(len(f_fruit), _SAMPLE)], drawn[min(len(f_fruit), _SAMPLE) :]]
-    if not picks:
-        rng = _seeded()
-        picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
+    # generator; numpy promises its streams only within one build, so no compiled copy of its sampler: stop 38)
+    rng = _seeded()
+    picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
     fc, bc = summary(f_fruit, picks[0]), summary(f_ring, picks[1])
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
@@ -1019,21 +1013,6 @@ _SEEDED = threading.local()
 
 #: :func:`colour_trim`'s samples: at most this many pixels of each region
 _SAMPLE = 400
-
-
-def _first_draws() -> np.ndarray:
-    """(2048,) uint64: the first outputs of ``np.random.PCG64(0)``, :func:`colour_trim`'s generator's (made once; the
-    compiled twin of its draws reads them, :func:`symfruit.core._jit.seeded_choices`, and asks numpy when they run
-    out)."""
-    found = _FIRST_DRAWS.get("raw")
-    if found is None:
-        found = np.random.PCG64(0).random_raw(2048)
-        found.flags.writeable = False
-        _FIRST_DRAWS["raw"] = found
-    return found
-
-
-_FIRST_DRAWS: dict[str, np.ndarray] = {}
 
 
 def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.ndarray:
