@@ -283,8 +283,13 @@ def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarr
     ``caps`` (r, m, 3) (:func:`symfruit.core.fits._cap_local`'s, about ``+z``) the least of the best direction so
     far and the cap turned about it (:func:`symfruit.core.fits._cap`: the basis of
     :func:`~symfruit.core.points.perpendicular_basis`, each row ``l0 e1 + l1 e2 + l2 d`` summed left to right, where
-    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,)."""
-    best = dirs[_least(slice_costs(q, dirs, bins))].copy()
+    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,). The best
+    direction so far is not costed again (issue 19, eighteenth round: its cost is known, unless the cap's flip turned
+    it)."""
+    costs = slice_costs(q, dirs, bins)
+    pick = _least(costs)
+    best = dirs[pick].copy()
+    best_cost = costs[pick]
     m = caps.shape[1]
     cand = np.empty((m + 1, 3))
     for r in range(caps.shape[0]):
@@ -305,9 +310,16 @@ def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarr
             if c2 < 0:
                 c0, c1, c2 = -c0, -c1, -c2
             cand[i + 1, 0], cand[i + 1, 1], cand[i + 1, 2] = c0, c1, c2
+        costs = np.empty(m + 1)
         if cand[0, 2] < 0:
             cand[0, 0], cand[0, 1], cand[0, 2] = -x, -y, -z
-        best = cand[_least(slice_costs(q, cand, bins))].copy()
+            costs[:] = slice_costs(q, cand, bins)
+        else:  # the best direction so far, as it was: its cost is known (each direction's cost is its own)
+            costs[0] = best_cost
+            costs[1:] = slice_costs(q, cand[1:], bins)
+        pick = _least(costs)
+        best = cand[pick].copy()
+        best_cost = costs[pick]
     return best
 
 
@@ -2226,6 +2238,68 @@ def column_means(p: np.ndarray) -> np.ndarray:
     for j in range(k):
         out[j] /= n
     return out
+
+
+# --- issue 19, eighteenth round (stop 38): the completion ---
+
+
+@_njit
+def ellipse_holds(
+    mask: np.ndarray, u0: int, v0: int, cu: float, cv: float, a00: float, a01: float, a11: float
+) -> tuple[int, int]:
+    """:func:`symfruit.core.raster.outline_cone`'s acceptance test: ``(n, held)``, the pixels of ``mask`` (h, w)
+    bool (a window at ``u0, v0``) and how many of them the ellipse holds, ``a00 u^2 + 2 a01 u v + a11 v^2 <= 1 +
+    1e-9`` about its centre ``(cu, cv)``, each term as the twin's numpy expression rounds it (left to right, ``2
+    a01`` first), so the same pixels; one pass over the window instead of the twin's coordinate arrays."""
+    h, w = mask.shape
+    n = 0
+    held = 0
+    b01 = 2 * a01
+    for r in range(h):
+        v = float(r + v0) - cv
+        for c in range(w):
+            if mask[r, c]:
+                u = float(c + u0) - cu
+                n += 1
+                held += a00 * u * u + b01 * u * v + a11 * v * v <= 1.0 + 1e-9
+    return n, held
+
+
+@_njit
+def close_ragged(mask: np.ndarray, radius: int) -> tuple[np.ndarray, int, int]:
+    """:func:`symfruit.core.raster.close_ragged`'s closing and counts: ``(closed (h, w) bool, added, outline)``,
+    ``mask`` (h, w) bool padded by ``radius`` pixels, closed by the ``2 radius + 1`` square (:func:`close_square`),
+    its holes filled over the closed mask's box grown by a pixel (:func:`filled`, as
+    :func:`~symfruit.core.raster.fill_holes`), the padding cut off again; ``added`` the pixels it adds to ``mask``,
+    ``outline`` the mask's outline pixels (``mask & ~interior(mask)``). The twin's steps, the same pixels, in one
+    call."""
+    h, w = mask.shape
+    hp, wp = h + 2 * radius, w + 2 * radius
+    padded = np.zeros((hp, wp), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            padded[r + radius, c + radius] = mask[r, c]
+    shut = np.empty((hp, wp), np.bool_)
+    close_square(padded, radius, shut)
+    full = shut.copy()
+    r0, r1, c0, c1 = _box(shut)
+    if r1 > 0:
+        r0, r1 = max(r0 - 1, 0), min(r1 + 1, hp)
+        c0, c1 = max(c0 - 1, 0), min(c1 + 1, wp)
+        filled(shut[r0:r1, c0:c1], full[r0:r1, c0:c1])
+    closed = full[radius : radius + h, radius : radius + w]
+    added = 0
+    outline = 0
+    for r in range(h):
+        for c in range(w):
+            m = mask[r, c]
+            added += closed[r, c] and not m
+            if m and not (
+                r > 0 and r < h - 1 and c > 0 and c < w - 1
+                and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
+            ):  # fmt: skip
+                outline += 1
+    return closed, added, outline
 
 
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
