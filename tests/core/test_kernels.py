@@ -2115,3 +2115,36 @@ def test_close_ragged_is_the_twins(seed, radius, holes, ragged):
     assert (fast is region) == (twin is region)
     assert (fast.u0, fast.v0, fast.fill_radius) == (twin.u0, twin.v0, twin.fill_radius)
     assert fast.mask.dtype == twin.mask.dtype == bool and np.array_equal(fast.mask, twin.mask)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300))
+def test_image_pixels_are_the_twins(seed, n):
+    """:func:`symfruit.core.raster._pixels` with the kernel and with the twins: points projecting onto half pixels
+    (exact ties of the rounding, on a camera whose arithmetic is exact there), onto the image's edges and beyond
+    them, behind the camera, at depth 0 and NaN: the same columns, rows and depths, in the same order (or the same
+    error when none projects into the image)."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import _pixels
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=512.0, fy=512.0, cx=319.5, cy=240.0, width=640, height=480)
+    z = rng.choice([0.25, 0.5, 1.0, 2.0], n)
+    u = rng.integers(-3, 645, n) + rng.choice([0.0, 0.5, -0.5, 0.25, 0.4999], n)
+    v = rng.integers(-3, 485, n) + rng.choice([0.0, 0.5, -0.5, 0.75], n)
+    pts = np.stack(((u - 319.5) * z / 512.0, (v - 240.0) * z / 512.0, z), axis=1)
+    odd = rng.random(n)
+    pts[odd < 0.05, 2] = 0.0
+    pts[(odd >= 0.05) & (odd < 0.1), 2] *= -1.0
+    pts[(odd >= 0.1) & (odd < 0.13), int(rng.integers(0, 3))] = np.nan
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # the twin's cast of NaN warns
+        try:
+            fast, twin = _both(mp, _pixels, pts, cam)
+        except InputError:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            with pytest.raises(InputError, match="no point projects"):
+                _pixels(pts, cam)
+            return
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+    assert len(fast[0]) and fast[0].min() >= 0 and fast[0].max() < 640 and fast[1].max() < 480

@@ -2339,6 +2339,32 @@ def close_ragged(mask: np.ndarray, radius: int) -> tuple[np.ndarray, int, int]:
     return closed, added, outline
 
 
+@_njit
+def image_pixels(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.raster._pixels`: the pixel column and row (whole numbers) and depth of each point of
+    ``points`` (n, 3) that projects into the ``width`` x ``height`` image, in the points' order
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, as :func:`inside_px` takes
+    it): the twin's pixels. A coordinate that is NaN or rounds outside the image leaves its point out, as the
+    twin's integer conversion and bounds do."""
+    n = points.shape[0]
+    col = np.empty(n, np.int64)
+    row = np.empty(n, np.int64)
+    z = np.empty(n)
+    m = 0
+    for i in range(n):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        if u >= 0.0 and u < width and v >= 0.0 and v < height:
+            col[m] = np.int64(u)
+            row[m] = np.int64(v)
+            z[m] = points[i, 2]
+            m += 1
+    return col[:m], row[:m], z[:m]
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 

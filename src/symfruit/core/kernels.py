@@ -6,7 +6,7 @@ quadric candidates' agreement (fourteenth round), the registration's key ranks a
 occlusion's pixel look-ups (sixteenth round), and the registration's exact costs and keys, extraction's depth tests,
 colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
 observation's band rays and outline pixels and the surface noise's measures (seventeenth round), and the outline
-ellipse's acceptance test and the ragged outline's closing (eighteenth round), with numba from the optional extra
+ellipse's acceptance test, the ragged outline's closing and the points' pixels (eighteenth round), with numba from the optional extra
 ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
@@ -27,8 +27,9 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 :func:`symfruit.core.occlusion.occlusion`, :func:`symfruit.core.raster.principal_widths`,
 :func:`symfruit.segment.colour.segment`'s hulls, labellings, floods, creases and sphere points,
 :func:`symfruit.core.agreement.observe`'s bands and outline, :func:`symfruit.core.fits.noise_measures` and
-:func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.core.raster.outline_cone` and
-:func:`~symfruit.core.raster.close_ragged`) then run their numpy twins, the code the kernels
+:func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.core.raster.outline_cone`,
+:func:`~symfruit.core.raster.close_ragged`, :func:`~symfruit.core.raster.silhouette` and
+:func:`~symfruit.core.raster.rasterise`) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'

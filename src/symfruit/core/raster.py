@@ -76,7 +76,18 @@ class View:
 
 
 def _pixels(points: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pixel column, row and depth of the points that project into the image."""
+    """Pixel column, row and depth of the points that project into the image; by the compiled twin
+    :func:`symfruit.core._jit.image_pixels` where numba is installed (the same pixels, in one pass)."""
+    if points.ndim == 2 and points.shape[1] == 3 and (jit := compiled()) is not None:
+        col, row, z = jit.image_pixels(np.ascontiguousarray(points, dtype=np.float64), float(camera.fx),
+                                       float(camera.fy), float(camera.cx), float(camera.cy), int(camera.width),
+                                       int(camera.height))  # fmt: skip
+        if not len(col):
+            raise InputError(
+                f"no point projects into the {camera.width}x{camera.height} image; "
+                "are the points in the camera's optical frame (z forward) and is this the right camera?"
+            )
+        return col, row, z
     uv = camera.project(points)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
