@@ -2123,3 +2123,111 @@ def test_the_allowed_box_is_the_box_of_the_allowed_pixels(seed, h, w, gap, thin)
         assert not found[0]
         return
     assert found[0] and tuple(found[1:]) == mask_box(_jit.allowed(hidden, seen, gap, thin))
+
+
+# --- issue 19, eighteenth round (stop 38): the completion -----------------------------------------------------------
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 0.5, 0.25]), st.sampled_from([1.0, 2.0, 4.0, 3.0]))
+def test_the_ellipse_holds_the_twins_pixels(seed, centre_frac, radius):
+    """:func:`symfruit.core._jit.ellipse_holds` against the twin's numpy expression on random windows (a corner
+    anywhere, holes) and ellipses whose terms reach exactly 1 on the pixel grid (whole-number offsets over radii of
+    powers of two: pixels on the ellipse, ties at its edge, and just beyond it): the same count, to the pixel."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    u0, v0 = int(rng.integers(0, 600)), int(rng.integers(0, 400))
+    cu = u0 + float(rng.integers(0, w)) + centre_frac
+    cv = v0 + float(rng.integers(0, h)) + centre_frac
+    a00, a11 = 1.0 / radius**2, 1.0 / (2.0 * radius) ** 2
+    a01 = float(rng.choice([0.0, 0.0, 1.0 / 64.0, float(rng.normal(0.0, 0.01))]))
+    n, held = _jit.ellipse_holds(mask, u0, v0, cu, cv, a00, a01, a11)
+    rows, cols = np.nonzero(mask)
+    u, v = cols + u0 - np.float64(cu), rows + v0 - np.float64(cv)
+    a2 = np.array([[a00, a01], [a01, a11]])
+    twin = (a2[0, 0] * u * u + 2 * a2[0, 1] * u * v + a2[1, 1] * v * v) <= 1.0 + 1e-9
+    assert n == len(rows) and held == int(twin.sum())
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 0.6))
+def test_outline_cones_are_the_twins(seed, cut):
+    """:func:`symfruit.core.raster.outline_cone` with the kernel and with the twins, on pixel ellipses (some cut by
+    a straight edge, the fit on the rest of the outline) in windows anywhere in the image: the same cone and axis
+    to the bit, or None alike."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette, outline_cone, outline_cracks
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(20, 90, 2))
+    rr, cc = np.mgrid[0:h, 0:w]
+    a, b, t = rng.uniform(5, h / 2), rng.uniform(5, w / 2), rng.uniform(0, np.pi)
+    y, x = rr - h / 2 + 0.5, cc - w / 2 + 0.5
+    mask = ((x * np.cos(t) + y * np.sin(t)) / b) ** 2 + ((-x * np.sin(t) + y * np.cos(t)) / a) ** 2 <= 1.0
+    mask &= cc >= cut * w
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 350)), mask, 0.0)
+    cam = Camera(fx=600.0, fy=610.0, cx=319.5, cy=240.25, width=640, height=480)
+    cracks = outline_cracks(region)
+    points = cracks[cracks[:, 0] > region.u0 + cut * w + 1.0]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, outline_cone, region, cam, points)
+    assert (fast is None) == (twin is None)
+    if fast is not None and twin is not None:
+        assert np.array_equal(fast[0], twin[0]) and np.array_equal(fast[1], twin[1])
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5), st.floats(0.0, 0.9), st.floats(0.0, 1.0))
+def test_close_ragged_is_the_twins(seed, radius, holes, ragged):
+    """:func:`symfruit.core.raster.close_ragged` with the kernel and with the twins, on discs with dropped pixels
+    (a ragged rim, holes, pixels at the window's edge) and on random masks: the same region, closed or not, to the
+    pixel, with the same fill radius."""
+    from symfruit.core.raster import Silhouette, close_ragged
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    rr, cc = np.mgrid[0:h, 0:w]
+    if rng.random() < 0.7:
+        mask = (rr - rng.uniform(0, h)) ** 2 + (cc - rng.uniform(0, w)) ** 2 <= rng.uniform(1, 40) ** 2
+        mask &= rng.random((h, w)) >= holes * rng.random((h, w))
+    else:
+        mask = rng.random((h, w)) < holes
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 400)), mask, float(rng.choice([0.0, 2.5])))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, close_ragged, region, radius=radius, ragged=ragged)
+    assert (fast is region) == (twin is region)
+    assert (fast.u0, fast.v0, fast.fill_radius) == (twin.u0, twin.v0, twin.fill_radius)
+    assert fast.mask.dtype == twin.mask.dtype == bool and np.array_equal(fast.mask, twin.mask)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300))
+def test_image_pixels_are_the_twins(seed, n):
+    """:func:`symfruit.core.raster._pixels` with the kernel and with the twins: points projecting onto half pixels
+    (exact ties of the rounding, on a camera whose arithmetic is exact there), onto the image's edges and beyond
+    them, behind the camera, at depth 0 and NaN: the same columns, rows and depths, in the same order (or the same
+    error when none projects into the image)."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import _pixels
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=512.0, fy=512.0, cx=319.5, cy=240.0, width=640, height=480)
+    z = rng.choice([0.25, 0.5, 1.0, 2.0], n)
+    u = rng.integers(-3, 645, n) + rng.choice([0.0, 0.5, -0.5, 0.25, 0.4999], n)
+    v = rng.integers(-3, 485, n) + rng.choice([0.0, 0.5, -0.5, 0.75], n)
+    pts = np.stack(((u - 319.5) * z / 512.0, (v - 240.0) * z / 512.0, z), axis=1)
+    odd = rng.random(n)
+    pts[odd < 0.05, 2] = 0.0
+    pts[(odd >= 0.05) & (odd < 0.1), 2] *= -1.0
+    pts[(odd >= 0.1) & (odd < 0.13), int(rng.integers(0, 3))] = np.nan
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # the twin's cast of NaN warns
+        try:
+            fast, twin = _both(mp, _pixels, pts, cam)
+        except InputError:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            with pytest.raises(InputError, match="no point projects"):
+                _pixels(pts, cam)
+            return
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+    assert len(fast[0]) and fast[0].min() >= 0 and fast[0].max() < 640 and fast[1].max() < 480

@@ -283,8 +283,13 @@ def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarr
     ``caps`` (r, m, 3) (:func:`symfruit.core.fits._cap_local`'s, about ``+z``) the least of the best direction so
     far and the cap turned about it (:func:`symfruit.core.fits._cap`: the basis of
     :func:`~symfruit.core.points.perpendicular_basis`, each row ``l0 e1 + l1 e2 + l2 d`` summed left to right, where
-    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,)."""
-    best = dirs[_least(slice_costs(q, dirs, bins))].copy()
+    BLAS's product may round it otherwise, flipped to ``z >= 0``). Returns the chosen direction (3,). The best
+    direction so far is not costed again (issue 19, eighteenth round: its cost is known, unless the cap's flip turned
+    it)."""
+    costs = slice_costs(q, dirs, bins)
+    pick = _least(costs)
+    best = dirs[pick].copy()
+    best_cost = costs[pick]
     m = caps.shape[1]
     cand = np.empty((m + 1, 3))
     for r in range(caps.shape[0]):
@@ -305,9 +310,16 @@ def revolution_search(q: np.ndarray, dirs: np.ndarray, bins: int, caps: np.ndarr
             if c2 < 0:
                 c0, c1, c2 = -c0, -c1, -c2
             cand[i + 1, 0], cand[i + 1, 1], cand[i + 1, 2] = c0, c1, c2
+        costs = np.empty(m + 1)
         if cand[0, 2] < 0:
             cand[0, 0], cand[0, 1], cand[0, 2] = -x, -y, -z
-        best = cand[_least(slice_costs(q, cand, bins))].copy()
+            costs[:] = slice_costs(q, cand, bins)
+        else:  # the best direction so far, as it was: its cost is known (each direction's cost is its own)
+            costs[0] = best_cost
+            costs[1:] = slice_costs(q, cand[1:], bins)
+        pick = _least(costs)
+        best = cand[pick].copy()
+        best_cost = costs[pick]
     return best
 
 
@@ -548,30 +560,43 @@ def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -
     true pixels), written into ``out`` (h, w): each pixel's distance to the nearest such pixel where that is at most
     ``reach``, +inf elsewhere. The same whole-number squared distances as the twin's shifts (each column's distance
     to its nearest pixel, capped past the reach, by two sweeps; then the nearest over ``2 floor(reach) + 1``
-    columns), and the same square roots: the twin's values to the bit."""
+    columns), and the same square roots: the twin's values to the bit. Since issue 19's eighteenth round the column
+    sweeps run row by row (each column's last wanted row kept), and a pixel's search over the columns starts at the
+    nearest column within its row whose distance is not capped (nearer columns are all capped, and a capped
+    column's term is never less than the pixel's own): the same least term."""
     h, w = mask.shape
     k = math.floor(reach)
     cap = k + 1
+    cap2 = cap * cap
     g2 = np.empty((h, w), np.int64)
-    for c in range(w):
-        last = -cap  # the row of the last wanted pixel above, or far enough to be beyond reach
-        for r in range(h):
-            if mask[r, c] == want:
-                last = r
-            g2[r, c] = min(r - last, cap)
-        last = h - 1 + cap
-        for r in range(h - 1, -1, -1):
-            if mask[r, c] == want:
-                last = r
-            g2[r, c] = min(g2[r, c], last - r)
+    last = np.empty(w, np.int64)
+    last[:] = -cap  # the row of each column's last wanted pixel above, or far enough to be beyond reach
     for r in range(h):
         for c in range(w):
-            g2[r, c] *= g2[r, c]
+            if mask[r, c] == want:
+                last[c] = r
+            g2[r, c] = min(r - last[c], cap)
+    last[:] = h - 1 + cap
+    for r in range(h - 1, -1, -1):
+        for c in range(w):
+            if mask[r, c] == want:
+                last[c] = r
+            d = min(g2[r, c], last[c] - r)
+            g2[r, c] = d * d
     limit = reach * reach
+    near = np.empty(w, np.int64)  # each column's distance to the nearest column of the row below the cap
     for r in range(h):
+        gap = w + k + 1  # none yet: farther than any search
+        for c in range(w):
+            gap = 0 if g2[r, c] < cap2 else gap + 1
+            near[c] = gap
+        gap = w + k + 1
+        for c in range(w - 1, -1, -1):
+            gap = 0 if g2[r, c] < cap2 else gap + 1
+            near[c] = min(near[c], gap)
         for c in range(w):
             best = g2[r, c]
-            for t in range(1, k + 1):
+            for t in range(max(near[c], 1), k + 1):
                 tt = t * t
                 if tt >= best:  # farther columns cannot be nearer
                     break
@@ -1649,23 +1674,47 @@ def connected(image: np.ndarray, seeds: np.ndarray, out: np.ndarray) -> None:
 def filled(mask: np.ndarray, out: np.ndarray) -> None:
     """``out`` (h, w) bool: ``mask`` (h, w) bool with its holes filled (the 4-connected pieces of its background not
     reaching the array's edge, :func:`symfruit.core.raster.fill_holes`' labelling), by a flood fill of the
-    background from the edge: the same pixels."""
+    background from the edge: the same pixels. Since issue 19's eighteenth round the flood runs on the background
+    framed by a ring of background pixels, by flat index (no bounds to test, no division): the ring touches every
+    background pixel on the edge, so it reaches the same pixels as a flood from those."""
     h, w = mask.shape
-    background = np.empty((h, w), np.bool_)
-    reached = np.zeros((h, w), np.bool_)
-    stack = np.empty(h * w, np.int64)
+    wp = w + 2
+    size = (h + 2) * wp
+    free = np.ones(size, np.bool_)  # background not yet reached; the ring is reached from the start
+    for r in range(h):
+        for c in range(w):
+            free[(r + 1) * wp + c + 1] = not mask[r, c]
+    stack = np.empty(size, np.int64)
     top = 0
-    for r in range(h):
-        for c in range(w):
-            background[r, c] = not mask[r, c]
-            if background[r, c] and (r == 0 or c == 0 or r == h - 1 or c == w - 1):
-                reached[r, c] = True
-                stack[top] = r * w + c
+    for i in range(wp):  # the ring's top and bottom rows, then its sides
+        free[i] = False
+        free[size - 1 - i] = False
+    for r in range(1, h + 1):
+        free[r * wp] = False
+        free[r * wp + w + 1] = False
+    for c in range(w):  # the ring's neighbours in the window: its edge pixels
+        for i in ((1 * wp + c + 1), (h * wp + c + 1)):
+            if free[i]:
+                free[i] = False
+                stack[top] = i
                 top += 1
-    _flood(background, reached, stack, top)
+    for r in range(1, h + 1):
+        for i in (r * wp + 1, r * wp + w):
+            if free[i]:
+                free[i] = False
+                stack[top] = i
+                top += 1
+    while top > 0:
+        top -= 1
+        i = stack[top]
+        for j in (i - wp, i + wp, i - 1, i + 1):
+            if free[j]:
+                free[j] = False
+                stack[top] = j
+                top += 1
     for r in range(h):
         for c in range(w):
-            out[r, c] = not reached[r, c]
+            out[r, c] = mask[r, c] or free[(r + 1) * wp + c + 1]
 
 
 @_njit
@@ -2226,6 +2275,94 @@ def column_means(p: np.ndarray) -> np.ndarray:
     for j in range(k):
         out[j] /= n
     return out
+
+
+# --- issue 19, eighteenth round (stop 38): the completion ---
+
+
+@_njit
+def ellipse_holds(
+    mask: np.ndarray, u0: int, v0: int, cu: float, cv: float, a00: float, a01: float, a11: float
+) -> tuple[int, int]:
+    """:func:`symfruit.core.raster.outline_cone`'s acceptance test: ``(n, held)``, the pixels of ``mask`` (h, w)
+    bool (a window at ``u0, v0``) and how many of them the ellipse holds, ``a00 u^2 + 2 a01 u v + a11 v^2 <= 1 +
+    1e-9`` about its centre ``(cu, cv)``, each term as the twin's numpy expression rounds it (left to right, ``2
+    a01`` first), so the same pixels; one pass over the window instead of the twin's coordinate arrays."""
+    h, w = mask.shape
+    n = 0
+    held = 0
+    b01 = 2 * a01
+    for r in range(h):
+        v = float(r + v0) - cv
+        for c in range(w):
+            if mask[r, c]:
+                u = float(c + u0) - cu
+                n += 1
+                held += a00 * u * u + b01 * u * v + a11 * v * v <= 1.0 + 1e-9
+    return n, held
+
+
+@_njit
+def close_ragged(mask: np.ndarray, radius: int) -> tuple[np.ndarray, int, int]:
+    """:func:`symfruit.core.raster.close_ragged`'s closing and counts: ``(closed (h, w) bool, added, outline)``,
+    ``mask`` (h, w) bool padded by ``radius`` pixels, closed by the ``2 radius + 1`` square (:func:`close_square`),
+    its holes filled over the closed mask's box grown by a pixel (:func:`filled`, as
+    :func:`~symfruit.core.raster.fill_holes`), the padding cut off again; ``added`` the pixels it adds to ``mask``,
+    ``outline`` the mask's outline pixels (``mask & ~interior(mask)``). The twin's steps, the same pixels, in one
+    call."""
+    h, w = mask.shape
+    hp, wp = h + 2 * radius, w + 2 * radius
+    padded = np.zeros((hp, wp), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            padded[r + radius, c + radius] = mask[r, c]
+    shut = np.empty((hp, wp), np.bool_)
+    close_square(padded, radius, shut)
+    full = shut.copy()
+    r0, r1, c0, c1 = _box(shut)
+    if r1 > 0:
+        r0, r1 = max(r0 - 1, 0), min(r1 + 1, hp)
+        c0, c1 = max(c0 - 1, 0), min(c1 + 1, wp)
+        filled(shut[r0:r1, c0:c1], full[r0:r1, c0:c1])
+    closed = full[radius : radius + h, radius : radius + w]
+    added = 0
+    outline = 0
+    for r in range(h):
+        for c in range(w):
+            m = mask[r, c]
+            added += closed[r, c] and not m
+            if m and not (
+                r > 0 and r < h - 1 and c > 0 and c < w - 1
+                and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
+            ):  # fmt: skip
+                outline += 1
+    return closed, added, outline
+
+
+@_njit
+def image_pixels(
+    points: np.ndarray, fx: float, fy: float, cx: float, cy: float, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.raster._pixels`: the pixel column and row (whole numbers) and depth of each point of
+    ``points`` (n, 3) that projects into the ``width`` x ``height`` image, in the points' order
+    (:meth:`~symfruit.core.camera.Camera.project`'s arithmetic, rounded half to even, as :func:`inside_px` takes
+    it): the twin's pixels. A coordinate that is NaN or rounds outside the image leaves its point out, as the
+    twin's integer conversion and bounds do."""
+    n = points.shape[0]
+    col = np.empty(n, np.int64)
+    row = np.empty(n, np.int64)
+    z = np.empty(n)
+    m = 0
+    for i in range(n):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        if u >= 0.0 and u < width and v >= 0.0 and v < height:
+            col[m] = np.int64(u)
+            row[m] = np.int64(v)
+            z[m] = points[i, 2]
+            m += 1
+    return col[:m], row[:m], z[:m]
 
 
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------

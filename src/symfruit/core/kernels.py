@@ -7,7 +7,8 @@ occlusion's pixel look-ups (sixteenth round), and the registration's exact costs
 colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
 observation's band rays and outline pixels and the surface noise's measures (seventeenth round), and the
 occlusion's maps with their nearest point pixels looked for only where they decide, the box of where a fruit may
-project and colour trimming's seeded samples (eighteenth round), with numba from the optional extra ``fast``.
+project, the outline ellipse's acceptance test, the ragged outline's closing and the points' pixels (eighteenth
+round), with numba from the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -28,9 +29,11 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 :func:`symfruit.segment.colour.segment`'s hulls, labellings, floods, creases and sphere points,
 :func:`symfruit.core.agreement.observe`'s bands and outline, :func:`symfruit.core.fits.noise_measures` and
 :func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.core.occlusion.occlusion`
-(:func:`symfruit.core._jit.occlusion_window`, the maps of ``occlusion_maps`` after ``nearest``) and
+(:func:`symfruit.core._jit.occlusion_window`, the maps of ``occlusion_maps`` after ``nearest``),
 :meth:`symfruit.core.occlusion.Occlusion.extent` (:func:`symfruit.core._jit.allowed_box`, the box of ``allowed``'s
-pixels)) then run their numpy twins, the code the kernels
+pixels), :func:`symfruit.core.raster.outline_cone`, :func:`~symfruit.core.raster.close_ragged`,
+:func:`~symfruit.core.raster.silhouette` and :func:`~symfruit.core.raster.rasterise`) then run their numpy twins, the
+code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'

@@ -76,7 +76,18 @@ class View:
 
 
 def _pixels(points: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Pixel column, row and depth of the points that project into the image."""
+    """Pixel column, row and depth of the points that project into the image; by the compiled twin
+    :func:`symfruit.core._jit.image_pixels` where numba is installed (the same pixels, in one pass)."""
+    if points.ndim == 2 and points.shape[1] == 3 and (jit := compiled()) is not None:
+        col, row, z = jit.image_pixels(np.ascontiguousarray(points, dtype=np.float64), float(camera.fx),
+                                       float(camera.fy), float(camera.cx), float(camera.cy), int(camera.width),
+                                       int(camera.height))  # fmt: skip
+        if not len(col):
+            raise InputError(
+                f"no point projects into the {camera.width}x{camera.height} image; "
+                "are the points in the camera's optical frame (z forward) and is this the right camera?"
+            )
+        return col, row, z
     uv = camera.project(points)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
@@ -198,6 +209,11 @@ def close_ragged(region: Silhouette, *, radius: int = 3, ragged: float = 0.3) ->
     mask = region.mask
     if radius <= 0 or not mask.any():
         return region
+    if mask.ndim == 2 and mask.dtype == bool and (jit := compiled()) is not None:  # the compiled twin of what follows
+        closed, added, outline = jit.close_ragged(np.ascontiguousarray(mask), int(radius))
+        if added <= ragged * max(outline, 1):
+            return region
+        return Silhouette(region.u0, region.v0, closed, max(region.fill_radius, float(radius)))
     padded = np.zeros((mask.shape[0] + 2 * radius, mask.shape[1] + 2 * radius), dtype=bool)  # np.pad is slow
     padded[radius:-radius, radius:-radius] = mask
     closed = _closed_mask(padded, radius)[radius:-radius, radius:-radius]
@@ -642,14 +658,23 @@ def outline_cone(
     if eig.min() <= 0:
         return None
     area = np.pi / np.sqrt(eig[0] * eig[1])
-    rows, cols = np.nonzero(region.mask)
-    n = len(rows)
-    if not n or area > max_area * n:
-        return None
-    u, v = cols + region.u0 - centre[0], rows + region.v0 - centre[1]
     a2 = conic[:2, :2]
-    held = (a2[0, 0] * u * u + 2 * a2[0, 1] * u * v + a2[1, 1] * v * v) <= 1.0 + 1e-9
-    if held.mean() < inside:
+    if region.mask.ndim == 2 and (jit := compiled()) is not None:  # the compiled twin of what follows: the same count
+        n, count = jit.ellipse_holds(np.ascontiguousarray(region.mask, dtype=bool), int(region.u0), int(region.v0),
+                                     float(centre[0]), float(centre[1]), float(a2[0, 0]), float(a2[0, 1]),
+                                     float(a2[1, 1]))  # fmt: skip
+        if not n or area > max_area * n:
+            return None
+        share = count / n
+    else:
+        rows, cols = np.nonzero(region.mask)
+        n = len(rows)
+        if not n or area > max_area * n:
+            return None
+        u, v = cols + region.u0 - centre[0], rows + region.v0 - centre[1]
+        held = (a2[0, 0] * u * u + 2 * a2[0, 1] * u * v + a2[1, 1] * v * v) <= 1.0 + 1e-9
+        share = held.mean()
+    if share < inside:
         return None
     return _image_cone(conic, centre, camera)
 
