@@ -60,3 +60,37 @@ def test_eval_boxes_records_a_box_per_scored_fruit_of_evaluate_frames(tmp_path, 
     assert list(rows) == ["frames|a,1|4|raw", "frames|a,1|4|sphere", "frames|b|7|raw"]
     for values, box in zip(rows.values(), boxes, strict=True):
         assert np.array_equal(values, np.r_[box.min, box.max])
+
+
+def test_hidden_apples_tables_of_one_small_apple_tree_frame(tmp_path, monkeypatch, capsys):
+    """``hidden_apples.py`` on one apple-tree frame of 8 apples (as `symfruit scenes --scene apple-tree --ripe 8`):
+    every matched apple in one visible-share column, the mostly hidden ones split by their mask's kind (the frame
+    rendered again from its seed, a wrong seed refused) and counted by their front; the settings file read."""
+    import importlib.util
+    import re
+
+    from symfruit.synthetic.scenes import write_scenes
+
+    spec = importlib.util.spec_from_file_location("hidden_apples", DOCS / "hidden_apples.py")
+    hidden = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hidden)
+    frames = tmp_path / "D"
+    write_scenes(frames, 1, seed=4, n_ripe=8, n_unripe=1, tree=True)
+    config = tmp_path / "before.yaml"
+    config.write_text("evidence:\n  cut_width: 0\n")
+    monkeypatch.setattr(sys, "argv", ["hidden_apples.py", "--frames", str(frames), "--seeds", "4", "--config",
+                                      str(config)])  # fmt: skip
+    hidden.main()
+    out = capsys.readouterr().out
+    matched = int(re.match(r"(\d+) matched apples; cut_width 0\n", out).group(1))
+    groups = [int(n) for n in re.findall(r"(?:visible|partly hidden|mostly hidden) \((\d+)\)", out)]
+    assert matched > 0 and len(groups) == 3 and sum(groups) == matched
+    kinds = re.findall(r"\| (?:drawn over the leaf|visible part only) \| (\d+) \|", out)
+    assert len(kinds) == 2 and sum(map(int, kinds)) == groups[2]
+    assert f" of {groups[2]}" in out.split("front over 15 mm behind: ")[1].splitlines()[0]
+    by_id = int(re.search(r"--match id\): (\d+) apples, IoU 0\.\d{3}, centre ", out).group(1))
+    assert matched <= by_id <= 8
+    assert (matched, by_id, kinds) == (7, 7, ["1", "0"])  # this seed's frame: one apple unboxed, one mostly hidden
+    monkeypatch.setattr(sys, "argv", ["hidden_apples.py", "--frames", str(frames), "--seeds", "5"])
+    with pytest.raises(SystemExit, match="not seed 5's apple-tree frame"):
+        hidden.main()
