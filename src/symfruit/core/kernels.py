@@ -5,8 +5,9 @@ quadric candidates' agreement (fourteenth round), the registration's key ranks a
 (fifteenth round), the solid of revolution's direction search, a marched candidate's agreement and the
 occlusion's pixel look-ups (sixteenth round), and the registration's exact costs and keys, extraction's depth tests,
 colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
-observation's band rays and outline pixels and the surface noise's measures (seventeenth round), with numba from
-the optional extra ``fast``.
+observation's band rays and outline pixels and the surface noise's measures (seventeenth round), and the colour
+segmenter's sphere fits, centre search and depth edges (eighteenth round), with numba from the optional extra
+``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -26,11 +27,13 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 :func:`symfruit.core.occlusion.occlusion`, :func:`symfruit.core.raster.principal_widths`,
 :func:`symfruit.segment.colour.segment`'s hulls, labellings, floods, creases and sphere points,
 :func:`symfruit.core.agreement.observe`'s bands and outline, :func:`symfruit.core.fits.noise_measures` and
-:func:`symfruit.core.points.column_means`) then run their numpy twins, the code the kernels
+:func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.segment.colour._sphere`,
+``_centres`` and ``_depth_edges``) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
-depth RMS does). Nothing
+depth RMS does, and the segmenter's sphere fits from Householder reflections instead of LAPACK's SVD, a nanometre
+apart, no mask changed on the checks of issue 19's eighteenth round). Nothing
 compiles when symfruit is imported: numba is imported by the first fit that asks for a kernel (about half a second),
 and each kernel is compiled on its first call (a few seconds in all) or loaded from numba's on-disk cache (beside
 the module, or the user's cache directory where that is read-only; without a cache where neither is writable).

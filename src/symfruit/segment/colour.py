@@ -1131,8 +1131,10 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     owner = np.zeros(region.shape, np.int64)
     for k, part in enumerate(parts, 1):
         owner[part] = k
-    counts = np.zeros((n + 1, len(parts) + 1), np.int64)
-    np.add.at(counts, (pieces.ravel(), owner.ravel()), 1)
+    # each (piece, owner) pair's pixels, counted by one bincount of the pairs' numbers (np.add.at's counts, several
+    # times faster; issue 19, eighteenth round)
+    counts = np.bincount(pieces.ravel() * (len(parts) + 1) + owner.ravel(), minlength=(n + 1) * (len(parts) + 1))
+    counts = counts.reshape(n + 1, len(parts) + 1)
     major = counts[:, 1:].argmax(axis=1) + 1
     total = counts[:, 1:].sum(axis=1)
     pure = counts[np.arange(n + 1), major] >= EDGE_PURITY * np.maximum(total, 1)
@@ -1172,11 +1174,11 @@ def _centres(
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     if float(edt.max()) < least:
         return []
+    if (jit := compiled()) is not None:  # the peaks and the walk below in one call, the same centres
+        found = jit.centre_search(edt, int(least), float(least), float(loose), float(waist), MAX_WAIST_TESTS)
+        return [(int(a), int(b), float(r), bool(f)) for a, b, r, f in found.tolist()]  # (issue 19, eighteenth round)
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
-    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.peaks`; seventeenth round)
-        peaks = jit.peaks(edt, int(least), float(least))
-    else:
-        peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
+    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
     pr, pc = np.nonzero(peaks)
     order = np.argsort(-edt[pr, pc], kind="stable")
     centres: list[tuple[int, int, float, bool]] = []
@@ -1321,7 +1323,23 @@ def _sphere(
     """The sphere (centre in the camera frame, metres; radius) that best fits the depth points of a mask in
     the window at ``origin`` (algebraic least squares, once more without the points far off it); None
     with fewer than 20 points or when the fit is not a fruit-like cap (its radius off the points' own
-    spread by more than 4x either way)."""
+    spread by more than 4x either way). Where numba is, one compiled call gives it
+    (:func:`symfruit.core._jit.sphere_fit`: the same points, its least squares by Householder reflections instead of
+    LAPACK's SVD, so the same sphere to rounding; issue 19, eighteenth round: 30 against 300 us a fit), and the
+    numpy code below (:func:`_sphere_lstsq`) where the kernel leaves a nearly singular system to ``lstsq``."""
+    if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
+        fit = np.empty(4)
+        found = jit.sphere_fit(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
+                               float(geo.focal), int(most), fit)  # fmt: skip
+        if found >= 0:
+            return (fit[:3], float(fit[3])) if found else None
+    return _sphere_lstsq(mask, depth, geo, origin, most)
+
+
+def _sphere_lstsq(
+    mask: np.ndarray, depth: np.ndarray, geo: _Geometry, origin: tuple[int, int], most: int = 1500
+) -> tuple[np.ndarray, float] | None:
+    """:func:`_sphere` by numpy's ``lstsq`` (the compiled kernel's twin)."""
     if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
         # the same points and spread (:func:`symfruit.core._jit.sphere_points`; issue 19, seventeenth round)
         p, spread = jit.sphere_points(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
@@ -1404,7 +1422,14 @@ def _depth_edges(
 ) -> np.ndarray:
     """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
     crease of the depth surface: where one fruit ends and another begins. ``seen``: the region's pixels with depth
-    (``region & (depth > 0)``), ``zm`` their median depth."""
+    (``region & (depth > 0)``), ``zm`` their median depth. Where numba is and 20 or more pixels have depth, the creases
+    and steps in one compiled call (:func:`symfruit.core._jit.depth_edges`: the same pixels; issue 19, eighteenth
+    round)."""
+    if (jit := compiled()) is not None and seen.sum() >= 20:
+        filled = np.take(np.ascontiguousarray(depth).ravel(), nearest_index(~seen))
+        weights, symmetric = _gaussian_weights(float(s.crease_sigma)) if s.crease_sigma > 0 else _IDENTITY
+        limit = -s.crease_curvature * (zm / focal) ** 2
+        return jit.depth_edges(filled, weights, symmetric, limit, region, depth, seen, float(s.depth_jump))
     z = np.where(seen, depth, np.nan)
     return (_creases(region, depth, seen, zm, s, focal) | _steps(z, s.depth_jump)) & region
 
