@@ -2176,3 +2176,51 @@ def test_the_column_correlation_is_scipys(seed, size, origin_shift):
     out = np.empty((h, w))
     _jit._correlate_columns(image, weights, symmetric, out)
     np.testing.assert_array_equal(out, ndimage.correlate1d(image, weights, 0))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.5, 0.9, 1.0]))
+def test_the_segmenters_cells_are_the_twins(seed, loose):
+    """Two to five overlapping discs and centres among their deepest pixels, random looseness: the same cells
+    with the kernel and with the twins."""
+    from symfruit.core.raster import distance_transform
+    from symfruit.segment.colour import _cells
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(10, 120, 2))
+    yy, xx = np.mgrid[:h, :w]
+    region = np.zeros((h, w), bool)
+    for _ in range(int(rng.integers(2, 6))):
+        region |= (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= rng.uniform(3, 30) ** 2
+    edt = distance_transform(region)
+    rows, cols = np.nonzero(edt >= max(1.0, 0.5 * edt.max()))
+    if len(rows) < 2:
+        return
+    pick = rng.choice(len(rows), size=min(len(rows), int(rng.integers(2, 5))), replace=False)
+    centres = [(int(rows[i]), int(cols[i]), float(edt[rows[i], cols[i]])) for i in pick]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _cells, region, centres, loose)
+    assert len(fast) == len(twin) and all(np.array_equal(a, b) for a, b in zip(fast, twin, strict=True))
+    assert len(fast) >= 1 and not (np.logical_or.reduce(fast) ^ region).any()
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_ripe_tests_median_redness_is_the_twins(seed, strided):
+    """Random colours (dark ones, R = 0, R below G and B) under a random mask, an odd or even count, a strided view:
+    the kernel's median redness is ``median(redness(...))`` of the twin, bit for bit."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import redness
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    image = rng.integers(0, 256, (2 * h, 2 * w, 4), dtype=np.uint8)
+    image[rng.random(image.shape[:2]) < 0.1, 0] = 0
+    c = image[::2, 1::2, :3] if strided else np.ascontiguousarray(image[:h, :w, :3])
+    red = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    got = _jit.red_median(c, red)
+    if not red.any():
+        assert np.isnan(got)
+        return
+    want = median(redness(c[red]))
+    assert want.dtype == np.float32 and got == float(want)

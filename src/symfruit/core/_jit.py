@@ -3748,3 +3748,91 @@ def depth_edges(
                 c + 1 < w and seen[r, c + 1] and abs(depth[r, c + 1] - z) > jump):  # fmt: skip
                 out[r, c] = True
     return out
+
+
+@_njit
+def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._cells` before its masks: (h, w) int32, each pixel of ``region`` (h, w) bool
+    numbered by its cell (1..k), 0 outside. ``centres`` (k, 3) rows ``row, col, radius``. The region's distance map
+    (:func:`distance` of it padded by a pixel), its 4-connected pieces deeper than ``loose`` times the least radius
+    (:func:`label`), each deep pixel to the centre of least power ``(r - row)^2 + (c - col)^2 - radius^2`` (the first
+    of equals, as ``np.argmin``) when in that centre's piece, the centres' own pixels to them, every region pixel to
+    its nearest core pixel (:func:`nearest`, scipy's choice). The twin's sums in its order: the same cells."""
+    h, w = region.shape
+    k = centres.shape[0]
+    pad = np.zeros((h + 2, w + 2), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            pad[r + 1, c + 1] = region[r, c]
+    dist = np.empty((h + 2, w + 2))
+    distance(pad, False, dist)
+    least = centres[0, 2]
+    for j in range(1, k):
+        least = min(least, centres[j, 2])
+    t = loose * least
+    above = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            above[r, c] = dist[r + 1, c + 1] > t
+    deep, _ = label(above, False)
+    at = np.empty(k, np.int32)
+    for j in range(k):
+        at[j] = deep[int(centres[j, 0]), int(centres[j, 1])]
+    cores = np.zeros((h, w), np.int32)
+    for r in range(h):
+        for c in range(w):
+            if deep[r, c] == 0:
+                continue
+            best, least_power = 0, np.inf
+            for j in range(k):
+                dr, dc, rad = r - centres[j, 0], c - centres[j, 1], centres[j, 2]
+                power = dr * dr + dc * dc - rad * rad
+                if power < least_power:
+                    best, least_power = j, power
+            if deep[r, c] == at[best]:
+                cores[r, c] = best + 1
+    for j in range(k):
+        cores[int(centres[j, 0]), int(centres[j, 1])] = j + 1
+    free = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            free[r, c] = cores[r, c] == 0
+    near = np.empty((h, w), np.int64)
+    nearest(free, near)
+    out = np.zeros((h, w), np.int32)
+    for r in range(h):
+        for c in range(w):
+            if region[r, c]:
+                q = near[r, c]
+                out[r, c] = cores[q // w, q % w]
+    return out
+
+
+@_njit
+def red_median(color: np.ndarray, red: np.ndarray) -> float:
+    """``median(redness(color[red]))`` of :func:`symfruit.segment.colour._segment_at`'s ripe test: the float32
+    redness ``(R - max(G, B)) / max(R, 1)`` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8, and
+    their median as ``core.points.median`` takes it (the middle value, or the float32 mean of the middle two); NaN
+    without a pixel. The same float32 operations: the same value."""
+    h, w = red.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += red[r, c]
+    if n == 0:
+        return np.nan
+    values = np.empty(n, np.float32)
+    k = 0
+    one = np.float32(1.0)
+    for r in range(h):
+        for c in range(w):
+            if red[r, c]:
+                x = np.float32(color[r, c, 0])
+                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+                values[k] = (x - gb) / (x if x > one else one)
+                k += 1
+    values.sort()
+    half = n // 2
+    if n % 2:
+        return float(values[half])
+    return float((values[half - 1] + values[half]) / np.float32(2.0))

@@ -585,7 +585,10 @@ def _segment_at(
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
-        if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
+        if (jit := compiled()) is not None:  # the same value in one compiled call (issue 19, eighteenth round)
+            if not red.any() or jit.red_median(c[sl], red) < s.ripe_median:
+                continue
+        elif not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
         hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
@@ -1401,7 +1404,11 @@ def _separate(
 def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: float) -> list[np.ndarray]:
     """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
     times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
-    touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
+    touch) and every other pixel to the nearest core, so two fruit meet at the waist between them. Where numba is, the
+    cells' map in one compiled call (:func:`symfruit.core._jit.cells`: the same cells; issue 19, eighteenth round)."""
+    if (jit := compiled()) is not None and region.ndim == 2 and region.dtype == bool:
+        cells = jit.cells(region, np.array(centres, dtype=np.float64).reshape(-1, 3), float(loose))
+        return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
     deep, _ = _label(edt > loose * float(cen[:, 2].min()))
