@@ -2224,3 +2224,21 @@ def test_the_ripe_tests_median_redness_is_the_twins(seed, strided):
         return
     want = median(redness(c[red]))
     assert want.dtype == np.float32 and got == float(want)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.int32, np.int64]))
+def test_the_segmenters_grouping_is_the_twins(seed, dtype):
+    """Random labels (none to many, some labels absent) and a random choice of those kept: the same labels, places
+    and run starts, of the same types, with the kernel's counting sort and with the twin's stable argsort."""
+    from symfruit.segment.colour import _grouped
+
+    rng = np.random.default_rng(seed)
+    m = int(rng.integers(1, 50))
+    labels = rng.integers(0, m, int(rng.integers(0, 3000))).astype(dtype)
+    keep = rng.random(m) < rng.uniform(0.0, 1.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _grouped, labels, keep)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype
+        np.testing.assert_array_equal(a, b)

@@ -3812,8 +3812,8 @@ def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
 def red_median(color: np.ndarray, red: np.ndarray) -> float:
     """``median(redness(color[red]))`` of :func:`symfruit.segment.colour._segment_at`'s ripe test: the float32
     redness ``(R - max(G, B)) / max(R, 1)`` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8, and
-    their median as ``core.points.median`` takes it (the middle value, or the float32 mean of the middle two); NaN
-    without a pixel. The same float32 operations: the same value."""
+    their median as ``core.points.median`` takes it (the middle value by :func:`select`, or the float32 mean of the
+    middle two); NaN without a pixel. The same float32 operations: the same value."""
     h, w = red.shape
     n = 0
     for r in range(h):
@@ -3831,8 +3831,45 @@ def red_median(color: np.ndarray, red: np.ndarray) -> float:
                 gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
                 values[k] = (x - gb) / (x if x > one else one)
                 k += 1
-    values.sort()
     half = n // 2
+    select(values, half)  # a quickselect: several times faster than a sort on a fruit's thousands of pixels
     if n % 2:
         return float(values[half])
-    return float((values[half - 1] + values[half]) / np.float32(2.0))
+    below = values[0]
+    for i in range(1, half):
+        below = max(below, values[i])
+    return float((below + values[half]) / np.float32(2.0))
+
+
+@_njit
+def grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.segment.colour._grouped`: the places in ``labels`` (n,) of the labels that ``keep`` marks,
+    grouped by label in ascending order, each label's in their own order (a counting sort: stable, as the twin's
+    ``argsort``); the labels present, and where each one's run starts (one more: the count). The same arrays."""
+    m = keep.shape[0]
+    count = np.zeros(m + 1, np.int64)
+    for i in range(labels.shape[0]):
+        k = labels[i]
+        if keep[k]:
+            count[k + 1] += 1
+    ids = 0
+    for k in range(m):
+        ids += count[k + 1] > 0
+        count[k + 1] += count[k]
+    at = np.empty(count[m], np.int64)
+    fill = count[:m].copy()
+    for i in range(labels.shape[0]):
+        k = labels[i]
+        if keep[k]:
+            at[fill[k]] = i
+            fill[k] += 1
+    present = np.empty(ids, labels.dtype)
+    first = np.empty(ids + 1, np.int64)
+    j = 0
+    for k in range(m):
+        if count[k + 1] > count[k]:
+            present[j] = k
+            first[j] = count[k]
+            j += 1
+    first[ids] = count[m]
+    return present, at, first
