@@ -2242,3 +2242,30 @@ def test_the_segmenters_grouping_is_the_twins(seed, dtype):
     for a, b in zip(fast, twin, strict=True):
         assert a.dtype == b.dtype
         np.testing.assert_array_equal(a, b)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_segmenters_pixel_redness_and_least_areas_are_the_twins(seed, strided):
+    """Random colours at random flat indices of a whole or a strided image: ``redness_at`` is ``redness`` of the
+    gathered pixels bit for bit; random labels and depths (some without, some labels with none): ``_least_areas``
+    with the kernel and with the twin, the same values."""
+    from symfruit.segment.colour import _least_areas, redness
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    image = rng.integers(0, 256, (2 * h, 2 * w, 3), dtype=np.uint8)
+    image[rng.random(image.shape[:2]) < 0.1, 0] = 0
+    c = image[::2, 1::2] if strided else np.ascontiguousarray(image[:h, :w])
+    at = rng.integers(0, h * w, int(rng.integers(0, 200)))
+    want = redness(np.ascontiguousarray(c).reshape(-1, 3).take(at, axis=0))
+    got = _jit.redness_at(c, at)
+    assert got.dtype == want.dtype == np.float32
+    np.testing.assert_array_equal(got, want)
+    n = int(rng.integers(0, 30))
+    labels = rng.integers(0, n + 1, int(rng.integers(0, 500))).astype(np.int32)
+    depth = np.where(rng.random(len(labels)) < 0.3, 0.0, rng.uniform(0.3, 3.0, len(labels)))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _least_areas, labels, depth, n, 0.06 * 900.0, 1.2)
+    assert fast.dtype == twin.dtype and fast.shape == twin.shape == (n + 1,)
+    np.testing.assert_array_equal(fast, twin)

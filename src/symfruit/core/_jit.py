@@ -3873,3 +3873,41 @@ def grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarra
             j += 1
     first[ids] = count[m]
     return present, at, first
+
+
+@_njit
+def redness_at(color: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """``redness(color.reshape(-1, 3).take(at, axis=0))`` of :mod:`symfruit.segment.colour`: (n,) float32, the
+    redness ``(R - max(G, B)) / max(R, 1)`` of the pixels at flat (row-major) indices ``at`` of ``color`` (h, w, >= 3)
+    uint8, any strides. The same float32 operations: the same values."""
+    w = color.shape[1]
+    out = np.empty(at.shape[0], np.float32)
+    one = np.float32(1.0)
+    for i in range(at.shape[0]):
+        r, c = at[i] // w, at[i] % w
+        x = np.float32(color[r, c, 0])
+        gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+        out[i] = (x - gb) / (x if x > one else one)
+    return out
+
+
+@_njit
+def least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._least_areas`: (n + 1,) the least fruit's area (pixels) at each label's mean
+    depth (``z_typical`` without depth), from the labels (k,) and depths (k,) of a window's region pixels: the depths
+    above 0 summed label by label in their order (``np.bincount``'s), over their count; ``pi / 4 (d / z)^2``. The
+    same values."""
+    count = np.zeros(n + 1)
+    total = np.zeros(n + 1)
+    for i in range(labels.shape[0]):
+        z = depth[i]
+        if z > 0:
+            count[labels[i]] += 1.0
+            total[labels[i]] += z
+    quarter = np.pi / 4
+    out = np.empty(n + 1)
+    for k in range(n + 1):
+        z = total[k] / max(count[k], 1.0) if count[k] > 0 else z_typical
+        x = diameter_px_m / z
+        out[k] = quarter * (x * x)
+    return out

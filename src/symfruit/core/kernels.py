@@ -6,8 +6,8 @@ quadric candidates' agreement (fourteenth round), the registration's key ranks a
 occlusion's pixel look-ups (sixteenth round), and the registration's exact costs and keys, extraction's depth tests,
 colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
 observation's band rays and outline pixels and the surface noise's measures (seventeenth round), and the colour
-segmenter's sphere fits, centre search and depth edges (eighteenth round), with numba from the optional extra
-``fast``.
+segmenter's sphere fits, centre search, depth edges, cells, ripe test's median redness, region grouping, pixel
+redness and least areas (eighteenth round), with numba from the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -28,7 +28,8 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 :func:`symfruit.segment.colour.segment`'s hulls, labellings, floods, creases and sphere points,
 :func:`symfruit.core.agreement.observe`'s bands and outline, :func:`symfruit.core.fits.noise_measures` and
 :func:`symfruit.core.points.column_means`; the eighteenth round's :func:`symfruit.segment.colour._sphere`,
-``_centres`` and ``_depth_edges``) then run their numpy twins, the code the kernels
+``_centres``, ``_depth_edges``, ``_cells``, ``_grouped``, ``_least_areas`` and ``_segment_at``'s redness) then run
+their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'

@@ -544,8 +544,11 @@ def _segment_at(
             # a region no larger than one fruit and not ripe-red is dropped before its masks are made: its pixels'
             # depths and colours read off at once
             at = image_at.take(grouped)
-            rgb = c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w]
-            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), redness(rgb), s, geo.focal, z_typical)
+            if (jit := compiled()) is not None:  # the same values in one call (issue 19, eighteenth round)
+                red_at = jit.redness_at(c, at)
+            else:
+                red_at = redness(c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w])
+            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), red_at, s, geo.focal, z_typical)
         for k, whole in zip(ids[ripe | ~one].tolist(), one[ripe | ~one].tolist(), strict=True):
             sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
@@ -1956,7 +1959,11 @@ def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: f
     """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
     regions without depth), from the labels ``1..n`` of a window's region pixels and their depths (in the
     window's raster order: each mean sums its depths in that order); ``diameter_px_m`` is the least diameter
-    times the focal length."""
+    times the focal length. Where numba is, in one compiled pass (:func:`symfruit.core._jit.least_areas`: the same
+    values; issue 19, eighteenth round)."""
+    if (jit := compiled()) is not None and labels.ndim == depth.ndim == 1 and depth.dtype == np.float64:
+        areas: np.ndarray = jit.least_areas(labels, depth, int(n), float(diameter_px_m), float(z_typical))
+        return areas
     valid = depth > 0
     lab = labels[valid]
     count = np.bincount(lab, minlength=n + 1).astype(np.float64)
@@ -1977,7 +1984,8 @@ def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarr
     run starts in them (one more at the end: their number). Where numba is, by a compiled counting sort
     (:func:`symfruit.core._jit.grouped`: the same arrays; issue 19, eighteenth round)."""
     if (jit := compiled()) is not None and labels.ndim == 1 and keep.ndim == 1 and keep.dtype == bool:
-        return jit.grouped(labels, keep)  # type: ignore[no-any-return]
+        found: tuple[np.ndarray, np.ndarray, np.ndarray] = jit.grouped(labels, keep)
+        return found
     at = np.flatnonzero(keep.take(labels))
     lab = labels.take(at)
     order = np.argsort(lab, kind="stable")
