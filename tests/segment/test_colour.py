@@ -546,8 +546,10 @@ def test_the_dilations_are_scipys():
 
 
 def test_the_sphere_fit_is_the_former_one_bit_for_bit():
+    """The numpy code (``_sphere_lstsq``) is the former fit bit for bit; ``_sphere``, by the compiled kernel where numba
+    is (Householder reflections instead of LAPACK's SVD), the same sphere to rounding."""
     from symfruit.core.points import median
-    from symfruit.segment.colour import _Geometry, _points, _sphere
+    from symfruit.segment.colour import _Geometry, _points, _sphere, _sphere_lstsq
 
     def former(mask, depth, geo, origin):  # norms and squared norms by numpy's reductions
         p = _points(mask, depth, geo, origin, 1500)
@@ -573,10 +575,14 @@ def test_the_sphere_fit_is_the_former_one_bit_for_bit():
             disc, 0.5 - np.sqrt(np.clip(r * r - (xx - 50) ** 2 - (yy - 40) ** 2, 0, None)) / 600 * 0.5, 0.0
         )
         depth = np.where(disc, depth + rng.normal(0, 0.001, depth.shape), 0.0)
-        fit = _sphere(disc, depth, geo, (0, 0))
+        fit = _sphere_lstsq(disc, depth, geo, (0, 0))
         assert fit is not None
         centre, radius = former(disc, depth, geo, (0, 0))
         assert np.array_equal(fit[0], centre) and fit[1] == radius
+        fast = _sphere(disc, depth, geo, (0, 0))
+        assert fast is not None
+        np.testing.assert_allclose(fast[0], centre, rtol=0, atol=1e-12)
+        assert abs(fast[1] - radius) <= 1e-12
 
 
 def test_ripe_seeds_are_the_former_look_ups():
@@ -1114,3 +1120,40 @@ def test_the_extent_of_a_disc_is_its_diameter():
     disc = (xx - 50) ** 2 + (yy - 50) ** 2 <= 40**2
     assert abs(_extent(_hull_vertices(disc), disc) - 81) <= 1.0
     assert _extent(None, np.ones((3, 3), bool)) == 3.0
+
+
+def test_the_edge_following_counts_are_the_former_ones():
+    """Random regions, edges and parts: ``_follow_edges`` (each piece's counts by one bincount) gives the former
+    pieces (counted by ``np.add.at``; issue 19, eighteenth round)."""
+    from symfruit.core.raster import nearest_index
+    from symfruit.segment.colour import EDGE_PURITY, _follow_edges, _label
+
+    def former(parts, region, edges):
+        pieces, n = _label(region & ~edges)
+        if n < 2:
+            return parts
+        owner = np.zeros(region.shape, np.int64)
+        for k, part in enumerate(parts, 1):
+            owner[part] = k
+        counts = np.zeros((n + 1, len(parts) + 1), np.int64)
+        np.add.at(counts, (pieces.ravel(), owner.ravel()), 1)
+        major = counts[:, 1:].argmax(axis=1) + 1
+        total = counts[:, 1:].sum(axis=1)
+        pure = counts[np.arange(n + 1), major] >= EDGE_PURITY * np.maximum(total, 1)
+        seeds = np.where(pure[pieces], major[pieces], owner)
+        seeds[(pieces == 0) | ~region] = 0
+        if not seeds.any():
+            return parts
+        grown = np.where(region, np.take(seeds.ravel(), nearest_index(seeds == 0)), 0)
+        return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
+
+    rng = np.random.default_rng(5)
+    for _ in range(30):
+        h, w = (int(x) for x in rng.integers(2, 50, 2))
+        region = rng.random((h, w)) < 0.9
+        edges = region & (rng.random((h, w)) < 0.2)
+        cut = rng.integers(1, 4)
+        parts = [region & (np.arange(w) % cut == k) for k in range(int(cut))]
+        parts = [p for p in parts if p.any()]
+        got, want = _follow_edges(parts, region, edges), former(parts, region, edges)
+        assert len(got) == len(want) and all(np.array_equal(a, b) for a, b in zip(got, want, strict=True))

@@ -3858,3 +3858,425 @@ def ground_steps(ground: np.ndarray, depth: np.ndarray, size: int, jump: float) 
         for q in range(w):
             out[r, q] = ground[r, q] and not edge[r, q]
     return out
+
+
+# --- issue 19, eighteenth round (stop 38): the segmenter's split and maps ---------------------------------------
+
+
+@_njit
+def sphere_solve(p: np.ndarray, sol: np.ndarray) -> bool:
+    """The algebraic sphere's least squares of :func:`symfruit.segment.colour._sphere`: ``sol`` (4,) minimising
+    ``|[2 p, 1] sol - |p|^2|`` for points ``p`` (n, 3; n >= 4), by Householder reflections of the (n, 4) system and
+    back substitution (LAPACK's ``gelsd`` there, an SVD: the same solution to rounding, not to the bit). False,
+    ``sol`` untouched, when a column is (nearly) dependent on those before it: the reflected diagonal under 1e-9 of
+    the largest (``lstsq`` then gives the least-norm solution, which the twin is left to find)."""
+    n = p.shape[0]
+    a = np.empty((4, n))  # the system's columns as rows: each reflection runs along contiguous memory
+    b = np.empty(n)
+    for i in range(n):
+        x, y, z = p[i, 0], p[i, 1], p[i, 2]
+        a[0, i], a[1, i], a[2, i], a[3, i] = 2.0 * x, 2.0 * y, 2.0 * z, 1.0
+        b[i] = x * x + y * y + z * z
+    diag = np.empty(4)
+    for k in range(4):
+        s = 0.0
+        for i in range(k, n):
+            s += a[k, i] * a[k, i]
+        norm = math.sqrt(s)
+        if norm == 0.0:
+            return False
+        alpha = -norm if a[k, k] >= 0.0 else norm
+        v0 = a[k, k] - alpha
+        vv = s - a[k, k] * a[k, k] + v0 * v0  # |v|^2, v = column k from row k on, less alpha at its first place
+        a[k, k] = v0
+        diag[k] = alpha
+        for j in range(k + 1, 4):
+            d = 0.0
+            for i in range(k, n):
+                d += a[k, i] * a[j, i]
+            f = 2.0 * d / vv
+            for i in range(k, n):
+                a[j, i] -= f * a[k, i]
+        d = 0.0
+        for i in range(k, n):
+            d += a[k, i] * b[i]
+        f = 2.0 * d / vv
+        for i in range(k, n):
+            b[i] -= f * a[k, i]
+    largest = 0.0
+    for k in range(4):
+        largest = max(largest, abs(diag[k]))
+    for k in range(4):
+        if not abs(diag[k]) > 1e-9 * largest:
+            return False
+    x = np.empty(4)
+    for k in range(3, -1, -1):
+        s = b[k]
+        for j in range(k + 1, 4):
+            s -= a[j, k] * x[j]
+        x[k] = s / diag[k]
+    for k in range(4):
+        sol[k] = x[k]
+    return True
+
+
+@_njit
+def sphere_fit(
+    mask: np.ndarray, depth: np.ndarray, r0: int, c0: int, cx: float, cy: float, focal: float, most: int,
+    fit: np.ndarray,
+) -> int:  # fmt: skip
+    """:func:`symfruit.segment.colour._sphere` in one call: the points and spread of :func:`sphere_points`, the
+    algebraic fit (:func:`sphere_solve`), the points off it dropped (:func:`sphere_inliers`), the fit again, and
+    the twin's test of a fruit-like cap (the radius within 0.25-4 times the spread). 1 with the centre and radius
+    in ``fit`` (4,), 0 for the twin's None, -1 where :func:`sphere_solve` leaves the system to the twin's
+    ``lstsq``. A non-finite fit is None, as the twin's NaN threshold keeps no point."""
+    p, spread = sphere_points(mask, depth, r0, c0, cx, cy, focal, most)
+    sol = np.zeros(4)
+    centre = np.zeros(3)
+    radius = 0.0
+    for it in range(2):
+        if p.shape[0] < 20:
+            return 0
+        if not sphere_solve(p, sol):
+            return -1
+        centre[0], centre[1], centre[2] = sol[0], sol[1], sol[2]
+        q = sol[3] + (centre[0] * centre[0] + centre[1] * centre[1] + centre[2] * centre[2])
+        radius = math.sqrt(q) if q > 0.0 else (0.0 if q <= 0.0 else q)  # max(q, 0) keeps a NaN, as Python's does
+        if not (np.isfinite(centre[0]) and np.isfinite(centre[1]) and np.isfinite(centre[2])
+                and np.isfinite(radius)):  # fmt: skip
+            return 0
+        if it == 0:
+            p = sphere_inliers(p, centre, radius)
+    if not (0.25 * spread <= radius <= 4.0 * spread):
+        return 0
+    fit[0], fit[1], fit[2], fit[3] = centre[0], centre[1], centre[2], radius
+    return 1
+
+
+@_njit
+def _on_path(edt: np.ndarray, p: int, q: int, centres: np.ndarray, m: int, t: float) -> bool:
+    """:func:`symfruit.segment.colour._on_path`: whether the straight path from ``(p, q)`` to one of the first ``m``
+    ``centres`` (rows ``row, col, ...``) stays deeper than ``t``, its pixels ``np.rint`` of the twin's
+    ``np.linspace`` (``i * step + start``, the last the end itself: the same pixels)."""
+    for k in range(m):
+        a, b = int(centres[k, 0]), int(centres[k, 1])
+        n = max(abs(a - p), abs(b - q)) + 1
+        dr, dc = float(a) - float(p), float(b) - float(q)
+        sr, sc = dr / n, dc / n
+        lowest = np.inf
+        for i in range(n + 1):
+            if i == n:
+                r, c = a, b
+            else:
+                yr = (i / n) * dr if sr == 0.0 else i * sr
+                yc = (i / n) * dc if sc == 0.0 else i * sc
+                r, c = int(np.rint(yr + p)), int(np.rint(yc + q))
+            v = edt[r, c]
+            lowest = v if v < lowest else lowest
+        if lowest > t:
+            return True
+    return False
+
+
+@_njit
+def _separate(edt: np.ndarray, p: int, q: int, centres: np.ndarray, m: int, t: float, budget: np.ndarray) -> bool:
+    """:func:`symfruit.segment.colour._separate`: whether ``(p, q)`` lies in another 4-connected component of
+    ``edt > t`` than each of the first ``m`` ``centres``; a path that stays above ``t`` joins them, and with no
+    labelling left in ``budget[0]`` it is taken as joined. The component walked by :func:`flood`."""
+    if _on_path(edt, p, q, centres, m, t):
+        return False
+    if budget[0] <= 0:
+        return False
+    budget[0] -= 1
+    above = edt > t
+    if not above[p, q]:
+        for k in range(m):
+            if not above[int(centres[k, 0]), int(centres[k, 1])]:
+                return False
+        return True
+    seed = np.zeros(edt.shape, np.bool_)
+    seed[p, q] = True
+    reached = flood(above, seed)
+    for k in range(m):
+        if reached[int(centres[k, 0]), int(centres[k, 1])]:
+            return False
+    return True
+
+
+@_njit
+def centre_search(edt: np.ndarray, radius: int, least: float, loose: float, waist: float, budget: int) -> np.ndarray:
+    """:func:`symfruit.segment.colour._centres` after its distance map ``edt``: its :func:`peaks` (``radius``,
+    ``least``), in raster order then by depth, deepest first (a stable sort, as the twin's), and the walk over the
+    first 400 of them: a peak inside a kept centre's inscribed disc is skipped, one not separated from the kept
+    centres at ``loose`` times its depth (:func:`_separate`, ``budget`` labellings in all) too; a kept one is firm
+    when separated at ``waist`` times its depth as well; at most 8 kept. (k, 4) rows ``row, col, radius, firm``
+    (whole numbers and the map's values: the twin's centres)."""
+    h, w = edt.shape
+    found = peaks(edt, radius, least)
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += found[r, c]
+    at = np.empty(n, np.int64)
+    neg = np.empty(n)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if found[r, c]:
+                at[k] = r * w + c
+                neg[k] = -edt[r, c]
+                k += 1
+    order = np.argsort(neg, kind="mergesort")
+    centres = np.empty((8, 4))
+    m = 0
+    left = np.full(1, budget, np.int64)
+    for i in order[:400]:
+        p, q = at[i] // w, at[i] % w
+        depth = edt[p, q]
+        inside = False
+        for j in range(m):
+            a, b, ra = centres[j, 0], centres[j, 1], centres[j, 2]
+            if (p - a) ** 2 + (q - b) ** 2 <= ra * ra:
+                inside = True
+                break
+        if inside:
+            continue
+        firm = True
+        if m > 0:
+            if not _separate(edt, p, q, centres, m, loose * depth, left):
+                continue
+            if waist < loose:
+                firm = _separate(edt, p, q, centres, m, waist * depth, left)
+        centres[m, 0], centres[m, 1], centres[m, 2], centres[m, 3] = p, q, depth, 1.0 if firm else 0.0
+        m += 1
+        if m >= 8 or left[0] <= 0:
+            break
+    return centres[:m].copy()
+
+
+@_njit
+def _correlate_columns(image: np.ndarray, weights: np.ndarray, symmetric: bool, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(image, weights, 0)`` (mode "reflect") of an (h, w) float64 image into ``out``: each
+    value's products and sums in :func:`_correlate_line`'s order (scipy's), worked a whole row at a time (rows
+    ``r + j`` reflected at the edges) instead of one gathered column at a time: the same values."""
+    h, w = image.shape
+    half = weights.shape[0] // 2
+    last = weights.shape[0] - half - 1
+    for r in range(h):
+        if symmetric:
+            mid = weights[half]
+            for c in range(w):
+                out[r, c] = image[r, c] * mid
+            for j in range(-half, 0):
+                a, b, wt = _reflected(r + j, h), _reflected(r - j, h), weights[half + j]
+                for c in range(w):
+                    out[r, c] += (image[a, c] + image[b, c]) * wt
+        else:
+            a, wt = _reflected(r + last, h), weights[half + last]
+            for c in range(w):
+                out[r, c] = image[a, c] * wt
+            for j in range(-half, last):
+                a, wt = _reflected(r + j, h), weights[half + j]
+                for c in range(w):
+                    out[r, c] += image[a, c] * wt
+
+
+@_njit
+def depth_edges(
+    filled: np.ndarray, weights: np.ndarray, symmetric: bool, limit: float, region: np.ndarray, depth: np.ndarray,
+    seen: np.ndarray, jump: float,
+) -> np.ndarray:  # fmt: skip
+    """:func:`symfruit.segment.colour._depth_edges` from the gap-filled depth ``filled``: the pixels of ``region`` on
+    a crease (:func:`creases`' test, its smoothing's first pass by :func:`_correlate_columns`) or on a depth step
+    (``depth`` of two 4-neighbours both ``seen`` more than ``jump`` apart: the twin's NaN elsewhere never steps).
+    The same values and pixels."""
+    h, w = filled.shape
+    across = np.empty((h, w))
+    _correlate_columns(filled, weights, symmetric, across)
+    smooth = np.empty((h, w))
+    for r in range(h):  # along axis 1
+        _correlate_line(across[r], weights, symmetric, smooth[r])
+    out = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if not region[r, c]:
+                continue
+            down = smooth[r, c] * -2.0
+            down += (smooth[_reflected(r - 1, h), c] + smooth[_reflected(r + 1, h), c]) * 1.0
+            side = smooth[r, c] * -2.0
+            side += (smooth[r, _reflected(c - 1, w)] + smooth[r, _reflected(c + 1, w)]) * 1.0
+            if down + side < limit:
+                out[r, c] = True
+                continue
+            z = depth[r, c]
+            if not seen[r, c]:
+                continue
+            if (r > 0 and seen[r - 1, c] and abs(z - depth[r - 1, c]) > jump) or (
+                r + 1 < h and seen[r + 1, c] and abs(depth[r + 1, c] - z) > jump) or (
+                c > 0 and seen[r, c - 1] and abs(z - depth[r, c - 1]) > jump) or (
+                c + 1 < w and seen[r, c + 1] and abs(depth[r, c + 1] - z) > jump):  # fmt: skip
+                out[r, c] = True
+    return out
+
+
+@_njit
+def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._cells` before its masks: (h, w) int32, each pixel of ``region`` (h, w) bool
+    numbered by its cell (1..k), 0 outside. ``centres`` (k, 3) rows ``row, col, radius``. The region's distance map
+    (:func:`distance` of it padded by a pixel), its 4-connected pieces deeper than ``loose`` times the least radius
+    (:func:`label`), each deep pixel to the centre of least power ``(r - row)^2 + (c - col)^2 - radius^2`` (the first
+    of equals, as ``np.argmin``) when in that centre's piece, the centres' own pixels to them, every region pixel to
+    its nearest core pixel (:func:`nearest`, scipy's choice). The twin's sums in its order: the same cells."""
+    h, w = region.shape
+    k = centres.shape[0]
+    pad = np.zeros((h + 2, w + 2), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            pad[r + 1, c + 1] = region[r, c]
+    dist = np.empty((h + 2, w + 2))
+    distance(pad, False, dist)
+    least = centres[0, 2]
+    for j in range(1, k):
+        least = min(least, centres[j, 2])
+    t = loose * least
+    above = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            above[r, c] = dist[r + 1, c + 1] > t
+    deep, _ = label(above, False)
+    at = np.empty(k, np.int32)
+    for j in range(k):
+        at[j] = deep[int(centres[j, 0]), int(centres[j, 1])]
+    cores = np.zeros((h, w), np.int32)
+    for r in range(h):
+        for c in range(w):
+            if deep[r, c] == 0:
+                continue
+            best, least_power = 0, np.inf
+            for j in range(k):
+                dr, dc, rad = r - centres[j, 0], c - centres[j, 1], centres[j, 2]
+                power = dr * dr + dc * dc - rad * rad
+                if power < least_power:
+                    best, least_power = j, power
+            if deep[r, c] == at[best]:
+                cores[r, c] = best + 1
+    for j in range(k):
+        cores[int(centres[j, 0]), int(centres[j, 1])] = j + 1
+    free = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            free[r, c] = cores[r, c] == 0
+    near = np.empty((h, w), np.int64)
+    nearest(free, near)
+    out = np.zeros((h, w), np.int32)
+    for r in range(h):
+        for c in range(w):
+            if region[r, c]:
+                q = near[r, c]
+                out[r, c] = cores[q // w, q % w]
+    return out
+
+
+@_njit
+def red_median(color: np.ndarray, red: np.ndarray) -> float:
+    """``median(redness(color[red]))`` of :func:`symfruit.segment.colour._segment_at`'s ripe test: the float32
+    redness ``(R - max(G, B)) / max(R, 1)`` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8, and
+    their median as ``core.points.median`` takes it (the middle value by :func:`select`, or the float32 mean of the
+    middle two); NaN without a pixel. The same float32 operations: the same value."""
+    h, w = red.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += red[r, c]
+    if n == 0:
+        return np.nan
+    values = np.empty(n, np.float32)
+    k = 0
+    one = np.float32(1.0)
+    for r in range(h):
+        for c in range(w):
+            if red[r, c]:
+                x = np.float32(color[r, c, 0])
+                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+                values[k] = (x - gb) / (x if x > one else one)
+                k += 1
+    half = n // 2
+    select(values, half)  # a quickselect: several times faster than a sort on a fruit's thousands of pixels
+    if n % 2:
+        return float(values[half])
+    below = values[0]
+    for i in range(1, half):
+        below = max(below, values[i])
+    return float((below + values[half]) / np.float32(2.0))
+
+
+@_njit
+def grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.segment.colour._grouped`: the places in ``labels`` (n,) of the labels that ``keep`` marks,
+    grouped by label in ascending order, each label's in their own order (a counting sort: stable, as the twin's
+    ``argsort``); the labels present, and where each one's run starts (one more: the count). The same arrays."""
+    m = keep.shape[0]
+    count = np.zeros(m + 1, np.int64)
+    for i in range(labels.shape[0]):
+        k = labels[i]
+        if keep[k]:
+            count[k + 1] += 1
+    ids = 0
+    for k in range(m):
+        ids += count[k + 1] > 0
+        count[k + 1] += count[k]
+    at = np.empty(count[m], np.int64)
+    fill = count[:m].copy()
+    for i in range(labels.shape[0]):
+        k = labels[i]
+        if keep[k]:
+            at[fill[k]] = i
+            fill[k] += 1
+    present = np.empty(ids, labels.dtype)
+    first = np.empty(ids + 1, np.int64)
+    j = 0
+    for k in range(m):
+        if count[k + 1] > count[k]:
+            present[j] = k
+            first[j] = count[k]
+            j += 1
+    first[ids] = count[m]
+    return present, at, first
+
+
+@_njit
+def redness_at(color: np.ndarray, at: np.ndarray) -> np.ndarray:
+    """``redness(color.reshape(-1, 3).take(at, axis=0))`` of :mod:`symfruit.segment.colour`: (n,) float32, the
+    redness ``(R - max(G, B)) / max(R, 1)`` of the pixels at flat (row-major) indices ``at`` of ``color`` (h, w, >= 3)
+    uint8, any strides. The same float32 operations: the same values."""
+    w = color.shape[1]
+    out = np.empty(at.shape[0], np.float32)
+    one = np.float32(1.0)
+    for i in range(at.shape[0]):
+        r, c = at[i] // w, at[i] % w
+        x = np.float32(color[r, c, 0])
+        gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+        out[i] = (x - gb) / (x if x > one else one)
+    return out
+
+
+@_njit
+def least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._least_areas`: (n + 1,) the least fruit's area (pixels) at each label's mean
+    depth (``z_typical`` without depth), from the labels (k,) and depths (k,) of a window's region pixels: the depths
+    above 0 summed label by label in their order (``np.bincount``'s), over their count; ``pi / 4 (d / z)^2``. The
+    same values."""
+    count = np.zeros(n + 1)
+    total = np.zeros(n + 1)
+    for i in range(labels.shape[0]):
+        z = depth[i]
+        if z > 0:
+            count[labels[i]] += 1.0
+            total[labels[i]] += z
+    quarter = np.pi / 4
+    out = np.empty(n + 1)
+    for k in range(n + 1):
+        z = total[k] / max(count[k], 1.0) if count[k] > 0 else z_typical
+        x = diameter_px_m / z
+        out[k] = quarter * (x * x)
+    return out

@@ -7,8 +7,9 @@ occlusion's pixel look-ups (sixteenth round), and the registration's exact costs
 colour trimming's regions, the occlusion's windows, the colour segmenter's hulls, labellings and round skins, the
 observation's band rays and outline pixels and the surface noise's measures (seventeenth round), and the
 occlusion's maps with their nearest point pixels looked for only where they decide, the box of where a fruit may
-project, the outline ellipse's acceptance test, the ragged outline's closing and the points' pixels (eighteenth
-round), with numba from the optional extra ``fast``.
+project, the outline ellipse's acceptance test, the ragged outline's closing, the points' pixels and the colour
+segmenter's sphere fits, centre search, depth edges, cells, ripe test's median redness, region grouping, pixel
+redness and least areas (eighteenth round), with numba from the optional extra ``fast``.
 
 :func:`compiled` returns the kernels' module, :mod:`symfruit.core._jit`, or None: when numba is not installed, or
 when the environment sets ``SYMFRUIT_KERNELS=numpy``. Its callers (:func:`symfruit.core.fits.fit_sphere`,
@@ -32,12 +33,14 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 (:func:`symfruit.core._jit.occlusion_window`, the maps of ``occlusion_maps`` after ``nearest``),
 :meth:`symfruit.core.occlusion.Occlusion.extent` (:func:`symfruit.core._jit.allowed_box`, the box of ``allowed``'s
 pixels), :func:`symfruit.core.raster.outline_cone`, :func:`~symfruit.core.raster.close_ragged`,
-:func:`~symfruit.core.raster.silhouette` and :func:`~symfruit.core.raster.rasterise`) then run their numpy twins, the
-code the kernels
+:func:`~symfruit.core.raster.silhouette`, :func:`~symfruit.core.raster.rasterise`,
+:func:`symfruit.segment.colour._sphere`, ``_centres``, ``_depth_edges``, ``_cells``, ``_grouped``, ``_least_areas``
+and ``_segment_at``'s redness) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
-depth RMS does). Nothing
+depth RMS does, and the segmenter's sphere fits from Householder reflections instead of LAPACK's SVD, a nanometre
+apart, no mask changed on the checks of issue 19's eighteenth round). Nothing
 compiles when symfruit is imported: numba is imported by the first fit that asks for a kernel (about half a second),
 and each kernel is compiled on its first call (a few seconds in all) or loaded from numba's on-disk cache (beside
 the module, or the user's cache directory where that is read-only; without a cache where neither is writable).

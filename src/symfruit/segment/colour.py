@@ -544,8 +544,11 @@ def _segment_at(
             # a region no larger than one fruit and not ripe-red is dropped before its masks are made: its pixels'
             # depths and colours read off at once
             at = image_at.take(grouped)
-            rgb = c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w]
-            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), redness(rgb), s, geo.focal, z_typical)
+            if (jit := compiled()) is not None:  # the same values in one call (issue 19, eighteenth round)
+                red_at = jit.redness_at(c, at)
+            else:
+                red_at = redness(c.reshape(-1, 3).take(at, axis=0) if c.flags.c_contiguous else c[at // w, at % w])
+            one, ripe = _one_fruit(first, sizes.take(ids), zw.take(grouped), red_at, s, geo.focal, z_typical)
         for k, whole in zip(ids[ripe | ~one].tolist(), one[ripe | ~one].tolist(), strict=True):
             sl = _pad(objects[k], 1, labels.shape)
             region = labels[sl] == k
@@ -585,7 +588,10 @@ def _segment_at(
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
-        if not red.any() or median(redness(c[sl][red])) < s.ripe_median:
+        if (jit := compiled()) is not None:  # the same value in one compiled call (issue 19, eighteenth round)
+            if not red.any() or jit.red_median(c[sl], red) < s.ripe_median:
+                continue
+        elif not red.any() or median(redness(c[sl][red])) < s.ripe_median:
             continue
         hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
@@ -1131,8 +1137,10 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     owner = np.zeros(region.shape, np.int64)
     for k, part in enumerate(parts, 1):
         owner[part] = k
-    counts = np.zeros((n + 1, len(parts) + 1), np.int64)
-    np.add.at(counts, (pieces.ravel(), owner.ravel()), 1)
+    # each (piece, owner) pair's pixels, counted by one bincount of the pairs' numbers (np.add.at's counts, several
+    # times faster; issue 19, eighteenth round)
+    counts = np.bincount(pieces.ravel() * (len(parts) + 1) + owner.ravel(), minlength=(n + 1) * (len(parts) + 1))
+    counts = counts.reshape(n + 1, len(parts) + 1)
     major = counts[:, 1:].argmax(axis=1) + 1
     total = counts[:, 1:].sum(axis=1)
     pure = counts[np.arange(n + 1), major] >= EDGE_PURITY * np.maximum(total, 1)
@@ -1172,11 +1180,11 @@ def _centres(
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     if float(edt.max()) < least:
         return []
+    if (jit := compiled()) is not None:  # the peaks and the walk below in one call, the same centres
+        found = jit.centre_search(edt, int(least), float(least), float(loose), float(waist), MAX_WAIST_TESTS)
+        return [(int(a), int(b), float(r), bool(f)) for a, b, r, f in found.tolist()]  # (issue 19, eighteenth round)
     # peaks: the deepest points within the smallest fruit's radius (two fruit's centres lie farther apart)
-    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.peaks`; seventeenth round)
-        peaks = jit.peaks(edt, int(least), float(least))
-    else:
-        peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
+    peaks = (edt >= ndimage.maximum_filter(edt, size=2 * int(least) + 1)) & (edt >= least)
     pr, pc = np.nonzero(peaks)
     order = np.argsort(-edt[pr, pc], kind="stable")
     centres: list[tuple[int, int, float, bool]] = []
@@ -1321,7 +1329,23 @@ def _sphere(
     """The sphere (centre in the camera frame, metres; radius) that best fits the depth points of a mask in
     the window at ``origin`` (algebraic least squares, once more without the points far off it); None
     with fewer than 20 points or when the fit is not a fruit-like cap (its radius off the points' own
-    spread by more than 4x either way)."""
+    spread by more than 4x either way). Where numba is, one compiled call gives it
+    (:func:`symfruit.core._jit.sphere_fit`: the same points, its least squares by Householder reflections instead of
+    LAPACK's SVD, so the same sphere to rounding; issue 19, eighteenth round: 30 against 300 us a fit), and the
+    numpy code below (:func:`_sphere_lstsq`) where the kernel leaves a nearly singular system to ``lstsq``."""
+    if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
+        fit = np.empty(4)
+        found = jit.sphere_fit(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
+                               float(geo.focal), int(most), fit)  # fmt: skip
+        if found >= 0:
+            return (fit[:3], float(fit[3])) if found else None
+    return _sphere_lstsq(mask, depth, geo, origin, most)
+
+
+def _sphere_lstsq(
+    mask: np.ndarray, depth: np.ndarray, geo: _Geometry, origin: tuple[int, int], most: int = 1500
+) -> tuple[np.ndarray, float] | None:
+    """:func:`_sphere` by numpy's ``lstsq`` (the compiled kernel's twin)."""
     if (jit := compiled()) is not None and mask.ndim == depth.ndim == 2 and mask.dtype == bool:
         # the same points and spread (:func:`symfruit.core._jit.sphere_points`; issue 19, seventeenth round)
         p, spread = jit.sphere_points(mask, depth, int(origin[0]), int(origin[1]), float(geo.cx), float(geo.cy),
@@ -1383,7 +1407,11 @@ def _separate(
 def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: float) -> list[np.ndarray]:
     """The region cut among fruit centres: each centre's core (the points around it deeper than ``loose``
     times the smallest centre's radius, shared out by power distance ``|x - c|^2 - r^2`` where cores
-    touch) and every other pixel to the nearest core, so two fruit meet at the waist between them."""
+    touch) and every other pixel to the nearest core, so two fruit meet at the waist between them. Where numba is, the
+    cells' map in one compiled call (:func:`symfruit.core._jit.cells`: the same cells; issue 19, eighteenth round)."""
+    if (jit := compiled()) is not None and region.ndim == 2 and region.dtype == bool:
+        cells = jit.cells(region, np.array(centres, dtype=np.float64).reshape(-1, 3), float(loose))
+        return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
     deep, _ = _label(edt > loose * float(cen[:, 2].min()))
@@ -1404,7 +1432,14 @@ def _depth_edges(
 ) -> np.ndarray:
     """Pixels of the region on a depth step (larger than ``depth_jump`` between neighbours) or on a concave
     crease of the depth surface: where one fruit ends and another begins. ``seen``: the region's pixels with depth
-    (``region & (depth > 0)``), ``zm`` their median depth."""
+    (``region & (depth > 0)``), ``zm`` their median depth. Where numba is and 20 or more pixels have depth, the creases
+    and steps in one compiled call (:func:`symfruit.core._jit.depth_edges`: the same pixels; issue 19, eighteenth
+    round)."""
+    if (jit := compiled()) is not None and seen.sum() >= 20:
+        filled = np.take(np.ascontiguousarray(depth).ravel(), nearest_index(~seen))
+        weights, symmetric = _gaussian_weights(float(s.crease_sigma)) if s.crease_sigma > 0 else _IDENTITY
+        limit = -s.crease_curvature * (zm / focal) ** 2
+        return jit.depth_edges(filled, weights, symmetric, limit, region, depth, seen, float(s.depth_jump))
     z = np.where(seen, depth, np.nan)
     return (_creases(region, depth, seen, zm, s, focal) | _steps(z, s.depth_jump)) & region
 
@@ -1924,7 +1959,11 @@ def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: f
     """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
     regions without depth), from the labels ``1..n`` of a window's region pixels and their depths (in the
     window's raster order: each mean sums its depths in that order); ``diameter_px_m`` is the least diameter
-    times the focal length."""
+    times the focal length. Where numba is, in one compiled pass (:func:`symfruit.core._jit.least_areas`: the same
+    values; issue 19, eighteenth round)."""
+    if (jit := compiled()) is not None and labels.ndim == depth.ndim == 1 and depth.dtype == np.float64:
+        areas: np.ndarray = jit.least_areas(labels, depth, int(n), float(diameter_px_m), float(z_typical))
+        return areas
     valid = depth > 0
     lab = labels[valid]
     count = np.bincount(lab, minlength=n + 1).astype(np.float64)
@@ -1942,7 +1981,11 @@ def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndar
 def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The pixels of the labels that ``keep`` marks, grouped by label: their labels in ascending order, the
     pixels' indices (into ``labels``) label by label (each label's in their own order), and where each label's
-    run starts in them (one more at the end: their number)."""
+    run starts in them (one more at the end: their number). Where numba is, by a compiled counting sort
+    (:func:`symfruit.core._jit.grouped`: the same arrays; issue 19, eighteenth round)."""
+    if (jit := compiled()) is not None and labels.ndim == 1 and keep.ndim == 1 and keep.dtype == bool:
+        found: tuple[np.ndarray, np.ndarray, np.ndarray] = jit.grouped(labels, keep)
+        return found
     at = np.flatnonzero(keep.take(labels))
     lab = labels.take(at)
     order = np.argsort(lab, kind="stable")
