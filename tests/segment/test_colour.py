@@ -956,7 +956,7 @@ def test_a_piece_of_ground_colour_hidden_in_part_by_a_leaf_in_front_is_one_conve
     from symfruit.segment.colour import _convex_outline, _hull_vertices
 
     # an apple-sized cap of ground colour with a leaf band across it 5 cm nearer (its edges without depth),
-    # the same band 5 cm behind (a gap through to leaves behind: two pieces, not one outline), and no depth at all
+    # the same band 10 cm behind (a gap through to leaves behind: two pieces, not one outline), and no depth at all
     _, patch, depth = patch_depth("apple")
     yy = np.mgrid[:1080, :1920][0]
     band = np.abs(yy - 540) <= 9
