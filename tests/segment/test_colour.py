@@ -907,6 +907,77 @@ def test_two_flat_pieces_joined_where_depth_is_missing_are_no_round_body():
     assert _round_body(patch, depth, _Geometry(HD_CAM.fx, HD_CAM.cy, HD_CAM.cx), APPLE, (0, 0)) is None
 
 
+def tof_rim(depth, disc, inner=4, outer=2, shift=0):
+    """A time-of-flight camera's view of ``depth``: no depth in a band about the silhouette of ``disc`` (``inner``
+    pixels inside it, ``outer`` outside), and depth registered ``shift`` pixels to the right of the colour."""
+    from scipy import ndimage
+
+    band = ndimage.binary_dilation(disc, iterations=outer) & ~ndimage.binary_erosion(disc, iterations=inner)
+    out = np.where(band, 0.0, depth)
+    return np.roll(out, shift, axis=1) if shift else out
+
+
+def blushed_apple(blush_px=9, z=1.5):
+    """A 78 mm apple at ``z`` (52 px across) turned with its yellow-green side to the camera, a red blush the
+    crescent of its left ``blush_px`` pixels; its colour, depth and silhouette."""
+    color, depth = hd_disc_frame([(900, 540)], radius=26, z=z)
+    disc = (color == RED).all(axis=2)
+    xx = np.mgrid[:1080, :1920][1]
+    shaded(color, disc & (xx >= 874 + blush_px), YELLOW_GREEN, depth, z)
+    return color, depth, disc
+
+
+def test_a_blush_along_the_rim_without_the_apples_depth_grows_over_its_ground_colour():
+    # the blush a crescent on the rim: a time-of-flight camera has no depth on the rim's mixed pixels and depth
+    # registered 6 px off puts the leaves behind on the rest of the crescent. The ground colour beside it lies
+    # in front of that depth: the blush is the rim of the apple whose surface that is, and grows over it
+    color, depth, disc = blushed_apple()
+    depth = tof_rim(depth, disc, shift=6)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    assert ((labels == 1) & disc).sum() > 0.85 * disc.sum() and ((labels == 1) & ~disc).sum() < 0.1 * disc.sum()
+    off = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    assert ((segment(color, depth, HD_CAM, off) > 0) & disc).sum() < 0.5 * disc.sum()  # not without ground_colour
+    # outside the depth camera's view nothing tells the apple's surface: the blush alone, as before
+    assert ((segment(color, np.zeros_like(depth), HD_CAM, APPLE) > 0) & disc).sum() < 0.5 * disc.sum()
+
+
+def test_a_red_apple_is_not_grown_over_a_yellow_green_leaf_in_front_of_it():
+    # a red apple (with its own depth) and a sunlit yellow-green leaf 6 cm in front of it overlapping its right
+    # side: the ground colour beside the red lies in front of it, but the red part's depth is an apple's own
+    color, depth = hd_disc_frame([(900, 540)], radius=26)
+    disc = (color == RED).all(axis=2)
+    yy, xx = np.mgrid[:1080, :1920]
+    leaf = ((xx - 935) / 24) ** 2 + ((yy - 540) / 12) ** 2 <= 1
+    depth[leaf] = 1.44 + 0.0003 * (xx[leaf] - 935)  # flat and a little tilted
+    shaded(color, leaf, YELLOW_GREEN, depth, 1.44)
+    depth = tof_rim(tof_rim(depth, disc), leaf)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    apple = disc & ~leaf
+    assert labels.max() == 1
+    assert ((labels == 1) & apple).sum() > 0.85 * apple.sum() and ((labels == 1) & leaf & ~disc).sum() == 0
+
+
+def test_a_piece_of_ground_colour_hidden_in_part_by_a_leaf_in_front_is_one_convex_outline():
+    from symfruit.segment.colour import _convex_outline, _hull_vertices
+
+    # an apple-sized cap of ground colour with a leaf band across it 5 cm nearer (its edges without depth),
+    # the same band 10 cm behind (a gap through to leaves behind: two pieces, not one outline), and no depth at all
+    _, patch, depth = patch_depth("apple")
+    yy = np.mgrid[:1080, :1920][0]
+    band = np.abs(yy - 540) <= 9
+    for z_band, convex in ((1.45, True), (1.6, False), (None, False)):
+        d = depth.copy()
+        if z_band is None:
+            d[:] = 0.0
+        else:
+            d[band] = z_band
+            d[band & (np.abs(yy - 540) >= 7)] = 0.0  # the band's invalid rim
+        part = patch & ~band
+        assert _convex_outline(part, _hull_vertices(part), d, APPLE.depth_jump) == convex
+    assert _convex_outline(patch, _hull_vertices(patch), depth, APPLE.depth_jump)  # whole: convex as it is
+
+
 def test_two_pieces_a_fruit_apart_in_depth_are_not_one_fruit_without_a_sphere():
     """Two red pieces, one in front of the other: where no sphere fits the larger (flat here, as a ragged or
     mixed-pixel cap can be), their median depths tell them apart when they lie further apart than the largest

@@ -59,7 +59,7 @@ from scipy import ndimage
 from ..core.kernels import compiled
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
-from ..core.raster import distance_transform, fill_holes, mask_box, nearest_index
+from ..core.raster import distance_transform, fill_holes, mask_box, nearest_index, square_filter
 from ..errors import InputError
 from ..settings import Section, SettingError, setting
 
@@ -1590,10 +1590,13 @@ def _round_skin(
     within ``depth_jump`` of its median depth (its hull's rim may lie on what is behind it). A bicoloured
     apple's yellow or yellow-green side joins its red blush; a leaf in front or behind, beyond a depth step,
     does not. When what is reached exceeds the largest fruit's disc (``round_max_diameter``) it is not one
-    fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. Returns
-    the grown window and mask."""
+    fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. With
+    ``ground_colour``, a red part that is a blush along a fruit's rim carrying the depth of what lies behind grows
+    from the depth of the ground colour beside it (:func:`_blush_rim`). Returns the grown window and mask."""
     z_sl = depth[sl]
     z_part = z_sl[hull & (z_sl > 0)]
+    if s.ground_colour and k > 0:  # a red part's blush along the rim: the depth of the apple beside it
+        sl, hull, z_part = _blush_rim(sl, hull, z_part, depth, color, s, owner, k)
     if len(z_part) < 20:
         return sl, hull
     rows, cols = np.nonzero(hull)
@@ -1632,6 +1635,49 @@ def _round_skin(
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
+
+
+def _blush_rim(
+    sl: Window,
+    hull: np.ndarray,
+    z_part: np.ndarray,
+    depth: _Depth,
+    color: np.ndarray,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+) -> tuple[Window, np.ndarray, np.ndarray]:
+    """The window, mask and depths a red part's skin grows from (:func:`_round_skin`): the part's own, or, for a
+    blush along a fruit's silhouette, the fruit's. A time-of-flight camera invalidates the mixed pixels along a
+    silhouette and depth registered a few pixels off the colour puts what lies behind on the rest of a thin rim,
+    so a blush crescent on an apple turned with its ground colour to the camera carries the depth of what
+    surrounds the apple, not the apple's. Such a part is told by two facts of depth: its median depth is that of
+    its other surroundings (its neighbours within :data:`GAP_PX` that are not ground colour, within ``depth_jump``:
+    a fruit's own surface stands in front of what surrounds it), and the ground-colour pixels beside it (free, with
+    depth) lie in front of it by more than ``depth_jump`` (the apple's body hides what is behind the rim). Then
+    the part is taken with the ground-colour pixels beside it at their depth, and grows from that depth. A red
+    fruit with a depth of its own is not changed (a yellow-green leaf in front of it is not its skin); nor is a
+    part with too little depth of its own to tell (fewer than 20 pixels; outside the depth camera's view nothing
+    changes)."""
+    if len(z_part) < 20:
+        return sl, hull, z_part
+    pad = GAP_PX
+    big = _pad(sl, pad, depth.shape)
+    z = depth[big]
+    part = np.zeros(z.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    beside = square_filter(part, pad) & ~part & (z > 0)
+    ground = _ground(color[big])
+    ring = beside & ground & ((owner[big] == 0) | (owner[big] == k))
+    other = beside & ~ground
+    if ring.sum() < 20 or other.sum() < 20:
+        return sl, hull, z_part
+    zm, front = float(median(z_part)), float(median(z[ring]))
+    if zm - front <= s.depth_jump or abs(zm - float(median(z[other]))) > s.depth_jump:
+        return sl, hull, z_part
+    near = ring & (np.abs(z - front) <= s.depth_jump)
+    return big, part | near, z[near]
 
 
 #: A round fruit's skin is looked for within this many times its red part's own radius (a red cap over a
@@ -1733,15 +1779,38 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
             sl = (slice(box[0].start + win[0].start, box[0].stop + win[0].start),
                   slice(box[1].start + win[1].start, box[1].stop + win[1].start))  # fmt: skip
             vertices = _hull_vertices(part)
-            if float(part.sum()) < GROUND_SOLIDITY * _hull_area_of(vertices, part):
-                continue  # not one convex outline: leaves, or fruit and leaves
             sub_z = z[sl]
+            if not _convex_outline(part, vertices, sub_z, s.depth_jump):
+                continue  # not one convex outline: leaves, or fruit and leaves
             fit = _round_body(part, sub_z, geo, s, (sl[0].start, sl[1].start))
             if fit is None:
                 continue
             hull = _hull_mask(vertices, part) & (part | ~_leaf(c[sl])) & ((owner[sl] == 0) | part)
             bodies.append(_Body(sl, _depth_consistent(hull, part, sub_z, s.depth_jump), *fit))
     return bodies
+
+
+def _convex_outline(part: np.ndarray, vertices: np.ndarray | None, depth: np.ndarray, jump: float) -> bool:
+    """Whether a ground-colour piece (``part``, its hull's ``vertices``, the window's ``depth``, 0: none) is one
+    convex outline: it fills at least :data:`GROUND_SOLIDITY` of its hull, not counting the hull's pixels that
+    something in front hides (a leaf, a twig or a stem across a fruit: their depth nearer than the piece's median
+    by more than ``jump``; a pixel without depth takes the nearest depth within :data:`GAP_PX`, the invalid rim of
+    an occluder's silhouette being the occluder's edge). A leaf behind a fruit, or beside it at its depth, does not
+    make its outline convex; without depth nothing is hidden."""
+    area = float(part.sum())
+    hull_area = _hull_area_of(vertices, part)
+    if area >= GROUND_SOLIDITY * hull_area:
+        return True
+    seen = part & (depth > 0)
+    if not seen.any():
+        return False
+    front = float(median(depth[seen])) - jump
+    rest = _hull_mask(vertices, part) & ~part
+    near = np.where(depth > 0, depth, np.inf)
+    near = ndimage.minimum_filter(near, size=GAP_PX, mode="nearest")
+    z = np.where(depth > 0, depth, near)
+    hidden = rest & (z < front)
+    return area >= GROUND_SOLIDITY * (hull_area - float(hidden.sum()))
 
 
 def _ground_steps(color: np.ndarray, depth: np.ndarray, size: int, jump: float) -> np.ndarray:
