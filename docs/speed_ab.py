@@ -8,7 +8,8 @@ both alike. CPU time, not wall time: a busy machine stretches the wall time far 
 e.g. ``python docs/speed_ab.py ../main/src src``. Each round starts a fresh process per tree (``PYTHONPATH``).
 ``--fits`` adds the completion's three iterative fits as stages (the solid of revolution's, the cone ellipsoid's
 and the sphere's, all of their calls in a frame), ``--wrap MODULE:NAME ...`` any other function as a stage (where
-the caller looks it up, e.g. ``symfruit.methods.evidence:observe``). With ``--dense`` the dense camera view of
+the caller looks it up, e.g. ``symfruit.methods.evidence:observe``), or a method (``MODULE:Class.name``, e.g.
+``symfruit.core.occlusion:Occlusion.extent``). With ``--dense`` the dense camera view of
 ``symfruit bench`` (about 14,000 points) is timed instead: the thread's CPU time of each ``complete``, ``--frames``
 per round.
 With ``--trees N`` the colour segmenter alone is timed instead, on N rendered apple-tree frames (1920x1080 with
@@ -37,6 +38,9 @@ spent = {}
 def wrap(name, stage):
     module, _, name = name.rpartition(":")
     module = importlib.import_module(module) if module else D
+    *owners, name = name.split(".")
+    for owner in owners:  # a method: MODULE:Class.name
+        module = getattr(module, owner)
     fn = getattr(module, name)
     def timed(*a, **k):
         start = time.thread_time()
