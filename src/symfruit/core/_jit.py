@@ -1238,40 +1238,51 @@ def nearest(image: np.ndarray, out: np.ndarray) -> None:
                     near[r, c] = b
     env = np.empty(w, np.int64)  # the envelope's columns, left to right
     for r in range(h):
-        top = -1
-        for u in range(w):
-            if near[r, u] < 0:
-                continue
-            dw = near[r, u] - r
-            wr = dw * dw
-            while top >= 1:
-                i1, i0 = env[top], env[top - 1]
-                a, b = i1 - i0, u - i1
-                c = a + b
-                d0, d1 = near[r, i0] - r, near[r, i1] - r
-                if c * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * c <= 0:
-                    break
-                top -= 1
-            top += 1
-            env[top] = u
+        row = near[r]
+        top = _row_envelope(row, r, env)
         if top < 0:  # no false pixel in the image: nothing to point to
             out[r, :] = -1
             continue
         k = 0
         for u in range(w):
-            i = env[k]
-            dr, dc = near[r, i] - r, i - u
+            i = env[k]  # the first parabola no farther than the next, walking on from the previous column's
+            dr, dc = row[i] - r, i - u
             best = dr * dr + dc * dc
             while k < top:
                 i = env[k + 1]
-                dr, dc = near[r, i] - r, i - u
+                dr, dc = row[i] - r, i - u
                 d = dr * dr + dc * dc
                 if best <= d:
                     break
                 best = d
                 k += 1
             i = env[k]
-            out[r, u] = near[r, i] * w + i
+            out[r, u] = row[i] * w + i
+
+
+@_njit
+def _row_envelope(row: np.ndarray, r: int, env: np.ndarray) -> int:
+    """:func:`nearest`'s row pass: into ``env`` the columns of the lower envelope of the parabolas
+    ``(u - c)^2 + (r - row[c])^2`` of the columns ``c`` with a nearest row (``row[c] >= 0``), left to right, a
+    parabola dropped when its predecessor and successor leave it nowhere least (scipy's test, in whole numbers);
+    the last entry's index (-1: no column has one). Shared with :func:`occlusion_window`."""
+    top = -1
+    for u in range(len(row)):
+        if row[u] < 0:
+            continue
+        dw = row[u] - r
+        wr = dw * dw
+        while top >= 1:
+            i1, i0 = env[top], env[top - 1]
+            a, b = i1 - i0, u - i1
+            c = a + b
+            d0, d1 = row[i0] - r, row[i1] - r
+            if c * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * c <= 0:
+                break
+            top -= 1
+        top += 1
+        env[top] = u
+    return top
 
 
 @_njit
@@ -3040,31 +3051,16 @@ def occlusion_window(
         if not rows[r]:
             continue
         done += 1
-        kr = place[r]
-        top = -1  # nearest()'s row pass, the same envelope and the same walk along it
-        for u in range(w):
-            if near[kr, u] < 0:
-                continue
-            dw = near[kr, u] - r
-            wr = dw * dw
-            while top >= 1:
-                i1, i0 = env[top], env[top - 1]
-                a, b = i1 - i0, u - i1
-                cs = a + b
-                d0, d1 = near[kr, i0] - r, near[kr, i1] - r
-                if cs * (d1 * d1) - b * (d0 * d0) - a * wr - a * b * cs <= 0:
-                    break
-                top -= 1
-            top += 1
-            env[top] = u
+        row = near[place[r]]
+        top = _row_envelope(row, r, env)  # nearest()'s row pass, the same envelope and the same walk along it
         q = 0
         for u in range(w):
             i = env[q]
-            dr, dc = near[kr, i] - r, i - u
+            dr, dc = row[i] - r, i - u
             best = dr * dr + dc * dc
             while q < top:
                 i = env[q + 1]
-                dr, dc = near[kr, i] - r, i - u
+                dr, dc = row[i] - r, i - u
                 d = dr * dr + dc * dc
                 if best <= d:
                     break
@@ -3072,7 +3068,7 @@ def occlusion_window(
                 q += 1
             if pending[r, u]:
                 i = env[q]
-                ref = own_z[near[kr, i], i] + tolerance
+                ref = own_z[row[i], i] + tolerance
                 x = seen[r, u]
                 hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
     return done
@@ -3690,19 +3686,27 @@ def creases(filled: np.ndarray, weights: np.ndarray, symmetric: bool, region: np
     smoothed by ``weights`` (:func:`~symfruit.segment.colour._gaussian`'s, along the rows then the columns;
     ``symmetric`` as scipy finds them) lies below ``limit``. scipy's correlations in scipy's order (mode "reflect"):
     the same values and pixels, the Laplacian worked out on the region's pixels alone."""
+    return _creased(_smoothed(filled, weights, symmetric), region, limit)
+
+
+@_njit
+def _smoothed(filled: np.ndarray, weights: np.ndarray, symmetric: bool) -> np.ndarray:
+    """(h, w): ``filled`` correlated with ``weights`` along the columns (:func:`_correlate_columns`) then along the
+    rows (:func:`_correlate_line`), scipy's order and mode "reflect" (:func:`creases`, :func:`depth_edges`)."""
     h, w = filled.shape
     across = np.empty((h, w))
-    line = np.empty(h)
-    done = np.empty(h)
-    for c in range(w):  # along axis 0
-        for r in range(h):
-            line[r] = filled[r, c]
-        _correlate_line(line, weights, symmetric, done)
-        for r in range(h):
-            across[r, c] = done[r]
+    _correlate_columns(filled, weights, symmetric, across)
     smooth = np.empty((h, w))
     for r in range(h):  # along axis 1
         _correlate_line(across[r], weights, symmetric, smooth[r])
+    return smooth
+
+
+@_njit
+def _creased(smooth: np.ndarray, region: np.ndarray, limit: float) -> np.ndarray:
+    """(h, w) bool: the pixels of ``region`` where ``ndimage.laplace``'s second differences of ``smooth`` (rows'
+    plus columns', mode "reflect", in its order) lie below ``limit`` (:func:`creases`, :func:`depth_edges`)."""
+    h, w = smooth.shape
     out = np.zeros((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
@@ -4091,22 +4095,10 @@ def depth_edges(
     (``depth`` of two 4-neighbours both ``seen`` more than ``jump`` apart: the twin's NaN elsewhere never steps).
     The same values and pixels."""
     h, w = filled.shape
-    across = np.empty((h, w))
-    _correlate_columns(filled, weights, symmetric, across)
-    smooth = np.empty((h, w))
-    for r in range(h):  # along axis 1
-        _correlate_line(across[r], weights, symmetric, smooth[r])
-    out = np.zeros((h, w), np.bool_)
+    out = _creased(_smoothed(filled, weights, symmetric), region, limit)
     for r in range(h):
         for c in range(w):
-            if not region[r, c]:
-                continue
-            down = smooth[r, c] * -2.0
-            down += (smooth[_reflected(r - 1, h), c] + smooth[_reflected(r + 1, h), c]) * 1.0
-            side = smooth[r, c] * -2.0
-            side += (smooth[r, _reflected(c - 1, w)] + smooth[r, _reflected(c + 1, w)]) * 1.0
-            if down + side < limit:
-                out[r, c] = True
+            if not region[r, c] or out[r, c]:
                 continue
             z = depth[r, c]
             if not seen[r, c]:
