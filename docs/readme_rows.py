@@ -7,6 +7,7 @@ brackets, the mean signed error).
     python docs/readme_rows.py LABEL=RESULTS/latest ...              # one row per folder
     python docs/readme_rows.py --by fruit RESULTS/latest             # one row per fruit, then the groups
     python docs/readme_rows.py --by occlusion RESULTS/latest         # one row per occlusion level
+    python docs/readme_rows.py --by level RESULTS/latest             # per level: the 7 proxies, each other kind
     python docs/readme_rows.py --confidence LABEL=RESULTS/latest ...  # the confidence table of evidence
 
 ``--confidence`` cells: pooled Spearman of confidence against centre error / mean within-fruit Spearman (each
@@ -87,7 +88,9 @@ def confidence_row(name, rows, method="evidence"):
 def main():
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("folders", nargs="+", help="LABEL=FOLDER (one row each) or FOLDER (with --by)")
-    parser.add_argument("--by", choices=("fruit", "occlusion"), help="one row per fruit or occlusion level")
+    parser.add_argument("--by", choices=("fruit", "occlusion", "level"),
+                        help="one row per fruit, per occlusion level, or per level and group (the 7 proxies, then "
+                        "each other kind)")  # fmt: skip
     parser.add_argument("--methods", default=",".join(METHODS))
     parser.add_argument("--cells", choices=("scores", "sizes"), default="scores")
     parser.add_argument("--confidence", action="store_true", help="the confidence table of evidence")
@@ -104,6 +107,13 @@ def main():
             sys.stdout.write(row(name, rows, methods, args.cells))
             continue
         groups = defaultdict(list)
+        if args.by == "level":  # README's "Camera views with a leaf in front"
+            for r in rows:
+                kind = "7 held-back proxies" if r["fruit"] in PROXIES else label(r)
+                groups[f"{float(r['occlusion']):.0%}, {kind}"].append(r)
+            for g in sorted(groups, key=lambda k: (float(k.split("%")[0]), "proxies" not in k, k)):
+                sys.stdout.write(row(g.replace("%", " %", 1), groups[g], methods, args.cells))
+            continue
         for r in rows:
             groups[label(r) if args.by == "fruit" else f"{float(r['occlusion']):.0%}"].append(r)
         for g in sorted(groups, key=lambda k: (k.startswith("scan/"), k)):
