@@ -20,8 +20,9 @@ Each frame's apples are found and completed as `symfruit evaluate --frames D --m
 4. every apple matched by its mask's label instead (as `symfruit evaluate --match id`: ``score_frame(...,
    by_id=True)``): IoU / centre mean (median), and how many are over 30 mm off.
 
-``--config``: a settings file (as `symfruit evaluate --config`), e.g. ``evidence: {cut_width: 0}`` for the
-prior's former width. Table 1 and table 2's widths do not depend on ``cut_width``.
+``--config``: a settings file (as `symfruit evaluate --config`), e.g. ``evidence: {cut_width: 1}`` for the apple
+profile's width (the default is 0, the geometric mean; stop 38's figures were taken with 1 as the default, their
+"before" with ``cut_width: 0``). Table 1 and table 2's widths do not depend on ``cut_width``.
 """
 
 import argparse

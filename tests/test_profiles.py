@@ -10,6 +10,8 @@ def test_profiles_ship_and_load(tmp_path):
     assert {"strawberry", "apple", "citrus", "tomato"} <= set(available_profiles())
     assert load_profile("strawberry").fused.revolution is True
     assert load_profile("apple").fused.mirror_weight == 0.25
+    assert load_profile("apple").evidence.cut_width == 1.0  # a round fruit: a cut outline's larger width
+    assert Settings().evidence.cut_width == 0.0 and load_profile("strawberry").evidence.cut_width == 0.0
     mine = tmp_path / "pear.yaml"
     mine.write_text("fused:\n  depth_ratio: 1.3\n")
     assert load_profile(mine).fused.depth_ratio == 1.3

@@ -203,7 +203,7 @@ def test_a_cut_outlines_prior_width_moves_towards_its_larger_width():
     """``fuse_depth``'s width for the depth prior: a whole outline's is the geometric mean of its widths; a half
     disc (a leaf across a ball of 40 px, the half below hidden) is a diameter wide and a radius high, and the
     more of its outline is a cut, the nearer its width to the diameter (the geometric mean's 0.71 of it), never
-    beyond; ``cut_width = 0`` keeps the geometric mean."""
+    beyond; ``cut_width = 0``, the default (the apple profile sets 1), keeps the geometric mean."""
     from symfruit import Box
     from symfruit.core.raster import Silhouette, across_sight
     from symfruit.methods.evidence import Combined, fuse_depth, prior_width
@@ -221,7 +221,7 @@ def test_a_cut_outlines_prior_width_moves_towards_its_larger_width():
     widths = []
     for contour in (1.0, 0.6, 0.3, 0.0):
         combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
-        _, _, width = fuse_depth(combined, [cand], region, cam, s=EvidenceSettings(), across=across)
+        _, _, width = fuse_depth(combined, [cand], region, cam, s=EvidenceSettings(cut_width=1.0), across=across)
         widths.append(width / (box.centre[2] / across.axis[2]))
         assert widths[-1] == pytest.approx(prior_width(across, contour), rel=1e-12)
         off = EvidenceSettings(cut_width=0.0)
