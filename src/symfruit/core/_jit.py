@@ -664,52 +664,77 @@ def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.nda
     0``, over the hidden pixels' box), ``seen`` and their joins across ``gap`` (over the seen pixels' box grown
     by ``2 gap``, as the twin's filters) that hold a seen pixel, by a flood fill from the seen pixels; the twin's
     pixels exactly (booleans)."""
+    s0, s1, t0, t1 = _box(seen)
+    join = _joins(hidden, seen, s0, s1, t0, t1, gap, thin)
+    return _flood_box(join, seen, s0, s1, t0, t1)[0]
+
+
+@_njit
+def _joins(
+    hidden: np.ndarray, seen: np.ndarray, s0: int, s1: int, t0: int, t1: int, gap: int, thin: int
+) -> np.ndarray:  # fmt: skip
+    """:func:`allowed`'s and :func:`allowed_box`'s pixels a fill from the seen pixels may cross: ``hidden`` opened
+    by a ``2 thin + 1`` square over its box (when ``thin > 0``), and the pixels within ``gap`` of both a seen and
+    such a pixel, over the seen pixels' box ``s0:s1, t0:t1`` grown by ``2 gap`` (the twin's filters,
+    :func:`_square_extreme`'s pixels)."""
     h, w = hidden.shape
     join = hidden.copy()
     if thin > 0:
-        b0, b1, a0, a1 = _box(hidden)
-        if b1 > b0:
-            part = hidden[b0:b1, a0:a1]
+        h0, h1, g0, g1 = _box(hidden)
+        if h1 > h0:
+            part = hidden[h0:h1, g0:g1]
             eroded = np.empty(part.shape, np.bool_)
-            square_filter(part, thin, True, eroded)
-            square_filter(eroded, thin, False, join[b0:b1, a0:a1])
+            _square_extreme(part, thin, True, eroded)
+            _square_extreme(eroded, thin, False, join[h0:h1, g0:g1])
     if gap > 0:
-        s0, s1, t0, t1 = _box(seen)
-        b0, b1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
-        a0, a1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
-        grown = np.empty((b1 - b0, a1 - a0), np.bool_)
-        square_filter(seen[b0:b1, a0:a1], gap, False, grown)
-        near = np.empty((b1 - b0, a1 - a0), np.bool_)
-        square_filter(join[b0:b1, a0:a1], gap, False, near)
-        for r in range(b1 - b0):
-            for c in range(a1 - a0):
+        e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+        f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
+        grown = np.empty((e1 - e0, f1 - f0), np.bool_)
+        _square_extreme(seen[e0:e1, f0:f1], gap, False, grown)
+        near = np.empty((e1 - e0, f1 - f0), np.bool_)
+        _square_extreme(join[e0:e1, f0:f1], gap, False, near)
+        for r in range(e1 - e0):
+            for c in range(f1 - f0):
                 if grown[r, c] and near[r, c]:
-                    join[b0 + r, a0 + c] = True
-    out = np.zeros((h, w), np.bool_)
+                    join[e0 + r, f0 + c] = True
+    return join
+
+
+@_njit
+def _flood_box(
+    join: np.ndarray, seen: np.ndarray, s0: int, s1: int, t0: int, t1: int
+) -> tuple[np.ndarray, int, int, int, int]:  # fmt: skip
+    """The 8-connected flood fill from the ``seen`` pixels (all within ``s0:s1, t0:t1``) over ``join``: the pixels
+    reached (the seen ones included) and their box ``(r0, r1, c0, c1)``, stops exclusive (:func:`allowed`,
+    :func:`allowed_box`)."""
+    h, w = join.shape
+    reached = seen.copy()
     stack = np.empty(h * w, np.int64)
     top = 0
-    for r in range(h):
-        for c in range(w):
+    for r in range(s0, s1):
+        for c in range(t0, t1):
             if seen[r, c]:
-                out[r, c] = True
                 stack[top] = r * w + c
                 top += 1
+    r0, r1, c0, c1 = s0, s1, t0, t1
     while top > 0:
         top -= 1
         r, c = divmod(stack[top], w)
-        for dr in range(-1, 2):
-            rr = r + dr
+        for ddr in range(-1, 2):
+            rr = r + ddr
             if rr < 0 or rr >= h:
                 continue
-            for dc in range(-1, 2):
-                cc = c + dc
-                if cc < 0 or cc >= w or out[rr, cc]:
+            for ddc in range(-1, 2):
+                cc = c + ddc
+                if cc < 0 or cc >= w or reached[rr, cc]:
                     continue
-                if join[rr, cc] or seen[rr, cc]:
-                    out[rr, cc] = True
+                if join[rr, cc]:
+                    reached[rr, cc] = True
+                    r0, r1 = min(r0, rr), max(r1, rr + 1)
+                    c0, c1 = min(c0, cc), max(c1, cc + 1)
                     stack[top] = rr * w + cc
                     top += 1
-    return out
+    return reached, r0, r1, c0, c1
 
 
 @_njit
@@ -3123,55 +3148,12 @@ def allowed_box(
                 t0, t1 = min(t0, c), max(t1, c + 1)
     if s1 == 0:
         return False, 0, 0, 0, 0
-    join = hidden.copy()
-    if thin > 0:
-        h0, h1, g0, g1 = _box(hidden)
-        if h1 > h0:
-            part = hidden[h0:h1, g0:g1]
-            eroded = np.empty(part.shape, np.bool_)
-            _square_extreme(part, thin, True, eroded)
-            _square_extreme(eroded, thin, False, join[h0:h1, g0:g1])
     seen = np.zeros((h, w), np.bool_)
     for r in range(s0, s1):
         for c in range(t0, t1):
             seen[r, c] = region[r - dr, c - dc]
-    if gap > 0:
-        e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
-        f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
-        grown = np.empty((e1 - e0, f1 - f0), np.bool_)
-        _square_extreme(seen[e0:e1, f0:f1], gap, False, grown)
-        near = np.empty((e1 - e0, f1 - f0), np.bool_)
-        _square_extreme(join[e0:e1, f0:f1], gap, False, near)
-        for r in range(e1 - e0):
-            for c in range(f1 - f0):
-                if grown[r, c] and near[r, c]:
-                    join[e0 + r, f0 + c] = True
-    reached = seen.copy()
-    stack = np.empty(h * w, np.int64)
-    top = 0
-    for r in range(s0, s1):
-        for c in range(t0, t1):
-            if seen[r, c]:
-                stack[top] = r * w + c
-                top += 1
-    r0, r1, c0, c1 = s0, s1, t0, t1
-    while top > 0:
-        top -= 1
-        r, c = divmod(stack[top], w)
-        for ddr in range(-1, 2):
-            rr = r + ddr
-            if rr < 0 or rr >= h:
-                continue
-            for ddc in range(-1, 2):
-                cc = c + ddc
-                if cc < 0 or cc >= w or reached[rr, cc]:
-                    continue
-                if join[rr, cc]:
-                    reached[rr, cc] = True
-                    r0, r1 = min(r0, rr), max(r1, rr + 1)
-                    c0, c1 = min(c0, cc), max(c1, cc + 1)
-                    stack[top] = rr * w + cc
-                    top += 1
+    join = _joins(hidden, seen, s0, s1, t0, t1, gap, thin)
+    _, r0, r1, c0, c1 = _flood_box(join, seen, s0, s1, t0, t1)
     return True, r0, r1, c0, c1
 
 
