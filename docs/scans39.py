@@ -19,7 +19,8 @@ one ``evaluate`` scored). ``--set NAME=key=value,...`` adds a variant of `eviden
 surface reaches beyond half the prior's width behind the front, over that width (98th percentile of the depths).
 
 Per-view rules: ``TmisK`` (the weights' temperature times the best closed shape's depth misfit over ``misfit_noise``
-times the noise, to the power K: correlated residuals where no shape explains the front), ``sdroundE`` (the prior's
+times the noise, to the power K: correlated residuals where no shape explains the front), ``DmisK`` (the depth term's
+weight alone divided by that ratio to the power K), ``sdroundE`` (the prior's
 deviation times ``1 + E max(0, 2 - elongation^2)``: a round outline leaves the long axis's tilt open), ``sdrecC``
 (times ``1 + C r``, ``r`` measured from the deepest seen point), ``rsCfF`` (times ``1 + C max(0, r - F)``, ``r`` from
 the 98th percentile: a view receding beyond the prior's premise lets the shapes keep their say). Suffix ``+rc``: the
@@ -133,6 +134,9 @@ RULES: dict[str, Rule] = {}
 for _k in (0.5, 1.0, 2.0):
     RULES[f"Tmis{_k:g}"] = (lambda k: lambda v, s: dataclasses.replace(
         s, temperature=s.temperature * _misfit_ratio(v) ** k))(_k)  # fmt: skip
+for _k in (1.0, 2.0):
+    RULES[f"Dmis{_k:g}"] = (lambda k: lambda v, s: dataclasses.replace(
+        s, depth_weight=s.depth_weight / _misfit_ratio(v) ** k))(_k)  # fmt: skip
 for _e in (1.0, 2.0):
     RULES[f"sdround{_e:g}"] = (lambda e: lambda v, s: dataclasses.replace(
         s, depth_ratio_sd=s.depth_ratio_sd * (1.0 + e * max(0.0, 2.0 - v["elongation"] ** 2))))(_e)  # fmt: skip
