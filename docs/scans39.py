@@ -134,6 +134,9 @@ RULES: dict[str, Rule] = {}
 for _k in (0.5, 1.0, 2.0):
     RULES[f"Tmis{_k:g}"] = (lambda k: lambda v, s: dataclasses.replace(
         s, temperature=s.temperature * _misfit_ratio(v) ** k))(_k)  # fmt: skip
+for _k, _cap in ((2.0, 2.0), (2.0, 3.0), (2.0, 4.0), (1.0, 2.0)):  # the temperature's factor at most _cap
+    RULES[f"Tmis{_k:g}c{_cap:g}"] = (lambda k, cap: lambda v, s: dataclasses.replace(
+        s, temperature=s.temperature * min(cap, _misfit_ratio(v) ** k)))(_k, _cap)  # fmt: skip
 for _k in (1.0, 2.0):
     RULES[f"Dmis{_k:g}"] = (lambda k: lambda v, s: dataclasses.replace(
         s, depth_weight=s.depth_weight / _misfit_ratio(v) ** k))(_k)  # fmt: skip
