@@ -19,7 +19,8 @@ one ``evaluate`` scored). ``--set NAME=key=value,...`` adds a variant of `eviden
 surface reaches beyond half the prior's width behind the front, over that width (98th percentile of the depths).
 
 Per-view rules: ``TmisK`` (the weights' temperature times the best closed shape's depth misfit over ``misfit_noise``
-times the noise, to the power K: correlated residuals where no shape explains the front), ``DmisK`` (the depth term's
+times the noise, to the power K: correlated residuals where no shape explains the front; ``TmisKcC``: that factor at
+most C), ``DmisK`` (the depth term's
 weight alone divided by that ratio to the power K), ``sdroundE`` (the prior's
 deviation times ``1 + E max(0, 2 - elongation^2)``: a round outline leaves the long axis's tilt open), ``sdrecC``
 (times ``1 + C r``, ``r`` measured from the deepest seen point), ``rsCfF`` (times ``1 + C max(0, r - F)``, ``r`` from
