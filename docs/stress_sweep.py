@@ -10,26 +10,25 @@ depth side and larger lateral side against the truth (mean absolute error, mean 
 apple's visible share, and the 2-D thin-lens estimate's (the mask's larger extent times the median depth over f).
 ``camera``: the camera protocol on generated fruit (``symfruit evaluate --protocol camera --sensor NAME``), its
 mean IoU / centre and the same two sides over all views. Each ``--set`` names a :class:`SensorModel` field and
-the values to try (the others stay as modelled); without ``--set``, the default sweep of each family (``SWEEP``).
+the values to try (the others stay as modelled; names and bounds: ``symfruit.synthetic.sensors.VARIABLE``, ``bias``
+a factor on both bias terms); without ``--set``, the default sweep of each family (``SWEEP``).
 A setting's frames are the same scenes (geometry drawn before the sensor), so rows compare like with like.
 Development seeds only (0-5): the held-out seeds 100-111 are not for choosing anything.
 """
 
 import argparse
 import sys
-from dataclasses import replace
 
 import numpy as np
 
 from symfruit.core.frame import Frame
 from symfruit.detect import detect
-from symfruit.evaluate import protocols
 from symfruit.evaluate.frames import VISIBILITY_GROUPS, score_frame
 from symfruit.evaluate.protocols import specs
 from symfruit.evaluate.runner import run
 from symfruit.settings import resolve_settings
 from symfruit.synthetic.scenes import make_tree_scene
-from symfruit.synthetic.sensors import SENSOR_MODELS, SensorModel
+from symfruit.synthetic.sensors import SENSOR_MODELS, SensorModel, varied
 
 #: The default sweep: each artefact at 0, 1, 2 and 3 times its modelled value (or the pixel sizes issue 18 names).
 SWEEP = {
@@ -53,16 +52,6 @@ SWEEP = {
         "bias": [0.0, 2.0, 3.0],
     },
 }
-
-
-def varied(model: SensorModel, name: str, value: float) -> SensorModel:
-    """``model`` with one artefact changed (``bias``: both bias terms scaled by ``value``)."""
-    if name == "bias":
-        return replace(model, bias_const=model.bias_const * value, bias_linear=model.bias_linear * value)
-    if name == "distance":
-        return model  # tree frames only: handled by the caller
-    old = getattr(model, name)
-    return replace(model, **{name: type(old)(value)})
 
 
 def tree_scores(model: SensorModel, seeds: list[int], settings, distance=(1.2, 2.0)) -> list:
@@ -107,18 +96,13 @@ def camera_row(label: str, rows: list) -> str:
     return f"| {label} | {len(ok)} ({len(rows) - len(ok)} failed) | {iou:.3f} / {centre:.2f} | {cell(dz, dl)} |"
 
 
-def camera_rows(model: SensorModel, fruits: list[str], n: int, seed: int, settings_for) -> list:
-    """The camera protocol through ``model`` (put in place of its namesake for the run, in this process)."""
-    saved = protocols.SENSOR_MODELS[model.name]
-    protocols.SENSOR_MODELS[model.name] = model
-    try:
-        rows = []
-        for fruit in fruits:
-            these = specs("camera", fruit, n=n, seed=seed, sensor=model.name)
-            rows += run(these, ["evidence"], settings_for(fruit), jobs=1, progress=False)
-        return rows
-    finally:
-        protocols.SENSOR_MODELS[model.name] = saved
+def camera_rows(sensor: str, changes: tuple, fruits: list[str], n: int, seed: int, settings_for, jobs: int) -> list:
+    """The camera protocol through the model ``sensor`` with ``changes`` (as ``evaluate --sensor-set``)."""
+    rows = []
+    for fruit in fruits:
+        these = specs("camera", fruit, n=n, seed=seed, sensor=sensor, sensor_set=changes)
+        rows += run(these, ["evidence"], settings_for(fruit), jobs=jobs, progress=False)
+    return rows
 
 
 def parse_sets(items: list[str] | None, family: str) -> dict[str, list[float]]:
@@ -143,6 +127,7 @@ def main() -> None:
     parser.add_argument("--n", type=int, default=20, help="camera: views per kind")
     parser.add_argument("--seed", type=int, default=0, help="camera: seed")
     parser.add_argument("--no-profile", action="store_true", help="camera: no fruit profile (the tables' setting)")
+    parser.add_argument("--jobs", type=int, default=1, help="camera: worker processes (default 1)")
     parser.add_argument("--set", nargs="*", dest="sets", help="NAME=V1,V2,...: a model field and values to try")
     parser.add_argument("--no-base", action="store_true", help="leave out the model as it is")
     args = parser.parse_args()
@@ -150,10 +135,10 @@ def main() -> None:
     base = SENSOR_MODELS[sensor]
     if any(s > 5 for s in args.seeds):
         parser.error("development seeds 0-5 only (the held-out frames are seeds 100-111)")
-    runs = [] if args.no_base else [("as modelled", base)]
+    runs = [] if args.no_base else [("as modelled", ())]
     for name, values in parse_sets(args.sets, base.family).items():
         for value in values:
-            runs.append((f"{name} = {value:g}", varied(base, name, value)))
+            runs.append((f"{name} = {value:g}", ((name, value),)))
     out = sys.stdout
     if args.what == "tree":
         settings = resolve_settings(config=args.config)
@@ -163,7 +148,8 @@ def main() -> None:
         out.write("| setting | matched | IoU / centre (mm) | " + " | ".join(f"evidence, {g}" for g in groups) + " | "
                   + " | ".join(f"thin-lens, {g}" for g in groups) + " |\n|" + "---|" * 9 + "\n")  # fmt: skip
         out.flush()
-        for label, model in runs:
+        for label, changes in runs:
+            model = varied(base, changes)
             out.write(tree_row(label, tree_scores(model, args.seeds, settings, tuple(args.distance))) + "\n")
             out.flush()
     else:
@@ -178,8 +164,9 @@ def main() -> None:
                   f"depth side / larger lateral side, mean abs (signed) mm\n\n")  # fmt: skip
         out.write("| setting | views | IoU / centre | depth / lateral (mm) |\n|---|---|---|---|\n")
         out.flush()
-        for label, model in runs:
-            out.write(camera_row(label, camera_rows(model, fruits, args.n, args.seed, settings_for)) + "\n")
+        for label, changes in runs:
+            rows = camera_rows(sensor, changes, fruits, args.n, args.seed, settings_for, args.jobs)
+            out.write(camera_row(label, rows) + "\n")
             out.flush()
 
 

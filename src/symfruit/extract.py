@@ -47,7 +47,9 @@ class ExtractSettings(Section):
     colour_trim_px : int
         With the frame's colour image (``detect``): a mask's outer band up to this many pixels (and a fifth of
         its equivalent radius) loses the pixels whose colour is the background's
-        (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); 0: never.
+        (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); where fruit and
+        surroundings do not separate in that band, twice and three times it are tried (:func:`trim_labels`: a mask
+        overshooting by more than the band); 0: never.
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).

@@ -130,7 +130,8 @@ class SensorModel:
         range [HALMETSCHLAGER]: 0.3 % (judgement).
     lateral_px : float, colour pixels
         Standard deviation of the lateral jitter of each de-projected pixel (judgement, as the
-        project's existing models: 0.3 px).
+        project's existing models: 0.3 px). Returned as :attr:`SensorFrame.jitter`; the scenes and the camera
+        protocol do not apply it (their points come from the registered depth image): ``docs/stress39.md``.
     edge_step : float, metres
         A depth pixel whose footprint spans more depth than this is *mixed* (judgement: 1.5 cm, above
         the depth range of a fruit's own slope inside one depth pixel at working distances).
