@@ -614,11 +614,12 @@ def test_scenes_of_an_apple_tree_go_through_the_azure_kinect_by_default(tmp_path
     """The arguments alone (rendering a 1920x1080 canopy is tested in tests/synthetic)."""
     from symfruit.synthetic import scenes
 
-    calls = []
+    calls, kept = [], []
 
     def fake(folder, n, **kwargs):
         sensor = kwargs["sensor"]
         calls.append((n, kwargs["seed"], kwargs["n_ripe"], kwargs["n_unripe"], sensor and sensor.name, kwargs["tree"]))
+        kept.append(sensor)
         return [folder / f"scene_{i:05d}" for i in range(n)]
 
     monkeypatch.setattr(scenes, "write_scenes", fake)
@@ -626,11 +627,15 @@ def test_scenes_of_an_apple_tree_go_through_the_azure_kinect_by_default(tmp_path
     assert main(["scenes", str(tmp_path / "u"), "--scene", "apple-tree", "--n", "1", "--ripe", "3",
                  "--sensor", "realsense-l515"]) == 0  # fmt: skip
     assert main(["scenes", str(tmp_path / "v"), "--n", "1"]) == 0
+    assert main(["scenes", str(tmp_path / "x"), "--scene", "apple-tree", "--n", "1", "--sensor-set",
+                 "rim_invalid_px=3"]) == 0  # fmt: skip
     assert calls == [
         (2, 6, 30, 4, "azure-kinect", True),
         (1, 0, 3, 4, "realsense-l515", True),
         (1, 0, 6, 2, None, False),
+        (1, 0, 30, 4, "azure-kinect", True),
     ]
+    assert kept[-1].rim_invalid_px == 3 and kept[0].rim_invalid_px == 1
     out = capsys.readouterr().out
     assert "wrote 2 apple-tree frames to" in out and "(seeds 6-7, azure-kinect at 1920x1080 with masks.png)" in out
     with pytest.raises(SystemExit):
@@ -776,6 +781,11 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["evaluate", "--occlusion", "0.25"], "evaluate --occlusion is for --protocol camera"),
      (["evaluate", "--protocol", "paper", "--sensor", "heldback"], "evaluate --sensor is for --protocol camera"),
      (["evaluate", "--frames", "f", "--views", "3"], "evaluate --views is for --protocol camera"),
+     (["evaluate", "--protocol", "camera", "--sensor-set", "fatten_px=4"], "evaluate --sensor-set is for --protocol "
+      "camera with a real camera model"),
+     (["evaluate", "--protocol", "camera", "--sensor", "azure-kinect", "--sensor-set", "rim_invalid_px=11"],
+      "--sensor-set rim_invalid_px=11: must be a whole number 0 to 10"),
+     (["scenes", "o", "--sensor-set", "fatten_px=4"], "scenes --sensor-set changes a real camera model: give"),
      (["evaluate", "--spheres", "s", "--no-profile"], "evaluate --no-profile is for the protocols and --frames"),
      (["evaluate", "--spheres", "s", "--fruit", "apple"], "evaluate --fruit is for the protocols and --frames"),
      (["evaluate", "--frames", "f", "--fruit", "apple,pear"], "--fruit 'apple,pear': give one fruit kind"),

@@ -199,6 +199,19 @@ def test_masks_are_colour_trimmed_in_the_colour_cameras_pixels():
     assert trim_labels(color, labels, ExtractSettings(colour_trim_px=0)) is labels
 
 
+def test_masks_overshooting_by_more_than_the_band_are_trimmed_all_round():
+    """Masks 7 px too large (the band is 4 px): the fruit's sample just inside the band holds leaves, the colours do
+    not separate there; twice the band they do, and each mask is trimmed back to its own disc (before: untouched)."""
+    color, _ = disc_frame([(50, 60), (115, 60)], radius=18)
+    yy, xx = np.mgrid[:120, :160]
+    labels = np.zeros((120, 160), np.int32)
+    for k, cx in ((1, 50), (2, 115)):
+        labels[(xx - cx) ** 2 + (yy - 60) ** 2 <= 25**2] = k
+    trimmed = trim_labels(color, labels)
+    for k, cx in ((1, 50), (2, 115)):
+        assert np.array_equal(trimmed == k, (xx - cx) ** 2 + (yy - 60) ** 2 <= 18**2)
+
+
 @pytest.mark.parametrize("name", ["lab-spheres-0", "lab-spheres-1"])
 def test_good_masks_of_real_shaded_spheres_are_not_trimmed(name):
     """The shared real Azure Kinect frames: each sphere's mask follows its colour edge to a pixel, and the

@@ -141,6 +141,10 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "0.01 z^2 noise, no dropout, 0.3-0.5 m), or a real camera model (symfruit.synthetic.sensors: rim "
                    "invalidation or edge fattening, flying pixels, registration, masks that overshoot, clutter; "
                    "1920x1080 or 1280x720, 0.25-2 m; default d435)")  # fmt: skip
+    p.add_argument("--sensor-set", metavar="NAME=VALUE,...",
+                   help="camera protocol with a real camera model: change its artefacts, e.g. rim_invalid_px=3,"
+                   "flying_share=0.3 (a camera not modelled, or how far the model's values matter; names and bounds: "
+                   "symfruit.synthetic.sensors.VARIABLE; docs/stress39.md)")  # fmt: skip
     p.add_argument("--pose", choices=("hanging", "upright", "uniform"),
                    help="pose distribution: hanging (stem up; scans as in their file), upright (scans stood up "
                    "first), uniform (any orientation; camera protocol); default hanging")  # fmt: skip
@@ -291,6 +295,10 @@ def _parser() -> argparse.ArgumentParser:
                    help="through a real camera model (symfruit.synthetic.sensors) at its resolution, fruit at "
                    "its working distances within 0.25-2 m, with the annotators' masks.png (default: the 640x480 "
                    "D435-like frames; apple trees: the Azure Kinect)")  # fmt: skip
+    p.add_argument("--sensor-set", metavar="NAME=VALUE,...",
+                   help="with a real camera model (--sensor or --scene apple-tree): change its artefacts, e.g. "
+                   "rim_invalid_px=3,flying_share=0.3 (names and bounds: "
+                   "symfruit.synthetic.sensors.VARIABLE)")  # fmt: skip
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
@@ -547,6 +555,8 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
         ("--pose", args.pose is not None, protocols, "the paper and camera protocols"),
         ("--occlusion", args.occlusion is not None, camera, "--protocol camera"),
         ("--sensor", args.sensor is not None, camera, "--protocol camera"),
+        ("--sensor-set", args.sensor_set is not None, camera and args.sensor in REAL_SENSORS,
+         f"--protocol camera with a real camera model (--sensor {'/'.join(REAL_SENSORS)})"),
         ("--views", args.views is not None, camera, "--protocol camera"),
         ("--fruit", args.fruit is not None, args.spheres is None,
          "the protocols and --frames (--spheres use no profile)"),
@@ -579,6 +589,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
     from .methods import get
+    from .synthetic.sensors import parse_sensor_set
     from .synthetic.shapes import FRUITS
     from .writers import check_results_root
 
@@ -627,6 +638,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     result = evaluate(
         protocol=args.protocol, fruits=fruits, methods=methods, n=args.n, seed=args.seed,
         occlusions=occlusions, sensor=args.sensor, poses=args.pose, views=args.views, quick=args.quick,
+        sensor_set=parse_sensor_set(args.sensor_set) if args.sensor_set is not None else (),
         config=args.config, output=args.output, jobs=args.jobs,
         settings=_plain_settings(args) if args.no_profile else None,
     )  # fmt: skip
@@ -906,10 +918,14 @@ def _scenes(args: argparse.Namespace) -> int:
     if not 0 <= args.seed <= 2**63 - args.n:  # as evaluate's seeds: every frame's seed below 2**63
         raise InputError(f"--seed must be a whole number >= 0 with --seed + --n at most 2**63, got {shown(args.seed)}")
     sensor = None
+    if args.sensor_set is not None and args.sensor is None and not tree:
+        raise InputError("scenes --sensor-set changes a real camera model: give --sensor or --scene apple-tree")
     if args.sensor is not None or tree:
-        from .synthetic.sensors import sensor_model
+        from .synthetic.sensors import parse_sensor_set, sensor_model, varied
 
         sensor = sensor_model(args.sensor or "azure-kinect")
+        if args.sensor_set is not None:
+            sensor = varied(sensor, parse_sensor_set(args.sensor_set))
     folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor, tree=tree)
     what = "apple-tree frames" if tree else "frames"
     through = f", {sensor.name} at {sensor.width}x{sensor.height} with masks.png" if sensor is not None else ""

@@ -47,7 +47,9 @@ class ExtractSettings(Section):
     colour_trim_px : int
         With the frame's colour image (``detect``): a mask's outer band up to this many pixels (and a fifth of
         its equivalent radius) loses the pixels whose colour is the background's
-        (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); 0: never.
+        (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); where fruit and
+        surroundings do not separate in that band, twice and three times it are tried (:func:`trim_labels`: a mask
+        overshooting by more than the band); 0: never.
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -280,11 +282,19 @@ def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
     return out
 
 
+#: Where fruit and surroundings do not separate in a mask's band (a mask overshooting by more than the band puts
+#: background into the fruit's sample), :func:`trim_labels` tries bands these times wider, up to ``WIDEST`` of the
+#: mask's equivalent radius (docs/stress39.md).
+WIDER = (2, 3)
+WIDEST = 0.4
+
+
 def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None,
                 *, boxes: list[tuple[slice, slice] | None] | None = None) -> np.ndarray:  # fmt: skip
     """``labels`` with each mask's outer band trimmed where its colour is the background's
     (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
-    equivalent radius).
+    equivalent radius; where fruit and surroundings do not separate there, twice and three times that band, at
+    most ``WIDEST`` of the radius: a mask overshooting by more than the band).
 
     Masks and colour share the colour camera's pixels, so this comes before :func:`register` moves the masks
     onto the depth image: trimmed after the move, a mask would be compared with colours several pixels off.
@@ -300,15 +310,17 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
         return labels
     out = labels
     h, w = labels.shape
-    pad = s.colour_trim_px + 2
+    pad = WIDER[-1] * s.colour_trim_px + 2
     for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
         if sl is None:
             continue
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
         mask = labels[r0:r1, c0:c1] == k
-        band = min(float(s.colour_trim_px), 0.2 * float(np.sqrt(mask.sum() / np.pi)))
-        kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band)
+        radius = float(np.sqrt(mask.sum() / np.pi))
+        band = min(float(s.colour_trim_px), 0.2 * radius)
+        wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
+        kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
         if (dropped := mask & ~kept).any():
             out = out.copy() if out is labels else out
             out[r0:r1, c0:c1][dropped] = 0

@@ -256,6 +256,26 @@ def test_colour_trim_removes_an_overshoot_onto_the_background():
     assert np.array_equal(colour_trim(color, small, band_px=4), small)
 
 
+def test_colour_trim_tries_wider_bands_for_a_mask_overshooting_all_round():
+    """A mask 9 px too large puts leaves into the fruit's sample of a 4 px band: nothing separates and nothing was
+    trimmed; a wider band's sample is the fruit's again. A band trimmed on one side only is no overshoot all round
+    (a shaded limb before a background of its own colour): the mask stays."""
+    yy, xx = np.mgrid[:H, :W]
+    r2 = (xx - 80) ** 2 + (yy - 60) ** 2
+    disc = r2 <= 25**2
+    color = np.zeros((H, W, 3), np.uint8)
+    color[...] = (40, 120, 50)  # leaves
+    color[disc] = (200, 30, 40)  # a red fruit
+    mask = r2 <= 34**2
+    assert np.array_equal(colour_trim(color, mask, band_px=4), mask)  # the one band: the colours do not separate
+    trimmed = colour_trim(color, mask, band_px=4, wider=(8.0, 12.0))
+    assert np.array_equal(trimmed, disc)
+    assert np.array_equal(colour_trim(color, disc, band_px=4, wider=(8.0, 12.0)), disc)  # a right mask stays
+    one_side = disc | ((r2 <= 34**2) & (xx < 80))  # 9 px too large on the left only
+    assert np.array_equal(colour_trim(color, one_side, band_px=4, wider=(8.0, 12.0)), one_side)
+    assert np.array_equal(colour_trim(color, one_side, band_px=4, wider=(8.0, 12.0), outline_share=0.3), disc)
+
+
 @settings(max_examples=40, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([3, 5]))
 def test_median_at_is_the_median_filter_at_those_pixels(seed, size):

@@ -188,3 +188,18 @@ def test_evaluate_refuses_arguments_it_cannot_run_with_before_any_work(kwargs, m
     with pytest.raises(InputError, match=re.escape(message)):
         evaluate(**{**args, **kwargs})
     assert not (tmp_path / "r").exists()  # refused before a results folder was made
+
+
+def test_a_camera_model_varied_by_sensor_set(tmp_path):
+    """``sensor_set`` reaches every view, is named in the title and settings.json, and is refused where no real camera
+    model is evaluated."""
+    kw = dict(protocol="camera", fruits=["plum"], methods=["raw"], n=1, sensor="azure-kinect", jobs=1, progress=False)
+    base = evaluate(**kw, output=None)
+    wider = evaluate(**kw, sensor_set={"rim_invalid_px": 3}, output=tmp_path)
+    assert wider.rows[0].n_visible < base.rows[0].n_visible
+    assert "(sensor set: rim_invalid_px=3)" in wider.table
+    assert json.loads((wider.folder / "settings.json").read_text())["sensor_set"] == {"rim_invalid_px": 3.0}
+    with pytest.raises(InputError, match="sensor_set changes a real camera model of the camera protocol"):
+        evaluate(**{**kw, "sensor": "heldback"}, sensor_set={"rim_invalid_px": 3}, output=None)
+    with pytest.raises(InputError, match="flying_share=2: must be 0 to 1"):
+        evaluate(**kw, sensor_set=[("flying_share", 2)], output=None)

@@ -173,3 +173,17 @@ def test_real_camera_sensors_are_named_in_specs():
     with pytest.raises(ValueError, match="azure-kinect"):
         Spec("camera", "apple", 0, 0, sensor="kinect")
     assert {s.sensor for s in specs("camera", "plum", n=2, sensor="realsense-d405")} == {"realsense-d405"}
+
+
+def test_a_camera_view_through_a_varied_model():
+    """``sensor_set``: the same view (fruit, pose, clutter) through the model with one artefact changed."""
+    base = build(Spec("camera", "apple", 0, 0, 0.0, 0, "azure-kinect"))
+    wider = build(Spec("camera", "apple", 0, 0, 0.0, 0, "azure-kinect", sensor_set=(("rim_invalid_px", 3),)))
+    assert np.array_equal(wider.truth_box.min, base.truth_box.min) and np.array_equal(wider.mask, base.mask)
+    assert ((wider.depth > 0) & wider.mask).sum() < ((base.depth > 0) & base.mask).sum()
+    assert {s.sensor_set for s in specs("camera", "plum", n=2, sensor="realsense-d435",
+                                        sensor_set=(("fatten_px", 6),))} == {(("fatten_px", 6.0),)}  # fmt: skip
+    with pytest.raises(ValueError, match="sensor_set changes a real camera model"):
+        Spec("camera", "apple", 0, 0, sensor="heldback", sensor_set=(("fatten_px", 6),))
+    with pytest.raises(ValueError, match="fatten_px=99: must be a whole number 0 to 20"):
+        Spec("camera", "apple", 0, 0, sensor="realsense-d435", sensor_set=(("fatten_px", 99),))

@@ -1,5 +1,6 @@
 """Sensor models of real RGB-D cameras: each artefact's known answer on a rendered sphere or plane."""
 
+import re
 from dataclasses import replace
 
 import numpy as np
@@ -199,3 +200,45 @@ def test_seeded_reproducibility():
     assert np.array_equal(a.depth, b.depth) and np.array_equal(a.labels, b.labels) and a.shift == b.shift
     assert np.array_equal(a.jitter, b.jitter) and not np.array_equal(a.depth, c.depth)
     assert a.depth.dtype == np.float32 and a.depth.shape == (SIDE, SIDE)
+
+
+def test_sensor_set_parses_checks_and_varies_a_model():
+    from symfruit.errors import InputError
+    from symfruit.synthetic.sensors import VARIABLE, parse_sensor_set, varied
+
+    ak = SENSOR_MODELS["azure-kinect"]
+    changes = parse_sensor_set("rim_invalid_px=3, flying_share=0.3,bias=2")
+    assert changes == (("rim_invalid_px", 3.0), ("flying_share", 0.3), ("bias", 2.0))
+    model = varied(ak, changes)
+    assert model.rim_invalid_px == 3 and isinstance(model.rim_invalid_px, int) and model.flying_share == 0.3
+    assert model.bias_const == pytest.approx(2 * ak.bias_const)
+    assert model.bias_linear == pytest.approx(2 * ak.bias_linear)
+    assert model.name == ak.name and replace(model, rim_invalid_px=1, flying_share=0.1, bias_const=ak.bias_const,
+                                             bias_linear=ak.bias_linear) == ak  # fmt: skip
+    assert varied(ak, {}) is ak and varied(ak, {"fatten_px": 4}).fatten_px == 4
+    assert all(hasattr(ak, name) for name in VARIABLE if name != "bias")
+    for text, message in (
+        ("rim_invalid_px=2.5", "rim_invalid_px=2.5: must be a whole number 0 to 10"),
+        ("flying_share=1.5", "flying_share=1.5: must be 0 to 1"),
+        ("width=3", "width: not a setting of a camera model; known: rim_invalid_px"),
+        ("lateral_px=big", "lateral_px=big: 'big' is not a number"),
+        ("lateral_px", "'lateral_px': expected NAME=VALUE"),
+        ("lateral_px=1,lateral_px=2", "names lateral_px twice"),
+        ("bias=2,bias_const=0.001", "bias (a factor on both bias terms) or bias_const/bias_linear, not both"),
+    ):
+        with pytest.raises(InputError, match=re.escape(message)):
+            varied(ak, parse_sensor_set(text))
+    with pytest.raises(InputError, match="must be a number"):
+        varied(ak, {"lateral_px": True})
+
+
+def test_a_varied_model_changes_its_artefact_alone():
+    """More rim invalidation widens the band without depth and changes nothing else of the frame."""
+    from symfruit.synthetic.sensors import varied
+
+    model = replace(SENSOR_MODELS["azure-kinect"], **QUIET)
+    cam = window(model)
+    shot = sphere_scene(cam, 1.0)
+    one, three = run(model, shot, cam), run(varied(model, {"rim_invalid_px": 3}), shot, cam)
+    assert (three.depth == 0).sum() > (one.depth == 0).sum()
+    assert np.array_equal(three.depth[three.depth > 0], one.depth[three.depth > 0])

@@ -931,7 +931,8 @@ def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact:
 
 
 def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
-                min_accuracy: float = 0.85, margin: float = 0.5) -> np.ndarray:  # fmt: skip
+                min_accuracy: float = 0.85, margin: float = 0.5, wider: tuple[float, ...] = (),
+                outline_share: float = 2.0 / 3.0) -> np.ndarray:  # fmt: skip
     """``mask`` less the pixels of its outer band whose colour is the background's, not the fruit's.
 
     Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
@@ -944,16 +945,39 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     do not separate (the summaries misclass more than ``1 - min_accuracy`` of their own samples: a white ball
     before a white wall), and nothing beyond the band.
 
+    A mask that overshoots by more than the band puts background into the fruit's sample, and the two then do
+    not separate either: ``wider`` bands (pixels) are tried in turn, each with its own fruit sample further in,
+    until one separates (docs/stress39.md: masks overshooting by 8-12 px at 1920x1080 were not trimmed at all).
+    A wider band's trim is taken only when it removes at least ``outline_share`` of the mask's outline pixels: an
+    overshooting mask's outline lies on the surroundings nearly all round, where a shaded limb darkening towards
+    a background of the fruit's own colour is one side of it (the real lab spheres' lower halves: 36-54 %).
+
     Parameters
     ----------
     color : (h, w, 3) uint8, RGB
     mask : (h, w) bool
     band_px : float, pixels
+    wider : floats, pixels
+        Bands tried, in order, when the colours do not separate at ``band_px`` (default none).
     """
     mask = np.asarray(mask, dtype=bool)
     if band_px <= 0 or not mask.any():
         return mask
     inner = inner_distance(mask)
+    kept = _colour_trim(color, mask, inner, float(band_px), centres, iterations, min_accuracy, margin)
+    if kept is not None:
+        return kept
+    for band in wider:
+        kept = _colour_trim(color, mask, inner, float(band), centres, iterations, min_accuracy, margin)
+        if kept is not None:
+            edge = mask & (inner <= 1.0)
+            return kept if (edge & ~kept).sum() >= outline_share * edge.sum() else mask
+    return mask
+
+
+def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px: float, centres: int,
+                 iterations: int, min_accuracy: float, margin: float) -> np.ndarray | None:  # fmt: skip
+    """:func:`colour_trim` with one band: the mask trimmed, or None where fruit and surroundings do not separate."""
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
@@ -967,7 +991,7 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
         band = mask & (inner <= band_px)
         n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
     if n_fruit < 20 or n_ring < 20 or not n_band:
-        return mask
+        return None
     color = np.asarray(color)
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
     jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
@@ -989,7 +1013,7 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
         return (_nearer_fruit if jit is None else jit.nearer_fruit)(x, fc, bc, float(margin))
 
     if is_fruit(f_fruit).mean() < min_accuracy or (~is_fruit(f_ring)).mean() < min_accuracy:
-        return mask
+        return None
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels

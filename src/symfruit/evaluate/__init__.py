@@ -17,7 +17,7 @@ import numpy as np
 from ..core.limits import shown
 from ..errors import InputError
 from ..settings import Settings
-from ..synthetic.sensors import SENSOR_MODELS
+from ..synthetic.sensors import SENSOR_MODELS, checked_sensor_set
 from ..synthetic.shapes import FRUITS
 from .protocols import PAPER_ANGLES, POSES, SENSORS, Spec, build, skipped_scans, specs
 from .report import markdown_table, write_results
@@ -50,6 +50,7 @@ def evaluate(
     seed: int = 0,
     occlusions: Sequence[float] = (0.0,),
     sensor: str = "d435",
+    sensor_set: Any = (),
     poses: str = "hanging",
     views: int = 1,
     quick: bool = False,
@@ -65,8 +66,10 @@ def evaluate(
     views per occlusion level (``camera``; default 100). ``sensor`` and ``poses`` choose the camera
     protocol's sensor model and pose distribution (:data:`~symfruit.evaluate.protocols.SENSORS`,
     :data:`~symfruit.evaluate.protocols.POSES`; ``poses="upright"`` also stands scans up in the paper
-    protocol); ``views`` how many of a generated fruit's camera views are of one fruit (default 1: every
-    view a fruit of its own). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
+    protocol); ``sensor_set`` changes artefacts of a real camera model (``(name, value)`` pairs or a dict,
+    :func:`symfruit.synthetic.sensors.varied`: a camera not modelled, or how far a model's values matter);
+    ``views`` how many of a generated fruit's camera views are of one fruit (default 1: every view a fruit of its
+    own). Results go to a new timestamped folder under ``output`` with a ``latest`` link to it;
     ``output=None`` writes nothing. Tables have a row per fruit kind, and per scan of a scan folder; a scan that
     cannot be read is left out, the others evaluated, and named in ``skipped`` (and ``settings.json``).
 
@@ -79,13 +82,18 @@ def evaluate(
         Before any work, for an argument the evaluation cannot run with (as ``symfruit evaluate`` checks its
         options): an unknown protocol, method, sensor or poses; ``fruits`` or ``methods`` empty, repeating a name
         or given as one string; ``n`` or ``views`` not 1-100000; ``jobs`` not 1-256; ``seed`` not 0 to 2**63 - 1;
-        an occlusion level outside [0, 1).
+        an occlusion level outside [0, 1); a ``sensor_set`` naming an unknown artefact, a value out of its bounds,
+        or given without a real camera model.
     """
     from ..profiles import available_profiles
     from ..settings import resolve_settings
 
     fruits, methods, occlusions = _check_arguments(protocol, fruits, methods, n, seed, occlusions, sensor, poses, views,
                                                    jobs, settings)  # fmt: skip
+    changes = checked_sensor_set(sensor_set)
+    if changes and (protocol != "camera" or sensor not in SENSOR_MODELS):
+        raise InputError(f"evaluate: sensor_set changes a real camera model of the camera protocol "
+                         f"({', '.join(SENSOR_MODELS)}), not {protocol} / {sensor}")  # fmt: skip
 
     def settings_for(fruit: str) -> Settings:
         if settings is not None:
@@ -98,7 +106,7 @@ def evaluate(
     rows, all_specs, used, skipped = [], [], {}, {}
     for fruit in fruits:
         these = specs(protocol, fruit, n=n, seed=seed, angles=angles, occlusions=tuple(occlusions), sensor=sensor,
-                      poses=poses, views=views)  # fmt: skip
+                      poses=poses, views=views, sensor_set=changes)  # fmt: skip
         skipped.update(skipped_scans(fruit) if fruit not in FRUITS else {})
         used[fruit] = settings_for(fruit)
         rows += run(these, methods, used[fruit], jobs=jobs, progress=progress)
@@ -108,6 +116,8 @@ def evaluate(
     title = f"symfruit evaluation: {protocol} protocol"
     if protocol == "camera":
         title += f", {sensor} sensor, {poses} poses"
+        if changes:
+            title += " (sensor set: " + ", ".join(f"{k}={v:g}" for k, v in changes) + ")"
     elif poses != "hanging":
         title += f", {poses} scans"
     table = markdown_table(summary, protocol=protocol, title=title)
@@ -131,6 +141,7 @@ def evaluate(
         meta = {
             "title": title, "version": __version__, "protocol": protocol, "fruits": list(fruits),
             "methods": list(methods), "n": n, "seed": seed, "occlusions": list(occlusions), "sensor": sensor,
+            "sensor_set": dict(changes),
             "poses": poses, "views": views, "quick": quick,
             "instances": len(all_specs), "settings": {f: s.to_dict() for f, s in used.items()},
             "skipped_scans": skipped,

@@ -62,7 +62,7 @@ import numpy as np
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
 from ..synthetic.render import SensorNoise, render
-from ..synthetic.sensors import SENSOR_MODELS, SensorModel, apply_sensor
+from ..synthetic.sensors import SENSOR_MODELS, SensorModel, apply_sensor, checked_sensor_set, varied
 from ..synthetic.shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
@@ -117,10 +117,17 @@ class Spec:
     seed: int = 0
     sensor: str = "d435"  # a key of SENSORS (camera protocol)
     poses: str = "hanging"  # a pose distribution of POSES
+    #: a real camera model's artefacts changed (``(name, value)`` pairs, :func:`symfruit.synthetic.sensors.varied`)
+    sensor_set: tuple[tuple[str, float], ...] = ()
 
     def __post_init__(self) -> None:
         if self.sensor not in SENSORS and self.sensor not in SENSOR_MODELS:
             raise ValueError(f"unknown sensor {self.sensor!r}; known: {', '.join([*SENSORS, *SENSOR_MODELS])}")
+        if self.sensor_set:
+            if self.sensor not in SENSOR_MODELS:
+                raise ValueError(f"sensor_set changes a real camera model ({', '.join(SENSOR_MODELS)}), not "
+                                 f"{self.sensor!r}")  # fmt: skip
+            object.__setattr__(self, "sensor_set", checked_sensor_set(self.sensor_set))
         if self.poses not in POSES:
             raise ValueError(f"unknown pose distribution {self.poses!r}; known: {', '.join(POSES)}")
         if self.protocol == "paper" and self.poses == "uniform":
@@ -154,12 +161,14 @@ class Instance:
 def specs(
     protocol: str, fruit: str, *, n: int, seed: int = 0, angles: tuple[int, ...] = PAPER_ANGLES,
     occlusions: tuple[float, ...] = (0.0,), sensor: str = "d435", poses: str = "hanging", views: int = 1,
+    sensor_set: tuple[tuple[str, float], ...] = (),
 ) -> list[Spec]:  # fmt: skip
     """All instance specs of a protocol: ``n`` fruits x the 19 poses (paper) or ``n`` views per
     occlusion level (camera; the views of a scan folder go round its scans, and a generated kind's go
     ``views`` to a fruit: ``n // views`` fruits, each seen from ``views`` poses and distances, so that
     confidence can be ranked among one fruit's views as on the scans); for a scan folder, the paper
-    protocol's ``n`` is capped by the number of scans."""
+    protocol's ``n`` is capped by the number of scans. ``sensor_set``: the camera protocol's real camera model with
+    these artefacts changed (:func:`symfruit.synthetic.sensors.varied`)."""
     if not 1 <= views <= 100_000:
         raise ValueError(f"views must be 1-100000 views a fruit, got {views}")
     if protocol == "paper":
@@ -169,7 +178,7 @@ def specs(
                 for a in angles]  # fmt: skip
     if protocol == "camera":
         count = len(_scans(fruit)) if fruit not in FRUITS else None
-        return [Spec("camera", fruit, i % count if count else i // views, i, occ, seed, sensor, poses)
+        return [Spec("camera", fruit, i % count if count else i // views, i, occ, seed, sensor, poses, sensor_set)
                 for occ in occlusions for i in range(n)]  # fmt: skip
     raise ValueError(f"unknown protocol {protocol!r}; use paper or camera")
 
@@ -234,7 +243,7 @@ def _paper(spec: Spec) -> Instance:
 
 def _camera(spec: Spec, camera: Camera) -> Instance:
     if spec.sensor in SENSOR_MODELS:
-        return _real_camera(spec, SENSOR_MODELS[spec.sensor])
+        return _real_camera(spec, varied(SENSOR_MODELS[spec.sensor], spec.sensor_set))
     fruit = _fruit(spec)
     sensor = SENSORS[spec.sensor]
     noise = sensor.noise

@@ -40,14 +40,26 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
 
 from ..core.camera import Camera
 from ..core.raster import distance_transform
+from ..errors import InputError
 
-__all__ = ["SENSOR_MODELS", "SensorFrame", "SensorModel", "apply_sensor", "sensor_model"]
+__all__ = [
+    "SENSOR_MODELS",
+    "VARIABLE",
+    "SensorFrame",
+    "SensorModel",
+    "apply_sensor",
+    "checked_sensor_set",
+    "parse_sensor_set",
+    "sensor_model",
+    "varied",
+]
 
 #: Sources cited by the models (short keys used in the field docs).
 SOURCES = {
@@ -118,7 +130,8 @@ class SensorModel:
         range [HALMETSCHLAGER]: 0.3 % (judgement).
     lateral_px : float, colour pixels
         Standard deviation of the lateral jitter of each de-projected pixel (judgement, as the
-        project's existing models: 0.3 px).
+        project's existing models: 0.3 px). Returned as :attr:`SensorFrame.jitter`; the scenes and the camera
+        protocol do not apply it (their points come from the registered depth image): ``docs/stress39.md``.
     edge_step : float, metres
         A depth pixel whose footprint spans more depth than this is *mixed* (judgement: 1.5 cm, above
         the depth range of a fruit's own slope inside one depth pixel at working distances).
@@ -278,6 +291,91 @@ def sensor_model(name: str) -> SensorModel:
         return SENSOR_MODELS[name]
     except KeyError:
         raise ValueError(f"unknown sensor model {name!r}; known: {', '.join(SENSOR_MODELS)}") from None
+
+
+#: The artefacts a user may set on a model (``symfruit evaluate --protocol camera --sensor NAME --sensor-set``,
+#: ``symfruit scenes --sensor-set``; :func:`varied`) and their bounds (inclusive; a whole number where the field is
+#: one): a camera not modelled, or a stress test of how far a model's judgement values matter (docs/stress39.md).
+#: ``bias`` is a factor on both bias terms (``bias_const`` and ``bias_linear``), as a camera's bias grows as a whole.
+VARIABLE: dict[str, tuple[float, float]] = {
+    "rim_invalid_px": (0, 10), "flying_share": (0.0, 1.0), "fatten_px": (0, 20), "edge_step": (0.002, 0.2),
+    "lateral_px": (0.0, 5.0), "registration_px": (0.0, 40.0), "colour_baseline": (0.0, 0.2),
+    "mask_overshoot_px": (0.0, 30.0), "mask_amodal_share": (0.0, 1.0), "grazing": (0.0, 1.0),
+    "grazing_dropout": (0.0, 1.0), "dropout": (0.0, 0.5), "multipath_bias": (0.0, 0.05),
+    "multipath_range": (0.001, 0.2), "sigma_const": (0.0, 0.05), "sigma_linear": (0.0, 0.05),
+    "subpixel": (0.01, 1.0), "bias_const": (-0.05, 0.05), "bias_linear": (-0.05, 0.05), "bias": (0.0, 10.0),
+}  # fmt: skip
+
+
+def parse_sensor_set(text: str) -> tuple[tuple[str, float], ...]:
+    """``"rim_invalid_px=3,flying_share=0.3"`` as ``(("rim_invalid_px", 3.0), ("flying_share", 0.3))``, each name one
+    of :data:`VARIABLE` and each value within its bounds.
+
+    Raises
+    ------
+    InputError
+        Naming the entry and what is wrong with it (unknown name, not a number, out of bounds, named twice).
+    """
+    out: list[tuple[str, float]] = []
+    for item in str(text).split(","):
+        name, eq, value = (part.strip() for part in item.partition("="))
+        if not eq or not name or not value:
+            raise InputError(f"--sensor-set {item.strip()!r}: expected NAME=VALUE, e.g. rim_invalid_px=3")
+        try:
+            number = float(value)
+        except ValueError:
+            raise InputError(f"--sensor-set {name}={value}: {value!r} is not a number") from None
+        out.append((name, number))
+    return checked_sensor_set(out)
+
+
+def checked_sensor_set(changes: object) -> tuple[tuple[str, float], ...]:
+    """``changes`` (pairs ``(name, value)`` or a mapping) checked against :data:`VARIABLE`, as a tuple of pairs.
+
+    Raises
+    ------
+    InputError
+    """
+    items = list(changes.items()) if isinstance(changes, dict) else changes
+    if isinstance(items, str | bytes) or not isinstance(items, list | tuple):
+        raise InputError(f"sensor_set must be (name, value) pairs or a dict, got {type(changes).__name__}")
+    out: list[tuple[str, float]] = []
+    for pair in items:
+        if not isinstance(pair, list | tuple) or len(pair) != 2:
+            raise InputError(f"sensor_set: expected (name, value) pairs, got {pair!r:.60}")
+        name, value = pair
+        if name not in VARIABLE:
+            known = ", ".join(VARIABLE)
+            raise InputError(f"--sensor-set {name!s:.40}: not a setting of a camera model; known: {known}")
+        low, high = VARIABLE[name]
+        whole = isinstance(getattr(SENSOR_MODELS["azure-kinect"], name, 0.0), int)
+        if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+            raise InputError(f"--sensor-set {name}: the value must be a number, got {value!r:.40}")
+        if not (low <= value <= high) or (whole and value != int(value)):
+            kind = "a whole number " if whole else ""
+            raise InputError(f"--sensor-set {name}={value:g}: must be {kind}{low:g} to {high:g}")
+        if any(name == seen for seen, _ in out):
+            raise InputError(f"--sensor-set names {name} twice")
+        out.append((str(name), float(value)))
+    if "bias" in (named := [name for name, _ in out]) and ("bias_const" in named or "bias_linear" in named):
+        raise InputError("--sensor-set: bias (a factor on both bias terms) or bias_const/bias_linear, not both")
+    return tuple(out)
+
+
+def varied(model: SensorModel, changes: object) -> SensorModel:
+    """``model`` with the artefacts ``changes`` names set (pairs ``(name, value)`` or a mapping, checked by
+    :func:`checked_sensor_set`; ``bias`` scales both bias terms); the model's name stays, so its views' random draws
+    are the model's own and a varied model's frames differ from the model's by the changed artefacts alone."""
+    fields: dict[str, Any] = {}
+    for name, value in checked_sensor_set(changes):
+        if name == "bias":
+            fields["bias_const"] = model.bias_const * value
+            fields["bias_linear"] = model.bias_linear * value
+        else:
+            fields[name] = int(value) if isinstance(getattr(model, name), int) else value
+    if model.family == "stereo" and not (fields.get("subpixel", model.subpixel) > 0):
+        raise ValueError("a stereo sensor needs subpixel > 0")
+    return replace(model, **fields) if fields else model
 
 
 @dataclass(frozen=True)
