@@ -899,6 +899,10 @@ def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, m
         _one_line_error(capsys, "segment --depth-scale 0.001 and", "cam.json's depth scale 0.0001 disagree")
     else:  # before: the camera file's depth_scale ignored, 0.001 used whatever it said
         assert code == 0 and seen == [used]
+    capsys.readouterr()
+    for bad in ("nan", "-1", "0", "2"):  # named as no depth scale, not as one disagreeing with the file's (was)
+        assert main([*args, "--depth-scale", bad]) == 2 and len(seen) == (used is not None)
+        _one_line_error(capsys, "segment --depth-scale must be metres per unit in (0, 1], got", bad)
 
 
 @pytest.mark.parametrize(

@@ -761,6 +761,8 @@ def _segment(args: argparse.Namespace) -> int:
     camera = load_camera(args.camera) if args.camera else None
     from .io.frames import file_depth_scale
 
+    if args.depth_scale is not None and not 0 < args.depth_scale <= 1:  # named as such, not as two that disagree
+        raise InputError(f"segment --depth-scale must be metres per unit in (0, 1], got {args.depth_scale:g}")
     stated = file_depth_scale(args.camera) if args.camera else None  # as a frame's camera.json: read, not ignored
     if stated is not None and args.depth_scale is not None and stated != args.depth_scale:
         raise InputError(f"segment --depth-scale {args.depth_scale:g} and {args.camera}'s depth scale {stated:g} "
