@@ -923,6 +923,13 @@ def test_evaluate_refuses_an_option_naming_no_fruit_or_method_or_one_twice(tmp_p
     assert not (tmp_path / "r").exists()
 
 
+def test_evaluate_refuses_an_occlusion_level_given_twice(tmp_path, capsys):
+    args = ["evaluate", "--quick", "--protocol", "camera", "--output", str(tmp_path / "r"), "--occlusion"]
+    assert main([*args, "0,0.5,0.50"]) == 2  # before: the level's views run twice, its row of twice as many
+    _one_line_error(capsys, "--occlusion names the level 0.5 twice")
+    assert not (tmp_path / "r").exists()
+
+
 @pytest.mark.parametrize("command", [["complete", "cloud.ply"], ["detect", "rec", "--output", "out"], ["demo"]])
 def test_an_empty_method_is_refused_not_read_as_the_default(tmp_path, monkeypatch, capsys, command):
     monkeypatch.chdir(tmp_path)
