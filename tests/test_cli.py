@@ -964,3 +964,17 @@ def test_evaluate_occlusion_levels_are_plain_numbers(tmp_path, capsys, value, wh
     assert main(["evaluate", "--protocol", "camera", "--occlusion", value, "--output", str(tmp_path / "r")]) == 2
     _one_line_error(capsys, f"--occlusion {value!r}: {what}; expected numbers such as 0,0.25,0.5")
     assert not (tmp_path / "r").exists()
+
+
+def test_a_failed_frame_named_with_a_line_break_is_one_printed_line(tmp_path, capsys):
+    rec = tmp_path / "rec"
+    shutil.copytree(small_frame(), rec / "x\n  failed y")  # a folder name is any bytes but / and NUL
+    (rec / "x\n  failed y" / "depth.png").write_bytes(b"broken")
+    shutil.copytree(small_frame(), rec / "ok\r\nz")
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
+    out = capsys.readouterr().out.splitlines()
+    # before: "  failed x", "  failed y: .../x", "  failed y/depth.png: ...": one failure read as three
+    assert [line for line in out if line.startswith("  failed")] == [
+        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: cannot read image (cannot identify image file "
+        f"'{rec}/x\\n  failed y/depth.png')"
+    ]

@@ -575,6 +575,12 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
     args.views = 1 if args.views is None else args.views
 
 
+def _line(text: str) -> str:
+    """One printed line per item: a line break in a name or reason (a frame folder named with one) shown as
+    ``\\n``; printed as it stood, one failed frame read as several, the second a frame of another name."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
 def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
@@ -635,7 +641,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     )  # fmt: skip
     print(result.table)
     for name, reason in result.skipped.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {result.folder}")
     return 1 if result.skipped else 0  # as detect: the evaluation went on past a bad scan, and says so
 
@@ -665,7 +671,7 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
         handle.write(table)
     print(table)
     for name, reason in failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
     return 1 if failed else 0  # as detect: the batch went on past a bad frame, and says so
 
@@ -686,7 +692,7 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
         handle.write(table)
     print(table)
     for name, reason in failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
     return 1 if failed or not rows else 0
 
@@ -743,7 +749,7 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         print(f"{s['crowd_regions']} crowd regions (iscrowd) ignored as COCO does: not counted as fruit, and "
               f"{s['ignored_in_crowd']} regions found in them counted neither matched nor false")  # fmt: skip
     for name, reason in ev.failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder} (masks.csv, summary.json, worst.png)")
     return 1 if ev.failed else 0
 
@@ -775,10 +781,10 @@ def _segment(args: argparse.Namespace) -> int:
                             depth_scale=depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
     if len(report.done) <= 20:
         for d in report.done:
-            print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
-                  f"{d.ms:.1f} ms)")  # fmt: skip
+            print(_line(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
+                        f"{d.ms:.1f} ms)"))  # fmt: skip
     for name, reason in report.failed.items():
-        print(f"  failed {name}: {reason}")
+        print(_line(f"  failed {name}: {reason}"))
     alone = sum(not d.used_depth for d in report.done)
     note = ""
     if alone and report.mask_source == "colour segmenter":
@@ -789,7 +795,7 @@ def _segment(args: argparse.Namespace) -> int:
     print(f"segment ({report.mask_source}): {len(report.done)} images, {report.fruit} fruit, {len(report.failed)} "
           f"failed{note}{median}; labels and overlays in {args.output}")  # fmt: skip
     if report.stopped:
-        print(f"symfruit: {report.stopped}", file=sys.stderr)
+        print(_line(f"symfruit: {report.stopped}"), file=sys.stderr)
     return 0 if report.ok else 1
 
 
@@ -825,16 +831,16 @@ def _detect(args: argparse.Namespace) -> int:
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
-        print(f"  failed {name}: {reason}")
+        print(_line(f"  failed {name}: {reason}"))
     renamed = {k: v for k, v in report.recordings.items() if v != Path(k).absolute().name}
     for given, folder in renamed.items():
-        print(f"  recording {given} -> {args.output / folder} (its name is shared or not a plain file name)")
+        print(_line(f"  recording {given} -> {args.output / folder} (its name is shared or not a plain file name)"))
     for name, reason in report.failed_recordings.items():
-        print(f"  recording not read {name}: {reason}")
+        print(_line(f"  recording not read {name}: {reason}"))
     if report.unprocessed:
         print(f"  not processed: {len(report.unprocessed)} frames (listed in errors.json)")
     if report.stopped:
-        print(f"symfruit: {report.stopped}", file=sys.stderr)
+        print(_line(f"symfruit: {report.stopped}"), file=sys.stderr)
     per = "per frame" if len(args.inputs) == 1 else "per recording, in it one per frame"
     print(f"results: {args.output} (one folder {per}; every fruit in detections.parquet)")
     if bag is not None:
