@@ -611,8 +611,8 @@ def _evaluate(args: argparse.Namespace) -> int:
     if any(not 0.0 <= x < 1.0 for x in occlusions):
         raise InputError("--occlusion levels must be in [0, 1)")
     if len(set(occlusions)) < len(occlusions):  # as --methods: the same views again, counted as more of them
-        twice = next(x for x in occlusions if occlusions.count(x) > 1)
-        raise InputError(f"--occlusion names the level {twice:g} twice")
+        level = next(x for x in occlusions if occlusions.count(x) > 1)
+        raise InputError(f"--occlusion names the level {level:g} twice")
     if args.n is not None and not 1 <= args.n <= 100_000:
         raise InputError("--n must be between 1 and 100000")
     if args.protocol == "paper" and args.pose == "uniform":
