@@ -909,6 +909,10 @@ def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, m
         _one_line_error(capsys, "segment --depth-scale 0.001 and", "cam.json's depth scale 0.0001 disagree")
     else:  # before: the camera file's depth_scale ignored, 0.001 used whatever it said
         assert code == 0 and seen == [used]
+    capsys.readouterr()
+    for bad in ("nan", "-1", "0", "2"):  # named as no depth scale, not as one disagreeing with the file's (was)
+        assert main([*args, "--depth-scale", bad]) == 2 and len(seen) == (used is not None)
+        _one_line_error(capsys, "segment --depth-scale must be metres per unit in (0, 1], got", bad)
 
 
 @pytest.mark.parametrize(
@@ -926,6 +930,13 @@ def test_segment_reads_depth_by_the_camera_files_depth_scale(tmp_path, capsys, m
 def test_evaluate_refuses_an_option_naming_no_fruit_or_method_or_one_twice(tmp_path, capsys, option, value, message):
     assert main(["evaluate", "--quick", option, value, "--output", str(tmp_path / "r")]) == 2
     _one_line_error(capsys, message)
+    assert not (tmp_path / "r").exists()
+
+
+def test_evaluate_refuses_an_occlusion_level_given_twice(tmp_path, capsys):
+    args = ["evaluate", "--quick", "--protocol", "camera", "--output", str(tmp_path / "r"), "--occlusion"]
+    assert main([*args, "0,0.5,0.50"]) == 2  # before: the level's views run twice, its row of twice as many
+    _one_line_error(capsys, "--occlusion names the level 0.5 twice")
     assert not (tmp_path / "r").exists()
 
 
@@ -963,3 +974,17 @@ def test_evaluate_occlusion_levels_are_plain_numbers(tmp_path, capsys, value, wh
     assert main(["evaluate", "--protocol", "camera", "--occlusion", value, "--output", str(tmp_path / "r")]) == 2
     _one_line_error(capsys, f"--occlusion {value!r}: {what}; expected numbers such as 0,0.25,0.5")
     assert not (tmp_path / "r").exists()
+
+
+def test_a_failed_frame_named_with_a_line_break_is_one_printed_line(tmp_path, capsys):
+    rec = tmp_path / "rec"
+    shutil.copytree(small_frame(), rec / "x\n  failed y")  # a folder name is any bytes but / and NUL
+    (rec / "x\n  failed y" / "depth.png").write_bytes(b"broken")
+    shutil.copytree(small_frame(), rec / "ok\r\nz")
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 1
+    out = capsys.readouterr().out.splitlines()
+    # before: "  failed x", "  failed y: .../x", "  failed y/depth.png: ...": one failure read as three
+    assert [line for line in out if line.startswith("  failed")] == [
+        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: cannot read image (cannot identify image file "
+        f"'{rec}/x\\n  failed y/depth.png')"
+    ]

@@ -167,6 +167,18 @@ def test_coco_and_label_folders_as_mask_sources(tmp_path):
         segment_images([folder], output=tmp_path / "o3", masks="nonsense")
 
 
+def test_photos_of_one_name_in_two_folders_take_each_its_own_coco_entry(tmp_path):
+    for row in ("row1", "row2"):
+        _photos(tmp_path / row, n=1)
+    coco = {"images": [{"id": 1, "file_name": "row1/p0.jpg"}, {"id": 2, "file_name": "row2/p0.jpg"}],
+            "annotations": [{"id": 1, "image_id": 1, "category_id": 1,
+                             "segmentation": [[40, 80, 120, 80, 120, 160, 40, 160]]}]}  # fmt: skip
+    (tmp_path / "t.json").write_text(json.dumps(coco))
+    report = segment_images([tmp_path / "row1", tmp_path / "row2"], output=tmp_path / "out", masks=tmp_path / "t.json")
+    # before: both found by the file name p0.jpg alone, so row2/p0.jpg took row1/p0.jpg's fruit
+    assert {d.path.parent.name: d.fruit for d in report.done} == {"row1": 1, "row2": 0}
+
+
 def test_label_writer_and_overlay_refuse_what_does_not_fit(tmp_path):
     with pytest.raises(FileFormatError, match="0-65535"):
         write_labels(tmp_path / "a.png", np.full((4, 4), 70000))

@@ -567,9 +567,10 @@ def _labeller(
             lambda path, color, depth, camera, turned=1: np.asarray(fn(color, depth=depth, camera=camera))
         ), getattr(masks, "__name__", "callable")
     source = masks if isinstance(masks, MaskSource) else mask_source(masks, settings=settings, images=images)
+    # named by its path: a COCO's row2/0001.png is not row1/0001.png (by file name alone it took row1's fruit)
     return (
         lambda path, color, depth, camera, turned=1: source(
-            color, depth, camera, name=path.name, color_file=(path, turned)
+            color, depth, camera, name=str(path), color_file=(path, turned)
         )[0]
     ), source.name
 

@@ -585,6 +585,12 @@ def _check_evaluate_options(args: argparse.Namespace) -> None:
     args.views = 1 if args.views is None else args.views
 
 
+def _line(text: str) -> str:
+    """One printed line per item: a line break in a name or reason (a frame folder named with one) shown as
+    ``\\n``; printed as it stood, one failed frame read as several, the second a frame of another name."""
+    return text.replace("\r", "\\r").replace("\n", "\\n")
+
+
 def _evaluate(args: argparse.Namespace) -> int:
     from .errors import InputError
     from .evaluate import evaluate
@@ -615,6 +621,9 @@ def _evaluate(args: argparse.Namespace) -> int:
     occlusions = [float(x) for x in _entries("--occlusion", args.occlusion, "numbers such as 0,0.25,0.5", numbers=True)]
     if any(not 0.0 <= x < 1.0 for x in occlusions):
         raise InputError("--occlusion levels must be in [0, 1)")
+    if len(set(occlusions)) < len(occlusions):  # as --methods: the same views again, counted as more of them
+        level = next(x for x in occlusions if occlusions.count(x) > 1)
+        raise InputError(f"--occlusion names the level {level:g} twice")
     if args.n is not None and not 1 <= args.n <= 100_000:
         raise InputError("--n must be between 1 and 100000")
     if args.protocol == "paper" and args.pose == "uniform":
@@ -644,7 +653,7 @@ def _evaluate(args: argparse.Namespace) -> int:
     )  # fmt: skip
     print(result.table)
     for name, reason in result.skipped.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {result.folder}")
     return 1 if result.skipped else 0  # as detect: the evaluation went on past a bad scan, and says so
 
@@ -674,7 +683,7 @@ def _evaluate_frames(args: argparse.Namespace, methods: list[str], settings) -> 
         handle.write(table)
     print(table)
     for name, reason in failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
     return 1 if failed else 0  # as detect: the batch went on past a bad frame, and says so
 
@@ -695,7 +704,7 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
         handle.write(table)
     print(table)
     for name, reason in failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
     return 1 if failed or not rows else 0
 
@@ -752,7 +761,7 @@ def _evaluate_masks(args: argparse.Namespace) -> int:
         print(f"{s['crowd_regions']} crowd regions (iscrowd) ignored as COCO does: not counted as fruit, and "
               f"{s['ignored_in_crowd']} regions found in them counted neither matched nor false")  # fmt: skip
     for name, reason in ev.failed.items():
-        print(f"skipped {name}: {reason}")
+        print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder} (masks.csv, summary.json, worst.png)")
     return 1 if ev.failed else 0
 
@@ -773,6 +782,8 @@ def _segment(args: argparse.Namespace) -> int:
     camera = load_camera(args.camera) if args.camera else None
     from .io.frames import file_depth_scale
 
+    if args.depth_scale is not None and not 0 < args.depth_scale <= 1:  # named as such, not as two that disagree
+        raise InputError(f"segment --depth-scale must be metres per unit in (0, 1], got {args.depth_scale:g}")
     stated = file_depth_scale(args.camera) if args.camera else None  # as a frame's camera.json: read, not ignored
     if stated is not None and args.depth_scale is not None and stated != args.depth_scale:
         raise InputError(f"segment --depth-scale {args.depth_scale:g} and {args.camera}'s depth scale {stated:g} "
@@ -782,10 +793,10 @@ def _segment(args: argparse.Namespace) -> int:
                             depth_scale=depth_scale, settings=_settings_for(args), progress=True)  # fmt: skip
     if len(report.done) <= 20:
         for d in report.done:
-            print(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
-                  f"{d.ms:.1f} ms)")  # fmt: skip
+            print(_line(f"{d.path.name}: {d.fruit} fruit ({'colour + depth' if d.used_depth else 'colour alone'}, "
+                        f"{d.ms:.1f} ms)"))  # fmt: skip
     for name, reason in report.failed.items():
-        print(f"  failed {name}: {reason}")
+        print(_line(f"  failed {name}: {reason}"))
     alone = sum(not d.used_depth for d in report.done)
     note = ""
     if alone and report.mask_source == "colour segmenter":
@@ -796,7 +807,7 @@ def _segment(args: argparse.Namespace) -> int:
     print(f"segment ({report.mask_source}): {len(report.done)} images, {report.fruit} fruit, {len(report.failed)} "
           f"failed{note}{median}; labels and overlays in {args.output}")  # fmt: skip
     if report.stopped:
-        print(f"symfruit: {report.stopped}", file=sys.stderr)
+        print(_line(f"symfruit: {report.stopped}"), file=sys.stderr)
     return 0 if report.ok else 1
 
 
@@ -832,16 +843,16 @@ def _detect(args: argparse.Namespace) -> int:
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():
-        print(f"  failed {name}: {reason}")
+        print(_line(f"  failed {name}: {reason}"))
     renamed = {k: v for k, v in report.recordings.items() if v != Path(k).absolute().name}
     for given, folder in renamed.items():
-        print(f"  recording {given} -> {args.output / folder} (its name is shared or not a plain file name)")
+        print(_line(f"  recording {given} -> {args.output / folder} (its name is shared or not a plain file name)"))
     for name, reason in report.failed_recordings.items():
-        print(f"  recording not read {name}: {reason}")
+        print(_line(f"  recording not read {name}: {reason}"))
     if report.unprocessed:
         print(f"  not processed: {len(report.unprocessed)} frames (listed in errors.json)")
     if report.stopped:
-        print(f"symfruit: {report.stopped}", file=sys.stderr)
+        print(_line(f"symfruit: {report.stopped}"), file=sys.stderr)
     per = "per frame" if len(args.inputs) == 1 else "per recording, in it one per frame"
     print(f"results: {args.output} (one folder {per}; every fruit in detections.parquet)")
     if bag is not None:

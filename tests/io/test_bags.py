@@ -560,6 +560,18 @@ def test_depth_image_refuses_a_depth_scale_that_is_no_metres_per_unit(scale):
     assert depth_image(msg, depth_scale=0.001).tolist() == [[1.0, 0.0]]
 
 
+@pytest.mark.parametrize("scale", [1e-300, 1e-9])
+def test_depth_image_refuses_a_depth_scale_no_camera_has(scale):
+    from symfruit.io.bags import depth_image
+
+    msg = SimpleNamespace(height=1, width=2, step=4, encoding="16UC1", is_bigendian=0, data=bytes([232, 3, 0, 0]))
+    with pytest.raises(InputError, match=rf"depth_scale {scale:g}: 16-bit depth would reach only .* m; no camera"):
+        depth_image(msg, depth_scale=scale)  # before: 1e-300 was 0 in float32, a frame without depth, unsaid
+    assert depth_image(msg, depth_scale=0.0001).tolist() == [[pytest.approx(0.1), 0.0]]  # 0.1 mm (D405)
+    floats = SimpleNamespace(height=1, width=1, step=4, encoding="32FC1", is_bigendian=0, data=bytes(4))
+    assert depth_image(floats, depth_scale=1e-9).tolist() == [[0.0]]  # metres: the scale is not used
+
+
 @pytest.mark.parametrize("size", [{"width": None}, {"height": "480"}, {"width": 640.5}])
 def test_camera_info_of_a_size_that_is_no_whole_number_is_refused_by_name(size):
     from symfruit.io.bags import camera_from_info

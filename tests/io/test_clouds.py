@@ -222,6 +222,10 @@ def test_text_clouds_are_bounded_in_rows_and_bytes(tmp_path, monkeypatch):
         "\ufeff0.031 -0.002 0.305\n0.032 -0.001 0.306\n",  # a UTF-8 byte-order mark before the first row
         "0.031,-0.002,0.305\n0.032,-0.001,0.306\n",
         "# comment\n0.031\t-0.002\t0.305\t7\n0.032 -0.001 0.306 8\n",
+        # blank and comment lines among or after the rows: were refused with numpy's note on max_rows
+        "0.031 -0.002 0.305\n0.032 -0.001 0.306\n\n",
+        "0.031 -0.002 0.305\r\n\r\n0.032 -0.001 0.306\r\n",
+        "0.031,-0.002,0.305\n# second scan\n   \n0.032,-0.001,0.306\n% end\n",
     ],
 )
 def test_text_clouds_keep_every_row_and_every_digit(tmp_path, text):

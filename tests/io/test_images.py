@@ -151,7 +151,13 @@ def test_depth_units(tmp_path):
     with pytest.raises(FileFormatError, match=r"d8\.png: depth PNG is 8-bit: at 0\.001 m per unit it reaches only "
                        r"0\.255 m, so it is a picture of depth"):  # fmt: skip
         read_depth_units(tmp_path / "d8.png", scale=0.001)
-    assert np.array_equal(read_depth_units(tmp_path / "d.png", scale=0.001), units)  # 16-bit: any scale
+    assert np.array_equal(read_depth_units(tmp_path / "d.png", scale=0.001), units)  # 16-bit: any real scale
+    assert np.array_equal(read_depth_units(tmp_path / "d.png", scale=0.0001), units)  # 0.1 mm (D405): 6.55 m
+    # ... but not one no camera has: 1e-300 m per unit was 0 in float32, every pixel without depth, unsaid
+    for scale, reach in ((1e-300, "6.55e-296"), (1e-9, "6.55e-05")):
+        with pytest.raises(FileFormatError, match=rf"d\.png: at {scale:g} m per unit its 16-bit depth reaches only "
+                           rf"{reach} m; no camera measures depth that finely"):  # fmt: skip
+            read_depth_units(tmp_path / "d.png", scale=scale)
 
 
 def test_labels_from_grey_palette_and_colour_images(tmp_path):

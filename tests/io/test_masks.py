@@ -207,6 +207,21 @@ def test_instances_from_polygons_and_rle_by_base_name(tmp_path):
         c.instances("b.jpg", (20, 30))
 
 
+def test_images_that_share_a_file_name_are_told_apart_by_their_folders(tmp_path):
+    square = {"id": 1, "image_id": 1, "category_id": 1, "segmentation": [[3, 5, 11, 5, 11, 9, 3, 9]]}
+    coco = {"images": [{"id": 1, "file_name": "row1/0001.png"}, {"id": 2, "file_name": "row2\\0001.png"}],
+            "annotations": [square]}  # fmt: skip
+    c = read_coco(_write(tmp_path, coco))
+    assert c.instances("row1/0001.png", (20, 30)).shape == (1, 20, 30)
+    assert c.instances("/data/row1/0001.png", (20, 30)).shape == (1, 20, 30)
+    assert c.instances("/data/row2/0001.png", (20, 30)).shape == (0, 20, 30)  # before: row1's fruit
+    with pytest.raises(FileFormatError, match=r"2 images are named '0001.png' \('row1/0001.png', 'row2\\\\0001.png'\); "
+                       r"which one '0001.png' is cannot be told"):  # fmt: skip
+        c.instances("0001.png", (20, 30))  # before: row1/0001.png's, whichever was meant
+    with pytest.raises(FileFormatError, match=r"which one '/data/row3/0001.png' is cannot be told"):
+        c.instances("/data/row3/0001.png", (20, 30))
+
+
 def test_sizes_in_the_file_are_checked_against_the_image(tmp_path):
     c = read_coco(_write(tmp_path, _coco([[0, 0, 5, 0, 5, 5]])))
     with pytest.raises(FileFormatError, match=r"30x20 in the file but 40x20 on disk$"):

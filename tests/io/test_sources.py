@@ -101,6 +101,16 @@ def test_what_is_no_recording_is_refused(tmp_path):
         open_source(tmp_path / "only_hidden")
 
 
+def test_a_bag_named_in_capitals_is_named_as_a_bag(tmp_path):
+    from ..conftest import EXAMPLES
+
+    shutil.copy(EXAMPLES / "realsense" / "fruit.bag", tmp_path / "ROW3.BAG")  # as a Windows tool may name it
+    # before: "neither a frame folder (color.png, depth.png, camera.json), a folder of them, nor a bag"
+    with pytest.raises(FileFormatError, match=r"ROW3\.BAG: a bag named '\.BAG': the bag reader \(rosbags\) opens only "
+                       r"names ending in '\.bag'; rename it ROW3\.bag"):  # fmt: skip
+        open_source(tmp_path / "ROW3.BAG")
+
+
 def test_the_registry_of_kinds(tmp_path, isolated_registry):
     assert source_kinds() == ["bag", "frame", "folder"]
     with pytest.raises(ValueError, match="frame source 'frame' is already registered"):

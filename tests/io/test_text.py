@@ -136,9 +136,15 @@ def test_holds_file_says_what_an_entry_that_is_no_file_is(tmp_path):
     (tmp_path / "loop.png").symlink_to("loop.png")
     (tmp_path / "gone.png").symlink_to("nowhere.png")
     os.mkfifo(tmp_path / "pipe.png")
+    (tmp_path / "to-pipe.png").symlink_to("pipe.png")
+    (tmp_path / "zero.png").symlink_to("/dev/zero")
     assert holds_file(tmp_path / "f.png") and not holds_file(tmp_path / "missing.png")
+    pipe = re.escape(os.path.realpath(tmp_path / "pipe.png"))
     for name, why in [("d.png", "a directory, not a file"), ("loop.png", "a link that leads to no file"),
-                      ("gone.png", "a link that leads to no file"), ("pipe.png", "not a regular file")]:  # fmt: skip
+                      ("gone.png", "a link that leads to no file"), ("pipe.png", "not a regular file"),
+                      # before: "its target is missing, or the links loop", of a target that is there
+                      ("to-pipe.png", rf"a link to {pipe}, which is not a regular file"),
+                      ("zero.png", "a link to /dev/zero, which is not a regular file")]:  # fmt: skip
         with pytest.raises(FileFormatError, match=rf"{name}: {why}"):
             holds_file(tmp_path / name)
 

@@ -362,3 +362,12 @@ def test_a_depth_scale_parameter_that_is_no_metres_per_unit_is_refused_at_start(
     with pytest.raises(SymfruitError, match=r"parameter depth_scale: expected metres per unit in \(0, 1\]"):
         checked_parameters({"depth_scale": scale})
     assert checked_parameters({"depth_scale": 0.0001})["depth_scale"] == 0.0001
+
+
+@pytest.mark.parametrize("scale", [1e-300, 1e-9])
+def test_a_depth_scale_parameter_no_camera_has_is_refused_at_start(scale):
+    from symfruit.ros.core import checked_parameters
+
+    # before: taken, 1e-300 being 0 in float32: every frame read as one without depth, unsaid
+    with pytest.raises(SymfruitError, match=rf"parameter depth_scale: {scale:g} m per unit; 16-bit depth would reach"):
+        checked_parameters({"depth_scale": scale})

@@ -50,6 +50,11 @@ def test_a_record_gives_one_row_per_fruit_and_one_per_frame():
         ({"fruits": [{"id": 2**40}]}, r"fruits\[0\].id is missing or out of range"),
         ({"header": {"stamp": {"sec": -1, "nanosec": 0}}}, "is not a time"),
         ({"fruits": [{"id": 1, "reliable": "yes"}]}, "not true or false"),
+        # values no run writes, which `symfruit report` refuses for the whole table (were taken in)
+        ({"fruits": [{"id": 1, "box": {"size": [-0.02, 0.04, 0.02]}}]}, r"fruits\[0\].box.size holds -0.02 m"),
+        ({"fruits": [{"id": 1, "box": {"size": [0.02, 1e300, 0.02]}}]}, r"box.size holds 1e\+300 m"),
+        ({"fruits": [{"id": 1, "confidence": 7.0}]}, r"fruits\[0\].confidence is 7; a confidence is in \[0, 1\]"),
+        ({"fruits": [{"id": k} for k in range(1, 1002)]}, "holds 1001 fruits; a frame holds at most 1000"),
     ],
 )
 def test_a_record_that_is_not_one_is_refused_by_name(tmp_path, change, message):
@@ -125,6 +130,12 @@ def test_a_serial_run_writes_the_tables_and_resume_keeps_each_fruit_once(tmp_pat
     damaged = run_batch(rec, out, method="raw", resume=True, progress=False)
     assert damaged.done == ["f3"] and damaged.skipped == ["f1", "f2"] and damaged.ok
     assert {r["frame"] for r in pq.read_table(out / "detections.parquet").to_pylist()} == {"f1", "f2", "f3"}
+    record = json.loads((out / "f1" / "detections.json").read_text())
+    record["fruits"][0]["box"]["size"][0] = -0.02  # no completion writes it: `symfruit report` refused the run
+    (out / "f1" / "detections.json").write_text(json.dumps(record))
+    tampered = run_batch(rec, out, method="raw", resume=True, progress=False)
+    assert tampered.done == ["f1"] and tampered.skipped == ["f2", "f3"] and tampered.ok  # before: f1 skipped
+    assert min(r["size_x"] for r in pq.read_table(out / "detections.parquet").to_pylist()) > 0
 
 
 def test_a_frame_named_like_a_table_gets_a_folder_of_its_own(tmp_path):

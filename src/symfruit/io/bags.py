@@ -32,6 +32,7 @@ from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size, shown
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
+from .images import MIN_16BIT_DEPTH_REACH
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = [
@@ -191,7 +192,8 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
     FileFormatError
         For anything :func:`image_array` refuses, or an image that is not one-channel depth.
     InputError
-        For a ``depth_scale`` that is not metres per unit in (0, 1].
+        For a ``depth_scale`` that is not metres per unit in (0, 1], or by which 16-bit units reach less than
+        :data:`~symfruit.io.images.MIN_16BIT_DEPTH_REACH`.
     """
     if (
         isinstance(depth_scale, bool)
@@ -204,6 +206,9 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
         raise FileFormatError(f"depth image has {raw.shape[2]} channels, expected 1")
     if raw.dtype not in (np.uint16, np.float32):
         raise FileFormatError(f"depth image encoding {msg.encoding!r}: expected 16UC1/mono16 units or 32FC1 metres")
+    if raw.dtype == np.uint16 and 65535 * depth_scale < MIN_16BIT_DEPTH_REACH:  # 1e-300 was 0 in float32: no depth
+        raise InputError(f"depth_scale {depth_scale:g}: 16-bit depth would reach only {65535 * depth_scale:.3g} m; no "
+                         "camera measures depth that finely (metres per unit, 0.001 for millimetres)")  # fmt: skip
     if raw.dtype == np.uint16:  # one pass, float32 as everywhere (units x scale)
         return np.multiply(raw, np.float32(depth_scale), dtype=np.float32)
     return np.nan_to_num(raw, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # image_array's own copy

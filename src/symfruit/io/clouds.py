@@ -440,7 +440,9 @@ def read_text(path: Path) -> np.ndarray:
         break
     if first is None:
         raise FileFormatError(f"{path}: no numeric x y z rows found")
-    body = "\n".join(lines[first:])
+    # blank and comment lines out: numpy warns of each under max_rows (a last empty line, a comment between rows),
+    # and that warning, an error here, refused the file with numpy's note on its 1.23 release
+    body = "\n".join(line for line in lines[first:] if line.strip() and not line.strip().startswith(_COMMENTS))
     if sep == ";":
         body = body.replace(",", ".")  # decimal commas
     try:

@@ -270,13 +270,16 @@ def decode_color(data: bytes, label: str) -> np.ndarray:
 #: that reaches less (0.255 m at millimetre units) is a picture of depth (normalised to 0-255 for viewing),
 #: not a measurement, and would give every pixel a wrong depth.
 MIN_8BIT_DEPTH_REACH = 1.0
+#: Depth a 16-bit depth image must reach (65535 units times the depth scale, metres): a scale below
+#: 1/65535 m (15 micrometres) is no camera's; 1e-300 became 0 in float32 and every pixel had no depth, unsaid.
+MIN_16BIT_DEPTH_REACH = 1.0
 
 
 def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndarray:
     """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each), as displayed.
 
     With ``scale`` (metres per unit), an 8-bit image is refused when 255 units reach less than
-    :data:`MIN_8BIT_DEPTH_REACH`.
+    :data:`MIN_8BIT_DEPTH_REACH`, a 16-bit one when 65535 units reach less than :data:`MIN_16BIT_DEPTH_REACH`.
     """
     return read_depth_units_oriented(path, scale=scale)[0]
 
@@ -293,6 +296,10 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
             raise FileFormatError(f"{path}: depth PNG is 8-bit: at {scale:g} m per unit it reaches only "
                                   f"{255 * scale:.3g} m, so it is a picture of depth, not depth; write 16-bit units "
                                   "(or give the depth scale that its 8-bit units stand for)")  # fmt: skip
+        if img.mode != "L" and scale is not None and 65535 * scale < MIN_16BIT_DEPTH_REACH:
+            raise FileFormatError(f"{path}: at {scale:g} m per unit its 16-bit depth reaches only {65535 * scale:.3g} "
+                                  "m; no camera measures depth that finely: give the depth scale its units stand "
+                                  "for (metres per unit, 0.001 for millimetres)")  # fmt: skip
         raw = np.asarray(img)
     if raw.ndim != 2:
         raise FileFormatError(f"{path}: depth PNG must be single-channel, got shape {raw.shape}")

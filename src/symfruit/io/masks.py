@@ -8,8 +8,8 @@ and the number of annotations per image and of vertices per polygon are bounded.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from pathlib import Path
+from dataclasses import dataclass, field
+from pathlib import Path, PurePosixPath
 from typing import Any
 
 import numpy as np
@@ -166,6 +166,14 @@ class CocoSet:
     images: dict[str, dict[str, Any]]
     annotations: dict[Any, list[dict[str, Any]]]
     categories: dict[int, str]
+    #: Base name -> the entries of that base name, where several share it (``row1/0001.png``, ``row2/0001.png``).
+    _shared: dict[str, list[dict[str, Any]]] = field(default_factory=dict, init=False, repr=False, compare=False)
+
+    def __post_init__(self) -> None:
+        by_base: dict[str, list[dict[str, Any]]] = {}
+        for entry in self.entries():
+            by_base.setdefault(Path(str(entry["file_name"]).replace("\\", "/")).name, []).append(entry)
+        self._shared.update({base: found for base, found in by_base.items() if len(found) > 1})
 
     def annotation_categories(self) -> set[Any]:
         """The ``category_id`` values the annotations use."""
@@ -198,9 +206,23 @@ class CocoSet:
         return sorted(unique.values(), key=lambda e: str(e["file_name"]))
 
     def image(self, name: str | Path) -> dict[str, Any]:
-        """The ``images`` entry of ``name`` (a file name or path; matched on the base name too)."""
+        """The ``images`` entry of ``name`` (a file name or path; matched on the base name too, and where several
+        entries share that base name, on the folders the path ends in: ``.../row2/0001.png`` is ``row2/0001.png``)."""
         key = str(name)
-        entry = self.images.get(key) or self.images.get(Path(key).name)
+        entry = self.images.get(key)
+        if entry is not None and entry["file_name"] != key:
+            entry = None  # the base name of an entry's file_name: checked against others of that name below
+        shared = self._shared.get(_parts(key)[-1] if _parts(key) else key) if entry is None else None
+        if shared:  # before: the first of them, whichever the image was (row2/0001.png got row1/0001.png's fruit)
+            given = _parts(key)
+            fits = [e for e in shared if _ends_in(given, _parts(e["file_name"]))]
+            if len(fits) != 1:
+                names = ", ".join(repr(e["file_name"]) for e in shared[:3])
+                raise FileFormatError(f"{self.path}: {len(shared)} images are named {_parts(key)[-1]!r} ({names}); "
+                                      f"which one {key!r} is cannot be told: name the image by a path ending in "
+                                      "its file_name")  # fmt: skip
+            entry = fits[0]
+        entry = entry or self.images.get(Path(key).name)
         if entry is None:
             raise FileFormatError(f"{self.path}: no image {Path(key).name!r} in this COCO file")
         return entry
@@ -261,6 +283,16 @@ class CocoSet:
                 raise FileFormatError(f"{label} is {stated[1]}x{stated[0]} in the file but {w}x{h} on disk"
                                       f"{turned if stated == (w, h) else ''}")  # fmt: skip
         return entry, (h, w)
+
+
+def _parts(name: str | Path) -> tuple[str, ...]:
+    """A file name's folders and name (``/`` or ``\\`` between them; a leading root or ``.`` dropped), to match
+    the end of an image's path."""
+    return tuple(p for p in PurePosixPath(str(name).replace("\\", "/")).parts if p not in ("/", "."))
+
+
+def _ends_in(path: tuple[str, ...], tail: tuple[str, ...]) -> bool:
+    return 0 < len(tail) <= len(path) and path[len(path) - len(tail) :] == tail
 
 
 def _key(value: Any) -> Any:

@@ -171,13 +171,16 @@ def open_source(path: str | Path, *, exclude: Sequence[Path] = ()) -> FrameSourc
 
 
 def _is_bag(path: Path) -> bool:
-    return (path.suffix == ".bag" and path.is_file()) or (path.is_dir() and (path / "metadata.yaml").is_file())
+    return (path.suffix.lower() == ".bag" and path.is_file()) or (path.is_dir() and (path / "metadata.yaml").is_file())
 
 
 def _open_bag(path: Path, exclude: Sequence[Path]) -> FrameSource:
     from .bags import BagSource
     from .realsense import RealSenseBagSource, is_realsense
 
+    if path.is_file() and path.suffix != ".bag":  # was "neither a frame folder ..., nor a bag"
+        raise FileFormatError(f"{path}: a bag named {path.suffix!r}: the bag reader (rosbags) opens only names "
+                              f"ending in '.bag'; rename it {path.stem}.bag")  # fmt: skip
     if path.suffix == ".bag" and is_realsense(path):
         return RealSenseBagSource(path)
     return BagSource(path)

@@ -57,6 +57,8 @@ def holds_file(path: Path) -> bool:
         return False
     if path.is_dir():
         why = "a directory, not a file"
+    elif path.is_symlink() and path.exists():  # was "its target is missing": a link to /dev/zero or a pipe
+        why = f"a link to {os.path.realpath(path)}, which is not a regular file (a device, pipe or socket)"
     elif path.is_symlink():
         why = "a link that leads to no file (its target is missing, or the links loop)"
     else:

@@ -33,6 +33,7 @@ from ..core.limits import shown
 from ..detect import FrameDetections, detect
 from ..errors import InputError, SymfruitError
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
+from ..io.images import MIN_16BIT_DEPTH_REACH
 from ..methods import DEFAULT_METHOD
 from ..methods import get as get_method
 from ..segment import mask_source
@@ -98,6 +99,10 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
     if not 0 < out["depth_scale"] <= 1:  # as a frame's camera.json: 0, negative or NaN would give no frame depth
         scale = shown(out["depth_scale"])
         raise SymfruitError(f"parameter depth_scale: expected metres per unit in (0, 1], got {scale}")
+    if 65535 * out["depth_scale"] < MIN_16BIT_DEPTH_REACH:  # 1e-300: float32 0, every frame without depth, unsaid
+        scale = out["depth_scale"]
+        raise SymfruitError(f"parameter depth_scale: {scale:g} m per unit; 16-bit depth would reach only "
+                            f"{65535 * scale:.3g} m, and no camera measures depth that finely")  # fmt: skip
     if not 0 <= out["slop"] <= 10:
         raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {shown(out['slop'])}")
     if not 1 <= out["queue_size"] <= 100:

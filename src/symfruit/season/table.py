@@ -46,7 +46,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..core.limits import MAX_TRUTH_BYTES
+from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TRUTH_BYTES
 from ..errors import FileFormatError, SymfruitError
 
 __all__ = [
@@ -74,6 +74,8 @@ INPUTS_KEY = "symfruit.recordings"
 MAX_RECORD_BYTES = MAX_TRUTH_BYTES
 #: Rows buffered before a row group is written (about 20 MB of rows in Python).
 ROW_GROUP = 16_384
+#: Largest box side (metres) a record may hold: what ``symfruit report`` reads (``season.report.MAX_SIZE_M``).
+MAX_BOX_M = MAX_DEPTH_METRES
 
 #: ``(name, arrow type name)`` of ``detections.parquet``, in order.
 FRUIT_COLUMNS: tuple[tuple[str, str], ...] = (
@@ -174,6 +176,8 @@ def frame_rows(record: Mapping[str, Any], recording: str) -> tuple[Row, list[Row
     if frame is None:
         raise FileFormatError("not a detections.json record (no frame name)")
     stamp = _stamp(record.get("header"))
+    if len(record["fruits"]) > MAX_INSTANCES:  # no run writes more; the report would refuse the whole table
+        raise FileFormatError(f"holds {len(record['fruits'])} fruits; a frame holds at most {MAX_INSTANCES}")
     fruits: list[Row] = []
     for k, fruit in enumerate(record["fruits"]):
         where = f"fruits[{k}]"
@@ -195,6 +199,13 @@ def frame_rows(record: Mapping[str, Any], recording: str) -> tuple[Row, list[Row
         })  # fmt: skip
         if fruits[-1]["id"] is None or not -(2**31) <= fruits[-1]["id"] < 2**31:
             raise FileFormatError(f"{where}.id is missing or out of range")
+        # values no completion writes: taken into the tables, they made `symfruit report` refuse the whole run
+        bad = next((v for v in extent if v is not None and not 0 <= v <= MAX_BOX_M), None)
+        if bad is not None:
+            raise FileFormatError(f"{where}.box.size holds {bad:g} m; box sides are metres in [0, {MAX_BOX_M:g}]")
+        conf = fruits[-1]["confidence"]
+        if conf is not None and not 0 <= conf <= 1:
+            raise FileFormatError(f"{where}.confidence is {conf:g}; a confidence is in [0, 1]")
     timings = record.get("timings")
     seconds = _number(timings.get("total"), "timings.total") if isinstance(timings, Mapping) else None
     located = sum(f["error"] is None and f["centre_x"] is not None for f in fruits)

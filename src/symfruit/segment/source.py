@@ -62,7 +62,7 @@ class MaskSource:
         camera : Camera-like, optional
             Needed with ``depth`` by the colour segmenter's depth rules.
         name : str
-            The image's file name (a COCO JSON's images are found by it; a folder's label PNGs by its stem).
+            The image's file name or path (a COCO JSON's images are found by it; a folder's label PNGs by its stem).
         own : (h, w) int, optional
             The frame's own masks (``auto``).
         color_file : (path, int), optional
