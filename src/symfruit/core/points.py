@@ -37,6 +37,12 @@ def bounds(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     ``points.max(axis=0)``, column by column: numpy reduces a C-ordered ``(n, 3)`` array along its first
     axis some 20 times slower than three contiguous-stride column reductions."""
     p = np.asarray(points)
+    if p.ndim == 2 and len(p) and p.dtype == np.float64 and p.flags.c_contiguous and (jit := compiled()) is not None:
+        # one compiled pass over the rows (issue 19, nineteenth round: 12 against 60 us on 14,000 points); numpy's
+        # where a bound is zero (its sign is numpy's to pick)
+        lo, hi, sure = jit.column_bounds(p)
+        if sure:
+            return lo, hi
     return (np.array([p[:, i].min() for i in range(p.shape[1])]),
             np.array([p[:, i].max() for i in range(p.shape[1])]))  # fmt: skip
 
