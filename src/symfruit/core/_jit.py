@@ -2317,34 +2317,48 @@ def column_means(p: np.ndarray) -> np.ndarray:
 
 
 @_njit
-def nearest_labels(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) -> tuple[np.ndarray, bool]:
-    """:func:`symfruit.core.agreement._labels_at`: ``(found (m,) bool, sure)``, the label (``labels`` (k,) bool) of the
-    point of ``points`` (k, 2) nearest each row of ``queries`` (m, 2), every point tried, the squared distances as
-    ``scipy.spatial.cKDTree`` takes them (``dx * dx + dy * dy``, the same roundings); ``sure`` is False (and
-    ``found`` unfinished) where a query's nearest points (equally near to the bit) carry both labels: the tree's
-    pick among them, the first it meets, is its own to make."""
+def nearest_labels(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.agreement._labels_at`: ``(found (m,) bool, unsure (m,) bool)``, the label (``labels`` (k,)
+    bool) of the point of ``points`` (k, 2) nearest each row of ``queries`` (m, 2), the squared distances as
+    ``scipy.spatial.cKDTree`` takes them (``dx * dx + dy * dy``, the same roundings); ``unsure`` where a query's
+    nearest points (equally near to the bit) carry both labels (the tree's pick among them, the first it meets, is
+    its own to make). The points are searched outwards from the query's place in their order along x, up to where
+    ``dx * dx`` alone passes the nearest yet (a farther point's distance is no less): every point as near as the
+    nearest is met, whatever the order."""
     k = points.shape[0]
     m = queries.shape[0]
+    order = np.argsort(points[:, 0])
+    xs = np.empty(k)
+    ys = np.empty(k)
+    ls = np.empty(k, np.bool_)
+    for i in range(k):
+        xs[i], ys[i], ls[i] = points[order[i], 0], points[order[i], 1], labels[order[i]]
     found = np.empty(m, np.bool_)
+    unsure = np.zeros(m, np.bool_)
     for j in range(m):
         qx, qy = queries[j, 0], queries[j, 1]
         best = np.inf
         label = False
         mixed = False
-        for i in range(k):
-            dx = qx - points[i, 0]
-            dy = qy - points[i, 1]
-            d = dx * dx + dy * dy
-            if d < best:
-                best = d
-                label = labels[i]
-                mixed = False
-            elif d == best and labels[i] != label:
-                mixed = True
-        if mixed:
-            return found, False
+        start = np.searchsorted(xs, qx)
+        for direction in (1, -1):
+            i = start if direction == 1 else start - 1
+            while 0 <= i < k:
+                dx = qx - xs[i]
+                if dx * dx > best:
+                    break
+                dy = qy - ys[i]
+                d = dx * dx + dy * dy
+                if d < best:
+                    best = d
+                    label = ls[i]
+                    mixed = False
+                elif d == best and ls[i] != label:
+                    mixed = True
+                i += direction
         found[j] = label
-    return found, True
+        unsure[j] = mixed
+    return found, unsure
 
 
 @_njit

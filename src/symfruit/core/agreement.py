@@ -279,6 +279,7 @@ def observe(
     # the share from the count (a whole number over the length: the mean of the booleans, to the bit)
     contour = np.count_nonzero(is_contour) / len(is_contour) if len(is_contour) else 1.0
     edged = len(is_contour) > 0  # the edge points' labels are looked up beside band pixels and cracks (_labels_at)
+    kept: dict[str, Any] = {}  # _labels_at's tree of these edge points, where one is made
 
     def bands_of(dist: np.ndarray, outside: bool) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
         """Each band's rays, weights and seen depths (the last two for the outside bands alone, the depths with
@@ -297,15 +298,15 @@ def observe(
         m = len(uv)
         weight: np.ndarray | None = None
         seen: np.ndarray | None = None
-        if edged and m:
-            weight = _labels_at(edge_uv, is_contour, uv).astype(np.float64)  # beyond a cut edge
+        hidden: np.ndarray | None = None
         if occlusion is not None and m:
-            u, v = uv[:, 0], uv[:, 1]
-            hidden = occlusion.at(u, v)
-            if hidden.any():  # (none: the weights times 1, and no depth seen)
-                # a hidden pixel: no evidence of background ...
-                weight = (np.ones(m) if weight is None else weight) * ~hidden
-                seen = np.where(hidden, occlusion.depth_at(u, v), np.nan)  # ... but of free space
+            hidden = occlusion.at(uv[:, 0], uv[:, 1])
+            hidden = hidden if hidden.any() else None  # (none: the weights times 1, and no depth seen)
+        if edged and m:  # beyond a cut edge (a hidden pixel's label is not read: its weight is 0 whatever it is)
+            weight = _labels_at(edge_uv, is_contour, uv, kept, moot=hidden).astype(np.float64)
+        if hidden is not None and occlusion is not None:
+            weight = (np.ones(m) if weight is None else weight) * ~hidden  # a hidden pixel: no evidence of background
+            seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
         weight = np.ones(m) if weight is None else weight
         if occlusion is not None and seen is None:
             seen = np.full(m, np.nan)
@@ -317,7 +318,7 @@ def observe(
     fitted = None
     if occlusion is not None and edged and contour_cone <= contour < 1.0:
         cracks = outline_cracks(region)
-        fitted = outline_cone(region, camera, cracks[_labels_at(edge_uv, is_contour, cracks)])
+        fitted = outline_cone(region, camera, cracks[_labels_at(edge_uv, is_contour, cracks, kept)])
     # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(rays_in), rays_out=tuple(rays_out),
@@ -422,23 +423,43 @@ def _occluded_edges(
     return uv, labels & ~occlusion.at(uv[:, 0], uv[:, 1], radius=radius)
 
 
-def _labels_at(edge_uv: np.ndarray, labels: np.ndarray, uv: np.ndarray) -> np.ndarray:
+def _labels_at(
+    edge_uv: np.ndarray,
+    labels: np.ndarray,
+    uv: np.ndarray,
+    kept: dict[str, Any] | None = None,
+    moot: np.ndarray | None = None,
+) -> np.ndarray:
     """(m,) bool: the label (``labels`` (k,) bool, ``k >= 1``) of the edge point (``edge_uv`` (k, 2), pixels) nearest
     each of ``uv`` (m, 2): ``labels[cKDTree(edge_uv).query(uv)[1]]``. Where every label is the same, that label (any
     nearest point has it); else by the compiled twin :func:`symfruit.core._jit.nearest_labels` where numba is
-    installed (every edge point tried, the same squared distances as the tree's: the same labels wherever the
-    nearest points of a pixel share their label, and the tree's pick where they do not; issue 19, nineteenth round:
-    a tree's query cost 70-200 us whatever its size, the kernel's a few), else by the tree."""
+    installed (the same squared distances as the tree's: the same labels wherever the nearest points of a pixel
+    share their label; the tree's pick for the pixels whose nearest points do not; issue 19, nineteenth round: a
+    fruit's look-ups on the benchmark frame take 9 us against 275 for a tree and its query), else by the tree. ``kept``: where the tree is kept for
+    further look-ups on the same edge points; ``moot`` (m,) bool: the pixels whose label the caller does not read
+    (any nearest point's label is returned there, the tree is not asked)."""
     n_true = np.count_nonzero(labels)
     if n_true == len(labels) or n_true == 0:
         return np.full(len(uv), n_true > 0)
-    if len(uv) and (jit := compiled()) is not None:
-        found, sure = jit.nearest_labels(np.ascontiguousarray(edge_uv, dtype=np.float64),
-                                         np.ascontiguousarray(labels, dtype=bool),
-                                         np.ascontiguousarray(uv, dtype=np.float64))  # fmt: skip
-        if sure:
+    jit = compiled() if len(uv) else None
+    found = unsure = None
+    if jit is not None:
+        found, unsure = jit.nearest_labels(np.ascontiguousarray(edge_uv, dtype=np.float64),
+                                           np.ascontiguousarray(labels, dtype=bool),
+                                           np.ascontiguousarray(uv, dtype=np.float64))  # fmt: skip
+        if moot is not None:
+            unsure &= ~moot
+        if not unsure.any():
             return found
-    return labels[cKDTree(edge_uv).query(uv)[1]]
+    tree = None if kept is None else kept.get("tree")
+    if tree is None:
+        tree = cKDTree(edge_uv)
+        if kept is not None:
+            kept["tree"] = tree
+    if found is None or unsure is None:
+        return labels[tree.query(uv)[1]]
+    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
+    return found
 
 
 def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
