@@ -2460,3 +2460,78 @@ def test_the_segmenters_pixel_redness_and_least_areas_are_the_twins(seed, stride
         fast, twin = _both(mp, _least_areas, labels, depth, n, 0.06 * 900.0, 1.2)
     assert fast.dtype == twin.dtype and fast.shape == twin.shape == (n + 1,)
     np.testing.assert_array_equal(fast, twin)
+
+
+# --- stop 39, observation
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_nearest_edge_labels_are_the_trees(seed, grid):
+    """Random edge points and queries, on whole pixels (many equally near points) or anywhere, labels mixed: where the
+    kernel is sure, the labels of ``cKDTree``'s picks; it is unsure exactly where equally near points carry both
+    labels; ``_labels_at`` gives the tree's labels either way, with the kernels and with the twins."""
+    from scipy.spatial import cKDTree
+
+    from symfruit.core.agreement import _labels_at
+
+    rng = np.random.default_rng(seed)
+    k, m = int(rng.integers(1, 60)), int(rng.integers(0, 200))
+    if grid:
+        edge = rng.integers(0, 12, (k, 2)).astype(np.float64)
+        queries = rng.integers(-3, 15, (m, 2)).astype(np.float64)
+    else:
+        edge = rng.uniform(0, 40, (k, 2))
+        queries = rng.uniform(-5, 45, (m, 2))
+    labels = rng.random(k) < rng.uniform(0.0, 1.0)
+    want = labels[cKDTree(edge).query(queries)[1]] if m else np.zeros(0, bool)
+    found, unsure = _jit.nearest_labels(edge, labels, queries)
+    d2 = ((queries[:, None, :] - edge[None, :, :]) ** 2).sum(axis=2)
+    ties = [labels[d2[j] == d2[j].min()] for j in range(m)]
+    np.testing.assert_array_equal(unsure, [t.any() and not t.all() for t in ties])
+    np.testing.assert_array_equal(found[~unsure], want[~unsure])
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _labels_at, edge, labels, queries)
+    np.testing.assert_array_equal(fast, want)
+    np.testing.assert_array_equal(twin, want)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 4))
+def test_the_column_bounds_are_numpys(seed, k):
+    """Random columns with NaN, infinities, zeros of either sign and ties: ``bounds`` with the kernel is numpy's
+    column minima and maxima to the bit (the signs of zeros included), and the kernel says when it is not sure."""
+    from symfruit.core.points import bounds
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 300))
+    p = rng.normal(size=(n, k)) * 10.0 ** rng.integers(-3, 3)
+    for special in (np.nan, np.inf, -np.inf, 0.0, -0.0):
+        if rng.random() < 0.25:
+            p[rng.integers(0, n, int(rng.integers(1, 3))), rng.integers(0, k)] = special
+    if rng.random() < 0.2:
+        p = np.abs(p)
+    lo, hi, sure = _jit.column_bounds(p)
+    want_lo = np.array([p[:, j].min() for j in range(k)])
+    want_hi = np.array([p[:, j].max() for j in range(k)])
+    if sure:
+        assert lo.tobytes() == want_lo.tobytes() and hi.tobytes() == want_hi.tobytes()
+    else:
+        assert ((want_lo == 0) | (want_hi == 0)).any()
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, bounds, p)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.tobytes() == b.tobytes()
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_mirrored_points_are_the_columns_differences(seed):
+    """``mirrored`` writes the points, then ``2 c - p`` column by column: the numpy expression's values to the bit."""
+    rng = np.random.default_rng(seed)
+    p = rng.normal(size=(int(rng.integers(0, 500)), 3))
+    centre2 = rng.normal(size=3)
+    out = np.empty((2 * len(p), 3))
+    _jit.mirrored(p, centre2, out)
+    want = np.concatenate((p, centre2[None, :] - p))
+    assert out.tobytes() == want.tobytes()

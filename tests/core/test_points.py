@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from symfruit import InputError
-from symfruit.core.points import as_points, check_cloud
+from symfruit.core.points import as_points, check_cloud, subsample
 
 from ..conftest import VISIBLE
 
@@ -260,3 +260,24 @@ def test_text_is_refused_not_parsed_as_numbers(points):
     with pytest.raises(InputError, match=r"^points must be a numeric \(n, 3\) array of x, y, z in metres, got text"):
         as_points(points)  # before: numpy parsed '0.3' as 0.3 (the one string: 'must be a numeric (n, 3) array')
     assert as_points(np.array([[0.01, 0.0, 0.3]], dtype=object)).dtype == np.float64  # numbers in objects: fine
+
+
+def test_subsample_draws_as_a_new_generator_does():
+    """The kept generator set back to its seed's state draws what ``np.random.default_rng(seed)`` draws, call after
+    call, whatever was drawn between (other sizes, other seeds), in another thread too."""
+    import threading
+
+    rng = np.random.default_rng(7)
+    points = rng.normal(size=(5000, 3))
+    for _trial in range(30):
+        size, n, seed = int(rng.integers(10, 5000)), int(rng.integers(1, 3000)), int(rng.integers(0, 3))
+        cloud = points[:size]
+        want = cloud if size <= n else cloud[np.sort(np.random.default_rng(seed).choice(size, size=n, replace=False))]
+        np.testing.assert_array_equal(subsample(cloud, n, seed=seed), want)
+    found = []
+    thread = threading.Thread(target=lambda: found.append(subsample(points, 100, seed=1)))
+    thread.start()
+    thread.join()
+    np.testing.assert_array_equal(
+        found[0], points[np.sort(np.random.default_rng(1).choice(5000, size=100, replace=False))]
+    )

@@ -356,3 +356,31 @@ def test_the_rim_coverage_takes_a_cut_inner_map_only_as_far_as_it_reaches():
     # a short map taken at its word would see a rim 1 px wide: the check is what keeps the share
     short = inner_distance(region.mask, 1.0)
     assert rim_coverage(points, region, DEFAULT_CAMERA, inner=short, inner_reach=np.inf) != want
+
+
+def _vectorised_weighted_median(values, weights):
+    """The weighted median as it was written before issue 19's nineteenth round (numpy throughout)."""
+    order = np.argsort(values, axis=0)
+    cw = np.cumsum(weights[order], axis=0)
+    pick = np.argmax(cw >= 0.5 * weights.sum(), axis=0)
+    return np.take_along_axis(values, np.take_along_axis(order, pick[None, :], axis=0), axis=0)[0]
+
+
+@pytest.mark.parametrize("seed", range(200))
+def test_weighted_median_is_the_vectorised_ones(seed):
+    """Random faces with ties and random weights (some zero, some tiny, exact halves): the same values to the bit as the
+    vectorised weighted median (the same order, running sums and comparison)."""
+    rng = np.random.default_rng(seed)
+    k, m = int(rng.integers(1, 9)), int(rng.integers(1, 7))
+    values = rng.normal(size=(k, m))
+    if rng.random() < 0.5:
+        values = np.round(values, 1)  # ties
+    weights = rng.random(k) ** int(rng.integers(1, 20))
+    weights[rng.random(k) < 0.2] = 0.0
+    if rng.random() < 0.3:
+        weights = np.ones(k)  # running sums that meet half exactly
+    if rng.random() < 0.5:
+        weights = weights / max(weights.sum(), 1e-300)
+    got = _weighted_median(values, weights)
+    want = _vectorised_weighted_median(values, weights)
+    assert got.dtype == want.dtype and got.tobytes() == want.tobytes()

@@ -2313,6 +2313,98 @@ def column_means(p: np.ndarray) -> np.ndarray:
     return out
 
 
+# --- issue 19, nineteenth round (stop 39): observation and rasters ---
+
+
+@_njit
+def nearest_labels(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.agreement._labels_at`: ``(found (m,) bool, unsure (m,) bool)``, the label (``labels`` (k,)
+    bool) of the point of ``points`` (k, 2) nearest each row of ``queries`` (m, 2), the squared distances as
+    ``scipy.spatial.cKDTree`` takes them (``dx * dx + dy * dy``, the same roundings); ``unsure`` where a query's
+    nearest points (equally near to the bit) carry both labels (the tree's pick among them, the first it meets, is
+    its own to make). The points are searched outwards from the query's place in their order along x, up to where
+    ``dx * dx`` alone passes the nearest yet (a farther point's distance is no less): every point as near as the
+    nearest is met, whatever the order."""
+    k = points.shape[0]
+    m = queries.shape[0]
+    order = np.argsort(points[:, 0])
+    xs = np.empty(k)
+    ys = np.empty(k)
+    ls = np.empty(k, np.bool_)
+    for i in range(k):
+        xs[i], ys[i], ls[i] = points[order[i], 0], points[order[i], 1], labels[order[i]]
+    found = np.empty(m, np.bool_)
+    unsure = np.zeros(m, np.bool_)
+    for j in range(m):
+        qx, qy = queries[j, 0], queries[j, 1]
+        best = np.inf
+        label = False
+        mixed = False
+        start = np.searchsorted(xs, qx)
+        for direction in (1, -1):
+            i = start if direction == 1 else start - 1
+            while 0 <= i < k:
+                dx = qx - xs[i]
+                if dx * dx > best:
+                    break
+                dy = qy - ys[i]
+                d = dx * dx + dy * dy
+                if d < best:
+                    best = d
+                    label = ls[i]
+                    mixed = False
+                elif d == best and ls[i] != label:
+                    mixed = True
+                i += direction
+        found[j] = label
+        unsure[j] = mixed
+    return found, unsure
+
+
+@_njit
+def column_bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
+    """:func:`symfruit.core.points.bounds` of ``p`` (n, k) float, ``n >= 1``: ``(min (k,), max (k,), sure)``, each
+    column's least and greatest value in one pass over the rows (selects, no branches; NaN where the column holds a
+    NaN, as numpy's reductions give). ``sure`` is False where a bound is zero: numpy's vectorised reduction may keep
+    either sign of a zero (its lanes meet the values in another order), so the caller asks numpy then."""
+    n, k = p.shape
+    lo = np.empty(k)
+    hi = np.empty(k)
+    sure = True
+    for j in range(k):
+        a = b = p[0, j]
+        bad = 0.0  # NaN once a value is
+        for i in range(n):
+            x = p[i, j]
+            a = x if x < a else a
+            b = x if x > b else b
+            bad = bad if x == x else x
+        if bad != bad or a != a:
+            a = b = np.nan
+        elif a == 0.0 or b == 0.0:
+            sure = False
+        lo[j] = a
+        hi[j] = b
+    return lo, hi, sure
+
+
+@_njit
+def mirrored(points: np.ndarray, centre2: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (2 n, 3): the rows of ``points`` (n, 3), then ``centre2 - points`` (each point's mirror image through
+    half of ``centre2`` (3,)), as :func:`symfruit.methods.evidence.evidence` writes them column by column: the same
+    copies and differences, in one pass."""
+    n = points.shape[0]
+    a, b, c = centre2[0], centre2[1], centre2[2]
+    for i in range(n):
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        out[i, 0] = x
+        out[i, 1] = y
+        out[i, 2] = z
+        out[n + i, 0] = a - x
+        out[n + i, 1] = b - y
+        out[n + i, 2] = c - z
+
+
 # --- issue 19, eighteenth round (stop 38): the completion ---
 
 

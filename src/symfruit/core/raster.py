@@ -18,7 +18,7 @@ from .box import Box
 from .camera import Camera
 from .kernels import compiled
 from .limits import MAX_WINDOW_PIXELS
-from .points import as_points, cross_rows
+from .points import as_points, column_means, cross_rows, squared_norms
 
 __all__ = [
     "MAX_WINDOW_PIXELS",
@@ -100,9 +100,12 @@ def _pixels(points: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray,
     return col[inside], row[inside], points[inside, 2]
 
 
-def _window(col: np.ndarray, row: np.ndarray, camera: Camera, margin: int) -> tuple[int, int, int, int]:
-    """``(u0, v0, h, w)``: the pixels' box grown by ``margin``, clipped to the image, bounded in size."""
-    c0, c1, r0, r1 = int(col.min()), int(col.max()), int(row.min()), int(row.max())
+def _window(
+    col: np.ndarray, row: np.ndarray, camera: Camera, margin: int, box: tuple[int, int, int, int] | None = None
+) -> tuple[int, int, int, int]:
+    """``(u0, v0, h, w)``: the pixels' box (``box``: their ``(c0, c1, r0, r1)`` when known) grown by ``margin``,
+    clipped to the image, bounded in size."""
+    c0, c1, r0, r1 = (int(col.min()), int(col.max()), int(row.min()), int(row.max())) if box is None else box
     u0, v0 = max(c0 - margin, 0), max(r0 - margin, 0)
     u1, v1 = min(c1 + margin + 1, camera.width), min(r1 + margin + 1, camera.height)
     h, w = v1 - v0, u1 - u0
@@ -181,11 +184,12 @@ def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius:
         When no point projects into the image.
     """
     col, row, _ = _pixels(as_points(points, min_count=1), camera)
+    box = int(col.min()), int(col.max()), int(row.min()), int(row.max())  # once (np.ptp and _window's own before)
     if fill_radius is None:
-        area = np.pi / 4.0 * (np.ptp(col) + 1) * (np.ptp(row) + 1)
-        fill_radius = _default_fill(col, row) if len(col) < 0.5 * area else 0.0
+        area = np.pi / 4.0 * (box[1] - box[0] + 1) * (box[3] - box[2] + 1)  # _default_fill's ellipse
+        fill_radius = 0.7 * float(np.sqrt(area / len(col))) if len(col) < 0.5 * area else 0.0
     half = int(np.ceil(fill_radius))
-    u0, v0, h, w = _window(col, row, camera, pad + half + 2)
+    u0, v0, h, w = _window(col, row, camera, pad + half + 2, box)
     hit = np.zeros((h, w), dtype=bool)
     hit.ravel()[(row - v0) * w + (col - u0)] = True  # by flat index: twice as fast as two index arrays
     return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
@@ -232,12 +236,17 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
     """
     _, mu, cov = _moments(region)
-    inv = np.linalg.inv(4.0 * (cov + np.eye(2) / 12.0))
+    inv = np.linalg.inv(4.0 * (cov + _TWELFTH))
     conic = np.zeros((3, 3))
     conic[:2, :2] = inv
     conic[:2, 2] = conic[2, :2] = -inv @ mu
     conic[2, 2] = mu @ inv @ mu - 1.0
     return _image_cone(conic, mu, camera)
+
+
+#: ``np.eye(2) / 12.0`` (a pixel's own covariance), made once.
+_TWELFTH = np.eye(2) / 12.0
+_TWELFTH.flags.writeable = False
 
 
 def _moments(region: Silhouette) -> tuple[float, np.ndarray, np.ndarray]:
@@ -618,11 +627,17 @@ def outline_cone(
         raise InputError(f"outline points must have shape (m, 2), got {pts.shape}")
     if len(pts) < max(min_points, 6):
         return None
-    mu = pts.mean(axis=0)
-    scale = float(np.sqrt(((pts - mu) ** 2).sum(axis=1).mean())) or 1.0
+    # the same values as ``pts.mean(axis=0)``, ``((pts - mu) ** 2).sum(axis=1)`` and two ``np.stack`` of columns, in
+    # fewer calls (issue 19, nineteenth round)
+    mu = column_means(np.ascontiguousarray(pts))
+    scale = float(np.sqrt(squared_norms(pts - mu).mean())) or 1.0
     x, y = (pts[:, 0] - mu[0]) / scale, (pts[:, 1] - mu[1]) / scale
-    d1 = np.stack((x * x, x * y, y * y), axis=1)  # np.stack: the same (m, 3) arrays as np.c_, without its overhead
-    d2 = np.stack((x, y, np.ones_like(x)), axis=1)
+    d1 = np.empty((len(x), 3))
+    np.multiply(x, x, out=d1[:, 0])
+    np.multiply(x, y, out=d1[:, 1])
+    np.multiply(y, y, out=d1[:, 2])
+    d2 = np.ones((len(x), 3))
+    d2[:, 0], d2[:, 1] = x, y
     s1, s2, s3 = d1.T @ d1, d1.T @ d2, d2.T @ d2
     try:
         t = -np.linalg.solve(s3, s2.T)
