@@ -2460,3 +2460,59 @@ def test_the_segmenters_pixel_redness_and_least_areas_are_the_twins(seed, stride
         fast, twin = _both(mp, _least_areas, labels, depth, n, 0.06 * 900.0, 1.2)
     assert fast.dtype == twin.dtype and fast.shape == twin.shape == (n + 1,)
     np.testing.assert_array_equal(fast, twin)
+
+
+# --- stop 39, candidates
+
+
+def _ulps(a, b):
+    """The largest distance in units in the last place between two float arrays (0: the same bits, NaN alike)."""
+    a, b = np.atleast_1d(np.asarray(a, dtype=np.float64)), np.atleast_1d(np.asarray(b, dtype=np.float64))
+    assert a.shape == b.shape and np.array_equal(np.isnan(a), np.isnan(b))
+    ok = ~np.isnan(a)
+    return int(np.abs(a[ok].view(np.int64) - b[ok].view(np.int64)).max(initial=0))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_across_sight_is_the_twins(seed, disc):
+    """:func:`symfruit.core.raster.across_sight` with the kernels (``across_frame``, ``across_extent``) and with the
+    twin, on discs, ellipses and random masks anywhere in the image of a camera with unequal focal lengths: the same
+    axis, basis, bounds and widths. The kernels repeat OpenBLAS's multiply-adds of the twin's small products (its
+    Haswell kernels: on this project's machines the same bits, checked on the benchmark frames); on a CPU whose BLAS
+    kernels round those products otherwise they may differ in the last place, hence the ulps."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette, across_sight
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=float(rng.uniform(300, 900)), fy=float(rng.uniform(300, 900)), cx=float(rng.uniform(200, 440)),
+                 cy=float(rng.uniform(150, 330)), width=640, height=480)  # fmt: skip
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    if disc:
+        rr, cc = np.mgrid[0:h, 0:w]
+        a, b, t = rng.uniform(1, 50), rng.uniform(1, 50), rng.uniform(0, np.pi)
+        x, y = cc - rng.uniform(0, w), rr - rng.uniform(0, h)
+        mask = ((x * np.cos(t) + y * np.sin(t)) / a) ** 2 + ((y * np.cos(t) - x * np.sin(t)) / b) ** 2 <= 1.0
+    else:
+        mask = rng.random((h, w)) < rng.uniform(0.05, 1.0)
+    if not mask.any():
+        mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True
+    region = Silhouette(int(rng.integers(-50, 600)), int(rng.integers(-50, 440)), mask, 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, across_sight, region, cam)
+    for name in ("axis", "basis", "lo", "hi", "minor", "major"):
+        assert _ulps(getattr(fast, name), getattr(twin, name)) <= 4, name
+    assert isinstance(fast.minor, float) and isinstance(fast.major, float)
+
+
+def test_across_sight_kernels_tangent_is_numpys_products():
+    """``_tangent``, the kernels' tangent coordinates of one pixel, against the twin's ``(rays @ basis.T) / (rays @
+    axis)`` on 400 random rays (OpenBLAS's ``(m, 3) @ (3, 2)`` and ``(m, 3) @ (3,)``), within 4 ulps (here: the same
+    bits)."""
+    rng = np.random.default_rng(5)
+    uv = rng.normal(size=(400, 2)) * 100.0
+    axis, basis = rng.normal(size=3), rng.normal(size=(2, 3))
+    tangent = np.array([_jit._tangent(u, v, axis, basis, 3.0, -2.0, 7.0, 5.0) for u, v in uv.tolist()])
+    rays = np.stack(((uv[:, 0] - 3.0) / 7.0, (uv[:, 1] + 2.0) / 5.0, np.ones(len(uv))), axis=1)
+    twin = (rays @ basis.T) / (rays @ axis)[:, None]
+    assert _ulps(tangent, twin) <= 4

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
+import llvmlite.ir  # type: ignore[import-untyped]  # (numba's own dependency)
 import numba
+import numba.extending
 import numpy as np
 
 
@@ -2399,6 +2401,113 @@ def image_pixels(
             z[m] = points[i, 2]
             m += 1
     return col[:m], row[:m], z[:m]
+
+
+# --- issue 19, nineteenth round (stop 39): the candidates ---
+
+
+def _fma_intrinsic(typingctx: Any, a: Any, b: Any, c: Any) -> Any:
+    """``_fma(a, b, c)``: ``a * b + c`` rounded once (LLVM's ``llvm.fma.f64``; in software where the CPU has no FMA
+    unit), the multiply-add OpenBLAS's kernels run on a few short products, so that a kernel repeating such a product
+    gets its values. Float64 arguments only."""
+    sig = numba.types.float64(numba.types.float64, numba.types.float64, numba.types.float64)
+
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        double = llvmlite.ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [double], llvmlite.ir.FunctionType(double, [double] * 3))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+_fma = cast(Callable[[float, float, float], float], numba.extending.intrinsic(_fma_intrinsic))
+
+
+@_njit
+def _tangent(
+    u: float, v: float, axis: np.ndarray, basis: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> tuple[float, float]:
+    """``across_sight``'s ``tangent`` of one pixel ``(u, v)``: the ray ``((u - cx) / fx, (v - cy) / fy, 1)`` over
+    its product with ``axis``, times ``basis.T``, as OpenBLAS (Haswell kernels) forms the twin's ``r @ basis.T``
+    (each element ``r2 b2 + (r1 b1 + r0 b0)``, two multiply-adds) and ``r @ axis`` (``r2 a2 + (r0 a0 + r1 a1)``)."""
+    r0 = (u - cx) / fx
+    r1 = (v - cy) / fy
+    den = _fma(1.0, axis[2], _fma(r0, axis[0], r1 * axis[1]))
+    s = _fma(1.0, basis[0, 2], _fma(r1, basis[0, 1], r0 * basis[0, 0])) / den
+    t = _fma(1.0, basis[1, 2], _fma(r1, basis[1, 1], r0 * basis[1, 0])) / den
+    return s, t
+
+
+@_njit
+def across_frame(
+    mu0: float, mu1: float, cov: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.raster.across_sight` up to its ``eigh``: the unit ray through the centroid ``(mu0, mu1)``
+    (3,), the tangent basis (2, 3) and the pixels' covariance ``cov`` (2, 2) carried to tangent coordinates, ``jac
+    @ cov @ jac.T`` (2, 2), each value the twin's (numpy's norms of 3-vectors sum left to right; the 2x2 products are
+    OpenBLAS's ``a1 b1 + a0 b0`` multiply-adds)."""
+    axis = np.empty(3)
+    axis[0] = (mu0 - cx) / fx
+    axis[1] = (mu1 - cy) / fy
+    axis[2] = 1.0
+    norm = math.sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2])
+    for i in range(3):
+        axis[i] = axis[i] / norm
+    basis = np.empty((2, 3))
+    basis[0, 0] = axis[2]
+    basis[0, 1] = 0.0
+    basis[0, 2] = -axis[0]
+    norm = math.sqrt(basis[0, 0] * basis[0, 0] + basis[0, 1] * basis[0, 1] + basis[0, 2] * basis[0, 2])
+    for i in range(3):
+        basis[0, i] = basis[0, i] / norm
+    basis[1, 0] = axis[1] * basis[0, 2] - axis[2] * basis[0, 1]
+    basis[1, 1] = axis[2] * basis[0, 0] - axis[0] * basis[0, 2]
+    basis[1, 2] = axis[0] * basis[0, 1] - axis[1] * basis[0, 0]
+    s0, t0 = _tangent(mu0 + 0.0, mu1 + 0.0, axis, basis, cx, cy, fx, fy)
+    su, tu = _tangent(mu0 + 1.0, mu1 + 0.0, axis, basis, cx, cy, fx, fy)
+    sv, tv = _tangent(mu0 + 0.0, mu1 + 1.0, axis, basis, cx, cy, fx, fy)
+    jac = np.empty((2, 2))
+    jac[0, 0], jac[1, 0] = su - s0, tu - t0
+    jac[0, 1], jac[1, 1] = sv - s0, tv - t0
+    left = np.empty((2, 2))
+    for i in range(2):
+        for j in range(2):
+            left[i, j] = _fma(jac[i, 1], cov[1, j], jac[i, 0] * cov[0, j])
+    out = np.empty((2, 2))
+    for i in range(2):
+        for j in range(2):
+            out[i, j] = _fma(left[i, 1], jac[j, 1], left[i, 0] * jac[j, 0])
+    return axis, basis, out
+
+
+@_njit
+def across_extent(
+    cracks: np.ndarray, axis: np.ndarray, basis: np.ndarray, vec: np.ndarray, cx: float, cy: float, fx: float,
+    fy: float,
+) -> tuple[np.ndarray, np.ndarray, float, float]:  # fmt: skip
+    """:func:`symfruit.core.raster.across_sight` after its ``eigh``: the outline's points ``cracks`` (m, 2), pixels,
+    in tangent coordinates, their least and greatest values along ``e1`` and ``e2`` (2,) each, and their widths along
+    the eigenvectors ``vec`` (2, 2, columns), the first and the second: each value the twin's (``edge @ vec`` as
+    OpenBLAS's multiply-adds)."""
+    lo = np.full(2, np.inf)
+    hi = np.full(2, -np.inf)
+    p_lo = np.full(2, np.inf)
+    p_hi = np.full(2, -np.inf)
+    nan = False
+    for i in range(cracks.shape[0]):
+        s, t = _tangent(cracks[i, 0], cracks[i, 1], axis, basis, cx, cy, fx, fy)
+        if s != s or t != t:
+            nan = True
+        lo[0], hi[0] = min(lo[0], s), max(hi[0], s)
+        lo[1], hi[1] = min(lo[1], t), max(hi[1], t)
+        for j in range(2):
+            p = _fma(t, vec[1, j], s * vec[0, j])
+            if p != p:
+                nan = True
+            p_lo[j], p_hi[j] = min(p_lo[j], p), max(p_hi[j], p)
+    if nan:  # numpy's reductions carry a NaN through
+        lo[:], hi[:], p_lo[:], p_hi[:] = np.nan, np.nan, np.nan, np.nan
+    return lo, hi, p_hi[0] - p_lo[0], p_hi[1] - p_lo[1]
 
 
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
