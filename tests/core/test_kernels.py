@@ -2516,3 +2516,37 @@ def test_across_sight_kernels_tangent_is_numpys_products():
     rays = np.stack(((uv[:, 0] - 3.0) / 7.0, (uv[:, 1] + 2.0) / 5.0, np.ones(len(uv))), axis=1)
     twin = (rays @ basis.T) / (rays @ axis)[:, None]
     assert _ulps(tangent, twin) <= 4
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([None, 1.0, 0.3]))
+def test_constrain_box_is_the_twins(seed, with_cone, pull):
+    """:func:`symfruit.core.candidates.constrain_box` with the kernel and with its twin in Python floats: boxes
+    beyond, within and across the seen box, equal faces, signed zeros and NaN faces, contour shares below, at and
+    above the floor, with and without the silhouette's cone: the same boxes, bit for bit."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.candidates import constrain_box
+
+    rng = np.random.default_rng(seed)
+
+    def vec():
+        v = rng.choice([rng.normal(0, 0.05), 0.0, -0.0, 0.01, np.nan], p=[0.8, 0.05, 0.05, 0.05, 0.05], size=3)
+        return v + np.array([0.0, 0.0, 0.4]) * (rng.random() < 0.8)
+
+    seen_lo = rng.normal(0, 0.03, 3) + [0, 0, 0.35]
+    seen_hi = seen_lo + rng.choice([0.0, 0.02, 0.05], 3) * rng.random(3)
+    lo, hi = vec(), vec()
+    if rng.random() < 0.3:
+        lo, hi = seen_lo.copy(), seen_hi.copy()
+    cone = None
+    if with_cone:
+        cam = Camera(fx=600.0, fy=610.0, cx=319.5, cy=241.0, width=640, height=480)
+        u, v = (float(x) for x in rng.uniform(100, 500, 2))
+        cone = ((u - 20.0, v - 15.0, u + float(rng.uniform(0, 40)), v + 30.0), cam)
+    front = float(rng.choice([seen_lo[2], seen_lo[2] - 0.003, 0.4]))
+    contour = float(rng.choice([0.0, 0.3, 0.5, 0.9, 1.0]))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, constrain_box, lo, hi, seen_lo, seen_hi, front, cone=cone, contour=contour, pull=pull)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.shape == b.shape == (3,) and a.dtype == b.dtype == np.float64
+        assert np.array_equal(a.view(np.int64), b.view(np.int64))

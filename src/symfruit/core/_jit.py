@@ -2510,6 +2510,57 @@ def across_extent(
     return lo, hi, p_hi[0] - p_lo[0], p_hi[1] - p_lo[1]
 
 
+@_njit
+def _lesser(a: float, b: float) -> float:
+    """``np.minimum`` of two numbers (:func:`symfruit.core.candidates._lesser`): NaN where either is, ``b`` where
+    they are equal."""
+    return a if a < b or a != a else b
+
+
+@_njit
+def _greater(a: float, b: float) -> float:
+    """``np.maximum`` of two numbers (:func:`symfruit.core.candidates._greater`)."""
+    return a if a > b or a != a else b
+
+
+@_njit
+def constrain_box(
+    lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray, front: float, scale: float,
+    cone: np.ndarray, intrinsics: np.ndarray, share: float,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.candidates.constrain_box` (its twin, in Python floats): the same operations in the same
+    order on the same IEEE doubles, so the same box. ``scale`` is ``REACH / max(contour, REACH_FLOOR)``; ``cone`` the
+    silhouette's pixel box ``(u_min, v_min, u_max, v_max)``, or empty for none; ``intrinsics`` ``(cx, cy, fx, fy)``;
+    ``share`` the pull's."""
+    s_lo = np.empty(3)
+    s_hi = np.empty(3)
+    out_lo = np.empty(3)
+    out_hi = np.empty(3)
+    for i in range(3):
+        s_lo[i] = seen_lo[i]
+    s_lo[2] = front
+    for i in range(3):
+        s_hi[i] = _greater(seen_hi[i], s_lo[i])
+        reach = scale * (s_hi[i] - s_lo[i])
+        out_lo[i] = _lesser(_greater(lo[i], s_hi[i] - reach), s_lo[i])
+        out_hi[i] = _greater(_lesser(hi[i], s_lo[i] + reach), s_hi[i])
+    out_lo[2] = front
+    top = front + 1e-4
+    out_hi[2] = top if top > out_hi[2] else out_hi[2]  # Python's max(out_hi[2], top): the first unless top is larger
+    if cone.shape[0] == 4:
+        cx, cy, fx, fy = intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3]
+        z0, z1 = out_lo[2], out_hi[2]
+        a, b = (cone[0] - cx) / fx, (cone[1] - cy) / fy
+        bound_lo0, bound_lo1 = _lesser(a * z0, a * z1), _lesser(b * z0, b * z1)
+        a, b = (cone[2] - cx) / fx, (cone[3] - cy) / fy
+        bound_hi0, bound_hi1 = _greater(a * z0, a * z1), _greater(b * z0, b * z1)
+        out_lo[0] = _lesser(s_lo[0], out_lo[0] + share * _greater(bound_lo0 - out_lo[0], 0.0))
+        out_hi[0] = _greater(s_hi[0], out_hi[0] - share * _greater(out_hi[0] - bound_hi0, 0.0))
+        out_lo[1] = _lesser(s_lo[1], out_lo[1] + share * _greater(bound_lo1 - out_lo[1], 0.0))
+        out_hi[1] = _greater(s_hi[1], out_hi[1] - share * _greater(out_hi[1] - bound_hi1, 0.0))
+    return out_lo, out_hi
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 
