@@ -2561,6 +2561,27 @@ def constrain_box(
     return out_lo, out_hi
 
 
+@_njit
+def cone_rays(points: np.ndarray, cone: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s rays: every point (n, 3) over its depth (n, 3), each ray's
+    ``r^T C r`` (n,) for the viewing cone ``cone`` (3, 3) and the depths (n,), contiguous; the twin's values (its
+    ``rays @ cone`` as OpenBLAS's two multiply-adds from the first term, the row sums of three left to right)."""
+    n = points.shape[0]
+    rays = np.empty((n, 3))
+    ray_cone = np.empty(n)
+    z = np.empty(n)
+    for i in range(n):
+        depth = points[i, 2]
+        r0, r1, r2 = points[i, 0] / depth, points[i, 1] / depth, depth / depth
+        rays[i, 0], rays[i, 1], rays[i, 2] = r0, r1, r2
+        c0 = _fma(r2, cone[2, 0], _fma(r1, cone[1, 0], r0 * cone[0, 0]))
+        c1 = _fma(r2, cone[2, 1], _fma(r1, cone[1, 1], r0 * cone[0, 1]))
+        c2 = _fma(r2, cone[2, 2], _fma(r1, cone[1, 2], r0 * cone[0, 2]))
+        ray_cone[i] = c0 * r0 + c1 * r1 + c2 * r2
+        z[i] = depth
+    return rays, ray_cone, z
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 

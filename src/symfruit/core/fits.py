@@ -1117,14 +1117,18 @@ def fit_cone_ellipsoid(
     points = points[:: max(1, -(-len(points) // max_points))]
     cone = np.asarray(cone, dtype=np.float64)
     axis = np.asarray(axis, dtype=np.float64)
-    rays = points / points[:, 2:3]
-    z = points[:, 2]
+    jit = compiled()
+    if jit is not None:  # the compiled twin of the rays, their r^T C r and the depths below: the same values
+        rays, ray_cone, z = jit.cone_rays(points, np.ascontiguousarray(cone))
+    else:
+        rays = points / points[:, 2:3]
+        z = points[:, 2]
+        ray_cone = ((rays @ cone) * rays).sum(axis=1)
     grid = _cone_grid(front, extent)
     tau_max = cone_thickness_bound(cone, min_thickness)
     np.minimum(grid[:, 3], tau_max, out=grid[:, 3])
 
     cone_inv = np.linalg.inv(cone)
-    ray_cone = ((rays @ cone) * rays).sum(axis=1)
     step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
     steps = np.diag(step)
     at = np.empty((5, 4))
@@ -1147,7 +1151,7 @@ def fit_cone_ellipsoid(
         a = np.abs(res)
         return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
 
-    if (jit := compiled()) is not None:  # the compiled twin of the grid search, the loop and the back face below
+    if jit is not None:  # the compiled twin of the grid search, the loop and the back face below
         cone_c, axis_c = np.ascontiguousarray(cone), np.ascontiguousarray(axis)
         p, both, status = jit.cone_fit(
             grid, cone_c, axis_c, rays, ray_cone, np.ascontiguousarray(z), step, huber, iterations, tolerance, tau_max
