@@ -12,7 +12,6 @@ import math
 from collections.abc import Callable
 from typing import Any, cast
 
-import llvmlite.ir  # type: ignore[import-untyped]  # (numba's own dependency)
 import numba
 import numba.extending
 import numpy as np
@@ -2413,8 +2412,10 @@ def _fma_intrinsic(typingctx: Any, a: Any, b: Any, c: Any) -> Any:
     sig = numba.types.float64(numba.types.float64, numba.types.float64, numba.types.float64)
 
     def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
-        double = llvmlite.ir.DoubleType()
-        fn = builder.module.declare_intrinsic("llvm.fma", [double], llvmlite.ir.FunctionType(double, [double] * 3))
+        from numba.core import cgutils  # its llvmlite.ir, the IR numba builds (llvmlite is numba's own dependency)
+
+        double = cgutils.ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [double], cgutils.ir.FunctionType(double, [double] * 3))
         return builder.call(fn, args)
 
     return sig, codegen
