@@ -136,3 +136,36 @@ def test_a_box_implausible_for_what_was_seen_is_no_candidate():
     assert not _plausible(seen_lo - [0.041, 0.0, 0.0], seen_hi, seen_lo, seen_hi, reach)
     # ... unless where the fruit can project is known (occlusion information): then it is only clipped.
     assert _plausible(seen_lo - [0.041, 0.0, 0.0], seen_hi, seen_lo, seen_hi, reach, lateral=False)
+
+
+def _former_plausible(lo, hi, seen_lo, seen_hi, reach, *, lateral=True, width=0.0):
+    """_plausible as numpy's (3,) arrays made it before issue 19's nineteenth round (Python floats since)."""
+    seen = seen_hi - seen_lo
+    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1], width):
+        return False
+    if lateral:
+        over = np.maximum(seen_lo[:2] - lo[:2], hi[:2] - seen_hi[:2])
+        return bool(np.all(over <= reach[0] * seen[:2]))
+    return True
+
+
+def test_plausible_is_the_former_array_arithmetic():
+    """The plausibility test in Python floats decides as the former array arithmetic did, on 5,000 boxes around and
+    beyond a seen box (faces on the bound, NaN faces, lateral test on and off)."""
+    from symfruit.core.candidates import _plausible
+
+    rng = np.random.default_rng(3)
+    for i in range(5000):
+        seen_lo = rng.normal(0, 0.02, 3) + [0, 0, 0.4]
+        seen_hi = seen_lo + rng.uniform(0, 0.05, 3)
+        seen = seen_hi - seen_lo
+        reach = (float(rng.choice([0.5, 1.0, 2.0])), float(rng.choice([0.5, 1.0, 1.5])))
+        lo = seen_lo - seen * rng.choice([0.0, 0.5, reach[0], 3.0], 3)
+        hi = seen_hi + seen * rng.choice([0.0, 0.5, reach[0], reach[1], 3.0], 3)
+        if i % 50 == 0:
+            hi[int(rng.integers(0, 3))] = np.nan
+        width = float(rng.choice([0.0, 0.03, 0.08]))
+        lateral = bool(i % 3)
+        with np.errstate(invalid="ignore"):
+            want = _former_plausible(lo, hi, seen_lo, seen_hi, reach, lateral=lateral, width=width)
+        assert _plausible(lo, hi, seen_lo, seen_hi, reach, lateral=lateral, width=width) is want

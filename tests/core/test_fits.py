@@ -605,3 +605,95 @@ def test_the_nearest_are_in_a_stable_order_of_the_distances(seed, n, step, large
     np.testing.assert_array_equal(got, want)
     d = ((pts[None, :, :] - queries[:, None, :]) ** 2).sum(axis=2)  # the same sums, another way
     np.testing.assert_array_equal(_squared_distances(pts, queries), d)
+
+
+# --- stop 39: the 2x2 closed forms that stand in for LAPACK calls ------------------------------------------------
+
+
+def _symmetric_2x2(rng, i):
+    """A symmetric 2x2 matrix's three numbers: scales from 1e-6 to 1e6, zero, tiny and equal entries among them."""
+    a, b, c = rng.normal(size=3) * 10.0 ** rng.integers(-6, 7, size=3)
+    if i % 3 == 0:
+        b = 0.0
+    elif i % 7 == 0:
+        b = a * 10.0 ** rng.uniform(-20, -14)
+    if i % 5 == 0:
+        c = a
+    if i % 11 == 0:
+        c = -a
+    return float(a), float(b), float(c)
+
+
+def test_eigenvalues2_are_eigvalsh_bit_for_bit():
+    """:func:`symfruit.core.fits.eigenvalues2` against ``np.linalg.eigvalsh`` on 20,000 symmetric 2x2 matrices
+    (definite, indefinite, diagonal, nearly diagonal, equal and opposite diagonals): the same values, to the bit on
+    this project's machines (LAPACK's ``dsterf`` and ``dlae2`` are portable Fortran), checked within 4 ulps so that a
+    LAPACK built to fuse multiply-adds (another architecture, a later numpy) does not fail it; None beyond the range
+    where LAPACK scales."""
+    from symfruit.core.fits import eigenvalues2
+
+    rng = np.random.default_rng(0)
+    for i in range(20_000):
+        a, b, c = _symmetric_2x2(rng, i)
+        got = eigenvalues2(a, b, c)
+        assert got is not None
+        want = np.linalg.eigvalsh(np.array([[a, b], [b, c]]))
+        np.testing.assert_array_max_ulp(np.array(got), want, maxulp=4)
+    assert eigenvalues2(1e-120, 0.5, 1.0) is None and eigenvalues2(np.nan, 0.0, 1.0) is None
+    assert eigenvalues2(1e120, 0.0, 1.0) is None and eigenvalues2(0.0, 0.0, 0.0) == (0.0, 0.0)
+
+
+def test_solve2_is_numpys_solve():
+    """:func:`symfruit.core.fits.solve2` against ``np.linalg.solve`` on 20,000 random 2x2 systems (symmetric and
+    not, rows to swap, scales from 1e-4 to 1e4): the same values (OpenBLAS's ``dgesv``: to the bit on this
+    project's machines; checked within 4 ulps, as its kernels may round otherwise on another CPU), the same error
+    on a singular matrix, None outside its range."""
+    from symfruit.core.fits import solve2
+
+    rng = np.random.default_rng(1)
+    for i in range(20_000):
+        m = rng.normal(size=(2, 2)) * 10.0 ** rng.integers(-4, 5)
+        if i % 4 == 0:
+            m[0, 1] = m[1, 0]
+        rhs = rng.normal(size=2)
+        got = solve2(*m.ravel().tolist(), *rhs.tolist())
+        want = np.linalg.solve(m, rhs)
+        assert got is not None
+        np.testing.assert_array_max_ulp(np.array(got), want, maxulp=4)
+    for singular in ([[0.0, 1.0], [0.0, 2.0]], [[1.0, 2.0], [2.0, 4.0]], [[0.0, 0.0], [0.0, 0.0]]):
+        with pytest.raises(np.linalg.LinAlgError):
+            np.linalg.solve(np.array(singular), np.ones(2))
+        with pytest.raises(np.linalg.LinAlgError):
+            solve2(*np.ravel(singular).tolist(), 1.0, 1.0)
+    assert solve2(1.0, 0.0, 0.0, 1.0, np.inf, 0.0) is None and solve2(1e-120, 0.0, 0.0, 1.0, 1.0, 1.0) is None
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_cone_thickness_bound_is_the_lapack_formulas(seed):
+    """:func:`symfruit.core.fits.cone_thickness_bound` by the closed forms is the bound the former LAPACK calls gave
+    (``b @ solve(a, b) - c`` and ``eigvalsh(a)[-1]``), bit for bit, on random viewing cones and on singular ones."""
+    from symfruit.core.fits import cone_thickness_bound
+
+    rng = np.random.default_rng(seed)
+    m = rng.normal(size=(3, 3))
+    cone = m + m.T
+    if seed % 5 == 0:
+        cone[1, :2] = cone[0, :2] * 2.0
+        cone[:2, 1] = cone[1, :2]
+    thickness = float(rng.uniform(0.05, 1.0))
+
+    def former():
+        a, b, c = cone[:2, :2], cone[:2, 2], cone[2, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            k = float(b @ np.linalg.solve(a, b) - c)
+            top = float(np.linalg.eigvalsh(a)[-1])
+            narrow = np.sqrt(k / top) if k > 0 and top > 0 else float("nan")
+        return float("inf") if not np.isfinite(narrow) or narrow <= 0 else float(-2.0 * np.log(thickness * narrow))
+
+    try:
+        want = former()
+    except np.linalg.LinAlgError:
+        with pytest.raises(np.linalg.LinAlgError):
+            cone_thickness_bound(cone, thickness)
+        return
+    assert cone_thickness_bound(cone, thickness) == want

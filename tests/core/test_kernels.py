@@ -2535,3 +2535,110 @@ def test_the_mirrored_points_are_the_columns_differences(seed):
     _jit.mirrored(p, centre2, out)
     want = np.concatenate((p, centre2[None, :] - p))
     assert out.tobytes() == want.tobytes()
+
+
+# --- stop 39, candidates
+
+
+def _ulps(a, b):
+    """The largest distance in units in the last place between two float arrays (0: the same bits, NaN alike)."""
+    a, b = np.atleast_1d(np.asarray(a, dtype=np.float64)), np.atleast_1d(np.asarray(b, dtype=np.float64))
+    assert a.shape == b.shape and np.array_equal(np.isnan(a), np.isnan(b))
+    ok = ~np.isnan(a)
+    return int(np.abs(a[ok].view(np.int64) - b[ok].view(np.int64)).max(initial=0))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_across_sight_is_the_twins(seed, disc):
+    """:func:`symfruit.core.raster.across_sight` with the kernels (``across_frame``, ``across_extent``) and with the
+    twin, on discs, ellipses and random masks anywhere in the image of a camera with unequal focal lengths: the same
+    axis, basis, bounds and widths. The kernels repeat OpenBLAS's multiply-adds of the twin's small products (its
+    Haswell kernels: on this project's machines the same bits, checked on the benchmark frames); on a CPU whose BLAS
+    kernels round those products otherwise they may differ in the last place, hence the ulps."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette, across_sight
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=float(rng.uniform(300, 900)), fy=float(rng.uniform(300, 900)), cx=float(rng.uniform(200, 440)),
+                 cy=float(rng.uniform(150, 330)), width=640, height=480)  # fmt: skip
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    if disc:
+        rr, cc = np.mgrid[0:h, 0:w]
+        a, b, t = rng.uniform(1, 50), rng.uniform(1, 50), rng.uniform(0, np.pi)
+        x, y = cc - rng.uniform(0, w), rr - rng.uniform(0, h)
+        mask = ((x * np.cos(t) + y * np.sin(t)) / a) ** 2 + ((y * np.cos(t) - x * np.sin(t)) / b) ** 2 <= 1.0
+    else:
+        mask = rng.random((h, w)) < rng.uniform(0.05, 1.0)
+    if not mask.any():
+        mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = True
+    region = Silhouette(int(rng.integers(-50, 600)), int(rng.integers(-50, 440)), mask, 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, across_sight, region, cam)
+    for name in ("axis", "basis", "lo", "hi", "minor", "major"):
+        assert _ulps(getattr(fast, name), getattr(twin, name)) <= 4, name
+    assert isinstance(fast.minor, float) and isinstance(fast.major, float)
+
+
+def test_across_sight_kernels_tangent_is_numpys_products():
+    """``_tangent``, the kernels' tangent coordinates of one pixel, against the twin's ``(rays @ basis.T) / (rays @
+    axis)`` on 400 random rays (OpenBLAS's ``(m, 3) @ (3, 2)`` and ``(m, 3) @ (3,)``), within 4 ulps (here: the same
+    bits)."""
+    rng = np.random.default_rng(5)
+    uv = rng.normal(size=(400, 2)) * 100.0
+    axis, basis = rng.normal(size=3), rng.normal(size=(2, 3))
+    tangent = np.array([_jit._tangent(u, v, axis, basis, 3.0, -2.0, 7.0, 5.0) for u, v in uv.tolist()])
+    rays = np.stack(((uv[:, 0] - 3.0) / 7.0, (uv[:, 1] + 2.0) / 5.0, np.ones(len(uv))), axis=1)
+    twin = (rays @ basis.T) / (rays @ axis)[:, None]
+    assert _ulps(tangent, twin) <= 4
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([None, 1.0, 0.3]))
+def test_constrain_box_is_the_twins(seed, with_cone, pull):
+    """:func:`symfruit.core.candidates.constrain_box` with the kernel and with its twin in Python floats: boxes
+    beyond, within and across the seen box, equal faces, signed zeros and NaN faces, contour shares below, at and
+    above the floor, with and without the silhouette's cone: the same boxes, bit for bit."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.candidates import constrain_box
+
+    rng = np.random.default_rng(seed)
+
+    def vec():
+        v = rng.choice([rng.normal(0, 0.05), 0.0, -0.0, 0.01, np.nan], p=[0.8, 0.05, 0.05, 0.05, 0.05], size=3)
+        return v + np.array([0.0, 0.0, 0.4]) * (rng.random() < 0.8)
+
+    seen_lo = rng.normal(0, 0.03, 3) + [0, 0, 0.35]
+    seen_hi = seen_lo + rng.choice([0.0, 0.02, 0.05], 3) * rng.random(3)
+    lo, hi = vec(), vec()
+    if rng.random() < 0.3:
+        lo, hi = seen_lo.copy(), seen_hi.copy()
+    cone = None
+    if with_cone:
+        cam = Camera(fx=600.0, fy=610.0, cx=319.5, cy=241.0, width=640, height=480)
+        u, v = (float(x) for x in rng.uniform(100, 500, 2))
+        cone = ((u - 20.0, v - 15.0, u + float(rng.uniform(0, 40)), v + 30.0), cam)
+    front = float(rng.choice([seen_lo[2], seen_lo[2] - 0.003, 0.4]))
+    contour = float(rng.choice([0.0, 0.3, 0.5, 0.9, 1.0]))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, constrain_box, lo, hi, seen_lo, seen_hi, front, cone=cone, contour=contour, pull=pull)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.shape == b.shape == (3,) and a.dtype == b.dtype == np.float64
+        assert np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.booleans())
+def test_cone_rays_are_the_twins(seed, n, strided):
+    """``cone_rays`` (the cone fit's rays, their ``r^T C r`` and depths) against the twin's ``points / z``, ``((rays
+    @ cone) * rays).sum(axis=1)`` and ``points[:, 2]`` on random points, every other row of a larger array too, and
+    random symmetric cones: within 4 ulps (the same bits on this project's machines, OpenBLAS's Haswell kernels)."""
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(0, 0.05, (2 * n if strided else n, 3)) + [0.0, 0.0, 0.4]
+    pts = pts[::2] if strided else pts
+    m = rng.normal(size=(3, 3))
+    cone = m + m.T
+    rays, ray_cone, z = _jit.cone_rays(pts, cone)
+    twin_rays = pts / pts[:, 2:3]
+    assert _ulps(rays, twin_rays) <= 4 and _ulps(ray_cone, ((twin_rays @ cone) * twin_rays).sum(axis=1)) <= 4
+    assert np.array_equal(z, pts[:, 2]) and z.flags.c_contiguous and rays.flags.c_contiguous

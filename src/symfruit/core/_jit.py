@@ -10,9 +10,10 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from typing import Any
+from typing import Any, cast
 
 import numba
+import numba.extending
 import numpy as np
 
 
@@ -2491,6 +2492,187 @@ def image_pixels(
             z[m] = points[i, 2]
             m += 1
     return col[:m], row[:m], z[:m]
+
+
+# --- issue 19, nineteenth round (stop 39): the candidates ---
+
+
+def _fma_intrinsic(typingctx: Any, a: Any, b: Any, c: Any) -> Any:
+    """``_fma(a, b, c)``: ``a * b + c`` rounded once (LLVM's ``llvm.fma.f64``; in software where the CPU has no FMA
+    unit), the multiply-add OpenBLAS's kernels run on a few short products, so that a kernel repeating such a product
+    gets its values. Float64 arguments only."""
+    sig = numba.types.float64(numba.types.float64, numba.types.float64, numba.types.float64)
+
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        from numba.core import cgutils  # its llvmlite.ir, the IR numba builds (llvmlite is numba's own dependency)
+
+        double = cgutils.ir.DoubleType()
+        fn = builder.module.declare_intrinsic("llvm.fma", [double], cgutils.ir.FunctionType(double, [double] * 3))
+        return builder.call(fn, args)
+
+    return sig, codegen
+
+
+_fma = cast(Callable[[float, float, float], float], numba.extending.intrinsic(_fma_intrinsic))
+
+
+@_njit
+def _tangent(
+    u: float, v: float, axis: np.ndarray, basis: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> tuple[float, float]:
+    """``across_sight``'s ``tangent`` of one pixel ``(u, v)``: the ray ``((u - cx) / fx, (v - cy) / fy, 1)`` over
+    its product with ``axis``, times ``basis.T``, as OpenBLAS (Haswell kernels) forms the twin's ``r @ basis.T``
+    (each element ``r2 b2 + (r1 b1 + r0 b0)``, two multiply-adds) and ``r @ axis`` (``r2 a2 + (r0 a0 + r1 a1)``)."""
+    r0 = (u - cx) / fx
+    r1 = (v - cy) / fy
+    den = _fma(1.0, axis[2], _fma(r0, axis[0], r1 * axis[1]))
+    s = _fma(1.0, basis[0, 2], _fma(r1, basis[0, 1], r0 * basis[0, 0])) / den
+    t = _fma(1.0, basis[1, 2], _fma(r1, basis[1, 1], r0 * basis[1, 0])) / den
+    return s, t
+
+
+@_njit
+def across_frame(
+    mu0: float, mu1: float, cov: np.ndarray, cx: float, cy: float, fx: float, fy: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.raster.across_sight` up to its ``eigh``: the unit ray through the centroid ``(mu0, mu1)``
+    (3,), the tangent basis (2, 3) and the pixels' covariance ``cov`` (2, 2) carried to tangent coordinates, ``jac
+    @ cov @ jac.T`` (2, 2), each value the twin's (numpy's norms of 3-vectors sum left to right; the 2x2 products are
+    OpenBLAS's ``a1 b1 + a0 b0`` multiply-adds)."""
+    axis = np.empty(3)
+    axis[0] = (mu0 - cx) / fx
+    axis[1] = (mu1 - cy) / fy
+    axis[2] = 1.0
+    norm = math.sqrt(axis[0] * axis[0] + axis[1] * axis[1] + axis[2] * axis[2])
+    for i in range(3):
+        axis[i] = axis[i] / norm
+    basis = np.empty((2, 3))
+    basis[0, 0] = axis[2]
+    basis[0, 1] = 0.0
+    basis[0, 2] = -axis[0]
+    norm = math.sqrt(basis[0, 0] * basis[0, 0] + basis[0, 1] * basis[0, 1] + basis[0, 2] * basis[0, 2])
+    for i in range(3):
+        basis[0, i] = basis[0, i] / norm
+    basis[1, 0] = axis[1] * basis[0, 2] - axis[2] * basis[0, 1]
+    basis[1, 1] = axis[2] * basis[0, 0] - axis[0] * basis[0, 2]
+    basis[1, 2] = axis[0] * basis[0, 1] - axis[1] * basis[0, 0]
+    s0, t0 = _tangent(mu0 + 0.0, mu1 + 0.0, axis, basis, cx, cy, fx, fy)
+    su, tu = _tangent(mu0 + 1.0, mu1 + 0.0, axis, basis, cx, cy, fx, fy)
+    sv, tv = _tangent(mu0 + 0.0, mu1 + 1.0, axis, basis, cx, cy, fx, fy)
+    jac = np.empty((2, 2))
+    jac[0, 0], jac[1, 0] = su - s0, tu - t0
+    jac[0, 1], jac[1, 1] = sv - s0, tv - t0
+    left = np.empty((2, 2))
+    for i in range(2):
+        for j in range(2):
+            left[i, j] = _fma(jac[i, 1], cov[1, j], jac[i, 0] * cov[0, j])
+    out = np.empty((2, 2))
+    for i in range(2):
+        for j in range(2):
+            out[i, j] = _fma(left[i, 1], jac[j, 1], left[i, 0] * jac[j, 0])
+    return axis, basis, out
+
+
+@_njit
+def across_extent(
+    cracks: np.ndarray, axis: np.ndarray, basis: np.ndarray, vec: np.ndarray, cx: float, cy: float, fx: float,
+    fy: float,
+) -> tuple[np.ndarray, np.ndarray, float, float]:  # fmt: skip
+    """:func:`symfruit.core.raster.across_sight` after its ``eigh``: the outline's points ``cracks`` (m, 2), pixels,
+    in tangent coordinates, their least and greatest values along ``e1`` and ``e2`` (2,) each, and their widths along
+    the eigenvectors ``vec`` (2, 2, columns), the first and the second: each value the twin's (``edge @ vec`` as
+    OpenBLAS's multiply-adds)."""
+    lo = np.full(2, np.inf)
+    hi = np.full(2, -np.inf)
+    p_lo = np.full(2, np.inf)
+    p_hi = np.full(2, -np.inf)
+    nan = False
+    for i in range(cracks.shape[0]):
+        s, t = _tangent(cracks[i, 0], cracks[i, 1], axis, basis, cx, cy, fx, fy)
+        if s != s or t != t:
+            nan = True
+        lo[0], hi[0] = min(lo[0], s), max(hi[0], s)
+        lo[1], hi[1] = min(lo[1], t), max(hi[1], t)
+        for j in range(2):
+            p = _fma(t, vec[1, j], s * vec[0, j])
+            if p != p:
+                nan = True
+            p_lo[j], p_hi[j] = min(p_lo[j], p), max(p_hi[j], p)
+    if nan:  # numpy's reductions carry a NaN through
+        lo[:], hi[:], p_lo[:], p_hi[:] = np.nan, np.nan, np.nan, np.nan
+    return lo, hi, p_hi[0] - p_lo[0], p_hi[1] - p_lo[1]
+
+
+@_njit
+def _lesser(a: float, b: float) -> float:
+    """``np.minimum`` of two numbers (:func:`symfruit.core.candidates._lesser`): NaN where either is, ``b`` where
+    they are equal."""
+    return a if a < b or a != a else b
+
+
+@_njit
+def _greater(a: float, b: float) -> float:
+    """``np.maximum`` of two numbers (:func:`symfruit.core.candidates._greater`)."""
+    return a if a > b or a != a else b
+
+
+@_njit
+def constrain_box(
+    lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray, front: float, scale: float,
+    cone: np.ndarray, intrinsics: np.ndarray, share: float,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.candidates.constrain_box` (its twin, in Python floats): the same operations in the same
+    order on the same IEEE doubles, so the same box. ``scale`` is ``REACH / max(contour, REACH_FLOOR)``; ``cone`` the
+    silhouette's pixel box ``(u_min, v_min, u_max, v_max)``, or empty for none; ``intrinsics`` ``(cx, cy, fx, fy)``;
+    ``share`` the pull's."""
+    s_lo = np.empty(3)
+    s_hi = np.empty(3)
+    out_lo = np.empty(3)
+    out_hi = np.empty(3)
+    for i in range(3):
+        s_lo[i] = seen_lo[i]
+    s_lo[2] = front
+    for i in range(3):
+        s_hi[i] = _greater(seen_hi[i], s_lo[i])
+        reach = scale * (s_hi[i] - s_lo[i])
+        out_lo[i] = _lesser(_greater(lo[i], s_hi[i] - reach), s_lo[i])
+        out_hi[i] = _greater(_lesser(hi[i], s_lo[i] + reach), s_hi[i])
+    out_lo[2] = front
+    top = front + 1e-4
+    out_hi[2] = top if top > out_hi[2] else out_hi[2]  # Python's max(out_hi[2], top): the first unless top is larger
+    if cone.shape[0] == 4:
+        cx, cy, fx, fy = intrinsics[0], intrinsics[1], intrinsics[2], intrinsics[3]
+        z0, z1 = out_lo[2], out_hi[2]
+        a, b = (cone[0] - cx) / fx, (cone[1] - cy) / fy
+        bound_lo0, bound_lo1 = _lesser(a * z0, a * z1), _lesser(b * z0, b * z1)
+        a, b = (cone[2] - cx) / fx, (cone[3] - cy) / fy
+        bound_hi0, bound_hi1 = _greater(a * z0, a * z1), _greater(b * z0, b * z1)
+        out_lo[0] = _lesser(s_lo[0], out_lo[0] + share * _greater(bound_lo0 - out_lo[0], 0.0))
+        out_hi[0] = _greater(s_hi[0], out_hi[0] - share * _greater(out_hi[0] - bound_hi0, 0.0))
+        out_lo[1] = _lesser(s_lo[1], out_lo[1] + share * _greater(bound_lo1 - out_lo[1], 0.0))
+        out_hi[1] = _greater(s_hi[1], out_hi[1] - share * _greater(out_hi[1] - bound_hi1, 0.0))
+    return out_lo, out_hi
+
+
+@_njit
+def cone_rays(points: np.ndarray, cone: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits.fit_cone_ellipsoid`'s rays: every point (n, 3) over its depth (n, 3), each ray's
+    ``r^T C r`` (n,) for the viewing cone ``cone`` (3, 3) and the depths (n,), contiguous; the twin's values (its
+    ``rays @ cone`` as OpenBLAS's two multiply-adds from the first term, the row sums of three left to right)."""
+    n = points.shape[0]
+    rays = np.empty((n, 3))
+    ray_cone = np.empty(n)
+    z = np.empty(n)
+    for i in range(n):
+        depth = points[i, 2]
+        r0, r1, r2 = points[i, 0] / depth, points[i, 1] / depth, depth / depth
+        rays[i, 0], rays[i, 1], rays[i, 2] = r0, r1, r2
+        c0 = _fma(r2, cone[2, 0], _fma(r1, cone[1, 0], r0 * cone[0, 0]))
+        c1 = _fma(r2, cone[2, 1], _fma(r1, cone[1, 1], r0 * cone[0, 1]))
+        c2 = _fma(r2, cone[2, 2], _fma(r1, cone[1, 2], r0 * cone[0, 2]))
+        ray_cone[i] = c0 * r0 + c1 * r1 + c2 * r2
+        z[i] = depth
+    return rays, ray_cone, z
 
 
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------

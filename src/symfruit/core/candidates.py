@@ -27,6 +27,7 @@ Closed candidates (sphere, ellipsoid, solid of revolution) are measured against 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -46,6 +47,7 @@ from .fits import (
     outline_radii,
     revolution_box,
 )
+from .kernels import compiled
 from .points import as_points, bounds
 from .raster import Silhouette, View
 from .symmetry import complete_by_symmetry
@@ -112,6 +114,18 @@ def constrain_box(
        edge is a contour; with occlusion information the box is where the fruit can project at all, and
        ``pull = 1`` brings every side back to it).
     """
+    if (jit := compiled()) is not None:  # the compiled twin of what follows (issue 19, nineteenth round)
+        arrays = [np.asarray(x, dtype=np.float64) for x in (lo, hi, seen_lo, seen_hi)]
+        if all(x.shape == (3,) for x in arrays):
+            if cone is None:
+                box, intrinsics, share = _NO_CONE, _NO_CONE, 0.0
+            else:
+                (u_lo, v_lo, u_hi, v_hi), camera = cone
+                box = np.array((u_lo, v_lo, u_hi, v_hi), dtype=np.float64)
+                intrinsics = np.array((camera.cx, camera.cy, camera.fx, camera.fy), dtype=np.float64)
+                share = float(contour if pull is None else pull)
+            out = jit.constrain_box(*arrays, float(front), REACH / max(contour, REACH_FLOOR), box, intrinsics, share)
+            return out[0], out[1]
     # Component by component in Python floats (issue 19, sixteenth round): the arithmetic of numpy's (3,) arrays
     # (np.minimum / np.maximum as _lesser / _greater: NaN carried, the second of equals), without some 40 numpy
     # calls' overhead on three numbers (about 40 calls a frame).
@@ -140,6 +154,11 @@ def constrain_box(
     return np.array(out_lo), np.array(out_hi)
 
 
+#: No silhouette box for :func:`symfruit.core._jit.constrain_box` (read-only).
+_NO_CONE = np.empty(0)
+_NO_CONE.flags.writeable = False
+
+
 def _lesser(a: float, b: float) -> float:
     """``np.minimum`` of two numbers: NaN where either is, ``b`` where they are equal (as for signed zeros)."""
     return a if a < b or a != a else b
@@ -156,12 +175,15 @@ def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.
     ``reach[1]`` times the seen box's largest lateral side (or ``width``, the silhouette's, when larger), and
     (``lateral``) no lateral face beyond the seen box by more than ``reach[0]`` times the seen extent along that
     axis."""
-    seen = seen_hi - seen_lo
-    if hi[2] - seen_hi[2] > reach[1] * max(seen[0], seen[1], width):
+    # In Python floats (issue 19, nineteenth round): the same differences and products as numpy's on the (3,)
+    # arrays, np.maximum as _greater
+    (l0, l1, _), (h0, h1, h2) = np.asarray(lo, dtype=np.float64).tolist(), np.asarray(hi, dtype=np.float64).tolist()
+    (s0, s1, _), (t0, t1, t2) = seen_lo.tolist(), seen_hi.tolist()
+    seen = (t0 - s0, t1 - s1)
+    if h2 - t2 > reach[1] * max(seen[0], seen[1], width):
         return False
     if lateral:
-        over = np.maximum(seen_lo[:2] - lo[:2], hi[:2] - seen_hi[:2])
-        return bool(np.all(over <= reach[0] * seen[:2]))
+        return _greater(s0 - l0, h0 - t0) <= reach[0] * seen[0] and _greater(s1 - l1, h1 - t1) <= reach[0] * seen[1]
     return True
 
 
@@ -254,7 +276,9 @@ def candidates(
         try:
             for shape in fitter(fit):
                 lo, hi = np.asarray(shape.lo, dtype=np.float64), np.asarray(shape.hi, dtype=np.float64)
-                if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))) or (hi - lo).max() > 10 * extent:
+                lo_, hi_ = lo.tolist(), hi.tolist()  # Python floats: the same tests as numpy's on (3,) arrays
+                finite = all(map(math.isfinite, lo_)) and all(map(math.isfinite, hi_))
+                if not finite or max(b - a for a, b in zip(lo_, hi_, strict=True)) > 10 * extent:
                     continue  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
                 if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible,
                                                             lateral=obs.extent is None, width=width):  # fmt: skip

@@ -14,6 +14,7 @@ of revolution) and the neighbourhoods of :func:`surface_noise` run as compiled k
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -939,6 +940,68 @@ _GRID_TAUS = np.tile(np.linspace(-4.0, 4.0, 7), 7)
 _GRID_DEPTHS.flags.writeable = _GRID_TAUS.flags.writeable = False
 
 
+#: LAPACK's relative machine precision (``dlamch('E')``, half numpy's ``eps``) and its square, as ``dsterf`` uses them.
+_LAPACK_EPS = 2.0**-53
+_LAPACK_EPS2 = _LAPACK_EPS * _LAPACK_EPS
+
+
+def _plain(*values: float) -> bool:
+    """Whether every value is zero or of a magnitude within 1e-100 .. 1e100: where LAPACK scales nothing and OpenBLAS
+    divides nothing by a tiny pivot's reciprocal, so :func:`eigenvalues2` and :func:`solve2` repeat it."""
+    return all(v == 0.0 or 1e-100 < abs(v) < 1e100 for v in values)
+
+
+def eigenvalues2(a: float, b: float, c: float) -> tuple[float, float] | None:
+    """The eigenvalues of the symmetric matrix ``[[a, b], [b, c]]``, least first, as ``np.linalg.eigvalsh`` gives
+    them (LAPACK's ``dsyevd``, whose ``dsterf`` splits off a negligible ``b`` and otherwise takes a 2x2 block's
+    eigenvalues from ``dlae2``): the same values bit for bit (tested against numpy), in Python floats, about 1 us
+    against the call's 20-30 (issue 19, nineteenth round). None where LAPACK would scale the matrix (a value beyond
+    :func:`_plain`'s range) or one is not finite: ask numpy there."""
+    if not _plain(a, b, c):
+        return None
+    if b == 0.0 or abs(b) <= (math.sqrt(abs(a)) * math.sqrt(abs(c))) * _LAPACK_EPS or \
+            b * b <= _LAPACK_EPS2 * abs(a * c):  # fmt: skip
+        return (a, c) if a <= c else (c, a)
+    b = math.sqrt(b * b)  # dsterf squares the off-diagonal and hands dlae2 its root
+    sm, adf, ab = a + c, abs(a - c), abs(b + b)
+    big, small = (a, c) if abs(a) > abs(c) else (c, a)
+    if adf > ab:
+        rt = adf * math.sqrt(1.0 + (ab / adf) ** 2)
+    elif adf < ab:
+        rt = ab * math.sqrt(1.0 + (adf / ab) ** 2)
+    else:
+        rt = ab * math.sqrt(2.0)
+    if sm < 0.0:
+        rt1 = 0.5 * (sm - rt)
+        rt2 = (big / rt1) * small - (b / rt1) * b
+    elif sm > 0.0:
+        rt1 = 0.5 * (sm + rt)
+        rt2 = (big / rt1) * small - (b / rt1) * b
+    else:
+        rt1, rt2 = 0.5 * rt, -0.5 * rt
+    return (rt1, rt2) if rt1 <= rt2 else (rt2, rt1)
+
+
+def solve2(a00: float, a01: float, a10: float, a11: float, b0: float, b1: float) -> tuple[float, float] | None:
+    """``np.linalg.solve([[a00, a01], [a10, a11]], [b0, b1])`` as OpenBLAS's ``dgesv`` works it out (partial
+    pivoting, the column below the pivot multiplied by the pivot's reciprocal, the triangular solves by division):
+    the same values bit for bit (tested against numpy), in Python floats (issue 19, nineteenth round). Raises
+    ``np.linalg.LinAlgError`` where numpy does (an exactly zero pivot); None where a value is not finite or beyond
+    :func:`_plain`'s range: ask numpy there."""
+    if not _plain(a00, a01, a10, a11, b0, b1):
+        return None
+    if abs(a10) > abs(a00):
+        a00, a01, a10, a11, b0, b1 = a10, a11, a00, a01, b1, b0
+    if a00 == 0.0:
+        raise np.linalg.LinAlgError("Singular matrix")
+    low = a10 * (1.0 / a00)
+    u11 = a11 - low * a01
+    if u11 == 0.0:
+        raise np.linalg.LinAlgError("Singular matrix")
+    x1 = (b1 - low * b0) / u11
+    return (b0 - a01 * x1) / a00, x1
+
+
 def cone_thickness_bound(cone: np.ndarray, min_thickness: float) -> float:
     """The largest shape parameter ``tau`` of :func:`cone_ellipsoid` whose ellipsoid is at least ``min_thickness``
     of the outline's narrowest width deep along the line of sight.
@@ -951,11 +1014,18 @@ def cone_thickness_bound(cone: np.ndarray, min_thickness: float) -> float:
     """
     if min_thickness <= 0:
         return float("inf")
-    a, b, c = cone[:2, :2], cone[:2, 2], cone[2, 2]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        k = float(b @ np.linalg.solve(a, b) - c)
-        top = float(np.linalg.eigvalsh(a)[-1])
-        narrow = np.sqrt(k / top) if k > 0 and top > 0 else float("nan")
+    (a00, a01, b0), (a10, a11, b1), (_, _, c) = np.asarray(cone, dtype=np.float64).tolist()
+    # numpy's solve and eigvalsh of the 2x2 block by their closed forms where those repeat LAPACK's values (Python
+    # floats: b @ x, a dot of two, sums left to right as numpy's does)
+    x = solve2(a00, a01, a10, a11, b0, b1)
+    values = eigenvalues2(a00, a10, a11)  # eigvalsh reads the lower triangle
+    if x is None or values is None:
+        a, b = np.asarray(cone, dtype=np.float64)[:2, :2], np.asarray(cone, dtype=np.float64)[:2, 2]
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x, values = tuple(np.linalg.solve(a, b).tolist()), tuple(np.linalg.eigvalsh(a).tolist())
+    k = b0 * x[0] + b1 * x[1] - c
+    top = values[1]
+    narrow = math.sqrt(k / top) if k > 0 and top > 0 else float("nan")
     if not np.isfinite(narrow) or narrow <= 0:
         return float("inf")
     return float(-2.0 * np.log(min_thickness * narrow))
@@ -1047,14 +1117,18 @@ def fit_cone_ellipsoid(
     points = points[:: max(1, -(-len(points) // max_points))]
     cone = np.asarray(cone, dtype=np.float64)
     axis = np.asarray(axis, dtype=np.float64)
-    rays = points / points[:, 2:3]
-    z = points[:, 2]
+    jit = compiled()
+    if jit is not None:  # the compiled twin of the rays, their r^T C r and the depths below: the same values
+        rays, ray_cone, z = jit.cone_rays(points, np.ascontiguousarray(cone))
+    else:
+        rays = points / points[:, 2:3]
+        z = points[:, 2]
+        ray_cone = ((rays @ cone) * rays).sum(axis=1)
     grid = _cone_grid(front, extent)
     tau_max = cone_thickness_bound(cone, min_thickness)
     np.minimum(grid[:, 3], tau_max, out=grid[:, 3])
 
     cone_inv = np.linalg.inv(cone)
-    ray_cone = ((rays @ cone) * rays).sum(axis=1)
     step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
     steps = np.diag(step)
     at = np.empty((5, 4))
@@ -1077,7 +1151,7 @@ def fit_cone_ellipsoid(
         a = np.abs(res)
         return np.where(a <= huber, 0.5 * res * res, huber * (a - 0.5 * huber)).sum(axis=-1)
 
-    if (jit := compiled()) is not None:  # the compiled twin of the grid search, the loop and the back face below
+    if jit is not None:  # the compiled twin of the grid search, the loop and the back face below
         cone_c, axis_c = np.ascontiguousarray(cone), np.ascontiguousarray(axis)
         p, both, status = jit.cone_fit(
             grid, cone_c, axis_c, rays, ray_cone, np.ascontiguousarray(z), step, huber, iterations, tolerance, tau_max

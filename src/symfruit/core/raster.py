@@ -542,6 +542,13 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     if not region.mask.any():
         raise InputError("the region is empty")
     _, mu, cov = _moments(region)
+    if (jit := compiled()) is not None:  # the compiled twin of what follows but the eigh: the same values
+        intrinsics = (float(camera.cx), float(camera.cy), float(camera.fx), float(camera.fy))
+        axis, basis, carried = jit.across_frame(float(mu[0]), float(mu[1]), cov, *intrinsics)
+        _, vec = np.linalg.eigh(carried)
+        lo, hi, minor, major = jit.across_extent(outline_cracks(region), axis, basis, np.ascontiguousarray(vec),
+                                                 *intrinsics)  # fmt: skip
+        return Across(axis, basis, lo, hi, float(minor), float(major))
     axis = camera.rays(mu[0], mu[1]).reshape(3)
     axis = axis / np.linalg.norm(axis)
     e1 = np.array([axis[2], 0.0, -axis[0]])
