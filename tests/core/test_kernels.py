@@ -2519,8 +2519,8 @@ def test_the_segmenters_ground_colour_is_the_twins(seed, strided):
 @settings(max_examples=100, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([np.float32, np.float64]))
 def test_the_segmenters_medians_are_the_twins(seed, dtype):
-    """Values with ties, of odd and even counts (one included; none gives NaN), some with a NaN: ``median_values`` (float64)
-    and ``median_values32`` (float32) give ``core.points.median``'s value to the bit, NaN where it is NaN."""
+    """Values with ties, of odd and even counts (one included; none gives NaN), some with a NaN: ``median_values``
+    (float64) and ``median_values32`` (float32) give ``core.points.median``'s value to the bit, NaN where it is NaN."""
     from symfruit.core.points import median
 
     rng = np.random.default_rng(seed)
