@@ -2642,3 +2642,244 @@ def test_cone_rays_are_the_twins(seed, n, strided):
     twin_rays = pts / pts[:, 2:3]
     assert _ulps(rays, twin_rays) <= 4 and _ulps(ray_cone, ((twin_rays @ cone) * twin_rays).sum(axis=1)) <= 4
     assert np.array_equal(z, pts[:, 2]) and z.flags.c_contiguous and rays.flags.c_contiguous
+
+
+# --- stop 39, segmenter
+
+
+def _odd_depths(rng, shape, dtype):
+    """Depths with what a depth image may hold beside metres: 0, negatives, -0.0, NaN and both infinities."""
+    z = rng.uniform(0.2, 3.0, shape).astype(dtype)
+    special = np.array([0.0, -0.0, -1.0, np.nan, np.inf, -np.inf], dtype)
+    pick = rng.random(shape) < 0.2
+    z[pick] = rng.choice(special, int(pick.sum()))
+    return z
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.float32, np.float64]))
+def test_the_segmenters_depth_reads_are_the_twins(seed, dtype):
+    """A depth image with invalid values of every kind, read through ``_Depth`` as windows (contiguous and strided)
+    and at flat indices: the same float64 values to the bit with the kernels and with the twin's ``np.where``."""
+    from symfruit.segment.colour import _Depth
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    z = np.ascontiguousarray(_odd_depths(rng, (h, w), dtype))
+    r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    step = int(rng.integers(1, 4))
+    at = rng.integers(0, h * w, int(rng.integers(0, 100)))
+    for window in ((slice(r0, h), slice(c0, w)), (slice(None, None, step), slice(None, None, step))):
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, lambda win=window: _Depth(z)[win])
+        assert fast.dtype == twin.dtype == np.float64
+        np.testing.assert_array_equal(fast.view(np.uint64), twin.view(np.uint64))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: _Depth(z).take(at))
+    assert fast.dtype == twin.dtype == np.float64
+    np.testing.assert_array_equal(fast.view(np.uint64), twin.view(np.uint64))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_segmenters_ground_colour_is_the_twins(seed, strided):
+    """Random colours (and yellow-green ones near the hue bounds), whole or strided: the same ground-colour pixels."""
+    from symfruit.segment.colour import _ground
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    image = rng.integers(0, 256, (2 * h, 2 * w, 4), dtype=np.uint8)
+    yellow = rng.random((2 * h, 2 * w)) < 0.5
+    image[yellow, 2] = image[yellow, 2] // 4
+    c = image[::2, 1::2, :3] if strided else np.ascontiguousarray(image[:h, :w, :3])
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _ground, c)
+    assert fast.dtype == twin.dtype == bool
+    np.testing.assert_array_equal(fast, twin)
+
+
+@settings(max_examples=100, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.float32, np.float64]))
+def test_the_segmenters_medians_are_the_twins(seed, dtype):
+    """Values with ties, of odd and even counts (one included; none gives NaN), some with a NaN: ``median_values``
+    (float64) and ``median_values32`` (float32) give ``core.points.median``'s value to the bit, NaN where it is NaN."""
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 60))
+    kernel = _jit.median_values if dtype == np.float64 else _jit.median_values32
+    assert np.isnan(kernel(np.zeros(0, dtype)))  # none: NaN (numpy's median warns and gives NaN)
+    x = rng.choice(rng.uniform(0.0, 2.0, max(n // 3, 1)), n).astype(dtype)
+    if rng.random() < 0.1:
+        x[int(rng.integers(0, n))] = np.nan
+    want = median(x)
+    got = kernel(x.copy())
+    if np.isnan(want):
+        assert np.isnan(got)
+    else:
+        assert type(want)(got) == want and np.dtype(type(want)) == np.dtype(dtype)
+
+
+def _depth_patch(rng, h, w):
+    """A window's depths with holes (0) and a step, and a random mask over it."""
+    z = rng.uniform(1.0, 1.1, (h, w))
+    z[rng.random((h, w)) < 0.15] = 0.0
+    z[: int(rng.integers(0, h + 1))] += rng.choice([0.0, 0.05])
+    return z, rng.random((h, w)) < rng.uniform(0.0, 1.0)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_segmenters_masked_depth_tests_are_the_twins(seed):
+    """Random masks over depths with holes and steps: ``_fruit_sized``, ``_largest_area`` and ``_depth_consistent``
+    with the kernels and with the twins give the same answers, areas and pixels; ``mask_centre`` the mean row and
+    column of ``np.nonzero`` to the bit."""
+    from symfruit.segment.colour import SegmentSettings, _depth_consistent, _fruit_sized, _largest_area
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    z, mask = _depth_patch(rng, h, w)
+    part = mask & (rng.random((h, w)) < 0.5)
+    s = SegmentSettings(round_fruit=True, min_diameter=float(rng.uniform(0.005, 0.03)))
+    focal = float(rng.uniform(300.0, 2000.0))
+    with pytest.MonkeyPatch.context() as mp:
+        assert len({_both(mp, _fruit_sized, mask, z, s, focal, 4.0, 1.5)[k] for k in (0, 1)}) == 1
+        fast, twin = _both(mp, _largest_area, mask, z, s, focal, 1.5)
+        assert fast == twin
+        fast, twin = _both(mp, _depth_consistent, mask, part, z, 0.015)
+        np.testing.assert_array_equal(fast, twin)
+    n, mr, mc = _jit.mask_centre(mask)
+    rows, cols = np.nonzero(mask)
+    assert n == len(rows)
+    if n:
+        assert mr == rows.mean() and mc == cols.mean()
+
+
+def _blush_scene(rng, front: bool):
+    """A red crescent (piece 1 of ``owner``) on a window's left with yellow-green skin beside it, in front of the
+    crescent's depth (``front``) or at it, the rest leaf green at the crescent's depth; noise, holes and a piece of
+    another fruit's pixels in the ring."""
+    h, w = (int(x) for x in rng.integers(30, 60, 2))
+    yy, xx = np.mgrid[0:h, 0:w]
+    cy, cx, r = h / 2, w / 2, min(h, w) / 3
+    disc = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
+    hull = disc & (xx < cx - 0.5 * r)
+    color = np.zeros((h, w, 3), np.uint8)
+    color[...] = (60, 140, 50)  # leaf green
+    color[disc] = (200, 190, 40)  # ground colour
+    color[hull] = (200, 30, 30)
+    z = 2.0 + rng.normal(0.0, 0.002, (h, w))
+    z[disc & ~hull] -= 0.05 if front else 0.0
+    z[rng.random((h, w)) < 0.1] = 0.0
+    owner = np.zeros((h, w), np.int16)
+    owner[hull] = 1
+    owner[disc & (yy < cy - 0.8 * r)] = int(rng.choice([0, 2]))
+    return hull, z, color, owner
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_segmenters_blush_rim_is_the_twins(seed, front):
+    """A blush crescent beside ground colour in front of it (the rim's test holds) or at its depth (it does not), in
+    the middle of an image or against its border: ``_blush_rim`` with the kernel and with the twin gives the same
+    window, mask and depths."""
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
+
+    rng = np.random.default_rng(seed)
+    hull, z, color, owner = _blush_scene(rng, front)
+    h, w = hull.shape
+    r0, c0 = int(rng.integers(0, 10)), int(rng.integers(0, 10))
+    big_z = np.zeros((h + 20, w + 20))
+    big_z[r0 : r0 + h, c0 : c0 + w] = z
+    big_c = np.zeros((h + 20, w + 20, 3), np.uint8)
+    big_c[r0 : r0 + h, c0 : c0 + w] = color
+    big_o = np.zeros((h + 20, w + 20), np.int16)
+    big_o[r0 : r0 + h, c0 : c0 + w] = owner
+    rows, cols = np.nonzero(hull)
+    box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
+    part = hull[box]
+    sl = (slice(box[0].start + r0, box[0].stop + r0), slice(box[1].start + c0, box[1].stop + c0))
+    z_part = big_z[sl][part & (big_z[sl] > 0)]
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _blush_rim, sl, part, z_part, _Depth(big_z), big_c, s, big_o, 1)
+    assert fast[0] == twin[0]
+    np.testing.assert_array_equal(fast[1], twin[1])
+    np.testing.assert_array_equal(fast[2].view(np.uint64), twin[2].view(np.uint64))
+    if front:
+        assert fast[0] != sl  # the test held: the ring in front was taken
+    else:
+        assert fast[0] == sl
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_segmenters_region_medians_are_the_twins(seed):
+    """Regions of random sizes (one pixel to many, some without depth) with depths and rednesses: ``_one_fruit`` with
+    the kernel's medians and with the twin's, the same regions one fruit and ripe."""
+    from symfruit.segment.colour import SegmentSettings, _one_fruit
+
+    rng = np.random.default_rng(seed)
+    sizes = rng.integers(1, 400, int(rng.integers(0, 12)))
+    first = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
+    depth = np.where(rng.random(int(first[-1])) < 0.3, 0.0, rng.uniform(1.0, 2.0, int(first[-1])))
+    for i in np.flatnonzero(rng.random(len(sizes)) < 0.2):
+        depth[first[i] : first[i + 1]] = 0.0
+    red = rng.choice(np.array([0.1, 0.2, 0.25, 0.5], np.float32), int(first[-1]))
+    s = SegmentSettings(round_fruit=True, ripe_median=float(rng.choice([0.2, 0.25, 0.3])))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _one_fruit, first, sizes, depth, red, s, 900.0, 1.5)
+    for a, b in zip(fast, twin, strict=True):
+        np.testing.assert_array_equal(a, b)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_merges_near_pieces_by_table_are_the_rows(seed):
+    """Random pieces (boxes near and apart, small and large): the pairs the merge tests, from one table and row by
+    row, the same and in the same order."""
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    pieces = []
+    for _ in range(int(rng.integers(1, 40))):
+        r0, c0 = (int(x) for x in rng.integers(0, 300, 2))
+        h, w = (int(x) for x in rng.integers(1, 40, 2))
+        pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), rng.random((h, w)) < 0.7, 1))
+    table = colour._near_pieces(pieces)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(colour, "NEAR_TABLE", 0)
+        rows = colour._near_pieces(pieces)
+    assert [table(i) for i in range(len(pieces))] == [rows(i) for i in range(len(pieces))]
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_ground_pieces_convex_outline_is_the_twins(seed):
+    """A disc with a bite out of it (a leaf across it: nearer, farther or at the disc's depth, its rim without depth),
+    with holes in the depth and against the window's edges: ``_convex_outline`` with the kernel's count of hidden
+    pixels and with the twin's minimum filter, the same answer; the count itself the twin's."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import GAP_PX, _convex_outline, _hull_mask, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 50, 2))
+    yy, xx = np.mgrid[0:h, 0:w]
+    cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(3, max(h, w))
+    disc = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
+    bite = np.abs(xx - cx - rng.uniform(-r, r)) < rng.uniform(1, r)
+    part = disc & ~bite
+    depth = rng.uniform(1.0, 1.02, (h, w))
+    depth[bite] += rng.choice([-0.1, 0.0, 0.1])
+    depth[rng.random((h, w)) < rng.uniform(0.0, 0.6)] = 0.0
+    vertices = _hull_vertices(part)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _convex_outline, part, vertices, depth, 0.015)
+    assert fast == twin
+    if vertices is not None:
+        rest = _hull_mask(vertices, part) & ~part
+        front = float(rng.uniform(0.9, 1.1))
+        near = ndimage.minimum_filter(np.where(depth > 0, depth, np.inf), size=GAP_PX, mode="nearest")
+        want = int((rest & (np.where(depth > 0, depth, near) < front)).sum())
+        assert _jit.hidden_count(rest, depth, front, GAP_PX) == want

@@ -4528,3 +4528,283 @@ def least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: fl
         x = diameter_px_m / z
         out[k] = quarter * (x * x)
     return out
+
+
+# --- issue 19, nineteenth round (stop 39): the colour segmenter ---
+
+
+@_njit
+def depth_window(given: np.ndarray) -> np.ndarray:
+    """:class:`symfruit.segment.colour._Depth`'s window: (h, w) float64, each depth of ``given`` (h, w) float, any
+    strides, where it is positive and below infinity (NaN is neither), else 0: the values of
+    ``np.where(_usable(given), given.astype(np.float64), 0.0)`` (the comparisons in the depth's own type, the cast
+    exact), in one pass instead of five."""
+    h, w = given.shape
+    out = np.empty((h, w), np.float64)
+    for r in range(h):
+        for c in range(w):
+            v = given[r, c]
+            out[r, c] = np.float64(v) if v > 0 and v < np.inf else 0.0
+    return out
+
+
+@_njit
+def depth_at(given: np.ndarray, flat: np.ndarray) -> np.ndarray:
+    """:meth:`symfruit.segment.colour._Depth.take`: the depths of ``given`` (n,) float at ``flat`` (k,), each as
+    float64 where positive and below infinity, else 0 (the same values)."""
+    out = np.empty(flat.shape[0], np.float64)
+    for i in range(flat.shape[0]):
+        v = given[flat[i]]
+        out[i] = np.float64(v) if v > 0 and v < np.inf else 0.0
+    return out
+
+
+@_njit
+def ground_pixels(color: np.ndarray, ground_hue: int, leaf_hue: int, dark: int) -> np.ndarray:
+    """:func:`symfruit.segment.colour._ground` of ``color`` (h, w, >= 3) uint8, any strides: (h, w) bool, blue the
+    least channel, the largest a third above it and above ``dark``, of a hue from ``ground_hue`` up to (not
+    including) ``leaf_hue`` degrees, by the twin's whole-number tests (no value of 8-bit channels overflows its int16
+    arithmetic: the same pixels)."""
+    h, w = color.shape[0], color.shape[1]
+    out = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            red, green, blue = np.int64(color[r, c, 0]), np.int64(color[r, c, 1]), np.int64(color[r, c, 2])
+            top = max(red, green)
+            gb, rb = green - blue, red - blue
+            out[r, c] = (
+                blue <= min(red, green)
+                and 3 * (top - blue) >= top
+                and top > dark
+                and 60 * gb >= ground_hue * rb
+                and (red >= green or 60 * (green - red) < (leaf_hue - 60) * gb)
+            )
+    return out
+
+
+@_njit
+def median_values(values: np.ndarray) -> float:
+    """``core.points.median`` of ``values`` (n,) float64 (overwritten: reordered): NaN when a value is NaN or there is
+    none, else the middle value (:func:`select`) or the mean of the middle two, halved as the twin halves it."""
+    n = values.shape[0]
+    if n == 0:
+        return np.nan
+    for i in range(n):
+        if np.isnan(values[i]):
+            return np.nan
+    half = n // 2
+    select(values, half)
+    if n % 2:
+        return values[half]
+    below = values[0]
+    for i in range(1, half):
+        below = max(below, values[i])
+    return (below + values[half]) / 2.0
+
+
+@_njit
+def masked_depths(mask: np.ndarray, z: np.ndarray) -> tuple[int, np.ndarray]:
+    """The pixels of ``mask`` (h, w) bool and the depths ``z[mask & (z > 0)]`` of ``z`` (h, w) float64, in raster
+    order (the twin's boolean index): their count and the (k,) depths."""
+    h, w = mask.shape
+    n = 0
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                n += 1
+                k += z[r, c] > 0
+    out = np.empty(k, np.float64)
+    j = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c] and z[r, c] > 0:
+                out[j] = z[r, c]
+                j += 1
+    return n, out
+
+
+@_njit
+def masked_median(mask: np.ndarray, z: np.ndarray) -> tuple[int, int, float]:
+    """The count of ``mask`` (h, w) bool's pixels, of those with depth (``z`` (h, w) float64 above 0), and
+    ``core.points.median`` of their depths (NaN without any): the twin's ``mask.sum()``, ``len(z[mask & (z > 0)])``
+    and its median, the same values."""
+    n, values = masked_depths(mask, z)
+    return n, values.shape[0], median_values(values)
+
+
+@_njit
+def depth_consistent(hull: np.ndarray, part: np.ndarray, z: np.ndarray, jump: float) -> np.ndarray:
+    """:func:`symfruit.segment.colour._depth_consistent`: ``part | (hull & ~off)``, ``off`` the pixels with depth
+    farther than ``jump`` from the median depth of ``part``'s pixels with depth (``hull`` itself when none has): the
+    twin's median and comparisons, the same pixels (a copy)."""
+    _, values = masked_depths(part, z)
+    if values.shape[0] == 0:
+        return hull.copy()
+    zm = median_values(values)
+    h, w = hull.shape
+    out = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            d = z[r, c]
+            out[r, c] = part[r, c] or (hull[r, c] and not (d > 0 and abs(d - zm) > jump))
+    return out
+
+
+@_njit
+def mask_centre(mask: np.ndarray) -> tuple[int, float, float]:
+    """The count of ``mask`` (h, w) bool's pixels and the mean of their rows and of their columns: ``rows.mean()``,
+    ``cols.mean()`` of ``np.nonzero(mask)`` (whole numbers summed exactly in any order below 2**53, then one
+    division by the count, as numpy's mean of integers; NaN without a pixel)."""
+    h, w = mask.shape
+    n = 0
+    sr = 0
+    sc = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                n += 1
+                sr += r
+                sc += c
+    if n == 0:
+        return 0, np.nan, np.nan
+    return n, float(sr) / float(n), float(sc) / float(n)
+
+
+@_njit
+def blush_rim(
+    part: np.ndarray,
+    z: np.ndarray,
+    color: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    pad: int,
+    z_part: np.ndarray,
+    jump: float,
+    ground_hue: int,
+    leaf_hue: int,
+    dark: int,
+) -> np.ndarray:
+    """:func:`symfruit.segment.colour._blush_rim`'s test in its padded window (``part`` the red part (h, w) bool,
+    ``z`` depth float64, ``color`` uint8, ``owner`` ids, ``z_part`` (n,) the part's depths, left as they are, whose
+    median is ``zm``): the ring of ground-colour
+    pixels (free: ``owner`` 0 or ``k``) and the other pixels with depth within ``pad`` of the part and not of it, at
+    least 20 of each, the ring's median depth in front of ``zm`` by more than ``jump`` and the others' within
+    ``jump`` of it: then the ring's pixels within ``jump`` of the ring's median depth ((h, w) bool), else a (0, 0)
+    array. The twin's pixels, medians and comparisons: the same answer."""
+    h, w = part.shape
+    beside = np.empty((h, w), np.bool_)
+    square_filter(part, pad, False, beside)
+    ground = ground_pixels(color, ground_hue, leaf_hue, dark)
+    n_ring = 0
+    n_other = 0
+    for r in range(h):
+        for c in range(w):
+            if beside[r, c] and not part[r, c] and z[r, c] > 0:
+                if ground[r, c]:
+                    n_ring += owner[r, c] == 0 or owner[r, c] == k
+                else:
+                    n_other += 1
+    none = np.zeros((0, 0), np.bool_)
+    if n_ring < 20 or n_other < 20:
+        return none
+    ring_z = np.empty(n_ring, np.float64)
+    other_z = np.empty(n_other, np.float64)
+    i = 0
+    j = 0
+    for r in range(h):
+        for c in range(w):
+            if beside[r, c] and not part[r, c] and z[r, c] > 0:
+                if ground[r, c]:
+                    if owner[r, c] == 0 or owner[r, c] == k:
+                        ring_z[i] = z[r, c]
+                        i += 1
+                else:
+                    other_z[j] = z[r, c]
+                    j += 1
+    zm = median_values(z_part.copy())
+    front = median_values(ring_z)
+    if zm - front <= jump or abs(zm - median_values(other_z)) > jump:
+        return none
+    near = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if (beside[r, c] and not part[r, c] and z[r, c] > 0 and ground[r, c]
+                    and (owner[r, c] == 0 or owner[r, c] == k) and abs(z[r, c] - front) <= jump):  # fmt: skip
+                near[r, c] = True
+    return near
+
+
+@_njit
+def median_values32(values: np.ndarray) -> np.float32:
+    """:func:`median_values` of (n,) float32 values (reordered), in float32 as the twin takes it: the middle value, or
+    the float32 mean of the middle two; NaN when a value is NaN or there is none."""
+    n = values.shape[0]
+    if n == 0:
+        return np.float32(np.nan)
+    for i in range(n):
+        if np.isnan(values[i]):
+            return np.float32(np.nan)
+    half = n // 2
+    select(values, half)
+    if n % 2:
+        return values[half]
+    below = values[0]
+    for i in range(1, half):
+        below = max(below, values[i])
+    return (below + values[half]) / np.float32(2.0)
+
+
+@_njit
+def region_medians(first: np.ndarray, depth: np.ndarray, red: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.segment.colour._one_fruit`'s medians of regions whose pixels' depths ``depth`` (k,) float64 (0:
+    none) and rednesses ``red`` (k,) float32 run from ``first[i]`` to ``first[i + 1]``: each region's count of depths
+    above 0, their median (NaN without), and the float32 median of its rednesses, as ``core.points.median`` takes
+    them (the same values)."""
+    n = first.shape[0] - 1
+    zmed = np.empty(n, np.float64)
+    nz = np.zeros(n, np.int64)
+    rmed = np.empty(n, np.float32)
+    for i in range(n):
+        a, b = first[i], first[i + 1]
+        k = 0
+        for j in range(a, b):
+            k += depth[j] > 0
+        values = np.empty(k, np.float64)
+        k = 0
+        for j in range(a, b):
+            if depth[j] > 0:
+                values[k] = depth[j]
+                k += 1
+        nz[i] = k
+        zmed[i] = median_values(values)
+        rmed[i] = median_values32(red[a:b].copy())
+    return zmed, nz, rmed
+
+
+@_njit
+def hidden_count(rest: np.ndarray, depth: np.ndarray, front: float, size: int) -> int:
+    """:func:`symfruit.segment.colour._convex_outline`'s hidden pixels: how many pixels of ``rest`` (h, w) bool have
+    a depth (``depth`` (h, w) float64 where above 0, else the least depth above 0 in the ``size`` box about the
+    pixel, edges repeated as ``ndimage.minimum_filter(..., mode="nearest")`` repeats them, infinity without one)
+    below ``front``. The twin filters the whole window; the box is read here at the pixels of ``rest`` without
+    depth alone (a least value is exact in any order: the same count)."""
+    h, w = rest.shape
+    lo = size // 2
+    hi = size - 1 - lo
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if not rest[r, c]:
+                continue
+            v = depth[r, c]
+            if not v > 0:
+                v = np.inf
+                for i in range(r - lo, r + hi + 1):
+                    ri = min(max(i, 0), h - 1)
+                    for j in range(c - lo, c + hi + 1):
+                        d = depth[ri, min(max(j, 0), w - 1)]
+                        if d > 0 and d < v:
+                            v = d
+            n += v < front
+    return n

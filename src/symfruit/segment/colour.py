@@ -870,15 +870,25 @@ class _Depth:
         z = self.read.get(key)
         if z is None:
             given = self.given[window]
-            z = np.where(_usable(given), given.astype(np.float64), 0.0)  # a select: faster than a masked copy
+            if (jit := compiled()) is not None and given.ndim == 2 and given.dtype in _FLOATS:
+                z = jit.depth_window(given)  # the same values in one pass (issue 19, nineteenth round)
+            else:
+                z = np.where(_usable(given), given.astype(np.float64), 0.0)  # a select: faster than a masked copy
             z.flags.writeable = False
             self.read[key] = z
         return z
 
     def take(self, flat: np.ndarray) -> np.ndarray:
         """The depths at flat (row-major) pixel indices."""
-        z = np.asarray(self.given).ravel().take(flat)
+        given = np.asarray(self.given)
+        if (jit := compiled()) is not None and given.dtype in _FLOATS and flat.ndim == 1:
+            return jit.depth_at(given.ravel(), flat)  # the same values (issue 19, nineteenth round)
+        z = given.ravel().take(flat)
         return np.where(_usable(z), z.astype(np.float64), 0.0)
+
+
+#: The depth types :class:`_Depth`'s compiled reads take (others, if any, are read by numpy).
+_FLOATS = (np.dtype(np.float32), np.dtype(np.float64))
 
 
 def _pad(sl: Window, pad: int, shape: tuple[int, int]) -> Window:
@@ -945,15 +955,9 @@ def _merge(
     merged = True
     while merged and len(pieces) > 1:
         merged = False
-        box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
-        area = np.array([p.area for p in pieces], dtype=np.float64)
+        near = _near_pieces(pieces)  # the pieces near each one, in order
         for i in range(len(pieces)):
-            # the pieces near this one (closer than an occluder narrower than the smaller fruit), in order
-            gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
-            rest = box[i + 1 :]
-            near = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
-                    & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
-            for j in (np.flatnonzero(near) + i + 1).tolist():
+            for j in near(i):
                 a, b = pieces[i], pieces[j]
                 if (a.source & b.source) or (a.serial, b.serial) in apart:
                     continue
@@ -977,6 +981,36 @@ def _merge(
             if merged:
                 break
     return pieces
+
+
+def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
+    """For each piece ``i``, the pieces ``j > i`` near it, in order (``near(i)``): their boxes closer than an occluder
+    narrower than the smaller fruit (a gap of half the square root of the smaller area, at least 2 pixels). Up to
+    :data:`NEAR_TABLE` pieces all pairs are tested in one pass over an (n, n) table (issue 19, nineteenth round: the
+    same values as the row-by-row test, which costs a dozen numpy calls a piece); more are tested row by row when
+    asked for (a merge round stops at its first merge)."""
+    box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
+    area = np.array([p.area for p in pieces], dtype=np.float64)
+    if len(pieces) <= NEAR_TABLE:
+        gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[:, None], area[None, :]))).astype(np.int64))
+        a, b = box[:, None, :], box[None, :, :]
+        table = ((a[..., 0] - gap < b[..., 1]) & (b[..., 0] - gap < a[..., 1])
+                 & (a[..., 2] - gap < b[..., 3]) & (b[..., 2] - gap < a[..., 3]))  # fmt: skip
+        rows = [np.flatnonzero(row).tolist() for row in np.triu(table, 1)]
+        return rows.__getitem__
+
+    def near(i: int) -> list[int]:
+        gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
+        rest = box[i + 1 :]
+        found = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
+                 & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
+        return (np.flatnonzero(found) + i + 1).tolist()
+
+    return near
+
+
+#: The most pieces :func:`_near_pieces` tests in one table (a frame of noise has up to :data:`MAX_PIECES`).
+NEAR_TABLE = 256
 
 
 #: Round fruit: two pieces whose union reaches further than this times the larger piece alone are two fruit.
@@ -1508,6 +1542,10 @@ _IDENTITY = (np.ones(1), True)
 def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
     """Area (pixels) of the largest round fruit's disc (``round_max_diameter``) at the mask's median depth
     (``z_typical`` where none of its pixels has depth)."""
+    if (jit := compiled()) is not None and mask.dtype == bool and depth.dtype == np.float64 and mask.ndim == 2:
+        _, valid, zm = jit.masked_median(mask, depth)  # the same median in one call (issue 19, nineteenth round)
+        zr = float(zm) if valid else z_typical
+        return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
     return _largest_disc(depth[mask & (depth > 0)], s, focal, z_typical)
 
 
@@ -1559,6 +1597,15 @@ def _one_fruit(
     the regions' pixels' depths (0: none) and rednesses, region by region, region ``i``'s from ``first[i]`` to
     ``first[i + 1]``; ``sizes``: their pixel counts. Returns two (n,) bool."""
     one, ripe = np.zeros(len(sizes), bool), np.zeros(len(sizes), bool)
+    if (jit := compiled()) is not None and depth.dtype == np.float64 and red.dtype == np.float32:
+        # every region's medians in one compiled call (:func:`symfruit.core._jit.region_medians`: the same values),
+        # the tests as below (issue 19, nineteenth round)
+        zmed, nz, rmed = jit.region_medians(np.ascontiguousarray(first, np.int64), depth, red)
+        for i, (size, zr, valid) in enumerate(zip(sizes.tolist(), zmed.tolist(), nz.tolist(), strict=True)):
+            if size <= float(np.pi / 4 * (focal * s.round_max_diameter / (zr if valid else z_typical)) ** 2):
+                one[i] = True
+                ripe[i] = rmed[i] >= s.ripe_median  # a float32 against the setting, as numpy compares them
+        return one, ripe
     for i, size in enumerate(sizes.tolist()):
         z = depth[first[i] : first[i + 1]]
         if size <= _largest_disc(z[z > 0], s, focal, z_typical):
@@ -1594,14 +1641,20 @@ def _round_skin(
     ``ground_colour``, a red part that is a blush along a fruit's rim carrying the depth of what lies behind grows
     from the depth of the ground colour beside it (:func:`_blush_rim`). Returns the grown window and mask."""
     z_sl = depth[sl]
-    z_part = z_sl[hull & (z_sl > 0)]
+    jit = compiled()
+    z_part = jit.masked_depths(hull, z_sl)[1] if jit is not None and hull.dtype == bool else z_sl[hull & (z_sl > 0)]
     if s.ground_colour and k > 0:  # a red part's blush along the rim: the depth of the apple beside it
         sl, hull, z_part = _blush_rim(sl, hull, z_part, depth, color, s, owner, k)
     if len(z_part) < 20:
         return sl, hull
-    rows, cols = np.nonzero(hull)
-    rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
-    own = float(np.sqrt(hull.sum() / np.pi))
+    if jit is not None and hull.dtype == bool:  # the count and mean row and column, the same values
+        count, mr, mc = jit.mask_centre(hull)
+        rc, cc = mr + sl[0].start, mc + sl[1].start
+        own = float(np.sqrt(count / np.pi))
+    else:
+        rows, cols = np.nonzero(hull)
+        rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
+        own = float(np.sqrt(hull.sum() / np.pi))
     reach = ROUND_REACH * own
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
@@ -1612,7 +1665,7 @@ def _round_skin(
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
     deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the seeds'
+    if jit is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the seeds'
         # components alone; issue 19, seventeenth round)
         skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
                               float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
@@ -1667,6 +1720,14 @@ def _blush_rim(
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and z.dtype == np.float64:
+        # the rim's test in one compiled call (:func:`symfruit.core._jit.blush_rim`: the same pixels, medians and
+        # answer; issue 19, nineteenth round)
+        near = jit.blush_rim(part, z, color[big], owner[big], int(k), pad, np.ascontiguousarray(z_part, np.float64),
+                             float(s.depth_jump), GROUND_HUE, LEAF_HUE, GROUND_DARK)  # fmt: skip
+        if near.shape != part.shape:
+            return sl, hull, z_part
+        return big, part | near, z[near]
     beside = square_filter(part, pad) & ~part & (z > 0)
     ground = _ground(color[big])
     ring = beside & ground & ((owner[big] == 0) | (owner[big] == k))
@@ -1689,7 +1750,11 @@ def _ground(color: np.ndarray) -> np.ndarray:
     """(h, w) bool: ground-colour pixels, yellow to yellow-green: saturated as :func:`_green` (the largest channel
     a third above the smallest), blue the smallest, of a hue from :data:`GROUND_HUE` up to (not including)
     :data:`LEAF_HUE` degrees, and not dark (the largest channel above :data:`GROUND_DARK`). Integer tests: with
-    R the largest the hue is ``60 (G - B) / (R - B)``, with G the largest ``60 + 60 (G - R) / (G - B)``."""
+    R the largest the hue is ``60 (G - B) / (R - B)``, with G the largest ``60 + 60 (G - R) / (G - B)``. Where numba
+    is, its compiled twin gives the same pixels (:func:`symfruit.core._jit.ground_pixels`; issue 19, nineteenth
+    round)."""
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] >= 3:
+        return jit.ground_pixels(color, GROUND_HUE, LEAF_HUE, GROUND_DARK)
     r, g, b = (color[:, :, k].astype(np.int16) for k in range(3))
     top = np.maximum(r, g)
     gb, rb = g - b, r - b
@@ -1806,6 +1871,8 @@ def _convex_outline(part: np.ndarray, vertices: np.ndarray | None, depth: np.nda
         return False
     front = float(median(depth[seen])) - jump
     rest = _hull_mask(vertices, part) & ~part
+    if (jit := compiled()) is not None and depth.dtype == np.float64:  # the same count, the box read where needed
+        return area >= GROUND_SOLIDITY * (hull_area - float(jit.hidden_count(rest, depth, front, GAP_PX)))
     near = np.where(depth > 0, depth, np.inf)
     near = ndimage.minimum_filter(near, size=GAP_PX, mode="nearest")
     z = np.where(depth > 0, depth, near)
@@ -2002,7 +2069,11 @@ GROUND_PLANE = 0.5
 
 
 def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray:
-    """Drop hull pixels (outside the colour part) whose depth is far from the part's median depth."""
+    """Drop hull pixels (outside the colour part) whose depth is far from the part's median depth. Where numba is, in
+    one compiled call (:func:`symfruit.core._jit.depth_consistent`: the same pixels; issue 19, nineteenth round)."""
+    if (jit := compiled()) is not None and hull.dtype == part.dtype == bool and depth.dtype == np.float64:
+        out: np.ndarray = jit.depth_consistent(hull, part, depth, float(jump))
+        return out
     z = depth[part & (depth > 0)]
     if len(z) == 0:
         return hull
@@ -2016,9 +2087,13 @@ def _fruit_sized(
 ) -> bool:
     """Whether a part is fruit-sized: without depth ``min_area`` pixels; with depth at least a disc of
     ``min_diameter`` at its median depth (``z_typical`` when none of its pixels has depth)."""
-    area = int(mask.sum())
     if depth is None:
-        return area >= min_area
+        return int(mask.sum()) >= min_area
+    if (jit := compiled()) is not None and mask.dtype == bool and depth.dtype == np.float64 and mask.ndim == 2:
+        area, valid, zm = jit.masked_median(mask, depth)  # the same values in one call (issue 19, nineteenth round)
+        diameter_px = focal * s.min_diameter / (float(zm) if valid else z_typical)
+        return int(area) >= np.pi / 4 * diameter_px**2
+    area = int(mask.sum())
     z = depth[mask & (depth > 0)]
     diameter_px = focal * s.min_diameter / (float(median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
