@@ -2519,3 +2519,27 @@ def test_surface_apex_erodes_by_one_taxicab_map(seed, iterations):
     first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
     got = _jit.surface_apex(own, iterations, near, depth, mask, int(r0), int(c0), 5)
     assert (int(got[0]), int(got[1])) == (int(rows[first]), int(cols[first]))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_outline_and_ray_pixels_are_nonzeros(seed, full):
+    """Random masks (empty, full, touching the array's edges, one row or column): ``outline_pixels`` is
+    ``np.nonzero(cap & ~interior(cap))`` and ``ray_pixels`` ``np.nonzero(keep)`` with the offsets from a pixel
+    anywhere, the same numbers and dtypes."""
+    from symfruit.core.raster import interior
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    cap = np.ones((h, w), bool) if full else rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    rows, cols = _jit.outline_pixels(cap)
+    want = np.nonzero(cap & ~interior(cap))
+    for got, expected in zip((rows, cols), want, strict=True):
+        assert got.dtype == expected.dtype
+        np.testing.assert_array_equal(got, expected)
+    r0, c0 = int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5))
+    found = _jit.ray_pixels(cap, r0, c0)
+    rr, cc = np.nonzero(cap)
+    for got, expected in zip(found, (rr, cc, rr - r0, cc - c0), strict=True):
+        assert got.dtype == expected.dtype
+        np.testing.assert_array_equal(got, expected)

@@ -3200,6 +3200,82 @@ def allowed_box(
     return True, r0, r1, c0, c1
 
 
+# --- issue 19, nineteenth round (stop 39): registration, extraction, occlusion ---
+
+
+@_njit
+def outline_pixels(cap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns (int64, raster order: ``np.nonzero``'s) of the pixels of ``cap`` (h, w) bool not in its
+    interior (:func:`symfruit.core.raster.interior`: a pixel whose four neighbours are all ``cap``'s, beyond the array
+    none): ``np.nonzero(cap & ~interior(cap))``, the same pixels."""
+    h, w = cap.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if cap[r, c] and not (0 < r < h - 1 and 0 < c < w - 1 and cap[r - 1, c] and cap[r + 1, c]
+                                  and cap[r, c - 1] and cap[r, c + 1]):  # fmt: skip
+                n += 1
+    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if cap[r, c] and not (0 < r < h - 1 and 0 < c < w - 1 and cap[r - 1, c] and cap[r + 1, c]
+                                  and cap[r, c - 1] and cap[r, c + 1]):  # fmt: skip
+                rows[i], cols[i] = r, c
+                i += 1
+    return rows, cols
+
+
+@_njit
+def ray_pixels(keep: np.ndarray, r0: int, c0: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rows and columns (int64, raster order: ``np.nonzero``'s) of the pixels of ``keep`` (h, w) bool and their
+    offsets from ``(r0, c0)``, ``rows - r0`` and ``cols - c0``: :func:`symfruit.core.surface.monotone_region`'s
+    pixels, the same numbers."""
+    h, w = keep.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += keep[r, c]
+    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
+    dy, dx = np.empty(n, np.int64), np.empty(n, np.int64)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c]:
+                rows[i], cols[i], dy[i], dx[i] = r, c, r - r0, c - c0
+                i += 1
+    return rows, cols, dy, dx
+
+
+@_njit
+def free_outline(
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, pad: int
+) -> np.ndarray:  # fmt: skip
+    """(n,) bool: :func:`symfruit.core.surface._free_points`' free points of the outline ``(rows, cols)`` (n >= 1):
+    on the outline's box grown by ``pad`` (clipped to the array), the gap (the pixels not ``cap``'s whose ``depth``
+    is at most 0 or at least ``far``), each pixel's distance to it within ``reach`` (:func:`near_distance`, as
+    :func:`symfruit.core.surface.within` has it: +inf beyond, and everywhere when there is no gap), read at the
+    points and compared with ``reach``. The twin's comparisons, distances and test: the same points."""
+    h, w = cap.shape
+    rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
+    for i in range(rows.shape[0]):
+        rmin, rmax = min(rmin, rows[i]), max(rmax, rows[i])
+        cmin, cmax = min(cmin, cols[i]), max(cmax, cols[i])
+    r0, c0 = max(rmin - pad, 0), max(cmin - pad, 0)
+    r1, c1 = min(rmax + pad + 1, h), min(cmax + pad + 1, w)
+    gap = np.empty((r1 - r0, c1 - c0), np.bool_)
+    for r in range(r0, r1):
+        for c in range(c0, c1):
+            z = depth[r, c]
+            gap[r - r0, c - c0] = (not cap[r, c]) and (z <= 0 or z >= far)
+    near = np.empty((r1 - r0, c1 - c0))
+    near_distance(gap, reach, True, near)
+    free = np.empty(rows.shape[0], np.bool_)
+    for i in range(rows.shape[0]):
+        free[i] = near[rows[i] - r0, cols[i] - c0] <= reach
+    return free
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 
