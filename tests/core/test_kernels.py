@@ -2883,3 +2883,86 @@ def test_the_ground_pieces_convex_outline_is_the_twins(seed):
         near = ndimage.minimum_filter(np.where(depth > 0, depth, np.inf), size=GAP_PX, mode="nearest")
         want = int((rest & (np.where(depth > 0, depth, near) < front)).sum())
         assert _jit.hidden_count(rest, depth, front, GAP_PX) == want
+
+
+# --- stop 39, registration
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1, 3, 5]), st.booleans())
+def test_least_median_counts_below_the_least_by_columns_in_any_order(seed, size, shuffled):
+    """The least median's column counts (issue 19, nineteenth round): pixels in raster order, or shuffled and repeated
+    (the counts made again wherever the row changes), on coarse values (equal medians: the first least is the one)
+    with +inf, on windows over the image's edges: the twin's first least median."""
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    image = rng.choice([0.3, 0.31, 0.32, np.inf], size=(h, w), p=[0.2, 0.3, 0.3, 0.2])
+    if rng.random() < 0.5:
+        image = image + rng.normal(0, 0.01, (h, w)).round(2)
+    rows, cols = np.nonzero(rng.random((h, w)) < rng.uniform(0.05, 1.0))
+    if not len(rows):
+        rows, cols = np.array([h // 2]), np.array([w // 2])
+    if shuffled:
+        pick = rng.integers(0, len(rows), int(rng.integers(1, 2 * len(rows) + 1)))
+        rows, cols = rows[pick], cols[pick]
+    expected = int(np.argmin(median_at(image, rows, cols, size=size)))
+    assert _jit.least_median(image, rows, cols, size) == expected
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 9))
+def test_surface_apex_erodes_by_one_taxicab_map(seed, iterations):
+    """The apex's core by one taxicab distance map of the box (issue 19, nineteenth round) on random masks with holes,
+    eroded 1-9 times, boxes anywhere in the window: the pixel of the twin's erosion, pixels and least median."""
+    from symfruit.core.raster import eroded
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(3, 60, 2))
+    yy, xx = np.mgrid[:h, :w]
+    cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(2.0, 40.0)
+    mask = ((yy - cy) ** 2 + (xx - cx) ** 2 <= r * r) & (rng.random((h, w)) >= rng.choice([0.0, 0.02]))
+    if not mask.any():
+        mask[h // 2, w // 2] = True
+    near = mask & (rng.random((h, w)) >= rng.choice([0.0, 0.1]))
+    if not near.any():
+        near[np.nonzero(mask)[0][0], np.nonzero(mask)[1][0]] = True
+    depth = np.round(rng.uniform(0.5, 0.52, (h, w)), 3)
+    rs, cs = np.nonzero(mask)
+    r0, r1, c0, c1 = rs.min(), rs.max() + 1, cs.min(), cs.max() + 1
+    own = mask[r0:r1, c0:c1]
+    core = eroded(own, iterations) & near[r0:r1, c0:c1]
+    if core.any():
+        rows, cols = np.nonzero(core)
+        rows, cols = rows + r0, cols + c0
+    else:
+        rows, cols = np.nonzero(near & mask if (near & mask).any() else near)
+    first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
+    got = _jit.surface_apex(own, iterations, near, depth, mask, int(r0), int(c0), 5)
+    assert (int(got[0]), int(got[1])) == (int(rows[first]), int(cols[first]))
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_outline_and_ray_pixels_are_nonzeros(seed, full):
+    """Random masks (empty, full, touching the array's edges, one row or column): ``outline_pixels`` is
+    ``np.nonzero(cap & ~interior(cap))`` and ``ray_pixels`` ``np.nonzero(keep)`` with the offsets from a pixel
+    anywhere, the same numbers and dtypes."""
+    from symfruit.core.raster import interior
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    cap = np.ones((h, w), bool) if full else rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    rows, cols = _jit.outline_pixels(cap)
+    want = np.nonzero(cap & ~interior(cap))
+    for got, expected in zip((rows, cols), want, strict=True):
+        assert got.dtype == expected.dtype
+        np.testing.assert_array_equal(got, expected)
+    r0, c0 = int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5))
+    found = _jit.ray_pixels(cap, r0, c0)
+    rr, cc = np.nonzero(cap)
+    for got, expected in zip(found, (rr, cc, rr - r0, cc - c0), strict=True):
+        assert got.dtype == expected.dtype
+        np.testing.assert_array_equal(got, expected)

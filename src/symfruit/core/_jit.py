@@ -1433,27 +1433,54 @@ def least_median(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, size: in
 def _least_median_of(
     image: np.ndarray, near: np.ndarray, masked: bool, rows: np.ndarray, cols: np.ndarray, n: int, size: int,
 ) -> int:  # fmt: skip
-    """:func:`least_median`'s pass over the first ``n`` pixels ``(rows, cols)``; with ``masked``, a window's pixel
-    outside ``near`` ((h, w) bool) counts as +inf (:func:`surface_apex`'s depth where near)."""
+    """:func:`least_median`'s pass over the first ``n`` pixels ``(rows, cols)`` (in raster order, or any order: the
+    counts below are made again wherever the row changes); with ``masked``, a window's pixel outside ``near`` ((h, w)
+    bool) counts as +inf (:func:`surface_apex`'s depth where near).
+
+    Since issue 19's nineteenth round the values the windows read are copied once, edges repeated and +inf where not
+    ``near``, into an array over the pixels' box grown by the windows' half size, and a window's count of values
+    below the least is the sum of ``size`` column counts, each column's values below the least in the window's rows,
+    counted once per row of pixels and again after the least falls (instead of reading each window's values): the
+    same counts, so the same pixels passed over and the same medians taken, the same pixel."""
     h, w = image.shape
     half = size // 2
     middle = size * size // 2
+    if n == 0:
+        return -1
+    rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
+    for i in range(n):
+        rmin, rmax = min(rmin, rows[i]), max(rmax, rows[i])
+        cmin, cmax = min(cmin, cols[i]), max(cmax, cols[i])
+    vh, vw = rmax - rmin + size, cmax - cmin + size
+    vals = np.empty((vh, vw))
+    for a in range(vh):
+        rr = min(max(rmin - half + a, 0), h - 1)
+        for b in range(vw):
+            cc = min(max(cmin - half + b, 0), w - 1)
+            vals[a, b] = image[rr, cc] if not masked or near[rr, cc] else np.inf
+    counts = np.zeros(vw, np.int64)  # per column of ``vals``: its values below ``least`` in the current window rows
     window = np.empty(size * size)
     best, least = -1, np.inf
+    counted = -1  # the window rows ``counts`` holds (their first row in ``vals``); -1: none, or the least fell
     for i in range(n):
-        r, c = rows[i], cols[i]
+        r0, c0 = rows[i] - rmin, cols[i] - cmin  # the window's first row and column in ``vals``
+        if best >= 0:
+            if counted != r0:
+                counts[:] = 0
+                for a in range(r0, r0 + size):
+                    for b in range(vw):
+                        counts[b] += vals[a, b] < least
+                counted = r0
+            below = 0
+            for b in range(c0, c0 + size):
+                below += counts[b]
+            if below <= middle:
+                continue  # at most ``middle`` values below the least: the median is not below it
         k = 0
-        below = 0
-        for dr in range(-half, half + 1):
-            rr = min(max(r + dr, 0), h - 1)
-            for dc in range(-half, half + 1):
-                cc = min(max(c + dc, 0), w - 1)
-                v = image[rr, cc] if not masked or near[rr, cc] else np.inf
-                window[k] = v
+        for a in range(size):
+            for b in range(size):
+                window[k] = vals[r0 + a, c0 + b]
                 k += 1
-                below += v < least
-        if best >= 0 and below <= middle:
-            continue  # at most ``middle`` values below the least: the median is not below it
         for a in range(1, k):
             v = window[a]
             b = a
@@ -1463,6 +1490,7 @@ def _least_median_of(
             window[b] = v
         if best < 0 or window[middle] < least:
             best, least = i, window[middle]
+            counted = -1
     return best
 
 
@@ -2916,23 +2944,38 @@ def surface_apex(
     x ``size`` median (edges repeated) of the window's depth where ``near`` (+inf elsewhere) among the core pixels:
     the mask's box ``own`` (at ``r0``, ``c0`` in the window) eroded ``iterations`` times by the cross (beyond the box
     not in it: :func:`symfruit.core.raster.eroded`) and ``near``; without any, the pixels of ``near`` and ``mask``,
-    or of ``near``. The twin's pixels in its (raster) order and :func:`least_median`'s pass: the same pixel."""
+    or of ``near``. The twin's pixels in its (raster) order and :func:`least_median`'s pass: the same pixel.
+
+    Since issue 19's nineteenth round the erosion is one taxicab distance map of the box instead of ``iterations``
+    passes: eroding by the cross ``k`` times keeps the pixels whose every pixel within ``k`` steps along rows and
+    columns is the mask's, those farther than ``k`` steps from a pixel not the mask's (or beyond the box), and the
+    city-block chamfer's two sweeps give those distances exactly (:func:`taxicab_within`'s, capped past ``k``)."""
     bh, bw = own.shape
-    core = own.copy()
-    nxt = np.empty((bh, bw), np.bool_)
-    for _ in range(iterations):
-        for r in range(bh):
-            for c in range(bw):
-                nxt[r, c] = (core[r, c] and r > 0 and r < bh - 1 and c > 0 and c < bw - 1
-                             and core[r - 1, c] and core[r + 1, c] and core[r, c - 1] and core[r, c + 1])  # fmt: skip
-        core, nxt = nxt, core
-    h, w = near.shape
-    n = 0
-    rows = np.empty(h * w, np.int64)
-    cols = np.empty(h * w, np.int64)
+    cap = iterations + 1
+    d = np.empty((bh, bw), np.int64)
     for r in range(bh):
         for c in range(bw):
-            if core[r, c] and near[r + r0, c + c0]:
+            if not own[r, c]:
+                d[r, c] = 0
+                continue
+            up = d[r - 1, c] if r > 0 else 0  # beyond the box: not the mask's
+            left = d[r, c - 1] if c > 0 else 0
+            d[r, c] = min(min(up, left) + 1, cap)
+    h, w = near.shape
+    rows = np.empty(h * w, np.int64)
+    cols = np.empty(h * w, np.int64)
+    for r in range(bh - 1, -1, -1):
+        for c in range(bw - 1, -1, -1):
+            v = d[r, c]
+            if v == 0:
+                continue
+            down = d[r + 1, c] if r + 1 < bh else 0
+            right = d[r, c + 1] if c + 1 < bw else 0
+            d[r, c] = min(v, min(down, right) + 1)
+    n = 0
+    for r in range(bh):
+        for c in range(bw):
+            if d[r, c] > iterations and near[r + r0, c + c0]:
                 rows[n], cols[n] = r + r0, c + c0
                 n += 1
     if n == 0:
@@ -3429,6 +3472,82 @@ def allowed_box(
     join = _joins(hidden, seen, s0, s1, t0, t1, gap, thin)
     _, r0, r1, c0, c1 = _flood_box(join, seen, s0, s1, t0, t1)
     return True, r0, r1, c0, c1
+
+
+# --- issue 19, nineteenth round (stop 39): registration, extraction, occlusion ---
+
+
+@_njit
+def outline_pixels(cap: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Rows and columns (int64, raster order: ``np.nonzero``'s) of the pixels of ``cap`` (h, w) bool not in its
+    interior (:func:`symfruit.core.raster.interior`: a pixel whose four neighbours are all ``cap``'s, beyond the array
+    none): ``np.nonzero(cap & ~interior(cap))``, the same pixels."""
+    h, w = cap.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if cap[r, c] and not (0 < r < h - 1 and 0 < c < w - 1 and cap[r - 1, c] and cap[r + 1, c]
+                                  and cap[r, c - 1] and cap[r, c + 1]):  # fmt: skip
+                n += 1
+    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if cap[r, c] and not (0 < r < h - 1 and 0 < c < w - 1 and cap[r - 1, c] and cap[r + 1, c]
+                                  and cap[r, c - 1] and cap[r, c + 1]):  # fmt: skip
+                rows[i], cols[i] = r, c
+                i += 1
+    return rows, cols
+
+
+@_njit
+def ray_pixels(keep: np.ndarray, r0: int, c0: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Rows and columns (int64, raster order: ``np.nonzero``'s) of the pixels of ``keep`` (h, w) bool and their
+    offsets from ``(r0, c0)``, ``rows - r0`` and ``cols - c0``: :func:`symfruit.core.surface.monotone_region`'s
+    pixels, the same numbers."""
+    h, w = keep.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += keep[r, c]
+    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
+    dy, dx = np.empty(n, np.int64), np.empty(n, np.int64)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c]:
+                rows[i], cols[i], dy[i], dx[i] = r, c, r - r0, c - c0
+                i += 1
+    return rows, cols, dy, dx
+
+
+@_njit
+def free_outline(
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, pad: int
+) -> np.ndarray:  # fmt: skip
+    """(n,) bool: :func:`symfruit.core.surface._free_points`' free points of the outline ``(rows, cols)`` (n >= 1):
+    on the outline's box grown by ``pad`` (clipped to the array), the gap (the pixels not ``cap``'s whose ``depth``
+    is at most 0 or at least ``far``), each pixel's distance to it within ``reach`` (:func:`near_distance`, as
+    :func:`symfruit.core.surface.within` has it: +inf beyond, and everywhere when there is no gap), read at the
+    points and compared with ``reach``. The twin's comparisons, distances and test: the same points."""
+    h, w = cap.shape
+    rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
+    for i in range(rows.shape[0]):
+        rmin, rmax = min(rmin, rows[i]), max(rmax, rows[i])
+        cmin, cmax = min(cmin, cols[i]), max(cmax, cols[i])
+    r0, c0 = max(rmin - pad, 0), max(cmin - pad, 0)
+    r1, c1 = min(rmax + pad + 1, h), min(cmax + pad + 1, w)
+    gap = np.empty((r1 - r0, c1 - c0), np.bool_)
+    for r in range(r0, r1):
+        for c in range(c0, c1):
+            z = depth[r, c]
+            gap[r - r0, c - c0] = (not cap[r, c]) and (z <= 0 or z >= far)
+    near = np.empty((r1 - r0, c1 - c0))
+    near_distance(gap, reach, True, near)
+    free = np.empty(rows.shape[0], np.bool_)
+    for i in range(rows.shape[0]):
+        free[i] = near[rows[i] - r0, cols[i] - c0] <= reach
+    return free
 
 
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------

@@ -435,9 +435,9 @@ def _labels_at(
     nearest point has it); else by the compiled twin :func:`symfruit.core._jit.nearest_labels` where numba is
     installed (the same squared distances as the tree's: the same labels wherever the nearest points of a pixel
     share their label; the tree's pick for the pixels whose nearest points do not; issue 19, nineteenth round: a
-    fruit's look-ups on the benchmark frame take 9 us against 275 for a tree and its query), else by the tree. ``kept``: where the tree is kept for
-    further look-ups on the same edge points; ``moot`` (m,) bool: the pixels whose label the caller does not read
-    (any nearest point's label is returned there, the tree is not asked)."""
+    fruit's look-ups on the benchmark frame take 9 us against 275 for a tree and its query), else by the tree.
+    ``kept``: where the tree is kept for further look-ups on the same edge points; ``moot`` (m,) bool: the pixels
+    whose label the caller does not read (any nearest point's label is returned there, the tree is not asked)."""
     n_true = np.count_nonzero(labels)
     if n_true == len(labels) or n_true == 0:
         return np.full(len(uv), n_true > 0)

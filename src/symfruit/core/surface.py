@@ -267,15 +267,19 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     tolerance : float, metres
     bins : int
     """
-    rows, cols = np.nonzero(keep)
+    jit = compiled() if isinstance(keep, np.ndarray) and keep.dtype == bool and keep.ndim == 2 else None
+    if jit is not None:  # the pixels and their offsets in one pass (issue 19, nineteenth round: the same numbers)
+        rows, cols, dy, dx = jit.ray_pixels(keep, int(apex[0]), int(apex[1]))
+    else:
+        rows, cols = np.nonzero(keep)
     out = np.zeros(keep.shape, dtype=bool)
     if not len(rows) or not np.isfinite(tolerance):
         return keep.copy() if len(rows) else out
-    dy, dx = rows - apex[0], cols - apex[1]
-    if (jit := compiled()) is not None:  # the compiled twin of what follows from the directions on (the same pixels)
+    if jit is not None:  # the compiled twin of what follows from the directions on (the same pixels)
         jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi),
                           float(tolerance), out)  # fmt: skip
         return out
+    dy, dx = rows - apex[0], cols - apex[1]
     sector = np.floor((np.arctan2(dy, dx) + np.pi) * (bins / (2.0 * np.pi))).astype(np.int64) % bins
     # by sector, then by distance from the apex (ties in their pixel order): one stable sort of an integer key
     # (squared distances order as the distances do) is the lexsort of (distance, sector), a few times faster
@@ -676,7 +680,10 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     if surface is None:
         return None
     cap = _connected(surface.pixels, surface.apex)
-    rows, cols = np.nonzero(cap & ~interior(cap))
+    if (jit := compiled()) is not None:  # the outline's pixels in one pass (issue 19, nineteenth round: the same)
+        rows, cols = jit.outline_pixels(cap)
+    else:
+        rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
     free, sides = _free_points(depth, cap, rows, cols, surface)
@@ -730,11 +737,16 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
     tol = max(3.0 * surface.noise, 0.003)
     # on the outline's box grown by the reach alone (the same answers: no farther pixel is within reach)
     r = int(_FREE_PX) + 1
-    r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
-    box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
-    gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
-    free = within(gap, _FREE_PX)[rows - r0, cols - c0]
-    if (jit := compiled()) is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
+    jit = compiled()
+    if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and cap.dtype == bool and len(rows):
+        # the gap, its distances and the points' test in one pass (issue 19, nineteenth round: the same points)
+        free = jit.free_outline(depth, cap, rows, cols, surface.front + surface.radius + tol, _FREE_PX, r)
+    else:
+        r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
+        box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
+        gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
+        free = within(gap, _FREE_PX)[rows - r0, cols - c0]
+    if jit is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
         dv, du = rows - rows.mean(), cols - cols.mean()
         radius = np.hypot(dv, du)
         bins = max(8, int(2.0 * np.pi * radius.mean()))
