@@ -237,12 +237,13 @@ LEAFY = (0.5, 0.3)
 
 #: :func:`thin_front`: (sheet, fruit, known): a surface whose mean curvature times the fruit's radius is below the
 #: first number, and below it plus 0.2 two standard errors up, is a sheet (a leaf: a fruit's cap reads about 1, a leaf
-#: about 0); a part behind it reading at least the second, its standard error at most the third, is the fruit.
+#: about 0); a part behind it reading at least the second is the fruit; either known to within the third (one standard
+#: error, times the radius).
 THIN = (0.3, 0.5, 0.25)
 
 
-def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float,
-               join: float) -> tuple[float, np.ndarray] | None:  # fmt: skip
+def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
+               noise: float = 0.0) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """``(front, sheet)`` when the mask's nearest surface is a thin sheet in front of the fruit (a leaf drawn into
     the mask, its depth fattened over the fruit's edge by a stereo camera), told by its shape alone: None when not.
 
@@ -254,7 +255,7 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths.
     Where noise bridges the step (``join`` a few noise deviations wide, a stereo camera's far depth), the parts
     are found again on the depth's 5 x 5 median (steps kept, the noise a third), joined at three of its own noise
-    deviations (read at a lag of the filter's width). A fruit alone (its cap is convex), a leaf with nothing
+    deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap is convex), a leaf with nothing
     convex behind, a mask without a sheet: None.
 
     Parameters
@@ -266,17 +267,24 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         The depth mode's front and the fruit's radius there (:func:`fruit_depth`).
     join : float, metres
         The largest depth difference between neighbours of one surface (the convexity test's tolerance).
+    noise : float, metres
+        The depth's noise (:func:`depth_noise`).
 
     Returns
     -------
     (front, sheet) : float metres and (h, w) bool (the sheet's pixels), or None
     """
-    found = _behind_sheet(depth, mask, focal, front, radius, join, *_smooth_parts(depth, mask, join))
+    # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
+    ok = mask & (depth > 0)
+    repeats = 1.0
+    for a, b, both in ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1])):
+        if both.any():
+            repeats /= max(1.0 - float(np.count_nonzero((a == b) & both)) / float(np.count_nonzero(both)), 0.1)
+    found = _behind_sheet(depth, mask, focal, front, radius, join, np.sqrt(repeats), *_smooth_parts(depth, mask, join))
     if found is not None:
         return found
-    ok = mask & (depth > 0)
-    if ok.sum() < 60:
-        return None
+    if 3.0 * noise <= 0.003 or ok.sum() < 60:
+        return None  # the step was not bridged by noise
     _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)  # no depth: its nearest pixel's
     smooth = np.where(ok, ndimage.median_filter(depth[ri, ci], 5, mode="nearest"), 0.0)
     a, b = smooth[:, 5:], smooth[:, :-5]
@@ -287,12 +295,14 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
-    return _behind_sheet(depth, mask, focal, front, radius, join, *_smooth_parts(smooth, mask, narrow))
+    return _behind_sheet(depth, mask, focal, front, radius, join, np.sqrt(repeats), *_smooth_parts(smooth, mask, narrow))
 
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
-                  parts: np.ndarray, count: int) -> tuple[float, np.ndarray] | None:  # fmt: skip
-    """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``)."""
+                  inflate: float, parts: np.ndarray, count: int) -> tuple[float, np.ndarray] | None:  # fmt: skip
+    """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
+    sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
+    a flat reading must hold on the camera's own pixels; the cap behind is not asked as much)."""
     if count < 2:
         return None
     near = (parts > 0) & (np.abs(depth - front) <= join)
@@ -304,7 +314,8 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     if len(rows) < 30:
         return None
     kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
-    if not (kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2):
+    error *= inflate
+    if not (kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]):
         return None
     far = float(np.median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
@@ -331,33 +342,32 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
 
 
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
-    """(h, w) int labels (0: none, 1..n) and n: the pixels of ``mask`` with depth joined into parts through
-    4-neighbours whose depths differ by at most ``join`` (a surface's depth runs on; a depth step is an edge)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
+    """(h, w) int labels (0: none, 1..n) and n: the pixels of ``mask`` with depth whose 4 neighbours (those in the
+    mask with depth) all lie within ``join`` of them, joined 4-connected (a surface's depth runs on; a pixel on a
+    depth step belongs to neither side)."""
     ok = mask & (depth > 0)
-    n = int(ok.sum())
-    index = np.full(mask.shape, -1, np.int64)
-    index[ok] = np.arange(n)
-    a, b = [], []
-    for za, zb, ia, ib in ((depth[1:], depth[:-1], index[1:], index[:-1]),
-                           (depth[:, 1:], depth[:, :-1], index[:, 1:], index[:, :-1])):  # fmt: skip
-        edge = (ia >= 0) & (ib >= 0) & (np.abs(za - zb) <= join)
-        a.append(ia[edge])
-        b.append(ib[edge])
-    ea, eb = np.concatenate(a), np.concatenate(b)
-    count, labels = connected_components(coo_matrix((np.ones(len(ea)), (ea, eb)), shape=(n, n)), directed=False)
-    out = np.zeros(mask.shape, np.int64)
-    out[ok] = labels + 1
-    return out, int(count)
+    smooth = ok.copy()
+    for za, zb, a, b in ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1])):
+        step = a & b & (np.abs(za - zb) > join)
+        if za.shape[0] < depth.shape[0]:
+            smooth[1:] &= ~step
+            smooth[:-1] &= ~step
+        else:
+            smooth[:, 1:] &= ~step
+            smooth[:, :-1] &= ~step
+    labels, count = ndimage.label(smooth)
+    return labels, int(count)
 
 
 def _mean_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: float) -> tuple[float, float]:
     """``(kappa, error)``, 1/metres: the mean curvature of the surface seen at the pixels (positive where depth grows
     away from its middle, as on a fruit's front: ``1 / R`` on a sphere of radius R) and its standard error, from a
     least-squares quadratic in the lateral coordinates fitted to inverse depth (exactly affine on a plane, whatever
-    its tilt)."""
+    its tilt); on at most 2,048 of the pixels drawn by a seeded generator (the fit needs no more; a stride through
+    their row order could alias with the rows' widths)."""
+    if len(z) > 2048:
+        some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
+        rows, cols, z = rows[some], cols[some], z[some]
     zm = float(np.median(z))
     x = (cols - cols.mean()) * (zm / focal)
     y = (rows - rows.mean()) * (zm / focal)
@@ -538,7 +548,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
     # camera's near fruit lost a third of its cap, issue 18)
     tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
-    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol)) is not None:
+    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol, noise)) is not None:
         front, sheet = found_leaf
         radius = radius_px * front / focal
         region = region.copy()
