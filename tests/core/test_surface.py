@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit.core.surface import (
+    _mean_curvature,
     colour_trim,
     depth_noise,
     depth_step,
@@ -15,9 +16,7 @@ from symfruit.core.surface import (
     fruit_surface,
     monotone_region,
     registration_shift,
-    thin_front,
 )
-from symfruit.core.surface import _mean_curvature
 
 F = 600.0  # focal length, pixels
 H, W = 120, 160

@@ -255,8 +255,8 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths.
     Where noise bridges the step (``join`` a few noise deviations wide, a stereo camera's far depth), the parts
     are found again on the depth's 5 x 5 median (steps kept, the noise a third), joined at three of its own noise
-    deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap is convex), a leaf with nothing
-    convex behind, a mask without a sheet: None.
+    deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap
+    is convex), a leaf with nothing convex behind, a mask without a sheet: None.
 
     Parameters
     ----------
@@ -277,10 +277,12 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
     ok = mask & (depth > 0)
     repeats = 1.0
-    for a, b, both in ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1])):
+    pairs = ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1]))
+    for a, b, both in pairs:
         if both.any():
             repeats /= max(1.0 - float(np.count_nonzero((a == b) & both)) / float(np.count_nonzero(both)), 0.1)
-    found = _behind_sheet(depth, mask, focal, front, radius, join, np.sqrt(repeats), *_smooth_parts(depth, mask, join))
+    inflate = float(np.sqrt(repeats))
+    found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(depth, mask, join))
     if found is not None:
         return found
     if 3.0 * noise <= 0.003 or ok.sum() < 60:
@@ -295,7 +297,7 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
-    return _behind_sheet(depth, mask, focal, front, radius, join, np.sqrt(repeats), *_smooth_parts(smooth, mask, narrow))
+    return _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(smooth, mask, narrow))
 
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
@@ -347,7 +349,8 @@ def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.
     depth step belongs to neither side)."""
     ok = mask & (depth > 0)
     smooth = ok.copy()
-    for za, zb, a, b in ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1])):
+    pairs = ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1]))
+    for za, zb, a, b in pairs:
         step = a & b & (np.abs(za - zb) > join)
         if za.shape[0] < depth.shape[0]:
             smooth[1:] &= ~step
