@@ -250,3 +250,19 @@ def test_extract_register_and_trim_labels_refuse_inputs_that_do_not_fit_by_name(
     for call, message in cases:  # before: numpy broadcast/index errors, AttributeError, or silently no points
         with pytest.raises(InputError, match=re.escape(message)):
             call()
+
+
+def test_a_leaf_in_front_that_the_mask_covers_is_not_the_fruit_without_colour():
+    """A ball 0.5 m away behind a flat leaf 2 cm nearer hiding its left part, the mask the ball's whole outline (an
+    annotator's amodal mask, no colour given): the points are the ball's, none the leaf's."""
+    cam = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
+    yy, xx = np.mgrid[:120, :160].astype(float)
+    d2 = ((xx - 80) ** 2 + (yy - 60) ** 2) / 20.0**2
+    r_m = 20 * 0.5 / 600
+    depth = np.where(d2 <= 1, 0.5 + r_m * (1 - np.sqrt(np.clip(1 - d2, 0, None))), 0.8)
+    leaf = (xx - 50) ** 2 + (yy - 60) ** 2 <= 22**2
+    depth = np.where(leaf, 0.48 + 0.0002 * (xx - 50), depth)
+    depth += np.random.default_rng(0).normal(scale=0.0005, size=depth.shape)
+    ex = extract(d2 <= 1, depth, cam, NO_EROSION)
+    assert len(ex.points) >= 0.8 * ((d2 <= 1) & ~leaf).sum()
+    assert ex.points[:, 2].min() > 0.497 and ex.points[:, 2].max() < 0.5 + r_m + 0.003

@@ -8,6 +8,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit.core.surface import (
+    _mean_curvature,
     colour_trim,
     depth_noise,
     depth_step,
@@ -97,6 +98,78 @@ def test_a_leaf_in_front_drawn_into_the_mask_is_passed_over_for_the_fruit_behind
     hidden = np.r_[leaf, 1.9 + rng.uniform(0, 0.003, 20)]
     assert fruit_depth(hidden, 20.0, F, leafy=np.r_[np.ones(900, bool), np.zeros(20, bool)])[0] == pytest.approx(
         1.5, abs=0.002)  # fmt: skip
+
+
+def sheet(depth, where, front, slope=(0.3, -0.2), centre=(80, 60)):
+    """``depth`` with a flat sheet (a leaf) drawn over ``where``: a plane through ``front`` metres at ``centre``,
+    tilted by ``slope`` (metres of depth a metre across and down), its depth exact under the camera's perspective."""
+    yy, xx = np.mgrid[:H, :W].astype(np.float64)
+    # a plane's inverse depth is affine in the pixel coordinates: n.X = d with X = z ((u - cu) / F, (v - cv) / F, 1)
+    inverse = (1.0 - slope[0] * (xx - centre[0]) / F - slope[1] * (yy - centre[1]) / F) / front
+    return np.where(where, 1.0 / inverse, depth)
+
+
+def leaf_over_ball(gap=0.02, *, noise=0.0005, seed=0):
+    """``(depth, mask, leaf)``: :func:`ball` (front 0.5 m) with a tilted leaf ``gap`` in front of its front pole
+    hiding its left part (a disc of 32 px at (45, 60): about 40 % of the ball's disc, its pole seen), the mask the
+    ball's whole outline drawn over the leaf, and noise."""
+    depth, disc = ball()
+    yy, xx = np.mgrid[:H, :W]
+    leaf = (xx - 45) ** 2 + (yy - 60) ** 2 <= 32**2
+    depth = sheet(depth, leaf, 0.5 - gap, slope=(0.15, -0.1), centre=(45, 60))
+    depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape)
+    return depth, disc, leaf
+
+
+def test_the_mean_curvature_of_a_ball_is_its_inverse_radius_and_a_planes_nothing():
+    depth, disc = ball()
+    rows, cols = np.nonzero(disc)
+    r_m = 20 * 0.5 / F
+    kappa, error = _mean_curvature(rows, cols, depth[rows, cols], F)
+    assert 1.0 < kappa * r_m < 2.0 and error * r_m < 0.05  # the whole cap: its rim steepens beyond a quadratic
+    inner = ((rows - 60) ** 2 + (cols - 80) ** 2) <= 10**2  # the cap within half the radius: near a quadratic
+    kappa, error = _mean_curvature(rows[inner], cols[inner], depth[rows, cols][inner], F)
+    assert kappa * r_m == pytest.approx(1.0, abs=0.1) and error * r_m < 0.05
+    plane = sheet(depth, np.ones_like(disc), 0.6)
+    kappa, error = _mean_curvature(rows, cols, plane[rows, cols], F)
+    assert abs(kappa * r_m) < 1e-6 and error * r_m < 1e-6  # a tilted plane is affine in inverse depth: exactly
+
+
+def test_a_leaf_in_front_drawn_into_the_mask_is_told_by_its_flatness_without_colour():
+    """A ball behind a flat, tilted leaf its mask is drawn over, no colour: the leaf's depth is the mask's largest
+    mode (what extraction kept before); the leaf is a sheet, the ball a convex cap bounded by its edge."""
+    depth, mask, leaf = leaf_over_ball()
+    before = fruit_surface(depth, mask, F)
+    assert before is not None and before.front < 0.485  # the leaf
+    found = fruit_surface(depth, mask, F, thin=True)
+    assert found is not None and found.front == pytest.approx(0.5, abs=0.002)
+    assert not (found.pixels & leaf).any()
+    assert (found.pixels & mask & ~leaf).sum() >= 0.9 * (mask & ~leaf).sum()
+    # the leaf nearer or farther, other noise: the same
+    for gap, seed in ((0.012, 1), (0.05, 2)):
+        depth, mask, leaf = leaf_over_ball(gap, seed=seed)
+        found = fruit_surface(depth, mask, F, thin=True)
+        assert found is not None and found.front == pytest.approx(0.5, abs=0.002), gap
+
+
+def test_no_sheet_no_change():
+    """A ball alone, a tilted plane alone, a leaf with only a wall behind it, two balls one behind the other: the
+    sheet test finds nothing and the surface is the one found without it."""
+    yy, xx = np.mgrid[:H, :W]
+    alone, disc = ball(noise=0.0005)
+    plane = sheet(np.full((H, W), 0.8), np.ones((H, W), bool), 0.6) + np.random.default_rng(3).normal(
+        scale=0.0005, size=(H, W))  # fmt: skip
+    leaf = (xx - 80) ** 2 + (yy - 60) ** 2 <= 20**2
+    wall_behind = sheet(np.full((H, W), 0.8), leaf, 0.5)  # a leaf, the mask 4 px over the wall
+    behind, _ = ball(centre=(80, 60), radius_px=20, front=0.5, wall=0.8)
+    front_ball, small = ball(centre=(70, 55), radius_px=12, front=0.45)
+    two = np.where(small, front_ball, behind)  # a small ball hiding part of a larger one behind
+    cases = [(alone, grown(disc, 3)), (plane, disc), (wall_behind, grown(leaf, 4)), (two, disc | small)]
+    for k, (depth, mask) in enumerate(cases):
+        a = fruit_surface(depth, mask, F)
+        b = fruit_surface(depth, mask, F, thin=True)
+        assert a is not None and b is not None, k
+        assert b.front == a.front and (b.pixels == a.pixels).all(), k
 
 
 def test_the_surface_leaves_out_wall_and_table():

@@ -45,6 +45,7 @@ __all__ = [
     "fruit_surface",
     "monotone_region",
     "registration_shift",
+    "thin_front",
     "within",
 ]
 
@@ -234,6 +235,159 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
 #: second share is not (:func:`fruit_depth`).
 LEAFY = (0.5, 0.3)
 
+#: :func:`thin_front`: (sheet, fruit, known): a surface whose mean curvature times the fruit's radius is below the
+#: first number, and below it plus 0.2 two standard errors up, is a sheet (a leaf: a fruit's cap reads about 1, a leaf
+#: about 0); a part behind it reading at least the second is the fruit; either known to within the third (one standard
+#: error, times the radius).
+THIN = (0.3, 0.5, 0.25)
+
+
+def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
+               noise: float = 0.0) -> tuple[float, np.ndarray] | None:  # fmt: skip
+    """``(front, sheet)`` when the mask's nearest surface is a thin sheet in front of the fruit (a leaf drawn into
+    the mask, its depth fattened over the fruit's edge by a stereo camera), told by its shape alone: None when not.
+
+    The mask's pixels with depth fall into smooth parts (neighbours whose depths differ by at most ``join``: a
+    surface's depth runs on, a leaf's edge over the fruit is a step). The part holding the depth mode's front
+    (``front``, :func:`fruit_depth`) is a sheet when its mean curvature is clearly below a fruit's (:data:`THIN`;
+    a convex cap's depth grows towards its outline as ``r^2 / 2R``, a leaf is flat or gently curved). The fruit is
+    then the largest part behind it, touching it (what the leaf hides is bounded by its edge), clearly convex
+    and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths.
+    Where noise bridges the step (``join`` a few noise deviations wide, a stereo camera's far depth), the parts
+    are found again on the depth's 5 x 5 median (steps kept, the noise a third), joined at three of its own noise
+    deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap
+    is convex), a leaf with nothing convex behind, a mask without a sheet: None.
+
+    Parameters
+    ----------
+    depth : (h, w) float, metres (0: none)
+    mask : (h, w) bool
+    focal : float, pixels
+    front, radius : float, metres
+        The depth mode's front and the fruit's radius there (:func:`fruit_depth`).
+    join : float, metres
+        The largest depth difference between neighbours of one surface (the convexity test's tolerance).
+    noise : float, metres
+        The depth's noise (:func:`depth_noise`).
+
+    Returns
+    -------
+    (front, sheet) : float metres and (h, w) bool (the sheet's pixels), or None
+    """
+    # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
+    ok = mask & (depth > 0)
+    repeats = 1.0
+    pairs = ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1]))
+    for a, b, both in pairs:
+        if both.any():
+            repeats /= max(1.0 - float(np.count_nonzero((a == b) & both)) / float(np.count_nonzero(both)), 0.1)
+    inflate = float(np.sqrt(repeats))
+    found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(depth, mask, join))
+    if found is not None:
+        return found
+    if 3.0 * noise <= 0.003 or ok.sum() < 60:
+        return None  # the step was not bridged by noise
+    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)  # no depth: its nearest pixel's
+    smooth = np.where(ok, ndimage.median_filter(depth[ri, ci], 5, mode="nearest"), 0.0)
+    a, b = smooth[:, 5:], smooth[:, :-5]
+    diff = (a - b)[mask[:, 5:] & mask[:, :-5] & (a > 0) & (b > 0)]
+    if len(diff) < 20:
+        return None
+    sigma = 1.4826 * float(median(np.abs(diff - median(diff)))) / np.sqrt(2.0)
+    narrow = min(join, max(3.0 * sigma, 0.003))
+    if narrow >= join:
+        return None  # the same parts
+    return _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(smooth, mask, narrow))
+
+
+def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
+                  inflate: float, parts: np.ndarray, count: int) -> tuple[float, np.ndarray] | None:  # fmt: skip
+    """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
+    sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
+    a flat reading must hold on the camera's own pixels; the cap behind is not asked as much)."""
+    if count < 2:
+        return None
+    near = (parts > 0) & (np.abs(depth - front) <= join)
+    if not near.any():
+        return None
+    sheet_id = int(np.argmax(np.bincount(parts[near], minlength=count + 1)[1:])) + 1
+    sheet = parts == sheet_id
+    rows, cols = np.nonzero(sheet)
+    if len(rows) < 30:
+        return None
+    kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
+    error *= inflate
+    if not (kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]):
+        return None
+    far = float(np.median(depth[rows, cols]))
+    # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
+    # shadow, a time-of-flight camera's invalid rim lie between)
+    reach = 3 + int(np.ceil(0.3 * np.sqrt(mask.sum() / np.pi)))
+    touching = ndimage.binary_dilation(sheet, iterations=reach)
+    sizes = np.bincount(parts.ravel(), minlength=count + 1)
+    order = np.argsort(-sizes[1:], kind="stable") + 1
+    for k in order:
+        if sizes[k] < max(30, 0.1 * len(rows)):
+            break
+        if k == sheet_id:
+            continue
+        pr, pc = np.nonzero(parts == k)
+        z = depth[pr, pc]
+        if float(np.median(z)) <= far + join or not touching[pr, pc].any():
+            continue
+        kappa, error = _mean_curvature(pr, pc, z, focal)
+        if kappa * radius >= THIN[1] and error * radius <= THIN[2]:
+            behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal)
+            if np.isfinite(behind) and behind > front:
+                return behind, sheet
+    return None
+
+
+def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
+    """(h, w) int labels (0: none, 1..n) and n: the pixels of ``mask`` with depth whose 4 neighbours (those in the
+    mask with depth) all lie within ``join`` of them, joined 4-connected (a surface's depth runs on; a pixel on a
+    depth step belongs to neither side)."""
+    ok = mask & (depth > 0)
+    smooth = ok.copy()
+    pairs = ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1]))
+    for za, zb, a, b in pairs:
+        step = a & b & (np.abs(za - zb) > join)
+        if za.shape[0] < depth.shape[0]:
+            smooth[1:] &= ~step
+            smooth[:-1] &= ~step
+        else:
+            smooth[:, 1:] &= ~step
+            smooth[:, :-1] &= ~step
+    labels, count = ndimage.label(smooth)
+    return labels, int(count)
+
+
+def _mean_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: float) -> tuple[float, float]:
+    """``(kappa, error)``, 1/metres: the mean curvature of the surface seen at the pixels (positive where depth grows
+    away from its middle, as on a fruit's front: ``1 / R`` on a sphere of radius R) and its standard error, from a
+    least-squares quadratic in the lateral coordinates fitted to inverse depth (exactly affine on a plane, whatever
+    its tilt); on at most 2,048 of the pixels drawn by a seeded generator (the fit needs no more; a stride through
+    their row order could alias with the rows' widths)."""
+    if len(z) > 2048:
+        some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
+        rows, cols, z = rows[some], cols[some], z[some]
+    zm = float(np.median(z))
+    x = (cols - cols.mean()) * (zm / focal)
+    y = (rows - rows.mean()) * (zm / focal)
+    a = np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
+    w = 1.0 / z
+    gram = a.T @ a
+    try:
+        inverse = np.linalg.inv(gram)
+    except np.linalg.LinAlgError:
+        return float("nan"), float("inf")
+    coef = inverse @ (a.T @ w)
+    res = w - a @ coef
+    var = float(res @ res) / max(len(w) - 6, 1)
+    kappa = -zm * zm * float(coef[3] + coef[5])
+    error = zm * zm * float(np.sqrt(max(var * (inverse[3, 3] + inverse[5, 5] + 2.0 * inverse[3, 5]), 0.0)))
+    return kappa, error
+
 
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """``np.histogram(z, bins=bins, range=span)`` of sorted ``z``: the counts between the same edges (each bin
@@ -334,7 +488,8 @@ def median_at(image: np.ndarray, rows: np.ndarray, cols: np.ndarray, *, size: in
 def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: float = 1.3,
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
-                  leafy: np.ndarray | None = None, step: float | None = None) -> Surface | None:  # fmt: skip
+                  leafy: np.ndarray | None = None, step: float | None = None,
+                  thin: bool = False) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -363,6 +518,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         The leaf-green pixels (:func:`fruit_depth`).
     step : float, metres, optional
         The depth's quantisation step added to the tolerance (default: measured in the mask, :func:`depth_step`).
+    thin : bool
+        Tell a thin occluder in front drawn into the mask (a leaf) by its shape, without colour
+        (:func:`thin_front`): where the depth mode's surface is flat and a convex cap lies behind it, bounded by its
+        edge, the cap is the fruit and the sheet's pixels are not.
 
     Returns
     -------
@@ -396,6 +555,11 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
     # camera's near fruit lost a third of its cap, issue 18)
     tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
+    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol, noise)) is not None:
+        front, sheet = found_leaf
+        radius = radius_px * front / focal
+        region = region.copy()
+        region[box] &= ~sheet
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
