@@ -1228,3 +1228,23 @@ def test_the_edge_following_counts_are_the_former_ones():
         parts = [p for p in parts if p.any()]
         got, want = _follow_edges(parts, region, edges), former(parts, region, edges)
         assert len(got) == len(want) and all(np.array_equal(a, b) for a, b in zip(got, want, strict=True))
+
+
+@pytest.mark.parametrize("kernels", ["numba", "numpy"])
+def test_the_ripe_test_compares_in_float32_with_and_without_the_kernels(monkeypatch, kernels):
+    """A region whose median redness is exactly the float32 of ``ripe_median`` (R 20, G 13: 7 / 20 is float32(0.35),
+    which lies below 0.35) is ripe with the compiled twin as with numpy (the kernel's value, compared in float64,
+    read it as below the setting); a shade less red is not."""
+    from symfruit.segment.colour import _ripe
+
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    else:
+        monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+    color = np.zeros((6, 7, 3), np.uint8)
+    color[..., 0], color[..., 1] = 20, 13
+    red = np.ones((6, 7), bool)
+    assert float(np.float32(7) / np.float32(20)) < 0.35  # the premise: the setting rounds down in float32
+    assert _ripe(color, red, 0.35)
+    color[..., 1] = 14
+    assert not _ripe(color, red, 0.35)

@@ -201,6 +201,15 @@ def _color(color: np.ndarray) -> np.ndarray:
     return c[:, :, :3]
 
 
+def _ripe(color: np.ndarray, red: np.ndarray, ripe_median: float) -> bool:
+    """Whether the median redness of the pixels ``red`` (h, w) bool of ``color`` (h, w, 3) uint8 reaches
+    ``ripe_median``: the float32 median compared in float32, with the compiled twin (issue 19, eighteenth round)
+    as without it (a setting such as 0.35 rounds down in float32, and a median equal to it is ripe either way)."""
+    jit = compiled()
+    value = jit.red_median(color, red) if jit is not None else median(redness(color[red]))
+    return bool(np.float32(value) >= np.float32(ripe_median))
+
+
 def redness(color: np.ndarray) -> np.ndarray:
     """Chromatic redness ``(R - max(G, B)) / R`` of each pixel (negative when not red).
 
@@ -588,10 +597,7 @@ def _segment_at(
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
-        if (jit := compiled()) is not None:  # the same value in one compiled call (issue 19, eighteenth round)
-            if not red.any() or jit.red_median(c[sl], red) < s.ripe_median:
-                continue
-        elif not red.any() or median(redness(c[sl][red])) < s.ripe_median:
+        if not red.any() or not _ripe(c[sl], red, s.ripe_median):
             continue
         hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
