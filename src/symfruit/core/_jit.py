@@ -4711,14 +4711,7 @@ def median_values(values: np.ndarray) -> float:
     for i in range(n):
         if np.isnan(values[i]):
             return np.nan
-    half = n // 2
-    select(values, half)
-    if n % 2:
-        return values[half]
-    below = values[0]
-    for i in range(1, half):
-        below = max(below, values[i])
-    return (below + values[half]) / 2.0
+    return _median_of(values)
 
 
 @_njit

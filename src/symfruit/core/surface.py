@@ -283,8 +283,8 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
             repeats /= max(1.0 - float(np.count_nonzero((a == b) & both)) / float(np.count_nonzero(both)), 0.1)
     inflate = float(np.sqrt(repeats))
     # the nearest surface clearly convex is the fruit's own front, not a sheet: nothing to look behind (one fit
-    # instead of the parts, their fits and the median's re-partition on every fruit seen whole: the frame's
-    # extraction 24.8 -> ms without it)
+    # instead of the parts, their fits and the median's re-partition on every fruit seen whole: the benchmark
+    # frame's extraction 24.8 -> 16.8 ms thread CPU, 7.6 without the test)
     rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
     if len(rows) >= 30:
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
