@@ -318,6 +318,18 @@ def test_a_truncated_recording_is_refused_by_name(tmp_path):
         assert "\n" not in str(info.value)
 
 
+def test_a_damaged_message_definition_is_one_short_line(tmp_path):
+    """rosbags quotes a definition it cannot parse whole (about 1.7 kB over many lines): one line instead."""
+    data = bytearray(BAG.read_bytes())
+    at = [i for i in range(len(data)) if data.startswith(b"message_definition=", i)][18]
+    data[at + 120 : at + 123] = b"@#!"
+    path = tmp_path / "damaged.bag"
+    path.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match=r"damaged\.bag: cannot open bag \(a message definition") as info:
+        open_source(path)
+    assert "\n" not in str(info.value) and len(str(info.value)) < 300
+
+
 def test_one_torn_image_fails_its_frame_not_the_recording(tmp_path):
     torn: list[bytes] = []
 

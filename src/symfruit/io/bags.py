@@ -72,6 +72,23 @@ def _require_rosbags() -> Any:
     return AnyReader
 
 
+#: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).
+REASON_CHARS = 160
+
+
+def reader_reason(exc: BaseException) -> str:
+    """One short line saying why rosbags refused a bag: a message definition it cannot parse is named as that
+    (rosbags quotes the whole definition, several lines, in its message), anything else is its first line, cut
+    to :data:`REASON_CHARS` characters."""
+    text = str(exc).strip() or type(exc).__name__
+    if text.startswith("Could not parse"):
+        return "a message definition in the bag cannot be parsed (damaged connection record)"
+    first = text.splitlines()[0].strip()
+    if len(first) > REASON_CHARS:
+        first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
+    return first
+
+
 def image_array(msg: Any, typename: str) -> np.ndarray:
     """The pixels of a ``sensor_msgs/Image`` or ``CompressedImage``: ``(h, w)`` or ``(h, w, 3)``.
 
@@ -386,7 +403,7 @@ class BagSource:
             self._reader = reader_cls([self.path])
             self._reader.open()
         except Exception as exc:  # rosbags raises its own ReaderError / AnyReaderError types
-            raise FileFormatError(f"{self.path}: cannot open bag ({exc})") from None
+            raise FileFormatError(f"{self.path}: cannot open bag ({reader_reason(exc)})") from None
         try:
             self._index()
         except SymfruitError as exc:
@@ -394,7 +411,8 @@ class BagSource:
             raise FileFormatError(f"{self.path}: {exc}") from None
         except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
             self.close()
-            raise FileFormatError(f"{self.path}: cannot index bag ({type(exc).__name__}: {exc})") from None
+            reason = f"{type(exc).__name__}: {reader_reason(exc)}"
+            raise FileFormatError(f"{self.path}: cannot index bag ({reason})") from None
 
     def _index(self) -> None:
         conns = self._reader.connections
@@ -458,7 +476,8 @@ class BagSource:
             try:
                 return self._reader.deserialize(raw, conn.msgtype)
             except Exception as exc:
-                raise FileFormatError(f"{self.path}: corrupt message on {conn.topic} at {stamp} ({exc})") from None
+                reason = reader_reason(exc)
+                raise FileFormatError(f"{self.path}: corrupt message on {conn.topic} at {stamp} ({reason})") from None
         raise FileFormatError(f"{self.path}: no message on {conn.topic} at {stamp}")  # pragma: no cover
 
     def read(self, index: int) -> Frame:

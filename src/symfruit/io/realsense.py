@@ -43,7 +43,7 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..core.limits import shown
 from ..errors import FileFormatError, InputError, SymfruitError
-from .bags import _require_rosbags, color_image, image_array
+from .bags import _require_rosbags, color_image, image_array, reader_reason
 from .frames import named_frame
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
@@ -121,7 +121,7 @@ class RealSenseBagSource:
             self._reader = reader_cls([self.path])
             self._reader.open()
         except Exception as exc:  # rosbags' own ReaderError / AnyReaderError types
-            raise FileFormatError(f"{self.path}: cannot open bag ({exc})") from None
+            raise FileFormatError(f"{self.path}: cannot open bag ({reader_reason(exc)})") from None
         try:
             self._index()
         except SymfruitError as exc:
@@ -129,7 +129,8 @@ class RealSenseBagSource:
             raise FileFormatError(f"{self.path}: {exc}") from None
         except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
             self.close()
-            raise FileFormatError(f"{self.path}: cannot index bag ({type(exc).__name__}: {exc})") from None
+            reason = f"{type(exc).__name__}: {reader_reason(exc)}"
+            raise FileFormatError(f"{self.path}: cannot index bag ({reason})") from None
 
     # --- indexing ---------------------------------------------------------------------------------------
 
@@ -140,7 +141,7 @@ class RealSenseBagSource:
         try:
             msg, pos = msgdef.deserialize_ros1(raw, 0, msgdef.cls, store)
         except Exception as exc:
-            raise FileFormatError(f"corrupt {conn.msgtype} message on {conn.topic} ({exc})") from None
+            raise FileFormatError(f"corrupt {conn.msgtype} message on {conn.topic} ({reader_reason(exc)})") from None
         tail = bytes(raw[pos:])
         allowed = 4 if conn.msgtype.endswith("/Image") else 0
         if len(tail) > allowed:
