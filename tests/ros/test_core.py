@@ -10,7 +10,7 @@ import pytest
 
 from symfruit import SymfruitError
 from symfruit.errors import InputError
-from symfruit.ros.core import FrameProcessor, LatestOnly, fruits_of, message_frame
+from symfruit.ros.core import FrameProcessor, LatestOnly, checked_parameters, fruits_of, message_frame
 
 
 def header(secs: int = 7, nsecs: int = 5, frame_id: str = "cam") -> SimpleNamespace:
@@ -182,9 +182,19 @@ def test_settings_resolve_like_the_cli(tmp_path):
 
 def test_processor_refuses_bad_settings_at_start(tmp_path):
     for kwargs in ({"method": "no-such-method"}, {"fruit": "no-such-fruit"}, {"config": tmp_path / "none.yaml"},
-                   {"depth_scale": 1.0}):  # fmt: skip
+                   {"depth_scale": 1.5}, {"depth_scale": 0.0}, {"depth_scale": float("nan")}, {"depth_scale": True},
+                   {"depth_scale": 1e-300}):  # fmt: skip
         with pytest.raises(SymfruitError):
             FrameProcessor(**kwargs)
+
+
+def test_processor_takes_the_depth_scales_the_nodes_document():
+    """(0, 1] metres per unit, as ``checked_parameters`` and a frame's camera.json (1.0 was refused)."""
+    for scale in (1.0, 0.001, 1e-4):
+        assert checked_parameters({"depth_scale": scale})["depth_scale"] == scale
+        assert FrameProcessor(depth_scale=scale).depth_scale == scale
+    with pytest.raises(InputError, match=r"^depth_scale: expected metres per unit in \(0, 1\], got 2.5$"):
+        FrameProcessor(depth_scale=2.5)
 
 
 def test_latest_only_drops_waiting_items_and_survives_errors():

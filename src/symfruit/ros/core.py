@@ -261,8 +261,10 @@ class FrameProcessor:
         overrides: Mapping[str, Any] | None = None,
     ) -> None:
         get_method(method)
-        if not 0 < depth_scale < 1:
-            raise InputError(f"depth_scale must be metres per unit in (0, 1), got {depth_scale!r}")
+        try:  # the nodes' own check: (0, 1] metres per unit, as documented and as a frame's camera.json
+            depth_scale = checked_parameters({"depth_scale": depth_scale})["depth_scale"]
+        except SymfruitError as exc:
+            raise InputError(str(exc).replace("parameter depth_scale: ", "depth_scale: ", 1)) from None
         self.method, self.masks, self.depth_scale = method, masks, float(depth_scale)
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
         self.mask_source = mask_source(masks, settings=self.settings)  # a bad model fails here, once
