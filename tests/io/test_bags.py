@@ -572,6 +572,15 @@ def test_depth_image_refuses_a_depth_scale_no_camera_has(scale):
     assert depth_image(floats, depth_scale=1e-9).tolist() == [[0.0]]  # metres: the scale is not used
 
 
+def test_a_flt_max_32fc1_depth_is_no_depth():
+    """FLT_MAX (a sentinel) overflowed the units check's float32 median (a RuntimeWarning): no depth, as inf."""
+    from symfruit.io.bags import depth_image
+
+    data = np.array([3e38, 0.5, np.inf, 1e7], "<f4").tobytes()
+    floats = SimpleNamespace(height=1, width=4, step=16, encoding="32FC1", is_bigendian=0, data=data)
+    assert depth_image(floats).tolist() == [[0.0, 0.5, 0.0, 0.0]]
+
+
 @pytest.mark.parametrize("size", [{"width": None}, {"height": "480"}, {"width": 640.5}])
 def test_camera_info_of_a_size_that_is_no_whole_number_is_refused_by_name(size):
     from symfruit.io.bags import camera_from_info

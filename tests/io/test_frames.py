@@ -180,6 +180,27 @@ def test_depth_npy_is_checked_and_cleaned(tmp_path):
         read_frame(tmp_path / "f")
 
 
+def test_a_flt_max_depth_npy_is_no_depth_not_a_runtime_warning(tmp_path):
+    """float32 3e38 (FLT_MAX, a sentinel of no depth) overflowed the median of the units check: a numpy
+    RuntimeWarning (an error under pytest). Beyond 1e6 m it is no depth, as inf and NaN are."""
+    from symfruit.core.limits import depth_metres
+    from symfruit.io.frames import read_depth_npy
+
+    color, depth = disc_frame([(80, 60)])
+    write_frame(tmp_path / "f", color, depth, CAM)
+    (tmp_path / "f" / "depth.png").unlink()
+    sentinel = depth.astype(np.float32)
+    sentinel[sentinel > 0] = 3e38
+    sentinel[0, :2] = [2e6, -3e38]
+    np.save(tmp_path / "f" / "depth.npy", sentinel)
+    frame = read_frame(tmp_path / "f")
+    assert not frame.depth.any()
+    depth_metres(frame.depth, "f")  # the frame's own check, as detect makes it
+    sentinel[5, 5] = 1e6  # the bound itself is read (and a frame of it refused by the units check)
+    np.save(tmp_path / "f" / "depth.npy", sentinel)
+    assert read_depth_npy(tmp_path / "f" / "depth.npy")[5, 5] == np.float32(1e6)
+
+
 def test_truth_keeps_the_ripe_fruit_with_their_ids(tmp_path):
     path = tmp_path / "truth.json"
     path.write_text(json.dumps({"fruits": [
@@ -453,7 +474,7 @@ def test_depth_units_that_are_not_text_and_float64_depth_beyond_float32_are_no_p
 @pytest.mark.parametrize(
     "extra, first, second",
     [("depth.npy", "depth.png", "depth.npy"), ("camera.yaml", "camera.json", "camera.yaml"),
-     ("masks.json", "masks.png", "masks.json")],
+     ("masks.json", "masks.png", "masks.json"), ("color.jpg", "color.png", "color.jpg")],
 )  # fmt: skip
 def test_a_frame_holding_two_depth_intrinsics_or_mask_files_is_refused(tmp_path, extra, first, second):
     frame = tmp_path / "f"
@@ -463,6 +484,8 @@ def test_a_frame_holding_two_depth_intrinsics_or_mask_files_is_refused(tmp_path,
         np.save(frame / extra, np.full((480, 640), 0.5))
     elif extra == "camera.yaml":
         (frame / extra).write_text("fx: 600\nfy: 600\ncx: 320\ncy: 240\nwidth: 640\nheight: 480\n")
+    elif extra == "color.jpg":  # before: color.png taken in silence
+        Image.new("RGB", (640, 480)).save(frame / extra)
     else:
         (frame / extra).write_text('{"annotations": []}')
     with pytest.raises(FileFormatError, match=rf"f: holds both {first} and {second}; which one is meant\? Keep one"):

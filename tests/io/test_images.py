@@ -145,6 +145,8 @@ def test_depth_units(tmp_path):
     assert eight.dtype == np.uint16 and np.array_equal(eight, units.astype(np.uint8))
     with pytest.raises(FileFormatError, match=r"c\.png: depth PNG must be single-channel 16-bit, got mode 'RGB'"):
         read_depth_units(save(Image.new("RGB", (2, 2)), tmp_path / "c.png"))
+    with pytest.raises(FileFormatError, match=r"c\.tif: depth TIFF must be single-channel 16-bit"):  # not "PNG"
+        read_depth_units(save(Image.new("RGB", (2, 2)), tmp_path / "c.tif"))
     # 8-bit depth is read where its units can reach real depth (centimetres: 2.55 m), and refused where they
     # cannot (millimetres: 0.255 m; a depth picture normalised for viewing)
     assert np.array_equal(read_depth_units(tmp_path / "d8.png", scale=0.01), units.astype(np.uint8))

@@ -32,7 +32,7 @@ from ..core.frame import MAX_STAMP_NS, Frame
 from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size, shown
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
-from .images import MIN_16BIT_DEPTH_REACH
+from .images import MIN_16BIT_DEPTH_REACH, float_depth
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = [
@@ -228,7 +228,7 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
                          "camera measures depth that finely (metres per unit, 0.001 for millimetres)")  # fmt: skip
     if raw.dtype == np.uint16:  # one pass, float32 as everywhere (units x scale)
         return np.multiply(raw, np.float32(depth_scale), dtype=np.float32)
-    return np.nan_to_num(raw, copy=False, nan=0.0, posinf=0.0, neginf=0.0)  # image_array's own copy
+    return float_depth(raw)  # image_array's own copy; NaN, inf, FLT_MAX (beyond NO_DEPTH_BEYOND): no depth
 
 
 def camera_from_info(

@@ -2,9 +2,9 @@
 
 A frame folder holds::
 
-    color.png | color.jpg     colour image, 8-bit RGB, read as displayed (an EXIF orientation applied)
+    color.png | color.jpg     colour image, 8-bit RGB, read as displayed (an EXIF orientation applied; one of them)
     depth.png                 depth aligned to colour, 16-bit, times depth_scale metres per unit
-    depth.npy                 ... or depth as float metres (0 or NaN: no depth)
+    depth.npy                 ... or depth as float metres (0, NaN, inf or beyond 1e6 m: no depth)
     camera.json | .yaml       intrinsics in any layout symfruit reads; an optional "depth_scale"
                               (metres per unit, default 0.001 as on Intel D400 cameras)
     masks.png                 optional: instance labels, 0 background, k fruit k (8- or 16-bit)
@@ -42,7 +42,13 @@ from ..core.limits import (
 )
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
-from .images import orientation_mismatch, read_color_oriented, read_depth_units_oriented, turned_mismatch
+from .images import (
+    float_depth,
+    orientation_mismatch,
+    read_color_oriented,
+    read_depth_units_oriented,
+    turned_mismatch,
+)
 from .text import as_path, holds_file, read_structured
 
 __all__ = [
@@ -68,13 +74,6 @@ COLOR_FILE = "color_file"
 COLOR_NAMES = ("color.png", "color.jpg", "color.jpeg")
 #: Largest truth.json read (bytes), and largest depth.npy (elements): :mod:`symfruit.core.limits`.
 MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
-
-
-def _first(folder: Path, *names: str) -> Path | None:
-    for name in names:
-        if holds_file(folder / name):
-            return folder / name
-    return None
 
 
 def _only(folder: Path, *names: str) -> Path | None:
@@ -108,7 +107,7 @@ def read_frame(folder: str | Path) -> Frame:
     folder = as_path(folder, "read_frame: the frame folder")
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such frame folder")
-    color_path = _first(folder, *COLOR_NAMES)
+    color_path = _only(folder, *COLOR_NAMES)  # color.png beside color.jpg: which one is meant?
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")
     cam_path = _only(folder, "camera.json", "camera.yaml", "camera.yml")
@@ -171,8 +170,7 @@ def read_depth_npy(path: Path) -> np.ndarray:
         depth = np.load(path, allow_pickle=False)
     except (ValueError, OSError, EOFError) as exc:
         raise FileFormatError(f"{path}: cannot read ({exc})") from None
-    with np.errstate(over="ignore", invalid="ignore"):  # float64 beyond float32 (1e300 m): inf, then no depth
-        return np.nan_to_num(depth.astype(np.float32), nan=0.0, posinf=0.0, neginf=0.0)
+    return float_depth(depth)  # NaN, inf, beyond float32 or NO_DEPTH_BEYOND (FLT_MAX, a sentinel): no depth
 
 
 def file_depth_scale(path: str | Path) -> float | None:

@@ -44,8 +44,10 @@ from .text import as_path, refuse_pipe
 
 __all__ = [
     "MAX_IMAGE_PIXELS",
+    "NO_DEPTH_BEYOND",
     "decode_color",
     "exif_orientation",
+    "float_depth",
     "image_suffixes",
     "orientation_mismatch",
     "read_color",
@@ -275,6 +277,21 @@ MIN_8BIT_DEPTH_REACH = 1.0
 MIN_16BIT_DEPTH_REACH = 1.0
 
 
+#: Float depth beyond this (metres, either sign) is no measurement, in metres or in millimetres (16-bit units reach
+#: 65,535): a sentinel such as FLT_MAX (3.4e38), read as no depth as inf and NaN are (kept, it overflowed numpy's
+#: median of the depth in float32: a RuntimeWarning instead of a clean refusal or a frame).
+NO_DEPTH_BEYOND = 1e6
+
+
+def float_depth(depth: np.ndarray) -> np.ndarray:
+    """Float depth in metres as ``float32``: NaN, infinities and values beyond :data:`NO_DEPTH_BEYOND` become 0 (no
+    depth); a float64 value beyond float32 is one of them. In place where ``depth`` is already ``float32``."""
+    with np.errstate(over="ignore", invalid="ignore"):  # float64 beyond float32 (1e300 m): inf, then no depth
+        out = np.asarray(depth).astype(np.float32, copy=False)
+        out[~(np.abs(out) <= NO_DEPTH_BEYOND)] = 0.0
+    return out
+
+
 def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndarray:
     """A single-channel depth image as ``(h, w) uint16`` raw units (``depth_scale`` metres each), as displayed.
 
@@ -290,10 +307,11 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
     with _open(path, str(path)) as img:
         _single(img, str(path), "a depth image")
         img, orientation = _decode(img, str(path))
+        kind = f"depth {img.format or 'image'}"  # PNG, TIFF, ... (a folder of depth images may hold any)
         if img.mode not in _WIDE_GREY and img.mode != "L":
-            raise FileFormatError(f"{path}: depth PNG must be single-channel 16-bit, got mode {img.mode!r}")
+            raise FileFormatError(f"{path}: {kind} must be single-channel 16-bit, got mode {img.mode!r}")
         if img.mode == "L" and scale is not None and 255 * scale < MIN_8BIT_DEPTH_REACH:
-            raise FileFormatError(f"{path}: depth PNG is 8-bit: at {scale:g} m per unit it reaches only "
+            raise FileFormatError(f"{path}: {kind} is 8-bit: at {scale:g} m per unit it reaches only "
                                   f"{255 * scale:.3g} m, so it is a picture of depth, not depth; write 16-bit units "
                                   "(or give the depth scale that its 8-bit units stand for)")  # fmt: skip
         if img.mode != "L" and scale is not None and 65535 * scale < MIN_16BIT_DEPTH_REACH:
@@ -302,9 +320,9 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
                                   "for (metres per unit, 0.001 for millimetres)")  # fmt: skip
         raw = np.asarray(img)
     if raw.ndim != 2:
-        raise FileFormatError(f"{path}: depth PNG must be single-channel, got shape {raw.shape}")
+        raise FileFormatError(f"{path}: {kind} must be single-channel, got shape {raw.shape}")
     if raw.dtype.kind not in "ui":
-        raise FileFormatError(f"{path}: depth PNG must hold integer units, got {raw.dtype}")
+        raise FileFormatError(f"{path}: {kind} must hold integer units, got {raw.dtype}")
     if raw.size and (raw.min() < 0 or raw.max() > 65535):
         raise FileFormatError(f"{path}: depth units outside 0-65535")
     return raw.astype(np.uint16), orientation
