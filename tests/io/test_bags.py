@@ -588,3 +588,17 @@ def test_camera_info_of_a_size_that_is_no_whole_number_is_refused_by_name(size):
     info = SimpleNamespace(**{"width": 640, "height": 480, "K": [600.0, 0, 320, 0, 600, 240, 0, 0, 1], **size})
     with pytest.raises(InputError, match="CameraInfo width and height must be whole numbers"):
         camera_from_info(info)  # before: TypeError / ValueError from int(), or 640.5 read as 640
+
+
+def test_a_camera_info_with_binning_or_a_region_of_interest_is_refused():
+    """A binned or cropped stream's K is the full sensor's: it was read as the image's, unsaid."""
+    from symfruit.io.bags import camera_from_info
+
+    roi = SimpleNamespace(x_offset=0, y_offset=0, width=0, height=0, do_rectify=False)
+    info = dict(width=640, height=480, K=[600.0, 0, 320, 0, 600, 240, 0, 0, 1], binning_x=0, binning_y=0, roi=roi)
+    assert camera_from_info(SimpleNamespace(**info)).cx == 320  # RealSense's: no binning, no roi
+    with pytest.raises(InputError, match=r"CameraInfo field 'binning_y' is 2: binned images are not read"):
+        camera_from_info(SimpleNamespace(**{**info, "binning_y": 2}))
+    cropped = SimpleNamespace(x_offset=8, y_offset=4, width=320, height=240, do_rectify=False)
+    with pytest.raises(InputError, match=r"CameraInfo field 'roi' is x_offset 8, y_offset 4, 320x240"):
+        camera_from_info(SimpleNamespace(**{**info, "roi": cropped}))

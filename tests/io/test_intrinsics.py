@@ -258,3 +258,29 @@ def test_intrinsics_given_twice_under_two_nests_that_differ_are_refused_not_one_
         load_camera(path)  # before: 'intrinsics' read, the colour camera's left unsaid
     path.write_text(json.dumps({"color": colour, "colour": colour, "depth": depth}))  # the same twice: no doubt
     assert load_camera(path).fx == 615
+
+
+@pytest.mark.parametrize(
+    "extra, error",
+    [({"binning_x": 2}, r"cam\.json: intrinsics field 'binning_x' is 2: binned images are not read"),
+     ({"binning_y": 4}, r"field 'binning_y' is 4"),
+     ({"roi": {"x_offset": 100, "y_offset": 0, "width": 320, "height": 240, "do_rectify": False}},
+      r"field 'roi' is x_offset 100, y_offset 0, 320x240: a region of interest is not applied"),
+     ({"roi": {"x_offset": 0, "y_offset": 0, "width": 320, "height": 240}}, r"field 'roi' is x_offset 0"),
+     ({"binning_x": 2.5}, r"field 'binning_x' must be a whole number, got 2\.5"),
+     ({"binning_x": 1e300}, r"field 'binning_x' must be a whole number, got 1e\+300"),
+     ({"roi": [0, 0]}, r"field 'roi' must be a mapping"),
+     ({"roi": {"x_offset": -1}}, r"field 'roi' must hold whole numbers")],
+)  # fmt: skip
+def test_binning_and_a_region_of_interest_are_refused_not_ignored(tmp_path, extra, error):
+    """K of a binned or cropped CameraInfo is the full sensor's: read as the image's, every point was misplaced."""
+    base = {"K": [600, 0, 320, 0, 600, 240, 0, 0, 1], "width": 640, "height": 480}
+    path = tmp_path / "cam.json"
+    path.write_text(json.dumps({**base, **extra}))
+    with pytest.raises(FileFormatError, match=error):
+        load_camera(path)
+    none = {"binning_x": 0, "binning_y": 1, "roi": {"x_offset": 0, "y_offset": 0, "width": 0, "height": 0}}
+    path.write_text(json.dumps({**base, **none}))  # ROS's "no binning, no roi"; so is the whole image's roi
+    assert load_camera(path) == Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
+    path.write_text(json.dumps({**base, "roi": {"x_offset": 0, "y_offset": 0, "width": 640, "height": 480}}))
+    assert load_camera(path).width == 640

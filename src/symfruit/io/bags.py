@@ -33,7 +33,7 @@ from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMA
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
 from .images import MIN_16BIT_DEPTH_REACH, float_depth
-from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
+from .intrinsics import check_binning_roi, check_pinhole_matrix, warn_distortion, warn_principal_point
 
 __all__ = [
     "BagSource",
@@ -271,6 +271,8 @@ def camera_from_info(
     w, h = w or (width or 0), h or (height or 0)
     camera = Camera(fx=k[0], fy=k[4], cx=k[2], cy=k[5], width=w, height=h)
     check_pinhole_matrix(k, "CameraInfo K")  # row-major; a transposed one would read cx = cy = 0
+    check_binning_roi(getattr(msg, "binning_x", None), getattr(msg, "binning_y", None), getattr(msg, "roi", None),
+                      camera, "CameraInfo")  # fmt: skip
     if source is not None:
         said = warned if warned is not None else set()
         if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3):

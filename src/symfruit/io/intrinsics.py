@@ -37,12 +37,21 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
+import numpy as np
+
 from ..core.camera import Camera
 from ..core.limits import MAX_DISTORTION_COEFFS, MAX_SETTINGS_BYTES, shown
 from ..errors import FileFormatError, InputError, SymfruitWarning
 from .text import as_path, read_structured
 
-__all__ = ["camera_from_dict", "check_pinhole_matrix", "load_camera", "warn_distortion", "warn_principal_point"]
+__all__ = [
+    "camera_from_dict",
+    "check_binning_roi",
+    "check_pinhole_matrix",
+    "load_camera",
+    "warn_distortion",
+    "warn_principal_point",
+]
 
 #: Largest intrinsics file read (bytes): that of a settings file (:mod:`symfruit.core.limits`).
 MAX_INTRINSICS_BYTES = MAX_SETTINGS_BYTES
@@ -340,4 +349,49 @@ def _camera_of(data: Any) -> Camera:
     camera = Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=width, height=height)
     if matrix is not None:  # after the camera's own checks: an all-zero matrix is 'focal lengths must be positive'
         check_pinhole_matrix(matrix[0], matrix[1], column_major=matrix[2])
+    check_binning_roi(data.get("binning_x"), data.get("binning_y"), data.get("roi"), camera, "intrinsics")
     return camera
+
+
+def _uint32(value: Any) -> bool:
+    """Whether ``value`` is a whole number a ``uint32`` field holds (never ``range``'s linear search of a float)."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        return False
+    return math.isfinite(value) and float(value).is_integer() and 0 <= value < 2**32
+
+
+def check_binning_roi(binning_x: Any, binning_y: Any, roi: Any, camera: Camera, what: str) -> None:
+    """Refuse a ``CameraInfo``'s binning (above 1) or region of interest (an offset, or a size not the image's):
+    ``K`` is then the full sensor's, not the stored images', and taking it as theirs would misplace every point
+    (these were ignored in silence). ``roi`` is a mapping (a file) or a message's ``RegionOfInterest``; 0 or absent
+    binning and an all-zero ``roi`` are "none", as ROS defines them.
+
+    Raises
+    ------
+    InputError
+        Naming ``what``, the field and what to give instead (the intrinsics of the images as stored).
+    """
+    for name, value in (("binning_x", binning_x), ("binning_y", binning_y)):
+        if value is None:
+            continue
+        if not _uint32(value):
+            raise InputError(f"{what} field {name!r} must be a whole number, got {shown(value)}")
+        if value > 1:
+            raise InputError(f"{what} field {name!r} is {int(value)}: binned images are not read (K is the full "
+                             "sensor's); give the intrinsics of the images as stored (fx, cx divided by the "
+                             "binning) and no binning")  # fmt: skip
+    if roi is None:
+        return
+    fields = ("x_offset", "y_offset", "width", "height")
+    get = roi.get if isinstance(roi, dict) else (lambda key, default=0: getattr(roi, key, default))
+    if not isinstance(roi, dict) and not all(hasattr(roi, f) for f in fields):
+        raise InputError(f"{what} field 'roi' must be a mapping of {', '.join(fields)}, got {shown(roi)}")
+    values = [get(f, 0) for f in fields]
+    if not all(_uint32(v) for v in values):
+        raise InputError(f"{what} field 'roi' must hold whole numbers {', '.join(fields)}, got "
+                         f"{', '.join(shown(v) for v in values)}")  # fmt: skip
+    x0, y0, w, h = (int(v) for v in values)
+    if x0 or y0 or ((w or h) and (w, h) != (camera.width, camera.height)):
+        raise InputError(f"{what} field 'roi' is x_offset {x0}, y_offset {y0}, {w}x{h}: a region of interest is not "
+                         f"applied (K is the full sensor's); give the intrinsics of the images as stored (cx - "
+                         "x_offset, cy - y_offset, their size) and no roi")  # fmt: skip
