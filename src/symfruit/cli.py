@@ -11,7 +11,6 @@ import argparse
 import contextlib
 import json
 import os
-import shutil
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -876,9 +875,7 @@ def _ros2_bag(args: argparse.Namespace) -> Iterator[Any]:
     try:
         yield bag
     except BaseException:
-        bag.close()
-        if bag.count == 0:
-            shutil.rmtree(args.ros2_bag, ignore_errors=True)
+        bag.close(keep=bag.count > 0)  # the frames done, in place complete; none: no bag
         raise
     bag.close()
 

@@ -55,6 +55,26 @@ def test_write_and_read_back(tmp_path, example_fruits, storage):
         assert_same(msg, example_fruits[:n], class_id="strawberry")
 
 
+def test_the_bag_appears_only_when_complete(tmp_path, example_fruits):
+    """Written in a hidden folder beside it and renamed into place once closed: a killed run never leaves a bag
+    without its metadata.yaml at the path (before: written there directly, frame by frame)."""
+    bag = Ros2DetectionBag(tmp_path / "bag").open()
+    bag.write(1, example_fruits)
+    assert not (tmp_path / "bag").exists() and [p.name[:13] for p in tmp_path.iterdir()] == [".bag.partial-"]
+    bag.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bag"] and (tmp_path / "bag" / "metadata.yaml").is_file()
+    assert len(read_back(tmp_path / "bag")) == 1
+    dropped = Ros2DetectionBag(tmp_path / "dropped").open()
+    dropped.write(1, example_fruits)
+    dropped.close(keep=False)
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bag"]
+    raced = Ros2DetectionBag(tmp_path / "raced").open()
+    (tmp_path / "raced").mkdir()  # made meanwhile: an empty folder rename() would replace
+    with pytest.raises(FileFormatError, match=r"raced: cannot put the ROS 2 bag in place .*appeared"):
+        raced.close()
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["bag", "raced"] and not any((tmp_path / "raced").iterdir())
+
+
 def test_an_existing_bag_is_not_overwritten_and_storage_is_checked(tmp_path):
     from symfruit import SymfruitError
 

@@ -18,6 +18,9 @@ appends each frame from the batch loop (:meth:`Ros2DetectionBag.write_frame` as 
 
 from __future__ import annotations
 
+import os
+import shutil
+import tempfile
 from collections.abc import Sequence
 from importlib import resources
 from pathlib import Path
@@ -97,21 +100,33 @@ class Ros2DetectionBag:
         self.count = 0
         self._writer: Any = None
         self._conn: Any = None
+        self._partial: Path | None = None  # the hidden folder the bag is written in until closed
 
     def open(self) -> Ros2DetectionBag:
+        """Start the bag in a hidden folder beside ``path`` (``.NAME.partial-XXXX/NAME``): :meth:`close` renames it
+        into place once rosbags has closed it (its ``metadata.yaml`` written), so ``path`` is never a bag cut
+        short (a killed run leaves only the hidden folder)."""
         _rosbags()
         from rosbags.rosbag2 import StoragePlugin, Writer
 
-        if self.path.exists():
+        if os.path.lexists(self.path):
             raise FileFormatError(f"{self.path}: exists already; a ROS 2 bag is written to a new folder")
         plugin = StoragePlugin.MCAP if self.storage == "mcap" else StoragePlugin.SQLITE3
         try:
-            self._writer = Writer(self.path, version=8, storage_plugin=plugin)
+            self.path.parent.mkdir(parents=True, exist_ok=True)  # as rosbags' writer makes a bag's parents
+            self._partial = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.partial-", dir=self.path.parent))
+            self._writer = Writer(self._partial / self.path.name, version=8, storage_plugin=plugin)
             self._writer.open()
         except Exception as exc:  # rosbags' WriterError, OSError
+            self._discard_partial()
             raise FileFormatError(f"{self.path}: cannot create ROS 2 bag ({exc})") from None
         self._conn = self._writer.add_connection(self.topic, MSGTYPE, typestore=self.store)
         return self
+
+    def _discard_partial(self) -> None:
+        if self._partial is not None:
+            shutil.rmtree(self._partial, ignore_errors=True)
+            self._partial = None
 
     def message(self, stamp_ns: int, fruits: Sequence[Fruit], frame_id: str = OPTICAL_FRAME):
         """The ``Detection3DArray`` (rosbags class) of one frame."""
@@ -154,10 +169,28 @@ class Ros2DetectionBag:
         self._writer.write(self._conn, int(stamp_ns), data)
         self.count += 1
 
-    def close(self) -> None:
+    def close(self, *, keep: bool = True) -> None:
+        """Close the bag and rename it into place (``keep``), or drop it (``keep=False``: nothing at ``path``)."""
         if self._writer is not None:
-            self._writer.close()
-            self._writer = None
+            writer, self._writer = self._writer, None
+            try:
+                writer.close()
+            except BaseException:
+                self._discard_partial()
+                raise
+        if self._partial is None:
+            return
+        if not keep:
+            self._discard_partial()
+            return
+        try:
+            if os.path.lexists(self.path):  # made while the batch ran; never renamed over (an empty folder would be)
+                raise FileExistsError(f"{self.path} appeared while the bag was written")
+            os.rename(self._partial / self.path.name, self.path)
+        except OSError as exc:
+            self._discard_partial()
+            raise FileFormatError(f"{self.path}: cannot put the ROS 2 bag in place ({exc})") from None
+        self._discard_partial()
 
     def __enter__(self) -> Ros2DetectionBag:
         return self.open()
