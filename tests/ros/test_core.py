@@ -381,3 +381,14 @@ def test_a_depth_scale_parameter_no_camera_has_is_refused_at_start(scale):
     # before: taken, 1e-300 being 0 in float32: every frame read as one without depth, unsaid
     with pytest.raises(SymfruitError, match=rf"parameter depth_scale: {scale:g} m per unit; 16-bit depth would reach"):
         checked_parameters({"depth_scale": scale})
+
+
+def test_unknown_parameters_name_the_first_and_leave_ross_own():
+    from symfruit.ros.core import unknown_parameters
+
+    unknown_parameters(["method", "use_sim_time", "qos_overrides./x.subscription.depth", "slop"])
+    with pytest.raises(SymfruitError, match=r"^parameter 'slop_s': no such parameter \(did you mean 'slop'\?\); "
+                       r"the node's are method, fruit"):  # fmt: skip
+        unknown_parameters(["slop_s", "zzz_unrelated"])
+    with pytest.raises(SymfruitError, match=r"^parameter 'zzz': no such parameter; the node's"):
+        unknown_parameters(["zzz"])

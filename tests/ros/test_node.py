@@ -9,6 +9,7 @@ stopped by its fixture.
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -383,3 +384,20 @@ def test_private_parameters_are_checked_as_the_ros2_nodes_are():
     ]:
         with pytest.raises(SymfruitError, match="^" + message):
             private_parameters(get_param(values))
+
+
+def test_a_private_parameter_the_node_does_not_have_is_refused_by_name():
+    """`_metod:=paper` set /symfruit/metod, which nothing read: the default method ran, unsaid."""
+    from symfruit.ros.node import given_private_names, private_parameters
+
+    names = ["/rosdistro", "/symfruit/metod", "/symfruit/fruit", "/symfruit/config/x", "/symfruit_other/a"]
+    given = given_private_names(names, "/symfruit")
+    assert given == ["config", "fruit", "metod"]
+    with pytest.raises(SymfruitError, match=r"^parameter 'metod': no such parameter \(did you mean 'method'\?\)"):
+        private_parameters(lambda name, default: default, given)
+    with pytest.raises(SymfruitError, match=r"^parameter 'qos': no such parameter"):  # ROS 1 has none
+        private_parameters(lambda name, default: default, ["qos"])
+    assert private_parameters(lambda name, default: default, ["fruit", "slop"])["fruit"] == "strawberry"
+    for value, hint in ((["a.yaml"], ""), ({"a": 1}, ""), (True, " (quote it")):
+        with pytest.raises(SymfruitError, match=rf"^parameter config: expected text, got .*{re.escape(hint)}"):
+            private_parameters(lambda name, default, v=value: v if name == "~config" else default)

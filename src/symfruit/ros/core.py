@@ -72,6 +72,31 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
 QOS_CHOICES = ("reliable", "sensor_data")
 
 
+#: Parameters ROS itself gives every node (never refused as unknown): ROS 2's ``use_sim_time``, its QoS overrides.
+ROS_OWN_PARAMETERS = ("use_sim_time", "qos_overrides.", "start_type_description_service")
+
+
+def unknown_parameters(names: Any, *, known: Any = PARAMETERS) -> None:
+    """Refuse a parameter given to the node that it does not have (``_metod:=paper``, ``-p slop_s:=0.1``): it was
+    ignored in silence, the default used. ``names`` are the node's given parameter names (private, without the
+    node's namespace).
+
+    Raises
+    ------
+    SymfruitError
+        One line naming the first unknown parameter, the closest known one and the known ones.
+    """
+    import difflib
+
+    for name in sorted(str(n) for n in names):
+        if name in known or any(name == own or (own.endswith(".") and name.startswith(own))
+                                for own in ROS_OWN_PARAMETERS):  # fmt: skip
+            continue
+        close = difflib.get_close_matches(name.lower(), list(known), n=1, cutoff=0.6)
+        hint = f" (did you mean {close[0]!r}?)" if close else ""
+        raise SymfruitError(f"parameter {shown(name)}: no such parameter{hint}; the node's are {', '.join(known)}")
+
+
 def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
     """The node's parameters from what ROS handed over (any types): strings as strings, numbers checked; the
     one check of the ROS 2 node's parameters and the ROS 1 node's private ones (which have no ``qos``).
@@ -85,7 +110,10 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
     out: dict[str, Any] = {}
     for name, (default, _) in PARAMETERS.items():
         value = values.get(name, default)
-        if isinstance(default, str):
+        if isinstance(default, str):  # text; a number as its text (rosparam types `_fruit:=123`), nothing else
+            if value is not None and (isinstance(value, bool) or not isinstance(value, str | int | float)):
+                hint = " (quote it: a YAML yes/no/true is a boolean)" if isinstance(value, bool) else ""
+                raise SymfruitError(f"parameter {name}: expected text, got {shown(value)}{hint}")
             out[name] = "" if value is None else str(value)
             continue
         kind = int if isinstance(default, int) else float

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import PARAMETERS, FrameProcessor, Fruit, LatestOnly, checked_parameters
+from .core import PARAMETERS, FrameProcessor, Fruit, LatestOnly, checked_parameters, unknown_parameters
 
 __all__ = ["DEFAULT_TOPICS", "SymfruitNode", "main"]
 
@@ -183,7 +183,7 @@ class SymfruitNode:
 
         self.rospy = rospy
         self.vision_msgs = load_vision_msgs()
-        p = private_parameters(rospy.get_param)
+        p = private_parameters(rospy.get_param, given_private_names(rospy.get_param_names(), rospy.get_name()))
         self.core = FrameProcessor(
             method=p["method"] or DEFAULT_METHOD, fruit=p["fruit"] or None, config=p["config"] or None,
             masks=p["masks"], depth_scale=p["depth_scale"],
@@ -264,12 +264,21 @@ Run the symfruit ROS 1 node (ROS_MASTER_URI from the environment). ROS arguments
 """
 
 
-def private_parameters(get_param: Any) -> dict[str, Any]:
+def private_parameters(get_param: Any, given: Sequence[str] = ()) -> dict[str, Any]:
     """The node's private parameters (``~method`` ... ``~queue_size``; ROS 1 has no ``qos``) through ``get_param``
     (``rospy.get_param``), checked as the ROS 2 node's are (:func:`~symfruit.ros.core.checked_parameters`): a
-    ``~queue_size`` that is no whole number, or a ``~slop`` out of [0, 10] s, is one line naming it."""
-    return checked_parameters({name: get_param(f"~{name}", default) for name, (default, _) in PARAMETERS.items()
-                               if name != "qos"})  # fmt: skip
+    ``~queue_size`` that is no whole number, or a ``~slop`` out of [0, 10] s, is one line naming it, and so is a
+    private parameter the node does not have among ``given`` (their names, :func:`given_private_names`)."""
+    known = {name: v for name, v in PARAMETERS.items() if name != "qos"}
+    unknown_parameters(given, known=known)
+    return checked_parameters({name: get_param(f"~{name}", default) for name, (default, _) in known.items()})
+
+
+def given_private_names(names: Sequence[str], node_name: str) -> list[str]:
+    """The private parameters among the parameter server's ``names`` (``rospy.get_param_names()``) of the node
+    ``node_name`` (``rospy.get_name()``): their first component below the node's namespace."""
+    prefix = node_name.rstrip("/") + "/"
+    return sorted({n[len(prefix) :].split("/")[0] for n in names if n.startswith(prefix) and len(n) > len(prefix)})
 
 
 def main(argv: Sequence[str] | None = None) -> int:

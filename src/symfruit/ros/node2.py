@@ -43,7 +43,16 @@ from typing import Any
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import PARAMETERS, QOS_CHOICES, FrameProcessor, Fruit, LatestOnly, checked_parameters, stop_signals
+from .core import (
+    PARAMETERS,
+    QOS_CHOICES,
+    FrameProcessor,
+    Fruit,
+    LatestOnly,
+    checked_parameters,
+    stop_signals,
+    unknown_parameters,
+)
 from .node import BOX_RGBA, CENTRE_DIAMETER, CENTRE_RGBA, CLOUD_FIELDS, cloud_array
 from .sync import ApproximateSync
 
@@ -202,6 +211,7 @@ class Ros2Node:
             for name, (default, text) in PARAMETERS.items():  # dynamic typing: `-p slop:=1` is 1 s, not an error
                 self.node.declare_parameter(name, default, ParameterDescriptor(description=text, read_only=True,
                                                                                 dynamic_typing=True))  # fmt: skip
+            unknown_parameters(getattr(self.node, "_parameter_overrides", {}))  # `-p metod:=...`: rclpy drops it
             self.params = checked_parameters({n: self.node.get_parameter(n).value for n in PARAMETERS})
             p = self.params
             self.core = FrameProcessor(method=p["method"] or DEFAULT_METHOD, fruit=p["fruit"] or None,
