@@ -242,3 +242,33 @@ def test_a_varied_model_changes_its_artefact_alone():
     one, three = run(model, shot, cam), run(varied(model, {"rim_invalid_px": 3}), shot, cam)
     assert (three.depth == 0).sum() > (one.depth == 0).sum()
     assert np.array_equal(three.depth[three.depth > 0], one.depth[three.depth > 0])
+
+
+def test_lateral_jitter_is_in_the_registered_depth():
+    """``lateral_px`` moves each colour pixel's depth sample: the ball's outline becomes ragged by about the
+    jitter, its inside and the plane keep their depth, and the other draws are those of ``lateral_px = 0``."""
+    base = replace(SENSOR_MODELS["azure-kinect"], **QUIET)
+    cam = window(base)
+    shot = sphere_scene(cam, 0.6)
+    still = run(base, shot, cam, seed=3)
+    moved = run(replace(base, lateral_px=1.5), shot, cam, seed=3)
+    assert moved.jitter.any() and not still.jitter.any()
+    changed = still.depth != moved.depth
+    assert 0 < changed.sum() < 0.2 * changed.size
+    # Where it changed, the value is the depth of a depth pixel within a few colour pixels (the jitter's 4 sigma).
+    reach = int(np.ceil(4 * 1.5 + base.footprint))
+    near = np.zeros_like(changed)
+    padded = np.pad(still.depth, reach, mode="edge")
+    for dv in range(-reach, reach + 1):
+        for du in range(-reach, reach + 1):
+            shifted = padded[reach + dv : reach + dv + SIDE, reach + du : reach + du + SIDE]
+            near[changed] |= shifted[changed] == moved.depth[changed]
+    assert near[changed].all()
+    # A pixel's jitter decides its sample: pixels whose jitter stays within their own depth pixel keep their depth.
+    ratio = base.footprint
+    u = np.arange(SIDE)[None, :] + moved.jitter[..., 0]
+    v = np.arange(SIDE)[:, None] + moved.jitter[..., 1]
+    same_cell = (np.floor(u / ratio) == np.floor(np.arange(SIDE)[None, :] / ratio)) & (
+        np.floor(v / ratio) == np.floor(np.arange(SIDE)[:, None] / ratio)
+    )
+    assert not changed[same_cell].any()

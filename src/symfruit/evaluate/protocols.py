@@ -325,6 +325,8 @@ def _real_camera(spec: Spec, model: SensorModel) -> Instance:
                        amodal=alone.astype(np.int32))  # fmt: skip
     mask = np.asarray(out.labels) == 1
     rows, cols = np.nonzero(mask & (out.depth > 0))
+    # Pixel centres: the lateral jitter is in ``out.depth`` already (as in a camera's image; the runner extracts
+    # from it as ``detect`` does), unlike the heldback branch's noise, which leaves it to the de-projection.
     visible = cam.deproject(np.c_[cols, rows].astype(np.float64), out.depth[rows, cols].astype(np.float64))
     surface = posed.sample(TRUTH_POINTS, np.random.default_rng([spec.seed, 3000, spec.index]))
     truth = Box.from_points(posed.vertices if posed.points is None else posed.points)

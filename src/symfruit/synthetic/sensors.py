@@ -130,8 +130,9 @@ class SensorModel:
         range [HALMETSCHLAGER]: 0.3 % (judgement).
     lateral_px : float, colour pixels
         Standard deviation of the lateral jitter of each de-projected pixel (judgement, as the
-        project's existing models: 0.3 px). Returned as :attr:`SensorFrame.jitter`; the scenes and the camera
-        protocol do not apply it (their points come from the registered depth image): ``docs/stress39.md``.
+        project's existing models: 0.3 px). Applied in the registered depth: each colour pixel takes the depth
+        pixel under its jittered position (what a camera's depth image holds; the scenes write it and the camera
+        protocol extracts from it), returned as :attr:`SensorFrame.jitter`, not to be added again.
     edge_step : float, metres
         A depth pixel whose footprint spans more depth than this is *mixed* (judgement: 1.5 cm, above
         the depth range of a fruit's own slope inside one depth pixel at working distances).
@@ -386,7 +387,8 @@ class SensorFrame:
     ----------
     depth : (h, w) float32, metres; 0 where the camera returns no depth (registered to colour)
     labels : (h, w) int32; the annotators' masks (0 none, k fruit k), or None without input labels
-    jitter : (h, w, 2) float; lateral jitter (colour pixels) to add to ``(u, v)`` before de-projecting
+    jitter : (h, w, 2) float; the lateral jitter (colour pixels, ``(du, dv)``) already applied in ``depth``: each
+        pixel holds the depth under ``(u, v) + jitter`` (de-project pixel centres; adding it again doubles it)
     shift : (float, float), colour pixels; the registration offset ``(du, dv)`` of depth against colour
     """
 
@@ -493,17 +495,23 @@ def apply_sensor(
     valid &= out > 0
     out = np.where(valid, out, 0.0)
     # Register to colour: each colour pixel takes the depth pixel under it, shifted by the registration offset.
+    # Lateral jitter: each colour pixel's depth is that of the point a jittered ray meets, i.e. the depth pixel
+    # under its jittered position (drawn here, after the registration's angle, as before it was applied: the
+    # other draws, and so the frames at lateral_px = 0, are unchanged).
     angle = rng.uniform(0.0, 2.0 * np.pi)
     du, dv = model.registration_px * math.cos(angle), model.registration_px * math.sin(angle)
-    src_v = np.floor((np.arange(h) - dv) / ratio).astype(np.int64)
-    src_u = np.floor((np.arange(w) - du) / ratio).astype(np.int64)
-    inside = (src_v[:, None] >= 0) & (src_v[:, None] < hd) & (src_u[None, :] >= 0) & (src_u[None, :] < wd)
-    registered = out[np.ix_(np.clip(src_v, 0, hd - 1), np.clip(src_u, 0, wd - 1))] * inside
+    jitter = rng.normal(scale=model.lateral_px, size=(h, w, 2)) if model.lateral_px > 0 else np.zeros((h, w, 2))
+    src_v = np.floor((np.arange(h) - dv) / ratio).astype(np.int64)[:, None]
+    src_u = np.floor((np.arange(w) - du) / ratio).astype(np.int64)[None, :]
+    inside = (src_v >= 0) & (src_v < hd) & (src_u >= 0) & (src_u < wd)  # the jitter opens no holes at the border
+    if model.lateral_px > 0:
+        src_v = np.floor((np.arange(h)[:, None] - dv + jitter[..., 1]) / ratio).astype(np.int64)
+        src_u = np.floor((np.arange(w)[None, :] - du + jitter[..., 0]) / ratio).astype(np.int64)
+    registered = out[np.clip(src_v, 0, hd - 1), np.clip(src_u, 0, wd - 1)] * inside
     registered *= _in_view(model, camera)
     if model.colour_baseline > 0:
         registered[_shadow(registered, camera.fx * model.colour_baseline)] = 0.0
     registered = np.round(registered / 0.001) * 0.001  # millimetre depth units (all four cameras)
-    jitter = rng.normal(scale=model.lateral_px, size=(h, w, 2)) if model.lateral_px > 0 else np.zeros((h, w, 2))
     masks = None if labels is None else annotate(model, labels, rng, amodal=amodal)
     return SensorFrame(registered.astype(np.float32), masks, jitter, (du, dv))
 
