@@ -109,6 +109,33 @@ def test_coco_uses_the_first_image_and_ids_or_order(tmp_path):
 
 
 @pytest.mark.parametrize(
+    "change, error",
+    [({"id": 2**40}, r"annotation 1 has id 1099511627776; a fruit's id is a whole number 1 to 2147483647"),
+     ({"id": 1.5}, r"annotation 1 has id 1\.5"), ({"id": True}, r"annotation 1 has id True"),
+     ({"id": "7"}, r"annotation 1 has id '7'"),
+     ({"segmentation": []}, r"annotation 1 has no valid segmentation \(segmentation is an empty list\)")],
+)  # fmt: skip
+def test_a_frames_coco_id_that_cannot_be_a_label_or_an_empty_outline_is_refused(tmp_path, change, error):
+    """Before: the id replaced by the annotation's place (matched to another fruit's truth), the fruit without
+    an outline dropped, in silence."""
+    path = tmp_path / "masks.json"
+    path.write_text(json.dumps([{"id": 5, "segmentation": [[2, 2, 5, 2, 5, 5, 2, 5]], **change}]))
+    with pytest.raises(FileFormatError, match=error):
+        coco_masks(path, (10, 10))
+
+
+def test_a_frames_coco_image_of_another_size_is_refused(tmp_path):
+    """Polygons drawn for a 320x240 image on the frame's 640x480 one were misplaced, unsaid."""
+    path = tmp_path / "masks.json"
+    coco = {"images": [{"id": 1, "width": 32, "height": 24}], "annotations": [
+        {"id": 1, "image_id": 1, "segmentation": [[2, 2, 5, 2, 5, 5, 2, 5]]}]}  # fmt: skip
+    path.write_text(json.dumps(coco))
+    with pytest.raises(FileFormatError, match=r"masks\.json: its image is 32x24 but the frame's is 16x12"):
+        coco_masks(path, (12, 16))
+    assert coco_masks(path, (24, 32))[3, 3] == 1
+
+
+@pytest.mark.parametrize(
     "ids, message",
     [((7, 7), "annotations 1 and 2 would both be fruit 7"), ((None, 1), "annotations 1 and 2 would both be fruit 1"),
      ((2, None), "annotations 1 and 2 would both be fruit 2")],

@@ -81,6 +81,8 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
             return rle_decode(seg)
         if not isinstance(seg, list):
             raise TypeError(f"segmentation is a {type(seg).__name__}")
+        if not seg:  # no outline at all: the fruit would vanish from the labels unsaid (as one without the key)
+            raise ValueError("segmentation is an empty list")
         img = Image.new("L", (w, h), 0)
         draw = ImageDraw.Draw(img)
         for poly in seg:
@@ -132,10 +134,27 @@ def coco_masks(path: Path, shape: tuple[int, int]) -> np.ndarray:
     if len(anns) > MAX_INSTANCES_PER_IMAGE:
         raise FileFormatError(f"{path}: {len(anns)} annotations for one image; at most {MAX_INSTANCES_PER_IMAGE}")
     h, w = _check_shape(shape, str(path))
+    if images and ("height" in images[0] or "width" in images[0]):  # polygons drawn at another size: misplaced
+        try:
+            stated = (int(images[0]["height"]), int(images[0]["width"]))
+        except (KeyError, TypeError, ValueError, OverflowError):
+            raise FileFormatError(f"{path}: the image's height/width are not whole numbers") from None
+        if stated != (h, w):
+            raise FileFormatError(f"{path}: its image is {stated[1]}x{stated[0]} but the frame's is {w}x{h}; "
+                                  "annotate the frame's own colour image")  # fmt: skip
     idents: dict[int, int] = {}  # label -> the annotation drawn with it: two fruit drawn as one label are one fruit
     for k, ann in enumerate(anns, 1):
         ident = ann.get("id")
-        label = ident if isinstance(ident, int) and not isinstance(ident, bool) and 0 < ident < 2**31 else k
+        whole = isinstance(ident, int) and not isinstance(ident, bool)
+        if ident is not None and not (whole and ident < 2**31):
+            # an id is the fruit's label and its truth.json id: one that cannot be (1.5, true, "7", 2**40) was
+            # replaced by the annotation's place in silence, and matched to another fruit's truth; none, 0 or a
+            # negative one (an exporter's "unset") is numbered by its place, as before
+            raise FileFormatError(
+                f"{path}: annotation {k} has id {shown(ident)}; a fruit's id is a whole number "
+                f"1 to {2**31 - 1} (its mask label), or none (0, -1) to number it by its place"
+            )
+        label = ident if whole and ident > 0 else k
         if label in idents:
             raise FileFormatError(f"{path}: annotations {idents[label]} and {k} would both be fruit {label} (an id "
                                   "given twice, or an annotation without an id numbered by its place); each fruit "
