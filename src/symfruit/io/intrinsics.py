@@ -357,7 +357,7 @@ def _uint32(value: Any) -> bool:
     """Whether ``value`` is a whole number a ``uint32`` field holds (never ``range``'s linear search of a float)."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
         return False
-    return math.isfinite(value) and float(value).is_integer() and 0 <= value < 2**32
+    return bool(math.isfinite(value) and float(value).is_integer() and 0 <= value < 2**32)
 
 
 def check_binning_roi(binning_x: Any, binning_y: Any, roi: Any, camera: Camera, what: str) -> None:
