@@ -349,6 +349,18 @@ def test_bad_parameter_is_one_line_and_exit_2(ros2_python, tmp_path):
     assert "Traceback" not in res.stderr
 
 
+def test_a_parameter_the_node_does_not_have_is_one_line_and_exit_2(ros2_python, tmp_path):
+    """rclpy drops an override of an undeclared parameter: `-p metod:=paper` ran the default method, unsaid."""
+    from symfruit.ros.camera2 import domain_lease, isolated_env
+
+    with domain_lease() as domain:
+        cmd = [ros2_python, "-m", "symfruit", "ros2", "--ros-args", "-p", "metod:=paper", "-p", "use_sim_time:=false"]
+        res = subprocess.run(cmd, env=isolated_env(domain, tmp_path), capture_output=True, text=True, timeout=TIMEOUT)
+    assert res.returncode == 2, res.stderr
+    assert res.stderr.startswith("symfruit: error: parameter 'metod': no such parameter (did you mean 'method'?)")
+    assert "Traceback" not in res.stderr
+
+
 def test_sigint_ends_the_shared_node_cleanly(world):
     """Last in this module: SIGINT ends the shared node (its context and node destroyed, exit status 0) and it
     leaves nothing in /dev/shm."""
