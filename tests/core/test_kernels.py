@@ -2966,3 +2966,103 @@ def test_outline_and_ray_pixels_are_nonzeros(seed, full):
     for got, expected in zip(found, (rr, cc, rr - r0, cc - c0), strict=True):
         assert got.dtype == expected.dtype
         np.testing.assert_array_equal(got, expected)
+
+
+# --- stop 40, speedcand40
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 90), st.integers(20, 400), st.sampled_from(["none", "loose", "tight"]))
+def test_slice_costs_below_are_slice_costs_or_surely_above_the_least(seed, k, n, known):
+    """Every direction it finishes has :func:`slice_costs`'s cost to the bit; every one it leaves (``inf``) has a cost
+    above the least known before it (``best``, or one found here), so the least (first least) is the same pick; the
+    least and its ``keep``-th smallest distance come back. On a pear's near half (directions near the axis cost
+    little, others much more) and on noise (costs close together)."""
+    rng = np.random.default_rng(seed)
+    if seed % 2:
+        points = FRUITS["pear"](rng).sample(2 * n, rng) @ rotation(*rng.uniform(0.0, 360.0, 3)).T
+        q = points[points[:, 2] <= np.median(points[:, 2])]
+    else:
+        q = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+        q[: n // 3] = np.round(q[: n // 3], 3)  # ties in the slices and the selection
+    q = np.ascontiguousarray(q - q.mean(axis=0))
+    dirs = rng.normal(size=(k, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    every = _jit.slice_costs(q, dirs, 12)
+    best, thr = np.inf, np.nan
+    if known != "none":  # the least of other directions, with its keep-th smallest distance
+        other = rng.normal(size=(3, 3))
+        other /= np.linalg.norm(other, axis=1, keepdims=True)
+        if known == "tight":
+            other[0] = dirs[int(np.argmin(every))]  # the least itself: every other direction may be left
+        costs = _jit.slice_costs(q, other, 12)
+        j = int(np.argmin(costs))
+        _, best, thr = _jit.slice_costs_below(q, other[j : j + 1], 12, np.inf, np.nan)  # its keep-th distance too
+        assert best == costs[j]
+    got, least, at = _jit.slice_costs_below(q, dirs, 12, best, thr)
+    done = np.isfinite(got)
+    np.testing.assert_array_equal(got[done], every[done])
+    assert (every[~done] > min(best, every[done].min(initial=np.inf))).all()
+    assert least == min(best, every.min())
+    assert _jit._least(np.r_[best, got]) == _jit._least(np.r_[best, every])
+    if least < best:
+        assert at == at  # a threshold comes with the least found here
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(8, 300), st.integers(1, 60))
+def test_cone_grid_best_is_the_first_least_huber_cost(seed, n, k):
+    """The grid's pick, each row given up once its cost reaches the least so far, is the first least
+    :func:`huber_cost` of every row's :func:`cone_residuals` (rows with invalid ellipsoids, saturated logistics,
+    ties between equal rows among them)."""
+    visible, cone, axis, _, _ = _cone_view("apple", 1)
+    rng = np.random.default_rng(seed)
+    pts = visible[rng.choice(len(visible), min(n, len(visible)), replace=False)]
+    rays, z = np.ascontiguousarray(pts / pts[:, 2:3]), np.ascontiguousarray(pts[:, 2])
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    grid = np.c_[rng.normal(0.0, 0.01, (k, 2)), np.log(rng.uniform(0.2, 0.8, k)), rng.uniform(-10, 10, k)]
+    grid[rng.random(k) < 0.1, 3] = 60.0  # saturated: no front on any ray
+    grid[rng.random(k) < 0.1, :2] = 1.0  # a centre outside the cone: no ellipsoid
+    if k > 2:
+        grid[-1] = grid[int(rng.integers(k - 1))]  # a tie: the first is picked
+    huber = float(rng.choice([0.003, 0.02, 1.0]))
+    res = np.empty((k, len(rays)))
+    _jit.cone_residuals(grid, cone, axis, rays, ray_cone, z, res)
+    costs = np.array([_jit.huber_cost(row, huber) for row in res])
+    want = int(np.argmin(costs)) if np.isfinite(costs).any() else -1
+    assert _jit.cone_grid_best(grid, cone, axis, rays, ray_cone, z, huber) == want
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 1200), st.sampled_from(["normal", "flat", "one point", "offset"]))
+def test_scaled_cloud_is_the_twins_bit_for_bit(monkeypatch, seed, n, kind):
+    """The two algebraic fits' beginnings in one call: the mean, the scale (numpy's pairwise sum, 1 for a single
+    point), the scaled points and both designs, numpy's values to the bit (beyond 128 points the pairwise sum's
+    splits matter)."""
+    from symfruit.core.fits import scaled_cloud
+
+    rng = np.random.default_rng(seed)
+    points = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1, 3)
+    if kind == "flat":
+        points[:, 2] = 0.0
+    elif kind == "one point":
+        points[:] = points[0]
+    elif kind == "offset":
+        points += [0.1, -0.2, 0.6]
+    fast, twin = _both(monkeypatch, scaled_cloud, points)
+    assert fast.scale == twin.scale
+    for name in ("mean", "q", "sphere_design", "sphere_rhs", "ellipsoid_design"):
+        got, want = getattr(fast, name), getattr(twin, name)
+        assert got.shape == want.shape and got.flags.c_contiguous
+        np.testing.assert_array_equal(got, want)
+
+
+@pytest.mark.parametrize("kind,seed", [("strawberry", 0), ("apple", 1), ("pear", 2), ("lemon", 3)])
+def test_the_fits_given_their_scaled_cloud_are_the_fits(kind, seed):
+    """A sphere and an ellipsoid fitted with the sample's :func:`scaled_cloud` made by the caller are the fits without
+    it, to the bit."""
+    from symfruit.core.fits import fit_ellipsoid, scaled_cloud
+
+    fruit = FRUITS[kind](np.random.default_rng(seed))
+    visible, _ = rendered_view(fruit, [0.01 * seed, -0.01, 0.35], noise=0.001 * seed, seed=seed)
+    cloud = scaled_cloud(visible)
+    for fit in (fit_sphere, fit_ellipsoid):
+        for got, want in zip(fit(visible, scaled=cloud), fit(visible), strict=True):
+            np.testing.assert_array_equal(got, want)

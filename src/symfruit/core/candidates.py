@@ -39,6 +39,7 @@ from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
     RevolutionInside,
+    ScaledCloud,
     ellipsoid_half_extents,
     fit_cone_ellipsoid,
     fit_ellipsoid,
@@ -46,6 +47,7 @@ from .fits import (
     fit_sphere,
     outline_radii,
     revolution_box,
+    scaled_cloud,
 )
 from .kernels import compiled
 from .points import as_points, bounds
@@ -325,6 +327,14 @@ class _Fitting:
     revolution_points: int
     revolution_coarse: int
     axes: list[np.ndarray] = field(default_factory=list)
+    cloud: ScaledCloud | None = None
+
+    def scaled(self) -> ScaledCloud:
+        """:func:`~symfruit.core.fits.scaled_cloud` of the sample, made once for the sphere and the ellipsoid (issue
+        19, twentieth round)."""
+        if self.cloud is None:
+            self.cloud = scaled_cloud(self.sample)
+        return self.cloud
 
 
 @dataclass(frozen=True)
@@ -340,12 +350,12 @@ class _Shape:
 
 
 def _sphere(fit: _Fitting) -> Iterator[_Shape]:
-    c, r = fit_sphere(fit.sample)
+    c, r = fit_sphere(fit.sample, scaled=fit.scaled())
     yield _Shape("sphere", c - r, c + r, Quadric(c, np.eye(3) / r**2), c)
 
 
 def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
-    ce, shape = fit_ellipsoid(fit.sample)
+    ce, shape = fit_ellipsoid(fit.sample, scaled=fit.scaled())
     with np.errstate(invalid="ignore"):
         half = ellipsoid_half_extents(shape)
     fit.axes.append(np.linalg.eigh(shape)[1].T)

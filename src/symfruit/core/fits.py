@@ -30,6 +30,7 @@ __all__ = [
     "ConeFit",
     "Revolution",
     "RevolutionInside",
+    "ScaledCloud",
     "closed_profile",
     "cone_ellipsoid",
     "cone_thickness_bound",
@@ -44,12 +45,59 @@ __all__ = [
     "outline_radii",
     "revolution_box",
     "revolution_inside",
+    "scaled_cloud",
     "surface_noise",
 ]
 
 
+@dataclass(frozen=True)
+class ScaledCloud:
+    """A cloud centred on its mean and scaled to a unit RMS distance from it, with the designs of :func:`fit_sphere`'s
+    and :func:`fit_ellipsoid`'s algebraic fits (:func:`scaled_cloud`): both fits of one sample take it, made once.
+
+    Attributes
+    ----------
+    mean : (3,) float, metres
+    scale : float, metres
+        The RMS distance from the mean (1 where it is 0).
+    q : (n, 3) float
+        ``(points - mean) / scale``.
+    sphere_design, sphere_rhs : (n, 4), (n,) float
+        ``[2 q, 1]`` and ``|q|^2``.
+    ellipsoid_design : (n, 10) float
+        ``[x^2, y^2, z^2, 2yz, 2xz, 2xy, 2x, 2y, 2z, 1]`` of ``q``'s columns.
+    """
+
+    mean: np.ndarray
+    scale: float
+    q: np.ndarray
+    sphere_design: np.ndarray
+    sphere_rhs: np.ndarray
+    ellipsoid_design: np.ndarray
+
+
+def scaled_cloud(points: np.ndarray) -> ScaledCloud:
+    """:class:`ScaledCloud` of ``points`` (n, 3), n >= 1: by the compiled twin :func:`symfruit.core._jit.scaled_cloud`
+    where numba is installed (one call, each value these expressions' bit for bit; issue 19, twentieth round)."""
+    points = as_points(points, min_count=1)
+    if (jit := compiled()) is not None:
+        return ScaledCloud(*jit.scaled_cloud(points))
+    mean = column_means(points)  # points.mean(axis=0), ((q**2).sum(axis=1)): the same values in fewer calls
+    q = points - mean
+    scale = float(np.sqrt(squared_norms(q).mean())) or 1.0
+    q = q / scale
+    x, y, z = q.T
+    d = np.column_stack([x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)])
+    return ScaledCloud(mean, scale, q, np.column_stack([2.0 * q, np.ones(len(q))]), squared_norms(q), d)
+
+
 def fit_sphere(
-    points: np.ndarray, *, refine: bool = True, iterations: int = 10, tolerance: float = 1e-7
+    points: np.ndarray,
+    *,
+    refine: bool = True,
+    iterations: int = 10,
+    tolerance: float = 1e-7,
+    scaled: ScaledCloud | None = None,
 ) -> tuple[np.ndarray, float]:
     """Fit a sphere to points.
 
@@ -68,6 +116,8 @@ def fit_sphere(
         round: a tenth of a micrometre instead of 1e-10 of the points' spread, a few picometres, which most
         fits never reached: on the benchmark frames' fruit 5-10 steps, mean 7.6, instead of 8-10, mean 9.8;
         the same boxes to 0.001 mm on every evaluation instance of docs/ablation.md's checks).
+    scaled : ScaledCloud, optional
+        :func:`scaled_cloud` of ``points``, where the caller has made it (it is made here otherwise).
 
     Returns
     -------
@@ -80,12 +130,17 @@ def fit_sphere(
         When the points are (nearly) coplanar or collinear, so no unique sphere exists.
     """
     points = as_points(points, min_count=4)
-    mean = column_means(points)  # points.mean(axis=0), ((q**2).sum(axis=1)): the same values in fewer calls
-    q = points - mean
-    scale = float(np.sqrt(squared_norms(q).mean())) or 1.0
-    q = q / scale
-    a = np.column_stack([2.0 * q, np.ones(len(q))])
-    b = squared_norms(q)
+    if scaled is None and compiled() is not None:
+        scaled = scaled_cloud(points)
+    if scaled is not None:
+        mean, scale, q, a, b = scaled.mean, scaled.scale, scaled.q, scaled.sphere_design, scaled.sphere_rhs
+    else:  # scaled_cloud's numpy twin, the sphere's part alone
+        mean = column_means(points)
+        q = points - mean
+        scale = float(np.sqrt(squared_norms(q).mean())) or 1.0
+        q = q / scale
+        a = np.column_stack([2.0 * q, np.ones(len(q))])
+        b = squared_norms(q)
     sol, _, rank, sv = np.linalg.lstsq(a, b, rcond=None)
     if rank < 4 or sv[-1] < 1e-6 * sv[0]:
         raise InputError("cannot fit a sphere: the points are (nearly) coplanar or collinear")
@@ -115,7 +170,7 @@ def fit_sphere(
     return c * scale + mean, r * scale
 
 
-def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Fit an ellipsoid ``(x - c)^T A (x - c) = 1`` to points, in any orientation.
 
     The quadric's ten coefficients are found by the ellipsoid-specific least-squares fit of Li and
@@ -125,6 +180,8 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     Parameters
     ----------
     points : (n, 3) float, metres, n >= 10
+    scaled : ScaledCloud, optional
+        :func:`scaled_cloud` of ``points``, where the caller has made it (it is made here otherwise).
 
     Returns
     -------
@@ -137,10 +194,8 @@ def fit_ellipsoid(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         When no ellipsoid fits (degenerate or planar points).
     """
     points = as_points(points, min_count=10)
-    mean = column_means(points)
-    scale = float(np.sqrt(squared_norms(points - mean).mean())) or 1.0
-    x, y, z = ((points - mean) / scale).T
-    d = np.column_stack([x * x, y * y, z * z, 2 * y * z, 2 * x * z, 2 * x * y, 2 * x, 2 * y, 2 * z, np.ones_like(x)])
+    cloud = scaled_cloud(points) if scaled is None else scaled
+    mean, scale, d = cloud.mean, cloud.scale, cloud.ellipsoid_design
     s = d.T @ d
     s11, s12, s22 = s[:6, :6], s[:6, 6:], s[6:, 6:]
     try:
