@@ -3066,3 +3066,113 @@ def test_the_fits_given_their_scaled_cloud_are_the_fits(kind, seed):
     for fit in (fit_sphere, fit_ellipsoid):
         for got, want in zip(fit(visible, scaled=cloud), fit(visible), strict=True):
             np.testing.assert_array_equal(got, want)
+
+
+# --- stop 40, speedobs40
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.sampled_from([0.0, 0.5, 1.0, 3.0]),
+       st.booleans())  # fmt: skip
+def test_the_shared_pixels_give_the_same_rim_coverage_and_inside_distances(seed, h, w, fill_radius, given_map):
+    """``point_pixels`` is numpy's rounded projection converted as numpy converts it (NaN included), and
+    ``rim_coverage`` and ``_inside_px`` from those pixels are their values from the points (kernel and twin), on
+    rim_coverage's random regions and points (inside and outside the window, on rounding ties, one at NaN)."""
+    from symfruit.core.agreement import _inside_px
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+    from symfruit.core.raster import Silhouette, inner_distance, point_pixels
+    from symfruit.methods.evidence import rim_coverage
+
+    rng = np.random.default_rng(seed)
+    mask = _blobs(rng, h, w, rng.uniform(0.05, 0.6))
+    region = Silhouette(int(rng.integers(0, 500)), int(rng.integers(0, 400)), mask, fill_radius)
+    n = int(rng.integers(1, 2 * h * w + 2))
+    u = region.u0 + rng.integers(-3, w + 3, n) + rng.choice([0.0, 0.5, -0.5, 0.3], n)
+    v = region.v0 + rng.integers(-3, h + 3, n) + rng.choice([0.0, 0.5, -0.4], n)
+    z = rng.uniform(0.3, 0.6, n)
+    points = np.stack(((u - camera.cx) * z / camera.fx, (v - camera.cy) * z / camera.fy, z), axis=1)
+    points[0, 0] = np.nan
+    pixels = point_pixels(points, camera)
+    with np.errstate(invalid="ignore"):
+        uv = np.rint(camera.project(points))
+        want = uv[:, 0].astype(np.int64), uv[:, 1].astype(np.int64)
+    assert pixels is not None
+    for got, expected in zip(pixels, want, strict=True):
+        assert got.dtype == np.int64
+        np.testing.assert_array_equal(got, expected)
+    inner = inner_distance(mask) if given_map else None
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):
+        fast, twin = _both(mp, rim_coverage, points, region, camera, inner=inner, pixels=pixels)
+        assert fast == twin == rim_coverage(points, region, camera, inner=inner) and type(fast) is float
+        full = inner_distance(mask)
+        shared, own = _both(mp, _inside_px, points, region, camera, full, pixels)
+    assert np.array_equal(shared, own) and np.array_equal(shared, _inside_px(points, region, camera, full))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_a_silhouette_from_the_shared_pixels_is_the_same(seed, off_image):
+    """``silhouette`` given the points' pixels (and its compiled box and marks) is the one it makes from the points
+    alone, with the kernels and with the twins: sparse and dense clouds, some points off the image (the pixels are
+    then not used) or none."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import point_pixels, silhouette
+
+    rng = np.random.default_rng(seed)
+    cam = Camera(fx=300.0, fy=310.0, cx=80.5, cy=60.0, width=160, height=120)
+    n = int(rng.integers(1, 3000))
+    z = rng.uniform(0.3, 0.6, n)
+    spread = 90.0 if off_image else 40.0
+    u = cam.cx + rng.normal(0.0, spread / 3, n).clip(-spread, spread)
+    v = cam.cy + rng.normal(0.0, spread / 4, n).clip(-spread, spread)
+    points = np.stack(((u - cam.cx) * z / cam.fx, (v - cam.cy) * z / cam.fy, z), axis=1)
+    pixels = point_pixels(points, cam)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, silhouette, points, cam, pixels=pixels)
+        plain, _ = _both(mp, silhouette, points, cam)
+    for a in (twin, plain):
+        assert (fast.u0, fast.v0, fast.fill_radius) == (a.u0, a.v0, a.fill_radius)
+        assert fast.mask.dtype == a.mask.dtype == bool and np.array_equal(fast.mask, a.mask)
+
+
+@settings(max_examples=120, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5), st.floats(0.0, 0.9))
+def test_close_ragged_closes_and_counts_as_the_twins_steps(seed, radius, holes):
+    """The kernel's closing over the mask's box grown by ``radius + 1`` alone: the closed mask, the pixels it adds and
+    the outline's pixels are the twin's (the padded mask closed and its holes filled, ``mask & ~interior(mask)``),
+    whether or not the closing is kept, for masks touching the window's edges, empty, full or scattered."""
+    from symfruit.core.raster import _closed_mask, interior
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    rr, cc = np.mgrid[0:h, 0:w]
+    kind = rng.random()
+    if kind < 0.6:
+        mask = (rr - rng.uniform(-5, h + 5)) ** 2 + (cc - rng.uniform(-5, w + 5)) ** 2 <= rng.uniform(1, 40) ** 2
+        mask &= rng.random((h, w)) >= holes * rng.random((h, w))
+    elif kind < 0.7:
+        mask = np.ones((h, w), bool)
+    else:
+        mask = rng.random((h, w)) < holes
+    closed, added, outline = _jit.close_ragged(mask, radius)
+    padded = np.zeros((h + 2 * radius, w + 2 * radius), dtype=bool)
+    padded[radius:-radius, radius:-radius] = mask
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = _closed_mask(padded, radius)[radius:-radius, radius:-radius]
+    assert closed.dtype == bool and np.array_equal(closed, want)
+    assert added == int((want & ~mask).sum()) and outline == int((mask & ~interior(mask)).sum())
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400))
+def test_the_cloud_checks_without_the_finiteness_pass_are_the_twins(seed, n):
+    """``check_cloud`` skips its finiteness pass when the compiled spread's diagonal is finite: the same clean points
+    and dropped count as the twin's, with NaN and infinite coordinates (either sign) in some rows or none."""
+    from symfruit.core.points import check_cloud
+
+    rng = np.random.default_rng(seed)
+    points = rng.normal(0.0, 0.02, (n + 12, 3)) + [0.0, 0.0, 0.4]
+    for _ in range(int(rng.integers(0, 4))):
+        points[rng.integers(0, len(points)), rng.integers(0, 3)] = rng.choice([np.nan, np.inf, -np.inf])
+    with pytest.MonkeyPatch.context() as mp:
+        (fast, fast_dropped), (twin, twin_dropped) = _both(mp, check_cloud, points, min_points=10)
+    assert fast_dropped == twin_dropped and np.array_equal(fast, twin)

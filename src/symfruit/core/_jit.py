@@ -906,48 +906,9 @@ def rim_coverage(
     other pixel holds a point); with ``fill > 0`` a point holds the ``2 fill + 1`` square about its pixel (the
     twin's maximum filter: its reflected border repeats pixels already within the square, as the window's edge
     cut here). Counts of whole numbers and the twin's two divisions: its value to the bit (issue 19, sixteenth
-    round)."""
-    h, w = mask.shape
-    rim = np.zeros((h, w), np.bool_)
-    n_rim = n_rest = 0
-    for r in range(h):
-        for c in range(w):
-            if mask[r, c]:
-                if inner[r, c] <= width:
-                    rim[r, c] = True
-                    n_rim += 1
-                else:
-                    n_rest += 1
-    if n_rim == 0 or n_rest == 0:
-        return 1.0
-    hit = np.zeros((h, w), np.bool_)
-    big = 9.223372036854775808e18  # 2^63
-    least = np.int64(-9223372036854775808)
-    for i in range(points.shape[0]):
-        inv_z = 1.0 / points[i, 2]
-        u = np.rint(fx * points[i, 0] * inv_z + cx)
-        v = np.rint(fy * points[i, 1] * inv_z + cy)
-        col = (np.int64(u) if -big <= u < big else least) - np.int64(u0)
-        row = (np.int64(v) if -big <= v < big else least) - np.int64(v0)
-        if 0 <= col < w and 0 <= row < h:
-            hit[row, col] = True
-    if fill > 0:
-        grown = np.empty((h, w), np.bool_)
-        square_filter(hit, fill, False, grown)
-        hit = grown
-    hit_rim = hit_rest = 0
-    for r in range(h):
-        for c in range(w):
-            if hit[r, c] and mask[r, c]:
-                if rim[r, c]:
-                    hit_rim += 1
-                else:
-                    hit_rest += 1
-    interior = hit_rest / n_rest
-    if interior <= 0:
-        return 1.0
-    share = hit_rim / n_rim / interior
-    return share if share < 1.0 else 1.0
+    round). The points' pixels by :func:`point_pixels`, then :func:`rim_coverage_pixels`."""
+    col, row = point_pixels(points, fx, fy, cx, cy)
+    return rim_coverage_pixels(col, row, u0, v0, mask, inner, width, fill)
 
 
 @_njit
@@ -2118,33 +2079,50 @@ def cloud_spread(points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray
     """``(min (3,), max (3,), scatter (3, 3))`` of the rows of ``points`` (n, 3), ``n >= 1``: the columns' least and
     greatest values (exactly :func:`symfruit.core.points.bounds`'s) and the sums of the products of the rows'
     deviations from their mean (the twin's ``centred.T @ centred``, within rounding: these sums run row by row, the
-    mean's too), in two passes over the points without the centred copy."""
+    mean's too), in two passes over the points without the centred copy. The sums run in scalars, not in the arrays
+    they end in (issue 19, stop 40: the same additions in the same order, so the same values, without a store and a
+    load of each sum per point: 95 against 30 us on a dense view's 14,000 points)."""
     n = points.shape[0]
+    lo0, lo1, lo2 = points[0, 0], points[0, 1], points[0, 2]
+    hi0, hi1, hi2 = lo0, lo1, lo2
+    m0 = m1 = m2 = 0.0
+    for i in range(n):
+        x, y, z = points[i, 0], points[i, 1], points[i, 2]
+        m0 += x
+        m1 += y
+        m2 += z
+        if x < lo0:
+            lo0 = x
+        if x > hi0:
+            hi0 = x
+        if y < lo1:
+            lo1 = y
+        if y > hi1:
+            hi1 = y
+        if z < lo2:
+            lo2 = z
+        if z > hi2:
+            hi2 = z
+    m0 /= n
+    m1 /= n
+    m2 /= n
+    s00 = s01 = s02 = s11 = s12 = s22 = 0.0
+    for i in range(n):
+        a, b, c = points[i, 0] - m0, points[i, 1] - m1, points[i, 2] - m2
+        s00 += a * a
+        s01 += a * b
+        s02 += a * c
+        s11 += b * b
+        s12 += b * c
+        s22 += c * c
     lo = np.empty(3)
     hi = np.empty(3)
-    mean = np.zeros(3)
-    for j in range(3):
-        lo[j] = hi[j] = points[0, j]
-    for i in range(n):
-        for j in range(3):
-            x = points[i, j]
-            mean[j] += x
-            if x < lo[j]:
-                lo[j] = x
-            if x > hi[j]:
-                hi[j] = x
-    for j in range(3):
-        mean[j] /= n
-    s = np.zeros((3, 3))
-    for i in range(n):
-        a, b, c = points[i, 0] - mean[0], points[i, 1] - mean[1], points[i, 2] - mean[2]
-        s[0, 0] += a * a
-        s[0, 1] += a * b
-        s[0, 2] += a * c
-        s[1, 1] += b * b
-        s[1, 2] += b * c
-        s[2, 2] += c * c
-    s[1, 0], s[2, 0], s[2, 1] = s[0, 1], s[0, 2], s[1, 2]
+    lo[0], lo[1], lo[2] = lo0, lo1, lo2
+    hi[0], hi[1], hi[2] = hi0, hi1, hi2
+    s = np.empty((3, 3))
+    s[0, 0], s[0, 1], s[0, 2] = s00, s01, s02
+    s[1, 0], s[1, 1], s[1, 2] = s01, s11, s12
+    s[2, 0], s[2, 1], s[2, 2] = s02, s12, s22
     return lo, hi, s
 
 
@@ -2431,6 +2409,105 @@ def mirrored(points: np.ndarray, centre2: np.ndarray, out: np.ndarray) -> None:
         out[n + i, 2] = c - z
 
 
+# --- issue 19, stop 40 (speedobs40): the dense view's points projected once ---
+
+
+@_njit
+def point_pixels(points: np.ndarray, fx: float, fy: float, cx: float, cy: float) -> tuple[np.ndarray, np.ndarray]:
+    """``(col (n,), row (n,))`` int64: each point's (n, 3) pixel, :meth:`~symfruit.core.camera.Camera.project`'s
+    arithmetic rounded half to even and converted as numpy converts it (a coordinate that is NaN, infinite or past
+    2^63 becomes its smallest integer), as :func:`inside_px`, :func:`rim_coverage` and :func:`image_pixels` take
+    it: one projection of a view's points that they share (issue 19, stop 40)."""
+    n = points.shape[0]
+    col = np.empty(n, np.int64)
+    row = np.empty(n, np.int64)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        inv_z = 1.0 / points[i, 2]
+        u = np.rint(fx * points[i, 0] * inv_z + cx)
+        v = np.rint(fy * points[i, 1] * inv_z + cy)
+        col[i] = np.int64(u) if -big <= u < big else least
+        row[i] = np.int64(v) if -big <= v < big else least
+    return col, row
+
+
+@_njit
+def inside_px_of(col: np.ndarray, row: np.ndarray, u0: int, v0: int, inner: np.ndarray) -> np.ndarray:
+    """:func:`inside_px` of the points whose pixels :func:`point_pixels` gave: the distance map ``inner`` (h, w) at
+    each pixel less the window's corner ``u0``, ``v0`` (wrapping around as numpy's subtraction does), clipped to
+    the window: the same values."""
+    h, w = inner.shape
+    n = col.shape[0]
+    out = np.empty(n)
+    for i in range(n):
+        out[i] = inner[min(max(row[i] - np.int64(v0), 0), h - 1), min(max(col[i] - np.int64(u0), 0), w - 1)]
+    return out
+
+
+@_njit
+def rim_coverage_pixels(
+    col: np.ndarray, row: np.ndarray, u0: int, v0: int, mask: np.ndarray, inner: np.ndarray, width: float, fill: int
+) -> float:
+    """:func:`rim_coverage` of the points whose pixels :func:`point_pixels` gave: the points' pixels marked, then
+    one pass over the window counting the rim's and the rest's pixels and those of each holding a point (the
+    former made the rim's map and counted it before marking the points: the same whole numbers, so the same
+    value)."""
+    h, w = mask.shape
+    hit = np.zeros((h, w), np.bool_)
+    for i in range(col.shape[0]):
+        c = col[i] - np.int64(u0)
+        r = row[i] - np.int64(v0)
+        if 0 <= c < w and 0 <= r < h:
+            hit[r, c] = True
+    if fill > 0:
+        grown = np.empty((h, w), np.bool_)
+        square_filter(hit, fill, False, grown)
+        hit = grown
+    n_rim = n_rest = hit_rim = hit_rest = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                if inner[r, c] <= width:
+                    n_rim += 1
+                    hit_rim += hit[r, c]
+                else:
+                    n_rest += 1
+                    hit_rest += hit[r, c]
+    if n_rim == 0 or n_rest == 0:
+        return 1.0
+    interior = hit_rest / n_rest
+    if interior <= 0:
+        return 1.0
+    share = hit_rim / n_rim / interior
+    return share if share < 1.0 else 1.0
+
+
+@_njit
+def pixel_box(col: np.ndarray, row: np.ndarray) -> tuple[int, int, int, int]:
+    """``(c0, c1, r0, r1)``: the least and greatest of ``col`` (n,) and of ``row`` (n,) int64, ``n >= 1``, in one pass
+    (:func:`symfruit.core.raster.silhouette`'s four reductions: the same whole numbers)."""
+    c0 = c1 = col[0]
+    r0 = r1 = row[0]
+    for i in range(col.shape[0]):
+        c, r = col[i], row[i]
+        c0 = c if c < c0 else c0
+        c1 = c if c > c1 else c1
+        r0 = r if r < r0 else r0
+        r1 = r if r > r1 else r1
+    return c0, c1, r0, r1
+
+
+@_njit
+def mark_pixels(col: np.ndarray, row: np.ndarray, u0: int, v0: int, h: int, w: int) -> np.ndarray:
+    """(h, w) bool: the pixels ``(row - v0, col - u0)`` of a window at ``u0, v0`` marked (every one in the window:
+    :func:`symfruit.core.raster.silhouette`'s flat-index assignment)."""
+    hit = np.zeros((h, w), np.bool_)
+    for i in range(col.shape[0]):
+        hit[row[i] - v0, col[i] - u0] = True
+    return hit
+
+
 # --- issue 19, eighteenth round (stop 38): the completion ---
 
 
@@ -2463,33 +2540,60 @@ def close_ragged(mask: np.ndarray, radius: int) -> tuple[np.ndarray, int, int]:
     its holes filled over the closed mask's box grown by a pixel (:func:`filled`, as
     :func:`~symfruit.core.raster.fill_holes`), the padding cut off again; ``added`` the pixels it adds to ``mask``,
     ``outline`` the mask's outline pixels (``mask & ~interior(mask)``). The twin's steps, the same pixels, in one
-    call."""
+    call.
+
+    Since issue 19's stop 40 the closing runs over the mask's box grown by ``radius + 1`` pixels (within the padded
+    array) alone: the dilation reaches ``radius`` pixels beyond the box, so that part's outer ring is not dilated,
+    and a pixel whose square reaches beyond the part meets that ring and is not in the erosion, as in the whole
+    array; nothing beyond the part is dilated, closed or a hole (0.34 against 0.23 ms on a dense view's window)."""
     h, w = mask.shape
     hp, wp = h + 2 * radius, w + 2 * radius
-    padded = np.zeros((hp, wp), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            padded[r + radius, c + radius] = mask[r, c]
-    shut = np.empty((hp, wp), np.bool_)
-    close_square(padded, radius, shut)
-    full = shut.copy()
-    r0, r1, c0, c1 = _box(shut)
-    if r1 > 0:
-        r0, r1 = max(r0 - 1, 0), min(r1 + 1, hp)
-        c0, c1 = max(c0 - 1, 0), min(c1 + 1, wp)
-        filled(shut[r0:r1, c0:c1], full[r0:r1, c0:c1])
-    closed = full[radius : radius + h, radius : radius + w]
-    added = 0
+    closed = np.zeros((h, w), np.bool_)
     outline = 0
+    m0, m1, n0, n1 = h, 0, w, 0  # the mask's box (rows m0:m1, columns n0:n1)
     for r in range(h):
         for c in range(w):
             m = mask[r, c]
-            added += closed[r, c] and not m
-            if m and not (
-                r > 0 and r < h - 1 and c > 0 and c < w - 1
-                and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
-            ):  # fmt: skip
-                outline += 1
+            if m:
+                m0, m1 = min(m0, r), r + 1
+                n0, n1 = min(n0, c), max(n1, c + 1)
+                if not (
+                    r > 0 and r < h - 1 and c > 0 and c < w - 1
+                    and mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]
+                ):  # fmt: skip
+                    outline += 1
+    if m1 == 0:  # an empty mask: nothing closes
+        return closed, 0, 0
+    # the part, in the padded array's rows and columns
+    g = radius + 1
+    s0, s1 = max(m0 + radius - g, 0), min(m1 + radius + g, hp)
+    t0, t1 = max(n0 + radius - g, 0), min(n1 + radius + g, wp)
+    hs, ws = s1 - s0, t1 - t0
+    part = np.zeros((hs, ws), np.bool_)
+    for i in range(hs):
+        r = s0 + i - radius
+        if 0 <= r < h:
+            for j in range(ws):
+                c = t0 + j - radius
+                if 0 <= c < w:
+                    part[i, j] = mask[r, c]
+    shut = np.empty((hs, ws), np.bool_)
+    close_square(part, radius, shut)
+    full = shut.copy()
+    r0, r1, c0, c1 = _box(shut)
+    if r1 > 0:
+        r0, r1 = max(r0 - 1, 0), min(r1 + 1, hs)
+        c0, c1 = max(c0 - 1, 0), min(c1 + 1, ws)
+        filled(shut[r0:r1, c0:c1], full[r0:r1, c0:c1])
+    added = 0
+    for i in range(hs):
+        r = s0 + i - radius
+        if 0 <= r < h:
+            for j in range(ws):
+                c = t0 + j - radius
+                if 0 <= c < w and full[i, j]:
+                    closed[r, c] = True
+                    added += not mask[r, c]
     return closed, added, outline
 
 

@@ -217,6 +217,7 @@ def observe(
     contour_cone: float = 0.3,
     thin_px: int = 3,
     inner_reach: float | None = None,
+    dense_pixels: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> Observation:
     """Reduce a view to sample rays and silhouette-band rays.
 
@@ -256,6 +257,8 @@ def observe(
         How far inside the edge :attr:`Observation.inner` must be exact for its caller (e.g. a rim band); it is
         then exact up to the larger of that and what this function reads of it (the bands, ``edge``, the 8 px
         of the edge points' neighbourhoods) and +inf beyond, instead of the whole map (None).
+    dense_pixels : ((N,), (N,)) int, optional
+        The pixels of ``dense`` (:func:`~symfruit.core.raster.point_pixels`), when known: not projected again.
     """
     points = as_points(points, min_count=3)
     sample = points[:: max(1, len(points) // n_rays)]
@@ -269,7 +272,7 @@ def observe(
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
-    edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner)
+    edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
     if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about one point per pixel: neighbours from the image grid
         edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
     else:
@@ -474,10 +477,15 @@ def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
     return np.stack((cols[::step] + region.u0, rows[::step] + region.v0), axis=1).astype(np.float64)
 
 
-def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray) -> np.ndarray:
+def _inside_px(points: np.ndarray, region: Silhouette, camera: Camera, inner: np.ndarray,
+               pixels: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:  # fmt: skip
     """(n,) float: how far inside the region's edge each point's pixel lies (``inner``: its distance map); by the
-    compiled twin :func:`symfruit.core._jit.inside_px` where numba is installed (the same values)."""
-    if (jit := compiled()) is not None:
+    compiled twin :func:`symfruit.core._jit.inside_px` where numba is installed (the same values), from the points'
+    pixels (:func:`~symfruit.core.raster.point_pixels`) where they are given (:func:`symfruit.core._jit.inside_px_of`,
+    the same values without projecting the points again)."""
+    if (jit := compiled()) is not None and pixels is not None and len(pixels[0]) == len(points):
+        return jit.inside_px_of(pixels[0], pixels[1], region.u0, region.v0, inner)
+    if jit is not None:
         return jit.inside_px(points, camera.fx, camera.fy, camera.cx, camera.cy, region.u0, region.v0, inner)
     uv = camera.project(points)
     col = np.clip(np.rint(uv[:, 0]).astype(np.intp) - region.u0, 0, inner.shape[1] - 1)

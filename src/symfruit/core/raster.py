@@ -35,6 +35,7 @@ __all__ = [
     "nearest_index",
     "outline_cone",
     "outline_cracks",
+    "point_pixels",
     "principal_widths",
     "rasterise",
     "silhouette",
@@ -164,7 +165,24 @@ class Silhouette:
     _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
 
 
-def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius: float | None = None) -> Silhouette:
+def point_pixels(points: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray] | None:
+    """``(col (n,), row (n,))`` int64: the pixel of each of ``points`` (n, 3) float64, C-ordered (as
+    :func:`~symfruit.core.points.as_points` gives them), :meth:`~symfruit.core.camera.Camera.project`'s coordinates
+    rounded half to even, by the compiled kernel :func:`symfruit.core._jit.point_pixels`: one projection of a view's
+    points that :func:`silhouette`, :func:`symfruit.core.agreement.observe` and
+    :func:`symfruit.methods.evidence.rim_coverage` share (each projected the points itself before; issue 19, stop
+    40). None where numba is not installed (or the points are not such an array): each of them projects its own."""
+    if (points.ndim == 2 and points.shape[1] == 3 and points.dtype == np.float64 and points.flags.c_contiguous
+            and len(points) and (jit := compiled()) is not None):  # fmt: skip
+        col, row = jit.point_pixels(points, float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy))
+        return col, row
+    return None
+
+
+def silhouette(
+    points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius: float | None = None,
+    pixels: tuple[np.ndarray, np.ndarray] | None = None,
+) -> Silhouette:  # fmt: skip
     """The seen region of one fruit: every point's pixel, gaps between neighbouring points closed, holes
     filled, in a window ``pad`` pixels wider than the region on every side (clipped to the image).
 
@@ -177,21 +195,38 @@ def silhouette(points: np.ndarray, camera: Camera, *, pad: int = 8, fill_radius:
     fill_radius : float, pixels, optional
         Default: as :func:`rasterise` (``0.7 sqrt(area / n)``) for a sparse cloud, and 0 (every pixel as
         it is) once there is a point for at least every second pixel of the region (a depth camera).
+    pixels : ((n,), (n,)) int, optional
+        The points' pixels (:func:`point_pixels`), when known: used where every one lies in the image (the same
+        pixels as projecting the points again).
 
     Raises
     ------
     InputError
         When no point projects into the image.
     """
-    col, row, _ = _pixels(as_points(points, min_count=1), camera)
-    box = int(col.min()), int(col.max()), int(row.min()), int(row.max())  # once (np.ptp and _window's own before)
+    box: tuple[int, int, int, int] | None = None
+    jit = compiled()
+    if pixels is not None and jit is not None and len(pixels[0]) == len(points) and len(pixels[0]):
+        c0, c1, r0, r1 = jit.pixel_box(pixels[0], pixels[1])
+        if c0 >= 0 and r0 >= 0 and c1 < camera.width and r1 < camera.height:  # all in the image: _pixels' own
+            (col, row), box = pixels, (int(c0), int(c1), int(r0), int(r1))
+    if box is None:
+        col, row, _ = _pixels(as_points(points, min_count=1), camera)
+        if jit is not None:  # the four reductions in one compiled pass (the same whole numbers)
+            b = jit.pixel_box(col, row)
+            box = (int(b[0]), int(b[1]), int(b[2]), int(b[3]))
+        else:
+            box = int(col.min()), int(col.max()), int(row.min()), int(row.max())  # once (np.ptp and _window's own)
     if fill_radius is None:
         area = np.pi / 4.0 * (box[1] - box[0] + 1) * (box[3] - box[2] + 1)  # _default_fill's ellipse
         fill_radius = 0.7 * float(np.sqrt(area / len(col))) if len(col) < 0.5 * area else 0.0
     half = int(np.ceil(fill_radius))
     u0, v0, h, w = _window(col, row, camera, pad + half + 2, box)
-    hit = np.zeros((h, w), dtype=bool)
-    hit.ravel()[(row - v0) * w + (col - u0)] = True  # by flat index: twice as fast as two index arrays
+    if jit is not None:  # the marks by the compiled kernel (the same pixels)
+        hit = jit.mark_pixels(col, row, u0, v0, h, w)
+    else:
+        hit = np.zeros((h, w), dtype=bool)
+        hit.ravel()[(row - v0) * w + (col - u0)] = True  # by flat index: twice as fast as two index arrays
     return Silhouette(u0, v0, _closed_mask(hit, half), float(fill_radius))
 
 

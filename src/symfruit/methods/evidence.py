@@ -59,7 +59,7 @@ from ..core.front import apex_depth
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import bounds, row_norms, subsample
-from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, silhouette
+from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, point_pixels, silhouette
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -378,7 +378,8 @@ def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
 
 
 def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15,
-                 inner: np.ndarray | None = None, inner_reach: float = np.inf) -> float:  # fmt: skip
+                 inner: np.ndarray | None = None, inner_reach: float = np.inf,
+                 pixels: tuple[np.ndarray, np.ndarray] | None = None) -> float:  # fmt: skip
     """How much of the seen region's rim holds seen points, relative to its interior, in [0, 1].
 
     The rim is the region's pixels within ``band`` equivalent radii (at least 2 px) of its edge; the share of
@@ -389,7 +390,8 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     pixels: the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the back face
     must then be extrapolated from the front's curvature alone. ``inner``: the region's distance map when known
     (:attr:`~symfruit.core.agreement.Observation.inner`), exact up to ``inner_reach`` pixels (it is made again
-    when that is short of the rim's width).
+    when that is short of the rim's width). ``pixels``: the points' pixels when known
+    (:func:`~symfruit.core.raster.point_pixels`; not projected again).
     """
     mask = region.mask
     width = rim_width(mask, band)
@@ -397,6 +399,9 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
         inner = inner_distance(mask)
     if (jit := compiled()) is not None:  # the compiled twin of what follows (its value to the bit)
         fill = int(np.ceil(region.fill_radius)) if region.fill_radius > 0 else 0
+        if pixels is not None and len(pixels[0]) == len(points):
+            return float(jit.rim_coverage_pixels(pixels[0], pixels[1], int(region.u0), int(region.v0), mask, inner,
+                                                 float(width), fill))  # fmt: skip
         return float(jit.rim_coverage(np.ascontiguousarray(points, dtype=np.float64), camera.fx, camera.fy, camera.cx,
                                       camera.cy, int(region.u0), int(region.v0), mask, inner, float(width),
                                       fill))  # fmt: skip
@@ -488,7 +493,8 @@ def evidence(
     """Candidates weighed by how well they explain the view; weighted-median box; confidence."""
     s = settings
     sample = subsample(points, s.fit_points)
-    region = close_ragged(silhouette(points, camera), radius=s.ragged_close_px, ragged=s.ragged_at)
+    pixels = point_pixels(points, camera)  # the points' pixels, projected once (None without numba)
+    region = close_ragged(silhouette(points, camera, pixels=pixels), radius=s.ragged_close_px, ragged=s.ragged_at)
     # about a point per pixel of the points' own region: a depth camera's view (the fruit's mask, joined below,
     # also holds the pixels a time-of-flight camera returns no depth for: its rim, a leaf's mixed edge)
     dense = len(points) >= 0.5 * np.count_nonzero(region.mask)
@@ -496,7 +502,7 @@ def evidence(
         region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
-                  thin_px=s.thin_px, inner_reach=rim_width(region.mask))  # fmt: skip
+                  thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
     apex, _ = apex_depth(sample)
     lo, hi = bounds(points)  # one compiled pass where numba is (the columns' least and greatest values)
     front = max(float(lo[2]), apex)
@@ -528,7 +534,7 @@ def evidence(
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
-    rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach)
+    rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
     seen_back = float(hi[2])
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=across)  # fmt: skip
