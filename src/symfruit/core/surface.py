@@ -23,6 +23,7 @@ numbers out.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import threading
 from collections.abc import Callable
@@ -636,12 +637,25 @@ class _Outline:
     _ranks: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+    #: :meth:`_points` per pad
+    _points_at: dict[int, tuple[int, np.ndarray]] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    @property
+    @functools.cached_property
     def axes(self) -> tuple[bool, bool]:
         """``(v, u)``: whether the outline tells a shift down the image (``dv``: its top and its bottom side free)
-        and across it (``du``: its left and its right side free)."""
+        and across it (``du``: its left and its right side free). Worked out once (the search asks for every
+        cost)."""
         return (True, True) if self.sides is None else _told_axes(self.sides)
+
+    def _points(self, pad: int) -> tuple[int, np.ndarray]:
+        """The width of the maps padded by ``pad`` and each outline point's flat index in them (n,), made once per
+        ``pad`` (the compiled costs move them back by each shift themselves)."""
+        found = self._points_at.get(pad)
+        if found is None:
+            width = self.inside.shape[1] + 2 * pad
+            found = (width, (self.rows + pad) * width + (self.cols + pad))
+            self._points_at[pad] = found
+        return found
 
     def _at(self, shifts: np.ndarray, reach: int, pad: int = 0) -> tuple[np.ndarray, int]:
         """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad (at
@@ -704,8 +718,7 @@ class _Outline:
         if not exact and (jit := compiled()) is not None:  # the compiled twin of the fast costs, all rows at once
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
             if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:  # a row's keys: < 2**16 apart
-                width = self.inside.shape[1] + 2 * pad
-                at = (self.rows + pad) * width + (self.cols + pad)
+                width, at = self._points(pad)
                 keep = max(1, int(trim * len(self.rows)))
                 return jit.outline_costs(*self.ranks(pad, reach), at, shifts, width, keep, self.band)
         rows = max(1, _BLOCK // max(1, len(self.rows)))
@@ -724,8 +737,7 @@ class _Outline:
         if exact and len(self.rows) and (jit := compiled()) is not None:
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)), pad)
             if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:
-                width = self.inside.shape[1] + 2 * pad
-                at = (self.rows + pad) * width + (self.cols + pad)
+                width, at = self._points(pad)
                 dev = jit.outline_deviations(*self.ranks(pad, reach), at, shifts, width, self.band)
                 keep = max(1, int(trim * dev.shape[1]))
                 return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
@@ -844,7 +856,14 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points)."""
     grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
-    inner = inner_distance(mask)
+    jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
+    found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
+    inside: np.ndarray | None = None
+    if jit is not None:  # both distance maps, the keys and their ranks in one call (issue 19, twentieth round)
+        inner, inside = np.empty(mask.shape), np.empty(mask.shape)
+        found = jit.outline_maps(mask, int(reach), int(reach), inner, inside)
+    else:
+        inner = inner_distance(mask)
     # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
     # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
     # (0, 17) px to (18, 0) and (-15, 15) (docs/ablation.md, "A fall of whole depth units")
@@ -863,8 +882,13 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
-    inside = inner - distance_transform(~mask)
-    return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)), sides)
+    if inside is None:
+        inside = inner - distance_transform(~mask)
+    outline = _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)), sides)
+    if found is not None and found[0]:  # the keys and ranks of the costs' pad (the search's shifts are within reach)
+        outline._padded[("keys", int(reach), int(reach))] = found[1]
+        outline._ranks[(int(reach), int(reach))] = (found[2], found[3])
+    return outline
 
 
 def _rim(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -1191,6 +1215,15 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     # generator; numpy promises its streams only within one build, so no compiled copy of its sampler: stop 38)
     rng = _seeded()
     picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
+    if jit is not None:  # the compiled twins of what follows (issue 19, twentieth round: the same centres and pixels)
+        fc = jit.trim_summary(f_fruit, picks[0], _spread(len(picks[0]), centres), iterations)
+        bc = jit.trim_summary(f_ring, picks[1], _spread(len(picks[1]), centres), iterations)
+        n_fruit_ok, n_ring_ok = jit.trim_separation(f_fruit, f_ring, fc, bc)
+        if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
+            return None
+        keep = np.empty(mask.shape, bool)
+        jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
+        return fill_holes(_connected(keep, fruit))
     fc, bc = summary(f_fruit, picks[0]), summary(f_ring, picks[1])
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
@@ -1201,6 +1234,18 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _spread(n: int, k: int) -> np.ndarray:
+    """(k,) int64: ``np.linspace(0, n - 1, k).astype(int)`` (``n >= 1``), :func:`_colour_trim`'s starting centres, in
+    Python floats as numpy computes them (``i * ((n - 1) / (k - 1))``, the last ``n - 1``), without its call (some
+    10 us)."""
+    if k < 2:
+        return np.zeros(k, np.int64)
+    step = float(n - 1) / (k - 1)
+    at = [int(i * step) if step != 0 else 0 for i in range(k)]
+    at[-1] = n - 1
+    return np.array(at, np.int64)
 
 
 def _seeded() -> np.random.Generator:
