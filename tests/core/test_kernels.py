@@ -3070,3 +3070,33 @@ def test_colour_trims_summary_separation_and_band_are_the_twins_to_the_bit(seed,
         out = np.empty(mask.shape, bool)
         _jit.trim_band(color, mask, band, fc, bc, margin, out)
         assert np.array_equal(out, keep)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_trims_regions_with_their_features_and_one_seeds_piece_are_the_twins(seed):
+    """``trim_features``: ``trim_regions``' fruit and band and ``colour_features`` of its fruit and ring, bit for bit;
+    ``connected_at``: ``connected`` with a seed image of that pixel alone."""
+    from symfruit.core.raster import inner_distance
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    mask = _blob_mask(rng, h, w)
+    color = rng.integers(0, 256, (h, w + 3, 3)).astype(np.uint8)[:, 1 : w + 1]  # a window of a wider image
+    inner = inner_distance(mask)
+    band_px = float(rng.uniform(0.5, 8.0))
+    fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
+    counts = _jit.trim_regions(inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0, fruit, ring, band)
+    got_fruit, got_band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    f_fruit, f_ring, n_band = _jit.trim_features(color, inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0,
+                                                 got_fruit, got_band)  # fmt: skip
+    assert np.array_equal(got_fruit, fruit) and np.array_equal(got_band, band) and n_band == counts[2]
+    assert np.array_equal(f_fruit, _jit.colour_features(color, fruit)) and len(f_fruit) == counts[0]
+    assert np.array_equal(f_ring, _jit.colour_features(color, ring)) and len(f_ring) == counts[1]
+    r, c = (int(x) for x in np.argwhere(mask)[int(rng.integers(0, mask.sum()))])
+    seeds = np.zeros(mask.shape, bool)
+    seeds[r, c] = True
+    want, got = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    _jit.connected(mask, seeds, want)
+    _jit.connected_at(mask, r, c, got)
+    assert np.array_equal(got, want)

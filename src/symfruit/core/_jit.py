@@ -3697,6 +3697,62 @@ def outline_maps(
 
 
 @_njit
+def connected_at(image: np.ndarray, r: int, c: int, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the piece of ``image`` (h, w) bool (4-connected) holding its pixel ``(r, c)`` (which must
+    be ``image``'s): :func:`connected` with that pixel alone for seed, without a seed image and its scan (the same
+    pixels)."""
+    h, w = image.shape
+    for i in range(h):
+        for j in range(w):
+            out[i, j] = False
+    out[r, c] = True
+    stack = np.empty(h * w, np.int64)
+    stack[0] = r * w + c
+    _flood(image, out, stack, 1)
+
+
+@_njit
+def trim_features(
+    color: np.ndarray, inner: np.ndarray, mask: np.ndarray, band_px: float, deep: float, ring_px: float,
+    fruit: np.ndarray, band: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, int]:  # fmt: skip
+    """:func:`trim_regions` (the fruit and band written into ``fruit`` and ``band`` (h, w) bool, the ring not kept)
+    and :func:`colour_features` of the fruit's and the ring's pixels of ``color`` (h, w, 3) uint8 in one call: the
+    features (n, 3) and (m, 3) in raster order, and how many pixels the band holds (the same pixels and values)."""
+    h, w = mask.shape
+    near = np.empty((h, w))
+    near_distance(mask, ring_px, True, near)
+    n_fruit = n_ring = n_band = 0
+    for r in range(h):
+        for c in range(w):
+            d = inner[r, c]
+            f = d > band_px and d <= deep
+            b = mask[r, c] and d <= band_px
+            fruit[r, c], band[r, c] = f, b
+            n_fruit += f
+            n_ring += (not mask[r, c]) and near[r, c] <= ring_px
+            n_band += b
+    f_fruit, f_ring = np.empty((n_fruit, 3)), np.empty((n_ring, 3))
+    i = j = 0
+    for r in range(h):
+        for c in range(w):
+            ring = (not mask[r, c]) and near[r, c] <= ring_px
+            if fruit[r, c] or ring:
+                red, green, blue = float(color[r, c, 0]), float(color[r, c, 1]), float(color[r, c, 2])
+                total = red + green + blue + 1.0
+                out = f_fruit if fruit[r, c] else f_ring
+                k = i if fruit[r, c] else j
+                out[k, 0] = red / total
+                out[k, 1] = green / total
+                out[k, 2] = 0.25 * total / (3 * 255.0)
+                if fruit[r, c]:
+                    i += 1
+                else:
+                    j += 1
+    return f_fruit, f_ring, n_band
+
+
+@_njit
 def trim_summary(x: np.ndarray, pick: np.ndarray, start: np.ndarray, iterations: int) -> np.ndarray:
     """:func:`symfruit.core.surface._colour_trim`'s summary of the rows ``pick`` (m,) of ``x`` (n, 3): :func:`kmeans`
     of ``x[pick]`` from its rows ``start`` (k,), gathered here instead of by numpy (the same rows, so the same

@@ -28,7 +28,7 @@ import importlib
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from scipy import ndimage
@@ -1189,7 +1189,11 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
-    if (jit := compiled()) is not None:  # the three regions and their sizes in one pass (the same pixels)
+    color = np.asarray(color)
+    jit = compiled()
+    if jit is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return _colour_trim_compiled(jit, color, mask, inner, band_px, centres, iterations, min_accuracy, margin)
+    if jit is not None:  # the three regions and their sizes in one pass (the same pixels)
         fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
         n_fruit, n_ring, n_band = jit.trim_regions(inner, mask, float(band_px), 3.0 * band_px + 1,
                                                    float(band_px + 1), fruit, ring, band)  # fmt: skip
@@ -1200,7 +1204,6 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
         n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
     if n_fruit < 20 or n_ring < 20 or not n_band:
         return None
-    color = np.asarray(color)
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
     jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
     feature = _colour_features if jit is None else jit.colour_features
@@ -1215,15 +1218,6 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     # generator; numpy promises its streams only within one build, so no compiled copy of its sampler: stop 38)
     rng = _seeded()
     picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
-    if jit is not None:  # the compiled twins of what follows (issue 19, twentieth round: the same centres and pixels)
-        fc = jit.trim_summary(f_fruit, picks[0], _spread(len(picks[0]), centres), iterations)
-        bc = jit.trim_summary(f_ring, picks[1], _spread(len(picks[1]), centres), iterations)
-        n_fruit_ok, n_ring_ok = jit.trim_separation(f_fruit, f_ring, fc, bc)
-        if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
-            return None
-        keep = np.empty(mask.shape, bool)
-        jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
-        return fill_holes(_connected(keep, fruit))
     fc, bc = summary(f_fruit, picks[0]), summary(f_ring, picks[1])
 
     def is_fruit(x: np.ndarray, margin: float = 1.0) -> np.ndarray:
@@ -1234,6 +1228,32 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px: float,
+                          centres: int, iterations: int, min_accuracy: float,
+                          margin: float) -> np.ndarray | None:  # fmt: skip
+    """:func:`_colour_trim` of a uint8 colour image by its compiled twins (issue 19, twentieth round): the regions and
+    their features in one call (:func:`symfruit.core._jit.trim_features`), each summary's rows gathered and its
+    k-means in one (``trim_summary``), the two accuracies' counts (``trim_separation``) and the band's test
+    (``trim_band``) in one each; the samples drawn by numpy as in the twin. The same regions, features, centres,
+    tests and pixels, bit for bit."""
+    fruit, band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    f_fruit, f_ring, n_band = jit.trim_features(color, inner, mask, float(band_px), 3.0 * band_px + 1,
+                                                float(band_px + 1), fruit, band)  # fmt: skip
+    if len(f_fruit) < 20 or len(f_ring) < 20 or not n_band:
+        return None
+    rng = _seeded()  # the twin's samples: the same generator, the same draws
+    picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
+    fc = jit.trim_summary(f_fruit, picks[0], _spread(len(picks[0]), centres), iterations)
+    bc = jit.trim_summary(f_ring, picks[1], _spread(len(picks[1]), centres), iterations)
+    n_fruit_ok, n_ring_ok = jit.trim_separation(f_fruit, f_ring, fc, bc)
+    # the twin's accuracies are the booleans' means: their counts over their rows
+    if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
+        return None
+    keep = np.empty(mask.shape, bool)
+    jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
+    return fill_holes(_connected(keep, fruit))
 
 
 def _spread(n: int, k: int) -> np.ndarray:
@@ -1275,11 +1295,11 @@ def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.nda
     pixels)."""
     image = np.asarray(image, dtype=bool)
     if (jit := compiled()) is not None and (not isinstance(seeds, tuple) or image[seeds]):
-        if isinstance(seeds, tuple):
-            at, seeds = seeds, np.zeros(image.shape, bool)
-            seeds[at] = True
         out = np.empty(image.shape, bool)
-        jit.connected(image, seeds, out)
+        if isinstance(seeds, tuple):  # one pixel: its flood alone (issue 19, twentieth round: the same pixels)
+            jit.connected_at(image, int(seeds[0]) % image.shape[0], int(seeds[1]) % image.shape[1], out)
+        else:
+            jit.connected(image, seeds, out)
         return out
     labels, n = ndimage.label(image)
     if isinstance(seeds, tuple):
