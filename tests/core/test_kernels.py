@@ -3176,3 +3176,137 @@ def test_the_cloud_checks_without_the_finiteness_pass_are_the_twins(seed, n):
     with pytest.MonkeyPatch.context() as mp:
         (fast, fast_dropped), (twin, twin_dropped) = _both(mp, check_cloud, points, min_points=10)
     assert fast_dropped == twin_dropped and np.array_equal(fast, twin)
+
+
+# --- stop 40, speedreg40
+
+
+def _blob_mask(rng: np.random.Generator, h: int, w: int) -> np.ndarray:
+    """A mask of both kinds of pixel: a disc, speckle, a whole row or a lone hole (rows and windows that are all mask
+    or all background, holes in a row spanning the window)."""
+    kind = int(rng.integers(0, 4))
+    if kind == 0:
+        yy, xx = np.mgrid[:h, :w]
+        mask = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 < rng.uniform(1, 40) ** 2
+    elif kind == 1:
+        mask = rng.random((h, w)) < rng.uniform(0.05, 0.95)
+    elif kind == 2:
+        mask = np.zeros((h, w), bool)
+        mask[int(rng.integers(0, h)), :] = True
+    else:
+        mask = np.ones((h, w), bool)
+        mask[int(rng.integers(0, h)), int(rng.integers(0, w))] = False
+    if mask.all() or not mask.any():
+        mask[0, 0] = not mask[0, 0]
+    return mask
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 25), st.booleans())
+def test_the_outlines_maps_keys_and_ranks_are_the_twins_to_the_bit(seed, reach, wide):
+    """``outline_maps`` on masks of every shape (wide windows: keys beyond 16 bits, no keys then): the mask's distance
+    map (``inner_distance``), the signed map (``inner - distance_transform(~mask)``), and the padded keys, places and
+    values of ``_Outline.keys`` and ``_Outline.ranks``, the same arrays and dtypes bit for bit."""
+    from symfruit.core.raster import distance_transform, inner_distance
+    from symfruit.core.surface import _Outline
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 200 if wide else 60, 2))
+    mask = _blob_mask(rng, h, w)
+    inner, inside = np.empty(mask.shape), np.empty(mask.shape)
+    pad = reach + int(rng.integers(0, 3))
+    ok, keys, ranks, values = _jit.outline_maps(mask, pad, reach, inner, inside)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_inner = inner_distance(mask)
+        want_inside = want_inner - distance_transform(~mask)
+        twin = _Outline(np.zeros(1, np.int64), np.zeros(1, np.int64), want_inside, 1.0)
+        want_keys = twin.keys(pad, reach)
+        assert np.array_equal(inner, want_inner) and np.array_equal(inside, want_inside)
+        assert want_keys is not None
+        assert ok == (want_keys.dtype == np.int16)
+        if ok:
+            want_ranks, want_values = twin.ranks(pad, reach)
+            assert keys.dtype == want_keys.dtype and np.array_equal(keys, want_keys)
+            assert ranks.dtype == want_ranks.dtype and np.array_equal(ranks, want_ranks)
+            assert np.array_equal(values, want_values)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_outlines_keys_and_ranks_made_with_its_maps_are_its_own(monkeypatch, seed):
+    """The keys and ranks ``_outline`` keeps from its maps' kernel are those ``_Outline.keys`` and ``ranks`` make from
+    its signed map, and its costs (fast and exact) the same numbers."""
+    from symfruit.core.surface import _Outline, _outline
+
+    depth, mask, _ = _ball_frame(seed)
+    outline = _outline(depth, mask, 600.0, 20)
+    assert outline is not None and ("keys", 20, 20) in outline._padded and (20, 20) in outline._ranks
+    again = _Outline(outline.rows, outline.cols, outline.inside, outline.band, outline.sides)
+    assert np.array_equal(outline.keys(20, 20), again.keys(20, 20))
+    for got, want in zip(outline.ranks(20, 20), again.ranks(20, 20), strict=True):
+        assert got.dtype == want.dtype and np.array_equal(got, want)
+    shifts = np.random.default_rng(seed).integers(-20, 21, (50, 2))
+    for exact in (False, True):
+        assert np.array_equal(outline.cost(shifts, 20, 0.7, exact=exact), again.cost(shifts, 20, 0.7, exact=exact))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 900), st.integers(1, 4), st.integers(1, 6))
+def test_colour_trims_summary_separation_and_band_are_the_twins_to_the_bit(seed, n, k, iterations):
+    """Colours on a coarse grid (equal features, rows as near two centres): ``trim_summary`` is ``kmeans`` of the
+    picked rows from ``np.linspace``'s starts, ``trim_separation`` the counts of ``nearer_fruit`` (margin 1) over
+    the fruit's rows and against it over the ring's, ``trim_band`` the mask with its band's pixels replaced by their
+    test, bit for bit."""
+    from symfruit.core.surface import _colour_features, _kmeans, _nearer_fruit, _spread
+
+    rng = np.random.default_rng(seed)
+    grid = np.arange(0, 256, 51)
+    x = _colour_features(rng.choice(grid, size=(n, 1, 3)).astype(np.uint8), np.ones((n, 1), bool))
+    pick = rng.choice(n, min(n, int(rng.integers(1, 500))), replace=False)
+    rows = x[pick]
+    want = _kmeans(rows, rows[np.linspace(0, len(rows) - 1, k).astype(int)], iterations)
+    assert np.array_equal(_jit.trim_summary(x, pick, _spread(len(pick), k), iterations), want)
+    m = int(rng.integers(1, 300))
+    ring = _colour_features(rng.choice(grid, size=(m, 1, 3)).astype(np.uint8), np.ones((m, 1), bool))
+    fc, bc = x[rng.integers(0, n, k)], x[rng.integers(0, n, k)] + rng.choice([0.0, 0.01])
+    counts = _jit.trim_separation(x, ring, fc, bc)
+    assert counts == (int(_nearer_fruit(x, fc, bc, 1.0).sum()), int((~_nearer_fruit(ring, fc, bc, 1.0)).sum()))
+    color = rng.choice(grid, size=(int(rng.integers(1, 30)), int(rng.integers(1, 30)), 3)).astype(np.uint8)
+    mask = rng.random(color.shape[:2]) < 0.7
+    band = mask & (rng.random(mask.shape) < 0.5)
+    for margin in (1.0, 0.5):
+        keep = mask.copy()
+        keep[band] = _nearer_fruit(_colour_features(color, band), fc, bc, margin)
+        out = np.empty(mask.shape, bool)
+        _jit.trim_band(color, mask, band, fc, bc, margin, out)
+        assert np.array_equal(out, keep)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_trims_regions_with_their_features_and_one_seeds_piece_are_the_twins(seed):
+    """``trim_features``: ``trim_regions``' fruit and band and ``colour_features`` of its fruit and ring, bit for bit;
+    ``connected_at``: ``connected`` with a seed image of that pixel alone."""
+    from symfruit.core.raster import inner_distance
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    mask = _blob_mask(rng, h, w)
+    color = rng.integers(0, 256, (h, w + 3, 3)).astype(np.uint8)[:, 1 : w + 1]  # a window of a wider image
+    inner = inner_distance(mask)
+    band_px = float(rng.uniform(0.5, 8.0))
+    fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
+    counts = _jit.trim_regions(inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0, fruit, ring, band)
+    got_fruit, got_band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    f_fruit, f_ring, n_band = _jit.trim_features(color, inner, mask, band_px, 3.0 * band_px + 1, band_px + 1.0,
+                                                 got_fruit, got_band)  # fmt: skip
+    assert np.array_equal(got_fruit, fruit) and np.array_equal(got_band, band) and n_band == counts[2]
+    assert np.array_equal(f_fruit, _jit.colour_features(color, fruit)) and len(f_fruit) == counts[0]
+    assert np.array_equal(f_ring, _jit.colour_features(color, ring)) and len(f_ring) == counts[1]
+    r, c = (int(x) for x in np.argwhere(mask)[int(rng.integers(0, mask.sum()))])
+    seeds = np.zeros(mask.shape, bool)
+    seeds[r, c] = True
+    want, got = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    _jit.connected(mask, seeds, want)
+    _jit.connected_at(mask, r, c, got)
+    assert np.array_equal(got, want)

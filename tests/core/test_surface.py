@@ -908,3 +908,15 @@ def test_the_trimmings_generator_draws_as_a_fresh_one():
     thread.start()
     thread.join()
     assert np.array_equal(found[0], want[2]) and _seeded() is not None
+
+
+def test_the_trims_starting_centres_are_linspaces():
+    """``_spread(n, k)``: ``np.linspace(0, n - 1, k).astype(int)``, the same numbers and dtype (issue 19, twentieth
+    round: colour trimming's starting centres without numpy's call)."""
+    from symfruit.core.surface import _spread
+
+    for n in range(1, 3000):
+        for k in range(9):
+            want = np.linspace(0, n - 1, k).astype(int)
+            got = _spread(n, k)
+            assert got.dtype == want.dtype and np.array_equal(got, want)

@@ -3871,6 +3871,264 @@ def free_outline(
     return free
 
 
+# --- issue 19, twentieth round (stop 40): registration and trimming ---------------------------------------------
+
+
+@_njit
+def _envelope(f: np.ndarray, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarray) -> None:
+    """``d2[u]`` (w,) the least ``(u - i)^2 + f[i]`` over the columns ``i`` of one row (``f`` (w,) whole numbers): the
+    lower envelope of the parabolas, :func:`distance`'s second phase (``s``, ``t`` (w,) its scratch)."""
+    q = 0
+    s[0] = 0
+    t[0] = 0
+    for u in range(1, w):
+        while q >= 0:
+            a, b = t[q] - s[q], t[q] - u
+            if a * a + f[s[q]] <= b * b + f[u]:
+                break
+            q -= 1
+        if q < 0:
+            q = 0
+            s[0] = u
+        else:
+            i = s[q]
+            start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
+            if start < w:
+                q += 1
+                s[q] = u
+                t[q] = start
+    for u in range(w - 1, -1, -1):
+        a = u - s[q]
+        d2[u] = a * a + f[s[q]]
+        if u == t[q]:
+            q -= 1
+
+
+@_njit
+def outline_maps(
+    mask: np.ndarray, pad: int, reach: int, inner: np.ndarray, inside: np.ndarray
+) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._outline`'s maps of a mask (h, w) bool holding pixels of both kinds, in one call:
+    ``inner`` (h, w) its distance map (:func:`symfruit.core.raster.inner_distance`, 0 off the mask) and ``inside``
+    (h, w) the signed one (``inner - distance_transform(~mask)``: ``-`` each outside pixel's distance to the mask),
+    written in place; and, where its whole-number keys fit 16 bits, :meth:`symfruit.core.surface._Outline.keys` of
+    pad ``pad`` and reach ``reach`` (int16, flattened) and :meth:`~symfruit.core.surface._Outline.ranks` (the places
+    and values): ``(True, keys, ranks, values)``; else ``(False, ...)`` with those left empty.
+
+    Both transforms are :func:`distance`'s (Meijster's, in whole numbers): one column pass for both (each pixel's
+    distance along its column to the nearest pixel of the other kind), then each row's lower envelope of the
+    parabolas for the mask's pixels (over the row's mask pixels and one column either side: the columns beyond are
+    farther outside pixels) and for the others (rows without such pixels skipped: their distances are 0). The same
+    least squared distances, so the same square roots (read off the ranks' values where there are ranks), keys,
+    places and values as the twins', bit for bit."""
+    h, w = mask.shape
+    big = h + w  # farther than any pixel: a column without a pixel of the other kind
+    g = np.empty((h, w), np.int64)
+    for c in range(w):
+        g[0, c] = big
+    for r in range(1, h):
+        for c in range(w):
+            g[r, c] = g[r - 1, c] + 1 if mask[r, c] == mask[r - 1, c] else 1
+    for r in range(h - 2, -1, -1):
+        for c in range(w):
+            if mask[r, c] != mask[r + 1, c]:
+                g[r, c] = 1
+            elif g[r + 1, c] + 1 < g[r, c]:
+                g[r, c] = g[r + 1, c] + 1
+    key = np.empty((h, w), np.int64)  # sign * the squared distance: + on the mask, - off it
+    f = np.empty(w, np.int64)
+    s = np.empty(w, np.int64)
+    t = np.empty(w, np.int64)
+    d2 = np.empty(w, np.int64)
+    floor = -(reach * reach)
+    top = reach * reach
+    low, high = (floor, floor) if pad > 0 else (np.int64(2**62), -np.int64(2**62))
+    for r in range(h):
+        first, last, n_in = w, -1, 0
+        for c in range(w):
+            if mask[r, c]:
+                first, last, n_in = min(first, c), c, n_in + 1
+        if last >= 0:  # the mask's pixels: their envelope over their columns and one more either side
+            a, b = max(first - 1, 0), min(last + 1, w - 1)
+            for c in range(a, b + 1):
+                f[c - a] = g[r, c] * g[r, c] if mask[r, c] else 0
+            _envelope(f, b + 1 - a, s, t, d2)
+            for c in range(first, last + 1):
+                if mask[r, c]:
+                    k = d2[c - a]
+                    key[r, c] = k
+                    top, high = max(top, k), max(high, k)
+        if n_in < w:  # outside pixels in the row: their envelope over the whole row
+            for c in range(w):
+                f[c] = 0 if mask[r, c] else g[r, c] * g[r, c]
+            _envelope(f, w, s, t, d2)
+            for c in range(w):
+                if not mask[r, c]:
+                    k = d2[c]
+                    key[r, c] = -k
+                    top, low = max(top, k), min(low, -k)
+    low, high = min(low, high), max(low, high)  # a map of one kind of pixel only: one of them still unset
+    if top >= 2**15 - 1:  # no 16-bit keys: the maps alone, by their square roots
+        for r in range(h):
+            for c in range(w):
+                k = key[r, c]
+                d = math.sqrt(float(k if k >= 0 else -k))
+                inner[r, c] = d if mask[r, c] else 0.0
+                inside[r, c] = d if mask[r, c] else -d
+        return False, np.empty(0, np.int16), np.empty(0, np.int32), np.empty(0)
+    place = np.zeros(high - low + 1, np.int64)
+    if pad > 0:
+        place[floor - low] = 1
+    for r in range(h):
+        for c in range(w):
+            place[key[r, c] - low] = 1
+    m = 0
+    for v in range(high - low + 1):
+        if place[v]:
+            place[v] = m
+            m += 1
+        else:
+            place[v] = -1
+    values = np.empty(m)
+    for v in range(high - low + 1):
+        if place[v] >= 0:
+            whole = float(v + low)
+            values[place[v]] = np.sign(whole) * np.sqrt(abs(whole))
+    width = w + 2 * pad
+    keys = np.empty((h + 2 * pad) * width, np.int16)
+    ranks = np.empty((h + 2 * pad) * width, np.int32)
+    border = place[floor - low] if pad > 0 else 0
+    for r in range(h + 2 * pad):  # the border: all of the first and last pad rows, pad columns either side between
+        whole_row = r < pad or r >= h + pad
+        for c in range(width):
+            if whole_row or c < pad or c >= pad + w:
+                keys[r * width + c] = floor
+                ranks[r * width + c] = border
+    for r in range(h):
+        base = (r + pad) * width + pad
+        for c in range(w):
+            k = key[r, c]
+            i = place[k - low]
+            d = values[i]  # sign * sqrt(|k|): the square root itself, or its negative
+            inner[r, c] = d if mask[r, c] else 0.0
+            inside[r, c] = d
+            keys[base + c] = k
+            ranks[base + c] = i
+    return True, keys, ranks, values
+
+
+@_njit
+def connected_at(image: np.ndarray, r: int, c: int, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the piece of ``image`` (h, w) bool (4-connected) holding its pixel ``(r, c)`` (which must
+    be ``image``'s): :func:`connected` with that pixel alone for seed, without a seed image and its scan (the same
+    pixels)."""
+    h, w = image.shape
+    for i in range(h):
+        for j in range(w):
+            out[i, j] = False
+    out[r, c] = True
+    stack = np.empty(h * w, np.int64)
+    stack[0] = r * w + c
+    _flood(image, out, stack, 1)
+
+
+@_njit
+def trim_features(
+    color: np.ndarray, inner: np.ndarray, mask: np.ndarray, band_px: float, deep: float, ring_px: float,
+    fruit: np.ndarray, band: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, int]:  # fmt: skip
+    """:func:`trim_regions` (the fruit and band written into ``fruit`` and ``band`` (h, w) bool, the ring not kept)
+    and :func:`colour_features` of the fruit's and the ring's pixels of ``color`` (h, w, 3) uint8 in one call: the
+    features (n, 3) and (m, 3) in raster order, and how many pixels the band holds (the same pixels and values)."""
+    h, w = mask.shape
+    near = np.empty((h, w))
+    near_distance(mask, ring_px, True, near)
+    n_fruit = n_ring = n_band = 0
+    for r in range(h):
+        for c in range(w):
+            d = inner[r, c]
+            f = d > band_px and d <= deep
+            b = mask[r, c] and d <= band_px
+            fruit[r, c], band[r, c] = f, b
+            n_fruit += f
+            n_ring += (not mask[r, c]) and near[r, c] <= ring_px
+            n_band += b
+    f_fruit, f_ring = np.empty((n_fruit, 3)), np.empty((n_ring, 3))
+    i = j = 0
+    for r in range(h):
+        for c in range(w):
+            ring = (not mask[r, c]) and near[r, c] <= ring_px
+            if fruit[r, c] or ring:
+                red, green, blue = float(color[r, c, 0]), float(color[r, c, 1]), float(color[r, c, 2])
+                total = red + green + blue + 1.0
+                out = f_fruit if fruit[r, c] else f_ring
+                k = i if fruit[r, c] else j
+                out[k, 0] = red / total
+                out[k, 1] = green / total
+                out[k, 2] = 0.25 * total / (3 * 255.0)
+                if fruit[r, c]:
+                    i += 1
+                else:
+                    j += 1
+    return f_fruit, f_ring, n_band
+
+
+@_njit
+def trim_summary(x: np.ndarray, pick: np.ndarray, start: np.ndarray, iterations: int) -> np.ndarray:
+    """:func:`symfruit.core.surface._colour_trim`'s summary of the rows ``pick`` (m,) of ``x`` (n, 3): :func:`kmeans`
+    of ``x[pick]`` from its rows ``start`` (k,), gathered here instead of by numpy (the same rows, so the same
+    centres)."""
+    m = pick.shape[0]
+    rows = np.empty((m, 3))
+    for i in range(m):
+        for a in range(3):
+            rows[i, a] = x[pick[i], a]
+    c = np.empty((start.shape[0], 3))
+    for j in range(start.shape[0]):
+        for a in range(3):
+            c[j, a] = rows[start[j], a]
+    return kmeans(rows, c, iterations)
+
+
+@_njit
+def trim_separation(fruit: np.ndarray, ring: np.ndarray, fc: np.ndarray, bc: np.ndarray) -> tuple[int, int]:
+    """How many rows of ``fruit`` (n, 3) are nearer the fruit's centres ``fc`` than the surroundings' ``bc``
+    (:func:`nearer_fruit`, margin 1) and how many rows of ``ring`` (m, 3) are not: the counts behind
+    :func:`symfruit.core.surface._colour_trim`'s two accuracies (``mean()`` of those booleans: the count over the
+    rows), without their arrays."""
+    n_fruit = 0
+    for i in range(fruit.shape[0]):
+        n_fruit += 1.0 * _nearest_centre(fruit, i, fc)[1] <= _nearest_centre(fruit, i, bc)[1]
+    n_ring = 0
+    for i in range(ring.shape[0]):
+        n_ring += not (1.0 * _nearest_centre(ring, i, fc)[1] <= _nearest_centre(ring, i, bc)[1])
+    return n_fruit, n_ring
+
+
+@_njit
+def trim_band(
+    color: np.ndarray, mask: np.ndarray, band: np.ndarray, fc: np.ndarray, bc: np.ndarray, margin: float,
+    out: np.ndarray,
+) -> None:  # fmt: skip
+    """``out`` (h, w) bool: ``mask`` with each pixel of ``band`` (h, w) bool kept only where its colour feature
+    (:func:`colour_features`' arithmetic) is nearer the fruit's centres ``fc`` than the surroundings' ``bc`` by
+    ``margin`` (:func:`nearer_fruit`): :func:`symfruit.core.surface._colour_trim`'s ``keep[band] = is_fruit(
+    feature(color, band), margin)`` in one pass, the same pixels."""
+    h, w = mask.shape
+    x = np.empty((1, 3))
+    for r in range(h):
+        for c in range(w):
+            if band[r, c]:
+                red, green, blue = float(color[r, c, 0]), float(color[r, c, 1]), float(color[r, c, 2])
+                total = red + green + blue + 1.0
+                x[0, 0] = red / total
+                x[0, 1] = green / total
+                x[0, 2] = 0.25 * total / (3 * 255.0)
+                out[r, c] = margin * _nearest_centre(x, 0, fc)[1] <= _nearest_centre(x, 0, bc)[1]
+            else:
+                out[r, c] = mask[r, c]
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 

@@ -23,11 +23,12 @@ numbers out.
 
 from __future__ import annotations
 
+import functools
 import importlib
 import threading
 from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from scipy import ndimage
@@ -636,12 +637,25 @@ class _Outline:
     _ranks: dict[tuple[int, int], tuple[np.ndarray, np.ndarray]] = field(
         default_factory=dict, init=False, repr=False, compare=False
     )
+    #: :meth:`_points` per pad
+    _points_at: dict[int, tuple[int, np.ndarray]] = field(default_factory=dict, init=False, repr=False, compare=False)
 
-    @property
+    @functools.cached_property
     def axes(self) -> tuple[bool, bool]:
         """``(v, u)``: whether the outline tells a shift down the image (``dv``: its top and its bottom side free)
-        and across it (``du``: its left and its right side free)."""
+        and across it (``du``: its left and its right side free). Worked out once (the search asks for every
+        cost)."""
         return (True, True) if self.sides is None else _told_axes(self.sides)
+
+    def _points(self, pad: int) -> tuple[int, np.ndarray]:
+        """The width of the maps padded by ``pad`` and each outline point's flat index in them (n,), made once per
+        ``pad`` (the compiled costs move them back by each shift themselves)."""
+        found = self._points_at.get(pad)
+        if found is None:
+            width = self.inside.shape[1] + 2 * pad
+            found = (width, (self.rows + pad) * width + (self.cols + pad))
+            self._points_at[pad] = found
+        return found
 
     def _at(self, shifts: np.ndarray, reach: int, pad: int = 0) -> tuple[np.ndarray, int]:
         """(k, n) flat indices into the padded maps of each outline point moved back by each shift, and the pad (at
@@ -704,8 +718,7 @@ class _Outline:
         if not exact and (jit := compiled()) is not None:  # the compiled twin of the fast costs, all rows at once
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)))
             if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:  # a row's keys: < 2**16 apart
-                width = self.inside.shape[1] + 2 * pad
-                at = (self.rows + pad) * width + (self.cols + pad)
+                width, at = self._points(pad)
                 keep = max(1, int(trim * len(self.rows)))
                 return jit.outline_costs(*self.ranks(pad, reach), at, shifts, width, keep, self.band)
         rows = max(1, _BLOCK // max(1, len(self.rows)))
@@ -724,8 +737,7 @@ class _Outline:
         if exact and len(self.rows) and (jit := compiled()) is not None:
             pad = max(int(reach), int(np.abs(shifts).max(initial=0)), pad)
             if (keys := self.keys(pad, reach)) is not None and keys.dtype == np.int16:
-                width = self.inside.shape[1] + 2 * pad
-                at = (self.rows + pad) * width + (self.cols + pad)
+                width, at = self._points(pad)
                 dev = jit.outline_deviations(*self.ranks(pad, reach), at, shifts, width, self.band)
                 keep = max(1, int(trim * dev.shape[1]))
                 return np.partition(dev, keep - 1, axis=1)[:, :keep].mean(axis=1)
@@ -844,7 +856,14 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points)."""
     grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
-    inner = inner_distance(mask)
+    jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
+    found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
+    inside: np.ndarray | None = None
+    if jit is not None:  # both distance maps, the keys and their ranks in one call (issue 19, twentieth round)
+        inner, inside = np.empty(mask.shape), np.empty(mask.shape)
+        found = jit.outline_maps(mask, int(reach), int(reach), inner, inside)
+    else:
+        inner = inner_distance(mask)
     # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
     # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
     # (0, 17) px to (18, 0) and (-15, 15) (docs/ablation.md, "A fall of whole depth units")
@@ -863,8 +882,13 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     if len(rows) < 12:
         return None
     step = max(1, len(rows) // max_points)
-    inside = inner - distance_transform(~mask)
-    return _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)), sides)
+    if inside is None:
+        inside = inner - distance_transform(~mask)
+    outline = _Outline(rows[::step], cols[::step], inside, 0.3 * float(np.sqrt(mask.sum() / np.pi)), sides)
+    if found is not None and found[0]:  # the keys and ranks of the costs' pad (the search's shifts are within reach)
+        outline._padded[("keys", int(reach), int(reach))] = found[1]
+        outline._ranks[(int(reach), int(reach))] = (found[2], found[3])
+    return outline
 
 
 def _rim(rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
@@ -1165,7 +1189,11 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
-    if (jit := compiled()) is not None:  # the three regions and their sizes in one pass (the same pixels)
+    color = np.asarray(color)
+    jit = compiled()
+    if jit is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+        return _colour_trim_compiled(jit, color, mask, inner, band_px, centres, iterations, min_accuracy, margin)
+    if jit is not None:  # the three regions and their sizes in one pass (the same pixels)
         fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
         n_fruit, n_ring, n_band = jit.trim_regions(inner, mask, float(band_px), 3.0 * band_px + 1,
                                                    float(band_px + 1), fruit, ring, band)  # fmt: skip
@@ -1176,7 +1204,6 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
         n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
     if n_fruit < 20 or n_ring < 20 or not n_band:
         return None
-    color = np.asarray(color)
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
     jit = jit if color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 else None
     feature = _colour_features if jit is None else jit.colour_features
@@ -1201,6 +1228,44 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
     keep = mask.copy()
     keep[band] = is_fruit(feature(color, band), margin)  # a mixed pixel on the outline, between the two, stays
     return fill_holes(_connected(keep, fruit))  # the pieces holding fruit pixels
+
+
+def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px: float,
+                          centres: int, iterations: int, min_accuracy: float,
+                          margin: float) -> np.ndarray | None:  # fmt: skip
+    """:func:`_colour_trim` of a uint8 colour image by its compiled twins (issue 19, twentieth round): the regions and
+    their features in one call (:func:`symfruit.core._jit.trim_features`), each summary's rows gathered and its
+    k-means in one (``trim_summary``), the two accuracies' counts (``trim_separation``) and the band's test
+    (``trim_band``) in one each; the samples drawn by numpy as in the twin. The same regions, features, centres,
+    tests and pixels, bit for bit."""
+    fruit, band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
+    f_fruit, f_ring, n_band = jit.trim_features(color, inner, mask, float(band_px), 3.0 * band_px + 1,
+                                                float(band_px + 1), fruit, band)  # fmt: skip
+    if len(f_fruit) < 20 or len(f_ring) < 20 or not n_band:
+        return None
+    rng = _seeded()  # the twin's samples: the same generator, the same draws
+    picks = [rng.choice(len(x), min(len(x), _SAMPLE), replace=False) for x in (f_fruit, f_ring)]
+    fc = jit.trim_summary(f_fruit, picks[0], _spread(len(picks[0]), centres), iterations)
+    bc = jit.trim_summary(f_ring, picks[1], _spread(len(picks[1]), centres), iterations)
+    n_fruit_ok, n_ring_ok = jit.trim_separation(f_fruit, f_ring, fc, bc)
+    # the twin's accuracies are the booleans' means: their counts over their rows
+    if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
+        return None
+    keep = np.empty(mask.shape, bool)
+    jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
+    return fill_holes(_connected(keep, fruit))
+
+
+def _spread(n: int, k: int) -> np.ndarray:
+    """(k,) int64: ``np.linspace(0, n - 1, k).astype(int)`` (``n >= 1``), :func:`_colour_trim`'s starting centres, in
+    Python floats as numpy computes them (``i * ((n - 1) / (k - 1))``, the last ``n - 1``), without its call (some
+    10 us)."""
+    if k < 2:
+        return np.zeros(k, np.int64)
+    step = float(n - 1) / (k - 1)
+    at = [int(i * step) if step != 0 else 0 for i in range(k)]
+    at[-1] = n - 1
+    return np.array(at, np.int64)
 
 
 def _seeded() -> np.random.Generator:
@@ -1230,11 +1295,11 @@ def _connected(image: np.ndarray, seeds: np.ndarray | tuple[int, int]) -> np.nda
     pixels)."""
     image = np.asarray(image, dtype=bool)
     if (jit := compiled()) is not None and (not isinstance(seeds, tuple) or image[seeds]):
-        if isinstance(seeds, tuple):
-            at, seeds = seeds, np.zeros(image.shape, bool)
-            seeds[at] = True
         out = np.empty(image.shape, bool)
-        jit.connected(image, seeds, out)
+        if isinstance(seeds, tuple):  # one pixel: its flood alone (issue 19, twentieth round: the same pixels)
+            jit.connected_at(image, int(seeds[0]) % image.shape[0], int(seeds[1]) % image.shape[1], out)
+        else:
+            jit.connected(image, seeds, out)
         return out
     labels, n = ndimage.label(image)
     if isinstance(seeds, tuple):
