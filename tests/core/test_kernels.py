@@ -2966,3 +2966,80 @@ def test_outline_and_ray_pixels_are_nonzeros(seed, full):
     for got, expected in zip(found, (rr, cc, rr - r0, cc - c0), strict=True):
         assert got.dtype == expected.dtype
         np.testing.assert_array_equal(got, expected)
+
+
+# --- stop 40, speedext40
+
+
+def test_the_switch_is_read_on_every_call_after_the_kernels_are_found(monkeypatch):
+    """compiled()'s look-up of an unset SYMFRUIT_KERNELS: the environment set or unset between calls (os.environ as
+    tests set it, and through monkeypatch) still switches, and a reset state is looked for again."""
+    import os
+
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+    assert kernels.compiled() is _jit and kernels.compiled() is _jit
+    os.environ["SYMFRUIT_KERNELS"] = "numpy"
+    try:
+        assert kernels.compiled() is None
+    finally:
+        del os.environ["SYMFRUIT_KERNELS"]
+    assert kernels.compiled() is _jit
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "NUMPY")
+    assert kernels.compiled() is None
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    monkeypatch.setattr(kernels, "_STATE", {})
+    assert kernels.compiled() is _jit and kernels._STATE == {"jit": _jit}
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 3), st.integers(0, 20),
+       st.booleans(), st.booleans(), st.sampled_from([0.0, 0.005, -0.005]))  # fmt: skip
+def test_the_occlusion_at_is_own_depths_then_the_window(seed, h, w, reach, pad, single, with_others, tol):
+    """occlusion_at against own_depths then occlusion_window with the points' least and greatest depth: the same
+    window, hidden pixels and seen depths, bit for bit; points off the image, points sharing a pixel, depths from a
+    few values (ties, depths on the bounds), dropouts as 0 and NaN, float32 and float64 images, other fruit or not."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 60))
+    uv = np.stack((rng.uniform(-5, w + 5, n), rng.uniform(-5, h + 5, n)), axis=1)
+    if rng.random() < 0.5:
+        uv = np.round(uv * 2) / 2  # halves: np.rint's ties to even
+    points = np.zeros((n, 3))
+    points[:, 2] = rng.choice([0.5, 0.51, 0.52, 0.53], n)
+    depth = rng.choice([0.0, np.nan, 0.49, 0.5, 0.505, 0.51, 0.515, 0.52, 0.525, 0.53, 0.535, 0.6], (h, w))
+    depth = depth.astype(np.float32 if single else np.float64)
+    mask = rng.random((h, w)) < 0.2
+    others = rng.random((h, w)) < 0.3 if with_others else np.zeros((0, 0), bool)
+    steps = _steps_within(reach)
+    found, u0, v0, u1, v1, own_z, _ = _jit.own_depths(uv, points, w, h, pad)
+    got = _jit.occlusion_at(uv, points, pad, depth, mask, others, tol, steps)
+    assert got[0] == found
+    if not found:
+        return
+    hidden, seen = np.empty((v1 - v0, u1 - u0), bool), np.empty((v1 - v0, u1 - u0))
+    near = others[v0:v1, u0:u1] if with_others else others
+    _jit.occlusion_window(np.ascontiguousarray(depth[v0:v1, u0:u1]), np.ascontiguousarray(mask[v0:v1, u0:u1]),
+                          own_z, np.ascontiguousarray(near), tol, steps, float(points[:, 2].min()),
+                          float(points[:, 2].max()), hidden, seen)  # fmt: skip
+    assert (got[1], got[2]) == (u0, v0)
+    assert got[3].dtype == bool and np.array_equal(got[3], hidden) and got[4].tobytes() == seen.tobytes()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_the_reach_box_is_the_flood_box(seed, h, w):
+    """_reach_box (the fill from the seen pixels' edge, by runs) against _flood_box's box on random joins and seen
+    regions (join and seen overlapping, seen pixels scattered or a block, touching the edges)."""
+    rng = np.random.default_rng(seed)
+    join = rng.random((h, w)) < rng.uniform(0.0, 0.9)
+    seen = np.zeros((h, w), bool)
+    if rng.random() < 0.5:
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        seen[r0 : r0 + int(rng.integers(1, 10)), c0 : c0 + int(rng.integers(1, 10))] = True
+    else:
+        seen = rng.random((h, w)) < 0.1
+    if not seen.any():
+        seen[h // 2, w // 2] = True
+    rows, cols = np.nonzero(seen)
+    box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
+    want = _jit._flood_box(join, seen, *box)[1:]
+    assert tuple(int(x) for x in _jit._reach_box(join, seen, *box)) == tuple(int(x) for x in want)

@@ -58,6 +58,13 @@ __all__ = ["compiled"]
 
 _STATE: dict[str, ModuleType | None] = {}
 
+#: ``os.environ`` and its own dictionary of encoded names (CPython on POSIX), as they were at import, for
+#: :func:`compiled`'s look-up of an unset ``SYMFRUIT_KERNELS``; None elsewhere.
+_ENVIRON = os.environ
+_DATA = getattr(os.environ, "_data", None) if os.name == "posix" else None
+_DATA = _DATA if isinstance(_DATA, dict) else None
+_KEY = b"SYMFRUIT_KERNELS"
+
 
 def _setting() -> str:
     """``SYMFRUIT_KERNELS`` as the environment holds it now ("" unset). Read on every call (a test or a caller may
@@ -73,7 +80,17 @@ def _setting() -> str:
 
 def compiled() -> ModuleType | None:
     """The compiled kernels' module, or None where the numpy twins are to run (no numba, or
-    ``SYMFRUIT_KERNELS=numpy``)."""
+    ``SYMFRUIT_KERNELS=numpy``).
+
+    The environment is read on every call (a test may set it at any time): where ``SYMFRUIT_KERNELS`` is unset
+    (the usual case) and the module has been looked for, by one membership test of ``os.environ``'s own dictionary
+    and one look-up of the module found, about a third of the full path's cost (some 900 calls a benchmark frame;
+    issue 19, twentieth round); set, or on the first call, by :func:`_setting` as before."""
+    if _DATA is not None and _KEY not in _DATA and os.environ is _ENVIRON:
+        try:
+            return _STATE["jit"]
+        except KeyError:  # not looked for yet (or the state was reset): below
+            pass
     if _setting().lower() == "numpy":
         return None
     if "jit" not in _STATE:
