@@ -3043,3 +3043,34 @@ def test_the_reach_box_is_the_flood_box(seed, h, w):
     box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
     want = _jit._flood_box(join, seen, *box)[1:]
     assert tuple(int(x) for x in _jit._reach_box(join, seen, *box)) == tuple(int(x) for x in want)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([8, 72, 7, 360]))
+def test_the_sectors_from_the_table_are_the_arctan2_ones(seed, bins):
+    """monotone_region's sectors read off _sector_table against monotone_rays' from numpy's arctan2: the same pixels,
+    on random caps with the apex anywhere (outside the window too), offsets on the axes and diagonals (where a
+    direction falls on a sector's edge), tables grown as a larger offset is asked for and none beyond the bound."""
+    from symfruit.core import surface
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    keep = rng.random((h, w)) < rng.uniform(0.1, 1.0)
+    depth = rng.choice([0.5, 0.501, 0.503, 0.51], (h, w))
+    apex = (int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5)))
+    rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
+    want = np.zeros((h, w), bool)
+    _jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi), 0.002, want)
+    reach = max(abs(apex[0]), abs(h - 1 - apex[0]), abs(apex[1]), abs(w - 1 - apex[1]))
+    table = surface._sector_table(bins, reach)
+    r = (table.shape[0] - 1) // 2
+    assert r >= reach and table.dtype == np.int16
+    got = np.zeros((h, w), bool)
+    _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, 0.002, got)
+    np.testing.assert_array_equal(got, want)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        np.testing.assert_array_equal(surface.monotone_region(depth, keep, apex, 0.002, bins=bins), want)
+        mp.setattr(surface, "_SECTOR_REACH", 0)  # beyond the tables' bound: arctan2 per pixel
+        assert surface._sector_table(bins, 1) is None
+        np.testing.assert_array_equal(surface.monotone_region(depth, keep, apex, 0.002, bins=bins), want)
