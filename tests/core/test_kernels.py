@@ -3074,3 +3074,29 @@ def test_the_sectors_from_the_table_are_the_arctan2_ones(seed, bins):
         mp.setattr(surface, "_SECTOR_REACH", 0)  # beyond the tables' bound: arctan2 per pixel
         assert surface._sector_table(bins, 1) is None
         np.testing.assert_array_equal(surface.monotone_region(depth, keep, apex, 0.002, bins=bins), want)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.sampled_from([0.001, 0.004, 0.006, 0.02]),
+       st.floats(0.001, 0.2))  # fmt: skip
+def test_one_slab_is_found_only_without_a_gap_and_the_clusters_are_the_twins(seed, n, distance, spread):
+    """_one_slab finds one slab only where the sorted depths have no gap over ``distance`` (depths drawn from a few
+    values, gaps just over and under ``distance``), and clusters (which then skips the sort) gives the numpy twin's
+    labels either way."""
+    from symfruit.extract import cluster
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-0.03, 0.03, (n, 3))
+    points[:, 2] = 0.5 + rng.choice(rng.uniform(0.0, spread, 8), n) if rng.random() < 0.5 else (
+        0.5 + rng.uniform(0.0, spread, n))  # fmt: skip
+    if rng.random() < 0.3 and n > 2:  # a gap of about the distance
+        points[: n // 2, 2] += rng.choice([distance * (1 - 1e-12), distance * (1 + 1e-12), 1.5 * distance])
+    single = _jit._one_slab(points, distance)
+    z = np.sort(points[:, 2])
+    if len(single) == n:
+        assert not (np.diff(z) > distance).any()
+    else:
+        assert len(single) == 0
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, cluster, points, distance)
+    np.testing.assert_array_equal(fast, twin)

@@ -2725,12 +2725,19 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
             if not math.isfinite(points[i, j]):
                 return empty, False
     voxel = distance / 2.0
-    order = np.argsort(points[:, 2], kind="mergesort")
+    # issue 19, twentieth round: where every bin of a quarter ``distance`` between the least and greatest depth holds
+    # a point, no two consecutive depths are more than ``distance`` apart (such a gap would hold two empty bins; the
+    # bins' floors are monotone in the depth and rounding moves them by far less than a bin), so the points are one
+    # slab, whose cubes and clusters do not depend on the points' order: the order is not sorted for
+    order = _one_slab(points, distance)
+    single = order.shape[0] == n
+    if not single:
+        order = np.argsort(points[:, 2], kind="mergesort")
     labels = np.empty(n, np.int64)
     next_label = 0
     lo = 0
     while lo < n:
-        hi = lo + 1
+        hi = n if single else lo + 1
         while hi < n and not (points[order[hi], 2] - points[order[hi - 1], 2] > distance):
             hi += 1
         if hi - lo == 1:
@@ -3248,6 +3255,33 @@ def monotone_table(
         sector[i] = np.int64(table[a + reach, b + reach])
         d2[i] = a * a + b * b
     monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+
+
+@_njit
+def _one_slab(points: np.ndarray, distance: float) -> np.ndarray:
+    """:func:`clusters`' test for a single slab (issue 19, twentieth round): ``arange(n)`` when every bin of width
+    ``distance / 4`` from the least to the greatest depth (``points[:, 2]``, finite) holds a point, so that no two
+    consecutive depths are more than ``distance`` apart; an empty array where a bin is empty (or ``distance`` is not
+    above 0), and the slabs are to be found by sorting."""
+    n = points.shape[0]
+    none = np.zeros(0, np.int64)
+    if n == 0 or not distance > 0.0:
+        return none
+    lo, hi = points[0, 2], points[0, 2]
+    for i in range(1, n):
+        lo, hi = min(lo, points[i, 2]), max(hi, points[i, 2])
+    width = distance / 4.0
+    span = (hi - lo) / width
+    if not span < n:  # more bins than points: one is empty
+        return none
+    bins = np.int64(math.floor(span)) + 1
+    held = np.zeros(bins, np.bool_)
+    for i in range(n):
+        held[min(np.int64(math.floor((points[i, 2] - lo) / width)), bins - 1)] = True
+    for b in range(bins):
+        if not held[b]:
+            return none
+    return np.arange(n)
 
 
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
