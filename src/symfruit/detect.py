@@ -277,7 +277,12 @@ def _extract_window(
     leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
     ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
-    # the mask's pixels all lie in the window (its box): the rest of the image is none of the outline's
-    outline = np.zeros_like(mask)
-    outline[r0:r1, c0:c1] = window if ex.silhouette is None else ex.silhouette
+    # the mask's pixels all lie in the window (its box): the rest of the image is none of the outline's. Where the
+    # outline is the window itself (extract keeps its mask's view), it is the mask: no image is copied (a whole
+    # image per fruit; issue 19, twentieth round)
+    if ex.silhouette is None or ex.silhouette is window:
+        outline = mask
+    else:
+        outline = np.zeros_like(mask)
+        outline[r0:r1, c0:c1] = ex.silhouette
     return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated, outline)

@@ -3310,3 +3310,137 @@ def test_trims_regions_with_their_features_and_one_seeds_piece_are_the_twins(see
     _jit.connected(mask, seeds, want)
     _jit.connected_at(mask, r, c, got)
     assert np.array_equal(got, want)
+
+
+# --- stop 40, speedext40
+
+
+def test_the_switch_is_read_on_every_call_after_the_kernels_are_found(monkeypatch):
+    """compiled()'s look-up of an unset SYMFRUIT_KERNELS: the environment set or unset between calls (os.environ as
+    tests set it, and through monkeypatch) still switches, and a reset state is looked for again."""
+    import os
+
+    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+    assert kernels.compiled() is _jit and kernels.compiled() is _jit
+    os.environ["SYMFRUIT_KERNELS"] = "numpy"
+    try:
+        assert kernels.compiled() is None
+    finally:
+        del os.environ["SYMFRUIT_KERNELS"]
+    assert kernels.compiled() is _jit
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "NUMPY")
+    assert kernels.compiled() is None
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    monkeypatch.setattr(kernels, "_STATE", {})
+    assert kernels.compiled() is _jit and kernels._STATE == {"jit": _jit}
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 3), st.integers(0, 20),
+       st.booleans(), st.booleans(), st.sampled_from([0.0, 0.005, -0.005]))  # fmt: skip
+def test_the_occlusion_at_is_own_depths_then_the_window(seed, h, w, reach, pad, single, with_others, tol):
+    """occlusion_at against own_depths then occlusion_window with the points' least and greatest depth: the same
+    window, hidden pixels and seen depths, bit for bit; points off the image, points sharing a pixel, depths from a
+    few values (ties, depths on the bounds), dropouts as 0 and NaN, float32 and float64 images, other fruit or not."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 60))
+    uv = np.stack((rng.uniform(-5, w + 5, n), rng.uniform(-5, h + 5, n)), axis=1)
+    if rng.random() < 0.5:
+        uv = np.round(uv * 2) / 2  # halves: np.rint's ties to even
+    points = np.zeros((n, 3))
+    points[:, 2] = rng.choice([0.5, 0.51, 0.52, 0.53], n)
+    depth = rng.choice([0.0, np.nan, 0.49, 0.5, 0.505, 0.51, 0.515, 0.52, 0.525, 0.53, 0.535, 0.6], (h, w))
+    depth = depth.astype(np.float32 if single else np.float64)
+    mask = rng.random((h, w)) < 0.2
+    others = rng.random((h, w)) < 0.3 if with_others else np.zeros((0, 0), bool)
+    steps = _steps_within(reach)
+    found, u0, v0, u1, v1, own_z, _ = _jit.own_depths(uv, points, w, h, pad)
+    got = _jit.occlusion_at(uv, points, pad, depth, mask, others, tol, steps)
+    assert got[0] == found
+    if not found:
+        return
+    hidden, seen = np.empty((v1 - v0, u1 - u0), bool), np.empty((v1 - v0, u1 - u0))
+    near = others[v0:v1, u0:u1] if with_others else others
+    _jit.occlusion_window(np.ascontiguousarray(depth[v0:v1, u0:u1]), np.ascontiguousarray(mask[v0:v1, u0:u1]),
+                          own_z, np.ascontiguousarray(near), tol, steps, float(points[:, 2].min()),
+                          float(points[:, 2].max()), hidden, seen)  # fmt: skip
+    assert (got[1], got[2]) == (u0, v0)
+    assert got[3].dtype == bool and np.array_equal(got[3], hidden) and got[4].tobytes() == seen.tobytes()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40))
+def test_the_reach_box_is_the_flood_box(seed, h, w):
+    """_reach_box (the fill from the seen pixels' edge, by runs) against _flood_box's box on random joins and seen
+    regions (join and seen overlapping, seen pixels scattered or a block, touching the edges)."""
+    rng = np.random.default_rng(seed)
+    join = rng.random((h, w)) < rng.uniform(0.0, 0.9)
+    seen = np.zeros((h, w), bool)
+    if rng.random() < 0.5:
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        seen[r0 : r0 + int(rng.integers(1, 10)), c0 : c0 + int(rng.integers(1, 10))] = True
+    else:
+        seen = rng.random((h, w)) < 0.1
+    if not seen.any():
+        seen[h // 2, w // 2] = True
+    rows, cols = np.nonzero(seen)
+    box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
+    want = _jit._flood_box(join, seen, *box)[1:]
+    assert tuple(int(x) for x in _jit._reach_box(join, seen, *box)) == tuple(int(x) for x in want)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([8, 72, 7, 360]))
+def test_the_sectors_from_the_table_are_the_arctan2_ones(seed, bins):
+    """monotone_region's sectors read off _sector_table against monotone_rays' from numpy's arctan2: the same pixels,
+    on random caps with the apex anywhere (outside the window too), offsets on the axes and diagonals (where a
+    direction falls on a sector's edge), tables grown as a larger offset is asked for and none beyond the bound."""
+    from symfruit.core import surface
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 90, 2))
+    keep = rng.random((h, w)) < rng.uniform(0.1, 1.0)
+    depth = rng.choice([0.5, 0.501, 0.503, 0.51], (h, w))
+    apex = (int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5)))
+    rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
+    want = np.zeros((h, w), bool)
+    _jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi), 0.002, want)
+    reach = max(abs(apex[0]), abs(h - 1 - apex[0]), abs(apex[1]), abs(w - 1 - apex[1]))
+    table = surface._sector_table(bins, reach)
+    r = (table.shape[0] - 1) // 2
+    assert r >= reach and table.dtype == np.int16
+    got = np.zeros((h, w), bool)
+    _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, 0.002, got)
+    np.testing.assert_array_equal(got, want)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        np.testing.assert_array_equal(surface.monotone_region(depth, keep, apex, 0.002, bins=bins), want)
+        mp.setattr(surface, "_SECTOR_REACH", 0)  # beyond the tables' bound: arctan2 per pixel
+        assert surface._sector_table(bins, 1) is None
+        np.testing.assert_array_equal(surface.monotone_region(depth, keep, apex, 0.002, bins=bins), want)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.sampled_from([0.001, 0.004, 0.006, 0.02]),
+       st.floats(0.001, 0.2))  # fmt: skip
+def test_one_slab_is_found_only_without_a_gap_and_the_clusters_are_the_twins(seed, n, distance, spread):
+    """_one_slab finds one slab only where the sorted depths have no gap over ``distance`` (depths drawn from a few
+    values, gaps just over and under ``distance``), and clusters (which then skips the sort) gives the numpy twin's
+    labels either way."""
+    from symfruit.extract import cluster
+
+    rng = np.random.default_rng(seed)
+    points = rng.uniform(-0.03, 0.03, (n, 3))
+    points[:, 2] = 0.5 + rng.choice(rng.uniform(0.0, spread, 8), n) if rng.random() < 0.5 else (
+        0.5 + rng.uniform(0.0, spread, n))  # fmt: skip
+    if rng.random() < 0.3 and n > 2:  # a gap of about the distance
+        points[: n // 2, 2] += rng.choice([distance * (1 - 1e-12), distance * (1 + 1e-12), 1.5 * distance])
+    single = _jit._one_slab(points, distance)
+    z = np.sort(points[:, 2])
+    if len(single) == n:
+        assert not (np.diff(z) > distance).any()
+    else:
+        assert len(single) == 0
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, cluster, points, distance)
+    np.testing.assert_array_equal(fast, twin)

@@ -3046,12 +3046,19 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
             if not math.isfinite(points[i, j]):
                 return empty, False
     voxel = distance / 2.0
-    order = np.argsort(points[:, 2], kind="mergesort")
+    # issue 19, twentieth round: where every bin of a quarter ``distance`` between the least and greatest depth holds
+    # a point, no two consecutive depths are more than ``distance`` apart (such a gap would hold two empty bins; the
+    # bins' floors are monotone in the depth and rounding moves them by far less than a bin), so the points are one
+    # slab, whose cubes and clusters do not depend on the points' order: the order is not sorted for
+    order = _one_slab(points, distance)
+    single = order.shape[0] == n
+    if not single:
+        order = np.argsort(points[:, 2], kind="mergesort")
     labels = np.empty(n, np.int64)
     next_label = 0
     lo = 0
     while lo < n:
-        hi = lo + 1
+        hi = n if single else lo + 1
         while hi < n and not (points[order[hi], 2] - points[order[hi - 1], 2] > distance):
             hi += 1
         if hi - lo == 1:
@@ -3344,6 +3351,258 @@ def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, 
             out[r, c] = hit
             some = some or hit
     return some
+
+
+# --- issue 19, twentieth round (stop 40): the occlusion maps in one pass ---
+
+
+@_njit
+def occlusion_at(
+    uv: np.ndarray,
+    points: np.ndarray,
+    pad: int,
+    depth: np.ndarray,
+    mask: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`own_depths` then :func:`occlusion_window` in one kernel (issue 19, twentieth round): ``depth``, ``mask``
+    and ``others`` (or (0, 0)) are the whole (H, W) images, read in place; the points' own depths are kept over their
+    pixels' box alone (no pixel outside it holds one), not as an (h, w) map of +inf the window pass reads again.
+    ``(found, u0, v0, hidden, seen)``: the window's top-left pixel and its maps, :func:`occlusion_window`'s to the
+    bit (``low`` and ``high`` the points' least and greatest depth, all of them); found False when no point falls
+    in the image."""
+    height, width = mask.shape
+    n = uv.shape[0]
+    cmin, cmax, rmin, rmax = width, -1, height, -1
+    low, high = np.inf, -np.inf
+    for i in range(n):
+        z = points[i, 2]
+        low, high = min(low, z), max(high, z)
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            c, r = int(u), int(v)
+            cmin, cmax, rmin, rmax = min(cmin, c), max(cmax, c), min(rmin, r), max(rmax, r)
+    if cmax < 0:
+        return False, 0, 0, np.empty((0, 0), np.bool_), np.empty((0, 0))
+    span_u, span_v = cmax - cmin + pad, rmax - rmin + pad
+    u0, v0 = max(cmin - span_u, 0), max(rmin - span_v, 0)
+    u1, v1 = min(cmax + span_u + 1, width), min(rmax + span_v + 1, height)
+    h, w = v1 - v0, u1 - u0
+    p0, p1, q0, q1 = rmin - v0, rmax + 1 - v0, cmin - u0, cmax + 1 - u0  # the point pixels' box in the window
+    mb, nb = p1 - p0, q1 - q0
+    own_z = np.full((mb, nb), np.inf)
+    for i in range(n):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            r, c = int(v) - rmin, int(u) - cmin
+            z = points[i, 2]
+            if z < own_z[r, c]:
+                own_z[r, c] = z
+    hidden = np.empty((h, w), np.bool_)
+    seen = np.empty((h, w))
+    lo, hi = low + tolerance, high + tolerance
+    k = steps.shape[0]
+    with_others = others.shape[0] > 0
+    # whether a pixel may lend its depth (neither the fruit's nor without depth), once a pixel
+    lend = np.empty((h, w), np.bool_)
+    for r in range(h):
+        inr = p0 <= r < p1
+        for c in range(w):
+            o = mask[v0 + r, u0 + c] or (inr and q0 <= c < q1 and math.isfinite(own_z[r - p0, c - q0]))
+            y = np.float64(depth[v0 + r, u0 + c])
+            lend[r, c] = not o and math.isfinite(y) and y > 0.0
+            if o:
+                hidden[r, c] = False
+                seen[r, c] = np.nan
+            else:
+                seen[r, c] = y  # NaN for now where it has no depth of its own (below)
+    rows = np.zeros(h, np.bool_)
+    for r in range(h):
+        for c in range(w):
+            x = seen[r, c]
+            if x != x and (mask[v0 + r, u0 + c] or (p0 <= r < p1 and q0 <= c < q1
+                                                        and math.isfinite(own_z[r - p0, c - q0]))):  # fmt: skip
+                continue  # the fruit's own
+            if not lend[r, c]:
+                x = np.nan
+                for j in range(k):
+                    rr, cc = r + steps[j, 0], c + steps[j, 1]
+                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
+                        x = np.float64(depth[v0 + rr, u0 + cc])
+                        break
+                seen[r, c] = x
+            if not math.isfinite(x):  # NaN: never nearer, never behind
+                hidden[r, c] = with_others and others[v0 + r, u0 + c]
+            elif x < lo:
+                hidden[r, c] = True
+            else:
+                hidden[r, c] = False
+                if x < hi:
+                    rows[r] = True
+    # the nearest point pixels of the rows that wait for them, as occlusion_window finds them (its column pass over
+    # the box, its row pass and walk)
+    place = np.full(h, -1, np.int64)
+    count = 0
+    for r in range(h):
+        if rows[r]:
+            place[r] = count
+            count += 1
+    near = np.full((count, nb), -1, np.int64)
+    run = np.full(nb, -1, np.int64)
+    for r in range(p0, h):
+        if r < p1:
+            for j in range(nb):
+                if math.isfinite(own_z[r - p0, j]):
+                    run[j] = r
+        kr = place[r]
+        if kr >= 0:
+            for j in range(nb):
+                near[kr, j] = run[j]
+    run[:] = -1
+    for r in range(p1 - 1, -1, -1):
+        if r >= p0:
+            for j in range(nb):
+                if math.isfinite(own_z[r - p0, j]):
+                    run[j] = r
+        kr = place[r]
+        if kr >= 0:
+            for j in range(nb):
+                a, b = near[kr, j], run[j]
+                if b >= 0 and (a < 0 or b - r < r - a):
+                    near[kr, j] = b
+    env = np.empty(nb, np.int64)
+    for r in range(h):
+        if not rows[r]:
+            continue
+        row = near[place[r]]
+        top = _row_envelope(row, r, env)
+        q = 0
+        for u in range(w):
+            x = seen[r, u]
+            if not (x >= lo and x < hi):
+                continue
+            i = env[q]
+            dr, dc = row[i] - r, i + q0 - u
+            best = dr * dr + dc * dc
+            while q < top:
+                i = env[q + 1]
+                dr, dc = row[i] - r, i + q0 - u
+                d = dr * dr + dc * dc
+                if best <= d:
+                    break
+                best = d
+                q += 1
+            i = env[q]
+            ref = own_z[row[i] - p0, i] + tolerance
+            hidden[r, u] = x < ref or (with_others and others[v0 + r, u0 + u] and not x >= ref)
+    return True, u0, v0, hidden, seen
+
+
+@_njit
+def _reach_box(join: np.ndarray, seen: np.ndarray, s0: int, s1: int, t0: int, t1: int) -> tuple[int, int, int, int]:
+    """:func:`_flood_box`'s box alone, from the fill's edge and by runs (issue 19, twentieth round): the pixels a fill
+    from the ``seen`` ones (all within ``s0:s1, t0:t1``) reaches over ``join`` are the seen ones and the pixels of
+    ``join`` not seen that are 8-connected through such pixels to one beside a seen pixel (a path through a seen
+    pixel starts again beside it). So the fill starts from those beside the seen ones, never visits the seen
+    pixels' insides, and takes a row's run of such pixels at once (a scanline fill: the runs of the rows above and
+    below that touch it, diagonals included, are its neighbours). ``(r0, r1, c0, c1)``, stops exclusive:
+    :func:`_flood_box`'s."""
+    h, w = join.shape
+    reached = np.zeros((h, w), np.bool_)
+    stack = np.empty(64, np.int64)
+    top = 0
+    r0, r1, c0, c1 = s0, s1, t0, t1
+    for r in range(max(s0 - 1, 0), min(s1 + 1, h)):
+        for c in range(max(t0 - 1, 0), min(t1 + 1, w)):
+            if seen[r, c] or not join[r, c]:
+                continue
+            beside = False
+            for rr in range(max(r - 1, 0), min(r + 2, h)):
+                for cc in range(max(c - 1, 0), min(c + 2, w)):
+                    if seen[rr, cc]:
+                        beside = True
+            if beside:
+                if top == stack.shape[0]:
+                    stack = np.concatenate((stack, np.empty(top, np.int64)))
+                stack[top] = r * w + c
+                top += 1
+    while top > 0:
+        top -= 1
+        r, c = divmod(stack[top], w)
+        if reached[r, c]:
+            continue
+        # the run through (r, c) of pixels the fill may cross, not reached yet
+        a = c
+        while a > 0 and not reached[r, a - 1] and join[r, a - 1] and not seen[r, a - 1]:
+            a -= 1
+        b = c + 1
+        while b < w and not reached[r, b] and join[r, b] and not seen[r, b]:
+            b += 1
+        for x in range(a, b):
+            reached[r, x] = True
+        r0, r1 = min(r0, r), max(r1, r + 1)
+        c0, c1 = min(c0, a), max(c1, b)
+        for rr in (r - 1, r + 1):  # the new runs it touches above and below (one seed a run)
+            if rr < 0 or rr >= h:
+                continue
+            inside = False
+            for x in range(max(a - 1, 0), min(b + 1, w)):
+                ok = not reached[rr, x] and join[rr, x] and not seen[rr, x]
+                if ok and not inside:
+                    if top == stack.shape[0]:
+                        stack = np.concatenate((stack, np.empty(top, np.int64)))
+                    stack[top] = rr * w + x
+                    top += 1
+                inside = ok
+    return r0, r1, c0, c1
+
+
+@_njit
+def monotone_table(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, dy: np.ndarray, dx: np.ndarray, table: np.ndarray,
+    reach: int, bins: int, tolerance: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`monotone_rays` with each pixel's sector read from ``table`` (2 reach + 1, 2 reach + 1), the sector of
+    every offset ``(dy, dx)`` within ``reach`` as :func:`monotone_rays` works it out from numpy's ``arctan2``
+    (:func:`symfruit.core.surface._sector_table`), instead of numpy's ``arctan2`` of every pixel (issue 19, twentieth
+    round). The same sectors, so the same pixels."""
+    n = rows.shape[0]
+    sector = np.empty(n, np.int64)
+    d2 = np.empty(n, np.int64)
+    for i in range(n):
+        a, b = np.int64(dy[i]), np.int64(dx[i])
+        sector[i] = np.int64(table[a + reach, b + reach])
+        d2[i] = a * a + b * b
+    monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+
+
+@_njit
+def _one_slab(points: np.ndarray, distance: float) -> np.ndarray:
+    """:func:`clusters`' test for a single slab (issue 19, twentieth round): ``arange(n)`` when every bin of width
+    ``distance / 4`` from the least to the greatest depth (``points[:, 2]``, finite) holds a point, so that no two
+    consecutive depths are more than ``distance`` apart; an empty array where a bin is empty (or ``distance`` is not
+    above 0), and the slabs are to be found by sorting."""
+    n = points.shape[0]
+    none = np.zeros(0, np.int64)
+    if n == 0 or not distance > 0.0:
+        return none
+    lo, hi = points[0, 2], points[0, 2]
+    for i in range(1, n):
+        lo, hi = min(lo, points[i, 2]), max(hi, points[i, 2])
+    width = distance / 4.0
+    span = (hi - lo) / width
+    if not span < n:  # more bins than points: one is empty
+        return none
+    bins = np.int64(math.floor(span)) + 1
+    held = np.zeros(bins, np.bool_)
+    for i in range(n):
+        held[min(np.int64(math.floor((points[i, 2] - lo) / width)), bins - 1)] = True
+    for b in range(bins):
+        if not held[b]:
+            return none
+    return np.arange(n)
 
 
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
@@ -3655,85 +3914,113 @@ def occlusion_window(
     lo, hi = low + tolerance, high + tolerance
     k = steps.shape[0]
     with_others = others.shape[0] > 0
-    pending = np.zeros((h, w), np.bool_)
+    # issue 19, twentieth round: whether a pixel may lend its depth (neither the fruit's nor without depth) is worked
+    # out once a pixel, not once per offset that reads it; the point pixels' box bounds the column sweeps (no point
+    # pixel lies outside it, so no column's nearest changes); a pixel waits for its nearest point pixel when its
+    # seen depth lies in [lo, hi) (read back from ``seen``), not by a map of its own
+    lend = np.empty((h, w), np.bool_)
+    own = np.empty((h, w), np.bool_)
+    p0, p1, q0, q1 = h, 0, w, 0  # the point pixels' box
+    for r in range(h):
+        for c in range(w):
+            pt = math.isfinite(own_z[r, c])
+            if pt:
+                p0, p1 = min(p0, r), r + 1
+                q0, q1 = min(q0, c), max(q1, c + 1)
+            o = mask[r, c] or pt
+            own[r, c] = o
+            y = np.float64(depth[r, c])
+            lend[r, c] = not o and math.isfinite(y) and y > 0.0
     rows = np.zeros(h, np.bool_)
     for r in range(h):
         for c in range(w):
-            hidden[r, c] = False
-            x = np.float64(depth[r, c])
-            if mask[r, c] or math.isfinite(own_z[r, c]):
+            if own[r, c]:
+                hidden[r, c] = False
                 seen[r, c] = np.nan
                 continue
-            if not (math.isfinite(x) and x > 0.0):
+            if lend[r, c]:
+                x = np.float64(depth[r, c])
+            else:
                 x = np.nan
                 for j in range(k):
                     rr, cc = r + steps[j, 0], c + steps[j, 1]
-                    if 0 <= rr < h and 0 <= cc < w and not (mask[rr, cc] or math.isfinite(own_z[rr, cc])):
-                        y = np.float64(depth[rr, cc])
-                        if math.isfinite(y) and y > 0.0:  # a pixel with depth: its own, never a filled one
-                            x = y
-                            break
+                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
+                        x = np.float64(depth[rr, cc])
+                        break
             seen[r, c] = x
             if not math.isfinite(x):  # NaN: never nearer, never behind
                 hidden[r, c] = with_others and others[r, c]
             elif x < lo:
                 hidden[r, c] = True
-            elif not x >= hi:
-                pending[r, c] = True
-                rows[r] = True
+            else:
+                hidden[r, c] = False
+                if x < hi:
+                    rows[r] = True
     # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
-    # the rows looked at alone: the nearest at or above by a sweep down, the nearest below by a sweep up
+    # the rows looked at alone and the point pixels' columns alone (q0 to q1: no other column has a nearest row):
+    # the nearest at or above by a sweep down, the nearest below by a sweep up, each over the point pixels' rows
+    # (beyond them its state does not change)
     place = np.full(h, -1, np.int64)
     count = 0
     for r in range(h):
         if rows[r]:
             place[r] = count
             count += 1
-    near = np.empty((count, w), np.int64)
-    run = np.full(w, -1, np.int64)
-    for r in range(h):
-        for c in range(w):
-            if math.isfinite(own_z[r, c]):
-                run[c] = r
-        if place[r] >= 0:
-            near[place[r], :] = run
-    run[:] = -1
-    for r in range(h - 1, -1, -1):
-        for c in range(w):
-            if math.isfinite(own_z[r, c]):
-                run[c] = r
+    nb = max(q1 - q0, 0)
+    near = np.full((count, nb), -1, np.int64)  # column q0 + j's nearest row, -1: none
+    run = np.full(nb, -1, np.int64)
+    for r in range(p0, h):
+        if r < p1:
+            for j in range(nb):
+                if math.isfinite(own_z[r, q0 + j]):
+                    run[j] = r
         kr = place[r]
         if kr >= 0:
-            for c in range(w):
-                a, b = near[kr, c], run[c]
+            for j in range(nb):
+                near[kr, j] = run[j]
+    run[:] = -1
+    for r in range(p1 - 1, -1, -1):
+        if r >= p0:
+            for j in range(nb):
+                if math.isfinite(own_z[r, q0 + j]):
+                    run[j] = r
+        kr = place[r]
+        if kr >= 0:
+            for j in range(nb):
+                a, b = near[kr, j], run[j]
                 if b >= 0 and (a < 0 or b - r < r - a):
-                    near[kr, c] = b
-    env = np.empty(w, np.int64)
+                    near[kr, j] = b
+    env = np.empty(max(nb, 1), np.int64)
     done = 0
     for r in range(h):
         if not rows[r]:
             continue
         done += 1
         row = near[place[r]]
-        top = _row_envelope(row, r, env)  # nearest()'s row pass, the same envelope and the same walk along it
+        top = _row_envelope(row, r, env)  # nearest()'s row pass, columns counted from q0: the same envelope (its
+        # tests are on differences of columns), and the same walk along it, taken at the waiting pixels alone: the
+        # walk moves on to the next parabola only while that is strictly nearer, and the next's lead over the last
+        # grows along the row, so the parabola it stops at for a pixel is the same whether it walked every pixel
+        # before or only some of them
         q = 0
         for u in range(w):
+            x = seen[r, u]
+            if not (x >= lo and x < hi):  # decided without its nearest point pixel (NaN: never waits)
+                continue
             i = env[q]
-            dr, dc = row[i] - r, i - u
+            dr, dc = row[i] - r, i + q0 - u
             best = dr * dr + dc * dc
             while q < top:
                 i = env[q + 1]
-                dr, dc = row[i] - r, i - u
+                dr, dc = row[i] - r, i + q0 - u
                 d = dr * dr + dc * dc
                 if best <= d:
                     break
                 best = d
                 q += 1
-            if pending[r, u]:
-                i = env[q]
-                ref = own_z[row[i], i] + tolerance
-                x = seen[r, u]
-                hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
+            i = env[q]
+            ref = own_z[row[i], i + q0] + tolerance
+            hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
     return done
 
 
@@ -3791,7 +4078,7 @@ def allowed_box(
         for c in range(t0, t1):
             seen[r, c] = region[r - dr, c - dc]
     join = _joins(hidden, seen, s0, s1, t0, t1, gap, thin)
-    _, r0, r1, c0, c1 = _flood_box(join, seen, s0, s1, t0, t1)
+    r0, r1, c0, c1 = _reach_box(join, seen, s0, s1, t0, t1)  # _flood_box's box (issue 19, twentieth round)
     return True, r0, r1, c0, c1
 
 

@@ -35,7 +35,10 @@ marched candidate and :meth:`symfruit.core.occlusion.Occlusion.at`; the seventee
 pixels), :func:`symfruit.core.raster.outline_cone`, :func:`~symfruit.core.raster.close_ragged`,
 :func:`~symfruit.core.raster.silhouette`, :func:`~symfruit.core.raster.rasterise`,
 :func:`symfruit.segment.colour._sphere`, ``_centres``, ``_depth_edges``, ``_cells``, ``_grouped``, ``_least_areas``
-and ``_segment_at``'s redness) then run their numpy twins, the code the kernels
+and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlusion.occlusion`
+(:func:`symfruit.core._jit.occlusion_at`), :func:`symfruit.core.surface.monotone_region`
+(:func:`symfruit.core._jit.monotone_table`) and :func:`symfruit.extract.cluster` (``_one_slab`` in
+:func:`symfruit.core._jit.clusters`)) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
@@ -58,6 +61,13 @@ __all__ = ["compiled"]
 
 _STATE: dict[str, ModuleType | None] = {}
 
+#: ``os.environ`` and its own dictionary of encoded names (CPython on POSIX), as they were at import, for
+#: :func:`compiled`'s look-up of an unset ``SYMFRUIT_KERNELS``; None elsewhere.
+_ENVIRON = os.environ
+_DATA = getattr(os.environ, "_data", None) if os.name == "posix" else None
+_DATA = _DATA if isinstance(_DATA, dict) else None
+_KEY = b"SYMFRUIT_KERNELS"
+
 
 def _setting() -> str:
     """``SYMFRUIT_KERNELS`` as the environment holds it now ("" unset). Read on every call (a test or a caller may
@@ -73,7 +83,17 @@ def _setting() -> str:
 
 def compiled() -> ModuleType | None:
     """The compiled kernels' module, or None where the numpy twins are to run (no numba, or
-    ``SYMFRUIT_KERNELS=numpy``)."""
+    ``SYMFRUIT_KERNELS=numpy``).
+
+    The environment is read on every call (a test may set it at any time): where ``SYMFRUIT_KERNELS`` is unset
+    (the usual case) and the module has been looked for, by one membership test of ``os.environ``'s own dictionary
+    and one look-up of the module found, about a third of the full path's cost (some 900 calls a benchmark frame;
+    issue 19, twentieth round); set, or on the first call, by :func:`_setting` as before."""
+    if _DATA is not None and _KEY not in _DATA and os.environ is _ENVIRON:
+        try:
+            return _STATE["jit"]
+        except KeyError:  # not looked for yet (or the state was reset): below
+            pass
     if _setting().lower() == "numpy":
         return None
     if "jit" not in _STATE:

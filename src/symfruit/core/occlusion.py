@@ -290,7 +290,10 @@ def occlusion(
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
     maps, bit for bit; the benchmark frame's 9 windows 4.9 against 9.1 ms; issue 19, fourteenth round), the
     nearest point pixels looked for only where they decide, on the rows holding such pixels
-    (:func:`symfruit.core._jit.occlusion_window`: the same maps; 2.0 against 3.0 ms; eighteenth round).
+    (:func:`symfruit.core._jit.occlusion_window`: the same maps; 2.0 against 3.0 ms; eighteenth round), and with the
+    window and the fruit's own depths in the same kernel, the images read in place and the own depths kept over the
+    points' pixels' box alone (:func:`symfruit.core._jit.occlusion_at`: the same maps; 1.98 against 3.48 ms for the
+    benchmark frame's 9 fruit, least of 40 passes of the recorded calls, on a loaded machine; twentieth round).
 
     Parameters
     ----------
@@ -338,23 +341,18 @@ def occlusion(
     points = as_points(points, min_count=1)
     uv = camera.project(points)
     if (jit := compiled()) is not None:  # as_points gives contiguous float64
-        # the window, the fruit's own depths and the maps below by compiled twins (the same bits; issue 19,
-        # seventeenth round: the window and own depths in one pass, not some fifteen numpy calls)
-        found, u0, v0, u1, v1, own_z, _ = jit.own_depths(uv, points, camera.width, camera.height, pad)
+        # the window, the fruit's own depths and the maps below in one compiled pass, the images read in place (the
+        # same bits: issue 19, seventeenth round, the window and own depths; eighteenth, the nearest point pixel
+        # looked for only where it decides, on the rows that need it alone; twentieth, the own depths kept over the
+        # points' pixels' box, the window's maps in one kernel)
+        image = depth if depth.dtype in (np.float32, np.float64) else np.asarray(depth, dtype=np.float64)
+        near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
+        found, u0, v0, hidden, seen = jit.occlusion_at(uv, points, pad, image, mask, near_to, tolerance, _steps(reach))
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
-        h, w = v1 - v0, u1 - u0
-        window = depth[v0:v1, u0:u1]
-        if window.dtype not in (np.float32, np.float64):
-            window = np.asarray(window, dtype=np.float64)
-        near_to = others[v0:v1, u0:u1] if others is not None else np.zeros((0, 0), bool)
-        hidden, seen = np.empty((h, w), bool), np.empty((h, w))
-        # the nearest point pixel looked for only where it decides (issue 19, eighteenth round: the maps of
-        # occlusion_maps after nearest_index(unseen), bit for bit, on the rows that need it alone)
-        z = points[:, 2]
-        jit.occlusion_window(window, mask[v0:v1, u0:u1], own_z, np.asarray(near_to, dtype=bool), tolerance,
-                             _steps(reach), float(z.min()), float(z.max()), hidden, seen)  # fmt: skip
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=seen)
+        h, w = hidden.shape
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0 : v0 + h, u0 : u0 + w].copy(),
+                         depth=seen)  # fmt: skip
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)

@@ -439,8 +439,14 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     if not len(rows) or not np.isfinite(tolerance):
         return keep.copy() if len(rows) else out
     if jit is not None:  # the compiled twin of what follows from the directions on (the same pixels)
-        jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi),
-                          float(tolerance), out)  # fmt: skip
+        h, w = keep.shape
+        reach = max(abs(int(apex[0])), abs(h - 1 - int(apex[0])), abs(int(apex[1])), abs(w - 1 - int(apex[1])))
+        if (table := _sector_table(bins, reach)) is not None:  # the sectors of the offsets, read off a table
+            jit.monotone_table(depth, rows, cols, dy, dx, table, (table.shape[0] - 1) // 2, bins, float(tolerance),
+                               out)  # fmt: skip
+        else:
+            jit.monotone_rays(depth, rows, cols, np.arctan2(dy, dx), dy, dx, bins, bins / (2.0 * np.pi),
+                              float(tolerance), out)  # fmt: skip
         return out
     dy, dx = rows - apex[0], cols - apex[1]
     sector = np.floor((np.arctan2(dy, dx) + np.pi) * (bins / (2.0 * np.pi))).astype(np.int64) % bins
@@ -459,6 +465,40 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     ok = fell == before
     out.ravel()[at[ok]] = True
     return out
+
+
+#: :func:`_sector_table`'s tables by ``bins``, and the largest offset made one (beyond it, ``arctan2`` per pixel)
+_SECTORS: dict[int, np.ndarray] = {}
+_SECTOR_REACH = 512
+
+
+def _sector_table(bins: int, reach: int) -> np.ndarray | None:
+    """(2 r + 1, 2 r + 1) int16, ``r >= reach``: the sector of :func:`monotone_region` of every whole-number offset
+    ``(dy, dx)`` within ``r`` of the apex (at ``[dy + r, dx + r]``), worked out as its compiled twin works out a
+    pixel's, from numpy's ``arctan2`` of the same whole numbers (``floor((arctan2(dy, dx) + pi) * bins / (2 pi)) %
+    bins``: the same values, elementwise); made once per ``bins`` for offsets up to a power of two of at least 64, and
+    again larger when a larger one is asked for, up to :data:`_SECTOR_REACH` (None beyond, or for more than
+    32767 bins). A fruit's sectors cost a look-up a pixel instead of an ``arctan2``, the most of
+    :func:`monotone_region`'s own time (issue 19, twentieth round)."""
+    if reach > _SECTOR_REACH or not 0 < bins <= 32767:
+        return None
+    table = _SECTORS.get(bins)
+    if table is None or (table.shape[0] - 1) // 2 < reach:
+        r = 64
+        while r < reach:
+            r *= 2
+        r = min(r, _SECTOR_REACH)
+        off = np.arange(-r, r + 1, dtype=np.int64)
+        dy, dx = np.repeat(off, 2 * r + 1), np.tile(off, 2 * r + 1)
+        per_radian = bins / (2.0 * np.pi)
+        sector = np.empty(len(dy), np.int64)
+        for i in range(0, len(dy), 2 * r + 1):  # a row at a time, as a fruit's pixels reach arctan2
+            sector[i : i + 2 * r + 1] = np.floor((np.arctan2(dy[i : i + 2 * r + 1], dx[i : i + 2 * r + 1]) + np.pi)
+                                                 * per_radian).astype(np.int64) % bins  # fmt: skip
+        table = sector.astype(np.int16).reshape(2 * r + 1, 2 * r + 1)
+        table.flags.writeable = False
+        _SECTORS[bins] = table
+    return table
 
 
 def _stable_order(key: np.ndarray) -> np.ndarray:
