@@ -341,12 +341,14 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     flat = kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]
     # not a sheet: still an occluder where a convex part behind it is larger (a fruit's own front is its largest part)
     least = max(30, 0.1 * len(rows)) if flat else len(rows) + 1
+    sizes = np.bincount(parts.ravel(), minlength=count + 1)
+    if max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id) < least:
+        return None  # no part large enough behind (a fruit's own front, not flat: the usual case, ended here)
     far = float(np.median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
     reach = 3 + int(np.ceil(0.3 * np.sqrt(mask.sum() / np.pi)))
     touching = ndimage.binary_dilation(sheet, iterations=reach)
-    sizes = np.bincount(parts.ravel(), minlength=count + 1)
     order = np.argsort(-sizes[1:], kind="stable") + 1
     for k in order:
         if sizes[k] < least:
