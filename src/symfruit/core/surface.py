@@ -253,7 +253,10 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     (``front``, :func:`fruit_depth`) is a sheet when its mean curvature is clearly below a fruit's (:data:`THIN`;
     a convex cap's depth grows towards its outline as ``r^2 / 2R``, a leaf is flat or gently curved). The fruit is
     then the largest part behind it, touching it (what the leaf hides is bounded by its edge), clearly convex
-    and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths.
+    and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths (bins
+    of the measured ``noise``). A front part not flat is passed over too, for a convex part behind it, touching it,
+    that holds more pixels than it (a leaf's depth a stereo camera fattens a few pixels into a mask of the visible
+    fruit; an occluder's part too small or curled to be told flat: a fruit's own front is its mask's largest part).
     Where noise bridges the step (``join`` a few noise deviations wide, a stereo camera's far depth), the parts
     are found again on the depth's 5 x 5 median (steps kept, the noise a third), joined at three of its own noise
     deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap
@@ -291,13 +294,19 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
         if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
             return None
-    found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(depth, mask, join))
+    found = _behind_sheet(
+        depth, mask, focal, front, radius, join, inflate, *_smooth_parts(depth, mask, join), noise=noise
+    )
     if found is not None:
         return found
     if 3.0 * noise <= 0.003 or ok.sum() < 60:
         return None  # the step was not bridged by noise
     _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)  # no depth: its nearest pixel's
-    smooth = np.where(ok, ndimage.median_filter(depth[ri, ci], 5, mode="nearest"), 0.0)
+    # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
+    # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels
+    rows, cols = np.nonzero(ok)
+    smooth = np.zeros(depth.shape)
+    smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
     a, b = smooth[:, 5:], smooth[:, :-5]
     diff = (a - b)[mask[:, 5:] & mask[:, :-5] & (a > 0) & (b > 0)]
     if len(diff) < 20:
@@ -306,14 +315,22 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
-    return _behind_sheet(depth, mask, focal, front, radius, join, inflate, *_smooth_parts(smooth, mask, narrow))
+    return _behind_sheet(
+        depth, mask, focal, front, radius, join, inflate, *_smooth_parts(smooth, mask, narrow), noise=noise
+    )
 
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
-                  inflate: float, parts: np.ndarray, count: int) -> tuple[float, np.ndarray] | None:  # fmt: skip
+                  inflate: float, parts: np.ndarray, count: int,
+                  *, noise: float = 0.001) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
     sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
-    a flat reading must hold on the camera's own pixels; the cap behind is not asked as much)."""
+    a flat reading must hold on the camera's own pixels; the cap behind is not asked as much). A front part that is
+    not a sheet is passed over only for a convex part behind it holding more pixels than it does: an occluder whose
+    shape is not told (a strip of a leaf's depth a stereo camera fattens into a mask of the visible fruit, a few
+    pixels wide; a leaf's small or curled part) hides less of the mask than the fruit shows, while a fruit's own front
+    is the mask's largest surface (stop 40, docs/leaf40.md). ``noise``: the depth's noise, for :func:`fruit_depth`'s
+    bins on the part behind."""
     if count < 2:
         return None
     near = (parts > 0) & (np.abs(depth - front) <= join)
@@ -326,17 +343,20 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         return None
     kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
     error *= inflate
-    if not (kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]):
-        return None
+    flat = kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]
+    # not a sheet: still an occluder where a convex part behind it is larger (a fruit's own front is its largest part)
+    least = max(30, 0.1 * len(rows)) if flat else len(rows) + 1
+    sizes = np.bincount(parts.ravel(), minlength=count + 1)
+    if max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id) < least:
+        return None  # no part large enough behind (a fruit's own front, not flat: the usual case, ended here)
     far = float(np.median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
     reach = 3 + int(np.ceil(0.3 * np.sqrt(mask.sum() / np.pi)))
     touching = ndimage.binary_dilation(sheet, iterations=reach)
-    sizes = np.bincount(parts.ravel(), minlength=count + 1)
     order = np.argsort(-sizes[1:], kind="stable") + 1
     for k in order:
-        if sizes[k] < max(30, 0.1 * len(rows)):
+        if sizes[k] < least:
             break
         if k == sheet_id:
             continue
@@ -346,7 +366,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         kappa, error = _mean_curvature(pr, pc, z, focal)
         if kappa * radius >= THIN[1] and error * radius <= THIN[2]:
-            behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal)
+            behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if np.isfinite(behind) and behind > front:
                 return behind, sheet
     return None
