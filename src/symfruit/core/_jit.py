@@ -3935,25 +3935,30 @@ def sphere_points(
 def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
     """:func:`symfruit.segment.colour._centres`' peaks of a distance map ``edt`` (h, w) float64: (h, w) bool, the
     pixels at least ``least`` deep and as deep as every pixel of the ``2 radius + 1`` square about them, the square
-    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). The largest
-    of each row's stretch, then of each column's: maxima are exact, the same pixels."""
+    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). Each pixel
+    deep enough is compared with its square's pixels, nearest rows first, until one is deeper (most are not peaks and
+    have a deeper neighbour; issue 19, twentieth round: the square's maxima, rows then columns, for every pixel before):
+    the same comparisons of the same values, the same pixels."""
     h, w = edt.shape
-    rows = np.empty((h, w))
-    for r in range(h):
-        for c in range(w):
-            best = edt[r, max(c - radius, 0)]
-            for q in range(max(c - radius, 0) + 1, min(c + radius, w - 1) + 1):
-                best = max(best, edt[r, q])
-            rows[r, c] = best
     out = np.zeros((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
-            if edt[r, c] < least:
+            v = edt[r, c]
+            if v < least:
                 continue
-            best = rows[max(r - radius, 0), c]
-            for q in range(max(r - radius, 0) + 1, min(r + radius, h - 1) + 1):
-                best = max(best, rows[q, c])
-            out[r, c] = edt[r, c] >= best
+            c0, c1 = max(c - radius, 0), min(c + radius, w - 1)
+            peak = True
+            for d in range(2 * radius + 1):
+                q = r + (d + 1) // 2 if d % 2 else r - d // 2  # rows r, r + 1, r - 1, r + 2, ...
+                if q < 0 or q >= h:
+                    continue
+                for j in range(c0, c1 + 1):
+                    if edt[q, j] > v:
+                        peak = False
+                        break
+                if not peak:
+                    break
+            out[r, c] = peak
     return out
 
 
