@@ -3444,3 +3444,60 @@ def test_one_slab_is_found_only_without_a_gap_and_the_clusters_are_the_twins(see
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, cluster, points, distance)
     np.testing.assert_array_equal(fast, twin)
+
+
+# --- stop 40, speedseg40
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.0, 2.0, 3.3]), st.booleans())
+def test_the_segmenters_split_up_to_its_centres_is_the_twins(seed, sigma, holes):
+    """Two to four fruit-like caps at random depths, some touching, with holes, pixels without depth and speckle, in a
+    window of random shape: ``split_seen`` is ``fill_holes``, the count of the region's pixels with depth and their
+    median, ``split_centres`` the twins' depth edges, carved region and centres (``_depth_edges``, ``fill_holes``,
+    ``_centres`` without coarsening), and ``_split`` cuts the same parts with the kernels and with the twins."""
+    from symfruit.core.points import median
+    from symfruit.core.raster import fill_holes
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(8, 120, 2))
+    yy, xx = np.mgrid[:h, :w]
+    depth = np.zeros((h, w))
+    region = np.zeros((h, w), bool)
+    for _ in range(int(rng.integers(2, 5))):
+        cy, cx, r, z = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(4, 35), rng.uniform(0.4, 0.6)
+        disc = (yy - cy) ** 2 + (xx - cx) ** 2 <= r * r
+        cap = z - 0.001 * np.sqrt(np.maximum(r * r - (yy - cy) ** 2 - (xx - cx) ** 2, 0.0))
+        depth = np.where(disc & ((depth == 0) | (cap < depth)), cap, depth)
+        region |= disc
+    depth += rng.normal(0.0, 0.0005, (h, w)) * (depth > 0)
+    depth[rng.random((h, w)) < 0.1] = 0.0
+    if holes:
+        region &= rng.random((h, w)) < 0.97
+    depth = np.where(region, depth, 0.0)
+    s = colour.SegmentSettings(crease_sigma=sigma)
+    geo = colour._Geometry(600.0, h / 2, w / 2)
+    full, k, zm = _jit.split_seen(region, depth)
+    want = fill_holes(region)
+    np.testing.assert_array_equal(full, want)
+    seen = want & (depth > 0)
+    assert k == int(seen.sum())
+    if k:
+        assert zm == float(median(depth[seen]))
+    if k >= 20:
+        least = max(0.25 * geo.focal * s.min_diameter / zm, 2.0)
+        weights, symmetric = colour._gaussian_weights(sigma) if sigma > 0 else (np.ones(1), True)
+        limit = -s.crease_curvature * (zm / geo.focal) ** 2
+        edges, found = _jit.split_centres(full, depth, weights, symmetric, limit, s.depth_jump, int(least), least,
+                                          colour.CANDIDATE_WAIST, s.waist, colour.MAX_WAIST_TESTS)  # fmt: skip
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin_edges = colour._depth_edges(full, depth, seen, float(zm), s, geo.focal)
+            carved = fill_holes(full & ~twin_edges)
+            twin = colour._centres(carved, least, s.waist, colour.CANDIDATE_WAIST, coarse=False)
+        np.testing.assert_array_equal(edges, twin_edges)
+        assert [(int(a), int(b), float(r), bool(f)) for a, b, r, f in found.tolist()] == twin
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin_parts = _both(mp, colour._split, region, depth, s, geo, (3, 5), 50.0)
+    assert len(fast) == len(twin_parts) and all(np.array_equal(a, b) for a, b in zip(fast, twin_parts, strict=True))

@@ -1248,3 +1248,21 @@ def test_the_ripe_test_compares_in_float32_with_and_without_the_kernels(monkeypa
     assert _ripe(color, red, 0.35)
     color[..., 1] = 14
     assert not _ripe(color, red, 0.35)
+
+
+def test_a_filled_polygon_is_pillows_image_as_bool():
+    """Random polygons (2-7 vertices, some off the image) on images of random shape: ``_fill_polygon``'s mask is
+    ``np.asarray(image, dtype=bool)`` of the Pillow drawing it reads its bytes from, shape, type and pixels."""
+    from PIL import Image, ImageDraw
+
+    from symfruit.segment.colour import _fill_polygon
+
+    rng = np.random.default_rng(40)
+    for _ in range(300):
+        h, w = (int(x) for x in rng.integers(1, 60, 2))
+        v = rng.uniform(-5.0, 65.0, (int(rng.integers(2, 8)), 2))
+        img = Image.new("L", (w, h), 0)
+        ImageDraw.Draw(img).polygon([tuple(p) for p in v.tolist()], fill=1, outline=1)
+        want = np.asarray(img, dtype=bool)
+        got = _fill_polygon(v, (h, w))
+        assert got.shape == want.shape and got.dtype == want.dtype and np.array_equal(got, want)

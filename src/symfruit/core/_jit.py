@@ -4801,25 +4801,30 @@ def sphere_points(
 def peaks(edt: np.ndarray, radius: int, least: float) -> np.ndarray:
     """:func:`symfruit.segment.colour._centres`' peaks of a distance map ``edt`` (h, w) float64: (h, w) bool, the
     pixels at least ``least`` deep and as deep as every pixel of the ``2 radius + 1`` square about them, the square
-    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). The largest
-    of each row's stretch, then of each column's: maxima are exact, the same pixels."""
+    cut at the image's edges (``ndimage.maximum_filter``'s "reflect" mode only repeats pixels inside it). Each pixel
+    deep enough is compared with its square's pixels, nearest rows first, until one is deeper (most are not peaks and
+    have a deeper neighbour; issue 19, twentieth round: the square's maxima, rows then columns, for every pixel before):
+    the same comparisons of the same values, the same pixels."""
     h, w = edt.shape
-    rows = np.empty((h, w))
-    for r in range(h):
-        for c in range(w):
-            best = edt[r, max(c - radius, 0)]
-            for q in range(max(c - radius, 0) + 1, min(c + radius, w - 1) + 1):
-                best = max(best, edt[r, q])
-            rows[r, c] = best
     out = np.zeros((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
-            if edt[r, c] < least:
+            v = edt[r, c]
+            if v < least:
                 continue
-            best = rows[max(r - radius, 0), c]
-            for q in range(max(r - radius, 0) + 1, min(r + radius, h - 1) + 1):
-                best = max(best, rows[q, c])
-            out[r, c] = edt[r, c] >= best
+            c0, c1 = max(c - radius, 0), min(c + radius, w - 1)
+            peak = True
+            for d in range(2 * radius + 1):
+                q = r + (d + 1) // 2 if d % 2 else r - d // 2  # rows r, r + 1, r - 1, r + 2, ...
+                if q < 0 or q >= h:
+                    continue
+                for j in range(c0, c1 + 1):
+                    if edt[q, j] > v:
+                        peak = False
+                        break
+                if not peak:
+                    break
+            out[r, c] = peak
     return out
 
 
@@ -5786,3 +5791,82 @@ def hidden_count(rest: np.ndarray, depth: np.ndarray, front: float, size: int) -
                             v = d
             n += v < front
     return n
+
+
+# --- issue 19, twentieth round (stop 40): the colour segmenter's split, up to its centres, in two calls -----------
+
+
+@_njit
+def _filled_box(mask: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.raster.fill_holes` of ``mask`` (h, w) bool: a copy with its holes filled by :func:`filled`
+    on the mask's box grown by a pixel (clipped), the twin's call: the same pixels."""
+    h, w = mask.shape
+    out = mask.copy()
+    r0, r1, c0, c1 = h, -1, w, -1
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                r0, r1 = min(r0, r), max(r1, r)
+                c0, c1 = min(c0, c), max(c1, c)
+    if r1 < 0:
+        return out
+    r0, r1, c0, c1 = max(r0 - 1, 0), min(r1 + 2, h), max(c0 - 1, 0), min(c1 + 2, w)
+    filled(mask[r0:r1, c0:c1], out[r0:r1, c0:c1])
+    return out
+
+
+@_njit
+def split_seen(region: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, int, float]:
+    """:func:`symfruit.segment.colour._split`'s start with depth: the region (h, w) bool with its holes filled
+    (:func:`_filled_box`, the twin's ``fill_holes``), how many of its pixels have depth (``depth`` (h, w) float64
+    above 0) and ``core.points.median`` of those depths (NaN without any; :func:`masked_median`): the twin's values."""
+    full = _filled_box(region)
+    _, k, zm = masked_median(full, depth)
+    return full, k, zm
+
+
+@_njit
+def split_centres(
+    region: np.ndarray, depth: np.ndarray, weights: np.ndarray, symmetric: bool, limit: float, jump: float,
+    radius: int, least: float, loose: float, waist: float, budget: int,
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.segment.colour._split` with depth from its filled ``region`` (h, w) bool and ``depth`` (h, w)
+    float64 (0: none) to its centres: the depth edges (:func:`depth_edges` of the depth filled from the nearest pixel
+    with depth of the region, scipy's choice, :func:`nearest`), the region less them with its holes filled
+    (:func:`_filled_box`), its distance map (:func:`distance` of it padded by a pixel) and, when that reaches
+    ``least``, the :func:`centre_search` (``radius`` the whole part of ``least``). Returns the edges (h, w) bool and the
+    centres (k, 4) (none when the map stays below ``least``): the twin's calls in one, the same values."""
+    h, w = region.shape
+    seen = np.empty((h, w), np.bool_)
+    free = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            seen[r, c] = region[r, c] and depth[r, c] > 0
+            free[r, c] = not seen[r, c]
+    near = np.empty((h, w), np.int64)
+    nearest(free, near)
+    fill = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            q = near[r, c]
+            fill[r, c] = depth[q // w, q % w]
+    edges = depth_edges(fill, weights, symmetric, limit, region, depth, seen, jump)
+    cut = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            cut[r, c] = region[r, c] and not edges[r, c]
+    carved = _filled_box(cut)
+    pad = np.zeros((h + 2, w + 2), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            pad[r + 1, c + 1] = carved[r, c]
+    dist = np.empty((h + 2, w + 2))
+    distance(pad, False, dist)
+    edt = dist[1:-1, 1:-1]
+    top = -np.inf
+    for r in range(h):
+        for c in range(w):
+            top = max(top, edt[r, c])
+    if top < least:
+        return edges, np.empty((0, 4))
+    return edges, centre_search(edt, radius, least, loose, waist, budget)

@@ -362,7 +362,9 @@ def _fill_polygon(vertices: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 
     img = Image.new("L", (shape[1], shape[0]), 0)
     ImageDraw.Draw(img).polygon([tuple(v) for v in vertices.tolist()], fill=1, outline=1)
-    return np.asarray(img, dtype=bool)
+    # its bytes (0 or 1) read as bool: ``np.asarray(img, dtype=bool)``'s values without its conversion (Pillow's array
+    # interface, then a cast: two thirds of the call on a 1920x1080 frame's hulls; issue 19, twentieth round)
+    return np.frombuffer(img.tobytes(), np.uint8).view(bool).reshape(shape[0], shape[1])
 
 
 def _hull_area(mask: np.ndarray) -> float:
@@ -1132,7 +1134,24 @@ def _split(
     min_area: float,
 ) -> list[np.ndarray]:
     """Cut a region into fruit (see the module docstring): at waists of its distance transform (the depth
-    steps and creases taken as part of its outline), keeping the cuts that evidence backs."""
+    steps and creases taken as part of its outline), keeping the cuts that evidence backs. Where numba is, with depth
+    and no closing, the steps up to the centres in two compiled calls (:func:`symfruit.core._jit.split_seen` and
+    :func:`symfruit.core._jit.split_centres`: the holes filled, the median depth, the depth edges, the carved region's
+    distance map and its centres; the same values as the calls below; issue 19, twentieth round)."""
+    jit = compiled()
+    if (jit is not None and depth is not None and not s.close_px and s.split in ("depth", "both")
+            and region.ndim == 2 and region.dtype == bool and depth.dtype == np.float64):  # fmt: skip
+        region, n_seen, zm = jit.split_seen(region, depth)
+        if n_seen >= 20:
+            zm = float(zm)
+            least = max(0.25 * geo.focal * s.min_diameter / zm, 2.0)
+            weights, symmetric = _gaussian_weights(float(s.crease_sigma)) if s.crease_sigma > 0 else _IDENTITY
+            limit = -s.crease_curvature * (zm / geo.focal) ** 2
+            edges, found = jit.split_centres(region, depth, weights, symmetric, limit, float(s.depth_jump),
+                                             int(least), float(least), CANDIDATE_WAIST, float(s.waist),
+                                             MAX_WAIST_TESTS)  # fmt: skip
+            centres = [(int(a), int(b), float(r), bool(f)) for a, b, r, f in found.tolist()]
+            return _cut(region, depth, s, geo, origin, centres, edges, True)
     region = fill_holes(region)
     if s.close_px:
         r = s.close_px
@@ -1155,6 +1174,21 @@ def _split(
     centres = _centres(
         carved, max(least, 2.0), s.waist, CANDIDATE_WAIST if use_depth else s.waist, coarse=not use_depth
     )
+    return _cut(region, depth, s, geo, origin, centres, edges, use_depth)
+
+
+def _cut(
+    region: np.ndarray,
+    depth: np.ndarray | None,
+    s: SegmentSettings,
+    geo: _Geometry,
+    origin: tuple[int, int],
+    centres: list[tuple[int, int, float, bool]],
+    edges: np.ndarray | None,
+    use_depth: bool,
+) -> list[np.ndarray]:
+    """:func:`_split`'s cut of the (filled) ``region`` among its ``centres``: the cells, the cuts evidence backs, the
+    cut moved onto the depth ``edges`` (None: without depth)."""
     if len(centres) < 2:
         return [region]
     cells = _cells(region, [(a, b, r) for a, b, r, _ in centres], CANDIDATE_WAIST if use_depth else s.waist)
