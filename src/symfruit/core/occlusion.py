@@ -285,7 +285,9 @@ def occlusion(
     fruit in front of anything clearly behind it (background: the fruit's edge there is its occluding
     contour); anything nearer, or at the fruit's own depth (a calyx lying on it, a touching fruit), may
     hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
-    pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden.
+    pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden. Last, a thin
+    band at the fruit's own depth beside its mask that ends in something not hiding it is the fruit's own edge
+    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40).
 
     Where numba is installed the maps are made in one compiled pass over the window
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
