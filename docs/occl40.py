@@ -8,6 +8,7 @@ The view is rebuilt as ``symfruit evaluate --protocol camera --sensor SENSOR --s
 (hanging), registered and extracted with the default settings.
 """
 
+import argparse
 import sys
 
 import numpy as np
@@ -47,4 +48,9 @@ def main(sensor: str, occluded: float, n: int) -> None:
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], float(sys.argv[2]), int(sys.argv[3]))
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("sensor", help="a camera model, e.g. realsense-d435")
+    parser.add_argument("occlusion", type=float, help="the leaf's share, e.g. 0 or 0.25")
+    parser.add_argument("n", type=int, help="fruit indices 0..N-1 of each kind")
+    args = parser.parse_args()
+    main(args.sensor, args.occlusion, args.n)
