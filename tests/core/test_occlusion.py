@@ -276,3 +276,50 @@ def test_the_fruits_own_pixels_among_the_others_change_nothing():
     a = occlusion(depth, disc, points, CAM, others=others)
     b = occlusion(depth, disc, points, CAM, others=others | disc)
     assert a.hidden.any() and np.array_equal(a.hidden, b.hidden)
+
+
+# --- stop 40, occl40: an active-stereo camera's fattened edge is the fruit's own, not an occluder
+
+BIG = Camera(fx=300.0, fy=300.0, cx=40.0, cy=30.0, width=80, height=60)
+
+
+def _fattened(band_px: int = 3, background: float = 1.0):
+    """An 80x60 depth image: a disc of radius 15 px at 0.3 m centred on (40, 30), its depth spread ``band_px``
+    pixels over the background around it (as an active-stereo camera's correlation window does)."""
+    vv, uu = np.mgrid[:60, :80]
+    r2 = (uu - 40) ** 2 + (vv - 30) ** 2
+    disc = r2 <= 15**2
+    depth = np.full((60, 80), background)
+    depth[r2 <= (15 + band_px) ** 2] = 0.3
+    rows, cols = np.nonzero(disc)
+    points = BIG.deproject(np.c_[cols, rows].astype(float), np.full(len(rows), 0.3))
+    return depth, disc, points, r2
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_fattened_edge_is_the_fruits_own_and_a_leaf_in_front_is_not(kernels, monkeypatch):
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    depth, disc, points, r2 = _fattened()
+    ring = (r2 > 15**2) & (r2 <= 18**2)
+    assert hidden_image(occlusion(depth, disc, points, BIG, band=0))[ring].all()  # the map without the post-step
+    assert not hidden_image(occlusion(depth, disc, points, BIG)).any()  # the fruit's own edge: nothing hidden
+    # a leaf 3 cm in front, beside the disc's right side, no wider than the band: clearly nearer, hidden
+    leaf = ring & (np.mgrid[:60, :80][1] > 50)
+    depth[leaf] = 0.27
+    full = hidden_image(occlusion(depth, disc, points, BIG))
+    assert full[leaf].all() and not full[ring & ~leaf].any()
+
+
+def test_a_support_at_the_fruits_depth_wider_than_the_band_and_another_fruit_stay_hidden():
+    depth, disc, points, r2 = _fattened()
+    cols = np.mgrid[:60, :80][1]
+    slab = ~disc & (cols < 40) & (np.abs(np.mgrid[:60, :80][0] - 30) <= 6)  # a support running left to the border
+    depth[slab] = 0.302
+    others = np.zeros((60, 80), bool)
+    other = ~disc & (r2 <= 18**2) & (cols > 50)  # another fruit's mask over part of the band
+    others[other] = True
+    full = hidden_image(occlusion(depth, disc, points, BIG, others=others))
+    assert full[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
+    assert full[other].all()
+    assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(np.mgrid[:60, :80][0] - 30) > 16)].any()

@@ -26,7 +26,7 @@ from .limits import check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
-__all__ = ["Occlusion", "occlusion", "with_own"]
+__all__ = ["Occlusion", "occlusion", "own_edge", "with_own"]
 
 
 @dataclass(frozen=True)
@@ -274,6 +274,7 @@ def occlusion(
     reach: int = 3,
     pad: int = 16,
     checked: bool = False,
+    band: int = 8,
 ) -> Occlusion:
     """The pixels around one fruit where the camera could not have seen it.
 
@@ -284,7 +285,9 @@ def occlusion(
     fruit in front of anything clearly behind it (background: the fruit's edge there is its occluding
     contour); anything nearer, or at the fruit's own depth (a calyx lying on it, a touching fruit), may
     hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
-    pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden.
+    pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden. Last, a thin
+    band at the fruit's own depth beside its mask that ends in something not hiding it is the fruit's own edge
+    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40).
 
     Where numba is installed the maps are made in one compiled pass over the window
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
@@ -313,6 +316,9 @@ def occlusion(
     pad : int, pixels
         The window is the points' pixel box grown on every side by this much plus the box's own size (a
         fruit hidden by half is no larger than that), clipped to the image.
+    band : int, pixels
+        The widest fattened edge an active-stereo camera spreads the fruit's own depth over (:func:`own_edge`, run
+        on the map last: 0 leaves it out).
     checked : bool
         ``depth`` has been through :func:`~symfruit.core.limits.depth_metres` already (a
         :class:`~symfruit.core.frame.Frame`'s has): its units are not sampled again. The sample reads one
@@ -351,8 +357,12 @@ def occlusion(
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0 : v0 + h, u0 : u0 + w].copy(),
-                         depth=seen)  # fmt: skip
+        own_w = mask[v0 : v0 + h, u0 : u0 + w]
+        if band > 0 and hidden.any():  # own_edge needs the fruit's own depths over the window (the same window)
+            own_z = jit.own_depths(uv, points, camera.width, camera.height, pad)[5]
+            others_w = near_to[v0 : v0 + h, u0 : u0 + w] if others is not None else None
+            hidden = own_edge(hidden, own_w | np.isfinite(own_z), own_z, seen, others_w, tolerance, band)
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w.copy(), depth=seen)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -381,7 +391,72 @@ def occlusion(
     hidden = near & ~own
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
+    hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
     return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=d)
+
+
+def own_edge(
+    hidden: np.ndarray,
+    own: np.ndarray,
+    own_z: np.ndarray,
+    depth: np.ndarray,
+    others: np.ndarray | None,
+    tolerance: float,
+    band: int,
+) -> np.ndarray:
+    """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening).
+
+    An active-stereo camera gives the pixels a few beyond a foreground's silhouette the foreground's depth (the
+    least depth its correlation window holds: ``synthetic.sensors``' ``fatten_px``), so beside a fruit with nothing
+    in front of it :func:`occlusion` found a thin ring "at the fruit's depth", and every outline pixel within a
+    completion's ``occluded_px`` of it read as cut (stop 40, docs/occl40.md: the contour share below 0.1 on 90 % of
+    the D435 model's views with nothing in front). Told by physics, not by the sensor: a hidden pixel is the fruit's
+    own edge, not something that may hide it, when
+
+    - it lies within ``band`` pixels of the fruit's own pixels (``own``: its mask and its points' pixels);
+    - it is not another fruit's (``others``);
+    - something not hiding the fruit (background clearly behind it, or no depth) lies within ``band + 1`` pixels of
+      it, and no hidden pixel farther than ``band`` from the fruit lies within ``band`` of it: the band ends there
+      (a leaf or a support at the fruit's depth wider than the band does not);
+    - it joins the fruit's own pixels through such pixels (not past a gap);
+    - its depth is not clearly nearer (by ``tolerance``) than the nearest of the fruit's own depths (``own_z``,
+      +inf where none) within ``2 band`` pixels: a spread depth is the least of the foreground's nearby, never in
+      front of it (a leaf 3 cm in front is).
+
+    Numpy and the compiled square filter, over the box of the own pixels grown by ``2 band + 1``; a window with no
+    hidden pixel within ``band`` of the fruit returns ``hidden`` itself.
+    """
+    if band <= 0 or not hidden.any():
+        return hidden
+    box = mask_box(own)
+    if box is None:
+        return hidden
+    h, w = hidden.shape
+    g = 2 * band + 1
+    b0, b1, a0, a1 = max(box[0] - g, 0), min(box[1] + g, h), max(box[2] - g, 0), min(box[3] + g, w)
+    hid, mine = hidden[b0:b1, a0:a1], own[b0:b1, a0:a1]
+    near = square_filter(mine, band)
+    cand = hid & near & ~mine
+    if others is not None:
+        cand &= ~np.asarray(others[b0:b1, a0:a1], dtype=bool)
+    if not cand.any():
+        return hidden
+    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
+    cand &= square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
+    if not cand.any():
+        return hidden
+    zmin = ndimage.minimum_filter(own_z[b0:b1, a0:a1], size=2 * band + 1, mode="constant", cval=np.inf)
+    with np.errstate(invalid="ignore"):
+        cand &= np.asarray(depth[b0:b1, a0:a1], dtype=np.float64) >= zmin - tolerance  # NaN: not the fruit's
+    if not cand.any():
+        return hidden
+    # the band runs on from the fruit's own pixels: what lies at the fruit's depth past a gap is something else
+    cand = ndimage.binary_dilation(mine, structure=np.ones((3, 3), bool), iterations=band, mask=cand | mine) & cand
+    if not cand.any():
+        return hidden
+    out = hidden.copy()
+    out[b0:b1, a0:a1] &= ~cand
+    return out
 
 
 def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
