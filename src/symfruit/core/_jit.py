@@ -169,15 +169,7 @@ def smallest_mean(x: np.ndarray, keep: int, a: np.ndarray, b: np.ndarray) -> flo
     (n,) scratch): those below the ``keep``-th smallest (:func:`kth_smallest`) added in ``x``'s order, then that
     value times the places left (its ties), over ``keep``. The same values as the mean of a partition's first
     ``keep``, added in another order."""
-    thr = kth_smallest(x, keep - 1, a, b)
-    total = 0.0
-    count = 0
-    for i in range(x.shape[0]):
-        v = x[i]
-        lt = v < thr
-        total += v if lt else 0.0  # no branch: which values lie below is as unpredictable as in the selection
-        count += lt
-    return (total + (keep - count) * thr) / keep
+    return _smallest_mean_at(x, keep, a, b)[0]
 
 
 @_njit
@@ -186,83 +178,8 @@ def slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
     centred points ``q`` (n, 3), one direction at a time over the points (the twin's (k, n) passes fused), each
     direction's lower 80 % of the squared distances averaged by :func:`smallest_mean` (issue 19, sixteenth round;
     :func:`select` and a sum of its first places before: the same values, added in another order)."""
-    k, n = dirs.shape[0], q.shape[0]
-    out = np.empty(k)
-    t = np.empty(n)
-    u = np.empty(n)
-    v = np.empty(n)
-    cu = np.empty(n)
-    cv = np.empty(n)
-    idx = np.empty(n, np.int64)
-    dist2 = np.empty(n)
-    scratch_a = np.empty(n)
-    scratch_b = np.empty(n)
-    cnt = np.empty(bins)
-    su = np.empty(bins)
-    sv = np.empty(bins)
-    sy = np.empty(bins)
-    keep = max(1, int(0.8 * n))
-    for j in range(k):
-        x, y, z = dirs[j, 0], dirs[j, 1], dirs[j, 2]
-        if abs(x) < 0.9:  # the basis of core.points.perpendicular_basis
-            a, b, c = 0.0, z, -y
-        else:
-            a, b, c = -z, 0.0, x
-        norm = math.sqrt(a * a + b * b + c * c)
-        a, b, c = a / norm, b / norm, c / norm
-        f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
-        lo, hi = np.inf, -np.inf
-        for i in range(n):
-            p0, p1, p2 = q[i, 0], q[i, 1], q[i, 2]
-            ti = x * p0 + y * p1 + z * p2
-            t[i] = ti
-            u[i] = a * p0 + b * p1 + c * p2
-            v[i] = f * p0 + g * p1 + h * p2
-            lo = min(lo, ti)
-            hi = max(hi, ti)
-        span = max(hi - lo, 1e-12)
-        cnt[:] = 0.0
-        su[:] = 0.0
-        sv[:] = 0.0
-        sy[:] = 0.0
-        for i in range(n):  # apart from the sums below, so that it runs on vectors
-            idx[i] = min(int((t[i] - lo) / span * bins), bins - 1)
-        for i in range(n):
-            s = idx[i]
-            cnt[s] += 1.0
-            su[s] += u[i]
-            sv[s] += v[i]
-            sy[s] += u[i] * u[i] + v[i] * v[i]
-        for s in range(bins):
-            d = max(cnt[s], 1.0)
-            su[s] /= d
-            sv[s] /= d
-            sy[s] /= d
-        a11 = a12 = a22 = b1 = b2 = 0.0
-        for i in range(n):  # the slices' centred values, kept for the residuals
-            s = idx[i]
-            du = u[i] - su[s]
-            dv = v[i] - sv[s]
-            dy = u[i] * u[i] + v[i] * v[i] - sy[s]
-            cu[i], cv[i], t[i] = du, dv, dy
-            a11 += du * du
-            a12 += du * dv
-            a22 += dv * dv
-            b1 += du * dy
-            b2 += dv * dy
-        det = a11 * a22 - a12 * a12
-        if not abs(det) > 1e-30:
-            det = 1e-30
-        au = 0.5 * (a22 * b1 - a12 * b2) / det
-        av = 0.5 * (a11 * b2 - a12 * b1) / det
-        for i in range(n):
-            res = t[i] - 2.0 * (au * cu[i] + av * cv[i])
-            ru = u[i] - au
-            rv = v[i] - av
-            rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
-            dist2[i] = res * res / rho2
-        out[j] = smallest_mean(dist2, keep, scratch_a, scratch_b)
-    return out
+    # slice_costs_below never bounds a cost against a NaN least, nor takes one as less: every cost, the same bits
+    return slice_costs_below(q, dirs, bins, np.nan, np.nan)[0]
 
 
 @_njit
