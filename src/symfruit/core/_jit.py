@@ -1079,33 +1079,13 @@ def distance(mask: np.ndarray, want: bool, out: np.ndarray) -> None:
     f = np.empty(w, np.int64)
     s = np.empty(w, np.int64)  # the envelope's parabolas (their columns), left to right
     t = np.empty(w, np.int64)  # where each of them starts to be the least
+    d2 = np.empty(w, np.int64)
     for r in range(h):
         for c in range(w):
             f[c] = g[r, c] * g[r, c]
-        q = 0
-        s[0] = 0
-        t[0] = 0
-        for u in range(1, w):
-            while q >= 0:
-                a, b = t[q] - s[q], t[q] - u
-                if a * a + f[s[q]] <= b * b + f[u]:
-                    break
-                q -= 1
-            if q < 0:
-                q = 0
-                s[0] = u
-            else:
-                i = s[q]
-                start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
-                if start < w:
-                    q += 1
-                    s[q] = u
-                    t[q] = start
-        for u in range(w - 1, -1, -1):
-            a = u - s[q]
-            out[r, u] = math.sqrt(float(a * a + f[s[q]]))
-            if u == t[q]:
-                q -= 1
+        _envelope(f, w, s, t, d2)  # the row's lower envelope of the parabolas
+        for u in range(w):
+            out[r, u] = math.sqrt(float(d2[u]))
 
 
 @_njit
