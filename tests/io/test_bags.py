@@ -279,6 +279,8 @@ def test_compressed_images(tmp_path):
     "msg, error",
     [
         (message(RGB, "yuv420"), "unsupported image encoding 'yuv420'"),
+        # stop 41: a message's encoding is its sender's text, printed whole before (a 5 kB line)
+        (message(RGB, "rgb8" + "x" * 5000), r"unsupported image encoding 'rgb8x+\.\.\. \(5006 characters\) \(use one"),
         (message(np.zeros((2, 3, 2), np.uint8), "YUYV"), "YUYV image of odd width 3: two pixels share each U and V"),
         (message(np.zeros((2, 4, 2), np.uint8), "yuv422", step=6), "image step 6 is shorter than a row of 4 yuv422"),
         (SimpleNamespace(height=2, width=4, step=8, encoding="YUYV", is_bigendian=0, data=bytes(15)),

@@ -104,13 +104,13 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if typename.endswith("CompressedImage"):
         fmt = str(getattr(msg, "format", ""))
         if "compresseddepth" in fmt.lower():
-            raise FileFormatError(f"compressedDepth images ({fmt!r}) are not supported; record raw depth")
+            raise FileFormatError(f"compressedDepth images ({shown(fmt)}) are not supported; record raw depth")
         from .images import decode_color
 
         return decode_color(bytes(msg.data), "compressed image")
     enc = str(msg.encoding).lower()
     if enc not in _ENCODINGS and enc not in _YUV422:
-        raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of "
+        raise FileFormatError(f"unsupported image encoding {shown(msg.encoding)} (use one of "
                               f"{', '.join([*_ENCODINGS, *_YUV422])})")  # fmt: skip
     dtype, channels = _ENCODINGS.get(enc, (np.uint8, 2))
     sizes = [getattr(msg, k, None) for k in ("height", "width", "step")]
@@ -193,7 +193,7 @@ def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray
     img = image_array(msg, typename)
     if img.dtype != np.uint8:
         eight = [e for e, (t, _) in _ENCODINGS.items() if t is np.uint8]
-        raise FileFormatError(f"colour image encoding {msg.encoding!r} is not 8-bit colour (use one of "
+        raise FileFormatError(f"colour image encoding {shown(msg.encoding)} is not 8-bit colour (use one of "
                               f"{', '.join([*eight, *_YUV422])})")  # fmt: skip
     if img.ndim == 2:
         img = np.repeat(img[:, :, None], 3, axis=2)
@@ -222,7 +222,8 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
     if raw.ndim != 2:
         raise FileFormatError(f"depth image has {raw.shape[2]} channels, expected 1")
     if raw.dtype not in (np.uint16, np.float32):
-        raise FileFormatError(f"depth image encoding {msg.encoding!r}: expected 16UC1/mono16 units or 32FC1 metres")
+        raise FileFormatError(f"depth image encoding {shown(msg.encoding)}: expected 16UC1/mono16 units or 32FC1 "
+                              "metres")  # fmt: skip
     if raw.dtype == np.uint16 and 65535 * depth_scale < MIN_16BIT_DEPTH_REACH:  # 1e-300 was 0 in float32: no depth
         raise InputError(f"depth_scale {depth_scale:g}: 16-bit depth would reach only {65535 * depth_scale:.3g} m; no "
                          "camera measures depth that finely (metres per unit, 0.001 for millimetres)")  # fmt: skip
