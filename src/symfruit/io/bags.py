@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -83,6 +84,8 @@ def reader_reason(exc: BaseException) -> str:
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"
+    if text.startswith("File end magic is invalid"):  # rosbags' MCAP reader on a file cut short
+        return "the MCAP file ends before its footer: a recording cut short (`mcap recover` rebuilds one) or damaged"
     first = text.splitlines()[0].strip()
     if len(first) > REASON_CHARS:
         first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
@@ -335,9 +338,20 @@ def _stamp(msg: Any, fallback: int) -> int:
     return value if value else fallback
 
 
+def listed(topics: Sequence[str], most: int = 6) -> str:
+    """Topics for an error message: at most ``most`` of them, each cut to 60 characters, and how many more (a
+    recording's topics are its own text and may be hundreds: tf, imu, diagnostics...)."""
+    named = [t if len(t) <= 60 else t[:57] + "..." for t in topics[:most]]
+    if len(topics) > most:
+        named.append(f"and {len(topics) - most} more")
+    return ", ".join(named) or "none"
+
+
 def _check_metadata(path: Path) -> None:
     """Refuse a ROS 2 bag's ``metadata.yaml`` that rosbags would read without end or bound: not a regular
-    file (a link to ``/dev/zero``, a pipe) or larger than :data:`~symfruit.core.limits.MAX_BAG_METADATA_BYTES`."""
+    file (a link to ``/dev/zero``, a pipe) or larger than :data:`~symfruit.core.limits.MAX_BAG_METADATA_BYTES`;
+    and one that is empty or holds no ``rosbag2_bagfile_information`` mapping (rosbags: "'NoneType' object is
+    not subscriptable")."""
     try:
         size = path.stat().st_size if path.is_file() else None
     except OSError as exc:
@@ -347,6 +361,11 @@ def _check_metadata(path: Path) -> None:
     if size > MAX_BAG_METADATA_BYTES:
         raise FileFormatError(f"{path}: bag metadata is {size:,} bytes; at most {MAX_BAG_METADATA_BYTES >> 20} MB "
                               "are read (a rosbag2 metadata.yaml takes a few kB)")  # fmt: skip
+    from .text import read_structured
+
+    data = read_structured(path, what="bag metadata", max_bytes=MAX_BAG_METADATA_BYTES)
+    if not isinstance(data, dict) or not isinstance(data.get("rosbag2_bagfile_information"), dict):
+        raise FileFormatError(f"{path}: not a ROS 2 bag's metadata (no rosbag2_bagfile_information mapping)")
 
 
 def _namespace(topic: str) -> str:
@@ -378,7 +397,7 @@ def _pick_topics(depth: list[Any], color: list[Any], info: list[Any]) -> tuple[A
     if not beside and len(info) == 1:
         beside = info
     if not beside:
-        topics = ", ".join(i.topic for i in info)
+        topics = listed([i.topic for i in info])
         raise FileFormatError(f"bag has several CameraInfo topics ({topics}) and none beside the colour topic "
                               f"{c.topic}: which are the colour camera's intrinsics?")  # fmt: skip
     return d, c, beside[0]
@@ -424,8 +443,9 @@ class BagSource:
         depth = [c for c in images if "depth" in c.topic.lower()]
         color = [c for c in images if "depth" not in c.topic.lower()]
         if not depth or not color:
-            raise FileFormatError(f"bag needs a colour and a depth image topic (topics: "
-                                  f"{', '.join(c.topic for c in conns) or 'none'})")  # fmt: skip
+            topics = sorted({c.topic for c in conns})
+            raise FileFormatError(f"bag needs a colour and a depth image topic (its image topics: "
+                                  f"{listed([c.topic for c in images])}; {len(topics)} topics in all)")  # fmt: skip
         if not info:
             raise FileFormatError("bag has no CameraInfo topic")
         self._depth, self._color, self._info = _pick_topics(depth, color, info)
