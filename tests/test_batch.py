@@ -598,3 +598,19 @@ def test_an_empty_recording_or_output_path_is_refused_not_read_as_the_working_fo
         segment_images(["f1/color.png"], output="")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["f1"]  # nothing written
     assert run_batch(b"f1", "out", method="raw", progress=False).done == ["f1"]  # a bytes path is one recording
+
+
+def test_a_warning_every_frame_gives_is_shown_once_per_recording(tmp_path, capsys):
+    """Intrinsics that put the principal point outside the image: a warning per frame read. Before (stop 41):
+    one line per frame (10,000 for a folder of 10,000 frames with distorted lenses)."""
+    rec = recording(tmp_path / "rec", "a", "b", "c")
+    for name in "abc":  # the small frame's own cx -80 is filtered out of every test (conftest)
+        cam = json.loads((rec / name / "camera.json").read_text())
+        (rec / name / "camera.json").write_text(json.dumps({**cam, "cx": -81.0}))
+    assert main(["detect", str(rec), "--output", str(tmp_path / "out"), "--method", "raw"]) == 0
+    err = capsys.readouterr().err
+    assert err.count("principal point") == 1 and f"{rec}/a/camera.json: the principal point" in err
+    assert f"symfruit: warning: {rec}: 2 more frames gave a warning above (each is shown for its first frame" in err
+    with pytest.warns(symfruit.SymfruitWarning, match="principal point") as caught:  # other filters as before
+        run_batch(rec, tmp_path / "out2", method="raw", progress=False)
+    assert [str(w.message).count("principal point") for w in caught] == [1, 0]

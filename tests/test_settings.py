@@ -87,6 +87,26 @@ def test_bad_files_name_the_file(tmp_path):
         load_settings(other)
 
 
+@pytest.mark.parametrize(
+    ("name", "text", "message"),
+    [
+        ("empty.yaml", "", "the settings file is empty"),
+        ("blank.yml", " \n\t\n", "the settings file is empty"),
+        ("empty.json", "", "the settings file is empty"),  # before: "not valid JSON: Expecting value"
+        ("comments.yaml", "# detect:\n#   method: paper\n", r"the settings file holds no settings \(only comments"),
+        ("null.yaml", "null\n", "the settings file holds no settings"),
+        ("null.json", "null", "the settings file holds no settings"),
+    ],
+)
+def test_an_empty_settings_file_is_refused_as_empty(tmp_path, name, text, message):
+    path = tmp_path / name  # before (stop 40): "expected a mapping of settings, got NoneType"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=rf"^{re.escape(str(path))}: {message}"):
+        load_settings(path)
+    with pytest.raises(ConfigError, match=message):
+        resolve_settings(fruit=path)  # a profile file is read the same way
+
+
 def test_yaml_is_loaded_safely(tmp_path):
     evil = tmp_path / "evil.yaml"
     evil.write_text("paper: !!python/object/apply:os.system ['echo hacked']\n")

@@ -221,35 +221,85 @@ def _run_recording(
     """The frames ``names`` of one recording, in this process, each in its error boundary."""
     now = src.names()
     where = {n: i for i, n in enumerate(now)} if now != names else None  # changed since it was listed
-    for index, name in enumerate(names):
-        key = rec.key + name
-        folder = rec.folder / frame_folder_name(name, reserved)
-        if resume and frame_done(folder):
-            report.skipped.append(key)
-            bar.update()
-            continue
+    with once_per_recording(str(rec.source)) as current:
+        for index, name in enumerate(names):
+            current[0] = name
+            if not _one(src, rec, index, name, names, where, masks, method, settings, resume, on_frame, reserved,
+                        report, bar, out):  # fmt: skip
+                return
 
-        def one_frame(index: int = index, name: str = name, folder: Path = folder) -> FrameDetections:
-            if where is not None and name not in where:
-                raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
-            found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
-                           settings=settings)  # fmt: skip
-            if on_frame is not None:
-                on_frame(index, found)
-            write_detections(folder, found, settings=settings)
-            return found
 
-        clear = partial(_clear_frame, folder, out)
-        done, found, report.stopped = _guarded(one_frame, item=key, failed=report.failed, target=folder,
-                                               at=f"frame {key}", cleanup=clear)  # fmt: skip
-        if report.stopped:
-            report.unprocessed = [rec.key + n for n in names[index + 1 :]]
-            return
-        if done and found is not None:
-            report.done.append(key)
-            report.fruits += sum(d.result is not None for d in found.detections)
-            report.failed_fruits += sum(d.result is None for d in found.detections)
+@contextlib.contextmanager
+def once_per_recording(source: str) -> Any:
+    """Show each of symfruit's warnings once per recording, not once per frame: a folder of frames whose
+    ``camera.json`` files all give lens distortion warned on every frame, 10,000 lines for 10,000 frames (bags
+    warn once already). Warnings that differ only by the frame folder's name (``.../NAME/...``, the name held
+    in the list yielded, set by the caller per frame) are one; how many were not shown is said at the end. Only
+    what would be shown is counted: the filters (``error``, ``ignore``) apply as before."""
+    import warnings
+
+    from .errors import SymfruitWarning
+
+    current: list[str] = [""]
+    seen: dict[str, int] = {}
+    with warnings.catch_warnings():  # restores showwarning on leaving
+        show = warnings.showwarning
+
+        def once(message: Any, category: type[Warning], filename: str, lineno: int, file: Any = None,
+                 line: str | None = None) -> None:  # fmt: skip
+            if issubclass(category, SymfruitWarning):
+                text = str(message)
+                key = text.replace(f"{os.sep}{current[0]}{os.sep}", f"{os.sep}*{os.sep}") if current[0] else text
+                if key in seen:
+                    seen[key] += 1
+                    return
+                seen[key] = 0
+            show(message, category, filename, lineno, file, line)
+
+        warnings.showwarning = once
+        yield current
+    more = sum(seen.values())
+    if more:
+        warnings.warn(f"{source}: {more} more frame{'s' if more != 1 else ''} gave a warning above (each is shown "
+                      "for its first frame only)", SymfruitWarning, stacklevel=2)  # fmt: skip
+
+
+def _one(
+    src: Any, rec: Recording, index: int, name: str, names: list[str], where: dict[str, int] | None, masks: str,
+    method: str, settings: Settings, resume: bool, on_frame: Callable[[int, FrameDetections], None] | None,
+    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder,
+) -> bool:  # fmt: skip
+    """Frame ``name`` (``index``) of a recording in its error boundary (:func:`_run_recording`); False when
+    the batch stops."""
+    key = rec.key + name
+    folder = rec.folder / frame_folder_name(name, reserved)
+    if resume and frame_done(folder):
+        report.skipped.append(key)
         bar.update()
+        return True
+
+    def one_frame(index: int = index, name: str = name, folder: Path = folder) -> FrameDetections:
+        if where is not None and name not in where:
+            raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
+        found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
+                       settings=settings)  # fmt: skip
+        if on_frame is not None:
+            on_frame(index, found)
+        write_detections(folder, found, settings=settings)
+        return found
+
+    clear = partial(_clear_frame, folder, out)
+    done, found, report.stopped = _guarded(one_frame, item=key, failed=report.failed, target=folder,
+                                           at=f"frame {key}", cleanup=clear)  # fmt: skip
+    if report.stopped:
+        report.unprocessed = [rec.key + n for n in names[index + 1 :]]
+        return False
+    if done and found is not None:
+        report.done.append(key)
+        report.fruits += sum(d.result is not None for d in found.detections)
+        report.failed_fruits += sum(d.result is None for d in found.detections)
+    bar.update()
+    return True
 
 
 def frame_done(folder: Path) -> bool:

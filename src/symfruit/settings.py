@@ -397,7 +397,11 @@ def read_settings_file(path: str | Path) -> dict[str, Any]:
         raise ConfigError(f"{path}: settings file must end in .yaml, .yml or .json")
     from .io.text import read_structured
 
-    return read_structured(path, what="settings file", max_bytes=MAX_SETTINGS_BYTES, error=ConfigError)
+    data = read_structured(path, what="settings file", max_bytes=MAX_SETTINGS_BYTES, error=ConfigError)
+    if data is None:  # YAML reads a file of comments or ``null`` alone as None: "got NoneType"
+        raise ConfigError(f"{path}: the settings file holds no settings (only comments or null); give at least one "
+                          "section, e.g. 'detect: {method: evidence}', or no settings file")  # fmt: skip
+    return data
 
 
 def load_settings(path: str | Path, base: Settings | None = None) -> Settings:

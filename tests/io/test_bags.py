@@ -32,6 +32,7 @@ def write_ros2_bag(
     encoding="rgb8",
     info_size=(160, 120),
     d=None,
+    storage="sqlite3",
 ):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
@@ -41,7 +42,9 @@ def write_ros2_bag(
     Image, Info = ts.types["sensor_msgs/msg/Image"], ts.types["sensor_msgs/msg/CameraInfo"]
     Header, Time = ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
     RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
-    with Writer(path, version=9) as writer:
+    from rosbags.rosbag2 import StoragePlugin
+
+    with Writer(path, version=9, storage_plugin=StoragePlugin[storage.upper()]) as writer:
         c_col = writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
         c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
         c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
@@ -113,6 +116,48 @@ def test_a_bag_whose_depth_topic_is_empty_is_named_not_read_as_no_frames(tmp_pat
     match = r"bad: depth topic /camera/aligned_depth_to_color/image_raw holds no messages"
     with pytest.raises(FileFormatError, match=match):  # before: a recording of 0 frames, done without a word
         open_source(path)
+
+
+def test_a_bag_without_a_depth_topic_lists_its_image_topics_bounded(tmp_path):
+    pytest.importorskip("rosbags")
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    String = ts.types["std_msgs/msg/String"]
+    with Writer(tmp_path / "many", version=9) as writer:
+        for k in range(40):  # a robot's recording: tf, imu, diagnostics... beside the camera's colour topic
+            conn = writer.add_connection(f"/robot/topic_{k:02d}" + "_x" * 30 * (k == 3), "std_msgs/msg/String",
+                                         typestore=ts)  # fmt: skip
+            writer.write(conn, 1, ts.serialize_cdr(String(data="x"), "std_msgs/msg/String"))
+        writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+    with pytest.raises(FileFormatError) as info:
+        open_source(tmp_path / "many")
+    # before (stop 41): every topic listed (41 topics, 900 characters here; a real robot's run has hundreds)
+    assert str(info.value) == (f"{tmp_path / 'many'}: bag needs a colour and a depth image topic (its image topics: "
+                               "/camera/color/image_raw; 41 topics in all)")  # fmt: skip
+    from symfruit.io.bags import listed
+
+    topics = [f"/robot/topic_{k:02d}" for k in range(9)] + ["/" + "y" * 500]
+    assert listed(topics) == ", ".join(topics[:6]) + ", and 4 more"
+    assert listed(["/" + "y" * 500]) == "/" + "y" * 56 + "..." and listed([]) == "none"
+
+
+def test_a_ros2_bag_cut_short_or_with_empty_metadata_is_named_as_such(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "cut", color, (depth * 1000).astype(np.uint16), frames=2, storage="mcap")
+    data = path / "cut.mcap"
+    data.write_bytes(data.read_bytes()[: data.stat().st_size * 2 // 3])  # `ros2 bag record` killed: no footer
+    with pytest.raises(FileFormatError, match=r"cut: cannot open bag \(the MCAP file ends before its footer: a "
+                       r"recording cut short \(`mcap recover` rebuilds one\)"):  # fmt: skip
+        open_source(path)  # before: "cannot open bag (File end magic is invalid.)"
+    meta = path / "metadata.yaml"
+    for text, message in (("", "the bag metadata is empty"), ("rosbag2_bagfile_information: 3\n", "not a ROS 2 "
+                          r"bag's metadata \(no rosbag2_bagfile_information mapping\)")):  # fmt: skip
+        meta.write_text(text)  # before: "Invalid bag metadata: 'NoneType' object is not subscriptable."
+        with pytest.raises(FileFormatError, match=rf"^{re.escape(str(meta))}: {message}"):
+            open_source(path)
 
 
 def test_messages_that_share_a_bag_time_are_each_their_own_frame(tmp_path):
@@ -279,6 +324,8 @@ def test_compressed_images(tmp_path):
     "msg, error",
     [
         (message(RGB, "yuv420"), "unsupported image encoding 'yuv420'"),
+        # stop 41: a message's encoding is its sender's text, printed whole before (a 5 kB line)
+        (message(RGB, "rgb8" + "x" * 5000), r"unsupported image encoding 'rgb8x+\.\.\. \(5006 characters\) \(use one"),
         (message(np.zeros((2, 3, 2), np.uint8), "YUYV"), "YUYV image of odd width 3: two pixels share each U and V"),
         (message(np.zeros((2, 4, 2), np.uint8), "yuv422", step=6), "image step 6 is shorter than a row of 4 yuv422"),
         (SimpleNamespace(height=2, width=4, step=8, encoding="YUYV", is_bigendian=0, data=bytes(15)),

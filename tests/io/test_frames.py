@@ -48,8 +48,16 @@ def test_frame_round_trip_png_and_npy(tmp_path):
             "unknown depth_units",
         ),
         (lambda f: (f / "truth.json").write_text("{"), "truth.json"),
+        # stop 41: before, only "no depth.png or depth.npy" beside a depth.tiff (a float TIFF of metres) or depth.PNG
+        (lambda f: (f / "depth.png").rename(f / "depth.tiff"), r"no depth.png or depth.npy; found depth.tiff, not "
+         "read"),
+        (lambda f: [(f / n).write_bytes((f / "depth.png").read_bytes()) for n in ("Depth.PNG", "depth.png.bak",
+                                                                                   "depth.a", "depth.b")]
+         + [(f / "depth.png").unlink()],
+         r"; found Depth.PNG, depth.a, depth.b and 1 more, not read: only the names above are$"),
+        (lambda f: (f / "camera.json").rename(f / "camera.JSON"), r"no camera.json \(intrinsics\); found camera.JSON"),
     ],
-)
+)  # fmt: skip
 def test_bad_frames_name_the_file(tmp_path, break_it, message):
     color, depth = disc_frame([(80, 60)])
     write_frame(tmp_path / "f", color, depth, CAM, truth={"fruits": []})
@@ -264,7 +272,13 @@ def test_masks_written_with_the_frame_come_back(tmp_path):
         ),
         ({"fruits": [{"min": [-1e308] * 3, "max": [1e308] * 3}]}, "more than 100 m from the camera"),
         ({"fruits": [{"min": [10**400, 0, 0.3], "max": [0.1, 0.1, 0.4]}]}, "int too large to convert to float"),
-        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2**40}]}, "id must be a whole number in 0-"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 2**40}]}, "id must be a whole number in 1-"),
+        # stop 41: before, taken, though no mask label is 0 (the background): never matched, by --match id or any
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 0}]}, r"fruit 1: id 0 is no mask label"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 1},
+                     {"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": 0, "ripe": False}]},
+         r"fruit 2: id 0 is no mask label \(0 is the background"),
+        ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "id": -1}]}, "id must be a whole number in 1-"),
         # a misspelt key was dropped: "rip": false counted an unripe fruit as a target
         ({"fruits": [{"min": [0, 0, 0.3], "max": [0.1, 0.1, 0.4], "rip": False}]}, r"unknown key 'rip'; did you "
          "mean 'ripe'"),

@@ -200,6 +200,23 @@ def test_a_recording_missing_a_stream_is_refused_by_name(tmp_path, drop, error):
     with pytest.raises(FileFormatError, match=error) as info:
         open_source(path).read(0)
     assert str(path) in str(info.value) and "\n" not in str(info.value)
+    assert len(str(info.value)) < 250 + len(str(path))  # stop 41: every topic listed, 845 characters before
+
+
+def test_a_recording_without_depth_names_the_streams_it_holds_in_one_bounded_line(tmp_path):
+    path = rewrite(tmp_path / "nodepth.bag", drop={"/device_0/sensor_0/Depth_0/image/data"})
+    with pytest.raises(FileFormatError) as info:
+        open_source(path).read(0)
+    assert str(info.value) == (f"{path}: no depth stream recorded (no /device_0/sensor_N/Depth_0/image/data topic; "
+                               "its image streams: device_0/sensor_1/Color_0; 18 topics in all)")  # fmt: skip
+    from symfruit.io.realsense import _streams
+
+    many = [f"/device_0/sensor_{k}/Infrared_{k}/image/data" for k in range(9)] + ["/x" * 200 + "/image/data", "/a"]
+    said = _streams(many)  # a bag's topic names are its own text: at most six streams, each cut to 60 characters
+    assert said.startswith("its image streams: device_0/sensor_0/Infrared_0, ") and said.endswith(
+        ", 4 more; 11 topics in all"
+    )
+    assert len(_streams(["/y" * 500 + "/image/data"])) < 100 and _streams([]) == "no image stream; 0 topics in all"
 
 
 def test_depth_units_fall_back_to_the_images_own(tmp_path):

@@ -51,6 +51,22 @@ def test_folder_order_is_by_name_hidden_folders_and_exclusions_skipped(tmp_path)
     assert "out" not in open_source(tmp_path, exclude=[tmp_path / "a" / ".." / "out"]).names()
 
 
+def test_a_link_back_to_the_recording_is_refused_as_such_and_the_frames_go_on(tmp_path):
+    rec = tmp_path / "rec"
+    make_frames(rec, "a", "c")
+    (rec / "b").symlink_to(rec)  # before (stop 41): "rec/b: no color.png or color.jpg"
+    (rec / "up").symlink_to(tmp_path)
+    (rec / "loop1").symlink_to(rec / "loop2")  # links in a loop, and one to nothing, are no folders: left out
+    (rec / "loop2").symlink_to(rec / "loop1")
+    src = open_source(rec)
+    assert src.names() == ["a", "b", "c", "up"]
+    with pytest.raises(FileFormatError, match=rf"^{rec}/b: a link back to the recording folder, not a frame folder$"):
+        src.read(1)
+    with pytest.raises(FileFormatError, match=rf"rec/up: a link back to {tmp_path}, which holds the recording"):
+        src.read(3)
+    assert src.read(0).name == "a" and src.read(2).name == "c"
+
+
 @pytest.mark.parametrize("left", ["errors.json", "detections.parquet", "frames.parquet", ".symfruit.lock",
                                   "summary.json"])  # fmt: skip
 def test_an_earlier_runs_output_inside_the_recording_is_no_frame(tmp_path, left):

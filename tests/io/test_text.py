@@ -18,8 +18,12 @@ def test_json_and_yaml_by_extension(tmp_path):
     (tmp_path / "a.yml").write_text("a: [1, 2.5, x]\n")
     for name in ("a.json", "a.yaml", "a.yml"):
         assert read_structured(tmp_path / name, what="file", max_bytes=100) == {"a": [1, 2.5, "x"]}
-    (tmp_path / "empty.yaml").write_text("")
-    assert read_structured(tmp_path / "empty.yaml", what="file", max_bytes=100) is None
+    for name in ("empty.yaml", "empty.json", "blank.yml"):  # stop 41: before, None from YAML, "Expecting value"
+        (tmp_path / name).write_text("" if name.startswith("empty") else "\n  \n")  # from JSON
+        with pytest.raises(FileFormatError, match=rf"^{re.escape(str(tmp_path / name))}: the truth file is empty$"):
+            read_structured(tmp_path / name, what="truth file", max_bytes=100)
+    (tmp_path / "comment.yaml").write_text("# nothing\n")
+    assert read_structured(tmp_path / "comment.yaml", what="file", max_bytes=100) is None
 
 
 def test_a_file_over_the_bound_is_refused(tmp_path):

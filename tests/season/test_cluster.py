@@ -189,12 +189,26 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
         ("127.0.0.1", "not a scheduler address"),
         ("tcp://127.0.0.1:\uff11\uff12", "not a scheduler address"),  # full-width digits: int() reads them
         ("8786", "not a scheduler address"),  # a port without a host
+        # stop 41: before, Dask's words ("not enough values to unpack (expected 3, got 1)") or a TypeError traceback
+        ("inproc://x", "reachable only from the Python process that started that scheduler"),
+        ("inproc://127.0.0.1/1/1", "reachable only from the Python process"),  # another process's
+        ("tls://127.0.0.1:1", "tls:// needs Dask's TLS settings"),
+        ("ucx://127.0.0.1:1", "not an address scheme symfruit can use ('ucx')"),
+        ("TCP://127.0.0.1:1", "not an address scheme symfruit can use ('TCP')"),
     ):  # before: tried for 10 s, or ": cannot reach"
         assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--scheduler", address]) == 2
         assert message in capsys.readouterr().err
     assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--chunk", "8"]) == 2  # before: ignored
     assert "--chunk (frames per Dask task) is for --scheduler or --workers" in capsys.readouterr().err
     assert not (tmp_path / "o" / "errors.json").exists()
+
+
+def test_an_in_process_address_of_this_process_passes_the_check():
+    from symfruit.season.cluster import check_address
+
+    check_address(f"inproc://127.0.0.1/{os.getpid()}/3")  # a Python caller's LocalCluster(processes=False)
+    with pytest.raises(InputError, match="reachable only from the Python process"):
+        check_address(f"inproc://127.0.0.1/{os.getpid() + 1}/3")
 
 
 def test_without_dask_the_message_names_the_extra(monkeypatch, tmp_path):

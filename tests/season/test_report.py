@@ -1,6 +1,8 @@
 """symfruit report: report.md and its plots from a run's tables, numbers a reader can check, written atomically;
 tables that are missing, too large or not symfruit's refused by name."""
 
+import json
+
 import numpy as np
 import pytest
 from PIL import Image
@@ -96,6 +98,18 @@ def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
     assert "--classes 'big'" in capsys.readouterr().err
     assert main(["report", str(tmp_path / "nothing")]) == 2
     assert "no such table; run `symfruit detect" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("where", ["f0", "rec/f0"])
+def test_a_run_without_tables_but_with_frame_records_is_told_to_resume(tmp_path, capsys, where):
+    """A run killed before its end (the tables appear when it ends), or one written by a symfruit before the
+    tables (2026-12-01): its frames' records are there, and `detect --resume` writes the tables from them."""
+    out = tmp_path / "out"
+    (out / where).mkdir(parents=True)
+    (out / where / "detections.json").write_text(json.dumps(_record("f0", [(0.03, 0.03, 0.03)])))
+    assert main(["report", str(out)]) == 2  # before: "no such table; run `symfruit detect ...` first"
+    err = capsys.readouterr().err
+    assert "no such table, but the run's frame records are there" in err and f"--output {out} --resume" in err
 
 
 def test_tables_too_large_or_not_ours_are_refused(run, monkeypatch):

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import math
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -83,6 +84,8 @@ def reader_reason(exc: BaseException) -> str:
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"
+    if text.startswith("File end magic is invalid"):  # rosbags' MCAP reader on a file cut short
+        return "the MCAP file ends before its footer: a recording cut short (`mcap recover` rebuilds one) or damaged"
     first = text.splitlines()[0].strip()
     if len(first) > REASON_CHARS:
         first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
@@ -104,13 +107,13 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     if typename.endswith("CompressedImage"):
         fmt = str(getattr(msg, "format", ""))
         if "compresseddepth" in fmt.lower():
-            raise FileFormatError(f"compressedDepth images ({fmt!r}) are not supported; record raw depth")
+            raise FileFormatError(f"compressedDepth images ({shown(fmt)}) are not supported; record raw depth")
         from .images import decode_color
 
         return decode_color(bytes(msg.data), "compressed image")
     enc = str(msg.encoding).lower()
     if enc not in _ENCODINGS and enc not in _YUV422:
-        raise FileFormatError(f"unsupported image encoding {msg.encoding!r} (use one of "
+        raise FileFormatError(f"unsupported image encoding {shown(msg.encoding)} (use one of "
                               f"{', '.join([*_ENCODINGS, *_YUV422])})")  # fmt: skip
     dtype, channels = _ENCODINGS.get(enc, (np.uint8, 2))
     sizes = [getattr(msg, k, None) for k in ("height", "width", "step")]
@@ -193,7 +196,7 @@ def color_image(msg: Any, typename: str = "sensor_msgs/msg/Image") -> np.ndarray
     img = image_array(msg, typename)
     if img.dtype != np.uint8:
         eight = [e for e, (t, _) in _ENCODINGS.items() if t is np.uint8]
-        raise FileFormatError(f"colour image encoding {msg.encoding!r} is not 8-bit colour (use one of "
+        raise FileFormatError(f"colour image encoding {shown(msg.encoding)} is not 8-bit colour (use one of "
                               f"{', '.join([*eight, *_YUV422])})")  # fmt: skip
     if img.ndim == 2:
         img = np.repeat(img[:, :, None], 3, axis=2)
@@ -222,7 +225,8 @@ def depth_image(msg: Any, typename: str = "sensor_msgs/msg/Image", *, depth_scal
     if raw.ndim != 2:
         raise FileFormatError(f"depth image has {raw.shape[2]} channels, expected 1")
     if raw.dtype not in (np.uint16, np.float32):
-        raise FileFormatError(f"depth image encoding {msg.encoding!r}: expected 16UC1/mono16 units or 32FC1 metres")
+        raise FileFormatError(f"depth image encoding {shown(msg.encoding)}: expected 16UC1/mono16 units or 32FC1 "
+                              "metres")  # fmt: skip
     if raw.dtype == np.uint16 and 65535 * depth_scale < MIN_16BIT_DEPTH_REACH:  # 1e-300 was 0 in float32: no depth
         raise InputError(f"depth_scale {depth_scale:g}: 16-bit depth would reach only {65535 * depth_scale:.3g} m; no "
                          "camera measures depth that finely (metres per unit, 0.001 for millimetres)")  # fmt: skip
@@ -334,9 +338,20 @@ def _stamp(msg: Any, fallback: int) -> int:
     return value if value else fallback
 
 
+def listed(topics: Sequence[str], most: int = 6) -> str:
+    """Topics for an error message: at most ``most`` of them, each cut to 60 characters, and how many more (a
+    recording's topics are its own text and may be hundreds: tf, imu, diagnostics...)."""
+    named = [t if len(t) <= 60 else t[:57] + "..." for t in topics[:most]]
+    if len(topics) > most:
+        named.append(f"and {len(topics) - most} more")
+    return ", ".join(named) or "none"
+
+
 def _check_metadata(path: Path) -> None:
     """Refuse a ROS 2 bag's ``metadata.yaml`` that rosbags would read without end or bound: not a regular
-    file (a link to ``/dev/zero``, a pipe) or larger than :data:`~symfruit.core.limits.MAX_BAG_METADATA_BYTES`."""
+    file (a link to ``/dev/zero``, a pipe) or larger than :data:`~symfruit.core.limits.MAX_BAG_METADATA_BYTES`;
+    and one that is empty or holds no ``rosbag2_bagfile_information`` mapping (rosbags: "'NoneType' object is
+    not subscriptable")."""
     try:
         size = path.stat().st_size if path.is_file() else None
     except OSError as exc:
@@ -346,6 +361,11 @@ def _check_metadata(path: Path) -> None:
     if size > MAX_BAG_METADATA_BYTES:
         raise FileFormatError(f"{path}: bag metadata is {size:,} bytes; at most {MAX_BAG_METADATA_BYTES >> 20} MB "
                               "are read (a rosbag2 metadata.yaml takes a few kB)")  # fmt: skip
+    from .text import read_structured
+
+    data = read_structured(path, what="bag metadata", max_bytes=MAX_BAG_METADATA_BYTES)
+    if not isinstance(data, dict) or not isinstance(data.get("rosbag2_bagfile_information"), dict):
+        raise FileFormatError(f"{path}: not a ROS 2 bag's metadata (no rosbag2_bagfile_information mapping)")
 
 
 def _namespace(topic: str) -> str:
@@ -377,7 +397,7 @@ def _pick_topics(depth: list[Any], color: list[Any], info: list[Any]) -> tuple[A
     if not beside and len(info) == 1:
         beside = info
     if not beside:
-        topics = ", ".join(i.topic for i in info)
+        topics = listed([i.topic for i in info])
         raise FileFormatError(f"bag has several CameraInfo topics ({topics}) and none beside the colour topic "
                               f"{c.topic}: which are the colour camera's intrinsics?")  # fmt: skip
     return d, c, beside[0]
@@ -423,8 +443,9 @@ class BagSource:
         depth = [c for c in images if "depth" in c.topic.lower()]
         color = [c for c in images if "depth" not in c.topic.lower()]
         if not depth or not color:
-            raise FileFormatError(f"bag needs a colour and a depth image topic (topics: "
-                                  f"{', '.join(c.topic for c in conns) or 'none'})")  # fmt: skip
+            topics = sorted({c.topic for c in conns})
+            raise FileFormatError(f"bag needs a colour and a depth image topic (its image topics: "
+                                  f"{listed([c.topic for c in images])}; {len(topics)} topics in all)")  # fmt: skip
         if not info:
             raise FileFormatError("bag has no CameraInfo topic")
         self._depth, self._color, self._info = _pick_topics(depth, color, info)

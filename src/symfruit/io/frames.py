@@ -86,6 +86,21 @@ def _only(folder: Path, *names: str) -> Path | None:
     return given[0] if given else None
 
 
+def _not_read(folder: Path, stem: str, most: int = 3) -> str:
+    """For the error of a frame folder missing its ``stem`` file: the files it holds under that name that are
+    not read (``depth.tiff``, ``Depth.PNG``, ``depth.png.bak``), at most ``most`` named, or nothing."""
+    try:
+        with os.scandir(folder) as entries:
+            near = sorted(e.name for e in entries if e.name.lower().startswith(stem + "."))
+    except OSError:
+        return ""
+    if not near:
+        return ""
+    named = ", ".join(shown(n) if len(n) > 40 else n for n in near[:most])
+    more = f" and {len(near) - most} more" if len(near) > most else ""
+    return f"; found {named}{more}, not read: only the names above are"
+
+
 def is_frame_folder(folder: Path) -> bool:
     """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
     that name is then refused by name when the frame is read)."""
@@ -112,14 +127,14 @@ def read_frame(folder: str | Path) -> Frame:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")
     cam_path = _only(folder, "camera.json", "camera.yaml", "camera.yml")
     if cam_path is None:
-        raise FileFormatError(f"{folder}: no camera.json (intrinsics)")
+        raise FileFormatError(f"{folder}: no camera.json (intrinsics){_not_read(folder, 'camera')}")
     cam_data = read_mapping(cam_path)
     camera = camera_from_file_data(cam_path, cam_data)
     scale = _depth_scale(cam_path, cam_data)
     color, color_orientation = read_color_oriented(color_path)
     depth_file = _only(folder, "depth.png", "depth.npy")
     if depth_file is None:
-        raise FileFormatError(f"{folder}: no depth.png or depth.npy")
+        raise FileFormatError(f"{folder}: no depth.png or depth.npy{_not_read(folder, 'depth')}")
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
@@ -228,6 +243,8 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
                 raise ValueError(f"fruit {k}: ripe must be true or false, got {shown(ripe)}")
             fid = item.get("id", k)
             if isinstance(fid, int) and not isinstance(fid, bool):  # other ids are refused below, if ripe
+                if fid == 0:  # matched with no fruit, ever: label 0 is the masks' background
+                    raise ValueError(f"fruit {k}: id 0 is no mask label (0 is the background; labels start at 1)")
                 if fid in seen_ids:
                     raise ValueError(f"fruit {k}: id {fid} is fruit {seen_ids[fid]}'s too; each fruit has its own "
                                      "id (its mask label)")  # fmt: skip
@@ -246,8 +263,8 @@ def _truth(path: Path) -> tuple[list[tuple[int, Box]], dict[int, float]]:
             if max(np.abs(lo).max(), np.abs(hi).max()) > MAX_DEPTH_METRES:
                 raise ValueError(f"fruit {k}: a box more than {MAX_DEPTH_METRES:g} m from the camera; boxes are in "
                                  "metres (these look like millimetres)")  # fmt: skip
-            if isinstance(fid, bool) or not isinstance(fid, int) or not 0 <= fid <= MAX_LABEL_ID:
-                raise ValueError(f"fruit {k}: id must be a whole number in 0-{MAX_LABEL_ID} (a label id)")
+            if isinstance(fid, bool) or not isinstance(fid, int) or not 1 <= fid <= MAX_LABEL_ID:
+                raise ValueError(f"fruit {k}: id must be a whole number in 1-{MAX_LABEL_ID} (a label id)")
             out.append((fid, Box(lo, hi)))
             if "visible" in item:
                 seen = item["visible"]

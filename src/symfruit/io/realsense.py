@@ -31,7 +31,7 @@ import bisect
 import re
 import struct
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -163,7 +163,8 @@ class RealSenseBagSource:
             raise FileFormatError(f"no intrinsics for {prefix} (topic /{prefix}/info/camera_info missing or empty)")
         model = str(info.distortion_model)
         if model not in LENS_MODELS:
-            raise FileFormatError(f"{prefix}: lens model {model!r} is not supported (known: {', '.join(LENS_MODELS)})")
+            raise FileFormatError(f"{prefix}: lens model {shown(model)} is not supported (known: "
+                                  f"{', '.join(LENS_MODELS)})")  # fmt: skip
         # librealsense writes D from rs2_intrinsics::coeffs, a float[5] (ros_writer.cpp), and reads five back: every
         # model's coefficients are those five, so a D of any other length is not its recording; refused, never cut
         # (counted before any value is converted: a D of millions is refused as it stands)
@@ -206,7 +207,7 @@ class RealSenseBagSource:
         for kind in ("Depth", "Color"):
             if kind not in images:
                 raise FileFormatError(f"no {kind.lower()} stream recorded (no /device_0/sensor_N/{kind}_0/image/data "
-                                      f"topic; topics: {', '.join(topics) or 'none'})")  # fmt: skip
+                                      f"topic; {_streams(topics)})")  # fmt: skip
         self._depth, self._color = images["Depth"], images["Color"]
         tfs: dict[str, tuple[int, Any]] = {}
         for conn in conns:
@@ -283,7 +284,7 @@ class RealSenseBagSource:
             cmsg, _ = self._message(self._color, self._color_stamps[near][1])
             color = color_image(cmsg, self._color.msgtype)
             if str(dmsg.encoding).lower() not in _DEPTH_ENCODINGS:
-                raise FileFormatError(f"depth image encoding {dmsg.encoding!r}: expected mono16 (Z16) units")
+                raise FileFormatError(f"depth image encoding {shown(dmsg.encoding)}: expected mono16 (Z16) units")
             units = image_array(dmsg, self._depth.msgtype)
             scale = self.depth_units
             if scale is None:
@@ -329,6 +330,18 @@ class RealSenseBagSource:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _streams(topics: Sequence[str], most: int = 6) -> str:
+    """What a recording without a needed stream holds, for its error: the image streams (``.../NAME/image/data``
+    topics) by name, at most ``most`` of them and each cut to 60 characters, and how many topics in all (a bag's
+    topics alone ran to 800 characters, the file's own text unbounded)."""
+    streams = [t[1 : -len("/image/data")] for t in topics if t.endswith("/image/data")]
+    named = [t if len(t) <= 60 else t[:57] + "..." for t in streams[:most]]
+    if len(streams) > most:
+        named.append(f"{len(streams) - most} more")
+    held = f"its image streams: {', '.join(named)}" if named else "no image stream"
+    return f"{held}; {len(topics)} topic{'s' if len(topics) != 1 else ''} in all"
 
 
 def _check_units(value: float, what: str) -> float:

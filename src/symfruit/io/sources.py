@@ -115,7 +115,13 @@ class FolderSource(_Closing):
 
     def read(self, index: int) -> Frame:
         _check_index(index, len(self._folders))
-        return read_frame(self._folders[index])
+        folder = self._folders[index]
+        if folder.is_symlink():
+            here, there = self.path.resolve(), folder.resolve()
+            if there == here or there in here.parents:  # read as a frame: "no color.png or color.jpg"
+                which = "the recording folder" if there == here else f"{there}, which holds the recording"
+                raise FileFormatError(f"{folder}: a link back to {which}, not a frame folder")
+        return read_frame(folder)
 
 
 def _check_index(index: int, n: int) -> None:

@@ -188,6 +188,8 @@ def read_structured(
         raise error(f"{path}: {what} is not UTF-8 text ({exc.reason} at byte {exc.start})") from None
     suffix = path.suffix.lower()
     kind = "JSON" if suffix == ".json" else "YAML"
+    if not text.strip():  # JSON: "Expecting value: line 1 column 1"; YAML: None, "got NoneType" further on
+        raise error(f"{path}: the {what} is empty")
     try:
         if kind == "JSON":
             return json.loads(text, object_pairs_hook=_unique_keys)

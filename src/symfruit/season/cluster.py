@@ -255,20 +255,45 @@ def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> An
                             dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
 
 
+#: The address schemes symfruit can reach a scheduler by (dask.distributed's, less ``ucx``, which needs a package
+#: of its own, and ``inproc``, checked apart).
+SCHEMES = ("tcp", "tls", "ws", "wss")
+
+
 def check_address(scheduler: Any) -> None:
     """Refuse a scheduler address that cannot be one before trying it for :data:`CONNECT_TIMEOUT`: empty (an
-    unset shell variable), or a port that is not 1-65535 (``tcp://HOST:PORT``; ``inproc://`` is not checked)."""
+    unset shell variable), a port that is not 1-65535 (``tcp://HOST:PORT``), a scheme Dask has no connector for
+    here (``udp://``, ``ucx://``), ``tls://`` or ``wss://`` without Dask's TLS settings, or an in-process address
+    (``inproc://``) of another process or not of the form Dask writes (``inproc://HOST/PID/N``)."""
     text = str(scheduler).strip()
     if not text:
         raise InputError("--scheduler '': an empty address (an unset shell variable?); give tcp://HOST:PORT")
-    if text.startswith("inproc://"):
+    scheme, sep, rest = text.partition("://")
+    scheme = scheme if sep else "tcp"  # distributed's schemes are lower case: ``TCP://`` is none
+    rest = rest if sep else text
+    if scheme == "inproc":
+        # distributed splits the rest in three and says "not enough values to unpack" if it cannot; an in-process
+        # scheduler is one of this process (a Python caller's LocalCluster(processes=False)), never the CLI's
+        pid = rest.rpartition("/")[0].rpartition("/")[2]
+        if not (pid.isascii() and pid.isdigit() and int(pid) == os.getpid()):
+            raise InputError(f"--scheduler {shown(text)}: an in-process (inproc://) address is reachable only from "
+                             "the Python process that started that scheduler; give tcp://HOST:PORT")  # fmt: skip
         return
-    rest = text.split("://", 1)[1] if "://" in text else text
+    if scheme not in SCHEMES:
+        raise InputError(f"--scheduler {shown(text)}: not an address scheme symfruit can use ({shown(scheme, 12)}); "
+                         "give tcp://HOST:PORT (or tls://, ws://, wss://)")  # fmt: skip
     _, colon, port = rest.rpartition(":")
     # ASCII digits only: str.isdigit() takes full-width and other scripts' digits and int() reads them, so a
     # mistyped port passed as another; ``8786`` alone has no port (distributed: "missing port number")
     if not colon or not (port.isascii() and port.isdigit()) or not 1 <= int(port) <= 65535:
         raise InputError(f"--scheduler {shown(text)}: not a scheduler address; give tcp://HOST:PORT, the port 1-65535")
+    if scheme in ("tls", "wss"):
+        distributed = require_distributed()
+        if distributed.Security().get_connection_args("client").get("ssl_context") is None:
+            # distributed: "TLS expects a `ssl_context` argument of type ssl.SSLContext ..." as a traceback
+            raise InputError(f"--scheduler {shown(text)}: {scheme}:// needs Dask's TLS settings (distributed.comm."
+                             "tls.ca-file, .client.cert, .client.key), and none are set; set them or give "
+                             "tcp://HOST:PORT")  # fmt: skip
 
 
 @contextlib.contextmanager
@@ -277,8 +302,10 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
     if scheduler is not None:
         try:
             client = distributed.Client(scheduler, timeout=CONNECT_TIMEOUT)
-        except (OSError, TimeoutError, ValueError) as exc:
-            raise InputError(f"{scheduler}: cannot reach the Dask scheduler ({exc})") from None
+        except (OSError, TimeoutError, ValueError, TypeError) as exc:
+            reason = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+            reason = reason if len(reason) <= 160 else reason[:157] + "..."
+            raise InputError(f"{scheduler}: cannot reach the Dask scheduler ({reason})") from None
         with client:
             yield client
         return

@@ -18,6 +18,7 @@ diameter here; they are counted, not sized.
 
 from __future__ import annotations
 
+import contextlib
 import itertools
 import math
 import os
@@ -86,6 +87,12 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
     from ..io.text import holds_file
 
     if not holds_file(path):  # a directory or broken link of that name says so, not "no such table"
+        if not os.path.lexists(path) and _has_records(path.parent):
+            # a run stopped before its end (the tables appear when it ends), or one of a symfruit before the tables
+            raise FileFormatError(f"{path}: no such table, but the run's frame records are there (a run stopped "
+                                  "before its end, or one by an older symfruit): `symfruit detect INPUT --output "
+                                  f"{path.parent} --resume` writes the tables from them without detecting "
+                                  "again")  # fmt: skip
         raise FileFormatError(f"{path}: no such table; run `symfruit detect ... --output {path.parent}` first")
     try:
         meta = pq.ParquetFile(path).metadata
@@ -108,6 +115,16 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
         raise FileFormatError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from None
     _check_types(path, table)
     return table
+
+
+def _has_records(folder: Path) -> bool:
+    """Whether ``folder`` holds a frame's ``detections.json`` (``F/detections.json`` or, from a run of several
+    recordings, ``R/F/detections.json``): the first found is enough."""
+    for pattern in ("*/detections.json", "*/*/detections.json"):
+        with contextlib.suppress(OSError):
+            if next(itertools.islice(folder.glob(pattern), 1), None) is not None:
+                return True
+    return False
 
 
 def _check_types(path: Path, table: Any) -> None:

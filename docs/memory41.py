@@ -1,0 +1,100 @@
+"""Memory of `symfruit detect` over a long generated recording (docs/robust41.md): the resident set size after
+each frame, as `run_batch` (what `symfruit detect` runs) goes through a recording of N copies of the shipped
+example frame (640x480, three strawberries), as a folder of frame folders or as a ROS 2 bag (16UC1 depth,
+rgb8 colour, CameraInfo).
+
+    python docs/memory41.py folder --frames 200
+    python docs/memory41.py bag --frames 200 [--method evidence]
+
+Prints the largest RSS up to frame 10, 50, 100, 150 and N, and up to the run's end (tables written). A
+measurement of minutes, not a test: memory that grows with the frames shows as a rising row.
+"""
+
+import argparse
+import json
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+
+def rss_mb() -> float:
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024.0
+    return float("nan")
+
+
+def folder_recording(root: Path, n: int, frame: Path) -> Path:
+    rec = root / "rec"
+    for k in range(n):
+        shutil.copytree(frame, rec / f"f{k:05d}", ignore=shutil.ignore_patterns("truth.json"))
+    return rec
+
+
+def bag_recording(root: Path, n: int, frame: Path) -> Path:
+    import numpy as np
+    from rosbags.rosbag2 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    from symfruit.io.frames import read_frame
+
+    f = read_frame(frame)
+    cam = json.loads((frame / "camera.json").read_text())
+    mm = np.round(f.depth * 1000).astype(np.uint16)
+    ts = get_typestore(Stores.ROS2_HUMBLE)
+    Image, Info = ts.types["sensor_msgs/msg/Image"], ts.types["sensor_msgs/msg/CameraInfo"]
+    Header, Time = ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
+    h, w = mm.shape
+    k = np.array([cam["fx"], 0, cam["cx"], 0, cam["fy"], cam["cy"], 0, 0, 1.0])
+    with Writer(root / "rec", version=9) as writer:
+        c_col = writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
+        for i in range(n):
+            t = 1_000_000_000 + i * 33_333_333
+            head = Header(stamp=Time(sec=t // 10**9, nanosec=t % 10**9), frame_id="camera_color_optical_frame")
+            info = Info(header=head, height=h, width=w, distortion_model="plumb_bob", d=np.zeros(5), k=k,
+                        r=np.eye(3).ravel(), p=np.array([*k[:3], 0, *k[3:6], 0, *k[6:], 0]), binning_x=0,
+                        binning_y=0, roi=RoI(x_offset=0, y_offset=0, height=0, width=0, do_rectify=False))  # fmt: skip
+            writer.write(c_inf, t, ts.serialize_cdr(info, "sensor_msgs/msg/CameraInfo"))
+            img = Image(header=head, height=h, width=w, encoding="rgb8", is_bigendian=0, step=3 * w,
+                        data=f.color.ravel())  # fmt: skip
+            writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
+            dep = Image(header=head, height=h, width=w, encoding="16UC1", is_bigendian=0, step=2 * w,
+                        data=mm.view(np.uint8).ravel())  # fmt: skip
+            writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
+    return root / "rec"
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("kind", choices=("folder", "bag"))
+    parser.add_argument("--frames", type=int, default=200)
+    parser.add_argument("--method", default=None, help="completion method (default: detect's)")
+    args = parser.parse_args()
+
+    from symfruit.batch import run_batch
+    from symfruit.demo import example_frame
+
+    with tempfile.TemporaryDirectory(prefix="symfruit-memory41-") as tmp, example_frame() as frame:
+        root = Path(tmp)
+        make = folder_recording if args.kind == "folder" else bag_recording
+        rec = make(root, args.frames, frame)
+        after: list[float] = []
+        extra = {} if args.method is None else {"method": args.method}
+        report = run_batch(rec, root / "out", progress=False, on_frame=lambda i, found: after.append(rss_mb()),
+                           **extra)  # fmt: skip
+        end = rss_mb()
+    out = sys.stdout
+    out.write(f"{args.kind}, {args.frames} frames: {len(report.done)} done, {len(report.failed)} failed\n")
+    for upto in (10, 50, 100, 150, args.frames):
+        if upto <= len(after):
+            out.write(f"  largest RSS up to frame {upto:5d}: {max(after[:upto]):7.1f} MB\n")
+    out.write(f"  after the run (tables written):  {end:7.1f} MB\n")
+
+
+if __name__ == "__main__":
+    main()
