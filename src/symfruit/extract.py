@@ -339,7 +339,7 @@ def register(
     """
     labels = _checked(labels, depth, camera, settings, "register", "labels")
     s = settings or ExtractSettings()
-    z = np.asarray(depth, dtype=np.float64)
+    z = np.asarray(depth)  # float64 window by window (registration_shift): no float64 copy of the whole frame
     du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,
                                 depth_range=(s.min_depth, s.max_depth), boxes=boxes)  # fmt: skip
     return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

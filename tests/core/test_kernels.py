@@ -3501,3 +3501,114 @@ def test_the_segmenters_split_up_to_its_centres_is_the_twins(seed, sigma, holes)
     with pytest.MonkeyPatch.context() as mp:
         fast, twin_parts = _both(mp, colour._split, region, depth, s, geo, (3, 5), 50.0)
     assert len(fast) == len(twin_parts) and all(np.array_equal(a, b) for a, b in zip(fast, twin_parts, strict=True))
+
+
+# --- stop 41, speedreg41
+
+
+def _frame_outlines(seed: int, reach: int):
+    """Four to six balls (one on a table, so told along one axis at most; noisy or not, rims without depth), their
+    depth a few pixels off their masks: the outlines ``registration_shift`` costs, each in its window."""
+    from symfruit.core import surface
+
+    from .test_surface import F, H, W, ball
+
+    rng = np.random.default_rng(seed)
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    centres = [(25, 25), (80, 27), (135, 24), (26, 92), (82, 90), (134, 93)][: int(rng.integers(4, 7))]
+    for k, centre in enumerate(centres):
+        d, disc = ball(centre=centre, radius_px=int(rng.integers(9, 15)), front=float(rng.uniform(0.4, 0.6)),
+                       rim=float(rng.uniform(0.0, 0.2)), table=k == 1)  # fmt: skip
+        depth = np.where(disc | ((k == 1) & (d < depth)), d, depth)
+        labels[disc] = k + 1
+    depth = depth + rng.normal(0.0, 0.001 * (seed % 2), depth.shape)
+    moved = np.roll(depth, (int(rng.integers(-5, 6)), int(rng.integers(-5, 6))), axis=(0, 1))
+    outlines = []
+    for k in range(1, len(centres) + 1):
+        rows, cols = np.nonzero(labels == k)
+        r0, c0 = max(rows.min() - reach - 8, 0), max(cols.min() - reach - 8, 0)
+        r1, c1 = rows.max() + reach + 9, cols.max() + reach + 9
+        found = surface._outline(moved[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, F, reach)
+        if found is not None and any(found.axes):
+            outlines.append(found)
+    return outlines
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_the_frames_fast_costs_are_the_outlines_to_the_bit(seed):
+    """``frame_costs`` (issue 19, stop 41): every stage's costs are ``_told``'s fast costs of each outline (its
+    one-axis outlines' too), bit for bit; the pruned stage leaves every shift ``_least_pruned`` can take and the same
+    costs in their columns; and ``_FrameCosts.least`` is the index of ``_least_pruned`` (more than ``_PRUNE_FROM``
+    shifts) and of the search's plain ``least`` (fewer), on whole grids, one-axis grids, and a few shifts, ties
+    included."""
+    from symfruit.core import surface
+
+    reach, trim = 10, 0.7
+    outlines = _frame_outlines(seed, reach)
+    assert len(outlines) >= 3
+    # one-axis outlines among them (a fruit on a board tells one axis): their axes as _free_points might count them
+    outlines[1].__dict__["axes"] = (True, False)
+    outlines[2].__dict__["axes"] = (False, True)
+
+    def cost(shifts, exact=True):
+        return np.mean([surface._told(o, shifts, reach, trim, exact) for o in outlines], axis=0)
+
+    frame = surface._FrameCosts.of(outlines, reach, trim)
+    assert frame is not None
+    rng = np.random.default_rng(seed)
+    coarse = np.arange(-reach, reach + 1, 2)
+    grids = [np.stack(np.meshgrid(coarse, coarse, indexing="ij"), -1).reshape(-1, 2),
+             np.stack(np.meshgrid(coarse, [0], indexing="ij"), -1).reshape(-1, 2),
+             rng.integers(-reach, reach + 1, (int(rng.integers(1, 30)), 2)),
+             np.zeros((40, 2), np.int64)]  # fmt: skip
+    for grid in grids:
+        grid = grid.astype(np.int64)
+        want = np.array([surface._told(o, grid, reach, trim, False) for o in outlines])
+        out = np.full((len(outlines), len(grid)), np.nan)
+        best = int(frame._stage(grid, 0, -1, 0.0, out)[0])
+        assert best == int(np.argmin(want[0])) and np.array_equal(out[0], want[0])
+        frame._stage(grid, 1, best, 0.0, out)
+        assert np.array_equal(out[:, best], want[:, best])
+        everything = frame._stage(grid, 3, -1, 0.0, out.copy())
+        assert np.array_equal(everything, np.arange(len(grid)))
+        limit = float(np.quantile(want.sum(axis=0), 0.3))
+        alive = frame._stage(grid, 2, best, limit, out)
+        summed = np.cumsum(want, axis=0)  # a shift is left while its sums in the outlines' order are within it
+        assert np.array_equal(alive, np.flatnonzero((summed <= limit).all(axis=0)))
+        assert np.array_equal(out[:, alive], want[:, alive])
+        if len(outlines) > 1 and len(grid) > surface._PRUNE_FROM:
+            twin = surface._least_pruned(outlines, grid, reach, trim, cost)
+        else:
+            fast = cost(grid, exact=False)
+            near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
+            twin = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
+        assert frame.least(grid, cost) == twin
+
+
+def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
+    """No ``_FrameCosts`` with the numpy twins, nor for an outline whose map has no 16-bit keys (the search costs
+    those outlines as before); ``registration_shift`` finds the same shift with it and without it."""
+    from symfruit.core import surface
+    from symfruit.core.surface import registration_shift
+
+    from .test_surface import F, H, W, ball
+
+    outlines = _frame_outlines(0, 10)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    assert surface._FrameCosts.of(outlines, 10, 0.7) is None
+    monkeypatch.delenv("SYMFRUIT_KERNELS")
+    wide = outlines[0]
+    monkeypatch.setitem(wide._padded, ("keys", 10, 10), wide.keys(10, 10).astype(np.int32))
+    assert surface._FrameCosts.of(outlines, 10, 0.7) is None
+    depth = np.full((H, W), 0.8)
+    labels = np.zeros((H, W), np.int32)
+    for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
+        d, disc = ball(centre=centre, radius_px=14, front=0.45 + 0.05 * k, rim=0.1)
+        depth = np.where(disc, np.minimum(depth, d), depth)
+        labels[disc] = k + 1
+    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    assert registration_shift(moved.astype(np.float32), labels, F, max_px=10) == (-2, 3)
+    found = registration_shift(moved, labels, F, max_px=10)
+    monkeypatch.setattr(surface._FrameCosts, "of", classmethod(lambda cls, *a: None))
+    assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)

@@ -1420,58 +1420,12 @@ def outline_costs(
     times deviation per rank: within ``keep`` units in the last place of the twin's fast costs, as those are of
     the exact ones (issue 19, fifteenth round; the twelfth round's kernel sorted each row's keys by counting and
     summed the run value by value, 1.5-2x slower)."""
-    k, n = shifts.shape[0], at.shape[0]
-    size = values.shape[0]
+    k = shifts.shape[0]
     out = np.empty(k)
-    count = np.zeros(size, np.int64)
-    row = np.empty(n, np.int64)  # the row's ranks, to clear their counts (not the whole span of ranks) after it
-    lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
+    count = np.zeros(values.shape[0], np.int64)
+    row = np.empty(at.shape[0], np.int64)  # the row's ranks, to clear their counts (not the whole span) after it
     for s in range(k):
-        offset = shifts[s, 0] * width + shifts[s, 1]
-        low, top = size, -1
-        for j in range(n):
-            r = np.int64(ranks[at[j] - offset])
-            row[j] = r
-            count[r] += 1
-            low, top = min(low, r), max(top, r)
-        b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
-        while seen <= lower:
-            b += 1
-            seen += count[b]
-        first = float(values[b])
-        if seen <= upper:  # place `upper` is in the next rank that holds any
-            b += 1
-            while count[b] == 0:
-                b += 1
-            second = float(values[b])
-        else:
-            second = first
-        median = 0.5 * (first + second) if n % 2 == 0 else second
-        middle = min(max(median, 0.0), band)
-        # the first rank at or above the band (bisected: values ascend), the one below it: the nearer one taken first
-        right = low + np.searchsorted(values[low : top + 1], middle)
-        left = right - 1
-        need = keep
-        total = 0.0
-        while need > 0:
-            while left >= low and count[left] == 0:
-                left -= 1
-            while right <= top and count[right] == 0:
-                right += 1
-            below = middle - float(values[left]) if left >= low else np.inf
-            above = float(values[right]) - middle if right <= top else np.inf
-            if below < above:
-                take = min(int(count[left]), need)
-                total += take * below
-                left -= 1
-            else:
-                take = min(int(count[right]), need)
-                total += take * above
-                right += 1
-            need -= take
-        for j in range(n):
-            count[row[j]] = 0
-        out[s] = total / keep
+        out[s] = _fast_cost(ranks, values, at, shifts[s, 0] * width + shifts[s, 1], keep, band, count, row)
     return out
 
 
@@ -4311,6 +4265,149 @@ def trim_band(
                 out[r, c] = margin * _nearest_centre(x, 0, fc)[1] <= _nearest_centre(x, 0, bc)[1]
             else:
                 out[r, c] = mask[r, c]
+
+
+# --- issue 19, stop 41 (speedreg41): the registration's fast costs of every outline in one call ---------------
+
+
+@_njit
+def _fast_cost(
+    ranks: np.ndarray, values: np.ndarray, at: np.ndarray, offset: int, keep: int, band: float, count: np.ndarray,
+    row: np.ndarray,
+) -> float:  # fmt: skip
+    """:func:`outline_costs`' cost of one shift, the points' flat indices ``at`` (n,) moved back by ``offset`` (``dv *
+    width + du``): ``count`` (the ranks' counts, all 0) and ``row`` (n,) its scratch, ``count`` left all 0."""
+    n = at.shape[0]
+    size = values.shape[0]
+    lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
+    low, top = size, -1
+    for j in range(n):
+        r = np.int64(ranks[at[j] - offset])
+        row[j] = r
+        count[r] += 1
+        low, top = min(low, r), max(top, r)
+    b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
+    while seen <= lower:
+        b += 1
+        seen += count[b]
+    first = float(values[b])
+    if seen <= upper:  # place `upper` is in the next rank that holds any
+        b += 1
+        while count[b] == 0:
+            b += 1
+        second = float(values[b])
+    else:
+        second = first
+    median = 0.5 * (first + second) if n % 2 == 0 else second
+    middle = min(max(median, 0.0), band)
+    # the first rank at or above the band (bisected: values ascend), the one below it: the nearer one taken first
+    right = low + np.searchsorted(values[low : top + 1], middle)
+    left = right - 1
+    need = keep
+    total = 0.0
+    while need > 0:
+        while left >= low and count[left] == 0:
+            left -= 1
+        while right <= top and count[right] == 0:
+            right += 1
+        below = middle - float(values[left]) if left >= low else np.inf
+        above = float(values[right]) - middle if right <= top else np.inf
+        if below < above:
+            take = min(int(count[left]), need)
+            total += take * below
+            left -= 1
+        else:
+            take = min(int(count[right]), need)
+            total += take * above
+            right += 1
+        need -= take
+    for j in range(n):
+        count[row[j]] = 0
+    return total / keep
+
+
+@_njit
+def frame_costs(
+    ranks: np.ndarray, values: np.ndarray, at: np.ndarray, starts: np.ndarray, widths: np.ndarray,
+    keeps: np.ndarray, bands: np.ndarray, axes: np.ndarray, shifts: np.ndarray, stage: int, best: int,
+    limit: float, out: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """Fast costs (:func:`outline_costs`'s, each the same number) of a frame's ``m`` outlines into ``out`` (m, k), in
+    one call each stage of :func:`symfruit.core.surface._least_pruned` (issue 19, stop 41). Outline ``o``'s ranks,
+    values and points are ``ranks[starts[o, 0]:starts[o + 1, 0]]``, ``values[starts[o, 1]:...]`` and
+    ``at[starts[o, 2]:...]`` (``starts`` (m + 1, 3)), its padded width ``widths[o]``, with ``keeps[o]`` and
+    ``bands[o]``; each shift (k, 2) ``(dv, du)`` costed as far as the outline tells it (``axes`` (m, 2) bool: as
+    :func:`symfruit.core.surface._told`, the cost of the shift with its untold part 0, each distinct one once).
+
+    ``stage`` 0: the first outline at every shift (row 0), returning ``[np.argmin(row 0)]``; 1: every other outline at
+    the shift ``best`` (column ``best``), returning ``[best]``; 2: with row 0 written, each further outline, in order,
+    at the shifts whose costs summed so far (in the outlines' order, as the twin sums them) are at most ``limit``
+    (row 0's shifts within it to start), returning those left (ascending), whose columns hold every outline's cost;
+    3: as 2 without a limit (every outline at every shift). Other entries of ``out`` are not written."""
+    m, k = out.shape
+    span = 0
+    for s in range(k):
+        span = max(span, abs(shifts[s, 0]), abs(shifts[s, 1]))
+    seen = np.zeros(2 * span + 1, np.bool_)  # a one-axis outline's cost per value of its told axis
+    cached = np.empty(2 * span + 1)
+    size, n_max = 1, 1
+    for o in range(m):
+        size = max(size, starts[o + 1, 1] - starts[o, 1])
+        n_max = max(n_max, starts[o + 1, 2] - starts[o, 2])
+    count = np.zeros(size, np.int64)
+    row = np.empty(n_max, np.int64)
+
+    def told(o: int, s: int) -> float:
+        tv, tu = axes[o, 0], axes[o, 1]
+        dv = shifts[s, 0] if tv else 0
+        du = shifts[s, 1] if tu else 0
+        rk = ranks[starts[o, 0] : starts[o + 1, 0]]
+        va = values[starts[o, 1] : starts[o + 1, 1]]
+        pts = at[starts[o, 2] : starts[o + 1, 2]]
+        if tv and tu:
+            return _fast_cost(rk, va, pts, dv * widths[o] + du, keeps[o], bands[o], count, row)
+        i = dv + du + span  # one of the two is 0
+        if not seen[i]:
+            cached[i] = _fast_cost(rk, va, pts, dv * widths[o] + du, keeps[o], bands[o], count, row)
+            seen[i] = True
+        return cached[i]
+
+    if stage == 0:
+        least, at_least = 0, np.inf
+        for s in range(k):
+            c = told(0, s)
+            out[0, s] = c
+            if c < at_least or (math.isnan(c) and not math.isnan(at_least)):  # np.argmin's: the first least or NaN
+                least, at_least = s, c
+        return np.array([least], np.int64)
+    if stage == 1:
+        for o in range(1, m):
+            seen[:] = False
+            out[o, best] = told(o, best)
+        return np.array([best], np.int64)
+    prune = stage == 2
+    alive = np.empty(k, np.int64)
+    summed = np.empty(k)
+    n_alive = 0
+    for s in range(k):
+        if not prune or out[0, s] <= limit:
+            alive[n_alive] = s
+            summed[n_alive] = out[0, s]
+            n_alive += 1
+    for o in range(1, m):
+        seen[:] = False
+        kept = 0
+        for i in range(n_alive):
+            s = alive[i]
+            part = told(o, s)
+            out[o, s] = part
+            total = summed[i] + part
+            if not prune or total <= limit:
+                alive[kept] = s
+                summed[kept] = total
+                kept += 1
+        n_alive = kept
+    return alive[:n_alive].copy()
 
 
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------

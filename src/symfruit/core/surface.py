@@ -1086,8 +1086,9 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
         mask = labels[r0:r1, c0:c1] == k
         if mask.sum() < 30:
             continue
-        # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds)
-        z = depth[r0:r1, c0:c1]
+        # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds), in float64 (a
+        # float32 frame converted window by window: the same values, without a float64 copy of the whole frame)
+        z = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
         if (jit := compiled()) is not None and z.dtype == np.float64:  # the same map by the extraction's kernel:
             valid = np.empty(z.shape)  # z > 0 and z >= lo is z >= the larger of lo and the least positive double
             jit.valid_depth(z, mask, max(float(lo), 5e-324), float(hi), valid, np.empty(z.shape, bool))
@@ -1102,9 +1103,14 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     def cost(shifts: np.ndarray, exact: bool = True) -> np.ndarray:
         return np.mean([_told(o, shifts, max_px, trim, exact) for o in outlines], axis=0)
 
+    # the fast costs of every outline in one call a stage where numba is (issue 19, stop 41: the same numbers)
+    frame = _FrameCosts.of(outlines, max_px, trim)
+
     def least(shifts: np.ndarray) -> int:
         """The first shift of least exact cost. The fast costs are within ``slack`` of the exact ones, so only
         the shifts within twice that of their least can be it; those (one, but for ties) are costed exactly."""
+        if frame is not None and int(np.abs(shifts).max(initial=0)) <= max_px:
+            return frame.least(shifts, cost)
         if len(outlines) > 1 and len(shifts) > _PRUNE_FROM:
             return _least_pruned(outlines, shifts, max_px, trim, cost)
         fast = cost(shifts, exact=False)
@@ -1176,6 +1182,73 @@ def _least_pruned(outlines: list[_Outline], shifts: np.ndarray, reach: int, trim
     fast = np.mean(rows, axis=0)
     near = alive[fast <= fast.min() + 2.0 * slack]
     return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
+
+
+class _FrameCosts:
+    """A frame's outlines' fast costs by one compiled call a stage (:func:`symfruit.core._jit.frame_costs`, issue 19,
+    stop 41), for :func:`registration_shift`'s ``least``: the same numbers as :meth:`_Outline.cost`'s compiled fast
+    costs (:func:`symfruit.core._jit.outline_costs`, whose cost of a shift it shares), each outline's shifts as far as
+    it tells them (:func:`_told`), pruned as :func:`_least_pruned` prunes them and averaged by numpy as there: the
+    same index. Without some 40 Python-level calls a frame (each outline's :func:`_told` per stage) and the
+    one-axis outlines' ``np.unique``. Made only where numba is and every outline's map has 16-bit keys (where
+    :meth:`_Outline.cost` takes the compiled fast costs), for shifts within the reach (the pad of its maps)."""
+
+    def __init__(self, jit: Any, outlines: list[_Outline], reach: int, trim: float) -> None:
+        self.jit, self.outlines, self.reach = jit, outlines, int(reach)
+        ranks, values, at, widths = [], [], [], []
+        for o in outlines:
+            rank, value = o.ranks(self.reach, reach)
+            width, points = o._points(self.reach)
+            ranks.append(rank)
+            values.append(value)
+            at.append(points)
+            widths.append(width)
+        self.starts = np.zeros((len(outlines) + 1, 3), np.int64)
+        for i, part in enumerate((ranks, values, at)):
+            np.cumsum([len(x) for x in part], out=self.starts[1:, i])
+        self.ranks, self.values, self.at = np.concatenate(ranks), np.concatenate(values), np.concatenate(at)
+        self.widths = np.array(widths, np.int64)
+        self.keeps = np.array([max(1, int(trim * len(o.rows))) for o in outlines], np.int64)
+        self.bands = np.array([o.band for o in outlines], np.float64)
+        self.axes = np.array([o.axes for o in outlines], np.bool_).reshape(-1, 2)
+
+    @classmethod
+    def of(cls, outlines: list[_Outline], reach: int, trim: float) -> _FrameCosts | None:
+        if (jit := compiled()) is None:
+            return None
+        for o in outlines:
+            keys = o.keys(int(reach), reach)
+            if keys is None or keys.dtype != np.int16 or not len(o.rows):
+                return None
+        return cls(jit, outlines, reach, trim)
+
+    def _stage(self, shifts: np.ndarray, stage: int, best: int, limit: float, out: np.ndarray) -> np.ndarray:
+        return self.jit.frame_costs(self.ranks, self.values, self.at, self.starts, self.widths, self.keeps,
+                                    self.bands, self.axes, shifts, stage, best, limit, out)  # fmt: skip
+
+    def least(self, shifts: np.ndarray, cost: Callable[..., np.ndarray]) -> int:
+        """``least(shifts)`` of :func:`registration_shift` (``cost``: its exact costs): with more than one outline
+        and more than :data:`_PRUNE_FROM` shifts :func:`_least_pruned`'s steps, else every outline at every shift;
+        the same fast costs, means, slack and exact costs of the shifts near the least."""
+        count = len(self.outlines)
+        shifts = np.ascontiguousarray(shifts, dtype=np.int64)
+        out = np.empty((count, len(shifts)))
+        best = int(self._stage(shifts, 0, -1, 0.0, out)[0])
+        if count > 1 and len(shifts) > _PRUNE_FROM:
+            self._stage(shifts, 1, best, 0.0, out)
+            upper = float(np.mean(np.ascontiguousarray(out[:, best : best + 1]), axis=0)[0])
+            top = max(float(np.hypot(*o.inside.shape)) + float(self.reach) + o.band for o in self.outlines)
+            slack = 1e-10 * (1.0 + top)
+            limit = (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
+            alive = self._stage(shifts, 2, best, limit, out)
+            fast = np.mean(out[:, alive], axis=0)
+            near = alive[fast <= fast.min() + 2.0 * slack]
+        else:
+            self._stage(shifts, 3, -1, 0.0, out)
+            fast = np.mean(out, axis=0)
+            slack = 1e-10 * (1.0 + float(np.abs(fast).max()))
+            near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
+        return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
 
 
 def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact: bool) -> np.ndarray:
