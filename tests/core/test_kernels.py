@@ -3612,3 +3612,27 @@ def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
     found = registration_shift(moved, labels, F, max_px=10)
     monkeypatch.setattr(surface._FrameCosts, "of", classmethod(lambda cls, *a: None))
     assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)
+
+
+# --- stop 41, speedobs41
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_near_distance_on_fruit_sized_windows_is_the_twins_to_the_bit(seed):
+    """stop 41's row walk of :func:`symfruit.core._jit.near_distance` on windows as large as a dense view's (ragged
+    discs and ellipses 40-150 px across, holes, a second blob), both sides, the reaches observation asks for and
+    more: the numpy twin's values to the bit."""
+    from symfruit.core.raster import _near_distance
+
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(40, 170)), int(rng.integers(40, 170))
+    rr, cc = np.mgrid[:h, :w]
+    a, b = rng.uniform(0.2, 0.5) * h, rng.uniform(0.2, 0.5) * w
+    mask = ((rr - h / 2) / a) ** 2 + ((cc - w / 2) / b) ** 2 <= 1.0
+    mask &= rng.random((h, w)) > rng.uniform(0.0, 0.05)  # dropped pixels: holes and a ragged edge
+    mask |= _blobs(rng, h, w, 0.002)
+    for reach in (0.0, 1.0, 2.5, 5.5, 8.0, 10.3, 15.0):
+        for want in (False, True):
+            out = np.full((h, w), -1.0)
+            _jit.near_distance(mask, reach, want, out)
+            assert np.array_equal(out, _near_distance(mask == want, reach))

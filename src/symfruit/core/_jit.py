@@ -484,48 +484,79 @@ def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -
     columns), and the same square roots: the twin's values to the bit. Since issue 19's eighteenth round the column
     sweeps run row by row (each column's last wanted row kept), and a pixel's search over the columns starts at the
     nearest column within its row whose distance is not capped (nearer columns are all capped, and a capped
-    column's term is never less than the pixel's own): the same least term."""
+    column's term is never less than the pixel's own): the same least term. Since issue 19's stop 41 (speedobs41) a
+    row's uncapped columns are found by one walk along it (each run of capped pixels between two of them knows both,
+    a pixel beyond reach of both is +inf at once) instead of two passes of running gaps, and the sweeps select
+    without a branch: 0.14-0.19 against 0.08-0.15 ms on a dense view's window, the same values."""
     h, w = mask.shape
     k = math.floor(reach)
     cap = k + 1
     cap2 = cap * cap
     g2 = np.empty((h, w), np.int64)
     last = np.empty(w, np.int64)
-    last[:] = -cap  # the row of each column's last wanted pixel above, or far enough to be beyond reach
+    last[:] = -cap
     for r in range(h):
         for c in range(w):
-            if mask[r, c] == want:
-                last[c] = r
-            g2[r, c] = min(r - last[c], cap)
+            lc = r if mask[r, c] == want else last[c]
+            last[c] = lc
+            g2[r, c] = min(r - lc, cap)
     last[:] = h - 1 + cap
     for r in range(h - 1, -1, -1):
         for c in range(w):
-            if mask[r, c] == want:
-                last[c] = r
-            d = min(g2[r, c], last[c] - r)
+            lc = r if mask[r, c] == want else last[c]
+            last[c] = lc
+            d = min(g2[r, c], lc - r)
             g2[r, c] = d * d
     limit = reach * reach
-    near = np.empty(w, np.int64)  # each column's distance to the nearest column of the row below the cap
+    inf = np.inf
     for r in range(h):
-        gap = w + k + 1  # none yet: farther than any search
-        for c in range(w):
-            gap = 0 if g2[r, c] < cap2 else gap + 1
-            near[c] = gap
-        gap = w + k + 1
-        for c in range(w - 1, -1, -1):
-            gap = 0 if g2[r, c] < cap2 else gap + 1
-            near[c] = min(near[c], gap)
-        for c in range(w):
-            best = g2[r, c]
-            for t in range(max(near[c], 1), k + 1):
-                tt = t * t
-                if tt >= best:  # farther columns cannot be nearer
-                    break
-                if c - t >= 0 and g2[r, c - t] + tt < best:
-                    best = g2[r, c - t] + tt
-                if c + t < w and g2[r, c + t] + tt < best:
-                    best = g2[r, c + t] + tt
-            out[r, c] = math.sqrt(float(best)) if best <= limit else np.inf
+        g = g2[r]
+        o = out[r]
+        # columns below the cap, one after the other: a pixel's search reaches from its own column to the nearest such
+        # column on each side, within k
+        prev = -(k + 2)  # the last column below the cap so far
+        c = 0
+        while c < w:
+            # the next column below the cap at or after c
+            nxt = c
+            while nxt < w and g[nxt] >= cap2:
+                nxt += 1
+            # pixels c .. nxt - 1 are capped: their nearest uncapped columns are prev and nxt
+            for q in range(c, nxt):
+                dl = q - prev
+                dr = nxt - q if nxt < w else k + 2
+                if dl > k and dr > k:
+                    o[q] = inf
+                    continue
+                best = cap2
+                t0 = min(dl, dr)
+                for t in range(t0, k + 1):
+                    tt = t * t
+                    if tt >= best:
+                        break
+                    if q - t >= 0 and g[q - t] + tt < best:
+                        best = g[q - t] + tt
+                    if q + t < w and g[q + t] + tt < best:
+                        best = g[q + t] + tt
+                o[q] = math.sqrt(float(best)) if best <= limit else inf
+            if nxt >= w:
+                break
+            # column nxt is below the cap
+            best = g[nxt]
+            if best == 0:
+                o[nxt] = 0.0
+            else:
+                for t in range(1, k + 1):
+                    tt = t * t
+                    if tt >= best:
+                        break
+                    if nxt - t >= 0 and g[nxt - t] + tt < best:
+                        best = g[nxt - t] + tt
+                    if nxt + t < w and g[nxt + t] + tt < best:
+                        best = g[nxt + t] + tt
+                o[nxt] = math.sqrt(float(best)) if best <= limit else inf
+            prev = nxt
+            c = nxt + 1
 
 
 @_njit

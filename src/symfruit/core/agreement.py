@@ -32,7 +32,16 @@ from .camera import Camera
 from .kernels import compiled
 from .occlusion import Occlusion
 from .points import as_points, row_norms
-from .raster import Silhouette, inner_distance, interior, outer_distance, outline_cone, outline_cracks, silhouette_cone
+from .raster import (
+    Silhouette,
+    inner_distance,
+    interior,
+    mask_box,
+    outer_distance,
+    outline_cone,
+    outline_cracks,
+    silhouette_cone,
+)
 
 __all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
@@ -266,9 +275,10 @@ def observe(
     mask = region.mask
     # every read of the map below compares it with at most this (the bands, ``edge``, _contour_points' 8 px)
     reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
-    inner = inner_distance(mask, reach)
+    box = mask_box(mask)  # once for both maps
+    inner = inner_distance(mask, reach, box=box)
     # the outside bands read the map out to the widest band alone
-    outer = outer_distance(mask, max(bands, default=0.0) + 0.5)
+    outer = outer_distance(mask, max(bands, default=0.0) + 0.5, box=box)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")

@@ -16,6 +16,7 @@ from scipy import ndimage
 from ..errors import InputError
 from .box import Box
 from .camera import Camera
+from .fits import _plain, eigenvalues2, solve2
 from .kernels import compiled
 from .limits import MAX_WINDOW_PIXELS
 from .points import as_points, column_means, cross_rows, squared_norms
@@ -271,12 +272,43 @@ def silhouette_cone(region: Silhouette, camera: Camera) -> tuple[np.ndarray, np.
     inside, scaled to a largest eigenvalue of magnitude 1; ``axis`` is the ray through the centroid.
     """
     _, mu, cov = _moments(region)
-    inv = np.linalg.inv(4.0 * (cov + _TWELFTH))
+    scaled = 4.0 * (cov + _TWELFTH)
+    inv = inverse2(scaled)  # numpy's inv to the bit, without LAPACK's call
+    if inv is None:
+        inv = np.linalg.inv(scaled)
     conic = np.zeros((3, 3))
     conic[:2, :2] = inv
     conic[:2, 2] = conic[2, :2] = -inv @ mu
     conic[2, 2] = mu @ inv @ mu - 1.0
     return _image_cone(conic, mu, camera)
+
+
+def inverse2(a: np.ndarray) -> np.ndarray | None:
+    """(2, 2) float: ``np.linalg.inv(a)`` of a 2x2 float64 matrix as OpenBLAS's ``dgesv`` works it out with the identity
+    on the right (partial pivoting; the column below the pivot and both triangular solves multiplied by the pivots'
+    reciprocals, as its ``trsm`` does for more than one right-hand side): the same values bit for bit (tested against
+    numpy), in Python floats, about 2 us against the call's 10-20 (issue 19, stop 41). None where a value is not
+    finite or beyond :func:`~symfruit.core.fits._plain`'s range, or a pivot is exactly zero: ask numpy there (it
+    raises on the last)."""
+    a00, a01, a10, a11 = a.ravel().tolist()
+    if not _plain(a00, a01, a10, a11):
+        return None
+    swap = abs(a10) > abs(a00)
+    if swap:
+        a00, a01, a10, a11 = a10, a11, a00, a01
+    if a00 == 0.0:
+        return None
+    r00 = 1.0 / a00
+    low = a10 * r00
+    u11 = a11 - low * a01
+    if u11 == 0.0:
+        return None
+    r11 = 1.0 / u11
+    # the identity's columns, rows swapped as the pivot swapped them
+    b0, b1 = (0.0, 1.0) if swap else (1.0, 0.0)
+    x1 = (b1 - low * b0) * r11
+    y1 = (b0 - low * b1) * r11  # the second column's (b0 and b1 exchanged)
+    return np.array([[(b0 - a01 * x1) * r00, (b1 - a01 * y1) * r00], [x1, y1]])
 
 
 #: ``np.eye(2) / 12.0`` (a pixel's own covariance), made once.
@@ -322,7 +354,9 @@ def mask_box(mask: np.ndarray) -> tuple[int, int, int, int] | None:
     return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
 
 
-def inner_distance(mask: np.ndarray, reach: float | None = None) -> np.ndarray:
+def inner_distance(
+    mask: np.ndarray, reach: float | None = None, *, box: tuple[int, int, int, int] | None = None
+) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(mask)`` (each mask pixel's distance to the nearest
     pixel outside it), transformed over the mask's box grown by a pixel (clipped to the image) alone: a pixel on
     that grown border in the row or column of any farther background pixel is nearer, so the distances are the
@@ -330,9 +364,10 @@ def inner_distance(mask: np.ndarray, reach: float | None = None) -> np.ndarray:
 
     ``reach`` (pixels, >= 0): only the distances up to it are wanted; they are the same, to the bit, and farther
     ones are +inf (:func:`_near_distance`'s shifts instead of scipy's transform: 0.24 against 0.40 ms for a disc
-    134 px across at 10.5 px; issue 19, seventh round)."""
+    134 px across at 10.5 px; issue 19, seventh round). ``box``: the mask's :func:`mask_box` when known (not
+    worked out again)."""
     out = np.zeros(mask.shape)
-    if (box := mask_box(mask)) is None:
+    if (box := mask_box(mask) if box is None else box) is None:
         return out
     r0, r1 = max(box[0] - 1, 0), min(box[1] + 1, mask.shape[0])
     c0, c1 = max(box[2] - 1, 0), min(box[3] + 1, mask.shape[1])
@@ -374,14 +409,15 @@ def nearest_index(image: np.ndarray) -> np.ndarray:
     return ri * image.shape[1] + ci
 
 
-def outer_distance(mask: np.ndarray, reach: float) -> np.ndarray:
+def outer_distance(mask: np.ndarray, reach: float, *, box: tuple[int, int, int, int] | None = None) -> np.ndarray:
     """(h, w) float, pixels: ``ndimage.distance_transform_edt(~mask)`` (each pixel's distance to the nearest mask
     pixel) wherever that is at most ``reach``, +inf wherever it is farther. An empty mask: scipy's map.
 
     Worked out over the mask's box grown by ``ceil(reach) + 1`` pixels (clipped to the image) by
     :func:`_near_distance`, not by scipy's whole transform (issue 19, seventh round: 0.25 against 0.73 ms for a
-    150 px window at the bands' reach of 5.5 px; the same values within reach, to the bit)."""
-    if (box := mask_box(mask)) is None:
+    150 px window at the bands' reach of 5.5 px; the same values within reach, to the bit). ``box``: the mask's
+    :func:`mask_box` when known (an empty mask's is worked out again)."""
+    if (box := mask_box(mask) if box is None else box) is None:
         return ndimage.distance_transform_edt(~mask)
     m = int(np.ceil(reach)) + 1
     out = np.full(mask.shape, np.inf)
@@ -703,16 +739,23 @@ def outline_cone(
     tr = np.array([[1 / scale, 0, -mu[0] / scale], [0, 1 / scale, -mu[1] / scale], [0, 0, 1]])
     conic = tr.T @ q @ tr
     a2 = conic[:2, :2]
+    # numpy's 2x2 solve and eigvalsh by the closed forms that repeat them bit for bit where they can
+    # (core.fits.solve2, eigenvalues2), not two LAPACK calls of 10-30 us (issue 19, stop 41)
+    (c00, c01, c02), (c10, c11, c12), _ = conic.tolist()
     try:
-        centre = np.linalg.solve(a2, -conic[:2, 2])
+        found = solve2(c00, c01, c10, c11, -c02, -c12)
+        centre = np.array(found) if found is not None else np.linalg.solve(a2, -conic[:2, 2])
     except np.linalg.LinAlgError:
         return None
     value = float(centre @ conic[:2, 2] + conic[2, 2])
     if value == 0 or not np.isfinite(value):
         return None
     conic = conic / -value  # -1 at the centre, 0 on the ellipse
-    eig = np.linalg.eigvalsh(conic[:2, :2])
-    if eig.min() <= 0:
+    (c00, _, _), (c10, c11, _), _ = conic.tolist()
+    eig = eigenvalues2(c00, c10, c11)  # eigvalsh reads the lower triangle
+    if eig is None:
+        eig = tuple(np.linalg.eigvalsh(conic[:2, :2]).tolist())
+    if eig[0] <= 0:  # the least first
         return None
     area = np.pi / np.sqrt(eig[0] * eig[1])
     a2 = conic[:2, :2]
