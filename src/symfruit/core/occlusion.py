@@ -353,16 +353,15 @@ def occlusion(
         # points' pixels' box, the window's maps in one kernel)
         image = depth if depth.dtype in (np.float32, np.float64) else np.asarray(depth, dtype=np.float64)
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
-        found, u0, v0, hidden, seen = jit.occlusion_at(uv, points, pad, image, mask, near_to, tolerance, _steps(reach))
+        # stop 41: own_edge on the maps in the same call (jit.occlusion_edge, the fruit's own depths over the window
+        # made there too)
+        found, u0, v0, hidden, seen = jit.occlusion_edge(uv, points, pad, image, mask, near_to, tolerance,
+                                                         _steps(reach), max(int(band), 0))  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
-        own_w = mask[v0 : v0 + h, u0 : u0 + w]
-        if band > 0 and hidden.any():  # own_edge needs the fruit's own depths over the window (the same window)
-            own_z = jit.own_depths(uv, points, camera.width, camera.height, pad)[5]
-            others_w = near_to[v0 : v0 + h, u0 : u0 + w] if others is not None else None
-            hidden = own_edge(hidden, own_w | np.isfinite(own_z), own_z, seen, others_w, tolerance, band)
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w.copy(), depth=seen)
+        own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=seen)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -424,10 +423,23 @@ def own_edge(
       front of it (a leaf 3 cm in front is).
 
     Numpy and the compiled square filter, over the box of the own pixels grown by ``2 band + 1``; a window with no
-    hidden pixel within ``band`` of the fruit returns ``hidden`` itself.
+    hidden pixel within ``band`` of the fruit returns ``hidden`` itself. Where numba is, in one compiled pass
+    (:func:`symfruit.core._jit.own_edge`: the same pixels, bit for bit; its eight dilation passes and scipy's minimum
+    filter were most of the occlusion maps' time; issue 19, stop 41), and :func:`occlusion` runs it in the same
+    kernel as the maps (:func:`symfruit.core._jit.occlusion_edge`).
     """
     if band <= 0 or not hidden.any():
         return hidden
+    shape = np.shape(hidden)
+    same = np.shape(own) == np.shape(own_z) == np.shape(depth) == shape
+    same = same and (others is None or np.shape(others) == shape)
+    if (jit := compiled()) is not None and same and len(shape) == 2:
+        out = np.array(hidden, dtype=bool, order="C")  # the compiled twin clears in place (the same pixels)
+        near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
+        z = np.asarray(own_z, dtype=np.float64)
+        found = jit.own_edge(out, np.asarray(own, dtype=bool), z, np.asarray(depth, dtype=np.float64), near_to,
+                             float(tolerance), int(band))  # fmt: skip
+        return out if found else hidden
     box = mask_box(own)
     if box is None:
         return hidden
