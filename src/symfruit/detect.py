@@ -152,21 +152,21 @@ def detect(
     _check_depth_range(frame, settings.extract.min_depth, settings.extract.max_depth)
     labels, source = frame_masks(frame, masks, settings)
     t1 = time.perf_counter()
-    if labels.size and labels.min() < 0:
+    lo, hi = (int(labels.min()), int(labels.max())) if labels.size else (0, 0)
+    if lo < 0:
         raise InputError(f"frame {frame.name}: masks hold negative labels")
-    if labels.size and int(labels.max()) > MAX_FRUIT_PER_FRAME:  # sparse ids: number them 1..k first
+    if hi > MAX_FRUIT_PER_FRAME:  # sparse ids: number them 1..k first
         values, inverse = np.unique(labels, return_inverse=True)
         count = len(values) - int(values[0] == 0)
         if count > MAX_FRUIT_PER_FRAME:
             raise InputError(f"frame {frame.name}: masks hold {count} instances; at most {MAX_FRUIT_PER_FRAME} "
                              "fruit per frame are read")  # fmt: skip
         labels = (inverse.reshape(labels.shape) + int(values[0] != 0)).astype(np.int32)
-    if labels.size:
-        whole = np.flatnonzero(np.bincount(labels.ravel())[1:] == labels.size)
-        if len(whole):
-            raise InputError(
-                f"frame {frame.name}: mask {int(whole[0]) + 1} covers the whole image; that is not a fruit"
-            )
+        lo, hi = int(labels.min()), int(labels.max())
+    # one mask covers the whole image when every pixel holds the same label above 0: the least and greatest labels
+    # tell it (a bincount of the image cost 0.3 ms a frame; issue 19, stop 41)
+    if labels.size and lo == hi and lo > 0:
+        raise InputError(f"frame {frame.name}: mask {lo} covers the whole image; that is not a fruit")
     t2 = time.perf_counter()  # trimming, registration and extraction start
     from scipy import ndimage
 

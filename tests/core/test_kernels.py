@@ -3636,3 +3636,132 @@ def test_near_distance_on_fruit_sized_windows_is_the_twins_to_the_bit(seed):
             out = np.full((h, w), -1.0)
             _jit.near_distance(mask, reach, want, out)
             assert np.array_equal(out, _near_distance(mask == want, reach))
+
+
+# --- stop 41, speedext41
+
+
+def _edge_case(seed: int, band: int):
+    """A window with a fruit's own pixels, a ring of hidden pixels at its depth beside them (some running on, some
+    behind a gap), other fruit, depths with NaN and the own depths (+inf off the points' pixels)."""
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(20, 70)), int(rng.integers(20, 70))
+    rr, cc = np.mgrid[0:h, 0:w]
+    r0, c0, rad = rng.uniform(0.3, 0.7) * h, rng.uniform(0.3, 0.7) * w, rng.uniform(4, 15)
+    dist = np.hypot(rr - r0, cc - c0)
+    own = dist <= rad
+    own_z = np.where(own & (rng.random((h, w)) < 0.9), 0.5 + 0.01 * rng.random((h, w)), np.inf)
+    depth = np.where(rng.random((h, w)) < 0.5, 0.5 + rng.normal(0.0, 0.01, (h, w)), 0.8)
+    depth[rng.random((h, w)) < 0.1] = np.nan
+    hidden = ~own & (((dist <= rad + rng.uniform(1, band + 4)) & (rng.random((h, w)) < 0.95))
+                     | (rng.random((h, w)) < rng.uniform(0.0, 0.3)))  # fmt: skip
+    others = (rng.random((h, w)) < 0.05) if rng.random() < 0.5 else None
+    return hidden, own, own_z, depth, others
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(0, 9))
+def test_the_own_edge_kernel_clears_the_twins_pixels(seed, band):
+    from symfruit.core.occlusion import own_edge
+
+    hidden, own, own_z, depth, others = _edge_case(seed, band)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, own_edge, hidden, own, own_z, depth, others, 0.005, band)
+    np.testing.assert_array_equal(fast, twin)
+    np.testing.assert_array_equal(hidden, _edge_case(seed, band)[0])  # its input is left alone
+
+
+def test_the_row_minimum_kernel_is_scipys_minimum_filter():
+    from scipy import ndimage
+
+    rng = np.random.default_rng(41)
+    for k in range(0, 9):
+        x = np.where(rng.random((7, 23)) < 0.6, rng.random((7, 23)), np.inf)
+        out = np.empty_like(x)
+        _jit._row_min(x, k, out)
+        want = ndimage.minimum_filter1d(x, size=2 * k + 1, axis=1, mode="constant", cval=np.inf)
+        np.testing.assert_array_equal(out, want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.sampled_from([0, 3, 8]), st.booleans(), st.booleans())
+def test_the_occlusion_in_one_call_gives_the_twins_maps(seed, band, with_others, single):
+    """core.occlusion.occlusion (jit.occlusion_edge: the maps, the own depths and own_edge in one kernel) against
+    the numpy twins on a disc fruit whose depth the sensor spread a few pixels past its mask (a fattened edge), a
+    leaf in front, another fruit beside, dropouts: the same window, hidden pixels and seen depths, bit for bit."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=300.0, fy=300.0, cx=40.0, cy=30.0, width=80, height=60)
+    rr, cc = np.mgrid[0:60, 0:80]
+    r0, c0, rad = rng.uniform(15, 45), rng.uniform(20, 60), rng.uniform(5, 12)
+    dist = np.hypot(rr - r0, cc - c0)
+    zf = 0.4 + 0.0005 * dist
+    depth = np.where(dist <= rad + rng.uniform(0, 6), zf, 1.0) + rng.normal(0.0, 0.001, (60, 80))
+    leaf = (np.abs(rr - rng.uniform(0, 60)) < rng.uniform(0, 4)) & (cc > rng.uniform(0, 80))
+    depth = np.where(leaf, 0.3, depth)
+    depth[rng.random((60, 80)) < 0.05] = 0.0
+    depth = depth.astype(np.float32 if single else np.float64)
+    mask = (dist <= rad) & ~leaf
+    sel = mask & (rng.random((60, 80)) < 0.9)
+    if not sel.any():
+        return
+    v, u = np.nonzero(sel)
+    z = zf[sel]
+    points = np.column_stack(((u - 40.0) * z / 300.0, (v - 30.0) * z / 300.0, z))
+    others = (np.hypot(rr - r0, cc - c0 - 2 * rad - 3) <= rad) if with_others else None
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occlusion, depth, mask, points, camera, others=others, band=band)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        plain = occlusion(depth, mask, points, camera, others=others, band=0)
+    assert (fast.u0, fast.v0) == (twin.u0, twin.v0) and np.array_equal(fast.hidden, twin.hidden)
+    assert np.array_equal(fast.own, twin.own) and fast.depth.tobytes() == twin.depth.tobytes()
+    if band == 0:
+        assert np.array_equal(fast.hidden, plain.hidden)
+
+
+def test_the_occlusion_in_one_call_clears_a_fattened_edge():
+    """The case the test above draws from, fixed: a disc whose depth runs 3 px past its mask onto background; the
+    ring is hidden without the band and cleared with it, by the kernel and by the twin."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    camera = Camera(fx=300.0, fy=300.0, cx=40.0, cy=30.0, width=80, height=60)
+    rr, cc = np.mgrid[0:60, 0:80]
+    dist = np.hypot(rr - 30, cc - 40)
+    depth = np.where(dist <= 13, 0.4, 1.0)
+    mask = dist <= 10
+    v, u = np.nonzero(mask)
+    points = np.column_stack(((u - 40.0) * 0.4 / 300.0, (v - 30.0) * 0.4 / 300.0, np.full(len(u), 0.4)))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, occlusion, depth, mask, points, camera, band=8)
+        bare, _ = _both(mp, occlusion, depth, mask, points, camera, band=0)
+    assert bare.hidden.sum() > 100 and not fast.hidden.any() and not twin.hidden.any()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([8, 72, 7]), st.sampled_from([0.0, 0.002, np.inf]))
+def test_monotone_at_is_ray_pixels_then_the_table(seed, bins, tol):
+    """monotone_at (one call) against ray_pixels then monotone_table, and monotone_region with the kernels against
+    its twin: the same pixels, the apex anywhere (outside the window too), no kept pixel, an infinite tolerance."""
+    from symfruit.core import surface
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 70, 2))
+    keep = rng.random((h, w)) < rng.choice([0.0, rng.uniform(0.1, 1.0)])
+    depth = rng.choice([0.5, 0.501, 0.503, 0.51], (h, w))
+    apex = (int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5)))
+    reach = max(abs(apex[0]), abs(h - 1 - apex[0]), abs(apex[1]), abs(w - 1 - apex[1]))
+    table = surface._sector_table(bins, reach)
+    r = (table.shape[0] - 1) // 2
+    if np.isfinite(tol):
+        rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
+        want = np.zeros((h, w), bool)
+        _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, tol, want)
+        got = np.zeros((h, w), bool)
+        assert _jit.monotone_at(depth, keep, apex[0], apex[1], table, r, bins, tol, got) == int(keep.sum())
+        np.testing.assert_array_equal(got, want)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, surface.monotone_region, depth, keep, apex, tol, bins=bins)
+    np.testing.assert_array_equal(fast, twin)

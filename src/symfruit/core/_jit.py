@@ -3487,6 +3487,238 @@ def _one_slab(points: np.ndarray, distance: float) -> np.ndarray:
     return np.arange(n)
 
 
+# --- issue 19, stop 41 (speedext41): the occlusion's own edge, and the occlusion in one call ---
+
+
+@_njit
+def _row_min(x: np.ndarray, k: int, out: np.ndarray) -> None:
+    """``out`` (h, w): the least of ``x`` (h, w) over the ``2 k + 1`` pixels of its row about each pixel, +inf
+    outside the array (``ndimage.minimum_filter1d`` along the rows, ``mode="constant", cval=inf``; a least is exact in
+    any order), by van Herk's blocks: the least from each block's start and to each block's end."""
+    h, w = x.shape
+    size = 2 * k + 1
+    n = w + 2 * k  # the row padded by k on each side
+    fwd = np.empty(n)
+    bwd = np.empty(n)
+    for r in range(h):
+        for i in range(n):
+            c = i - k
+            v = x[r, c] if 0 <= c < w else np.inf
+            fwd[i] = v if i % size == 0 else min(fwd[i - 1], v)
+        for i in range(n - 1, -1, -1):
+            c = i - k
+            v = x[r, c] if 0 <= c < w else np.inf
+            bwd[i] = v if (i % size == size - 1 or i == n - 1) else min(bwd[i + 1], v)
+        for c in range(w):  # the padded window [c, c + 2k]: to its first block's end, from its last block's start
+            out[r, c] = min(bwd[c], fwd[c + size - 1])
+
+
+@_njit
+def own_edge(
+    hidden: np.ndarray,
+    own: np.ndarray,
+    own_z: np.ndarray,
+    depth: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    band: int,
+) -> int:  # fmt: skip
+    """:func:`symfruit.core.occlusion.own_edge` in one pass, ``hidden`` (h, w) bool cleared in place (the number of
+    pixels cleared returned): ``own`` (h, w) bool, ``own_z`` and ``depth`` (h, w) float, ``others`` (h, w) bool or
+    (0, 0) for none. The same steps over the own pixels' box grown by ``2 band + 1`` (its square filters by
+    :func:`_square_extreme`, the own depths' least by :func:`_row_min` then down the columns at the candidates alone),
+    and the band's run from the own pixels (``ndimage.binary_dilation`` of them by ``band`` steps of the 3 x 3 square
+    within the candidates and own pixels) a breadth-first walk from the candidates beside them, ``band`` steps deep:
+    the twin's pixels, bit for bit (issue 19, stop 41: the eight dilation passes and scipy's minimum filter were
+    most of the occlusion maps' time)."""
+    h, w = hidden.shape
+    if band <= 0:
+        return 0
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        for c in range(w):
+            if own[r, c]:
+                r0, r1 = min(r0, r), r + 1
+                c0, c1 = min(c0, c), max(c1, c + 1)
+    if r1 == 0:
+        return 0
+    g = 2 * band + 1
+    b0, b1, a0, a1 = max(r0 - g, 0), min(r1 + g, h), max(c0 - g, 0), min(c1 + g, w)
+    m, n = b1 - b0, a1 - a0
+    with_others = others.shape[0] > 0
+    mine = np.empty((m, n), np.bool_)
+    hid = np.empty((m, n), np.bool_)
+    for r in range(m):
+        for c in range(n):
+            mine[r, c] = own[b0 + r, a0 + c]
+            hid[r, c] = hidden[b0 + r, a0 + c]
+    near = np.empty((m, n), np.bool_)
+    _square_extreme(mine, band, False, near)
+    cand = np.empty((m, n), np.bool_)
+    any_cand = False
+    for r in range(m):
+        for c in range(n):
+            x = hid[r, c] and near[r, c] and not mine[r, c] and not (with_others and others[b0 + r, a0 + c])
+            cand[r, c] = x
+            any_cand |= x
+    if not any_cand:
+        return 0
+    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
+    free = np.empty((m, n), np.bool_)
+    past = np.empty((m, n), np.bool_)
+    for r in range(m):
+        for c in range(n):
+            free[r, c] = not hid[r, c] and not mine[r, c]
+            past[r, c] = hid[r, c] and not near[r, c]
+    ends = np.empty((m, n), np.bool_)
+    _square_extreme(free, band + 1, False, ends)
+    runs = np.empty((m, n), np.bool_)
+    _square_extreme(past, band, False, runs)
+    any_cand = False
+    for r in range(m):
+        for c in range(n):
+            x = cand[r, c] and ends[r, c] and not runs[r, c]
+            cand[r, c] = x
+            any_cand |= x
+    if not any_cand:
+        return 0
+    # not clearly nearer than the own depths within the band's square
+    zs = np.empty((m, n))
+    for r in range(m):
+        for c in range(n):
+            zs[r, c] = own_z[b0 + r, a0 + c]
+    rowmin = np.empty((m, n))
+    _row_min(zs, band, rowmin)
+    count = 0
+    for r in range(m):
+        for c in range(n):
+            if cand[r, c]:
+                z = np.inf
+                for rr in range(max(r - band, 0), min(r + band + 1, m)):
+                    z = min(z, rowmin[rr, c])
+                x = np.float64(depth[b0 + r, a0 + c]) >= z - tolerance  # NaN: not the fruit's
+                cand[r, c] = x
+                count += x
+    if count == 0:
+        return 0
+    # the band runs on from the fruit's own pixels: breadth first through the candidates, band steps at most
+    queue = np.empty(count, np.int64)
+    reached = np.zeros((m, n), np.bool_)
+    end = 0
+    for r in range(m):
+        for c in range(n):
+            if cand[r, c]:
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if 0 <= rr < m:
+                        for dc in range(-1, 2):
+                            cc = c + dc
+                            if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
+                                reached[r, c] = True
+                                queue[end] = r * n + c
+                                end += 1
+    start = 0
+    for _ in range(1, band):
+        stop = end
+        for i in range(start, stop):
+            r, c = queue[i] // n, queue[i] % n
+            for dr in range(-1, 2):
+                rr = r + dr
+                if 0 <= rr < m:
+                    for dc in range(-1, 2):
+                        cc = c + dc
+                        if 0 <= cc < n and cand[rr, cc] and not reached[rr, cc]:
+                            reached[rr, cc] = True
+                            queue[end] = rr * n + cc
+                            end += 1
+        start = stop
+        if start == end:
+            break
+    for i in range(end):
+        r, c = queue[i] // n, queue[i] % n
+        hidden[b0 + r, a0 + c] = False
+    return end
+
+
+@_njit
+def occlusion_edge(
+    uv: np.ndarray,
+    points: np.ndarray,
+    pad: int,
+    depth: np.ndarray,
+    mask: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+    band: int,
+) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`occlusion_at`, then the fruit's own depths over its window (:func:`own_depths`' map) and
+    :func:`own_edge` on the maps, in one call (issue 19, stop 41: three calls and the own depths' two boxed arrays
+    were a fifth of the compiled occlusion's time): ``(found, u0, v0, hidden, seen)``, :func:`symfruit.core.occlusion.
+    occlusion`'s maps bit for bit."""
+    found, u0, v0, hidden, seen = occlusion_at(uv, points, pad, depth, mask, others, tolerance, steps)
+    if not found or band <= 0:
+        return found, u0, v0, hidden, seen
+    h, w = hidden.shape
+    some = False
+    for r in range(h):
+        for c in range(w):
+            if hidden[r, c]:
+                some = True
+                break
+        if some:
+            break
+    if not some:
+        return found, u0, v0, hidden, seen
+    height, width = mask.shape
+    own_z = np.full((h, w), np.inf)
+    for i in range(uv.shape[0]):
+        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
+        if u >= 0 and u < width and v >= 0 and v < height:
+            r, c = int(v) - v0, int(u) - u0
+            z = points[i, 2]
+            if z < own_z[r, c]:
+                own_z[r, c] = z
+    own = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            own[r, c] = mask[v0 + r, u0 + c] or math.isfinite(own_z[r, c])
+    near = others[v0 : v0 + h, u0 : u0 + w] if others.shape[0] > 0 else np.zeros((0, 0), np.bool_)
+    own_edge(hidden, own, own_z, seen, near, tolerance, band)
+    return found, u0, v0, hidden, seen
+
+
+@_njit
+def monotone_at(
+    depth: np.ndarray, keep: np.ndarray, r0: int, c0: int, table: np.ndarray, reach: int, bins: int,
+    tolerance: float, out: np.ndarray,
+) -> int:  # fmt: skip
+    """:func:`ray_pixels` then :func:`monotone_table` in one call, the pixels' rows, columns and offsets never boxed
+    (issue 19, stop 41: four arrays a call, twice a fruit's surface): ``out`` (h, w) bool (all false on entry) gets
+    :func:`symfruit.core.surface.monotone_region`'s pixels, the same ones; the number of ``keep``'s pixels
+    returned."""
+    h, w = keep.shape
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += keep[r, c]
+    if n == 0:
+        return 0
+    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
+    sector, d2 = np.empty(n, np.int64), np.empty(n, np.int64)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if keep[r, c]:
+                a, b = np.int64(r - r0), np.int64(c - c0)
+                rows[i], cols[i] = r, c
+                sector[i] = np.int64(table[a + reach, b + reach])
+                d2[i] = a * a + b * b
+                i += 1
+    monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+    return n
+
+
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
 
 

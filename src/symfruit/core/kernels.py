@@ -38,7 +38,10 @@ pixels), :func:`symfruit.core.raster.outline_cone`, :func:`~symfruit.core.raster
 and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlusion.occlusion`
 (:func:`symfruit.core._jit.occlusion_at`), :func:`symfruit.core.surface.monotone_region`
 (:func:`symfruit.core._jit.monotone_table`) and :func:`symfruit.extract.cluster` (``_one_slab`` in
-:func:`symfruit.core._jit.clusters`)) then run their numpy twins, the code the kernels
+:func:`symfruit.core._jit.clusters`); stop 41's :func:`symfruit.core.occlusion.own_edge`
+(:func:`symfruit.core._jit.own_edge`, in :func:`symfruit.core._jit.occlusion_edge` with the maps) and
+:func:`~symfruit.core.surface.monotone_region` (:func:`symfruit.core._jit.monotone_at`)) then run their numpy
+twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'

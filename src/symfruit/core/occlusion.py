@@ -296,7 +296,9 @@ def occlusion(
     (:func:`symfruit.core._jit.occlusion_window`: the same maps; 2.0 against 3.0 ms; eighteenth round), and with the
     window and the fruit's own depths in the same kernel, the images read in place and the own depths kept over the
     points' pixels' box alone (:func:`symfruit.core._jit.occlusion_at`: the same maps; 1.98 against 3.48 ms for the
-    benchmark frame's 9 fruit, least of 40 passes of the recorded calls, on a loaded machine; twentieth round).
+    benchmark frame's 9 fruit, least of 40 passes of the recorded calls, on a loaded machine; twentieth round), and
+    with :func:`own_edge` on the maps in the same kernel (:func:`symfruit.core._jit.occlusion_edge`: the same maps;
+    the benchmark frame's occlusion stage 6.6 against 4.0 ms least thread CPU; issue 19, stop 41).
 
     Parameters
     ----------
@@ -353,16 +355,15 @@ def occlusion(
         # points' pixels' box, the window's maps in one kernel)
         image = depth if depth.dtype in (np.float32, np.float64) else np.asarray(depth, dtype=np.float64)
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
-        found, u0, v0, hidden, seen = jit.occlusion_at(uv, points, pad, image, mask, near_to, tolerance, _steps(reach))
+        # stop 41: own_edge on the maps in the same call (jit.occlusion_edge, the fruit's own depths over the window
+        # made there too)
+        found, u0, v0, hidden, seen = jit.occlusion_edge(uv, points, pad, image, mask, near_to, tolerance,
+                                                         _steps(reach), max(int(band), 0))  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
-        own_w = mask[v0 : v0 + h, u0 : u0 + w]
-        if band > 0 and hidden.any():  # own_edge needs the fruit's own depths over the window (the same window)
-            own_z = jit.own_depths(uv, points, camera.width, camera.height, pad)[5]
-            others_w = near_to[v0 : v0 + h, u0 : u0 + w] if others is not None else None
-            hidden = own_edge(hidden, own_w | np.isfinite(own_z), own_z, seen, others_w, tolerance, band)
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w.copy(), depth=seen)
+        own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=seen)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -424,10 +425,23 @@ def own_edge(
       front of it (a leaf 3 cm in front is).
 
     Numpy and the compiled square filter, over the box of the own pixels grown by ``2 band + 1``; a window with no
-    hidden pixel within ``band`` of the fruit returns ``hidden`` itself.
+    hidden pixel within ``band`` of the fruit returns ``hidden`` itself. Where numba is, in one compiled pass
+    (:func:`symfruit.core._jit.own_edge`: the same pixels, bit for bit; its eight dilation passes and scipy's minimum
+    filter were most of the occlusion maps' time; issue 19, stop 41), and :func:`occlusion` runs it in the same
+    kernel as the maps (:func:`symfruit.core._jit.occlusion_edge`).
     """
     if band <= 0 or not hidden.any():
         return hidden
+    shape = np.shape(hidden)
+    same = np.shape(own) == np.shape(own_z) == np.shape(depth) == shape
+    same = same and (others is None or np.shape(others) == shape)
+    if (jit := compiled()) is not None and same and len(shape) == 2:
+        out = np.array(hidden, dtype=bool, order="C")  # the compiled twin clears in place (the same pixels)
+        near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
+        z = np.asarray(own_z, dtype=np.float64)
+        found = jit.own_edge(out, np.asarray(own, dtype=bool), z, np.asarray(depth, dtype=np.float64), near_to,
+                             float(tolerance), int(band))  # fmt: skip
+        return out if found else hidden
     box = mask_box(own)
     if box is None:
         return hidden

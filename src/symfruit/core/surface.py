@@ -451,6 +451,14 @@ def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], 
     bins : int
     """
     jit = compiled() if isinstance(keep, np.ndarray) and keep.dtype == bool and keep.ndim == 2 else None
+    if jit is not None and np.isfinite(tolerance) and np.shape(depth) == keep.shape:
+        h, w = keep.shape
+        reach = max(abs(int(apex[0])), abs(h - 1 - int(apex[0])), abs(int(apex[1])), abs(w - 1 - int(apex[1])))
+        if (table := _sector_table(bins, reach)) is not None:  # the pixels, their sectors and the rays in one call
+            out = np.zeros(keep.shape, dtype=bool)  # (issue 19, stop 41: monotone_at, the same pixels)
+            jit.monotone_at(depth, keep, int(apex[0]), int(apex[1]), table, (table.shape[0] - 1) // 2, bins,
+                            float(tolerance), out)  # fmt: skip
+            return out
     if jit is not None:  # the pixels and their offsets in one pass (issue 19, nineteenth round: the same numbers)
         rows, cols, dy, dx = jit.ray_pixels(keep, int(apex[0]), int(apex[1]))
     else:
