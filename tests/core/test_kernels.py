@@ -3765,3 +3765,80 @@ def test_monotone_at_is_ray_pixels_then_the_table(seed, bins, tol):
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, surface.monotone_region, depth, keep, apex, tol, bins=bins)
     np.testing.assert_array_equal(fast, twin)
+
+
+# --- stop 41, speedcand41
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 20), st.booleans(), st.sampled_from(["any", "first", "last"]))
+def test_revolution_box_and_profile_are_the_twins(seed, bins, close, widest):
+    """:func:`symfruit.core.fits.box_and_profile` with the kernel and with its twin (:func:`closed_profile` and the
+    rings' box): the same profile and box bit for bit, on profiles with unseen (NaN) slices, fewer than two seen ones,
+    the widest slice first or last (closed by symmetry) or inside, axes along a coordinate axis (no spread there) and
+    tilted ones; and :func:`revolution_box` is its box."""
+    from symfruit.core.fits import Revolution, box_and_profile, revolution_box
+
+    rng = np.random.default_rng(seed)
+    direction = rng.normal(size=3) if rng.random() < 0.8 else np.eye(3)[int(rng.integers(3))] * rng.choice([-1, 1])
+    direction = direction / np.linalg.norm(direction)
+    edges = np.sort(rng.normal(0.0, 0.03, bins + 1))
+    radii = rng.uniform(0.001, 0.04, bins)
+    if widest == "first":
+        radii = np.sort(radii)[::-1].copy()
+    elif widest == "last":
+        radii = np.sort(radii)
+    radii[rng.random(bins) < 0.2] = np.nan
+    rev = Revolution(rng.normal(0.0, 0.05, 3) + [0, 0, 0.4], direction, edges, radii, 0.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, box_and_profile, rev, close=close)
+        box = _both(mp, revolution_box, rev, close=close)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype == np.float64 and a.shape == b.shape
+        assert np.array_equal(a.view(np.int64), b.view(np.int64))
+    for got, want in zip(box[0] + box[1], twin[:2] + twin[:2], strict=True):
+        assert np.array_equal(got.view(np.int64), want.view(np.int64))
+
+
+def test_a_solid_of_revolution_marches_the_profile_it_was_given():
+    """:class:`~symfruit.core.fits.RevolutionInside` given its :func:`closed_profile` (the candidates hand it the one
+    :func:`box_and_profile` made) marches the same rays to the same depths as one that works it out itself."""
+    from symfruit.core.fits import RevolutionInside, box_and_profile
+
+    rng = np.random.default_rng(3)
+    points = FRUITS["pear"](rng).sample(800, rng) + CENTRE
+    rev = fit_revolution_slices(points[points[:, 2] <= np.median(points[:, 2])])
+    _, _, t, r = box_and_profile(rev)
+    rays = np.column_stack([rng.uniform(-0.1, 0.1, (300, 2)), np.ones(300)])
+    given_, own = RevolutionInside(rev, profile=(t, r)), RevolutionInside(rev)
+    for a, b in zip(given_.march(rays, 0.3, 0.6, 24), own.march(rays, 0.3, 0.6, 24), strict=True):
+        assert np.array_equal(a, b, equal_nan=a.dtype.kind == "f")
+
+
+@pytest.mark.parametrize("with_extent", [False, True])
+def test_candidates_constrain_their_boxes_as_constrain_box_does(monkeypatch, with_extent):
+    """The candidates' boxes by the kernel called straight (:func:`symfruit.core.candidates._constrainer`) are
+    :func:`~symfruit.core.candidates.constrain_box`'s, bit for bit, with and without the kernels, for boxes of every
+    kind (float64 or not, the silhouette's cone from the seen points or from where the fruit can project)."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.candidates import _constrainer, constrain_box
+
+    cam = Camera(fx=600.0, fy=610.0, cx=319.5, cy=241.0, width=640, height=480)
+    rng = np.random.default_rng(7)
+    seen_lo = rng.normal(0, 0.03, 3) + [0, 0, 0.35]
+    seen_hi = seen_lo + rng.uniform(0.0, 0.05, 3)
+    cone = ((100.0, 120.5, 180.0, 210.0) if with_extent else (90.5, 99.5, 170.5, 201.5), cam)
+    pull = 1.0 if with_extent else None
+    for kernels_on in (True, False):
+        if not kernels_on:
+            monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+        for contour in (0.2, 0.7, 1.0):
+            constrain = _constrainer(seen_lo, seen_hi, 0.349, cone, contour, pull)
+            for _ in range(20):
+                lo, hi = seen_lo + rng.normal(0, 0.02, 3), seen_hi + rng.normal(0, 0.02, 3)
+                if rng.random() < 0.2:
+                    lo, hi = lo.astype(np.float32), hi.astype(np.float32)
+                got = constrain(lo, hi)
+                want = constrain_box(lo, hi, seen_lo, seen_hi, 0.349, cone=cone, contour=contour, pull=pull)
+                for a, b in zip(got, want, strict=True):
+                    assert np.array_equal(a.view(np.int64), b.view(np.int64))

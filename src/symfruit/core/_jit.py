@@ -2906,6 +2906,98 @@ def scaled_cloud(p: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarr
     return mean, scale, q, a, b, d
 
 
+# --- issue 19, stop 41 (speedcand41): the candidates ---
+
+
+@_njit
+def _least_nan(x: np.ndarray) -> float:
+    """``x.min()`` of a non-empty array: NaN where any value is."""
+    m = x[0]
+    for i in range(1, x.shape[0]):
+        v = x[i]
+        if m == m and (v < m or v != v):
+            m = v
+    return m
+
+
+@_njit
+def _greatest_nan(x: np.ndarray) -> float:
+    """``x.max()`` of a non-empty array: NaN where any value is."""
+    m = x[0]
+    for i in range(1, x.shape[0]):
+        v = x[i]
+        if m == m and (v > m or v != v):
+            m = v
+    return m
+
+
+@_njit
+def revolution_box(
+    point: np.ndarray, direction: np.ndarray, edges: np.ndarray, radii: np.ndarray, close: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits.revolution_box` and the profile it is the box of in one call (issue 19, stop 41):
+    ``(lo (3,), hi (3,), t (m,), r (m,))``, :func:`~symfruit.core.fits.closed_profile`'s ``t`` and ``r`` and
+    :func:`~symfruit.core.fits._rings_box`'s box of their rings, each value the twin's (element by element the same
+    operations; the boxes' least and greatest values, NaN where any is)."""
+    b = radii.shape[0]
+    mid = np.empty(b)
+    count = 0
+    for j in range(b):
+        mid[j] = 0.5 * (edges[j] + edges[j + 1])
+        count += math.isfinite(radii[j])
+    t = np.empty(count)
+    r = np.empty(count)
+    k = 0
+    for j in range(b):
+        if math.isfinite(radii[j]):
+            t[k], r[k] = mid[j], radii[j]
+            k += 1
+    if count < 2:
+        t = np.empty(2)
+        t[0], t[1] = edges[0], edges[b]
+        r = np.zeros(2)
+    else:
+        widest = 0
+        for j in range(1, count):  # np.argmax: the first greatest (every radius here is finite)
+            if r[j] > r[widest]:
+                widest = j
+        if close and widest == count - 1:
+            t2, r2 = np.empty(2 * count - 1), np.empty(2 * count - 1)
+            last = t[count - 1]
+            for j in range(count):
+                t2[j], r2[j] = t[j], r[j]
+            for j in range(count - 1):  # 2 t[-1] - t[:-1][::-1]
+                t2[count + j] = 2 * last - t[count - 2 - j]
+                r2[count + j] = r[count - 2 - j]
+            t, r = t2, r2
+        elif close and widest == 0:
+            t2, r2 = np.empty(2 * count - 1), np.empty(2 * count - 1)
+            first = t[0]
+            for j in range(count - 1):  # 2 t[0] - t[1:][::-1]
+                t2[j] = 2 * first - t[count - 1 - j]
+                r2[j] = r[count - 1 - j]
+            for j in range(count):
+                t2[count - 1 + j], r2[count - 1 + j] = t[j], r[j]
+            t, r = t2, r2
+    m = t.shape[0]
+    lo = np.empty(3)
+    hi = np.empty(3)
+    low = np.empty(m)
+    high = np.empty(m)
+    for c in range(3):
+        d = direction[c]
+        spread = 1.0 - d * d  # direction**2
+        spread = math.sqrt(spread if spread > 0.0 or spread != spread else 0.0)  # np.clip(..., 0.0, None)
+        for j in range(m):
+            centre = point[c] + t[j] * d
+            reach = r[j] * spread
+            low[j] = centre - reach
+            high[j] = centre + reach
+        lo[c] = _least_nan(low)
+        hi[c] = _greatest_nan(high)
+    return lo, hi, t, r
+
+
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------
 
 

@@ -40,13 +40,13 @@ from .camera import Camera
 from .fits import (
     RevolutionInside,
     ScaledCloud,
+    box_and_profile,
     ellipsoid_half_extents,
     fit_cone_ellipsoid,
     fit_ellipsoid,
     fit_revolution_slices,
     fit_sphere,
     outline_radii,
-    revolution_box,
     scaled_cloud,
 )
 from .kernels import compiled
@@ -271,6 +271,7 @@ def candidates(
         cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
     fit = _Fitting(sample, obs, camera, front, extent, region, outline_profile, revolution_points,
                    revolution_coarse)  # fmt: skip
+    constrain = _constrainer(seen_lo, seen_hi, front, cone, obs.contour, pull)
     out: list[Candidate] = []
     for name, (fitter, failures) in _FITTERS.items():
         if name not in shapes or _explained(out, explained):
@@ -286,7 +287,7 @@ def candidates(
                                                             lateral=obs.extent is None, width=width):  # fmt: skip
                     continue
                 ev = explain(shape.inside, (lo, hi), obs, steps=steps)
-                box = constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=obs.contour, pull=pull)
+                box = constrain(lo, hi)
                 out.append(Candidate(shape.name, *box, ev, np.asarray(shape.centre, dtype=np.float64),
                                      shape.back_std))  # fmt: skip
         except failures:
@@ -295,13 +296,44 @@ def candidates(
     if mirror is not None:
         mirrored = complete_by_symmetry(sample, camera, **mirror, view=view)
         back = mirrored.points[len(sample) :]
-        lo, hi = constrain_box(back.min(axis=0), back.max(axis=0), seen_lo, seen_hi, front, cone=cone,
-                               contour=obs.contour, pull=pull)  # fmt: skip
+        lo, hi = constrain(back.min(axis=0), back.max(axis=0))
         out.append(Candidate("mirror", lo, hi, None, 0.5 * (lo + hi)))
 
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
     out.append(Candidate("raw", lo, hi, None, 0.5 * (lo + hi)))
     return out
+
+
+def _constrainer(
+    seen_lo: np.ndarray, seen_hi: np.ndarray, front: float, cone: tuple[tuple[float, float, float, float], Camera],
+    contour: float, pull: float | None,
+) -> Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]:  # fmt: skip
+    """``constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=contour, pull=pull)`` as a function of
+    ``lo, hi``: with the kernels, their arguments but the box made once per view and the kernel called straight for
+    each candidate's float64 (3,) box (the same call as :func:`constrain_box`'s, without its checks and conversions
+    each time; issue 19, stop 41), else :func:`constrain_box` itself."""
+    jit = compiled()
+    seen = np.asarray(seen_lo), np.asarray(seen_hi)
+    if jit is None or not all(x.dtype == np.float64 and x.shape == (3,) for x in seen):
+
+        def twin(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+            return constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=contour, pull=pull)
+
+        return twin
+    (u_lo, v_lo, u_hi, v_hi), camera = cone
+    box = np.array((u_lo, v_lo, u_hi, v_hi), dtype=np.float64)
+    intrinsics = np.array((camera.cx, camera.cy, camera.fx, camera.fy), dtype=np.float64)
+    args = (seen[0], seen[1], float(front), REACH / max(contour, REACH_FLOOR), box, intrinsics,
+            float(contour if pull is None else pull))  # fmt: skip
+    kernel = jit.constrain_box
+
+    def fast(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        if lo.dtype == np.float64 and hi.dtype == np.float64 and lo.shape == hi.shape == (3,):
+            out = kernel(lo, hi, *args)
+            return out[0], out[1]
+        return constrain_box(lo, hi, seen_lo, seen_hi, front, cone=cone, contour=contour, pull=pull)
+
+    return fast
 
 
 def _explained(out: list[Candidate], explained: float | None) -> bool:
@@ -385,10 +417,11 @@ def _revolution(fit: _Fitting) -> Iterator[_Shape]:
         if fit.outline_profile == "replace":
             rev = shaped
         else:
-            olo, ohi = revolution_box(shaped)
-            yield _Shape("outline", olo, ohi, RevolutionInside(shaped), 0.5 * (olo + ohi))
-    lo, hi = revolution_box(rev)
-    yield _Shape("revolution", lo, hi, RevolutionInside(rev), 0.5 * (lo + hi))
+            olo, ohi, *profile = box_and_profile(shaped)
+            yield _Shape("outline", olo, ohi, RevolutionInside(shaped, profile=(profile[0], profile[1])),
+                         0.5 * (olo + ohi))  # fmt: skip
+    lo, hi, t, r = box_and_profile(rev)  # the box and the profile its march reads, in one call (issue 19, stop 41)
+    yield _Shape("revolution", lo, hi, RevolutionInside(rev, profile=(t, r)), 0.5 * (lo + hi))
 
 
 _Fitter = Callable[[_Fitting], Iterator[_Shape]]

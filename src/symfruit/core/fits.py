@@ -31,6 +31,7 @@ __all__ = [
     "Revolution",
     "RevolutionInside",
     "ScaledCloud",
+    "box_and_profile",
     "closed_profile",
     "cone_ellipsoid",
     "cone_thickness_bound",
@@ -835,8 +836,25 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
 
 def revolution_box(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray]:
     """Axis-aligned box ``(min (3,), max (3,))``, metres, of a fitted solid (see :func:`closed_profile`)."""
+    lo, hi, _, _ = box_and_profile(rev, close=close)
+    return lo, hi
+
+
+def box_and_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`revolution_box` and the :func:`closed_profile` it is the box of: ``(lo (3,), hi (3,), t (m,), r (m,))``;
+    by the compiled twin :func:`symfruit.core._jit.revolution_box` where numba is installed (one call for some 15
+    numpy calls, each value theirs; issue 19, stop 41). The profile is handed to :class:`RevolutionInside`, whose
+    march needs it again."""
+    jit = compiled()
+    if jit is not None and rev.edges.shape == (len(rev.radii) + 1,) and rev.radii.ndim == 1 and len(rev.radii):
+        lo, hi, t, r = jit.revolution_box(
+            np.ascontiguousarray(rev.point, dtype=np.float64), np.ascontiguousarray(rev.direction, dtype=np.float64),
+            np.ascontiguousarray(rev.edges, dtype=np.float64), np.ascontiguousarray(rev.radii, dtype=np.float64),
+            bool(close),
+        )  # fmt: skip
+        return lo, hi, t, r
     t, r = closed_profile(rev, close=close)
-    return _rings_box(rev.point, rev.direction, t, r)
+    return (*_rings_box(rev.point, rev.direction, t, r), t, r)
 
 
 def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> np.ndarray:
@@ -870,6 +888,8 @@ class RevolutionInside:
 
     rev: Revolution
     close: bool = True
+    #: :func:`closed_profile` ``(t, r)`` of ``rev`` with ``close``, where the caller has it (:func:`box_and_profile`)
+    profile: tuple[np.ndarray, np.ndarray] | None = None
 
     def __call__(self, x: np.ndarray) -> np.ndarray:
         return revolution_inside(self.rev, x, close=self.close)
@@ -880,7 +900,7 @@ class RevolutionInside:
         jit = compiled()
         if jit is None:
             return None
-        t, r = closed_profile(self.rev, close=self.close)
+        t, r = closed_profile(self.rev, close=self.close) if self.profile is None else self.profile
         return jit.revolution_march(
             np.ascontiguousarray(self.rev.point, dtype=np.float64), np.ascontiguousarray(self.rev.direction,
             dtype=np.float64), np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(r, dtype=np.float64),
