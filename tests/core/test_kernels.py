@@ -3501,3 +3501,63 @@ def test_the_segmenters_split_up_to_its_centres_is_the_twins(seed, sigma, holes)
     with pytest.MonkeyPatch.context() as mp:
         fast, twin_parts = _both(mp, colour._split, region, depth, s, geo, (3, 5), 50.0)
     assert len(fast) == len(twin_parts) and all(np.array_equal(a, b) for a, b in zip(fast, twin_parts, strict=True))
+
+
+# --- stop 41, speedseg41
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_red_regions_in_one_pass_are_the_twins_and_the_former_kernels(seed, window):
+    """Red blobs, rings, combs and U shapes (regions whose provisional labels join late, from the right above) over
+    random colours and weak specks, whole or a strided window: :func:`_jit.red_regions_once` gives the former kernel's
+    values (values and types) and the numpy twin's (``_red_regions`` with ``SYMFRUIT_KERNELS=numpy``)."""
+    from symfruit.segment.colour import SegmentSettings, _red_regions, _red_tables
+
+    rng = np.random.default_rng(100 + seed)
+    h, w = 120, 150
+    image = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    image[rng.random((h, w)) < 0.05] = (200, 40, 30)  # specks, some seeded
+    yy, xx = np.mgrid[:h, :w]
+    for _ in range(5):
+        cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(4, 25)
+        d = (yy - cy) ** 2 + (xx - cx) ** 2
+        shape = d <= r * r if rng.random() < 0.5 else (d <= r * r) & (d >= (0.6 * r) ** 2)  # discs and rings
+        image[shape] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), int(rng.integers(0, 90)))
+    image[60:62, 10:70] = (190, 30, 30)  # a comb: teeth joined by a bar below them
+    image[40:62, 10:70:6] = (190, 30, 30)
+    image[20:50, 100] = image[20:50, 130] = (150, 80, 60)  # a U: two arms meeting at the bottom
+    image[50, 100:131] = (150, 80, 60)
+    c = image[3:117, 2:149:2] if window else image
+    s = SegmentSettings()
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    args = (low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
+    once, former = _jit.red_regions_once(c, *args), _jit.red_regions(c, *args)
+    assert int(once[2]) == int(former[2]) > 10 and once[6].sum() >= 2
+    for a, b in zip(once, former, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _red_regions, c, s)
+    for a, b in zip(fast, twin, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+        else:
+            assert a == b
+
+
+def test_the_red_regions_in_one_pass_without_red():
+    """A window without a weak pixel: no labels, an empty list of pixels, the background's size alone."""
+    from symfruit.segment.colour import SegmentSettings, _red_tables
+
+    s = SegmentSettings()
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    c = np.zeros((7, 9, 3), np.uint8)
+    c[..., 1] = 200
+    mask, labels, n, weak, strong, lab, seeded, sizes, rows, cols = _jit.red_regions_once(
+        c, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
+    )
+    assert n == 0 and not mask.any() and not labels.any() and len(weak) == len(strong) == len(lab) == 0
+    assert sizes.tolist() == [0] and seeded.tolist() == [False] and len(rows) == len(cols) == 0
