@@ -3561,3 +3561,35 @@ def test_the_red_regions_in_one_pass_without_red():
     )
     assert n == 0 and not mask.any() and not labels.any() and len(weak) == len(strong) == len(lab) == 0
     assert sizes.tolist() == [0] and seeded.tolist() == [False] and len(rows) == len(cols) == 0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_found_fruits_claim_is_the_twins(seed):
+    """Hulls over a label window partly taken (by a larger fruit, -1, or by numbers), strided as ``out[sl]`` is, some
+    mostly inside what is taken, one empty: the same answer, the same pixels set to -1 in the window, the same box
+    as :func:`symfruit.core.raster.mask_box` of the freed pixels, with the kernel and with the twin."""
+    from symfruit.segment.colour import _claim
+
+    rng = np.random.default_rng(200 + seed)
+    image = np.zeros((80, 90), np.int32)
+    image[rng.random((80, 90)) < 0.1] = -1
+    image[10:40, 20:60] = 3  # a larger fruit over most of the window's upper left
+    hulls = [rng.random((50, 60)) < p for p in (0.0, 0.3, 0.9)]
+    yy, xx = np.mgrid[:50, :60]
+    hulls.append((yy - 25) ** 2 + (xx - 30) ** 2 <= 20**2)
+    answers = []
+    for hull in hulls:
+        got = []
+        for env in ("", "numpy"):
+            with pytest.MonkeyPatch.context() as mp:
+                mp.setenv("SYMFRUIT_KERNELS", env)
+                out = image.copy()
+                claimed = _claim(out[5:55, 12:72], hull)
+                got.append((out, claimed))
+        (out_a, a), (out_b, b) = got
+        np.testing.assert_array_equal(out_a, out_b)
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert a[0].dtype == b[0].dtype and np.array_equal(a[0], b[0]) and a[1] == b[1]
+        answers.append(a is not None)
+    assert answers == [True, True, True, False]  # the disc lies mostly under the larger fruit

@@ -5838,3 +5838,35 @@ def red_regions_once(
         seeded[out[strong_at[i] // w, strong_at[i] % w]] = True
     seeded[0] = False
     return mask, out, m, weak_at, strong_at, lab, seeded, sizes, rows, cols
+
+
+@_njit
+def claim(out: np.ndarray, hull: np.ndarray) -> tuple[np.ndarray, int, int, int, int]:
+    """:func:`symfruit.segment.colour._claim`: a found fruit's ``hull`` (h, w) bool takes the pixels of ``out`` (h, w)
+    ints, its window of the image's labels, that are still 0, unless those are fewer than half its pixels (the
+    twin's float comparison of the counts): then they are set to -1 and returned with their box ``(row_start,
+    row_stop, col_start, col_stop)``, else a (0, 0) array and zeros. The twin's pixels, in one pass over the window
+    and one over the hull's, not five numpy passes and a box's two reductions (issue 19, stop 41)."""
+    h, w = hull.shape
+    n_hull = 0
+    n_free = 0
+    for r in range(h):
+        for c in range(w):
+            if hull[r, c]:
+                n_hull += 1
+                if out[r, c] == 0:
+                    n_free += 1
+    if n_free < 0.5 * n_hull:
+        return np.zeros((0, 0), np.bool_), 0, 0, 0, 0
+    free = np.zeros((h, w), np.bool_)
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        for c in range(w):
+            if hull[r, c] and out[r, c] == 0:
+                free[r, c] = True
+                out[r, c] = -1
+                r0, r1 = min(r0, r), max(r1, r + 1)
+                c0, c1 = min(c0, c), max(c1, c + 1)
+    if r1 == 0:
+        r0 = c0 = 0
+    return free, r0, r1, c0, c1
