@@ -3842,3 +3842,95 @@ def test_candidates_constrain_their_boxes_as_constrain_box_does(monkeypatch, wit
                 want = constrain_box(lo, hi, seen_lo, seen_hi, 0.349, cone=cone, contour=contour, pull=pull)
                 for a, b in zip(got, want, strict=True):
                     assert np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+# --- stop 41, speedseg41
+
+
+@pytest.mark.parametrize("seed", range(6))
+@pytest.mark.parametrize("window", [False, True])
+def test_the_red_regions_in_one_pass_are_the_twins_and_the_former_kernels(seed, window):
+    """Red blobs, rings, combs and U shapes (regions whose provisional labels join late, from the right above) over
+    random colours and weak specks, whole or a strided window: :func:`_jit.red_regions_once` gives the former kernel's
+    values (values and types) and the numpy twin's (``_red_regions`` with ``SYMFRUIT_KERNELS=numpy``)."""
+    from symfruit.segment.colour import SegmentSettings, _red_regions, _red_tables
+
+    rng = np.random.default_rng(100 + seed)
+    h, w = 120, 150
+    image = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    image[rng.random((h, w)) < 0.05] = (200, 40, 30)  # specks, some seeded
+    yy, xx = np.mgrid[:h, :w]
+    for _ in range(5):
+        cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(4, 25)
+        d = (yy - cy) ** 2 + (xx - cx) ** 2
+        shape = d <= r * r if rng.random() < 0.5 else (d <= r * r) & (d >= (0.6 * r) ** 2)  # discs and rings
+        image[shape] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), int(rng.integers(0, 90)))
+    image[60:62, 10:70] = (190, 30, 30)  # a comb: teeth joined by a bar below them
+    image[40:62, 10:70:6] = (190, 30, 30)
+    image[20:50, 100] = image[20:50, 130] = (150, 80, 60)  # a U: two arms meeting at the bottom
+    image[50, 100:131] = (150, 80, 60)
+    c = image[3:117, 2:149:2] if window else image
+    s = SegmentSettings()
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    args = (low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
+    once, former = _jit.red_regions_once(c, *args), _jit.red_regions(c, *args)
+    assert int(once[2]) == int(former[2]) > 10 and once[6].sum() >= 2
+    for a, b in zip(once, former, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _red_regions, c, s)
+    for a, b in zip(fast, twin, strict=True):
+        if isinstance(a, np.ndarray):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+        else:
+            assert a == b
+
+
+def test_the_red_regions_in_one_pass_without_red():
+    """A window without a weak pixel: no labels, an empty list of pixels, the background's size alone."""
+    from symfruit.segment.colour import SegmentSettings, _red_tables
+
+    s = SegmentSettings()
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    c = np.zeros((7, 9, 3), np.uint8)
+    c[..., 1] = 200
+    mask, labels, n, weak, strong, lab, seeded, sizes, rows, cols = _jit.red_regions_once(
+        c, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
+    )
+    assert n == 0 and not mask.any() and not labels.any() and len(weak) == len(strong) == len(lab) == 0
+    assert sizes.tolist() == [0] and seeded.tolist() == [False] and len(rows) == len(cols) == 0
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_a_found_fruits_claim_is_the_twins(seed):
+    """Hulls over a label window partly taken (by a larger fruit, -1, or by numbers), strided as ``out[sl]`` is, some
+    mostly inside what is taken, one empty: the same answer, the same pixels set to -1 in the window, the same box
+    as :func:`symfruit.core.raster.mask_box` of the freed pixels, with the kernel and with the twin."""
+    from symfruit.segment.colour import _claim
+
+    rng = np.random.default_rng(200 + seed)
+    image = np.zeros((80, 90), np.int32)
+    image[rng.random((80, 90)) < 0.1] = -1
+    image[10:40, 20:60] = 3  # a larger fruit over most of the window's upper left
+    hulls = [rng.random((50, 60)) < p for p in (0.0, 0.3, 0.9)]
+    yy, xx = np.mgrid[:50, :60]
+    hulls.append((yy - 25) ** 2 + (xx - 30) ** 2 <= 20**2)
+    answers = []
+    for hull in hulls:
+        got = []
+        for env in ("", "numpy"):
+            with pytest.MonkeyPatch.context() as mp:
+                mp.setenv("SYMFRUIT_KERNELS", env)
+                out = image.copy()
+                claimed = _claim(out[5:55, 12:72], hull)
+                got.append((out, claimed))
+        (out_a, a), (out_b, b) = got
+        np.testing.assert_array_equal(out_a, out_b)
+        assert (a is None) == (b is None)
+        if a is not None:
+            assert a[0].dtype == b[0].dtype and np.array_equal(a[0], b[0]) and a[1] == b[1]
+        answers.append(a is not None)
+    assert answers == [True, True, True, False]  # the disc lies mostly under the larger fruit

@@ -1266,3 +1266,26 @@ def test_a_filled_polygon_is_pillows_image_as_bool():
         want = np.asarray(img, dtype=bool)
         got = _fill_polygon(v, (h, w))
         assert got.shape == want.shape and got.dtype == want.dtype and np.array_equal(got, want)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
+    """The pairs of near pieces read off the table by one ``np.nonzero`` (stop 41) are the row-by-row test's, in
+    its order (each piece's later neighbours ascending), for clusters of boxes of many sizes, touching, overlapping
+    and apart; some pieces have no neighbour."""
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    pieces = []
+    for _ in range(40):
+        r0, c0 = int(rng.integers(0, 300)), int(rng.integers(0, 300))
+        h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+        mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
+        mask[0, 0] = True
+        pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), mask, 1))
+    table = colour._near_pieces(pieces)
+    monkeypatch.setattr(colour, "NEAR_TABLE", 0)
+    rows = colour._near_pieces(pieces)
+    found = [table(i) for i in range(len(pieces))]
+    assert found == [rows(i) for i in range(len(pieces))]
+    assert sum(map(len, found)) >= 10 and any(not f for f in found)

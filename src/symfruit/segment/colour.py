@@ -595,7 +595,7 @@ def _segment_at(
         body_map[body.window][body.mask] = i  # type: ignore[index]
     taken = np.zeros(len(bodies) + 1, bool)
     out = np.zeros((h, w), np.int32)
-    found: list[tuple[Window, np.ndarray]] = []
+    found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]] = []
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         red = part & weak[sl]
@@ -616,28 +616,41 @@ def _segment_at(
             continue
         if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
             continue
-        free = hull & (out[sl] == 0)
-        if free.sum() < 0.5 * hull.sum():  # mostly inside a larger fruit: a piece of it, not a fruit
+        claimed = _claim(out[sl], hull)
+        if claimed is None:  # mostly inside a larger fruit: a piece of it, not a fruit
             continue
-        out[sl][free] = -1
-        found.append((sl, free))
+        found.append((sl, *claimed))
     for i, body in enumerate(bodies, 1):  # the rest: fruit with no red to seed them
         if taken[i] or z is None:
             continue
         sl, hull = _round_skin(body.window, body.mask, z, c, geo, s, owner, -1)
         if not _fruit_sized(hull, z[sl], s, geo.focal, min_area, z_typical):
             continue
-        free = hull & (out[sl] == 0)
-        if free.sum() < 0.5 * hull.sum():
+        claimed = _claim(out[sl], hull)
+        if claimed is None:
             continue
-        out[sl][free] = -1
-        found.append((sl, free))
+        found.append((sl, *claimed))
     # number the fruit left to right (then top to bottom) by their box centres, for stable ids
-    order = sorted(range(len(found)), key=lambda i: _box_centre(*found[i]))
+    order = sorted(range(len(found)), key=lambda i: _box_centre(found[i][0], found[i][2]))
     for new, i in enumerate(order, 1):
-        sl, free = found[i]
+        sl, free, _ = found[i]
         out[sl][free] = new
     return out
+
+
+def _claim(out: np.ndarray, hull: np.ndarray) -> tuple[np.ndarray, tuple[int, int, int, int]] | None:
+    """A found fruit's ``hull`` takes the pixels of ``out`` (its window of the image's labels) that are still 0,
+    unless those are fewer than half its pixels (mostly inside a larger fruit: a piece of it, not a fruit; None):
+    they are set to -1 and returned, with their box (:func:`symfruit.core.raster.mask_box`, for the numbering).
+    Where numba is, its compiled twin does the same in one call (:func:`symfruit.core._jit.claim`; stop 41)."""
+    if (jit := compiled()) is not None and hull.dtype == bool and hull.ndim == 2:
+        free, r0, r1, c0, c1 = jit.claim(out, hull)
+        return None if free.shape != hull.shape else (free, (int(r0), int(r1), int(c0), int(c1)))
+    free = hull & (out == 0)
+    if free.sum() < 0.5 * hull.sum():
+        return None
+    out[free] = -1
+    return free, mask_box(free) or (0, 0, 0, 0)
 
 
 def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
@@ -659,10 +672,11 @@ def _red_regions(
     n, the weak pixels' labels (in raster order), which regions hold a strong pixel, each one's size ((n + 1,), the
     background's 0 and unseeded), the weak pixels' rows and columns; None without a weak pixel. Where numba is, its
     compiled twin gives the same (:func:`symfruit.core._jit.red_regions`: one call, not a dozen numpy ones on each of
-    a frame's windows; issue 19, seventeenth round)."""
+    a frame's windows; issue 19, seventeenth round; since stop 41 :func:`symfruit.core._jit.red_regions_once`, the
+    tests and the labelling in one pass, the labels numbered over the weak pixels alone)."""
     if (jit := compiled()) is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3:
         low, high = _red_tables(s.red_low, s.red_high, s.dark)
-        weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions(
+        weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions_once(
             cw, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
         )
         return None if len(weak_at) == 0 else (weak_w, labels, int(n), lab, seeded, sizes, rows, cols)
@@ -774,8 +788,10 @@ def _join_boxes(boxes: list[tuple[int, int, int, int]]) -> list[tuple[int, int, 
     return boxes
 
 
-def _box_centre(sl: Window, mask: np.ndarray) -> tuple[int, float]:
-    r0, r1, c0, c1 = mask_box(mask) or (0, 0, 0, 0)  # a found piece is never empty
+def _box_centre(sl: Window, box: tuple[int, int, int, int]) -> tuple[int, float]:
+    """A found fruit's sort key (left to right in columns of 20 pixels, then top to bottom) from its box in ``sl``
+    (:func:`_claim`'s; a found piece is never empty)."""
+    r0, r1, c0, c1 = box
     x = sl[1].start + (c0 + c1) / 2
     y = sl[0].start + (r0 + r1) / 2
     return round(x / 20), y
@@ -1004,7 +1020,12 @@ def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
         a, b = box[:, None, :], box[None, :, :]
         table = ((a[..., 0] - gap < b[..., 1]) & (b[..., 0] - gap < a[..., 1])
                  & (a[..., 2] - gap < b[..., 3]) & (b[..., 2] - gap < a[..., 3]))  # fmt: skip
-        rows = [np.flatnonzero(row).tolist() for row in np.triu(table, 1)]
+        # the pairs by one nonzero of the table (row-major: each row's columns ascending, as a row's flatnonzero gives
+        # them), not one call a row (stop 41)
+        rows: list[list[int]] = [[] for _ in range(len(pieces))]
+        first, second = np.nonzero(np.triu(table, 1))
+        for i, j in zip(first.tolist(), second.tolist(), strict=True):
+            rows[i].append(j)
         return rows.__getitem__
 
     def near(i: int) -> list[int]:
