@@ -8,7 +8,14 @@ import pytest
 
 from symfruit import Camera
 from symfruit.synthetic.render import render
-from symfruit.synthetic.sensors import SENSOR_MODELS, SensorModel, annotate, apply_sensor, sensor_model
+from symfruit.synthetic.sensors import (
+    SENSOR_MODELS,
+    SensorModel,
+    annotate,
+    apply_sensor,
+    correlated_noise,
+    sensor_model,
+)
 
 from ..conftest import ball_mesh
 
@@ -125,7 +132,9 @@ def test_registration_shift_moves_depth_against_the_masks():
 
 @pytest.mark.parametrize("name", ["realsense-d435", "azure-kinect"])
 def test_noise_and_bias_grow_with_distance_as_the_model_says(name):
-    model = replace(SENSOR_MODELS[name], lateral_px=0.0, dropout=0.0, registration_px=0.0, colour_baseline=0.0)
+    # Independent noise here (noise_corr_px 0): the bias's tolerance counts every depth pixel as one draw.
+    model = replace(SENSOR_MODELS[name], lateral_px=0.0, dropout=0.0, registration_px=0.0, colour_baseline=0.0,
+                    noise_corr_px=0.0)  # fmt: skip
     cam = window(model)
     plane = np.array([[-2.0, -2.0, 0.0], [2.0, -2.0, 0.0], [2.0, 2.0, 0.0], [-2.0, 2.0, 0.0]])
     measured = {}
@@ -272,3 +281,68 @@ def test_lateral_jitter_is_in_the_registered_depth():
         np.floor(v / ratio) == np.floor(np.arange(SIDE)[:, None] / ratio)
     )
     assert not changed[same_cell].any()
+
+
+def _acf_length(field: np.ndarray, lags=range(1, 25)) -> float:
+    """The lag (pixels, linear between lags) where the autocorrelation along rows and columns falls below 1/e."""
+    prev = 1.0
+    f = field - field.mean()
+    for lag in lags:
+        r = float(((f[:, :-lag] * f[:, lag:]).mean() + (f[:-lag] * f[lag:]).mean()) / 2 / f.var())
+        if r < 1 / np.e:
+            return lag - 1 + (prev - 1 / np.e) / (prev - r)
+        prev = r
+    return float(lags[-1])
+
+
+@pytest.mark.parametrize("length", [1.5, 3.5, 6.0])
+def test_correlated_noise_has_its_length_and_unit_spread(length):
+    """White draws filtered by correlated_noise: unit standard deviation, the autocorrelation exp(-(lag/L)^2) (1/e at
+    L, 0.78 at L/2), the same field for the same draws; length 0 hands the draws back untouched."""
+    white = np.random.default_rng(5).normal(size=(400, 400))
+    field = correlated_noise(white, length)
+    assert field.std() == pytest.approx(1.0, abs=0.06)
+    assert _acf_length(field) == pytest.approx(length, rel=0.08)
+    half = max(1, round(length / 2))
+    r = float((field[:, :-half] * field[:, half:]).mean() / field.var())
+    assert r == pytest.approx(np.exp(-((half / length) ** 2)), abs=0.05)
+    assert np.array_equal(field, correlated_noise(white.copy(), length))
+    assert correlated_noise(white, 0.0) is white
+
+
+def test_correlated_depth_noise_on_a_flat_plane_matches_the_model():
+    """The Azure Kinect model with only its noise on: on a fronto-parallel plane at 1 m the depth pixels spread by
+    sigma(1 m) and the noise falls to 1/e at noise_corr_px depth pixels; the same seed gives the same frame, and
+    noise_corr_px = 0 gives independent pixels of the same spread (the draws themselves unchanged)."""
+    base = replace(SENSOR_MODELS["azure-kinect"], **{**QUIET, "sigma_const": 0.002, "sigma_linear": 0.0})
+    assert SENSOR_MODELS["azure-kinect"].noise_corr_px == 3.5
+    cam = Camera(fx=base.camera().fx, fy=base.camera().fx, cx=300.0, cy=300.0, width=600, height=600)
+    plane = np.array([[-2.0, -2.0, 1.0], [2.0, -2.0, 1.0], [2.0, 2.0, 1.0], [-2.0, 2.0, 1.0]])
+    shot = render([(plane, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+    ratio = base.footprint
+    centres = ((np.arange(int(600 / ratio)) + 0.5) * ratio).astype(int)  # one colour pixel per depth pixel
+    for length in (3.5, 0.0):
+        model = replace(base, noise_corr_px=length)
+        out = run(model, shot, cam, seed=11)
+        grid = out.depth[np.ix_(centres, centres)].astype(float) - 1.0
+        assert (out.depth[np.ix_(centres, centres)] > 0).all()
+        assert grid.std() == pytest.approx(np.hypot(0.002, 0.001 / np.sqrt(12)), rel=0.12)
+        measured = _acf_length(grid)
+        if length:
+            assert measured == pytest.approx(length, rel=0.15)
+            assert np.array_equal(out.depth, run(model, shot, cam, seed=11).depth)
+            assert not np.array_equal(out.depth, run(model, shot, cam, seed=12).depth)
+        else:
+            assert measured < 0.7  # independent: below 1/e already at one depth pixel
+
+
+def test_noise_corr_px_is_set_by_sensor_set():
+    from symfruit.errors import InputError
+    from symfruit.synthetic.sensors import parse_sensor_set, varied
+
+    d435 = SENSOR_MODELS["realsense-d435"]
+    assert d435.noise_corr_px == 4.0 and SENSOR_MODELS["realsense-l515"].noise_corr_px == 0.0
+    assert varied(d435, parse_sensor_set("noise_corr_px=0")).noise_corr_px == 0.0
+    assert varied(d435, parse_sensor_set("noise_corr_px=7.5")).noise_corr_px == 7.5
+    with pytest.raises(InputError, match="noise_corr_px=25: must be 0 to 20"):
+        parse_sensor_set("noise_corr_px=25")

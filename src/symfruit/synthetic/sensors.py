@@ -22,9 +22,10 @@ depth pixels):
    is invalid (the stereo occlusion band, ``baseline`` and the disparities decide its width);
 3. multipath (time-of-flight): depth pushed away from the camera near where two surfaces meet,
    ``multipath_bias`` at the junction decaying over ``multipath_range``;
-4. axial noise and bias growing with distance (:meth:`SensorModel.sigma`, :meth:`SensorModel.bias`),
-   grazing-angle and random dropout, no depth outside the depth camera's field of view, millimetre
-   quantisation;
+4. axial noise and bias growing with distance (:meth:`SensorModel.sigma`, :meth:`SensorModel.bias`), the noise
+   correlated over ``noise_corr_px`` depth pixels (a Gaussian autocorrelation: the depth engine's filtering, a
+   stereo matcher's window), grazing-angle and random dropout, no depth outside the depth camera's field of
+   view, millimetre quantisation;
 5. registers depth to colour: nearest depth pixel per colour pixel, shifted by ``registration_px``
    (in a direction drawn per frame), with the parallax band a depth camera ``colour_baseline`` away
    from the colour camera cannot see left invalid;
@@ -56,6 +57,7 @@ __all__ = [
     "SensorModel",
     "apply_sensor",
     "checked_sensor_set",
+    "correlated_noise",
     "parse_sensor_set",
     "sensor_model",
     "varied",
@@ -79,6 +81,8 @@ SOURCES = {
     "26(1), 2019 (bias and noise against distance, edge behaviour)",
     "LOURENCO": "Lourenco and Araujo, Intel RealSense SR305, D415 and L515: experimental evaluation and "
     "comparison of depth estimation, VISAPP 2021",
+    "KESELMAN": "Keselman, Woodfill, Grunnet-Jepsen, Bhowmik, Intel RealSense stereoscopic depth cameras, CVPR "
+    "workshops 2017, arXiv:1705.05548 (the D400's depth from a correlation of image windows)",
     "ISSUE18": "issue 18: the held-back Azure Kinect frames of apples on a tree and the shared lab frames",
 }
 
@@ -122,6 +126,16 @@ class SensorModel:
         Active stereo: axial noise ``z^2 * subpixel / (f_depth * baseline)`` [D400-TUNE]; subpixel RMS
         0.08 (the white paper's typical value for a well-textured scene) [D400-TUNE]; baseline D435
         50 mm, D405 18 mm [D400-DS].
+    noise_corr_px : float, depth pixels
+        Correlation length of the axial noise: its autocorrelation is ``exp(-(lag / noise_corr_px)^2)`` (1/e at
+        ``noise_corr_px``; white noise Gaussian-filtered with ``noise_corr_px / 2`` and rescaled, so the per-pixel
+        standard deviation stays :meth:`sigma`); 0: independent per depth pixel. Azure Kinect 3.5: MEASURED on the
+        shared lab frames (``../shared/data/real-frames``): residuals of planes fitted to flat background patches
+        fall to 1/e at 8 colour pixels (1920x1080), i.e. 3.5 of this model's depth pixels (footprint 2.30;
+        ``docs/sensors.md``, ``python -m symfruit.evaluate.sensorcheck``). D435 and D405 4 (from sources, not
+        measured: the D4's depth is a correlation of windows of the two images [KESELMAN], so neighbours share most
+        of a window and its error; a 7-pixel window, the half-window ``fatten_px`` = 3 already assumed, a box
+        correlation falling to 1/e at 0.63 x 7 = 4.4 px; judgement 4). L515 0 (no measurement, no source).
     bias_const, bias_linear : float, metres and metres per metre
         Systematic depth error ``bias_const + bias_linear * z`` (positive: too far). Azure Kinect: < 11 mm
         + 0.1 % of distance [AK-HW], typical units a few mm [TOLGYESSY]: 2 mm + 0.1 % (judgement). L515:
@@ -195,6 +209,7 @@ class SensorModel:
     sigma_linear: float = 0.0
     subpixel: float = 0.0
     baseline: float = 0.0
+    noise_corr_px: float = 0.0
     bias_const: float = 0.0
     bias_linear: float = 0.0
     lateral_px: float = 0.3
@@ -263,7 +278,8 @@ class SensorModel:
 SENSOR_MODELS: dict[str, SensorModel] = {
     "azure-kinect": SensorModel(
         "azure-kinect", "tof", 1920, 1080, 90.0, 59.0, 640, 75.0, 65.0, (0.5, 2.0),
-        sigma_const=0.0006, sigma_linear=0.0006, bias_const=0.002, bias_linear=0.001, rim_invalid_px=1,
+        sigma_const=0.0006, sigma_linear=0.0006, noise_corr_px=3.5, bias_const=0.002, bias_linear=0.001,
+        rim_invalid_px=1,
         flying_share=0.1, multipath_bias=0.005, multipath_range=0.02, registration_px=6.0, colour_baseline=0.032,
         mask_overshoot_px=4.0, mask_amodal_share=0.5,
     ),
@@ -275,12 +291,14 @@ SENSOR_MODELS: dict[str, SensorModel] = {
     ),
     "realsense-d435": SensorModel(
         "realsense-d435", "stereo", 1280, 720, 69.0, 42.0, 1280, 87.0, 58.0, (0.28, 2.0),
-        subpixel=0.08, baseline=0.050, bias_linear=0.003, fatten_px=3, registration_px=2.0, colour_baseline=0.015,
+        subpixel=0.08, baseline=0.050, noise_corr_px=4.0, bias_linear=0.003, fatten_px=3, registration_px=2.0,
+        colour_baseline=0.015,
         mask_overshoot_px=3.0, mask_amodal_share=0.5,
     ),
     "realsense-d405": SensorModel(
         "realsense-d405", "stereo", 1280, 720, 87.0, 58.0, 1280, 87.0, 58.0, (0.25, 0.5),
-        subpixel=0.08, baseline=0.018, bias_linear=0.003, fatten_px=3, registration_px=0.0, colour_baseline=0.0,
+        subpixel=0.08, baseline=0.018, noise_corr_px=4.0, bias_linear=0.003, fatten_px=3, registration_px=0.0,
+        colour_baseline=0.0,
         mask_overshoot_px=3.0, mask_amodal_share=0.5,
     ),
 }  # fmt: skip
@@ -304,7 +322,8 @@ VARIABLE: dict[str, tuple[float, float]] = {
     "mask_overshoot_px": (0.0, 30.0), "mask_amodal_share": (0.0, 1.0), "grazing": (0.0, 1.0),
     "grazing_dropout": (0.0, 1.0), "dropout": (0.0, 0.5), "multipath_bias": (0.0, 0.05),
     "multipath_range": (0.001, 0.2), "sigma_const": (0.0, 0.05), "sigma_linear": (0.0, 0.05),
-    "subpixel": (0.01, 1.0), "bias_const": (-0.05, 0.05), "bias_linear": (-0.05, 0.05), "bias": (0.0, 10.0),
+    "subpixel": (0.01, 1.0), "noise_corr_px": (0.0, 20.0), "bias_const": (-0.05, 0.05),
+    "bias_linear": (-0.05, 0.05), "bias": (0.0, 10.0),
 }  # fmt: skip
 
 
@@ -487,7 +506,7 @@ def apply_sensor(
             valid |= spread
         valid &= ~_shadow(np.where(valid, out, 0.0), f_d * model.baseline)
     # Noise and bias grow with distance; dropout at grazing angles and at random; nothing outside the field of view.
-    noise = rng.normal(size=(hd, wd)) * model.sigma(out)
+    noise = correlated_noise(rng.normal(size=(hd, wd)), model.noise_corr_px) * model.sigma(out)
     out = out + model.bias(out) + noise
     if face is not None and model.grazing_dropout > 0:
         valid &= ~((face < model.grazing) & (rng.random((hd, wd)) < model.grazing_dropout))
@@ -514,6 +533,21 @@ def apply_sensor(
     registered = np.round(registered / 0.001) * 0.001  # millimetre depth units (all four cameras)
     masks = None if labels is None else annotate(model, labels, rng, amodal=amodal)
     return SensorFrame(registered.astype(np.float32), masks, jitter, (du, dv))
+
+
+def correlated_noise(white: np.ndarray, length: float) -> np.ndarray:
+    """``white`` (independent unit normal draws) correlated over ``length`` pixels: Gaussian-filtered with
+    ``length / 2`` (the autocorrelation ``exp(-(lag / length)^2)``, 1/e at ``length``), wrapping round the image
+    (stationary: every pixel's variance the same) and divided by the kernel's norm, so each pixel stays unit normal.
+    ``length`` 0 returns ``white`` itself."""
+    if length <= 0:
+        return white
+    s = length / 2.0
+    radius = max(1, math.ceil(4.0 * s))
+    kernel = np.exp(-0.5 * (np.arange(-radius, radius + 1) / s) ** 2)
+    kernel /= kernel.sum()
+    smooth = ndimage.gaussian_filter(white, s, mode="wrap", truncate=radius / s)
+    return smooth / float(np.sum(kernel**2))  # 2-D variance: (sum k^2)^2, its square root
 
 
 def _multipath(z: np.ndarray, sid: np.ndarray, model: SensorModel, focal: float) -> np.ndarray:
