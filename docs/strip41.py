@@ -10,6 +10,7 @@ python docs/strip41.py camera SENSOR SEED N [KIND:INDEX ...]
     did; ``KIND:INDEX`` limits it to those views
 """
 
+import argparse
 import csv
 import json
 import sys
@@ -94,7 +95,19 @@ def camera(sensor: str, seed: int, n: int, only: list[str]) -> None:
 
 
 if __name__ == "__main__":
-    if sys.argv[1] == "frames":
-        frames(*sys.argv[2:5])
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="what", required=True)
+    f = sub.add_parser("frames", help="per-instance moves of two eval_boxes.py frame CSVs against the truth")
+    f.add_argument("root")
+    f.add_argument("a")
+    f.add_argument("b")
+    c = sub.add_parser("camera", help="the camera protocol's replica at 0 %% hidden")
+    c.add_argument("sensor")
+    c.add_argument("seed", type=int)
+    c.add_argument("n", type=int)
+    c.add_argument("views", nargs="*", help="KIND:INDEX")
+    args = parser.parse_args()
+    if args.what == "frames":
+        frames(args.root, args.a, args.b)
     else:
-        camera(sys.argv[2], int(sys.argv[3]), int(sys.argv[4]), sys.argv[5:])
+        camera(args.sensor, args.seed, args.n, args.views)
