@@ -256,7 +256,10 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     and holding at least a tenth of the sheet's pixels; its front is :func:`fruit_depth`'s of its own depths (bins
     of the measured ``noise``). A front part not flat is passed over too, for a convex part behind it, touching it,
     that holds more pixels than it (a leaf's depth a stereo camera fattens a few pixels into a mask of the visible
-    fruit; an occluder's part too small or curled to be told flat: a fruit's own front is its mask's largest part).
+    fruit; an occluder's part too small or curled to be told flat: a fruit's own front is its mask's largest part),
+    and only where it lies in front of that part's surface extended under it by more than ``join`` (an occluder lies
+    in front of the fruit; the fruit's own front seen apart from the rest of it, a hole in the leaves or a step of
+    noise between, lies on it: stop 41, docs/strip41.md).
     Where noise bridges the step (``join`` a few noise deviations wide, a stereo camera's far depth), the parts
     are found again on the depth's 5 x 5 median (steps kept, the noise a third), joined at three of its own noise
     deviations (read at a lag of the filter's width), when three of ``noise`` exceed 3 mm. A fruit alone (its cap
@@ -329,8 +332,10 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     not a sheet is passed over only for a convex part behind it holding more pixels than it does: an occluder whose
     shape is not told (a strip of a leaf's depth a stereo camera fattens into a mask of the visible fruit, a few
     pixels wide; a leaf's small or curled part) hides less of the mask than the fruit shows, while a fruit's own front
-    is the mask's largest surface (stop 40, docs/leaf40.md). ``noise``: the depth's noise, for :func:`fruit_depth`'s
-    bins on the part behind."""
+    is the mask's largest surface (stop 40, docs/leaf40.md). Such a front part must also lie in front of the part
+    behind's surface extended under it (:func:`_offset_from`) by more than ``join``: one lying on it is that fruit's
+    own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's noise, for
+    :func:`fruit_depth`'s bins on the part behind."""
     if count < 2:
         return None
     near = (parts > 0) & (np.abs(depth - front) <= join)
@@ -367,9 +372,33 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         kappa, error = _mean_curvature(pr, pc, z, focal)
         if kappa * radius >= THIN[1] and error * radius <= THIN[2]:
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
+            if not flat and _offset_from(pr, pc, z, rows, cols, depth[rows, cols], focal) >= -join:
+                continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
             if np.isfinite(behind) and behind > front:
                 return behind, sheet
     return None
+
+
+def _offset_from(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, at_rows: np.ndarray, at_cols: np.ndarray,
+                 at_z: np.ndarray, focal: float) -> float:  # fmt: skip
+    """Metres: the median depth of the pixels ``at_*`` less the depth there of the surface seen at ``rows, cols, z``,
+    extended under them (:func:`_mean_curvature`'s quadratic in inverse depth, on the same seeded 2,048 of its pixels
+    at most): negative where they lie in front of it (an occluder), about 0 where they lie on it (the same surface,
+    parted by a step). A surface whose extension turns away (no positive inverse depth there) lies infinitely far."""
+    if len(z) > 2048:
+        some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
+        rows, cols, z = rows[some], cols[some], z[some]
+    zm = float(np.median(z))
+    r0, c0 = float(rows.mean()), float(cols.mean())
+
+    def design(r: np.ndarray, c: np.ndarray) -> np.ndarray:
+        x, y = (c - c0) * (zm / focal), (r - r0) * (zm / focal)
+        return np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
+
+    coef, *_ = np.linalg.lstsq(design(rows, cols), 1.0 / z, rcond=None)
+    inverse = design(at_rows, at_cols) @ coef
+    there = np.where(inverse > 0, 1.0 / np.where(inverse > 0, inverse, 1.0), np.inf)
+    return float(np.median(at_z - there))
 
 
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
