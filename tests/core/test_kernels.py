@@ -3849,10 +3849,11 @@ def test_candidates_constrain_their_boxes_as_constrain_box_does(monkeypatch, wit
 
 @pytest.mark.parametrize("seed", range(6))
 @pytest.mark.parametrize("window", [False, True])
-def test_the_red_regions_in_one_pass_are_the_twins_and_the_former_kernels(seed, window):
+def test_the_red_regions_in_one_pass_are_the_twins(seed, window):
     """Red blobs, rings, combs and U shapes (regions whose provisional labels join late, from the right above) over
-    random colours and weak specks, whole or a strided window: :func:`_jit.red_regions_once` gives the former kernel's
-    values (values and types) and the numpy twin's (``_red_regions`` with ``SYMFRUIT_KERNELS=numpy``)."""
+    random colours and weak specks, whole or a strided window: :func:`_jit.red_regions_once` gives
+    :func:`_jit.red_pixels`' pixels and the numpy twin's values and types (``_red_regions`` with
+    ``SYMFRUIT_KERNELS=numpy``)."""
     from symfruit.segment.colour import SegmentSettings, _red_regions, _red_tables
 
     rng = np.random.default_rng(100 + seed)
@@ -3873,12 +3874,11 @@ def test_the_red_regions_in_one_pass_are_the_twins_and_the_former_kernels(seed, 
     s = SegmentSettings()
     low, high = _red_tables(s.red_low, s.red_high, s.dark)
     args = (low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
-    once, former = _jit.red_regions_once(c, *args), _jit.red_regions(c, *args)
-    assert int(once[2]) == int(former[2]) > 10 and once[6].sum() >= 2
-    for a, b in zip(once, former, strict=True):
-        if isinstance(a, np.ndarray):
-            assert a.dtype == b.dtype
-            np.testing.assert_array_equal(a, b)
+    once = _jit.red_regions_once(c, *args)
+    assert int(once[2]) > 10 and once[6].sum() >= 2
+    weak, strong = _jit.red_pixels(c, *args)
+    np.testing.assert_array_equal(once[3], weak)
+    np.testing.assert_array_equal(once[4], strong)
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, _red_regions, c, s)
     for a, b in zip(fast, twin, strict=True):

@@ -4851,16 +4851,28 @@ def red_pixels(
     n_weak = n_strong = 0
     for r in range(h):
         for q in range(w):
-            red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
-            most = max(green, blue)
-            if red <= most or most > low[red]:
+            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            if kind == 0:
                 continue
             weak[n_weak] = r * w + q
             n_weak += 1
-            if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+            if kind == 2:
                 strong[n_strong] = r * w + q
                 n_strong += 1
     return weak[:n_weak].copy(), strong[:n_strong].copy()
+
+
+@_njit
+def _red_kind(c: np.ndarray, r: int, q: int, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float) -> int:
+    """The red tests of pixel ``(r, q)`` of ``c`` (:func:`red_pixels`' and :func:`red_regions_once`'s, on the twin's
+    whole numbers and products): 0 not red, 1 weakly red, 2 strongly red too."""
+    red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+    most = max(green, blue)
+    if red <= most or most > low[red]:
+        return 0
+    if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+        return 2
+    return 1
 
 
 @_njit
@@ -5374,35 +5386,6 @@ def round_skin(
             if part[r, c]:
                 skin[r, c] = True
     return skin
-
-
-@_njit
-def red_regions(
-    c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
-) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
-    """:func:`symfruit.segment.colour._red_regions` of a window ``c`` (h, w, 3) uint8: its weak pixels' mask (h, w)
-    bool, their regions' labels (8-connected, :func:`label`) and count n, the weak and strong pixels' flat indices
-    (:func:`red_pixels`), the weak pixels' labels (int32), which regions hold a strong pixel and how many pixels each
-    has ((n + 1,), 0 the background's: none), and the weak pixels' rows and columns. The twin's values."""
-    h, w = c.shape[0], c.shape[1]
-    weak_at, strong_at = red_pixels(c, low, high, sqrt3, tan_hue)
-    mask = np.zeros((h, w), np.bool_)
-    for i in range(weak_at.shape[0]):
-        mask[weak_at[i] // w, weak_at[i] % w] = True
-    labels, n = label(mask, True)
-    lab = np.empty(weak_at.shape[0], np.int32)
-    rows = np.empty(weak_at.shape[0], np.int64)
-    cols = np.empty(weak_at.shape[0], np.int64)
-    sizes = np.zeros(n + 1, np.int64)
-    for i in range(weak_at.shape[0]):
-        rows[i], cols[i] = weak_at[i] // w, weak_at[i] % w
-        lab[i] = labels[rows[i], cols[i]]
-        sizes[lab[i]] += 1
-    seeded = np.zeros(n + 1, np.bool_)
-    for i in range(strong_at.shape[0]):
-        seeded[labels[strong_at[i] // w, strong_at[i] % w]] = True
-    seeded[0] = False
-    return mask, labels, n, weak_at, strong_at, lab, seeded, sizes, rows, cols
 
 
 # --- issue 19, eighteenth round: the colour segmenter's ground-colour candidates ----------------------------------
@@ -6228,7 +6211,7 @@ def split_centres(
 def red_regions_once(
     c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
-    """:func:`red_regions`' values (the twin's, :func:`symfruit.segment.colour._red_regions`) in one raster pass over
+    """:func:`symfruit.segment.colour._red_regions`' values (the twin's) in one raster pass over
     the window: each pixel's red tests (:func:`red_pixels`' whole numbers and products) and, for a weak pixel, its
     provisional label (:func:`label`'s union-find with eight neighbours, the same unions in the same order), then the
     roots numbered over the weak pixels alone, in raster order (as :func:`label`'s second pass meets them: the same
@@ -6243,13 +6226,12 @@ def red_regions_once(
     n = 0
     for r in range(h):
         for q in range(w):
-            red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
-            most = max(green, blue)
-            if red <= most or most > low[red]:
+            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            if kind == 0:
                 continue
             weak[n_weak] = r * w + q
             n_weak += 1
-            if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+            if kind == 2:
                 strong[n_strong] = r * w + q
                 n_strong += 1
             mask[r, q] = True

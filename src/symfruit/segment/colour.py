@@ -671,9 +671,9 @@ def _red_regions(
     """A window's weakly red regions (8-connected): its weak pixels' mask (:func:`_red_pixels`), their labels and count
     n, the weak pixels' labels (in raster order), which regions hold a strong pixel, each one's size ((n + 1,), the
     background's 0 and unseeded), the weak pixels' rows and columns; None without a weak pixel. Where numba is, its
-    compiled twin gives the same (:func:`symfruit.core._jit.red_regions`: one call, not a dozen numpy ones on each of
-    a frame's windows; issue 19, seventeenth round; since stop 41 :func:`symfruit.core._jit.red_regions_once`, the
-    tests and the labelling in one pass, the labels numbered over the weak pixels alone)."""
+    compiled twin gives the same (:func:`symfruit.core._jit.red_regions_once`: one call, not a dozen numpy ones on
+    each of a frame's windows, issue 19's seventeenth round; since stop 41 the tests and the labelling in one pass,
+    the labels numbered over the weak pixels alone)."""
     if (jit := compiled()) is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3:
         low, high = _red_tables(s.red_low, s.red_high, s.dark)
         weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions_once(
