@@ -3507,32 +3507,10 @@ def test_the_segmenters_split_up_to_its_centres_is_the_twins(seed, sigma, holes)
 
 
 def _frame_outlines(seed: int, reach: int):
-    """Four to six balls (one on a table, so told along one axis at most; noisy or not, rims without depth), their
-    depth a few pixels off their masks: the outlines ``registration_shift`` costs, each in its window."""
-    from symfruit.core import surface
+    """:func:`tests.core.test_surface.ball_outlines` told along at least one axis."""
+    from .test_surface import ball_outlines
 
-    from .test_surface import F, H, W, ball
-
-    rng = np.random.default_rng(seed)
-    depth = np.full((H, W), 0.8)
-    labels = np.zeros((H, W), np.int32)
-    centres = [(25, 25), (80, 27), (135, 24), (26, 92), (82, 90), (134, 93)][: int(rng.integers(4, 7))]
-    for k, centre in enumerate(centres):
-        d, disc = ball(centre=centre, radius_px=int(rng.integers(9, 15)), front=float(rng.uniform(0.4, 0.6)),
-                       rim=float(rng.uniform(0.0, 0.2)), table=k == 1)  # fmt: skip
-        depth = np.where(disc | ((k == 1) & (d < depth)), d, depth)
-        labels[disc] = k + 1
-    depth = depth + rng.normal(0.0, 0.001 * (seed % 2), depth.shape)
-    moved = np.roll(depth, (int(rng.integers(-5, 6)), int(rng.integers(-5, 6))), axis=(0, 1))
-    outlines = []
-    for k in range(1, len(centres) + 1):
-        rows, cols = np.nonzero(labels == k)
-        r0, c0 = max(rows.min() - reach - 8, 0), max(cols.min() - reach - 8, 0)
-        r1, c1 = rows.max() + reach + 9, cols.max() + reach + 9
-        found = surface._outline(moved[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, F, reach)
-        if found is not None and any(found.axes):
-            outlines.append(found)
-    return outlines
+    return [found for found in ball_outlines(seed, reach) if any(found.axes)]
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -903,12 +903,10 @@ def test_the_sort_choice_survives_numpy_moving_its_private_cpu_features(monkeypa
 # --- issue 19, eighteenth round: the registration's search fruit by fruit, the trimming's generator -------------
 
 
-@pytest.mark.parametrize("seed", range(6))
-def test_the_pruned_search_finds_the_full_searchs_shift(seed):
-    """Four to six balls, their depth a few pixels off their masks (noise, rims without depth, one on a table): the
-    coarse grid's least by :func:`_least_pruned` is the full search's (every outline at every shift, the least fast
-    cost's shifts costed exactly), index for index, on the grid and on a grid of ties (a shift along one axis
-    only); and it costs the later outlines at fewer shifts than the first."""
+def ball_outlines(seed: int, reach: int) -> list:
+    """Four to six balls (one on a table, so told along one axis at most; noisy or not, rims without depth), their
+    depth a few pixels off their masks: the outlines ``registration_shift`` costs, each in its window (``reach`` + 8
+    px around its mask)."""
     from symfruit.core import surface
 
     rng = np.random.default_rng(seed)
@@ -925,9 +923,22 @@ def test_the_pruned_search_finds_the_full_searchs_shift(seed):
     outlines = []
     for k in range(1, len(centres) + 1):
         rows, cols = np.nonzero(labels == k)
-        r0, r1, c0, c1 = max(rows.min() - 18, 0), rows.max() + 19, max(cols.min() - 18, 0), cols.max() + 19
-        if (found := surface._outline(moved[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, F, 10)) is not None:
+        r0, c0 = max(rows.min() - reach - 8, 0), max(cols.min() - reach - 8, 0)
+        r1, c1 = rows.max() + reach + 9, cols.max() + reach + 9
+        if (found := surface._outline(moved[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, F, reach)) is not None:
             outlines.append(found)
+    return outlines
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_pruned_search_finds_the_full_searchs_shift(seed):
+    """Four to six balls, their depth a few pixels off their masks (noise, rims without depth, one on a table): the
+    coarse grid's least by :func:`_least_pruned` is the full search's (every outline at every shift, the least fast
+    cost's shifts costed exactly), index for index, on the grid and on a grid of ties (a shift along one axis
+    only); and it costs the later outlines at fewer shifts than the first."""
+    from symfruit.core import surface
+
+    outlines = ball_outlines(seed, 10)
     assert len(outlines) >= 3
     seen = []
 
