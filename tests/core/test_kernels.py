@@ -3570,7 +3570,7 @@ def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
     from symfruit.core import surface
     from symfruit.core.surface import registration_shift
 
-    from .test_surface import F, H, W, ball
+    from .test_surface import F, three_balls_moved
 
     outlines = _frame_outlines(0, 10)
     monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
@@ -3579,13 +3579,7 @@ def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
     wide = outlines[0]
     monkeypatch.setitem(wide._padded, ("keys", 10, 10), wide.keys(10, 10).astype(np.int32))
     assert surface._FrameCosts.of(outlines, 10, 0.7) is None
-    depth = np.full((H, W), 0.8)
-    labels = np.zeros((H, W), np.int32)
-    for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
-        d, disc = ball(centre=centre, radius_px=14, front=0.45 + 0.05 * k, rim=0.1)
-        depth = np.where(disc, np.minimum(depth, d), depth)
-        labels[disc] = k + 1
-    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    moved, labels = three_balls_moved()
     assert registration_shift(moved.astype(np.float32), labels, F, max_px=10) == (-2, 3)
     found = registration_shift(moved, labels, F, max_px=10)
     monkeypatch.setattr(surface._FrameCosts, "of", classmethod(lambda cls, *a: None))

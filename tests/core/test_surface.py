@@ -964,16 +964,21 @@ def test_the_pruned_search_finds_the_full_searchs_shift(seed):
             assert min(seen[1:]) < len(grid)
 
 
-def test_registration_is_the_same_with_and_without_the_pruned_search(monkeypatch):
-    """A frame of three balls moved against their masks: the same shift whether the coarse grid is searched fruit by
-    fruit or whole."""
+def three_balls_moved() -> tuple[np.ndarray, np.ndarray]:
+    """Three balls whose depth lies (3, -2) px off their masks: the depth and the masks' labels."""
     depth = np.full((H, W), 0.8)
     labels = np.zeros((H, W), np.int32)
     for k, centre in enumerate(((35, 35), (110, 40), (70, 90))):
         d, disc = ball(centre=centre, radius_px=14, front=0.45 + 0.05 * k, rim=0.1)
         depth = np.where(disc, np.minimum(depth, d), depth)
         labels[disc] = k + 1
-    moved = np.roll(depth, (3, -2), axis=(0, 1))
+    return np.roll(depth, (3, -2), axis=(0, 1)), labels
+
+
+def test_registration_is_the_same_with_and_without_the_pruned_search(monkeypatch):
+    """A frame of three balls moved against their masks: the same shift whether the coarse grid is searched fruit by
+    fruit or whole."""
+    moved, labels = three_balls_moved()
     found = registration_shift(moved, labels, F, max_px=10)
     monkeypatch.setattr("symfruit.core.surface._PRUNE_FROM", 10**9)
     assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)
