@@ -333,9 +333,9 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     shape is not told (a strip of a leaf's depth a stereo camera fattens into a mask of the visible fruit, a few
     pixels wide; a leaf's small or curled part) hides less of the mask than the fruit shows, while a fruit's own front
     is the mask's largest surface (stop 40, docs/leaf40.md). Such a front part must also lie in front of the part
-    behind's surface extended under it (:func:`_offset_from`) by more than ``join``: one lying on it is that fruit's
-    own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's noise, for
-    :func:`fruit_depth`'s bins on the part behind."""
+    behind's surface extended under it (:meth:`_InverseQuadratic.offset`) by more than ``join``: one lying on it is
+    that fruit's own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's
+    noise, for :func:`fruit_depth`'s bins on the part behind."""
     if count < 2:
         return None
     near = (parts > 0) & (np.abs(depth - front) <= join)
@@ -369,36 +369,15 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         z = depth[pr, pc]
         if float(np.median(z)) <= far + join or not touching[pr, pc].any():
             continue
-        kappa, error = _mean_curvature(pr, pc, z, focal)
+        seen = _InverseQuadratic(pr, pc, z, focal)
+        kappa, error = seen.curvature()
         if kappa * radius >= THIN[1] and error * radius <= THIN[2]:
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
-            if not flat and _offset_from(pr, pc, z, rows, cols, depth[rows, cols], focal) >= -join:
+            if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
             if np.isfinite(behind) and behind > front:
                 return behind, sheet
     return None
-
-
-def _offset_from(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, at_rows: np.ndarray, at_cols: np.ndarray,
-                 at_z: np.ndarray, focal: float) -> float:  # fmt: skip
-    """Metres: the median depth of the pixels ``at_*`` less the depth there of the surface seen at ``rows, cols, z``,
-    extended under them (:func:`_mean_curvature`'s quadratic in inverse depth, on the same seeded 2,048 of its pixels
-    at most): negative where they lie in front of it (an occluder), about 0 where they lie on it (the same surface,
-    parted by a step). A surface whose extension turns away (no positive inverse depth there) lies infinitely far."""
-    if len(z) > 2048:
-        some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
-        rows, cols, z = rows[some], cols[some], z[some]
-    zm = float(np.median(z))
-    r0, c0 = float(rows.mean()), float(cols.mean())
-
-    def design(r: np.ndarray, c: np.ndarray) -> np.ndarray:
-        x, y = (c - c0) * (zm / focal), (r - r0) * (zm / focal)
-        return np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
-
-    coef, *_ = np.linalg.lstsq(design(rows, cols), 1.0 / z, rcond=None)
-    inverse = design(at_rows, at_cols) @ coef
-    there = np.where(inverse > 0, 1.0 / np.where(inverse > 0, inverse, 1.0), np.inf)
-    return float(np.median(at_z - there))
 
 
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
@@ -422,29 +401,59 @@ def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.
 
 def _mean_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: float) -> tuple[float, float]:
     """``(kappa, error)``, 1/metres: the mean curvature of the surface seen at the pixels (positive where depth grows
-    away from its middle, as on a fruit's front: ``1 / R`` on a sphere of radius R) and its standard error, from a
-    least-squares quadratic in the lateral coordinates fitted to inverse depth (exactly affine on a plane, whatever
-    its tilt); on at most 2,048 of the pixels drawn by a seeded generator (the fit needs no more; a stride through
-    their row order could alias with the rows' widths)."""
-    if len(z) > 2048:
-        some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
-        rows, cols, z = rows[some], cols[some], z[some]
-    zm = float(np.median(z))
-    x = (cols - cols.mean()) * (zm / focal)
-    y = (rows - rows.mean()) * (zm / focal)
-    a = np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
-    w = 1.0 / z
-    gram = a.T @ a
-    try:
-        inverse = np.linalg.inv(gram)
-    except np.linalg.LinAlgError:
-        return float("nan"), float("inf")
-    coef = inverse @ (a.T @ w)
-    res = w - a @ coef
-    var = float(res @ res) / max(len(w) - 6, 1)
-    kappa = -zm * zm * float(coef[3] + coef[5])
-    error = zm * zm * float(np.sqrt(max(var * (inverse[3, 3] + inverse[5, 5] + 2.0 * inverse[3, 5]), 0.0)))
-    return kappa, error
+    away from its middle, as on a fruit's front: ``1 / R`` on a sphere of radius R) and its standard error
+    (:class:`_InverseQuadratic`)."""
+    return _InverseQuadratic(rows, cols, z, focal).curvature()
+
+
+class _InverseQuadratic:
+    """A least-squares quadratic in the lateral coordinates fitted to the inverse depth ``z`` seen at the pixels
+    ``rows, cols`` (exactly affine on a plane, whatever its tilt); on at most 2,048 of the pixels drawn by a seeded
+    generator (the fit needs no more; a stride through their row order could alias with the rows' widths). Its mean
+    curvature (:meth:`curvature`) and the depth of the surface it extends under other pixels (:meth:`offset`) from
+    the one fit."""
+
+    def __init__(self, rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: float) -> None:
+        if len(z) > 2048:
+            some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
+            rows, cols, z = rows[some], cols[some], z[some]
+        self.zm, self.focal = float(np.median(z)), focal
+        self.r0, self.c0 = float(rows.mean()), float(cols.mean())
+        a = self._design(rows, cols)
+        w = 1.0 / z
+        try:
+            self.inverse: np.ndarray | None = np.linalg.inv(a.T @ a)
+        except np.linalg.LinAlgError:
+            self.inverse = None
+            return
+        self.coef = self.inverse @ (a.T @ w)
+        res = w - a @ self.coef
+        self.var = float(res @ res) / max(len(w) - 6, 1)
+
+    def _design(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+        x = (cols - self.c0) * (self.zm / self.focal)
+        y = (rows - self.r0) * (self.zm / self.focal)
+        return np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
+
+    def curvature(self) -> tuple[float, float]:
+        """``(kappa, error)``, 1/metres: :func:`_mean_curvature`'s; ``(nan, inf)`` where the fit is singular."""
+        if self.inverse is None:
+            return float("nan"), float("inf")
+        i, zm = self.inverse, self.zm
+        kappa = -zm * zm * float(self.coef[3] + self.coef[5])
+        error = zm * zm * float(np.sqrt(max(self.var * (i[3, 3] + i[5, 5] + 2.0 * i[3, 5]), 0.0)))
+        return kappa, error
+
+    def offset(self, at_rows: np.ndarray, at_cols: np.ndarray, at_z: np.ndarray) -> float:
+        """Metres: the median depth ``at_z`` of the pixels ``at_rows, at_cols`` less the depth there of the surface,
+        extended under them: negative where they lie in front of it (an occluder), about 0 where they lie on it (the
+        same surface, parted by a step). A surface whose extension turns away (no positive inverse depth there), or
+        a singular fit, lies infinitely far."""
+        if self.inverse is None:
+            return float("-inf")
+        inverse = self._design(at_rows, at_cols) @ self.coef
+        there = np.where(inverse > 0, 1.0 / np.where(inverse > 0, inverse, 1.0), np.inf)
+        return float(np.median(at_z - there))
 
 
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
