@@ -160,6 +160,19 @@ def test_a_ros2_bag_cut_short_or_with_empty_metadata_is_named_as_such(tmp_path):
             open_source(path)
 
 
+def test_a_ros2_bag_newer_than_rosbags_reads_says_to_upgrade_rosbags(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "new", color, (depth * 1000).astype(np.uint16), frames=1)
+    meta = path / "metadata.yaml"
+    text = meta.read_text()
+    assert re.search(r"^ *version: *\d+$", text, flags=re.M)
+    meta.write_text(re.sub(r"^( *version:) *\d+$", r"\1 99", text, count=1, flags=re.M))  # a rosbag2 of the future
+    with pytest.raises(FileFormatError, match=r"new: cannot open bag \(its metadata is rosbag2 version 99, newer than "
+                       r"the installed rosbags reads \(pip install -U rosbags"):  # fmt: skip
+        open_source(path)  # before: rosbags' own "Rosbag2 version 99 not supported; please report issue."
+
+
 def test_messages_that_share_a_bag_time_are_each_their_own_frame(tmp_path):
     pytest.importorskip("rosbags")
     color, depth = disc_frame([(80, 60)])

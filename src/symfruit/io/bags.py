@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import math
+import re
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -86,6 +87,10 @@ def reader_reason(exc: BaseException) -> str:
         return "a message definition in the bag cannot be parsed (damaged connection record)"
     if text.startswith("File end magic is invalid"):  # rosbags' MCAP reader on a file cut short
         return "the MCAP file ends before its footer: a recording cut short (`mcap recover` rebuilds one) or damaged"
+    newer = re.match(r"Rosbag2 version (\S+) not supported", text)
+    if newer:  # rosbags' own words end "please report issue": it is the installed rosbags that is too old
+        return (f"its metadata is rosbag2 version {newer.group(1)[:20]}, newer than the installed rosbags reads "
+                "(pip install -U rosbags, or `ros2 bag convert` it to an older version)")  # fmt: skip
     first = text.splitlines()[0].strip()
     if len(first) > REASON_CHARS:
         first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
