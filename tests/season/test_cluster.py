@@ -295,3 +295,38 @@ def test_run_distributed_refuses_an_empty_output_path_before_any_cluster(tmp_pat
     with pytest.raises(InputError, match="run_distributed: the output folder is an empty path"):
         run_distributed(str(small_frame()), "", workers=1)  # before: the results written into the working folder
     assert not list(tmp_path.iterdir())
+
+
+def test_a_tls_scheduler_runs_the_recording_as_a_serial_run_does(recording, tmp_path):
+    """``--scheduler tls://`` against a real scheduler that speaks only TLS (a self-signed certificate made here by
+    openssl, Dask's TLS settings pointing at it, scheduler and worker on 127.0.0.1): the detections are the
+    serial run's. Without the settings the address is refused before any connection (check_address)."""
+    import subprocess
+
+    import dask
+    from distributed import LocalCluster
+    from distributed.security import Security
+
+    if shutil.which("openssl") is None:
+        pytest.skip("needs the openssl command to make a certificate")
+    key, cert = tmp_path / "key.pem", tmp_path / "cert.pem"
+    subprocess.run(["openssl", "req", "-x509", "-newkey", "rsa:2048", "-nodes", "-keyout", str(key), "-out", str(cert),
+                    "-days", "2", "-subj", "/CN=127.0.0.1", "-addext", "subjectAltName=IP:127.0.0.1"], check=True,
+                   capture_output=True, timeout=60)  # fmt: skip
+    tls = {"distributed.comm.tls.ca-file": str(cert)}
+    for who in ("scheduler", "worker", "client"):
+        tls |= {f"distributed.comm.tls.{who}.cert": str(cert), f"distributed.comm.tls.{who}.key": str(key)}
+    rec = tmp_path / "rec"
+    for k in range(2):
+        shutil.copytree(recording / f"scene_{k:05d}", rec / f"scene_{k:05d}")
+    serial = run_batch(rec, tmp_path / "serial", method="raw", progress=False)
+    with dask.config.set(tls):
+        with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tls://", host="127.0.0.1",
+                          dashboard_address=None, security=Security()) as tls_cluster:  # fmt: skip
+            address = tls_cluster.scheduler_address
+            assert address.startswith("tls://127.0.0.1:")
+            report = run_distributed(rec, tmp_path / "out", scheduler=address, chunk=1, method="raw", progress=False)
+    assert report.done == serial.done and len(report.done) == 2
+    assert _fruits(tmp_path / "out") == _fruits(tmp_path / "serial") != {}
+    with pytest.raises(InputError, match=r"tls:// needs Dask's TLS settings"):
+        run_distributed(rec, tmp_path / "none", scheduler=address, method="raw", progress=False)
