@@ -3919,3 +3919,52 @@ def test_a_found_fruits_claim_is_the_twins(seed):
             assert a[0].dtype == b[0].dtype and np.array_equal(a[0], b[0]) and a[1] == b[1]
         answers.append(a is not None)
     assert answers == [True, True, True, False]  # the disc lies mostly under the larger fruit
+
+
+# --- stop 42, speedreg42
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_pruning_limit_and_the_tightened_stage_are_their_twins(seed):
+    """``prune_limit`` is ``surface._limit`` to the bit; the pruned stage, whose bound falls to the frame cost at the
+    least running sum after each outline (the outlines costed fewest points first), leaves the twin's shifts with the
+    twin's costs written, a subset of those the first bound leaves that holds every shift within the margin of the
+    least frame cost; and the search's index is the same as costing every outline at every shift."""
+    from symfruit.core import _jit, surface
+
+    rng = np.random.default_rng(seed)
+    for upper, slack, count in zip(rng.uniform(0, 30, 50), rng.uniform(0, 1e-8, 50), rng.integers(1, 12, 50),
+                                   strict=True):  # fmt: skip
+        assert _jit.prune_limit(float(upper), float(slack), int(count)) == surface._limit(upper, slack, int(count))
+    reach, trim = 10, 0.7
+    outlines = _frame_outlines(seed, reach)
+    outlines[-1].__dict__["axes"] = (False, True)  # a one-axis outline among them
+    frame, twin = surface._FrameCosts.of(outlines, reach, trim), surface._FrameCosts(outlines, reach, trim)
+    assert frame.jit is not None and twin.jit is None
+    assert np.array_equal(frame.order, np.argsort([len(o.rows) for o in outlines], kind="stable"))
+    coarse = np.arange(-reach, reach + 1, 2)
+    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), -1).reshape(-1, 2).astype(np.int64)
+    want = np.array([surface._told(o, grid, reach, trim, False) for o in outlines])
+    out = np.full(want.shape, np.nan)
+    best = int(frame._stage(grid, 0, -1, 0.0, 0.0, out)[0])
+    frame._stage(grid, 1, best, 0.0, 0.0, out)
+    upper, slack = float(want[:, best].mean()), 1e-10
+    mine, theirs = out.copy(), out.copy()
+    alive = frame._stage(grid, 2, best, upper, slack, mine)
+    assert np.array_equal(twin._stage(grid, 2, best, upper, slack, theirs), alive)
+    assert np.array_equal(mine, theirs, equal_nan=True)
+    written = ~np.isnan(mine)
+    assert np.array_equal(mine[written], want[written])
+    limit = surface._limit(upper, slack, len(outlines))
+    first_bound = np.flatnonzero((np.cumsum(want[frame.order], axis=0) <= limit).all(axis=0))
+    assert np.isin(alive, first_bound).all()
+    means = want.mean(axis=0)
+    assert np.isin(np.flatnonzero(means <= means.min() + 1e-9), alive).all()
+
+    def cost(shifts, exact=True):
+        return np.mean([surface._told(o, shifts, reach, trim, exact) for o in outlines], axis=0)
+
+    fast = cost(grid, exact=False)
+    near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
+    full = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
+    assert frame.least(grid, cost) == twin.least(grid, cost) == full

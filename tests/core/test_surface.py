@@ -933,9 +933,9 @@ def ball_outlines(seed: int, reach: int) -> list:
 @pytest.mark.parametrize("seed", range(6))
 def test_the_pruned_search_finds_the_full_searchs_shift(seed):
     """Four to six balls, their depth a few pixels off their masks (noise, rims without depth, one on a table): the
-    coarse grid's least by the pruned search (:meth:`_FrameCosts.least` by :func:`_told`) is the full search's (every outline at every shift, the least fast
-    cost's shifts costed exactly), index for index, on the grid and on a grid of ties (a shift along one axis
-    only); and it costs the later outlines at fewer shifts than the first."""
+    coarse grid's least by the pruned search (:meth:`_FrameCosts.least` by :func:`_told`) is the full search's
+    (every outline at every shift, the least fast cost's shifts costed exactly), index for index, on the grid and on
+    a grid of ties (a shift along one axis only); and it costs the later outlines at fewer shifts than the first."""
     from symfruit.core import surface
 
     outlines = ball_outlines(seed, 10)

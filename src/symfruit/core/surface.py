@@ -1284,20 +1284,19 @@ class _FrameCosts:
         With more than one outline and more than :data:`_PRUNE_FROM` shifts (issue 19, eighteenth round: the coarse
         grid's 441 shifts of 9 fruit were most of the registration), not every outline at every shift. A shift's
         cost is the mean of the outlines' costs, each at least 0, so the outlines' costs summed so far, divided by
-        their number, are a lower bound of it. The outline of fewest points is costed first, at every shift, and the
-        frame's cost at that outline's least shift bounds the least one from above; each further outline is costed only at the
-        shifts whose lower bound is not above that by more than the margin (:func:`_limit`), which is more than twice
-        the slack (made with a bound of the largest cost an outline can have: its window's diagonal plus the reach
-        and its band) and more than the sums' rounding. After each outline, the frame's cost at the shift left of
-        least sum so far bounds the least one from above too, and lowers the bound when less (stop 42: the first
-        outline's least shift can cost the frame several times the least, bench seed 2's 7.47 px against 1.19,
-        and the pruning then kept most shifts; this halves the outline-shifts costed there and on seeds 5 and 7, and
-        leaves the benchmark frame's, whose bound is the least already). Any frame cost at any shift is such a
-        bound, so the same shifts stay within twice the slack of the least. A shift left out cannot be among those within twice the slack of
-        the least fast cost; those left in have every outline's fast cost, their mean taken as for every shift.
-        The shifts within twice the larger slack of the least are costed exactly, the first least returned: any
-        taken beyond the plain search's own lie more than its slack above its least fast cost, so above the least
-        exact one, and are never it."""
+        their number, are a lower bound of it. The outline of fewest points is costed first, at every shift, and
+        the frame's cost at that outline's least shift bounds the least one from above; each further outline is
+        costed only at the shifts whose lower bound is not above that by more than the margin (:func:`_limit`),
+        which is more than twice the slack (made with a bound of the largest cost an outline can have: its
+        window's diagonal plus the reach and its band) and more than the sums' rounding. After each outline, the
+        frame's cost at the shift left of least sum so far bounds the least one too, and lowers the bound when less
+        (stop 42: the first outline's least shift can cost the frame several times the least one, bench seed 2's
+        7.47 px against 1.19, and the pruning then kept most shifts). Any frame cost at any shift is such a bound,
+        and the rows of ``out`` are the outlines' whatever the order they are costed in: a shift left out cannot be
+        among those within twice the slack of the least fast cost; those left in have every outline's fast cost,
+        their mean taken as for every shift. The shifts within twice the larger slack of the least are costed
+        exactly, the first least returned: any taken beyond the plain search's own lie more than its slack above
+        its least fast cost, so above the least exact one, and are never it."""
         count = len(self.outlines)
         shifts = np.ascontiguousarray(shifts, dtype=np.int64)
         out = np.empty((count, len(shifts)))
