@@ -3968,3 +3968,33 @@ def test_the_pruning_limit_and_the_tightened_stage_are_their_twins(seed):
     near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
     full = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
     assert frame.least(grid, cost) == twin.least(grid, cost) == full
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_trim_kept_is_the_band_test_the_pieces_and_their_holes_by_the_twins(seed, monkeypatch):
+    """``trim_kept`` (stop 42): the band's test, the pieces holding a fruit pixel and their holes filled in one call,
+    the numpy twins' pixels (``keep[band] = _nearer_fruit(...)``, ``_connected``, ``fill_holes``): ragged discs on a
+    noisy image whose band test cuts pieces off and leaves holes, fruit seeds in some pieces, none at all."""
+    from symfruit.core import _jit
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import _colour_features, _connected, _nearer_fruit, fill_holes
+
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(30, 90)), int(rng.integers(30, 90))
+    yy, xx = np.mgrid[:h, :w]
+    mask = np.hypot(yy - h / 2, xx - w / 2) < rng.uniform(8, 0.45 * min(h, w)) + rng.normal(0, 1.5, (h, w))
+    color = rng.integers(0, 256, (h, w, 3)).astype(np.uint8)
+    inner = inner_distance(mask)
+    band_px = float(rng.uniform(2, 5))
+    band = mask & (inner <= band_px) | (mask & (rng.random((h, w)) < 0.05))  # a few holes inside too
+    fruit = (inner > band_px) & (inner <= 3 * band_px + 1) & (rng.random((h, w)) < (0.0 if seed == 5 else 0.3))
+    fc, bc = rng.random((3, 3)), rng.random((2, 3))
+    margin = float(rng.uniform(0.5, 1.5))
+    out = np.empty((h, w), bool)
+    _jit.trim_kept(color, mask, band, fruit, fc, bc, margin, out)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    keep = mask.copy()
+    keep[band] = _nearer_fruit(_colour_features(color, band), fc, bc, margin)
+    want = fill_holes(_connected(keep, fruit))
+    assert np.array_equal(out, want)
+    assert (out != keep).any() or seed == 5  # the fill or the pieces changed something

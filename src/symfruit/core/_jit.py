@@ -4805,6 +4805,27 @@ def prune_limit(upper: float, slack: float, count: int) -> float:
     return (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
 
 
+@_njit
+def trim_kept(
+    color: np.ndarray, mask: np.ndarray, band: np.ndarray, fruit: np.ndarray, fc: np.ndarray, bc: np.ndarray,
+    margin: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """``out`` (h, w) bool: :func:`symfruit.core.surface._colour_trim`'s last step in one call (stop 42): the band's
+    test (:func:`trim_band`), the pieces holding a pixel of ``fruit`` (:func:`connected`) and their holes filled
+    (:func:`filled` over the pieces' box grown by a pixel, as :func:`symfruit.core.raster.fill_holes`), without the
+    Python-level calls, box and copies between them: the same pixels."""
+    h, w = mask.shape
+    keep = np.empty((h, w), np.bool_)
+    trim_band(color, mask, band, fc, bc, margin, keep)
+    connected(keep, fruit, out)
+    r0, r1, c0, c1 = _box(out)
+    if r1 == 0:
+        return
+    r0, r1, c0, c1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
+    pieces = out[r0:r1, c0:c1].copy()
+    filled(pieces, out[r0:r1, c0:c1])
+
+
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------
 
 

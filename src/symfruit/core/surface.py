@@ -1443,8 +1443,9 @@ def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: 
     """:func:`_colour_trim` of a uint8 colour image by its compiled twins (issue 19, twentieth round): the regions and
     their features in one call (:func:`symfruit.core._jit.trim_features`), each summary's rows gathered and its
     k-means in one (``trim_summary``), the two accuracies' counts (``trim_separation``) and the band's test
-    (``trim_band``) in one each; the samples drawn by numpy as in the twin. The same regions, features, centres,
-    tests and pixels, bit for bit."""
+    (``trim_band``, with the pieces holding fruit pixels and their holes filled since stop 42: ``trim_kept``) in one
+    each; the samples drawn by numpy as in the twin. The same regions, features, centres, tests and pixels, bit for
+    bit."""
     fruit, band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
     f_fruit, f_ring, n_band = jit.trim_features(color, inner, mask, float(band_px), 3.0 * band_px + 1,
                                                 float(band_px + 1), fruit, band)  # fmt: skip
@@ -1458,9 +1459,9 @@ def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: 
     # the twin's accuracies are the booleans' means: their counts over their rows
     if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
         return None
-    keep = np.empty(mask.shape, bool)
-    jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
-    return fill_holes(_connected(keep, fruit))
+    kept = np.empty(mask.shape, bool)  # the band's test, the pieces holding fruit pixels, their holes filled
+    jit.trim_kept(color, mask, band, fruit, fc, bc, float(margin), kept)
+    return kept
 
 
 def _spread(n: int, k: int) -> np.ndarray:
