@@ -3521,11 +3521,11 @@ def _frame_outlines(seed: int, reach: int):
 @pytest.mark.parametrize("seed", range(8))
 def test_the_frames_fast_costs_are_the_outlines_to_the_bit(seed):
     """``frame_costs`` (issue 19, stop 41): every stage's costs are ``_told``'s fast costs of each outline (its
-    one-axis outlines' too), bit for bit; the pruned stage leaves every shift ``_least_pruned`` can take and the same
-    costs in their columns; and ``_FrameCosts.least`` is the index of ``_least_pruned`` (more than ``_PRUNE_FROM``
-    shifts) and of the search's plain ``least`` (fewer), on whole grids, one-axis grids, and a few shifts, ties
-    included."""
-    from symfruit.core import surface
+    one-axis outlines' too), bit for bit; the pruned stage leaves every shift the numpy search can take and the same
+    costs in their columns; and ``_FrameCosts.least`` is the index of its numpy twin's (``_told`` outline by outline,
+    stop 42; pruned with more than ``_PRUNE_FROM`` shifts) and of the search's plain ``least`` (fewer), on whole
+    grids, one-axis grids, and a few shifts, ties included."""
+    from symfruit.core import _jit, surface
 
     reach, trim = 10, 0.7
     outlines = _frame_outlines(seed, reach)
@@ -3538,7 +3538,8 @@ def test_the_frames_fast_costs_are_the_outlines_to_the_bit(seed):
         return np.mean([surface._told(o, shifts, reach, trim, exact) for o in outlines], axis=0)
 
     frame = surface._FrameCosts.of(outlines, reach, trim)
-    assert frame is not None
+    assert frame.jit is not None
+    twin = surface._FrameCosts(outlines, reach, trim)  # the numpy stages
     rng = np.random.default_rng(seed)
     coarse = np.arange(-reach, reach + 1, 2)
     grids = [np.stack(np.meshgrid(coarse, coarse, indexing="ij"), -1).reshape(-1, 2),
@@ -3549,29 +3550,40 @@ def test_the_frames_fast_costs_are_the_outlines_to_the_bit(seed):
         grid = grid.astype(np.int64)
         want = np.array([surface._told(o, grid, reach, trim, False) for o in outlines])
         out = np.full((len(outlines), len(grid)), np.nan)
-        best = int(frame._stage(grid, 0, -1, 0.0, out)[0])
-        assert best == int(np.argmin(want[0])) and np.array_equal(out[0], want[0])
-        frame._stage(grid, 1, best, 0.0, out)
+        f = int(frame.order[0])  # the outline of fewest points first (stop 42)
+        assert len(outlines[f].rows) == min(len(o.rows) for o in outlines)
+        best = int(frame._stage(grid, 0, -1, 0.0, 0.0, out)[0])
+        assert best == int(np.argmin(want[f])) and np.array_equal(out[f], want[f])
+        frame._stage(grid, 1, best, 0.0, 0.0, out)
         assert np.array_equal(out[:, best], want[:, best])
-        everything = frame._stage(grid, 3, -1, 0.0, out.copy())
+        everything = frame._stage(grid, 3, -1, 0.0, 0.0, out.copy())
         assert np.array_equal(everything, np.arange(len(grid)))
-        limit = float(np.quantile(want.sum(axis=0), 0.3))
-        alive = frame._stage(grid, 2, best, limit, out)
-        summed = np.cumsum(want, axis=0)  # a shift is left while its sums in the outlines' order are within it
-        assert np.array_equal(alive, np.flatnonzero((summed <= limit).all(axis=0)))
-        assert np.array_equal(out[:, alive], want[:, alive])
-        if len(outlines) > 1 and len(grid) > surface._PRUNE_FROM:
-            twin = surface._least_pruned(outlines, grid, reach, trim, cost)
-        else:
+        sums = want.sum(axis=0)
+        slack = 1e-10
+        for upper in (float(np.quantile(sums, 0.3)) / len(outlines), float(want[:, best].mean())):
+            limit = surface._limit(upper, slack, len(outlines))
+            assert limit == _jit.prune_limit(upper, slack, len(outlines))
+            stage = out.copy()
+            alive = frame._stage(grid, 2, best, upper, slack, stage)
+            summed = np.cumsum(want[frame.order], axis=0)  # every shift left has its sums in order within the limit
+            within = np.flatnonzero((summed <= limit).all(axis=0))
+            assert np.isin(alive, within).all() and np.array_equal(stage[:, alive], want[:, alive])
+            # the bound lowered by the frame costs it found: no shift as cheap as the least of those dropped
+            least_sum = sums[within].min() if len(within) else np.inf
+            assert np.isin(within[sums[within] <= least_sum + 1e-9], alive).all()
+            twin_out = out.copy()
+            assert np.array_equal(twin._stage(grid, 2, best, upper, slack, twin_out), alive)
+            assert np.array_equal(twin_out, stage, equal_nan=True)
+        if len(outlines) == 1 or len(grid) <= surface._PRUNE_FROM:  # the plain search
             fast = cost(grid, exact=False)
             near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
-            twin = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
-        assert frame.least(grid, cost) == twin
+            assert twin.least(grid, cost) == (int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0]))
+        assert frame.least(grid, cost) == twin.least(grid, cost)
 
 
 def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
-    """No ``_FrameCosts`` with the numpy twins, nor for an outline whose map has no 16-bit keys (the search costs
-    those outlines as before); ``registration_shift`` finds the same shift with it and without it."""
+    """No compiled ``_FrameCosts`` with the numpy twins, nor for an outline whose map has no 16-bit keys (the search
+    costs those outlines by ``_told``); ``registration_shift`` finds the same shift with it and without it."""
     from symfruit.core import surface
     from symfruit.core.surface import registration_shift
 
@@ -3579,15 +3591,16 @@ def test_the_frames_fast_costs_wait_for_16_bit_keys(monkeypatch):
 
     outlines = _frame_outlines(0, 10)
     monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
-    assert surface._FrameCosts.of(outlines, 10, 0.7) is None
+    assert surface._FrameCosts.of(outlines, 10, 0.7).jit is None
     monkeypatch.delenv("SYMFRUIT_KERNELS")
+    assert surface._FrameCosts.of(outlines, 10, 0.7).jit is not None
     wide = outlines[0]
     monkeypatch.setitem(wide._padded, ("keys", 10, 10), wide.keys(10, 10).astype(np.int32))
-    assert surface._FrameCosts.of(outlines, 10, 0.7) is None
+    assert surface._FrameCosts.of(outlines, 10, 0.7).jit is None
     moved, labels = three_balls_moved()
     assert registration_shift(moved.astype(np.float32), labels, F, max_px=10) == (-2, 3)
     found = registration_shift(moved, labels, F, max_px=10)
-    monkeypatch.setattr(surface._FrameCosts, "of", classmethod(lambda cls, *a: None))
+    monkeypatch.setattr(surface._FrameCosts, "of", classmethod(lambda cls, *a: cls(*a)))  # the numpy stages
     assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)
 
 
@@ -3911,3 +3924,82 @@ def test_a_found_fruits_claim_is_the_twins(seed):
             assert a[0].dtype == b[0].dtype and np.array_equal(a[0], b[0]) and a[1] == b[1]
         answers.append(a is not None)
     assert answers == [True, True, True, False]  # the disc lies mostly under the larger fruit
+
+
+# --- stop 42, speedreg42
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_pruning_limit_and_the_tightened_stage_are_their_twins(seed):
+    """``prune_limit`` is ``surface._limit`` to the bit; the pruned stage, whose bound falls to the frame cost at the
+    least running sum after each outline (the outlines costed fewest points first), leaves the twin's shifts with the
+    twin's costs written, a subset of those the first bound leaves that holds every shift within the margin of the
+    least frame cost; and the search's index is the same as costing every outline at every shift."""
+    from symfruit.core import _jit, surface
+
+    rng = np.random.default_rng(seed)
+    for upper, slack, count in zip(rng.uniform(0, 30, 50), rng.uniform(0, 1e-8, 50), rng.integers(1, 12, 50),
+                                   strict=True):  # fmt: skip
+        assert _jit.prune_limit(float(upper), float(slack), int(count)) == surface._limit(upper, slack, int(count))
+    reach, trim = 10, 0.7
+    outlines = _frame_outlines(seed, reach)
+    outlines[-1].__dict__["axes"] = (False, True)  # a one-axis outline among them
+    frame, twin = surface._FrameCosts.of(outlines, reach, trim), surface._FrameCosts(outlines, reach, trim)
+    assert frame.jit is not None and twin.jit is None
+    assert np.array_equal(frame.order, np.argsort([len(o.rows) for o in outlines], kind="stable"))
+    coarse = np.arange(-reach, reach + 1, 2)
+    grid = np.stack(np.meshgrid(coarse, coarse, indexing="ij"), -1).reshape(-1, 2).astype(np.int64)
+    want = np.array([surface._told(o, grid, reach, trim, False) for o in outlines])
+    out = np.full(want.shape, np.nan)
+    best = int(frame._stage(grid, 0, -1, 0.0, 0.0, out)[0])
+    frame._stage(grid, 1, best, 0.0, 0.0, out)
+    upper, slack = float(want[:, best].mean()), 1e-10
+    mine, theirs = out.copy(), out.copy()
+    alive = frame._stage(grid, 2, best, upper, slack, mine)
+    assert np.array_equal(twin._stage(grid, 2, best, upper, slack, theirs), alive)
+    assert np.array_equal(mine, theirs, equal_nan=True)
+    written = ~np.isnan(mine)
+    assert np.array_equal(mine[written], want[written])
+    limit = surface._limit(upper, slack, len(outlines))
+    first_bound = np.flatnonzero((np.cumsum(want[frame.order], axis=0) <= limit).all(axis=0))
+    assert np.isin(alive, first_bound).all()
+    means = want.mean(axis=0)
+    assert np.isin(np.flatnonzero(means <= means.min() + 1e-9), alive).all()
+
+    def cost(shifts, exact=True):
+        return np.mean([surface._told(o, shifts, reach, trim, exact) for o in outlines], axis=0)
+
+    fast = cost(grid, exact=False)
+    near = np.flatnonzero(fast <= fast.min() + 2e-10 * (1.0 + float(np.abs(fast).max())))
+    full = int(near[np.argmin(cost(grid[near]))]) if len(near) > 1 else int(near[0])
+    assert frame.least(grid, cost) == twin.least(grid, cost) == full
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_trim_kept_is_the_band_test_the_pieces_and_their_holes_by_the_twins(seed, monkeypatch):
+    """``trim_kept`` (stop 42): the band's test, the pieces holding a fruit pixel and their holes filled in one call,
+    the numpy twins' pixels (``keep[band] = _nearer_fruit(...)``, ``_connected``, ``fill_holes``): ragged discs on a
+    noisy image whose band test cuts pieces off and leaves holes, fruit seeds in some pieces, none at all."""
+    from symfruit.core import _jit
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import _colour_features, _connected, _nearer_fruit, fill_holes
+
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(30, 90)), int(rng.integers(30, 90))
+    yy, xx = np.mgrid[:h, :w]
+    mask = np.hypot(yy - h / 2, xx - w / 2) < rng.uniform(8, 0.45 * min(h, w)) + rng.normal(0, 1.5, (h, w))
+    color = rng.integers(0, 256, (h, w, 3)).astype(np.uint8)
+    inner = inner_distance(mask)
+    band_px = float(rng.uniform(2, 5))
+    band = mask & (inner <= band_px) | (mask & (rng.random((h, w)) < 0.05))  # a few holes inside too
+    fruit = (inner > band_px) & (inner <= 3 * band_px + 1) & (rng.random((h, w)) < (0.0 if seed == 5 else 0.3))
+    fc, bc = rng.random((3, 3)), rng.random((2, 3))
+    margin = float(rng.uniform(0.5, 1.5))
+    out = np.empty((h, w), bool)
+    _jit.trim_kept(color, mask, band, fruit, fc, bc, margin, out)
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    keep = mask.copy()
+    keep[band] = _nearer_fruit(_colour_features(color, band), fc, bc, margin)
+    want = fill_holes(_connected(keep, fruit))
+    assert np.array_equal(out, want)
+    assert (out != keep).any() or seed == 5  # the fill or the pieces changed something

@@ -933,9 +933,9 @@ def ball_outlines(seed: int, reach: int) -> list:
 @pytest.mark.parametrize("seed", range(6))
 def test_the_pruned_search_finds_the_full_searchs_shift(seed):
     """Four to six balls, their depth a few pixels off their masks (noise, rims without depth, one on a table): the
-    coarse grid's least by :func:`_least_pruned` is the full search's (every outline at every shift, the least fast
-    cost's shifts costed exactly), index for index, on the grid and on a grid of ties (a shift along one axis
-    only); and it costs the later outlines at fewer shifts than the first."""
+    coarse grid's least by the pruned search (:meth:`_FrameCosts.least` by :func:`_told`) is the full search's
+    (every outline at every shift, the least fast cost's shifts costed exactly), index for index, on the grid and on
+    a grid of ties (a shift along one axis only); and it costs the later outlines at fewer shifts than the first."""
     from symfruit.core import surface
 
     outlines = ball_outlines(seed, 10)
@@ -958,7 +958,7 @@ def test_the_pruned_search_finds_the_full_searchs_shift(seed):
         real_told, seen = surface._told, []
         with pytest.MonkeyPatch.context() as mp:
             mp.setattr(surface, "_told", told)
-            assert surface._least_pruned(outlines, grid, 10, 0.7, cost) == full
+            assert surface._FrameCosts(outlines, 10, 0.7).least(grid, cost) == full
         assert seen[0] == len(grid)
         if len(grid) == 121:  # the whole grid: the later outlines costed at fewer shifts
             assert min(seen[1:]) < len(grid)

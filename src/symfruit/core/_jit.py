@@ -4684,21 +4684,27 @@ def _fast_cost(
 @_njit
 def frame_costs(
     ranks: np.ndarray, values: np.ndarray, at: np.ndarray, starts: np.ndarray, widths: np.ndarray,
-    keeps: np.ndarray, bands: np.ndarray, axes: np.ndarray, shifts: np.ndarray, stage: int, best: int,
-    limit: float, out: np.ndarray,
+    keeps: np.ndarray, bands: np.ndarray, axes: np.ndarray, order: np.ndarray, shifts: np.ndarray, stage: int,
+    best: int, upper: float, slack: float, out: np.ndarray,
 ) -> np.ndarray:  # fmt: skip
     """Fast costs (:func:`outline_costs`'s, each the same number) of a frame's ``m`` outlines into ``out`` (m, k), in
-    one call each stage of :func:`symfruit.core.surface._least_pruned` (issue 19, stop 41). Outline ``o``'s ranks,
-    values and points are ``ranks[starts[o, 0]:starts[o + 1, 0]]``, ``values[starts[o, 1]:...]`` and
-    ``at[starts[o, 2]:...]`` (``starts`` (m + 1, 3)), its padded width ``widths[o]``, with ``keeps[o]`` and
-    ``bands[o]``; each shift (k, 2) ``(dv, du)`` costed as far as the outline tells it (``axes`` (m, 2) bool: as
-    :func:`symfruit.core.surface._told`, the cost of the shift with its untold part 0, each distinct one once).
+    one call each stage of :meth:`symfruit.core.surface._FrameCosts.least` (issue 19, stop 41; its numpy twin is
+    ``_FrameCosts._twin_stage``). Outline ``o``'s ranks, values and points are ``ranks[starts[o, 0]:starts[o + 1,
+    0]]``, ``values[starts[o, 1]:...]`` and ``at[starts[o, 2]:...]`` (``starts`` (m + 1, 3)), its padded width
+    ``widths[o]``, with ``keeps[o]`` and ``bands[o]``; each shift (k, 2) ``(dv, du)`` costed as far as the outline
+    tells it (``axes`` (m, 2) bool: as :func:`symfruit.core.surface._told`, the cost of the shift with its untold
+    part 0, each distinct one once).
 
-    ``stage`` 0: the first outline at every shift (row 0), returning ``[np.argmin(row 0)]``; 1: every other outline at
-    the shift ``best`` (column ``best``), returning ``[best]``; 2: with row 0 written, each further outline, in order,
-    at the shifts whose costs summed so far (in the outlines' order, as the twin sums them) are at most ``limit``
-    (row 0's shifts within it to start), returning those left (ascending), whose columns hold every outline's cost;
-    3: as 2 without a limit (every outline at every shift). Other entries of ``out`` are not written."""
+    The outlines are costed in the order ``order`` (m,) (a permutation; stop 42), each into its own row. ``stage`` 0:
+    the first outline ``f = order[0]`` at every shift (row ``f``), returning ``[np.argmin(row f)]``; 1: every other
+    outline at the shift ``best`` (column ``best``), returning ``[best]``; 2: with row ``f`` and column ``best``
+    written, each further outline, in order, at the shifts whose costs summed so far (in that order) are at most
+    the limit (:func:`prune_limit` of ``upper``, a frame cost at some shift, and ``slack``; row ``f``'s shifts within
+    it to start), returning those left (ascending), whose columns hold every outline's cost. After each outline but
+    the last, the shift left of least sum so far (the first such) is costed by every outline not yet (stop 42): its
+    frame cost (the outlines' costs summed in the rows' order, over ``m``) lowers ``upper`` and the limit when it is
+    less. 3:
+    as 2 without a limit (every outline at every shift). Other entries of ``out`` are not written."""
     m, k = out.shape
     span = 0
     for s in range(k):
@@ -4712,57 +4718,112 @@ def frame_costs(
     count = np.zeros(size, np.int64)
     row = np.empty(n_max, np.int64)
 
-    def told(o: int, s: int) -> float:
-        tv, tu = axes[o, 0], axes[o, 1]
-        dv = shifts[s, 0] if tv else 0
-        du = shifts[s, 1] if tu else 0
+    def once(o: int, s: int) -> float:
+        dv = shifts[s, 0] if axes[o, 0] else 0
+        du = shifts[s, 1] if axes[o, 1] else 0
         rk = ranks[starts[o, 0] : starts[o + 1, 0]]
         va = values[starts[o, 1] : starts[o + 1, 1]]
         pts = at[starts[o, 2] : starts[o + 1, 2]]
-        if tv and tu:
-            return _fast_cost(rk, va, pts, dv * widths[o] + du, keeps[o], bands[o], count, row)
-        i = dv + du + span  # one of the two is 0
+        return _fast_cost(rk, va, pts, dv * widths[o] + du, keeps[o], bands[o], count, row)
+
+    def told(o: int, s: int) -> float:
+        if axes[o, 0] and axes[o, 1]:
+            return once(o, s)
+        i = (shifts[s, 0] if axes[o, 0] else 0) + (shifts[s, 1] if axes[o, 1] else 0) + span  # one of them is 0
         if not seen[i]:
-            cached[i] = _fast_cost(rk, va, pts, dv * widths[o] + du, keeps[o], bands[o], count, row)
+            cached[i] = once(o, s)
             seen[i] = True
         return cached[i]
 
+    first = order[0]
     if stage == 0:
         least, at_least = 0, np.inf
         for s in range(k):
-            c = told(0, s)
-            out[0, s] = c
+            c = told(first, s)
+            out[first, s] = c
             if c < at_least or (math.isnan(c) and not math.isnan(at_least)):  # np.argmin's: the first least or NaN
                 least, at_least = s, c
         return np.array([least], np.int64)
     if stage == 1:
-        for o in range(1, m):
+        for n in range(1, m):
             seen[:] = False
-            out[o, best] = told(o, best)
+            out[order[n], best] = told(order[n], best)
         return np.array([best], np.int64)
     prune = stage == 2
+    limit = prune_limit(upper, slack, m) if prune else np.inf
+    full = np.zeros(k, np.bool_)  # the shifts every outline is costed at already
+    if prune:
+        full[best] = True
     alive = np.empty(k, np.int64)
     summed = np.empty(k)
     n_alive = 0
     for s in range(k):
-        if not prune or out[0, s] <= limit:
+        if not prune or out[first, s] <= limit:
             alive[n_alive] = s
-            summed[n_alive] = out[0, s]
+            summed[n_alive] = out[first, s]
             n_alive += 1
-    for o in range(1, m):
+    for n in range(1, m):
+        o = order[n]
         seen[:] = False
         kept = 0
         for i in range(n_alive):
             s = alive[i]
-            part = told(o, s)
-            out[o, s] = part
-            total = summed[i] + part
+            if not full[s]:
+                out[o, s] = told(o, s)
+            total = summed[i] + out[o, s]
             if not prune or total <= limit:
                 alive[kept] = s
                 summed[kept] = total
                 kept += 1
         n_alive = kept
+        if prune and n < m - 1 and n_alive > 1:
+            j = 0
+            for i in range(1, n_alive):
+                if summed[i] < summed[j]:
+                    j = i
+            s = alive[j]
+            if not full[s]:
+                for p in range(n + 1, m):
+                    out[order[p], s] = once(order[p], s)
+                full[s] = True
+                total = 0.0
+                for p in range(m):
+                    total += out[p, s]
+                mean = total / m
+                if mean < upper:
+                    upper, limit = mean, prune_limit(mean, slack, m)
     return alive[:n_alive].copy()
+
+
+# --- stop 42, speedreg42: the registration's pruning bound -----------------------------------------------------------
+
+
+@_njit
+def prune_limit(upper: float, slack: float, count: int) -> float:
+    """:func:`symfruit.core.surface._limit`'s twin: the bound of ``count`` outlines' fast costs summed at a shift that
+    can be the least one, from a frame cost ``upper`` (the same expression, the same number)."""
+    return (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
+
+
+@_njit
+def trim_kept(
+    color: np.ndarray, mask: np.ndarray, band: np.ndarray, fruit: np.ndarray, fc: np.ndarray, bc: np.ndarray,
+    margin: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """``out`` (h, w) bool: :func:`symfruit.core.surface._colour_trim`'s last step in one call (stop 42): the band's
+    test (:func:`trim_band`), the pieces holding a pixel of ``fruit`` (:func:`connected`) and their holes filled
+    (:func:`filled` over the pieces' box grown by a pixel, as :func:`symfruit.core.raster.fill_holes`), without the
+    Python-level calls, box and copies between them: the same pixels."""
+    h, w = mask.shape
+    keep = np.empty((h, w), np.bool_)
+    trim_band(color, mask, band, fc, bc, margin, keep)
+    connected(keep, fruit, out)
+    r0, r1, c0, c1 = _box(out)
+    if r1 == 0:
+        return
+    r0, r1, c0, c1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
+    pieces = out[r0:r1, c0:c1].copy()
+    filled(pieces, out[r0:r1, c0:c1])
 
 
 # --- issue 19, sixteenth round: the colour segmenter's red pixels and windows --------------------------------------

@@ -1151,18 +1151,7 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
 
     # the fast costs of every outline in one call a stage where numba is (issue 19, stop 41: the same numbers)
     frame = _FrameCosts.of(outlines, max_px, trim)
-
-    def least(shifts: np.ndarray) -> int:
-        """The first shift of least exact cost. The fast costs are within ``slack`` of the exact ones, so only
-        the shifts within twice that of their least can be it; those (one, but for ties) are costed exactly."""
-        if frame is not None and int(np.abs(shifts).max(initial=0)) <= max_px:
-            return frame.least(shifts, cost)
-        if len(outlines) > 1 and len(shifts) > _PRUNE_FROM:
-            return _least_pruned(outlines, shifts, max_px, trim, cost)
-        fast = cost(shifts, exact=False)
-        slack = 1e-10 * (1.0 + float(np.abs(fast).max()))  # some 10^4 times the sums' rounding
-        near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
-        return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
+    least = functools.partial(frame.least, cost=cost)
 
     # an axis is searched when the frame's outlines, pooled, tell it (a fruit whose side is free by a few points
     # does not outvote the others) and a fruit tells it; otherwise it keeps 0
@@ -1181,66 +1170,35 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     fine = fine.reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     best = least(fine)
-    if cost(fine[best : best + 1])[0] > zero - gain or (np.abs(fine[best]) >= max_px).any():
+    # the unshifted masks' cost again when the least shift is none (a frame registered well: the same number)
+    at_best = zero if not fine[best].any() else cost(fine[best : best + 1])[0]
+    if at_best > zero - gain or (np.abs(fine[best]) >= max_px).any():
         return 0, 0  # no gain; or a least cost at the search's border, still falling beyond it: no minimum found
     return int(fine[best, 1]), int(fine[best, 0])
 
 
-#: :func:`registration_shift`'s search costs a set of more shifts than this fruit by fruit (:func:`_least_pruned`)
+#: :func:`registration_shift`'s search costs a set of more shifts than this fruit by fruit, pruned
+#: (:meth:`_FrameCosts.least`)
 _PRUNE_FROM = 30
 
 
-def _least_pruned(outlines: list[_Outline], shifts: np.ndarray, reach: int, trim: float,
-                  cost: Callable[..., np.ndarray]) -> int:  # fmt: skip
-    """:func:`registration_shift`'s ``least(shifts)``, the same index, without the fast cost of every outline at
-    every shift (issue 19, eighteenth round: the coarse grid's 441 shifts of 9 fruit were most of the registration).
-
-    A shift's cost is the mean of the outlines' costs, each at least 0, so the outlines' costs summed so far,
-    divided by their number, are a lower bound of it. The first outline is costed at every shift and the frame's
-    cost at that outline's least shift (the same number the search computes there) bounds the least one from
-    above; each further outline is costed only at the shifts whose lower bound is not above that by more than the
-    margin, which is more than twice ``least``'s slack (made with a bound of the largest cost an outline can have:
-    its window's diagonal plus the reach and its band) and more than the sums' rounding. A shift left out cannot
-    be among those within twice the slack of the least fast cost; those left in have every outline's fast cost,
-    each row's the same numbers the search has (a row's cost depends on that row alone), their mean taken as the
-    search does. The shifts within twice the larger slack of the least are costed exactly, the first least
-    returned: any taken beyond the search's own lie more than the slack above its least fast cost, so above the
-    least exact one, and are never it."""
-    first = _told(outlines[0], shifts, reach, trim, False)
-    count = len(outlines)
-    best = int(np.argmin(first))
-    upper = float(cost(shifts[best : best + 1], exact=False)[0])
-    # no distance in a window exceeds its diagonal (beyond it the map reads -reach): no fast cost exceeds ``top``
-    top = max(float(np.hypot(*o.inside.shape)) + float(reach) + o.band for o in outlines)
-    slack = 1e-10 * (1.0 + top)  # at least the search's
-    limit = (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
-    alive = np.flatnonzero(first <= limit)
-    summed = first[alive]
-    rows = [first[alive]]
-    for o in outlines[1:]:
-        part = _told(o, shifts[alive], reach, trim, False)
-        summed = summed + part
-        keep = summed <= limit
-        if not keep.all():
-            alive, summed, part = alive[keep], summed[keep], part[keep]
-            rows = [r[keep] for r in rows]
-        rows.append(part)
-    fast = np.mean(rows, axis=0)
-    near = alive[fast <= fast.min() + 2.0 * slack]
-    return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
-
-
 class _FrameCosts:
-    """A frame's outlines' fast costs by one compiled call a stage (:func:`symfruit.core._jit.frame_costs`, issue 19,
-    stop 41), for :func:`registration_shift`'s ``least``: the same numbers as :meth:`_Outline.cost`'s compiled fast
-    costs (:func:`symfruit.core._jit.outline_costs`, whose cost of a shift it shares), each outline's shifts as far as
-    it tells them (:func:`_told`), pruned as :func:`_least_pruned` prunes them and averaged by numpy as there: the
-    same index. Without some 40 Python-level calls a frame (each outline's :func:`_told` per stage) and the
-    one-axis outlines' ``np.unique``. Made only where numba is and every outline's map has 16-bit keys (where
-    :meth:`_Outline.cost` takes the compiled fast costs), for shifts within the reach (the pad of its maps)."""
+    """A frame's outlines' fast costs a stage at a time, for :func:`registration_shift`'s ``least``
+    (:meth:`least`): each outline's shifts as far as it tells them (:func:`_told`). Where numba is and every
+    outline's map has 16-bit keys (where :meth:`_Outline.cost` takes the compiled fast costs), for shifts within the
+    reach (the pad of its maps), one compiled call a stage (:func:`symfruit.core._jit.frame_costs`, issue 19, stop
+    41: the same numbers as :meth:`_Outline.cost`'s compiled fast costs, :func:`symfruit.core._jit.outline_costs`,
+    whose cost of a shift it shares; without some 40 Python-level calls a frame and the one-axis outlines'
+    ``np.unique``); else :func:`_told` outline by outline (:meth:`_twin_stage`, the kernel's twin). One search
+    serves both (stop 42: it was written twice, ``_least_pruned`` the numpy one)."""
 
-    def __init__(self, jit: Any, outlines: list[_Outline], reach: int, trim: float) -> None:
-        self.jit, self.outlines, self.reach = jit, outlines, int(reach)
+    def __init__(self, outlines: list[_Outline], reach: int, trim: float, jit: Any = None) -> None:
+        self.jit, self.outlines, self.reach, self.trim = jit, outlines, int(reach), float(trim)
+        # the outlines costed fewest points first (stop 42): the first one is costed at every shift; each keeps its own
+        # row of the costs, so their means are the same numbers whatever the order
+        self.order = np.argsort([len(o.rows) for o in outlines], kind="stable").astype(np.int64)
+        if jit is None:
+            return
         ranks, values, at, widths = [], [], [], []
         for o in outlines:
             rank, value = o.ranks(self.reach, reach)
@@ -1259,42 +1217,112 @@ class _FrameCosts:
         self.axes = np.array([o.axes for o in outlines], np.bool_).reshape(-1, 2)
 
     @classmethod
-    def of(cls, outlines: list[_Outline], reach: int, trim: float) -> _FrameCosts | None:
-        if (jit := compiled()) is None:
-            return None
-        for o in outlines:
+    def of(cls, outlines: list[_Outline], reach: int, trim: float) -> _FrameCosts:
+        """The frame's costs, compiled where they can be (the class docstring), else by :func:`_told`."""
+        jit = compiled()
+        for o in outlines if jit is not None else ():
             keys = o.keys(int(reach), reach)
             if keys is None or keys.dtype != np.int16 or not len(o.rows):
-                return None
-        return cls(jit, outlines, reach, trim)
+                jit = None
+                break
+        return cls(outlines, reach, trim, jit)
 
-    def _stage(self, shifts: np.ndarray, stage: int, best: int, limit: float, out: np.ndarray) -> np.ndarray:
+    def _stage(self, shifts: np.ndarray, stage: int, best: int, upper: float, slack: float,
+               out: np.ndarray) -> np.ndarray:  # fmt: skip
+        """One stage of :meth:`least` into ``out`` (m, k), as :func:`symfruit.core._jit.frame_costs` documents it."""
+        if self.jit is None or int(np.abs(shifts).max(initial=0)) > self.reach:
+            return self._twin_stage(shifts, stage, best, upper, slack, out)
         return self.jit.frame_costs(self.ranks, self.values, self.at, self.starts, self.widths, self.keeps,
-                                    self.bands, self.axes, shifts, stage, best, limit, out)  # fmt: skip
+                                    self.bands, self.axes, self.order, shifts, stage, best, upper, slack,
+                                    out)  # fmt: skip
+
+    def _twin_stage(self, shifts: np.ndarray, stage: int, best: int, upper: float, slack: float,
+                    out: np.ndarray) -> np.ndarray:  # fmt: skip
+        """:func:`symfruit.core._jit.frame_costs`' stage by :func:`_told`, outline by outline: the same shifts left,
+        the same costs (each row's cost depends on that row alone), the same running sums and bounds."""
+        reach, trim, count = self.reach, self.trim, len(self.outlines)
+        order = self.order
+        first, rest = int(order[0]), [int(i) for i in order[1:]]
+        if stage == 0:
+            out[first] = _told(self.outlines[first], shifts, reach, trim, False)
+            return np.array([int(np.argmin(out[first]))], np.int64)
+        if stage == 1:
+            for i in rest:
+                out[i, best] = _told(self.outlines[i], shifts[best : best + 1], reach, trim, False)[0]
+            return np.array([best], np.int64)
+        prune = stage == 2
+        limit = _limit(upper, slack, count) if prune else np.inf
+        full = np.zeros(len(shifts), bool)  # the shifts every outline is costed at already
+        if prune:
+            full[best] = True
+        alive = np.flatnonzero(out[first] <= limit) if prune else np.arange(len(shifts))
+        summed = out[first, alive]
+        for n, i in enumerate(rest, 2):
+            if len(todo := alive[~full[alive]]):
+                out[i, todo] = _told(self.outlines[i], shifts[todo], reach, trim, False)
+            summed = summed + out[i, alive]
+            if not prune:
+                continue
+            keep = summed <= limit
+            alive, summed = alive[keep], summed[keep]
+            if n < count and len(alive) > 1:  # the least sum so far: its frame cost may bound lower (stop 42)
+                at = int(alive[int(np.argmin(summed))])  # no NaN is left in: each sum is within the limit
+                if not full[at]:
+                    for j in rest[n - 1 :]:
+                        out[j, at] = _told(self.outlines[j], shifts[at : at + 1], reach, trim, False)[0]
+                    full[at] = True
+                    mean = sum(out[:, at].tolist()) / count  # in the outlines' order, as the kernel sums them
+                    if mean < upper:
+                        upper, limit = mean, _limit(mean, slack, count)
+        return alive
 
     def least(self, shifts: np.ndarray, cost: Callable[..., np.ndarray]) -> int:
-        """``least(shifts)`` of :func:`registration_shift` (``cost``: its exact costs): with more than one outline
-        and more than :data:`_PRUNE_FROM` shifts :func:`_least_pruned`'s steps, else every outline at every shift;
-        the same fast costs, means, slack and exact costs of the shifts near the least."""
+        """``least(shifts)`` of :func:`registration_shift` (``cost``: its exact costs): the first shift of least exact
+        cost. The fast costs are within ``slack`` of the exact ones, so only the shifts within twice that of their
+        least can be it; those (one, but for ties) are costed exactly.
+
+        With more than one outline and more than :data:`_PRUNE_FROM` shifts (issue 19, eighteenth round: the coarse
+        grid's 441 shifts of 9 fruit were most of the registration), not every outline at every shift. A shift's
+        cost is the mean of the outlines' costs, each at least 0, so the outlines' costs summed so far, divided by
+        their number, are a lower bound of it. The outline of fewest points is costed first, at every shift, and
+        the frame's cost at that outline's least shift bounds the least one from above; each further outline is
+        costed only at the shifts whose lower bound is not above that by more than the margin (:func:`_limit`),
+        which is more than twice the slack (made with a bound of the largest cost an outline can have: its
+        window's diagonal plus the reach and its band) and more than the sums' rounding. After each outline, the
+        frame's cost at the shift left of least sum so far bounds the least one too, and lowers the bound when less
+        (stop 42: the first outline's least shift can cost the frame several times the least one, bench seed 2's
+        7.47 px against 1.19, and the pruning then kept most shifts). Any frame cost at any shift is such a bound,
+        and the rows of ``out`` are the outlines' whatever the order they are costed in: a shift left out cannot be
+        among those within twice the slack of the least fast cost; those left in have every outline's fast cost,
+        their mean taken as for every shift. The shifts within twice the larger slack of the least are costed
+        exactly, the first least returned: any taken beyond the plain search's own lie more than its slack above
+        its least fast cost, so above the least exact one, and are never it."""
         count = len(self.outlines)
         shifts = np.ascontiguousarray(shifts, dtype=np.int64)
         out = np.empty((count, len(shifts)))
-        best = int(self._stage(shifts, 0, -1, 0.0, out)[0])
+        best = int(self._stage(shifts, 0, -1, 0.0, 0.0, out)[0])
         if count > 1 and len(shifts) > _PRUNE_FROM:
-            self._stage(shifts, 1, best, 0.0, out)
+            self._stage(shifts, 1, best, 0.0, 0.0, out)
             upper = float(np.mean(np.ascontiguousarray(out[:, best : best + 1]), axis=0)[0])
+            # no distance in a window exceeds its diagonal (beyond it the map reads -reach): no fast cost exceeds it
             top = max(float(np.hypot(*o.inside.shape)) + float(self.reach) + o.band for o in self.outlines)
             slack = 1e-10 * (1.0 + top)
-            limit = (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
-            alive = self._stage(shifts, 2, best, limit, out)
+            alive = self._stage(shifts, 2, best, upper, slack, out)
             fast = np.mean(out[:, alive], axis=0)
             near = alive[fast <= fast.min() + 2.0 * slack]
         else:
-            self._stage(shifts, 3, -1, 0.0, out)
+            self._stage(shifts, 3, -1, 0.0, 0.0, out)
             fast = np.mean(out, axis=0)
-            slack = 1e-10 * (1.0 + float(np.abs(fast).max()))
+            slack = 1e-10 * (1.0 + float(np.abs(fast).max()))  # some 10^4 times the sums' rounding
             near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
         return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
+
+
+def _limit(upper: float, slack: float, count: int) -> float:
+    """:meth:`_FrameCosts.least`'s bound of the sum of ``count`` outlines' fast costs at a shift that can be the least
+    one, from a frame cost ``upper`` at some shift: more than twice ``slack`` above it, and more than the sums'
+    rounding (the compiled twin: :func:`symfruit.core._jit.prune_limit`, the same number)."""
+    return (upper + 2.0 * slack + 1e-9 * (1.0 + upper)) * count
 
 
 def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact: bool) -> np.ndarray:
@@ -1415,8 +1443,9 @@ def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: 
     """:func:`_colour_trim` of a uint8 colour image by its compiled twins (issue 19, twentieth round): the regions and
     their features in one call (:func:`symfruit.core._jit.trim_features`), each summary's rows gathered and its
     k-means in one (``trim_summary``), the two accuracies' counts (``trim_separation``) and the band's test
-    (``trim_band``) in one each; the samples drawn by numpy as in the twin. The same regions, features, centres,
-    tests and pixels, bit for bit."""
+    (``trim_band``, with the pieces holding fruit pixels and their holes filled since stop 42: ``trim_kept``) in one
+    each; the samples drawn by numpy as in the twin. The same regions, features, centres, tests and pixels, bit for
+    bit."""
     fruit, band = np.empty(mask.shape, bool), np.empty(mask.shape, bool)
     f_fruit, f_ring, n_band = jit.trim_features(color, inner, mask, float(band_px), 3.0 * band_px + 1,
                                                 float(band_px + 1), fruit, band)  # fmt: skip
@@ -1430,9 +1459,9 @@ def _colour_trim_compiled(jit: Any, color: np.ndarray, mask: np.ndarray, inner: 
     # the twin's accuracies are the booleans' means: their counts over their rows
     if n_fruit_ok / len(f_fruit) < min_accuracy or n_ring_ok / len(f_ring) < min_accuracy:
         return None
-    keep = np.empty(mask.shape, bool)
-    jit.trim_band(color, mask, band, fc, bc, float(margin), keep)
-    return fill_holes(_connected(keep, fruit))
+    kept = np.empty(mask.shape, bool)  # the band's test, the pieces holding fruit pixels, their holes filled
+    jit.trim_kept(color, mask, band, fruit, fc, bc, float(margin), kept)
+    return kept
 
 
 def _spread(n: int, k: int) -> np.ndarray:
