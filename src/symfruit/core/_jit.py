@@ -4851,7 +4851,8 @@ def red_pixels(
     n_weak = n_strong = 0
     for r in range(h):
         for q in range(w):
-            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            red = np.int64(c[r, q, 0])
+            kind = _red_kind(red, np.int64(c[r, q, 1]), np.int64(c[r, q, 2]), low[red], high[red], sqrt3, tan_hue)
             if kind == 0:
                 continue
             weak[n_weak] = r * w + q
@@ -4863,14 +4864,15 @@ def red_pixels(
 
 
 @_njit
-def _red_kind(c: np.ndarray, r: int, q: int, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float) -> int:
-    """The red tests of pixel ``(r, q)`` of ``c`` (:func:`red_pixels`' and :func:`red_regions_once`'s, on the twin's
-    whole numbers and products): 0 not red, 1 weakly red, 2 strongly red too."""
-    red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+def _red_kind(red: int, green: int, blue: int, low: int, high: int, sqrt3: float, tan_hue: float) -> int:
+    """The red tests of a pixel (:func:`red_pixels`' and :func:`red_regions_once`'s, on the twin's whole numbers and
+    products) from its channels and the tables' entries at its red (``low[red]``, ``high[red]``): 0 not red, 1 weakly
+    red, 2 strongly red too. Whole numbers, no arrays: an array passed to a compiled function is reference-counted on
+    every call, and per pixel that cost 15 ms of a 1920x1080 tree frame (stop 42)."""
     most = max(green, blue)
-    if red <= most or most > low[red]:
+    if red <= most or most > low:
         return 0
-    if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+    if most <= high and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
         return 2
     return 1
 
@@ -6192,7 +6194,8 @@ def red_regions_once(
     n_weak = n_strong = 0
     for r in range(h):
         for q in range(w):
-            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            red = np.int64(c[r, q, 0])
+            kind = _red_kind(red, np.int64(c[r, q, 1]), np.int64(c[r, q, 2]), low[red], high[red], sqrt3, tan_hue)
             if kind == 0:
                 continue
             weak[n_weak] = r * w + q
