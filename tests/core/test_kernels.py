@@ -4003,3 +4003,66 @@ def test_trim_kept_is_the_band_test_the_pieces_and_their_holes_by_the_twins(seed
     want = fill_holes(_connected(keep, fruit))
     assert np.array_equal(out, want)
     assert (out != keep).any() or seed == 5  # the fill or the pieces changed something
+
+
+# --- stop 42, speedseg42
+
+
+@pytest.mark.parametrize("eight", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_the_shared_labelling_of_set_pixels_is_scipys(seed, eight):
+    """:func:`_jit._label_pixels` (the labelling :func:`_jit.label` and :func:`_jit.red_regions_once` share) from the
+    flat indices of a mask's set pixels: ``ndimage.label``'s labels and count, on random masks, a U and a comb whose
+    provisional labels join late, a one-row and a one-column mask, and no pixel at all."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(420 + seed)
+    u = np.zeros((9, 11), bool)
+    u[1:8, 2] = u[1:8, 8] = u[7, 2:9] = True  # two arms joined at the bottom: one label for both
+    comb = np.zeros((8, 13), bool)
+    comb[0:7, 0:13:3] = True
+    comb[7, :] = True
+    masks = [rng.random((31, 47)) < d for d in (0.1, 0.45, 0.8)] + [u, comb, rng.random((1, 40)) < 0.5]
+    masks += [rng.random((40, 1)) < 0.5, np.zeros((5, 6), bool)]
+    for mask in masks:
+        want, n = ndimage.label(mask, structure=np.ones((3, 3), bool) if eight else None)
+        out = np.zeros(mask.shape, np.int32)
+        m = _jit._label_pixels(out, np.flatnonzero(mask).astype(np.int64), eight)
+        np.testing.assert_array_equal(out, want)
+        assert m == n
+    assert m == 0 and n == 0  # the last mask: no pixel
+
+
+def test_the_red_kind_of_every_colour_is_the_twins():
+    """:func:`_jit._red_kind` from a pixel's channels and its tables' entries, on every red level with green and
+    blue on a grid of 0-255 (and equal to red, one below it): the numpy twin's weak and strong pixels
+    (``_red_pixels`` with ``SYMFRUIT_KERNELS=numpy``), 1 for weak alone and 2 for strong."""
+    from symfruit.segment.colour import SegmentSettings, _red_pixels, _red_tables
+
+    s = SegmentSettings()
+    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    levels = np.unique(np.concatenate((np.arange(0, 256, 15), [1, 2, 41, 254, 255])))
+    r, g, b = np.meshgrid(np.arange(256), levels, levels, indexing="ij")
+    image = np.stack((r, g, b), axis=-1).reshape(256, -1, 3).astype(np.uint8)
+    image[:, :2] = np.stack((np.arange(256), np.arange(256), np.maximum(np.arange(256) - 1, 0)), -1)[:, None]
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        weak, strong = _red_pixels(image, s)
+    want = np.zeros(image.shape[:2], np.int64).ravel()
+    want[weak] = 1
+    want[strong] = 2
+    sqrt3, tan_hue = float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
+    got = [_jit._red_kind(int(p[0]), int(p[1]), int(p[2]), int(low[p[0]]), int(high[p[0]]), sqrt3, tan_hue)
+           for p in image.reshape(-1, 3)]  # fmt: skip
+    np.testing.assert_array_equal(np.array(got), want)
+    assert (want == 1).any() and (want == 2).any()
+
+
+def test_the_reflected_index_is_scipys_reflect_mode():
+    """:func:`_jit._reflected` for lines of 1-6 values and indices from three lines before to three after: numpy's
+    "symmetric" padding (scipy's "reflect": the edge value repeated) of the line's own indices, inside the line the
+    index itself."""
+    for n in range(1, 7):
+        padded = np.pad(np.arange(n), 3 * n, mode="symmetric")
+        for i in range(-3 * n, 4 * n):
+            assert _jit._reflected(i, n) == padded[i + 3 * n]

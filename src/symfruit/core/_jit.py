@@ -4912,7 +4912,8 @@ def red_pixels(
     n_weak = n_strong = 0
     for r in range(h):
         for q in range(w):
-            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            red = np.int64(c[r, q, 0])
+            kind = _red_kind(red, np.int64(c[r, q, 1]), np.int64(c[r, q, 2]), low[red], high[red], sqrt3, tan_hue)
             if kind == 0:
                 continue
             weak[n_weak] = r * w + q
@@ -4924,14 +4925,16 @@ def red_pixels(
 
 
 @_njit
-def _red_kind(c: np.ndarray, r: int, q: int, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float) -> int:
-    """The red tests of pixel ``(r, q)`` of ``c`` (:func:`red_pixels`' and :func:`red_regions_once`'s, on the twin's
-    whole numbers and products): 0 not red, 1 weakly red, 2 strongly red too."""
-    red, green, blue = np.int64(c[r, q, 0]), np.int64(c[r, q, 1]), np.int64(c[r, q, 2])
+def _red_kind(red: int, green: int, blue: int, low: int, high: int, sqrt3: float, tan_hue: float) -> int:
+    """The red tests of a pixel (:func:`red_pixels`' and :func:`red_regions_once`'s, on the twin's whole numbers and
+    products) from its channels and the tables' entries at its red (``low[red]``, ``high[red]``): 0 not red, 1 weakly
+    red, 2 strongly red too. Whole numbers, no arrays: with the image and tables as arguments it was not inlined and
+    their reference counts were taken and dropped on every call (6 increfs, 13 decrefs in its caller's loop), per
+    pixel 15 of a 1920x1080 tree frame's 58 ms (stop 42)."""
     most = max(green, blue)
-    if red <= most or most > low[red]:
+    if red <= most or most > low:
         return 0
-    if most <= high[red] and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
+    if most <= high and sqrt3 * float(green - blue) < tan_hue * float(2 * red - green - blue):
         return 2
     return 1
 
@@ -5266,55 +5269,26 @@ def _union(parent: np.ndarray, a: int, b: int) -> int:
 def label(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int]:
     """``ndimage.label(mask)`` of a 2-d bool ``mask`` (``eight``: ``structure=np.ones((3, 3))``, else the
     4-neighbourhood): (h, w) int32 labels 1..n numbered by their first pixel in raster order, as scipy numbers them,
-    and n. One raster pass joining each pixel with its labelled neighbours above and to the left (union-find; with
-    eight neighbours the one above joins all three of the others already, else the left and upper-left ones are
-    joined and the upper-right one may join them), one numbering the roots in the order their first pixels come."""
+    and n: the set pixels' flat indices gathered in one raster pass and labelled by :func:`_label_pixels` (the
+    labelling :func:`red_regions_once` shares, stop 42)."""
     h, w = mask.shape
+    at = np.empty(h * w, np.int64)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            at[k] = r * w + c  # kept when set: no branch
+            k += 1 if mask[r, c] else 0
     out = np.zeros((h, w), np.int32)
-    parent = np.empty(h * w + 1, np.int64)
-    n = 0
-    for r in range(h):
-        for c in range(w):
-            if not mask[r, c]:
-                continue
-            up = out[r - 1, c] if r > 0 else 0
-            left = out[r, c - 1] if c > 0 else 0
-            own = 0
-            if eight:
-                if up:
-                    own = up
-                else:
-                    own = left if left else (out[r - 1, c - 1] if r > 0 and c > 0 else 0)
-                    right = out[r - 1, c + 1] if r > 0 and c + 1 < w else 0
-                    if right:
-                        own = _union(parent, own, right) if own else right
-            elif up and left:
-                own = _union(parent, up, left) if up != left else up
-            else:
-                own = up if up else left
-            if own == 0:
-                n += 1
-                parent[n] = n
-                own = n
-            out[r, c] = own
-    final = np.zeros(n + 1, np.int32)
-    m = 0
-    for r in range(h):
-        for c in range(w):
-            if out[r, c] == 0:
-                continue
-            root = _root(parent, out[r, c])
-            if final[root] == 0:
-                m += 1
-                final[root] = m
-            out[r, c] = final[root]
-    return out, m
+    return out, _label_pixels(out, at[:k], eight)
 
 
 @_njit
 def _reflected(i: int, n: int) -> int:
     """The index that ``i`` reads in a line of ``n`` values extended by scipy's "reflect" mode (d c b a | a b c d |
-    d c b a: the edge value repeated)."""
+    d c b a: the edge value repeated). Inside the line, ``i`` itself without a division (called for every pixel of the
+    segmenter's crease test and smoothing: four divisions a pixel were a third of the depth edges' time; stop 42)."""
+    if 0 <= i < n:
+        return i
     if n == 1:
         return 0
     i %= 2 * n
@@ -6272,22 +6246,21 @@ def split_centres(
 def red_regions_once(
     c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
-    """:func:`symfruit.segment.colour._red_regions`' values (the twin's) in one raster pass over
-    the window: each pixel's red tests (:func:`red_pixels`' whole numbers and products) and, for a weak pixel, its
-    provisional label (:func:`label`'s union-find with eight neighbours, the same unions in the same order), then the
-    roots numbered over the weak pixels alone, in raster order (as :func:`label`'s second pass meets them: the same
-    numbers), not over every pixel of a window that may span most of a 1920x1080 image (issue 19, stop 41)."""
+    """:func:`symfruit.segment.colour._red_regions`' values (the twin's): one raster pass over
+    the window making each pixel's red tests (:func:`red_pixels`' whole numbers and products) and gathering the weak
+    and strong pixels, then the weak pixels labelled with eight neighbours by :func:`_label_pixels` (:func:`label`'s
+    labelling: the same numbers), over the weak pixels alone, not every pixel of a window that may span most of a
+    1920x1080 image (issue 19, stop 41; the labelling shared with :func:`label` since stop 42)."""
     h, w = c.shape[0], c.shape[1]
     mask = np.zeros((h, w), np.bool_)
     out = np.zeros((h, w), np.int32)
     weak = np.empty(h * w, np.int64)
     strong = np.empty(h * w, np.int64)
-    parent = np.empty(h * w + 1, np.int64)
     n_weak = n_strong = 0
-    n = 0
     for r in range(h):
         for q in range(w):
-            kind = _red_kind(c, r, q, low, high, sqrt3, tan_hue)
+            red = np.int64(c[r, q, 0])
+            kind = _red_kind(red, np.int64(c[r, q, 1]), np.int64(c[r, q, 2]), low[red], high[red], sqrt3, tan_hue)
             if kind == 0:
                 continue
             weak[n_weak] = r * w + q
@@ -6296,41 +6269,20 @@ def red_regions_once(
                 strong[n_strong] = r * w + q
                 n_strong += 1
             mask[r, q] = True
-            up = out[r - 1, q] if r > 0 else 0
-            if up:
-                own = up
-            else:
-                left = out[r, q - 1] if q > 0 else 0
-                own = left if left else (out[r - 1, q - 1] if r > 0 and q > 0 else 0)
-                right = out[r - 1, q + 1] if r > 0 and q + 1 < w else 0
-                if right:
-                    own = _union(parent, own, right) if own else right
-            if own == 0:
-                n += 1
-                parent[n] = n
-                own = n
-            out[r, q] = own
     weak_at = weak[:n_weak].copy()
     strong_at = strong[:n_strong].copy()
-    final = np.zeros(n + 1, np.int32)
-    m = 0
+    m = _label_pixels(out, weak_at, True)
+    flat = out.reshape(-1)
     lab = np.empty(n_weak, np.int32)
     rows = np.empty(n_weak, np.int64)
     cols = np.empty(n_weak, np.int64)
-    for i in range(n_weak):
-        r, q = weak_at[i] // w, weak_at[i] % w
-        root = _root(parent, out[r, q])
-        if final[root] == 0:
-            m += 1
-            final[root] = m
-        out[r, q] = final[root]
-        rows[i], cols[i], lab[i] = r, q, final[root]
     sizes = np.zeros(m + 1, np.int64)
     for i in range(n_weak):
+        rows[i], cols[i], lab[i] = weak_at[i] // w, weak_at[i] % w, flat[weak_at[i]]
         sizes[lab[i]] += 1
     seeded = np.zeros(m + 1, np.bool_)
     for i in range(n_strong):
-        seeded[out[strong_at[i] // w, strong_at[i] % w]] = True
+        seeded[flat[strong_at[i]]] = True
     seeded[0] = False
     return mask, out, m, weak_at, strong_at, lab, seeded, sizes, rows, cols
 
@@ -6365,3 +6317,57 @@ def claim(out: np.ndarray, hull: np.ndarray) -> tuple[np.ndarray, int, int, int,
     if r1 == 0:
         r0 = c0 = 0
     return free, r0, r1, c0, c1
+
+
+# --- stop 42, speedseg42: one labelling for label and red_regions_once; the segmenter's kernels -----------------------
+
+
+@_njit
+def _label_pixels(out: np.ndarray, at: np.ndarray, eight: bool) -> int:
+    """Label the pixels at the flat indices ``at`` (ascending) of ``out`` (h, w) int32, C-contiguous, all 0 on entry,
+    as ``ndimage.label`` of the mask they make (``eight``: ``structure=np.ones((3, 3))``, else the 4-neighbourhood):
+    labels 1..m numbered by their first pixel in raster order, as scipy numbers them; returns m. One pass over the
+    pixels joining each with its labelled neighbours above and to the left (union-find, :func:`_union`; with eight
+    neighbours the one above joins all three of the others already, else the left and upper-left ones are joined and
+    the upper-right one may join them), one numbering the roots in the order their first pixels come. The one
+    labelling of :func:`label` and :func:`red_regions_once` (stop 42: one call a window, the pixels' loop inside)."""
+    w = out.shape[1]
+    flat = out.reshape(-1)  # a view: ``out`` is C-contiguous
+    parent = np.empty(len(at) + 1, np.int64)
+    n = 0
+    r = 0
+    for i in range(len(at)):
+        p = at[i]
+        while p >= (r + 1) * w:  # the row, without a division: the pixels come in raster order
+            r += 1
+        c = p - r * w
+        up = flat[p - w] if r > 0 else 0
+        if eight:
+            if up:
+                own = up
+            else:
+                left = flat[p - 1] if c > 0 else 0
+                own = left if left else (flat[p - w - 1] if r > 0 and c > 0 else 0)
+                right = flat[p - w + 1] if r > 0 and c + 1 < w else 0
+                if right:
+                    own = _union(parent, own, right) if own else right
+        else:
+            left = flat[p - 1] if c > 0 else 0
+            if up and left:
+                own = _union(parent, up, left) if up != left else up
+            else:
+                own = up if up else left
+        if own == 0:
+            n += 1
+            parent[n] = n
+            own = n
+        flat[p] = own
+    final = np.zeros(n + 1, np.int32)
+    m = 0
+    for i in range(len(at)):
+        root = _root(parent, flat[at[i]])
+        if final[root] == 0:
+            m += 1
+            final[root] = m
+        flat[at[i]] = final[root]
+    return m
