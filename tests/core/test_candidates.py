@@ -105,6 +105,12 @@ def test_candidates_of_a_noisy_ball():
     cone = by["cone"]  # tangent to the silhouette's cone: its box is the ball's, back face included
     np.testing.assert_allclose(cone.centre, [0.01, 0.0, 0.4], atol=0.001)
     assert cone.hi[2] == pytest.approx(0.435, abs=0.0015)
+    # the seen points' bounds handed in: the same candidates to the bit
+    seen = (visible.min(axis=0), visible.max(axis=0))
+    again = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=front, seen=seen)
+    assert [c.name for c in again] == list(by)
+    for a, b in zip(again, cands, strict=True):
+        assert a.lo.tobytes() == b.lo.tobytes() and a.hi.tobytes() == b.hi.tobytes() and a.agreement == b.agreement
 
 
 def test_the_outline_candidate_takes_its_profile_from_the_silhouette():

@@ -4066,3 +4066,52 @@ def test_the_reflected_index_is_scipys_reflect_mode():
         padded = np.pad(np.arange(n), 3 * n, mode="symmetric")
         for i in range(-3 * n, 4 * n):
             assert _jit._reflected(i, n) == padded[i + 3 * n]
+
+
+# --- stop 42, speedcomp42
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 7))
+def test_the_projected_box_is_the_projections_bounds(seed, step):
+    """Points with NaN, infinities, a zero depth and ties, every ``step``-th taken: the kernel's pixel box (the
+    candidates' silhouette box without occlusion information) is the one of ``Camera.project``'s coordinates to the
+    bit, with the kernel and with the twin; a 3-point cloud's known answer."""
+    from symfruit import DEFAULT_CAMERA as cam
+    from symfruit.core.candidates import _projected_box
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 200))
+    p = rng.normal(size=(n, 3)) * [0.05, 0.05, 0.02] + [0.0, 0.0, 0.4]
+    for special in (np.nan, np.inf, -np.inf, 0.0):
+        if rng.random() < 0.2:
+            p[rng.integers(0, n), rng.integers(0, 3)] = special
+    if rng.random() < 0.3:
+        p[: n // 2] = p[0]  # ties
+    uv = cam.project(p[::step])
+    with np.errstate(invalid="ignore"):
+        want = np.array([uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5])
+    got = _jit.projected_box(p, step, cam.fx, cam.fy, cam.cx, cam.cy)
+    assert got.tobytes() == want.tobytes()
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _projected_box, p, step, cam)
+    assert np.array(fast).tobytes() == np.array(twin).tobytes() == want.tobytes()
+    known = np.array([[0.0, 0.0, 0.5], [0.05, -0.025, 0.5], [-0.1, 0.1, 1.0]])
+    f, c = cam.fx, cam.cx
+    want = [c - 0.1 * f - 0.5, cam.cy - 0.05 * f - 0.5, c + 0.1 * f + 0.5, cam.cy + 0.1 * f + 0.5]
+    assert _jit.projected_box(known, 1, f, f, c, cam.cy).tolist() == want
+
+
+def test_the_column_bounds_of_points_meet_every_column_in_one_pass():
+    """(n, 3) points (the one-pass path) against (n, 3) columns met one at a time (the same array as (n, 4) with a
+    column more): the same bounds to the bit, NaN in a column's two bounds alone, infinities kept."""
+    p = np.array([[1.0, -2.0, 3.0], [-4.0, np.inf, 0.5], [2.5, 7.0, np.nan], [1.0, -2.5, 0.25]])
+    lo, hi, sure = _jit.column_bounds(p)
+    assert sure and lo[:2].tolist() == [-4.0, -2.5] and hi[:2].tolist() == [2.5, np.inf]
+    assert np.isnan(lo[2]) and np.isnan(hi[2])
+    wide = np.column_stack((p, np.ones(4)))  # four columns: the column-by-column path
+    lo4, hi4, _ = _jit.column_bounds(wide)
+    assert lo.tobytes() == lo4[:3].tobytes() and hi.tobytes() == hi4[:3].tobytes()
+    first_nan = np.array([[np.nan, 1.0, 2.0], [1.0, 1.0, 2.0]])  # a NaN first in its column
+    lo, hi, _ = _jit.column_bounds(first_nan)
+    assert np.isnan(lo[0]) and np.isnan(hi[0]) and lo[1:].tolist() == [1.0, 2.0]

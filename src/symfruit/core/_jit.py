@@ -2257,14 +2257,20 @@ def column_bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
     lo = np.empty(k)
     hi = np.empty(k)
     sure = True
+    if k == 3:  # points: the three columns' chains side by side in one pass over the rows (the same values in the
+        # same order each; 20 against 50 us on 14,000 points, issue 19, stop 42), then the checks below
+        _column_bounds3(p, lo, hi)
     for j in range(k):
-        a = b = p[0, j]
-        bad = 0.0  # NaN once a value is
-        for i in range(n):
-            x = p[i, j]
-            a = x if x < a else a
-            b = x if x > b else b
-            bad = bad if x == x else x
+        if k == 3:
+            a, b, bad = lo[j], hi[j], 0.0  # NaN where the column holds one (``a != a`` below)
+        else:
+            a = b = p[0, j]
+            bad = 0.0  # NaN once a value is
+            for i in range(n):
+                x = p[i, j]
+                a = x if x < a else a
+                b = x if x > b else b
+                bad = bad if x == x else x
         if bad != bad or a != a:
             a = b = np.nan
         elif a == 0.0 or b == 0.0:
@@ -2996,6 +3002,71 @@ def revolution_box(
         lo[c] = _least_nan(low)
         hi[c] = _greatest_nan(high)
     return lo, hi, t, r
+
+
+# --- issue 19, stop 42 (speedcomp42): the completion's per-call overhead ---------------------------------------
+
+
+@_njit
+def projected_box(points: np.ndarray, step: int, fx: float, fy: float, cx: float, cy: float) -> np.ndarray:
+    """:func:`symfruit.core.candidates._projected_box`: ``(u_min - 0.5, v_min - 0.5, u_max + 0.5, v_max + 0.5)`` of the
+    rows ``points[::step]`` (n, 3) projected by :meth:`~symfruit.core.camera.Camera.project`'s arithmetic
+    (``fx * x * (1 / z) + cx``, left to right), in one pass without the (m, 2) array; NaN in a coordinate's two
+    bounds where one of its values is (numpy's reductions propagate it). ``n >= 1``."""
+    n = points.shape[0]
+    out = np.empty(4)
+    u_lo = v_lo = math.inf
+    u_hi = v_hi = -math.inf
+    nan_u = nan_v = False
+    for i in range(0, n, step):
+        inv_z = 1.0 / points[i, 2]
+        u = fx * points[i, 0] * inv_z + cx
+        v = fy * points[i, 1] * inv_z + cy
+        if u != u:
+            nan_u = True
+        if v != v:
+            nan_v = True
+        u_lo = u if u < u_lo else u_lo
+        u_hi = u if u > u_hi else u_hi
+        v_lo = v if v < v_lo else v_lo
+        v_hi = v if v > v_hi else v_hi
+    if nan_u:
+        u_lo = u_hi = math.nan
+    if nan_v:
+        v_lo = v_hi = math.nan
+    out[0] = u_lo - 0.5
+    out[1] = v_lo - 0.5
+    out[2] = u_hi + 0.5
+    out[3] = v_hi + 0.5
+    return out
+
+
+@_njit
+def _column_bounds3(p: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> None:
+    """:func:`column_bounds`' pass over an (n, 3) ``p``, ``n >= 1``: each column's least and greatest value into
+    ``lo`` and ``hi`` (3,), NaN in both where the column holds a NaN; each column's values met in row order, as
+    :func:`column_bounds` meets them one column at a time."""
+    a0 = b0 = p[0, 0]
+    a1 = b1 = p[0, 1]
+    a2 = b2 = p[0, 2]
+    n0 = n1 = n2 = 0.0  # NaN once a value of the column is
+    for i in range(p.shape[0]):
+        x, y, z = p[i, 0], p[i, 1], p[i, 2]
+        a0 = x if x < a0 else a0
+        b0 = x if x > b0 else b0
+        n0 = n0 if x == x else x
+        a1 = y if y < a1 else a1
+        b1 = y if y > b1 else b1
+        n1 = n1 if y == y else y
+        a2 = z if z < a2 else a2
+        b2 = z if z > b2 else b2
+        n2 = n2 if z == z else z
+    lo[0] = a0 if n0 == n0 else n0
+    hi[0] = b0 if n0 == n0 else n0
+    lo[1] = a1 if n1 == n1 else n1
+    hi[1] = b1 if n1 == n1 else n1
+    lo[2] = a2 if n2 == n2 else n2
+    hi[2] = b2 if n2 == n2 else n2
 
 
 # --- issue 19, sixteenth round: extraction's clustering and a fruit's depth mode ---------------------------------

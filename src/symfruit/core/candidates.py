@@ -207,6 +207,7 @@ def candidates(
     outline_profile: str = "off",
     plausible: tuple[float, float] | None = None,
     width: float = 0.0,
+    seen: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -251,6 +252,9 @@ def candidates(
     explained : float, optional
         When the ``cone`` ellipsoid gets at most this share of the silhouette-band rays wrong, the view is
         explained and the solid of revolution is not fitted (no other shape can explain the outline better).
+    seen : ((3,), (3,)) float, metres, optional
+        :func:`~symfruit.core.points.bounds` of ``points``, when the caller has them (not read again; issue 19,
+        stop 42).
 
     Returns
     -------
@@ -259,7 +263,7 @@ def candidates(
     """
     points = as_points(points, min_count=4)
     sample = as_points(sample, min_count=4, name="sample")
-    seen_lo, seen_hi = bounds(points)
+    seen_lo, seen_hi = bounds(points) if seen is None else seen
     extent = float((seen_hi - seen_lo).max())
     pull: float | None = None
     if obs.extent is not None:
@@ -267,8 +271,7 @@ def candidates(
         u_lo, v_lo, u_hi, v_hi = (float(x) for x in obs.extent)
         cone, pull = ((u_lo, v_lo, u_hi, v_hi), camera), 1.0
     else:  # the seen points' pixel box
-        uv = camera.project(points[:: max(1, len(points) // 4000)])
-        cone = ((uv[:, 0].min() - 0.5, uv[:, 1].min() - 0.5, uv[:, 0].max() + 0.5, uv[:, 1].max() + 0.5), camera)
+        cone = (_projected_box(points, max(1, len(points) // 4000), camera), camera)
     fit = _Fitting(sample, obs, camera, front, extent, region, outline_profile, revolution_points,
                    revolution_coarse)  # fmt: skip
     constrain = _constrainer(seen_lo, seen_hi, front, cone, obs.contour, pull)
@@ -302,6 +305,19 @@ def candidates(
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
     out.append(Candidate("raw", lo, hi, None, 0.5 * (lo + hi)))
     return out
+
+
+def _projected_box(points: np.ndarray, step: int, camera: Camera) -> tuple[float, float, float, float]:
+    """``(u_min - 0.5, v_min - 0.5, u_max + 0.5, v_max + 0.5)`` of ``points[::step]`` ((n, 3) float64, n >= 1)
+    projected by ``camera``: by the compiled twin :func:`symfruit.core._jit.projected_box` where numba is (one pass
+    over the rows, the same values; issue 19, stop 42), else from :meth:`~symfruit.core.camera.Camera.project`."""
+    if (jit := compiled()) is not None:
+        box = jit.projected_box(points, step, float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy))
+        u_lo, v_lo, u_hi, v_hi = box.tolist()
+        return u_lo, v_lo, u_hi, v_hi
+    uv = camera.project(points[::step])
+    return (float(uv[:, 0].min() - 0.5), float(uv[:, 1].min() - 0.5), float(uv[:, 0].max() + 0.5),
+            float(uv[:, 1].max() + 0.5))  # fmt: skip
 
 
 def _constrainer(

@@ -530,7 +530,7 @@ def evidence(
         width=across.major * front / float(across.axis[2]) if occlusion is not None else 0.0,
         mirror=s.mirror.options() if s.mirror_candidate else None, revolution_points=s.revolution_points,
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
-        region=region, plausible=(s.lateral_reach, s.depth_reach),
+        region=region, plausible=(s.lateral_reach, s.depth_reach), seen=(lo, hi),
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
