@@ -34,9 +34,9 @@ class OcclusionSettings(Section):
         A pixel without depth takes the depth of the nearest pixel with depth (not the fruit's) within this
         many pixels (sensor dropout beside edges).
     trim_own : bool
-        The fruit's mask as the completion reads its outline loses the pixels beyond its points where the camera
-        spreads the fruit's own depth over (a mask overshooting the fruit onto an active-stereo camera's spread
-        edge; :func:`symfruit.core.occlusion.overshoot`; stop 42, docs/sil42.md), for a mask not trimmed by colour.
+        Find the pixels a mask not trimmed by colour overshoots the fruit by, where an active-stereo camera spread
+        the fruit's own depth beyond its points (:func:`symfruit.core.occlusion.overshoot`): the completion reads the
+        fruit's width and silhouette cone without them (stop 42, docs/sil42.md).
     """
 
     enabled: bool = setting(True)

@@ -439,15 +439,16 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
       pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
       where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots: the
       mask is the only measure of the fruit's width there, and nothing is taken off (None);
-    - active stereo: mostly the fruit's own depth (less than ``tolerance`` behind the nearest of its points'
-      pixels' and not that much in front of the nearest of its points' depths within ``reach`` pixels), the
-      foreground's depth spread beyond its silhouette by the correlation window (``synthetic.sensors``'
-      ``fatten_px``), which extraction dropped: the band is the camera's and the mask's, not the fruit's, and its
+    - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
+      least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
+      pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest of
+      its points' depths within ``reach`` pixels; extraction dropped it: the band is the camera's and the mask's, not the fruit's, and its
       pixels are the overshoot, peeled from the mask's border inwards (a pixel inside the points' region stays),
       all but those seen clearly in front of the fruit (an occluder an amodal mask was drawn over).
 
-    Which of the two: whether the band holds the fruit's depth on more pixels than it holds none (a per-view
-    majority, no constant of a sensor). ``eroded``: the mask's border extraction never takes points from (its
+    Which of the two: whether the band holds such a spread depth on more pixels than it holds none (a per-view
+    majority, no constant of a sensor; a time-of-flight camera's mixed pixels and the rim pixels extraction dropped
+    lie behind the rim beside them, not in front). ``eroded``: the mask's border extraction never takes points from (its
     ``erode_px``): that much of the band next to what is kept stays the fruit's (a mask drawn right loses nothing).
     """
     h, w = own.shape
@@ -475,7 +476,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     z_near = ndimage.minimum_filter(own_z, size=2 * reach + 1, mode="constant", cval=np.inf)[band]
     z = d[band]
     ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
-    spread = np.count_nonzero(~ahead & (z < z_ref + tolerance))  # at the fruit's own depth
+    spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
     if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
         return None
     drop = beyond.copy()
