@@ -441,15 +441,17 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
       mask is the only measure of the fruit's width there, and nothing is taken off (None);
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
-      pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest of
-      its points' depths within ``reach`` pixels; extraction dropped it: the band is the camera's and the mask's, not the fruit's, and its
-      pixels are the overshoot, peeled from the mask's border inwards (a pixel inside the points' region stays),
-      all but those seen clearly in front of the fruit (an occluder an amodal mask was drawn over).
+      pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
+      of its points' depths within ``reach`` pixels. Extraction dropped it: the band is the camera's and the
+      mask's, not the fruit's, and its pixels are the overshoot, peeled from the mask's border inwards (a pixel
+      inside the points' region stays), all but those seen clearly in front of the fruit (an occluder an amodal
+      mask was drawn over).
 
     Which of the two: whether the band holds such a spread depth on more pixels than it holds none (a per-view
-    majority, no constant of a sensor; a time-of-flight camera's mixed pixels and the rim pixels extraction dropped
-    lie behind the rim beside them, not in front). ``eroded``: the mask's border extraction never takes points from (its
-    ``erode_px``): that much of the band next to what is kept stays the fruit's (a mask drawn right loses nothing).
+    majority, no constant of a sensor; a time-of-flight camera's mixed pixels and the rim pixels extraction
+    dropped lie behind the rim beside them, not in front). ``eroded``: the mask's border extraction never takes
+    points from (its ``erode_px``): that much of the band next to what is kept stays the fruit's (a mask drawn
+    right loses nothing).
     """
     h, w = own.shape
     col = np.rint(uv[:, 0]).astype(np.intp) - u0
