@@ -513,13 +513,15 @@ def evidence(
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
                   thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
-    # The fruit's outline without what the mask overshoots it by (stop 42: an active-stereo camera's spread edge
-    # under a mask drawn a few pixels wide, :func:`~symfruit.core.occlusion.overshoot`): the silhouette's cone and
-    # the fruit's width (the depth prior's, the lateral faces') are read from it; the observation keeps the whole
-    # mask for the rest (its contour share reads the outline's surroundings).
+    # A whole outline (at least ``covered_contour`` of it a contour) without what the mask overshoots the fruit by
+    # (stop 42: an active-stereo camera's spread edge under a mask drawn a few pixels wide,
+    # :func:`~symfruit.core.occlusion.overshoot`): the silhouette's cone and the fruit's width (the depth prior's,
+    # the lateral faces') are read from it; the observation keeps the whole mask for the rest (its contour share
+    # reads the outline's surroundings). Not on a cut outline: the leaf-occluded views lost there (docs/sil42.md).
     trimmed = None
-    if occlusion is not None and occlusion.overshoot is not None and occlusion.overshoot.any():
-        trimmed = with_own(seen_region, occlusion, trimmed=True)
+    over = None if occlusion is None else occlusion.overshoot
+    if over is not None and obs.contour >= s.covered_contour and over.any():
+        trimmed = with_own(seen_region, occlusion, trimmed=True)  # type: ignore[arg-type]
         if obs.cone_source == "moments":
             cone, axis = silhouette_cone(trimmed, camera)
             obs = replace(obs, cone=cone, axis=axis)
