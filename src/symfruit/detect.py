@@ -173,6 +173,7 @@ def detect(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = ndimage.find_objects(labels)
+    colour_trimmed = frame.color is not None and settings.extract.colour_trim_px > 0
     if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
         trimmed = trim_labels(frame.color, labels, settings.extract, boxes=boxes)
         if trimmed is not labels:
@@ -209,9 +210,11 @@ def detect(
         occ = None
         try:
             # the frame checked its depth's units when it was made; every fruit's pixels are the others' (this
-            # fruit's own are never hidden: the same occlusion without two whole-image operations per fruit)
+            # fruit's own are never hidden: the same occlusion without two whole-image operations per fruit); a
+            # mask trimmed by colour already lost what it overshot the fruit by (stop 42, docs/sil42.md)
             occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
-                                  others=fruit_px, checked=True)  # fmt: skip
+                                  others=fruit_px, checked=True, eroded=settings.extract.erode_px,
+                                  drawn=not colour_trimmed)  # fmt: skip
             t_occlusion += time.perf_counter() - b
             result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))

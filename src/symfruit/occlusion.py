@@ -33,11 +33,16 @@ class OcclusionSettings(Section):
     reach_px : int
         A pixel without depth takes the depth of the nearest pixel with depth (not the fruit's) within this
         many pixels (sensor dropout beside edges).
+    trim_own : bool
+        Find the pixels a mask not trimmed by colour overshoots the fruit by, where an active-stereo camera spread
+        the fruit's own depth beyond its points (:func:`symfruit.core.occlusion.overshoot`): the completion reads the
+        fruit's width and silhouette cone without them (stop 42, docs/sil42.md).
     """
 
     enabled: bool = setting(True)
     tolerance: float = setting(0.005, ge=-1.0, le=1.0)
     reach_px: int = setting(3, ge=0, le=50)
+    trim_own: bool = setting(True)
 
 
 def fruit_occlusion(
@@ -49,11 +54,17 @@ def fruit_occlusion(
     others: np.ndarray | None = None,
     *,
     checked: bool = False,
+    eroded: int = 1,
+    drawn: bool = True,
 ) -> Occlusion | None:
     """:func:`~symfruit.core.occlusion.occlusion` with the section's values, or None when it is disabled (the one
     place both ``detect`` and the evaluation's rendered views make it). ``checked``: ``depth`` is a
-    :class:`~symfruit.core.frame.Frame`'s, its units checked already."""
+    :class:`~symfruit.core.frame.Frame`'s, its units checked already. ``eroded``: the mask's
+    border the points were never taken from (:attr:`symfruit.extract.ExtractSettings.erode_px`); ``drawn``: the
+    mask is as drawn (not trimmed by colour, :func:`symfruit.extract.trim_labels`, which takes off what a mask
+    overshoots the fruit by where it can: the overshoot is looked for only in a mask as drawn)."""
     if not settings.enabled:
         return None
     return occlusion(depth, mask, points, camera, others=others, tolerance=settings.tolerance,
-                     reach=settings.reach_px, checked=checked)  # fmt: skip
+                     reach=settings.reach_px, checked=checked,
+                     trim_own=settings.trim_own and drawn, eroded=eroded)  # fmt: skip

@@ -323,3 +323,49 @@ def test_a_support_at_the_fruits_depth_wider_than_the_band_and_another_fruit_sta
     assert full[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
     assert full[other].all()
     assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(np.mgrid[:60, :80][0] - 30) > 16)].any()
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_an_overshooting_mask_is_trimmed_where_the_camera_spreads_the_fruits_depth(kernels, monkeypatch):
+    """Stop 42: a mask 3 px wider than the fruit's points, its ring mostly at the fruit's depth (an active-stereo
+    camera's spread edge, a little nearer than the rim), overshoots by that ring, peeled from the border inwards:
+    not where something lies clearly in front (an amodal mask over a leaf), not a pixel inside the points' region;
+    a ring mostly without depth (a time-of-flight camera's lost rim) overshoots by nothing; the mask's border
+    extraction never took points from stays the fruit's."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    vv, uu = np.mgrid[:60, :80]
+    r2 = (uu - 40) ** 2 + (vv - 30) ** 2
+    disc, mask = r2 <= 15**2, r2 <= 18**2
+    ring = mask & ~disc
+    hole = (vv == 30) & (uu == 40)  # no point there, the fruit's depth
+    depth = np.full((60, 80), 1.0)  # the background
+    depth[mask] = 0.3 + 0.0002 * r2[mask]  # a rounded front, the rim 4.5 cm behind its apex ...
+    depth[ring] = 0.3 + 0.0002 * 12**2  # ... its depth 3 px in spread over the ring
+    rows, cols = np.nonzero(disc & ~hole)
+    points = BIG.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    top, right = ring & (vv < 20) & (uu <= 53), ring & (uu > 53)
+    depth[top] = 0.25  # a leaf in front under an amodal mask
+    depth[right] = 1.0  # the background, where the mask runs past the spread band
+
+    def overshoot_of(depth, **kw):
+        occ = occlusion(depth, mask, points, BIG, **kw)
+        if occ.overshoot is None:
+            return None
+        out = np.zeros((60, 80), bool)
+        out[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+        return out
+
+    over = overshoot_of(depth, eroded=0)
+    assert over is not None and over[ring & ~top].all() and not over[~ring | top].any()
+    # the ring extraction never took points from (1 px by default) stays next to what is kept
+    kept = ndimage.binary_dilation(mask & ~over, structure=np.ones((3, 3), bool))
+    assert np.array_equal(overshoot_of(depth), over & ~kept)
+    assert overshoot_of(depth, trim_own=False) is None  # switched off
+    tof = depth.copy()
+    tof[ring & (uu > 30)] = 0.0  # most of the ring without depth: the mask is the only measure of the rim
+    assert overshoot_of(tof) is None
+    region = Silhouette(0, 0, disc, 0.0)
+    occ = occlusion(depth, mask, points, BIG)
+    assert with_own(region, occ).mask.sum() == mask.sum()
+    assert with_own(region, occ, trimmed=True).mask.sum() == (mask & ~(over & ~kept)).sum()

@@ -26,7 +26,7 @@ from .limits import check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
-__all__ = ["Occlusion", "occlusion", "own_edge", "with_own"]
+__all__ = ["Occlusion", "occlusion", "overshoot", "own_edge", "with_own"]
 
 
 @dataclass(frozen=True)
@@ -49,6 +49,9 @@ class Occlusion:
     depth : (h, w) float, metres, optional
         What the camera saw at each pixel of the window (NaN: nothing): a hidden pixel hides the fruit only
         behind that depth, so a completion there must lie behind it (:meth:`depth_at`).
+    overshoot : (h, w) bool, optional
+        The pixels of :attr:`own` the mask overshoots the fruit by (:func:`overshoot`): the fruit's width is read
+        without them (:func:`with_own`, ``trimmed``).
     """
 
     u0: int
@@ -58,6 +61,7 @@ class Occlusion:
     height: int
     own: np.ndarray | None = None
     depth: np.ndarray | None = None
+    overshoot: np.ndarray | None = None
     #: :attr:`hidden` grown by each radius asked for (:meth:`grown`), made once (the maps are read-only).
     _grown: dict[int, np.ndarray] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -83,6 +87,11 @@ class Occlusion:
             if own.shape != hidden.shape or own.dtype != bool:
                 raise InputError(f"occlusion own must be a bool image of the window's {w}x{h}, got {own.dtype} "
                                  f"{own.shape}")  # fmt: skip
+        if self.overshoot is not None:
+            over = np.asarray(self.overshoot)
+            if over.shape != hidden.shape or over.dtype != bool:
+                raise InputError(f"occlusion overshoot must be a bool image of the window's {w}x{h}, got "
+                                 f"{over.dtype} {over.shape}")  # fmt: skip
         if self.depth is not None:
             seen = np.asarray(self.depth)
             if seen.shape != hidden.shape or seen.dtype.kind != "f":
@@ -275,6 +284,8 @@ def occlusion(
     pad: int = 16,
     checked: bool = False,
     band: int = 8,
+    trim_own: bool = True,
+    eroded: int = 1,
 ) -> Occlusion:
     """The pixels around one fruit where the camera could not have seen it.
 
@@ -321,6 +332,12 @@ def occlusion(
     band : int, pixels
         The widest fattened edge an active-stereo camera spreads the fruit's own depth over (:func:`own_edge`, run
         on the map last: 0 leaves it out).
+    trim_own : bool
+        Find the pixels the mask overshoots the fruit by (:attr:`Occlusion.overshoot`, :func:`overshoot`; the
+        maps are made with the whole mask); off: none.
+    eroded : int, pixels
+        The mask's border its points were never taken from (extraction's ``erode_px``), handed to
+        :func:`overshoot`.
     checked : bool
         ``depth`` has been through :func:`~symfruit.core.limits.depth_metres` already (a
         :class:`~symfruit.core.frame.Frame`'s has): its units are not sampled again. The sample reads one
@@ -363,7 +380,14 @@ def occlusion(
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
         own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
-        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=seen)
+        over = (
+            overshoot(
+                own_w, depth[v0 : v0 + h, u0 : u0 + w], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded)
+            )
+            if trim_own
+            else None
+        )
+        return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=seen, overshoot=over)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -393,7 +417,78 @@ def occlusion(
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
     hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
-    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=mask[v0:v1, u0:u1].copy(), depth=d)
+    own_w = mask[v0:v1, u0:u1].copy()
+    over = (
+        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded))
+        if trim_own
+        else None
+    )
+    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over)
+
+
+def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.ndarray, u0: int, v0: int,
+              tolerance: float, reach: int, eroded: int = 0) -> np.ndarray | None:  # fmt: skip
+    """(h, w) bool: the pixels of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit,
+    where the camera spreads the fruit's own depth beyond its silhouette; None where it does not.
+
+    Masks drawn by people or models overshoot a fruit by a few pixels (issue 18, point 4), and the completion reads
+    the fruit's width from its outline (:func:`with_own`), then its depth from that width. Beyond the fruit's
+    points (``uv``: their pixels, image coordinates) the mask's band holds, by camera family:
+
+    - time of flight: mostly no depth (``depth`` 0 or NaN), the rim the camera invalidates (grazing and mixed
+      pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
+      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots: the
+      mask is the only measure of the fruit's width there, and nothing is taken off (None);
+    - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
+      least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
+      pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
+      of its points' depths within ``reach`` pixels. Extraction dropped it: the band is the camera's and the
+      mask's, not the fruit's, and its pixels are the overshoot, peeled from the mask's border inwards (a pixel
+      inside the points' region stays), all but those seen clearly in front of the fruit (an occluder an amodal
+      mask was drawn over).
+
+    Which of the two: whether the band holds such a spread depth on more pixels than it holds none (a per-view
+    majority, no constant of a sensor; a time-of-flight camera's mixed pixels and the rim pixels extraction
+    dropped lie behind the rim beside them, not in front). ``eroded``: the mask's border extraction never takes
+    points from (its ``erode_px``): that much of the band next to what is kept stays the fruit's (a mask drawn
+    right loses nothing).
+    """
+    h, w = own.shape
+    col = np.rint(uv[:, 0]).astype(np.intp) - u0
+    row = np.rint(uv[:, 1]).astype(np.intp) - v0
+    ok = (col >= 0) & (col < w) & (row >= 0) & (row < h)
+    if not ok.any():
+        return None
+    flat = np.full(h * w, np.inf)
+    np.minimum.at(flat, row[ok] * w + col[ok], points[ok, 2])
+    own_z = flat.reshape(h, w)
+    seen = np.isfinite(own_z)
+    d = np.asarray(depth, dtype=np.float64)
+    beyond = own & ~seen
+    with np.errstate(invalid="ignore"):
+        band = beyond & np.isfinite(d) & (d > 0)
+    if not band.any():
+        return None
+    # the nearest point pixel's depth, over the box of the mask and the points' pixels alone
+    b0, b1, a0, a1 = mask_box(own | seen)  # type: ignore[misc]
+    near = np.take(own_z[b0:b1, a0:a1].ravel(), nearest_index(~seen[b0:b1, a0:a1]))
+    z_ref = near.reshape(b1 - b0, a1 - a0)[band[b0:b1, a0:a1]]
+    # the nearest of the fruit's own depths within ``reach`` pixels: a spread depth is the least the correlation
+    # window holds, nearer than the rim's own (as :func:`own_edge` reads it)
+    z_near = ndimage.minimum_filter(own_z, size=2 * reach + 1, mode="constant", cval=np.inf)[band]
+    z = d[band]
+    ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
+    spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
+    if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
+        return None
+    drop = beyond.copy()
+    drop[band] = ~ahead  # all but what lies clearly in front
+    # peeled from the mask's border inwards: what a mask overshoots lies at its border
+    edge = drop & ~square_filter(own, 1, every=True)
+    drop = ndimage.binary_propagation(edge, structure=np.ones((3, 3), bool), mask=drop)
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop
 
 
 def own_edge(
@@ -552,9 +647,13 @@ def open_square(mask: np.ndarray, size: int) -> np.ndarray:
     return ndimage.maximum_filter(eroded, size=size, mode="constant", cval=False)
 
 
-def with_own(region: Silhouette, occ: Occlusion) -> Silhouette:
-    """``region`` joined with the fruit's own pixels (:attr:`Occlusion.own`), in a window holding both."""
-    if occ.own is None or (own_box := mask_box(occ.own)) is None:
+def with_own(region: Silhouette, occ: Occlusion, *, trimmed: bool = False) -> Silhouette:
+    """``region`` joined with the fruit's own pixels (:attr:`Occlusion.own`), in a window holding both;
+    ``trimmed``: but those the mask overshoots the fruit by (:attr:`Occlusion.overshoot`)."""
+    own = occ.own
+    if trimmed and own is not None and occ.overshoot is not None:
+        own = own & ~occ.overshoot
+    if own is None or (own_box := mask_box(own)) is None:
         return region
     b0, b1, a0, a1 = own_box
     h, w = region.mask.shape
@@ -562,8 +661,8 @@ def with_own(region: Silhouette, occ: Occlusion) -> Silhouette:
     u1, v1 = max(region.u0 + w, occ.u0 + a1), max(region.v0 + h, occ.v0 + b1)
     mask = np.zeros((v1 - v0, u1 - u0), dtype=bool)
     mask[region.v0 - v0 : region.v0 - v0 + h, region.u0 - u0 : region.u0 - u0 + w] = region.mask
-    oh, ow = occ.own.shape
+    oh, ow = own.shape
     r0, c0 = max(occ.v0, v0), max(occ.u0, u0)
     r1, c1 = min(occ.v0 + oh, v1), min(occ.u0 + ow, u1)
-    mask[r0 - v0 : r1 - v0, c0 - u0 : c1 - u0] |= occ.own[r0 - occ.v0 : r1 - occ.v0, c0 - occ.u0 : c1 - occ.u0]
+    mask[r0 - v0 : r1 - v0, c0 - u0 : c1 - u0] |= own[r0 - occ.v0 : r1 - occ.v0, c0 - occ.u0 : c1 - occ.u0]
     return Silhouette(u0, v0, mask, region.fill_radius)

@@ -117,7 +117,8 @@ def _evaluate_instance(spec: Spec, methods: Sequence[str], settings: Settings) -
     rows = []
     occlusion = None
     if inst.depth is not None and mask is not None and len(visible) and not failed:
-        occlusion = fruit_occlusion(inst.depth, mask, visible, camera, settings.occlusion)
+        occlusion = fruit_occlusion(inst.depth, mask, visible, camera, settings.occlusion,
+                                    eroded=settings.extract.erode_px if inst.extract else 0)  # fmt: skip
     for method in methods:
         try:
             if failed:

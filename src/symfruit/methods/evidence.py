@@ -44,7 +44,7 @@ behind every constant are in ``docs/ablation.md``.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any, Literal
 
 import numpy as np
@@ -59,7 +59,16 @@ from ..core.front import apex_depth
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import bounds, row_norms, subsample
-from ..core.raster import Across, Silhouette, across_sight, close_ragged, inner_distance, point_pixels, silhouette
+from ..core.raster import (
+    Across,
+    Silhouette,
+    across_sight,
+    close_ragged,
+    inner_distance,
+    point_pixels,
+    silhouette,
+    silhouette_cone,
+)
 from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
@@ -498,11 +507,24 @@ def evidence(
     # about a point per pixel of the points' own region: a depth camera's view (the fruit's mask, joined below,
     # also holds the pixels a time-of-flight camera returns no depth for: its rim, a leaf's mixed edge)
     dense = len(points) >= 0.5 * np.count_nonzero(region.mask)
+    seen_region = region
     if occlusion is not None:
         region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
                   thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
+    # A whole outline (at least ``covered_contour`` of it a contour) without what the mask overshoots the fruit by
+    # (stop 42: an active-stereo camera's spread edge under a mask drawn a few pixels wide,
+    # :func:`~symfruit.core.occlusion.overshoot`): the silhouette's cone and the fruit's width (the depth prior's,
+    # the lateral faces') are read from it; the observation keeps the whole mask for the rest (its contour share
+    # reads the outline's surroundings). Not on a cut outline: the leaf-occluded views lost there (docs/sil42.md).
+    trimmed = None
+    over = None if occlusion is None else occlusion.overshoot
+    if over is not None and obs.contour >= s.covered_contour and over.any():
+        trimmed = with_own(seen_region, occlusion, trimmed=True)  # type: ignore[arg-type]
+        if obs.cone_source == "moments":
+            cone, axis = silhouette_cone(trimmed, camera)
+            obs = replace(obs, cone=cone, axis=axis)
     apex, _ = apex_depth(sample)
     lo, hi = bounds(points)  # one compiled pass where numba is (the columns' least and greatest values)
     front = max(float(lo[2]), apex)
@@ -536,8 +558,9 @@ def evidence(
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
     seen_back = float(hi[2])
+    sized = across if trimmed is None else across_sight(trimmed, camera)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
-                                     across=across)  # fmt: skip
+                                     across=sized)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
     # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
