@@ -2971,6 +2971,10 @@ def revolution_box(
         for j in range(widest):
             if not r[j] >= floor:
                 head = False
+        along = direction[2]
+        endon = along * along >= 0.5  # the axis nearer the line of sight than the image plane
+        tail = widest == count - 1 or (endon and along > 0 and tail)
+        head = widest == 0 or (endon and along < 0 and head)
         if close and tail:
             t2, r2 = np.empty(2 * count - 1), np.empty(2 * count - 1)
             last = t[count - 1]

@@ -817,11 +817,14 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
     """Slice positions and radii of a fitted solid, an unseen end closed: ``(t (m,), r (m,))``, metres.
 
     A fruit's profile closes at both ends. Where the seen profile is still widening when the data stop
-    (no slice from the widest to the last, or from the first to the widest, narrower than the widest by more
-    than the fit's own RMS, ``sqrt(cost)``: the far half of a fruit seen end-on hides behind its widest ring,
-    and the slice at that ring, seen edge-on, reads a hair narrower than the one before it), the missing half
-    is the mirror image of the seen one about the end slice. A profile that narrows towards an end by more
-    than that, however bluntly, ends there. ``close=False``: the seen profile as it is.
+    (its widest slice is the first or the last: the far half of a fruit seen end-on hides behind its widest
+    ring), the missing half is the mirror image of the seen one about the end slice. Seen end-on (the axis
+    within 45 deg of the line of sight, ``direction[2] ** 2 >= 0.5``), the far end is closed so too when no
+    slice from the widest to it is narrower than the widest by more than the fit's own RMS, ``sqrt(cost)``: the
+    slice at the widest ring, seen edge-on, reads a hair narrower than the one before it. A profile that
+    narrows towards an end by more than that, however bluntly, or whose near end, or whose end seen across
+    the line of sight (where a mirrored half would show beside the outline), falls short of the widest at
+    all, ends there. ``close=False``: the seen profile as it is.
 
     Issue 18, stop 42 (docs/scan42.md): with the widest slice required to be the end one, the end-on views of
     the paper protocol's pears and lemons (and the real pear stood up) were closed at their deepest seen point
@@ -834,9 +837,11 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
         return np.array([rev.edges[0], rev.edges[-1]]), np.zeros(2)
     widest = int(np.argmax(r))
     floor = r[widest] - _flat(rev)
-    if close and bool((r[widest:] >= floor).all()):
+    along = float(rev.direction[2])
+    endon = along * along >= 0.5  # the axis nearer the line of sight than the image plane
+    if close and (widest == len(t) - 1 or (endon and along > 0 and bool((r[widest:] >= floor).all()))):
         t, r = np.concatenate((t, 2 * t[-1] - t[:-1][::-1])), np.concatenate((r, r[:-1][::-1]))
-    elif close and bool((r[: widest + 1] >= floor).all()):
+    elif close and (widest == 0 or (endon and along < 0 and bool((r[: widest + 1] >= floor).all()))):
         t, r = np.concatenate((2 * t[0] - t[1:][::-1], t)), np.concatenate((r[1:][::-1], r))
     return t, r
 
