@@ -262,6 +262,30 @@ def test_an_end_still_widening_is_closed_by_symmetry():
     assert len(closed_profile(lemon)[0]) == 4
 
 
+def test_a_far_end_short_of_the_widest_by_less_than_the_fits_rms_is_still_widening():
+    """The rim's slice of a fruit seen end-on reads a little narrower than the one before it (issue 18, stop 42):
+    within the fit's own RMS of the widest it is the widest ring seen edge-on, and the unseen half is the mirror
+    image about that far end slice; short of it by more, the profile narrows there and ends. Likewise with the axis
+    the other way (the first slice the far one); not at the near end, nor with the axis across the line of sight
+    (a mirrored half would show beside the outline)."""
+    edges = np.linspace(-0.035, 0.0, 8)
+    radii = np.array([0.010, 0.020, 0.026, 0.030, 0.033, 0.0350, 0.0347])  # the last 0.3 mm under the widest
+    centre, away = np.array([0.0, 0.0, 0.4]), np.array([0.0, 0.0, 1.0])
+    rim = Revolution(centre, away, edges, radii, 0.0005**2)  # points 0.5 mm RMS from their slice circles
+    t, r = closed_profile(rim)
+    assert len(t) == 13 and t[-1] == pytest.approx(2 * t[6] - t[0]) and np.array_equal(r, np.r_[radii, radii[5::-1]])
+    assert revolution_box(rim)[1][2] == pytest.approx(0.4 + 2 * t[6] - t[0], abs=1e-12)
+    tight = Revolution(centre, away, edges, radii, 0.0002**2)  # 0.2 mm RMS: the last slice narrows
+    assert np.array_equal(closed_profile(tight)[1], radii)
+    back = radii[::-1].copy()  # the first slice the far one along an axis pointing at the camera
+    t, r = closed_profile(Revolution(centre, -away, edges, back, 0.0005**2))
+    assert len(t) == 13 and t[0] == pytest.approx(2 * t[6] - t[-1]) and np.array_equal(r, np.r_[radii[:6], back])
+    assert np.array_equal(closed_profile(Revolution(centre, -away, edges, back, 0.0002**2))[1], back)
+    assert np.array_equal(closed_profile(Revolution(centre, -away, edges, radii, 0.0005**2))[1], radii)  # near end
+    across = Revolution(centre, np.array([0.0, 0.8, 0.6]), edges, radii, 0.0005**2)  # 53 deg from the line of sight
+    assert np.array_equal(closed_profile(across)[1], radii)
+
+
 def test_slice_revolution_of_a_noisy_ball_view_reaches_its_back():
     visible, _ = rendered_view(ball_mesh(), [0.0, 0.0, 0.4], noise=0.01, seed=2)
     _, hi = revolution_box(fit_revolution_slices(visible[::10]))

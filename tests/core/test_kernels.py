@@ -4115,3 +4115,33 @@ def test_the_column_bounds_of_points_meet_every_column_in_one_pass():
     first_nan = np.array([[np.nan, 1.0, 2.0], [1.0, 1.0, 2.0]])  # a NaN first in its column
     lo, hi, _ = _jit.column_bounds(first_nan)
     assert np.isnan(lo[0]) and np.isnan(hi[0]) and lo[1:].tolist() == [1.0, 2.0]
+
+
+# --- stop 42, scan42
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(2, 20), st.booleans(), st.sampled_from(["first", "last"]))
+def test_revolution_box_closes_ends_within_the_fits_rms_as_its_twin(seed, bins, close, end):
+    """:func:`symfruit.core.fits.box_and_profile` with the kernel and with its twin on profiles whose end slices fall
+    short of the widest by about the fit's RMS (``sqrt(cost)``: some within it, closed by symmetry, some beyond it,
+    left as they are), with unseen (NaN) slices: the same profile and box bit for bit."""
+    from symfruit.core.fits import Revolution, box_and_profile
+
+    rng = np.random.default_rng(seed)
+    direction = rng.normal(size=3)
+    direction = direction / np.linalg.norm(direction)
+    edges = np.sort(rng.normal(0.0, 0.03, bins + 1))
+    radii = np.sort(rng.uniform(0.005, 0.04, bins))
+    rms = float(rng.uniform(0.0002, 0.002))
+    tail = int(rng.integers(1, 4))
+    radii[-tail:] = radii.max() - rng.uniform(0.0, 2.0 * rms, min(tail, bins))  # short by 0-2 RMS
+    if end == "first":
+        radii = radii[::-1].copy()
+    radii[rng.random(bins) < 0.15] = np.nan
+    rev = Revolution(rng.normal(0.0, 0.05, 3) + [0, 0, 0.4], direction, edges, radii, rms**2)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, box_and_profile, rev, close=close)
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype == np.float64 and a.shape == b.shape
+        assert np.array_equal(a.view(np.int64), b.view(np.int64))

@@ -2939,12 +2939,13 @@ def _greatest_nan(x: np.ndarray) -> float:
 
 @_njit
 def revolution_box(
-    point: np.ndarray, direction: np.ndarray, edges: np.ndarray, radii: np.ndarray, close: bool
+    point: np.ndarray, direction: np.ndarray, edges: np.ndarray, radii: np.ndarray, close: bool, flat: float
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """:func:`symfruit.core.fits.revolution_box` and the profile it is the box of in one call (issue 19, stop 41):
     ``(lo (3,), hi (3,), t (m,), r (m,))``, :func:`~symfruit.core.fits.closed_profile`'s ``t`` and ``r`` and
     :func:`~symfruit.core.fits._rings_box`'s box of their rings, each value the twin's (element by element the same
-    operations; the boxes' least and greatest values, NaN where any is)."""
+    operations; the boxes' least and greatest values, NaN where any is). ``flat``: :func:`~symfruit.core.fits._flat`,
+    how far an end slice may fall short of the widest and still be closed by symmetry (issue 18, stop 42)."""
     b = radii.shape[0]
     mid = np.empty(b)
     count = 0
@@ -2967,7 +2968,20 @@ def revolution_box(
         for j in range(1, count):  # np.argmax: the first greatest (every radius here is finite)
             if r[j] > r[widest]:
                 widest = j
-        if close and widest == count - 1:
+        floor = r[widest] - flat
+        tail = True  # every radius from the widest to the last within ``flat`` of it
+        for j in range(widest + 1, count):
+            if not r[j] >= floor:
+                tail = False
+        head = True  # likewise from the first to the widest
+        for j in range(widest):
+            if not r[j] >= floor:
+                head = False
+        along = direction[2]
+        endon = along * along >= 0.5  # the axis nearer the line of sight than the image plane
+        tail = widest == count - 1 or (endon and along > 0 and tail)
+        head = widest == 0 or (endon and along < 0 and head)
+        if close and tail:
             t2, r2 = np.empty(2 * count - 1), np.empty(2 * count - 1)
             last = t[count - 1]
             for j in range(count):
@@ -2976,7 +2990,7 @@ def revolution_box(
                 t2[count + j] = 2 * last - t[count - 2 - j]
                 r2[count + j] = r[count - 2 - j]
             t, r = t2, r2
-        elif close and widest == 0:
+        elif close and head:
             t2, r2 = np.empty(2 * count - 1), np.empty(2 * count - 1)
             first = t[0]
             for j in range(count - 1):  # 2 t[0] - t[1:][::-1]

@@ -817,9 +817,18 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
     """Slice positions and radii of a fitted solid, an unseen end closed: ``(t (m,), r (m,))``, metres.
 
     A fruit's profile closes at both ends. Where the seen profile is still widening when the data stop
-    (its widest slice is the first or the last: the far half of a fruit seen end-on hides behind its
-    widest ring), the missing half is the mirror image of the seen one about that slice. A profile that
-    narrows towards an end, however bluntly, ends there. ``close=False``: the seen profile as it is.
+    (its widest slice is the first or the last: the far half of a fruit seen end-on hides behind its widest
+    ring), the missing half is the mirror image of the seen one about the end slice. Seen end-on (the axis
+    within 45 deg of the line of sight, ``direction[2] ** 2 >= 0.5``), the far end is closed so too when no
+    slice from the widest to it is narrower than the widest by more than the fit's own RMS, ``sqrt(cost)``: the
+    slice at the widest ring, seen edge-on, reads a hair narrower than the one before it. A profile that
+    narrows towards an end by more than that, however bluntly, or whose near end, or whose end seen across
+    the line of sight (where a mirrored half would show beside the outline), falls short of the widest at
+    all, ends there. ``close=False``: the seen profile as it is.
+
+    Issue 18, stop 42 (docs/scan42.md): with the widest slice required to be the end one, the end-on views of
+    the paper protocol's pears and lemons (and the real pear stood up) were closed at their deepest seen point
+    on most views, as short as the raw box, the rim's slice reading 0.2-1 mm under the one before it.
     """
     mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     ok = np.isfinite(rev.radii)
@@ -827,11 +836,22 @@ def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, 
     if len(t) < 2:
         return np.array([rev.edges[0], rev.edges[-1]]), np.zeros(2)
     widest = int(np.argmax(r))
-    if close and widest == len(t) - 1:
+    floor = r[widest] - _flat(rev)
+    along = float(rev.direction[2])
+    endon = along * along >= 0.5  # the axis nearer the line of sight than the image plane
+    if close and (widest == len(t) - 1 or (endon and along > 0 and bool((r[widest:] >= floor).all()))):
         t, r = np.concatenate((t, 2 * t[-1] - t[:-1][::-1])), np.concatenate((r, r[:-1][::-1]))
-    elif close and widest == 0:
+    elif close and (widest == 0 or (endon and along < 0 and bool((r[: widest + 1] >= floor).all()))):
         t, r = np.concatenate((2 * t[0] - t[1:][::-1], t)), np.concatenate((r[1:][::-1], r))
     return t, r
+
+
+def _flat(rev: Revolution) -> float:
+    """How far a slice's radius may fall short of the widest one's and still be no narrowing, metres: the fit's own
+    RMS distance of the points to their slice circles (``sqrt(cost)``). A slice's radius is read to about that (its
+    points' mean distance to the axis), so a profile's end within it of the widest radius is the widest ring seen
+    edge-on, not an end closing (issue 18, stop 42)."""
+    return float(np.sqrt(max(float(rev.cost), 0.0)))
 
 
 def revolution_box(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray]:
@@ -850,7 +870,7 @@ def box_and_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray,
         lo, hi, t, r = jit.revolution_box(
             np.ascontiguousarray(rev.point, dtype=np.float64), np.ascontiguousarray(rev.direction, dtype=np.float64),
             np.ascontiguousarray(rev.edges, dtype=np.float64), np.ascontiguousarray(rev.radii, dtype=np.float64),
-            bool(close),
+            bool(close), _flat(rev),
         )  # fmt: skip
         return lo, hi, t, r
     t, r = closed_profile(rev, close=close)
