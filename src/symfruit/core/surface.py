@@ -317,7 +317,10 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
     if len(rows) >= 30:
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
-        if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
+        # ... unless it reaches the mask's outline: a fruit's nearest point lies inside its outline, while the nearest
+        # edge of a tilted leaf, or a leaf's depth fattened over the fruit, runs along it (a narrow band whose fit
+        # reads any curvature)
+        if (kappa - 2.0 * inflate * error) * radius >= THIN[0] and not (mask & ~interior(mask))[rows, cols].any():
             return None
     parts, count = _smooth_parts(depth, mask, join)
     found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
@@ -396,7 +399,9 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
-        if (kappa * radius >= THIN[1] and error * radius <= THIN[2]) or (outside and kappa * radius >= THIN[0]):
+        # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors
+        convex = outside and kappa * radius >= THIN[0] and kappa > 2.0 * error
+        if (kappa * radius >= THIN[1] and error * radius <= THIN[2]) or convex:
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
