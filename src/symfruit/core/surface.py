@@ -375,13 +375,23 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     # not a sheet: still an occluder where a convex part behind it is larger (a fruit's own front is its largest part)
     least = max(30, 0.1 * len(rows)) if flat else len(rows) + 1
     sizes = np.bincount(parts.ravel(), minlength=count + 1)
-    # a surface whose most pixels lie outside the mask is not the fruit the mask is drawn on (a leaf running on
-    # beyond the fruit's outline): the part behind it need not prove itself convex
-    outside = around is not None and around.beyond(sheet, join) > len(rows)
-    if outside:
-        least = max(30, 0.1 * len(rows))
-    if max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id) < least:
+    largest = max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id)
+    if largest < max(30, 0.1 * len(rows)):
         return None  # no part large enough behind (a fruit's own front, not flat: the usual case, ended here)
+    # a surface whose most pixels lie outside the mask is not the fruit the mask is drawn on (a leaf running on
+    # beyond the fruit's outline): a smaller part behind it is looked at, and it need not prove itself convex (the
+    # window's parts are followed only where this decides: once a mask)
+    known: list[bool] = []
+
+    def outside() -> bool:
+        if not known:
+            known.append(around is not None and around.beyond(sheet, join) > len(rows))
+        return known[0]
+
+    if not flat and outside():
+        least = max(30, 0.1 * len(rows))
+    if largest < least:
+        return None
     far = float(np.median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
@@ -399,9 +409,9 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
+        told = kappa * radius >= THIN[1] and error * radius <= THIN[2]
         # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors
-        convex = outside and kappa * radius >= THIN[0] and kappa > 2.0 * error
-        if (kappa * radius >= THIN[1] and error * radius <= THIN[2]) or convex:
+        if told or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
