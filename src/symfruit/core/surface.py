@@ -243,8 +243,30 @@ LEAFY = (0.5, 0.3)
 THIN = (0.3, 0.5, 0.25)
 
 
+@dataclass(frozen=True)
+class Around:
+    """The depth around a mask's box (:func:`thin_front`): ``depth`` (0: none) and ``mask`` on a window holding the
+    box at rows ``r0``, columns ``c0``."""
+
+    depth: np.ndarray
+    mask: np.ndarray
+    r0: int
+    c0: int
+
+    def beyond(self, part: np.ndarray, join: float) -> int:
+        """How many pixels outside the mask continue the surface of ``part`` (a (h, w) bool image on the box): the
+        window's pixels with depth, joined to it through neighbours within ``join`` (:func:`_smooth_parts`)."""
+        labels, _ = _smooth_parts(self.depth, self.depth > 0, join)
+        h, w = part.shape
+        inside = labels[self.r0 : self.r0 + h, self.c0 : self.c0 + w][part]
+        ids = np.unique(inside[inside > 0])
+        if not len(ids):
+            return 0
+        return int(np.count_nonzero(np.isin(labels, ids) & ~self.mask))
+
+
 def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
-               noise: float = 0.0) -> tuple[float, np.ndarray] | None:  # fmt: skip
+               noise: float = 0.0, *, around: Around | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """``(front, sheet)`` when the mask's nearest surface is a thin sheet in front of the fruit (a leaf drawn into
     the mask, its depth fattened over the fruit's edge by a stereo camera), told by its shape alone: None when not.
 
@@ -295,11 +317,13 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
     if len(rows) >= 30:
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
-        if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
+        # ... unless it reaches the mask's outline: a fruit's nearest point lies inside its outline, while the nearest
+        # edge of a tilted leaf, or a leaf's depth fattened over the fruit, runs along it (a narrow band whose fit
+        # reads any curvature)
+        if (kappa - 2.0 * inflate * error) * radius >= THIN[0] and not (mask & ~interior(mask))[rows, cols].any():
             return None
-    found = _behind_sheet(
-        depth, mask, focal, front, radius, join, inflate, *_smooth_parts(depth, mask, join), noise=noise
-    )
+    parts, count = _smooth_parts(depth, mask, join)
+    found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
     if found is not None:
         return found
     if 3.0 * noise <= 0.003 or ok.sum() < 60:
@@ -318,14 +342,13 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
-    return _behind_sheet(
-        depth, mask, focal, front, radius, join, inflate, *_smooth_parts(smooth, mask, narrow), noise=noise
-    )
+    parts, count = _smooth_parts(smooth, mask, narrow)
+    return _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
 
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
-                  inflate: float, parts: np.ndarray, count: int,
-                  *, noise: float = 0.001) -> tuple[float, np.ndarray] | None:  # fmt: skip
+                  inflate: float, parts: np.ndarray, count: int, *, noise: float = 0.001,
+                  around: Around | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
     sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
     a flat reading must hold on the camera's own pixels; the cap behind is not asked as much). A front part that is
@@ -352,8 +375,23 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     # not a sheet: still an occluder where a convex part behind it is larger (a fruit's own front is its largest part)
     least = max(30, 0.1 * len(rows)) if flat else len(rows) + 1
     sizes = np.bincount(parts.ravel(), minlength=count + 1)
-    if max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id) < least:
+    largest = max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id)
+    if largest < max(30, 0.1 * len(rows)):
         return None  # no part large enough behind (a fruit's own front, not flat: the usual case, ended here)
+    # a surface whose most pixels lie outside the mask is not the fruit the mask is drawn on (a leaf running on
+    # beyond the fruit's outline): a smaller part behind it is looked at, and it need not prove itself convex (the
+    # window's parts are followed only where this decides: once a mask)
+    known: list[bool] = []
+
+    def outside() -> bool:
+        if not known:
+            known.append(around is not None and around.beyond(sheet, join) > len(rows))
+        return known[0]
+
+    if not flat and outside():
+        least = max(30, 0.1 * len(rows))
+    if largest < least:
+        return None
     far = float(np.median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
@@ -371,7 +409,9 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
-        if kappa * radius >= THIN[1] and error * radius <= THIN[2]:
+        told = kappa * radius >= THIN[1] and error * radius <= THIN[2]
+        # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors
+        if told or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
@@ -670,7 +710,13 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
     # camera's near fruit lost a third of its cap, issue 18)
     tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
-    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol, noise)) is not None:
+    around = None
+    if thin:
+        g = int(np.ceil(radius_px))  # the depth within the fruit's size around its mask's box
+        w0, w1 = max(r0 - g, 0), min(r1 + g, depth.shape[0])
+        v0, v1 = max(c0 - g, 0), min(c1 + g, depth.shape[1])
+        around = Around(depth[w0:w1, v0:v1], np.asarray(mask[w0:w1, v0:v1], dtype=bool), r0 - w0, c0 - v0)
+    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol, noise, around=around)) is not None:
         front, sheet = found_leaf
         radius = radius_px * front / focal
         region = region.copy()
