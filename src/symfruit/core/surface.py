@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
+from numpy.linalg import _umath_linalg  # type: ignore[attr-defined]
 from scipy import ndimage
 
 from .kernels import compiled
@@ -304,12 +305,19 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return found
     if 3.0 * noise <= 0.003 or ok.sum() < 60:
         return None  # the step was not bridged by noise
-    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)  # no depth: its nearest pixel's
     # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
-    # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels
+    # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
+    # takes its nearest pixel's
     rows, cols = np.nonzero(ok)
     smooth = np.zeros(depth.shape)
-    smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
+    if (jit := compiled()) is not None and depth.dtype == np.float64:
+        # the compiled twin of the windows' values median_at reads (stop 42: the same values in the same places)
+        values = np.empty((len(rows), 25))
+        jit.filled_windows(depth, ok, 5, values)
+        smooth[rows, cols] = np.partition(values, 12, axis=1)[:, 12]
+    else:
+        _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
+        smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
     a, b = smooth[:, 5:], smooth[:, :-5]
     diff = (a - b)[mask[:, 5:] & mask[:, :-5] & (a > 0) & (b > 0)]
     if len(diff) < 20:
@@ -354,7 +362,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     sizes = np.bincount(parts.ravel(), minlength=count + 1)
     if max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id) < least:
         return None  # no part large enough behind (a fruit's own front, not flat: the usual case, ended here)
-    far = float(np.median(depth[rows, cols]))
+    far = float(median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
     reach = 3 + int(np.ceil(0.3 * np.sqrt(mask.sum() / np.pi)))
@@ -367,7 +375,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         pr, pc = np.nonzero(parts == k)
         z = depth[pr, pc]
-        if float(np.median(z)) <= far + join or not touching[pr, pc].any():
+        if float(median(z)) <= far + join or not touching[pr, pc].any():
             continue
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
@@ -383,7 +391,12 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
     """(h, w) int labels (0: none, 1..n) and n: the pixels of ``mask`` with depth whose 4 neighbours (those in the
     mask with depth) all lie within ``join`` of them, joined 4-connected (a surface's depth runs on; a pixel on a
-    depth step belongs to neither side)."""
+    depth step belongs to neither side). By its compiled twin where numba is (:func:`symfruit.core._jit.smooth_parts`:
+    the same labels; stop 42)."""
+    jit = compiled()
+    if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and mask.dtype == bool:
+        labels = np.empty(depth.shape, np.int32)
+        return labels, int(jit.smooth_parts(depth, mask, float(join), labels))
     ok = mask & (depth > 0)
     smooth = ok.copy()
     pairs = ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1]))
@@ -417,12 +430,14 @@ class _InverseQuadratic:
         if len(z) > 2048:
             some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
             rows, cols, z = rows[some], cols[some], z[some]
-        self.zm, self.focal = float(np.median(z)), focal
+        # stop 42: points.median (np.median's value, bit for bit) and LAPACK's inverse without np.linalg.inv's
+        # checks (the same call, the same singular matrices raising): 45 and 4 us a fit
+        self.zm, self.focal = float(median(z)), focal
         self.r0, self.c0 = float(rows.mean()), float(cols.mean())
         a = self._design(rows, cols)
         w = 1.0 / z
         try:
-            self.inverse: np.ndarray | None = np.linalg.inv(a.T @ a)
+            self.inverse: np.ndarray | None = _inverse(a.T @ a)
         except np.linalg.LinAlgError:
             self.inverse = None
             return
@@ -453,7 +468,18 @@ class _InverseQuadratic:
             return float("-inf")
         inverse = self._design(at_rows, at_cols) @ self.coef
         there = np.where(inverse > 0, 1.0 / np.where(inverse > 0, inverse, 1.0), np.inf)
-        return float(np.median(at_z - there))
+        return float(median(at_z - there))
+
+
+def _inverse(a: np.ndarray) -> np.ndarray:
+    """``np.linalg.inv(a)`` of a float64 (k, k) matrix: LAPACK's own call, under the error state ``inv`` sets (a
+    singular matrix raises ``LinAlgError``), without its argument checks and conversions."""
+    with np.errstate(call=_singular, invalid="call", over="ignore", divide="ignore", under="ignore"):
+        return _umath_linalg.inv(a, signature="d->d")  # type: ignore[no-any-return]
+
+
+def _singular(err: Any, flag: Any) -> None:
+    raise np.linalg.LinAlgError("Singular matrix")
 
 
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
