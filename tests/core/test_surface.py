@@ -1012,3 +1012,18 @@ def test_the_trims_starting_centres_are_linspaces():
             want = np.linspace(0, n - 1, k).astype(int)
             got = _spread(n, k)
             assert got.dtype == want.dtype and np.array_equal(got, want)
+
+
+# --- stop 42, speedext42
+
+
+def test_the_fits_inverse_is_numpys_and_raises_on_a_singular_matrix():
+    """_InverseQuadratic's inverse: np.linalg.inv's bits; a singular matrix raises LinAlgError, as inv does."""
+    from symfruit.core.surface import _inverse
+
+    rng = np.random.default_rng(42)
+    a = rng.normal(size=(50, 6))
+    m = a.T @ a
+    assert _inverse(m).tobytes() == np.linalg.inv(m).tobytes()
+    with pytest.raises(np.linalg.LinAlgError):
+        _inverse(np.zeros((6, 6)))
