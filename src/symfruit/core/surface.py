@@ -31,7 +31,7 @@ from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
-from numpy.linalg import _umath_linalg  # type: ignore[attr-defined]
+from numpy.linalg import _umath_linalg
 from scipy import ndimage
 
 from .kernels import compiled
@@ -448,7 +448,14 @@ class _InverseQuadratic:
     def _design(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         x = (cols - self.c0) * (self.zm / self.focal)
         y = (rows - self.r0) * (self.zm / self.focal)
-        return np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
+        # np.stack((ones, x, y, x x, x y, y y), axis=1)'s array, its columns written in place (stop 42)
+        a = np.empty((len(x), 6))
+        a[:, 0] = 1.0
+        a[:, 1], a[:, 2] = x, y
+        np.multiply(x, x, out=a[:, 3])
+        np.multiply(x, y, out=a[:, 4])
+        np.multiply(y, y, out=a[:, 5])
+        return a
 
     def curvature(self) -> tuple[float, float]:
         """``(kappa, error)``, 1/metres: :func:`_mean_curvature`'s; ``(nan, inf)`` where the fit is singular."""
@@ -475,7 +482,7 @@ def _inverse(a: np.ndarray) -> np.ndarray:
     """``np.linalg.inv(a)`` of a float64 (k, k) matrix: LAPACK's own call, under the error state ``inv`` sets (a
     singular matrix raises ``LinAlgError``), without its argument checks and conversions."""
     with np.errstate(call=_singular, invalid="call", over="ignore", divide="ignore", under="ignore"):
-        return _umath_linalg.inv(a, signature="d->d")  # type: ignore[no-any-return]
+        return _umath_linalg.inv(a, signature="d->d")
 
 
 def _singular(err: Any, flag: Any) -> None:
