@@ -323,3 +323,20 @@ def test_a_support_at_the_fruits_depth_wider_than_the_band_and_another_fruit_sta
     assert full[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
     assert full[other].all()
     assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(np.mgrid[:60, :80][0] - 30) > 16)].any()
+
+
+# --- stop 42, speedext42
+
+
+def test_the_occlusion_made_without_checks_is_the_checked_one():
+    """occlusion()'s maps made by Occlusion._made: equal to the dataclass made with its checks from the same fields,
+    the same fields and types, and a cache of its own for the grown maps."""
+
+    rng = np.random.default_rng(42)
+    hidden, own = rng.random((12, 15)) < 0.3, rng.random((12, 15)) < 0.2
+    seen = rng.random((12, 15))
+    made = Occlusion._made(np.int64(3), 4, hidden, 40, 30, own, seen)
+    checked = Occlusion(3, 4, hidden, 40, 30, own=own, depth=seen)
+    assert made == checked and type(made.u0) is int and type(made.v0) is int
+    assert made.own is own and made.depth is seen and made._grown == {} and made._grown is not checked._grown
+    np.testing.assert_array_equal(made.grown(1), checked.grown(1))
