@@ -4145,3 +4145,122 @@ def test_revolution_box_closes_ends_within_the_fits_rms_as_its_twin(seed, bins, 
     for a, b in zip(fast, twin, strict=True):
         assert a.dtype == b.dtype == np.float64 and a.shape == b.shape
         assert np.array_equal(a.view(np.int64), b.view(np.int64))
+
+
+# --- stop 42, speedext42
+
+
+def _parts_case(seed: int):
+    """A window of depths from a few values (steps between them, ties), dropouts, a mask, a join."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(v) for v in rng.integers(1, 40, 2))
+    depth = rng.choice([0.0, 0.5, 0.501, 0.52, 0.6], size=(h, w))
+    if rng.random() < 0.5:
+        depth = depth + rng.normal(0.0, 0.002, (h, w))
+    depth[rng.random((h, w)) < 0.1] = 0.0
+    mask = rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    return depth, mask, float(rng.choice([0.003, 0.01, 0.05]))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_smooth_parts_kernel_gives_the_twins_labels(seed):
+    """smooth_parts against _smooth_parts' twin (ndimage.label's numbering): the same labels, count and type."""
+    from symfruit.core.surface import _smooth_parts
+
+    depth, mask, join = _parts_case(seed)
+    with pytest.MonkeyPatch.context() as mp:
+        (fast, n_fast), (twin, n_twin) = _both(mp, _smooth_parts, depth, mask, join)
+    assert n_fast == n_twin and fast.dtype == twin.dtype
+    np.testing.assert_array_equal(fast, twin)
+
+
+def test_the_smooth_parts_kernel_parts_a_step_and_numbers_in_raster_order():
+    """Known answer: a plane at 0.5 m with a square at 0.6 m: the square is one part, the plane around it another,
+    the pixels either side of the step in neither; the part met first in raster order is 1."""
+    depth = np.full((8, 9), 0.5)
+    depth[3:6, 5:8] = 0.6
+    mask = np.ones((8, 9), bool)
+    labels = np.empty((8, 9), np.int32)
+    assert _jit.smooth_parts(depth, mask, 0.01, labels) == 2
+    assert labels[0, 0] == 1 and labels[4, 6] == 2
+    assert labels[4, 4] == 0 and labels[4, 5] == 0 and labels[2, 6] == 0 and labels[3, 6] == 0
+    assert (labels == 2).sum() == 1  # the square's one pixel with no neighbour across the step
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_filled_windows_are_median_ats_values(seed):
+    """filled_windows against the twin's nearest pixels (scipy's feature transform) and median_at's windows: the
+    same values in the same places, so the same medians."""
+    from scipy import ndimage
+
+    depth, mask, _ = _parts_case(seed)
+    ok = mask & (depth > 0)
+    if not ok.any():
+        ok[0, 0], depth[0, 0] = True, 0.5
+    rows, cols = np.nonzero(ok)
+    values = np.empty((len(rows), 25))
+    _jit.filled_windows(depth, ok, 5, values)
+    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
+    filled = depth[ri, ci]
+    off = np.arange(5) - 2
+    r = np.clip(rows[:, None, None] + off[None, :, None], 0, depth.shape[0] - 1)
+    c = np.clip(cols[:, None, None] + off[None, None, :], 0, depth.shape[1] - 1)
+    np.testing.assert_array_equal(values, filled[r, c].reshape(len(rows), 25))
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_thin_fronts_median_partition_is_the_twins(seed):
+    """thin_front with the kernels and with the twins on a flat sheet 1 cm in front of a cap, noise of 2 mm and a
+    join of 15 mm bridging the step (so the parts are found again on the 5 x 5 median, smooth_parts and
+    filled_windows both run): the same front and sheet; the sheet is found, the fruit's front behind it."""
+    from symfruit.core.surface import thin_front
+
+    rng = np.random.default_rng(seed)
+    rr, cc = np.mgrid[0:60, 0:60]
+    d2 = (rr - 30.0) ** 2 + (cc - 30.0) ** 2
+    mask = d2 <= 27**2
+    depth = np.where(mask, 0.6 + d2 * 2e-5, 0.0) + rng.normal(0.0, 0.002, (60, 60))
+    sheet = mask & (cc < 25)
+    depth[sheet] = 0.59 + rng.normal(0.0, 0.002, int(sheet.sum()))
+    depth[~mask] = 0.0
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, thin_front, depth, mask, 600.0, 0.59, 0.02, 0.015, 0.002)
+    assert fast is not None and twin is not None
+    assert fast[0] == twin[0] and fast[0] > 0.595
+    np.testing.assert_array_equal(fast[1], twin[1])
+    assert fast[1].sum() > 0.9 * sheet.sum()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(0, 3), st.booleans(),
+       st.booleans(), st.integers(0, 5))  # fmt: skip
+def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reach, single, with_others, pad):
+    """occlusion_at (whole images read in place, the own depths over the points' box) and occlusion_window (the
+    window's images and own depths map) run one pass, _occlusion_pass: the same maps, bit for bit, on the window
+    occlusion_at picks; and occlusion_edge without a band is occlusion_at."""
+    rng = np.random.default_rng(seed)
+    big_h, big_w = h + 10, w + 12
+    n = int(rng.integers(1, max(2, h * w // 4)))
+    uv = np.stack((rng.integers(0, w, n) + 5.2, rng.integers(0, h, n) + 4.7), axis=1).astype(np.float64)
+    points = np.zeros((n, 3))
+    points[:, 2] = rng.choice([0.5, 0.51, 0.52, 0.53], n)
+    depth = rng.choice([0.0, np.nan, 0.49, 0.5, 0.505, 0.51, 0.52, 0.53, 0.6], (big_h, big_w))
+    depth = depth.astype(np.float32 if single else np.float64)
+    mask = rng.random((big_h, big_w)) < 0.2
+    others = rng.random((big_h, big_w)) < 0.3 if with_others else np.zeros((0, 0), bool)
+    steps = _steps_within(reach)
+    found, u0, v0, hidden, seen = _jit.occlusion_at(uv, points, pad, depth, mask, others, 0.005, steps)
+    assert found
+    hh, ww = hidden.shape
+    own_z = np.full((hh, ww), np.inf)
+    np.minimum.at(own_z, (np.rint(uv[:, 1]).astype(int) - v0, np.rint(uv[:, 0]).astype(int) - u0), points[:, 2])
+    hid, sn = np.empty((hh, ww), bool), np.empty((hh, ww))
+    win = (slice(v0, v0 + hh), slice(u0, u0 + ww))
+    _jit.occlusion_window(np.ascontiguousarray(depth[win]), np.ascontiguousarray(mask[win]), own_z,
+                          np.ascontiguousarray(others[win]) if with_others else others, 0.005, steps,
+                          float(points[:, 2].min()), float(points[:, 2].max()), hid, sn)  # fmt: skip
+    assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
+    edge = _jit.occlusion_edge(uv, points, pad, depth, mask, others, 0.005, steps, 0)
+    assert edge[:3] == (found, u0, v0) and np.array_equal(edge[3], hidden) and edge[4].tobytes() == seen.tobytes()

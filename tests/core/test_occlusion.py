@@ -369,3 +369,24 @@ def test_an_overshooting_mask_is_trimmed_where_the_camera_spreads_the_fruits_dep
     occ = occlusion(depth, mask, points, BIG)
     assert with_own(region, occ).mask.sum() == mask.sum()
     assert with_own(region, occ, trimmed=True).mask.sum() == (mask & ~(over & ~kept)).sum()
+
+
+# --- stop 42, speedext42
+
+
+def test_the_occlusion_made_without_checks_is_the_checked_one():
+    """occlusion()'s maps made by Occlusion._made: equal to the dataclass made with its checks from the same fields,
+    the same fields and types, and a cache of its own for the grown maps."""
+
+    rng = np.random.default_rng(42)
+    hidden, own = rng.random((12, 15)) < 0.3, rng.random((12, 15)) < 0.2
+    seen = rng.random((12, 15))
+    made = Occlusion._made(np.int64(3), 4, hidden, 40, 30, own, seen)
+    checked = Occlusion(3, 4, hidden, 40, 30, own=own, depth=seen)
+    assert made == checked and type(made.u0) is int and type(made.v0) is int
+    assert made.own is own and made.depth is seen and made._grown == {} and made._grown is not checked._grown
+    np.testing.assert_array_equal(made.grown(1), checked.grown(1))
+    over = rng.random((12, 15)) < 0.1  # with the mask's overshoot (stop 42, sil42)
+    assert Occlusion._made(3, 4, hidden, 40, 30, own, seen, over) == Occlusion(3, 4, hidden, 40, 30, own=own,
+                                                                               depth=seen, overshoot=over)  # fmt: skip
+    assert made.overshoot is None

@@ -3416,7 +3416,7 @@ def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, 
 
 
 @_njit
-def occlusion_at(
+def _occlusion_box(
     uv: np.ndarray,
     points: np.ndarray,
     pad: int,
@@ -3425,13 +3425,10 @@ def occlusion_at(
     others: np.ndarray,
     tolerance: float,
     steps: np.ndarray,
-) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`own_depths` then :func:`occlusion_window` in one kernel (issue 19, twentieth round): ``depth``, ``mask``
-    and ``others`` (or (0, 0)) are the whole (H, W) images, read in place; the points' own depths are kept over their
-    pixels' box alone (no pixel outside it holds one), not as an (h, w) map of +inf the window pass reads again.
-    ``(found, u0, v0, hidden, seen)``: the window's top-left pixel and its maps, :func:`occlusion_window`'s to the
-    bit (``low`` and ``high`` the points' least and greatest depth, all of them); found False when no point falls
-    in the image."""
+) -> tuple[bool, int, int, np.ndarray, np.ndarray, np.ndarray, int, int]:  # fmt: skip
+    """:func:`occlusion_at`, with the points' own depths over their pixels' box and the box's top-left pixel in the
+    window: ``(found, u0, v0, hidden, seen, own_z, p0, q0)`` (stop 42: :func:`occlusion_edge` reads them instead of
+    projecting the points again)."""
     height, width = mask.shape
     n = uv.shape[0]
     cmin, cmax, rmin, rmax = width, -1, height, -1
@@ -3444,7 +3441,7 @@ def occlusion_at(
             c, r = int(u), int(v)
             cmin, cmax, rmin, rmax = min(cmin, c), max(cmax, c), min(rmin, r), max(rmax, r)
     if cmax < 0:
-        return False, 0, 0, np.empty((0, 0), np.bool_), np.empty((0, 0))
+        return False, 0, 0, np.empty((0, 0), np.bool_), np.empty((0, 0)), np.empty((0, 0)), 0, 0
     span_u, span_v = cmax - cmin + pad, rmax - rmin + pad
     u0, v0 = max(cmin - span_u, 0), max(rmin - span_v, 0)
     u1, v1 = min(cmax + span_u + 1, width), min(rmax + span_v + 1, height)
@@ -3461,102 +3458,30 @@ def occlusion_at(
                 own_z[r, c] = z
     hidden = np.empty((h, w), np.bool_)
     seen = np.empty((h, w))
-    lo, hi = low + tolerance, high + tolerance
-    k = steps.shape[0]
-    with_others = others.shape[0] > 0
-    # whether a pixel may lend its depth (neither the fruit's nor without depth), once a pixel
-    lend = np.empty((h, w), np.bool_)
-    for r in range(h):
-        inr = p0 <= r < p1
-        for c in range(w):
-            o = mask[v0 + r, u0 + c] or (inr and q0 <= c < q1 and math.isfinite(own_z[r - p0, c - q0]))
-            y = np.float64(depth[v0 + r, u0 + c])
-            lend[r, c] = not o and math.isfinite(y) and y > 0.0
-            if o:
-                hidden[r, c] = False
-                seen[r, c] = np.nan
-            else:
-                seen[r, c] = y  # NaN for now where it has no depth of its own (below)
-    rows = np.zeros(h, np.bool_)
-    for r in range(h):
-        for c in range(w):
-            x = seen[r, c]
-            if x != x and (mask[v0 + r, u0 + c] or (p0 <= r < p1 and q0 <= c < q1
-                                                        and math.isfinite(own_z[r - p0, c - q0]))):  # fmt: skip
-                continue  # the fruit's own
-            if not lend[r, c]:
-                x = np.nan
-                for j in range(k):
-                    rr, cc = r + steps[j, 0], c + steps[j, 1]
-                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
-                        x = np.float64(depth[v0 + rr, u0 + cc])
-                        break
-                seen[r, c] = x
-            if not math.isfinite(x):  # NaN: never nearer, never behind
-                hidden[r, c] = with_others and others[v0 + r, u0 + c]
-            elif x < lo:
-                hidden[r, c] = True
-            else:
-                hidden[r, c] = False
-                if x < hi:
-                    rows[r] = True
-    # the nearest point pixels of the rows that wait for them, as occlusion_window finds them (its column pass over
-    # the box, its row pass and walk)
-    place = np.full(h, -1, np.int64)
-    count = 0
-    for r in range(h):
-        if rows[r]:
-            place[r] = count
-            count += 1
-    near = np.full((count, nb), -1, np.int64)
-    run = np.full(nb, -1, np.int64)
-    for r in range(p0, h):
-        if r < p1:
-            for j in range(nb):
-                if math.isfinite(own_z[r - p0, j]):
-                    run[j] = r
-        kr = place[r]
-        if kr >= 0:
-            for j in range(nb):
-                near[kr, j] = run[j]
-    run[:] = -1
-    for r in range(p1 - 1, -1, -1):
-        if r >= p0:
-            for j in range(nb):
-                if math.isfinite(own_z[r - p0, j]):
-                    run[j] = r
-        kr = place[r]
-        if kr >= 0:
-            for j in range(nb):
-                a, b = near[kr, j], run[j]
-                if b >= 0 and (a < 0 or b - r < r - a):
-                    near[kr, j] = b
-    env = np.empty(nb, np.int64)
-    for r in range(h):
-        if not rows[r]:
-            continue
-        row = near[place[r]]
-        top = _row_envelope(row, r, env)
-        q = 0
-        for u in range(w):
-            x = seen[r, u]
-            if not (x >= lo and x < hi):
-                continue
-            i = env[q]
-            dr, dc = row[i] - r, i + q0 - u
-            best = dr * dr + dc * dc
-            while q < top:
-                i = env[q + 1]
-                dr, dc = row[i] - r, i + q0 - u
-                d = dr * dr + dc * dc
-                if best <= d:
-                    break
-                best = d
-                q += 1
-            i = env[q]
-            ref = own_z[row[i] - p0, i] + tolerance
-            hidden[r, u] = x < ref or (with_others and others[v0 + r, u0 + u] and not x >= ref)
-    return True, u0, v0, hidden, seen
+    _occlusion_pass(depth, mask, others, v0, u0, own_z, p0, q0, tolerance, steps, low, high, hidden, seen)
+    return True, u0, v0, hidden, seen, own_z, p0, q0
+
+
+@_njit
+def occlusion_at(
+    uv: np.ndarray,
+    points: np.ndarray,
+    pad: int,
+    depth: np.ndarray,
+    mask: np.ndarray,
+    others: np.ndarray,
+    tolerance: float,
+    steps: np.ndarray,
+) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`own_depths` then :func:`occlusion_window` in one kernel (issue 19, twentieth round): ``depth``, ``mask``
+    and ``others`` (or (0, 0)) are the whole (H, W) images, read in place; the points' own depths are kept over their
+    pixels' box alone (no pixel outside it holds one), not as an (h, w) map of +inf the window pass reads again.
+    ``(found, u0, v0, hidden, seen)``: the window's top-left pixel and its maps, :func:`occlusion_window`'s to the
+    bit (``low`` and ``high`` the points' least and greatest depth, all of them); found False when no point falls
+    in the image. Since stop 42 the window's pass is :func:`occlusion_window`'s own (:func:`_occlusion_pass`, on
+    the images' window in place)."""
+    found, u0, v0, hidden, seen, _, _, _ = _occlusion_box(uv, points, pad, depth, mask, others, tolerance, steps)
+    return found, u0, v0, hidden, seen
 
 
 @_njit
@@ -3833,7 +3758,7 @@ def occlusion_edge(
     :func:`own_edge` on the maps, in one call (issue 19, stop 41: three calls and the own depths' two boxed arrays
     were a fifth of the compiled occlusion's time): ``(found, u0, v0, hidden, seen)``, :func:`symfruit.core.occlusion.
     occlusion`'s maps bit for bit."""
-    found, u0, v0, hidden, seen = occlusion_at(uv, points, pad, depth, mask, others, tolerance, steps)
+    found, u0, v0, hidden, seen, box_z, p0, q0 = _occlusion_box(uv, points, pad, depth, mask, others, tolerance, steps)
     if not found or band <= 0:
         return found, u0, v0, hidden, seen
     h, w = hidden.shape
@@ -3847,15 +3772,8 @@ def occlusion_edge(
             break
     if not some:
         return found, u0, v0, hidden, seen
-    height, width = mask.shape
-    own_z = np.full((h, w), np.inf)
-    for i in range(uv.shape[0]):
-        u, v = np.rint(uv[i, 0]), np.rint(uv[i, 1])
-        if u >= 0 and u < width and v >= 0 and v < height:
-            r, c = int(v) - v0, int(u) - u0
-            z = points[i, 2]
-            if z < own_z[r, c]:
-                own_z[r, c] = z
+    own_z = np.full((h, w), np.inf)  # the box's own depths (the least of a pixel's points) placed in the window
+    own_z[p0 : p0 + box_z.shape[0], q0 : q0 + box_z.shape[1]] = box_z
     own = np.empty((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
@@ -3894,6 +3812,223 @@ def monotone_at(
                 i += 1
     monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
     return n
+
+
+# --- stop 42, speedext42: the occlusion window's one pass, the thin-front test's parts and median ---------------
+
+
+# inlined into its two callers at numba's level: called, it cost occlusion_at 6-8 % (its loops optimised apart)
+@numba.njit(cache=True, error_model="numpy", nogil=True, inline="always")
+def _occlusion_pass(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    others: np.ndarray,
+    v0: int,
+    u0: int,
+    own_z: np.ndarray,
+    p0: int,
+    q0: int,
+    tolerance: float,
+    steps: np.ndarray,
+    low: float,
+    high: float,
+    hidden: np.ndarray,
+    seen: np.ndarray,
+) -> int:  # fmt: skip
+    """The pass :func:`occlusion_window` and :func:`occlusion_at` share (stop 42: they held it twice): the window is
+    ``hidden``'s (h, w) pixels from ``(v0, u0)`` of the images ``depth``, ``mask`` and ``others`` (or (0, 0)), read
+    in place (views of a window would be strided arrays, 10 % slower); ``own_z`` the points' own depths over their
+    pixels' box, whose top-left pixel is ``(p0, q0)`` in the window (+inf where none: no point pixel lies outside
+    it), ``low`` and ``high`` the points' least and greatest depth. ``hidden`` and ``seen`` get
+    :func:`occlusion_window`'s maps; the number of rows whose nearest point pixels were looked for is returned."""
+    h, w = hidden.shape
+    p1, q1 = p0 + own_z.shape[0], q0 + own_z.shape[1]
+    lo, hi = low + tolerance, high + tolerance
+    k = steps.shape[0]
+    with_others = others.shape[0] > 0
+    # issue 19, twentieth round: whether a pixel may lend its depth (neither the fruit's nor without depth) is worked
+    # out once a pixel, not once per offset that reads it; the point pixels' box bounds the column sweeps (no point
+    # pixel lies outside it, so no column's nearest changes); a pixel waits for its nearest point pixel when its
+    # seen depth lies in [lo, hi) (read back from ``seen``), not by a map of its own
+    lend = np.empty((h, w), np.bool_)
+    for r in range(h):
+        inr = p0 <= r < p1
+        for c in range(w):
+            o = mask[v0 + r, u0 + c] or (inr and q0 <= c < q1 and math.isfinite(own_z[r - p0, c - q0]))
+            y = np.float64(depth[v0 + r, u0 + c])
+            lend[r, c] = not o and math.isfinite(y) and y > 0.0
+            if o:
+                hidden[r, c] = False
+                seen[r, c] = np.nan
+            else:
+                seen[r, c] = y  # NaN for now where it has no depth of its own (below)
+    rows = np.zeros(h, np.bool_)
+    for r in range(h):
+        for c in range(w):
+            x = seen[r, c]
+            if x != x and (mask[v0 + r, u0 + c] or (p0 <= r < p1 and q0 <= c < q1
+                                                        and math.isfinite(own_z[r - p0, c - q0]))):  # fmt: skip
+                continue  # the fruit's own
+            if not lend[r, c]:
+                x = np.nan
+                for j in range(k):
+                    rr, cc = r + steps[j, 0], c + steps[j, 1]
+                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
+                        x = np.float64(depth[v0 + rr, u0 + cc])
+                        break
+                seen[r, c] = x
+            if not math.isfinite(x):  # NaN: never nearer, never behind
+                hidden[r, c] = with_others and others[v0 + r, u0 + c]
+            elif x < lo:
+                hidden[r, c] = True
+            else:
+                hidden[r, c] = False
+                if x < hi:
+                    rows[r] = True
+    # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
+    # the rows looked at alone and the point pixels' columns alone (q0 to q1: no other column has a nearest row):
+    # the nearest at or above by a sweep down, the nearest below by a sweep up, each over the point pixels' rows
+    # (beyond them its state does not change)
+    place = np.full(h, -1, np.int64)
+    count = 0
+    for r in range(h):
+        if rows[r]:
+            place[r] = count
+            count += 1
+    nb = max(q1 - q0, 0)
+    near = np.full((count, nb), -1, np.int64)  # column q0 + j's nearest row, -1: none
+    run = np.full(nb, -1, np.int64)
+    for r in range(p0, h):
+        if r < p1:
+            for j in range(nb):
+                if math.isfinite(own_z[r - p0, j]):
+                    run[j] = r
+        kr = place[r]
+        if kr >= 0:
+            for j in range(nb):
+                near[kr, j] = run[j]
+    run[:] = -1
+    for r in range(p1 - 1, -1, -1):
+        if r >= p0:
+            for j in range(nb):
+                if math.isfinite(own_z[r - p0, j]):
+                    run[j] = r
+        kr = place[r]
+        if kr >= 0:
+            for j in range(nb):
+                a, b = near[kr, j], run[j]
+                if b >= 0 and (a < 0 or b - r < r - a):
+                    near[kr, j] = b
+    env = np.empty(max(nb, 1), np.int64)
+    done = 0
+    for r in range(h):
+        if not rows[r]:
+            continue
+        done += 1
+        row = near[place[r]]
+        top = _row_envelope(row, r, env)  # nearest()'s row pass, columns counted from q0: the same envelope (its
+        # tests are on differences of columns), and the same walk along it, taken at the waiting pixels alone: the
+        # walk moves on to the next parabola only while that is strictly nearer, and the next's lead over the last
+        # grows along the row, so the parabola it stops at for a pixel is the same whether it walked every pixel
+        # before or only some of them
+        q = 0
+        for u in range(w):
+            x = seen[r, u]
+            if not (x >= lo and x < hi):  # decided without its nearest point pixel (NaN: never waits)
+                continue
+            i = env[q]
+            dr, dc = row[i] - r, i + q0 - u
+            best = dr * dr + dc * dc
+            while q < top:
+                i = env[q + 1]
+                dr, dc = row[i] - r, i + q0 - u
+                d = dr * dr + dc * dc
+                if best <= d:
+                    break
+                best = d
+                q += 1
+            i = env[q]
+            ref = own_z[row[i] - p0, i] + tolerance
+            hidden[r, u] = x < ref or (with_others and others[v0 + r, u0 + u] and not x >= ref)
+    return done
+
+
+@_njit
+def smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float, labels: np.ndarray) -> int:
+    """:func:`symfruit.core.surface._smooth_parts` into ``labels`` ((h, w) int32, every pixel written) and the number
+    of parts: the pixels of ``mask`` with depth (above 0) none of whose 4 neighbours in the mask with depth lies
+    more than ``join`` from it, joined 4-connected and numbered from 1 in the raster order of each part's first
+    pixel (``ndimage.label``'s numbering, so the same labels; stop 42)."""
+    h, w = depth.shape
+    smooth = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            z = depth[r, c]
+            if not (mask[r, c] and z > 0):
+                continue
+            s = True
+            if r > 0 and mask[r - 1, c] and depth[r - 1, c] > 0 and abs(z - depth[r - 1, c]) > join:
+                s = False
+            elif r + 1 < h and mask[r + 1, c] and depth[r + 1, c] > 0 and abs(depth[r + 1, c] - z) > join:
+                s = False
+            elif c > 0 and mask[r, c - 1] and depth[r, c - 1] > 0 and abs(z - depth[r, c - 1]) > join:
+                s = False
+            elif c + 1 < w and mask[r, c + 1] and depth[r, c + 1] > 0 and abs(depth[r, c + 1] - z) > join:
+                s = False
+            smooth[r, c] = s
+    labels[:] = 0
+    stack = np.empty(max(h * w, 1), np.int64)
+    count = 0
+    for r in range(h):
+        for c in range(w):
+            if not smooth[r, c] or labels[r, c] != 0:
+                continue
+            count += 1
+            labels[r, c] = count
+            stack[0] = r * w + c
+            top = 1
+            while top > 0:
+                top -= 1
+                rr, cc = stack[top] // w, stack[top] % w
+                for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
+                    a, b = rr + dr, cc + dc
+                    if 0 <= a < h and 0 <= b < w and smooth[a, b] and labels[a, b] == 0:
+                        labels[a, b] = count
+                        stack[top] = a * w + b
+                        top += 1
+    return count
+
+
+@_njit
+def filled_windows(depth: np.ndarray, ok: np.ndarray, size: int, values: np.ndarray) -> None:
+    """``values`` ((n, size * size) float64, n the pixels of ``ok``, which must hold one): row ``i`` the ``size`` x
+    ``size`` window (odd ``size``, edges repeated; row by row) of ``depth`` around the ``i``-th pixel of ``ok`` in
+    raster order (``np.nonzero``'s), every pixel not ``ok`` taking its nearest ``ok`` pixel's depth
+    (``ndimage.distance_transform_edt(~ok, return_indices=True)``'s pixel, by :func:`nearest`):
+    :func:`symfruit.core.surface.median_at`'s values in :func:`symfruit.core.surface.thin_front`, the same ones in
+    the same places (stop 42; numpy's partition then takes their medians: its SIMD selection is faster than
+    :func:`select` or a sort here). The filled depth is laid out once with the edges repeated, as
+    :func:`_least_median_of` does."""
+    h, w = ok.shape
+    idx = np.empty((h, w), np.int64)
+    nearest(np.logical_not(ok), idx)
+    half = size // 2
+    vals = np.empty((h + 2 * half, w + 2 * half))
+    for a in range(h + 2 * half):
+        rr = min(max(a - half, 0), h - 1)
+        for b in range(w + 2 * half):
+            i = idx[rr, min(max(b - half, 0), w - 1)]
+            vals[a, b] = np.float64(depth[i // w, i % w])
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                k = 0
+                for a in range(size):
+                    for b in range(size):
+                        values[n, k] = vals[r + a, c + b]
+                        k += 1
+                n += 1
 
 
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
@@ -4202,117 +4337,15 @@ def occlusion_window(
     its first offset with depth (:func:`occlusion_maps`' fill; whether a pixel has depth is worked out where it is
     looked at)."""
     h, w = mask.shape
-    lo, hi = low + tolerance, high + tolerance
-    k = steps.shape[0]
-    with_others = others.shape[0] > 0
-    # issue 19, twentieth round: whether a pixel may lend its depth (neither the fruit's nor without depth) is worked
-    # out once a pixel, not once per offset that reads it; the point pixels' box bounds the column sweeps (no point
-    # pixel lies outside it, so no column's nearest changes); a pixel waits for its nearest point pixel when its
-    # seen depth lies in [lo, hi) (read back from ``seen``), not by a map of its own
-    lend = np.empty((h, w), np.bool_)
-    own = np.empty((h, w), np.bool_)
     p0, p1, q0, q1 = h, 0, w, 0  # the point pixels' box
     for r in range(h):
         for c in range(w):
-            pt = math.isfinite(own_z[r, c])
-            if pt:
+            if math.isfinite(own_z[r, c]):
                 p0, p1 = min(p0, r), r + 1
                 q0, q1 = min(q0, c), max(q1, c + 1)
-            o = mask[r, c] or pt
-            own[r, c] = o
-            y = np.float64(depth[r, c])
-            lend[r, c] = not o and math.isfinite(y) and y > 0.0
-    rows = np.zeros(h, np.bool_)
-    for r in range(h):
-        for c in range(w):
-            if own[r, c]:
-                hidden[r, c] = False
-                seen[r, c] = np.nan
-                continue
-            if lend[r, c]:
-                x = np.float64(depth[r, c])
-            else:
-                x = np.nan
-                for j in range(k):
-                    rr, cc = r + steps[j, 0], c + steps[j, 1]
-                    if 0 <= rr < h and 0 <= cc < w and lend[rr, cc]:  # a pixel with depth: its own, never filled
-                        x = np.float64(depth[rr, cc])
-                        break
-            seen[r, c] = x
-            if not math.isfinite(x):  # NaN: never nearer, never behind
-                hidden[r, c] = with_others and others[r, c]
-            elif x < lo:
-                hidden[r, c] = True
-            else:
-                hidden[r, c] = False
-                if x < hi:
-                    rows[r] = True
-    # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
-    # the rows looked at alone and the point pixels' columns alone (q0 to q1: no other column has a nearest row):
-    # the nearest at or above by a sweep down, the nearest below by a sweep up, each over the point pixels' rows
-    # (beyond them its state does not change)
-    place = np.full(h, -1, np.int64)
-    count = 0
-    for r in range(h):
-        if rows[r]:
-            place[r] = count
-            count += 1
-    nb = max(q1 - q0, 0)
-    near = np.full((count, nb), -1, np.int64)  # column q0 + j's nearest row, -1: none
-    run = np.full(nb, -1, np.int64)
-    for r in range(p0, h):
-        if r < p1:
-            for j in range(nb):
-                if math.isfinite(own_z[r, q0 + j]):
-                    run[j] = r
-        kr = place[r]
-        if kr >= 0:
-            for j in range(nb):
-                near[kr, j] = run[j]
-    run[:] = -1
-    for r in range(p1 - 1, -1, -1):
-        if r >= p0:
-            for j in range(nb):
-                if math.isfinite(own_z[r, q0 + j]):
-                    run[j] = r
-        kr = place[r]
-        if kr >= 0:
-            for j in range(nb):
-                a, b = near[kr, j], run[j]
-                if b >= 0 and (a < 0 or b - r < r - a):
-                    near[kr, j] = b
-    env = np.empty(max(nb, 1), np.int64)
-    done = 0
-    for r in range(h):
-        if not rows[r]:
-            continue
-        done += 1
-        row = near[place[r]]
-        top = _row_envelope(row, r, env)  # nearest()'s row pass, columns counted from q0: the same envelope (its
-        # tests are on differences of columns), and the same walk along it, taken at the waiting pixels alone: the
-        # walk moves on to the next parabola only while that is strictly nearer, and the next's lead over the last
-        # grows along the row, so the parabola it stops at for a pixel is the same whether it walked every pixel
-        # before or only some of them
-        q = 0
-        for u in range(w):
-            x = seen[r, u]
-            if not (x >= lo and x < hi):  # decided without its nearest point pixel (NaN: never waits)
-                continue
-            i = env[q]
-            dr, dc = row[i] - r, i + q0 - u
-            best = dr * dr + dc * dc
-            while q < top:
-                i = env[q + 1]
-                dr, dc = row[i] - r, i + q0 - u
-                d = dr * dr + dc * dc
-                if best <= d:
-                    break
-                best = d
-                q += 1
-            i = env[q]
-            ref = own_z[row[i], i + q0] + tolerance
-            hidden[r, u] = x < ref or (with_others and others[r, u] and not x >= ref)
-    return done
+    # stop 42: the pass shared with occlusion_at (the window's maps from the own depths over the point pixels' box)
+    return _occlusion_pass(depth, mask, others, 0, 0, own_z[p0:p1, q0:q1], p0, q0, tolerance, steps, low, high,
+                           hidden, seen)  # fmt: skip
 
 
 @_njit

@@ -328,12 +328,19 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return found
     if 3.0 * noise <= 0.003 or ok.sum() < 60:
         return None  # the step was not bridged by noise
-    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)  # no depth: its nearest pixel's
     # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
-    # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels
+    # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
+    # takes its nearest pixel's
     rows, cols = np.nonzero(ok)
     smooth = np.zeros(depth.shape)
-    smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
+    if (jit := compiled()) is not None and depth.dtype == np.float64:
+        # the compiled twin of the windows' values median_at reads (stop 42: the same values in the same places)
+        values = np.empty((len(rows), 25))
+        jit.filled_windows(depth, ok, 5, values)
+        smooth[rows, cols] = np.partition(values, 12, axis=1)[:, 12]
+    else:
+        _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
+        smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
     a, b = smooth[:, 5:], smooth[:, :-5]
     diff = (a - b)[mask[:, 5:] & mask[:, :-5] & (a > 0) & (b > 0)]
     if len(diff) < 20:
@@ -392,7 +399,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         least = max(30, 0.1 * len(rows))
     if largest < least:
         return None
-    far = float(np.median(depth[rows, cols]))
+    far = float(median(depth[rows, cols]))
     # what the sheet hides is bounded by its edge: a part touching it (a few pixels apart: a stereo camera's
     # shadow, a time-of-flight camera's invalid rim lie between)
     reach = 3 + int(np.ceil(0.3 * np.sqrt(mask.sum() / np.pi)))
@@ -405,7 +412,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             continue
         pr, pc = np.nonzero(parts == k)
         z = depth[pr, pc]
-        if float(np.median(z)) <= far + join or not touching[pr, pc].any():
+        if float(median(z)) <= far + join or not touching[pr, pc].any():
             continue
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
@@ -423,7 +430,12 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
     """(h, w) int labels (0: none, 1..n) and n: the pixels of ``mask`` with depth whose 4 neighbours (those in the
     mask with depth) all lie within ``join`` of them, joined 4-connected (a surface's depth runs on; a pixel on a
-    depth step belongs to neither side)."""
+    depth step belongs to neither side). By its compiled twin where numba is (:func:`symfruit.core._jit.smooth_parts`:
+    the same labels; stop 42)."""
+    jit = compiled()
+    if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and mask.dtype == bool:
+        labels = np.empty(depth.shape, np.int32)
+        return labels, int(jit.smooth_parts(depth, mask, float(join), labels))
     ok = mask & (depth > 0)
     smooth = ok.copy()
     pairs = ((depth[1:], depth[:-1], ok[1:], ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:], ok[:, :-1]))
@@ -457,7 +469,8 @@ class _InverseQuadratic:
         if len(z) > 2048:
             some = np.sort(np.random.default_rng(0).choice(len(z), 2048, replace=False))
             rows, cols, z = rows[some], cols[some], z[some]
-        self.zm, self.focal = float(np.median(z)), focal
+        # stop 42: points.median (np.median's value, bit for bit): 45 us a fit less
+        self.zm, self.focal = float(median(z)), focal
         self.r0, self.c0 = float(rows.mean()), float(cols.mean())
         a = self._design(rows, cols)
         w = 1.0 / z
@@ -473,7 +486,14 @@ class _InverseQuadratic:
     def _design(self, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
         x = (cols - self.c0) * (self.zm / self.focal)
         y = (rows - self.r0) * (self.zm / self.focal)
-        return np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1)
+        # np.stack((ones, x, y, x x, x y, y y), axis=1)'s array, its columns written in place (stop 42)
+        a = np.empty((len(x), 6))
+        a[:, 0] = 1.0
+        a[:, 1], a[:, 2] = x, y
+        np.multiply(x, x, out=a[:, 3])
+        np.multiply(x, y, out=a[:, 4])
+        np.multiply(y, y, out=a[:, 5])
+        return a
 
     def curvature(self) -> tuple[float, float]:
         """``(kappa, error)``, 1/metres: :func:`_mean_curvature`'s; ``(nan, inf)`` where the fit is singular."""
@@ -493,7 +513,7 @@ class _InverseQuadratic:
             return float("-inf")
         inverse = self._design(at_rows, at_cols) @ self.coef
         there = np.where(inverse > 0, 1.0 / np.where(inverse > 0, inverse, 1.0), np.inf)
-        return float(np.median(at_z - there))
+        return float(median(at_z - there))
 
 
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
