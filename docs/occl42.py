@@ -17,8 +17,8 @@ the leaf's; ``shift`` / ``true``: the registration's estimate and the model's of
 
 from __future__ import annotations
 
+import argparse
 import csv
-import sys
 
 import numpy as np
 
@@ -129,8 +129,14 @@ def view(spec: P.Spec, st: Settings) -> dict:
 
 
 def main() -> None:
-    sensor, occs, out = sys.argv[1], tuple(float(x) for x in sys.argv[2].split(",")), sys.argv[3]
-    seeds = [int(x) for x in sys.argv[4].split(",")] if len(sys.argv) > 4 else [0]
+    parser = argparse.ArgumentParser(description="Where the camera protocol's leaf views go wrong (docs/occl42.md).")
+    parser.add_argument("sensor", help="a camera model, e.g. realsense-d435")
+    parser.add_argument("occlusions", help="leaf levels, e.g. 0.25,0.5")
+    parser.add_argument("out", help="the CSV written, one row a view")
+    parser.add_argument("seeds", nargs="?", default="0", help="seeds, e.g. 0,1 (default 0)")
+    args = parser.parse_args()
+    sensor, occs, out = args.sensor, tuple(float(x) for x in args.occlusions.split(",")), args.out
+    seeds = [int(x) for x in args.seeds.split(",")]
     st = Settings()
     rows = [view(spec, st) for seed in seeds for kind in KINDS
             for spec in specs("camera", kind, n=10, seed=seed, occlusions=occs, sensor=sensor)]  # fmt: skip
