@@ -162,15 +162,9 @@ def ceiling(paths: list[str]) -> None:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="cmd", required=True)
-    c = sub.add_parser("collect", help="confidence_features.py's collect, with the refit and softer-weight columns")
-    c.add_argument("out", help="the CSV to write")
-    c.add_argument("--protocol", default="camera", choices=("camera", "paper"))
-    c.add_argument("--fruit", default="examples/scans", help="a scan folder, generated kinds (comma-separated) or all")
-    c.add_argument("--n", type=int, default=190)
-    c.add_argument("--pose", default="hanging")
-    c.add_argument("--sensor", default="heldback")
-    c.add_argument("--seed", type=int, default=0)
-    c.add_argument("--views", type=int, default=1, help="views a generated fruit")
+    cf.collect_arguments(
+        sub.add_parser("collect", help="confidence_features.py's collect, with the refit and softer-weight columns")
+    )
     t = sub.add_parser("table", help="within / pooled Spearman of each feature and formula, a column a CSV")
     t.add_argument("csv", nargs="+")
     g = sub.add_parser("ceiling", help="a linear mix of every feature fitted on the first CSV, read on each")

@@ -261,10 +261,8 @@ def table(args: argparse.Namespace) -> None:
         out.write(f"{path}: {ratio:.2f}; {1000 * float(np.median(d['recede'])):.1f} mm\n")
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    sub = parser.add_subparsers(dest="cmd", required=True)
-    c = sub.add_parser("collect", help="run the evaluation's instances, write a CSV of per-view quantities")
+def collect_arguments(c: argparse.ArgumentParser) -> argparse.ArgumentParser:
+    """The ``collect`` command's arguments (docs/conf42.py's ``collect`` takes the same)."""
     c.add_argument("out", help="the CSV to write")
     c.add_argument("--protocol", default="camera", choices=("camera", "paper"))
     c.add_argument("--fruit", default="examples/scans", help="a scan folder, generated kinds (comma-separated) or all")
@@ -273,6 +271,15 @@ def main() -> None:
     c.add_argument("--sensor", default="heldback")
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--views", type=int, default=1, help="views a generated fruit")
+    return c
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="cmd", required=True)
+    collect_arguments(
+        sub.add_parser("collect", help="run the evaluation's instances, write a CSV of per-view quantities")
+    )
     t = sub.add_parser("table", help="print the feature and formula tables from collected CSVs")
     t.add_argument("csv", nargs="+")
     args = parser.parse_args()

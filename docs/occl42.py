@@ -31,46 +31,23 @@ from symfruit.extract import extract, register, shift_labels
 from symfruit.methods.complete import complete
 from symfruit.occlusion import fruit_occlusion
 from symfruit.settings import Settings
-from symfruit.synthetic.render import render
-from symfruit.synthetic.sensors import SENSOR_MODELS, apply_sensor, varied
+from symfruit.synthetic.sensors import SENSOR_MODELS, varied
 
 KINDS = ("strawberry", "apple", "citrus", "tomato", "lemon", "peach", "plum")
 
 
 def build(spec: P.Spec) -> dict:
-    """``protocols._real_camera``'s view, the same draws, with the render's truth kept."""
+    """``protocols._real_camera``'s view (:func:`symfruit.evaluate.protocols.real_view`, the same draws), with the
+    render's truth kept."""
     model = varied(SENSOR_MODELS[spec.sensor], spec.sensor_set)
-    fruit, full = P._fruit(spec), model.camera()
-    rng = np.random.default_rng([spec.seed, 4000 + P._KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
-                                 round(spec.occlusion * 1000), list(SENSOR_MODELS).index(model.name)])  # fmt: skip
-    rot, _ = P._pose(spec, rng)
-    distance = float(rng.uniform(*model.distance))
-    radius = float(np.linalg.norm(fruit.vertices, axis=1).max())
-    tan_u = min((full.width / 2 - 10) / full.fx, np.tan(np.radians(model.depth_hfov) / 2) * 0.97)
-    tan_v = min((full.height / 2 - 10) / full.fy, np.tan(np.radians(model.depth_vfov) / 2) * 0.97)
-    half_u, half_v = max(tan_u * distance - radius, 0.0), max(tan_v * distance - radius, 0.0)
-    centre = np.array([rng.uniform(-1, 1) * half_u, rng.uniform(-1, 1) * half_v, distance])
-    posed = fruit.transformed(rot, centre)
-    u, v = full.project(centre[None])[0]
-    reach = 1.8 * full.fx * radius / distance + 24
-    c0, c1 = max(int(u - reach), 0), min(int(u + reach) + 1, full.width)
-    r0, r1 = max(int(v - reach), 0), min(int(v + reach) + 1, full.height)
-    cam = Camera(fx=full.fx, fy=full.fy, cx=full.cx - c0, cy=full.cy - r0, width=c1 - c0, height=r1 - r0)
-    meshes = [(posed.vertices, posed.faces)]
-    if spec.occlusion > 0:
-        meshes.append(P._leaf(posed, cam, spec.occlusion, rng))
-    meshes += P._clutter(posed, model, rng)
-    shot = render(meshes, cam)
-    alone = render([(posed.vertices, posed.faces)], cam)
-    seen = shot.ids == 0
-    out = apply_sensor(model, shot.depth, shot.ids, cam, rng, facing=shot.facing, labels=seen.astype(np.int32),
-                       amodal=(alone.ids == 0).astype(np.int32))  # fmt: skip
+    v = P.real_view(spec, model)
+    posed, shot, alone, out = v.posed, v.shot, v.alone, v.out
     truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
     surface = posed.sample(P.TRUTH_POINTS, np.random.default_rng([spec.seed, 3000, spec.index]))
-    return dict(model=model, cam=cam, ids=shot.ids, clean=np.nan_to_num(shot.depth, posinf=0.0),
-                alone=alone.ids == 0, alone_depth=np.nan_to_num(alone.depth, posinf=0.0), seen=seen,
+    return dict(model=model, cam=v.camera, ids=shot.ids, clean=np.nan_to_num(shot.depth, posinf=0.0),
+                alone=alone.ids == 0, alone_depth=np.nan_to_num(alone.depth, posinf=0.0), seen=shot.ids == 0,
                 depth=out.depth, mask=np.asarray(out.labels) == 1, truth=truth, surface=surface,
-                distance=distance, shift=out.shift)  # fmt: skip
+                distance=v.distance, shift=out.shift)  # fmt: skip
 
 
 def centre_mm(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, cam: Camera, b: dict, st: Settings) -> float:

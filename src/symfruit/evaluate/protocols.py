@@ -61,8 +61,8 @@ import numpy as np
 
 from ..core.box import Box
 from ..core.camera import DEFAULT_CAMERA, Camera
-from ..synthetic.render import SensorNoise, render
-from ..synthetic.sensors import SENSOR_MODELS, SensorModel, apply_sensor, checked_sensor_set, varied
+from ..synthetic.render import Rendering, SensorNoise, render
+from ..synthetic.sensors import SENSOR_MODELS, SensorFrame, SensorModel, apply_sensor, checked_sensor_set, varied
 from ..synthetic.shapes import FRUITS, Fruit, leaf_outline, load_scans, paper_visible, rotation, rotation_x
 
 __all__ = ["PAPER_ANGLES", "PAPER_DISTANCE", "POSES", "SENSORS", "Instance", "Sensor", "Spec", "build", "specs"]
@@ -291,9 +291,27 @@ def _pose(spec: Spec, rng: np.random.Generator) -> tuple[np.ndarray, tuple[float
     return rotation(*angles), angles
 
 
-def _real_camera(spec: Spec, model: SensorModel) -> Instance:
+@dataclass(frozen=True)
+class RealView:
+    """What :func:`_real_camera` renders for one view, before it is made an :class:`Instance`: the posed fruit, the
+    window's camera, the fruit's pixels alone (``alone``) and as seen among the leaf and clutter (``seen``), the
+    render itself (``shot``: its ``depth`` is the scene's clean depth, ``ids`` which mesh each pixel shows) and what
+    the camera model made of it (``out``: depth, labels and the registration ``shift`` it drew). The evaluation's
+    diagnostics (docs/occl42.py) rebuild a view from it with the render's truth."""
+
+    fruit: Fruit
+    posed: Fruit
+    camera: Camera
+    angles: tuple[float, float, float]
+    distance: float
+    shot: Rendering
+    alone: Rendering
+    out: SensorFrame
+
+
+def real_view(spec: Spec, model: SensorModel) -> RealView:
     """A view through a real camera model: the fruit, an optional occluding leaf, clutter behind and beside,
-    rendered in a window of the camera's colour image around the fruit."""
+    rendered in a window of the camera's colour image around the fruit (:class:`RealView`)."""
     fruit = _fruit(spec)
     full = model.camera()
     rng = np.random.default_rng([spec.seed, 4000 + _KIND_IDS.get(spec.fruit, 99), spec.index, spec.pose,
@@ -319,10 +337,18 @@ def _real_camera(spec: Spec, model: SensorModel) -> Instance:
         meshes.append(_leaf(posed, cam, spec.occlusion, rng))
     meshes += _clutter(posed, model, rng)
     shot = render(meshes, cam)
-    alone = render([(posed.vertices, posed.faces)], cam).ids == 0
-    seen = shot.ids == 0
-    out = apply_sensor(model, shot.depth, shot.ids, cam, rng, facing=shot.facing, labels=seen.astype(np.int32),
-                       amodal=alone.astype(np.int32))  # fmt: skip
+    alone = render([(posed.vertices, posed.faces)], cam)
+    out = apply_sensor(model, shot.depth, shot.ids, cam, rng, facing=shot.facing,
+                       labels=(shot.ids == 0).astype(np.int32), amodal=(alone.ids == 0).astype(np.int32))  # fmt: skip
+    return RealView(fruit, posed, cam, angles, distance, shot, alone, out)
+
+
+def _real_camera(spec: Spec, model: SensorModel) -> Instance:
+    """:func:`real_view`'s view as the evaluation's instance: the fruit's points extracted from the camera model's
+    depth under its annotators' mask (``extract``), the truth from the posed fruit."""
+    view = real_view(spec, model)
+    fruit, posed, cam, out = view.fruit, view.posed, view.camera, view.out
+    seen, alone = view.shot.ids == 0, view.alone.ids == 0
     mask = np.asarray(out.labels) == 1
     rows, cols = np.nonzero(mask & (out.depth > 0))
     # Pixel centres: the lateral jitter is in ``out.depth`` already (as in a camera's image; the runner extracts
@@ -332,7 +358,7 @@ def _real_camera(spec: Spec, model: SensorModel) -> Instance:
     truth = Box.from_points(posed.vertices if posed.points is None else posed.points)
     return Instance(
         spec=spec, kind=fruit.kind, visible=visible, truth_box=truth, truth_surface=surface, camera=cam,
-        angles=angles, distance=distance, hidden=float(1.0 - seen.sum() / max(alone.sum(), 1)),
+        angles=view.angles, distance=view.distance, hidden=float(1.0 - seen.sum() / max(alone.sum(), 1)),
         depth=out.depth, mask=mask, extract=True,
     )  # fmt: skip
 
