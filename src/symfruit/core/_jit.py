@@ -6370,25 +6370,13 @@ def red_regions_once(
     labelling: the same numbers), over the weak pixels alone, not every pixel of a window that may span most of a
     1920x1080 image (issue 19, stop 41; the labelling shared with :func:`label` since stop 42)."""
     h, w = c.shape[0], c.shape[1]
+    weak_at, strong_at = red_pixels(c, low, high, sqrt3, tan_hue)
+    n_weak, n_strong = weak_at.shape[0], strong_at.shape[0]
     mask = np.zeros((h, w), np.bool_)
+    mask_flat = mask.reshape(-1)
+    for i in range(n_weak):
+        mask_flat[weak_at[i]] = True
     out = np.zeros((h, w), np.int32)
-    weak = np.empty(h * w, np.int64)
-    strong = np.empty(h * w, np.int64)
-    n_weak = n_strong = 0
-    for r in range(h):
-        for q in range(w):
-            red = np.int64(c[r, q, 0])
-            kind = _red_kind(red, np.int64(c[r, q, 1]), np.int64(c[r, q, 2]), low[red], high[red], sqrt3, tan_hue)
-            if kind == 0:
-                continue
-            weak[n_weak] = r * w + q
-            n_weak += 1
-            if kind == 2:
-                strong[n_strong] = r * w + q
-                n_strong += 1
-            mask[r, q] = True
-    weak_at = weak[:n_weak].copy()
-    strong_at = strong[:n_strong].copy()
     m = _label_pixels(out, weak_at, True)
     flat = out.reshape(-1)
     lab = np.empty(n_weak, np.int32)
