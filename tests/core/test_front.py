@@ -29,11 +29,15 @@ def test_apex_depth_refuses_too_few_points():
         apex_depth(np.zeros((5, 3)))
 
 
-def _former_fit(p, seed, k):
-    """apex_depth's quadric fit around ``seed`` as it was before issue 19's nineteenth round (LAPACK's eigvalsh and
-    solve of the 2x2 Hessian)."""
-    from symfruit.core.points import squared_norms
+def _former_apex_depth(points, share=0.08, min_points=12):
+    """apex_depth as it was before issue 19's nineteenth round (LAPACK's eigvalsh and solve of the 2x2 Hessian)."""
+    from symfruit.core.points import column_means, squared_norms
 
+    p = np.asarray(points, dtype=np.float64)
+    n = len(p)
+    front = max(1, int(0.02 * n))
+    seed = column_means(p[np.argpartition(p[:, 2], front - 1)[:front], :2])
+    k = min(n, max(min_points, int(share * n)))
     d2 = squared_norms(p[:, :2] - seed)
     pick = np.argpartition(d2, k - 1)[:k]
     near = p[pick]
@@ -51,25 +55,6 @@ def _former_fit(p, seed, k):
             zv = float(np.array([1.0, v[0], v[1], v[0] ** 2, v[0] * v[1], v[1] ** 2]) @ coef)
             if zv < best_z:
                 best_z, best_xy, vertex = zv, v, True
-    return best_z, best_xy, vertex
-
-
-def _former_apex_depth(points, share=0.08, min_points=12):
-    """apex_depth by LAPACK's eigvalsh and solve (:func:`_former_fit`), with stop 43's second fit around the vertex
-    of the quadric through all the points when the first one's lowest value lies nearer than every point."""
-    from symfruit.core.front import WIDE_SHARE, _vertex
-    from symfruit.core.points import column_means
-
-    p = np.asarray(points, dtype=np.float64)
-    n = len(p)
-    front = max(1, int(0.02 * n))
-    seed = column_means(p[np.argpartition(p[:, 2], front - 1)[:front], :2])
-    k = min(n, max(min_points, int(share * n)))
-    best_z, best_xy, vertex = _former_fit(p, seed, k)
-    wide = min(n, int(WIDE_SHARE * n))
-    if best_z < p[:, 2].min() and wide > k and (centre := _vertex(p)) is not None:
-        seed = centre
-        best_z, best_xy, vertex = _former_fit(p, seed, wide)
     return best_z, np.concatenate((best_xy + seed, [best_z])), vertex
 
 
@@ -94,29 +79,3 @@ def test_apex_depth_is_the_former_lapack_one_bit_for_bit():
         np.testing.assert_allclose(got_apex, want_apex, rtol=1e-12, atol=1e-15)
         vertices += vertex
     assert vertices > 50
-
-
-def test_a_front_fitted_to_a_bump_of_correlated_noise_is_fitted_again_around_the_surfaces_vertex():
-    """Stop 43 (docs/front43.md): the camera protocol's D435 view of citrus 8 (seed 0, 1.51 m; the model's noise 5.2
-    mm, correlated over 4 depth pixels). The front-most 2 % of the extracted points lie on a patch of noise standing
-    out of the surface; the quadric fitted over 8 % of the points around them bends through it, its lowest value
-    nearer than every point, so the front was the nearest noisy point, 7.6 mm in front of the fruit's nearest point.
-    Fitted again around the vertex of the quadric through all the points, over 40 % of them: within 1 mm."""
-    from symfruit.core.points import subsample
-    from symfruit.evaluate.protocols import Spec, build
-    from symfruit.extract import extract, register
-
-    inst = build(Spec("camera", "citrus", 8, 8, 0.0, 0, "realsense-d435"))
-    assert inst.depth is not None and inst.mask is not None
-    near = float(inst.truth_box.min[2])
-    assert near == pytest.approx(1.4736, abs=0.0005)
-    moved, shift = register(inst.mask.astype(np.int32), inst.depth, inst.camera)
-    points = extract(moved > 0, inst.depth, inst.camera.shifted(*shift)).points
-    sample = subsample(points, 1000)  # as evidence reads it
-    lowest = float(points[:, 2].min())
-    first, _, _ = _former_fit(sample, sample[np.argsort(sample[:, 2])[: len(sample) // 50], :2].mean(axis=0),
-                              int(0.08 * len(sample)))  # fmt: skip
-    assert first < lowest < near - 0.007  # the first fit below every point: the nearest point was the front
-    z, apex = apex_depth(sample)
-    assert max(lowest, z) == z == pytest.approx(near, abs=0.001)
-    assert apex[2] == z

@@ -45,27 +45,6 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     front = max(1, int(0.02 * n))
     seed = column_means(p[np.argpartition(z, front - 1)[:front], :2])  # .mean(axis=0), the same values
     k = min(n, max(min_points, int(share * n)))
-    best_z, best_xy = _cap_fit(p, seed, k)
-    # A quadric whose lowest value lies nearer than every point it was fitted to followed a bump of the depth noise
-    # (the front-most points chose the seed, and a noise correlated over several pixels, as a stereo camera's, makes
-    # them a patch standing out of the surface): the cap is fitted again around the vertex of the quadric through all
-    # the points, over ``WIDE_SHARE`` of them (docs/front43.md).
-    if best_z < float(z.min()) and (wide := min(n, int(WIDE_SHARE * n))) > k and (vertex := _vertex(p)) is not None:
-        seed = vertex
-        best_z, best_xy = _cap_fit(p, seed, wide)
-    return best_z, np.concatenate((best_xy + seed, [best_z]))
-
-
-#: :func:`apex_depth`'s share of the points fitted again around the surface's vertex when the first fit followed the
-#: noise: the points within about ``sqrt(0.4) = 0.63`` radii of a round fruit's apex, where a quadric describes a
-#: sphere's cap to ``share^2 R / 8``, 0.7 mm on a 70 mm fruit (judgement).
-WIDE_SHARE = 0.4
-
-
-def _cap_fit(p: np.ndarray, seed: np.ndarray, k: int) -> tuple[float, np.ndarray]:
-    """The quadric ``z = a + b x + c y + d x^2 + e x y + f y^2`` through the ``k`` points of ``p`` nearest ``seed`` in
-    the image plane: ``(lowest value, its (x, y) from seed)`` over those points, or its vertex when convex and among
-    them."""
     d2 = squared_norms(p[:, :2] - seed)  # ((...) ** 2).sum(axis=1), the same values
     pick = np.argpartition(d2, k - 1)[:k]
     near = p[pick]
@@ -94,20 +73,4 @@ def _cap_fit(p: np.ndarray, seed: np.ndarray, k: int) -> tuple[float, np.ndarray
             zv = float(np.array([1.0, v[0], v[1], v[0] ** 2, v[0] * v[1], v[1] ** 2]) @ coef)
             if zv < best_z:
                 best_z, best_xy = zv, v
-    return best_z, best_xy
-
-
-def _vertex(p: np.ndarray) -> np.ndarray | None:
-    """The (x, y) vertex of the quadric fitted to all of ``p``, when it is convex and lies within the points' extent
-    in the image plane (None otherwise)."""
-    centre = column_means(p[:, :2])
-    x, y = p[:, 0] - centre[0], p[:, 1] - centre[1]
-    a = np.stack((np.ones(len(p)), x, y, x * x, x * y, y * y), axis=1)
-    coef, *_ = np.linalg.lstsq(a, p[:, 2], rcond=None)
-    hessian = np.array([[2 * coef[3], coef[4]], [coef[4], 2 * coef[5]]])
-    if np.linalg.eigvalsh(hessian)[0] <= 0:
-        return None
-    v = np.linalg.solve(hessian, -coef[1:3])
-    if not (x.min() <= v[0] <= x.max() and y.min() <= v[1] <= y.max()):
-        return None
-    return v + centre
+    return best_z, np.concatenate((best_xy + seed, [best_z]))
