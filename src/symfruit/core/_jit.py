@@ -27,6 +27,16 @@ def _njit(func: Callable[..., Any]) -> Any:
         return numba.njit(error_model="numpy", nogil=True)(func)
 
 
+def _njit_inlined(func: Callable[..., Any]) -> Any:
+    """:func:`_njit` for a small helper that kernels call inside their loops with arrays: inlined into each caller at
+    numba's level (``inline="always"``), so that no call passes the arrays (each such call paid their reference
+    counts; stop 43, speedext43). The same operations in the same order: the same values, bit for bit."""
+    try:
+        return numba.njit(cache=True, error_model="numpy", nogil=True, inline="always")(func)
+    except RuntimeError:
+        return numba.njit(error_model="numpy", nogil=True, inline="always")(func)
+
+
 @_njit
 def solve(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
     """Solve ``a x = b`` for a small square ``a`` by Gaussian elimination with partial pivoting (``a`` and ``b``
@@ -689,7 +699,7 @@ def _flood_box(
     return reached, r0, r1, c0, c1
 
 
-@_njit
+@_njit_inlined
 def _scatter(points: np.ndarray, idx: np.ndarray, n: int, out: np.ndarray) -> None:
     """The scatter matrix (3, 3) of ``points[idx[:n]]`` about their mean (the sum of the outer products of their
     deviations, not divided by ``n``), into ``out``: summed in ``idx``'s order."""
@@ -1248,7 +1258,7 @@ def colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
     return out
 
 
-@_njit
+@_njit_inlined
 def _nearest_centre(x: np.ndarray, i: int, c: np.ndarray) -> tuple[int, float]:
     """The first centre of ``c`` (k, 3) nearest row ``i`` of ``x``, and its squared distance (the twin's terms in
     their order)."""
@@ -2695,7 +2705,7 @@ def cone_rays(points: np.ndarray, cone: np.ndarray) -> tuple[np.ndarray, np.ndar
 # --- issue 19, twentieth round (stop 40): the candidates ---
 
 
-@_njit
+@_njit_inlined
 def _smallest_mean_at(x: np.ndarray, keep: int, a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     """:func:`smallest_mean` of ``x`` (the same value, worked out the same way) and the ``keep``-th smallest value it
     found on the way."""
@@ -3192,7 +3202,7 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
     return out, True
 
 
-@_njit
+@_njit_inlined
 def _count_below(z: np.ndarray, x: float, right: bool) -> int:
     """``np.searchsorted(z, x, side)`` of sorted ``z`` without NaN: how many values are below ``x`` (``right``: at
     most ``x``), by bisection."""
@@ -3206,7 +3216,7 @@ def _count_below(z: np.ndarray, x: float, right: bool) -> int:
     return lo
 
 
-@_njit
+@_njit_inlined
 def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
     """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
@@ -4485,7 +4495,7 @@ def free_outline(
 # --- issue 19, twentieth round (stop 40): registration and trimming ---------------------------------------------
 
 
-@_njit
+@_njit_inlined
 def _envelope(f: np.ndarray, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarray) -> None:
     """``d2[u]`` (w,) the least ``(u - i)^2 + f[i]`` over the columns ``i`` of one row (``f`` (w,) whole numbers): the
     lower envelope of the parabolas, :func:`distance`'s second phase (``s``, ``t`` (w,) its scratch)."""
