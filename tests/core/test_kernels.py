@@ -4361,3 +4361,53 @@ def test_the_inlined_envelope_is_the_least_parabola(seed):
         _jit._envelope(f, w, s, t, d2)
         u = np.arange(w)
         np.testing.assert_array_equal(d2, ((u[:, None] - u[None, :]) ** 2 + f[None, :]).min(axis=1))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 25), st.integers(1, 25), st.booleans())
+def test_the_thin_counts_are_the_twins(seed, h, w, view):
+    """thin_counts against _thin_counts on depths from a few values (ties between neighbours, a camera's repeated
+    pixels), no depth, NaN and infinities, on an array or a strided view of one: the same ok pixels, counts and front
+    pixels."""
+    from symfruit.core.surface import _thin_counts
+
+    rng = np.random.default_rng(seed)
+    depth = rng.choice([0.0, np.nan, np.inf, -0.1, 0.5, 0.501, 0.505, 0.52, 0.6], (h + 3, w + 2))
+    mask = rng.random((h + 3, w + 2)) < 0.7
+    if view:
+        depth, mask = depth[1 : h + 1, 2:], mask[1 : h + 1, 2:]
+    front, join = float(rng.choice([0.5, 0.505])), float(rng.choice([0.0, 0.004, 0.02]))
+    ok = np.empty(depth.shape, bool)
+    counts, rows, cols = _jit.thin_counts(depth, mask, front, join, ok)
+    twin_ok, twin_counts, twin_rows, twin_cols = _thin_counts(depth, mask, front, join)
+    np.testing.assert_array_equal(ok, twin_ok)
+    np.testing.assert_array_equal(counts, twin_counts)
+    np.testing.assert_array_equal(rows, twin_rows)
+    np.testing.assert_array_equal(cols, twin_cols)
+
+
+def test_the_thin_counts_known_answer():
+    """A 2 x 3 mask with depth everywhere, the left column repeated down and the top row's first two equal: 6 pixels,
+    3 vertical pairs (1 equal), 4 horizontal pairs (1 equal); the pixels within 1.5 mm of 0.5 m."""
+    depth = np.array([[0.5, 0.5, 0.52], [0.5, 0.501, 0.53]])
+    ok = np.empty((2, 3), bool)
+    counts, rows, cols = _jit.thin_counts(depth, np.ones((2, 3), bool), 0.5, 0.0015, ok)
+    assert ok.all() and counts.tolist() == [6, 3, 1, 4, 1]
+    assert rows.tolist() == [0, 0, 1, 1] and cols.tolist() == [0, 1, 0, 1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 25), st.integers(1, 25), st.integers(1, 6))
+def test_the_lag_differences_are_the_twins(seed, h, w, lag):
+    """lag_differences against _lag_differences (medians from a strided column, as thin_front's partition gives
+    them; zeros and negative values among them): the same smoothed image and differences, bit for bit."""
+    from symfruit.core.surface import _lag_differences
+
+    rng = np.random.default_rng(seed)
+    ok = rng.random((h, w)) < 0.6
+    mask = ok | (rng.random((h, w)) < 0.2)
+    table = rng.choice([0.0, -0.01, 0.5, 0.5 + 1e-9, 0.51, 0.6], (int(ok.sum()), 3))
+    smooth = np.full((h, w), np.nan)
+    diff = _jit.lag_differences(table[:, 1], ok, mask, lag, smooth)
+    twin_smooth, twin_diff = _lag_differences(table[:, 1], ok, mask, lag)
+    assert smooth.tobytes() == twin_smooth.tobytes() and diff.tobytes() == twin_diff.tobytes()

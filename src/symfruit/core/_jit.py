@@ -4041,6 +4041,74 @@ def filled_windows(depth: np.ndarray, ok: np.ndarray, size: int, values: np.ndar
                 n += 1
 
 
+# --- stop 43, speedext43: the thin-front test's counts, front pixels and lagged differences ---------------------
+
+
+@_njit
+def thin_counts(
+    depth: np.ndarray, mask: np.ndarray, front: float, join: float, ok: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface.thin_front`'s first pass over a mask (h, w) bool and its depth (h, w) float64
+    (:func:`symfruit.core.surface._thin_counts`' twin): ``ok`` (h, w) bool written in place (the mask's pixels with
+    depth above 0); the counts (5,) int64: ``ok``'s pixels, then of the vertical and of the horizontal neighbours
+    both ``ok``, how many pairs and how many of them hold equal depths; and the rows and columns (raster order,
+    ``np.nonzero``'s) of the ``ok`` pixels within ``join`` of ``front``. Whole numbers and the same comparisons:
+    the twin's, bit for bit (stop 43)."""
+    h, w = mask.shape
+    counts = np.zeros(5, np.int64)
+    n_front = 0
+    for r in range(h):
+        for c in range(w):
+            good = mask[r, c] and depth[r, c] > 0
+            ok[r, c] = good
+            if good:
+                counts[0] += 1
+                n_front += abs(depth[r, c] - front) <= join
+    rows = np.empty(n_front, np.int64)
+    cols = np.empty(n_front, np.int64)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                if r > 0 and ok[r - 1, c]:
+                    counts[1] += 1
+                    counts[2] += depth[r, c] == depth[r - 1, c]
+                if c > 0 and ok[r, c - 1]:
+                    counts[3] += 1
+                    counts[4] += depth[r, c] == depth[r, c - 1]
+                if abs(depth[r, c] - front) <= join:
+                    rows[k], cols[k] = r, c
+                    k += 1
+    return counts, rows, cols
+
+
+@_njit
+def lag_differences(medians: np.ndarray, ok: np.ndarray, mask: np.ndarray, lag: int, smooth: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.surface.thin_front`'s smoothed depth and its noise's differences
+    (:func:`symfruit.core.surface._lag_differences`' twin): ``smooth`` (h, w) written in place, 0 but at the pixels
+    of ``ok`` (h, w) bool, which take ``medians`` (n,) in raster order; and the differences (m,) ``smooth[r, c + lag]
+    - smooth[r, c]`` where both pixels are ``mask``'s (h, w) bool and both values above 0, in raster order: the
+    twin's subtractions in its order, bit for bit (stop 43)."""
+    h, w = ok.shape
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                smooth[r, c] = medians[k]
+                k += 1
+            else:
+                smooth[r, c] = 0.0
+    out = np.empty(max(h * (w - lag), 0))
+    m = 0
+    for r in range(h):
+        for c in range(w - lag):
+            a, b = smooth[r, c + lag], smooth[r, c]
+            if mask[r, c + lag] and mask[r, c] and a > 0 and b > 0:
+                out[m] = a - b
+                m += 1
+    return out[:m]
+
+
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
 
 
