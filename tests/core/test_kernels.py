@@ -4264,3 +4264,150 @@ def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reac
     assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
     edge = _jit.occlusion_edge(uv, points, pad, depth, mask, others, 0.005, steps, 0)
     assert edge[:3] == (found, u0, v0) and np.array_equal(edge[3], hidden) and edge[4].tobytes() == seen.tobytes()
+
+
+# --- stop 43, speedext43
+
+
+def test_the_helpers_called_in_loops_are_inlined():
+    """The small helpers kernels call inside their loops with arrays are inlined at numba's level (each call paid the
+    arrays' reference counts): ``inline="always"`` on every one."""
+    for name in ("_scatter", "_nearest_centre", "_count_below", "_leaf_share", "_smallest_mean_at", "_envelope"):
+        assert getattr(_jit, name).targetoptions.get("inline") == "always", name
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_inlined_nearest_centre_keeps_the_twins_clusters_and_ties(seed):
+    """kmeans, nearer_fruit, trim_separation and trim_band (all through the inlined _nearest_centre) against the
+    numpy twins on colour features with repeated rows and a repeated centre (a tie: the first centre wins): the same
+    centres, pixels and counts, bit for bit."""
+    from symfruit.core.surface import _colour_features, _kmeans, _nearer_fruit
+
+    rng = np.random.default_rng(seed)
+    color = rng.integers(0, 256, (30, 40, 3)).astype(np.uint8)
+    color[::3, ::2] = color[0, 0]  # repeated features
+    band = rng.random((30, 40)) < 0.4
+    mask = band | (rng.random((30, 40)) < 0.3)
+    x = _colour_features(color, band)
+    c = x[rng.choice(len(x), 3, replace=False)].copy()
+    c[2] = c[0]  # two equal centres: the first is every such row's
+    assert _jit.kmeans(x, c, 5).tobytes() == _kmeans(x, c, 5).tobytes()
+    fc, bc = x[:2].copy(), np.concatenate((x[:1], x[5:7]))
+    for margin in (1.0, 1.3):
+        near = _jit.nearer_fruit(x, fc, bc, margin)
+        np.testing.assert_array_equal(near, _nearer_fruit(x, fc, bc, margin))
+        out = np.empty((30, 40), bool)
+        _jit.trim_band(color, mask, band, fc, bc, margin, out)
+        expected = mask.copy()
+        expected[band] = near
+        np.testing.assert_array_equal(out, expected)
+    ring = x[::-1].copy()
+    n_fruit, n_ring = _jit.trim_separation(x, ring, fc, bc)
+    assert n_fruit == int(_nearer_fruit(x, fc, bc, 1.0).sum())
+    assert n_ring == int((~_nearer_fruit(ring, fc, bc, 1.0)).sum())
+
+
+def test_the_inlined_count_below_is_searchsorted():
+    """_count_below is np.searchsorted on either side, ties and the ends included."""
+    z = np.array([0.5, 0.5, 0.6, 0.7, 0.7, 0.7, 0.9])
+    for x in (0.4, 0.5, 0.55, 0.7, 0.9, 1.0):
+        assert _jit._count_below(z, x, False) == np.searchsorted(z, x, "left")
+        assert _jit._count_below(z, x, True) == np.searchsorted(z, x, "right")
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_inlined_leaf_share_keeps_fruit_depths_leaf_test(seed, monkeypatch):
+    """fruit_depth with leaf-green pixels (the inlined _leaf_share and _count_below) against its twin: a leaf's peak
+    in front of the fruit passed over, the same front and radius, bit for bit."""
+    from symfruit.core.surface import fruit_depth
+
+    rng = np.random.default_rng(seed)
+    leaf_z = rng.normal(0.50, 0.002, 300)
+    fruit_z = rng.normal(0.56, 0.004, 500)
+    values = np.round(np.concatenate((leaf_z, fruit_z, [0.0, np.nan])), 3)  # whole millimetres: ties
+    leafy = np.zeros(len(values), bool)
+    leafy[: len(leaf_z)] = rng.random(len(leaf_z)) < 0.9
+    fast, twin = _both(monkeypatch, fruit_depth, values, 30.0, 600.0, noise=0.002, leafy=leafy)
+    assert fast == twin
+    assert fast[0] > 0.54  # the leaf in front passed over
+
+
+def test_the_inlined_scatter_and_smallest_mean_on_whole_numbers():
+    """_scatter (neighbour_covariances) and _smallest_mean_at (smallest_mean) on whole numbers, where every sum is
+    exact: the scatter matrix about the mean, and the mean of the keep smallest with the keep-th (ties included)."""
+    pts = np.array([[0.0, 0.0, 0.0], [2.0, 0.0, 0.0], [0.0, 4.0, 0.0], [2.0, 4.0, 8.0]])
+    out = np.empty((3, 3))
+    _jit._scatter(pts, np.array([3, 0, 1, 2]), 4, out)
+    dev = pts - pts.mean(axis=0)
+    np.testing.assert_array_equal(out, dev.T @ dev)
+    small, large = _jit.neighbour_covariances(pts, 1, 4, 4)
+    np.testing.assert_array_equal(small[0], dev.T @ dev / 4)
+    np.testing.assert_array_equal(large[3], dev.T @ dev / 4)
+    x = np.array([5.0, 1.0, 3.0, 3.0, 9.0, 3.0, 0.0])
+    a, b = np.empty(7), np.empty(7)
+    for keep, mean, kth in ((1, 0.0, 0.0), (3, 4.0 / 3.0, 3.0), (4, 7.0 / 4.0, 3.0), (6, 15.0 / 6.0, 5.0)):
+        assert _jit._smallest_mean_at(x, keep, a, b) == (mean, kth)
+        assert _jit.smallest_mean(x, keep, a, b) == mean
+
+
+@pytest.mark.parametrize("seed", range(5))
+def test_the_inlined_envelope_is_the_least_parabola(seed):
+    """_envelope (outline_maps' and distance's rows) against the brute-force least (u - i)^2 + f[i] on whole
+    numbers: equal."""
+    rng = np.random.default_rng(seed)
+    for w in (1, 2, 7, 40):
+        f = rng.integers(0, 50, w).astype(np.int64) ** 2
+        s, t, d2 = (np.empty(w, np.int64) for _ in range(3))
+        _jit._envelope(f, w, s, t, d2)
+        u = np.arange(w)
+        np.testing.assert_array_equal(d2, ((u[:, None] - u[None, :]) ** 2 + f[None, :]).min(axis=1))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 25), st.integers(1, 25), st.booleans())
+def test_the_thin_counts_are_the_twins(seed, h, w, view):
+    """thin_counts against _thin_counts on depths from a few values (ties between neighbours, a camera's repeated
+    pixels), no depth, NaN and infinities, on an array or a strided view of one: the same ok pixels, counts and front
+    pixels."""
+    from symfruit.core.surface import _thin_counts
+
+    rng = np.random.default_rng(seed)
+    depth = rng.choice([0.0, np.nan, np.inf, -0.1, 0.5, 0.501, 0.505, 0.52, 0.6], (h + 3, w + 2))
+    mask = rng.random((h + 3, w + 2)) < 0.7
+    if view:
+        depth, mask = depth[1 : h + 1, 2:], mask[1 : h + 1, 2:]
+    front, join = float(rng.choice([0.5, 0.505])), float(rng.choice([0.0, 0.004, 0.02]))
+    ok = np.empty(depth.shape, bool)
+    counts, rows, cols = _jit.thin_counts(depth, mask, front, join, ok)
+    twin_ok, twin_counts, twin_rows, twin_cols = _thin_counts(depth, mask, front, join)
+    np.testing.assert_array_equal(ok, twin_ok)
+    np.testing.assert_array_equal(counts, twin_counts)
+    np.testing.assert_array_equal(rows, twin_rows)
+    np.testing.assert_array_equal(cols, twin_cols)
+
+
+def test_the_thin_counts_known_answer():
+    """A 2 x 3 mask with depth everywhere, the left column repeated down and the top row's first two equal: 6 pixels,
+    3 vertical pairs (1 equal), 4 horizontal pairs (1 equal); the pixels within 1.5 mm of 0.5 m."""
+    depth = np.array([[0.5, 0.5, 0.52], [0.5, 0.501, 0.53]])
+    ok = np.empty((2, 3), bool)
+    counts, rows, cols = _jit.thin_counts(depth, np.ones((2, 3), bool), 0.5, 0.0015, ok)
+    assert ok.all() and counts.tolist() == [6, 3, 1, 4, 1]
+    assert rows.tolist() == [0, 0, 1, 1] and cols.tolist() == [0, 1, 0, 1]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 25), st.integers(1, 25), st.integers(1, 6))
+def test_the_lag_differences_are_the_twins(seed, h, w, lag):
+    """lag_differences against _lag_differences (medians from a strided column, as thin_front's partition gives
+    them; zeros and negative values among them): the same smoothed image and differences, bit for bit."""
+    from symfruit.core.surface import _lag_differences
+
+    rng = np.random.default_rng(seed)
+    ok = rng.random((h, w)) < 0.6
+    mask = ok | (rng.random((h, w)) < 0.2)
+    table = rng.choice([0.0, -0.01, 0.5, 0.5 + 1e-9, 0.51, 0.6], (int(ok.sum()), 3))
+    smooth = np.full((h, w), np.nan)
+    diff = _jit.lag_differences(table[:, 1], ok, mask, lag, smooth)
+    twin_smooth, twin_diff = _lag_differences(table[:, 1], ok, mask, lag)
+    assert smooth.tobytes() == twin_smooth.tobytes() and diff.tobytes() == twin_diff.tobytes()

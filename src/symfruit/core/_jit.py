@@ -27,6 +27,16 @@ def _njit(func: Callable[..., Any]) -> Any:
         return numba.njit(error_model="numpy", nogil=True)(func)
 
 
+def _njit_inlined(func: Callable[..., Any]) -> Any:
+    """:func:`_njit` for a small helper that kernels call inside their loops with arrays: inlined into each caller at
+    numba's level (``inline="always"``), so that no call passes the arrays (each such call paid their reference
+    counts; stop 43, speedext43). The same operations in the same order: the same values, bit for bit."""
+    try:
+        return numba.njit(cache=True, error_model="numpy", nogil=True, inline="always")(func)
+    except RuntimeError:
+        return numba.njit(error_model="numpy", nogil=True, inline="always")(func)
+
+
 @_njit
 def solve(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
     """Solve ``a x = b`` for a small square ``a`` by Gaussian elimination with partial pivoting (``a`` and ``b``
@@ -689,7 +699,7 @@ def _flood_box(
     return reached, r0, r1, c0, c1
 
 
-@_njit
+@_njit_inlined
 def _scatter(points: np.ndarray, idx: np.ndarray, n: int, out: np.ndarray) -> None:
     """The scatter matrix (3, 3) of ``points[idx[:n]]`` about their mean (the sum of the outer products of their
     deviations, not divided by ``n``), into ``out``: summed in ``idx``'s order."""
@@ -1248,7 +1258,7 @@ def colour_features(color: np.ndarray, where: np.ndarray) -> np.ndarray:
     return out
 
 
-@_njit
+@_njit_inlined
 def _nearest_centre(x: np.ndarray, i: int, c: np.ndarray) -> tuple[int, float]:
     """The first centre of ``c`` (k, 3) nearest row ``i`` of ``x``, and its squared distance (the twin's terms in
     their order)."""
@@ -2695,7 +2705,7 @@ def cone_rays(points: np.ndarray, cone: np.ndarray) -> tuple[np.ndarray, np.ndar
 # --- issue 19, twentieth round (stop 40): the candidates ---
 
 
-@_njit
+@_njit_inlined
 def _smallest_mean_at(x: np.ndarray, keep: int, a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
     """:func:`smallest_mean` of ``x`` (the same value, worked out the same way) and the ``keep``-th smallest value it
     found on the way."""
@@ -3192,7 +3202,7 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
     return out, True
 
 
-@_njit
+@_njit_inlined
 def _count_below(z: np.ndarray, x: float, right: bool) -> int:
     """``np.searchsorted(z, x, side)`` of sorted ``z`` without NaN: how many values are below ``x`` (``right``: at
     most ``x``), by bisection."""
@@ -3206,7 +3216,7 @@ def _count_below(z: np.ndarray, x: float, right: bool) -> int:
     return lo
 
 
-@_njit
+@_njit_inlined
 def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
     """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
@@ -4031,6 +4041,74 @@ def filled_windows(depth: np.ndarray, ok: np.ndarray, size: int, values: np.ndar
                 n += 1
 
 
+# --- stop 43, speedext43: the thin-front test's counts, front pixels and lagged differences ---------------------
+
+
+@_njit
+def thin_counts(
+    depth: np.ndarray, mask: np.ndarray, front: float, join: float, ok: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface.thin_front`'s first pass over a mask (h, w) bool and its depth (h, w) float64
+    (:func:`symfruit.core.surface._thin_counts`' twin): ``ok`` (h, w) bool written in place (the mask's pixels with
+    depth above 0); the counts (5,) int64: ``ok``'s pixels, then of the vertical and of the horizontal neighbours
+    both ``ok``, how many pairs and how many of them hold equal depths; and the rows and columns (raster order,
+    ``np.nonzero``'s) of the ``ok`` pixels within ``join`` of ``front``. Whole numbers and the same comparisons:
+    the twin's, bit for bit (stop 43)."""
+    h, w = mask.shape
+    counts = np.zeros(5, np.int64)
+    n_front = 0
+    for r in range(h):
+        for c in range(w):
+            good = mask[r, c] and depth[r, c] > 0
+            ok[r, c] = good
+            if good:
+                counts[0] += 1
+                n_front += abs(depth[r, c] - front) <= join
+    rows = np.empty(n_front, np.int64)
+    cols = np.empty(n_front, np.int64)
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                if r > 0 and ok[r - 1, c]:
+                    counts[1] += 1
+                    counts[2] += depth[r, c] == depth[r - 1, c]
+                if c > 0 and ok[r, c - 1]:
+                    counts[3] += 1
+                    counts[4] += depth[r, c] == depth[r, c - 1]
+                if abs(depth[r, c] - front) <= join:
+                    rows[k], cols[k] = r, c
+                    k += 1
+    return counts, rows, cols
+
+
+@_njit
+def lag_differences(medians: np.ndarray, ok: np.ndarray, mask: np.ndarray, lag: int, smooth: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.surface.thin_front`'s smoothed depth and its noise's differences
+    (:func:`symfruit.core.surface._lag_differences`' twin): ``smooth`` (h, w) written in place, 0 but at the pixels
+    of ``ok`` (h, w) bool, which take ``medians`` (n,) in raster order; and the differences (m,) ``smooth[r, c + lag]
+    - smooth[r, c]`` where both pixels are ``mask``'s (h, w) bool and both values above 0, in raster order: the
+    twin's subtractions in its order, bit for bit (stop 43)."""
+    h, w = ok.shape
+    k = 0
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                smooth[r, c] = medians[k]
+                k += 1
+            else:
+                smooth[r, c] = 0.0
+    out = np.empty(max(h * (w - lag), 0))
+    m = 0
+    for r in range(h):
+        for c in range(w - lag):
+            a, b = smooth[r, c + lag], smooth[r, c]
+            if mask[r, c + lag] and mask[r, c] and a > 0 and b > 0:
+                out[m] = a - b
+                m += 1
+    return out[:m]
+
+
 # --- issue 19, seventeenth round: registration, trimming, extraction, occlusion ---------------------------------
 
 
@@ -4485,7 +4563,7 @@ def free_outline(
 # --- issue 19, twentieth round (stop 40): registration and trimming ---------------------------------------------
 
 
-@_njit
+@_njit_inlined
 def _envelope(f: np.ndarray, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarray) -> None:
     """``d2[u]`` (w,) the least ``(u - i)^2 + f[i]`` over the columns ``i`` of one row (``f`` (w,) whole numbers): the
     lower envelope of the parabolas, :func:`distance`'s second phase (``s``, ``t`` (w,) its scratch)."""

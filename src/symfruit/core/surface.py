@@ -304,17 +304,21 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     (front, sheet) : float metres and (h, w) bool (the sheet's pixels), or None
     """
     # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
-    ok = mask & (depth > 0)
+    plain = depth.dtype == np.float64 and depth.ndim == 2 and mask.dtype == bool and mask.shape == depth.shape
+    if (jit := compiled() if plain else None) is not None:
+        ok = np.empty(depth.shape, bool)  # the compiled twin of _thin_counts (stop 43: the same counts and pixels)
+        counts, rows, cols = jit.thin_counts(depth, mask, float(front), float(join), ok)
+    else:
+        ok, counts, rows, cols = _thin_counts(depth, mask, front, join)
     repeats = 1.0
-    pairs = ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1]))
-    for a, b, both in pairs:
-        if both.any():
-            repeats /= max(1.0 - float(np.count_nonzero((a == b) & both)) / float(np.count_nonzero(both)), 0.1)
+    for both, equal in ((counts[1], counts[2]), (counts[3], counts[4])):
+        if both:
+            repeats /= max(1.0 - float(equal) / float(both), 0.1)
     inflate = float(np.sqrt(repeats))
     # the nearest surface clearly convex is the fruit's own front, not a sheet: nothing to look behind (one fit
     # instead of the parts, their fits and the median's re-partition on every fruit seen whole: the benchmark
-    # frame's extraction 24.8 -> 16.8 ms thread CPU, 7.6 without the test)
-    rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
+    # frame's extraction 24.8 -> 16.8 ms thread CPU, 7.6 without the test); rows, cols: the pixels with depth within
+    # join of the front
     if len(rows) >= 30:
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
         # ... unless it reaches the mask's outline: a fruit's nearest point lies inside its outline, while the nearest
@@ -326,23 +330,22 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
     if found is not None:
         return found
-    if 3.0 * noise <= 0.003 or ok.sum() < 60:
+    if 3.0 * noise <= 0.003 or counts[0] < 60:
         return None  # the step was not bridged by noise
     # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
     # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
     # takes its nearest pixel's
-    rows, cols = np.nonzero(ok)
-    smooth = np.zeros(depth.shape)
-    if (jit := compiled()) is not None and depth.dtype == np.float64:
-        # the compiled twin of the windows' values median_at reads (stop 42: the same values in the same places)
-        values = np.empty((len(rows), 25))
+    if jit is not None:
+        # the compiled twin of the windows' values median_at reads (stop 42: the same values in the same places),
+        # and of _lag_differences (stop 43: the same image and differences)
+        values = np.empty((int(counts[0]), 25))
         jit.filled_windows(depth, ok, 5, values)
-        smooth[rows, cols] = np.partition(values, 12, axis=1)[:, 12]
+        smooth = np.empty(depth.shape)
+        diff = jit.lag_differences(np.partition(values, 12, axis=1)[:, 12], ok, mask, 5, smooth)
     else:
+        rows, cols = np.nonzero(ok)
         _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
-        smooth[rows, cols] = median_at(depth[ri, ci], rows, cols, size=5)
-    a, b = smooth[:, 5:], smooth[:, :-5]
-    diff = (a - b)[mask[:, 5:] & mask[:, :-5] & (a > 0) & (b > 0)]
+        smooth, diff = _lag_differences(median_at(depth[ri, ci], rows, cols, size=5), ok, mask, 5)
     if len(diff) < 20:
         return None
     sigma = 1.4826 * float(median(np.abs(diff - median(diff)))) / np.sqrt(2.0)
@@ -351,6 +354,36 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return None  # the same parts
     parts, count = _smooth_parts(smooth, mask, narrow)
     return _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
+
+
+def _thin_counts(
+    depth: np.ndarray, mask: np.ndarray, front: float, join: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`thin_front`'s first pass: ``ok`` (h, w) bool, the mask's pixels with depth above 0; the counts (5,)
+    int: ``ok``'s pixels, then of the vertical and of the horizontal neighbours both ``ok``, how many pairs and how
+    many of them hold equal depths (a registered depth image repeats a coarser camera's pixels); and the rows and
+    columns (``np.nonzero``'s) of the ``ok`` pixels within ``join`` of ``front``. The compiled twin:
+    :func:`symfruit.core._jit.thin_counts` (stop 43)."""
+    ok = mask & (depth > 0)
+    counts = [int(np.count_nonzero(ok))]
+    pairs = ((depth[1:], depth[:-1], ok[1:] & ok[:-1]), (depth[:, 1:], depth[:, :-1], ok[:, 1:] & ok[:, :-1]))
+    for a, b, both in pairs:
+        counts += [int(np.count_nonzero(both)), int(np.count_nonzero((a == b) & both))]
+    rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
+    return ok, np.array(counts, np.int64), rows, cols
+
+
+def _lag_differences(
+    medians: np.ndarray, ok: np.ndarray, mask: np.ndarray, lag: int
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`thin_front`'s smoothed depth (h, w): 0 but at the pixels of ``ok`` (h, w) bool, which take ``medians``
+    (n,) in raster order; and the differences (m,) ``smooth[r, c + lag] - smooth[r, c]`` where both pixels are
+    ``mask``'s and both values above 0, in raster order. The compiled twin: :func:`symfruit.core._jit.lag_differences`
+    (stop 43)."""
+    smooth = np.zeros(ok.shape)
+    smooth[ok] = medians
+    a, b = smooth[:, lag:], smooth[:, :-lag]
+    return smooth, (a - b)[mask[:, lag:] & mask[:, :-lag] & (a > 0) & (b > 0)]
 
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
