@@ -52,6 +52,9 @@ class Occlusion:
     overshoot : (h, w) bool, optional
         The pixels of :attr:`own` the mask overshoots the fruit by (:func:`overshoot`): the fruit's width is read
         without them (:func:`with_own`, ``trimmed``).
+    seen_past : bool
+        :attr:`overshoot` is where a time-of-flight camera saw past the fruit (:func:`overshoot`): no occluder's,
+        so it is read on a cut outline too (stop 43).
     """
 
     u0: int
@@ -62,6 +65,7 @@ class Occlusion:
     own: np.ndarray | None = None
     depth: np.ndarray | None = None
     overshoot: np.ndarray | None = None
+    seen_past: bool = False
     #: :attr:`hidden` grown by each radius asked for (:meth:`grown`), made once (the maps are read-only).
     _grown: dict[int, np.ndarray] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -100,14 +104,15 @@ class Occlusion:
 
     @classmethod
     def _made(cls, u0: int, v0: int, hidden: np.ndarray, width: int, height: int, own: np.ndarray,
-              depth: np.ndarray, overshoot: np.ndarray | None = None) -> Occlusion:  # fmt: skip
+              depth: np.ndarray, overshoot: np.ndarray | None = None,
+              seen_past: bool = False) -> Occlusion:  # fmt: skip
         """``Occlusion(u0, v0, hidden, width, height, own=own, depth=depth, overshoot=overshoot)`` without the checks
         that maps :func:`occlusion` made itself always pass (whole numbers, a window within a valid camera's image,
         bool and float maps of one shape): the same fields, the same object (stop 42: the checks cost about 25 us a
         fruit)."""
         made = object.__new__(cls)
         made.__dict__.update(u0=int(u0), v0=int(v0), hidden=hidden, width=int(width), height=int(height), own=own,
-                             depth=depth, overshoot=overshoot, _grown={})  # fmt: skip
+                             depth=depth, overshoot=overshoot, seen_past=seen_past, _grown={})  # fmt: skip
         return made
 
     def at(self, u: np.ndarray, v: np.ndarray, *, radius: int = 0) -> np.ndarray:
@@ -394,12 +399,13 @@ def occlusion(
         own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
         over = (
             overshoot(
-                own_w, depth[v0 : v0 + h, u0 : u0 + w], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded)
+                own_w, depth[v0 : v0 + h, u0 : u0 + w], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded),
+                float(np.sqrt(camera.fx * camera.fy)),
             )
             if trim_own
             else None
         )
-        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, over)
+        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *_kind(over))
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -431,15 +437,26 @@ def occlusion(
     hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
-        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded))
+        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded),
+                  float(np.sqrt(camera.fx * camera.fy)))
         if trim_own
         else None
     )
-    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over)
+    over, past = _kind(over)
+    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over, seen_past=past)
+
+
+def _kind(over: np.ndarray | None) -> tuple[np.ndarray | None, bool]:
+    """:func:`overshoot`'s pixels and whether a time-of-flight camera saw past the fruit there (:class:`_SeenPast`)."""
+    return (np.asarray(over, dtype=bool), True) if isinstance(over, _SeenPast) else (over, False)
+
+
+class _SeenPast(np.ndarray):
+    """A bool map :func:`overshoot` found where the camera saw past the fruit (a view of it, marked)."""
 
 
 def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.ndarray, u0: int, v0: int,
-              tolerance: float, reach: int, eroded: int = 0) -> np.ndarray | None:  # fmt: skip
+              tolerance: float, reach: int, eroded: int = 0, focal: float = 0.0) -> np.ndarray | None:  # fmt: skip
     """(h, w) bool: the pixels of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit,
     where the camera spreads the fruit's own depth beyond its silhouette; None where it does not.
 
@@ -449,8 +466,14 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
 
     - time of flight: mostly no depth (``depth`` 0 or NaN), the rim the camera invalidates (grazing and mixed
       pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
-      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots: the
-      mask is the only measure of the fruit's width there, and nothing is taken off (None);
+      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots. The
+      fruit reaches at most as far as its points and the pixels without depth joined to them (what the sensor
+      loses at a rim): a pixel seen behind the fruit (farther than its front plus half the mask's width, which no
+      point of a round fruit's visible side is, ``focal``: the camera's focal length in pixels) is not the fruit,
+      nor what lies beyond it. Those pixels are the overshoot only when they lie nearly all round the mask's
+      outline (at least ``OUTLINE_SHARE`` of it): a mask an annotator or a model drew too wide overshoots all
+      round, where the depth camera seeing past one side of a fruit (its baseline to the colour camera, a
+      registration a pixel or two off) is one side (stop 43, docs/treeover43.md). Without ``focal``: None;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
       pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
@@ -492,7 +515,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
     spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
     if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
-        return None
+        return _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
     drop = beyond.copy()
     drop[band] = ~ahead  # all but what lies clearly in front
     # peeled from the mask's border inwards: what a mask overshoots lies at its border
@@ -501,6 +524,59 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
     return drop
+
+
+#: The share of a mask's outline a trim must take to be an overshoot all round (as
+#: :func:`~symfruit.core.surface.colour_trim`'s ``outline_share``, docs/stress39.md: "nearly all round").
+OUTLINE_SHARE = 2.0 / 3.0
+#: Angular sectors a time-of-flight view's edge is found in (:func:`overshoot`): a sector spans 2-4 px of the
+#: outline of a fruit 40-70 px across (issue 18's apples at 1.2-2 m), the depth pixels' footprint.
+SECTORS = 48
+
+
+def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarray, points: np.ndarray,
+               focal: float, eroded: int, tolerance: float, sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
+    """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge, where
+    the camera saw past it, when that is nearly all round.
+
+    About the points' centroid, in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's
+    last depth) and the nearest mask pixel seen behind the fruit (farther than its front plus half the mask's
+    width, which no point of a round fruit's visible side is). Between the two the camera returned nothing: the
+    mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
+    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway. A sector where nothing was seen past
+    the fruit takes its neighbours' edge (periodic interpolation). The mask beyond that edge is the overshoot
+    when the camera saw past the fruit in at least ``OUTLINE_SHARE`` of the sectors holding points."""
+    front = float(points[:, 2].min())
+    half = 0.5 * np.sqrt(4.0 * np.count_nonzero(own) / np.pi) * front / focal  # the mask's half-width, metres
+    past = band & (np.where(band, d, 0.0) > front + half + tolerance)
+    if not past.any():
+        return None
+    rs, cs = np.nonzero(seen)
+    r0, c0 = rs.mean(), cs.mean()
+    vv, uu = np.nonzero(own | past)
+    ang = np.arctan2(vv - r0, uu - c0)
+    sec = np.minimum(((ang + np.pi) / (2 * np.pi) * sectors).astype(np.intp), sectors - 1)
+    rad = np.hypot(vv - r0, uu - c0)
+    is_seen, is_past = seen[vv, uu], past[vv, uu]
+    last = np.full(sectors, -np.inf)
+    np.maximum.at(last, sec[is_seen], rad[is_seen])
+    first = np.full(sectors, np.inf)
+    np.minimum.at(first, sec[is_past], rad[is_past])
+    held = np.isfinite(last)
+    both = held & np.isfinite(first) & (first > last)
+    # all round: no third of the outline without a sector seen past (a camera seeing past one side of a fruit,
+    # a registration a few pixels off, leaves the other side: the shared lab spheres' 135-180 degrees)
+    at = np.flatnonzero(both)
+    if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
+        return None
+    centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
+    edge = np.interp(centre, centre[both], 0.5 * (last[both] + first[both]), period=2 * np.pi)
+    drop = np.zeros(own.shape, bool)
+    out = own[vv, uu] & ~is_seen & (rad > edge[sec])
+    drop[vv[out], uu[out]] = True
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop.view(_SeenPast) if drop.any() else None
 
 
 def own_edge(
