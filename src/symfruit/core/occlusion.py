@@ -382,6 +382,7 @@ def occlusion(
         raise InputError(f"occlusion others must be a {shape[1]}x{shape[0]} image, got {np.shape(others)[::-1]}")
     points = as_points(points, min_count=1)
     uv = camera.project(points)
+    focal = float(np.sqrt(camera.fx * camera.fy))  # overshoot reads the mask's width in metres
     if (jit := compiled()) is not None:  # as_points gives contiguous float64
         # the window, the fruit's own depths and the maps below in one compiled pass, the images read in place (the
         # same bits: issue 19, seventeenth round, the window and own depths; eighteenth, the nearest point pixel
@@ -399,13 +400,21 @@ def occlusion(
         own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
         over = (
             overshoot(
-                own_w, depth[v0 : v0 + h, u0 : u0 + w], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded),
-                float(np.sqrt(camera.fx * camera.fy)),
+                own_w,
+                depth[v0 : v0 + h, u0 : u0 + w],
+                uv,
+                points,
+                u0,
+                v0,
+                tolerance,
+                max(int(band), 1),
+                int(eroded),
+                focal,
             )
             if trim_own
-            else None
+            else (None, False)
         )
-        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *_kind(over))
+        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *over)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -437,28 +446,20 @@ def occlusion(
     hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
-        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded),
-                  float(np.sqrt(camera.fx * camera.fy)))
+        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded), focal)
         if trim_own
-        else None
+        else (None, False)
     )
-    over, past = _kind(over)
-    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over, seen_past=past)
-
-
-def _kind(over: np.ndarray | None) -> tuple[np.ndarray | None, bool]:
-    """:func:`overshoot`'s pixels and whether a time-of-flight camera saw past the fruit there (:class:`_SeenPast`)."""
-    return (np.asarray(over, dtype=bool), True) if isinstance(over, _SeenPast) else (over, False)
-
-
-class _SeenPast(np.ndarray):
-    """A bool map :func:`overshoot` found where the camera saw past the fruit (a view of it, marked)."""
+    return Occlusion(
+        u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over[0], seen_past=over[1]
+    )
 
 
 def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.ndarray, u0: int, v0: int,
-              tolerance: float, reach: int, eroded: int = 0, focal: float = 0.0) -> np.ndarray | None:  # fmt: skip
-    """(h, w) bool: the pixels of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit,
-    where the camera spreads the fruit's own depth beyond its silhouette; None where it does not.
+              tolerance: float, reach: int, eroded: int = 0,
+              focal: float = 0.0) -> tuple[np.ndarray | None, bool]:  # fmt: skip
+    """The pixels ((h, w) bool) of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit
+    (None: none found), and whether they are where a time-of-flight camera saw past the fruit.
 
     Masks drawn by people or models overshoot a fruit by a few pixels (issue 18, point 4), and the completion reads
     the fruit's width from its outline (:func:`with_own`), then its depth from that width. Beyond the fruit's
@@ -466,14 +467,11 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
 
     - time of flight: mostly no depth (``depth`` 0 or NaN), the rim the camera invalidates (grazing and mixed
       pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
-      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots. The
-      fruit reaches at most as far as its points and the pixels without depth joined to them (what the sensor
-      loses at a rim): a pixel seen behind the fruit (farther than its front plus half the mask's width, which no
-      point of a round fruit's visible side is, ``focal``: the camera's focal length in pixels) is not the fruit,
-      nor what lies beyond it. Those pixels are the overshoot only when they lie nearly all round the mask's
-      outline (at least ``OUTLINE_SHARE`` of it): a mask an annotator or a model drew too wide overshoots all
-      round, where the depth camera seeing past one side of a fruit (its baseline to the colour camera, a
-      registration a pixel or two off) is one side (stop 43, docs/treeover43.md). Without ``focal``: None;
+      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots. Where
+      the camera saw past the fruit (a pixel farther than the fruit's front plus half the mask's width: behind
+      the outline of a round fruit that wide) nearly all round the outline, the mask beyond the fruit's edge there
+      is the overshoot (:func:`_seen_past`, ``focal``: the camera's focal length in pixels; stop 43,
+      docs/treeover43.md); elsewhere the mask is the only measure of the fruit's width, and nothing is taken off;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
       pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
@@ -493,7 +491,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     row = np.rint(uv[:, 1]).astype(np.intp) - v0
     ok = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     if not ok.any():
-        return None
+        return None, False
     flat = np.full(h * w, np.inf)
     np.minimum.at(flat, row[ok] * w + col[ok], points[ok, 2])
     own_z = flat.reshape(h, w)
@@ -503,7 +501,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     with np.errstate(invalid="ignore"):
         band = beyond & np.isfinite(d) & (d > 0)
     if not band.any():
-        return None
+        return None, False
     # the nearest point pixel's depth, over the box of the mask and the points' pixels alone
     b0, b1, a0, a1 = mask_box(own | seen)  # type: ignore[misc]
     near = np.take(own_z[b0:b1, a0:a1].ravel(), nearest_index(~seen[b0:b1, a0:a1]))
@@ -515,7 +513,8 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
     spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
     if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
-        return _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
+        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
+        return past, past is not None
     drop = beyond.copy()
     drop[band] = ~ahead  # all but what lies clearly in front
     # peeled from the mask's border inwards: what a mask overshoots lies at its border
@@ -523,12 +522,9 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     drop = ndimage.binary_propagation(edge, structure=np.ones((3, 3), bool), mask=drop)
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
-    return drop
+    return drop, False
 
 
-#: The share of a mask's outline a trim must take to be an overshoot all round (as
-#: :func:`~symfruit.core.surface.colour_trim`'s ``outline_share``, docs/stress39.md: "nearly all round").
-OUTLINE_SHARE = 2.0 / 3.0
 #: Angular sectors a time-of-flight view's edge is found in (:func:`overshoot`): a sector spans 2-4 px of the
 #: outline of a fruit 40-70 px across (issue 18's apples at 1.2-2 m), the depth pixels' footprint.
 SECTORS = 48
@@ -536,16 +532,20 @@ SECTORS = 48
 
 def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarray, points: np.ndarray,
                focal: float, eroded: int, tolerance: float, sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
-    """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge, where
-    the camera saw past it, when that is nearly all round.
+    """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge where the
+    camera saw past the fruit nearly all round it (None: not so, or nothing beyond).
 
-    About the points' centroid, in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's
-    last depth) and the nearest mask pixel seen behind the fruit (farther than its front plus half the mask's
-    width, which no point of a round fruit's visible side is). Between the two the camera returned nothing: the
-    mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
-    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway. A sector where nothing was seen past
-    the fruit takes its neighbours' edge (periodic interpolation). The mask beyond that edge is the overshoot
-    when the camera saw past the fruit in at least ``OUTLINE_SHARE`` of the sectors holding points."""
+    About the points' centroid, in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's last
+    depth) and the nearest mask pixel seen past the fruit (farther than its front plus half the mask's width, the
+    depth of a round fruit's outline were it as wide as the mask, plus ``tolerance``). Between the two the camera
+    returned nothing: the mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
+    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (the grazing rim lost inside the edge
+    makes that an upper bound); a sector where nothing was seen past takes its neighbours' edge (periodic
+    interpolation). Nearly all round: no third of the outline without a sector seen past. A mask an annotator or
+    a model drew too wide overshoots all round; a depth camera seeing past one side of a fruit (its baseline to the
+    colour camera, a registration a few pixels off) is one side, and the mask there is kept (the shared lab
+    spheres leave 180-315 degrees without: docs/treeover43.md).
+    """
     front = float(points[:, 2].min())
     half = 0.5 * np.sqrt(4.0 * np.count_nonzero(own) / np.pi) * front / focal  # the mask's half-width, metres
     past = band & (np.where(band, d, 0.0) > front + half + tolerance)
@@ -564,8 +564,7 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     np.minimum.at(first, sec[is_past], rad[is_past])
     held = np.isfinite(last)
     both = held & np.isfinite(first) & (first > last)
-    # all round: no third of the outline without a sector seen past (a camera seeing past one side of a fruit,
-    # a registration a few pixels off, leaves the other side: the shared lab spheres' 135-180 degrees)
+    # nearly all round: no third of the outline without a sector seen past
     at = np.flatnonzero(both)
     if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
         return None
@@ -576,7 +575,7 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
-    return drop.view(_SeenPast) if drop.any() else None
+    return drop if drop.any() else None
 
 
 def own_edge(
