@@ -539,8 +539,9 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     depth) and the nearest mask pixel seen past the fruit (farther than its front plus half the mask's width, the
     depth of a round fruit's outline were it as wide as the mask, plus ``tolerance``). Between the two the camera
     returned nothing: the mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
-    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (the grazing rim lost inside the edge
-    makes that an upper bound); a sector where nothing was seen past takes its neighbours' edge (periodic
+    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where the camera also loses the grazing
+    rim inside the edge, halfway lies inside it by half the difference: the rendered apple trees lose 3.5-6 px inside
+    and 2 outside, docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic
     interpolation). Nearly all round: no third of the outline without a sector seen past. A mask an annotator or
     a model drew too wide overshoots all round; a depth camera seeing past one side of a fruit (its baseline to the
     colour camera, a registration a few pixels off) is one side, and the mask there is kept (the shared lab
