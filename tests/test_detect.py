@@ -333,3 +333,27 @@ def test_a_windows_camera_is_the_constructors():
     far = Camera(fx=600.0, fy=600.0, cx=MAX_FOCAL_PX, cy=240.0, width=640, height=480)
     with pytest.raises(InputError, match="implausible"):
         _window_camera(far, 0, 10, -5, 10)
+
+
+def test_a_mask_the_colour_cannot_trim_is_trimmed_where_the_camera_saw_past_the_fruit():
+    """Stop 43: a 44 px fruit as grey as its background (the colour trim cannot tell them apart), a time-of-flight
+    camera's ring of 4 px without depth about its outline, a mask drawn 8 px wide onto the background: the mask is
+    still as drawn, and the overshoot is found where the camera saw past the fruit (cut halfway into the ring,
+    22 px). A red fruit's mask drawn 4 px wide, which the colour trims, is not looked at again."""
+    yy, xx = np.mgrid[:120, :160]
+    r = np.hypot(xx - 80, yy - 60)
+    for colour, wide, seen_past in (((90, 90, 90), 30, True), ((200, 20, 30), 26, False)):
+        mask = (r <= wide).astype(np.int32)
+        color, depth = disc_frame([(80, 60)], radius=22, colour=colour)
+        depth[(r > 20) & (r < 24)] = 0.0
+        found = detect(Frame("tof", color, depth, SMALL_CAM, masks=mask), method="evidence")
+        (d,) = found.detections
+        assert d.occlusion is not None and d.occlusion.seen_past is seen_past
+        if seen_past:
+            assert d.mask.sum() == mask.sum()  # not trimmed by colour
+            kept = np.zeros(mask.shape, bool)
+            o = d.occlusion
+            kept[o.v0 : o.v0 + o.own.shape[0], o.u0 : o.u0 + o.own.shape[1]] = o.own & ~o.overshoot
+            assert abs(np.sqrt(kept.sum() / np.pi) - 22) < 1.5
+        else:
+            assert d.occlusion.overshoot is None and d.mask.sum() < mask.sum()

@@ -173,11 +173,17 @@ def detect(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = ndimage.find_objects(labels)
-    colour_trimmed = frame.color is not None and settings.extract.colour_trim_px > 0
+    # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
+    # looked for in the depth, docs/treeover43.md)
+    colour_trimmed: set[int] = set()
     if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
         trimmed = trim_labels(frame.color, labels, settings.extract, boxes=boxes)
         if trimmed is not labels:
-            boxes = [_box_within(trimmed, k, sl) for k, sl in enumerate(boxes, 1)]
+            new_boxes = [_box_within(trimmed, k, sl) for k, sl in enumerate(boxes, 1)]
+            colour_trimmed = {k for k, (a, b) in enumerate(zip(boxes, new_boxes, strict=True), 1)
+                              if a is not None and (b != a or np.count_nonzero(trimmed[a] == k)
+                                                    != np.count_nonzero(labels[a] == k))}  # fmt: skip
+            boxes = new_boxes
         labels = trimmed
     t_trim = time.perf_counter() - t2
     moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
@@ -214,7 +220,7 @@ def detect(
             # mask trimmed by colour already lost what it overshot the fruit by (stop 42, docs/sil42.md)
             occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
                                   others=fruit_px, checked=True, eroded=settings.extract.erode_px,
-                                  drawn=not colour_trimmed)  # fmt: skip
+                                  drawn=k not in colour_trimmed)  # fmt: skip
             t_occlusion += time.perf_counter() - b
             result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
             detections.append(Detection(int(k), mask, ex, result, occlusion=occ))

@@ -35,8 +35,9 @@ class OcclusionSettings(Section):
         many pixels (sensor dropout beside edges).
     trim_own : bool
         Find the pixels a mask not trimmed by colour overshoots the fruit by, where an active-stereo camera spread
-        the fruit's own depth beyond its points (:func:`symfruit.core.occlusion.overshoot`): the completion reads the
-        fruit's width and silhouette cone without them (stop 42, docs/sil42.md).
+        the fruit's own depth beyond its points or a time-of-flight camera saw past the fruit nearly all round it
+        (:func:`symfruit.core.occlusion.overshoot`): the completion reads the fruit's width and silhouette cone
+        without them (stops 42 and 43, docs/sil42.md, docs/treeover43.md).
     """
 
     enabled: bool = setting(True)

@@ -371,6 +371,39 @@ def test_an_overshooting_mask_is_trimmed_where_the_camera_spreads_the_fruits_dep
     assert with_own(region, occ, trimmed=True).mask.sum() == (mask & ~(over & ~kept)).sum()
 
 
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_is_trimmed(kernels, monkeypatch):
+    """Stop 43: a fruit whose points reach 12 px from its centre, a ring of 4 px without depth (the mixed pixels a
+    time-of-flight camera invalidates on both sides of its edge at 14 px), the background 0.7 m behind, a mask drawn
+    20 px wide: the mask beyond halfway between the last point (12 px) and the first pixel seen past (16 px) is
+    overshoot (the border ring extraction never took points from is given back). The same background seen past
+    one side alone (a registration a few pixels off) is no overshoot, nor is a ring without depth all round."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    vv, uu = np.mgrid[:60, :80]
+    r = np.hypot(uu - 40, vv - 30)
+    disc, mask = r <= 12, r <= 20
+    depth = np.full((60, 80), 1.0)  # the background
+    depth[disc] = 0.3 + 0.0002 * r[disc] ** 2
+    depth[(r > 12) & (r < 16)] = 0.0  # the invalidated ring
+    rows, cols = np.nonzero(disc)
+    points = BIG.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    occ = occlusion(depth, mask, points, BIG, eroded=0)
+    assert occ.overshoot is not None and occ.seen_past
+    over = np.zeros((60, 80), bool)
+    over[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+    kept = mask & ~over
+    radius = np.sqrt(kept.sum() / np.pi)
+    assert 13.5 < radius < 15.0  # halfway: 14 px
+    assert not over[r <= 13.5].any() and over[mask & (r > 15)].all()
+    one_side = depth.copy()
+    one_side[mask & ~disc & (uu < 40)] = 0.0  # seen past on the right only
+    assert occlusion(one_side, mask, points, BIG).overshoot is None
+    nothing = depth.copy()
+    nothing[mask & ~disc] = 0.0  # the mask's band all without depth: the mask is the only measure
+    assert occlusion(nothing, mask, points, BIG).overshoot is None
+
+
 # --- stop 42, speedext42
 
 

@@ -415,3 +415,37 @@ def test_a_mask_overshooting_onto_a_spread_edge_does_not_widen_the_fruit():
     assert abs(trimmed.extras["width"] - 0.07) < 0.001 < whole.extras["width"] - trimmed.extras["width"]
     assert np.abs(trimmed.box.size - truth.size).max() < 0.001
     assert np.abs(whole.box.size - truth.size).max() > 0.005
+
+
+def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_does_not_widen_it():
+    """Stop 43: a 70 mm ball at 0.5 m through a time-of-flight camera (no depth on the 2 px either side of its
+    outline, the mixed pixels it invalidates; the background 0.5 m behind), its mask drawn 6 px wide of it all
+    round onto the background the camera sees: the width and the box come from the mask cut halfway between the
+    ball's last depth and the first pixel seen past it (:func:`symfruit.core.occlusion.overshoot`); the whole mask
+    read as the outline made the box more than 8 mm too wide and too deep."""
+    from scipy import ndimage
+
+    from symfruit import Box
+    from symfruit.core.occlusion import occlusion
+    from symfruit.synthetic.render import render
+
+    cam = DEFAULT_CAMERA
+    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
+    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
+    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+    fruit = shot.ids == 0
+    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    square = np.ones((3, 3), bool)
+    rim = ndimage.binary_dilation(fruit, square, 2) & ~ndimage.binary_erosion(fruit, square, 2)
+    depth[rim] = 0.0  # invalidated on both sides of the outline
+    rows, cols = np.nonzero(ndimage.binary_erosion(fruit & ~rim, square))  # extract's erode_px
+    points = cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    mask = ndimage.binary_dilation(fruit, square, 6)
+    truth = Box(ball.vertices.min(axis=0), ball.vertices.max(axis=0))
+    occ = occlusion(depth, mask, points, cam)
+    assert occ.seen_past and occ.overshoot is not None
+    trimmed = complete(points, camera=cam, occlusion=occ)
+    whole = complete(points, camera=cam, occlusion=occlusion(depth, mask, points, cam, trim_own=False))
+    assert abs(trimmed.extras["width"] - 0.07) < 0.002
+    assert np.abs(trimmed.box.size - truth.size).max() < 0.004
+    assert (whole.box.size - truth.size)[[0, 2]].min() > 0.008

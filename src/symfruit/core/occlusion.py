@@ -52,6 +52,9 @@ class Occlusion:
     overshoot : (h, w) bool, optional
         The pixels of :attr:`own` the mask overshoots the fruit by (:func:`overshoot`): the fruit's width is read
         without them (:func:`with_own`, ``trimmed``).
+    seen_past : bool
+        :attr:`overshoot` is where a time-of-flight camera saw past the fruit (:func:`overshoot`): no occluder's,
+        so it is read on a cut outline too (stop 43).
     """
 
     u0: int
@@ -62,6 +65,7 @@ class Occlusion:
     own: np.ndarray | None = None
     depth: np.ndarray | None = None
     overshoot: np.ndarray | None = None
+    seen_past: bool = False
     #: :attr:`hidden` grown by each radius asked for (:meth:`grown`), made once (the maps are read-only).
     _grown: dict[int, np.ndarray] = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -100,14 +104,15 @@ class Occlusion:
 
     @classmethod
     def _made(cls, u0: int, v0: int, hidden: np.ndarray, width: int, height: int, own: np.ndarray,
-              depth: np.ndarray, overshoot: np.ndarray | None = None) -> Occlusion:  # fmt: skip
+              depth: np.ndarray, overshoot: np.ndarray | None = None,
+              seen_past: bool = False) -> Occlusion:  # fmt: skip
         """``Occlusion(u0, v0, hidden, width, height, own=own, depth=depth, overshoot=overshoot)`` without the checks
         that maps :func:`occlusion` made itself always pass (whole numbers, a window within a valid camera's image,
         bool and float maps of one shape): the same fields, the same object (stop 42: the checks cost about 25 us a
         fruit)."""
         made = object.__new__(cls)
         made.__dict__.update(u0=int(u0), v0=int(v0), hidden=hidden, width=int(width), height=int(height), own=own,
-                             depth=depth, overshoot=overshoot, _grown={})  # fmt: skip
+                             depth=depth, overshoot=overshoot, seen_past=seen_past, _grown={})  # fmt: skip
         return made
 
     def at(self, u: np.ndarray, v: np.ndarray, *, radius: int = 0) -> np.ndarray:
@@ -377,6 +382,7 @@ def occlusion(
         raise InputError(f"occlusion others must be a {shape[1]}x{shape[0]} image, got {np.shape(others)[::-1]}")
     points = as_points(points, min_count=1)
     uv = camera.project(points)
+    focal = float(np.sqrt(camera.fx * camera.fy))  # overshoot reads the mask's width in metres
     if (jit := compiled()) is not None:  # as_points gives contiguous float64
         # the window, the fruit's own depths and the maps below in one compiled pass, the images read in place (the
         # same bits: issue 19, seventeenth round, the window and own depths; eighteenth, the nearest point pixel
@@ -394,12 +400,21 @@ def occlusion(
         own_w = mask[v0 : v0 + h, u0 : u0 + w].copy()
         over = (
             overshoot(
-                own_w, depth[v0 : v0 + h, u0 : u0 + w], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded)
+                own_w,
+                depth[v0 : v0 + h, u0 : u0 + w],
+                uv,
+                points,
+                u0,
+                v0,
+                tolerance,
+                max(int(band), 1),
+                int(eroded),
+                focal,
             )
             if trim_own
-            else None
+            else (None, False)
         )
-        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, over)
+        return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *over)
     col = np.rint(uv[:, 0]).astype(np.intp)
     row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
@@ -431,17 +446,20 @@ def occlusion(
     hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
-        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded))
+        overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded), focal)
         if trim_own
-        else None
+        else (None, False)
     )
-    return Occlusion(u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over)
+    return Occlusion(
+        u0, v0, hidden, camera.width, camera.height, own=own_w, depth=d, overshoot=over[0], seen_past=over[1]
+    )
 
 
 def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.ndarray, u0: int, v0: int,
-              tolerance: float, reach: int, eroded: int = 0) -> np.ndarray | None:  # fmt: skip
-    """(h, w) bool: the pixels of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit,
-    where the camera spreads the fruit's own depth beyond its silhouette; None where it does not.
+              tolerance: float, reach: int, eroded: int = 0,
+              focal: float = 0.0) -> tuple[np.ndarray | None, bool]:  # fmt: skip
+    """The pixels ((h, w) bool) of the fruit's mask ``own`` (a window at ``(u0, v0)``) that overshoot the fruit
+    (None: none found), and whether they are where a time-of-flight camera saw past the fruit.
 
     Masks drawn by people or models overshoot a fruit by a few pixels (issue 18, point 4), and the completion reads
     the fruit's width from its outline (:func:`with_own`), then its depth from that width. Beyond the fruit's
@@ -449,8 +467,11 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
 
     - time of flight: mostly no depth (``depth`` 0 or NaN), the rim the camera invalidates (grazing and mixed
       pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
-      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots: the
-      mask is the only measure of the fruit's width there, and nothing is taken off (None);
+      where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots. Where
+      the camera saw past the fruit (a pixel farther than the fruit's front plus half the mask's width: behind
+      the outline of a round fruit that wide) nearly all round the outline, the mask beyond the fruit's edge there
+      is the overshoot (:func:`_seen_past`, ``focal``: the camera's focal length in pixels; stop 43,
+      docs/treeover43.md); elsewhere the mask is the only measure of the fruit's width, and nothing is taken off;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
       pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
@@ -470,7 +491,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     row = np.rint(uv[:, 1]).astype(np.intp) - v0
     ok = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     if not ok.any():
-        return None
+        return None, False
     flat = np.full(h * w, np.inf)
     np.minimum.at(flat, row[ok] * w + col[ok], points[ok, 2])
     own_z = flat.reshape(h, w)
@@ -480,7 +501,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     with np.errstate(invalid="ignore"):
         band = beyond & np.isfinite(d) & (d > 0)
     if not band.any():
-        return None
+        return None, False
     # the nearest point pixel's depth, over the box of the mask and the points' pixels alone
     b0, b1, a0, a1 = mask_box(own | seen)  # type: ignore[misc]
     near = np.take(own_z[b0:b1, a0:a1].ravel(), nearest_index(~seen[b0:b1, a0:a1]))
@@ -492,7 +513,8 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
     spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
     if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
-        return None
+        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
+        return past, past is not None
     drop = beyond.copy()
     drop[band] = ~ahead  # all but what lies clearly in front
     # peeled from the mask's border inwards: what a mask overshoots lies at its border
@@ -500,7 +522,61 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     drop = ndimage.binary_propagation(edge, structure=np.ones((3, 3), bool), mask=drop)
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
-    return drop
+    return drop, False
+
+
+#: Angular sectors a time-of-flight view's edge is found in (:func:`overshoot`): a sector spans 2-4 px of the
+#: outline of a fruit 40-70 px across (issue 18's apples at 1.2-2 m), the depth pixels' footprint.
+SECTORS = 48
+
+
+def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarray, points: np.ndarray,
+               focal: float, eroded: int, tolerance: float, sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
+    """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge where the
+    camera saw past the fruit nearly all round it (None: not so, or nothing beyond).
+
+    About the points' centroid, in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's last
+    depth) and the nearest mask pixel seen past the fruit (farther than its front plus half the mask's width, the
+    depth of a round fruit's outline were it as wide as the mask, plus ``tolerance``). Between the two the camera
+    returned nothing: the mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
+    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where the camera also loses the grazing
+    rim inside the edge, halfway lies inside it by half the difference: the rendered apple trees lose 3.5-6 px inside
+    and 2 outside, docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic
+    interpolation). Nearly all round: no third of the outline without a sector seen past. A mask an annotator or
+    a model drew too wide overshoots all round; a depth camera seeing past one side of a fruit (its baseline to the
+    colour camera, a registration a few pixels off) is one side, and the mask there is kept (the shared lab
+    spheres leave 180-315 degrees without: docs/treeover43.md).
+    """
+    front = float(points[:, 2].min())
+    half = 0.5 * np.sqrt(4.0 * np.count_nonzero(own) / np.pi) * front / focal  # the mask's half-width, metres
+    past = band & (np.where(band, d, 0.0) > front + half + tolerance)
+    if not past.any():
+        return None
+    rs, cs = np.nonzero(seen)
+    r0, c0 = rs.mean(), cs.mean()
+    vv, uu = np.nonzero(own | past)
+    ang = np.arctan2(vv - r0, uu - c0)
+    sec = np.minimum(((ang + np.pi) / (2 * np.pi) * sectors).astype(np.intp), sectors - 1)
+    rad = np.hypot(vv - r0, uu - c0)
+    is_seen, is_past = seen[vv, uu], past[vv, uu]
+    last = np.full(sectors, -np.inf)
+    np.maximum.at(last, sec[is_seen], rad[is_seen])
+    first = np.full(sectors, np.inf)
+    np.minimum.at(first, sec[is_past], rad[is_past])
+    held = np.isfinite(last)
+    both = held & np.isfinite(first) & (first > last)
+    # nearly all round: no third of the outline without a sector seen past
+    at = np.flatnonzero(both)
+    if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
+        return None
+    centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
+    edge = np.interp(centre, centre[both], 0.5 * (last[both] + first[both]), period=2 * np.pi)
+    drop = np.zeros(own.shape, bool)
+    out = own[vv, uu] & ~is_seen & (rad > edge[sec])
+    drop[vv[out], uu[out]] = True
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop if drop.any() else None
 
 
 def own_edge(

@@ -520,7 +520,7 @@ def evidence(
     # reads the outline's surroundings). Not on a cut outline: the leaf-occluded views lost there (docs/sil42.md).
     trimmed = None
     over = None if occlusion is None else occlusion.overshoot
-    if over is not None and obs.contour >= s.covered_contour and over.any():
+    if over is not None and (obs.contour >= s.covered_contour or occlusion.seen_past) and over.any():  # type: ignore[union-attr]
         trimmed = with_own(seen_region, occlusion, trimmed=True)  # type: ignore[arg-type]
         if obs.cone_source == "moments":
             cone, axis = silhouette_cone(trimmed, camera)
