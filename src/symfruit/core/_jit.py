@@ -5426,17 +5426,29 @@ def _correlate_line(line: np.ndarray, weights: np.ndarray, symmetric: bool, out:
     ext = np.empty(n + half + last)
     for i in range(-half, n + last):
         ext[i + half] = line[_reflected(i, n)]
-    for k in range(n):
-        at = k + half
-        if symmetric:
-            acc = ext[at] * weights[half]
-            for j in range(-half, 0):
-                acc += (ext[at + j] + ext[at - j]) * weights[half + j]
-        else:
-            acc = ext[at + last] * weights[half + last]
-            for j in range(-half, last):
-                acc += ext[at + j] * weights[half + j]
-        out[k] = acc
+    # each product and sum in that order for every value at once (the order of one value's sum is kept: the same
+    # values), along views of the buffer (indices from 0 up: no check for negative ones), which numba vectorises; a
+    # value at a time it was one chain of dependent additions (stop 43: the rows' pass 0.65 to 0.45 ms a tree frame)
+    if symmetric:
+        mid = weights[half]
+        e0 = ext[half : half + n]
+        for k in range(n):
+            out[k] = e0[k] * mid
+        for j in range(half, 0, -1):  # outermost first
+            wt = weights[half - j]
+            e1, e2 = ext[half - j : half - j + n], ext[half + j : half + j + n]
+            for k in range(n):
+                out[k] += (e1[k] + e2[k]) * wt
+    else:
+        wt = weights[half + last]
+        e0 = ext[half + last : half + last + n]
+        for k in range(n):
+            out[k] = e0[k] * wt
+        for j in range(size - 1):
+            wt = weights[j]
+            e1 = ext[j : j + n]
+            for k in range(n):
+                out[k] += e1[k] * wt
 
 
 @_njit
