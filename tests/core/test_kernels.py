@@ -4313,24 +4313,6 @@ def test_the_blush_rim_beside_another_fruits_ground_colour_is_the_twins(taken):
         assert (fast[0] == sl) == (taken == 1.0)
 
 
-@pytest.mark.parametrize("shape", [(1, 40), (40, 1), (37, 53)])
-def test_the_red_regions_rows_and_columns_are_the_pixels(shape):
-    """Red specks over one row, one column and a window: :func:`_jit.red_regions_once`'s rows and columns (found
-    without a division, the pixels in raster order) are ``divmod`` of the weak pixels' flat indices."""
-    from symfruit.segment.colour import SegmentSettings, _red_tables
-
-    rng = np.random.default_rng(shape[0] * 100 + shape[1])
-    c = rng.integers(0, 256, (*shape, 3), dtype=np.uint8)
-    c[rng.random(shape) < 0.3] = (200, 40, 30)
-    s = SegmentSettings()
-    low, high = _red_tables(s.red_low, s.red_high, s.dark)
-    found = _jit.red_regions_once(c, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
-    weak, rows, cols = found[3], found[8], found[9]
-    assert len(weak) > 3
-    np.testing.assert_array_equal(rows, weak // shape[1])
-    np.testing.assert_array_equal(cols, weak % shape[1])
-
-
 @pytest.mark.parametrize("n", [1, 2, 5, 8, 9, 30, 200])
 def test_the_correlation_along_views_is_scipys_on_lines_of_every_length(n):
     """:func:`_jit._correlate_line` (every value's products at once along views of its buffer) against scipy's

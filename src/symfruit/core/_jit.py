@@ -6389,12 +6389,8 @@ def red_regions_once(
     rows = np.empty(n_weak, np.int64)
     cols = np.empty(n_weak, np.int64)
     sizes = np.zeros(m + 1, np.int64)
-    r = 0
     for i in range(n_weak):
-        p = weak_at[i]
-        while p >= (r + 1) * w:  # the row, without a division: the pixels come in raster order (stop 43)
-            r += 1
-        rows[i], cols[i], lab[i] = r, p - r * w, flat[p]
+        rows[i], cols[i], lab[i] = weak_at[i] // w, weak_at[i] % w, flat[weak_at[i]]
         sizes[lab[i]] += 1
     seeded = np.zeros(m + 1, np.bool_)
     for i in range(n_strong):
