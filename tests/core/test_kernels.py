@@ -4411,3 +4411,69 @@ def test_the_lag_differences_are_the_twins(seed, h, w, lag):
     diff = _jit.lag_differences(table[:, 1], ok, mask, lag, smooth)
     twin_smooth, twin_diff = _lag_differences(table[:, 1], ok, mask, lag)
     assert smooth.tobytes() == twin_smooth.tobytes() and diff.tobytes() == twin_diff.tobytes()
+
+
+# --- stop 43, speedseg43
+
+
+def test_the_ground_colour_test_of_every_colour_is_the_twins():
+    """Every colour on a grid of each channel's levels (0-255 in steps of 5, and the levels about the tests'
+    bounds): :func:`_jit.ground_pixels` (each pixel's :func:`_jit._is_ground`, whole numbers, no branch) gives the
+    twin's pixels (``_ground`` with ``SYMFRUIT_KERNELS=numpy``), some ground colour and some not."""
+    from symfruit.segment.colour import _ground
+
+    levels = np.unique(np.concatenate((np.arange(0, 256, 5), [39, 40, 41, 42, 127, 128, 254])))
+    r, g, b = np.meshgrid(levels, levels, levels, indexing="ij")
+    image = np.stack((r, g, b), axis=-1).reshape(len(levels), -1, 3).astype(np.uint8)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _ground, image)
+    np.testing.assert_array_equal(fast, twin)
+    assert 0 < int(twin.sum()) < twin.size // 2
+    assert _jit._is_ground(200, 190, 40, 40, 90, 40) and not _jit._is_ground(60, 140, 50, 40, 90, 40)
+
+
+@pytest.mark.parametrize("taken", [0.0, 0.6, 1.0])
+def test_the_blush_rim_beside_another_fruits_ground_colour_is_the_twins(taken):
+    """A blush crescent before ground colour in front of it, that ground colour a share ``taken`` of another fruit's
+    (``owner`` 2: neither the ring nor the other pixels): ``_blush_rim`` with the kernel (each pixel beside the part
+    tested there alone) and with the twin, the same window, mask and depths; none of it taken, the ring joins the
+    part, all of it, the part stays as it was."""
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
+
+    rng = np.random.default_rng(43)
+    hull, z, color, owner = _blush_scene(rng, True)
+    h, w = hull.shape
+    xx = np.mgrid[:h, :w][1]
+    ground = (color == (200, 190, 40)).all(axis=2)
+    owner[ground & (xx < taken * w + (taken == 1.0))] = 2
+    rows, cols = np.nonzero(hull)
+    sl = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
+    part = hull[sl]
+    z_part = z[sl][part & (z[sl] > 0)]
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _blush_rim, sl, part, z_part, _Depth(z), color, s, owner, 1)
+    assert fast[0] == twin[0]
+    np.testing.assert_array_equal(fast[1], twin[1])
+    np.testing.assert_array_equal(fast[2].view(np.uint64), twin[2].view(np.uint64))
+    if taken in (0.0, 1.0):  # none taken: the ring in front is taken; all of it another's: the part as it was
+        assert (fast[0] == sl) == (taken == 1.0)
+
+
+@pytest.mark.parametrize("n", [1, 2, 5, 8, 9, 30, 200])
+def test_the_correlation_along_views_is_scipys_on_lines_of_every_length(n):
+    """:func:`_jit._correlate_line` (every value's products at once along views of its buffer) against scipy's
+    ``correlate1d`` (mode "reflect"): the same values bit for bit, for lines shorter than, as long as and longer than
+    the weights, symmetric (the Gaussian's of sigma 2, 17 weights) or not (even and odd counts)."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _gaussian_weights
+
+    rng = np.random.default_rng(n)
+    line = rng.normal(size=n) * 0.37 + 1.3
+    for weights, symmetric in ((_gaussian_weights(2.0)[0], True), (rng.normal(size=4), False),
+                               (rng.normal(size=7), False)):  # fmt: skip
+        out = np.empty(n)
+        _jit._correlate_line(line, weights, symmetric, out)
+        scipy = ndimage.correlate1d(line, weights, mode="reflect")
+        np.testing.assert_array_equal(out.view(np.uint64), scipy.view(np.uint64))

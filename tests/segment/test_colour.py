@@ -1289,3 +1289,37 @@ def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
     found = [table(i) for i in range(len(pieces))]
     assert found == [rows(i) for i in range(len(pieces))]
     assert sum(map(len, found)) >= 10 and any(not f for f in found)
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_coarse_regions_are_the_ripe_seeds_labelled(seed, monkeypatch):
+    """Red blobs and specks over random colours: ``_coarse_regions`` (the grid's ``_red_regions``, stop 43) gives
+    what it gave from :func:`ripe_seeds`: the weak grid points labelled with eight neighbours (scipy's numbers), each
+    label's size (0 for the background) and whether it holds a strong point, with the kernels and without."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import COARSE_STEP, _coarse_regions
+
+    rng = np.random.default_rng(seed)
+    h, w = 160, 200
+    image = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    yy, xx = np.mgrid[:h, :w]
+    for _ in range(6):
+        cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(6, 30)
+        image[(yy - cy) ** 2 + (xx - cx) ** 2 <= r * r] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), 20)
+    s = SegmentSettings()
+    strong, weak = ripe_seeds(image[::COARSE_STEP, ::COARSE_STEP], s)
+    lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    sizes[0] = 0
+    seeded = np.zeros(n + 1, bool)
+    seeded[lab[strong]] = True
+    for kernels in ("numpy", ""):
+        monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
+        found = _coarse_regions(image, s)
+        assert found is not None
+        for a, b in zip(found, (lab, sizes, seeded), strict=True):
+            assert a.dtype == b.dtype
+            np.testing.assert_array_equal(a, b)
+    assert n > 3 and seeded.sum() >= 3
+    assert _coarse_regions(np.zeros((40, 40, 3), np.uint8), s) is None

@@ -713,15 +713,14 @@ COARSE_STEP = 4
 
 def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
     """The weakly red regions on a coarse grid of step :data:`COARSE_STEP`: their labels, sizes (grid
-    points) and whether each holds a seed (strongly red) point; None without any."""
-    strong, weak = ripe_seeds(c[::COARSE_STEP, ::COARSE_STEP], s)
-    if not weak.any():
+    points) and whether each holds a seed (strongly red) point; None without any. The grid's :func:`_red_regions`
+    (one compiled call where numba is: the red tests, the labels and their sizes and seeds together), the values of
+    :func:`ripe_seeds`' masks labelled with eight neighbours, their ``bincount`` and seeds (stop 43: their bincount
+    over the grid's labels alone was 0.7 ms of a 1920x1080 frame)."""
+    regions = _red_regions(c[::COARSE_STEP, ::COARSE_STEP], s)
+    if regions is None:
         return None
-    lab, n = _label(weak, eight=True)
-    sizes = np.bincount(lab.ravel(), minlength=n + 1)
-    sizes[0] = 0
-    seeded = np.zeros(n + 1, bool)
-    seeded[lab[strong]] = True
+    _, lab, _, _, seeded, sizes, _, _ = regions
     return lab, sizes, seeded
 
 
