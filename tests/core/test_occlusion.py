@@ -390,3 +390,21 @@ def test_the_occlusion_made_without_checks_is_the_checked_one():
     assert Occlusion._made(3, 4, hidden, 40, 30, own, seen, over) == Occlusion(3, 4, hidden, 40, 30, own=own,
                                                                                depth=seen, overshoot=over)  # fmt: skip
     assert made.overshoot is None
+
+
+# --- stop 43, robust43
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("tolerance", float("nan")), ("tolerance", "0.005"), ("tolerance", 2.0), ("reach", -1), ("reach", 10**9),
+     ("reach", 2.5), ("pad", 16.0), ("pad", -1), ("band", 2.5), ("band", True), ("eroded", -1)],
+)  # fmt: skip
+def test_occlusion_refuses_parameters_it_cannot_use_naming_them(key, value):
+    """Before: NaN and a negative reach were taken in silence, a reach of 10**9 was numpy's MemoryError (exbibytes
+    of offsets) and a band of 2.5 a TypeError from slicing."""
+    depth, disc, points = _disc_frame()
+    with pytest.raises(InputError, match=f"occlusion: {key} must be"):
+        occlusion(depth, disc, points, CAM, **{key: value})
+    fine = occlusion(depth, disc, points, CAM, reach=np.int64(3), pad=np.int32(16), tolerance=np.float32(0.005))
+    np.testing.assert_array_equal(fine.hidden, occlusion(depth, disc, points, CAM).hidden)

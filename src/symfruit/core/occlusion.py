@@ -22,7 +22,7 @@ from scipy import ndimage
 from ..errors import InputError
 from .camera import Camera
 from .kernels import compiled
-from .limits import check_image_size, depth_metres
+from .limits import MAX_IMAGE_SIDE, check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
@@ -367,6 +367,7 @@ def occlusion(
     """
     if not isinstance(camera, Camera):
         raise InputError(f"occlusion: camera must be a symfruit Camera, got {type(camera).__name__}")
+    _check_parameters(tolerance, reach, pad, band, eroded)
     depth = np.asarray(depth) if checked else depth_metres(depth, "occlusion depth")
     mask = np.asarray(mask, dtype=bool)
     shape = (camera.height, camera.width)
@@ -622,6 +623,28 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
     src_w = (src_i // pw - reach) * w + src_i % pw - reach
     out.ravel()[(dst_i // pw - reach) * w + dst_i % pw - reach] = np.take(d.ravel(), src_w)
     return out
+
+
+#: The widest ``reach``, ``band`` and ``eroded`` :func:`occlusion` takes, pixels: the settings' bound on
+#: ``occlusion.reach_px`` and ``extract.erode_px`` (:data:`symfruit.extract.MAX_RADIUS_PX`). ``reach`` makes a
+#: table of every offset within it, ``(2 reach + 1)^2`` of them: 10**9 asked for exbibytes.
+MAX_OCCLUSION_PX = 50
+
+
+def _check_parameters(tolerance: object, reach: object, pad: object, band: object, eroded: object) -> None:
+    """Refuse :func:`occlusion`'s parameters it cannot use, naming them (before: NaN and a negative ``reach`` were
+    taken in silence, a ``reach`` of 10**9 was numpy's MemoryError and a ``band`` of 2.5 a TypeError from slicing)."""
+    if (
+        isinstance(tolerance, bool)
+        or not isinstance(tolerance, int | float | np.integer | np.floating)
+        or not (-1.0 <= float(tolerance) <= 1.0)
+    ):  # NaN fails the range too
+        raise InputError(f"occlusion: tolerance must be a number of metres in [-1, 1], got {tolerance!r:.40}")
+    for name, value, most in (("reach", reach, MAX_OCCLUSION_PX), ("pad", pad, MAX_IMAGE_SIDE),
+                              ("band", band, MAX_OCCLUSION_PX), ("eroded", eroded, MAX_OCCLUSION_PX)):  # fmt: skip
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or not 0 <= value <= most:
+            raise InputError(f"occlusion: {name} must be a whole number of pixels from 0 to {most}, got "
+                             f"{value!r:.40}")  # fmt: skip
 
 
 def _offsets(reach: int) -> list[tuple[int, int]]:
