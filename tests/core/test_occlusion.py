@@ -408,3 +408,17 @@ def test_occlusion_refuses_parameters_it_cannot_use_naming_them(key, value):
         occlusion(depth, disc, points, CAM, **{key: value})
     fine = occlusion(depth, disc, points, CAM, reach=np.int64(3), pad=np.int32(16), tolerance=np.float32(0.005))
     np.testing.assert_array_equal(fine.hidden, occlusion(depth, disc, points, CAM).hidden)
+
+
+def test_occlusion_of_non_finite_points_is_refused_without_numpys_warning(monkeypatch):
+    """Before: the numpy twin cast NaN pixels to integers, and numpy's RuntimeWarning 'invalid value encountered in
+    cast' reached the caller before the InputError."""
+    import warnings
+
+    depth, disc, _ = _disc_frame()
+    for kernels in ("", "numpy"):
+        monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(InputError, match="occlusion: no point of the fruit projects into the image"):
+                occlusion(depth, disc, np.full((10, 3), np.nan), CAM)

@@ -367,7 +367,9 @@ def occlusion(
     """
     if not isinstance(camera, Camera):
         raise InputError(f"occlusion: camera must be a symfruit Camera, got {type(camera).__name__}")
-    _check_parameters(tolerance, reach, pad, band, eroded)
+    # plain float and ints from here: a numpy integer or float32 would be a kernel compiled anew (uint64 mixed with
+    # int64 is float64 in numba, no slice index)
+    tolerance, reach, pad, band, eroded = _check_parameters(tolerance, reach, pad, band, eroded)
     depth = np.asarray(depth) if checked else depth_metres(depth, "occlusion depth")
     mask = np.asarray(mask, dtype=bool)
     shape = (camera.height, camera.width)
@@ -401,8 +403,9 @@ def occlusion(
             else None
         )
         return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, over)
-    col = np.rint(uv[:, 0]).astype(np.intp)
-    row = np.rint(uv[:, 1]).astype(np.intp)
+    with np.errstate(invalid="ignore"):  # a non-finite point's pixel is no pixel of the image (not numpy's warning)
+        col = np.rint(uv[:, 0]).astype(np.intp)
+        row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
     if not ok.any():
         raise InputError("occlusion: no point of the fruit projects into the image")
@@ -631,9 +634,12 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
 MAX_OCCLUSION_PX = 50
 
 
-def _check_parameters(tolerance: object, reach: object, pad: object, band: object, eroded: object) -> None:
+def _check_parameters(
+    tolerance: object, reach: object, pad: object, band: object, eroded: object
+) -> tuple[float, int, int, int, int]:
     """Refuse :func:`occlusion`'s parameters it cannot use, naming them (before: NaN and a negative ``reach`` were
-    taken in silence, a ``reach`` of 10**9 was numpy's MemoryError and a ``band`` of 2.5 a TypeError from slicing)."""
+    taken in silence, a ``reach`` of 10**9 was numpy's MemoryError and a ``band`` of 2.5 a TypeError from slicing);
+    ``(tolerance, reach, pad, band, eroded)`` as a float and ints."""
     if (
         isinstance(tolerance, bool)
         or not isinstance(tolerance, int | float | np.integer | np.floating)
@@ -645,6 +651,7 @@ def _check_parameters(tolerance: object, reach: object, pad: object, band: objec
         if isinstance(value, bool) or not isinstance(value, int | np.integer) or not 0 <= value <= most:
             raise InputError(f"occlusion: {name} must be a whole number of pixels from 0 to {most}, got "
                              f"{value!r:.40}")  # fmt: skip
+    return float(tolerance), int(reach), int(pad), int(band), int(eroded)  # type: ignore[call-overload]
 
 
 def _offsets(reach: int) -> list[tuple[int, int]]:
