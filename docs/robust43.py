@@ -53,16 +53,11 @@ def example() -> tuple[np.ndarray, np.ndarray, symfruit.Camera]:
     return rgb, raw.astype(np.float32) * np.float32(0.001), cam
 
 
-RGB, DEPTH, ECAM = example()
-H, W = DEPTH.shape
-
-
 def labels_of() -> np.ndarray:
     """The example frame's own instance labels (the colour segmenter's)."""
     return segment(RGB, DEPTH, ECAM)
 
 
-LABELS = labels_of()
 P = fruit()
 
 
@@ -366,8 +361,6 @@ add("segment/settings-dict", "error", lambda: segment(RGB, settings={"min_area_s
 
 
 # --- occlusion and extract -------------------------------------------------------------------------------------
-MASK1 = LABELS == 1
-PTS1 = extract(MASK1, DEPTH, ECAM).points
 add("occlusion/good", "result", lambda: occlusion(DEPTH, MASK1, PTS1, ECAM))
 add("occlusion/mask-int", "any", lambda: occlusion(DEPTH, MASK1.astype(int), PTS1, ECAM))
 add("occlusion/mask-labels", "any", lambda: occlusion(DEPTH, LABELS, PTS1, ECAM))
@@ -435,12 +428,14 @@ def _img(a: np.ndarray, encoding: str) -> SimpleNamespace:
                            data=rows.tobytes(), header=_hdr())  # fmt: skip
 
 
-def _info(fx: float = ECAM.fx, width: int = W, height: int = H, cx: float = ECAM.cx) -> SimpleNamespace:
+def _info(fx: float | None = None, width: int | None = None, height: int | None = None,
+          cx: float | None = None) -> SimpleNamespace:  # fmt: skip
+    fx, cx = ECAM.fx if fx is None else fx, ECAM.cx if cx is None else cx
+    width, height = W if width is None else width, H if height is None else height
     return SimpleNamespace(width=width, height=height, header=_hdr(),
                            K=[fx, 0.0, cx, 0.0, ECAM.fy, ECAM.cy, 0.0, 0.0, 1.0])  # fmt: skip
 
 
-RAW = (DEPTH * 1000).astype(np.uint16)
 _PROC: list[Any] = []
 
 
@@ -502,11 +497,24 @@ def origin(exc: BaseException) -> str:
     return f"{type(exc).__module__}.{type(exc).__name__} at {where}: {str(exc)[:120]!r}"
 
 
+def load() -> None:
+    """The example frame, its labels and one fruit's points and mask, which the cases read (made after the command
+    line is read: ``--help`` does no work)."""
+    global RGB, DEPTH, ECAM, H, W, LABELS, MASK1, PTS1, RAW
+    RGB, DEPTH, ECAM = example()
+    H, W = DEPTH.shape
+    LABELS = labels_of()
+    MASK1 = LABELS == 1
+    PTS1 = extract(MASK1, DEPTH, ECAM).points
+    RAW = (DEPTH * 1000).astype(np.uint16)
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="")
     parser.add_argument("--defects", action="store_true", help="print the defects alone")
     args = parser.parse_args()
+    load()
     signal.signal(signal.SIGALRM, _alarm)
     counts = {"error": 0, "result": 0, "DEFECT": 0}
     for name, expect, fn in CASES:
