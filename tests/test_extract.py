@@ -266,3 +266,18 @@ def test_a_leaf_in_front_that_the_mask_covers_is_not_the_fruit_without_colour():
     ex = extract(d2 <= 1, depth, cam, NO_EROSION)
     assert len(ex.points) >= 0.8 * ((d2 <= 1) & ~leaf).sum()
     assert ex.points[:, 2].min() > 0.497 and ex.points[:, 2].max() < 0.5 + r_m + 0.003
+
+
+# --- stop 43, robust43
+
+
+def test_extract_refuses_a_depth_in_millimetres_rather_than_giving_no_points():
+    """Float millimetres handed over as metres: before, every pixel lay beyond extract.max_depth and the fruit had 0
+    points, unsaid; a Frame's depth (checked=True) is not sampled again."""
+    color, depth = disc_frame([(80, 60)])
+    mask = np.all(color == (200, 20, 30), axis=2)
+    assert len(extract(mask, depth, CAM).points) > 0
+    with pytest.raises(InputError, match=r"extract: depth is .* m typically; depth must be metres"):
+        extract(mask, depth * 1000.0, CAM)
+    assert len(extract(mask, depth * 1000.0, CAM, checked=True).points) == 0
+    assert len(extract(mask, np.full_like(depth, np.nan), CAM).points) == 0  # no depth at all: 0 points, as before

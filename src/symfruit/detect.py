@@ -284,7 +284,7 @@ def _extract_window(
     window = mask[r0:r1, c0:c1]
     local = _window_camera(cam, r0, r1, c0, c1)
     leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
-    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy)
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy, checked=True)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     # the mask's pixels all lie in the window (its box): the rest of the image is none of the outline's. Where the
     # outline is the window itself (extract keeps its mask's view), it is the mask: no image is copied (a whole

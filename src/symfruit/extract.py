@@ -13,6 +13,7 @@ from scipy import ndimage
 
 from .core.camera import Camera
 from .core.kernels import compiled
+from .core.limits import depth_metres
 from .core.points import bounds
 from .core.raster import square_filter
 from .core.surface import colour_trim, fruit_surface, registration_shift
@@ -201,7 +202,7 @@ def _checked(image: Any, beside: Any, camera: Any, settings: Any, what: str, nam
 
 
 def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None,
-            *, leafy: np.ndarray | None = None) -> Extraction:  # fmt: skip
+            *, leafy: np.ndarray | None = None, checked: bool = False) -> Extraction:  # fmt: skip
     """The 3D points of the fruit under ``mask``.
 
     Parameters
@@ -210,6 +211,10 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     depth : (h, w) float, metres (0 or NaN = no depth), registered to the mask (:func:`register`)
     camera : Camera
     settings : ExtractSettings
+    checked : bool
+        ``depth`` is (a window of) a :class:`~symfruit.core.frame.Frame`'s, its units checked already. Else, when the
+        mask holds no depth within ``min_depth``-``max_depth``, the depth image's units are checked
+        (:func:`~symfruit.core.limits.depth_metres`): a depth in millimetres is refused, not 0 points.
 
     Returns
     -------
@@ -244,6 +249,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         usable = core & valid
         n_usable = int(usable.sum())
         z_valid = np.where(valid, z_all, 0.0) if n_usable >= 10 else z_all
+    if n_usable == 0 and not checked:  # nothing in range: the units are looked at then alone (no cost otherwise)
+        depth_metres(z_all, "extract")  # stop 43: millimetres handed over as metres gave 0 points, unsaid
     outline = np.asarray(mask, dtype=bool)
     surface = None
     if n_usable >= 10:

@@ -150,3 +150,16 @@ def test_project_and_deproject_refuse_coordinates_of_another_shape_by_name(camer
         camera.deproject(np.zeros((3, 2)), [0.4, 0.5])  # before: numpy's broadcast ValueError
     with pytest.raises(InputError, match=r"one depth per pixel: \(3,\) pixels, depth \(\)"):
         camera.deproject(np.zeros((3, 2)), 0.4)  # before: numpy's 'all input arrays must have the same shape'
+
+
+# --- stop 43, robust43
+
+
+def test_rays_refuse_text_and_coordinates_of_two_shapes():
+    """Before: numpy's UFuncTypeError for text, np.stack's ValueError for u and v of two shapes."""
+    cam = Camera(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)
+    with pytest.raises(InputError, match="rays needs pixel coordinates as numbers, got <U1"):
+        cam.rays("a", "b")
+    with pytest.raises(InputError, match=r"rays needs u and v of one shape, got \(3,\) and \(2,\)"):
+        cam.rays(np.zeros(3), np.zeros(2))
+    np.testing.assert_array_equal(cam.rays(np.array([820]), np.array([240.0])), [[1.0, 0.0, 1.0]])

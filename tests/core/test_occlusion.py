@@ -423,3 +423,35 @@ def test_the_occlusion_made_without_checks_is_the_checked_one():
     assert Occlusion._made(3, 4, hidden, 40, 30, own, seen, over) == Occlusion(3, 4, hidden, 40, 30, own=own,
                                                                                depth=seen, overshoot=over)  # fmt: skip
     assert made.overshoot is None
+
+
+# --- stop 43, robust43
+
+
+@pytest.mark.parametrize(
+    ("key", "value"),
+    [("tolerance", float("nan")), ("tolerance", "0.005"), ("tolerance", 2.0), ("reach", -1), ("reach", 10**9),
+     ("reach", 2.5), ("pad", 16.0), ("pad", -1), ("band", 2.5), ("band", True), ("eroded", -1)],
+)  # fmt: skip
+def test_occlusion_refuses_parameters_it_cannot_use_naming_them(key, value):
+    """Before: NaN and a negative reach were taken in silence, a reach of 10**9 was numpy's MemoryError (exbibytes
+    of offsets) and a band of 2.5 a TypeError from slicing."""
+    depth, disc, points = _disc_frame()
+    with pytest.raises(InputError, match=f"occlusion: {key} must be"):
+        occlusion(depth, disc, points, CAM, **{key: value})
+    fine = occlusion(depth, disc, points, CAM, reach=np.int64(3), pad=np.int32(16), tolerance=np.float32(0.005))
+    np.testing.assert_array_equal(fine.hidden, occlusion(depth, disc, points, CAM).hidden)
+
+
+def test_occlusion_of_non_finite_points_is_refused_without_numpys_warning(monkeypatch):
+    """Before: the numpy twin cast NaN pixels to integers, and numpy's RuntimeWarning 'invalid value encountered in
+    cast' reached the caller before the InputError."""
+    import warnings
+
+    depth, disc, _ = _disc_frame()
+    for kernels in ("", "numpy"):
+        monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            with pytest.raises(InputError, match="occlusion: no point of the fruit projects into the image"):
+                occlusion(depth, disc, np.full((10, 3), np.nan), CAM)

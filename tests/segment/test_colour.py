@@ -1323,3 +1323,19 @@ def test_the_coarse_regions_are_the_ripe_seeds_labelled(seed, monkeypatch):
             np.testing.assert_array_equal(a, b)
     assert n > 3 and seeded.sum() >= 3
     assert _coarse_regions(np.zeros((40, 40, 3), np.uint8), s) is None
+
+
+# --- stop 43, robust43
+
+
+@pytest.mark.parametrize("bad", [{"fx": "615", "fy": "615"}, {"fx": True, "fy": 615.0}, {"fx": 615.0, "fy": b"6"},
+                                 {"fx": 615.0, "fy": 615.0, "cx": "80"}])  # fmt: skip
+def test_segment_refuses_a_camera_of_text_or_booleans_for_numbers(bad):
+    """Before: float() read "615" as 615 and True as 1 (a 1-pixel focal length) in silence; symfruit.Camera refuses
+    both."""
+    from types import SimpleNamespace
+
+    color, depth = disc_frame([(80, 60)])
+    with pytest.raises(InputError, match="segment: camera must be a Camera with numbers fx, fy"):
+        segment(color, depth, SimpleNamespace(**bad))
+    assert segment(color, depth, SimpleNamespace(fx=600.0, fy=600.0)).max() == 1

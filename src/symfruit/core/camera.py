@@ -156,10 +156,14 @@ class Camera:
         >>> Camera(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480).rays(820.0, 240.0)
         array([1., 0., 1.])
         """
-        x = (np.asarray(u) - self.cx) / self.fx
-        y = (np.asarray(v) - self.cy) / self.fy
-        if np.shape(x) != np.shape(y):  # np.stack's error for coordinates of different shapes
-            return np.stack([x, y, np.ones_like(x, dtype=np.float64)], axis=-1)
+        u, v = np.asarray(u), np.asarray(v)
+        # stop 43: text was numpy's UFuncTypeError, coordinates of two shapes np.stack's ValueError
+        if u.dtype.kind not in "iuf" or v.dtype.kind not in "iuf":
+            raise InputError(f"rays needs pixel coordinates as numbers, got {u.dtype} and {v.dtype}")
+        if u.shape != v.shape:
+            raise InputError(f"rays needs u and v of one shape, got {u.shape} and {v.shape}")
+        x = (u - self.cx) / self.fx
+        y = (v - self.cy) / self.fy
         out = np.empty(np.shape(x) + (3,), dtype=np.result_type(x, y, np.float64))  # as np.stack's, in place
         out[..., 0] = x
         out[..., 1] = y

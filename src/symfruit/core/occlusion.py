@@ -22,7 +22,7 @@ from scipy import ndimage
 from ..errors import InputError
 from .camera import Camera
 from .kernels import compiled
-from .limits import check_image_size, depth_metres
+from .limits import MAX_IMAGE_SIDE, check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
@@ -372,6 +372,9 @@ def occlusion(
     """
     if not isinstance(camera, Camera):
         raise InputError(f"occlusion: camera must be a symfruit Camera, got {type(camera).__name__}")
+    # plain float and ints from here: a numpy integer or float32 would be a kernel compiled anew (uint64 mixed with
+    # int64 is float64 in numba, no slice index)
+    tolerance, reach, pad, band, eroded = _check_parameters(tolerance, reach, pad, band, eroded)
     depth = np.asarray(depth) if checked else depth_metres(depth, "occlusion depth")
     mask = np.asarray(mask, dtype=bool)
     shape = (camera.height, camera.width)
@@ -415,8 +418,9 @@ def occlusion(
             else (None, False)
         )
         return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *over)
-    col = np.rint(uv[:, 0]).astype(np.intp)
-    row = np.rint(uv[:, 1]).astype(np.intp)
+    with np.errstate(invalid="ignore"):  # a non-finite point's pixel is no pixel of the image (not numpy's warning)
+        col = np.rint(uv[:, 0]).astype(np.intp)
+        row = np.rint(uv[:, 1]).astype(np.intp)
     ok = (col >= 0) & (col < camera.width) & (row >= 0) & (row < camera.height)
     if not ok.any():
         raise InputError("occlusion: no point of the fruit projects into the image")
@@ -698,6 +702,32 @@ def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.n
     src_w = (src_i // pw - reach) * w + src_i % pw - reach
     out.ravel()[(dst_i // pw - reach) * w + dst_i % pw - reach] = np.take(d.ravel(), src_w)
     return out
+
+
+#: The widest ``reach``, ``band`` and ``eroded`` :func:`occlusion` takes, pixels: the settings' bound on
+#: ``occlusion.reach_px`` and ``extract.erode_px`` (:data:`symfruit.extract.MAX_RADIUS_PX`). ``reach`` makes a
+#: table of every offset within it, ``(2 reach + 1)^2`` of them: 10**9 asked for exbibytes.
+MAX_OCCLUSION_PX = 50
+
+
+def _check_parameters(
+    tolerance: object, reach: object, pad: object, band: object, eroded: object
+) -> tuple[float, int, int, int, int]:
+    """Refuse :func:`occlusion`'s parameters it cannot use, naming them (before: NaN and a negative ``reach`` were
+    taken in silence, a ``reach`` of 10**9 was numpy's MemoryError and a ``band`` of 2.5 a TypeError from slicing);
+    ``(tolerance, reach, pad, band, eroded)`` as a float and ints."""
+    if (
+        isinstance(tolerance, bool)
+        or not isinstance(tolerance, int | float | np.integer | np.floating)
+        or not (-1.0 <= float(tolerance) <= 1.0)
+    ):  # NaN fails the range too
+        raise InputError(f"occlusion: tolerance must be a number of metres in [-1, 1], got {tolerance!r:.40}")
+    for name, value, most in (("reach", reach, MAX_OCCLUSION_PX), ("pad", pad, MAX_IMAGE_SIDE),
+                              ("band", band, MAX_OCCLUSION_PX), ("eroded", eroded, MAX_OCCLUSION_PX)):  # fmt: skip
+        if isinstance(value, bool) or not isinstance(value, int | np.integer) or not 0 <= value <= most:
+            raise InputError(f"occlusion: {name} must be a whole number of pixels from 0 to {most}, got "
+                             f"{value!r:.40}")  # fmt: skip
+    return float(tolerance), int(reach), int(pad), int(band), int(eroded)  # type: ignore[call-overload]
 
 
 def _offsets(reach: int) -> list[tuple[int, int]]:

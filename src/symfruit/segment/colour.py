@@ -848,6 +848,8 @@ def _depth(depth: np.ndarray | None, camera: _Focal | None, shape: tuple[int, in
     if camera is None:
         raise InputError("segment: a camera (fx, fy) is needed with depth")
     try:
+        if any(isinstance(getattr(camera, k, 0.0), str | bytes | bool) for k in ("fx", "fy", "cx", "cy")):
+            raise TypeError  # float() reads "615" as 615 and True as 1 in silence, as symfruit.Camera refuses (stop 43)
         fx, fy = float(camera.fx), float(camera.fy)
         cx, cy = float(getattr(camera, "cx", shape[1] / 2)), float(getattr(camera, "cy", shape[0] / 2))
     except (TypeError, ValueError, AttributeError):  # AttributeError: no camera at all (a path, a mapping)
