@@ -4477,3 +4477,89 @@ def test_the_correlation_along_views_is_scipys_on_lines_of_every_length(n):
         _jit._correlate_line(line, weights, symmetric, out)
         scipy = ndimage.correlate1d(line, weights, mode="reflect")
         np.testing.assert_array_equal(out.view(np.uint64), scipy.view(np.uint64))
+
+
+# --- stop 43, speedcomp43 ---------------------------------------------------------------------------------------
+
+
+def _cloud(kind: int, n: int, rng: np.random.Generator) -> np.ndarray:
+    """A test cloud for the grid's neighbourhoods: 0 a blob, 1 a lattice's whole millimetres (ties everywhere),
+    2 a sphere's near cap, 3 a depth image's pixel grid on three depth steps, 4 points on a line (or one point
+    repeated), 5 two blobs a metre apart; a tenth of the points repeated (ties at distance 0)."""
+    if kind == 0:
+        pts = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    elif kind == 1:
+        pts = rng.integers(0, int(rng.integers(1, 12)), size=(n, 3)).astype(np.float64) * 0.001
+    elif kind == 2:
+        v = rng.normal(size=(n, 3))
+        v /= np.linalg.norm(v, axis=1, keepdims=True)
+        v[:, 2] = -np.abs(v[:, 2])
+        pts = v * 0.04 + np.array([0.01, -0.02, 0.5])
+    elif kind == 3:
+        k = int(np.sqrt(n)) + 1
+        u, w = np.meshgrid(np.arange(k), np.arange(k))
+        pts = np.stack((u.ravel()[:n] * 0.001, w.ravel()[:n] * 0.001, 0.5 + 1e-4 * rng.integers(0, 3, n)), axis=1)
+    elif kind == 4:
+        pts = np.zeros((n, 3))
+        pts[:, 0] = rng.uniform(0.0, 0.1, n) if rng.random() < 0.8 else 0.0
+    else:
+        pts = rng.normal(size=(n, 3)) * 0.001 + rng.choice([0.0, 1.0], size=(n, 1))
+    pts[: n // 10] = pts[n // 10 : 2 * (n // 10)]
+    return np.ascontiguousarray(pts)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 5), st.integers(3, 1200), st.integers(1, 40), st.integers(1, 40),
+       st.booleans())  # fmt: skip
+def test_grid_covariances_are_the_brute_forces_to_the_bit(seed, kind, n, step, large, nan):
+    """The grid's neighbourhoods (grid_covariances, the noise measure's) are the brute force's
+    (neighbour_covariances), bit for bit, on blobs, lattices, caps, pixel grids, lines and far-apart clusters,
+    and within rounding the numpy twin's; a NaN coordinate sends the call to the brute force."""
+    from symfruit.core.fits import _neighbour_covariances
+
+    rng = np.random.default_rng(seed)
+    pts = _cloud(kind, n, rng)
+    if nan:
+        pts[int(rng.integers(n)), int(rng.integers(3))] = np.nan
+    large = min(large, n)
+    small = int(rng.integers(1, large + 1))
+    grid = _jit.grid_covariances(pts, step, small, large)
+    brute = _jit.neighbour_covariances(pts, step, small, large)
+    for a, b in zip(grid, brute, strict=True):
+        assert a.shape == b.shape == (len(pts[::step]), 3, 3)
+        assert a.tobytes() == b.tobytes()
+    if not nan and large >= 2:
+        twin = _neighbour_covariances(pts, step, small, large)
+        for a, b in zip(grid, twin, strict=True):
+            np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
+
+
+def test_grid_covariances_known_neighbourhoods_on_a_line():
+    """Points 1 mm apart on x (a grid of seven cells along it): the three nearest of the first point are the first
+    three (variance 2/3 mm^2 along x), of an inner point itself and its two sides (the same); two nearest of the
+    first: itself and the next (1/4 mm^2)."""
+    pts = np.zeros((10, 3))
+    pts[:, 0] = np.arange(10) * 0.001
+    small, large = _jit.grid_covariances(pts, 4, 2, 3)
+    assert small.shape == large.shape == (3, 3, 3)
+    for q in range(3):
+        assert large[q, 0, 0] == pytest.approx(2e-6 / 3, rel=1e-12)
+        assert np.count_nonzero(large[q]) == 1
+    assert small[0, 0, 0] == pytest.approx(0.25e-6, rel=1e-12)
+    assert small[1, 0, 0] == pytest.approx(0.25e-6, rel=1e-12)  # 4 mm: 3 and 4 or 4 and 5, either a 1 mm pair
+
+
+def test_noise_measures_read_the_grids_neighbourhoods():
+    """noise_measures (the default method's call) on a noisy cap: the same ratio and noise, to the bit, as the least
+    eigenvalues' medians of the brute force's neighbourhoods (the kernel's own arithmetic on them)."""
+    rng = np.random.default_rng(3)
+    pts = _cloud(2, 1000, rng) + rng.normal(scale=5e-4, size=(1000, 3))
+    step, small, large = 8, 8, 30
+    ratio, noise = _jit.noise_measures(pts, step, small, large)
+    cov_small, cov_large = _jit.neighbour_covariances(pts, step, small, large)
+    a = np.empty((3, 3))
+    least_small = np.median([_jit.least_eigenvalue(c, a) for c in cov_small])
+    least_large = np.median([_jit.least_eigenvalue(c, a) for c in cov_large])
+    assert noise == np.sqrt(max(least_small, 0.0))
+    assert ratio == np.sqrt(max(least_large, 0.0)) / max(noise, 1e-15)
+    assert 0.0 < noise < 1e-3 and ratio > 1.0
