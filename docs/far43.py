@@ -185,10 +185,31 @@ def variants(src: Path, pattern: str = "*") -> None:
         sys.stdout.write(f"hidden {occ_:.2f} {'beyond' if far else 'up to'} 1.3 m, {len(v)} views: {cells}\n")
 
 
-if __name__ == "__main__":
-    if sys.argv[1] == "dump":
-        dump(sys.argv[2], sys.argv[3], sys.argv[4], Path(sys.argv[5]))
-    elif sys.argv[1] == "variants":
-        variants(Path(sys.argv[2]), *sys.argv[3:4])
+def main(argv: list[str]) -> None:
+    import argparse
+
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True)
+    d = sub.add_parser("dump", help="the views' inputs, one pickle each")
+    d.add_argument("sensor")
+    d.add_argument("occlusions", help="hidden shares, e.g. 0,0.5")
+    d.add_argument("seeds", help="e.g. 0,1")
+    d.add_argument("folder", type=Path)
+    r = sub.add_parser("run", help="complete the dumped views with this tree")
+    r.add_argument("folder", type=Path)
+    r.add_argument("out", help="CSV to write")
+    r.add_argument("glob", nargs="?")
+    v = sub.add_parser("variants", help="the ideal input under variants")
+    v.add_argument("folder", type=Path)
+    v.add_argument("glob", nargs="?")
+    a = parser.parse_args(argv)
+    if a.command == "dump":
+        dump(a.sensor, a.occlusions, a.seeds, a.folder)
+    elif a.command == "variants":
+        variants(a.folder, *([a.glob] if a.glob else []))
     else:
-        run(Path(sys.argv[2]), sys.argv[3], *sys.argv[4:5])
+        run(a.folder, a.out, *([a.glob] if a.glob else []))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
