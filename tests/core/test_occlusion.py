@@ -404,6 +404,51 @@ def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_is
     assert occlusion(nothing, mask, points, BIG).overshoot is None
 
 
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_curved_fruits_mask_is_not_read_by_sectors(kernels, monkeypatch):
+    """Stop 43: the sectors about the points' centroid give one edge per direction only on a star-shaped silhouette.
+    A fruit curved as a banana seen from the side (an arch 8 px thick), receding from 0.30 to 0.45 m along its length,
+    whose points are its near part (the slab extraction keeps), a 2 px ring without depth round it, the background
+    beyond, a mask 5 px wider all round: read by sectors (the gate off), the arch's own far part (its depth beyond
+    the front plus half the mask's width) is taken for the background seen past, and more than half the arch is
+    cut off; the mask fills under :data:`STAR_SHARE` of its star polygon, so it is not cut. A 3:1 ellipse (convex)
+    with the background seen past all round is still trimmed, to within its ring."""
+    import symfruit.core.occlusion as core_occlusion
+
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    vv, uu = np.mgrid[:60, :80]
+    r = np.hypot(uu - 40, vv - 62)
+    angle = np.degrees(np.arctan2(uu - 40, 62 - vv))
+    arch = (r >= 22) & (r <= 30) & (np.abs(angle) <= 60)
+
+    def view(fruit, fruit_depth, points_at):
+        mask = ndimage.binary_dilation(fruit, iterations=5)
+        ring = ndimage.binary_dilation(fruit, iterations=2) & ~fruit
+        depth = np.full(fruit.shape, 1.0)
+        depth[ring] = 0.0
+        depth[fruit] = fruit_depth
+        rows, cols = np.nonzero(points_at)
+        return depth, mask, BIG.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+
+    recede = 0.3 + 0.15 * (angle[arch] + 60) / 120
+    depth, mask, points = view(arch, recede, arch & (np.where(arch, 0.3 + 0.15 * (angle + 60) / 120, 1) < 0.36))
+    assert occlusion(depth, mask, points, BIG, eroded=0).overshoot is None
+    with monkeypatch.context() as patched:
+        patched.setattr(core_occlusion, "STAR_SHARE", 0.0)
+        occ = occlusion(depth, mask, points, BIG, eroded=0)
+    cut = np.zeros(mask.shape, bool)
+    cut[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+    assert (cut & arch).sum() > 0.5 * arch.sum()  # what the gate keeps from happening
+    ellipse = ((uu - 40) / 21.0) ** 2 + ((vv - 30) / 7.0) ** 2 <= 1.0
+    depth, mask, points = view(ellipse, 0.3, ellipse)
+    occ = occlusion(depth, mask, points, BIG, eroded=0)
+    assert occ.overshoot is not None and occ.seen_past
+    kept = mask.copy()
+    kept[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] &= ~occ.overshoot
+    assert ellipse.sum() < kept.sum() < ndimage.binary_dilation(ellipse, iterations=3).sum()
+
+
 # --- stop 42, speedext42
 
 
