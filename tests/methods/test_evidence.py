@@ -16,6 +16,17 @@ from symfruit.synthetic.shapes import FRUITS, rotation
 from ..conftest import REAL_SCANS, ball_mesh, needs_real_scans, rendered_view
 
 
+def _ball_before_a_wall():
+    """A 70 mm ball 0.5 m before :data:`DEFAULT_CAMERA`, a wall 1 m away behind it: the mesh, the rendering, the
+    ball's pixels and the depth image (0 where nothing was hit)."""
+    from symfruit.synthetic.render import render
+
+    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
+    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
+    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], DEFAULT_CAMERA)
+    return ball, shot, shot.ids == 0, np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+
+
 def test_locates_a_noisy_ball_and_is_confident():
     visible, _ = rendered_view(ball_mesh(), [0.03, 0.02, 0.42], noise=0.01, seed=4)
     r = complete(visible)
@@ -147,14 +158,9 @@ def test_a_time_of_flight_view_without_its_rim_is_still_a_depth_cameras_view():
     seen point). Without both only the raw box was left."""
     from symfruit import Box
     from symfruit.core.occlusion import occlusion
-    from symfruit.synthetic.render import render
 
     cam = DEFAULT_CAMERA
-    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
-    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
-    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
-    mask = shot.ids == 0
-    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    ball, _shot, mask, depth = _ball_before_a_wall()
     rows, cols = np.nonzero(mask)
     yy, xx = np.mgrid[: depth.shape[0], : depth.shape[1]]
     rim = mask & (np.hypot(yy - rows.mean(), xx - cols.mean()) > 0.68 * np.sqrt(mask.sum() / np.pi))
@@ -396,14 +402,9 @@ def test_a_mask_overshooting_onto_a_spread_edge_does_not_widen_the_fruit():
 
     from symfruit import Box
     from symfruit.core.occlusion import occlusion
-    from symfruit.synthetic.render import render
 
     cam = DEFAULT_CAMERA
-    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
-    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
-    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
-    fruit = shot.ids == 0
-    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    ball, _shot, fruit, depth = _ball_before_a_wall()
     rows, cols = np.nonzero(ndimage.binary_erosion(fruit, structure=np.ones((3, 3), bool)))  # extract's erode_px
     points = cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
     mask = ndimage.binary_dilation(fruit, iterations=4)
@@ -427,14 +428,9 @@ def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_do
 
     from symfruit import Box
     from symfruit.core.occlusion import occlusion
-    from symfruit.synthetic.render import render
 
     cam = DEFAULT_CAMERA
-    ball = ball_mesh(0.035).transformed(np.eye(3), np.array([0.02, -0.01, 0.5]))
-    back = np.array([[-3.0, -3.0, 1.0], [3.0, -3.0, 1.0], [3.0, 3.0, 1.0], [-3.0, 3.0, 1.0]])
-    shot = render([(ball.vertices, ball.faces), (back, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
-    fruit = shot.ids == 0
-    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    ball, _shot, fruit, depth = _ball_before_a_wall()
     square = np.ones((3, 3), bool)
     rim = ndimage.binary_dilation(fruit, square, 2) & ~ndimage.binary_erosion(fruit, square, 2)
     depth[rim] = 0.0  # invalidated on both sides of the outline
