@@ -725,6 +725,19 @@ def _scatter(points: np.ndarray, idx: np.ndarray, n: int, out: np.ndarray) -> No
     out[2, 0], out[2, 1], out[2, 2] = c02, c12, c22
 
 
+@_njit_inlined
+def _covariances_at(points: np.ndarray, best_i: np.ndarray, small: int, large: int, scatter: np.ndarray,
+                    out_small: np.ndarray, out_large: np.ndarray, q: int) -> None:  # fmt: skip
+    """Query ``q``'s covariances of its ``small`` and ``large`` nearest (``best_i``, nearest first) into
+    ``out_small[q]`` and ``out_large[q]`` (``scatter`` a (3, 3) scratch): :func:`neighbour_covariances` and
+    :func:`grid_covariances` alike."""
+    for kk, out in ((small, out_small), (large, out_large)):
+        _scatter(points, best_i, kk, scatter)
+        for r in range(3):
+            for c in range(3):
+                out[q, r, c] = scatter[r, c] / kk
+
+
 @_njit
 def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int) -> tuple[np.ndarray, np.ndarray]:
     """:func:`symfruit.core.fits._neighbour_covariances`: for each query point ``points[::step]``, the covariances
@@ -784,11 +797,7 @@ def neighbour_covariances(points: np.ndarray, step: int, small: int, large: int)
                     slot -= 1
                 best_d[slot] = d
                 best_i[slot] = j
-        for kk, out in ((small, out_small), (large, out_large)):
-            _scatter(points, best_i, kk, scatter)
-            for r in range(3):
-                for c in range(3):
-                    out[q, r, c] = scatter[r, c] / kk
+        _covariances_at(points, best_i, small, large, scatter, out_small, out_large, q)
     return out_small, out_large
 
 
@@ -3241,11 +3250,7 @@ def grid_covariances(points: np.ndarray, step: int, small: int, large: int) -> t
                     slot -= 1
                 best_d[slot] = d
                 best_i[slot] = j
-        for kk, out in ((small, out_small), (large, out_large)):
-            _scatter(points, best_i, kk, scatter)
-            for r in range(3):
-                for c in range(3):
-                    out[q, r, c] = scatter[r, c] / kk
+        _covariances_at(points, best_i, small, large, scatter, out_small, out_large, q)
     return out_small, out_large
 
 
