@@ -94,3 +94,47 @@ def test_hidden_apples_tables_of_one_small_apple_tree_frame(tmp_path, monkeypatc
     monkeypatch.setattr(sys, "argv", ["hidden_apples.py", "--frames", str(frames), "--seeds", "5"])
     with pytest.raises(SystemExit, match="not seed 5's apple-tree frame"):
         hidden.main()
+
+
+def _slab44():
+    import importlib.util
+
+    spec = importlib.util.spec_from_file_location("slab44", DOCS / "slab44.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def test_slab44_classes_points_on_an_apple_behind_it_and_in_front_of_it():
+    """``slab44.point_classes``: points on a 70 mm ball's surface (and 5 mm off it) are the fruit's; a leaf 3 cm
+    behind its back, beside it, is behind; a point off the ball on its near side is in front."""
+    import numpy as np
+
+    sl = _slab44()
+    centre, size = np.array([0.1, 0.0, 1.4]), np.full(3, 0.07)
+    rng = np.random.default_rng(0)
+    d = rng.normal(size=(200, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    surface = centre + 0.035 * d
+    outside = centre + 0.040 * d  # 5 mm off: within the 6 mm margin
+    foreign = np.array([[0.1, 0.0, 1.4 + 0.035 + 0.03], [0.1 + 0.05, 0.0, 1.41], [0.1 + 0.05, 0.0, 1.39]])
+    on, behind, front = sl.point_classes(np.vstack([surface, outside, foreign]), centre, size)
+    assert on[:400].all() and not on[400:].any()
+    assert behind[400:].tolist() == [True, True, False] and front[400:].tolist() == [False, False, True]
+    assert not (on & behind).any() and not (on & front).any() and (on | behind | front).all()
+
+
+def test_slab44_spur_leaves_lie_around_an_apple_at_its_own_depth():
+    """``slab44.spur_leaf_centres``: 1.0-1.6 radii from the apple's centre across the line of sight, -0.3 to +1.0
+    radii along it; seeded."""
+    import numpy as np
+
+    sl = _slab44()
+    centre = np.array([0.2, -0.1, 1.5])
+    c = sl.spur_leaf_centres(centre, 0.04, 500, np.random.default_rng(3))
+    across = np.linalg.norm(c[:, :2] - centre[:2], axis=1)
+    along = c[:, 2] - centre[2]
+    assert c.shape == (500, 3)
+    assert across.min() >= 0.04 - 1e-12 and across.max() <= 0.064 + 1e-12 and np.ptp(across) > 0.02
+    assert along.min() >= -0.012 - 1e-12 and along.max() <= 0.04 + 1e-12
+    assert np.array_equal(c, sl.spur_leaf_centres(centre, 0.04, 500, np.random.default_rng(3)))
