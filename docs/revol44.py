@@ -1,7 +1,7 @@
 """Stop 44's measurements for issue 18's elliptic sections (docs/revol44.md): nothing here changes the library.
 
     python docs/revol44.py synthetic
-    python docs/revol44.py run RATIO|cone BOXES.csv evaluate ARGS...
+    python docs/revol44.py run RATIO|cone|three BOXES.csv evaluate ARGS...
     python docs/revol44.py table RESULTS_DIR [RESULTS_DIR ...]
 
 ``synthetic`` fits :func:`~symfruit.core.fits.fit_revolution_slices` to the front of ellipsoids of revolution about
@@ -10,9 +10,10 @@ prints the solid's back face against the truth's with circles and with the true 
 robust RMS over a grid of ratios (what the view's own fit can tell). ``run`` is docs/eval_boxes.py's ``run`` with
 every solid of revolution of ``evidence`` fitted at a fixed section ratio (``RATIO``), or at the ratio of the
 ``cone`` ellipsoid's depth to its width across the solid's axis (``cone``, clipped to 0.7-1.3; the axis nearer the
-image plane than the line of sight). ``table`` prints per kind mean IoU / centre error (mm) / views over 10 mm of
-``evidence`` in each run's ``instances.csv`` and, for two runs or more, of the per-view best (the oracle: each view
-the run whose centre is nearest). Run with ``PYTHONPATH=TREE/src`` from the repository's root.
+image plane than the line of sight), or (``three``) with two more solids of revolution beside the circular one, at
+ratios 0.85 and 1.15, left to the evidence's weights. ``table`` prints per kind mean IoU / centre error (mm) /
+views over 10 mm of ``evidence`` in each run's ``instances.csv`` and, for two runs or more, of the per-view best (the
+oracle: each view the run whose centre is nearest). Run with ``PYTHONPATH=TREE/src`` from the repository's root.
 """
 
 from __future__ import annotations
@@ -83,6 +84,20 @@ def _cone_ratio(fit, rev) -> float:  # type: ignore[no-untyped-def]
 def _patch(mode: str) -> None:
     import symfruit.core.candidates as cands
 
+    if mode == "three":
+        plain = cands._revolution
+
+        def three(fit) -> Iterator:  # type: ignore[no-untyped-def]
+            yield from plain(fit)
+            for ratio in (0.85, 1.15):
+                rev = cands.fit_revolution_slices(fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)],
+                                                  extra_directions=np.vstack(fit.axes) if fit.axes else None,
+                                                  coarse=fit.revolution_coarse, ratio=ratio)  # fmt: skip
+                lo, hi, t, r = cands.box_and_profile(rev)
+                yield cands._Shape("revolution", lo, hi, cands.RevolutionInside(rev, profile=(t, r)), 0.5 * (lo + hi))
+
+        cands._FITTERS["revolution"] = (three, cands._FITTERS["revolution"][1])
+        return
     if mode != "cone":
         cands.fit_revolution_slices = functools.partial(cands.fit_revolution_slices, ratio=float(mode))  # type: ignore[assignment]
         return
