@@ -262,6 +262,47 @@ def test_an_end_still_widening_is_closed_by_symmetry():
     assert len(closed_profile(lemon)[0]) == 4
 
 
+def _squashed(cloud: np.ndarray, ratio: float) -> np.ndarray:
+    """``cloud`` squashed about :data:`CENTRE` by ``ratio`` along the line of sight to it (issue 18, stop 44)."""
+    deep = CENTRE / np.linalg.norm(CENTRE)
+    rel = cloud - CENTRE
+    return CENTRE + rel + np.outer((ratio - 1.0) * (rel @ deep), deep)
+
+
+@pytest.mark.parametrize("ratio", [0.8, 1.2])
+def test_slice_revolution_with_the_sections_ratio_is_the_squashed_solids(ratio):
+    """An egg of elliptic sections (the egg about y squashed along the line of sight): fitted with the ratio, the
+    solid's box is the whole egg's and its seen points lie on it; fitted with circles, its back is off by about
+    ``(a^2 - b^2) / b`` (stop 43, docs/pear43.md)."""
+    whole = _squashed(revolution_cloud(), ratio)
+    visible = _squashed(front_half(revolution_cloud()), ratio)
+    rev = fit_revolution_slices(visible, ratio=ratio)
+    assert rev.ratio == ratio and rev.deep is not None and np.sqrt(rev.cost) < 5e-4
+    lo, hi = revolution_box(rev)
+    np.testing.assert_allclose(lo, whole.min(axis=0), atol=1.5e-3)
+    np.testing.assert_allclose(hi, whole.max(axis=0), atol=1.5e-3)
+    assert np.abs(np.median(revolution_inside(rev, visible))) < 5e-4
+    assert revolution_inside(rev, CENTRE) > 0.01
+    _, hi_circles = revolution_box(fit_revolution_slices(visible))
+    assert abs(hi_circles[2] - whole[:, 2].max()) > 3e-3
+
+
+def test_a_squashed_revolutions_box_holds_its_inside():
+    """Rings squashed by 1/2 along z about an axis along y: the box is as deep as half the radius; every point the
+    inside test calls inside lies in the box, and the box's depth is reached."""
+    edges = np.linspace(-0.02, 0.02, 5)
+    rev = Revolution(np.array([0.0, 0.0, 0.4]), np.array([0.0, 1.0, 0.0]), edges, np.array([0.01, 0.02, 0.02, 0.01]),
+                     0.0, 0.5, np.array([0.0, 0.0, 1.0]))  # fmt: skip
+    lo, hi = revolution_box(rev, close=False)
+    t, r = closed_profile(rev, close=False)
+    np.testing.assert_allclose(hi - lo, [2 * r.max(), t[-1] - t[0], r.max()], atol=1e-12)
+    x = np.random.default_rng(1).uniform(lo - 0.01, hi + 0.01, (20000, 3))
+    inside = revolution_inside(rev, x, close=False) > 0
+    assert inside.sum() > 1000
+    assert (x[inside] >= lo - 1e-12).all() and (x[inside] <= hi + 1e-12).all()
+    assert x[inside][:, 2].max() > hi[2] - 1e-3 and x[inside][:, 0].max() > hi[0] - 1e-3
+
+
 def test_a_far_end_short_of_the_widest_by_less_than_the_fits_rms_is_still_widening():
     """The rim's slice of a fruit seen end-on reads a little narrower than the one before it (issue 18, stop 42):
     within the fit's own RMS of the widest it is the widest ring seen edge-on, and the unseen half is the mirror

@@ -4563,3 +4563,40 @@ def test_noise_measures_read_the_grids_neighbourhoods():
     assert noise == np.sqrt(max(least_small, 0.0))
     assert ratio == np.sqrt(max(least_large, 0.0)) / max(noise, 1e-15)
     assert 0.0 < noise < 1e-3 and ratio > 1.0
+
+
+# --- stop 44, revol44
+
+
+@given(st.integers(0, 2**32 - 1), st.sampled_from([0.7, 0.85, 1.25]), st.booleans())
+def test_a_squashed_revolution_marches_and_boxes_as_its_twins(seed, ratio, close):
+    """Issue 18, stop 44: a solid of revolution squashed along the line of sight (elliptic sections) is marched by
+    the kernel on its rays and axis mapped into the circular solid; the numpy twin marches its inside test. The same
+    hits and depths; :func:`box_and_profile` (the kernel's profile, the squashed rings' box) is its twin's."""
+    import dataclasses
+
+    from symfruit.core.agreement import march
+    from symfruit.core.fits import RevolutionInside, box_and_profile
+
+    circles, visible = _lemon_revolution(seed % 4)
+    centre = visible.mean(axis=0)
+    rev = dataclasses.replace(circles, ratio=ratio, deep=centre / np.linalg.norm(centre))
+    rng = np.random.default_rng(seed)
+    rays = np.c_[centre[:2] / centre[2] + rng.normal(0.0, 0.08, (200, 2)), np.ones(200)]
+    z0, z1 = float(visible[:, 2].min()) - 0.03, float(visible[:, 2].max()) + 0.05
+    inside = RevolutionInside(rev, close=close)
+    marched = inside.march(rays, z0, z1, steps=24)
+    assert marched is not None
+    hit, depth = marched
+    hit_twin, depth_twin = march(inside, rays, z0, z1, steps=24)
+    assert np.array_equal(hit, hit_twin) and hit.any() and not hit.all()
+    np.testing.assert_allclose(depth[hit], depth_twin[hit], atol=1e-12)
+    plain = march(RevolutionInside(circles, close=close), rays, z0, z1, steps=24)
+    assert not np.array_equal(plain[1][hit], depth[hit])  # the squash moved the surface
+    mp = pytest.MonkeyPatch()
+    try:
+        fast, twin = _both(mp, box_and_profile, rev, close=close)
+    finally:
+        mp.undo()
+    for a, b in zip(fast, twin, strict=True):
+        np.testing.assert_array_equal(a, b)

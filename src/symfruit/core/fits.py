@@ -475,10 +475,18 @@ def fit_revolution(points: np.ndarray, normals: np.ndarray, *, bins: int = 24) -
     return Box(lo, hi), a0, d
 
 
-def _rings_box(point: np.ndarray, direction: np.ndarray, t: np.ndarray, r: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _rings_box(point: np.ndarray, direction: np.ndarray, t: np.ndarray, r: np.ndarray, ratio: float = 1.0,
+               deep: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Axis-aligned box ``(min, max)`` of rings of radius ``r`` (k,) centred on ``point + t direction`` (k,)
-    in the planes perpendicular to ``direction`` (unit): a ring spans ``r sqrt(1 - d_i^2)`` along axis ``i``."""
-    spread = np.sqrt(np.clip(1.0 - direction**2, 0.0, None))
+    in the planes perpendicular to ``direction`` (unit): a ring spans ``r sqrt(1 - d_i^2)`` along axis ``i``. With
+    ``ratio`` other than 1 and ``deep`` (unit), the rings and their axis squashed about ``point`` by ``ratio`` along
+    ``deep`` (the map ``S = I + (ratio - 1) deep deep^T``; see :class:`Revolution`): ring centres ``point + t S
+    direction``, each an ellipse spanning ``r sqrt((S^2)_ii - (S direction)_i^2)`` along axis ``i``."""
+    if ratio != 1.0 and deep is not None:
+        direction = _squash(direction, deep, ratio)
+        spread = np.sqrt(np.clip(1.0 + (ratio * ratio - 1.0) * deep**2 - direction**2, 0.0, None))
+    else:
+        spread = np.sqrt(np.clip(1.0 - direction**2, 0.0, None))
     centres = point[None, :] + t[:, None] * direction[None, :]
     return (centres - r[:, None] * spread).min(axis=0), (centres + r[:, None] * spread).max(axis=0)
 
@@ -500,6 +508,13 @@ class Revolution:
         Radius of each slice (NaN where a slice had fewer than 3 points).
     cost : float, metres^2
         Robust mean squared distance of the points to their slice circles.
+    ratio : float
+        The solid is this solid of revolution (circular sections) squashed about ``point`` by ``ratio`` along
+        ``deep``: the map ``x -> point + S (x - point)``, ``S = I + (ratio - 1) deep deep^T`` (1: none). With the
+        axis across ``deep`` every section is an ellipse, ``radii[j]`` across and ``ratio radii[j]`` along ``deep``
+        (issue 18, stop 44, docs/revol44.md). ``direction``, ``edges`` and ``radii`` are the circular solid's.
+    deep : (3,) float, unit, optional
+        The direction squashed (the line of sight to the fitted points' centre; None when ``ratio`` is 1).
     """
 
     point: np.ndarray
@@ -507,6 +522,8 @@ class Revolution:
     edges: np.ndarray
     radii: np.ndarray
     cost: float
+    ratio: float = 1.0
+    deep: np.ndarray | None = None
 
 
 def _slice_costs(q: np.ndarray, dirs: np.ndarray, bins: int) -> np.ndarray:
@@ -676,6 +693,7 @@ def fit_revolution_slices(
     gauss_newton_steps: int = 5,
     search_points: int = 240,
     coarse: int = 64,
+    ratio: float = 1.0,
 ) -> Revolution:
     """Fit a solid of revolution to points seen from one side, without normals.
 
@@ -704,6 +722,11 @@ def fit_revolution_slices(
         The direction search uses an evenly spread subset of at most this many points.
     coarse : int
         Directions of the coarse stage over the hemisphere (about; 0: ``extra_directions`` only).
+    ratio : float
+        The sections' depth over their width: the solid is fitted to the points stretched by ``1 / ratio`` along
+        the line of sight to their centre (the camera at the origin) and squashed back (:class:`Revolution`'s
+        ``ratio`` and ``deep``); 1: circular sections, the fit as before (issue 18, stop 44: the view's own fit
+        cannot tell the ratio, docs/revol44.md, so nothing in the library sets it).
 
     Returns
     -------
@@ -721,6 +744,9 @@ def fit_revolution_slices(
         raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
     centre = column_means(pts)
     q = pts - centre
+    deep = centre / max(float(np.linalg.norm(centre)), 1e-12) if ratio != 1.0 else None  # the line of sight
+    if deep is not None:  # the circular solid is fitted to the points stretched along it
+        q = _squash(q, deep, 1.0 / ratio)
     qs = q[:: max(1, len(q) // search_points)]
     dirs = _COARSE if coarse == 64 else _hemisphere(coarse) if coarse > 0 else np.empty((0, 3))
     if extra_directions is not None:
@@ -745,7 +771,10 @@ def fit_revolution_slices(
     a2, edges, radii, cost = found[0], found[1], found[2], float(found[3])
     axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
     edges = edges + float(centre @ best - axis_point @ best)
-    return Revolution(axis_point, best, edges, radii, cost)
+    if deep is None:
+        return Revolution(axis_point, best, edges, radii, cost)
+    # Fitted to the points stretched along the line of sight: the solid is that fit squashed back about the centre
+    return Revolution(centre + _squash(axis_point - centre, deep, ratio), best, edges, radii, cost, ratio, deep)
 
 
 def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], camera: Camera,
@@ -772,8 +801,9 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
         occluder's edge, not the outline: that slice gets no radius.
     """
     mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
-    c = rev.point[None, :] + mid[:, None] * rev.direction[None, :]  # (b, 3)
-    e = cross_rows(rev.direction, c)
+    axis = rev.direction if rev.ratio == 1.0 or rev.deep is None else _squash(rev.direction, rev.deep, rev.ratio)
+    c = rev.point[None, :] + mid[:, None] * axis[None, :]  # (b, 3)
+    e = cross_rows(axis, c)
     e /= np.maximum(row_norms(e), 1e-12)[:, None]
     uc = camera.project(c)
     du = camera.project(c + 1e-3 * e) - uc
@@ -872,9 +902,23 @@ def box_and_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray,
             np.ascontiguousarray(rev.edges, dtype=np.float64), np.ascontiguousarray(rev.radii, dtype=np.float64),
             bool(close), _flat(rev),
         )  # fmt: skip
+        if rev.ratio != 1.0 and rev.deep is not None:  # elliptic sections: the same profile, their box
+            lo, hi = _rings_box(rev.point, rev.direction, t, r, rev.ratio, rev.deep)
         return lo, hi, t, r
     t, r = closed_profile(rev, close=close)
-    return (*_rings_box(rev.point, rev.direction, t, r), t, r)
+    return (*_rings_box(rev.point, rev.direction, t, r, rev.ratio, rev.deep), t, r)
+
+
+def _squash(x: np.ndarray, deep: np.ndarray, ratio: float) -> np.ndarray:
+    """Vectors ``x`` (n, 3) (or (3,)) with their component along ``deep`` (unit) times ``ratio``."""
+    along = x @ deep
+    return x + np.multiply.outer((ratio - 1.0) * along, deep)
+
+
+def _unsquash(rev: Revolution, x: np.ndarray) -> np.ndarray:
+    """Vectors ``x`` (n, 3) from ``rev.point`` mapped into the solid of circular sections ``rev`` was fitted as: their
+    component along ``rev.deep`` divided by ``rev.ratio``."""
+    return _squash(x, np.asarray(rev.deep, dtype=np.float64), 1.0 / rev.ratio)
 
 
 def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> np.ndarray:
@@ -890,6 +934,8 @@ def revolution_inside(rev: Revolution, x: np.ndarray, *, close: bool = True) -> 
     rel = np.empty_like(flat)
     for c in range(3):  # three components, not a loop over points
         np.subtract(flat[:, c], rev.point[c], out=rel[:, c])
+    if rev.ratio != 1.0 and rev.deep is not None:  # elliptic sections: measured in the circular solid they map to
+        rel = _unsquash(rev, rel)
     t = rel @ rev.direction
     off = [rel[:, c] - t * rev.direction[c] for c in range(3)]
     total = off[0] * off[0] + off[1] * off[1]  # as row_norms: numpy sums the three squares left to right
@@ -921,9 +967,14 @@ class RevolutionInside:
         if jit is None:
             return None
         t, r = closed_profile(self.rev, close=self.close) if self.profile is None else self.profile
+        point = np.asarray(self.rev.point, dtype=np.float64)
+        if self.rev.ratio != 1.0 and self.rev.deep is not None:
+            # Elliptic sections: the rays and the axis point mapped (a linear map: the ray z * ray goes to
+            # z * unsquashed ray) into the circular solid, where the kernel marches the same depths z.
+            point, rays = _unsquash(self.rev, point[None, :])[0], _unsquash(self.rev, np.asarray(rays, np.float64))
         return jit.revolution_march(
-            np.ascontiguousarray(self.rev.point, dtype=np.float64), np.ascontiguousarray(self.rev.direction,
-            dtype=np.float64), np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(r, dtype=np.float64),
+            np.ascontiguousarray(point), np.ascontiguousarray(self.rev.direction, dtype=np.float64),
+            np.ascontiguousarray(t, dtype=np.float64), np.ascontiguousarray(r, dtype=np.float64),
             np.ascontiguousarray(rays, dtype=np.float64), float(z0), float(z1), int(steps),
         )  # fmt: skip
 
