@@ -518,11 +518,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
     spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
     if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
-        past = None
-        if focal > 0:
-            front_of = np.zeros(own.shape, bool)  # what lies clearly in front of the fruit in the mask's band
-            front_of[band] = ahead
-            past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance, front_of)
+        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
         return past, past is not None
     drop = beyond.copy()
     drop[band] = ~ahead  # all but what lies clearly in front
@@ -546,8 +542,7 @@ STAR_SHARE = 0.9
 
 
 def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarray, points: np.ndarray,
-               focal: float, eroded: int, tolerance: float, ahead: np.ndarray | None = None,
-               sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
+               focal: float, eroded: int, tolerance: float, sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
     """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge where the
     camera saw past the fruit nearly all round it (None: not so, or nothing beyond).
 
@@ -557,14 +552,12 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     beyond extraction's slab (a banana's far end, a pear's body seen end-on past its neck) steps in depth by what a
     surface can per pixel, the background seen past a silhouette lies a step behind it. About the points' centroid,
     in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's last depth) and the nearest pixel
-    seen past. Between the two the camera returned nothing: the
-    mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
-    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where the camera also loses the grazing
-    rim inside the edge, halfway lies inside it by half the difference: docs/treeover43.md); a sector where
-    nothing was seen past takes its neighbours' edge (periodic interpolation), but for one whose band holds
-    something clearly in front of the fruit (``ahead``, two pixels or more): the mask's border there is the
-    occluder's, and it is kept. Nearly all round: no third of the outline without a sector seen past. A mask an
-    annotator or a model drew too wide overshoots all round; a depth camera seeing past one side of a fruit (its
+    seen past. Between the two the camera returned nothing: the mixed pixels a time-of-flight camera invalidates on
+    both sides of an edge (AK-DEPTH, ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where
+    the camera also loses the grazing rim inside the edge, halfway lies inside it by half the difference:
+    docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic interpolation).
+    Nearly all round: no third of the outline without a sector seen past. A mask an annotator or a model drew too
+    wide overshoots all round; a depth camera seeing past one side of a fruit (its
     baseline to the colour camera, a registration a few pixels off) is one side, and the mask there is kept (the
     shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the points is never
     cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid (stop 43's gate
@@ -585,14 +578,13 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     ang = np.arctan2(vv - r0, uu - c0)
     sec = np.minimum(((ang + np.pi) / (2 * np.pi) * sectors).astype(np.intp), sectors - 1)
     rad = np.hypot(vv - r0, uu - c0)
-    is_joined, is_past, is_own = joined[vv, uu], past[vv, uu], own[vv, uu]
+    is_joined, is_past, is_seen = joined[vv, uu], past[vv, uu], seen[vv, uu]
     if STAR_SHARE > 0:
         reach = np.zeros(sectors)  # the star polygon of the mask: its farthest pixel (its outer side) in each sector
-        np.maximum.at(reach, sec[is_own], rad[is_own] + 0.5)
+        np.maximum.at(reach, sec, rad + 0.5)
         if np.count_nonzero(own) < STAR_SHARE * 0.5 * float(reach @ reach) * (2 * np.pi / sectors):
             return None  # not star-shaped about the centroid: sectors do not give one edge per direction
     last = np.full(sectors, -np.inf)
-    is_seen = seen[vv, uu]
     np.maximum.at(last, sec[is_seen], rad[is_seen])
     first = np.full(sectors, np.inf)
     np.minimum.at(first, sec[is_past], rad[is_past])
@@ -604,14 +596,8 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
         return None
     centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
     edge = np.interp(centre, centre[both], 0.5 * (last[both] + first[both]), period=2 * np.pi)
-    if OCCLUDER and ahead is not None and ahead.any():
-        # a sector where the mask's band holds something in front of the fruit and nothing seen past: the mask's
-        # border there is an occluder's, not the fruit's outline; no edge is carried across it from its neighbours
-        va, ua = np.nonzero(ahead)
-        sa = np.minimum(((np.arctan2(va - r0, ua - c0) + np.pi) / (2 * np.pi) * sectors).astype(np.intp), sectors - 1)
-        edge[(np.bincount(sa, minlength=sectors) >= 2) & ~both] = np.inf
     drop = np.zeros(own.shape, bool)
-    out = is_own & ~is_joined & (rad > edge[sec])
+    out = ~is_joined & (rad > edge[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
@@ -622,8 +608,6 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
 #: footprint (the tangent of the angle between the surface and the image plane): 4.9 at ``|cos| = 0.2`` between ray
 #: and normal, where ``symfruit.synthetic.sensors`` has half the pixels return nothing (its ``grazing`` judgement).
 SLOPE = 5.0
-
-OCCLUDER = True
 
 
 def _joined(own: np.ndarray, seen: np.ndarray, d: np.ndarray, focal: float, tolerance: float) -> np.ndarray:
@@ -641,11 +625,15 @@ def _joined(own: np.ndarray, seen: np.ndarray, d: np.ndarray, focal: float, tole
     z = d[b0:b1, a0:a1]
     with np.errstate(invalid="ignore"):
         ok = np.isfinite(z) & (z > 0)
-    z = np.pad(np.where(ok, z, np.inf), 1, constant_values=np.inf)
-    nearer = np.minimum(np.minimum(z[:-2], z[1:-1]), z[2:])  # the least depth of the 3x3 neighbourhood
-    nearer = np.minimum(np.minimum(nearer[:, :-2], nearer[:, 1:-1]), nearer[:, 2:])
+    z = np.where(ok, z, np.inf)
+    rows = z.copy()  # the least depth of the 3x3 neighbourhood: of three rows, then of three columns
+    np.minimum(rows[1:], z[:-1], out=rows[1:])
+    np.minimum(rows[:-1], z[1:], out=rows[:-1])
+    nearer = rows.copy()
+    np.minimum(nearer[:, 1:], rows[:, :-1], out=nearer[:, 1:])
+    np.minimum(nearer[:, :-1], rows[:, 1:], out=nearer[:, :-1])
     with np.errstate(invalid="ignore"):
-        step = z[1:-1, 1:-1] - nearer > tolerance + SLOPE * nearer / focal  # inf - inf: NaN, False
+        step = z - nearer > tolerance + SLOPE * nearer / focal  # inf - inf: NaN, False
     mine = seen[b0:b1, a0:a1]
     way = (ok & ~step & own[b0:b1, a0:a1]) | mine
     labels, n = ndimage.label(way, structure=np.ones((3, 3), bool))
