@@ -473,9 +473,10 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
       pixels; the shared Azure Kinect frames lose the outer 13 % of every sphere's radius), and the background
       where the depth camera sees past the edge (its baseline to the colour camera) or the mask overshoots. Where
       the camera saw past the fruit (a pixel farther than the fruit's front plus half the mask's width: behind
-      the outline of a round fruit that wide) nearly all round the outline, the mask beyond the fruit's edge there
-      is the overshoot (:func:`_seen_past`, ``focal``: the camera's focal length in pixels; stop 43,
-      docs/treeover43.md); elsewhere the mask is the only measure of the fruit's width, and nothing is taken off;
+      the outline of a round fruit that wide; and not joined to its points by a continuous surface, stop 44)
+      nearly all round the outline, the mask beyond the fruit's edge there is the overshoot (:func:`_seen_past`,
+      ``focal``: the camera's focal length in pixels; stop 43, docs/treeover43.md); elsewhere the mask is the
+      only measure of the fruit's width, and nothing is taken off;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
       pixels (its rim beside the band, where the surface recedes) but not by ``tolerance`` nearer than the nearest
@@ -545,37 +546,44 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge where the
     camera saw past the fruit nearly all round it (None: not so, or nothing beyond).
 
-    About the points' centroid, in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's last
-    depth) and the nearest mask pixel seen past the fruit (farther than its front plus half the mask's width, the
-    depth of a round fruit's outline were it as wide as the mask, plus ``tolerance``). Between the two the camera
-    returned nothing: the mixed pixels a time-of-flight camera invalidates on both sides of an edge (AK-DEPTH,
-    ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where the camera also loses the grazing
-    rim inside the edge, halfway lies inside it by half the difference: the rendered apple trees lose 3.5-6 px inside
-    and 2 outside, docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic
-    interpolation). Nearly all round: no third of the outline without a sector seen past. A mask an annotator or
-    a model drew too wide overshoots all round; a depth camera seeing past one side of a fruit (its baseline to the
-    colour camera, a registration a few pixels off) is one side, and the mask there is kept (the shared lab
-    spheres leave 180-315 degrees without: docs/treeover43.md). Only on a star-shaped mask (:data:`STAR_SHARE`):
-    a curved fruit's silhouette is not read by sectors about its centroid: the far part of a banana receding beyond
-    extraction's slab reads as the background seen past it (the real banana scan through the Azure Kinect model: its
-    larger lateral side -0.0 -> -10.5 mm on average without this gate, docs/ablation.md).
+    Seen past: a pixel of the mask's band (``band``) farther than the fruit's front plus half the mask's width (the
+    depth of a round fruit's outline were it as wide as the mask) plus ``tolerance``, and not joined to the fruit's
+    points by a continuous surface (:func:`_joined`, stop 44, docs/guard44.md): a fruit's own surface receding
+    beyond extraction's slab (a banana's far end, a pear's body seen end-on past its neck) steps in depth by what a
+    surface can per pixel, the background seen past a silhouette lies a step behind it. About the points' centroid,
+    in each of ``sectors`` angular sectors: the farthest point pixel (the fruit's last depth) and the nearest pixel
+    seen past. Between the two the camera returned nothing: the mixed pixels a time-of-flight camera invalidates on
+    both sides of an edge (AK-DEPTH, ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where
+    the camera also loses the grazing rim inside the edge, halfway lies inside it by half the difference:
+    docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic interpolation).
+    Nearly all round: no third of the outline without a sector seen past. A mask an annotator or a model drew too
+    wide overshoots all round; a depth camera seeing past one side of a fruit (its
+    baseline to the colour camera, a registration a few pixels off) is one side, and the mask there is kept (the
+    shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the points is never
+    cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid (stop 43's gate
+    for curved fruit, before the surface test).
     """
     front = float(points[:, 2].min())
     half = 0.5 * np.sqrt(4.0 * np.count_nonzero(own) / np.pi) * front / focal  # the mask's half-width, metres
     past = band & (np.where(band, d, 0.0) > front + half + tolerance)
     if not past.any():
         return None
+    joined = _joined(own, seen, d, focal, tolerance)
+    past &= ~joined
+    if not past.any():
+        return None
     rs, cs = np.nonzero(seen)
     r0, c0 = rs.mean(), cs.mean()
-    vv, uu = np.nonzero(own | past)
+    vv, uu = np.nonzero(own)  # past lies in the mask's band
     ang = np.arctan2(vv - r0, uu - c0)
     sec = np.minimum(((ang + np.pi) / (2 * np.pi) * sectors).astype(np.intp), sectors - 1)
     rad = np.hypot(vv - r0, uu - c0)
-    is_seen, is_past, is_own = seen[vv, uu], past[vv, uu], own[vv, uu]
-    reach = np.zeros(sectors)  # the star polygon of the mask: its farthest pixel (its outer side) in each sector
-    np.maximum.at(reach, sec[is_own], rad[is_own] + 0.5)
-    if np.count_nonzero(own) < STAR_SHARE * 0.5 * float(reach @ reach) * (2 * np.pi / sectors):
-        return None  # not star-shaped about the centroid: sectors do not give one edge per direction
+    is_joined, is_past, is_seen = joined[vv, uu], past[vv, uu], seen[vv, uu]
+    if STAR_SHARE > 0:
+        reach = np.zeros(sectors)  # the star polygon of the mask: its farthest pixel (its outer side) in each sector
+        np.maximum.at(reach, sec, rad + 0.5)
+        if np.count_nonzero(own) < STAR_SHARE * 0.5 * float(reach @ reach) * (2 * np.pi / sectors):
+            return None  # not star-shaped about the centroid: sectors do not give one edge per direction
     last = np.full(sectors, -np.inf)
     np.maximum.at(last, sec[is_seen], rad[is_seen])
     first = np.full(sectors, np.inf)
@@ -589,11 +597,50 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
     edge = np.interp(centre, centre[both], 0.5 * (last[both] + first[both]), period=2 * np.pi)
     drop = np.zeros(own.shape, bool)
-    out = is_own & ~is_seen & (rad > edge[sec])
+    out = ~is_joined & (rad > edge[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
     return drop if drop.any() else None
+
+
+#: The steepest a fruit's own surface is read at by a time-of-flight camera, as depth per pixel over the pixel's
+#: footprint (the tangent of the angle between the surface and the image plane): 4.9 at ``|cos| = 0.2`` between ray
+#: and normal, where ``symfruit.synthetic.sensors`` has half the pixels return nothing (its ``grazing`` judgement).
+SLOPE = 5.0
+
+
+def _joined(own: np.ndarray, seen: np.ndarray, d: np.ndarray, focal: float, tolerance: float) -> np.ndarray:
+    """The pixels of the mask ``own`` with depth joined to the fruit's points' pixels (``seen``) by a continuous
+    surface: reached from them through pixels with depth, none farther than a neighbour with depth by more than a
+    surface can step over a pixel (:data:`SLOPE` times the pixel's footprint at the nearer depth, plus
+    ``tolerance`` for the noise). A fruit's own surface beyond extraction's slab (a banana's far end) is so joined;
+    the background the camera saw past a silhouette is not: the first pixel of it beside the fruit, or beside a
+    flying pixel between the two, lies a step farther (a neighbour with no depth joins nothing)."""
+    box = mask_box(own | seen)
+    out = np.zeros(own.shape, bool)
+    if box is None:
+        return out
+    b0, b1, a0, a1 = box
+    z = d[b0:b1, a0:a1]
+    with np.errstate(invalid="ignore"):
+        ok = np.isfinite(z) & (z > 0)
+    z = np.where(ok, z, np.inf)
+    rows = z.copy()  # the least depth of the 3x3 neighbourhood: of three rows, then of three columns
+    np.minimum(rows[1:], z[:-1], out=rows[1:])
+    np.minimum(rows[:-1], z[1:], out=rows[:-1])
+    nearer = rows.copy()
+    np.minimum(nearer[:, 1:], rows[:, :-1], out=nearer[:, 1:])
+    np.minimum(nearer[:, :-1], rows[:, 1:], out=nearer[:, :-1])
+    with np.errstate(invalid="ignore"):
+        step = z - nearer > tolerance + SLOPE * nearer / focal  # inf - inf: NaN, False
+    mine = seen[b0:b1, a0:a1]
+    way = (ok & ~step & own[b0:b1, a0:a1]) | mine
+    labels, n = ndimage.label(way, structure=np.ones((3, 3), bool))
+    keep = np.zeros(n + 1, bool)
+    keep[labels[mine]] = True  # the pieces holding a point pixel (none is 0: ``mine`` lies in ``way``)
+    out[b0:b1, a0:a1] = keep[labels]
+    return out
 
 
 def own_edge(
