@@ -14,6 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
+from . import lapack
 from .box import Box
 from .camera import Camera
 from .fits import _plain, eigenvalues2, solve2
@@ -616,7 +617,7 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     if (jit := compiled()) is not None:  # the compiled twin of what follows but the eigh: the same values
         intrinsics = (float(camera.cx), float(camera.cy), float(camera.fx), float(camera.fy))
         axis, basis, carried = jit.across_frame(float(mu[0]), float(mu[1]), cov, *intrinsics)
-        _, vec = np.linalg.eigh(carried)
+        _, vec = lapack.eigh(carried)
         lo, hi, minor, major = jit.across_extent(outline_cracks(region), axis, basis, np.ascontiguousarray(vec),
                                                  *intrinsics)  # fmt: skip
         return Across(axis, basis, lo, hi, float(minor), float(major))
@@ -646,7 +647,7 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
     k = camera.matrix
     cone = k.T @ conic @ k
     axis = camera.rays(centre[0], centre[1])
-    return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
+    return cone / np.abs(lapack.eigvalsh(cone)).max(), axis
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
@@ -718,16 +719,15 @@ def outline_cone(
     d2[:, 0], d2[:, 1] = x, y
     s1, s2, s3 = d1.T @ d1, d1.T @ d2, d2.T @ d2
     try:
-        t = -np.linalg.solve(s3, s2.T)
+        t = -lapack.solve(s3, s2.T)
     except np.linalg.LinAlgError:
         return None
     m = s1 + s2 @ t
     m = np.array([m[2] / 2.0, -m[1], m[0] / 2.0])
     try:
-        _, vecs = np.linalg.eig(m)
+        _, vecs = lapack.eig_real(m)  # np.real of np.linalg.eig's vectors
     except np.linalg.LinAlgError:
         return None
-    vecs = np.real(vecs)
     cond = 4.0 * vecs[0] * vecs[2] - vecs[1] ** 2
     good = np.flatnonzero(cond > 0)
     if not len(good):
