@@ -4600,3 +4600,43 @@ def test_a_squashed_revolution_marches_and_boxes_as_its_twins(seed, ratio, close
         mp.undo()
     for a, b in zip(fast, twin, strict=True):
         np.testing.assert_array_equal(a, b)
+
+
+# --- stop 44, speedcand44
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 10_000), st.integers(1, 400), st.sampled_from(["cracks", "normal", "same", "nan"]))
+def test_conic_design_is_its_twins_to_the_bit(seed, m, kind):
+    """The outline ellipse's design (core.raster.outline_cone's first step) against its numpy twin byte for byte:
+    crack midpoints (half-integers, as outline_cone reads them), scattered pixels, one repeated point (scale 1)
+    and a NaN."""
+    from symfruit.core.raster import _conic_design
+
+    rng = np.random.default_rng(seed)
+    if kind == "cracks":
+        pts = rng.integers(0, 640, size=(m, 2)) + rng.choice([0.0, 0.5], size=(m, 2))
+    elif kind == "same":
+        pts = np.tile(rng.normal(size=(1, 2)) * 300.0, (m, 1))
+    else:
+        pts = rng.normal(size=(m, 2)) * 10.0 ** rng.integers(-3, 4) + 320.0
+        if kind == "nan":
+            pts[rng.integers(m), rng.integers(2)] = np.nan
+    got, twin = _jit.conic_design(pts), _conic_design(pts)
+    assert type(got[1]) is float and (got[1] == twin[1] or (np.isnan(got[1]) and np.isnan(twin[1])))
+    for a, b in zip((got[0], got[2], got[3]), (twin[0], twin[2], twin[3]), strict=True):
+        assert a.shape == b.shape and a.tobytes() == b.tobytes()
+
+
+def test_conic_design_known_values():
+    """Four points on a square about (10, 20) at distance sqrt(2): mean (10, 20), scale sqrt(2), the designs of
+    (+-1, +-1) / sqrt(2); a single point: scale 1 and the designs of the origin."""
+    pts = np.array([[9.0, 19.0], [11.0, 19.0], [9.0, 21.0], [11.0, 21.0]])
+    mean, scale, d1, d2 = _jit.conic_design(pts)
+    assert mean.tolist() == [10.0, 20.0] and scale == np.sqrt(2.0)
+    x, y = (pts[:, 0] - 10.0) / np.sqrt(2.0), (pts[:, 1] - 20.0) / np.sqrt(2.0)
+    assert d1.tolist() == np.stack((x * x, x * y, y * y), axis=1).tolist()
+    assert d2.tolist() == np.stack((x, y, np.ones(4)), axis=1).tolist()
+    mean, scale, d1, d2 = _jit.conic_design(np.array([[3.0, 4.0]]))
+    assert mean.tolist() == [3.0, 4.0] and scale == 1.0 and d1.tolist() == [[0.0, 0.0, 0.0]]
+    assert d2.tolist() == [[0.0, 0.0, 1.0]]

@@ -505,3 +505,28 @@ def test_inverse2_is_numpys_inv():
         inverse2(np.array([[np.inf, 0.0], [0.0, 1.0]])) is None
         and inverse2(np.array([[1e-120, 0.0], [0.0, 1.0]])) is None
     )
+
+
+def test_outline_cone_is_the_same_with_its_kernels_and_without(camera, monkeypatch):
+    """Arcs of ellipses at crack midpoints (half pixels), some accepted, some not: the same cone and axis to the bit
+    with the compiled design (core._jit.conic_design, where numba is) and with its numpy twin (issue 19, stop 44)."""
+    from symfruit.core.raster import Silhouette, outline_cone
+
+    vv, uu = np.mgrid[:120, :140]
+    rng = np.random.default_rng(5)
+    found = 0
+    for a, b, cut in ((40.0, 25.0, 5.0), (30.0, 30.0, -10.0), (50.0, 20.0, 15.0), (35.0, 28.0, 0.0)):
+        full = ((uu - 70.0) / a) ** 2 + ((vv - 60.0) / b) ** 2 <= 1.0
+        region = Silhouette(250, 180, full & (vv < 60.0 + cut), 0.0)
+        t = np.sort(rng.uniform(np.pi, 2 * np.pi, 150))
+        arc = np.round(np.c_[70.0 + a * np.cos(t), 60.0 + b * np.sin(t)] * 2.0) / 2.0 + [250, 180]
+        for pts in (arc, arc[::3], arc + rng.normal(scale=0.7, size=arc.shape)):
+            monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+            got = outline_cone(region, camera, pts)
+            monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = outline_cone(region, camera, pts)
+            assert (got is None) == (twin is None)
+            if got is not None and twin is not None:
+                found += 1
+                assert got[0].tobytes() == twin[0].tobytes() and got[1].tobytes() == twin[1].tobytes()
+    assert found >= 4

@@ -35,6 +35,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from . import lapack
 from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
@@ -406,7 +407,7 @@ def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
     ce, shape = fit_ellipsoid(fit.sample, scaled=fit.scaled())
     with np.errstate(invalid="ignore"):
         half = ellipsoid_half_extents(shape)
-    fit.axes.append(np.linalg.eigh(shape)[1].T)
+    fit.axes.append(lapack.eigh(shape)[1].T)
     yield _Shape("ellipsoid", ce - half, ce + half, Quadric(ce, shape), ce)
 
 
@@ -417,8 +418,8 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
     found = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=fit.front, extent=fit.extent)
     cc, cs = found.centre, found.shape
     ch = np.sqrt(np.diag(cs))
-    inv = np.linalg.inv(cs)
-    fit.axes.append(np.linalg.eigh(cs)[1].T)
+    inv = lapack.inv(cs)
+    fit.axes.append(lapack.eigh(cs)[1].T)
     yield _Shape("cone", cc - ch, cc + ch, Quadric(cc, inv), cc, found.back_std)
 
 

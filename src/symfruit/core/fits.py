@@ -21,6 +21,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from ..errors import InputError
+from . import lapack
 from .box import Box
 from .camera import Camera
 from .kernels import compiled
@@ -142,7 +143,7 @@ def fit_sphere(
         q = q / scale
         a = np.column_stack([2.0 * q, np.ones(len(q))])
         b = squared_norms(q)
-    sol, _, rank, sv = np.linalg.lstsq(a, b, rcond=None)
+    sol, rank, sv = lapack.lstsq(a, b)  # np.linalg.lstsq(a, b, rcond=None) but its residuals
     if rank < 4 or sv[-1] < 1e-6 * sv[0]:
         raise InputError("cannot fit a sphere: the points are (nearly) coplanar or collinear")
     c = sol[:3]
@@ -200,12 +201,11 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
     s = d.T @ d
     s11, s12, s22 = s[:6, :6], s[:6, 6:], s[6:, 6:]
     try:
-        s22_inv_s21 = np.linalg.solve(s22, s12.T)
-        m = np.linalg.solve(_LI_GRIFFITHS, s11 - s12 @ s22_inv_s21)
-        values, vectors = np.linalg.eig(m)
+        s22_inv_s21 = lapack.solve(s22, s12.T)
+        m = lapack.solve(_LI_GRIFFITHS, s11 - s12 @ s22_inv_s21)
+        values, vectors = lapack.eig_real(m)  # the real parts of np.linalg.eig's
     except np.linalg.LinAlgError:
         raise InputError("cannot fit an ellipsoid: the points are degenerate") from None
-    values, vectors = values.real, vectors.real
     # The solution is the eigenvector of the one positive eigenvalue; on exact data it tends to 0 and
     # may come out a rounding error below it.
     if values.max() < -1e-9 * np.abs(values).max():
@@ -217,12 +217,12 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
     quad = np.array([[a, h, g], [h, b, f], [g, f, c]])
     lin = np.array([p, q, r])
     try:
-        centre = -np.linalg.solve(quad, lin)
+        centre = -lapack.solve(quad, lin)
     except np.linalg.LinAlgError:
         raise InputError("cannot fit an ellipsoid: the quadric has no centre") from None
     level = centre @ quad @ centre - dd
     shape = quad / level
-    if not np.all(np.linalg.eigvalsh(shape) > 0):
+    if not np.all(lapack.eigvalsh(shape) > 0):
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
 
@@ -245,7 +245,7 @@ def ellipsoid_half_extents(shape: np.ndarray) -> np.ndarray:
 
     The box of an ellipsoid with shape matrix ``A`` has half-widths ``sqrt(diag(A^-1))``.
     """
-    return np.sqrt(np.diag(np.linalg.inv(np.asarray(shape, dtype=np.float64))))
+    return np.sqrt(np.diag(lapack.inv(np.asarray(shape, dtype=np.float64))))
 
 
 def surface_noise(
@@ -1274,7 +1274,7 @@ def fit_cone_ellipsoid(
     tau_max = cone_thickness_bound(cone, min_thickness)
     np.minimum(grid[:, 3], tau_max, out=grid[:, 3])
 
-    cone_inv = np.linalg.inv(cone)
+    cone_inv = lapack.inv(cone)
     step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
     steps = np.diag(step)
     at = np.empty((5, 4))

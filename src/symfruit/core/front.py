@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import lapack
 from .fits import eigenvalues2, solve2
 from .points import as_points, column_means, squared_norms
 
@@ -54,7 +55,7 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     np.multiply(x, x, out=a[:, 3])
     np.multiply(x, y, out=a[:, 4])
     np.multiply(y, y, out=a[:, 5])
-    coef, *_ = np.linalg.lstsq(a, near[:, 2], rcond=None)
+    coef, _, _ = lapack.lstsq(a, near[:, 2])  # np.linalg.lstsq(..., rcond=None)'s
     fitted = a @ coef
     i = int(np.argmin(fitted))
     best_z, best_xy = float(fitted[i]), np.array([x[i], y[i]])

@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import InputError
+from . import lapack
 from .kernels import compiled
 from .limits import MAX_DEPTH_METRES, MIN_DEPTH_METRES, unmasked
 
@@ -274,7 +275,7 @@ def check_cloud(
     if scatter is None:
         centred = arr - mean_point(arr)
         scatter = centred.T @ centred
-    spread = np.linalg.eigvalsh(scatter)  # ascending variances (times n)
+    spread = lapack.eigvalsh(scatter)  # ascending variances (times n)
     if spread[2] <= 1e-18 * len(arr):
         raise InputError("all points are identical; a fruit needs points spread over its surface")
     if spread[1] <= 1e-12 * spread[2]:

@@ -14,6 +14,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..errors import InputError
+from . import lapack
 from .box import Box
 from .camera import Camera
 from .fits import _plain, eigenvalues2, solve2
@@ -616,7 +617,7 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     if (jit := compiled()) is not None:  # the compiled twin of what follows but the eigh: the same values
         intrinsics = (float(camera.cx), float(camera.cy), float(camera.fx), float(camera.fy))
         axis, basis, carried = jit.across_frame(float(mu[0]), float(mu[1]), cov, *intrinsics)
-        _, vec = np.linalg.eigh(carried)
+        _, vec = lapack.eigh(carried)
         lo, hi, minor, major = jit.across_extent(outline_cracks(region), axis, basis, np.ascontiguousarray(vec),
                                                  *intrinsics)  # fmt: skip
         return Across(axis, basis, lo, hi, float(minor), float(major))
@@ -646,7 +647,7 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
     k = camera.matrix
     cone = k.T @ conic @ k
     axis = camera.rays(centre[0], centre[1])
-    return cone / np.abs(np.linalg.eigvalsh(cone)).max(), axis
+    return cone / np.abs(lapack.eigvalsh(cone)).max(), axis
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
@@ -705,35 +706,26 @@ def outline_cone(
         raise InputError(f"outline points must have shape (m, 2), got {pts.shape}")
     if len(pts) < max(min_points, 6):
         return None
-    # the same values as ``pts.mean(axis=0)``, ``((pts - mu) ** 2).sum(axis=1)`` and two ``np.stack`` of columns, in
-    # fewer calls (issue 19, nineteenth round)
-    mu = column_means(np.ascontiguousarray(pts))
-    scale = float(np.sqrt(squared_norms(pts - mu).mean())) or 1.0
-    x, y = (pts[:, 0] - mu[0]) / scale, (pts[:, 1] - mu[1]) / scale
-    d1 = np.empty((len(x), 3))
-    np.multiply(x, x, out=d1[:, 0])
-    np.multiply(x, y, out=d1[:, 1])
-    np.multiply(y, y, out=d1[:, 2])
-    d2 = np.ones((len(x), 3))
-    d2[:, 0], d2[:, 1] = x, y
+    jit = compiled()
+    pts = np.ascontiguousarray(pts)
+    mu, scale, d1, d2 = _conic_design(pts) if jit is None else jit.conic_design(pts)
     s1, s2, s3 = d1.T @ d1, d1.T @ d2, d2.T @ d2
     try:
-        t = -np.linalg.solve(s3, s2.T)
+        t = -lapack.solve(s3, s2.T)
     except np.linalg.LinAlgError:
         return None
     m = s1 + s2 @ t
     m = np.array([m[2] / 2.0, -m[1], m[0] / 2.0])
     try:
-        _, vecs = np.linalg.eig(m)
+        _, vecs = lapack.eig_real(m)  # np.real of np.linalg.eig's vectors
     except np.linalg.LinAlgError:
         return None
-    vecs = np.real(vecs)
-    cond = 4.0 * vecs[0] * vecs[2] - vecs[1] ** 2
-    good = np.flatnonzero(cond > 0)
-    if not len(good):
+    # the first eigenvector with 4 v0 v2 - v1^2 > 0, in Python floats (numpy's products and difference, left to right)
+    good = [j for j, (v0, v1, v2) in enumerate(zip(*vecs.tolist(), strict=True)) if 4.0 * v0 * v2 - v1 * v1 > 0]
+    if not good:
         return None
     a1 = vecs[:, good[0]]
-    a, b, c, d, e, f = np.concatenate((a1, t @ a1))
+    (a, b, c), (d, e, f) = a1.tolist(), (t @ a1).tolist()
     # Back to pixels: x = (u - mu_u) / s, y = (v - mu_v) / s.
     q = np.array([[a, b / 2, d / 2], [b / 2, c, e / 2], [d / 2, e / 2, f]])
     tr = np.array([[1 / scale, 0, -mu[0] / scale], [0, 1 / scale, -mu[1] / scale], [0, 0, 1]])
@@ -759,7 +751,7 @@ def outline_cone(
         return None
     area = np.pi / np.sqrt(eig[0] * eig[1])
     a2 = conic[:2, :2]
-    if region.mask.ndim == 2 and (jit := compiled()) is not None:  # the compiled twin of what follows: the same count
+    if region.mask.ndim == 2 and jit is not None:  # the compiled twin of what follows: the same count
         n, count = jit.ellipse_holds(np.ascontiguousarray(region.mask, dtype=bool), int(region.u0), int(region.v0),
                                      float(centre[0]), float(centre[1]), float(a2[0, 0]), float(a2[0, 1]),
                                      float(a2[1, 1]))  # fmt: skip
@@ -777,6 +769,25 @@ def outline_cone(
     if share < inside:
         return None
     return _image_cone(conic, centre, camera)
+
+
+def _conic_design(pts: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarray]:
+    """``(mean (2,), scale, [x^2, x y, y^2] (m, 3), [x, y, 1] (m, 3))`` of :func:`outline_cone`'s points ``pts`` (m,
+    2), ``x, y`` their coordinates less the mean over the scale (the root of their mean squared distance from the
+    mean, 1 where that is 0). ``column_means``, ``squared_norms`` and the columns filled one by one: the values of
+    ``pts.mean(axis=0)``, ``((pts - mu) ** 2).sum(axis=1)`` and two ``np.stack`` of columns (issue 19, nineteenth
+    round). By the compiled twin :func:`symfruit.core._jit.conic_design` where numba is installed (the same values,
+    in one call; stop 44)."""
+    mu = column_means(pts)
+    scale = float(np.sqrt(squared_norms(pts - mu).mean())) or 1.0
+    x, y = (pts[:, 0] - mu[0]) / scale, (pts[:, 1] - mu[1]) / scale
+    d1 = np.empty((len(x), 3))
+    np.multiply(x, x, out=d1[:, 0])
+    np.multiply(x, y, out=d1[:, 1])
+    np.multiply(y, y, out=d1[:, 2])
+    d2 = np.ones((len(x), 3))
+    d2[:, 0], d2[:, 1] = x, y
+    return mu, scale, d1, d2
 
 
 def rasterise(points: np.ndarray, camera: Camera, *, fill_radius: float | None = None) -> View:
