@@ -4640,3 +4640,98 @@ def test_conic_design_known_values():
     mean, scale, d1, d2 = _jit.conic_design(np.array([[3.0, 4.0]]))
     assert mean.tolist() == [3.0, 4.0] and scale == 1.0 and d1.tolist() == [[0.0, 0.0, 0.0]]
     assert d2.tolist() == [[0.0, 0.0, 1.0]]
+
+
+# --- stop 44, speedocc44
+
+
+def _overshoot_case(seed: int, wide: bool):
+    """A window for overshoot's maps: a disc-like mask (or random pixels), points' pixels on its inner part (some
+    outside the mask, repeated pixels with other depths: ties and minima), the depth a cap with steps, dropouts
+    (0, NaN, inf), pixels in front and behind; float32 or float64, a strided view or not."""
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+    rr, cc = np.mgrid[:h, :w]
+    r0, c0, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(1, 20)
+    dist = np.hypot(rr - r0, cc - c0)
+    own = dist < rad if rng.random() < 0.8 else rng.random((h, w)) < 0.5
+    inner = np.flatnonzero((dist < rad * rng.uniform(0.2, 1.1)).ravel() | (rng.random(h * w) < 0.05))
+    n = int(rng.integers(1, 3 * max(len(inner), 1) + 1))
+    at = rng.choice(inner, size=n) if len(inner) else rng.integers(0, h * w, size=n)
+    rows, cols = (at // w).astype(np.intp), (at % w).astype(np.intp)
+    z = np.round(1.0 + 0.002 * dist.ravel()[at] + rng.normal(scale=0.002, size=n), 3)
+    depth = np.round(1.0 + 0.002 * dist + rng.choice([-0.05, 0.0, 0.0, 0.003, 0.2], size=(h, w)), 3)
+    drop = rng.random((h, w))
+    depth[drop < 0.2] = 0.0
+    depth[(drop >= 0.2) & (drop < 0.25)] = np.nan
+    depth[(drop >= 0.25) & (drop < 0.27)] = np.inf
+    depth = depth.astype(rng.choice([np.float32, np.float64]))
+    if wide:  # a view of a wider image, as overshoot reads the frame's depth
+        big = np.zeros((h, 2 * w + 3), depth.dtype)
+        big[:, 3::2] = depth
+        depth = big[:, 3::2]
+    return own, depth, rows, cols, z, float(rng.choice([0.0, 0.002, 0.005])), int(rng.integers(0, 9))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_overshoot_band_is_the_twins(seed, wide):
+    """overshoot_band (overshoot's maps: the own depths, the band, what lies ahead, the band's, the spread's and the
+    beyond pixels' counts) is its numpy twin's, bit for bit, on windows with ties, dropouts, NaN and inf depth,
+    float32 and strided depth, any reach."""
+    from symfruit.core.occlusion import _overshoot_band
+
+    own, depth, rows, cols, z, tolerance, reach = _overshoot_case(seed, wide)
+    h, w = own.shape
+    maps = [(np.empty((h, w)), np.empty((h, w), bool), np.empty((h, w), bool)) for _ in range(2)]
+    got = _jit.overshoot_band(own, depth, rows, cols, z, tolerance, reach, *maps[0])
+    want = _overshoot_band(own, depth, rows, cols, z, tolerance, reach, *maps[1])
+    assert got == want
+    for a, b in zip(maps[0], maps[1], strict=True):
+        assert a.tobytes() == b.tobytes()
+
+
+def test_overshoot_band_known_answer():
+    """A 1 x 7 row: points at columns 2 and 3 (depths 1.0 and 0.9, the nearer twice at column 3); the mask columns
+    0-5. Column 1 (depth 0.95) is beyond the points with depth: nearer than its nearest point pixel's (1.0) but not
+    by the tolerance, a spread pixel; column 0 (0.5) lies ahead; column 4 (0) holds none; column 5 (0.895): its
+    nearest point pixel is column 3 (0.9), within reach 2 also 0.9, so not ahead by 0.01 but nearer: spread."""
+    own = np.array([[1, 1, 1, 1, 1, 1, 0]], bool)
+    depth = np.array([[0.5, 0.95, 1.0, 0.9, 0.0, 0.895, 0.7]])
+    rows, cols = np.zeros(3, np.intp), np.array([2, 3, 3], np.intp)
+    z = np.array([1.0, 0.95, 0.9])
+    own_z, band, ahead = np.empty((1, 7)), np.empty((1, 7), bool), np.empty((1, 7), bool)
+    assert _jit.overshoot_band(own, depth, rows, cols, z, 0.01, 2, own_z, band, ahead) == (3, 2, 4)
+    assert np.array_equal(own_z[0], [np.inf, np.inf, 1.0, 0.9, np.inf, np.inf, np.inf])
+    assert np.array_equal(band[0], [1, 1, 0, 0, 0, 1, 0])
+    assert np.array_equal(ahead[0], [1, 0, 0, 0, 0, 0, 0])
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_peel_is_the_twins_propagation(seed):
+    """peel (a flood fill from the mask's border through the pixels to drop) gives scipy's binary_propagation's
+    pixels (occlusion._peel), on random masks and drops, rings and holes included."""
+    from symfruit.core.occlusion import _peel
+
+    rng = np.random.default_rng(seed)
+    h, w = int(rng.integers(1, 30)), int(rng.integers(1, 30))
+    own = rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    drop = own & (rng.random((h, w)) < rng.uniform(0.1, 0.9))
+    out = np.empty((h, w), bool)
+    _jit.peel(own, drop, out)
+    assert np.array_equal(out, _peel(own, drop))
+
+
+def test_peel_keeps_a_pocket_inside():
+    """A full 7 x 7 mask: a ring on its border and a pocket at its centre, apart; the ring is peeled, the pocket (no
+    pixel of it on the border, none joined to one) stays."""
+    own = np.ones((7, 7), bool)
+    drop = np.zeros((7, 7), bool)
+    drop[0, :] = drop[:, 0] = True
+    drop[3, 3] = True
+    out = np.empty((7, 7), bool)
+    _jit.peel(own, drop, out)
+    want = drop.copy()
+    want[3, 3] = False
+    assert np.array_equal(out, want)

@@ -6773,3 +6773,125 @@ def conic_design(p: np.ndarray) -> tuple[np.ndarray, float, np.ndarray, np.ndarr
         d1[i, 0], d1[i, 1], d1[i, 2] = x * x, x * y, y * y
         d2[i, 0], d2[i, 1], d2[i, 2] = x, y, 1.0
     return mean, scale, d1, d2
+
+
+@_njit
+def overshoot_band(own: np.ndarray, depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, z: np.ndarray,
+                   tolerance: float, reach: int, own_z: np.ndarray, band: np.ndarray,
+                   ahead: np.ndarray) -> tuple[int, int, int]:  # fmt: skip
+    """:func:`symfruit.core.occlusion.overshoot`'s maps in one pass (twin: ``occlusion._overshoot_band``, the same
+    values, bit for bit): ``own_z`` (h, w) the least of the points' depths ``z`` at their pixels (``rows``,
+    ``cols``, inside the window; +inf elsewhere), ``band`` (h, w) the mask's pixels (``own``) beyond the points'
+    with depth (``depth`` finite and above 0), ``ahead`` (h, w) the band's pixels clearly in front of the fruit
+    (nearer by ``tolerance`` than both the nearest point pixel's depth and the least of the own depths within
+    ``reach`` pixels); returns the band's pixel count, how many of its pixels are not ahead but nearer than the
+    nearest point pixel's depth (the spread), and the mask's pixels beyond the points'.
+
+    The nearest point pixel is scipy's feature transform's over the box of the mask and the points' pixels
+    (:func:`nearest`); the least own depth within ``reach`` is a minimum over the square, worked out along the rows
+    of the points' pixels' box alone (+inf beyond it), then down the columns at the band's pixels alone, not scipy's
+    17 x 17 filter over the window (minima are exact, in any order)."""
+    h, w = own.shape
+    for r in range(h):
+        for c in range(w):
+            own_z[r, c] = np.inf
+    s0, s1, t0, t1 = h, 0, w, 0  # the box of the points' pixels
+    for i in range(z.shape[0]):
+        r, c, v = rows[i], cols[i], z[i]
+        if v < own_z[r, c] or v != v:  # np.minimum's: NaN propagates
+            own_z[r, c] = v
+    n_beyond = 0
+    n_band = 0
+    b0, b1, a0, a1 = h, 0, w, 0  # the box of the mask and the points' pixels
+    for r in range(h):
+        for c in range(w):
+            seen = math.isfinite(own_z[r, c])
+            if seen:
+                s0, s1, t0, t1 = min(s0, r), max(s1, r + 1), min(t0, c), max(t1, c + 1)
+            if seen or own[r, c]:
+                b0, b1, a0, a1 = min(b0, r), max(b1, r + 1), min(a0, c), max(a1, c + 1)
+            ahead[r, c] = False
+            band[r, c] = False
+            if own[r, c] and not seen:
+                n_beyond += 1
+                d = float(depth[r, c])
+                if math.isfinite(d) and d > 0:
+                    band[r, c] = True
+                    n_band += 1
+    if n_band == 0:
+        return 0, 0, n_beyond
+    bh, bw = b1 - b0, a1 - a0
+    image = np.empty((bh, bw), np.bool_)
+    for r in range(bh):
+        for c in range(bw):
+            image[r, c] = not math.isfinite(own_z[b0 + r, a0 + c])
+    index = np.empty((bh, bw), np.int64)
+    nearest(image, index)
+    # the least own depth along each row within reach, over the rows and the reach of the points' pixels' box
+    q0, q1 = max(t0 - reach, 0), min(t1 + reach, w)
+    along = np.full((max(s1 - s0, 0), max(q1 - q0, 0)), np.inf)
+    for r in range(s0, s1):
+        for c in range(q0, q1):
+            m = np.inf
+            for k in range(max(c - reach, t0), min(c + reach + 1, t1)):
+                if own_z[r, k] < m:
+                    m = own_z[r, k]
+            along[r - s0, c - q0] = m
+    spread = 0
+    for r in range(b0, b1):
+        for c in range(a0, a1):
+            if not band[r, c]:
+                continue
+            near = np.inf
+            if q0 <= c < q1:
+                for k in range(max(r - reach, s0), min(r + reach + 1, s1)):
+                    if along[k - s0, c - q0] < near:
+                        near = along[k - s0, c - q0]
+            j = index[r - b0, c - a0]
+            if j < 0:  # no point pixel with a finite depth: np.take's last
+                j += bh * bw
+            ref = own_z[b0 + j // bw, a0 + j % bw]
+            d = float(depth[r, c])
+            front = ref if ref < near else near
+            if d < front - tolerance:
+                ahead[r, c] = True
+            elif d < ref:
+                spread += 1
+    return n_band, spread, n_beyond
+
+
+@_njit
+def peel(own: np.ndarray, drop: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: the pixels of ``drop`` joined (8-connected, through ``drop``) to a pixel of ``drop`` on
+    the mask's border (a pixel of its 3 x 3 square not in ``own`` or beyond the window): the twin's
+    ``ndimage.binary_propagation`` from ``drop & ~square_filter(own, 1, every=True)`` within ``drop``
+    (``occlusion._peel``), by one flood fill instead of dilations until nothing changes."""
+    h, w = own.shape
+    stack = np.empty(h * w, np.int64)
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = False
+    for r in range(h):
+        for c in range(w):
+            if not drop[r, c]:
+                continue
+            border = r == 0 or c == 0 or r == h - 1 or c == w - 1
+            if not border:
+                for dr in range(-1, 2):
+                    for dc in range(-1, 2):
+                        if not own[r + dr, c + dc]:
+                            border = True
+            if border:
+                out[r, c] = True
+                stack[n] = r * w + c
+                n += 1
+    while n > 0:
+        n -= 1
+        r, c = stack[n] // w, stack[n] % w
+        for rr in range(max(r - 1, 0), min(r + 2, h)):
+            for cc in range(max(c - 1, 0), min(c + 2, w)):
+                if drop[rr, cc] and not out[rr, cc]:
+                    out[rr, cc] = True
+                    stack[n] = rr * w + cc
+                    n += 1

@@ -497,16 +497,50 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     ok = (col >= 0) & (col < w) & (row >= 0) & (row < h)
     if not ok.any():
         return None, False
+    own = np.ascontiguousarray(own, dtype=bool)
+    own_z, band, ahead = np.empty((h, w)), np.empty((h, w), bool), np.empty((h, w), bool)
+    # the maps in one compiled pass where numba is (issue 19, stop 44: scipy's 17 x 17 minimum filter over the
+    # window and a dozen numpy passes were most of this function's time; the same values, bit for bit)
+    maps = _overshoot_band if (jit := compiled()) is None else jit.overshoot_band
+    n_band, spread, n_beyond = maps(own, depth, row[ok], col[ok], np.ascontiguousarray(points[ok, 2]), float(tolerance),
+                                    int(reach), own_z, band, ahead)  # fmt: skip
+    if not n_band:
+        return None, False
+    seen = np.isfinite(own_z)
+    if spread <= n_beyond - n_band:  # no more than hold no depth: not a spread edge
+        d = np.asarray(depth, dtype=np.float64)
+        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
+        return past, past is not None
+    drop = own & ~seen & ~ahead  # all but what lies clearly in front
+    # peeled from the mask's border inwards: what a mask overshoots lies at its border
+    if jit is None:
+        drop = _peel(own, drop)
+    else:
+        peeled = np.empty((h, w), bool)
+        jit.peel(own, drop, peeled)
+        drop = peeled
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop, False
+
+
+def _overshoot_band(own: np.ndarray, depth: np.ndarray, row: np.ndarray, col: np.ndarray, z: np.ndarray,
+                    tolerance: float, reach: int, own_z: np.ndarray, band: np.ndarray,
+                    ahead: np.ndarray) -> tuple[int, int, int]:  # fmt: skip
+    """The numpy twin of :func:`symfruit.core._jit.overshoot_band` (:func:`overshoot`'s maps, into ``own_z``,
+    ``band`` and ``ahead``; the band's pixel count, the spread's and the mask's pixels beyond the points')."""
+    h, w = own.shape
     flat = np.full(h * w, np.inf)
-    np.minimum.at(flat, row[ok] * w + col[ok], points[ok, 2])
-    own_z = flat.reshape(h, w)
+    np.minimum.at(flat, row * w + col, z)
+    own_z[...] = flat.reshape(h, w)
     seen = np.isfinite(own_z)
     d = np.asarray(depth, dtype=np.float64)
     beyond = own & ~seen
     with np.errstate(invalid="ignore"):
-        band = beyond & np.isfinite(d) & (d > 0)
+        band[...] = beyond & np.isfinite(d) & (d > 0)
+    ahead[...] = False
     if not band.any():
-        return None, False
+        return 0, 0, int(np.count_nonzero(beyond))
     # the nearest point pixel's depth, over the box of the mask and the points' pixels alone
     b0, b1, a0, a1 = mask_box(own | seen)  # type: ignore[misc]
     near = np.take(own_z[b0:b1, a0:a1].ravel(), nearest_index(~seen[b0:b1, a0:a1]))
@@ -514,20 +548,18 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     # the nearest of the fruit's own depths within ``reach`` pixels: a spread depth is the least the correlation
     # window holds, nearer than the rim's own (as :func:`own_edge` reads it)
     z_near = ndimage.minimum_filter(own_z, size=2 * reach + 1, mode="constant", cval=np.inf)[band]
-    z = d[band]
-    ahead = z < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
-    spread = np.count_nonzero(~ahead & (z < z_ref))  # the fruit's own depth, nearer than its rim beside it
-    if spread <= np.count_nonzero(beyond) - len(z):  # no more than hold no depth: not a spread edge
-        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
-        return past, past is not None
-    drop = beyond.copy()
-    drop[band] = ~ahead  # all but what lies clearly in front
-    # peeled from the mask's border inwards: what a mask overshoots lies at its border
+    zb = d[band]
+    is_ahead = zb < np.minimum(z_ref, z_near) - tolerance  # clearly in front of the fruit: an occluder
+    ahead[band] = is_ahead
+    spread = np.count_nonzero(~is_ahead & (zb < z_ref))  # the fruit's own depth, nearer than its rim beside it
+    return len(zb), int(spread), int(np.count_nonzero(beyond))
+
+
+def _peel(own: np.ndarray, drop: np.ndarray) -> np.ndarray:
+    """The numpy twin of :func:`symfruit.core._jit.peel`: the pixels of ``drop`` joined to its pixels on the mask's
+    border (a pixel of their 3 x 3 square outside ``own`` or the window) through ``drop``."""
     edge = drop & ~square_filter(own, 1, every=True)
-    drop = ndimage.binary_propagation(edge, structure=np.ones((3, 3), bool), mask=drop)
-    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
-        drop &= ~square_filter(own & ~drop, eroded)
-    return drop, False
+    return np.asarray(ndimage.binary_propagation(edge, structure=np.ones((3, 3), bool), mask=drop))
 
 
 #: Angular sectors a time-of-flight view's edge is found in (:func:`overshoot`): a sector spans 2-4 px of the
