@@ -19,8 +19,9 @@ depth pixels):
    ``rim_invalid_px`` depth pixels of a mixed one on the nearer surface's side (``rim_far_px`` on the farther
    side's) are invalidated (the depth engine's mixed-pixel filter: the real Azure Kinect frames keep the
    background's depth up to the outline, ``docs/realism44.md``); active stereo: the foreground's depth
-   spreads ``fatten_px`` depth pixels over the background (the matching window straddles the edge) and background the right imager cannot see
-   is invalid (the stereo occlusion band, ``baseline`` and the disparities decide its width);
+   spreads ``fatten_px`` depth pixels over the background (the matching window straddles the edge) and
+   background the right imager cannot see is invalid (the stereo occlusion band, ``baseline`` and the
+   disparities decide its width);
 3. multipath (time-of-flight): depth pushed away from the camera near where two surfaces meet,
    ``multipath_bias`` at the junction decaying over ``multipath_range``;
 4. axial noise and bias growing with distance (:meth:`SensorModel.sigma`, :meth:`SensorModel.bias`), the noise
