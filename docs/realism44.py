@@ -152,6 +152,49 @@ def profile(depth: np.ndarray, mask: np.ndarray, camera: Camera) -> dict:
     }
 
 
+def sides(depth: np.ndarray, mask: np.ndarray, camera: Camera) -> dict:
+    """Left, right and top of one sphere (90-degree sectors about the outline's centre): where the sphere's depth
+    stops (first bin, coming out from 16 px inside, below half), where the background's starts (first bin at half or
+    more; None: not a silhouette there) and the flying pixels within 4 px; and the share of pixels with the sphere's
+    depth against ``|cos|`` over the left and right sectors together (a registration across cancels to first order)."""
+    rows, cols = np.nonzero(mask)
+    cv, cu = rows.mean(), cols.mean()
+    r_px = math.sqrt(mask.sum() / math.pi)
+    vv, uu = np.mgrid[0 : depth.shape[0], 0 : depth.shape[1]]
+    rad = np.hypot(uu - cu, vv - cv)
+    s = r_px - rad
+    th = np.arctan2(vv - cv, uu - cu)
+    z_front = np.percentile(depth[(s > 0.3 * r_px) & (depth > 0)], 5)
+    z_c = z_front * (1 + r_px / camera.fx)
+    sphere = (depth > z_front - 0.02) & (depth < z_c + 0.02)
+    bg = depth > z_c + 0.1
+    out: dict = {}
+    for name, sel in (
+        ("left", np.abs(np.abs(th) - np.pi) < np.pi / 4),
+        ("right", np.abs(th) < np.pi / 4),
+        ("top", np.abs(th + np.pi / 2) < np.pi / 4),
+    ):
+        stop = start = None
+        flying = near = 0
+        for b in range(16, -9, -1):
+            x = sel & (np.rint(s) == b)
+            if stop is None and sphere[x].mean() < 0.5:
+                stop = b
+            if start is None and bg[x].mean() >= 0.5:
+                start = b
+            if abs(b) <= 4:
+                flying += int(((depth[x] > 0) & ~sphere[x] & ~bg[x]).sum())
+                near += int(x.sum())
+        out[name] = (stop, start, flying, near)
+    facing = np.sqrt(1 - np.clip(rad / r_px, 0, 1) ** 2)
+    lr = (np.abs(np.sin(th)) < math.sin(math.pi / 4)) & (s > 0)
+    out["by_cos"] = [
+        float(sphere[lr & (facing >= a) & (facing < b)].mean())
+        for a, b in zip(COS_EDGES[:-1], COS_EDGES[1:] + (COS_EDGES[1:] == 1.0) * 0.01, strict=True)
+    ]
+    return out
+
+
 def real(folder: str) -> list[tuple[str, int, dict]]:
     from PIL import Image
 
@@ -162,7 +205,7 @@ def real(folder: str) -> list[tuple[str, int, dict]]:
         depth = np.asarray(Image.open(frame / "depth.png"), dtype=np.float64) * float(meta.get("depth_scale", 0.001))
         labels = np.asarray(Image.open(frame / "masks.png"))
         for k in np.unique(labels[labels > 0]):
-            out.append((frame.name, int(k), profile(depth, labels == k, cam)))
+            out.append((frame.name, int(k), {**profile(depth, labels == k, cam), **sides(depth, labels == k, cam)}))
     return out
 
 
@@ -186,7 +229,10 @@ def model(name: str, seed: int, sensor_set: object) -> list[tuple[str, int, dict
     fr = apply_sensor(m, shot.depth, shot.ids, cam, np.random.default_rng(seed), facing=shot.facing)
     depth = np.asarray(fr.depth, dtype=np.float64)
     tag = f"{name} seed {seed} (shift {fr.shift[0]:+.1f}, {fr.shift[1]:+.1f})"
-    return [(tag, k + 1, profile(depth, shot.ids == k, cam)) for k in range(len(LAB_SPHERES))]
+    return [
+        (tag, k + 1, {**profile(depth, shot.ids == k, cam), **sides(depth, shot.ids == k, cam)})
+        for k in range(len(LAB_SPHERES))
+    ]
 
 
 def report(rows: list[tuple[str, int, dict]]) -> None:
@@ -208,6 +254,13 @@ def report(rows: list[tuple[str, int, dict]]) -> None:
     print("sphere share against |cos| (bins " + ", ".join(f"{a:.2f}" for a in COS_EDGES[:-1]) + "):")
     for frame, k, p in rows:
         print(f"  {frame} {k}: " + " ".join("  -  " if not np.isfinite(x) else f"{x:.2f}" for x in p["by_cos"]))
+    print()
+    print("left / right / top: depth stops at (px inside), background from (px inside; None: none within 8 px out),")
+    print("flying pixels within 4 px; then the left and right sectors' share with the sphere's depth against |cos|:")
+    for frame, k, p in rows:
+        cells = [f"{n} {p[n][0]}, {p[n][1]}, {p[n][2]}/{p[n][3]}" for n in ("left", "right", "top")]
+        cos = " ".join(f"{x:.2f}" for x in p["by_cos"])
+        print(f"  {frame} {k}: " + "; ".join(cells) + " | " + cos)
     print()
     print("profile (s px: sphere / flying / none / background), pooled per sphere:")
     for frame, k, p in rows:

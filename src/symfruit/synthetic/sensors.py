@@ -539,7 +539,10 @@ def apply_sensor(
     if face is not None and model.grazing_dropout > 0:
         limit: np.ndarray | float = model.grazing
         if model.grazing_ramp > 0:  # the threshold varies smoothly along the rim
-            wave = correlated_noise(rng.normal(size=(hd, wd)), max(model.noise_corr_px, 2.0))
+            # drawn from a stream of its own (a child of the frame's seed): the frame's other draws (registration,
+            # jitter, masks) stay what they are without the ramp, so a model with and without it differ at the rim
+            side = np.random.default_rng(rng.bit_generator.seed_seq.spawn(1)[0])  # type: ignore[attr-defined]
+            wave = correlated_noise(side.normal(size=(hd, wd)), max(model.noise_corr_px, 2.0))
             limit = model.grazing + model.grazing_ramp * special.ndtr(wave)
         valid &= ~((face < limit) & (rng.random((hd, wd)) < model.grazing_dropout))
     valid &= rng.random((hd, wd)) >= model.dropout
