@@ -16,15 +16,19 @@ depth pixels):
    ``edge_step`` or a surface and nothing;
 2. time-of-flight: a mixed pixel is a *flying pixel* (depth the footprint's mean: between the fruit and
    what is behind it) with probability ``flying_share``, otherwise invalid, and valid pixels within
-   ``rim_invalid_px`` depth pixels of a mixed one are invalidated (the depth engine's mixed-pixel
-   filter); active stereo: the foreground's depth spreads ``fatten_px`` depth pixels over the
-   background (the matching window straddles the edge) and background the right imager cannot see
-   is invalid (the stereo occlusion band, ``baseline`` and the disparities decide its width);
+   ``rim_invalid_px`` depth pixels of a mixed one on the nearer surface's side (``rim_far_px`` on the farther
+   side's) are invalidated (the depth engine's mixed-pixel filter: the real Azure Kinect frames keep the
+   background's depth up to the outline, ``docs/realism44.md``); active stereo: the foreground's depth
+   spreads ``fatten_px`` depth pixels over the background (the matching window straddles the edge) and
+   background the right imager cannot see is invalid (the stereo occlusion band, ``baseline`` and the
+   disparities decide its width);
 3. multipath (time-of-flight): depth pushed away from the camera near where two surfaces meet,
    ``multipath_bias`` at the junction decaying over ``multipath_range``;
 4. axial noise and bias growing with distance (:meth:`SensorModel.sigma`, :meth:`SensorModel.bias`), the noise
    correlated over ``noise_corr_px`` depth pixels (a Gaussian autocorrelation: the depth engine's filtering, a
-   stereo matcher's window), grazing-angle and random dropout, no depth outside the depth camera's field of
+   stereo matcher's window), grazing-angle dropout (time of flight: wherever the surface turns
+   further from the ray than a threshold that varies smoothly between ``grazing`` and ``grazing + grazing_ramp``)
+   and random dropout, no depth outside the depth camera's field of
    view, millimetre quantisation;
 5. registers depth to colour: nearest depth pixel per colour pixel, shifted by ``registration_px``
    (in a direction drawn per frame), with the parallax band a depth camera ``colour_baseline`` away
@@ -44,7 +48,7 @@ from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
-from scipy import ndimage
+from scipy import ndimage, special
 
 from ..core.camera import Camera
 from ..core.raster import distance_transform
@@ -151,20 +155,41 @@ class SensorModel:
         A depth pixel whose footprint spans more depth than this is *mixed* (judgement: 1.5 cm, above
         the depth range of a fruit's own slope inside one depth pixel at working distances).
     rim_invalid_px : int, depth pixels
-        Time of flight: valid pixels this close to a mixed one are invalidated [AK-DEPTH: the depth
-        engine invalidates mixed pixels and their neighbourhood]; 1 (judgement; the lab frames show a
-        band of about 2-6 colour pixels, ``docs/sensors.md``).
+        Time of flight: valid pixels this close to a mixed one *on the nearer surface's side* (the fruit's: depth
+        more than ``edge_step`` in front of what the mixed pixel straddles) are invalidated [AK-DEPTH: the depth
+        engine invalidates mixed pixels and their neighbourhood]; 1 (judgement; with the grazing loss below the
+        modelled rim loss matches the lab frames', ``docs/realism44.md``).
+    rim_far_px : int, depth pixels
+        Time of flight: the same on the farther surface's side (the background's). 0: MEASURED on the shared lab
+        frames (``../shared/data/real-frames``, ``python docs/realism44.py``): the background's depth reaches the
+        spheres' colour outline within about 1 colour pixel where no parallax band lies (sphere 1's left side 3 px
+        inside, its right side 5 px outside with the 3.4 px band the 32 mm colour baseline leaves, the 2 px
+        registration across between them; docs/realism44.md), i.e. no ring of invalid pixels outside the
+        silhouette. Before stop 44 both sides were invalidated (``rim_invalid_px`` about the edge).
     flying_share : float
         Time of flight: share of mixed pixels that survive the filter with a depth between the fruit and
-        what is behind (flying pixels [TOLGYESSY, AK-DEPTH]); 0.1 for the Azure Kinect (judgement: the
-        filter catches most), 0.3 for the L515 (judgement: flying pixels are a known L515 artefact,
-        [LOURENCO]).
+        what is behind (flying pixels [TOLGYESSY, AK-DEPTH]). Azure Kinect 0.005: MEASURED, none on the lab frames
+        (0 of about 1,750 pixels with depth within 4 px of the spheres' free outlines per frame, two frames; the
+        model at 0.1 put 5-10 there per sphere, so the frames bound it below about 0.006; docs/realism44.md; before
+        stop 44 0.1, a judgement). L515 0.3 (judgement: flying pixels are a known L515 artefact, [LOURENCO]; no
+        real L515 frames).
     fatten_px : int, depth pixels
         Active stereo: the foreground's depth spreads this far over the background (half the D4
         matching window; judgement: 3, an object looks about 2 x 3 depth pixels wider, [HALMETSCHLAGER]).
-    grazing, grazing_dropout : float
-        A pixel whose surface faces the ray at ``|cos| < grazing`` returns no depth with probability
-        ``grazing_dropout`` (low return / foreshortening; judgement 0.2 and 0.5).
+    grazing, grazing_dropout, grazing_ramp : float
+        A pixel whose surface faces the ray at ``|cos| < grazing + grazing_ramp * u`` returns no depth with
+        probability ``grazing_dropout``; ``u`` is uniform in 0-1, a smooth field over the image (a normal field
+        correlated over ``max(noise_corr_px, 2)`` depth pixels, :func:`correlated_noise`, through its CDF), so the
+        depth stops along a wavy line where the rim turns away: a time-of-flight pixel's return falls with ``|cos|``
+        (a diffuse surface) and the depth engine invalidates low returns [AK-DEPTH: pixels with too little signal
+        are invalid]. ``grazing_ramp`` 0: a hard threshold, drawn per pixel (the stereo models: 0.2 and 0.5,
+        judgement). Azure Kinect 0.3, 1.0, 0.35 (lost below ``|cos|`` 0.3, kept above 0.65, half lost at 0.475):
+        MEASURED on the shared lab frames' free outlines (``python docs/realism44.py``; sphere 1, 120 px across at
+        1.51 m, its left and right sides: share of pixels with depth 0.02, 0.06, 0.09, 0.20, 0.36, 0.62, 0.94, 1.00
+        in ``|cos|`` bins 0-0.1, ..., 0.6-0.7, 0.7-0.85; the depth stops 8 px inside the colour outline (6 and 10
+        px, the 2 px registration across between them), the outer 13 % of the radius; the white polystyrene
+        spheres, so a darker fruit skin loses no less). Before stop 44: 0.2 and 0.5, a judgement that stopped the
+        depth 3 px inside. L515 the same (judgement: the same physics of the return, no real L515 frames).
     dropout : float
         Probability that any pixel returns no depth (judgement: 0.005).
     multipath_bias, multipath_range : float, metres
@@ -215,10 +240,12 @@ class SensorModel:
     lateral_px: float = 0.3
     edge_step: float = 0.015
     rim_invalid_px: int = 0
+    rim_far_px: int = 0
     flying_share: float = 0.0
     fatten_px: int = 0
     grazing: float = 0.2
     grazing_dropout: float = 0.5
+    grazing_ramp: float = 0.0
     dropout: float = 0.005
     multipath_bias: float = 0.0
     multipath_range: float = 0.02
@@ -279,14 +306,15 @@ SENSOR_MODELS: dict[str, SensorModel] = {
     "azure-kinect": SensorModel(
         "azure-kinect", "tof", 1920, 1080, 90.0, 59.0, 640, 75.0, 65.0, (0.5, 2.0),
         sigma_const=0.0006, sigma_linear=0.0006, noise_corr_px=3.5, bias_const=0.002, bias_linear=0.001,
-        rim_invalid_px=1,
-        flying_share=0.1, multipath_bias=0.005, multipath_range=0.02, registration_px=6.0, colour_baseline=0.032,
+        rim_invalid_px=1, rim_far_px=0, flying_share=0.005, grazing=0.3, grazing_ramp=0.35, grazing_dropout=1.0,
+        multipath_bias=0.005, multipath_range=0.02, registration_px=6.0, colour_baseline=0.032,
         mask_overshoot_px=4.0, mask_amodal_share=0.5,
     ),
     "realsense-l515": SensorModel(
         "realsense-l515", "tof", 1920, 1080, 70.0, 43.0, 1024, 70.0, 55.0, (0.25, 2.0),
         sigma_const=0.001, sigma_linear=0.0015, bias_const=0.002, bias_linear=0.001, rim_invalid_px=1,
-        flying_share=0.3, multipath_bias=0.003, multipath_range=0.02, registration_px=4.0, colour_baseline=0.025,
+        rim_far_px=0, flying_share=0.3, grazing=0.3, grazing_ramp=0.35, grazing_dropout=1.0,
+        multipath_bias=0.003, multipath_range=0.02, registration_px=4.0, colour_baseline=0.025,
         mask_overshoot_px=4.0, mask_amodal_share=0.5,
     ),
     "realsense-d435": SensorModel(
@@ -320,7 +348,8 @@ VARIABLE: dict[str, tuple[float, float]] = {
     "rim_invalid_px": (0, 10), "flying_share": (0.0, 1.0), "fatten_px": (0, 20), "edge_step": (0.002, 0.2),
     "lateral_px": (0.0, 5.0), "registration_px": (0.0, 40.0), "colour_baseline": (0.0, 0.2),
     "mask_overshoot_px": (0.0, 30.0), "mask_amodal_share": (0.0, 1.0), "grazing": (0.0, 1.0),
-    "grazing_dropout": (0.0, 1.0), "dropout": (0.0, 0.5), "multipath_bias": (0.0, 0.05),
+    "grazing_dropout": (0.0, 1.0), "grazing_ramp": (0.0, 1.0), "rim_far_px": (0, 10), "dropout": (0.0, 0.5),
+    "multipath_bias": (0.0, 0.05),
     "multipath_range": (0.001, 0.2), "sigma_const": (0.0, 0.05), "sigma_linear": (0.0, 0.05),
     "subpixel": (0.01, 1.0), "noise_corr_px": (0.0, 20.0), "bias_const": (-0.05, 0.05),
     "bias_linear": (-0.05, 0.05), "bias": (0.0, 10.0),
@@ -491,9 +520,8 @@ def apply_sensor(
         flying = mixed & (rng.random((hd, wd)) < model.flying_share)
         out[flying] = mean[flying]
         valid = (valid | flying) & ~(mixed & ~flying)
-        if model.rim_invalid_px > 0:
-            near_mixed = ndimage.binary_dilation(mixed, iterations=model.rim_invalid_px)
-            valid &= ~(near_mixed & ~mixed)
+        # A footprint partly on nothing straddles the farthest depth there is: its neighbours are all in front.
+        valid &= ~_rim(mixed, np.where(n_hit < count, np.inf, z_max).reshape(hd, wd), z, model)
         if model.multipath_bias > 0:
             out = out + _multipath(z, sid, model, f_d)
     else:
@@ -509,7 +537,14 @@ def apply_sensor(
     noise = correlated_noise(rng.normal(size=(hd, wd)), model.noise_corr_px) * model.sigma(out)
     out = out + model.bias(out) + noise
     if face is not None and model.grazing_dropout > 0:
-        valid &= ~((face < model.grazing) & (rng.random((hd, wd)) < model.grazing_dropout))
+        limit: np.ndarray | float = model.grazing
+        if model.grazing_ramp > 0:  # the threshold varies smoothly along the rim
+            # drawn from a stream of its own (a child of the frame's seed): the frame's other draws (registration,
+            # jitter, masks) stay what they are without the ramp, so a model with and without it differ at the rim
+            side = np.random.default_rng(rng.bit_generator.seed_seq.spawn(1)[0])  # type: ignore[attr-defined]
+            wave = correlated_noise(side.normal(size=(hd, wd)), max(model.noise_corr_px, 2.0))
+            limit = model.grazing + model.grazing_ramp * special.ndtr(wave)
+        valid &= ~((face < limit) & (rng.random((hd, wd)) < model.grazing_dropout))
     valid &= rng.random((hd, wd)) >= model.dropout
     valid &= out > 0
     out = np.where(valid, out, 0.0)
@@ -548,6 +583,26 @@ def correlated_noise(white: np.ndarray, length: float) -> np.ndarray:
     kernel /= kernel.sum()
     smooth = ndimage.gaussian_filter(white, s, mode="wrap", truncate=radius / s)
     return smooth / float(np.sum(kernel**2))  # 2-D variance: (sum k^2)^2, its square root
+
+
+def _rim(mixed: np.ndarray, z_max: np.ndarray, z: np.ndarray, model: SensorModel) -> np.ndarray:
+    """(hd, wd) bool: valid depth pixels the depth engine invalidates beside a mixed one: within ``rim_invalid_px``
+    on the nearer surface's side (depth more than ``edge_step`` in front of the farthest depth a mixed pixel within
+    that reach straddles) and within ``rim_far_px`` on the farther surface's side. Not the mixed pixels themselves."""
+    out = np.zeros(mixed.shape, bool)
+    reach = max(model.rim_invalid_px, model.rim_far_px)
+    if reach <= 0 or not mixed.any():
+        return out
+    for r, near_side in ((model.rim_invalid_px, True), (model.rim_far_px, False)):
+        if r <= 0:
+            continue
+        ii, jj = np.mgrid[-r : r + 1, -r : r + 1]
+        diamond = np.abs(ii) + np.abs(jj) <= r  # what ``binary_dilation(iterations=r)`` reaches
+        far = ndimage.grey_dilation(np.where(mixed, z_max, 0.0), footprint=diamond, mode="constant", cval=0.0)
+        with np.errstate(invalid="ignore"):
+            front = (z > 0) & (z < far - model.edge_step)
+        out |= (far > 0) & ~mixed & (front if near_side else ~front)
+    return out
 
 
 def _multipath(z: np.ndarray, sid: np.ndarray, model: SensorModel, focal: float) -> np.ndarray:
