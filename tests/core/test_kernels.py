@@ -4563,3 +4563,71 @@ def test_noise_measures_read_the_grids_neighbourhoods():
     assert noise == np.sqrt(max(least_small, 0.0))
     assert ratio == np.sqrt(max(least_large, 0.0)) / max(noise, 1e-15)
     assert 0.0 < noise < 1e-3 and ratio > 1.0
+
+
+# --- stop 44, speedseg44
+
+
+def _polygon_masks(rng, n):
+    """``n`` masks whose hulls a segmenter meets: noisy discs and ellipses (5-400 pixels across), sparse specks, single
+    rows and columns, a few scattered pixels."""
+    for t in range(n):
+        h, w = (int(v) for v in rng.integers(1, 60 if t % 5 else 400, 2))
+        yy, xx = np.mgrid[:h, :w]
+        kind = t % 4
+        if kind == 0:
+            cy, cx = rng.random(2) * (h, w)
+            r = rng.uniform(0.05, 1.0) * max(h, w) * 0.5
+            mask = ((yy - cy) ** 2 * rng.uniform(0.3, 3.0) + (xx - cx) ** 2 <= r * r) & (rng.random((h, w)) < 0.9)
+        elif kind == 1:
+            mask = rng.random((h, w)) < rng.random() * 0.2
+        elif kind == 2:
+            mask = np.zeros((h, w), bool)
+            mask[rng.integers(0, h, 4), rng.integers(0, w, 4)] = True
+        else:
+            mask = np.zeros((h, w), bool)
+            if t % 8 == 3:
+                mask[int(rng.integers(0, h)), :] = rng.random(w) < 0.5
+            else:
+                mask[:, int(rng.integers(0, w))] = rng.random(h) < 0.5
+        yield mask
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_hull_fill_is_pillows(seed):
+    """:func:`_jit.polygon_fill` (Pillow's scan-line fill, written out) gives Pillow's pixels: ``_hull_mask`` with the
+    kernel and with the twin (Pillow's drawing, ``SYMFRUIT_KERNELS=numpy``) on 600 masks' hulls, the same pixels; and
+    on polygons of any whole-number vertices (any order, repeated vertices, horizontal runs, partly or wholly off the
+    image), the kernel over an empty mask against ``_fill_polygon``."""
+    from symfruit.segment.colour import _fill_polygon, _hull_mask, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    hulls = 0
+    for mask in _polygon_masks(rng, 600):
+        vertices = _hull_vertices(mask)
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _hull_mask, vertices, mask)
+        np.testing.assert_array_equal(fast, twin)
+        hulls += vertices is not None and int(twin.sum()) > int(mask.sum())
+    assert hulls > 200
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        vertices = rng.integers(-10, 50, (int(rng.integers(2, 9)), 2)).astype(np.float64)
+        if t % 3 == 0:
+            vertices[:, 1] = np.round(vertices[:, 1] / 8) * 8  # horizontal edges, some in a row
+        if t % 5 == 0:
+            vertices[1] = vertices[0]
+        fast = _jit.polygon_fill(vertices, np.zeros((h, w), bool))
+        np.testing.assert_array_equal(fast, _fill_polygon(vertices, (h, w)))
+
+
+def test_the_hull_fill_known_answers():
+    """The doctest's right triangle (15 pixels: the legs and the hypotenuse included); a thin sliver's corner, where
+    Pillow joins a corner's two crossings to the next row's (rows 6 and 7 of the triangle (24, 6), (33, 10), (36, 12):
+    pixels 24-25, then 26); a vertex that is not a whole number: no fill (the caller's Pillow draws it)."""
+    tri = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]])
+    assert int(_jit.polygon_fill(tri, np.zeros((5, 5), bool)).sum()) == 15
+    sliver = _jit.polygon_fill(np.array([[24.0, 6.0], [33.0, 10.0], [36.0, 12.0]]), np.zeros((13, 41), bool))
+    assert np.flatnonzero(sliver[6]).tolist() == [24, 25]
+    assert np.flatnonzero(sliver[7]).tolist() == [26]
+    assert _jit.polygon_fill(np.array([[0.0, 0.0], [4.5, 0.0], [0.0, 4.0]]), np.zeros((5, 5), bool)).shape == (0, 0)

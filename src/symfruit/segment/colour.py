@@ -321,9 +321,15 @@ def convex_hull_mask(mask: np.ndarray) -> np.ndarray:
 
 
 def _hull_mask(vertices: np.ndarray | None, mask: np.ndarray) -> np.ndarray:
-    """:func:`convex_hull_mask` from the mask's :func:`_hull_vertices`."""
+    """:func:`convex_hull_mask` from the mask's :func:`_hull_vertices`. Where numba is, the hull is filled in the
+    mask's copy by the compiled twin of Pillow's fill (:func:`symfruit.core._jit.polygon_fill`: the same pixels; its
+    image, drawing and copy were 2.5 ms a 1920x1080 tree frame; stop 44)."""
     if vertices is None:
         return mask.copy()
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool and vertices.dtype == np.float64:
+        out: np.ndarray = jit.polygon_fill(vertices, mask)
+        if out.shape == mask.shape:  # whole-number vertices (a hull's always are)
+            return out
     return _fill_polygon(vertices, mask.shape) | mask
 
 
@@ -500,7 +506,7 @@ def _upsample(small: np.ndarray, step: int, shape: tuple[int, int], *, hull: boo
             v = _hull_vertices(mask)
             if v is not None:
                 pts = (v[:, None, :] * step + corners[None]).reshape(-1, 2)
-                full = full | _fill_polygon(_polygon(pts), (r1 - r0, c1 - c0))
+                full = _hull_mask(_polygon(pts), full)  # the polygon filled in, as over a mask
         window = out[r0:r1, c0:c1]
         window[full & (window == 0)] = k
     return out
