@@ -4633,3 +4633,29 @@ def test_the_hull_fill_known_answers():
     assert np.flatnonzero(sliver[6]).tolist() == [24, 25]
     assert np.flatnonzero(sliver[7]).tolist() == [26]
     assert _jit.polygon_fill(np.array([[0.0, 0.0], [4.5, 0.0], [0.0, 4.0]]), np.zeros((5, 5), bool)).shape == (0, 0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_depth_windows_read_along_the_image_are_the_twins(dtype):
+    """``_Depth``'s windows read along the whole image's rows (:func:`_jit.depth_window_at`) against the twin's
+    (``np.where`` over the window, ``SYMFRUIT_KERNELS=numpy``), bit for bit: NaN, infinite, negative and -0.0 depths
+    0, the rest as float64; plain windows, windows past the border, empty ones, every other or fourth pixel, and the
+    whole image; and against :func:`_jit.depth_window` of the window's view."""
+    from symfruit.segment.colour import _Depth
+
+    rng = np.random.default_rng(44)
+    z = rng.uniform(0.3, 2.0, (61, 83)).astype(dtype)
+    z[rng.random(z.shape) < 0.1] = 0.0
+    for bad in (np.nan, np.inf, -np.inf, -0.5, -0.0):
+        z[rng.random(z.shape) < 0.03] = bad
+    windows = [(slice(3, 20), slice(5, 60)), (slice(50, 99), slice(70, 200)), (slice(9, 4), slice(0, 10)),
+               (slice(None, None, 4), slice(None, None, 4)), (slice(1, None, 2), slice(2, 77, 3)),
+               (slice(None), slice(None)), (slice(0, 1), slice(82, 83))]  # fmt: skip
+    for window in windows:
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, lambda w: _Depth(z)[w], window)
+        assert fast.dtype == twin.dtype == np.float64 and fast.shape == twin.shape == z[window].shape
+        assert fast.tobytes() == twin.tobytes()
+        rows, cols = window[0].indices(61), window[1].indices(83)
+        assert _jit.depth_window_at(z, rows, cols).tobytes() == _jit.depth_window(z[window]).tobytes()
+    assert (_Depth(z)[windows[0]] > 0).sum() > 0.7 * z[windows[0]].size

@@ -6907,3 +6907,27 @@ def _add_edge(edges: np.ndarray, slope: np.ndarray, n: int, x0: int, y0: int, x1
     edges[n, 2], edges[n, 4] = min(x0, x1), max(x0, x1)
     edges[n, 3], edges[n, 5] = min(y0, y1), max(y0, y1)
     slope[n] = np.float32(0.0) if y0 == y1 else np.float32(np.float64(x1 - x0) / np.float64(y1 - y0))
+
+
+@_njit
+def depth_window_at(given: np.ndarray, rows: tuple[int, int, int], cols: tuple[int, int, int]) -> np.ndarray:
+    """:func:`depth_window` of the window ``given[r0:r1:rs, c0:c1:cs]`` of a C-contiguous depth image ``given``
+    (h, w) float, ``rows`` and ``cols`` the ``(start, stop, step)`` of ``slice.indices`` (steps positive): the same
+    values. Read through the whole image's rows, not a window's view of unknown strides: on a window of whole rows,
+    each row's loop runs over contiguous values, which numba vectorises (4.8 to 2.1 ns a pixel, 102 windows and 0.6
+    million pixels a 1920x1080 tree frame; stop 44)."""
+    r0, r1, rs = rows
+    c0, c1, cs = cols
+    out = np.empty((max(r1 - r0 + rs - 1, 0) // rs, max(c1 - c0 + cs - 1, 0) // cs), np.float64)
+    for i in range(out.shape[0]):
+        row = given[r0 + i * rs]
+        line = out[i]
+        if cs == 1:
+            for c in range(out.shape[1]):
+                v = row[c0 + c]
+                line[c] = np.float64(v) if (v > 0) & (v < np.inf) else 0.0
+        else:
+            for c in range(out.shape[1]):
+                v = row[c0 + c * cs]
+                line[c] = np.float64(v) if (v > 0) & (v < np.inf) else 0.0
+    return out

@@ -911,7 +911,14 @@ class _Depth:
         z = self.read.get(key)
         if z is None:
             given = self.given[window]
-            if (jit := compiled()) is not None and given.ndim == 2 and given.dtype in _FLOATS:
+            jit = compiled()
+            rows, cols = a.indices(self.shape[0]), b.indices(self.shape[1])
+            if jit is not None and given.ndim == 2 and given.dtype in _FLOATS and rows[2] > 0 and cols[2] > 0 and (
+                    self.given.flags.c_contiguous):  # fmt: skip
+                # read along the whole image's rows (:func:`symfruit.core._jit.depth_window_at`: the same values;
+                # twice as fast as through the window's view, stop 44)
+                z = jit.depth_window_at(self.given, rows, cols)
+            elif jit is not None and given.ndim == 2 and given.dtype in _FLOATS:
                 z = jit.depth_window(given)  # the same values in one pass (issue 19, nineteenth round)
             else:
                 z = np.where(_usable(given), given.astype(np.float64), 0.0)  # a select: faster than a masked copy
