@@ -4659,3 +4659,42 @@ def test_the_depth_windows_read_along_the_image_are_the_twins(dtype):
         rows, cols = window[0].indices(61), window[1].indices(83)
         assert _jit.depth_window_at(z, rows, cols).tobytes() == _jit.depth_window(z[window]).tobytes()
     assert (_Depth(z)[windows[0]] > 0).sum() > 0.7 * z[windows[0]].size
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_bulge_sums_are_the_bincounts(seed):
+    """``_bulging`` with :func:`_jit.bulge_sums` (one pass per sum) and with the twin's ``np.bincount`` calls: the same
+    answers on caps of balls (bulging), planes and saddles, some pixels without depth, some pieces too small;
+    and the sums themselves are the twin's bincounts to the bit."""
+    from symfruit.segment.colour import SegmentSettings, _bulging, _Geometry
+
+    rng = np.random.default_rng(seed)
+    n = 12
+    size = rng.integers(5, 300, n + 1)
+    labels = np.repeat(np.arange(n + 1), size)
+    rng.shuffle(labels)
+    centre = rng.integers(20, 250, (n + 1, 2)) * 4  # each piece a patch of the grid's pixels 40 px about its centre
+    rows = centre[labels, 0] + rng.integers(-10, 11, len(labels)) * 4
+    cols = centre[labels, 1] + rng.integers(-10, 11, len(labels)) * 4
+    geo = _Geometry(1400.0, 540.0, 960.0)
+    dx, dy = (cols - centre[labels, 1]) * 0.9 / geo.focal, (rows - centre[labels, 0]) * 0.9 / geo.focal
+    shape = labels % 3  # 0: a 4 cm ball's cap towards the camera, 1: a slanted plane, 2: a saddle
+    cap = 0.9 + 0.04 - np.sqrt(np.maximum(0.04**2 - dx**2 - dy**2, 0.0))
+    depth = np.where(shape == 0, cap, np.where(shape == 1, 0.9 + 0.3 * dx, 0.9 + 20 * dx * dy))
+    depth += rng.normal(0, 2e-4, len(labels))
+    depth[rng.random(len(labels)) < 0.1] = 0.0
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _bulging, labels, rows, cols, depth, n, geo, s)
+    np.testing.assert_array_equal(fast, twin)
+    kind = np.arange(n + 1) % 3
+    assert fast[kind == 0].all() and not fast[kind == 1].any()  # the caps bulge, the planes do not
+    count, m, rhs, zz = _jit.bulge_sums(labels, rows, cols, depth, n, geo.cx, geo.cy, geo.focal)
+    ok = depth > 0
+    lab, z = labels[ok], depth[ok]
+    x = (cols[ok] - geo.cx) * z / geo.focal
+    x = x - (np.bincount(lab, weights=x, minlength=n + 1) / np.maximum(count, 1.0))[lab]
+    assert count.tobytes() == np.bincount(lab, minlength=n + 1).astype(np.float64).tobytes()
+    assert m[:, 1, 1].tobytes() == np.bincount(lab, weights=x * x, minlength=n + 1).tobytes()
+    assert rhs[:, 1].tobytes() == np.bincount(lab, weights=x * z, minlength=n + 1).tobytes()
+    assert zz.tobytes() == np.bincount(lab, weights=z * z, minlength=n + 1).tobytes()
