@@ -6913,9 +6913,9 @@ def _add_edge(edges: np.ndarray, slope: np.ndarray, n: int, x0: int, y0: int, x1
 def depth_window_at(given: np.ndarray, rows: tuple[int, int, int], cols: tuple[int, int, int]) -> np.ndarray:
     """:func:`depth_window` of the window ``given[r0:r1:rs, c0:c1:cs]`` of a C-contiguous depth image ``given``
     (h, w) float, ``rows`` and ``cols`` the ``(start, stop, step)`` of ``slice.indices`` (steps positive): the same
-    values. Read through the whole image's rows, not a window's view of unknown strides: on a window of whole rows,
-    each row's loop runs over contiguous values, which numba vectorises (4.8 to 2.1 ns a pixel, 102 windows and 0.6
-    million pixels a 1920x1080 tree frame; stop 44)."""
+    values. Read through the whole image's rows, not a window's view of unknown strides: with a step of one, each
+    row's loop runs over contiguous values, which numba vectorises (100 random windows of a 1920x1080 tree frame's
+    depth, 5.95 to 4.06 ms in one process; 4.7 to 2.1 ns a pixel on windows of 150 pixels; stop 44)."""
     r0, r1, rs = rows
     c0, c1, cs = cols
     out = np.empty((max(r1 - r0 + rs - 1, 0) // rs, max(c1 - c0 + cs - 1, 0) // cs), np.float64)

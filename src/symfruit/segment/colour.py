@@ -916,7 +916,7 @@ class _Depth:
             if jit is not None and given.ndim == 2 and given.dtype in _FLOATS and rows[2] > 0 and cols[2] > 0 and (
                     self.given.flags.c_contiguous):  # fmt: skip
                 # read along the whole image's rows (:func:`symfruit.core._jit.depth_window_at`: the same values;
-                # twice as fast as through the window's view, stop 44)
+                # vectorised rows, about 1.5 times as fast as through the window's view; stop 44)
                 z = jit.depth_window_at(self.given, rows, cols)
             elif jit is not None and given.ndim == 2 and given.dtype in _FLOATS:
                 z = jit.depth_window(given)  # the same values in one pass (issue 19, nineteenth round)
