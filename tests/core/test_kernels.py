@@ -4735,3 +4735,138 @@ def test_peel_keeps_a_pocket_inside():
     want = drop.copy()
     want[3, 3] = False
     assert np.array_equal(out, want)
+
+
+# --- stop 44, speedseg44
+
+
+def _polygon_masks(rng, n):
+    """``n`` masks whose hulls a segmenter meets: noisy discs and ellipses (5-400 pixels across), sparse specks, single
+    rows and columns, a few scattered pixels."""
+    for t in range(n):
+        h, w = (int(v) for v in rng.integers(1, 60 if t % 5 else 400, 2))
+        yy, xx = np.mgrid[:h, :w]
+        kind = t % 4
+        if kind == 0:
+            cy, cx = rng.random(2) * (h, w)
+            r = rng.uniform(0.05, 1.0) * max(h, w) * 0.5
+            mask = ((yy - cy) ** 2 * rng.uniform(0.3, 3.0) + (xx - cx) ** 2 <= r * r) & (rng.random((h, w)) < 0.9)
+        elif kind == 1:
+            mask = rng.random((h, w)) < rng.random() * 0.2
+        elif kind == 2:
+            mask = np.zeros((h, w), bool)
+            mask[rng.integers(0, h, 4), rng.integers(0, w, 4)] = True
+        else:
+            mask = np.zeros((h, w), bool)
+            if t % 8 == 3:
+                mask[int(rng.integers(0, h)), :] = rng.random(w) < 0.5
+            else:
+                mask[:, int(rng.integers(0, w))] = rng.random(h) < 0.5
+        yield mask
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_hull_fill_is_pillows(seed):
+    """:func:`_jit.polygon_fill` (Pillow's scan-line fill, written out) gives Pillow's pixels: ``_hull_mask`` with the
+    kernel and with the twin (Pillow's drawing, ``SYMFRUIT_KERNELS=numpy``) on 600 masks' hulls, the same pixels; and
+    on polygons of any whole-number vertices (any order, repeated vertices, horizontal runs, partly or wholly off the
+    image), the kernel over an empty mask against ``_fill_polygon``."""
+    from symfruit.segment.colour import _fill_polygon, _hull_mask, _hull_vertices, _pillow_fill
+
+    if not _pillow_fill():
+        pytest.skip("a Pillow older than 12.1 fills polygons otherwise (the kernel is not used with it)")
+    rng = np.random.default_rng(seed)
+    hulls = 0
+    for mask in _polygon_masks(rng, 600):
+        vertices = _hull_vertices(mask)
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _hull_mask, vertices, mask)
+        np.testing.assert_array_equal(fast, twin)
+        hulls += vertices is not None and int(twin.sum()) > int(mask.sum())
+    assert hulls > 200
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        vertices = rng.integers(-10, 50, (int(rng.integers(2, 9)), 2)).astype(np.float64)
+        if t % 3 == 0:
+            vertices[:, 1] = np.round(vertices[:, 1] / 8) * 8  # horizontal edges, some in a row
+        if t % 5 == 0:
+            vertices[1] = vertices[0]
+        fast = _jit.polygon_fill(vertices, np.zeros((h, w), bool))
+        np.testing.assert_array_equal(fast, _fill_polygon(vertices, (h, w)))
+
+
+def test_the_hull_fill_known_answers():
+    """The doctest's right triangle (15 pixels: the legs and the hypotenuse included); a thin sliver's corner, where
+    Pillow joins a corner's two crossings to the next row's (rows 6 and 7 of the triangle (24, 6), (33, 10), (36, 12):
+    pixels 24-25, then 26); a vertex that is not a whole number: no fill (the caller's Pillow draws it)."""
+    tri = np.array([[0.0, 0.0], [4.0, 0.0], [0.0, 4.0]])
+    assert int(_jit.polygon_fill(tri, np.zeros((5, 5), bool)).sum()) == 15
+    sliver = _jit.polygon_fill(np.array([[24.0, 6.0], [33.0, 10.0], [36.0, 12.0]]), np.zeros((13, 41), bool))
+    assert np.flatnonzero(sliver[6]).tolist() == [24, 25]
+    assert np.flatnonzero(sliver[7]).tolist() == [26]
+    assert _jit.polygon_fill(np.array([[0.0, 0.0], [4.5, 0.0], [0.0, 4.0]]), np.zeros((5, 5), bool)).shape == (0, 0)
+
+
+@pytest.mark.parametrize("dtype", [np.float32, np.float64])
+def test_the_depth_windows_read_along_the_image_are_the_twins(dtype):
+    """``_Depth``'s windows read along the whole image's rows (:func:`_jit.depth_window_at`) against the twin's
+    (``np.where`` over the window, ``SYMFRUIT_KERNELS=numpy``), bit for bit: NaN, infinite, negative and -0.0 depths
+    0, the rest as float64; plain windows, windows past the border, empty ones, every other or fourth pixel, and the
+    whole image; and against :func:`_jit.depth_window` of the window's view."""
+    from symfruit.segment.colour import _Depth
+
+    rng = np.random.default_rng(44)
+    z = rng.uniform(0.3, 2.0, (61, 83)).astype(dtype)
+    z[rng.random(z.shape) < 0.1] = 0.0
+    for bad in (np.nan, np.inf, -np.inf, -0.5, -0.0):
+        z[rng.random(z.shape) < 0.03] = bad
+    windows = [(slice(3, 20), slice(5, 60)), (slice(50, 99), slice(70, 200)), (slice(9, 4), slice(0, 10)),
+               (slice(None, None, 4), slice(None, None, 4)), (slice(1, None, 2), slice(2, 77, 3)),
+               (slice(None), slice(None)), (slice(0, 1), slice(82, 83))]  # fmt: skip
+    for window in windows:
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, lambda w: _Depth(z)[w], window)
+        assert fast.dtype == twin.dtype == np.float64 and fast.shape == twin.shape == z[window].shape
+        assert fast.tobytes() == twin.tobytes()
+        rows, cols = window[0].indices(61), window[1].indices(83)
+        assert _jit.depth_window_at(z, rows, cols).tobytes() == _jit.depth_window(z[window]).tobytes()
+    assert (_Depth(z)[windows[0]] > 0).sum() > 0.7 * z[windows[0]].size
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_bulge_sums_are_the_bincounts(seed):
+    """``_bulging`` with :func:`_jit.bulge_sums` (one pass per sum) and with the twin's ``np.bincount`` calls: the same
+    answers on caps of balls (bulging), planes and saddles, some pixels without depth, some pieces too small;
+    and the sums themselves are the twin's bincounts to the bit."""
+    from symfruit.segment.colour import SegmentSettings, _bulging, _Geometry
+
+    rng = np.random.default_rng(seed)
+    n = 12
+    size = rng.integers(5, 300, n + 1)
+    labels = np.repeat(np.arange(n + 1), size)
+    rng.shuffle(labels)
+    centre = rng.integers(20, 250, (n + 1, 2)) * 4  # each piece a patch of the grid's pixels 40 px about its centre
+    rows = centre[labels, 0] + rng.integers(-10, 11, len(labels)) * 4
+    cols = centre[labels, 1] + rng.integers(-10, 11, len(labels)) * 4
+    geo = _Geometry(1400.0, 540.0, 960.0)
+    dx, dy = (cols - centre[labels, 1]) * 0.9 / geo.focal, (rows - centre[labels, 0]) * 0.9 / geo.focal
+    shape = labels % 3  # 0: a 4 cm ball's cap towards the camera, 1: a slanted plane, 2: a saddle
+    cap = 0.9 + 0.04 - np.sqrt(np.maximum(0.04**2 - dx**2 - dy**2, 0.0))
+    depth = np.where(shape == 0, cap, np.where(shape == 1, 0.9 + 0.3 * dx, 0.9 + 20 * dx * dy))
+    depth += rng.normal(0, 2e-4, len(labels))
+    depth[rng.random(len(labels)) < 0.1] = 0.0
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _bulging, labels, rows, cols, depth, n, geo, s)
+    np.testing.assert_array_equal(fast, twin)
+    kind = np.arange(n + 1) % 3
+    assert fast[kind == 0].all() and not fast[kind == 1].any()  # the caps bulge, the planes do not
+    count, m, rhs, zz = _jit.bulge_sums(labels, rows, cols, depth, n, geo.cx, geo.cy, geo.focal)
+    ok = depth > 0
+    lab, z = labels[ok], depth[ok]
+    x = (cols[ok] - geo.cx) * z / geo.focal
+    x = x - (np.bincount(lab, weights=x, minlength=n + 1) / np.maximum(count, 1.0))[lab]
+    assert count.tobytes() == np.bincount(lab, minlength=n + 1).astype(np.float64).tobytes()
+    assert m[:, 1, 1].tobytes() == np.bincount(lab, weights=x * x, minlength=n + 1).tobytes()
+    assert rhs[:, 1].tobytes() == np.bincount(lab, weights=x * z, minlength=n + 1).tobytes()
+    assert zz.tobytes() == np.bincount(lab, weights=z * z, minlength=n + 1).tobytes()
