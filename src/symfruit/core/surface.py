@@ -1072,7 +1072,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
     # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
     # (0, 17) px to (18, 0) and (-15, 15) (docs/ablation.md, "A fall of whole depth units")
-    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0)
+    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0, thin=True)
     if surface is None:
         return None
     cap = _connected(surface.pixels, surface.apex)
