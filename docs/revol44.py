@@ -160,7 +160,11 @@ def main(argv: list[str]) -> int:
 
         _patch(argv[1])
         return eval_boxes.run(argv[2], argv[3:])
-    _say(__doc__)
+    usage = "usage: revol44.py synthetic | run RATIO|cone|three BOXES.csv evaluate ARGS... | table RESULTS_DIR...\n"
+    if argv[:1] in (["-h"], ["--help"]):
+        sys.stdout.write(usage + (__doc__ or ""))
+        return 0
+    sys.stderr.write(usage)
     return 2
 
 
