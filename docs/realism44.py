@@ -28,7 +28,6 @@ sphere's front and its centre's depth + 2 cm), ``background`` (within 3 cm of th
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import sys
 from pathlib import Path
@@ -196,17 +195,10 @@ def sides(depth: np.ndarray, mask: np.ndarray, camera: Camera) -> dict:
 
 
 def real(folder: str) -> list[tuple[str, int, dict]]:
-    from PIL import Image
+    from symfruit.evaluate.sensorcheck import frame_spheres
 
-    out = []
-    for frame in sorted(p for p in Path(folder).iterdir() if (p / "depth.png").is_file()):
-        meta = json.loads((frame / "camera.json").read_text())
-        cam = Camera(meta["fx"], meta["fy"], meta["cx"], meta["cy"], meta["width"], meta["height"])
-        depth = np.asarray(Image.open(frame / "depth.png"), dtype=np.float64) * float(meta.get("depth_scale", 0.001))
-        labels = np.asarray(Image.open(frame / "masks.png"))
-        for k in np.unique(labels[labels > 0]):
-            out.append((frame.name, int(k), {**profile(depth, labels == k, cam), **sides(depth, labels == k, cam)}))
-    return out
+    return [(name, k, {**profile(depth, mask, cam), **sides(depth, mask, cam)})
+            for name, k, depth, mask, cam in frame_spheres(folder)]  # fmt: skip
 
 
 def model(name: str, seed: int, sensor_set: object) -> list[tuple[str, int, dict]]:

@@ -30,6 +30,7 @@ from __future__ import annotations
 import json
 import math
 import sys
+from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
 
@@ -194,19 +195,24 @@ def _best_shift(mask: np.ndarray, silhouette: np.ndarray, search: int) -> tuple[
     return float(iou.flat[k]), int(shifts[k % len(shifts)]), int(shifts[k // len(shifts)])
 
 
-def real_frames(folder: str | Path) -> list[dict[str, Any]]:
-    """Measure every sphere of every frame folder under ``folder``."""
+def frame_spheres(folder: str | Path) -> Iterator[tuple[str, int, np.ndarray, np.ndarray, Camera]]:
+    """Every sphere of every frame folder under ``folder`` (the lab frames' layout: ``depth.png``, ``masks.png``,
+    ``camera.json``): its frame's name, its label, the frame's depth (metres), its mask and the camera."""
     from PIL import Image
 
-    out = []
     for frame in sorted(p for p in Path(folder).iterdir() if (p / "depth.png").is_file()):
         meta = json.loads((frame / "camera.json").read_text())
         cam = Camera(meta["fx"], meta["fy"], meta["cx"], meta["cy"], meta["width"], meta["height"])
         depth = np.asarray(Image.open(frame / "depth.png"), dtype=np.float64) * float(meta.get("depth_scale", 0.001))
         labels = np.asarray(Image.open(frame / "masks.png"))
         for k in np.unique(labels[labels > 0]):
-            out.append({"frame": frame.name, "sphere": int(k), **measure_sphere(depth, labels == k, cam)})
-    return out
+            yield frame.name, int(k), depth, labels == k, cam
+
+
+def real_frames(folder: str | Path) -> list[dict[str, Any]]:
+    """Measure every sphere of every frame folder under ``folder``."""
+    return [{"frame": name, "sphere": k, **measure_sphere(depth, mask, cam)}
+            for name, k, depth, mask, cam in frame_spheres(folder)]  # fmt: skip
 
 
 #: The lab frames' layout: (diameter m, centre depth m, u, v at 1920x1080), read off the frames.
