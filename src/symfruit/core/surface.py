@@ -406,16 +406,19 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     if not near.any():
         return None
     sheet_id = int(np.argmax(np.bincount(parts[near], minlength=count + 1)[1:])) + 1
+    sizes = np.bincount(parts.ravel(), minlength=count + 1)
+    n_sheet = int(sizes[sheet_id])
+    if n_sheet < 30:
+        return None
+    others = sizes[1:].copy()
+    others[sheet_id - 1] = 0  # the largest other part (every part holds a pixel: the same maximum)
+    largest = int(others.max())
+    if largest < max(30, 0.1 * n_sheet):
+        # no part large enough behind (a fruit's own front, not flat: the usual case, ended here), whatever the
+        # sheet's fit reads: asked before it and before the sheet's pixels are listed (stop 44, speedreg44)
+        return None
     sheet = parts == sheet_id
     rows, cols = np.nonzero(sheet)
-    if len(rows) < 30:
-        return None
-    sizes = np.bincount(parts.ravel(), minlength=count + 1)
-    largest = max(int(n) for k, n in enumerate(sizes[1:], 1) if k != sheet_id)
-    if largest < max(30, 0.1 * len(rows)):
-        # no part large enough behind (a fruit's own front, not flat: the usual case, ended here), whatever the
-        # sheet's fit reads: asked before it (stop 44, speedreg44)
-        return None
     kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
     error *= inflate
     flat = kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]
