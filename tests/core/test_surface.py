@@ -1076,3 +1076,27 @@ def test_the_registration_outline_passes_over_a_leaf_in_front_drawn_into_the_mas
     mask = np.asarray(view.out.labels) == 1
     _, shift = register(mask.astype(np.int32), view.out.depth, view.camera)
     assert np.abs(np.subtract(shift, view.out.shift)).max() <= 1.5, shift
+
+
+def test_the_sheet_test_fits_nothing_that_cannot_decide(monkeypatch):
+    """Stop 44 (speedreg44): ``thin_front`` asks whether the nearest surface reaches the mask's outline before it fits
+    that surface's curvature (where it does, the fit decides nothing), and ``_behind_sheet`` whether any part behind
+    the front part is large enough before it fits the front part. A ball whose mask is cut through its front pole (the
+    nearest surface reaches the outline), alone and with a patch of 20 pixels 0.2 m behind it (two parts, the one
+    behind too small): no sheet, and not one fit."""
+    import symfruit.core.surface as surface
+
+    fits = []
+    fit = surface._mean_curvature
+    monkeypatch.setattr(surface, "_mean_curvature", lambda *a: fits.append(1) or fit(*a))
+    yy, xx = np.mgrid[:H, :W]
+    depth, disc = ball(noise=0.0005)
+    half = disc & (xx <= 80)
+    patch = (yy >= 58) & (yy < 62) & (xx >= 30) & (xx < 35)
+    behind = np.where(patch, 0.7, depth)
+    for d, mask in ((depth, half), (behind, half | patch)):
+        noise = depth_noise(d, mask)
+        front, radius = fruit_depth(d[mask], float(np.sqrt(mask.sum() / np.pi)), F, noise=noise)
+        assert front == pytest.approx(0.5, abs=0.001)
+        assert thin_front(d, mask, F, front, radius, max(3.0 * noise, 0.003), noise) is None
+    assert fits == []
