@@ -203,21 +203,13 @@ def real(folder: str) -> list[tuple[str, int, dict]]:
 
 def model(name: str, seed: int, sensor_set: object) -> list[tuple[str, int, dict]]:
     """The lab layout of ``symfruit.evaluate.sensorcheck`` through ``name``; masks the true silhouettes."""
-    from symfruit.evaluate.sensorcheck import LAB_SPHERES
+    from symfruit.evaluate.sensorcheck import LAB_SPHERES, lab_meshes
     from symfruit.synthetic.render import render
     from symfruit.synthetic.sensors import SENSOR_MODELS, apply_sensor, varied
-    from symfruit.synthetic.shapes import _revolve
 
     m = varied(SENSOR_MODELS[name], sensor_set)
     cam = m.camera()
-    meshes = []
-    for diameter, z, u, v in LAB_SPHERES:
-        t = np.linspace(0, np.pi, 90)
-        ball = _revolve(diameter / 2 * np.sin(t), -diameter / 2 * np.cos(t), name="ball", n_phi=96)
-        meshes.append((ball.vertices + cam.deproject(np.array([u, v], float), np.array(z)), ball.faces))
-    wall = np.array([[-3.0, -3.0, 1.73], [3.0, -3.0, 1.73], [3.0, 3.0, 1.73], [-3.0, 3.0, 1.73]])
-    meshes.append((wall, np.array([[0, 1, 2], [0, 2, 3]])))
-    shot = render(meshes, cam)
+    shot = render(lab_meshes(cam), cam)
     fr = apply_sensor(m, shot.depth, shot.ids, cam, np.random.default_rng(seed), facing=shot.facing)
     depth = np.asarray(fr.depth, dtype=np.float64)
     tag = f"{name} seed {seed} (shift {fr.shift[0]:+.1f}, {fr.shift[1]:+.1f})"

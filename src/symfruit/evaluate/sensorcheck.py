@@ -219,15 +219,11 @@ def real_frames(folder: str | Path) -> list[dict[str, Any]]:
 LAB_SPHERES = ((0.19, 1.44, 1148, 420), (0.12, 1.27, 905, 483), (0.064, 1.02, 1052, 588), (0.06, 1.27, 1290, 531))
 
 
-def _model_shot(name: str, seed: int, sensor_set: object = ()) -> tuple[np.ndarray, np.ndarray, Camera]:
-    """The lab layout rendered through the sensor model ``name`` (``sensor_set`` varied, seeded): (depth, masks,
-    camera)."""
-    from ..synthetic.render import render
-    from ..synthetic.sensors import SENSOR_MODELS, apply_sensor, varied
+def lab_meshes(cam: Camera) -> list[tuple[np.ndarray, np.ndarray]]:
+    """The lab frames' layout as meshes (vertices, faces) for ``cam``: the four spheres of :data:`LAB_SPHERES`
+    (mesh ids 0-3) and the flat background 1.73 m away (id 4)."""
     from ..synthetic.shapes import _revolve
 
-    model = varied(SENSOR_MODELS[name], sensor_set)
-    cam = model.camera()
     meshes = []
     for diameter, z, u, v in LAB_SPHERES:
         t = np.linspace(0, np.pi, 90)
@@ -236,7 +232,18 @@ def _model_shot(name: str, seed: int, sensor_set: object = ()) -> tuple[np.ndarr
         meshes.append((ball.vertices + centre, ball.faces))
     wall = np.array([[-3.0, -3.0, 1.73], [3.0, -3.0, 1.73], [3.0, 3.0, 1.73], [-3.0, 3.0, 1.73]])
     meshes.append((wall, np.array([[0, 1, 2], [0, 2, 3]])))
-    shot = render(meshes, cam)
+    return meshes
+
+
+def _model_shot(name: str, seed: int, sensor_set: object = ()) -> tuple[np.ndarray, np.ndarray, Camera]:
+    """The lab layout rendered through the sensor model ``name`` (``sensor_set`` varied, seeded): (depth, masks,
+    camera)."""
+    from ..synthetic.render import render
+    from ..synthetic.sensors import SENSOR_MODELS, apply_sensor, varied
+
+    model = varied(SENSOR_MODELS[name], sensor_set)
+    cam = model.camera()
+    shot = render(lab_meshes(cam), cam)
     labels = np.where((shot.ids >= 0) & (shot.ids < len(LAB_SPHERES)), shot.ids + 1, 0)
     out = apply_sensor(model, shot.depth, shot.ids, cam, np.random.default_rng(seed), facing=shot.facing,
                        labels=labels)  # fmt: skip
