@@ -4870,3 +4870,169 @@ def test_the_bulge_sums_are_the_bincounts(seed):
     assert m[:, 1, 1].tobytes() == np.bincount(lab, weights=x * x, minlength=n + 1).tobytes()
     assert rhs[:, 1].tobytes() == np.bincount(lab, weights=x * z, minlength=n + 1).tobytes()
     assert zz.tobytes() == np.bincount(lab, weights=z * z, minlength=n + 1).tobytes()
+
+
+# --- stop 45, speedreg45
+
+
+def _batcher_median25() -> list[tuple[int, int, int]]:
+    """:data:`_jit.MEDIAN25` built as its comment says: Batcher's odd-even merge sort of 32 values, the pairs touching
+    the last 7 dropped, pruned back from the median's output (kind 0 both outputs read on, 1 the min, 2 the max)."""
+    pairs, p = [], 1
+    while p < 32:
+        k = p
+        while k >= 1:
+            for j in range(k % p, 32 - k, 2 * k):
+                for i in range(min(k, 32 - j - k)):
+                    if (i + j) // (2 * p) == (i + j + k) // (2 * p) and i + j + k < 25:
+                        pairs.append((i + j, i + j + k))
+            k //= 2
+        p *= 2
+    need, kept = {12}, []
+    for i, j in reversed(pairs):
+        if i in need and j in need:
+            kept.append((i, j, 0))
+        elif i in need:
+            kept.append((i, j, 1))
+        elif j in need:
+            kept.append((i, j, 2))
+        need |= {i, j} if (i in need or j in need) else set()
+    return kept[::-1]
+
+
+def test_the_median_network_selects_the_median_of_every_25_bits():
+    """MEDIAN25 is the network its comment builds, and it puts the median in v12 for all 2^25 inputs of 0 and 1 (the
+    0-1 principle: then for every input; each wire a bit per input, a min an AND, a max an OR); the network one
+    pair short is wrong on some input."""
+    assert list(_jit.MEDIAN25) == _batcher_median25() and len(_jit.MEDIAN25) == 113
+    word = np.arange(2**19, dtype=np.uint64)  # input x's bit k: within a 64-bit word for k < 6, of the word beyond
+    low = [sum(1 << b for b in range(64) if (b >> k) & 1) for k in range(6)]
+    wires = [np.full(2**19, low[k], np.uint64) for k in range(6)]
+    wires += [np.where((word >> np.uint64(k - 6)) & np.uint64(1), ~np.uint64(0), np.uint64(0)) for k in range(6, 25)]
+    x = np.arange(2**25, dtype=np.uint32)
+    expect = np.packbits(np.bitwise_count(x) >= 13, bitorder="little").view(np.uint64)
+
+    def run(network):
+        v = list(wires)
+        for i, j, kind in network:
+            lo, hi = v[i] & v[j], v[i] | v[j]
+            if kind in (0, 1):
+                v[i] = lo
+            if kind in (0, 2):
+                v[j] = hi
+        return v[12]
+
+    assert np.array_equal(run(_jit.MEDIAN25), expect)
+    assert not np.array_equal(run(_jit.MEDIAN25[:60] + _jit.MEDIAN25[61:]), expect)
+
+
+def test_the_window_medians_kernel_runs_the_median_network():
+    """window_medians' written-out pairs are MEDIAN25's, in its order, and return v12."""
+    import inspect
+    import re
+
+    source = inspect.getsource(_jit.window_medians.py_func)
+    found = []
+    for line in source.splitlines():
+        if m := re.fullmatch(r"\s*v(\d+), v(\d+) = min\(v\1, v\2\), max\(v\1, v\2\)", line):
+            found.append((int(m[1]), int(m[2]), 0))
+        elif m := re.fullmatch(r"\s*v(\d+) = min\(v\1, v(\d+)\)", line):
+            found.append((int(m[1]), int(m[2]), 1))
+        elif m := re.fullmatch(r"\s*v(\d+) = max\(v(\d+), v\1\)", line):
+            found.append((int(m[2]), int(m[1]), 2))
+    assert found == list(_jit.MEDIAN25)
+    assert "medians[n] = v12" in source
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_window_medians_are_the_partitions(seed):
+    """window_medians against _window_medians (scipy's nearest pixels, median_at's partition) and against
+    filled_windows' windows partitioned: the same medians to the bit, on windows of a few depths (ties, steps),
+    dropouts, masks down to one pixel and windows a pixel wide."""
+    from symfruit.core.surface import _window_medians
+
+    depth, mask, _ = _parts_case(seed)
+    ok = mask & (depth > 0)
+    if not ok.any():
+        ok[0, 0], depth[0, 0] = True, 0.5
+    medians = np.empty(int(ok.sum()))
+    _jit.window_medians(depth, ok, medians)
+    assert medians.tobytes() == _window_medians(depth, ok).tobytes()
+    values = np.empty((len(medians), 25))
+    _jit.filled_windows(depth, ok, 5, values)
+    assert medians.tobytes() == np.partition(values, 12, axis=1)[:, 12].tobytes()
+
+
+def test_the_window_medians_of_a_known_image():
+    """A 5 x 7 image of the numbers 1..35 in raster order, every pixel ok: at (2, 3) the window holds rows 0-4 and
+    columns 1-5, whose median is the middle row's middle value, 18; at the corner (0, 0) the edges repeat rows 0, 0,
+    0, 1, 2 and columns 0, 0, 0, 1, 2: the median is 3 (the values 1 x 9, 2 x 3, 3 x 3, 8 x 3, 9, 10, 15 x 3, 16, 17).
+    A pixel not ok takes its nearest ok pixel's depth."""
+    depth = np.arange(1.0, 36.0).reshape(5, 7)
+    ok = np.ones((5, 7), bool)
+    medians = np.empty(35)
+    _jit.window_medians(depth, ok, medians)
+    assert medians[2 * 7 + 3] == 18.0 and medians[0] == 3.0
+    ok[:, 3:] = False  # columns 3-6 take column 2's depths
+    medians = np.empty(15)
+    _jit.window_medians(depth, ok, medians)
+    filled = np.repeat(depth[:, 2:3], 7, axis=1)
+    filled[:, :3] = depth[:, :3]
+    expect = [np.median(np.pad(filled, 2, mode="edge")[r : r + 5, c : c + 5]) for r in range(5) for c in range(3)]
+    assert medians.tolist() == expect
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_reaches_outline_is_the_twins(seed):
+    """reaches_outline against _reaches_outline (the outline of interior()): the same answer on random masks and
+    pixels of them, some on the array's border."""
+    from symfruit.core.surface import _reaches_outline
+
+    _, mask, _ = _parts_case(seed)
+    rng = np.random.default_rng(seed)
+    rows, cols = np.nonzero(mask)
+    pick = rng.random(len(rows)) < rng.uniform(0.0, 0.3)
+    rows, cols = rows[pick], cols[pick]
+    assert _jit.reaches_outline(mask, rows, cols) == _reaches_outline(mask, rows, cols)
+
+
+def test_reaches_outline_of_a_square():
+    """A 5 x 5 square in a 9 x 9 mask: its centre is not on the outline, its corner is; a square filling the array
+    reaches it at the array's border."""
+    mask = np.zeros((9, 9), bool)
+    mask[2:7, 2:7] = True
+    centre, corner = (np.array([4, 3]), np.array([4, 4])), (np.array([4, 2]), np.array([4, 2]))
+    assert not _jit.reaches_outline(mask, *centre) and _jit.reaches_outline(mask, *corner)
+    whole = np.ones((9, 9), bool)
+    assert not _jit.reaches_outline(whole, np.array([4]), np.array([4]))
+    assert _jit.reaches_outline(whole, np.array([0]), np.array([4]))
+    assert not _jit.reaches_outline(mask, np.zeros(0, np.int64), np.zeros(0, np.int64))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_part_sizes_are_the_twins_bincounts(seed):
+    """part_sizes against _part_sizes (two np.bincount calls) on smooth_parts' partitions of random windows: the same
+    counts, of the same type."""
+    from symfruit.core.surface import _part_sizes
+
+    depth, mask, join = _parts_case(seed)
+    parts = np.empty(depth.shape, np.int32)
+    count = int(_jit.smooth_parts(depth, mask, join, parts))
+    front = float(np.random.default_rng(seed).choice([0.5, 0.52, 0.6]))
+    sizes, near = _jit.part_sizes(parts, count, depth, front, join)
+    twin_sizes, twin_near = _part_sizes(parts, count, depth, front, join)
+    assert sizes.dtype == twin_sizes.dtype == near.dtype == twin_near.dtype
+    np.testing.assert_array_equal(sizes, twin_sizes)
+    np.testing.assert_array_equal(near, twin_near)
+
+
+def test_the_part_sizes_of_two_parts():
+    """Parts 1 (3 pixels, depths 0.5) and 2 (2 pixels, 0.6) and 4 pixels of none: the sizes 4, 3, 2; within 5 mm of
+    0.6 only part 2's."""
+    parts = np.array([[1, 1, 0], [1, 0, 2], [0, 0, 2]], np.int32)
+    depth = np.where(parts == 2, 0.6, np.where(parts == 1, 0.5, 0.6))
+    sizes, near = _jit.part_sizes(parts, 2, depth, 0.6, 0.005)
+    assert sizes.tolist() == [4, 3, 2] and near.tolist() == [0, 0, 2]

@@ -7138,3 +7138,226 @@ def bulge_sums(
             for q in range(p + 1, 4):
                 m[b, q, p] = m[b, p, q]
     return count, m, rhs, zz
+
+
+# --- stop 45, speedreg45 ------------------------------------------------------------------------------------------
+# thin_front's 5 x 5 medians of the filled depth by a selection network, without numpy's partition of the windows
+
+
+#: The selection network of :func:`window_medians`: (i, j, kind) in order, on 25 values ``v0``..``v24``; kind 0 puts
+#: the smaller of ``v_i`` and ``v_j`` in ``v_i`` and the larger in ``v_j``, 1 the smaller alone in ``v_i``, 2 the larger
+#: alone in ``v_j``; ``v12`` is then the median. Batcher's odd-even merge sort of 32 values (Knuth, TAOCP 3, 5.3.4)
+#: with the last 7 taken as +inf (the pairs that touch them change nothing: dropped) and pruned back from ``v12``
+#: (a pair none of whose outputs is read on dropped, one with one output read kept as that min or max): 113 of the
+#: 140 pairs. Exact by the 0-1 principle, checked on all 2^25 inputs of 0 and 1 (tests/core/test_kernels.py).
+# fmt: off
+MEDIAN25 = (
+    (0, 1, 0), (2, 3, 0), (4, 5, 0), (6, 7, 0), (8, 9, 0), (10, 11, 0), (12, 13, 0), (14, 15, 0),
+    (16, 17, 0), (18, 19, 0), (20, 21, 0), (22, 23, 0), (0, 2, 0), (1, 3, 0), (4, 6, 0), (5, 7, 0),
+    (8, 10, 0), (9, 11, 0), (12, 14, 0), (13, 15, 0), (16, 18, 0), (17, 19, 0), (20, 22, 0), (21, 23, 0),
+    (1, 2, 0), (5, 6, 0), (9, 10, 0), (13, 14, 0), (17, 18, 0), (21, 22, 0), (0, 4, 0), (1, 5, 0),
+    (2, 6, 0), (3, 7, 0), (8, 12, 0), (9, 13, 0), (10, 14, 0), (11, 15, 0), (16, 20, 0), (17, 21, 0),
+    (18, 22, 0), (19, 23, 0), (2, 4, 0), (3, 5, 0), (10, 12, 0), (11, 13, 0), (18, 20, 0), (19, 21, 0),
+    (1, 2, 0), (3, 4, 0), (5, 6, 0), (9, 10, 0), (11, 12, 0), (13, 14, 0), (17, 18, 0), (19, 20, 0),
+    (21, 22, 0), (0, 8, 0), (1, 9, 0), (2, 10, 0), (3, 11, 0), (4, 12, 0), (5, 13, 0), (6, 14, 0),
+    (7, 15, 1), (16, 24, 0), (4, 8, 0), (5, 9, 0), (6, 10, 0), (7, 11, 0), (20, 24, 0), (2, 4, 0),
+    (3, 5, 0), (6, 8, 0), (7, 9, 0), (10, 12, 0), (11, 13, 0), (18, 20, 0), (19, 21, 0), (22, 24, 0),
+    (1, 2, 0), (3, 4, 0), (5, 6, 0), (7, 8, 0), (9, 10, 0), (11, 12, 0), (13, 14, 1), (17, 18, 0),
+    (19, 20, 0), (21, 22, 0), (23, 24, 0), (0, 16, 2), (1, 17, 2), (2, 18, 2), (3, 19, 2), (4, 20, 2),
+    (5, 21, 2), (6, 22, 1), (7, 23, 1), (8, 24, 1), (8, 16, 2), (9, 17, 2), (10, 18, 1), (11, 19, 1),
+    (12, 20, 1), (13, 21, 1), (6, 10, 2), (7, 11, 2), (12, 16, 1), (13, 17, 1), (10, 12, 2), (11, 13, 1),
+    (11, 12, 2),
+)
+# fmt: on
+
+
+@_njit
+def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> None:
+    """``medians`` ((n,) float64, n the pixels of ``ok`` (h, w) bool, which must hold one): the median of the 5 x 5
+    window (edges repeated) of ``depth`` (h, w) float64 around each pixel of ``ok`` in raster order, every pixel not
+    ``ok`` taking its nearest ``ok`` pixel's depth (:func:`nearest`, scipy's feature transform): what
+    :func:`filled_windows` and numpy's ``np.partition(values, 12, axis=1)[:, 12]`` give, the same values (a median is
+    one of the window's values, whichever way it is selected), by :data:`MEDIAN25`'s network on the 25 values in
+    registers, the windows never laid out (stop 45, speedreg45: 0.5 against 0.86 + 0.59 ms a frame for the partition
+    and the windows, thread CPU on the benchmark frame's 14 calls). Its numpy twin:
+    :func:`symfruit.core.surface._window_medians`. Every value must be a number (no NaN: ``thin_front``'s depth
+    above 0 is)."""
+    h, w = ok.shape
+    idx = np.empty((h, w), np.int64)
+    nearest(np.logical_not(ok), idx)
+    vals = np.empty((h + 4, w + 4))
+    for a in range(h + 4):
+        rr = min(max(a - 2, 0), h - 1)
+        for b in range(w + 4):
+            i = idx[rr, min(max(b - 2, 0), w - 1)]
+            vals[a, b] = np.float64(depth[i // w, i % w])
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            if not ok[r, c]:
+                continue
+            q = vals[r]
+            v0, v1, v2, v3, v4 = q[c], q[c + 1], q[c + 2], q[c + 3], q[c + 4]
+            q = vals[r + 1]
+            v5, v6, v7, v8, v9 = q[c], q[c + 1], q[c + 2], q[c + 3], q[c + 4]
+            q = vals[r + 2]
+            v10, v11, v12, v13, v14 = q[c], q[c + 1], q[c + 2], q[c + 3], q[c + 4]
+            q = vals[r + 3]
+            v15, v16, v17, v18, v19 = q[c], q[c + 1], q[c + 2], q[c + 3], q[c + 4]
+            q = vals[r + 4]
+            v20, v21, v22, v23, v24 = q[c], q[c + 1], q[c + 2], q[c + 3], q[c + 4]
+            # MEDIAN25, written out: each pair (i, j) min to v_i and max to v_j (one of them where only it is read on)
+            v0, v1 = min(v0, v1), max(v0, v1)
+            v2, v3 = min(v2, v3), max(v2, v3)
+            v4, v5 = min(v4, v5), max(v4, v5)
+            v6, v7 = min(v6, v7), max(v6, v7)
+            v8, v9 = min(v8, v9), max(v8, v9)
+            v10, v11 = min(v10, v11), max(v10, v11)
+            v12, v13 = min(v12, v13), max(v12, v13)
+            v14, v15 = min(v14, v15), max(v14, v15)
+            v16, v17 = min(v16, v17), max(v16, v17)
+            v18, v19 = min(v18, v19), max(v18, v19)
+            v20, v21 = min(v20, v21), max(v20, v21)
+            v22, v23 = min(v22, v23), max(v22, v23)
+            v0, v2 = min(v0, v2), max(v0, v2)
+            v1, v3 = min(v1, v3), max(v1, v3)
+            v4, v6 = min(v4, v6), max(v4, v6)
+            v5, v7 = min(v5, v7), max(v5, v7)
+            v8, v10 = min(v8, v10), max(v8, v10)
+            v9, v11 = min(v9, v11), max(v9, v11)
+            v12, v14 = min(v12, v14), max(v12, v14)
+            v13, v15 = min(v13, v15), max(v13, v15)
+            v16, v18 = min(v16, v18), max(v16, v18)
+            v17, v19 = min(v17, v19), max(v17, v19)
+            v20, v22 = min(v20, v22), max(v20, v22)
+            v21, v23 = min(v21, v23), max(v21, v23)
+            v1, v2 = min(v1, v2), max(v1, v2)
+            v5, v6 = min(v5, v6), max(v5, v6)
+            v9, v10 = min(v9, v10), max(v9, v10)
+            v13, v14 = min(v13, v14), max(v13, v14)
+            v17, v18 = min(v17, v18), max(v17, v18)
+            v21, v22 = min(v21, v22), max(v21, v22)
+            v0, v4 = min(v0, v4), max(v0, v4)
+            v1, v5 = min(v1, v5), max(v1, v5)
+            v2, v6 = min(v2, v6), max(v2, v6)
+            v3, v7 = min(v3, v7), max(v3, v7)
+            v8, v12 = min(v8, v12), max(v8, v12)
+            v9, v13 = min(v9, v13), max(v9, v13)
+            v10, v14 = min(v10, v14), max(v10, v14)
+            v11, v15 = min(v11, v15), max(v11, v15)
+            v16, v20 = min(v16, v20), max(v16, v20)
+            v17, v21 = min(v17, v21), max(v17, v21)
+            v18, v22 = min(v18, v22), max(v18, v22)
+            v19, v23 = min(v19, v23), max(v19, v23)
+            v2, v4 = min(v2, v4), max(v2, v4)
+            v3, v5 = min(v3, v5), max(v3, v5)
+            v10, v12 = min(v10, v12), max(v10, v12)
+            v11, v13 = min(v11, v13), max(v11, v13)
+            v18, v20 = min(v18, v20), max(v18, v20)
+            v19, v21 = min(v19, v21), max(v19, v21)
+            v1, v2 = min(v1, v2), max(v1, v2)
+            v3, v4 = min(v3, v4), max(v3, v4)
+            v5, v6 = min(v5, v6), max(v5, v6)
+            v9, v10 = min(v9, v10), max(v9, v10)
+            v11, v12 = min(v11, v12), max(v11, v12)
+            v13, v14 = min(v13, v14), max(v13, v14)
+            v17, v18 = min(v17, v18), max(v17, v18)
+            v19, v20 = min(v19, v20), max(v19, v20)
+            v21, v22 = min(v21, v22), max(v21, v22)
+            v0, v8 = min(v0, v8), max(v0, v8)
+            v1, v9 = min(v1, v9), max(v1, v9)
+            v2, v10 = min(v2, v10), max(v2, v10)
+            v3, v11 = min(v3, v11), max(v3, v11)
+            v4, v12 = min(v4, v12), max(v4, v12)
+            v5, v13 = min(v5, v13), max(v5, v13)
+            v6, v14 = min(v6, v14), max(v6, v14)
+            v7 = min(v7, v15)
+            v16, v24 = min(v16, v24), max(v16, v24)
+            v4, v8 = min(v4, v8), max(v4, v8)
+            v5, v9 = min(v5, v9), max(v5, v9)
+            v6, v10 = min(v6, v10), max(v6, v10)
+            v7, v11 = min(v7, v11), max(v7, v11)
+            v20, v24 = min(v20, v24), max(v20, v24)
+            v2, v4 = min(v2, v4), max(v2, v4)
+            v3, v5 = min(v3, v5), max(v3, v5)
+            v6, v8 = min(v6, v8), max(v6, v8)
+            v7, v9 = min(v7, v9), max(v7, v9)
+            v10, v12 = min(v10, v12), max(v10, v12)
+            v11, v13 = min(v11, v13), max(v11, v13)
+            v18, v20 = min(v18, v20), max(v18, v20)
+            v19, v21 = min(v19, v21), max(v19, v21)
+            v22, v24 = min(v22, v24), max(v22, v24)
+            v1, v2 = min(v1, v2), max(v1, v2)
+            v3, v4 = min(v3, v4), max(v3, v4)
+            v5, v6 = min(v5, v6), max(v5, v6)
+            v7, v8 = min(v7, v8), max(v7, v8)
+            v9, v10 = min(v9, v10), max(v9, v10)
+            v11, v12 = min(v11, v12), max(v11, v12)
+            v13 = min(v13, v14)
+            v17, v18 = min(v17, v18), max(v17, v18)
+            v19, v20 = min(v19, v20), max(v19, v20)
+            v21, v22 = min(v21, v22), max(v21, v22)
+            v23, v24 = min(v23, v24), max(v23, v24)
+            v16 = max(v0, v16)
+            v17 = max(v1, v17)
+            v18 = max(v2, v18)
+            v19 = max(v3, v19)
+            v20 = max(v4, v20)
+            v21 = max(v5, v21)
+            v6 = min(v6, v22)
+            v7 = min(v7, v23)
+            v8 = min(v8, v24)
+            v16 = max(v8, v16)
+            v17 = max(v9, v17)
+            v10 = min(v10, v18)
+            v11 = min(v11, v19)
+            v12 = min(v12, v20)
+            v13 = min(v13, v21)
+            v10 = max(v6, v10)
+            v11 = max(v7, v11)
+            v12 = min(v12, v16)
+            v13 = min(v13, v17)
+            v12 = max(v10, v12)
+            v11 = min(v11, v13)
+            v12 = max(v11, v12)
+            medians[n] = v12
+            n += 1
+
+
+@_njit
+def reaches_outline(mask: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> bool:
+    """Whether one of the pixels ``(rows, cols)`` (int arrays, within ``mask`` (h, w) bool) lies on ``mask``'s outline:
+    a pixel of the mask with a 4-neighbour outside it or beyond the array. The twin,
+    :func:`symfruit.core.surface._reaches_outline`, is ``(mask & ~interior(mask))[rows, cols].any()``; here the
+    neighbours of the listed pixels alone are read, and the first found ends it (stop 45, speedreg45)."""
+    h, w = mask.shape
+    for k in range(rows.shape[0]):
+        r, c = rows[k], cols[k]
+        if not mask[r, c]:
+            continue
+        if r == 0 or c == 0 or r == h - 1 or c == w - 1:
+            return True
+        if not (mask[r - 1, c] and mask[r + 1, c] and mask[r, c - 1] and mask[r, c + 1]):
+            return True
+    return False
+
+
+@_njit
+def part_sizes(
+    parts: np.ndarray, count: int, depth: np.ndarray, front: float, join: float
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._behind_sheet`'s counts of a partition ``parts`` (h, w) int (0 none, 1..``count``)
+    in one pass: ``sizes`` (count + 1,) int64, ``np.bincount(parts.ravel(), minlength=count + 1)``, and ``near``
+    (count + 1,), the same count of the parts' pixels whose ``depth`` (h, w) lies within ``join`` of ``front``
+    (``np.bincount(parts[(parts > 0) & (np.abs(depth - front) <= join)], minlength=count + 1)``; 0 at 0). Whole
+    numbers: the twin's, :func:`symfruit.core.surface._part_sizes` (stop 45, speedreg45)."""
+    sizes = np.zeros(count + 1, np.int64)
+    near = np.zeros(count + 1, np.int64)
+    h, w = parts.shape
+    for r in range(h):
+        for c in range(w):
+            p = parts[r, c]
+            sizes[p] += 1
+            if p > 0 and abs(depth[r, c] - front) <= join:
+                near[p] += 1
+    return sizes, near

@@ -323,7 +323,9 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # edge of a tilted leaf, or a leaf's depth fattened over the fruit, runs along it (a narrow band whose fit reads
     # any curvature). The outline is asked first: where it is reached the fit decides nothing (stop 44, speedreg44:
     # the registration's cue, its depth a few pixels off the mask, reaches it on most fruit)
-    if len(rows) >= 30 and not (mask & ~interior(mask))[rows, cols].any():
+    if len(rows) >= 30 and not (
+        jit.reaches_outline(mask, rows, cols) if jit is not None else _reaches_outline(mask, rows, cols)
+    ):  # fmt: skip
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
         if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
             return None
@@ -337,16 +339,14 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
     # takes its nearest pixel's
     if jit is not None:
-        # the compiled twin of the windows' values median_at reads (stop 42: the same values in the same places),
-        # and of _lag_differences (stop 43: the same image and differences)
-        values = np.empty((int(counts[0]), 25))
-        jit.filled_windows(depth, ok, 5, values)
+        # the compiled twin of _window_medians (stop 45: the same values, by a selection network, the windows never
+        # laid out), and of _lag_differences (stop 43: the same image and differences)
+        medians = np.empty(int(counts[0]))
+        jit.window_medians(depth, ok, medians)
         smooth = np.empty(depth.shape)
-        diff = jit.lag_differences(np.partition(values, 12, axis=1)[:, 12], ok, mask, 5, smooth)
+        diff = jit.lag_differences(medians, ok, mask, 5, smooth)
     else:
-        rows, cols = np.nonzero(ok)
-        _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
-        smooth, diff = _lag_differences(median_at(depth[ri, ci], rows, cols, size=5), ok, mask, 5)
+        smooth, diff = _lag_differences(_window_medians(depth, ok), ok, mask, 5)
     if len(diff) < 20:
         return None
     sigma = 1.4826 * float(median(np.abs(diff - median(diff)))) / np.sqrt(2.0)
@@ -355,6 +355,12 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return None  # the same parts
     parts, count = _smooth_parts(smooth, mask, narrow)
     return _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
+
+
+def _reaches_outline(mask: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> bool:
+    """Whether one of the pixels ``(rows, cols)`` lies on ``mask``'s outline (a pixel of it with a 4-neighbour outside
+    it or beyond the array). The compiled twin: :func:`symfruit.core._jit.reaches_outline` (stop 45)."""
+    return bool((mask & ~interior(mask))[rows, cols].any())
 
 
 def _thin_counts(
@@ -372,6 +378,15 @@ def _thin_counts(
         counts += [int(np.count_nonzero(both)), int(np.count_nonzero((a == b) & both))]
     rows, cols = np.nonzero(ok & (np.abs(depth - front) <= join))
     return ok, np.array(counts, np.int64), rows, cols
+
+
+def _window_medians(depth: np.ndarray, ok: np.ndarray) -> np.ndarray:
+    """(n,) the 5 x 5 median (edges repeated) of ``depth`` (h, w) at the pixels of ``ok`` (h, w) bool (raster order;
+    it must hold one), each pixel not ``ok`` taking its nearest ``ok`` pixel's depth (scipy's feature transform):
+    :func:`thin_front`'s smoothed depth. The compiled twin: :func:`symfruit.core._jit.window_medians` (stop 45)."""
+    rows, cols = np.nonzero(ok)
+    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
+    return median_at(depth[ri, ci], rows, cols, size=5)
 
 
 def _lag_differences(
@@ -402,11 +417,14 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     noise, for :func:`fruit_depth`'s bins on the part behind."""
     if count < 2:
         return None
-    near = (parts > 0) & (np.abs(depth - front) <= join)
+    plain = parts.ndim == 2 and parts.shape == depth.shape and depth.dtype == np.float64
+    if (jit := compiled() if plain else None) is not None:  # the compiled twin of _part_sizes (stop 45: the same)
+        sizes, near = jit.part_sizes(parts, int(count), depth, float(front), float(join))
+    else:
+        sizes, near = _part_sizes(parts, count, depth, front, join)
     if not near.any():
         return None
-    sheet_id = int(np.argmax(np.bincount(parts[near], minlength=count + 1)[1:])) + 1
-    sizes = np.bincount(parts.ravel(), minlength=count + 1)
+    sheet_id = int(np.argmax(near[1:])) + 1
     n_sheet = int(sizes[sheet_id])
     if n_sheet < 30:
         return None
@@ -464,6 +482,16 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
             if np.isfinite(behind) and behind > front:
                 return behind, sheet
     return None
+
+
+def _part_sizes(
+    parts: np.ndarray, count: int, depth: np.ndarray, front: float, join: float
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """(count + 1,) int each: the pixels of each part of ``parts`` (0 none, 1..``count``), and of each part those whose
+    depth lies within ``join`` of ``front`` (0 at 0). The compiled twin: :func:`symfruit.core._jit.part_sizes`
+    (stop 45)."""
+    near = (parts > 0) & (np.abs(depth - front) <= join)
+    return np.bincount(parts.ravel(), minlength=count + 1), np.bincount(parts[near], minlength=count + 1)
 
 
 def _smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float) -> tuple[np.ndarray, int]:
@@ -820,7 +848,8 @@ def _surface(depth: np.ndarray, mask: np.ndarray, near: np.ndarray, apex: tuple[
     """:func:`fruit_surface` from its apex on: the convex cap from the apex, and every pixel of ``near`` deeper than
     ``deep_px`` inside the mask (``inner``: the mask's distance map, when the caller has it)."""
     if inner is None or inner.shape != mask.shape:
-        inner = inner_distance(mask)
+        # the distances up to deep_px alone, farther ones +inf: the same comparison (stop 45, speedreg45)
+        inner = inner_distance(mask, max(deep_px, 0.0))
     deep = inner > deep_px
     return Surface(monotone_region(depth, near, apex, tol) | (near & deep), front, radius, noise, apex)
 
