@@ -7178,8 +7178,8 @@ def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> No
     ``ok`` taking its nearest ``ok`` pixel's depth (:func:`nearest`, scipy's feature transform): what
     :func:`filled_windows` and numpy's ``np.partition(values, 12, axis=1)[:, 12]`` give, the same values (a median is
     one of the window's values, whichever way it is selected), by :data:`MEDIAN25`'s network on the 25 values in
-    registers, the windows never laid out (stop 45, speedreg45: 0.5 against 0.86 + 0.59 ms a frame for the partition
-    and the windows, thread CPU on the benchmark frame's 14 calls). Its numpy twin:
+    registers, the windows never laid out (stop 45, speedreg45: 0.70 against 0.86 + 0.59 ms a frame for the partition
+    and the windows, thread CPU on the benchmark frame's 14 calls, a busy machine). Its numpy twin:
     :func:`symfruit.core.surface._window_medians`. Every value must be a number (no NaN: ``thin_front``'s depth
     above 0 is)."""
     h, w = ok.shape
