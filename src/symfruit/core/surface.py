@@ -474,8 +474,12 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
         told = kappa * radius >= THIN[1] and error * radius <= THIN[2]
-        # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors
-        if told or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
+        # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors;
+        # behind a sheet told flat, a part whose curvature is not known (its fit's error beyond THIN[2]) but may be a
+        # fruit's (THIN[1] within two standard errors): what a leaf hides is the fruit's, and a stereo camera's far,
+        # fattened depth leaves of it a few noisy pixels whose fit tells nothing (stop 45, docs/leaf45.md)
+        unknown = flat and error * radius > THIN[2] and (kappa + 2.0 * error) * radius >= THIN[1]
+        if told or unknown or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
