@@ -575,3 +575,33 @@ def test_a_fruits_own_surface_joined_to_its_points_is_never_seen_past(kernels, m
         cut, seen_past = _cut(depth, mask, points)
         kept = np.sqrt((mask & ~cut).sum() / np.pi)
         assert seen_past and not (cut & ball).any() and 16.0 <= kept <= 16.0 + ring + 1.0
+
+
+# --- stop 45, hidden45
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_leaf_over_the_fruits_edge_is_no_mixed_gap(kernels, monkeypatch):
+    """Stop 45: a ball 16 px in radius before a wall, its mixed pixels 2 px either side of its edge without depth, a
+    leaf in front over its right rim (u 86-95, 15 rows; its own edge without depth), the mask drawn 4 px wider over
+    the leaf (an annotator's whole outline). Seen past all round; in the leaf's sectors the gap between the last
+    point and the background is the leaf's, and halfway across it (stop 43-44) cut 65 of the ball's pixels under
+    the leaf (the right side read at 91 px instead of 96). The edge there is the background less half the gap of
+    the sectors without a leaf: no ball pixel is cut, the mask beyond the ball still is (at least 3/4 of it)."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    vv, uu = np.mgrid[:120, :160].astype(float)
+    db = np.hypot(uu - 80, vv - 60)
+    ball = db <= 16
+    depth = np.where(ball, 0.30 + 0.001 * (16 - np.sqrt(np.clip(256 - db**2, 0, None))), 0.9)
+    depth[ndimage.binary_dilation(ball, iterations=2) & ~ndimage.binary_erosion(ball, iterations=2)] = 0.0
+    leaf = (uu >= 86) & (uu <= 95) & (np.abs(vv - 60) <= 7)
+    depth[leaf] = 0.25
+    depth[ndimage.binary_dilation(leaf) & ~leaf] = 0.0
+    mask = ndimage.binary_dilation(ball, iterations=4)
+    rows, cols = np.nonzero(ndimage.binary_erosion(ball & (depth > 0.26), iterations=1))
+    points = WIDE.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    cut, seen_past = _cut(depth, mask, points)
+    assert seen_past and not (cut & ball).any()
+    assert (cut & ~ball).sum() > 0.75 * (mask & ~ball).sum()
+    assert np.nonzero((mask & ~cut & leaf.any(axis=1)[:, None]).any(axis=0))[0].max() == 96

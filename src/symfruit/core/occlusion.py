@@ -509,7 +509,7 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
     seen = np.isfinite(own_z)
     if spread <= n_beyond - n_band:  # no more than hold no depth: not a spread edge
         d = np.asarray(depth, dtype=np.float64)
-        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance) if focal > 0 else None
+        past = _seen_past(own, seen, d, band, points, focal, eroded, tolerance, ahead=ahead) if focal > 0 else None
         return past, past is not None
     drop = own & ~seen & ~ahead  # all but what lies clearly in front
     # peeled from the mask's border inwards: what a mask overshoots lies at its border
@@ -574,7 +574,8 @@ STAR_SHARE = 0.9
 
 
 def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarray, points: np.ndarray,
-               focal: float, eroded: int, tolerance: float, sectors: int = SECTORS) -> np.ndarray | None:  # fmt: skip
+               focal: float, eroded: int, tolerance: float, sectors: int = SECTORS, *,
+               ahead: np.ndarray | None = None) -> np.ndarray | None:  # fmt: skip
     """:func:`overshoot` on a time-of-flight camera's view: the mask's pixels beyond the fruit's edge where the
     camera saw past the fruit nearly all round it (None: not so, or nothing beyond).
 
@@ -587,13 +588,17 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     seen past. Between the two the camera returned nothing: the mixed pixels a time-of-flight camera invalidates on
     both sides of an edge (AK-DEPTH, ``symfruit.synthetic.sensors.SOURCES``), so the edge is taken halfway (where
     the camera also loses the grazing rim inside the edge, halfway lies inside it by half the difference:
-    docs/treeover43.md); a sector where nothing was seen past takes its neighbours' edge (periodic interpolation).
-    Nearly all round: no third of the outline without a sector seen past. A mask an annotator or a model drew too
-    wide overshoots all round; a depth camera seeing past one side of a fruit (its
-    baseline to the colour camera, a registration a few pixels off) is one side, and the mask there is kept (the
-    shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the points is never
-    cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid (stop 43's gate
-    for curved fruit, before the surface test).
+    docs/treeover43.md); but where the mask's band holds an occluder between the two (``ahead``: its pixels clearly
+    in front of the fruit, from :func:`overshoot`'s maps), the gap is the occluder's, not the fruit's edge: the
+    fruit may reach under it as far as the background less the mixed pixels outside an edge (half the gap of the
+    sectors with no occluder between; stop 45, docs/hidden45.md: halfway across a leaf cut a mostly hidden apple's
+    mask drawn over it towards the visible crescent's width). A sector where nothing was seen past takes its
+    neighbours' edge (periodic interpolation). Nearly all round: no third of the outline without a sector seen
+    past. A mask an annotator or a model drew too wide overshoots all round; a depth camera seeing past one side of
+    a fruit (its baseline to the colour camera, a registration a few pixels off) is one side, and the mask there
+    is kept (the shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the
+    points is never cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid
+    (stop 43's gate for curved fruit, before the surface test).
     """
     front = float(points[:, 2].min())
     half = 0.5 * np.sqrt(4.0 * np.count_nonzero(own) / np.pi) * front / focal  # the mask's half-width, metres
@@ -627,13 +632,34 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
         return None
     centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
-    edge = np.interp(centre, centre[both], 0.5 * (last[both] + first[both]), period=2 * np.pi)
+    with np.errstate(invalid="ignore"):  # inf - inf: NaN where not ``both``, never read
+        halfway = 0.5 * (last + first)
+    if ahead is not None and (behind := both & _occluder_between(ahead[vv, uu], sec, rad, last, first)).any():
+        # an occluder between the fruit's last depth and the background (stop 45): the fruit may reach under it up
+        # to the background, less the mixed pixels the camera invalidates outside an edge, read in the sectors
+        # where nothing lies between (half their gap); with none such, the gap's outer end
+        free = both & ~behind
+        ring = 0.5 * float(np.median(first[free] - last[free])) if free.any() else 0.0
+        halfway[behind] = np.maximum(first[behind] - ring, halfway[behind])
+    edge = np.interp(centre, centre[both], halfway[both], period=2 * np.pi)
     drop = np.zeros(own.shape, bool)
     out = ~is_joined & (rad > edge[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
     return drop if drop.any() else None
+
+
+def _occluder_between(is_ahead: np.ndarray, sec: np.ndarray, rad: np.ndarray, last: np.ndarray,
+                      first: np.ndarray) -> np.ndarray:  # fmt: skip
+    """(sectors,) bool: the sectors holding a mask pixel clearly in front of the fruit (``is_ahead``, per pixel of
+    the mask, with its sector ``sec`` and radius ``rad`` about the points' centroid) beyond the fruit's farthest
+    point pixel (``last``) and short of the nearest pixel seen past (``first``): an occluder covering the span
+    where the fruit's edge lies, so the gap there is not the mixed pixels of the fruit's own edge."""
+    hit = is_ahead & (rad > last[sec]) & (rad < first[sec])
+    out = np.zeros(len(last), bool)
+    out[sec[hit]] = True
+    return out
 
 
 #: The steepest a fruit's own surface is read at by a time-of-flight camera, as depth per pixel over the pixel's
