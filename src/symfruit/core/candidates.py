@@ -398,9 +398,13 @@ class _Shape:
     back_std: float = float("nan")
 
 
+_EYE3 = np.eye(3)
+_EYE3.flags.writeable = False
+
+
 def _sphere(fit: _Fitting) -> Iterator[_Shape]:
     c, r = fit_sphere(fit.sample, scaled=fit.scaled())
-    yield _Shape("sphere", c - r, c + r, Quadric(c, np.eye(3) / r**2), c)
+    yield _Shape("sphere", c - r, c + r, Quadric(c, _EYE3 / r**2), c)  # np.eye(3)'s values, made once
 
 
 def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
@@ -417,7 +421,7 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
         return
     found = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=fit.front, extent=fit.extent)
     cc, cs = found.centre, found.shape
-    ch = np.sqrt(np.diag(cs))
+    ch = np.sqrt(cs.diagonal())  # np.diag's values
     inv = lapack.inv(cs)
     fit.axes.append(lapack.eigh(cs)[1].T)
     yield _Shape("cone", cc - ch, cc + ch, Quadric(cc, inv), cc, found.back_std)
@@ -425,7 +429,7 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
 
 def _revolution(fit: _Fitting) -> Iterator[_Shape]:
     rev = fit_revolution_slices(fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)],
-                                extra_directions=np.vstack(fit.axes) if fit.axes else None,
+                                extra_directions=np.concatenate(fit.axes) if fit.axes else None,
                                 coarse=fit.revolution_coarse)  # fmt: skip
     if fit.region is not None and fit.outline_profile != "off":
         region = fit.region
