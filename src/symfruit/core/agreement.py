@@ -666,6 +666,10 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
     return hit, np.where(hit, depth, np.nan)
 
 
+#: No seen depths, for the kernels (empty: nothing in it to change, so writable, the kernels' usual array type).
+_NO_SEEN = np.empty(0)
+
+
 def explain(
     inside: Inside,
     box: tuple[np.ndarray, np.ndarray],
@@ -702,7 +706,7 @@ def explain(
     n = len(obs.rays)
     if isinstance(inside, Quadric) and n and (jit := compiled()) is not None:  # one pass over the rays, compiled
         b = _bands(obs)
-        seen = np.empty(0) if b.seen is None else b.seen
+        seen = _NO_SEEN if b.seen is None else b.seen
         rms, ins, outs = jit.explain_quadric(inside.centre, inside.shape, b.rays, z0, z1, obs.depth,
                                              max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
                                              b.out_wsum, seen, free)  # fmt: skip
@@ -721,7 +725,7 @@ def explain(
         rms, ins, outs = jit.agreement(np.ascontiguousarray(hit_all, dtype=bool),
                                        np.ascontiguousarray(depth_all, dtype=np.float64), z0, z1, obs.depth,
                                        max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
-                                       b.out_wsum, np.empty(0) if b.seen is None else b.seen, free)  # fmt: skip
+                                       b.out_wsum, _NO_SEEN if b.seen is None else b.seen, free)  # fmt: skip
         return Agreement(depth=rms, inside=ins, outside=outs)
     hit, depth = hit_all[:n], depth_all[:n]
     res = np.where(hit, obs.depth - np.where(hit, depth, 0.0), z1 - z0)

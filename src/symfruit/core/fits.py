@@ -212,8 +212,8 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
         raise InputError("cannot fit an ellipsoid to these points")
     v1 = vectors[:, int(np.argmax(values))]
     v2 = -s22_inv_s21 @ v1
-    a, b, c, f, g, h = v1
-    p, q, r, dd = v2
+    a, b, c, f, g, h = v1.tolist()  # Python floats: the same float64 values in the arrays below (issue 19, stop 45)
+    p, q, r, dd = v2.tolist()
     quad = np.array([[a, h, g], [h, b, f], [g, f, c]])
     lin = np.array([p, q, r])
     try:
@@ -222,7 +222,7 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
         raise InputError("cannot fit an ellipsoid: the quadric has no centre") from None
     level = centre @ quad @ centre - dd
     shape = quad / level
-    if not np.all(lapack.eigvalsh(shape) > 0):
+    if not (lapack.eigvalsh(shape) > 0).all():
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
 
