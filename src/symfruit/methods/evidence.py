@@ -618,7 +618,7 @@ def evidence(
             c.name: {
                 "min": c.lo.tolist(), "max": c.hi.tolist(),
                 "evidence": None if (a := c.agreement) is None else [a.depth, a.inside, a.outside],
-                "back_std": None if not np.isfinite(c.back_std) else c.back_std,
+                "back_std": None if not math.isfinite(c.back_std) else c.back_std,
             }
             for c in cands
         },
