@@ -335,3 +335,41 @@ def test_an_observation_with_its_inner_map_cut_at_a_reach_is_the_same(noise, rim
     np.testing.assert_array_equal(cut.inner[within], full.inner[within])
     assert np.all(np.isinf(cut.inner[~within])) and (~within).any()
     np.testing.assert_array_equal(full.inner, inner_distance(region.mask))
+
+
+@pytest.mark.parametrize("occluded", [False, True])
+def test_the_bands_kept_whole_by_observe_are_the_joined_ones(camera, occluded):
+    """Issue 19, stop 45: :func:`observe` keeps its bands whole and ``_bands`` packs those instead of joining the
+    per-band tuples again: every packed array the same bytes as the joined ones, with occlusion information (seen
+    depths, weights) and without; an observation whose tuples were replaced packs its own."""
+    import dataclasses
+
+    from symfruit.core.agreement import _bands
+
+    from ..conftest import occluded_view
+
+    visible, depth, mask, _ = occluded_view(ball_mesh(), np.array([0.0, 0.0, 0.4]), below=255, occluder_z=0.33,
+                                            noise=0.01, seed=2)  # fmt: skip
+    occ = None
+    if occluded:
+        from symfruit.core.occlusion import occlusion
+
+        occ = occlusion(depth, mask, visible, camera)
+    obs = observe(visible[::10], silhouette(visible, camera), camera, dense=visible, occlusion=occ)
+    assert obs._parts is not None and (obs.out_depth is not None) == occluded
+    joined = dataclasses.replace(obs, _parts=None)
+    kept, made = _bands(obs), _bands(joined)
+    assert _bands(obs) is kept  # made once
+    for name in ("rays", "n_in", "in_starts", "in_sizes", "in_ok", "out_starts", "out_w", "out_wsum", "out_rays",
+                 "out_ok", "seen", "finite"):  # fmt: skip
+        a, b = getattr(kept, name), getattr(made, name)
+        assert (a is None) == (b is None)
+        if a is not None:
+            a, b = np.asarray(a), np.asarray(b)
+            assert a.dtype == b.dtype and a.shape == b.shape and a.tobytes() == b.tobytes(), name
+    assert made.n_in == sum(len(r) for r in obs.rays_in) > 0 and made.out_w.sum() > 0
+    # other tuples than the parts were sliced into: the parts are not read
+    cut_depth = None if obs.out_depth is None else tuple(d[:3] for d in obs.out_depth)
+    other = dataclasses.replace(obs, rays_out=tuple(r[:3] for r in obs.rays_out),
+                                out_weights=tuple(w[:3] for w in obs.out_weights), out_depth=cut_depth)  # fmt: skip
+    assert len(_bands(other).rays) == len(obs.rays) + made.n_in + 3 * len(obs.rays_out)

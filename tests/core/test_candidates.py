@@ -175,3 +175,6 @@ def test_plausible_is_the_former_array_arithmetic():
         with np.errstate(invalid="ignore"):
             want = _former_plausible(lo, hi, seen_lo, seen_hi, reach, lateral=lateral, width=width)
         assert _plausible(lo, hi, seen_lo, seen_hi, reach, lateral=lateral, width=width) is want
+        # the corners as the lists of Python floats candidates() hands it (issue 19, stop 45): the same decision
+        listed = (lo.tolist(), hi.tolist(), seen_lo.tolist(), seen_hi.tolist())
+        assert _plausible(*listed, reach, lateral=lateral, width=width) is want

@@ -5036,3 +5036,58 @@ def test_the_part_sizes_of_two_parts():
     depth = np.where(parts == 2, 0.6, np.where(parts == 1, 0.5, 0.6))
     sizes, near = _jit.part_sizes(parts, 2, depth, 0.6, 0.005)
     assert sizes.tolist() == [4, 3, 2] and near.tolist() == [0, 0, 2]
+
+
+# --- stop 45, speedcomp45
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_revolution_directions_are_the_twins(seed):
+    """:func:`_jit.revolution_directions` and its twin (``np.linalg.norm``, the flip to ``z >= 0``, ``np.vstack``):
+    the same bytes on the coarse directions with 1-9 extra ones across twelve orders of magnitude, some with ``z``
+    negative, zero or the vector zero (NaN both ways); and known values."""
+    from symfruit.core.fits import _COARSE, _revolution_directions
+
+    rng = np.random.default_rng(seed)
+    for m in (1, 3, 6, 9):
+        extra = rng.normal(size=(m, 3)) * 10.0 ** rng.uniform(-6, 6, (m, 1))
+        extra[0, 2] = -abs(extra[0, 2])
+        if m > 3:
+            extra[1, 2], extra[2] = 0.0, 0.0
+        with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # the zero vector: 0 / 0
+            fast, twin = _both(mp, _revolution_directions, _COARSE, extra)
+        assert fast.shape == twin.shape == (len(_COARSE) + m, 3)
+        assert fast.tobytes() == twin.tobytes()
+        assert fast[len(_COARSE)][2] >= 0
+    got = _jit.revolution_directions(np.zeros((0, 3)), np.array([[0.0, 3.0, -4.0], [6.0, 0.0, 8.0]]))
+    np.testing.assert_array_equal(got, [[-0.0, -0.6, 0.8], [0.6, 0.0, 0.8]])
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_apex_kernels_are_the_twins(seed):
+    """``apex_depth`` with :func:`_jit.apex_near` and :func:`_jit.apex_design` and with the twins: the same depth and
+    apex to the bit on noisy caps of spheres (the fit's inputs are the same bytes, so LAPACK gets the same matrix);
+    the kernels' values those of the twin's expressions; and a known answer (a paraboloid's vertex)."""
+    from symfruit.core.front import apex_depth
+    from symfruit.core.points import column_means, squared_norms
+
+    rng = np.random.default_rng(seed)
+    pts = random_sphere(n=int(rng.integers(200, 3000)), seed=seed)
+    pts = pts[pts[:, 2] < CENTRE[2]]
+    pts = np.ascontiguousarray(pts + rng.normal(0, 5e-4, pts.shape))
+    with pytest.MonkeyPatch.context() as mp:
+        (z_fast, apex_fast), (z_twin, apex_twin) = _both(mp, apex_depth, pts)
+    assert z_fast == z_twin and apex_fast.tobytes() == apex_twin.tobytes()
+    front = np.argpartition(pts[:, 2], 9)[:10]
+    seed_, d2 = _jit.apex_near(pts, front)
+    assert seed_.tobytes() == column_means(pts[front, :2]).tobytes()
+    assert d2.tobytes() == squared_norms(pts[:, :2] - seed_).tobytes()
+    pick = np.argpartition(d2, 40)[:41]
+    a, z = _jit.apex_design(pts, pick, seed_)
+    x, y = pts[pick, 0] - seed_[0], pts[pick, 1] - seed_[1]
+    assert a.tobytes() == np.stack((np.ones_like(x), x, y, x * x, x * y, y * y), axis=1).tobytes()
+    assert z.tobytes() == pts[pick, 2].tobytes()
+    g = np.stack(np.meshgrid(np.linspace(-0.02, 0.02, 21), np.linspace(-0.02, 0.02, 21)), -1).reshape(-1, 2)
+    bowl = np.column_stack((g + 0.003, 0.4 + 5.0 * ((g[:, 0] - 0.001) ** 2 + g[:, 1] ** 2)))
+    z_min, apex = apex_depth(np.ascontiguousarray(bowl))
+    assert z_min == pytest.approx(0.4, abs=1e-9) and apex[:2] == pytest.approx([0.004, 0.003], abs=1e-6)

@@ -9,7 +9,7 @@ from symfruit import DEFAULT_CAMERA, ConfigError, box_iou, centre_deviation, com
 from symfruit.core.agreement import Agreement
 from symfruit.core.candidates import Candidate
 from symfruit.evaluate.protocols import Spec, build
-from symfruit.methods.evidence import EvidenceSettings, _weighted_median, clean_share, combine
+from symfruit.methods.evidence import EvidenceSettings, _spread, _weighted_median, clean_share, combine
 from symfruit.settings import Settings
 from symfruit.synthetic.shapes import FRUITS, rotation
 
@@ -445,3 +445,29 @@ def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_do
     assert abs(trimmed.extras["width"] - 0.07) < 0.002
     assert np.abs(trimmed.box.size - truth.size).max() < 0.004
     assert (whole.box.size - truth.size)[[0, 2]].min() > 0.008
+
+
+@pytest.mark.parametrize("seed", range(50))
+def test_the_spread_in_python_floats_is_numpys(seed):
+    """Issue 19, stop 45: ``combine``'s spread of the candidates' centres about the box centre in Python floats, the
+    same value to the bit as numpy's expression, for 1-9 candidates (8 and more: numpy itself), some tied faces, some
+    weights zero; and a known value."""
+    from symfruit.core.box import Box
+    from symfruit.core.points import row_norms
+
+    rng = np.random.default_rng(seed)
+    k = int(rng.integers(1, 10))
+    lo = rng.normal(0.0, 0.05, (k, 3)) + np.array([0.0, 0.0, 0.4])
+    hi = lo + rng.uniform(0.0, 0.08, (k, 3))
+    if k > 2 and rng.random() < 0.5:
+        lo[1], hi[1] = lo[0], hi[0]  # ties
+    w = rng.random(k) ** int(rng.integers(1, 10))
+    w[rng.random(k) < 0.2] = 0.0
+    w = w / max(w.sum(), 1e-300)
+    faces = np.concatenate((lo, hi), axis=1)
+    box = Box(faces.min(axis=0)[:3], faces.max(axis=0)[3:])
+    want = float((w * row_norms(0.5 * (faces[:, :3] + faces[:, 3:]) - box.centre)).sum())
+    got = _spread([row.tolist() for row in faces], w, box)
+    assert type(got) is float and got == want
+    two = [[0.0, 0.0, 0.0, 2.0, 2.0, 2.0], [1.0, 1.0, 1.0, 1.0, 5.0, 1.0]]
+    assert _spread(two, np.array([0.5, 0.5]), Box(np.zeros(3), np.full(3, 2.0))) == 1.0

@@ -7361,3 +7361,71 @@ def part_sizes(
             if p > 0 and abs(depth[r, c] - front) <= join:
                 near[p] += 1
     return sizes, near
+
+
+# --- stop 45, speedcomp45
+
+
+@_njit
+def revolution_directions(dirs: np.ndarray, extra: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.core.fits._revolution_directions`: the coarse directions ``dirs`` (k, 3) followed by the
+    ``extra`` ones (m, 3), each of those divided by its norm (``np.linalg.norm(extra, axis=1)``: numpy sums a row of
+    three squares left to right) and turned to ``z >= 0`` (times -1.0 where the unit vector's ``z`` is negative, times
+    1.0 elsewhere, as the twin multiplies): the same values, one call for five."""
+    k, m = dirs.shape[0], extra.shape[0]
+    out = np.empty((k + m, 3))
+    for i in range(k):
+        for c in range(3):
+            out[i, c] = dirs[i, c]
+    for i in range(m):
+        x, y, z = extra[i, 0], extra[i, 1], extra[i, 2]
+        norm = math.sqrt((x * x + y * y) + z * z)
+        ux, uy, uz = x / norm, y / norm, z / norm
+        sign = -1.0 if uz < 0 else 1.0
+        out[k + i, 0] = ux * sign
+        out[k + i, 1] = uy * sign
+        out[k + i, 2] = uz * sign
+    return out
+
+
+@_njit
+def apex_near(p: np.ndarray, front: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.front.apex_depth`'s seed and squared image-plane distances: ``seed``, the mean of the
+    ``x, y`` of the rows ``front`` of ``p`` (n, 3) (as :func:`column_means` of those rows: summed in order from 0,
+    divided by their count), and ``d2`` (n,), each row's ``(x - seed_x)^2 + (y - seed_y)^2`` (the two squares added
+    as :func:`symfruit.core.points.squared_norms` adds them): the twin's values, one call for six."""
+    seed = np.zeros(2)
+    for i in range(front.shape[0]):
+        seed[0] += p[front[i], 0]
+        seed[1] += p[front[i], 1]
+    seed[0] /= front.shape[0]
+    seed[1] /= front.shape[0]
+    n = p.shape[0]
+    d2 = np.empty(n)
+    for i in range(n):
+        dx = p[i, 0] - seed[0]
+        dy = p[i, 1] - seed[1]
+        d2[i] = dx * dx + dy * dy
+    return seed, d2
+
+
+@_njit
+def apex_design(p: np.ndarray, pick: np.ndarray, seed: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.front.apex_depth`'s least squares: the design (k, 6) of the rows ``pick`` of ``p`` (n, 3),
+    columns ``1, x, y, x x, x y, y y`` with ``x, y`` less ``seed`` (the twin's differences and products), and their
+    depths (k,): one call for eight."""
+    k = pick.shape[0]
+    a = np.empty((k, 6))
+    z = np.empty(k)
+    for r in range(k):
+        i = pick[r]
+        x = p[i, 0] - seed[0]
+        y = p[i, 1] - seed[1]
+        a[r, 0] = 1.0
+        a[r, 1] = x
+        a[r, 2] = y
+        a[r, 3] = x * x
+        a[r, 4] = x * y
+        a[r, 5] = y * y
+        z[r] = p[i, 2]
+    return a, z

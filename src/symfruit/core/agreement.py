@@ -179,6 +179,9 @@ class Observation:
     _made: dict[str, Any] = field(default_factory=dict, init=False, repr=False, compare=False)
     #: ``(occlusion, region)`` that :meth:`hidden_map` makes :attr:`hidden` of, when not given.
     _hidden_of: tuple[Occlusion, Silhouette] | None = field(default=None, repr=False, compare=False)
+    #: The bands as :func:`observe` made them, whole (:class:`_BandParts`): :func:`_bands` reads them instead of
+    #: joining the per-band tuples again, while those are the ones they were sliced into.
+    _parts: _BandParts | None = field(default=None, repr=False, compare=False)
 
     def hidden_map(self) -> np.ndarray | None:
         """:attr:`hidden`, or where :func:`observe` had occlusion information, the region's window pixels with a
@@ -294,19 +297,23 @@ def observe(
     edged = len(is_contour) > 0  # the edge points' labels are looked up beside band pixels and cracks (_labels_at)
     kept: dict[str, Any] = {}  # _labels_at's tree of these edge points, where one is made
 
+    whole: list[tuple[np.ndarray, list[int], np.ndarray | None, np.ndarray | None]] = []  # for _BandParts
+
     def bands_of(dist: np.ndarray, outside: bool) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray]]:
         """Each band's rays, weights and seen depths (the last two for the outside bands alone, the depths with
         occlusion information alone); the bands' pixels looked up together (every look-up is pixel by pixel: the
-        same values as band by band, in a quarter of the calls)."""
+        same values as band by band, in a quarter of the calls). The whole arrays go to ``whole``."""
         if not bands:  # no bands asked for
             return [], [], []
         uv, rays, sizes = _band_rays(dist, bands, n_band, region, camera)
         starts, ends = [0], []
-        for size in sizes.tolist():  # each band's rows, sliced (np.split's views, its calls)
+        size_list = sizes.tolist()
+        for size in size_list:  # each band's rows, sliced (np.split's views, its calls)
             ends.append(starts[-1] + size)
             starts.append(ends[-1])
         cut = list(zip(starts, ends, strict=False))
         if not outside:
+            whole.append((rays, size_list, None, None))
             return [rays[a:b] for a, b in cut], [], []
         m = len(uv)
         weight: np.ndarray | None = None
@@ -323,6 +330,7 @@ def observe(
         weight = np.ones(m) if weight is None else weight
         if occlusion is not None and seen is None:
             seen = np.full(m, np.nan)
+        whole.append((rays, size_list, weight, seen))
         return ([rays[a:b] for a, b in cut], [weight[a:b] for a, b in cut],
                 [] if seen is None else [seen[a:b] for a, b in cut])  # fmt: skip
 
@@ -334,13 +342,34 @@ def observe(
         fitted = outline_cone(region, camera, cracks[_labels_at(edge_uv, is_contour, cracks, kept)])
     # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
-    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuple(rays_in), rays_out=tuple(rays_out),
+    tuples = (tuple(rays_in), tuple(rays_out), tuple(out_weights), None if occlusion is None else tuple(out_depth))
+    parts = None
+    if len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
+        (in_rays, in_sizes, _, _), (out_rays, out_sizes, out_w, out_seen) = whole
+        parts = _BandParts(in_rays, in_sizes, out_rays, out_sizes, out_w, out_seen, tuples)  # type: ignore[arg-type]
+    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuples[0], rays_out=tuples[1],
                        contour=contour, cone=cone, axis=axis, interior=points[depth_px >= edge],
-                       out_weights=tuple(out_weights), out_depth=None if occlusion is None else tuple(out_depth),
+                       out_weights=tuples[2], out_depth=tuples[3], _parts=parts,
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        inner=inner, inner_reach=float("inf") if reach is None else reach,
                        _hidden_of=None if occlusion is None else (occlusion, region))  # fmt: skip
+
+
+@dataclass(frozen=True, eq=False)
+class _BandParts:
+    """:func:`observe`'s bands before they are sliced band by band: the inside and outside bands' rays (each one
+    array, the bands one after the other) and sizes, the outside bands' weights and seen depths (None without
+    occlusion information), and the tuples of :class:`Observation` they were sliced into (:func:`_bands` reads the
+    parts only while the observation holds those very tuples)."""
+
+    rays_in: np.ndarray
+    in_sizes: list[int]
+    rays_out: np.ndarray
+    out_sizes: list[int]
+    out_w: np.ndarray
+    seen: np.ndarray | None
+    of: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...] | None]
 
 
 @dataclass(frozen=True)
@@ -370,6 +399,11 @@ def _bands(obs: Observation) -> _Bands:
     found = obs._made.get("bands")
     if found is not None:
         return found
+    parts = obs._parts
+    if parts is not None and all(a is b for a, b in zip(parts.of, (obs.rays_in, obs.rays_out, obs.out_weights,
+                                                                   obs.out_depth), strict=True)):  # fmt: skip
+        found = obs._made["bands"] = _bands_of_parts(obs.rays, parts)
+        return found
     in_sizes = np.array([len(r) for r in obs.rays_in], dtype=np.intp)
     out_sizes = np.array([len(r) for r in obs.rays_out], dtype=np.intp)
     in_starts = np.concatenate(([0], np.cumsum(in_sizes)[:-1])).astype(np.intp)
@@ -392,6 +426,36 @@ def _bands(obs: Observation) -> _Bands:
     )  # fmt: skip
     obs._made["bands"] = found
     return found
+
+
+def _bands_of_parts(rays: np.ndarray, parts: _BandParts) -> _Bands:
+    """:func:`_bands` from :func:`observe`'s whole bands (issue 19, stop 45): the same arrays as joining the bands'
+    slices back (the rays, weights and seen depths those slices were cut from; each band's start the running sum of
+    the sizes before it, whole numbers), the per-band weight sums the same slices' sums."""
+    in_sizes, out_sizes = parts.in_sizes, parts.out_sizes
+    in_starts, out_starts, at = [], [], 0
+    for size in in_sizes:
+        in_starts.append(at)
+        at += size
+    n_in, at = at, 0
+    for size in out_sizes:
+        out_starts.append(at)
+        at += size
+    out_w, seen = parts.out_w, parts.seen
+    finite = None
+    counted = out_w
+    if seen is not None:
+        finite = np.isfinite(seen)
+        counted = np.where(finite, 1.0, out_w)
+    out_wsum = np.array([counted[s : s + k].sum() for s, k in zip(out_starts, out_sizes, strict=True)])
+    in_sizes_a = np.array(in_sizes, dtype=np.intp)
+    out_sizes_a = np.array(out_sizes, dtype=np.intp)
+    return _Bands(
+        rays=np.concatenate((rays, parts.rays_in, parts.rays_out)), n_in=n_in,
+        in_starts=np.array(in_starts, dtype=np.intp), in_sizes=in_sizes_a, in_ok=in_sizes_a > 0,
+        out_starts=np.array(out_starts, dtype=np.intp), out_w=out_w, out_wsum=out_wsum, out_rays=out_sizes_a > 0,
+        out_ok=(out_sizes_a > 0) & (out_wsum > 0), seen=seen, finite=finite,
+    )  # fmt: skip
 
 
 def _band_pixels(dist: np.ndarray, bands: tuple[float, ...], n_band: int) -> tuple[np.ndarray, np.ndarray]:
@@ -602,6 +666,10 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
     return hit, np.where(hit, depth, np.nan)
 
 
+#: No seen depths, for the kernels (empty: nothing in it to change, so writable, the kernels' usual array type).
+_NO_SEEN = np.empty(0)
+
+
 def explain(
     inside: Inside,
     box: tuple[np.ndarray, np.ndarray],
@@ -638,7 +706,7 @@ def explain(
     n = len(obs.rays)
     if isinstance(inside, Quadric) and n and (jit := compiled()) is not None:  # one pass over the rays, compiled
         b = _bands(obs)
-        seen = np.empty(0) if b.seen is None else b.seen
+        seen = _NO_SEEN if b.seen is None else b.seen
         rms, ins, outs = jit.explain_quadric(inside.centre, inside.shape, b.rays, z0, z1, obs.depth,
                                              max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
                                              b.out_wsum, seen, free)  # fmt: skip
@@ -657,7 +725,7 @@ def explain(
         rms, ins, outs = jit.agreement(np.ascontiguousarray(hit_all, dtype=bool),
                                        np.ascontiguousarray(depth_all, dtype=np.float64), z0, z1, obs.depth,
                                        max(1, int(trim * n)), b.in_starts, b.in_sizes, b.out_starts, b.out_w,
-                                       b.out_wsum, np.empty(0) if b.seen is None else b.seen, free)  # fmt: skip
+                                       b.out_wsum, _NO_SEEN if b.seen is None else b.seen, free)  # fmt: skip
         return Agreement(depth=rms, inside=ins, outside=outs)
     hit, depth = hit_all[:n], depth_all[:n]
     res = np.where(hit, obs.depth - np.where(hit, depth, 0.0), z1 - z0)

@@ -172,16 +172,23 @@ def _greater(a: float, b: float) -> float:
     return a if a > b or a != a else b
 
 
-def _plausible(lo: np.ndarray, hi: np.ndarray, seen_lo: np.ndarray, seen_hi: np.ndarray,
-               reach: tuple[float, float], *, lateral: bool = True, width: float = 0.0) -> bool:  # fmt: skip
+def _floats(x: np.ndarray | list[float]) -> list[float]:
+    """A (3,) box corner as three Python floats (a list of them as it is)."""
+    return x if isinstance(x, list) else np.asarray(x, dtype=np.float64).tolist()
+
+
+def _plausible(lo: np.ndarray | list[float], hi: np.ndarray | list[float], seen_lo: np.ndarray | list[float],
+               seen_hi: np.ndarray | list[float], reach: tuple[float, float], *, lateral: bool = True,
+               width: float = 0.0) -> bool:  # fmt: skip
     """Whether a box could be the fruit's: its hidden depth beyond the deepest seen point at most
     ``reach[1]`` times the seen box's largest lateral side (or ``width``, the silhouette's, when larger), and
     (``lateral``) no lateral face beyond the seen box by more than ``reach[0]`` times the seen extent along that
-    axis."""
+    axis. Each corner a (3,) float array or a list of its three values as Python floats (``tolist()``'s, made once
+    by the caller; issue 19, stop 45)."""
     # In Python floats (issue 19, nineteenth round): the same differences and products as numpy's on the (3,)
     # arrays, np.maximum as _greater
-    (l0, l1, _), (h0, h1, h2) = np.asarray(lo, dtype=np.float64).tolist(), np.asarray(hi, dtype=np.float64).tolist()
-    (s0, s1, _), (t0, t1, t2) = seen_lo.tolist(), seen_hi.tolist()
+    (l0, l1, _), (h0, h1, h2) = _floats(lo), _floats(hi)
+    (s0, s1, _), (t0, t1, t2) = _floats(seen_lo), _floats(seen_hi)
     seen = (t0 - s0, t1 - s1)
     if h2 - t2 > reach[1] * max(seen[0], seen[1], width):
         return False
@@ -277,6 +284,7 @@ def candidates(
                    revolution_coarse)  # fmt: skip
     constrain = _constrainer(seen_lo, seen_hi, front, cone, obs.contour, pull)
     out: list[Candidate] = []
+    seen_floats = _floats(seen_lo), _floats(seen_hi)  # once for every candidate's plausibility
     for name, (fitter, failures) in _FITTERS.items():
         if name not in shapes or _explained(out, explained):
             continue
@@ -287,7 +295,7 @@ def candidates(
                 finite = all(map(math.isfinite, lo_)) and all(map(math.isfinite, hi_))
                 if not finite or max(b - a for a, b in zip(lo_, hi_, strict=True)) > 10 * extent:
                     continue  # a degenerate fit (e.g. an ellipsoid through nearly flat points)
-                if plausible is not None and not _plausible(lo, hi, seen_lo, seen_hi, plausible,
+                if plausible is not None and not _plausible(lo_, hi_, seen_floats[0], seen_floats[1], plausible,
                                                             lateral=obs.extent is None, width=width):  # fmt: skip
                     continue
                 ev = explain(shape.inside, (lo, hi), obs, steps=steps)
@@ -398,9 +406,13 @@ class _Shape:
     back_std: float = float("nan")
 
 
+_EYE3 = np.eye(3)
+_EYE3.flags.writeable = False
+
+
 def _sphere(fit: _Fitting) -> Iterator[_Shape]:
     c, r = fit_sphere(fit.sample, scaled=fit.scaled())
-    yield _Shape("sphere", c - r, c + r, Quadric(c, np.eye(3) / r**2), c)
+    yield _Shape("sphere", c - r, c + r, Quadric(c, _EYE3 / r**2), c)  # np.eye(3)'s values, made once
 
 
 def _ellipsoid(fit: _Fitting) -> Iterator[_Shape]:
@@ -417,7 +429,7 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
         return
     found = fit_cone_ellipsoid(obs.interior, cone=obs.cone, axis=obs.axis, front=fit.front, extent=fit.extent)
     cc, cs = found.centre, found.shape
-    ch = np.sqrt(np.diag(cs))
+    ch = np.sqrt(cs.diagonal())  # np.diag's values
     inv = lapack.inv(cs)
     fit.axes.append(lapack.eigh(cs)[1].T)
     yield _Shape("cone", cc - ch, cc + ch, Quadric(cc, inv), cc, found.back_std)
@@ -425,7 +437,7 @@ def _cone(fit: _Fitting) -> Iterator[_Shape]:
 
 def _revolution(fit: _Fitting) -> Iterator[_Shape]:
     rev = fit_revolution_slices(fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)],
-                                extra_directions=np.vstack(fit.axes) if fit.axes else None,
+                                extra_directions=np.concatenate(fit.axes) if fit.axes else None,
                                 coarse=fit.revolution_coarse)  # fmt: skip
     if fit.region is not None and fit.outline_profile != "off":
         region = fit.region

@@ -212,8 +212,8 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
         raise InputError("cannot fit an ellipsoid to these points")
     v1 = vectors[:, int(np.argmax(values))]
     v2 = -s22_inv_s21 @ v1
-    a, b, c, f, g, h = v1
-    p, q, r, dd = v2
+    a, b, c, f, g, h = v1.tolist()  # Python floats: the same float64 values in the arrays below (issue 19, stop 45)
+    p, q, r, dd = v2.tolist()
     quad = np.array([[a, h, g], [h, b, f], [g, f, c]])
     lin = np.array([p, q, r])
     try:
@@ -222,7 +222,7 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
         raise InputError("cannot fit an ellipsoid: the quadric has no centre") from None
     level = centre @ quad @ centre - dd
     shape = quad / level
-    if not np.all(lapack.eigvalsh(shape) > 0):
+    if not (lapack.eigvalsh(shape) > 0).all():
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
 
@@ -245,7 +245,7 @@ def ellipsoid_half_extents(shape: np.ndarray) -> np.ndarray:
 
     The box of an ellipsoid with shape matrix ``A`` has half-widths ``sqrt(diag(A^-1))``.
     """
-    return np.sqrt(np.diag(lapack.inv(np.asarray(shape, dtype=np.float64))))
+    return np.sqrt(lapack.inv(np.asarray(shape, dtype=np.float64)).diagonal())  # np.diag's values, one call less
 
 
 def surface_noise(
@@ -750,9 +750,7 @@ def fit_revolution_slices(
     qs = q[:: max(1, len(q) // search_points)]
     dirs = _COARSE if coarse == 64 else _hemisphere(coarse) if coarse > 0 else np.empty((0, 3))
     if extra_directions is not None:
-        extra = np.asarray(extra_directions, dtype=np.float64).reshape(-1, 3)
-        extra = extra / np.linalg.norm(extra, axis=1, keepdims=True)
-        dirs = np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
+        dirs = _revolution_directions(dirs, np.asarray(extra_directions, dtype=np.float64).reshape(-1, 3))
     if not len(dirs):
         raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
     jit = compiled()
@@ -775,6 +773,16 @@ def fit_revolution_slices(
         return Revolution(axis_point, best, edges, radii, cost)
     # Fitted to the points stretched along the line of sight: the solid is that fit squashed back about the centre
     return Revolution(centre + _squash(axis_point - centre, deep, ratio), best, edges, radii, cost, ratio, deep)
+
+
+def _revolution_directions(dirs: np.ndarray, extra: np.ndarray) -> np.ndarray:
+    """(k + m, 3): the coarse directions ``dirs`` (k, 3) followed by the ``extra`` ones (m, 3) made unit and turned to
+    ``z >= 0``; by the compiled twin :func:`symfruit.core._jit.revolution_directions` where numba is (the same values,
+    one call for five; issue 19, stop 45)."""
+    if (jit := compiled()) is not None and dirs.dtype == np.float64 and dirs.ndim == 2 and dirs.shape[1] == 3:
+        return jit.revolution_directions(np.ascontiguousarray(dirs), np.ascontiguousarray(extra))
+    extra = extra / np.linalg.norm(extra, axis=1, keepdims=True)
+    return np.vstack([dirs, extra * np.where(extra[:, 2:3] < 0, -1.0, 1.0)])
 
 
 def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], camera: Camera,
@@ -1276,8 +1284,7 @@ def fit_cone_ellipsoid(
 
     cone_inv = lapack.inv(cone)
     step = np.array([1e-4, 1e-4, 1e-4, 1e-3])
-    steps = np.diag(step)
-    at = np.empty((5, 4))
+    steps = at = np.empty(0)  # the twin's (below; the kernels need neither)
 
     def residuals(p: np.ndarray, split: int = 0) -> np.ndarray:
         fronts, valid = _cone_fronts(p, cone, axis, rays, ray_cone, split=split)
@@ -1307,6 +1314,7 @@ def fit_cone_ellipsoid(
             if not valid:
                 raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")
             return ConeFit(centre, shape, back_std, rms)
+    steps, at = np.diag(step), np.empty((5, 4))
     costs = cost(residuals(grid))
     if not np.isfinite(costs).any():
         raise InputError("no ellipsoid with the silhouette's outline meets the seen rays")

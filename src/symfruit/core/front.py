@@ -11,6 +11,7 @@ import numpy as np
 
 from . import lapack
 from .fits import eigenvalues2, solve2
+from .kernels import compiled
 from .points import as_points, column_means, squared_norms
 
 __all__ = ["apex_depth"]
@@ -44,18 +45,30 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
     n = len(p)
     z = p[:, 2]
     front = max(1, int(0.02 * n))
-    seed = column_means(p[np.argpartition(z, front - 1)[:front], :2])  # .mean(axis=0), the same values
     k = min(n, max(min_points, int(share * n)))
-    d2 = squared_norms(p[:, :2] - seed)  # ((...) ** 2).sum(axis=1), the same values
+    # by the compiled twins where numba is and the points are C-ordered float64 (the same values; issue 19, stop 45:
+    # two calls for fourteen), the partitions numpy's either way (their order of the picked rows is the fit's)
+    jit = compiled() if p.dtype == np.float64 and p.flags.c_contiguous else None
+    if jit is not None:
+        seed, d2 = jit.apex_near(p, np.argpartition(z, front - 1)[:front])
+    else:
+        seed = column_means(p[np.argpartition(z, front - 1)[:front], :2])  # .mean(axis=0), the same values
+        d2 = squared_norms(p[:, :2] - seed)  # ((...) ** 2).sum(axis=1), the same values
     pick = np.argpartition(d2, k - 1)[:k]
-    near = p[pick]
-    a = np.empty((k, 6))  # the array of np.stack((1, x, y, x x, x y, y y), axis=1), column by column
-    a[:, 0] = 1.0
-    x, y = np.subtract(near[:, 0], seed[0], out=a[:, 1]), np.subtract(near[:, 1], seed[1], out=a[:, 2])
-    np.multiply(x, x, out=a[:, 3])
-    np.multiply(x, y, out=a[:, 4])
-    np.multiply(y, y, out=a[:, 5])
-    coef, _, _ = lapack.lstsq(a, near[:, 2])  # np.linalg.lstsq(..., rcond=None)'s
+    if jit is not None:
+        a, near_z = jit.apex_design(p, pick, seed)
+    else:
+        near = p[pick]
+        a = np.empty((k, 6))  # the array of np.stack((1, x, y, x x, x y, y y), axis=1), column by column
+        a[:, 0] = 1.0
+        np.subtract(near[:, 0], seed[0], out=a[:, 1])
+        np.subtract(near[:, 1], seed[1], out=a[:, 2])
+        np.multiply(a[:, 1], a[:, 1], out=a[:, 3])
+        np.multiply(a[:, 1], a[:, 2], out=a[:, 4])
+        np.multiply(a[:, 2], a[:, 2], out=a[:, 5])
+        near_z = near[:, 2]
+    x, y = a[:, 1], a[:, 2]
+    coef, _, _ = lapack.lstsq(a, near_z)  # np.linalg.lstsq(..., rcond=None)'s
     fitted = a @ coef
     i = int(np.argmin(fitted))
     best_z, best_xy = float(fitted[i]), np.array([x[i], y[i]])
