@@ -3862,7 +3862,7 @@ def test_the_red_regions_in_one_pass_are_the_twins(seed, window):
     image[50, 100:131] = (150, 80, 60)
     c = image[3:117, 2:149:2] if window else image
     s = SegmentSettings()
-    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
     args = (low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))))
     once = _jit.red_regions_once(c, *args)
     assert int(once[2]) > 10 and once[6].sum() >= 2
@@ -3884,7 +3884,7 @@ def test_the_red_regions_in_one_pass_without_red():
     from symfruit.segment.colour import SegmentSettings, _red_tables
 
     s = SegmentSettings()
-    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
     c = np.zeros((7, 9, 3), np.uint8)
     c[..., 1] = 200
     mask, labels, n, weak, strong, lab, seeded, sizes, rows, cols = _jit.red_regions_once(
@@ -4040,7 +4040,7 @@ def test_the_red_kind_of_every_colour_is_the_twins():
     from symfruit.segment.colour import SegmentSettings, _red_pixels, _red_tables
 
     s = SegmentSettings()
-    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
     levels = np.unique(np.concatenate((np.arange(0, 256, 15), [1, 2, 41, 254, 255])))
     r, g, b = np.meshgrid(np.arange(256), levels, levels, indexing="ij")
     image = np.stack((r, g, b), axis=-1).reshape(256, -1, 3).astype(np.uint8)

@@ -213,11 +213,17 @@ def test_joining_pieces_keeps_each_piece_s_surface_once_with_the_same_answers(mo
 
 
 def test_redness_and_seeds_known_answers():
-    px = np.array([[[200, 50, 40], [100, 25, 20], [90, 90, 90], [30, 5, 5], [210, 120, 40]]], np.uint8)
+    px = np.array([[[200, 50, 40], [100, 25, 20], [90, 90, 90], [30, 5, 5], [210, 120, 40], [30, 20, 18],
+                    [30, 18, 10]]], np.uint8)  # fmt: skip
     assert np.allclose(redness(px)[0, :3], [0.75, 0.75, 0.0])
     strong, weak = ripe_seeds(px)
-    assert strong[0].tolist() == [True, True, False, False, False]  # dark pixels never red; orange never seeds
-    assert weak[0].tolist() == [True, True, False, False, True]
+    # a dim pixel (R <= dark, 40) is red when R exceeds G and B by dark_chroma (12) levels: a crimson apple in shade
+    # is, a brownish shadow (redness 0.33 and 0.4, but R only 10 and 12 above) is not; orange never seeds
+    assert strong[0].tolist() == [True, True, False, True, False, False, True]
+    assert weak[0].tolist() == [True, True, False, True, True, False, True]
+    strong, weak = ripe_seeds(px, SegmentSettings(dark_chroma=0))  # stops 1-44: dim pixels never red
+    assert strong[0].tolist() == [True, True, False, False, False, False, False]
+    assert weak[0].tolist() == [True, True, False, False, True, False, False]
 
 
 def test_convex_hull_mask_fills_a_c_shape():
@@ -594,10 +600,10 @@ def test_ripe_seeds_are_the_former_look_ups():
         levels = np.arange(256, dtype=np.float64)
         low = np.floor((1.0 - s.red_low) * levels + 1e-9).astype(np.int16)
         high = np.floor((1.0 - s.red_high) * levels + 1e-9).astype(np.int16)
-        low[: s.dark + 1] = -1
-        high[: s.dark + 1] = -1
-        weak = mgb <= low[r]
-        strong = mgb <= high[r]
+        dim = (r <= s.dark) & (s.dark_chroma > 0) & (mgb.astype(int) <= r.astype(int) - s.dark_chroma)
+        weak, strong = mgb <= low[r], mgb <= high[r]  # the redness tests; then dim pixels by their margin alone
+        weak = np.where(r <= s.dark, dim & weak, weak)
+        strong = np.where(r <= s.dark, dim & strong, strong)
         idx = np.flatnonzero(strong)
         rs, gs, bs = (ch.ravel()[idx].astype(np.int16) for ch in (r, g, b))
         ok = np.sqrt(3.0) * (gs - bs) < np.tan(np.radians(s.hue_max)) * (2 * rs - gs - bs)
@@ -608,7 +614,8 @@ def test_ripe_seeds_are_the_former_look_ups():
     rng = np.random.default_rng(11)
     every = np.stack(np.meshgrid(np.arange(256), np.arange(256), indexing="ij"), -1).reshape(-1, 2)
     for settings in (SegmentSettings(), SegmentSettings(red_low=0.3, red_high=0.3, dark=0, hue_max=10.0),
-                     SegmentSettings(red_low=0.01, red_high=0.9, dark=254)):  # fmt: skip
+                     SegmentSettings(red_low=0.01, red_high=0.9, dark=254),
+                     SegmentSettings(dark_chroma=0), SegmentSettings(dark=80, dark_chroma=30)):  # fmt: skip
         # every (R, max(G, B)) pair, with the other channel random, and a strided window of a random image
         c = np.zeros((256, 256, 3), np.uint8)
         c[..., 0] = every[:, 0].reshape(256, 256)
@@ -1145,7 +1152,7 @@ def test_segment_refuses_a_camera_or_settings_of_another_type_by_name():
 
 
 def _apples_outside_the_depth_view(apart, leaf=0):
-    """An apple (28 px) with a dark rim at (300, 540) and, ``apart`` px to its right, one (26 px) partly behind it;
+    """An apple (28 px) with a dark grey rim at (300, 540) and, ``apart`` px to its right, one (26 px) partly behind it;
     with ``leaf``, a leaf band ``2 leaf + 1`` px high across the front one instead. The depth camera sees x >= 600
     only (outside its view, no depth: nothing to tell two surfaces apart)."""
     yy, xx = np.mgrid[:1080, :1920]
@@ -1156,7 +1163,9 @@ def _apples_outside_the_depth_view(apart, leaf=0):
     if apart:
         behind = (xx - 300 - apart) ** 2 + (yy - 540) ** 2 <= 26**2
         color[behind] = (180, 25, 35)
-        color[(xx - 300) ** 2 + (yy - 540) ** 2 <= 30**2] = (40, 20, 20)
+        # a dark rim, grey in shadow (R only 6 above G and B: not red even as a dim pixel, ``dark_chroma``; a rim of
+        # (40, 20, 20), 20 above, is dim red since stop 45 and joins the two into one region)
+        color[(xx - 300) ** 2 + (yy - 540) ** 2 <= 30**2] = (30, 24, 24)
     color[front] = RED
     if leaf:
         band = np.abs(yy - 540) <= leaf

@@ -103,3 +103,87 @@ def test_sensor_noise_is_seeded_and_a_perfect_sensor_returns_the_ideal_depth():
     edges = SensorNoise(axial_at_03=0.0, lateral_px=0.0, edge_dropout=1.0, grazing_dropout=0.0, dropout=0.0)
     depth, _ = edges.apply(shot, np.random.default_rng(0))
     assert depth[240, 320] == 0.5 and depth[360, 320] == 0.0  # the silhouette's bottom edge drops out
+
+
+# --- stop 45, apples45: a colour camera's photometry (Photometric)
+_OFF = dict(exposure_ev=0.0, cast_deg=0.0, shadow_share=0.0, specular=0.0, full_well=0.0, blur_px=0.0, jpeg_quality=0)
+
+
+def _flat(value=(0.6, 0.32, 0.2), shape=(64, 96)):
+    return np.broadcast_to(np.asarray(value, float), (*shape, 3)).copy()
+
+
+def test_photometric_with_every_effect_off_keeps_the_colours():
+    from symfruit.synthetic.render import Photometric
+
+    out = Photometric(**_OFF).apply(_flat(), np.zeros((64, 96)), 1000.0, np.random.default_rng(0))
+    assert out.dtype == np.uint8 and out.shape == (64, 96, 3)
+    assert np.array_equal(out[0, 0], [153, 82, 51]) and (out == out[0, 0]).all()  # 0.6, 0.32, 0.2 of 255, rounded
+
+
+def test_photometric_exposure_scales_linear_light_by_at_most_its_stops():
+    from symfruit.synthetic.render import Photometric
+
+    p = Photometric(**{**_OFF, "exposure_ev": 0.5})
+    for seed in range(5):
+        out = p.apply(_flat((0.5, 0.5, 0.5)), np.zeros((64, 96)), 1000.0, np.random.default_rng(seed))
+        linear = (out[0, 0, 0] / 255) ** 2.2 / 0.5**2.2
+        assert 2**-0.5 - 0.02 <= linear <= 2**0.5 + 0.02
+        assert (out == out[0, 0]).all() and out[0, 0, 0] == out[0, 0, 1] == out[0, 0, 2]  # grey stays grey
+
+
+def test_photometric_white_balance_error_is_an_angle_up_to_cast_deg():
+    from symfruit.synthetic.render import _cast
+
+    rng = np.random.default_rng(1)
+    angles = []
+    for _ in range(200):
+        g = _cast(8.0, rng)
+        assert g.mean() == pytest.approx(1.0)
+        angles.append(np.degrees(np.arccos(g.sum() / np.sqrt(3.0) / np.linalg.norm(g))))
+    assert max(angles) <= 8.0 + 1e-9 and 3.0 <= np.median(angles) <= 5.0  # uniform in 0-8 degrees: median 4
+    assert np.array_equal(_cast(0.0, rng), np.ones(3))
+
+
+def test_photometric_leaf_shadows_cover_their_share_in_patches_of_their_size():
+    from scipy import ndimage
+
+    from symfruit.synthetic.render import Photometric, _shadow_mask
+
+    mask = _shadow_mask(540, 960, 40.0, 0.33, np.random.default_rng(2))
+    assert mask.mean() == pytest.approx(0.33, abs=0.03)
+    labels, _ = ndimage.label(mask)
+    sizes = np.bincount(labels.ravel())[1:]
+    assert 20 <= np.sqrt(np.median(sizes[sizes > 50])) <= 200  # patches of tens of pixels, not specks nor halves
+    p = Photometric(**{**_OFF, "shadow_share": 0.33})
+    out = p.apply(_flat((0.5, 0.5, 0.5), (540, 960)), np.zeros((540, 960)), 40.0 / 0.07, np.random.default_rng(2))
+    shade = out[:, :, 0] < 100
+    assert shade.mean() == pytest.approx(0.33, abs=0.03)
+    assert (out[shade][:, 2] > out[shade][:, 0]).all()  # skylight is bluer than sunlight
+    assert out[~shade][:, 0].min() > 128  # auto exposure: the sunlit parts brighter than 0.5 (128)
+
+
+def test_photometric_specular_highlight_is_near_white_on_red_skin():
+    from symfruit.synthetic.render import Photometric
+
+    spec = np.zeros((64, 96))
+    spec[30:34, 40:44] = 1.0
+    out = Photometric(**{**_OFF, "specular": 0.6}).apply(_flat(), spec, 1000.0, np.random.default_rng(0))
+    assert (out[31, 41] >= 200).all() and out[31, 41].min() >= 0.7 * out[31, 41].max()
+    assert np.abs(out[0, 0].astype(int) - [153, 82, 51]).max() <= 1  # auto exposure: the spot is small
+
+
+def test_photometric_noise_grows_with_the_signal_and_jpeg_keeps_a_flat_colour():
+    from symfruit.synthetic.render import Photometric
+
+    p = Photometric(**{**_OFF, "full_well": 16000.0, "read_noise": 5.0})
+    dark = p.apply(_flat((0.1, 0.1, 0.1)), np.zeros((64, 96)), 1000.0, np.random.default_rng(3)).astype(float)
+    bright = p.apply(_flat((0.8, 0.8, 0.8)), np.zeros((64, 96)), 1000.0, np.random.default_rng(3)).astype(float)
+    assert 0.1 < dark.std() and 0.1 < bright.std()  # visible, a level or more
+    e_dark, e_bright = 0.1**2.2 * 16000, 0.8**2.2 * 16000
+    assert bright.std() / dark.std() == pytest.approx(
+        (np.sqrt(e_bright) * 0.8 / e_bright) / (np.sqrt(e_dark) * 0.1 / e_dark), rel=0.25
+    )  # shot noise, gamma-coded
+    out = Photometric(**{**_OFF, "jpeg_quality": 90}).apply(_flat(), np.zeros((64, 96)), 1000.0,
+                                                             np.random.default_rng(0))  # fmt: skip
+    assert np.abs(out.astype(int) - [153, 82, 51]).max() <= 3

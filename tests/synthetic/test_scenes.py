@@ -187,9 +187,10 @@ def test_a_written_apple_tree_frame_carries_its_truth_and_masks(tmp_path, monkey
 
     calls, make = [], scenes.make_tree_scene
 
-    def small_tree(seed, *, sensor=None, n_apples=30, n_green=4):
+    def small_tree(seed, *, sensor=None, n_apples=30, n_green=4, photometric=None):
         calls.append((seed, sensor.name, n_apples, n_green))
-        return make(seed, sensor=sensor.at(320, 180), n_apples=n_apples, n_green=n_green, n_leaves=200)
+        return make(seed, sensor=sensor.at(320, 180), n_apples=n_apples, n_green=n_green, n_leaves=200,
+                    photometric=photometric)  # fmt: skip
 
     monkeypatch.setattr(scenes, "make_tree_scene", small_tree)
     [folder] = write_scenes(tmp_path / "t", 1, seed=5, n_ripe=4, n_unripe=1, sensor=sensor_model("azure-kinect"),
@@ -239,3 +240,21 @@ def test_repeated_frames_are_put_in_place_atomically_never_written_into(tmp_path
     for name in first:
         a, b = out / "scene_00000" / name, out / "scene_00001" / name
         assert a.read_bytes() == b.read_bytes() and os.path.samefile(a, b) is links
+
+
+def test_an_apple_trees_colour_camera_changes_the_colours_alone(tree):
+    """``photometric=None``: the colours of stops 30-44 bit for bit (the digest of the base tree's frame); the
+    colour camera's effects (the default) draw from an RNG of their own, so depth and labels stay the same."""
+    import hashlib
+
+    from symfruit.synthetic.scenes import make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    old = make_tree_scene(3, sensor=sensor_model("azure-kinect").at(480, 270), n_apples=12, n_green=2, n_leaves=600,
+                          photometric=None)  # fmt: skip
+    assert hashlib.sha256(old.color.tobytes()).hexdigest()[:16] == "b6d5367255a030f3"
+    assert hashlib.sha256(old.depth.tobytes()).hexdigest()[:16] == "cd188c0c62d0254a"
+    assert np.array_equal(old.depth, tree.depth) and np.array_equal(old.labels, tree.labels)
+    assert np.array_equal(old.masks, tree.masks) and old.truth() == tree.truth()
+    changed = np.abs(old.color.astype(int) - tree.color).max(axis=2) > 8
+    assert changed.mean() > 0.3  # shadows, exposure, white balance: most of the frame

@@ -92,8 +92,15 @@ class SegmentSettings(Section):
         Seed pixels must have a hue below this (red-magenta to red-orange: ``atan2(sqrt(3) (G - B),
         2R - G - B)``); skin and orange tones above it do not seed.
     dark : int, 0-255
-        Pixels with red channel at or below this are never fruit (black borders, deep shadow, where
-        the chromaticity is noise).
+        Pixels with red channel at or below this are dim: their chromaticity is noise unless the red
+        channel clearly exceeds the others (``dark_chroma``); black borders, deep shadow.
+    dark_chroma : int, 0-255
+        A dim pixel (red at or below ``dark``) is red only when its red channel also exceeds green and blue by
+        this many levels, besides the redness tests: an apple in a leaf's shadow (R 20-40 with G and B near
+        10 in an auto-exposed outdoor frame) keeps its colour, a grey or brownish shadow pixel whose channels
+        differ by noise does not. 0: dim pixels are never red (stops 1-44). Default 12: a 8-bit camera frame's
+        noise in shadow is about 2 levels a channel (after demosaicing and JPEG), so the difference of two
+        channels about 3 and the largest of two about 2 more; 12 is over three of those spreads.
     close_px : int, pixels
         Radius of a closing of each region before it is split (bridges seeds on its outline); 0: none.
     min_area_share : float
@@ -159,6 +166,7 @@ class SegmentSettings(Section):
     red_low: float = setting(0.12, gt=0.0, lt=1.0)
     hue_max: float = setting(25.0, gt=0.0, lt=90.0)
     dark: int = setting(40, ge=0, le=254)
+    dark_chroma: int = setting(12, ge=0, le=255)
     close_px: int = setting(0, ge=0, le=MAX_RADIUS_PX)
     min_area_share: float = setting(0.002, ge=0.0, lt=1.0)
     merge_slack: float = setting(0.08, ge=0.0, le=1.0)
@@ -259,7 +267,7 @@ def ripe_seeds(color: np.ndarray, settings: SegmentSettings | None = None) -> tu
 
 def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray]:
     """The flat indices (ascending) of :func:`ripe_seeds`' weak and strong pixels of a checked colour image."""
-    low, high = _red_tables(s.red_low, s.red_high, s.dark)
+    low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
     if (jit := compiled()) is not None and c.dtype == np.uint8 and c.ndim == 3 and c.shape[2] == 3:
         # the compiled twin of what follows (:func:`symfruit.core._jit.red_pixels`: the same pixels; issue 19, sixteenth
         # round), on the window as it is
@@ -284,14 +292,17 @@ def _red_pixels(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarr
 
 
 @functools.lru_cache(maxsize=16)
-def _red_tables(red_low: float, red_high: float, dark: int) -> tuple[np.ndarray, np.ndarray]:
+def _red_tables(red_low: float, red_high: float, dark: int, dark_chroma: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """:func:`_red_pixels`' look-up tables, (256,) int16 each, read-only: redness >= t  <=>  max(G, B) <= (1 - t) R,
-    compared against per-R tables (integers only); worked out once per setting, not for each of a frame's windows."""
+    compared against per-R tables (integers only); worked out once per setting, not for each of a frame's windows.
+    Dim pixels (R <= dark) also need max(G, B) <= R - dark_chroma (never red with ``dark_chroma`` 0)."""
     levels = np.arange(256, dtype=np.float64)
     low = np.floor((1.0 - red_low) * levels + 1e-9).astype(np.int16)
     high = np.floor((1.0 - red_high) * levels + 1e-9).astype(np.int16)
-    low[: dark + 1] = -1  # dark pixels are never red
-    high[: dark + 1] = -1
+    dim = np.arange(dark + 1, dtype=np.int16)
+    margin = dim - dark_chroma if dark_chroma > 0 else np.full(dark + 1, -1, np.int16)
+    low[: dark + 1] = np.maximum(np.minimum(low[: dark + 1], margin), -1)  # -1: never red
+    high[: dark + 1] = np.maximum(np.minimum(high[: dark + 1], margin), -1)
     low.flags.writeable = False
     high.flags.writeable = False
     return low, high
@@ -691,7 +702,7 @@ def _red_regions(
     each of a frame's windows, issue 19's seventeenth round; since stop 41 the tests and the labelling in one pass,
     the labels numbered over the weak pixels alone)."""
     if (jit := compiled()) is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3:
-        low, high = _red_tables(s.red_low, s.red_high, s.dark)
+        low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
         weak_w, labels, n, weak_at, _, lab, seeded, sizes, rows, cols = jit.red_regions_once(
             cw, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max)))
         )

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..core.camera import Camera
 
-__all__ = ["Rendering", "SensorNoise", "render"]
+__all__ = ["Photometric", "Rendering", "SensorNoise", "render"]
 
 
 @dataclass(frozen=True)
@@ -188,3 +188,141 @@ class SensorNoise:
         noisy[drop | ~seen] = 0.0
         jitter = rng.normal(scale=self.lateral_px, size=depth.shape + (2,))
         return noisy, jitter
+
+
+@dataclass(frozen=True)
+class Photometric:
+    """What a colour camera outdoors does to a frame's colours (issue 18, stop 45), for rendered apple trees.
+
+    The renderer's colours are clean: one white light, no shadow from leaves, no highlight, the same exposure
+    and white balance in every frame. A real orchard frame differs by what the sun and the camera do; each
+    effect is one attribute (0 or ``False``: off), its value and its source next to it. :meth:`apply` takes the
+    rendered colour (display-coded, 0-1), the apples' specular term and the frame's own RNG.
+
+    Attributes
+    ----------
+    exposure_ev : float, stops
+        Auto exposure keeps the frame's mean brightness (linear light) where it was without shadows and
+        highlights, off by a uniform ``+-exposure_ev``: the metering sees sky, sunlit and shaded canopy in shares
+        that differ from frame to frame (stated: half a stop). With shadows the sunlit parts come out brighter.
+    cast_deg : float, degrees
+        Each frame's white balance is off by an angular error uniform in ``0-cast_deg`` (median half of it) in a
+        random direction of chromaticity: a cast from the sky or the canopy. Stated: median 4 degrees, as the
+        median angular errors of grey-world and camera-style white balance on the Gehler-Shi set (about 3-6
+        degrees; Gijsenij, Gevers & van de Weijer 2011, "Computational color constancy: survey and
+        experiments", IEEE TIP 20(9)).
+    shadow_share : float
+        Share of the frame in hard shadow of leaves between the sun and the scene (stated: a third; inside a
+        canopy much of what is seen lies in some leaf's shadow).
+    shadow_size : float, metres
+        Size of the shadow patches at the canopy (a leaf's, 5-9 cm: the scene's own leaves); the sun's half
+        degree gives a penumbra of 1-3 mm at 10-30 cm behind a leaf, under a pixel at 1.2-2 m: hard edges.
+    shadow_gain : float
+        Light in shadow over light in sun: skylight alone. The diffuse share of a clear day's light is 0.1-0.2
+        (Erbs, Klein & Duffie 1982, Solar Energy 28(4)); the canopy's interreflections lift it (stated: 0.35).
+    shadow_tint : (3,) float
+        Skylight's colour relative to sunlight, R G B (skylight is bluer: a correlated colour temperature
+        of about 10,000 K against the sun's 5,500 K; Wyszecki & Stiles, "Color Science", 1982; stated gains).
+    specular, shininess : float
+        An apple's waxy cuticle reflects the sun as a near-white highlight: Blinn-Phong ``specular (n.h) **
+        shininess`` in linear light, white, where the skin is sunlit (stated: 0.6 and 40, a small bright spot).
+    full_well, read_noise : float, electrons
+        Shot and read noise in linear light. The Azure Kinect's colour sensor (OV12A10, 1.25 um pixels) holds
+        about 4,000-5,000 electrons per pixel (typical of 1.1-1.4 um pixels); its 1920x1080 stream is scaled
+        from 3840x2160, four pixels a pixel: 16,000 electrons and a read noise of 2 x 2.5 (stated).
+    blur_px : float, pixels
+        Gaussian softness of optics, demosaicing and the scaling to 1920x1080 (stated: 0.6 px).
+    jpeg_quality : int
+        The 1920x1080 colour stream of the Azure Kinect is MJPEG (Azure Kinect DK hardware specification, colour
+        camera operating modes): JPEG with 4:2:0 chroma (colour at half resolution each way, blocking). 0: none;
+        stated 90 (the camera's own quality is not published).
+    apple_palette : bool
+        Apples' red from dark crimson (hue -13 degrees, value 0.3) to orange-red (hue +16 degrees) instead of the
+        old -11 to +7 degrees, value 0.45-0.8 (red cultivars from 'Red Delicious' to 'Gala'; stated).
+    gamma : float
+        The display coding of the rendered colours (sRGB's 2.2); the effects act in linear light.
+    """
+
+    exposure_ev: float = 0.5
+    cast_deg: float = 8.0
+    shadow_share: float = 0.33
+    shadow_size: float = 0.07
+    shadow_gain: float = 0.35
+    shadow_tint: tuple[float, float, float] = (0.88, 1.0, 1.18)
+    specular: float = 0.6
+    shininess: float = 40.0
+    full_well: float = 16000.0
+    read_noise: float = 5.0
+    blur_px: float = 0.6
+    jpeg_quality: int = 90
+    apple_palette: bool = True
+    gamma: float = 2.2
+
+    def apply(self, color: np.ndarray, spec: np.ndarray, px_per_metre: float, rng: np.random.Generator) -> np.ndarray:
+        """The camera's frame: ``color`` (h, w, 3) float display-coded 0-1, ``spec`` (h, w) the apples' specular
+        term (0 elsewhere), ``px_per_metre`` the image scale at the canopy; (h, w, 3) uint8."""
+        h, w = color.shape[:2]
+        lin = np.clip(color, 0.0, 1.0) ** self.gamma
+        metered = float(lin.mean())
+        sun = np.ones((h, w))
+        if self.shadow_share > 0:
+            shade = _shadow_mask(h, w, self.shadow_size * px_per_metre, self.shadow_share, rng)
+            sun[shade] = 0.0
+            lin[shade] *= self.shadow_gain * np.asarray(self.shadow_tint)
+        if self.specular > 0:
+            lin += (self.specular * spec * sun)[:, :, None]
+        gain = metered / max(float(lin.mean()), 1e-9)  # auto exposure
+        gain *= 2.0 ** rng.uniform(-self.exposure_ev, self.exposure_ev) if self.exposure_ev > 0 else 1.0
+        lin *= gain * _cast(self.cast_deg, rng)
+        if self.full_well > 0:
+            e = np.clip(lin, 0.0, None) * self.full_well
+            lin = (e + rng.normal(size=e.shape) * np.sqrt(e + self.read_noise**2)) / self.full_well
+        out = np.clip(lin, 0.0, 1.0) ** (1.0 / self.gamma)  # saturation: a clipped channel
+        if self.blur_px > 0:
+            from scipy import ndimage
+
+            out = ndimage.gaussian_filter(out, (self.blur_px, self.blur_px, 0), mode="nearest")
+        img = (np.clip(out, 0, 1) * 255 + 0.5).astype(np.uint8)
+        if self.jpeg_quality > 0:
+            img = _jpeg(img, self.jpeg_quality)
+        return img
+
+
+def _cast(cast_deg: float, rng: np.random.Generator) -> np.ndarray:
+    """Channel gains (3,) of a white-balance error: an angle uniform in ``0-cast_deg`` between white and the gains,
+    in a uniform direction orthogonal to grey; mean gain 1."""
+    if cast_deg <= 0:
+        return np.ones(3)
+    angle = np.radians(rng.uniform(0.0, cast_deg))
+    phi = rng.uniform(0.0, 2 * np.pi)
+    u = np.array([1.0, -1.0, 0.0]) / np.sqrt(2.0)
+    v = np.array([1.0, 1.0, -2.0]) / np.sqrt(6.0)
+    direction = np.cos(phi) * u + np.sin(phi) * v
+    gains = np.ones(3) + np.tan(angle) * np.sqrt(3.0) * direction
+    return gains / gains.mean()
+
+
+def _shadow_mask(h: int, w: int, size_px: float, share: float, rng: np.random.Generator) -> np.ndarray:
+    """(h, w) bool: ``share`` of the frame in hard-edged patches about ``size_px`` across (smoothed noise on a grid
+    of a quarter patch, cut at its ``share`` quantile, brought to full resolution bilinearly and cut again)."""
+    from scipy import ndimage
+
+    step = max(1, int(size_px / 4))
+    gh, gw = h // step + 2, w // step + 2
+    field = ndimage.gaussian_filter(rng.normal(size=(gh, gw)), 1.0, mode="wrap")
+    yy = (np.arange(h) + 0.5) / step
+    xx = (np.arange(w) + 0.5) / step
+    full = ndimage.map_coordinates(field, np.meshgrid(yy, xx, indexing="ij"), order=1, mode="nearest")
+    return full < np.quantile(field, share)
+
+
+def _jpeg(img: np.ndarray, quality: int) -> np.ndarray:
+    """``img`` through JPEG at ``quality`` with 4:2:0 chroma (Pillow), as an MJPEG colour stream delivers it."""
+    import io
+
+    from PIL import Image
+
+    buf = io.BytesIO()
+    Image.fromarray(img).save(buf, format="JPEG", quality=int(quality), subsampling=2)
+    buf.seek(0)
+    return np.asarray(Image.open(buf).convert("RGB")).copy()

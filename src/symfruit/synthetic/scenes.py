@@ -26,7 +26,7 @@ from ..core.points import perpendicular_basis
 from ..errors import OutputError
 from ..io.atomic import atomic_write, folder_fd
 from ..io.text import as_path
-from .render import SensorNoise, render
+from .render import Photometric, SensorNoise, render
 from .sensors import SENSOR_MODELS, SensorModel, apply_sensor
 from .shapes import apple, leaf_outline, rotation, strawberry
 
@@ -313,6 +313,7 @@ def make_tree_scene(
     n_green: int = 4,
     n_leaves: int = 2500,
     distance: tuple[float, float] = (1.2, 2.0),
+    photometric: Photometric | None = Photometric(),  # noqa: B008 (frozen)
 ) -> Scene:
     """Render one seeded frame of an apple tree's canopy, the way an orchard robot sees it (issue 18).
 
@@ -323,7 +324,11 @@ def make_tree_scene(
     blush faces a random side, so some show mostly green); ``n_green`` apples are green (unripe, not to be
     found). Shading follows the surface normal with a brighter sunlit side, plus pixel noise. The frame goes
     through ``sensor`` (default the Azure Kinect model: rim invalidation, flying pixels, registration,
-    noise, multipath; :func:`~symfruit.synthetic.sensors.apply_sensor`).
+    noise, multipath; :func:`~symfruit.synthetic.sensors.apply_sensor`). The colour image then goes through what a
+    colour camera outdoors does (``photometric``, :class:`~symfruit.synthetic.render.Photometric`: exposure and
+    white balance off per frame, leaves' hard shadows, highlights on the apples' waxy skin, apples' red from
+    crimson to orange-red, shot noise, softness, MJPEG), drawn from an RNG of its own: depth, labels and truth are
+    the same with it or without; ``photometric=None`` gives the colours of stops 30-44 bit for bit.
 
     Returns
     -------
@@ -333,6 +338,8 @@ def make_tree_scene(
     """
     sensor = sensor or SENSOR_MODELS["azure-kinect"]
     rng = np.random.default_rng([seed, 19])
+    photo_rng = np.random.default_rng([seed, 19, 45])  # the colour camera's own draws: the scene's stay as they were
+    palette = photometric is not None and photometric.apple_palette
     camera = sensor.camera()
     z0 = float(np.exp(rng.uniform(np.log(distance[0]), np.log(distance[1]))))
     half_x = 0.5 * camera.width / camera.fx * z0
@@ -361,6 +368,9 @@ def make_tree_scene(
         fruits.append(SceneFruit(k + 1, ripe, "apple", Box.from_points(posed.vertices), len(meshes)))
         red = colorsys.hsv_to_rgb(rng.uniform(-0.03, 0.02) % 1.0, rng.uniform(0.65, 0.9), rng.uniform(0.45, 0.8))
         yellow = colorsys.hsv_to_rgb(rng.uniform(0.12, 0.2), rng.uniform(0.45, 0.7), rng.uniform(0.55, 0.8))
+        if palette:  # dark crimson to orange-red (Photometric.apple_palette)
+            hue = photo_rng.uniform(-13, 16) / 360 % 1.0
+            red = colorsys.hsv_to_rgb(hue, photo_rng.uniform(0.6, 0.92), photo_rng.uniform(0.3, 0.8))
         if not ripe:
             skins.append((len(meshes), centre, radius, np.array(yellow), np.array(yellow), 0.0))
         elif rng.random() < 0.6:  # red all over, a paler streak side
@@ -395,6 +405,7 @@ def make_tree_scene(
     # apple skins: blush and base colour by the direction from the apple's centre, sunlit from the upper left
     sun = np.array([-0.5, -0.7, -0.5]) / np.linalg.norm([-0.5, -0.7, -0.5])
     yy, xx = np.mgrid[: camera.height, : camera.width]
+    spec = np.zeros(shot.ids.shape)
     for index, centre, _radius, base, blush, share in skins:
         on = shot.ids == index
         if not on.any():
@@ -410,7 +421,14 @@ def make_tree_scene(
         skin = base[None] * (1 - w[:, None]) + blush[None] * w[:, None]
         light = 0.3 + 0.45 * shot.facing[on] + 0.35 * np.clip(-(d @ sun), 0, 1)
         color[on] = skin * light[:, None] + rng.normal(scale=0.015, size=(len(d), 3))
-    color = (np.clip(color, 0, 1) * 255).astype(np.uint8)
+        if photometric is not None:  # Blinn-Phong: the half vector of the sun's direction and the camera's
+            half = -sun[None] - p / np.linalg.norm(p, axis=1, keepdims=True)
+            half /= np.linalg.norm(half, axis=1, keepdims=True)
+            spec[on] = np.clip(np.einsum("ij,ij->i", d, half), 0, 1) ** photometric.shininess
+    if photometric is None:
+        color = (np.clip(color, 0, 1) * 255).astype(np.uint8)
+    else:
+        color = photometric.apply(color, spec, camera.fx / z0, photo_rng)
     ripe_labels = np.where(np.isin(labels, [f.id for f in fruits if f.ripe]), labels, 0)
     out = apply_sensor(sensor, shot.depth, shot.ids, camera, rng, facing=shot.facing, labels=ripe_labels,
                        amodal=amodal)  # fmt: skip
@@ -432,6 +450,7 @@ def _shade(shot, colours: list[tuple[float, float, float]], rng: np.random.Gener
 def write_scenes(
     folder: str | Path, n: int, *, seed: int = 0, distinct: int | None = None, n_ripe: int = 6, n_unripe: int = 2,
     n_leaves: int = 3, sensor: SensorModel | None = None, tree: bool = False,
+    photometric: Photometric | None = Photometric(),  # noqa: B008 (frozen)
 ) -> list[Path]:  # fmt: skip
     """Write ``n`` frame folders ``scene_00000`` ... (colour, depth, camera, truth) of seeds ``seed``,
     ``seed + 1``, ...; with ``distinct``, only that many are rendered and the rest repeat them as hard links
@@ -439,7 +458,8 @@ def write_scenes(
     and disk. Through a real camera model (``sensor``) each folder also gets the annotators' ``masks.png``
     (which ``detect`` and ``evaluate --frames`` then use instead of the colour segmenter). ``tree``: apple-tree frames
     (:func:`make_tree_scene`, ``n_ripe`` apples and ``n_unripe`` green ones a frame, through ``sensor`` or the
-    Azure Kinect model; ``n_leaves`` is not used).
+    Azure Kinect model; ``n_leaves`` is not used; ``photometric`` their colour camera, None: the colours of stops
+    30-44).
 
     Returns
     -------
@@ -450,12 +470,12 @@ def write_scenes(
 
     folder = as_path(folder, "write_scenes: the output folder")  # '' was the working folder
     with OutputFolder(folder):  # locked while written; no link inside it followed
-        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor, tree)
+        return _write_scenes(folder, n, seed, distinct, n_ripe, n_unripe, n_leaves, sensor, tree, photometric)
 
 
 def _write_scenes(
     folder: Path, n: int, seed: int, distinct: int | None, n_ripe: int, n_unripe: int, n_leaves: int,
-    sensor: SensorModel | None, tree: bool,
+    sensor: SensorModel | None, tree: bool, photometric: Photometric | None = Photometric(),  # noqa: B008 (frozen)
 ) -> list[Path]:  # fmt: skip
     from ..io.frames import write_frame
 
@@ -465,7 +485,8 @@ def _write_scenes(
         target = folder / f"scene_{i:05d}"
         if i < unique:
             if tree:
-                scene = make_tree_scene(seed + i, sensor=sensor, n_apples=n_ripe, n_green=n_unripe)
+                scene = make_tree_scene(seed + i, sensor=sensor, n_apples=n_ripe, n_green=n_unripe,
+                                        photometric=photometric)  # fmt: skip
             else:
                 scene = make_scene(seed + i, n_ripe=n_ripe, n_unripe=n_unripe, n_leaves=n_leaves, sensor=sensor)
             written.append(write_frame(target, scene.color, scene.depth, scene.camera, truth=scene.truth(),
