@@ -614,12 +614,13 @@ def test_scenes_of_an_apple_tree_go_through_the_azure_kinect_by_default(tmp_path
     """The arguments alone (rendering a 1920x1080 canopy is tested in tests/synthetic)."""
     from symfruit.synthetic import scenes
 
-    calls, kept = [], []
+    calls, kept, looks = [], [], []
 
     def fake(folder, n, **kwargs):
         sensor = kwargs["sensor"]
         calls.append((n, kwargs["seed"], kwargs["n_ripe"], kwargs["n_unripe"], sensor and sensor.name, kwargs["tree"]))
         kept.append(sensor)
+        looks.append(kwargs.get("photometric", "default"))
         return [folder / f"scene_{i:05d}" for i in range(n)]
 
     monkeypatch.setattr(scenes, "write_scenes", fake)
@@ -636,7 +637,12 @@ def test_scenes_of_an_apple_tree_go_through_the_azure_kinect_by_default(tmp_path
         (1, 0, 30, 4, "azure-kinect", True),
     ]
     assert kept[-1].rim_invalid_px == 3 and kept[0].rim_invalid_px == 1
+    assert looks == ["default"] * 4  # the colour camera's effects unless asked otherwise
+    assert main(["scenes", str(tmp_path / "y"), "--scene", "apple-tree", "--n", "1", "--plain-colour"]) == 0
+    assert looks[-1] is None  # the frames of stops 30-44
     out = capsys.readouterr().out
+    assert main(["scenes", str(tmp_path / "z"), "--n", "1", "--plain-colour"]) == 2
+    assert "--plain-colour is for --scene apple-tree" in capsys.readouterr().err
     assert "wrote 2 apple-tree frames to" in out and "(seeds 6-7, azure-kinect at 1920x1080 with masks.png)" in out
     with pytest.raises(SystemExit):
         main(["scenes", str(tmp_path / "w"), "--scene", "pear-tree"])

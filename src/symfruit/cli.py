@@ -298,6 +298,11 @@ def _parser() -> argparse.ArgumentParser:
                    help="with a real camera model (--sensor or --scene apple-tree): change its artefacts, e.g. "
                    "rim_invalid_px=3,flying_share=0.3 (names and bounds: "
                    "symfruit.synthetic.sensors.VARIABLE)")  # fmt: skip
+    p.add_argument("--plain-colour", action="store_true",
+                   help="apple trees: the colour image without the colour camera's effects (exposure, "
+                   "white-balance cast, leaf shadows, highlights, noise, softness, JPEG; "
+                   "symfruit.synthetic.render.Photometric): the frames of stops 30-44, for their tables; depth, "
+                   "masks and truth are the same either way")  # fmt: skip
     p = sub.add_parser("settings", help="print the effective settings as YAML (defaults, --fruit, then --config)")
     p.add_argument("--fruit", help="fruit profile: strawberry, apple, citrus, tomato, or a profile file (.yaml)")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
@@ -934,7 +939,13 @@ def _scenes(args: argparse.Namespace) -> int:
         sensor = sensor_model(args.sensor or "azure-kinect")
         if args.sensor_set is not None:
             sensor = varied(sensor, parse_sensor_set(args.sensor_set))
-    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor, tree=tree)
+    if args.plain_colour and not tree:
+        raise InputError(
+            "scenes --plain-colour is for --scene apple-tree (the strawberry frames have no camera effects)"
+        )
+    looks = {"photometric": None} if args.plain_colour else {}
+    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor, tree=tree,
+                           **looks)  # fmt: skip
     what = "apple-tree frames" if tree else "frames"
     through = f", {sensor.name} at {sensor.width}x{sensor.height} with masks.png" if sensor is not None else ""
     print(f"wrote {len(folders)} {what} to {args.output} (seeds {args.seed}-{args.seed + args.n - 1}{through})")
