@@ -445,3 +445,30 @@ def test_a_mask_overshooting_where_a_time_of_flight_camera_saw_past_the_fruit_do
     assert abs(trimmed.extras["width"] - 0.07) < 0.002
     assert np.abs(trimmed.box.size - truth.size).max() < 0.004
     assert (whole.box.size - truth.size)[[0, 2]].min() > 0.008
+
+
+def test_the_prior_width_reads_the_tilt_when_given():
+    """``prior_width`` with a :class:`~symfruit.core.raster.Tilt`: the prolate spheroid's depth over the outline's
+    major half-width, times the outline's major width (a prolate spheroid lying across the line of sight is as deep
+    as its minor width, not the geometric mean); no estimate (``count`` 0) or none given: the geometric mean; a cut
+    outline moves towards the larger width as before."""
+    from dataclasses import replace
+
+    from symfruit.core.raster import Across, Tilt
+    from symfruit.methods.evidence import prior_width
+
+    across = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.04, 0.09)
+    lying = Tilt(0.045, 0.02, 0.0, 0.0, 1.0, 0.0, 500)
+    assert prior_width(across, 1.0) == pytest.approx(0.06, rel=1e-12)
+    assert prior_width(across, 1.0, 0.0, lying, prolate=True) == pytest.approx(0.04, rel=1e-12)
+    assert prior_width(across, 1.0, 0.0, lying) == pytest.approx(0.04, rel=1e-12)  # its cap: round sections
+    assert prior_width(across, 1.0, 0.0, replace(lying, count=0)) == pytest.approx(0.06, rel=1e-12)
+    # tilted 40 deg towards the camera (a = 20, c = 52.6 mm): deeper than its minor width
+    a, th = 0.02, np.radians(40.0)
+    c = np.sqrt((0.045**2 - a**2 * np.sin(th) ** 2) / np.cos(th) ** 2)
+    slope = np.tan(th) * (1.0 - a**2 / 0.045**2)
+    depth = 2.0 * np.sqrt(c**2 * np.sin(th) ** 2 + a**2 * np.cos(th) ** 2)
+    tilted = Tilt(0.045, a, slope, 0.0, 1.0, 0.0, 500)
+    assert prior_width(across, 1.0, 0.0, tilted, prolate=True) == pytest.approx(depth, rel=1e-9)
+    # a cut outline: towards the larger width, by the square of the cut share
+    assert prior_width(across, 0.0, 1.0, lying, prolate=True) == pytest.approx(0.09, rel=1e-12)
