@@ -472,3 +472,10 @@ def test_the_prior_width_reads_the_tilt_when_given():
     assert prior_width(across, 1.0, 0.0, tilted, prolate=True) == pytest.approx(depth, rel=1e-9)
     # a cut outline: towards the larger width, by the square of the cut share
     assert prior_width(across, 0.0, 1.0, lying, prolate=True) == pytest.approx(0.09, rel=1e-12)
+    # a near-round outline (major 1.02 minor) with a midline slope of 0.1: the slope is divided by the floor
+    # (0.05 or 0.3 of major^2), not by the outline's 0.039 (H^2 = minor^2 + s^2 major^4 / gap)
+    ball = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.05, 0.051)
+    sloped = Tilt(0.0255, 0.025, 0.1, 0.0, 1.0, 0.0, 500)
+    for floor in (0.05, 0.3):
+        want = 2.0 * np.sqrt(0.025**2 + 0.01 * 0.0255**2 / floor) / 0.0255 * 0.051 / 2.0
+        assert prior_width(ball, 1.0, 0.0, sloped, prolate=True, floor=floor) == pytest.approx(want, rel=1e-9)
