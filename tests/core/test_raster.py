@@ -530,3 +530,70 @@ def test_outline_cone_is_the_same_with_its_kernels_and_without(camera, monkeypat
                 found += 1
                 assert got[0].tobytes() == twin[0].tobytes() and got[1].tobytes() == twin[1].tobytes()
     assert found >= 4
+
+
+def _spheroid_front(a, c, tilt_deg, roll_deg, *, noise=0.0, seed=0, dist=0.4):
+    """A spheroid's seen front (half-axes ``a`` across, ``c`` along its axis, the axis tilted ``tilt_deg`` out of the
+    image plane and turned ``roll_deg`` in it), one ray per pixel of a 640 x 480 camera, depth noise ``noise``
+    metres (seeded), and its true depth half-extent."""
+    from symfruit.core.camera import Camera
+
+    cam = Camera(fx=600.0, fy=600.0, cx=320.0, cy=240.0, width=640, height=480)
+    t, r = np.radians(tilt_deg), np.radians(roll_deg)
+    u = np.array([np.cos(t) * np.cos(r), np.cos(t) * np.sin(r), np.sin(t)])
+    q = np.eye(3) / a**2 + np.outer(u, u) * (1.0 / c**2 - 1.0 / a**2)
+    centre = np.array([0.01, -0.005, dist])
+    uu, vv = np.meshgrid(np.arange(640.0), np.arange(480.0))
+    d = cam.rays(uu.ravel(), vv.ravel()).reshape(-1, 3)
+    qa = np.einsum("ni,ij,nj->n", d, q, d)
+    qb = -2.0 * d @ q @ centre
+    qc = centre @ q @ centre - 1.0
+    disc = qb * qb - 4.0 * qa * qc
+    hit = disc > 0
+    z = (-qb[hit] - np.sqrt(disc[hit])) / (2.0 * qa[hit])
+    pts = d[hit] * z[:, None]
+    pts *= (1.0 + noise * np.random.default_rng(seed).standard_normal(len(pts)) / pts[:, 2])[:, None]
+    return pts, cam, float(np.sqrt(np.linalg.inv(q)[2, 2]))
+
+
+@pytest.mark.parametrize(
+    ("a", "c", "tilt", "noise", "geometric_off"),
+    [(0.03, 0.05, 0, 0.0, True), (0.03, 0.05, 30, 0.0016, False), (0.03, 0.05, 55, 0.0016, True),
+     (0.04, 0.028, 0, 0.0016, True), (0.04, 0.028, 25, 0.0016, False), (0.03, 0.03, 40, 0.0016, False)],
+)  # fmt: skip
+def test_axis_tilt_finds_a_spheroids_depth(a, c, tilt, noise, geometric_off):
+    from symfruit.core.raster import across_sight, axis_tilt, silhouette
+
+    pts, cam, depth = _spheroid_front(a, c, tilt, 30.0, noise=noise)
+    region = silhouette(pts, cam)
+    across = across_sight(region, cam)
+    t = axis_tilt(pts, region, cam, across)
+    assert t.count > 1000
+    # the half-widths are at the front's median distance, nearer than the centre: compare ratios to the outline
+    scale = a / t.minor if c >= a else a / t.major
+    assert t.half_depth() * scale == pytest.approx(depth, rel=0.07)
+    geometric = float(np.sqrt(t.major * t.minor)) * scale
+    if geometric_off:  # the outline's geometric mean (the prior's width before) is off by more than the tolerance
+        assert abs(geometric / depth - 1.0) > 0.1
+    if c > a:  # a prolate spheroid: its midline slopes along the outline's major axis, by tan(tilt)(1 - a^2/M^2)
+        assert abs(t.slope_minor) < 0.05
+        expected = np.tan(np.radians(tilt)) * (1.0 - (t.minor / t.major) ** 2)
+        assert abs(t.slope_major) == pytest.approx(expected, abs=0.05)
+
+
+def test_tilt_half_depths_know_the_spheroids_formula():
+    from symfruit.core.raster import Tilt
+
+    # a prolate spheroid a = 30, c = 50 mm tilted 40 deg: outline major sqrt(c^2 cos^2 + a^2 sin^2), midline slope
+    a, c, th = 0.03, 0.05, np.radians(40.0)
+    major = np.sqrt(c**2 * np.cos(th) ** 2 + a**2 * np.sin(th) ** 2)
+    slope = np.tan(th) * (1.0 - a**2 / major**2)
+    t = Tilt(major, a, slope, 0.0, 1.0, 0.0, 500)
+    prolate, oblate = t.half_depths()
+    assert prolate == pytest.approx(np.sqrt(c**2 * np.sin(th) ** 2 + a**2 * np.cos(th) ** 2), rel=1e-12)
+    assert oblate == pytest.approx(major, rel=1e-12)
+    # its cap is the prolate's own: the depth is the prolate's
+    cap = np.sqrt(1.0 + slope**2 * major**2 / (major**2 - a**2))
+    assert Tilt(major, a, slope, 0.0, cap, 0.0, 500).half_depth() == pytest.approx(prolate, rel=1e-9)
+    # no estimate: the geometric mean of the two
+    assert Tilt(major, a, slope, 0.0, cap, 0.0, 0).half_depth() == pytest.approx(np.sqrt(prolate * oblate))

@@ -471,3 +471,37 @@ def test_the_spread_in_python_floats_is_numpys(seed):
     assert type(got) is float and got == want
     two = [[0.0, 0.0, 0.0, 2.0, 2.0, 2.0], [1.0, 1.0, 1.0, 1.0, 5.0, 1.0]]
     assert _spread(two, np.array([0.5, 0.5]), Box(np.zeros(3), np.full(3, 2.0))) == 1.0
+
+
+def test_the_prior_width_reads_the_tilt_when_given():
+    """``prior_width`` with a :class:`~symfruit.core.raster.Tilt`: the prolate spheroid's depth over the outline's
+    major half-width, times the outline's major width (a prolate spheroid lying across the line of sight is as deep
+    as its minor width, not the geometric mean); no estimate (``count`` 0) or none given: the geometric mean; a cut
+    outline moves towards the larger width as before."""
+    from dataclasses import replace
+
+    from symfruit.core.raster import Across, Tilt
+    from symfruit.methods.evidence import prior_width
+
+    across = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.04, 0.09)
+    lying = Tilt(0.045, 0.02, 0.0, 0.0, 1.0, 0.0, 500)
+    assert prior_width(across, 1.0) == pytest.approx(0.06, rel=1e-12)
+    assert prior_width(across, 1.0, 0.0, lying, prolate=True) == pytest.approx(0.04, rel=1e-12)
+    assert prior_width(across, 1.0, 0.0, lying) == pytest.approx(0.04, rel=1e-12)  # its cap: round sections
+    assert prior_width(across, 1.0, 0.0, replace(lying, count=0)) == pytest.approx(0.06, rel=1e-12)
+    # tilted 40 deg towards the camera (a = 20, c = 52.6 mm): deeper than its minor width
+    a, th = 0.02, np.radians(40.0)
+    c = np.sqrt((0.045**2 - a**2 * np.sin(th) ** 2) / np.cos(th) ** 2)
+    slope = np.tan(th) * (1.0 - a**2 / 0.045**2)
+    depth = 2.0 * np.sqrt(c**2 * np.sin(th) ** 2 + a**2 * np.cos(th) ** 2)
+    tilted = Tilt(0.045, a, slope, 0.0, 1.0, 0.0, 500)
+    assert prior_width(across, 1.0, 0.0, tilted, prolate=True) == pytest.approx(depth, rel=1e-9)
+    # a cut outline: towards the larger width, by the square of the cut share
+    assert prior_width(across, 0.0, 1.0, lying, prolate=True) == pytest.approx(0.09, rel=1e-12)
+    # a near-round outline (major 1.02 minor) with a midline slope of 0.1: the slope is divided by the floor
+    # (0.05 or 0.3 of major^2), not by the outline's 0.039 (H^2 = minor^2 + s^2 major^4 / gap)
+    ball = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.05, 0.051)
+    sloped = Tilt(0.0255, 0.025, 0.1, 0.0, 1.0, 0.0, 500)
+    for floor in (0.05, 0.3):
+        want = 2.0 * np.sqrt(0.025**2 + 0.01 * 0.0255**2 / floor) / 0.0255 * 0.051 / 2.0
+        assert prior_width(ball, 1.0, 0.0, sloped, prolate=True, floor=floor) == pytest.approx(want, rel=1e-9)

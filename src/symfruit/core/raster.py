@@ -26,8 +26,10 @@ __all__ = [
     "MAX_WINDOW_PIXELS",
     "Across",
     "Silhouette",
+    "Tilt",
     "View",
     "across_sight",
+    "axis_tilt",
     "close_ragged",
     "distance_transform",
     "fill_holes",
@@ -884,3 +886,160 @@ def silhouette_coverage(view: View, box: Box, camera: Camera) -> float:
     inside = ((uu - uc) / au) ** 2 + ((vv - vc) / av) ** 2 <= 1.0
     seen = inside & view.mask[vv - view.v0, uu - view.u0]
     return float(min(1.0, seen.sum() / (np.pi * au * av)))
+
+
+@dataclass(frozen=True)
+class Tilt:
+    """How a fruit's axis is tilted out of the image plane, read off one view (:func:`axis_tilt`).
+
+    Attributes
+    ----------
+    major, minor : float, metres
+        The outline's half-widths along and across its principal axis, at the seen front's distance.
+    slope_major, slope_minor : float
+        Depth per lateral metre of the seen front's midline (the front plus the depth the outline's local
+        half-width would give a round section) along the outline's major and minor axis.
+    cap : float
+        The seen front's sag over the outline's local half-width: 1 for round sections across the major axis
+        (a solid of revolution lying in the image plane), ``major / minor`` for an oblate spheroid seen side on.
+    slope_sd : float
+        The standard deviation of ``slope_major`` (and of ``slope_minor``) from the fit's residuals.
+    count : int
+        Points the fit used (0: no estimate; every other field is then 0 but the half-widths).
+    """
+
+    major: float
+    minor: float
+    slope_major: float
+    slope_minor: float
+    cap: float
+    slope_sd: float
+    count: int
+
+    def half_depths(self, floor: float = 0.05) -> tuple[float, float]:
+        """The depth half-extents ``(prolate, oblate)`` of the spheroid that has this outline and these midline
+        slopes (metres).
+
+        A spheroid's dual quadric is ``a^2 I + (c^2 - a^2) u u^T`` (``a`` its equatorial radius, ``c`` its half-length,
+        ``u`` its axis); seen along ``z`` its outline's semi-axes are two of that matrix's image-plane entries and its
+        midline's slopes the depth column over them, and the matrix minus ``a^2 I`` has rank one. A prolate spheroid
+        (``c > a``) projects its axis on the outline's major axis and its equator on the minor one (``a = minor``,
+        whatever the tilt), and its depth half-extent is ``H^2 = minor^2 + s^2 major^4 / (major^2 - minor^2)``, with
+        ``s`` the midline's slope along the major axis (``s = tan(tilt) (1 - minor^2 / major^2)``: the tilt's tangent
+        ``t`` gives ``H^2 = minor^2 + t^2 (major^2 - minor^2)``). An oblate one (``c < a``) projects its axis on the
+        minor axis: ``a = major``, ``H^2 = major^2 - s^2 minor^4 / (major^2 - minor^2)`` (``s`` along the minor axis),
+        at least ``minor / 2``. ``floor``: the least ``(major^2 - minor^2) / major^2`` divided by (a near-round outline
+        says nothing of the tilt); the slopes' noise variance is taken off their squares first.
+        """
+        big, small = self.major, self.minor
+        gap = max(big * big - small * small, floor * big * big)
+        var = self.slope_sd**2
+        prolate = small * small + max(self.slope_major**2 - var, 0.0) * big**4 / gap
+        oblate = big * big - max(self.slope_minor**2 - var, 0.0) * small**4 / gap
+        return float(np.sqrt(prolate)), float(np.sqrt(max(oblate, 0.25 * small * small)))
+
+    def half_depth(self, floor: float = 0.05) -> float:
+        """The depth half-extent (metres) between :meth:`half_depths`' two, in log by where :attr:`cap` lies between
+        the two spheroids' own (the prolate's ``sqrt(1 + s^2 major^2 / gap)``, the oblate's
+        ``(major / minor) sqrt(1 - s^2 minor^2 / gap)``), clipped to them; their geometric mean when they agree or
+        there is no estimate."""
+        prolate, oblate = self.half_depths(floor)
+        if self.count == 0:
+            return float(np.sqrt(prolate * oblate))
+        big, small = self.major, self.minor
+        gap = max(big * big - small * small, floor * big * big)
+        var = self.slope_sd**2
+        cap_p = np.sqrt(1.0 + max(self.slope_major**2 - var, 0.0) * big * big / gap)
+        cap_o = big / small * np.sqrt(max(1.0 - max(self.slope_minor**2 - var, 0.0) * small * small / gap, 0.25))
+        lo, hi = np.log(max(cap_p, 1e-6)), np.log(max(cap_o, 1e-6))
+        if abs(hi - lo) < 1e-3:
+            return float(np.sqrt(prolate * oblate))
+        share = float(np.clip((np.log(max(self.cap, 1e-6)) - lo) / (hi - lo), 0.0, 1.0))
+        return float(prolate ** (1.0 - share) * oblate**share)
+
+
+def axis_tilt(
+    points: np.ndarray, region: Silhouette, camera: Camera, across: Across, *, bins: int = 24, inner: float = 0.4,
+    ends: float = 0.1, rounds: int = 2,
+) -> Tilt:  # fmt: skip
+    """The tilt of a fruit's axis out of the image plane and the shape of its sections, from its seen front and
+    its outline (:class:`Tilt`).
+
+    The outline (:func:`outline_cracks` in :func:`across_sight`'s tangent coordinates, times the front's distance)
+    is cut into ``bins`` slices across its principal major axis (the outline's own covariance); each slice's
+    half-width ``h`` and middle ``q_c``, interpolated along the axis, give every seen point at ``(p, q)`` the depth a
+    round section through it would show, ``g = sqrt(h^2 - (q - q_c)^2)``. The points' depths along the centroid's ray
+    are then fitted by least squares as ``z0 + s_major p + s_minor q - cap g``: a solid of revolution lying in the
+    image plane has ``cap = 1`` and no slopes, whatever its profile (a pear's neck and body alike); a spheroid
+    tilted out of it keeps its outline's minor half-width and turns its midline by ``s_major``
+    (:meth:`Tilt.half_depths`). Only points where ``g`` is at least ``inner`` of ``h`` (the rim's depths are the
+    noisiest, and ``g`` there the most sensitive to the outline) and at least ``ends`` of the major width from
+    either end are fitted; ``rounds`` refits drop points whose residual is over 2.5 robust standard deviations.
+    """
+    pts = as_points(points, min_count=1)
+    big, small = 0.5 * float(across.major), 0.5 * float(across.minor)
+    depth = pts @ across.axis
+    dist = float(np.median(depth))
+    empty = Tilt(big * dist, small * dist, 0.0, 0.0, 1.0, 0.0, 0)
+    cracks = outline_cracks(region)
+    if len(pts) < 20 or len(cracks) < 8 or big <= 0 or small <= 0:
+        return empty
+    rays = camera.rays(cracks[:, 0], cracks[:, 1]).reshape(-1, 3)
+    edge = (rays @ across.basis.T) / (rays @ across.axis)[:, None]  # tangent coordinates
+    centre = edge.mean(axis=0)
+    _, vec = np.linalg.eigh(np.cov((edge - centre).T))
+    frame = vec[:, ::-1]  # columns: major, minor
+    e = (edge - centre) @ frame
+    x = ((pts @ across.basis.T) / depth[:, None] - centre) @ frame  # tangent coordinates, then metres at each depth
+    lo, hi = float(e[:, 0].min()), float(e[:, 0].max())
+    span = hi - lo
+    if span <= 0:
+        return empty
+    big, small = 0.5 * span, 0.5 * float(np.ptp(e[:, 1]))  # this outline's own (the region's, the points')
+    which = np.clip(((e[:, 0] - lo) / span * bins).astype(np.intp), 0, bins - 1)
+    top = np.full(bins, -np.inf)
+    bottom = np.full(bins, np.inf)
+    np.maximum.at(top, which, e[:, 1])
+    np.minimum.at(bottom, which, e[:, 1])
+    ok = np.isfinite(top) & np.isfinite(bottom)
+    if ok.sum() < 3:
+        return empty
+    mids = lo + (np.arange(bins) + 0.5) / bins * span
+    half_t = np.interp(x[:, 0], mids[ok], 0.5 * (top - bottom)[ok])
+    off_t = x[:, 1] - np.interp(x[:, 0], mids[ok], 0.5 * (top + bottom)[ok])
+    inside = (half_t * half_t - off_t * off_t >= (inner * half_t) ** 2) & (x[:, 0] >= lo + ends * span)
+    keep = inside & (x[:, 0] <= hi - ends * span)
+    if keep.sum() < 20:
+        return empty
+    xm = x * depth[:, None]
+    coef = np.zeros(4)
+    design = np.empty((len(pts), 4))
+    for scale in (dist, None):
+        # the outline lies at the rim's distance, the midline's depth at the centre (``z0``), nearer than the
+        # seen points' median: a round section's sag is its half-width there
+        at = dist if scale is not None else max(float(coef[0]), dist)
+        half, off = half_t * at, off_t * depth
+        design = np.column_stack(
+            (np.ones(len(pts)), xm[:, 0], xm[:, 1], -np.sqrt(np.maximum(half * half - off * off, 0.0)))
+        )
+        fit = keep.copy()
+        for _ in range(rounds + 1):
+            coef = np.linalg.lstsq(design[fit], depth[fit], rcond=None)[0]
+            res = depth - design @ coef
+            sd = 1.4826 * float(np.median(np.abs(res[fit] - np.median(res[fit]))))
+            if sd <= 0:
+                break
+            nxt = fit & (np.abs(res) <= 2.5 * sd)
+            if nxt.sum() < 20 or np.array_equal(nxt, fit):
+                break
+            fit = nxt
+        keep_fit = fit
+    dist = max(float(coef[0]), dist)
+    a = design[keep_fit]
+    try:
+        cov = np.linalg.inv(a.T @ a) * float(np.mean((depth[keep_fit] - a @ coef) ** 2))
+    except np.linalg.LinAlgError:
+        return empty
+    slope_sd = float(np.sqrt(max(0.5 * (cov[1, 1] + cov[2, 2]), 0.0)))
+    keep = keep_fit
+    return Tilt(big * dist, small * dist, float(coef[1]), float(coef[2]), float(coef[3]), slope_sd, int(keep.sum()))

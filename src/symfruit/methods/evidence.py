@@ -63,7 +63,9 @@ from ..core.points import bounds, row_norms, subsample
 from ..core.raster import (
     Across,
     Silhouette,
+    Tilt,
     across_sight,
+    axis_tilt,
     close_ragged,
     inner_distance,
     point_pixels,
@@ -130,6 +132,15 @@ class EvidenceSettings(Section):
         profile sets 1 (mostly hidden apples' boxes were 9 mm too shallow, docs/ablation.md "Hidden apples'
         boxes"). Not the default: on an elongated fruit the larger width is its length, and through the D435
         model the real scans (a banana and a pear) fell from 0.634 / 14.3 mm to 0.607 / 16.9 with it.
+    prior_tilt, tilt_floor : {"off", "cap", "prolate"}, float
+        In a depth camera's view of a whole outline (at least ``covered_contour`` of it a contour), the prior's width
+        from the tilt of the fruit's axis out of the image plane instead of the geometric mean
+        (:func:`~symfruit.core.raster.axis_tilt`, stop 45, docs/axis45.md): ``prolate`` the depth of the prolate
+        spheroid with the outline and the seen front's midline slope (its minor half-width, deeper as the axis
+        tilts towards the camera), ``cap`` between that and the oblate spheroid's by the seen front's sag over the
+        outline's half-width, ``off`` (the default: neither helped on every table) the geometric mean.
+        ``tilt_floor``: the least ``(major^2 - minor^2) / major^2`` the midline's slope is divided by
+        (:meth:`~symfruit.core.raster.Tilt.half_depths`: a near-round outline says little of the tilt).
     shape_error, rim_error, back_inflation : float, float, float
         The candidates' back face has standard deviation ``hypot(back_inflation * back_std, spread / 2, width *
         (shape_error + rim_error * (1 - rim)))``: the ``cone`` fit's own back-face deviation (from ray residuals
@@ -222,6 +233,8 @@ class EvidenceSettings(Section):
     depth_ratio: float = setting(1.0, gt=0.0, le=10.0)
     depth_ratio_sd: float = setting(0.15, ge=0.0, le=10.0)
     cut_width: float = setting(0.0, ge=0.0, le=1.0)
+    prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
+    tilt_floor: float = setting(0.05, gt=0.0, le=1.0)
     shape_error: float = setting(0.02, gt=0.0, le=10.0)
     rim_error: float = setting(1.0, ge=0.0, le=100.0)
     back_inflation: float = setting(1.5, ge=0.0, le=1000.0)
@@ -375,7 +388,8 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
 
 
-def prior_width(across: Across, contour: float, cut_width: float = 1.0) -> float:
+def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Tilt | None = None,
+                prolate: bool = False, floor: float = 0.05) -> float:  # fmt: skip
     """The silhouette's width the depth prior reads (tangent units: times the distance, metres): the geometric
     mean of its widths across and along its principal axis for a whole outline (a solid of revolution is as deep
     as one of them, whichever way its axis lies in the image), moved in log towards the larger by ``cut_width``
@@ -397,6 +411,12 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0) -> float
     if small <= 0.0:
         return big
     cut = min(max(1.0 - float(contour), 0.0), 1.0) ** 2 * cut_width
+    if tilt is not None and tilt.count > 0 and tilt.major > 0:
+        # the spheroid's depth for the outline and the seen front's tilt (core.raster.axis_tilt), in the outline's
+        # tangent units, then towards the larger width as the geometric mean is
+        half = tilt.half_depths(floor)[0] if prolate else tilt.half_depth(floor)
+        depth = min(max(half / tilt.major * big, 0.5 * small), 2.0 * big)
+        return depth * (big / depth) ** cut
     return big * (small / big) ** (0.5 * (1.0 - cut))
 
 
@@ -461,6 +481,7 @@ def fuse_depth(
     rim: float = 1.0,
     seen_back: float | None = None,
     across: Across | None = None,
+    tilt: Tilt | None = None,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -484,7 +505,8 @@ def fuse_depth(
     spread = float((w * np.abs(backs - fit_back)).sum())
     back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
-    width = float(prior_width(across, combined.contour, s.cut_width) * box.centre[2] / across.axis[2])
+    width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor)
+                  * box.centre[2] / across.axis[2])  # fmt: skip
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
     fit_sd = float(np.sqrt((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
     if s.depth_ratio_sd <= 0 or width <= 0:
@@ -578,8 +600,12 @@ def evidence(
     rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
     seen_back = float(hi[2])
     sized = across if trimmed is None else across_sight(trimmed, camera)
+    tilt = None
+    if s.prior_tilt != "off" and dense and obs.contour >= s.covered_contour:
+        # the points' own outline: the mask's may be shifted from the depth (registration) or reach past it
+        tilt = axis_tilt(sample, seen_region, camera, sized)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
-                                     across=sized)  # fmt: skip
+                                     across=sized, tilt=tilt)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
     # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
