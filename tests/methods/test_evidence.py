@@ -332,6 +332,34 @@ def test_a_front_no_shape_explains_makes_the_back_uncertain():
     assert complete(build(Spec("paper", "citrus", 0, 13)).visible).extras["unexplained"] == 0.0
 
 
+def test_a_cut_outline_and_a_silhouette_wider_than_the_shapes_make_the_centre_uncertain():
+    """A leaf hides the lower part of a lemon (the frame's occlusion information says where): part of its outline
+    is a cut, beyond which nothing was seen, and the shapes' box and the silhouette's lateral extent disagree.
+    Both add to the predicted uncertainty in quadrature (times the elongation): ``cut_scale`` times the cut share
+    times the box's largest side, ``lateral_scale`` times the disagreement; with both scales 0 they are gone, and
+    the box does not move. A whole outline has no cut term (docs/conf45.md)."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    fruit = FRUITS["lemon"](np.random.default_rng(3))
+    visible, depth, mask, _ = occluded_view(fruit, [0.0, 0.0, 0.4], below=250, occluder_z=0.35, noise=0.01, seed=1,
+                                            rotation=rotation(20, 40, 10))  # fmt: skip
+    occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
+    r = complete(visible, occlusion=occ)
+    off = complete(visible, occlusion=occ, settings=Settings().replace(evidence={"cut_scale": 0.0,
+                                                                                 "lateral_scale": 0.0}))  # fmt: skip
+    e, s = r.extras, EvidenceSettings()
+    assert e["contour"] < 0.8 and e["cut"] > 0.2 * 0.04 and e["lateral"] > 0.0
+    terms = (s.cut_scale * e["cut"]) ** 2 + (s.lateral_scale * e["lateral"]) ** 2
+    assert e["uncertainty"] ** 2 - off.extras["uncertainty"] ** 2 == pytest.approx(e["elongation"] ** 2 * terms)
+    assert r.confidence < off.confidence
+    np.testing.assert_array_equal(off.box.min, r.box.min)  # the confidence never moves the box
+    np.testing.assert_array_equal(off.box.max, r.box.max)
+    whole, _ = rendered_view(ball_mesh(), [0.03, 0.02, 0.42], noise=0.01, seed=4)
+    assert complete(whole).extras["cut"] == 0.0
+
+
 def test_completed_points_are_the_seen_and_their_mirror_images_through_the_box_centre():
     """Written column by column: the same values as ``np.vstack([points, 2 centre - points])``, to the bit."""
     visible, _ = rendered_view(ball_mesh(0.03), [0.02, -0.01, 0.4], noise=0.01, seed=4)

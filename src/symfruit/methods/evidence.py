@@ -34,9 +34,10 @@ completion is right for every fruit, and the view itself says which ones fit. Th
 7. predicts its centre's uncertainty (millimetres, ``extras["uncertainty"]``) from the best-posed fit's
    own noise, the candidates' disagreement, what no candidate explains (of the outline, and of the seen
    depths beyond the sensor's noise), how far the prior moved the back face from the shapes' (half of it,
-   as the centre moves) and how far the fruit recedes along the line of sight, all scaled by the outline's
-   elongation, and reports
-   ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 2.5 mm``.
+   as the centre moves), how far the fruit recedes along the line of sight, how much of the outline is a
+   cut and how far the silhouette's lateral extent disagrees with the shapes' box, all scaled by the
+   outline's elongation, and reports
+   ``confidence = exp(-uncertainty / 3 mm)`` and ``reliable = uncertainty <= 3 mm``.
 
 No fruit profile is needed: nothing in it depends on the kind of fruit. The design and the ablation
 behind every constant are in ``docs/ablation.md``.
@@ -186,25 +187,31 @@ class EvidenceSettings(Section):
         best shape there is.
     mirror_energy, raw_energy : float
         Fixed energies of the mirror and raw candidates (raw's grows with the cut share, see above).
-    misfit_scale, recede_scale, unexplained_scale, misfit_noise : float
+    misfit_scale, recede_scale, unexplained_scale, misfit_noise, cut_scale, lateral_scale : float
     uncertainty_scale, reliable_uncertainty : float (metres), float (metres)
         The predicted centre uncertainty ``u = elongation * hypot(hypot(back_std, spread) + misfit_scale * wrong * size,
-        moved / 2, recede_scale * recede, unexplained_scale * unexplained)``: ``back_std`` the ``cone`` ellipsoid's
-        back-face standard deviation from its own fit (the sensor's noise), ``spread`` the weighted mean distance of the
-        candidates' centres from the result's (what the shapes disagree on), ``wrong`` the best closed candidate's share
-        of silhouette-band rays wrong and ``size`` the result's largest side (what no shape explains), ``moved`` how far
-        :func:`fuse_depth` moved the back face (the prior against the shapes); ``recede`` how much deeper than half the
-        silhouette's width the points of a depth camera's view reach behind the front, times the contour share (a round
-        fruit shows about half its depth in front of its rim; a fruit receding along the line of sight, a pear or banana
-        pointing at the camera, has a back that nothing seen mirrors); ``unexplained`` the seen depths' misfit that no
-        closed shape explains, ``sqrt(max(0, rms**2 - (misfit_noise * noise)**2))``, ``rms`` the best closed candidate's
-        robust RMS depth misfit and ``noise`` the points' small-scale plane residual
-        (:func:`~symfruit.core.fits.surface_noise`; a shape that does not explain the front it was fitted to does not
-        predict the back it extrapolates; 0 for a sparse cloud); ``elongation`` the square root of the silhouette's
+        moved / 2, recede_scale * recede, unexplained_scale * unexplained, cut_scale * cut, lateral_scale * lateral)``:
+        ``back_std`` the ``cone`` ellipsoid's back-face standard deviation from its own fit (the sensor's noise),
+        ``spread`` the weighted mean distance of the candidates' centres from the result's (what the shapes disagree
+        on), ``wrong`` the best closed candidate's share of silhouette-band rays wrong and ``size`` the result's largest
+        side (what no shape explains), ``moved`` how far :func:`fuse_depth` moved the back face (the prior against the
+        shapes); ``recede`` how much deeper than half the silhouette's width the points of a depth camera's view reach
+        behind the front, times the contour share (a round fruit shows about half its depth in front of its rim; a fruit
+        receding along the line of sight, a pear or banana pointing at the camera, has a back that nothing seen
+        mirrors); ``unexplained`` the seen depths' misfit that no closed shape explains, ``sqrt(max(0, rms**2 -
+        (misfit_noise * noise)**2))``, ``rms`` the best closed candidate's robust RMS depth misfit and ``noise`` the
+        points' small-scale plane residual (:func:`~symfruit.core.fits.surface_noise`; a shape that does not explain the
+        front it was fitted to does not predict the back it extrapolates; 0 for a sparse cloud; ``unexplained_scale`` 3:
+        the back lies about a diameter behind the front the misfit was measured on, docs/conf45.md); ``cut`` the share
+        of the outline that is a cut (``1 - contour``) times the shapes' box's largest side (beyond a cut nothing was
+        seen of the fruit); ``lateral`` the largest distance between a lateral face of the shapes' box and the
+        silhouette's extent across the line of sight at the box's distance (:func:`fuse_depth`'s, before it moves the
+        faces: two measures of the fruit's width that disagree); ``elongation`` the square root of the silhouette's
         major over minor width (an elongated outline leaves the tilt of the long axis out of the image unseen, and every
         error above grows with it). ``confidence = exp(-u / uncertainty_scale)``; ``reliable`` when ``u <=
-        reliable_uncertainty``. Issue 18's block jackknife of the ``cone`` fit's back face (angular sectors of the seen
-        depths, or of the outline, left out) was measured and predicts nothing on the real scans (docs/ablation.md).
+        reliable_uncertainty`` (3 mm: docs/conf45.md). Issue 18's block jackknife of the ``cone`` fit's back face
+        (angular sectors of the seen depths, or of the outline, left out) was measured and predicts nothing on the real
+        scans (docs/ablation.md).
     mirror_candidate : bool
         Add the mirror completion as a candidate (off by default: ~3 ms per fruit for means that moved
         by less than 0.1 mm in the ablation).
@@ -248,10 +255,12 @@ class EvidenceSettings(Section):
     raw_energy: float = setting(5.0, ge=0.0, le=1e6)
     misfit_scale: float = setting(0.1, ge=0.0, le=100.0)
     recede_scale: float = setting(0.1, ge=0.0, le=100.0)
-    unexplained_scale: float = setting(1.0, ge=0.0, le=100.0)
+    unexplained_scale: float = setting(3.0, ge=0.0, le=100.0)
     misfit_noise: float = setting(2.0, ge=0.0, le=100.0)
+    cut_scale: float = setting(0.1, ge=0.0, le=100.0)
+    lateral_scale: float = setting(0.5, ge=0.0, le=100.0)
     uncertainty_scale: float = setting(0.003, gt=0.0, le=1.0)
-    reliable_uncertainty: float = setting(0.0025, ge=0.0, le=1.0)
+    reliable_uncertainty: float = setting(0.003, ge=0.0, le=1.0)
     occluded_px: int = setting(4, ge=0, le=50)
     thin_px: int = setting(3, ge=0, le=50)
     contour_cone: float = setting(0.3, ge=0.0, le=1.0)
@@ -622,8 +631,16 @@ def evidence(
         if noise is None:
             _, noise = noise_measures(sample, queries=s.noise_queries)
         unexplained = float(np.sqrt(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
+    # What the outline says the shapes miss (docs/conf45.md): the share of it that is a cut, beyond which the fruit
+    # was not seen, times the box's largest side; and how far the silhouette's lateral extent (across the line of
+    # sight at the box's distance, as fuse_depth reads it) disagrees with the shapes' box, on its worse side.
+    cut = (1.0 - combined.contour) * float(combined.box.size.max())
+    dist = 0.5 * float(box.min[2] + box.max[2]) / float(sized.axis[2])
+    lateral = float(max(np.abs(dist * (sized.axis[:2] + sized.lo) - combined.box.min[:2]).max(),
+                        np.abs(dist * (sized.axis[:2] + sized.hi) - combined.box.max[:2]).max()))  # fmt: skip
     uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2
-                                             + (s.unexplained_scale * unexplained) ** 2))  # fmt: skip
+                                             + (s.unexplained_scale * unexplained) ** 2 + (s.cut_scale * cut) ** 2
+                                             + (s.lateral_scale * lateral) ** 2))  # fmt: skip
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
         "confidence": confidence,
@@ -631,6 +648,8 @@ def evidence(
         "uncertainty": uncertainty,
         "recede": recede,
         "unexplained": unexplained,
+        "cut": cut,
+        "lateral": lateral,
         "elongation": elongation,
         "back_sd": back_sd,
         "rim": rim,
