@@ -399,3 +399,20 @@ def test_the_default_settings_are_made_once_while_the_sections_stay():
         assert grown is not first and grown.speedocc45_extra == Extra()
     again = _default_settings()  # the section gone: the defaults without it, made anew
     assert again == first and not hasattr(again, "speedocc45_extra")
+
+
+def test_one_pixel_of_depth_in_range_off_the_sample_is_enough(example):
+    # _check_depth_range reads every 97th pixel first and the whole image only when none of them is in range: a frame
+    # whose one pixel in range lies between the samples passes, as does a strided view of that depth
+    from symfruit.detect import _check_depth_range
+
+    depth = np.zeros_like(example.depth)
+    depth[1, 1] = 1.0  # flat index w + 1: not a multiple of 97 on the example's image
+    assert (depth.shape[1] + 1) % 97 != 0
+    _check_depth_range(replace(example, depth=depth), 0.1, 3.0)
+    wide = np.zeros((depth.shape[0], 2 * depth.shape[1]), depth.dtype)
+    wide[:, ::2] = depth
+    _check_depth_range(replace(example, depth=wide[:, ::2]), 0.1, 3.0)
+    depth[1, 1] = 5.0
+    with pytest.raises(InputError, match="no depth within extraction's range"):
+        _check_depth_range(replace(example, depth=depth), 0.1, 3.0)

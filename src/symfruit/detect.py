@@ -122,7 +122,11 @@ def _check_depth_range(frame: Frame, near: float, far: float) -> None:
     """Refuse a frame whose depth holds nothing extraction could use: no depth at all, or none within its range
     (a wrong ``depth_scale`` puts a whole frame 10 or 1000 times too far or too near)."""
     depth = frame.depth
-    if ((depth >= max(near, 1e-9)) & (depth <= far)).any():  # one pass over the image on every usable frame
+    low = max(near, 1e-9)
+    # every 97th pixel first (a usable frame has depth in range among them; stop 45: 0.07 ms a frame for the pass
+    # over the whole image), the whole image when none is: the same answer either way
+    sample = depth.reshape(-1)[::97] if depth.flags.c_contiguous else depth[::8, ::8]
+    if ((sample >= low) & (sample <= far)).any() or ((depth >= low) & (depth <= far)).any():
         return
     if not (depth > 0).any():
         raise InputError(f"frame {frame.name}: the depth image holds no valid depth")
