@@ -357,3 +357,62 @@ def test_a_mask_the_colour_cannot_trim_is_trimmed_where_the_camera_saw_past_the_
             assert abs(np.sqrt(kept.sum() / np.pi) - 22) < 1.5
         else:
             assert d.occlusion.overshoot is None and d.mask.sum() < mask.sum()
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_the_masks_boxes_are_find_objects(seed):
+    # detect finds the masks' boxes by one compiled pass (symfruit.core._jit.label_boxes) where numba is, by
+    # find_objects where not: the same boxes, labels without pixels None
+    from scipy import ndimage
+
+    from symfruit.detect import _label_boxes
+
+    rng = np.random.default_rng(seed)
+    labels = (rng.integers(0, 7, (30, 70)) * (rng.random((30, 70)) < rng.uniform(0.0, 0.5))).astype(np.int32)
+    count = int(labels.max())
+    want = ndimage.find_objects(labels)
+    assert _label_boxes(labels, count) == want
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        assert _label_boxes(labels, count) == want
+
+
+def test_the_default_settings_are_made_once_while_the_sections_stay():
+    """``detect`` without settings reads ``Settings()``, made once (immutable) and made anew when a section is
+    registered after it."""
+    from dataclasses import dataclass
+
+    from symfruit import settings as settings_module
+    from symfruit.detect import _default_settings
+    from symfruit.settings import Section
+
+    first = _default_settings()
+    assert first == Settings() and _default_settings() is first
+
+    @dataclass(frozen=True)
+    class Extra(Section):
+        value: int = 1
+
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setitem(settings_module._SECTIONS, "speedocc45_extra", Extra)
+        grown = _default_settings()
+        assert grown is not first and grown.speedocc45_extra == Extra()
+    again = _default_settings()  # the section gone: the defaults without it, made anew
+    assert again == first and not hasattr(again, "speedocc45_extra")
+
+
+def test_one_pixel_of_depth_in_range_off_the_sample_is_enough(example):
+    # _check_depth_range reads every 97th pixel first and the whole image only when none of them is in range: a frame
+    # whose one pixel in range lies between the samples passes, as does a strided view of that depth
+    from symfruit.detect import _check_depth_range
+
+    depth = np.zeros_like(example.depth)
+    depth[1, 1] = 1.0  # flat index w + 1: not a multiple of 97 on the example's image
+    assert (depth.shape[1] + 1) % 97 != 0
+    _check_depth_range(replace(example, depth=depth), 0.1, 3.0)
+    wide = np.zeros((depth.shape[0], 2 * depth.shape[1]), depth.dtype)
+    wide[:, ::2] = depth
+    _check_depth_range(replace(example, depth=wide[:, ::2]), 0.1, 3.0)
+    depth[1, 1] = 5.0
+    with pytest.raises(InputError, match="no depth within extraction's range"):
+        _check_depth_range(replace(example, depth=depth), 0.1, 3.0)

@@ -281,3 +281,19 @@ def test_extract_refuses_a_depth_in_millimetres_rather_than_giving_no_points():
         extract(mask, depth * 1000.0, CAM)
     assert len(extract(mask, depth * 1000.0, CAM, checked=True).points) == 0
     assert len(extract(mask, np.full_like(depth, np.nan), CAM).points) == 0  # no depth at all: 0 points, as before
+
+
+def test_trim_labels_names_the_masks_it_trimmed():
+    """``trimmed`` gets the labels of the masks that lost pixels: a mask 3 px too large (trimmed) and one drawn to its
+    disc (not), labels 1 and 3 with 2 missing; none when the trim is off."""
+    color, _ = disc_frame([(50, 60), (115, 60)], radius=18)
+    yy, xx = np.mgrid[:120, :160]
+    labels = np.zeros((120, 160), np.int32)
+    labels[(xx - 50) ** 2 + (yy - 60) ** 2 <= 21**2] = 1
+    labels[(xx - 115) ** 2 + (yy - 60) ** 2 <= 18**2] = 3
+    trimmed: set[int] = set()
+    out = trim_labels(color, labels, trimmed=trimmed)
+    assert trimmed == {1} and (out == 1).sum() < (labels == 1).sum()
+    assert np.array_equal(out == 3, labels == 3)
+    off: set[int] = set()
+    assert trim_labels(color, labels, ExtractSettings(colour_trim_px=0), trimmed=off) is labels and off == set()

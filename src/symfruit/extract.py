@@ -297,7 +297,8 @@ WIDEST = 0.4
 
 
 def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None,
-                *, boxes: list[tuple[slice, slice] | None] | None = None) -> np.ndarray:  # fmt: skip
+                *, boxes: list[tuple[slice, slice] | None] | None = None,
+                trimmed: set[int] | None = None) -> np.ndarray:  # fmt: skip
     """``labels`` with each mask's outer band trimmed where its colour is the background's
     (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
     equivalent radius; where fruit and surroundings do not separate there, twice and three times that band, at
@@ -306,7 +307,7 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     Masks and colour share the colour camera's pixels, so this comes before :func:`register` moves the masks
     onto the depth image: trimmed after the move, a mask would be compared with colours several pixels off.
     ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
-    is trimmed.
+    is trimmed. ``trimmed``: a set given the labels of the masks that lost pixels.
     """
     color = np.asarray(color)
     if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
@@ -331,6 +332,8 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
         if (dropped := mask & ~kept).any():
             out = out.copy() if out is labels else out
             out[r0:r1, c0:c1][dropped] = 0
+            if trimmed is not None:
+                trimmed.add(k)
     return out
 
 

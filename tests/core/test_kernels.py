@@ -5091,3 +5091,125 @@ def test_the_apex_kernels_are_the_twins(seed):
     bowl = np.column_stack((g + 0.003, 0.4 + 5.0 * ((g[:, 0] - 0.001) ** 2 + g[:, 1] ** 2)))
     z_min, apex = apex_depth(np.ascontiguousarray(bowl))
     assert z_min == pytest.approx(0.4, abs=1e-9) and apex[:2] == pytest.approx([0.004, 0.003], abs=1e-6)
+
+
+# --- stop 45, speedocc45
+
+
+def _fattened_scene(rng, h, w, with_others):
+    """A disc fruit whose depth the sensor spread a few pixels past its mask, a leaf in front, another fruit beside,
+    dropouts, on an (h, w) image: ``(uv, points, depth, mask, others)`` as :func:`_jit.occlusion_edge` takes them."""
+    rr, cc = np.mgrid[0:h, 0:w]
+    r0, c0, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(2, 12)
+    dist = np.hypot(rr - r0, cc - c0)
+    zf = 0.4 + 0.0005 * dist
+    depth = np.where(dist <= rad + rng.uniform(0, 9), zf, rng.choice([0.4, 1.0])) + rng.normal(0.0, 0.001, (h, w))
+    leaf = (np.abs(rr - rng.uniform(0, h)) < rng.uniform(0, 4)) & (cc > rng.uniform(0, w))
+    depth = np.where(leaf, rng.choice([0.3, 0.4]), depth)
+    depth[rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])] = rng.choice([0.0, np.nan])
+    mask = (dist <= rad) & ~leaf
+    sel = (dist <= rad + rng.integers(-2, 3)) & (rng.random((h, w)) < 0.9)  # the points' pixels: not quite the mask's
+    if not sel.any():
+        sel[int(min(r0, h - 1)), int(min(c0, w - 1))] = True
+    v, u = np.nonzero(sel)
+    z = zf[sel] + rng.choice([0.0, 0.004, -0.01], len(u))
+    uv = np.column_stack((u + rng.uniform(-0.4, 0.4, len(u)), v + rng.uniform(-0.4, 0.4, len(u))))
+    points = np.column_stack((uv[:, 0] * z / 300.0, uv[:, 1] * z / 300.0, z))
+    others = (
+        (np.hypot(rr - r0, cc - c0 - 2 * rad - rng.integers(0, 5)) <= rad) if with_others else np.zeros((0, 0), bool)
+    )
+    return uv, points, depth, mask, others
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.booleans(), st.integers(6, 70),
+       st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3))  # fmt: skip
+def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, w, tolerance, reach):
+    """occlusion_edge_boxed (own_edge's square filters from summed-area tables, the own depths' least from the points'
+    box alone, no window-sized own maps) against occlusion_edge (own_edge on the window's maps), the kernels, and
+    against occlusion's numpy twin: the same window, hidden pixels and seen depths, bit for bit; fruit at the image's
+    border, fattened edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    rng = np.random.default_rng(seed)
+    uv, points, depth, mask, others = _fattened_scene(rng, h, w, with_others)
+    depth = depth.astype(np.float32 if single else np.float64)
+    steps = _steps_within(reach)
+    want = _jit.occlusion_edge(uv, points, 16, depth, mask, others, tolerance, steps, band)
+    got = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, others, tolerance, steps, band)
+    assert got[:3] == want[:3] and got[3].tobytes() == want[3].tobytes() and got[4].tobytes() == want[4].tobytes()
+    camera = Camera(fx=300.0, fy=300.0, cx=0.0, cy=0.0, width=w, height=h)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = occlusion(depth, mask, points, camera, others=others if with_others else None, tolerance=tolerance,
+                         reach=reach, band=band, trim_own=False)  # fmt: skip
+    assert (twin.u0, twin.v0) == got[1:3] and twin.hidden.tobytes() == got[3].tobytes()
+
+
+def test_the_boxed_own_edge_known_answers():
+    """A disc whose depth runs 3 px past its mask onto background: the ring (hidden without the band) cleared, every
+    pixel of it, and own_edge_boxed returns their count; with the ring 2 cm in front of the fruit (a leaf), it stays;
+    with a leaf at the fruit's depth running on past the band to the right, the ring stays on its middle row and is
+    cleared on the other side."""
+    h, w = 60, 80
+    rr, cc = np.mgrid[0:h, 0:w]
+    dist = np.hypot(rr - 30, cc - 40)
+    mask = dist <= 10
+    v, u = np.nonzero(mask)
+    uv = np.column_stack((u.astype(float), v.astype(float)))
+    points = np.column_stack((u * 0.4 / 300.0, v * 0.4 / 300.0, np.full(len(u), 0.4)))
+    steps, none = _steps_within(3), np.zeros((0, 0), bool)
+    ring = (dist > 10) & (dist <= 13)
+
+    def both(depth):
+        bare = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 0)
+        return bare, _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 8)
+
+    bare, (found, u0, v0, hidden, seen) = both(np.where(dist <= 13, 0.4, 1.0))
+    assert found and int(bare[3].sum()) == int(ring.sum()) and not hidden.any()
+    again = bare[3].copy()
+    box_z = np.where(mask[20:41, 30:51], 0.4, np.inf)
+    count = _jit.own_edge_boxed(again, mask, v0, u0, box_z, 20 - v0, 30 - u0, seen, none, 0.005, 8)
+    assert count == int(ring.sum()) and not again.any()
+    bare, front = both(np.where(dist <= 10, 0.4, np.where(dist <= 13, 0.38, 1.0)))
+    assert int(bare[3].sum()) == int(ring.sum()) and np.array_equal(front[3], bare[3])
+    leaf = (np.abs(rr - 30) <= 1) & (cc > 40)
+    bare, cut = both(np.where((dist <= 13) | leaf, 0.4, 1.0))
+    kept = np.zeros((h, w), bool)
+    kept[cut[2] : cut[2] + cut[3].shape[0], cut[1] : cut[1] + cut[3].shape[1]] = cut[3]
+    assert kept[30, 51:54].all() and not kept[ring & (cc < 40)].any()  # the leaf's middle row beside the fruit
+
+
+def test_the_label_boxes_known_answer():
+    """Three labels, one missing, one in the last column and row, a run longer than the 32-pixel blocks: the boxes,
+    stops exclusive, r1 = 0 for the missing one."""
+    labels = np.zeros((5, 70), np.int32)
+    labels[1:3, 2:40] = 1
+    labels[4, 69] = 3
+    labels[0, 35] = 3
+    got = _jit.label_boxes(labels, 4)
+    assert got.tolist() == [[1, 3, 2, 40], [5, 0, 70, 0], [0, 5, 35, 70], [5, 0, 70, 0]]
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(1, 50), st.integers(1, 130), st.integers(1, 12))
+def test_the_label_boxes_are_find_objects(seed, h, w, n):
+    """label_boxes against ``ndimage.find_objects`` on random label images: sparse and dense labels, runs across the
+    32-pixel blocks, labels without pixels, labels above the count asked for (background to both)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    labels = np.zeros((h, w), np.int32)
+    for _ in range(int(rng.integers(0, 8))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        labels[r0 : r0 + int(rng.integers(1, 20)), c0 : c0 + int(rng.integers(1, 80))] = rng.integers(1, n + 3)
+    labels[rng.random((h, w)) < rng.choice([0.0, 0.01, 0.3])] = rng.integers(0, n + 3)
+    if rng.random() < 0.5:
+        labels = labels[:, ::-1]  # a strided view
+    got = _jit.label_boxes(labels, n)
+    want = ndimage.find_objects(np.where(labels <= n, labels, 0), n)
+    for k in range(n):
+        sl = want[k]
+        expect = [h, 0, w, 0] if sl is None else [sl[0].start, sl[0].stop, sl[1].start, sl[1].stop]
+        assert got[k].tolist() == expect
