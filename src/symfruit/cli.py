@@ -943,9 +943,12 @@ def _scenes(args: argparse.Namespace) -> int:
         raise InputError(
             "scenes --plain-colour is for --scene apple-tree (the strawberry frames have no camera effects)"
         )
-    looks = {"photometric": None} if args.plain_colour else {}
-    folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor, tree=tree,
-                           **looks)  # fmt: skip
+    if args.plain_colour:
+        folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor,
+                               tree=tree, photometric=None)  # fmt: skip
+    else:  # the colour camera's effects, write_scenes' default
+        folders = write_scenes(args.output, args.n, seed=args.seed, n_ripe=ripe, n_unripe=unripe, sensor=sensor,
+                               tree=tree)  # fmt: skip
     what = "apple-tree frames" if tree else "frames"
     through = f", {sensor.name} at {sensor.width}x{sensor.height} with masks.png" if sensor is not None else ""
     print(f"wrote {len(folders)} {what} to {args.output} (seeds {args.seed}-{args.seed + args.n - 1}{through})")
