@@ -3676,7 +3676,7 @@ def test_the_row_minimum_kernel_is_scipys_minimum_filter():
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.sampled_from([0, 3, 8]), st.booleans(), st.booleans())
 def test_the_occlusion_in_one_call_gives_the_twins_maps(seed, band, with_others, single):
-    """core.occlusion.occlusion (jit.occlusion_edge: the maps, the own depths and own_edge in one kernel) against
+    """core.occlusion.occlusion (jit.occlusion_edge_boxed: the maps, the own depths and own_edge in one kernel) against
     the numpy twins on a disc fruit whose depth the sensor spread a few pixels past its mask (a fattened edge), a
     leaf in front, another fruit beside, dropouts: the same window, hidden pixels and seen depths, bit for bit."""
     from symfruit.core.camera import Camera
@@ -4239,7 +4239,7 @@ def test_the_thin_fronts_median_partition_is_the_twins(seed):
 def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reach, single, with_others, pad):
     """occlusion_at (whole images read in place, the own depths over the points' box) and occlusion_window (the
     window's images and own depths map) run one pass, _occlusion_pass: the same maps, bit for bit, on the window
-    occlusion_at picks; and occlusion_edge without a band is occlusion_at."""
+    occlusion_at picks; and occlusion_edge_boxed without a band is occlusion_at."""
     rng = np.random.default_rng(seed)
     big_h, big_w = h + 10, w + 12
     n = int(rng.integers(1, max(2, h * w // 4)))
@@ -4262,7 +4262,7 @@ def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reac
                           np.ascontiguousarray(others[win]) if with_others else others, 0.005, steps,
                           float(points[:, 2].min()), float(points[:, 2].max()), hid, sn)  # fmt: skip
     assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
-    edge = _jit.occlusion_edge(uv, points, pad, depth, mask, others, 0.005, steps, 0)
+    edge = _jit.occlusion_edge_boxed(uv, points, pad, depth, mask, others, 0.005, steps, 0)
     assert edge[:3] == (found, u0, v0) and np.array_equal(edge[3], hidden) and edge[4].tobytes() == seen.tobytes()
 
 
@@ -5098,7 +5098,8 @@ def test_the_apex_kernels_are_the_twins(seed):
 
 def _fattened_scene(rng, h, w, with_others):
     """A disc fruit whose depth the sensor spread a few pixels past its mask, a leaf in front, another fruit beside,
-    dropouts, on an (h, w) image: ``(uv, points, depth, mask, others)`` as :func:`_jit.occlusion_edge` takes them."""
+    dropouts, on an (h, w) image: ``(uv, points, depth, mask, others)`` as :func:`_jit.occlusion_edge_boxed` takes
+    them."""
     rr, cc = np.mgrid[0:h, 0:w]
     r0, c0, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(2, 12)
     dist = np.hypot(rr - r0, cc - c0)
@@ -5126,9 +5127,9 @@ def _fattened_scene(rng, h, w, with_others):
        st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3))  # fmt: skip
 def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, w, tolerance, reach):
     """occlusion_edge_boxed (own_edge's square filters from summed-area tables, the own depths' least from the points'
-    box alone, no window-sized own maps) against occlusion_edge (own_edge on the window's maps), the kernels, and
-    against occlusion's numpy twin: the same window, hidden pixels and seen depths, bit for bit; fruit at the image's
-    border, fattened edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9."""
+    box alone, no window-sized own maps) against occlusion_at's window and seen depths, and against occlusion's
+    numpy twin (own_edge on the window's maps): the same window, hidden pixels and seen depths, bit for bit; fruit at
+    the image's border, fattened edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9."""
     from symfruit.core.camera import Camera
     from symfruit.core.occlusion import occlusion
 
@@ -5136,9 +5137,9 @@ def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, 
     uv, points, depth, mask, others = _fattened_scene(rng, h, w, with_others)
     depth = depth.astype(np.float32 if single else np.float64)
     steps = _steps_within(reach)
-    want = _jit.occlusion_edge(uv, points, 16, depth, mask, others, tolerance, steps, band)
     got = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, others, tolerance, steps, band)
-    assert got[:3] == want[:3] and got[3].tobytes() == want[3].tobytes() and got[4].tobytes() == want[4].tobytes()
+    found, u0, v0, _, seen = _jit.occlusion_at(uv, points, 16, depth, mask, others, tolerance, steps)
+    assert got[:3] == (found, u0, v0) and got[4].tobytes() == seen.tobytes()  # own_edge clears hidden pixels only
     camera = Camera(fx=300.0, fy=300.0, cx=0.0, cy=0.0, width=w, height=h)
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("SYMFRUIT_KERNELS", "numpy")

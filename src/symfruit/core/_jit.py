@@ -3598,8 +3598,8 @@ def _occlusion_box(
     steps: np.ndarray,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray, np.ndarray, int, int]:  # fmt: skip
     """:func:`occlusion_at`, with the points' own depths over their pixels' box and the box's top-left pixel in the
-    window: ``(found, u0, v0, hidden, seen, own_z, p0, q0)`` (stop 42: :func:`occlusion_edge` reads them instead of
-    projecting the points again)."""
+    window: ``(found, u0, v0, hidden, seen, own_z, p0, q0)`` (stop 42: the occlusion kernel,
+    :func:`occlusion_edge_boxed` since stop 45, reads them instead of projecting the points again)."""
     height, width = mask.shape
     n = uv.shape[0]
     cmin, cmax, rmin, rmax = width, -1, height, -1
@@ -3911,47 +3911,6 @@ def own_edge(
         r, c = queue[i] // n, queue[i] % n
         hidden[b0 + r, a0 + c] = False
     return end
-
-
-@_njit
-def occlusion_edge(
-    uv: np.ndarray,
-    points: np.ndarray,
-    pad: int,
-    depth: np.ndarray,
-    mask: np.ndarray,
-    others: np.ndarray,
-    tolerance: float,
-    steps: np.ndarray,
-    band: int,
-) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`occlusion_at`, then the fruit's own depths over its window (:func:`own_depths`' map) and
-    :func:`own_edge` on the maps, in one call (issue 19, stop 41: three calls and the own depths' two boxed arrays
-    were a fifth of the compiled occlusion's time): ``(found, u0, v0, hidden, seen)``, :func:`symfruit.core.occlusion.
-    occlusion`'s maps bit for bit."""
-    found, u0, v0, hidden, seen, box_z, p0, q0 = _occlusion_box(uv, points, pad, depth, mask, others, tolerance, steps)
-    if not found or band <= 0:
-        return found, u0, v0, hidden, seen
-    h, w = hidden.shape
-    some = False
-    for r in range(h):
-        for c in range(w):
-            if hidden[r, c]:
-                some = True
-                break
-        if some:
-            break
-    if not some:
-        return found, u0, v0, hidden, seen
-    own_z = np.full((h, w), np.inf)  # the box's own depths (the least of a pixel's points) placed in the window
-    own_z[p0 : p0 + box_z.shape[0], q0 : q0 + box_z.shape[1]] = box_z
-    own = np.empty((h, w), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            own[r, c] = mask[v0 + r, u0 + c] or math.isfinite(own_z[r, c])
-    near = others[v0 : v0 + h, u0 : u0 + w] if others.shape[0] > 0 else np.zeros((0, 0), np.bool_)
-    own_edge(hidden, own, own_z, seen, near, tolerance, band)
-    return found, u0, v0, hidden, seen
 
 
 @_njit
@@ -7456,7 +7415,7 @@ def own_edge_boxed(
     tolerance: float,
     band: int,
 ) -> int:  # fmt: skip
-    """:func:`own_edge` on :func:`occlusion_edge`'s maps, without the window's own depths and own pixels as (h, w)
+    """:func:`own_edge` on :func:`occlusion_edge_boxed`'s maps, without the window's own depths and own pixels as (h, w)
     maps (issue 19, stop 45): ``hidden`` (h, w) bool cleared in place (the number of pixels cleared returned), the
     fruit's own pixels read from ``mask`` (the whole image, the window at ``(v0, u0)``) and ``box_z`` (the points' own
     depths over their pixels' box, at ``(p0, q0)`` in the window, +inf where none), ``seen`` the window's depths,
@@ -7605,8 +7564,10 @@ def occlusion_edge_boxed(
     steps: np.ndarray,
     band: int,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`occlusion_edge` with :func:`own_edge_boxed` (issue 19, stop 45): the same ``(found, u0, v0, hidden,
-    seen)``, bit for bit, without the window's own depths and own pixels as (h, w) maps."""
+    """:func:`occlusion_at`, then :func:`own_edge_boxed` on the maps, in one call: ``(found, u0, v0, hidden, seen)``,
+    :func:`symfruit.core.occlusion.occlusion`'s maps bit for bit (issue 19, stop 41: one kernel instead of three calls;
+    stop 45: own_edge's square filters from summed-area tables over the own pixels' box, without the window's own
+    depths and own pixels as (h, w) maps, which the kernel of stops 41-44 built for :func:`own_edge`)."""
     found, u0, v0, hidden, seen, box_z, p0, q0 = _occlusion_box(uv, points, pad, depth, mask, others, tolerance, steps)
     if not found or band <= 0:
         return found, u0, v0, hidden, seen

@@ -325,8 +325,8 @@ def occlusion(
     window and the fruit's own depths in the same kernel, the images read in place and the own depths kept over the
     points' pixels' box alone (:func:`symfruit.core._jit.occlusion_at`: the same maps; 1.98 against 3.48 ms for the
     benchmark frame's 9 fruit, least of 40 passes of the recorded calls, on a loaded machine; twentieth round), and
-    with :func:`own_edge` on the maps in the same kernel (:func:`symfruit.core._jit.occlusion_edge`: the same maps;
-    the benchmark frame's occlusion stage 6.6 against 4.0 ms least thread CPU; issue 19, stop 41).
+    with :func:`own_edge` on the maps in the same kernel (:func:`symfruit.core._jit.occlusion_edge_boxed`: the same
+    maps; the benchmark frame's occlusion stage 6.6 against 4.0 ms least thread CPU; issue 19, stop 41).
 
     Parameters
     ----------
@@ -734,7 +734,7 @@ def own_edge(
     hidden pixel within ``band`` of the fruit returns ``hidden`` itself. Where numba is, in one compiled pass
     (:func:`symfruit.core._jit.own_edge`: the same pixels, bit for bit; its eight dilation passes and scipy's minimum
     filter were most of the occlusion maps' time; issue 19, stop 41), and :func:`occlusion` runs it in the same
-    kernel as the maps (:func:`symfruit.core._jit.occlusion_edge`).
+    kernel as the maps (:func:`symfruit.core._jit.occlusion_edge_boxed`).
     """
     if band <= 0 or not hidden.any():
         return hidden
