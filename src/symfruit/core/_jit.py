@@ -3786,6 +3786,51 @@ def _row_min(x: np.ndarray, k: int, out: np.ndarray) -> None:
             out[r, c] = min(bwd[c], fwd[c + size - 1])
 
 
+@_njit_inlined
+def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden: np.ndarray, b0: int,
+               a0: int) -> int:  # fmt: skip
+    """The band of :func:`own_edge` and :func:`own_edge_boxed` runs on from the fruit's own pixels ``mine`` (m, n):
+    a breadth-first walk through the ``count`` candidates ``cand`` (m, n) beside them, ``band`` steps deep; the
+    pixels reached are cleared in ``hidden`` at ``(b0, a0)`` and their number returned."""
+    m, n = cand.shape
+    queue = np.empty(count, np.int64)
+    reached = np.zeros((m, n), np.bool_)
+    end = 0
+    for r in range(m):
+        for c in range(n):
+            if cand[r, c]:
+                for dr in range(-1, 2):
+                    rr = r + dr
+                    if 0 <= rr < m:
+                        for dc in range(-1, 2):
+                            cc = c + dc
+                            if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
+                                reached[r, c] = True
+                                queue[end] = r * n + c
+                                end += 1
+    start = 0
+    for _ in range(1, band):
+        stop = end
+        for i in range(start, stop):
+            r, c = queue[i] // n, queue[i] % n
+            for dr in range(-1, 2):
+                rr = r + dr
+                if 0 <= rr < m:
+                    for dc in range(-1, 2):
+                        cc = c + dc
+                        if 0 <= cc < n and cand[rr, cc] and not reached[rr, cc]:
+                            reached[rr, cc] = True
+                            queue[end] = rr * n + cc
+                            end += 1
+        start = stop
+        if start == end:
+            break
+    for i in range(end):
+        r, c = queue[i] // n, queue[i] % n
+        hidden[b0 + r, a0 + c] = False
+    return end
+
+
 @_njit
 def own_edge(
     hidden: np.ndarray,
@@ -3874,43 +3919,7 @@ def own_edge(
                 count += x
     if count == 0:
         return 0
-    # the band runs on from the fruit's own pixels: breadth first through the candidates, band steps at most
-    queue = np.empty(count, np.int64)
-    reached = np.zeros((m, n), np.bool_)
-    end = 0
-    for r in range(m):
-        for c in range(n):
-            if cand[r, c]:
-                for dr in range(-1, 2):
-                    rr = r + dr
-                    if 0 <= rr < m:
-                        for dc in range(-1, 2):
-                            cc = c + dc
-                            if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
-                                reached[r, c] = True
-                                queue[end] = r * n + c
-                                end += 1
-    start = 0
-    for _ in range(1, band):
-        stop = end
-        for i in range(start, stop):
-            r, c = queue[i] // n, queue[i] % n
-            for dr in range(-1, 2):
-                rr = r + dr
-                if 0 <= rr < m:
-                    for dc in range(-1, 2):
-                        cc = c + dc
-                        if 0 <= cc < n and cand[rr, cc] and not reached[rr, cc]:
-                            reached[rr, cc] = True
-                            queue[end] = rr * n + cc
-                            end += 1
-        start = stop
-        if start == end:
-            break
-    for i in range(end):
-        r, c = queue[i] // n, queue[i] % n
-        hidden[b0 + r, a0 + c] = False
-    return end
+    return _band_walk(cand, mine, count, band, hidden, b0, a0)
 
 
 @_njit
@@ -7513,43 +7522,7 @@ def own_edge_boxed(
             count += x
     if count == 0:
         return 0
-    # the band runs on from the fruit's own pixels: breadth first through the candidates, band steps at most
-    queue = np.empty(count, np.int64)
-    reached = np.zeros((m, n), np.bool_)
-    end = 0
-    for r in range(m):
-        for c in range(n):
-            if cand[r, c]:
-                for dr in range(-1, 2):
-                    rr = r + dr
-                    if 0 <= rr < m:
-                        for dc in range(-1, 2):
-                            cc = c + dc
-                            if 0 <= cc < n and mine[rr, cc] and not reached[r, c]:
-                                reached[r, c] = True
-                                queue[end] = r * n + c
-                                end += 1
-    start = 0
-    for _ in range(1, band):
-        stop = end
-        for i in range(start, stop):
-            r, c = queue[i] // n, queue[i] % n
-            for dr in range(-1, 2):
-                rr = r + dr
-                if 0 <= rr < m:
-                    for dc in range(-1, 2):
-                        cc = c + dc
-                        if 0 <= cc < n and cand[rr, cc] and not reached[rr, cc]:
-                            reached[rr, cc] = True
-                            queue[end] = rr * n + cc
-                            end += 1
-        start = stop
-        if start == end:
-            break
-    for i in range(end):
-        r, c = queue[i] // n, queue[i] % n
-        hidden[b0 + r, a0 + c] = False
-    return end
+    return _band_walk(cand, mine, count, band, hidden, b0, a0)
 
 
 @_njit
