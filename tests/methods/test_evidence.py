@@ -9,7 +9,7 @@ from symfruit import DEFAULT_CAMERA, ConfigError, box_iou, centre_deviation, com
 from symfruit.core.agreement import Agreement
 from symfruit.core.candidates import Candidate
 from symfruit.evaluate.protocols import Spec, build
-from symfruit.methods.evidence import EvidenceSettings, _spread, _weighted_median, clean_share, combine
+from symfruit.methods.evidence import EvidenceSettings, _spread, _weighted_median, clean_share, combine, midmean
 from symfruit.settings import Settings
 from symfruit.synthetic.shapes import FRUITS, rotation
 
@@ -533,3 +533,39 @@ def test_the_prior_width_reads_the_tilt_when_given():
     for floor in (0.05, 0.3):
         want = 2.0 * np.sqrt(0.025**2 + 0.01 * 0.0255**2 / floor) / 0.0255 * 0.051 / 2.0
         assert prior_width(ball, 1.0, 0.0, sloped, prolate=True, floor=floor) == pytest.approx(want, rel=1e-9)
+
+
+# --- stop 46, paper46
+
+
+def test_midmean_averages_the_middle_of_the_weight():
+    v = np.array([5.0, 0.0, 1.0, 2.0, 10.0])
+    w = np.array([0.2, 0.2, 0.2, 0.2, 0.2])
+    # quantiles 0.25-0.75 take 0.15 of 1.0, 0.2 of 2.0, 0.15 of 5.0
+    assert midmean(v, w, 0.25) == pytest.approx((0.15 * 1.0 + 0.2 * 2.0 + 0.15 * 5.0) / 0.5)
+    assert midmean(v, w, 0.0) == pytest.approx(3.6)  # the weighted mean
+    assert midmean(v, w, 0.5) == 2.0  # the lower weighted median, as _weighted_median's
+    assert midmean(v, w, 0.5) == _weighted_median(v[:, None], w)[0]
+    # an outlier holding less than the trimmed share moves nothing, whatever its value
+    heavy = np.array([0.3, 0.3, 0.3, 0.05, 0.05])
+    # sorted: -50 [0, 0.05], 1 [0.05, 0.35], 2 [0.35, 0.65], 3 [0.65, 0.95], 80 [0.95, 1]: 0.1, 0.3, 0.1 inside
+    assert midmean(np.array([1.0, 2.0, 3.0, -50.0, 80.0]), heavy, 0.25) == pytest.approx(2.0)
+    assert midmean(np.array([1.0, 2.0, 3.0, -5e3, 8e3]), heavy, 0.25) == pytest.approx(2.0)
+    assert midmean(np.array([1.0, 2.0, 4.0, -50.0, 80.0]), heavy, 0.25) == pytest.approx(2.2)
+
+
+def test_the_back_face_is_the_candidates_midmean_and_only_the_back_face():
+    front = np.array([-0.02, -0.02, 0.30])
+    cands = [
+        Candidate(name, front, np.array([0.02 + d, 0.02, back]), Agreement(0.001, 0.0, 0.0), np.zeros(3))
+        for name, d, back in (("sphere", 0.001, 0.33), ("ellipsoid", 0.0, 0.34), ("revolution", -0.001, 0.36))
+    ]
+    s = EvidenceSettings()
+    median = combine(cands, contour=1.0, clean=1.0, s=s)
+    trimmed = combine(cands, contour=1.0, clean=1.0, s=EvidenceSettings(back_trim=0.25))
+    assert median.box.max[2] == 0.34  # equal energies: the middle candidate's back face
+    # equal weights of a third: 0.25-0.75 holds 1/12 of 0.33, 1/3 of 0.34 and 1/12 of 0.36
+    assert trimmed.box.max[2] == pytest.approx((0.33 / 12 + 0.34 / 3 + 0.36 / 12) / 0.5)
+    np.testing.assert_array_equal(trimmed.box.min, median.box.min)
+    np.testing.assert_array_equal(trimmed.box.max[:2], median.box.max[:2])
+    assert trimmed.weights == median.weights

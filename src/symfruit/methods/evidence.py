@@ -112,6 +112,12 @@ class EvidenceSettings(Section):
         Weights are ``exp(-energy / temperature)``: the energies count about ``rays`` correlated ray residuals
         as if they were independent, which makes the plain ``exp(-energy)`` far too sure of the best
         candidate (issue 18's diagnosis; 2 keeps the ranking and lets close candidates share the box).
+    back_trim : float in [0, 0.5]
+        The candidates' back face is their weighted mean over the weighted quantiles ``back_trim`` to ``1 -
+        back_trim`` of their back faces (:func:`midmean`: 0.25, the interquartile mean; 0.5, the default, the
+        weighted median, as every other face). The weighted median takes one candidate's back face whole, and
+        where two shapes share the weight it jumps between them with noise in the weights; the back face is where
+        the centre's error lies (issue 18: 94-96 % of its square, docs/paper46.md).
     depth_ratio, depth_ratio_sd : float, float
         The prior on the depth extent: ``depth_ratio`` times the silhouette's width (the geometric mean of its
         widths across and along its principal axis, measured across the line of sight through its centroid
@@ -238,6 +244,7 @@ class EvidenceSettings(Section):
     covered_contour: float = setting(0.9, ge=0.0, le=1.0)
     explained_at: float = setting(0.02, ge=0.0, le=2.0)
     temperature: float = setting(2.0, gt=0.0, le=1e6)
+    back_trim: float = setting(0.5, ge=0.0, le=0.5)
     depth_ratio: float = setting(1.0, gt=0.0, le=10.0)
     depth_ratio_sd: float = setting(0.15, ge=0.0, le=10.0)
     cut_width: float = setting(0.0, ge=0.0, le=1.0)
@@ -349,6 +356,26 @@ def _weighted_median(values: np.ndarray, weights: np.ndarray, *, listed: list[li
     return np.array(out, dtype=values.dtype)
 
 
+def midmean(values: np.ndarray, weights: np.ndarray, trim: float) -> float:
+    """The weighted mean of ``values`` (k,) over their weighted quantiles ``trim`` to ``1 - trim`` (``weights`` (k,),
+    at least one positive): each value counts with the part of its weight inside that range, so ``trim`` 0 is the
+    weighted mean and 0.25 the interquartile mean; at ``trim`` 0.5 (no weight inside) the lower weighted median.
+
+    >>> round(midmean(np.array([0.0, 1.0, 2.0, 10.0]), np.ones(4), 0.25), 6)
+    1.5
+    >>> float(midmean(np.array([3.0, 1.0, 2.0]), np.array([0.2, 0.5, 0.3]), 0.5))
+    1.0
+    """
+    order = np.argsort(values, kind="stable")
+    v, w = values[order], weights[order] / weights.sum()
+    upper = np.cumsum(w)
+    part = np.clip(np.minimum(upper, 1.0 - trim) - np.maximum(upper - w, trim), 0.0, None)
+    total = float(part.sum())
+    if total <= 0.0:
+        return float(v[min(int(np.searchsorted(upper, 0.5)), len(v) - 1)])
+    return float((part * v).sum() / total)
+
+
 def clean_share(ratio: float, threshold: float) -> float:
     """How far a view is a clean scan rather than a depth camera's view, in [0, 1], from the growth of its
     local plane-fit residual with scale (:func:`~symfruit.core.fits.surface_noise`): 0 below
@@ -386,6 +413,8 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     rows = [c.lo.tolist() + c.hi.tolist() for c in cands]
     faces = np.array(rows)
     box_faces = _weighted_median(faces, w, listed=rows)
+    if s.back_trim < 0.5:  # the back face over the middle of the weight (EvidenceSettings.back_trim)
+        box_faces[5] = max(midmean(faces[:, 5], w, s.back_trim), float(box_faces[2]) + 1e-4)
     box = Box(box_faces[:3], box_faces[3:])
     spread = _spread(rows, w, box)
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
