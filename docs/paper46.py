@@ -4,6 +4,7 @@
     python docs/paper46.py where OUT.pkl [...]                     (where the centre error comes from)
     python docs/paper46.py views OUT.pkl [--kind K] [--over 3]     (one line a view)
     python docs/paper46.py candidates OUT.pkl [...]                (each candidate's faces against the truth)
+    python docs/paper46.py variants LABEL=OUT.pkl[:KIND] [...] --variant NAME[+key:value,...] [...]
 
 ``collect`` is docs/evid40.py's (``symfruit evaluate EVALUATE-ARGS --methods evidence --no-profile --jobs 1``,
 every view's candidates and the inputs of ``combine`` and ``fuse_depth`` kept; a pickle: read only your own).
@@ -14,7 +15,10 @@ their sum); it prints, per kind, the mean centre error of the result, of the wei
 face, and with the true front face, and which candidate holds the most weight. ``views`` prints one line a view
 (pose, error, its xyz parts, front and back face errors, the winner and every candidate's weight and back face
 against the truth). ``candidates`` prints, per kind, each candidate's mean signed and absolute front, back and
-lateral face errors and its mean weight. Run with ``PYTHONPATH=TREE/src`` from the repository's root.
+lateral face errors and its mean weight. ``variants`` replays ``combine`` and ``fuse_depth`` on each set (``KIND``: one
+kind, as ``where`` names it) under a rule (:data:`RULES`, :data:`TRIMS`, ``closed25`` or ``default``) and `evidence`'s
+settings changed by ``+key:value,...``; cells mean IoU / mean centre error (mm) / views over 10 mm (``default``
+reproduces ``evaluate``'s figures). Run with ``PYTHONPATH=TREE/src`` from the repository's root.
 """
 
 from __future__ import annotations
@@ -238,6 +242,24 @@ def _trim_patch(lo: float, hi: float, every: int = 0) -> Any:
     return patched
 
 
+_COMBINE = ev.combine
+
+
+def _closed_combine(cands: Any, **kw: Any) -> Any:
+    """``combine`` with the back face the midmean (0.25) of the closed candidates' alone (the raw box left out)."""
+    import dataclasses
+
+    c = _COMBINE(cands, **kw)
+    w = np.array([c.weights[x.name] for x in cands])
+    backs = np.array([x.hi[2] for x in cands])
+    closed = np.array([x.agreement is not None for x in cands])
+    if closed.sum() >= 2:
+        hi = c.box.max.copy()
+        hi[2] = max(ev.midmean(backs[closed], w[closed], 0.25), float(c.box.min[2]) + 1e-4)
+        c = dataclasses.replace(c, box=Box(c.box.min, hi))
+    return c
+
+
 def variants(sets: list[str], names: list[str]) -> None:
     """docs/evid40.py's variants with this script's :data:`RULES` (``NAME+key:value,...`` adds settings)."""
     loaded = []
@@ -255,6 +277,8 @@ def variants(sets: list[str], names: list[str]) -> None:
         base = ev.EvidenceSettings().model_copy(update=over) if hasattr(ev.EvidenceSettings, "model_copy") else \
             __import__("dataclasses").replace(ev.EvidenceSettings(), **over)  # fmt: skip
         cells = []
+        if key == "closed25":
+            ev.combine = _closed_combine  # type: ignore[assignment]
         if key in TRIMS:
             ev._weighted_median = _trim_patch(*TRIMS[key])  # type: ignore[assignment]
         for _, vs in loaded:
@@ -270,6 +294,7 @@ def variants(sets: list[str], names: list[str]) -> None:
             cells.append(f"{a[:, 0].mean():.3f} / {a[:, 1].mean():.2f} / {(a[:, 1] > 10).sum()}")
         say(f"| {name} | " + " | ".join(cells) + " |")
         ev._weighted_median = _WM  # type: ignore[assignment]
+        ev.combine = _COMBINE  # type: ignore[assignment]
 
 
 _WM = ev._weighted_median
