@@ -5214,3 +5214,74 @@ def test_the_label_boxes_are_find_objects(seed, h, w, n):
         sl = want[k]
         expect = [h, 0, w, 0] if sl is None else [sl[0].start, sl[0].stop, sl[1].start, sl[1].stop]
         assert got[k].tolist() == expect
+
+
+# --- stop 46, compspeed46
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_batched_quadrics_agreement_is_each_ones(seed):
+    """explain_quadrics (one kernel call for several quadrics) against explain_quadric on each, byte for byte: spheres
+    and rotated ellipsoids about the truth, one missing every ray, one holding the camera, with and without the
+    frame's depth beside the fruit; and agreement.explain_quadrics against explain of each (the kernels' path and,
+    without them, the twin's)."""
+    from symfruit.core.agreement import _NO_SEEN, Quadric, _bands, explain, explain_quadrics, observe
+    from symfruit.core.camera import DEFAULT_CAMERA as camera
+
+    rng = np.random.default_rng(seed)
+    centre, visible, region, occ = _ball_behind_a_leaf(seed)
+    for o in (None, occ):
+        obs = observe(visible[::10], region, camera, dense=visible, occlusion=o)
+        quadrics = []
+        for k in range(7):
+            r = rng.uniform(0.02, 0.05)
+            c = centre + rng.normal(0.0, 0.01, 3) * (k % 3 != 0)
+            if k == 5:
+                c = centre + [0.5, 0.0, 0.0]  # no ray meets it
+            if k == 6:
+                c = np.array([0.0, 0.0, 0.05])  # the camera inside
+            axes = rng.uniform(0.6, 1.6, 3) * r
+            turn = rotation(*rng.uniform(0.0, 180.0, 3))
+            shape = turn @ np.diag(1.0 / axes**2) @ turn.T if k % 2 else np.eye(3) / r**2
+            quadrics.append((Quadric(c, shape), (c - axes.max(), c + axes.max())))
+        b = _bands(obs)
+        seen = _NO_SEEN if b.seen is None else b.seen
+        keep = max(1, int(0.8 * len(obs.rays)))
+        spans = np.array([(float(lo[2]) - 1e-3, float(hi[2]) + 1e-3) for _, (lo, hi) in quadrics])
+        got = _jit.explain_quadrics(np.array([q.centre for q, _ in quadrics]), np.array([q.shape for q, _ in quadrics]),
+                                    spans, b.rays, obs.depth, keep, b.in_starts, b.in_sizes, b.out_starts, b.out_w,
+                                    b.out_wsum, seen, 0.01)  # fmt: skip
+        for (q, _), (z0, z1), row in zip(quadrics, spans, got, strict=True):
+            one = _jit.explain_quadric(q.centre, q.shape, b.rays, z0, z1, obs.depth, keep, b.in_starts, b.in_sizes,
+                                       b.out_starts, b.out_w, b.out_wsum, seen, 0.01)  # fmt: skip
+            assert np.array(one).tobytes() == row.tobytes()
+        assert explain_quadrics(quadrics, obs) == [explain(q, box, obs) for q, box in quadrics]
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            assert explain_quadrics(quadrics, obs) == [explain(q, box, obs) for q, box in quadrics]
+        assert got[5, 0] > 0.0 and got[5, 1] == 1.0  # missing every ray: off by its depth range, every inside ray wrong
+
+
+def test_the_batched_quadrics_agreement_known_answer():
+    """A ball whose every depth ray is seen on its front (depth RMS 0 up to rounding), and a ball far to the side: every
+    inside ray misses it, no outside ray meets it; an empty batch is empty."""
+    from symfruit.core.agreement import Observation, Quadric, explain_quadrics
+
+    c, r = np.array([0.0, 0.0, 0.4]), 0.03
+    rays = np.array([[0.0, 0.0, 1.0], [0.01, 0.0, 1.0], [0.0, 0.02, 1.0]])
+    depth = np.array([_front(c, r, ray) for ray in rays])
+    inner = (np.array([[0.0, 0.0, 1.0], [0.02, 0.0, 1.0]]),)
+    outer = (np.array([[0.2, 0.0, 1.0], [0.0, 0.2, 1.0]]),)
+    obs = Observation(rays=rays, depth=depth, rays_in=inner, rays_out=outer)
+    far = c + [0.3, 0.0, 0.0]
+    got = explain_quadrics([(Quadric(c, np.eye(3) / r**2), (c - r, c + r)),
+                            (Quadric(far, np.eye(3) / r**2), (far - r, far + r))], obs)  # fmt: skip
+    assert got[0].depth == pytest.approx(0.0, abs=1e-12) and (got[0].inside, got[0].outside) == (0.0, 0.0)
+    assert got[1].depth == pytest.approx(2 * r + 2e-3) and (got[1].inside, got[1].outside) == (1.0, 0.0)
+    assert explain_quadrics([], obs) == []
+
+
+def _front(c: np.ndarray, r: float, ray: np.ndarray) -> float:
+    """The depth where ``z * ray`` first meets the ball (c, r)."""
+    a, b, cc = ray @ ray, ray @ c, c @ c - r * r
+    return float((b - np.sqrt(b * b - a * cc)) / a)
