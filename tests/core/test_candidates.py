@@ -178,36 +178,3 @@ def test_plausible_is_the_former_array_arithmetic():
         # the corners as the lists of Python floats candidates() hands it (issue 19, stop 45): the same decision
         listed = (lo.tolist(), hi.tolist(), seen_lo.tolist(), seen_hi.tolist())
         assert _plausible(*listed, reach, lateral=lateral, width=width) is want
-
-
-@pytest.mark.parametrize("explained", [None, 1.0])
-def test_the_quadrics_measured_together_are_the_candidates_measured_one_by_one(monkeypatch, explained):
-    """With the kernels the sphere's, the ellipsoid's and the cone's agreements come from one explain_quadrics call
-    before the solid of revolution is fitted (issue 19, stop 46): the same candidates, in the same order, to the bit,
-    as explain of each one as it is fitted; with ``explained`` the cone's measure read before the solid of revolution
-    (1.0: explained, so none)."""
-    from symfruit.core import candidates as module
-    from symfruit.core.agreement import explain
-
-    visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=5)
-    sample = visible[::8]
-    obs = observe(sample, silhouette(visible, DEFAULT_CAMERA), DEFAULT_CAMERA)
-    calls = []
-
-    def together(quadrics, o):
-        calls.append(len(quadrics))
-        return [explain(q, box, o) for q, box in quadrics]
-
-    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
-    batched = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=0.365, explained=explained)
-    monkeypatch.setattr(module, "explain_quadrics", together)
-    again = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=0.365, explained=explained)
-    names = ["sphere", "ellipsoid", "cone"] + (["revolution"] if explained is None else []) + ["raw"]
-    assert [c.name for c in batched] == [c.name for c in again] == names
-    assert calls == ([3] if module.compiled() is not None else [])
-    monkeypatch.setattr(module, "compiled", lambda: None)  # no batch: explain as each shape is fitted
-    single = candidates(visible, sample=sample, obs=obs, camera=DEFAULT_CAMERA, front=0.365, explained=explained)
-    assert [c.name for c in single] == names and calls in ([3], [])
-    for a, b, c in zip(batched, again, single, strict=True):
-        assert a.lo.tobytes() == b.lo.tobytes() == c.lo.tobytes() and a.hi.tobytes() == b.hi.tobytes() == c.hi.tobytes()
-        assert a.agreement == b.agreement == c.agreement

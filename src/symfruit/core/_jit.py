@@ -1879,36 +1879,6 @@ def explain_quadric(
 
 
 @_njit
-def explain_quadrics(
-    centres: np.ndarray,
-    shapes: np.ndarray,
-    spans: np.ndarray,
-    rays: np.ndarray,
-    depth: np.ndarray,
-    keep: int,
-    in_starts: np.ndarray,
-    in_sizes: np.ndarray,
-    out_starts: np.ndarray,
-    out_w: np.ndarray,
-    out_wsum: np.ndarray,
-    seen: np.ndarray,
-    free: float,
-) -> np.ndarray:
-    """:func:`explain_quadric` of several quadrics on the same observation in one call (issue 19, stop 46): ``centres``
-    (k, 3), ``shapes`` (k, 3, 3), ``spans`` (k, 2) each one's ``z0, z1``; (k, 3) of ``(depth RMS, inside, outside)``
-    rows. Each row is :func:`explain_quadric`'s own call on that quadric, so its values to the bit."""
-    k = centres.shape[0]
-    out = np.empty((k, 3))
-    for i in range(k):
-        rms, ins, outs = explain_quadric(centres[i], shapes[i], rays, spans[i, 0], spans[i, 1], depth, keep,
-                                         in_starts, in_sizes, out_starts, out_w, out_wsum, seen, free)  # fmt: skip
-        out[i, 0] = rms
-        out[i, 1] = ins
-        out[i, 2] = outs
-    return out
-
-
-@_njit
 def agreement(
     hit: np.ndarray,
     at: np.ndarray,

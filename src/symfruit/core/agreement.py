@@ -43,17 +43,7 @@ from .raster import (
     silhouette_cone,
 )
 
-__all__ = [
-    "Agreement",
-    "Inside",
-    "Observation",
-    "Quadric",
-    "explain",
-    "explain_quadrics",
-    "intersect_quadric",
-    "march",
-    "observe",
-]
+__all__ = ["Agreement", "Inside", "Observation", "Quadric", "explain", "intersect_quadric", "march", "observe"]
 
 #: ``inside(x)`` for points ``x`` (..., 3), metres: positive inside the shape (a signed distance, or any
 #: function with the same sign), shape ``x.shape[:-1]``.
@@ -678,30 +668,6 @@ def march(inside: Inside, rays: np.ndarray, z0: float, z1: float, *, steps: int 
 
 #: No seen depths, for the kernels (empty: nothing in it to change, so writable, the kernels' usual array type).
 _NO_SEEN = np.empty(0)
-
-
-def explain_quadrics(
-    quadrics: list[tuple[Quadric, tuple[np.ndarray, np.ndarray]]],
-    obs: Observation,
-    *,
-    trim: float = 0.8,
-    free: float = 0.01,
-) -> list[Agreement]:
-    """:func:`explain` of several :class:`Quadric` candidates (each with its box) on one observation: by one call of
-    the compiled :func:`symfruit.core._jit.explain_quadrics` where numba is installed (each row
-    :func:`symfruit.core._jit.explain_quadric`'s own call, so :func:`explain`'s values to the bit, one kernel call a
-    view instead of one a candidate; issue 19, stop 46), else by :func:`explain` of each."""
-    n = len(obs.rays)
-    if len(quadrics) < 2 or not n or (jit := compiled()) is None:
-        return [explain(q, box, obs, trim=trim, free=free) for q, box in quadrics]
-    b = _bands(obs)
-    centres = np.array([q.centre for q, _ in quadrics], dtype=np.float64)
-    shapes = np.array([q.shape for q, _ in quadrics], dtype=np.float64)
-    spans = np.array([(float(lo[2]) - 1e-3, float(hi[2]) + 1e-3) for _, (lo, hi) in quadrics])
-    found = jit.explain_quadrics(centres, shapes, spans, b.rays, obs.depth, max(1, int(trim * n)), b.in_starts,
-                                 b.in_sizes, b.out_starts, b.out_w, b.out_wsum, _NO_SEEN if b.seen is None else b.seen,
-                                 free).tolist()  # fmt: skip
-    return [Agreement(depth=rms, inside=ins, outside=outs) for rms, ins, outs in found]
 
 
 def explain(

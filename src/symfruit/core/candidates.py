@@ -36,7 +36,7 @@ import numpy as np
 
 from ..errors import InputError
 from . import lapack
-from .agreement import Agreement, Inside, Observation, Quadric, explain, explain_quadrics
+from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
     RevolutionInside,
@@ -285,15 +285,8 @@ def candidates(
     constrain = _constrainer(seen_lo, seen_hi, front, cone, obs.contour, pull)
     out: list[Candidate] = []
     seen_floats = _floats(seen_lo), _floats(seen_hi)  # once for every candidate's plausibility
-    # With the kernels, the quadrics' agreements in one kernel call (explain_quadrics: explain's values, which raise
-    # nothing there), made before a fitter that is not a quadric's (the solid of revolution reads the cone's first)
-    pending: list[tuple[_Shape, np.ndarray, np.ndarray]] | None = [] if len(obs.rays) and compiled() else None
     for name, (fitter, failures) in _FITTERS.items():
-        if name not in shapes:
-            continue
-        if pending and name not in _QUADRICS:
-            out.extend(_measured(pending, obs, constrain))
-        if _explained(out, explained):
+        if name not in shapes or _explained(out, explained):
             continue
         try:
             for shape in fitter(fit):
@@ -305,17 +298,12 @@ def candidates(
                 if plausible is not None and not _plausible(lo_, hi_, seen_floats[0], seen_floats[1], plausible,
                                                             lateral=obs.extent is None, width=width):  # fmt: skip
                     continue
-                if pending is not None and isinstance(shape.inside, Quadric):
-                    pending.append((shape, lo, hi))
-                    continue
                 ev = explain(shape.inside, (lo, hi), obs, steps=steps)
                 box = constrain(lo, hi)
                 out.append(Candidate(shape.name, *box, ev, np.asarray(shape.centre, dtype=np.float64),
                                      shape.back_std))  # fmt: skip
         except failures:
             pass
-    if pending:
-        out.extend(_measured(pending, obs, constrain))
 
     if mirror is not None:
         mirrored = complete_by_symmetry(sample, camera, **mirror, view=view)
@@ -326,24 +314,6 @@ def candidates(
     lo, hi = constrain_box(seen_lo, seen_hi, seen_lo, seen_hi, front)
     out.append(Candidate("raw", lo, hi, None, 0.5 * (lo + hi)))
     return out
-
-
-#: The fitters whose shapes are :class:`~symfruit.core.agreement.Quadric` s (their agreements measured together).
-_QUADRICS = frozenset(("sphere", "ellipsoid", "cone"))
-
-
-_Constrain = Callable[[np.ndarray, np.ndarray], tuple[np.ndarray, np.ndarray]]
-
-
-def _measured(pending: list[tuple[_Shape, np.ndarray, np.ndarray]], obs: Observation,
-              constrain: _Constrain) -> list[Candidate]:  # fmt: skip
-    """The candidates of the quadric shapes ``pending`` (each with its float64 box), in their order, measured by one
-    :func:`~symfruit.core.agreement.explain_quadrics` call (issue 19, stop 46); ``pending`` is emptied."""
-    found = explain_quadrics([(shape.inside, (lo, hi)) for shape, lo, hi in pending], obs)  # type: ignore[misc]
-    made = [Candidate(shape.name, *constrain(lo, hi), ev, np.asarray(shape.centre, dtype=np.float64), shape.back_std)
-            for (shape, lo, hi), ev in zip(pending, found, strict=True)]  # fmt: skip
-    pending.clear()
-    return made
 
 
 def _projected_box(points: np.ndarray, step: int, camera: Camera) -> tuple[float, float, float, float]:
