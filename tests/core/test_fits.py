@@ -774,3 +774,16 @@ def test_cone_thickness_bound_is_the_lapack_formulas(seed):
     a, b, c = cone[:2, :2], cone[:2, 2], cone[2, 2]
     terms = float(np.abs(b) @ np.abs(np.linalg.solve(a, b)) + abs(c)) / abs(float(b @ np.linalg.solve(a, b) - c))
     assert abs(got - want) <= 16.0 * np.finfo(float).eps * (terms + 1.0)
+
+
+def test_plain_is_the_former_generator_test():
+    """fits._plain as a loop (issue 19, stop 46) decides as ``all(v == 0.0 or 1e-100 < abs(v) < 1e100 for v in
+    values)`` did, on every triple of zeros, the range's ends and just past them, NaN, infinities and ordinary values;
+    no values: True."""
+    from symfruit.core.fits import _plain
+
+    edges = [0.0, -0.0, 1e-100, -1e-100, 1.0000000000000001e-100, 1e-101, 1e100, -1e100, 9.999999999999999e99, 1e99,
+             5e-324, float("nan"), float("inf"), -float("inf"), 1.0, -0.5]  # fmt: skip
+    for values in itertools.product(edges, repeat=3):
+        assert _plain(*values) == all(v == 0.0 or 1e-100 < abs(v) < 1e100 for v in values)
+    assert _plain() and _plain(0.3, -2.0) and not _plain(1.0, float("nan")) and not _plain(1e-200)
