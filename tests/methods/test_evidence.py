@@ -533,3 +533,23 @@ def test_the_prior_width_reads_the_tilt_when_given():
     for floor in (0.05, 0.3):
         want = 2.0 * np.sqrt(0.025**2 + 0.01 * 0.0255**2 / floor) / 0.0255 * 0.051 / 2.0
         assert prior_width(ball, 1.0, 0.0, sloped, prolate=True, floor=floor) == pytest.approx(want, rel=1e-9)
+
+
+def test_the_tilts_outer_outline_is_the_mask_without_its_overshoot():
+    """``tilt_outline: mask`` hands :func:`~symfruit.core.raster.axis_tilt` the fruit's own mask less what it
+    overshoots the fruit by, in the mask's window; ``points`` (the default) or no mask hands it nothing."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.methods.evidence import EvidenceSettings, _tilt_outer
+
+    own = np.zeros((6, 7), dtype=bool)
+    own[1:5, 1:6] = True
+    over = np.zeros_like(own)
+    over[1, 1:6] = True
+    occ = Occlusion(3, 4, np.zeros_like(own), 640, 480, own=own, overshoot=over)
+    got = _tilt_outer(occ, "mask")
+    assert got is not None and (got.u0, got.v0) == (3, 4)
+    assert np.array_equal(got.mask, own & ~over)
+    assert _tilt_outer(occ, "points") is None and _tilt_outer(None, "mask") is None
+    assert _tilt_outer(Occlusion(3, 4, np.zeros_like(own), 640, 480), "mask") is None
+    s = EvidenceSettings()
+    assert (s.prior_tilt, s.tilt_outline, s.tilt_blocks) == ("off", "points", 0)
