@@ -938,7 +938,9 @@ class Tilt:
         ``t`` gives ``H^2 = minor^2 + t^2 (major^2 - minor^2)``). An oblate one (``c < a``) projects its axis on the
         minor axis: ``a = major``, ``H^2 = major^2 - s^2 minor^4 / (major^2 - minor^2)`` (``s`` along the minor axis),
         at least ``minor / 2``. ``floor``: the least ``(major^2 - minor^2) / major^2`` divided by (a near-round outline
-        says nothing of the tilt); the slopes' noise variance is taken off their squares first.
+        says nothing of the tilt); the slopes' noise variance is taken off their squares first. A bent axis
+        (:attr:`bend` beyond :attr:`bend_sd`) deepens the prolate one by half its sagitta, ``|bend| (major^2 -
+        minor^2) / 2`` (weighted by the outline's elongation: stop 46, docs/tilt46.md).
         """
         big, small = self.major, self.minor
         gap = max(big * big - small * small, floor * big * big)
