@@ -597,3 +597,130 @@ def test_tilt_half_depths_know_the_spheroids_formula():
     assert Tilt(major, a, slope, 0.0, cap, 0.0, 500).half_depth() == pytest.approx(prolate, rel=1e-9)
     # no estimate: the geometric mean of the two
     assert Tilt(major, a, slope, 0.0, cap, 0.0, 0).half_depth() == pytest.approx(np.sqrt(prolate * oblate))
+
+
+def _eroded(region, px):
+    """``region`` with ``px`` pixels taken off its rim (a time-of-flight camera's lost band)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import Silhouette
+
+    return Silhouette(region.u0, region.v0, ndimage.binary_erosion(region.mask, iterations=px), region.fill_radius)
+
+
+def test_axis_tilt_scales_an_eroded_outline_to_the_whole_one():
+    from symfruit.core.raster import across_sight, axis_tilt, silhouette
+
+    # an oblate spheroid 40 x 28 mm seen side on: cap major / minor = 1.43, depth its major half-width
+    pts, cam, depth = _spheroid_front(0.04, 0.028, 0, 30.0, noise=0.0)
+    whole = silhouette(pts, cam)
+    part = _eroded(whole, 4)
+    rows, cols = (np.rint(cam.project(pts)[:, ::-1]).astype(int) - [part.v0, part.u0]).T
+    inner = pts[part.mask[rows, cols]]
+    across = across_sight(whole, cam)
+    clean = axis_tilt(pts, whole, cam, across)
+    eroded = axis_tilt(inner, part, cam, across)
+    fixed = axis_tilt(inner, part, cam, across, outer=whole)
+    # the eroded outline reads the front as flatter than it is (its cap falls towards the prolate's 1)
+    assert eroded.cap < clean.cap - 0.1
+    assert fixed.cap == pytest.approx(clean.cap, abs=0.05)
+    assert fixed.major == pytest.approx(clean.major, rel=0.02) and fixed.minor == pytest.approx(clean.minor, rel=0.02)
+    assert fixed.half_depth() / fixed.major == pytest.approx(depth / 0.04, rel=0.05)
+    # an outer outline the same as the region's changes nothing (but rounding)
+    same = axis_tilt(pts, whole, cam, across, outer=whole)
+    assert same.count == clean.count and same.cap == pytest.approx(clean.cap, rel=1e-12)
+
+
+def test_block_jackknife_knows_a_mean_and_correlated_noise():
+    from symfruit.core.raster import _block_jackknife
+
+    # the mean of 8 blocks of equal size: the jackknife variance is the blocks' means' variance over 8 (sample SD)
+    rng = np.random.default_rng(0)
+    group = np.repeat(np.arange(8), 50)
+    b = rng.standard_normal(400) + np.repeat(rng.standard_normal(8), 50)  # a shared offset per block
+    means = np.array([b[group == g].mean() for g in range(8)])
+    got = _block_jackknife(np.ones((400, 1)), b, group, 8)
+    assert got[0] == pytest.approx(means.var(ddof=1) / 8, rel=1e-9)
+    # independent residuals would say 1/400 of the total variance: the block offsets make it several times more
+    assert got[0] > 3.0 * b.var() / 400
+    # empty blocks are left out
+    assert _block_jackknife(np.ones((400, 1)), b, group, 10)[0] == pytest.approx(got[0], rel=1e-9)
+
+
+def test_tilt_share_shrinks_to_the_geometric_mean_when_the_cap_cannot_tell():
+    from symfruit.core.raster import Tilt
+
+    # a level midline: prolate depth minor (cap 1), oblate major (cap major / minor); the cap says oblate
+    sure = Tilt(0.04, 0.034, 0.0, 0.0, 0.04 / 0.034, 0.0, 500)
+    assert sure.half_depth() == pytest.approx(0.04, rel=1e-9)
+    # the cap known to no better than the two hypotheses are apart: halfway (in log) back to the geometric mean
+    gap = np.log(0.04 / 0.034)
+    unsure = Tilt(0.04, 0.034, 0.0, 0.0, 0.04 / 0.034, 0.0, 500, cap_sd=gap * 0.04 / 0.034)
+    assert unsure.half_depth() == pytest.approx(0.04**0.75 * 0.034**0.25, rel=1e-9)
+    hopeless = Tilt(0.04, 0.034, 0.0, 0.0, 0.04 / 0.034, 0.0, 500, cap_sd=100.0)
+    assert hopeless.half_depth() == pytest.approx(np.sqrt(0.04 * 0.034), rel=1e-6)
+
+
+def test_axis_tilt_blocks_measure_the_fits_uncertainty():
+    from symfruit.core.raster import across_sight, axis_tilt, silhouette
+
+    pts, cam, _ = _spheroid_front(0.03, 0.05, 30, 30.0, noise=0.0016)
+    region = silhouette(pts, cam)
+    across = across_sight(region, cam)
+    plain = axis_tilt(pts, region, cam, across)
+    t = axis_tilt(pts, region, cam, across, blocks=8)
+    # the same fit, with a cap SD that independent noise of 1.6 mm keeps small, and a slope SD no smaller
+    assert (t.cap, t.slope_major, t.count) == (plain.cap, plain.slope_major, plain.count)
+    assert plain.cap_sd == 0.0 and 0.0 < t.cap_sd < 0.05 and t.slope_sd >= plain.slope_sd
+    # noise correlated over blocks of the front (a camera's, over a few pixels): a larger cap SD
+    rng = np.random.default_rng(1)
+    uv = cam.project(pts)
+    patch = rng.standard_normal((100, 100))[(uv[:, 1] // 12).astype(int), (uv[:, 0] // 12).astype(int)]
+    lumpy = pts * (1.0 + 0.003 * patch / pts[:, 2])[:, None]
+    assert axis_tilt(lumpy, region, cam, across, blocks=8).cap_sd > 2.0 * t.cap_sd
+
+
+def test_bracket_tilt_is_unsure_by_half_the_outlines_disagreement():
+    from symfruit.core.raster import Tilt, bracket_tilt
+
+    inner = Tilt(0.036, 0.030, 0.10, 0.02, 0.9, 0.01, 800, 0.02)  # the eroded outline: flatter
+    outer = Tilt(0.040, 0.034, 0.14, 0.00, 1.3, 0.01, 900, 0.03)  # the grown mask: rounder than round
+    b = bracket_tilt(inner, outer)
+    assert b.major == pytest.approx(np.sqrt(0.036 * 0.040)) and b.minor == pytest.approx(np.sqrt(0.030 * 0.034))
+    assert b.cap == pytest.approx(np.sqrt(0.9 * 1.3)) and b.count == 800
+    assert (b.slope_major, b.slope_minor, b.slope_sd) == pytest.approx((0.12, 0.01, 0.02))
+    assert b.cap_sd == pytest.approx(np.hypot(0.03, 0.5 * np.log(1.3 / 0.9) * b.cap))
+    # agreeing fits: the fit's own uncertainty; one without an estimate: the other
+    same = bracket_tilt(outer, outer)
+    assert same.cap == pytest.approx(1.3) and same.cap_sd == pytest.approx(0.03)
+    assert bracket_tilt(Tilt(0.04, 0.03, 0.0, 0.0, 1.0, 0.0, 0), outer) is outer
+    # the disagreement pulls the depth towards the geometric mean more than the outer fit alone would
+    lone = Tilt(b.major, b.minor, 0.0, 0.0, b.cap, 0.0, 800)
+    gm = np.sqrt(b.major * b.minor)
+    unsure = Tilt(b.major, b.minor, 0.0, 0.0, b.cap, 0.0, 800, b.cap_sd)
+    assert abs(np.log(unsure.half_depth() / gm)) < abs(np.log(lone.half_depth() / gm))
+
+
+def test_axis_tilt_bend_reads_a_bowed_midline_and_naught_on_a_spheroid():
+    from symfruit.core.raster import across_sight, axis_tilt, silhouette
+
+    # a prolate spheroid 30 x 50 mm lying across the line of sight (turned 30 deg in the image): its midline is
+    # straight, so the bend is naught within its noise
+    pts, cam, _ = _spheroid_front(0.03, 0.05, 0, 30.0, noise=0.0016)
+    region = silhouette(pts, cam)
+    across = across_sight(region, cam)
+    straight = axis_tilt(pts, region, cam, across, bend=True)
+    assert abs(straight.bend) < 3.0 * straight.bend_sd + 0.2
+    assert straight.half_depth() == pytest.approx(axis_tilt(pts, region, cam, across).half_depth(), rel=0.03)
+    # the same front bowed away from the camera by k p^2 (p along the axis): a banana's sagitta of k M^2 = 10 mm
+    k = 0.010 / 0.05**2
+    axis = np.array([np.cos(np.radians(30.0)), np.sin(np.radians(30.0))])
+    p = (pts[:, :2] - pts[:, :2].mean(axis=0)) @ axis
+    bowed = pts * (1.0 + k * p**2 / pts[:, 2])[:, None]
+    t = axis_tilt(bowed, region, cam, across, bend=True)
+    assert t.bend == pytest.approx(k, rel=0.1) and t.bend_sd < 0.1 * k
+    # the depth half-extent grows by half the sagitta beyond its noise, times the outline's elongation
+    # 1 - minor^2 / major^2 (0.64 here: a near-round outline's major axis is no axis that bends)
+    want = 0.5 * (abs(t.bend) - t.bend_sd) * (t.major**2 - t.minor**2)
+    assert want == pytest.approx(0.5 * 0.010 * 0.64, rel=0.15)
+    assert t.half_depths()[0] - straight.half_depths()[0] == pytest.approx(want, abs=0.001)

@@ -569,3 +569,21 @@ def test_the_back_face_is_the_candidates_midmean_and_only_the_back_face():
     np.testing.assert_array_equal(trimmed.box.min, median.box.min)
     np.testing.assert_array_equal(trimmed.box.max[:2], median.box.max[:2])
     assert trimmed.weights == median.weights
+def test_the_tilts_outer_outline_is_the_mask_without_its_overshoot():
+    """``tilt_outline: mask`` hands :func:`~symfruit.core.raster.axis_tilt` the fruit's own mask less what it
+    overshoots the fruit by, in the mask's window; ``points`` (the default) or no mask hands it nothing."""
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.methods.evidence import EvidenceSettings, _tilt_outer
+
+    own = np.zeros((6, 7), dtype=bool)
+    own[1:5, 1:6] = True
+    over = np.zeros_like(own)
+    over[1, 1:6] = True
+    occ = Occlusion(3, 4, np.zeros_like(own), 640, 480, own=own, overshoot=over)
+    got = _tilt_outer(occ, "mask")
+    assert got is not None and (got.u0, got.v0) == (3, 4)
+    assert np.array_equal(got.mask, own & ~over)
+    assert _tilt_outer(occ, "points") is None and _tilt_outer(None, "mask") is None
+    assert _tilt_outer(Occlusion(3, 4, np.zeros_like(own), 640, 480), "mask") is None
+    s = EvidenceSettings()
+    assert (s.prior_tilt, s.tilt_outline, s.tilt_blocks) == ("off", "points", 0)

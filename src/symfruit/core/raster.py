@@ -906,6 +906,12 @@ class Tilt:
         The standard deviation of ``slope_major`` (and of ``slope_minor``) from the fit's residuals.
     count : int
         Points the fit used (0: no estimate; every other field is then 0 but the half-widths).
+    cap_sd : float
+        The standard deviation of ``cap`` (0: not estimated; :func:`axis_tilt`'s ``blocks``).
+    bend, bend_sd : float, 1 / metres
+        The midline's depth per square metre along the major axis about its vertex, and its standard deviation (0:
+        not fitted; :func:`axis_tilt`'s ``bend``): a bent axis's sagitta over the outline's half-length is
+        ``bend * major^2``.
     """
 
     major: float
@@ -915,6 +921,9 @@ class Tilt:
     cap: float
     slope_sd: float
     count: int
+    cap_sd: float = 0.0
+    bend: float = 0.0
+    bend_sd: float = 0.0
 
     def half_depths(self, floor: float = 0.05) -> tuple[float, float]:
         """The depth half-extents ``(prolate, oblate)`` of the spheroid that has this outline and these midline
@@ -929,20 +938,27 @@ class Tilt:
         ``t`` gives ``H^2 = minor^2 + t^2 (major^2 - minor^2)``). An oblate one (``c < a``) projects its axis on the
         minor axis: ``a = major``, ``H^2 = major^2 - s^2 minor^4 / (major^2 - minor^2)`` (``s`` along the minor axis),
         at least ``minor / 2``. ``floor``: the least ``(major^2 - minor^2) / major^2`` divided by (a near-round outline
-        says nothing of the tilt); the slopes' noise variance is taken off their squares first.
+        says nothing of the tilt); the slopes' noise variance is taken off their squares first. A bent axis
+        (:attr:`bend` beyond :attr:`bend_sd`) deepens the prolate one by half its sagitta, ``|bend| (major^2 -
+        minor^2) / 2`` (weighted by the outline's elongation: stop 46, docs/tilt46.md).
         """
         big, small = self.major, self.minor
         gap = max(big * big - small * small, floor * big * big)
         var = self.slope_sd**2
         prolate = small * small + max(self.slope_major**2 - var, 0.0) * big**4 / gap
         oblate = big * big - max(self.slope_minor**2 - var, 0.0) * small**4 / gap
-        return float(np.sqrt(prolate)), float(np.sqrt(max(oblate, 0.25 * small * small)))
+        # a bent axis: the sagitta beyond its noise, half of it on each side of the middle; the prolate's long axis
+        # only, as far as the outline is elongated (a near-round outline's major axis is no axis that bends)
+        sag = 0.5 * max(abs(self.bend) - self.bend_sd, 0.0) * (big * big - small * small)
+        return float(np.sqrt(prolate) + sag), float(np.sqrt(max(oblate, 0.25 * small * small)))
 
     def half_depth(self, floor: float = 0.05) -> float:
         """The depth half-extent (metres) between :meth:`half_depths`' two, in log by where :attr:`cap` lies between
         the two spheroids' own (the prolate's ``sqrt(1 + s^2 major^2 / gap)``, the oblate's
         ``(major / minor) sqrt(1 - s^2 minor^2 / gap)``), clipped to them; their geometric mean when they agree or
-        there is no estimate."""
+        there is no estimate. With :attr:`cap_sd` the share is shrunk towards a half (the geometric mean of the two,
+        which is the outline's for a level midline) by ``d^2 / (d^2 + (cap_sd / cap)^2)``, ``d`` the two
+        hypotheses' caps apart in log: a cap that cannot tell them apart says nothing of which it is."""
         prolate, oblate = self.half_depths(floor)
         if self.count == 0:
             return float(np.sqrt(prolate * oblate))
@@ -955,12 +971,35 @@ class Tilt:
         if abs(hi - lo) < 1e-3:
             return float(np.sqrt(prolate * oblate))
         share = float(np.clip((np.log(max(self.cap, 1e-6)) - lo) / (hi - lo), 0.0, 1.0))
+        if self.cap_sd > 0:
+            noise = (self.cap_sd / max(self.cap, 1e-6)) ** 2
+            share = 0.5 + (share - 0.5) * (hi - lo) ** 2 / ((hi - lo) ** 2 + noise)
         return float(prolate ** (1.0 - share) * oblate**share)
+
+
+def _outline_to(
+    e: np.ndarray, outer: Silhouette, camera: Camera, across: Across, centre: np.ndarray, frame: np.ndarray,
+    reach: float,
+) -> np.ndarray:  # fmt: skip
+    """The outline ``e`` (tangent coordinates about ``centre`` in the axes ``frame``) scaled about its middle to the
+    widths ``outer``'s outline has along those axes, by no more than ``reach`` either way (:func:`axis_tilt`)."""
+    cracks = outline_cracks(outer)
+    if len(cracks) < 8:
+        return e
+    rays = camera.rays(cracks[:, 0], cracks[:, 1]).reshape(-1, 3)
+    o = ((rays @ across.basis.T) / (rays @ across.axis)[:, None] - centre) @ frame
+    own = np.ptp(e, axis=0)
+    if not np.all(own > 0):
+        return e
+    grow = np.clip(np.ptp(o, axis=0) / own, 1.0 / reach, reach)
+    mid = 0.5 * (e.min(axis=0) + e.max(axis=0))
+    return mid + (e - mid) * grow
 
 
 def axis_tilt(
     points: np.ndarray, region: Silhouette, camera: Camera, across: Across, *, bins: int = 24, inner: float = 0.4,
-    ends: float = 0.1, rounds: int = 2,
+    ends: float = 0.1, rounds: int = 2, outer: Silhouette | None = None, reach: float = 1.5, blocks: int = 0,
+    bend: bool = False,
 ) -> Tilt:  # fmt: skip
     """The tilt of a fruit's axis out of the image plane and the shape of its sections, from its seen front and
     its outline (:class:`Tilt`).
@@ -975,6 +1014,25 @@ def axis_tilt(
     (:meth:`Tilt.half_depths`). Only points where ``g`` is at least ``inner`` of ``h`` (the rim's depths are the
     noisiest, and ``g`` there the most sensitive to the outline) and at least ``ends`` of the major width from
     either end are fitted; ``rounds`` refits drop points whose residual is over 2.5 robust standard deviations.
+
+    ``outer``: the fruit's whole outline where the points' ``region`` falls short of it (the instance mask: a
+    time-of-flight camera returns no depth on a band of the rim, whose light grazes the surface, so the points'
+    region is eroded by a few pixels all round; stop 46, docs/tilt46.md). The points' outline is scaled about its
+    centre to the outer one's widths along its own two axes (widths, not positions: a registration shift between
+    the mask and the depth moves the mask's outline, and moves no width), by no more than ``reach`` either way.
+    An eroded outline makes a round section's sag ``g`` too small at its middle and too steep towards its rim, and
+    the fit then reads the front as flatter than a round section (``cap`` under 1: the Azure Kinect model's apples
+    read 0.8-1.0 where the render's own depth gives 1.1-1.4).
+
+    ``blocks`` (0: off): the fit's uncertainty from a delete-a-block jackknife over that many sectors of the points
+    about the outline's middle (:attr:`Tilt.cap_sd`, and :attr:`Tilt.slope_sd` at least the jackknife's): a depth
+    camera's noise is correlated over a few pixels (the Azure Kinect model's over 3.5), so the residuals read as
+    independent understate it by several times on a fruit a few tens of pixels wide.
+
+    ``bend``: the midline's depth also gets a term in the square of the position along the major axis
+    (:attr:`Tilt.bend`). A spheroid's sections have their centres on a line (a conjugate diameter) whatever its
+    tilt, so the term is naught for every spheroid and every solid of revolution with a straight axis; a fruit
+    whose axis bends towards or away from the camera (a banana hanging) shows it, and no outline does.
     """
     pts = as_points(points, min_count=1)
     big, small = 0.5 * float(across.major), 0.5 * float(across.minor)
@@ -991,6 +1049,8 @@ def axis_tilt(
     frame = vec[:, ::-1]  # columns: major, minor
     e = (edge - centre) @ frame
     x = ((pts @ across.basis.T) / depth[:, None] - centre) @ frame  # tangent coordinates, then metres at each depth
+    if outer is not None:
+        e = _outline_to(e, outer, camera, across, centre, frame, reach)
     lo, hi = float(e[:, 0].min()), float(e[:, 0].max())
     span = hi - lo
     if span <= 0:
@@ -1012,16 +1072,16 @@ def axis_tilt(
     if keep.sum() < 20:
         return empty
     xm = x * depth[:, None]
-    coef = np.zeros(4)
-    design = np.empty((len(pts), 4))
+    width = 5 if bend else 4
+    coef = np.zeros(width)
+    design = np.empty((len(pts), width))
     for scale in (dist, None):
         # the outline lies at the rim's distance, the midline's depth at the centre (``z0``), nearer than the
         # seen points' median: a round section's sag is its half-width there
         at = dist if scale is not None else max(float(coef[0]), dist)
         half, off = half_t * at, off_t * depth
-        design = np.column_stack(
-            (np.ones(len(pts)), xm[:, 0], xm[:, 1], -np.sqrt(np.maximum(half * half - off * off, 0.0)))
-        )
+        columns = [np.ones(len(pts)), xm[:, 0], xm[:, 1], -np.sqrt(np.maximum(half * half - off * off, 0.0))]
+        design = np.column_stack(columns + [xm[:, 0] ** 2] if bend else columns)
         fit = keep.copy()
         for _ in range(rounds + 1):
             coef = np.linalg.lstsq(design[fit], depth[fit], rcond=None)[0]
@@ -1041,5 +1101,59 @@ def axis_tilt(
     except np.linalg.LinAlgError:
         return empty
     slope_sd = float(np.sqrt(max(0.5 * (cov[1, 1] + cov[2, 2]), 0.0)))
+    cap_sd = 0.0
+    bow, bow_sd = (float(coef[4]), float(np.sqrt(max(cov[4, 4], 0.0)))) if bend else (0.0, 0.0)
+    if blocks >= 2:
+        # the points' angle about the outline's middle, on the outline's own scale: ``blocks`` even sectors
+        mid = 0.5 * (e.min(axis=0) + e.max(axis=0))
+        rel = (x[keep_fit] - mid) / np.array([big, small])
+        turn = (np.arctan2(rel[:, 1], rel[:, 0]) + np.pi) / (2.0 * np.pi)
+        jk = _block_jackknife(a, depth[keep_fit], np.minimum((turn * blocks).astype(np.intp), blocks - 1), blocks)
+        slope_sd = max(slope_sd, float(np.sqrt(0.5 * (jk[1] + jk[2]))))
+        cap_sd = float(np.sqrt(jk[3]))
+        bow_sd = max(bow_sd, float(np.sqrt(jk[4]))) if bend else 0.0
     keep = keep_fit
-    return Tilt(big * dist, small * dist, float(coef[1]), float(coef[2]), float(coef[3]), slope_sd, int(keep.sum()))
+    return Tilt(big * dist, small * dist, float(coef[1]), float(coef[2]), float(coef[3]), slope_sd, int(keep.sum()),
+                cap_sd, bow, bow_sd)  # fmt: skip
+
+
+def bracket_tilt(inner: Tilt, outer: Tilt) -> Tilt:
+    """One :class:`Tilt` from two fits of the same front with two outlines that bracket the fruit's (the points'
+    own, which a time-of-flight camera's lost rim band erodes, and the instance mask's, which its annotators grow by
+    a few pixels: :func:`axis_tilt`'s ``outer``): their geometric means (half-widths, cap) and means (slopes),
+    and standard deviations at least half their difference (``cap_sd`` combined with the fits' own): the outline's
+    uncertainty is what makes the cap unsure on a fruit a few tens of pixels wide, and :meth:`Tilt.half_depth`
+    then leans on it the less. ``count`` 0 from either: the other."""
+    if inner.count == 0 or outer.count == 0:
+        return outer if inner.count == 0 else inner
+    half = 0.5 * abs(float(np.log(max(outer.cap, 1e-6) / max(inner.cap, 1e-6))))
+    cap = float(np.sqrt(max(inner.cap, 1e-6) * max(outer.cap, 1e-6)))
+    return Tilt(
+        float(np.sqrt(inner.major * outer.major)), float(np.sqrt(inner.minor * outer.minor)),
+        0.5 * (inner.slope_major + outer.slope_major), 0.5 * (inner.slope_minor + outer.slope_minor), cap,
+        max(inner.slope_sd, outer.slope_sd, 0.5 * abs(inner.slope_major - outer.slope_major),
+            0.5 * abs(inner.slope_minor - outer.slope_minor)),
+        min(inner.count, outer.count), float(np.hypot(max(inner.cap_sd, outer.cap_sd), half * cap)),
+        0.5 * (inner.bend + outer.bend), max(inner.bend_sd, outer.bend_sd, 0.5 * abs(inner.bend - outer.bend)),
+    )  # fmt: skip
+
+
+def _block_jackknife(a: np.ndarray, b: np.ndarray, group: np.ndarray, blocks: int) -> np.ndarray:
+    """(k,) float: the delete-a-block jackknife variance of each of the least-squares coefficients of ``a x = b``
+    (``a`` (n, k)), the blocks ``group`` (n,) int in ``[0, blocks)``. Each block's own normal equations are taken
+    off the whole's and the rest solved at once; a block without points, or one whose rest is singular, is left
+    out. Contiguous blocks keep a camera's depth noise, correlated over a few pixels, within one block, and a
+    shape the model misses in one part of the front: the spread of the fits without each says what the
+    residuals of one fit, read as independent, do not."""
+    k = a.shape[1]
+    onehot = np.zeros((len(a), blocks))
+    onehot[np.arange(len(a)), group] = 1.0
+    ata_g = np.einsum("ng,ni,nj->gij", onehot, a, a)
+    atb_g = np.einsum("ng,ni,n->gi", onehot, a, b)
+    rest, rhs = ata_g.sum(axis=0) - ata_g, atb_g.sum(axis=0) - atb_g
+    ok = (onehot.sum(axis=0) > 0) & (np.abs(np.linalg.det(rest)) > 1e-300)
+    if ok.sum() < 2:
+        return np.zeros(k)
+    theta = np.linalg.solve(rest[ok], rhs[ok][..., None])[..., 0]
+    m = int(ok.sum())
+    return (m - 1) / m * ((theta - theta.mean(axis=0)) ** 2).sum(axis=0)

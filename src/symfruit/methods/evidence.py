@@ -67,6 +67,7 @@ from ..core.raster import (
     Tilt,
     across_sight,
     axis_tilt,
+    bracket_tilt,
     close_ragged,
     inner_distance,
     point_pixels,
@@ -149,6 +150,16 @@ class EvidenceSettings(Section):
         ``tilt_floor``: the least ``(major^2 - minor^2) / major^2`` the midline's slope is divided by
         (:meth:`~symfruit.core.raster.Tilt.half_depths`: a near-round outline says little of the tilt; 0.3, the
         measured variant: 0.05 put the D435 model's proxies at 4.30 mm against 4.06).
+    tilt_outline, tilt_blocks, tilt_bend : {"points", "mask", "both"}, int, bool
+        How the tilt is read (stop 46, docs/tilt46.md; none is on by default, as ``prior_tilt`` is not).
+        ``tilt_outline``: the points' own outline (``points``), which a time-of-flight camera's lost rim band erodes
+        so that the seen front reads flatter than a round section (the Azure Kinect model's apples too shallow by
+        10 mm); that outline scaled to the mask's widths (``mask``), which its annotators draw a few pixels wide;
+        or both fits, with the cap as unsure as they disagree (``both``, :func:`~symfruit.core.raster.bracket_tilt`).
+        ``tilt_blocks``: the fit's uncertainty from a jackknife over that many sectors of the front (0: off; a
+        camera's correlated noise), which shrinks the prolate/oblate share towards the geometric mean.
+        ``tilt_bend``: the midline's bow along the outline's axis (a banana hanging), whose sagitta deepens the
+        prolate hypothesis as far as the outline is elongated.
     shape_error, rim_error, back_inflation : float, float, float
         The candidates' back face has standard deviation ``hypot(back_inflation * back_std, spread / 2, width *
         (shape_error + rim_error * (1 - rim)))``: the ``cone`` fit's own back-face deviation (from ray residuals
@@ -250,6 +261,9 @@ class EvidenceSettings(Section):
     cut_width: float = setting(0.0, ge=0.0, le=1.0)
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
+    tilt_outline: Literal["points", "mask", "both"] = setting("points")
+    tilt_blocks: int = setting(0, ge=0, le=64)
+    tilt_bend: bool = setting(False)
     shape_error: float = setting(0.02, gt=0.0, le=10.0)
     rim_error: float = setting(1.0, ge=0.0, le=100.0)
     back_inflation: float = setting(1.5, ge=0.0, le=1000.0)
@@ -459,6 +473,16 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
     return big * (small / big) ** (0.5 * (1.0 - cut))
 
 
+def _tilt_outer(occlusion: Occlusion | None, which: str) -> Silhouette | None:
+    """The whole outline :func:`~symfruit.core.raster.axis_tilt` scales the points' outline to (``tilt_outline``
+    ``mask`` or ``both``): the fruit's own mask without what it overshoots the fruit by; None for ``points`` or no
+    mask."""
+    if which == "points" or occlusion is None or occlusion.own is None:
+        return None
+    own = occlusion.own if occlusion.overshoot is None else occlusion.own & ~occlusion.overshoot
+    return Silhouette(occlusion.u0, occlusion.v0, own, 0.0) if own.any() else None
+
+
 def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
     """:func:`rim_coverage`'s rim width, pixels: ``band`` equivalent radii of the region ``mask``, at least 2."""
     return max(2.0, band * float(np.sqrt(np.count_nonzero(mask) / np.pi)))  # the count: the sum's, 20x faster
@@ -642,7 +666,12 @@ def evidence(
     tilt = None
     if s.prior_tilt != "off" and dense and obs.contour >= s.covered_contour:
         # the points' own outline: the mask's may be shifted from the depth (registration) or reach past it
-        tilt = axis_tilt(sample, seen_region, camera, sized)
+        outer = _tilt_outer(occlusion, s.tilt_outline)
+        tilt = axis_tilt(sample, seen_region, camera, sized, outer=outer if s.tilt_outline == "mask" else None,
+                         blocks=s.tilt_blocks, bend=s.tilt_bend)  # fmt: skip
+        if s.tilt_outline == "both" and outer is not None:
+            wide = axis_tilt(sample, seen_region, camera, sized, outer=outer, blocks=s.tilt_blocks, bend=s.tilt_bend)
+            tilt = bracket_tilt(tilt, wide)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=sized, tilt=tilt)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
