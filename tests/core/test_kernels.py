@@ -5299,25 +5299,3 @@ def test_the_principal_widths_with_the_extents_kernel_are_the_twins(seed):
     m = np.zeros((9, 20), bool)
     m[2:7, 3:17] = True
     assert principal_widths(m) == (5.0, 14.0)
-
-
-@settings(max_examples=100, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.booleans())
-def test_the_valid_depth_of_a_float32_window_is_its_float64_copys(seed, view):
-    """valid_depth read on a float32 depth window (registration_shift since stop 46) and on its float64 copy (before):
-    the same float64 map, usable pixels and counts, bit for bit (depths of every float32 kind: 0, negative, NaN,
-    infinities, the range's ends, subnormals; a strided view)."""
-    rng = np.random.default_rng(seed)
-    h, w = (int(x) for x in rng.integers(1, 30, 2))
-    lo, hi = 0.3, 1.7
-    values = np.array([0.0, -0.0, -1.0, np.nan, np.inf, -np.inf, lo, hi, 1e-40, 0.29999998, 1.7000001], np.float32)
-    z = np.where(rng.random((h, w + 1)) < 0.5, rng.choice(values, (h, w + 1)),
-                 rng.uniform(0.0, 2.0, (h, w + 1))).astype(np.float32)  # fmt: skip
-    z = z[:, 1:] if view else z[:, :w]
-    mask = rng.random((h, w)) < 0.6
-    a, b = np.empty((h, w)), np.empty((h, w))
-    ua, ub = np.empty((h, w), bool), np.empty((h, w), bool)
-    got = _jit.valid_depth(z, mask, max(lo, 5e-324), hi, a, ua)
-    want = _jit.valid_depth(np.asarray(z, dtype=np.float64), mask, max(lo, 5e-324), hi, b, ub)
-    assert got == want
-    assert np.array_equal(a.view(np.int64), b.view(np.int64)) and np.array_equal(ua, ub)

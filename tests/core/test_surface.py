@@ -1186,17 +1186,3 @@ def test_the_curvature_fits_sample_is_a_fresh_generators():
         mp.setattr(surface, "_seeded", lambda: np.random.default_rng(0))
         want = _mean_curvature(rows, cols, z, F)
     assert got == want and got[0] > 0
-
-
-@pytest.mark.parametrize("seed", range(3))
-def test_registration_of_float32_depth_is_that_of_its_float64_copy(seed):
-    """registration_shift reads a float32 depth window as it is (stop 46): the same shift as on its float64 copy (the
-    same values), for a ball 0-3 px off its mask."""
-    rng = np.random.default_rng(seed)
-    du, dv = (int(x) for x in rng.integers(-3, 4, 2))
-    depth, _ = ball(centre=(80 + du, 60 + dv), radius_px=20, rim=0.1, noise=0.001, seed=seed)
-    _, mask = ball(radius_px=20)
-    low = depth.astype(np.float32)
-    found = registration_shift(low, mask.astype(np.int32), F, max_px=10)
-    assert found == registration_shift(low.astype(np.float64), mask.astype(np.int32), F, max_px=10)
-    assert abs(found[0] - du) <= 1 and abs(found[1] - dv) <= 1

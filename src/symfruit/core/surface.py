@@ -1273,15 +1273,12 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
             continue
         # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds), in float64 (a
         # float32 frame converted window by window: the same values, without a float64 copy of the whole frame)
-        z = depth[r0:r1, c0:c1]
-        if (jit := compiled()) is not None and z.dtype in (np.float32, np.float64):  # the same map by extraction's
-            # kernel: z > 0 and z >= lo is z >= the larger of lo and the least positive double; a float32 window read
-            # as it is (each depth compared and stored as its float64, exactly: no float64 copy first; stop 46)
-            valid = np.empty(z.shape)
+        z = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
+        if (jit := compiled()) is not None and z.dtype == np.float64:  # the same map by the extraction's kernel:
+            valid = np.empty(z.shape)  # z > 0 and z >= lo is z >= the larger of lo and the least positive double
             jit.valid_depth(z, mask, max(float(lo), 5e-324), float(hi), valid, np.empty(z.shape, bool))
             z = valid
         else:
-            z = np.asarray(z, dtype=np.float64)
             z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
         if (found := _outline(z, mask, focal, max_px)) is not None and any(found.axes):
             outlines.append(found)
