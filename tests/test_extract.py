@@ -297,3 +297,16 @@ def test_trim_labels_names_the_masks_it_trimmed():
     assert np.array_equal(out == 3, labels == 3)
     off: set[int] = set()
     assert trim_labels(color, labels, ExtractSettings(colour_trim_px=0), trimmed=off) is labels and off == set()
+
+
+def test_one_cluster_keeps_every_point_on_the_fruit():
+    """A mask well inside a fruit's disc (one cluster, stop 46's path without picking a cluster): every mask pixel's
+    point kept, nothing counted as another cluster, the points those of the pixels in raster order."""
+    _, depth = disc_frame([(80, 60)])
+    yy, xx = np.mgrid[:120, :160]
+    mask = (xx - 80) ** 2 + (yy - 60) ** 2 <= 12**2
+    ex = extract(mask, depth, CAM, NO_EROSION)
+    assert len(ex.points) == int(mask.sum()) and ex.n_other_clusters == 0 and ex.n_invalid == 0
+    rows, cols = np.nonzero(mask)
+    np.testing.assert_array_equal(ex.points[:, 2], depth[rows, cols].astype(np.float64))
+    assert cluster(ex.points, NO_EROSION.cluster_distance).max() == 0

@@ -265,8 +265,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         rows, cols = np.nonzero(usable if surface is None else usable & surface.pixels)
         points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
     dropped = int(n_usable - len(points))
-    if len(points) >= 2:
-        labels = cluster(points, s.cluster_distance)
+    # one cluster (every label 0): every point kept, nothing dropped, no cluster picked (stop 46)
+    if len(points) >= 2 and int((labels := cluster(points, s.cluster_distance)).max()) > 0:
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         # the nearest of the big clusters (one alone needs no medians)

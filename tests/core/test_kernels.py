@@ -5214,3 +5214,88 @@ def test_the_label_boxes_are_find_objects(seed, h, w, n):
         sl = want[k]
         expect = [h, 0, w, 0] if sl is None else [sl[0].start, sl[0].stop, sl[1].start, sl[1].stop]
         assert got[k].tolist() == expect
+
+
+# --- stop 46, regspeed46
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_the_envelope_of_some_columns_is_their_least_parabola_over_the_whole_row(seed):
+    """_envelope_of (outline_maps' outside pixels) against the brute-force least (u - i)^2 + f[i] over the columns
+    lo..hi alone, at every column u of the row (left and right of them too): equal; and where the other columns'
+    parabolas lie above (f of at least (h + w)^2, as outline_maps' columns without a mask pixel), _envelope's over
+    the whole row."""
+    rng = np.random.default_rng(seed)
+    for w in (1, 2, 7, 40, 90):
+        lo = int(rng.integers(0, w))
+        hi = int(rng.integers(lo, w))
+        f = rng.integers(0, 30, w).astype(np.int64) ** 2
+        s, t, d2 = (np.empty(w, np.int64) for _ in range(3))
+        _jit._envelope_of(f, lo, hi, w, s, t, d2)
+        u, i = np.arange(w), np.arange(lo, hi + 1)
+        np.testing.assert_array_equal(d2, ((u[:, None] - i[None, :]) ** 2 + f[None, lo : hi + 1]).min(axis=1))
+        far = f.copy()
+        far[:lo] = (30 + w) ** 2 + rng.integers(0, 5, lo)
+        far[hi + 1 :] = (30 + w) ** 2 + rng.integers(0, 5, w - hi - 1)
+        whole = np.empty(w, np.int64)
+        _jit._envelope(far, w, s, t, whole)
+        np.testing.assert_array_equal(d2, whole)
+
+
+def test_the_outline_maps_of_a_pixel_in_a_wide_window_are_its_distances():
+    """A mask of one pixel in a window wider and taller than it (columns without a mask pixel either side): every
+    outside pixel's signed distance is minus its distance to that pixel, the pixel's own 1 (and the twin's)."""
+    from symfruit.core.raster import distance_transform, inner_distance
+
+    mask = np.zeros((5, 9), bool)
+    mask[2, 4] = True
+    inner, inside = np.empty(mask.shape), np.empty(mask.shape)
+    ok, keys, ranks, values = _jit.outline_maps(mask, 3, 3, inner, inside)
+    rr, cc = np.mgrid[0:5, 0:9]
+    want = -np.sqrt(((rr - 2) ** 2 + (cc - 4) ** 2).astype(np.float64))
+    want[2, 4] = 1.0
+    np.testing.assert_array_equal(inside, want)
+    assert inside[0, 0] == -np.sqrt(20.0) and inside[4, 8] == -np.sqrt(20.0)
+    np.testing.assert_array_equal(inner, np.where(mask, 1.0, 0.0))
+    assert ok and keys[(2 + 3) * 15 + 4 + 3] == 1 and values[ranks[(2 + 3) * 15 + 4 + 3]] == 1.0
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        np.testing.assert_array_equal(inside, inner_distance(mask) - distance_transform(~mask))
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40))
+def test_the_column_extents_are_numpys_ptp(seed, n):
+    """column_extents against np.ptp of each column on values with ties, zeros of both signs, infinities and NaN:
+    the same numbers (NaN where numpy's is), but for a zero's sign (principal_widths adds 1: no sign left)."""
+    rng = np.random.default_rng(seed)
+    p = rng.choice([0.0, -0.0, 1.5, -2.25, 3.0, 1e300, -1e-300, np.inf, -np.inf, np.nan], (n, 2), p=[0.15, 0.15]
+                   + [0.68 / 7] * 7 + [0.02])  # fmt: skip
+    if rng.random() < 0.5:
+        p = rng.normal(0.0, 50.0, (n, 2))
+    got = _jit.column_extents(np.ascontiguousarray(p))
+    for j in (0, 1):
+        with np.errstate(invalid="ignore"):  # inf - inf: NaN, as the kernel's
+            want = np.ptp(p[:, j])
+        assert (np.isnan(got[j]) and np.isnan(want)) or got[j] + 1.0 == want + 1.0 or got[j] == want
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_principal_widths_with_the_extents_kernel_are_the_twins(seed):
+    """raster.principal_widths with its kernels (centred pixels, column_extents) and with SYMFRUIT_KERNELS=numpy on
+    random blobs at an origin: the same two floats, bit for bit; and a known answer (a 5 x 14 rectangle)."""
+    from symfruit.core.raster import principal_widths
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 50, 2))
+    mask = _blob_mask(rng, h, w)
+    origin = (int(rng.integers(0, 500)), int(rng.integers(0, 500)))
+    got = principal_widths(mask, origin=origin)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = principal_widths(mask, origin=origin)
+    assert got == want
+    m = np.zeros((9, 20), bool)
+    m[2:7, 3:17] = True
+    assert principal_widths(m) == (5.0, 14.0)

@@ -1141,3 +1141,48 @@ def test_behind_a_sheet_told_flat_a_part_too_noisy_to_fit_is_the_fruit():
     assert len(points) >= 100
     assert float(np.min(points[:, 2])) > near - 0.008
     assert float(np.median(points[:, 2])) > near + 0.005
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_colour_trim_with_the_bands_distances_alone_is_the_whole_maps(seed, kernels):
+    """colour_trim's first band reads the mask's distances up to 3 band + 1 alone (stop 46): the trim it gives is
+    the one the whole distance map gives (``_colour_trim`` with ``inner_distance(mask)``; a mask overshooting by 0-10
+    px onto leaves, a shaded side, a band of 1.5-6 px), with the kernels and with their numpy twins."""
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import _colour_trim
+
+    rng = np.random.default_rng(seed)
+    yy, xx = np.mgrid[:H, :W]
+    cx, cy, r = float(rng.uniform(40, 120)), float(rng.uniform(35, 85)), float(rng.uniform(10, 30))
+    r2 = (xx - cx) ** 2 + (yy - cy) ** 2
+    color = rng.integers(30, 60, (H, W, 3)).astype(np.uint8)
+    color[..., 1] += 70  # leaves
+    disc = r2 <= r * r
+    color[disc] = (200, 30, 40)
+    color[disc & (xx < cx)] = (150, 25, 30)
+    mask = r2 <= (r + float(rng.uniform(0, 10))) ** 2
+    band = float(rng.uniform(1.5, 6.0))
+    with pytest.MonkeyPatch.context() as mp:
+        if not kernels:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        got = colour_trim(color, mask, band_px=band)
+        want = _colour_trim(color, mask, inner_distance(mask), band, 3, 5, 0.85, 0.5)
+    assert np.array_equal(got, mask if want is None else want)
+
+
+def test_the_curvature_fits_sample_is_a_fresh_generators():
+    """_InverseQuadratic's 2,048 of more pixels drawn from the thread's generator set back to seed 0 (stop 46): the
+    same fit, bit for bit, as one drawn by a fresh ``np.random.default_rng(0)``, also after the generator drew other
+    numbers."""
+    import symfruit.core.surface as surface
+
+    rng = np.random.default_rng(3)
+    rows, cols = rng.integers(0, 90, 5000), rng.integers(0, 120, 5000)
+    z = 0.5 + 1e-4 * ((rows - 45.0) ** 2 + (cols - 60.0) ** 2) / 100 + rng.normal(0.0, 0.001, 5000)
+    surface._seeded().random(7)  # the generator moved on
+    got = _mean_curvature(rows, cols, z, F)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setattr(surface, "_seeded", lambda: np.random.default_rng(0))
+        want = _mean_curvature(rows, cols, z, F)
+    assert got == want and got[0] > 0

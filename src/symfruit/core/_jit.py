@@ -4722,6 +4722,39 @@ def _envelope(f: np.ndarray, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarra
             q -= 1
 
 
+@_njit_inlined
+def _envelope_of(f: np.ndarray, lo: int, hi: int, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarray) -> None:
+    """``d2[u]`` (w,) the least ``(u - i)^2 + f[i]`` over the columns ``lo <= i <= hi`` alone (``0 <= lo <= hi < w``),
+    for every column ``u`` of the row (stop 46, regspeed46): :func:`_envelope`'s steps with the parabolas of those
+    columns only, over the same domain. Where every other column's parabola lies above one of these everywhere (the
+    caller's columns without a mask pixel, whose ``f`` exceeds any squared distance within the image), the same
+    least, so the same numbers as :func:`_envelope` over the whole row."""
+    q = 0
+    s[0] = lo
+    t[0] = 0
+    for u in range(lo + 1, hi + 1):
+        while q >= 0:
+            a, b = t[q] - s[q], t[q] - u
+            if a * a + f[s[q]] <= b * b + f[u]:
+                break
+            q -= 1
+        if q < 0:
+            q = 0
+            s[0] = u
+        else:
+            i = s[q]
+            start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
+            if start < w:
+                q += 1
+                s[q] = u
+                t[q] = start
+    for u in range(w - 1, -1, -1):
+        a = u - s[q]
+        d2[u] = a * a + f[s[q]]
+        if u == t[q]:
+            q -= 1
+
+
 @_njit
 def outline_maps(
     mask: np.ndarray, pad: int, reach: int, inner: np.ndarray, inside: np.ndarray
@@ -4736,7 +4769,9 @@ def outline_maps(
     Both transforms are :func:`distance`'s (Meijster's, in whole numbers): one column pass for both (each pixel's
     distance along its column to the nearest pixel of the other kind), then each row's lower envelope of the
     parabolas for the mask's pixels (over the row's mask pixels and one column either side: the columns beyond are
-    farther outside pixels) and for the others (rows without such pixels skipped: their distances are 0). The same
+    farther outside pixels) and for the others (rows without such pixels skipped: their distances are 0; since stop
+    46 over the parabolas of the mask's columns alone, :func:`_envelope_of`: a column without a mask pixel has a
+    column distance of at least ``h + w``, so its parabola is above every other column's everywhere). The same
     least squared distances, so the same square roots (read off the ranks' values where there are ranks), keys,
     places and values as the twins', bit for bit."""
     h, w = mask.shape
@@ -4761,11 +4796,17 @@ def outline_maps(
     floor = -(reach * reach)
     top = reach * reach
     low, high = (floor, floor) if pad > 0 else (np.int64(2**62), -np.int64(2**62))
+    firsts, lasts, n_ins = np.empty(h, np.int64), np.empty(h, np.int64), np.empty(h, np.int64)
+    lo_c, hi_c = w, -1  # the mask's first and last column: the outside pixels' only sites (stop 46)
     for r in range(h):
         first, last, n_in = w, -1, 0
         for c in range(w):
             if mask[r, c]:
                 first, last, n_in = min(first, c), c, n_in + 1
+        firsts[r], lasts[r], n_ins[r] = first, last, n_in
+        lo_c, hi_c = min(lo_c, first), max(hi_c, last)
+    for r in range(h):
+        first, last, n_in = firsts[r], lasts[r], n_ins[r]
         if last >= 0:  # the mask's pixels: their envelope over their columns and one more either side
             a, b = max(first - 1, 0), min(last + 1, w - 1)
             for c in range(a, b + 1):
@@ -4776,10 +4817,10 @@ def outline_maps(
                     k = d2[c - a]
                     key[r, c] = k
                     top, high = max(top, k), max(high, k)
-        if n_in < w:  # outside pixels in the row: their envelope over the whole row
-            for c in range(w):
+        if n_in < w:  # outside pixels in the row: their envelope over the whole row, of the mask's columns' parabolas
+            for c in range(lo_c, hi_c + 1):
                 f[c] = 0 if mask[r, c] else g[r, c] * g[r, c]
-            _envelope(f, w, s, t, d2)
+            _envelope_of(f, lo_c, hi_c, w, s, t, d2)
             for c in range(w):
                 if not mask[r, c]:
                     k = d2[c]
@@ -7597,3 +7638,23 @@ def label_boxes(labels: np.ndarray, n: int) -> np.ndarray:
             out[k, 2] = min(out[k, 2], start)
             out[k, 3] = max(out[k, 3], c)
     return out
+
+
+# --- stop 46, regspeed46: the principal widths' extents -----------------------------------------------------------
+
+
+@_njit
+def column_extents(p: np.ndarray) -> tuple[float, float]:
+    """``(np.ptp(p[:, 0]), np.ptp(p[:, 1]))`` of ``p`` (n, 2) float64, ``n >= 1``, in one pass: each column's greatest
+    less its least (NaN where the column holds a NaN, as numpy's maximum and minimum propagate it). A greatest and a
+    least are values of the column, whatever the order they are found in: the same difference, but where both are
+    zeros of either sign (then a zero, whose sign :func:`symfruit.core.raster.principal_widths` loses adding 1)."""
+    lo0, hi0, lo1, hi1 = p[0, 0], p[0, 0], p[0, 1], p[0, 1]
+    nan0, nan1 = False, False
+    for i in range(p.shape[0]):
+        a, b = p[i, 0], p[i, 1]
+        nan0 = nan0 or a != a
+        nan1 = nan1 or b != b
+        lo0, hi0 = min(lo0, a), max(hi0, a)
+        lo1, hi1 = min(lo1, b), max(hi1, b)
+    return (np.nan if nan0 else hi0 - lo0), (np.nan if nan1 else hi1 - lo1)

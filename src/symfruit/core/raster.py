@@ -565,6 +565,9 @@ def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> t
         xy -= np.array([int(cols.sum()), int(rows.sum())], dtype=np.float64) / len(rows)
     _, vec = lapack.eigh(xy.T @ xy)  # np.linalg.eigh without its wrapper: the same LAPACK call (stop 45)
     p = xy @ vec
+    if (jit := compiled()) is not None and p.dtype == np.float64:  # both extents in one pass (stop 46: the same)
+        minor, major = jit.column_extents(p)
+        return float(minor + 1.0), float(major + 1.0)
     return float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0)
 
 
