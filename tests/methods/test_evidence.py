@@ -569,6 +569,8 @@ def test_the_back_face_is_the_candidates_midmean_and_only_the_back_face():
     np.testing.assert_array_equal(trimmed.box.min, median.box.min)
     np.testing.assert_array_equal(trimmed.box.max[:2], median.box.max[:2])
     assert trimmed.weights == median.weights
+
+
 def test_the_tilts_outer_outline_is_the_mask_without_its_overshoot():
     """``tilt_outline: mask`` hands :func:`~symfruit.core.raster.axis_tilt` the fruit's own mask less what it
     overshoots the fruit by, in the mask's window; ``points`` (the default) or no mask hands it nothing."""
