@@ -57,7 +57,7 @@ from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.fits import noise_measures
-from ..core.front import apex_depth
+from ..core.front import apex_depth, sphere_front
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
 from ..core.points import bounds, row_norms, subsample
@@ -133,6 +133,11 @@ class EvidenceSettings(Section):
         profile sets 1 (mostly hidden apples' boxes were 9 mm too shallow, docs/ablation.md "Hidden apples'
         boxes"). Not the default: on an elongated fruit the larger width is its length, and through the D435
         model the real scans (a banana and a pear) fell from 0.634 / 14.3 mm to 0.607 / 16.9 with it.
+    hidden_front : {"sphere", "off"}
+        With occlusion information, where the outline is cut and the front of the sphere as wide as the prior's
+        width that best fits the seen points lies in front of the seen front at a pixel the occlusion map hides,
+        that sphere's front is the shared front (:func:`hidden_front`: a leaf over the fruit's nearest part, stop
+        46, docs/apex46.md); ``off``: the seen front (``max(nearest seen depth, apex_depth)``) always.
     prior_tilt, tilt_floor : {"off", "cap", "prolate"}, float
         In a depth camera's view of a whole outline (at least ``covered_contour`` of it a contour), the prior's width
         from the tilt of the fruit's axis out of the image plane instead of the geometric mean
@@ -237,6 +242,7 @@ class EvidenceSettings(Section):
     revolution_coarse: int = setting(64, ge=0, le=10_000)
     covered_contour: float = setting(0.9, ge=0.0, le=1.0)
     explained_at: float = setting(0.02, ge=0.0, le=2.0)
+    hidden_front: Literal["off", "sphere"] = setting("sphere")
     temperature: float = setting(2.0, gt=0.0, le=1e6)
     depth_ratio: float = setting(1.0, gt=0.0, le=10.0)
     depth_ratio_sd: float = setting(0.15, ge=0.0, le=10.0)
@@ -430,6 +436,35 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
     return big * (small / big) ** (0.5 * (1.0 - cut))
 
 
+def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occlusion, camera: Camera) -> float:
+    """The shared front where a leaf may hide the fruit's nearest part (``hidden_front``, stop 46): metres.
+
+    The nearest seen point of a fruit whose front lies behind a leaf is on the seen part's edge, behind the
+    fruit's front (docs/hidden45.md: the mostly hidden apples' boxes' fronts 7 mm behind the truth's, 3 of them
+    the hidden front). The sphere as wide as the silhouette (``width``, tangent units: the prior's width over the
+    distance, read at the sphere's centre) that best fits the seen points (:func:`~symfruit.core.front.sphere_front`)
+    places the front instead, when that front lies in front of ``front`` at a pixel where the camera could not have
+    seen it: something was seen in front of it there (a leaf, under the fruit's mask or beside it), or the
+    occlusion map hides the pixel (the image ends there) and nothing was seen behind it; otherwise ``front``
+    stands.
+    """
+    if width <= 0.0 or len(sample) < 4:
+        return front
+    diameter = width * front
+    diameter = width * (front + 0.5 * diameter)  # at the sphere's centre, half a diameter behind its front
+    z, at = sphere_front(sample, 0.5 * diameter)
+    if not (np.isfinite(z) and 0.0 < z < front):
+        return front
+    u, v = camera.project(at[None, :])[0]
+    uu, vv = np.array([u]), np.array([v])
+    seen = float(occlusion.depth_at(uu, vv)[0])
+    # something seen in front of the sphere's front there (a leaf, under the fruit's mask or beside it), or a pixel
+    # the map hides with nothing seen behind that front (what was seen there behind it would be the fruit)
+    if seen < z or (bool(occlusion.at(uu, vv)[0]) and not seen > z):
+        return z
+    return front
+
+
 def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
     """:func:`rim_coverage`'s rim width, pixels: ``band`` equivalent radii of the region ``mask``, at least 2."""
     return max(2.0, band * float(np.sqrt(np.count_nonzero(mask) / np.pi)))  # the count: the sum's, 20x faster
@@ -579,6 +614,10 @@ def evidence(
     apex, _ = apex_depth(sample)
     lo, hi = bounds(points)  # one compiled pass where numba is (the columns' least and greatest values)
     front = max(float(lo[2]), apex)
+    across = across_sight(region, camera)
+    sized = across if trimmed is None else across_sight(trimmed, camera)
+    if occlusion is not None and s.hidden_front == "sphere" and obs.contour < 1.0:
+        front = hidden_front(sample, front, sized.major / float(sized.axis[2]), occlusion, camera)
     shapes: tuple[str, ...] = SHAPES
     explained: float | None = None
     clean = 0.0
@@ -597,7 +636,6 @@ def evidence(
     else:
         ratio, noise = noise_measures(sample, queries=s.noise_queries)
         clean = clean_share(ratio, s.clean_ratio)
-    across = across_sight(region, camera)
     cands = candidates(
         points, sample=sample, obs=obs, camera=camera, front=front,
         width=across.major * front / float(across.axis[2]) if occlusion is not None else 0.0,
@@ -609,7 +647,6 @@ def evidence(
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
     seen_back = float(hi[2])
-    sized = across if trimmed is None else across_sight(trimmed, camera)
     tilt = None
     if s.prior_tilt != "off" and dense and obs.contour >= s.covered_contour:
         # the points' own outline: the mask's may be shifted from the depth (registration) or reach past it
