@@ -436,17 +436,19 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
     return big * (small / big) ** (0.5 * (1.0 - cut))
 
 
-def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occlusion, camera: Camera) -> float:
+def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occlusion, camera: Camera,
+                 points: np.ndarray | None = None) -> float:  # fmt: skip
     """The shared front where a leaf may hide the fruit's nearest part (``hidden_front``, stop 46): metres.
 
     The nearest seen point of a fruit whose front lies behind a leaf is on the seen part's edge, behind the
     fruit's front (docs/hidden45.md: the mostly hidden apples' boxes' fronts 7 mm behind the truth's, 3 of them
-    the hidden front). The sphere as wide as the silhouette (``width``, tangent units: the prior's width over the
+    the hidden front). The sphere as wide as the silhouette (``width``, tangent units: its larger width over the
     distance, read at the sphere's centre) that best fits the seen points (:func:`~symfruit.core.front.sphere_front`)
-    places the front instead, when that front lies in front of ``front`` at a pixel where the camera could not have
-    seen it: something was seen in front of it there (a leaf, under the fruit's mask or beside it), or the
-    occlusion map hides the pixel (the image ends there) and nothing was seen behind it; otherwise ``front``
-    stands.
+    places the front instead, when that front lies in front of ``front`` at a pixel where the camera could not
+    have seen it: the occlusion map hides the pixel (something nearer was seen there, or the image ends) and
+    nothing was seen there behind the sphere's front, or the pixel is the fruit's own (its mask) but holds none of
+    its seen points (``points``, default ``sample``) within twice their spacing in the mask (a leaf under the mask,
+    its depth dropped by extraction). Otherwise ``front`` stands.
     """
     if width <= 0.0 or len(sample) < 4:
         return front
@@ -457,12 +459,17 @@ def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occl
         return front
     u, v = camera.project(at[None, :])[0]
     uu, vv = np.array([u]), np.array([v])
-    seen = float(occlusion.depth_at(uu, vv)[0])
-    # something seen in front of the sphere's front there (a leaf, under the fruit's mask or beside it), or a pixel
-    # the map hides with nothing seen behind that front (what was seen there behind it would be the fruit)
-    if seen < z or (bool(occlusion.at(uu, vv)[0]) and not seen > z):
-        return z
-    return front
+    if bool(occlusion.at(uu, vv)[0]):
+        return front if float(occlusion.depth_at(uu, vv)[0]) > z else z  # seen behind it there: the fruit would be
+    own = occlusion.own
+    col, row = int(np.rint(u)) - occlusion.u0, int(np.rint(v)) - occlusion.v0
+    if own is None or not (0 <= row < own.shape[0] and 0 <= col < own.shape[1]) or not own[row, col]:
+        return front
+    seen = sample if points is None else points
+    uv = camera.project(seen)
+    spacing = float(np.sqrt(np.count_nonzero(own) / len(seen)))  # pixels of the mask per seen point, along a side
+    gap = float(np.min((uv[:, 0] - u) ** 2 + (uv[:, 1] - v) ** 2))
+    return z if gap > (2.0 * max(spacing, 1.0)) ** 2 else front
 
 
 def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
@@ -617,7 +624,7 @@ def evidence(
     across = across_sight(region, camera)
     sized = across if trimmed is None else across_sight(trimmed, camera)
     if occlusion is not None and s.hidden_front == "sphere" and obs.contour < 1.0:
-        front = hidden_front(sample, front, sized.major / float(sized.axis[2]), occlusion, camera)
+        front = hidden_front(sample, front, sized.major / float(sized.axis[2]), occlusion, camera, points)
     shapes: tuple[str, ...] = SHAPES
     explained: float | None = None
     clean = 0.0
