@@ -134,10 +134,11 @@ class EvidenceSettings(Section):
         boxes"). Not the default: on an elongated fruit the larger width is its length, and through the D435
         model the real scans (a banana and a pear) fell from 0.634 / 14.3 mm to 0.607 / 16.9 with it.
     hidden_front : {"sphere", "off"}
-        With occlusion information, where the outline is cut and the front of the sphere as wide as the prior's
-        width that best fits the seen points lies in front of the seen front at a pixel the occlusion map hides,
-        that sphere's front is the shared front (:func:`hidden_front`: a leaf over the fruit's nearest part, stop
-        46, docs/apex46.md); ``off``: the seen front (``max(nearest seen depth, apex_depth)``) always.
+        With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
+        larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
+        could not have seen it (hidden, or in the mask without seen points), that sphere's front is the shared
+        front (:func:`hidden_front`: a leaf over the fruit's nearest part, stop 46, docs/apex46.md: the dev trees'
+        mostly hidden apples 7.78 -> 6.64 mm); ``off``: the seen front (``max(nearest seen depth, apex_depth)``).
     prior_tilt, tilt_floor : {"off", "cap", "prolate"}, float
         In a depth camera's view of a whole outline (at least ``covered_contour`` of it a contour), the prior's width
         from the tilt of the fruit's axis out of the image plane instead of the geometric mean
