@@ -7,7 +7,8 @@ completion is right for every fruit, and the view itself says which ones fit. Th
 
 1. estimates the front depth from a quadric fitted around the nearest part of the surface
    (:func:`~symfruit.core.front.apex_depth`; the noisy minimum of a D435's depths sits 3-4 mm in front of
-   the fruit), shared by every candidate;
+   the fruit), shared by every candidate; where a leaf hides the fruit's nearest part, the front of the sphere
+   as wide as the outline through the seen points instead (:func:`hidden_front`);
 2. fits the candidates of :mod:`symfruit.core.candidates`: a sphere, a general (Li-Griffiths) ellipsoid,
    the ellipsoid whose outline is the silhouette (``cone``: five of its nine degrees of freedom come from
    the silhouette, which a depth camera measures far better than depth), a solid of revolution,
