@@ -589,3 +589,27 @@ def test_the_tilts_outer_outline_is_the_mask_without_its_overshoot():
     assert _tilt_outer(Occlusion(3, 4, np.zeros_like(own), 640, 480), "mask") is None
     s = EvidenceSettings()
     assert (s.prior_tilt, s.tilt_outline, s.tilt_blocks) == ("off", "points", 0)
+
+
+def test_a_front_hidden_behind_a_leaf_is_placed_by_the_sphere_through_the_seen_cap():
+    """A leaf hides a 70 mm ball's lower two thirds, its nearest part among them (stop 46, ``hidden_front``): the
+    nearest seen point lies 4.7 mm behind the ball's front, and so did the box's front; the sphere as wide as the
+    outline through the seen cap puts it within 3 mm, in front of every seen point. A ball seen whole keeps its
+    front."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    off = Settings().replace(evidence={"hidden_front": "off"})
+    visible, depth, mask, _ = occluded_view(ball_mesh(), [0.0, 0.03, 0.45], below=255, occluder_z=0.38, noise=0.005,
+                                            seed=1)  # fmt: skip
+    occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
+    truth = 0.45 - 0.035
+    on_front = complete(visible, occlusion=occ).box.min[2]
+    off_front = complete(visible, occlusion=occ, settings=off).box.min[2]
+    assert off_front > truth + 0.005
+    assert on_front < visible[:, 2].min() and abs(on_front - truth) < 0.003
+    visible, depth, mask, _ = occluded_view(ball_mesh(), [0.0, 0.0, 0.45], below=400, occluder_z=0.38, noise=0.005,
+                                            seed=1)  # fmt: skip
+    occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
+    assert complete(visible, occlusion=occ).box.min[2] == complete(visible, occlusion=occ, settings=off).box.min[2]

@@ -9,12 +9,13 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..errors import InputError
 from . import lapack
 from .fits import eigenvalues2, solve2
 from .kernels import compiled
 from .points import as_points, column_means, squared_norms
 
-__all__ = ["apex_depth"]
+__all__ = ["apex_depth", "sphere_front"]
 
 
 def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12) -> tuple[float, np.ndarray]:
@@ -88,3 +89,57 @@ def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12)
             if zv < best_z:
                 best_z, best_xy = zv, v
     return best_z, np.concatenate((best_xy + seed, [best_z]))
+
+
+def sphere_front(points: np.ndarray, radius: float, *, iterations: int = 20,
+                 tolerance: float = 1e-7) -> tuple[float, np.ndarray]:  # fmt: skip
+    """The front of the sphere of ``radius`` that best fits the points: ``(z_min, apex (3,))``, metres.
+
+    Where a leaf hides the nearest part of a fruit, the nearest seen point lies on the seen part's edge, behind
+    the fruit's front; the seen part's curvature and the silhouette's width still place the fruit (stop 46,
+    docs/apex46.md). The centre ``c`` minimises ``sum (|p - c| - radius)^2`` (Gauss-Newton from ``radius`` behind
+    the points' centroid, at most ``iterations`` steps, until a step moves less than ``tolerance`` metres);
+    ``z_min = c_z - radius``, the apex ``c - (0, 0, radius)``.
+
+    Parameters
+    ----------
+    points : (n, 3) float, metres, camera frame, n >= 4
+    radius : float, metres, > 0
+    iterations : int
+    tolerance : float, metres
+
+    Returns
+    -------
+    z_min : float, metres
+    apex : (3,) float, metres
+
+    Raises
+    ------
+    InputError
+        On fewer than 4 points, a wrong shape or a radius not above 0.
+
+    >>> t = np.linspace(0.0, 2.0 * np.pi, 40, endpoint=False)
+    >>> ring = np.stack((0.03 * np.cos(t), 0.03 * np.sin(t), np.full(40, 0.54)), axis=1)  # 30 mm off the axis
+    >>> z, apex = sphere_front(ring, 0.05)  # the ring lies 40 mm in front of the centre, the front 50
+    >>> round(z, 6), round(float(np.hypot(apex[0], apex[1])), 6)
+    (0.53, 0.0)
+    """
+    p = as_points(points, min_count=4)
+    r = float(radius)
+    if not r > 0.0:
+        raise InputError(f"sphere_front needs a radius above 0, got {radius!r}")
+    c = column_means(p)
+    c[2] += r
+    jac = np.empty((len(p), 3))
+    for _ in range(iterations):
+        diff = p - c
+        dist = np.maximum(np.sqrt(squared_norms(diff)), 1e-12)
+        np.divide(diff, -dist[:, None], out=jac)
+        try:
+            step = np.linalg.solve(jac.T @ jac, -(jac.T @ (dist - r)))
+        except np.linalg.LinAlgError:
+            step, *_ = np.linalg.lstsq(jac, -(dist - r), rcond=None)
+        c = c + step
+        if np.abs(step).max() < tolerance:
+            break
+    return float(c[2] - r), np.array([c[0], c[1], c[2] - r])
