@@ -1003,7 +1003,11 @@ def _merge(
     pixels in it that are neither piece (a stem, a leaf or the calyx lying across the fruit), exceeds
     their own hulls by at most ``merge_slack``; with depth, the smaller piece's points must also lie on
     the sphere of the larger (:func:`_same_surface`). Parts cut from one region (the same ``source``)
-    were kept apart on purpose and are not joined again."""
+    were kept apart on purpose and are not joined again, except with ``round_fruit`` (stop 46): there a
+    camera's softness and 4:2:0 chroma join the red on both sides of a thin leaf or twig across one apple into
+    one region that the split cuts at the leaf (its cut sees neither the leaf's green nor the one sphere), and the
+    merge's own tests (the green discounted, :func:`_two_extents`, the one sphere) decide, as they do for the
+    pieces of two regions."""
     slack = s.merge_slack
     pieces = sorted(pieces, key=lambda p: -p.area)
     for k, piece in enumerate(pieces):
@@ -1018,7 +1022,7 @@ def _merge(
         for i in range(len(pieces)):
             for j in near(i):
                 a, b = pieces[i], pieces[j]
-                if (a.source & b.source) or (a.serial, b.serial) in apart:
+                if (a.source & b.source and not s.round_fruit) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
                 vertices = _hull_vertices(union)
@@ -1726,7 +1730,8 @@ def _round_skin(
     k: int,
 ) -> tuple[Window, np.ndarray]:
     """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
-    within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
+    within :data:`ROUND_REACH` times the part's own radius of its centre, or the largest fruit's diameter
+    (``round_max_diameter`` at the part's median depth) where that is farther (stop 46), reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
     ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
     (``owner``, whole image: red pixels of piece ``k`` or of none). The growth starts from the part's pixels
@@ -1751,12 +1756,14 @@ def _round_skin(
         rows, cols = np.nonzero(hull)
         rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
         own = float(np.sqrt(hull.sum() / np.pi))
-    reach = ROUND_REACH * own
+    zm = float(median(z_part))
+    # the skin lies within the fruit's diameter of any of its pixels: at least the largest fruit's at the part's depth
+    # (stop 46; a blush cut to a thin crescent by shadow and the camera's 4:2:0 chroma is small against its apple)
+    reach = max(ROUND_REACH * own, s.round_max_diameter * geo.focal / zm)
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
     z = depth[big]
-    zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
