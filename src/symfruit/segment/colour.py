@@ -1757,9 +1757,7 @@ def _round_skin(
         rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
         own = float(np.sqrt(hull.sum() / np.pi))
     zm = float(median(z_part))
-    # the skin lies within the fruit's diameter of any of its pixels: at least the largest fruit's at the part's depth
-    # (stop 46; a blush cut to a thin crescent by shadow and the camera's 4:2:0 chroma is small against its apple)
-    reach = max(ROUND_REACH * own, s.round_max_diameter * geo.focal / zm)
+    reach = ROUND_REACH * own
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
@@ -1788,9 +1786,67 @@ def _round_skin(
         reached[lab[seeds]] = True
         reached[0] = False
         skin = reached[lab] | part
+    far = s.round_max_diameter * geo.focal / zm
+    if far > reach and _at_reach(skin, big, rc, cc, reach):
+        big, z, skin = _wider_skin(sl, hull, depth, color, geo, s, owner, k, (rc, cc, far, deep_limit, zm))
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
+
+
+def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float) -> bool:
+    """Whether :func:`_round_skin`'s skin (in window ``big``) may have been stopped by its reach: a pixel of it on the
+    window's edge, or with a neighbour outside the disc of radius ``reach`` about ``(rc, cc)``. When not, a wider
+    reach grows the same skin (every pixel next to it lies inside both discs and windows, and is refused there by
+    the same tests or by a depth step the wider window only adds to)."""
+    rows, cols = np.nonzero(skin)
+    if len(rows) == 0:
+        return False
+    if rows[0] == 0 or rows[-1] == skin.shape[0] - 1 or cols.min() == 0 or cols.max() == skin.shape[1] - 1:
+        return True
+    dy, dx = rows + (big[0].start - rc), cols + (big[1].start - cc)
+    return bool((dy * dy + dx * dx > (reach - 1.0) ** 2).any())
+
+
+def _wider_skin(
+    sl: Window,
+    hull: np.ndarray,
+    depth: _Depth,
+    color: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+    grow: tuple[float, float, float, float, float],
+) -> tuple[Window, np.ndarray, np.ndarray]:
+    """:func:`_round_skin`'s growth again, out to the largest fruit's diameter at the part's depth (``grow``: the
+    part's centre row and column, that reach in pixels, the depth limit and the median depth), where its own reach
+    (:data:`ROUND_REACH` times the part's radius) stopped it (stop 46): the skin lies within the fruit's diameter
+    of any of its pixels, and a blush cut to a thin crescent by a leaf's shadow and the camera's 4:2:0 chroma is
+    small against its apple. The window, its depth and the skin."""
+    rc, cc, reach, deep_limit, zm = grow
+    h, w = depth.shape
+    big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
+           slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
+    z = depth[big]
+    part = np.zeros(z.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    if (jit := compiled()) is not None:  # the same pixels as below (the kernel and twin of :func:`_round_skin`)
+        skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
+                              float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
+                              LEAF_HUE)  # fmt: skip
+        return big, z, skin
+    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
+    free = (owner[big] == 0) | (owner[big] == k)
+    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+    candidate = near & (z > 0) & (np.abs(z - zm) <= deep_limit) & ~_leaf(color[big]) & free
+    allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
+    lab, n = ndimage.label(allowed)
+    reached = np.zeros(n + 1, bool)
+    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
+    reached[0] = False
+    return big, z, reached[lab] | part
 
 
 def _blush_rim(
