@@ -1382,3 +1382,19 @@ def test_a_thin_blush_grows_over_the_whole_apple_with_depth():
     assert labels.max() == 1
     found = labels == 1
     assert (found & disc).sum() > 0.9 * disc.sum() and (found & ~disc).sum() < 0.02 * disc.sum()
+
+
+def test_a_skin_is_at_its_reach_where_it_meets_the_disc_or_the_window_edge():
+    """_at_reach: a skin well inside its reach and window is not (a wider reach grows the same skin); one with a
+    pixel next to the disc's outline or on the window's edge is."""
+    from symfruit.segment.colour import _at_reach
+
+    yy, xx = np.mgrid[:60, :60]
+    big = (slice(100, 160), slice(200, 260))
+    inside = (yy - 30) ** 2 + (xx - 30) ** 2 <= 10**2
+    assert not _at_reach(inside, big, 130.0, 230.0, 20.0)
+    assert _at_reach(inside, big, 130.0, 230.0, 10.5)  # its rim 10 px out: a neighbour past the disc of 10.5
+    edge = inside.copy()
+    edge[30, 0] = True
+    assert _at_reach(edge, big, 130.0, 230.0, 100.0)
+    assert not _at_reach(np.zeros((60, 60), bool), big, 130.0, 230.0, 20.0)
