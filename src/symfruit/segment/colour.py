@@ -1799,13 +1799,20 @@ def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float)
     window's edge, or with a neighbour outside the disc of radius ``reach`` about ``(rc, cc)``. When not, a wider
     reach grows the same skin (every pixel next to it lies inside both discs and windows, and is refused there by
     the same tests or by a depth step the wider window only adds to)."""
-    rows, cols = np.nonzero(skin)
-    if len(rows) == 0:
+    box = mask_box(skin)
+    if box is None:
         return False
-    if rows[0] == 0 or rows[-1] == skin.shape[0] - 1 or cols.min() == 0 or cols.max() == skin.shape[1] - 1:
+    r0, r1, c0, c1 = box
+    if r0 == 0 or c0 == 0 or r1 == skin.shape[0] or c1 == skin.shape[1]:
         return True
-    dy, dx = rows + (big[0].start - rc), cols + (big[1].start - cc)
-    return bool((dy * dy + dx * dx > (reach - 1.0) ** 2).any())
+    # the box's farthest corner inside the disc: every pixel is (two reductions, not every pixel's coordinates)
+    dy = max(abs(r0 + big[0].start - rc), abs(r1 - 1 + big[0].start - rc))
+    dx = max(abs(c0 + big[1].start - cc), abs(c1 - 1 + big[1].start - cc))
+    if dy * dy + dx * dx <= (reach - 1.0) ** 2:
+        return False
+    rows, cols = np.nonzero(skin[r0:r1, c0:c1])
+    dr, dc = rows + (r0 + big[0].start - rc), cols + (c0 + big[1].start - cc)
+    return bool((dr * dr + dc * dc > (reach - 1.0) ** 2).any())
 
 
 def _wider_skin(
