@@ -1348,3 +1348,53 @@ def test_segment_refuses_a_camera_of_text_or_booleans_for_numbers(bad):
     with pytest.raises(InputError, match="segment: camera must be a Camera with numbers fx, fy"):
         segment(color, depth, SimpleNamespace(**bad))
     assert segment(color, depth, SimpleNamespace(fx=600.0, fy=600.0)).max() == 1
+
+
+# --- stop 46, segrecall46
+
+
+def test_an_apple_cut_by_a_leaf_whose_soft_edge_joins_its_red_is_one_fruit():
+    """A leaf 5 px wide 5 cm in front of an apple, its edge softened to a weakly red bridge of 1-7 px
+    (a camera's blur and 4:2:0 chroma): the red of both sides is one region, which the split cuts at the leaf;
+    with ``round_fruit`` the merge joins the two pieces of one sphere again (before stop 46: two fruit)."""
+    yy, xx = np.mgrid[:1080, :1920]
+    for bridge in (0, 1, 3):
+        color, depth = hd_disc_frame([(900, 540)], radius=30)
+        apple = (color == RED).all(axis=2)
+        band = (np.abs(yy - 540) <= 2) & (np.abs(xx - 900) <= 45)
+        color[band], depth[band] = (60, 120, 50), 1.40
+        color[band & (np.abs(xx - 900) <= bridge)] = (150, 110, 90)  # redness 0.27: weakly red, no seed
+        labels = segment(color, depth, HD_CAM, APPLE)
+        assert labels.max() == 1, bridge
+        assert (labels[apple & ~band] == 1).all(), bridge
+
+
+def test_a_thin_blush_grows_over_the_whole_apple_with_depth():
+    """A blush a crescent 8 px wide along the rim of an apple 60 px across, the rest yellow-green: the skin grows
+    from the red part up to the largest fruit's diameter at its depth, not twice the crescent's own radius (about
+    15 px: a third of the apple, before stop 46); the leaves behind (10 cm back) are not taken."""
+    color, depth = hd_disc_frame([(900, 540)], radius=30)
+    disc = (color == RED).all(axis=2)
+    xx = np.mgrid[:1080, :1920][1]
+    shaded(color, disc & (xx > 878), YELLOW_GREEN, depth, 1.5)
+    s = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    labels = segment(color, depth, HD_CAM, s)  # no ground_colour: the skin is grown from the red part alone
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.9 * disc.sum() and (found & ~disc).sum() < 0.02 * disc.sum()
+
+
+def test_a_skin_is_at_its_reach_where_it_meets_the_disc_or_the_window_edge():
+    """_at_reach: a skin well inside its reach and window is not (a wider reach grows the same skin); one with a
+    pixel next to the disc's outline or on the window's edge is."""
+    from symfruit.segment.colour import _at_reach
+
+    yy, xx = np.mgrid[:60, :60]
+    big = (slice(100, 160), slice(200, 260))
+    inside = (yy - 30) ** 2 + (xx - 30) ** 2 <= 10**2
+    assert not _at_reach(inside, big, 130.0, 230.0, 20.0)
+    assert _at_reach(inside, big, 130.0, 230.0, 10.5)  # its rim 10 px out: a neighbour past the disc of 10.5
+    edge = inside.copy()
+    edge[30, 0] = True
+    assert _at_reach(edge, big, 130.0, 230.0, 100.0)
+    assert not _at_reach(np.zeros((60, 60), bool), big, 130.0, 230.0, 20.0)

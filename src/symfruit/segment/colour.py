@@ -1003,7 +1003,11 @@ def _merge(
     pixels in it that are neither piece (a stem, a leaf or the calyx lying across the fruit), exceeds
     their own hulls by at most ``merge_slack``; with depth, the smaller piece's points must also lie on
     the sphere of the larger (:func:`_same_surface`). Parts cut from one region (the same ``source``)
-    were kept apart on purpose and are not joined again."""
+    were kept apart on purpose and are not joined again, except with ``round_fruit`` (stop 46): there a
+    camera's softness and 4:2:0 chroma join the red on both sides of a thin leaf or twig across one apple into
+    one region that the split cuts at the leaf (its cut sees neither the leaf's green nor the one sphere), and the
+    merge's own tests (the green discounted, :func:`_two_extents`, the one sphere) decide, as they do for the
+    pieces of two regions."""
     slack = s.merge_slack
     pieces = sorted(pieces, key=lambda p: -p.area)
     for k, piece in enumerate(pieces):
@@ -1018,7 +1022,7 @@ def _merge(
         for i in range(len(pieces)):
             for j in near(i):
                 a, b = pieces[i], pieces[j]
-                if (a.source & b.source) or (a.serial, b.serial) in apart:
+                if (a.source & b.source and not s.round_fruit) or (a.serial, b.serial) in apart:
                     continue
                 window, union = _union(a, b)
                 vertices = _hull_vertices(union)
@@ -1726,7 +1730,8 @@ def _round_skin(
     k: int,
 ) -> tuple[Window, np.ndarray]:
     """The rest of a round fruit's visible skin around its red part (``hull`` in window ``sl``): the pixels
-    within :data:`ROUND_REACH` times the part's own radius of its centre that are reached from it without
+    within :data:`ROUND_REACH` times the part's own radius of its centre, or the largest fruit's diameter
+    (``round_max_diameter`` at the part's median depth) where that is farther (stop 46), reached from it without
     crossing a depth step (half ``depth_jump`` between neighbours), lie within the part's radius plus
     ``depth_jump`` of its median depth, and are neither leaf green (:func:`_leaf`) nor another fruit's
     (``owner``, whole image: red pixels of piece ``k`` or of none). The growth starts from the part's pixels
@@ -1751,12 +1756,12 @@ def _round_skin(
         rows, cols = np.nonzero(hull)
         rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
         own = float(np.sqrt(hull.sum() / np.pi))
+    zm = float(median(z_part))
     reach = ROUND_REACH * own
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
     z = depth[big]
-    zm = float(median(z_part))
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
@@ -1781,9 +1786,74 @@ def _round_skin(
         reached[lab[seeds]] = True
         reached[0] = False
         skin = reached[lab] | part
+    far = s.round_max_diameter * geo.focal / zm
+    if far > reach and _at_reach(skin, big, rc, cc, reach):
+        big, z, skin = _wider_skin(sl, hull, depth, color, geo, s, owner, k, (rc, cc, far, deep_limit, zm))
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
+
+
+def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float) -> bool:
+    """Whether :func:`_round_skin`'s skin (in window ``big``) may have been stopped by its reach: a pixel of it on the
+    window's edge, or with a neighbour outside the disc of radius ``reach`` about ``(rc, cc)``. When not, a wider
+    reach grows the same skin (every pixel next to it lies inside both discs and windows, and is refused there by
+    the same tests or by a depth step the wider window only adds to)."""
+    box = mask_box(skin)
+    if box is None:
+        return False
+    r0, r1, c0, c1 = box
+    if r0 == 0 or c0 == 0 or r1 == skin.shape[0] or c1 == skin.shape[1]:
+        return True
+    # the box's farthest corner inside the disc: every pixel is (two reductions, not every pixel's coordinates)
+    dy = max(abs(r0 + big[0].start - rc), abs(r1 - 1 + big[0].start - rc))
+    dx = max(abs(c0 + big[1].start - cc), abs(c1 - 1 + big[1].start - cc))
+    if dy * dy + dx * dx <= (reach - 1.0) ** 2:
+        return False
+    rows, cols = np.nonzero(skin[r0:r1, c0:c1])
+    dr, dc = rows + (r0 + big[0].start - rc), cols + (c0 + big[1].start - cc)
+    return bool((dr * dr + dc * dc > (reach - 1.0) ** 2).any())
+
+
+def _wider_skin(
+    sl: Window,
+    hull: np.ndarray,
+    depth: _Depth,
+    color: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+    grow: tuple[float, float, float, float, float],
+) -> tuple[Window, np.ndarray, np.ndarray]:
+    """:func:`_round_skin`'s growth again, out to the largest fruit's diameter at the part's depth (``grow``: the
+    part's centre row and column, that reach in pixels, the depth limit and the median depth), where its own reach
+    (:data:`ROUND_REACH` times the part's radius) stopped it (stop 46): the skin lies within the fruit's diameter
+    of any of its pixels, and a blush cut to a thin crescent by a leaf's shadow and the camera's 4:2:0 chroma is
+    small against its apple. The window, its depth and the skin."""
+    rc, cc, reach, deep_limit, zm = grow
+    h, w = depth.shape
+    big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
+           slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
+    z = depth[big]
+    part = np.zeros(z.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    if (jit := compiled()) is not None:  # the same pixels as below (the kernel and twin of :func:`_round_skin`)
+        skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
+                              float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
+                              LEAF_HUE)  # fmt: skip
+        return big, z, skin
+    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
+    free = (owner[big] == 0) | (owner[big] == k)
+    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
+    candidate = near & (z > 0) & (np.abs(z - zm) <= deep_limit) & ~_leaf(color[big]) & free
+    allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
+    lab, n = ndimage.label(allowed)
+    reached = np.zeros(n + 1, bool)
+    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
+    reached[0] = False
+    return big, z, reached[lab] | part
 
 
 def _blush_rim(
