@@ -1191,3 +1191,26 @@ def test_a_fruit_whose_own_surface_ends_inside_its_mask_is_not_passed_over():
         assert _behind_crossing(depth, mask, F, 0.5, 0.0167, 0.0035, depth_noise(depth, mask)) is None
         found = fruit_surface(depth, mask, F, thin=True, crossing=True)
         assert found is not None and found.front == pytest.approx(0.5, abs=0.003)
+
+
+def test_the_least_curvature_of_a_ball_is_its_inverse_radius_and_a_branch_s_nothing():
+    """:func:`_least_curvature`: the lesser principal curvature of the inverse-depth fit, 1 / R on a ball's cap (in
+    every direction, as a fruit's), 0 along a branch (a cylinder of the same radius, whose mean curvature is half a
+    ball's) and on a tilted plane: what tells a fruit's own front joined to a leaf from a branch across its mask."""
+    from symfruit.core.surface import _least_curvature
+
+    yy, xx = np.mgrid[:60, :60].astype(np.float64)
+    z0, r = 0.5, 0.03
+    x, y = (xx - 30) * z0 / F, (yy - 30) * z0 / F
+    cap = x**2 + y**2 < (0.8 * r) ** 2
+    rows, cols = np.nonzero(cap)
+    ball_z = z0 + r - np.sqrt(r**2 - x[cap] ** 2 - y[cap] ** 2)
+    assert _least_curvature(rows, cols, ball_z, F) * r == pytest.approx(1.0, abs=0.25)
+    band = np.abs(x) < 0.8 * r
+    rows, cols = np.nonzero(band)
+    branch_z = z0 + r - np.sqrt(r**2 - x[band] ** 2)
+    assert abs(_least_curvature(rows, cols, branch_z, F) * r) < 0.05
+    assert _mean_curvature(rows, cols, branch_z, F)[0] * r == pytest.approx(0.5, abs=0.15)
+    plane_z = 1.0 / (1.0 / z0 + 0.2 * x[band] - 0.1 * y[band])
+    assert abs(_least_curvature(rows, cols, plane_z, F) * r) < 0.01
+    assert np.isnan(_least_curvature(rows[:20], cols[:20], plane_z[:20], F))

@@ -558,8 +558,9 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
         own = parts == k
         if cross[k] <= 0.1 * cross[sheet] and ndimage.binary_dilation(passed, iterations=reach)[own].any():
             behind, _ = fruit_depth(d[own & m], float(np.sqrt(m.sum() / np.pi)), focal, noise=noise)
-            # a separate layer: beyond the fruit's own surface, which lies within about a radius of its nearest point
-            return behind if np.isfinite(behind) and behind > front + radius else None
+            # a separate layer: the occluder lies in front of the whole fruit, more than a fruit's depth (about its
+            # width, two radii) before what it hides; nearer, the part behind may be the fruit's own far side
+            return behind if np.isfinite(behind) and behind > front + 2.0 * radius else None
         if cross[k] >= CROSSING * outline:
             passed |= own  # an occluder behind the first, running on across the outline too
     return None
