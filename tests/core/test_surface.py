@@ -1143,15 +1143,15 @@ def test_behind_a_sheet_told_flat_a_part_too_noisy_to_fit_is_the_fruit():
     assert float(np.median(points[:, 2])) > near + 0.005
 
 
-def leaf_across(radius_px=30, *, leaf_front=0.40, noise=0.0005, seed=0):
+def leaf_across(radius_px=30, *, leaf_front=0.40, leaf_x=60, noise=0.0005, seed=0):
     """``(depth, mask, leaf)``: :func:`ball` (front 0.5 m, 30 px, the outer tenth of its radius without depth as a
     time-of-flight camera loses it) under a flat leaf 10 cm in front of it, a disc of 42 px at (60, 60) that hides
     all of the ball but a crescent on its right (about 150 pixels with depth) and runs on beyond the mask on the left;
     the mask the ball's whole outline grown by 2 px (an annotator's, drawn over the leaf)."""
     depth, disc = ball(radius_px=radius_px, rim=0.1)
     yy, xx = np.mgrid[:H, :W]
-    leaf = (xx - 60) ** 2 + (yy - 60) ** 2 <= 42**2
-    depth = sheet(depth, leaf, leaf_front, slope=(0.1, -0.05), centre=(60, 60))
+    leaf = (xx - leaf_x) ** 2 + (yy - 60) ** 2 <= 42**2
+    depth = sheet(depth, leaf, leaf_front, slope=(0.1, -0.05), centre=(leaf_x, 60))
     depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape) * (depth > 0)
     return depth, grown(disc, 2), leaf
 
@@ -1214,3 +1214,21 @@ def test_the_least_curvature_of_a_ball_is_its_inverse_radius_and_a_branch_s_noth
     plane_z = 1.0 / (1.0 / z0 + 0.2 * x[band] - 0.1 * y[band])
     assert abs(_least_curvature(rows, cols, plane_z, F) * r) < 0.01
     assert np.isnan(_least_curvature(rows[:20], cols[:20], plane_z[:20], F))
+
+
+def test_a_second_leaf_ending_inside_the_mask_is_passed_over_too():
+    """:func:`leaf_across` (the leaf 5 px further left: a crescent of about 500 pixels) with a second flat leaf 6 cm
+    behind the first and 4.5 cm in front of the ball, over the top of the crescent and ending inside the mask (the
+    development tree seed 6's apple 30 under three leaves, the third within its mask): it does not cross the outline,
+    but told flat it is a leaf, not the fruit, and the crescent behind it is taken (without the flatness test, the
+    second leaf's front, 0.46 m)."""
+    yy, xx = np.mgrid[:H, :W]
+    for seed in range(3):
+        depth, mask, leaf = leaf_across(leaf_x=55, seed=seed)
+        small = ((xx - 104) ** 2 + (yy - 42) ** 2 <= 13**2) & ~leaf & mask
+        depth = np.where(small, sheet(depth, small, 0.46, slope=(0.1, 0.0), centre=(104, 42)), depth)
+        depth = depth + np.random.default_rng(seed + 10).normal(scale=0.0005, size=depth.shape) * small
+        assert small.sum() >= 150
+        found = fruit_surface(depth, mask, F, thin=True, crossing=True)
+        assert found is not None and 0.50 < found.front < 0.515, seed
+        assert (found.pixels & (leaf | small)).sum() == 0

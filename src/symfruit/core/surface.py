@@ -514,8 +514,12 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
     nearest surface (the smooth part, :func:`_smooth_parts` on the depth in and around the mask, holding the depth
     mode's front) is passed over when it runs on across the outline along at least :data:`CROSSING` of it; the fruit
     is then the nearest part behind it, in the mask with at least 10 pixels, that does not run on across the outline
-    (at most a tenth of its own crossing pixel pairs the front's) and that touches a part passed over (what an
-    occluder hides is bounded by its edge). Its front is :func:`fruit_depth`'s of its own depths."""
+    (at most a tenth of the crossing pixel pairs the front's holds), that touches a part passed over (what an
+    occluder hides is bounded by its edge) and that is not told flat (:data:`THIN`, as :func:`thin_front` tells a
+    sheet: a leaf ending inside the mask is passed over too); its front, :func:`fruit_depth`'s of its own depths,
+    must lie more than two radii behind ``front`` (the occluder a separate layer in front of the whole fruit). A
+    nearest surface curved in every direction as a fruit's cap (its least principal curvature at least ``THIN[0] /
+    radius``) is the fruit's own front, joined to a surface at its depth that crosses: not passed over."""
     found = mask_box(mask)
     if found is None:
         return None
@@ -557,6 +561,12 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
             continue
         own = parts == k
         if cross[k] <= 0.1 * cross[sheet] and ndimage.binary_dilation(passed, iterations=reach)[own].any():
+            rows, cols = np.nonzero(own & m)
+            kappa, error = _mean_curvature(rows, cols, d[rows, cols], focal)
+            r_k = radius * z_k / front
+            if kappa * r_k < THIN[0] and (kappa + 2.0 * error) * r_k < THIN[0] + 0.2 and error * r_k <= THIN[2]:
+                passed |= own  # told flat as thin_front tells a sheet: a leaf ending inside the mask, not the fruit
+                continue
             behind, _ = fruit_depth(d[own & m], float(np.sqrt(m.sum() / np.pi)), focal, noise=noise)
             # a separate layer: the occluder lies in front of the whole fruit, more than a fruit's depth (about its
             # width, two radii) before what it hides; nearer, the part behind may be the fruit's own far side
