@@ -257,7 +257,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         focal = float(np.sqrt(camera.fx * camera.fy))
         surface = fruit_surface(z_valid, core, focal, slab=s.slab,
                                 tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
-                                leafy=leafy, thin=True)  # fmt: skip
+                                leafy=leafy, thin=True, crossing=True)  # fmt: skip
     if jit is not None:
         points = jit.pixel_points(usable, usable if surface is None else surface.pixels, z_all, float(camera.cx),
                                   float(camera.cy), float(camera.fx), float(camera.fy))  # fmt: skip

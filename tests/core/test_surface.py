@@ -1186,3 +1186,94 @@ def test_the_curvature_fits_sample_is_a_fresh_generators():
         mp.setattr(surface, "_seeded", lambda: np.random.default_rng(0))
         want = _mean_curvature(rows, cols, z, F)
     assert got == want and got[0] > 0
+
+
+def leaf_across(radius_px=30, *, leaf_front=0.40, leaf_x=60, noise=0.0005, seed=0):
+    """``(depth, mask, leaf)``: :func:`ball` (front 0.5 m, 30 px, the outer tenth of its radius without depth as a
+    time-of-flight camera loses it) under a flat leaf 10 cm in front of it, a disc of 42 px at (60, 60) that hides
+    all of the ball but a crescent on its right (about 150 pixels with depth) and runs on beyond the mask on the left;
+    the mask the ball's whole outline grown by 2 px (an annotator's, drawn over the leaf)."""
+    depth, disc = ball(radius_px=radius_px, rim=0.1)
+    yy, xx = np.mgrid[:H, :W]
+    leaf = (xx - leaf_x) ** 2 + (yy - 60) ** 2 <= 42**2
+    depth = sheet(depth, leaf, leaf_front, slope=(0.1, -0.05), centre=(leaf_x, 60))
+    depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape) * (depth > 0)
+    return depth, grown(disc, 2), leaf
+
+
+def test_behind_a_leaf_running_on_across_the_mask_s_outline_the_fruit_is_taken():
+    """The mask drawn over a leaf in front that hides all but a crescent of the fruit (stop 46, docs/overleaf46.md:
+    on the development trees the by-label apples 14-35 cm off): the crescent holds under a tenth of the leaf's pixels
+    in the mask, so neither the depth mode nor :func:`thin_front` looks behind the leaf, and the surface was the leaf's
+    (its front 0.40 m). The leaf runs on across the mask's outline; the fruit's own surface ends inside it: the part
+    behind that does not cross the outline is the fruit. Its front is the crescent's (about 0.508 m), no leaf pixel
+    kept."""
+    from symfruit.core.surface import _behind_crossing
+
+    for seed in range(3):
+        depth, mask, leaf = leaf_across(seed=seed)
+        crescent = mask & ~leaf & (depth > 0) & (depth < 0.6)
+        assert 100 <= crescent.sum() < 0.1 * (mask & leaf).sum()
+        found = fruit_surface(depth, mask, F, thin=True, crossing=True)
+        assert found is not None and 0.50 < found.front < 0.515, seed
+        assert (found.pixels & leaf).sum() == 0 and (found.pixels & crescent).sum() >= 0.8 * crescent.sum()
+        noise = depth_noise(depth, mask)
+        assert _behind_crossing(depth, mask, F, 0.40, 0.012, 0.003 + depth_step(depth, mask), noise) is not None
+
+
+def test_a_fruit_whose_own_surface_ends_inside_its_mask_is_not_passed_over():
+    """The fruit seen whole (its mask grown by 2 px over the wall), and with a leaf behind it that runs on across the
+    mask's outline at the ball's rim depth: the nearest surface is the ball's own and ends inside the outline, so
+    :func:`_behind_crossing` says None and the surface's front is the ball's pole."""
+    from symfruit.core.surface import _behind_crossing
+
+    yy, xx = np.mgrid[:H, :W]
+    for behind in (False, True):
+        depth, disc = ball(rim=0.1, noise=0.0005)
+        if behind:
+            depth = sheet(depth, ((xx - 40) ** 2 + (yy - 60) ** 2 <= 35**2) & ~disc, 0.52, slope=(0.0, 0.0))
+        mask = grown(disc, 2)
+        assert _behind_crossing(depth, mask, F, 0.5, 0.0167, 0.0035, depth_noise(depth, mask)) is None
+        found = fruit_surface(depth, mask, F, thin=True, crossing=True)
+        assert found is not None and found.front == pytest.approx(0.5, abs=0.003)
+
+
+def test_the_least_curvature_of_a_ball_is_its_inverse_radius_and_a_branch_s_nothing():
+    """:func:`_least_curvature`: the lesser principal curvature of the inverse-depth fit, 1 / R on a ball's cap (in
+    every direction, as a fruit's), 0 along a branch (a cylinder of the same radius, whose mean curvature is half a
+    ball's) and on a tilted plane: what tells a fruit's own front joined to a leaf from a branch across its mask."""
+    from symfruit.core.surface import _least_curvature
+
+    yy, xx = np.mgrid[:60, :60].astype(np.float64)
+    z0, r = 0.5, 0.03
+    x, y = (xx - 30) * z0 / F, (yy - 30) * z0 / F
+    cap = x**2 + y**2 < (0.8 * r) ** 2
+    rows, cols = np.nonzero(cap)
+    ball_z = z0 + r - np.sqrt(r**2 - x[cap] ** 2 - y[cap] ** 2)
+    assert _least_curvature(rows, cols, ball_z, F) * r == pytest.approx(1.0, abs=0.25)
+    band = np.abs(x) < 0.8 * r
+    rows, cols = np.nonzero(band)
+    branch_z = z0 + r - np.sqrt(r**2 - x[band] ** 2)
+    assert abs(_least_curvature(rows, cols, branch_z, F) * r) < 0.05
+    assert _mean_curvature(rows, cols, branch_z, F)[0] * r == pytest.approx(0.5, abs=0.15)
+    plane_z = 1.0 / (1.0 / z0 + 0.2 * x[band] - 0.1 * y[band])
+    assert abs(_least_curvature(rows, cols, plane_z, F) * r) < 0.01
+    assert np.isnan(_least_curvature(rows[:20], cols[:20], plane_z[:20], F))
+
+
+def test_a_second_leaf_ending_inside_the_mask_is_passed_over_too():
+    """:func:`leaf_across` (the leaf 5 px further left: a crescent of about 500 pixels) with a second flat leaf 6 cm
+    behind the first and 4.5 cm in front of the ball, over the top of the crescent and ending inside the mask (the
+    development tree seed 6's apple 30 under three leaves, the third within its mask): it does not cross the outline,
+    but told flat it is a leaf, not the fruit, and the crescent behind it is taken (without the flatness test, the
+    second leaf's front, 0.46 m)."""
+    yy, xx = np.mgrid[:H, :W]
+    for seed in range(3):
+        depth, mask, leaf = leaf_across(leaf_x=55, seed=seed)
+        small = ((xx - 104) ** 2 + (yy - 42) ** 2 <= 13**2) & ~leaf & mask
+        depth = np.where(small, sheet(depth, small, 0.46, slope=(0.1, 0.0), centre=(104, 42)), depth)
+        depth = depth + np.random.default_rng(seed + 10).normal(scale=0.0005, size=depth.shape) * small
+        assert small.sum() >= 150
+        found = fruit_surface(depth, mask, F, thin=True, crossing=True)
+        assert found is not None and 0.50 < found.front < 0.515, seed
+        assert (found.pixels & (leaf | small)).sum() == 0

@@ -488,6 +488,114 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     return None
 
 
+def _crossings(parts: np.ndarray, mask: np.ndarray, count: int) -> tuple[np.ndarray, int]:
+    """(count + 1,) int: for each part of ``parts`` (0 none, 1..``count``), how many pairs of 4-neighbours it holds
+    with one pixel in ``mask`` and the other outside it (its surface running on across the mask's outline); and the
+    mask's outline pixels (those with a 4-neighbour outside it, within the array)."""
+    cross = np.zeros(count + 1, np.int64)
+    edge = np.zeros(mask.shape, bool)
+    for a, b in ((np.s_[1:], np.s_[:-1]), (np.s_[:-1], np.s_[1:])):
+        for pa, pb in (((a, slice(None)), (b, slice(None))), ((slice(None), a), (slice(None), b))):
+            out = mask[pa] & ~mask[pb]
+            edge[pa] |= out
+            same = out & (parts[pa] == parts[pb]) & (parts[pa] > 0)
+            cross += np.bincount(parts[pa][same], minlength=count + 1)
+    return cross, int(np.count_nonzero(edge))
+
+
+def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
+                     noise: float) -> float | None:  # fmt: skip
+    """The front of the fruit behind an occluder its mask is drawn over, told by where surfaces end: None when the
+    mask's nearest surface is not such an occluder.
+
+    An annotator draws a fruit's mask round the fruit (a few pixels over its edge), so the fruit's own surface ends
+    inside the mask's outline: its rim, a step to what lies behind or a rim without depth. A leaf or branch in front
+    that the mask is drawn over is larger than what it hides of the fruit and runs on across the outline. The mask's
+    nearest surface (the smooth part, :func:`_smooth_parts` on the depth in and around the mask, holding the depth
+    mode's front) is passed over when it runs on across the outline along at least :data:`CROSSING` of it; the fruit
+    is then the nearest part behind it, in the mask with at least 10 pixels, that does not run on across the outline
+    (at most a tenth of the crossing pixel pairs the front's holds), that touches a part passed over (what an
+    occluder hides is bounded by its edge) and that is not told flat (:data:`THIN`, as :func:`thin_front` tells a
+    sheet: a leaf ending inside the mask is passed over too); its front, :func:`fruit_depth`'s of its own depths,
+    must lie more than two radii behind ``front`` (the occluder a separate layer in front of the whole fruit). A
+    nearest surface curved in every direction as a fruit's cap (its least principal curvature at least ``THIN[0] /
+    radius``) is the fruit's own front, joined to a surface at its depth that crosses: not passed over."""
+    found = mask_box(mask)
+    if found is None:
+        return None
+    r0, r1 = max(found[0] - 1, 0), min(found[1] + 1, mask.shape[0])
+    c0, c1 = max(found[2] - 1, 0), min(found[3] + 1, mask.shape[1])
+    d, m = depth[r0:r1, c0:c1], np.asarray(mask[r0:r1, c0:c1], dtype=bool)
+    rim = m & ~interior(m)
+    if np.count_nonzero(rim & (d > 0) & (d <= front + radius)) < CROSSING * np.count_nonzero(rim):
+        return None  # too little of the outline in front of the fruit's middle for a surface there to run on across
+    parts, count = _smooth_parts(d, d > 0, join)
+    if count < 2:
+        return None
+    cross, outline = _crossings(parts, m, count)
+    inside = np.bincount(parts[m], minlength=count + 1)
+    near = m & (parts > 0) & (np.abs(d - front) <= join)
+    if not near.any():
+        return None
+    sheet = int(np.argmax(np.bincount(parts[near], minlength=count + 1)))
+    if cross[sheet] < CROSSING * outline:
+        return None  # the nearest surface ends inside the outline: the fruit's own (the usual case, ended here)
+    # ... or it is the fruit's own front, joined to a surface at its depth that crosses (a leaf touching its rim): its
+    # part in the mask is then curved in every direction as a fruit's cap is, where a leaf is flat and a branch is
+    # curved across its length only
+    rows, cols = np.nonzero(m & (parts == sheet))
+    if _least_curvature(rows, cols, d[rows, cols], focal) * radius >= THIN[0]:
+        return None
+    ids = np.flatnonzero((inside >= 10) & (np.arange(count + 1) > 0))
+    if len(ids) < 2:
+        return None
+    inner = parts * m
+    medians = np.asarray(ndimage.median(d, inner, ids), dtype=np.float64)
+    order = np.argsort(medians, kind="stable")
+    sheet_depth = float(medians[int(np.flatnonzero(ids == sheet)[0])]) if sheet in ids else front
+    passed = parts == sheet
+    reach = 3 + int(np.ceil(0.3 * np.sqrt(m.sum() / np.pi)))
+    for j in order:
+        k, z_k = int(ids[j]), float(medians[j])
+        if k == sheet or z_k <= sheet_depth + join:
+            continue
+        own = parts == k
+        if cross[k] <= 0.1 * cross[sheet] and ndimage.binary_dilation(passed, iterations=reach)[own].any():
+            rows, cols = np.nonzero(own & m)
+            kappa, error = _mean_curvature(rows, cols, d[rows, cols], focal)
+            r_k = radius * z_k / front
+            if kappa * r_k < THIN[0] and (kappa + 2.0 * error) * r_k < THIN[0] + 0.2 and error * r_k <= THIN[2]:
+                passed |= own  # told flat as thin_front tells a sheet: a leaf ending inside the mask, not the fruit
+                continue
+            behind, _ = fruit_depth(d[own & m], float(np.sqrt(m.sum() / np.pi)), focal, noise=noise)
+            # a separate layer: the occluder lies in front of the whole fruit, more than a fruit's depth (about its
+            # width, two radii) before what it hides; nearer, the part behind may be the fruit's own far side
+            return behind if np.isfinite(behind) and behind > front + 2.0 * radius else None
+        if cross[k] >= CROSSING * outline:
+            passed |= own  # an occluder behind the first, running on across the outline too
+    return None
+
+
+def _least_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: float) -> float:
+    """1/metres: the lesser principal curvature of the surface seen at the pixels (:class:`_InverseQuadratic`'s fit;
+    its mean is :func:`_mean_curvature`'s): about ``1 / R`` on a fruit's cap, 0 on a leaf or along a branch; NaN
+    where the fit is singular or too few pixels (under 30)."""
+    if len(z) < 30:
+        return float("nan")
+    fit = _InverseQuadratic(rows, cols, z, focal)
+    if fit.inverse is None:
+        return float("nan")
+    a, b, c = (float(fit.coef[k]) for k in (3, 4, 5))
+    # the principal curvatures are -zm^2 times the eigenvalues of the inverse depth's Hessian [[2a, b], [b, 2c]] (on a
+    # sphere a = c = -1 / (2 R zm^2): both 1 / R); the lesser is the greater eigenvalue's
+    return -fit.zm * fit.zm * float(np.linalg.eigvalsh(np.array([[2.0 * a, b], [b, 2.0 * c]]))[1])
+
+
+#: :func:`_behind_crossing`: the least share of a mask's outline along which its nearest surface runs on across it
+#: for that surface to be an occluder drawn over, not the fruit (whose own surface ends inside its mask's outline).
+CROSSING = 0.125
+
+
 def _part_sizes(
     parts: np.ndarray, count: int, depth: np.ndarray, front: float, join: float
 ) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
@@ -736,7 +844,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
                   leafy: np.ndarray | None = None, step: float | None = None,
-                  thin: bool = False) -> Surface | None:  # fmt: skip
+                  thin: bool = False, crossing: bool = False) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -769,6 +877,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         Tell a thin occluder in front drawn into the mask (a leaf) by its shape, without colour
         (:func:`thin_front`): where the depth mode's surface is flat and a convex cap lies behind it, bounded by its
         edge, the cap is the fruit and the sheet's pixels are not.
+    crossing : bool
+        Where ``thin`` finds no sheet, pass over a nearest surface that runs on across the mask's outline for the
+        fruit behind it that does not (:func:`_behind_crossing`: an occluder the mask is drawn over; extraction's, not
+        the registration's cue, which reads the depth a few pixels off the mask).
 
     Returns
     -------
@@ -813,6 +925,12 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         radius = radius_px * front / focal
         region = region.copy()
         region[box] &= ~sheet
+    if thin and crossing and (behind := _behind_crossing(depth, mask, focal, front, radius, tol, noise)) is not None:
+        # the nearest surface (behind a sheet thin_front passed over, if any) runs on across the mask's outline: an
+        # occluder the mask is drawn over (stop 46, docs/overleaf46.md); what lies in front of the fruit's front is
+        # left out by the slab below
+        front = behind
+        radius = radius_px * front / focal
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
