@@ -5304,7 +5304,7 @@ def test_the_cut_along_the_edges_is_the_twins(seed):
     rng = np.random.default_rng(seed)
     seen = set()
     for t in range(400):
-        region, edges, parts = _two_fruit_region(rng)
+        _, edges, parts = _two_fruit_region(rng)
         a, b = parts[0], parts[1]
         if t % 7 == 0:  # apart: no cut
             b = np.zeros_like(a)
