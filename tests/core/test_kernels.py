@@ -5299,3 +5299,156 @@ def test_the_principal_widths_with_the_extents_kernel_are_the_twins(seed):
     m = np.zeros((9, 20), bool)
     m[2:7, 3:17] = True
     assert principal_widths(m) == (5.0, 14.0)
+
+
+# --- stop 46, segspeed46
+
+
+def _two_fruit_region(rng):
+    """A region the segmenter's split meets (two or three overlapping noisy discs in a 20-90 px window), depth edges
+    across it (a circular rim, straight lines, scattered pixels, or none) and its cells (a cut by the nearest of the
+    discs' centres, some parts empty or a speck)."""
+    h, w = (int(v) for v in rng.integers(20, 90, 2))
+    yy, xx = np.mgrid[:h, :w]
+    k = int(rng.integers(2, 4))
+    centres = rng.random((k, 2)) * (h, w)
+    radii = rng.uniform(0.15, 0.45, k) * min(h, w)
+    d2 = (yy[..., None] - centres[:, 0]) ** 2 + (xx[..., None] - centres[:, 1]) ** 2
+    region = ((d2 <= radii**2).any(axis=2)) & (rng.random((h, w)) < rng.choice([1.0, 0.97]))
+    kind = int(rng.integers(0, 4))
+    if kind == 0:
+        edges = np.abs(np.sqrt(d2[..., 0]) - radii[0]) < rng.uniform(0.5, 1.5)
+    elif kind == 1:
+        edges = np.zeros((h, w), bool)
+        for _ in range(int(rng.integers(1, 4))):
+            if rng.random() < 0.5:
+                edges[int(rng.integers(0, h)), :] = True
+            else:
+                edges[:, int(rng.integers(0, w))] = True
+    elif kind == 2:
+        edges = rng.random((h, w)) < rng.uniform(0.02, 0.3)
+    else:
+        edges = np.zeros((h, w), bool)
+    edges &= region if rng.random() < 0.8 else True
+    nearest_centre = d2.argmin(axis=2)
+    parts = [region & (nearest_centre == j) for j in range(k)]
+    if rng.random() < 0.2:
+        parts[-1] = np.zeros((h, w), bool)
+        parts[-1][int(rng.integers(0, h)), int(rng.integers(0, w))] = True
+    return region, edges, parts
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_following_the_depth_edges_is_the_twins(seed):
+    """``_follow_edges`` with :func:`_jit.follow_edges` and with its numpy twin on 300 regions: the same parts, pixel
+    for pixel and in order (fewer than two pieces, pure and mixed pieces, edges all over the region, parts that are a
+    speck); and most of them moved the cut."""
+    from symfruit.segment.colour import _follow_edges
+
+    rng = np.random.default_rng(seed)
+    moved = 0
+    for _ in range(300):
+        region, edges, parts = _two_fruit_region(rng)
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _follow_edges, parts, region, edges)
+        assert len(fast) == len(twin)
+        for a, b in zip(fast, twin, strict=True):
+            np.testing.assert_array_equal(a, b)
+        moved += fast is not parts
+    assert moved > 150
+
+
+def test_following_the_depth_edges_known_answer(monkeypatch):
+    """A 6x21 region cut by a depth edge down column 10 into two pieces, the parts split at column 9: the left piece
+    (54 of its 60 pixels the first part's: 0.9, pure) goes whole to the first part, the right one to the second, and
+    the edge column, equally near both, to the left seed (scipy's choice); with the twin the same. One piece: the
+    parts as they were."""
+    from symfruit.segment.colour import _follow_edges
+
+    region = np.ones((6, 21), bool)
+    edges = np.zeros((6, 21), bool)
+    edges[:, 10] = True
+    first = np.zeros((6, 21), bool)
+    first[:, :9] = True
+    owner = np.where(first, 1, 2).astype(np.int64)
+    grown, moved = _jit.follow_edges(region, edges, owner, 2, 0.9)
+    assert moved and (grown[:, :11] == 1).all() and (grown[:, 11:] == 2).all()
+    fast, twin = _both(monkeypatch, _follow_edges, [first, ~first], region, edges)
+    for a, b, k in zip(fast, twin, (1, 2), strict=True):
+        np.testing.assert_array_equal(a, grown == k)
+        np.testing.assert_array_equal(b, grown == k)
+    assert not _jit.follow_edges(region, np.zeros((6, 21), bool), owner, 2, 0.9)[1]
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_cut_along_the_edges_is_the_twins(seed):
+    """:func:`_jit.near_edge_cut` against ``_supported``'s numpy test on 400 pairs of cells: no cut (-1, cells apart),
+    a cut with at least half of its pixels within two 4-neighbour steps of an edge (1) or not (0), ties included."""
+    from symfruit.segment.colour import _dilate
+
+    rng = np.random.default_rng(seed)
+    seen = set()
+    for t in range(400):
+        _, edges, parts = _two_fruit_region(rng)
+        a, b = parts[0], parts[1]
+        if t % 7 == 0:  # apart: no cut
+            b = np.zeros_like(a)
+            b[-1, -1] = not _dilate(a, square=True)[-1, -1]
+        cut = (a & _dilate(b, square=True)) | (b & _dilate(a, square=True))
+        want = -1 if not cut.any() else int(_dilate(_dilate(edges))[cut].mean() >= 0.5)
+        assert _jit.near_edge_cut(a, b, edges) == want
+        seen.add(want)
+    assert seen == {-1, 0, 1}
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_surface_hull_and_its_green_are_the_twins(seed):
+    """``_surface_hull`` and ``_green_in_hull`` with :func:`_jit.surface_hull` and :func:`_jit.green_in_hull` and
+    with their twins (Pillow's fill and numpy's masks) on 400 masks' hulls: random colours (a third of the pixels
+    green), owner maps with other pieces, this piece (``k``) and none, with and without the surface rule; the same
+    pixels and counts, and the rules take pixels off."""
+    from symfruit.segment.colour import _green_in_hull, _hull_vertices, _pillow_fill, _surface_hull
+
+    if not _pillow_fill():
+        pytest.skip("a Pillow older than 12.1 fills polygons otherwise (the kernels are not used with it)")
+    rng = np.random.default_rng(seed)
+    taken = counted = 0
+    for t, mask in enumerate(_polygon_masks(rng, 400)):
+        h, w = mask.shape
+        colour = rng.integers(0, 256, (h, w, 3)).astype(np.uint8)
+        green = rng.random((h, w)) < 0.3
+        colour[green, 1] = np.maximum(colour[green, 1], 200)
+        colour[green, 0] //= 2
+        owner = rng.choice(np.array([0, 0, 3, 5], np.int16), (h, w)) if t % 3 else np.zeros((h, w), np.int16)
+        vertices = _hull_vertices(mask)
+        for surface in (True, False):
+            with pytest.MonkeyPatch.context() as mp:
+                fast, twin = _both(mp, _surface_hull, vertices, mask, owner, 3, colour, surface)
+            np.testing.assert_array_equal(fast, twin)
+            taken += vertices is not None and int(twin.sum()) < int(_jit.polygon_fill(vertices, mask).sum())
+        with pytest.MonkeyPatch.context() as mp:
+            fast_n, twin_n = _both(mp, _green_in_hull, vertices, mask, colour)
+        assert fast_n == twin_n
+        counted += twin_n > 0
+    assert taken > 100 and counted > 50
+
+
+def test_the_surface_hull_known_answer():
+    """A 5x5 square's corners as the part (its hull the whole square): a green pixel inside the hull off the part is
+    left out with the surface rule and kept without it, a pixel another piece owns is left out, the part's own green
+    pixel is kept; the green count outside the part is 1."""
+    part = np.zeros((5, 5), bool)
+    part[[0, 0, 4, 4], [0, 4, 0, 4]] = True
+    colour = np.full((5, 5, 3), (200, 40, 30), np.uint8)
+    colour[2, 2] = colour[0, 0] = (30, 180, 40)  # green: inside the hull, and a pixel of the part
+    owner = np.zeros((5, 5), np.int16)
+    owner[1, 3] = 7
+    owner[3, 1] = 2
+    vertices = np.array([[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0]])
+    got = _jit.surface_hull(vertices, part, owner, 2, colour, True)
+    want = np.ones((5, 5), bool)
+    want[2, 2] = want[1, 3] = False
+    np.testing.assert_array_equal(got, want)
+    want[2, 2] = True
+    np.testing.assert_array_equal(_jit.surface_hull(vertices, part, owner, 2, colour, False), want)
+    assert _jit.green_in_hull(vertices, part, colour) == 1

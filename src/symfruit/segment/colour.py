@@ -567,6 +567,8 @@ def _segment_at(
             continue
         weak_w, labels, n, lab, seeded, sizes, rows, cols = regions
         weak[win] = weak_w
+        if not seeded.any():  # no region is kept: none is seeded (half the windows of the benchmark frame; stop 46)
+            continue
         # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
         if z is None:
             least: float | np.ndarray = min_area
@@ -628,10 +630,9 @@ def _segment_at(
         red = part & weak[sl]
         if not red.any() or not _ripe(c[sl], red, s.ripe_median):
             continue
-        hull = _hull_mask(piece.hull_vertices(), part) & ((owner[sl] == 0) | (owner[sl] == k))
         sub_z = None if z is None else z[sl]
-        if s.fill == "surface" or (s.fill == "auto" and sub_z is not None):
-            hull &= part | ~_green(c[sl])  # the calyx, a leaf or a stem over the fruit is not its surface
+        surface = s.fill == "surface" or (s.fill == "auto" and sub_z is not None)
+        hull = _surface_hull(piece.hull_vertices(), part, owner[sl], k, c[sl], surface)
         if sub_z is not None:
             hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
             if s.round_fruit and z is not None:  # the rest of a round fruit's skin
@@ -678,6 +679,39 @@ def _claim(out: np.ndarray, hull: np.ndarray) -> tuple[np.ndarray, tuple[int, in
         return None
     out[free] = -1
     return free, mask_box(free) or (0, 0, 0, 0)
+
+
+def _surface_hull(
+    vertices: np.ndarray | None, part: np.ndarray, owner: np.ndarray, k: int, color: np.ndarray, surface: bool
+) -> np.ndarray:
+    """A piece's filled hull (its ``vertices``, over its ``part``) less the pixels another piece owns (``owner``, the
+    window of the image's map: 0 and ``k`` free) and, with ``surface``, less the green pixels that are not the part's
+    (the calyx, a leaf or a stem over the fruit is not its surface). Where numba is, in one call
+    (:func:`symfruit.core._jit.surface_hull`: the same pixels; stop 46)."""
+    jit = compiled()
+    if (jit is not None and vertices is not None and vertices.dtype == np.float64 and part.ndim == 2
+            and part.dtype == bool and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3
+            and _pillow_fill()):  # fmt: skip
+        out: np.ndarray = jit.surface_hull(vertices, part, owner, int(k), color, bool(surface))
+        if out.shape == part.shape:
+            return out
+    hull = _hull_mask(vertices, part) & ((owner == 0) | (owner == k))
+    if surface:
+        hull &= part | ~_green(color)
+    return hull
+
+
+def _green_in_hull(vertices: np.ndarray | None, union: np.ndarray, color: np.ndarray) -> int:
+    """How many pixels of the filled hull (``vertices``, over ``union``) outside ``union`` are green. Where numba is,
+    in one call (:func:`symfruit.core._jit.green_in_hull`: the same count; stop 46)."""
+    jit = compiled()
+    if (jit is not None and vertices is not None and vertices.dtype == np.float64 and union.ndim == 2
+            and union.dtype == bool and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3
+            and _pillow_fill()):  # fmt: skip
+        n = int(jit.green_in_hull(vertices, union, color))
+        if n >= 0:
+            return n
+    return int((_hull_mask(vertices, union) & ~union & _green(color)).sum())
 
 
 def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
@@ -1031,7 +1065,7 @@ def _merge(
                     continue
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
-                    hull -= float((_hull_mask(vertices, union) & ~union & _green(color[window])).sum())
+                    hull -= float(_green_in_hull(vertices, union, color[window]))
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
                     depth is None or _same_surface(a, b, depth, weak, geo, s, surfaces) is not False
                 ):
@@ -1255,8 +1289,16 @@ def _cut(
     if len(cells) < 2:
         return [region]
     firm = [f for *_, f in centres]
-    spheres = [_sphere(c, depth, geo, origin) if use_depth and depth is not None else None for c in cells]
-    parts = _supported(cells, firm, spheres, edges, s, by_shape=s.split in ("watershed", "both"))
+    fits: dict[int, tuple[np.ndarray, float] | None] = {}
+
+    def sphere(i: int) -> tuple[np.ndarray, float] | None:
+        """Cell ``i``'s sphere, fitted when a test first asks (most cuts are settled by the depth edges or have no
+        neighbour: 1 pair test for 6 cells on the benchmark frame, 15 for 69 on tree frames 0-2; stop 46)."""
+        if i not in fits:
+            fits[i] = _sphere(cells[i], depth, geo, origin) if use_depth and depth is not None else None
+        return fits[i]
+
+    parts = _supported(cells, firm, sphere, edges, s, by_shape=s.split in ("watershed", "both"))
     return parts if edges is None or len(parts) < 2 else _follow_edges(parts, region, edges)
 
 
@@ -1264,7 +1306,15 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     """Move the cut between fruit onto the depth steps and creases where they run: every piece of the region
     that the edges enclose goes whole to the fruit holding most of it (when one holds at least
     :data:`EDGE_PURITY` of it), and the edge pixels to the nearest piece. A front fruit's rim, not a straight
-    line through the one behind, then separates them."""
+    line through the one behind, then separates them. Where numba is, in one call
+    (:func:`symfruit.core._jit.follow_edges`: the same labels, counts, seeds and nearest seeds, so the same parts;
+    stop 46)."""
+    if (jit := compiled()) is not None and region.dtype == edges.dtype == bool and region.ndim == edges.ndim == 2:
+        owner = np.zeros(region.shape, np.int64)
+        for k, part in enumerate(parts, 1):
+            owner[part] = k
+        grown, moved = jit.follow_edges(region, edges, owner, len(parts), EDGE_PURITY)
+        return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()] if moved else parts
     pieces, n = _label(region & ~edges)
     if n < 2:
         return parts
@@ -1358,7 +1408,7 @@ def _on_path(edt: np.ndarray, p: tuple[int, int], others: list[tuple[int, int]],
 def _supported(
     cells: list[np.ndarray],
     firm: list[bool],
-    spheres: list[tuple[np.ndarray, float] | None],
+    spheres: Callable[[int], tuple[np.ndarray, float] | None],
     edges: np.ndarray | None,
     s: SegmentSettings,
     *,
@@ -1375,10 +1425,18 @@ def _supported(
       ``merge_slack`` (they are not one convex body).
     """
     n = len(cells)
-    grown = [_dilate(c, square=True) for c in cells]
-    hulls = [_hull_area(c) for c in cells]
-    near_edges = None if edges is None else _dilate(_dilate(edges))
+    # with the edges, where numba is, each pair's cut and its edge test in one call at the cut's pixels alone
+    # (:func:`symfruit.core._jit.near_edge_cut`: the same answers as the masks below; stop 46)
+    jit = compiled() if edges is not None and edges.dtype == bool and all(c.dtype == bool for c in cells) else None
+    grown = [] if jit is not None else [_dilate(c, square=True) for c in cells]
+    near_edges = None if edges is None or jit is not None else _dilate(_dilate(edges))
     owner = list(range(n))
+    hulls: dict[int, float] = {}  # a cell's hull area, worked out when a shape test first asks (stop 46)
+
+    def hull(i: int) -> float:
+        if i not in hulls:
+            hulls[i] = _hull_area(cells[i])
+        return hulls[i]
 
     def root(i: int) -> int:
         while owner[i] != i:
@@ -1387,19 +1445,24 @@ def _supported(
 
     for i in range(n):
         for j in range(i + 1, n):
-            cut = (cells[i] & grown[j]) | (cells[j] & grown[i])
-            if not cut.any():
-                continue
-            if near_edges is not None and near_edges[cut].mean() >= 0.5:
-                continue  # a depth step or crease runs along the cut
-            two = _two_spheres(spheres[i], spheres[j], s)
+            if jit is not None:
+                along = jit.near_edge_cut(cells[i], cells[j], edges)
+                if along != 0:
+                    continue  # no cut (-1), or a depth step or crease runs along it (1)
+            else:
+                cut = (cells[i] & grown[j]) | (cells[j] & grown[i])
+                if not cut.any():
+                    continue
+                if near_edges is not None and near_edges[cut].mean() >= 0.5:
+                    continue  # a depth step or crease runs along the cut
+            two = _two_spheres(spheres(i), spheres(j), s)
             if two:
                 continue  # two surfaces
             if (
                 two is None
                 and by_shape
                 and firm[j]
-                and _hull_area(cells[i] | cells[j]) > (1 + s.merge_slack) * (hulls[i] + hulls[j])
+                and _hull_area(cells[i] | cells[j]) > (1 + s.merge_slack) * (hull(i) + hull(j))
             ):
                 continue  # a waist, and concave where they meet: two convex bodies touching
             owner[root(j)] = root(i)
