@@ -523,20 +523,16 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
     found = mask_box(mask)
     if found is None:
         return None
-    pad = RUN_ON_PX + 1
-    r0, r1 = max(found[0] - pad, 0), min(found[1] + pad, mask.shape[0])
-    c0, c1 = max(found[2] - pad, 0), min(found[3] + pad, mask.shape[1])
+    r0, r1 = max(found[0] - 1, 0), min(found[1] + 1, mask.shape[0])
+    c0, c1 = max(found[2] - 1, 0), min(found[3] + 1, mask.shape[1])
     d, m = depth[r0:r1, c0:c1], np.asarray(mask[r0:r1, c0:c1], dtype=bool)
-    # the outline a surface must run on across: RUN_ON_PX beyond the mask's, past a fruit's own edge spread by the
-    # sensor (an active-stereo camera's fattened foreground)
-    wide = ndimage.binary_dilation(m, iterations=RUN_ON_PX)
-    rim = wide & ~interior(wide)
+    rim = m & ~interior(m)
     if np.count_nonzero(rim & (d > 0) & (d <= front + radius)) < CROSSING * np.count_nonzero(rim):
         return None  # too little of the outline in front of the fruit's middle for a surface there to run on across
     parts, count = _smooth_parts(d, d > 0, join)
     if count < 2:
         return None
-    cross, outline = _crossings(parts, wide, count)
+    cross, outline = _crossings(parts, m, count)
     inside = np.bincount(parts[m], minlength=count + 1)
     near = m & (parts > 0) & (np.abs(d - front) <= join)
     if not near.any():
@@ -598,13 +594,6 @@ def _least_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: f
 #: :func:`_behind_crossing`: the least share of a mask's outline along which its nearest surface runs on across it
 #: for that surface to be an occluder drawn over, not the fruit (whose own surface ends inside its mask's outline).
 CROSSING = 0.125
-
-#: :func:`_behind_crossing`: pixels past the mask's outline a surface must reach to run on across it. An active-stereo
-#: camera spreads a foreground's depth over the background by half its matching window (3 px for the 7 px window of
-#: the D435 and D405 models, ``synthetic.sensors`` ``fatten_px``), so a fruit's own front reaches that far past a
-#: mask drawn on its colour; one pixel more. (Stop 46: at 1 px the rule passed over the real banana scan's own
-#: fattened front through the D435 and D405 models.)
-RUN_ON_PX = 4
 
 
 def _part_sizes(
