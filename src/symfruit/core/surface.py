@@ -568,9 +568,12 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
                 passed |= own  # told flat as thin_front tells a sheet: a leaf ending inside the mask, not the fruit
                 continue
             behind, _ = fruit_depth(d[own & m], float(np.sqrt(m.sum() / np.pi)), focal, noise=noise)
-            # a separate layer: the occluder lies in front of the whole fruit, more than a fruit's depth (about its
-            # width, two radii) before what it hides; nearer, the part behind may be the fruit's own far side
-            return behind if np.isfinite(behind) and behind > front + 2.0 * radius else None
+            # a separate layer: the occluder lies in front of the whole fruit, more than a fruit's depth before what
+            # it hides (about its width, two radii, for a round fruit; up to its length for an elongated one, read off
+            # the mask's longer principal width: a banana seen obliquely has its far end that far behind its near
+            # one, stop 46); nearer, the part behind may be the fruit's own far side
+            length = principal_widths(m)[1] * front / focal
+            return behind if np.isfinite(behind) and behind > front + max(2.0 * radius, length) else None
         if cross[k] >= CROSSING * outline:
             passed |= own  # an occluder behind the first, running on across the outline too
     return None
