@@ -4695,31 +4695,9 @@ def free_outline(
 @_njit_inlined
 def _envelope(f: np.ndarray, w: int, s: np.ndarray, t: np.ndarray, d2: np.ndarray) -> None:
     """``d2[u]`` (w,) the least ``(u - i)^2 + f[i]`` over the columns ``i`` of one row (``f`` (w,) whole numbers): the
-    lower envelope of the parabolas, :func:`distance`'s second phase (``s``, ``t`` (w,) its scratch)."""
-    q = 0
-    s[0] = 0
-    t[0] = 0
-    for u in range(1, w):
-        while q >= 0:
-            a, b = t[q] - s[q], t[q] - u
-            if a * a + f[s[q]] <= b * b + f[u]:
-                break
-            q -= 1
-        if q < 0:
-            q = 0
-            s[0] = u
-        else:
-            i = s[q]
-            start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
-            if start < w:
-                q += 1
-                s[q] = u
-                t[q] = start
-    for u in range(w - 1, -1, -1):
-        a = u - s[q]
-        d2[u] = a * a + f[s[q]]
-        if u == t[q]:
-            q -= 1
+    lower envelope of the parabolas, :func:`distance`'s second phase (``s``, ``t`` (w,) its scratch);
+    :func:`_envelope_of` over every column."""
+    _envelope_of(f, 0, w - 1, w, s, t, d2)
 
 
 @_njit_inlined
