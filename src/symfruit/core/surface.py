@@ -33,6 +33,7 @@ from typing import Any, Literal
 import numpy as np
 from scipy import ndimage
 
+from .fits import eigenvalues2
 from .kernels import compiled
 from .points import median
 from .raster import distance_transform, eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
@@ -517,7 +518,8 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
     (at most a tenth of the crossing pixel pairs the front's holds), that touches a part passed over (what an
     occluder hides is bounded by its edge) and that is not told flat (:data:`THIN`, as :func:`thin_front` tells a
     sheet: a leaf ending inside the mask is passed over too); its front, :func:`fruit_depth`'s of its own depths,
-    must lie more than two radii behind ``front`` (the occluder a separate layer in front of the whole fruit). A
+    must lie further behind ``front`` than the fruit can be deep: two radii, or the mask's longer principal width
+    for an elongated fruit (the occluder a separate layer in front of the whole fruit). A
     nearest surface curved in every direction as a fruit's cap (its least principal curvature at least ``THIN[0] /
     radius``) is the fruit's own front, joined to a surface at its depth that crosses: not passed over."""
     found = mask_box(mask)
@@ -590,8 +592,12 @@ def _least_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: f
         return float("nan")
     a, b, c = (float(fit.coef[k]) for k in (3, 4, 5))
     # the principal curvatures are -zm^2 times the eigenvalues of the inverse depth's Hessian [[2a, b], [b, 2c]] (on a
-    # sphere a = c = -1 / (2 R zm^2): both 1 / R); the lesser is the greater eigenvalue's
-    return -fit.zm * fit.zm * float(np.linalg.eigvalsh(np.array([[2.0 * a, b], [b, 2.0 * c]]))[1])
+    # sphere a = c = -1 / (2 R zm^2): both 1 / R); the lesser is the greater eigenvalue's (eigenvalues2: eigvalsh's
+    # values bit for bit, numpy's call only where LAPACK would scale the matrix)
+    eig = eigenvalues2(2.0 * a, b, 2.0 * c)
+    if eig is None:
+        eig = tuple(np.linalg.eigvalsh(np.array([[2.0 * a, b], [b, 2.0 * c]])))
+    return -fit.zm * fit.zm * float(eig[1])
 
 
 #: :func:`_behind_crossing`: the least share of a mask's outline along which its nearest surface runs on across it
