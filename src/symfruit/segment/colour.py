@@ -1821,37 +1821,14 @@ def _round_skin(
         own = float(np.sqrt(hull.sum() / np.pi))
     zm = float(median(z_part))
     reach = ROUND_REACH * own
-    h, w = depth.shape
-    big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
-           slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
-    z = depth[big]
-    part = np.zeros(z.shape, bool)
-    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
-    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
     deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    if jit is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the seeds'
-        # components alone; issue 19, seventeenth round)
-        skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
-                              float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
-                              LEAF_HUE)  # fmt: skip
-    else:
-        # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
-        yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
-        free = (owner[big] == 0) | (owner[big] == k)
-        near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
-        deep = np.abs(z - zm) <= deep_limit
-        candidate = near & (z > 0) & deep & ~_leaf(color[big]) & free
-        # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
-        allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
-        seeds = part & (np.abs(z - zm) <= s.depth_jump)
-        lab, n = ndimage.label(allowed)
-        reached = np.zeros(n + 1, bool)
-        reached[lab[seeds]] = True
-        reached[0] = False
-        skin = reached[lab] | part
+    big, z, skin = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, reach, deep_limit, zm))
     far = s.round_max_diameter * geo.focal / zm
     if far > reach and _at_reach(skin, big, rc, cc, reach):
-        big, z, skin = _wider_skin(sl, hull, depth, color, geo, s, owner, k, (rc, cc, far, deep_limit, zm))
+        # again out to the largest fruit's diameter at the part's depth (stop 46): the skin lies within the fruit's
+        # diameter of any of its pixels, and a blush cut to a thin crescent by a leaf's shadow and the camera's
+        # 4:2:0 chroma is small against its apple
+        big, z, skin = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, far, deep_limit, zm))
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
@@ -1878,22 +1855,19 @@ def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float)
     return bool((dr * dr + dc * dc > (reach - 1.0) ** 2).any())
 
 
-def _wider_skin(
+def _skin_flood(
     sl: Window,
     hull: np.ndarray,
     depth: _Depth,
     color: np.ndarray,
-    geo: _Geometry,
     s: SegmentSettings,
     owner: np.ndarray,
     k: int,
     grow: tuple[float, float, float, float, float],
 ) -> tuple[Window, np.ndarray, np.ndarray]:
-    """:func:`_round_skin`'s growth again, out to the largest fruit's diameter at the part's depth (``grow``: the
-    part's centre row and column, that reach in pixels, the depth limit and the median depth), where its own reach
-    (:data:`ROUND_REACH` times the part's radius) stopped it (stop 46): the skin lies within the fruit's diameter
-    of any of its pixels, and a blush cut to a thin crescent by a leaf's shadow and the camera's 4:2:0 chroma is
-    small against its apple. The window, its depth and the skin."""
+    """:func:`_round_skin`'s growth from the red part ``hull`` (in window ``sl``) within a reach (``grow``: the
+    part's centre row and column, the reach in pixels, the depth limit and the median depth), in the window that
+    holds both: the window, its depth and the skin."""
     rc, cc, reach, deep_limit, zm = grow
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
@@ -1902,15 +1876,18 @@ def _wider_skin(
     part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
-    if (jit := compiled()) is not None:  # the same pixels as below (the kernel and twin of :func:`_round_skin`)
+    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the
+        # seeds' components alone; issue 19, seventeenth round)
         skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
                               float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
                               LEAF_HUE)  # fmt: skip
         return big, z, skin
+    # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
     yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     free = (owner[big] == 0) | (owner[big] == k)
     near = (yy - rc) ** 2 + (xx - cc) ** 2 <= reach**2
     candidate = near & (z > 0) & (np.abs(z - zm) <= deep_limit) & ~_leaf(color[big]) & free
+    # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
     allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
     lab, n = ndimage.label(allowed)
     reached = np.zeros(n + 1, bool)
