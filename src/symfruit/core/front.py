@@ -135,10 +135,10 @@ def sphere_front(points: np.ndarray, radius: float, *, iterations: int = 20,
         diff = p - c
         dist = np.maximum(np.sqrt(squared_norms(diff)), 1e-12)
         np.divide(diff, -dist[:, None], out=jac)
-        try:
-            step = np.linalg.solve(jac.T @ jac, -(jac.T @ (dist - r)))
+        try:  # core.lapack: numpy's solve and lstsq without their wrappers, the same values and errors
+            step = lapack.solve(jac.T @ jac, -(jac.T @ (dist - r)))
         except np.linalg.LinAlgError:
-            step, *_ = np.linalg.lstsq(jac, -(dist - r), rcond=None)
+            step = lapack.lstsq(jac, -(dist - r))[0]
         c = c + step
         if np.abs(step).max() < tolerance:
             break

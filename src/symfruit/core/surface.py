@@ -33,6 +33,7 @@ from typing import Any, Literal
 import numpy as np
 from scipy import ndimage
 
+from . import lapack
 from .fits import eigenvalues2
 from .kernels import compiled
 from .points import median
@@ -596,7 +597,7 @@ def _least_curvature(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, focal: f
     # values bit for bit, numpy's call only where LAPACK would scale the matrix)
     eig = eigenvalues2(2.0 * a, b, 2.0 * c)
     if eig is None:
-        eig = tuple(np.linalg.eigvalsh(np.array([[2.0 * a, b], [b, 2.0 * c]])))
+        eig = tuple(lapack.eigvalsh(np.array([[2.0 * a, b], [b, 2.0 * c]])))
     return -fit.zm * fit.zm * float(eig[1])
 
 
