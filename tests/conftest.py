@@ -283,6 +283,28 @@ def disc_frame(centres, radius=20, z=0.3, colour=(200, 20, 30)) -> tuple[np.ndar
     return color, depth
 
 
+def leaf_across_frame(seed: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(color, depth (float32), mask)`` seen by :data:`SMALL_CAM`: a red ball of 30 px at (80, 60), its front 0.5 m,
+    the outer tenth of its radius without depth (a time-of-flight camera's grazing pixels), under a grey flat leaf
+    at 0.40 m, a disc of 42 px at (60, 60) that hides all of it but a crescent on its right and runs on beyond it
+    on the left; ``mask`` the ball's outline grown by 2 px, drawn over the leaf as an annotator draws it (the scene
+    of tests/core/test_surface.py's ``leaf_across``, stop 46)."""
+    yy, xx = np.mgrid[:120, :160].astype(np.float64)
+    d2 = ((xx - 80) ** 2 + (yy - 60) ** 2) / 30**2
+    disc = d2 <= 1.0
+    depth = np.where(disc, 0.5 + 0.025 * (1.0 - np.sqrt(np.clip(1.0 - d2, 0.0, None))), 0.8)
+    leaf = (xx - 60) ** 2 + (yy - 60) ** 2 <= 42**2
+    depth = np.where(leaf, 0.40 / (1.0 - 0.1 * (xx - 60) / 600 + 0.05 * (yy - 60) / 600), depth)
+    depth = depth + np.random.default_rng(seed).normal(scale=0.0005, size=depth.shape)
+    depth[disc & ~leaf & (d2 > 0.81)] = 0.0
+    color = np.full((120, 160, 3), 90, np.uint8)
+    color[disc] = (200, 20, 30)
+    color[leaf] = (90, 90, 90)
+    yy, xx = np.mgrid[:120, :160]
+    mask = (xx - 80) ** 2 + (yy - 60) ** 2 <= 32**2
+    return color, depth.astype(np.float32), mask
+
+
 # --- cloud files -----------------------------------------------------------------------------------------
 
 #: A small seeded cloud the readers and writers round-trip.

@@ -12,7 +12,7 @@ from symfruit.core.frame import Frame
 from symfruit.detect import MAX_FRUIT_PER_FRAME, Detection, FrameDetections, detect, frame_masks
 from symfruit.evaluate.frames import match
 
-from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame
+from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame, leaf_across_frame
 
 
 @pytest.fixture
@@ -416,3 +416,31 @@ def test_one_pixel_of_depth_in_range_off_the_sample_is_enough(example):
     depth[1, 1] = 5.0
     with pytest.raises(InputError, match="no depth within extraction's range"):
         _check_depth_range(replace(example, depth=depth), 0.1, 3.0)
+
+
+def test_the_colour_segmenter_s_masks_skip_the_test_for_an_occluder_drawn_over(monkeypatch):
+    """The same mask, drawn over a leaf that runs on across its outline (:func:`leaf_across_frame`), from two sources:
+    given (a label array, as a masks file or a model's), extraction passes the leaf over for the fruit behind it
+    (its crescent beyond 0.5 m); said to be the colour segmenter's (the segmenter replaced by one returning that
+    mask), the test is skipped and the points are the leaf's at 0.40 m (the segmenter's own masks hold the fruit's
+    colour only, never an occluder drawn over; stop 47, docs/mask47.md)."""
+    import symfruit.core.surface as surface
+    import symfruit.segment.colour as colour
+
+    color, depth, mask = leaf_across_frame()
+    frame = Frame("leaf", color, depth, SMALL_CAM)
+    registered = resolve_settings(overrides={"extract": {"registration_px": 0}})  # the depth as drawn
+    given = detect(frame, masks=mask.astype(np.int32), method="raw", settings=registered)
+    assert given.mask_source == "label array"
+    points = given.detections[0].extraction.points
+    assert 120 <= len(points) <= 200 and points[:, 2].min() > 0.5
+    monkeypatch.setattr(colour, "segment", lambda *args, **kwargs: mask.astype(np.int32))
+    calls = []
+    behind_crossing = surface._behind_crossing
+    monkeypatch.setattr(surface, "_behind_crossing", lambda *args: calls.append(1) or behind_crossing(*args))
+    segmented = detect(frame, masks="color", method="raw", settings=registered)
+    assert segmented.mask_source == "colour segmenter" and calls == []
+    points = segmented.detections[0].extraction.points
+    assert len(points) > 2000 and points[:, 2].max() < 0.41
+    detect(frame, masks=mask.astype(np.int32), method="raw", settings=registered)
+    assert calls == [1]  # given, the same mask is tested again

@@ -31,7 +31,12 @@ import numpy as np
 from ..errors import FileFormatError, InputError
 from ..settings import Settings
 
-__all__ = ["MaskSource", "mask_source"]
+__all__ = ["COLOUR_SEGMENTER", "MaskSource", "mask_source"]
+
+#: The word a :class:`MaskSource` gives for the colour segmenter's labels (``color``, or ``auto`` without a masks
+#: file): masks grown from the fruit's own colour, never drawn over what lies in front of it (``detect`` skips
+#: extraction's test for an occluder drawn over, stop 47).
+COLOUR_SEGMENTER = "colour segmenter"
 
 #: ``(color, depth, camera, name, own, color_file) -> (labels, word)``: see :class:`MaskSource`.
 Labeller = Callable[[np.ndarray, Any, Any, str, Any, Any], tuple[np.ndarray, str]]
@@ -88,7 +93,7 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
     if not text.strip():  # Path("") is the working folder: never taken for a folder of label PNGs unsaid
         raise InputError("--masks '': expected color, maskrcnn:CHECKPOINT, onnx:MODEL, a COCO .json, a folder of "
                          "label PNGs, or one label .png")  # fmt: skip
-    colour = "colour segmenter"
+    colour = COLOUR_SEGMENTER
 
     def by_colour(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         return segment(color, depth, camera, settings.segment), colour
