@@ -313,14 +313,14 @@ def test_one_cluster_keeps_every_point_on_the_fruit():
 
 
 @pytest.mark.parametrize("seed", [0, 1])
-def test_a_drawn_mask_over_a_leaf_running_on_across_its_outline_gives_the_fruit_behind(seed):
+def test_an_outlined_mask_over_a_leaf_running_on_across_it_gives_the_fruit_behind(seed):
     """An annotator's mask drawn over a leaf 10 cm in front that hides all but a crescent of the fruit and runs on
-    across the outline (``drawn``, the default: :func:`~symfruit.core.surface._behind_crossing` passes it over):
-    the crescent's points, none nearer than the fruit's front (0.5 m). ``drawn=False``, as for the colour
+    across the outline (``outlined``, the default: :func:`~symfruit.core.surface._behind_crossing` passes it over):
+    the crescent's points, none nearer than the fruit's front (0.5 m). ``outlined=False``, as for the colour
     segmenter's masks (stop 47, docs/mask47.md), skips that test: the points are the leaf's (0.40 m), every one."""
     _, depth, mask = leaf_across_frame(seed)
     fruit = extract(mask, depth, CAM)
     assert 120 <= len(fruit.points) <= 200 and fruit.points[:, 2].min() > 0.5
-    assert np.array_equal(extract(mask, depth, CAM, drawn=True).points, fruit.points)
-    leaf = extract(mask, depth, CAM, drawn=False)
+    assert np.array_equal(extract(mask, depth, CAM, outlined=True).points, fruit.points)
+    leaf = extract(mask, depth, CAM, outlined=False)
     assert len(leaf.points) > 2000 and leaf.points[:, 2].max() < 0.41

@@ -150,9 +150,9 @@ def detect(
     others are unaffected. A mask covering the whole image is refused (it is not a fruit).
 
     Masks from the colour segmenter (``masks`` ``"color"``, or ``"auto"`` for a frame without a masks file) are
-    extracted with ``drawn=False`` (:func:`~symfruit.extract.extract`: no test for an occluder the mask is drawn
-    over); every other source (a masks file or folder, a label array, a learned model, a callable) with
-    ``drawn=True``.
+    extracted with ``outlined=False`` (:func:`~symfruit.extract.extract`: the visible surface alone, no test for an
+    occluder the mask is drawn over); every other source (a masks file or folder, a label array, a learned model,
+    a callable) with ``outlined=True``.
     """
     if not isinstance(frame, Frame):
         raise InputError(f"detect needs a Frame (symfruit.io.read_frame or a frame source), got {type(frame).__name__}")
@@ -199,10 +199,11 @@ def detect(
     # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
     # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
     camera = frame.camera.shifted(*shift)
-    # masks drawn round the fruit (a masks file, a label array, a model) may cover a leaf or branch in front that
-    # runs on across their outline; the colour segmenter's, grown from the fruit's colour, never do: extraction's
-    # test for such an occluder is skipped on them (0.4 ms a fruit; stop 47, docs/mask47.md)
-    drawn = source != COLOUR_SEGMENTER
+    # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
+    # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
+    # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
+    # stop 47, docs/mask47.md)
+    outlined = source != COLOUR_SEGMENTER
     detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
     fruit_px = labels > 0
@@ -212,7 +213,7 @@ def detect(
         mask = np.zeros(labels.shape, bool)
         mask[sl] = labels[sl] == k
         a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=shift, drawn=drawn)
+        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=shift, outlined=outlined)
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
@@ -317,9 +318,9 @@ def _window_camera(cam: Camera, r0: int, r1: int, c0: int, c1: int) -> Camera:
 
 def _extract_window(
     mask: np.ndarray, sl: tuple[slice, slice], depth: np.ndarray, cam: Camera, settings: Settings,
-    *, color: np.ndarray | None = None, shift: tuple[int, int] = (0, 0), drawn: bool = True,
+    *, color: np.ndarray | None = None, shift: tuple[int, int] = (0, 0), outlined: bool = True,
 ) -> Extraction:  # fmt: skip
-    """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test; ``drawn`` as
+    """:func:`extract` on the mask's bounding window (with a margin), keeping the truncation test; ``outlined`` as
     :func:`extract`'s."""
     h, w = mask.shape
     pad = settings.extract.erode_px + 2
@@ -328,7 +329,7 @@ def _extract_window(
     window = mask[r0:r1, c0:c1]
     local = _window_camera(cam, r0, r1, c0, c1)
     leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
-    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy, checked=True, drawn=drawn)
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy, checked=True, outlined=outlined)
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     # the mask's pixels all lie in the window (its box): the rest of the image is none of the outline's. Where the
     # outline is the window itself (extract keeps its mask's view), it is the mask: no image is copied (a whole

@@ -201,8 +201,8 @@ def _checked(image: Any, beside: Any, camera: Any, settings: Any, what: str, nam
     return (arr != 0) if name == "mask" and arr.dtype != bool else arr
 
 
-def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None,
-            *, leafy: np.ndarray | None = None, checked: bool = False, drawn: bool = True) -> Extraction:  # fmt: skip
+def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None, *,
+            leafy: np.ndarray | None = None, checked: bool = False, outlined: bool = True) -> Extraction:  # fmt: skip
     """The 3D points of the fruit under ``mask``.
 
     Parameters
@@ -215,13 +215,13 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         ``depth`` is (a window of) a :class:`~symfruit.core.frame.Frame`'s, its units checked already. Else, when the
         mask holds no depth within ``min_depth``-``max_depth``, the depth image's units are checked
         (:func:`~symfruit.core.limits.depth_metres`): a depth in millimetres is refused, not 0 points.
-    drawn : bool
-        The mask was drawn round the fruit, by a person or a model trained on such masks (a masks file, a label
-        array, a learned segmenter): it may be drawn over a leaf or branch in front that runs on across its
-        outline, which is then passed over for the fruit behind it
-        (:func:`~symfruit.core.surface.fruit_surface`'s ``crossing``). False for the colour segmenter's masks
-        (:func:`symfruit.segment.colour.segment`), grown from the fruit's own colour and cut at depth steps: they
-        hold no occluder drawn over, and the test is skipped (0.4 ms a fruit; stop 47, docs/mask47.md).
+    outlined : bool
+        The mask is the fruit's whole outline as a person draws it (a masks file, a label array, a learned model
+        trained on such masks): it may be drawn over a leaf or branch in front, which is passed over for the fruit
+        behind it where it runs on across the outline (:func:`~symfruit.core.surface.fruit_surface`'s
+        ``crossing``). False for a mask of the visible surface alone, occluders left out: the colour segmenter's
+        given depth (:func:`symfruit.segment.colour.segment`: leaf, calyx and stem pixels and pixels off the
+        fruit's depth dropped), on which the test is skipped (0.4 ms a fruit; stop 47, docs/mask47.md).
 
     Returns
     -------
@@ -264,7 +264,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         focal = float(np.sqrt(camera.fx * camera.fy))
         surface = fruit_surface(z_valid, core, focal, slab=s.slab,
                                 tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
-                                leafy=leafy, thin=True, crossing=drawn)  # fmt: skip
+                                leafy=leafy, thin=True, crossing=outlined)  # fmt: skip
     if jit is not None:
         points = jit.pixel_points(usable, usable if surface is None else surface.pixels, z_all, float(camera.cx),
                                   float(camera.cy), float(camera.fx), float(camera.fy))  # fmt: skip
