@@ -615,7 +615,6 @@ def test_a_front_hidden_behind_a_leaf_is_placed_by_the_sphere_through_the_seen_c
     assert complete(visible, occlusion=occ).box.min[2] == complete(visible, occlusion=occ, settings=off).box.min[2]
 
 
-
 def _former_faces(box, across, front, back, share, grow):
     """``fuse_depth``'s box faces as numpy worked them out before stop 47 (the (2,) arrays)."""
     dist = 0.5 * (front + back) / across.axis[2]
