@@ -677,3 +677,16 @@ def test_fuse_depths_faces_and_the_lateral_misfit_are_the_former_numpy_values():
             lo, hi = _lateral_faces(box, across, 0.5, 0.56, 0.2, 0.5)
             assert np.array_equal(np.array(lo), want_lo, equal_nan=True)
             assert np.array_equal(np.array(hi), want_hi, equal_nan=True)
+
+
+def test_clean_shares_clip_is_numpys():
+    """Issue 19, stop 47: ``_clip01`` (``clean_share``'s clip in Python floats) is ``float(np.clip(x, 0.0, 1.0))`` to
+    the bit: NaN, infinities, both zeros (numpy's clip keeps ``-0.0``), the ends, just beyond them and seeded random
+    values."""
+    from symfruit.methods.evidence import _clip01
+
+    values = [-0.0, 0.0, 1.0, -1.0, 2.0, 0.5, np.nan, np.inf, -np.inf, 5e-324, -5e-324, 1 - 2**-53, 1 + 2**-52]
+    values += np.random.default_rng(47).normal(0.5, 1.0, 2000).tolist()
+    for x in values:
+        assert np.array(_clip01(x)).tobytes() == np.array(float(np.clip(x, 0.0, 1.0))).tobytes()
+    assert clean_share(5.0, 3.0) == 1.0 and clean_share(1.0, 3.0) == 0.0 and clean_share(3.0, 3.0) == 0.5
