@@ -613,3 +613,80 @@ def test_a_front_hidden_behind_a_leaf_is_placed_by_the_sphere_through_the_seen_c
                                             seed=1)  # fmt: skip
     occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
     assert complete(visible, occlusion=occ).box.min[2] == complete(visible, occlusion=occ, settings=off).box.min[2]
+
+
+def _former_faces(box, across, front, back, share, grow):
+    """``fuse_depth``'s box faces as numpy worked them out before stop 47 (the (2,) arrays)."""
+    dist = 0.5 * (front + back) / across.axis[2]
+    sil_lo = dist * (across.axis[:2] + across.lo)
+    sil_hi = dist * (across.axis[:2] + across.hi)
+    lo, hi = box.min.copy(), box.max.copy()
+    d_lo, d_hi = sil_lo - lo[:2], sil_hi - hi[:2]
+    lo[:2] += np.where(d_lo < 0.0, grow, share) * d_lo
+    hi[:2] += np.where(d_hi > 0.0, grow, share) * d_hi
+    hi[2] = back
+    return lo, hi
+
+
+def _former_lateral(dist, across, box):
+    """The completion's ``lateral`` as numpy worked it out before stop 47."""
+    return float(max(np.abs(dist * (across.axis[:2] + across.lo) - box.min[:2]).max(),
+                     np.abs(dist * (across.axis[:2] + across.hi) - box.max[:2]).max()))  # fmt: skip
+
+
+def test_fuse_depths_faces_and_the_lateral_misfit_are_the_former_numpy_values():
+    """Issue 19, stop 47: ``fuse_depth``'s box faces (``_lateral_faces``) and the completion's ``lateral``
+    (``_lateral``) in Python floats are numpy's former (2,)-array arithmetic to the bit: on seeded random boxes and
+    silhouettes, faces on both sides of the silhouette's and on it (a difference of 0, where ``np.where`` took
+    ``share``), and with NaN in the silhouette (numpy's ``.max()`` of two NaN where either is, then Python's
+    ``max``)."""
+    from symfruit import Box
+    from symfruit.core.raster import Across
+    from symfruit.methods.evidence import _lateral, _lateral_faces
+
+    rng = np.random.default_rng(47)
+    moved = 0
+    for i in range(500):
+        axis = np.array([*rng.normal(0.0, 0.2, 2), 1.0])
+        axis /= np.linalg.norm(axis)
+        across = Across(axis, np.zeros((2, 3)), -rng.uniform(0.01, 0.1, 2), rng.uniform(0.01, 0.1, 2), 0.05, 0.1)
+        half = rng.uniform(0.005, 0.06, 3)
+        centre = np.array([*rng.normal(0.0, 0.05, 2), rng.uniform(0.3, 1.0)])
+        box = Box(centre - half, centre + half)
+        front, back = float(box.min[2]), float(box.max[2] + rng.uniform(0.0, 0.01))
+        dist = 0.5 * (front + back) / axis[2]
+        if i % 10 == 0:  # the silhouette's faces where the box's are: differences of 0 (or a rounding)
+            across = Across(axis, np.zeros((2, 3)), box.min[:2] / dist - axis[:2], box.max[:2] / dist - axis[:2],
+                            0.05, 0.1)  # fmt: skip
+        grow = float(rng.uniform(0.0, 1.0))
+        share = grow * float(rng.uniform(0.0, 1.0)) ** 2
+        lo, hi = _lateral_faces(box, across, front, back, share, grow)
+        want_lo, want_hi = _former_faces(box, across, front, back, share, grow)
+        assert np.array_equal(np.array(lo), want_lo) and np.array_equal(np.array(hi), want_hi)
+        moved += bool(lo[0] != box.min[0])
+        assert _lateral(float(dist), across, box) == _former_lateral(float(dist), across, box)
+    assert moved > 300
+    box = Box(np.array([-0.03, -0.03, 0.5]), np.array([0.03, 0.03, 0.56]))
+    for bad in ((np.nan, 0.0), (0.0, np.nan), (np.nan, np.nan)):
+        for lo2, hi2 in ((np.array(bad), np.array([0.05, 0.05])), (np.array([-0.05, -0.05]), np.array(bad))):
+            across = Across(np.array([0.0, 0.0, 1.0]), np.zeros((2, 3)), lo2, hi2, 0.1, 0.1)
+            want, got = _former_lateral(0.53, across, box), _lateral(0.53, across, box)
+            assert (np.isnan(want) and np.isnan(got)) or want == got
+            assert np.isnan(want) == bool(np.isnan(lo2).any())  # Python's max keeps a NaN only when it comes first
+            want_lo, want_hi = _former_faces(box, across, 0.5, 0.56, 0.2, 0.5)
+            lo, hi = _lateral_faces(box, across, 0.5, 0.56, 0.2, 0.5)
+            assert np.array_equal(np.array(lo), want_lo, equal_nan=True)
+            assert np.array_equal(np.array(hi), want_hi, equal_nan=True)
+
+
+def test_clean_shares_clip_is_numpys():
+    """Issue 19, stop 47: ``_clip01`` (``clean_share``'s clip in Python floats) is ``float(np.clip(x, 0.0, 1.0))`` to
+    the bit: NaN, infinities, both zeros (numpy's clip keeps ``-0.0``), the ends, just beyond them and seeded random
+    values."""
+    from symfruit.methods.evidence import _clip01
+
+    values = [-0.0, 0.0, 1.0, -1.0, 2.0, 0.5, np.nan, np.inf, -np.inf, 5e-324, -5e-324, 1 - 2**-53, 1 + 2**-52]
+    values += np.random.default_rng(47).normal(0.5, 1.0, 2000).tolist()
+    for x in values:
+        assert np.array(_clip01(x)).tobytes() == np.array(float(np.clip(x, 0.0, 1.0))).tobytes()
+    assert clean_share(5.0, 3.0) == 1.0 and clean_share(1.0, 3.0) == 0.0 and clean_share(3.0, 3.0) == 0.5

@@ -447,15 +447,20 @@ def _bands_of_parts(rays: np.ndarray, parts: _BandParts) -> _Bands:
     if seen is not None:
         finite = np.isfinite(seen)
         counted = np.where(finite, 1.0, out_w)
-    out_wsum = np.array([counted[s : s + k].sum() for s, k in zip(out_starts, out_sizes, strict=True)])
+    # ``np.add.reduce`` is what ``ndarray.sum`` calls (the same sums, without its Python wrappers; issue 19, stop 47)
+    out_wsum = np.array([_add(counted[s : s + k]) for s, k in zip(out_starts, out_sizes, strict=True)])
     in_sizes_a = np.array(in_sizes, dtype=np.intp)
     out_sizes_a = np.array(out_sizes, dtype=np.intp)
+    out_rays = out_sizes_a > 0
     return _Bands(
         rays=np.concatenate((rays, parts.rays_in, parts.rays_out)), n_in=n_in,
         in_starts=np.array(in_starts, dtype=np.intp), in_sizes=in_sizes_a, in_ok=in_sizes_a > 0,
-        out_starts=np.array(out_starts, dtype=np.intp), out_w=out_w, out_wsum=out_wsum, out_rays=out_sizes_a > 0,
-        out_ok=(out_sizes_a > 0) & (out_wsum > 0), seen=seen, finite=finite,
+        out_starts=np.array(out_starts, dtype=np.intp), out_w=out_w, out_wsum=out_wsum, out_rays=out_rays,
+        out_ok=out_rays & (out_wsum > 0), seen=seen, finite=finite,
     )  # fmt: skip
+
+
+_add = np.add.reduce
 
 
 def _band_pixels(dist: np.ndarray, bands: tuple[float, ...], n_band: int) -> tuple[np.ndarray, np.ndarray]:

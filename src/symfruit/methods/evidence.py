@@ -403,7 +403,16 @@ def clean_share(ratio: float, threshold: float) -> float:
     local plane-fit residual with scale (:func:`~symfruit.core.fits.surface_noise`): 0 below
     ``threshold - 0.8``, 1 above ``threshold + 0.8``, linear between (clean scans measure 4.5-6.7,
     depth-camera views 1.5-2.2)."""
-    return float(np.clip((ratio - threshold + 0.8) / 1.6, 0.0, 1.0))
+    return _clip01(float((ratio - threshold + 0.8) / 1.6))
+
+
+def _clip01(x: float) -> float:
+    """``float(np.clip(x, 0.0, 1.0))`` of a float in Python (issue 19, stop 47: a scalar's ``np.clip`` costs some
+    5-10 us): NaN kept, and as numpy's clip an end is taken only where ``x`` is beyond it (``-0.0`` stays ``-0.0``)."""
+    if x != x:
+        return x
+    y = x if x >= 0.0 else 0.0
+    return y if y <= 1.0 else 1.0
 
 
 def combine(cands: list[Candidate], *, contour: float, clean: float, s: EvidenceSettings,
@@ -442,11 +451,28 @@ def combine(cands: list[Candidate], *, contour: float, clean: float, s: Evidence
     wrong = min((c.agreement.inside + c.agreement.outside for c in closed if c.agreement is not None),
                 default=2.0)  # fmt: skip
     size = float(box.size.max())
-    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     uncertainty = float(np.hypot(back_std, spread) + s.misfit_scale * wrong * size)
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     return Combined(box, dict(zip(names, w.tolist(), strict=True)), energies, confidence, spread,
                     1.0 - wrong / 2.0, contour, uncertainty)  # fmt: skip
+
+
+def _nanmax2(a: float, b: float) -> float:
+    """``np.max`` of two numbers: NaN where either is, else the greater."""
+    return math.nan if a != a or b != b else a if a >= b else b
+
+
+def _lateral(dist: float, sized: Across, box: Box) -> float:
+    """How far the silhouette's lateral extent at ``dist`` (``sized``: :func:`~symfruit.core.raster.across_sight`'s)
+    lies from ``box``'s lateral faces, on its worse side: ``max(np.abs(dist * (axis[:2] + lo) - box.min[:2]).max(),
+    np.abs(dist * (axis[:2] + hi) - box.max[:2]).max())`` in Python floats (issue 19, stop 47: the same products,
+    sums and absolute values; each ``.max()`` of two NaN where either is; the outer ``max`` Python's, as before)."""
+    (a0, a1, _), (s0, s1), (t0, t1) = sized.axis.tolist(), sized.lo.tolist(), sized.hi.tolist()
+    (l0, l1, _), (h0, h1, _) = box.min.tolist(), box.max.tolist()
+    low = _nanmax2(abs(dist * (a0 + s0) - l0), abs(dist * (a1 + s1) - l1))
+    high = _nanmax2(abs(dist * (a0 + t0) - h0), abs(dist * (a1 + t1) - h1))
+    return max(low, high)
 
 
 def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Tilt | None = None,
@@ -529,7 +555,8 @@ def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occl
 
 def rim_width(mask: np.ndarray, band: float = 0.15) -> float:
     """:func:`rim_coverage`'s rim width, pixels: ``band`` equivalent radii of the region ``mask``, at least 2."""
-    return max(2.0, band * float(np.sqrt(np.count_nonzero(mask) / np.pi)))  # the count: the sum's, 20x faster
+    # the count: the sum's, 20x faster; math.sqrt of the (non-negative) quotient: np.sqrt's, both correctly rounded
+    return max(2.0, band * math.sqrt(np.count_nonzero(mask) / np.pi))
 
 
 def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band: float = 0.15,
@@ -610,12 +637,12 @@ def fuse_depth(
     backs = np.array([c.hi[2] for c in cands])
     fit_back = float(box.max[2])
     spread = float((w * np.abs(backs - fit_back)).sum())
-    back_std = next((c.back_std for c in cands if c.name == "cone" and np.isfinite(c.back_std)), 0.0)
+    back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor)
                   * box.centre[2] / across.axis[2])  # fmt: skip
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
-    fit_sd = float(np.sqrt((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
+    fit_sd = math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
     if s.depth_ratio_sd <= 0 or width <= 0:
         return box, fit_sd, width
     front = float(box.min[2])
@@ -629,18 +656,27 @@ def fuse_depth(
     # The silhouette's box: its widths across the line of sight (a sphere's diameter wherever it is in the
     # image, where the pixel box times the depth is stretched off the optical axis), about the posterior
     # centre's point on the ray through the silhouette's centroid.
-    dist = 0.5 * (front + back) / across.axis[2]
-    sil_lo = dist * (across.axis[:2] + across.lo)
-    sil_hi = dist * (across.axis[:2] + across.hi)
     # Outwards by the prior's share alone: the fruit covers at least what it was seen to cover, cut or not
     # (the contour share only says how far beyond a cut edge it may reach, which pulls inwards).
-    grow = b / (a + b)
-    lo, hi = box.min.copy(), box.max.copy()
-    d_lo, d_hi = sil_lo - lo[:2], sil_hi - hi[:2]
-    lo[:2] += np.where(d_lo < 0.0, grow, share) * d_lo
-    hi[:2] += np.where(d_hi > 0.0, grow, share) * d_hi
+    lo, hi = _lateral_faces(box, across, front, back, share, b / (a + b))
+    return Box(np.array(lo), np.array(hi)), 1.0 / math.sqrt(a + b), width
+
+
+def _lateral_faces(box: Box, across: Across, front: float, back: float, share: float,
+                   grow: float) -> tuple[list[float], list[float]]:  # fmt: skip
+    """:func:`fuse_depth`'s box faces: ``box``'s lateral faces moved towards the silhouette's (``across``, about the
+    point at depth ``0.5 (front + back)`` on its centroid's ray) by ``grow`` outwards and ``share`` inwards, its
+    back face ``back``. In Python floats (issue 19, stop 47): the same products and sums as numpy's on the (2,)
+    arrays before, ``np.where``'s test a comparison (False for NaN there too), without a dozen numpy calls."""
+    (a0, a1, a2), (s0, s1), (t0, t1) = across.axis.tolist(), across.lo.tolist(), across.hi.tolist()
+    dist = 0.5 * (front + back) / a2
+    lo, hi = box.min.tolist(), box.max.tolist()
+    for i, (ax, sil_lo, sil_hi) in enumerate(((a0, s0, t0), (a1, s1, t1))):
+        d_lo, d_hi = dist * (ax + sil_lo) - lo[i], dist * (ax + sil_hi) - hi[i]
+        lo[i] += (grow if d_lo < 0.0 else share) * d_lo
+        hi[i] += (grow if d_hi > 0.0 else share) * d_hi
     hi[2] = back
-    return Box(lo, hi), float(1.0 / np.sqrt(a + b)), width
+    return lo, hi
 
 
 @register("evidence", settings=EvidenceSettings, occlusion=True)
@@ -735,17 +771,16 @@ def evidence(
     if dense and best_rms is not None and s.unexplained_scale > 0:
         if noise is None:
             _, noise = noise_measures(sample, queries=s.noise_queries)
-        unexplained = float(np.sqrt(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
+        unexplained = math.sqrt(float(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
     # What the outline says the shapes miss (docs/conf45.md): the share of it that is a cut, beyond which the fruit
     # was not seen, times the box's largest side; and how far the silhouette's lateral extent (across the line of
     # sight at the box's distance, as fuse_depth reads it) disagrees with the shapes' box, on its worse side.
     cut = (1.0 - combined.contour) * float(combined.box.size.max())
     dist = 0.5 * float(box.min[2] + box.max[2]) / float(sized.axis[2])
-    lateral = float(max(np.abs(dist * (sized.axis[:2] + sized.lo) - combined.box.min[:2]).max(),
-                        np.abs(dist * (sized.axis[:2] + sized.hi) - combined.box.max[:2]).max()))  # fmt: skip
-    uncertainty = elongation * float(np.sqrt(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2
-                                             + (s.unexplained_scale * unexplained) ** 2 + (s.cut_scale * cut) ** 2
-                                             + (s.lateral_scale * lateral) ** 2))  # fmt: skip
+    lateral = _lateral(dist, sized, combined.box)
+    uncertainty = elongation * math.sqrt(float(combined.uncertainty**2 + moved**2 + (s.recede_scale * recede) ** 2
+                                               + (s.unexplained_scale * unexplained) ** 2 + (s.cut_scale * cut) ** 2
+                                               + (s.lateral_scale * lateral) ** 2))  # fmt: skip
     confidence = float(np.exp(-uncertainty / s.uncertainty_scale))
     extras: dict[str, Any] = {
         "confidence": confidence,
