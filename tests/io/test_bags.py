@@ -662,3 +662,24 @@ def test_a_camera_info_with_binning_or_a_region_of_interest_is_refused():
     cropped = SimpleNamespace(x_offset=8, y_offset=4, width=320, height=240, do_rectify=False)
     with pytest.raises(InputError, match=r"CameraInfo field 'roi' is x_offset 8, y_offset 4, 320x240"):
         camera_from_info(SimpleNamespace(**{**info, "roi": cropped}))
+
+
+def test_a_ros2_bag_whose_mcap_is_damaged_is_said_in_our_words(tmp_path):
+    """Stop 47 (robust47): an MCAP file whose header record claims 72 PB was "cannot open bag (MemoryError)", one
+    ending after its magic "cannot open bag (ord() expected a character, but string of length 0 found)"."""
+    from symfruit.io.sources import open_source
+
+    for name, body, why in [("huge", b"\x01" * 999, "a record in the bag claims more bytes than memory holds: the bag "
+                             "is damaged"), ("cut", b"", "the file ends inside a record: the bag is cut short or "
+                             "damaged")]:  # fmt: skip
+        bag = tmp_path / name
+        bag.mkdir()
+        (bag / "metadata.yaml").write_text(
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths: [a.mcap]\n"
+            "  message_count: 1\n  topics_with_message_count: []\n  duration: {nanoseconds: 1}\n"
+            "  starting_time: {nanoseconds_since_epoch: 0}\n"
+        )
+        (bag / "a.mcap").write_bytes(b"\x89MCAP0\r\n" + body)
+        with pytest.raises(FileFormatError) as info:
+            open_source(bag)
+        assert str(info.value) == f"{bag}: cannot open bag ({why})"
