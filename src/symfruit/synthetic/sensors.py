@@ -400,9 +400,9 @@ def checked_sensor_set(changes: object) -> tuple[tuple[str, float], ...]:
         if name not in VARIABLE:  # the names near it, not all of them (a line of 394 characters; stop 47)
             from ..settings import _closest, known_names
 
+            close = _closest(str(name), VARIABLE)
             known = known_names(str(name), VARIABLE, where="symfruit.synthetic.sensors.VARIABLE")
-            raise InputError(f"--sensor-set {name!s:.40}: not a setting of a camera model{_closest(str(name), VARIABLE)}"
-                             f"; {known}")  # fmt: skip
+            raise InputError(f"--sensor-set {name!s:.40}: not a setting of a camera model{close}; {known}")
         low, high = VARIABLE[name]
         whole = isinstance(getattr(SENSOR_MODELS["azure-kinect"], name, 0.0), int)
         if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
