@@ -547,9 +547,9 @@ def settings_cases() -> None:
                 add(f"settings/{name}.{f.name}={label}", "error", lambda p=path: cli("settings", "--config", p),
                     f"{name}.{f.name}")  # fmt: skip
         # a misspelt key: the message names it and the nearby valid names, in one short line
-        for f in dataclasses.fields(cls):
+        for k, f in enumerate(dataclasses.fields(cls)):
             wrong = f.name[:-1] if len(f.name) > 4 else f.name + "s"
-            path = d / f"{name}.{f.name}.misspelt.yaml"
+            path = d / f"{name}.mis{k}.yaml"  # a short name: the line's length is the message's
             path.write_text(f"{name}:\n  {wrong}: 1\n")
             add(f"settings/{name}.{wrong}=unknown", "error", lambda p=path: cli("settings", "--config", p),
                 f.name)  # fmt: skip

@@ -683,3 +683,16 @@ def test_a_ros2_bag_whose_mcap_is_damaged_is_said_in_our_words(tmp_path):
         with pytest.raises(FileFormatError) as info:
             open_source(bag)
         assert str(info.value) == f"{bag}: cannot open bag ({why})"
+
+
+def test_random_bytes_named_bag_are_said_in_our_words(tmp_path):
+    """Stop 47 (robust47): "cannot open bag ('utf-8' codec can't decode byte 0xff in position 0: invalid start
+    byte)", Python's codec's words."""
+    from symfruit.io.sources import open_source
+
+    bag = tmp_path / "noise.bag"
+    bag.write_bytes(b"\xff" + np.random.default_rng(1).bytes(10_000))
+    with pytest.raises(FileFormatError) as info:
+        open_source(bag)
+    assert str(info.value) == (f"{bag}: cannot open bag (bytes that are no text where a bag holds text: not a bag, or "
+                               "a damaged one)")  # fmt: skip

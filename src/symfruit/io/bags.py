@@ -83,7 +83,8 @@ def damage_reason(exc: BaseException) -> str | None:
     another failure: a chunk that cannot be decompressed (the LZ4 library: ``RuntimeError: LZ4F_decompress failed
     with code: ERROR_decompressionFailed``), a record claiming more bytes than memory holds (``MemoryError``:
     rosbags reads a record's length from the file and asks for that many bytes) or a file ending inside a record
-    (``ord() expected a character, but string of length 0 found``). Stop 47 (robust47)."""
+    (``ord() expected a character, but string of length 0 found``), or bytes that are no UTF-8 where a bag holds text
+    (``'utf-8' codec can't decode byte 0xff in position 0``). Stop 47 (robust47)."""
     text = str(exc)
     if "decompress" in text.lower() or text.startswith("Invalid data stream"):  # LZ4, zstd; bz2
         return "a compressed chunk of the bag cannot be decompressed: the bag is damaged"
@@ -91,6 +92,8 @@ def damage_reason(exc: BaseException) -> str | None:
         return "a record in the bag claims more bytes than memory holds: the bag is damaged"
     if isinstance(exc, TypeError) and text.startswith("ord() expected a character"):
         return "the file ends inside a record: the bag is cut short or damaged"
+    if isinstance(exc, UnicodeDecodeError):  # rosbags decodes a ROS 1 bag's header fields as UTF-8
+        return "bytes that are no text where a bag holds text: not a bag, or a damaged one"
     return None
 
 
