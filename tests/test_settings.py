@@ -417,3 +417,23 @@ def test_an_empty_config_path_is_refused_as_such(config):
         resolve_settings(fruit="apple", config=config)  # before: '.: settings file must end in .yaml, .yml or .json'
     with pytest.raises(ConfigError, match="config is an empty path"):
         load_settings(config)
+
+
+def test_an_unknown_setting_of_a_large_section_names_the_near_ones_in_one_short_line(tmp_path):
+    # stop 47 (robust47): evidence.tilt_bends listed all 49 evidence settings, a line of 780 characters
+    config = tmp_path / "run.yaml"
+    config.write_text("evidence:\n  tilt_bends: true\n")
+    with pytest.raises(ConfigError) as info:
+        resolve_settings(config=config)
+    message = str(info.value)
+    assert message.endswith(
+        "run.yaml: unknown setting evidence.tilt_bends (did you mean 'tilt_bend'?); known: tilt_bend, tilt_blocks, "
+        "tilt_outline, prior_tilt, tilt_floor and 44 more (`symfruit settings` lists them with their values)"
+    )
+    assert len(message) - len(str(config)) < 220
+    with pytest.raises(ConfigError, match=r"unknown setting evidence\.zzz; known: back_inflation, back_trim, "
+                       r"band_rays, clean_ratio, contour_cone, contour_cut_energy and 43 more"):  # fmt: skip
+        resolve_settings(overrides={"evidence": {"zzz": 1}})
+    # a small section is still listed whole
+    with pytest.raises(ConfigError, match=r"unknown setting input\.max_pts.*; known: max_extent, max_points, "):
+        resolve_settings(overrides={"input": {"max_pts": 1}})

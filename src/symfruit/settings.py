@@ -48,6 +48,7 @@ __all__ = [
     "SettingError",
     "Settings",
     "from_dict",
+    "known_names",
     "load_settings",
     "merge",
     "read_settings_file",
@@ -346,8 +347,8 @@ def _build(cls: type, data: Mapping[str, Any], where: str) -> Any:
         raise ConfigError(f"{where or 'settings'}: setting names must be text, got {bad[0]!r}")
     unknown = sorted(set(data) - set(fields))
     if unknown:
-        raise ConfigError(f"unknown setting {prefix}{unknown[0]}{_closest(unknown[0], fields)}; known: "
-                          f"{', '.join(sorted(fields))}")  # fmt: skip
+        raise ConfigError(f"unknown setting {prefix}{unknown[0]}{_closest(unknown[0], fields)}; "
+                          f"{_known(unknown[0], fields)}")  # fmt: skip
     kwargs = {name: _coerce(value, hints[name], prefix + name) for name, value in data.items()}
     try:
         return cls(**kwargs)
@@ -377,6 +378,32 @@ def _closest(key: str, known: Iterable[str]) -> str:
 
     close = difflib.get_close_matches(key.lower(), list(known), n=1, cutoff=0.6)
     return f" (did you mean {close[0]!r}?)" if close else ""
+
+
+#: Characters of known names an unknown name's error lists whole; a longer list (evidence has 49 settings, 700
+#: characters) is cut to the names near the unknown one, so that the error stays one short line.
+KNOWN_LISTED = 160
+
+
+def known_names(key: str, known: Iterable[str], *, where: str) -> str:
+    """``known: ...`` for the error of an unknown name ``key``: every name of ``known`` where they are few
+    (:data:`KNOWN_LISTED` characters), else the ones near it (close in spelling, or sharing a word: ``tilt`` ->
+    ``tilt_bend, tilt_blocks, ...``; the first ones where none is), at most six, how many more there are and
+    ``where`` the rest are listed."""
+    import difflib
+
+    names = list(known)
+    listed = ", ".join(names)
+    if len(listed) <= KNOWN_LISTED:
+        return f"known: {listed}"
+    near = difflib.get_close_matches(str(key).lower(), names, n=3, cutoff=0.5)
+    words = {w for w in str(key).lower().replace(".", "_").split("_") if len(w) > 1}
+    near = (near + [n for n in names if n not in near and words & set(n.split("_"))])[:6] or names[:6]
+    return f"known: {', '.join(near)} and {len(names) - len(near)} more ({where})"
+
+
+def _known(key: str, known: Iterable[str]) -> str:
+    return known_names(key, sorted(known), where="`symfruit settings` lists them with their values")
 
 
 def _not_a_mapping(name: str, value: Any) -> Any:

@@ -605,3 +605,20 @@ def test_a_leaf_over_the_fruits_edge_is_no_mixed_gap(kernels, monkeypatch):
     assert seen_past and not (cut & ball).any()
     assert (cut & ~ball).sum() > 0.75 * (mask & ~ball).sum()
     assert np.nonzero((mask & ~cut & leaf.any(axis=1)[:, None]).any(axis=0))[0].max() == 96
+
+
+# --- stop 47, robust47
+
+
+@pytest.mark.parametrize("dtype", [">f8", ">f4", "f2"])
+def test_occlusion_reads_a_big_endian_or_float16_depth_as_its_native_float(dtype):
+    """Before: numba's TypingError from the kernels the depth went to as given (``python docs/robust43.py``:
+    occlusion/depth-float16, occlusion/depth-bigendian)."""
+    depth, disc, points = _disc_frame()
+    depth[12:18, :22] = 0.25  # a bar in front of the disc's left half
+    native = depth.astype(dtype).astype(np.dtype(dtype).newbyteorder("="))
+    want = occlusion(native, disc, points, CAM, trim_own=True)
+    got = occlusion(depth.astype(dtype), disc, points, CAM, trim_own=True)
+    assert want.hidden.any()
+    np.testing.assert_array_equal(got.hidden, want.hidden)
+    assert (got.u0, got.v0) == (want.u0, want.v0)

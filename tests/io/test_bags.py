@@ -662,3 +662,37 @@ def test_a_camera_info_with_binning_or_a_region_of_interest_is_refused():
     cropped = SimpleNamespace(x_offset=8, y_offset=4, width=320, height=240, do_rectify=False)
     with pytest.raises(InputError, match=r"CameraInfo field 'roi' is x_offset 8, y_offset 4, 320x240"):
         camera_from_info(SimpleNamespace(**{**info, "roi": cropped}))
+
+
+def test_a_ros2_bag_whose_mcap_is_damaged_is_said_in_our_words(tmp_path):
+    """Stop 47 (robust47): an MCAP file whose header record claims 72 PB was "cannot open bag (MemoryError)", one
+    ending after its magic "cannot open bag (ord() expected a character, but string of length 0 found)"."""
+    from symfruit.io.sources import open_source
+
+    for name, body, why in [("huge", b"\x01" * 999, "a record in the bag claims more bytes than memory holds: the bag "
+                             "is damaged"), ("cut", b"", "the file ends inside a record: the bag is cut short or "
+                             "damaged")]:  # fmt: skip
+        bag = tmp_path / name
+        bag.mkdir()
+        (bag / "metadata.yaml").write_text(
+            "rosbag2_bagfile_information:\n  version: 5\n  storage_identifier: mcap\n  relative_file_paths: [a.mcap]\n"
+            "  message_count: 1\n  topics_with_message_count: []\n  duration: {nanoseconds: 1}\n"
+            "  starting_time: {nanoseconds_since_epoch: 0}\n"
+        )
+        (bag / "a.mcap").write_bytes(b"\x89MCAP0\r\n" + body)
+        with pytest.raises(FileFormatError) as info:
+            open_source(bag)
+        assert str(info.value) == f"{bag}: cannot open bag ({why})"
+
+
+def test_random_bytes_named_bag_are_said_in_our_words(tmp_path):
+    """Stop 47 (robust47): "cannot open bag ('utf-8' codec can't decode byte 0xff in position 0: invalid start
+    byte)", Python's codec's words."""
+    from symfruit.io.sources import open_source
+
+    bag = tmp_path / "noise.bag"
+    bag.write_bytes(b"\xff" + np.random.default_rng(1).bytes(10_000))
+    with pytest.raises(FileFormatError) as info:
+        open_source(bag)
+    assert str(info.value) == (f"{bag}: cannot open bag (bytes that are no text where a bag holds text: not a bag, or "
+                               "a damaged one)")  # fmt: skip

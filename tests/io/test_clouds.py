@@ -442,3 +442,14 @@ def test_a_link_that_leads_to_no_file_is_named_as_such_not_no_such_file(tmp_path
         read_cloud(link)  # before: 'no such file', though cloud.ply is there
     with pytest.raises(FileFormatError, match=r"nothing\.ply: no such file"):
         read_cloud(tmp_path / "nothing.ply")
+
+
+def test_an_npy_header_cut_short_says_so_in_its_own_words(tmp_path):
+    # stop 47 (robust47): numpy's words and type were quoted, "(ValueError: EOF: reading array header, expected
+    # 49912 bytes got 498)"
+    path = tmp_path / "cut.npy"
+    path.write_bytes(b"\x93NUMPY\x01\x00" + b"\xf8\xc2" + b"x" * 498)
+    with pytest.raises(FileFormatError) as info:
+        read_cloud(path)
+    assert str(info.value) == (f"{path}: not a valid .npy file (its array header claims 49,912 bytes but only 498 "
+                               "follow: cut short or damaged)")  # fmt: skip

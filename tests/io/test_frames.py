@@ -546,3 +546,24 @@ def test_write_frame_refuses_an_empty_folder_path(tmp_path, monkeypatch):
     with pytest.raises(InputError, match="write_frame: the frame folder is an empty path"):
         write_frame("", color, depth, SMALL_CAM)  # before: color.png, depth.png, camera.json into the working folder
     assert not list(tmp_path.iterdir())
+
+
+def test_a_frame_whose_camera_json_does_not_fit_its_images_names_camera_json(tmp_path):
+    """Stop 47 (robust47): the frame folder alone was named for intrinsics of another size, and depth.png for a
+    camera.json depth_scale of 1e-9 ("give the depth scale its units stand for", which camera.json states)."""
+    from symfruit.io.frames import read_frame
+
+    frame = tmp_path / "frame"
+    shutil.copytree(EXAMPLE_FRAME, frame)
+    cam = json.loads((frame / "camera.json").read_text())
+    (frame / "camera.json").write_text(json.dumps({**cam, "width": 1920}))
+    with pytest.raises(InputError) as info:
+        read_frame(frame)
+    assert str(info.value) == (f"{frame / 'camera.json'}: intrinsics are for 1920x480 but the images are 640x480; "
+                               "give the colour camera's intrinsics at the images' size")  # fmt: skip
+    (frame / "camera.json").write_text(json.dumps({**cam, "depth_scale": 1e-9}))
+    with pytest.raises(InputError) as info:
+        read_frame(frame)
+    assert str(info.value) == (f"{frame / 'camera.json'}: depth_scale 1e-09 m per unit: depth.png's 16-bit units "
+                               "would reach only 6.55e-05 m, and no camera measures depth that finely (0.001 for "
+                               "millimetres)")  # fmt: skip

@@ -295,3 +295,14 @@ def test_a_transparent_pixel_of_an_rgba_label_image_is_background(tmp_path):
     assert out.tolist() == [[0, 2, 0], [1, 0, 2]]  # before: [[3, 2, 3], [1, 3, 2]], the background fruit 3
     rgba[:, :, 3] = 255  # opaque white: a colour like any other (no black in the image: every colour a fruit)
     assert read_labels(save(Image.fromarray(rgba, "RGBA"), tmp_path / "opaque.png")).tolist() == [[3, 2, 3], [1, 3, 2]]
+
+
+def test_a_float_depth_tiff_says_where_float_metres_are_read(tmp_path):
+    """Stop 47 (robust47): "depth TIFF must be single-channel 16-bit, got mode 'F'" for a float32 TIFF of metres,
+    as many tools save depth, without saying how symfruit reads float metres."""
+    path = save(Image.fromarray(np.full((4, 6), 0.5, np.float32)), tmp_path / "depth.tiff")
+    with pytest.raises(FileFormatError) as info:
+        read_depth_units(path)
+    assert str(info.value) == (f"{path}: depth TIFF holds 32-bit floats; a depth image must hold 16-bit units "
+                               "(depth in float metres is read from a .npy file: numpy.save('depth.npy', "
+                               "metres))")  # fmt: skip

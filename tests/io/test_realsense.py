@@ -513,3 +513,17 @@ def test_a_camera_info_distortion_is_counted_before_any_value_is_converted(monke
     monkeypatch.setattr(realsense.RealSenseBagSource, "_only", poisoned)
     with pytest.raises(FileFormatError, match=r"Color_0: camera info K has 9 values and D 100000; expected 9 and 5"):
         RealSenseBagSource(BAG)
+
+
+def test_a_chunk_that_cannot_be_decompressed_is_said_in_our_words(tmp_path):
+    """Stop 47 (robust47): 256 random bytes at a tenth of fruit.bag (inside an LZ4 chunk) gave the LZ4 library's
+    words, "cannot index bag (RuntimeError: LZ4F_decompress failed with code: ERROR_decompressionFailed)"."""
+    data = bytearray(BAG.read_bytes())
+    at = len(data) // 10
+    data[at : at + 256] = np.random.default_rng(0).integers(0, 256, 256, dtype=np.uint8).tobytes()
+    path = tmp_path / "flipped.bag"
+    path.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError) as info:
+        open_source(path)
+    assert str(info.value) == (f"{path}: cannot index bag (a compressed chunk of the bag cannot be decompressed: the "
+                               "bag is damaged)")  # fmt: skip

@@ -195,3 +195,18 @@ def test_yaml_numbers_with_an_exponent_are_numbers_as_in_yaml_1_2(tmp_path):
     import yaml
 
     assert yaml.safe_load("1e6") == "1e6"  # PyYAML's own loader is left as it is
+
+
+def test_a_yaml_error_is_one_short_line_with_its_position(tmp_path):
+    # stop 47 (robust47): PyYAML's message quotes the line and a caret under it: a quote left open in a settings
+    # file or a cut metadata.yaml gave 307-361 characters over several lines
+    path = tmp_path / "run.yaml"
+    path.write_text("evidence:\n  hidden_front: 'sph")
+    with pytest.raises(ConfigError) as info:
+        load_settings(path)
+    assert str(info.value) == (f"{path}: not valid YAML: while scanning a quoted scalar: found unexpected end of "
+                               "stream (at line 2, column 21)")  # fmt: skip
+    path.write_text("a:\n  b: [1, 2\n")
+    with pytest.raises(FileFormatError, match=r"run\.yaml: not valid YAML: while parsing a flow sequence: expected "
+                       r"',' or '\]', but got '<stream end>' \(at line 3, column 1\)$"):  # fmt: skip
+        read_structured(path, what="file", max_bytes=1000)

@@ -420,3 +420,17 @@ def test_noise_corr_px_is_set_by_sensor_set():
     assert varied(d435, parse_sensor_set("noise_corr_px=7.5")).noise_corr_px == 7.5
     with pytest.raises(InputError, match="noise_corr_px=25: must be 0 to 20"):
         parse_sensor_set("noise_corr_px=25")
+
+
+def test_an_unknown_sensor_set_name_names_the_near_ones_in_one_short_line():
+    """Stop 47 (robust47): every one of the 23 names was listed, `symfruit evaluate ... --sensor-set rim_invalid=3`
+    a line of 394 characters."""
+    from symfruit.errors import InputError
+    from symfruit.synthetic.sensors import parse_sensor_set, sensor_model, varied
+
+    with pytest.raises(InputError) as info:
+        varied(sensor_model("azure-kinect"), parse_sensor_set("rim_invalid=3"))
+    assert str(info.value) == (
+        "--sensor-set rim_invalid: not a setting of a camera model (did you mean 'rim_invalid_px'?); known: "
+        "rim_invalid_px, rim_far_px and 21 more (symfruit.synthetic.sensors.VARIABLE)"
+    )

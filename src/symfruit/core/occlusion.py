@@ -289,6 +289,10 @@ class Occlusion:
         return float(self.hidden.mean()) if self.hidden.size else 0.0
 
 
+#: The depth dtypes the kernels read (native byte order).
+_NATIVE_FLOATS = (np.dtype(np.float32), np.dtype(np.float64))
+
+
 def occlusion(
     depth: np.ndarray,
     mask: np.ndarray,
@@ -376,6 +380,8 @@ def occlusion(
     # int64 is float64 in numba, no slice index)
     tolerance, reach, pad, band, eroded = _check_parameters(tolerance, reach, pad, band, eroded)
     depth = np.asarray(depth) if checked else depth_metres(depth, "occlusion depth")
+    if depth.dtype not in _NATIVE_FLOATS:  # float16, big-endian: every kernel below reads native float32 or float64
+        depth = depth.astype(np.float64 if depth.dtype.itemsize > 4 else np.float32)  # (stop 47: numba TypingErrors)
     mask = np.asarray(mask, dtype=bool)
     shape = (camera.height, camera.width)
     if depth.shape != shape or mask.shape != shape:

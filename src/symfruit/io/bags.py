@@ -78,10 +78,38 @@ def _require_rosbags() -> Any:
 REASON_CHARS = 160
 
 
+def damage_reason(exc: BaseException) -> str | None:
+    """What a damaged bag made rosbags (or the compression library under it) fail with, in our words, or None for
+    another failure: a chunk that cannot be decompressed (the LZ4 library: ``RuntimeError: LZ4F_decompress failed
+    with code: ERROR_decompressionFailed``), a record claiming more bytes than memory holds (``MemoryError``:
+    rosbags reads a record's length from the file and asks for that many bytes) or a file ending inside a record
+    (``ord() expected a character, but string of length 0 found``), or bytes that are no UTF-8 where a bag holds text
+    (``'utf-8' codec can't decode byte 0xff in position 0``). Stop 47 (robust47)."""
+    text = str(exc)
+    if "decompress" in text.lower() or text.startswith("Invalid data stream"):  # LZ4, zstd; bz2
+        return "a compressed chunk of the bag cannot be decompressed: the bag is damaged"
+    if isinstance(exc, MemoryError):
+        return "a record in the bag claims more bytes than memory holds: the bag is damaged"
+    if isinstance(exc, TypeError) and text.startswith("ord() expected a character"):
+        return "the file ends inside a record: the bag is cut short or damaged"
+    if isinstance(exc, UnicodeDecodeError):  # rosbags decodes a ROS 1 bag's header fields as UTF-8
+        return "bytes that are no text where a bag holds text: not a bag, or a damaged one"
+    return None
+
+
+def index_reason(exc: BaseException) -> str:
+    """Why indexing a bag failed inside rosbags, one short line: :func:`damage_reason`'s words where it knows
+    them, else the exception's type and :func:`reader_reason`."""
+    return damage_reason(exc) or f"{type(exc).__name__}: {reader_reason(exc)}"
+
+
 def reader_reason(exc: BaseException) -> str:
     """One short line saying why rosbags refused a bag: a message definition it cannot parse is named as that
-    (rosbags quotes the whole definition, several lines, in its message), anything else is its first line, cut
-    to :data:`REASON_CHARS` characters."""
+    (rosbags quotes the whole definition, several lines, in its message), a damaged bag as :func:`damage_reason`
+    says, anything else is its first line, cut to :data:`REASON_CHARS` characters."""
+    damaged = damage_reason(exc)
+    if damaged is not None:
+        return damaged
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"
@@ -438,8 +466,7 @@ class BagSource:
             raise FileFormatError(f"{self.path}: {exc}") from None
         except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
             self.close()
-            reason = f"{type(exc).__name__}: {reader_reason(exc)}"
-            raise FileFormatError(f"{self.path}: cannot index bag ({reason})") from None
+            raise FileFormatError(f"{self.path}: cannot index bag ({index_reason(exc)})") from None
 
     def _index(self) -> None:
         conns = self._reader.connections

@@ -496,7 +496,7 @@ def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
     except FileFormatError:
         raise
     except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...
-        raise FileFormatError(f"{path}: not a valid .npy file ({type(exc).__name__}: {exc})") from None
+        raise FileFormatError(f"{path}: not a valid .npy file ({_npy_reason(exc)})") from None
     if dtype.hasobject:
         raise FileFormatError(f"{path}: .npy holds Python objects; symfruit never unpickles files")
     need = int(np.prod(shape, dtype=np.float64) * dtype.itemsize)
@@ -504,6 +504,17 @@ def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
         raise FileFormatError(f"{path}: .npy header promises {shape} {dtype} ({need} bytes) but the file holds "
                               f"{size - start} bytes of data")  # fmt: skip
     return tuple(int(v) for v in shape), dtype
+
+
+def _npy_reason(exc: BaseException) -> str:
+    """Why numpy could not read a ``.npy`` header, in a few words: a header cut short says so (numpy: ``EOF: reading
+    array header, expected 49912 bytes got 498``), anything else is numpy's first line, cut to 120 characters."""
+    text = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
+    cut = re.match(r"EOF: reading (.+?), expected (\d+) bytes got (\d+)", text)
+    if cut:
+        return (f"its {cut.group(1)} claims {int(cut.group(2)):,} bytes but only {int(cut.group(3)):,} follow: cut "
+                "short or damaged")  # fmt: skip
+    return f"its header cannot be parsed: {text[:120]}"
 
 
 def read_npy(path: Path) -> np.ndarray:
@@ -514,7 +525,7 @@ def read_npy(path: Path) -> np.ndarray:
     try:
         arr = np.load(path, allow_pickle=False, mmap_mode="r")
     except Exception as exc:  # numpy parses the header with ast/tokenize: SyntaxError, TokenError, ...
-        raise FileFormatError(f"{path}: not a valid .npy file ({type(exc).__name__}: {exc})") from None
+        raise FileFormatError(f"{path}: not a valid .npy file ({_npy_reason(exc)})") from None
     if arr.dtype.names:
         missing = [c for c in ("x", "y", "z") if c not in arr.dtype.names]
         if missing:

@@ -43,6 +43,7 @@ from ..core.limits import (
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
 from .images import (
+    MIN_16BIT_DEPTH_REACH,
     float_depth,
     orientation_mismatch,
     read_color_oriented,
@@ -135,8 +136,17 @@ def read_frame(folder: str | Path) -> Frame:
     depth_file = _only(folder, "depth.png", "depth.npy")
     if depth_file is None:
         raise FileFormatError(f"{folder}: no depth.png or depth.npy{_not_read(folder, 'depth')}")
+    if depth_file.suffix.lower() != ".npy" and 65535 * scale < MIN_16BIT_DEPTH_REACH:  # the scale's file, named
+        raise InputError(f"{cam_path}: depth_scale {scale:g} m per unit: {depth_file.name}'s 16-bit units would reach "
+                         f"only {65535 * scale:.3g} m, and no camera measures depth that finely (0.001 for "
+                         "millimetres)")  # fmt: skip
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
+    if (camera.height, camera.width) != color.shape[:2] == depth.shape[:2]:  # the intrinsics' file named (the frame
+        # alone before; images of two sizes: the Frame's error says which)
+        raise InputError(f"{cam_path}: intrinsics are for {camera.width}x{camera.height} but the images are "
+                         f"{color.shape[1]}x{color.shape[0]}; give the colour camera's intrinsics at the images' "
+                         "size")  # fmt: skip
     # a label image too must turn as the colour does: a mirrored or half-turned mask keeps the size
     oriented = (str(color_path), color_orientation)
     masks = read_masks(folder, color.shape[:2], color=oriented) if _only(folder, "masks.png", "masks.json") else None

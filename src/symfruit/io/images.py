@@ -308,6 +308,10 @@ def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -
         _single(img, str(path), "a depth image")
         img, orientation = _decode(img, str(path))
         kind = f"depth {img.format or 'image'}"  # PNG, TIFF, ... (a folder of depth images may hold any)
+        if img.mode == "F":  # a float TIFF of metres, as many tools write depth: say where float depth is read
+            raise FileFormatError(f"{path}: {kind} holds 32-bit floats; a depth image must hold 16-bit units "
+                                  "(depth in float metres is read from a .npy file: numpy.save('depth.npy', "
+                                  "metres))")  # fmt: skip
         if img.mode not in _WIDE_GREY and img.mode != "L":
             raise FileFormatError(f"{path}: {kind} must be single-channel 16-bit, got mode {img.mode!r}")
         if img.mode == "L" and scale is not None and 255 * scale < MIN_8BIT_DEPTH_REACH:

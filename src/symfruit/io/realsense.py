@@ -43,7 +43,7 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..core.limits import shown
 from ..errors import FileFormatError, InputError, SymfruitError
-from .bags import _require_rosbags, color_image, image_array, reader_reason
+from .bags import _require_rosbags, color_image, image_array, index_reason, reader_reason
 from .frames import named_frame
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 
@@ -129,8 +129,7 @@ class RealSenseBagSource:
             raise FileFormatError(f"{self.path}: {exc}") from None
         except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
             self.close()
-            reason = f"{type(exc).__name__}: {reader_reason(exc)}"
-            raise FileFormatError(f"{self.path}: cannot index bag ({reason})") from None
+            raise FileFormatError(f"{self.path}: cannot index bag ({index_reason(exc)})") from None
 
     # --- indexing ---------------------------------------------------------------------------------------
 

@@ -201,5 +201,24 @@ def read_structured(
     except RecursionError:
         raise error(f"{path}: {what} is nested too deeply to be a {what}") from None
     except Exception as exc:  # json.JSONDecodeError / yaml.YAMLError carry the position
-        message = str(exc).replace("\n", " ")
-        raise error(f"{path}: not valid {kind}: {message}") from None
+        raise error(f"{path}: not valid {kind}: {_parse_reason(exc)}") from None
+
+
+#: Longest parser reason quoted in a refusal.
+PARSE_REASON_CHARS = 160
+
+
+def _parse_reason(exc: BaseException) -> str:
+    """One short line saying why a JSON or YAML parser refused a file: a YAML error's problem, context and
+    position (PyYAML's own message quotes the line and a caret under it over several lines: 300-400 characters
+    for a quote left open), anything else its first line, cut to :data:`PARSE_REASON_CHARS` characters."""
+    problem = getattr(exc, "problem", None)
+    mark = getattr(exc, "problem_mark", None)
+    if isinstance(problem, str) and mark is not None:  # yaml.MarkedYAMLError
+        context = getattr(exc, "context", None)
+        text = f"{context}: {problem}" if isinstance(context, str) and context else problem
+        text = f"{text} (at line {mark.line + 1}, column {mark.column + 1})"
+    else:
+        lines = str(exc).strip().splitlines()
+        text = lines[0].strip() if lines else type(exc).__name__
+    return text if len(text) <= PARSE_REASON_CHARS else f"{text[:PARSE_REASON_CHARS]}..."

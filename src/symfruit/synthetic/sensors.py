@@ -397,9 +397,12 @@ def checked_sensor_set(changes: object) -> tuple[tuple[str, float], ...]:
         if not isinstance(pair, list | tuple) or len(pair) != 2:
             raise InputError(f"sensor_set: expected (name, value) pairs, got {pair!r:.60}")
         name, value = pair
-        if name not in VARIABLE:
-            known = ", ".join(VARIABLE)
-            raise InputError(f"--sensor-set {name!s:.40}: not a setting of a camera model; known: {known}")
+        if name not in VARIABLE:  # the names near it, not all of them (a line of 394 characters; stop 47)
+            from ..settings import _closest, known_names
+
+            close = _closest(str(name), VARIABLE)
+            known = known_names(str(name), VARIABLE, where="symfruit.synthetic.sensors.VARIABLE")
+            raise InputError(f"--sensor-set {name!s:.40}: not a setting of a camera model{close}; {known}")
         low, high = VARIABLE[name]
         whole = isinstance(getattr(SENSOR_MODELS["azure-kinect"], name, 0.0), int)
         if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
