@@ -613,3 +613,18 @@ def test_a_front_hidden_behind_a_leaf_is_placed_by_the_sphere_through_the_seen_c
                                             seed=1)  # fmt: skip
     occ = occlusion(depth, mask, visible, DEFAULT_CAMERA)
     assert complete(visible, occlusion=occ).box.min[2] == complete(visible, occlusion=occ, settings=off).box.min[2]
+
+
+# --- stop 47, pearview47
+
+
+def test_sections_are_off_by_default_and_move_only_a_sparse_clouds_solid():
+    assert EvidenceSettings().sections == 0.0
+    inst = build(Spec("paper", "pear", 1, 9, 0.0, 0))  # seed 0's second pear across the view: 0.90 deep over wide
+    base = complete(inst.visible, camera=inst.camera)
+    on = complete(inst.visible, camera=inst.camera, settings={"evidence": {"sections": 0.5}})
+    back = inst.truth_box.max[2]
+    assert abs(on.box.max[2] - back) < abs(base.box.max[2] - back)
+    visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=4)  # a camera's view: not read
+    dense = complete(visible, settings={"evidence": {"sections": 0.5}})
+    assert dense.box.max.tobytes() == complete(visible).box.max.tobytes()
