@@ -178,3 +178,54 @@ def test_plausible_is_the_former_array_arithmetic():
         # the corners as the lists of Python floats candidates() hands it (issue 19, stop 45): the same decision
         listed = (lo.tolist(), hi.tolist(), seen_lo.tolist(), seen_hi.tolist())
         assert _plausible(*listed, reach, lateral=lateral, width=width) is want
+
+
+# --- stop 47, pearview47
+
+
+def _half_ellipsoid(ratio: float, angle: float, n: int, seed: int) -> tuple[np.ndarray, float]:
+    """The paper's visible half (:func:`~symfruit.synthetic.shapes.paper_visible`) of ``n`` points on an ellipsoid,
+    35 mm across, 45 along its axis (y, turned ``angle`` degrees about x), ``35 ratio`` deep, 0.3 m away; and its
+    back face's depth."""
+    from symfruit.synthetic.shapes import paper_visible, rotation_x
+
+    rng = np.random.default_rng(seed)
+    u = rng.normal(size=(40 * n, 3))
+    u /= np.linalg.norm(u, axis=1)[:, None]
+    radii = np.array([0.035, 0.045, 0.035 * ratio])
+    g = 1.0 / np.linalg.norm(u / radii, axis=1)  # about uniform over the surface
+    p = (u * radii)[rng.random(len(u)) < g / g.max()][:n] @ rotation_x(angle).T + [0.0, 0.0, 0.3]
+    return p[paper_visible(p)], float(p[:, 2].max())
+
+
+@pytest.mark.parametrize(("ratio", "angle"), [(0.85, 0.0), (1.0, 0.0), (1.15, 0.0), (0.85, 20.0), (1.15, 20.0)])
+def test_the_section_ratio_is_read_off_the_seen_half(ratio, angle):
+    from symfruit.core.candidates import section_ratio
+    from symfruit.core.fits import fit_revolution_slices
+
+    seen, _ = _half_ellipsoid(ratio, angle, 4000, 3)
+    assert section_ratio(seen, fit_revolution_slices(seen).direction) == pytest.approx(ratio, abs=0.03)
+
+
+def test_no_section_ratio_along_the_line_of_sight_or_on_a_thin_cap():
+    from symfruit.core.candidates import section_ratio
+
+    seen, _ = _half_ellipsoid(0.85, 0.0, 4000, 3)
+    assert section_ratio(seen, np.array([0.0, 0.4, np.sqrt(0.84)])) == 1.0  # the axis 66 deg out of the image
+    cap = seen[seen[:, 2] < seen[:, 2].min() + 0.004]  # 4 mm of the front: no slice seen deep enough
+    assert section_ratio(cap, np.array([0.0, 1.0, 0.0])) == 1.0
+
+
+def test_sections_bring_the_solids_back_to_a_flattened_fruits():
+    seen, back = _half_ellipsoid(0.85, 0.0, 1200, 5)
+    obs = observe(seen, silhouette(seen, DEFAULT_CAMERA), DEFAULT_CAMERA)
+    kwargs = {"sample": seen, "obs": obs, "camera": DEFAULT_CAMERA, "front": float(seen[:, 2].min()),
+              "shapes": ("revolution",)}  # fmt: skip
+    circles = {c.name: c for c in candidates(seen, **kwargs)}["revolution"]
+    flat = {c.name: c for c in candidates(seen, **kwargs, sections=1.0)}["revolution"]
+    # circles through a section 0.85 as deep as wide: about 35 * 2 * 0.15 = 10 mm too deep
+    assert circles.hi[2] - back > 0.006
+    assert abs(flat.hi[2] - back) < 0.3 * (circles.hi[2] - back)
+    assert flat.lo.tolist()[:2] == pytest.approx(circles.lo.tolist()[:2], abs=0.002)
+    again = {c.name: c for c in candidates(seen, **kwargs, sections=0.0)}["revolution"]
+    assert again.hi.tobytes() == circles.hi.tobytes()  # 0: the circles, to the bit

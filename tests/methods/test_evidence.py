@@ -690,3 +690,18 @@ def test_clean_shares_clip_is_numpys():
     for x in values:
         assert np.array(_clip01(x)).tobytes() == np.array(float(np.clip(x, 0.0, 1.0))).tobytes()
     assert clean_share(5.0, 3.0) == 1.0 and clean_share(1.0, 3.0) == 0.0 and clean_share(3.0, 3.0) == 0.5
+
+
+# --- stop 47, pearview47
+
+
+def test_sections_are_off_by_default_and_move_only_a_sparse_clouds_solid():
+    assert EvidenceSettings().sections == 0.0
+    inst = build(Spec("paper", "pear", 1, 9, 0.0, 0))  # seed 0's second pear across the view: 0.90 deep over wide
+    base = complete(inst.visible, camera=inst.camera)
+    on = complete(inst.visible, camera=inst.camera, settings={"evidence": {"sections": 0.5}})
+    back = inst.truth_box.max[2]
+    assert abs(on.box.max[2] - back) < abs(base.box.max[2] - back)
+    visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=4)  # a camera's view: not read
+    dense = complete(visible, settings={"evidence": {"sections": 0.5}})
+    assert dense.box.max.tobytes() == complete(visible).box.max.tobytes()

@@ -39,6 +39,7 @@ from . import lapack
 from .agreement import Agreement, Inside, Observation, Quadric, explain
 from .camera import Camera
 from .fits import (
+    Revolution,
     RevolutionInside,
     ScaledCloud,
     box_and_profile,
@@ -55,7 +56,7 @@ from .points import as_points, bounds
 from .raster import Silhouette, View
 from .symmetry import complete_by_symmetry
 
-__all__ = ["REACH", "SHAPES", "Candidate", "candidates", "constrain_box"]
+__all__ = ["REACH", "SHAPES", "Candidate", "candidates", "constrain_box", "section_ratio"]
 
 #: No face of a candidate's box lies farther than this many seen extents from the opposite seen face (see
 #: :func:`constrain_box`).
@@ -216,6 +217,7 @@ def candidates(
     plausible: tuple[float, float] | None = None,
     width: float = 0.0,
     seen: tuple[np.ndarray, np.ndarray] | None = None,
+    sections: float = 0.0,
 ) -> list[Candidate]:
     """Fit and measure every candidate of one view.
 
@@ -263,6 +265,11 @@ def candidates(
     seen : ((3,), (3,)) float, metres, optional
         :func:`~symfruit.core.points.bounds` of ``points``, when the caller has them (not read again; issue 19,
         stop 42).
+    sections : float in [0, 1]
+        How far the solid of revolution's sections go from circles towards the depth-over-width ratio the view
+        shows (:func:`section_ratio`; refitted squashed across its axis, clipped to :data:`SECTION_CLIP`): 0
+        circles (as before stop 47); meant for clouds whose seen edge lies at the sections' widest (the paper's
+        visibility cut), not for a camera's rim, which perspective puts in front of it.
 
     Returns
     -------
@@ -281,7 +288,7 @@ def candidates(
     else:  # the seen points' pixel box
         cone = (_projected_box(points, max(1, len(points) // 4000), camera), camera)
     fit = _Fitting(sample, obs, camera, front, extent, region, outline_profile, revolution_points,
-                   revolution_coarse)  # fmt: skip
+                   revolution_coarse, sections=sections)  # fmt: skip
     constrain = _constrainer(seen_lo, seen_hi, front, cone, obs.contour, pull)
     out: list[Candidate] = []
     seen_floats = _floats(seen_lo), _floats(seen_hi)  # once for every candidate's plausibility
@@ -385,6 +392,7 @@ class _Fitting:
     revolution_coarse: int
     axes: list[np.ndarray] = field(default_factory=list)
     cloud: ScaledCloud | None = None
+    sections: float = 0.0
 
     def scaled(self) -> ScaledCloud:
         """:func:`~symfruit.core.fits.scaled_cloud` of the sample, made once for the sphere and the ellipsoid (issue
@@ -439,6 +447,8 @@ def _revolution(fit: _Fitting) -> Iterator[_Shape]:
     rev = fit_revolution_slices(fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)],
                                 extra_directions=np.concatenate(fit.axes) if fit.axes else None,
                                 coarse=fit.revolution_coarse)  # fmt: skip
+    if fit.sections > 0.0:
+        rev = _sectioned(fit, rev)
     if fit.region is not None and fit.outline_profile != "off":
         region = fit.region
         r_out = outline_radii(rev, region.mask, (region.u0, region.v0), fit.camera, hidden=fit.obs.hidden_map())
@@ -451,6 +461,110 @@ def _revolution(fit: _Fitting) -> Iterator[_Shape]:
                          0.5 * (olo + ohi))  # fmt: skip
     lo, hi, t, r = box_and_profile(rev)  # the box and the profile its march reads, in one call (issue 19, stop 41)
     yield _Shape("revolution", lo, hi, RevolutionInside(rev, profile=(t, r)), 0.5 * (lo + hi))
+
+
+#: The section ratio :func:`candidates`' ``sections`` may move the solid of revolution to (its sections' depth over
+#: width), after the share.
+SECTION_CLIP = (0.85, 1.15)
+
+
+def section_ratio(points: np.ndarray, direction: np.ndarray, *, bins: int = 8, span: float = 0.6,
+                  inner: float = 0.85, min_sag: float = 0.6) -> float:  # fmt: skip
+    """The depth-over-width ratio of a solid of revolution's sections as the seen points show it (issue 18, stop 47,
+    docs/pearview47.md); 1 where they cannot tell.
+
+    The points (n, 3), metres, the camera at the origin looking along +z, are sliced by planes along the line of
+    sight across ``direction``'s image direction (``bins`` slices over the middle ``span`` of the points along it).
+    In each slice the lateral extremes give the half-width ``a`` and the middle (both as quadratics along the axis,
+    so that the profile's change within a slice does not read as depth), and the depths are fitted as ``z = z_c - B
+    sqrt(1 - u^2)``, ``u`` the lateral offset over ``a`` (points beyond ``inner`` of it left out: a sparse sample's
+    extremes fall short of the widest point, where ``u`` is most sensitive). That presumes the seen edge lies at the
+    sections' widest (``z_c``): the paper's visibility cut through the axis, an orthographic view's rim. The
+    slices' ``z_c`` along the axis give its tilt out of the image plane, and each slice's ratio is ``B cos(tilt) /
+    a``; the result is their median weighted by points and width. A slice seen less than ``min_sag`` of its
+    half-width deep (a cap cut off near its front) is left out. With the axis within 60 degrees of the line of
+    sight or fewer than three slices left, 1.
+    """
+    q = np.asarray(points, dtype=np.float64)
+    d = np.asarray(direction, dtype=np.float64)
+    n = float(np.hypot(d[0], d[1]))
+    if n < 0.5 or len(q) < 3 * bins:
+        return 1.0
+    e = d[:2] / n
+    q = q - q.mean(axis=0)
+    s, t, z = q[:, :2] @ e, q[:, :2] @ np.array([-e[1], e[0]]), q[:, 2]
+    lo, hi = np.quantile(s, [0.5 - 0.5 * span, 0.5 + 0.5 * span])
+    if not hi > lo:
+        return 1.0
+    idx = np.floor((s - lo) / (hi - lo) * bins).astype(np.int64)
+    keep = (idx >= 0) & (idx < bins)
+    idx, s, t, z = idx[keep], s[keep], t[keep], z[keep]
+    count = np.bincount(idx, minlength=bins)
+    order = np.lexsort((t, idx))  # by slice, then across: each slice's first and last are its extremes
+    first = order[np.minimum(np.searchsorted(idx[order], np.arange(bins)), len(t) - 1)]
+    last = order[np.maximum(np.searchsorted(idx[order], np.arange(bins), side="right") - 1, 0)]
+    good = count >= 8
+    a, mid, at = 0.5 * (t[last] - t[first]), 0.5 * (t[last] + t[first]), 0.5 * (s[first] + s[last])
+    good &= a > 0.0
+    if good.sum() < 3:
+        return 1.0
+    w = np.sqrt(good.astype(np.float64))
+    design = np.stack([np.ones(bins), at, at * at], axis=1) * w[:, None]
+    ca = np.linalg.lstsq(design, np.where(good, a, 0.0) * w, rcond=None)[0]
+    cm = np.linalg.lstsq(design, np.where(good, mid, 0.0) * w, rcond=None)[0]
+    u = (t - (cm[0] + cm[1] * s + cm[2] * s * s)) / np.maximum(ca[0] + ca[1] * s + ca[2] * s * s, 1e-9)
+    root = np.sqrt(np.clip(1.0 - u * u, 0.0, 1.0))
+    m = (np.abs(u) < inner).astype(np.float64)
+    s1, sw, sww = np.bincount(idx, m, bins), np.bincount(idx, root * m, bins), np.bincount(idx, root * root * m, bins)
+    sz, swz = np.bincount(idx, z * m, bins), np.bincount(idx, root * z * m, bins)
+    det = s1 * sww - sw * sw
+    good &= det > 1e-12 * np.maximum(s1, 1.0) ** 2
+    det = np.where(good, det, 1.0)
+    zc, depth = (sww * sz - sw * swz) / det, (sw * sz - s1 * swz) / det
+    centre = np.bincount(idx, s, bins) / np.maximum(count, 1)
+    half = ca[0] + ca[1] * centre + ca[2] * centre * centre
+    z_lo, z_hi = np.full(bins, np.inf), np.full(bins, -np.inf)
+    np.minimum.at(z_lo, idx, z)
+    np.maximum.at(z_hi, idx, z)
+    good &= (half > 0.3 * float(np.where(good, a, 0.0).max())) & (z_hi - z_lo > min_sag * half)
+    if good.sum() < 3:
+        return 1.0
+    weight = count * good
+    w = np.sqrt(weight.astype(np.float64))
+    slope = float(np.linalg.lstsq(np.stack([np.ones(bins), centre], axis=1) * w[:, None], zc * w, rcond=None)[0][1])
+    ratio = depth / np.where(good, half, 1.0) / math.sqrt(1.0 + slope * slope)
+    ranked = np.argsort(np.where(good, ratio, np.inf))
+    total = np.cumsum((weight * np.where(good, half, 0.0))[ranked])
+    return float(ratio[ranked][np.searchsorted(total, 0.5 * total[-1])])
+
+
+def _sectioned(fit: _Fitting, rev: Revolution) -> Revolution:
+    """``rev`` refitted with the sections :func:`section_ratio` reads, ``fit.sections`` of the way from circles,
+    squashed across its axis only (the line of sight's part perpendicular to it: its length is not squashed, as
+    :func:`~symfruit.core.fits.fit_revolution_slices`' ``ratio`` would along the line of sight); ``rev`` where they
+    are near circles, the axis is near the line of sight, or the refit's back moves against its sections (flatter
+    and deeper: another axis found)."""
+    pts = fit.sample[:: max(1, len(fit.sample) // fit.revolution_points)]
+    k = 1.0 + fit.sections * (section_ratio(pts, rev.direction) - 1.0)
+    k = min(max(k, SECTION_CLIP[0]), SECTION_CLIP[1])
+    centre = pts.mean(axis=0)
+    deep = centre / max(float(np.linalg.norm(centre)), 1e-12)
+    deep = deep - float(deep @ rev.direction) * rev.direction
+    size = float(np.linalg.norm(deep))
+    if abs(k - 1.0) <= 0.02 or size < 0.3:
+        return rev
+    deep = deep / size
+    q = pts - centre
+    found = fit_revolution_slices(centre + q + np.multiply.outer((1.0 / k - 1.0) * (q @ deep), deep),
+                                  extra_directions=np.concatenate(fit.axes) if fit.axes else None,
+                                  coarse=fit.revolution_coarse)  # fmt: skip
+    p = found.point - centre
+    out = Revolution(centre + p + (k - 1.0) * float(p @ deep) * deep, found.direction, found.edges, found.radii,
+                     found.cost, k, deep)  # fmt: skip
+    # flatter sections make the solid no deeper, rounder ones no shallower: else the refit found another axis
+    # (a runaway the circles' own fit was spared), and the circles stand
+    moved = float(box_and_profile(out)[1][2] - box_and_profile(rev)[1][2])
+    return out if moved * (k - 1.0) >= 0.0 else rev
 
 
 _Fitter = Callable[[_Fitting], Iterator[_Shape]]

@@ -103,6 +103,12 @@ class EvidenceSettings(Section):
         Ray-march steps per ray through each candidate.
     revolution_coarse : int
         Directions of the solid of revolution's coarse axis search (the ellipsoids' axes are added).
+    sections : float in [0, 1]
+        On a sparse cloud (not a depth camera's view): how far the solid of revolution's sections go from circles
+        towards the depth-over-width ratio the view shows (:func:`~symfruit.core.candidates.section_ratio`; issue 18,
+        stop 47, docs/pearview47.md: circles through a section flatter in depth than across over-extend the back).
+        Not on a camera's view, whose rim perspective puts in front of the sections' widest. 0 (circles, the default):
+        0.5 gains on the generated paper protocol and loses the real pear hanging (the check), docs/pearview47.md.
     covered_contour : float in [0, 1]
         In a depth camera's view (about a point per pixel of the silhouette) whose outline is at least this
         much an occluding contour, the sphere and the unconstrained ellipsoid are not fitted: the ``cone``
@@ -259,6 +265,7 @@ class EvidenceSettings(Section):
     band_rays: int = setting(64, ge=4, le=100_000)
     march_steps: int = setting(16, ge=4, le=1000)
     revolution_coarse: int = setting(64, ge=0, le=10_000)
+    sections: float = setting(0.0, ge=0.0, le=1.0)
     covered_contour: float = setting(0.9, ge=0.0, le=1.0)
     explained_at: float = setting(0.02, ge=0.0, le=2.0)
     hidden_front: Literal["off", "sphere"] = setting("sphere")
@@ -741,6 +748,7 @@ def evidence(
         revolution_coarse=s.revolution_coarse, steps=s.march_steps, shapes=shapes, explained=explained,
         region=region, plausible=(s.lateral_reach, s.depth_reach), seen=(lo, hi),
         outline_profile=s.outline_profile if obs.contour >= s.covered_contour else "off",
+        sections=0.0 if dense else s.sections,
     )  # fmt: skip
     combined = combine(cands, contour=obs.contour, clean=clean, s=s, cone_source=obs.cone_source)
     rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
