@@ -231,7 +231,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     s = settings or ExtractSettings()
     # bool masks' counts by np.count_nonzero: the same whole numbers, without sum's cast of every pixel to an integer
     # (some 10-50 us a window; stop 47)
-    area = np.count_nonzero(mask)
+    area = int(np.count_nonzero(mask))
     truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
     core = mask
     if s.erode_px:
