@@ -236,12 +236,14 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         raise InputError(f"extract: leafy must be an (h, w) bool image of the mask's shape {mask.shape}, got "
                          f"{np.asarray(leafy).dtype} {np.shape(leafy)}")  # fmt: skip
     s = settings or ExtractSettings()
-    area = int(mask.sum())
+    # bool masks' counts by np.count_nonzero: the same whole numbers, without sum's cast of every pixel to an integer
+    # (some 10-50 us a window; stop 47)
+    area = int(np.count_nonzero(mask))
     truncated = bool(mask[0].any() or mask[-1].any() or mask[:, 0].any() or mask[:, -1].any())
     core = mask
     if s.erode_px:
         eroded = square_filter(mask, s.erode_px, every=True)
-        if eroded.sum() >= max(s.min_points, area // 4):  # small masks keep their border
+        if np.count_nonzero(eroded) >= max(s.min_points, area // 4):  # small masks keep their border
             core = eroded
     z_all = np.asarray(depth, dtype=np.float64)
     # the depth tests and the points' deprojection by compiled twins where numba is (issue 19, seventeenth round:
@@ -281,7 +283,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
-    return Extraction(points, area, n_invalid, int(area - core.sum()), dropped, truncated, outline)
+    return Extraction(points, area, n_invalid, area - np.count_nonzero(core), dropped, truncated, outline)
 
 
 def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
@@ -332,7 +334,7 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
         mask = labels[r0:r1, c0:c1] == k
-        radius = float(np.sqrt(mask.sum() / np.pi))
+        radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
         band = min(float(s.colour_trim_px), 0.2 * radius)
         wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
         kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)

@@ -5452,3 +5452,76 @@ def test_the_surface_hull_known_answer():
     want[2, 2] = True
     np.testing.assert_array_equal(_jit.surface_hull(vertices, part, owner, 2, colour, False), want)
     assert _jit.green_in_hull(vertices, part, colour) == 1
+
+
+# --- stop 47, extspeed47
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_the_sphere_residuals_are_the_twins(seed):
+    """:func:`_jit.sphere_residuals` against ``front._sphere_residuals`` bit for bit: noisy caps of spheres of 1-1,000
+    points at random centres, a point at the centre (its distance clipped to 1e-12), a NaN point (NaN kept)."""
+    from symfruit.core.front import _sphere_residuals
+
+    rng = np.random.default_rng(seed)
+    for t in range(60):
+        n = int(rng.integers(1, 1000))
+        p = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1) + rng.uniform(-0.2, 0.8, 3)
+        c = p.mean(axis=0) + rng.normal(size=3) * 0.05
+        if t % 5 == 0:
+            p[0] = c
+        if t % 7 == 0:
+            p[-1, int(rng.integers(3))] = np.nan
+        r = float(rng.uniform(0.01, 0.1))
+        jac, resid = np.empty((n, 3)), np.empty(n)
+        _jit.sphere_residuals(p, c, r, jac, resid)
+        twin_jac = np.empty((n, 3))
+        twin_resid = _sphere_residuals(p, c, r, twin_jac)
+        np.testing.assert_array_equal(jac.view(np.int64), twin_jac.view(np.int64))  # the bits, NaN and zeros' signs
+        np.testing.assert_array_equal(resid.view(np.int64), twin_resid.view(np.int64))
+    p = np.array([[0.0, 0.0, 1.0], [3.0, 4.0, 1.0]])
+    jac, resid = np.empty((2, 3)), np.empty(2)
+    _jit.sphere_residuals(p, np.array([0.0, 0.0, 1.0]), 2.0, jac, resid)
+    np.testing.assert_array_equal(resid, [1e-12 - 2.0, 3.0])  # the first at the centre, the second 5 away
+    np.testing.assert_array_equal(jac[1], [-0.6, -0.8, -0.0])
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_sphere_front_is_the_twins(monkeypatch, seed):
+    """``sphere_front`` with the kernel and with the twin: the same front and apex to the bit, on caps of noisy spheres
+    seen from the camera (a leaf's hole cut out of some), as ``evidence.hidden_front`` fits them."""
+    from symfruit.core.front import sphere_front
+
+    rng = np.random.default_rng(seed)
+    for t in range(20):
+        radius = float(rng.uniform(0.02, 0.05))
+        centre = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(0.4, 1.2)])
+        d = rng.normal(size=(int(rng.integers(20, 1200)), 3))
+        d /= np.linalg.norm(d, axis=1)[:, None]
+        d = d[d[:, 2] < -0.2]  # the cap towards the camera
+        if t % 2:
+            d = d[d[:, 0] > -0.3]  # a leaf over part of it
+        p = centre + radius * d + rng.normal(scale=0.0007, size=d.shape)
+        fast, twin = _both(monkeypatch, sphere_front, p, radius * float(rng.uniform(0.9, 1.1)))
+        assert fast[0] == twin[0]
+        np.testing.assert_array_equal(fast[1], twin[1])
+        assert abs(fast[0] - (centre[2] - radius)) < 0.01
+
+
+def test_the_median_deviation_is_the_twins():
+    """:func:`_jit.median_deviation` against ``points.median(abs(x - points.median(x)))`` bit for bit: odd and even
+    counts, ties, zeros of both signs, a NaN (NaN); and a known answer."""
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(0)
+    for t in range(300):
+        n = int(rng.integers(1, 400))
+        x = rng.normal(size=n) * 0.002 if t % 3 else rng.integers(-4, 5, n) * 0.001
+        if t % 11 == 0:
+            x[: n // 2] = -0.0
+        if t % 13 == 0:
+            x[int(rng.integers(n))] = np.nan
+        want = median(np.abs(x - median(x)))
+        got = _jit.median_deviation(x.copy())
+        assert (np.isnan(got) and np.isnan(want)) or np.float64(got).view(np.int64) == np.float64(want).view(np.int64)
+    assert _jit.median_deviation(np.array([1.0, 2.0, 4.0, 8.0])) == 1.5  # median 3; deviations 2, 1, 1, 5

@@ -7794,3 +7794,46 @@ def green_in_hull(vertices: np.ndarray, union: np.ndarray, color: np.ndarray) ->
                 red, green, blue = np.int64(color[r, c, 0]), np.int64(color[r, c, 1]), np.int64(color[r, c, 2])
                 n += 1 if green > red and green >= blue and 3 * (green - min(red, blue)) >= green else 0
     return n
+
+
+# --- stop 47, extspeed47: the hidden front's sphere residuals, thin_front's noise deviation -------------------------
+
+
+@_njit
+def sphere_residuals(p: np.ndarray, c: np.ndarray, r: float, jac: np.ndarray, resid: np.ndarray) -> None:
+    """:func:`symfruit.core.front.sphere_front`'s Jacobian and residuals at the centre ``c`` (3,), the radius ``r``, of
+    the points ``p`` (n, 3) float64: ``jac`` (n, 3) gets ``diff / -dist`` and ``resid`` (n,) ``dist - r``, where
+    ``diff = p - c`` and ``dist`` is ``sqrt(diff[:, 0]^2 + diff[:, 1]^2 + diff[:, 2]^2)`` (added in that order, as
+    :func:`symfruit.core.points.squared_norms` adds them) and at least 1e-12 (NaN kept, as ``np.maximum`` keeps it).
+    The twin's (:func:`symfruit.core.front._sphere_residuals`) operations one by one, so its values bit for bit; the
+    products ``jac.T @ jac`` and ``jac.T @ resid`` stay numpy's (OpenBLAS's last bits are the CPU's, stop 42)."""
+    c0, c1, c2 = c[0], c[1], c[2]
+    for i in range(p.shape[0]):
+        d0, d1, d2 = p[i, 0] - c0, p[i, 1] - c1, p[i, 2] - c2
+        total = d0 * d0
+        total += d1 * d1
+        total += d2 * d2
+        dist = math.sqrt(total)
+        if not (dist >= 1e-12 or dist != dist):
+            dist = 1e-12
+        neg = -dist
+        jac[i, 0] = d0 / neg
+        jac[i, 1] = d1 / neg
+        jac[i, 2] = d2 / neg
+        resid[i] = dist - r
+
+
+@_njit
+def median_deviation(x: np.ndarray) -> float:
+    """``median(abs(x - median(x)))`` of ``x`` (n,) float64, ``n >= 1`` (:func:`symfruit.core.points.median`'s
+    values: order statistics, the middle two's sum halved; NaN when a value is NaN), reordering and overwriting ``x``:
+    :func:`symfruit.core.surface.thin_front`'s noise deviation of its smoothed depth's differences in one call instead
+    of two partitions and two passes (stop 47; :func:`depth_noise`'s medians)."""
+    n = x.shape[0]
+    for i in range(n):
+        if np.isnan(x[i]):
+            return np.nan
+    middle = _median_of(x)
+    for i in range(n):
+        x[i] = abs(x[i] - middle)
+    return _median_of(x)

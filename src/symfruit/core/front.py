@@ -131,15 +131,31 @@ def sphere_front(points: np.ndarray, radius: float, *, iterations: int = 20,
     c = column_means(p)
     c[2] += r
     jac = np.empty((len(p), 3))
+    resid = np.empty(len(p))
+    jit = compiled()
     for _ in range(iterations):
-        diff = p - c
-        dist = np.maximum(np.sqrt(squared_norms(diff)), 1e-12)
-        np.divide(diff, -dist[:, None], out=jac)
+        # the Jacobian and residuals by the compiled twin where numba is (stop 47: the same values, one call for
+        # numpy's six passes, its divide broadcast over rows of 3); the products stay numpy's (OpenBLAS's bits)
+        if jit is not None:
+            jit.sphere_residuals(p, c, r, jac, resid)
+        else:
+            resid = _sphere_residuals(p, c, r, jac)
+        jt = jac.T
         try:  # core.lapack: numpy's solve and lstsq without their wrappers, the same values and errors
-            step = lapack.solve(jac.T @ jac, -(jac.T @ (dist - r)))
+            step = lapack.solve(jt @ jac, -(jt @ resid))
         except np.linalg.LinAlgError:
-            step = lapack.lstsq(jac, -(dist - r))[0]
+            step = lapack.lstsq(jac, -resid)[0]
         c = c + step
-        if np.abs(step).max() < tolerance:
+        s0, s1, s2 = step.tolist()  # np.abs(step).max() < tolerance: every one below (a NaN none, as its max)
+        if abs(s0) < tolerance and abs(s1) < tolerance and abs(s2) < tolerance:
             break
     return float(c[2] - r), np.array([c[0], c[1], c[2] - r])
+
+
+def _sphere_residuals(p: np.ndarray, c: np.ndarray, r: float, jac: np.ndarray) -> np.ndarray:
+    """:func:`sphere_front`'s Jacobian (into ``jac`` (n, 3)) and residuals (n,) at the centre ``c`` (3,) of the points
+    ``p`` (n, 3): the numpy twin of :func:`symfruit.core._jit.sphere_residuals`."""
+    diff = p - c
+    dist = np.maximum(np.sqrt(squared_norms(diff)), 1e-12)
+    np.divide(diff, -dist[:, None], out=jac)
+    return dist - r
