@@ -7796,7 +7796,7 @@ def green_in_hull(vertices: np.ndarray, union: np.ndarray, color: np.ndarray) ->
     return n
 
 
-# --- stop 47, segspeed47: the round skin's reach test ------------------------------------------------------------------
+# --- stop 47, segspeed47: the round skin's reach test -----------------------------------------------------------------
 
 
 @_njit
