@@ -5525,3 +5525,53 @@ def test_the_median_deviation_is_the_twins():
         got = _jit.median_deviation(x.copy())
         assert (np.isnan(got) and np.isnan(want)) or np.float64(got).view(np.int64) == np.float64(want).view(np.int64)
     assert _jit.median_deviation(np.array([1.0, 2.0, 4.0, 8.0])) == 1.5  # median 3; deviations 2, 1, 1, 5
+
+
+# --- stop 47, segspeed47
+
+
+def test_the_round_skins_reach_test_against_its_twin():
+    """``_at_reach`` with its kernel and with numpy on random skins (discs, blobs, specks, empty, touching the window's
+    edge or not) about random centres and reaches, the window at random offsets: the same answer each time, both
+    answers and each of the twin's three ways to decide among them."""
+    from symfruit.segment.colour import _at_reach
+
+    rng = np.random.default_rng(47)
+    answers = {True: 0, False: 0}
+    for _ in range(600):
+        h, w = (int(v) for v in rng.integers(3, 60, 2))
+        r0, c0 = (int(v) for v in rng.integers(0, 500, 2))
+        yy, xx = np.mgrid[:h, :w]
+        kind = rng.integers(0, 4)
+        if kind == 0:  # a disc, inside the window or running over its edge
+            cy, cx, rad = rng.uniform(-2, h + 2), rng.uniform(-2, w + 2), rng.uniform(1, 20)
+            skin = (yy - cy) ** 2 + (xx - cx) ** 2 <= rad**2
+        elif kind == 1:  # a disc well inside the window
+            rad = rng.uniform(1, max(min(h, w) / 2 - 2, 1.5))
+            skin = (yy - h / 2) ** 2 + (xx - w / 2) ** 2 <= rad**2
+            skin[[0, -1], :] = skin[:, [0, -1]] = False
+        elif kind == 2:  # specks
+            skin = rng.random((h, w)) < rng.uniform(0, 0.3)
+        else:
+            skin = np.zeros((h, w), bool)
+        skin = skin if rng.random() < 0.8 else np.asfortranarray(skin)
+        rc, cc = r0 + rng.uniform(-5, h + 5), c0 + rng.uniform(-5, w + 5)
+        reach = float(rng.uniform(1, 40))
+        big = (slice(r0, r0 + h), slice(c0, c0 + w))
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _at_reach, skin, big, rc, cc, reach)
+        assert fast == twin and isinstance(fast, bool)
+        answers[twin] += 1
+    assert min(answers.values()) > 100
+
+
+def test_the_round_skins_reach_test_known_answer():
+    """A 3x3 skin in the middle of a 9x9 window at (10, 20), about its centre (14, 24): within a reach of 3.9 (its
+    corners 1.42 px off, inside 2.9), not within 2.4 (outside 1.4); on the window's edge always."""
+    skin = np.zeros((9, 9), bool)
+    skin[3:6, 3:6] = True
+    assert not _jit.at_reach(skin, 10, 20, 14.0, 24.0, (3.9 - 1.0) ** 2)
+    assert _jit.at_reach(skin, 10, 20, 14.0, 24.0, (2.4 - 1.0) ** 2)
+    skin[0, 4] = True
+    assert _jit.at_reach(skin, 10, 20, 14.0, 24.0, 100.0)
+    assert not _jit.at_reach(np.zeros((9, 9), bool), 10, 20, 14.0, 24.0, 0.0)

@@ -151,6 +151,29 @@ def test_rendered_touching_fruit_are_split_with_depth():
     assert best[3] != best[4] and best[5] != best[6] and min(best.values()) > 0
 
 
+def test_the_kept_whole_image_maps_are_zero_between_calls(monkeypatch):
+    """The segmenter's whole-image maps kept for the next call (stop 47) are all zero between calls, a call that
+    raises half way keeps none that is not, and the labels are those of a first call."""
+    from symfruit.segment import colour
+
+    scene = make_scene(0)
+    colour._SPARE.clear()
+    first = segment(scene.color, scene.depth, scene.camera)
+    kept = [a for maps in colour._SPARE.values() for a in maps]
+    assert len(kept) == 2 and not any(a.any() for a in kept)  # the weak pixels' and the pieces' maps
+
+    def broken(*args, **kwargs):
+        raise RuntimeError("half way")
+
+    with monkeypatch.context() as mp:
+        mp.setattr(colour, "_merge", broken)  # after the weak pixels are written
+        with pytest.raises(RuntimeError, match="half way"):
+            segment(scene.color, scene.depth, scene.camera)
+    assert not any(a.any() for maps in colour._SPARE.values() for a in maps)
+    np.testing.assert_array_equal(segment(scene.color, scene.depth, scene.camera), first)
+    np.testing.assert_array_equal(segment(scene.color, scene.depth, scene.camera), first)
+
+
 def test_settings_are_bounded_and_checked():
     with pytest.raises(ConfigError, match="red_low"):
         SegmentSettings(red_low=0.5, red_high=0.3)

@@ -57,6 +57,7 @@ import numpy as np
 from scipy import ndimage
 
 from ..core.kernels import compiled
+from ..core.lapack import lstsq
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
 from ..core.points import median, row_norms
 from ..core.raster import distance_transform, fill_holes, mask_box, nearest_index, square_filter
@@ -556,7 +557,7 @@ def _segment_at(
     h, w = c.shape[:2]
     # Red pixels are looked for at full resolution around what the coarse grid found: a region that no grid
     # point falls in is far smaller than a fruit.
-    weak = np.zeros((h, w), bool)
+    weak = _zeroed((h, w), np.bool_)
     pieces: list[_Piece] = []
     sources = 0
     for win in windows:
@@ -614,12 +615,12 @@ def _segment_at(
     # which piece each red pixel is part of (no hull takes another's), and below which ground-colour body each pixel
     # is: whole-image maps, in the narrowest integer type that numbers them (an 8 MB int32 image is 0.5-1 ms of
     # zeroing alone)
-    owner = np.zeros((h, w), _id_type(len(pieces)))
+    owner = _zeroed((h, w), _id_type(len(pieces)))
     for k, piece in enumerate(pieces, 1):
         owner[piece.window][piece.mask] = k
     # fruit showing their ground colour: joined to the red fruit whose skin reaches them, else fruit of their own
     bodies = _ground_bodies(c, z, geo, s, owner) if ground and z is not None else []
-    body_map = np.zeros((h, w), _id_type(len(bodies))) if bodies else None
+    body_map = _zeroed((h, w), _id_type(len(bodies))) if bodies else None
     for i, body in enumerate(bodies, 1):
         body_map[body.window][body.mask] = i  # type: ignore[index]
     taken = np.zeros(len(bodies) + 1, bool)
@@ -663,7 +664,39 @@ def _segment_at(
     for new, i in enumerate(order, 1):
         sl, free, _ = found[i]
         out[sl][free] = new
+    _give_back(weak, windows)
+    _give_back(owner, [piece.window for piece in pieces])
+    if body_map is not None:
+        _give_back(body_map, [body.window for body in bodies])
     return out
+
+
+#: Zeroed whole-image maps of :func:`_segment_at` kept for its next call, by shape and type: zeroing a fresh
+#: 1920x1080 map of int16 is about 0.5 ms (glibc's ``calloc`` from reused heap memory), setting the windows written
+#: back to 0 a few microseconds (stop 47). A map is taken out while in use: a second thread, or a call that raised,
+#: never shares or hands back one that is not all 0.
+_SPARE: dict[tuple[tuple[int, ...], type[np.generic]], list[np.ndarray]] = {}
+
+
+def _zeroed(shape: tuple[int, int], dtype: type[np.generic]) -> np.ndarray:
+    """A zeroed map, one of :data:`_SPARE` if one is kept."""
+    try:
+        return _SPARE[(shape, dtype)].pop()
+    except (KeyError, IndexError):
+        return np.zeros(shape, dtype)
+
+
+def _give_back(a: np.ndarray, windows: list[Window]) -> None:
+    """Keep map ``a`` for the next call (:data:`_SPARE`) once the ``windows`` it was written in are 0 again: two maps
+    of a shape and type (the pieces' and the bodies' may both be int16), of at most four shapes and types (a process
+    segmenting images of many sizes keeps no more)."""
+    for key in {(w[0].start, w[0].stop, w[1].start, w[1].stop) for w in windows}:
+        a[key[0] : key[1], key[2] : key[3]] = 0
+    if len(_SPARE) >= 4 and (a.shape, a.dtype.type) not in _SPARE:
+        _SPARE.clear()
+    spares = _SPARE.setdefault((a.shape, a.dtype.type), [])
+    if len(spares) < 2:
+        spares.append(a)
 
 
 def _claim(out: np.ndarray, hull: np.ndarray) -> tuple[np.ndarray, tuple[int, int, int, int]] | None:
@@ -1838,7 +1871,10 @@ def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float)
     """Whether :func:`_round_skin`'s skin (in window ``big``) may have been stopped by its reach: a pixel of it on the
     window's edge, or with a neighbour outside the disc of radius ``reach`` about ``(rc, cc)``. When not, a wider
     reach grows the same skin (every pixel next to it lies inside both discs and windows, and is refused there by
-    the same tests or by a depth step the wider window only adds to)."""
+    the same tests or by a depth step the wider window only adds to). Where numba is, in one call
+    (:func:`symfruit.core._jit.at_reach`: the same answer; stop 47)."""
+    if (jit := compiled()) is not None and skin.dtype == bool and skin.ndim == 2:
+        return bool(jit.at_reach(skin, big[0].start, big[1].start, float(rc), float(cc), (reach - 1.0) ** 2))
     box = mask_box(skin)
     if box is None:
         return False
@@ -2255,7 +2291,7 @@ def _round_body(
     a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
     keep = np.ones(len(p), bool)
     for _ in range(2):  # fit, drop the points far off the plane (a leaf's mixed rim pixels), fit again: as the sphere
-        coef, *_ = np.linalg.lstsq(a[keep], p[keep, 2], rcond=None)
+        coef = lstsq(a[keep], p[keep, 2])[0]  # numpy's LAPACK call without its wrapper: the same values (stop 47)
         off = np.abs(a @ coef - p[:, 2])
         keep = off <= max(3.0 * float(median(off)) * 1.4826, 1e-4)
     plane = float(median(off))
