@@ -5575,3 +5575,67 @@ def test_the_round_skins_reach_test_known_answer():
     skin[0, 4] = True
     assert _jit.at_reach(skin, 10, 20, 14.0, 24.0, 100.0)
     assert not _jit.at_reach(np.zeros((9, 9), bool), 10, 20, 14.0, 24.0, 0.0)
+
+
+# --- stop 47, yellowfast47
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_bridged_depth_is_the_twins(seed):
+    """:func:`_jit.bridge_gaps` on a depth as handed over (float32 or float64; 0, negative, -0.0, NaN and infinite
+    values without depth) and its twin ``_bridged`` on the cleaned depth (the feature transform: scipy's with the
+    twins, :func:`_jit.nearest` with the kernels) on 600 windows padded by 4 px (less at the image's edges), the
+    depths of four values (equally near pixels of other depths everywhere: the choice among them counts), a fifth
+    to nearly all of the pixels without depth: the same values, gaps filled and gaps left."""
+    from symfruit.segment.colour import BRIDGE_PX, _bridged
+
+    rng = np.random.default_rng(seed)
+    filled = left = 0
+    bad = np.array([0.0, -0.0, -1.0, np.nan, np.inf, -np.inf])
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        given = rng.choice(np.array([0.5, 1.25, 2.0, 3.5]), (h, w))
+        gap = rng.random((h, w)) < rng.choice([0.2, 0.6, 0.9, 0.97])
+        given[gap] = rng.choice(bad, int(gap.sum()))
+        given = given.astype(np.float32 if t % 2 else np.float64)
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+        out = np.empty((r1 - r0, c1 - c0))
+        _jit.bridge_gaps(given, r0, r1, c0, c1, BRIDGE_PX, out)
+        clean = np.maximum(np.nan_to_num(given.astype(np.float64), nan=0, posinf=0, neginf=0), 0)
+        a, b = max(r0 - 4, 0), max(c0 - 4, 0)
+        padded = clean[a : r1 + 4, b : c1 + 4]
+        inner = (slice(r0 - a, r1 - a), slice(c0 - b, c1 - b))
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _bridged, padded, inner)
+        np.testing.assert_array_equal(out, twin)
+        np.testing.assert_array_equal(fast, twin)
+        assert not np.signbit(out).any()
+        filled += int((gap[r0:r1, c0:c1] & (out > 0)).sum())
+        left += int((gap[r0:r1, c0:c1] & (out == 0)).sum())
+    assert filled > 10_000 and left > 1_000
+
+
+def test_the_bridged_depth_known_answer():
+    """A pixel without depth 2 px from depths 1 (left), 2 (right) and 3 (above) takes the left one's (the leftmost
+    column's of those as near); with the left one gone and 4 below, the upper one's of its column (3), not the
+    right one's; a pixel whose nearest depth is 4 px off keeps 0, 3 px off (or 3 and 1 across) is filled, 3 and 2
+    across is not (13 > 3.5^2); depth is kept, NaN is none."""
+    z = np.zeros((9, 9))
+    z[4, 2], z[4, 6], z[2, 4] = 1.0, 2.0, 3.0
+    out = np.empty((9, 9))
+    _jit.bridge_gaps(z, 0, 9, 0, 9, 3.5, out)
+    assert out[4, 4] == 1.0 and out[4, 2] == 1.0
+    z[4, 2], z[6, 4] = np.nan, 4.0
+    _jit.bridge_gaps(z, 0, 9, 0, 9, 3.5, out)
+    assert out[4, 4] == 3.0 and out[4, 2] == 3.0  # (2, 4) and (4, 6) 8 off, the left one's column first
+    row = np.zeros((1, 12))
+    row[0, 0] = 5.0
+    got = np.empty((1, 12))
+    _jit.bridge_gaps(row, 0, 1, 0, 12, 3.5, got)
+    np.testing.assert_array_equal(got[0], [5.0] * 4 + [0.0] * 8)
+    z = np.zeros((5, 5), np.float32)
+    z[0, 0] = 6.0
+    got = np.empty((4, 4))
+    _jit.bridge_gaps(z, 1, 5, 1, 5, 3.5, got)
+    assert got[2, 0] == 6.0 and got[2, 1] == 0.0  # (3, 1) from the depth: 10 <= 12.25; (3, 2): 13 > 12.25

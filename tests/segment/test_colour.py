@@ -1421,3 +1421,49 @@ def test_a_skin_is_at_its_reach_where_it_meets_the_disc_or_the_window_edge():
     edge[30, 0] = True
     assert _at_reach(edge, big, 130.0, 230.0, 100.0)
     assert not _at_reach(np.zeros((60, 60), bool), big, 130.0, 230.0, 20.0)
+
+
+# --- stop 47, yellow47
+
+
+def test_a_yellow_green_apple_crossed_by_a_band_without_depth_is_one_fruit_beside_flat_leaves():
+    # a bicoloured apple turned with its yellow-green side to the camera (its blush a 12 px crescent on the left),
+    # flat leaf-green leaves beside it at its depth, a time-of-flight camera's invalid rim, depth registered 6 px
+    # off, and a band 5 px wide without depth across the apple (a twig's edge that the colour camera sees past and
+    # the depth camera does not). The skin grew from the blush along depth and stopped at the band: two fruit, a
+    # fifth of the apple and the rest. Bridged from both sides, the band is crossed: one fruit, not the leaves
+    from symfruit.segment.colour import BRIDGE_PX
+
+    color, depth, disc = blushed_apple(blush_px=12)
+    yy, xx = np.mgrid[:1080, :1920]
+    leaves = (np.abs(yy - 540) <= 12) & (xx >= 932) & (xx < 990)
+    color[leaves] = (60, 120, 40)  # leaf green, hue 110 degrees
+    depth[leaves] = 1.5
+    depth = tof_rim(depth, disc, shift=6)
+    band = disc & (np.abs(xx - 892) <= 2)
+    depth[band] = 0.0
+    assert 5 <= 2 * BRIDGE_PX  # bridged from both sides
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & disc).sum() > 0.85 * disc.sum()
+    assert (found & leaves & ~disc).sum() == 0 and (found & ~disc).sum() < 0.05 * disc.sum()
+    off = SegmentSettings(round_fruit=True, ripe_median=0.35, min_diameter=0.03, round_max_diameter=0.10)
+    assert ((segment(color, depth, HD_CAM, off) > 0) & disc).sum() < 0.5 * disc.sum()  # not without ground_colour
+
+
+def test_bridged_depth_takes_the_nearest_depth_within_its_reach_only():
+    from symfruit.segment.colour import BRIDGE_PX, _BridgedDepth, _Depth
+
+    depth = np.zeros((20, 40))
+    depth[:, :10] = 1.0
+    depth[:, 30:] = 2.0
+    depth[:, 14:17] = 1.5  # a short gap between 1.0 and 1.5 (10-13) and a long one between 1.5 and 2.0 (17-29)
+    z = _BridgedDepth(_Depth.of(depth))[(slice(5, 15), slice(0, 40))]
+    assert BRIDGE_PX == 3.5
+    row = z[0]
+    assert row[:10].tolist() == [1.0] * 10 and row[30:].tolist() == [2.0] * 10  # depth kept
+    assert row[10:12].tolist() == [1.0, 1.0] and row[12:14].tolist() == [1.5, 1.5]  # the gap split at its middle
+    assert row[17:21].tolist() == [1.5] * 3 + [0.0]  # 3 px from the depth: bridged, 4 px: not
+    assert row[27:30].tolist() == [2.0] * 3 and row[21:27].tolist() == [0.0] * 6
+    assert (z == _BridgedDepth(_Depth.of(depth))[(slice(5, 15), slice(0, 40))]).all()  # read again: the same

@@ -7875,3 +7875,71 @@ def at_reach(skin: np.ndarray, r_off: int, c_off: int, rc: float, cc: float, lim
                 if dr * dr + dc * dc > limit:
                     return True
     return False
+
+
+# --- stop 47, yellowfast47: the depth camera's short gaps bridged, window by window
+
+
+@_njit
+def bridge_gaps(z: np.ndarray, r0: int, r1: int, c0: int, c1: int, reach: float, out: np.ndarray) -> None:
+    """:class:`symfruit.segment.colour._BridgedDepth`'s window ``z[r0:r1, c0:c1]`` into ``out`` (r1 - r0, c1 - c0)
+    float64: ``z`` (h, w) float a depth image (a pixel has depth where its value is above 0 and below infinity, as
+    :class:`symfruit.segment.colour._Depth` reads it; the whole image or a window of it padded by more than
+    ``reach``), each pixel's depth as float64, and each pixel without depth the depth of the nearest pixel with
+    depth when that lies within ``reach`` pixels, else 0; among as near pixels the one scipy's feature transform
+    (:func:`nearest`) picks: the leftmost column's, in it the upper.
+
+    Its twin, :func:`symfruit.segment.colour._bridged`, runs the feature transform over the padded window; here
+    only the disc within ``reach`` counts: each column's nearest pixel with depth within ``k = floor(reach)`` rows
+    (the upper of two as near) by a sweep down the rows and one up, then each pixel without depth weighs the
+    ``2k + 1`` columns about it left to right, a later one taken only when strictly nearer (stop 47,
+    yellowfast47)."""
+    h, w = z.shape
+    k = int(reach)
+    most = reach * reach
+    ra, rb = max(r0 - k, 0), min(r1 + k, h)
+    ca, cb = max(c0 - k, 0), min(c1 + k, w)
+    n = cb - ca
+    near = np.full((r1 - r0, n), -1, np.int32)  # each pixel's column's nearest row with depth within k, -1: none
+    last = np.full(n, -(k + 1) - h, np.int32)
+    for r in range(ra, r1):
+        row = z[r]
+        for c in range(n):
+            v = row[ca + c]
+            if (v > 0) & (v < np.inf):
+                last[c] = r
+        if r >= r0:
+            line = near[r - r0]
+            for c in range(n):
+                if r - last[c] <= k:
+                    line[c] = last[c]
+    last[:] = 2 * h + k + 1
+    for r in range(rb - 1, r0 - 1, -1):
+        row = z[r]
+        for c in range(n):
+            v = row[ca + c]
+            if (v > 0) & (v < np.inf):
+                last[c] = r
+        if r < r1:
+            line = near[r - r0]
+            for c in range(n):
+                b = last[c]
+                if b - r <= k and (line[c] < 0 or b - r < r - line[c]):  # as near: the upper one stays
+                    line[c] = b
+    for i in range(r1 - r0):
+        r = r0 + i
+        row, line, dst = z[r], near[i], out[i]
+        for j in range(c1 - c0):
+            c = c0 + j
+            v = row[c]
+            if (v > 0) & (v < np.inf):
+                dst[j] = np.float64(v)
+                continue
+            best, at = most + 1.0, -1
+            for u in range(max(c - k, 0), min(c + k + 1, w)):
+                nr = line[u - ca]
+                if nr >= 0:
+                    d = float((u - c) * (u - c) + (nr - r) * (nr - r))
+                    if d < best:
+                        best, at = d, u
+            dst[j] = np.float64(z[line[at - ca], at]) if at >= 0 and best <= most else 0.0
