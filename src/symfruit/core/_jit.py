@@ -6519,15 +6519,10 @@ def _filled_box(mask: np.ndarray) -> np.ndarray:
     on the mask's box grown by a pixel (clipped), the twin's call: the same pixels."""
     h, w = mask.shape
     out = mask.copy()
-    r0, r1, c0, c1 = h, -1, w, -1
-    for r in range(h):
-        for c in range(w):
-            if mask[r, c]:
-                r0, r1 = min(r0, r), max(r1, r)
-                c0, c1 = min(c0, c), max(c1, c)
-    if r1 < 0:
+    r0, r1, c0, c1 = _box(mask)
+    if r1 == 0:
         return out
-    r0, r1, c0, c1 = max(r0 - 1, 0), min(r1 + 2, h), max(c0 - 1, 0), min(c1 + 2, w)
+    r0, r1, c0, c1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
     filled(mask[r0:r1, c0:c1], out[r0:r1, c0:c1])
     return out
 
@@ -7850,16 +7845,9 @@ def at_reach(skin: np.ndarray, r_off: int, c_off: int, rc: float, cc: float, lim
     corner's and pixels' offsets, sums and comparisons in float64: the same answer, in one pass over the window
     and one over the box instead of two reductions, a ``nonzero`` and four array sums (stop 47)."""
     h, w = skin.shape
-    r0, r1, c0, c1 = h, -1, w, -1
-    for r in range(h):
-        for c in range(w):
-            if skin[r, c]:
-                r0, r1 = min(r0, r), max(r1, r)
-                c0, c1 = min(c0, c), max(c1, c)
-    if r1 < 0:
+    r0, r1, c0, c1 = _box(skin)
+    if r1 == 0:
         return False
-    r1 += 1
-    c1 += 1
     if r0 == 0 or c0 == 0 or r1 == h or c1 == w:
         return True
     dy = max(abs(float(r0 + r_off) - rc), abs(float(r1 - 1 + r_off) - rc))
