@@ -23,6 +23,7 @@ axis is within 17 deg of the image plane). Run with ``PYTHONPATH=TREE/src`` from
 
 from __future__ import annotations
 
+import argparse
 import sys
 from collections.abc import Iterator
 from dataclasses import replace
@@ -206,19 +207,26 @@ def views(kind: str) -> None:
 
 
 def main(argv: list[str]) -> int:
-    if argv[:1] == ["synthetic"]:
+    parser = argparse.ArgumentParser(prog="pearview47.py", description=__doc__.split("\n\n")[0],
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)  # fmt: skip
+    sub = parser.add_subparsers(dest="command", required=True)
+    sub.add_parser("synthetic", help="the estimate on ellipsoids of known ratio")
+    sub.add_parser("views", help="the estimate per fruit of the paper protocol").add_argument("kind")
+    run = sub.add_parser("run", help="docs/eval_boxes.py run with the sections refitted")
+    run.add_argument("variant", choices=sorted(VARIANTS))
+    run.add_argument("boxes", help="the per-instance CSV to write")
+    run.add_argument("command_line", nargs=argparse.REMAINDER, help="evaluate ARGS...")
+    args = parser.parse_args(argv)
+    if args.command == "synthetic":
         synthetic()
         return 0
-    if argv[:1] == ["views"] and len(argv) == 2:
-        views(argv[1])
+    if args.command == "views":
+        views(args.kind)
         return 0
-    if argv[:1] == ["run"] and len(argv) > 3 and argv[1] in VARIANTS:
-        import eval_boxes
+    import eval_boxes
 
-        _patch(argv[1])
-        return eval_boxes.run(argv[2], argv[3:])
-    sys.stderr.write("usage: pearview47.py synthetic | views KIND | run VARIANT BOXES.csv evaluate ARGS...\n")
-    return 2
+    _patch(args.variant)
+    return eval_boxes.run(args.boxes, args.command_line)
 
 
 if __name__ == "__main__":
