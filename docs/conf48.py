@@ -12,6 +12,7 @@ between the errors of two collections of the same views (one noise draw against 
     python docs/conf48.py table A.csv [B.csv ...]
     python docs/conf48.py kinds A.csv
     python docs/conf48.py repeat A.csv RENOISED.csv
+    python docs/conf48.py among A.csv [B.csv ...] [--group K]
     python docs/conf48.py ceiling --train A.csv [A2.csv ...] --test B.csv [...]
 """
 
@@ -211,6 +212,36 @@ def ceiling(train: list[str], test: list[str]) -> None:
 FEATURES = (*conf45.FEATURES, "cand_zsd", "cand_backsd", "hidden_depth", "dz_mm", "dxy_mm", "true_depth")
 
 
+def among(paths: list[str], group: int = 0) -> None:
+    """A confidence among one fruit's views (a multi-view use; not `evidence`'s per-view `u`): each view's `u` times
+    the fruit's median box size over its own, size ``width^2 x box depth`` (or ``(width^3 x box depth)^0.5``): the
+    fruit does not change size between views, and a view whose box comes out smaller than its others' is the
+    under-extended one. Within / pooled Spearman, the share reliable at 3 mm and the views over 4 mm said reliable.
+    ``group``: a fruit's views taken ``group`` at a time (views 0 to group - 1, ...), as fewer views of a fruit."""
+    w = sys.stdout.write
+    w("| size, power | " + " | ".join(paths) + " |\n" + "|---" * (len(paths) + 1) + "|\n")
+    for label, size, k in (("base", None, 0.0), ("width^2 x box depth, 1", 2.0, 1.0),
+                           ("(width^3 x box depth)^0.5, 1", 3.0, 0.5)):  # fmt: skip
+        cells = []
+        for p in paths:
+            d = load(p)
+            if group:
+                d["fruit_id"] = np.array([f"{f}/{int(v) // group}" for f, v in zip(d["fruit_id"], d["pose_ix"],
+                                                                                  strict=True)])  # fmt: skip
+            u = d["uncertainty"].copy()
+            if size is not None:
+                s = (d["width"] ** size * d["box_depth"]) ** k
+                rel = np.empty_like(u)
+                for fruit in dict.fromkeys(d["fruit_id"]):
+                    ix = d["fruit_id"] == fruit
+                    rel[ix] = np.median(s[ix]) / s[ix]
+                u = u * rel
+            r = u <= 0.003
+            cells.append(f"{_within(d, u):+.2f} / {cf.pooled(d, u):+.2f} / {r.mean():.0%} / "
+                         f"{int((r & (d['centre_mm'] > 4)).sum())}")  # fmt: skip
+        w(f"| {label} | " + " | ".join(cells) + " |\n")
+
+
 def _u(d: cf.Columns, extra: float | np.ndarray = 0.0, us: float = 3.0) -> np.ndarray:
     """`evidence`'s uncertainty (stop 45's terms, docs/conf45.py's ``U``) with one more term under the root."""
     return np.sqrt(conf45.U(d, us=us, cut=0.1, lat=0.5) ** 2 + (d["elongation"] * np.asarray(extra)) ** 2)
@@ -257,6 +288,9 @@ def main() -> None:
     r = sub.add_parser("repeat", help="within-fruit Spearman of the errors of two noise draws")
     r.add_argument("a")
     r.add_argument("b")
+    m = sub.add_parser("among", help="u times the fruit's median box size over the view's")
+    m.add_argument("csv", nargs="+")
+    m.add_argument("--group", type=int, default=0, help="a fruit's views this many at a time (0: all)")
     g = sub.add_parser("ceiling", help="least squares of the log error on logs of features, within fruit")
     g.add_argument("--train", nargs="+", required=True)
     g.add_argument("--test", nargs="+", required=True)
@@ -267,6 +301,8 @@ def main() -> None:
         kinds(args.csv)
     elif args.cmd == "repeat":
         repeat(args.a, args.b)
+    elif args.cmd == "among":
+        among(args.csv, args.group)
     elif args.cmd == "ceiling":
         ceiling(args.train, args.test)
     else:
