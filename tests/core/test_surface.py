@@ -984,6 +984,78 @@ def test_registration_is_the_same_with_and_without_the_pruned_search(monkeypatch
     assert registration_shift(moved, labels, F, max_px=10) == found == (-2, 3)
 
 
+# --- stop 48, regspeed48: the gain test from the fast costs, the one-axis outlines early ------------------------------
+
+
+def test_the_gain_test_is_told_by_the_fast_costs_only_beyond_their_slack():
+    """``_no_gain(at_best, zero, gain)`` is ``at_best > zero - gain`` where the two fast costs are more than four slacks
+    (``1e-10`` of one plus the larger) from deciding otherwise, else None (the exact costs decide); NaN or infinity:
+    None."""
+    from symfruit.core.surface import _no_gain
+
+    assert _no_gain(1.0, 1.5, 0.25) is False  # 0.5 px less: a gain
+    assert _no_gain(1.4, 1.5, 0.25) is True  # 0.1 px less: no gain
+    assert _no_gain(2.0, 1.5, 0.25) is True
+    assert _no_gain(1.25, 1.5, 0.25) is None  # on the threshold
+    assert _no_gain(1.25 + 8e-10, 1.5, 0.25) is None  # within four slacks (1e-9 at 1.5)
+    assert _no_gain(1.25 - 8e-10, 1.5, 0.25) is None
+    assert _no_gain(1.25 + 2e-9, 1.5, 0.25) is True
+    assert _no_gain(1.25 - 2e-9, 1.5, 0.25) is False
+    assert _no_gain(np.nan, 1.5, 0.25) is None
+    assert _no_gain(1.0, np.inf, 0.25) is None
+
+
+@pytest.mark.parametrize("numpy_twins", [False, True])
+@pytest.mark.parametrize("seed", range(4))
+def test_the_frames_fast_costs_are_each_outlines_mean_and_near_the_exact_ones(seed, numpy_twins, monkeypatch):
+    """``_FrameCosts.fast``: the outlines' fast costs (``_told``'s, ``exact=False``), their mean as the search takes
+    it, bit for bit, by the compiled stages and by their twins; within the slack the gain test allows of the exact
+    costs. The outline of fewest points is costed first, then those telling one axis alone."""
+    from symfruit.core import surface
+
+    if numpy_twins:
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    outlines = ball_outlines(seed, 10)
+    shifts = np.array([[0, 0], [2, -4], [-6, 10], [9, 1], [0, -3]], np.int64)
+    frame = surface._FrameCosts.of(outlines, 10, 0.7)
+    assert (frame.jit is None) == numpy_twins
+    fast = np.mean([surface._told(o, shifts, 10, 0.7, False) for o in outlines], axis=0)
+    exact = np.mean([surface._told(o, shifts, 10, 0.7, True) for o in outlines], axis=0)
+    assert np.array_equal(frame.fast(shifts), fast)
+    assert np.all(np.abs(fast - exact) <= 1e-10 * (1.0 + np.abs(exact)))
+    sizes = [len(o.rows) for o in outlines]
+    one_axis = [not all(o.axes) for o in outlines]
+    order = [int(i) for i in frame.order]
+    assert sorted(order) == list(range(len(outlines))) and sizes[order[0]] == min(sizes)
+    later = [one_axis[i] for i in order[1:]]
+    assert later == sorted(later, reverse=True)  # the one-axis outlines first among the rest
+
+
+def test_the_gain_test_takes_no_exact_cost_where_the_fast_ones_decide(monkeypatch):
+    """Three balls moved (3, -2) px against their masks: the shift found with the gain test told by the fast costs,
+    without an exact cost of one shift (the search's ties are costed exactly, two shifts at a time), is the one found
+    with the exact costs compared."""
+    from symfruit.core import surface
+
+    moved, labels = three_balls_moved()
+    exact = []
+    real_told = surface._told
+
+    def told(o, shifts, reach, trim, is_exact):
+        if is_exact:
+            exact.append(len(shifts))
+        return real_told(o, shifts, reach, trim, is_exact)
+
+    monkeypatch.setattr(surface, "_told", told)
+    assert registration_shift(moved, labels, F, max_px=10) == (-2, 3)
+    ties = list(exact)
+    assert 1 not in ties
+    exact.clear()
+    monkeypatch.setattr(surface, "_no_gain", lambda *args: None)  # the exact costs always compared
+    assert registration_shift(moved, labels, F, max_px=10) == (-2, 3)
+    assert sorted(exact) == sorted(ties + [1] * 6)  # and the unshifted masks' and the shift's, three outlines each
+
+
 def test_the_trimmings_generator_draws_as_a_fresh_one():
     """_seeded() after earlier draws, and in another thread: the draws of np.random.default_rng(0)."""
     import threading

@@ -1434,18 +1434,45 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     coarse = np.arange(-max_px, max_px + 1, 2)
     grid = np.stack(np.meshgrid(coarse if tell_v else [0], coarse if tell_u else [0], indexing="ij"), axis=-1)
     grid = grid.reshape(-1, 2)
-    zero = cost(np.zeros((1, 2), np.int64))[0]
     dv, du = grid[least(grid)]
     near = np.arange(-2, 3)
     fine = np.stack(np.meshgrid(dv + (near if tell_v else 0), du + (near if tell_u else 0), indexing="ij"), axis=-1)
     fine = fine.reshape(-1, 2)
     fine = fine[(np.abs(fine) <= max_px).all(axis=1)]
     best = least(fine)
-    # the unshifted masks' cost again when the least shift is none (a frame registered well: the same number)
-    at_best = zero if not fine[best].any() else cost(fine[best : best + 1])[0]
-    if at_best > zero - gain or (np.abs(fine[best]) >= max_px).any():
-        return 0, 0  # no gain; or a least cost at the search's border, still falling beyond it: no minimum found
+    if not fine[best].any() or (np.abs(fine[best]) >= max_px).any():
+        # the least shift is none (its cost is the unshifted masks': no gain, whatever the number); or a least cost
+        # at the search's border, still falling beyond it: no minimum found
+        return 0, 0
+    # no gain: the exact costs compared only where the fast ones, each within the slack of its exact cost, do not
+    # decide (stop 48, regspeed48: the same answer without 2 x 9 exact costs a frame)
+    zero_at = np.flatnonzero(~fine.any(axis=1))
+    zero_fast = frame.means[zero_at[0]] if len(zero_at) else frame.fast(np.zeros((1, 2), np.int64))[0]
+    no_gain = _no_gain(frame.means[best], zero_fast, gain)
+    if no_gain is None:
+        zero = cost(np.zeros((1, 2), np.int64))[0]
+        no_gain = bool(cost(fine[best : best + 1])[0] > zero - gain)
+    if no_gain:
+        return 0, 0
     return int(fine[best, 1]), int(fine[best, 0])
+
+
+def _no_gain(at_best: float, zero: float, gain: float) -> bool | None:
+    """:func:`registration_shift`'s ``at_best > zero - gain`` (the least shift's exact cost against the unshifted
+    masks') told from the two shifts' fast costs ``at_best`` and ``zero`` (:meth:`_FrameCosts.least`'s means), or
+    None where they do not tell it. Each fast cost is within a slack of its exact cost (``1e-10`` of one plus the
+    cost: the same keep deviations summed in another order, some 10^4 times their rounding; the margin the search's
+    ``least`` takes too); a difference more than twice that slack (doubled again for the subtraction's rounding) from
+    ``-gain`` is the exact costs' answer. NaN or an infinity: None (the exact costs decide)."""
+    if not (np.isfinite(at_best) and np.isfinite(zero)):
+        return None
+    slack = 1e-10 * (1.0 + max(abs(float(at_best)), abs(float(zero))))
+    margin = float(at_best) - (float(zero) - gain)
+    if margin > 4.0 * slack:
+        return True
+    if margin < -4.0 * slack:
+        return False
+    return None
 
 
 #: :func:`registration_shift`'s search costs a set of more shifts than this fruit by fruit, pruned
@@ -1466,8 +1493,15 @@ class _FrameCosts:
     def __init__(self, outlines: list[_Outline], reach: int, trim: float, jit: Any = None) -> None:
         self.jit, self.outlines, self.reach, self.trim = jit, outlines, int(reach), float(trim)
         # the outlines costed fewest points first (stop 42): the first one is costed at every shift; each keeps its own
-        # row of the costs, so their means are the same numbers whatever the order
-        self.order = np.argsort([len(o.rows) for o in outlines], kind="stable").astype(np.int64)
+        # row of the costs, so their means are the same numbers whatever the order. After the first, the outlines
+        # that tell one axis alone (stop 48): each costs at most one shift per value of that axis however many
+        # shifts are left, so it prunes the later ones at next to no cost of its own
+        order = np.argsort([len(o.rows) for o in outlines], kind="stable")
+        rest = order[1:]
+        one_axis = np.array([not all(outlines[i].axes) for i in rest], bool)
+        self.order = np.concatenate([order[:1], rest[one_axis], rest[~one_axis]]).astype(np.int64)
+        #: :meth:`least`'s fast costs (the outlines' mean) of its last shifts, NaN at those it left out
+        self.means = np.empty(0)
         if jit is None:
             return
         ranks, values, at, widths = [], [], [], []
@@ -1547,6 +1581,15 @@ class _FrameCosts:
                         upper, limit = mean, _limit(mean, slack, count)
         return alive
 
+    def fast(self, shifts: np.ndarray) -> np.ndarray:
+        """(k,) the fast cost of each shift of ``shifts`` (k, 2): every outline's (as far as it tells it), their mean as
+        :meth:`least` takes it."""
+        shifts = np.ascontiguousarray(shifts, dtype=np.int64)
+        out = np.empty((len(self.outlines), len(shifts)))
+        self._stage(shifts, 0, -1, 0.0, 0.0, out)  # the first outline's row, then the others' (as least's plain search)
+        self._stage(shifts, 3, -1, 0.0, 0.0, out)
+        return np.mean(out, axis=0)
+
     def least(self, shifts: np.ndarray, cost: Callable[..., np.ndarray]) -> int:
         """``least(shifts)`` of :func:`registration_shift` (``cost``: its exact costs): the first shift of least exact
         cost. The fast costs are within ``slack`` of the exact ones, so only the shifts within twice that of their
@@ -1571,6 +1614,7 @@ class _FrameCosts:
         count = len(self.outlines)
         shifts = np.ascontiguousarray(shifts, dtype=np.int64)
         out = np.empty((count, len(shifts)))
+        self.means = np.full(len(shifts), np.nan)
         best = int(self._stage(shifts, 0, -1, 0.0, 0.0, out)[0])
         if count > 1 and len(shifts) > _PRUNE_FROM:
             self._stage(shifts, 1, best, 0.0, 0.0, out)
@@ -1580,10 +1624,12 @@ class _FrameCosts:
             slack = 1e-10 * (1.0 + top)
             alive = self._stage(shifts, 2, best, upper, slack, out)
             fast = np.mean(out[:, alive], axis=0)
+            self.means[alive] = fast
             near = alive[fast <= fast.min() + 2.0 * slack]
         else:
             self._stage(shifts, 3, -1, 0.0, 0.0, out)
             fast = np.mean(out, axis=0)
+            self.means[:] = fast
             slack = 1e-10 * (1.0 + float(np.abs(fast).max()))  # some 10^4 times the sums' rounding
             near = np.flatnonzero(fast <= fast.min() + 2.0 * slack)
         return int(near[np.argmin(cost(shifts[near]))]) if len(near) > 1 else int(near[0])
