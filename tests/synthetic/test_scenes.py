@@ -253,7 +253,8 @@ def test_an_apple_trees_colour_camera_changes_the_colours_alone(tree):
     old = make_tree_scene(3, sensor=sensor_model("azure-kinect").at(480, 270), n_apples=12, n_green=2, n_leaves=600,
                           photometric=None)  # fmt: skip
     assert hashlib.sha256(old.color.tobytes()).hexdigest()[:16] == "b6d5367255a030f3"
-    assert hashlib.sha256(old.depth.tobytes()).hexdigest()[:16] == "cd188c0c62d0254a"
+    # the depth since stop 48 (an apple's stem is its own surface for the multipath, docs/azure48.md; cd188c0c62d0254a)
+    assert hashlib.sha256(old.depth.tobytes()).hexdigest()[:16] == "5ac1b77560cd0bc2"
     assert np.array_equal(old.depth, tree.depth) and np.array_equal(old.labels, tree.labels)
     assert np.array_equal(old.masks, tree.masks) and old.truth() == tree.truth()
     changed = np.abs(old.color.astype(int) - tree.color).max(axis=2) > 8
