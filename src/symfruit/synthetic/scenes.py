@@ -134,7 +134,7 @@ def _sensor_surfaces(ids: np.ndarray, parts: dict[int, int]) -> np.ndarray:
     with the line between them). A stem of 1.2-1.5 mm radius is a few per cent of the half space a corner's second
     surface fills. Neither is the junction of two extended surfaces the model's 5 mm stands for; as separate meshes
     they pushed every berry back by 2-4 mm (``docs/azure48.md``: 549 of the 602 junction pixels beside fruit in
-    the Azure Kinect strawberry frames of seed 0)."""
+    the Azure Kinect strawberry frames of seeds 0-5)."""
     if not parts:
         return ids
     lut = np.arange(max(max(parts) + 1, int(ids.max(initial=-1)) + 1), dtype=np.int64)
