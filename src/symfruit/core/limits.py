@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import InputError, SymfruitError
 
 __all__ = [
+    "MAX_BAG_CHUNK_BYTES",
     "MAX_BAG_METADATA_BYTES",
     "MAX_CLOUD_POINTS",
     "MAX_COCO_BYTES",
@@ -69,6 +70,11 @@ MAX_COCO_BYTES = 256 << 20
 #: Largest ``metadata.yaml`` of a ROS 2 bag folder (bytes), checked before rosbags reads it whole: a few kB per
 #: topic and split file; as large as a truth file may be.
 MAX_BAG_METADATA_BYTES = MAX_TRUTH_BYTES
+#: Largest chunk of a ROS 2 bag's MCAP file, uncompressed (bytes), checked (with every record's length against
+#: the bytes left in the file) before rosbags reads the file: rosbag2 writes chunks of 768 kB (the MCAP writer's
+#: default ``chunk_size``, 786432) and a message larger than that alone in its chunk; the largest image message
+#: read (40 megapixels of 32-bit depth) is 160 MB.
+MAX_BAG_CHUNK_BYTES = 1024 << 20
 #: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
 MAX_INSTANCES = 1000
 MAX_LABEL_ID = 2**31 - 1
