@@ -202,7 +202,10 @@ def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
 def _unknown_message(key: str, where: str, close: str | None) -> str:
     if where and key in DEPTH_KEYS:
         return f"{key!r} under {where[:-1]!r} is not read: write it at the top level of the file"
-    hint = f"; did you mean {close!r}?" if close else f"; known keys: {', '.join(sorted(LAYOUT_KEYS | DEPTH_KEYS))}"
+    from ..settings import known_names  # the near ones and a count: every key was a line of 400+ characters (robust48)
+
+    listed = known_names(key, sorted(LAYOUT_KEYS | DEPTH_KEYS), where="README's table of inputs, row 'intrinsics', lists the layouts")
+    hint = f"; did you mean {close!r}?" if close else f"; {listed.replace('known:', 'known keys:', 1)}"
     return f"unknown key {where + key!r} (not a key of any intrinsics layout symfruit reads){hint}"
 
 
