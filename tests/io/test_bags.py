@@ -753,3 +753,22 @@ def test_an_mcap_whose_records_claim_sizes_it_cannot_hold_is_refused_before_rosb
     assert f"its footer's summary offset {chunk[0] + 1:,} is no record's start" in tampered(
         "summary", footer[0] + 9, chunk[0] + 1
     )
+
+
+def test_a_fisheye_camera_info_is_warned_about_with_coefficients_all_zero():
+    """Stop 48 (robust48): a CameraInfo of distortion_model 'equidistant' and d all 0 was taken as pinhole in
+    silence (a fisheye radius grows with the angle, a pinhole's with its tangent: 17 % apart at 40 degrees)."""
+    import warnings
+
+    from symfruit import SymfruitWarning
+    from symfruit.io.bags import camera_from_info
+
+    info = dict(k=[600.0, 0, 80, 0, 600, 60, 0, 0, 1], d=[0.0] * 4, width=160, height=120)
+    with pytest.warns(SymfruitWarning) as said:
+        camera_from_info(SimpleNamespace(**info, distortion_model="equidistant"), source="ros")
+    assert [str(w.message) for w in said] == ["ros: distortion model 'equidistant' is a fisheye lens, not applied: "
+                                              "symfruit treats the image as pinhole; rectify it first (image_proc), "
+                                              "else points away from the centre are misplaced"]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        camera_from_info(SimpleNamespace(**info, distortion_model="plumb_bob"), source="ros")  # pinhole: silent

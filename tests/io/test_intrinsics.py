@@ -299,3 +299,12 @@ def test_a_key_no_layout_has_and_none_is_close_to_lists_the_near_ones_in_one_sho
     assert str(info.value) == (f"{path}: unknown key 'serial' (not a key of any intrinsics layout symfruit reads); "
                                f"known keys: D, K, P, R, binning_x, binning_y and {rest} more (README's table of "
                                "inputs, row 'intrinsics', lists the layouts)")  # fmt: skip
+
+
+def test_an_intrinsics_file_of_a_fisheye_model_is_warned_about_with_coefficients_all_zero(tmp_path):
+    """Stop 48 (robust48): ``distortion_model: equidistant`` with ``D`` all 0 was read as pinhole in silence."""
+    ros = {"height": 480, "width": 640, "distortion_model": "equidistant", "D": [0.0] * 4,
+           "K": [615.0, 0, 320, 0, 615, 240, 0, 0, 1]}  # fmt: skip
+    path = _written(tmp_path / "cam.json", ros)
+    with pytest.warns(SymfruitWarning, match=r"cam\.json: distortion model 'equidistant' is a fisheye lens"):
+        assert load_camera(path).fx == 615.0

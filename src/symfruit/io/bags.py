@@ -43,7 +43,13 @@ from ..core.limits import (
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
 from .images import MIN_16BIT_DEPTH_REACH, float_depth
-from .intrinsics import check_binning_roi, check_pinhole_matrix, warn_distortion, warn_principal_point
+from .intrinsics import (
+    FISHEYE_MODELS,
+    check_binning_roi,
+    check_pinhole_matrix,
+    warn_distortion,
+    warn_principal_point,
+)
 
 __all__ = [
     "BagSource",
@@ -320,11 +326,18 @@ def camera_from_info(
                       camera, "CameraInfo")  # fmt: skip
     if source is not None:
         said = warned if warned is not None else set()
-        if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3):
+        model = getattr(msg, "distortion_model", None)
+        if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3, model=model):
             said.add("distortion")
         if "principal point" not in said and warn_principal_point(source, camera, stacklevel=3):
             said.add("principal point")
     return camera
+
+
+def fisheye(msg: Any) -> bool:
+    """Whether a ``CameraInfo``'s ``distortion_model`` is a fisheye one (:data:`~.intrinsics.FISHEYE_MODELS`)."""
+    model = getattr(msg, "distortion_model", None)
+    return isinstance(model, str) and model.lower() in FISHEYE_MODELS
 
 
 def info_distortion(msg: Any) -> tuple[str, list[float]]:
@@ -593,6 +606,7 @@ class BagSource:
         self._cameras: list[tuple[int, Camera | str, tuple[bool, bool]]] = []
         last: Any = None
         distorted: tuple[str, list[float]] | None = None  # the first non-zero distortion: warned about once
+        model: Any = None  # its lens model (a fisheye one is warned about with coefficients 0)
         for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
             if conn == self._depth:
                 self._depth_stamps.append(stamp)
@@ -605,8 +619,9 @@ class BagSource:
                     msg = self._reader.deserialize(raw, conn.msgtype)
                     sizeless = (not int(msg.width), not int(msg.height))  # as the live node: the image's size
                     camera: Camera | str = camera_from_info(msg, width=1, height=1)
-                    if distorted is None and any((coeffs := info_distortion(msg))[1]):
-                        distorted = coeffs
+                    coeffs = info_distortion(msg)
+                    if distorted is None and (any(coeffs[1]) or fisheye(msg)):
+                        distorted, model = coeffs, getattr(msg, "distortion_model", None)
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
                 if not self._cameras or self._cameras[-1][1:] != (camera, sizeless):  # kept on change: each
@@ -620,7 +635,7 @@ class BagSource:
         self._camera_stamps = [s for s, _, _ in self._cameras]
         self._off_centre_said = False  # a principal point outside the image: warned about at the first frame
         if distorted is not None:
-            warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4)
+            warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4, model=model)
 
     def __len__(self) -> int:
         return len(self._depth_stamps)
