@@ -209,5 +209,6 @@ def test_a_bag_under_a_file_is_refused_naming_the_file(tmp_path):
     (tmp_path / "notes").write_text("x")
     with pytest.raises(OutputError) as info:
         Ros2DetectionBag(tmp_path / "notes" / "bag").open()
-    assert str(info.value) == f"{tmp_path / 'notes' / 'bag'}: cannot create ROS 2 bag ({tmp_path / 'notes'} is a file, not a folder)"
+    notes = tmp_path / "notes"
+    assert str(info.value) == f"{notes / 'bag'}: cannot create ROS 2 bag ({notes} is a file, not a folder)"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["notes"]

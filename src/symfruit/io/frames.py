@@ -142,8 +142,10 @@ def read_frame(folder: str | Path) -> Frame:
                          f"only {65535 * scale:.3g} m, and no camera measures depth that finely (0.001 for "
                          "millimetres)")  # fmt: skip
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
-    if depth_file.suffix.lower() != ".npy" and (typical := typical_depth(depth)) is not None and (
-        typical > MAX_DEPTH_METRES
+    if (
+        depth_file.suffix.lower() != ".npy"
+        and (typical := typical_depth(depth)) is not None
+        and (typical > MAX_DEPTH_METRES)
     ):  # the units are the scale's (stop 48, robust48: "FOLDER: depth is 7009 m typically", the frame folder alone)
         raise InputError(f"{cam_path}: at its depth scale, {scale:g} m per unit, {depth_file.name}'s depth is "
                          f"{typical:.4g} m typically: its units look like millimetres or finer; state their scale "

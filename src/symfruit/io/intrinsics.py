@@ -171,9 +171,7 @@ def warn_principal_point(source: str, camera: Camera, *, stacklevel: int = 2) ->
 FISHEYE_MODELS = frozenset({"equidistant", "fisheye", "kannala_brandt", "kb4"})
 
 
-def warn_distortion(
-    source: str, key: str, values: Sequence[float], *, stacklevel: int = 2, model: Any = None
-) -> bool:
+def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2, model: Any = None) -> bool:
     """Warn (:class:`SymfruitWarning`) that the distortion coefficients ``values`` (field ``key``) of the camera
     ``source`` names are not applied, when one is non-zero, or that its lens ``model`` is a fisheye one
     (:data:`FISHEYE_MODELS`, coefficients all 0 too: stop 48, robust48); whether it warned. The one rule for
@@ -223,7 +221,8 @@ def _unknown_message(key: str, where: str, close: str | None) -> str:
         return f"{key!r} under {where[:-1]!r} is not read: write it at the top level of the file"
     from ..settings import known_names  # the near ones and a count: every key was a line of 400+ characters (robust48)
 
-    listed = known_names(key, sorted(LAYOUT_KEYS | DEPTH_KEYS), where="README's table of inputs, row 'intrinsics', lists the layouts")
+    where_listed = "README's table of inputs, row 'intrinsics', lists the layouts"
+    listed = known_names(key, sorted(LAYOUT_KEYS | DEPTH_KEYS), where=where_listed)
     hint = f"; did you mean {close!r}?" if close else f"; {listed.replace('known:', 'known keys:', 1)}"
     return f"unknown key {where + key!r} (not a key of any intrinsics layout symfruit reads){hint}"
 
