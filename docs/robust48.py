@@ -603,24 +603,34 @@ def killed_cases() -> None:
         return ""
 
     def killed(argv: list[str], target: Path, delays: tuple[float, ...]) -> Any:
-        bad = []
+        bad, whole_files, temporaries, absent = [], 0, 0, 0
         for delay in delays:
             if target.is_dir():
                 shutil.rmtree(target)
-            elif target.exists():
-                target.unlink()
+            for q in target.parent.iterdir() if target.suffix else []:
+                if q.is_file() and target.stem in q.name:
+                    q.unlink()
             p = subprocess.Popen([sys.executable, "-m", "symfruit", *argv], env=env, stdout=subprocess.DEVNULL,
                                  stderr=subprocess.DEVNULL)  # fmt: skip
             time.sleep(delay)
             p.send_signal(signal.SIGKILL)
             p.wait()
-            files = [target] if target.suffix else [q for q in target.rglob("*") if q.is_file()]
+            if target.suffix:
+                files = [q for q in target.parent.iterdir() if q.is_file() and target.stem in q.name]
+            else:
+                files = [q for q in target.rglob("*") if q.is_file()] if target.exists() else []
+            absent += not files
             for q in files:
-                if q.exists() and not q.name.endswith(".tmp") and (why := whole(q)):
+                if q.name.endswith(".tmp"):
+                    temporaries += 1
+                elif why := whole(q):
                     bad.append(f"{q.relative_to(T())} partial after {delay} s ({why})")
+                else:
+                    whole_files += 1
         if bad:
             raise AssertionError("; ".join(bad[:3]))
-        return "no partial file"
+        return (f"{len(delays)} kills: {whole_files} whole files, {temporaries} temporaries left, {absent} kills "
+                "before any file; no partial file")  # fmt: skip
 
     out_ply = T() / "cases48/killed/out.ply"
     out_ply.parent.mkdir(parents=True, exist_ok=True)

@@ -596,7 +596,7 @@ def test_a_camera_info_whose_k_is_transposed_fails_its_frames_by_name(tmp_path):
         ({"height": 2.5}, "height, width and step must be whole numbers, got 2.5, 3, 9"),  # before: read as 2 rows
         ({"width": "3"}, "height, width and step must be whole numbers, got 2, '3', 9"),  # before: text read as 3
         ({"step": None}, "height, width and step must be whole numbers, got 2, 3, None"),
-        ({"data": None}, "image data must be bytes"),  # before: TypeError from bytes()
+        ({"data": None}, "image data must be bytes (uint8[]), got nothing (None)"),  # TypeError; NoneType (stop 48)
         ({"data": "abcdefghijklmnopqr"}, "image data must be bytes"),  # before: TypeError
         ({"data": [300] * 18}, "image data must be bytes"),  # before: ValueError 'bytes must be in range(0, 256)'
         ({"data": 10**12}, "image data must be bytes"),  # before: bytes(10**12), a terabyte of zeros allocated

@@ -210,7 +210,8 @@ def _message_bytes(data: Any) -> bytes:
             return bytes(data)
         except (TypeError, ValueError):
             pass
-    raise FileFormatError(f"image data must be bytes (uint8[]), got {type(data).__name__}")
+    got = "nothing (None)" if data is None else type(data).__name__  # not Python's "NoneType" (robust48)
+    raise FileFormatError(f"image data must be bytes (uint8[]), got {got}")
 
 
 def yuv422_rgb(rows: np.ndarray, order: tuple[int, int, int, int]) -> np.ndarray:
