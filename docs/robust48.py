@@ -493,6 +493,33 @@ def batch_cases() -> None:
     for exc in crashes:
         add(f"batch/segment-item-raises-{type(exc).__name__}", "result", lambda e=exc: seg(e), "")
 
+    def jobs_worker_dies() -> str:
+        """``evaluate --jobs 2`` whose worker dies (``os._exit``, as the OOM killer ends it) on one instance."""
+        import symfruit.evaluate.runner as runner
+
+        parent, real = os.getpid(), runner._evaluate
+
+        def dies(spec: Any, methods: Any, settings: Any) -> Any:
+            if spec.index == 3 and os.getpid() != parent:
+                os._exit(9)
+            return real(spec, methods, settings)
+
+        o = out("jobs-dies")
+        runner._evaluate = dies  # type: ignore[assignment]  # the workers are forked: they see it
+        try:
+            run = cli("evaluate", "--quick", "--methods", "raw", "--jobs", "2", "--output", o)
+        finally:
+            runner._evaluate = real  # type: ignore[assignment]
+        if run.rc != 0:
+            raise AssertionError(f"exit {run.rc}: {run.err.strip()[-200:]!r}")
+        table = next(o.glob("*/instances.csv")).read_text().splitlines()
+        died = [line for line in table if "worker process ended abruptly" in line]
+        if not 0 < len(died) < len(table) - 1:
+            raise AssertionError(f"{len(died)} rows of a dead worker among {len(table) - 1}")
+        return f"{len(died)} of {len(table) - 1} rows (the instances numbered 3) say their worker died; the rest ran"
+
+    add("batch/evaluate-jobs-worker-dies", "result", jobs_worker_dies)
+
 
 # --- MCAP records --------------------------------------------------------------------------------------------
 def mcap_cases() -> None:
