@@ -412,6 +412,48 @@ def ros_cases() -> None:
     add("ros/info-fisheye-warned", "result", fisheye_warned)
 
 
+def sync_cases() -> None:
+    """The ROS 2 node's pairing of colour, depth and camera info by stamp (``ApproximateSync``, no ROS needed):
+    stamps apart, missing, of text, NaN, huge, out of order, a flood; each case returns what was paired, and a
+    pair of stamps beyond the slop, an exception or an unbounded queue raises."""
+    from symfruit.io.bags import header_stamp
+    from symfruit.ros.sync import ApproximateSync
+
+    def msg(sec: Any, nanosec: Any = 0) -> SimpleNamespace:
+        return SimpleNamespace(header=SimpleNamespace(stamp=SimpleNamespace(sec=sec, nanosec=nanosec)))
+
+    def both(sec: Any) -> list[tuple[int, Any]]:
+        """Depth and camera info (topics 1 and 2) stamped ``sec``."""
+        return [(1, msg(sec)), (2, msg(sec))]
+
+    def paired(feed: list[tuple[int, Any]], slop: float = 0.01, queue: int = 5) -> str:
+        sets: list[tuple[Any, ...]] = []
+        sync = ApproximateSync(3, lambda *m: sets.append(m), slop=slop, queue_size=queue)
+        for topic, m in feed:
+            sync.add(topic, m)
+            if any(len(q) > queue for q in getattr(sync, "_queues", [])):
+                raise AssertionError("a queue grew past queue_size")
+        for members in sets:
+            stamps = [header_stamp(m) * 1e-9 for m in members]
+            if max(stamps) - min(stamps) > slop + 1e-9:
+                raise AssertionError(f"paired stamps {stamps} beyond the slop {slop}")
+        return f"{len(sets)} sets; late {sync.late}, unstamped {sync.unstamped}, resets {sync.resets}"
+
+    add("sync/good", "result", lambda: paired([(t, msg(5)) for t in (0, 1, 2)]))
+    add("sync/apart-1s", "result", lambda: paired([(0, msg(5)), (1, msg(6)), (2, msg(5))]))
+    add("sync/apart-1h", "result", lambda: paired([(0, msg(5)), (1, msg(3605)), (2, msg(5))]))
+    for bad in ("5", None, float("nan"), float("inf"), -5, 10**30, 2.5, [5]):
+        add(f"sync/stamp-{bad!r}", "result",
+            lambda b=bad: paired([(0, msg(b)), *both(5), (0, msg(6)), *both(6)]))  # fmt: skip
+    add("sync/nanosec-over", "result", lambda: paired([(0, msg(5, 3 * 10**9)), (1, msg(8)), (2, msg(8))]))
+    add("sync/no-header", "result", lambda: paired([(0, SimpleNamespace()), (1, msg(5)), (2, msg(5))]))
+    add("sync/out-of-order", "result",
+        lambda: paired([(0, msg(9)), *both(9), (0, msg(8)), *both(8)]))  # fmt: skip
+    add("sync/clock-reset", "result",
+        lambda: paired([(0, msg(9000)), *both(9000), (0, msg(1)), *both(1)]))  # fmt: skip
+    add("sync/flood-one-topic", "result", lambda: paired([(0, msg(k)) for k in range(100_000)]))
+
+
 def padded(m: SimpleNamespace, pad: int) -> SimpleNamespace:
     rows = np.frombuffer(m.data, np.uint8).reshape(m.height, m.step)
     wide = np.zeros((m.height, m.step + pad), np.uint8)
@@ -720,6 +762,7 @@ def main() -> int:
         output_cases,
         camera_cases,
         ros_cases,
+        sync_cases,
         batch_cases,
         mcap_cases,
         killed_cases,

@@ -487,6 +487,11 @@ def test_a_stamp_that_is_not_a_time_is_no_stamp():
     assert header_stamp(msg(3, 5)) == 3_000_000_005 and header_stamp(msg(1, 4_000_000_000)) == 5_000_000_000
     assert header_stamp(msg(-5)) is None and header_stamp(msg(MAX_STAMP_NS // 1_000_000_000)) is None
     assert header_stamp(SimpleNamespace()) is None
+    # stop 48 (robust48): a hand-made stamp of text, None, NaN, inf, a list or 2.5 s is no time (int() raised on
+    # all but text and 2.5, which it read as 5 s and cut to 2 s)
+    for sec in ("5", None, float("nan"), float("inf"), [5], 2.5, True):
+        assert header_stamp(msg(sec)) is None and header_stamp(msg(5, sec)) is None
+    assert header_stamp(msg(np.uint32(5), 7.0)) == 5_000_000_007
 
 
 def test_a_colour_image_stamped_before_1970_is_stamped_with_the_bags_time(tmp_path):

@@ -376,9 +376,11 @@ def header_stamp(msg: Any) -> int | None:
     stamp = getattr(getattr(msg, "header", None), "stamp", None)
     if stamp is None:
         return None
-    sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
-    nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
-    value = int(sec) * 1_000_000_000 + int(nsec)
+    sec = _whole(getattr(stamp, "sec", getattr(stamp, "secs", 0)))
+    nsec = _whole(getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0)))
+    if sec is None or nsec is None:  # a hand-made message's text, None, NaN, inf or 2.5: no time (stop 48,
+        return None  # robust48: int() raised TypeError / ValueError / OverflowError, or cut 2.5 s to 2)
+    value = sec * 1_000_000_000 + nsec
     return value if 0 <= value < MAX_STAMP_NS else None
 
 
