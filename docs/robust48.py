@@ -280,6 +280,30 @@ def camera_cases() -> None:
     detect48("depth/npy-negative-all", "error", b, r47.depth_npy(lambda d: -np.abs(d).astype("f4") - 0.1), names="")
 
 
+def bomb_cases() -> None:
+    """Images whose header claims 400 megapixels in a 48 kB file (a 1-bit 20000 x 20000 PNG): refused from the
+    header, before Pillow decodes (allocates) them, as colour, depth and masks of a frame and as segment's input."""
+
+    def bomb(name: str) -> Callable[[Path], None]:
+        def go(f: Path) -> None:
+            from PIL import Image
+
+            Image.new("1", (20000, 20000)).save(f / name, optimize=True)
+
+        return go
+
+    for name in ("color.png", "depth.png", "masks.png"):
+        detect48(f"bomb/{name}", "error", "f640", bomb(name), names=name)
+
+    def segment_bomb() -> Run:
+        p = fixture("bomb.png")
+        bomb("bomb.png")(p.parent)
+        o = out("bomb")
+        return cli("segment", p, "--output", o, output=o)
+
+    add("bomb/segment-input", "failed", segment_bomb, "bomb.png")
+
+
 def camera_raw(key: str, literal: str) -> Callable[[Path], None]:
     def go(f: Path) -> None:
         data = json.loads((f / "camera.json").read_text())
@@ -761,6 +785,7 @@ def main() -> int:
         file_cases,
         output_cases,
         camera_cases,
+        bomb_cases,
         ros_cases,
         sync_cases,
         batch_cases,
