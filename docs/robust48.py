@@ -55,6 +55,13 @@ def T() -> Path:
     return r47.T
 
 
+def _src() -> str:
+    """The folder the symfruit under test is imported from (a child process runs the same one)."""
+    import symfruit
+
+    return str(Path(symfruit.__file__).resolve().parents[1])
+
+
 def fixture(name: str) -> Path:
     """A fresh file or folder path for one case (removed if left by an earlier run)."""
     p = T() / "cases48" / name
@@ -658,7 +665,7 @@ def mcap_cases() -> None:
 def killed_cases() -> None:
     """The command line in a child process, killed (SIGKILL) after a delay: no output file may be left
     partial under its own name (a ``.NAME.PID-TOKEN.tmp`` may stay; the next run clears it)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    env = {**os.environ, "PYTHONPATH": _src() + os.pathsep + os.environ.get("PYTHONPATH", "")}
     big = None
 
     def big_cloud() -> Path:
@@ -695,14 +702,23 @@ def killed_cases() -> None:
             return f"{type(exc).__name__}"
         return ""
 
-    def killed(argv: list[str], target: Path, delays: tuple[float, ...]) -> Any:
+    def clear(target: Path) -> None:
+        if target.is_dir():
+            shutil.rmtree(target)
+        for q in target.parent.iterdir() if target.suffix else []:
+            if q.is_file() and target.stem in q.name:
+                q.unlink()
+
+    def killed(argv: list[str], target: Path, shares: tuple[float, ...]) -> Any:
+        """A whole run first (its wall time ``D``), then runs killed at ``share * D`` each."""
+        clear(target)
+        start = time.perf_counter()
+        subprocess.run([sys.executable, "-m", "symfruit", *argv], env=env, capture_output=True, check=True)
+        whole_run = time.perf_counter() - start
         bad, whole_files, temporaries, absent = [], 0, 0, 0
+        delays = [round(share * whole_run, 2) for share in shares]
         for delay in delays:
-            if target.is_dir():
-                shutil.rmtree(target)
-            for q in target.parent.iterdir() if target.suffix else []:
-                if q.is_file() and target.stem in q.name:
-                    q.unlink()
+            clear(target)
             p = subprocess.Popen([sys.executable, "-m", "symfruit", *argv], env=env, stdout=subprocess.DEVNULL,
                                  stderr=subprocess.DEVNULL)  # fmt: skip
             time.sleep(delay)
@@ -722,14 +738,15 @@ def killed_cases() -> None:
                     whole_files += 1
         if bad:
             raise AssertionError("; ".join(bad[:3]))
-        return (f"{len(delays)} kills: {whole_files} whole files, {temporaries} temporaries left, {absent} kills "
-                "before any file; no partial file")  # fmt: skip
+        return (f"a whole run {whole_run:.1f} s; {len(delays)} kills at {min(delays)}-{max(delays)} s: "
+                f"{whole_files} whole files, {temporaries} temporaries left, {absent} kills before any file; "
+                "no partial file")  # fmt: skip
 
     out_ply = T() / "cases48/killed/out.ply"
     out_ply.parent.mkdir(parents=True, exist_ok=True)
     add("killed/complete-output", "result",
         lambda: killed(["complete", str(big_cloud()), "--method", "sphere", "--output", str(out_ply)], out_ply,
-                       (1.5, 2.5, 3.5, 5.0)))  # fmt: skip
+                       (0.5, 0.8, 0.9, 0.95, 0.98, 0.99)))  # fmt: skip
 
     def recording() -> Path:
         rec = T() / "cases48/killed-rec"
@@ -740,14 +757,14 @@ def killed_cases() -> None:
 
     o = T() / "cases48/killed/detect"
     add("killed/detect-recording", "result",
-        lambda: killed(["detect", str(recording()), "--output", str(o)], o, (3.0, 5.0, 8.0)))  # fmt: skip
+        lambda: killed(["detect", str(recording()), "--output", str(o)], o, (0.4, 0.6, 0.75, 0.9, 0.97)))  # fmt: skip
 
 
 # --- memory over a long recording ----------------------------------------------------------------------------
 def memory_cases() -> None:
     """``bench --recording N`` (``detect`` over a generated N-frame recording, in a child process: its peak
     resident memory) at 4 and 24 frames: the peak may not grow with the recording (at most 10 %)."""
-    env = {**os.environ, "PYTHONPATH": str(ROOT / "src") + os.pathsep + os.environ.get("PYTHONPATH", "")}
+    env = {**os.environ, "PYTHONPATH": _src() + os.pathsep + os.environ.get("PYTHONPATH", "")}
 
     def peak(n: int) -> float:
         done = subprocess.run([sys.executable, "-m", "symfruit", "bench", "--recording", str(n)], env=env,
