@@ -287,7 +287,7 @@ def test_binning_and_a_region_of_interest_are_refused_not_ignored(tmp_path, extr
 
 
 def test_a_key_no_layout_has_and_none_is_close_to_lists_the_near_ones_in_one_short_line(tmp_path):
-    """Stop 48 (robust48): every key of every layout was listed (35 names, a line of 445 characters naming the
+    """Stop 48 (robust48): every key of every layout was listed (33 names, a line of 445 characters naming the
     file) for a key near none of them (a camera's ``serial`` or ``model`` written beside its intrinsics)."""
     path = _written(tmp_path / "cam.json", {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640,
                                             "height": 480, "serial": "123"})  # fmt: skip
