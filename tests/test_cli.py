@@ -968,7 +968,7 @@ def test_report_classes_refuse_an_empty_entry_or_what_is_no_plain_number(tmp_pat
     assert main(["report", str(tmp_path / "run"), f"--classes={classes}"]) == 2
     assert f"--classes {classes!r}: {what}; expected diameters in mm" in capsys.readouterr().err
     assert main(["report", str(tmp_path / "run"), "--classes", " 18, 2.5e1 "]) == 2  # read: on to the missing run
-    assert "detections.parquet: no such table" in capsys.readouterr().err
+    assert "run: no such folder" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

@@ -347,3 +347,21 @@ def test_one_depth_file_for_several_images_or_a_device_as_depth_is_refused_befor
     with pytest.raises(FileFormatError, match="/dev/zero: not a regular file"):  # before: the image failed
         segment_images(images[:1], output=tmp_path / "out", depth="/dev/zero", camera=camera, progress=False)
     assert not (tmp_path / "out").exists()
+
+
+def test_a_depth_folder_holding_no_images_depth_is_refused_not_read_as_colour_alone(tmp_path):
+    """Stop 48 (robust48): `segment --depth FOLDER` of a folder holding none of the images' depth (a wrong
+    folder) segmented every image on colour alone, said only in the summary's note."""
+    folder = _photos(tmp_path / "in", n=2)
+    depth = tmp_path / "depth"
+    depth.mkdir()
+    Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "other.png")
+    cam = Camera(fx=600, fy=600, cx=160, cy=120, width=320, height=240)
+    with pytest.raises(FileFormatError) as info:
+        segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert str(info.value) == (f"{depth}: holds the depth of none of the 2 image(s) (looked for p0.png / .npy / "
+                               "p0_depth.png / .npy): is it the depth folder?")  # fmt: skip
+    assert not (tmp_path / "out").exists()
+    Image.fromarray(np.full((240, 320), 400, np.uint16)).save(depth / "p1_depth.png")  # one image's: as before
+    report = segment_images([folder], output=tmp_path / "out", depth=depth, camera=cam)
+    assert [d.used_depth for d in report.done] == [False, True]

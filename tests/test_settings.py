@@ -439,3 +439,14 @@ def test_an_unknown_setting_of_a_large_section_names_the_near_ones_in_one_short_
     # a small section is still listed whole
     with pytest.raises(ConfigError, match=r"unknown setting input\.max_pts.*; known: max_extent, max_points, "):
         resolve_settings(overrides={"input": {"max_pts": 1}})
+
+
+def test_a_section_with_nothing_under_it_says_so_not_nonetype(tmp_path):
+    """Stop 48 (robust48): a settings file cut after ``evidence:`` was "evidence: expected a mapping of settings,
+    got NoneType", Python's name of null."""
+    path = tmp_path / "cut.yaml"
+    path.write_text("evidence:\n")
+    with pytest.raises(ConfigError) as info:
+        load_settings(path)
+    assert str(info.value) == (f"{path}: evidence: holds no settings (nothing under it); give its settings indented "
+                               "below it, or remove the line")  # fmt: skip

@@ -604,6 +604,15 @@ def _depth_file(image: Path, depth: Path | None, n_images: int) -> Path | None:
     return depth
 
 
+def _depth_named(image: Path, folder: Path) -> bool:
+    """Whether ``folder`` holds an entry named as ``image``'s depth (one that is no file counts: its image fails
+    by name)."""
+    try:
+        return _depth_file(image, folder, 0) is not None
+    except SymfruitError:
+        return True
+
+
 def _labeller(
     masks: str | Path | MaskSource | Masker, settings: Settings | None, images: Sequence[Path]
 ) -> tuple[Callable[[Path, np.ndarray, np.ndarray | None, Any, int], np.ndarray], str]:
@@ -724,6 +733,11 @@ def segment_images(
             if len(images) != 1:  # before: refused once per image, each image failed with it
                 raise InputError(f"--depth {depth_path} is one file but there are {len(images)} images: give a "
                                  "folder of depth images")  # fmt: skip
+        elif not any(_depth_named(p, depth_path) for p in images):  # a folder of no image's depth
+            # (stop 48, robust48: every image was segmented on colour alone, said in the summary's note alone)
+            raise FileFormatError(f"{depth_path}: holds the depth of none of the {len(images)} image(s) (looked for "
+                                  f"{images[0].stem}.png / .npy / {images[0].stem}_depth.png / .npy): is it the "
+                                  "depth folder?")  # fmt: skip
     if not (np.isfinite(depth_scale) and 0 < depth_scale <= 1.0):
         raise InputError(f"depth_scale must be in (0, 1] metres per unit, got {depth_scale}")
     labeller, source = _labeller(masks, settings, images)

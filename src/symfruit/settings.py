@@ -407,6 +407,9 @@ def _known(key: str, known: Iterable[str]) -> str:
 
 
 def _not_a_mapping(name: str, value: Any) -> Any:
+    if value is None:  # `evidence:` with nothing under it (a file cut after its first line): not Python's "NoneType"
+        raise ConfigError(f"{name}: holds no settings (nothing under it); give its settings indented below it, or "
+                          "remove the line")  # fmt: skip
     raise ConfigError(f"{name}: expected a mapping of settings, got {type(value).__name__}")
 
 

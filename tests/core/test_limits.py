@@ -57,6 +57,8 @@ def test_readme_limits_are_the_enforced_constants():
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
     assert limits.MAX_BAG_METADATA_BYTES == limits.MAX_TRUTH_BYTES  # stated beside the truth file's
+    mcap = _numbers(next(v for k, v in table.items() if k.startswith("a ROS 2 bag's MCAP")))
+    assert mcap[0] == limits.MAX_BAG_CHUNK_BYTES  # stop 48 (robust48)
     tables = _numbers(next(v for k, v in table.items() if k.startswith("a run's fruit table")))
     assert tables == [limits.MAX_TABLE_ROWS, limits.MAX_TABLE_BYTES]
     masks = _numbers(next(v for k, v in table.items() if k.startswith("fruit per")))
@@ -84,6 +86,7 @@ def test_the_modules_use_the_one_set_of_bounds():
 
     assert colour.MAX_PIECES is limits.MAX_PIECES == limits.MAX_INSTANCES  # README: "at most 1000 candidate pieces"
     assert bags.MAX_BAG_METADATA_BYTES is limits.MAX_BAG_METADATA_BYTES
+    assert bags.MAX_BAG_CHUNK_BYTES is limits.MAX_BAG_CHUNK_BYTES
 
 
 @pytest.mark.parametrize(("w", "h", "message"), [

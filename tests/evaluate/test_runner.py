@@ -83,6 +83,29 @@ def test_a_bad_instance_or_a_method_fault_in_a_worker_pool_is_recorded_and_the_r
     assert 0 < rows[1].iou < 1 and 0 < rows[3].iou < 1 and math.isnan(rows[4].iou)
 
 
+def test_a_worker_that_dies_fails_its_instance_and_the_others_go_on(monkeypatch):
+    """Stop 48 (robust48): a worker process killed (out of memory, a crash in compiled code) ended the evaluation
+    with a BrokenProcessPool traceback, every finished batch lost. The batches not back are evaluated again, each
+    instance in a process of its own: the one that dies again is a row saying so."""
+    import os
+
+    from symfruit.evaluate import runner
+
+    parent, real = os.getpid(), runner._evaluate
+
+    def dies_on_the_second(spec, methods, settings):
+        if spec.index == 1 and os.getpid() != parent:
+            os._exit(9)  # as the kernel's OOM killer ends a process: no exception, no cleanup
+        return real(spec, methods, settings)
+
+    monkeypatch.setattr(runner, "_evaluate", dies_on_the_second)  # workers are forked: they see it
+    specs = [*SPECS, Spec("paper", "strawberry", 2, 0)]
+    rows = run(specs, ("raw",), jobs=2, progress=False)
+    assert [(r.fruit_index, r.method) for r in rows] == [(0, "raw"), (1, "raw"), (2, "raw")]
+    assert [r.error for r in rows] == ["", f"the instance: {runner.WORKER_DIED}", ""]
+    assert 0 < rows[0].iou < 1 and math.isnan(rows[1].iou) and 0 < rows[2].iou < 1
+
+
 def row(method="raw", iou=0.5, centre_mm=2.0, confidence=float("nan"), error="", occlusion=0.0, **kw):
     base = dict(protocol="paper", fruit="apple", kind="apple", fruit_index=0, pose=0, angle_x=0.0, angle_y=0.0,
                 angle_z=0.0, distance_m=0.3, occlusion=occlusion, hidden=0.1, n_visible=100, method=method, iou=iou,

@@ -487,6 +487,11 @@ def test_a_stamp_that_is_not_a_time_is_no_stamp():
     assert header_stamp(msg(3, 5)) == 3_000_000_005 and header_stamp(msg(1, 4_000_000_000)) == 5_000_000_000
     assert header_stamp(msg(-5)) is None and header_stamp(msg(MAX_STAMP_NS // 1_000_000_000)) is None
     assert header_stamp(SimpleNamespace()) is None
+    # stop 48 (robust48): a hand-made stamp of text, None, NaN, inf, a list or 2.5 s is no time (int() raised on
+    # all but text and 2.5, which it read as 5 s and cut to 2 s)
+    for sec in ("5", None, float("nan"), float("inf"), [5], 2.5, True):
+        assert header_stamp(msg(sec)) is None and header_stamp(msg(5, sec)) is None
+    assert header_stamp(msg(np.uint32(5), 7.0)) == 5_000_000_007
 
 
 def test_a_colour_image_stamped_before_1970_is_stamped_with_the_bags_time(tmp_path):
@@ -596,7 +601,7 @@ def test_a_camera_info_whose_k_is_transposed_fails_its_frames_by_name(tmp_path):
         ({"height": 2.5}, "height, width and step must be whole numbers, got 2.5, 3, 9"),  # before: read as 2 rows
         ({"width": "3"}, "height, width and step must be whole numbers, got 2, '3', 9"),  # before: text read as 3
         ({"step": None}, "height, width and step must be whole numbers, got 2, 3, None"),
-        ({"data": None}, "image data must be bytes"),  # before: TypeError from bytes()
+        ({"data": None}, "image data must be bytes (uint8[]), got nothing (None)"),  # TypeError; NoneType (stop 48)
         ({"data": "abcdefghijklmnopqr"}, "image data must be bytes"),  # before: TypeError
         ({"data": [300] * 18}, "image data must be bytes"),  # before: ValueError 'bytes must be in range(0, 256)'
         ({"data": 10**12}, "image data must be bytes"),  # before: bytes(10**12), a terabyte of zeros allocated
@@ -669,9 +674,9 @@ def test_a_ros2_bag_whose_mcap_is_damaged_is_said_in_our_words(tmp_path):
     ending after its magic "cannot open bag (ord() expected a character, but string of length 0 found)"."""
     from symfruit.io.sources import open_source
 
-    for name, body, why in [("huge", b"\x01" * 999, "a record in the bag claims more bytes than memory holds: the bag "
-                             "is damaged"), ("cut", b"", "the file ends inside a record: the bag is cut short or "
-                             "damaged")]:  # fmt: skip
+    huge = "the record at byte 8 claims 72,340,172,838,076,673 bytes, more than the 990 left in the file: the MCAP "
+    cut = "the file ends inside a record: the bag is cut short or damaged"
+    for name, body, why in [("huge", b"\x01" * 999, huge + "file is damaged"), ("cut", b"", cut)]:
         bag = tmp_path / name
         bag.mkdir()
         (bag / "metadata.yaml").write_text(
@@ -682,7 +687,8 @@ def test_a_ros2_bag_whose_mcap_is_damaged_is_said_in_our_words(tmp_path):
         (bag / "a.mcap").write_bytes(b"\x89MCAP0\r\n" + body)
         with pytest.raises(FileFormatError) as info:
             open_source(bag)
-        assert str(info.value) == f"{bag}: cannot open bag ({why})"
+        # stop 48: the header record's length is checked before rosbags asks for that many bytes (robust48)
+        assert str(info.value) == f"{bag / 'a.mcap' if name == 'huge' else bag}: cannot open bag ({why})"
 
 
 def test_random_bytes_named_bag_are_said_in_our_words(tmp_path):
@@ -696,3 +702,78 @@ def test_random_bytes_named_bag_are_said_in_our_words(tmp_path):
         open_source(bag)
     assert str(info.value) == (f"{bag}: cannot open bag (bytes that are no text where a bag holds text: not a bag, or "
                                "a damaged one)")  # fmt: skip
+
+
+def _mcap_records(data):
+    """(start, opcode, length) of an MCAP file's top-level records."""
+    pos, out = 8, []
+    while pos < len(data) - 8:
+        op, length = data[pos], int.from_bytes(data[pos + 1 : pos + 9], "little")
+        out.append((pos, op, length))
+        if op == 0x02:
+            break
+        pos += 9 + length
+    return out
+
+
+def test_an_mcap_whose_records_claim_sizes_it_cannot_hold_is_refused_before_rosbags_reads_them(tmp_path):
+    """Stop 48 (robust48): rosbags reads a record's length from the file and asks for that many bytes (16 GB of a
+    header record claiming it: "Truncated record at offset 17: expected 17179869184 bytes, got 294681.", after
+    the allocation), and decompresses a chunk whole at the size its chunk index states."""
+    pytest.importorskip("rosbags")
+    import shutil
+
+    from symfruit.core.limits import MAX_BAG_CHUNK_BYTES
+
+    color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+    good = write_ros2_bag(tmp_path / "good", color, (depth * 1000).astype(np.uint16), frames=3, storage="mcap")
+    assert len(open_source(good)) == 3  # a bag rosbag2 would write passes the walk
+    data = (good / "good.mcap").read_bytes()
+    records = _mcap_records(data)
+    chunk = next(r for r in records if r[1] == 0x06)
+    index = next(r for r in records if r[1] == 0x08)
+    footer = next(r for r in records if r[1] == 0x02)
+
+    def tampered(name, at, value):
+        bag = tmp_path / name
+        shutil.copytree(good, bag)
+        raw = bytearray(data)
+        raw[at : at + 8] = int(value).to_bytes(8, "little")
+        (bag / "good.mcap").write_bytes(bytes(raw))
+        with pytest.raises(FileFormatError) as info:
+            open_source(bag)
+        assert str(info.value).startswith(f"{bag / 'good.mcap'}: cannot open bag (")
+        return str(info.value)
+
+    left = len(data) - 8 - 8 - 9
+    assert f"the record at byte 8 claims 17,179,869,184 bytes, more than the {left:,} left in the file" in tampered(
+        "header", 9, 16 << 30
+    )
+    assert (f"the chunk at byte {chunk[0]} claims {MAX_BAG_CHUNK_BYTES + 1:,} bytes uncompressed; at most 1024 MB "
+            "are read") in tampered("unpacked", chunk[0] + 9 + 16, MAX_BAG_CHUNK_BYTES + 1)  # fmt: skip
+    assert f"the chunk index at byte {index[0]:,} points at no chunk of its sizes" in tampered(
+        "index", index[0] + 9 + index[2] - 8, 16 << 30
+    )
+    assert f"the chunk index at byte {index[0]:,} points at no chunk" in tampered("offset", index[0] + 9 + 16, 9)
+    assert f"its footer's summary offset {chunk[0] + 1:,} is no record's start" in tampered(
+        "summary", footer[0] + 9, chunk[0] + 1
+    )
+
+
+def test_a_fisheye_camera_info_is_warned_about_with_coefficients_all_zero():
+    """Stop 48 (robust48): a CameraInfo of distortion_model 'equidistant' and d all 0 was taken as pinhole in
+    silence (a fisheye radius grows with the angle, a pinhole's with its tangent: 17 % apart at 40 degrees)."""
+    import warnings
+
+    from symfruit import SymfruitWarning
+    from symfruit.io.bags import camera_from_info
+
+    info = dict(k=[600.0, 0, 80, 0, 600, 60, 0, 0, 1], d=[0.0] * 4, width=160, height=120)
+    with pytest.warns(SymfruitWarning) as said:
+        camera_from_info(SimpleNamespace(**info, distortion_model="equidistant"), source="ros")
+    assert [str(w.message) for w in said] == ["ros: distortion model 'equidistant' is a fisheye lens, not applied: "
+                                              "symfruit treats the image as pinhole; rectify it first (image_proc), "
+                                              "else points away from the centre are misplaced"]  # fmt: skip
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        camera_from_info(SimpleNamespace(**info, distortion_model="plumb_bob"), source="ros")  # pinhole: silent

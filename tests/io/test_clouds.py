@@ -453,3 +453,13 @@ def test_an_npy_header_cut_short_says_so_in_its_own_words(tmp_path):
         read_cloud(path)
     assert str(info.value) == (f"{path}: not a valid .npy file (its array header claims 49,912 bytes but only 498 "
                                "follow: cut short or damaged)")  # fmt: skip
+
+
+def test_a_text_cloud_of_bytes_that_are_no_text_is_said_in_our_words(tmp_path):
+    """Stop 48 (robust48): a PNG named .xyz was "cannot read as XYZ ('utf-8' codec can't decode byte 0x89 in
+    position 0: invalid start byte)", Python's codec's words."""
+    path = tmp_path / "photo.xyz"
+    path.write_bytes(b"\x89PNG\r\n\x1a\n" + bytes(range(256)))
+    with pytest.raises(FileFormatError) as info:
+        read_cloud(path)
+    assert str(info.value) == f"{path}: cannot read as XYZ (not UTF-8 text: invalid start byte at byte 0)"

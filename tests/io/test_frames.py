@@ -567,3 +567,24 @@ def test_a_frame_whose_camera_json_does_not_fit_its_images_names_camera_json(tmp
     assert str(info.value) == (f"{frame / 'camera.json'}: depth_scale 1e-09 m per unit: depth.png's 16-bit units "
                                "would reach only 6.55e-05 m, and no camera measures depth that finely (0.001 for "
                                "millimetres)")  # fmt: skip
+
+
+def test_a_camera_json_depth_scale_of_metres_for_millimetre_units_names_camera_json(tmp_path):
+    """Stop 48 (robust48): a depth_scale of 1 (metres per unit) over a millimetre depth.png was "FOLDER: depth is
+    7009 m typically; depth must be metres (... multiply by the depth scale first)", the frame folder alone, when
+    the scale camera.json states is what is wrong."""
+    from symfruit.io.frames import read_frame
+
+    frame = tmp_path / "frame"
+    shutil.copytree(EXAMPLE_FRAME, frame)
+    cam = json.loads((frame / "camera.json").read_text())
+    (frame / "camera.json").write_text(json.dumps({**cam, "depth_scale": 1.0}))
+    with pytest.raises(InputError) as info:
+        read_frame(frame)
+    typical = str(info.value).split("depth is ")[-1].split(" m typically")[0]
+    assert 100 < float(typical) < 65535
+    assert str(info.value) == (f"{frame / 'camera.json'}: at its depth scale, 1 m per unit, depth.png's depth is "
+                               f"{typical} m typically: its units look like millimetres or finer; state their scale "
+                               "(0.001 for millimetres)")  # fmt: skip
+    (frame / "camera.json").write_text(json.dumps({**cam, "depth_scale": 0.01}))  # centimetres: up to 655 m, read
+    assert read_frame(frame).depth.shape == (480, 640)

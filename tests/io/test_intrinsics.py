@@ -284,3 +284,27 @@ def test_binning_and_a_region_of_interest_are_refused_not_ignored(tmp_path, extr
     assert load_camera(path) == Camera(fx=600, fy=600, cx=320, cy=240, width=640, height=480)
     path.write_text(json.dumps({**base, "roi": {"x_offset": 0, "y_offset": 0, "width": 640, "height": 480}}))
     assert load_camera(path).width == 640
+
+
+def test_a_key_no_layout_has_and_none_is_close_to_lists_the_near_ones_in_one_short_line(tmp_path):
+    """Stop 48 (robust48): every key of every layout was listed (33 names, a line of 445 characters naming the
+    file) for a key near none of them (a camera's ``serial`` or ``model`` written beside its intrinsics)."""
+    path = _written(tmp_path / "cam.json", {"fx": 615.0, "fy": 616.0, "cx": 321.0, "cy": 239.0, "width": 640,
+                                            "height": 480, "serial": "123"})  # fmt: skip
+    from symfruit.io.intrinsics import DEPTH_KEYS, LAYOUT_KEYS
+
+    with pytest.raises(FileFormatError) as info:
+        load_camera(path)
+    rest = len(LAYOUT_KEYS | DEPTH_KEYS) - 6
+    assert str(info.value) == (f"{path}: unknown key 'serial' (not a key of any intrinsics layout symfruit reads); "
+                               f"known keys: D, K, P, R, binning_x, binning_y and {rest} more (README's table of "
+                               "inputs, row 'intrinsics', lists the layouts)")  # fmt: skip
+
+
+def test_an_intrinsics_file_of_a_fisheye_model_is_warned_about_with_coefficients_all_zero(tmp_path):
+    """Stop 48 (robust48): ``distortion_model: equidistant`` with ``D`` all 0 was read as pinhole in silence."""
+    ros = {"height": 480, "width": 640, "distortion_model": "equidistant", "D": [0.0] * 4,
+           "K": [615.0, 0, 320, 0, 615, 240, 0, 0, 1]}  # fmt: skip
+    path = _written(tmp_path / "cam.json", ros)
+    with pytest.warns(SymfruitWarning, match=r"cam\.json: distortion model 'equidistant' is a fisheye lens"):
+        assert load_camera(path).fx == 615.0

@@ -210,3 +210,14 @@ def test_a_yaml_error_is_one_short_line_with_its_position(tmp_path):
     with pytest.raises(FileFormatError, match=r"run\.yaml: not valid YAML: while parsing a flow sequence: expected "
                        r"',' or '\]', but got '<stream end>' \(at line 3, column 1\)$"):  # fmt: skip
         read_structured(path, what="file", max_bytes=1000)
+
+
+def test_a_folder_named_as_a_file_says_an_before_a_vowel(tmp_path):
+    """Stop 48 (robust48): "is a folder, not a intrinsics file"."""
+    from symfruit.io.text import read_limited
+
+    with pytest.raises(FileFormatError) as info:
+        read_limited(tmp_path, what="intrinsics file", max_bytes=10)
+    assert str(info.value) == f"{tmp_path}: is a folder, not an intrinsics file"
+    with pytest.raises(FileFormatError, match="is a folder, not a settings file"):
+        read_limited(tmp_path, what="settings file", max_bytes=10)

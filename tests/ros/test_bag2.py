@@ -200,3 +200,15 @@ def test_run_batch_on_frame_sees_every_frame_and_its_failures_are_the_frames(tmp
     seen.clear()
     run_batch(tmp_path / "rec", tmp_path / "out", method="raw", progress=False, resume=True, on_frame=on_frame)
     assert [i for i, _, _ in seen] == [1]  # resumed: only the frame that was not done
+
+
+def test_a_bag_under_a_file_is_refused_naming_the_file(tmp_path):
+    """Stop 48 (robust48): "cannot create ROS 2 bag ([Errno 17] File exists: '.../notes')", Python's words."""
+    from symfruit.errors import OutputError
+
+    (tmp_path / "notes").write_text("x")
+    with pytest.raises(OutputError) as info:
+        Ros2DetectionBag(tmp_path / "notes" / "bag").open()
+    notes = tmp_path / "notes"
+    assert str(info.value) == f"{notes / 'bag'}: cannot create ROS 2 bag ({notes} is a file, not a folder)"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["notes"]

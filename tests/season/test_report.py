@@ -97,7 +97,7 @@ def test_the_command_writes_into_the_folder_named(run, tmp_path, capsys):
     assert main(["report", str(run), "--classes", "big"]) == 2
     assert "--classes 'big'" in capsys.readouterr().err
     assert main(["report", str(tmp_path / "nothing")]) == 2
-    assert "no such table; run `symfruit detect" in capsys.readouterr().err
+    assert "nothing: no such folder; `symfruit report` reads the --output folder" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("where", ["f0", "rec/f0"])
@@ -297,3 +297,18 @@ def test_a_recording_name_holding_a_bar_or_a_line_break_stays_in_its_table_cell(
     assert rows[0].startswith("| row\\|1 | 1 | 1 | 1 | 1 |") and rows[1].startswith("| row 2 | 1 | 1 | 1 | 1 |")
     assert len(rows) == 4 and all(row.replace("\\|", "").count("|") == rows[0].replace("\\|", "").count("|")
                                   for row in rows[:2])  # fmt: skip
+
+
+def test_a_run_that_is_a_file_or_a_runs_table_is_said_to_be_so(run, tmp_path, capsys):
+    """Stop 48 (robust48): a file was "FILE/detections.parquet: no such table; run `symfruit detect ... --output
+    FILE` first"."""
+    text = tmp_path / "notes.txt"
+    text.write_text("x")
+    assert main(["report", str(text)]) == 2
+    said = "not a folder; `symfruit report` reads the --output folder of a `symfruit detect` run (with detections"
+    assert capsys.readouterr().err.strip() == f"symfruit: error: {text}: {said}.parquet)"
+    assert main(["report", str(run / "detections.parquet")]) == 2
+    assert f"is a run's table; name the run's folder: `symfruit report {run}`" in capsys.readouterr().err
+    (tmp_path / "empty").mkdir()
+    assert main(["report", str(tmp_path / "empty")]) == 2  # a folder without tables: as before
+    assert "empty/detections.parquet: no such table; run `symfruit detect" in capsys.readouterr().err

@@ -18,6 +18,7 @@ import numpy as np
 from ..errors import InputError, SymfruitError
 
 __all__ = [
+    "MAX_BAG_CHUNK_BYTES",
     "MAX_BAG_METADATA_BYTES",
     "MAX_CLOUD_POINTS",
     "MAX_COCO_BYTES",
@@ -42,6 +43,7 @@ __all__ = [
     "depth_metres",
     "instance_labels",
     "shown",
+    "typical_depth",
     "unmasked",
 ]
 
@@ -69,6 +71,11 @@ MAX_COCO_BYTES = 256 << 20
 #: Largest ``metadata.yaml`` of a ROS 2 bag folder (bytes), checked before rosbags reads it whole: a few kB per
 #: topic and split file; as large as a truth file may be.
 MAX_BAG_METADATA_BYTES = MAX_TRUTH_BYTES
+#: Largest chunk of a ROS 2 bag's MCAP file, uncompressed (bytes), checked (with every record's length against
+#: the bytes left in the file) before rosbags reads the file: rosbag2 writes chunks of 768 kB (the MCAP writer's
+#: default ``chunk_size``, 786432) and a message larger than that alone in its chunk; the largest image message
+#: read (40 megapixels of 32-bit depth) is 160 MB.
+MAX_BAG_CHUNK_BYTES = 1024 << 20
 #: Most fruit (instances) one image's masks may hold, and the largest label id (32-bit signed).
 MAX_INSTANCES = 1000
 MAX_LABEL_ID = 2**31 - 1
@@ -213,13 +220,19 @@ def depth_metres(depth: Any, what: str, *, error: type[SymfruitError] = InputErr
     if not np.issubdtype(arr.dtype, np.floating):
         raise error(f"{what}: depth is {arr.dtype}; depth must be float metres (raw units such as 16-bit "
                     "millimetres: multiply by the depth scale, e.g. 0.001, first)")  # fmt: skip
-    # a spread sample of the pixels tells units apart (metres against millimetres is a factor of 1000); rows
-    # and columns strided alike, so a 640x480 frame costs 4,800 pixels and a 1920x1080 one 8,100
-    stride = max(1, int(np.sqrt(arr.size / 8_000)))
-    sample = arr[::stride, ::stride].ravel()
+    typical = typical_depth(arr)
+    if typical is not None and typical > MAX_DEPTH_METRES:
+        raise error(f"{what}: depth is {typical:g} m typically; depth must be metres (these look like millimetres "
+                    "or raw units: multiply by the depth scale first)")  # fmt: skip
+    return arr
+
+
+def typical_depth(depth: np.ndarray) -> float | None:
+    """The median of a spread sample of a 2-D depth image's valid (finite, positive) pixels, or None where the
+    sample holds none: it tells units apart (metres against millimetres is a factor of 1000). Rows and columns
+    are strided alike, so a 640x480 frame costs 4,800 pixels and a 1920x1080 one 8,100."""
+    stride = max(1, int(np.sqrt(depth.size / 8_000)))
+    sample = depth[::stride, ::stride].ravel()
     with np.errstate(invalid="ignore"):
         valid = sample[np.isfinite(sample) & (sample > 0)]
-    if len(valid) and float(np.median(valid)) > MAX_DEPTH_METRES:
-        raise error(f"{what}: depth is {float(np.median(valid)):g} m typically; depth must be metres (these look "
-                    "like millimetres or raw units: multiply by the depth scale first)")  # fmt: skip
-    return arr
+    return float(np.median(valid)) if len(valid) else None

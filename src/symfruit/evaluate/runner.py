@@ -5,6 +5,7 @@ from __future__ import annotations
 import os
 from collections.abc import Sequence
 from concurrent.futures import ProcessPoolExecutor
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from typing import Any
 
@@ -83,11 +84,34 @@ def _evaluate(spec: Spec, methods: Sequence[str], settings: Settings) -> list[Ro
     try:
         return _evaluate_instance(spec, methods, settings)
     except Exception as exc:  # the instance itself: every method's row says why
-        nan = float("nan")
-        return [Row(protocol=spec.protocol, fruit=spec.fruit, kind="", fruit_index=spec.index, pose=spec.pose,
-                    angle_x=nan, angle_y=nan, angle_z=nan, distance_m=nan, occlusion=spec.occlusion, hidden=nan,
-                    n_visible=0, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan, precision=nan,
-                    recall=nan, seconds=nan, error=f"the instance: {_reason(exc)}") for method in methods]  # fmt: skip
+        return _failed_rows(spec, methods, _reason(exc))
+
+
+def _failed_rows(spec: Spec, methods: Sequence[str], reason: str) -> list[Row]:
+    """The rows of an instance that could not be evaluated, each method's carrying ``the instance: reason``."""
+    nan = float("nan")
+    return [Row(protocol=spec.protocol, fruit=spec.fruit, kind="", fruit_index=spec.index, pose=spec.pose,
+                angle_x=nan, angle_y=nan, angle_z=nan, distance_m=nan, occlusion=spec.occlusion, hidden=nan,
+                n_visible=0, method=method, iou=nan, centre_mm=nan, chamfer_mm=nan, f1=nan, precision=nan,
+                recall=nan, seconds=nan, error=f"the instance: {reason}") for method in methods]  # fmt: skip
+
+
+#: A row's reason when the worker process evaluating its instance died (stop 48, robust48).
+WORKER_DIED = ("its worker process ended abruptly (killed, e.g. out of memory, or a crash in compiled code); "
+               "the others went on")  # fmt: skip
+
+
+def _isolated(batch: list[Spec], methods: Sequence[str], settings: Settings) -> list[Row]:
+    """``batch`` evaluated again after its worker pool broke, each instance in a worker process of its own: the
+    instance whose process dies again gets rows saying so (:data:`WORKER_DIED`), the others their results."""
+    rows: list[Row] = []
+    for spec in batch:
+        try:
+            with ProcessPoolExecutor(max_workers=1, initializer=_single_thread) as one:
+                rows += one.submit(_batch, ([spec], methods, settings)).result()
+        except BrokenProcessPool:
+            rows += _failed_rows(spec, methods, WORKER_DIED)
+    return rows
 
 
 def _reason(exc: BaseException) -> str:
@@ -173,7 +197,14 @@ def run(
                 bar.update(len(b))
         else:
             with ProcessPoolExecutor(max_workers=jobs, initializer=_single_thread) as pool:
-                for b, rows in zip(batches, pool.map(_batch, [(b, methods, settings) for b in batches]), strict=True):
+                futures = [pool.submit(_batch, (b, methods, settings)) for b in batches]
+                for b, future in zip(batches, futures, strict=True):
+                    try:
+                        rows = future.result()
+                    except BrokenProcessPool:  # a worker died (killed, out of memory): the pool is lost, every
+                        # batch not yet back is evaluated again alone (stop 48, robust48: a BrokenProcessPool
+                        # traceback ended the evaluation, every finished batch lost)
+                        rows = _isolated(b, methods, settings)
                     out.append(rows)
                     bar.update(len(b))
     return [row for rows in out for row in rows]

@@ -22,6 +22,7 @@ from __future__ import annotations
 import bisect
 import math
 import re
+import struct
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -31,11 +32,24 @@ import numpy as np
 
 from ..core.camera import Camera
 from ..core.frame import MAX_STAMP_NS, Frame
-from ..core.limits import MAX_BAG_METADATA_BYTES, MAX_DISTORTION_COEFFS, MAX_IMAGE_PIXELS, check_image_size, shown
+from ..core.limits import (
+    MAX_BAG_CHUNK_BYTES,
+    MAX_BAG_METADATA_BYTES,
+    MAX_DISTORTION_COEFFS,
+    MAX_IMAGE_PIXELS,
+    check_image_size,
+    shown,
+)
 from ..errors import FileFormatError, InputError, SymfruitError
 from .frames import named_frame
 from .images import MIN_16BIT_DEPTH_REACH, float_depth
-from .intrinsics import check_binning_roi, check_pinhole_matrix, warn_distortion, warn_principal_point
+from .intrinsics import (
+    FISHEYE_MODELS,
+    check_binning_roi,
+    check_pinhole_matrix,
+    warn_distortion,
+    warn_principal_point,
+)
 
 __all__ = [
     "BagSource",
@@ -196,7 +210,8 @@ def _message_bytes(data: Any) -> bytes:
             return bytes(data)
         except (TypeError, ValueError):
             pass
-    raise FileFormatError(f"image data must be bytes (uint8[]), got {type(data).__name__}")
+    got = "nothing (None)" if data is None else type(data).__name__  # not Python's "NoneType" (robust48)
+    raise FileFormatError(f"image data must be bytes (uint8[]), got {got}")
 
 
 def yuv422_rgb(rows: np.ndarray, order: tuple[int, int, int, int]) -> np.ndarray:
@@ -312,11 +327,18 @@ def camera_from_info(
                       camera, "CameraInfo")  # fmt: skip
     if source is not None:
         said = warned if warned is not None else set()
-        if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3):
+        model = getattr(msg, "distortion_model", None)
+        if "distortion" not in said and warn_distortion(source, key, coeffs, stacklevel=3, model=model):
             said.add("distortion")
         if "principal point" not in said and warn_principal_point(source, camera, stacklevel=3):
             said.add("principal point")
     return camera
+
+
+def fisheye(msg: Any) -> bool:
+    """Whether a ``CameraInfo``'s ``distortion_model`` is a fisheye one (:data:`~.intrinsics.FISHEYE_MODELS`)."""
+    model = getattr(msg, "distortion_model", None)
+    return isinstance(model, str) and model.lower() in FISHEYE_MODELS
 
 
 def info_distortion(msg: Any) -> tuple[str, list[float]]:
@@ -354,9 +376,11 @@ def header_stamp(msg: Any) -> int | None:
     stamp = getattr(getattr(msg, "header", None), "stamp", None)
     if stamp is None:
         return None
-    sec = getattr(stamp, "sec", getattr(stamp, "secs", 0))
-    nsec = getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0))
-    value = int(sec) * 1_000_000_000 + int(nsec)
+    sec = _whole(getattr(stamp, "sec", getattr(stamp, "secs", 0)))
+    nsec = _whole(getattr(stamp, "nanosec", getattr(stamp, "nsecs", 0)))
+    if sec is None or nsec is None:  # a hand-made message's text, None, NaN, inf or 2.5: no time (stop 48,
+        return None  # robust48: int() raised TypeError / ValueError / OverflowError, or cut 2.5 s to 2)
+    value = sec * 1_000_000_000 + nsec
     return value if 0 <= value < MAX_STAMP_NS else None
 
 
@@ -399,6 +423,99 @@ def _check_metadata(path: Path) -> None:
     data = read_structured(path, what="bag metadata", max_bytes=MAX_BAG_METADATA_BYTES)
     if not isinstance(data, dict) or not isinstance(data.get("rosbag2_bagfile_information"), dict):
         raise FileFormatError(f"{path}: not a ROS 2 bag's metadata (no rosbag2_bagfile_information mapping)")
+
+
+_MCAP_MAGIC = b"\x89MCAP0\r\n"
+#: Largest MCAP record read whole by the walk (a chunk index: a few dozen bytes and 10 a channel).
+_MCAP_INDEX_BYTES = 1 << 20
+
+
+def check_mcap(path: Path) -> None:
+    """Refuse an MCAP file (a ROS 2 bag's) whose records claim sizes it cannot hold, before rosbags reads it:
+    rosbags reads each record's length from the file and asks for that many bytes (the header record's, a
+    chunk's, a chunk index's compressed size), and decompresses a chunk whole. Walks the top-level records
+    (9 bytes read a record, a seek past it): every record's length within the bytes left before the end magic;
+    a chunk's uncompressed size at most :data:`~symfruit.core.limits.MAX_BAG_CHUNK_BYTES`, its compressed
+    data within its record; the footer's summary offset and every chunk index's chunk offset a record's start
+    (a chunk's), its sizes the chunk's. Of a file without the end magic (cut short) only the header record is
+    checked (rosbags reads it, then refuses the file as cut short). Stop 48 (robust48)."""
+    try:
+        with open(path, "rb") as f:
+            size = f.seek(0, 2)
+            if size < 16:
+                return  # rosbags: empty, or its magic alone ("the file ends inside a record")
+            f.seek(size - 8)
+            whole = f.read(8) == _MCAP_MAGIC
+            end = size - 8 if whole else size
+            pos = 8
+            starts: dict[int, int] = {}  # record start -> opcode
+            chunks: dict[int, tuple[int, int, int]] = {}  # chunk start -> uncompressed, compressed, record size
+            indexes: list[tuple[int, bytes]] = []
+            footer: bytes | None = None
+            while pos < end:
+                f.seek(pos)
+                head = f.read(9)
+                if len(head) < 9:
+                    raise FileFormatError(f"the record at byte {pos:,} is cut short: the MCAP file is damaged")
+                op, length = head[0], int.from_bytes(head[1:], "little")
+                left = max(end - pos - 9, 0)
+                if length > left:
+                    raise FileFormatError(f"the record at byte {pos:,} claims {length:,} bytes, more than the "
+                                          f"{left:,} left in the file: the MCAP file is damaged")  # fmt: skip
+                if not whole:  # rosbags reads the header record, then refuses the missing end magic itself
+                    return
+                starts[pos] = op
+                if op == 0x06:  # chunk: start, end, uncompressed size (u64 each), crc (u32), compression, records
+                    body = f.read(min(length, 32))
+                    if len(body) < 32:
+                        raise FileFormatError(f"the chunk at byte {pos:,} is too short to be one: the MCAP file is "
+                                              "damaged")  # fmt: skip
+                    unpacked = int.from_bytes(body[16:24], "little")
+                    name_len = int.from_bytes(body[28:32], "little")
+                    if unpacked > MAX_BAG_CHUNK_BYTES:
+                        raise FileFormatError(f"the chunk at byte {pos:,} claims {unpacked:,} bytes uncompressed; "
+                                              f"at most {MAX_BAG_CHUNK_BYTES >> 20} MB are read (rosbag2 writes "
+                                              "chunks of 768 kB)")  # fmt: skip
+                    if 32 + name_len + 8 > length:
+                        raise FileFormatError(f"the chunk at byte {pos:,} names a compression longer than itself: "
+                                              "the MCAP file is damaged")  # fmt: skip
+                    f.seek(pos + 9 + 32 + name_len)
+                    packed = int.from_bytes(f.read(8), "little")
+                    if 32 + name_len + 8 + packed > length:
+                        raise FileFormatError(f"the chunk at byte {pos:,} claims {packed:,} compressed bytes, more "
+                                              "than its record holds: the MCAP file is damaged")  # fmt: skip
+                    chunks[pos] = (unpacked, packed, length)
+                elif op == 0x08:  # chunk index: read whole (small), checked once every chunk is known
+                    if length > _MCAP_INDEX_BYTES:
+                        raise FileFormatError(f"the chunk index at byte {pos:,} claims {length:,} bytes; a chunk "
+                                              f"index takes a few dozen: the MCAP file is damaged")  # fmt: skip
+                    indexes.append((pos, f.read(length)))
+                elif op == 0x02:  # footer: summary start, summary offset start (u64), crc
+                    footer = f.read(length)
+                    break
+                pos += 9 + length
+    except OSError as exc:
+        raise FileFormatError(f"cannot read {path.name} ({exc.strerror or exc})") from None
+    if footer is not None and len(footer) >= 8:
+        summary = int.from_bytes(footer[:8], "little")
+        if summary and summary not in starts:
+            raise FileFormatError(f"its footer's summary offset {summary:,} is no record's start: the MCAP file is "
+                                  "damaged")  # fmt: skip
+    for at, rec in indexes:
+        try:
+            start = struct.unpack_from("<QQQQ", rec, 0)[2:]
+            (map_len,) = struct.unpack_from("<I", rec, 32)
+            k = 36 + map_len + 8
+            (name_len,) = struct.unpack_from("<I", rec, k)
+            packed, unpacked = struct.unpack_from("<QQ", rec, k + 4 + name_len)
+        except struct.error:
+            raise FileFormatError(f"the chunk index at byte {at:,} is cut short: the MCAP file is damaged") from None
+        offset, length = start
+        chunk = chunks.get(offset)
+        if chunk is None or length != chunk[2] + 9 or (unpacked, packed) != chunk[:2]:
+            raise FileFormatError(f"the chunk index at byte {at:,} points at no chunk of its sizes (offset "
+                                  f"{shown(offset)}, {shown(packed)} bytes compressed, {shown(unpacked)} "
+                                  "uncompressed): the MCAP file is damaged")  # fmt: skip
 
 
 def _namespace(topic: str) -> str:
@@ -454,6 +571,11 @@ class BagSource:
         reader_cls = _require_rosbags()
         if self.path.is_dir():
             _check_metadata(self.path / "metadata.yaml")
+            for mcap in sorted(self.path.glob("*.mcap")):
+                try:
+                    check_mcap(mcap)
+                except FileFormatError as exc:
+                    raise FileFormatError(f"{mcap}: cannot open bag ({exc})") from None
         try:
             self._reader = reader_cls([self.path])
             self._reader.open()
@@ -487,6 +609,7 @@ class BagSource:
         self._cameras: list[tuple[int, Camera | str, tuple[bool, bool]]] = []
         last: Any = None
         distorted: tuple[str, list[float]] | None = None  # the first non-zero distortion: warned about once
+        model: Any = None  # its lens model (a fisheye one is warned about with coefficients 0)
         for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
             if conn == self._depth:
                 self._depth_stamps.append(stamp)
@@ -499,8 +622,9 @@ class BagSource:
                     msg = self._reader.deserialize(raw, conn.msgtype)
                     sizeless = (not int(msg.width), not int(msg.height))  # as the live node: the image's size
                     camera: Camera | str = camera_from_info(msg, width=1, height=1)
-                    if distorted is None and any((coeffs := info_distortion(msg))[1]):
-                        distorted = coeffs
+                    coeffs = info_distortion(msg)
+                    if distorted is None and (any(coeffs[1]) or fisheye(msg)):
+                        distorted, model = coeffs, getattr(msg, "distortion_model", None)
                 except Exception as exc:  # a corrupt or invalid CameraInfo: frames after it fail, not the bag
                     camera = f"invalid CameraInfo on {conn.topic} ({exc})"
                 if not self._cameras or self._cameras[-1][1:] != (camera, sizeless):  # kept on change: each
@@ -514,7 +638,7 @@ class BagSource:
         self._camera_stamps = [s for s, _, _ in self._cameras]
         self._off_centre_said = False  # a principal point outside the image: warned about at the first frame
         if distorted is not None:
-            warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4)
+            warn_distortion(f"{self.path}: CameraInfo on {self._info.topic}", *distorted, stacklevel=4, model=model)
 
     def __len__(self) -> int:
         return len(self._depth_stamps)

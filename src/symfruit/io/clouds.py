@@ -54,7 +54,11 @@ def read_cloud(path: str | Path) -> np.ndarray:
             points = reader(path)  # non-finite points, dropped with the rest (never a warning from the cast)
     except FileFormatError:
         raise
-    except (ValueError, OSError, EOFError, IndexError, KeyError, UnicodeDecodeError) as exc:
+    except UnicodeDecodeError as exc:  # a text cloud of bytes that are no text (stop 48, robust48: the codec's words,
+        # "'utf-8' codec can't decode byte 0x89 in position 0: invalid start byte", for a PNG named .xyz)
+        raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} (not UTF-8 text: "
+                              f"{exc.reason} at byte {exc.start})") from None  # fmt: skip
+    except (ValueError, OSError, EOFError, IndexError, KeyError) as exc:
         raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({exc})") from None
     if points.ndim != 2 or points.shape[1] != 3:
         raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")

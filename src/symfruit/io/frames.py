@@ -39,6 +39,7 @@ from ..core.limits import (
     depth_metres,
     instance_labels,
     shown,
+    typical_depth,
 )
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write, write_json
@@ -141,6 +142,14 @@ def read_frame(folder: str | Path) -> Frame:
                          f"only {65535 * scale:.3g} m, and no camera measures depth that finely (0.001 for "
                          "millimetres)")  # fmt: skip
     depth = read_depth(depth_file, scale, color=(color_path, color_orientation))
+    if (
+        depth_file.suffix.lower() != ".npy"
+        and (typical := typical_depth(depth)) is not None
+        and (typical > MAX_DEPTH_METRES)
+    ):  # the units are the scale's (stop 48, robust48: "FOLDER: depth is 7009 m typically", the frame folder alone)
+        raise InputError(f"{cam_path}: at its depth scale, {scale:g} m per unit, {depth_file.name}'s depth is "
+                         f"{typical:.4g} m typically: its units look like millimetres or finer; state their scale "
+                         "(0.001 for millimetres)")  # fmt: skip
     turned_mismatch(color_path, color.shape, {f"the intrinsics ({cam_path.name})": (camera.height, camera.width)})
     if (camera.height, camera.width) != color.shape[:2] == depth.shape[:2]:  # the intrinsics' file named (the frame
         # alone before; images of two sizes: the Frame's error says which)

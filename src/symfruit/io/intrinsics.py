@@ -139,8 +139,9 @@ def _checked(data: Any, source: str) -> Camera:
     ``source`` names where the intrinsics came from."""
     camera = _camera_with_keys_checked(data)
     distortion = _distortion(data)
-    if distortion is not None:
-        warn_distortion(source, *distortion, stacklevel=4)
+    model = data.get("distortion_model") if isinstance(data, dict) else None
+    if distortion is not None or model is not None:
+        warn_distortion(source, *(distortion or ("D", [])), stacklevel=4, model=model)
     warn_principal_point(source, camera, stacklevel=4)
     return camera
 
@@ -164,10 +165,26 @@ def warn_principal_point(source: str, camera: Camera, *, stacklevel: int = 2) ->
     return True
 
 
-def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2) -> bool:
+#: Lens models (a ``CameraInfo``'s or an intrinsics file's ``distortion_model``) that are no pinhole one even with
+#: every coefficient 0: a fisheye image's radius grows with the angle (equidistant: r = f * theta), a pinhole's with
+#: its tangent (ROS image_pipeline's ``equidistant``; OpenCV's ``fisheye`` is the same Kannala-Brandt model).
+FISHEYE_MODELS = frozenset({"equidistant", "fisheye", "kannala_brandt", "kb4"})
+
+
+def warn_distortion(source: str, key: str, values: Sequence[float], *, stacklevel: int = 2, model: Any = None) -> bool:
     """Warn (:class:`SymfruitWarning`) that the distortion coefficients ``values`` (field ``key``) of the camera
-    ``source`` names are not applied, when one is non-zero; whether it warned. The one rule for intrinsics files,
-    bags' and live ``CameraInfo`` messages and RealSense recordings' colour lens."""
+    ``source`` names are not applied, when one is non-zero, or that its lens ``model`` is a fisheye one
+    (:data:`FISHEYE_MODELS`, coefficients all 0 too: stop 48, robust48); whether it warned. The one rule for
+    intrinsics files, bags' and live ``CameraInfo`` messages and RealSense recordings' colour lens."""
+    if isinstance(model, str) and model.lower() in FISHEYE_MODELS:
+        warnings.warn(
+            SymfruitWarning(
+                f"{source}: distortion model {model!r} is a fisheye lens, not applied: symfruit treats the image as "
+                "pinhole; rectify it first (image_proc), else points away from the centre are misplaced"
+            ),
+            stacklevel=stacklevel,
+        )
+        return True
     if not any(values):
         return False
     largest = max(values, key=abs)
@@ -202,7 +219,11 @@ def _unknown_key(data: Any, where: str) -> tuple[str, str, str | None] | None:
 def _unknown_message(key: str, where: str, close: str | None) -> str:
     if where and key in DEPTH_KEYS:
         return f"{key!r} under {where[:-1]!r} is not read: write it at the top level of the file"
-    hint = f"; did you mean {close!r}?" if close else f"; known keys: {', '.join(sorted(LAYOUT_KEYS | DEPTH_KEYS))}"
+    from ..settings import known_names  # the near ones and a count: every key was a line of 400+ characters (robust48)
+
+    where_listed = "README's table of inputs, row 'intrinsics', lists the layouts"
+    listed = known_names(key, sorted(LAYOUT_KEYS | DEPTH_KEYS), where=where_listed)
+    hint = f"; did you mean {close!r}?" if close else f"; {listed.replace('known:', 'known keys:', 1)}"
     return f"unknown key {where + key!r} (not a key of any intrinsics layout symfruit reads){hint}"
 
 

@@ -90,7 +90,7 @@ def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitE
     except FileNotFoundError:
         raise error(f"{path}: no such {what}") from None
     except IsADirectoryError:
-        raise error(f"{path}: is a folder, not a {what}") from None
+        raise error(f"{path}: is a folder, not {'an' if what[:1] in 'aeiou' else 'a'} {what}") from None
     except OSError as exc:
         raise error(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:

@@ -30,7 +30,7 @@ import numpy as np
 
 from ..core.frame import Frame
 from ..detect import FrameDetections
-from ..errors import FileFormatError, SymfruitError
+from ..errors import FileFormatError, OutputError, SymfruitError
 from ..writers import OPTICAL_FRAME
 from .core import Fruit, fruits_of
 
@@ -117,7 +117,12 @@ class Ros2DetectionBag:
             self._partial = Path(tempfile.mkdtemp(prefix=f".{self.path.name}.partial-", dir=self.path.parent))
             self._writer = Writer(self._partial / self.path.name, version=8, storage_plugin=plugin)
             self._writer.open()
-        except Exception as exc:  # rosbags' WriterError, OSError
+        except OSError as exc:  # a folder on the way is a file (stop 48, robust48: "[Errno 17] File exists: ...")
+            self._discard_partial()
+            file = next((p for p in self.path.parents if p.exists() and not p.is_dir()), None)
+            why = f"{file} is a file, not a folder" if file is not None else exc.strerror or exc
+            raise OutputError(f"{self.path}: cannot create ROS 2 bag ({why})", exc.errno) from None
+        except Exception as exc:  # rosbags' WriterError
             self._discard_partial()
             raise FileFormatError(f"{self.path}: cannot create ROS 2 bag ({exc})") from None
         self._conn = self._writer.add_connection(self.topic, MSGTYPE, typestore=self.store)

@@ -252,6 +252,21 @@ def _check_folder(output: Path, folder: Path) -> None:
                           "the run")  # fmt: skip
 
 
+def _check_run(output: Path) -> None:
+    """Refuse a run folder that is missing or a file in its own words (stop 48, robust48: a file was
+    ``FILE/detections.parquet: no such table; run symfruit detect ... --output FILE first``); a run's table
+    named instead of its folder is told which folder to name."""
+    if not os.path.lexists(output):
+        raise FileFormatError(f"{output}: no such folder; `symfruit report` reads the --output folder of a "
+                              f"`symfruit detect` run: run `symfruit detect ... --output {output}` first")  # fmt: skip
+    if not output.is_dir():
+        if output.name in (TABLE_NAME, FRAMES_NAME):
+            raise FileFormatError(f"{output}: is a run's table; name the run's folder: `symfruit report "
+                                  f"{output.parent}`")  # fmt: skip
+        raise FileFormatError(f"{output}: not a folder; `symfruit report` reads the --output folder of a "
+                              "`symfruit detect` run (with detections.parquet)")  # fmt: skip
+
+
 def write_report(
     output: str | Path, *, folder: str | Path | None = None, classes: Sequence[float] = DEFAULT_CLASSES_MM
 ) -> Report:
@@ -275,6 +290,7 @@ def write_report(
     from ..io.outputs import OutputFolder
 
     output = as_path(output, "write_report: the run folder")  # '' was the working folder
+    _check_run(output)
     if folder is None and (output / "report").is_symlink():  # the default is the run's own: never a link out of it
         link = output / "report"
         raise OutputError(f"{link}: is a symbolic link (to {os.readlink(link)}); symfruit does not write through "
