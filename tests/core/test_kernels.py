@@ -5639,3 +5639,51 @@ def test_the_bridged_depth_known_answer():
     got = np.empty((4, 4))
     _jit.bridge_gaps(z, 1, 5, 1, 5, 3.5, got)
     assert got[2, 0] == 6.0 and got[2, 1] == 0.0  # (3, 1) from the depth: 10 <= 12.25; (3, 2): 13 > 12.25
+
+
+# --- stop 48, seg640_48
+
+
+def test_the_inner_distance_is_the_padded_maps():
+    """:func:`_jit.inner_distance` of 600 random masks (1-40 px a side; specks, discs, full and empty masks, rows and
+    columns of one pixel) against its twin, ``ndimage.distance_transform_edt`` of the mask padded by a pixel (its
+    inside), and against :func:`_jit.distance` of the padded copy, as the split's kernels had it: the same values, bit
+    for bit."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(48)
+    deep = 0
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 41, 2))
+        if t % 3 == 0:  # a disc or two, off centre
+            rr, cc = np.mgrid[:h, :w]
+            mask = np.zeros((h, w), bool)
+            for _ in range(int(rng.integers(1, 3))):
+                r, c, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(0.5, 25.0)
+                mask |= (rr - r) ** 2 + (cc - c) ** 2 <= rad * rad
+        else:
+            mask = rng.random((h, w)) < rng.choice([0.0, 0.3, 0.7, 0.95, 1.0])
+        out = np.full((h, w), np.nan)
+        _jit.inner_distance(mask, out)
+        twin = ndimage.distance_transform_edt(np.pad(mask, 1))[1:-1, 1:-1]
+        np.testing.assert_array_equal(out, twin)
+        padded = np.empty((h + 2, w + 2))
+        _jit.distance(np.pad(mask, 1), False, padded)
+        np.testing.assert_array_equal(out, padded[1:-1, 1:-1])
+        deep += int((out > 2).sum())
+    assert deep > 10_000
+
+
+def test_the_inner_distance_known_answer():
+    """A 5x7 mask all set: each pixel's distance to the array's edge (the padding), 3 at the middle; a pixel cleared
+    at (2, 1): 0 there, 1 beside it, the middle (2, 3) 2 from it, (1, 3) 2 from the top edge (sqrt(5) from the cleared
+    pixel), (1, 2) sqrt(2) from it."""
+    mask = np.ones((5, 7), bool)
+    out = np.empty((5, 7))
+    _jit.inner_distance(mask, out)
+    np.testing.assert_array_equal(out[2], [1.0, 2.0, 3.0, 3.0, 3.0, 2.0, 1.0])
+    np.testing.assert_array_equal(out[:, 3], [1.0, 2.0, 3.0, 2.0, 1.0])
+    mask[2, 1] = False
+    _jit.inner_distance(mask, out)
+    assert out[2, 1] == 0.0 and out[2, 2] == 1.0 and out[2, 3] == 2.0 and out[1, 3] == 2.0
+    assert out[1, 2] == np.sqrt(2.0) and out[0, 0] == 1.0
