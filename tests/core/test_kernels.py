@@ -5687,3 +5687,51 @@ def test_the_inner_distance_known_answer():
     _jit.inner_distance(mask, out)
     assert out[2, 1] == 0.0 and out[2, 2] == 1.0 and out[2, 3] == 2.0 and out[1, 3] == 2.0
     assert out[1, 2] == np.sqrt(2.0) and out[0, 0] == 1.0
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_ripe_test_is_the_twins(seed):
+    """:func:`_jit.red_ripe` on 2,000 random windows (1-30 px a side, views of a larger image; colours drawn from a few
+    values so that rednesses repeat, 0-100 % of the pixels red, odd and even counts) against its twin,
+    ``median(redness(color[red]))`` reaching the threshold in float32, and against :func:`_jit.red_median`'s: the
+    thresholds the window's own rednesses, the float32 means of two of them (a median of an even count lands there)
+    and their float32 neighbours, and settings as 0.2: the same answers, ripe and not."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import redness
+
+    rng = np.random.default_rng(seed)
+    ripe = unripe = 0
+    for _ in range(2000):
+        h, w = (int(v) for v in rng.integers(1, 31, 2))
+        levels = rng.choice(np.arange(256), int(rng.integers(2, 8)))
+        color = rng.choice(levels, (h + 3, w + 4, 3)).astype(np.uint8)[1 : h + 1, 2 : w + 2]  # a window's view
+        red = rng.random((h, w)) < rng.choice([0.0, 0.05, 0.5, 1.0])
+        values = redness(color[red]).astype(np.float32) if red.any() else np.zeros(0, np.float32)
+        pool = [np.float32(0.2), np.float32(0.35), np.float32(-1.0)]
+        if len(values):
+            a, b = rng.choice(values, 2)
+            mean = (a + b) / np.float32(2.0)
+            pool += [a, b, mean, np.nextafter(mean, np.float32(2.0)), np.nextafter(mean, np.float32(-2.0))]
+            pool.append(np.float32(median(values)))
+        for least in pool:
+            least = np.float32(least)
+            got = _jit.red_ripe(color, red, least)
+            twin = bool(np.float32(median(values)) >= least) if len(values) else False
+            assert got == twin
+            assert got == bool(np.float32(_jit.red_median(color, red)) >= least)
+            ripe += got
+            unripe += not got
+    assert ripe > 1000 and unripe > 1000
+
+
+def test_the_ripe_test_known_answer():
+    """Rednesses 0.5, 0.5, 0.25, 0 (R 200 less G 100, 100, 150, 200): the median of four is (0.25 + 0.5) / 2 = 0.375,
+    ripe at 0.375, not at the next float32 above; without the last pixel (three, median 0.5) ripe at 0.5; no pixel:
+    not ripe."""
+    color = np.array([[[200, 100, 0], [200, 100, 50], [200, 150, 0], [200, 200, 0]]], np.uint8)
+    red = np.ones((1, 4), bool)
+    assert _jit.red_ripe(color, red, np.float32(0.375))
+    assert not _jit.red_ripe(color, red, np.nextafter(np.float32(0.375), np.float32(1.0)))
+    red[0, 3] = False
+    assert _jit.red_ripe(color, red, np.float32(0.5)) and not _jit.red_ripe(color, red, np.float32(0.51))
+    assert not _jit.red_ripe(color, np.zeros((1, 4), bool), np.float32(-1.0))

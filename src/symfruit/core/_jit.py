@@ -6127,11 +6127,11 @@ def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     out = np.zeros((h, w), np.int32)
+    flat = cores.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
             if region[r, c]:
-                q = near[r, c]
-                out[r, c] = cores[q // w, q % w]
+                out[r, c] = flat[near[r, c]]
     return out
 
 
@@ -6556,10 +6556,10 @@ def split_centres(
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     fill = np.empty((h, w))
+    flat = depth.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
-            q = near[r, c]
-            fill[r, c] = depth[q // w, q % w]
+            fill[r, c] = flat[near[r, c]]
     edges = depth_edges(fill, weights, symmetric, limit, region, depth, seen, jump)
     cut = np.empty((h, w), np.bool_)
     for r in range(h):
@@ -7679,11 +7679,11 @@ def follow_edges(
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     grown = np.zeros((h, w), np.int64)
+    flat = seeds.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
             if region[r, c]:
-                q = near[r, c]
-                grown[r, c] = seeds[q // w, q % w]
+                grown[r, c] = flat[near[r, c]]
     return grown, True
 
 
@@ -7975,3 +7975,33 @@ def inner_distance(mask: np.ndarray, out: np.ndarray) -> None:
             _envelope(f, n, s, t, d2)
             for i in range(a, c):
                 out[r, i] = math.sqrt(float(d2[i - a + 1]))
+
+
+@_njit
+def red_ripe(color: np.ndarray, red: np.ndarray, least: np.float32) -> bool:
+    """Whether :func:`red_median` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8 reaches ``least``
+    (float32), compared in float32 (:func:`symfruit.segment.colour._ripe`'s test), mostly without the median: the
+    middle value of an odd count reaches it exactly when no more than half the values (``n // 2``) lie below it; of an
+    even count, the float32 mean of the middle two reaches it when both do (fewer than ``n // 2`` values below: their
+    sum rounds to no less than twice ``least``). Otherwise (an even count with half or more below: the mean may still
+    round up to it) the median itself as :func:`red_median` has it. The same answer, without the quickselect for a
+    ripe fruit (stop 48)."""
+    h, w = red.shape
+    n = 0
+    below = 0
+    one = np.float32(1.0)
+    for r in range(h):
+        for c in range(w):
+            if red[r, c]:
+                x = np.float32(color[r, c, 0])
+                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+                n += 1
+                below += (x - gb) / (x if x > one else one) < least
+    if n == 0:
+        return False  # the median is NaN
+    half = n // 2
+    if n % 2:
+        return below <= half
+    if below < half:
+        return True
+    return np.float32(red_median(color, red)) >= least
