@@ -5735,3 +5735,27 @@ def test_the_ripe_test_known_answer():
     red[0, 3] = False
     assert _jit.red_ripe(color, red, np.float32(0.5)) and not _jit.red_ripe(color, red, np.float32(0.51))
     assert not _jit.red_ripe(color, np.zeros((1, 4), bool), np.float32(-1.0))
+
+
+def test_the_group_boxes_are_the_twins(monkeypatch):
+    """``_group_boxes`` (:func:`_jit.group_boxes`) of the kept labels of 300 random label sets (1-3,000 pixels, up to
+    40 labels, a third kept, rows and columns up to 2,000) against its twin, ``reduceat``'s minima and maxima: the same
+    boxes in the same order; and a known answer."""
+    from symfruit.segment.colour import _group_boxes, _grouped
+
+    rng = np.random.default_rng(48)
+    boxes = 0
+    for _ in range(300):
+        n = int(rng.integers(1, 3001))
+        k = int(rng.integers(1, 41))
+        labels = rng.integers(1, k + 1, n)
+        keep = rng.random(k + 1) < 0.35
+        rows, cols = rng.integers(0, 2000, n), rng.integers(0, 2000, n)
+        grouped = _grouped(labels, keep)
+        fast, twin = _both(monkeypatch, _group_boxes, *grouped, rows, cols)
+        assert list(fast.items()) == list(twin.items())
+        boxes += len(fast)
+    assert boxes > 1000
+    labels, rows, cols = np.array([2, 1, 2, 2]), np.array([5, 0, 3, 9]), np.array([1, 4, 7, 2])
+    found = _group_boxes(*_grouped(labels, np.array([False, True, True])), rows, cols)
+    assert found == {1: (slice(0, 1), slice(4, 5)), 2: (slice(3, 10), slice(1, 8))}

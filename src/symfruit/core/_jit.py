@@ -8005,3 +8005,24 @@ def red_ripe(color: np.ndarray, red: np.ndarray, least: np.float32) -> bool:
     if below < half:
         return True
     return np.float32(red_median(color, red)) >= least
+
+
+@_njit
+def group_boxes(at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.segment.colour._group_boxes`' boxes: for each group ``i`` of the pixels ``at[first[i]:first[i +
+    1]]`` (indices into ``rows`` and ``cols``; every group holds one or more), the least and one past the greatest row
+    and column, (k, 4) int64 rows ``r0, r1, c0, c1`` (the twin's ``reduceat`` minima and maxima: the same numbers) in
+    one call, not a dozen numpy ones a window (stop 48)."""
+    k = first.shape[0] - 1
+    out = np.empty((k, 4), np.int64)
+    for i in range(k):
+        j = at[first[i]]
+        r0 = r1 = rows[j]
+        c0 = c1 = cols[j]
+        for m in range(first[i] + 1, first[i + 1]):
+            j = at[m]
+            r, c = rows[j], cols[j]
+            r0, r1 = min(r0, r), max(r1, r)
+            c0, c1 = min(c0, c), max(c1, c)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r0, r1 + 1, c0, c1 + 1
+    return out
