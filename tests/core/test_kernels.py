@@ -5639,3 +5639,123 @@ def test_the_bridged_depth_known_answer():
     got = np.empty((4, 4))
     _jit.bridge_gaps(z, 1, 5, 1, 5, 3.5, got)
     assert got[2, 0] == 6.0 and got[2, 1] == 0.0  # (3, 1) from the depth: 10 <= 12.25; (3, 2): 13 > 12.25
+
+
+# --- stop 48, seg640_48
+
+
+def test_the_inner_distance_is_the_padded_maps():
+    """:func:`_jit.inner_distance` of 600 random masks (1-40 px a side; specks, discs, full and empty masks, rows and
+    columns of one pixel) against its twin, ``ndimage.distance_transform_edt`` of the mask padded by a pixel (its
+    inside), and against :func:`_jit.distance` of the padded copy, as the split's kernels had it: the same values, bit
+    for bit."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(48)
+    deep = 0
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 41, 2))
+        if t % 3 == 0:  # a disc or two, off centre
+            rr, cc = np.mgrid[:h, :w]
+            mask = np.zeros((h, w), bool)
+            for _ in range(int(rng.integers(1, 3))):
+                r, c, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(0.5, 25.0)
+                mask |= (rr - r) ** 2 + (cc - c) ** 2 <= rad * rad
+        else:
+            mask = rng.random((h, w)) < rng.choice([0.0, 0.3, 0.7, 0.95, 1.0])
+        out = np.full((h, w), np.nan)
+        _jit.inner_distance(mask, out)
+        twin = ndimage.distance_transform_edt(np.pad(mask, 1))[1:-1, 1:-1]
+        np.testing.assert_array_equal(out, twin)
+        padded = np.empty((h + 2, w + 2))
+        _jit.distance(np.pad(mask, 1), False, padded)
+        np.testing.assert_array_equal(out, padded[1:-1, 1:-1])
+        deep += int((out > 2).sum())
+    assert deep > 10_000
+
+
+def test_the_inner_distance_known_answer():
+    """A 5x7 mask all set: each pixel's distance to the array's edge (the padding), 3 at the middle; a pixel cleared
+    at (2, 1): 0 there, 1 beside it, the middle (2, 3) 2 from it, (1, 3) 2 from the top edge (sqrt(5) from the cleared
+    pixel), (1, 2) sqrt(2) from it."""
+    mask = np.ones((5, 7), bool)
+    out = np.empty((5, 7))
+    _jit.inner_distance(mask, out)
+    np.testing.assert_array_equal(out[2], [1.0, 2.0, 3.0, 3.0, 3.0, 2.0, 1.0])
+    np.testing.assert_array_equal(out[:, 3], [1.0, 2.0, 3.0, 2.0, 1.0])
+    mask[2, 1] = False
+    _jit.inner_distance(mask, out)
+    assert out[2, 1] == 0.0 and out[2, 2] == 1.0 and out[2, 3] == 2.0 and out[1, 3] == 2.0
+    assert out[1, 2] == np.sqrt(2.0) and out[0, 0] == 1.0
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_ripe_test_is_the_twins(seed):
+    """:func:`_jit.red_ripe` on 2,000 random windows (1-30 px a side, views of a larger image; colours drawn from a few
+    values so that rednesses repeat, 0-100 % of the pixels red, odd and even counts) against its twin,
+    ``median(redness(color[red]))`` reaching the threshold in float32, and against :func:`_jit.red_median`'s: the
+    thresholds the window's own rednesses, the float32 means of two of them (a median of an even count lands there)
+    and their float32 neighbours, and settings as 0.2: the same answers, ripe and not."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import redness
+
+    rng = np.random.default_rng(seed)
+    ripe = unripe = 0
+    for _ in range(2000):
+        h, w = (int(v) for v in rng.integers(1, 31, 2))
+        levels = rng.choice(np.arange(256), int(rng.integers(2, 8)))
+        color = rng.choice(levels, (h + 3, w + 4, 3)).astype(np.uint8)[1 : h + 1, 2 : w + 2]  # a window's view
+        red = rng.random((h, w)) < rng.choice([0.0, 0.05, 0.5, 1.0])
+        values = redness(color[red]).astype(np.float32) if red.any() else np.zeros(0, np.float32)
+        pool = [np.float32(0.2), np.float32(0.35), np.float32(-1.0)]
+        if len(values):
+            a, b = rng.choice(values, 2)
+            mean = (a + b) / np.float32(2.0)
+            pool += [a, b, mean, np.nextafter(mean, np.float32(2.0)), np.nextafter(mean, np.float32(-2.0))]
+            pool.append(np.float32(median(values)))
+        for least in pool:
+            least = np.float32(least)
+            got = _jit.red_ripe(color, red, least)
+            twin = bool(np.float32(median(values)) >= least) if len(values) else False
+            assert got == twin
+            assert got == bool(np.float32(_jit.red_median(color, red)) >= least)
+            ripe += got
+            unripe += not got
+    assert ripe > 1000 and unripe > 1000
+
+
+def test_the_ripe_test_known_answer():
+    """Rednesses 0.5, 0.5, 0.25, 0 (R 200 less G 100, 100, 150, 200): the median of four is (0.25 + 0.5) / 2 = 0.375,
+    ripe at 0.375, not at the next float32 above; without the last pixel (three, median 0.5) ripe at 0.5; no pixel:
+    not ripe."""
+    color = np.array([[[200, 100, 0], [200, 100, 50], [200, 150, 0], [200, 200, 0]]], np.uint8)
+    red = np.ones((1, 4), bool)
+    assert _jit.red_ripe(color, red, np.float32(0.375))
+    assert not _jit.red_ripe(color, red, np.nextafter(np.float32(0.375), np.float32(1.0)))
+    red[0, 3] = False
+    assert _jit.red_ripe(color, red, np.float32(0.5)) and not _jit.red_ripe(color, red, np.float32(0.51))
+    assert not _jit.red_ripe(color, np.zeros((1, 4), bool), np.float32(-1.0))
+
+
+def test_the_group_boxes_are_the_twins(monkeypatch):
+    """``_group_boxes`` (:func:`_jit.group_boxes`) of the kept labels of 300 random label sets (1-3,000 pixels, up to
+    40 labels, a third kept, rows and columns up to 2,000) against its twin, ``reduceat``'s minima and maxima: the same
+    boxes in the same order; and a known answer."""
+    from symfruit.segment.colour import _group_boxes, _grouped
+
+    rng = np.random.default_rng(48)
+    boxes = 0
+    for _ in range(300):
+        n = int(rng.integers(1, 3001))
+        k = int(rng.integers(1, 41))
+        labels = rng.integers(1, k + 1, n)
+        keep = rng.random(k + 1) < 0.35
+        rows, cols = rng.integers(0, 2000, n), rng.integers(0, 2000, n)
+        grouped = _grouped(labels, keep)
+        fast, twin = _both(monkeypatch, _group_boxes, *grouped, rows, cols)
+        assert list(fast.items()) == list(twin.items())
+        boxes += len(fast)
+    assert boxes > 1000
+    labels, rows, cols = np.array([2, 1, 2, 2]), np.array([5, 0, 3, 9]), np.array([1, 4, 7, 2])
+    found = _group_boxes(*_grouped(labels, np.array([False, True, True])), rows, cols)
+    assert found == {1: (slice(0, 1), slice(4, 5)), 2: (slice(3, 10), slice(1, 8))}

@@ -6084,18 +6084,15 @@ def depth_edges(
 def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
     """:func:`symfruit.segment.colour._cells` before its masks: (h, w) int32, each pixel of ``region`` (h, w) bool
     numbered by its cell (1..k), 0 outside. ``centres`` (k, 3) rows ``row, col, radius``. The region's distance map
-    (:func:`distance` of it padded by a pixel), its 4-connected pieces deeper than ``loose`` times the least radius
-    (:func:`label`), each deep pixel to the centre of least power ``(r - row)^2 + (c - col)^2 - radius^2`` (the first
-    of equals, as ``np.argmin``) when in that centre's piece, the centres' own pixels to them, every region pixel to
-    its nearest core pixel (:func:`nearest`, scipy's choice). The twin's sums in its order: the same cells."""
+    (:func:`distance` of it padded by a pixel, by :func:`inner_distance` since stop 48), its 4-connected pieces
+    deeper than ``loose`` times the least radius (:func:`label`), each deep pixel to the centre of least power
+    ``(r - row)^2 + (c - col)^2 - radius^2`` (the first of equals, as ``np.argmin``) when in that centre's piece, the
+    centres' own pixels to them, every region pixel to its nearest core pixel (:func:`nearest`, scipy's choice). The
+    twin's sums in its order: the same cells."""
     h, w = region.shape
     k = centres.shape[0]
-    pad = np.zeros((h + 2, w + 2), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            pad[r + 1, c + 1] = region[r, c]
-    dist = np.empty((h + 2, w + 2))
-    distance(pad, False, dist)
+    dist = np.empty((h, w))
+    inner_distance(region, dist)  # the padded map's inside (stop 48)
     least = centres[0, 2]
     for j in range(1, k):
         least = min(least, centres[j, 2])
@@ -6103,7 +6100,7 @@ def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
     above = np.empty((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
-            above[r, c] = dist[r + 1, c + 1] > t
+            above[r, c] = dist[r, c] > t
     deep, _ = label(above, False)
     at = np.empty(k, np.int32)
     for j in range(k):
@@ -6130,11 +6127,11 @@ def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     out = np.zeros((h, w), np.int32)
+    flat = cores.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
             if region[r, c]:
-                q = near[r, c]
-                out[r, c] = cores[q // w, q % w]
+                out[r, c] = flat[near[r, c]]
     return out
 
 
@@ -6545,7 +6542,8 @@ def split_centres(
     """:func:`symfruit.segment.colour._split` with depth from its filled ``region`` (h, w) bool and ``depth`` (h, w)
     float64 (0: none) to its centres: the depth edges (:func:`depth_edges` of the depth filled from the nearest pixel
     with depth of the region, scipy's choice, :func:`nearest`), the region less them with its holes filled
-    (:func:`_filled_box`), its distance map (:func:`distance` of it padded by a pixel) and, when that reaches
+    (:func:`_filled_box`), its distance map (:func:`distance` of it padded by a pixel, by :func:`inner_distance` since
+    stop 48) and, when that reaches
     ``least``, the :func:`centre_search` (``radius`` the whole part of ``least``). Returns the edges (h, w) bool and the
     centres (k, 4) (none when the map stays below ``least``): the twin's calls in one, the same values."""
     h, w = region.shape
@@ -6558,23 +6556,18 @@ def split_centres(
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     fill = np.empty((h, w))
+    flat = depth.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
-            q = near[r, c]
-            fill[r, c] = depth[q // w, q % w]
+            fill[r, c] = flat[near[r, c]]
     edges = depth_edges(fill, weights, symmetric, limit, region, depth, seen, jump)
     cut = np.empty((h, w), np.bool_)
     for r in range(h):
         for c in range(w):
             cut[r, c] = region[r, c] and not edges[r, c]
     carved = _filled_box(cut)
-    pad = np.zeros((h + 2, w + 2), np.bool_)
-    for r in range(h):
-        for c in range(w):
-            pad[r + 1, c + 1] = carved[r, c]
-    dist = np.empty((h + 2, w + 2))
-    distance(pad, False, dist)
-    edt = dist[1:-1, 1:-1]
+    edt = np.empty((h, w))
+    inner_distance(carved, edt)  # the padded map's inside (stop 48)
     top = -np.inf
     for r in range(h):
         for c in range(w):
@@ -7686,11 +7679,11 @@ def follow_edges(
     near = np.empty((h, w), np.int64)
     nearest(free, near)
     grown = np.zeros((h, w), np.int64)
+    flat = seeds.ravel()  # read by the flat index itself: no division a pixel (stop 48)
     for r in range(h):
         for c in range(w):
             if region[r, c]:
-                q = near[r, c]
-                grown[r, c] = seeds[q // w, q % w]
+                grown[r, c] = flat[near[r, c]]
     return grown, True
 
 
@@ -7931,3 +7924,105 @@ def bridge_gaps(z: np.ndarray, r0: int, r1: int, c0: int, c1: int, reach: float,
                     if d < best:
                         best, at = d, u
             dst[j] = np.float64(z[line[at - ca], at]) if at >= 0 and best <= most else 0.0
+
+
+# --- stop 48, seg640_48: the colour segmenter's split at 640x480 ------------------------------------------------------
+
+
+@_njit
+def inner_distance(mask: np.ndarray, out: np.ndarray) -> None:
+    """Into ``out`` (h, w) the distance map of ``mask`` (h, w) bool padded by a pixel of False, its inside: each mask
+    pixel's distance to the nearest pixel off the mask or outside the array, 0 off the mask (``distance(pad, False,
+    dist)[1:-1, 1:-1]`` of :func:`distance` over the padded copy, ``ndimage.distance_transform_edt(np.pad(mask, 1))``'s
+    inside). Without the padded copy: the columns' distances with the border rows as the pixels off the mask, then
+    each row's lower envelope (:func:`_envelope`) run by run of the row's mask pixels, over the run's columns and the
+    pixel off the mask either side (distance 0): a column beyond those lies farther along the row than the run's end
+    that bounds it, so its parabola is nowhere below the least one. The same least squared distances, so the same
+    square roots, bit for bit, at about two thirds of the padded map's time (the split's windows)."""
+    h, w = mask.shape
+    g = np.empty((h, w), np.int64)
+    for c in range(w):
+        g[0, c] = 1 if mask[0, c] else 0
+    for r in range(1, h):
+        for c in range(w):
+            g[r, c] = g[r - 1, c] + 1 if mask[r, c] else 0
+    for c in range(w):
+        if g[h - 1, c] > 1:
+            g[h - 1, c] = 1
+    for r in range(h - 2, -1, -1):
+        for c in range(w):
+            if g[r + 1, c] + 1 < g[r, c]:
+                g[r, c] = g[r + 1, c] + 1
+    f = np.empty(w + 2, np.int64)
+    s = np.empty(w + 2, np.int64)
+    t = np.empty(w + 2, np.int64)
+    d2 = np.empty(w + 2, np.int64)
+    for r in range(h):
+        c = 0
+        while c < w:
+            if not mask[r, c]:
+                out[r, c] = 0.0
+                c += 1
+                continue
+            a = c
+            while c < w and mask[r, c]:
+                c += 1
+            n = c - a + 2  # the run a..c-1 and the pixels off the mask at a-1 and c (f = 0), locally 0..n-1
+            f[0] = 0
+            for i in range(a, c):
+                f[i - a + 1] = g[r, i] * g[r, i]
+            f[n - 1] = 0
+            _envelope(f, n, s, t, d2)
+            for i in range(a, c):
+                out[r, i] = math.sqrt(float(d2[i - a + 1]))
+
+
+@_njit
+def red_ripe(color: np.ndarray, red: np.ndarray, least: np.float32) -> bool:
+    """Whether :func:`red_median` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8 reaches ``least``
+    (float32), compared in float32 (:func:`symfruit.segment.colour._ripe`'s test), mostly without the median: the
+    middle value of an odd count reaches it exactly when no more than half the values (``n // 2``) lie below it; of an
+    even count, the float32 mean of the middle two reaches it when both do (fewer than ``n // 2`` values below: their
+    sum rounds to no less than twice ``least``). Otherwise (an even count with half or more below: the mean may still
+    round up to it) the median itself as :func:`red_median` has it. The same answer, without the quickselect for a
+    ripe fruit (stop 48)."""
+    h, w = red.shape
+    n = 0
+    below = 0
+    one = np.float32(1.0)
+    for r in range(h):
+        for c in range(w):
+            if red[r, c]:
+                x = np.float32(color[r, c, 0])
+                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+                n += 1
+                below += (x - gb) / (x if x > one else one) < least
+    if n == 0:
+        return False  # the median is NaN
+    half = n // 2
+    if n % 2:
+        return below <= half
+    if below < half:
+        return True
+    return np.float32(red_median(color, red)) >= least
+
+
+@_njit
+def group_boxes(at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
+    """:func:`symfruit.segment.colour._group_boxes`' boxes: for each group ``i`` of the pixels ``at[first[i]:first[i +
+    1]]`` (indices into ``rows`` and ``cols``; every group holds one or more), the least and one past the greatest row
+    and column, (k, 4) int64 rows ``r0, r1, c0, c1`` (the twin's ``reduceat`` minima and maxima: the same numbers) in
+    one call, not a dozen numpy ones a window (stop 48)."""
+    k = first.shape[0] - 1
+    out = np.empty((k, 4), np.int64)
+    for i in range(k):
+        j = at[first[i]]
+        r0 = r1 = rows[j]
+        c0 = c1 = cols[j]
+        for m in range(first[i] + 1, first[i + 1]):
+            j = at[m]
+            r, c = rows[j], cols[j]
+            r0, r1 = min(r0, r), max(r1, r)
+            c0, c1 = min(c0, c), max(c1, c)
+        out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r0, r1 + 1, c0, c1 + 1
+    return out

@@ -213,8 +213,11 @@ def _color(color: np.ndarray) -> np.ndarray:
 def _ripe(color: np.ndarray, red: np.ndarray, ripe_median: float) -> bool:
     """Whether the median redness of the pixels ``red`` (h, w) bool of ``color`` (h, w, 3) uint8 reaches
     ``ripe_median``: the float32 median compared in float32, with the compiled twin (issue 19, eighteenth round)
-    as without it (a setting such as 0.35 rounds down in float32, and a median equal to it is ripe either way)."""
+    as without it (a setting such as 0.35 rounds down in float32, and a median equal to it is ripe either way); where
+    numba is, the answer mostly by counting the values below it (:func:`symfruit.core._jit.red_ripe`, stop 48)."""
     jit = compiled()
+    if jit is not None and red.ndim == 2 and red.dtype == bool and color.dtype == np.uint8 and color.ndim == 3:
+        return bool(jit.red_ripe(color, red, np.float32(ripe_median)))  # mostly without the median (stop 48)
     value = jit.red_median(color, red) if jit is not None else median(redness(color[red]))
     return bool(np.float32(value) >= np.float32(ripe_median))
 
@@ -1354,7 +1357,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
         for k, part in enumerate(parts, 1):
             owner[part] = k
         grown, moved = jit.follow_edges(region, edges, owner, len(parts), EDGE_PURITY)
-        return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()] if moved else parts
+        return [m for k in range(1, len(parts) + 1) if (m := grown == k).any()] if moved else parts
     pieces, n = _label(region & ~edges)
     if n < 2:
         return parts
@@ -1373,7 +1376,7 @@ def _follow_edges(parts: list[np.ndarray], region: np.ndarray, edges: np.ndarray
     if not seeds.any():
         return parts
     grown = np.where(region, np.take(seeds.ravel(), nearest_index(seeds == 0)), 0)
-    return [grown == k for k in range(1, len(parts) + 1) if (grown == k).any()]
+    return [m for k in range(1, len(parts) + 1) if (m := grown == k).any()]
 
 
 #: Share of an edge-enclosed piece that one fruit must already hold for the whole piece to go to it.
@@ -1648,7 +1651,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cells' map in one compiled call (:func:`symfruit.core._jit.cells`: the same cells; issue 19, eighteenth round)."""
     if (jit := compiled()) is not None and region.ndim == 2 and region.dtype == bool:
         cells = jit.cells(region, np.array(centres, dtype=np.float64).reshape(-1, 3), float(loose))
-        return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
+        return [m for k in range(1, len(centres) + 1) if (m := cells == k).any()]
     edt = distance_transform(_pad1(region))[1:-1, 1:-1]  # scipy's map, compiled where numba is
     cen = np.array(centres, dtype=np.float64)
     deep, _ = _label(edt > loose * float(cen[:, 2].min()))
@@ -1661,7 +1664,7 @@ def _cells(region: np.ndarray, centres: list[tuple[int, int, float]], loose: flo
     cores[rows[keep], cols[keep]] = near[keep] + 1
     cores[cen[:, 0].astype(int), cen[:, 1].astype(int)] = np.arange(1, len(cen) + 1)
     cells = np.where(region, np.take(cores.ravel(), nearest_index(cores == 0)), 0)
-    return [cells == k for k in range(1, len(centres) + 1) if (cells == k).any()]
+    return [m for k in range(1, len(centres) + 1) if (m := cells == k).any()]
 
 
 def _depth_edges(
@@ -2394,9 +2397,13 @@ def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarr
 def _group_boxes(
     ids: np.ndarray, at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.ndarray
 ) -> dict[int, Window]:
-    """:func:`_boxes` of the groups of :func:`_grouped`."""
+    """:func:`_boxes` of the groups of :func:`_grouped`. Where numba is, in one call
+    (:func:`symfruit.core._jit.group_boxes`: the same boxes; stop 48)."""
     if len(at) == 0:
         return {}
+    if (jit := compiled()) is not None and at.ndim == first.ndim == rows.ndim == cols.ndim == 1:
+        boxes = jit.group_boxes(at, first, rows, cols).tolist()
+        return {k: (slice(a, b), slice(d, e)) for k, (a, b, d, e) in zip(ids.tolist(), boxes, strict=True)}
     r, c, first = rows.take(at), cols.take(at), first[:-1]
     r0, r1 = np.minimum.reduceat(r, first), np.maximum.reduceat(r, first) + 1
     c0, c1 = np.minimum.reduceat(c, first), np.maximum.reduceat(c, first) + 1
