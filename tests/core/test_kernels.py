@@ -5759,3 +5759,45 @@ def test_the_group_boxes_are_the_twins(monkeypatch):
     labels, rows, cols = np.array([2, 1, 2, 2]), np.array([5, 0, 3, 9]), np.array([1, 4, 7, 2])
     found = _group_boxes(*_grouped(labels, np.array([False, True, True])), rows, cols)
     assert found == {1: (slice(0, 1), slice(4, 5)), 2: (slice(3, 10), slice(1, 8))}
+
+
+# --- stop 48, occspeed48
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(1, 40))
+def test_the_reach_fill_on_a_fixed_stack_is_the_flood_box_or_says_it_ran_out(seed, h, w, cap):
+    """_reach_fill with a stack of ``cap`` seeds: either ok and _flood_box's box, or not ok (it needed more); with
+    5 h w + 16 seeds (_reach_box's second try) always ok. Random joins and seen pixels, scattered."""
+    rng = np.random.default_rng(seed)
+    join = rng.random((h, w)) < rng.uniform(0.0, 0.95)
+    seen = rng.random((h, w)) < rng.uniform(0.01, 0.3)
+    if not seen.any():
+        seen[h // 2, w // 2] = True
+    rows, cols = np.nonzero(seen)
+    box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
+    want = tuple(int(x) for x in _jit._flood_box(join, seen, *box)[1:])
+    ok, *got = _jit._reach_fill(join, seen, *box, np.empty(cap, np.int64))
+    assert not ok or tuple(int(x) for x in got) == want
+    ok, *got = _jit._reach_fill(join, seen, *box, np.empty(5 * h * w + 16, np.int64))
+    assert ok and tuple(int(x) for x in got) == want
+
+
+def test_the_reach_box_past_its_first_stack_known_answer():
+    """A seen row of 1,100 pixels in a 3 x 1,200 window of join pixels has 2,200 pixels beside it, more than the
+    first try's 1,024 seeds: the second try gives the whole window's box, as _flood_box; a lone join pixel two rows
+    below a seen one (a gap between) is not reached, one diagonally beside it is."""
+    join = np.ones((3, 1200), bool)
+    seen = np.zeros((3, 1200), bool)
+    seen[1, 50:1150] = True
+    box = (1, 2, 50, 1150)
+    assert not _jit._reach_fill(join, seen, *box, np.empty(1024, np.int64))[0]
+    assert tuple(int(x) for x in _jit._reach_box(join, seen, *box)) == (0, 3, 0, 1200)
+    assert tuple(int(x) for x in _jit._flood_box(join, seen, *box)[1:]) == (0, 3, 0, 1200)
+    join = np.zeros((5, 5), bool)
+    seen = np.zeros((5, 5), bool)
+    seen[1, 1] = True
+    join[3, 1] = True  # row 2 between is not join's
+    assert tuple(int(x) for x in _jit._reach_box(join, seen, 1, 2, 1, 2)) == (1, 2, 1, 2)
+    join[2, 2] = True  # diagonally beside the seen pixel, and beside (3, 1)
+    assert tuple(int(x) for x in _jit._reach_box(join, seen, 1, 2, 1, 2)) == (1, 4, 1, 3)
