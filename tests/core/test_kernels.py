@@ -5639,3 +5639,68 @@ def test_the_bridged_depth_known_answer():
     got = np.empty((4, 4))
     _jit.bridge_gaps(z, 1, 5, 1, 5, 3.5, got)
     assert got[2, 0] == 6.0 and got[2, 1] == 0.0  # (3, 1) from the depth: 10 <= 12.25; (3, 2): 13 > 12.25
+
+
+# --- stop 48, compspeed48
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 45), st.booleans())
+def test_square_any_is_its_twins(seed, h, w, radius, want):
+    """Blobs (edges, holes, thin parts; squares wider than the array): the pixels with one equal to ``want`` within
+    the square clipped to the array, as the twin's maximum filter of ``src == want`` finds them."""
+    from scipy import ndimage
+
+    src = _blobs(np.random.default_rng(seed), h, w, 0.3)
+    out = np.empty((h, w), bool)
+    _jit._square_any(src, radius, want, out)
+    assert np.array_equal(out, ndimage.maximum_filter(src == want, size=2 * radius + 1, mode="constant", cval=False))
+
+
+def test_square_any_known_answer():
+    """One true pixel at (1, 4) of a 4 x 7 array, radius 2: true over rows 0-3 and columns 2-6 (clipped), false
+    elsewhere; ``want`` False on a full array: nothing."""
+    src = np.zeros((4, 7), bool)
+    src[1, 4] = True
+    out = np.empty((4, 7), bool)
+    _jit._square_any(src, 2, True, out)
+    want = np.zeros((4, 7), bool)
+    want[:, 2:] = True
+    assert np.array_equal(out, want)
+    _jit._square_any(np.ones((4, 7), bool), 2, False, out)
+    assert not out.any()
+
+
+def test_filled_spans_known_answers():
+    """A square ring holds a hole of 3 x 3; with a gap in its wall the inside reaches the edge (not a hole); a
+    winding corridor from a ring's inside out through another ring's wall, upwards then down: no hole either. On a
+    strided view, as the callers' boxes are."""
+    ring = np.zeros((7, 7), bool)
+    ring[1, 1:6] = ring[5, 1:6] = ring[1:6, 1] = ring[1:6, 5] = True
+    out = np.empty((7, 7), bool)
+    _jit.filled(ring, out)
+    want = ring.copy()
+    want[2:5, 2:5] = True
+    assert np.array_equal(out, want)
+    ring[3, 5] = False  # a gap in the right wall
+    _jit.filled(ring, out)
+    assert np.array_equal(out, ring)
+    # the inside of the outer ring (rows 1-9, columns 1-11) joins the edge only through the column-10 corridor's
+    # top, which the inner wall's row 2 hides from the rows below
+    m = np.zeros((11, 13), bool)
+    m[0, :] = m[10, :] = m[:, 0] = m[:, 12] = True
+    m[0, 10] = False  # the way out: up column 10 to the top edge
+    m[2, 1:10] = True
+    m[2:9, 9] = True  # a wall: the room below row 2, left of column 9, reaches column 10 only along row 9
+    out = np.empty(m.shape, bool)
+    _jit.filled(m, out)
+    assert np.array_equal(out, m)
+    m[9, 1:9] = True  # the room closed at its bottom: rows 3-8, columns 1-8 are a hole
+    _jit.filled(m, out)
+    want = m.copy()
+    want[3:9, 1:9] = True
+    assert np.array_equal(out, want)
+    big = np.zeros((13, 26), bool)
+    big[1:12, ::2] = m
+    view, got = big[1:12, ::2], np.empty((11, 13), bool)
+    _jit.filled(view, got)
+    assert np.array_equal(got, want)
