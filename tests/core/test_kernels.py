@@ -5704,3 +5704,44 @@ def test_filled_spans_known_answers():
     view, got = big[1:12, ::2], np.empty((11, 13), bool)
     _jit.filled(view, got)
     assert np.array_equal(got, want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(3, 1200), st.integers(3, 150), st.sampled_from(["blob", "grid", "flat"]))
+def test_noise_level_is_noise_measures_noise_to_the_bit(seed, n, queries, kind):
+    """Clouds as a view's (a pixel grid's ties straddling the 8th place among them, a flat one): the kernel's noise
+    level is ``noise_measures``' second value byte for byte, and the twin's (``SYMFRUIT_KERNELS=numpy``) is that."""
+    from symfruit.core.fits import noise_level, noise_measures
+
+    rng = np.random.default_rng(seed)
+    if kind == "blob":
+        p = rng.normal(size=(n, 3)) * [0.03, 0.03, 0.01] + [0.0, 0.0, 0.5]
+    elif kind == "grid":
+        u, v = rng.integers(0, 30, n), rng.integers(0, 30, n)
+        p = np.stack([u * 1e-3, v * 1e-3, 0.5 + np.round(rng.normal(0.0, 1e-3, n), 4)], axis=1)
+    else:
+        p = rng.normal(size=(n, 3))
+        p[:, 2] = 0.0
+    step, k_large = max(1, n // queries), min(30, n)
+    got = _jit.noise_level(p, step, min(8, k_large), k_large)
+    assert np.float64(got).tobytes() == np.float64(_jit.noise_measures(p, step, min(8, k_large), k_large)[1]).tobytes()
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: (noise_level(p, queries=queries), noise_measures(p, queries=queries)[1]))
+    assert np.float64(fast[0]).tobytes() == np.float64(fast[1]).tobytes()
+    assert np.float64(twin[0]).tobytes() == np.float64(twin[1]).tobytes()
+
+
+def test_noise_level_known_answer():
+    """Points on a plane have no noise (0, exactly: the least eigenvalue's median clipped at 0); a NaN point sends
+    the kernel to the whole measure, whose noise it returns."""
+    rng = np.random.default_rng(5)
+    plane = np.zeros((400, 3))
+    plane[:, :2] = rng.normal(size=(400, 2))
+    assert _jit.noise_level(plane, 10, 8, 30) == _jit.noise_measures(plane, 10, 8, 30)[1]
+    assert _jit.noise_level(plane, 10, 8, 30) < 1e-12
+    bumpy = plane.copy()
+    bumpy[:, 2] = rng.normal(0.0, 0.01, 400)
+    bumpy[7, 0] = np.nan
+    want = _jit.noise_measures(bumpy, 10, 8, 30)[1]
+    got = _jit.noise_level(bumpy, 10, 8, 30)
+    assert np.float64(got).tobytes() == np.float64(want).tobytes()

@@ -2196,6 +2196,36 @@ def noise_measures(points: np.ndarray, step: int, small: int, large: int) -> tup
 
 
 @_njit
+def noise_level(points: np.ndarray, step: int, small: int, large: int) -> float:
+    """``noise_measures(points, step, small, large)[1]`` (:func:`symfruit.core.fits.noise_level`), the same value to
+    the bit, without the ``large`` neighbourhoods (issue 19, stop 48, compspeed48): each query's ``small`` nearest
+    are the first ``small`` in the order of distance, ties by index, of any set of points holding them, so
+    :func:`grid_covariances` asked for ``small`` of them (its grid sized for ``small``, its search bounded by the
+    ``small``-th distance) finds the same points in the same order, and their covariances and least eigenvalues
+    are the same operations on them. A coordinate that is not finite (NaN distances, whose order is the brute
+    force's insertion's) goes to :func:`noise_measures` whole."""
+    n = points.shape[0]
+    for i in range(n):
+        if not (math.isfinite(points[i, 0]) and math.isfinite(points[i, 1]) and math.isfinite(points[i, 2])):
+            return noise_measures(points, step, small, large)[1]
+    cov_small, _ = grid_covariances(points, step, small, small)
+    m = cov_small.shape[0]
+    scratch = np.empty((3, 3))
+    least_small = np.empty(m)
+    for q in range(m):
+        least_small[q] = least_eigenvalue(cov_small[q], scratch)
+    x = np.sort(least_small)  # NaN last, as numpy sorts
+    h = m // 2
+    if m == 0 or math.isnan(x[m - 1]):
+        res = math.nan
+    elif m % 2:
+        res = x[h]
+    else:
+        res = (x[h - 1] + x[h]) / 2.0
+    return 0.0 if 0.0 > res else math.sqrt(res)
+
+
+@_njit
 def outline_uv(mask: np.ndarray, count: int, u0: int, v0: int) -> np.ndarray:
     """:func:`symfruit.core.agreement._outline_uv`: the image coordinates (m, 2) of every ``max(1, k // (2 count))``-th
     of the ``k`` outline pixels of ``mask`` (h, w) bool (a mask pixel with a 4-neighbour outside it or beyond the
