@@ -296,7 +296,6 @@ def noise_measures(points: np.ndarray, small: int = 8, large: int = 30, queries:
     return ratio, noise
 
 
-
 def noise_level(points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120) -> float:
     """``noise_measures(points, small, large, queries)[1]``, the same value: by the compiled
     :func:`symfruit.core._jit.noise_level` where :func:`noise_measures` calls its kernel (the ``small``
@@ -309,6 +308,7 @@ def noise_level(points: np.ndarray, small: int = 8, large: int = 30, queries: in
     if jit is not None and len(points) * len(range(0, len(points), step)) <= _BRUTE_NEIGHBOURS:
         return float(jit.noise_level(points, step, min(small, k_large), k_large))
     return noise_measures(points, small, large, queries)[1]
+
 
 #: :func:`surface_noise` finds neighbours by the kernel's brute force up to this many distances (points times
 #: queries: 40,000 in the default method's call on 1,000 points), by a search tree beyond.
