@@ -5745,3 +5745,13 @@ def test_noise_level_known_answer():
     want = _jit.noise_measures(bumpy, 10, 8, 30)[1]
     got = _jit.noise_level(bumpy, 10, 8, 30)
     assert np.float64(got).tobytes() == np.float64(want).tobytes()
+
+
+def test_outline_cracks_known_answer():
+    """An L of three pixels at window (u0, v0) = (10, 20): the cracks above, then below, left and right, each
+    row-major, at half-integers."""
+    mask = np.zeros((3, 3), bool)
+    mask[1, 1] = mask[2, 1] = mask[2, 2] = True
+    got = _jit.outline_cracks(mask, 10, 20)
+    want = [[11, 20.5], [12, 21.5]] + [[11, 22.5], [12, 22.5]] + [[10.5, 21], [10.5, 22]] + [[11.5, 21], [12.5, 22]]
+    np.testing.assert_array_equal(got, want)

