@@ -787,3 +787,22 @@ def test_plain_is_the_former_generator_test():
     for values in itertools.product(edges, repeat=3):
         assert _plain(*values) == all(v == 0.0 or 1e-100 < abs(v) < 1e100 for v in values)
     assert _plain() and _plain(0.3, -2.0) and not _plain(1.0, float("nan")) and not _plain(1e-200)
+
+
+@pytest.mark.parametrize("n", [3, 25, 1000, 3000])
+def test_noise_level_is_noise_measures_noise(n):
+    """``noise_level`` is ``noise_measures``' second value, byte for byte (a noisy sphere's seen side; 3 points: the
+    neighbourhoods are the whole cloud), with and without the kernels (stop 48)."""
+    from symfruit.core.fits import noise_level, noise_measures
+
+    rng = np.random.default_rng(n)
+    cloud = front_half(CENTRE + 0.035 * fibonacci_sphere(2 * n + 8))[:n]
+    points = cloud + rng.normal(0.0, 4e-4, cloud.shape)
+    for kernels in ("", "numpy"):
+        with pytest.MonkeyPatch.context() as mp:
+            if kernels:
+                mp.setenv("SYMFRUIT_KERNELS", kernels)
+            else:
+                mp.delenv("SYMFRUIT_KERNELS", raising=False)
+            got, want = noise_level(points, queries=40), noise_measures(points, queries=40)[1]
+        assert np.float64(got).tobytes() == np.float64(want).tobytes()

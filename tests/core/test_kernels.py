@@ -5807,3 +5807,119 @@ def test_the_reach_box_past_its_first_stack_known_answer():
     assert tuple(int(x) for x in _jit._reach_box(join, seen, 1, 2, 1, 2)) == (1, 2, 1, 2)
     join[2, 2] = True  # diagonally beside the seen pixel, and beside (3, 1)
     assert tuple(int(x) for x in _jit._reach_box(join, seen, 1, 2, 1, 2)) == (1, 4, 1, 3)
+
+
+# --- stop 48, compspeed48
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.integers(0, 45), st.booleans())
+def test_square_any_is_its_twins(seed, h, w, radius, want):
+    """Blobs (edges, holes, thin parts; squares wider than the array): the pixels with one equal to ``want`` within
+    the square clipped to the array, as the twin's maximum filter of ``src == want`` finds them."""
+    from scipy import ndimage
+
+    src = _blobs(np.random.default_rng(seed), h, w, 0.3)
+    out = np.empty((h, w), bool)
+    _jit._square_any(src, radius, want, out)
+    assert np.array_equal(out, ndimage.maximum_filter(src == want, size=2 * radius + 1, mode="constant", cval=False))
+
+
+def test_square_any_known_answer():
+    """One true pixel at (1, 4) of a 4 x 7 array, radius 2: true over rows 0-3 and columns 2-6 (clipped), false
+    elsewhere; ``want`` False on a full array: nothing."""
+    src = np.zeros((4, 7), bool)
+    src[1, 4] = True
+    out = np.empty((4, 7), bool)
+    _jit._square_any(src, 2, True, out)
+    want = np.zeros((4, 7), bool)
+    want[:, 2:] = True
+    assert np.array_equal(out, want)
+    _jit._square_any(np.ones((4, 7), bool), 2, False, out)
+    assert not out.any()
+
+
+def test_filled_spans_known_answers():
+    """A square ring holds a hole of 3 x 3; with a gap in its wall the inside reaches the edge (not a hole); a
+    winding corridor from a ring's inside out through another ring's wall, upwards then down: no hole either. On a
+    strided view, as the callers' boxes are."""
+    ring = np.zeros((7, 7), bool)
+    ring[1, 1:6] = ring[5, 1:6] = ring[1:6, 1] = ring[1:6, 5] = True
+    out = np.empty((7, 7), bool)
+    _jit.filled(ring, out)
+    want = ring.copy()
+    want[2:5, 2:5] = True
+    assert np.array_equal(out, want)
+    ring[3, 5] = False  # a gap in the right wall
+    _jit.filled(ring, out)
+    assert np.array_equal(out, ring)
+    # the inside of the outer ring (rows 1-9, columns 1-11) joins the edge only through the column-10 corridor's
+    # top, which the inner wall's row 2 hides from the rows below
+    m = np.zeros((11, 13), bool)
+    m[0, :] = m[10, :] = m[:, 0] = m[:, 12] = True
+    m[0, 10] = False  # the way out: up column 10 to the top edge
+    m[2, 1:10] = True
+    m[2:9, 9] = True  # a wall: the room below row 2, left of column 9, reaches column 10 only along row 9
+    out = np.empty(m.shape, bool)
+    _jit.filled(m, out)
+    assert np.array_equal(out, m)
+    m[9, 1:9] = True  # the room closed at its bottom: rows 3-8, columns 1-8 are a hole
+    _jit.filled(m, out)
+    want = m.copy()
+    want[3:9, 1:9] = True
+    assert np.array_equal(out, want)
+    big = np.zeros((13, 26), bool)
+    big[1:12, ::2] = m
+    view, got = big[1:12, ::2], np.empty((11, 13), bool)
+    _jit.filled(view, got)
+    assert np.array_equal(got, want)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(3, 1200), st.integers(3, 150), st.sampled_from(["blob", "grid", "flat"]))
+def test_noise_level_is_noise_measures_noise_to_the_bit(seed, n, queries, kind):
+    """Clouds as a view's (a pixel grid's ties straddling the 8th place among them, a flat one): the kernel's noise
+    level is ``noise_measures``' second value byte for byte, and the twin's (``SYMFRUIT_KERNELS=numpy``) is that."""
+    from symfruit.core.fits import noise_level, noise_measures
+
+    rng = np.random.default_rng(seed)
+    if kind == "blob":
+        p = rng.normal(size=(n, 3)) * [0.03, 0.03, 0.01] + [0.0, 0.0, 0.5]
+    elif kind == "grid":
+        u, v = rng.integers(0, 30, n), rng.integers(0, 30, n)
+        p = np.stack([u * 1e-3, v * 1e-3, 0.5 + np.round(rng.normal(0.0, 1e-3, n), 4)], axis=1)
+    else:
+        p = rng.normal(size=(n, 3))
+        p[:, 2] = 0.0
+    step, k_large = max(1, n // queries), min(30, n)
+    got = _jit.noise_level(p, step, min(8, k_large), k_large)
+    assert np.float64(got).tobytes() == np.float64(_jit.noise_measures(p, step, min(8, k_large), k_large)[1]).tobytes()
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, lambda: (noise_level(p, queries=queries), noise_measures(p, queries=queries)[1]))
+    assert np.float64(fast[0]).tobytes() == np.float64(fast[1]).tobytes()
+    assert np.float64(twin[0]).tobytes() == np.float64(twin[1]).tobytes()
+
+
+def test_noise_level_known_answer():
+    """Points on a plane have no noise (0, exactly: the least eigenvalue's median clipped at 0); a NaN point sends
+    the kernel to the whole measure, whose noise it returns."""
+    rng = np.random.default_rng(5)
+    plane = np.zeros((400, 3))
+    plane[:, :2] = rng.normal(size=(400, 2))
+    assert _jit.noise_level(plane, 10, 8, 30) == _jit.noise_measures(plane, 10, 8, 30)[1]
+    assert _jit.noise_level(plane, 10, 8, 30) < 1e-12
+    bumpy = plane.copy()
+    bumpy[:, 2] = rng.normal(0.0, 0.01, 400)
+    bumpy[7, 0] = np.nan
+    want = _jit.noise_measures(bumpy, 10, 8, 30)[1]
+    got = _jit.noise_level(bumpy, 10, 8, 30)
+    assert np.float64(got).tobytes() == np.float64(want).tobytes()
+
+
+def test_outline_cracks_known_answer():
+    """An L of three pixels at window (u0, v0) = (10, 20): the cracks above, then below, left and right, each
+    row-major, at half-integers."""
+    mask = np.zeros((3, 3), bool)
+    mask[1, 1] = mask[2, 1] = mask[2, 2] = True
+    got = _jit.outline_cracks(mask, 10, 20)
+    want = [[11, 20.5], [12, 21.5]] + [[11, 22.5], [12, 22.5]] + [[10.5, 21], [10.5, 22]] + [[11.5, 21], [12.5, 22]]
+    np.testing.assert_array_equal(got, want)

@@ -281,3 +281,16 @@ def test_subsample_draws_as_a_new_generator_does():
     np.testing.assert_array_equal(
         found[0], points[np.sort(np.random.default_rng(1).choice(5000, size=100, replace=False))]
     )
+
+
+def test_subsample_takes_the_indexed_rows():
+    """The rows ``take`` copies are the indexed rows, byte for byte: of a strided view, of float32 points, of a
+    column-ordered array; a 1-D array's elements likewise."""
+    rng = np.random.default_rng(3)
+    base = rng.normal(size=(4000, 6))
+    keep = np.sort(np.random.default_rng(0).choice(2000, size=300, replace=False))
+    for cloud in (base[::2, 1:4], base[:2000, :3].astype(np.float32), np.asfortranarray(base[:2000, 3:])):
+        got = subsample(cloud, 300)
+        assert got.dtype == cloud.dtype and got.tobytes() == cloud[keep].tobytes()
+    got = subsample(np.arange(20.0), 5)
+    assert np.array_equal(got, np.arange(20.0)[np.sort(np.random.default_rng(0).choice(20, size=5, replace=False))])

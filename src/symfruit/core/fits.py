@@ -43,6 +43,7 @@ __all__ = [
     "fit_revolution",
     "fit_revolution_slices",
     "fit_sphere",
+    "noise_level",
     "noise_measures",
     "outline_radii",
     "revolution_box",
@@ -293,6 +294,20 @@ def noise_measures(points: np.ndarray, small: int = 8, large: int = 30, queries:
         return float(ratio), float(noise)
     ratio, noise, _ = surface_noise(points, small, large, queries)
     return ratio, noise
+
+
+def noise_level(points: np.ndarray, small: int = 8, large: int = 30, queries: int = 120) -> float:
+    """``noise_measures(points, small, large, queries)[1]``, the same value: by the compiled
+    :func:`symfruit.core._jit.noise_level` where :func:`noise_measures` calls its kernel (the ``small``
+    neighbourhoods alone, no ``large`` ones: the same neighbours, covariances and median; issue 19, stop 48), else
+    :func:`noise_measures`' value."""
+    points = as_points(points, min_count=3)
+    k_large = min(large, len(points))
+    step = max(1, len(points) // queries)
+    jit = compiled()
+    if jit is not None and len(points) * len(range(0, len(points), step)) <= _BRUTE_NEIGHBOURS:
+        return float(jit.noise_level(points, step, min(small, k_large), k_large))
+    return noise_measures(points, small, large, queries)[1]
 
 
 #: :func:`surface_noise` finds neighbours by the kernel's brute force up to this many distances (points times

@@ -322,8 +322,10 @@ def subsample(points: np.ndarray, n: int | None, *, seed: int = 0) -> np.ndarray
     same subset), in the original order; ``points`` itself when it is small enough or ``n`` is None."""
     if n is None or len(points) <= n:
         return points
-    keep = _generator(seed).choice(len(points), size=n, replace=False)
-    return points[np.sort(keep)]
+    keep = np.sort(_generator(seed).choice(len(points), size=n, replace=False))
+    # take along the first axis: the same rows as indexing by ``keep``, without the general indexing's set-up (2 against
+    # 10 us for a dense view's 1,000 of 14,000 points; issue 19, stop 48)
+    return points.take(keep, axis=0) if isinstance(points, np.ndarray) else points[keep]
 
 
 #: Per thread: ``{seed: (generator, its state when new)}`` (:func:`_generator`).

@@ -57,7 +57,7 @@ from ..core.agreement import observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
-from ..core.fits import noise_measures
+from ..core.fits import noise_level, noise_measures
 from ..core.front import apex_depth, sphere_front
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, with_own
@@ -778,7 +778,7 @@ def evidence(
     unexplained = 0.0
     if dense and best_rms is not None and s.unexplained_scale > 0:
         if noise is None:
-            _, noise = noise_measures(sample, queries=s.noise_queries)
+            noise = noise_level(sample, queries=s.noise_queries)  # the ratio is not read here
         unexplained = math.sqrt(float(max(0.0, best_rms**2 - (s.misfit_noise * noise) ** 2)))
     # What the outline says the shapes miss (docs/conf45.md): the share of it that is a cut, beyond which the fruit
     # was not seen, times the box's largest side; and how far the silhouette's lateral extent (across the line of
