@@ -2185,27 +2185,31 @@ def noise_measures(points: np.ndarray, step: int, small: int, large: int) -> tup
     twin's :func:`~symfruit.core.points.median`: the middle value, or the mean of the middle two; NaN where one
     is NaN)."""
     cov_small, cov_large = grid_covariances(points, step, small, large)  # stop 43: neighbour_covariances' values
-    m = cov_small.shape[0]
     scratch = np.empty((3, 3))
-    least_small = np.empty(m)
-    least_large = np.empty(m)
-    for q in range(m):
-        least_small[q] = least_eigenvalue(cov_small[q], scratch)
-        least_large[q] = least_eigenvalue(cov_large[q], scratch)
-    res = np.empty(2)
-    for i, values in enumerate((least_small, least_large)):
-        x = np.sort(values)  # NaN last, as numpy sorts
-        h = m // 2
-        if m == 0 or math.isnan(x[m - 1]):
-            res[i] = math.nan
-        elif m % 2:
-            res[i] = x[h]
-        else:
-            res[i] = (x[h - 1] + x[h]) / 2.0
-    # the twin's Python max(x, 0.0) and max(small, 1e-15): the first argument unless the second is greater (NaN kept)
-    small_res = 0.0 if 0.0 > res[0] else math.sqrt(res[0])
-    large_res = 0.0 if 0.0 > res[1] else math.sqrt(res[1])
+    small_res, large_res = _median_root(cov_small, scratch), _median_root(cov_large, scratch)
+    # the twin's Python max(small, 1e-15): the first argument unless the second is greater (NaN kept)
     return large_res / (1e-15 if 1e-15 > small_res else small_res), small_res
+
+
+@_njit
+def _median_root(cov: np.ndarray, scratch: np.ndarray) -> float:
+    """The square root of the median of the least eigenvalues of ``cov`` (m, 3, 3) by :func:`least_eigenvalue`
+    (``scratch`` (3, 3)): the middle value or the mean of the middle two, NaN where one is NaN, 0 below 0 (the
+    twin's Python ``max(x, 0.0)``: the first argument unless the second is greater); :func:`noise_measures`' and
+    :func:`noise_level`'s."""
+    m = cov.shape[0]
+    least = np.empty(m)
+    for q in range(m):
+        least[q] = least_eigenvalue(cov[q], scratch)
+    x = np.sort(least)  # NaN last, as numpy sorts
+    h = m // 2
+    if m == 0 or math.isnan(x[m - 1]):
+        res = math.nan
+    elif m % 2:
+        res = x[h]
+    else:
+        res = (x[h - 1] + x[h]) / 2.0
+    return 0.0 if 0.0 > res else math.sqrt(res)
 
 
 @_njit
@@ -2222,20 +2226,7 @@ def noise_level(points: np.ndarray, step: int, small: int, large: int) -> float:
         if not (math.isfinite(points[i, 0]) and math.isfinite(points[i, 1]) and math.isfinite(points[i, 2])):
             return noise_measures(points, step, small, large)[1]
     cov_small, _ = grid_covariances(points, step, small, small)
-    m = cov_small.shape[0]
-    scratch = np.empty((3, 3))
-    least_small = np.empty(m)
-    for q in range(m):
-        least_small[q] = least_eigenvalue(cov_small[q], scratch)
-    x = np.sort(least_small)  # NaN last, as numpy sorts
-    h = m // 2
-    if m == 0 or math.isnan(x[m - 1]):
-        res = math.nan
-    elif m % 2:
-        res = x[h]
-    else:
-        res = (x[h - 1] + x[h]) / 2.0
-    return 0.0 if 0.0 > res else math.sqrt(res)
+    return _median_root(cov_small, np.empty((3, 3)))
 
 
 @_njit
@@ -6217,6 +6208,16 @@ def cells(region: np.ndarray, centres: np.ndarray, loose: float) -> np.ndarray:
 
 
 @_njit
+def _redness_at(color: np.ndarray, r: int, c: int) -> np.float32:
+    """The float32 redness ``(R - max(G, B)) / max(R, 1)`` of pixel ``(r, c)`` of ``color`` (h, w, >= 3) uint8, as
+    :func:`symfruit.segment.colour.redness` has it (:func:`red_median` and :func:`red_ripe`)."""
+    x = np.float32(color[r, c, 0])
+    gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
+    one = np.float32(1.0)
+    return (x - gb) / (x if x > one else one)
+
+
+@_njit
 def red_median(color: np.ndarray, red: np.ndarray) -> float:
     """``median(redness(color[red]))`` of :func:`symfruit.segment.colour._segment_at`'s ripe test: the float32
     redness ``(R - max(G, B)) / max(R, 1)`` of the pixels of ``red`` (h, w) bool in ``color`` (h, w, >= 3) uint8, and
@@ -6231,13 +6232,10 @@ def red_median(color: np.ndarray, red: np.ndarray) -> float:
         return np.nan
     values = np.empty(n, np.float32)
     k = 0
-    one = np.float32(1.0)
     for r in range(h):
         for c in range(w):
             if red[r, c]:
-                x = np.float32(color[r, c, 0])
-                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
-                values[k] = (x - gb) / (x if x > one else one)
+                values[k] = _redness_at(color, r, c)
                 k += 1
     half = n // 2
     select(values, half)  # a quickselect: several times faster than a sort on a fruit's thousands of pixels
@@ -8070,14 +8068,11 @@ def red_ripe(color: np.ndarray, red: np.ndarray, least: np.float32) -> bool:
     h, w = red.shape
     n = 0
     below = 0
-    one = np.float32(1.0)
     for r in range(h):
         for c in range(w):
             if red[r, c]:
-                x = np.float32(color[r, c, 0])
-                gb = np.float32(max(color[r, c, 1], color[r, c, 2]))
                 n += 1
-                below += (x - gb) / (x if x > one else one) < least
+                below += _redness_at(color, r, c) < least
     if n == 0:
         return False  # the median is NaN
     half = n // 2
