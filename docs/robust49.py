@@ -105,7 +105,7 @@ def file_cases() -> None:
     settings = T() / "cases49-good.yaml"
     settings.write_text("evidence:\n  rays: 64\n")
 
-    def each(label: str, suffix: str, argv: Callable[[Path], list[Any]], output: Callable[[], Path | None] = lambda: None,
+    def each(label: str, suffix: str, argv: Callable[[Path], list[Any]], output: Callable[[], Any] = lambda: None,
              expect: dict[str, str] | None = None) -> None:  # fmt: skip
         for kind, make in kinds(suffix).items():
 
@@ -129,13 +129,22 @@ def file_cases() -> None:
     each("detect/config", ".yaml", lambda p: ["detect", F640, "--output", out("d3"), "--config", p])
     each("detect/masks-json", ".json", lambda p: ["detect", F640, "--output", out("d5"), "--masks", p])
     each("segment/input", ".png", lambda p: ["segment", p, "--output", out("s1")])
-    each("segment/camera", ".json",
-         lambda p: ["segment", F640 / "color.png", "--output", out("s4"), "--depth", F640 / "depth.png", "--camera", p])
+    each(
+        "segment/camera",
+        ".json",
+        lambda p: ["segment", F640 / "color.png", "--output", out("s4"), "--depth", F640 / "depth.png", "--camera", p],
+    )
     each("segment/masks", ".json", lambda p: ["segment", F640 / "color.png", "--output", out("s5"), "--masks", p])
-    each("evaluate/truth", ".json",
-         lambda p: ["evaluate", "--protocol", "masks", "--images", F640, "--truth", p, "--output", out("e1")])
-    each("evaluate/config", ".yaml",
-         lambda p: ["evaluate", "--quick", "--config", p, "--output", out("e2"), "--methods", "raw"])
+    each(
+        "evaluate/truth",
+        ".json",
+        lambda p: ["evaluate", "--protocol", "masks", "--images", F640, "--truth", p, "--output", out("e1")],
+    )
+    each(
+        "evaluate/config",
+        ".yaml",
+        lambda p: ["evaluate", "--quick", "--config", p, "--output", out("e2"), "--methods", "raw"],
+    )
 
     # a frame folder whose own files are of these kinds (each file of the frame in turn)
     for file in ("color.png", "depth.png", "camera.json"):
@@ -180,16 +189,28 @@ def image_cases() -> None:
 
         add(f"image/{name}", expect, run, names or file)
 
-    frame_with("depth-palette", "depth.png",
-               lambda p: Image.fromarray((depth // 256).astype(np.uint8)).convert("P").save(p), "error")
+    frame_with(
+        "depth-palette",
+        "depth.png",
+        lambda p: Image.fromarray((depth // 256).astype(np.uint8)).convert("P").save(p),
+        "error",
+    )
     frame_with("depth-1bit", "depth.png", lambda p: Image.fromarray(depth > 0).save(p), "error")
-    frame_with("depth-grey-alpha", "depth.png",
-               lambda p: Image.fromarray(np.dstack([(depth // 256).astype(np.uint8)] * 2), "LA").save(p), "error")
+    frame_with(
+        "depth-grey-alpha",
+        "depth.png",
+        lambda p: Image.fromarray(np.dstack([(depth // 256).astype(np.uint8)] * 2), "LA").save(p),
+        "error",
+    )
     frame_with("depth-width-0", "depth.png", lambda p: p.write_bytes(png_of_size(0, 480)), "error")
     frame_with("colour-width-0", "color.png", lambda p: p.write_bytes(png_of_size(0, 480)), "error")
     frame_with("colour-1x1", "color.png", lambda p: Image.new("RGB", (1, 1)).save(p), "error", names="colour")
-    frame_with("colour-cmyk-jpeg-as-png", "color.png",
-               lambda p: Image.open(F640 / "color.png").convert("CMYK").save(p, "JPEG"), "any")
+    frame_with(
+        "colour-cmyk-jpeg-as-png",
+        "color.png",
+        lambda p: Image.open(F640 / "color.png").convert("CMYK").save(p, "JPEG"),
+        "any",
+    )
     frame_with("colour-16bit-grey", "color.png", lambda p: Image.fromarray(depth).save(p), "any")
 
     def masks_with(name: str, save: Callable[[Path], None], expect: str) -> None:

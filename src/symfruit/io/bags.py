@@ -117,7 +117,7 @@ def bounded_decompress(data: bytes, compression: str, limit: int) -> bytes:
         try:
             from compression import zstd  # type: ignore[import-not-found]  # Python 3.14
         except ImportError:
-            from backports import zstd  # type: ignore[import-not-found,no-redef]
+            from backports import zstd
         make: Any = zstd.ZstdDecompressor
     elif compression == "lz4":
         from lz4.frame import LZ4FrameDecompressor  # type: ignore[import-untyped]
@@ -205,7 +205,7 @@ def _bound_decompression() -> None:
             setattr(table[name], "_symfruit", True)  # noqa: B010
     module = getattr(ros2, "zstd", None)
     if module is not None and not isinstance(module, _BoundedZstd):
-        ros2.zstd = _BoundedZstd(module)
+        setattr(ros2, "zstd", _BoundedZstd(module))  # noqa: B010  # rosbags' module, seen by its reader
 
 
 #: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).
