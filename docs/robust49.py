@@ -3,11 +3,11 @@
 New kinds of file input, given to every command's file inputs (as docs/robust48.py's ``kinds`` are): a FIFO
 (a reader that opens it waits for a writer for ever), a symbolic link to itself (a loop), a dangling link,
 JSON and YAML nested 100,000 deep, numbers of 5,000 digits; then frames whose depth or masks PNG is of an
-unexpected mode (palette, 1-bit, 32-bit integer, grey with alpha, big-endian 16-bit), a PNG header of width 0,
-frame and recording names that are no UTF-8 or hold a newline, a folder of 2,000 empty frame folders, outputs that
-are a FIFO or a link to a file elsewhere, and bags whose compressed chunks expand past their stated size (a
-decompression bomb). A local Dask cluster whose frame kills every worker is tested in
-``tests/season/test_cluster.py`` (a minute per run; not repeated here).
+unexpected mode (palette, 1-bit, grey with alpha, 16-bit grey as colour, CMYK JPEG named .png), a PNG header
+of width 0, frame and recording names that are no UTF-8 or hold a newline, paths of 5,000 characters, a folder
+of 2,000 empty frame folders, outputs that are a FIFO or a link to a file elsewhere, and an MCAP chunk that
+expands past its stated size (a decompression bomb). A local Dask cluster whose frame kills every worker is
+tested in ``tests/season/test_cluster.py`` (a minute a run; not repeated here).
 
 Cases run in this process under an alarm and are judged as docs/robust47.py judges them (its ``judge``, ``cli``
 and helpers are imported; robust48's classifier of Python's words too).
@@ -256,6 +256,27 @@ def name_cases() -> None:
         return cli("detect", rec, "--output", o, "--method", "sphere", output=o)
 
     add("names/2000-empty-frame-folders", "error", empty_frames, "empty-frames")
+
+    long = "x" * 5000
+    for label, argv in [
+        ("detect-input", ["detect", long, "--output", "OUT"]),
+        ("detect-output", ["detect", F640, "--output", f"OUT/{long}"]),
+        ("complete-cloud", ["complete", f"{long}.ply"]),
+        ("complete-output", ["complete", PLY, "--output", f"{long}.ply"]),
+        ("complete-camera", ["complete", PLY, "--camera", f"{long}.json"]),
+        ("segment-input", ["segment", f"{long}.png", "--output", "OUT"]),
+        ("evaluate-frames", ["evaluate", "--frames", long, "--output", "OUT"]),
+        ("settings-fruit", ["settings", "--fruit", long]),
+        ("settings-config", ["settings", "--config", f"{long}.yaml"]),
+        ("detect-masks", ["detect", F640, "--output", "OUT", "--masks", f"{long}.png"]),
+        ("report-run", ["report", long]),
+    ]:
+
+        def too_long(label: str = label, argv: list[Any] = argv) -> Run:
+            o = out(f"long-{label}")
+            return cli(*[str(a).replace("OUT", str(o)) for a in argv])
+
+        add(f"names/5000-characters/{label}", "error", too_long, "characters)")
 
     def output_fifo() -> Run:
         p = fixture("out.fifo")
