@@ -992,8 +992,8 @@ def test_a_failed_frame_named_with_a_line_break_is_one_printed_line(tmp_path, ca
     out = capsys.readouterr().out.splitlines()
     # before: "  failed x", "  failed y: .../x", "  failed y/depth.png: ...": one failure read as three
     assert [line for line in out if line.startswith("  failed")] == [
-        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: not an image of a format Pillow reads (PNG, JPEG, "
-        "TIFF, ...), or its header is damaged"
+        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: cannot read image (not of an image format Pillow "
+        "reads, PNG, JPEG, TIFF, ...; or its header is damaged)"
     ]
 
 

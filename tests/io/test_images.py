@@ -326,9 +326,10 @@ def test_an_image_pillow_does_not_know_is_said_in_our_words(tmp_path):
     )
     with pytest.raises(FileFormatError) as info:
         read_color(path)
-    assert str(info.value) == f"{path}: its PNG header states a size of 0x480 pixels: no image, or a damaged header"
+    assert str(info.value) == (f"{path}: cannot read image (its PNG header states a size of 0x480 pixels: no image, "
+                               "or a damaged header)")  # fmt: skip
     path.write_bytes(b"these are notes\n" * 10)
     with pytest.raises(FileFormatError) as info:
         read_color(path)
-    assert str(info.value) == (f"{path}: not an image of a format Pillow reads (PNG, JPEG, TIFF, ...), or its header "
-                               "is damaged")  # fmt: skip
+    assert str(info.value) == (f"{path}: cannot read image (not of an image format Pillow reads, PNG, JPEG, TIFF, "
+                               "...; or its header is damaged)")  # fmt: skip

@@ -95,7 +95,7 @@ def _open(source: Path | bytes, label: str) -> Any:
         size = f"image of {int(claimed.group(1)):,} pixels" if claimed else "image too large"
         raise FileFormatError(f"{label}: {size}; at most {MAX_IMAGE_PIXELS:,} pixels are read") from None
     except UnidentifiedImageError:
-        raise FileFormatError(f"{label}: {_unidentified(source)}") from None
+        raise FileFormatError(f"{label}: cannot read image ({_unidentified(source)})") from None
     except (OSError, SyntaxError, ValueError) as exc:
         raise FileFormatError(f"{label}: cannot read image ({exc})") from None
     try:
@@ -119,7 +119,7 @@ def _unidentified(source: Path | bytes) -> str:
     if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
         width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
         return f"its PNG header states a size of {width}x{height} pixels: no image, or a damaged header"
-    return "not an image of a format Pillow reads (PNG, JPEG, TIFF, ...), or its header is damaged"
+    return "not of an image format Pillow reads, PNG, JPEG, TIFF, ...; or its header is damaged"
 
 
 def _single(img: Any, label: str, what: str) -> None:
