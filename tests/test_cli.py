@@ -2,6 +2,7 @@
 
 import json
 import os
+import re
 import shutil
 from pathlib import Path
 
@@ -991,6 +992,31 @@ def test_a_failed_frame_named_with_a_line_break_is_one_printed_line(tmp_path, ca
     out = capsys.readouterr().out.splitlines()
     # before: "  failed x", "  failed y: .../x", "  failed y/depth.png: ...": one failure read as three
     assert [line for line in out if line.startswith("  failed")] == [
-        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: cannot read image (cannot identify image file "
-        f"'{rec}/x\\n  failed y/depth.png')"
+        f"  failed x\\n  failed y: {rec}/x\\n  failed y/depth.png: cannot read image (not of an image format Pillow "
+        "reads, PNG, JPEG, TIFF, ...; or its header is damaged)"
     ]
+
+
+def test_a_name_too_long_for_the_system_is_one_short_line_not_a_traceback(tmp_path, capsys):
+    """Stop 49 (robust49): a path of 5,000 characters (or a name part over 255 bytes) was pathlib's OSError
+    `[Errno 36] File name too long` out of `main` for detect, complete, segment, evaluate --frames, settings
+    --fruit and --masks; a refusal naming such a path was a line of 5,000 characters."""
+    long = "x" * 5000
+    frame = small_frame()
+    for argv in (
+        ["detect", long, "--output", tmp_path / "o"],
+        ["detect", frame, "--output", tmp_path / long],
+        ["complete", f"{long}.ply"],
+        ["segment", f"{long}.png", "--output", tmp_path / "o"],
+        ["evaluate", "--frames", long, "--output", tmp_path / "o"],
+        ["complete", EXAMPLES / "strawberry_partial.ply", "--output", f"{long}.ply"],
+        ["complete", EXAMPLES / "strawberry_partial.ply", "--camera", f"{long}.json"],
+        ["settings", "--fruit", long],
+        ["detect", frame, "--output", tmp_path / "o", "--masks", f"{long}.png"],
+    ):
+        assert main([str(a) for a in argv]) == 2, argv
+        err = capsys.readouterr().err.strip().splitlines()
+        assert len(err) == 1 and len(err[0]) < 300 and "Errno" not in err[0], err
+        assert re.search(r"\.\.\.x+(\.[a-z]+)?'? \(5,\d{3} characters\)", err[0]), err
+    assert main(["settings", "--fruit", long]) == 2
+    assert "no fruit profile 'xxxx" in capsys.readouterr().err

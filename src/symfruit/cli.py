@@ -11,6 +11,7 @@ import argparse
 import contextlib
 import json
 import os
+import re
 import sys
 from collections.abc import Iterator, Sequence
 from pathlib import Path
@@ -1043,6 +1044,21 @@ def _show_warnings(own: type[Warning]) -> None:
     warnings.showwarning = show
 
 
+#: Longest word (a path, a name) an error line shows whole; a longer one is shown by its two ends.
+LONGEST_WORD = 120
+
+
+def _short_words(message: str) -> str:
+    """``message`` with each word (a run without spaces: a path) longer than :data:`LONGEST_WORD` shown by its
+    ends and its length: a path of 5,000 characters made an error line of 5,000 (stop 49, robust49)."""
+
+    def short(m: re.Match[str]) -> str:
+        word = m.group(0).rstrip(":;,")
+        return f"{word[:30]}...{word[-15:]} ({len(word):,} characters){m.group(0)[len(word) :]}"
+
+    return re.sub(rf"[^ ]{{{LONGEST_WORD + 1},}}", short, message)
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Entry point of the ``symfruit`` console script; returns the exit status."""
     _printable_names()
@@ -1059,16 +1075,24 @@ def main(argv: Sequence[str] | None = None) -> int:
     except SymfruitError as exc:
         if args.debug:
             raise
-        message = f"symfruit: error: {exc}".replace("\n", " ")
+        message = f"symfruit: error: {_short_words(str(exc))}".replace("\n", " ")
         # Paths that are not valid UTF-8 must not crash the error report itself.
+        print(message.encode("utf-8", "backslashreplace").decode("utf-8"), file=sys.stderr)
+        return 2
+    except OSError as exc:  # a name no file system holds, met by pathlib's exists()/is_file() anywhere
+        import errno
+
+        if exc.errno != errno.ENAMETOOLONG or args.debug:
+            raise
+        name = os.fsdecode(exc.filename) if exc.filename is not None else "a path"
+        message = (f"symfruit: error: {_short_words(name)}: a file name longer than this system takes "
+                   f"({len(name):,} characters; at most 255 bytes a name and 4096 a path)")  # fmt: skip
         print(message.encode("utf-8", "backslashreplace").decode("utf-8"), file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("symfruit: interrupted", file=sys.stderr)
         return 130
     except BrokenPipeError:  # output piped into e.g. `head`: not an error of ours
-        import os
-
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
 

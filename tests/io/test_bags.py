@@ -33,6 +33,7 @@ def write_ros2_bag(
     info_size=(160, 120),
     d=None,
     storage="sqlite3",
+    compression=None,
 ):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
@@ -44,7 +45,12 @@ def write_ros2_bag(
     RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
     from rosbags.rosbag2 import StoragePlugin
 
-    with Writer(path, version=9, storage_plugin=StoragePlugin[storage.upper()]) as writer:
+    writer = Writer(path, version=9, storage_plugin=StoragePlugin[storage.upper()])
+    if compression is not None:  # (mode, format) names, e.g. ("storage", "zstd") as `ros2 bag record` can
+        from rosbags.rosbag2 import CompressionFormat, CompressionMode
+
+        writer.set_compression(CompressionMode[compression[0].upper()], CompressionFormat[compression[1].upper()])
+    with writer:
         c_col = writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
         c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
         c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
@@ -777,3 +783,83 @@ def test_a_fisheye_camera_info_is_warned_about_with_coefficients_all_zero():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         camera_from_info(SimpleNamespace(**info, distortion_model="plumb_bob"), source="ros")  # pinhole: silent
+
+
+def test_a_decompression_bomb_is_stopped_at_its_bound_before_the_rest_is_allocated():
+    """Stop 49 (robust49): rosbags decompressed an MCAP chunk (zstd, lz4) or a ROS 1 chunk (bz2, lz4) whole and
+    compared its size afterwards: 1 kB of zstd held 256 MB of zeros, all of it allocated."""
+    import bz2
+    import tracemalloc
+
+    import lz4.frame
+
+    from symfruit.io.bags import ChunkExpands, bounded_decompress
+
+    try:
+        from compression import zstd
+    except ImportError:
+        from backports import zstd
+    block = bytes(1 << 20)
+    packer = zstd.ZstdCompressor()
+    bomb = b"".join(packer.compress(block) for _ in range(256)) + packer.flush()  # 256 MB in a few kB
+    assert len(bomb) < 20_000
+    tracemalloc.start()
+    try:
+        with pytest.raises(ChunkExpands, match=r"a zstd chunk of [\d,]+ compressed bytes expands past"):
+            bounded_decompress(bomb, "zstd", 1 << 20)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 8 << 20
+    data = bytes(range(256)) * 40
+    for name, pack in [("zstd", zstd.compress), ("lz4", lz4.frame.compress), ("bz2", bz2.compress)]:
+        packed = pack(data)
+        assert bounded_decompress(packed, name, len(data)) == data  # exactly its size: read
+        with pytest.raises(ChunkExpands):
+            bounded_decompress(packed, name, len(data) - 1)
+        with pytest.raises(FileFormatError, match="is cut short"):
+            bounded_decompress(packed[: len(packed) // 2], name, len(data))
+    two = zstd.compress(b"ab") + zstd.compress(b"cd")  # concatenated frames, as zstd.decompress reads them
+    assert bounded_decompress(two, "zstd", 4) == b"abcd"
+    small = lz4.frame.compress(bytes(2 << 20))
+    tracemalloc.start()
+    try:  # the bound is no allocation: the LZ4 decompressor allocates what it is allowed up front
+        assert len(bounded_decompress(small, "lz4", 1 << 30)) == 2 << 20
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak < 32 << 20
+
+
+def test_an_mcap_chunk_that_expands_past_its_stated_size_is_refused_naming_the_chunk(tmp_path):
+    """Stop 49 (robust49): a zstd chunk whose stated uncompressed size (and its chunk index's) is less than its
+    data holds was decompressed whole by rosbags, then refused as "Chunk size mismatch: expected 1,234 bytes,
+    got ..."; now decompression stops at the stated size, and the file and chunk are named."""
+    pytest.importorskip("rosbags")
+    import shutil
+
+    color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+    good = write_ros2_bag(tmp_path / "good", color, (depth * 1000).astype(np.uint16), frames=2, storage="mcap",
+                          compression=("storage", "zstd"))  # fmt: skip
+    assert len(open_source(good)) == 2
+    mcap = next(good.glob("*.mcap"))
+    data = mcap.read_bytes()
+    records = _mcap_records(data)
+    chunk = next(r for r in records if r[1] == 0x06)
+    assert data[chunk[0] + 9 + 32 : chunk[0] + 9 + 36] == b"zstd"
+    unpacked = int.from_bytes(data[chunk[0] + 9 + 16 : chunk[0] + 9 + 24], "little")
+    packed = int.from_bytes(data[chunk[0] + 9 + 36 : chunk[0] + 9 + 44], "little")
+    stated = unpacked // 4
+    raw = bytearray(data)
+    raw[chunk[0] + 9 + 16 : chunk[0] + 9 + 24] = stated.to_bytes(8, "little")
+    for pos, op, length in records:
+        if op == 0x08:  # the chunk index states it too (its last 8 bytes)
+            raw[pos + 9 + length - 8 : pos + 9 + length] = stated.to_bytes(8, "little")
+    bomb = tmp_path / "bomb"
+    shutil.copytree(good, bomb)
+    (bomb / mcap.name).write_bytes(bytes(raw))
+    with pytest.raises(FileFormatError) as info:
+        open_source(bomb)
+    assert str(info.value) == (f"{bomb / mcap.name}: the zstd chunk at byte {chunk[0]:,} ({packed:,} bytes "
+                               f"compressed) expands past its stated {stated:,} bytes uncompressed (decompression "
+                               "stopped there): the bag is damaged")  # fmt: skip

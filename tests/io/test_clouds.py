@@ -463,3 +463,16 @@ def test_a_text_cloud_of_bytes_that_are_no_text_is_said_in_our_words(tmp_path):
     with pytest.raises(FileFormatError) as info:
         read_cloud(path)
     assert str(info.value) == f"{path}: cannot read as XYZ (not UTF-8 text: invalid start byte at byte 0)"
+
+
+def test_a_cloud_that_is_a_pipe_is_not_called_a_folder(tmp_path):
+    """Stop 49 (robust49): a FIFO named cloud.ply was "not a regular file (a folder or a device)"."""
+    fifo = tmp_path / "cloud.ply"
+    os.mkfifo(fifo)
+    with pytest.raises(FileFormatError) as info:
+        read_cloud(fifo)  # refused before it is opened: a reader would wait for a writer
+    assert str(info.value) == f"{fifo}: not a regular file (a pipe, socket or device)"
+    folder = tmp_path / "folder.ply"
+    folder.mkdir()
+    with pytest.raises(FileFormatError, match=r"folder\.ply: not a regular file \(a folder\)"):
+        read_cloud(folder)

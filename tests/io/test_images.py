@@ -306,3 +306,30 @@ def test_a_float_depth_tiff_says_where_float_metres_are_read(tmp_path):
     assert str(info.value) == (f"{path}: depth TIFF holds 32-bit floats; a depth image must hold 16-bit units "
                                "(depth in float metres is read from a .npy file: numpy.save('depth.npy', "
                                "metres))")  # fmt: skip
+
+
+def test_an_image_pillow_does_not_know_is_said_in_our_words(tmp_path):
+    """Stop 49 (robust49): a PNG whose header states a width of 0, or bytes of no image format, were "cannot read
+    image (cannot identify image file 'PATH')": Pillow's words, the path twice and not why."""
+    import struct
+    import zlib
+
+    from symfruit.io.images import read_color
+
+    def chunk(kind, data):
+        return struct.pack(">I", len(data)) + kind + data + struct.pack(">I", zlib.crc32(kind + data))
+
+    path = tmp_path / "color.png"
+    ihdr = struct.pack(">IIBBBBB", 0, 480, 8, 0, 0, 0, 0)
+    path.write_bytes(
+        b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", ihdr) + chunk(b"IDAT", zlib.compress(b"\0")) + chunk(b"IEND", b"")
+    )
+    with pytest.raises(FileFormatError) as info:
+        read_color(path)
+    assert str(info.value) == (f"{path}: cannot read image (its PNG header states a size of 0x480 pixels: no image, "
+                               "or a damaged header)")  # fmt: skip
+    path.write_bytes(b"these are notes\n" * 10)
+    with pytest.raises(FileFormatError) as info:
+        read_color(path)
+    assert str(info.value) == (f"{path}: cannot read image (not of an image format Pillow reads, PNG, JPEG, TIFF, "
+                               "...; or its header is damaged)")  # fmt: skip

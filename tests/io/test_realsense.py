@@ -527,3 +527,19 @@ def test_a_chunk_that_cannot_be_decompressed_is_said_in_our_words(tmp_path):
         open_source(path)
     assert str(info.value) == (f"{path}: cannot index bag (a compressed chunk of the bag cannot be decompressed: the "
                                "bag is damaged)")  # fmt: skip
+
+
+def test_a_chunk_that_expands_past_the_bound_is_refused_naming_the_bag(tmp_path, monkeypatch):
+    """Stop 49 (robust49): a ROS 1 chunk's LZ4 / bz2 data was decompressed whole by rosbags (a ROS 1 chunk states
+    no size rosbags reads): now at most MAX_BAG_CHUNK_BYTES come out, a chunk of more is refused. The bound is
+    lowered here to stand for a bomb."""
+    from symfruit.io import bags
+
+    path = rewrite(tmp_path / "lz4.bag")
+    assert len(open_source(path)) == 2
+    monkeypatch.setattr(bags, "MAX_BAG_CHUNK_BYTES", 1000)
+    with pytest.raises(FileFormatError) as info:
+        open_source(path)
+    assert re.fullmatch(rf"{re.escape(str(path))}: an LZ4 chunk of [\d,]+ compressed bytes expands past 1,000 "
+                        r"bytes, the most a chunk is read to \(decompression stopped there\): the bag is damaged",
+                        str(info.value))  # fmt: skip

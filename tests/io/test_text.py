@@ -221,3 +221,23 @@ def test_a_folder_named_as_a_file_says_an_before_a_vowel(tmp_path):
     assert str(info.value) == f"{tmp_path}: is a folder, not an intrinsics file"
     with pytest.raises(FileFormatError, match="is a folder, not a settings file"):
         read_limited(tmp_path, what="settings file", max_bytes=10)
+
+
+def test_a_number_of_thousands_of_digits_and_deep_nesting_are_said_in_our_words(tmp_path):
+    """Stop 49 (robust49): a camera.json or settings file holding a number of 5,001 digits quoted Python ("Exceeds
+    the limit (4300 digits) for integer string conversion: ...; use sys.set_int_max_str_digits() to increase the
+    limit"); an intrinsics file nested 100,000 deep was "nested too deeply to be a intrinsics file"."""
+    for suffix, kind in ((".json", "JSON"), (".yaml", "YAML")):
+        path = tmp_path / f"camera{suffix}"
+        path.write_text('{"fx": 1' + "0" * 5000 + "}")
+        with pytest.raises(FileFormatError) as info:
+            read_structured(path, what="intrinsics file", max_bytes=1 << 20)
+        assert str(info.value) == f"{path}: not valid {kind}: a number of 5,001 digits (at most 4,300 are read)"
+        path.write_text("[" * 100_000 + "]" * 100_000)
+        with pytest.raises(FileFormatError) as info:
+            read_structured(path, what="intrinsics file", max_bytes=1 << 20)
+        assert str(info.value) == f"{path}: intrinsics file is nested too deeply to be an intrinsics file"
+    path = tmp_path / "bad.json"
+    path.write_text('{"fx": 1,}')
+    with pytest.raises(FileFormatError, match=r"not valid JSON: Expecting property name enclosed in double quotes"):
+        read_structured(path, what="intrinsics file", max_bytes=1 << 20)  # other ValueErrors: the parser's reason

@@ -330,3 +330,51 @@ def test_a_tls_scheduler_runs_the_recording_as_a_serial_run_does(recording, tmp_
     assert _fruits(tmp_path / "out") == _fruits(tmp_path / "serial") != {}
     with pytest.raises(InputError, match=r"tls:// needs Dask's TLS settings"):
         run_distributed(rec, tmp_path / "none", scheduler=address, method="raw", progress=False)
+
+
+#: A worker preload (every worker, restarted ones too): frame FRAME makes its worker exit at once, every time (as a
+#: crash in compiled code or the OOM killer would).
+KILL_ON_FRAME = """
+import os
+import symfruit.season.cluster as cluster
+
+real = getattr(cluster, "_real_detect", cluster.detect)
+cluster._real_detect = real
+
+
+def detect(frame, **kwargs):
+    if frame.name == FRAME:
+        os._exit(1)
+    return real(frame, **kwargs)
+
+
+cluster.detect = detect
+"""
+
+
+def test_a_frame_that_kills_every_worker_is_lost_alone_and_the_batch_goes_on(recording, tmp_path, capsys):
+    """Stop 49 (robust49): `detect --workers 2` with a frame that killed every worker it landed on hung for ever:
+    Dask's local cluster closed a nanny whose worker was not back within 15 s (lost-worker-timeout), until no worker
+    was left; and every frame of the frame's task (and of the tasks queued on the same worker) was lost with it."""
+    import dask
+
+    rec = tmp_path / "rec"
+    for name in ("scene_00000", "scene_00001", "scene_00002"):
+        shutil.copytree(recording / name, rec / name)
+    preload = tmp_path / "kill_on_frame.py"
+    preload.write_text(f"FRAME = 'scene_00001'\n{KILL_ON_FRAME}")
+    out = tmp_path / "out"
+    args = ["detect", str(rec), "--output", str(out), "--method", "sphere", "--workers", "1", "--chunk", "2"]
+    with dask.config.set({"distributed.worker.preload": [str(preload)], "distributed.scheduler.allowed-failures": 1}):
+        assert main(args) == 1
+    said = capsys.readouterr().out
+    assert "frames: 2 done, 0 skipped (resume), 1 failed" in said
+    reason = "the workers running this frame died 2 times, the last 2 running it alone (killed or out of memory)"
+    assert f"failed scene_00001: {reason}" in said
+    errors = json.loads((out / "errors.json").read_text())
+    assert errors == {"failed": [{"frame": "scene_00001", "reason": reason}], "stopped": ""}
+    assert sorted(p.parent.name for p in out.glob("*/detections.json")) == ["scene_00000", "scene_00002"]
+    assert not (out / "scene_00001").exists() or not list((out / "scene_00001").iterdir())
+    assert not list(out.rglob("*.tmp"))
+    frames = pq.read_table(out / "frames.parquet").column("frame").to_pylist()
+    assert frames == ["scene_00000", "scene_00002"]

@@ -85,7 +85,127 @@ def _require_rosbags() -> Any:
         raise SymfruitError(
             "reading bags needs the rosbags package: pip install 'symfruit[bag]' (or pip install rosbags)"
         ) from None
+    _bound_decompression()
     return AnyReader
+
+
+class ChunkExpands(FileFormatError):
+    """A bag's compressed chunk (or message) that decompresses to more than it states (an MCAP chunk's
+    ``uncompressed_size``) or, where nothing is stated (a ROS 1 chunk, a ROS 2 message), more than
+    :data:`~symfruit.core.limits.MAX_BAG_CHUNK_BYTES`: decompression stops at the bound, before the rest is
+    allocated. Stop 49 (robust49)."""
+
+    def __init__(self, compression: str, packed: int, stated: int | None, limit: int) -> None:
+        self.compression, self.packed, self.stated = compression, packed, stated
+        bound = (f"its stated {stated:,} bytes uncompressed" if stated is not None else
+                 f"{limit:,} bytes, the most a chunk is read to")  # fmt: skip
+        super().__init__(f"{_named(compression)} chunk of {packed:,} compressed bytes expands past {bound} "
+                         "(decompression stopped there): the bag is damaged")  # fmt: skip
+
+
+def _named(compression: str) -> str:
+    return "an LZ4" if compression == "lz4" else f"a {compression}"
+
+
+def bounded_decompress(data: bytes, compression: str, limit: int) -> bytes:
+    """``data`` decompressed (``zstd``, ``lz4`` frame or ``bz2``) to at most ``limit`` bytes: a stream of more
+    raises :class:`ChunkExpands` once ``limit + 1`` bytes are out, before the rest is decompressed (a
+    decompression bomb: a few kB of zstd expand to gigabytes). zstd and bz2 read every concatenated frame
+    (stream), as their ``decompress`` does; an lz4 frame is one frame, as ``lz4.frame.decompress``. A stream
+    cut short is refused as the libraries refuse it. Stop 49 (robust49)."""
+    if compression == "zstd":
+        try:
+            from compression import zstd  # type: ignore[import-not-found]  # Python 3.14
+        except ImportError:
+            from backports import zstd
+        make: Any = zstd.ZstdDecompressor
+    elif compression == "lz4":
+        from lz4.frame import LZ4FrameDecompressor  # type: ignore[import-untyped]
+
+        make = LZ4FrameDecompressor
+    elif compression == "bz2":
+        import bz2
+
+        make = bz2.BZ2Decompressor
+    else:  # pragma: no cover - the callers pass these three
+        raise ValueError(f"unknown compression {compression!r}")
+    rest, out, n = bytes(data), [], 0
+    while rest:
+        unpacker = make()
+        piece = unpacker.decompress(rest, max_length=min(limit + 1 - n, _STEP_BYTES))
+        while True:
+            n += len(piece)
+            if n > limit:
+                raise ChunkExpands(compression, len(data), None, limit)
+            out.append(piece)
+            if unpacker.eof:
+                break
+            if unpacker.needs_input:
+                raise FileFormatError(f"{_named(compression)} chunk of {len(data):,} compressed bytes is cut "
+                                      "short (cannot decompress it): the bag is damaged")  # fmt: skip
+            piece = unpacker.decompress(b"", max_length=min(limit + 1 - n, _STEP_BYTES))
+        rest = b"" if compression == "lz4" else unpacker.unused_data
+    return out[0] if len(out) == 1 else b"".join(out)
+
+
+#: Most bytes one decompression step gives (the LZ4 decompressor allocates its ``max_length`` up front).
+_STEP_BYTES = 8 << 20
+
+
+def _stated(compression: str) -> Any:
+    def unpack(data: bytes, size: int) -> bytes:
+        limit = min(int(size), MAX_BAG_CHUNK_BYTES)
+        try:
+            return bounded_decompress(data, compression, limit)
+        except ChunkExpands:
+            raise ChunkExpands(compression, len(data), int(size) if size == limit else None, limit) from None
+
+    return unpack
+
+
+def _capped(compression: str) -> Any:
+    return lambda data: bounded_decompress(data, compression, MAX_BAG_CHUNK_BYTES)
+
+
+class _BoundedZstd:
+    """rosbags' ``zstd`` module as its ROS 2 reader sees it: ``decompress`` (a message of a bag compressed per
+    message) bounded, the rest the module's."""
+
+    def __init__(self, module: Any) -> None:
+        self._module = module
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._module, name)
+
+    def decompress(self, data: bytes) -> bytes:
+        return bounded_decompress(data, "zstd", MAX_BAG_CHUNK_BYTES)
+
+
+def _bound_decompression() -> None:
+    """Put :func:`bounded_decompress` in place of rosbags' whole-buffer decompression (once): an MCAP chunk's
+    zstd / lz4 data to its stated ``uncompressed_size`` (rosbags compared the sizes after decompressing it all),
+    a ROS 1 chunk's bz2 / lz4 and a per-message zstd ROS 2 message to
+    :data:`~symfruit.core.limits.MAX_BAG_CHUNK_BYTES` (they state no size rosbags reads). Where rosbags has not
+    the tables (another version), it is left as it is. Stop 49 (robust49)."""
+    try:
+        from rosbags.rosbag1 import reader as ros1
+        from rosbags.rosbag2 import reader as ros2
+        from rosbags.rosbag2 import storage_mcap
+    except ImportError:  # pragma: no cover - another rosbags layout
+        return
+    table = getattr(storage_mcap, "DECOMPRESSORS", None)
+    if isinstance(table, dict) and not getattr(table.get("zstd"), "_symfruit", False):
+        for name in ("zstd", "lz4"):
+            table[name] = _stated(name)
+            setattr(table[name], "_symfruit", True)  # noqa: B010
+    table = getattr(ros1, "decompressors", None)
+    if isinstance(table, dict) and not getattr(table.get("bz2"), "_symfruit", False):
+        for name in ("bz2", "lz4"):
+            table[name] = _capped(name)
+            setattr(table[name], "_symfruit", True)  # noqa: B010
+    module = getattr(ros2, "zstd", None)
+    if module is not None and not isinstance(module, _BoundedZstd):
+        setattr(ros2, "zstd", _BoundedZstd(module))  # noqa: B010  # rosbags' module, seen by its reader
 
 
 #: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).
@@ -99,6 +219,8 @@ def damage_reason(exc: BaseException) -> str | None:
     rosbags reads a record's length from the file and asks for that many bytes) or a file ending inside a record
     (``ord() expected a character, but string of length 0 found``), or bytes that are no UTF-8 where a bag holds text
     (``'utf-8' codec can't decode byte 0xff in position 0``). Stop 47 (robust47)."""
+    if isinstance(exc, SymfruitError):  # ours, from inside rosbags (a chunk that expands past its size)
+        return str(exc)
     text = str(exc)
     if "decompress" in text.lower() or text.startswith("Invalid data stream"):  # LZ4, zstd; bz2
         return "a compressed chunk of the bag cannot be decompressed: the bag is damaged"
@@ -430,7 +552,7 @@ _MCAP_MAGIC = b"\x89MCAP0\r\n"
 _MCAP_INDEX_BYTES = 1 << 20
 
 
-def check_mcap(path: Path) -> None:
+def check_mcap(path: Path) -> dict[int, tuple[int, int, int]]:
     """Refuse an MCAP file (a ROS 2 bag's) whose records claim sizes it cannot hold, before rosbags reads it:
     rosbags reads each record's length from the file and asks for that many bytes (the header record's, a
     chunk's, a chunk index's compressed size), and decompresses a chunk whole. Walks the top-level records
@@ -438,12 +560,15 @@ def check_mcap(path: Path) -> None:
     a chunk's uncompressed size at most :data:`~symfruit.core.limits.MAX_BAG_CHUNK_BYTES`, its compressed
     data within its record; the footer's summary offset and every chunk index's chunk offset a record's start
     (a chunk's), its sizes the chunk's. Of a file without the end magic (cut short) only the header record is
-    checked (rosbags reads it, then refuses the file as cut short). Stop 48 (robust48)."""
+    checked (rosbags reads it, then refuses the file as cut short). Stop 48 (robust48).
+
+    Returns the chunks found (start -> uncompressed size, compressed size, record length): a chunk that
+    expands past its size when rosbags decompresses it is named by them (:class:`ChunkExpands`)."""
     try:
         with open(path, "rb") as f:
             size = f.seek(0, 2)
             if size < 16:
-                return  # rosbags: empty, or its magic alone ("the file ends inside a record")
+                return {}  # rosbags: empty, or its magic alone ("the file ends inside a record")
             f.seek(size - 8)
             whole = f.read(8) == _MCAP_MAGIC
             end = size - 8 if whole else size
@@ -463,7 +588,7 @@ def check_mcap(path: Path) -> None:
                     raise FileFormatError(f"the record at byte {pos:,} claims {length:,} bytes, more than the "
                                           f"{left:,} left in the file: the MCAP file is damaged")  # fmt: skip
                 if not whole:  # rosbags reads the header record, then refuses the missing end magic itself
-                    return
+                    return {}
                 starts[pos] = op
                 if op == 0x06:  # chunk: start, end, uncompressed size (u64 each), crc (u32), compression, records
                     body = f.read(min(length, 32))
@@ -516,6 +641,7 @@ def check_mcap(path: Path) -> None:
             raise FileFormatError(f"the chunk index at byte {at:,} points at no chunk of its sizes (offset "
                                   f"{shown(offset)}, {shown(packed)} bytes compressed, {shown(unpacked)} "
                                   "uncompressed): the MCAP file is damaged")  # fmt: skip
+    return chunks
 
 
 def _namespace(topic: str) -> str:
@@ -569,26 +695,43 @@ class BagSource:
         self.path = Path(path)
         self.max_skew = max_skew
         reader_cls = _require_rosbags()
+        self._chunks: dict[Path, dict[int, tuple[int, int, int]]] = {}  # each MCAP file's chunks (ChunkExpands)
         if self.path.is_dir():
             _check_metadata(self.path / "metadata.yaml")
             for mcap in sorted(self.path.glob("*.mcap")):
                 try:
-                    check_mcap(mcap)
+                    self._chunks[mcap] = check_mcap(mcap)
                 except FileFormatError as exc:
                     raise FileFormatError(f"{mcap}: cannot open bag ({exc})") from None
         try:
             self._reader = reader_cls([self.path])
             self._reader.open()
+        except ChunkExpands as exc:  # an MCAP without a summary: rosbags decompresses every chunk to index it
+            raise FileFormatError(self._expands(exc)) from None
         except Exception as exc:  # rosbags raises its own ReaderError / AnyReaderError types
             raise FileFormatError(f"{self.path}: cannot open bag ({reader_reason(exc)})") from None
         try:
             self._index()
+        except ChunkExpands as exc:
+            self.close()
+            raise FileFormatError(self._expands(exc)) from None
         except SymfruitError as exc:
             self.close()
             raise FileFormatError(f"{self.path}: {exc}") from None
         except Exception as exc:  # a corrupt bag fails inside rosbags while indexing
             self.close()
             raise FileFormatError(f"{self.path}: cannot index bag ({index_reason(exc)})") from None
+
+    def _expands(self, exc: ChunkExpands) -> str:
+        """``exc`` naming the MCAP file and the chunk (its byte) whose sizes it has, where one chunk has them."""
+        at = [(mcap, pos) for mcap, chunks in self._chunks.items() for pos, (unpacked, packed, _) in chunks.items()
+              if packed == exc.packed and unpacked == exc.stated]  # fmt: skip
+        if len(at) != 1:
+            return f"{self.path}: {exc}"
+        mcap, pos = at[0]
+        return (f"{mcap}: the {exc.compression} chunk at byte {pos:,} ({exc.packed:,} bytes compressed) expands "
+                f"past its stated {exc.stated:,} bytes uncompressed (decompression stopped there): the bag is "
+                "damaged")  # fmt: skip
 
     def _index(self) -> None:
         conns = self._reader.connections
@@ -682,6 +825,8 @@ class BagSource:
             if any(sizeless):  # a camera info of width or height 0 is for the images' size (the live node's rule)
                 camera = replace(camera, width=depth.shape[1] if sizeless[0] else camera.width,
                                  height=depth.shape[0] if sizeless[1] else camera.height)  # fmt: skip
+        except ChunkExpands as exc:
+            raise FileFormatError(self._expands(exc)) from None
         except FileFormatError as exc:
             message = str(exc)
             named = message if message.startswith(str(self.path)) else f"{self.path}: {message}"

@@ -48,7 +48,9 @@ def read_cloud(path: str | Path) -> np.ndarray:
             raise FileFormatError(f"{path}: a link that leads to no file (its target is missing, or the links loop)")
         raise FileFormatError(f"{path}: no such file")
     if not path.is_file():
-        raise FileFormatError(f"{path}: not a regular file (a folder or a device)")
+        raise FileFormatError(
+            f"{path}: not a regular file ({'a folder' if path.is_dir() else 'a pipe, socket or device'})"
+        )
     try:
         with np.errstate(invalid="ignore", over="ignore"):  # a signalling NaN or a huge float64 stored as float32:
             points = reader(path)  # non-finite points, dropped with the rest (never a warning from the cast)

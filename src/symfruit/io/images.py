@@ -30,6 +30,7 @@ errors, including its decompression-bomb error, never escape.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import re
 import warnings
@@ -93,7 +94,9 @@ def _open(source: Path | bytes, label: str) -> Any:
         claimed = re.search(r"\((\d+) pixels\)", str(exc))
         size = f"image of {int(claimed.group(1)):,} pixels" if claimed else "image too large"
         raise FileFormatError(f"{label}: {size}; at most {MAX_IMAGE_PIXELS:,} pixels are read") from None
-    except (UnidentifiedImageError, OSError, SyntaxError, ValueError) as exc:
+    except UnidentifiedImageError:
+        raise FileFormatError(f"{label}: cannot read image ({_unidentified(source)})") from None
+    except (OSError, SyntaxError, ValueError) as exc:
         raise FileFormatError(f"{label}: cannot read image ({exc})") from None
     try:
         check_image_size(
@@ -103,6 +106,20 @@ def _open(source: Path | bytes, label: str) -> Any:
         img.close()
         raise
     return img
+
+
+def _unidentified(source: Path | bytes) -> str:
+    """Why Pillow did not know an image, in our words (its own, ``cannot identify image file 'PATH'``, says the
+    path again and not why): a PNG whose header states a side of 0 (Pillow takes no such PNG), else a file of
+    no image format Pillow reads, or a damaged header. Stop 49 (robust49)."""
+    head = source[:24] if isinstance(source, bytes) else b""
+    if not isinstance(source, bytes):
+        with contextlib.suppress(OSError), open(source, "rb") as f:
+            head = f.read(24)
+    if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
+        width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+        return f"its PNG header states a size of {width}x{height} pixels: no image, or a damaged header"
+    return "not of an image format Pillow reads, PNG, JPEG, TIFF, ...; or its header is damaged"
 
 
 def _single(img: Any, label: str, what: str) -> None:

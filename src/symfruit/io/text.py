@@ -19,6 +19,7 @@ import json
 import os
 import re
 import stat
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -90,7 +91,7 @@ def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitE
     except FileNotFoundError:
         raise error(f"{path}: no such {what}") from None
     except IsADirectoryError:
-        raise error(f"{path}: is a folder, not {'an' if what[:1] in 'aeiou' else 'a'} {what}") from None
+        raise error(f"{path}: is a folder, not {_a(what)}") from None
     except OSError as exc:
         raise error(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:
@@ -199,9 +200,25 @@ def read_structured(
         finally:
             loader.dispose()
     except RecursionError:
-        raise error(f"{path}: {what} is nested too deeply to be a {what}") from None
+        raise error(f"{path}: {what} is nested too deeply to be {_a(what)}") from None
+    except ValueError as exc:
+        digits = _DIGITS.search(str(exc))
+        if digits is None:  # json.JSONDecodeError is a ValueError: its position, below
+            raise error(f"{path}: not valid {kind}: {_parse_reason(exc)}") from None
+        raise error(f"{path}: not valid {kind}: a number of {int(digits.group(1)):,} digits (at most "
+                    f"{sys.get_int_max_str_digits():,} are read)") from None  # fmt: skip
     except Exception as exc:  # json.JSONDecodeError / yaml.YAMLError carry the position
         raise error(f"{path}: not valid {kind}: {_parse_reason(exc)}") from None
+
+
+#: Python's refusal of a whole number of more digits than ``sys.get_int_max_str_digits()`` (4,300): its words
+#: tell the user to call ``sys.set_int_max_str_digits()`` (stop 49, robust49).
+_DIGITS = re.compile(r"Exceeds the limit \(\d+ digits\) for integer string conversion: value has (\d+) digits")
+
+
+def _a(what: str) -> str:
+    """``what`` with its article: an intrinsics file, a settings file."""
+    return f"{'an' if what[:1] in 'aeiou' else 'a'} {what}"
 
 
 #: Longest parser reason quoted in a refusal.

@@ -35,7 +35,7 @@ def profile_data(name_or_path: str | Path) -> tuple[str, Any]:
     if path.suffix.lower() in (".yaml", ".yml", ".json"):
         return str(path), read_settings_file(path)
     resource = resources.files(__package__) / f"{name_or_path}.yaml"
-    if not resource.is_file():
+    if len(str(name_or_path)) > 200 or not resource.is_file():  # a longer name no file system holds (OSError)
         raise ConfigError(
             f"no fruit profile {str(name_or_path)!r}; shipped: {', '.join(available_profiles())}, "
             "or give a profile file (.yaml)"

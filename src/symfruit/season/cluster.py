@@ -76,6 +76,12 @@ LOCAL_MEMORY_LIMIT = "2GiB"
 #: before it levels off); nobody looks at it without the dashboard. For workers you start yourself:
 #: ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
 NO_PROFILER = {"distributed.worker.profile.enabled": False}
+#: A local cluster keeps its workers however long one takes to come back: Dask's cluster closes a worker's nanny
+#: (and runs on with one worker fewer) when no worker of its name is back within ``lost-worker-timeout`` (15 s) of
+#: its death. A worker that dies at once again, or is slow to start (importing symfruit and numba on a loaded
+#: machine: 10-20 s), is not back then: a frame that killed every worker it landed on left a cluster of no worker
+#: and the run waiting for one for ever (stop 49, robust49). The nanny restarts each worker itself.
+KEEP_LOST_WORKERS = {"distributed.deploy.lost-worker-timeout": "3650 days"}
 #: How long to try to reach a scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
@@ -309,7 +315,13 @@ def _client(scheduler: str | None, workers: int | None) -> Iterator[Any]:
         with client:
             yield client
         return
-    with local_cluster(int(workers or 1)) as cluster, distributed.Client(cluster) as client:
+    import dask
+
+    with (
+        dask.config.set(KEEP_LOST_WORKERS),
+        local_cluster(int(workers or 1)) as cluster,
+        distributed.Client(cluster) as client,
+    ):
         yield client
 
 
@@ -521,22 +533,48 @@ def _run(
                 pending.add(future)
                 state["sent"] = indices[-1] + 1
 
+        # frames of a task whose workers died (KilledWorker): each is run again alone once nothing else of the run
+        # is in flight, so that only a frame that kills its worker by itself is lost, not its task's other frames
+        # nor the tasks that were queued on the same worker (the scheduler counts a death against all of them)
+        suspects: list[int] = []
+        alone: set[str] = set()
         send()
-        for future in pending:
-            part = part_of.pop(future.key)
-            outcomes, whole = _outcomes(future, part, distributed)
-            future.release()
-            for o in outcomes:
-                i = part.base + o.index
-                results[i] = o
-                if whole:  # the task died as a whole: what its attempts left is no result
-                    _clear_frame(target[i], out)
-                if o.stop and not state["stopped"]:
-                    state["stopped"] = True
-                    report.stopped = o.stop
-            bar.update(len(part.indices))
-            flush()
-            send()
+        while True:
+            for future in pending:
+                part = part_of.pop(future.key)
+                outcomes, whole = _outcomes(future, part, distributed)
+                killed = whole and future.key not in alone and outcomes[0].reason.startswith(_DIED)
+                future.release()
+                for o in outcomes:
+                    i = part.base + o.index
+                    if whole:  # the task died as a whole: what its attempts left is no result
+                        _clear_frame(target[i], out)
+                    if killed:
+                        suspects.append(i)
+                        continue
+                    results[i] = o
+                    if o.stop and not state["stopped"]:
+                        state["stopped"] = True
+                        report.stopped = o.stop
+                if not killed:
+                    bar.update(len(part.indices))
+                flush()
+                if not suspects:
+                    send()
+            if not suspects:
+                break
+            i = suspects.pop(0)
+            j = frames.owner[i]
+            base = frames.bases[j]
+            direct = frames.direct[i]
+            part = Part((i - base,), (frames.raw[i],), (str(target[i].absolute()),),
+                        None if direct is None else (str(direct),), base)  # fmt: skip
+            future = client.submit(
+                detect_part, frames.jobs[j], part, key=f"symfruit-detect-{frames.jobs[j].run}-{i}-alone"
+            )
+            alone.add(future.key)
+            part_of[future.key] = part
+            pending.add(future)
     state["stopped"] = True
     flush()
 
@@ -582,13 +620,17 @@ def _preflight(client: Any, jobs: Sequence[Job]) -> None:
             )
 
 
+#: How the reason of a frame whose workers died begins.
+_DIED = "the workers running this frame died"
+
+
 def _outcomes(future: Any, part: Part, distributed: Any) -> tuple[list[Outcome], bool]:
     """The outcomes of a finished task, and whether it failed as a whole (each of its frames failed then)."""
     try:
         return list(future.result()), False
     except distributed.scheduler.KilledWorker as exc:
         times = getattr(exc, "allowed_failures", 3) + 1
-        reason = f"the workers running this frame died {times} times (killed or out of memory)"
+        reason = f"{_DIED} {times} times, the last {times} running it alone (killed or out of memory)"
     except Exception as exc:  # the task as a whole: e.g. a worker that cannot unpickle it
         reason = f"the task failed on its worker ({type(exc).__name__}: {exc})"
     return [Outcome(i, n, "failed", reason=reason) for i, n in zip(part.indices, part.names, strict=True)], True

@@ -21,6 +21,7 @@ A learned model fails here, once, when its extra is missing or the model cannot 
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -114,7 +115,7 @@ def mask_source(spec: str | Path, *, settings: Settings | None = None,
         from ..io.masks import read_masks
 
         path = Path(text)  # a file or folder read for every frame: checked once, here, not failed by each frame
-        if not path.exists():
+        if not os.path.exists(path):  # False for a name too long for the system too (pathlib: OSError)
             raise InputError(f"--masks {text!r}: no such file or folder (expected auto, color, maskrcnn:CHECKPOINT, "
                              "onnx:MODEL, a COCO .json, a folder of frames' masks, or one label .png)")  # fmt: skip
         if not path.is_dir() and path.suffix.lower() not in (".png", ".json"):
