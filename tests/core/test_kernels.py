@@ -7,6 +7,7 @@ iterates on its sums, so whole fits are compared to a nanometre (the evaluation'
 kernels (whole numbers, booleans) are compared to the bit.
 """
 
+import math
 import subprocess
 import sys
 import types
@@ -5923,3 +5924,65 @@ def test_outline_cracks_known_answer():
     got = _jit.outline_cracks(mask, 10, 20)
     want = [[11, 20.5], [12, 21.5]] + [[11, 22.5], [12, 22.5]] + [[10.5, 21], [10.5, 22]] + [[11.5, 21], [12.5, 22]]
     np.testing.assert_array_equal(got, want)
+
+
+# --- stop 49, compspeed49: the solid of revolution's search in interleaved runs ------------------------------------
+
+
+def _range_one_run(t: np.ndarray) -> tuple[float, float]:
+    """``slice_costs_below``'s range until stop 48: ``min``/``max`` from ``inf``/``-inf`` in one run (numba's and
+    Python's ``min(a, b)``: ``b`` only where ``b < a``, so a NaN is passed over)."""
+    lo, hi = np.inf, -np.inf
+    for x in t.tolist():
+        lo = x if x < lo else lo
+        hi = x if x > hi else hi
+    return lo, hi
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 40), st.sampled_from(["normal", "specials", "zeros"]))
+def test_range4_is_the_one_run_range(seed, n, kind):
+    """The four interleaved runs give the one run's least and greatest (any length, the tail shorter than four; NaN
+    passed over, infinities, both zeros); where a zero's sign differs, ``t - lo`` and ``hi - lo`` are the same bits,
+    which is all that :func:`slice_costs_below` reads of them."""
+    rng = np.random.default_rng(seed)
+    t = rng.normal(size=n)
+    if kind == "specials" and n:
+        t[rng.random(n) < 0.3] = rng.choice([np.nan, np.inf, -np.inf, 0.0, -0.0])
+    elif kind == "zeros":
+        t = rng.choice([0.0, -0.0, 1.0, -1.0], size=n)
+    lo, hi = _jit._range4(t, n)
+    want_lo, want_hi = _range_one_run(t)
+    assert lo == want_lo and hi == want_hi
+    with np.errstate(invalid="ignore"):
+        for got, want in (((t - lo), (t - want_lo)), (np.float64(hi - lo), np.float64(want_hi - want_lo))):
+            np.testing.assert_array_equal(np.asarray(got).view(np.int64), np.asarray(want).view(np.int64))
+
+
+def test_range4_known_answer():
+    """A NaN first and last, the extremes in the tail beyond the last four."""
+    t = np.array([np.nan, 3.0, -1.0, 2.0, 0.5, -7.5, 9.0, np.nan])
+    assert _jit._range4(t, 8) == (-7.5, 9.0)
+    assert _jit._range4(t, 1) == (np.inf, -np.inf)  # nothing but a NaN: the starting values
+    assert _jit._range4(t, 6) == (-7.5, 3.0)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(0, 600), st.floats(1e-6, 10.0))
+def test_clipped_sum4_is_the_clipped_sum(seed, n, thr):
+    """Every value clipped at ``thr`` (a NaN counted as ``thr``) and summed, to rounding (another order of the same
+    additions), and whether all are below infinity."""
+    rng = np.random.default_rng(seed)
+    w = rng.exponential(thr, size=n)
+    if n and seed % 3 == 0:
+        w[rng.integers(n)] = rng.choice([np.nan, np.inf])
+    total, finite = _jit._clipped_sum4(w, n, thr)
+    clipped = [x if x < thr else thr for x in w.tolist()]
+    assert total == pytest.approx(math.fsum(clipped), rel=1e-13, abs=0.0)
+    assert finite == bool((w < np.inf).all())
+
+
+def test_clipped_sum4_known_answer():
+    """Five values (a tail of one beyond four), two clipped at 1."""
+    w = np.array([0.25, 2.0, 0.5, 0.125, 3.0])
+    assert _jit._clipped_sum4(w, 5, 1.0) == (0.25 + 1.0 + 0.5 + 0.125 + 1.0, True)
+    w[1] = np.inf
+    assert _jit._clipped_sum4(w, 5, 1.0) == (2.875, False)

@@ -2787,6 +2787,55 @@ _BOUND_MARGIN = 1e-9
 _BOUNDED_POINTS = 1_000_000
 
 
+@_njit_inlined
+def _range4(t: np.ndarray, n: int) -> tuple[float, float]:
+    """The least and the greatest of ``t[:n]`` as :func:`slice_costs_below` took them until stop 48 (``lo = min(lo,
+    t[i])`` from ``inf``, ``hi = max(hi, t[i])`` from ``-inf``: a NaN is passed over), in four interleaved runs
+    joined at the end (stop 49, compspeed49: four chains of comparisons instead of one, the solid of revolution's
+    search about 15 % faster). The least and the greatest of a set of numbers do not depend on the order they are
+    met in, but for the sign of a zero; :func:`slice_costs_below` reads them only as ``t - lo`` and ``hi - lo``,
+    which are the same for either zero (``x - 0.0 == x - (-0.0)``; ``0.0 - 0.0`` and ``-0.0 - (-0.0)`` are both
+    ``0.0``), so the slices and costs are the same to the bit."""
+    l0 = l1 = l2 = l3 = np.inf
+    h0 = h1 = h2 = h3 = -np.inf
+    i = 0
+    while i + 4 <= n:
+        a0, a1, a2, a3 = t[i], t[i + 1], t[i + 2], t[i + 3]
+        l0, l1, l2, l3 = min(l0, a0), min(l1, a1), min(l2, a2), min(l3, a3)
+        h0, h1, h2, h3 = max(h0, a0), max(h1, a1), max(h2, a2), max(h3, a3)
+        i += 4
+    while i < n:
+        l0, h0 = min(l0, t[i]), max(h0, t[i])
+        i += 1
+    return min(min(l0, l1), min(l2, l3)), max(max(h0, h1), max(h2, h3))
+
+
+@_njit_inlined
+def _clipped_sum4(w: np.ndarray, n: int, thr: float) -> tuple[float, bool]:
+    """``sum(min(w[:n], thr))`` (a NaN counted as ``thr``) and whether every ``w[:n]`` is below ``inf``, for
+    :func:`slice_costs_below`'s bound: in four interleaved running sums, joined as ``(s0 + s1) + (s2 + s3)`` (stop
+    49, compspeed49; one running sum until stop 48). Another order of the same additions: the sum differs from the
+    one-chain sum by rounding alone, far inside the bound's :data:`_BOUND_MARGIN`, and the bound only decides which
+    directions' costs are not finished, none of them the least (so the search's pick is the same, bit for bit)."""
+    s0 = s1 = s2 = s3 = 0.0
+    finite = True
+    i = 0
+    while i + 4 <= n:
+        w0, w1, w2, w3 = w[i], w[i + 1], w[i + 2], w[i + 3]
+        finite &= (w0 < np.inf) & (w1 < np.inf) & (w2 < np.inf) & (w3 < np.inf)
+        s0 += w0 if w0 < thr else thr
+        s1 += w1 if w1 < thr else thr
+        s2 += w2 if w2 < thr else thr
+        s3 += w3 if w3 < thr else thr
+        i += 4
+    while i < n:
+        w0 = w[i]
+        finite &= w0 < np.inf
+        s0 += w0 if w0 < thr else thr
+        i += 1
+    return (s0 + s1) + (s2 + s3), finite
+
+
 @_njit
 def slice_costs_below(
     q: np.ndarray, dirs: np.ndarray, bins: int, best: float, thr: float
@@ -2840,10 +2889,7 @@ def slice_costs_below(
             t[i] = x * p0 + y * p1 + z * p2
             u[i] = a * p0 + b * p1 + c * p2
             v[i] = f * p0 + g * p1 + h * p2
-        lo, hi = np.inf, -np.inf
-        for i in range(n):
-            lo = min(lo, t[i])
-            hi = max(hi, t[i])
+        lo, hi = _range4(t, n)
         span = max(hi - lo, 1e-12)
         cnt[:] = 0.0
         su[:] = 0.0
@@ -2886,12 +2932,7 @@ def slice_costs_below(
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
             dist2[i] = res * res / rho2
         if bounded and best < np.inf:  # best is finite (not NaN), so is thr
-            total = 0.0
-            finite = True
-            for i in range(n):
-                w = dist2[i]
-                finite &= w < np.inf
-                total += w if w < thr else thr
+            total, finite = _clipped_sum4(dist2, n, thr)
             if finite and total * (1.0 - _BOUND_MARGIN) - (n - keep) * thr * (1.0 + _BOUND_MARGIN) > \
                     keep * best * (1.0 + _BOUND_MARGIN):  # fmt: skip
                 out[j] = np.inf
