@@ -444,3 +444,25 @@ def test_the_colour_segmenter_s_masks_skip_the_test_for_an_occluder_drawn_over(m
     assert len(points) > 2000 and points[:, 2].max() < 0.41
     detect(frame, masks=mask.astype(np.int32), method="raw", settings=registered)
     assert calls == [1]  # given, the same mask is tested again
+
+
+def test_a_mask_holding_only_the_background_is_reported_with_its_reason_not_boxed_on_it():
+    """Ball 2's own pixels have no depth (a small fruit far off through a time-of-flight camera) and its mask
+    overshoots onto the wall 0.7 m behind it: what the mask holds is the wall. It is reported with that reason and no
+    points (before: the wall's points were kept and completed, refused here only for lying on a plane, which a real
+    backdrop need not); ball 1 is as before (issue 18, stop 49)."""
+    from symfruit.writers import detection_record
+
+    color, depth = disc_frame([(40, 60), (120, 60)], radius=15)
+    yy, xx = np.mgrid[:120, :160]
+    labels = np.zeros((120, 160), np.int32)
+    labels[(xx - 40) ** 2 + (yy - 60) ** 2 <= 15**2] = 1
+    labels[(xx - 120) ** 2 + (yy - 60) ** 2 <= 18**2] = 2
+    depth[(xx - 120) ** 2 + (yy - 60) ** 2 <= 15**2] = 0.0
+    grey = np.full_like(color, 90)  # no colour to trim the overshoot by
+    ball, wall = detect(Frame("wall", grey, depth, SMALL_CAM), masks=labels, method="raw").detections
+    assert ball.result is not None and ball.extraction.points[:, 2].max() < 0.31
+    assert wall.result is None and len(wall.extraction.points) == 0 and wall.visible_box is None
+    assert wall.error.startswith("no depth of the fruit's own: the ") and "(at 1.000 m)" in wall.error
+    assert wall.error.endswith("; 0 mask pixels nearer")
+    assert detection_record(wall)["error"] == wall.error and detection_record(wall)["n_points"] == 0

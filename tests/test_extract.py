@@ -10,7 +10,16 @@ from hypothesis import strategies as st
 
 from symfruit import ConfigError, InputError
 from symfruit.core.camera import Camera
-from symfruit.extract import ExtractSettings, cluster, extract, register, shift_labels, trim_labels
+from symfruit.extract import (
+    ExtractSettings,
+    backdrop,
+    cluster,
+    extract,
+    own_surface,
+    register,
+    shift_labels,
+    trim_labels,
+)
 from symfruit.io import read_frame
 
 from .conftest import EXAMPLE_FRAME, SMALL_CAM, disc_frame, leaf_across_frame
@@ -58,7 +67,7 @@ def test_known_pixels_and_depths_are_deprojected_exactly():
 def test_invalid_depth_is_dropped_and_counted():
     mask = np.zeros((120, 160), bool)
     mask[50:60, 70:80] = True  # 100 pixels
-    depth = np.full((120, 160), 0.4, np.float32)
+    depth = np.where(mask, 0.4, 1.0).astype(np.float32)  # before a wall (a flat depth all round is no fruit's)
     depth[50, 70:74] = [0.0, np.nan, np.inf, -0.4]  # no depth, NaN, infinite, negative
     depth[51, 70:72] = [0.05, 3.5]  # nearer than min_depth, farther than max_depth
     depth[59, 79] = 0.1  # exactly min_depth: valid
@@ -89,7 +98,7 @@ def test_a_far_cluster_is_dropped_and_the_nearest_big_one_kept():
 def test_erosion_drops_the_border_unless_the_mask_is_small():
     mask = np.zeros((120, 160), bool)
     mask[40:60, 60:80] = True  # 20 x 20
-    depth = np.full((120, 160), 0.4, np.float32)
+    depth = np.where(mask, 0.4, 1.0).astype(np.float32)  # before a wall (a flat depth all round is no fruit's)
     ex = extract(mask, depth, CAM, ExtractSettings(erode_px=1))
     assert ex.mask_area == 400 and ex.n_border == 400 - 18 * 18 and len(ex.points) == 18 * 18
     ex2 = extract(mask, depth, CAM, ExtractSettings(erode_px=2))
@@ -97,7 +106,7 @@ def test_erosion_drops_the_border_unless_the_mask_is_small():
     assert extract(mask, depth, CAM, NO_EROSION).n_border == 0
     small = np.zeros((120, 160), bool)
     small[40:46, 60:66] = True  # 6 x 6: eroded it would keep 16 pixels, under min_points (30)
-    ex3 = extract(small, depth, CAM, ExtractSettings(erode_px=1))
+    ex3 = extract(small, np.where(small, 0.4, 1.0).astype(np.float32), CAM, ExtractSettings(erode_px=1))
     assert ex3.n_border == 0 and len(ex3.points) == 36
 
 
@@ -324,3 +333,64 @@ def test_an_outlined_mask_over_a_leaf_running_on_across_it_gives_the_fruit_behin
     assert np.array_equal(extract(mask, depth, CAM, outlined=True).points, fruit.points)
     leaf = extract(mask, depth, CAM, outlined=False)
     assert len(leaf.points) > 2000 and leaf.points[:, 2].max() < 0.41
+
+
+def _ball_before_a_wall(off: int = 0, mask_px: int = 14, rim: float = 0.0):
+    """(depth, mask) seen by a 160x120 camera of f = 600 px: a ball of 12 px (its front 0.6 m) before a wall 1.2 m
+    away, a mask of ``mask_px`` pixels about a point ``off`` pixels left of the ball's centre (an annotator's mask off
+    the fruit, or a registration off it); ``rim``: the ball's outer share of its radius left without depth."""
+    yy, xx = np.mgrid[:120, :160].astype(float)
+    d2 = ((xx - 80) ** 2 + (yy - 60) ** 2) / 12.0**2
+    depth = np.where(d2 <= 1, 0.6 + 0.012 * (1 - np.sqrt(np.clip(1 - d2, 0, None))), 1.2)
+    depth[(d2 <= 1) & (d2 >= (1 - rim) ** 2)] = 0.0
+    mask = ((xx - 80 + off) ** 2 + (yy - 60) ** 2) <= mask_px**2
+    return depth, mask
+
+
+BALL_CAM = Camera(fx=600, fy=600, cx=80, cy=60, width=160, height=120)
+
+
+def test_the_wall_around_a_mask_is_behind_a_fruit_and_level_with_the_wall():
+    depth, mask = _ball_before_a_wall()
+    ball = extract(mask, depth, BALL_CAM)
+    behind, level, count = backdrop(ball.points, mask, depth, 600.0)
+    assert behind == 1.0 and level == 0.0 and count > 100  # everything around the ball is the wall, 0.6 m behind it
+    wall = np.array([[0.0, 0.0, 1.2]] * 40)
+    assert backdrop(wall, mask, depth, 600.0)[:2] == (0.0, 1.0)  # the wall's own depth all around
+    assert backdrop(wall[:0], mask, depth, 600.0)[2] == 0 and backdrop(wall, mask & False, depth, 600.0)[2] == 0
+
+
+@pytest.mark.parametrize("off", [14, 16, 20])
+def test_a_mask_off_the_fruit_gives_the_fruits_points_not_the_wall_behind(off):
+    """The mask holds more wall than ball: extraction's depth mode is the wall's, 0.6 m behind; around the mask the
+    wall runs on at that depth and nothing lies behind it, so the ball's pixels in front are taken (before: the wall,
+    a box 0.6 m off)."""
+    depth, mask = _ball_before_a_wall(off)
+    wall = extract(mask, depth, BALL_CAM, own=False)
+    assert np.median(wall.points[:, 2]) == pytest.approx(1.2)  # what extraction kept before
+    ex = extract(mask, depth, BALL_CAM)
+    assert len(ex.points) >= 30 and ex.error == ""
+    assert ex.points[:, 2].max() < 0.613 and ex.points[:, 2].min() >= 0.6  # the ball's front, nothing else
+    assert ex.n_other_clusters == ex.mask_area - ex.n_border - ex.n_invalid - len(ex.points)
+
+
+def test_a_mask_holding_only_the_wall_gives_no_points_and_says_why():
+    """A ball whose own pixels the camera left without depth (a small fruit far off through a time-of-flight camera)
+    under a mask overshooting it: what the mask holds is the wall; no points, the reason."""
+    depth, mask = _ball_before_a_wall(0, mask_px=17, rim=1.0)
+    ex = extract(mask, depth, BALL_CAM)
+    assert len(ex.points) == 0
+    why = (r"no depth of the fruit's own: the \d+ points its mask holds \(at 1\.200 m\) run on past its outline at "
+           r"their depth \(100% of the pixels around it\) with nothing around behind them \(the background seen "
+           r"through the mask, not the fruit\); 0 mask pixels nearer")  # fmt: skip
+    assert re.fullmatch(why, ex.error)
+    assert extract(mask, depth, BALL_CAM, own=False).error == ""
+
+
+def test_a_fruit_before_a_wall_or_against_a_leaf_keeps_its_points():
+    depth, mask = _ball_before_a_wall(8)  # the mask off the ball, but holding more ball than wall
+    ex = extract(mask, depth, BALL_CAM, own=False)
+    assert own_surface(ex, mask, depth, BALL_CAM) is ex
+    _, depth, mask = leaf_across_frame()  # a leaf in front running on across the outline: no wall behind
+    ex = extract(mask, depth, CAM, own=False)
+    assert own_surface(ex, mask, depth, CAM) is ex

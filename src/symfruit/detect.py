@@ -23,7 +23,7 @@ from .core.limits import MAX_FOCAL_PX, MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .core.raster import mask_box
 from .errors import InputError, SymfruitError
-from .extract import Extraction, ExtractSettings, extract, register, trim_labels
+from .extract import Extraction, ExtractSettings, extract, own_surface, register, trim_labels
 from .io.frames import COLOR_FILE
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
@@ -217,6 +217,9 @@ def detect(
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
         t_extract += b - a
+        if ex.error:  # the mask's depth is what lies behind the fruit: reported, never completed (a box metres off)
+            detections.append(Detection(int(k), mask, ex, error=ex.error))
+            continue
         if len(ex.points) < settings.extract.min_points:
             why = (f"only {len(ex.points)} points with valid depth (extract.min_points = "
                    f"{settings.extract.min_points}); {ex.n_invalid} of {ex.mask_area} mask pixels "
@@ -329,7 +332,11 @@ def _extract_window(
     window = mask[r0:r1, c0:c1]
     local = _window_camera(cam, r0, r1, c0, c1)
     leafy = None if color is None else _leafy(color, shift, (r0, r1, c0, c1))
-    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy, checked=True, outlined=outlined)
+    ex = extract(window, depth[r0:r1, c0:c1], local, settings.extract, leafy=leafy, checked=True, outlined=outlined,
+                 own=False)  # fmt: skip
+    # are the points what lies behind the fruit (docs/far49.md)? Told by the depth around the mask, beyond the window
+    ex = own_surface(ex, mask, depth, cam, settings.extract, box=(sl[0].start, sl[0].stop, sl[1].start, sl[1].stop),
+                     window=(r0, r1, c0, c1), leafy=leafy, outlined=outlined)  # fmt: skip
     truncated = bool(sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w)
     # the mask's pixels all lie in the window (its box): the rest of the image is none of the outline's. Where the
     # outline is the window itself (extract keeps its mask's view), it is the mask: no image is copied (a whole
@@ -339,4 +346,5 @@ def _extract_window(
     else:
         outline = np.zeros_like(mask)
         outline[r0:r1, c0:c1] = ex.silhouette
-    return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated, outline)
+    return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated, outline,
+                      ex.error)  # fmt: skip

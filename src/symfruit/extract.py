@@ -5,7 +5,7 @@ fruit behind leak in through a mask, flying pixels bridge them), de-projected.""
 from __future__ import annotations
 
 import itertools
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -15,15 +15,20 @@ from .core.camera import Camera
 from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds
-from .core.raster import square_filter
+from .core.raster import mask_box, square_filter
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "cluster", "extract", "register", "shift_labels", "trim_labels"]
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "extract", "own_surface", "register",
+           "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
+
+#: :func:`backdrop` reads the depth around a mask on every ``radius / AROUND_STEPS``-th pixel (a near fruit's ring of
+#: 100 000 pixels counted on a few thousand: shares, not pixels, are wanted).
+AROUND_STEPS = 8
 
 
 @dataclass(frozen=True)
@@ -101,6 +106,9 @@ class Extraction:
         The mask touches the image border: the fruit may continue outside the image.
     silhouette : (h, w) bool, optional
         The fruit's outline as the completion sees it (the mask).
+    error : str
+        Why the mask holds no depth of the fruit's own (:func:`own_surface`: what it held is what lies behind the
+        fruit), "" otherwise; the points are then none.
     """
 
     points: np.ndarray
@@ -110,6 +118,7 @@ class Extraction:
     n_other_clusters: int
     truncated: bool
     silhouette: np.ndarray | None = None
+    error: str = ""
 
 
 def cluster(points: np.ndarray, distance: float) -> np.ndarray:
@@ -202,7 +211,8 @@ def _checked(image: Any, beside: Any, camera: Any, settings: Any, what: str, nam
 
 
 def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: ExtractSettings | None = None, *,
-            leafy: np.ndarray | None = None, checked: bool = False, outlined: bool = True) -> Extraction:  # fmt: skip
+            leafy: np.ndarray | None = None, checked: bool = False, outlined: bool = True,
+            own: bool = True) -> Extraction:  # fmt: skip
     """The 3D points of the fruit under ``mask``.
 
     Parameters
@@ -222,6 +232,10 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         ``crossing``). False for a mask of the visible surface alone, occluders left out: the colour segmenter's
         given depth (:func:`symfruit.segment.colour.segment`: leaf, calyx and stem pixels and pixels off the
         fruit's depth dropped), on which the test is skipped (0.4 ms a fruit; stop 47, docs/mask47.md).
+    own : bool
+        Check that the points kept are the fruit's own surface, not what lies behind it (:func:`own_surface`, on the
+        depth around the mask: ``depth`` must hold the fruit's radius beyond the mask; ``detect`` extracts on a
+        window and checks on the image). False: not checked.
 
     Returns
     -------
@@ -229,7 +243,8 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         Its points are the mask's pixels (the border eroded) on the fruit's own surface
         (:func:`~symfruit.core.surface.fruit_surface`: its depth mode, a slab of ``slab`` radii behind its
         front, the convex cap from its nearest point), then the cluster nearest the camera among the clusters
-        holding at least ``cluster_share`` of the largest one's points.
+        holding at least ``cluster_share`` of the largest one's points; with ``own``, none where those are what lies
+        behind the fruit and the mask holds no other surface (:func:`own_surface`; the reason in its ``error``).
     """
     mask = _checked(mask, depth, camera, settings, "extract", "mask")
     if leafy is not None and (np.shape(leafy) != mask.shape or np.asarray(leafy).dtype != bool):
@@ -283,7 +298,110 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
-    return Extraction(points, area, n_invalid, area - np.count_nonzero(core), dropped, truncated, outline)
+    ex = Extraction(points, area, n_invalid, area - np.count_nonzero(core), dropped, truncated, outline)
+    return own_surface(ex, mask, z_all, camera, s, leafy=leafy, outlined=outlined) if own else ex
+
+
+#: :func:`own_surface`: points extraction kept are what lies behind the fruit when no more than this share of the
+#: valid depth around the mask lies behind them by more than the fruit's radius ...
+BEHIND_SHARE = 0.05
+#: ... while at least this share of the pixels around it (with depth or without) lies at their depth, within that
+#: radius (the surface runs on past the outline).
+LEVEL_SHARE = 0.5
+
+
+def backdrop(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, focal: float,
+             box: tuple[int, int, int, int] | None = None) -> tuple[float, float, int]:  # fmt: skip
+    """How the depth around a mask lies against the points kept of it: ``(behind, level, count)``. Around the mask:
+    its pixels within the fruit's radius beyond it (at least 4 pixels; from 2 pixels beyond it, or the sampling step
+    where the ring is read on every ``step``-th pixel, :data:`AROUND_STEPS`). ``behind``: the share of those with
+    valid depth lying behind the points' median depth ``z`` by more than the fruit's radius ``r`` (the mask's larger
+    extent in pixels at ``z``, halved: the 2-D thin-lens size); ``level``: the share of all of them (with depth or
+    without: where the camera has none, nothing is known to run on) lying within ``r`` of ``z``; ``count``: those
+    with depth (NaN, NaN, 0 without points or depth around). A stereo camera's depth runs on a few pixels past a
+    near fruit's edge (the matching window) and leaves a band without depth beside it: a ring of the fruit's own
+    width reaches past both.
+
+    ``mask`` and ``depth`` (metres, 0 or NaN: none) are the same (h, w) image or window, ``box`` the mask's rows and
+    columns ``(r0, r1, c0, c1)`` when known (:func:`~symfruit.core.raster.mask_box`); pixels beyond it are none.
+    """
+    found = box if box is not None else mask_box(np.asarray(mask, dtype=bool))
+    if found is None or not len(points):
+        return float("nan"), float("nan"), 0
+    r0, r1, c0, c1 = found
+    h, w = mask.shape
+    radius_px = float(np.sqrt(np.count_nonzero(mask[r0:r1, c0:c1]) / np.pi))
+    grow = int(max(np.ceil(radius_px), 4))
+    step = max(1, grow // AROUND_STEPS)
+    a0, a1, b0, b1 = max(r0 - grow - 1, 0), min(r1 + grow + 1, h), max(c0 - grow - 1, 0), min(c1 + grow + 1, w)
+    m = np.ascontiguousarray(np.asarray(mask[a0:a1:step, b0:b1:step], dtype=bool))
+    ring = square_filter(m, max(grow // step, 2)) & ~square_filter(m, 1)
+    d = np.asarray(depth[a0:a1:step, b0:b1:step], dtype=np.float64)[ring]
+    around = len(d)
+    d = d[np.isfinite(d) & (d > 0)]
+    if not len(d):
+        return float("nan"), float("nan"), 0
+    z = float(np.median(points[:, 2]))
+    r = 0.5 * max(r1 - r0, c1 - c0) * z / focal
+    return np.count_nonzero(d > z + r) / len(d), np.count_nonzero(np.abs(d - z) <= r) / around, len(d)
+
+
+def own_surface(ex: Extraction, mask: np.ndarray, depth: np.ndarray, camera: Camera,
+                settings: ExtractSettings | None = None, *, box: tuple[int, int, int, int] | None = None,
+                window: tuple[int, int, int, int] | None = None, leafy: np.ndarray | None = None,
+                outlined: bool = True) -> Extraction:  # fmt: skip
+    """``ex`` (:func:`extract`'s of ``mask``) when its points can be the fruit's own surface; else the points of the
+    fruit in front of them, or none with the reason in ``error`` (issue 18, stop 49: docs/far49.md).
+
+    A fruit is a body in front of what lies behind it: where no occluder covers its outline the camera sees past its
+    edge to something farther. Points that run on past the mask's outline at their depth (at least
+    :data:`LEVEL_SHARE` of the pixels around the mask, :func:`backdrop`) with nothing around lying behind them
+    (at most :data:`BEHIND_SHARE`) are what lies behind the fruit: the background seen through a mask that is off
+    the fruit, or around a small fruit whose own pixels a time-of-flight camera left without depth (mixed and
+    grazing pixels). The mask's pixels nearer than them by the fruit's radius are then extracted alone; their points
+    are the fruit's when they pass the same test, else the fruit has none (``detect`` reports it with the reason as
+    its ``error``: a box on the background lies metres off, a fruit reported without one is looked at again). Fewer
+    points than ``min_points`` are not looked at (the fruit is reported for too few points either way).
+
+    ``mask``, ``depth`` (metres): the (h, w) image, ``camera`` its camera; ``box``: the mask's rows and columns
+    ``(r0, r1, c0, c1)`` when known; ``window``: those the points are extracted again on (default the whole image),
+    ``leafy`` that window's leaf-green pixels, ``outlined`` as :func:`extract`'s.
+    """
+    s = settings or ExtractSettings()
+    if len(ex.points) < s.min_points:  # too few to complete: reported so whatever they are
+        return ex
+    focal = float(np.sqrt(camera.fx * camera.fy))
+    box = box if box is not None else mask_box(np.asarray(mask, dtype=bool))
+    behind, level, count = backdrop(ex.points, mask, depth, focal, box)
+    if box is None or count < 10 or not (behind <= BEHIND_SHARE and level >= LEVEL_SHARE):
+        return ex
+    z = float(np.median(ex.points[:, 2]))
+    r = 0.5 * max(box[1] - box[0], box[3] - box[2]) * z / focal
+    r0, r1, c0, c1 = window or (0, mask.shape[0], 0, mask.shape[1])
+    d = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
+    nearer = np.where(np.isfinite(d) & (d > 0) & (d < z - r), d, 0.0)
+    m = np.asarray(mask[r0:r1, c0:c1], dtype=bool)
+    n_nearer = int(np.count_nonzero(m & (nearer > 0)))
+    n = len(ex.points)
+    why = (f"no depth of the fruit's own: the {n} point{'s' * (n != 1)} its mask holds (at {z:.3f} m) run on past "
+           f"its outline at their depth ({level:.0%} of the pixels around it) with nothing around behind them "
+           "(the background seen through the mask, not the fruit)")  # fmt: skip
+    again = None
+    if n_nearer >= 10:
+        local = Camera(fx=camera.fx, fy=camera.fy, cx=camera.cx - c0, cy=camera.cy - r0, width=c1 - c0,
+                       height=r1 - r0)  # fmt: skip
+        again = extract(m, nearer, local, s, leafy=leafy, checked=True, outlined=outlined, own=False)
+    if again is None or not len(again.points):
+        why += f"; {n_nearer} mask pixels nearer" if again is None else f"; no surface in the {n_nearer} pixels nearer"
+    else:
+        behind, level, count = backdrop(again.points, mask, depth, focal, box)
+        if count < 10 or not (behind <= BEHIND_SHARE and level >= LEVEL_SHARE):
+            kept = len(again.points)  # the fruit's own, in front: what the mask held behind it is dropped
+            return replace(ex, points=again.points,
+                           n_other_clusters=max(ex.mask_area - ex.n_border - ex.n_invalid - kept, 0))  # fmt: skip
+        why += f"; the {len(again.points)} points nearer run on past it too"
+    return replace(ex, points=np.zeros((0, 3)), n_other_clusters=ex.mask_area - ex.n_border - ex.n_invalid,
+                   error=why)  # fmt: skip
 
 
 def shift_labels(labels: np.ndarray, du: int, dv: int) -> np.ndarray:
