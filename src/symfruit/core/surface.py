@@ -915,9 +915,9 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     if clean:
         pass  # finite, above 0 or 0: the cleaning below would give the same values
     elif jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
-        clean = np.empty(depth.shape)
-        jit.positive_depth(depth, clean)
-        depth = clean
+        cleaned = np.empty(depth.shape)
+        jit.positive_depth(depth, cleaned)
+        depth = cleaned
     else:
         valid = np.isfinite(depth) & (depth > 0)
         depth = np.where(valid, depth, 0.0)
