@@ -4948,7 +4948,7 @@ def test_the_window_medians_kernel_runs_the_median_network():
         elif m := re.fullmatch(r"\s*v(\d+) = max\(v(\d+), v\1\)", line):
             found.append((int(m[2]), int(m[1]), 2))
     assert found == list(_jit.MEDIAN25)
-    assert "medians[n] = v12" in source
+    assert "row[c] = v12" in source  # each row's medians, the ok pixels' kept (stop 49)
 
 
 @settings(max_examples=200, deadline=None)
@@ -5986,3 +5986,77 @@ def test_clipped_sum4_known_answer():
     assert _jit._clipped_sum4(w, 5, 1.0) == (0.25 + 1.0 + 0.5 + 0.125 + 1.0, True)
     w[1] = np.inf
     assert _jit._clipped_sum4(w, 5, 1.0) == (2.875, False)
+
+
+# --- stop 49, regspeed49 ------------------------------------------------------------------------------------------
+
+
+def _noise_values(seed: int) -> np.ndarray:
+    """Values as the surface's noise medians meet them: a few whole depth units (many ties), noise, a step among equal
+    values, or infinities."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400))
+    kind = seed % 4
+    if kind == 0:
+        return rng.normal(size=n)
+    if kind == 1:
+        return rng.integers(-3, 4, n) * 0.001
+    if kind == 2:
+        x = np.full(n, 0.5)
+        x[rng.integers(0, n, max(1, n // 10))] = rng.normal(size=max(1, n // 10))
+        return x
+    return rng.choice([1.0, 2.0, np.inf, -np.inf], n)
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_branchless_selection_is_the_quickselect_s(seed):
+    """select_lomuto puts the kth smallest value at kth, none larger before and none smaller after: the value select
+    puts there; median_lomuto is _median_of's value, deviation_median the two medians' of the former kernels and of
+    points.median (without infinities), to the bit."""
+    from symfruit.core.points import median
+
+    x = _noise_values(seed)
+    k = int(np.random.default_rng(seed + 1).integers(0, len(x)))
+    a, b = x.copy(), x.copy()
+    _jit.select(a, k)
+    _jit.select_lomuto(b, k)
+    assert a[k] == b[k] and (b[:k] <= b[k]).all() and (b[k + 1 :] >= b[k]).all()
+    assert np.array_equal(np.sort(b), np.sort(x))  # reordered, nothing lost
+    assert np.float64(_jit.median_lomuto(x.copy())).tobytes() == np.float64(_jit._median_of(x.copy())).tobytes()
+    before = x.copy()
+    middle = _jit._median_of(before)
+    with np.errstate(invalid="ignore"):
+        before = np.abs(before - middle)
+    want = _jit._median_of(before)
+    assert np.float64(_jit.deviation_median(x.copy())).tobytes() == np.float64(want).tobytes()
+    if np.isfinite(x).all():
+        assert np.float64(want).tobytes() == np.float64(median(np.abs(x - median(x)))).tobytes()
+
+
+def test_the_branchless_selection_known_answers():
+    """Known medians: one value, two, all equal, an odd run with ties, an even one (the middle two halved)."""
+    assert _jit.median_lomuto(np.array([3.0])) == 3.0
+    assert _jit.median_lomuto(np.array([4.0, 1.0])) == 2.5
+    assert _jit.median_lomuto(np.full(9, 0.25)) == 0.25
+    assert _jit.median_lomuto(np.array([5.0, 1.0, 1.0, 3.0, 1.0, 9.0, 3.0])) == 3.0
+    assert _jit.median_lomuto(np.array([5.0, 1.0, 2.0, 8.0])) == 3.5
+    # |x - 3| of 1, 1, 1, 3, 3, 5, 9: 2, 2, 2, 0, 0, 2, 6 -> 2
+    assert _jit.deviation_median(np.array([5.0, 1.0, 1.0, 3.0, 1.0, 9.0, 3.0])) == 2.0
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_finite_positive_is_the_twin_s(seed):
+    """finite_positive: numpy's np.isfinite(v) & (v > 0) and v[ok], to the bit (NaN, infinities, zeros of both signs,
+    negative values, none left or all)."""
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(0, 300))
+    v = rng.choice([np.nan, np.inf, -np.inf, 0.0, -0.0, -1.5, 5e-324, 0.7, 1.25, 3.0], n)
+    some = rng.random(n) < 0.5  # fruit's depths among them
+    v[some] = rng.uniform(0.1, 3.0, int(np.count_nonzero(some)))
+    ok = np.empty(n, bool)
+    kept = _jit.finite_positive(v, ok)
+    want = np.isfinite(v) & (v > 0)
+    assert np.array_equal(ok, want)
+    assert kept.dtype == np.float64 and kept.tobytes() == v[want].tobytes()

@@ -1349,3 +1349,34 @@ def test_a_second_leaf_ending_inside_the_mask_is_passed_over_too():
         found = fruit_surface(depth, mask, F, thin=True, crossing=True)
         assert found is not None and 0.50 < found.front < 0.515, seed
         assert (found.pixels & (leaf | small)).sum() == 0
+
+
+# --- stop 49, regspeed49: a clean depth read as it is ---------------------------------------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_fruit_surface_of_a_clean_depth_read_as_it_is_is_the_cleaned_one_s(seed):
+    """``clean=True`` (the registration's window: finite, above 0 or 0) gives the surface the cleaning gives: the same
+    pixels, front, radius, noise and apex, with the kernels and with their twins; the depth is not written."""
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(6, 30))
+    centre = (int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3)))
+    depth, disc = ball(centre=centre, radius_px=radius, noise=0.001, table=bool(rng.random() < 0.5),
+                       rim=float(rng.uniform(0.0, 0.2)), seed=int(rng.integers(0, 100)))  # fmt: skip
+    depth = np.where(rng.random((H, W)) < 0.05, 0.0, depth)  # dropouts
+    mask = disc & (rng.random((H, W)) < 0.97)
+    region = np.pad(mask, 4)[:H, :W] | mask if rng.random() < 0.5 else None
+    kept = depth.copy()
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        for kernels in ("compiled", "numpy"):
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            a = fruit_surface(depth, mask, F, region=region, thin=True, step=0.0)
+            b = fruit_surface(depth, mask, F, region=region, thin=True, step=0.0, clean=True)
+            assert (a is None) == (b is None)
+            if a is not None:
+                assert np.array_equal(a.pixels, b.pixels)
+                assert (a.front, a.radius, a.noise, a.apex) == (b.front, b.radius, b.noise, b.apex)
+    assert depth.tobytes() == kept.tobytes()

@@ -187,8 +187,14 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     Where numba is, its compiled twin does the same steps (:func:`symfruit.core._jit.fruit_depth`: the same numbers,
     bit for bit; issue 19, sixteenth round).
     """
-    ok = np.isfinite(values) & (values > 0)
-    kept = values[ok]
+    if (jit := compiled()) is not None and isinstance(values, np.ndarray) and values.dtype == np.float64 and (
+        values.ndim == 1
+    ):  # fmt: skip
+        ok = np.empty(values.shape, bool)  # the compiled twin of the two lines below (stop 49: the same depths)
+        kept = jit.finite_positive(values, ok)
+    else:
+        ok = np.isfinite(values) & (values > 0)
+        kept = values[ok]
     z = np.sort(kept)
     if (jit := compiled()) is not None and z.dtype == np.float64 and kept.ndim == 1 and (
         leafy is None or np.shape(leafy) == np.shape(values)
@@ -857,7 +863,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
                   leafy: np.ndarray | None = None, step: float | None = None,
-                  thin: bool = False, crossing: bool = False) -> Surface | None:  # fmt: skip
+                  thin: bool = False, crossing: bool = False, clean: bool = False) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -894,6 +900,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         Where ``thin`` finds no sheet, pass over a nearest surface that runs on across the mask's outline for the
         fruit behind it that does not (:func:`_behind_crossing`: an occluder the mask is drawn over; extraction's, not
         the registration's cue, which reads the depth a few pixels off the mask).
+    clean : bool
+        ``depth`` is already what its cleaning makes of it: every value finite and either above 0 or +0.0 (the
+        registration's window, :func:`symfruit.core._jit.valid_depth`'s with a least depth above 0), so it is read
+        as it is, not copied (stop 49: the same values).
 
     Returns
     -------
@@ -902,10 +912,12 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     region = mask if region is None else region
     valid: np.ndarray | None = None  # with depth cleaned, its pixels above 0 (made only where wanted)
     jit = compiled() if isinstance(depth, np.ndarray) and depth.dtype == np.float64 and depth.ndim == 2 else None
-    if jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
-        clean = np.empty(depth.shape)
-        jit.positive_depth(depth, clean)
-        depth = clean
+    if clean:
+        pass  # finite, above 0 or 0: the cleaning below would give the same values
+    elif jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
+        cleaned = np.empty(depth.shape)
+        jit.positive_depth(depth, cleaned)
+        depth = cleaned
     else:
         valid = np.isfinite(depth) & (depth > 0)
         depth = np.where(valid, depth, 0.0)
@@ -1229,9 +1241,11 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
     return np.sort(keys, axis=1, kind=_KIND16 if keys.dtype.itemsize <= 2 else None)
 
 
-def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160) -> _Outline | None:
+def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160, *,
+             clean: bool = False) -> _Outline | None:  # fmt: skip
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
-    and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points)."""
+    and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points).
+    ``clean``: :func:`fruit_surface`'s (the depth finite, above 0 or 0 already)."""
     grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
     found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
@@ -1244,7 +1258,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
     # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
     # (0, 17) px to (18, 0) and (-15, 15) (docs/ablation.md, "A fall of whole depth units")
-    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0, thin=True)
+    surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0, thin=True, clean=clean)
     if surface is None:
         return None
     cap = _connected(surface.pixels, surface.apex)
@@ -1320,7 +1334,9 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
         gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
         free = within(gap, _FREE_PX)[rows - r0, cols - c0]
     if jit is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
-        dv, du = rows - rows.mean(), cols - cols.mean()
+        # the means from whole-number sums (exact in any order, as numpy's float64 sums of them are; its mean divides
+        # the same sum): rows.mean() and cols.mean() bit for bit, without their casts (stop 49)
+        dv, du = rows - int(rows.sum()) / len(rows), cols - int(cols.sum()) / len(cols)
         radius = np.hypot(dv, du)
         bins = max(8, int(2.0 * np.pi * radius.mean()))
         return free, jit.rim_sides(dv, du, radius, np.arctan2(dv, du), bins, bins / (2.0 * np.pi), free)
@@ -1412,7 +1428,8 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
             z = valid
         else:
             z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
-        if (found := _outline(z, mask, focal, max_px)) is not None and any(found.axes):
+        # z is finite, above 0 or 0 (valid_depth's least depth is above 0): fruit_surface reads it as it is (stop 49)
+        if (found := _outline(z, mask, focal, max_px, clean=True)) is not None and any(found.axes):
             outlines.append(found)
     if not outlines:
         return 0, 0
