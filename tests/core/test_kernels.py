@@ -5923,3 +5923,37 @@ def test_outline_cracks_known_answer():
     got = _jit.outline_cracks(mask, 10, 20)
     want = [[11, 20.5], [12, 21.5]] + [[11, 22.5], [12, 22.5]] + [[10.5, 21], [10.5, 22]] + [[11.5, 21], [12.5, 22]]
     np.testing.assert_array_equal(got, want)
+
+
+# --- stop 49, treeseg49
+
+
+@pytest.mark.parametrize("reach", [0.5, 1.0, 2.5, 3.5, 5.0, 7.2])
+def test_the_bridged_depth_at_any_reach(reach):
+    """:func:`_jit.bridge_gaps` at reaches other than ``BRIDGE_PX`` (its keys' low bits widen with the reach) against
+    a pixel-by-pixel search of the disc: each pixel without depth takes the depth of the least (squared distance,
+    column, row) pixel with depth within ``reach``, else 0; windows at the image's edges, depths of three values."""
+    rng = np.random.default_rng(int(reach * 10))
+    for _ in range(60):
+        h, w = (int(v) for v in rng.integers(1, 30, 2))
+        z = rng.choice(np.array([0.75, 1.5, 2.25]), (h, w)).astype(np.float32)
+        z[rng.random((h, w)) < rng.choice([0.5, 0.8, 0.95])] = 0.0
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+        got = np.empty((r1 - r0, c1 - c0))
+        _jit.bridge_gaps(z, r0, r1, c0, c1, reach, got)
+        rows, cols = np.nonzero(z > 0)
+        want = z[r0:r1, c0:c1].astype(np.float64)
+        for i, j in zip(*np.nonzero(want == 0), strict=True):
+            d2 = (rows - (r0 + i)) ** 2 + (cols - (c0 + j)) ** 2
+            if len(d2) and d2.min() <= reach * reach:
+                best = np.lexsort((rows, cols, d2))[0]
+                want[i, j] = z[rows[best], cols[best]]
+        np.testing.assert_array_equal(got, want)
+
+
+def test_the_bridged_depth_of_an_empty_window():
+    """An empty window of :func:`_jit.bridge_gaps` writes nothing and does not fail."""
+    out = np.empty((0, 3))
+    _jit.bridge_gaps(np.ones((4, 4)), 2, 2, 0, 3, 3.5, out)
+    assert out.shape == (0, 3)
