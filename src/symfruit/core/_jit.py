@@ -8126,3 +8126,41 @@ def group_boxes(at: np.ndarray, first: np.ndarray, rows: np.ndarray, cols: np.nd
             c0, c1 = min(c0, c), max(c1, c)
         out[i, 0], out[i, 1], out[i, 2], out[i, 3] = r0, r1 + 1, c0, c1 + 1
     return out
+
+
+# --- stop 49, treeseg49: the bridged skin's trim ---------------------------------------------------------------------
+
+
+@_njit
+def bridged_trim(skin: np.ndarray, z: np.ndarray, part: np.ndarray, r0: int, c0: int) -> tuple[np.ndarray, bool]:
+    """:func:`symfruit.segment.colour._bridged_skin`'s trim of a skin grown over bridged depth: ``skin`` (h, w) bool
+    less its pixels without depth (``z`` (h, w) float64, 0: none) outside the convex hull of its pixels with depth
+    and of ``part`` (ph, pw) bool at ``(r0, c0)`` (:func:`hull_vertices`, then :func:`polygon_fill` as Pillow fills
+    it), and whether that was worked out: False when a hull vertex is not a whole number (never: the twin draws
+    it). When every skin pixel has depth no hull is drawn: the skin is returned as it is, the twin's pixels."""
+    h, w = skin.shape
+    core = np.empty((h, w), np.bool_)
+    gap = False
+    for r in range(h):
+        for c in range(w):
+            seen = z[r, c] > 0
+            core[r, c] = skin[r, c] and seen
+            gap |= skin[r, c] and not seen
+    if not gap:
+        return skin, True
+    for r in range(part.shape[0]):
+        for c in range(part.shape[1]):
+            if part[r, c]:
+                core[r0 + r, c0 + c] = True
+    v = hull_vertices(core)
+    if len(v) == 0:
+        hull = core
+    else:
+        hull = polygon_fill(v, core)
+        if hull.shape != core.shape:
+            return skin, False
+    out = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            out[r, c] = skin[r, c] and (z[r, c] > 0 or hull[r, c])
+    return out, True

@@ -2525,10 +2525,17 @@ def _bridged_skin(
     gap into a branch or a neighbour at its depth) the skin grown without bridging is taken, as before."""
     grown_sl, skin = _round_skin(sl, part, bridged, color, geo, s, owner, k)  # type: ignore[arg-type]
     z = depth[grown_sl]
-    core = skin & (z > 0)
     r0, c0 = sl[0].start - grown_sl[0].start, sl[1].start - grown_sl[1].start
-    core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
-    skin = skin & ((z > 0) | convex_hull_mask(core))
+    jit = compiled()
+    done = False
+    if jit is not None and skin.dtype == part.dtype == bool and z.dtype == np.float64 and _pillow_fill():
+        # the same pixels in one call, no hull where the skin has depth throughout (:func:`symfruit.core._jit.
+        # bridged_trim`; stop 49, treeseg49)
+        skin, done = jit.bridged_trim(skin, z, part, r0, c0)
+    if not done:
+        core = skin & (z > 0)
+        core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
+        skin = skin & ((z > 0) | convex_hull_mask(core))
     if skin.sum() < GROUND_SOLIDITY * _hull_area(skin):
         return _round_skin(sl, part, depth, color, geo, s, owner, k)
     return grown_sl, skin
