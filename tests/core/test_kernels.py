@@ -6060,3 +6060,97 @@ def test_finite_positive_is_the_twin_s(seed):
     want = np.isfinite(v) & (v > 0)
     assert np.array_equal(ok, want)
     assert kept.dtype == np.float64 and kept.tobytes() == v[want].tobytes()
+
+
+# --- stop 49, treeseg49
+
+
+@pytest.mark.parametrize("reach", [0.5, 1.0, 2.5, 3.5, 5.0, 7.2])
+def test_the_bridged_depth_at_any_reach(reach):
+    """:func:`_jit.bridge_gaps` at reaches other than ``BRIDGE_PX`` (its keys' low bits widen with the reach) against
+    a pixel-by-pixel search of the disc: each pixel without depth takes the depth of the least (squared distance,
+    column, row) pixel with depth within ``reach``, else 0; windows at the image's edges, depths of three values."""
+    rng = np.random.default_rng(int(reach * 10))
+    for _ in range(60):
+        h, w = (int(v) for v in rng.integers(1, 30, 2))
+        z = rng.choice(np.array([0.75, 1.5, 2.25]), (h, w)).astype(np.float32)
+        z[rng.random((h, w)) < rng.choice([0.5, 0.8, 0.95])] = 0.0
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+        got = np.empty((r1 - r0, c1 - c0))
+        _jit.bridge_gaps(z, r0, r1, c0, c1, reach, got)
+        rows, cols = np.nonzero(z > 0)
+        want = z[r0:r1, c0:c1].astype(np.float64)
+        for i, j in zip(*np.nonzero(want == 0), strict=True):
+            d2 = (rows - (r0 + i)) ** 2 + (cols - (c0 + j)) ** 2
+            if len(d2) and d2.min() <= reach * reach:
+                best = np.lexsort((rows, cols, d2))[0]
+                want[i, j] = z[rows[best], cols[best]]
+        np.testing.assert_array_equal(got, want)
+
+
+def test_the_bridged_depth_of_an_empty_window():
+    """An empty window of :func:`_jit.bridge_gaps` writes nothing and does not fail."""
+    out = np.empty((0, 3))
+    _jit.bridge_gaps(np.ones((4, 4)), 2, 2, 0, 3, 3.5, out)
+    assert out.shape == (0, 3)
+
+
+def _trim_twin(skin, z, part, r0, c0):
+    """:func:`symfruit.segment.colour._bridged_skin`'s trim in numpy (its code without the kernel)."""
+    from symfruit.segment.colour import convex_hull_mask
+
+    core = skin & (z > 0)
+    core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
+    return skin & ((z > 0) | convex_hull_mask(core))
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_bridged_trim_is_the_twins(seed):
+    """:func:`_jit.bridged_trim` against the numpy trim (Pillow's fill and Qhull with the twins) on 300 skins: discs
+    and blobs with gaps in their depth, parts inside and on the edge, specks, empty skins, skins with depth
+    throughout (returned as they are)."""
+    from symfruit.segment.colour import _pillow_fill
+
+    if not _pillow_fill():
+        pytest.skip("the kernel follows Pillow 12.1's fill")
+    rng = np.random.default_rng(seed)
+    kept = cut = 0
+    for _ in range(300):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        yy, xx = np.mgrid[:h, :w]
+        r = rng.uniform(1, 20)
+        skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
+        skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
+        z = rng.uniform(0.5, 2.0, (h, w))
+        z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
+        ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
+        r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
+        part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+        with pytest.MonkeyPatch.context() as mp:
+            _, twin = _both(mp, _trim_twin, skin, z, part, r0, c0)
+        got, done = _jit.bridged_trim(skin, z, part, r0, c0)
+        assert done
+        np.testing.assert_array_equal(got, twin)
+        kept += int(np.array_equal(got, skin))
+        cut += int(not np.array_equal(got, skin))
+    assert kept > 30 and cut > 30
+
+
+def test_the_bridged_trim_known_answer():
+    """A skin whose pixels without depth lie inside the hull of those with depth keeps them; one outside (the band
+    beyond the rim) is dropped, unless the part reaches past it; a skin with depth throughout is returned itself."""
+    skin = np.zeros((5, 9), bool)
+    skin[1:4, 1:8] = True
+    z = np.where(skin, 1.0, 0.0)
+    z[2, 4] = 0.0  # a gap inside
+    z[1:4, 7] = 0.0  # a band at the right
+    part = np.zeros((1, 1), bool)
+    got, done = _jit.bridged_trim(skin, z, part, 0, 0)
+    assert done and got[2, 4] and not got[1:4, 7].any() and got[1:4, 1:7].all()
+    part[0, 0] = True
+    got, _ = _jit.bridged_trim(skin, z, part, 2, 7)  # the part on the band's middle pixel: that pixel is kept
+    assert got[2, 7] and not got[1, 7] and not got[3, 7]
+    full = np.ones((3, 3), bool)
+    same, _ = _jit.bridged_trim(full, np.ones((3, 3)), part, 0, 0)
+    assert same is full

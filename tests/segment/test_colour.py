@@ -1467,3 +1467,25 @@ def test_bridged_depth_takes_the_nearest_depth_within_its_reach_only():
     assert row[17:21].tolist() == [1.5] * 3 + [0.0]  # 3 px from the depth: bridged, 4 px: not
     assert row[27:30].tolist() == [2.0] * 3 and row[21:27].tolist() == [0.0] * 6
     assert (z == _BridgedDepth(_Depth.of(depth))[(slice(5, 15), slice(0, 40))]).all()  # read again: the same
+
+
+# --- stop 49, treeseg49
+
+
+def test_bridged_depth_cut_from_a_window_filled_before_is_the_same():
+    """A window read inside one :class:`_BridgedDepth` filled just before is cut out of that one (no fill of its own)
+    and holds the values it has when filled alone, read-only and contiguous; a window reaching past it is filled."""
+    from symfruit.segment.colour import _BridgedDepth, _Depth
+
+    rng = np.random.default_rng(3)
+    depth = rng.choice(np.array([0.0, 1.0, 1.5, 2.0]), (40, 50), p=[0.6, 0.2, 0.1, 0.1])
+    bridged = _BridgedDepth(_Depth.of(depth))
+    filled = []
+    fill = bridged._fill
+    bridged._fill = lambda *a: filled.append(a[1:]) or fill(*a)  # type: ignore[method-assign]
+    bridged[(slice(5, 35), slice(3, 40))]
+    inner = bridged[(slice(9, 20), slice(10, 31))]
+    assert len(filled) == 1 and inner.flags.c_contiguous and not inner.flags.writeable
+    np.testing.assert_array_equal(inner, _BridgedDepth(_Depth.of(depth))[(slice(9, 20), slice(10, 31))])
+    bridged[(slice(0, 20), slice(10, 31))]
+    assert len(filled) == 2

@@ -1847,6 +1847,8 @@ def _round_skin(
     fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. With
     ``ground_colour``, a red part that is a blush along a fruit's rim carrying the depth of what lies behind grows
     from the depth of the ground colour beside it (:func:`_blush_rim`). Returns the grown window and mask."""
+    if s.ground_colour and k > 0 and isinstance(depth, _BridgedDepth):
+        depth[_pad(sl, GAP_PX, depth.shape)]  # :func:`_blush_rim`'s window first: the part's is cut from it (treeseg49)
     z_sl = depth[sl]
     jit = compiled()
     z_part = jit.masked_depths(hull, z_sl)[1] if jit is not None and hull.dtype == bool else z_sl[hull & (z_sl > 0)]
@@ -2438,27 +2440,45 @@ class _BridgedDepth:
         self.depth = depth
         self.shape = depth.shape
         self.read: dict[tuple[int | None, ...], np.ndarray] = {}
+        self.recent: list[tuple[int, int, int, int, np.ndarray]] = []  # the last windows filled, their bounds
 
     def __getitem__(self, window: tuple[slice, slice]) -> np.ndarray:
         a, b = window
         key = (a.start, a.stop, b.start, b.stop)
         z = self.read.get(key)
         if z is None:
-            jit = compiled()
-            given = self.depth.given
-            if jit is not None and given.ndim == 2 and given.dtype in _FLOATS:  # only the pixels without depth
-                # search, over the disc about them, in the depth as handed over (stop 47, yellowfast47)
-                (r0, r1, _), (c0, c1, _) = a.indices(self.shape[0]), b.indices(self.shape[1])
-                z = np.empty((max(r1 - r0, 0), max(c1 - c0, 0)), np.float64)
-                jit.bridge_gaps(given, r0, r1, c0, c1, BRIDGE_PX, z)
+            (r0, r1, _), (c0, c1, _) = a.indices(self.shape[0]), b.indices(self.shape[1])
+            for q0, q1, p0, p1, held in self.recent:
+                # inside a window filled just before (the blush rim's holds its part's; stop 49, treeseg49): cut out
+                # of it, a pixel's bridged depth being the same in any window
+                if q0 <= r0 and r1 <= q1 and p0 <= c0 and c1 <= p1:
+                    z = np.ascontiguousarray(held[r0 - q0 : r1 - q0, c0 - p0 : c1 - p0])
+                    break
             else:
-                big = _pad(window, int(BRIDGE_PX) + 1, self.shape)  # the gaps' nearest depths may lie outside
-                r0, c0 = a.start - big[0].start, b.start - big[1].start
-                inner = (slice(r0, r0 + a.stop - a.start), slice(c0, c0 + b.stop - b.start))
-                z = _bridged(self.depth[big], inner)
+                z = self._fill(window, r0, r1, c0, c1)
+                self.recent = [(r0, r1, c0, c1, z), *self.recent[: RECENT_FILLS - 1]]
             z.flags.writeable = False
             self.read[key] = z
         return z
+
+    def _fill(self, window: tuple[slice, slice], r0: int, r1: int, c0: int, c1: int) -> np.ndarray:
+        """The window's bridged depth, worked out."""
+        jit = compiled()
+        given = self.depth.given
+        if jit is not None and given.ndim == 2 and given.dtype in _FLOATS:  # only the pixels without depth
+            # search, over the disc about them, in the depth as handed over (stop 47, yellowfast47)
+            z = np.empty((max(r1 - r0, 0), max(c1 - c0, 0)), np.float64)
+            jit.bridge_gaps(given, r0, r1, c0, c1, BRIDGE_PX, z)
+            return z
+        a, b = window
+        big = _pad(window, int(BRIDGE_PX) + 1, self.shape)  # the gaps' nearest depths may lie outside
+        r0, c0 = a.start - big[0].start, b.start - big[1].start
+        inner = (slice(r0, r0 + a.stop - a.start), slice(c0, c0 + b.stop - b.start))
+        return _bridged(self.depth[big], inner)
+
+
+#: How many of the last windows :class:`_BridgedDepth` filled a window read is looked for in.
+RECENT_FILLS = 4
 
 
 def _bridged(zb: np.ndarray, inner: Window) -> np.ndarray:
@@ -2505,10 +2525,17 @@ def _bridged_skin(
     gap into a branch or a neighbour at its depth) the skin grown without bridging is taken, as before."""
     grown_sl, skin = _round_skin(sl, part, bridged, color, geo, s, owner, k)  # type: ignore[arg-type]
     z = depth[grown_sl]
-    core = skin & (z > 0)
     r0, c0 = sl[0].start - grown_sl[0].start, sl[1].start - grown_sl[1].start
-    core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
-    skin = skin & ((z > 0) | convex_hull_mask(core))
+    jit = compiled()
+    done = False
+    if jit is not None and skin.dtype == part.dtype == bool and z.dtype == np.float64 and _pillow_fill():
+        # the same pixels in one call, no hull where the skin has depth throughout (:func:`symfruit.core._jit.
+        # bridged_trim`; stop 49, treeseg49)
+        skin, done = jit.bridged_trim(skin, z, part, r0, c0)
+    if not done:
+        core = skin & (z > 0)
+        core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
+        skin = skin & ((z > 0) | convex_hull_mask(core))
     if skin.sum() < GROUND_SOLIDITY * _hull_area(skin):
         return _round_skin(sl, part, depth, color, geo, s, owner, k)
     return grown_sl, skin
