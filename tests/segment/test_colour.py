@@ -1467,3 +1467,29 @@ def test_bridged_depth_takes_the_nearest_depth_within_its_reach_only():
     assert row[17:21].tolist() == [1.5] * 3 + [0.0]  # 3 px from the depth: bridged, 4 px: not
     assert row[27:30].tolist() == [2.0] * 3 and row[21:27].tolist() == [0.0] * 6
     assert (z == _BridgedDepth(_Depth.of(depth))[(slice(5, 15), slice(0, 40))]).all()  # read again: the same
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_pieces_in_two_calls_are_the_five_calls_labels(seed, monkeypatch):
+    """``_plain_piece`` (a found piece's ripe test, hull, depth test and median depth in two compiled calls; stop 49)
+    gives the labels that the five calls it stands for give (``_plain_piece`` left out), on rendered strawberry frames
+    with depth, the default settings and with the hull's colour test off; and it took the pieces."""
+    import symfruit.segment.colour as colour
+
+    scene = make_scene(seed)
+    taken = [0]
+    plain = colour._plain_piece
+
+    def counted(*args, **kwargs):
+        found = plain(*args, **kwargs)
+        taken[0] += found is not None
+        return found
+
+    for settings in (SegmentSettings(), SegmentSettings(fill="hull")):
+        monkeypatch.setattr(colour, "_plain_piece", counted)
+        fast = segment(scene.color, scene.depth, scene.camera, settings)
+        monkeypatch.setattr(colour, "_plain_piece", lambda *args, **kwargs: None)
+        np.testing.assert_array_equal(fast, segment(scene.color, scene.depth, scene.camera, settings))
+        assert fast.max() >= 3
+    kernels = pytest.importorskip("symfruit.core.kernels")
+    assert taken[0] >= 6 or kernels.compiled() is None
