@@ -6154,3 +6154,131 @@ def test_the_bridged_trim_known_answer():
     full = np.ones((3, 3), bool)
     same, _ = _jit.bridged_trim(full, np.ones((3, 3)), part, 0, 0)
     assert same is full
+
+
+# --- stop 49, seg640_49
+
+
+def test_the_quick_median_is_the_twins():
+    """:func:`_jit.median_quick` of 3,000 random arrays (0-3,000 values; drawn from a few values so that they tie, or
+    spread; odd and even counts; now and then a NaN) against ``core.points.median`` (``np.median``'s value) and
+    :func:`_jit.median_values`, and :func:`_jit.median_of_quick` against :func:`_jit._median_of` without NaN: the same
+    value bit for bit (NaN where a value is NaN or there is none), the values left as they were; and a known
+    answer."""
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(49)
+    ties = 0
+    for t in range(3000):
+        n = int(rng.integers(0, 3001)) if t % 4 else int(rng.integers(0, 6))
+        if t % 3 == 0:
+            values = rng.choice(rng.uniform(0.2, 2.0, int(rng.integers(1, 6))), n)
+        else:
+            values = rng.normal(0.5, 0.05, n)
+        if t % 50 == 7 and n:
+            values[int(rng.integers(0, n))] = np.nan
+        kept = values.copy()
+        got = _jit.median_quick(values)
+        np.testing.assert_array_equal(values, kept)
+        twin = median(values) if n else np.nan  # (np.median warns without a value)
+        assert (np.isnan(got) and np.isnan(twin)) or got == twin
+        assert np.array_equal(got, _jit.median_values(values.copy()), equal_nan=True)
+        if n and not np.isnan(values).any():  # the sphere fits' median (no NaN there)
+            assert _jit.median_of_quick(values) == _jit._median_of(values.copy()) == got
+        ties += n % 2 == 0 and n > 0 and len(np.unique(values)) < n
+    assert ties > 300
+    assert _jit.median_quick(np.array([3.0, 1.0, 2.0, 1.0])) == 1.5
+    assert _jit.median_quick(np.array([2.0, 1.0, 2.0, 2.0])) == 2.0
+    assert _jit.median_quick(np.array([5.0])) == 5.0 and np.isnan(_jit.median_quick(np.zeros(0)))
+
+
+def _random_piece(rng, h, w):
+    """A found piece's inputs as ``_segment_at`` hands them over: a blob and a speck as the part, its weak (red)
+    pixels, an owner map's window (other pieces' numbers, 0 and the piece's own 3), a colour window (views of a larger
+    image, some pixels green) and depths (float64, holes of 0, an outlying patch), and the part's hull vertices."""
+    from symfruit.segment.colour import _hull_vertices
+
+    rr, cc = np.mgrid[:h, :w]
+    r, c, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(0.5, 0.6 * max(h, w) + 1.0)
+    part = (rr - r) ** 2 + (cc - c) ** 2 <= rad * rad
+    part |= rng.random((h, w)) < 0.02
+    weak = part & (rng.random((h, w)) < rng.choice([0.0, 0.6, 0.95, 1.0]))
+    owner = rng.choice(np.array([0, 0, 0, 3, 5], np.int16), (h, w))
+    big = rng.integers(0, 256, (h + 2, w + 3, 3)).astype(np.uint8)
+    big[rng.random((h + 2, w + 3)) < 0.2] = (40, 180, 50)  # green: a calyx or a leaf
+    color = big[1 : h + 1, 2 : w + 2]
+    z = rng.normal(0.6, 0.01, (h, w))
+    if rng.random() < 0.5:  # a step: the fruit behind
+        z[rng.uniform(0, 1, (h, w)) < 0.3] += 0.08
+    z[rng.random((h, w)) < rng.choice([0.0, 0.1, 1.0])] = 0.0
+    if rng.random() < 0.3:  # depth only on the red pixels (all of the hull's depths red)
+        z[~weak] = 0.0
+    if rng.random() < 0.3:  # whole millimetres: ties
+        z = np.round(z, 3)
+    return part, weak, owner, color, z, _hull_vertices(part)
+
+
+def _twin_hull(vertices, part, owner, color, surface, red, z, jump):
+    """What :func:`_jit.piece_hull`'s hull stands for: ``_surface_hull`` (piece number 3), then ``_depth_consistent``
+    against the red pixels."""
+    from symfruit.segment.colour import _depth_consistent, _surface_hull
+
+    return _depth_consistent(_surface_hull(vertices, part, owner, 3, color, surface), red, z, jump)
+
+
+def test_the_piece_calls_are_the_twins(monkeypatch):
+    """:func:`_jit.piece_ripe` and :func:`_jit.piece_hull` on 800 random pieces (1-40 px a side, see
+    ``_random_piece``) against the calls they stand for, with the kernels and their numpy twins: ``red.any()`` and
+    ``_ripe`` of ``part & weak``; ``_surface_hull``, ``_depth_consistent`` against the red pixels and the hull's pixel
+    count, count with depth and median depth (``core.points.median``): the same answers, hulls and values."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import _ripe
+
+    rng = np.random.default_rng(49)
+    hulls = ripe = shared = 0
+    for t in range(800):
+        h, w = (int(v) for v in rng.integers(1, 41, 2))
+        part, weak, owner, color, z, vertices = _random_piece(rng, h, w)
+        least = np.float32(rng.choice([0.2, 0.35, -1.0]))
+        red = part & weak
+        got = _jit.piece_ripe(color, part, weak, least)
+        assert got == (red.any() and _ripe(color, red, float(least)))
+        ripe += got
+        if vertices is None:
+            continue
+        surface, jump = bool(t % 3), float(rng.choice([0.02, 0.05]))
+        hull, area, valid, zm = _jit.piece_hull(vertices, part, weak, owner, 3, color, surface, z, jump)
+        for twin in _both(monkeypatch, _twin_hull, vertices, part, owner, color, surface, red, z, jump):
+            np.testing.assert_array_equal(hull, twin)
+        depths = z[hull & (z > 0)]
+        assert area == int(hull.sum()) and valid == len(depths)
+        assert (valid == 0 and np.isnan(zm)) or zm == median(depths)
+        hulls += valid > 0
+        shared += valid > 0 and np.array_equal(hull & (z > 0), red & (z > 0))
+    assert ripe > 100 and hulls > 300 and shared > 80
+
+
+def test_the_piece_hull_known_answer():
+    """A 2x4 part in a 3x4 window, its hull the part; depths 1.0, 1.0, 1.2 on three red pixels and 1.1 on the one that
+    is not red (the other row without depth): the red median 1.0, the pixel that is not red 0.1 off it, dropped
+    beyond a jump of 0.05 (7 pixels, the median the red one's) and kept within 0.2 (8 pixels, the median of four
+    depths, (1.0 + 1.1) / 2); a part's pixel that another piece owns stays when it is red."""
+    from symfruit.segment.colour import _hull_vertices
+
+    part = np.zeros((3, 4), bool)
+    part[:2] = True
+    weak = part.copy()
+    weak[0, 3] = False
+    z = np.zeros((3, 4))
+    z[0] = [1.0, 1.0, 1.2, 1.1]
+    color = np.zeros((3, 4, 3), np.uint8)
+    color[..., 0] = 200
+    vertices = _hull_vertices(part)
+    owner = np.zeros((3, 4), np.int16)
+    hull, area, valid, zm = _jit.piece_hull(vertices, part, weak, owner, 1, color, True, z, 0.05)
+    assert hull.tolist() == weak.tolist() and (area, valid, zm) == (7, 3, 1.0)
+    owner[1, 0] = 2
+    hull, area, valid, zm = _jit.piece_hull(vertices, part, weak, owner, 1, color, True, z, 0.2)
+    assert hull.tolist() == part.tolist() and (area, valid, zm) == (8, 4, (1.0 + 1.1) / 2)
+    assert _jit.piece_ripe(color, part, weak, np.float32(0.99))
+    assert not _jit.piece_ripe(color, part, ~part, np.float32(-1.0))

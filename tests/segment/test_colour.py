@@ -1489,3 +1489,29 @@ def test_bridged_depth_cut_from_a_window_filled_before_is_the_same():
     np.testing.assert_array_equal(inner, _BridgedDepth(_Depth.of(depth))[(slice(9, 20), slice(10, 31))])
     bridged[(slice(0, 20), slice(10, 31))]
     assert len(filled) == 2
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_the_pieces_in_two_calls_are_the_five_calls_labels(seed, monkeypatch):
+    """``_plain_piece`` (a found piece's ripe test, hull, depth test and median depth in two compiled calls; stop 49)
+    gives the labels that the five calls it stands for give (``_plain_piece`` left out), on rendered strawberry frames
+    with depth, the default settings and with the hull's colour test off; and it took the pieces."""
+    import symfruit.segment.colour as colour
+
+    scene = make_scene(seed)
+    taken = [0]
+    plain = colour._plain_piece
+
+    def counted(*args, **kwargs):
+        found = plain(*args, **kwargs)
+        taken[0] += found is not None
+        return found
+
+    for settings in (SegmentSettings(), SegmentSettings(fill="hull")):
+        monkeypatch.setattr(colour, "_plain_piece", counted)
+        fast = segment(scene.color, scene.depth, scene.camera, settings)
+        monkeypatch.setattr(colour, "_plain_piece", lambda *args, **kwargs: None)
+        np.testing.assert_array_equal(fast, segment(scene.color, scene.depth, scene.camera, settings))
+        assert fast.max() >= 3
+    kernels = pytest.importorskip("symfruit.core.kernels")
+    assert taken[0] >= 6 or kernels.compiled() is None

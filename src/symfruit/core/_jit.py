@@ -5443,13 +5443,13 @@ def window_points(
 def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarray:
     """:func:`symfruit.segment.colour._sphere`'s points ``p`` (n, 3; n >= 1, finite) kept after a fit: those whose
     distance off the sphere (``|row_norm(p - centre) - radius|``, the twin's terms in its order) is at most 3 x
-    1.4826 times the median distance (:func:`_median_of`: np.median's value), or 1e-4. The same points."""
+    1.4826 times the median distance (:func:`_median_of`'s value: np.median's), or 1e-4. The same points."""
     n = p.shape[0]
     res = np.empty(n)
     for i in range(n):
         a, b, c = p[i, 0] - centre[0], p[i, 1] - centre[1], p[i, 2] - centre[2]
         res[i] = abs(math.sqrt(a * a + b * b + c * c) - radius)
-    limit = 3.0 * _median_of(res.copy()) * 1.4826
+    limit = 3.0 * median_of_quick(res) * 1.4826  # _median_of's value (stop 49)
     if 1e-4 > limit:
         limit = 1e-4
     keep = 0
@@ -5674,7 +5674,7 @@ def sphere_points(
     if n < 20:
         return np.empty((0, 3)), 0.0
     spread = math.sqrt(_variance(p[:, 0]) + _variance(p[:, 1])) * math.sqrt(2.0)
-    zm = _median_of(p[:, 2].copy())
+    zm = median_of_quick(p[:, 2])  # _median_of's value (stop 49)
     keep = 0
     for i in range(n):
         keep += abs(p[i, 2] - zm) <= 2.0 * spread
@@ -6656,10 +6656,11 @@ def _filled_box(mask: np.ndarray) -> np.ndarray:
 def split_seen(region: np.ndarray, depth: np.ndarray) -> tuple[np.ndarray, int, float]:
     """:func:`symfruit.segment.colour._split`'s start with depth: the region (h, w) bool with its holes filled
     (:func:`_filled_box`, the twin's ``fill_holes``), how many of its pixels have depth (``depth`` (h, w) float64
-    above 0) and ``core.points.median`` of those depths (NaN without any; :func:`masked_median`): the twin's values."""
+    above 0) and ``core.points.median`` of those depths (NaN without any; :func:`masked_median`'s values, the median
+    by :func:`median_quick` since stop 49): the twin's values."""
     full = _filled_box(region)
-    _, k, zm = masked_median(full, depth)
-    return full, k, zm
+    _, values = masked_depths(full, depth)
+    return full, values.shape[0], median_quick(values)
 
 
 @_njit
@@ -8317,3 +8318,103 @@ def bridged_trim(skin: np.ndarray, z: np.ndarray, part: np.ndarray, r0: int, c0:
         for c in range(w):
             out[r, c] = skin[r, c] and (z[r, c] > 0 or hull[r, c])
     return out, True
+
+
+# --- stop 49, seg640_49: the colour segmenter's found pieces at 640x480 in fewer calls --------------------------------
+
+
+@_njit
+def piece_ripe(color: np.ndarray, part: np.ndarray, weak: np.ndarray, least: np.float32) -> bool:
+    """:func:`symfruit.segment.colour._segment_at`'s ripe test of a piece: :func:`red_ripe` of its red pixels ``part &
+    weak`` ((h, w) bool each) in ``color`` (h, w, >= 3) uint8 (False without one: the twin's ``red.any()``), without
+    the red mask made and tested in numpy first: the same answer (stop 49)."""
+    h, w = part.shape
+    red = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            red[r, c] = part[r, c] and weak[r, c]
+    return red_ripe(color, red, least)
+
+
+@_njit
+def median_quick(values: np.ndarray) -> float:
+    """:func:`median_values` of ``values`` (n,) float64 (left as they are) by :func:`median_of_quick`: NaN when a value
+    is NaN or there is none. The same value (stop 49)."""
+    n = values.shape[0]
+    if n == 0:
+        return np.nan
+    for i in range(n):
+        if np.isnan(values[i]):
+            return np.nan
+    return median_of_quick(values)
+
+
+@_njit
+def median_of_quick(values: np.ndarray) -> float:
+    """:func:`_median_of` of ``values`` (n >= 1, no NaN; left as they are) by :func:`kth_smallest`, the quickselect
+    without branches, instead of :func:`select` (whose comparisons, going either way at random, cost most of its time):
+    the middle value, or the mean of the middle two halved as the twin halves it; of an even count the lower middle
+    value is the largest value below the upper one when that many lie below it, else the upper one itself (a tie).
+    Order statistics, so the same value (stop 49)."""
+    n = values.shape[0]
+    half = n // 2
+    upper = kth_smallest(values, half, np.empty(n), np.empty(n))
+    if n % 2:
+        return upper
+    below = upper
+    less = 0
+    for i in range(n):
+        v = values[i]
+        if v < upper:
+            less += 1
+            if less == 1 or v > below:
+                below = v
+    if less < half:  # the place below the middle holds a value equal to it
+        below = upper
+    return (below + upper) / 2.0
+
+
+@_njit
+def piece_hull(
+    vertices: np.ndarray, part: np.ndarray, weak: np.ndarray, owner: np.ndarray, k: int, color: np.ndarray,
+    surface: bool, z: np.ndarray, jump: float,
+) -> tuple[np.ndarray, int, int, float]:  # fmt: skip
+    """A ripe piece's hull and what its size test reads, in one call (:func:`symfruit.segment.colour._segment_at` with
+    depth and without the round fruit's skin): :func:`surface_hull` of the piece's ``part`` (h, w) bool, then
+    :func:`depth_consistent` of it against the piece's red pixels (``part & weak``) and the depths ``z`` (h, w)
+    float64, then :func:`masked_median` of the hull: the hull (h, w) bool, its pixel count, how many of them have
+    depth and their median depth. The twin's calls in one, the same values; a (0, 0) hull where
+    :func:`surface_hull` gives one (a vertex not a whole number: the twin then fills by Pillow). The medians by
+    :func:`median_quick`; where no pixel of the hull but its red ones has depth (the hull holds them all), the hull's
+    median depth is the red pixels' own, not taken again (stop 49)."""
+    hull = surface_hull(vertices, part, owner, k, color, surface)
+    h, w = part.shape
+    if hull.shape[0] != h or hull.shape[1] != w:
+        return hull, 0, 0, np.nan
+    n = 0
+    for r in range(h):
+        for c in range(w):
+            n += part[r, c] and weak[r, c] and z[r, c] > 0
+    if n > 0:  # depth_consistent against the red pixels' median depth (none with depth: the hull as it is)
+        values = np.empty(n, np.float64)
+        j = 0
+        for r in range(h):
+            for c in range(w):
+                if part[r, c] and weak[r, c] and z[r, c] > 0:
+                    values[j] = z[r, c]
+                    j += 1
+        zm = median_quick(values)
+        area = 0
+        other = 0  # the hull's pixels with depth that are not red
+        for r in range(h):
+            for c in range(w):
+                d = z[r, c]
+                red = part[r, c] and weak[r, c]
+                keep = red or (hull[r, c] and not (d > 0 and abs(d - zm) > jump))
+                hull[r, c] = keep
+                area += keep
+                other += keep and not red and d > 0
+        if other == 0:  # the hull's pixels with depth are the red ones: their median
+            return hull, area, n, zm
+    area, depths = masked_depths(hull, z)
+    return hull, area, depths.shape[0], median_quick(depths)

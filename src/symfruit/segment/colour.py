@@ -632,6 +632,11 @@ def _segment_at(
     found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]] = []
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
+        if z is not None and not s.round_fruit and (plain := _plain_piece(piece, k, c, weak, owner, z, s, geo.focal,
+                                                                           z_typical)) is not None:  # fmt: skip
+            if isinstance(plain, np.ndarray) and (claimed := _claim(out[sl], plain)) is not None:  # (stop 49)
+                found.append((sl, *claimed))
+            continue
         red = part & weak[sl]
         if not red.any() or not _ripe(c[sl], red, s.ripe_median):
             continue
@@ -2349,12 +2354,47 @@ def _fruit_sized(
         return int(mask.sum()) >= min_area
     if (jit := compiled()) is not None and mask.dtype == bool and depth.dtype == np.float64 and mask.ndim == 2:
         area, valid, zm = jit.masked_median(mask, depth)  # the same values in one call (issue 19, nineteenth round)
-        diameter_px = focal * s.min_diameter / (float(zm) if valid else z_typical)
-        return int(area) >= np.pi / 4 * diameter_px**2
+        return _sized(int(area), float(zm) if valid else z_typical, s, focal)
     area = int(mask.sum())
     z = depth[mask & (depth > 0)]
     diameter_px = focal * s.min_diameter / (float(median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
+
+
+def _sized(area: int, zm: float, s: SegmentSettings, focal: float) -> bool:
+    """:func:`_fruit_sized`'s test with depth, from the part's ``area`` (pixels) and median depth ``zm``."""
+    diameter_px = focal * s.min_diameter / zm
+    return area >= np.pi / 4 * diameter_px**2
+
+
+def _plain_piece(
+    piece: _Piece, k: int, c: np.ndarray, weak: np.ndarray, owner: np.ndarray, z: _Depth, s: SegmentSettings,
+    focal: float, z_typical: float,
+) -> np.ndarray | bool | None:  # fmt: skip
+    """:func:`_segment_at`'s tests of a found ``piece`` (the ``k``-th) with depth and without the round fruit's skin,
+    in two compiled calls where numba is (:func:`symfruit.core._jit.piece_ripe`, then its hull, the hull's depth test
+    and the median depth the size test reads by :func:`symfruit.core._jit.piece_hull`), not five calls and their masks
+    (stop 49): the hull to claim, False when the piece is not a ripe fruit-sized one, None where the calls below it
+    are to be made (no numba, other types, a hull that Pillow fills). The same hull and answers."""
+    jit = compiled()
+    if jit is None or c.dtype != np.uint8 or not _pillow_fill():
+        return None
+    sl, part = piece.window, piece.mask
+    if part.dtype != bool or part.ndim != 2:
+        return None
+    color = c[sl]
+    if not jit.piece_ripe(color, part, weak[sl], np.float32(s.ripe_median)):
+        return False
+    vertices = piece.hull_vertices()
+    sub_z = z[sl]
+    if vertices is None or vertices.dtype != np.float64 or sub_z.dtype != np.float64:
+        return None
+    surface = s.fill in ("surface", "auto")
+    hull, area, valid, zm = jit.piece_hull(vertices, part, weak[sl], owner[sl], int(k), color, surface, sub_z,
+                                           float(s.depth_jump))  # fmt: skip
+    if hull.shape != part.shape:
+        return None
+    return hull if _sized(int(area), float(zm) if valid else z_typical, s, focal) else False
 
 
 def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
