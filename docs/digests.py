@@ -1,0 +1,82 @@
+"""Digests that say whether a speed change kept the results bit for bit (issue 19): ``detect``'s records on the
+benchmark frames (``symfruit bench --frame``'s frame, seeds 0-2, methods ``evidence`` and ``paper``: every
+detection's points, box, scores and extras) and the colour segmenter's labels (strawberry frames of seeds 0-7 with
+and without depth, seed 0 through the four camera models, apple-tree frames of seeds 0-3 with depth and the apple
+profile). Run it on the tree before and after a change (``SYMFRUIT_KERNELS=numpy`` for the numpy twins); the same
+digests mean the same results. The digests depend on the host's libraries (BLAS), so compare on one host.
+
+    python docs/digests.py [records] [labels]
+"""
+
+import argparse
+import hashlib
+import sys
+
+import numpy as np
+
+
+def records() -> str:
+    from symfruit.detect import detect
+    from symfruit.evaluate.bench import _bench_scene
+
+    h = hashlib.sha256()
+    for seed in (0, 1, 2):
+        frame, _ = _bench_scene(None, seed)
+        for method in ("evidence", "paper"):
+            for d in detect(frame, method=method).detections:
+                h.update(f"{seed}{method}{d.id}{d.error}".encode())
+                h.update(np.ascontiguousarray(d.extraction.points, dtype=np.float64).tobytes())
+                r = d.result
+                if r is None:
+                    continue
+                h.update(np.ascontiguousarray(r.points, dtype=np.float64).tobytes())
+                h.update(np.asarray([r.box.min, r.box.max], dtype=np.float64).tobytes())
+                h.update(np.float64(r.score).tobytes())
+                h.update(np.ascontiguousarray(r.scores, dtype=np.float64).tobytes())
+                for k in sorted(r.extras):
+                    v = r.extras[k]
+                    h.update(k.encode())
+                    numeric = isinstance(v, np.ndarray | float | int)
+                    h.update(np.asarray(v).tobytes() if numeric else repr(v).encode())
+    return h.hexdigest()[:16]
+
+
+def labels() -> tuple[str, int]:
+    from symfruit.profiles import load_profile
+    from symfruit.segment.colour import segment
+    from symfruit.synthetic.scenes import make_scene, make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    h = hashlib.sha256()
+    found = 0
+    runs = []
+    for seed in range(8):
+        sc = make_scene(seed, n_ripe=8, n_unripe=2)
+        runs += [(sc.color, None, None, None), (sc.color, sc.depth, sc.camera, None)]
+    for name in ("azure-kinect", "realsense-l515", "realsense-d435", "realsense-d405"):
+        sc = make_scene(0, n_ripe=8, n_unripe=2, sensor=sensor_model(name))
+        runs.append((sc.color, sc.depth, sc.camera, None))
+    apple = load_profile("apple").segment
+    for seed in range(4):
+        sc = make_tree_scene(seed, sensor=sensor_model("azure-kinect"))
+        runs.append((sc.color, sc.depth, sc.camera, apple))
+    for color, depth, camera, settings in runs:
+        lab = segment(color, depth, camera, settings)
+        h.update(np.ascontiguousarray(lab, dtype=np.int32).tobytes())
+        found += int(lab.max())
+    return h.hexdigest()[:16], found
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("what", nargs="*", choices=("records", "labels"), default=["records", "labels"])
+    args = parser.parse_args()
+    if "records" in args.what:
+        sys.stdout.write(f"records {records()}\n")
+    if "labels" in args.what:
+        digest, found = labels()
+        sys.stdout.write(f"labels {digest} {found} fruit\n")
+
+
+if __name__ == "__main__":
+    main()
