@@ -1532,10 +1532,16 @@ def key_ranks(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 def _median_of(x: np.ndarray) -> float:
     """np.median of ``x`` (n >= 1, no NaN), reordering it: :func:`select` at the middle place, the place below it
     (even ``n``) the largest before it, their sum halved (:func:`symfruit.core.points.median`'s value bit for bit)."""
-    n = x.shape[0]
-    h = n // 2
+    h = x.shape[0] // 2
     select(x, h)
-    if n % 2:
+    return _selected_median(x, h)
+
+
+@_njit
+def _selected_median(x: np.ndarray, h: int) -> float:
+    """The median of ``x`` (n,) once a selection has put its ``h = n // 2``-th smallest value at ``x[h]`` and the
+    smaller ones before it: that value, or (even ``n``) its sum with the largest before it halved."""
+    if x.shape[0] % 2:
         return x[h]
     below = x[0]
     for i in range(1, h):
@@ -8234,15 +8240,9 @@ def select_lomuto(x: np.ndarray, kth: int) -> None:
 @_njit
 def median_lomuto(x: np.ndarray) -> float:
     """:func:`_median_of` (``x`` (n,), n >= 1, no NaN, reordered) by :func:`select_lomuto`: the same value."""
-    n = x.shape[0]
-    h = n // 2
+    h = x.shape[0] // 2
     select_lomuto(x, h)
-    if n % 2:
-        return x[h]
-    below = x[0]
-    for i in range(1, h):
-        below = max(below, x[i])
-    return (below + x[h]) / 2.0
+    return _selected_median(x, h)
 
 
 @_njit
