@@ -69,20 +69,26 @@ def solve(a: np.ndarray, b: np.ndarray, x: np.ndarray) -> bool:
 
 
 @_njit
+def _pivot(x: np.ndarray, lo: int, hi: int) -> float:
+    """The median of ``x[lo]``, ``x[hi]`` and the value midway between them: a selection's pivot."""
+    a, b, c = x[lo], x[(lo + hi) >> 1], x[hi]
+    if a > b:
+        a, b = b, a
+    if b > c:
+        b = c
+        if a > b:
+            b = a
+    return b
+
+
+@_njit
 def select(x: np.ndarray, kth: int) -> None:
     """Reorder ``x`` (n,) in place so that ``x[kth]`` is its ``kth`` smallest value, none larger before it and none
     smaller after (quickselect, median-of-three pivots: a partition without ``np.partition``'s copy, half its
     time on a few hundred values)."""
     lo, hi = 0, x.shape[0] - 1
     while hi > lo:
-        mid = (lo + hi) >> 1
-        a, b, c = x[lo], x[mid], x[hi]
-        if a > b:
-            a, b = b, a
-        if b > c:
-            b = c
-            if a > b:
-                b = a
+        b = _pivot(x, lo, hi)
         i, j = lo, hi
         while i <= j:
             while x[i] < b:
@@ -8206,14 +8212,7 @@ def select_lomuto(x: np.ndarray, kth: int) -> None:
     :func:`depth_noise` calls 0.8 -> 0.4 ms)."""
     lo, hi = 0, x.shape[0] - 1
     while hi > lo:
-        mid = (lo + hi) >> 1
-        a, b, c = x[lo], x[mid], x[hi]
-        if a > b:
-            a, b = b, a
-        if b > c:
-            b = c
-            if a > b:
-                b = a
+        b = _pivot(x, lo, hi)
         i = lo  # the values below the pivot b to x[lo:i]
         for j in range(lo, hi + 1):
             v = x[j]
