@@ -69,8 +69,9 @@ def labels() -> tuple[str, int]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("what", nargs="*", choices=("records", "labels"), default=["records", "labels"])
+    parser.add_argument("what", nargs="*", choices=("records", "labels"), help="default: both")
     args = parser.parse_args()
+    args.what = args.what or ["records", "labels"]
     if "records" in args.what:
         sys.stdout.write(f"records {records()}\n")
     if "labels" in args.what:
