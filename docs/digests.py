@@ -69,9 +69,11 @@ def labels() -> tuple[str, int]:
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("what", nargs="*", choices=("records", "labels"), help="default: both")
+    parser.add_argument("what", nargs="*", help="records, labels or both (default: both)")
     args = parser.parse_args()
     args.what = args.what or ["records", "labels"]
+    if not set(args.what) <= {"records", "labels"}:
+        parser.error(f"what: give records and/or labels, got {' '.join(args.what)}")
     if "records" in args.what:
         sys.stdout.write(f"records {records()}\n")
     if "labels" in args.what:
