@@ -6424,16 +6424,20 @@ def ground_pixels(color: np.ndarray, ground_hue: int, leaf_hue: int, dark: int) 
 
 
 @_njit
+def _empty_or_nan(values: np.ndarray) -> bool:
+    """Whether ``values`` (n,) is empty or holds a NaN: where the medians of :func:`median_values` and
+    :func:`median_quick` are NaN."""
+    for i in range(values.shape[0]):
+        if np.isnan(values[i]):
+            return True
+    return values.shape[0] == 0
+
+
+@_njit
 def median_values(values: np.ndarray) -> float:
     """``core.points.median`` of ``values`` (n,) float64 (overwritten: reordered): NaN when a value is NaN or there is
     none, else the middle value (:func:`select`) or the mean of the middle two, halved as the twin halves it."""
-    n = values.shape[0]
-    if n == 0:
-        return np.nan
-    for i in range(n):
-        if np.isnan(values[i]):
-            return np.nan
-    return _median_of(values)
+    return np.nan if _empty_or_nan(values) else _median_of(values)
 
 
 @_njit
@@ -8339,13 +8343,7 @@ def piece_ripe(color: np.ndarray, part: np.ndarray, weak: np.ndarray, least: np.
 def median_quick(values: np.ndarray) -> float:
     """:func:`median_values` of ``values`` (n,) float64 (left as they are) by :func:`median_of_quick`: NaN when a value
     is NaN or there is none. The same value (stop 49)."""
-    n = values.shape[0]
-    if n == 0:
-        return np.nan
-    for i in range(n):
-        if np.isnan(values[i]):
-            return np.nan
-    return median_of_quick(values)
+    return np.nan if _empty_or_nan(values) else median_of_quick(values)
 
 
 @_njit
