@@ -102,9 +102,10 @@ def main(argv: list[str] | None = None) -> int:
     for _ in range(args.frames):
         detect.detect(frame, method=args.method)
     per = (time.thread_time() - start) / args.frames
-    print(f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({args.frames} frames)")
+    lines = [f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({args.frames} frames)"]
     for key, seconds in sorted(spent.items(), key=lambda kv: -kv[1])[: args.top]:
-        print(f"{seconds / args.frames * 1e3:8.2f} ms {calls[key] / args.frames:8.1f} calls  {key}")
+        lines.append(f"{seconds / args.frames * 1e3:8.2f} ms {calls[key] / args.frames:8.1f} calls  {key}")
+    sys.stdout.write("\n".join(lines) + "\n")
     return 0
 
 
