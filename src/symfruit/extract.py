@@ -14,7 +14,7 @@ from scipy import ndimage
 from .core.camera import Camera
 from .core.kernels import compiled
 from .core.limits import depth_metres
-from .core.points import bounds
+from .core.points import bounds, median
 from .core.raster import mask_box, square_filter
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .errors import InputError
@@ -294,7 +294,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         # the nearest of the big clusters (one alone needs no medians)
-        near = big[0] if len(big) == 1 else big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
+        near = big[0] if len(big) == 1 else big[np.argmin([median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
@@ -341,7 +341,7 @@ def backdrop(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, focal: flo
     d = d[np.isfinite(d) & (d > 0)]
     if not len(d):
         return float("nan"), float("nan"), 0
-    z = float(np.median(points[:, 2]))
+    z = float(median(points[:, 2]))  # np.median's value, bit for bit, without its general-axis machinery
     r = 0.5 * max(r1 - r0, c1 - c0) * z / focal
     return np.count_nonzero(d > z + r) / len(d), np.count_nonzero(np.abs(d - z) <= r) / around, len(d)
 
@@ -375,7 +375,7 @@ def own_surface(ex: Extraction, mask: np.ndarray, depth: np.ndarray, camera: Cam
     behind, level, count = backdrop(ex.points, mask, depth, focal, box)
     if box is None or count < 10 or not (behind <= BEHIND_SHARE and level >= LEVEL_SHARE):
         return ex
-    z = float(np.median(ex.points[:, 2]))
+    z = float(median(ex.points[:, 2]))
     r = 0.5 * max(box[1] - box[0], box[3] - box[2]) * z / focal
     r0, r1, c0, c1 = window or (0, mask.shape[0], 0, mask.shape[1])
     d = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
