@@ -337,9 +337,9 @@ def backdrop(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, focal: flo
     z = float(median(points[:, 2]))  # np.median's value, bit for bit, without its general-axis machinery
     r = 0.5 * max(r1 - r0, c1 - c0) * z / focal
     jit = compiled()
-    if jit is not None and mask.dtype == bool and depth.ndim == 2 and depth.dtype in (np.float32, np.float64):
+    if jit is not None and mask.dtype == bool and depth.shape == mask.shape and depth.dtype in (np.float32, np.float64):
         # the ring's sampling, its two square filters and the counts below in one call (stop 50, docs/speed50.md:
-        # the same pixels and counts)
+        # the same pixels and counts; the kernel reads both images at the same places, so only where they match)
         around, count, n_behind, n_level = jit.backdrop_counts(mask, depth, a0, a1, b0, b1, step, max(grow // step, 2),
                                                                z, r)  # fmt: skip
         if not count:
