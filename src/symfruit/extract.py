@@ -14,7 +14,7 @@ from scipy import ndimage
 from .core.camera import Camera
 from .core.kernels import compiled
 from .core.limits import depth_metres
-from .core.points import bounds
+from .core.points import bounds, median
 from .core.raster import mask_box, square_filter
 from .core.surface import colour_trim, fruit_surface, registration_shift
 from .errors import InputError
@@ -294,7 +294,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         # the nearest of the big clusters (one alone needs no medians)
-        near = big[0] if len(big) == 1 else big[np.argmin([np.median(points[labels == k, 2]) for k in big])]
+        near = big[0] if len(big) == 1 else big[np.argmin([median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
@@ -334,6 +334,17 @@ def backdrop(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, focal: flo
     grow = int(max(np.ceil(radius_px), 4))
     step = max(1, grow // AROUND_STEPS)
     a0, a1, b0, b1 = max(r0 - grow - 1, 0), min(r1 + grow + 1, h), max(c0 - grow - 1, 0), min(c1 + grow + 1, w)
+    z = float(median(points[:, 2]))  # np.median's value, bit for bit, without its general-axis machinery
+    r = 0.5 * max(r1 - r0, c1 - c0) * z / focal
+    jit = compiled()
+    if jit is not None and mask.dtype == bool and depth.shape == mask.shape and depth.dtype in (np.float32, np.float64):
+        # the ring's sampling, its two square filters and the counts below in one call (stop 50, docs/speed50.md:
+        # the same pixels and counts; the kernel reads both images at the same places, so only where they match)
+        around, count, n_behind, n_level = jit.backdrop_counts(mask, depth, a0, a1, b0, b1, step, max(grow // step, 2),
+                                                               z, r)  # fmt: skip
+        if not count:
+            return float("nan"), float("nan"), 0
+        return n_behind / count, n_level / around, count
     m = np.ascontiguousarray(np.asarray(mask[a0:a1:step, b0:b1:step], dtype=bool))
     ring = square_filter(m, max(grow // step, 2)) & ~square_filter(m, 1)
     d = np.asarray(depth[a0:a1:step, b0:b1:step], dtype=np.float64)[ring]
@@ -341,8 +352,6 @@ def backdrop(points: np.ndarray, mask: np.ndarray, depth: np.ndarray, focal: flo
     d = d[np.isfinite(d) & (d > 0)]
     if not len(d):
         return float("nan"), float("nan"), 0
-    z = float(np.median(points[:, 2]))
-    r = 0.5 * max(r1 - r0, c1 - c0) * z / focal
     return np.count_nonzero(d > z + r) / len(d), np.count_nonzero(np.abs(d - z) <= r) / around, len(d)
 
 
@@ -375,7 +384,7 @@ def own_surface(ex: Extraction, mask: np.ndarray, depth: np.ndarray, camera: Cam
     behind, level, count = backdrop(ex.points, mask, depth, focal, box)
     if box is None or count < 10 or not (behind <= BEHIND_SHARE and level >= LEVEL_SHARE):
         return ex
-    z = float(np.median(ex.points[:, 2]))
+    z = float(median(ex.points[:, 2]))
     r = 0.5 * max(box[1] - box[0], box[3] - box[2]) * z / focal
     r0, r1, c0, c1 = window or (0, mask.shape[0], 0, mask.shape[1])
     d = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)

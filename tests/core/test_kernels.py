@@ -6282,3 +6282,34 @@ def test_the_piece_hull_known_answer():
     assert hull.tolist() == part.tolist() and (area, valid, zm) == (8, 4, (1.0 + 1.1) / 2)
     assert _jit.piece_ripe(color, part, weak, np.float32(0.99))
     assert not _jit.piece_ripe(color, part, ~part, np.float32(-1.0))
+
+
+# --- stop 50, speed50: the backdrop's ring ---------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_backdrop_counts_are_the_twins(monkeypatch, seed):
+    """:func:`symfruit.extract.backdrop` by :func:`_jit.backdrop_counts` and by its numpy twin on random masks (a disc
+    of 2-40 px radius, cut by the image's edge or not, a few pixels flipped) over depth that is float32 or float64,
+    with NaN, 0 and negative pixels, around random points' depths: the same shares and counts (NaN where no ring pixel
+    holds depth), whatever the ring's sampling step."""
+    from symfruit.extract import backdrop
+
+    rng = np.random.default_rng(seed)
+    found = 0
+    for t in range(40):
+        h, w = (int(v) for v in rng.integers(20, 160, 2))
+        rr, cc = np.mgrid[:h, :w]
+        radius = float(rng.uniform(2, 40))
+        mask = (rr - rng.uniform(-10, h + 10)) ** 2 + (cc - rng.uniform(-10, w + 10)) ** 2 <= radius**2
+        mask ^= rng.random((h, w)) < 0.01
+        dtype = np.float32 if t % 2 else np.float64
+        depth = rng.choice([0.4, 0.5, 0.6, 2.0], size=(h, w)) + rng.normal(0, 0.05, (h, w))
+        depth[rng.random((h, w)) < 0.1] = rng.choice([0.0, np.nan, -1.0])
+        depth = depth.astype(dtype)
+        points = np.column_stack((rng.normal(size=(50, 2)), rng.uniform(0.4, 0.6, 50)))
+        kernel, twin = _both(monkeypatch, backdrop, points, mask, depth, float(rng.uniform(300, 900)))
+        assert np.array_equal(np.array(kernel, float), np.array(twin, float), equal_nan=True), (t, kernel, twin)
+        assert type(kernel[2]) is int or kernel[2] == 0
+        found += kernel[2] > 0
+    assert found > 20

@@ -8415,3 +8415,40 @@ def piece_hull(
             return hull, area, n, zm
     area, depths = masked_depths(hull, z)
     return hull, area, depths.shape[0], median_quick(depths)
+
+
+# --- stop 50, speed50: the backdrop's ring in one call ---------------------------------------------------------------
+
+
+@_njit
+def backdrop_counts(
+    mask: np.ndarray, depth: np.ndarray, a0: int, a1: int, b0: int, b1: int, step: int, grow: int, z: float, r: float
+) -> tuple[int, int, int, int]:  # fmt: skip
+    """:func:`symfruit.extract.backdrop`'s counts in one call: ``(around, count, behind, level)`` over the ring of the
+    sampled window ``mask[a0:a1:step, b0:b1:step]`` (``mask`` and ``depth`` the (h, w) image, read in place): the
+    pixels with a mask pixel within ``grow`` of them (the ``2 grow + 1`` square, :func:`square_filter`'s) but none
+    within 1. ``around`` the ring's pixels, ``count`` those whose depth (as float64) is finite and above 0, ``behind``
+    of those the ones deeper than ``z + r``, ``level`` the ones with ``|depth - z| <= r``: the twin's boolean index and
+    its counts (whole numbers, in any order the same), its float64 sum and comparisons."""
+    rows = (a1 - a0 + step - 1) // step
+    cols = (b1 - b0 + step - 1) // step
+    m = np.empty((rows, cols), np.bool_)
+    for i in range(rows):
+        for j in range(cols):
+            m[i, j] = mask[a0 + i * step, b0 + j * step]
+    wide = np.empty((rows, cols), np.bool_)
+    near = np.empty((rows, cols), np.bool_)
+    _square_any(m, grow, True, wide)
+    _square_any(m, 1, True, near)
+    zr = z + r
+    around = count = behind = level = 0
+    for i in range(rows):
+        for j in range(cols):
+            if wide[i, j] and not near[i, j]:
+                around += 1
+                y = np.float64(depth[a0 + i * step, b0 + j * step])
+                if math.isfinite(y) and y > 0.0:
+                    count += 1
+                    behind += y > zr
+                    level += abs(y - z) <= r
+    return around, count, behind, level

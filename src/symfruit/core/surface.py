@@ -674,7 +674,7 @@ class _InverseQuadratic:
         a = self._design(rows, cols)
         w = 1.0 / z
         try:
-            self.inverse: np.ndarray | None = np.linalg.inv(a.T @ a)
+            self.inverse: np.ndarray | None = lapack.inv(a.T @ a)  # np.linalg.inv's LAPACK call and values
         except np.linalg.LinAlgError:
             self.inverse = None
             return

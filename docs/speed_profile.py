@@ -1,0 +1,113 @@
+"""Where the benchmark frame's time goes, function by function: every function of ``symfruit`` (module-level
+functions, the methods of its classes with ``--methods``, and the compiled kernels' Python-level calls) wrapped in a
+``time.thread_time`` timer, then ``detect`` run on the benchmark frame (``symfruit bench --frame``); prints each
+function's inclusive thread CPU per frame and its calls per frame, the largest first.
+
+    python docs/speed_profile.py [--only SUBSTRING ...] [--methods] [--frames 8] [--top 60] [--method evidence]
+
+e.g. ``PYTHONPATH=src python docs/speed_profile.py --only evidence agreement candidates jit.``. cProfile cannot
+time this code (with a profiler hook set, numba's calls take a slow path, README "Speed", stop 48); these wrappers
+can, at a cost: each wrapped call adds about a microsecond, so a frame timed with every function wrapped reads
+about half again its own time, and a small function called often reads high. ``--only`` wraps only the functions
+whose qualified name holds one of the substrings (``jit.NAME`` for a kernel): the fewer wrapped, the nearer the
+figures are to the frame's own. Inclusive times: a function's callees are counted in it too. A function looked up
+before the wrappers were set (a method's entry in ``symfruit.methods``' registry, a kernel called from another
+kernel) is not seen: wrap its callees. Compare figures within one run (thread CPU, the host's load still shows).
+"""
+
+import argparse
+import importlib
+import pkgutil
+import sys
+import time
+import types
+from collections import Counter, defaultdict
+from typing import Any
+
+#: Modules left out (optional dependencies, entry points, plots): nothing of the frame runs in them.
+SKIP = ("ros", "dask", "cli", "__main__", "viz", "plot")
+
+
+def _timed(fn: Any, key: str, spent: dict[str, float], calls: Counter) -> Any:
+    def timed(*a: Any, **k: Any) -> Any:
+        start = time.thread_time()
+        try:
+            return fn(*a, **k)
+        finally:
+            spent[key] += time.thread_time() - start
+            calls[key] += 1
+
+    timed.__wrapped__ = fn  # type: ignore[attr-defined]
+    return timed
+
+
+def _wrap_all(only: list[str], methods: bool, spent: dict[str, float], calls: Counter) -> int:
+    """Every wanted function of every ``symfruit`` module replaced by its timed wrapper wherever a module holds it;
+    the number wrapped."""
+    import symfruit
+
+    def wanted(key: str) -> bool:
+        return not only or any(part in key for part in only)
+
+    made: dict[int, Any] = {}
+    for info in pkgutil.walk_packages(symfruit.__path__, "symfruit."):
+        if any(part in info.name for part in SKIP):
+            continue
+        try:
+            module = importlib.import_module(info.name)
+        except ImportError:  # an optional extra not installed
+            continue
+        for name, obj in list(vars(module).items()):
+            if methods and isinstance(obj, type) and obj.__module__ == module.__name__:
+                for attr, fn in list(vars(obj).items()):
+                    key = f"{obj.__module__}.{obj.__qualname__}.{attr}"
+                    if isinstance(fn, types.FunctionType) and not attr.startswith("__") and wanted(key):
+                        setattr(obj, attr, _timed(fn, key, spent, calls))
+                continue
+            if isinstance(obj, types.FunctionType) and obj.__module__.startswith("symfruit"):
+                key = f"{obj.__module__}.{obj.__qualname__}"
+            elif type(obj).__name__ == "CPUDispatcher":  # a numba kernel, as Python calls it
+                key = f"jit.{name}"
+            else:
+                continue
+            # core.lapack's error callbacks are keys of its settings table: not replaced
+            if (module.__name__.endswith(".lapack") and name.startswith("_")) or not wanted(key):
+                continue
+            if id(obj) not in made:
+                made[id(obj)] = _timed(obj, key, spent, calls)
+            setattr(module, name, made[id(obj)])
+    return len(made)
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--only", nargs="*", default=[], help="wrap only names holding one of these")
+    parser.add_argument("--methods", action="store_true", help="wrap the methods of symfruit's classes too")
+    parser.add_argument("--frames", type=int, default=8)
+    parser.add_argument("--top", type=int, default=60)
+    parser.add_argument("--method", default="evidence")
+    args = parser.parse_args(argv)
+    spent: dict[str, float] = defaultdict(float)
+    calls: Counter = Counter()
+    count = _wrap_all(args.only, args.methods, spent, calls)
+    import symfruit.detect as detect
+    from symfruit.evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, 0)
+    for _ in range(3):  # warm-up: compiled kernels loaded, caches made
+        detect.detect(frame, method=args.method)
+    spent.clear()
+    calls.clear()
+    start = time.thread_time()
+    for _ in range(args.frames):
+        detect.detect(frame, method=args.method)
+    per = (time.thread_time() - start) / args.frames
+    lines = [f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({args.frames} frames)"]
+    for key, seconds in sorted(spent.items(), key=lambda kv: -kv[1])[: args.top]:
+        lines.append(f"{seconds / args.frames * 1e3:8.2f} ms {calls[key] / args.frames:8.1f} calls  {key}")
+    sys.stdout.write("\n".join(lines) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
