@@ -399,8 +399,9 @@ def test_a_scheduler_without_workers_is_refused_after_the_time_out_not_waited_on
 def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocessed(recording, tmp_path, monkeypatch):
     """The one worker leaves once the first frame is written (each frame takes a second here): after the time-out
     the run stops, the frames not done recorded unprocessed (``--resume`` takes them up), not waited on for ever."""
-    import symfruit.season.cluster as cluster
     from distributed import LocalCluster
+
+    import symfruit.season.cluster as cluster
 
     real = cluster.detect
 
