@@ -422,7 +422,7 @@ def run_distributed(
         target += [rec.folder / frame_folder_name(n, reserved) for n in names]
         direct += rec_direct if rec_direct is not None else [None] * len(names)
     try:
-        done_before = {i for i in range(len(keys)) if resume and frame_done(target[i])}
+        done_before = {i for i in range(len(keys)) if resume and frame_done(target[i], raw[i])}
         todo = [i for i in range(len(keys)) if i not in done_before]
         with contextlib.ExitStack() as stack:
             client = stack.enter_context(_client(scheduler, workers)) if todo else None
