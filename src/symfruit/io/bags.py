@@ -232,10 +232,9 @@ class _BoundedFile:
         if self._out > max(self._room, 0):
             room = max(self._room, 0)
             raise BagFileExpands(
-                f"{self._name}: compressed as a whole file (rosbag2's deprecated file compression), it expands past "
-                f"{room / 1e6:,.0f} MB, what the disk of {tempfile.gettempdir()} holds with "
-                f"{BAG_FILE_DISK_RESERVE >> 20} MB kept free (decompression stopped there): a damaged file, or "
-                "decompress it yourself where there is room (zstd -d) and read that"
+                f"{self._name}: compressed whole (rosbag2's file compression), it expands past {room / 1e6:,.0f} MB, "
+                f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
+                "damaged, or zstd -d it where there is room"
             )
         return data
 
