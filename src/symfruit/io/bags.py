@@ -291,7 +291,7 @@ def _bound_decompression() -> None:
         folder_reader.STORAGE_PLUGINS = {**plugins, "mcap": _checked_mcap(plugins["mcap"])}  # type: ignore[union-attr]
     chunk_reader = getattr(getattr(ros1, "Reader", None), "read_chunk", None)
     if chunk_reader is not None and not getattr(chunk_reader, "_symfruit", False):
-        ros1.Reader.read_chunk = _sized_chunks(chunk_reader)
+        setattr(ros1.Reader, "read_chunk", _sized_chunks(chunk_reader))  # noqa: B010  # rosbags, for its reader
 
 
 def _sized_chunks(read_chunk: Any) -> Any:

@@ -437,19 +437,8 @@ def run_distributed(
                 try:
                     named = {v: k for k, v in report.recordings.items()}
                     with TableWriter(output, root=out, inputs=named) as table:
-                        _run(
-                            frames,
-                            client,
-                            todo,
-                            done_before,
-                            chunk,
-                            max_ahead,
-                            report,
-                            table,
-                            bar,
-                            out,
-                            no_worker_timeout,
-                        )
+                        _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out,
+                             no_worker_timeout)  # fmt: skip
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
             if client is not None:
