@@ -28,7 +28,6 @@ from __future__ import annotations
 import argparse
 import json
 import shutil
-import signal
 import sys
 import tempfile
 import time
@@ -42,33 +41,18 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import robust47 as r47
-import robust48 as r48
 import robust49 as r49
 
-ROOT = r47.ROOT
 #: A case's alarm (s): the scheduler without workers waited for ever before.
 LIMIT_S = 90
-CASES: list[tuple[str, str, Callable[[], Any], str]] = []
-cli, Run = r47.cli, r47.Run
+#: robust49's helpers: the fixtures' folder (``T()``), a fresh fixture path, an output folder, the command line.
+ROOT, T, fixture, cli, Run = r47.ROOT, r49.T, r49.fixture, r47.cli, r47.Run
 F640 = ROOT / "examples/realsense/aligned_00000"
+CASES: list[tuple[str, str, Callable[[], Any], str]] = []
 
 
 def add(name: str, expect: str, fn: Callable[[], Any], names: str = "") -> None:
     CASES.append((name, expect, fn, names))
-
-
-def T() -> Path:
-    return r47.T
-
-
-def fixture(name: str) -> Path:
-    p = T() / "cases50" / name
-    if p.is_dir() and not p.is_symlink():
-        shutil.rmtree(p)
-    elif p.exists() or p.is_symlink():
-        p.unlink()
-    p.parent.mkdir(parents=True, exist_ok=True)
-    return p
 
 
 def small() -> tuple[np.ndarray, np.ndarray, Any]:
@@ -402,47 +386,13 @@ def main() -> int:
     args = parser.parse_args()
     import logging
 
-    import symfruit
-
     warnings.simplefilter("ignore")
     logging.getLogger("distributed").setLevel(logging.CRITICAL)
     r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust50-"))
     r47.T.mkdir(parents=True, exist_ok=True)
     for build in (api_cases, report_cases, ros_cases, bag_cases):
         build()
-    signal.signal(signal.SIGALRM, r47._alarm)
-    counts = {"error": 0, "failed": 0, "result": 0, "DEFECT": 0}
-    for name, expect, fn, names in CASES:
-        if not any(part in name for part in args.only.split(",")):
-            continue
-        signal.alarm(LIMIT_S)
-        try:
-            value = fn()
-            signal.alarm(0)
-            if isinstance(value, str) and value.startswith("DEFECT"):
-                kind, text = "DEFECT", value.removeprefix("DEFECT: ")
-            else:
-                kind, text = r47.judge(value, expect, names)
-        except symfruit.SymfruitError as exc:
-            signal.alarm(0)
-            msg = str(exc).replace(str(r47.T), "T")
-            kind, text = ("DEFECT", f"refused what it should take: {msg[:150]}") if expect == "result" else (
-                "error", msg[:150])  # fmt: skip
-            if len(msg) > 300 or r47._FOREIGN.search(msg):
-                kind, text = "DEFECT", f"message of {len(msg)} characters or another library's words: {msg[:150]}"
-        except r47.Hang:
-            kind, text = "DEFECT", f"hang (over {LIMIT_S} s)"
-        except Exception as exc:  # the point of the sweep
-            signal.alarm(0)
-            kind, text = "DEFECT", r47.origin(exc)
-        if kind != "DEFECT" and (said := r48._PYTHON_SPEAK.search(text) or r49._PYTHON_SPEAK.search(text)):
-            kind, text = "DEFECT", f"Python's words ({said.group(0)!r}): {text[:150]}"
-        counts[kind] += 1
-        if kind == "DEFECT" or not args.defects:
-            sys.stdout.write(f"{kind:6} {name:52} {text}\n")
-            sys.stdout.flush()
-    sys.stdout.write(f"# {sum(counts.values())} cases: {counts['error']} clear errors, {counts['failed']} failed items "
-                     f"reported, {counts['result']} results, {counts['DEFECT']} defects\n")  # fmt: skip
+    counts = r49.sweep(CASES, only=args.only, defects=args.defects, limit=LIMIT_S, width=52)
     if not args.keep:
         shutil.rmtree(r47.T, ignore_errors=True)
     return 1 if counts["DEFECT"] else 0
