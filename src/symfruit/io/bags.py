@@ -201,14 +201,14 @@ def bag_file_room() -> int:
     return shutil.disk_usage(tempfile.gettempdir()).free - BAG_FILE_DISK_RESERVE
 
 
-class BagFileExpands(FileFormatError):
-    """A bag file compressed whole (zstd) that decompresses past :func:`bag_file_room`: refused once past it,
-    before the disk is full. Stop 50 (robust50)."""
+class BagFileRefused(FileFormatError):
+    """A bag file compressed whole (zstd) that decompresses past :func:`bag_file_room` (refused once past it,
+    before the disk is full), or whose MCAP file, decompressed, :func:`check_mcap` refuses. Stop 50 (robust50)."""
 
 
 class _BoundedFile:
     """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
-    (:class:`BagFileExpands`) once more bytes come out than :func:`bag_file_room` leaves on that disk."""
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` leaves on that disk."""
 
     def __init__(self, opened: Any, name: str) -> None:
         self._opened, self._name, self._out = opened, name, 0
@@ -223,15 +223,16 @@ class _BoundedFile:
     def __getattr__(self, name: str) -> Any:
         return getattr(self._opened, name)
 
-    def read(self, size: int = -1) -> bytes:
+    def read(self, size: int | None = -1) -> bytes:
         import tempfile
 
-        step = _STEP_BYTES if size is None or size < 0 else min(size, _STEP_BYTES)
-        data = self._opened.read(step)
+        if size is None or size < 0:  # all of it: in steps, each counted
+            return b"".join(iter(lambda: self.read(_STEP_BYTES), b""))
+        data = self._opened.read(min(size, _STEP_BYTES))
         self._out += len(data)
         if self._out > max(self._room, 0):
             room = max(self._room, 0)
-            raise BagFileExpands(
+            raise BagFileRefused(
                 f"{self._name}: compressed whole (rosbag2's file compression), it expands past {room / 1e6:,.0f} MB, "
                 f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
                 "damaged, or zstd -d it where there is room"
@@ -253,7 +254,7 @@ def _checked_mcap(plugin: Any) -> Any:
         try:
             check_mcap(Path(path))
         except FileFormatError as exc:
-            raise BagFileExpands(f"its MCAP file {Path(path).name}, decompressed: {exc}") from None
+            raise BagFileRefused(f"its MCAP file {Path(path).name}, decompressed: {exc}") from None
         return plugin(path)
 
     make._symfruit = True  # type: ignore[attr-defined]
@@ -823,7 +824,7 @@ class BagSource:
             self._reader.open()
         except ChunkExpands as exc:  # an MCAP without a summary: rosbags decompresses every chunk to index it
             raise FileFormatError(self._expands(exc)) from None
-        except BagFileExpands as exc:  # a bag compressed as whole files
+        except BagFileRefused as exc:  # a bag compressed as whole files
             message = str(exc)
             raise FileFormatError(
                 message if message.startswith(str(self.path)) else f"{self.path}: {message}"
