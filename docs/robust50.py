@@ -210,6 +210,20 @@ def report_cases() -> None:
     damaged("method-of-100000-characters", "detections", lambda r: [dict(x, method="m" * 100_000) for x in r], "any")
     damaged("recording-with-a-bar-and-a-newline", None, lambda r: [dict(x, recording="a\nb|c") for x in r], "result")
     damaged("seconds-negative", "frames", at("seconds", -5.0), "any")
+
+    def large_string() -> Run:  # another tool's text type for the names: the tables compared alike
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+
+        d = fixture("report-large-string")
+        shutil.copytree(run_fixture(), d)
+        t = pq.read_table(d / "frames.parquet")
+        k = t.schema.get_field_index("recording")
+        pq.write_table(t.set_column(k, pa.field("recording", pa.large_string()), t.column(k).cast(pa.large_string())),
+                       d / "frames.parquet")  # fmt: skip
+        return cli("report", d)
+
+    add("report/names-of-large_string", "result", large_string)
     for label, classes in [("descending", "25,18"), ("nan", "18,nan"), ("empty", ""), ("1e400", "18,1e400"),
                            ("text", "small,large"), ("zero", "0,18")]:  # fmt: skip
         damaged(f"classes-{label}", None, None, "error", "", ("--classes", classes))

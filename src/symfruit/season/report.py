@@ -221,28 +221,37 @@ def _check_agree(output: Path, fruit: Any, frames: Any) -> None:
     import pyarrow as pa
     import pyarrow.compute as pc
 
-    where = {id(frames): output / FRAMES_NAME, id(fruit): output / TABLE_NAME}
-    for table in (frames, fruit):
-        for name in ("recording", "frame"):
-            if table.column(name).null_count:
-                raise FileFormatError(f"{where[id(table)]}: column {name} has {table.column(name).null_count} empty "
-                                      "rows; every row names its recording and frame (not a symfruit table, or "
-                                      "damaged)")  # fmt: skip
     keys = ["recording", "frame"]
-    for table, key, what in ((frames, keys, "frame"), (fruit, [*keys, "id"], "fruit")):
+
+    def keyed(table: Any, path: Path, more: list[str]) -> Any:
+        """The key columns (refused with a row of no name) as large_string, a join's one type for both tables
+        (another tool may write either), and ``more``."""
+        columns = {}
+        for name in keys:
+            if table.column(name).null_count:
+                raise FileFormatError(f"{path}: column {name} has {table.column(name).null_count} empty rows; "
+                                      "every row names its recording and frame (not a symfruit table, or "
+                                      "damaged)")  # fmt: skip
+            columns[name] = pc.cast(table.column(name), pa.large_string())
+        return pa.table({**columns, **{name: table.column(name) for name in more}})
+
+    frames = keyed(frames, output / FRAMES_NAME, ["fruit", "located"])
+    fruit = keyed(fruit, output / TABLE_NAME, ["id", "error", "centre_x"])
+    for table, key, what, path in ((frames, keys, "frame", output / FRAMES_NAME),
+                                   (fruit, [*keys, "id"], "fruit", output / TABLE_NAME)):  # fmt: skip
         counted = table.select(key).group_by(key).aggregate([([], "count_all")])
         twice = counted.filter(pc.greater(counted.column("count_all"), 1))
         if twice.num_rows:
             row = twice.slice(0, 1).to_pylist()[0]
             named = "/".join(shown(str(row[k]), 60) for k in keys)
             named = f"{row['id']} of frame {named}" if what == "fruit" else named
-            raise FileFormatError(f"{where[id(table)]}: {what} {named} is listed {row['count_all']} times; a run "
+            raise FileFormatError(f"{path}: {what} {named} is listed {row['count_all']} times; a run "
                                   f"lists each {what} once (not a symfruit table, or damaged)")  # fmt: skip
     located = pc.and_(pc.is_null(fruit.column("error")), pc.is_valid(fruit.column("centre_x")))
     rows = (pa.table({"recording": fruit.column("recording"), "frame": fruit.column("frame"),
                       "located_rows": pc.cast(located, pa.int64())})
             .group_by(keys).aggregate([([], "count_all"), ("located_rows", "sum")]))  # fmt: skip
-    listed = frames.select([*keys, "fruit", "located"]).append_column("listed", pa.repeat(True, frames.num_rows))
+    listed = frames.append_column("listed", pa.repeat(True, frames.num_rows))
     both = listed.join(rows, keys=keys, join_type="full outer")
     orphan = both.filter(pc.is_null(both.column("listed")))
     if orphan.num_rows:
