@@ -343,24 +343,19 @@ def bag_cases() -> None:
 _PYTHON_SPEAK = re.compile(r"set_int_max_str_digits|\bbe a [aeiou]\w+ file\b|cannot identify image file")
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
-    parser.add_argument("--defects", action="store_true", help="print the defects alone")
-    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
-    args = parser.parse_args()
+def sweep(cases: list[tuple[str, str, Callable[[], Any], str]], *, only: str = "", defects: bool = False,
+          limit: int = LIMIT_S, width: int = 48) -> dict[str, int]:  # fmt: skip
+    """Run ``cases`` (those whose name holds one of ``only``'s comma-separated parts) under a ``limit`` s alarm,
+    judge each (robust47's ``judge``, robust48's and this sweep's Python's words), print a line each (the defects
+    alone with ``defects``) and the counts; return the counts. robust50 runs its cases through it too."""
     import symfruit
 
-    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust49-"))
-    r47.T.mkdir(parents=True, exist_ok=True)
-    for build in (file_cases, image_cases, name_cases, bag_cases):
-        build()
     signal.signal(signal.SIGALRM, r47._alarm)
     counts = {"error": 0, "failed": 0, "result": 0, "DEFECT": 0}
-    for name, expect, fn, names in CASES:
-        if not any(part in name for part in args.only.split(",")):
+    for name, expect, fn, names in cases:
+        if not any(part in name for part in only.split(",")):
             continue
-        signal.alarm(LIMIT_S)
+        signal.alarm(limit)
         try:
             value = fn()
             signal.alarm(0)
@@ -376,18 +371,32 @@ def main() -> int:
             if len(msg) > 300 or r47._FOREIGN.search(msg):
                 kind, text = "DEFECT", f"message of {len(msg)} characters or another library's words: {msg[:150]}"
         except r47.Hang:
-            kind, text = "DEFECT", f"hang (over {LIMIT_S} s)"
+            kind, text = "DEFECT", f"hang (over {limit} s)"
         except Exception as exc:  # the point of the sweep
             signal.alarm(0)
             kind, text = "DEFECT", r47.origin(exc)
         if kind != "DEFECT" and (said := r48._PYTHON_SPEAK.search(text) or _PYTHON_SPEAK.search(text)):
             kind, text = "DEFECT", f"Python's words ({said.group(0)!r}): {text[:150]}"
         counts[kind] += 1
-        if kind == "DEFECT" or not args.defects:
-            sys.stdout.write(f"{kind:6} {name:48} {text}\n")
+        if kind == "DEFECT" or not defects:
+            sys.stdout.write(f"{kind:6} {name:{width}} {text}\n")
             sys.stdout.flush()
     sys.stdout.write(f"# {sum(counts.values())} cases: {counts['error']} clear errors, {counts['failed']} failed items "
                      f"reported, {counts['result']} results, {counts['DEFECT']} defects\n")  # fmt: skip
+    return counts
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
+    parser.add_argument("--defects", action="store_true", help="print the defects alone")
+    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
+    args = parser.parse_args()
+    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust49-"))
+    r47.T.mkdir(parents=True, exist_ok=True)
+    for build in (file_cases, image_cases, name_cases, bag_cases):
+        build()
+    counts = sweep(CASES, only=args.only, defects=args.defects, limit=LIMIT_S)
     if not args.keep:
         shutil.rmtree(r47.T, ignore_errors=True)
     return 1 if counts["DEFECT"] else 0

@@ -68,6 +68,22 @@ def test_resume_runs_again_a_frame_whose_record_cannot_be_read_back(tmp_path):
     assert again.skipped == ["f1", "f2"] and again.ok
 
 
+def test_resume_runs_again_a_frame_whose_record_is_another_frames(tmp_path):
+    """Stop 50 (robust50): a frame folder copied over another's (its record names the other frame) was skipped,
+    and the tables listed the other frame twice, this one not at all."""
+    import pyarrow.parquet as pq
+
+    frames = recording(tmp_path / "rec", "f1", "f2")
+    out = tmp_path / "out"
+    run_batch(frames, out, method="raw", progress=False)
+    before = _fruits(out)
+    (out / "f2" / "detections.json").write_bytes((out / "f1" / "detections.json").read_bytes())
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == ["f1"] and again.done == ["f2"] and again.ok
+    assert _fruits(out) == before
+    assert pq.read_table(out / "frames.parquet").column("frame").to_pylist() == ["f1", "f2"]
+
+
 def test_frame_folder_names_stay_in_their_folder_and_never_collide():
     assert frame_folder_name("f1") == "f1"
     assert frame_folder_name("../../etc/passwd").startswith("etc_passwd+")

@@ -450,3 +450,9 @@ def test_a_section_with_nothing_under_it_says_so_not_nonetype(tmp_path):
         load_settings(path)
     assert str(info.value) == (f"{path}: evidence: holds no settings (nothing under it); give its settings indented "
                                "below it, or remove the line")  # fmt: skip
+
+
+def test_a_section_of_another_type_is_named_with_its_article():
+    """Stop 50 (robust50): ``settings section 'evidence' must be a EvidenceSettings``."""
+    with pytest.raises(ConfigError, match=r"section 'evidence' must be an EvidenceSettings, got int$"):
+        Settings(evidence=5)

@@ -97,6 +97,19 @@ def test_stamps_go_into_the_header_and_failures_into_the_record(found):
     assert detections_record(found, settings=Settings())["settings"] == Settings().to_dict()
 
 
+def test_counts_numpy_computed_are_written_as_json_numbers(tmp_path, found):
+    """Stop 50 (robust50): an extraction's counts computed by numpy (``n_other_clusters`` of a mask whose points
+    behind the fruit are dropped, an ``np.int64``) failed the frame: ``TypeError: Object of type int64 is not JSON
+    serializable`` (robust49's ``--masks`` PNG cases on 35f8d31)."""
+    d = found.detections[0]
+    ex = replace(d.extraction, mask_area=np.int64(d.extraction.mask_area), n_invalid=np.int64(3),
+                 n_other_clusters=np.int64(684), truncated=np.bool_(False))  # fmt: skip
+    numpy_counts = replace(found, detections=[replace(d, extraction=ex), *found.detections[1:]])
+    write_detections(tmp_path / "f", numpy_counts)
+    fruit = json.loads((tmp_path / "f" / "detections.json").read_text())["fruits"][0]
+    assert (fruit["n_dropped_clusters"], fruit["n_invalid_depth"], fruit["truncated"]) == (684, 3, False)
+
+
 def test_a_rerun_with_fewer_fruit_leaves_exactly_its_own_files(tmp_path, found):
     write_detections(tmp_path, found)
     assert len(list(tmp_path.glob("fruit_*.ply"))) == 6

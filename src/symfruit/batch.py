@@ -273,7 +273,7 @@ def _one(
     the batch stops."""
     key = rec.key + name
     folder = rec.folder / frame_folder_name(name, reserved)
-    if resume and frame_done(folder):
+    if resume and frame_done(folder, name):
         report.skipped.append(key)
         bar.update()
         return True
@@ -302,19 +302,20 @@ def _one(
     return True
 
 
-def frame_done(folder: Path) -> bool:
+def frame_done(folder: Path, name: str | None = None) -> bool:
     """Whether a frame's output ``folder`` holds a whole ``detections.json`` record (``--resume`` skips it): one
     that cannot be read back into the tables (truncated by a copy, a crash outside symfruit's atomic writes,
-    another tool) means the frame is run again, not skipped and then left out of the tables."""
+    another tool), or (``name`` given) the record of another frame (a folder copied over), means the frame is run
+    again, not skipped and then left out of the tables or listed under the other frame's name."""
     from .season.table import read_frame_rows
 
     if not (folder / "detections.json").is_file():
         return False
     try:
-        read_frame_rows(folder / "detections.json", "")
+        row, _ = read_frame_rows(folder / "detections.json", "")
     except SymfruitError:
         return False
-    return True
+    return name is None or row["frame"] == name
 
 
 @dataclass(frozen=True)

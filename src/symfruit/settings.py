@@ -204,7 +204,9 @@ class Settings:
             if value is None:
                 value = cls()
             elif not isinstance(value, cls):
-                raise ConfigError(f"settings section {name!r} must be a {cls.__name__}, got {type(value).__name__}")
+                article = "an" if cls.__name__[:1] in "AEIOU" else "a"  # "a EvidenceSettings" before
+                raise ConfigError(f"settings section {name!r} must be {article} {cls.__name__}, got "
+                                  f"{type(value).__name__}")  # fmt: skip
             values[name] = value
         object.__setattr__(self, "_sections", values)
 

@@ -166,9 +166,11 @@ def bbox_record(box: Box) -> dict[str, Any]:
 def detection_record(d: Detection) -> dict[str, Any]:
     """One entry of ``detections.json``; ``bbox`` is a ``vision_msgs/BoundingBox3D``."""
     ex = d.extraction
+    # Python's ints and bools: a count computed by numpy (an np.int64) made json.dumps fail the frame ("Object of
+    # type int64 is not JSON serializable", stop 50: robust49's masks cases on 35f8d31)
     out: dict[str, Any] = {
-        "id": d.id, "mask_area": ex.mask_area, "n_points": len(ex.points), "truncated": ex.truncated,
-        "n_invalid_depth": ex.n_invalid, "n_dropped_clusters": ex.n_other_clusters,
+        "id": int(d.id), "mask_area": int(ex.mask_area), "n_points": len(ex.points), "truncated": bool(ex.truncated),
+        "n_invalid_depth": int(ex.n_invalid), "n_dropped_clusters": int(ex.n_other_clusters),
     }  # fmt: skip
     if d.error or d.result is None:
         return {**out, "error": d.error}

@@ -863,3 +863,46 @@ def test_an_mcap_chunk_that_expands_past_its_stated_size_is_refused_naming_the_c
     assert str(info.value) == (f"{bomb / mcap.name}: the zstd chunk at byte {chunk[0]:,} ({packed:,} bytes "
                                f"compressed) expands past its stated {stated:,} bytes uncompressed (decompression "
                                "stopped there): the bag is damaged")  # fmt: skip
+
+
+def test_a_bag_compressed_as_whole_files_is_decompressed_to_the_disk_room_and_no_further(tmp_path, monkeypatch):
+    """Stop 50 (robust50): a ROS 2 bag compressed as whole files (rosbag2's deprecated ``compression_mode: file``)
+    is decompressed by rosbags into a temporary folder before it is read; nothing states its size, so a bomb (a few
+    kB of zstd holding gigabytes) filled the disk. Now decompression stops once past what the temporary folder's
+    disk holds less BAG_FILE_DISK_RESERVE (lowered here to stand for a full disk), naming the file; and the MCAP
+    file decompressed is checked (check_mcap) as a bag folder's own are, which the folder's check never saw."""
+    from symfruit.io import bags
+
+    try:
+        from compression import zstd
+    except ImportError:
+        from backports import zstd
+
+    color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+    good = write_ros2_bag(tmp_path / "good", color, (depth * 1000).astype(np.uint16), frames=2, storage="mcap",
+                          compression=("file", "zstd"))  # fmt: skip
+    packed = next(good.glob("*.mcap.zstd"))
+    plain = zstd.decompress(packed.read_bytes())
+    frames = open_source(good)
+    assert len(frames) == 2 and np.array_equal(frames.read(0).color, color)  # read as before
+    frames.close()
+
+    bomb = tmp_path / "bomb"
+    bomb.mkdir()
+    (bomb / "metadata.yaml").write_text((good / "metadata.yaml").read_text())
+    (bomb / packed.name).write_bytes(zstd.compress(plain + bytes(64 << 20)))  # the bag, then 64 MB of zeros
+    assert (bomb / packed.name).stat().st_size < 100_000
+    monkeypatch.setattr(bags, "bag_file_room", lambda: 4 << 20)
+    with pytest.raises(FileFormatError) as info:
+        open_source(bomb)
+    assert str(info.value).startswith(f"{bomb / packed.name}: compressed whole (rosbag2's file compression), it "
+                                      "expands past 4 MB, the room in ")  # fmt: skip
+    assert str(info.value).endswith(" less 256 MB (decompression stopped): damaged, or zstd -d it where there is room")
+
+    monkeypatch.undo()
+    raw = bytearray(plain)
+    raw[8 + 1 : 8 + 9] = (1 << 40).to_bytes(8, "little")  # the header record claims a TB
+    (bomb / packed.name).write_bytes(zstd.compress(bytes(raw)))
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(bomb))}: its MCAP file {packed.stem}, decompressed: "
+                       r"the (header )?record at byte 8"):  # fmt: skip
+        open_source(bomb)

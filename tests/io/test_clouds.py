@@ -476,3 +476,12 @@ def test_a_cloud_that_is_a_pipe_is_not_called_a_folder(tmp_path):
     folder.mkdir()
     with pytest.raises(FileFormatError, match=r"folder\.ply: not a regular file \(a folder\)"):
         read_cloud(folder)
+
+
+def test_write_ply_of_no_path_is_refused_in_our_words(tmp_path):
+    """Stop 50 (robust50): ``write_ply(None, points)`` was pathlib's ``TypeError: expected str, bytes or
+    os.PathLike object, not NoneType``."""
+    with pytest.raises(InputError, match=r"^write_ply: the PLY file must be a path \(str or os.PathLike\), got None$"):
+        write_ply(None, POINTS)
+    with pytest.raises(InputError, match=r"^write_ply: the PLY file is an empty path"):
+        write_ply("", POINTS)

@@ -588,3 +588,25 @@ def test_a_camera_json_depth_scale_of_metres_for_millimetre_units_names_camera_j
                                "(0.001 for millimetres)")  # fmt: skip
     (frame / "camera.json").write_text(json.dumps({**cam, "depth_scale": 0.01}))  # centimetres: up to 655 m, read
     assert read_frame(frame).depth.shape == (480, 640)
+
+
+def test_write_frame_refuses_images_and_a_camera_of_other_sizes_before_writing(tmp_path):
+    """Stop 50 (robust50): depth or masks of another size than the colour image, and a camera for another image
+    size, were written (a folder read_frame then refuses); a camera given as a mapping was an AttributeError
+    (``'dict' object has no attribute 'to_dict'``) after the images were written."""
+    color, depth = disc_frame([(60, 60)], radius=15)
+    cases = [
+        (dict(depth=depth[:60]), r"depth is 160x60, the colour image 160x120; a frame's images are of one size"),
+        (dict(masks=np.zeros((60, 160), np.uint8)), r"masks are 160x60, the colour image 160x120"),
+        (dict(camera=Camera(fx=600.0, fy=600.0, cx=320.0, cy=240.0, width=640, height=480)),
+         r"the camera is for 640x480 images, the colour image is 160x120"),
+        (dict(camera=SMALL_CAM.to_dict()), r"camera must be a symfruit.Camera \(symfruit.io.camera_from_dict makes "
+                                           r"one from a mapping\), got dict"),
+    ]  # fmt: skip
+    for k, (change, said) in enumerate(cases):
+        args = {"color": color, "depth": depth, "camera": SMALL_CAM, **change}
+        with pytest.raises(InputError, match=rf"^write_frame {re.escape(str(tmp_path / str(k)))}: {said}"):
+            write_frame(tmp_path / str(k), **args)
+        assert not (tmp_path / str(k)).exists()
+    write_frame(tmp_path / "good", color, depth, SMALL_CAM, masks=np.zeros(depth.shape, np.uint8))
+    assert read_frame(tmp_path / "good").depth.shape == depth.shape

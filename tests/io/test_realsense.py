@@ -543,3 +543,27 @@ def test_a_chunk_that_expands_past_the_bound_is_refused_naming_the_bag(tmp_path,
     assert re.fullmatch(rf"{re.escape(str(path))}: an LZ4 chunk of [\d,]+ compressed bytes expands past 1,000 "
                         r"bytes, the most a chunk is read to \(decompression stopped there\): the bag is damaged",
                         str(info.value))  # fmt: skip
+
+
+def test_a_chunk_that_expands_past_its_own_stated_size_is_refused_at_that_size(tmp_path):
+    """Stop 50 (robust50): a ROS 1 chunk states its uncompressed ``size`` in its header; rosbags does not read it,
+    and stop 49 bounded every chunk at MAX_BAG_CHUNK_BYTES (1024 MB). Now a chunk is decompressed to its own stated
+    size and no further: here each chunk's stated size is halved."""
+    path = rewrite(tmp_path / "lz4.bag")
+    data = bytearray(path.read_bytes())
+    field = b"\x09\x00\x00\x00size="
+    sizes = []
+    at = data.find(field)
+    while at >= 0:
+        pos = at + len(field)
+        stated = int.from_bytes(data[pos : pos + 4], "little")
+        sizes.append(stated)
+        data[pos : pos + 4] = (stated // 2).to_bytes(4, "little")
+        at = data.find(field, pos)
+    assert sizes
+    path.write_bytes(bytes(data))
+    with pytest.raises(FileFormatError) as info:
+        open_source(path).read(0)
+    assert re.fullmatch(rf"{re.escape(str(path))}: an LZ4 chunk of [\d,]+ compressed bytes expands past its stated "
+                        r"[\d,]+ bytes uncompressed \(decompression stopped there\): the bag is damaged",
+                        str(info.value))  # fmt: skip

@@ -113,7 +113,7 @@ def test_other_problems_name_the_file(tmp_path):
 
 def test_as_path_takes_paths_and_refuses_anything_else_by_name(tmp_path):
     assert as_path("a/b.png", "x") == as_path(b"a/b.png", "x") == as_path(Path("a/b.png"), "x") == Path("a/b.png")
-    for value, kind in ((None, "NoneType"), (3, "int"), (["a"], "list"), (np.zeros(3), "ndarray")):
+    for value, kind in ((None, "None"), (3, "int"), (["a"], "list"), (np.zeros(3), "ndarray")):
         with pytest.raises(InputError, match=rf"^the image must be a path \(str or os\.PathLike\), got {kind}$"):
             as_path(value, "the image")
 
@@ -125,7 +125,7 @@ def test_as_path_takes_paths_and_refuses_anything_else_by_name(tmp_path):
 def test_every_reader_refuses_what_is_not_a_path_by_name(reader):
     import symfruit.io
 
-    with pytest.raises(InputError, match=rf"^{reader}: the .* must be a path \(str or os\.PathLike\), got NoneType"):
+    with pytest.raises(InputError, match=rf"^{reader}: the .* must be a path \(str or os\.PathLike\), got None$"):
         getattr(symfruit.io, reader)(None)
     for empty in ("", b""):  # before: the working folder '.' (open_source opened it as a recording)
         with pytest.raises(InputError, match=rf"^{reader}: the .* is an empty path \(an unset variable\?\)$"):

@@ -378,3 +378,53 @@ def test_a_frame_that_kills_every_worker_is_lost_alone_and_the_batch_goes_on(rec
     assert not list(out.rglob("*.tmp"))
     frames = pq.read_table(out / "frames.parquet").column("frame").to_pylist()
     assert frames == ["scene_00000", "scene_00002"]
+
+
+def test_a_scheduler_without_workers_is_refused_after_the_time_out_not_waited_on_for_ever(recording, tmp_path):
+    """A scheduler that has no worker (none started, or all gone) keeps the tasks queued: the run waited for ever
+    (stop 49 left it). Now it waits ``no_worker_timeout`` seconds for the first worker and says so by address."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=0, processes=False, protocol="tcp://", host="127.0.0.1",
+                      dashboard_address=None) as empty:  # fmt: skip
+        address = empty.scheduler_address
+        start = time.monotonic()
+        with pytest.raises(InputError, match=rf"{address}: the Dask scheduler has no worker \(waited 2 s for one\)"):
+            run_distributed(recording, tmp_path / "o", scheduler=address, method="raw", progress=False,
+                            no_worker_timeout=2)  # fmt: skip
+        assert time.monotonic() - start < 60
+    assert not (tmp_path / "o" / "errors.json").exists()
+
+
+def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocessed(recording, tmp_path, monkeypatch):
+    """The one worker leaves once the first frame is written (each frame takes a second here): after the time-out
+    the run stops, the frames not done recorded unprocessed (``--resume`` takes them up), not waited on for ever."""
+    from distributed import LocalCluster
+
+    import symfruit.season.cluster as cluster
+
+    real = cluster.detect
+
+    def slow(frame, **kwargs):
+        time.sleep(1.0)
+        return real(frame, **kwargs)
+
+    monkeypatch.setattr(cluster, "detect", slow)  # the in-process worker runs this module
+    out = tmp_path / "o"
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+                      dashboard_address=None) as one:  # fmt: skip
+        result: dict = {}
+        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
+            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
+            no_worker_timeout=2)))  # fmt: skip
+        runner.start()
+        _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
+        one.scale(0)
+        runner.join(120)
+        assert not runner.is_alive()
+    report = result["report"]
+    assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
+    assert len(report.done) >= 1 and report.unprocessed and len(report.done) + len(report.unprocessed) == 4
+    assert not report.failed
+    errors = json.loads((out / "errors.json").read_text())
+    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)

@@ -169,7 +169,8 @@ def _capped(compression: str) -> Any:
 
 class _BoundedZstd:
     """rosbags' ``zstd`` module as its ROS 2 reader sees it: ``decompress`` (a message of a bag compressed per
-    message) bounded, the rest the module's."""
+    message) bounded, ``open`` (a bag compressed as whole files) read through :class:`_BoundedFile`, the rest the
+    module's."""
 
     def __init__(self, module: Any) -> None:
         self._module = module
@@ -179,6 +180,85 @@ class _BoundedZstd:
 
     def decompress(self, data: bytes) -> bytes:
         return bounded_decompress(data, "zstd", MAX_BAG_CHUNK_BYTES)
+
+    def open(self, file: Any, mode: str = "rb", *args: Any, **kwargs: Any) -> Any:
+        opened = self._module.open(file, mode, *args, **kwargs)
+        return _BoundedFile(opened, str(getattr(file, "name", file))) if "r" in mode else opened
+
+
+#: Bytes of the temporary folder's disk left free when a bag compressed as whole files (rosbag2's deprecated
+#: ``compression_mode: file``) is decompressed there: rosbags decompresses each file whole before reading it, and
+#: nothing in the bag states its size.
+BAG_FILE_DISK_RESERVE = 256 << 20
+
+
+def bag_file_room() -> int:
+    """The most bytes one whole-file-compressed bag file may decompress to: the temporary folder's free space
+    less :data:`BAG_FILE_DISK_RESERVE`."""
+    import shutil
+    import tempfile
+
+    return shutil.disk_usage(tempfile.gettempdir()).free - BAG_FILE_DISK_RESERVE
+
+
+class BagFileRefused(FileFormatError):
+    """A bag file compressed whole (zstd) that decompresses past :func:`bag_file_room` (refused once past it,
+    before the disk is full), or whose MCAP file, decompressed, :func:`check_mcap` refuses. Stop 50 (robust50)."""
+
+
+class _BoundedFile:
+    """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` leaves on that disk."""
+
+    def __init__(self, opened: Any, name: str) -> None:
+        self._opened, self._name, self._out = opened, name, 0
+        self._room = bag_file_room()
+
+    def __enter__(self) -> _BoundedFile:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._opened.close()
+
+    def __getattr__(self, name: str) -> Any:
+        return getattr(self._opened, name)
+
+    def read(self, size: int | None = -1) -> bytes:
+        import tempfile
+
+        if size is None or size < 0:  # all of it: in steps, each counted
+            return b"".join(iter(lambda: self.read(_STEP_BYTES), b""))
+        data = self._opened.read(min(size, _STEP_BYTES))
+        self._out += len(data)
+        if self._out > max(self._room, 0):
+            room = max(self._room, 0)
+            raise BagFileRefused(
+                f"{self._name}: compressed whole (rosbag2's file compression), it expands past {room / 1e6:,.0f} MB, "
+                f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
+                "damaged, or zstd -d it where there is room"
+            )
+        return data
+
+    def readinto(self, buffer: Any) -> int:
+        data = self.read(len(buffer))
+        buffer[: len(data)] = data
+        return len(data)
+
+
+def _checked_mcap(plugin: Any) -> Any:
+    """rosbags' MCAP storage reader, made only after :func:`check_mcap` passes the file: a bag compressed as
+    whole files is decompressed by rosbags into a temporary folder, which :class:`BagSource`'s own check of the
+    bag folder's ``*.mcap`` never sees."""
+
+    def make(path: Any) -> Any:
+        try:
+            check_mcap(Path(path))
+        except FileFormatError as exc:
+            raise BagFileRefused(f"its MCAP file {Path(path).name}, decompressed: {exc}") from None
+        return plugin(path)
+
+    make._symfruit = True  # type: ignore[attr-defined]
+    return make
 
 
 def _bound_decompression() -> None:
@@ -206,6 +286,42 @@ def _bound_decompression() -> None:
     module = getattr(ros2, "zstd", None)
     if module is not None and not isinstance(module, _BoundedZstd):
         setattr(ros2, "zstd", _BoundedZstd(module))  # noqa: B010  # rosbags' module, seen by its reader
+    folder_reader = getattr(ros2, "DirectoryReader", None)  # a bag folder's reader (rosbags 0.10 and later)
+    plugins = getattr(folder_reader, "STORAGE_PLUGINS", None)
+    if isinstance(plugins, dict) and "mcap" in plugins and not getattr(plugins["mcap"], "_symfruit", False):
+        folder_reader.STORAGE_PLUGINS = {**plugins, "mcap": _checked_mcap(plugins["mcap"])}  # type: ignore[union-attr]
+    chunk_reader = getattr(getattr(ros1, "Reader", None), "read_chunk", None)
+    if chunk_reader is not None and not getattr(chunk_reader, "_symfruit", False):
+        setattr(ros1.Reader, "read_chunk", _sized_chunks(chunk_reader))  # noqa: B010  # rosbags, for its reader
+
+
+def _sized_chunks(read_chunk: Any) -> Any:
+    """rosbags' ROS 1 ``Reader.read_chunk``, its chunk's decompressor bounded by the ``size`` (uncompressed) the
+    chunk's header states (rosbags reads the header and leaves that field; the bound was
+    :data:`~symfruit.core.limits.MAX_BAG_CHUNK_BYTES` for every chunk). A header without it keeps that bound."""
+    import os
+
+    from rosbags.rosbag1 import reader as ros1
+
+    def sized(self: Any) -> Any:
+        start = self.bio.tell()
+        chunk = read_chunk(self)
+        end = self.bio.tell()
+        try:
+            self.bio.seek(start)
+            header = ros1.Header.read(self.bio, ros1.RecordType.CHUNK)
+            compression, size = header.get_string("compression"), header.get_uint32("size")
+        except Exception:  # no size stated: the bound stays MAX_BAG_CHUNK_BYTES
+            return chunk
+        finally:
+            self.bio.seek(end, os.SEEK_SET)
+        if compression not in ("bz2", "lz4"):
+            return chunk
+        unpack = _stated(compression)
+        return chunk._replace(decompressor=lambda data: unpack(data, size))
+
+    sized._symfruit = True  # type: ignore[attr-defined]
+    return sized
 
 
 #: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).
@@ -708,6 +824,11 @@ class BagSource:
             self._reader.open()
         except ChunkExpands as exc:  # an MCAP without a summary: rosbags decompresses every chunk to index it
             raise FileFormatError(self._expands(exc)) from None
+        except BagFileRefused as exc:  # a bag compressed as whole files
+            message = str(exc)
+            raise FileFormatError(
+                message if message.startswith(str(self.path)) else f"{self.path}: {message}"
+            ) from None
         except Exception as exc:  # rosbags raises its own ReaderError / AnyReaderError types
             raise FileFormatError(f"{self.path}: cannot open bag ({reader_reason(exc)})") from None
         try:

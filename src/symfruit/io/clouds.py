@@ -576,6 +576,7 @@ def write_ply(path: str | Path, points: np.ndarray, *, labels: np.ndarray | None
 
     from ..core.points import as_points
 
+    path = as_path(path, "write_ply: the PLY file")  # None was pathlib's TypeError
     points = as_points(points, min_count=0, name=f"{path}: points")
     with np.errstate(invalid="ignore"):
         if (np.abs(points) > np.finfo(np.float32).max).any():

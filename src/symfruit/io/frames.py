@@ -342,7 +342,17 @@ def write_frame(
     color = np.asarray(color)
     if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
         raise InputError(f"{what}: colour must be (h, w, 3) uint8 RGB, got {color.dtype} {color.shape}")
+    if not isinstance(camera, Camera):  # a mapping was an AttributeError (no to_dict) after the images were written
+        raise InputError(f"{what}: camera must be a symfruit.Camera (symfruit.io.camera_from_dict makes one from a "
+                         f"mapping), got {type(camera).__name__}")  # fmt: skip
+    h, w = color.shape[:2]
+    if (camera.width, camera.height) != (w, h):  # written before: a folder read_frame refuses
+        raise InputError(f"{what}: the camera is for {camera.width}x{camera.height} images, the colour image is "
+                         f"{w}x{h}")  # fmt: skip
     depth = depth_metres(depth, what)
+    if depth.shape != (h, w):  # written before: depth of another size beside the colour, refused when read
+        raise InputError(f"{what}: depth is {depth.shape[1] if depth.ndim > 1 else '?'}x{depth.shape[0]}, the "
+                         f"colour image {w}x{h}; a frame's images are of one size")  # fmt: skip
     with np.errstate(invalid="ignore"):
         far = float(np.nanmax(np.where(np.isfinite(depth), depth, np.nan), initial=0.0))
     if far / depth_scale > 65535.5:  # clipped before: the far depth written as 65535 units in silence
@@ -350,6 +360,8 @@ def write_frame(
                          "depth_scale")  # fmt: skip
     if masks is not None:
         masks = instance_labels(masks, f"{what}: masks")
+        if masks.shape != (h, w):
+            raise InputError(f"{what}: masks are {masks.shape[1]}x{masks.shape[0]}, the colour image {w}x{h}")
         if masks.size and int(masks.max()) > 65535:  # before: wrapped into another fruit's id by astype(uint16)
             raise InputError(f"{what}: masks hold label {int(masks.max())}; a 16-bit masks.png holds 0-65535")
     folder.mkdir(parents=True, exist_ok=True)

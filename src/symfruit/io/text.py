@@ -39,7 +39,8 @@ def as_path(value: Any, what: str) -> Path:
             return Path(os.fsdecode(value))
         except TypeError:  # an os.PathLike whose __fspath__ returns neither str nor bytes
             pass
-    raise InputError(f"{what} must be a path (str or os.PathLike), got {type(value).__name__}")
+    got = "None" if value is None else type(value).__name__  # not Python's "NoneType" (robust50)
+    raise InputError(f"{what} must be a path (str or os.PathLike), got {got}")
 
 
 def holds_file(path: Path) -> bool:

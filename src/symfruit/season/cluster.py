@@ -84,6 +84,13 @@ NO_PROFILER = {"distributed.worker.profile.enabled": False}
 KEEP_LOST_WORKERS = {"distributed.deploy.lost-worker-timeout": "3650 days"}
 #: How long to try to reach a scheduler before giving up.
 CONNECT_TIMEOUT = "10s"
+#: How long (s) a run waits while its cluster has no worker at all: for the first worker of a scheduler you
+#: started (``--scheduler``; before any task is sent), and at any time during the run, after which the frames not
+#: done are recorded ``unprocessed`` and the batch stops (``--resume`` takes them up). A scheduler keeps tasks
+#: queued while it has no worker, so the run waited for ever (stop 49, robust50). A local cluster's nannies
+#: restart its workers (importing symfruit and numba: 10-20 s on a loaded machine): it gets longer.
+NO_WORKER_TIMEOUT = 60.0
+LOCAL_NO_WORKER_TIMEOUT = 300.0
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
 #: scheduler's task count however long the recording (with a task that takes long, the others wait at most
 #: this far ahead of it).
@@ -339,11 +346,13 @@ def run_distributed(
     progress: bool = True,
     exclude: Sequence[str | Path] = (),
     max_ahead: int = MAX_AHEAD,
+    no_worker_timeout: float | None = None,
 ) -> BatchReport:
     """:func:`symfruit.batch.run_batch` on a Dask cluster: an existing one (``scheduler``, its address) or a
     local one of ``workers`` processes; ``chunk`` frames per task (see the module docstring). ``source``: one
     recording or several, laid out as :func:`symfruit.batch.run_batch` does (a task holds frames of one
-    recording).
+    recording). ``no_worker_timeout`` (s; default :data:`NO_WORKER_TIMEOUT` for a scheduler,
+    :data:`LOCAL_NO_WORKER_TIMEOUT` for a local cluster): how long the run waits while the cluster has no worker.
 
     Raises
     ------
@@ -360,6 +369,8 @@ def run_distributed(
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {chunk}")
     if workers is not None and not 1 <= workers <= 256:  # refused before the inputs are read, not taken as 1
         raise InputError(f"--workers must be between 1 and 256, got {workers}")
+    if no_worker_timeout is None:
+        no_worker_timeout = NO_WORKER_TIMEOUT if scheduler is not None else LOCAL_NO_WORKER_TIMEOUT
     if not isinstance(masks, str):
         raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
     require_distributed()
@@ -411,12 +422,12 @@ def run_distributed(
         target += [rec.folder / frame_folder_name(n, reserved) for n in names]
         direct += rec_direct if rec_direct is not None else [None] * len(names)
     try:
-        done_before = {i for i in range(len(keys)) if resume and frame_done(target[i])}
+        done_before = {i for i in range(len(keys)) if resume and frame_done(target[i], raw[i])}
         todo = [i for i in range(len(keys)) if i not in done_before]
         with contextlib.ExitStack() as stack:
             client = stack.enter_context(_client(scheduler, workers)) if todo else None
             if client is not None:
-                _preflight(client, jobs)
+                _preflight(client, jobs, scheduler, no_worker_timeout)
             reserve_record(output / "errors.json", _errors_record({}, keys, "the batch is running (or was killed)",
                            report.failed_recordings, recordings), entries=len(keys), root=out)  # fmt: skip
             with Progress(len(keys), "detect", enabled=progress and len(keys) > 1) as bar:
@@ -426,7 +437,8 @@ def run_distributed(
                 try:
                     named = {v: k for k, v in report.recordings.items()}
                     with TableWriter(output, root=out, inputs=named) as table:
-                        _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out)
+                        _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out,
+                             no_worker_timeout)  # fmt: skip
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
             if client is not None:
@@ -475,9 +487,11 @@ def _parts(todo: Sequence[int], chunk: int, owner: Sequence[int] | None = None) 
 def _run(
     frames: _Frames, client: Any, todo: list[int], done_before: set[int], chunk: int, max_ahead: int,
     report: BatchReport, table: TableWriter, bar: Progress, out: OutputFolder,
+    no_worker_timeout: float = NO_WORKER_TIMEOUT,
 ) -> None:  # fmt: skip
     """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
-    and write the tables in frame order."""
+    and write the tables in frame order; stop, the frames not done unprocessed, once the cluster has had no worker
+    for ``no_worker_timeout`` seconds (:class:`_NoWorkers`)."""
     keys, target = frames.keys, frames.target
     results: dict[int, Outcome] = {}  # outcomes not yet in the tables, by frame index (in the run)
     state = {"flushed": 0, "sent": 0, "stopped": False}  # frames below "flushed" are in the report and tables
@@ -505,6 +519,7 @@ def _run(
         pending = distributed.as_completed()
         part_of: dict[Any, Part] = {}
         window = {"tasks": 0, "at": -1.0}
+        watch = _NoWorkers(client, no_worker_timeout)
 
         def room() -> bool:
             """Whether another task may go: within the frames ahead, and within the tasks the workers can
@@ -515,7 +530,7 @@ def _run(
             return state["sent"] - state["flushed"] < max_ahead and len(part_of) < window["tasks"]
 
         def send() -> None:
-            while not state["stopped"] and room():
+            while not state["stopped"] and not watch.gone.is_set() and room():
                 indices = next(parts, None)
                 if indices is None:
                     state["sent"] = len(keys)
@@ -530,6 +545,7 @@ def _run(
                 future = client.submit(detect_part, frames.jobs[j], part,
                                        key=f"symfruit-detect-{frames.jobs[j].run}-{indices[0]}")  # fmt: skip
                 part_of[future.key] = part
+                watch.track(future)
                 pending.add(future)
                 state["sent"] = indices[-1] + 1
 
@@ -538,45 +554,116 @@ def _run(
         # nor the tasks that were queued on the same worker (the scheduler counts a death against all of them)
         suspects: list[int] = []
         alone: set[str] = set()
-        send()
-        while True:
-            for future in pending:
-                part = part_of.pop(future.key)
-                outcomes, whole = _outcomes(future, part, distributed)
-                killed = whole and future.key not in alone and outcomes[0].reason.startswith(_DIED)
-                future.release()
-                for o in outcomes:
-                    i = part.base + o.index
-                    if whole:  # the task died as a whole: what its attempts left is no result
-                        _clear_frame(target[i], out)
-                    if killed:
-                        suspects.append(i)
+        with watch:
+            send()
+            while True:
+                for future in pending:
+                    part = part_of.pop(future.key)
+                    watch.untrack(future)
+                    if watch.gone.is_set() and future.cancelled():  # by the watch: not run, not failed
+                        _unprocessed(part, watch.reason, state, report, results)
+                        flush()
                         continue
-                    results[i] = o
-                    if o.stop and not state["stopped"]:
-                        state["stopped"] = True
-                        report.stopped = o.stop
-                if not killed:
-                    bar.update(len(part.indices))
-                flush()
+                    outcomes, whole = _outcomes(future, part, distributed)
+                    killed = whole and future.key not in alone and outcomes[0].reason.startswith(_DIED)
+                    future.release()
+                    for o in outcomes:
+                        i = part.base + o.index
+                        if whole:  # the task died as a whole: what its attempts left is no result
+                            _clear_frame(target[i], out)
+                        if killed:
+                            suspects.append(i)
+                            continue
+                        results[i] = o
+                        if o.stop and not state["stopped"]:
+                            state["stopped"] = True
+                            report.stopped = o.stop
+                    if not killed:
+                        bar.update(len(part.indices))
+                    flush()
+                    if not suspects:
+                        send()
                 if not suspects:
-                    send()
-            if not suspects:
-                break
-            i = suspects.pop(0)
-            j = frames.owner[i]
-            base = frames.bases[j]
-            direct = frames.direct[i]
-            part = Part((i - base,), (frames.raw[i],), (str(target[i].absolute()),),
-                        None if direct is None else (str(direct),), base)  # fmt: skip
-            future = client.submit(
-                detect_part, frames.jobs[j], part, key=f"symfruit-detect-{frames.jobs[j].run}-{i}-alone"
-            )
-            alone.add(future.key)
-            part_of[future.key] = part
-            pending.add(future)
+                    break
+                i = suspects.pop(0)
+                j = frames.owner[i]
+                base = frames.bases[j]
+                direct = frames.direct[i]
+                part = Part((i - base,), (frames.raw[i],), (str(target[i].absolute()),),
+                            None if direct is None else (str(direct),), base)  # fmt: skip
+                if watch.gone.is_set():
+                    _unprocessed(part, watch.reason, state, report, results)
+                    continue
+                future = client.submit(
+                    detect_part, frames.jobs[j], part, key=f"symfruit-detect-{frames.jobs[j].run}-{i}-alone"
+                )
+                alone.add(future.key)
+                part_of[future.key] = part
+                watch.track(future)
+                pending.add(future)
     state["stopped"] = True
     flush()
+
+
+class _NoWorkers:
+    """Watches a run's cluster from a thread of its own (every second, while the run lives): once it has had no
+    worker for ``timeout`` seconds, :attr:`gone` is set and the run's tasks (:meth:`track`) are cancelled, so
+    that the client, which waits on them, goes on; it records their frames unprocessed (:func:`_unprocessed`).
+    A scheduler keeps tasks queued while it has no worker: without this the run waited for ever."""
+
+    def __init__(self, client: Any, timeout: float) -> None:
+        self.client, self.timeout = client, timeout
+        self.gone, self._done = threading.Event(), threading.Event()
+        self._futures: dict[Any, Any] = {}
+        self._lock = threading.Lock()
+        self._thread = threading.Thread(target=self._watch, name="symfruit-no-workers", daemon=True)
+        address = getattr(getattr(client, "scheduler", None), "address", None) or "the scheduler"
+        self.reason = (f"the Dask cluster ({address}) had no worker for {timeout:g} s: the frames not done are "
+                       "unprocessed; start workers and run again with --resume")  # fmt: skip
+
+    def __enter__(self) -> _NoWorkers:
+        self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._done.set()
+        self._thread.join()
+
+    def track(self, future: Any) -> None:
+        with self._lock:
+            self._futures[future.key] = future
+
+    def untrack(self, future: Any) -> None:
+        with self._lock:
+            self._futures.pop(future.key, None)
+
+    def _watch(self) -> None:
+        since: float | None = None
+        while not self._done.wait(1.0):
+            if not self.gone.is_set():
+                try:
+                    workers = len(self.client.nthreads())
+                except Exception:  # the scheduler itself gone: the client's own errors reach the run
+                    continue
+                since = None if workers else since if since is not None else time.monotonic()
+                if since is None or time.monotonic() - since < self.timeout:
+                    continue
+                self.gone.set()
+            with self._lock:  # every tick once gone: a task sent just before the run saw it is cancelled too
+                futures = list(self._futures.values())
+            if futures:
+                with contextlib.suppress(Exception):
+                    self.client.cancel(futures)
+
+
+def _unprocessed(part: Part, reason: str, state: dict[str, Any], report: BatchReport,
+                 results: dict[int, Outcome]) -> None:  # fmt: skip
+    """Record a part's frames unprocessed and stop the run (no worker to run them)."""
+    for index, name in zip(part.indices, part.names, strict=True):
+        results[part.base + index] = Outcome(index, name, "unprocessed")
+    if not state["stopped"]:
+        state["stopped"] = True
+        report.stopped = reason
 
 
 def _record(o: Outcome, key: str, report: BatchReport, table: TableWriter) -> None:
@@ -599,10 +686,21 @@ def _worker_check(sources: Sequence[str], output: str) -> dict[str, Any]:
     return {"version": __version__, "missing": [p for p in [*sources, output] if not os.path.exists(p)]}
 
 
-def _preflight(client: Any, jobs: Sequence[Job]) -> None:
-    """Refuse a cluster whose workers cannot run these jobs: symfruit missing or of another version, or a
-    recording or the output folder not at the same path on a worker."""
+def _preflight(client: Any, jobs: Sequence[Job], scheduler: str | None = None,
+               timeout: float = NO_WORKER_TIMEOUT) -> None:  # fmt: skip
+    """Refuse a cluster whose workers cannot run these jobs: no worker within ``timeout`` seconds (a scheduler
+    you started), symfruit missing or of another version, or a recording or the output folder not at the same path
+    on a worker."""
     from .. import __version__
+
+    if not client.nthreads():
+        try:
+            client.wait_for_workers(1, timeout=timeout)
+        except TimeoutError:  # distributed's WorkerStartTimeoutError: "Only 0/1 workers arrived after 60"
+            where = f"{scheduler}: the Dask scheduler" if scheduler else "the local Dask cluster"
+            raise InputError(f"{where} has no worker (waited {timeout:g} s for one); start workers, "
+                             f"dask worker {scheduler or 'ADDRESS'}, or give --workers N for a local "
+                             "cluster") from None  # fmt: skip
 
     try:
         checks = client.run(_worker_check, [job.source for job in jobs], jobs[0].output)

@@ -211,6 +211,68 @@ def _check_confidence(path: Path, conf: np.ndarray) -> None:
                               "[0, 1] (not a symfruit table, or damaged)")  # fmt: skip
 
 
+def _check_agree(output: Path, fruit: Any, frames: Any) -> None:
+    """Refuse tables that disagree, as no run writes them (a table edited, or the two from different runs): a row
+    without its recording or frame name, a frame listed twice, a fruit (recording, frame, id) twice, a fruit of a
+    frame ``frames.parquet`` does not list, and a frame whose fruit and located counts are not its rows' (located:
+    no error and a centre, as :func:`symfruit.season.table.frame_rows` counts). Before, each was reported as if
+    whole: a fruit twice counted and sized twice, fruit of no frame in the sizes but not per frame, ``None`` a
+    recording of its own. Stop 50 (robust50)."""
+    import pyarrow as pa
+    import pyarrow.compute as pc
+
+    keys = ["recording", "frame"]
+
+    def keyed(table: Any, path: Path, more: list[str]) -> Any:
+        """The key columns (refused with a row of no name) as large_string, a join's one type for both tables
+        (another tool may write either), and ``more``."""
+        columns = {}
+        for name in keys:
+            if table.column(name).null_count:
+                raise FileFormatError(f"{path}: column {name} has {table.column(name).null_count} empty rows; "
+                                      "every row names its recording and frame (not a symfruit table, or "
+                                      "damaged)")  # fmt: skip
+            columns[name] = pc.cast(table.column(name), pa.large_string())
+        return pa.table({**columns, **{name: table.column(name) for name in more}})
+
+    frames = keyed(frames, output / FRAMES_NAME, ["fruit", "located"])
+    fruit = keyed(fruit, output / TABLE_NAME, ["id", "error", "centre_x"])
+    for table, key, what, path in ((frames, keys, "frame", output / FRAMES_NAME),
+                                   (fruit, [*keys, "id"], "fruit", output / TABLE_NAME)):  # fmt: skip
+        counted = table.select(key).group_by(key).aggregate([([], "count_all")])
+        twice = counted.filter(pc.greater(counted.column("count_all"), 1))
+        if twice.num_rows:
+            row = twice.slice(0, 1).to_pylist()[0]
+            named = "/".join(shown(str(row[k]), 60) for k in keys)
+            named = f"{row['id']} of frame {named}" if what == "fruit" else named
+            raise FileFormatError(f"{path}: {what} {named} is listed {row['count_all']} times; a run "
+                                  f"lists each {what} once (not a symfruit table, or damaged)")  # fmt: skip
+    located = pc.and_(pc.is_null(fruit.column("error")), pc.is_valid(fruit.column("centre_x")))
+    rows = (pa.table({"recording": fruit.column("recording"), "frame": fruit.column("frame"),
+                      "located_rows": pc.cast(located, pa.int64())})
+            .group_by(keys).aggregate([([], "count_all"), ("located_rows", "sum")]))  # fmt: skip
+    listed = frames.append_column("listed", pa.repeat(True, frames.num_rows))
+    both = listed.join(rows, keys=keys, join_type="full outer")
+    orphan = both.filter(pc.is_null(both.column("listed")))
+    if orphan.num_rows:
+        row = orphan.slice(0, 1).to_pylist()[0]
+        raise FileFormatError(f"{output / TABLE_NAME}: holds {row['count_all']} fruit of frame "
+                              f"{shown(str(row['recording']), 60)}/{shown(str(row['frame']), 60)}, which "
+                              f"{FRAMES_NAME} does not list (the tables disagree: damaged, or of different "
+                              "runs)")  # fmt: skip
+    seen = pc.fill_null(both.column("count_all"), 0)
+    found = pc.fill_null(both.column("located_rows_sum"), 0)
+    off = both.filter(pc.or_(pc.not_equal(pc.cast(both.column("fruit"), pa.int64()), seen),
+                             pc.not_equal(pc.cast(both.column("located"), pa.int64()), found)))  # fmt: skip
+    if off.num_rows:
+        row = off.slice(0, 1).to_pylist()[0]
+        raise FileFormatError(f"{output / FRAMES_NAME}: frame {shown(str(row['recording']), 60)}/"
+                              f"{shown(str(row['frame']), 60)} counts {row['fruit']} fruit, {row['located']} located, "
+                              f"but {TABLE_NAME} holds {row['count_all'] or 0} of its fruit, "
+                              f"{row['located_rows_sum'] or 0} located (the tables disagree: damaged, or of different "
+                              "runs)")  # fmt: skip
+
+
 def _errors(output: Path) -> tuple[int, int]:
     """Frames ``errors.json`` lists as failed or not reached, and recordings it lists as not read (0, 0 without
     the file)."""
@@ -299,8 +361,8 @@ def write_report(
         _check_folder(output, Path(folder))
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
-    fruit = _read(output / TABLE_NAME, ["recording", "frame", "size_x", "size_z", "confidence", "reliable",
-                                        "truncated", "error", "method"])  # fmt: skip
+    fruit = _read(output / TABLE_NAME, ["recording", "frame", "id", "centre_x", "size_x", "size_z", "confidence",
+                                        "reliable", "truncated", "error", "method"])  # fmt: skip
     frames = _read(output / FRAMES_NAME, ["recording", "frame", "fruit", "located"])
     inputs = recording_inputs(fruit.schema.metadata)
     failed, failed_recordings = _errors(output)
@@ -318,6 +380,7 @@ def write_report(
     conf = np.array([np.nan if v is None else v for v in col["confidence"]], float)
     _check_confidence(output / TABLE_NAME, conf)
     _check_counts(output / FRAMES_NAME, seen_f, located_f)
+    _check_agree(output, fruit, frames)
     reliable = np.array([v is True for v in col["reliable"]], bool)
     methods = sorted({str(m) for m in col["method"] if m is not None})
     recordings = list(dict.fromkeys(rec_f.tolist()))
