@@ -1515,3 +1515,43 @@ def test_the_pieces_in_two_calls_are_the_five_calls_labels(seed, monkeypatch):
         assert fast.max() >= 3
     kernels = pytest.importorskip("symfruit.core.kernels")
     assert taken[0] >= 6 or kernels.compiled() is None
+
+
+def _sphere_depth(shape: tuple[int, int], focal: float, centre: np.ndarray, radius: float) -> np.ndarray:
+    """The depth (metres, 0 off it) of a sphere's front seen by a pinhole camera of ``focal`` (pixels) whose
+    principal point is the image's centre: each pixel's ray met with the sphere."""
+    rows, cols = np.mgrid[0 : shape[0], 0 : shape[1]].astype(np.float64)
+    cy, cx = shape[0] / 2, shape[1] / 2
+    d = np.stack(((cols - cx) / focal, (rows - cy) / focal, np.ones(shape)), axis=-1)
+    dc, dd = d @ centre, (d * d).sum(axis=-1)
+    disc = dc * dc - dd * (centre @ centre - radius * radius)
+    t = (dc - np.sqrt(np.maximum(disc, 0.0))) / dd
+    return np.where(disc > 0, t, 0.0)
+
+
+def test_a_rim_piece_with_depth_from_behind_lies_on_its_fruits_sphere():
+    """A round fruit's piece along its silhouette, most of whose pixels carry the depth of what lies far behind
+    (mixed and misregistered pixels on the rim) or far in front (the leaf that cut it off), lies on its fruit's
+    sphere by its points that may be a fruit's surface there (:func:`_near_surface`; joined by the merge: it was
+    told apart by a median over all its points); a piece of a second fruit beside the first, with the same share of
+    such pixels, still does not."""
+    from symfruit.segment.colour import _Depth, _Geometry, _Piece, _same_surface
+
+    s = SegmentSettings(round_fruit=True, round_max_diameter=0.10)
+    geo = _Geometry(900.0, 100.0, 100.0)
+    r = 0.035
+    one = _sphere_depth((200, 200), geo.focal, np.array([0.0, 0.0, 1.5 + r]), r)
+    two = _sphere_depth((200, 200), geo.focal, np.array([2.6 * r, 0.0, 1.5 + r]), r)
+    cols = np.arange(200)[None, :]
+    rows = np.arange(200)[:, None]
+    big = (one > 0) & (cols < 98)
+    outlier = (rows + cols) % 5 < 3  # three pixels in five off any fruit's surface
+    whole = (slice(0, 200), slice(0, 200))
+    for told, small, sphere in ((True, (one > 0) & (cols > 110), one), (False, (two > 0) & (cols > 156), two)):
+        depth = np.where(big, one, 0.0) + np.where(small, sphere, 0.0)
+        depth[small & outlier & (rows % 2 == 0)] = 4.5  # the background behind the rim
+        depth[small & outlier & (rows % 2 == 1)] = 1.2  # a leaf in front
+        weak = big | small
+        got = _same_surface(_Piece(whole, big.copy(), 1), _Piece(whole, small.copy(), 2), _Depth.of(depth), weak,
+                            geo, s)  # fmt: skip
+        assert got is told

@@ -1234,7 +1234,8 @@ def _same_surface(
     surfaces: dict[int, _Surface] | None = None,
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
-    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``). Without
+    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``; with
+    ``round_fruit``, of its points that may be a fruit's surface there, :func:`_near_surface`). Without
     a fit: not when the two pieces' median depths lie further apart than the largest fruit is across
     (``round_max_diameter``: two fruit, one behind the other), else None (nothing to tell)."""
     big, small = (a, b) if a.area >= b.area else (b, a)
@@ -1244,6 +1245,8 @@ def _same_surface(
         big_s, small_s = (surfaces.setdefault(x.serial, _Surface(x, depth, weak, geo)) for x in (big, small))
     fit = big_s.sphere()
     p = small_s.cloud()
+    if fit is not None and s.round_fruit:
+        p = _near_surface(p, fit, s)
     if fit is None or len(p) < 20:
         zs = [big_s.z(), small_s.z()]
         if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
@@ -1251,6 +1254,19 @@ def _same_surface(
         return None
     off = np.abs(row_norms(p - fit[0]) - fit[1])
     return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+
+
+def _near_surface(p: np.ndarray, fit: tuple[np.ndarray, float], s: SegmentSettings) -> np.ndarray:
+    """The points (n, 3) of a round fruit's piece that may be a fruit's surface near the sphere ``fit`` (centre,
+    radius): those whose depth lies within the sphere's depth span (its centre's depth, plus or minus its radius)
+    widened by the largest fruit's diameter (``round_max_diameter``). A piece along a fruit's silhouette, or one cut
+    off by a leaf across the fruit, carries besides its own surface the depth of what lies far in front (the leaf:
+    the depth camera sees it from a few centimetres beside the colour camera) and far behind (mixed and
+    misregistered pixels on the rim); those are no fruit's surface there and tell nothing of whether the piece lies
+    on the sphere, yet can be most of a thin piece's points and carry their median off it. A second fruit beside or
+    behind the first keeps its points (within a fruit's diameter), off the sphere by about its radius."""
+    reach = fit[1] + s.round_max_diameter
+    return p[np.abs(p[:, 2] - fit[0][2]) <= reach]
 
 
 #: Depth points each piece needs for :func:`_same_surface` to compare their median depths without a sphere.
