@@ -1555,3 +1555,46 @@ def test_a_rim_piece_with_depth_from_behind_lies_on_its_fruits_sphere():
         got = _same_surface(_Piece(whole, big.copy(), 1), _Piece(whole, small.copy(), 2), _Depth.of(depth), weak,
                             geo, s)  # fmt: skip
         assert got is told
+
+
+def test_a_small_apple_cut_by_a_wide_leaf_in_front_is_one_fruit():
+    """A small apple (42 px across, about 1.9 m) behind a leaf band 12-14 px wide, 30 cm in front: the two halves
+    either side are farther apart than half the square root of either's area, yet no further than the gap two pieces
+    of one round fruit may leave (:func:`_near_pieces` with ``round_fruit``), so the merge tests them and joins them
+    (one sphere, the leaf's green discounted: before, two fruit). Without ``round_fruit`` they are not tested."""
+    from dataclasses import replace
+
+    yy, xx = np.mgrid[:1080, :1920]
+    for half in (6, 7):
+        color, depth = hd_disc_frame([(900, 540)], radius=21, z=1.9)
+        apple = (color == RED).all(axis=2)
+        band = (np.abs(yy - 540) <= half) & (np.abs(xx - 900) <= 40)
+        color[band], depth[band] = (60, 120, 50), 1.6
+        labels = segment(color, depth, HD_CAM, APPLE)
+        assert labels.max() == 1, half
+        assert (labels[apple & ~band] == 1).all(), half
+        plain = segment(color, depth, HD_CAM, replace(APPLE, round_fruit=False, ground_colour=False))
+        assert plain.max() == 2, half
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypatch):
+    """With ``round_fruit`` (the gap a leaf across one fruit may leave), the table's pairs are the row-by-row test's,
+    and include every pair of the plain test."""
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    pieces = []
+    for _ in range(40):
+        r0, c0 = int(rng.integers(0, 300)), int(rng.integers(0, 300))
+        h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
+        mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
+        mask[0, 0] = True
+        pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), mask, 1))
+    table, plain = colour._near_pieces(pieces, True), colour._near_pieces(pieces)
+    monkeypatch.setattr(colour, "NEAR_TABLE", 0)
+    rows = colour._near_pieces(pieces, True)
+    found = [table(i) for i in range(len(pieces))]
+    assert found == [rows(i) for i in range(len(pieces))]
+    assert all(set(plain(i)) <= set(found[i]) for i in range(len(pieces)))
+    assert sum(map(len, found)) > sum(len(plain(i)) for i in range(len(pieces)))

@@ -1100,7 +1100,7 @@ def _merge(
     merged = True
     while merged and len(pieces) > 1:
         merged = False
-        near = _near_pieces(pieces)  # the pieces near each one, in order
+        near = _near_pieces(pieces, s.round_fruit)  # the pieces near each one, in order
         for i in range(len(pieces)):
             for j in near(i):
                 a, b = pieces[i], pieces[j]
@@ -1128,16 +1128,23 @@ def _merge(
     return pieces
 
 
-def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
+def _near_pieces(pieces: list[_Piece], round_fruit: bool = False) -> Callable[[int], list[int]]:
     """For each piece ``i``, the pieces ``j > i`` near it, in order (``near(i)``): their boxes closer than an occluder
-    narrower than the smaller fruit (a gap of half the square root of the smaller area, at least 2 pixels). Up to
+    narrower than the smaller fruit (a gap of half the square root of the smaller area, at least 2 pixels). With
+    ``round_fruit``, also closer than the gap two pieces of one round fruit may leave between them: the union of a
+    fruit's pieces reaches at most :data:`ROUND_EXTENT` times the larger piece's extent (:func:`_two_extents`), so a
+    leaf across the fruit may leave up to ``ROUND_EXTENT - 1`` of the larger box's longer side between them (a leaf
+    across a small apple is wider than half the square root of either half's area; the merge's tests decide). Up to
     :data:`NEAR_TABLE` pieces all pairs are tested in one pass over an (n, n) table (issue 19, nineteenth round: the
     same values as the row-by-row test, which costs a dozen numpy calls a piece); more are tested row by row when
     asked for (a merge round stops at its first merge)."""
     box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
     area = np.array([p.area for p in pieces], dtype=np.float64)
+    side = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2]) if round_fruit else np.zeros(len(pieces), int)
+    reach = ((ROUND_EXTENT - 1.0) * side).astype(np.int64)  # 0 but for round fruit
     if len(pieces) <= NEAR_TABLE:
         gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[:, None], area[None, :]))).astype(np.int64))
+        gap = np.maximum(gap, np.maximum(reach[:, None], reach[None, :]))
         a, b = box[:, None, :], box[None, :, :]
         table = ((a[..., 0] - gap < b[..., 1]) & (b[..., 0] - gap < a[..., 1])
                  & (a[..., 2] - gap < b[..., 3]) & (b[..., 2] - gap < a[..., 3]))  # fmt: skip
@@ -1151,6 +1158,7 @@ def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
 
     def near(i: int) -> list[int]:
         gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
+        gap = np.maximum(gap, np.maximum(reach[i], reach[i + 1 :]))
         rest = box[i + 1 :]
         found = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
                  & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
