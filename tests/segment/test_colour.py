@@ -1300,11 +1300,8 @@ def test_a_filled_polygon_is_pillows_image_as_bool():
         assert got.shape == want.shape and got.dtype == want.dtype and np.array_equal(got, want)
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
-    """The pairs of near pieces read off the table by one ``np.nonzero`` (stop 41) are the row-by-row test's, in
-    its order (each piece's later neighbours ascending), for clusters of boxes of many sizes, touching, overlapping
-    and apart; some pieces have no neighbour."""
+def _random_pieces(seed: int) -> list:
+    """40 pieces of random boxes and fill (touching, overlapping and apart; each with its corner pixel set)."""
     from symfruit.segment import colour
 
     rng = np.random.default_rng(seed)
@@ -1315,6 +1312,17 @@ def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
         mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
         mask[0, 0] = True
         pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), mask, 1))
+    return pieces
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
+    """The pairs of near pieces read off the table by one ``np.nonzero`` (stop 41) are the row-by-row test's, in
+    its order (each piece's later neighbours ascending), for clusters of boxes of many sizes, touching, overlapping
+    and apart; some pieces have no neighbour."""
+    from symfruit.segment import colour
+
+    pieces = _random_pieces(seed)
     table = colour._near_pieces(pieces)
     monkeypatch.setattr(colour, "NEAR_TABLE", 0)
     rows = colour._near_pieces(pieces)
@@ -1558,7 +1566,7 @@ def test_a_rim_piece_with_depth_from_behind_lies_on_its_fruits_sphere():
 
 
 def test_a_small_apple_cut_by_a_wide_leaf_in_front_is_one_fruit():
-    """A small apple (42 px across, about 1.9 m) behind a leaf band 12-14 px wide, 30 cm in front: the two halves
+    """A small apple (42 px across, about 1.9 m) behind a leaf band 13-15 px wide, 30 cm in front: the two halves
     either side are farther apart than half the square root of either's area, yet no further than the gap two pieces
     of one round fruit may leave (:func:`_near_pieces` with ``round_fruit``), so the merge tests them and joins them
     (one sphere, the leaf's green discounted: before, two fruit). Without ``round_fruit`` they are not tested."""
@@ -1583,14 +1591,7 @@ def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypat
     and include every pair of the plain test."""
     from symfruit.segment import colour
 
-    rng = np.random.default_rng(seed)
-    pieces = []
-    for _ in range(40):
-        r0, c0 = int(rng.integers(0, 300)), int(rng.integers(0, 300))
-        h, w = int(rng.integers(1, 40)), int(rng.integers(1, 40))
-        mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
-        mask[0, 0] = True
-        pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), mask, 1))
+    pieces = _random_pieces(seed)
     table, plain = colour._near_pieces(pieces, True), colour._near_pieces(pieces)
     monkeypatch.setattr(colour, "NEAR_TABLE", 0)
     rows = colour._near_pieces(pieces, True)
