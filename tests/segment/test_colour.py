@@ -1300,11 +1300,8 @@ def test_a_filled_polygon_is_pillows_image_as_bool():
         assert got.shape == want.shape and got.dtype == want.dtype and np.array_equal(got, want)
 
 
-@pytest.mark.parametrize("seed", range(4))
-def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
-    """The pairs of near pieces read off the table by one ``np.nonzero`` (stop 41) are the row-by-row test's, in
-    its order (each piece's later neighbours ascending), for clusters of boxes of many sizes, touching, overlapping
-    and apart; some pieces have no neighbour."""
+def _random_pieces(seed: int) -> list:
+    """40 pieces of random boxes and fill (touching, overlapping and apart; each with its corner pixel set)."""
     from symfruit.segment import colour
 
     rng = np.random.default_rng(seed)
@@ -1315,6 +1312,17 @@ def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
         mask = rng.random((h, w)) < rng.uniform(0.2, 1.0)
         mask[0, 0] = True
         pieces.append(colour._Piece((slice(r0, r0 + h), slice(c0, c0 + w)), mask, 1))
+    return pieces
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
+    """The pairs of near pieces read off the table by one ``np.nonzero`` (stop 41) are the row-by-row test's, in
+    its order (each piece's later neighbours ascending), for clusters of boxes of many sizes, touching, overlapping
+    and apart; some pieces have no neighbour."""
+    from symfruit.segment import colour
+
+    pieces = _random_pieces(seed)
     table = colour._near_pieces(pieces)
     monkeypatch.setattr(colour, "NEAR_TABLE", 0)
     rows = colour._near_pieces(pieces)
@@ -1515,3 +1523,79 @@ def test_the_pieces_in_two_calls_are_the_five_calls_labels(seed, monkeypatch):
         assert fast.max() >= 3
     kernels = pytest.importorskip("symfruit.core.kernels")
     assert taken[0] >= 6 or kernels.compiled() is None
+
+
+def _sphere_depth(shape: tuple[int, int], focal: float, centre: np.ndarray, radius: float) -> np.ndarray:
+    """The depth (metres, 0 off it) of a sphere's front seen by a pinhole camera of ``focal`` (pixels) whose
+    principal point is the image's centre: each pixel's ray met with the sphere."""
+    rows, cols = np.mgrid[0 : shape[0], 0 : shape[1]].astype(np.float64)
+    cy, cx = shape[0] / 2, shape[1] / 2
+    d = np.stack(((cols - cx) / focal, (rows - cy) / focal, np.ones(shape)), axis=-1)
+    dc, dd = d @ centre, (d * d).sum(axis=-1)
+    disc = dc * dc - dd * (centre @ centre - radius * radius)
+    t = (dc - np.sqrt(np.maximum(disc, 0.0))) / dd
+    return np.where(disc > 0, t, 0.0)
+
+
+def test_a_rim_piece_with_depth_from_behind_lies_on_its_fruits_sphere():
+    """A round fruit's piece along its silhouette, most of whose pixels carry the depth of what lies far behind
+    (mixed and misregistered pixels on the rim) or far in front (the leaf that cut it off), lies on its fruit's
+    sphere by its points that may be a fruit's surface there (:func:`_near_surface`; joined by the merge: it was
+    told apart by a median over all its points); a piece of a second fruit beside the first, with the same share of
+    such pixels, still does not."""
+    from symfruit.segment.colour import _Depth, _Geometry, _Piece, _same_surface
+
+    s = SegmentSettings(round_fruit=True, round_max_diameter=0.10)
+    geo = _Geometry(900.0, 100.0, 100.0)
+    r = 0.035
+    one = _sphere_depth((200, 200), geo.focal, np.array([0.0, 0.0, 1.5 + r]), r)
+    two = _sphere_depth((200, 200), geo.focal, np.array([2.6 * r, 0.0, 1.5 + r]), r)
+    cols = np.arange(200)[None, :]
+    rows = np.arange(200)[:, None]
+    big = (one > 0) & (cols < 98)
+    outlier = (rows + cols) % 5 < 3  # three pixels in five off any fruit's surface
+    whole = (slice(0, 200), slice(0, 200))
+    for told, small, sphere in ((True, (one > 0) & (cols > 110), one), (False, (two > 0) & (cols > 156), two)):
+        depth = np.where(big, one, 0.0) + np.where(small, sphere, 0.0)
+        depth[small & outlier & (rows % 2 == 0)] = 4.5  # the background behind the rim
+        depth[small & outlier & (rows % 2 == 1)] = 1.2  # a leaf in front
+        weak = big | small
+        got = _same_surface(_Piece(whole, big.copy(), 1), _Piece(whole, small.copy(), 2), _Depth.of(depth), weak,
+                            geo, s)  # fmt: skip
+        assert got is told
+
+
+def test_a_small_apple_cut_by_a_wide_leaf_in_front_is_one_fruit():
+    """A small apple (42 px across, about 1.9 m) behind a leaf band 13-15 px wide, 30 cm in front: the two halves
+    either side are farther apart than half the square root of either's area, yet no further than the gap two pieces
+    of one round fruit may leave (:func:`_near_pieces` with ``round_fruit``), so the merge tests them and joins them
+    (one sphere, the leaf's green discounted: before, two fruit). Without ``round_fruit`` they are not tested."""
+    from dataclasses import replace
+
+    yy, xx = np.mgrid[:1080, :1920]
+    for half in (6, 7):
+        color, depth = hd_disc_frame([(900, 540)], radius=21, z=1.9)
+        apple = (color == RED).all(axis=2)
+        band = (np.abs(yy - 540) <= half) & (np.abs(xx - 900) <= 40)
+        color[band], depth[band] = (60, 120, 50), 1.6
+        labels = segment(color, depth, HD_CAM, APPLE)
+        assert labels.max() == 1, half
+        assert (labels[apple & ~band] == 1).all(), half
+        plain = segment(color, depth, HD_CAM, replace(APPLE, round_fruit=False, ground_colour=False))
+        assert plain.max() == 2, half
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypatch):
+    """With ``round_fruit`` (the gap a leaf across one fruit may leave), the table's pairs are the row-by-row test's,
+    and include every pair of the plain test."""
+    from symfruit.segment import colour
+
+    pieces = _random_pieces(seed)
+    table, plain = colour._near_pieces(pieces, True), colour._near_pieces(pieces)
+    monkeypatch.setattr(colour, "NEAR_TABLE", 0)
+    rows = colour._near_pieces(pieces, True)
+    found = [table(i) for i in range(len(pieces))]
+    assert found == [rows(i) for i in range(len(pieces))]
+    assert all(set(plain(i)) <= set(found[i]) for i in range(len(pieces)))
+    assert sum(map(len, found)) > sum(len(plain(i)) for i in range(len(pieces)))

@@ -1100,7 +1100,7 @@ def _merge(
     merged = True
     while merged and len(pieces) > 1:
         merged = False
-        near = _near_pieces(pieces)  # the pieces near each one, in order
+        near = _near_pieces(pieces, s.round_fruit)  # the pieces near each one, in order
         for i in range(len(pieces)):
             for j in near(i):
                 a, b = pieces[i], pieces[j]
@@ -1128,16 +1128,23 @@ def _merge(
     return pieces
 
 
-def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
+def _near_pieces(pieces: list[_Piece], round_fruit: bool = False) -> Callable[[int], list[int]]:
     """For each piece ``i``, the pieces ``j > i`` near it, in order (``near(i)``): their boxes closer than an occluder
-    narrower than the smaller fruit (a gap of half the square root of the smaller area, at least 2 pixels). Up to
+    narrower than the smaller fruit (a gap of half the square root of the smaller area, at least 2 pixels). With
+    ``round_fruit``, also closer than the gap two pieces of one round fruit may leave between them: the union of a
+    fruit's pieces reaches at most :data:`ROUND_EXTENT` times the larger piece's extent (:func:`_two_extents`), so a
+    leaf across the fruit may leave up to ``ROUND_EXTENT - 1`` of the larger box's longer side between them (a leaf
+    across a small apple is wider than half the square root of either half's area; the merge's tests decide). Up to
     :data:`NEAR_TABLE` pieces all pairs are tested in one pass over an (n, n) table (issue 19, nineteenth round: the
     same values as the row-by-row test, which costs a dozen numpy calls a piece); more are tested row by row when
     asked for (a merge round stops at its first merge)."""
     box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
     area = np.array([p.area for p in pieces], dtype=np.float64)
+    side = np.maximum(box[:, 1] - box[:, 0], box[:, 3] - box[:, 2]) if round_fruit else np.zeros(len(pieces), int)
+    reach = ((ROUND_EXTENT - 1.0) * side).astype(np.int64)  # 0 but for round fruit
     if len(pieces) <= NEAR_TABLE:
         gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[:, None], area[None, :]))).astype(np.int64))
+        gap = np.maximum(gap, np.maximum(reach[:, None], reach[None, :]))
         a, b = box[:, None, :], box[None, :, :]
         table = ((a[..., 0] - gap < b[..., 1]) & (b[..., 0] - gap < a[..., 1])
                  & (a[..., 2] - gap < b[..., 3]) & (b[..., 2] - gap < a[..., 3]))  # fmt: skip
@@ -1151,6 +1158,7 @@ def _near_pieces(pieces: list[_Piece]) -> Callable[[int], list[int]]:
 
     def near(i: int) -> list[int]:
         gap = np.maximum(2, (0.5 * np.sqrt(np.minimum(area[i], area[i + 1 :]))).astype(np.int64))
+        gap = np.maximum(gap, np.maximum(reach[i], reach[i + 1 :]))
         rest = box[i + 1 :]
         found = ((box[i, 0] - gap < rest[:, 1]) & (rest[:, 0] - gap < box[i, 1])
                  & (box[i, 2] - gap < rest[:, 3]) & (rest[:, 2] - gap < box[i, 3]))  # fmt: skip
@@ -1234,7 +1242,8 @@ def _same_surface(
     surfaces: dict[int, _Surface] | None = None,
 ) -> bool | None:
     """Whether the smaller piece's depth points lie on the sphere fitted to the larger one (the median
-    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``). Without
+    distance off it at most ``sphere_apart`` times its radius, and at most a depth step ``depth_jump``; with
+    ``round_fruit``, of its points that may be a fruit's surface there, :func:`_near_surface`). Without
     a fit: not when the two pieces' median depths lie further apart than the largest fruit is across
     (``round_max_diameter``: two fruit, one behind the other), else None (nothing to tell)."""
     big, small = (a, b) if a.area >= b.area else (b, a)
@@ -1244,6 +1253,8 @@ def _same_surface(
         big_s, small_s = (surfaces.setdefault(x.serial, _Surface(x, depth, weak, geo)) for x in (big, small))
     fit = big_s.sphere()
     p = small_s.cloud()
+    if fit is not None and s.round_fruit:
+        p = _near_surface(p, fit, s)
     if fit is None or len(p) < 20:
         zs = [big_s.z(), small_s.z()]
         if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
@@ -1251,6 +1262,19 @@ def _same_surface(
         return None
     off = np.abs(row_norms(p - fit[0]) - fit[1])
     return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+
+
+def _near_surface(p: np.ndarray, fit: tuple[np.ndarray, float], s: SegmentSettings) -> np.ndarray:
+    """The points (n, 3) of a round fruit's piece that may be a fruit's surface near the sphere ``fit`` (centre,
+    radius): those whose depth lies within the sphere's depth span (its centre's depth, plus or minus its radius)
+    widened by the largest fruit's diameter (``round_max_diameter``). A piece along a fruit's silhouette, or one cut
+    off by a leaf across the fruit, carries besides its own surface the depth of what lies far in front (the leaf:
+    the depth camera sees it from a few centimetres beside the colour camera) and far behind (mixed and
+    misregistered pixels on the rim); those are no fruit's surface there and tell nothing of whether the piece lies
+    on the sphere, yet can be most of a thin piece's points and carry their median off it. A second fruit beside or
+    behind the first keeps its points (within a fruit's diameter), off the sphere by about its radius."""
+    reach = fit[1] + s.round_max_diameter
+    return p[np.abs(p[:, 2] - fit[0][2]) <= reach]
 
 
 #: Depth points each piece needs for :func:`_same_surface` to compare their median depths without a sphere.
