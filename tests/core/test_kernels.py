@@ -6313,3 +6313,79 @@ def test_backdrop_counts_are_the_twins(monkeypatch, seed):
         assert type(kernel[2]) is int or kernel[2] == 0
         found += kernel[2] > 0
     assert found > 20
+
+
+# --- stop 50, outline50: the registration's outline in fewer calls ------------------------------------------------
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 25), st.booleans())
+def test_outline_windows_are_the_taxicab_window_and_the_outline_maps_to_the_bit(seed, reach, wide):
+    """``outline_windows`` on masks of every shape: the grown window is scipy's taxicab distance within ``reach``, the
+    maps, keys, places and values those of ``outline_maps`` with pad and reach ``reach``, the same arrays bit for
+    bit."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 200 if wide else 60, 2))
+    mask = _blob_mask(rng, h, w)
+    grown, inner, inside = np.empty(mask.shape, bool), np.empty(mask.shape), np.empty(mask.shape)
+    found = _jit.outline_windows(mask, reach, grown, inner, inside)
+    assert np.array_equal(grown, ndimage.distance_transform_cdt(~mask, metric="taxicab") <= reach)
+    want_inner, want_inside = np.empty(mask.shape), np.empty(mask.shape)
+    want = _jit.outline_maps(mask, reach, reach, want_inner, want_inside)
+    assert np.array_equal(inner, want_inner) and np.array_equal(inside, want_inside) and found[0] == want[0]
+    for got, expected in zip(found[1:], want[1:], strict=True):
+        assert got.dtype == expected.dtype and np.array_equal(got, expected)
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40))
+def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, least):
+    """``cap_outline`` on random caps (blobs with holes, several pieces, touching the array's edges) over depth with
+    holes, pixels behind and in front: the cap is the apex's piece (``ndimage.label``'s), its outline
+    ``np.nonzero(cap & ~interior(cap))``, and its free points ``_free_points``' numpy twin's, whenever the outline holds
+    at least ``least`` points (none computed below)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import interior
+    from symfruit.core.surface import _FREE_PX, Surface, _free_far, _free_points
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 90, 2))
+    pixels = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
+    if not pixels.any():
+        pixels[0, 0] = True
+    where = np.flatnonzero(pixels)
+    r, c = divmod(int(where[rng.integers(0, len(where))]), w)
+    depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
+    depth[depth < 0.1] = 0.0
+    surface = Surface(pixels, 0.5, float(rng.uniform(0.01, 0.08)), float(rng.uniform(0.0, 0.004)), (r, c))
+    rows, cols, free = _jit.cap_outline(pixels, r, c, depth, _free_far(surface), _FREE_PX, int(_FREE_PX) + 1, least)
+    labels, _ = ndimage.label(pixels)
+    cap = labels == labels[r, c]
+    want_rows, want_cols = np.nonzero(cap & ~interior(cap))
+    assert np.array_equal(rows, want_rows) and np.array_equal(cols, want_cols)
+    if len(rows) < least:
+        assert len(free) == 0
+        return
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_free, _ = _free_points(depth, cap, want_rows, want_cols, surface)
+    assert free.dtype == want_free.dtype and np.array_equal(free, want_free)
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("reach", [6, 20])
+def test_the_registrations_outline_is_the_twins_to_the_bit(monkeypatch, seed, reach):
+    """``_outline`` (its window, maps, cap, outline and free points by ``outline_windows`` and ``cap_outline``) with
+    the kernels and with the numpy twins on a ball's frame: the same points, signed map, band and sides."""
+    from symfruit.core.surface import _outline
+
+    depth, mask, _ = _ball_frame(seed)
+    outline, twin = _both(monkeypatch, _outline, depth, mask, 600.0, reach)
+    assert outline is not None and twin is not None
+    for a, b in ((outline.rows, twin.rows), (outline.cols, twin.cols), (outline.inside, twin.inside),
+                 (outline.sides, twin.sides)):  # fmt: skip
+        assert np.array_equal(a, b)
+    assert outline.band == twin.band

@@ -8452,3 +8452,35 @@ def backdrop_counts(
                     behind += y > zr
                     level += abs(y - z) <= r
     return around, count, behind, level
+
+
+# --- stop 50, outline50: the registration's per-fruit outline in fewer calls ----------------------------------------
+
+
+@_njit
+def outline_windows(
+    mask: np.ndarray, reach: int, grown: np.ndarray, inner: np.ndarray, inside: np.ndarray
+) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._outline`'s maps of a mask (h, w) bool holding pixels of both kinds, in one call:
+    ``grown`` (h, w) bool the pixels within ``reach`` taxicab steps of the mask (:func:`taxicab_within`) and
+    :func:`outline_maps` of pad and reach ``reach`` (``inner`` and ``inside`` written in place, its keys and ranks
+    returned): the two kernels' own loops one after the other, the same pixels and numbers."""
+    taxicab_within(mask, reach, grown)
+    return outline_maps(mask, reach, reach, inner, inside)
+
+
+@_njit
+def cap_outline(
+    pixels: np.ndarray, r: int, c: int, depth: np.ndarray, far: float, reach: float, pad: int, least: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._outline`'s cap and its outline in one call: the piece of ``pixels`` (h, w) bool
+    holding its pixel ``(r, c)`` (which must be ``pixels``'): :func:`connected_at`; its outline's rows and columns
+    (raster order): :func:`outline_pixels`; and, where there are at least ``least`` of them, which are free
+    (:func:`free_outline` over ``depth`` (h, w) float64 with ``far``, ``reach`` and ``pad``; else an empty array):
+    the three kernels one after the other, the same pixels and points."""
+    cap = np.empty(pixels.shape, np.bool_)
+    connected_at(pixels, r, c, cap)
+    rows, cols = outline_pixels(cap)
+    if rows.shape[0] < least:
+        return rows, cols, np.empty(0, np.bool_)
+    return rows, cols, free_outline(depth, cap, rows, cols, far, reach, pad)

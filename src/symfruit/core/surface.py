@@ -1246,14 +1246,14 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points).
     ``clean``: :func:`fruit_surface`'s (the depth finite, above 0 or 0 already)."""
-    grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
     jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
     found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
     inside: np.ndarray | None = None
-    if jit is not None:  # both distance maps, the keys and their ranks in one call (issue 19, twentieth round)
-        inner, inside = np.empty(mask.shape), np.empty(mask.shape)
-        found = jit.outline_maps(mask, int(reach), int(reach), inner, inside)
+    if jit is not None:  # the grown window, both distance maps, the keys and their ranks in one call (stop 50)
+        grown, inner, inside = np.empty(mask.shape, bool), np.empty(mask.shape), np.empty(mask.shape)
+        found = jit.outline_windows(mask, int(reach), grown, inner, inside)
     else:
+        grown = _taxicab_within(mask, reach)  # = binary_dilation, reach times
         inner = inner_distance(mask)
     # the outline cue keeps the cap it was measured with (the tolerance without the depth's unit): with the unit, two
     # banana views of the D405 model (true shift 0), whose outlines slide along their length, went from (0, 0) and
@@ -1261,14 +1261,23 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
     surface = fruit_surface(depth, mask, focal, region=grown, inner=inner, step=0.0, thin=True, clean=clean)
     if surface is None:
         return None
-    cap = _connected(surface.pixels, surface.apex)
-    if (jit := compiled()) is not None:  # the outline's pixels in one pass (issue 19, nineteenth round: the same)
-        rows, cols = jit.outline_pixels(cap)
+    jit = compiled()
+    pixels, apex = surface.pixels, surface.apex
+    free: np.ndarray | None = None
+    if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and pixels.dtype == bool and pixels[apex]:
+        # the cap, its outline and the outline's free points in one call (stop 50: the same pixels and points)
+        cap = pixels  # not read below: _free_points is given the free points
+        rows, cols, free = jit.cap_outline(pixels, apex[0], apex[1], depth, _free_far(surface), _FREE_PX,
+                                           int(_FREE_PX) + 1, 12)  # fmt: skip
     else:
-        rows, cols = np.nonzero(cap & ~interior(cap))
+        cap = _connected(pixels, apex)
+        if jit is not None:  # the outline's pixels in one pass (issue 19, nineteenth round: the same)
+            rows, cols = jit.outline_pixels(cap)
+        else:
+            rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
-    free, sides = _free_points(depth, cap, rows, cols, surface)
+    free, sides = _free_points(depth, cap, rows, cols, surface, free=free)
     rows, cols = rows[free], cols[free]  # where the depth runs on, no band lies to be measured
     if len(rows) < 12:
         return None
@@ -1308,8 +1317,14 @@ _FREE_PX = 4.0
 _FREE_SHARE = 0.5
 
 
-def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray,
-                 surface: Surface) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+def _free_far(surface: Surface) -> float:
+    """:func:`_free_points`' depth beyond which a pixel is behind the fruit's rim: its front plus its radius, plus the
+    convexity test's tolerance."""
+    return surface.front + surface.radius + max(3.0 * surface.noise, 0.003)
+
+
+def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, surface: Surface, *,
+                 free: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Which points of a depth cap's outline (``rows``, ``cols``) are *free*: a true silhouette, whose band inside
     the mask (:func:`registration_shift`) is there to be measured; and of the points on its top, bottom, left
     and right side, how many are free and how many there are: ``((n,) bool, (4, 2) int)``.
@@ -1320,18 +1335,20 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
     lies behind its rim). Where the depth runs on at the fruit's own depth or nearer, into a support, a
     neighbour or a leaf in front, the outline is the junction, not the silhouette, and no band lies there.
     The sides are counted on the outline's rim (:func:`_rim`); a point belongs to the side its direction from the
-    outline's centroid points to most."""
-    tol = max(3.0 * surface.noise, 0.003)
+    outline's centroid points to most. ``free``: the free points when the caller has them (:func:`_outline`'s
+    :func:`symfruit.core._jit.cap_outline`; ``cap`` is then not read)."""
     # on the outline's box grown by the reach alone (the same answers: no farther pixel is within reach)
     r = int(_FREE_PX) + 1
     jit = compiled()
-    if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and cap.dtype == bool and len(rows):
+    if free is not None:
+        pass
+    elif jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and cap.dtype == bool and len(rows):
         # the gap, its distances and the points' test in one pass (issue 19, nineteenth round: the same points)
-        free = jit.free_outline(depth, cap, rows, cols, surface.front + surface.radius + tol, _FREE_PX, r)
+        free = jit.free_outline(depth, cap, rows, cols, _free_far(surface), _FREE_PX, r)
     else:
         r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
         box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
-        gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= surface.front + surface.radius + tol))
+        gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= _free_far(surface)))
         free = within(gap, _FREE_PX)[rows - r0, cols - c0]
     if jit is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
         # the means from whole-number sums (exact in any order, as numpy's float64 sums of them are; its mean divides
