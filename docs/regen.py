@@ -561,7 +561,10 @@ def run_part(name: str, sections: list[Section], ctx: Ctx, jobs: int) -> None:
         failed = [r for r in results if r.rc not in (0, 1) or (r.results is None and r.cmd.argv[1] == "evaluate")]
         for r in failed:
             lines.append(f"(failed, exit {r.rc}: {r.folder}/stderr.txt)")
-        lines += s.rows(results) + [""]
+        try:
+            lines += s.rows(results) + [""]
+        except (OSError, ValueError, KeyError, IndexError) as exc:  # one table's rows, not the whole run
+            lines += [f"(rows failed: {type(exc).__name__}: {exc})", ""]
     (out / "rows.md").write_text("\n".join(lines))
     status = {c.text(): {"rc": ctx.done[c.key()].rc, "cpu_s": ctx.done[c.key()].cpu_s} for c in cmds}
     (out / "status.json").write_text(json.dumps({"part": name, "wall_s": round(time.time() - t0, 1),
