@@ -50,7 +50,9 @@ def test_every_part_is_defined_and_its_readme_anchor_is_in_readme(regen):
         for s in sections:
             assert s.cmds, (name, s.title)
             if s.anchor is not None:
-                assert regen.readme_tables(texts[s.anchor[0]], s.anchor[1]) is not None, (name, s.title)
+                found = s.anchor[1] if isinstance(s.anchor[1], list) else [s.anchor[1]]
+                for text in filter(None, found):
+                    assert regen.readme_tables(texts[s.anchor[0]], text) is not None, (name, s.title, text)
 
 
 def test_the_commands_keep_readmes_own(regen):
@@ -106,6 +108,21 @@ def test_readme_confirms_a_row_names_a_differing_cell_and_a_row_it_lacks(regen, 
     assert "x | a table | raw: confirmed" in said
     assert "x | a table | `evidence`: differs: centre (mm): README 1.30 (2 failed), printed 1.20 (2 failed)" in said
     assert "x | another | paper: no README row of that label" in said
+
+
+def test_readme_reads_one_anchor_per_printed_table_and_leaves_out_counts_and_timings(regen, tmp_path):
+    root = tmp_path / "tree"
+    root.mkdir()
+    (root / "README.md").write_text(
+        "**A**\n\n| m | x | ms per image |\n|---|---|---|\n| raw | 1.0 (+1.0) | 3.9 |\n\n"
+        "**B**\n\n| m | y |\n|---|---|\n| raw | 2.0 |\n"
+    )
+    text = ('## t\n\nREADME table: README.md, after ["**A**", null, "**B**"]\n\n'
+            "| m | x | ms per image |\n|---|---|---|\n| raw | 1.0 (+1.0) (n 12) | 4.2 |\n\n"
+            "| m | z |\n|---|---|\n| raw | 7 |\n\n| m | y |\n|---|---|\n| raw | 2.5 |\n")  # fmt: skip
+    said = []
+    assert regen.check_readme(write_out(tmp_path / "out", text), root, said.append) == (1, 1, 0)
+    assert said[:2] == ["x | t | raw: confirmed", "x | t | raw: differs: y: README 2.0, printed 2.5"]
 
 
 def test_readme_matches_by_value_where_the_columns_differ(regen, tmp_path):
