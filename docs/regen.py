@@ -117,6 +117,7 @@ class Result:
     results: Path | None  # symfruit evaluate's results folder, from its "results: FOLDER" line
     rc: int
     cpu_s: float
+    wall_s: float = 0.0
 
 
 @dataclass
@@ -535,7 +536,7 @@ def render(args: list[str], ctx: Ctx) -> Path:
     )
     if rc:
         raise SystemExit(f"symfruit scenes {shlex.join(args)} failed (exit {rc}): see {ctx.out}/_scenes/{key}.log")
-    marker.write_text(json.dumps({"args": args, "cpu_s": cpu, "wall_s": time.time() - t0}))
+    write_atomic(marker, json.dumps({"args": args, "cpu_s": cpu, "wall_s": time.time() - t0}))
     _rendered[key] = target
     return target
 
@@ -559,10 +560,10 @@ def run_cmd(cmd: Cmd, ctx: Ctx) -> Result:
         rc, cpu, _ = execute(argv, folder)
         info = {"command": cmd.text(), "argv": argv, "rc": rc, "cpu_s": round(cpu, 1),
                 "wall_s": round(time.time() - t0, 1)}  # fmt: skip
-        (folder / "status.json").write_text(json.dumps(info, indent=1))
+        write_atomic(folder / "status.json", json.dumps(info, indent=1))
     stdout = read_text(folder / "stdout.txt")
     m = re.search(r"^results: (\S+)", stdout, re.M)
-    result = Result(cmd, folder, stdout, Path(m.group(1)) if m else None, info["rc"], info["cpu_s"])
+    result = Result(cmd, folder, stdout, Path(m.group(1)) if m else None, info["rc"], info["cpu_s"], info["wall_s"])
     ctx.done[key] = result
     return result
 
@@ -575,7 +576,6 @@ def run_part(name: str, sections: list[Section], ctx: Ctx, jobs: int) -> None:
     for c in cmds:
         for args in c.scenes():
             render(args, ctx)
-    t0 = time.time()
     with ThreadPoolExecutor(max(1, jobs)) as pool:
         list(pool.map(lambda c: run_cmd(c, ctx), cmds))
     lines = [f"# {name}", ""]
@@ -594,12 +594,25 @@ def run_part(name: str, sections: list[Section], ctx: Ctx, jobs: int) -> None:
             lines += s.rows(results) + [""]
         except (OSError, ValueError, KeyError, IndexError) as exc:  # one table's rows, not the whole run
             lines += [f"(rows failed: {type(exc).__name__}: {exc})", ""]
-    (out / "rows.md").write_text("\n".join(lines))
-    status = {c.text(): {"rc": ctx.done[c.key()].rc, "cpu_s": ctx.done[c.key()].cpu_s} for c in cmds}
-    (out / "status.json").write_text(json.dumps({"part": name, "wall_s": round(time.time() - t0, 1),
-                                                 "cpu_s": round(sum(v["cpu_s"] for v in status.values()), 1),
-                                                 "commands": status}, indent=1))  # fmt: skip
-    say(f"{name}: {out}/rows.md ({sum(v['cpu_s'] for v in status.values()):.0f} s CPU)")
+    write_atomic(out / "rows.md", "\n".join(lines))
+    status = {c.text(): {k: getattr(ctx.done[c.key()], k) for k in ("rc", "cpu_s", "wall_s")} for c in cmds}
+    frames = {}
+    for c in cmds:
+        for args in c.scenes():
+            marker = ctx.out / "_scenes" / scenes_key(args) / ".regen-done"
+            info = json.loads(read_text(marker))
+            frames["symfruit scenes " + shlex.join(args)] = {k: round(info[k], 1) for k in ("cpu_s", "wall_s")}
+    cpu = sum(v["cpu_s"] for v in [*status.values(), *frames.values()])
+    wall = sum(v["wall_s"] for v in [*status.values(), *frames.values()])
+    write_atomic(out / "status.json", json.dumps({"part": name, "cpu_s": round(cpu, 1), "wall_s": round(wall, 1),
+                                                  "commands": status, "scenes": frames}, indent=1))  # fmt: skip
+    say(f"{name}: {out}/rows.md ({cpu:.0f} s CPU, {wall:.0f} s, rendered frames included)")
+
+
+def write_atomic(path: Path, text: str) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
 
 
 # ---------------------------------------------------------------- reading rows.md
