@@ -108,6 +108,7 @@ def test_readme_confirms_a_row_names_a_differing_cell_and_a_row_it_lacks(regen, 
     assert "x | a table | raw: confirmed" in said
     assert "x | a table | `evidence`: differs: centre (mm): README 1.30 (2 failed), printed 1.20 (2 failed)" in said
     assert "x | another | paper: no README row of that label" in said
+    assert said[-1] == "README rows confirmed 1, differing 1, printed rows without a README row 1"
 
 
 def test_readme_reads_one_anchor_per_printed_table_and_leaves_out_counts_and_timings(regen, tmp_path):
@@ -137,6 +138,13 @@ def test_readme_matches_by_value_where_the_columns_differ(regen, tmp_path):
     said = []
     assert regen.check_readme(write_out(tmp_path / "out", text), root, said.append) == (0, 1, 0)
     assert said[0] == "x | t | raw: differs: centre (mm): README 20.3, printed (not printed)"
+
+
+def test_readme_names_the_tables_it_cannot_check(regen, tmp_path):
+    out = write_out(tmp_path / "out", "## prose only\n\n    python docs/tree_masks.py\n\nseeds 0-11: 308 of 360\n")
+    said = []
+    assert regen.check_readme(out, tmp_path, said.append) == (0, 0, 0)
+    assert said[0] == "x | prose only: no README table (its figures are in README's text: compare by hand)"
 
 
 def test_a_tiny_part_runs_writes_its_rows_and_resumes_without_running_again(regen, tmp_path, monkeypatch):
