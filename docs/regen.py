@@ -107,6 +107,9 @@ class Section:
     cmds: list[Cmd]
     rows: Callable[[list[Result]], list[str]]
     anchor: tuple[str, str | list[str | None]] | None = None
+    #: README's label of a printed row where the printing script labels it otherwise (by the label without a
+    #: trailing parenthesis, e.g. ``half 0 (503 images)`` -> README's ``photos, half 0 (503 images, development)``).
+    aliases: dict[str, str] = field(default_factory=dict)
 
 
 @dataclass
@@ -456,7 +459,9 @@ def parts() -> dict[str, list[Section]]:
     ]  # fmt: skip
     p["photos"] = [
         Section("strawberry photographs, halves", [py("photo_halves.py", "{shared}/strawberry-photos/train")],
-                printed, (README, "On the shared strawberry photos (971 Roboflow images")),
+                printed, (README, "On the shared strawberry photos (971 Roboflow images"),
+                {"half 0": "photos, half 0 (503 images, development)",
+                 "half 1": "photos, half 1 (468 images, held out)", "all": "all 971 photos"}),
         *(Section(f"rendered strawberry scenes {a}-{a + 19}, {what}",
                   [masks_scene(*(("--seed", str(a)) if a else ()), "--n", "20", *flag)],
                   masks_row(f"rendered scenes {a}-{a + 19}, {what}"),
@@ -584,6 +589,8 @@ def run_part(name: str, sections: list[Section], ctx: Ctx, jobs: int) -> None:
         lines += [f"## {s.title}", ""]
         if s.anchor:
             lines += [f"README table: {s.anchor[0]}, after {json.dumps(s.anchor[1])}", ""]
+        if s.aliases:
+            lines += [f"README labels: {json.dumps(s.aliases)}", ""]
         renders = list(dict.fromkeys(shlex.join(["symfruit", "scenes", "_scenes/" + scenes_key(a), *a])
                                      for c in s.cmds for a in c.scenes()))  # fmt: skip
         lines += [f"    {x}" for x in renders + [c.text() for c in s.cmds]] + [""]
@@ -623,7 +630,9 @@ def split_row(line: str) -> list[str]:
 
 
 def norm(label: str) -> str:
-    return re.sub(r"\s+", " ", label.replace("*", "").replace("`", "")).strip().lower()
+    """A label or cell as compared with README's: no markup, one space, ``99.5%`` as ``99.5 %``, lower case."""
+    text = re.sub(r"(\d)%", r"\1 %", label.replace("*", "").replace("`", ""))
+    return re.sub(r"\s+", " ", text).strip().lower()
 
 
 def read_rows(text: str) -> dict[tuple[str, int, str], tuple[list[str], list[str]]]:
@@ -749,6 +758,9 @@ def check_readme(out: Path, root: Path, say: Callable[[str], object] = say) -> t
         text = read_text(path)
         anchors = dict(re.findall(r"^## (.+)\n\nREADME table: .+?, after ([\"\[].*)$", text, re.M))
         files = dict(re.findall(r"^## (.+)\n\nREADME table: (.+?), after ", text, re.M))
+        aliases = {
+            k: json.loads(v) for k, v in re.findall(r"^## (.+)\n\nREADME table: .+\n\nREADME labels: (.+)$", text, re.M)
+        }
         prose += [f"{path.parent.name} | {x}" for x in re.findall(r"^## (.+)$", text, re.M) if x not in anchors]
         for (section, table, label), (header, cells) in read_rows(text).items():
             if section not in anchors or table == 0:
@@ -763,6 +775,8 @@ def check_readme(out: Path, root: Path, say: Callable[[str], object] = say) -> t
                 texts[name] = read_text(root / name) if (root / name).is_file() else ""
             found = readme_tables(texts[name], anchor)
             where = f"{path.parent.name} | {section} | {label}"
+            alias = aliases.get(section, {})
+            label = alias.get(label, alias.get(re.sub(r"\s*\([^()]*\)$", "", label), label))
             if found is None or norm(label) not in found[1]:
                 unmatched += 1
                 say(f"{where}: no README row of that label")

@@ -140,6 +140,16 @@ def test_readme_matches_by_value_where_the_columns_differ(regen, tmp_path):
     assert said[0] == "x | t | raw: differs: centre (mm): README 20.3, printed (not printed)"
 
 
+def test_readme_reads_a_row_by_its_readme_label_and_a_share_written_without_a_space(regen, tmp_path):
+    (tmp_path / "README.md").write_text(
+        "**P**\n\n| data | matched |\n|---|---|\n| photos, half 0 (dev) | 551 (99.5 %) |\n"
+    )
+    text = ('## p\n\nREADME table: README.md, after "**P**"\n\nREADME labels: {"half 0": "photos, half 0 (dev)"}\n\n'
+            "| data | matched |\n|---|---|\n| half 0 (503 images) | 551 (99.5%) |\n")  # fmt: skip
+    said = []
+    assert regen.check_readme(write_out(tmp_path / "out", text), tmp_path, said.append) == (1, 0, 0)
+
+
 def test_readme_names_the_tables_it_cannot_check(regen, tmp_path):
     out = write_out(tmp_path / "out", "## prose only\n\n    python docs/tree_masks.py\n\nseeds 0-11: 308 of 360\n")
     said = []
