@@ -191,4 +191,20 @@ def test_scan_labels_and_leaf_cells(regen, monkeypatch):
     printed = ["| 0% | 70 | 0.753 / 4.60 / 15 / 2 / 0 |", "| 25% | 70 | 0.671 / 7.04 / 70 / 10 / 3 |"]
     monkeypatch.setattr(regen, "rows_script", lambda *args: printed)
     result = regen.Result(regen.Cmd(("x",)), Path("."), "", Path("."), 0, 0.0)
-    assert regen.leaf_cells(["Azure Kinect"])([result])[-1] == "| Azure Kinect | 0.753 / 4.6 (2) | 0.671 / 7.0 (10) |"
+    assert regen.leaf_cells(["Azure Kinect"])([result])[-2:] == [
+        "| Azure Kinect | 0.753 / 4.6 (2) | 0.671 / 7.0 (10) |",
+        "",
+    ]
+
+
+def test_readme_leaves_out_the_columns_of_earlier_stops(regen, tmp_path):
+    (tmp_path / "README.md").write_text(
+        "**L**\n\n| s | 0 % | 25 % at stop 39 |\n|---|---|---|\n| D435 | 0.768 | 0.524 |\n"
+    )
+    text = '## l\n\nREADME table: README.md, after "**L**"\n\n| D435 | 0.768 |\n'
+    said = []
+    assert regen.check_readme(write_out(tmp_path / "out", text), tmp_path, said.append) == (1, 0, 0)
+    text = '## l\n\nREADME table: README.md, after "**L**"\n\n| D435 | 0.770 |\n'
+    said.clear()
+    assert regen.check_readme(write_out(tmp_path / "out2", text), tmp_path, said.append) == (0, 1, 0)
+    assert said[0] == "x | l | D435: differs: 0 %: README 0.768, printed (not printed)"
