@@ -38,6 +38,7 @@ import json
 import os
 import re
 import shlex
+import shutil
 import subprocess
 import sys
 import time
@@ -129,7 +130,8 @@ class Ctx:
     out: Path
     shared: Path
     resume: bool
-    done: dict[str, Result] = field(default_factory=dict)
+    done: dict[str, Result] = field(default_factory=dict)  # commands run or kept by this invocation
+    rendered: set[str] = field(default_factory=set)  # frame folders rendered or kept by this invocation
 
 
 def sym(*args: str) -> Cmd:
@@ -524,18 +526,13 @@ def execute(argv: list[str], log: Path) -> tuple[int, float, str]:
     return proc.returncode, usage.ru_utime + usage.ru_stime, read_text(log / "stdout.txt")
 
 
-_rendered: dict[str, Path] = {}
-
-
 def render(args: list[str], ctx: Ctx) -> Path:
     key = scenes_key(args)
     target = ctx.out / "_scenes" / key
     marker = target / ".regen-done"
-    if key in _rendered or (ctx.resume and marker.exists()):
+    if key in ctx.rendered or (ctx.resume and marker.exists()):
         return target
     if target.exists():
-        import shutil
-
         shutil.rmtree(target)
     t0 = time.time()
     rc, cpu, _ = execute(
@@ -544,7 +541,7 @@ def render(args: list[str], ctx: Ctx) -> Path:
     if rc:
         raise SystemExit(f"symfruit scenes {shlex.join(args)} failed (exit {rc}): see {ctx.out}/_scenes/{key}.log")
     write_atomic(marker, json.dumps({"args": args, "cpu_s": cpu, "wall_s": time.time() - t0}))
-    _rendered[key] = target
+    ctx.rendered.add(key)
     return target
 
 
@@ -554,12 +551,9 @@ def run_cmd(cmd: Cmd, ctx: Ctx) -> Result:
         return ctx.done[key]
     folder = ctx.out / "_runs" / key
     status = folder / "status.json"
-    if ctx.resume and status.exists():
-        info = json.loads(read_text(status))
-    else:
+    info = json.loads(read_text(status)) if ctx.resume and status.exists() else None
+    if info is None or info["rc"] not in (0, 1):  # 1: went on past a bad item and said so; else run it (again)
         if folder.exists():
-            import shutil
-
             shutil.rmtree(folder)
         folder.mkdir(parents=True)
         argv = [a.replace("{results}", str(folder / "results")) for a in fill(cmd, ctx)]

@@ -174,6 +174,17 @@ def test_a_tiny_part_runs_writes_its_rows_and_resumes_without_running_again(rege
     assert counter.read_text() == "xx"  # afresh without --resume
 
 
+def test_resume_runs_again_a_command_that_failed(regen, tmp_path):
+    counter = tmp_path / "count"
+    code = f"import pathlib, sys; p = pathlib.Path({str(counter)!r}); p.write_text('x'); sys.exit(3)"
+    section = regen.Section("fails", [regen.Cmd(("python", "-c", code))], regen.printed)
+    regen.run_part("p", [section], regen.Ctx(tmp_path / "out", tmp_path, resume=False), 1)
+    assert "(failed, exit 3: " in (tmp_path / "out" / "p" / "rows.md").read_text()
+    counter.unlink()
+    regen.run_part("p", [section], regen.Ctx(tmp_path / "out", tmp_path, resume=True), 1)
+    assert counter.exists()
+
+
 def test_a_failed_rows_printer_is_named_not_fatal(regen, tmp_path):
     def broken(results):
         raise KeyError("scores")
