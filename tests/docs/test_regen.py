@@ -41,6 +41,13 @@ def write_out(folder: Path, text: str, part: str = "x") -> Path:
     return folder
 
 
+def check(regen, folder: Path, readme: str, text: str, out: str = "out") -> tuple[tuple[int, int, int], list[str]]:
+    """``readme`` of an OUT holding ``text`` as part x's rows against a README.md of ``readme``."""
+    (folder / "README.md").write_text(readme)
+    said: list[str] = []
+    return regen.check_readme(write_out(folder / out, text), folder, said.append), said
+
+
 def test_every_part_is_defined_and_its_readme_anchor_is_in_readme(regen):
     parts = regen.parts()
     assert set(parts) == set(regen.PART_ORDER)
@@ -112,42 +119,33 @@ def test_readme_confirms_a_row_names_a_differing_cell_and_a_row_it_lacks(regen, 
 
 
 def test_readme_reads_one_anchor_per_printed_table_and_leaves_out_counts_and_timings(regen, tmp_path):
-    root = tmp_path / "tree"
-    root.mkdir()
-    (root / "README.md").write_text(
+    readme = (
         "**A**\n\n| m | x | ms per image |\n|---|---|---|\n| raw | 1.0 (+1.0) | 3.9 |\n\n"
         "**B**\n\n| m | y |\n|---|---|\n| raw | 2.0 |\n"
     )
     text = ('## t\n\nREADME table: README.md, after ["**A**", null, "**B**"]\n\n'
             "| m | x | ms per image |\n|---|---|---|\n| raw | 1.0 (+1.0) (n 12) | 4.2 |\n\n"
             "| m | z |\n|---|---|\n| raw | 7 |\n\n| m | y |\n|---|---|\n| raw | 2.5 |\n")  # fmt: skip
-    said = []
-    assert regen.check_readme(write_out(tmp_path / "out", text), root, said.append) == (1, 1, 0)
+    counts, said = check(regen, tmp_path, readme, text)
+    assert counts == (1, 1, 0)
     assert said[:2] == ["x | t | raw: confirmed", "x | t | raw: differs: y: README 2.0, printed 2.5"]
 
 
 def test_readme_matches_by_value_where_the_columns_differ(regen, tmp_path):
-    root = tmp_path / "tree"
-    root.mkdir()
-    (root / "README.md").write_text(
-        "**T**\n\n| method | IoU mean | centre (mm) |\n|---|---|---|\n| raw | 0.224 | 20.3 |\n"
-    )
+    readme = "**T**\n\n| method | IoU mean | centre (mm) |\n|---|---|---|\n| raw | 0.224 | 20.3 |\n"
     text = ('## t\n\nREADME table: README.md, after "**T**"\n\n'
             "| method | IoU mean | IoU median | centre dev mean (mm) |\n|---|---|---|---|\n"
             "| raw | 0.224 | 0.230 | 20.4 |\n")  # fmt: skip
-    said = []
-    assert regen.check_readme(write_out(tmp_path / "out", text), root, said.append) == (0, 1, 0)
+    counts, said = check(regen, tmp_path, readme, text)
+    assert counts == (0, 1, 0)
     assert said[0] == "x | t | raw: differs: centre (mm): README 20.3, printed (not printed)"
 
 
 def test_readme_reads_a_row_by_its_readme_label_and_a_share_written_without_a_space(regen, tmp_path):
-    (tmp_path / "README.md").write_text(
-        "**P**\n\n| data | matched |\n|---|---|\n| photos, half 0 (dev) | 551 (99.5 %) |\n"
-    )
+    readme = "**P**\n\n| data | matched |\n|---|---|\n| photos, half 0 (dev) | 551 (99.5 %) |\n"
     text = ('## p\n\nREADME table: README.md, after "**P**"\n\nREADME labels: {"half 0": "photos, half 0 (dev)"}\n\n'
             "| data | matched |\n|---|---|\n| half 0 (503 images) | 551 (99.5%) |\n")  # fmt: skip
-    said = []
-    assert regen.check_readme(write_out(tmp_path / "out", text), tmp_path, said.append) == (1, 0, 0)
+    assert check(regen, tmp_path, readme, text)[0] == (1, 0, 0)
 
 
 def test_readme_names_the_tables_it_cannot_check(regen, tmp_path):
@@ -209,13 +207,9 @@ def test_scan_labels_and_leaf_cells(regen, monkeypatch):
 
 
 def test_readme_leaves_out_the_columns_of_earlier_stops(regen, tmp_path):
-    (tmp_path / "README.md").write_text(
-        "**L**\n\n| s | 0 % | 25 % at stop 39 |\n|---|---|---|\n| D435 | 0.768 | 0.524 |\n"
-    )
+    readme = "**L**\n\n| s | 0 % | 25 % at stop 39 |\n|---|---|---|\n| D435 | 0.768 | 0.524 |\n"
     text = '## l\n\nREADME table: README.md, after "**L**"\n\n| D435 | 0.768 |\n'
-    said = []
-    assert regen.check_readme(write_out(tmp_path / "out", text), tmp_path, said.append) == (1, 0, 0)
-    text = '## l\n\nREADME table: README.md, after "**L**"\n\n| D435 | 0.770 |\n'
-    said.clear()
-    assert regen.check_readme(write_out(tmp_path / "out2", text), tmp_path, said.append) == (0, 1, 0)
+    assert check(regen, tmp_path, readme, text)[0] == (1, 0, 0)
+    counts, said = check(regen, tmp_path, readme, text.replace("0.768", "0.770"), out="out2")
+    assert counts == (0, 1, 0)
     assert said[0] == "x | l | D435: differs: 0 %: README 0.768, printed (not printed)"
