@@ -2,7 +2,7 @@
 
     python docs/regen.py run OUT [PART ...] [--jobs N] [--resume]   # run from the tree to measure (PYTHONPATH=src)
     python docs/regen.py compare OLD NEW [--tolerance T] [--all]    # every printed cell of the parts in both
-    python docs/regen.py readme OUT [--readme README.md]            # which README figures the printed rows confirm
+    python docs/regen.py readme OUT [--root TREE]                   # which README figures the printed rows confirm
     python docs/regen.py list                                       # the parts and the commands each runs
 
 ``run`` runs, from the working folder (the tree measured: its ``src`` on ``PYTHONPATH``, its ``docs/`` scripts,
@@ -10,10 +10,11 @@ its ``examples/``), each part's commands as README gives them, ``symfruit evalua
 results land in ``OUT/_runs/<command>/``; frames that several commands read (``symfruit scenes``) are rendered once
 into ``OUT/_scenes/``. Each part then writes ``OUT/PART/rows.md``: per table a section (``## title``), the
 commands, and the rows printed by ``docs/readme_rows.py`` (or the script README names, or ``symfruit evaluate``'s
-own table). ``OUT/PART/status.json`` holds each command's exit status and CPU seconds (its own and its worker
-processes', from ``wait4``). ``--resume`` keeps every command already finished in OUT (a part cut short goes on
-where it stopped); without it every command of the named parts is run afresh. ``--jobs N`` runs N commands at
-once (each ``symfruit evaluate`` keeps its own default worker count, as README's commands do).
+own table). ``OUT/PART/status.json`` holds each command's exit status, CPU seconds (its own and its worker
+processes', from ``wait4``) and wall seconds, and the frames it rendered. ``--resume`` keeps every command already
+finished in OUT (a part cut short goes on where it stopped; a command that failed runs again) and prints every
+``rows.md`` anew; without it every command of the named parts is run afresh. ``--jobs N`` runs N commands at once
+(each ``symfruit evaluate`` keeps its own default worker count, as README's commands do).
 
 ``compare`` reads two OUT folders' ``rows.md``: every cell (a section, a row by its label, a column) moved beyond
 ``--tolerance`` (each number in the cell, absolute; default 0: any change of the printed text) is listed with both
@@ -52,7 +53,7 @@ PROXIES = "strawberry,apple,citrus,lemon,peach,pear,plum"
 LEAF_KINDS = "strawberry,apple,citrus,tomato,lemon,peach,plum"
 SENSORS = (("azure-kinect", "Azure Kinect"), ("realsense-l515", "L515"), ("realsense-d435", "D435"),
            ("realsense-d405", "D405"))  # fmt: skip
-#: README's labels of the camera models' rows ("Through real depth cameras").
+#: README's labels of the camera models' rows ("Annotated frames through each camera", "Through real depth cameras").
 SENSOR_FRAMES = {"azure-kinect": "Azure Kinect (1920x1080)", "realsense-l515": "L515 (1920x1080)",
                  "realsense-d435": "D435 (1280x720)", "realsense-d405": "D405 (1280x720)"}  # fmt: skip
 SENSOR_ROW = {"azure-kinect": "Azure Kinect (ToF, 1920x1080, 0.5-2 m)",
