@@ -1028,6 +1028,31 @@ def test_two_pieces_a_fruit_apart_in_depth_are_not_one_fruit_without_a_sphere():
         assert _same_surface(pa, pb, _Depth.of(depth), weak, geo, s) is told, far
 
 
+def test_a_piece_at_the_depth_seen_past_its_fruit_tells_nothing_with_round_fruit():
+    """A round fruit's larger piece whose depth is torn between its own surface and what the depth camera sees past
+    the fruit's edge (4.8 m behind, a shifted view), and a smaller piece lying wholly at that far depth: the far depth
+    is the same background over both, so nothing is told (None) with ``round_fruit`` (before: two fruit, one behind
+    the other). A larger piece with one depth, or a smaller piece at a third depth, still tells them apart, as does
+    the plain path."""
+    from symfruit.segment.colour import _Depth, _Geometry, _Piece, _same_surface
+
+    geo = _Geometry(900.0, 100.0, 100.0)
+    a, b = np.zeros((200, 200), bool), np.zeros((200, 200), bool)
+    a[20:90, 20:90], b[100:150, 100:150] = True, True
+    whole = (slice(0, 200), slice(0, 200))
+    cols = np.arange(200)[None, :]
+    for torn, far, round_fruit, told in ((True, 4.8, True, None), (True, 4.8, False, False), (False, 4.8, True, False),
+                                         (True, 3.0, True, False)):  # fmt: skip
+        depth = np.zeros((200, 200))
+        depth[a] = 1.20  # flat: no sphere fits
+        if torn:
+            depth[a & (cols >= 60)] = 4.8  # the depth camera's view past the fruit's edge
+        depth[b] = far
+        s = SegmentSettings(round_fruit=round_fruit, round_max_diameter=0.10)
+        got = _same_surface(_Piece(whole, a.copy(), 1), _Piece(whole, b.copy(), 2), _Depth.of(depth), a | b, geo, s)
+        assert got is told, (torn, far, round_fruit)
+
+
 def test_depth_off_the_sampling_grid_is_still_used():
     """The depth's validity is looked for on every 8th pixel first, and over the whole image only when none is there:
     depth on pixels off that grid alone is depth all the same (the same labels as with it made explicit)."""
