@@ -28,6 +28,8 @@ local cluster (``workers=N``) runs one thread per process under a memory limit i
 
 from __future__ import annotations
 
+import asyncio
+import concurrent.futures
 import contextlib
 import dataclasses
 import os
@@ -559,12 +561,15 @@ def _run(
             while True:
                 for future in pending:
                     part = part_of.pop(future.key)
+                    # tracked until its outcome is in: a result lost with the last worker before it was gathered
+                    # is rescheduled by the client, and only the watch's cancel ends the wait for it
+                    got = None if future.cancelled() else _outcomes(future, part, distributed)
                     watch.untrack(future)
-                    if watch.gone.is_set() and future.cancelled():  # by the watch: not run, not failed
+                    if got is None:  # cancelled by the watch (no worker): not run, not failed
                         _unprocessed(part, watch.reason, state, report, results)
                         flush()
                         continue
-                    outcomes, whole = _outcomes(future, part, distributed)
+                    outcomes, whole = got
                     killed = whole and future.key not in alone and outcomes[0].reason.startswith(_DIED)
                     future.release()
                     for o in outcomes:
@@ -722,10 +727,13 @@ def _preflight(client: Any, jobs: Sequence[Job], scheduler: str | None = None,
 _DIED = "the workers running this frame died"
 
 
-def _outcomes(future: Any, part: Part, distributed: Any) -> tuple[list[Outcome], bool]:
-    """The outcomes of a finished task, and whether it failed as a whole (each of its frames failed then)."""
+def _outcomes(future: Any, part: Part, distributed: Any) -> tuple[list[Outcome], bool] | None:
+    """The outcomes of a finished task, and whether it failed as a whole (each of its frames failed then); None
+    when it was cancelled (only :class:`_NoWorkers` cancels a run's tasks), also while its result was awaited."""
     try:
         return list(future.result()), False
+    except (concurrent.futures.CancelledError, asyncio.CancelledError):
+        return None
     except distributed.scheduler.KilledWorker as exc:
         times = getattr(exc, "allowed_failures", 3) + 1
         reason = f"{_DIED} {times} times, the last {times} running it alone (killed or out of memory)"
