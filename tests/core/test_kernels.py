@@ -6389,3 +6389,32 @@ def test_the_registrations_outline_is_the_twins_to_the_bit(monkeypatch, seed, re
                  (outline.sides, twin.sides)):  # fmt: skip
         assert np.array_equal(a, b)
     assert outline.band == twin.band
+
+
+# --- stop 50, observe50: the completion's observe in fewer calls --------------------------------------------------
+
+
+@settings(max_examples=120, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 14.0), st.floats(0.5, 9.0), st.booleans())
+def test_observe_maps_are_the_inner_and_outer_distance_to_the_bit(seed, inner_reach, outer_reach, wide):
+    """``observe_maps`` on masks of every shape (discs cut by the window's edge, speckle, a whole row, a lone hole,
+    empty, full): wherever it says it is done, its maps are ``inner_distance`` and ``outer_distance``'s numpy twins',
+    bit for bit; it declines exactly where those take another path (an empty mask, a grown box with no pixel outside
+    the mask); and ``distance_maps`` gives the twins' maps either way."""
+    from symfruit.core.raster import distance_maps, inner_distance, mask_box, outer_distance
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 160 if wide else 40, 2))
+    kind = int(rng.integers(0, 6))
+    mask = _blob_mask(rng, h, w) if kind < 4 else np.full((h, w), kind == 5)
+    done, inner, outer = _jit.observe_maps(mask, inner_reach, outer_reach)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_inner, want_outer = inner_distance(mask, inner_reach), outer_distance(mask, outer_reach)
+        box = mask_box(mask)
+        declines = box is None or mask[max(box[0] - 1, 0) : box[1] + 1, max(box[2] - 1, 0) : box[3] + 1].all()
+    assert done is not declines
+    if done:
+        assert np.array_equal(inner, want_inner) and np.array_equal(outer, want_outer)
+    got_inner, got_outer = distance_maps(mask, inner_reach, outer_reach)
+    assert np.array_equal(got_inner, want_inner) and np.array_equal(got_outer, want_outer)

@@ -34,6 +34,7 @@ from .occlusion import Occlusion
 from .points import as_points, row_norms
 from .raster import (
     Silhouette,
+    distance_maps,
     inner_distance,
     interior,
     mask_box,
@@ -278,10 +279,13 @@ def observe(
     mask = region.mask
     # every read of the map below compares it with at most this (the bands, ``edge``, _contour_points' 8 px)
     reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
-    box = mask_box(mask)  # once for both maps
-    inner = inner_distance(mask, reach, box=box)
     # the outside bands read the map out to the widest band alone
-    outer = outer_distance(mask, max(bands, default=0.0) + 0.5, box=box)
+    out_reach = max(bands, default=0.0) + 0.5
+    if reach is None:
+        box = mask_box(mask)  # once for both maps
+        inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
+    else:  # both maps in one call (issue 19, stop 50)
+        inner, outer = distance_maps(mask, reach, out_reach)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
