@@ -6418,3 +6418,32 @@ def test_observe_maps_are_the_inner_and_outer_distance_to_the_bit(seed, inner_re
         assert np.array_equal(inner, want_inner) and np.array_equal(outer, want_outer)
     got_inner, got_outer = distance_maps(mask, inner_reach, outer_reach)
     assert np.array_equal(got_inner, want_inner) and np.array_equal(got_outer, want_outer)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
+    """``Occlusion.seen_at`` (``hidden_seen``) with the kernels and with the numpy twins on random windows, depths
+    (none, float32, float64, with NaN) and pixels (half-way ones, off the window, off the image): the same hidden
+    pixels, and where hidden the same depths (float64), NaN elsewhere; the twin's are ``at`` and ``depth_at``."""
+    from symfruit.core.occlusion import Occlusion
+
+    rng = np.random.default_rng(seed)
+    width, height = (int(x) for x in rng.integers(20, 120, 2))
+    h, w = int(rng.integers(1, height + 1)), int(rng.integers(1, width + 1))
+    v0, u0 = int(rng.integers(0, height - h + 1)), int(rng.integers(0, width - w + 1))
+    hidden = rng.random((h, w)) < rng.uniform(0.0, 0.8)
+    kind = seed % 3
+    depth = None if kind == 0 else rng.uniform(0.3, 2.0, (h, w)).astype(np.float32 if kind == 1 else np.float64)
+    if depth is not None:
+        depth[rng.random((h, w)) < 0.1] = np.nan
+    occ = Occlusion(u0, v0, hidden, width, height, depth=depth)
+    m = int(rng.integers(0, 300))
+    u = np.round(rng.uniform(-5, width + 5, m) * 2) / 2
+    v = np.round(rng.uniform(-5, height + 5, m) * 2) / 2
+    (hid, seen), (want_hid, want_seen) = _both(monkeypatch, occ.seen_at, u, v)
+    assert hid.dtype == bool and np.array_equal(hid, want_hid) and np.array_equal(hid, occ.at(u, v))
+    assert seen.dtype == want_seen.dtype == np.float64 and np.array_equal(seen, want_seen, equal_nan=True)
+    with monkeypatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = np.where(want_hid, occ.depth_at(u, v), np.nan)
+    assert np.array_equal(seen, want, equal_nan=True)

@@ -8543,3 +8543,28 @@ def observe_maps(mask: np.ndarray, inner_reach: float, outer_reach: float) -> tu
     a0, a1, b0, b1 = max(r0 - m, 0), min(r1 + m, h), max(c0 - m, 0), min(c1 + m, w)
     near_distance(mask[a0:a1, b0:b1], outer_reach, True, outer[a0:a1, b0:b1])
     return True, inner, outer
+
+
+@_njit
+def hidden_seen(
+    u: np.ndarray, v: np.ndarray, hidden: np.ndarray, depth: np.ndarray, u0: int, v0: int, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:meth:`symfruit.core.occlusion.Occlusion.seen_at` in one call: ``(hid, seen)``, ``hid`` (m,) bool
+    :func:`occluded_at` of the pixels ``(u, v)`` (m,) with radius 0, ``seen`` (m,) float64 where ``hid``, the depth
+    ``depth`` (h, w) (the window ``hidden``'s; (0, 0): none) holds at the pixel (rounded half to even, as
+    ``occluded_at``; NaN off the window), NaN elsewhere: the twin's values (the depth's value as float64)."""
+    hid = occluded_at(u, v, hidden, u0, v0, width, height, 0)
+    n = u.shape[0]
+    h, w = depth.shape
+    seen = np.empty(n)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        seen[i] = np.nan
+        if hid[i]:
+            fu, fv = np.rint(u[i]), np.rint(v[i])
+            col = (np.int64(fu) if -big <= fu < big else least) - np.int64(u0)
+            row = (np.int64(fv) if -big <= fv < big else least) - np.int64(v0)
+            if 0 <= col < w and 0 <= row < h:
+                seen[i] = np.float64(depth[row, col])
+    return hid, seen

@@ -323,14 +323,15 @@ def observe(
         weight: np.ndarray | None = None
         seen: np.ndarray | None = None
         hidden: np.ndarray | None = None
-        if occlusion is not None and m:
-            hidden = occlusion.at(uv[:, 0], uv[:, 1])
+        seen_at = np.zeros(0)
+        if occlusion is not None and m:  # the pixels hidden and, where they are, the depth seen (one call)
+            hidden, seen_at = occlusion.seen_at(uv[:, 0], uv[:, 1])
             hidden = hidden if hidden.any() else None  # (none: the weights times 1, and no depth seen)
         if edged and m:  # beyond a cut edge (a hidden pixel's label is not read: its weight is 0 whatever it is)
             weight = _labels_at(edge_uv, is_contour, uv, kept, moot=hidden).astype(np.float64)
         if hidden is not None and occlusion is not None:
             weight = (np.ones(m) if weight is None else weight) * ~hidden  # a hidden pixel: no evidence of background
-            seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
+            seen = seen_at  # ... but of free space (NaN where not hidden)
         weight = np.ones(m) if weight is None else weight
         if occlusion is not None and seen is None:
             seen = np.full(m, np.nan)
