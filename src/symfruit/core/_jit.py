@@ -5479,6 +5479,26 @@ def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarr
 # --- issue 19, seventeenth round: the colour segmenter ------------------------------------------------------------
 
 
+@_njit_inlined
+def _row_ends(mask: np.ndarray, r: int) -> tuple[int, int]:
+    """``(first, last)``: the columns of row ``r``'s first and last true pixel of ``mask`` (h, w) bool, found from both
+    ends of the row; ``(-1, -1)`` where it holds none."""
+    w = mask.shape[1]
+    first = -1
+    for c in range(w):
+        if mask[r, c]:
+            first = c
+            break
+    if first < 0:
+        return -1, -1
+    last = first
+    for c in range(w - 1, first, -1):
+        if mask[r, c]:
+            last = c
+            break
+    return first, last
+
+
 @_njit
 def hull_vertices(mask: np.ndarray) -> np.ndarray:
     """:func:`symfruit.segment.colour._hull_vertices` of a 2-d bool ``mask``: (m, 2) float64 ``(x, y)`` vertices of
@@ -5487,22 +5507,13 @@ def hull_vertices(mask: np.ndarray) -> np.ndarray:
     twin's Qhull gives, rolled to that start. Andrew's monotone chain on the row ends, which come sorted by ``(y, x)``;
     its cross products in whole numbers. A (0, 2) array where the hull is degenerate (fewer than three vertices:
     the twin's None)."""
-    h, w = mask.shape
+    h = mask.shape[0]
     pts = np.empty((2 * h, 2), np.int64)  # (y, x) of the row ends, sorted
     n = 0
     for r in range(h):
-        first = -1
-        for c in range(w):
-            if mask[r, c]:
-                first = c
-                break
+        first, last = _row_ends(mask, r)
         if first < 0:
             continue
-        last = first
-        for c in range(w - 1, first, -1):
-            if mask[r, c]:
-                last = c
-                break
         pts[n, 0], pts[n, 1] = r, first
         n += 1
         if last != first:
@@ -8503,19 +8514,10 @@ def observe_maps(mask: np.ndarray, inner_reach: float, outer_reach: float) -> tu
     r1 = -1
     c0 = w
     c1 = -1
-    for r in range(h):  # each row from both ends to its first and last true pixel
-        first = -1
-        for c in range(w):
-            if mask[r, c]:
-                first = c
-                break
+    for r in range(h):
+        first, last = _row_ends(mask, r)
         if first < 0:
             continue
-        last = first
-        for c in range(w - 1, first, -1):
-            if mask[r, c]:
-                last = c
-                break
         r0 = min(r0, r)
         r1 = r
         c0 = min(c0, first)
