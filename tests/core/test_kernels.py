@@ -6389,3 +6389,61 @@ def test_the_registrations_outline_is_the_twins_to_the_bit(monkeypatch, seed, re
                  (outline.sides, twin.sides)):  # fmt: skip
         assert np.array_equal(a, b)
     assert outline.band == twin.band
+
+
+# --- stop 50, observe50: the completion's observe in fewer calls --------------------------------------------------
+
+
+@settings(max_examples=120, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 14.0), st.floats(0.5, 9.0), st.booleans())
+def test_observe_maps_are_the_inner_and_outer_distance_to_the_bit(seed, inner_reach, outer_reach, wide):
+    """``observe_maps`` on masks of every shape (discs cut by the window's edge, speckle, a whole row, a lone hole,
+    empty, full): wherever it says it is done, its maps are ``inner_distance`` and ``outer_distance``'s numpy twins',
+    bit for bit; it declines exactly where those take another path (an empty mask, a grown box with no pixel outside
+    the mask); and ``distance_maps`` gives the twins' maps either way."""
+    from symfruit.core.raster import distance_maps, inner_distance, mask_box, outer_distance
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 160 if wide else 40, 2))
+    kind = int(rng.integers(0, 6))
+    mask = _blob_mask(rng, h, w) if kind < 4 else np.full((h, w), kind == 5)
+    done, inner, outer = _jit.observe_maps(mask, inner_reach, outer_reach)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_inner, want_outer = inner_distance(mask, inner_reach), outer_distance(mask, outer_reach)
+        box = mask_box(mask)
+        declines = box is None or mask[max(box[0] - 1, 0) : box[1] + 1, max(box[2] - 1, 0) : box[3] + 1].all()
+    assert done is not declines
+    if done:
+        assert np.array_equal(inner, want_inner) and np.array_equal(outer, want_outer)
+    got_inner, got_outer = distance_maps(mask, inner_reach, outer_reach)
+    assert np.array_equal(got_inner, want_inner) and np.array_equal(got_outer, want_outer)
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
+    """``Occlusion.seen_at`` (``hidden_seen``) with the kernels and with the numpy twins on random windows, depths
+    (none, float32, float64, with NaN) and pixels (half-way ones, off the window, off the image): the same hidden
+    pixels, and where hidden the same depths (float64), NaN elsewhere; the twin's are ``at`` and ``depth_at``."""
+    from symfruit.core.occlusion import Occlusion
+
+    rng = np.random.default_rng(seed)
+    width, height = (int(x) for x in rng.integers(20, 120, 2))
+    h, w = int(rng.integers(1, height + 1)), int(rng.integers(1, width + 1))
+    v0, u0 = int(rng.integers(0, height - h + 1)), int(rng.integers(0, width - w + 1))
+    hidden = rng.random((h, w)) < rng.uniform(0.0, 0.8)
+    kind = seed % 3
+    depth = None if kind == 0 else rng.uniform(0.3, 2.0, (h, w)).astype(np.float32 if kind == 1 else np.float64)
+    if depth is not None:
+        depth[rng.random((h, w)) < 0.1] = np.nan
+    occ = Occlusion(u0, v0, hidden, width, height, depth=depth)
+    m = int(rng.integers(0, 300))
+    u = np.round(rng.uniform(-5, width + 5, m) * 2) / 2
+    v = np.round(rng.uniform(-5, height + 5, m) * 2) / 2
+    (hid, seen), (want_hid, want_seen) = _both(monkeypatch, occ.seen_at, u, v)
+    assert hid.dtype == bool and np.array_equal(hid, want_hid) and np.array_equal(hid, occ.at(u, v))
+    assert seen.dtype == want_seen.dtype == np.float64 and np.array_equal(seen, want_seen, equal_nan=True)
+    with monkeypatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = np.where(want_hid, occ.depth_at(u, v), np.nan)
+    assert np.array_equal(seen, want, equal_nan=True)

@@ -5479,6 +5479,26 @@ def sphere_inliers(p: np.ndarray, centre: np.ndarray, radius: float) -> np.ndarr
 # --- issue 19, seventeenth round: the colour segmenter ------------------------------------------------------------
 
 
+@_njit_inlined
+def _row_ends(mask: np.ndarray, r: int) -> tuple[int, int]:
+    """``(first, last)``: the columns of row ``r``'s first and last true pixel of ``mask`` (h, w) bool, found from both
+    ends of the row; ``(-1, -1)`` where it holds none."""
+    w = mask.shape[1]
+    first = -1
+    for c in range(w):
+        if mask[r, c]:
+            first = c
+            break
+    if first < 0:
+        return -1, -1
+    last = first
+    for c in range(w - 1, first, -1):
+        if mask[r, c]:
+            last = c
+            break
+    return first, last
+
+
 @_njit
 def hull_vertices(mask: np.ndarray) -> np.ndarray:
     """:func:`symfruit.segment.colour._hull_vertices` of a 2-d bool ``mask``: (m, 2) float64 ``(x, y)`` vertices of
@@ -5487,22 +5507,13 @@ def hull_vertices(mask: np.ndarray) -> np.ndarray:
     twin's Qhull gives, rolled to that start. Andrew's monotone chain on the row ends, which come sorted by ``(y, x)``;
     its cross products in whole numbers. A (0, 2) array where the hull is degenerate (fewer than three vertices:
     the twin's None)."""
-    h, w = mask.shape
+    h = mask.shape[0]
     pts = np.empty((2 * h, 2), np.int64)  # (y, x) of the row ends, sorted
     n = 0
     for r in range(h):
-        first = -1
-        for c in range(w):
-            if mask[r, c]:
-                first = c
-                break
+        first, last = _row_ends(mask, r)
         if first < 0:
             continue
-        last = first
-        for c in range(w - 1, first, -1):
-            if mask[r, c]:
-                last = c
-                break
         pts[n, 0], pts[n, 1] = r, first
         n += 1
         if last != first:
@@ -8484,3 +8495,78 @@ def cap_outline(
     if rows.shape[0] < least:
         return rows, cols, np.empty(0, np.bool_)
     return rows, cols, free_outline(depth, cap, rows, cols, far, reach, pad)
+
+
+# --- stop 50, observe50: the completion's observe in fewer calls -----------------------------------------------------
+
+
+@_njit
+def observe_maps(mask: np.ndarray, inner_reach: float, outer_reach: float) -> tuple[bool, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.agreement.observe`'s two distance maps of ``mask`` (h, w) bool in one call: ``(done,
+    inner, outer)``, ``inner`` :func:`symfruit.core.raster.inner_distance` with ``reach`` ``inner_reach`` and
+    ``outer`` :func:`symfruit.core.raster.outer_distance` with ``reach`` ``outer_reach``: the mask's box (the rows and
+    columns holding a true pixel, :func:`~symfruit.core.raster.mask_box`'s), each map's part of the image (the box
+    grown by 1 and by ``ceil(outer_reach) + 1``, clipped) by :func:`near_distance` in place, 0 and +inf elsewhere:
+    the same pixels and values. ``done`` False (the maps unset) where those functions take another path: an empty
+    mask, or a grown box holding no pixel outside the mask (the whole transform)."""
+    h, w = mask.shape
+    r0 = h
+    r1 = -1
+    c0 = w
+    c1 = -1
+    for r in range(h):
+        first, last = _row_ends(mask, r)
+        if first < 0:
+            continue
+        r0 = min(r0, r)
+        r1 = r
+        c0 = min(c0, first)
+        c1 = max(c1, last)
+    inner = np.zeros((h, w))
+    outer = np.empty((h, w))
+    if r1 < 0:
+        return False, inner, outer
+    r1 += 1
+    c1 += 1
+    a0, a1, b0, b1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
+    full = True
+    for r in range(a0, a1):
+        for c in range(b0, b1):
+            if not mask[r, c]:
+                full = False
+                break
+        if not full:
+            break
+    if full:
+        return False, inner, outer
+    near_distance(mask[a0:a1, b0:b1], inner_reach, False, inner[a0:a1, b0:b1])
+    m = math.ceil(outer_reach) + 1
+    outer[:] = np.inf
+    a0, a1, b0, b1 = max(r0 - m, 0), min(r1 + m, h), max(c0 - m, 0), min(c1 + m, w)
+    near_distance(mask[a0:a1, b0:b1], outer_reach, True, outer[a0:a1, b0:b1])
+    return True, inner, outer
+
+
+@_njit
+def hidden_seen(
+    u: np.ndarray, v: np.ndarray, hidden: np.ndarray, depth: np.ndarray, u0: int, v0: int, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+    """:meth:`symfruit.core.occlusion.Occlusion.seen_at` in one call: ``(hid, seen)``, ``hid`` (m,) bool
+    :func:`occluded_at` of the pixels ``(u, v)`` (m,) with radius 0, ``seen`` (m,) float64 where ``hid``, the depth
+    ``depth`` (h, w) (the window ``hidden``'s; (0, 0): none) holds at the pixel (rounded half to even, as
+    ``occluded_at``; NaN off the window), NaN elsewhere: the twin's values (the depth's value as float64)."""
+    hid = occluded_at(u, v, hidden, u0, v0, width, height, 0)
+    n = u.shape[0]
+    h, w = depth.shape
+    seen = np.empty(n)
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    for i in range(n):
+        seen[i] = np.nan
+        if hid[i]:
+            fu, fv = np.rint(u[i]), np.rint(v[i])
+            col = (np.int64(fu) if -big <= fu < big else least) - np.int64(u0)
+            row = (np.int64(fv) if -big <= fv < big else least) - np.int64(v0)
+            if 0 <= col < w and 0 <= row < h:
+                seen[i] = np.float64(depth[row, col])
+    return hid, seen

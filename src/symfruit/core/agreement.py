@@ -34,6 +34,7 @@ from .occlusion import Occlusion
 from .points import as_points, row_norms
 from .raster import (
     Silhouette,
+    distance_maps,
     inner_distance,
     interior,
     mask_box,
@@ -278,10 +279,13 @@ def observe(
     mask = region.mask
     # every read of the map below compares it with at most this (the bands, ``edge``, _contour_points' 8 px)
     reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
-    box = mask_box(mask)  # once for both maps
-    inner = inner_distance(mask, reach, box=box)
     # the outside bands read the map out to the widest band alone
-    outer = outer_distance(mask, max(bands, default=0.0) + 0.5, box=box)
+    out_reach = max(bands, default=0.0) + 0.5
+    if reach is None:
+        box = mask_box(mask)  # once for both maps
+        inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
+    else:  # both maps in one call (issue 19, stop 50)
+        inner, outer = distance_maps(mask, reach, out_reach)
 
     depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
@@ -319,14 +323,15 @@ def observe(
         weight: np.ndarray | None = None
         seen: np.ndarray | None = None
         hidden: np.ndarray | None = None
-        if occlusion is not None and m:
-            hidden = occlusion.at(uv[:, 0], uv[:, 1])
+        seen_at = np.zeros(0)
+        if occlusion is not None and m:  # the pixels hidden and, where they are, the depth seen (one call)
+            hidden, seen_at = occlusion.seen_at(uv[:, 0], uv[:, 1])
             hidden = hidden if hidden.any() else None  # (none: the weights times 1, and no depth seen)
         if edged and m:  # beyond a cut edge (a hidden pixel's label is not read: its weight is 0 whatever it is)
             weight = _labels_at(edge_uv, is_contour, uv, kept, moot=hidden).astype(np.float64)
         if hidden is not None and occlusion is not None:
             weight = (np.ones(m) if weight is None else weight) * ~hidden  # a hidden pixel: no evidence of background
-            seen = np.where(hidden, occlusion.depth_at(uv[:, 0], uv[:, 1]), np.nan)  # ... but of free space
+            seen = seen_at  # ... but of free space (NaN where not hidden)
         weight = np.ones(m) if weight is None else weight
         if occlusion is not None and seen is None:
             seen = np.full(m, np.nan)

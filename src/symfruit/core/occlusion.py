@@ -191,6 +191,20 @@ class Occlusion:
         out[inside] = self.depth[row[inside], col[inside]]
         return out
 
+    def seen_at(self, u: np.ndarray, v: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """``(hidden (m,) bool, seen (m,) float)``: :meth:`at` of pixels ``(u, v)`` (radius 0) and, where hidden,
+        :meth:`depth_at` there (NaN elsewhere). By one compiled call where numba is installed
+        (:func:`symfruit.core._jit.hidden_seen`: the same booleans and depths; issue 19, stop 50)."""
+        u, v = np.asarray(u, dtype=np.float64), np.asarray(v, dtype=np.float64)
+        if u.ndim == 1 and u.shape == v.shape and (jit := compiled()) is not None:
+            depth = _NO_DEPTH if self.depth is None else self.depth
+            if depth.ndim == 2 and depth.dtype in _NATIVE_FLOATS:
+                return jit.hidden_seen(np.ascontiguousarray(u), np.ascontiguousarray(v), self.hidden, depth,
+                                       self.u0, self.v0, self.width, self.height)  # fmt: skip
+        hidden = self.at(u, v)
+        seen = np.where(hidden, self.depth_at(u, v), np.nan) if hidden.any() else np.full(hidden.shape, np.nan)
+        return hidden, seen
+
     def window(self, region: Silhouette, *, radius: int = 0) -> np.ndarray:
         """(h, w) bool in ``region``'s window: :meth:`at` of every pixel (cut from the grown map, no per-pixel
         look-up)."""
@@ -291,6 +305,8 @@ class Occlusion:
 
 #: The depth dtypes the kernels read (native byte order).
 _NATIVE_FLOATS = (np.dtype(np.float32), np.dtype(np.float64))
+#: :meth:`Occlusion.seen_at`'s depth without one (no pixel inside it: NaN throughout).
+_NO_DEPTH = np.zeros((0, 0))
 
 
 def occlusion(
