@@ -1028,32 +1028,6 @@ def test_two_pieces_a_fruit_apart_in_depth_are_not_one_fruit_without_a_sphere():
         assert _same_surface(pa, pb, _Depth.of(depth), weak, geo, s) is told, far
 
 
-def test_a_piece_at_the_depth_seen_past_its_fruit_tells_nothing_with_round_fruit():
-    """Two pieces cut from one red region: the larger's depth torn between its own surface and what the depth camera
-    sees past the fruit's edge (4.8 m behind, a shifted view), the smaller lying wholly at that far depth. The far
-    depth is the same background over both, so nothing is told (None) with ``round_fruit`` (before: two fruit, one
-    behind the other). A larger piece with one depth, a smaller piece at a third depth, or pieces of two red regions
-    are still told apart, as by the plain path; so is a larger piece whose rim alone, one pixel wide, carries the
-    far depth (a fruit in front of another just behind it)."""
-    from symfruit.segment.colour import _Depth, _Geometry, _Piece, _same_surface
-
-    geo = _Geometry(900.0, 100.0, 100.0)
-    a, b = np.zeros((200, 200), bool), np.zeros((200, 200), bool)
-    a[20:90, 20:90], b[100:150, 100:150] = True, True
-    whole = (slice(0, 200), slice(0, 200))
-    cols = np.arange(200)[None, :]
-    cases = ((60, 4.8, True, 1, None), (60, 4.8, False, 1, False), (90, 4.8, True, 1, False),
-             (60, 3.0, True, 1, False), (60, 4.8, True, 2, False), (89, 4.8, True, 1, False))  # fmt: skip
-    for torn, far, round_fruit, other, told in cases:  # torn: the first column of the larger's far depth
-        depth = np.zeros((200, 200))
-        depth[a] = 1.20  # flat: no sphere fits
-        depth[a & (cols >= torn)] = 4.8  # the depth camera's view past the fruit's edge (89: its rim alone)
-        depth[b] = far
-        s = SegmentSettings(round_fruit=round_fruit, round_max_diameter=0.10)
-        pa, pb = _Piece(whole, a.copy(), 1), _Piece(whole, b.copy(), other)  # other 1: the same red region
-        assert _same_surface(pa, pb, _Depth.of(depth), a | b, geo, s) is told, (torn, far, round_fruit, other)
-
-
 def test_depth_off_the_sampling_grid_is_still_used():
     """The depth's validity is looked for on every 8th pixel first, and over the whole image only when none is there:
     depth on pixels off that grid alone is depth all the same (the same labels as with it made explicit)."""

@@ -1258,8 +1258,7 @@ def _same_surface(
     if fit is None or len(p) < 20:
         zs = [big_s.z(), small_s.z()]
         if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
-            torn = s.round_fruit and bool(a.source & b.source) and _torn(zs[0], median(zs[1]), s.round_max_diameter)
-            return None if torn else False
+            return False
         return None
     off = np.abs(row_norms(p - fit[0]) - fit[1])
     return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
@@ -1276,21 +1275,6 @@ def _near_surface(p: np.ndarray, fit: tuple[np.ndarray, float], s: SegmentSettin
     behind the first keeps its points (within a fruit's diameter), off the sphere by about its radius."""
     reach = fit[1] + s.round_max_diameter
     return p[np.abs(p[:, 2] - fit[0][2]) <= reach]
-
-
-def _torn(z: np.ndarray, at: float, diameter: float) -> bool:
-    """Whether a piece's depths ``z`` lie both at the other piece's depth ``at`` and away from it (by more than the
-    largest fruit's ``diameter``): at least :data:`SAME_SURFACE_POINTS` points away, and at it more than a rim of
-    mixed pixels holds (one pixel wide along the side facing the other piece: half a disc's perimeter of its points,
-    ``sqrt(pi n)``). :func:`_same_surface` asks it of the larger of two pieces cut from one red region (colour saw one
-    connected skin; depth alone cut it). One piece is the skin of one fruit, which is no deeper than a fruit is
-    across, so depth torn apart within it, over more than its rim, is not its surface but the depth camera's view
-    shifted off it (from a few centimetres beside the colour camera it sees past the fruit's edge to what lies
-    behind, or a leaf in front). The other piece lying at that depth then tells nothing of whether the two are one
-    fruit or two (the merge's other tests decide): it is the same background or leaf. A fruit in front of another
-    just behind it carries the other's depth on its rim alone; those are still told apart."""
-    near = int((np.abs(z - at) <= diameter).sum())
-    return near > max(SAME_SURFACE_POINTS, np.sqrt(np.pi * len(z))) and len(z) - near >= SAME_SURFACE_POINTS
 
 
 #: Depth points each piece needs for :func:`_same_surface` to compare their median depths without a sphere.
