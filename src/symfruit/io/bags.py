@@ -411,7 +411,11 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
     if enc in _YUV422 and w % 2:
         raise FileFormatError(f"{msg.encoding} image of odd width {w}: two pixels share each U and V")
-    dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
+    big = getattr(msg, "is_bigendian", 0)
+    if not isinstance(big, bool) and _whole(big) not in (0, 1):  # a uint8 of 0 or 1; 2-255 is no byte order
+        raise FileFormatError(f"image is_bigendian is {shown(big)}: 0 (little-endian) or 1 (big-endian) "
+                              f"expected; the message is malformed")  # fmt: skip
+    dt = np.dtype(dtype).newbyteorder(">" if big else "<")
     row_bytes = w * channels * dt.itemsize
     if step < row_bytes:
         raise FileFormatError(f"image step {step} is shorter than a row of {w} {enc} pixels ({row_bytes} bytes)")
