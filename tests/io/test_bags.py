@@ -918,6 +918,17 @@ def test_a_bag_compressed_as_whole_files_is_decompressed_to_the_disk_room_and_no
                                       "expands past 4 MB, the room in ")  # fmt: skip
     assert str(info.value).endswith(" less 256 MB (decompression stopped): damaged, or zstd -d it where there is room")
 
+    # stop 51 (robust51): two runs decompressing at once each saw the whole room when they began; the room is asked
+    # again as the file comes out (here the other run has taken it all after the first check)
+    rooms = iter([1 << 30])
+    monkeypatch.setattr(bags, "bag_file_room", lambda: next(rooms, -1))
+    with pytest.raises(FileFormatError) as info:
+        open_source(bomb)
+    assert str(info.value).startswith(f"{bomb / packed.name}: compressed whole (rosbag2's file compression), 8 MB "
+                                      "decompressed so far, and the room in ")  # fmt: skip
+    assert str(info.value).endswith(" fell below 256 MB (another program writes there too; decompression stopped): "
+                                    "zstd -d it where there is room, or run again when there is")  # fmt: skip
+
     monkeypatch.undo()
     raw = bytearray(plain)
     raw[8 + 1 : 8 + 9] = (1 << 40).to_bytes(8, "little")  # the header record claims a TB

@@ -208,10 +208,12 @@ class BagFileRefused(FileFormatError):
 
 class _BoundedFile:
     """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
-    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` leaves on that disk."""
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when it was
+    opened, or once that room, asked again every :data:`_STEP_BYTES` out, is gone (two runs decompressing at once
+    each saw the whole room when they began)."""
 
     def __init__(self, opened: Any, name: str) -> None:
-        self._opened, self._name, self._out = opened, name, 0
+        self._opened, self._name, self._out, self._checked = opened, name, 0, 0
         self._room = bag_file_room()
 
     def __enter__(self) -> _BoundedFile:
@@ -237,6 +239,15 @@ class _BoundedFile:
                 f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
                 "damaged, or zstd -d it where there is room"
             )
+        if self._out - self._checked >= _STEP_BYTES:  # the room asked again as it goes: another run (or program)
+            self._checked = self._out  # decompressing there at once saw the same room when it began (robust51)
+            if bag_file_room() < 0:
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), {self._out / 1e6:,.0f} MB "
+                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (another program writes there too; decompression stopped): "
+                    "zstd -d it where there is room, or run again when there is"
+                )
         return data
 
     def readinto(self, buffer: Any) -> int:
