@@ -629,9 +629,10 @@ def _run(
 
 class _NoWorkers:
     """Watches a run's cluster from a thread of its own (every second, while the run lives): once it has had no
-    worker that can run a task (:func:`working_workers`: none, or all paused or silent) for ``timeout`` seconds, :attr:`gone` is set and the run's tasks (:meth:`track`) are cancelled, so
-    that the client, which waits on them, goes on; it records their frames unprocessed (:func:`_unprocessed`).
-    A scheduler keeps tasks queued while it has no worker: without this the run waited for ever."""
+    worker that can run a task (:func:`working_workers`: none, or all paused or silent) for ``timeout`` seconds,
+    :attr:`gone` is set and the run's tasks (:meth:`track`) are cancelled, so that the client, which waits on
+    them, goes on; it records their frames unprocessed (:func:`_unprocessed`). A scheduler keeps tasks queued
+    while it has no worker: without this the run waited for ever."""
 
     def __init__(self, client: Any, timeout: float) -> None:
         self.client, self.timeout = client, timeout
