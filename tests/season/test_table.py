@@ -70,6 +70,7 @@ def test_a_record_gives_one_row_per_fruit_and_one_per_frame():
             r"float's range$",
         ),
         ({"fruits": [{"id": 1, "confidence": 10**400}]}, r"fruits\[0\].confidence is a whole number beyond"),
+        ({"fruits": [{"id": 10**400}]}, r"fruits\[0\].id is 100000000000\.\.\. \(401 digits\), not a whole number$"),
     ],
 )
 def test_a_record_that_is_not_one_is_refused_by_name(tmp_path, change, message):

@@ -20,7 +20,9 @@ non-finite refused, non-zero warned about once per bag): the live ROS node (:mod
 from __future__ import annotations
 
 import bisect
+import errno
 import math
+import os
 import re
 import struct
 from collections.abc import Sequence
@@ -304,6 +306,9 @@ def _bound_decompression() -> None:
     chunk_reader = getattr(getattr(ros1, "Reader", None), "read_chunk", None)
     if chunk_reader is not None and not getattr(chunk_reader, "_symfruit", False):
         setattr(ros1.Reader, "read_chunk", _sized_chunks(chunk_reader))  # noqa: B010  # rosbags, for its reader
+    opener = getattr(getattr(ros1, "Reader", None), "open", None)
+    if opener is not None and not getattr(opener, "_symfruit", False):
+        setattr(ros1.Reader, "open", _indexed_within(opener))  # noqa: B010  # rosbags, for its reader
 
 
 def _sized_chunks(read_chunk: Any) -> Any:
@@ -333,6 +338,41 @@ def _sized_chunks(read_chunk: Any) -> Any:
 
     sized._symfruit = True  # type: ignore[attr-defined]
     return sized
+
+
+def _indexed_within(open_bag: Any) -> Any:
+    """rosbags' ROS 1 ``Reader.open``, after a check that the bag header's ``index_pos`` lies within the file:
+    rosbags seeks there, and a position past what the file system holds failed in the system's words (``[Errno 22]
+    Invalid argument``, ``cannot fit 'int' into an offset-sized integer``; stop 51, robust51). A chunk position
+    in the index past it (rosbags seeks to each) is said so too."""
+    from rosbags.rosbag1 import reader as ros1
+
+    def checked(self: Any) -> Any:
+        size = None
+        try:
+            size = os.stat(self.path).st_size
+            with open(self.path, "rb") as bio:
+                if bio.readline(64) == b"#ROSBAG V2.0\n":
+                    index_pos = ros1.Header.read(bio, ros1.RecordType.BAGHEADER).get_uint64("index_pos")
+                else:
+                    index_pos = 0
+        except Exception:  # anything else is rosbags' to say, as before
+            index_pos = 0
+        if size is not None and index_pos >= size:
+            raise FileFormatError(f"the bag header puts its index at byte {index_pos:,}, past the end of the file "
+                                  f"({size:,} bytes): the bag is damaged")  # fmt: skip
+        try:
+            return open_bag(self)
+        except (OSError, ValueError, OverflowError) as exc:
+            past = (isinstance(exc, OSError) and exc.errno == errno.EINVAL) or isinstance(exc, OverflowError) or (
+                isinstance(exc, ValueError) and "offset-sized" in str(exc))  # fmt: skip
+            if not past:
+                raise
+            raise FileFormatError("the bag's index gives a chunk position past what the file holds: the bag is "
+                                  "damaged") from None  # fmt: skip
+
+    checked._symfruit = True  # type: ignore[attr-defined]
+    return checked
 
 
 #: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).

@@ -46,7 +46,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TRUTH_BYTES
+from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TRUTH_BYTES, shown
 from ..errors import FileFormatError, SymfruitError
 
 __all__ = [
@@ -110,7 +110,7 @@ def _number(value: Any, what: str, *, whole: bool = False) -> Any:
         raise FileFormatError(f"{what} is {type(value).__name__}, not a number")
     if whole:
         if not isinstance(value, int) or not -(2**62) <= value <= 2**62:
-            raise FileFormatError(f"{what} is {value!r}, not a whole number")
+            raise FileFormatError(f"{what} is {shown(value)}, not a whole number")  # 400 digits were 400 (robust51)
         return value
     try:
         value = float(value)
