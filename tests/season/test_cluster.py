@@ -242,6 +242,7 @@ def test_a_worker_counts_while_it_runs_and_is_heard_from():
     info["b"].update(status="running", last_seen=2.0)  # resumed, heard from
     assert working_workers(info, heard, SILENT_WORKER_S + 1) == 2
     assert working_workers({}, heard, SILENT_WORKER_S + 2) == 0 and heard == {}  # the workers gone are forgotten
+    assert working_workers({"d": {}}, heard, 0.0) == 1 == working_workers({"d": {}}, heard, 10 * SILENT_WORKER_S)
 
 
 def test_an_in_process_address_of_this_process_passes_the_check():

@@ -693,7 +693,9 @@ def working_workers(info: dict[str, Any], heard: dict[str, tuple[Any, float]], n
         seen = worker.get("last_seen")
         if address not in heard or heard[address][0] != seen:
             heard[address] = (seen, now)
-        if worker.get("status") == "running" and now - heard[address][1] <= SILENT_WORKER_S:
+        silent = seen is not None and now - heard[address][1] > SILENT_WORKER_S
+        # a Dask that states no status or last_seen (an older one) is taken as running and heard from
+        if worker.get("status", "running") == "running" and not silent:
             count += 1
     return count
 
