@@ -27,14 +27,11 @@ returns ``DEFECT: ...`` when it is broken.
 
 from __future__ import annotations
 
-import argparse
 import json
 import os
 import shutil
 import struct
 import sys
-import tempfile
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -49,6 +46,7 @@ import robust49 as r49
 #: A case's alarm (s): a file that is a link to /dev/zero is read for ever without a bound.
 LIMIT_S = 60
 ROOT, T, fixture, cli, Run = r47.ROOT, r49.T, r49.fixture, r47.cli, r47.Run
+camera, camera_text = r47.camera_edit, r47.camera_text  # camera.json changed, or written as this text
 BAG1 = ROOT / "examples/realsense/fruit.bag"
 CASES: list[tuple[str, str, Callable[[], Any], str]] = []
 
@@ -76,19 +74,6 @@ def frame_case(name: str, expect: str, change: Callable[[Path], Any], names: str
         return cli("detect", f, "--output", o, "--method", "sphere", *extra, output=o)
 
     add(f"frame/{name}", expect, go, names)
-
-
-def camera(**change: Any) -> Callable[[Path], None]:
-    def go(f: Path) -> None:
-        cam = json.loads((f / "camera.json").read_text())
-        cam.update(change)
-        (f / "camera.json").write_text(json.dumps(cam))
-
-    return go
-
-
-def camera_text(text: str) -> Callable[[Path], None]:
-    return lambda f: (f / "camera.json").write_text(text)
 
 
 def depth_npy(make: Callable[[np.ndarray], np.ndarray]) -> Callable[[Path], None]:
@@ -524,23 +509,14 @@ def cli_cases() -> None:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
-    parser.add_argument("--defects", action="store_true", help="print the defects alone")
-    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
-    args = parser.parse_args()
-    import logging
-
-    warnings.simplefilter("ignore")
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
-    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust51-"))
-    r47.T.mkdir(parents=True, exist_ok=True)
-    for build in (frame_cases, settings_cases, mesh_cases, bag_cases, ros_cases, table_cases, cli_cases):
-        build()
-    counts = r49.sweep(CASES, only=args.only, defects=args.defects, limit=LIMIT_S, width=56)
-    if not args.keep:
-        shutil.rmtree(r47.T, ignore_errors=True)
-    return 1 if counts["DEFECT"] else 0
+    return r49.run_main(
+        __doc__,
+        (frame_cases, settings_cases, mesh_cases, bag_cases, ros_cases, table_cases, cli_cases),
+        CASES,
+        prefix="robust51-",
+        limit=LIMIT_S,
+        width=56,
+    )
 
 
 if __name__ == "__main__":
