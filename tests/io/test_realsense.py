@@ -364,6 +364,17 @@ def test_a_bag_header_whose_index_position_lies_past_the_file_is_named_damaged(t
         open_source(path)
 
 
+def test_an_empty_or_unindexed_bag_is_said_to_be_so_not_its_index_past_the_end(tmp_path):
+    (tmp_path / "empty.bag").write_bytes(b"")
+    with pytest.raises(FileFormatError, match=r"empty\.bag: cannot open bag \(File .* seems to be empty\.\)$"):
+        open_source(tmp_path / "empty.bag")
+    data = BAG.read_bytes()
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    (tmp_path / "unindexed.bag").write_bytes(data[:at] + bytes(8) + data[at + 8 :])
+    with pytest.raises(FileFormatError, match=r"unindexed\.bag: cannot open bag \(Bag is not indexed"):
+        open_source(tmp_path / "unindexed.bag")
+
+
 @pytest.mark.parametrize("chunk_pos", [2**64 - 1])  # 2**62: EINVAL on ext4, read as an empty record on tmpfs
 def test_an_index_whose_chunk_position_lies_past_what_a_file_holds_is_named_damaged(tmp_path, chunk_pos):
     data = BAG.read_bytes()

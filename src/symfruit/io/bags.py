@@ -358,7 +358,7 @@ def _indexed_within(open_bag: Any) -> Any:
                     index_pos = 0
         except Exception:  # anything else is rosbags' to say, as before
             index_pos = 0
-        if size is not None and index_pos >= size:
+        if size is not None and 0 < index_pos and index_pos >= size:  # 0: not indexed, as rosbags says
             raise FileFormatError(f"the bag header puts its index at byte {index_pos:,}, past the end of the file "
                                   f"({size:,} bytes): the bag is damaged")  # fmt: skip
         try:
