@@ -386,6 +386,30 @@ def sweep(cases: list[tuple[str, str, Callable[[], Any], str]], *, only: str = "
     return counts
 
 
+def run_main(doc: str, builds: tuple[Callable[[], None], ...], cases: list[tuple[str, str, Callable[[], Any], str]],
+             *, prefix: str, limit: int, width: int) -> int:  # fmt: skip
+    """A later sweep's command line (robust50, robust51): ``--only``, ``--defects``, ``--keep``; its ``builds``
+    fill ``cases``, run through :func:`sweep`; exit 1 when a case is a defect."""
+    import logging
+    import warnings
+
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
+    parser.add_argument("--defects", action="store_true", help="print the defects alone")
+    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    logging.getLogger("distributed").setLevel(logging.CRITICAL)
+    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix=prefix))
+    r47.T.mkdir(parents=True, exist_ok=True)
+    for build in builds:
+        build()
+    counts = sweep(cases, only=args.only, defects=args.defects, limit=limit, width=width)
+    if not args.keep:
+        shutil.rmtree(r47.T, ignore_errors=True)
+    return 1 if counts["DEFECT"] else 0
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")

@@ -25,13 +25,10 @@ returns ``DEFECT: ...`` when the rule is broken.
 
 from __future__ import annotations
 
-import argparse
 import json
 import shutil
 import sys
-import tempfile
 import time
-import warnings
 from collections.abc import Callable
 from pathlib import Path
 from types import SimpleNamespace
@@ -393,23 +390,9 @@ def bag_cases() -> None:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
-    parser.add_argument("--defects", action="store_true", help="print the defects alone")
-    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
-    args = parser.parse_args()
-    import logging
-
-    warnings.simplefilter("ignore")
-    logging.getLogger("distributed").setLevel(logging.CRITICAL)
-    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust50-"))
-    r47.T.mkdir(parents=True, exist_ok=True)
-    for build in (api_cases, report_cases, ros_cases, bag_cases):
-        build()
-    counts = r49.sweep(CASES, only=args.only, defects=args.defects, limit=LIMIT_S, width=52)
-    if not args.keep:
-        shutil.rmtree(r47.T, ignore_errors=True)
-    return 1 if counts["DEFECT"] else 0
+    return r49.run_main(
+        __doc__, (api_cases, report_cases, ros_cases, bag_cases), CASES, prefix="robust50-", limit=LIMIT_S, width=52
+    )
 
 
 if __name__ == "__main__":

@@ -245,6 +245,11 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
                        "processes (127.0.0.1)")  # fmt: skip
     p.add_argument("--chunk", type=int, default=None, metavar="N",
                    help="with --scheduler or --workers: frames per task (default 4)")  # fmt: skip
+    p.add_argument("--no-worker-timeout", type=float, default=None, metavar="S",
+                   help="with --scheduler or --workers: seconds to wait while the cluster has no worker (for the "
+                   "first one, and at any time during the run, after which the frames not done are recorded "
+                   "unprocessed and the run stops); 1 to 86400, default 60 with --scheduler, 300 with --workers "
+                   "(its workers restart themselves)")  # fmt: skip
 
 
 def _add_report(sub: argparse._SubParsersAction) -> None:
@@ -826,6 +831,13 @@ def _detect(args: argparse.Namespace) -> int:
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {args.chunk}")
     if args.chunk is not None and not args.scheduler and args.workers is None:
         raise InputError("--chunk (frames per Dask task) is for --scheduler or --workers; here it would be ignored")
+    if args.no_worker_timeout is not None:  # refused whether or not a cluster uses it, before anything is read
+        from .season.cluster import check_no_worker_timeout
+
+        check_no_worker_timeout(args.no_worker_timeout)
+        if not args.scheduler and args.workers is None:
+            raise InputError("--no-worker-timeout (the wait for a Dask worker) is for --scheduler or --workers; here "
+                             "it would be ignored")  # fmt: skip
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
@@ -844,7 +856,8 @@ def _detect(args: argparse.Namespace) -> int:
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
-                           workers=args.workers, chunk=args.chunk or 4)  # fmt: skip
+                           workers=args.workers, chunk=args.chunk or 4,
+                           no_worker_timeout=args.no_worker_timeout)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():

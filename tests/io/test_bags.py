@@ -34,6 +34,7 @@ def write_ros2_bag(
     d=None,
     storage="sqlite3",
     compression=None,
+    depth_bigendian=0,
 ):
     """A ROS 2 bag of ``frames`` colour (rgb8), depth (16UC1, 1 us after the colour) and camera info messages."""
     from rosbags.rosbag2 import Writer
@@ -70,7 +71,7 @@ def write_ros2_bag(
                         data=color.ravel())  # fmt: skip
             if colour_topic:
                 writer.write(c_col, t, ts.serialize_cdr(img, "sensor_msgs/msg/Image"))
-            dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=0, step=320,
+            dep = Image(header=head, height=120, width=160, encoding="16UC1", is_bigendian=depth_bigendian, step=320,
                         data=(depth_mm + np.uint16(i * depth_step)).view(np.uint8).ravel())  # fmt: skip
             if depth_topic:
                 writer.write(c_dep, t + 1000, ts.serialize_cdr(dep, "sensor_msgs/msg/Image"))
@@ -323,6 +324,24 @@ def test_depth_encodings_keep_their_type():
     metres = np.array([[0.3, np.nan], [0.25, 1.0]], np.float32)
     out = image_array(message(metres, "32FC1"), "sensor_msgs/msg/Image")
     assert out.dtype == np.float32 and np.array_equal(out, metres, equal_nan=True)
+
+
+@pytest.mark.parametrize("flag", [2, 255, -1, 1.5, "1", None])
+def test_an_is_bigendian_other_than_0_or_1_is_refused_as_malformed(flag):
+    # stop 51: a uint8 of 2-255 was read as big-endian (any non-zero); a hand-made message's text or None too
+    with pytest.raises(FileFormatError, match=r"^image is_bigendian is .*: 0 \(little-endian\) or 1 \(big-endian\)"):
+        image_array(SimpleNamespace(**{**vars(message(RGB, "rgb8")), "is_bigendian": flag}), "sensor_msgs/msg/Image")
+    for ok in (0, 1, False, True, np.uint8(1)):  # rclpy and rosbags give an int, a hand-made message may give a bool
+        assert image_array(SimpleNamespace(**{**vars(message(RGB, "rgb8")), "is_bigendian": ok}),
+                           "sensor_msgs/msg/Image").shape == RGB.shape  # fmt: skip
+
+
+def test_an_is_bigendian_of_2_in_a_bag_names_the_bag_and_the_topic(tmp_path):
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "big2", color, (depth * 1000).astype(np.uint16), depth_bigendian=2)
+    with pytest.raises(FileFormatError, match=r"big2.*aligned_depth_to_color.*is_bigendian is 2"):
+        open_source(path).read(0)
 
 
 def test_compressed_images(tmp_path):
@@ -898,6 +917,17 @@ def test_a_bag_compressed_as_whole_files_is_decompressed_to_the_disk_room_and_no
     assert str(info.value).startswith(f"{bomb / packed.name}: compressed whole (rosbag2's file compression), it "
                                       "expands past 4 MB, the room in ")  # fmt: skip
     assert str(info.value).endswith(" less 256 MB (decompression stopped): damaged, or zstd -d it where there is room")
+
+    # stop 51 (robust51): two runs decompressing at once each saw the whole room when they began; the room is asked
+    # again as the file comes out (here the other run has taken it all after the first check)
+    rooms = iter([1 << 30])
+    monkeypatch.setattr(bags, "bag_file_room", lambda: next(rooms, -1))
+    with pytest.raises(FileFormatError) as info:
+        open_source(bomb)
+    assert str(info.value).startswith(f"{bomb / packed.name}: compressed whole (rosbag2's file compression), 8 MB "
+                                      "decompressed so far, and the room in ")  # fmt: skip
+    assert str(info.value).endswith(" fell below 256 MB (another program writes there too; decompression stopped): "
+                                    "zstd -d it where there is room, or run again when there is")  # fmt: skip
 
     monkeypatch.undo()
     raw = bytearray(plain)

@@ -347,6 +347,45 @@ def test_a_damaged_message_definition_is_one_short_line(tmp_path):
     assert "\n" not in str(info.value) and len(str(info.value)) < 300
 
 
+@pytest.mark.parametrize("index_pos", [2**64 - 1, 2**62, 10**9])
+def test_a_bag_header_whose_index_position_lies_past_the_file_is_named_damaged(tmp_path, index_pos):
+    """Stop 51 (robust51): a ROS 1 bag header whose index_pos lies past the file made rosbags' seek fail in the
+    system's words (``[Errno 22] Invalid argument`` on ext4, ``cannot fit 'int' into an offset-sized integer``), or
+    read an empty record there ("Header could not be read from file")."""
+    data = BAG.read_bytes()
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    path = tmp_path / "lying.bag"
+    path.write_bytes(data[:at] + index_pos.to_bytes(8, "little") + data[at + 8 :])
+    with pytest.raises(
+        FileFormatError,
+        match=rf"lying\.bag: cannot open bag \(the bag header puts its index at byte "
+        rf"{index_pos:,}, past the end of the file \({len(data):,} bytes\): the bag is damaged\)$",
+    ):
+        open_source(path)
+
+
+def test_an_empty_or_unindexed_bag_is_said_to_be_so_not_its_index_past_the_end(tmp_path):
+    (tmp_path / "empty.bag").write_bytes(b"")
+    with pytest.raises(FileFormatError, match=r"empty\.bag: cannot open bag \(File .* seems to be empty\.\)$"):
+        open_source(tmp_path / "empty.bag")
+    data = BAG.read_bytes()
+    at = data.index(b"index_pos=") + len(b"index_pos=")
+    (tmp_path / "unindexed.bag").write_bytes(data[:at] + bytes(8) + data[at + 8 :])
+    with pytest.raises(FileFormatError, match=r"unindexed\.bag: cannot open bag \(Bag is not indexed"):
+        open_source(tmp_path / "unindexed.bag")
+
+
+@pytest.mark.parametrize("chunk_pos", [2**64 - 1])  # 2**62: EINVAL on ext4, read as an empty record on tmpfs
+def test_an_index_whose_chunk_position_lies_past_what_a_file_holds_is_named_damaged(tmp_path, chunk_pos):
+    data = BAG.read_bytes()
+    at = data.rindex(b"chunk_pos=") + len(b"chunk_pos=")  # the last chunk's, in the index at the end
+    path = tmp_path / "lying.bag"
+    path.write_bytes(data[:at] + chunk_pos.to_bytes(8, "little") + data[at + 8 :])
+    with pytest.raises(FileFormatError, match=r"lying\.bag: cannot open bag \(the bag's index gives a chunk position "
+                       r"past what the file holds: the bag is damaged\)$"):  # fmt: skip
+        open_source(path)
+
+
 def test_one_torn_image_fails_its_frame_not_the_recording(tmp_path):
     torn: list[bytes] = []
 

@@ -203,6 +203,48 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
     assert not (tmp_path / "o" / "errors.json").exists()
 
 
+@pytest.mark.parametrize("seconds", ["0", "-5", "0.5", "nan", "inf", "1e9", "86401"])
+def test_a_no_worker_timeout_out_of_its_bounds_is_refused_before_anything_runs(recording, tmp_path, capsys, seconds):
+    """Stop 51 (robust51): the wait for a worker was a module constant (60 s, a local cluster 300 s); now
+    --no-worker-timeout sets it, 1 s to a day, refused before the inputs are read or a cluster started."""
+    argv = ["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "1", "--no-worker-timeout"]
+    assert main([*argv, seconds]) == 2
+    assert f"--no-worker-timeout must be between 1 and 86400 s, got {float(seconds)!r}" in capsys.readouterr().err
+    with pytest.raises(InputError, match=r"--no-worker-timeout must be between 1 and 86400 s"):
+        run_distributed(recording, tmp_path / "o", workers=1, no_worker_timeout=float(seconds))
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_no_worker_timeout_without_a_cluster_is_refused_not_ignored(recording, tmp_path, capsys):
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--no-worker-timeout", "30"]) == 2
+    assert "--no-worker-timeout (the wait for a Dask worker) is for --scheduler or --workers" in capsys.readouterr().err
+    with pytest.raises(InputError, match=r"no_worker_timeout \(--no-worker-timeout\) is for a Dask cluster"):
+        run_batch(recording, tmp_path / "o", no_worker_timeout=30)
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(SystemExit):
+        main(["detect", "--help"])
+    assert "--no-worker-timeout S" in " ".join(capsys.readouterr().out.split())
+
+
+def test_a_worker_counts_while_it_runs_and_is_heard_from():
+    """Paused (memory above Dask's pause fraction), closing, or silent for SILENT_WORKER_S: no worker for the
+    watch (:class:`_NoWorkers`); a worker heard from again, or a new one, counts again."""
+    from symfruit.season.cluster import SILENT_WORKER_S, working_workers
+
+    heard: dict = {}
+    info = {"a": {"status": "running", "last_seen": 1.0}, "b": {"status": "paused", "last_seen": 1.0},
+            "c": {"status": "closing_gracefully", "last_seen": 1.0}}  # fmt: skip
+    assert working_workers(info, heard, 0.0) == 1
+    assert working_workers(info, heard, SILENT_WORKER_S) == 1  # a's last_seen unchanged, but not for long enough
+    assert working_workers(info, heard, SILENT_WORKER_S + 0.5) == 0  # silent since 0.0
+    info["a"]["last_seen"] = 2.0
+    assert working_workers(info, heard, SILENT_WORKER_S + 1) == 1  # heard from again
+    info["b"].update(status="running", last_seen=2.0)  # resumed, heard from
+    assert working_workers(info, heard, SILENT_WORKER_S + 1) == 2
+    assert working_workers({}, heard, SILENT_WORKER_S + 2) == 0 and heard == {}  # the workers gone are forgotten
+    assert working_workers({"d": {}}, heard, 0.0) == 1 == working_workers({"d": {}}, heard, 10 * SILENT_WORKER_S)
+
+
 def test_an_in_process_address_of_this_process_passes_the_check():
     from symfruit.season.cluster import check_address
 
@@ -389,7 +431,11 @@ def test_a_scheduler_without_workers_is_refused_after_the_time_out_not_waited_on
                       dashboard_address=None) as empty:  # fmt: skip
         address = empty.scheduler_address
         start = time.monotonic()
-        with pytest.raises(InputError, match=rf"{address}: the Dask scheduler has no worker \(waited 2 s for one\)"):
+        with pytest.raises(
+            InputError,
+            match=rf"{address}: the Dask scheduler has no worker \(waited 2 s for one, "
+            r"--no-worker-timeout\); start workers",
+        ):
             run_distributed(recording, tmp_path / "o", scheduler=address, method="raw", progress=False,
                             no_worker_timeout=2)  # fmt: skip
         assert time.monotonic() - start < 60
@@ -430,6 +476,60 @@ def test_a_result_lost_with_the_last_worker_before_it_was_gathered_is_unprocesse
     assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
     assert not report.failed
     assert report.unprocessed and len(report.done) + len(report.unprocessed) == 4
+    errors = json.loads((out / "errors.json").read_text())
+    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
+
+
+@pytest.mark.parametrize("how", ["paused", "silent"])
+def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recording, tmp_path, monkeypatch, how):
+    """Stop 51 (robust51): a worker paused (its memory above Dask's pause fraction) or no longer heard from (its
+    heartbeat stopped: a frozen process, a lost network) stays registered, and the watch counted it: the run
+    waited for ever (paused) or for the scheduler's worker-ttl. Now neither counts: after the time-out the run
+    stops, the frames not done unprocessed."""
+    from distributed import LocalCluster
+    from distributed.core import Status
+
+    import symfruit.season.cluster as cluster
+
+    real = cluster.detect
+    release, calls = threading.Event(), []
+
+    def held(frame, **kwargs):  # the first frame goes through; the others wait until the test ends
+        calls.append(frame.name)
+        if len(calls) > 1:
+            release.wait(60)
+        return real(frame, **kwargs)
+
+    monkeypatch.setattr(cluster, "detect", held)  # the in-process worker runs this module
+    monkeypatch.setattr(cluster, "SILENT_WORKER_S", 2.0)
+    out = tmp_path / "o"
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+                      dashboard_address=None) as one:  # fmt: skip
+        worker = next(iter(one.workers.values()))
+        result: dict = {}
+        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
+            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
+            no_worker_timeout=2)), daemon=True)  # fmt: skip
+        runner.start()
+        _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
+
+        def stop() -> None:  # on the worker's event loop, as Dask's memory monitor pauses it
+            if how == "paused":  # and kept so: its memory monitor would resume it, memory being low here
+                worker.periodic_callbacks["memory_monitor"].stop()
+                worker.status = Status.paused
+            else:
+                worker.periodic_callbacks["heartbeat"].stop()
+
+        one.loop.add_callback(stop)
+        runner.join(50)
+        alive = runner.is_alive()
+        release.set()
+        assert not alive, f"the run waited on a {how} worker"
+        assert len(one.scheduler.workers) == 1  # still registered
+    report = result["report"]
+    assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
+    assert len(report.done) == 1 and len(report.unprocessed) == 3
+    assert not report.failed
     errors = json.loads((out / "errors.json").read_text())
     assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
 

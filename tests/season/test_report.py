@@ -2,6 +2,7 @@
 tables that are missing, too large or not symfruit's refused by name."""
 
 import json
+import re
 
 import numpy as np
 import pytest
@@ -350,6 +351,29 @@ def test_tables_that_disagree_are_refused_not_reported_as_whole(run, table, edit
     stood, a row without its recording a recording 'None' of its own: each a report in silence."""
     _edited(run, table, edit)
     with pytest.raises(FileFormatError, match=message):
+        write_report(run)
+    assert not (run / "report").exists()
+
+
+@pytest.mark.parametrize(
+    "change, shown",
+    [
+        ({"centre_x": float("nan")}, "nan, "),
+        ({"centre_z": float("inf")}, ", inf"),
+        ({"centre_y": -float("inf")}, "-inf"),
+        ({"centre_x": 1e6}, "1e+06"),
+        ({"centre_y": None}, "empty"),
+    ],
+)
+def test_a_centre_of_nan_inf_or_in_part_is_refused_not_counted_as_located(run, change, shown):
+    """Stop 51 (robust51): a NaN centre (a value, not empty) was a located fruit, in the report's counts as in the
+    tables' agreement; a centre given in part, or of a million metres, too."""
+    _edited(run, "detections.parquet", lambda r: [dict(r[0], **change), *r[1:]])
+    with pytest.raises(
+        FileFormatError,
+        match=rf"detections\.parquet: row 1 has centre \(.*{re.escape(shown)}.*\); "
+        r"a located fruit's centre is three numbers of metres within \d+, one not located has none",
+    ):
         write_report(run)
     assert not (run / "report").exists()
 

@@ -55,6 +55,22 @@ def test_a_record_gives_one_row_per_fruit_and_one_per_frame():
         ({"fruits": [{"id": 1, "box": {"size": [0.02, 1e300, 0.02]}}]}, r"box.size holds 1e\+300 m"),
         ({"fruits": [{"id": 1, "confidence": 7.0}]}, r"fruits\[0\].confidence is 7; a confidence is in \[0, 1\]"),
         ({"fruits": [{"id": k} for k in range(1, 1002)]}, "holds 1001 fruits; a frame holds at most 1000"),
+        # stop 51 (robust51): a NaN or null coordinate was left empty and the fruit counted as located; a whole
+        # number of 400 digits was Python's OverflowError
+        (
+            {"fruits": [{"id": 1, "centre": [0.0, float("nan"), 0.3]}]},
+            r"fruits\[0\].centre is not three finite "
+            r"numbers of metres within 100$",
+        ),
+        ({"fruits": [{"id": 1, "centre": [None, 0.0, 0.3]}]}, r"fruits\[0\].centre is not three finite"),
+        ({"fruits": [{"id": 1, "centre": [0.0, 0.0, 1e6]}]}, r"fruits\[0\].centre is not three finite"),
+        (
+            {"fruits": [{"id": 1, "centre": [10**400, 0.0, 0.3]}]},
+            r"fruits\[0\].centre is a whole number beyond a "
+            r"float's range$",
+        ),
+        ({"fruits": [{"id": 1, "confidence": 10**400}]}, r"fruits\[0\].confidence is a whole number beyond"),
+        ({"fruits": [{"id": 10**400}]}, r"fruits\[0\].id is 100000000000\.\.\. \(401 digits\), not a whole number$"),
     ],
 )
 def test_a_record_that_is_not_one_is_refused_by_name(tmp_path, change, message):

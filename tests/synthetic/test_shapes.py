@@ -112,3 +112,29 @@ def test_load_scans_errors(tmp_path):
     failed = {}
     assert [s.kind for s in load_scans(tmp_path, failed=failed)] == ["scan/whole"]
     assert "at least 100 points, got 20" in failed[str(tmp_path / "tiny.npy")]
+
+
+@pytest.mark.parametrize(
+    "change, message",
+    [
+        (lambda v, f: (v * 1000, f), r"the scan is 80\.6 m across; fruit scans are in metres, 0\.001-2 m across "
+         r"\(millimetres, or no fruit\?\)$"),
+        (lambda v, f: (v * 1e30, f), r"the scan is 8\.06e\+28 m across"),
+        (lambda v, f: (v * 1e-6, f), r"the scan is 8\.06e-08 m across"),
+        (lambda v, f: (v, np.repeat(f[:, :1], 3, axis=1)), r"the mesh's 9,984 faces have no area \(each a point or "
+         r"a line\)$"),
+        (lambda v, f: (v, f[:, [0, 1, 1]]), r"the mesh's 9,984 faces have no area"),
+    ],
+)  # fmt: skip
+def test_a_scan_of_no_area_or_of_a_size_no_fruit_has_is_refused_by_name(tmp_path, change, message):
+    """Stop 51 (robust51): a mesh whose every face is a point or a line failed in numpy when sampled
+    ("Probabilities contain NaN"); a scan of 1e30 m, or in millimetres (an apple of 80 m), was taken."""
+    from symfruit import FileFormatError
+
+    fruit = FRUITS["apple"](np.random.default_rng(0))
+    vertices, faces = change(fruit.vertices, fruit.faces)
+    with (tmp_path / "s.obj").open("w") as f:
+        f.writelines(f"v {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in vertices)
+        f.writelines(f"f {a} {b} {c}\n" for a, b, c in faces + 1)
+    with pytest.raises(FileFormatError, match=rf"s\.obj: {message}"):
+        load_scans(tmp_path)

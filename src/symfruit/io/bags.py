@@ -20,7 +20,9 @@ non-finite refused, non-zero warned about once per bag): the live ROS node (:mod
 from __future__ import annotations
 
 import bisect
+import errno
 import math
+import os
 import re
 import struct
 from collections.abc import Sequence
@@ -208,10 +210,12 @@ class BagFileRefused(FileFormatError):
 
 class _BoundedFile:
     """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
-    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` leaves on that disk."""
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when it was
+    opened, or once that room, asked again every :data:`_STEP_BYTES` out, is gone (two runs decompressing at once
+    each saw the whole room when they began)."""
 
     def __init__(self, opened: Any, name: str) -> None:
-        self._opened, self._name, self._out = opened, name, 0
+        self._opened, self._name, self._out, self._checked = opened, name, 0, 0
         self._room = bag_file_room()
 
     def __enter__(self) -> _BoundedFile:
@@ -237,6 +241,15 @@ class _BoundedFile:
                 f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
                 "damaged, or zstd -d it where there is room"
             )
+        if self._out - self._checked >= _STEP_BYTES:  # the room asked again as it goes: another run (or program)
+            self._checked = self._out  # decompressing there at once saw the same room when it began (robust51)
+            if bag_file_room() < 0:
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), {self._out / 1e6:,.0f} MB "
+                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (another program writes there too; decompression stopped): "
+                    "zstd -d it where there is room, or run again when there is"
+                )
         return data
 
     def readinto(self, buffer: Any) -> int:
@@ -293,6 +306,9 @@ def _bound_decompression() -> None:
     chunk_reader = getattr(getattr(ros1, "Reader", None), "read_chunk", None)
     if chunk_reader is not None and not getattr(chunk_reader, "_symfruit", False):
         setattr(ros1.Reader, "read_chunk", _sized_chunks(chunk_reader))  # noqa: B010  # rosbags, for its reader
+    opener = getattr(getattr(ros1, "Reader", None), "open", None)
+    if opener is not None and not getattr(opener, "_symfruit", False):
+        setattr(ros1.Reader, "open", _indexed_within(opener))  # noqa: B010  # rosbags, for its reader
 
 
 def _sized_chunks(read_chunk: Any) -> Any:
@@ -322,6 +338,41 @@ def _sized_chunks(read_chunk: Any) -> Any:
 
     sized._symfruit = True  # type: ignore[attr-defined]
     return sized
+
+
+def _indexed_within(open_bag: Any) -> Any:
+    """rosbags' ROS 1 ``Reader.open``, after a check that the bag header's ``index_pos`` lies within the file:
+    rosbags seeks there, and a position past what the file system holds failed in the system's words (``[Errno 22]
+    Invalid argument``, ``cannot fit 'int' into an offset-sized integer``; stop 51, robust51). A chunk position
+    in the index past it (rosbags seeks to each) is said so too."""
+    from rosbags.rosbag1 import reader as ros1
+
+    def checked(self: Any) -> Any:
+        size = None
+        try:
+            size = os.stat(self.path).st_size
+            with open(self.path, "rb") as bio:
+                if bio.readline(64) == b"#ROSBAG V2.0\n":
+                    index_pos = ros1.Header.read(bio, ros1.RecordType.BAGHEADER).get_uint64("index_pos")
+                else:
+                    index_pos = 0
+        except Exception:  # anything else is rosbags' to say, as before
+            index_pos = 0
+        if size is not None and 0 < index_pos and index_pos >= size:  # 0: not indexed, as rosbags says
+            raise FileFormatError(f"the bag header puts its index at byte {index_pos:,}, past the end of the file "
+                                  f"({size:,} bytes): the bag is damaged")  # fmt: skip
+        try:
+            return open_bag(self)
+        except (OSError, ValueError, OverflowError) as exc:
+            past = (isinstance(exc, OSError) and exc.errno == errno.EINVAL) or isinstance(exc, OverflowError) or (
+                isinstance(exc, ValueError) and "offset-sized" in str(exc))  # fmt: skip
+            if not past:
+                raise
+            raise FileFormatError("the bag's index gives a chunk position past what the file holds: the bag is "
+                                  "damaged") from None  # fmt: skip
+
+    checked._symfruit = True  # type: ignore[attr-defined]
+    return checked
 
 
 #: Longest reason from rosbags quoted in a refusal (its parser quotes a whole message definition, 1-2 kB).
@@ -411,7 +462,11 @@ def image_array(msg: Any, typename: str) -> np.ndarray:
     check_image_size(w, h, f"{enc} image message", error=FileFormatError)
     if enc in _YUV422 and w % 2:
         raise FileFormatError(f"{msg.encoding} image of odd width {w}: two pixels share each U and V")
-    dt = np.dtype(dtype).newbyteorder(">" if msg.is_bigendian else "<")
+    big = getattr(msg, "is_bigendian", 0)
+    if not isinstance(big, bool) and _whole(big) not in (0, 1):  # a uint8 of 0 or 1; 2-255 is no byte order
+        raise FileFormatError(f"image is_bigendian is {shown(big)}: 0 (little-endian) or 1 (big-endian) "
+                              f"expected; the message is malformed")  # fmt: skip
+    dt = np.dtype(dtype).newbyteorder(">" if big else "<")
     row_bytes = w * channels * dt.itemsize
     if step < row_bytes:
         raise FileFormatError(f"image step {step} is shorter than a row of {w} {enc} pixels ({row_bytes} bytes)")

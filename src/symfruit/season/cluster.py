@@ -93,6 +93,13 @@ CONNECT_TIMEOUT = "10s"
 #: restart its workers (importing symfruit and numba: 10-20 s on a loaded machine): it gets longer.
 NO_WORKER_TIMEOUT = 60.0
 LOCAL_NO_WORKER_TIMEOUT = 300.0
+#: A worker the scheduler has not heard from (its heartbeat, every 0.5-5 s) for this long (s) counts as none in
+#: the watch for workers (:class:`_NoWorkers`), as does one that is paused (its memory above Dask's pause
+#: fraction) or closing: registered, such workers kept a run waiting for ever (a paused one) or for the
+#: scheduler's ``worker-ttl`` (5 minutes; none if unset) (stop 50 left it; robust51).
+SILENT_WORKER_S = 60.0
+#: The bounds of ``no_worker_timeout`` (``--no-worker-timeout``, s): a second to a day.
+NO_WORKER_TIMEOUT_RANGE = (1.0, 86_400.0)
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
 #: scheduler's task count however long the recording (with a task that takes long, the others wait at most
 #: this far ahead of it).
@@ -100,6 +107,15 @@ MAX_AHEAD = 4096
 #: Tasks in flight per worker thread (one running, the next ones already there): enough to keep every worker
 #: busy, few enough that a worker that dies has little to hand over.
 TASKS_PER_THREAD = 3
+
+
+def check_no_worker_timeout(seconds: Any) -> float:
+    """``seconds`` as the wait for a worker (:data:`NO_WORKER_TIMEOUT`), refused outside
+    :data:`NO_WORKER_TIMEOUT_RANGE` (NaN, inf, 0, negative, text) before anything is read."""
+    low, high = NO_WORKER_TIMEOUT_RANGE
+    if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not low <= seconds <= high:
+        raise InputError(f"--no-worker-timeout must be between {low:g} and {high:g} s, got {shown(seconds)}")
+    return float(seconds)
 
 
 def require_distributed() -> Any:
@@ -373,6 +389,7 @@ def run_distributed(
         raise InputError(f"--workers must be between 1 and 256, got {workers}")
     if no_worker_timeout is None:
         no_worker_timeout = NO_WORKER_TIMEOUT if scheduler is not None else LOCAL_NO_WORKER_TIMEOUT
+    no_worker_timeout = check_no_worker_timeout(no_worker_timeout)
     if not isinstance(masks, str):
         raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
     require_distributed()
@@ -612,9 +629,10 @@ def _run(
 
 class _NoWorkers:
     """Watches a run's cluster from a thread of its own (every second, while the run lives): once it has had no
-    worker for ``timeout`` seconds, :attr:`gone` is set and the run's tasks (:meth:`track`) are cancelled, so
-    that the client, which waits on them, goes on; it records their frames unprocessed (:func:`_unprocessed`).
-    A scheduler keeps tasks queued while it has no worker: without this the run waited for ever."""
+    worker that can run a task (:func:`working_workers`: none, or all paused or silent) for ``timeout`` seconds,
+    :attr:`gone` is set and the run's tasks (:meth:`track`) are cancelled, so that the client, which waits on
+    them, goes on; it records their frames unprocessed (:func:`_unprocessed`). A scheduler keeps tasks queued
+    while it has no worker: without this the run waited for ever."""
 
     def __init__(self, client: Any, timeout: float) -> None:
         self.client, self.timeout = client, timeout
@@ -644,12 +662,14 @@ class _NoWorkers:
 
     def _watch(self) -> None:
         since: float | None = None
+        heard: dict[str, tuple[Any, float]] = {}
         while not self._done.wait(1.0):
             if not self.gone.is_set():
                 try:
-                    workers = len(self.client.nthreads())
+                    info = self.client.scheduler_info(n_workers=-1).get("workers", {})
                 except Exception:  # the scheduler itself gone: the client's own errors reach the run
                     continue
+                workers = working_workers(info, heard, time.monotonic())
                 since = None if workers else since if since is not None else time.monotonic()
                 if since is None or time.monotonic() - since < self.timeout:
                     continue
@@ -659,6 +679,25 @@ class _NoWorkers:
             if futures:
                 with contextlib.suppress(Exception):
                     self.client.cancel(futures)
+
+
+def working_workers(info: dict[str, Any], heard: dict[str, tuple[Any, float]], now: float) -> int:
+    """How many of the scheduler's workers (``info``: its identity's ``workers``) can run a task: status
+    ``running`` (not paused, closing, ...), and heard from (their ``last_seen`` changed) within
+    :data:`SILENT_WORKER_S` of ``now`` (the caller's monotonic clock: the scheduler's may be another host's).
+    ``heard`` (address: (last_seen, when it last changed)) is kept between calls."""
+    for gone in heard.keys() - info.keys():
+        del heard[gone]
+    count = 0
+    for address, worker in info.items():
+        seen = worker.get("last_seen")
+        if address not in heard or heard[address][0] != seen:
+            heard[address] = (seen, now)
+        silent = seen is not None and now - heard[address][1] > SILENT_WORKER_S
+        # a Dask that states no status or last_seen (an older one) is taken as running and heard from
+        if worker.get("status", "running") == "running" and not silent:
+            count += 1
+    return count
 
 
 def _unprocessed(part: Part, reason: str, state: dict[str, Any], report: BatchReport,
@@ -703,8 +742,8 @@ def _preflight(client: Any, jobs: Sequence[Job], scheduler: str | None = None,
             client.wait_for_workers(1, timeout=timeout)
         except TimeoutError:  # distributed's WorkerStartTimeoutError: "Only 0/1 workers arrived after 60"
             where = f"{scheduler}: the Dask scheduler" if scheduler else "the local Dask cluster"
-            raise InputError(f"{where} has no worker (waited {timeout:g} s for one); start workers, "
-                             f"dask worker {scheduler or 'ADDRESS'}, or give --workers N for a local "
+            raise InputError(f"{where} has no worker (waited {timeout:g} s for one, --no-worker-timeout); start "
+                             f"workers, dask worker {scheduler or 'ADDRESS'}, or give --workers N for a local "
                              "cluster") from None  # fmt: skip
 
     try:

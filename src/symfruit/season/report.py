@@ -192,6 +192,22 @@ def _check_sizes(path: Path, *sizes: np.ndarray) -> None:
                                   f"metres in [0, {MAX_SIZE_M:g}] (not a symfruit table, or damaged)")  # fmt: skip
 
 
+def _check_centres(path: Path, fruit: Any) -> np.ndarray:
+    """Which fruit have a centre; a table whose centre is NaN, infinite, beyond :data:`MAX_SIZE_M` or given in part
+    refused: a fruit not located has none (three empty cells), as :func:`symfruit.season.table.frame_rows` writes.
+    A NaN centre (a value, not an empty cell) was counted as located (stop 51, robust51)."""
+    given = np.array([fruit.column(f"centre_{a}").is_valid().to_numpy(zero_copy_only=False) for a in "xyz"], bool)
+    xyz = np.array([fruit.column(f"centre_{a}").to_numpy(zero_copy_only=False) for a in "xyz"], float)
+    bad = np.flatnonzero((given.any(0) & ~given.all(0)) | (given & ~(np.abs(xyz) <= MAX_SIZE_M)).any(0))
+    if len(bad):
+        k = int(bad[0])
+        shown_xyz = ", ".join(f"{xyz[a, k]:g}" if given[a, k] else "empty" for a in range(3))
+        raise FileFormatError(f"{path}: row {k + 1} has centre ({shown_xyz}); a located fruit's centre is three "
+                              f"numbers of metres within {MAX_SIZE_M:g}, one not located has none (not a symfruit "
+                              "table, or damaged)")  # fmt: skip
+    return given.all(0).reshape(-1)
+
+
 def _check_counts(path: Path, fruit: np.ndarray, located: np.ndarray) -> None:
     """Refuse a frames table whose counts no run writes: a frame's fruit 0-:data:`MAX_INSTANCES`, located 0 to its
     fruit (a negative count made "-5 located per frame", a huge one a billion-bin histogram)."""
@@ -361,8 +377,9 @@ def write_report(
         _check_folder(output, Path(folder))
     folder = Path(folder) if folder is not None else output / "report"
     size_classes(np.ones(1), classes)  # checked before anything is read
-    fruit = _read(output / TABLE_NAME, ["recording", "frame", "id", "centre_x", "size_x", "size_z", "confidence",
-                                        "reliable", "truncated", "error", "method"])  # fmt: skip
+    fruit = _read(output / TABLE_NAME, ["recording", "frame", "id", "centre_x", "centre_y", "centre_z", "size_x",
+                                        "size_z", "confidence", "reliable", "truncated", "error",
+                                        "method"])  # fmt: skip
     frames = _read(output / FRAMES_NAME, ["recording", "frame", "fruit", "located"])
     inputs = recording_inputs(fruit.schema.metadata)
     failed, failed_recordings = _errors(output)
@@ -370,7 +387,8 @@ def write_report(
     rec_f = frames.column("recording").to_numpy(zero_copy_only=False).astype(str)
     located_f = frames.column("located").to_numpy(zero_copy_only=False).astype(np.int64)
     seen_f = frames.column("fruit").to_numpy(zero_copy_only=False).astype(np.int64)
-    ok = np.array([e is None for e in col["error"]], bool)
+    centred = _check_centres(output / TABLE_NAME, fruit)
+    ok = np.array([e is None for e in col["error"]], bool) & centred  # located: no error and a centre (frame_rows)
     size_x = np.array([np.nan if v is None else v for v in col["size_x"]], float)
     size_z = np.array([np.nan if v is None else v for v in col["size_z"]], float)
     truncated = np.array([bool(v) for v in col["truncated"]], bool)

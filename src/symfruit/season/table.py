@@ -46,7 +46,7 @@ from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
-from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TRUTH_BYTES
+from ..core.limits import MAX_DEPTH_METRES, MAX_INSTANCES, MAX_TRUTH_BYTES, shown
 from ..errors import FileFormatError, SymfruitError
 
 __all__ = [
@@ -110,9 +110,13 @@ def _number(value: Any, what: str, *, whole: bool = False) -> Any:
         raise FileFormatError(f"{what} is {type(value).__name__}, not a number")
     if whole:
         if not isinstance(value, int) or not -(2**62) <= value <= 2**62:
-            raise FileFormatError(f"{what} is {value!r}, not a whole number")
+            raise FileFormatError(f"{what} is {shown(value)}, not a whole number")  # 400 digits were 400 (robust51)
         return value
-    return float(value) if math.isfinite(value) else None
+    try:
+        value = float(value)
+    except OverflowError:  # a whole number of hundreds of digits, which JSON holds: not OverflowError (robust51)
+        raise FileFormatError(f"{what} is a whole number beyond a float's range") from None
+    return value if math.isfinite(value) else None
 
 
 def _flag(value: Any, what: str) -> bool | None:
@@ -200,6 +204,9 @@ def frame_rows(record: Mapping[str, Any], recording: str) -> tuple[Row, list[Row
         if fruits[-1]["id"] is None or not -(2**31) <= fruits[-1]["id"] < 2**31:
             raise FileFormatError(f"{where}.id is missing or out of range")
         # values no completion writes: taken into the tables, they made `symfruit report` refuse the whole run
+        if fruit.get("centre") is not None and any(v is None or not abs(v) <= MAX_BOX_M for v in centre):
+            # a NaN, inf or null coordinate was left empty and the fruit counted as located (robust51)
+            raise FileFormatError(f"{where}.centre is not three finite numbers of metres within {MAX_BOX_M:g}")
         bad = next((v for v in extent if v is not None and not 0 <= v <= MAX_BOX_M), None)
         if bad is not None:
             raise FileFormatError(f"{where}.box.size holds {bad:g} m; box sides are metres in [0, {MAX_BOX_M:g}]")

@@ -450,6 +450,16 @@ def load_scans(folder: str | Path, *, failed: dict[str, str] | None = None) -> l
     return fruits
 
 
+#: The sizes of a complete fruit scan (m, its box's longest side): a scan in millimetres, or of nothing, is refused.
+MIN_SCAN_M, MAX_SCAN_M = 0.001, 2.0
+
+
+def _area(vertices: np.ndarray, faces: np.ndarray) -> float:
+    """The total area (m^2) of a triangle mesh's faces."""
+    tri = vertices[faces]
+    return float(0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1).sum())
+
+
 def _load_scan(path: Path, suffix: str) -> Fruit:
     """One scan of :func:`load_scans`, centred on its box centre; a bad one raises naming ``path``."""
     from ..io import read_cloud, read_mesh
@@ -457,6 +467,13 @@ def _load_scan(path: Path, suffix: str) -> Fruit:
     vertices, faces = read_mesh(path) if suffix in (".obj", ".ply") else (read_cloud(path), None)
     if len(vertices) < 100:
         raise FileFormatError(f"{path}: a complete scan needs at least 100 points, got {len(vertices)}")
+    across = float((vertices.max(axis=0) - vertices.min(axis=0)).max())
+    if not MIN_SCAN_M <= across <= MAX_SCAN_M:  # 1e30 m was taken; a scan in millimetres made fruit of metres
+        raise FileFormatError(f"{path}: the scan is {across:.3g} m across; fruit scans are in metres, "
+                              f"{MIN_SCAN_M:g}-{MAX_SCAN_M:g} m across (millimetres, or no fruit?)")  # fmt: skip
+    if faces is not None and len(faces) and not _area(vertices, faces) > 0:
+        # every face a point or a line: sampling it was numpy's "Probabilities contain NaN" (robust51)
+        raise FileFormatError(f"{path}: the mesh's {len(faces):,} faces have no area (each a point or a line)")
     centre = (vertices.min(axis=0) + vertices.max(axis=0)) / 2.0
     vertices = vertices - centre
     kind = f"scan/{path.stem}"
