@@ -9,6 +9,7 @@ import pytest
 from symfruit import FileFormatError, InputError
 from symfruit.core import limits
 from symfruit.core.limits import check_image_size, depth_metres, instance_labels, shown
+from symfruit.synthetic import shapes
 
 README = Path(__file__).resolve().parents[2] / "README.md"
 
@@ -53,7 +54,8 @@ def test_readme_limits_are_the_enforced_constants():
     cloud = _numbers(next(v for k, v in table.items() if k.startswith("a cloud file")))
     assert cloud[:2] == [limits.MAX_CLOUD_POINTS, limits.MAX_TEXT_CLOUD_BYTES]
     mesh = _numbers(next(v for k, v in table.items() if k.startswith("a mesh")))
-    assert mesh == [limits.MAX_CLOUD_POINTS, limits.MAX_FACES, limits.MAX_OBJ_BYTES]
+    assert mesh[:3] == [limits.MAX_CLOUD_POINTS, limits.MAX_FACES, limits.MAX_OBJ_BYTES]
+    assert mesh[3:] == [shapes.MIN_SCAN_M * 1000, shapes.MAX_SCAN_M]  # "1 mm-2 m across"
     files = _numbers(next(v for k, v in table.items() if k.startswith("settings")))
     assert files[:3] == [limits.MAX_SETTINGS_BYTES, limits.MAX_TRUTH_BYTES, limits.MAX_COCO_BYTES]
     assert limits.MAX_BAG_METADATA_BYTES == limits.MAX_TRUTH_BYTES  # stated beside the truth file's
