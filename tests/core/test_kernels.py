@@ -6447,3 +6447,84 @@ def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         want = np.where(want_hid, occ.depth_at(u, v), np.nan)
     assert np.array_equal(seen, want, equal_nan=True)
+
+
+# --- stop 51, bands51: observe's bands, both sides, in one call ---------------------------------------------------
+
+
+def _observation_parts(obs):
+    """Every array and number of an observation's bands and of what ``explain`` reads of them (``_bands``)."""
+    from symfruit.core.agreement import _bands
+
+    b = _bands(obs)
+    return [*obs.rays_in, *obs.rays_out, *(obs.out_weights or ()), *(obs.out_depth or ()), obs.out_depth is None,
+            b.rays, b.n_in, b.in_starts, b.in_sizes, b.in_ok, b.out_starts, b.out_w, b.out_wsum, b.out_rays, b.out_ok,
+            b.seen, b.finite, obs.contour, obs.cone, obs.rays]  # fmt: skip
+
+
+def _same_bits(a, b) -> bool:
+    """Arrays of one dtype and shape with the same values (NaN where NaN), or equal other values (None, numbers)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape
+                and np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))  # fmt: skip
+    return type(a) is type(b) and a == b
+
+
+@pytest.mark.parametrize("seed", range(36))
+def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
+    """``observe``'s bands by ``observe_bands`` (``_observed_bands``) and by the pieces called one by one (``bands_of``:
+    ``_band_rays`` twice, ``Occlusion.seen_at``, ``_labels_at``, then ``_bands_of_parts``), with the kernels and with
+    the numpy twins: the same rays, weights, seen depths and packed bands to the bit, on views of a ball with and
+    without occlusion information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge
+    labels mix and tie), with bands that overlap, bands past the map, and one ray per band."""
+    from symfruit.core import agreement
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import silhouette
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(500.0, 500.0, 80.0, 60.0, 160, 120)
+    centre = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.04, 0.04), rng.uniform(0.3, 0.5)])
+    d = rng.normal(size=(3000, 3))
+    ball = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + centre
+    visible = ball[ball[:, 2] < centre[2]]  # the near half
+    region = silhouette(visible, camera)
+    occ = None
+    if seed % 4:
+        u0, v0 = int(rng.integers(0, region.u0 + 1)), int(rng.integers(0, region.v0 + 1))
+        w, h = int(rng.integers(1, camera.width - u0 + 1)), int(rng.integers(1, camera.height - v0 + 1))
+        hidden = rng.random((h, w)) < rng.uniform(0.0, 0.4)
+        depth = None if seed % 4 == 1 else rng.uniform(0.2, 0.6, (h, w)).astype(np.float32 if seed % 4 == 2 else float)
+        if depth is not None:
+            depth[rng.random((h, w)) < 0.1] = np.nan
+        occ = Occlusion(u0, v0, hidden, camera.width, camera.height, depth=depth)
+    bands = [(2.0, 5.0), (3.0,), (2.0, 2.5, 9.0), (1.0, 40.0)][seed // 4 % 4]  # with each kind of occlusion
+    n_band = [64, 5, 1, 400][int(rng.integers(0, 4))]
+    kwargs = {"n_band": n_band, "bands": bands, "occlusion": occ, "dense": visible if seed % 3 else None}
+    made = []
+    real = agreement._observed_bands
+
+    def counted(*args):
+        found = real(*args)
+        made.append(found is not None)
+        return found
+
+    def observed(mp, packed):
+        mp.setattr(agreement, "_observed_bands", counted if packed else (lambda *args: None))
+        obs = agreement.observe(visible[::7], region, camera, **kwargs)
+        parts = obs._parts
+        assert parts is not None and (parts.packed is not None) == packed
+        if packed:  # the parts it holds pack to the same bands
+            remade = vars(agreement._bands_of_parts(obs.rays, parts)).values()
+            assert all(_same_bits(a, b) for a, b in zip(_observation_parts(obs)[-15:-3], remade, strict=True))
+        return _observation_parts(obs)
+
+    with monkeypatch.context() as mp:
+        got, want = observed(mp, True), observed(mp, False)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = observed(mp, False)
+    assert made == [True]
+    assert all(_same_bits(a, b) for a, b in zip(got, want, strict=True))
+    # the numpy twins' bands: the same (their edge labels come from the same outline pixels wherever occlusion is given)
+    if occ is not None:
+        assert all(_same_bits(a, b) for a, b in zip(got[:-3], twin[:-3], strict=True))

@@ -8570,3 +8570,56 @@ def hidden_seen(
             if 0 <= col < w and 0 <= row < h:
                 seen[i] = np.float64(depth[row, col])
     return hid, seen
+
+
+# ---- bands51 (issue 19, stop 51): core.agreement.observe's bands, both sides, in one call ----
+
+
+@_njit
+def observe_bands(
+    rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int,
+    fx: float, fy: float, cx: float, cy: float, edge_uv: np.ndarray, labels: np.ndarray, occluded: bool,
+    hidden: np.ndarray, depth: np.ndarray, h_u0: int, h_v0: int, width: int, height: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._observed_bands`: the inside bands' (``inner``) and outside bands' (``outer``)
+    :func:`band_rays`, the outside pixels' :func:`hidden_seen` (``occluded``: ``hidden``, ``depth`` at ``h_u0,
+    h_v0``) and :func:`nearest_labels` of the edge points (``edge_uv`` (k, 2), ``labels`` (k,); none: every label
+    true), packed as :func:`symfruit.core.agreement._bands_of_parts` packs them. Returns ``(every (n + a + b, 3):
+    rays then both sides' band rays, uv (b, 2) the outside pixels, in_sizes, in_starts, out_sizes, out_starts,
+    unsure (b,) bool: a tie of labels the caller resolves (never on a hidden pixel), weight (b,): 1.0 where the label
+    is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite (b,)
+    bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
+    called one by one (the sums are of whole numbers, exact in any order)."""
+    _, rays_in, in_sizes = band_rays(inner, bands, n_band, u0, v0, fx, fy, cx, cy)
+    uv, rays_out, out_sizes = band_rays(outer, bands, n_band, u0, v0, fx, fy, cx, cy)
+    n, a, b = rays.shape[0], rays_in.shape[0], rays_out.shape[0]
+    every = np.empty((n + a + b, 3))
+    every[:n] = rays
+    every[n : n + a] = rays_in
+    every[n + a :] = rays_out
+    k = in_sizes.shape[0]
+    in_starts = np.zeros(k, np.int64)
+    out_starts = np.zeros(k, np.int64)
+    for i in range(1, k):
+        in_starts[i] = in_starts[i - 1] + in_sizes[i - 1]
+        out_starts[i] = out_starts[i - 1] + out_sizes[i - 1]
+    if labels.shape[0] and b:
+        found, unsure = nearest_labels(edge_uv, labels, uv)
+    else:
+        found, unsure = np.ones(b, np.bool_), np.zeros(b, np.bool_)
+    if occluded and b:
+        hid, seen = hidden_seen(uv[:, 0].copy(), uv[:, 1].copy(), hidden, depth, h_u0, h_v0, width, height)
+    else:
+        hid, seen = np.zeros(b, np.bool_), np.full(b, np.nan)
+    weight = np.empty(b)
+    finite = np.empty(b, np.bool_)
+    for i in range(b):
+        unsure[i] = unsure[i] and not hid[i]
+        weight[i] = 1.0 if found[i] and not hid[i] else 0.0
+        finite[i] = occluded and np.isfinite(seen[i])
+    wsum = np.zeros(k)
+    for j in range(k):
+        for i in range(out_starts[j], out_starts[j] + out_sizes[j]):
+            wsum[j] += 1.0 if finite[i] else weight[i]
+    return every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum

@@ -30,7 +30,7 @@ from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .kernels import compiled
-from .occlusion import Occlusion
+from .occlusion import _NATIVE_FLOATS, _NO_DEPTH, Occlusion
 from .points import as_points, row_norms
 from .raster import (
     Silhouette,
@@ -339,8 +339,15 @@ def observe(
         return ([rays[a:b] for a, b in cut], [weight[a:b] for a, b in cut],
                 [] if seen is None else [seen[a:b] for a, b in cut])  # fmt: skip
 
-    rays_in, _, _ = bands_of(inner, False)
-    rays_out, out_weights, out_depth = bands_of(outer, True)
+    made = None
+    if bands and (jit := compiled()) is not None:  # both sides' bands in one call (issue 19, stop 51)
+        made = _observed_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
+                               occlusion, kept)  # fmt: skip
+    if made is None:
+        rays_in, _, _ = bands_of(inner, False)
+        rays_out, out_weights, out_depth = bands_of(outer, True)
+    else:
+        rays_in, rays_out, out_weights, out_depth, packed = made
     fitted = None
     if occlusion is not None and edged and contour_cone <= contour < 1.0:
         cracks = outline_cracks(region)
@@ -349,7 +356,11 @@ def observe(
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     tuples = (tuple(rays_in), tuple(rays_out), tuple(out_weights), None if occlusion is None else tuple(out_depth))
     parts = None
-    if len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
+    if made is not None:
+        n, n_in = len(rays), packed.n_in  # the parts the packed bands hold, as bands_of's parts (views)
+        parts = _BandParts(packed.rays[n : n + n_in], [len(r) for r in rays_in], packed.rays[n + n_in :],
+                           [len(r) for r in rays_out], packed.out_w, packed.seen, tuples, packed)  # fmt: skip
+    elif len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
         (in_rays, in_sizes, _, _), (out_rays, out_sizes, out_w, out_seen) = whole
         parts = _BandParts(in_rays, in_sizes, out_rays, out_sizes, out_w, out_seen, tuples)  # type: ignore[arg-type]
     return Observation(rays=rays, depth=sample[:, 2], rays_in=tuples[0], rays_out=tuples[1],
@@ -375,6 +386,8 @@ class _BandParts:
     out_w: np.ndarray
     seen: np.ndarray | None
     of: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...] | None]
+    #: The :class:`_Bands` of these parts where :func:`_observed_bands` made them (read instead of made again).
+    packed: _Bands | None = None
 
 
 @dataclass(frozen=True)
@@ -407,7 +420,7 @@ def _bands(obs: Observation) -> _Bands:
     parts = obs._parts
     if parts is not None and all(a is b for a, b in zip(parts.of, (obs.rays_in, obs.rays_out, obs.out_weights,
                                                                    obs.out_depth), strict=True)):  # fmt: skip
-        found = obs._made["bands"] = _bands_of_parts(obs.rays, parts)
+        found = obs._made["bands"] = parts.packed if parts.packed is not None else _bands_of_parts(obs.rays, parts)
         return found
     in_sizes = np.array([len(r) for r in obs.rays_in], dtype=np.intp)
     out_sizes = np.array([len(r) for r in obs.rays_out], dtype=np.intp)
@@ -538,15 +551,76 @@ def _labels_at(
             unsure &= ~moot
         if not unsure.any():
             return found
+    tree = _tree(edge_uv, kept)
+    if found is None or unsure is None:
+        return labels[tree.query(uv)[1]]
+    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
+    return found
+
+
+def _tree(edge_uv: np.ndarray, kept: dict[str, Any] | None) -> cKDTree:
+    """:func:`_labels_at`'s ``cKDTree(edge_uv)``, the one in ``kept`` where there is one (made and kept there else)."""
     tree = None if kept is None else kept.get("tree")
     if tree is None:
         tree = cKDTree(edge_uv)
         if kept is not None:
             kept["tree"] = tree
-    if found is None or unsure is None:
-        return labels[tree.query(uv)[1]]
-    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
-    return found
+    return tree
+
+
+def _observed_bands(
+    jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
+    region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion | None,
+    kept: dict[str, Any],
+) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.ndarray], _Bands] | None:  # fmt: skip
+    """:func:`observe`'s bands by one compiled call (:func:`symfruit.core._jit.observe_bands`; issue 19, stop 51):
+    ``(rays_in, rays_out, out_weights, out_depth, bands)``, each band's rays, the outside bands' weights and seen
+    depths (none without ``occlusion``), and the :class:`_Bands` that :func:`_bands_of_parts` would make of them: the
+    same values as ``observe``'s ``bands_of`` on both sides (the same pieces, :func:`_band_rays`,
+    :meth:`~symfruit.core.occlusion.Occlusion.seen_at` and :func:`_labels_at`, in one call; a label tied between
+    nearest edge points of both labels is the tree's pick, as there). None where ``seen_at`` would not take its
+    kernel (a depth map of another dtype or byte order): the caller takes ``bands_of``."""
+    hidden, depth, h_u0, h_v0, width, height = _NO_HIDDEN, _NO_DEPTH, 0, 0, 0, 0
+    if occlusion is not None:
+        hidden, h_u0, h_v0, width, height = (
+            occlusion.hidden,
+            occlusion.u0,
+            occlusion.v0,
+            occlusion.width,
+            occlusion.height,
+        )
+        depth = _NO_DEPTH if occlusion.depth is None else occlusion.depth
+        if depth.ndim != 2 or depth.dtype not in _NATIVE_FLOATS:
+            return None
+    edge = np.ascontiguousarray(edge_uv, dtype=np.float64)
+    labels = np.ascontiguousarray(is_contour, dtype=bool)
+    every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = jit.observe_bands(
+        rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
+        float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), edge, labels, occlusion is not None,
+        hidden, depth, h_u0, h_v0, width, height)  # fmt: skip
+    if unsure.any():  # ties between labels: the tree's pick (_labels_at's), each band's sum moved by the change
+        at = np.flatnonzero(unsure)
+        picked = labels[_tree(edge, kept).query(uv[at])[1]].tolist()
+        band = np.searchsorted(out_starts, at, side="right") - 1
+        for i, j, label in zip(at.tolist(), band.tolist(), picked, strict=True):
+            value = 1.0 if label else 0.0
+            wsum[j] += value - weight[i]  # whole numbers: the sum made again, to the bit
+            weight[i] = value
+    n, n_in = len(rays), int(in_sizes.sum())
+    cut_in = [(n + s, n + s + k) for s, k in zip(in_starts.tolist(), in_sizes.tolist(), strict=True)]
+    cut_out = [(s, s + k) for s, k in zip(out_starts.tolist(), out_sizes.tolist(), strict=True)]
+    rays_in = [every[a:b] for a, b in cut_in]
+    rays_out = [every[n + n_in + a : n + n_in + b] for a, b in cut_out]
+    out_depth = [] if occlusion is None else [seen[a:b] for a, b in cut_out]
+    out_rays = out_sizes > 0
+    packed = _Bands(rays=every, n_in=n_in, in_starts=in_starts, in_sizes=in_sizes, in_ok=in_sizes > 0,
+                    out_starts=out_starts, out_w=weight, out_wsum=wsum, out_rays=out_rays, out_ok=out_rays & (wsum > 0),
+                    seen=None if occlusion is None else seen, finite=None if occlusion is None else finite)  # fmt: skip
+    return rays_in, rays_out, [weight[a:b] for a, b in cut_out], out_depth, packed
+
+
+#: :func:`_observed_bands`' hidden map without occlusion information (not read).
+_NO_HIDDEN = np.zeros((0, 0), dtype=bool)
 
 
 def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
