@@ -6472,10 +6472,12 @@ def _same_bits(a, b) -> bool:
 
 @pytest.mark.parametrize("seed", range(36))
 def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
-    """``observe``'s bands by ``observe_bands`` (``_observed_bands``) and by the pieces called one by one (``bands_of``:
-    ``_band_rays`` twice, ``Occlusion.seen_at``, ``_labels_at``, then ``_bands_of_parts``), with the kernels and with
-    the numpy twins: the same rays, weights, seen depths and packed bands to the bit, on views of a ball with and
-    without occlusion information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge
+    """``observe``'s bands by ``observe_bands`` (``_observed_bands``) or, with occlusion information, ``outline_bands``
+    (``_outline_bands``: the outline's edge labels and the cracks' labels too) and by the pieces called one by one
+    (``_occluded_edges``, ``bands_of``: ``_band_rays`` twice, ``Occlusion.seen_at``, ``_labels_at``, then
+    ``_bands_of_parts``; the cracks' ``_labels_at``), with the kernels and with the numpy twins: the same rays, weights,
+    seen depths, packed bands, contour share and cone to the bit, on views of a ball with and without occlusion
+    information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge
     labels mix and tie), with bands that overlap, bands past the map, and one ray per band."""
     from symfruit.core import agreement
     from symfruit.core.camera import Camera
@@ -6502,29 +6504,99 @@ def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
     n_band = [64, 5, 1, 400][int(rng.integers(0, 4))]
     kwargs = {"n_band": n_band, "bands": bands, "occlusion": occ, "dense": visible if seed % 3 else None}
     made = []
-    real = agreement._observed_bands
 
-    def counted(*args):
-        found = real(*args)
-        made.append(found is not None)
-        return found
+    def counted(real):
+        def call(*args):
+            found = real(*args)
+            made.append((real.__name__, found is not None))
+            return found
+
+        return call
+
+    cone_points = []
+    real_cone = agreement.outline_cone
+
+    def outline_cone(region, camera, points):  # the cracks beside contour edges, as each path picked them
+        cone_points.append(points)
+        return real_cone(region, camera, points)
 
     def observed(mp, packed):
-        mp.setattr(agreement, "_observed_bands", counted if packed else (lambda *args: None))
+        for name in ("_observed_bands", "_outline_bands"):  # the pieces one by one where not packed
+            mp.setattr(agreement, name, counted(getattr(agreement, name)) if packed else (lambda *args: None))
+        mp.setattr(agreement, "outline_cone", outline_cone)
+        cone_points.clear()
         obs = agreement.observe(visible[::7], region, camera, **kwargs)
         parts = obs._parts
         assert parts is not None and (parts.packed is not None) == packed
         if packed:  # the parts it holds pack to the same bands
             remade = vars(agreement._bands_of_parts(obs.rays, parts)).values()
             assert all(_same_bits(a, b) for a, b in zip(_observation_parts(obs)[-15:-3], remade, strict=True))
-        return _observation_parts(obs)
+        return [*_observation_parts(obs), *cone_points]
 
     with monkeypatch.context() as mp:
         got, want = observed(mp, True), observed(mp, False)
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         twin = observed(mp, False)
-    assert made == [True]
+    # with occlusion information the outline's edges, labels and bands in one call, where the normals' labels allow
+    assert made in ([("_observed_bands", True)], [("_outline_bands", True)],
+                    [("_outline_bands", False), ("_observed_bands", True)])  # fmt: skip
+    assert made[0][0] == ("_observed_bands" if occ is None else "_outline_bands")
     assert all(_same_bits(a, b) for a, b in zip(got, want, strict=True))
     # the numpy twins' bands: the same (their edge labels come from the same outline pixels wherever occlusion is given)
     if occ is not None:
-        assert all(_same_bits(a, b) for a, b in zip(got[:-3], twin[:-3], strict=True))
+        assert all(_same_bits(a, b) for a, b in zip(got[:-3 - len(cone_points)], twin[:-3 - len(cone_points)],
+                                                    strict=True))  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_outline_bands_are_the_occluded_edges_bands_and_crack_labels(seed):
+    """``_outline_bands`` (``outline_bands``) against ``_occluded_edges``, ``_observed_bands`` and the cracks'
+    ``_labels_at`` called one by one, for edge normals' labels none, all true, all false (those it takes) and mixed
+    (it declines): the same outline pixels, labels, bands and crack labels (ties: the tree's pick) to the bit."""
+    from symfruit.core import agreement
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import distance_maps, outline_cracks, silhouette
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(500.0, 500.0, 80.0, 60.0, 160, 120)
+    centre = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.04, 0.04), rng.uniform(0.3, 0.5)])
+    d = rng.normal(size=(3000, 3))
+    ball = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + centre
+    region = silhouette(ball[ball[:, 2] < centre[2]], camera)
+    h, w = camera.height, camera.width
+    hidden = rng.random((h, w)) < rng.uniform(0.0, 0.3)
+    occ = Occlusion(0, 0, hidden, w, h, depth=rng.uniform(0.2, 0.6, (h, w)).astype(np.float32))
+    inner, outer = distance_maps(region.mask, 8.0, 5.5)
+    rays = rng.normal(size=(int(rng.integers(0, 30)), 3))
+    kind = seed % 4
+    normals = rng.uniform(0, w, (int(rng.integers(1, 40)), 2)) if kind else np.empty((0, 2))
+    labels = [None, np.ones(len(normals), bool), np.zeros(len(normals), bool), rng.random(len(normals)) < 0.5][kind]
+    labels = np.empty(0, bool) if labels is None else labels
+    if kind == 3:
+        labels[:2] = True, False  # mixed
+    count, radius, share, bands = (
+        int(rng.integers(5, 150)),
+        int(rng.integers(0, 6)),
+        float(rng.uniform(0, 1)),
+        (2.0, 5.0),
+    )
+    jit = kernels.compiled()
+    kept, want_kept = {}, {}
+    got = agreement._outline_bands(jit, rays, inner, outer, bands, 64, region, camera, normals, labels, occ, count,
+                                   radius, share, kept)  # fmt: skip
+    if kind == 3:
+        assert got is None
+        return
+    uv, is_contour = agreement._occluded_edges(region, occ, normals, labels, count, radius)
+    want = agreement._observed_bands(jit, rays, inner, outer, bands, 64, region, camera, uv, is_contour, occ, want_kept)
+    contour = np.count_nonzero(is_contour) / len(is_contour) if len(is_contour) else 1.0
+    cracks = outline_cracks(region)
+    want_cracks = agreement._labels_at(uv, is_contour, cracks, want_kept) if share <= contour < 1.0 else None
+    assert _same_bits(got[0], uv) and _same_bits(got[1], is_contour)
+    for a, b in zip(got[2][:4], want[:4], strict=True):
+        assert all(_same_bits(x, y) for x, y in zip(a, b, strict=True))
+    assert all(_same_bits(x, y) for x, y in zip(vars(got[2][4]).values(), vars(want[4]).values(), strict=True))
+    assert (got[3] is None) == (want_cracks is None)
+    if want_cracks is not None:
+        assert _same_bits(got[3], want_cracks)

@@ -8623,3 +8623,35 @@ def observe_bands(
         for i in range(out_starts[j], out_starts[j] + out_sizes[j]):
             wsum[j] += 1.0 if finite[i] else weight[i]
     return every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum
+
+
+@_njit
+def outline_bands(
+    mask: np.ndarray, count: int, radius: int, base: bool, cracks: np.ndarray, share: float, rays: np.ndarray,
+    inner: np.ndarray, outer: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int, fx: float, fy: float,
+    cx: float, cy: float, hidden: np.ndarray, depth: np.ndarray, h_u0: int, h_v0: int, width: int, height: int,
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._outline_bands`: with occlusion information and every edge normal's label
+    ``base`` (none: true), ``observe``'s edge labels, bands and the outline cracks' labels in one call. The edge
+    points are :func:`outline_uv`'s (``count``) labelled ``base`` where no hidden pixel lies within ``radius``
+    (:func:`occluded_at`; ``_occluded_edges``); then :func:`observe_bands` of them; then, where ``share`` is at most
+    the share of true labels and that share is below 1, :func:`nearest_labels` of ``cracks`` (k, 2). Returns ``(uv,
+    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``): the
+    pieces' values."""
+    edge = outline_uv(mask, count, u0, v0)
+    m = edge.shape[0]
+    occ = occluded_at(edge[:, 0].copy(), edge[:, 1].copy(), hidden, h_u0, h_v0, width, height, radius)
+    labels = np.empty(m, np.bool_)
+    n_true = 0
+    for i in range(m):
+        labels[i] = base and not occ[i]
+        n_true += labels[i]
+    made = observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge, labels, True, hidden,
+                         depth, h_u0, h_v0, width, height)  # fmt: skip
+    took = m > 0 and share <= n_true / m < 1.0
+    if took:
+        found, unsure = nearest_labels(edge, labels, cracks)
+    else:
+        found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
+    return edge, labels, made, took, found, unsure

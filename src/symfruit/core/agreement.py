@@ -294,12 +294,21 @@ def observe(
         edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
     else:
         edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
-    if occlusion is not None:
+    kept: dict[str, Any] = {}  # _labels_at's tree of the edge points, where one is made
+    jit = compiled() if bands else None
+    made: _Banded | None = None
+    crack_labels = None
+    outlined = None
+    if occlusion is not None and jit is not None:  # the edges, bands and crack labels in one call (issue 19, stop 51)
+        outlined = _outline_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
+                                  occlusion, contour_points, occluded_px, contour_cone, kept)  # fmt: skip
+    if outlined is not None:
+        edge_uv, is_contour, made, crack_labels = outlined
+    elif occlusion is not None:
         edge_uv, is_contour = _occluded_edges(region, occlusion, edge_uv, is_contour, contour_points, occluded_px)
     # the share from the count (a whole number over the length: the mean of the booleans, to the bit)
     contour = np.count_nonzero(is_contour) / len(is_contour) if len(is_contour) else 1.0
     edged = len(is_contour) > 0  # the edge points' labels are looked up beside band pixels and cracks (_labels_at)
-    kept: dict[str, Any] = {}  # _labels_at's tree of these edge points, where one is made
 
     whole: list[tuple[np.ndarray, list[int], np.ndarray | None, np.ndarray | None]] = []  # for _BandParts
 
@@ -339,8 +348,7 @@ def observe(
         return ([rays[a:b] for a, b in cut], [weight[a:b] for a, b in cut],
                 [] if seen is None else [seen[a:b] for a, b in cut])  # fmt: skip
 
-    made = None
-    if bands and (jit := compiled()) is not None:  # both sides' bands in one call (issue 19, stop 51)
+    if made is None and jit is not None:  # both sides' bands in one call (issue 19, stop 51)
         made = _observed_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
                                occlusion, kept)  # fmt: skip
     if made is None:
@@ -351,7 +359,9 @@ def observe(
     fitted = None
     if occlusion is not None and edged and contour_cone <= contour < 1.0:
         cracks = outline_cracks(region)
-        fitted = outline_cone(region, camera, cracks[_labels_at(edge_uv, is_contour, cracks, kept)])
+        if crack_labels is None:
+            crack_labels = _labels_at(edge_uv, is_contour, cracks, kept)
+        fitted = outline_cone(region, camera, cracks[crack_labels])
     # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     tuples = (tuple(rays_in), tuple(rays_out), tuple(out_weights), None if occlusion is None else tuple(out_depth))
@@ -568,37 +578,78 @@ def _tree(edge_uv: np.ndarray, kept: dict[str, Any] | None) -> cKDTree:
     return tree
 
 
+def _occlusion_maps(occlusion: Occlusion | None) -> tuple[np.ndarray, np.ndarray, int, int, int, int] | None:
+    """``(hidden, depth, u0, v0, width, height)`` of ``occlusion`` as the kernels read them (without one: empty maps),
+    or None where :meth:`~symfruit.core.occlusion.Occlusion.seen_at` would not take its kernel (a depth map of another
+    dtype or byte order)."""
+    if occlusion is None:
+        return _NO_HIDDEN, _NO_DEPTH, 0, 0, 0, 0
+    depth = _NO_DEPTH if occlusion.depth is None else occlusion.depth
+    if depth.ndim != 2 or depth.dtype not in _NATIVE_FLOATS:
+        return None
+    return occlusion.hidden, depth, occlusion.u0, occlusion.v0, occlusion.width, occlusion.height
+
+
 def _observed_bands(
     jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
     region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion | None,
     kept: dict[str, Any],
-) -> tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.ndarray], _Bands] | None:  # fmt: skip
+) -> _Banded | None:  # fmt: skip
     """:func:`observe`'s bands by one compiled call (:func:`symfruit.core._jit.observe_bands`; issue 19, stop 51):
-    ``(rays_in, rays_out, out_weights, out_depth, bands)``, each band's rays, the outside bands' weights and seen
-    depths (none without ``occlusion``), and the :class:`_Bands` that :func:`_bands_of_parts` would make of them: the
-    same values as ``observe``'s ``bands_of`` on both sides (the same pieces, :func:`_band_rays`,
+    the same values as ``observe``'s ``bands_of`` on both sides (the same pieces, :func:`_band_rays`,
     :meth:`~symfruit.core.occlusion.Occlusion.seen_at` and :func:`_labels_at`, in one call; a label tied between
     nearest edge points of both labels is the tree's pick, as there). None where ``seen_at`` would not take its
-    kernel (a depth map of another dtype or byte order): the caller takes ``bands_of``."""
-    hidden, depth, h_u0, h_v0, width, height = _NO_HIDDEN, _NO_DEPTH, 0, 0, 0, 0
-    if occlusion is not None:
-        hidden, h_u0, h_v0, width, height = (
-            occlusion.hidden,
-            occlusion.u0,
-            occlusion.v0,
-            occlusion.width,
-            occlusion.height,
-        )
-        depth = _NO_DEPTH if occlusion.depth is None else occlusion.depth
-        if depth.ndim != 2 or depth.dtype not in _NATIVE_FLOATS:
-            return None
+    kernel: the caller takes ``bands_of``."""
+    maps = _occlusion_maps(occlusion)
+    if maps is None:
+        return None
     edge = np.ascontiguousarray(edge_uv, dtype=np.float64)
     labels = np.ascontiguousarray(is_contour, dtype=bool)
-    every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = jit.observe_bands(
+    made = jit.observe_bands(rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0),
+                             int(region.v0), float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy),
+                             edge, labels, occlusion is not None, *maps)  # fmt: skip
+    return _unpacked(made, len(rays), edge, labels, occlusion is not None, kept)
+
+
+def _outline_bands(
+    jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
+    region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion,
+    count: int, radius: int, share: float, kept: dict[str, Any],
+) -> tuple[np.ndarray, np.ndarray, _Banded, np.ndarray | None] | None:  # fmt: skip
+    """:func:`_occluded_edges`, :func:`_observed_bands` and the outline cracks' labels (:func:`observe`'s ``cracks``,
+    where ``share <= contour < 1``) by one compiled call (:func:`symfruit.core._jit.outline_bands`; issue 19, stop 51):
+    ``(uv, contour labels, bands, the cracks' labels or None)``, the same values (ties of labels the tree's pick, as
+    :func:`_labels_at` takes them). Where the edge normals' labels (``is_contour``) are all alike or none: their
+    outline labels need no look-up (``_labels_at`` gives that label everywhere); else, or where ``_observed_bands``
+    or ``_outline_uv`` would not take their kernels, None: the caller takes the pieces one by one."""
+    n_true = np.count_nonzero(is_contour)
+    maps = _occlusion_maps(occlusion)
+    mask = region.mask
+    if maps is None or count < 1 or 0 < n_true < len(is_contour) or mask.ndim != 2 or mask.dtype != bool:
+        return None
+    cracks = outline_cracks(region)
+    uv, labels, made, took, found, unsure = jit.outline_bands(
+        np.ascontiguousarray(mask), count, int(radius), bool(n_true > 0 or not len(is_contour)), cracks, float(share),
         rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
-        float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), edge, labels, occlusion is not None,
-        hidden, depth, h_u0, h_v0, width, height)  # fmt: skip
-    if unsure.any():  # ties between labels: the tree's pick (_labels_at's), each band's sum moved by the change
+        float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), *maps)  # fmt: skip
+    banded = _unpacked(made, len(rays), uv, labels, True, kept)
+    if took and unsure.any():  # _labels_at's tree among ties, as for the bands
+        found[unsure] = labels[_tree(uv, kept).query(cracks[unsure])[1]]
+    return uv, labels, banded, found if took else None
+
+
+#: :func:`_observed_bands`' result: each band's rays (inside, outside), the outside bands' weights and seen depths
+#: (none without occlusion information), and the :class:`_Bands` that :func:`_bands_of_parts` would make of them.
+_Banded = tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.ndarray], "_Bands"]
+
+
+def _unpacked(made: tuple[np.ndarray, ...], n: int, edge: np.ndarray, labels: np.ndarray, occluded: bool,
+              kept: dict[str, Any]) -> _Banded:  # fmt: skip
+    """:func:`symfruit.core._jit.observe_bands`' result ``made`` (``n`` depth rays, the edge points ``edge`` with
+    ``labels``) as :func:`_observed_bands` returns it; a label tied between nearest edge points of both labels (its
+    ``unsure``) is ``_labels_at``'s tree's pick (kept in ``kept``), each band's weight sum moved by the change."""
+    every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = made
+    if unsure.any():
         at = np.flatnonzero(unsure)
         picked = labels[_tree(edge, kept).query(uv[at])[1]].tolist()
         band = np.searchsorted(out_starts, at, side="right") - 1
@@ -606,16 +657,16 @@ def _observed_bands(
             value = 1.0 if label else 0.0
             wsum[j] += value - weight[i]  # whole numbers: the sum made again, to the bit
             weight[i] = value
-    n, n_in = len(rays), int(in_sizes.sum())
+    n_in = int(in_sizes.sum())
     cut_in = [(n + s, n + s + k) for s, k in zip(in_starts.tolist(), in_sizes.tolist(), strict=True)]
     cut_out = [(s, s + k) for s, k in zip(out_starts.tolist(), out_sizes.tolist(), strict=True)]
     rays_in = [every[a:b] for a, b in cut_in]
     rays_out = [every[n + n_in + a : n + n_in + b] for a, b in cut_out]
-    out_depth = [] if occlusion is None else [seen[a:b] for a, b in cut_out]
+    out_depth = [seen[a:b] for a, b in cut_out] if occluded else []
     out_rays = out_sizes > 0
     packed = _Bands(rays=every, n_in=n_in, in_starts=in_starts, in_sizes=in_sizes, in_ok=in_sizes > 0,
                     out_starts=out_starts, out_w=weight, out_wsum=wsum, out_rays=out_rays, out_ok=out_rays & (wsum > 0),
-                    seen=None if occlusion is None else seen, finite=None if occlusion is None else finite)  # fmt: skip
+                    seen=seen if occluded else None, finite=finite if occluded else None)  # fmt: skip
     return rays_in, rays_out, [weight[a:b] for a, b in cut_out], out_depth, packed
 
 
