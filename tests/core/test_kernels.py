@@ -6457,9 +6457,9 @@ def _observation_parts(obs):
     from symfruit.core.agreement import _bands
 
     b = _bands(obs)
-    return [*obs.rays_in, *obs.rays_out, *(obs.out_weights or ()), *(obs.out_depth or ()), obs.out_depth is None,
-            b.rays, b.n_in, b.in_starts, b.in_sizes, b.in_ok, b.out_starts, b.out_w, b.out_wsum, b.out_rays, b.out_ok,
-            b.seen, b.finite, obs.contour, obs.cone, obs.rays]  # fmt: skip
+    return [obs.inner, obs.interior, *obs.rays_in, *obs.rays_out, *(obs.out_weights or ()), *(obs.out_depth or ()),
+            obs.out_depth is None, b.rays, b.n_in, b.in_starts, b.in_sizes, b.in_ok, b.out_starts, b.out_w, b.out_wsum,
+            b.out_rays, b.out_ok, b.seen, b.finite, obs.contour, obs.cone, obs.rays]  # fmt: skip
 
 
 def _same_bits(a, b) -> bool:
@@ -6471,23 +6471,25 @@ def _same_bits(a, b) -> bool:
 
 
 @pytest.mark.parametrize("seed", range(36))
-def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
-    """``observe``'s bands by ``observe_bands`` (``_observed_bands``) or, with occlusion information, ``outline_bands``
-    (``_outline_bands``: the outline's edge labels and the cracks' labels too) and by the pieces called one by one
-    (``_occluded_edges``, ``bands_of``: ``_band_rays`` twice, ``Occlusion.seen_at``, ``_labels_at``, then
-    ``_bands_of_parts``; the cracks' ``_labels_at``), with the kernels and with the numpy twins: the same rays, weights,
-    seen depths, packed bands, contour share and cone to the bit, on views of a ball with and without occlusion
-    information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge
-    labels mix and tie), with bands that overlap, bands past the map, and one ray per band."""
+def test_observe_edges_and_bands_are_the_steps_made_one_by_one(monkeypatch, seed):
+    """``observe`` with its fused calls and with the steps called one by one, with the kernels and with the numpy
+    twins, on views of a ball (a cloud sparser than the pixels or about one point a pixel) with and without occlusion
+    information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge labels mix and tie),
+    bands that overlap, bands past the map and one ray per band. The fused calls: ``observe_edges``
+    (``_observed_edges``, where an inside reach is given: the distance maps, both ``_inside_px`` and
+    ``_contour_pixels``), ``observe_bands`` (``_observed_bands``: ``bands_of`` on both sides, ``_band_rays``,
+    ``Occlusion.seen_at``, ``_labels_at``, then ``_bands_of_parts``) or with occlusion information ``outline_bands``
+    (``_outline_bands``: ``_occluded_edges``, the bands and the cracks' ``_labels_at``). The same maps, interior
+    points, rays, weights, seen depths, packed bands, contour share, cracks and cone to the bit."""
     from symfruit.core import agreement
     from symfruit.core.camera import Camera
     from symfruit.core.occlusion import Occlusion
-    from symfruit.core.raster import silhouette
+    from symfruit.core.raster import point_pixels, silhouette
 
     rng = np.random.default_rng(seed)
     camera = Camera(500.0, 500.0, 80.0, 60.0, 160, 120)
     centre = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.04, 0.04), rng.uniform(0.3, 0.5)])
-    d = rng.normal(size=(3000, 3))
+    d = rng.normal(size=(3000 if seed % 2 else 30000, 3))  # sparser than the pixels, or about one point a pixel
     ball = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + centre
     visible = ball[ball[:, 2] < centre[2]]  # the near half
     region = silhouette(visible, camera)
@@ -6502,7 +6504,10 @@ def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
         occ = Occlusion(u0, v0, hidden, camera.width, camera.height, depth=depth)
     bands = [(2.0, 5.0), (3.0,), (2.0, 2.5, 9.0), (1.0, 40.0)][seed // 4 % 4]  # with each kind of occlusion
     n_band = [64, 5, 1, 400][int(rng.integers(0, 4))]
-    kwargs = {"n_band": n_band, "bands": bands, "occlusion": occ, "dense": visible if seed % 3 else None}
+    kwargs = {"n_band": n_band, "bands": bands, "occlusion": occ, "dense": visible if seed % 3 else None,
+              "inner_reach": [None, 3.0, 12.0][seed % 3]}  # fmt: skip
+    if seed % 3 and seed % 2:
+        kwargs["dense_pixels"] = point_pixels(visible, camera)
     made = []
 
     def counted(real):
@@ -6514,7 +6519,7 @@ def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
         return call
 
     cone_points = []
-    real_cone = agreement.outline_cone
+    real_cone, real_edges = agreement.outline_cone, agreement._observed_edges
 
     def outline_cone(region, camera, points):  # the cracks beside contour edges, as each path picked them
         cone_points.append(points)
@@ -6523,6 +6528,7 @@ def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
     def observed(mp, packed):
         for name in ("_observed_bands", "_outline_bands"):  # the pieces one by one where not packed
             mp.setattr(agreement, name, counted(getattr(agreement, name)) if packed else (lambda *args: None))
+        mp.setattr(agreement, "_observed_edges", counted(real_edges) if packed else (lambda *args: None))
         mp.setattr(agreement, "outline_cone", outline_cone)
         cone_points.clear()
         obs = agreement.observe(visible[::7], region, camera, **kwargs)
@@ -6538,9 +6544,11 @@ def test_observe_bands_are_the_bands_made_one_by_one(monkeypatch, seed):
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         twin = observed(mp, False)
     # with occlusion information the outline's edges, labels and bands in one call, where the normals' labels allow
-    assert made in ([("_observed_bands", True)], [("_outline_bands", True)],
-                    [("_outline_bands", False), ("_observed_bands", True)])  # fmt: skip
-    assert made[0][0] == ("_observed_bands" if occ is None else "_outline_bands")
+    # the maps, depths inside the edge and edge normals in one call where an inside reach is given
+    edges = [("_observed_edges", True)] if kwargs["inner_reach"] is not None else []
+    assert made in (edges + [("_observed_bands", True)], edges + [("_outline_bands", True)],
+                    edges + [("_outline_bands", False), ("_observed_bands", True)])  # fmt: skip
+    assert made[len(edges)][0] == ("_observed_bands" if occ is None else "_outline_bands")
     assert all(_same_bits(a, b) for a, b in zip(got, want, strict=True))
     # the numpy twins' bands: the same (their edge labels come from the same outline pixels wherever occlusion is given)
     if occ is not None:

@@ -8655,3 +8655,39 @@ def outline_bands(
     else:
         found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
     return edge, labels, made, took, found, unsure
+
+
+@_njit
+def observe_edges(
+    mask: np.ndarray, reach: float, out_reach: float, points: np.ndarray, dense: np.ndarray, col: np.ndarray,
+    row: np.ndarray, given: int, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, count: int, half: int,
+) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._observed_edges`: ``observe``'s first steps in one call, each the kernel it called
+    before: :func:`observe_maps` of ``mask`` (a window at ``u0, v0``); :func:`inside_px` of ``points`` in the inside
+    map; that of ``dense`` (``given`` 0: none, the points' own; 1: projected; 2: at its pixels ``col``, ``row``,
+    :func:`inside_px_of`); and where the edge cloud has about a point per pixel (at least half as many points as
+    ``mask`` pixels), :func:`contour_pixels` of it. ``(done, inner, outer, depth_px, edge_px, grid, uv, contour)``:
+    ``done`` False where ``observe_maps`` declines (nothing else made), ``grid`` False where the cloud is sparser
+    (``uv``, ``contour`` empty)."""
+    done, inner, outer = observe_maps(mask, reach, out_reach)
+    none2, none1 = np.empty((0, 2)), np.empty(0, np.bool_)
+    if not done:
+        return False, inner, outer, np.empty(0), np.empty(0), False, none2, none1
+    depth_px = inside_px(points, fx, fy, cx, cy, u0, v0, inner)
+    edge = points if given == 0 else dense
+    if given == 0:
+        edge_px = depth_px
+    elif given == 1:
+        edge_px = inside_px(dense, fx, fy, cx, cy, u0, v0, inner)
+    else:
+        edge_px = inside_px_of(col, row, u0, v0, inner)
+    filled = 0
+    for r in range(mask.shape[0]):
+        for c in range(mask.shape[1]):
+            filled += mask[r, c]
+    grid = edge.shape[0] >= 0.5 * filled
+    if not grid:
+        return True, inner, outer, depth_px, edge_px, False, none2, none1
+    h, w = mask.shape
+    uv, contour = contour_pixels(edge, edge_px, fx, fy, cx, cy, u0, v0, h, w, count, half)
+    return True, inner, outer, depth_px, edge_px, True, uv, contour

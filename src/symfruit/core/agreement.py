@@ -281,19 +281,26 @@ def observe(
     reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
     # the outside bands read the map out to the widest band alone
     out_reach = max(bands, default=0.0) + 0.5
-    if reach is None:
-        box = mask_box(mask)  # once for both maps
-        inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
-    else:  # both maps in one call (issue 19, stop 50)
-        inner, outer = distance_maps(mask, reach, out_reach)
-
-    depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
-    edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
-    if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about one point per pixel: neighbours from the image grid
-        edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
+    # the maps, the points' and edge points' depths inside the edge and the edge normals in one call (issue 19, stop 51)
+    edged_px = None if reach is None else _observed_edges(points, edge_points, dense, dense_pixels, region, camera,
+                                                          reach, out_reach, contour_points)  # fmt: skip
+    if edged_px is not None:
+        inner, outer, depth_px, edge_px, edges = edged_px
+        edge_uv, is_contour = edges if edges is not None else _contour_points(edge_points, edge_px, camera,
+                                                                              contour_points)  # fmt: skip
     else:
-        edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
+        if reach is None:
+            box = mask_box(mask)  # once for both maps
+            inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
+        else:  # both maps in one call (issue 19, stop 50)
+            inner, outer = distance_maps(mask, reach, out_reach)
+        depth_px = _inside_px(points, region, camera, inner)
+        edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
+        if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about a point per pixel: neighbours from the image grid
+            edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
+        else:
+            edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
     kept: dict[str, Any] = {}  # _labels_at's tree of the edge points, where one is made
     jit = compiled() if bands else None
     made: _Banded | None = None
@@ -576,6 +583,34 @@ def _tree(edge_uv: np.ndarray, kept: dict[str, Any] | None) -> cKDTree:
         if kept is not None:
             kept["tree"] = tree
     return tree
+
+
+def _observed_edges(
+    points: np.ndarray, edge_points: np.ndarray, dense: np.ndarray | None,
+    dense_pixels: tuple[np.ndarray, np.ndarray] | None, region: Silhouette, camera: Camera, reach: float,
+    out_reach: float, count: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None] | None:  # fmt: skip
+    """:func:`observe`'s :func:`~symfruit.core.raster.distance_maps`, both :func:`_inside_px` and, for a cloud with
+    about a point per pixel, :func:`_contour_pixels` by one compiled call (:func:`symfruit.core._jit.observe_edges`;
+    issue 19, stop 51): ``(inner, outer, depth_px, edge_px, (edge_uv, is_contour) or None for a sparser cloud)``,
+    the same values (each step the kernel it called). None without numba, for a mask that is not a 2-D bool image,
+    or where ``observe_maps`` declines (the twins' other paths): the caller takes the steps one by one."""
+    mask = region.mask
+    if mask.ndim != 2 or mask.dtype != bool or (jit := compiled()) is None:
+        return None
+    given, col, row = (0, _NO_PIXELS, _NO_PIXELS) if dense is None else (1, _NO_PIXELS, _NO_PIXELS)
+    if dense_pixels is not None and dense is not None and len(dense_pixels[0]) == len(edge_points):
+        given, (col, row) = 2, dense_pixels
+    done, inner, outer, depth_px, edge_px, grid, uv, contour = jit.observe_edges(
+        mask, float(reach), float(out_reach), points, edge_points, col, row, given, camera.fx, camera.fy, camera.cx,
+        camera.cy, region.u0, region.v0, count, 3)  # fmt: skip
+    if not done:
+        return None
+    return inner, outer, depth_px, edge_px, (uv, contour) if grid else None
+
+
+#: :func:`_observed_edges`' pixels of a dense cloud not given (not read).
+_NO_PIXELS = np.zeros(0, dtype=np.int64)
 
 
 def _occlusion_maps(occlusion: Occlusion | None) -> tuple[np.ndarray, np.ndarray, int, int, int, int] | None:
