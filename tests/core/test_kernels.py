@@ -6447,3 +6447,164 @@ def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         want = np.where(want_hid, occ.depth_at(u, v), np.nan)
     assert np.array_equal(seen, want, equal_nan=True)
+
+
+# --- stop 51, bands51: observe's bands, both sides, in one call ---------------------------------------------------
+
+
+def _observation_parts(obs):
+    """Every array and number of an observation's bands and of what ``explain`` reads of them (``_bands``)."""
+    from symfruit.core.agreement import _bands
+
+    b = _bands(obs)
+    return [obs.inner, obs.interior, *obs.rays_in, *obs.rays_out, *(obs.out_weights or ()), *(obs.out_depth or ()),
+            obs.out_depth is None, b.rays, b.n_in, b.in_starts, b.in_sizes, b.in_ok, b.out_starts, b.out_w, b.out_wsum,
+            b.out_rays, b.out_ok, b.seen, b.finite, obs.contour, obs.cone, obs.rays]  # fmt: skip
+
+
+def _same_bits(a, b) -> bool:
+    """Arrays of one dtype and shape with the same values (NaN where NaN), or equal other values (None, numbers)."""
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return (isinstance(a, np.ndarray) and isinstance(b, np.ndarray) and a.dtype == b.dtype and a.shape == b.shape
+                and np.array_equal(a, b, equal_nan=a.dtype.kind == "f"))  # fmt: skip
+    return type(a) is type(b) and a == b
+
+
+@pytest.mark.parametrize("seed", range(36))
+def test_observe_edges_and_bands_are_the_steps_made_one_by_one(monkeypatch, seed):
+    """``observe`` with its fused calls and with the steps called one by one, with the kernels and with the numpy
+    twins, on views of a ball (a cloud sparser than the pixels or about one point a pixel) with and without occlusion
+    information (no depth, float32 and float64 depth with NaN; hidden pixels scattered so that edge labels mix and tie),
+    bands that overlap, bands past the map and one ray per band. The fused calls: ``observe_edges``
+    (``_observed_edges``, where an inside reach is given: the distance maps, both ``_inside_px`` and
+    ``_contour_pixels``), ``observe_bands`` (``_observed_bands``: ``bands_of`` on both sides, ``_band_rays``,
+    ``Occlusion.seen_at``, ``_labels_at``, then ``_bands_of_parts``) or with occlusion information ``outline_bands``
+    (``_outline_bands``: ``_occluded_edges``, the bands and the cracks' ``_labels_at``). The same maps, interior
+    points, rays, weights, seen depths, packed bands, contour share, cracks and cone to the bit."""
+    from symfruit.core import agreement
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import point_pixels, silhouette
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(500.0, 500.0, 80.0, 60.0, 160, 120)
+    centre = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.04, 0.04), rng.uniform(0.3, 0.5)])
+    d = rng.normal(size=(3000 if seed % 2 else 30000, 3))  # sparser than the pixels, or about one point a pixel
+    ball = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + centre
+    visible = ball[ball[:, 2] < centre[2]]  # the near half
+    region = silhouette(visible, camera)
+    occ = None
+    if seed % 4:
+        u0, v0 = int(rng.integers(0, region.u0 + 1)), int(rng.integers(0, region.v0 + 1))
+        w, h = int(rng.integers(1, camera.width - u0 + 1)), int(rng.integers(1, camera.height - v0 + 1))
+        hidden = rng.random((h, w)) < rng.uniform(0.0, 0.4)
+        depth = None if seed % 4 == 1 else rng.uniform(0.2, 0.6, (h, w)).astype(np.float32 if seed % 4 == 2 else float)
+        if depth is not None:
+            depth[rng.random((h, w)) < 0.1] = np.nan
+        occ = Occlusion(u0, v0, hidden, camera.width, camera.height, depth=depth)
+    bands = [(2.0, 5.0), (3.0,), (2.0, 2.5, 9.0), (1.0, 40.0)][seed // 4 % 4]  # with each kind of occlusion
+    n_band = [64, 5, 1, 400][int(rng.integers(0, 4))]
+    kwargs = {"n_band": n_band, "bands": bands, "occlusion": occ, "dense": visible if seed % 3 else None,
+              "inner_reach": [None, 3.0, 12.0][seed % 3]}  # fmt: skip
+    if seed % 3 and seed % 2:
+        kwargs["dense_pixels"] = point_pixels(visible, camera)
+    made = []
+
+    def counted(real):
+        def call(*args):
+            found = real(*args)
+            made.append((real.__name__, found is not None))
+            return found
+
+        return call
+
+    cone_points = []
+    real_cone, real_edges = agreement.outline_cone, agreement._observed_edges
+
+    def outline_cone(region, camera, points):  # the cracks beside contour edges, as each path picked them
+        cone_points.append(points)
+        return real_cone(region, camera, points)
+
+    def observed(mp, packed):
+        for name in ("_observed_bands", "_outline_bands"):  # the pieces one by one where not packed
+            mp.setattr(agreement, name, counted(getattr(agreement, name)) if packed else (lambda *args: None))
+        mp.setattr(agreement, "_observed_edges", counted(real_edges) if packed else (lambda *args: None))
+        mp.setattr(agreement, "outline_cone", outline_cone)
+        cone_points.clear()
+        obs = agreement.observe(visible[::7], region, camera, **kwargs)
+        parts = obs._parts
+        assert parts is not None and (parts.packed is not None) == packed
+        if packed:  # the parts it holds pack to the same bands
+            remade = vars(agreement._bands_of_parts(obs.rays, parts)).values()
+            assert all(_same_bits(a, b) for a, b in zip(_observation_parts(obs)[-15:-3], remade, strict=True))
+        return [*_observation_parts(obs), *cone_points]
+
+    with monkeypatch.context() as mp:
+        got, want = observed(mp, True), observed(mp, False)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = observed(mp, False)
+    # with occlusion information the outline's edges, labels and bands in one call, where the normals' labels allow
+    # the maps, depths inside the edge and edge normals in one call where an inside reach is given
+    edges = [("_observed_edges", True)] if kwargs["inner_reach"] is not None else []
+    assert made in (edges + [("_observed_bands", True)], edges + [("_outline_bands", True)],
+                    edges + [("_outline_bands", False), ("_observed_bands", True)])  # fmt: skip
+    assert made[len(edges)][0] == ("_observed_bands" if occ is None else "_outline_bands")
+    assert all(_same_bits(a, b) for a, b in zip(got, want, strict=True))
+    # the numpy twins' bands: the same (their edge labels come from the same outline pixels wherever occlusion is given)
+    if occ is not None:
+        assert all(_same_bits(a, b) for a, b in zip(got[:-3 - len(cone_points)], twin[:-3 - len(cone_points)],
+                                                    strict=True))  # fmt: skip
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_outline_bands_are_the_occluded_edges_bands_and_crack_labels(seed):
+    """``_outline_bands`` (``outline_bands``) against ``_occluded_edges``, ``_observed_bands`` and the cracks'
+    ``_labels_at`` called one by one, for edge normals' labels none, all true, all false (those it takes) and mixed
+    (it declines): the same outline pixels, labels, bands and crack labels (ties: the tree's pick) to the bit."""
+    from symfruit.core import agreement
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import Occlusion
+    from symfruit.core.raster import distance_maps, outline_cracks, silhouette
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(500.0, 500.0, 80.0, 60.0, 160, 120)
+    centre = np.array([rng.uniform(-0.05, 0.05), rng.uniform(-0.04, 0.04), rng.uniform(0.3, 0.5)])
+    d = rng.normal(size=(3000, 3))
+    ball = 0.03 * d / np.linalg.norm(d, axis=1, keepdims=True) + centre
+    region = silhouette(ball[ball[:, 2] < centre[2]], camera)
+    h, w = camera.height, camera.width
+    hidden = rng.random((h, w)) < rng.uniform(0.0, 0.3)
+    occ = Occlusion(0, 0, hidden, w, h, depth=rng.uniform(0.2, 0.6, (h, w)).astype(np.float32))
+    inner, outer = distance_maps(region.mask, 8.0, 5.5)
+    rays = rng.normal(size=(int(rng.integers(0, 30)), 3))
+    kind = seed % 4
+    normals = rng.uniform(0, w, (int(rng.integers(1, 40)), 2)) if kind else np.empty((0, 2))
+    labels = [None, np.ones(len(normals), bool), np.zeros(len(normals), bool), rng.random(len(normals)) < 0.5][kind]
+    labels = np.empty(0, bool) if labels is None else labels
+    if kind == 3:
+        labels[:2] = True, False  # mixed
+    count, radius, share, bands = (
+        int(rng.integers(5, 150)),
+        int(rng.integers(0, 6)),
+        float(rng.uniform(0, 1)),
+        (2.0, 5.0),
+    )
+    jit = kernels.compiled()
+    kept, want_kept = {}, {}
+    got = agreement._outline_bands(jit, rays, inner, outer, bands, 64, region, camera, normals, labels, occ, count,
+                                   radius, share, kept)  # fmt: skip
+    if kind == 3:
+        assert got is None
+        return
+    uv, is_contour = agreement._occluded_edges(region, occ, normals, labels, count, radius)
+    want = agreement._observed_bands(jit, rays, inner, outer, bands, 64, region, camera, uv, is_contour, occ, want_kept)
+    contour = np.count_nonzero(is_contour) / len(is_contour) if len(is_contour) else 1.0
+    cracks = outline_cracks(region)
+    want_cracks = agreement._labels_at(uv, is_contour, cracks, want_kept) if share <= contour < 1.0 else None
+    assert _same_bits(got[0], uv) and _same_bits(got[1], is_contour)
+    for a, b in zip(got[2][:4], want[:4], strict=True):
+        assert all(_same_bits(x, y) for x, y in zip(a, b, strict=True))
+    assert all(_same_bits(x, y) for x, y in zip(vars(got[2][4]).values(), vars(want[4]).values(), strict=True))
+    assert (got[3] is None) == (want_cracks is None)
+    if want_cracks is not None:
+        assert _same_bits(got[3], want_cracks)

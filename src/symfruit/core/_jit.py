@@ -8570,3 +8570,124 @@ def hidden_seen(
             if 0 <= col < w and 0 <= row < h:
                 seen[i] = np.float64(depth[row, col])
     return hid, seen
+
+
+# ---- bands51 (issue 19, stop 51): core.agreement.observe's bands, both sides, in one call ----
+
+
+@_njit
+def observe_bands(
+    rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int,
+    fx: float, fy: float, cx: float, cy: float, edge_uv: np.ndarray, labels: np.ndarray, occluded: bool,
+    hidden: np.ndarray, depth: np.ndarray, h_u0: int, h_v0: int, width: int, height: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._observed_bands`: the inside bands' (``inner``) and outside bands' (``outer``)
+    :func:`band_rays`, the outside pixels' :func:`hidden_seen` (``occluded``: ``hidden``, ``depth`` at ``h_u0,
+    h_v0``) and :func:`nearest_labels` of the edge points (``edge_uv`` (k, 2), ``labels`` (k,); none: every label
+    true), packed as :func:`symfruit.core.agreement._bands_of_parts` packs them. Returns ``(every (n + a + b, 3):
+    rays then both sides' band rays, uv (b, 2) the outside pixels, in_sizes, in_starts, out_sizes, out_starts,
+    unsure (b,) bool: a tie of labels the caller resolves (never on a hidden pixel), weight (b,): 1.0 where the label
+    is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite (b,)
+    bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
+    called one by one (the sums are of whole numbers, exact in any order)."""
+    _, rays_in, in_sizes = band_rays(inner, bands, n_band, u0, v0, fx, fy, cx, cy)
+    uv, rays_out, out_sizes = band_rays(outer, bands, n_band, u0, v0, fx, fy, cx, cy)
+    n, a, b = rays.shape[0], rays_in.shape[0], rays_out.shape[0]
+    every = np.empty((n + a + b, 3))
+    every[:n] = rays
+    every[n : n + a] = rays_in
+    every[n + a :] = rays_out
+    k = in_sizes.shape[0]
+    in_starts = np.zeros(k, np.int64)
+    out_starts = np.zeros(k, np.int64)
+    for i in range(1, k):
+        in_starts[i] = in_starts[i - 1] + in_sizes[i - 1]
+        out_starts[i] = out_starts[i - 1] + out_sizes[i - 1]
+    if labels.shape[0] and b:
+        found, unsure = nearest_labels(edge_uv, labels, uv)
+    else:
+        found, unsure = np.ones(b, np.bool_), np.zeros(b, np.bool_)
+    if occluded and b:
+        hid, seen = hidden_seen(uv[:, 0].copy(), uv[:, 1].copy(), hidden, depth, h_u0, h_v0, width, height)
+    else:
+        hid, seen = np.zeros(b, np.bool_), np.full(b, np.nan)
+    weight = np.empty(b)
+    finite = np.empty(b, np.bool_)
+    for i in range(b):
+        unsure[i] = unsure[i] and not hid[i]
+        weight[i] = 1.0 if found[i] and not hid[i] else 0.0
+        finite[i] = occluded and np.isfinite(seen[i])
+    wsum = np.zeros(k)
+    for j in range(k):
+        for i in range(out_starts[j], out_starts[j] + out_sizes[j]):
+            wsum[j] += 1.0 if finite[i] else weight[i]
+    return every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum
+
+
+@_njit
+def outline_bands(
+    mask: np.ndarray, count: int, radius: int, base: bool, cracks: np.ndarray, share: float, rays: np.ndarray,
+    inner: np.ndarray, outer: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int, fx: float, fy: float,
+    cx: float, cy: float, hidden: np.ndarray, depth: np.ndarray, h_u0: int, h_v0: int, width: int, height: int,
+) -> tuple[np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray], bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._outline_bands`: with occlusion information and every edge normal's label
+    ``base`` (none: true), ``observe``'s edge labels, bands and the outline cracks' labels in one call. The edge
+    points are :func:`outline_uv`'s (``count``) labelled ``base`` where no hidden pixel lies within ``radius``
+    (:func:`occluded_at`; ``_occluded_edges``); then :func:`observe_bands` of them; then, where ``share`` is at most
+    the share of true labels and that share is below 1, :func:`nearest_labels` of ``cracks`` (k, 2). Returns ``(uv,
+    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``): the
+    pieces' values."""
+    edge = outline_uv(mask, count, u0, v0)
+    m = edge.shape[0]
+    occ = occluded_at(edge[:, 0].copy(), edge[:, 1].copy(), hidden, h_u0, h_v0, width, height, radius)
+    labels = np.empty(m, np.bool_)
+    n_true = 0
+    for i in range(m):
+        labels[i] = base and not occ[i]
+        n_true += labels[i]
+    made = observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge, labels, True, hidden,
+                         depth, h_u0, h_v0, width, height)  # fmt: skip
+    took = m > 0 and share <= n_true / m < 1.0
+    if took:
+        found, unsure = nearest_labels(edge, labels, cracks)
+    else:
+        found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
+    return edge, labels, made, took, found, unsure
+
+
+@_njit
+def observe_edges(
+    mask: np.ndarray, reach: float, out_reach: float, points: np.ndarray, dense: np.ndarray, col: np.ndarray,
+    row: np.ndarray, given: int, fx: float, fy: float, cx: float, cy: float, u0: int, v0: int, count: int, half: int,
+) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray, np.ndarray, bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.agreement._observed_edges`: ``observe``'s first steps in one call, each the kernel it called
+    before: :func:`observe_maps` of ``mask`` (a window at ``u0, v0``); :func:`inside_px` of ``points`` in the inside
+    map; that of ``dense`` (``given`` 0: none, the points' own; 1: projected; 2: at its pixels ``col``, ``row``,
+    :func:`inside_px_of`); and where the edge cloud has about a point per pixel (at least half as many points as
+    ``mask`` pixels), :func:`contour_pixels` of it. ``(done, inner, outer, depth_px, edge_px, grid, uv, contour)``:
+    ``done`` False where ``observe_maps`` declines (nothing else made), ``grid`` False where the cloud is sparser
+    (``uv``, ``contour`` empty)."""
+    done, inner, outer = observe_maps(mask, reach, out_reach)
+    none2, none1 = np.empty((0, 2)), np.empty(0, np.bool_)
+    if not done:
+        return False, inner, outer, np.empty(0), np.empty(0), False, none2, none1
+    depth_px = inside_px(points, fx, fy, cx, cy, u0, v0, inner)
+    edge = points if given == 0 else dense
+    if given == 0:
+        edge_px = depth_px
+    elif given == 1:
+        edge_px = inside_px(dense, fx, fy, cx, cy, u0, v0, inner)
+    else:
+        edge_px = inside_px_of(col, row, u0, v0, inner)
+    filled = 0
+    for r in range(mask.shape[0]):
+        for c in range(mask.shape[1]):
+            filled += mask[r, c]
+    grid = edge.shape[0] >= 0.5 * filled
+    if not grid:
+        return True, inner, outer, depth_px, edge_px, False, none2, none1
+    h, w = mask.shape
+    uv, contour = contour_pixels(edge, edge_px, fx, fy, cx, cy, u0, v0, h, w, count, half)
+    return True, inner, outer, depth_px, edge_px, True, uv, contour

@@ -30,7 +30,7 @@ from scipy.spatial import cKDTree
 
 from .camera import Camera
 from .kernels import compiled
-from .occlusion import Occlusion
+from .occlusion import _NATIVE_FLOATS, _NO_DEPTH, Occlusion
 from .points import as_points, row_norms
 from .raster import (
     Silhouette,
@@ -281,25 +281,41 @@ def observe(
     reach = None if inner_reach is None else max(inner_reach, max(bands, default=0.0) + 0.5, edge, 8.0)
     # the outside bands read the map out to the widest band alone
     out_reach = max(bands, default=0.0) + 0.5
-    if reach is None:
-        box = mask_box(mask)  # once for both maps
-        inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
-    else:  # both maps in one call (issue 19, stop 50)
-        inner, outer = distance_maps(mask, reach, out_reach)
-
-    depth_px = _inside_px(points, region, camera, inner)
     edge_points = points if dense is None else as_points(dense, min_count=3, name="dense")
-    edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
-    if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about one point per pixel: neighbours from the image grid
-        edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
+    # the maps, the points' and edge points' depths inside the edge and the edge normals in one call (issue 19, stop 51)
+    edged_px = None if reach is None else _observed_edges(points, edge_points, dense, dense_pixels, region, camera,
+                                                          reach, out_reach, contour_points)  # fmt: skip
+    if edged_px is not None:
+        inner, outer, depth_px, edge_px, edges = edged_px
+        edge_uv, is_contour = edges if edges is not None else _contour_points(edge_points, edge_px, camera,
+                                                                              contour_points)  # fmt: skip
     else:
-        edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
-    if occlusion is not None:
+        if reach is None:
+            box = mask_box(mask)  # once for both maps
+            inner, outer = inner_distance(mask, box=box), outer_distance(mask, out_reach, box=box)
+        else:  # both maps in one call (issue 19, stop 50)
+            inner, outer = distance_maps(mask, reach, out_reach)
+        depth_px = _inside_px(points, region, camera, inner)
+        edge_px = depth_px if dense is None else _inside_px(edge_points, region, camera, inner, dense_pixels)
+        if len(edge_points) >= 0.5 * np.count_nonzero(mask):  # about a point per pixel: neighbours from the image grid
+            edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
+        else:
+            edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
+    kept: dict[str, Any] = {}  # _labels_at's tree of the edge points, where one is made
+    jit = compiled() if bands else None
+    made: _Banded | None = None
+    crack_labels = None
+    outlined = None
+    if occlusion is not None and jit is not None:  # the edges, bands and crack labels in one call (issue 19, stop 51)
+        outlined = _outline_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
+                                  occlusion, contour_points, occluded_px, contour_cone, kept)  # fmt: skip
+    if outlined is not None:
+        edge_uv, is_contour, made, crack_labels = outlined
+    elif occlusion is not None:
         edge_uv, is_contour = _occluded_edges(region, occlusion, edge_uv, is_contour, contour_points, occluded_px)
     # the share from the count (a whole number over the length: the mean of the booleans, to the bit)
     contour = np.count_nonzero(is_contour) / len(is_contour) if len(is_contour) else 1.0
     edged = len(is_contour) > 0  # the edge points' labels are looked up beside band pixels and cracks (_labels_at)
-    kept: dict[str, Any] = {}  # _labels_at's tree of these edge points, where one is made
 
     whole: list[tuple[np.ndarray, list[int], np.ndarray | None, np.ndarray | None]] = []  # for _BandParts
 
@@ -339,17 +355,29 @@ def observe(
         return ([rays[a:b] for a, b in cut], [weight[a:b] for a, b in cut],
                 [] if seen is None else [seen[a:b] for a, b in cut])  # fmt: skip
 
-    rays_in, _, _ = bands_of(inner, False)
-    rays_out, out_weights, out_depth = bands_of(outer, True)
+    if made is None and jit is not None:  # both sides' bands in one call (issue 19, stop 51)
+        made = _observed_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
+                               occlusion, kept)  # fmt: skip
+    if made is None:
+        rays_in, _, _ = bands_of(inner, False)
+        rays_out, out_weights, out_depth = bands_of(outer, True)
+    else:
+        rays_in, rays_out, out_weights, out_depth, packed = made
     fitted = None
     if occlusion is not None and edged and contour_cone <= contour < 1.0:
         cracks = outline_cracks(region)
-        fitted = outline_cone(region, camera, cracks[_labels_at(edge_uv, is_contour, cracks, kept)])
+        if crack_labels is None:
+            crack_labels = _labels_at(edge_uv, is_contour, cracks, kept)
+        fitted = outline_cone(region, camera, cracks[crack_labels])
     # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     tuples = (tuple(rays_in), tuple(rays_out), tuple(out_weights), None if occlusion is None else tuple(out_depth))
     parts = None
-    if len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
+    if made is not None:
+        n, n_in = len(rays), packed.n_in  # the parts the packed bands hold, as bands_of's parts (views)
+        parts = _BandParts(packed.rays[n : n + n_in], [len(r) for r in rays_in], packed.rays[n + n_in :],
+                           [len(r) for r in rays_out], packed.out_w, packed.seen, tuples, packed)  # fmt: skip
+    elif len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
         (in_rays, in_sizes, _, _), (out_rays, out_sizes, out_w, out_seen) = whole
         parts = _BandParts(in_rays, in_sizes, out_rays, out_sizes, out_w, out_seen, tuples)  # type: ignore[arg-type]
     return Observation(rays=rays, depth=sample[:, 2], rays_in=tuples[0], rays_out=tuples[1],
@@ -375,6 +403,8 @@ class _BandParts:
     out_w: np.ndarray
     seen: np.ndarray | None
     of: tuple[tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...], tuple[np.ndarray, ...] | None]
+    #: The :class:`_Bands` of these parts where :func:`_observed_bands` made them (read instead of made again).
+    packed: _Bands | None = None
 
 
 @dataclass(frozen=True)
@@ -407,7 +437,7 @@ def _bands(obs: Observation) -> _Bands:
     parts = obs._parts
     if parts is not None and all(a is b for a, b in zip(parts.of, (obs.rays_in, obs.rays_out, obs.out_weights,
                                                                    obs.out_depth), strict=True)):  # fmt: skip
-        found = obs._made["bands"] = _bands_of_parts(obs.rays, parts)
+        found = obs._made["bands"] = parts.packed if parts.packed is not None else _bands_of_parts(obs.rays, parts)
         return found
     in_sizes = np.array([len(r) for r in obs.rays_in], dtype=np.intp)
     out_sizes = np.array([len(r) for r in obs.rays_out], dtype=np.intp)
@@ -538,15 +568,145 @@ def _labels_at(
             unsure &= ~moot
         if not unsure.any():
             return found
+    tree = _tree(edge_uv, kept)
+    if found is None or unsure is None:
+        return labels[tree.query(uv)[1]]
+    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
+    return found
+
+
+def _tree(edge_uv: np.ndarray, kept: dict[str, Any] | None) -> cKDTree:
+    """:func:`_labels_at`'s ``cKDTree(edge_uv)``, the one in ``kept`` where there is one (made and kept there else)."""
     tree = None if kept is None else kept.get("tree")
     if tree is None:
         tree = cKDTree(edge_uv)
         if kept is not None:
             kept["tree"] = tree
-    if found is None or unsure is None:
-        return labels[tree.query(uv)[1]]
-    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
-    return found
+    return tree
+
+
+def _observed_edges(
+    points: np.ndarray, edge_points: np.ndarray, dense: np.ndarray | None,
+    dense_pixels: tuple[np.ndarray, np.ndarray] | None, region: Silhouette, camera: Camera, reach: float,
+    out_reach: float, count: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, tuple[np.ndarray, np.ndarray] | None] | None:  # fmt: skip
+    """:func:`observe`'s :func:`~symfruit.core.raster.distance_maps`, both :func:`_inside_px` and, for a cloud with
+    about a point per pixel, :func:`_contour_pixels` by one compiled call (:func:`symfruit.core._jit.observe_edges`;
+    issue 19, stop 51): ``(inner, outer, depth_px, edge_px, (edge_uv, is_contour) or None for a sparser cloud)``,
+    the same values (each step the kernel it called). None without numba, for a mask that is not a 2-D bool image,
+    or where ``observe_maps`` declines (the twins' other paths): the caller takes the steps one by one."""
+    mask = region.mask
+    if mask.ndim != 2 or mask.dtype != bool or (jit := compiled()) is None:
+        return None
+    given, col, row = (0, _NO_PIXELS, _NO_PIXELS) if dense is None else (1, _NO_PIXELS, _NO_PIXELS)
+    if dense_pixels is not None and dense is not None and len(dense_pixels[0]) == len(edge_points):
+        given, (col, row) = 2, dense_pixels
+    done, inner, outer, depth_px, edge_px, grid, uv, contour = jit.observe_edges(
+        mask, float(reach), float(out_reach), points, edge_points, col, row, given, camera.fx, camera.fy, camera.cx,
+        camera.cy, region.u0, region.v0, count, 3)  # fmt: skip
+    if not done:
+        return None
+    return inner, outer, depth_px, edge_px, (uv, contour) if grid else None
+
+
+#: :func:`_observed_edges`' pixels of a dense cloud not given (not read).
+_NO_PIXELS = np.zeros(0, dtype=np.int64)
+
+
+def _occlusion_maps(occlusion: Occlusion | None) -> tuple[np.ndarray, np.ndarray, int, int, int, int] | None:
+    """``(hidden, depth, u0, v0, width, height)`` of ``occlusion`` as the kernels read them (without one: empty maps),
+    or None where :meth:`~symfruit.core.occlusion.Occlusion.seen_at` would not take its kernel (a depth map of another
+    dtype or byte order)."""
+    if occlusion is None:
+        return _NO_HIDDEN, _NO_DEPTH, 0, 0, 0, 0
+    depth = _NO_DEPTH if occlusion.depth is None else occlusion.depth
+    if depth.ndim != 2 or depth.dtype not in _NATIVE_FLOATS:
+        return None
+    return occlusion.hidden, depth, occlusion.u0, occlusion.v0, occlusion.width, occlusion.height
+
+
+def _observed_bands(
+    jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
+    region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion | None,
+    kept: dict[str, Any],
+) -> _Banded | None:  # fmt: skip
+    """:func:`observe`'s bands by one compiled call (:func:`symfruit.core._jit.observe_bands`; issue 19, stop 51):
+    the same values as ``observe``'s ``bands_of`` on both sides (the same pieces, :func:`_band_rays`,
+    :meth:`~symfruit.core.occlusion.Occlusion.seen_at` and :func:`_labels_at`, in one call; a label tied between
+    nearest edge points of both labels is the tree's pick, as there). None where ``seen_at`` would not take its
+    kernel: the caller takes ``bands_of``."""
+    maps = _occlusion_maps(occlusion)
+    if maps is None:
+        return None
+    edge = np.ascontiguousarray(edge_uv, dtype=np.float64)
+    labels = np.ascontiguousarray(is_contour, dtype=bool)
+    made = jit.observe_bands(rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0),
+                             int(region.v0), float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy),
+                             edge, labels, occlusion is not None, *maps)  # fmt: skip
+    return _unpacked(made, len(rays), edge, labels, occlusion is not None, kept)
+
+
+def _outline_bands(
+    jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
+    region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion,
+    count: int, radius: int, share: float, kept: dict[str, Any],
+) -> tuple[np.ndarray, np.ndarray, _Banded, np.ndarray | None] | None:  # fmt: skip
+    """:func:`_occluded_edges`, :func:`_observed_bands` and the outline cracks' labels (:func:`observe`'s ``cracks``,
+    where ``share <= contour < 1``) by one compiled call (:func:`symfruit.core._jit.outline_bands`; issue 19, stop 51):
+    ``(uv, contour labels, bands, the cracks' labels or None)``, the same values (ties of labels the tree's pick, as
+    :func:`_labels_at` takes them). Where the edge normals' labels (``is_contour``) are all alike or none: their
+    outline labels need no look-up (``_labels_at`` gives that label everywhere); else, or where ``_observed_bands``
+    or ``_outline_uv`` would not take their kernels, None: the caller takes the pieces one by one."""
+    n_true = np.count_nonzero(is_contour)
+    maps = _occlusion_maps(occlusion)
+    mask = region.mask
+    if maps is None or count < 1 or 0 < n_true < len(is_contour) or mask.ndim != 2 or mask.dtype != bool:
+        return None
+    cracks = outline_cracks(region)
+    uv, labels, made, took, found, unsure = jit.outline_bands(
+        np.ascontiguousarray(mask), count, int(radius), bool(n_true > 0 or not len(is_contour)), cracks, float(share),
+        rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
+        float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), *maps)  # fmt: skip
+    banded = _unpacked(made, len(rays), uv, labels, True, kept)
+    if took and unsure.any():  # _labels_at's tree among ties, as for the bands
+        found[unsure] = labels[_tree(uv, kept).query(cracks[unsure])[1]]
+    return uv, labels, banded, found if took else None
+
+
+#: :func:`_observed_bands`' result: each band's rays (inside, outside), the outside bands' weights and seen depths
+#: (none without occlusion information), and the :class:`_Bands` that :func:`_bands_of_parts` would make of them.
+_Banded = tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.ndarray], "_Bands"]
+
+
+def _unpacked(made: tuple[np.ndarray, ...], n: int, edge: np.ndarray, labels: np.ndarray, occluded: bool,
+              kept: dict[str, Any]) -> _Banded:  # fmt: skip
+    """:func:`symfruit.core._jit.observe_bands`' result ``made`` (``n`` depth rays, the edge points ``edge`` with
+    ``labels``) as :func:`_observed_bands` returns it; a label tied between nearest edge points of both labels (its
+    ``unsure``) is ``_labels_at``'s tree's pick (kept in ``kept``), each band's weight sum moved by the change."""
+    every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = made
+    if unsure.any():
+        at = np.flatnonzero(unsure)
+        picked = labels[_tree(edge, kept).query(uv[at])[1]].tolist()
+        band = np.searchsorted(out_starts, at, side="right") - 1
+        for i, j, label in zip(at.tolist(), band.tolist(), picked, strict=True):
+            value = 1.0 if label else 0.0
+            wsum[j] += value - weight[i]  # whole numbers: the sum made again, to the bit
+            weight[i] = value
+    n_in = int(in_sizes.sum())
+    cut_in = [(n + s, n + s + k) for s, k in zip(in_starts.tolist(), in_sizes.tolist(), strict=True)]
+    cut_out = [(s, s + k) for s, k in zip(out_starts.tolist(), out_sizes.tolist(), strict=True)]
+    rays_in = [every[a:b] for a, b in cut_in]
+    rays_out = [every[n + n_in + a : n + n_in + b] for a, b in cut_out]
+    out_depth = [seen[a:b] for a, b in cut_out] if occluded else []
+    out_rays = out_sizes > 0
+    packed = _Bands(rays=every, n_in=n_in, in_starts=in_starts, in_sizes=in_sizes, in_ok=in_sizes > 0,
+                    out_starts=out_starts, out_w=weight, out_wsum=wsum, out_rays=out_rays, out_ok=out_rays & (wsum > 0),
+                    seen=seen if occluded else None, finite=finite if occluded else None)  # fmt: skip
+    return rays_in, rays_out, [weight[a:b] for a, b in cut_out], out_depth, packed
+
+
+#: :func:`_observed_bands`' hidden map without occlusion information (not read).
+_NO_HIDDEN = np.zeros((0, 0), dtype=bool)
 
 
 def _outline_uv(region: Silhouette, count: int) -> np.ndarray:
