@@ -2601,5 +2601,83 @@ def _bridged_skin(
         core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
         skin = skin & ((z > 0) | convex_hull_mask(core))
     if skin.sum() < GROUND_SOLIDITY * _hull_area(skin):
-        return _round_skin(sl, part, depth, color, geo, s, owner, k)
-    return grown_sl, skin
+        grown_sl, skin = _round_skin(sl, part, depth, color, geo, s, owner, k)
+    return _across_leaves(grown_sl, skin, bridged, color, geo, s, owner, k)
+
+
+def _across_leaves(
+    sl: Window,
+    skin: np.ndarray,
+    depth: _Depth,
+    color: np.ndarray,
+    geo: _Geometry,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+) -> tuple[Window, np.ndarray]:
+    """A round fruit's skin (``skin`` in window ``sl``, :func:`_bridged_skin`'s) joined with the pieces of its skin
+    that a leaf or twig lying across the fruit cuts off (stop 51). The skin grows only along depth without a step and
+    over no leaf green, so it stops at such an occluder; the skin beyond it (on a bicoloured apple turned with its
+    yellow-green side to the camera, all that is not red) is no piece the merge could join. A piece is taken when:
+
+    - it is skin as the growth would take it: pixels with depth within the largest fruit's radius
+      (``round_max_diameter``) plus ``depth_jump`` of the skin's median depth, on no depth step (half ``depth_jump``
+      between neighbours), not leaf green, of no other fruit, and no nearer to the skin than :data:`GAP_PX` (the band
+      of mixed and misregistered pixels along a silhouette is the rim, not skin beyond an occluder);
+    - it is at least a quarter of the least fruit at the skin's depth (``min_diameter``: the fragments
+      :func:`_segment_at` keeps) and 20 pixels;
+    - it is reached from the skin through what hides the fruit: leaf green, or depth nearer than the skin by more
+      than ``depth_jump`` (the depth camera, beside the colour camera, sees the leaf a few pixels off its colour);
+    - the skin with it reaches no further than the largest fruit is across, nor :data:`ROUND_EXTENT` times the skin
+      alone (:func:`_two_extents`' rule: the larger piece of a fruit seen past a leaf spans most of it);
+    - its median depth lies within half that extent (the fruit's radius) of the skin's: one fruit's visible surface
+      spans at most its radius in depth, a leaf in front or one behind lies further off;
+    - what it adds to the skin's convex hull is, by :data:`GROUND_SOLIDITY` at least, the piece or what hides the
+      fruit (a piece beside the fruit, across a gap to what is behind it, is not its skin).
+
+    Pieces are tried largest first. Returns the window and mask, unchanged when nothing is taken."""
+    z_sl = depth[sl]
+    zs = z_sl[skin & (z_sl > 0)]
+    if len(zs) < 20:
+        return sl, skin
+    zm = float(median(zs))
+    first = _extent(_hull_vertices(skin), skin)
+    most = min(s.round_max_diameter * geo.focal / zm, ROUND_EXTENT * first)  # the farthest the skin may reach
+    pad = int(most - first)
+    if pad < 2:
+        return sl, skin
+    big = _pad(sl, pad, depth.shape)
+    z = depth[big]
+    own = np.zeros(z.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    own[r : r + skin.shape[0], c : c + skin.shape[1]] = skin
+    free = (owner[big] == 0) | (owner[big] == k)
+    leaf = _leaf(color[big])
+    at = (z > 0) & (np.abs(z - zm) <= 0.5 * s.round_max_diameter + s.depth_jump)
+    cand = at & free & ~leaf & ~square_filter(own, GAP_PX) & ~_steps(z, 0.5 * s.depth_jump)
+    lab, n = _label(cand)
+    least = max(20.0, 0.25 * np.pi / 4.0 * (s.min_diameter * geo.focal / zm) ** 2)
+    sizes = np.bincount(lab.ravel(), minlength=n + 1)
+    sizes[0] = 0
+    if n == 0 or sizes.max() < least:
+        return sl, skin
+    hidden = free & (leaf | ((z > 0) & (z < zm - s.depth_jump)))
+    through, _ = _label(own | hidden | cand)
+    reached = np.zeros(int(through.max()) + 1, bool)
+    reached[through[own]] = True
+    reached[0] = False
+    ids = np.unique(lab[reached[through] & cand])
+    ids = ids[(ids > 0) & (sizes[ids] >= least)]
+    taken = False
+    for i in ids[np.argsort(-sizes[ids], kind="stable")].tolist():
+        piece = lab == i
+        union = own | piece
+        vertices = _hull_vertices(union)
+        extent = _extent(vertices, union)
+        if extent > most or abs(float(median(z[piece])) - zm) > 0.5 * extent * zm / geo.focal:
+            continue
+        added = _hull_mask(vertices, union) & ~_hull_mask(_hull_vertices(own), own)
+        if (added & (union | hidden)).sum() < GROUND_SOLIDITY * added.sum():
+            continue
+        own, taken = union, True
+    return (big, own) if taken else (sl, skin)
