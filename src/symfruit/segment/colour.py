@@ -2602,13 +2602,14 @@ def _bridged_skin(
         skin = skin & ((z > 0) | convex_hull_mask(core))
     if skin.sum() < GROUND_SOLIDITY * _hull_area(skin):
         grown_sl, skin = _round_skin(sl, part, depth, color, geo, s, owner, k)
-    return _across_leaves(grown_sl, skin, bridged, color, geo, s, owner, k)
+        return _across_leaves(grown_sl, skin, depth[grown_sl], color, geo, s, owner, k)
+    return _across_leaves(grown_sl, skin, bridged[grown_sl], color, geo, s, owner, k)
 
 
 def _across_leaves(
     sl: Window,
     skin: np.ndarray,
-    depth: _Depth,
+    z: np.ndarray,
     color: np.ndarray,
     geo: _Geometry,
     s: SegmentSettings,
@@ -2636,23 +2637,17 @@ def _across_leaves(
       fruit (a piece beside the fruit, across a gap to what is behind it, is not its skin).
 
     Pieces are tried largest first. Returns the window and mask, unchanged when nothing is taken."""
-    z_sl = depth[sl]
-    zs = z_sl[skin & (z_sl > 0)]
+    zs = z[skin & (z > 0)]
     if len(zs) < 20:
         return sl, skin
     zm = float(median(zs))
     first = _extent(_hull_vertices(skin), skin)
     most = min(s.round_max_diameter * geo.focal / zm, ROUND_EXTENT * first)  # the farthest the skin may reach
-    pad = int(most - first)
-    if pad < 2:
+    if most - first < 2:
         return sl, skin
-    big = _pad(sl, pad, depth.shape)
-    z = depth[big]
-    own = np.zeros(z.shape, bool)
-    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
-    own[r : r + skin.shape[0], c : c + skin.shape[1]] = skin
-    free = (owner[big] == 0) | (owner[big] == k)
-    leaf = _leaf(color[big])
+    own = skin
+    free = (owner[sl] == 0) | (owner[sl] == k)
+    leaf = _leaf(color[sl])
     at = (z > 0) & (np.abs(z - zm) <= 0.5 * s.round_max_diameter + s.depth_jump)
     cand = at & free & ~leaf & ~square_filter(own, GAP_PX) & ~_steps(z, 0.5 * s.depth_jump)
     lab, n = _label(cand)
@@ -2668,16 +2663,15 @@ def _across_leaves(
     reached[0] = False
     ids = np.unique(lab[reached[through] & cand])
     ids = ids[(ids > 0) & (sizes[ids] >= least)]
-    taken = False
     for i in ids[np.argsort(-sizes[ids], kind="stable")].tolist():
         piece = lab == i
         union = own | piece
         vertices = _hull_vertices(union)
         extent = _extent(vertices, union)
-        if extent > most or abs(float(median(z[piece])) - zm) > 0.5 * extent * zm / geo.focal:
+        if extent > most or abs(float(median(z[piece])) - zm) > np.sqrt(union.sum() / np.pi) * zm / geo.focal:
             continue
         added = _hull_mask(vertices, union) & ~_hull_mask(_hull_vertices(own), own)
         if (added & (union | hidden)).sum() < GROUND_SOLIDITY * added.sum():
             continue
-        own, taken = union, True
-    return (big, own) if taken else (sl, skin)
+        own = union
+    return sl, own
