@@ -1599,3 +1599,47 @@ def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypat
     assert found == [rows(i) for i in range(len(pieces))]
     assert all(set(plain(i)) <= set(found[i]) for i in range(len(pieces)))
     assert sum(map(len, found)) > sum(len(plain(i)) for i in range(len(pieces)))
+
+
+# --- stop 51, apples51
+
+
+def apple_behind_a_leaf(leaf_x: int, width: int = 10, patch: bool = False):
+    """A 78 mm apple at 1.5 m (52 px across) turned with its yellow-green side to the camera, its red blush the
+    crescent of its left 14 px, a leaf-green leaf ``width`` px wide and 6 cm in front of the apple crossing it
+    upright from column ``leaf_x``, depth registered 3 px off the colour (the depth camera sees the leaf beside where
+    the colour camera does); with ``patch``, a flat yellow-green patch (a sunlit leaf) at the apple's depth right of
+    it. Colour, depth, the apple's visible pixels and the patch."""
+    color, depth, disc = blushed_apple(blush_px=14)
+    yy, xx = np.mgrid[:1080, :1920]
+    leaf = (xx >= leaf_x) & (xx < leaf_x + width) & (np.abs(yy - 540) <= 40)
+    other = (xx >= leaf_x + width) & (xx < leaf_x + width + 30) & (np.abs(yy - 540) <= 14) & ~disc if patch else None
+    if patch:
+        color[other], depth[other] = (150, 160, 60), 1.5 - 0.01  # ground colour, flat, at the apple's depth
+    color[leaf] = (60, 120, 40)  # leaf green, hue 110 degrees
+    depth[np.roll(leaf, 3, axis=1)] = 1.5 - 0.026 - 0.06
+    return color, depth, disc & ~leaf, other
+
+
+def test_the_skin_beyond_a_leaf_across_a_bicoloured_apple_joins_it():
+    """The skin grows from the blush over the ground colour along depth and stops at a leaf lying across the apple
+    (leaf green, and in front by depth): the yellow-green side beyond the leaf was no piece the merge could join,
+    a fruit of its own or nothing. It is the skin beyond the leaf (:func:`_across_leaves`: reached through what lies
+    in front, at the apple's depth, within one fruit's extent): one fruit, the leaf not in it."""
+    color, depth, visible, _ = apple_behind_a_leaf(896)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    found = labels == 1
+    assert (found & visible).sum() > 0.8 * visible.sum()  # less the skin carrying the leaf's depth beside it
+    assert (found & ~visible).sum() < 0.05 * visible.sum()  # not the leaf
+
+
+def test_a_leaf_along_a_whole_apples_rim_does_not_join_what_lies_beyond_it():
+    """A leaf along the rim of a whole apple, a flat yellow-green patch at the apple's depth beyond it: the two
+    together reach further than the largest fruit is across (``round_max_diameter``), so the patch is no skin of
+    the apple."""
+    color, depth, visible, patch = apple_behind_a_leaf(924, patch=True)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    apple = np.bincount(labels[visible]).argmax()
+    assert apple > 0 and ((labels == apple) & visible).sum() > 0.9 * visible.sum()
+    assert ((labels == apple) & patch).sum() == 0

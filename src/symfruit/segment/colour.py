@@ -2657,7 +2657,7 @@ def _across_leaves(
     if n == 0 or sizes.max() < least:
         return sl, skin
     hidden = free & (leaf | ((z > 0) & (z < zm - s.depth_jump)))
-    through, _ = _label(own | hidden | cand)
+    through, _ = _label(own | hidden | (at & free))  # the occluder's edges are depth steps at the fruit's depth
     reached = np.zeros(int(through.max()) + 1, bool)
     reached[through[own]] = True
     reached[0] = False
@@ -2668,7 +2668,8 @@ def _across_leaves(
         union = own | piece
         vertices = _hull_vertices(union)
         extent = _extent(vertices, union)
-        if extent > most or abs(float(median(z[piece])) - zm) > np.sqrt(union.sum() / np.pi) * zm / geo.focal:
+        zp = float(median(z[piece]))
+        if extent > most or zp < zm - s.depth_jump or zp - zm > np.sqrt(union.sum() / np.pi) * zm / geo.focal:
             continue
         added = _hull_mask(vertices, union) & ~_hull_mask(_hull_vertices(own), own)
         if (added & (union | hidden)).sum() < GROUND_SOLIDITY * added.sum():
