@@ -6447,3 +6447,44 @@ def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         want = np.where(want_hid, occ.depth_at(u, v), np.nan)
     assert np.array_equal(seen, want, equal_nan=True)
+
+
+def test_the_pixels_beyond_a_leaf_are_the_twins(monkeypatch):
+    """:func:`symfruit.segment.colour._across_pixels` (stop 51): the same candidates, hidden pixels and passage with
+    the kernel and with the twin, on windows of a frame (strided colour and owner views) with depth missing, steps,
+    leaf green, ground colour and other fruit's pixels; and the known ones on a leaf across a skin."""
+    from symfruit.segment.colour import GAP_PX, SegmentSettings, _across_pixels
+
+    s = SegmentSettings(round_fruit=True, ground_colour=True, round_max_diameter=0.10)
+    rng = np.random.default_rng(51)
+    for _ in range(4):
+        h, w = rng.integers(20, 90, 2)
+        color = rng.integers(0, 256, (h + 10, w + 10, 3)).astype(np.uint8)
+        owner = rng.choice(np.array([0, 0, 0, 1, 2, -1], np.int16), (h + 10, w + 10))
+        z = 1.5 + rng.choice([0.0, 0.005, -0.03, 0.08, -0.2], (h, w)) + rng.normal(0.0, 0.002, (h, w))
+        z[rng.random((h, w)) < 0.1] = 0.0
+        skin = np.zeros((h, w), bool)
+        skin[h // 3 : h // 2, w // 4 : w // 2] = True
+        for k in (1, -1):
+            args = (z, skin, owner[3 : 3 + h, 5 : 5 + w], k, color[3 : 3 + h, 5 : 5 + w], 1.5, s)
+            fast, twin = _both(monkeypatch, _across_pixels, *args)
+            for a, b in zip(fast, twin, strict=True):
+                np.testing.assert_array_equal(a, b)
+    # a skin (columns 0-9), a leaf 6 cm in front (columns 12-17: green, its depth 3 px right), the fruit beyond it
+    z = np.full((30, 40), 1.5)
+    z[:, 15:21] = 1.44
+    color = np.full((30, 40, 3), (160, 175, 60), np.uint8)
+    color[:, 12:18] = (60, 120, 40)
+    skin = np.zeros((30, 40), bool)
+    skin[:, :10] = True
+    owner = np.zeros((30, 40), np.int16)
+    owner[:, 35:] = 2  # another fruit's red pixels
+    fast, twin = _both(monkeypatch, _across_pixels, z, skin, owner, 1, color, 1.5, s)
+    for a, b in zip(fast, twin, strict=True):
+        np.testing.assert_array_equal(a, b)
+    cand, hidden, passage = fast
+    assert not cand[:, : 10 + GAP_PX].any() and not cand[:, 12:18].any() and not cand[:, 35:].any()
+    assert cand[:, 18:20].all()  # the leaf's depth beside its colour: within the fruit's span (refused later by depth)
+    assert not cand[:, 20:22].any() and cand[:, 22:35].all()  # the depth step's two sides, then the fruit beyond
+    assert hidden[:, 12:21].all() and not hidden[:, 21:].any() and not hidden[:, :12].any()
+    assert passage[:, :35].all() and not passage[:, 35:].any()

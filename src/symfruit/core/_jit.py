@@ -8570,3 +8570,61 @@ def hidden_seen(
             if 0 <= col < w and 0 <= row < h:
                 seen[i] = np.float64(depth[row, col])
     return hid, seen
+
+
+# --- stop 51 (apples51): the skin beyond a leaf across a round fruit -------------------------------------------
+
+
+@_njit
+def across_pixels(
+    z: np.ndarray,
+    skin: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    color: np.ndarray,
+    zm: float,
+    span: float,
+    front: float,
+    step: float,
+    gap: int,
+    leaf_hue: int,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.segment.colour._across_pixels` in one pass: ``(cand, hidden, passage)``, each (h, w) bool, of
+    the window's depth ``z`` (h, w) float64, the skin ``skin`` (h, w) bool, ``owner`` ids and ``color`` (h, w, 3)
+    uint8 (any strides). Free: ``owner`` 0 or ``k``; at the fruit's depth: ``|z - zm| <= span``; leaf green as
+    :func:`green_pixels` with ``leaf_hue``; on a step: a 4-neighbour's depth more than ``step`` away. ``cand``: at
+    the fruit's depth, free, not leaf green, on no step and with no skin pixel within the ``2 gap + 1`` square;
+    ``hidden``: free and leaf green or with depth nearer than ``zm - front``; ``passage``: the skin, ``hidden`` or
+    free at the fruit's depth. The twin's tests on the same numbers: the same pixels."""
+    h, w = z.shape
+    near = np.empty((h, w), np.bool_)
+    _square_any(skin, gap, True, near)
+    cand = np.zeros((h, w), np.bool_)
+    hidden = np.zeros((h, w), np.bool_)
+    passage = np.zeros((h, w), np.bool_)
+    nearer = zm - front
+    for r in range(h):
+        for c in range(w):
+            zc = z[r, c]
+            free = owner[r, c] == 0 or owner[r, c] == k
+            red, green, blue = np.int64(color[r, c, 0]), np.int64(color[r, c, 1]), np.int64(color[r, c, 2])
+            leaf = False
+            if green > red and green >= blue:
+                over = green - min(red, blue)
+                leaf = 3 * over >= green and 60 * (green - red) >= (leaf_hue - 60) * over
+            at = abs(zc - zm) <= span
+            hid = free and (leaf or (zc > 0 and zc < nearer))
+            hidden[r, c] = hid
+            passage[r, c] = skin[r, c] or hid or (at and free)
+            if not at or near[r, c] or not free or leaf:
+                continue
+            if r > 0 and abs(z[r - 1, c] - zc) > step:
+                continue
+            if r + 1 < h and abs(z[r + 1, c] - zc) > step:
+                continue
+            if c > 0 and abs(z[r, c - 1] - zc) > step:
+                continue
+            if c + 1 < w and abs(z[r, c + 1] - zc) > step:
+                continue
+            cand[r, c] = True
+    return cand, hidden, passage

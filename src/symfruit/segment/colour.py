@@ -2616,53 +2616,63 @@ def _across_leaves(
     owner: np.ndarray,
     k: int,
 ) -> tuple[Window, np.ndarray]:
-    """A round fruit's skin (``skin`` in window ``sl``, :func:`_bridged_skin`'s) joined with the pieces of its skin
-    that a leaf or twig lying across the fruit cuts off (stop 51). The skin grows only along depth without a step and
-    over no leaf green, so it stops at such an occluder; the skin beyond it (on a bicoloured apple turned with its
-    yellow-green side to the camera, all that is not red) is no piece the merge could join. A piece is taken when:
+    """A round fruit's skin (``skin`` in window ``sl``, ``z`` its depth there: :func:`_bridged_skin`'s) joined with
+    the pieces of its skin that a leaf or twig lying across the fruit cuts off (stop 51). The skin grows only along
+    depth without a step and over no leaf green, so it stops at such an occluder, and the skin beyond it (on a
+    bicoloured apple turned with its yellow-green side to the camera, all that is not red) is no piece the merge
+    could join. A piece (:func:`_across_pixels`) is taken when:
 
-    - it is skin as the growth would take it: pixels with depth within the largest fruit's radius
-      (``round_max_diameter``) plus ``depth_jump`` of the skin's median depth, on no depth step (half ``depth_jump``
-      between neighbours), not leaf green, of no other fruit, and no nearer to the skin than :data:`GAP_PX` (the band
-      of mixed and misregistered pixels along a silhouette is the rim, not skin beyond an occluder);
+    - it is skin as the growth would take it: depth within the largest fruit's radius (``round_max_diameter``) plus
+      ``depth_jump`` of the skin's median, on no depth step, not leaf green, of no other fruit, and no nearer to the
+      skin than :data:`GAP_PX` (the band of mixed and misregistered pixels along a silhouette is its rim, not skin
+      beyond an occluder);
     - it is at least a quarter of the least fruit at the skin's depth (``min_diameter``: the fragments
       :func:`_segment_at` keeps) and 20 pixels;
-    - it is reached from the skin through what hides the fruit: leaf green, or depth nearer than the skin by more
-      than ``depth_jump`` (the depth camera, beside the colour camera, sees the leaf a few pixels off its colour);
+    - it is reached from the skin through what hides the fruit (leaf green, or depth nearer than the skin's by more
+      than ``depth_jump``: the depth camera, beside the colour camera, sees the leaf a few pixels off its colour) and
+      what lies at the fruit's depth (the occluder's edges are depth steps there);
     - the skin with it reaches no further than the largest fruit is across, nor :data:`ROUND_EXTENT` times the skin
       alone (:func:`_two_extents`' rule: the larger piece of a fruit seen past a leaf spans most of it);
-    - its median depth lies within half that extent (the fruit's radius) of the skin's: one fruit's visible surface
-      spans at most its radius in depth, a leaf in front or one behind lies further off;
+    - its median depth lies no nearer than the skin's by ``depth_jump``, nor further than the radius of a disc of the
+      two's area: one fruit's visible surface spans at most its radius in depth and recedes from the skin the growth
+      found first towards its outline; a leaf hanging against the fruit lies nearer;
     - what it adds to the skin's convex hull is, by :data:`GROUND_SOLIDITY` at least, the piece or what hides the
       fruit (a piece beside the fruit, across a gap to what is behind it, is not its skin).
 
-    Pieces are tried largest first. Returns the window and mask, unchanged when nothing is taken."""
+    Pieces are tried largest first, in the skin's box widened by what the farthest reach leaves (a piece lies
+    within it of every skin pixel). Returns the window and mask, the skin itself when nothing is taken."""
     zs = z[skin & (z > 0)]
     if len(zs) < 20:
         return sl, skin
     zm = float(median(zs))
+    across = s.round_max_diameter * geo.focal / zm
+    r0, r1, c0, c1 = mask_box(skin)  # type: ignore[misc]
+    if min(across, ROUND_EXTENT * (np.hypot(r1 - r0 - 1, c1 - c0 - 1) + 1.0)) - max(r1 - r0, c1 - c0) < 2:
+        return sl, skin  # the skin's extent lies between its box's longer side and its diagonal: nothing may join
     first = _extent(_hull_vertices(skin), skin)
-    most = min(s.round_max_diameter * geo.focal / zm, ROUND_EXTENT * first)  # the farthest the skin may reach
+    most = min(across, ROUND_EXTENT * first)  # the farthest the skin may reach
     if most - first < 2:
         return sl, skin
-    own = skin
-    free = (owner[sl] == 0) | (owner[sl] == k)
-    leaf = _leaf(color[sl])
-    at = (z > 0) & (np.abs(z - zm) <= 0.5 * s.round_max_diameter + s.depth_jump)
-    cand = at & free & ~leaf & ~square_filter(own, GAP_PX) & ~_steps(z, 0.5 * s.depth_jump)
-    lab, n = _label(cand)
+    # a piece lies within ``most`` of every pixel of the skin: within the skin's box widened by what its sides leave
+    reach = int(most)
+    box = (slice(max(r1 - 1 - reach, 0), r0 + reach + 1), slice(max(c1 - 1 - reach, 0), c0 + reach + 1))
+    z, own = z[box], skin[box]
     least = max(20.0, 0.25 * np.pi / 4.0 * (s.min_diameter * geo.focal / zm) ** 2)
+    cand, hidden, passage = _across_pixels(z, own, owner[sl][box], k, color[sl][box], zm, s)
+    if np.count_nonzero(cand) < least:
+        return sl, skin
+    lab, n = _label(cand)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     sizes[0] = 0
     if n == 0 or sizes.max() < least:
         return sl, skin
-    hidden = free & (leaf | ((z > 0) & (z < zm - s.depth_jump)))
-    through, _ = _label(own | hidden | (at & free))  # the occluder's edges are depth steps at the fruit's depth
+    through, _ = _label(passage)
     reached = np.zeros(int(through.max()) + 1, bool)
     reached[through[own]] = True
     reached[0] = False
-    ids = np.unique(lab[reached[through] & cand])
-    ids = ids[(ids > 0) & (sizes[ids] >= least)]
+    hit = np.zeros(n + 1, bool)
+    hit[lab[reached[through]]] = True
+    ids = np.flatnonzero(hit & (sizes >= least))  # sizes[0] is 0
     for i in ids[np.argsort(-sizes[ids], kind="stable")].tolist():
         piece = lab == i
         union = own | piece
@@ -2675,4 +2685,32 @@ def _across_leaves(
         if (added & (union | hidden)).sum() < GROUND_SOLIDITY * added.sum():
             continue
         own = union
-    return sl, own
+    if own.sum() == np.count_nonzero(skin[box]):
+        return sl, skin
+    grown = skin.copy()
+    grown[box] = own
+    return sl, grown
+
+
+def _across_pixels(
+    z: np.ndarray, skin: np.ndarray, owner: np.ndarray, k: int, color: np.ndarray, zm: float, s: SegmentSettings
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_across_leaves`' pixels in the skin's window (``z`` its depth, ``skin``, ``owner``, ``color``):
+    ``(cand, hidden, passage)``. ``cand``: what may be the fruit's skin beyond an occluder (depth within the largest
+    fruit's radius plus ``depth_jump`` of ``zm``, of no other fruit than ``k``, not leaf green, on no depth step of
+    half ``depth_jump``, not within :data:`GAP_PX` of the skin); ``hidden``: what hides the fruit (of no other fruit,
+    leaf green or nearer than ``zm`` by more than ``depth_jump``); ``passage``: the skin, ``hidden`` and what lies at
+    the fruit's depth (an occluder's edges are depth steps there). Where numba is, in one pass
+    (:func:`symfruit.core._jit.across_pixels`: the same pixels)."""
+    span, step = 0.5 * s.round_max_diameter + s.depth_jump, 0.5 * s.depth_jump
+    if (jit := compiled()) is not None and z.dtype == np.float64 and skin.dtype == bool and color.dtype == np.uint8:
+        out: tuple[np.ndarray, np.ndarray, np.ndarray] = jit.across_pixels(
+            z, skin, owner, int(k), color, float(zm), float(span), float(s.depth_jump), float(step), GAP_PX, LEAF_HUE
+        )
+        return out
+    free = (owner == 0) | (owner == k)
+    leaf = _leaf(color)
+    at = np.abs(z - zm) <= span
+    cand = at & free & ~leaf & ~_steps(z, step) & ~square_filter(skin, GAP_PX)
+    hidden = free & (leaf | ((z > 0) & (z < zm - s.depth_jump)))
+    return cand, hidden, skin | hidden | (at & free)
