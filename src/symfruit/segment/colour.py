@@ -2586,7 +2586,8 @@ def _bridged_skin(
     grown that have no depth of their own, only those inside the convex hull of the part and the grown pixels with
     depth are kept (a gap inside the fruit, not the band outside its rim, where the background is). Where the
     skin is then not one convex outline (filling under :data:`GROUND_SOLIDITY` of its hull: it ran on through a
-    gap into a branch or a neighbour at its depth) the skin grown without bridging is taken, as before."""
+    gap into a branch or a neighbour at its depth) the skin grown without bridging is taken, as before. Either skin is
+    then joined with what of it lies beyond a leaf across the fruit (:func:`_across_leaves`; stop 51)."""
     grown_sl, skin = _round_skin(sl, part, bridged, color, geo, s, owner, k)  # type: ignore[arg-type]
     z = depth[grown_sl]
     r0, c0 = sl[0].start - grown_sl[0].start, sl[1].start - grown_sl[1].start
