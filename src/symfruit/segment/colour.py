@@ -2643,11 +2643,12 @@ def _across_leaves(
     Pieces are tried largest first, in the skin's box widened by what the farthest reach leaves (a piece lies
     within it of every skin pixel). Returns the window and mask, the skin itself when nothing is taken."""
     zs = z[skin & (z > 0)]
-    if len(zs) < 20:
+    bounds = mask_box(skin)
+    if len(zs) < 20 or bounds is None:
         return sl, skin
     zm = float(median(zs))
     across = s.round_max_diameter * geo.focal / zm
-    r0, r1, c0, c1 = mask_box(skin)  # type: ignore[misc]
+    r0, r1, c0, c1 = bounds
     if min(across, ROUND_EXTENT * (np.hypot(r1 - r0 - 1, c1 - c0 - 1) + 1.0)) - max(r1 - r0, c1 - c0) < 2:
         return sl, skin  # the skin's extent lies between its box's longer side and its diagonal: nothing may join
     first = _extent(_hull_vertices(skin), skin)
