@@ -1606,10 +1606,10 @@ def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypat
 
 def apple_behind_a_leaf(leaf_x: int, width: int = 10, patch: bool = False):
     """A 78 mm apple at 1.5 m (52 px across) turned with its yellow-green side to the camera, its red blush the
-    crescent of its left 14 px, a leaf-green leaf ``width`` px wide at 1.414 m (4.5 cm in front of the apple's nearest
-    point) crossing it upright from column ``leaf_x``, depth registered 3 px off the colour (the depth camera sees the leaf beside where
-    the colour camera does); with ``patch``, a flat yellow-green patch (a sunlit leaf) at the apple's depth right of
-    it. Colour, depth, the apple's visible pixels and the patch."""
+    crescent of its left 14 px; a leaf-green leaf ``width`` px wide at 1.414 m (4.5 cm in front of the apple's
+    nearest point) crossing it upright from column ``leaf_x``, its depth registered 3 px off its colour (the depth
+    camera sees the leaf beside where the colour camera does); with ``patch``, a flat yellow-green patch (a sunlit
+    leaf) at the apple's depth right of it. Colour, depth, the apple's visible pixels and the patch."""
     color, depth, disc = blushed_apple(blush_px=14)
     yy, xx = np.mgrid[:1080, :1920]
     leaf = (xx >= leaf_x) & (xx < leaf_x + width) & (np.abs(yy - 540) <= 40)
