@@ -774,6 +774,18 @@ def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
     return labels, int(n)
 
 
+def _labelled(mask: np.ndarray) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
+    """:func:`_label` of a 2-d bool ``mask`` with eight neighbours, and the labelled pixels' flat indices (ascending)
+    and labels. Where numba is, in one call (:func:`symfruit.core._jit.label_flat`: the same arrays; stop 51)."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        lab, n, at, la = jit.label_flat(mask, True)
+        return lab, int(n), at, la
+    lab, n = _label(mask, eight=True)
+    flat = lab.ravel()
+    at = np.flatnonzero(flat)
+    return lab, n, at, flat.take(at)
+
+
 def _red_regions(
     cw: np.ndarray, s: SegmentSettings
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
@@ -2080,12 +2092,9 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     if not (z_grid > 0).any():
         return []
     cand = _ground_steps(c[::g, ::g], z_grid, 3, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
-    lab, n = _label(cand, eight=True)
+    lab, n, at, la = _labelled(cand)
     if n == 0:
         return []
-    flat = lab.ravel()
-    at = np.flatnonzero(flat)
-    la = flat.take(at)
     count, disc = _piece_discs(la, z_grid.ravel().take(at), n, focal)
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
@@ -2111,12 +2120,9 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         if not (zw > 0).any():
             continue
         cand = _ground_steps(c[win], zw, GAP_PX, s.depth_jump) & (owner[win] == 0)
-        lab, n = _label(cand, eight=True)
+        lab, n, at, la = _labelled(cand)
         if n == 0:
             continue
-        flat = lab.ravel()
-        at = np.flatnonzero(flat)
-        la = flat.take(at)
         count, disc = _piece_discs(la, zw.ravel().take(at), n, focal)
         keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
         keep[0] = False
@@ -2310,15 +2316,10 @@ def _round_body(
     twice as closely as a plane (:data:`GROUND_PLANE`, median distances, each fit once more without the points far
     off it: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits neither
     well). Returns the sphere (centre, radius), or None."""
-    seen = part & (depth > 0)
-    if seen.sum() < 20:
+    surface = _largest_surface(part, depth, s.depth_jump)
+    if surface is None:
         return None
-    # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
-    # (4-connected: the steps are looked for between 4-neighbours)
-    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
-    if n == 0:
-        return None
-    part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
+    part = surface
     fit = _sphere(part, depth, geo, origin)
     if fit is None:
         return None
@@ -2338,6 +2339,24 @@ def _round_body(
     plane = float(median(off))
     sphere = float(median(np.abs(row_norms(p - centre) - radius)))
     return (centre, radius) if sphere <= GROUND_PLANE * plane else None
+
+
+def _largest_surface(part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray | None:
+    """:func:`_round_body`'s surface: the largest piece of the pixels of ``part`` with depth and on no depth step
+    (larger than ``jump`` between 4-neighbours with depth): not two leaves' pieces joined where depth is missing
+    (4-connected: the steps are looked for between 4-neighbours); None with fewer than 20 pixels with depth. Where
+    numba is, in one call (:func:`symfruit.core._jit.largest_surface`: the same pixels; stop 51)."""
+    if (jit := compiled()) is not None and part.ndim == depth.ndim == 2 and part.dtype == bool and (
+            depth.dtype == np.float64):  # fmt: skip
+        out: np.ndarray = jit.largest_surface(part, depth, float(jump))
+        return out if out.shape == part.shape else None
+    seen = part & (depth > 0)
+    if seen.sum() < 20:
+        return None
+    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), jump))
+    if n == 0:
+        return None
+    return lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
 
 
 #: A ground-colour piece is one fruit's outline when it fills at least this share of its convex hull.
@@ -2532,7 +2551,8 @@ class _BridgedDepth:
         if jit is not None and given.ndim == 2 and given.dtype in _FLOATS:  # only the pixels without depth
             # search, over the disc about them, in the depth as handed over (stop 47, yellowfast47)
             z = np.empty((max(r1 - r0, 0), max(c1 - c0, 0)), np.float64)
-            jit.bridge_gaps(given, r0, r1, c0, c1, BRIDGE_PX, z)
+            for a0, a1, b0, b1 in self._new_bands(z, r0, r1, c0, c1):
+                jit.bridge_gaps(given, a0, a1, b0, b1, BRIDGE_PX, z[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0])
             return z
         a, b = window
         big = _pad(window, int(BRIDGE_PX) + 1, self.shape)  # the gaps' nearest depths may lie outside
@@ -2540,9 +2560,32 @@ class _BridgedDepth:
         inner = (slice(r0, r0 + a.stop - a.start), slice(c0, c0 + b.stop - b.start))
         return _bridged(self.depth[big], inner)
 
+    def _new_bands(self, z: np.ndarray, r0: int, r1: int, c0: int, c1: int) -> list[tuple[int, int, int, int]]:
+        """The parts of window ``r0:r1, c0:c1`` (``z``, its bridged depth to be) left to fill once its overlap with
+        the one of the last windows filled that it overlaps most is copied from that one into ``z`` (a pixel's
+        bridged depth being the same in any window): up to four bands ``(r0, r1, c0, c1)`` about the overlap, or the
+        whole window when that overlap is under :data:`REUSED_SHARE` of it. The skin's windows of a fruit overlap
+        one another (its part padded, then its flood's reach, then a wider reach): a third of the pixels a tree
+        frame filled were filled before (stop 51, seg51)."""
+        best, most = None, REUSED_SHARE * (r1 - r0) * (c1 - c0)
+        for q0, q1, p0, p1, held in self.recent:
+            i0, i1, j0, j1 = max(r0, q0), min(r1, q1), max(c0, p0), min(c1, p1)
+            if i1 > i0 and j1 > j0 and (i1 - i0) * (j1 - j0) > most:
+                best, most = (i0, i1, j0, j1, q0, p0, held), (i1 - i0) * (j1 - j0)
+        if best is None:
+            return [(r0, r1, c0, c1)]
+        i0, i1, j0, j1, q0, p0, held = best
+        z[i0 - r0 : i1 - r0, j0 - c0 : j1 - c0] = held[i0 - q0 : i1 - q0, j0 - p0 : j1 - p0]
+        bands = ((r0, i0, c0, c1), (i1, r1, c0, c1), (i0, i1, c0, j0), (i0, i1, j1, c1))
+        return [(a0, a1, b0, b1) for a0, a1, b0, b1 in bands if a1 > a0 and b1 > b0]
+
 
 #: How many of the last windows :class:`_BridgedDepth` filled a window read is looked for in.
 RECENT_FILLS = 4
+
+#: The least share of a window that the overlap with a window filled before must cover for
+#: :meth:`_BridgedDepth._new_bands` to copy it and fill only the rest.
+REUSED_SHARE = 0.25
 
 
 def _bridged(zb: np.ndarray, inner: Window) -> np.ndarray:
