@@ -6486,3 +6486,21 @@ def test_the_labelled_pixels_are_the_twins(seed):
     assert fast[1] == twin[1]
     for a, b in ((fast[0], twin[0]), (fast[2], twin[2]), (fast[3], twin[3])):
         assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_extent_is_the_twins(seed):
+    """``_extent`` (:func:`_jit.widest_pair`) with the kernels and with the twins on a random mask's hull vertices and
+    on random float vertices: the same value."""
+    from symfruit.segment.colour import _extent, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random(tuple(int(x) for x in rng.integers(1, 40, 2))) < rng.uniform(0.0, 0.3)
+    with pytest.MonkeyPatch.context() as mp:
+        vertices = _hull_vertices(mask)
+        fast, twin = _both(mp, _extent, vertices, mask)
+        assert fast == twin
+        points = rng.uniform(-50.0, 50.0, (int(rng.integers(1, 30)), 2))
+        fast, twin = _both(mp, _extent, points, mask)
+        assert fast == twin

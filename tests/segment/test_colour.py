@@ -1599,38 +1599,3 @@ def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypat
     assert found == [rows(i) for i in range(len(pieces))]
     assert all(set(plain(i)) <= set(found[i]) for i in range(len(pieces)))
     assert sum(map(len, found)) > sum(len(plain(i)) for i in range(len(pieces)))
-
-
-# --- stop 51, seg51
-
-
-@pytest.mark.parametrize("seed", range(12))
-def test_bridged_depth_filled_beside_a_window_filled_before_is_the_same(seed):
-    """A window overlapping one :class:`_BridgedDepth` filled before by a quarter or more is copied from it where they
-    overlap and filled only in the bands about that (fewer pixels filled): every window read in a random sequence holds
-    the values it has when filled alone in a fresh reader."""
-    from symfruit.segment.colour import _BridgedDepth, _Depth
-
-    rng = np.random.default_rng(seed)
-    depth = rng.choice(np.array([0.0, 1.0, 1.5, 2.0]), (60, 70), p=[0.6, 0.2, 0.1, 0.1])
-    bridged = _BridgedDepth(_Depth.of(depth))
-    for _ in range(10):
-        r0, c0 = int(rng.integers(0, 50)), int(rng.integers(0, 60))
-        window = (slice(r0, int(rng.integers(r0 + 1, 61))), slice(c0, int(rng.integers(c0 + 1, 71))))
-        np.testing.assert_array_equal(bridged[window], _BridgedDepth(_Depth.of(depth))[window])
-
-
-def test_bridged_depth_fills_only_the_bands_about_a_window_filled_before(monkeypatch):
-    """With the kernels, a window reaching past one filled before has only its bands about the overlap filled."""
-    import symfruit.core._jit as jit
-    from symfruit.segment.colour import _BridgedDepth, _Depth
-
-    monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
-    depth = np.random.default_rng(1).choice(np.array([0.0, 1.0, 2.0]), (40, 50), p=[0.5, 0.3, 0.2])
-    filled = []
-    fill = jit.bridge_gaps
-    monkeypatch.setattr(jit, "bridge_gaps", lambda z, *a: filled.append(a[:4]) or fill(z, *a))
-    bridged = _BridgedDepth(_Depth.of(depth))
-    bridged[(slice(10, 30), slice(10, 30))]
-    bridged[(slice(5, 30), slice(10, 40))]  # the first, a band above it and one to its right
-    assert filled == [(10, 30, 10, 30), (5, 10, 10, 40), (10, 30, 30, 40)]

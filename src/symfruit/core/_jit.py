@@ -8648,3 +8648,19 @@ def label_flat(mask: np.ndarray, eight: bool) -> tuple[np.ndarray, int, np.ndarr
     for i in range(k):
         labels[i] = flat[pixels[i]]
     return out, n, pixels, labels
+
+
+@_njit
+def widest_pair(vertices: np.ndarray) -> float:
+    """:func:`symfruit.segment.colour._extent`'s largest squared distance between two of the ``vertices`` (m, 2)
+    float64 (m >= 1): each pair's differences squared and summed as the twin's ``(d * d).sum(axis=2)`` sums its two
+    terms, the largest of them; the same value without the (m, m, 2) arrays (a round fruit's merge asks for some 36
+    extents a tree frame)."""
+    m = vertices.shape[0]
+    best = -np.inf
+    for i in range(m):
+        x, y = vertices[i, 0], vertices[i, 1]
+        for j in range(m):
+            dx, dy = x - vertices[j, 0], y - vertices[j, 1]
+            best = max(best, dx * dx + dy * dy)
+    return best

@@ -1191,6 +1191,8 @@ def _extent(vertices: np.ndarray | None, mask: np.ndarray) -> float:
     """The largest distance across a mask (between its hull's vertices, plus a pixel), in pixels."""
     if vertices is None:
         return float(np.sqrt(mask.sum()))
+    if (jit := compiled()) is not None and vertices.ndim == 2 and vertices.dtype == np.float64:
+        return float(np.sqrt(jit.widest_pair(vertices))) + 1.0  # the same largest square (stop 51)
     d = vertices[:, None, :] - vertices[None, :, :]
     return float(np.sqrt((d * d).sum(axis=2).max())) + 1.0
 
@@ -2551,8 +2553,7 @@ class _BridgedDepth:
         if jit is not None and given.ndim == 2 and given.dtype in _FLOATS:  # only the pixels without depth
             # search, over the disc about them, in the depth as handed over (stop 47, yellowfast47)
             z = np.empty((max(r1 - r0, 0), max(c1 - c0, 0)), np.float64)
-            for a0, a1, b0, b1 in self._new_bands(z, r0, r1, c0, c1):
-                jit.bridge_gaps(given, a0, a1, b0, b1, BRIDGE_PX, z[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0])
+            jit.bridge_gaps(given, r0, r1, c0, c1, BRIDGE_PX, z)
             return z
         a, b = window
         big = _pad(window, int(BRIDGE_PX) + 1, self.shape)  # the gaps' nearest depths may lie outside
@@ -2560,32 +2561,9 @@ class _BridgedDepth:
         inner = (slice(r0, r0 + a.stop - a.start), slice(c0, c0 + b.stop - b.start))
         return _bridged(self.depth[big], inner)
 
-    def _new_bands(self, z: np.ndarray, r0: int, r1: int, c0: int, c1: int) -> list[tuple[int, int, int, int]]:
-        """The parts of window ``r0:r1, c0:c1`` (``z``, its bridged depth to be) left to fill once its overlap with
-        the one of the last windows filled that it overlaps most is copied from that one into ``z`` (a pixel's
-        bridged depth being the same in any window): up to four bands ``(r0, r1, c0, c1)`` about the overlap, or the
-        whole window when that overlap is under :data:`REUSED_SHARE` of it. The skin's windows of a fruit overlap
-        one another (its part padded, then its flood's reach, then a wider reach): a third of the pixels a tree
-        frame filled were filled before (stop 51, seg51)."""
-        best, most = None, REUSED_SHARE * (r1 - r0) * (c1 - c0)
-        for q0, q1, p0, p1, held in self.recent:
-            i0, i1, j0, j1 = max(r0, q0), min(r1, q1), max(c0, p0), min(c1, p1)
-            if i1 > i0 and j1 > j0 and (i1 - i0) * (j1 - j0) > most:
-                best, most = (i0, i1, j0, j1, q0, p0, held), (i1 - i0) * (j1 - j0)
-        if best is None:
-            return [(r0, r1, c0, c1)]
-        i0, i1, j0, j1, q0, p0, held = best
-        z[i0 - r0 : i1 - r0, j0 - c0 : j1 - c0] = held[i0 - q0 : i1 - q0, j0 - p0 : j1 - p0]
-        bands = ((r0, i0, c0, c1), (i1, r1, c0, c1), (i0, i1, c0, j0), (i0, i1, j1, c1))
-        return [(a0, a1, b0, b1) for a0, a1, b0, b1 in bands if a1 > a0 and b1 > b0]
-
 
 #: How many of the last windows :class:`_BridgedDepth` filled a window read is looked for in.
 RECENT_FILLS = 4
-
-#: The least share of a window that the overlap with a window filled before must cover for
-#: :meth:`_BridgedDepth._new_bands` to copy it and fill only the rest.
-REUSED_SHARE = 0.25
 
 
 def _bridged(zb: np.ndarray, inner: Window) -> np.ndarray:
