@@ -2351,7 +2351,7 @@ def _largest_surface(part: np.ndarray, depth: np.ndarray, jump: float) -> np.nda
     if (jit := compiled()) is not None and part.ndim == depth.ndim == 2 and part.dtype == bool and (
             depth.dtype == np.float64):  # fmt: skip
         out: np.ndarray = jit.largest_surface(part, depth, float(jump))
-        return out if out.shape == part.shape else None
+        return out if out.shape == part.shape and out.size else None  # (0, 0): none
     seen = part & (depth > 0)
     if seen.sum() < 20:
         return None
