@@ -4,6 +4,7 @@ functions, the methods of its classes with ``--methods``, and the compiled kerne
 function's inclusive thread CPU per frame and its calls per frame, the largest first.
 
     python docs/speed_profile.py [--only SUBSTRING ...] [--methods] [--frames 8] [--top 60] [--method evidence]
+                                 [--trees N]
 
 e.g. ``PYTHONPATH=src python docs/speed_profile.py --only evidence agreement candidates jit.``. cProfile cannot
 time this code (with a profiler hook set, numba's calls take a slow path, README "Speed", stop 48); these wrappers
@@ -13,6 +14,8 @@ whose qualified name holds one of the substrings (``jit.NAME`` for a kernel): th
 figures are to the frame's own. Inclusive times: a function's callees are counted in it too. A function looked up
 before the wrappers were set (a method's entry in ``symfruit.methods``' registry, a kernel called from another
 kernel) is not seen: wrap its callees. Compare figures within one run (thread CPU, the host's load still shows).
+With ``--trees N`` the colour segmenter alone is profiled instead, on N rendered apple-tree frames (1920x1080 with
+depth, the apple profile's settings, as ``docs/speed_ab.py --trees``): figures per tree frame.
 """
 
 import argparse
@@ -79,6 +82,32 @@ def _wrap_all(only: list[str], methods: bool, spent: dict[str, float], calls: Co
     return len(made)
 
 
+def _frame(method: str) -> Any:
+    """``detect`` on the benchmark frame, as a call of no arguments."""
+    import symfruit.detect as detect
+    from symfruit.evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, 0)
+    return lambda: detect.detect(frame, method=method)
+
+
+def _trees(n: int) -> Any:
+    """The colour segmenter on ``n`` rendered apple-tree frames (as ``docs/speed_ab.py --trees``), as a call of no
+    arguments: one call segments each frame once."""
+    import symfruit.segment.colour as colour
+    from symfruit.settings import resolve_settings
+    from symfruit.synthetic.scenes import make_tree_scene
+
+    settings = resolve_settings(fruit="apple").segment
+    frames = [make_tree_scene(k) for k in range(n)]
+
+    def run() -> None:
+        for f in frames:
+            colour.segment(f.color, f.depth, f.camera, settings)
+
+    return run
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--only", nargs="*", default=[], help="wrap only names holding one of these")
@@ -86,25 +115,25 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--top", type=int, default=60)
     parser.add_argument("--method", default="evidence")
+    parser.add_argument("--trees", type=int, default=0, help="profile the colour segmenter on this many apple-tree "
+                        "frames instead (1920x1080 with depth, the apple profile; --frames times each)")  # fmt: skip
     args = parser.parse_args(argv)
     spent: dict[str, float] = defaultdict(float)
     calls: Counter = Counter()
     count = _wrap_all(args.only, args.methods, spent, calls)
-    import symfruit.detect as detect
-    from symfruit.evaluate.bench import _bench_scene
-
-    frame, _ = _bench_scene(None, 0)
-    for _ in range(3):  # warm-up: compiled kernels loaded, caches made
-        detect.detect(frame, method=args.method)
+    run = _trees(args.trees) if args.trees else _frame(args.method)
+    for _ in range(1 if args.trees else 3):  # warm-up: compiled kernels loaded, caches made
+        run()
     spent.clear()
     calls.clear()
     start = time.thread_time()
     for _ in range(args.frames):
-        detect.detect(frame, method=args.method)
-    per = (time.thread_time() - start) / args.frames
-    lines = [f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({args.frames} frames)"]
+        run()
+    frames = args.frames * max(args.trees, 1)  # with --trees, each run segments every tree frame
+    per = (time.thread_time() - start) / frames
+    lines = [f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({frames} frames)"]
     for key, seconds in sorted(spent.items(), key=lambda kv: -kv[1])[: args.top]:
-        lines.append(f"{seconds / args.frames * 1e3:8.2f} ms {calls[key] / args.frames:8.1f} calls  {key}")
+        lines.append(f"{seconds / frames * 1e3:8.2f} ms {calls[key] / frames:8.1f} calls  {key}")
     sys.stdout.write("\n".join(lines) + "\n")
     return 0
 

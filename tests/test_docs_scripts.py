@@ -138,3 +138,16 @@ def test_slab44_spur_leaves_lie_around_an_apple_at_its_own_depth():
     assert across.min() >= 0.04 - 1e-12 and across.max() <= 0.064 + 1e-12 and np.ptp(across) > 0.02
     assert along.min() >= -0.012 - 1e-12 and along.max() <= 0.04 + 1e-12
     assert np.array_equal(c, sl.spur_leaf_centres(centre, 0.04, 500, np.random.default_rng(3)))
+
+
+def test_speed_profile_profiles_the_segmenter_on_tree_frames(tmp_path):
+    """``speed_profile.py --trees N`` (stop 51): the colour segmenter alone on N apple-tree frames, figures per frame
+    (one ``segment`` call a frame)."""
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPATH": str(DOCS.parent / "src")}
+    args = ["--only", "colour.segment", "--trees", "1", "--frames", "2", "--top", "5"]
+    done = subprocess.run([sys.executable, str(DOCS / "speed_profile.py"), *args], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = done.stdout.splitlines()
+    assert lines[0].endswith("(2 frames)")
+    assert any(line.endswith("1.0 calls  symfruit.segment.colour.segment") for line in lines[1:])

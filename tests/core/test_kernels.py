@@ -6608,3 +6608,60 @@ def test_outline_bands_are_the_occluded_edges_bands_and_crack_labels(seed):
     assert (got[3] is None) == (want_cracks is None)
     if want_cracks is not None:
         assert _same_bits(got[3], want_cracks)
+
+
+# --- stop 51, seg51: the colour segmenter's speed
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_largest_surface_is_the_twins(seed):
+    """``_largest_surface`` (a ground-colour body's surface without depth steps, :func:`_jit.largest_surface`) with the
+    kernels and with the twins on random masks over depths with holes and steps (several values: equal pieces, the
+    first kept; fewer than 20 pixels with depth: none): the same pixels."""
+    from symfruit.segment.colour import _largest_surface
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    z, mask = _depth_patch(rng, h, w)
+    z[rng.random((h, w)) < rng.uniform(0.0, 0.3)] += rng.choice([0.02, 0.05, 0.1])  # steps inside, some at the limit
+    jump = float(rng.choice([0.015, 0.02, 0.05]))
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _largest_surface, mask, z, jump)
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert fast.dtype == bool and np.array_equal(fast, twin)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_labelled_pixels_are_the_twins(seed):
+    """``_labelled`` (:func:`_jit.label_flat`) with the kernels and with the twins on random masks: the same labels,
+    count, flat indices and labels there, of the same types."""
+    from symfruit.segment.colour import _labelled
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random(tuple(int(x) for x in rng.integers(1, 40, 2))) < rng.uniform(0.0, 1.0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _labelled, mask)
+    assert fast[1] == twin[1]
+    for a, b in ((fast[0], twin[0]), (fast[2], twin[2]), (fast[3], twin[3])):
+        assert a.dtype == b.dtype and np.array_equal(a, b)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_extent_is_the_twins(seed):
+    """``_extent`` (:func:`_jit.widest_pair`) with the kernels and with the twins on a random mask's hull vertices and
+    on random float vertices: the same value."""
+    from symfruit.segment.colour import _extent, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random(tuple(int(x) for x in rng.integers(1, 40, 2))) < rng.uniform(0.0, 0.3)
+    with pytest.MonkeyPatch.context() as mp:
+        vertices = _hull_vertices(mask)
+        fast, twin = _both(mp, _extent, vertices, mask)
+        assert fast == twin
+        points = rng.uniform(-50.0, 50.0, (int(rng.integers(1, 30)), 2))
+        fast, twin = _both(mp, _extent, points, mask)
+        assert fast == twin

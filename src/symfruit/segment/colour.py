@@ -774,6 +774,18 @@ def _label(mask: np.ndarray, *, eight: bool = False) -> tuple[np.ndarray, int]:
     return labels, int(n)
 
 
+def _labelled(mask: np.ndarray) -> tuple[np.ndarray, int, np.ndarray, np.ndarray]:
+    """:func:`_label` of a 2-d bool ``mask`` with eight neighbours, and the labelled pixels' flat indices (ascending)
+    and labels. Where numba is, in one call (:func:`symfruit.core._jit.label_flat`: the same arrays; stop 51)."""
+    if (jit := compiled()) is not None and mask.ndim == 2 and mask.dtype == bool:
+        lab, n, at, la = jit.label_flat(mask, True)
+        return lab, int(n), at, la
+    lab, n = _label(mask, eight=True)
+    flat = lab.ravel()
+    at = np.flatnonzero(flat)
+    return lab, n, at, flat.take(at)
+
+
 def _red_regions(
     cw: np.ndarray, s: SegmentSettings
 ) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None:
@@ -1179,6 +1191,8 @@ def _extent(vertices: np.ndarray | None, mask: np.ndarray) -> float:
     """The largest distance across a mask (between its hull's vertices, plus a pixel), in pixels."""
     if vertices is None:
         return float(np.sqrt(mask.sum()))
+    if (jit := compiled()) is not None and vertices.ndim == 2 and vertices.dtype == np.float64:
+        return float(np.sqrt(jit.widest_pair(vertices))) + 1.0  # the same largest square (stop 51)
     d = vertices[:, None, :] - vertices[None, :, :]
     return float(np.sqrt((d * d).sum(axis=2).max())) + 1.0
 
@@ -2080,12 +2094,9 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     if not (z_grid > 0).any():
         return []
     cand = _ground_steps(c[::g, ::g], z_grid, 3, 2.0 * s.depth_jump)  # a grid step spans 4 pixels of a surface
-    lab, n = _label(cand, eight=True)
+    lab, n, at, la = _labelled(cand)
     if n == 0:
         return []
-    flat = lab.ravel()
-    at = np.flatnonzero(flat)
-    la = flat.take(at)
     count, disc = _piece_discs(la, z_grid.ravel().take(at), n, focal)
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
@@ -2111,12 +2122,9 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         if not (zw > 0).any():
             continue
         cand = _ground_steps(c[win], zw, GAP_PX, s.depth_jump) & (owner[win] == 0)
-        lab, n = _label(cand, eight=True)
+        lab, n, at, la = _labelled(cand)
         if n == 0:
             continue
-        flat = lab.ravel()
-        at = np.flatnonzero(flat)
-        la = flat.take(at)
         count, disc = _piece_discs(la, zw.ravel().take(at), n, focal)
         keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
         keep[0] = False
@@ -2310,15 +2318,10 @@ def _round_body(
     twice as closely as a plane (:data:`GROUND_PLANE`, median distances, each fit once more without the points far
     off it: a leaf or the background seen through a gap is flat; a leaf curled in one direction fits neither
     well). Returns the sphere (centre, radius), or None."""
-    seen = part & (depth > 0)
-    if seen.sum() < 20:
+    surface = _largest_surface(part, depth, s.depth_jump)
+    if surface is None:
         return None
-    # the largest surface without a depth step in it: not two leaves' pieces joined where depth is missing
-    # (4-connected: the steps are looked for between 4-neighbours)
-    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), s.depth_jump))
-    if n == 0:
-        return None
-    part = lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
+    part = surface
     fit = _sphere(part, depth, geo, origin)
     if fit is None:
         return None
@@ -2338,6 +2341,24 @@ def _round_body(
     plane = float(median(off))
     sphere = float(median(np.abs(row_norms(p - centre) - radius)))
     return (centre, radius) if sphere <= GROUND_PLANE * plane else None
+
+
+def _largest_surface(part: np.ndarray, depth: np.ndarray, jump: float) -> np.ndarray | None:
+    """:func:`_round_body`'s surface: the largest piece of the pixels of ``part`` with depth and on no depth step
+    (larger than ``jump`` between 4-neighbours with depth): not two leaves' pieces joined where depth is missing
+    (4-connected: the steps are looked for between 4-neighbours); None with fewer than 20 pixels with depth. Where
+    numba is, in one call (:func:`symfruit.core._jit.largest_surface`: the same pixels; stop 51)."""
+    if (jit := compiled()) is not None and part.ndim == depth.ndim == 2 and part.dtype == bool and (
+            depth.dtype == np.float64):  # fmt: skip
+        out: np.ndarray = jit.largest_surface(part, depth, float(jump))
+        return out if out.shape == part.shape and out.size else None  # (0, 0): none
+    seen = part & (depth > 0)
+    if seen.sum() < 20:
+        return None
+    lab, n = _label(seen & ~_steps(np.where(seen, depth, np.nan), jump))
+    if n == 0:
+        return None
+    return lab == np.argmax(np.bincount(lab.ravel())[1:]) + 1
 
 
 #: A ground-colour piece is one fruit's outline when it fills at least this share of its convex hull.
