@@ -6447,3 +6447,123 @@ def test_hidden_seen_is_the_occlusions_at_and_depth_at(monkeypatch, seed):
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         want = np.where(want_hid, occ.depth_at(u, v), np.nan)
     assert np.array_equal(seen, want, equal_nan=True)
+
+
+# --- stop 51, surface51: thin_front's passes in one call -----------------------------------------------------------
+
+
+def _sheet_scene(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int, int, int]]:
+    """(depth, mask, window depth, box) of a fruit's cap seen at 0.4-1.5 m: alone, behind a flat or tilted sheet a few
+    mm to 3 cm in front over part of its mask (cut at the mask or running on beyond it), with a patch behind, noise of
+    0-3 mm, depth repeated from a coarser camera's pixels or rounded to millimetres, holes; the mask cut through its
+    front or not. ``depth`` and ``mask`` are the mask's box of the window (``box``: rows and columns there)."""
+    h, w = (int(x) for x in rng.integers(40, 110, 2))
+    rr, cc = np.mgrid[:h, :w].astype(np.float64)
+    cy, cx = rng.uniform(0.35, 0.65) * h, rng.uniform(0.35, 0.65) * w
+    r_px = rng.uniform(0.15, 0.35) * min(h, w)
+    d2 = (rr - cy) ** 2 + (cc - cx) ** 2
+    disc = d2 <= r_px**2
+    z0 = rng.uniform(0.4, 1.5)
+    r_m = r_px * z0 / 600.0
+    depth = np.where(disc, z0 + r_m - np.sqrt(np.clip(r_m**2 - d2 * (z0 / 600.0) ** 2, 0.0, None)), 0.0)
+    depth = np.where(disc, depth, z0 + rng.uniform(0.05, 0.4))  # what lies behind
+    mask = disc.copy()
+    if rng.random() < 0.3:
+        mask &= cc <= cx + rng.uniform(-0.3, 0.6) * r_px  # cut through its front: the front reaches the outline
+    kind = int(rng.integers(0, 4))
+    if kind:
+        a = rng.uniform(0, 2 * np.pi)
+        side = np.cos(a) * (cc - cx) + np.sin(a) * (rr - cy) < rng.uniform(-0.5, 0.6) * r_px
+        sheet = side & (disc if kind == 1 else np.ones_like(disc))
+        tilt = rng.uniform(-1.0, 1.0) * 1e-4 if kind == 3 else 0.0
+        depth = np.where(sheet, z0 - rng.uniform(0.004, 0.03) + tilt * (cc - cx), depth)
+    if rng.random() < 0.3:
+        patch = (np.abs(rr - cy - 0.5 * r_px) < 3) & (np.abs(cc - cx) < 6)
+        depth = np.where(patch, depth + 0.2, depth)
+    noise = float(rng.choice([0.0, 0.0005, 0.001, 0.002, 0.003]))
+    depth = depth + rng.normal(0.0, noise, depth.shape)
+    coarse = int(rng.integers(1, 3))
+    if coarse > 1:  # a coarser camera's pixels repeated
+        depth = np.repeat(np.repeat(depth[::coarse, ::coarse], coarse, 0), coarse, 1)[:h, :w]
+    if rng.random() < 0.3:
+        depth = np.round(depth * 1000.0) / 1000.0
+    depth[rng.random(depth.shape) < rng.uniform(0.0, 0.1)] = 0.0
+    rows, cols = np.nonzero(mask)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    return depth[r0:r1, c0:c1].copy(), mask[r0:r1, c0:c1].copy(), depth, (int(r0), int(c0), int(h), int(w))
+
+
+def _thin_case(rng: np.random.Generator) -> tuple[tuple, dict]:
+    """``thin_front``'s arguments on a :func:`_sheet_scene`, as ``fruit_surface`` makes them (its noise, front, radius
+    and the convexity test's tolerance as the join; with the window's depth as ``around`` or not)."""
+    from symfruit.core.surface import Around, depth_noise, fruit_depth
+
+    depth, mask, window, (r0, c0, _, _) = _sheet_scene(rng)
+    noise = depth_noise(depth, mask)
+    radius_px = float(np.sqrt(np.count_nonzero(mask) / np.pi))
+    front, radius = fruit_depth(depth[mask], radius_px, 600.0, noise=noise)
+    join = max(3.0 * noise, 0.003) + float(rng.choice([0.0, 0.001]))
+    big = np.zeros(window.shape, bool)
+    big[r0 : r0 + mask.shape[0], c0 : c0 + mask.shape[1]] = mask
+    around = Around(window, big, r0, c0) if rng.random() < 0.5 else None
+    return (depth, mask, 600.0, front, radius, join, noise), {"around": around}
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_thin_front_by_its_passes_in_one_call_is_the_twins_to_the_bit(seed):
+    """``thin_front`` (``thin_passes``: the counts, the outline test, both partitions and their sizes, the 5 x 5
+    median and its noise in one call, the fits in numpy between) with the kernels and with the numpy twins on caps
+    alone and behind sheets of every kind: the same answer, front and sheet pixels, bit for bit."""
+    from symfruit.core.surface import thin_front
+
+    args, kwargs = _thin_case(np.random.default_rng(seed))
+    if not np.isfinite(args[3]):
+        return
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, thin_front, *args, **kwargs)
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert fast[0] == twin[0] and fast[1].dtype == twin[1].dtype and np.array_equal(fast[1], twin[1])
+
+
+def test_thin_passes_reach_every_answer_and_give_the_twins_parts():
+    """``thin_passes`` on 120 :func:`_sheet_scene` cases reaches each of its answers, and where it hands a partition
+    back, its labels, sizes and near counts are ``_smooth_parts``' and ``_part_sizes``' numpy twins' (of the depth at
+    the join, or of the 5 x 5 median at its narrower join); where it asks for the fit, the pixels are
+    ``_thin_counts``'; its counts and ``ok`` always are."""
+    import symfruit.core.surface as surface
+
+    seen = set()
+    for seed in range(120):
+        (depth, mask, _, front, _, join, noise), _ = _thin_case(np.random.default_rng(seed))
+        if not np.isfinite(front):
+            continue
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            want_ok, want_counts, want_rows, want_cols = surface._thin_counts(depth, mask, front, join)
+            parts, count = surface._smooth_parts(depth, mask, join)
+            smooth, diff = surface._lag_differences(surface._window_medians(depth, want_ok), want_ok, mask, 5)
+            sigma = 1.4826 * float(surface.median(np.abs(diff - surface.median(diff)))) / np.sqrt(2.0) if len(
+                diff) else 0.0  # fmt: skip
+            narrow = min(join, max(3.0 * sigma, 0.003))
+            smoothed, smooth_count = surface._smooth_parts(smooth, mask, narrow)
+        ok, counts, labels = np.empty(depth.shape, bool), np.empty(5, np.int64), np.empty(depth.shape, np.int32)
+        answers = []
+        for stage in (0, 1, 2):
+            answer, rows, cols, n, sizes, near = _jit.thin_passes(depth, mask, front, join, noise, stage, ok, counts,
+                                                                  labels)  # fmt: skip
+            assert np.array_equal(ok, want_ok) and np.array_equal(counts, want_counts)
+            answers.append(answer)
+            if answer == _jit.THIN_FIT:
+                assert np.array_equal(rows, want_rows) and np.array_equal(cols, want_cols)
+            if answer in (_jit.THIN_SHEET, _jit.THIN_SMOOTHED):
+                p, k = (parts, count) if answer == _jit.THIN_SHEET else (smoothed, smooth_count)
+                assert n == k and np.array_equal(labels, p)
+                want_sizes, want_near = surface._part_sizes(p, k, depth, front, join)
+                assert np.array_equal(sizes, want_sizes) and np.array_equal(near, want_near)
+        # stage 0 goes on as stage 1 unless it asks for the fit, stage 1 as stage 2 unless it hands a partition back
+        assert answers[0] in (_jit.THIN_FIT, answers[1]) and answers[1] in (_jit.THIN_SHEET, answers[2])
+        assert answers[2] in (_jit.THIN_NONE, _jit.THIN_SMOOTHED)
+        seen.update(answers)
+    assert seen == {_jit.THIN_NONE, _jit.THIN_FIT, _jit.THIN_SHEET, _jit.THIN_SMOOTHED}

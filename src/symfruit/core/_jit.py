@@ -8570,3 +8570,97 @@ def hidden_seen(
             if 0 <= col < w and 0 <= row < h:
                 seen[i] = np.float64(depth[row, col])
     return hid, seen
+
+
+# --- stop 51, surface51: thin_front's passes in one call -------------------------------------------------------------
+
+#: :func:`thin_passes`' answers: the test ends, None (``THIN_NONE``); the front pixels want the curvature fit
+#: (``THIN_FIT``); the first partition, then the one of the 5 x 5 median, wants the rest of ``_behind_sheet``
+#: (``THIN_SHEET``, ``THIN_SMOOTHED``).
+THIN_NONE, THIN_FIT, THIN_SHEET, THIN_SMOOTHED = 0, 1, 2, 3
+
+
+@_njit_inlined
+def _sheet_sizes(
+    labels: np.ndarray, count: int, depth: np.ndarray, front: float, join: float
+) -> tuple[bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._behind_sheet`'s tests before its fits on the partition ``labels`` (0 none,
+    1..``count``): whether they pass (False where it returns None: fewer than two parts, no part near ``front``, the
+    sheet (the first part holding the most pixels near it, ``np.argmax``'s) under 30 pixels, no other part holding
+    ``max(30, 0.1 n_sheet)``), and :func:`part_sizes`' counts. Whole numbers: the same answer."""
+    if count < 2:
+        return False, np.zeros(0, np.int64), np.zeros(0, np.int64)
+    sizes, near = part_sizes(labels, count, depth, front, join)
+    sheet = 0
+    best = 0
+    for k in range(1, count + 1):
+        if near[k] > best:
+            sheet, best = k, near[k]
+    if sheet == 0:
+        return False, sizes, near
+    n_sheet = sizes[sheet]
+    if n_sheet < 30:
+        return False, sizes, near
+    largest = 0
+    for k in range(1, count + 1):
+        if k != sheet and sizes[k] > largest:
+            largest = sizes[k]
+    return not (largest < 30 or largest < 0.1 * n_sheet), sizes, near
+
+
+@_njit
+def thin_passes(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    front: float,
+    join: float,
+    noise: float,
+    stage: int,
+    ok: np.ndarray,
+    counts: np.ndarray,
+    labels: np.ndarray,
+) -> tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface.thin_front`'s passes between its fits in one call, each the kernel it called (the
+    same pixels, parts and numbers): ``(answer, rows, cols, count, sizes, near)``, ``answer`` one of ``THIN_*``.
+
+    ``stage`` 0 from the start: :func:`thin_counts` (``ok`` (h, w) bool and ``counts`` (5,) int64 written in place,
+    the front pixels ``rows, cols`` returned) and, with at least 30 front pixels, :func:`reaches_outline`; where they
+    do not reach the mask's outline, ``THIN_FIT`` (the caller fits them and comes back with stage 1). Stage 1:
+    :func:`smooth_parts` of ``depth`` joined at ``join`` into ``labels`` (h, w) int32 and :func:`_sheet_sizes`;
+    passed, ``THIN_SHEET`` with ``count``, ``sizes`` and ``near`` (the caller's ``_behind_sheet`` goes on; stage 2
+    when it finds nothing). Stage 2: with three ``noise`` deviations above 3 mm and at least 60 pixels with depth,
+    the 5 x 5 median (:func:`window_medians`), its lagged differences (:func:`lag_differences`, at least 20), their
+    deviation (:func:`median_deviation`), the narrower join ``min(join, max(3 sigma, 0.003))`` and, narrower than
+    ``join``, the parts of the median joined at it with :func:`_sheet_sizes`: ``THIN_SMOOTHED`` where it passes.
+    ``THIN_NONE`` wherever ``thin_front`` returns None (stop 51)."""
+    none = np.zeros(0, np.int64)
+    if stage == 0:
+        found, rows, cols = thin_counts(depth, mask, front, join, ok)
+        counts[:] = found
+        if rows.shape[0] >= 30 and not reaches_outline(mask, rows, cols):
+            return THIN_FIT, rows, cols, 0, none, none
+        stage = 1
+    if stage == 1:
+        count = smooth_parts(depth, mask, join, labels)
+        passed, sizes, near = _sheet_sizes(labels, count, depth, front, join)
+        if passed:
+            return THIN_SHEET, none, none, count, sizes, near
+    if 3.0 * noise <= 0.003 or counts[0] < 60:
+        return THIN_NONE, none, none, 0, none, none
+    medians = np.empty(counts[0])
+    window_medians(depth, ok, medians)
+    smooth = np.empty(depth.shape)
+    diff = lag_differences(medians, ok, mask, 5, smooth)
+    if diff.shape[0] < 20:
+        return THIN_NONE, none, none, 0, none, none
+    sigma = 1.4826 * median_deviation(diff) / math.sqrt(2.0)
+    wide = 3.0 * sigma
+    if 0.003 > wide:
+        wide = 0.003
+    if not wide < join:
+        return THIN_NONE, none, none, 0, none, none
+    count = smooth_parts(smooth, mask, wide, labels)
+    passed, sizes, near = _sheet_sizes(labels, count, depth, front, join)
+    if passed:
+        return THIN_SMOOTHED, none, none, count, sizes, near
+    return THIN_NONE, none, none, 0, none, none

@@ -314,15 +314,12 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
     plain = depth.dtype == np.float64 and depth.ndim == 2 and mask.dtype == bool and mask.shape == depth.shape
     if (jit := compiled() if plain else None) is not None:
-        ok = np.empty(depth.shape, bool)  # the compiled twin of _thin_counts (stop 43: the same counts and pixels)
-        counts, rows, cols = jit.thin_counts(depth, mask, float(front), float(join), ok)
-    else:
-        ok, counts, rows, cols = _thin_counts(depth, mask, front, join)
-    repeats = 1.0
-    for both, equal in ((counts[1], counts[2]), (counts[3], counts[4])):
-        if both:
-            repeats /= max(1.0 - float(equal) / float(both), 0.1)
-    inflate = float(np.sqrt(repeats))
+        # every pass between the fits in one call (stop 51, surface51: the same pixels, parts and numbers)
+        return _thin_front_compiled(jit, depth, mask, focal, front, radius, join, noise, around)
+    # the numpy twin of what follows (thin_passes' twin: _thin_counts, _reaches_outline, _smooth_parts, _part_sizes,
+    # _window_medians, _lag_differences, the deviation's medians)
+    ok, counts, rows, cols = _thin_counts(depth, mask, front, join)
+    inflate = _inflation(counts)
     # the nearest surface clearly convex is the fruit's own front, not a sheet: nothing to look behind (one fit
     # instead of the parts, their fits and the median's re-partition on every fruit seen whole: the benchmark
     # frame's extraction 24.8 -> 16.8 ms thread CPU, 7.6 without the test); rows, cols: the pixels with depth within
@@ -331,9 +328,7 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # edge of a tilted leaf, or a leaf's depth fattened over the fruit, runs along it (a narrow band whose fit reads
     # any curvature). The outline is asked first: where it is reached the fit decides nothing (stop 44, speedreg44:
     # the registration's cue, its depth a few pixels off the mask, reaches it on most fruit)
-    if len(rows) >= 30 and not (
-        jit.reaches_outline(mask, rows, cols) if jit is not None else _reaches_outline(mask, rows, cols)
-    ):  # fmt: skip
+    if len(rows) >= 30 and not _reaches_outline(mask, rows, cols):
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
         if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
             return None
@@ -345,27 +340,63 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return None  # the step was not bridged by noise
     # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
     # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
-    # takes its nearest pixel's
-    if jit is not None:
-        # the compiled twin of _window_medians (stop 45: the same values, by a selection network, the windows never
-        # laid out), and of _lag_differences (stop 43: the same image and differences)
-        medians = np.empty(int(counts[0]))
-        jit.window_medians(depth, ok, medians)
-        smooth = np.empty(depth.shape)
-        diff = jit.lag_differences(medians, ok, mask, 5, smooth)
-    else:
-        smooth, diff = _lag_differences(_window_medians(depth, ok), ok, mask, 5)
+    # takes its nearest pixel's (compiled: window_medians, lag_differences and median_deviation in thin_passes)
+    smooth, diff = _lag_differences(_window_medians(depth, ok), ok, mask, 5)
     if len(diff) < 20:
         return None
-    # the differences' median absolute deviation by the compiled twin where numba is (stop 47: the same order
-    # statistics in one call; diff is its own, reordered there)
-    mad = jit.median_deviation(diff) if jit is not None else median(np.abs(diff - median(diff)))
+    mad = median(np.abs(diff - median(diff)))
     sigma = 1.4826 * float(mad) / np.sqrt(2.0)
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
     parts, count = _smooth_parts(smooth, mask, narrow)
     return _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
+
+
+def _inflation(counts: np.ndarray) -> float:
+    """:func:`thin_front`'s factor on the sheet's standard error from :func:`_thin_counts`' counts: the square root of
+    how many pixels repeat one depth pixel (a registered depth image repeats a coarser camera's pixels)."""
+    repeats = 1.0
+    for both, equal in ((counts[1], counts[2]), (counts[3], counts[4])):
+        if both:
+            repeats /= max(1.0 - float(equal) / float(both), 0.1)
+    return float(np.sqrt(repeats))
+
+
+def _thin_front_compiled(
+    jit: Any,
+    depth: np.ndarray,
+    mask: np.ndarray,
+    focal: float,
+    front: float,
+    radius: float,
+    join: float,
+    noise: float,
+    around: Around | None,
+) -> tuple[float, np.ndarray] | None:
+    """:func:`thin_front` by :func:`symfruit.core._jit.thin_passes` (``depth`` (h, w) float64, ``mask`` bool of its
+    shape): every pass of the twin's between its fits (the counts, the outline test, both partitions into smooth parts
+    and their sizes, the 5 x 5 median and its noise) in one call, the fits and the rest of :func:`_behind_sheet` here,
+    in the twin's order: the same answer, bit for bit (stop 51, surface51)."""
+    ok, counts, labels = np.empty(depth.shape, bool), np.empty(5, np.int64), np.empty(depth.shape, np.int32)
+    args = (depth, mask, float(front), float(join), float(noise))
+    answer, rows, cols, count, sizes, near = jit.thin_passes(*args, 0, ok, counts, labels)
+    inflate = _inflation(counts)
+    if answer == jit.THIN_FIT:  # the nearest surface clearly convex is the fruit's own front (as the twin asks)
+        kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
+        if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
+            return None
+        answer, _, _, count, sizes, near = jit.thin_passes(*args, 1, ok, counts, labels)
+    if answer == jit.THIN_SHEET:
+        found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, labels, int(count), noise=noise,
+                              around=around, counted=(sizes, near))  # fmt: skip
+        if found is not None:
+            return found
+        answer, _, _, count, sizes, near = jit.thin_passes(*args, 2, ok, counts, labels)
+    if answer == jit.THIN_SMOOTHED:
+        return _behind_sheet(depth, mask, focal, front, radius, join, inflate, labels, int(count), noise=noise,
+                             around=around, counted=(sizes, near))  # fmt: skip
+    return None
 
 
 def _reaches_outline(mask: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> bool:
@@ -415,7 +446,8 @@ def _lag_differences(
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
                   inflate: float, parts: np.ndarray, count: int, *, noise: float = 0.001,
-                  around: Around | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
+                  around: Around | None = None,
+                  counted: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
     sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
     a flat reading must hold on the camera's own pixels; the cap behind is not asked as much). A front part that is
@@ -425,11 +457,14 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     is the mask's largest surface (stop 40, docs/leaf40.md). Such a front part must also lie in front of the part
     behind's surface extended under it (:meth:`_InverseQuadratic.offset`) by more than ``join``: one lying on it is
     that fruit's own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's
-    noise, for :func:`fruit_depth`'s bins on the part behind."""
+    noise, for :func:`fruit_depth`'s bins on the part behind. ``counted``: :func:`_part_sizes`' counts when the caller
+    has them (:func:`symfruit.core._jit.thin_passes`)."""
     if count < 2:
         return None
     plain = parts.ndim == 2 and parts.shape == depth.shape and depth.dtype == np.float64
-    if (jit := compiled() if plain else None) is not None:  # the compiled twin of _part_sizes (stop 45: the same)
+    if counted is not None:
+        sizes, near = counted
+    elif (jit := compiled() if plain else None) is not None:  # the compiled twin of _part_sizes (stop 45: the same)
         sizes, near = jit.part_sizes(parts, int(count), depth, float(front), float(join))
     else:
         sizes, near = _part_sizes(parts, count, depth, front, join)
