@@ -6567,3 +6567,124 @@ def test_thin_passes_reach_every_answer_and_give_the_twins_parts():
         assert answers[2] in (_jit.THIN_NONE, _jit.THIN_SMOOTHED)
         seen.update(answers)
     assert seen == {_jit.THIN_NONE, _jit.THIN_FIT, _jit.THIN_SHEET, _jit.THIN_SMOOTHED}
+
+
+# --- stop 51, surface51: fruit_surface's depth mode and its cap in one call each -----------------------------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
+def test_mask_values_are_the_noise_depths_and_step_to_the_bit(seed, with_leafy, odd):
+    """``mask_values`` (then ``fruit_depth``'s kernel on its depths) on :func:`_sheet_scene`'s masks (with leaf pixels
+    or not; with NaN, infinite and negative depths, and few pixels, or not): ``depth_noise``'s and ``depth_step``'s
+    numpy twins' numbers, and the mask's depths and leaf pixels as ``fruit_depth`` keeps them (its twin's front and
+    radius from them, bit for bit, wherever its kernel says it is done)."""
+    from symfruit.core.surface import LEAFY, depth_noise, depth_step, fruit_depth
+
+    rng = np.random.default_rng(seed)
+    depth, mask, _, _ = _sheet_scene(rng)
+    if odd:
+        depth[rng.random(depth.shape) < 0.05] = rng.choice([np.nan, np.inf, -0.5])
+        mask &= rng.random(mask.shape) < rng.choice([0.02, 0.5, 1.0])
+    leafy = rng.random(depth.shape) < rng.uniform(0.0, 1.0)
+    radius_px = float(np.sqrt(np.count_nonzero(mask) / np.pi))
+    noise, kept, leaf, step = _jit.mask_values(depth, mask, leafy if with_leafy else np.zeros((0, 0), bool),
+                                               with_leafy, 0.0005)  # fmt: skip
+    front, radius, done = _jit.fruit_depth(np.sort(kept), kept, radius_px, 600.0, noise, leaf, with_leafy,
+                                           (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # inf - inf: NaN, left out there
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_noise = depth_noise(depth, mask)
+        want = fruit_depth(depth[mask], radius_px, 600.0, noise=want_noise, leafy=leafy[mask] if with_leafy else None)
+        want_step = depth_step(depth, mask)
+    assert noise == want_noise and step == want_step
+    valid = np.isfinite(depth[mask]) & (depth[mask] > 0)
+    assert np.array_equal(kept, depth[mask][valid]) and np.array_equal(leaf, leafy[mask][valid] if with_leafy else [])
+    if done:
+        assert np.array_equal((front, radius), want, equal_nan=True)
+    else:
+        assert math.isnan(front) and math.isnan(radius)
+
+
+def _surface_case(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, dict]:
+    """A window's depth and mask (:func:`_sheet_scene`'s) and ``fruit_surface``'s keywords as its callers give them:
+    the registration's (a region grown beyond the mask, the mask's distance map, no unit, ``thin``) or extraction's
+    (leaf pixels, ``thin`` and ``crossing``; the convexity test off, an infinite tolerance, now and then)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance
+
+    _, _, depth, (r0, c0, h, w) = _sheet_scene(rng)
+    _, mask, _, _ = _sheet_scene(np.random.default_rng(int(rng.integers(2**32))))
+    big = np.zeros((h, w), bool)
+    mh, mw = min(mask.shape[0], h - r0), min(mask.shape[1], w - c0)
+    big[r0 : r0 + mh, c0 : c0 + mw] = mask[:mh, :mw]
+    if rng.random() < 0.5:
+        grown = ndimage.binary_dilation(big, iterations=int(rng.integers(1, 8)))
+        return depth, big, {"region": grown, "inner": inner_distance(big), "step": 0.0, "thin": True}
+    leafy = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    tolerance = np.inf if rng.random() < 0.2 else 3.0
+    return depth, big, {"leafy": leafy, "thin": True, "crossing": True, "tolerance": tolerance}
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_fruit_surface_by_its_compiled_measures_and_cap_is_the_twins_to_the_bit(seed, fresh):
+    """``fruit_surface`` (``mask_values``, ``thin_passes`` and ``surface_cap`` with the fits and the principal widths
+    between) with the kernels and with the numpy twins, as the registration and extraction call it on a cap alone
+    and behind sheets: the same pixels, front, radius, noise and apex, bit for bit; ``fresh``: the sectors' table
+    not made yet (so the first cap reaching beyond 64 px from its apex is left to ``monotone_region``, which grows
+    it)."""
+    import symfruit.core.surface as surface
+
+    depth, mask, kwargs = _surface_case(np.random.default_rng(seed))
+    with pytest.MonkeyPatch.context() as mp:
+        if fresh:
+            mp.setattr(surface, "_SECTORS", {})
+        fast, twin = _both(mp, surface.fruit_surface, depth, mask, 600.0, **kwargs)
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert (fast.front, fast.radius, fast.noise, fast.apex) == (twin.front, twin.radius, twin.noise, twin.apex)
+        assert fast.pixels.dtype == twin.pixels.dtype and np.array_equal(fast.pixels, twin.pixels)
+
+
+def test_surface_cap_reaches_each_answer():
+    """``surface_cap`` on a disc's depth: no pixel in the slab (0); the cap done (1), its pixels ``monotone_region``'s
+    or'd with the deep ones (the distance map given, or made in the call as ``inner_distance`` makes it); left to the
+    caller (2) with the tolerance infinite or the sectors' table too small for the apex's farthest pixel, the apex the
+    same; and (3) the map left to the caller too where the mask fills its box grown by a pixel."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import _sector_table, monotone_region
+
+    yy, xx = np.mgrid[:90, :150]
+    d2 = (yy - 45.0) ** 2 + (xx - 75.0) ** 2
+    mask = d2 <= 30.0**2
+    depth = np.where(mask, 0.5 + d2 * 1e-5, 0.9)
+    inner = ndimage.distance_transform_edt(mask)
+    table = _sector_table(72, 80)
+    mid = table.shape[0] // 2
+    small = table[mid - 40 : mid + 41, mid - 40 : mid + 41].copy()  # offsets within 40 px alone
+    answers = []
+    for low, high, tol, tab in ((0.1, 0.2, 0.003, table), (0.49, 0.6, 0.003, table), (0.49, 0.6, np.inf, table),
+                                (0.49, 0.6, 0.003, small)):  # fmt: skip
+        near, out = np.empty(mask.shape, bool), np.zeros(mask.shape, bool)
+        for have in (True, False):
+            made = inner.copy() if have else np.zeros(mask.shape)
+            out[:] = False
+            answer, r, c = _jit.surface_cap(depth, mask, mask, 15, 45, 76, 106, 4, low, high, made, have, 8.0, tab,
+                                            72, tol, near, out)  # fmt: skip
+            answers.append(answer)
+            if answer:
+                assert (r, c) == (45, 75) and np.array_equal(near, mask & (depth >= low) & (depth <= high))
+            if answer == 1:
+                deep = (inner if have else inner_distance(mask, 8.0)) > 8.0
+                assert np.array_equal(out, monotone_region(depth, near, (45, 75), tol) | (near & deep))
+                assert have or np.array_equal(made, inner_distance(mask, 8.0))
+    assert answers == [0, 0, 1, 1, 2, 2, 2, 2]
+    full = np.ones(mask.shape, bool)  # its box grown by a pixel (clipped) all the mask's
+    near, out = np.empty(mask.shape, bool), np.zeros(mask.shape, bool)
+    answer, r, c = _jit.surface_cap(depth, full, full, 0, 0, 90, 150, 4, 0.49, 0.6, np.zeros(mask.shape), False, 8.0,
+                                    table, 72, 0.003, near, out)  # fmt: skip
+    assert answer == 3 and not out.any()

@@ -8664,3 +8664,105 @@ def thin_passes(
     if passed:
         return THIN_SMOOTHED, none, none, count, sizes, near
     return THIN_NONE, none, none, 0, none, none
+
+
+# --- stop 51, surface51: fruit_surface's measures of the mask's depth, and its cap, in one call each -----------------
+
+
+@_njit
+def mask_values(
+    depth: np.ndarray, mask: np.ndarray, leafy: np.ndarray, with_leafy: bool, floor: float
+) -> tuple[float, np.ndarray, np.ndarray, float]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface`'s measures of a mask's depth before the depth mode in one call, each
+    the kernel or numpy step it took (the same numbers, bit for bit): ``(noise, kept, leaf, step)``. ``noise``:
+    :func:`symfruit.core.surface.depth_noise` of ``depth`` (h, w) float64 under ``mask`` (h, w) bool with ``floor``
+    (:func:`depth_noise`'s deviation); ``kept``: the mask's depths finite and above 0 in raster order
+    (``depth[mask]``'s :func:`finite_positive`), ``leaf`` ``leafy`` (h, w) bool at them where ``with_leafy`` (else
+    empty), as :func:`symfruit.core.surface.fruit_depth` takes them (numpy sorts them there, several times faster
+    than numba's sort); ``step``: :func:`depth_step` (stop 51)."""
+    n, mad = depth_noise(depth, mask)
+    noise = floor
+    if n < 10:
+        if 0.002 > noise:
+            noise = 0.002
+    else:
+        x = 1.4826 * mad / math.sqrt(2.0)
+        if x > noise:
+            noise = x
+    h, w = depth.shape
+    m = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                v = np.float64(depth[r, c])
+                m += np.isfinite(v) and v > 0
+    kept = np.empty(m)
+    leaf = np.empty(m if with_leafy else 0, np.bool_)
+    j = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                v = np.float64(depth[r, c])
+                if np.isfinite(v) and v > 0:
+                    kept[j] = v
+                    if with_leafy:
+                        leaf[j] = leafy[r, c]
+                    j += 1
+    return noise, kept, leaf, depth_step(depth, mask)
+
+
+@_njit
+def surface_cap(
+    depth: np.ndarray,
+    region: np.ndarray,
+    mask: np.ndarray,
+    r0: int,
+    c0: int,
+    r1: int,
+    c1: int,
+    iterations: int,
+    low: float,
+    high: float,
+    inner: np.ndarray,
+    have_inner: bool,
+    deep_px: float,
+    table: np.ndarray,
+    bins: int,
+    tolerance: float,
+    near: np.ndarray,
+    out: np.ndarray,
+) -> tuple[int, int, int]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface` from its slab on, in one call, each step the kernel it called (the
+    same pixels): ``near`` (h, w) bool the pixels of ``region`` with ``depth`` within ``low`` .. ``high``
+    (:func:`near_pixels`), the apex (:func:`surface_apex` of the mask's box ``r0:r1, c0:c1`` eroded ``iterations``
+    times, 5 x 5 medians) and ``out`` (h, w) bool, all false on entry, the convex cap from the apex
+    (:func:`monotone_at` with the sector ``table`` of ``bins`` sectors and ``tolerance``) or'd with the pixels of
+    ``near`` deeper than ``deep_px`` in the mask's distance map ``inner`` (h, w) float64: the caller's where
+    ``have_inner``, else made here as :func:`symfruit.core.raster.inner_distance` with reach ``max(deep_px, 0)``
+    makes it (:func:`near_distance` over the mask's box, ``r0:r1, c0:c1``, grown by a pixel; ``inner`` all 0 on
+    entry). ``(answer, row, column)``, ``answer`` 0 where ``near`` is empty (no surface), 1 done, 2 the apex found
+    but ``out`` left to the caller (the table too small for the apex's farthest pixel, or ``tolerance`` not finite:
+    ``monotone_region``'s other paths), 3 as 2 with ``inner`` left to the caller too (the grown box all the mask's:
+    ``inner_distance``'s other path; stop 51)."""
+    if not near_pixels(depth, region, low, high, near):
+        return 0, 0, 0
+    r, c = surface_apex(mask[r0:r1, c0:c1], iterations, near, depth, mask, r0, c0, 5)
+    h, w = near.shape
+    if not have_inner:
+        a0, a1, b0, b1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
+        full = True
+        for i in range(a0, a1):
+            for j in range(b0, b1):
+                full = full and mask[i, j]
+        if full:
+            return 3, r, c
+        near_distance(mask[a0:a1, b0:b1], max(deep_px, 0.0), False, inner[a0:a1, b0:b1])
+    reach = max(max(abs(r), abs(h - 1 - r)), max(abs(c), abs(w - 1 - c)))
+    half = (table.shape[0] - 1) // 2
+    if not math.isfinite(tolerance) or reach > half:
+        return 2, r, c
+    monotone_at(depth, near, r, c, table, half, bins, tolerance, out)
+    for i in range(h):
+        for j in range(w):
+            out[i, j] = out[i, j] or (near[i, j] and inner[i, j] > deep_px)
+    return 1, r, c

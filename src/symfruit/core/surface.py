@@ -78,7 +78,12 @@ class Surface:
     apex: tuple[int, int]
 
 
-def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -> float:
+#: :func:`depth_noise`'s least noise (metres), and an empty leaf image (:func:`fruit_surface`'s compiled measures).
+_NOISE_FLOOR = 0.0005
+_NO_LEAF = np.zeros((0, 0), bool)
+
+
+def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = _NOISE_FLOOR) -> float:
     """Depth noise (metres) of a surface: the robust spread of the differences between horizontally
     neighbouring depth pixels of ``mask``, divided by ``sqrt(2)``, at least ``floor``.
 
@@ -762,8 +767,12 @@ def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tu
     return np.diff(at), edges
 
 
+#: :func:`monotone_region`'s rays: this many sectors of directions.
+_RAYS = 72
+
+
 def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], tolerance: float,
-                    *, bins: int = 72) -> np.ndarray:  # fmt: skip
+                    *, bins: int = _RAYS) -> np.ndarray:  # fmt: skip
     """(h, w) bool: the pixels of ``keep`` reached from ``apex`` along straight image rays on which depth
     never falls more than ``tolerance`` below its running maximum.
 
@@ -963,18 +972,40 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     r0, r1, c0, c1 = found
     box = (slice(r0, r1), slice(c0, c1))
     own, own_depth = mask[box], depth[box]
-    noise = depth_noise(own_depth, own)
     # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
     radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
-    front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                leafy=None if leafy is None else leafy[box][own])  # fmt: skip
+    unit: float | None = None  # the depth's step, when measured with the noise and the front
+    leaf = None if leafy is None else leafy[box]
+    jit = compiled()
+    if (
+        jit is not None
+        and own.dtype == bool
+        and own_depth.dtype == np.float64
+        and (leafy is None or (np.shape(leafy) == np.shape(mask) and np.asarray(leafy).dtype == bool))
+    ):
+        # the noise, the mask's valid depths and the depth's step in one call, then the depth mode's kernel on them
+        # sorted (stop 51, surface51: fruit_depth's steps, the same numbers)
+        noise, kept, leaf_kept, unit = jit.mask_values(own_depth, own, _NO_LEAF if leaf is None else leaf,
+                                                       leaf is not None, _NOISE_FLOOR)  # fmt: skip
+        front, radius, done = jit.fruit_depth(np.sort(kept), kept, radius_px, float(focal), float(noise), leaf_kept,
+                                              leaf is not None, (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        front, radius = float(front), float(radius)
+        if not done:  # left to the twin (fruit_depth's kernel declines)
+            front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                        leafy=None if leaf is None else leaf[own])  # fmt: skip
+    else:
+        noise = depth_noise(own_depth, own)
+        front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                    leafy=None if leaf is None else leaf[own])  # fmt: skip
     if not np.isfinite(front):
         return None
     # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
     # known to a unit: without it a 3 mm tolerance on millimetre depth cuts every 3 mm fall that float32 rounding
     # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
     # camera's near fruit lost a third of its cap, issue 18)
-    tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
+    if step is None:
+        step = depth_step(own_depth, own) if unit is None else unit
+    tol = max(tolerance * noise, 0.003) + step
     around = None
     if thin:
         g = int(np.ceil(radius_px))  # the depth within the fruit's size around its mask's box
@@ -995,6 +1026,16 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
+    # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
+    # (a banana's inner side, a pear's neck) and is kept.
+    deep_px = interior * min(radius_px, 0.5 * minor_px)
+    if (jit := compiled()) is not None and depth.dtype == np.float64 and depth.ndim == 2 and (
+        np.shape(region) == np.shape(mask) == depth.shape
+    ):  # fmt: skip
+        # the slab's pixels, the apex, the convex cap and the deep pixels in one call (stop 51, surface51: the same)
+        return _surface_compiled(jit, depth, mask, np.asarray(region, dtype=bool), (r0, c0, r1, c1),
+                                 max(1, int(0.15 * radius_px)), (front - tol, front + slab * reach), tol, front,
+                                 radius, noise, inner, deep_px)  # fmt: skip
     if (jit := compiled()) is not None and depth.dtype == np.float64 and np.shape(region) == depth.shape:
         near = np.empty(depth.shape, bool)  # the compiled twin of the comparisons below: the same pixels
         if not jit.near_pixels(depth, np.asarray(region, dtype=bool), front - tol, front + slab * reach, near):
@@ -1021,10 +1062,35 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     else:
         first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
     apex = (int(rows[first]), int(cols[first]))
-    # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
-    # (a banana's inner side, a pear's neck) and is kept.
-    deep_px = interior * min(radius_px, 0.5 * minor_px)
     return _surface(depth, mask, near, apex, tol, front, radius, noise, inner, deep_px)
+
+
+def _surface_compiled(jit: Any, depth: np.ndarray, mask: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
+                      iterations: int, slab: tuple[float, float], tol: float, front: float, radius: float, noise: float,
+                      inner: np.ndarray | None, deep_px: float) -> Surface | None:  # fmt: skip
+    """:func:`fruit_surface` from its slab (depths ``slab``) on by :func:`symfruit.core._jit.surface_cap`: the pixels
+    of ``region`` in the slab, the apex (the mask's ``box`` eroded ``iterations`` times), the convex cap and the
+    pixels deeper than ``deep_px`` in the mask, each step the kernel it was, in one call; None where no pixel lies in
+    the slab. Where the cap is left to it (``monotone_region``'s other paths), :func:`monotone_region` (stop 51)."""
+    # the mask's distance map up to deep_px (farther +inf), as _surface takes it: the caller's, else made in the call
+    # (a bool mask; another made here, as before)
+    if (inner is None or inner.shape != mask.shape) and mask.dtype != bool:
+        inner = inner_distance(mask, max(deep_px, 0.0))
+    have = inner is not None and inner.shape == mask.shape
+    inner = np.asarray(inner, dtype=np.float64) if have else np.zeros(mask.shape)
+    near, pixels = np.empty(depth.shape, bool), np.zeros(depth.shape, bool)
+    table = _sector_table(_RAYS, 0)  # the sectors' table as it is (made the first time): grown by the twin's path
+    assert table is not None
+    answer, r, c = jit.surface_cap(depth, region, np.asarray(mask, dtype=bool), *box, iterations, *slab, inner, have,
+                                   float(deep_px), table, _RAYS, float(tol), near, pixels)  # fmt: skip
+    if answer == 0:
+        return None
+    apex = (int(r), int(c))
+    if answer == 3:  # the mask fills its box grown by a pixel: the whole transform
+        inner = inner_distance(mask, max(deep_px, 0.0))
+    if answer >= 2:
+        pixels = monotone_region(depth, near, apex, tol) | (near & (inner > deep_px))
+    return Surface(pixels, front, radius, noise, apex)
 
 
 def _surface(depth: np.ndarray, mask: np.ndarray, near: np.ndarray, apex: tuple[int, int], tol: float, front: float,
