@@ -6575,7 +6575,7 @@ def test_thin_passes_reach_every_answer_and_give_the_twins_parts():
 @settings(max_examples=150, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
 def test_mask_values_are_the_noise_depths_and_step_to_the_bit(seed, with_leafy, odd):
-    """``mask_values`` (then ``fruit_depth``'s kernel on its depths) on :func:`_sheet_scene`'s masks (with leaf pixels
+    """``mask_values`` (then ``depth_mode`` on its depths) on :func:`_sheet_scene`'s masks (with leaf pixels
     or not; with NaN, infinite and negative depths, and few pixels, or not): ``depth_noise``'s and ``depth_step``'s
     numpy twins' numbers, and the mask's depths and leaf pixels as ``fruit_depth`` keeps them (its twin's front and
     radius from them, bit for bit, wherever its kernel says it is done)."""
@@ -6590,8 +6590,8 @@ def test_mask_values_are_the_noise_depths_and_step_to_the_bit(seed, with_leafy, 
     radius_px = float(np.sqrt(np.count_nonzero(mask) / np.pi))
     noise, kept, leaf, step = _jit.mask_values(depth, mask, leafy if with_leafy else np.zeros((0, 0), bool),
                                                with_leafy, 0.0005)  # fmt: skip
-    front, radius, done = _jit.fruit_depth(np.sort(kept), kept, radius_px, 600.0, noise, leaf, with_leafy,
-                                           (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+    front, radius, done = _jit.depth_mode(kept, radius_px, 600.0, noise, leaf, with_leafy,
+                                          (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
     with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # inf - inf: NaN, left out there
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         want_noise = depth_noise(depth, mask)
@@ -6688,3 +6688,39 @@ def test_surface_cap_reaches_each_answer():
     answer, r, c = _jit.surface_cap(depth, full, full, 0, 0, 90, 150, 4, 0.49, 0.6, np.zeros(mask.shape), False, 8.0,
                                     table, 72, 0.003, near, out)  # fmt: skip
     assert answer == 3 and not out.any()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 4), st.booleans())
+def test_the_depth_mode_without_the_sort_is_fruit_depths_to_the_bit(seed, kind, with_leafy):
+    """``depth_mode`` (the depths not sorted) on depths of every kind (a fruit before a background, three layers,
+    millimetre steps with many equal values, a few depths, one value over and over, far-apart outliers; leaf pixels
+    or not): ``fruit_depth``'s kernel's numbers on the sorted depths, and where that declines it declines too; the
+    numpy twin's front and radius wherever it is done."""
+    from symfruit.core.surface import LEAFY, fruit_depth
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([3, 9, 10, 11, 12, 40, 400, 3000]))
+    if kind == 0:
+        kept = np.concatenate((rng.uniform(0.5, 0.53, n), rng.uniform(0.6, 1.2, int(rng.integers(0, n + 1)))))
+    elif kind == 1:
+        kept = np.concatenate([rng.normal(z, 0.003, int(rng.integers(1, n + 1))) for z in (0.45, 0.5, 0.8)])
+    elif kind == 2:
+        kept = np.round(rng.uniform(0.5, 0.6, n) * 1000.0) / 1000.0
+    elif kind == 3:
+        kept = np.full(n, rng.uniform(0.3, 2.0))
+    else:
+        kept = np.concatenate((rng.uniform(0.5, 0.52, n), rng.uniform(5.0, 60.0, 3)))
+    kept = np.abs(kept) + 1e-6
+    rng.shuffle(kept)
+    leaf = rng.random(len(kept)) < rng.uniform(0.0, 1.0) if with_leafy else np.zeros(0, bool)
+    shares = (float(LEAFY[0]), float(LEAFY[1]))
+    radius_px, noise = float(rng.uniform(3.0, 60.0)), float(rng.choice([0.0005, 0.002, 0.01]))
+    got = _jit.depth_mode(kept, radius_px, 600.0, noise, leaf, with_leafy, shares)
+    want = _jit.fruit_depth(np.sort(kept), kept, radius_px, 600.0, noise, leaf, with_leafy, shares)
+    assert got[2] == want[2] and np.array_equal(got[:2], want[:2], equal_nan=True)
+    if got[2]:
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = fruit_depth(kept, radius_px, 600.0, noise=noise, leafy=leaf if with_leafy else None)
+        assert np.array_equal(got[:2], twin, equal_nan=True)

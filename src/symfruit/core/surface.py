@@ -983,12 +983,12 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         and own_depth.dtype == np.float64
         and (leafy is None or (np.shape(leafy) == np.shape(mask) and np.asarray(leafy).dtype == bool))
     ):
-        # the noise, the mask's valid depths and the depth's step in one call, then the depth mode's kernel on them
-        # sorted (stop 51, surface51: fruit_depth's steps, the same numbers)
+        # the noise, the mask's valid depths and the depth's step in one call, then the depth mode on them without
+        # sorting them (stop 51, surface51: fruit_depth's steps, the same numbers)
         noise, kept, leaf_kept, unit = jit.mask_values(own_depth, own, _NO_LEAF if leaf is None else leaf,
                                                        leaf is not None, _NOISE_FLOOR)  # fmt: skip
-        front, radius, done = jit.fruit_depth(np.sort(kept), kept, radius_px, float(focal), float(noise), leaf_kept,
-                                              leaf is not None, (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        front, radius, done = jit.depth_mode(kept, radius_px, float(focal), float(noise), leaf_kept, leaf is not None,
+                                             (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
         front, radius = float(front), float(radius)
         if not done:  # left to the twin (fruit_depth's kernel declines)
             front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
