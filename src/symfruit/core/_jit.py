@@ -3481,9 +3481,14 @@ def _count_below(z: np.ndarray, x: float, right: bool) -> int:
 
 @_njit_inlined
 def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
-    """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient."""
+    """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient. The depths
+    between the edges counted on ``z``, the depths sorted, by bisection, or where ``z`` is empty on ``kept`` by a pass
+    (:func:`_below`; :func:`depth_mode`, stop 51): the same whole numbers."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
-    a, b = _count_below(z, lo, False), _count_below(z, hi, True)
+    if z.shape[0] > 0:
+        a, b = _count_below(z, lo, False), _count_below(z, hi, True)
+    else:
+        a, b = _below(kept, lo, False), _below(kept, hi, True)
     if b - a < 10:
         return 0.0
     count = 0
@@ -3512,74 +3517,16 @@ def fruit_depth(
         return np.nan, np.nan, True
     half = n // 2
     median = z[half] if n % 2 else (z[half - 1] + z[half]) / 2.0
-    radius = radius_px * median / focal
-    step = radius / 3.0
-    if 0.004 > step:
-        step = 0.004
-    if 2.0 * noise > step:
-        step = 2.0 * noise
-    c = np.ceil((z[n - 1] - z[0]) / step)
-    if not math.isfinite(c):  # the twin's int() refuses it
+    ok, n_bins, _, edges = _mode_edges(z[0], z[n - 1], median, radius_px, focal, noise)
+    if not ok:
         return np.nan, np.nan, False
-    if 1 > c:
-        c = 1.0
-    if 4096 < c:
-        c = 4096.0
-    n_bins = int(c)
-    lo, hi = z[0], z[0] + n_bins * step
-    if not lo < hi:
-        return np.nan, np.nan, False
-    delta = hi - lo
-    width = delta / n_bins
-    edges = np.empty(n_bins + 1)
-    for k in range(n_bins + 1):
-        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
-    edges[n_bins] = hi
     at = np.empty(n_bins + 1, np.int64)
     for k in range(n_bins):
         at[k] = _count_below(z, edges[k], False)
-    at[n_bins] = _count_below(z, hi, True)
-    counts = np.empty(n_bins, np.int64)
-    for k in range(n_bins):
-        counts[k] = at[k + 1] - at[k]
-    # np.convolve(counts, np.ones(3), mode="same"): max(n_bins, 3) values of the full convolution from the shorter
-    # array's half length on (with fewer than 3 bins the ones are the longer array, and the masses run past the bins)
-    size = max(n_bins, 3)
-    offset = 1 if n_bins >= 3 else 0
-    mass = np.zeros(size)
-    for k in range(size):
-        j = k + offset  # the full convolution's place: the bins j - 2 .. j
-        s = 0.0
-        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
-            s += counts[q]
-        mass[k] = s
-    top = mass.max()
-    i = -1
-    for k in range(size):
-        after = mass[k + 1] if k + 1 < size else -1.0
-        before = mass[k - 1] if k > 0 else -1.0
-        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * top:
-            i = k
-            break
-    if i < 0 or i >= n_bins:  # not met (the twin's masses run past the bins by two at most, its peak never)
+    at[n_bins] = _count_below(z, edges[n_bins], True)
+    found, a_edge, b_edge = _mode_bin(at, n, z, kept, leaf, edges, with_leafy, leafy_shares)
+    if not found:
         return np.nan, np.nan, False
-    if with_leafy and _leaf_share(z, kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
-        for k in range(i + 1, n_bins):
-            after = mass[k + 1] if k + 1 < size else -1.0
-            before = mass[k - 1] if k > 0 else -1.0
-            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * top):
-                continue
-            if _leaf_share(z, kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
-                i = k
-                break
-    least = 0.01 * n
-    if 2 > least:
-        least = 2.0
-    first = i
-    while first > 0 and counts[first - 1] >= least:
-        first -= 1
-    a_edge = edges[first]
-    b_edge = edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
     a, b = _count_below(z, a_edge, False), _count_below(z, b_edge, True)
     size = b - a
     if size < 1:
@@ -8821,29 +8768,10 @@ def depth_mode(
             z_first = v
         if v > z_last:
             z_last = v
-    radius = radius_px * median / focal
-    step = radius / 3.0
-    if 0.004 > step:
-        step = 0.004
-    if 2.0 * noise > step:
-        step = 2.0 * noise
-    c = np.ceil((z_last - z_first) / step)
-    if not math.isfinite(c):
+    ok, n_bins, width, edges = _mode_edges(z_first, z_last, median, radius_px, focal, noise)
+    if not ok:
         return np.nan, np.nan, False
-    if 1 > c:
-        c = 1.0
-    if 4096 < c:
-        c = 4096.0
-    n_bins = int(c)
-    lo, hi = z_first, z_first + n_bins * step
-    if not lo < hi:
-        return np.nan, np.nan, False
-    delta = hi - lo
-    width = delta / n_bins
-    edges = np.empty(n_bins + 1)
-    for k in range(n_bins + 1):
-        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
-    edges[n_bins] = hi
+    lo, hi = edges[0], edges[n_bins]
     # a value's place among the first n_bins edges: how many of them lie at or below it (they never fall); it lies
     # below edge k exactly where k is at least its place. Guessed from the bin width, then moved while an edge says
     # otherwise (a step or none: branches a processor foresees, where a bisection's are a coin's toss each)
@@ -8864,45 +8792,9 @@ def depth_mode(
         run += places[k]
         at[k] = run
     at[n_bins] = top
-    counts = np.empty(n_bins, np.int64)
-    for k in range(n_bins):
-        counts[k] = at[k + 1] - at[k]
-    size = max(n_bins, 3)
-    offset = 1 if n_bins >= 3 else 0
-    mass = np.zeros(size)
-    for k in range(size):
-        j = k + offset
-        s = 0.0
-        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
-            s += counts[q]
-        mass[k] = s
-    most = mass.max()
-    i = -1
-    for k in range(size):
-        after = mass[k + 1] if k + 1 < size else -1.0
-        before = mass[k - 1] if k > 0 else -1.0
-        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * most:
-            i = k
-            break
-    if i < 0 or i >= n_bins:
+    found, a_edge, b_edge = _mode_bin(at, n, np.empty(0), kept, leaf, edges, with_leafy, leafy_shares)
+    if not found:
         return np.nan, np.nan, False
-    if with_leafy and _leaf_share_of(kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
-        for k in range(i + 1, n_bins):
-            after = mass[k + 1] if k + 1 < size else -1.0
-            before = mass[k - 1] if k > 0 else -1.0
-            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * most):
-                continue
-            if _leaf_share_of(kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
-                i = k
-                break
-    least = 0.01 * n
-    if 2 > least:
-        least = 2.0
-    first = i
-    while first > 0 and counts[first - 1] >= least:
-        first -= 1
-    a_edge = edges[first]
-    b_edge = edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
     size = _below(kept, b_edge, True) - _below(kept, a_edge, False)
     if size < 1:
         return np.nan, np.nan, False
@@ -8924,14 +8816,88 @@ def depth_mode(
 
 
 @_njit_inlined
-def _leaf_share_of(kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
-    """:func:`_leaf_share` of the depths not sorted (:func:`_below`'s counts): the same counts, the same quotient."""
-    lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
-    a, b = _below(kept, lo, False), _below(kept, hi, True)
-    if b - a < 10:
-        return 0.0
-    count = 0
-    for j in range(kept.shape[0]):
-        if leaf[j] and kept[j] >= lo and kept[j] <= hi:
-            count += 1
-    return count / (b - a)
+def _mode_edges(
+    z_first: float, z_last: float, median: float, radius_px: float, focal: float, noise: float
+) -> tuple[bool, int, float, np.ndarray]:  # fmt: skip
+    """:func:`fruit_depth`'s bins of the depths from ``z_first`` to ``z_last`` (their least and greatest) with their
+    ``median``: ``(ok, n_bins, width, edges)``, the edges as ``np.linspace`` makes them (``i * width + lo``, the last
+    one the range's end) and their width; ``ok`` False where the twin is to run instead (a bin count ``int()``
+    refuses, a range numpy widens). Shared by :func:`fruit_depth` and :func:`depth_mode` (stop 51)."""
+    radius = radius_px * median / focal
+    step = radius / 3.0
+    if 0.004 > step:
+        step = 0.004
+    if 2.0 * noise > step:
+        step = 2.0 * noise
+    c = np.ceil((z_last - z_first) / step)
+    if not math.isfinite(c):  # the twin's int() refuses it
+        return False, 0, 0.0, np.empty(0)
+    if 1 > c:
+        c = 1.0
+    if 4096 < c:
+        c = 4096.0
+    n_bins = int(c)
+    lo, hi = z_first, z_first + n_bins * step
+    if not lo < hi:
+        return False, 0, 0.0, np.empty(0)
+    delta = hi - lo
+    width = delta / n_bins
+    edges = np.empty(n_bins + 1)
+    for k in range(n_bins + 1):
+        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
+    edges[n_bins] = hi
+    return True, n_bins, width, edges
+
+
+@_njit_inlined
+def _mode_bin(
+    at: np.ndarray, n: int, z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, with_leafy: bool,
+    leafy_shares: tuple[float, float],
+) -> tuple[bool, float, float]:  # fmt: skip
+    """:func:`fruit_depth`'s front bin from the counts below each edge ``at`` (n_bins + 1,) of the ``n`` depths: the
+    three-bin masses (``np.convolve``'s ``"same"`` window of sums of whole numbers: exact), the first peak holding
+    half the largest mass, the leaf test's shares (``leaf`` aligned with ``kept``; counted on ``z``, the depths sorted,
+    or on ``kept`` where ``z`` is empty: the same whole numbers) and the walk nearer over filled bins: ``(found,
+    a_edge, b_edge)``, the depths of the front's quantile lying from ``a_edge`` to ``b_edge`` (both included);
+    ``found`` False where no peak is met. Shared by :func:`fruit_depth` and :func:`depth_mode` (stop 51)."""
+    n_bins = at.shape[0] - 1
+    counts = np.empty(n_bins, np.int64)
+    for k in range(n_bins):
+        counts[k] = at[k + 1] - at[k]
+    # np.convolve(counts, np.ones(3), mode="same"): max(n_bins, 3) values of the full convolution from the shorter
+    # array's half length on (with fewer than 3 bins the ones are the longer array, and the masses run past the bins)
+    size = max(n_bins, 3)
+    offset = 1 if n_bins >= 3 else 0
+    mass = np.zeros(size)
+    for k in range(size):
+        j = k + offset  # the full convolution's place: the bins j - 2 .. j
+        s = 0.0
+        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
+            s += counts[q]
+        mass[k] = s
+    top = mass.max()
+    i = -1
+    for k in range(size):
+        after = mass[k + 1] if k + 1 < size else -1.0
+        before = mass[k - 1] if k > 0 else -1.0
+        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * top:
+            i = k
+            break
+    if i < 0 or i >= n_bins:  # not met (the twin's masses run past the bins by two at most, its peak never)
+        return False, 0.0, 0.0
+    if with_leafy and _leaf_share(z, kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
+        for k in range(i + 1, n_bins):
+            after = mass[k + 1] if k + 1 < size else -1.0
+            before = mass[k - 1] if k > 0 else -1.0
+            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * top):
+                continue
+            if _leaf_share(z, kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
+                i = k
+                break
+    least = 0.01 * n
+    if 2 > least:
+        least = 2.0
+    first = i
+    while first > 0 and counts[first - 1] >= least:
+        first -= 1
+    return True, edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
