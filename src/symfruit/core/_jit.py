@@ -3485,17 +3485,23 @@ def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.nda
     between the edges counted on ``z``, the depths sorted, by bisection, or where ``z`` is empty on ``kept`` by a pass
     (:func:`_below`; :func:`depth_mode`, stop 51): the same whole numbers."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
-    if z.shape[0] > 0:
-        a, b = _count_below(z, lo, False), _count_below(z, hi, True)
-    else:
-        a, b = _below(kept, lo, False), _below(kept, hi, True)
-    if b - a < 10:
-        return 0.0
     count = 0
-    for j in range(kept.shape[0]):
-        if leaf[j] and kept[j] >= lo and kept[j] <= hi:
-            count += 1
-    return count / (b - a)
+    if z.shape[0] > 0:
+        between = _count_below(z, hi, True) - _count_below(z, lo, False)
+        if between < 10:
+            return 0.0
+        for j in range(kept.shape[0]):
+            if leaf[j] and kept[j] >= lo and kept[j] <= hi:
+                count += 1
+    else:  # both counts in the one pass (the depths from lo to hi, lo <= hi: as many as the sorted ones between)
+        between = 0
+        for j in range(kept.shape[0]):
+            inside = kept[j] >= lo and kept[j] <= hi
+            between += inside
+            count += leaf[j] and inside
+        if between < 10:
+            return 0.0
+    return count / between
 
 
 @_njit
