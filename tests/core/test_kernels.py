@@ -6665,3 +6665,280 @@ def test_the_extent_is_the_twins(seed):
         points = rng.uniform(-50.0, 50.0, (int(rng.integers(1, 30)), 2))
         fast, twin = _both(mp, _extent, points, mask)
         assert fast == twin
+
+
+# --- stop 51, surface51: thin_front's passes in one call -----------------------------------------------------------
+
+
+def _sheet_scene(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray, tuple[int, int, int, int]]:
+    """(depth, mask, window depth, box) of a fruit's cap seen at 0.4-1.5 m: alone, behind a flat or tilted sheet a few
+    mm to 3 cm in front over part of its mask (cut at the mask or running on beyond it), with a patch behind, noise of
+    0-3 mm, depth repeated from a coarser camera's pixels or rounded to millimetres, holes; the mask cut through its
+    front or not. ``depth`` and ``mask`` are the mask's box of the window (``box``: rows and columns there)."""
+    h, w = (int(x) for x in rng.integers(40, 110, 2))
+    rr, cc = np.mgrid[:h, :w].astype(np.float64)
+    cy, cx = rng.uniform(0.35, 0.65) * h, rng.uniform(0.35, 0.65) * w
+    r_px = rng.uniform(0.15, 0.35) * min(h, w)
+    d2 = (rr - cy) ** 2 + (cc - cx) ** 2
+    disc = d2 <= r_px**2
+    z0 = rng.uniform(0.4, 1.5)
+    r_m = r_px * z0 / 600.0
+    depth = np.where(disc, z0 + r_m - np.sqrt(np.clip(r_m**2 - d2 * (z0 / 600.0) ** 2, 0.0, None)), 0.0)
+    depth = np.where(disc, depth, z0 + rng.uniform(0.05, 0.4))  # what lies behind
+    mask = disc.copy()
+    if rng.random() < 0.3:
+        mask &= cc <= cx + rng.uniform(-0.3, 0.6) * r_px  # cut through its front: the front reaches the outline
+    kind = int(rng.integers(0, 4))
+    if kind:
+        a = rng.uniform(0, 2 * np.pi)
+        side = np.cos(a) * (cc - cx) + np.sin(a) * (rr - cy) < rng.uniform(-0.5, 0.6) * r_px
+        sheet = side & (disc if kind == 1 else np.ones_like(disc))
+        tilt = rng.uniform(-1.0, 1.0) * 1e-4 if kind == 3 else 0.0
+        depth = np.where(sheet, z0 - rng.uniform(0.004, 0.03) + tilt * (cc - cx), depth)
+    if rng.random() < 0.3:
+        patch = (np.abs(rr - cy - 0.5 * r_px) < 3) & (np.abs(cc - cx) < 6)
+        depth = np.where(patch, depth + 0.2, depth)
+    noise = float(rng.choice([0.0, 0.0005, 0.001, 0.002, 0.003]))
+    depth = depth + rng.normal(0.0, noise, depth.shape)
+    coarse = int(rng.integers(1, 3))
+    if coarse > 1:  # a coarser camera's pixels repeated
+        depth = np.repeat(np.repeat(depth[::coarse, ::coarse], coarse, 0), coarse, 1)[:h, :w]
+    if rng.random() < 0.3:
+        depth = np.round(depth * 1000.0) / 1000.0
+    depth[rng.random(depth.shape) < rng.uniform(0.0, 0.1)] = 0.0
+    rows, cols = np.nonzero(mask)
+    r0, r1, c0, c1 = rows.min(), rows.max() + 1, cols.min(), cols.max() + 1
+    return depth[r0:r1, c0:c1].copy(), mask[r0:r1, c0:c1].copy(), depth, (int(r0), int(c0), int(h), int(w))
+
+
+def _thin_case(rng: np.random.Generator) -> tuple[tuple, dict]:
+    """``thin_front``'s arguments on a :func:`_sheet_scene`, as ``fruit_surface`` makes them (its noise, front, radius
+    and the convexity test's tolerance as the join; with the window's depth as ``around`` or not)."""
+    from symfruit.core.surface import Around, depth_noise, fruit_depth
+
+    depth, mask, window, (r0, c0, _, _) = _sheet_scene(rng)
+    noise = depth_noise(depth, mask)
+    radius_px = float(np.sqrt(np.count_nonzero(mask) / np.pi))
+    front, radius = fruit_depth(depth[mask], radius_px, 600.0, noise=noise)
+    join = max(3.0 * noise, 0.003) + float(rng.choice([0.0, 0.001]))
+    big = np.zeros(window.shape, bool)
+    big[r0 : r0 + mask.shape[0], c0 : c0 + mask.shape[1]] = mask
+    around = Around(window, big, r0, c0) if rng.random() < 0.5 else None
+    return (depth, mask, 600.0, front, radius, join, noise), {"around": around}
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_thin_front_by_its_passes_in_one_call_is_the_twins_to_the_bit(seed):
+    """``thin_front`` (``thin_passes``: the counts, the outline test, both partitions and their sizes, the 5 x 5
+    median and its noise in one call, the fits in numpy between) with the kernels and with the numpy twins on caps
+    alone and behind sheets of every kind: the same answer, front and sheet pixels, bit for bit."""
+    from symfruit.core.surface import thin_front
+
+    args, kwargs = _thin_case(np.random.default_rng(seed))
+    if not np.isfinite(args[3]):
+        return
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, thin_front, *args, **kwargs)
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert fast[0] == twin[0] and fast[1].dtype == twin[1].dtype and np.array_equal(fast[1], twin[1])
+
+
+def test_thin_passes_reach_every_answer_and_give_the_twins_parts():
+    """``thin_passes`` on 120 :func:`_sheet_scene` cases reaches each of its answers, and where it hands a partition
+    back, its labels, sizes and near counts are ``_smooth_parts``' and ``_part_sizes``' numpy twins' (of the depth at
+    the join, or of the 5 x 5 median at its narrower join); where it asks for the fit, the pixels are
+    ``_thin_counts``'; its counts and ``ok`` always are."""
+    import symfruit.core.surface as surface
+
+    seen = set()
+    for seed in range(120):
+        (depth, mask, _, front, _, join, noise), _ = _thin_case(np.random.default_rng(seed))
+        if not np.isfinite(front):
+            continue
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            want_ok, want_counts, want_rows, want_cols = surface._thin_counts(depth, mask, front, join)
+            parts, count = surface._smooth_parts(depth, mask, join)
+            smooth, diff = surface._lag_differences(surface._window_medians(depth, want_ok), want_ok, mask, 5)
+            sigma = 1.4826 * float(surface.median(np.abs(diff - surface.median(diff)))) / np.sqrt(2.0) if len(
+                diff) else 0.0  # fmt: skip
+            narrow = min(join, max(3.0 * sigma, 0.003))
+            smoothed, smooth_count = surface._smooth_parts(smooth, mask, narrow)
+        ok, counts, labels = np.empty(depth.shape, bool), np.empty(5, np.int64), np.empty(depth.shape, np.int32)
+        answers = []
+        for stage in (0, 1, 2):
+            answer, rows, cols, n, sizes, near = _jit.thin_passes(depth, mask, front, join, noise, stage, ok, counts,
+                                                                  labels)  # fmt: skip
+            assert np.array_equal(ok, want_ok) and np.array_equal(counts, want_counts)
+            answers.append(answer)
+            if answer == _jit.THIN_FIT:
+                assert np.array_equal(rows, want_rows) and np.array_equal(cols, want_cols)
+            if answer in (_jit.THIN_SHEET, _jit.THIN_SMOOTHED):
+                p, k = (parts, count) if answer == _jit.THIN_SHEET else (smoothed, smooth_count)
+                assert n == k and np.array_equal(labels, p)
+                want_sizes, want_near = surface._part_sizes(p, k, depth, front, join)
+                assert np.array_equal(sizes, want_sizes) and np.array_equal(near, want_near)
+        # stage 0 goes on as stage 1 unless it asks for the fit, stage 1 as stage 2 unless it hands a partition back
+        assert answers[0] in (_jit.THIN_FIT, answers[1]) and answers[1] in (_jit.THIN_SHEET, answers[2])
+        assert answers[2] in (_jit.THIN_NONE, _jit.THIN_SMOOTHED)
+        seen.update(answers)
+    assert seen == {_jit.THIN_NONE, _jit.THIN_FIT, _jit.THIN_SHEET, _jit.THIN_SMOOTHED}
+
+
+# --- stop 51, surface51: fruit_surface's depth mode and its cap in one call each -----------------------------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans())
+def test_mask_values_are_the_noise_depths_and_step_to_the_bit(seed, with_leafy, odd):
+    """``mask_values`` (then ``depth_mode`` on its depths) on :func:`_sheet_scene`'s masks (with leaf pixels
+    or not; with NaN, infinite and negative depths, and few pixels, or not): ``depth_noise``'s and ``depth_step``'s
+    numpy twins' numbers, and the mask's depths and leaf pixels as ``fruit_depth`` keeps them (its twin's front and
+    radius from them, bit for bit, wherever its kernel says it is done)."""
+    from symfruit.core.surface import LEAFY, depth_noise, depth_step, fruit_depth
+
+    rng = np.random.default_rng(seed)
+    depth, mask, _, _ = _sheet_scene(rng)
+    if odd:
+        depth[rng.random(depth.shape) < 0.05] = rng.choice([np.nan, np.inf, -0.5])
+        mask &= rng.random(mask.shape) < rng.choice([0.02, 0.5, 1.0])
+    leafy = rng.random(depth.shape) < rng.uniform(0.0, 1.0)
+    radius_px = float(np.sqrt(np.count_nonzero(mask) / np.pi))
+    noise, kept, leaf, step = _jit.mask_values(depth, mask, leafy if with_leafy else np.zeros((0, 0), bool),
+                                               with_leafy, 0.0005)  # fmt: skip
+    front, radius, done = _jit.depth_mode(kept, radius_px, 600.0, noise, leaf, with_leafy,
+                                          (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # inf - inf: NaN, left out there
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want_noise = depth_noise(depth, mask)
+        want = fruit_depth(depth[mask], radius_px, 600.0, noise=want_noise, leafy=leafy[mask] if with_leafy else None)
+        want_step = depth_step(depth, mask)
+    assert noise == want_noise and step == want_step
+    valid = np.isfinite(depth[mask]) & (depth[mask] > 0)
+    assert np.array_equal(kept, depth[mask][valid]) and np.array_equal(leaf, leafy[mask][valid] if with_leafy else [])
+    if done:
+        assert np.array_equal((front, radius), want, equal_nan=True)
+    else:
+        assert math.isnan(front) and math.isnan(radius)
+
+
+def _surface_case(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, dict]:
+    """A window's depth and mask (:func:`_sheet_scene`'s) and ``fruit_surface``'s keywords as its callers give them:
+    the registration's (a region grown beyond the mask, the mask's distance map, no unit, ``thin``) or extraction's
+    (leaf pixels, ``thin`` and ``crossing``; the convexity test off, an infinite tolerance, now and then)."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance
+
+    _, _, depth, (r0, c0, h, w) = _sheet_scene(rng)
+    _, mask, _, _ = _sheet_scene(np.random.default_rng(int(rng.integers(2**32))))
+    big = np.zeros((h, w), bool)
+    mh, mw = min(mask.shape[0], h - r0), min(mask.shape[1], w - c0)
+    big[r0 : r0 + mh, c0 : c0 + mw] = mask[:mh, :mw]
+    if rng.random() < 0.5:
+        grown = ndimage.binary_dilation(big, iterations=int(rng.integers(1, 8)))
+        return depth, big, {"region": grown, "inner": inner_distance(big), "step": 0.0, "thin": True}
+    leafy = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    tolerance = np.inf if rng.random() < 0.2 else 3.0
+    return depth, big, {"leafy": leafy, "thin": True, "crossing": True, "tolerance": tolerance}
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_fruit_surface_by_its_compiled_measures_and_cap_is_the_twins_to_the_bit(seed, fresh):
+    """``fruit_surface`` (``mask_values``, ``thin_passes`` and ``surface_cap`` with the fits and the principal widths
+    between) with the kernels and with the numpy twins, as the registration and extraction call it on a cap alone
+    and behind sheets: the same pixels, front, radius, noise and apex, bit for bit; ``fresh``: the sectors' table
+    not made yet (so the first cap reaching beyond 64 px from its apex is left to ``monotone_region``, which grows
+    it)."""
+    import symfruit.core.surface as surface
+
+    depth, mask, kwargs = _surface_case(np.random.default_rng(seed))
+    with pytest.MonkeyPatch.context() as mp:
+        if fresh:
+            mp.setattr(surface, "_SECTORS", {})
+        fast, twin = _both(mp, surface.fruit_surface, depth, mask, 600.0, **kwargs)
+    assert (fast is None) == (twin is None)
+    if fast is not None:
+        assert (fast.front, fast.radius, fast.noise, fast.apex) == (twin.front, twin.radius, twin.noise, twin.apex)
+        assert fast.pixels.dtype == twin.pixels.dtype and np.array_equal(fast.pixels, twin.pixels)
+
+
+def test_surface_cap_reaches_each_answer():
+    """``surface_cap`` on a disc's depth: no pixel in the slab (0); the cap done (1), its pixels ``monotone_region``'s
+    or'd with the deep ones (the distance map given, or made in the call as ``inner_distance`` makes it); left to the
+    caller (2) with the tolerance infinite or the sectors' table too small for the apex's farthest pixel, the apex the
+    same; and (3) the map left to the caller too where the mask fills its box grown by a pixel."""
+    from scipy import ndimage
+
+    from symfruit.core.raster import inner_distance
+    from symfruit.core.surface import _sector_table, monotone_region
+
+    yy, xx = np.mgrid[:90, :150]
+    d2 = (yy - 45.0) ** 2 + (xx - 75.0) ** 2
+    mask = d2 <= 30.0**2
+    depth = np.where(mask, 0.5 + d2 * 1e-5, 0.9)
+    inner = ndimage.distance_transform_edt(mask)
+    table = _sector_table(72, 80)
+    mid = table.shape[0] // 2
+    small = table[mid - 40 : mid + 41, mid - 40 : mid + 41].copy()  # offsets within 40 px alone
+    answers = []
+    for low, high, tol, tab in ((0.1, 0.2, 0.003, table), (0.49, 0.6, 0.003, table), (0.49, 0.6, np.inf, table),
+                                (0.49, 0.6, 0.003, small)):  # fmt: skip
+        near, out = np.empty(mask.shape, bool), np.zeros(mask.shape, bool)
+        for have in (True, False):
+            made = inner.copy() if have else np.zeros(mask.shape)
+            out[:] = False
+            answer, r, c = _jit.surface_cap(depth, mask, mask, 15, 45, 76, 106, 4, low, high, made, have, 8.0, tab,
+                                            72, tol, near, out)  # fmt: skip
+            answers.append(answer)
+            if answer:
+                assert (r, c) == (45, 75) and np.array_equal(near, mask & (depth >= low) & (depth <= high))
+            if answer == 1:
+                deep = (inner if have else inner_distance(mask, 8.0)) > 8.0
+                assert np.array_equal(out, monotone_region(depth, near, (45, 75), tol) | (near & deep))
+                assert have or np.array_equal(made, inner_distance(mask, 8.0))
+    assert answers == [0, 0, 1, 1, 2, 2, 2, 2]
+    full = np.ones(mask.shape, bool)  # its box grown by a pixel (clipped) all the mask's
+    near, out = np.empty(mask.shape, bool), np.zeros(mask.shape, bool)
+    answer, r, c = _jit.surface_cap(depth, full, full, 0, 0, 90, 150, 4, 0.49, 0.6, np.zeros(mask.shape), False, 8.0,
+                                    table, 72, 0.003, near, out)  # fmt: skip
+    assert answer == 3 and not out.any()
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 4), st.booleans())
+def test_the_depth_mode_without_the_sort_is_fruit_depths_to_the_bit(seed, kind, with_leafy):
+    """``depth_mode`` (the depths not sorted) on depths of every kind (a fruit before a background, three layers,
+    millimetre steps with many equal values, a few depths, one value over and over, far-apart outliers; leaf pixels
+    or not): ``fruit_depth``'s kernel's numbers on the sorted depths, and where that declines it declines too; the
+    numpy twin's front and radius wherever it is done."""
+    from symfruit.core.surface import LEAFY, fruit_depth
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([3, 9, 10, 11, 12, 40, 400, 3000]))
+    if kind == 0:
+        kept = np.concatenate((rng.uniform(0.5, 0.53, n), rng.uniform(0.6, 1.2, int(rng.integers(0, n + 1)))))
+    elif kind == 1:
+        kept = np.concatenate([rng.normal(z, 0.003, int(rng.integers(1, n + 1))) for z in (0.45, 0.5, 0.8)])
+    elif kind == 2:
+        kept = np.round(rng.uniform(0.5, 0.6, n) * 1000.0) / 1000.0
+    elif kind == 3:
+        kept = np.full(n, rng.uniform(0.3, 2.0))
+    else:
+        kept = np.concatenate((rng.uniform(0.5, 0.52, n), rng.uniform(5.0, 60.0, 3)))
+    kept = np.abs(kept) + 1e-6
+    rng.shuffle(kept)
+    leaf = rng.random(len(kept)) < rng.uniform(0.0, 1.0) if with_leafy else np.zeros(0, bool)
+    shares = (float(LEAFY[0]), float(LEAFY[1]))
+    radius_px, noise = float(rng.uniform(3.0, 60.0)), float(rng.choice([0.0005, 0.002, 0.01]))
+    got = _jit.depth_mode(kept, radius_px, 600.0, noise, leaf, with_leafy, shares)
+    want = _jit.fruit_depth(np.sort(kept), kept, radius_px, 600.0, noise, leaf, with_leafy, shares)
+    assert got[2] == want[2] and np.array_equal(got[:2], want[:2], equal_nan=True)
+    if got[2]:
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = fruit_depth(kept, radius_px, 600.0, noise=noise, leafy=leaf if with_leafy else None)
+        assert np.array_equal(got[:2], twin, equal_nan=True)

@@ -3487,16 +3487,27 @@ def _count_below(z: np.ndarray, x: float, right: bool) -> int:
 
 @_njit_inlined
 def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
-    """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient."""
+    """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient. The depths
+    between the edges counted on ``z``, the depths sorted, by bisection, or where ``z`` is empty on ``kept`` by a pass
+    (:func:`_below`; :func:`depth_mode`, stop 51): the same whole numbers."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
-    a, b = _count_below(z, lo, False), _count_below(z, hi, True)
-    if b - a < 10:
-        return 0.0
     count = 0
-    for j in range(kept.shape[0]):
-        if leaf[j] and kept[j] >= lo and kept[j] <= hi:
-            count += 1
-    return count / (b - a)
+    if z.shape[0] > 0:
+        between = _count_below(z, hi, True) - _count_below(z, lo, False)
+        if between < 10:
+            return 0.0
+        for j in range(kept.shape[0]):
+            if leaf[j] and kept[j] >= lo and kept[j] <= hi:
+                count += 1
+    else:  # both counts in the one pass (the depths from lo to hi, lo <= hi: as many as the sorted ones between)
+        between = 0
+        for j in range(kept.shape[0]):
+            inside = kept[j] >= lo and kept[j] <= hi
+            between += inside
+            count += leaf[j] and inside
+        if between < 10:
+            return 0.0
+    return count / between
 
 
 @_njit
@@ -3518,74 +3529,16 @@ def fruit_depth(
         return np.nan, np.nan, True
     half = n // 2
     median = z[half] if n % 2 else (z[half - 1] + z[half]) / 2.0
-    radius = radius_px * median / focal
-    step = radius / 3.0
-    if 0.004 > step:
-        step = 0.004
-    if 2.0 * noise > step:
-        step = 2.0 * noise
-    c = np.ceil((z[n - 1] - z[0]) / step)
-    if not math.isfinite(c):  # the twin's int() refuses it
+    ok, n_bins, _, edges = _mode_edges(z[0], z[n - 1], median, radius_px, focal, noise)
+    if not ok:
         return np.nan, np.nan, False
-    if 1 > c:
-        c = 1.0
-    if 4096 < c:
-        c = 4096.0
-    n_bins = int(c)
-    lo, hi = z[0], z[0] + n_bins * step
-    if not lo < hi:
-        return np.nan, np.nan, False
-    delta = hi - lo
-    width = delta / n_bins
-    edges = np.empty(n_bins + 1)
-    for k in range(n_bins + 1):
-        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
-    edges[n_bins] = hi
     at = np.empty(n_bins + 1, np.int64)
     for k in range(n_bins):
         at[k] = _count_below(z, edges[k], False)
-    at[n_bins] = _count_below(z, hi, True)
-    counts = np.empty(n_bins, np.int64)
-    for k in range(n_bins):
-        counts[k] = at[k + 1] - at[k]
-    # np.convolve(counts, np.ones(3), mode="same"): max(n_bins, 3) values of the full convolution from the shorter
-    # array's half length on (with fewer than 3 bins the ones are the longer array, and the masses run past the bins)
-    size = max(n_bins, 3)
-    offset = 1 if n_bins >= 3 else 0
-    mass = np.zeros(size)
-    for k in range(size):
-        j = k + offset  # the full convolution's place: the bins j - 2 .. j
-        s = 0.0
-        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
-            s += counts[q]
-        mass[k] = s
-    top = mass.max()
-    i = -1
-    for k in range(size):
-        after = mass[k + 1] if k + 1 < size else -1.0
-        before = mass[k - 1] if k > 0 else -1.0
-        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * top:
-            i = k
-            break
-    if i < 0 or i >= n_bins:  # not met (the twin's masses run past the bins by two at most, its peak never)
+    at[n_bins] = _count_below(z, edges[n_bins], True)
+    found, a_edge, b_edge = _mode_bin(at, n, z, kept, leaf, edges, with_leafy, leafy_shares)
+    if not found:
         return np.nan, np.nan, False
-    if with_leafy and _leaf_share(z, kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
-        for k in range(i + 1, n_bins):
-            after = mass[k + 1] if k + 1 < size else -1.0
-            before = mass[k - 1] if k > 0 else -1.0
-            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * top):
-                continue
-            if _leaf_share(z, kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
-                i = k
-                break
-    least = 0.01 * n
-    if 2 > least:
-        least = 2.0
-    first = i
-    while first > 0 and counts[first - 1] >= least:
-        first -= 1
-    a_edge = edges[first]
-    b_edge = edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
     a, b = _count_below(z, a_edge, False), _count_below(z, b_edge, True)
     size = b - a
     if size < 1:
@@ -8784,3 +8737,387 @@ def widest_pair(vertices: np.ndarray) -> float:
             dx, dy = x - vertices[j, 0], y - vertices[j, 1]
             best = max(best, dx * dx + dy * dy)
     return best
+
+
+# --- stop 51, surface51: thin_front's passes in one call -------------------------------------------------------------
+
+#: :func:`thin_passes`' answers: the test ends, None (``THIN_NONE``); the front pixels want the curvature fit
+#: (``THIN_FIT``); the first partition, then the one of the 5 x 5 median, wants the rest of ``_behind_sheet``
+#: (``THIN_SHEET``, ``THIN_SMOOTHED``).
+THIN_NONE, THIN_FIT, THIN_SHEET, THIN_SMOOTHED = 0, 1, 2, 3
+
+
+@_njit_inlined
+def _sheet_sizes(
+    labels: np.ndarray, count: int, depth: np.ndarray, front: float, join: float
+) -> tuple[bool, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface._behind_sheet`'s tests before its fits on the partition ``labels`` (0 none,
+    1..``count``): whether they pass (False where it returns None: fewer than two parts, no part near ``front``, the
+    sheet (the first part holding the most pixels near it, ``np.argmax``'s) under 30 pixels, no other part holding
+    ``max(30, 0.1 n_sheet)``), and :func:`part_sizes`' counts. Whole numbers: the same answer."""
+    if count < 2:
+        return False, np.zeros(0, np.int64), np.zeros(0, np.int64)
+    sizes, near = part_sizes(labels, count, depth, front, join)
+    sheet = 0
+    best = 0
+    for k in range(1, count + 1):
+        if near[k] > best:
+            sheet, best = k, near[k]
+    if sheet == 0:
+        return False, sizes, near
+    n_sheet = sizes[sheet]
+    if n_sheet < 30:
+        return False, sizes, near
+    largest = 0
+    for k in range(1, count + 1):
+        if k != sheet and sizes[k] > largest:
+            largest = sizes[k]
+    return not (largest < 30 or largest < 0.1 * n_sheet), sizes, near
+
+
+@_njit
+def thin_passes(
+    depth: np.ndarray,
+    mask: np.ndarray,
+    front: float,
+    join: float,
+    noise: float,
+    stage: int,
+    ok: np.ndarray,
+    counts: np.ndarray,
+    labels: np.ndarray,
+) -> tuple[int, np.ndarray, np.ndarray, int, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`symfruit.core.surface.thin_front`'s passes between its fits in one call, each the kernel it called (the
+    same pixels, parts and numbers): ``(answer, rows, cols, count, sizes, near)``, ``answer`` one of ``THIN_*``.
+
+    ``stage`` 0 from the start: :func:`thin_counts` (``ok`` (h, w) bool and ``counts`` (5,) int64 written in place,
+    the front pixels ``rows, cols`` returned) and, with at least 30 front pixels, :func:`reaches_outline`; where they
+    do not reach the mask's outline, ``THIN_FIT`` (the caller fits them and comes back with stage 1). Stage 1:
+    :func:`smooth_parts` of ``depth`` joined at ``join`` into ``labels`` (h, w) int32 and :func:`_sheet_sizes`;
+    passed, ``THIN_SHEET`` with ``count``, ``sizes`` and ``near`` (the caller's ``_behind_sheet`` goes on; stage 2
+    when it finds nothing). Stage 2: with three ``noise`` deviations above 3 mm and at least 60 pixels with depth,
+    the 5 x 5 median (:func:`window_medians`), its lagged differences (:func:`lag_differences`, at least 20), their
+    deviation (:func:`median_deviation`), the narrower join ``min(join, max(3 sigma, 0.003))`` and, narrower than
+    ``join``, the parts of the median joined at it with :func:`_sheet_sizes`: ``THIN_SMOOTHED`` where it passes.
+    ``THIN_NONE`` wherever ``thin_front`` returns None (stop 51)."""
+    none = np.zeros(0, np.int64)
+    if stage == 0:
+        found, rows, cols = thin_counts(depth, mask, front, join, ok)
+        counts[:] = found
+        if rows.shape[0] >= 30 and not reaches_outline(mask, rows, cols):
+            return THIN_FIT, rows, cols, 0, none, none
+        stage = 1
+    if stage == 1:
+        count = smooth_parts(depth, mask, join, labels)
+        passed, sizes, near = _sheet_sizes(labels, count, depth, front, join)
+        if passed:
+            return THIN_SHEET, none, none, count, sizes, near
+    if 3.0 * noise <= 0.003 or counts[0] < 60:
+        return THIN_NONE, none, none, 0, none, none
+    medians = np.empty(counts[0])
+    window_medians(depth, ok, medians)
+    smooth = np.empty(depth.shape)
+    diff = lag_differences(medians, ok, mask, 5, smooth)
+    if diff.shape[0] < 20:
+        return THIN_NONE, none, none, 0, none, none
+    sigma = 1.4826 * median_deviation(diff) / math.sqrt(2.0)
+    wide = 3.0 * sigma
+    if 0.003 > wide:
+        wide = 0.003
+    if not wide < join:
+        return THIN_NONE, none, none, 0, none, none
+    count = smooth_parts(smooth, mask, wide, labels)
+    passed, sizes, near = _sheet_sizes(labels, count, depth, front, join)
+    if passed:
+        return THIN_SMOOTHED, none, none, count, sizes, near
+    return THIN_NONE, none, none, 0, none, none
+
+
+# --- stop 51, surface51: fruit_surface's measures of the mask's depth, and its cap, in one call each -----------------
+
+
+@_njit
+def mask_values(
+    depth: np.ndarray, mask: np.ndarray, leafy: np.ndarray, with_leafy: bool, floor: float
+) -> tuple[float, np.ndarray, np.ndarray, float]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface`'s measures of a mask's depth before the depth mode in one call, each
+    the kernel or numpy step it took (the same numbers, bit for bit): ``(noise, kept, leaf, step)``. ``noise``:
+    :func:`symfruit.core.surface.depth_noise` of ``depth`` (h, w) float64 under ``mask`` (h, w) bool with ``floor``
+    (:func:`depth_noise`'s deviation); ``kept``: the mask's depths finite and above 0 in raster order
+    (``depth[mask]``'s :func:`finite_positive`), ``leaf`` ``leafy`` (h, w) bool at them where ``with_leafy`` (else
+    empty), as :func:`symfruit.core.surface.fruit_depth` takes them (:func:`depth_mode`'s); ``step``:
+    :func:`depth_step` (stop 51)."""
+    n, mad = depth_noise(depth, mask)
+    noise = floor
+    if n < 10:
+        if 0.002 > noise:
+            noise = 0.002
+    else:
+        x = 1.4826 * mad / math.sqrt(2.0)
+        if x > noise:
+            noise = x
+    h, w = depth.shape
+    m = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                v = np.float64(depth[r, c])
+                m += np.isfinite(v) and v > 0
+    kept = np.empty(m)
+    leaf = np.empty(m if with_leafy else 0, np.bool_)
+    j = 0
+    for r in range(h):
+        for c in range(w):
+            if mask[r, c]:
+                v = np.float64(depth[r, c])
+                if np.isfinite(v) and v > 0:
+                    kept[j] = v
+                    if with_leafy:
+                        leaf[j] = leafy[r, c]
+                    j += 1
+    return noise, kept, leaf, depth_step(depth, mask)
+
+
+@_njit
+def surface_cap(
+    depth: np.ndarray,
+    region: np.ndarray,
+    mask: np.ndarray,
+    r0: int,
+    c0: int,
+    r1: int,
+    c1: int,
+    iterations: int,
+    low: float,
+    high: float,
+    inner: np.ndarray,
+    have_inner: bool,
+    deep_px: float,
+    table: np.ndarray,
+    bins: int,
+    tolerance: float,
+    near: np.ndarray,
+    out: np.ndarray,
+) -> tuple[int, int, int]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface` from its slab on, in one call, each step the kernel it called (the
+    same pixels): ``near`` (h, w) bool the pixels of ``region`` with ``depth`` within ``low`` .. ``high``
+    (:func:`near_pixels`), the apex (:func:`surface_apex` of the mask's box ``r0:r1, c0:c1`` eroded ``iterations``
+    times, 5 x 5 medians) and ``out`` (h, w) bool, all false on entry, the convex cap from the apex
+    (:func:`monotone_at` with the sector ``table`` of ``bins`` sectors and ``tolerance``) or'd with the pixels of
+    ``near`` deeper than ``deep_px`` in the mask's distance map ``inner`` (h, w) float64: the caller's where
+    ``have_inner``, else made here as :func:`symfruit.core.raster.inner_distance` with reach ``max(deep_px, 0)``
+    makes it (:func:`near_distance` over the mask's box, ``r0:r1, c0:c1``, grown by a pixel; ``inner`` all 0 on
+    entry). ``(answer, row, column)``, ``answer`` 0 where ``near`` is empty (no surface), 1 done, 2 the apex found
+    but ``out`` left to the caller (the table too small for the apex's farthest pixel, or ``tolerance`` not finite:
+    ``monotone_region``'s other paths), 3 as 2 with ``inner`` left to the caller too (the grown box all the mask's:
+    ``inner_distance``'s other path; stop 51)."""
+    if not near_pixels(depth, region, low, high, near):
+        return 0, 0, 0
+    r, c = surface_apex(mask[r0:r1, c0:c1], iterations, near, depth, mask, r0, c0, 5)
+    h, w = near.shape
+    if not have_inner:
+        a0, a1, b0, b1 = max(r0 - 1, 0), min(r1 + 1, h), max(c0 - 1, 0), min(c1 + 1, w)
+        full = True
+        for i in range(a0, a1):
+            for j in range(b0, b1):
+                full = full and mask[i, j]
+        if full:
+            return 3, r, c
+        near_distance(mask[a0:a1, b0:b1], max(deep_px, 0.0), False, inner[a0:a1, b0:b1])
+    reach = max(max(abs(r), abs(h - 1 - r)), max(abs(c), abs(w - 1 - c)))
+    half = (table.shape[0] - 1) // 2
+    if not math.isfinite(tolerance) or reach > half:
+        return 2, r, c
+    monotone_at(depth, near, r, c, table, half, bins, tolerance, out)
+    for i in range(h):
+        for j in range(w):
+            out[i, j] = out[i, j] or (near[i, j] and inner[i, j] > deep_px)
+    return 1, r, c
+
+
+@_njit_inlined
+def _below(values: np.ndarray, x: float, right: bool) -> int:
+    """:func:`_count_below` of ``values`` (n,) float64 without NaN, not sorted: how many are below ``x`` (``right``: at
+    most ``x``), by one pass (the sorted values' count, the same whole number)."""
+    n = 0
+    for v in values:
+        n += v < x or (right and v == x)
+    return n
+
+
+@_njit_inlined
+def _kth_pair(values: np.ndarray, k: int) -> tuple[float, float]:
+    """The ``k``-th and ``k + 1``-th smallest of ``values`` (n,) float64 without NaN, ``k + 1 < n`` (``z[k]`` and
+    ``z[k + 1]`` of the sorted values), by :func:`select` on a copy."""
+    work = values.copy()
+    select(work, k)
+    nxt = work[k + 1]
+    for i in range(k + 2, work.shape[0]):
+        if work[i] < nxt:
+            nxt = work[i]
+    return work[k], nxt
+
+
+@_njit
+def depth_mode(
+    kept: np.ndarray, radius_px: float, focal: float, noise: float, leaf: np.ndarray, with_leafy: bool,
+    leafy_shares: tuple[float, float],
+) -> tuple[float, float, bool]:  # fmt: skip
+    """:func:`fruit_depth` of the valid depths ``kept`` (n,) float64 (no NaN) without sorting them: the same numbers,
+    bit for bit. Each value of the sorted depths it reads is found without the sort: the ends as the least and
+    greatest, the median and the front's two order statistics by :func:`select` (a value, or the same two halved),
+    each edge's count below it (``np.searchsorted``'s) as the number of values whose place among the edges (guessed
+    from the bin width and moved until the edges agree, the edges never falling) is at most its own, the counts
+    between two depths by a pass (:func:`_below`). ``(front, radius, done)`` as :func:`fruit_depth` gives them
+    (stop 51)."""
+    n = kept.shape[0]
+    if n < 10:
+        return np.nan, np.nan, True
+    half = n // 2
+    if n % 2:
+        work = kept.copy()
+        select(work, half)
+        median = work[half]
+    else:
+        za, zb = _kth_pair(kept, half - 1)
+        median = (za + zb) / 2.0
+    z_first = kept[0]
+    z_last = kept[0]
+    for v in kept:
+        if v < z_first:
+            z_first = v
+        if v > z_last:
+            z_last = v
+    ok, n_bins, width, edges = _mode_edges(z_first, z_last, median, radius_px, focal, noise)
+    if not ok:
+        return np.nan, np.nan, False
+    lo, hi = edges[0], edges[n_bins]
+    # a value's place among the first n_bins edges: how many of them lie at or below it (they never fall); it lies
+    # below edge k exactly where k is at least its place. Guessed from the bin width, then moved while an edge says
+    # otherwise (a step or none: branches a processor foresees, where a bisection's are a coin's toss each)
+    places = np.zeros(n_bins + 1, np.int64)
+    top = 0
+    for v in kept:
+        guess = (v - lo) / width if width > 0 else 0.0
+        a = int(min(max(guess, 0.0), float(n_bins)))
+        while a > 0 and edges[a - 1] > v:
+            a -= 1
+        while a < n_bins and edges[a] <= v:
+            a += 1
+        places[a] += 1
+        top += v <= hi
+    at = np.empty(n_bins + 1, np.int64)
+    run = 0
+    for k in range(n_bins):
+        run += places[k]
+        at[k] = run
+    at[n_bins] = top
+    found, a_edge, b_edge = _mode_bin(at, n, np.empty(0), kept, leaf, edges, with_leafy, leafy_shares)
+    if not found:
+        return np.nan, np.nan, False
+    size = _below(kept, b_edge, True) - _below(kept, a_edge, False)
+    if size < 1:
+        return np.nan, np.nan, False
+    inside = np.empty(size)
+    m = 0
+    for v in kept:
+        if v >= a_edge and v <= b_edge:
+            inside[m] = v
+            m += 1
+    if size == 1:
+        front = inside[0]
+    else:
+        where = (size - 1) * 0.05
+        below = np.int64(np.floor(where))
+        t = where - below
+        za, zb = _kth_pair(inside, below)
+        front = zb - (zb - za) * (1.0 - t) if t >= 0.5 else za + (zb - za) * t
+    return front, radius_px * front / focal, True
+
+
+@_njit_inlined
+def _mode_edges(
+    z_first: float, z_last: float, median: float, radius_px: float, focal: float, noise: float
+) -> tuple[bool, int, float, np.ndarray]:  # fmt: skip
+    """:func:`fruit_depth`'s bins of the depths from ``z_first`` to ``z_last`` (their least and greatest) with their
+    ``median``: ``(ok, n_bins, width, edges)``, the edges as ``np.linspace`` makes them (``i * width + lo``, the last
+    one the range's end) and their width; ``ok`` False where the twin is to run instead (a bin count ``int()``
+    refuses, a range numpy widens). Shared by :func:`fruit_depth` and :func:`depth_mode` (stop 51)."""
+    radius = radius_px * median / focal
+    step = radius / 3.0
+    if 0.004 > step:
+        step = 0.004
+    if 2.0 * noise > step:
+        step = 2.0 * noise
+    c = np.ceil((z_last - z_first) / step)
+    if not math.isfinite(c):  # the twin's int() refuses it
+        return False, 0, 0.0, np.empty(0)
+    if 1 > c:
+        c = 1.0
+    if 4096 < c:
+        c = 4096.0
+    n_bins = int(c)
+    lo, hi = z_first, z_first + n_bins * step
+    if not lo < hi:
+        return False, 0, 0.0, np.empty(0)
+    delta = hi - lo
+    width = delta / n_bins
+    edges = np.empty(n_bins + 1)
+    for k in range(n_bins + 1):
+        edges[k] = (k / n_bins * delta if width == 0 else k * width) + lo
+    edges[n_bins] = hi
+    return True, n_bins, width, edges
+
+
+@_njit_inlined
+def _mode_bin(
+    at: np.ndarray, n: int, z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, with_leafy: bool,
+    leafy_shares: tuple[float, float],
+) -> tuple[bool, float, float]:  # fmt: skip
+    """:func:`fruit_depth`'s front bin from the counts below each edge ``at`` (n_bins + 1,) of the ``n`` depths: the
+    three-bin masses (``np.convolve``'s ``"same"`` window of sums of whole numbers: exact), the first peak holding
+    half the largest mass, the leaf test's shares (``leaf`` aligned with ``kept``; counted on ``z``, the depths sorted,
+    or on ``kept`` where ``z`` is empty: the same whole numbers) and the walk nearer over filled bins: ``(found,
+    a_edge, b_edge)``, the depths of the front's quantile lying from ``a_edge`` to ``b_edge`` (both included);
+    ``found`` False where no peak is met. Shared by :func:`fruit_depth` and :func:`depth_mode` (stop 51)."""
+    n_bins = at.shape[0] - 1
+    counts = np.empty(n_bins, np.int64)
+    for k in range(n_bins):
+        counts[k] = at[k + 1] - at[k]
+    # np.convolve(counts, np.ones(3), mode="same"): max(n_bins, 3) values of the full convolution from the shorter
+    # array's half length on (with fewer than 3 bins the ones are the longer array, and the masses run past the bins)
+    size = max(n_bins, 3)
+    offset = 1 if n_bins >= 3 else 0
+    mass = np.zeros(size)
+    for k in range(size):
+        j = k + offset  # the full convolution's place: the bins j - 2 .. j
+        s = 0.0
+        for q in range(max(j - 2, 0), min(j, n_bins - 1) + 1):
+            s += counts[q]
+        mass[k] = s
+    top = mass.max()
+    i = -1
+    for k in range(size):
+        after = mass[k + 1] if k + 1 < size else -1.0
+        before = mass[k - 1] if k > 0 else -1.0
+        if mass[k] >= after and mass[k] >= before and mass[k] >= 0.5 * top:
+            i = k
+            break
+    if i < 0 or i >= n_bins:  # not met (the twin's masses run past the bins by two at most, its peak never)
+        return False, 0.0, 0.0
+    if with_leafy and _leaf_share(z, kept, leaf, edges, i, n_bins) >= leafy_shares[0]:
+        for k in range(i + 1, n_bins):
+            after = mass[k + 1] if k + 1 < size else -1.0
+            before = mass[k - 1] if k > 0 else -1.0
+            if not (mass[k] >= after and mass[k] >= before and mass[k] >= 0.1 * top):
+                continue
+            if _leaf_share(z, kept, leaf, edges, k, n_bins) < leafy_shares[1] and mass[k] >= 10:
+                i = k
+                break
+    least = 0.01 * n
+    if 2 > least:
+        least = 2.0
+    first = i
+    while first > 0 and counts[first - 1] >= least:
+        first -= 1
+    return True, edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]

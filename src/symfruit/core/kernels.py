@@ -43,7 +43,9 @@ and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlus
 :func:`~symfruit.core.surface.monotone_region` (:func:`symfruit.core._jit.monotone_at`); stop 42's
 :func:`symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.smooth_parts`,
 :func:`~symfruit.core._jit.filled_windows`; since stop 45 :func:`~symfruit.core._jit.window_medians`,
-:func:`~symfruit.core._jit.reaches_outline`, :func:`~symfruit.core._jit.part_sizes`)) then run their numpy
+:func:`~symfruit.core._jit.reaches_outline`, :func:`~symfruit.core._jit.part_sizes`; since stop 51 all of them in
+:func:`~symfruit.core._jit.thin_passes`) and stop 51's :func:`symfruit.core.surface.fruit_surface`
+(:func:`symfruit.core._jit.mask_values`, :func:`~symfruit.core._jit.surface_cap`)) then run their numpy
 twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the

@@ -78,7 +78,12 @@ class Surface:
     apex: tuple[int, int]
 
 
-def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = 0.0005) -> float:
+#: :func:`depth_noise`'s least noise (metres), and an empty leaf image (:func:`fruit_surface`'s compiled measures).
+_NOISE_FLOOR = 0.0005
+_NO_LEAF = np.zeros((0, 0), bool)
+
+
+def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = _NOISE_FLOOR) -> float:
     """Depth noise (metres) of a surface: the robust spread of the differences between horizontally
     neighbouring depth pixels of ``mask``, divided by ``sqrt(2)``, at least ``floor``.
 
@@ -314,15 +319,12 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # a registered depth image repeats a coarser camera's pixels: the fits' standard errors count its own pixels
     plain = depth.dtype == np.float64 and depth.ndim == 2 and mask.dtype == bool and mask.shape == depth.shape
     if (jit := compiled() if plain else None) is not None:
-        ok = np.empty(depth.shape, bool)  # the compiled twin of _thin_counts (stop 43: the same counts and pixels)
-        counts, rows, cols = jit.thin_counts(depth, mask, float(front), float(join), ok)
-    else:
-        ok, counts, rows, cols = _thin_counts(depth, mask, front, join)
-    repeats = 1.0
-    for both, equal in ((counts[1], counts[2]), (counts[3], counts[4])):
-        if both:
-            repeats /= max(1.0 - float(equal) / float(both), 0.1)
-    inflate = float(np.sqrt(repeats))
+        # every pass between the fits in one call (stop 51, surface51: the same pixels, parts and numbers)
+        return _thin_front_compiled(jit, depth, mask, focal, front, radius, join, noise, around)
+    # the numpy twin of what follows (thin_passes' twin: _thin_counts, _reaches_outline, _smooth_parts, _part_sizes,
+    # _window_medians, _lag_differences, the deviation's medians)
+    ok, counts, rows, cols = _thin_counts(depth, mask, front, join)
+    inflate = _inflation(counts)
     # the nearest surface clearly convex is the fruit's own front, not a sheet: nothing to look behind (one fit
     # instead of the parts, their fits and the median's re-partition on every fruit seen whole: the benchmark
     # frame's extraction 24.8 -> 16.8 ms thread CPU, 7.6 without the test); rows, cols: the pixels with depth within
@@ -331,9 +333,7 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
     # edge of a tilted leaf, or a leaf's depth fattened over the fruit, runs along it (a narrow band whose fit reads
     # any curvature). The outline is asked first: where it is reached the fit decides nothing (stop 44, speedreg44:
     # the registration's cue, its depth a few pixels off the mask, reaches it on most fruit)
-    if len(rows) >= 30 and not (
-        jit.reaches_outline(mask, rows, cols) if jit is not None else _reaches_outline(mask, rows, cols)
-    ):  # fmt: skip
+    if len(rows) >= 30 and not _reaches_outline(mask, rows, cols):
         kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
         if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
             return None
@@ -345,27 +345,63 @@ def thin_front(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, 
         return None  # the step was not bridged by noise
     # the 5 x 5 median (edges repeated) at the mask's pixels with depth alone, the only ones read: the same values as
     # ndimage.median_filter(..., mode="nearest") there, without sweeping the box's other pixels; a pixel without depth
-    # takes its nearest pixel's
-    if jit is not None:
-        # the compiled twin of _window_medians (stop 45: the same values, by a selection network, the windows never
-        # laid out), and of _lag_differences (stop 43: the same image and differences)
-        medians = np.empty(int(counts[0]))
-        jit.window_medians(depth, ok, medians)
-        smooth = np.empty(depth.shape)
-        diff = jit.lag_differences(medians, ok, mask, 5, smooth)
-    else:
-        smooth, diff = _lag_differences(_window_medians(depth, ok), ok, mask, 5)
+    # takes its nearest pixel's (compiled: window_medians, lag_differences and median_deviation in thin_passes)
+    smooth, diff = _lag_differences(_window_medians(depth, ok), ok, mask, 5)
     if len(diff) < 20:
         return None
-    # the differences' median absolute deviation by the compiled twin where numba is (stop 47: the same order
-    # statistics in one call; diff is its own, reordered there)
-    mad = jit.median_deviation(diff) if jit is not None else median(np.abs(diff - median(diff)))
+    mad = median(np.abs(diff - median(diff)))
     sigma = 1.4826 * float(mad) / np.sqrt(2.0)
     narrow = min(join, max(3.0 * sigma, 0.003))
     if narrow >= join:
         return None  # the same parts
     parts, count = _smooth_parts(smooth, mask, narrow)
     return _behind_sheet(depth, mask, focal, front, radius, join, inflate, parts, count, noise=noise, around=around)
+
+
+def _inflation(counts: np.ndarray) -> float:
+    """:func:`thin_front`'s factor on the sheet's standard error from :func:`_thin_counts`' counts: the square root of
+    how many pixels repeat one depth pixel (a registered depth image repeats a coarser camera's pixels)."""
+    repeats = 1.0
+    for both, equal in ((counts[1], counts[2]), (counts[3], counts[4])):
+        if both:
+            repeats /= max(1.0 - float(equal) / float(both), 0.1)
+    return float(np.sqrt(repeats))
+
+
+def _thin_front_compiled(
+    jit: Any,
+    depth: np.ndarray,
+    mask: np.ndarray,
+    focal: float,
+    front: float,
+    radius: float,
+    join: float,
+    noise: float,
+    around: Around | None,
+) -> tuple[float, np.ndarray] | None:
+    """:func:`thin_front` by :func:`symfruit.core._jit.thin_passes` (``depth`` (h, w) float64, ``mask`` bool of its
+    shape): every pass of the twin's between its fits (the counts, the outline test, both partitions into smooth parts
+    and their sizes, the 5 x 5 median and its noise) in one call, the fits and the rest of :func:`_behind_sheet` here,
+    in the twin's order: the same answer, bit for bit (stop 51, surface51)."""
+    ok, counts, labels = np.empty(depth.shape, bool), np.empty(5, np.int64), np.empty(depth.shape, np.int32)
+    args = (depth, mask, float(front), float(join), float(noise))
+    answer, rows, cols, count, sizes, near = jit.thin_passes(*args, 0, ok, counts, labels)
+    inflate = _inflation(counts)
+    if answer == jit.THIN_FIT:  # the nearest surface clearly convex is the fruit's own front (as the twin asks)
+        kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
+        if (kappa - 2.0 * inflate * error) * radius >= THIN[0]:
+            return None
+        answer, _, _, count, sizes, near = jit.thin_passes(*args, 1, ok, counts, labels)
+    if answer == jit.THIN_SHEET:
+        found = _behind_sheet(depth, mask, focal, front, radius, join, inflate, labels, int(count), noise=noise,
+                              around=around, counted=(sizes, near))  # fmt: skip
+        if found is not None:
+            return found
+        answer, _, _, count, sizes, near = jit.thin_passes(*args, 2, ok, counts, labels)
+    if answer == jit.THIN_SMOOTHED:
+        return _behind_sheet(depth, mask, focal, front, radius, join, inflate, labels, int(count), noise=noise,
+                             around=around, counted=(sizes, near))  # fmt: skip
+    return None
 
 
 def _reaches_outline(mask: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> bool:
@@ -415,7 +451,8 @@ def _lag_differences(
 
 def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: float, radius: float, join: float,
                   inflate: float, parts: np.ndarray, count: int, *, noise: float = 0.001,
-                  around: Around | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
+                  around: Around | None = None,
+                  counted: tuple[np.ndarray, np.ndarray] | None = None) -> tuple[float, np.ndarray] | None:  # fmt: skip
     """:func:`thin_front` on one partition of the mask into smooth parts (``parts``: 0 none, 1..``count``), the
     sheet's curvature's standard error times ``inflate`` (the square root of how many pixels repeat one depth pixel:
     a flat reading must hold on the camera's own pixels; the cap behind is not asked as much). A front part that is
@@ -425,11 +462,14 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     is the mask's largest surface (stop 40, docs/leaf40.md). Such a front part must also lie in front of the part
     behind's surface extended under it (:meth:`_InverseQuadratic.offset`) by more than ``join``: one lying on it is
     that fruit's own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's
-    noise, for :func:`fruit_depth`'s bins on the part behind."""
+    noise, for :func:`fruit_depth`'s bins on the part behind. ``counted``: :func:`_part_sizes`' counts when the caller
+    has them (:func:`symfruit.core._jit.thin_passes`)."""
     if count < 2:
         return None
     plain = parts.ndim == 2 and parts.shape == depth.shape and depth.dtype == np.float64
-    if (jit := compiled() if plain else None) is not None:  # the compiled twin of _part_sizes (stop 45: the same)
+    if counted is not None:
+        sizes, near = counted
+    elif (jit := compiled() if plain else None) is not None:  # the compiled twin of _part_sizes (stop 45: the same)
         sizes, near = jit.part_sizes(parts, int(count), depth, float(front), float(join))
     else:
         sizes, near = _part_sizes(parts, count, depth, front, join)
@@ -727,8 +767,12 @@ def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tu
     return np.diff(at), edges
 
 
+#: :func:`monotone_region`'s rays: this many sectors of directions.
+_RAYS = 72
+
+
 def monotone_region(depth: np.ndarray, keep: np.ndarray, apex: tuple[int, int], tolerance: float,
-                    *, bins: int = 72) -> np.ndarray:  # fmt: skip
+                    *, bins: int = _RAYS) -> np.ndarray:  # fmt: skip
     """(h, w) bool: the pixels of ``keep`` reached from ``apex`` along straight image rays on which depth
     never falls more than ``tolerance`` below its running maximum.
 
@@ -928,18 +972,40 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     r0, r1, c0, c1 = found
     box = (slice(r0, r1), slice(c0, c1))
     own, own_depth = mask[box], depth[box]
-    noise = depth_noise(own_depth, own)
     # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
     radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
-    front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                leafy=None if leafy is None else leafy[box][own])  # fmt: skip
+    unit: float | None = None  # the depth's step, when measured with the noise and the front
+    leaf = None if leafy is None else leafy[box]
+    jit = compiled()
+    if (
+        jit is not None
+        and own.dtype == bool
+        and own_depth.dtype == np.float64
+        and (leafy is None or (np.shape(leafy) == np.shape(mask) and np.asarray(leafy).dtype == bool))
+    ):
+        # the noise, the mask's valid depths and the depth's step in one call, then the depth mode on them without
+        # sorting them (stop 51, surface51: fruit_depth's steps, the same numbers)
+        noise, kept, leaf_kept, unit = jit.mask_values(own_depth, own, _NO_LEAF if leaf is None else leaf,
+                                                       leaf is not None, _NOISE_FLOOR)  # fmt: skip
+        front, radius, done = jit.depth_mode(kept, radius_px, float(focal), float(noise), leaf_kept, leaf is not None,
+                                             (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        front, radius = float(front), float(radius)
+        if not done:  # left to the twin (fruit_depth's kernel declines)
+            front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                        leafy=None if leaf is None else leaf[own])  # fmt: skip
+    else:
+        noise = depth_noise(own_depth, own)
+        front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                    leafy=None if leaf is None else leaf[own])  # fmt: skip
     if not np.isfinite(front):
         return None
     # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
     # known to a unit: without it a 3 mm tolerance on millimetre depth cuts every 3 mm fall that float32 rounding
     # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
     # camera's near fruit lost a third of its cap, issue 18)
-    tol = max(tolerance * noise, 0.003) + (depth_step(own_depth, own) if step is None else step)
+    if step is None:
+        step = depth_step(own_depth, own) if unit is None else unit
+    tol = max(tolerance * noise, 0.003) + step
     around = None
     if thin:
         g = int(np.ceil(radius_px))  # the depth within the fruit's size around its mask's box
@@ -960,6 +1026,16 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
+    # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
+    # (a banana's inner side, a pear's neck) and is kept.
+    deep_px = interior * min(radius_px, 0.5 * minor_px)
+    if (jit := compiled()) is not None and depth.dtype == np.float64 and depth.ndim == 2 and (
+        np.shape(region) == np.shape(mask) == depth.shape
+    ):  # fmt: skip
+        # the slab's pixels, the apex, the convex cap and the deep pixels in one call (stop 51, surface51: the same)
+        return _surface_compiled(jit, depth, mask, np.asarray(region, dtype=bool), (r0, c0, r1, c1),
+                                 max(1, int(0.15 * radius_px)), (front - tol, front + slab * reach), tol, front,
+                                 radius, noise, inner, deep_px)  # fmt: skip
     if (jit := compiled()) is not None and depth.dtype == np.float64 and np.shape(region) == depth.shape:
         near = np.empty(depth.shape, bool)  # the compiled twin of the comparisons below: the same pixels
         if not jit.near_pixels(depth, np.asarray(region, dtype=bool), front - tol, front + slab * reach, near):
@@ -986,10 +1062,35 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     else:
         first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
     apex = (int(rows[first]), int(cols[first]))
-    # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
-    # (a banana's inner side, a pear's neck) and is kept.
-    deep_px = interior * min(radius_px, 0.5 * minor_px)
     return _surface(depth, mask, near, apex, tol, front, radius, noise, inner, deep_px)
+
+
+def _surface_compiled(jit: Any, depth: np.ndarray, mask: np.ndarray, region: np.ndarray, box: tuple[int, int, int, int],
+                      iterations: int, slab: tuple[float, float], tol: float, front: float, radius: float, noise: float,
+                      inner: np.ndarray | None, deep_px: float) -> Surface | None:  # fmt: skip
+    """:func:`fruit_surface` from its slab (depths ``slab``) on by :func:`symfruit.core._jit.surface_cap`: the pixels
+    of ``region`` in the slab, the apex (the mask's ``box`` eroded ``iterations`` times), the convex cap and the
+    pixels deeper than ``deep_px`` in the mask, each step the kernel it was, in one call; None where no pixel lies in
+    the slab. Where the cap is left to it (``monotone_region``'s other paths), :func:`monotone_region` (stop 51)."""
+    # the mask's distance map up to deep_px (farther +inf), as _surface takes it: the caller's, else made in the call
+    # (a bool mask; another made here, as before)
+    if (inner is None or inner.shape != mask.shape) and mask.dtype != bool:
+        inner = inner_distance(mask, max(deep_px, 0.0))
+    have = inner is not None and inner.shape == mask.shape
+    inner = np.asarray(inner, dtype=np.float64) if have else np.zeros(mask.shape)
+    near, pixels = np.empty(depth.shape, bool), np.zeros(depth.shape, bool)
+    table = _sector_table(_RAYS, 0)  # the sectors' table as it is (made the first time): grown by the twin's path
+    assert table is not None
+    answer, r, c = jit.surface_cap(depth, region, np.asarray(mask, dtype=bool), *box, iterations, *slab, inner, have,
+                                   float(deep_px), table, _RAYS, float(tol), near, pixels)  # fmt: skip
+    if answer == 0:
+        return None
+    apex = (int(r), int(c))
+    if answer == 3:  # the mask fills its box grown by a pixel: the whole transform
+        inner = inner_distance(mask, max(deep_px, 0.0))
+    if answer >= 2:
+        pixels = monotone_region(depth, near, apex, tol) | (near & (inner > deep_px))
+    return Surface(pixels, front, radius, noise, apex)
 
 
 def _surface(depth: np.ndarray, mask: np.ndarray, near: np.ndarray, apex: tuple[int, int], tol: float, front: float,
