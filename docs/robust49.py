@@ -411,19 +411,8 @@ def run_main(doc: str, builds: tuple[Callable[[], None], ...], cases: list[tuple
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--only", default="", help="the cases whose name holds one of these (comma-separated)")
-    parser.add_argument("--defects", action="store_true", help="print the defects alone")
-    parser.add_argument("--keep", type=Path, help="make or reuse the fixtures in this folder")
-    args = parser.parse_args()
-    r47.T = args.keep.resolve() if args.keep else Path(tempfile.mkdtemp(prefix="robust49-"))
-    r47.T.mkdir(parents=True, exist_ok=True)
-    for build in (file_cases, image_cases, name_cases, bag_cases):
-        build()
-    counts = sweep(CASES, only=args.only, defects=args.defects, limit=LIMIT_S)
-    if not args.keep:
-        shutil.rmtree(r47.T, ignore_errors=True)
-    return 1 if counts["DEFECT"] else 0
+    return run_main(__doc__ or "", (file_cases, image_cases, name_cases, bag_cases), CASES, prefix="robust49-",
+                    limit=LIMIT_S, width=48)  # fmt: skip
 
 
 if __name__ == "__main__":
