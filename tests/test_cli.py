@@ -770,6 +770,13 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["bench", "--images", "x"], "bench --images is for --segment"),
      (["bench", "--frame", "--profile", "--stages"], "--profile and --stages do not go together"),
      (["bench", "--frame", "--profile", "--json"], "--profile and --json do not go together"),
+     (["bench", "--threads", "2"], "bench --threads is for --frame; here it would be ignored"),
+     (["bench", "--frame", "--threads", "0"], "--threads must be a whole number from 1 to 64, got 0"),
+     (["bench", "--frame", "--threads", "65"], "--threads must be a whole number from 1 to 64, got 65"),
+     (["bench", "--frame", "--profile", "--threads", "2"], "--profile and --threads do not go together"),
+     (["detect", "in", "--output", "o", "--threads", "65"], "--threads must be a whole number from 1 to 64"),
+     (["detect", "in", "--output", "o", "--workers", "2", "--threads", "2"], "threads 2 (--threads) are for this "
+      "process: a Dask cluster's workers run their frames with one each"),
      (["bench", "--segment", "--scene", "apple-tree", "--size", "64x48"], "--scene and --size do not go together"),
      (["evaluate", "--match", "id"], "evaluate --match is for --frames"),
      (["evaluate", "--frames", "x", "--spheres", "y"], "--frames and --spheres are two evaluations"),

@@ -466,3 +466,78 @@ def test_a_mask_holding_only_the_background_is_reported_with_its_reason_not_boxe
     assert wall.error.startswith("no depth of the fruit's own: the ") and "(at 1.000 m)" in wall.error
     assert wall.error.endswith("; 0 mask pixels nearer")
     assert detection_record(wall)["error"] == wall.error and detection_record(wall)["n_points"] == 0
+
+
+def _record(d):
+    """Everything of a detection that does not depend on the clock (its result's ``seconds`` does)."""
+    r = d.result
+    out = [d.id, d.error, d.extraction.points.tobytes(), d.mask.tobytes(), d.extraction.mask_area]
+    if r is not None:
+        out += [r.points.tobytes(), r.box.min.tobytes(), r.box.max.tobytes(), repr(r.plane), float(r.score),
+                r.scores.tobytes(), repr(sorted(r.extras.items())), r.confidence, r.reliable]  # fmt: skip
+    return out
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_fruit_on_several_threads_give_the_same_records_in_the_same_order(seed):
+    from symfruit.evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, seed)
+    one = detect(frame, method="evidence", threads=1)
+    for threads in (2, 64):  # 64: more threads than fruit
+        found = detect(frame, method="evidence", threads=threads)
+        assert [_record(d) for d in found.detections] == [_record(d) for d in one.detections]
+        assert set(found.timings) == set(one.timings) and found.registration == one.registration
+
+
+def test_fruit_with_errors_on_several_threads_are_reported_as_on_one():
+    labels = np.zeros((120, 160), np.int32)
+    labels[45:76, 25:56] = 1
+    labels[2:4, 2:4] = 2  # four pixels: too few points
+    labels[45:76, 105:136] = 3
+    one, two = (detect(small_frame(), masks=labels, method="raw", threads=t).detections for t in (1, 2))
+    assert [_record(d) for d in two] == [_record(d) for d in one] and "only 4 points" in two[1].error
+
+
+def test_the_first_failing_fruit_s_error_is_raised_whatever_the_threads(monkeypatch):
+    import time
+
+    import symfruit.detect as module
+
+    real = module.complete
+
+    def failing(points, *, camera, **kw):  # fruit 1 fails late, fruit 2 at once: fruit 1's error is the one raised
+        if points[:, 0].mean() < 0:
+            time.sleep(0.2)
+            raise ValueError("left fruit")
+        raise ValueError("right fruit")
+
+    monkeypatch.setattr(module, "complete", failing)
+    for threads in (1, 2):
+        with pytest.raises(ValueError, match="left fruit"):
+            detect(small_frame(), method="raw", threads=threads)
+    monkeypatch.setattr(module, "complete", real)
+
+
+def test_the_cpu_time_counts_the_threads_the_fruit_ran_on(monkeypatch):
+    import threading
+    import time
+
+    import symfruit.detect as module
+
+    main, calls = threading.main_thread(), []
+
+    def thread_time():  # the calling thread's clock never moves; each worker's moves 1 s a reading
+        calls.append(1)
+        return 0.0 if threading.current_thread() is main else float(len(calls))
+
+    monkeypatch.setattr(module, "time", type("T", (), {"perf_counter": time.perf_counter,
+                                                       "thread_time": staticmethod(thread_time)}))  # fmt: skip
+    found = detect(small_frame(), method="raw", threads=2)
+    assert found.timings["cpu"] >= 2.0  # two fruit, each on a worker read twice: at least 1 s each
+
+
+@pytest.mark.parametrize("threads", [0, 65, -1, 1.5, True, "2"])
+def test_the_threads_are_bounded(threads):
+    with pytest.raises(InputError, match="threads must be a whole number from 1 to 64"):
+        detect(small_frame(), method="raw", threads=threads)

@@ -23,7 +23,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .core.limits import instance_labels
-from .detect import FrameDetections, detect
+from .detect import FrameDetections, check_threads, detect
 from .errors import FileFormatError, InputError, OutputError, SymfruitError
 from .io.atomic import folder_fd
 from .io.frames import is_frame_folder
@@ -107,6 +107,7 @@ def run_batch(
     workers: int | None = None,
     chunk: int = 4,
     no_worker_timeout: float | None = None,
+    threads: int | None = None,
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
     fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.season.table`).
@@ -119,7 +120,9 @@ def run_batch(
     In this process, or on a Dask cluster (``pip install 'symfruit[cluster]'``): ``scheduler`` (an existing
     one's address, ``tcp://host:port``) or ``workers`` (a local cluster of that many worker processes),
     ``chunk`` frames per task, ``no_worker_timeout`` seconds waited while the cluster has no worker
-    (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there).
+    (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there). ``threads``: the
+    threads each frame's fruit are run on in this process (:func:`~symfruit.detect.detect`'s; 1 to 64, default 1);
+    a cluster runs its frames with one each (its workers run several tasks at once already), and refuses more.
 
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
@@ -145,6 +148,7 @@ def run_batch(
         or its extra missing); per-frame problems go into the report.
     """
     get_method(method)  # an unknown method or a masks spec no frame can use: refused before any frame, never
+    threads = check_threads(threads)
     if isinstance(masks, str | Path) and not (  # reported once per frame of a recording
         (scheduler is not None or workers is not None) and str(masks).startswith(("maskrcnn:", "onnx:"))
     ):  # a model is loaded (once: cached) where it runs; on a cluster, by the workers
@@ -156,6 +160,9 @@ def run_batch(
 
         if on_frame is not None:
             raise InputError("on_frame (--ros2-bag) runs in this process: it cannot be combined with a Dask cluster")
+        if threads > 1:
+            raise InputError(f"threads {threads} (--threads) are for this process: a Dask cluster's workers run their "
+                             "frames with one each (their own --nthreads run several at once)")  # fmt: skip
         return run_distributed(source, output, scheduler=scheduler, workers=workers, chunk=chunk, masks=masks,
                                method=method, settings=settings, resume=resume, progress=progress,
                                exclude=exclude, no_worker_timeout=no_worker_timeout)  # fmt: skip
@@ -193,7 +200,7 @@ def run_batch(
                     continue
                 try:
                     _run_recording(src, rec, names, masks, method, settings, resume, on_frame, reserved, report,
-                                   bar, out)  # fmt: skip
+                                   bar, out, threads)  # fmt: skip
                 finally:
                     src.close()
                     held = None
@@ -220,7 +227,7 @@ def run_batch(
 def _run_recording(
     src: Any, rec: Recording, names: list[str], masks: str, method: str, settings: Settings, resume: bool,
     on_frame: Callable[[int, FrameDetections], None] | None, reserved: Sequence[str], report: BatchReport,
-    bar: Progress, out: OutputFolder,
+    bar: Progress, out: OutputFolder, threads: int = 1,
 ) -> None:  # fmt: skip
     """The frames ``names`` of one recording, in this process, each in its error boundary."""
     now = src.names()
@@ -229,7 +236,7 @@ def _run_recording(
         for index, name in enumerate(names):
             current[0] = name
             if not _one(src, rec, index, name, names, where, masks, method, settings, resume, on_frame, reserved,
-                        report, bar, out):  # fmt: skip
+                        report, bar, out, threads):  # fmt: skip
                 return
 
 
@@ -271,7 +278,7 @@ def once_per_recording(source: str) -> Any:
 def _one(
     src: Any, rec: Recording, index: int, name: str, names: list[str], where: dict[str, int] | None, masks: str,
     method: str, settings: Settings, resume: bool, on_frame: Callable[[int, FrameDetections], None] | None,
-    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder,
+    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder, threads: int = 1,
 ) -> bool:  # fmt: skip
     """Frame ``name`` (``index``) of a recording in its error boundary (:func:`_run_recording`); False when
     the batch stops."""
@@ -286,7 +293,7 @@ def _one(
         if where is not None and name not in where:
             raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
         found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
-                       settings=settings)  # fmt: skip
+                       settings=settings, threads=threads)  # fmt: skip
         if on_frame is not None:
             on_frame(index, found)
         write_detections(folder, found, settings=settings)

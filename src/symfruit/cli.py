@@ -95,12 +95,14 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    help="with --frame: only this method (default paper, fused and evidence); with --recording: the "
                    "completion method (default evidence)")  # fmt: skip
     p.add_argument("--profile", action="store_true",
-                   help="with --frame: print a cProfile of the frame instead (5 runs of --method)")  # fmt: skip
+                   help="with --frame: print a cProfile of the frame instead (5 runs of --method, the fruit on one "
+                   "thread)")  # fmt: skip
     p.add_argument("--stages", action="store_true",
                    help="with --frame: median and least wall time of each stage of `detect` and the thread's CPU "
                    "time per frame (--repeat runs of each method)")  # fmt: skip
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
+    _add_threads_option(p, "a frame's fruit are run on, with --frame")
     p.add_argument(
         "--segment",
         action="store_true",
@@ -204,6 +206,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resume", action="store_true",
                    help="skip frames whose detections.json is a whole record (one that cannot be read back, "
                    "truncated by a copy, is run again)")  # fmt: skip
+    _add_threads_option(p, "each frame's fruit are run on in this process (not with --scheduler or --workers)")
     _add_ros2_bag_options(p)
     _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
@@ -223,6 +226,22 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--method", default=None, help="completion method (default evidence)")
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
+
+
+def _add_threads_option(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument("--threads", type=int, metavar="N",
+                   help=f"threads {what}: 1 to 64; default the CPU cores this process may use "
+                   "(os.sched_getaffinity)")  # fmt: skip
+
+
+def _threads(args: argparse.Namespace, *, alone: bool = True) -> int:
+    """``--threads`` checked (1-64), or its default: the cores this process may use where it runs the frames
+    ``alone`` (the one process of a command), else 1."""
+    from .detect import available_cores, check_threads
+
+    if args.threads is None:
+        return available_cores() if alone else 1
+    return check_threads(args.threads, "--threads")
 
 
 def _add_ros2_bag_options(p: argparse.ArgumentParser) -> None:
@@ -412,6 +431,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
         ("--profile", args.profile, ("--frame",)),
         ("--stages", args.stages, ("--frame",)),
         ("--workers", args.workers is not None, ("--recording",)),
+        ("--threads", args.threads is not None, ("--frame",)),
         ("--images", args.images is not None, ("--segment",)),
         ("--size", args.size is not None, ("--segment",)),
         ("--scene", args.scene is not None, ("--segment",)),
@@ -422,6 +442,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
             raise InputError(f"bench {option} is for {need}; here it would be ignored")
     for a, b, on in (("--profile", "--stages", args.profile and args.stages),
                      ("--profile", "--json", args.profile and args.json),
+                     ("--profile", "--threads", args.profile and args.threads is not None),
                      ("--scene", "--images", args.scene is not None and args.images is not None),
                      ("--scene", "--size", args.scene is not None and args.size is not None)):  # fmt: skip
         if on:
@@ -491,6 +512,7 @@ def _bench(args: argparse.Namespace) -> int:
               f"{rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
+    threads = _threads(args) if args.frame else 1
     if args.frame:
         from .evaluate.bench import bench_frame, profile_frame
 
@@ -503,21 +525,24 @@ def _bench(args: argparse.Namespace) -> int:
 
             from .evaluate.bench import STAGES, bench_stages
 
-            found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor) for m in methods}
+            found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor, threads=threads)
+                     for m in methods}  # fmt: skip
             if args.json:
                 print(json.dumps({"machine": machine(), "stages": {m: {k: v.tolist() for k, v in ms.items()}
                                                                    for m, ms in found.items()}}))  # fmt: skip
                 return 0
             runs = len(next(iter(found.values()))["total"])
-            print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least; "
-                  "wall time per stage, CPU time of the thread ('cpu'); trim and register are part of extract, "
-                  "occlusion of complete")  # fmt: skip
+            print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least, "
+                  f"the fruit on {threads} thread{'s' if threads > 1 else ''}; wall time per stage (each fruit's own "
+                  "summed), CPU time of the threads ('cpu'); trim and register are part of extract, occlusion of "
+                  "complete")  # fmt: skip
             print(f"{'stage':<10}" + "".join(f"{m:>22}" for m in methods))
             for stage in STAGES:
                 cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
                 print(f"{stage:<10}{cells}")
             return 0
-        rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor) for m in methods]
+        rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor, threads=threads)
+                for m in methods]  # fmt: skip
     else:
         rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     if args.json:
@@ -525,7 +550,8 @@ def _bench(args: argparse.Namespace) -> int:
         return 0
     info = machine()
     print(
-        f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process "
+        f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process"
+        f"{f', the fruit on {threads} threads' if threads > 1 else ''} "
         f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
     )
     print(f"{'case':<26} {'points':>6} {'planes':>6} {'median ms':>10} {'min':>8} {'p10':>8} {'p90':>8}")
@@ -851,13 +877,14 @@ def _detect(args: argparse.Namespace) -> int:
         if os.path.commonpath([bag_at, out_at]) == bag_at:  # the bag's folder would hold the run's files
             raise InputError(f"--ros2-bag {args.ros2_bag} holds --output {args.output}: the bag's files and the "
                              "run's would share a folder; give the bag a folder of its own (e.g. OUT/bag)")  # fmt: skip
+    threads = _threads(args, alone=not args.scheduler and args.workers is None)
     with _ros2_bag(args) as bag:
         source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
                            workers=args.workers, chunk=args.chunk or 4,
-                           no_worker_timeout=args.no_worker_timeout)  # fmt: skip
+                           no_worker_timeout=args.no_worker_timeout, threads=threads)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():

@@ -7,8 +7,10 @@ overlay) and the ROS node into messages.
 
 from __future__ import annotations
 
+import os
 import time
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,10 +36,41 @@ from .segment.colour import _leaf as leaf_green
 from .segment.source import COLOUR_SEGMENTER
 from .settings import Settings, section_types
 
-__all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
+__all__ = [
+    "MAX_FRUIT_PER_FRAME",
+    "MAX_THREADS",
+    "Detection",
+    "FrameDetections",
+    "available_cores",
+    "check_threads",
+    "detect",
+    "frame_masks",
+]
 
 #: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
 MAX_FRUIT_PER_FRAME = MAX_INSTANCES
+
+#: Most threads :func:`detect` runs a frame's fruit on.
+MAX_THREADS = 64
+
+
+def check_threads(threads: int | None, what: str = "threads") -> int:
+    """``threads`` as :func:`detect` takes it: a whole number 1..:data:`MAX_THREADS` (None: 1), else
+    :class:`~symfruit.errors.InputError` naming ``what`` (``--threads`` for the command line)."""
+    if threads is None:
+        return 1
+    if isinstance(threads, bool) or not isinstance(threads, int | np.integer) or not 1 <= threads <= MAX_THREADS:
+        raise InputError(f"{what} must be a whole number from 1 to {MAX_THREADS}, got {threads!r}")
+    return int(threads)
+
+
+def available_cores() -> int:
+    """The CPU cores this process may run on (``os.sched_getaffinity``, where the system has it; else
+    ``os.cpu_count()``), at most :data:`MAX_THREADS`: the ``threads`` of :func:`detect` for a process that has the
+    machine to itself (the command line, the ROS nodes, ``symfruit bench``), never for one of several."""
+    getaffinity = getattr(os, "sched_getaffinity", None)
+    cores = len(getaffinity(0)) if getaffinity is not None else (os.cpu_count() or 1)
+    return max(1, min(cores, MAX_THREADS))
 
 
 @dataclass(frozen=True)
@@ -65,7 +98,8 @@ class FrameDetections:
 
     ``timings``: wall seconds of ``segment``, ``extract`` (of which ``trim`` and ``register``, the colour trimming
     and registration of the whole frame's masks), ``complete`` (of which ``occlusion``, the occlusion maps) and
-    ``total``, and ``cpu``, the CPU seconds of this thread over the whole frame."""
+    ``total``, and ``cpu``, the CPU seconds of this thread over the whole frame (and of the threads its fruit ran on,
+    :func:`detect`'s ``threads``)."""
 
     frame: Frame
     detections: list[Detection]
@@ -143,6 +177,7 @@ def detect(
     masks: str | Path | MaskSource | Segmenter | np.ndarray = "auto",
     method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
+    threads: int | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.
 
@@ -153,6 +188,14 @@ def detect(
     extracted with ``outlined=False`` (:func:`~symfruit.extract.extract`: the visible surface alone, no test for an
     occluder the mask is drawn over); every other source (a masks file or folder, a label array, a learned model,
     a callable) with ``outlined=True``.
+
+    ``threads`` (1 to :data:`MAX_THREADS`, None: 1): the threads the frame's fruit are extracted, occluded and
+    completed on (:func:`available_cores` for a process that has the machine to itself). The detections are the same
+    whatever their number, in the same order; an error a fruit raises is the first failing fruit's. With more than
+    one, ``timings``' ``extract``, ``occlusion`` and ``complete`` are the sums of each fruit's own wall times (more
+    than the frame's wall time they took) and ``cpu`` counts the threads' CPU too. Stop 52 (docs/threads52.md): on
+    two cores the fruit's mostly short compiled kernels and numpy calls hand the GIL back and forth, and two threads
+    gained nothing on the benchmark frame.
     """
     if not isinstance(frame, Frame):
         raise InputError(f"detect needs a Frame (symfruit.io.read_frame or a frame source), got {type(frame).__name__}")
@@ -160,6 +203,7 @@ def detect(
         raise InputError(f"settings must be a Settings (symfruit.resolve_settings), got {type(settings).__name__}")
     settings = settings or _default_settings()
     get_method(method)  # an unknown method is refused before any work, not reported once per fruit
+    threads = check_threads(threads)
     t0, cpu0 = time.perf_counter(), time.thread_time()
     _check_depth_range(frame, settings.extract.min_depth, settings.extract.max_depth)
     labels, source = frame_masks(frame, masks, settings)
@@ -204,47 +248,85 @@ def detect(
     # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
     # stop 47, docs/mask47.md)
     outlined = source != COLOUR_SEGMENTER
-    detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
+    t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
-    fruit_px = labels > 0
-    for k, sl in enumerate(boxes, 1):
-        if sl is None:
-            continue
-        mask = np.zeros(labels.shape, bool)
-        mask[sl] = labels[sl] == k
-        a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=shift, outlined=outlined)
+    fruit = _Fruit(labels, frame, camera, settings, method, shift, outlined, labels > 0, colour_trimmed)
+    jobs = [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
+    workers = min(threads, len(jobs))
+    cpu_workers = 0.0
+    if workers <= 1:
+        done = [fruit(k, sl) for k, sl in jobs]
+    else:
+        done = _in_threads(fruit, jobs, workers)
+        cpu_workers = sum(d[4] for d in done)
+    detections = [d[0] for d in done]
+    for _, ext, occl, comp, _ in done:
+        t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
+    total = time.perf_counter() - t0
+    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
+               "occlusion": t_occlusion, "complete": t_complete, "total": total,
+               "cpu": time.thread_time() - cpu0 + cpu_workers}  # fmt: skip
+    return FrameDetections(frame, detections, timings, source, shift)
+
+
+#: What one fruit's task gives back: its detection, the wall seconds of its extraction, occlusion maps and completion
+#: (occlusion included), and the CPU seconds of the thread it ran on while it ran.
+_Done = tuple[Detection, float, float, float, float]
+
+
+class _Fruit:
+    """One fruit's extraction, occlusion maps and completion, given the frame's labels and what every fruit shares
+    (read, never written: the fruit of a frame may run on several threads at once, :func:`_in_threads`)."""
+
+    def __init__(
+        self, labels: np.ndarray, frame: Frame, camera: Camera, settings: Settings, method: str,
+        shift: tuple[int, int], outlined: bool, fruit_px: np.ndarray, colour_trimmed: set[int],
+    ) -> None:  # fmt: skip
+        self.labels, self.frame, self.camera, self.settings, self.method = labels, frame, camera, settings, method
+        self.shift, self.outlined, self.fruit_px, self.colour_trimmed = shift, outlined, fruit_px, colour_trimmed
+
+    def __call__(self, k: int, sl: tuple[slice, slice]) -> _Done:
+        cpu0, a = time.thread_time(), time.perf_counter()
+        frame, settings, camera = self.frame, self.settings, self.camera
+        mask = np.zeros(self.labels.shape, bool)
+        mask[sl] = self.labels[sl] == k
+        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=self.shift,
+                             outlined=self.outlined)  # fmt: skip
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
-        t_extract += b - a
         if ex.error:  # the mask's depth is what lies behind the fruit: reported, never completed (a box metres off)
-            detections.append(Detection(int(k), mask, ex, error=ex.error))
-            continue
+            return Detection(int(k), mask, ex, error=ex.error), b - a, 0.0, 0.0, time.thread_time() - cpu0
         if len(ex.points) < settings.extract.min_points:
             why = (f"only {len(ex.points)} points with valid depth (extract.min_points = "
                    f"{settings.extract.min_points}); {ex.n_invalid} of {ex.mask_area} mask pixels "
                    "had no depth")  # fmt: skip
-            detections.append(Detection(int(k), mask, ex, error=why))
-            continue
-        occ = None
+            return Detection(int(k), mask, ex, error=why), b - a, 0.0, 0.0, time.thread_time() - cpu0
+        occ, t_occlusion = None, 0.0
         try:
             # the frame checked its depth's units when it was made; every fruit's pixels are the others' (this
             # fruit's own are never hidden: the same occlusion without two whole-image operations per fruit); a
             # mask trimmed by colour already lost what it overshot the fruit by (stop 42, docs/sil42.md)
             occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
-                                  others=fruit_px, checked=True, eroded=settings.extract.erode_px,
-                                  drawn=k not in colour_trimmed)  # fmt: skip
-            t_occlusion += time.perf_counter() - b
-            result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
-            detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
+                                  others=self.fruit_px, checked=True, eroded=settings.extract.erode_px,
+                                  drawn=k not in self.colour_trimmed)  # fmt: skip
+            t_occlusion = time.perf_counter() - b
+            result = complete(ex.points, camera=camera, method=self.method, settings=settings, occlusion=occ)
+            found = Detection(int(k), mask, ex, result, occlusion=occ)
         except SymfruitError as exc:
-            detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
-        t_complete += time.perf_counter() - b
-    total = time.perf_counter() - t0
-    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
-               "occlusion": t_occlusion, "complete": t_complete, "total": total,
-               "cpu": time.thread_time() - cpu0}  # fmt: skip
-    return FrameDetections(frame, detections, timings, source, shift)
+            found = Detection(int(k), mask, ex, error=str(exc), occlusion=occ)
+        return found, b - a, t_occlusion, time.perf_counter() - b, time.thread_time() - cpu0
+
+
+def _in_threads(fruit: _Fruit, jobs: list[tuple[int, tuple[slice, slice]]], workers: int) -> list[_Done]:
+    """``[fruit(k, sl) for k, sl in jobs]`` on ``workers`` threads: the same list, in the same order; an error
+    raised by a fruit is the first failing fruit's, as the loop would raise it (the fruit not yet started are
+    dropped, those running finish first)."""
+    pool = ThreadPoolExecutor(max_workers=workers, thread_name_prefix="symfruit-detect")
+    try:
+        futures = [pool.submit(fruit, k, sl) for k, sl in jobs]
+        return [f.result() for f in futures]
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
 
 
 def _default_settings() -> Settings:

@@ -1,0 +1,139 @@
+"""Stop 52 (issue 19, docs/threads52.md): does the second core pay for a frame's fruit? Wall and CPU time of
+``detect`` on the benchmark frame (``symfruit bench --frame``'s) with its fruit on one thread or on two, the two
+alternated round by round; or with half of the fruit in a second, forked and warm, process (the frame and the
+fruit's shared arrays pickled to it, its detections pickled back); or ``docs/digests.py``'s records digest with
+``detect``'s threads forced.
+
+    python docs/threads52.py threads [--method evidence] [--rounds 6] [--repeat 15] [--threads 2]
+    python docs/threads52.py processes [--method evidence] [--rounds 6] [--repeat 15]
+    python docs/threads52.py digests [--threads 2]
+
+Wall time is what the question is about, and on a machine other work keeps busy it says little: the figures of
+docs/threads52.md were taken as ``chrt -f 5 env OPENBLAS_NUM_THREADS=1 python docs/threads52.py ...`` (real-time
+priority: the two cores as on a quiet machine for the seconds it runs; OpenBLAS on one thread, else two Python
+threads each calling a two-thread OpenBLAS oversubscribe the two cores).
+"""
+
+import argparse
+import os
+import sys
+import time
+from functools import partial
+
+import numpy as np
+
+
+def _say(text: str) -> None:
+    sys.stdout.write(text + "\n")
+
+
+def _frame(method: str):
+    from symfruit.detect import detect
+    from symfruit.evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, 0)
+    for _ in range(3):
+        detect(frame, method=method)
+    return frame
+
+
+def _ab(run_a, run_b, rounds: int, repeat: int) -> dict[str, list[tuple[float, dict]]]:
+    """Wall seconds and timings of each run, the two alternated (a b, b a, ...)."""
+    found: dict[str, list[tuple[float, dict]]] = {"a": [], "b": []}
+    for r in range(rounds):
+        for name in ("a", "b") if r % 2 == 0 else ("b", "a"):
+            run = run_a if name == "a" else run_b
+            for _ in range(repeat):
+                start = time.perf_counter()
+                timings = run().timings
+                found[name].append((time.perf_counter() - start, timings))
+    return found
+
+
+def _print(label: str, runs: list[tuple[float, dict]]) -> None:
+    wall = np.array([w for w, _ in runs]) * 1e3
+    cpu = np.array([t["cpu"] for _, t in runs]) * 1e3
+    # the fruit's part of the frame: its wall time, and the fruit's own wall times summed
+    part = np.array([t["total"] - t["segment"] - t["trim"] - t["register"] for _, t in runs]) * 1e3
+    summed = np.array([t["extract"] - t["trim"] - t["register"] + t["complete"] for _, t in runs]) * 1e3
+    _say(f"{label:<30} wall median {np.median(wall):6.1f} least {wall.min():6.1f} ms, cpu median "
+          f"{np.median(cpu):6.1f}; the fruit's part: wall {np.median(part):5.1f}, each fruit's summed "
+          f"{np.median(summed):5.1f}")  # fmt: skip
+
+
+def threads(method: str, rounds: int, repeat: int, count: int) -> None:
+    from symfruit.detect import detect
+
+    frame = _frame(method)
+    found = _ab(partial(detect, frame, method=method, threads=1),
+                partial(detect, frame, method=method, threads=count), rounds, repeat)  # fmt: skip
+    _say(f"{method}, load {os.getloadavg()[0]:.1f}, {rounds} rounds of {repeat} frames each")
+    _print("fruit on 1 thread", found["a"])
+    _print(f"fruit on {count} threads", found["b"])
+
+
+def processes(method: str, rounds: int, repeat: int) -> None:
+    import multiprocessing
+
+    import symfruit.detect as D
+
+    frame = _frame(method)
+    pool = multiprocessing.get_context("fork").Pool(1)  # forked once, warm: its kernels loaded as here
+    pool.apply(os.getpid)
+    in_threads = D._in_threads
+
+    def split(fruit, jobs, workers):  # every other fruit in the second process, the rest here at the same time
+        there = pool.apply_async(_run, (fruit, jobs[1::2]))
+        here = [fruit(k, sl) for k, sl in jobs[0::2]]
+        theirs = there.get()
+        return [here[i // 2] if i % 2 == 0 else theirs[i // 2] for i in range(len(jobs))]
+
+    try:
+        D._in_threads = split
+        one, two = D.detect(frame, method=method), D.detect(frame, method=method, threads=2)
+        same = all(np.array_equal(a.extraction.points, b.extraction.points) and a.error == b.error and
+                   (a.result is None or np.array_equal(a.result.points, b.result.points))
+                   for a, b in zip(one.detections, two.detections, strict=True))  # fmt: skip
+        found = _ab(partial(D.detect, frame, method=method, threads=1),
+                    partial(D.detect, frame, method=method, threads=2), rounds, repeat)  # fmt: skip
+    finally:
+        D._in_threads = in_threads
+        pool.terminate()
+    _say(f"{method}, load {os.getloadavg()[0]:.1f}, {rounds} rounds of {repeat} frames each; the same detections: "
+          f"{same}")  # fmt: skip
+    _print("one process", found["a"])
+    _print("half of the fruit in another", found["b"])
+
+
+def _run(fruit, jobs):
+    return [fruit(k, sl) for k, sl in jobs]
+
+
+def digests(count: int) -> None:
+    import symfruit.detect as D
+
+    sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+    import digests as digests_module
+
+    D.detect = partial(D.detect, threads=count)
+    _say(f"records {digests_module.records()} (the fruit on {count} threads)")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("what", choices=("threads", "processes", "digests"))
+    parser.add_argument("--method", default="evidence")
+    parser.add_argument("--rounds", type=int, default=6)
+    parser.add_argument("--repeat", type=int, default=15)
+    parser.add_argument("--threads", type=int, default=2)
+    args = parser.parse_args()
+    if args.what == "threads":
+        threads(args.method, args.rounds, args.repeat, args.threads)
+    elif args.what == "processes":
+        processes(args.method, args.rounds, args.repeat)
+    else:
+        digests(args.threads)
+
+
+if __name__ == "__main__":
+    main()
