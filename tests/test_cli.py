@@ -201,9 +201,9 @@ def test_bench_frame_times_one_method_or_profiles_it(capsys, monkeypatch):
 
     real, found = detect_module.detect, {}
 
-    def detect_once(frame, *, method):
+    def detect_once(frame, *, method, threads=1):
         if (id(frame), method) not in found:
-            found[(id(frame), method)] = real(frame, method=method)
+            found[(id(frame), method)] = real(frame, method=method, threads=threads)
         return found[(id(frame), method)]
 
     monkeypatch.setattr(detect_module, "detect", detect_once)

@@ -877,7 +877,7 @@ def _detect(args: argparse.Namespace) -> int:
         if os.path.commonpath([bag_at, out_at]) == bag_at:  # the bag's folder would hold the run's files
             raise InputError(f"--ros2-bag {args.ros2_bag} holds --output {args.output}: the bag's files and the "
                              "run's would share a folder; give the bag a folder of its own (e.g. OUT/bag)")  # fmt: skip
-    threads = _threads(args, alone=not args.scheduler and args.workers is None)
+    threads = _threads(args, alone=args.scheduler is None and args.workers is None)
     with _ros2_bag(args) as bag:
         source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
