@@ -8,6 +8,7 @@ records digest with ``detect``'s threads forced.
     python docs/threads52.py threads [--method evidence] [--rounds 6] [--repeat 15] [--threads 2]
     python docs/threads52.py processes [--method evidence] [--rounds 6] [--repeat 15] [--pickled]
     python docs/threads52.py digests [--threads 2]
+    python docs/threads52.py memory [--frames 400] [--threads 2]
 
 Wall time is what the question is about, and on a machine other work keeps busy it says little: the figures of
 docs/threads52.md were taken as ``chrt -f 5 env OPENBLAS_NUM_THREADS=1 python docs/threads52.py ...`` (real-time
@@ -189,9 +190,26 @@ def digests(count: int) -> None:
     _say(f"records {digests_module.records()} (the fruit on {count} threads)")
 
 
+def memory(frames: int, count: int) -> None:
+    """The resident set after frames 10, 50, 100, ... of ``detect`` on the benchmark frame, its fruit on ``count``
+    threads (a pool made and shut down per frame: nothing should grow)."""
+    from symfruit.detect import detect
+    from symfruit.evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, 0)
+    page = os.sysconf("SC_PAGE_SIZE")
+    for i in range(1, frames + 1):
+        detect(frame, method="evidence", threads=count)
+        if i in (10, 50) or i % 100 == 0 or i == frames:
+            with open("/proc/self/statm") as f:
+                rss = int(f.read().split()[1]) * page / 2**20
+            _say(f"threads {count}, frame {i}: resident {rss:.1f} MB")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("what", choices=("threads", "processes", "digests"))
+    parser.add_argument("what", choices=("threads", "processes", "digests", "memory"))
+    parser.add_argument("--frames", type=int, default=400, help="memory: frames")
     parser.add_argument("--method", default="evidence")
     parser.add_argument("--rounds", type=int, default=6)
     parser.add_argument("--repeat", type=int, default=15)
@@ -202,8 +220,10 @@ def main() -> None:
         threads(args.method, args.rounds, args.repeat, args.threads)
     elif args.what == "processes":
         processes(args.method, args.rounds, args.repeat, args.pickled)
-    else:
+    elif args.what == "digests":
         digests(args.threads)
+    else:
+        memory(args.frames, args.threads)
 
 
 if __name__ == "__main__":
