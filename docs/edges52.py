@@ -7,8 +7,11 @@ region, the views whose edge normals come from the image grid) and over the spar
 - ``calls``: how many, and how many had occlusion information (``detect``'s fruit, the camera protocol's views);
 - ``voted``: the calls whose edge test found at least 3 edge points (their normals label the outline);
 - ``edges``: the edge points found, summed, and the share of them labelled a cut (a normal facing the camera);
-- ``own``: the same edge test measured from the points' own region (``evidence``'s region before it is grown to
-  the fruit's mask, ``core.occlusion.with_own``): the calls it would find edge points in, and their cut share.
+- ``contour share``: the mean of the calls' :attr:`~symfruit.core.agreement.Observation.contour`;
+- ``own region``: the same edge test measured from the points' own region (``evidence``'s region before it is grown
+  to the fruit's mask, ``core.occlusion.with_own``): the calls it would find edge points in, their edge points and
+  cut share; ``1.5 + eroded px``: the same on the grown region with the test's 1.5 px moved inward by extraction's
+  default erosion (:data:`ERODED`).
 
     python docs/edges52.py bench                      # detect on the benchmark frames (seeds 0-2, evidence)
     python docs/edges52.py -- evaluate --protocol paper --fruit examples/scans --n 2 --pose hanging --no-profile \\

@@ -249,9 +249,9 @@ def observe(
         window (pixels the camera did not see are no evidence).
     contour_points : int
         Edge points whose normals decide :attr:`Observation.contour`: at most this many of the points (of ``dense``
-        where given) within 1.5 px of the region's edge. A region grown beyond the points (``evidence``'s, to the
-        fruit's mask around an eroded border) has none: its outline is labelled by ``occlusion`` alone, and without
-        that, all of it is a contour (issue 18, docs/edges52.md).
+        where given) within 1.5 px of the region's edge. A region grown a pixel or more beyond the points all round
+        (``evidence``'s: the fruit's mask around the border extraction leaves out) has none: its outline is then
+        labelled by ``occlusion`` alone, and without that, all of it is a contour (issue 18, docs/edges52.md).
     edge : float, pixels
         Points at least this far inside the silhouette's edge are :attr:`Observation.interior`.
     dense : (N, 3) float, metres, optional
