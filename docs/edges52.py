@@ -24,6 +24,7 @@ region, the views whose edge normals come from the image grid) and over the spar
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import io
 import sys
@@ -153,17 +154,20 @@ def bench() -> None:
 
 
 def main(argv: list[str]) -> int:
-    if not argv or argv[0] in ("-h", "--help"):
-        say(__doc__)
-        return 0 if argv else 2
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("what", nargs=argparse.REMAINDER, help="bench, or -- and a symfruit command")
+    what = parser.parse_args(argv).what
+    what = what[1:] if what[:1] == ["--"] else what
+    if not what:
+        parser.error("name a case (bench) or a symfruit command after --")
     with counted():
-        if argv == ["bench"]:
+        if what == ["bench"]:
             bench()
             title = "detect on the benchmark frames (seeds 0-2, evidence)"
         else:
             from symfruit.cli import main as cli
 
-            command = argv[1:] if argv[0] == "--" else argv
+            command = list(what)
             if "--protocol" in command and "--jobs" not in command:
                 command += ["--jobs", "1"]
             with contextlib.redirect_stdout(io.StringIO()):

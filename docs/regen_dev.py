@@ -3,13 +3,14 @@
 
     python docs/regen_dev.py run OUT PART ... [--jobs N] [--resume]   # from the tree to measure (PYTHONPATH=src)
 
-Everything else (``compare``, ``list``: the commands kept) is ``docs/regen.py``'s. It reads the ``docs/regen.py`` of
-the working folder, so it measures any tree that has one (e.g. a base tree: ``cd BASE && PYTHONPATH=src python
-/path/to/docs/regen_dev.py run OUT spheres``).
+Everything else (``compare``, ``list``: the commands kept) is the ``docs/regen.py`` beside this script. As with it,
+``run`` measures the tree it is run from (its ``src``, ``docs/`` scripts and ``examples/``), so it measures a base
+tree too: ``cd BASE && PYTHONPATH=src python /path/to/docs/regen_dev.py run OUT spheres``.
 """
 
 from __future__ import annotations
 
+import argparse
 import importlib.util
 import re
 import sys
@@ -22,9 +23,7 @@ REFUSED = ("heldback", "conf")
 
 
 def load_regen() -> object:
-    path = Path("docs/regen.py")
-    if not path.is_file():
-        sys.exit("regen_dev: run from the tree to measure (its docs/regen.py)")
+    path = Path(__file__).resolve().with_name("regen.py")
     spec = importlib.util.spec_from_file_location("regen", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
@@ -34,6 +33,11 @@ def load_regen() -> object:
 
 
 def main(argv: list[str]) -> int:
+    if not argv or argv[0] in ("-h", "--help"):
+        parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+        parser.add_argument("what", choices=("run", "compare", "readme", "list"), help="as docs/regen.py's")
+        parser.add_argument("args", nargs=argparse.REMAINDER, help="as docs/regen.py's")
+        parser.parse_args(argv)  # --help: the usage; nothing: the usage and an error
     regen = load_regen()
     every = regen.parts  # type: ignore[attr-defined]
 
