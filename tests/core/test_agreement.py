@@ -373,3 +373,46 @@ def test_the_bands_kept_whole_by_observe_are_the_joined_ones(camera, occluded):
     other = dataclasses.replace(obs, rays_out=tuple(r[:3] for r in obs.rays_out),
                                 out_weights=tuple(w[:3] for w in obs.out_weights), out_depth=cut_depth)  # fmt: skip
     assert len(_bands(other).rays) == len(obs.rays) + made.n_in + 3 * len(obs.rays_out)
+
+
+def _masked_view(camera, rim_px: int, cap: float | None = None):
+    """A fruit seen whole (nothing in front of it, a backdrop at 1 m): a ball at 0.4 m, or with ``cap`` (metres)
+    only its front cap nearer than ``0.4 - cap`` (the rest of the ball is backdrop: the cap's edge faces the camera).
+    Its mask is the fruit's pixels, its points those at least ``rim_px`` inside the mask's edge, as ``detect`` takes
+    a fruit: extraction leaves out the mask's mixed border (``extract.erode_px``, 1 px), and a time-of-flight camera
+    returns no depth on a grazing rim besides. ``(points, own region, region grown to the mask, occlusion)``."""
+    from scipy import ndimage
+
+    from symfruit.core.occlusion import occlusion, with_own
+
+    from ..conftest import occluded_view
+
+    _, depth, mask, _ = occluded_view(ball_mesh(), np.array([0.0, 0.0, 0.4]), below=10 * camera.height,
+                                      occluder_z=0.3)  # fmt: skip
+    if cap is not None:
+        depth = np.where(mask & (depth > 0.4 - cap), 1.0, depth)
+        mask = mask & (depth < 0.4 - cap)
+    kept = ndimage.binary_erosion(mask, np.ones((3, 3), bool), iterations=rim_px)
+    depth = np.where(mask & ~kept, 0.0, depth)  # no depth on the border the points were not taken from
+    rows, cols = np.nonzero(kept)
+    points = camera.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    own = silhouette(points, camera)
+    occ = occlusion(depth, mask, points, camera, eroded=1)
+    return points, own, with_own(own, occ), occ
+
+
+@pytest.mark.parametrize(("rim_px", "cap"), [(1, 0.02), (10, None)])
+def test_edge_normals_do_not_vote_on_a_region_grown_to_the_fruits_mask(camera, rim_px, cap):
+    """Issue 18, stop 52 (docs/edges52.md): the edge points whose normals label the outline are the points within
+    1.5 px of the region's edge. ``evidence`` grows the region to the fruit's mask (``with_own``) before
+    ``observe``, and every point of a fruit ``detect`` extracted lies at least 2 px inside the mask (the eroded
+    border), so the normals never vote there: the outline's labels come from the occlusion information alone (none
+    hidden near the outline here: all of it a contour). Measured from the points' own edge instead, the normals
+    vote: a front cap's edge (1 px eroded) faces the camera, and so does a whole ball's where a time-of-flight
+    camera lost its grazing rim (10 px here, the real sphere frames' case): most of the outline would be a cut."""
+    points, own, grown, occ = _masked_view(camera, rim_px, cap)
+    assert grown.mask.sum() > own.mask.sum()  # the mask reaches beyond the points
+    silent = observe(points[::10], grown, camera, dense=points, occlusion=occ, inner_reach=8.0)
+    assert silent.contour == 1.0
+    voting = observe(points[::10], own, camera, dense=points, occlusion=occ, inner_reach=8.0)
+    assert voting.contour < 0.5

@@ -248,7 +248,10 @@ def observe(
         partial coverage does not matter, 5 px grades larger outline errors. Bands are cut by the image
         window (pixels the camera did not see are no evidence).
     contour_points : int
-        Edge points whose normals decide :attr:`Observation.contour`.
+        Edge points whose normals decide :attr:`Observation.contour`: at most this many of the points (of ``dense``
+        where given) within 1.5 px of the region's edge. A region grown a pixel or more beyond the points all round
+        (``evidence``'s: the fruit's mask around the border extraction leaves out) has none: its outline is then
+        labelled by ``occlusion`` alone, and without that, all of it is a contour (issue 18, docs/edges52.md).
     edge : float, pixels
         Points at least this far inside the silhouette's edge are :attr:`Observation.interior`.
     dense : (N, 3) float, metres, optional

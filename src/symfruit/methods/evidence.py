@@ -700,7 +700,11 @@ def evidence(
     dense = len(points) >= 0.5 * np.count_nonzero(region.mask)
     seen_region = region
     if occlusion is not None:
-        region = with_own(region, occlusion)  # the fruit's mask reaches beyond its points (an eroded border)
+        # the fruit's mask reaches beyond its points (an eroded border, a time-of-flight camera's lost rim): its
+        # outline is labelled by the occlusion information alone, since no point lies within observe's 1.5 px of it
+        # and the edge normals do not vote (measured from the points' own edge they call a lost rim a cut; issue 18,
+        # docs/edges52.md)
+        region = with_own(region, occlusion)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
                   thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
