@@ -394,3 +394,41 @@ def test_a_fruit_before_a_wall_or_against_a_leaf_keeps_its_points():
     _, depth, mask = leaf_across_frame()  # a leaf in front running on across the outline: no wall behind
     ex = extract(mask, depth, CAM, own=False)
     assert own_surface(ex, mask, depth, CAM) is ex
+
+
+# --- stop 52, register52
+
+
+@pytest.mark.parametrize("kernels", ["numba", "numpy"])
+@pytest.mark.parametrize("min_depth", [0.0, 0.1])
+def test_extraction_hands_its_cleaned_depth_to_the_surface_as_it_is(monkeypatch, kernels, min_depth):
+    """With a least depth above 0 the depth extraction keeps is finite and above 0 or 0, and ``fruit_surface`` is
+    told so (``clean``: not cleaned again); at 0 it is cleaned as before. The points are the same either way, on a
+    ball with NaN, infinite, negative and zero depths among its pixels (with the kernels and with the twins)."""
+    import symfruit.extract as extract_module
+
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    _, depth = disc_frame([(80, 60)])
+    depth = depth.astype(np.float64)
+    rng = np.random.default_rng(3)
+    spoilt = rng.random(depth.shape) < 0.05
+    depth[spoilt] = rng.choice([np.nan, np.inf, -0.3, 0.0, -0.0], size=int(spoilt.sum()))
+    yy, xx = np.mgrid[:120, :160]
+    mask = (xx - 80) ** 2 + (yy - 60) ** 2 <= 20**2
+    s = ExtractSettings(min_depth=min_depth)
+    told, own = [], extract_module.fruit_surface
+
+    def surface(*args, clean=False, **kwargs):
+        told.append(clean)
+        return own(*args, clean=clean, **kwargs)
+
+    monkeypatch.setattr(extract_module, "fruit_surface", surface)
+    ex = extract(mask, depth, CAM, s)
+    assert told == [min_depth > 0]
+
+    def cleaned(*args, clean=False, **kwargs):
+        return own(*args, clean=False, **kwargs)
+
+    monkeypatch.setattr(extract_module, "fruit_surface", cleaned)
+    assert np.array_equal(ex.points, extract(mask, depth, CAM, s).points) and len(ex.points) > 500

@@ -279,9 +279,11 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
     surface = None
     if n_usable >= 10:
         focal = float(np.sqrt(camera.fx * camera.fy))
+        # with a least depth above 0 the depth kept is finite and above 0, or 0: fruit_surface reads it as it is, as
+        # the registration's (stop 52, register52: the same values; its cleaning a copy of the window a fruit)
         surface = fruit_surface(z_valid, core, focal, slab=s.slab,
                                 tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf,
-                                leafy=leafy, thin=True, crossing=outlined)  # fmt: skip
+                                leafy=leafy, thin=True, crossing=outlined, clean=s.min_depth > 0)  # fmt: skip
     if jit is not None:
         points = jit.pixel_points(usable, usable if surface is None else surface.pixels, z_all, float(camera.cx),
                                   float(camera.cy), float(camera.fx), float(camera.fy))  # fmt: skip

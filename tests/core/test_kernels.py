@@ -6942,3 +6942,74 @@ def test_the_depth_mode_without_the_sort_is_fruit_depths_to_the_bit(seed, kind, 
             mp.setenv("SYMFRUIT_KERNELS", "numpy")
             twin = fruit_depth(kept, radius_px, 600.0, noise=noise, leafy=leaf if with_leafy else None)
         assert np.array_equal(got[:2], twin, equal_nan=True)
+
+
+# --- stop 52, register52: fruit_surface's mask box, measures and depth mode in one call ------------------------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.booleans(), st.integers(0, 9))
+def test_mask_mode_is_the_box_measures_and_depth_mode_to_the_bit(seed, with_leafy, odd, where):
+    """``mask_mode`` on a window holding one of :func:`_sheet_scene`'s masks (anywhere in it, at its border, or
+    none: ``where`` 0), with leaf pixels or not, with NaN, infinite and negative depths and sparse masks or not: the
+    box ``mask_box`` finds, the mask's count, ``mask_values``' noise, depths, leaf pixels and step on that box and
+    ``depth_mode``'s front and radius, bit for bit; and the numpy twins' (``mask_box``, ``depth_noise``,
+    ``depth_step``, ``fruit_depth``) wherever the depth mode is done."""
+    from symfruit.core.raster import mask_box
+    from symfruit.core.surface import LEAFY, depth_noise, depth_step, fruit_depth
+
+    rng = np.random.default_rng(seed)
+    _, mask, depth, (r0, c0, h, w) = _sheet_scene(rng)
+    depth = np.ascontiguousarray(depth, dtype=np.float64)
+    window = np.zeros(depth.shape, bool)
+    if where:  # the mask moved to a corner or an edge now and then (boxes from row or column 0, or to the end)
+        a = 0 if where == 1 else depth.shape[0] - min(mask.shape[0], depth.shape[0]) if where == 2 else min(r0, h)
+        b = 0 if where == 3 else depth.shape[1] - min(mask.shape[1], depth.shape[1]) if where == 4 else min(c0, w)
+        mh, mw = min(mask.shape[0], depth.shape[0] - a), min(mask.shape[1], depth.shape[1] - b)
+        window[a : a + mh, b : b + mw] = mask[:mh, :mw]
+    if odd:
+        depth[rng.random(depth.shape) < 0.05] = rng.choice([np.nan, np.inf, -0.5])
+        window &= rng.random(depth.shape) < rng.choice([0.02, 0.5, 1.0])
+    leafy = rng.random(depth.shape) < rng.uniform(0.0, 1.0)
+    shares = (float(LEAFY[0]), float(LEAFY[1]))
+    got = _jit.mask_mode(depth, window, leafy if with_leafy else np.zeros((0, 0), bool), with_leafy, 0.0005, 615.0,
+                         shares)  # fmt: skip
+    box = mask_box(window)
+    assert got[0] == (box is not None)
+    if box is None:
+        return
+    assert got[1:5] == box and got[5] == np.count_nonzero(window)
+    own, own_depth, own_leaf = (x[box[0] : box[1], box[2] : box[3]] for x in (window, depth, leafy))
+    radius_px = float(np.sqrt(np.count_nonzero(own) / np.pi))
+    noise, kept, leaf, step = _jit.mask_values(own_depth, own, own_leaf if with_leafy else np.zeros((0, 0), bool),
+                                               with_leafy, 0.0005)  # fmt: skip
+    mode = _jit.depth_mode(kept, radius_px, 615.0, noise, leaf, with_leafy, shares)
+    assert got[6] == noise and got[9] == step and np.array_equal(got[7], kept) and np.array_equal(got[8], leaf)
+    assert got[12] == mode[2] and np.array_equal(got[10:12], mode[:2], equal_nan=True)
+    with pytest.MonkeyPatch.context() as mp, np.errstate(invalid="ignore"):  # inf - inf: NaN, left out there
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        assert mask_box(window) == box
+        want_noise = depth_noise(own_depth, own)
+        want = fruit_depth(own_depth[own], radius_px, 615.0, noise=want_noise,
+                           leafy=own_leaf[own] if with_leafy else None)  # fmt: skip
+        want_step = depth_step(own_depth, own)
+    assert got[6] == want_noise and got[9] == want_step
+    if got[12]:
+        assert np.array_equal(got[10:12], want, equal_nan=True)
+
+
+def test_mask_mode_of_a_known_mask():
+    """A 5 x 4 block of depth 0.5 m (one pixel with none) at rows 3-7, columns 2-5 of a 12 x 10 window: its box and
+    count, the 19 depths kept, and the front at 0.5 m; an empty mask: none found."""
+    depth = np.full((12, 10), 0.9)
+    depth[3:8, 2:6] = 0.5
+    depth[4, 3] = 0.0
+    mask = np.zeros((12, 10), bool)
+    mask[3:8, 2:6] = True
+    found, r0, r1, c0, c1, count, _, kept, _, _, front, radius, done = _jit.mask_mode(
+        depth, mask, np.zeros((0, 0), bool), False, 0.0005, 600.0, (0.5, 0.3))  # fmt: skip
+    assert found and (r0, r1, c0, c1) == (3, 8, 2, 6) and count == 20
+    assert np.array_equal(kept, np.full(19, 0.5)) and done and front == 0.5
+    assert radius == pytest.approx(math.sqrt(20 / math.pi) * 0.5 / 600.0)
+    assert not _jit.mask_mode(depth, np.zeros((12, 10), bool), np.zeros((0, 0), bool), False, 0.0005, 600.0,
+                              (0.5, 0.3))[0]  # fmt: skip

@@ -3489,7 +3489,7 @@ def _count_below(z: np.ndarray, x: float, right: bool) -> int:
 def _leaf_share(z: np.ndarray, kept: np.ndarray, leaf: np.ndarray, edges: np.ndarray, k: int, n_bins: int) -> float:
     """:func:`symfruit.core.surface.fruit_depth`'s ``leaf_share(k)``: the same counts, the same quotient. The depths
     between the edges counted on ``z``, the depths sorted, by bisection, or where ``z`` is empty on ``kept`` by a pass
-    (:func:`_below`; :func:`depth_mode`, stop 51): the same whole numbers."""
+    (:func:`depth_mode`, stop 51): the same whole numbers."""
     lo, hi = edges[max(k - 1, 0)], edges[min(k + 2, n_bins)]
     count = 0
     if z.shape[0] > 0:
@@ -8935,29 +8935,6 @@ def surface_cap(
     return 1, r, c
 
 
-@_njit_inlined
-def _below(values: np.ndarray, x: float, right: bool) -> int:
-    """:func:`_count_below` of ``values`` (n,) float64 without NaN, not sorted: how many are below ``x`` (``right``: at
-    most ``x``), by one pass (the sorted values' count, the same whole number)."""
-    n = 0
-    for v in values:
-        n += v < x or (right and v == x)
-    return n
-
-
-@_njit_inlined
-def _kth_pair(values: np.ndarray, k: int) -> tuple[float, float]:
-    """The ``k``-th and ``k + 1``-th smallest of ``values`` (n,) float64 without NaN, ``k + 1 < n`` (``z[k]`` and
-    ``z[k + 1]`` of the sorted values), by :func:`select` on a copy."""
-    work = values.copy()
-    select(work, k)
-    nxt = work[k + 1]
-    for i in range(k + 2, work.shape[0]):
-        if work[i] < nxt:
-            nxt = work[i]
-    return work[k], nxt
-
-
 @_njit
 def depth_mode(
     kept: np.ndarray, radius_px: float, focal: float, noise: float, leaf: np.ndarray, with_leafy: bool,
@@ -8965,29 +8942,28 @@ def depth_mode(
 ) -> tuple[float, float, bool]:  # fmt: skip
     """:func:`fruit_depth` of the valid depths ``kept`` (n,) float64 (no NaN) without sorting them: the same numbers,
     bit for bit. Each value of the sorted depths it reads is found without the sort: the ends as the least and
-    greatest, the median and the front's two order statistics by :func:`select` (a value, or the same two halved),
-    each edge's count below it (``np.searchsorted``'s) as the number of values whose place among the edges (guessed
-    from the bin width and moved until the edges agree, the edges never falling) is at most its own, the counts
-    between two depths by a pass (:func:`_below`). ``(front, radius, done)`` as :func:`fruit_depth` gives them
-    (stop 51)."""
+    greatest (found while the depths are copied), the median and the front's two order statistics by
+    :func:`select_lomuto` (a value, or the same two halved; which value lies at a place does not depend on how it is
+    selected), each edge's count below it (``np.searchsorted``'s) as the number of values whose place among the
+    edges (guessed from the bin width and moved until the edges agree, the edges never falling) is at most its own,
+    the depths between two edges gathered by a pass. ``(front, radius, done)`` as :func:`fruit_depth` gives them
+    (stop 51; stop 52, register52: the selections without branches and one pass fewer, the same numbers)."""
     n = kept.shape[0]
     if n < 10:
         return np.nan, np.nan, True
-    half = n // 2
-    if n % 2:
-        work = kept.copy()
-        select(work, half)
-        median = work[half]
-    else:
-        za, zb = _kth_pair(kept, half - 1)
-        median = (za + zb) / 2.0
+    # the ends found while the depths are copied, the median by the selection without branches on the copy (stop 52,
+    # register52: the same values; the even median's lower middle is the greatest value before the upper one)
+    work = np.empty(n)
     z_first = kept[0]
     z_last = kept[0]
-    for v in kept:
+    for i in range(n):
+        v = kept[i]
+        work[i] = v
         if v < z_first:
             z_first = v
         if v > z_last:
             z_last = v
+    median = median_lomuto(work)
     ok, n_bins, width, edges = _mode_edges(z_first, z_last, median, radius_px, focal, noise)
     if not ok:
         return np.nan, np.nan, False
@@ -9015,22 +8991,26 @@ def depth_mode(
     found, a_edge, b_edge = _mode_bin(at, n, np.empty(0), kept, leaf, edges, with_leafy, leafy_shares)
     if not found:
         return np.nan, np.nan, False
-    size = _below(kept, b_edge, True) - _below(kept, a_edge, False)
+    # the depths from a_edge to b_edge (a_edge <= b_edge: as many as the counts below each give) gathered into the
+    # median's copy in one pass, each written and kept by the comparison's outcome (stop 52: no branch to foresee)
+    size = 0
+    for v in kept:
+        work[size] = v
+        size += (v >= a_edge) & (v <= b_edge)
     if size < 1:
         return np.nan, np.nan, False
-    inside = np.empty(size)
-    m = 0
-    for v in kept:
-        if v >= a_edge and v <= b_edge:
-            inside[m] = v
-            m += 1
+    inside = work[:size]
     if size == 1:
         front = inside[0]
     else:
         where = (size - 1) * 0.05
         below = np.int64(np.floor(where))
         t = where - below
-        za, zb = _kth_pair(inside, below)
+        select_lomuto(inside, below)  # z[below] and z[below + 1] of the sorted depths: the value there, the least after
+        za, zb = inside[below], inside[below + 1]
+        for i in range(below + 2, size):
+            if inside[i] < zb:
+                zb = inside[i]
         front = zb - (zb - za) * (1.0 - t) if t >= 0.5 else za + (zb - za) * t
     return front, radius_px * front / focal, True
 
@@ -9121,3 +9101,48 @@ def _mode_bin(
     while first > 0 and counts[first - 1] >= least:
         first -= 1
     return True, edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+
+
+# --- stop 52, register52: fruit_surface's mask box, measures and depth mode in one call ------------------------------
+
+
+@_njit
+def mask_mode(
+    depth: np.ndarray, mask: np.ndarray, leafy: np.ndarray, with_leafy: bool, floor: float, focal: float,
+    leafy_shares: tuple[float, float],
+) -> tuple[bool, int, int, int, int, int, float, np.ndarray, np.ndarray, float, float, float, bool]:  # fmt: skip
+    """:func:`symfruit.core.surface.fruit_surface`'s first steps on a window in one call, each the code it ran (the
+    same numbers, bit for bit): the box of ``mask`` (h, w) bool (:func:`symfruit.core.raster.mask_box`), the count of
+    its pixels, then on the box :func:`mask_values` of ``depth`` (h, w) float64 (``leafy`` (h, w) bool where
+    ``with_leafy``; ``floor`` the noise's) and :func:`depth_mode` of its depths with the mask's equivalent radius
+    ``sqrt(count / pi)`` and ``focal``. ``(found, r0, r1, c0, c1, count, noise, kept, leaf, step, front, radius,
+    done)``: ``found`` False for an empty mask (nothing else set); ``kept`` and ``leaf`` as :func:`mask_values` gives
+    them, for :func:`symfruit.core.surface.fruit_depth` where ``done`` is False (stop 52: two kernels' calls and
+    ``mask_box``'s numpy steps, 20-40 us a fruit, in one)."""
+    h, w = mask.shape
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        first, last = -1, -1
+        for c in range(w):
+            if mask[r, c]:
+                last = c
+                if first < 0:
+                    first = c
+        if first >= 0:
+            r0 = min(r0, r)
+            r1 = r + 1
+            c0 = min(c0, first)
+            c1 = max(c1, last + 1)
+    none = np.empty(0)
+    if r1 == 0:
+        return False, 0, 0, 0, 0, 0, 0.0, none, np.empty(0, np.bool_), 0.0, np.nan, np.nan, True
+    own = mask[r0:r1, c0:c1]
+    count = 0
+    for r in range(r1 - r0):
+        for c in range(c1 - c0):
+            count += own[r, c]
+    radius_px = math.sqrt(count / np.pi)
+    leaf_box = leafy[r0:r1, c0:c1] if with_leafy else leafy
+    noise, kept, leaf, step = mask_values(depth[r0:r1, c0:c1], own, leaf_box, with_leafy, floor)
+    front, radius, done = depth_mode(kept, radius_px, focal, noise, leaf, with_leafy, leafy_shares)
+    return True, r0, r1, c0, c1, count, noise, kept, leaf, step, front, radius, done

@@ -967,36 +967,43 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         depth = np.where(valid, depth, 0.0)
     # What depends on the mask alone is worked out on the mask's box (the same values: pixels outside it are not
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
-    if (found := mask_box(mask)) is None:
-        return None  # no depth in an empty mask
-    r0, r1, c0, c1 = found
-    box = (slice(r0, r1), slice(c0, c1))
-    own, own_depth = mask[box], depth[box]
-    # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
-    radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
     unit: float | None = None  # the depth's step, when measured with the noise and the front
-    leaf = None if leafy is None else leafy[box]
     jit = compiled()
     if (
         jit is not None
-        and own.dtype == bool
-        and own_depth.dtype == np.float64
-        and (leafy is None or (np.shape(leafy) == np.shape(mask) and np.asarray(leafy).dtype == bool))
+        and isinstance(mask, np.ndarray)
+        and mask.dtype == bool
+        and mask.ndim == 2
+        and np.shape(depth) == mask.shape
+        and depth.dtype == np.float64
+        and (leafy is None or (np.shape(leafy) == mask.shape and np.asarray(leafy).dtype == bool))
     ):
-        # the noise, the mask's valid depths and the depth's step in one call, then the depth mode on them without
-        # sorting them (stop 51, surface51: fruit_depth's steps, the same numbers)
-        noise, kept, leaf_kept, unit = jit.mask_values(own_depth, own, _NO_LEAF if leaf is None else leaf,
-                                                       leaf is not None, _NOISE_FLOOR)  # fmt: skip
-        front, radius, done = jit.depth_mode(kept, radius_px, float(focal), float(noise), leaf_kept, leaf is not None,
-                                             (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        # the mask's box and count, the noise, the mask's valid depths, the depth's step and the depth mode on them
+        # without sorting them in one call (stop 52, register52: mask_box, mask_values and depth_mode of stop 51,
+        # fruit_depth's steps: the same numbers)
+        found, r0, r1, c0, c1, count, noise, _, _, unit, front, radius, done = jit.mask_mode(
+            depth, mask, _NO_LEAF if leafy is None else np.asarray(leafy), leafy is not None, _NOISE_FLOOR,
+            float(focal), (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+        if not found:
+            return None  # no depth in an empty mask
+        box = (slice(r0, r1), slice(c0, c1))
+        own, own_depth = mask[box], depth[box]
+        radius_px = float(np.sqrt(count / np.pi))
         front, radius = float(front), float(radius)
         if not done:  # left to the twin (fruit_depth's kernel declines)
             front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                        leafy=None if leaf is None else leaf[own])  # fmt: skip
+                                        leafy=None if leafy is None else leafy[box][own])  # fmt: skip
     else:
+        if (found_box := mask_box(mask)) is None:
+            return None  # no depth in an empty mask
+        r0, r1, c0, c1 = found_box
+        box = (slice(r0, r1), slice(c0, c1))
+        own, own_depth = mask[box], depth[box]
+        # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
+        radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
         noise = depth_noise(own_depth, own)
         front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                    leafy=None if leaf is None else leaf[own])  # fmt: skip
+                                    leafy=None if leafy is None else leafy[box][own])  # fmt: skip
     if not np.isfinite(front):
         return None
     # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
