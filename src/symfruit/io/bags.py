@@ -20,7 +20,6 @@ non-finite refused, non-zero warned about once per bag): the live ROS node (:mod
 from __future__ import annotations
 
 import bisect
-import errno
 import math
 import os
 import re
@@ -309,6 +308,9 @@ def _bound_decompression() -> None:
     opener = getattr(getattr(ros1, "Reader", None), "open", None)
     if opener is not None and not getattr(opener, "_symfruit", False):
         setattr(ros1.Reader, "open", _indexed_within(opener))  # noqa: B010  # rosbags, for its reader
+    info_reader = getattr(getattr(ros1, "Reader", None), "read_chunk_info", None)
+    if info_reader is not None and not getattr(info_reader, "_symfruit", False):
+        setattr(ros1.Reader, "read_chunk_info", _chunk_within(info_reader))  # noqa: B010  # rosbags, for its reader
 
 
 def _sized_chunks(read_chunk: Any) -> Any:
@@ -344,7 +346,7 @@ def _indexed_within(open_bag: Any) -> Any:
     """rosbags' ROS 1 ``Reader.open``, after a check that the bag header's ``index_pos`` lies within the file:
     rosbags seeks there, and a position past what the file system holds failed in the system's words (``[Errno 22]
     Invalid argument``, ``cannot fit 'int' into an offset-sized integer``; stop 51, robust51). A chunk position
-    in the index past it (rosbags seeks to each) is said so too."""
+    in the index past it is :func:`_chunk_within`'s."""
     from rosbags.rosbag1 import reader as ros1
 
     def checked(self: Any) -> Any:
@@ -361,15 +363,25 @@ def _indexed_within(open_bag: Any) -> Any:
         if size is not None and 0 < index_pos and index_pos >= size:  # 0: not indexed, as rosbags says
             raise FileFormatError(f"the bag header puts its index at byte {index_pos:,}, past the end of the file "
                                   f"({size:,} bytes): the bag is damaged")  # fmt: skip
-        try:
-            return open_bag(self)
-        except (OSError, ValueError, OverflowError) as exc:
-            past = (isinstance(exc, OSError) and exc.errno == errno.EINVAL) or isinstance(exc, OverflowError) or (
-                isinstance(exc, ValueError) and "offset-sized" in str(exc))  # fmt: skip
-            if not past:
-                raise
-            raise FileFormatError("the bag's index gives a chunk position past what the file holds: the bag is "
-                                  "damaged") from None  # fmt: skip
+        return open_bag(self)  # its index's chunk positions are checked as read (_chunk_within)
+
+    checked._symfruit = True  # type: ignore[attr-defined]
+    return checked
+
+
+def _chunk_within(read_chunk_info: Any) -> Any:
+    """rosbags' ROS 1 ``Reader.read_chunk_info`` (an index entry), refused when the chunk position it gives lies
+    past the end of the file: rosbags seeks there, and read an empty record where the file system lets it seek
+    (``Header could not be read from file.``, rosbags' words; stop 51 left it) or failed in the system's words where
+    it does not. Stop 52 (robust52)."""
+
+    def checked(self: Any) -> Any:
+        info = read_chunk_info(self)
+        size = os.fstat(self.bio.fileno()).st_size
+        if not 0 <= info.pos < size:
+            raise FileFormatError(f"the bag's index puts a chunk at byte {info.pos:,}, past the end of the file "
+                                  f"({size:,} bytes): the bag is damaged")  # fmt: skip
+        return info
 
     checked._symfruit = True  # type: ignore[attr-defined]
     return checked
