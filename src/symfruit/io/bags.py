@@ -20,6 +20,7 @@ non-finite refused, non-zero warned about once per bag): the live ROS node (:mod
 from __future__ import annotations
 
 import bisect
+import contextlib
 import math
 import os
 import re
@@ -209,52 +210,160 @@ class BagFileRefused(FileFormatError):
 
 class _BoundedFile:
     """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
-    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when it was
-    opened, or once that room, asked again every :data:`_STEP_BYTES` out, is gone (two runs decompressing at once
-    each saw the whole room when they began)."""
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when the first
+    came out, or than the room left now less what other runs decompressing there have claimed.
+
+    Each run claims the room before it hands bytes on (:class:`_RoomClaims`: up to :data:`_STEP_BYTES` at a time,
+    checked and recorded under a lock shared by the runs on that temporary folder), and counts its claim written
+    once it is asked for more (rosbags writes what it read before it reads again). So the reserve holds across
+    processes: the room each run checks is the disk's free space less the reserve less the claims of the others
+    not yet written (stop 51 asked the disk alone every 8 MB: two runs at once could each pass the reserve by up to
+    8 MB; stop 52, robust52)."""
 
     def __init__(self, opened: Any, name: str) -> None:
-        self._opened, self._name, self._out, self._checked = opened, name, 0, 0
-        self._room = bag_file_room()
+        self._opened, self._name, self._out, self._claimed = opened, name, 0, 0
+        self._room: int | None = None
+        self._claims = _RoomClaims()
 
     def __enter__(self) -> _BoundedFile:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        self._claims.close()
         self._opened.close()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._opened, name)
 
     def read(self, size: int | None = -1) -> bytes:
-        import tempfile
-
         if size is None or size < 0:  # all of it: in steps, each counted
             return b"".join(iter(lambda: self.read(_STEP_BYTES), b""))
         data = self._opened.read(min(size, _STEP_BYTES))
-        self._out += len(data)
-        if self._out > max(self._room, 0):
-            room = max(self._room, 0)
-            raise BagFileRefused(
-                f"{self._name}: compressed whole (rosbag2's file compression), it expands past {room / 1e6:,.0f} MB, "
-                f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
-                "damaged, or zstd -d it where there is room"
-            )
-        if self._out - self._checked >= _STEP_BYTES:  # the room asked again as it goes: another run (or program)
-            self._checked = self._out  # decompressing there at once saw the same room when it began (robust51)
-            if bag_file_room() < 0:
-                raise BagFileRefused(
-                    f"{self._name}: compressed whole (rosbag2's file compression), {self._out / 1e6:,.0f} MB "
-                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
-                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (another program writes there too; decompression stopped): "
-                    "zstd -d it where there is room, or run again when there is"
-                )
+        written, self._out = self._out, self._out + len(data)  # what came out before is written by now
+        if self._out > self._claimed:
+            self._claim(written)
         return data
+
+    def _claim(self, written: int) -> None:
+        """Claim room for the bytes out beyond the claims so far (at least :data:`_STEP_BYTES` where there is
+        room), ``written`` of those out so far being on the disk; refuse when there is not room for them."""
+        import tempfile
+
+        with self._claims as others:
+            room = bag_file_room()
+            if self._room is None:
+                self._room = room
+            available = room - others - (self._claimed - written)
+            need = self._out - self._claimed
+            if self._out > max(self._room, 0):
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), it expands past "
+                    f"{max(self._room, 0) / 1e6:,.0f} MB, the room in {tempfile.gettempdir()} less "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): damaged, or zstd -d it where there is "
+                    "room"
+                )
+            if need > available:
+                held = f", {others / 1e6:,.0f} MB of it held by other runs decompressing there" if others else ""
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), {written / 1e6:,.0f} MB "
+                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB{held} (another program writes there too; decompression "
+                    "stopped): zstd -d it where there is room, or run again when there is"
+                )
+            self._claimed += min(max(need, _STEP_BYTES), available)
+            self._claims.hold(self._claimed - written)
 
     def readinto(self, buffer: Any) -> int:
         data = self.read(len(buffer))
         buffer[: len(data)] = data
         return len(data)
+
+
+class _RoomClaims:
+    """The temporary disk's room claimed by the runs decompressing a bag there (:class:`_BoundedFile`): a file
+    per claimant in ``<tmp>/symfruit-bag-room/`` holding the bytes it claimed and has not yet written, locked
+    (``flock``) by its claimant while it lives, so that a claim whose process died is not counted; and a lock
+    file taken while a claim is checked and recorded (``with claims as others``: the others' bytes). Where the
+    folder cannot be used (another user's, read-only), the claims of the others count as none: the disk alone is
+    asked, as before (stop 51)."""
+
+    FOLDER = "symfruit-bag-room"
+
+    def __init__(self) -> None:
+        import tempfile
+        import uuid
+
+        self._folder = Path(tempfile.gettempdir()) / self.FOLDER
+        self._path = self._folder / f"{os.getpid()}-{uuid.uuid4().hex}.claim"
+        self._mine: Any = None
+        self._lock: Any = None
+        try:
+            if not self._folder.is_dir():
+                self._folder.mkdir()
+                self._folder.chmod(0o1777)  # every user's runs claim there (sticky: each removes its own alone)
+            made = self._path.with_suffix(".new")  # named a claim once locked: never taken for a dead one's
+            self._mine = open(made, "w+")  # held, and locked, while this claimant lives
+            _flock(self._mine, exclusive=True)
+            made.rename(self._path)
+        except OSError:
+            self.close()
+
+    def __enter__(self) -> int:
+        if self._mine is None:
+            return 0
+        try:
+            self._lock = open(self._folder / ".lock", "a")
+            _flock(self._lock, exclusive=True, wait=True)
+        except OSError:
+            self._lock = None
+            return 0
+        return sum(self._held(path) for path in self._folder.glob("*.claim") if path != self._path)
+
+    def __exit__(self, *exc: object) -> None:
+        if self._lock is not None:
+            self._lock.close()  # its lock with it
+            self._lock = None
+
+    def hold(self, nbytes: int) -> None:
+        """Record ``nbytes`` as claimed by this run and not yet written."""
+        if self._mine is not None:
+            self._mine.seek(0)
+            self._mine.truncate()
+            self._mine.write(str(nbytes))
+            self._mine.flush()
+
+    @staticmethod
+    def _held(path: Path) -> int:
+        """The bytes another claimant holds: none when its lock is free (its process gone; the file removed)."""
+        try:
+            with open(path) as file:
+                if _flock(file, exclusive=False):
+                    path.unlink(missing_ok=True)
+                    return 0
+                text = file.read(32).strip()
+        except OSError:
+            return 0
+        return int(text) if text.isdigit() else 0
+
+    def close(self) -> None:
+        if self._mine is not None:
+            self._mine.close()
+            self._mine = None
+        for path in (self._path, self._path.with_suffix(".new")):
+            with contextlib.suppress(OSError):
+                path.unlink(missing_ok=True)
+
+
+def _flock(file: Any, *, exclusive: bool, wait: bool = False) -> bool:
+    """Lock ``file`` (``flock``); without ``wait``, True when taken, False when another holds it."""
+    import fcntl
+
+    flags = (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | (0 if wait else fcntl.LOCK_NB)
+    try:
+        fcntl.flock(file.fileno(), flags)
+    except BlockingIOError:
+        return False
+    return True
 
 
 def _checked_mcap(plugin: Any) -> Any:
