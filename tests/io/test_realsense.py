@@ -609,3 +609,15 @@ def test_a_chunk_that_expands_past_its_own_stated_size_is_refused_at_that_size(t
     assert re.fullmatch(rf"{re.escape(str(path))}: an LZ4 chunk of [\d,]+ compressed bytes expands past its stated "
                         r"[\d,]+ bytes uncompressed \(decompression stopped there\): the bag is damaged",
                         str(info.value))  # fmt: skip
+
+
+def test_a_bag_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreadable_place):
+    """Stop 52 (robust52): "cannot open bag ([Errno 13] Permission denied: 'PATH')", read as a user who may not."""
+    import shutil
+
+    from ..conftest import refusal_as_nobody
+
+    path = unreadable_place / "b.bag"
+    shutil.copy(BAG, path)
+    said = refusal_as_nobody("from symfruit.io.sources import open_source; open_source(P0)", path)
+    assert said == f"refused: {path}: cannot open bag (Permission denied)"

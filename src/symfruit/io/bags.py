@@ -534,6 +534,8 @@ def reader_reason(exc: BaseException) -> str:
     damaged = damage_reason(exc)
     if damaged is not None:
         return damaged
+    if isinstance(exc, OSError) and exc.strerror:  # "Permission denied", not "[Errno 13] ...: 'PATH'" (robust52)
+        return exc.strerror
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"

@@ -34,6 +34,7 @@ import contextlib
 import io
 import re
 import warnings
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -96,8 +97,9 @@ def _open(source: Path | bytes, label: str) -> Any:
         raise FileFormatError(f"{label}: {size}; at most {MAX_IMAGE_PIXELS:,} pixels are read") from None
     except UnidentifiedImageError:
         raise FileFormatError(f"{label}: cannot read image ({_unidentified(source)})") from None
-    except (OSError, SyntaxError, ValueError) as exc:
-        raise FileFormatError(f"{label}: cannot read image ({exc})") from None
+    except (OSError, SyntaxError, ValueError) as exc:  # an OSError's reason alone, not "[Errno 13] ...: 'PATH'"
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise FileFormatError(f"{label}: cannot read image ({why})") from None
     try:
         check_image_size(
             *img.size, label, error=FileFormatError, max_pixels=MAX_IMAGE_PIXELS
@@ -139,15 +141,72 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
     orientation (1-8)."""
     from PIL import Image
 
+    png = _png_bytes(img)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
+    if png is not None:
+        _png_whole(img, png, label)
     orientation = _orientation(img)
     turn = _TRANSPOSE.get(orientation)
     return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
+
+
+def _png_bytes(img: Any) -> bytes | None:
+    """The file of an opened (not yet decoded) PNG, for :func:`_png_whole`; None for another format."""
+    if getattr(img, "format", None) != "PNG" or getattr(img, "fp", None) is None:
+        return None
+    try:
+        at = img.fp.tell()
+        img.fp.seek(0)
+        data = img.fp.read()
+        img.fp.seek(at)
+    except (OSError, ValueError):  # not seekable: Pillow's decoding says what it can
+        return None
+    return bytes(data)
+
+
+#: Samples per pixel of each PNG colour type (grey, RGB, palette, grey and alpha, RGBA).
+_PNG_SAMPLES = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
+
+
+def _png_whole(img: Any, png: bytes, label: str) -> None:
+    """Refuse a PNG whose image data holds fewer rows than its header states: Pillow decodes such a file without
+    a word, the rows missing left 0 (no depth, black) when the compressed stream ends cleanly before them (stop
+    52, robust52). The rows are counted (the data inflated again, nothing kept) only where the decoded image's
+    last row is all 0 or the file is interlaced: a last row of data was decoded, so every row before it was."""
+    width, height = img.size
+    if png[12:16] != b"IHDR" or len(png) < 33:
+        return
+    depth, kind, interlaced = png[24], png[25], png[28]
+    if not interlaced and img.crop((0, height - 1, width, height)).getbbox() is not None:
+        return
+    row = 1 + (width * _PNG_SAMPLES.get(kind, 1) * depth + 7) // 8
+    passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
+    expected = height * row if not interlaced else sum(
+        ((height - y0 + dy - 1) // dy) * (1 + (((width - x0 + dx - 1) // dx) * _PNG_SAMPLES.get(kind, 1) * depth + 7)
+                                          // 8) * (width > x0) for x0, dx, y0, dy in passes if height > y0)  # fmt: skip
+    inflate, found, at = zlib.decompressobj(), 0, 8
+    while at + 8 <= len(png) and found < expected:
+        size, name = int.from_bytes(png[at : at + 4], "big"), png[at + 4 : at + 8]
+        if name == b"IDAT":
+            pending = png[at + 8 : at + 8 + size]
+            try:
+                while pending and found < expected:
+                    found += len(inflate.decompress(pending, 1 << 20))
+                    pending = inflate.unconsumed_tail
+            except zlib.error:  # damaged data: Pillow decoded it as it could; not this check's to say
+                return
+        elif name == b"IEND":
+            break
+        at += 12 + size
+    if found < expected:
+        held = f"{found // row:,} of the {height:,} rows" if not interlaced else f"{found:,} of {expected:,} bytes"
+        raise FileFormatError(f"{label}: its PNG data holds {held} its header states: the file is cut short or "
+                              "damaged")  # fmt: skip
 
 
 #: EXIF orientation -> the ``Image.Transpose`` that shows the image as displayed (2-8; 1 is as stored): as
