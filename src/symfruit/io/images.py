@@ -141,49 +141,49 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
     orientation (1-8)."""
     from PIL import Image
 
-    png = _png_bytes(img)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
-    if png is not None:
-        _png_whole(img, png, label)
+    if getattr(img, "format", None) == "PNG":
+        _png_whole(img, label)
     orientation = _orientation(img)
     turn = _TRANSPOSE.get(orientation)
     return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
 
 
-def _png_bytes(img: Any) -> bytes | None:
-    """The file of an opened (not yet decoded) PNG, for :func:`_png_whole`; None for another format."""
-    if getattr(img, "format", None) != "PNG" or getattr(img, "fp", None) is None:
-        return None
+def _png_file(img: Any) -> bytes | None:
+    """The bytes of a decoded PNG's file (Pillow has closed a file it opened by name) or buffer; None when gone."""
+    name = getattr(img, "filename", "")
     try:
-        at = img.fp.tell()
-        img.fp.seek(0)
-        data = img.fp.read()
-        img.fp.seek(at)
-    except (OSError, ValueError):  # not seekable: Pillow's decoding says what it can
+        if name:
+            with open(name, "rb") as file:
+                return file.read()
+        fp = getattr(img, "fp", None)
+        return fp.getvalue() if isinstance(fp, io.BytesIO) else None
+    except (OSError, ValueError):  # gone or changed since: Pillow's decoding stands
         return None
-    return bytes(data)
 
 
 #: Samples per pixel of each PNG colour type (grey, RGB, palette, grey and alpha, RGBA).
 _PNG_SAMPLES = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
 
 
-def _png_whole(img: Any, png: bytes, label: str) -> None:
+def _png_whole(img: Any, label: str) -> None:
     """Refuse a PNG whose image data holds fewer rows than its header states: Pillow decodes such a file without
     a word, the rows missing left 0 (no depth, black) when the compressed stream ends cleanly before them (stop
     52, robust52). The rows are counted (the data inflated again, nothing kept) only where the decoded image's
     last row is all 0 or the file is interlaced: a last row of data was decoded, so every row before it was."""
     width, height = img.size
-    if png[12:16] != b"IHDR" or len(png) < 33:
-        return
-    depth, kind, interlaced = png[24], png[25], png[28]
+    interlaced = bool(img.info.get("interlace"))
     if not interlaced and img.crop((0, height - 1, width, height)).getbbox() is not None:
         return
+    png = _png_file(img)
+    if png is None or png[12:16] != b"IHDR" or len(png) < 33:
+        return
+    depth, kind = png[24], png[25]
     row = 1 + (width * _PNG_SAMPLES.get(kind, 1) * depth + 7) // 8
     passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
     expected = height * row if not interlaced else sum(
