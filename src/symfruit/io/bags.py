@@ -298,7 +298,7 @@ class _RoomClaims:
         self._mine: Any = None
         self._lock: Any = None
         try:
-            if not self._folder.is_dir():
+            with contextlib.suppress(FileExistsError):  # another run may make it at once
                 self._folder.mkdir()
                 self._folder.chmod(0o1777)  # every user's runs claim there (sticky: each removes its own alone)
             made = self._path.with_suffix(".new")  # named a claim once locked: never taken for a dead one's
