@@ -41,9 +41,10 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import robust47 as r47
 import robust49 as r49
+import robust51 as r51
 
 LIMIT_S = 60
-ROOT, fixture, cli, Run = r47.ROOT, r49.fixture, r47.cli, r47.Run
+ROOT, fixture, cli, Run, small = r47.ROOT, r49.fixture, r47.cli, r47.Run, r51.small
 camera, camera_text = r47.camera_edit, r47.camera_text
 BAG1 = ROOT / "examples/realsense/fruit.bag"
 PLY = ROOT / "examples/strawberry_partial.ply"
@@ -56,13 +57,6 @@ CASES: list[tuple[str, str, Callable[[], Any], str]] = []
 
 def add(name: str, expect: str, fn: Callable[[], Any], names: str = "") -> None:
     CASES.append((name, expect, fn, names))
-
-
-def small() -> Path:
-    sys.path.insert(0, str(ROOT))
-    from tests.conftest import small_frame
-
-    return small_frame()
 
 
 def as_nobody(*argv: Any, output: Path | None = None) -> Run:
@@ -287,14 +281,9 @@ def nobody_cases() -> None:
 
 # --- adversarial inputs -----------------------------------------------------------------------------------------
 def frame_case(name: str, expect: str, change: Callable[[Path], Any], names: str = "", *extra: Any) -> None:
-    def go() -> Any:
-        f = fixture(f"frame-{name}")
-        shutil.copytree(small(), f)
-        change(f)
-        o = r49.out(f"frame-{name}")
-        return cli("detect", f, "--output", o, "--method", "sphere", *extra, output=o)
-
-    add(f"frame/{name}", expect, go, names)
+    """robust51's: ``symfruit detect`` of a copy of the small frame changed by ``change``, a case of this sweep."""
+    r51.frame_case(name, expect, change, names, *extra)
+    CASES.append(r51.CASES.pop())
 
 
 def _chunk(kind: bytes, data: bytes) -> bytes:
