@@ -154,15 +154,15 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
     return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
 
 
-def _png_file(img: Any) -> bytes | None:
-    """The bytes of a decoded PNG's file (Pillow has closed a file it opened by name) or buffer; None when gone."""
+def _png_file(img: Any) -> Any:
+    """A decoded PNG's file opened anew (Pillow has closed a file it opened by name), or its buffer at its start;
+    None when gone."""
     name = getattr(img, "filename", "")
     try:
         if name:
-            with open(name, "rb") as file:
-                return file.read()
+            return open(name, "rb")  # closed by the caller
         fp = getattr(img, "fp", None)
-        return fp.getvalue() if isinstance(fp, io.BytesIO) else None
+        return io.BytesIO(fp.getbuffer()) if isinstance(fp, io.BytesIO) else None
     except (OSError, ValueError):  # gone or changed since: Pillow's decoding stands
         return None
 
@@ -180,33 +180,56 @@ def _png_whole(img: Any, label: str) -> None:
     interlaced = bool(img.info.get("interlace"))
     if not interlaced and img.crop((0, height - 1, width, height)).getbbox() is not None:
         return
-    png = _png_file(img)
-    if png is None or png[12:16] != b"IHDR" or len(png) < 33:
+    file = _png_file(img)
+    if file is None:
         return
-    depth, kind = png[24], png[25]
-    row = 1 + (width * _PNG_SAMPLES.get(kind, 1) * depth + 7) // 8
-    passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
-    expected = height * row if not interlaced else sum(
-        ((height - y0 + dy - 1) // dy) * (1 + (((width - x0 + dx - 1) // dx) * _PNG_SAMPLES.get(kind, 1) * depth + 7)
-                                          // 8) * (width > x0) for x0, dx, y0, dy in passes if height > y0)  # fmt: skip
-    inflate, found, at = zlib.decompressobj(), 0, 8
-    while at + 8 <= len(png) and found < expected:
-        size, name = int.from_bytes(png[at : at + 4], "big"), png[at + 4 : at + 8]
-        if name == b"IDAT":
-            pending = png[at + 8 : at + 8 + size]
-            try:
-                while pending and found < expected:
-                    found += len(inflate.decompress(pending, 1 << 20))
-                    pending = inflate.unconsumed_tail
-            except zlib.error:  # damaged data: Pillow decoded it as it could; not this check's to say
-                return
-        elif name == b"IEND":
-            break
-        at += 12 + size
+    with file:
+        head = file.read(33)
+        if head[12:16] != b"IHDR" or len(head) < 33:
+            return
+        depth, kind = head[24], head[25]
+        row = 1 + (width * _PNG_SAMPLES.get(kind, 1) * depth + 7) // 8
+        passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
+        expected = height * row if not interlaced else sum(
+            ((height - y0 + dy - 1) // dy) * (1 + (((width - x0 + dx - 1) // dx) * _PNG_SAMPLES.get(kind, 1) * depth
+                                                   + 7) // 8) * (width > x0) for x0, dx, y0, dy in passes
+            if height > y0)  # fmt: skip
+        found = _png_inflated(file, expected)
+        if found is None:
+            return
     if found < expected:
         held = f"{found // row:,} of the {height:,} rows" if not interlaced else f"{found:,} of {expected:,} bytes"
         raise FileFormatError(f"{label}: its PNG data holds {held} its header states: the file is cut short or "
                               "damaged")  # fmt: skip
+
+
+def _png_inflated(file: Any, expected: int) -> int | None:
+    """How many bytes a PNG's image data (``file`` past its signature and header) inflates to, counted up to
+    ``expected`` (read 1 MB at a time, nothing kept); None for data that cannot be inflated (Pillow's to say)."""
+    inflate, found = zlib.decompressobj(), 0
+    file.seek(8)
+    while found < expected:
+        head = file.read(8)
+        if len(head) < 8 or head[4:] == b"IEND":
+            break
+        size = int.from_bytes(head[:4], "big")
+        if head[4:] != b"IDAT":
+            file.seek(size + 4, io.SEEK_CUR)
+            continue
+        left = size
+        while left and found < expected:
+            piece = file.read(min(left, 1 << 20))
+            if not piece:
+                return found
+            left -= len(piece)
+            try:
+                found += len(inflate.decompress(piece, expected - found + 1))
+                while inflate.unconsumed_tail and found < expected:
+                    found += len(inflate.decompress(inflate.unconsumed_tail, expected - found + 1))
+            except zlib.error:
+                return None
+        file.seek(left + 4, io.SEEK_CUR)
+    return found
 
 
 #: EXIF orientation -> the ``Image.Transpose`` that shows the image as displayed (2-8; 1 is as stored): as
