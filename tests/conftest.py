@@ -424,3 +424,56 @@ def isolated_registry(monkeypatch):
     monkeypatch.setattr(settings_module, "_SECTIONS", dict(settings_module._SECTIONS))
     monkeypatch.setattr(registry, "_REGISTRY", dict(registry._REGISTRY))
     monkeypatch.setattr(sources, "_KINDS", list(sources._KINDS))
+
+
+#: The user a test reads unreadable files as, when it runs as root (root reads a file whatever its mode).
+NOBODY = 65534
+
+
+@pytest.fixture
+def unreadable_place():
+    """A folder anyone may enter (pytest's own are of mode 0700), for files a test makes unreadable (mode 000)
+    and reads through :func:`as_nobody`; removed after. Skips, saying why, where no user can be found to whom a
+    file of mode 000 is unreadable: root without ``setpriv`` to become nobody."""
+    import shutil
+    import tempfile
+
+    if os.geteuid() == 0 and shutil.which("setpriv") is None:
+        pytest.skip("running as root, who reads files of mode 000, and no setpriv to run as nobody")
+    place = Path(tempfile.mkdtemp(prefix="symfruit-unreadable-"))
+    place.chmod(0o755)
+    yield place
+    for path in [place, *place.rglob("*")]:
+        if not path.is_symlink():
+            path.chmod(0o755)
+    shutil.rmtree(place, ignore_errors=True)
+
+
+def as_nobody(code: str) -> str:
+    """Run ``code`` (Python) as a user to whom a file of mode 000 is unreadable, and return what it printed: nobody
+    (``setpriv``, its HOME /nonexistent as nobody's is) when the tests run as root, else this user. The kernels'
+    numpy twins (nobody writes no numba cache; compiling them takes minutes)."""
+    import subprocess
+    import sys
+
+    drop = ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups"] if os.geteuid() == 0 else []
+    env = {**os.environ, "HOME": "/nonexistent", "SYMFRUIT_KERNELS": "numpy",
+           "PYTHONPATH": os.pathsep.join([str(Path(symfruit.__file__).resolve().parents[1]), str(ROOT)])}  # fmt: skip
+    done = subprocess.run([*drop, sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True,
+                          env=env, timeout=300, cwd="/")  # fmt: skip
+    assert done.returncode == 0, done.stderr[-600:]
+    return done.stdout.strip()
+
+
+def refusal_as_nobody(call: str, *paths: Path) -> str:
+    """The one-line refusal (a :class:`~symfruit.errors.SymfruitError`) of ``call`` (a Python expression, its
+    imports before it: ``"from m import f; f(P0)"``, ``P0``... the ``paths`` made unreadable), read as nobody;
+    any other exception fails the test with its traceback."""
+    for path in paths:
+        path.chmod(0o000)
+    setup = "".join(f"P{k} = {str(p)!r}; " for k, p in enumerate(paths))
+    *imports, expr = call.split("; ")
+    code = (f"{'; '.join(imports)}\nfrom symfruit.errors import SymfruitError\n{setup}\ntry:\n    {expr}\n"
+            "except SymfruitError as exc:\n    print('refused:', exc)\nelse:\n    print('taken')")  # fmt: skip
+    # e.g. "from m import f; r = f(P0); print(r)": the last part is tried, the ones before it run first
+    return as_nobody(code)

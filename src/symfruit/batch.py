@@ -107,6 +107,7 @@ def run_batch(
     workers: int | None = None,
     chunk: int = 4,
     no_worker_timeout: float | None = None,
+    silent_worker_timeout: float | None = None,
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
     fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.season.table`).
@@ -118,7 +119,8 @@ def run_batch(
 
     In this process, or on a Dask cluster (``pip install 'symfruit[cluster]'``): ``scheduler`` (an existing
     one's address, ``tcp://host:port``) or ``workers`` (a local cluster of that many worker processes),
-    ``chunk`` frames per task, ``no_worker_timeout`` seconds waited while the cluster has no worker
+    ``chunk`` frames per task, ``no_worker_timeout`` seconds waited while the cluster has no worker, a worker
+    not heard from for ``silent_worker_timeout`` seconds counting as none
     (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there).
 
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
@@ -158,9 +160,11 @@ def run_batch(
             raise InputError("on_frame (--ros2-bag) runs in this process: it cannot be combined with a Dask cluster")
         return run_distributed(source, output, scheduler=scheduler, workers=workers, chunk=chunk, masks=masks,
                                method=method, settings=settings, resume=resume, progress=progress,
-                               exclude=exclude, no_worker_timeout=no_worker_timeout)  # fmt: skip
-    if no_worker_timeout is not None:
-        raise InputError("no_worker_timeout (--no-worker-timeout) is for a Dask cluster (scheduler or workers)")
+                               exclude=exclude, no_worker_timeout=no_worker_timeout,
+                               silent_worker_timeout=silent_worker_timeout)  # fmt: skip
+    for name, value in (("no_worker_timeout", no_worker_timeout), ("silent_worker_timeout", silent_worker_timeout)):
+        if value is not None:
+            raise InputError(f"{name} (--{name.replace('_', '-')}) is for a Dask cluster (scheduler or workers)")
     settings = settings or Settings()
     output = as_path(output, "run_batch: the output folder")  # '' was the working folder
     report = BatchReport()

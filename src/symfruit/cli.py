@@ -250,6 +250,9 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
                    "first one, and at any time during the run, after which the frames not done are recorded "
                    "unprocessed and the run stops); 1 to 86400, default 60 with --scheduler, 300 with --workers "
                    "(its workers restart themselves)")  # fmt: skip
+    p.add_argument("--silent-worker-timeout", type=float, default=None, metavar="S",
+                   help="with --scheduler or --workers: a worker the scheduler has not heard from for S seconds "
+                   "counts as none (as a paused one does); 10 to 86400, default 60")  # fmt: skip
 
 
 def _add_report(sub: argparse._SubParsersAction) -> None:
@@ -831,13 +834,18 @@ def _detect(args: argparse.Namespace) -> int:
         raise InputError(f"--chunk must be between 1 and 10000 frames per task, got {args.chunk}")
     if args.chunk is not None and not args.scheduler and args.workers is None:
         raise InputError("--chunk (frames per Dask task) is for --scheduler or --workers; here it would be ignored")
-    if args.no_worker_timeout is not None:  # refused whether or not a cluster uses it, before anything is read
-        from .season.cluster import check_no_worker_timeout
+    from .season.cluster import check_no_worker_timeout, check_silent_worker_timeout
 
-        check_no_worker_timeout(args.no_worker_timeout)
+    for option, value, check, what in (
+        ("--no-worker-timeout", args.no_worker_timeout, check_no_worker_timeout, "the wait for a Dask worker"),
+        ("--silent-worker-timeout", args.silent_worker_timeout, check_silent_worker_timeout,
+         "when a Dask worker not heard from counts as none"),
+    ):  # fmt: skip
+        if value is None:  # refused whether or not a cluster uses it, before anything is read
+            continue
+        check(value)
         if not args.scheduler and args.workers is None:
-            raise InputError("--no-worker-timeout (the wait for a Dask worker) is for --scheduler or --workers; here "
-                             "it would be ignored")  # fmt: skip
+            raise InputError(f"{option} ({what}) is for --scheduler or --workers; here it would be ignored")
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
@@ -857,7 +865,8 @@ def _detect(args: argparse.Namespace) -> int:
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
                            workers=args.workers, chunk=args.chunk or 4,
-                           no_worker_timeout=args.no_worker_timeout)  # fmt: skip
+                           no_worker_timeout=args.no_worker_timeout,
+                           silent_worker_timeout=args.silent_worker_timeout)  # fmt: skip
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():

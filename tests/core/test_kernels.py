@@ -8,6 +8,7 @@ kernels (whole numbers, booleans) are compared to the bit.
 """
 
 import math
+import os
 import subprocess
 import sys
 import types
@@ -7013,3 +7014,20 @@ def test_mask_mode_of_a_known_mask():
     assert radius == pytest.approx(math.sqrt(20 / math.pi) * 0.5 / 600.0)
     assert not _jit.mask_mode(depth, np.zeros((12, 10), bool), np.zeros((0, 0), bool), False, 0.0005, 600.0,
                               (0.5, 0.3))[0]  # fmt: skip
+
+
+def test_the_kernels_load_where_numba_finds_no_folder_to_cache_them():
+    """Stop 52 (robust52): a user who can write neither beside the installed package nor a home of their own (the
+    nobody user, HOME=/nonexistent, a root-owned site-packages) got numba's traceback ("cannot cache function
+    '_occlusion_pass': no locator available") from every command that runs a kernel: one kernel was decorated with
+    numba.njit(cache=True) itself, not through _njit_inlined's fallback to no cache. Here numba is left no cache
+    locator at all and the kernels module imported (nothing compiles until a kernel is called)."""
+    import subprocess
+    import sys
+
+    code = ("import numba.core.caching as c; c.CacheImpl._locator_classes = []; import symfruit.core._jit as j; "
+            "print('loaded', len([k for k in vars(j).values() if hasattr(k, 'py_func')]))")  # fmt: skip
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120,
+                          env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})  # fmt: skip
+    assert done.returncode == 0, done.stderr[-300:]
+    assert done.stdout.startswith("loaded ") and int(done.stdout.split()[1]) > 10

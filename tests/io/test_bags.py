@@ -936,3 +936,72 @@ def test_a_bag_compressed_as_whole_files_is_decompressed_to_the_disk_room_and_no
     with pytest.raises(FileFormatError, match=rf"^{re.escape(str(bomb))}: its MCAP file {packed.stem}, decompressed: "
                        r"the (header )?record at byte 8"):  # fmt: skip
         open_source(bomb)
+
+
+def test_two_runs_decompressing_at_once_keep_the_reserve_between_them(tmp_path, monkeypatch):
+    """Stop 52 (robust52): two runs decompressing whole-file-compressed bags into one temporary folder at once each
+    asked the disk alone every 8 MB, so each could pass the reserve by up to 8 MB (stop 51 left it). Now each
+    claims the room before it hands bytes on, under a lock the runs share: here the disk (a model of it: its
+    room is 12 MB less what both have written) never loses more than its room."""
+    import io
+    import tempfile
+
+    from symfruit.io import bags
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    written = [0, 0]
+    monkeypatch.setattr(bags, "bag_file_room", lambda: (12 << 20) - sum(written))
+    runs = [bags._BoundedFile(io.BytesIO(bytes(10 << 20)), f"run{k}.mcap.zstd") for k in range(2)]
+    ended: dict[int, str] = {}
+    while len(ended) < 2:  # as rosbags copies each out (copyfileobj: 64 kB a read), the two interleaved
+        for k, run in enumerate(runs):
+            if k in ended:
+                continue
+            try:
+                data = run.read(64 << 10)
+            except FileFormatError as exc:
+                ended[k] = str(exc)
+                continue
+            written[k] += len(data)
+            if not data:
+                ended[k] = "done"
+    assert sum(written) <= 12 << 20  # before: 16 MB, each run's 8 MB past its check
+    assert any(
+        "decompressed so far, and the room in " in said and "MB of it held by other runs decompressing there" in said
+        for said in ended.values()
+    ), ended
+    for run in runs:
+        run.__exit__()
+    assert not list((tmp_path / "symfruit-bag-room").glob("*.claim"))  # each run's claim gone with it
+
+
+def test_the_room_claimed_by_another_process_counts_until_it_ends(tmp_path, monkeypatch):
+    """The claims are seen across processes, and a claim whose process died (its lock freed) is not counted."""
+    import os
+    import subprocess
+    import sys
+    import tempfile
+
+    from symfruit.io.bags import _RoomClaims
+
+    monkeypatch.setattr(tempfile, "tempdir", str(tmp_path))
+    code = ("import sys, tempfile; tempfile.tempdir = sys.argv[1]; from symfruit.io.bags import _RoomClaims; "
+            "c = _RoomClaims(); c.hold(10 << 20); print('held', flush=True); sys.stdin.read()")  # fmt: skip
+    holder = subprocess.Popen([sys.executable, "-c", code, str(tmp_path)], stdin=subprocess.PIPE,
+                              stdout=subprocess.PIPE, text=True,
+                              env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})  # fmt: skip
+    try:
+        assert holder.stdout is not None and holder.stdout.readline().strip() == "held"
+        mine = _RoomClaims()
+        with mine as others:
+            assert others == 10 << 20
+        holder.kill()  # no clean-up: its claim file stays, its lock goes with the process
+        holder.wait(30)
+        assert len(list((tmp_path / "symfruit-bag-room").glob("*.claim"))) == 2
+        with mine as others:
+            assert others == 0
+        assert len(list((tmp_path / "symfruit-bag-room").glob("*.claim"))) == 1  # the dead one's removed
+        mine.close()
+    finally:
+        holder.kill()
+        holder.wait(30)

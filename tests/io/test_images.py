@@ -333,3 +333,73 @@ def test_an_image_pillow_does_not_know_is_said_in_our_words(tmp_path):
         read_color(path)
     assert str(info.value) == (f"{path}: cannot read image (not of an image format Pillow reads, PNG, JPEG, TIFF, "
                                "...; or its header is damaged)")  # fmt: skip
+
+
+def test_an_image_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreadable_place):
+    """Stop 52 (robust52): read as a user who may not (the sweeps ran as root, who reads every file): Python's
+    "[Errno 13] Permission denied: 'PATH'" inside ours, the path said twice."""
+    from PIL import Image
+
+    from ..conftest import refusal_as_nobody
+
+    path = unreadable_place / "c.png"
+    Image.new("RGB", (8, 8)).save(path)
+    said = refusal_as_nobody("from symfruit.io.images import read_color; read_color(P0)", path)
+    assert said == f"refused: {path}: cannot read image (Permission denied)"
+
+
+def _png(width: int, height: int, rows: bytes, *, bits: int = 8, kind: int = 0, interlaced: int = 0) -> bytes:
+    import struct
+    import zlib
+
+    def chunk(name: bytes, data: bytes) -> bytes:
+        return struct.pack(">I", len(data)) + name + data + struct.pack(">I", zlib.crc32(name + data) & 0xFFFFFFFF)
+
+    header = struct.pack(">IIBBBBB", width, height, bits, kind, 0, 0, interlaced)
+    return b"\x89PNG\r\n\x1a\n" + chunk(b"IHDR", header) + chunk(b"IDAT", zlib.compress(rows)) + chunk(b"IEND", b"")
+
+
+@pytest.mark.parametrize("held", [4, 80, 159])  # 0 or 1 row: Pillow says "image file is truncated" itself
+def test_a_png_whose_data_holds_fewer_rows_than_its_header_states_is_refused(tmp_path, held):
+    """Stop 52 (robust52): Pillow decodes a PNG whose compressed data ends cleanly before the rows its header
+    states without a word, the rows missing left 0: half a depth image read as no depth, half a photo black."""
+    from symfruit.io.images import read_color, read_depth_units
+
+    rows = np.arange(160 * 160, dtype=np.uint16).reshape(160, 160) % 4000 + 1
+    data = b"".join(b"\0" + r.astype(">u2").tobytes() for r in rows[:held])
+    (tmp_path / "depth.png").write_bytes(_png(160, 160, data, bits=16))
+    with pytest.raises(FileFormatError, match=rf"depth\.png: its PNG data holds {held} of the 160 rows its header "
+                       "states: the file is cut short or damaged$"):  # fmt: skip
+        read_depth_units(tmp_path / "depth.png")
+    colour = b"".join(b"\0" + bytes([200, 10, 10]) * 40 for _ in range(min(held // 4 + 2, 39)))
+    (tmp_path / "c.png").write_bytes(_png(40, 40, colour, kind=2))
+    with pytest.raises(FileFormatError, match=r"c\.png: its PNG data holds \d+ of the 40 rows"):
+        read_color(tmp_path / "c.png")
+    whole = b"".join(b"\0" + r.astype(">u2").tobytes() for r in rows)  # whole, its last row of data: read
+    (tmp_path / "whole.png").write_bytes(_png(160, 160, whole, bits=16))
+    assert np.array_equal(read_depth_units(tmp_path / "whole.png"), rows)
+    rows[-3:] = 0  # whole, its last rows 0 (no depth at the bottom): counted, and read
+    (tmp_path / "zeros.png").write_bytes(_png(160, 160, b"".join(b"\0" + r.astype(">u2").tobytes() for r in rows),
+                                              bits=16))  # fmt: skip
+    assert np.array_equal(read_depth_units(tmp_path / "zeros.png"), rows)
+
+
+def test_an_interlaced_png_is_counted_by_its_seven_passes(tmp_path):
+    """Adam7: each pass its own rows of its own width; a whole interlaced PNG is read, one cut short refused."""
+    from symfruit.io.images import read_color
+
+    width, height = 13, 11
+    passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
+    data, last = b"", 0
+    for x0, dx, y0, dy in passes:
+        cols, rows = len(range(x0, width, dx)), len(range(y0, height, dy))
+        if cols and rows:
+            data += (b"\0" + bytes([90, 30, 200]) * cols) * rows
+            last = (1 + 3 * cols) * rows
+    (tmp_path / "i.png").write_bytes(_png(width, height, data, kind=2, interlaced=1))
+    image = read_color(tmp_path / "i.png")
+    assert image.shape == (height, width, 3) and (image == [90, 30, 200]).all()
+    cut = len(data) - last  # all but the seventh pass (the odd rows): Pillow leaves them black without a word
+    (tmp_path / "cut.png").write_bytes(_png(width, height, data[:cut], kind=2, interlaced=1))
+    with pytest.raises(FileFormatError, match=rf"cut\.png: its PNG data holds {cut} of {len(data)} bytes"):
+        read_color(tmp_path / "cut.png")

@@ -375,14 +375,17 @@ def test_an_empty_or_unindexed_bag_is_said_to_be_so_not_its_index_past_the_end(t
         open_source(tmp_path / "unindexed.bag")
 
 
-@pytest.mark.parametrize("chunk_pos", [2**64 - 1])  # 2**62: EINVAL on ext4, read as an empty record on tmpfs
-def test_an_index_whose_chunk_position_lies_past_what_a_file_holds_is_named_damaged(tmp_path, chunk_pos):
+@pytest.mark.parametrize("past", [0, 1000, 2**62, 2**64 - 1], ids=["at-the-end", "1000-past", "2^62", "2^64-1"])
+def test_an_index_whose_chunk_position_lies_past_the_file_is_named_damaged(tmp_path, past):
+    """Any position past the end, whatever the file system makes of it (2**62: EINVAL on ext4, an empty record on
+    tmpfs; 1000 bytes past: an empty record on both, rosbags' "Header could not be read from file.")."""
     data = BAG.read_bytes()
     at = data.rindex(b"chunk_pos=") + len(b"chunk_pos=")  # the last chunk's, in the index at the end
     path = tmp_path / "lying.bag"
+    chunk_pos = min(len(data) + past, 2**64 - 1)
     path.write_bytes(data[:at] + chunk_pos.to_bytes(8, "little") + data[at + 8 :])
-    with pytest.raises(FileFormatError, match=r"lying\.bag: cannot open bag \(the bag's index gives a chunk position "
-                       r"past what the file holds: the bag is damaged\)$"):  # fmt: skip
+    said = rf"at byte {chunk_pos:,}, past the end of the file \({len(data):,} bytes\): the bag is damaged\)$"
+    with pytest.raises(FileFormatError, match=r"lying\.bag: cannot open bag \(the bag's index puts a chunk " + said):
         open_source(path)
 
 
@@ -606,3 +609,15 @@ def test_a_chunk_that_expands_past_its_own_stated_size_is_refused_at_that_size(t
     assert re.fullmatch(rf"{re.escape(str(path))}: an LZ4 chunk of [\d,]+ compressed bytes expands past its stated "
                         r"[\d,]+ bytes uncompressed \(decompression stopped there\): the bag is damaged",
                         str(info.value))  # fmt: skip
+
+
+def test_a_bag_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreadable_place):
+    """Stop 52 (robust52): "cannot open bag ([Errno 13] Permission denied: 'PATH')", read as a user who may not."""
+    import shutil
+
+    from ..conftest import refusal_as_nobody
+
+    path = unreadable_place / "b.bag"
+    shutil.copy(BAG, path)
+    said = refusal_as_nobody("from symfruit.io.sources import open_source; open_source(P0)", path)
+    assert said == f"refused: {path}: cannot open bag (Permission denied)"

@@ -169,3 +169,29 @@ def test_evaluate_results_written_into_the_frames_folder_are_no_frames_of_it(tmp
         (new_results_folder(tmp_path, tag) / "summary.json").write_text("{}")
     # before: each results folder and the latest link counted as a frame, and failed ('no color.png')
     assert open_source(tmp_path).names() == ["a", "b"]
+
+
+def test_a_folder_this_user_may_not_open_is_refused_and_a_batch_goes_on_past_one(unreadable_place):
+    """Stop 52 (robust52): a recording, or one of its frame folders, of mode 000 read as a user who may not open
+    it: pathlib's PermissionError from the probes (is it a bag? a run's output?) ended the whole batch."""
+    import shutil
+
+    from ..conftest import refusal_as_nobody, small_frame
+
+    rec = unreadable_place / "rec"
+    for k in range(3):
+        shutil.copytree(small_frame(), rec / f"f_{k}")
+    out = unreadable_place / "out"
+    out.mkdir(mode=0o777)
+    out.chmod(0o777)
+    said = refusal_as_nobody(
+        "from symfruit.batch import run_batch; r = run_batch(" + repr(str(rec)) + ", " + repr(str(out / "o")) + ", "
+        "method='raw', progress=False); print(sorted(r.done), r.failed)",
+        rec / "f_1",
+    )
+    assert said.splitlines()[-2:] == [
+        "['f_0', 'f_2'] {'f_1': '" + str(rec / "f_1") + ": cannot read frame folder (Permission denied: this user may "
+        "not list it or open what it holds)'}", "taken"]  # fmt: skip
+    said = refusal_as_nobody("from symfruit.io.sources import open_source; open_source(P0)", rec)
+    assert said == (f"refused: {rec}: cannot read folder (Permission denied: this user may not list it or open what "
+                    "it holds)")  # fmt: skip

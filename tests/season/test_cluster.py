@@ -226,6 +226,32 @@ def test_a_no_worker_timeout_without_a_cluster_is_refused_not_ignored(recording,
     assert "--no-worker-timeout S" in " ".join(capsys.readouterr().out.split())
 
 
+@pytest.mark.parametrize("seconds", ["0", "-5", "9.9", "nan", "inf", "86401"])
+def test_a_silent_worker_timeout_out_of_its_bounds_is_refused_before_anything_runs(recording, tmp_path, capsys,
+                                                                                  seconds):  # fmt: skip
+    """Stop 52 (robust52): the time after which a worker not heard from counts as none was a module constant
+    (SILENT_WORKER_S, 60 s); now --silent-worker-timeout sets it, 10 s (twice Dask's longest heartbeat) to a day,
+    refused before the inputs are read or a cluster started."""
+    argv = ["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "1", "--silent-worker-timeout"]
+    assert main([*argv, seconds]) == 2
+    assert f"--silent-worker-timeout must be between 10 and 86400 s, got {float(seconds)!r}" in capsys.readouterr().err
+    with pytest.raises(InputError, match=r"--silent-worker-timeout must be between 10 and 86400 s"):
+        run_distributed(recording, tmp_path / "o", workers=1, silent_worker_timeout=float(seconds))
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_silent_worker_timeout_without_a_cluster_is_refused_not_ignored(recording, tmp_path, capsys):
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--silent-worker-timeout", "30"]) == 2
+    assert ("--silent-worker-timeout (when a Dask worker not heard from counts as none) is for --scheduler or "
+            "--workers") in capsys.readouterr().err  # fmt: skip
+    with pytest.raises(InputError, match=r"silent_worker_timeout \(--silent-worker-timeout\) is for a Dask cluster"):
+        run_batch(recording, tmp_path / "o", silent_worker_timeout=30)
+    assert not (tmp_path / "o").exists()
+    with pytest.raises(SystemExit):
+        main(["detect", "--help"])
+    assert "--silent-worker-timeout S" in " ".join(capsys.readouterr().out.split())
+
+
 def test_a_worker_counts_while_it_runs_and_is_heard_from():
     """Paused (memory above Dask's pause fraction), closing, or silent for SILENT_WORKER_S: no worker for the
     watch (:class:`_NoWorkers`); a worker heard from again, or a new one, counts again."""
@@ -243,6 +269,10 @@ def test_a_worker_counts_while_it_runs_and_is_heard_from():
     assert working_workers(info, heard, SILENT_WORKER_S + 1) == 2
     assert working_workers({}, heard, SILENT_WORKER_S + 2) == 0 and heard == {}  # the workers gone are forgotten
     assert working_workers({"d": {}}, heard, 0.0) == 1 == working_workers({"d": {}}, heard, 10 * SILENT_WORKER_S)
+    one: dict = {"e": {"status": "running", "last_seen": 1.0}}  # silent_s (--silent-worker-timeout): sooner, later
+    assert working_workers(one, heard, 0.0, 20.0) == 1
+    assert working_workers(one, heard, 20.5, 20.0) == 0 < working_workers(one, heard, 20.5)
+    assert working_workers(one, heard, SILENT_WORKER_S + 0.5, 2 * SILENT_WORKER_S) == 1
 
 
 def test_an_in_process_address_of_this_process_passes_the_check():
@@ -485,7 +515,7 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
     """Stop 51 (robust51): a worker paused (its memory above Dask's pause fraction) or no longer heard from (its
     heartbeat stopped: a frozen process, a lost network) stays registered, and the watch counted it: the run
     waited for ever (paused) or for the scheduler's worker-ttl. Now neither counts: after the time-out the run
-    stops, the frames not done unprocessed."""
+    stops, the frames not done unprocessed. The silence is --silent-worker-timeout's (its least, 10 s; stop 52)."""
     from distributed import LocalCluster
     from distributed.core import Status
 
@@ -501,7 +531,6 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
         return real(frame, **kwargs)
 
     monkeypatch.setattr(cluster, "detect", held)  # the in-process worker runs this module
-    monkeypatch.setattr(cluster, "SILENT_WORKER_S", 2.0)
     out = tmp_path / "o"
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
                       dashboard_address=None) as one:  # fmt: skip
@@ -509,7 +538,7 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
         result: dict = {}
         runner = threading.Thread(target=lambda: result.update(report=run_distributed(
             recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
-            no_worker_timeout=2)), daemon=True)  # fmt: skip
+            no_worker_timeout=2, silent_worker_timeout=10)), daemon=True)  # fmt: skip
         runner.start()
         _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
 

@@ -4038,7 +4038,7 @@ def monotone_at(
 
 
 # inlined into its two callers at numba's level: called, it cost occlusion_at 6-8 % (its loops optimised apart)
-@numba.njit(cache=True, error_model="numpy", nogil=True, inline="always")
+@_njit_inlined
 def _occlusion_pass(
     depth: np.ndarray,
     mask: np.ndarray,

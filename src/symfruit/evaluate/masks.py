@@ -424,8 +424,9 @@ def _coco_item(folder: Path, coco: Any, name: str, category: int | None, files: 
     if not path.is_file():
         path = folder / Path(name).name
     if not path.is_file():
+        said = "" if name == path.name else f" as {name!r}"  # the name once (it was three times: 350 characters)
         raise FileFormatError(f"{folder / Path(name).name if not inside else folder / name}: listed in "
-                              f"{coco.path.name} as {name!r} but not in {folder}")  # fmt: skip
+                              f"{coco.path.name}{said}, but there is no such file")  # fmt: skip
     color, orientation = read_color_oriented(path)
     crowd = coco.crowd(name, color.shape[:2], category=category)
     extra = {"name": name, "color_file": (path, orientation)} if files else {}

@@ -20,7 +20,7 @@ non-finite refused, non-zero warned about once per bag): the live ROS node (:mod
 from __future__ import annotations
 
 import bisect
-import errno
+import contextlib
 import math
 import os
 import re
@@ -210,52 +210,160 @@ class BagFileRefused(FileFormatError):
 
 class _BoundedFile:
     """A zstd file opened for reading, as rosbags copies it out whole into its temporary folder: refused
-    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when it was
-    opened, or once that room, asked again every :data:`_STEP_BYTES` out, is gone (two runs decompressing at once
-    each saw the whole room when they began)."""
+    (:class:`BagFileRefused`) once more bytes come out than :func:`bag_file_room` left on that disk when the first
+    came out, or than the room left now less what other runs decompressing there have claimed.
+
+    Each run claims the room before it hands bytes on (:class:`_RoomClaims`: up to :data:`_STEP_BYTES` at a time,
+    checked and recorded under a lock shared by the runs on that temporary folder), and counts its claim written
+    once it is asked for more (rosbags writes what it read before it reads again). So the reserve holds across
+    processes: the room each run checks is the disk's free space less the reserve less the claims of the others
+    not yet written (stop 51 asked the disk alone every 8 MB: two runs at once could each pass the reserve by up to
+    8 MB; stop 52, robust52)."""
 
     def __init__(self, opened: Any, name: str) -> None:
-        self._opened, self._name, self._out, self._checked = opened, name, 0, 0
-        self._room = bag_file_room()
+        self._opened, self._name, self._out, self._claimed = opened, name, 0, 0
+        self._room: int | None = None
+        self._claims = _RoomClaims()
 
     def __enter__(self) -> _BoundedFile:
         return self
 
     def __exit__(self, *exc: object) -> None:
+        self._claims.close()
         self._opened.close()
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._opened, name)
 
     def read(self, size: int | None = -1) -> bytes:
-        import tempfile
-
         if size is None or size < 0:  # all of it: in steps, each counted
             return b"".join(iter(lambda: self.read(_STEP_BYTES), b""))
         data = self._opened.read(min(size, _STEP_BYTES))
-        self._out += len(data)
-        if self._out > max(self._room, 0):
-            room = max(self._room, 0)
-            raise BagFileRefused(
-                f"{self._name}: compressed whole (rosbag2's file compression), it expands past {room / 1e6:,.0f} MB, "
-                f"the room in {tempfile.gettempdir()} less {BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): "
-                "damaged, or zstd -d it where there is room"
-            )
-        if self._out - self._checked >= _STEP_BYTES:  # the room asked again as it goes: another run (or program)
-            self._checked = self._out  # decompressing there at once saw the same room when it began (robust51)
-            if bag_file_room() < 0:
-                raise BagFileRefused(
-                    f"{self._name}: compressed whole (rosbag2's file compression), {self._out / 1e6:,.0f} MB "
-                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
-                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (another program writes there too; decompression stopped): "
-                    "zstd -d it where there is room, or run again when there is"
-                )
+        written, self._out = self._out, self._out + len(data)  # what came out before is written by now
+        if self._out > self._claimed:
+            self._claim(written)
         return data
+
+    def _claim(self, written: int) -> None:
+        """Claim room for the bytes out beyond the claims so far (at least :data:`_STEP_BYTES` where there is
+        room), ``written`` of those out so far being on the disk; refuse when there is not room for them."""
+        import tempfile
+
+        with self._claims as others:
+            room = bag_file_room()
+            if self._room is None:
+                self._room = room
+            available = room - others - (self._claimed - written)
+            need = self._out - self._claimed
+            if self._out > max(self._room, 0):
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), it expands past "
+                    f"{max(self._room, 0) / 1e6:,.0f} MB, the room in {tempfile.gettempdir()} less "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB (decompression stopped): damaged, or zstd -d it where there is "
+                    "room"
+                )
+            if need > available:
+                held = f", {others / 1e6:,.0f} MB of it held by other runs decompressing there" if others else ""
+                raise BagFileRefused(
+                    f"{self._name}: compressed whole (rosbag2's file compression), {written / 1e6:,.0f} MB "
+                    f"decompressed so far, and the room in {tempfile.gettempdir()} fell below "
+                    f"{BAG_FILE_DISK_RESERVE >> 20} MB{held} (another program writes there too; decompression "
+                    "stopped): zstd -d it where there is room, or run again when there is"
+                )
+            self._claimed += min(max(need, _STEP_BYTES), available)
+            self._claims.hold(self._claimed - written)
 
     def readinto(self, buffer: Any) -> int:
         data = self.read(len(buffer))
         buffer[: len(data)] = data
         return len(data)
+
+
+class _RoomClaims:
+    """The temporary disk's room claimed by the runs decompressing a bag there (:class:`_BoundedFile`): a file
+    per claimant in ``<tmp>/symfruit-bag-room/`` holding the bytes it claimed and has not yet written, locked
+    (``flock``) by its claimant while it lives, so that a claim whose process died is not counted; and a lock
+    file taken while a claim is checked and recorded (``with claims as others``: the others' bytes). Where the
+    folder cannot be used (another user's, read-only), the claims of the others count as none: the disk alone is
+    asked, as before (stop 51)."""
+
+    FOLDER = "symfruit-bag-room"
+
+    def __init__(self) -> None:
+        import tempfile
+        import uuid
+
+        self._folder = Path(tempfile.gettempdir()) / self.FOLDER
+        self._path = self._folder / f"{os.getpid()}-{uuid.uuid4().hex}.claim"
+        self._mine: Any = None
+        self._lock: Any = None
+        try:
+            with contextlib.suppress(FileExistsError):  # another run may make it at once
+                self._folder.mkdir()
+                self._folder.chmod(0o1777)  # every user's runs claim there (sticky: each removes its own alone)
+            made = self._path.with_suffix(".new")  # named a claim once locked: never taken for a dead one's
+            self._mine = open(made, "w+")  # held, and locked, while this claimant lives
+            _flock(self._mine, exclusive=True)
+            made.rename(self._path)
+        except OSError:
+            self.close()
+
+    def __enter__(self) -> int:
+        if self._mine is None:
+            return 0
+        try:
+            self._lock = open(self._folder / ".lock", "a")
+            _flock(self._lock, exclusive=True, wait=True)
+        except OSError:
+            self._lock = None
+            return 0
+        return sum(self._held(path) for path in self._folder.glob("*.claim") if path != self._path)
+
+    def __exit__(self, *exc: object) -> None:
+        if self._lock is not None:
+            self._lock.close()  # its lock with it
+            self._lock = None
+
+    def hold(self, nbytes: int) -> None:
+        """Record ``nbytes`` as claimed by this run and not yet written."""
+        if self._mine is not None:
+            self._mine.seek(0)
+            self._mine.truncate()
+            self._mine.write(str(nbytes))
+            self._mine.flush()
+
+    @staticmethod
+    def _held(path: Path) -> int:
+        """The bytes another claimant holds: none when its lock is free (its process gone; the file removed)."""
+        try:
+            with open(path) as file:
+                if _flock(file, exclusive=False):
+                    path.unlink(missing_ok=True)
+                    return 0
+                text = file.read(32).strip()
+        except OSError:
+            return 0
+        return int(text) if text.isdigit() else 0
+
+    def close(self) -> None:
+        if self._mine is not None:
+            self._mine.close()
+            self._mine = None
+        for path in (self._path, self._path.with_suffix(".new")):
+            with contextlib.suppress(OSError):
+                path.unlink(missing_ok=True)
+
+
+def _flock(file: Any, *, exclusive: bool, wait: bool = False) -> bool:
+    """Lock ``file`` (``flock``); without ``wait``, True when taken, False when another holds it."""
+    import fcntl
+
+    flags = (fcntl.LOCK_EX if exclusive else fcntl.LOCK_SH) | (0 if wait else fcntl.LOCK_NB)
+    try:
+        fcntl.flock(file.fileno(), flags)
+    except BlockingIOError:
+        return False
+    return True
 
 
 def _checked_mcap(plugin: Any) -> Any:
@@ -309,6 +417,9 @@ def _bound_decompression() -> None:
     opener = getattr(getattr(ros1, "Reader", None), "open", None)
     if opener is not None and not getattr(opener, "_symfruit", False):
         setattr(ros1.Reader, "open", _indexed_within(opener))  # noqa: B010  # rosbags, for its reader
+    info_reader = getattr(getattr(ros1, "Reader", None), "read_chunk_info", None)
+    if info_reader is not None and not getattr(info_reader, "_symfruit", False):
+        setattr(ros1.Reader, "read_chunk_info", _chunk_within(info_reader))  # noqa: B010  # rosbags, for its reader
 
 
 def _sized_chunks(read_chunk: Any) -> Any:
@@ -344,7 +455,7 @@ def _indexed_within(open_bag: Any) -> Any:
     """rosbags' ROS 1 ``Reader.open``, after a check that the bag header's ``index_pos`` lies within the file:
     rosbags seeks there, and a position past what the file system holds failed in the system's words (``[Errno 22]
     Invalid argument``, ``cannot fit 'int' into an offset-sized integer``; stop 51, robust51). A chunk position
-    in the index past it (rosbags seeks to each) is said so too."""
+    in the index past it is :func:`_chunk_within`'s."""
     from rosbags.rosbag1 import reader as ros1
 
     def checked(self: Any) -> Any:
@@ -361,15 +472,25 @@ def _indexed_within(open_bag: Any) -> Any:
         if size is not None and 0 < index_pos and index_pos >= size:  # 0: not indexed, as rosbags says
             raise FileFormatError(f"the bag header puts its index at byte {index_pos:,}, past the end of the file "
                                   f"({size:,} bytes): the bag is damaged")  # fmt: skip
-        try:
-            return open_bag(self)
-        except (OSError, ValueError, OverflowError) as exc:
-            past = (isinstance(exc, OSError) and exc.errno == errno.EINVAL) or isinstance(exc, OverflowError) or (
-                isinstance(exc, ValueError) and "offset-sized" in str(exc))  # fmt: skip
-            if not past:
-                raise
-            raise FileFormatError("the bag's index gives a chunk position past what the file holds: the bag is "
-                                  "damaged") from None  # fmt: skip
+        return open_bag(self)  # its index's chunk positions are checked as read (_chunk_within)
+
+    checked._symfruit = True  # type: ignore[attr-defined]
+    return checked
+
+
+def _chunk_within(read_chunk_info: Any) -> Any:
+    """rosbags' ROS 1 ``Reader.read_chunk_info`` (an index entry), refused when the chunk position it gives lies
+    past the end of the file: rosbags seeks there, and read an empty record where the file system lets it seek
+    (``Header could not be read from file.``, rosbags' words; stop 51 left it) or failed in the system's words where
+    it does not. Stop 52 (robust52)."""
+
+    def checked(self: Any) -> Any:
+        info = read_chunk_info(self)
+        size = os.fstat(self.bio.fileno()).st_size
+        if not 0 <= info.pos < size:
+            raise FileFormatError(f"the bag's index puts a chunk at byte {info.pos:,}, past the end of the file "
+                                  f"({size:,} bytes): the bag is damaged")  # fmt: skip
+        return info
 
     checked._symfruit = True  # type: ignore[attr-defined]
     return checked
@@ -413,6 +534,8 @@ def reader_reason(exc: BaseException) -> str:
     damaged = damage_reason(exc)
     if damaged is not None:
         return damaged
+    if isinstance(exc, OSError) and exc.strerror:  # "Permission denied", not "[Errno 13] ...: 'PATH'" (robust52)
+        return exc.strerror
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"

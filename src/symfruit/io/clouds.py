@@ -61,7 +61,8 @@ def read_cloud(path: str | Path) -> np.ndarray:
         raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} (not UTF-8 text: "
                               f"{exc.reason} at byte {exc.start})") from None  # fmt: skip
     except (ValueError, OSError, EOFError, IndexError, KeyError) as exc:
-        raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({exc})") from None
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc  # not "[Errno 13] ...: 'PATH'"
+        raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({why})") from None
     if points.ndim != 2 or points.shape[1] != 3:
         raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")
     with np.errstate(invalid="ignore", over="ignore"):
@@ -515,6 +516,8 @@ def npy_header(path: Path) -> tuple[tuple[int, ...], np.dtype]:
 def _npy_reason(exc: BaseException) -> str:
     """Why numpy could not read a ``.npy`` header, in a few words: a header cut short says so (numpy: ``EOF: reading
     array header, expected 49912 bytes got 498``), anything else is numpy's first line, cut to 120 characters."""
+    if isinstance(exc, OSError) and exc.strerror:  # the file cannot be opened: "Permission denied", not its path again
+        return f"cannot read it: {exc.strerror}"
     text = (str(exc).strip().splitlines() or [type(exc).__name__])[0]
     cut = re.match(r"EOF: reading (.+?), expected (\d+) bytes got (\d+)", text)
     if cut:

@@ -21,6 +21,7 @@ ROS 2 bag folder (:mod:`.bags`).
 
 from __future__ import annotations
 
+import errno
 import os
 from pathlib import Path
 from typing import Any
@@ -103,6 +104,14 @@ def _not_read(folder: Path, stem: str, most: int = 3) -> str:
     return f"; found {named}{more}, not read: only the names above are"
 
 
+def unreadable_folder(path: Path) -> bool:
+    """Whether ``path`` is a folder this process's user may not list or open anything in (its mode; root may
+    always): asking whether it holds a file then raised pathlib's ``PermissionError`` (stop 52, robust52)."""
+    return path.is_dir() and not os.access(
+        path, os.R_OK | os.X_OK, effective_ids=os.access in os.supports_effective_ids
+    )
+
+
 def is_frame_folder(folder: Path) -> bool:
     """Whether ``folder`` holds an entry under one of :data:`COLOR_NAMES` (a colour image; anything else of
     that name is then refused by name when the frame is read)."""
@@ -124,6 +133,9 @@ def read_frame(folder: str | Path) -> Frame:
     folder = as_path(folder, "read_frame: the frame folder")
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such frame folder")
+    if unreadable_folder(folder):
+        raise FileFormatError(f"{folder}: cannot read frame folder ({os.strerror(errno.EACCES)}: this user may not "
+                              "list it or open what it holds)")  # fmt: skip
     color_path = _only(folder, *COLOR_NAMES)  # color.png beside color.jpg: which one is meant?
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")

@@ -34,6 +34,7 @@ import contextlib
 import io
 import re
 import warnings
+import zlib
 from pathlib import Path
 from typing import Any
 
@@ -96,8 +97,9 @@ def _open(source: Path | bytes, label: str) -> Any:
         raise FileFormatError(f"{label}: {size}; at most {MAX_IMAGE_PIXELS:,} pixels are read") from None
     except UnidentifiedImageError:
         raise FileFormatError(f"{label}: cannot read image ({_unidentified(source)})") from None
-    except (OSError, SyntaxError, ValueError) as exc:
-        raise FileFormatError(f"{label}: cannot read image ({exc})") from None
+    except (OSError, SyntaxError, ValueError) as exc:  # an OSError's reason alone, not "[Errno 13] ...: 'PATH'"
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        raise FileFormatError(f"{label}: cannot read image ({why})") from None
     try:
         check_image_size(
             *img.size, label, error=FileFormatError, max_pixels=MAX_IMAGE_PIXELS
@@ -145,9 +147,89 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
+    if getattr(img, "format", None) == "PNG":
+        _png_whole(img, label)
     orientation = _orientation(img)
     turn = _TRANSPOSE.get(orientation)
     return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
+
+
+def _png_file(img: Any) -> Any:
+    """A decoded PNG's file opened anew (Pillow has closed a file it opened by name), or its buffer at its start;
+    None when gone."""
+    name = getattr(img, "filename", "")
+    try:
+        if name:
+            return open(name, "rb")  # closed by the caller
+        fp = getattr(img, "fp", None)
+        return io.BytesIO(fp.getbuffer()) if isinstance(fp, io.BytesIO) else None
+    except (OSError, ValueError):  # gone or changed since: Pillow's decoding stands
+        return None
+
+
+#: Samples per pixel of each PNG colour type (grey, RGB, palette, grey and alpha, RGBA).
+_PNG_SAMPLES = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
+
+
+def _png_whole(img: Any, label: str) -> None:
+    """Refuse a PNG whose image data holds fewer rows than its header states: Pillow decodes such a file without
+    a word, the rows missing left 0 (no depth, black) when the compressed stream ends cleanly before them (stop
+    52, robust52). The rows are counted (the data inflated again, nothing kept) only where the decoded image's
+    last row is all 0 or the file is interlaced: a last row of data was decoded, so every row before it was."""
+    width, height = img.size
+    interlaced = bool(img.info.get("interlace"))
+    if not interlaced and img.crop((0, height - 1, width, height)).getbbox() is not None:
+        return
+    file = _png_file(img)
+    if file is None:
+        return
+    with file:
+        head = file.read(33)
+        if head[12:16] != b"IHDR" or len(head) < 33:
+            return
+        depth, kind = head[24], head[25]
+        row = 1 + (width * _PNG_SAMPLES.get(kind, 1) * depth + 7) // 8
+        passes = ((0, 8, 0, 8), (4, 8, 0, 8), (0, 4, 4, 8), (2, 4, 0, 4), (0, 2, 2, 4), (1, 2, 0, 2), (0, 1, 1, 2))
+        expected = height * row if not interlaced else sum(
+            ((height - y0 + dy - 1) // dy) * (1 + (((width - x0 + dx - 1) // dx) * _PNG_SAMPLES.get(kind, 1) * depth
+                                                   + 7) // 8) * (width > x0) for x0, dx, y0, dy in passes
+            if height > y0)  # fmt: skip
+        found = _png_inflated(file, expected)
+        if found is None:
+            return
+    if found < expected:
+        held = f"{found // row:,} of the {height:,} rows" if not interlaced else f"{found:,} of {expected:,} bytes"
+        raise FileFormatError(f"{label}: its PNG data holds {held} its header states: the file is cut short or "
+                              "damaged")  # fmt: skip
+
+
+def _png_inflated(file: Any, expected: int) -> int | None:
+    """How many bytes a PNG's image data (``file`` past its signature and header) inflates to, counted up to
+    ``expected`` (read 1 MB at a time, nothing kept); None for data that cannot be inflated (Pillow's to say)."""
+    inflate, found = zlib.decompressobj(), 0
+    file.seek(8)
+    while found < expected:
+        head = file.read(8)
+        if len(head) < 8 or head[4:] == b"IEND":
+            break
+        size = int.from_bytes(head[:4], "big")
+        if head[4:] != b"IDAT":
+            file.seek(size + 4, io.SEEK_CUR)
+            continue
+        left = size
+        while left and found < expected:
+            piece = file.read(min(left, 1 << 20))
+            if not piece:
+                return found
+            left -= len(piece)
+            try:
+                found += len(inflate.decompress(piece, expected - found + 1))
+                while inflate.unconsumed_tail and found < expected:
+                    found += len(inflate.decompress(inflate.unconsumed_tail, expected - found + 1))
+            except zlib.error:
+                return None
+        file.seek(left + 4, io.SEEK_CUR)
+    return found
 
 
 #: EXIF orientation -> the ``Image.Transpose`` that shows the image as displayed (2-8; 1 is as stored): as

@@ -18,11 +18,12 @@ def read_mesh(path: str | Path) -> tuple[np.ndarray, np.ndarray | None]:
     """Read ``(vertices (v, 3) float, faces (f, 3) int or None)``; polygons are split into fans."""
     path = as_path(path, "read_mesh: the mesh file")
     suffix = path.suffix.lower()
-    if suffix == ".obj":
-        return _read_obj(path)
-    if suffix == ".ply":
-        return _read_ply_mesh(path)
-    raise FileFormatError(f"{path}: meshes must be .obj or .ply")
+    if suffix not in (".obj", ".ply"):
+        raise FileFormatError(f"{path}: meshes must be .obj or .ply")
+    try:
+        return _read_obj(path) if suffix == ".obj" else _read_ply_mesh(path)
+    except PermissionError as exc:  # one not this user's to read: pathlib's "[Errno 13] Permission denied: 'PATH'"
+        raise FileFormatError(f"{path}: cannot read mesh ({exc.strerror})") from None
 
 
 def _read_ply_mesh(path: Path) -> tuple[np.ndarray, np.ndarray | None]:

@@ -20,6 +20,8 @@ folder      a folder of frame folders, in name order (hidden folders, ROS 2 bags
 
 from __future__ import annotations
 
+import errno
+import os
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -27,7 +29,7 @@ from typing import Protocol, runtime_checkable
 
 from ..core.frame import Frame
 from ..errors import FileFormatError
-from .frames import is_frame_folder, read_frame
+from .frames import is_frame_folder, read_frame, unreadable_folder
 from .outputs import LOCK_NAME
 from .text import as_path
 
@@ -99,9 +101,8 @@ class FolderSource(_Closing):
             if p.is_dir()
             and not p.name.startswith(".")
             and p.resolve() not in skip
-            and not _is_bag_output(p)
-            and not _is_run_output(p)
-        )
+            and (unreadable_folder(p) or not (_is_bag_output(p) or _is_run_output(p)))
+        )  # one this user may not open is a frame folder, refused by name when read (not pathlib's PermissionError)
 
     def __len__(self) -> int:
         return len(self._folders)
@@ -167,6 +168,9 @@ def open_source(path: str | Path, *, exclude: Sequence[Path] = ()) -> FrameSourc
         When ``path`` is none of the registered kinds.
     """
     path = as_path(path, "open_source: the recording")
+    if unreadable_folder(path):  # probing what it holds was pathlib's PermissionError (stop 52, robust52)
+        raise FileFormatError(f"{path}: cannot read folder ({os.strerror(errno.EACCES)}: this user may not list it "
+                              "or open what it holds)")  # fmt: skip
     for kind in _KINDS:
         if kind.probe(path):
             return kind.open(path, exclude)

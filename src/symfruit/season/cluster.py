@@ -96,10 +96,14 @@ LOCAL_NO_WORKER_TIMEOUT = 300.0
 #: A worker the scheduler has not heard from (its heartbeat, every 0.5-5 s) for this long (s) counts as none in
 #: the watch for workers (:class:`_NoWorkers`), as does one that is paused (its memory above Dask's pause
 #: fraction) or closing: registered, such workers kept a run waiting for ever (a paused one) or for the
-#: scheduler's ``worker-ttl`` (5 minutes; none if unset) (stop 50 left it; robust51).
+#: scheduler's ``worker-ttl`` (5 minutes; none if unset) (stop 50 left it; robust51). The default of
+#: ``silent_worker_timeout`` (``--silent-worker-timeout``; stop 52, robust52).
 SILENT_WORKER_S = 60.0
 #: The bounds of ``no_worker_timeout`` (``--no-worker-timeout``, s): a second to a day.
 NO_WORKER_TIMEOUT_RANGE = (1.0, 86_400.0)
+#: The bounds of ``silent_worker_timeout`` (``--silent-worker-timeout``, s): twice the longest heartbeat Dask
+#: gives a worker (5 s, in a large cluster), so that a worker is never taken for silent between two beats, to a day.
+SILENT_WORKER_TIMEOUT_RANGE = (10.0, 86_400.0)
 #: Frames sent to the cluster and not yet written into the tables, at most: bounds the client's memory and the
 #: scheduler's task count however long the recording (with a task that takes long, the others wait at most
 #: this far ahead of it).
@@ -112,9 +116,20 @@ TASKS_PER_THREAD = 3
 def check_no_worker_timeout(seconds: Any) -> float:
     """``seconds`` as the wait for a worker (:data:`NO_WORKER_TIMEOUT`), refused outside
     :data:`NO_WORKER_TIMEOUT_RANGE` (NaN, inf, 0, negative, text) before anything is read."""
-    low, high = NO_WORKER_TIMEOUT_RANGE
+    return _seconds_within(seconds, "--no-worker-timeout", NO_WORKER_TIMEOUT_RANGE)
+
+
+def check_silent_worker_timeout(seconds: Any) -> float:
+    """``seconds`` as the time after which a worker not heard from counts as none (:data:`SILENT_WORKER_S`),
+    refused outside :data:`SILENT_WORKER_TIMEOUT_RANGE` (NaN, inf, below two heartbeats, text) before anything
+    is read."""
+    return _seconds_within(seconds, "--silent-worker-timeout", SILENT_WORKER_TIMEOUT_RANGE)
+
+
+def _seconds_within(seconds: Any, option: str, bounds: tuple[float, float]) -> float:
+    low, high = bounds
     if isinstance(seconds, bool) or not isinstance(seconds, int | float) or not low <= seconds <= high:
-        raise InputError(f"--no-worker-timeout must be between {low:g} and {high:g} s, got {shown(seconds)}")
+        raise InputError(f"{option} must be between {low:g} and {high:g} s, got {shown(seconds)}")
     return float(seconds)
 
 
@@ -365,12 +380,15 @@ def run_distributed(
     exclude: Sequence[str | Path] = (),
     max_ahead: int = MAX_AHEAD,
     no_worker_timeout: float | None = None,
+    silent_worker_timeout: float | None = None,
 ) -> BatchReport:
     """:func:`symfruit.batch.run_batch` on a Dask cluster: an existing one (``scheduler``, its address) or a
     local one of ``workers`` processes; ``chunk`` frames per task (see the module docstring). ``source``: one
     recording or several, laid out as :func:`symfruit.batch.run_batch` does (a task holds frames of one
     recording). ``no_worker_timeout`` (s; default :data:`NO_WORKER_TIMEOUT` for a scheduler,
     :data:`LOCAL_NO_WORKER_TIMEOUT` for a local cluster): how long the run waits while the cluster has no worker.
+    ``silent_worker_timeout`` (s; default :data:`SILENT_WORKER_S`): a worker the scheduler has not heard from for
+    that long counts as none (:func:`working_workers`).
 
     Raises
     ------
@@ -390,6 +408,7 @@ def run_distributed(
     if no_worker_timeout is None:
         no_worker_timeout = NO_WORKER_TIMEOUT if scheduler is not None else LOCAL_NO_WORKER_TIMEOUT
     no_worker_timeout = check_no_worker_timeout(no_worker_timeout)
+    silent_s = check_silent_worker_timeout(SILENT_WORKER_S if silent_worker_timeout is None else silent_worker_timeout)
     if not isinstance(masks, str):
         raise InputError("on a Dask cluster the mask source must be a spec (auto, color, a file, maskrcnn:, onnx:)")
     require_distributed()
@@ -457,7 +476,7 @@ def run_distributed(
                     named = {v: k for k, v in report.recordings.items()}
                     with TableWriter(output, root=out, inputs=named) as table:
                         _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out,
-                             no_worker_timeout)  # fmt: skip
+                             no_worker_timeout, silent_s)  # fmt: skip
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
             if client is not None:
@@ -506,11 +525,11 @@ def _parts(todo: Sequence[int], chunk: int, owner: Sequence[int] | None = None) 
 def _run(
     frames: _Frames, client: Any, todo: list[int], done_before: set[int], chunk: int, max_ahead: int,
     report: BatchReport, table: TableWriter, bar: Progress, out: OutputFolder,
-    no_worker_timeout: float = NO_WORKER_TIMEOUT,
+    no_worker_timeout: float = NO_WORKER_TIMEOUT, silent_s: float = SILENT_WORKER_S,
 ) -> None:  # fmt: skip
     """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
     and write the tables in frame order; stop, the frames not done unprocessed, once the cluster has had no worker
-    for ``no_worker_timeout`` seconds (:class:`_NoWorkers`)."""
+    (none heard from within ``silent_s`` seconds) for ``no_worker_timeout`` seconds (:class:`_NoWorkers`)."""
     keys, target = frames.keys, frames.target
     results: dict[int, Outcome] = {}  # outcomes not yet in the tables, by frame index (in the run)
     state = {"flushed": 0, "sent": 0, "stopped": False}  # frames below "flushed" are in the report and tables
@@ -538,7 +557,7 @@ def _run(
         pending = distributed.as_completed()
         part_of: dict[Any, Part] = {}
         window = {"tasks": 0, "at": -1.0}
-        watch = _NoWorkers(client, no_worker_timeout)
+        watch = _NoWorkers(client, no_worker_timeout, silent_s)
 
         def room() -> bool:
             """Whether another task may go: within the frames ahead, and within the tasks the workers can
@@ -634,8 +653,8 @@ class _NoWorkers:
     them, goes on; it records their frames unprocessed (:func:`_unprocessed`). A scheduler keeps tasks queued
     while it has no worker: without this the run waited for ever."""
 
-    def __init__(self, client: Any, timeout: float) -> None:
-        self.client, self.timeout = client, timeout
+    def __init__(self, client: Any, timeout: float, silent_s: float = SILENT_WORKER_S) -> None:
+        self.client, self.timeout, self.silent_s = client, timeout, silent_s
         self.gone, self._done = threading.Event(), threading.Event()
         self._futures: dict[Any, Any] = {}
         self._lock = threading.Lock()
@@ -669,7 +688,7 @@ class _NoWorkers:
                     info = self.client.scheduler_info(n_workers=-1).get("workers", {})
                 except Exception:  # the scheduler itself gone: the client's own errors reach the run
                     continue
-                workers = working_workers(info, heard, time.monotonic())
+                workers = working_workers(info, heard, time.monotonic(), self.silent_s)
                 since = None if workers else since if since is not None else time.monotonic()
                 if since is None or time.monotonic() - since < self.timeout:
                     continue
@@ -681,10 +700,12 @@ class _NoWorkers:
                     self.client.cancel(futures)
 
 
-def working_workers(info: dict[str, Any], heard: dict[str, tuple[Any, float]], now: float) -> int:
+def working_workers(info: dict[str, Any], heard: dict[str, tuple[Any, float]], now: float,
+                    silent_s: float | None = None) -> int:  # fmt: skip
     """How many of the scheduler's workers (``info``: its identity's ``workers``) can run a task: status
-    ``running`` (not paused, closing, ...), and heard from (their ``last_seen`` changed) within
-    :data:`SILENT_WORKER_S` of ``now`` (the caller's monotonic clock: the scheduler's may be another host's).
+    ``running`` (not paused, closing, ...), and heard from (their ``last_seen`` changed) within ``silent_s``
+    (default :data:`SILENT_WORKER_S`) of ``now`` (the caller's monotonic clock: the scheduler's may be another
+    host's).
     ``heard`` (address: (last_seen, when it last changed)) is kept between calls."""
     for gone in heard.keys() - info.keys():
         del heard[gone]
@@ -693,7 +714,7 @@ def working_workers(info: dict[str, Any], heard: dict[str, tuple[Any, float]], n
         seen = worker.get("last_seen")
         if address not in heard or heard[address][0] != seen:
             heard[address] = (seen, now)
-        silent = seen is not None and now - heard[address][1] > SILENT_WORKER_S
+        silent = seen is not None and now - heard[address][1] > (SILENT_WORKER_S if silent_s is None else silent_s)
         # a Dask that states no status or last_seen (an older one) is taken as running and heard from
         if worker.get("status", "running") == "running" and not silent:
             count += 1

@@ -19,6 +19,7 @@ diameter here; they are counted, not sized.
 from __future__ import annotations
 
 import contextlib
+import errno
 import itertools
 import math
 import os
@@ -111,6 +112,8 @@ def _read(path: Path, columns: Sequence[str]) -> Any:
         table = pq.read_table(path, columns=list(columns))
     except SymfruitError:
         raise
+    except PermissionError:  # pyarrow's "[Errno 13] Failed to open local file 'PATH'. Detail: ..." (robust52)
+        raise FileFormatError(f"{path}: cannot read table ({os.strerror(errno.EACCES)})") from None
     except Exception as exc:  # pyarrow's own errors for a corrupt or truncated file
         raise FileFormatError(f"{path}: cannot read table ({type(exc).__name__}: {exc})") from None
     _check_types(path, table)
