@@ -426,20 +426,23 @@ def isolated_registry(monkeypatch):
     monkeypatch.setattr(sources, "_KINDS", list(sources._KINDS))
 
 
-#: The user a test reads unreadable files as, when it runs as root (root reads a file whatever its mode).
-NOBODY = 65534
+#: What root gives up to read files as any other user would (root reads a file whatever its mode by these two
+#: capabilities): ``setpriv`` drops them from the bounding set, so the command run keeps root's user id (the
+#: repository, its environment and numba's cache stay readable wherever the clone lies, a folder of mode 0700 under
+#: /root too, where the nobody user could not even start the interpreter) but a file of mode 000 is unreadable to it.
+DROP_READ_ALL = ["setpriv", "--bounding-set=-dac_override,-dac_read_search", "--"]
 
 
 @pytest.fixture
 def unreadable_place():
-    """A folder anyone may enter (pytest's own are of mode 0700), for files a test makes unreadable (mode 000)
-    and reads through :func:`as_nobody`; removed after. Skips, saying why, where no user can be found to whom a
-    file of mode 000 is unreadable: root without ``setpriv`` to become nobody."""
+    """A folder for files a test makes unreadable (mode 000) and reads through :func:`as_unprivileged`; removed after.
+    Skips, saying why, where nothing can be run to which a file of mode 000 is unreadable: root without ``setpriv``
+    to give up its reading capabilities."""
     import shutil
     import tempfile
 
     if os.geteuid() == 0 and shutil.which("setpriv") is None:
-        pytest.skip("running as root, who reads files of mode 000, and no setpriv to run as nobody")
+        pytest.skip("running as root, who reads files of mode 000, and no setpriv to give that up")
     place = Path(tempfile.mkdtemp(prefix="symfruit-unreadable-"))
     place.chmod(0o755)
     yield place
@@ -449,14 +452,14 @@ def unreadable_place():
     shutil.rmtree(place, ignore_errors=True)
 
 
-def as_nobody(code: str) -> str:
-    """Run ``code`` (Python) as a user to whom a file of mode 000 is unreadable, and return what it printed: nobody
-    (``setpriv``, its HOME /nonexistent as nobody's is) when the tests run as root, else this user. The kernels'
-    numpy twins (nobody writes no numba cache; compiling them takes minutes)."""
+def as_unprivileged(code: str) -> str:
+    """Run ``code`` (Python) as a user to whom a file of mode 000 is unreadable, and return what it printed: root
+    without its reading capabilities (:data:`DROP_READ_ALL`) when the tests run as root, else this user; HOME
+    /nonexistent (as nobody's is), and the kernels' numpy twins (compiling them in a fresh process takes minutes)."""
     import subprocess
     import sys
 
-    drop = ["setpriv", f"--reuid={NOBODY}", f"--regid={NOBODY}", "--clear-groups"] if os.geteuid() == 0 else []
+    drop = DROP_READ_ALL if os.geteuid() == 0 else []
     env = {**os.environ, "HOME": "/nonexistent", "SYMFRUIT_KERNELS": "numpy",
            "PYTHONPATH": os.pathsep.join([str(Path(symfruit.__file__).resolve().parents[1]), str(ROOT)])}  # fmt: skip
     done = subprocess.run([*drop, sys.executable, "-W", "ignore", "-c", code], capture_output=True, text=True,
@@ -465,10 +468,10 @@ def as_nobody(code: str) -> str:
     return done.stdout.strip()
 
 
-def refusal_as_nobody(call: str, *paths: Path) -> str:
+def refusal_unprivileged(call: str, *paths: Path) -> str:
     """The one-line refusal (a :class:`~symfruit.errors.SymfruitError`) of ``call`` (a Python expression, its
-    imports before it: ``"from m import f; f(P0)"``, ``P0``... the ``paths`` made unreadable), read as nobody;
-    any other exception fails the test with its traceback."""
+    imports before it: ``"from m import f; f(P0)"``, ``P0``... the ``paths`` made unreadable), read through
+    :func:`as_unprivileged`; any other exception fails the test with its traceback."""
     for path in paths:
         path.chmod(0o000)
     setup = "".join(f"P{k} = {str(p)!r}; " for k, p in enumerate(paths))
@@ -476,4 +479,4 @@ def refusal_as_nobody(call: str, *paths: Path) -> str:
     code = (f"{'; '.join(imports)}\nfrom symfruit.errors import SymfruitError\n{setup}\ntry:\n    {expr}\n"
             "except SymfruitError as exc:\n    print('refused:', exc)\nelse:\n    print('taken')")  # fmt: skip
     # e.g. "from m import f; r = f(P0); print(r)": the last part is tried, the ones before it run first
-    return as_nobody(code)
+    return as_unprivileged(code)

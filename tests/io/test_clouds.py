@@ -489,12 +489,12 @@ def test_write_ply_of_no_path_is_refused_in_our_words(tmp_path):
 
 def test_a_cloud_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreadable_place):
     """Stop 52 (robust52): "cannot read as PLY ([Errno 13] Permission denied: 'PATH')" read as a user who may not."""
-    from ..conftest import refusal_as_nobody
+    from ..conftest import refusal_unprivileged
 
     ply, npy = unreadable_place / "c.ply", unreadable_place / "c.npy"
     write_ply(ply, np.random.default_rng(0).normal(size=(50, 3)))
     np.save(npy, np.zeros((50, 3)))
-    said = refusal_as_nobody("from symfruit.io.clouds import read_cloud; read_cloud(P0)", ply)
+    said = refusal_unprivileged("from symfruit.io.clouds import read_cloud; read_cloud(P0)", ply)
     assert said == f"refused: {ply}: cannot read as PLY (Permission denied)"
-    npy_said = refusal_as_nobody("from symfruit.io.clouds import read_cloud; read_cloud(P0)", npy)
+    npy_said = refusal_unprivileged("from symfruit.io.clouds import read_cloud; read_cloud(P0)", npy)
     assert npy_said == f"refused: {npy}: not a valid .npy file (cannot read it: Permission denied)"

@@ -340,11 +340,11 @@ def test_an_image_this_user_may_not_read_is_refused_in_its_words_not_errnos(unre
     "[Errno 13] Permission denied: 'PATH'" inside ours, the path said twice."""
     from PIL import Image
 
-    from ..conftest import refusal_as_nobody
+    from ..conftest import refusal_unprivileged
 
     path = unreadable_place / "c.png"
     Image.new("RGB", (8, 8)).save(path)
-    said = refusal_as_nobody("from symfruit.io.images import read_color; read_color(P0)", path)
+    said = refusal_unprivileged("from symfruit.io.images import read_color; read_color(P0)", path)
     assert said == f"refused: {path}: cannot read image (Permission denied)"
 
 

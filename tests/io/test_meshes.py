@@ -184,12 +184,12 @@ def test_a_ply_mesh_that_is_a_folder_or_a_looping_link_is_named_as_such(tmp_path
 
 def test_a_mesh_this_user_may_not_read_is_refused_by_name(unreadable_place):
     """Stop 52 (robust52): pathlib's PermissionError from the PLY and OBJ readers, read as a user who may not."""
-    from ..conftest import refusal_as_nobody
+    from ..conftest import refusal_unprivileged
 
     obj = unreadable_place / "m.obj"
     obj.write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n")
     ply = unreadable_place / "m.ply"
     ply.write_bytes(b"ply\nformat ascii 1.0\nelement vertex 0\nproperty float x\nend_header\n")
     for path in (obj, ply):
-        said = refusal_as_nobody("from symfruit.io.meshes import read_mesh; read_mesh(P0)", path)
+        said = refusal_unprivileged("from symfruit.io.meshes import read_mesh; read_mesh(P0)", path)
         assert said == f"refused: {path}: cannot read {'OBJ ' if path.suffix == '.obj' else ''}mesh (Permission denied)"

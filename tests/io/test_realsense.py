@@ -615,9 +615,9 @@ def test_a_bag_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreada
     """Stop 52 (robust52): "cannot open bag ([Errno 13] Permission denied: 'PATH')", read as a user who may not."""
     import shutil
 
-    from ..conftest import refusal_as_nobody
+    from ..conftest import refusal_unprivileged
 
     path = unreadable_place / "b.bag"
     shutil.copy(BAG, path)
-    said = refusal_as_nobody("from symfruit.io.sources import open_source; open_source(P0)", path)
+    said = refusal_unprivileged("from symfruit.io.sources import open_source; open_source(P0)", path)
     assert said == f"refused: {path}: cannot open bag (Permission denied)"

@@ -176,7 +176,7 @@ def test_a_folder_this_user_may_not_open_is_refused_and_a_batch_goes_on_past_one
     it: pathlib's PermissionError from the probes (is it a bag? a run's output?) ended the whole batch."""
     import shutil
 
-    from ..conftest import refusal_as_nobody, small_frame
+    from ..conftest import refusal_unprivileged, small_frame
 
     rec = unreadable_place / "rec"
     for k in range(3):
@@ -184,7 +184,7 @@ def test_a_folder_this_user_may_not_open_is_refused_and_a_batch_goes_on_past_one
     out = unreadable_place / "out"
     out.mkdir(mode=0o777)
     out.chmod(0o777)
-    said = refusal_as_nobody(
+    said = refusal_unprivileged(
         "from symfruit.batch import run_batch; r = run_batch(" + repr(str(rec)) + ", " + repr(str(out / "o")) + ", "
         "method='raw', progress=False); print(sorted(r.done), r.failed)",
         rec / "f_1",
@@ -192,6 +192,6 @@ def test_a_folder_this_user_may_not_open_is_refused_and_a_batch_goes_on_past_one
     assert said.splitlines()[-2:] == [
         "['f_0', 'f_2'] {'f_1': '" + str(rec / "f_1") + ": cannot read frame folder (Permission denied: this user may "
         "not list it or open what it holds)'}", "taken"]  # fmt: skip
-    said = refusal_as_nobody("from symfruit.io.sources import open_source; open_source(P0)", rec)
+    said = refusal_unprivileged("from symfruit.io.sources import open_source; open_source(P0)", rec)
     assert said == (f"refused: {rec}: cannot read folder (Permission denied: this user may not list it or open what "
                     "it holds)")  # fmt: skip

@@ -394,10 +394,10 @@ def test_tables_whose_names_are_of_the_other_text_type_are_compared_alike(run):
 def test_a_table_this_user_may_not_read_is_refused_in_its_words_not_pyarrows(unreadable_place):
     """Stop 52 (robust52): pyarrow's "PermissionError: [Errno 13] Failed to open local file 'PATH'. Detail:
     [errno 13] Permission denied" inside ours, read as a user who may not."""
-    from ..conftest import refusal_as_nobody
+    from ..conftest import refusal_unprivileged
 
     path = unreadable_place / "detections.parquet"
     path.write_bytes(b"PAR1")
-    said = refusal_as_nobody("from symfruit.season.report import _read; _read(__import__('pathlib').Path(P0), ['x'])",
-                             path)  # fmt: skip
+    said = refusal_unprivileged(
+        "from symfruit.season.report import _read; _read(__import__('pathlib').Path(P0), ['x'])", path)  # fmt: skip
     assert said == f"refused: {path}: cannot read table (Permission denied)"
