@@ -6942,3 +6942,43 @@ def test_the_depth_mode_without_the_sort_is_fruit_depths_to_the_bit(seed, kind, 
             mp.setenv("SYMFRUIT_KERNELS", "numpy")
             twin = fruit_depth(kept, radius_px, 600.0, noise=noise, leafy=leaf if with_leafy else None)
         assert np.array_equal(got[:2], twin, equal_nan=True)
+
+
+# --- stop 52, round52: the round fruit's pieces in fewer calls
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_hull_area_is_the_twins(seed):
+    """``_hull_area_of`` (:func:`_jit.hull_area_of`) with the kernels and with the twins on random masks' hull vertices
+    (whole numbers), on random whole-number polygons (1 to 300 vertices: numpy's sum one by one, in eight lanes and
+    split in halves) out to the kernel's bound of 2 ** 15 and past it (the twin's numpy then), and on vertices that
+    are not whole numbers (numpy too): the same value."""
+    from symfruit.segment.colour import _hull_area, _hull_area_of, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    shape = tuple(int(x) for x in rng.integers(1, 400, 2))
+    yy, xx = np.indices(shape)
+    r = rng.uniform(0.5, 0.6) * min(shape)
+    mask = ((yy - shape[0] / 2) ** 2 + (xx - shape[1] / 2) ** 2 <= r * r) | (rng.random(shape) < 0.001)
+    big = float(rng.choice([64.0, 32768.0, 32769.0, 1e6]))
+    polygons = [
+        rng.integers(-int(big), int(big) + 1, (int(rng.integers(1, 300)), 2)).astype(np.float64),
+        rng.uniform(0.0, 100.0, (int(rng.integers(1, 30)), 2)),
+        np.round(rng.uniform(0.0, 100.0, (int(rng.integers(1, 30)), 2)) * 2.0) / 2.0,
+    ]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _hull_area, mask)
+        assert fast == twin
+        for v in [_hull_vertices(mask), *polygons]:
+            fast, twin = _both(mp, _hull_area_of, v, mask)
+            assert type(fast) is float and fast == twin
+
+
+def test_the_hull_area_of_a_square():
+    """The hull of a filled 3 x 4 block: its pixels, 12 (the centres' rectangle 2 x 3, half its perimeter 5, 1)."""
+    from symfruit.segment.colour import _hull_area_of
+
+    v = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]])
+    assert _jit.hull_area_of(v) == _hull_area_of(v, np.ones((3, 4), bool)) == 12.0
+    assert _jit.hull_area_of(v + 0.5) == -1.0

@@ -406,9 +406,14 @@ def _hull_area(mask: np.ndarray) -> float:
 
 def _hull_area_of(v: np.ndarray | None, mask: np.ndarray) -> float:
     """:func:`_hull_area` from the mask's :func:`_hull_vertices` (each vertex's successor by one concatenation:
-    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead)."""
+    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead). Where numba is,
+    in one call for whole-number vertices (:func:`symfruit.core._jit.hull_area_of`: the same value; stop 52)."""
     if v is None:
         return float(mask.sum())
+    if (jit := compiled()) is not None and v.ndim == 2 and len(v) and v.shape[1] == 2 and v.dtype == np.float64:
+        area = float(jit.hull_area_of(v))  # the same value in one call (stop 52, round52)
+        if area >= 0.0:
+            return area
     x, y = v[:, 0], v[:, 1]
     xn, yn = np.concatenate((x[1:], x[:1])), np.concatenate((y[1:], y[:1]))
     area = 0.5 * abs(float(np.dot(x, yn) - np.dot(y, xn)))
