@@ -6982,3 +6982,117 @@ def test_the_hull_area_of_a_square():
     v = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]])
     assert _jit.hull_area_of(v) == _hull_area_of(v, np.ones((3, 4), bool)) == 12.0
     assert _jit.hull_area_of(v + 0.5) == -1.0
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([0.0, 0.5, 0.97]))
+def test_the_skin_seed_is_the_twins(seed, front, holes):
+    """A blush crescent beside ground colour in front of it or at its depth (``_blush_scene``), with more depth missing
+    (too few depths to grow from: none is taken): ``_skin_seed`` (:func:`_jit.skin_seed`) gives the window, mask,
+    depth count, median depth and centre of the twin's calls (the part's depths, ``_blush_rim``, ``median``,
+    ``np.nonzero``'s means), bit for bit, and ``_round_skin`` the same skin with the kernels and with the twins."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth, _Geometry, _round_skin, _skin_seed
+
+    rng = np.random.default_rng(seed)
+    hull, z, color, owner = _blush_scene(rng, front)
+    h, w = hull.shape
+    z[rng.random((h, w)) < holes] = 0.0
+    r0, c0 = int(rng.integers(0, 10)), int(rng.integers(0, 10))
+    big_z = np.zeros((h + 20, w + 20))
+    big_z[r0 : r0 + h, c0 : c0 + w] = z
+    big_c = np.zeros((h + 20, w + 20, 3), np.uint8)
+    big_c[r0 : r0 + h, c0 : c0 + w] = color
+    big_o = np.zeros((h + 20, w + 20), np.int16)
+    big_o[r0 : r0 + h, c0 : c0 + w] = owner
+    rows, cols = np.nonzero(hull)
+    box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
+    part = hull[box]
+    sl = (slice(box[0].start + r0, box[0].stop + r0), slice(box[1].start + c0, box[1].stop + c0))
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    got = _skin_seed(sl, part, _Depth(big_z), big_c, s, big_o, 1)
+    assert got is not None
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        assert _skin_seed(sl, part, _Depth(big_z), big_c, s, big_o, 1) is None
+        z_sl = big_z[sl]
+        window, mask, z_part = _blush_rim(sl, part, z_sl[part & (z_sl > 0)], _Depth(big_z), big_c, s, big_o, 1)
+    assert got[0] == window and got[1].dtype == bool and np.array_equal(got[1], mask) and got[2] == len(z_part)
+    if len(z_part) >= 20:
+        rows, cols = np.nonzero(mask)
+        want = (float(median(z_part)), int(mask.sum()), float(rows.mean()), float(cols.mean()))
+        assert np.array_equal(np.array(got[3:]).view(np.uint64), np.array(want).view(np.uint64))
+    if not front or holes > 0.9:
+        assert window == sl  # the ring at the crescent's depth, or too few depths to tell
+    elif holes == 0.0:
+        assert window != sl  # the ring in front taken
+    geo = _Geometry(600.0, (h + 20) / 2, (w + 20) / 2)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _round_skin, sl, part, _Depth(big_z), big_c, geo, s, big_o, 1)
+    assert fast[0] == twin[0] and np.array_equal(fast[1], twin[1])
+
+
+def test_the_round_piece_is_the_twins(monkeypatch):
+    """:func:`_jit.round_piece` on 600 random pieces (``_random_piece``) against the calls it stands for, with the
+    kernels and their numpy twins: ``red.any()`` and ``_ripe`` of ``part & weak`` (0: not ripe), then
+    ``_surface_hull`` and ``_depth_consistent`` against the red pixels (1 and the hull): the same answers and hulls."""
+    from symfruit.segment.colour import _pillow_fill, _ripe
+
+    if not _pillow_fill():
+        pytest.skip("the kernel follows Pillow 12.1's fill")
+    rng = np.random.default_rng(52)
+    unripe = hulls = 0
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 41, 2))
+        part, weak, owner, color, z, vertices = _random_piece(rng, h, w)
+        if vertices is None:
+            continue
+        least = np.float32(rng.choice([0.2, 0.35, -1.0]))
+        red = part & weak
+        surface, jump = bool(t % 3), float(rng.choice([0.02, 0.05]))
+        state, hull = _jit.round_piece(color, part, weak, least, vertices, owner, 3, surface, z, jump)
+        if not (red.any() and _ripe(color, red, float(least))):
+            assert state == 0 and hull.shape == (0, 0)
+            unripe += 1
+            continue
+        assert state == 1
+        for twin in _both(monkeypatch, _twin_hull, vertices, part, owner, color, surface, red, z, jump):
+            np.testing.assert_array_equal(hull, twin)
+        hulls += 1
+    state, _ = _jit.round_piece(color, part, weak, np.float32(-1.0), vertices + 0.5, owner, 3, True, z, 0.02)
+    assert state == 2  # not whole numbers: Pillow's fill
+    assert unripe > 50 and hulls > 60
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_bridged_solid_is_the_twins(seed):
+    """:func:`_jit.bridged_solid` against the numpy trim and ``_bridged_skin``'s test (the trimmed skin's pixel count
+    below ``GROUND_SOLIDITY`` of ``_hull_area``, Pillow's fill, Qhull and numpy with the twins) on 300 skins as
+    ``test_the_bridged_trim_is_the_twins`` makes them, and on random solidities: the same pixels and answers."""
+    from symfruit.segment.colour import _hull_area, _pillow_fill
+
+    if not _pillow_fill():
+        pytest.skip("the kernel follows Pillow 12.1's fill")
+    rng = np.random.default_rng(seed)
+    answers = set()
+    for _ in range(300):
+        h, w = (int(v) for v in rng.integers(1, 40, 2))
+        yy, xx = np.mgrid[:h, :w]
+        r = rng.uniform(1, 20)
+        skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
+        skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
+        z = rng.uniform(0.5, 2.0, (h, w))
+        z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
+        ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
+        r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
+        part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+        solidity = float(rng.choice([0.75, rng.uniform(0.0, 1.2)]))
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = _trim_twin(skin, z, part, r0, c0)
+            want = 2 if twin.sum() < solidity * _hull_area(twin) else 1
+        got, state = _jit.bridged_solid(skin, z, part, r0, c0, solidity)
+        np.testing.assert_array_equal(got, twin)
+        assert state == want
+        answers.add(state)
+    assert answers == {1, 2}
