@@ -2783,17 +2783,14 @@ def _blush_scene(rng, front: bool):
     return hull, z, color, owner
 
 
-@settings(max_examples=40, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.booleans())
-def test_the_segmenters_blush_rim_is_the_twins(seed, front):
-    """A blush crescent beside ground colour in front of it (the rim's test holds) or at its depth (it does not), in
-    the middle of an image or against its border: ``_blush_rim`` with the kernel and with the twin gives the same
-    window, mask and depths."""
-    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
-
-    rng = np.random.default_rng(seed)
+def _blush_window(rng, front: bool, holes: float = 0.0):
+    """``_blush_scene`` (with a share ``holes`` of its depth missing besides) placed at random in an image 20 pixels
+    wider and taller, and its crescent's box: the crescent's mask in its window, the window, and the image's depth,
+    colour and owner."""
     hull, z, color, owner = _blush_scene(rng, front)
     h, w = hull.shape
+    if holes:
+        z[rng.random((h, w)) < holes] = 0.0
     r0, c0 = int(rng.integers(0, 10)), int(rng.integers(0, 10))
     big_z = np.zeros((h + 20, w + 20))
     big_z[r0 : r0 + h, c0 : c0 + w] = z
@@ -2803,8 +2800,19 @@ def test_the_segmenters_blush_rim_is_the_twins(seed, front):
     big_o[r0 : r0 + h, c0 : c0 + w] = owner
     rows, cols = np.nonzero(hull)
     box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
-    part = hull[box]
     sl = (slice(box[0].start + r0, box[0].stop + r0), slice(box[1].start + c0, box[1].stop + c0))
+    return hull[box], sl, big_z, big_c, big_o
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_segmenters_blush_rim_is_the_twins(seed, front):
+    """A blush crescent beside ground colour in front of it (the rim's test holds) or at its depth (it does not), in
+    the middle of an image or against its border: ``_blush_rim`` with the kernel and with the twin gives the same
+    window, mask and depths."""
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
+
+    part, sl, big_z, big_c, big_o = _blush_window(np.random.default_rng(seed), front)
     z_part = big_z[sl][part & (big_z[sl] > 0)]
     s = SegmentSettings(round_fruit=True, ground_colour=True)
     with pytest.MonkeyPatch.context() as mp:
@@ -6105,6 +6113,22 @@ def _trim_twin(skin, z, part, r0, c0):
     return skin & ((z > 0) | convex_hull_mask(core))
 
 
+def _trim_case(rng):
+    """A skin to trim (a disc, specks), its depth with gaps (none to 95 %), and a part of it inside or on its edge at
+    ``(r0, c0)``: ``skin, z, part, r0, c0``."""
+    h, w = (int(v) for v in rng.integers(1, 40, 2))
+    yy, xx = np.mgrid[:h, :w]
+    r = rng.uniform(1, 20)
+    skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
+    skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
+    z = rng.uniform(0.5, 2.0, (h, w))
+    z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
+    ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
+    r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
+    part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+    return skin, z, part, r0, c0
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_bridged_trim_is_the_twins(seed):
     """:func:`_jit.bridged_trim` against the numpy trim (Pillow's fill and Qhull with the twins) on 300 skins: discs
@@ -6117,16 +6141,7 @@ def test_the_bridged_trim_is_the_twins(seed):
     rng = np.random.default_rng(seed)
     kept = cut = 0
     for _ in range(300):
-        h, w = (int(v) for v in rng.integers(1, 40, 2))
-        yy, xx = np.mgrid[:h, :w]
-        r = rng.uniform(1, 20)
-        skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
-        skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
-        z = rng.uniform(0.5, 2.0, (h, w))
-        z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
-        ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
-        r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
-        part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+        skin, z, part, r0, c0 = _trim_case(rng)
         with pytest.MonkeyPatch.context() as mp:
             _, twin = _both(mp, _trim_twin, skin, z, part, r0, c0)
         got, done = _jit.bridged_trim(skin, z, part, r0, c0)
@@ -6994,21 +7009,8 @@ def test_the_skin_seed_is_the_twins(seed, front, holes):
     from symfruit.core.points import median
     from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth, _Geometry, _round_skin, _skin_seed
 
-    rng = np.random.default_rng(seed)
-    hull, z, color, owner = _blush_scene(rng, front)
-    h, w = hull.shape
-    z[rng.random((h, w)) < holes] = 0.0
-    r0, c0 = int(rng.integers(0, 10)), int(rng.integers(0, 10))
-    big_z = np.zeros((h + 20, w + 20))
-    big_z[r0 : r0 + h, c0 : c0 + w] = z
-    big_c = np.zeros((h + 20, w + 20, 3), np.uint8)
-    big_c[r0 : r0 + h, c0 : c0 + w] = color
-    big_o = np.zeros((h + 20, w + 20), np.int16)
-    big_o[r0 : r0 + h, c0 : c0 + w] = owner
-    rows, cols = np.nonzero(hull)
-    box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
-    part = hull[box]
-    sl = (slice(box[0].start + r0, box[0].stop + r0), slice(box[1].start + c0, box[1].stop + c0))
+    part, sl, big_z, big_c, big_o = _blush_window(np.random.default_rng(seed), front, holes)
+    h, w = big_z.shape
     s = SegmentSettings(round_fruit=True, ground_colour=True)
     got = _skin_seed(sl, part, _Depth(big_z), big_c, s, big_o, 1)
     assert got is not None
@@ -7026,7 +7028,7 @@ def test_the_skin_seed_is_the_twins(seed, front, holes):
         assert window == sl  # the ring at the crescent's depth, or too few depths to tell
     elif holes == 0.0:
         assert window != sl  # the ring in front taken
-    geo = _Geometry(600.0, (h + 20) / 2, (w + 20) / 2)
+    geo = _Geometry(600.0, h / 2, w / 2)
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, _round_skin, sl, part, _Depth(big_z), big_c, geo, s, big_o, 1)
     assert fast[0] == twin[0] and np.array_equal(fast[1], twin[1])
@@ -7067,8 +7069,8 @@ def test_the_round_piece_is_the_twins(monkeypatch):
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_bridged_solid_is_the_twins(seed):
     """:func:`_jit.bridged_solid` against the numpy trim and ``_bridged_skin``'s test (the trimmed skin's pixel count
-    below ``GROUND_SOLIDITY`` of ``_hull_area``, Pillow's fill, Qhull and numpy with the twins) on 300 skins as
-    ``test_the_bridged_trim_is_the_twins`` makes them, and on random solidities: the same pixels and answers."""
+    below ``GROUND_SOLIDITY`` of ``_hull_area``, Pillow's fill, Qhull and numpy with the twins) on 300 skins
+    (``_trim_case``), and on random solidities: the same pixels and answers."""
     from symfruit.segment.colour import _hull_area, _pillow_fill
 
     if not _pillow_fill():
@@ -7076,16 +7078,7 @@ def test_the_bridged_solid_is_the_twins(seed):
     rng = np.random.default_rng(seed)
     answers = set()
     for _ in range(300):
-        h, w = (int(v) for v in rng.integers(1, 40, 2))
-        yy, xx = np.mgrid[:h, :w]
-        r = rng.uniform(1, 20)
-        skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
-        skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
-        z = rng.uniform(0.5, 2.0, (h, w))
-        z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
-        ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
-        r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
-        part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+        skin, z, part, r0, c0 = _trim_case(rng)
         solidity = float(rng.choice([0.75, rng.uniform(0.0, 1.2)]))
         with pytest.MonkeyPatch.context() as mp:
             mp.setenv("SYMFRUIT_KERNELS", "numpy")
