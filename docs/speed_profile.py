@@ -4,18 +4,20 @@ functions, the methods of its classes with ``--methods``, and the compiled kerne
 function's inclusive thread CPU per frame and its calls per frame, the largest first.
 
     python docs/speed_profile.py [--only SUBSTRING ...] [--methods] [--frames 8] [--top 60] [--method evidence]
-                                 [--trees N]
+                                 [--trees N] [--self]
 
 e.g. ``PYTHONPATH=src python docs/speed_profile.py --only evidence agreement candidates jit.``. cProfile cannot
 time this code (with a profiler hook set, numba's calls take a slow path, README "Speed", stop 48); these wrappers
 can, at a cost: each wrapped call adds about a microsecond, so a frame timed with every function wrapped reads
 about half again its own time, and a small function called often reads high. ``--only`` wraps only the functions
 whose qualified name holds one of the substrings (``jit.NAME`` for a kernel): the fewer wrapped, the nearer the
-figures are to the frame's own. Inclusive times: a function's callees are counted in it too. A function looked up
-before the wrappers were set (a method's entry in ``symfruit.methods``' registry, a kernel called from another
-kernel) is not seen: wrap its callees. Compare figures within one run (thread CPU, the host's load still shows).
-With ``--trees N`` the colour segmenter alone is profiled instead, on N rendered apple-tree frames (1920x1080 with
-depth, the apple profile's settings, as ``docs/speed_ab.py --trees``): figures per tree frame.
+figures are to the frame's own. Inclusive times: a function's callees are counted in it too; with ``--self``, each
+function's own time (less that of the wrapped functions it calls), and the sums of the kernels' and the rest's (the
+wrappers' own cost lands in the rest). A function looked up before the wrappers were set (a method's entry in
+``symfruit.methods``' registry, a kernel called from another kernel) is not seen: wrap its callees. Compare figures
+within one run (thread CPU, the host's load still shows). With ``--trees N`` the colour segmenter alone is profiled
+instead, on N rendered apple-tree frames (1920x1080 with depth, the apple profile's settings, as ``docs/speed_ab.py
+--trees``): figures per tree frame.
 """
 
 import argparse
@@ -31,14 +33,24 @@ from typing import Any
 SKIP = ("ros", "dask", "cli", "__main__", "viz", "plot")
 
 
+#: ``--self``: the time of each wrapped call still open spent in the wrapped calls it made (one entry a call).
+_OPEN: list[float] = []
+_SELF = [False]
+
+
 def _timed(fn: Any, key: str, spent: dict[str, float], calls: Counter) -> Any:
     def timed(*a: Any, **k: Any) -> Any:
         start = time.thread_time()
+        _OPEN.append(0.0)
         try:
             return fn(*a, **k)
         finally:
-            spent[key] += time.thread_time() - start
+            took = time.thread_time() - start
+            inner = _OPEN.pop()
+            spent[key] += took - inner if _SELF[0] else took
             calls[key] += 1
+            if _OPEN:
+                _OPEN[-1] += took
 
     timed.__wrapped__ = fn  # type: ignore[attr-defined]
     return timed
@@ -115,11 +127,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--frames", type=int, default=8)
     parser.add_argument("--top", type=int, default=60)
     parser.add_argument("--method", default="evidence")
+    parser.add_argument("--self", action="store_true", help="each function's own time: less that of the wrapped "
+                        "functions it calls (the kernels' with jit.)")  # fmt: skip
     parser.add_argument("--trees", type=int, default=0, help="profile the colour segmenter on this many apple-tree "
                         "frames instead (1920x1080 with depth, the apple profile; --frames times each)")  # fmt: skip
     args = parser.parse_args(argv)
     spent: dict[str, float] = defaultdict(float)
     calls: Counter = Counter()
+    _SELF[0] = args.self
     count = _wrap_all(args.only, args.methods, spent, calls)
     run = _trees(args.trees) if args.trees else _frame(args.method)
     for _ in range(1 if args.trees else 3):  # warm-up: compiled kernels loaded, caches made
@@ -132,6 +147,10 @@ def main(argv: list[str] | None = None) -> int:
     frames = args.frames * max(args.trees, 1)  # with --trees, each run segments every tree frame
     per = (time.thread_time() - start) / frames
     lines = [f"{count} functions wrapped; frame {per * 1e3:.1f} ms thread CPU with the wrappers ({frames} frames)"]
+    if args.self:
+        kernels = sum(v for k, v in spent.items() if k.startswith("jit."))
+        lines.append(f"own times: the kernels {kernels / frames * 1e3:.2f} ms, the rest "
+                     f"{(sum(spent.values()) - kernels) / frames * 1e3:.2f} ms a frame")  # fmt: skip
     for key, seconds in sorted(spent.items(), key=lambda kv: -kv[1])[: args.top]:
         lines.append(f"{seconds / frames * 1e3:8.2f} ms {calls[key] / frames:8.1f} calls  {key}")
     sys.stdout.write("\n".join(lines) + "\n")

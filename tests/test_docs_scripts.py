@@ -151,3 +151,18 @@ def test_speed_profile_profiles_the_segmenter_on_tree_frames(tmp_path):
     lines = done.stdout.splitlines()
     assert lines[0].endswith("(2 frames)")
     assert any(line.endswith("1.0 calls  symfruit.segment.colour.segment") for line in lines[1:])
+
+
+def test_speed_profile_gives_own_times(tmp_path):
+    """``speed_profile.py --self`` (stop 52): each function's own time, less the wrapped functions it calls: the
+    segmenter's entry point, nearly all of whose time is ``_segment_at``'s, then reads far less than it, and the
+    kernels' and the rest's sums are printed."""
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPATH": str(DOCS.parent / "src")}
+    args = ["--only", "colour.segment", "colour._segment_at", "--trees", "1", "--frames", "1", "--self"]
+    done = subprocess.run([sys.executable, str(DOCS / "speed_profile.py"), *args], cwd=tmp_path, env=env,
+                          capture_output=True, text=True, timeout=600)  # fmt: skip
+    assert done.returncode == 0, done.stderr[-2000:]
+    lines = done.stdout.splitlines()
+    assert lines[1].startswith("own times: the kernels 0.00 ms, the rest ")
+    own = {line.split()[-1]: float(line.split()[0]) for line in lines[2:]}
+    assert own["symfruit.segment.colour.segment"] < 0.5 * own["symfruit.segment.colour._segment_at"]

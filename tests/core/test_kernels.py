@@ -2784,17 +2784,14 @@ def _blush_scene(rng, front: bool):
     return hull, z, color, owner
 
 
-@settings(max_examples=40, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.booleans())
-def test_the_segmenters_blush_rim_is_the_twins(seed, front):
-    """A blush crescent beside ground colour in front of it (the rim's test holds) or at its depth (it does not), in
-    the middle of an image or against its border: ``_blush_rim`` with the kernel and with the twin gives the same
-    window, mask and depths."""
-    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
-
-    rng = np.random.default_rng(seed)
+def _blush_window(rng, front: bool, holes: float = 0.0):
+    """``_blush_scene`` (with a share ``holes`` of its depth missing besides) placed at random in an image 20 pixels
+    wider and taller, and its crescent's box: the crescent's mask in its window, the window, and the image's depth,
+    colour and owner."""
     hull, z, color, owner = _blush_scene(rng, front)
     h, w = hull.shape
+    if holes:
+        z[rng.random((h, w)) < holes] = 0.0
     r0, c0 = int(rng.integers(0, 10)), int(rng.integers(0, 10))
     big_z = np.zeros((h + 20, w + 20))
     big_z[r0 : r0 + h, c0 : c0 + w] = z
@@ -2804,8 +2801,19 @@ def test_the_segmenters_blush_rim_is_the_twins(seed, front):
     big_o[r0 : r0 + h, c0 : c0 + w] = owner
     rows, cols = np.nonzero(hull)
     box = (slice(rows.min(), rows.max() + 1), slice(cols.min(), cols.max() + 1))
-    part = hull[box]
     sl = (slice(box[0].start + r0, box[0].stop + r0), slice(box[1].start + c0, box[1].stop + c0))
+    return hull[box], sl, big_z, big_c, big_o
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_the_segmenters_blush_rim_is_the_twins(seed, front):
+    """A blush crescent beside ground colour in front of it (the rim's test holds) or at its depth (it does not), in
+    the middle of an image or against its border: ``_blush_rim`` with the kernel and with the twin gives the same
+    window, mask and depths."""
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth
+
+    part, sl, big_z, big_c, big_o = _blush_window(np.random.default_rng(seed), front)
     z_part = big_z[sl][part & (big_z[sl] > 0)]
     s = SegmentSettings(round_fruit=True, ground_colour=True)
     with pytest.MonkeyPatch.context() as mp:
@@ -6106,6 +6114,22 @@ def _trim_twin(skin, z, part, r0, c0):
     return skin & ((z > 0) | convex_hull_mask(core))
 
 
+def _trim_case(rng):
+    """A skin to trim (a disc, specks), its depth with gaps (none to 95 %), and a part of it inside or on its edge at
+    ``(r0, c0)``: ``skin, z, part, r0, c0``."""
+    h, w = (int(v) for v in rng.integers(1, 40, 2))
+    yy, xx = np.mgrid[:h, :w]
+    r = rng.uniform(1, 20)
+    skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
+    skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
+    z = rng.uniform(0.5, 2.0, (h, w))
+    z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
+    ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
+    r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
+    part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+    return skin, z, part, r0, c0
+
+
 @pytest.mark.parametrize("seed", [0, 1])
 def test_the_bridged_trim_is_the_twins(seed):
     """:func:`_jit.bridged_trim` against the numpy trim (Pillow's fill and Qhull with the twins) on 300 skins: discs
@@ -6118,16 +6142,7 @@ def test_the_bridged_trim_is_the_twins(seed):
     rng = np.random.default_rng(seed)
     kept = cut = 0
     for _ in range(300):
-        h, w = (int(v) for v in rng.integers(1, 40, 2))
-        yy, xx = np.mgrid[:h, :w]
-        r = rng.uniform(1, 20)
-        skin = (yy - rng.uniform(0, h)) ** 2 + (xx - rng.uniform(0, w)) ** 2 <= r * r
-        skin |= rng.random((h, w)) < rng.choice([0.0, 0.05, 0.3])
-        z = rng.uniform(0.5, 2.0, (h, w))
-        z[rng.random((h, w)) < rng.choice([0.0, 0.1, 0.5, 0.95])] = 0.0
-        ph, pw = int(rng.integers(1, h + 1)), int(rng.integers(1, w + 1))
-        r0, c0 = int(rng.integers(0, h - ph + 1)), int(rng.integers(0, w - pw + 1))
-        part = (rng.random((ph, pw)) < rng.choice([0.0, 0.2, 0.9])) & skin[r0 : r0 + ph, c0 : c0 + pw]
+        skin, z, part, r0, c0 = _trim_case(rng)
         with pytest.MonkeyPatch.context() as mp:
             _, twin = _both(mp, _trim_twin, skin, z, part, r0, c0)
         got, done = _jit.bridged_trim(skin, z, part, r0, c0)
@@ -7031,3 +7046,135 @@ def test_the_kernels_load_where_numba_finds_no_folder_to_cache_them():
                           env={**os.environ, "PYTHONPATH": os.pathsep.join(sys.path)})  # fmt: skip
     assert done.returncode == 0, done.stderr[-300:]
     assert done.stdout.startswith("loaded ") and int(done.stdout.split()[1]) > 10
+
+
+# --- stop 52, round52: the round fruit's pieces in fewer calls
+
+
+@settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_hull_area_is_the_twins(seed):
+    """``_hull_area_of`` (:func:`_jit.hull_area_of`) with the kernels and with the twins on random masks' hull vertices
+    (whole numbers), on random whole-number polygons (1 to 300 vertices: numpy's sum one by one, in eight lanes and
+    split in halves) out to the kernel's bound of 2 ** 15 and past it (the twin's numpy then), and on vertices that
+    are not whole numbers (numpy too): the same value."""
+    from symfruit.segment.colour import _hull_area, _hull_area_of, _hull_vertices
+
+    rng = np.random.default_rng(seed)
+    shape = tuple(int(x) for x in rng.integers(1, 400, 2))
+    yy, xx = np.indices(shape)
+    r = rng.uniform(0.5, 0.6) * min(shape)
+    mask = ((yy - shape[0] / 2) ** 2 + (xx - shape[1] / 2) ** 2 <= r * r) | (rng.random(shape) < 0.001)
+    big = float(rng.choice([64.0, 32768.0, 32769.0, 1e6]))
+    polygons = [
+        rng.integers(-int(big), int(big) + 1, (int(rng.integers(1, 300)), 2)).astype(np.float64),
+        rng.uniform(0.0, 100.0, (int(rng.integers(1, 30)), 2)),
+        np.round(rng.uniform(0.0, 100.0, (int(rng.integers(1, 30)), 2)) * 2.0) / 2.0,
+    ]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _hull_area, mask)
+        assert fast == twin
+        for v in [_hull_vertices(mask), *polygons]:
+            fast, twin = _both(mp, _hull_area_of, v, mask)
+            assert type(fast) is float and fast == twin
+
+
+def test_the_hull_area_of_a_square():
+    """The hull of a filled 3 x 4 block: its pixels, 12 (the centres' rectangle 2 x 3, half its perimeter 5, 1)."""
+    from symfruit.segment.colour import _hull_area_of
+
+    v = np.array([[0.0, 0.0], [3.0, 0.0], [3.0, 2.0], [0.0, 2.0]])
+    assert _jit.hull_area_of(v) == _hull_area_of(v, np.ones((3, 4), bool)) == 12.0
+    assert _jit.hull_area_of(v + 0.5) == -1.0
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans(), st.sampled_from([0.0, 0.5, 0.97]))
+def test_the_skin_seed_is_the_twins(seed, front, holes):
+    """A blush crescent beside ground colour in front of it or at its depth (``_blush_scene``), with more depth missing
+    (too few depths to grow from: none is taken): ``_skin_seed`` (:func:`_jit.skin_seed`) gives the window, mask,
+    depth count, median depth and centre of the twin's calls (the part's depths, ``_blush_rim``, ``median``,
+    ``np.nonzero``'s means), bit for bit, and ``_round_skin`` the same skin with the kernels and with the twins."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import SegmentSettings, _blush_rim, _Depth, _Geometry, _round_skin, _skin_seed
+
+    part, sl, big_z, big_c, big_o = _blush_window(np.random.default_rng(seed), front, holes)
+    h, w = big_z.shape
+    s = SegmentSettings(round_fruit=True, ground_colour=True)
+    got = _skin_seed(sl, part, _Depth(big_z), big_c, s, big_o, 1)
+    assert got is not None
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        assert _skin_seed(sl, part, _Depth(big_z), big_c, s, big_o, 1) is None
+        z_sl = big_z[sl]
+        window, mask, z_part = _blush_rim(sl, part, z_sl[part & (z_sl > 0)], _Depth(big_z), big_c, s, big_o, 1)
+    assert got[0] == window and got[1].dtype == bool and np.array_equal(got[1], mask) and got[2] == len(z_part)
+    if len(z_part) >= 20:
+        rows, cols = np.nonzero(mask)
+        want = (float(median(z_part)), int(mask.sum()), float(rows.mean()), float(cols.mean()))
+        assert np.array_equal(np.array(got[3:]).view(np.uint64), np.array(want).view(np.uint64))
+    if not front or holes > 0.9:
+        assert window == sl  # the ring at the crescent's depth, or too few depths to tell
+    elif holes == 0.0:
+        assert window != sl  # the ring in front taken
+    geo = _Geometry(600.0, h / 2, w / 2)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _round_skin, sl, part, _Depth(big_z), big_c, geo, s, big_o, 1)
+    assert fast[0] == twin[0] and np.array_equal(fast[1], twin[1])
+
+
+def test_the_round_piece_is_the_twins(monkeypatch):
+    """:func:`_jit.round_piece` on 600 random pieces (``_random_piece``) against the calls it stands for, with the
+    kernels and their numpy twins: ``red.any()`` and ``_ripe`` of ``part & weak`` (0: not ripe), then
+    ``_surface_hull`` and ``_depth_consistent`` against the red pixels (1 and the hull): the same answers and hulls."""
+    from symfruit.segment.colour import _pillow_fill, _ripe
+
+    if not _pillow_fill():
+        pytest.skip("the kernel follows Pillow 12.1's fill")
+    rng = np.random.default_rng(52)
+    unripe = hulls = 0
+    for t in range(600):
+        h, w = (int(v) for v in rng.integers(1, 41, 2))
+        part, weak, owner, color, z, vertices = _random_piece(rng, h, w)
+        if vertices is None:
+            continue
+        least = np.float32(rng.choice([0.2, 0.35, -1.0]))
+        red = part & weak
+        surface, jump = bool(t % 3), float(rng.choice([0.02, 0.05]))
+        state, hull = _jit.round_piece(color, part, weak, least, vertices, owner, 3, surface, z, jump)
+        if not (red.any() and _ripe(color, red, float(least))):
+            assert state == 0 and hull.shape == (0, 0)
+            unripe += 1
+            continue
+        assert state == 1
+        for twin in _both(monkeypatch, _twin_hull, vertices, part, owner, color, surface, red, z, jump):
+            np.testing.assert_array_equal(hull, twin)
+        hulls += 1
+    state, _ = _jit.round_piece(color, part, weak, np.float32(-1.0), vertices + 0.5, owner, 3, True, z, 0.02)
+    assert state == 2  # not whole numbers: Pillow's fill
+    assert unripe > 50 and hulls > 60
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_the_bridged_solid_is_the_twins(seed):
+    """:func:`_jit.bridged_solid` against the numpy trim and ``_bridged_skin``'s test (the trimmed skin's pixel count
+    below ``GROUND_SOLIDITY`` of ``_hull_area``, Pillow's fill, Qhull and numpy with the twins) on 300 skins
+    (``_trim_case``), and on random solidities: the same pixels and answers."""
+    from symfruit.segment.colour import _hull_area, _pillow_fill
+
+    if not _pillow_fill():
+        pytest.skip("the kernel follows Pillow 12.1's fill")
+    rng = np.random.default_rng(seed)
+    answers = set()
+    for _ in range(300):
+        skin, z, part, r0, c0 = _trim_case(rng)
+        solidity = float(rng.choice([0.75, rng.uniform(0.0, 1.2)]))
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = _trim_twin(skin, z, part, r0, c0)
+            want = 2 if twin.sum() < solidity * _hull_area(twin) else 1
+        got, state = _jit.bridged_solid(skin, z, part, r0, c0, solidity)
+        np.testing.assert_array_equal(got, twin)
+        assert state == want
+        answers.add(state)
+    assert answers == {1, 2}

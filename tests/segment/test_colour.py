@@ -1599,3 +1599,39 @@ def test_near_pieces_of_round_fruit_table_is_the_row_by_row_test(seed, monkeypat
     assert found == [rows(i) for i in range(len(pieces))]
     assert all(set(plain(i)) <= set(found[i]) for i in range(len(pieces)))
     assert sum(map(len, found)) > sum(len(plain(i)) for i in range(len(pieces)))
+
+
+@pytest.mark.parametrize("seed", [3, 5])
+def test_the_round_pieces_in_one_call_are_the_calls_labels(seed, monkeypatch):
+    """``_round_piece`` (a round fruit's found piece's ripe test, hull and depth test in one compiled call) and
+    ``_skin_seed`` (its skin's start: the part's depths, the blush rim's test, the median depth and centre in one; stop
+    52) give the labels that the calls they stand for give (both left out), on small rendered apple-tree frames with
+    the apple profile; and they took the pieces."""
+    import symfruit.segment.colour as colour
+    from symfruit.settings import resolve_settings
+    from symfruit.synthetic.scenes import make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    scene = make_tree_scene(seed, sensor=sensor_model("azure-kinect").at(480, 270), n_apples=12, n_green=2)
+    settings = resolve_settings(fruit="apple").segment
+    taken = {"_round_piece": 0, "_skin_seed": 0}
+
+    def counted(name):
+        fn = getattr(colour, name)
+
+        def call(*args, **kwargs):
+            found = fn(*args, **kwargs)
+            taken[name] += found is not None
+            return found
+
+        return call
+
+    for name in taken:
+        monkeypatch.setattr(colour, name, counted(name))
+    fast = segment(scene.color, scene.depth, scene.camera, settings)
+    for name in taken:
+        monkeypatch.setattr(colour, name, lambda *args, **kwargs: None)
+    np.testing.assert_array_equal(fast, segment(scene.color, scene.depth, scene.camera, settings))
+    assert fast.max() >= 3
+    kernels = pytest.importorskip("symfruit.core.kernels")
+    assert min(taken.values()) >= 3 or kernels.compiled() is None

@@ -9146,3 +9146,131 @@ def mask_mode(
     noise, kept, leaf, step = mask_values(depth[r0:r1, c0:c1], own, leaf_box, with_leafy, floor)
     front, radius, done = depth_mode(kept, radius_px, focal, noise, leaf, with_leafy, leafy_shares)
     return True, r0, r1, c0, c1, count, noise, kept, leaf, step, front, radius, done
+
+
+# --- stop 52, round52: the round fruit's pieces in fewer calls --------------------------------------------------------
+
+
+@_njit
+def hull_area_of(v: np.ndarray) -> float:
+    """:func:`symfruit.segment.colour._hull_area_of` of hull vertices ``v`` (m, 2) float64 (x, y), m >= 1: the
+    polygon's area (the shoelace sums ``x . roll(y, -1)`` and ``y . roll(x, -1)``) plus half its perimeter (numpy's
+    ``np.hypot`` of the edges, libm's ``hypot`` as numba calls it, summed pairwise as numpy sums) plus 1. The two dot
+    products are sums of whole numbers below 2 ** 53 when every vertex is a whole number of at most 2 ** 15 in size
+    (a hull's vertices are pixel centres): exact, so the same in any order as numpy's BLAS ``ddot`` sums them; -1.0
+    for other vertices (the twin's numpy then). The same value (stop 52)."""
+    m = v.shape[0]
+    for i in range(m):
+        for j in range(2):
+            a = v[i, j]
+            if not (abs(a) <= 32768.0 and a == math.floor(a)):
+                return -1.0
+    sx = 0.0
+    sy = 0.0
+    edges = np.empty(m)
+    for i in range(m):
+        n = i + 1 if i + 1 < m else 0
+        sx += v[i, 0] * v[n, 1]
+        sy += v[i, 1] * v[n, 0]
+        edges[i] = np.hypot(v[n, 0] - v[i, 0], v[n, 1] - v[i, 1])
+    area = 0.5 * abs(sx - sy)
+    perimeter = 0.0 + _pairwise_sum(edges, 0, m)
+    return area + 0.5 * perimeter + 1.0
+
+
+@_njit
+def skin_seed(
+    hull: np.ndarray,
+    z: np.ndarray,
+    r0: int,
+    c0: int,
+    color: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    pad: int,
+    jump: float,
+    ground_hue: int,
+    leaf_hue: int,
+    dark: int,
+) -> tuple[bool, np.ndarray, int, float, int, float, float]:
+    """:func:`symfruit.segment.colour._round_skin`'s start for a red part (``hull`` (h, w) bool, its window at row
+    ``r0`` and column ``c0`` of the window padded by ``pad`` about it, whose depth ``z`` float64, ``color`` uint8 and
+    ``owner`` ids are given): the part's depths (:func:`masked_depths`), :func:`blush_rim`'s test (made with 20 of
+    them or more), then what the growth starts from: whether the blush test moved the part to the padded window
+    (then the part with the ring's pixels beside it, else ``hull`` itself), how many depths it grows from (the part's,
+    or the ring pixels' taken), their median (:func:`median_values`, the twin's ``core.points.median``) and the
+    mask's :func:`mask_centre`. The twin's calls in one, the same values (stop 52)."""
+    h, w = hull.shape
+    _, z_part = masked_depths(hull, z[r0 : r0 + h, c0 : c0 + w])
+    mask = hull
+    moved = False
+    if z_part.shape[0] >= 20:
+        zh, zw = z.shape
+        part = np.zeros((zh, zw), np.bool_)
+        part[r0 : r0 + h, c0 : c0 + w] = hull
+        near = blush_rim(part, z, color, owner, k, pad, z_part, jump, ground_hue, leaf_hue, dark)
+        if near.shape[0] == zh and near.shape[1] == zw:
+            moved = True
+            mask = part | near
+            _, z_part = masked_depths(near, z)  # the ring's pixels all have depth: ``z[near]``
+    n = z_part.shape[0]
+    zm = median_values(z_part) if n >= 20 else np.nan
+    count, mr, mc = mask_centre(mask) if n >= 20 else (0, np.nan, np.nan)
+    return moved, mask, n, zm, count, mr, mc
+
+
+@_njit
+def round_piece(
+    color: np.ndarray,
+    part: np.ndarray,
+    weak: np.ndarray,
+    least: np.float32,
+    vertices: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    surface: bool,
+    z: np.ndarray,
+    jump: float,
+) -> tuple[int, np.ndarray]:
+    """:func:`symfruit.segment.colour._segment_at`'s first tests of a round fruit's found piece (``part`` (h, w) bool,
+    the ``k``-th) in one call: its red pixels ``part & weak`` ripe (:func:`red_ripe` in ``color`` (h, w, 3) uint8
+    against ``least``; none: not), then its hull (:func:`surface_hull` of the hull ``vertices`` over ``owner``'s
+    window) less the pixels far from the red pixels' median depth in ``z`` (h, w) float64 (:func:`depth_consistent`).
+    Returns 0 and a (0, 0) array (not ripe), 1 and the hull, or 2 (a vertex not a whole number: the twin's Pillow
+    then). The twin's calls in one, the same answer and pixels (stop 52)."""
+    h, w = part.shape
+    red = np.empty((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            red[r, c] = part[r, c] and weak[r, c]
+    if not red_ripe(color, red, least):
+        return 0, np.zeros((0, 0), np.bool_)
+    hull = surface_hull(vertices, part, owner, k, color, surface)
+    if hull.shape[0] != h or hull.shape[1] != w:
+        return 2, hull
+    return 1, depth_consistent(hull, red, z, jump)
+
+
+@_njit
+def bridged_solid(
+    skin: np.ndarray, z: np.ndarray, part: np.ndarray, r0: int, c0: int, solidity: float
+) -> tuple[np.ndarray, int]:
+    """:func:`bridged_trim` of a skin grown over bridged depth, then :func:`symfruit.segment.colour._bridged_skin`'s
+    test of the trimmed skin: whether its pixel count falls below ``solidity`` times its hull's area
+    (:func:`hull_vertices`, :func:`hull_area_of`; the count itself without a hull). Returns the skin and 0 (the trim
+    not worked out: the twin's numpy then, the skin as given), 1 (the skin one convex outline), 2 (it is not) or 3
+    (the area not worked out: a vertex not a whole number). The twin's calls in one, the same pixels and answer
+    (stop 52)."""
+    out, done = bridged_trim(skin, z, part, r0, c0)
+    if not done:
+        return out, 0
+    h, w = out.shape
+    count = 0
+    for r in range(h):
+        for c in range(w):
+            count += out[r, c]
+    v = hull_vertices(out)
+    area = float(count) if len(v) == 0 else hull_area_of(v)
+    if area < 0.0:
+        return out, 3
+    return out, 2 if count < solidity * area else 1

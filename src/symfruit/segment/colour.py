@@ -406,9 +406,14 @@ def _hull_area(mask: np.ndarray) -> float:
 
 def _hull_area_of(v: np.ndarray | None, mask: np.ndarray) -> float:
     """:func:`_hull_area` from the mask's :func:`_hull_vertices` (each vertex's successor by one concatenation:
-    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead)."""
+    the values of ``np.roll(x, -1)`` and ``np.diff(x, append=x[0])``, without their calls' overhead). Where numba is,
+    in one call for whole-number vertices (:func:`symfruit.core._jit.hull_area_of`: the same value; stop 52)."""
     if v is None:
         return float(mask.sum())
+    if (jit := compiled()) is not None and v.ndim == 2 and len(v) and v.shape[1] == 2 and v.dtype == np.float64:
+        area = float(jit.hull_area_of(v))  # the same value in one call (stop 52, round52)
+        if area >= 0.0:
+            return area
     x, y = v[:, 0], v[:, 1]
     xn, yn = np.concatenate((x[1:], x[:1])), np.concatenate((y[1:], y[:1]))
     area = 0.5 * abs(float(np.dot(x, yn) - np.dot(y, xn)))
@@ -637,22 +642,28 @@ def _segment_at(
             if isinstance(plain, np.ndarray) and (claimed := _claim(out[sl], plain)) is not None:  # (stop 49)
                 found.append((sl, *claimed))
             continue
-        red = part & weak[sl]
-        if not red.any() or not _ripe(c[sl], red, s.ripe_median):
-            continue
         sub_z = None if z is None else z[sl]
-        surface = s.fill == "surface" or (s.fill == "auto" and sub_z is not None)
-        hull = _surface_hull(piece.hull_vertices(), part, owner[sl], k, c[sl], surface)
-        if sub_z is not None:
-            hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
-            if s.round_fruit and z is not None:  # the rest of a round fruit's skin
-                if bridged is not None:  # across the depth camera's invalid bands (stop 47)
-                    sl, hull = _bridged_skin(sl, hull, z, bridged, c, geo, s, owner, k)
-                else:
-                    sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
-                if body_map is not None:
-                    sl, hull = _join_bodies(sl, hull, bodies, body_map, taken, z, geo, s)
-                sub_z = z[sl]
+        tested = _round_piece(piece, k, c, weak, owner, z, s) if z is not None and s.round_fruit else None
+        if tested is False:  # not ripe (stop 52)
+            continue
+        if isinstance(tested, np.ndarray):  # the hull of a ripe round fruit's piece, in one call (stop 52)
+            hull = tested
+        else:
+            red = part & weak[sl]
+            if not red.any() or not _ripe(c[sl], red, s.ripe_median):
+                continue
+            surface = s.fill == "surface" or (s.fill == "auto" and sub_z is not None)
+            hull = _surface_hull(piece.hull_vertices(), part, owner[sl], k, c[sl], surface)
+            if sub_z is not None:
+                hull = _depth_consistent(hull, red, sub_z, s.depth_jump)
+        if s.round_fruit and z is not None:  # the rest of a round fruit's skin
+            if bridged is not None:  # across the depth camera's invalid bands (stop 47)
+                sl, hull = _bridged_skin(sl, hull, z, bridged, c, geo, s, owner, k)
+            else:
+                sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
+            if body_map is not None:
+                sl, hull = _join_bodies(sl, hull, bodies, body_map, taken, z, geo, s)
+            sub_z = z[sl]
         if not _fruit_sized(hull, sub_z, s, geo.focal, min_area, z_typical):
             continue
         if sub_z is None and _elongation(hull) > s.max_elongation:  # with depth, a sliver seen past a leaf is kept
@@ -1890,24 +1901,32 @@ def _round_skin(
     fruit's skin (bark or a branch at the fruit's depth joined it) and the part is kept as it was. With
     ``ground_colour``, a red part that is a blush along a fruit's rim carrying the depth of what lies behind grows
     from the depth of the ground colour beside it (:func:`_blush_rim`). Returns the grown window and mask."""
-    if s.ground_colour and k > 0 and isinstance(depth, _BridgedDepth):
-        depth[_pad(sl, GAP_PX, depth.shape)]  # :func:`_blush_rim`'s window first: the part's is cut from it (treeseg49)
-    z_sl = depth[sl]
     jit = compiled()
-    z_part = jit.masked_depths(hull, z_sl)[1] if jit is not None and hull.dtype == bool else z_sl[hull & (z_sl > 0)]
-    if s.ground_colour and k > 0:  # a red part's blush along the rim: the depth of the apple beside it
-        sl, hull, z_part = _blush_rim(sl, hull, z_part, depth, color, s, owner, k)
-    if len(z_part) < 20:
-        return sl, hull
-    if jit is not None and hull.dtype == bool:  # the count and mean row and column, the same values
-        count, mr, mc = jit.mask_centre(hull)
+    seed = _skin_seed(sl, hull, depth, color, s, owner, k) if s.ground_colour and k > 0 else None
+    if seed is not None:  # the part's start in one call (stop 52, round52)
+        sl, hull, n, zm, count, mr, mc = seed
+        if n < 20:
+            return sl, hull
         rc, cc = mr + sl[0].start, mc + sl[1].start
         own = float(np.sqrt(count / np.pi))
     else:
-        rows, cols = np.nonzero(hull)
-        rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
-        own = float(np.sqrt(hull.sum() / np.pi))
-    zm = float(median(z_part))
+        if s.ground_colour and k > 0 and isinstance(depth, _BridgedDepth):
+            depth[_pad(sl, GAP_PX, depth.shape)]  # :func:`_blush_rim`'s window first: the part's is cut from it
+        z_sl = depth[sl]
+        z_part = jit.masked_depths(hull, z_sl)[1] if jit is not None and hull.dtype == bool else z_sl[hull & (z_sl > 0)]
+        if s.ground_colour and k > 0:  # a red part's blush along the rim: the depth of the apple beside it
+            sl, hull, z_part = _blush_rim(sl, hull, z_part, depth, color, s, owner, k)
+        if len(z_part) < 20:
+            return sl, hull
+        if jit is not None and hull.dtype == bool:  # the count and mean row and column, the same values
+            count, mr, mc = jit.mask_centre(hull)
+            rc, cc = mr + sl[0].start, mc + sl[1].start
+            own = float(np.sqrt(count / np.pi))
+        else:
+            rows, cols = np.nonzero(hull)
+            rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
+            own = float(np.sqrt(hull.sum() / np.pi))
+        zm = float(median(z_part))
     reach = ROUND_REACH * own
     deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
     big, z, skin = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, reach, deep_limit, zm))
@@ -1920,6 +1939,29 @@ def _round_skin(
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
+
+
+def _skin_seed(
+    sl: Window, hull: np.ndarray, depth: _Depth, color: np.ndarray, s: SegmentSettings, owner: np.ndarray, k: int
+) -> tuple[Window, np.ndarray, int, float, int, float, float] | None:
+    """:func:`_round_skin`'s start for a red part (``hull`` in window ``sl``, the ``k``-th piece, with
+    ``ground_colour``) in one compiled call where numba is (:func:`symfruit.core._jit.skin_seed`: the part's depths,
+    :func:`_blush_rim`'s test in the window padded by :data:`GAP_PX`, the median depth and the centre it grows from),
+    not five calls and their arrays: the window and mask it grows from, how many depths it has, their median, the
+    mask's pixel count and mean row and column in its window. None where the calls are to be made (no numba, other
+    types). The same values (stop 52, round52)."""
+    jit = compiled()
+    if jit is None or hull.dtype != bool or hull.ndim != 2 or color.dtype != np.uint8 or color.ndim != 3:
+        return None
+    big = _pad(sl, GAP_PX, depth.shape)  # read first: the part's own window is cut from it (treeseg49)
+    z = depth[big]
+    if z.dtype != np.float64:
+        return None
+    moved, mask, n, zm, count, mr, mc = jit.skin_seed(
+        np.ascontiguousarray(hull), z, sl[0].start - big[0].start, sl[1].start - big[1].start, color[big], owner[big],
+        int(k), GAP_PX, float(s.depth_jump), GROUND_HUE, LEAF_HUE, GROUND_DARK)  # fmt: skip
+    return (big, mask, int(n), float(zm), int(count), float(mr), float(mc)) if moved else (
+        sl, hull, int(n), float(zm), int(count), float(mr), float(mc))  # fmt: skip
 
 
 def _at_reach(skin: np.ndarray, big: Window, rc: float, cc: float, reach: float) -> bool:
@@ -2442,6 +2484,26 @@ def _plain_piece(
     return hull if _sized(int(area), float(zm) if valid else z_typical, s, focal) else False
 
 
+def _round_piece(
+    piece: _Piece, k: int, c: np.ndarray, weak: np.ndarray, owner: np.ndarray, z: _Depth, s: SegmentSettings
+) -> np.ndarray | bool | None:
+    """:func:`_segment_at`'s first tests of a round fruit's found ``piece`` (the ``k``-th) with depth in one compiled
+    call where numba is (:func:`symfruit.core._jit.round_piece`: its red pixels ripe, its surface hull, the hull's
+    depth test), not three calls and their masks: the hull, False when the piece is not ripe, None where the calls
+    are to be made (no numba, other types, a hull that Pillow fills). The same hull and answer (stop 52, round52)."""
+    jit = compiled()
+    sl, part = piece.window, piece.mask
+    if jit is None or c.dtype != np.uint8 or part.dtype != bool or part.ndim != 2 or not _pillow_fill():
+        return None
+    vertices = piece.hull_vertices()
+    sub_z = z[sl]
+    if vertices is None or vertices.dtype != np.float64 or sub_z.dtype != np.float64:
+        return None
+    state, hull = jit.round_piece(c[sl], part, weak[sl], np.float32(s.ripe_median), vertices, owner[sl], int(k),
+                                  s.fill in ("surface", "auto"), sub_z, float(s.depth_jump))  # fmt: skip
+    return hull if state == 1 else False if state == 0 else None
+
+
 def _least_areas(labels: np.ndarray, depth: np.ndarray, n: int, diameter_px_m: float, z_typical: float) -> np.ndarray:
     """(n + 1,) the least fruit's area (pixels) at each labelled region's mean depth (``z_typical`` for
     regions without depth), from the labels ``1..n`` of a window's region pixels and their depths (in the
@@ -2612,15 +2674,15 @@ def _bridged_skin(
     z = depth[grown_sl]
     r0, c0 = sl[0].start - grown_sl[0].start, sl[1].start - grown_sl[1].start
     jit = compiled()
-    done = False
+    state = 0
     if jit is not None and skin.dtype == part.dtype == bool and z.dtype == np.float64 and _pillow_fill():
         # the same pixels in one call, no hull where the skin has depth throughout (:func:`symfruit.core._jit.
-        # bridged_trim`; stop 49, treeseg49)
-        skin, done = jit.bridged_trim(skin, z, part, r0, c0)
-    if not done:
+        # bridged_trim`; stop 49, treeseg49), and the test below (:func:`symfruit.core._jit.bridged_solid`; stop 52)
+        skin, state = jit.bridged_solid(skin, z, part, r0, c0, GROUND_SOLIDITY)
+    if state == 0:
         core = skin & (z > 0)
         core[r0 : r0 + part.shape[0], c0 : c0 + part.shape[1]] |= part
         skin = skin & ((z > 0) | convex_hull_mask(core))
-    if skin.sum() < GROUND_SOLIDITY * _hull_area(skin):
+    if state == 2 or (state in (0, 3) and skin.sum() < GROUND_SOLIDITY * _hull_area(skin)):
         return _round_skin(sl, part, depth, color, geo, s, owner, k)
     return grown_sl, skin
