@@ -140,15 +140,19 @@ def test_slab44_spur_leaves_lie_around_an_apple_at_its_own_depth():
     assert np.array_equal(c, sl.spur_leaf_centres(centre, 0.04, 500, np.random.default_rng(3)))
 
 
-def test_speed_profile_profiles_the_segmenter_on_tree_frames(tmp_path):
-    """``speed_profile.py --trees N`` (stop 51): the colour segmenter alone on N apple-tree frames, figures per frame
-    (one ``segment`` call a frame)."""
+def _speed_profile(tmp_path, *args: str) -> list[str]:
+    """``docs/speed_profile.py ARGS`` run from ``tmp_path`` with this tree's sources: its printed lines."""
     env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPATH": str(DOCS.parent / "src")}
-    args = ["--only", "colour.segment", "--trees", "1", "--frames", "2", "--top", "5"]
     done = subprocess.run([sys.executable, str(DOCS / "speed_profile.py"), *args], cwd=tmp_path, env=env,
                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert done.returncode == 0, done.stderr[-2000:]
-    lines = done.stdout.splitlines()
+    return done.stdout.splitlines()
+
+
+def test_speed_profile_profiles_the_segmenter_on_tree_frames(tmp_path):
+    """``speed_profile.py --trees N`` (stop 51): the colour segmenter alone on N apple-tree frames, figures per frame
+    (one ``segment`` call a frame)."""
+    lines = _speed_profile(tmp_path, "--only", "colour.segment", "--trees", "1", "--frames", "2", "--top", "5")
     assert lines[0].endswith("(2 frames)")
     assert any(line.endswith("1.0 calls  symfruit.segment.colour.segment") for line in lines[1:])
 
@@ -157,12 +161,8 @@ def test_speed_profile_gives_own_times(tmp_path):
     """``speed_profile.py --self`` (stop 52): each function's own time, less the wrapped functions it calls: the
     segmenter's entry point, nearly all of whose time is ``_segment_at``'s, then reads far less than it, and the
     kernels' and the rest's sums are printed."""
-    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1", "PYTHONPATH": str(DOCS.parent / "src")}
-    args = ["--only", "colour.segment", "colour._segment_at", "--trees", "1", "--frames", "1", "--self"]
-    done = subprocess.run([sys.executable, str(DOCS / "speed_profile.py"), *args], cwd=tmp_path, env=env,
-                          capture_output=True, text=True, timeout=600)  # fmt: skip
-    assert done.returncode == 0, done.stderr[-2000:]
-    lines = done.stdout.splitlines()
+    lines = _speed_profile(tmp_path, "--only", "colour.segment", "colour._segment_at", "--trees", "1", "--frames", "1",
+                           "--self")  # fmt: skip
     assert lines[1].startswith("own times: the kernels 0.00 ms, the rest ")
     own = {line.split()[-1]: float(line.split()[0]) for line in lines[2:]}
     assert own["symfruit.segment.colour.segment"] < 0.5 * own["symfruit.segment.colour._segment_at"]
