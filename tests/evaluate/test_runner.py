@@ -193,3 +193,30 @@ def test_scans_are_grouped_by_scan():
     rows = [row(fruit="/data/scans", kind="scan/pear", pose=0), row(fruit="/data/scans", kind="scan/banana", pose=1)]
     assert {s["fruit"] for s in summarise(rows)} == {"scan/pear", "scan/banana"}
     assert rows[0].label == "scan/pear" and row().label == "apple"
+
+
+def _blas_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return sorted({info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"})
+
+
+def test_a_worker_runs_numpys_blas_on_one_thread():
+    """Stop 52: a forked worker inherits the BLAS threads numpy's OpenBLAS started with (OPENBLAS_NUM_THREADS set
+    after the fork no longer reaches it); the workers' initializer limits them by threadpoolctl. The parent is
+    given two threads here (the test processes run with one), so a worker that kept them would say 2."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from symfruit.evaluate.runner import _single_thread
+
+    fork = multiprocessing.get_context("fork")  # the runner's workers on Linux (Python's default there before 3.14)
+
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() != [2]:
+            pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
+            assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork, initializer=_single_thread) as pool:
+            assert pool.submit(_blas_threads).result() == [1]
