@@ -215,7 +215,7 @@ def _single_thread() -> None:
 
     The variables reach what the worker loads from now on; numpy's OpenBLAS, loaded before the fork, is limited
     directly by threadpoolctl (the ``fast`` extra). Without it the worker keeps the parent's BLAS threads: two
-    workers on two cores ran four, 10-18 % slower (stop 52; README "Speed")."""
+    workers on two cores ran four, about 10 % slower (stop 52; README "Speed")."""
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ.setdefault(var, "1")
     try:
