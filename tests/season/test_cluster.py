@@ -203,53 +203,43 @@ def test_what_the_cluster_cannot_do_is_refused_before_anything_runs(recording, t
     assert not (tmp_path / "o" / "errors.json").exists()
 
 
-@pytest.mark.parametrize("seconds", ["0", "-5", "0.5", "nan", "inf", "1e9", "86401"])
-def test_a_no_worker_timeout_out_of_its_bounds_is_refused_before_anything_runs(recording, tmp_path, capsys, seconds):
+#: The cluster's two time-outs: option, least seconds, what it sets (as its refusals say), values out of bounds.
+TIMEOUTS = [
+    ("--no-worker-timeout", 1, "the wait for a Dask worker", ["0", "-5", "0.5", "nan", "inf", "1e9", "86401"]),
+    ("--silent-worker-timeout", 10, "when a Dask worker not heard from counts as none",
+     ["0", "-5", "9.9", "nan", "inf", "86401"]),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("option", "least", "seconds"), [(option, least, seconds) for option, least, _, out in TIMEOUTS for seconds in out]
+)
+def test_a_worker_timeout_out_of_its_bounds_is_refused_before_anything_runs(recording, tmp_path, capsys, option,
+                                                                           least, seconds):  # fmt: skip
     """Stop 51 (robust51): the wait for a worker was a module constant (60 s, a local cluster 300 s); now
-    --no-worker-timeout sets it, 1 s to a day, refused before the inputs are read or a cluster started."""
-    argv = ["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "1", "--no-worker-timeout"]
+    --no-worker-timeout sets it, 1 s to a day. Stop 52 (robust52): so does --silent-worker-timeout the time after
+    which a worker not heard from counts as none (SILENT_WORKER_S, 60 s), 10 s (twice Dask's longest heartbeat) to
+    a day. Each refused before the inputs are read or a cluster started."""
+    argv = ["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "1", option]
     assert main([*argv, seconds]) == 2
-    assert f"--no-worker-timeout must be between 1 and 86400 s, got {float(seconds)!r}" in capsys.readouterr().err
-    with pytest.raises(InputError, match=r"--no-worker-timeout must be between 1 and 86400 s"):
-        run_distributed(recording, tmp_path / "o", workers=1, no_worker_timeout=float(seconds))
+    assert f"{option} must be between {least} and 86400 s, got {float(seconds)!r}" in capsys.readouterr().err
+    keyword = option.lstrip("-").replace("-", "_")
+    with pytest.raises(InputError, match=rf"{option} must be between {least} and 86400 s"):
+        run_distributed(recording, tmp_path / "o", workers=1, **{keyword: float(seconds)})
     assert not (tmp_path / "o").exists()
 
 
-def test_a_no_worker_timeout_without_a_cluster_is_refused_not_ignored(recording, tmp_path, capsys):
-    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--no-worker-timeout", "30"]) == 2
-    assert "--no-worker-timeout (the wait for a Dask worker) is for --scheduler or --workers" in capsys.readouterr().err
-    with pytest.raises(InputError, match=r"no_worker_timeout \(--no-worker-timeout\) is for a Dask cluster"):
-        run_batch(recording, tmp_path / "o", no_worker_timeout=30)
+@pytest.mark.parametrize(("option", "what"), [(option, what) for option, _, what, _ in TIMEOUTS])
+def test_a_worker_timeout_without_a_cluster_is_refused_not_ignored(recording, tmp_path, capsys, option, what):
+    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), option, "30"]) == 2
+    assert f"{option} ({what}) is for --scheduler or --workers" in capsys.readouterr().err
+    keyword = option.lstrip("-").replace("-", "_")
+    with pytest.raises(InputError, match=rf"{keyword} \({option}\) is for a Dask cluster"):
+        run_batch(recording, tmp_path / "o", **{keyword: 30})
     assert not (tmp_path / "o").exists()
     with pytest.raises(SystemExit):
         main(["detect", "--help"])
-    assert "--no-worker-timeout S" in " ".join(capsys.readouterr().out.split())
-
-
-@pytest.mark.parametrize("seconds", ["0", "-5", "9.9", "nan", "inf", "86401"])
-def test_a_silent_worker_timeout_out_of_its_bounds_is_refused_before_anything_runs(recording, tmp_path, capsys,
-                                                                                  seconds):  # fmt: skip
-    """Stop 52 (robust52): the time after which a worker not heard from counts as none was a module constant
-    (SILENT_WORKER_S, 60 s); now --silent-worker-timeout sets it, 10 s (twice Dask's longest heartbeat) to a day,
-    refused before the inputs are read or a cluster started."""
-    argv = ["detect", str(recording), "--output", str(tmp_path / "o"), "--workers", "1", "--silent-worker-timeout"]
-    assert main([*argv, seconds]) == 2
-    assert f"--silent-worker-timeout must be between 10 and 86400 s, got {float(seconds)!r}" in capsys.readouterr().err
-    with pytest.raises(InputError, match=r"--silent-worker-timeout must be between 10 and 86400 s"):
-        run_distributed(recording, tmp_path / "o", workers=1, silent_worker_timeout=float(seconds))
-    assert not (tmp_path / "o").exists()
-
-
-def test_a_silent_worker_timeout_without_a_cluster_is_refused_not_ignored(recording, tmp_path, capsys):
-    assert main(["detect", str(recording), "--output", str(tmp_path / "o"), "--silent-worker-timeout", "30"]) == 2
-    assert ("--silent-worker-timeout (when a Dask worker not heard from counts as none) is for --scheduler or "
-            "--workers") in capsys.readouterr().err  # fmt: skip
-    with pytest.raises(InputError, match=r"silent_worker_timeout \(--silent-worker-timeout\) is for a Dask cluster"):
-        run_batch(recording, tmp_path / "o", silent_worker_timeout=30)
-    assert not (tmp_path / "o").exists()
-    with pytest.raises(SystemExit):
-        main(["detect", "--help"])
-    assert "--silent-worker-timeout S" in " ".join(capsys.readouterr().out.split())
+    assert f"{option} S" in " ".join(capsys.readouterr().out.split())
 
 
 def test_a_worker_counts_while_it_runs_and_is_heard_from():
