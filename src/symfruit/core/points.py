@@ -336,7 +336,7 @@ def _shuffled(population: int, size: int) -> bool:
     False where numpy 2's choice takes the same branch either way (issue 19, stop 53): Floyd's algorithm (a
     population of at most 10,000, or a size at most a fiftieth of it), whose ``shuffle`` only permutes the drawn
     values after drawing them, or the tail shuffle (a size above a twentieth), which does not read it; the same
-    values, so the same sorted rows, without shuffling them (about 5 us for 1,000 of 3,000). True (choice's default)
+    values, so the same sorted rows, without shuffling them (docs/complete53.md). True (choice's default)
     between the two cut-offs, where ``shuffle`` picks the branch."""
     return 10_000 < population and population // 50 < size <= population // 20
 
