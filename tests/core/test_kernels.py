@@ -7178,3 +7178,52 @@ def test_the_bridged_solid_is_the_twins(seed):
         assert state == want
         answers.add(state)
     assert answers == {1, 2}
+
+
+# --- stop 53, complete53 ---
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    h=st.integers(0, 40),
+    w=st.integers(0, 70),
+    share=st.sampled_from([0.0, 0.002, 0.02, 0.3, 1.0]),
+    seed=st.integers(0, 2**16),
+)
+def test_mask_box_is_the_twins(h, w, share, seed):
+    """:func:`_jit.mask_box` against its numpy twin (``raster._mask_box``: the reductions and ``nonzero``) on random
+    masks of 0-40 by 0-70 pixels, empty to full, with a lone pixel or a blob placed anywhere (at the edges too), and
+    as the byte values numpy may hold in a bool image (not 0 or 1): the same box, None where none is true; the
+    strided view takes the twin and gives the same."""
+    from symfruit.core.raster import _mask_box, mask_box
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random((h, w)) < share
+    if h and w and seed % 3 == 0:  # a lone pixel or a small blob anywhere
+        r, c = int(rng.integers(0, h)), int(rng.integers(0, w))
+        mask[max(r - 1, 0) : r + int(rng.integers(1, 3)), c : c + int(rng.integers(1, 4))] = True
+    found, r0, r1, c0, c1 = _jit.mask_box(mask)
+    want = _mask_box(mask)
+    assert (want is None and not found and (r0, r1, c0, c1) == (0, 0, 0, 0)) or (found and (r0, r1, c0, c1) == want)
+    assert mask_box(mask) == want
+    assert mask_box(mask[:, ::2]) == _mask_box(mask[:, ::2])  # not C-ordered: the twin
+    bytes_ = mask.view(np.uint8) * np.uint8(1 + seed % 200)  # true pixels held as other bytes than 1
+    odd = bytes_.view(bool)
+    found, r0, r1, c0, c1 = _jit.mask_box(odd)
+    assert (None if not found else (r0, r1, c0, c1)) == _mask_box(odd) == want
+
+
+def test_mask_box_known_answers():
+    """A blob's box, a lone pixel in each corner, a full and an empty image, a row and a column."""
+    m = np.zeros((6, 8), bool)
+    m[1:3, 2:7] = True
+    assert _jit.mask_box(m) == (True, 1, 3, 2, 7)
+    for r, c in ((0, 0), (0, 7), (5, 0), (5, 7)):
+        m = np.zeros((6, 8), bool)
+        m[r, c] = True
+        assert _jit.mask_box(m) == (True, r, r + 1, c, c + 1)
+    assert _jit.mask_box(np.ones((3, 4), bool)) == (True, 0, 3, 0, 4)
+    assert _jit.mask_box(np.zeros((3, 4), bool))[0] is False
+    assert _jit.mask_box(np.zeros((0, 4), bool))[0] is False
+    assert _jit.mask_box(np.ones((1, 9), bool)) == (True, 0, 1, 0, 9)
+    assert _jit.mask_box(np.ones((9, 1), bool)) == (True, 0, 9, 0, 1)

@@ -283,6 +283,19 @@ def test_subsample_draws_as_a_new_generator_does():
     )
 
 
+@pytest.mark.parametrize("size", [10, 3000, 10_000, 10_001, 20_000, 20_049, 50_000])
+def test_subsample_is_a_shuffled_choices_rows_about_the_cut_offs(size):
+    """Without the drawn values' shuffle where numpy's choice takes the same branch either way, the same rows as the
+    shuffled choice sorted: sizes at, below and above a fiftieth and a twentieth of populations about 10,000 (between
+    those cut-offs the branch is the shuffle's: it fails when the shuffle is left out there too)."""
+    idx = np.arange(size, dtype=np.float64)
+    counts = {1, 2, size // 50, size // 50 + 1, size // 20, size // 20 + 1, size // 3, size - 1}
+    for n in sorted(c for c in counts if 1 <= c < size):
+        for seed in (0, 5):
+            want = np.sort(np.random.default_rng(seed).choice(size, size=n, replace=False))
+            np.testing.assert_array_equal(subsample(idx, n, seed=seed), want.astype(np.float64))
+
+
 def test_subsample_takes_the_indexed_rows():
     """The rows ``take`` copies are the indexed rows, byte for byte: of a strided view, of float32 points, of a
     column-ordered array; a 1-D array's elements likewise."""

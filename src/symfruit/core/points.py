@@ -240,19 +240,22 @@ def check_cloud(
             lo, hi, scatter = jit.cloud_spread(arr)
         else:
             lo, hi = bounds(arr)
-    if lo[2] <= 0:  # the least depth (the bounds are numpy's minima and maxima exactly)
+    # the tests below in Python floats (issue 19, stop 53): the same comparisons, differences and greatest values as
+    # numpy's on the (3,) bounds (finite: the rows that are not were dropped above)
+    lo_, hi_ = lo.tolist(), hi.tolist()
+    if lo_[2] <= 0:  # the least depth (the bounds are numpy's minima and maxima exactly)
         behind = int((arr[:, 2] <= 0).sum())
         raise InputError(
             f"{behind} of {len(arr)} points are at or behind the camera (z <= 0); points must be in "
             "the camera optical frame (x right, y down, z forward), in metres"
         )
-    extent = float((hi - lo).max())
+    extent = max(b - a for a, b in zip(lo_, hi_, strict=True))
     if extent > max_extent:
         raise InputError(
             f"the cloud is {extent:.3g} m across, too large for one fruit ({key}max_extent = {max_extent} m); "
             "if it is in millimetres, use --units mm (or divide by 1000)"
         )
-    reach = float(np.abs(np.concatenate([lo, hi])).max())
+    reach = max(abs(x) for x in lo_ + hi_)
     if reach > MAX_DEPTH_METRES:  # a fruit-sized cloud a kilometre off: beyond any depth camera, a wrong origin
         raise InputError(
             f"the points lie up to {reach:.3g} m from the camera, beyond any depth camera's reach "
@@ -266,7 +269,7 @@ def check_cloud(
             f"{min_extent * 1000:g} mm); check the units (--units m for metres)"
         )
     # after the extents: a cloud in metres read as millimetres (--units mm) is told its units, not its depth
-    if lo[2] < MIN_DEPTH_METRES:
+    if lo_[2] < MIN_DEPTH_METRES:
         near = int((arr[:, 2] < MIN_DEPTH_METRES).sum())
         raise InputError(
             f"{near} of {len(arr)} points are nearer the camera than {MIN_DEPTH_METRES * 1000:g} mm (z as small as "
@@ -275,12 +278,12 @@ def check_cloud(
     if scatter is None:
         centred = arr - mean_point(arr)
         scatter = centred.T @ centred
-    spread = lapack.eigvalsh(scatter)  # ascending variances (times n)
-    if spread[2] <= 1e-18 * len(arr):
+    s0, s1, s2 = lapack.eigvalsh(scatter).tolist()  # ascending variances (times n)
+    if s2 <= 1e-18 * len(arr):
         raise InputError("all points are identical; a fruit needs points spread over its surface")
-    if spread[1] <= 1e-12 * spread[2]:
+    if s1 <= 1e-12 * s2:
         raise InputError("all points lie on a line; a fruit needs points spread over its surface")
-    if spread[0] <= 1e-12 * spread[2]:
+    if s0 <= 1e-12 * s2:
         raise InputError(
             "all points lie on a plane; a fruit's visible surface is curved (is this a depth image "
             "of a flat object, or a cloud with its depth dropped?)"
@@ -322,10 +325,20 @@ def subsample(points: np.ndarray, n: int | None, *, seed: int = 0) -> np.ndarray
     same subset), in the original order; ``points`` itself when it is small enough or ``n`` is None."""
     if n is None or len(points) <= n:
         return points
-    keep = np.sort(_generator(seed).choice(len(points), size=n, replace=False))
+    keep = np.sort(_generator(seed).choice(len(points), size=n, replace=False, shuffle=_shuffled(len(points), n)))
     # take along the first axis: the same rows as indexing by ``keep``, without the general indexing's set-up (2 against
     # 10 us for a dense view's 1,000 of 14,000 points; issue 19, stop 48)
     return points.take(keep, axis=0) if isinstance(points, np.ndarray) else points[keep]
+
+
+def _shuffled(population: int, size: int) -> bool:
+    """``shuffle`` for :func:`subsample`'s ``Generator.choice(population, size, replace=False)`` whose rows it sorts:
+    False where numpy 2's choice takes the same branch either way (issue 19, stop 53): Floyd's algorithm (a
+    population of at most 10,000, or a size at most a fiftieth of it), whose ``shuffle`` only permutes the drawn
+    values after drawing them, or the tail shuffle (a size above a twentieth), which does not read it; the same
+    values, so the same sorted rows, without shuffling them (docs/complete53.md). True (choice's default)
+    between the two cut-offs, where ``shuffle`` picks the branch."""
+    return 10_000 < population and population // 50 < size <= population // 20
 
 
 #: Per thread: ``{seed: (generator, its state when new)}`` (:func:`_generator`).

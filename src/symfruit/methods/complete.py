@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -222,12 +223,14 @@ def complete(
 
 def _check_completion(box: Box, visible: np.ndarray, method: str, max_extent: float) -> None:
     """A completed box must be finite, hold the visible points and stay a fruit's size."""
-    size = box.size
-    if not (np.all(np.isfinite(box.min)) and np.all(np.isfinite(box.max))):
+    # in Python floats (issue 19, stop 53): the same tests and size as numpy's on the (3,) float64 corners
+    lo, hi = box.min.tolist(), box.max.tolist()
+    if not (all(map(math.isfinite, lo)) and all(map(math.isfinite, hi))):
         raise InputError(f"method {method!r} gave a non-finite box for these points (degenerate geometry)")
-    if size.max() > max_extent:
+    size = max(b - a for a, b in zip(lo, hi, strict=True))
+    if size > max_extent:
         raise InputError(
-            f"method {method!r} completed these points to a box {size.max():.3g} m across, larger than one fruit "
+            f"method {method!r} completed these points to a box {size:.3g} m across, larger than one fruit "
             f"(input.max_extent = {max_extent} m): the visible points do not constrain a fruit (degenerate geometry)"
         )
 
