@@ -279,7 +279,7 @@ class FruitPool:
     # ---- workers ------------------------------------------------------------------------------------------------
 
     def _start(self) -> None:
-        ctx = multiprocessing.get_context(self.start_method)
+        ctx: Any = multiprocessing.get_context(self.start_method)
         self._lock, self._counter = ctx.Lock(), ctx.RawValue("q", 0)
         for _ in range(self.processes):
             here, there = ctx.Pipe(duplex=True)
@@ -467,7 +467,7 @@ def _main_hidden() -> Iterator[None]:
     if main is None:
         yield
         return
-    saved = {key: main.__dict__[key] for key in ("__file__", "__spec__") if key in main.__dict__}
+    saved: dict[str, Any] = {key: main.__dict__[key] for key in ("__file__", "__spec__") if key in main.__dict__}
     main.__dict__.pop("__file__", None)
     main.__dict__["__spec__"] = None
     try:
@@ -588,7 +588,7 @@ def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: d
            lock: Any, counter: Any, outbox: queue.SimpleQueue[bytes | None]) -> None:  # fmt: skip
     """One frame's share: fruit taken from the shared counter until none is left, each answer queued for the
     sender, then the frame's end. ``kind``: the per-fruit task's class (``detect``'s ``_Fruit``)."""
-    fruit = object.__new__(kind)
+    fruit: Any = object.__new__(kind)
     arrays = {key: None if at is None else np.ndarray(at[2], at[1], buffer=buf, offset=at[0])
               for key, at in layout.items()}  # fmt: skip
     fruit.__dict__.update(rest, **arrays)
@@ -608,7 +608,7 @@ def _send_all(conn: Any, outbox: queue.SimpleQueue[bytes | None]) -> None:
 def _map(name: str, size: int) -> mmap.mmap:
     """The caller's segment ``name`` mapped here without registering it with the resource tracker (the caller
     unlinks it; a worker's registration would unlink it when the worker ends, or warn)."""
-    import _posixshmem
+    import _posixshmem  # type: ignore[import-not-found]  # POSIX shared memory, as multiprocessing's own
 
     fd = _posixshmem.shm_open("/" + name, os.O_RDWR, mode=0o600)
     try:
