@@ -161,12 +161,13 @@ class _State:
         workers, self.workers = self.workers, []
         if os.getpid() != self.owner:  # a forked child's copy: the workers and the segment are the owner's
             return
-        for w in workers:
-            if gently and w.process.is_alive():
+        gently = [gently and w.ready for w in workers]  # one still warming up would hear it only when warm
+        for w, ask in zip(workers, gently, strict=True):
+            if ask and w.process.is_alive():
                 with contextlib.suppress(OSError, ValueError):
                     w.conn.send(("stop",))
-        for w in workers:
-            w.process.join(STOP_TIMEOUT if gently else 0.0)
+        for w, ask in zip(workers, gently, strict=True):
+            w.process.join(STOP_TIMEOUT if ask else 0.0)
             if w.process.is_alive():
                 w.process.terminate()
                 w.process.join(STOP_TIMEOUT)
