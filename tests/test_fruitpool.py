@@ -12,7 +12,7 @@ import types
 import numpy as np
 import pytest
 
-from symfruit import InputError
+from symfruit import InputError, SymfruitError
 from symfruit import fruitpool as fp
 from symfruit.core.frame import Frame
 from symfruit.detect import _Fruit, detect
@@ -265,6 +265,8 @@ def test_the_number_of_processes_is_bounded(bad):
 def test_fork_is_refused_and_zero_workers_is_one_process():
     with pytest.raises(InputError, match="never fork"):
         FruitPool(1, start_method="fork")
+    with pytest.raises(SymfruitError, match="no-such-method"):
+        FruitPool(1, method="no-such-method")  # before any worker starts
     with FruitPool(0) as none:
         assert not none.active and none.reason == "no worker process asked for (0)" and none.starts == 0
         frame = four()

@@ -161,12 +161,12 @@ class _State:
         workers, self.workers = self.workers, []
         if os.getpid() != self.owner:  # a forked child's copy: the workers and the segment are the owner's
             return
-        gently = [gently and w.ready for w in workers]  # one still warming up would hear it only when warm
-        for w, ask in zip(workers, gently, strict=True):
+        asks = [gently and w.ready for w in workers]  # one still warming up would hear it only when warm
+        for w, ask in zip(workers, asks, strict=True):
             if ask and w.process.is_alive():
                 with contextlib.suppress(OSError, ValueError):
                     w.conn.send(("stop",))
-        for w, ask in zip(workers, gently, strict=True):
+        for w, ask in zip(workers, asks, strict=True):
             w.process.join(STOP_TIMEOUT if ask else 0.0)
             if w.process.is_alive():
                 w.process.terminate()
@@ -226,6 +226,8 @@ class FruitPool:
     ------
     InputError
         ``processes`` out of bounds, an unknown ``start_method``.
+    SymfruitError
+        An unknown ``method``.
     """
 
     #: Whether the calling process takes fruit too (tests set it False on a pool: the workers then do every fruit).
@@ -238,6 +240,10 @@ class FruitPool:
         self.processes = check_fruit_processes(processes)
         if start_method not in ("forkserver", "spawn"):
             raise InputError(f"start_method must be forkserver or spawn (never fork), got {start_method!r}")
+        if method is not None:  # an unknown method is refused here, not by every worker's warm-up
+            from .methods.registry import get as get_method
+
+            get_method(method)
         self.method, self.start_method = method, start_method
         self.reason = one_process_reason(self.processes)
         self.started_s, self.fruit_elsewhere, self.starts, self.last_loss = float("nan"), 0, 0, ""
@@ -247,12 +253,15 @@ class FruitPool:
         self._failed_starts, self._seq = 0, 0
         self._lock: Any = None
         self._counter: Any = None
+        self._started_at = 0.0  # time.monotonic() when the current set of workers was started
         if not self.reason:
-            t0 = time.perf_counter()
-            self._start()
-            if wait:
-                self._wait_ready(START_TIMEOUT)
-                self.started_s = time.perf_counter() - t0
+            try:
+                self._start()
+                if wait and self._wait_ready(START_TIMEOUT):
+                    self.started_s = time.monotonic() - self._started_at
+            except BaseException:  # interrupted while waiting: no worker outlives the failed constructor
+                self.close()
+                raise
 
     @property
     def active(self) -> bool:
@@ -282,6 +291,7 @@ class FruitPool:
     def _start(self) -> None:
         ctx: Any = multiprocessing.get_context(self.start_method)
         self._lock, self._counter = ctx.Lock(), ctx.RawValue("q", 0)
+        self._started_at = time.monotonic()
         for _ in range(self.processes):
             here, there = ctx.Pipe(duplex=True)
             process = ctx.Process(target=_worker_main, args=(there, self._lock, self._counter, self.method),
@@ -303,9 +313,10 @@ class FruitPool:
                     if not w.process.is_alive():
                         self._lost(f"a worker process ended during its start (exit code {w.process.exitcode})")
                         return False
+                    if time.monotonic() - self._started_at > START_TIMEOUT:
+                        self._lost(f"a worker process was not ready after {START_TIMEOUT:.0f} s")
+                        return False
                     if left <= 0:
-                        if timeout >= START_TIMEOUT:
-                            self._lost(f"a worker process was not ready after {START_TIMEOUT:.0f} s")
                         return False
                     continue
                 try:
