@@ -141,9 +141,12 @@ def test_a_processor_with_a_fruit_worker_gives_the_same_fruit_and_closes_it(exam
 
     alone = FrameProcessor(fruit="strawberry")
     assert not alone.pool.active  # the library's default: no process
+    assert alone.workers_said() == "no fruit worker process (no worker process asked for (0))"
     shared = FrameProcessor(fruit="strawberry", fruit_processes=1)
     try:
         assert shared.pool.active == (one_process_reason(1) == "")
+        assert shared.workers_said() == ("1 fruit worker process (warming up)" if shared.pool.active else
+                                         f"no fruit worker process ({one_process_reason(1)})")  # fmt: skip
         assert shared.pool._wait_ready(600) or not shared.pool.active
         shared.pool._caller_shares = False  # the worker does every fruit
         messages = example_messages(example_images)

@@ -317,6 +317,13 @@ class FrameProcessor:
         """End the fruit workers (:meth:`symfruit.fruitpool.FruitPool.close`); frames after it run in this process."""
         self.pool.close()
 
+    def workers_said(self) -> str:
+        """The fruit workers in a line for the node's start-up log."""
+        pool = self.pool
+        if pool.active:
+            return f"{pool.processes} fruit worker process{'es' if pool.processes > 1 else ''} (warming up)"
+        return f"no fruit worker process ({pool.reason})"
+
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
         """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`); the first camera
         info with non-zero distortion is warned about, once per processor (not on every frame), and so is the

@@ -207,6 +207,7 @@ class SymfruitNode:
         self.sync.registerCallback(self._on_frame)
         rospy.on_shutdown(self._stop)
         rospy.loginfo("symfruit: method %s, listening to %s, %s, %s", self.core.method, *self.topics.values())
+        rospy.loginfo("symfruit: %s", self.core.workers_said())
 
     def _on_frame(self, color, depth, info) -> None:  # subscriber thread: hand over, never block
         if self.worker.put((time.perf_counter(), color, depth, info)):

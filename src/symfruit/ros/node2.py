@@ -241,6 +241,7 @@ class Ros2Node:
             f"symfruit: method {self.core.method}, fruit {p['fruit'] or '-'}, qos {p['qos']}, listening to "
             + ", ".join(self.topics.values())
         )
+        self.log.info(f"symfruit: {self.core.workers_said()}")
 
     def input_topic(self, name: str) -> str:
         """``name`` as remapped with ``-r name:=...``, else its RealSense default (which may itself be remapped)."""
