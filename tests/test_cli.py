@@ -201,7 +201,7 @@ def test_bench_frame_times_one_method_or_profiles_it(capsys, monkeypatch):
 
     real, found = detect_module.detect, {}
 
-    def detect_once(frame, *, method):
+    def detect_once(frame, *, method, pool=None):
         if (id(frame), method) not in found:
             found[(id(frame), method)] = real(frame, method=method)
         return found[(id(frame), method)]

@@ -145,8 +145,14 @@ class Failing(_Fruit):
         if k in self.die and fp._IN_WORKER:
             os.kill(os.getpid(), signal.SIGKILL)
         if k in self.fail:
-            raise ValueError(self.fail[k])
+            raise (Unpicklable if self.fail[k] == "unpicklable" else ValueError)(self.fail[k])
         return super().__call__(k, sl)
+
+
+class Unpicklable(Exception):
+    def __init__(self, text):
+        super().__init__(text)
+        self.hook = lambda: text  # no pickle of it
 
 
 def fruit_task(frame, cls=Failing, fail=None, die=()):
@@ -183,6 +189,14 @@ def test_the_first_failing_fruits_error_is_raised_as_one_process_raises_it(pool,
     assert pool.starts == starts, pool.last_loss  # no worker lost
     done, _ = pool.run(task, jobs)  # the pool goes on
     assert [d[0].id for d in done] == [1, 2, 3, 4]
+
+
+def test_an_exception_that_does_not_pickle_comes_back_as_its_type_and_text(workers_only):
+    task, jobs = fruit_task(four(), fail={3: "unpicklable"})
+    starts = workers_only.starts
+    with pytest.raises(RuntimeError, match=r"^Unpicklable: unpicklable$"):
+        workers_only.run(task, jobs)
+    assert workers_only.starts == starts, workers_only.last_loss
 
 
 def test_a_worker_killed_between_frames_gives_the_next_frame_right_and_a_new_worker(pool):

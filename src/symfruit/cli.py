@@ -541,8 +541,7 @@ def _bench_frame(args: argparse.Namespace, methods: tuple[str, ...], pool: Any) 
         runs = len(next(iter(found.values()))["total"])
         print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least; "
               "wall time per stage, CPU time of the thread ('cpu', and the fruit workers' on their fruit); trim and "
-              "register are part of extract, "
-              "occlusion of complete")  # fmt: skip
+              "register are part of extract, occlusion of complete")  # fmt: skip
         print(f"{'stage':<10}" + "".join(f"{m:>22}" for m in methods))
         for stage in STAGES:
             cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
@@ -553,6 +552,7 @@ def _bench_frame(args: argparse.Namespace, methods: tuple[str, ...], pool: Any) 
 
 
 def _processes(args: argparse.Namespace) -> str:
+    """Where ``bench``'s rows ran, for its header line."""
     n = getattr(args, "fruit_processes", None) or 0
     return f"the fruit shared with {n} worker process{'es' if n > 1 else ''}" if n else "one process"
 

@@ -38,7 +38,6 @@ import contextlib
 import mmap
 import multiprocessing
 import os
-import pickle
 import queue
 import signal
 import sys
@@ -432,7 +431,7 @@ class FruitPool:
         heard = False
         while w.conn.poll(0.0 if heard else wait):
             try:
-                word = pickle.loads(w.conn.recv_bytes())
+                word = w.conn.recv()  # from this pool's own worker, over a pipe no one else holds
             except (EOFError, OSError):
                 return f"a worker process ended within a frame (exit code {w.process.exitcode})", heard
             heard = True
@@ -519,10 +518,7 @@ def _packed(got: tuple[str, Any]) -> tuple[Any, ...]:
     kind, value = got
     if kind == "raised":
         value.add_note(f"(in FruitPool worker {os.getpid()}:\n{''.join(traceback.format_exception(value))})")
-        try:
-            return ("raised", pickle.dumps(value))
-        except Exception:  # an exception that does not pickle: its type and text
-            return ("raised", pickle.dumps(RuntimeError(f"{type(value).__name__}: {value}")))
+        return ("raised", value)  # the sender tells it as text if it does not pickle (_send_all)
     d, *times = value
     mask, ex = d.mask, d.extraction
     rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
@@ -537,7 +533,7 @@ def _packed(got: tuple[str, Any]) -> tuple[Any, ...]:
 def _unpacked(packed: tuple[Any, ...]) -> tuple[str, Any]:
     """:func:`_packed`'s answer as :func:`_attempt` gives it."""
     if packed[0] == "raised":
-        return "raised", pickle.loads(packed[1])
+        return "raised", packed[1]
     from .detect import Detection
     from .extract import Extraction
 
@@ -562,9 +558,9 @@ def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None
     global _IN_WORKER
     _IN_WORKER = True
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C in a terminal reaches the whole group: the caller decides
-    outbox: queue.SimpleQueue[bytes | None] = queue.SimpleQueue()
+    outbox: queue.SimpleQueue[tuple[Any, ...] | None] = queue.SimpleQueue()
     sender = threading.Thread(target=_send_all, args=(conn, outbox), daemon=True)
-    sender.start()  # pickled here, sent there: a full pipe never holds the next fruit up
+    sender.start()  # sent from there: a full pipe never holds the next fruit up
     try:
         try:
             if method is not None:
@@ -597,7 +593,7 @@ def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None
 
 
 def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: dict[str, Any], todo: list[Any],
-           lock: Any, counter: Any, outbox: queue.SimpleQueue[bytes | None]) -> None:  # fmt: skip
+           lock: Any, counter: Any, outbox: queue.SimpleQueue[tuple[Any, ...] | None]) -> None:  # fmt: skip
     """One frame's share: fruit taken from the shared counter until none is left, each answer queued for the
     sender, then the frame's end. ``kind``: the per-fruit task's class (``detect``'s ``_Fruit``)."""
     fruit: Any = object.__new__(kind)
@@ -605,14 +601,22 @@ def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: d
               for key, at in layout.items()}  # fmt: skip
     fruit.__dict__.update(rest, **arrays)
     while (i := _claim(lock, counter, len(todo))) is not None:
-        outbox.put(pickle.dumps(("fruit", seq, i, _packed(_attempt(fruit, *todo[i]))), pickle.HIGHEST_PROTOCOL))
-    outbox.put(pickle.dumps(("done", seq)))
+        outbox.put(("fruit", seq, i, _packed(_attempt(fruit, *todo[i]))))
+    outbox.put(("done", seq))
 
 
-def _send_all(conn: Any, outbox: queue.SimpleQueue[bytes | None]) -> None:
-    while (data := outbox.get()) is not None:
+def _send_all(conn: Any, outbox: queue.SimpleQueue[tuple[Any, ...] | None]) -> None:
+    """The worker's sender thread: each answer sent (pickled by the pipe) until ``None``; an exception that does not
+    pickle goes as a ``RuntimeError`` with its type and text."""
+    while (word := outbox.get()) is not None:
         try:
-            conn.send_bytes(data)
+            try:
+                conn.send(word)
+            except OSError:
+                raise
+            except Exception:  # only a fruit's exception can fail to pickle: sent nothing, told as text
+                exc = word[3][1]
+                conn.send((*word[:3], ("raised", RuntimeError(f"{type(exc).__name__}: {exc}"))))
         except OSError:
             return
 
