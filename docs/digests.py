@@ -5,7 +5,10 @@ and without depth, seed 0 through the four camera models, apple-tree frames of s
 profile). Run it on the tree before and after a change (``SYMFRUIT_KERNELS=numpy`` for the numpy twins); the same
 digests mean the same results. The digests depend on the host's libraries (BLAS), so compare on one host.
 
-    python docs/digests.py [records] [labels]
+    python docs/digests.py [records] [labels] [--fruit-processes N]
+
+``--fruit-processes N``: the records with each frame's fruit shared with N worker processes
+(:class:`symfruit.fruitpool.FruitPool`, stop 53): the same digest as without them.
 """
 
 import argparse
@@ -15,15 +18,26 @@ import sys
 import numpy as np
 
 
-def records() -> str:
+def records(fruit_processes: int = 0) -> str:
     from symfruit.detect import detect
     from symfruit.evaluate.bench import _bench_scene
+    from symfruit.fruitpool import FruitPool
 
+    with FruitPool(fruit_processes) as pool:
+        if fruit_processes and not pool.active:
+            raise SystemExit(f"--fruit-processes {fruit_processes}: no worker here ({pool.reason})")
+        found = _records(detect, _bench_scene, pool)
+        if fruit_processes and not pool.fruit_elsewhere:
+            raise SystemExit(f"--fruit-processes {fruit_processes}: the workers did no fruit")
+    return found
+
+
+def _records(detect, bench_scene, pool) -> str:
     h = hashlib.sha256()
     for seed in (0, 1, 2):
-        frame, _ = _bench_scene(None, seed)
+        frame, _ = bench_scene(None, seed)
         for method in ("evidence", "paper"):
-            for d in detect(frame, method=method).detections:
+            for d in detect(frame, method=method, pool=pool).detections:
                 h.update(f"{seed}{method}{d.id}{d.error}".encode())
                 h.update(np.ascontiguousarray(d.extraction.points, dtype=np.float64).tobytes())
                 r = d.result
@@ -70,12 +84,19 @@ def labels() -> tuple[str, int]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("what", nargs="*", help="records, labels or both (default: both)")
+    parser.add_argument(
+        "--fruit-processes",
+        type=int,
+        default=0,
+        metavar="N",
+        help="records: each frame's fruit shared with N worker processes (default 0: none)",
+    )
     args = parser.parse_args()
     args.what = args.what or ["records", "labels"]
     if not set(args.what) <= {"records", "labels"}:
         parser.error(f"what: give records and/or labels, got {' '.join(args.what)}")
     if "records" in args.what:
-        sys.stdout.write(f"records {records()}\n")
+        sys.stdout.write(f"records {records(args.fruit_processes)}\n")
     if "labels" in args.what:
         digest, found = labels()
         sys.stdout.write(f"labels {digest} {found} fruit\n")

@@ -5,6 +5,10 @@ rgb8 colour, CameraInfo).
 
     python docs/memory41.py folder --frames 200
     python docs/memory41.py bag --frames 200 [--method evidence]
+    python docs/memory41.py folder --frames 200 --fruit-processes 1
+
+``--fruit-processes N``: each frame's fruit shared with N worker processes (:class:`symfruit.fruitpool.FruitPool`,
+started and warm before the first frame; stop 53): the workers' RSS is printed too, and the run's seconds.
 
 Prints the largest RSS up to frame 10, 50, 100, 150 and N, and up to the run's end (tables written). A
 measurement of minutes, not a test: memory that grows with the frames shows as a rising row.
@@ -15,11 +19,12 @@ import json
 import shutil
 import sys
 import tempfile
+import time
 from pathlib import Path
 
 
-def rss_mb() -> float:
-    with open("/proc/self/status") as status:
+def rss_mb(pid: int | str = "self") -> float:
+    with open(f"/proc/{pid}/status") as status:
         for line in status:
             if line.startswith("VmRSS:"):
                 return int(line.split()[1]) / 1024.0
@@ -74,26 +79,45 @@ def main() -> None:
     parser.add_argument("kind", choices=("folder", "bag"))
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--method", default=None, help="completion method (default: detect's)")
+    parser.add_argument("--fruit-processes", type=int, default=0, help="fruit worker processes (default 0: none)")
     args = parser.parse_args()
 
     from symfruit.batch import run_batch
     from symfruit.demo import example_frame
+    from symfruit.fruitpool import FruitPool
+    from symfruit.methods import DEFAULT_METHOD
 
     with tempfile.TemporaryDirectory(prefix="symfruit-memory41-") as tmp, example_frame() as frame:
         root = Path(tmp)
         make = folder_recording if args.kind == "folder" else bag_recording
         rec = make(root, args.frames, frame)
         after: list[float] = []
+        theirs: list[list[float]] = []
         extra = {} if args.method is None else {"method": args.method}
-        report = run_batch(rec, root / "out", progress=False, on_frame=lambda i, found: after.append(rss_mb()),
-                           **extra)  # fmt: skip
-        end = rss_mb()
+        with FruitPool(args.fruit_processes, method=args.method or DEFAULT_METHOD) as pool:
+            if args.fruit_processes and not pool.active:
+                raise SystemExit(f"--fruit-processes: no worker here ({pool.reason})")
+            pids = [w.process.pid for w in pool._state.workers]
+
+            def note(i, found):
+                after.append(rss_mb())
+                theirs.append([rss_mb(pid) for pid in pids])
+
+            t0 = time.perf_counter()
+            report = run_batch(rec, root / "out", progress=False, on_frame=note, pool=pool, **extra)
+            seconds = time.perf_counter() - t0
+            end, end_theirs = rss_mb(), [rss_mb(pid) for pid in pids]
+            elsewhere = pool.fruit_elsewhere
     out = sys.stdout
-    out.write(f"{args.kind}, {args.frames} frames: {len(report.done)} done, {len(report.failed)} failed\n")
+    out.write(f"{args.kind}, {args.frames} frames: {len(report.done)} done, {len(report.failed)} failed, "
+              f"{seconds:.1f} s ({args.frames / seconds:.1f} frames/s)")  # fmt: skip
+    out.write(f"; {elsewhere} of {report.fruits + report.failed_fruits} fruit in the workers\n" if pids else "\n")
     for upto in (10, 50, 100, 150, args.frames):
         if upto <= len(after):
-            out.write(f"  largest RSS up to frame {upto:5d}: {max(after[:upto]):7.1f} MB\n")
-    out.write(f"  after the run (tables written):  {end:7.1f} MB\n")
+            workers = "".join(f", worker {max(t[j] for t in theirs[:upto]):7.1f} MB" for j in range(len(pids)))
+            out.write(f"  largest RSS up to frame {upto:5d}: {max(after[:upto]):7.1f} MB{workers}\n")
+    workers = "".join(f", worker {v:7.1f} MB" for v in end_theirs)
+    out.write(f"  after the run (tables written):  {end:7.1f} MB{workers}\n")
 
 
 if __name__ == "__main__":

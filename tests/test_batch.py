@@ -53,6 +53,25 @@ def test_batch_goes_on_past_a_bad_frame_and_resumes(tmp_path):
     assert again.skipped == ["f1", "f3"] and (out / "f1" / "detections.json").read_bytes() == before
 
 
+def test_a_fruit_pool_gives_the_same_records_and_is_refused_with_a_cluster(tmp_path):
+    from symfruit.errors import InputError
+    from symfruit.fruitpool import FruitPool, one_process_reason
+
+    frames = tmp_path / "rec"
+    for name in ("f1", "f2"):
+        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    run_batch(frames, tmp_path / "one", progress=False)
+    if one_process_reason(1):
+        pytest.skip(f"no worker processes here: {one_process_reason(1)}")
+    with FruitPool(1, method=None) as pool:
+        pool._caller_shares = False  # the worker does every fruit
+        report = run_batch(frames, tmp_path / "two", progress=False, pool=pool)
+        assert report.done == ["f1", "f2"] and pool.fruit_elsewhere == report.fruits >= 4
+        with pytest.raises(InputError, match="a Dask cluster's workers are one of several processes already"):
+            run_batch(frames, tmp_path / "three", progress=False, pool=pool, workers=2)
+    assert _fruits(tmp_path / "one") == _fruits(tmp_path / "two")
+
+
 def test_resume_runs_again_a_frame_whose_record_cannot_be_read_back(tmp_path):
     # a detections.json truncated by a copy was trusted: the frame was skipped, then left out of the tables
     frames = recording(tmp_path / "rec", "f1", "f2")

@@ -201,7 +201,7 @@ def test_bench_frame_times_one_method_or_profiles_it(capsys, monkeypatch):
 
     real, found = detect_module.detect, {}
 
-    def detect_once(frame, *, method):
+    def detect_once(frame, *, method, pool=None):
         if (id(frame), method) not in found:
             found[(id(frame), method)] = real(frame, method=method)
         return found[(id(frame), method)]
@@ -226,6 +226,21 @@ def test_cli_detect_and_evaluate_frames(tmp_path, capsys):
     assert main(["evaluate", "--frames", frames, "--methods", "raw,paper", "--output", str(tmp_path)]) == 0
     assert "Table 3" in capsys.readouterr().out
     assert main(["detect", str(tmp_path / "nothing"), "--output", str(tmp_path / "x")]) == 2
+
+
+def test_detect_with_fruit_processes_writes_the_same_detections(tmp_path, capsys):
+    """``detect --fruit-processes 1``: the same records (the workers warm up meanwhile: whether they take a fruit of
+    these few frames is the host's; tests/test_fruitpool.py and test_batch.py check the workers' fruit) and no worker
+    left afterwards."""
+    import multiprocessing
+
+    for name, extra in (("one", []), ("two", ["--fruit-processes", "1"])):
+        assert main(["detect", str(EXAMPLE_FRAME), "--output", str(tmp_path / name), *extra]) == 0
+    one, two = ((tmp_path / n / "example_frame" / "detections.json").read_text() for n in ("one", "two"))
+    strip = lambda text: [{k: v for k, v in f.items() if k != "seconds"} for f in json.loads(text)["fruits"]]  # noqa: E731
+    assert strip(one) == strip(two) and len(strip(one)) >= 2
+    assert not [p for p in multiprocessing.active_children() if p.name == "symfruit-fruit"]
+    assert "no worker process" not in capsys.readouterr().out
 
 
 def test_evaluate_frames_goes_on_past_a_bad_frame_and_exits_1(tmp_path, capsys):
@@ -803,7 +818,15 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
       "segment --depth is for --masks color (the colour segmenter; --masks labels does not use depth)"),
      (["detect", "rec", "--output", "o", "--ros2-storage", "sqlite3"], "--ros2-storage (the storage of --ros2-bag) is"),
      (["detect", "rec", "--output", "o", "--ros2-bag", "o"], "--ros2-bag o holds --output o: the bag's files and"),
-     (["detect", "rec", "--output", "b/o", "--ros2-bag", "b"], "--ros2-bag b holds --output b/o")],
+     (["detect", "rec", "--output", "b/o", "--ros2-bag", "b"], "--ros2-bag b holds --output b/o"),
+     (["detect", "rec", "--output", "o", "--fruit-processes", "17"], "--fruit-processes must be a whole number from 0 "
+      "to 16, got 17"),
+     (["detect", "rec", "--output", "o", "--fruit-processes", "-1"], "--fruit-processes must be a whole number"),
+     (["detect", "rec", "--output", "o", "--fruit-processes", "1", "--workers", "2"], "--fruit-processes shares each "
+      "frame's fruit with processes of this one: a Dask cluster's workers (--scheduler, --workers) are one of"),
+     (["bench", "--fruit-processes", "1"], "bench --fruit-processes is for --frame; here it would be ignored"),
+     (["bench", "--frame", "--fruit-processes", "17"], "--fruit-processes must be a whole number from 0 to 16"),
+     (["bench", "--frame", "--profile", "--fruit-processes", "1"], "--profile and --fruit-processes do not go")],
 )  # fmt: skip
 def test_options_the_chosen_run_would_ignore_are_refused(tmp_path, capsys, monkeypatch, args, message):
     monkeypatch.chdir(tmp_path)  # before: run without them (bench --workers 2: the cloud bench, one process)

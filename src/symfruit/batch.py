@@ -25,6 +25,7 @@ import numpy as np
 from .core.limits import instance_labels
 from .detect import FrameDetections, detect
 from .errors import FileFormatError, InputError, OutputError, SymfruitError
+from .fruitpool import FruitPool
 from .io.atomic import folder_fd
 from .io.frames import is_frame_folder
 from .io.images import image_suffixes
@@ -108,6 +109,7 @@ def run_batch(
     chunk: int = 4,
     no_worker_timeout: float | None = None,
     silent_worker_timeout: float | None = None,
+    pool: FruitPool | None = None,
 ) -> BatchReport:
     """Detect fruit in every frame of ``source`` and write each frame's results under ``output``, and the
     fruit of every frame done into ``detections.parquet`` and ``frames.parquet`` (:mod:`symfruit.season.table`).
@@ -122,6 +124,10 @@ def run_batch(
     ``chunk`` frames per task, ``no_worker_timeout`` seconds waited while the cluster has no worker, a worker
     not heard from for ``silent_worker_timeout`` seconds counting as none
     (:func:`symfruit.season.cluster.run_distributed`; ``on_frame`` is not available there).
+
+    ``pool``: a :class:`~symfruit.fruitpool.FruitPool` the caller keeps, each frame's fruit shared with its workers
+    (:func:`~symfruit.detect.detect`'s ``pool``; in this process only: refused with a cluster, whose workers are one
+    of several processes already).
 
     ``on_frame(index, found)`` is called with each frame's detections (``index``: its place in the source)
     inside the frame's error boundary, just before its files are written, so ``detections.json`` still marks
@@ -158,6 +164,9 @@ def run_batch(
 
         if on_frame is not None:
             raise InputError("on_frame (--ros2-bag) runs in this process: it cannot be combined with a Dask cluster")
+        if pool is not None and pool.processes:
+            raise InputError("a fruit pool (--fruit-processes) shares the fruit of the frames run in this process: a "
+                             "Dask cluster's workers are one of several processes already")  # fmt: skip
         return run_distributed(source, output, scheduler=scheduler, workers=workers, chunk=chunk, masks=masks,
                                method=method, settings=settings, resume=resume, progress=progress,
                                exclude=exclude, no_worker_timeout=no_worker_timeout,
@@ -197,7 +206,7 @@ def run_batch(
                     continue
                 try:
                     _run_recording(src, rec, names, masks, method, settings, resume, on_frame, reserved, report,
-                                   bar, out)  # fmt: skip
+                                   bar, out, pool)  # fmt: skip
                 finally:
                     src.close()
                     held = None
@@ -224,7 +233,7 @@ def run_batch(
 def _run_recording(
     src: Any, rec: Recording, names: list[str], masks: str, method: str, settings: Settings, resume: bool,
     on_frame: Callable[[int, FrameDetections], None] | None, reserved: Sequence[str], report: BatchReport,
-    bar: Progress, out: OutputFolder,
+    bar: Progress, out: OutputFolder, pool: FruitPool | None = None,
 ) -> None:  # fmt: skip
     """The frames ``names`` of one recording, in this process, each in its error boundary."""
     now = src.names()
@@ -233,7 +242,7 @@ def _run_recording(
         for index, name in enumerate(names):
             current[0] = name
             if not _one(src, rec, index, name, names, where, masks, method, settings, resume, on_frame, reserved,
-                        report, bar, out):  # fmt: skip
+                        report, bar, out, pool):  # fmt: skip
                 return
 
 
@@ -275,7 +284,7 @@ def once_per_recording(source: str) -> Any:
 def _one(
     src: Any, rec: Recording, index: int, name: str, names: list[str], where: dict[str, int] | None, masks: str,
     method: str, settings: Settings, resume: bool, on_frame: Callable[[int, FrameDetections], None] | None,
-    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder,
+    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder, pool: FruitPool | None = None,
 ) -> bool:  # fmt: skip
     """Frame ``name`` (``index``) of a recording in its error boundary (:func:`_run_recording`); False when
     the batch stops."""
@@ -290,7 +299,7 @@ def _one(
         if where is not None and name not in where:
             raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
         found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
-                       settings=settings)  # fmt: skip
+                       settings=settings, pool=pool)  # fmt: skip
         if on_frame is not None:
             on_frame(index, found)
         write_detections(folder, found, settings=settings)

@@ -101,6 +101,9 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
                    "time per frame (--repeat runs of each method)")  # fmt: skip
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
+    p.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+                   help="with --frame: each frame's fruit shared with N worker processes, started and warmed up "
+                   "before the timing (0-16, default 0; as symfruit detect --fruit-processes)")  # fmt: skip
     p.add_argument(
         "--segment",
         action="store_true",
@@ -204,6 +207,10 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resume", action="store_true",
                    help="skip frames whose detections.json is a whole record (one that cannot be read back, "
                    "truncated by a copy, is run again)")  # fmt: skip
+    p.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+                   help="share each frame's fruit with N worker processes kept for the run (0-16, default 0; 1 on "
+                   "two cores: about a fifth off a frame's detection once they are warm, docs/proc53.md); not with "
+                   "--scheduler or --workers")  # fmt: skip
     _add_ros2_bag_options(p)
     _add_cluster_options(p)
     p = sub.add_parser("segment", help="instance masks of the ripe fruit in images (colour alone, or with depth)")
@@ -415,6 +422,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
         ("--profile", args.profile, ("--frame",)),
         ("--stages", args.stages, ("--frame",)),
         ("--workers", args.workers is not None, ("--recording",)),
+        ("--fruit-processes", args.fruit_processes is not None, ("--frame",)),
         ("--images", args.images is not None, ("--segment",)),
         ("--size", args.size is not None, ("--segment",)),
         ("--scene", args.scene is not None, ("--segment",)),
@@ -424,6 +432,7 @@ def _check_bench_options(args: argparse.Namespace) -> None:
             need = " or ".join(k or "the cloud bench (no --frame, --recording or --segment)" for k in kinds_for)
             raise InputError(f"bench {option} is for {need}; here it would be ignored")
     for a, b, on in (("--profile", "--stages", args.profile and args.stages),
+                     ("--profile", "--fruit-processes", args.profile and args.fruit_processes is not None),
                      ("--profile", "--json", args.profile and args.json),
                      ("--scene", "--images", args.scene is not None and args.images is not None),
                      ("--scene", "--size", args.scene is not None and args.size is not None)):  # fmt: skip
@@ -495,40 +504,70 @@ def _bench(args: argparse.Namespace) -> int:
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
     if args.frame:
-        from .evaluate.bench import bench_frame, profile_frame
+        from .evaluate.bench import profile_frame
+        from .fruitpool import FruitPool
 
         if args.profile:
             print(profile_frame(repeat=min(args.repeat, 5), method=_method(args), sensor=args.sensor))
             return 0
         methods = (_method(args),) if args.method is not None else ("paper", "fused", "evidence")
-        if args.stages:
-            import numpy as np
+        fruit_processes = _fruit_processes(args)
+        with FruitPool(fruit_processes, method=methods[0]) as pool:
+            if fruit_processes and not pool.active:
+                raise InputError(f"bench --fruit-processes {fruit_processes}: no worker process here ({pool.reason})")
+            if fruit_processes and not args.json:
+                print(f"symfruit bench --frame: {fruit_processes} fruit worker process"
+                      f"{'es' if fruit_processes > 1 else ''} started and warm in {pool.started_s:.1f} s")  # fmt: skip
+            return _bench_frame(args, methods, pool)
+    rows = run_bench(repeat=args.repeat, points=tuple(args.points))
+    return _bench_rows(args, rows)
 
-            from .evaluate.bench import STAGES, bench_stages
 
-            found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor) for m in methods}
-            if args.json:
-                print(json.dumps({"machine": machine(), "stages": {m: {k: v.tolist() for k, v in ms.items()}
-                                                                   for m, ms in found.items()}}))  # fmt: skip
-                return 0
-            runs = len(next(iter(found.values()))["total"])
-            print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least; "
-                  "wall time per stage, CPU time of the thread ('cpu'); trim and register are part of extract, "
-                  "occlusion of complete")  # fmt: skip
-            print(f"{'stage':<10}" + "".join(f"{m:>22}" for m in methods))
-            for stage in STAGES:
-                cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
-                print(f"{stage:<10}{cells}")
+def _bench_frame(args: argparse.Namespace, methods: tuple[str, ...], pool: Any) -> int:
+    """``symfruit bench --frame`` (but for ``--profile``), each frame's fruit shared with ``pool``'s workers."""
+    from .evaluate.bench import bench_frame, machine
+
+    if args.stages:
+        import numpy as np
+
+        from .evaluate.bench import STAGES, bench_stages
+
+        found = {m: bench_stages(repeat=min(args.repeat, 200), method=m, sensor=args.sensor, pool=pool)
+                 for m in methods}  # fmt: skip
+        if args.json:
+            print(json.dumps({"machine": machine(), "stages": {m: {k: v.tolist() for k, v in ms.items()}
+                                                               for m, ms in found.items()}}))  # fmt: skip
             return 0
-        rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor) for m in methods]
-    else:
-        rows = run_bench(repeat=args.repeat, points=tuple(args.points))
+        runs = len(next(iter(found.values()))["total"])
+        print(f"symfruit bench --frame --stages: ms per frame over {runs} runs after a warm-up, median / least; "
+              "wall time per stage, CPU time of the thread ('cpu', and the fruit workers' on their fruit); trim and "
+              "register are part of extract, occlusion of complete")  # fmt: skip
+        print(f"{'stage':<10}" + "".join(f"{m:>22}" for m in methods))
+        for stage in STAGES:
+            cells = "".join(f"{np.median(found[m][stage]):>13.1f} / {found[m][stage].min():>6.1f}" for m in methods)
+            print(f"{stage:<10}{cells}")
+        return 0
+    rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor, pool=pool) for m in methods]
+    return _bench_rows(args, rows)
+
+
+def _processes(args: argparse.Namespace) -> str:
+    """Where ``bench``'s rows ran, for its header line."""
+    n = getattr(args, "fruit_processes", None) or 0
+    return f"the fruit shared with {n} worker process{'es' if n > 1 else ''}" if n else "one process"
+
+
+def _bench_rows(args: argparse.Namespace, rows: list[Any]) -> int:
+    """The rows of ``symfruit bench`` or ``bench --frame`` printed (``--json``: as JSON)."""
+    from .evaluate.bench import machine
+
     if args.json:
         print(json.dumps({"machine": machine(), "rows": [r.to_dict() for r in rows]}, indent=2))
         return 0
     info = machine()
     print(
-        f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, one process "
+        f"symfruit bench: median of {rows[0].repeat} runs per {'frame' if args.frame else 'fruit'}, "
+        f"{_processes(args)} "
         f"(Python {info['python']}, numpy {info['numpy']}, {info['cpus']} CPUs)"
     )
     print(f"{'case':<26} {'points':>6} {'planes':>6} {'median ms':>10} {'min':>8} {'p10':>8} {'p90':>8}")
@@ -824,6 +863,13 @@ def _segment(args: argparse.Namespace) -> int:
     return 0 if report.ok else 1
 
 
+def _fruit_processes(args: argparse.Namespace) -> int:
+    """``--fruit-processes`` checked (0 when not given)."""
+    from .fruitpool import check_fruit_processes
+
+    return 0 if args.fruit_processes is None else check_fruit_processes(args.fruit_processes, "--fruit-processes")
+
+
 def _detect(args: argparse.Namespace) -> int:
     from .batch import run_batch
     from .errors import InputError
@@ -846,6 +892,10 @@ def _detect(args: argparse.Namespace) -> int:
         check(value)
         if not args.scheduler and args.workers is None:
             raise InputError(f"{option} ({what}) is for --scheduler or --workers; here it would be ignored")
+    fruit_processes = _fruit_processes(args)
+    if fruit_processes and (args.scheduler or args.workers is not None):
+        raise InputError("--fruit-processes shares each frame's fruit with processes of this one: a Dask cluster's "
+                         "workers (--scheduler, --workers) are one of several processes already")  # fmt: skip
     settings = _settings_for(args)
     if (args.scheduler or args.workers is not None) and args.ros2_bag is not None:
         raise InputError("--ros2-bag is written by this process frame by frame: it cannot be combined with "
@@ -859,14 +909,19 @@ def _detect(args: argparse.Namespace) -> int:
         if os.path.commonpath([bag_at, out_at]) == bag_at:  # the bag's folder would hold the run's files
             raise InputError(f"--ros2-bag {args.ros2_bag} holds --output {args.output}: the bag's files and the "
                              "run's would share a folder; give the bag a folder of its own (e.g. OUT/bag)")  # fmt: skip
-    with _ros2_bag(args) as bag:
+    from .fruitpool import FruitPool
+
+    # the workers warm up while the first frames run here alone (wait=False): no frame waits for them
+    with _ros2_bag(args) as bag, FruitPool(fruit_processes, method=_method(args), wait=False) as pool:
         source = args.inputs[0] if len(args.inputs) == 1 else args.inputs
         report = run_batch(source, args.output, masks=args.masks, method=_method(args), settings=settings,
                            resume=args.resume, on_frame=None if bag is None else bag.write_frame,
                            exclude=[] if bag is None else [args.ros2_bag], scheduler=args.scheduler,
                            workers=args.workers, chunk=args.chunk or 4,
                            no_worker_timeout=args.no_worker_timeout,
-                           silent_worker_timeout=args.silent_worker_timeout)  # fmt: skip
+                           silent_worker_timeout=args.silent_worker_timeout, pool=pool)  # fmt: skip
+    if fruit_processes and pool.reason != "the pool is closed":
+        print(_line(f"  --fruit-processes {fruit_processes}: no worker process ({pool.reason})"))
     print(f"frames: {len(report.done)} done, {len(report.skipped)} skipped (resume), {len(report.failed)} failed; "
           f"fruit: {report.fruits} located, {report.failed_fruits} failed")  # fmt: skip
     for name, reason in report.failed.items():

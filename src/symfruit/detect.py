@@ -24,6 +24,7 @@ from .core.occlusion import Occlusion
 from .core.raster import mask_box
 from .errors import InputError, SymfruitError
 from .extract import Extraction, ExtractSettings, extract, own_surface, register, trim_labels
+from .fruitpool import FruitPool
 from .io.frames import COLOR_FILE
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
@@ -34,7 +35,7 @@ from .segment.colour import _leaf as leaf_green
 from .segment.source import COLOUR_SEGMENTER
 from .settings import Settings, section_types
 
-__all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "detect", "frame_masks"]
+__all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "FruitPool", "detect", "frame_masks"]
 
 #: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
 MAX_FRUIT_PER_FRAME = MAX_INSTANCES
@@ -65,7 +66,8 @@ class FrameDetections:
 
     ``timings``: wall seconds of ``segment``, ``extract`` (of which ``trim`` and ``register``, the colour trimming
     and registration of the whole frame's masks), ``complete`` (of which ``occlusion``, the occlusion maps) and
-    ``total``, and ``cpu``, the CPU seconds of this thread over the whole frame."""
+    ``total``, and ``cpu``, the CPU seconds of this thread over the whole frame (and of a
+    :class:`~symfruit.fruitpool.FruitPool`'s workers on its fruit)."""
 
     frame: Frame
     detections: list[Detection]
@@ -143,6 +145,7 @@ def detect(
     masks: str | Path | MaskSource | Segmenter | np.ndarray = "auto",
     method: str = DEFAULT_METHOD,
     settings: Settings | None = None,
+    pool: FruitPool | None = None,
 ) -> FrameDetections:
     """Find, extract, complete and box every fruit of a frame.
 
@@ -153,6 +156,13 @@ def detect(
     extracted with ``outlined=False`` (:func:`~symfruit.extract.extract`: the visible surface alone, no test for an
     occluder the mask is drawn over); every other source (a masks file or folder, a label array, a learned model,
     a callable) with ``outlined=True``.
+
+    ``pool``: a :class:`~symfruit.fruitpool.FruitPool` the caller keeps open across frames (``with FruitPool(1) as
+    pool: ...``): the frame's fruit are shared between this process and the pool's workers (issue 19, stop 53,
+    docs/proc53.md). The detections are the same, bit for bit, in the same order; an error a fruit raises is the
+    first failing fruit's; ``timings``' ``extract``, ``occlusion`` and ``complete`` are then the sums of each fruit's
+    own wall times (more than the frame's wall time they took) and ``cpu`` counts the workers' CPU on the fruit too.
+    None (the default), an inactive pool or a frame of fewer than two fruit: everything in this process.
     """
     if not isinstance(frame, Frame):
         raise InputError(f"detect needs a Frame (symfruit.io.read_frame or a frame source), got {type(frame).__name__}")
@@ -160,6 +170,8 @@ def detect(
         raise InputError(f"settings must be a Settings (symfruit.resolve_settings), got {type(settings).__name__}")
     settings = settings or _default_settings()
     get_method(method)  # an unknown method is refused before any work, not reported once per fruit
+    if pool is not None and not isinstance(pool, FruitPool):
+        raise InputError(f"pool must be a FruitPool (symfruit.fruitpool) or None, got {type(pool).__name__}")
     t0, cpu0 = time.perf_counter(), time.thread_time()
     _check_depth_range(frame, settings.extract.min_depth, settings.extract.max_depth)
     labels, source = frame_masks(frame, masks, settings)
@@ -204,47 +216,77 @@ def detect(
     # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
     # stop 47, docs/mask47.md)
     outlined = source != COLOUR_SEGMENTER
-    detections, t_extract, t_complete, t_occlusion = [], time.perf_counter() - t2, 0.0, 0.0
+    t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
     t_register = t_extract - t_trim
-    fruit_px = labels > 0
-    for k, sl in enumerate(boxes, 1):
-        if sl is None:
-            continue
-        mask = np.zeros(labels.shape, bool)
-        mask[sl] = labels[sl] == k
-        a = time.perf_counter()
-        ex = _extract_window(mask, sl, frame.depth, camera, settings, color=frame.color, shift=shift, outlined=outlined)
+    fruit = _Fruit(labels, frame.depth, frame.color, camera, settings, method, shift, outlined, labels > 0,
+                   colour_trimmed)  # fmt: skip
+    jobs = [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
+    cpu_elsewhere = 0.0
+    if pool is None or not pool.active or len(jobs) < 2:
+        done = [fruit(k, sl) for k, sl in jobs]
+    else:  # the first failing fruit's error is raised, as the loop above raises it
+        done, cpu_elsewhere = pool.run(fruit, jobs)
+    detections = [d[0] for d in done]
+    for _, ext, occl, comp, _ in done:
+        t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
+    total = time.perf_counter() - t0
+    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
+               "occlusion": t_occlusion, "complete": t_complete, "total": total,
+               "cpu": time.thread_time() - cpu0 + cpu_elsewhere}  # fmt: skip
+    return FrameDetections(frame, detections, timings, source, shift)
+
+
+#: What one fruit's task gives back: its detection, the wall seconds of its extraction, occlusion maps and completion
+#: (occlusion included), and the CPU seconds of the thread it ran on while it ran.
+_Done = tuple[Detection, float, float, float, float]
+
+
+class _Fruit:
+    """One fruit's extraction, occlusion maps and completion, given the frame's labels and what every fruit shares
+    (read, never written: a :class:`~symfruit.fruitpool.FruitPool`'s worker runs it on views of shared memory).
+    ``labels``, ``depth``, ``color`` and ``fruit_px`` are the frame's arrays (:data:`ARRAYS`); the rest is small."""
+
+    #: The attributes that are whole-image arrays (a pool sends them through shared memory, the rest pickled).
+    ARRAYS = ("labels", "depth", "color", "fruit_px")
+
+    def __init__(
+        self, labels: np.ndarray, depth: np.ndarray, color: np.ndarray | None, camera: Camera, settings: Settings,
+        method: str, shift: tuple[int, int], outlined: bool, fruit_px: np.ndarray, colour_trimmed: set[int],
+    ) -> None:  # fmt: skip
+        self.labels, self.depth, self.color, self.camera, self.settings = labels, depth, color, camera, settings
+        self.method, self.shift, self.outlined, self.fruit_px = method, shift, outlined, fruit_px
+        self.colour_trimmed = colour_trimmed
+
+    def __call__(self, k: int, sl: tuple[slice, slice]) -> _Done:
+        cpu0, a = time.thread_time(), time.perf_counter()
+        depth, settings, camera = self.depth, self.settings, self.camera
+        mask = np.zeros(self.labels.shape, bool)
+        mask[sl] = self.labels[sl] == k
+        ex = _extract_window(mask, sl, depth, camera, settings, color=self.color, shift=self.shift,
+                             outlined=self.outlined)  # fmt: skip
         mask = ex.silhouette if ex.silhouette is not None else mask
         b = time.perf_counter()
-        t_extract += b - a
         if ex.error:  # the mask's depth is what lies behind the fruit: reported, never completed (a box metres off)
-            detections.append(Detection(int(k), mask, ex, error=ex.error))
-            continue
+            return Detection(int(k), mask, ex, error=ex.error), b - a, 0.0, 0.0, time.thread_time() - cpu0
         if len(ex.points) < settings.extract.min_points:
             why = (f"only {len(ex.points)} points with valid depth (extract.min_points = "
                    f"{settings.extract.min_points}); {ex.n_invalid} of {ex.mask_area} mask pixels "
                    "had no depth")  # fmt: skip
-            detections.append(Detection(int(k), mask, ex, error=why))
-            continue
-        occ = None
+            return Detection(int(k), mask, ex, error=why), b - a, 0.0, 0.0, time.thread_time() - cpu0
+        occ, t_occlusion = None, 0.0
         try:
             # the frame checked its depth's units when it was made; every fruit's pixels are the others' (this
             # fruit's own are never hidden: the same occlusion without two whole-image operations per fruit); a
             # mask trimmed by colour already lost what it overshot the fruit by (stop 42, docs/sil42.md)
-            occ = fruit_occlusion(frame.depth, mask, ex.points, camera, settings.occlusion,
-                                  others=fruit_px, checked=True, eroded=settings.extract.erode_px,
-                                  drawn=k not in colour_trimmed)  # fmt: skip
-            t_occlusion += time.perf_counter() - b
-            result = complete(ex.points, camera=camera, method=method, settings=settings, occlusion=occ)
-            detections.append(Detection(int(k), mask, ex, result, occlusion=occ))
+            occ = fruit_occlusion(depth, mask, ex.points, camera, settings.occlusion,
+                                  others=self.fruit_px, checked=True, eroded=settings.extract.erode_px,
+                                  drawn=k not in self.colour_trimmed)  # fmt: skip
+            t_occlusion = time.perf_counter() - b
+            result = complete(ex.points, camera=camera, method=self.method, settings=settings, occlusion=occ)
+            found = Detection(int(k), mask, ex, result, occlusion=occ)
         except SymfruitError as exc:
-            detections.append(Detection(int(k), mask, ex, error=str(exc), occlusion=occ))
-        t_complete += time.perf_counter() - b
-    total = time.perf_counter() - t0
-    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
-               "occlusion": t_occlusion, "complete": t_complete, "total": total,
-               "cpu": time.thread_time() - cpu0}  # fmt: skip
-    return FrameDetections(frame, detections, timings, source, shift)
+            found = Detection(int(k), mask, ex, error=str(exc), occlusion=occ)
+        return found, b - a, t_occlusion, time.perf_counter() - b, time.thread_time() - cpu0
 
 
 def _default_settings() -> Settings:

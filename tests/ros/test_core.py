@@ -136,6 +136,31 @@ def test_camera_info_ros1_and_ros2_names_and_image_size():
         frame_of(color, depth, info_msg())
 
 
+def test_a_processor_with_a_fruit_worker_gives_the_same_fruit_and_closes_it(example_images):
+    from symfruit.fruitpool import one_process_reason
+
+    alone = FrameProcessor(fruit="strawberry")
+    assert not alone.pool.active  # the library's default: no process
+    assert alone.workers_said() == "no fruit worker process (no worker process asked for (0))"
+    shared = FrameProcessor(fruit="strawberry", fruit_processes=1)
+    try:
+        assert shared.pool.active == (one_process_reason(1) == "")
+        assert shared.workers_said() == ("1 fruit worker process (warming up)" if shared.pool.active else
+                                         f"no fruit worker process ({one_process_reason(1)})")  # fmt: skip
+        assert shared.pool._wait_ready(600) or not shared.pool.active
+        shared.pool._caller_shares = False  # the worker does every fruit
+        messages = example_messages(example_images)
+        a, b = alone.process(*messages), shared.process(*messages)
+        assert [(f.id, f.centre.tolist(), f.size.tolist(), f.score) for f in a.fruits] == [
+            (f.id, f.centre.tolist(), f.size.tolist(), f.score) for f in b.fruits]  # fmt: skip
+        assert shared.pool.fruit_elsewhere == (len(b.fruits) if shared.pool.active else 0)
+        processes = [w.process for w in shared.pool._state.workers]
+    finally:
+        shared.close()
+        alone.close()
+    assert not shared.pool.active and not any(p.is_alive() for p in processes)
+
+
 @pytest.mark.parametrize(("color_encoding", "depth_encoding"), [("rgb8", "16UC1"), ("bgr8", "32FC1")])
 def test_processor_equals_detect_on_the_example_frame(example_images, example_fruits, color_encoding,
                                                       depth_encoding):  # fmt: skip

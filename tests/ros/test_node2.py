@@ -43,6 +43,7 @@ def test_parameters_are_checked_by_name():
     assert defaults == {name: default for name, (default, _) in PARAMETERS.items()}
     got = checked_parameters({"slop": 1, "queue_size": 3.0, "fruit": "apple", "config": None})
     assert got["slop"] == 1.0 and isinstance(got["slop"], float) and got["queue_size"] == 3 and got["config"] == ""
+    assert defaults["fruit_processes"] == 1 and checked_parameters({"fruit_processes": 0})["fruit_processes"] == 0
     for bad, message in [
         ({"slop": "abc"}, "parameter slop: expected a number, got 'abc'"),
         ({"slop": -0.1}, "parameter slop: expected seconds in [0, 10]"),
@@ -50,6 +51,9 @@ def test_parameters_are_checked_by_name():
         ({"queue_size": 0}, "parameter queue_size: expected 1 to 100"),
         ({"depth_scale": True}, "parameter depth_scale: expected a number, got True"),
         ({"qos": "best_effort"}, "parameter qos: expected one of reliable, sensor_data"),
+        ({"fruit_processes": 17}, "parameter fruit_processes: expected 0 to 16, got 17"),
+        ({"fruit_processes": -1}, "parameter fruit_processes: expected 0 to 16, got -1"),
+        ({"fruit_processes": 1.5}, "parameter fruit_processes: expected a whole number, got 1.5"),
     ]:
         with pytest.raises(SymfruitError, match="^" + message.replace("[", r"\[").replace("]", r"\]")):
             checked_parameters(bad)

@@ -136,18 +136,18 @@ def _bench_scene(sensor: str | None, seed: int) -> Any:
 
 
 def bench_frame(
-    *, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None
+    *, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None, pool: Any = None
 ) -> BenchRow:
     """Time :func:`symfruit.detect.detect` end to end (segment, extract, complete, box; no file I/O)
     on a 640x480 synthetic frame with 8 ripe strawberries (and 2 unripe ones to ignore); with ``sensor``
     (a key of :data:`symfruit.synthetic.sensors.SENSOR_MODELS`) the frame is rendered through that camera
     model at its colour resolution (1920x1080 or 1280x720) and its annotators' masks are used instead of the
-    colour segmenter."""
+    colour segmenter. ``pool``: :func:`~symfruit.detect.detect`'s (a :class:`~symfruit.fruitpool.FruitPool`)."""
     from ..detect import detect
 
     frame, model = _bench_scene(sensor, seed)
-    found = detect(frame, method=method)
-    ms = _time(lambda: detect(frame, method=method), repeat)
+    found = detect(frame, method=method, pool=pool)
+    ms = _time(lambda: detect(frame, method=method, pool=pool), repeat)
     n = sum(d.result is not None for d in found.detections)
     where = "" if model is None else f", {sensor} {model.width}x{model.height}"
     return _row(f"frame, {n} fruit, {method}{where}", method, Settings().paper.n_hypotheses, n, ms)
@@ -158,18 +158,18 @@ STAGES = ("segment", "trim", "register", "extract", "occlusion", "complete", "to
 
 
 def bench_stages(
-    *, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None
+    *, repeat: int = 20, seed: int = 0, method: str = DEFAULT_METHOD, sensor: str | None = None, pool: Any = None
 ) -> dict[str, np.ndarray]:
     """Milliseconds per stage of :func:`bench_frame`'s frame, ``repeat`` runs after a warm-up: each of
     :data:`STAGES` (``detect``'s timings; ``trim`` and ``register`` are part of ``extract``, ``occlusion`` of
     ``complete``; ``cpu`` the CPU time of the calling thread over the frame, which a busy machine disturbs
-    less than the wall time)."""
+    less than the wall time; with a ``pool``, :func:`~symfruit.detect.detect`'s, its workers' on their fruit too)."""
     from ..detect import detect
 
     frame, _ = _bench_scene(sensor, seed)
     for _ in range(min(5, repeat)):
-        detect(frame, method=method)
-    runs = [detect(frame, method=method).timings for _ in range(repeat)]
+        detect(frame, method=method, pool=pool)
+    runs = [detect(frame, method=method, pool=pool).timings for _ in range(repeat)]
     return {stage: np.array([t[stage] for t in runs]) * 1000.0 for stage in STAGES}
 
 

@@ -32,6 +32,7 @@ from ..core.frame import Frame
 from ..core.limits import shown
 from ..detect import FrameDetections, detect
 from ..errors import InputError, SymfruitError
+from ..fruitpool import MAX_FRUIT_PROCESSES, FruitPool
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
 from ..io.images import MIN_16BIT_DEPTH_REACH
 from ..methods import DEFAULT_METHOD
@@ -68,6 +69,10 @@ PARAMETERS: dict[str, tuple[Any, str]] = {
     "slop": (0.05, "largest stamp difference of a synchronised colour, depth and camera info, seconds"),
     "queue_size": (5, "messages kept per input topic for the synchroniser"),
     "qos": ("reliable", "input QoS: reliable (as the RealSense wrapper publishes) or sensor_data (best effort)"),
+    "fruit_processes": (
+        1,
+        "worker processes kept to share each frame's fruit with (0-16; 0: none; none either with fewer than two cores)",
+    ),
 }
 QOS_CHOICES = ("reliable", "sensor_data")
 
@@ -105,7 +110,7 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
     ------
     SymfruitError
         One line naming the parameter, for a number that is not one or is out of range (``depth_scale`` (0, 1] metres
-        per unit, ``slop`` 0-10 s, ``queue_size`` 1-100), or an unknown ``qos``.
+        per unit, ``slop`` 0-10 s, ``queue_size`` 1-100, ``fruit_processes`` 0-16), or an unknown ``qos``.
     """
     out: dict[str, Any] = {}
     for name, (default, _) in PARAMETERS.items():
@@ -135,6 +140,9 @@ def checked_parameters(values: dict[str, Any]) -> dict[str, Any]:
         raise SymfruitError(f"parameter slop: expected seconds in [0, 10], got {shown(out['slop'])}")
     if not 1 <= out["queue_size"] <= 100:
         raise SymfruitError(f"parameter queue_size: expected 1 to 100, got {shown(out['queue_size'])}")
+    if not 0 <= out["fruit_processes"] <= MAX_FRUIT_PROCESSES:
+        raise SymfruitError(f"parameter fruit_processes: expected 0 to {MAX_FRUIT_PROCESSES}, got "
+                            f"{shown(out['fruit_processes'])}")  # fmt: skip
     if out["qos"] not in QOS_CHOICES:
         raise SymfruitError(f"parameter qos: expected one of {', '.join(QOS_CHOICES)}, got {shown(out['qos'])}")
     return out
@@ -270,6 +278,10 @@ class FrameProcessor:
         Metres per unit of 16-bit depth images (0.001: millimetres).
     overrides : mapping, optional
         Nested ``{section: {key: value}}`` over the file.
+    fruit_processes : int
+        Worker processes kept to share each frame's fruit with (a :class:`~symfruit.fruitpool.FruitPool`, 0-16;
+        0, the default here: none; the nodes' parameter defaults to 1). They warm up while the first frames run in
+        this process alone; :meth:`close` ends them.
 
     Raises
     ------
@@ -287,6 +299,7 @@ class FrameProcessor:
         masks: str = "auto",
         depth_scale: float = 0.001,
         overrides: Mapping[str, Any] | None = None,
+        fruit_processes: int = 0,
     ) -> None:
         get_method(method)
         try:  # the nodes' own check: (0, 1] metres per unit, as documented and as a frame's camera.json
@@ -297,6 +310,19 @@ class FrameProcessor:
         self.settings = resolve_settings(fruit=fruit or None, config=config or None, overrides=overrides)
         self.mask_source = mask_source(masks, settings=self.settings)  # a bad model fails here, once
         self._warned: set[str] = set()  # what was said of the camera infos ("distortion", "principal point")
+        # last: a bad parameter above starts no process; no frame waits for the workers' warm-up (wait=False)
+        self.pool = FruitPool(fruit_processes, method=method, wait=False)
+
+    def close(self) -> None:
+        """End the fruit workers (:meth:`symfruit.fruitpool.FruitPool.close`); frames after it run in this process."""
+        self.pool.close()
+
+    def workers_said(self) -> str:
+        """The fruit workers in a line for the node's start-up log."""
+        pool = self.pool
+        if pool.active:
+            return f"{pool.processes} fruit worker process{'es' if pool.processes > 1 else ''} (warming up)"
+        return f"no fruit worker process ({pool.reason})"
 
     def frame(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Frame:
         """The :class:`~symfruit.core.frame.Frame` of the three messages (:func:`message_frame`); the first camera
@@ -310,7 +336,7 @@ class FrameProcessor:
         t0 = time.perf_counter()
         frame = self.frame(color, depth, info, name=name, source=source)
         t1 = time.perf_counter()
-        found = detect(frame, masks=self.mask_source, method=self.method, settings=self.settings)
+        found = detect(frame, masks=self.mask_source, method=self.method, settings=self.settings, pool=self.pool)
         t2 = time.perf_counter()
         fruits = fruits_of(found)
         t3 = time.perf_counter()

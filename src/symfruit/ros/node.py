@@ -19,8 +19,9 @@ itself) and publishes, per frame and with the colour image's header:
 
 Private parameters: ``~method`` (the default method, ``evidence``), ``~fruit`` (strawberry), ``~config``
 (settings file, ""), ``~masks`` (auto), resolved by :func:`symfruit.settings.resolve_settings` as on the command line;
-``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5), checked at start
-(:func:`private_parameters`). A frame that cannot be
+``~depth_scale`` (0.001 m per 16UC1 unit), ``~slop`` (0.05 s), ``~queue_size`` (5), ``~fruit_processes`` (1: a
+worker process kept to share each frame's fruit with, :class:`symfruit.fruitpool.FruitPool`; 0 for none), checked at
+start (:func:`private_parameters`). A frame that cannot be
 used is logged and skipped; frames arriving while one is processed are dropped (only the newest waits).
 Each frame logs its latency. Everything but rospy lives in :mod:`symfruit.ros.core`.
 """
@@ -186,7 +187,7 @@ class SymfruitNode:
         p = private_parameters(rospy.get_param, given_private_names(rospy.get_param_names(), rospy.get_name()))
         self.core = FrameProcessor(
             method=p["method"] or DEFAULT_METHOD, fruit=p["fruit"] or None, config=p["config"] or None,
-            masks=p["masks"], depth_scale=p["depth_scale"],
+            masks=p["masks"], depth_scale=p["depth_scale"], fruit_processes=p["fruit_processes"],
         )  # fmt: skip
         self.pub_detections = rospy.Publisher("~detections", self.vision_msgs.Detection3DArray, queue_size=2)
         self.pub_markers = rospy.Publisher("~markers", MarkerArray, queue_size=2)
@@ -204,12 +205,18 @@ class SymfruitNode:
         ]
         self.sync = message_filters.ApproximateTimeSynchronizer(subs, queue_size=queue_size, slop=slop)
         self.sync.registerCallback(self._on_frame)
-        rospy.on_shutdown(self.worker.stop)
+        rospy.on_shutdown(self._stop)
         rospy.loginfo("symfruit: method %s, listening to %s, %s, %s", self.core.method, *self.topics.values())
+        rospy.loginfo("symfruit: %s", self.core.workers_said())
 
     def _on_frame(self, color, depth, info) -> None:  # subscriber thread: hand over, never block
         if self.worker.put((time.perf_counter(), color, depth, info)):
             self.rospy.logdebug("symfruit: fell behind, dropped a frame (%d so far)", self.worker.dropped)
+
+    def _stop(self) -> None:
+        """At shutdown: the current frame finished, then the fruit workers ended."""
+        self.worker.stop()
+        self.core.close()
 
     def _on_error(self, item: Any, exc: BaseException) -> None:  # a bug, not a bad frame: log it, carry on
         self.rospy.logerr("symfruit: frame %s failed: %r", _stamp(item[1]), exc, exc_info=exc)
@@ -260,6 +267,7 @@ USAGE = """usage: symfruit ros [ROS arguments]
 Run the symfruit ROS 1 node (ROS_MASTER_URI from the environment). ROS arguments, e.g.:
   color:=/my/color/image_raw depth:=/my/depth camera_info:=/my/camera_info   remap the inputs
   _method:=evidence _fruit:=strawberry _config:=settings.yaml _masks:=auto   private parameters
+  _fruit_processes:=0                                                         no fruit worker process (default 1)
   __name:=symfruit __ns:=/robot                                               node name, namespace
 """
 

@@ -23,7 +23,8 @@ with the colour image's header:
 Parameters (``--ros-args -p name:=value``, read at start): ``method`` (the default method), ``fruit``
 (strawberry), ``config`` (settings file, ""), ``masks`` (auto), resolved as on the command line;
 ``depth_scale`` (0.001 m per 16UC1 unit), ``slop`` (0.05 s), ``queue_size`` (5), ``qos`` (``reliable``, as
-the RealSense wrapper publishes; ``sensor_data`` for best effort). A frame that cannot be used is logged
+the RealSense wrapper publishes; ``sensor_data`` for best effort), ``fruit_processes`` (1: a worker process kept to
+share each frame's fruit with, :class:`symfruit.fruitpool.FruitPool`; 0 for none). A frame that cannot be used is logged
 and skipped; frames arriving while one is processed are dropped (only the newest waits). SIGINT and
 SIGTERM end it cleanly (node and context destroyed). Everything but rclpy lives in :mod:`symfruit.ros.core`.
 """
@@ -216,7 +217,8 @@ class Ros2Node:
             p = self.params
             self.core = FrameProcessor(method=p["method"] or DEFAULT_METHOD, fruit=p["fruit"] or None,
                                        config=p["config"] or None, masks=p["masks"] or "auto",
-                                       depth_scale=p["depth_scale"])  # fmt: skip
+                                       depth_scale=p["depth_scale"],
+                                       fruit_processes=p["fruit_processes"])  # fmt: skip
         except Exception:
             self.node.destroy_node()
             raise
@@ -239,6 +241,7 @@ class Ros2Node:
             f"symfruit: method {self.core.method}, fruit {p['fruit'] or '-'}, qos {p['qos']}, listening to "
             + ", ".join(self.topics.values())
         )
+        self.log.info(f"symfruit: {self.core.workers_said()}")
 
     def input_topic(self, name: str) -> str:
         """``name`` as remapped with ``-r name:=...``, else its RealSense default (which may itself be remapped)."""
@@ -301,6 +304,7 @@ class Ros2Node:
         from rclpy.logging import get_logger
 
         self.worker.stop()
+        self.core.close()  # the fruit workers, after the last frame
         self.node.destroy_node()
         # after a signal the context is gone, and with it /rosout: this line goes to the console only
         get_logger(NODE_NAME).info(
@@ -313,6 +317,7 @@ USAGE = """usage: symfruit ros2 [--ros-args ...]
 Run the symfruit ROS 2 node (rclpy; `make ros2-env` builds .venv-ros2 with it). ROS arguments, e.g.:
   --ros-args -p method:=paper -p fruit:=apple -p config:=/abs/my.yaml -p masks:=auto      parameters
   --ros-args -p qos:=sensor_data                      best-effort inputs (default reliable, as RealSense)
+  --ros-args -p fruit_processes:=0                    no worker process for the fruit (default 1)
   --ros-args -r color:=/cam/rgb -r depth:=/cam/depth_aligned -r camera_info:=/cam/rgb/info   remap inputs
   --ros-args -r __node:=fruit_finder -r __ns:=/robot                                 node name, namespace
 Topics: in /camera/camera/color/image_raw, /camera/camera/aligned_depth_to_color/image_raw,

@@ -1,0 +1,642 @@
+"""A frame's fruit on worker processes kept between frames: :class:`FruitPool` (issue 19, stop 53; docs/proc53.md).
+
+The fruit of a frame are independent of each other, but two threads of one process gain nothing on them (the GIL;
+stop 52, docs/threads52.md). A :class:`FruitPool` keeps worker processes, started once (``forkserver``: never a fork
+of a process that may run threads, as the ROS nodes' executors) and warmed up (their compiled kernels loaded), and
+:func:`symfruit.detect.detect` with ``pool=`` shares each frame's fruit between the calling process and them::
+
+    with FruitPool(1) as pool:  # seconds, once
+        for frame in frames:
+            found = detect(frame, pool=pool)  # the same detections as without the pool, bit for bit
+
+How a frame goes: its arrays (depth, colour, labels, fruit pixels) are copied into one shared-memory segment, made
+as large as the frame needs and made anew when a larger frame comes; each worker is sent the small rest of the
+per-fruit task (camera, settings, method: a few kB pickled) and the fruit's boxes, sorted longest first (by mask
+pixels); the calling process and the workers then take the next fruit from one shared counter until none is left,
+so neither waits while fruit are left; each detection a worker made comes back pickled (its whole-image mask cut to
+its box), and the detections are returned in the frame's order. An error a fruit raises (not a fruit's ``error``,
+which is a detection: an exception) is the first failing fruit's in the frame's order, as one process raises it.
+
+A worker that dies (killed, a crash) or stays silent for :data:`STALL_TIMEOUT` seconds within a frame is ended: the
+fruit it had not returned are done in the calling process, and new workers are started at once for the next
+frames (a frame that comes before they are warm runs in the calling process: no frame waits for a start-up). The
+pool gives up after :data:`MAX_RESTARTS` starts in a row whose workers never finished a frame (it then stays
+inactive, :attr:`FruitPool.reason` says why). Every wait is bounded (the constants below give each bound's reason).
+
+The pool runs everything in the calling process (it is *inactive*, :attr:`FruitPool.reason` says why) where a second
+process does not belong: in a process ``multiprocessing`` started (an evaluation's or a multiprocessing pool's
+worker, a Dask worker under its nanny: they are one of several already, and daemonic ones cannot start children),
+in a Dask worker, with fewer than two usable cores (``os.sched_getaffinity``), with ``processes=0``, in a child
+forked from the pool's owner, and off POSIX. The shared-memory segment is unlinked when the pool is closed (the
+``with`` block's end, :meth:`FruitPool.close`, the pool collected, or the interpreter's exit), also after a worker
+died or the caller was interrupted.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import mmap
+import multiprocessing
+import os
+import queue
+import signal
+import sys
+import threading
+import time
+import traceback
+import weakref
+from collections.abc import Callable, Iterator
+from multiprocessing import shared_memory
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from .errors import InputError
+
+if TYPE_CHECKING:
+    from .detect import _Done, _Fruit
+
+__all__ = ["MAX_FRUIT_PROCESSES", "FruitPool", "check_fruit_processes", "one_process_reason", "usable_cores"]
+
+#: Most worker processes a :class:`FruitPool` starts (more than the cores less one gain nothing).
+MAX_FRUIT_PROCESSES = 16
+
+#: Seconds a worker's start and warm-up may take: imports and a small frame's detection, about 3-5 s with numba's
+#: cache warm, but a cold cache compiles every kernel (3-4 minutes on two loaded cores).
+START_TIMEOUT = 900.0
+
+#: Seconds a worker may stay silent within a frame before it is taken for stuck, ended, and its fruit done in the
+#: calling process: a fruit takes milliseconds (the slowest of the benchmark frames' about 10 ms, a 1080p frame's
+#: fruit tens of ms), so this only ends a worker that will not answer.
+STALL_TIMEOUT = 120.0
+
+#: Seconds a worker is given to stop when the pool closes before it is terminated (then killed).
+STOP_TIMEOUT = 10.0
+
+#: Starts in a row whose workers die before they finish a frame after which the pool stays inactive.
+MAX_RESTARTS = 3
+
+#: Seconds between two looks at a worker while waiting for it (its answer ends the wait at once).
+_POLL = 0.05
+
+#: Bytes a shared-memory segment is rounded up to (a slightly larger frame reuses it).
+_SEGMENT_STEP = 1 << 20
+
+#: Set in a pool's worker process: a worker never starts workers of its own.
+_IN_WORKER = False
+
+
+def check_fruit_processes(processes: Any, what: str = "processes") -> int:
+    """``processes`` as :class:`FruitPool` takes it: a whole number 0..:data:`MAX_FRUIT_PROCESSES`, else
+    :class:`~symfruit.errors.InputError` naming ``what`` (``--fruit-processes`` on the command line)."""
+    if (
+        isinstance(processes, bool)
+        or not isinstance(processes, int | np.integer)
+        or not (0 <= processes <= MAX_FRUIT_PROCESSES)
+    ):
+        raise InputError(f"{what} must be a whole number from 0 to {MAX_FRUIT_PROCESSES}, got {processes!r}")
+    return int(processes)
+
+
+def usable_cores() -> int:
+    """The CPU cores this process may run on (``os.sched_getaffinity`` where the system has it, else
+    ``os.cpu_count()``)."""
+    getaffinity = getattr(os, "sched_getaffinity", None)
+    return max(1, len(getaffinity(0)) if getaffinity is not None else (os.cpu_count() or 1))
+
+
+def one_process_reason(processes: int = 1) -> str:
+    """Why a :class:`FruitPool` of ``processes`` workers would run everything in this process ("" if it would
+    not): see the module's docstring."""
+    if processes == 0:
+        return "no worker process asked for (0)"
+    if os.name != "posix":
+        return "worker processes need POSIX shared memory"
+    if _IN_WORKER:
+        return "this process is a FruitPool worker"
+    if multiprocessing.current_process().daemon or multiprocessing.parent_process() is not None:
+        return ("this process was started by multiprocessing (an evaluation's, a multiprocessing pool's or a Dask "
+                "worker): it is one of several already")  # fmt: skip
+    if _in_dask_worker():
+        return "this process is a Dask worker: it is one of several already"
+    cores = usable_cores()
+    if cores < 2:
+        return f"this process may use {cores} core: a second process would only take turns with it"
+    return ""
+
+
+def _in_dask_worker() -> bool:
+    distributed = sys.modules.get("distributed")  # never imported for the question
+    if distributed is None:
+        return False
+    try:
+        distributed.get_worker()
+    except (ValueError, AttributeError):
+        return False
+    return True
+
+
+class _Lost(Exception):
+    """A worker was lost within a frame (dead, silent, or its pipe broken)."""
+
+
+class _Worker:
+    """One worker process and the calling side of its pipe."""
+
+    def __init__(self, process: Any, conn: Any) -> None:
+        self.process, self.conn, self.ready = process, conn, False
+
+
+class _State:
+    """What closing a pool ends: its workers and its shared-memory segment (apart from the pool, for
+    ``weakref.finalize``)."""
+
+    def __init__(self) -> None:
+        self.owner = os.getpid()
+        self.workers: list[_Worker] = []
+        self.segment: shared_memory.SharedMemory | None = None
+
+    def stop_workers(self, gently: bool) -> None:
+        workers, self.workers = self.workers, []
+        if os.getpid() != self.owner:  # a forked child's copy: the workers and the segment are the owner's
+            return
+        asks = [gently and w.ready for w in workers]  # one still warming up would hear it only when warm
+        for w, ask in zip(workers, asks, strict=True):
+            if ask and w.process.is_alive():
+                with contextlib.suppress(OSError, ValueError):
+                    w.conn.send(("stop",))
+        for w, ask in zip(workers, asks, strict=True):
+            w.process.join(STOP_TIMEOUT if ask else 0.0)
+            if w.process.is_alive():
+                w.process.terminate()
+                w.process.join(STOP_TIMEOUT)
+            if w.process.is_alive():
+                w.process.kill()
+                w.process.join(STOP_TIMEOUT)
+            w.conn.close()
+
+    def drop_segment(self) -> None:
+        segment, self.segment = self.segment, None
+        if segment is None or os.getpid() != self.owner:
+            return
+        segment.close()
+        with contextlib.suppress(FileNotFoundError):
+            segment.unlink()
+
+    def close(self) -> None:
+        try:
+            self.stop_workers(gently=True)
+        finally:
+            self.drop_segment()
+
+
+class FruitPool:
+    """Worker processes that take a share of each frame's fruit in :func:`symfruit.detect.detect` (``pool=``),
+    kept from frame to frame; a context manager (closed at the ``with`` block's end). See the module's docstring.
+
+    Parameters
+    ----------
+    processes : int
+        Worker processes, 0 to :data:`MAX_FRUIT_PROCESSES` (0: none, the pool is inactive). On two cores one is
+        what pays (the calling process works too).
+    method : str or None
+        The completion method the workers' warm-up runs (a small synthetic frame's detection: loads the compiled
+        kernels, seconds); None: no warm-up (the workers' first frame loads them).
+    wait : bool
+        Wait for the workers to be warm (bounded by :data:`START_TIMEOUT`) before returning; else the frames that
+        come before they are run in the calling process.
+    start_method : str
+        ``forkserver`` (default) or ``spawn``: never ``fork``, which copies a process that may be running threads.
+
+    Attributes
+    ----------
+    reason : str
+        Why the pool runs everything in the calling process ("" while it has workers).
+    started_s : float
+        Seconds the first workers took to start and warm up (with ``wait``; NaN otherwise).
+    fruit_elsewhere : int
+        Fruit the workers have done so far.
+    starts : int
+        Sets of workers started (1 and one more after each loss).
+    last_loss : str
+        Why the last set of workers was ended ("" while none was).
+
+    Raises
+    ------
+    InputError
+        ``processes`` out of bounds, an unknown ``start_method``.
+    SymfruitError
+        An unknown ``method``.
+    """
+
+    #: Whether the calling process takes fruit too (tests set it False on a pool: the workers then do every fruit).
+    _caller_shares = True
+
+    def __init__(
+        self, processes: int = 1, *, method: str | None = "evidence", wait: bool = True,
+        start_method: str = "forkserver",
+    ) -> None:  # fmt: skip
+        self.processes = check_fruit_processes(processes)
+        if start_method not in ("forkserver", "spawn"):
+            raise InputError(f"start_method must be forkserver or spawn (never fork), got {start_method!r}")
+        if method is not None:  # an unknown method is refused here, not by every worker's warm-up
+            from .methods.registry import get as get_method
+
+            get_method(method)
+        self.method, self.start_method = method, start_method
+        self.reason = one_process_reason(self.processes)
+        self.started_s, self.fruit_elsewhere, self.starts, self.last_loss = float("nan"), 0, 0, ""
+        self._state = _State()
+        self._close = weakref.finalize(self, self._state.close)
+        self._busy = threading.Lock()  # one frame at a time; another thread's frame meanwhile runs here alone
+        self._failed_starts, self._seq = 0, 0
+        self._lock: Any = None
+        self._counter: Any = None
+        self._started_at = 0.0  # time.monotonic() when the current set of workers was started
+        if not self.reason:
+            try:
+                self._start()
+                if wait and self._wait_ready(START_TIMEOUT):
+                    self.started_s = time.monotonic() - self._started_at
+            except BaseException:  # interrupted while waiting: no worker outlives the failed constructor
+                self.close()
+                raise
+
+    @property
+    def active(self) -> bool:
+        """Whether frames may use workers (in the process that made the pool)."""
+        return not self.reason and os.getpid() == self._state.owner
+
+    def __enter__(self) -> FruitPool:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def close(self) -> None:
+        """End the workers (asked to stop, then terminated after :data:`STOP_TIMEOUT` s) and unlink the shared
+        memory; the pool is inactive afterwards. Closing twice is harmless."""
+        if not self.reason:
+            self.reason = "the pool is closed"
+        self._close()
+        self._lock = self._counter = None  # their semaphore is unlinked when collected
+
+    def __repr__(self) -> str:
+        how = f"{len(self._state.workers)} workers" if self.active else f"inactive: {self.reason}"
+        return f"FruitPool({self.processes}, {how})"
+
+    # ---- workers ------------------------------------------------------------------------------------------------
+
+    def _start(self) -> None:
+        ctx: Any = multiprocessing.get_context(self.start_method)
+        self._lock, self._counter = ctx.Lock(), ctx.RawValue("q", 0)
+        self._started_at = time.monotonic()
+        for _ in range(self.processes):
+            here, there = ctx.Pipe(duplex=True)
+            process = ctx.Process(target=_worker_main, args=(there, self._lock, self._counter, self.method),
+                                  name="symfruit-fruit", daemon=True)  # fmt: skip
+            with _main_hidden():
+                process.start()
+            there.close()  # the worker's end lives in the worker alone: its death closes the pipe
+            self._state.workers.append(_Worker(process, here))
+        self.starts += 1
+
+    def _wait_ready(self, timeout: float) -> bool:
+        """Wait up to ``timeout`` seconds for every worker's word that it is warm; False if one is not yet. A worker
+        that died or failed its warm-up ends the set (:meth:`_lost`)."""
+        deadline = time.monotonic() + timeout
+        for w in self._state.workers:
+            while not w.ready:
+                left = deadline - time.monotonic()
+                if not w.conn.poll(max(0.0, min(left, _POLL))):
+                    if not w.process.is_alive():
+                        self._lost(f"a worker process ended during its start (exit code {w.process.exitcode})")
+                        return False
+                    if time.monotonic() - self._started_at > START_TIMEOUT:
+                        self._lost(f"a worker process was not ready after {START_TIMEOUT:.0f} s")
+                        return False
+                    if left <= 0:
+                        return False
+                    continue
+                try:
+                    word = w.conn.recv()
+                except (EOFError, OSError):
+                    self._lost("a worker process ended during its start")
+                    return False
+                if word[0] != "ready":
+                    self._lost(f"a worker process failed its warm-up: {word[1]}", give_up=True)
+                    return False
+                w.ready = True
+        return True
+
+    def _lost(self, why: str, *, give_up: bool = False) -> None:
+        """End the workers after a loss and start new ones (up to :data:`MAX_RESTARTS` sets in a row that never
+        finished a frame; then the pool stays inactive with ``why``)."""
+        self.last_loss = why
+        self._state.stop_workers(gently=False)
+        self._failed_starts += 1
+        if give_up or self._failed_starts >= MAX_RESTARTS:
+            self.reason = f"{why}; no more workers are started"
+            return
+        self._start()
+
+    # ---- a frame ------------------------------------------------------------------------------------------------
+
+    def run(self, fruit: _Fruit, jobs: list[tuple[int, tuple[slice, slice]]]) -> tuple[list[_Done], float]:
+        """``[fruit(k, sl) for k, sl in jobs]`` shared with the workers: the same list, in the same order, and the
+        CPU seconds the workers spent on their fruit. An exception a fruit raises is raised after the others are
+        done, the first failing fruit's in ``jobs``' order. Called by :func:`symfruit.detect.detect`."""
+        if not self.active or not self._busy.acquire(blocking=False):
+            return [fruit(k, sl) for k, sl in jobs], 0.0
+        try:
+            if not self._workers_ready():
+                return [fruit(k, sl) for k, sl in jobs], 0.0
+            try:
+                out, cpu = self._run(fruit, jobs)
+            except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
+                if self.active:
+                    self._lost("the calling process was interrupted within a frame")
+                raise
+        finally:
+            self._busy.release()
+        for kind, value in out:  # the first failing fruit's error, in the frame's order
+            if kind == "raised":
+                raise value
+        return [value for _, value in out], cpu
+
+    def _workers_ready(self) -> bool:
+        for w in self._state.workers:
+            if not w.process.is_alive():  # killed between frames: new workers for the next frames
+                self._lost(f"a worker process ended between frames (exit code {w.process.exitcode})")
+                return False
+        return self._wait_ready(0.0) if self.active else False
+
+    def _run(self, fruit: _Fruit, jobs: list[tuple[int, tuple[slice, slice]]]) -> tuple[list[tuple[str, Any]], float]:
+        """:meth:`run`'s work: each fruit's :func:`_attempt`, in ``jobs``' order, and the workers' CPU seconds."""
+        from .detect import _Fruit
+
+        # longest first (mask pixels; ties in the frame's order): the last fruit taken are the short ones
+        pixels = [int(np.count_nonzero(fruit.labels[sl] == k)) for k, sl in jobs]
+        order = sorted(range(len(jobs)), key=lambda i: -pixels[i])
+        todo = [jobs[i] for i in order]
+        arrays = {name: getattr(fruit, name) for name in _Fruit.ARRAYS}
+        name, size, layout = self._share(arrays)
+        rest = {k: v for k, v in fruit.__dict__.items() if k not in arrays}
+        self._seq += 1
+        seq, workers = self._seq, list(self._state.workers)
+        self._counter.value = 0  # no worker takes a fruit between frames: each said "done" to the last one
+        message = ("frame", seq, name, size, layout, type(fruit), rest, todo, os.environ.get("SYMFRUIT_KERNELS"))
+        found: list[Any] = [None] * len(todo)  # ("ok", _Done) or ("raised", exception), in ``todo``'s order
+        theirs, done, cpu, lost = [False] * len(todo), [False] * len(workers), 0.0, ""
+        for w in workers:
+            try:
+                w.conn.send(message)
+            except OSError:
+                lost = "a worker process's pipe broke"
+        while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
+            found[i] = _attempt(fruit, *todo[i])
+            for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
+                lost = lost or self._take(w, seq, found, theirs, done, j, wait=0.0)[0]
+        for j, w in enumerate(workers):
+            silent_since = time.monotonic()
+            while not lost and not done[j]:
+                lost, heard = self._take(w, seq, found, theirs, done, j, wait=_POLL)
+                if heard:
+                    silent_since = time.monotonic()
+                elif not w.process.is_alive():
+                    lost = f"a worker process ended within a frame (exit code {w.process.exitcode})"
+                elif time.monotonic() - silent_since > STALL_TIMEOUT:
+                    lost = f"a worker process was silent for {STALL_TIMEOUT:.0f} s within a frame"
+        if lost:  # the fruit not returned are done here; new workers for the next frames
+            self._lost(lost)
+            for i, got in enumerate(found):
+                if got is None:
+                    found[i] = _attempt(fruit, *todo[i])
+                    theirs[i] = False
+        else:
+            self._failed_starts = 0
+        out: list[Any] = [None] * len(jobs)
+        for i, got in enumerate(found):
+            out[order[i]] = got
+            if theirs[i] and got[0] == "ok":
+                cpu += got[1][4]
+                self.fruit_elsewhere += 1
+        return out, cpu
+
+    def _take(self, w: _Worker, seq: int, found: list[Any], theirs: list[bool], done: list[bool], j: int,
+              wait: float) -> tuple[str, bool]:  # fmt: skip
+        """Read what worker ``w`` (the ``j``-th) sent, waiting up to ``wait`` seconds for a first message: its fruit
+        into ``found`` (``theirs`` marked), the end of its share into ``done``. Returns why it is lost ("" if it is
+        not) and whether anything came."""
+        heard = False
+        while w.conn.poll(0.0 if heard else wait):
+            try:
+                word = w.conn.recv()  # from this pool's own worker, over a pipe no one else holds
+            except (EOFError, OSError):
+                return f"a worker process ended within a frame (exit code {w.process.exitcode})", heard
+            heard = True
+            if word[1] != seq:  # cannot happen: each worker said "done" to the frame before
+                return "a worker process answered another frame", heard
+            if word[0] == "done":
+                done[j] = True
+                break
+            found[word[2]], theirs[word[2]] = _unpacked(word[3]), True
+        return "", heard
+
+    def _share(self, arrays: dict[str, np.ndarray | None]) -> tuple[str, int, dict[str, Any]]:
+        """Copy ``arrays`` into the shared segment (a larger one made first when they do not fit); its name, size
+        and each array's place ``(offset, dtype, shape)`` (None for a None)."""
+        layout: dict[str, Any] = {}
+        at = 0
+        for key, a in arrays.items():
+            if a is None:
+                layout[key] = None
+                continue
+            layout[key] = (at, a.dtype.str, a.shape)
+            at += -(-a.nbytes // 64) * 64
+        segment = self._state.segment
+        if segment is None or segment.size < at:
+            self._state.drop_segment()  # a worker keeps its mapping of the old one until the next frame's
+            size = max(_SEGMENT_STEP, -(-at // _SEGMENT_STEP) * _SEGMENT_STEP)
+            segment = self._state.segment = shared_memory.SharedMemory(create=True, size=size)
+        for key, a in arrays.items():
+            if a is not None:
+                offset, dtype, shape = layout[key]
+                np.copyto(np.ndarray(shape, dtype, buffer=segment.buf, offset=offset), a)
+        return segment.name, segment.size, layout
+
+
+# ---- both sides ---------------------------------------------------------------------------------------------------
+
+
+@contextlib.contextmanager
+def _main_hidden() -> Iterator[None]:
+    """While a worker starts: this process's ``__main__`` without its file and spec, so that the worker does not
+    import it again (as ``spawn`` and ``forkserver`` do, running a script without an ``if __name__ == "__main__"``
+    guard once more): the worker needs nothing of it."""
+    main = sys.modules.get("__main__")
+    if main is None:
+        yield
+        return
+    saved: dict[str, Any] = {key: main.__dict__[key] for key in ("__file__", "__spec__") if key in main.__dict__}
+    main.__dict__.pop("__file__", None)
+    main.__dict__["__spec__"] = None
+    try:
+        yield
+    finally:
+        main.__dict__.pop("__spec__", None)
+        main.__dict__.update(saved)
+
+
+def _claim(lock: Any, counter: Any, count: int) -> int | None:
+    """The next fruit's place in the frame's list (the shared counter taken and moved on under the shared lock),
+    None when none is left. A lock not had within :data:`STALL_TIMEOUT` s (its holder died holding it) ends the
+    taking: None."""
+    if not lock.acquire(timeout=STALL_TIMEOUT):
+        return None
+    try:
+        i = counter.value
+        if i >= count:
+            return None
+        counter.value = i + 1
+        return int(i)
+    finally:
+        lock.release()
+
+
+def _attempt(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tuple[str, Any]:
+    """``("ok", fruit(k, sl))``, or ``("raised", the exception)`` (an ``Exception``; anything else goes up)."""
+    try:
+        return "ok", fruit(k, sl)
+    except Exception as exc:
+        return "raised", exc
+
+
+def _packed(got: tuple[str, Any]) -> tuple[Any, ...]:
+    """A worker's answer for one fruit, small to pickle: a detection's whole-image mask cut to its box (its
+    extraction's outline is the same array or none), an exception pickled or told as text."""
+    kind, value = got
+    if kind == "raised":
+        value.add_note(f"(in FruitPool worker {os.getpid()}:\n{''.join(traceback.format_exception(value))})")
+        return ("raised", value)  # the sender tells it as text if it does not pickle (_send_all)
+    d, *times = value
+    mask, ex = d.mask, d.extraction
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    box = (int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1) if len(rows) else (0, 0, 0, 0)
+    same = ex.silhouette is mask
+    fields = {k: v for k, v in d.__dict__.items() if k not in ("mask", "extraction")}
+    ex_fields = ex.__dict__ | ({"silhouette": None} if same else {})
+    window = np.ascontiguousarray(mask[box[0] : box[1], box[2] : box[3]])
+    return ("ok", fields, ex_fields, mask.shape, box, window, same, tuple(times))
+
+
+def _unpacked(packed: tuple[Any, ...]) -> tuple[str, Any]:
+    """:func:`_packed`'s answer as :func:`_attempt` gives it."""
+    if packed[0] == "raised":
+        return "raised", packed[1]
+    from .detect import Detection
+    from .extract import Extraction
+
+    _, fields, ex_fields, shape, box, window, same, times = packed
+    mask = np.zeros(shape, bool)
+    mask[box[0] : box[1], box[2] : box[3]] = window
+    ex = object.__new__(Extraction)
+    ex.__dict__.update(ex_fields)
+    if same:
+        ex.__dict__["silhouette"] = mask
+    d = object.__new__(Detection)
+    d.__dict__.update(fields, mask=mask, extraction=ex)
+    return "ok", (d, *times)
+
+
+# ---- the worker ---------------------------------------------------------------------------------------------------
+
+
+def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None:
+    """A worker process: warm up, say so, then take fruit of each frame it is sent until told to stop or its pipe
+    closes (the calling process ended)."""
+    global _IN_WORKER
+    _IN_WORKER = True
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C in a terminal reaches the whole group: the caller decides
+    outbox: queue.SimpleQueue[tuple[Any, ...] | None] = queue.SimpleQueue()
+    sender = threading.Thread(target=_send_all, args=(conn, outbox), daemon=True)
+    sender.start()  # sent from there: a full pipe never holds the next fruit up
+    try:
+        try:
+            if method is not None:
+                _warm_up(method)
+        except Exception as exc:
+            conn.send(("failed", f"{type(exc).__name__}: {exc}"))
+            return
+        conn.send(("ready", os.getpid()))
+        mapped: tuple[str, mmap.mmap] | None = None
+        while True:
+            message = conn.recv()
+            if message[0] != "frame":
+                return
+            _, seq, name, size, layout, kind, rest, todo, kernels = message
+            if kernels is None:
+                os.environ.pop("SYMFRUIT_KERNELS", None)
+            else:
+                os.environ["SYMFRUIT_KERNELS"] = kernels
+            if mapped is None or mapped[0] != name:
+                if mapped is not None:
+                    with contextlib.suppress(BufferError):
+                        mapped[1].close()
+                mapped = (name, _map(name, size))
+            _frame(mapped[1], seq, layout, kind, rest, todo, lock, counter, outbox)
+    except (EOFError, OSError, KeyboardInterrupt):
+        return
+    finally:
+        outbox.put(None)
+        sender.join(STOP_TIMEOUT)
+
+
+def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: dict[str, Any], todo: list[Any],
+           lock: Any, counter: Any, outbox: queue.SimpleQueue[tuple[Any, ...] | None]) -> None:  # fmt: skip
+    """One frame's share: fruit taken from the shared counter until none is left, each answer queued for the
+    sender, then the frame's end. ``kind``: the per-fruit task's class (``detect``'s ``_Fruit``)."""
+    fruit: Any = object.__new__(kind)
+    arrays = {key: None if at is None else np.ndarray(at[2], at[1], buffer=buf, offset=at[0])
+              for key, at in layout.items()}  # fmt: skip
+    fruit.__dict__.update(rest, **arrays)
+    while (i := _claim(lock, counter, len(todo))) is not None:
+        outbox.put(("fruit", seq, i, _packed(_attempt(fruit, *todo[i]))))
+    outbox.put(("done", seq))
+
+
+def _send_all(conn: Any, outbox: queue.SimpleQueue[tuple[Any, ...] | None]) -> None:
+    """The worker's sender thread: each answer sent (pickled by the pipe) until ``None``; an exception that does not
+    pickle goes as a ``RuntimeError`` with its type and text."""
+    while (word := outbox.get()) is not None:
+        try:
+            try:
+                conn.send(word)
+            except OSError:
+                raise
+            except Exception:  # only a fruit's exception can fail to pickle: sent nothing, told as text
+                exc = word[3][1]
+                conn.send((*word[:3], ("raised", RuntimeError(f"{type(exc).__name__}: {exc}"))))
+        except OSError:
+            return
+
+
+def _map(name: str, size: int) -> mmap.mmap:
+    """The caller's segment ``name`` mapped here without registering it with the resource tracker (the caller
+    unlinks it; a worker's registration would unlink it when the worker ends, or warn)."""
+    import _posixshmem  # type: ignore[import-not-found]  # POSIX shared memory, as multiprocessing's own
+
+    fd = _posixshmem.shm_open("/" + name, os.O_RDWR, mode=0o600)
+    try:
+        return mmap.mmap(fd, size)
+    finally:
+        os.close(fd)
+
+
+def _warm_up(method: str) -> None:
+    """A small synthetic frame's detection with ``method``: the compiled kernels loaded before the first frame."""
+    from .detect import detect
+    from .evaluate.bench import _bench_scene
+
+    frame, _ = _bench_scene(None, 0)
+    detect(frame, method=method)
