@@ -430,3 +430,26 @@ def test_a_png_whose_last_row_is_0_is_known_whole_without_inflating_it_again(tmp
             images.read_color(tmp_path / "marked.png")[:-1], images.read_color(tmp_path / "zeros.png")[:-1]
         )
         assert counted == [1]
+
+
+def test_an_image_grown_while_it_is_decoded_is_refused_naming_it(tmp_path, monkeypatch):
+    """Robust53: a photo (``segment``), a masks PNG (``detect --masks``) or any image written on while it is
+    decoded is refused by name, not taken as it was at that moment."""
+    import symfruit.io.images as images
+
+    path = tmp_path / "c.png"
+    Image.fromarray(np.full((8, 8, 3), 90, np.uint8)).save(path)
+    size = path.stat().st_size
+    real = images._decode
+
+    def decode_then_grow(img, label):
+        out = real(img, label)
+        with open(path, "ab") as f:
+            f.write(b"\0\0")
+        return out
+
+    monkeypatch.setattr(images, "_decode", decode_then_grow)
+    for read in (images.read_color, images.read_labels, images.read_depth_units):
+        with pytest.raises(FileFormatError, match=rf"c\.png: changed while it was read \(its size went from {size:,} "):
+            read(path)
+        size += 2

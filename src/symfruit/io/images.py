@@ -42,7 +42,7 @@ import numpy as np
 
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  # checked before decoding
 from ..errors import FileFormatError
-from .text import as_path, refuse_pipe
+from .text import as_path, refuse_pipe, unchanged_while
 
 __all__ = [
     "MAX_IMAGE_PIXELS",
@@ -385,7 +385,7 @@ def read_color(path: str | Path) -> np.ndarray:
 def read_color_oriented(path: str | Path) -> tuple[np.ndarray, int]:
     """:func:`read_color`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_color: the image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         shown, orientation = _decode(img, str(path))
         return _to_rgb(shown, str(path)), orientation
 
@@ -438,7 +438,7 @@ def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndar
 def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -> tuple[np.ndarray, int]:
     """:func:`read_depth_units`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_depth_units: the depth image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         _single(img, str(path), "a depth image")
         img, orientation = _decode(img, str(path))
         kind = f"depth {img.format or 'image'}"  # PNG, TIFF, ... (a folder of depth images may hold any)
@@ -475,7 +475,7 @@ def read_labels(path: str | Path) -> np.ndarray:
 def read_labels_oriented(path: str | Path) -> tuple[np.ndarray, int]:
     """:func:`read_labels`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_labels: the label image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         _single(img, str(path), "a label image")
         img, orientation = _decode(img, str(path))
         mode = img.mode
