@@ -583,3 +583,40 @@ def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocess
     # the first frame is written, but its result may be lost with the worker before the client gathers it (then
     # it is unprocessed too: the test above): done may be none
     _stopped_with_the_rest_unprocessed(result["report"], one.scheduler_address, out)
+
+
+def _blas_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return sorted({info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"})
+
+
+def _first_task(job, part) -> list[int]:
+    from symfruit.season.cluster import detect_part
+
+    detect_part(job, part)
+    return _blas_threads()
+
+
+def test_a_worker_process_runs_numpys_blas_on_one_thread_from_its_first_task(tmp_path):
+    """Robust53: a worker started without a nanny (``dask worker --no-nanny``) kept numpy's OpenBLAS on every core:
+    two on two cores took 1.3-1.6x the CPU (docs/robust53.md). Its first task limits it to one thread, in a
+    worker process of its own; in the client's own process (an in-process cluster) the caller's BLAS is left be.
+    The worker is a forked process whose parent runs two BLAS threads (a process that kept them would say 2)."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from symfruit.season.cluster import Job, Part
+
+    part = Part(indices=(), names=(), folders=())  # no frame: the task's set-up alone
+    job = Job(run="r", source=str(tmp_path), shown=str(tmp_path), output=str(tmp_path / "o"), recording="r",
+              inputs=(), input_folders=(), exclude=(), client=os.getpid())  # fmt: skip
+    fork = multiprocessing.get_context("fork")
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() != [2]:
+            pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
+            assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
+            assert pool.submit(_first_task, job, part).result() == [1]
+        assert _first_task(job, part) == [2]  # the client's own process: its BLAS left be
