@@ -169,7 +169,7 @@ def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitE
     except OSError as exc:
         raise error(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:
-        raise error(f"{path}: {what} is larger than {max_bytes // 1024} kB; this cannot be a {what}")
+        raise error(f"{path}: {what} is larger than {max_bytes // 1024} kB; this cannot be {_a(what)}")
     return data
 
 
