@@ -3,6 +3,7 @@ works on a frame, gives the serial run's detections frame for frame and tables w
 after --resume; the client refuses what the workers could not do."""
 
 import contextlib
+import dataclasses
 import importlib.util
 import json
 import os
@@ -620,3 +621,5 @@ def test_a_worker_process_runs_numpys_blas_on_one_thread_from_its_first_task(tmp
             assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
             assert pool.submit(_first_task, job, part).result() == [1]
         assert _first_task(job, part) == [2]  # the client's own process: its BLAS left be
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:  # a job that names no client: left be
+            assert pool.submit(_first_task, dataclasses.replace(job, client=0), part).result() == [2]

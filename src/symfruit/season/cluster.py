@@ -242,19 +242,20 @@ def _read(job: Job, part: Part, k: int) -> Any:
     return frame
 
 
-#: Whether this worker process has limited its BLAS to one thread (:func:`_one_blas_thread`).
-_BLAS_LIMITED = False
+#: The process that limited its BLAS to one thread (:func:`_one_blas_thread`): a process forked from it has not.
+_BLAS_LIMITED_IN = 0
 
 
 def _one_blas_thread(job: Job) -> None:
     """A worker process's first task limits its BLAS to one thread (:func:`symfruit.threads.one_blas_thread`): a
     worker started without a nanny (``dask worker --no-nanny``) ran numpy's OpenBLAS on every core, two such
     workers on two cores 1.3-1.6x the CPU of one thread each (robust53; a nanny's workers already run one).
-    Not in the client's own process (a Python caller's in-process cluster): its BLAS is the caller's."""
-    global _BLAS_LIMITED
-    if _BLAS_LIMITED or os.getpid() == job.client:
+    Not in the client's own process (a Python caller's in-process cluster), nor for a job that names no client
+    (one a caller made without :func:`run_distributed`): its BLAS is the caller's."""
+    global _BLAS_LIMITED_IN
+    if _BLAS_LIMITED_IN == os.getpid() or not job.client or os.getpid() == job.client:
         return
-    _BLAS_LIMITED = True
+    _BLAS_LIMITED_IN = os.getpid()
     one_blas_thread()
 
 
