@@ -3,7 +3,7 @@
 A worker process forked after numpy is loaded keeps the BLAS threads numpy's OpenBLAS started with (one per core;
 ``OPENBLAS_NUM_THREADS`` set after the fork no longer reaches it), and so does a Dask worker started without a
 nanny (``dask worker --no-nanny``; a nanny sets the variables before its worker starts): two workers on two cores
-ran four BLAS threads, 10 % slower in the evaluation (stop 52) and a third to a half slower in ``detect
+ran four BLAS threads, 10 % slower in the evaluation (stop 52) and 1.1-1.6x the CPU in ``detect
 --scheduler`` (robust53; README "Speed")."""
 
 from __future__ import annotations

@@ -99,7 +99,7 @@ FileState = tuple[int, int, int, int] | None
 
 
 def file_states(paths: Iterable[Path]) -> dict[Path, FileState]:
-    """Each path's :data:`FileState` now: taken before a read, compared after it by :func:`check_unchanged`."""
+    """Each path's :data:`FileState` now: taken before a read, compared after it by :func:`changed`."""
     states: dict[Path, FileState] = {}
     for path in paths:
         try:

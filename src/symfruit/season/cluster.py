@@ -249,7 +249,7 @@ _BLAS_LIMITED_IN = 0
 def _one_blas_thread(job: Job) -> None:
     """A worker process's first task limits its BLAS to one thread (:func:`symfruit.threads.one_blas_thread`): a
     worker started without a nanny (``dask worker --no-nanny``) ran numpy's OpenBLAS on every core, two such
-    workers on two cores 1.3-1.6x the CPU of one thread each (robust53; a nanny's workers already run one).
+    workers on two cores 1.1-1.6x the CPU of one thread each (robust53; a nanny's workers already run one).
     Not in the client's own process (a Python caller's in-process cluster), nor for a job that names no client
     (one a caller made without :func:`run_distributed`): its BLAS is the caller's."""
     global _BLAS_LIMITED_IN
