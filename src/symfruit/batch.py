@@ -463,7 +463,7 @@ def _tables(output: Path, recordings: list[tuple[str, list[tuple[str, Path]]]], 
     try:
         bad = write_run_tables(output, recordings, root=out, inputs={v: k for k, v in inputs.items()})
     except SymfruitError as exc:
-        report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
+        report.stopped = report.stopped or f"cannot write the run's tables ({exc})"  # exc names the table
         return
     for name, reason in bad.items():
         report.failed[name] = reason

@@ -209,7 +209,7 @@ def test_a_worker_runs_numpys_blas_on_one_thread():
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor
 
-    from symfruit.evaluate.runner import _single_thread
+    from symfruit.threads import one_blas_thread
 
     fork = multiprocessing.get_context("fork")  # the runner's workers on Linux (Python's default there before 3.14)
 
@@ -218,5 +218,5 @@ def test_a_worker_runs_numpys_blas_on_one_thread():
             pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
         with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
             assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
-        with ProcessPoolExecutor(max_workers=1, mp_context=fork, initializer=_single_thread) as pool:
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork, initializer=one_blas_thread) as pool:
             assert pool.submit(_blas_threads).result() == [1]

@@ -1005,3 +1005,23 @@ def test_the_room_claimed_by_another_process_counts_until_it_ends(tmp_path, monk
     finally:
         holder.kill()
         holder.wait(30)
+
+
+def test_a_bag_changed_after_it_was_opened_fails_its_frames_naming_the_file(tmp_path):
+    """Robust53: a bag's index is taken when it is opened; a file of it grown, replaced or rewritten since (a
+    recorder still writing, a copy landing over it) was read by that stale index. Now each frame read looks at
+    its files first: one changed fails the frame, naming the file and how; the frames read before stand."""
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    bag = write_ros2_bag(tmp_path / "rec", color, (depth * 1000).astype(np.uint16), frames=3, storage="mcap")
+    (mcap,) = sorted(bag.glob("*.mcap"))
+    with open_source(bag) as src:
+        assert src.read(0).name == src.names()[0]
+        size = mcap.stat().st_size
+        with open(mcap, "ab") as f:
+            f.write(b"\0" * 7)
+        for k in (1, 2):
+            with pytest.raises(FileFormatError, match=rf"^{re.escape(str(mcap))}: changed since the bag was opened "
+                               rf"\(its size went from {size:,} to {size + 7:,} bytes\); it is being written or "
+                               "replaced: read it again once it is whole$"):  # fmt: skip
+                src.read(k)

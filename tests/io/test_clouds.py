@@ -498,3 +498,31 @@ def test_a_cloud_this_user_may_not_read_is_refused_in_its_words_not_errnos(unrea
     assert said == f"refused: {ply}: cannot read as PLY (Permission denied)"
     npy_said = refusal_unprivileged("from symfruit.io.clouds import read_cloud; read_cloud(P0)", npy)
     assert npy_said == f"refused: {npy}: not a valid .npy file (cannot read it: Permission denied)"
+
+
+@pytest.mark.parametrize("suffix", [".npy", ".ply", ".xyz"])
+def test_a_cloud_grown_while_it_is_read_is_refused_naming_it(tmp_path, monkeypatch, suffix):
+    """Robust53: a cloud file written on while it was read was taken as it was at that moment (part old, part
+    new); now it is refused by name, saying how it changed (the change made by the reader itself: no race)."""
+    import symfruit.io.clouds as clouds
+
+    path = tmp_path / f"c{suffix}"
+    if suffix == ".npy":
+        np.save(path, POINTS)
+    elif suffix == ".ply":
+        write_ply(path, POINTS)
+    else:
+        np.savetxt(path, POINTS)
+    size = path.stat().st_size
+    real = clouds.CLOUD_READERS[suffix]
+
+    def read_then_grow(p):
+        points = real(p)
+        with open(p, "ab") as f:
+            f.write(b"\n")
+        return points
+
+    monkeypatch.setitem(clouds.CLOUD_READERS, suffix, read_then_grow)
+    with pytest.raises(FileFormatError, match=rf"c\{suffix}: changed while it was read \(its size went from "
+                       rf"{size:,} to {size + 1:,} bytes\); it is being written or replaced"):  # fmt: skip
+        read_cloud(path)

@@ -610,3 +610,102 @@ def test_write_frame_refuses_images_and_a_camera_of_other_sizes_before_writing(t
         assert not (tmp_path / str(k)).exists()
     write_frame(tmp_path / "good", color, depth, SMALL_CAM, masks=np.zeros(depth.shape, np.uint8))
     assert read_frame(tmp_path / "good").depth.shape == depth.shape
+
+
+def _change(path, how: str) -> None:
+    """Change ``path`` as another program would while it is read: grow it, replace it with a copy of itself,
+    rewrite it the same size (a newer modification time) or remove it."""
+    import os
+
+    if how == "grown":
+        with open(path, "ab") as f:
+            f.write(b"\0" * 10)
+    elif how == "replaced":
+        shutil.copyfile(path, f"{path}.new")
+        os.replace(f"{path}.new", path)
+    elif how == "rewritten":
+        st = os.stat(path)
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 1_000_000))
+    else:
+        os.remove(path)
+
+
+CHANGES = {
+    "grown": r"its size went from ([\d,]+) to \1 bytes",  # the size said (filled in by the test)
+    "replaced": r"it was replaced by another file",
+    "rewritten": r"it was rewritten: its modification time changed",
+    "removed": r"it was removed",
+}
+
+
+@pytest.mark.parametrize("how", list(CHANGES))
+def test_a_file_changed_while_the_frame_is_read_fails_the_frame_naming_it(tmp_path, monkeypatch, how):
+    """Robust53: a frame's colour image changed after it was read and before the frame was whole (another
+    program writing the folder) was taken as it was: the frame paired one moment's colour with another's depth.
+    Now each file is looked at before and after, and one that changed fails the frame, naming it and how. The
+    change is made by the reader of the depth (no race)."""
+    import symfruit.io.frames as frames
+
+    folder = tmp_path / "f"
+    shutil.copytree(EXAMPLE_FRAME, folder)
+    size = (folder / "color.png").stat().st_size
+    real = frames.read_depth
+
+    def depth_then_change(*args, **kwargs):
+        depth = real(*args, **kwargs)
+        _change(folder / "color.png", how)
+        return depth
+
+    monkeypatch.setattr(frames, "read_depth", depth_then_change)
+    said = CHANGES[how].replace(r"([\d,]+) to \1", f"{size:,} to {size + 10:,}")
+    colour = re.escape(str(folder / "color.png"))
+    with pytest.raises(FileFormatError, match=rf"^{colour}: changed while the frame was read \({said}\); it is being "
+                       "written or replaced: read it again once it is whole$"):  # fmt: skip
+        read_frame(folder)
+    monkeypatch.setattr(frames, "read_depth", real)
+    if how != "removed":
+        assert read_frame(folder).color.shape  # read again once still: read
+
+
+def test_a_file_cut_while_read_is_refused_as_changed_not_in_the_parsers_words(tmp_path, monkeypatch):
+    """A depth PNG cut to a third while it is decoded fails the decoder; the change is the reason said."""
+    import symfruit.io.images as images
+
+    folder = tmp_path / "f"
+    shutil.copytree(EXAMPLE_FRAME, folder)
+    real = images._open
+
+    def cut_then_open(source, label):
+        if str(source).endswith("depth.png"):
+            data = source.read_bytes()
+            source.write_bytes(data[: len(data) // 3])
+        return real(source, label)
+
+    monkeypatch.setattr(images, "_open", cut_then_open)
+    with pytest.raises(FileFormatError, match=r"depth\.png: changed while the frame was read \(its size went from"):
+        read_frame(folder)
+
+
+def test_a_batch_goes_on_past_a_frame_changed_while_it_was_read(tmp_path, monkeypatch):
+    """Three frames, the second's depth grown while the frame is read: it fails by name, the others are done."""
+    import symfruit.io.frames as frames
+    from symfruit.batch import run_batch
+
+    from ..conftest import small_frame
+
+    rec = tmp_path / "rec"
+    for k in range(3):
+        shutil.copytree(small_frame(), rec / f"f_{k}")
+    real = frames.read_depth
+
+    def depth_then_change(path, *args, **kwargs):
+        depth = real(path, *args, **kwargs)
+        if path.parent.name == "f_1":
+            _change(path, "grown")
+        return depth
+
+    monkeypatch.setattr(frames, "read_depth", depth_then_change)
+    report = run_batch(rec, tmp_path / "out", method="raw", progress=False)
+    assert sorted(report.done) == ["f_0", "f_2"]
+    assert list(report.failed) == ["f_1"]
+    assert report.failed["f_1"].startswith(f"{rec / 'f_1' / 'depth.png'}: changed while the frame was read (its size")

@@ -403,3 +403,53 @@ def test_an_interlaced_png_is_counted_by_its_seven_passes(tmp_path):
     (tmp_path / "cut.png").write_bytes(_png(width, height, data[:cut], kind=2, interlaced=1))
     with pytest.raises(FileFormatError, match=rf"cut\.png: its PNG data holds {cut} of {len(data)} bytes"):
         read_color(tmp_path / "cut.png")
+
+
+@pytest.mark.parametrize("mode", ["I;16", "L", "1", "RGB", "P"])  # RGBA, LA: a last row of alpha 255 is not 0
+def test_a_png_whose_last_row_is_0_is_known_whole_without_inflating_it_again(tmp_path, monkeypatch, mode):
+    """Robust53: a depth PNG whose bottom rows hold no depth (0) had its data inflated a second time to count its
+    rows (+13-16 ms a 1080p read, docs/robust52.md). Its last row is now marked before Pillow decodes it: the
+    decoder wrote over the mark, so the PNG is whole, and nothing is inflated again. A last row holding the mark
+    itself is counted (and read); one cut short still refused (the tests above)."""
+    import symfruit.io.images as images
+
+    counted = []
+    real = images._png_inflated
+    monkeypatch.setattr(images, "_png_inflated", lambda *a: counted.append(1) or real(*a))
+    pixels = (np.arange(30 * 20).reshape(30, 20) % 200 + 1).astype(np.uint16 if mode == "I;16" else np.uint8)
+    pixels[-5:] = 0
+    image = Image.fromarray(pixels).convert(mode) if mode != "I;16" else Image.fromarray(pixels)
+    image.save(tmp_path / "zeros.png")
+    assert images.read_color(tmp_path / "zeros.png").shape == (30, 20, 3)
+    assert not counted, "the rows were counted: the data inflated again"
+    pixels[-1] = images._MARK * (0x101 if mode == "I;16" else 1)  # the last row is the mark itself: counted
+    image = Image.fromarray(pixels).convert(mode) if mode != "I;16" else Image.fromarray(pixels)
+    image.save(tmp_path / "marked.png")
+    if mode in ("I;16", "L", "RGB"):  # the modes whose whole last row this makes the mark, band by band
+        assert np.array_equal(
+            images.read_color(tmp_path / "marked.png")[:-1], images.read_color(tmp_path / "zeros.png")[:-1]
+        )
+        assert counted == [1]
+
+
+def test_an_image_grown_while_it_is_decoded_is_refused_naming_it(tmp_path, monkeypatch):
+    """Robust53: a photo (``segment``), a masks PNG (``detect --masks``) or any image written on while it is
+    decoded is refused by name, not taken as it was at that moment."""
+    import symfruit.io.images as images
+
+    path = tmp_path / "c.png"
+    Image.fromarray(np.full((8, 8, 3), 90, np.uint8)).save(path)
+    size = path.stat().st_size
+    real = images._decode
+
+    def decode_then_grow(img, label):
+        out = real(img, label)
+        with open(path, "ab") as f:
+            f.write(b"\0\0")
+        return out
+
+    monkeypatch.setattr(images, "_decode", decode_then_grow)
+    for read in (images.read_color, images.read_labels, images.read_depth_units):
+        with pytest.raises(FileFormatError, match=rf"c\.png: changed while it was read \(its size went from {size:,} "):
+            read(path)
+        size += 2

@@ -113,7 +113,10 @@ def test_coco_uses_the_first_image_and_ids_or_order(tmp_path):
     [({"id": 2**40}, r"annotation 1 has id 1099511627776; a fruit's id is a whole number 1 to 2147483647"),
      ({"id": 1.5}, r"annotation 1 has id 1\.5"), ({"id": True}, r"annotation 1 has id True"),
      ({"id": "7"}, r"annotation 1 has id '7'"),
-     ({"segmentation": []}, r"annotation 1 has no valid segmentation \(segmentation is an empty list\)")],
+     ({"segmentation": []}, r"annotation 1 has no valid segmentation \(segmentation is an empty list\)"),
+     ({"segmentation": None}, r"annotation 1 has no valid segmentation \(segmentation must be polygons \(a list\) "
+                              r"or an RLE \(an object\), got null\)$"),  # robust53: was "... is a NoneType"
+     ({"segmentation": "abc"}, r"\(segmentation must be polygons \(a list\) or an RLE \(an object\), got 'abc'\)$")],
 )  # fmt: skip
 def test_a_frames_coco_id_that_cannot_be_a_label_or_an_empty_outline_is_refused(tmp_path, change, error):
     """Before: the id replaced by the annotation's place (matched to another fruit's truth), the fruit without

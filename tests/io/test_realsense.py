@@ -621,3 +621,20 @@ def test_a_bag_this_user_may_not_read_is_refused_in_its_words_not_errnos(unreada
     shutil.copy(BAG, path)
     said = refusal_unprivileged("from symfruit.io.sources import open_source; open_source(P0)", path)
     assert said == f"refused: {path}: cannot open bag (Permission denied)"
+
+
+def test_a_recording_replaced_after_it_was_opened_fails_its_frames_naming_it(tmp_path):
+    """Robust53: a RealSense bag replaced after its index was read (a new recording copied over it) fails each
+    frame read since, by name, not read by the old index."""
+    import os
+    import shutil
+
+    bag = tmp_path / "fruit.bag"
+    shutil.copyfile(BAG, bag)
+    with RealSenseBagSource(bag) as src:
+        assert src.read(0).color.shape
+        shutil.copyfile(BAG, tmp_path / "new.bag")
+        os.replace(tmp_path / "new.bag", bag)
+        with pytest.raises(FileFormatError, match=rf"^{re.escape(str(bag))}: changed since the bag was opened \(it "
+                           r"was replaced by another file\)"):  # fmt: skip
+            src.read(0)

@@ -32,6 +32,10 @@ def test_a_file_over_the_bound_is_refused(tmp_path):
     with pytest.raises(FileFormatError, match=r"big\.json: settings file is larger than 1 kB"):
         read_structured(path, what="settings file", max_bytes=1024)
     assert len(read_limited(path, what="file", max_bytes=4096)) == path.stat().st_size
+    # robust53: "this cannot be a intrinsics file" (a camera.json of a million distortion coefficients)
+    with pytest.raises(FileFormatError, match=r"big\.json: intrinsics file is larger than 1 kB; this cannot be an "
+                       "intrinsics file$"):  # fmt: skip
+        read_limited(path, what="intrinsics file", max_bytes=1024)
 
 
 @pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="needs /dev/zero")

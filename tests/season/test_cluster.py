@@ -2,6 +2,8 @@
 works on a frame, gives the serial run's detections frame for frame and tables with each fruit once, also
 after --resume; the client refuses what the workers could not do."""
 
+import contextlib
+import dataclasses
 import importlib.util
 import json
 import os
@@ -88,6 +90,33 @@ def recording(tmp_path_factory):
     for k in range(4):
         shutil.copytree(small_frame(), rec / f"scene_{k:05d}")
     return rec
+
+
+@contextlib.contextmanager
+def _one_worker(recording, out: Path, **options):
+    """An in-process cluster of one worker on 127.0.0.1 and ``run_distributed`` of ``recording`` into ``out`` on
+    it in a thread (chunk 1, method raw, --no-worker-timeout 2 and ``options``): yields the cluster, the thread
+    (for the test to start, once what it patches knows the cluster) and the dict its report lands in
+    (``report``). The three tests whose one worker leaves, pauses or falls silent share it (robust53)."""
+    from distributed import LocalCluster
+
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
+                      dashboard_address=None) as one:  # fmt: skip
+        result: dict = {}
+        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
+            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
+            no_worker_timeout=2, **options)), daemon=True)  # fmt: skip
+        yield one, runner, result
+
+
+def _stopped_with_the_rest_unprocessed(report, address: str, out: Path) -> None:
+    """The run stopped for want of a worker after 2 s, nothing failed, the frames not done recorded unprocessed
+    (``--resume`` takes them up) in errors.json."""
+    assert report.stopped.startswith(f"the Dask cluster ({address}) had no worker for 2 s")
+    assert not report.failed
+    assert report.unprocessed and len(report.done) + len(report.unprocessed) == 4
+    errors = json.loads((out / "errors.json").read_text())
+    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
 
 
 def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(cluster, recording, tmp_path, capsys):
@@ -466,38 +495,28 @@ def test_a_result_lost_with_the_last_worker_before_it_was_gathered_is_unprocesse
     """The one worker leaves after the first task finished but before the client gathered its result (a race that
     a worker leaving at any moment can hit): the client reschedules that task on no worker, and the run, which
     waits on its result, stops after the time-out with it unprocessed, not waited on for ever."""
-    from distributed import LocalCluster
-
     import symfruit.season.cluster as cluster
 
     real = cluster._outcomes
     left = threading.Event()
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
-                      dashboard_address=None) as one:  # fmt: skip
+    running: dict = {}  # the cluster, once started
 
-        def late(future, part, distributed):  # the first finished task's result is asked for once the worker left
-            if not left.is_set():
-                left.set()
-                one.scale(0)
-                _wait_for(lambda: not one.scheduler.workers, 60, "the worker to leave")
-            return real(future, part, distributed)
+    def late(future, part, distributed):  # the first finished task's result is asked for once the worker left
+        if not left.is_set():
+            left.set()
+            running["cluster"].scale(0)
+            _wait_for(lambda: not running["cluster"].scheduler.workers, 60, "the worker to leave")
+        return real(future, part, distributed)
 
-        monkeypatch.setattr(cluster, "_outcomes", late)
-        out = tmp_path / "o"
-        result: dict = {}
-        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
-            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
-            no_worker_timeout=2)), daemon=True)  # fmt: skip
+    monkeypatch.setattr(cluster, "_outcomes", late)
+    out = tmp_path / "o"
+    with _one_worker(recording, out) as (one, runner, result):
+        running["cluster"] = one
         runner.start()
         runner.join(120)
         assert not runner.is_alive(), "the run waited for a result lost with the last worker"
-    report = result["report"]
     assert left.is_set()
-    assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
-    assert not report.failed
-    assert report.unprocessed and len(report.done) + len(report.unprocessed) == 4
-    errors = json.loads((out / "errors.json").read_text())
-    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
+    _stopped_with_the_rest_unprocessed(result["report"], one.scheduler_address, out)
 
 
 @pytest.mark.parametrize("how", ["paused", "silent"])
@@ -506,7 +525,6 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
     heartbeat stopped: a frozen process, a lost network) stays registered, and the watch counted it: the run
     waited for ever (paused) or for the scheduler's worker-ttl. Now neither counts: after the time-out the run
     stops, the frames not done unprocessed. The silence is --silent-worker-timeout's (its least, 10 s; stop 52)."""
-    from distributed import LocalCluster
     from distributed.core import Status
 
     import symfruit.season.cluster as cluster
@@ -522,13 +540,8 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
 
     monkeypatch.setattr(cluster, "detect", held)  # the in-process worker runs this module
     out = tmp_path / "o"
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
-                      dashboard_address=None) as one:  # fmt: skip
+    with _one_worker(recording, out, silent_worker_timeout=10) as (one, runner, result):
         worker = next(iter(one.workers.values()))
-        result: dict = {}
-        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
-            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
-            no_worker_timeout=2, silent_worker_timeout=10)), daemon=True)  # fmt: skip
         runner.start()
         _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
 
@@ -545,19 +558,13 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
         release.set()
         assert not alive, f"the run waited on a {how} worker"
         assert len(one.scheduler.workers) == 1  # still registered
-    report = result["report"]
-    assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
-    assert len(report.done) == 1 and len(report.unprocessed) == 3
-    assert not report.failed
-    errors = json.loads((out / "errors.json").read_text())
-    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
+    _stopped_with_the_rest_unprocessed(result["report"], one.scheduler_address, out)
+    assert len(result["report"].done) == 1 and len(result["report"].unprocessed) == 3
 
 
 def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocessed(recording, tmp_path, monkeypatch):
     """The one worker leaves once the first frame is written (each frame takes a second here): after the time-out
     the run stops, the frames not done recorded unprocessed (``--resume`` takes them up), not waited on for ever."""
-    from distributed import LocalCluster
-
     import symfruit.season.cluster as cluster
 
     real = cluster.detect
@@ -568,22 +575,51 @@ def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocess
 
     monkeypatch.setattr(cluster, "detect", slow)  # the in-process worker runs this module
     out = tmp_path / "o"
-    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tcp://", host="127.0.0.1",
-                      dashboard_address=None) as one:  # fmt: skip
-        result: dict = {}
-        runner = threading.Thread(target=lambda: result.update(report=run_distributed(
-            recording, out, scheduler=one.scheduler_address, chunk=1, method="raw", progress=False,
-            no_worker_timeout=2)))  # fmt: skip
+    with _one_worker(recording, out) as (one, runner, result):
         runner.start()
         _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
         one.scale(0)
         runner.join(120)
         assert not runner.is_alive()
-    report = result["report"]
-    assert report.stopped.startswith(f"the Dask cluster ({one.scheduler_address}) had no worker for 2 s")
     # the first frame is written, but its result may be lost with the worker before the client gathers it (then
     # it is unprocessed too: the test above): done may be none
-    assert report.unprocessed and len(report.done) + len(report.unprocessed) == 4
-    assert not report.failed
-    errors = json.loads((out / "errors.json").read_text())
-    assert sorted(errors["unprocessed"]) == sorted(report.unprocessed)
+    _stopped_with_the_rest_unprocessed(result["report"], one.scheduler_address, out)
+
+
+def _blas_threads() -> list[int]:
+    from threadpoolctl import threadpool_info
+
+    return sorted({info["num_threads"] for info in threadpool_info() if info["user_api"] == "blas"})
+
+
+def _first_task(job, part) -> list[int]:
+    from symfruit.season.cluster import detect_part
+
+    detect_part(job, part)
+    return _blas_threads()
+
+
+def test_a_worker_process_runs_numpys_blas_on_one_thread_from_its_first_task(tmp_path):
+    """Robust53: a worker started without a nanny (``dask worker --no-nanny``) kept numpy's OpenBLAS on every core:
+    two on two cores took 1.3-1.6x the CPU (docs/robust53.md). Its first task limits it to one thread, in a
+    worker process of its own; in the client's own process (an in-process cluster) the caller's BLAS is left be.
+    The worker is a forked process whose parent runs two BLAS threads (a process that kept them would say 2)."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor
+
+    from symfruit.season.cluster import Job, Part
+
+    part = Part(indices=(), names=(), folders=())  # no frame: the task's set-up alone
+    job = Job(run="r", source=str(tmp_path), shown=str(tmp_path), output=str(tmp_path / "o"), recording="r",
+              inputs=(), input_folders=(), exclude=(), client=os.getpid())  # fmt: skip
+    fork = multiprocessing.get_context("fork")
+    with threadpoolctl.threadpool_limits(limits=2, user_api="blas"):
+        if _blas_threads() != [2]:
+            pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
+            assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
+            assert pool.submit(_first_task, job, part).result() == [1]
+        assert _first_task(job, part) == [2]  # the client's own process: its BLAS left be
+        with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:  # a job that names no client: left be
+            assert pool.submit(_first_task, dataclasses.replace(job, client=0), part).result() == [2]

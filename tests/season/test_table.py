@@ -164,3 +164,28 @@ def test_a_frame_named_like_a_table_gets_a_folder_of_its_own(tmp_path):
 
 def test_the_recording_is_named_by_its_input():
     assert recording_name("/data/season/row_12.bag") == "row_12.bag" and recording_name("rec/") == "rec"
+
+
+def test_a_table_that_cannot_be_opened_leaves_the_earlier_runs_tables_as_they_were(tmp_path, monkeypatch):
+    """Robust53 (``detect --resume`` into an output whose frames.parquet became a folder): the second table could
+    not be opened, and the first, opened, was put in place of the earlier run's detections.parquet as its header
+    alone (4 bytes, no table), its writer left to say "Exception ignored in ParquetWriter.__del__" at exit. Now
+    neither table is touched and no writer is left open."""
+    import gc
+    import sys
+
+    from symfruit import SymfruitError
+
+    with TableWriter(tmp_path) as table:  # an earlier run's tables
+        table.add(*frame_rows(RECORD, "rec"))
+    before = (tmp_path / "detections.parquet").read_bytes()
+    (tmp_path / "frames.parquet").unlink()
+    (tmp_path / "frames.parquet").mkdir()
+    unraised: list = []
+    monkeypatch.setattr(sys, "unraisablehook", unraised.append)
+    with pytest.raises(SymfruitError, match=r"frames\.parquet: is a folder"), TableWriter(tmp_path):
+        pass
+    gc.collect()
+    assert (tmp_path / "detections.parquet").read_bytes() == before
+    assert not unraised, [str(u.exc_value) for u in unraised]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["detections.parquet", "frames.parquet"]  # no temporary

@@ -175,3 +175,21 @@ def test_a_masks_file_that_is_no_png_or_json_is_refused_when_the_source_is_made(
     (tmp_path / "labels.tif").write_bytes(b"")
     with pytest.raises(FileFormatError, match=r"labels\.tif: masks must be a label \.png or a COCO \.json"):
         mask_source(tmp_path / "labels.tif")
+
+
+def test_a_frames_mask_that_is_a_link_loop_or_a_folder_is_refused_by_name_not_taken_for_none(photo, tmp_path):
+    """Robust53: ``detect --masks FOLDER`` whose ``<frame>.png`` was a link that loops (or leads nowhere, or a
+    folder) said "no masks for frame" as if nothing had that name."""
+    import os
+
+    from symfruit import FileFormatError
+
+    color, _ = photo
+    os.symlink("frame_1.png", tmp_path / "frame_1.png")
+    os.symlink("gone.png", tmp_path / "frame_2.png")
+    (tmp_path / "frame_3.png").mkdir()
+    source = mask_source(tmp_path)
+    for name, why in (("frame_1", "a link that leads to no file"), ("frame_2", "a link that leads to no file"),
+                      ("frame_3", "a directory, not a file")):  # fmt: skip
+        with pytest.raises(FileFormatError, match=rf"{name}\.png: {why}"):
+            source(color, name=name)

@@ -17,6 +17,7 @@ from ..methods.complete import complete
 from ..occlusion import fruit_occlusion
 from ..progress import Progress
 from ..settings import Settings
+from ..threads import one_blas_thread
 from .metrics import score_completion
 from .protocols import Spec, build
 
@@ -107,7 +108,7 @@ def _isolated(batch: list[Spec], methods: Sequence[str], settings: Settings) -> 
     rows: list[Row] = []
     for spec in batch:
         try:
-            with ProcessPoolExecutor(max_workers=1, initializer=_single_thread) as one:
+            with ProcessPoolExecutor(max_workers=1, initializer=one_blas_thread) as one:
                 rows += one.submit(_batch, ([spec], methods, settings)).result()
         except BrokenProcessPool:
             rows += _failed_rows(spec, methods, WORKER_DIED)
@@ -196,7 +197,7 @@ def run(
                 out.append(_batch((b, methods, settings)))
                 bar.update(len(b))
         else:
-            with ProcessPoolExecutor(max_workers=jobs, initializer=_single_thread) as pool:
+            with ProcessPoolExecutor(max_workers=jobs, initializer=one_blas_thread) as pool:
                 futures = [pool.submit(_batch, (b, methods, settings)) for b in batches]
                 for b, future in zip(batches, futures, strict=True):
                     try:
@@ -208,21 +209,6 @@ def run(
                     out.append(rows)
                     bar.update(len(b))
     return [row for rows in out for row in rows]
-
-
-def _single_thread() -> None:
-    """A worker process's initializer: numpy's BLAS (and OpenMP) on one thread, as many workers as cores.
-
-    The variables reach what the worker loads from now on; numpy's OpenBLAS, loaded before the fork, is limited
-    directly by threadpoolctl (the ``fast`` extra). Without it the worker keeps the parent's BLAS threads: two
-    workers on two cores ran four, about 10 % slower (stop 52; README "Speed")."""
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-        os.environ.setdefault(var, "1")
-    try:
-        from threadpoolctl import threadpool_limits
-    except ImportError:
-        return
-    threadpool_limits(1)
 
 
 def average_ranks(x: np.ndarray) -> np.ndarray:

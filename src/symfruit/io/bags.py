@@ -52,6 +52,7 @@ from .intrinsics import (
     warn_distortion,
     warn_principal_point,
 )
+from .text import FileState, file_states, unchanged_while
 
 __all__ = [
     "BagSource",
@@ -78,6 +79,17 @@ _YUV422 = {"yuyv": (0, 1, 2, 3), "yuy2": (0, 1, 2, 3), "yuv422_yuy2": (0, 1, 2, 
 #: Largest image a message may claim (pixels), checked before its data is touched (with the largest side:
 #: :func:`symfruit.core.limits.check_image_size`).
 MAX_MESSAGE_PIXELS = MAX_IMAGE_PIXELS
+
+
+def bag_files(path: Path) -> dict[Path, FileState]:
+    """The states (:func:`~symfruit.io.text.file_states`) of the files a bag is read from: the file, or a ROS 2
+    bag folder's ``metadata.yaml`` and every file beside it. A frame read after one changed is refused naming
+    it (robust53): the index taken at the opening is of the bag as it was."""
+    if not path.is_dir():
+        return file_states([path])
+    with contextlib.suppress(OSError):
+        return file_states([path / "metadata.yaml", *sorted(p for p in path.iterdir() if p.is_file())])
+    return file_states([path / "metadata.yaml"])
 
 
 def _require_rosbags() -> Any:
@@ -988,6 +1000,7 @@ class BagSource:
     def __init__(self, path: Path, *, max_skew: float = 0.05) -> None:
         self.path = Path(path)
         self.max_skew = max_skew
+        self._files = bag_files(self.path)  # each frame read checks that none changed since (robust53)
         reader_cls = _require_rosbags()
         self._chunks: dict[Path, dict[int, tuple[int, int, int]]] = {}  # each MCAP file's chunks (ChunkExpands)
         if self.path.is_dir():
@@ -1102,6 +1115,10 @@ class BagSource:
         raise FileFormatError(f"{self.path}: no message on {conn.topic} at {stamp}")  # pragma: no cover
 
     def read(self, index: int) -> Frame:
+        with unchanged_while(self._files, "since the bag was opened"):
+            return self._read(index)
+
+    def _read(self, index: int) -> Frame:
         if not 0 <= index < len(self._depth_stamps):
             raise IndexError(f"frame index {index} out of range for {len(self._depth_stamps)} frames")
         stamp = self._depth_stamps[index]

@@ -20,7 +20,7 @@ import numpy as np
 from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write
-from .text import as_path, refuse_pipe
+from .text import as_path, refuse_pipe, unchanged_while
 
 __all__ = ["CLOUD_READERS", "npy_header", "read_cloud", "read_npy", "read_pcd", "read_ply", "read_text", "write_ply"]
 
@@ -51,6 +51,16 @@ def read_cloud(path: str | Path) -> np.ndarray:
         raise FileFormatError(
             f"{path}: not a regular file ({'a folder' if path.is_dir() else 'a pipe, socket or device'})"
         )
+    with unchanged_while([path], "while it was read"):
+        points = _read_points(path, reader)
+    if points.ndim != 2 or points.shape[1] != 3:
+        raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")
+    with np.errstate(invalid="ignore", over="ignore"):
+        return np.ascontiguousarray(points, dtype=np.float64)
+
+
+def _read_points(path: Path, reader: Any) -> np.ndarray:
+    """``reader(path)``, its failures in one line naming the file."""
     try:
         with np.errstate(invalid="ignore", over="ignore"):  # a signalling NaN or a huge float64 stored as float32:
             points = reader(path)  # non-finite points, dropped with the rest (never a warning from the cast)
@@ -63,10 +73,7 @@ def read_cloud(path: str | Path) -> np.ndarray:
     except (ValueError, OSError, EOFError, IndexError, KeyError) as exc:
         why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc  # not "[Errno 13] ...: 'PATH'"
         raise FileFormatError(f"{path}: cannot read as {path.suffix.lstrip('.').upper()} ({why})") from None
-    if points.ndim != 2 or points.shape[1] != 3:
-        raise FileFormatError(f"{path}: expected x, y, z columns, got an array of shape {points.shape}")
-    with np.errstate(invalid="ignore", over="ignore"):
-        return np.ascontiguousarray(points, dtype=np.float64)
+    return points
 
 
 def _header(path: Path, kind: str, magic: bytes, end: re.Pattern[bytes]) -> tuple[bytes, int, int]:

@@ -52,7 +52,7 @@ from .images import (
     read_depth_units_oriented,
     turned_mismatch,
 )
-from .text import as_path, holds_file, read_structured
+from .text import as_path, holds_file, read_structured, unchanged_while
 
 __all__ = [
     "COLOR_FILE",
@@ -75,6 +75,9 @@ DEFAULT_DEPTH_SCALE = 0.001
 COLOR_FILE = "color_file"
 #: Colour image names a frame folder may use, in order of preference.
 COLOR_NAMES = ("color.png", "color.jpg", "color.jpeg")
+#: The other files a frame folder's frame is read from (:func:`read_frame`).
+FRAME_FILES = ("camera.json", "camera.yaml", "camera.yml", "depth.png", "depth.npy", "masks.png", "masks.json",
+               "truth.json")  # fmt: skip
 #: Largest truth.json read (bytes), and largest depth.npy (elements): :mod:`symfruit.core.limits`.
 MAX_DEPTH_ELEMENTS = MAX_IMAGE_PIXELS
 
@@ -125,17 +128,24 @@ def read_frame(folder: str | Path) -> Frame:
     ------
     FileFormatError or InputError
         Naming the file and the problem: missing file, unreadable image, sizes that disagree, unknown
-        depth units.
+        depth units, a file changed while the frame was read.
     """
-    from .intrinsics import camera_from_file_data, read_mapping
-    from .masks import read_masks
-
     folder = as_path(folder, "read_frame: the frame folder")
     if not folder.is_dir():
         raise FileFormatError(f"{folder}: no such frame folder")
     if unreadable_folder(folder):
         raise FileFormatError(f"{folder}: cannot read frame folder ({os.strerror(errno.EACCES)}: this user may not "
                               "list it or open what it holds)")  # fmt: skip
+    # every file a frame may be read from, looked at before and after: one changed in between fails the frame
+    with unchanged_while([folder / name for name in (*COLOR_NAMES, *FRAME_FILES)], "while the frame was read"):
+        return _read_frame(folder)
+
+
+def _read_frame(folder: Path) -> Frame:
+    """:func:`read_frame` of a folder that is one and may be read."""
+    from .intrinsics import camera_from_file_data, read_mapping
+    from .masks import read_masks
+
     color_path = _only(folder, *COLOR_NAMES)  # color.png beside color.jpg: which one is meant?
     if color_path is None:
         raise FileFormatError(f"{folder}: no color.png or color.jpg")

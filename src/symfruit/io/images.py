@@ -42,7 +42,7 @@ import numpy as np
 
 from ..core.limits import MAX_IMAGE_PIXELS, check_image_size, instance_labels  # checked before decoding
 from ..errors import FileFormatError
-from .text import as_path, refuse_pipe
+from .text import as_path, refuse_pipe, unchanged_while
 
 __all__ = [
     "MAX_IMAGE_PIXELS",
@@ -144,11 +144,12 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("error", Image.DecompressionBombWarning)
+            marked = _png_mark(img)
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
         raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
     if getattr(img, "format", None) == "PNG":
-        _png_whole(img, label)
+        _png_whole(img, label, marked)
     orientation = _orientation(img)
     turn = _TRANSPOSE.get(orientation)
     return (img if turn is None else img.transpose(Image.Transpose[turn])), orientation
@@ -171,14 +172,48 @@ def _png_file(img: Any) -> Any:
 _PNG_SAMPLES = {0: 1, 2: 3, 3: 1, 4: 2, 6: 4}
 
 
-def _png_whole(img: Any, label: str) -> None:
+#: The value :func:`_png_mark` fills a PNG's last row with before Pillow decodes it (each band; 16-bit: 0x5A5A):
+#: any value would do; one that a whole row of an image rarely holds (a row of 0, no depth, is common).
+_MARK = 0x5A
+
+
+def _png_mark(img: Any) -> tuple[Any, bytes] | None:
+    """Before a single, non-interlaced PNG is decoded: the image memory Pillow will decode it into, made here
+    with its last row filled with :data:`_MARK` (Pillow keeps image memory of the right mode and size, and
+    leaves a row its data does not reach as it was), and that row's bytes as stored, so that
+    :func:`_png_whole` sees whether the decoder wrote the row without inflating the data again (robust53);
+    None where not so marked."""
+    from PIL import Image
+
+    if getattr(img, "format", None) != "PNG" or img.info.get("interlace") or getattr(img, "is_animated", False):
+        return None
+    try:
+        width, height = img.size
+        row = (0, height - 1, width, height)
+        memory = Image.core.new(img.mode, img.size)
+        value = _MARK * 0x101 if img.mode in _WIDE_GREY else _MARK
+        memory.paste(value if len(img.getbands()) == 1 else (value,) * len(img.getbands()), row)
+        stored = img._new(memory.crop(row)).tobytes()
+    except Exception:  # a Pillow that makes image memory otherwise: the rows are counted (_png_whole)
+        return None
+    img.im = memory
+    return memory, stored
+
+
+def _png_whole(img: Any, label: str, marked: tuple[Any, bytes] | None = None) -> None:
     """Refuse a PNG whose image data holds fewer rows than its header states: Pillow decodes such a file without
     a word, the rows missing left 0 (no depth, black) when the compressed stream ends cleanly before them (stop
-    52, robust52). The rows are counted (the data inflated again, nothing kept) only where the decoded image's
-    last row is all 0 or the file is interlaced: a last row of data was decoded, so every row before it was."""
+    52, robust52). A last row of data was decoded, so every row before it was: where the decoder wrote over the
+    mark :func:`_png_mark` left in the last row (``marked``: Pillow decoded into that memory), or, unmarked,
+    where the last row is not all 0, the PNG is whole. Otherwise (interlaced; a last row that holds the mark
+    itself; unmarked and all 0) the rows are counted: the data inflated again, nothing kept."""
     width, height = img.size
     interlaced = bool(img.info.get("interlace"))
-    if not interlaced and img.crop((0, height - 1, width, height)).getbbox() is not None:
+    last = img.crop((0, height - 1, width, height))
+    if marked is not None and getattr(img, "im", None) is marked[0]:
+        if last.tobytes() != marked[1]:
+            return
+    elif not interlaced and last.getbbox() is not None:
         return
     file = _png_file(img)
     if file is None:
@@ -350,7 +385,7 @@ def read_color(path: str | Path) -> np.ndarray:
 def read_color_oriented(path: str | Path) -> tuple[np.ndarray, int]:
     """:func:`read_color`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_color: the image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         shown, orientation = _decode(img, str(path))
         return _to_rgb(shown, str(path)), orientation
 
@@ -403,7 +438,7 @@ def read_depth_units(path: str | Path, *, scale: float | None = None) -> np.ndar
 def read_depth_units_oriented(path: str | Path, *, scale: float | None = None) -> tuple[np.ndarray, int]:
     """:func:`read_depth_units`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_depth_units: the depth image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         _single(img, str(path), "a depth image")
         img, orientation = _decode(img, str(path))
         kind = f"depth {img.format or 'image'}"  # PNG, TIFF, ... (a folder of depth images may hold any)
@@ -440,7 +475,7 @@ def read_labels(path: str | Path) -> np.ndarray:
 def read_labels_oriented(path: str | Path) -> tuple[np.ndarray, int]:
     """:func:`read_labels`, and the EXIF orientation it applied (1: none)."""
     path = as_path(path, "read_labels: the label image")
-    with _open(path, str(path)) as img:
+    with unchanged_while([path], "while it was read"), _open(path, str(path)) as img:
         _single(img, str(path), "a label image")
         img, orientation = _decode(img, str(path))
         mode = img.mode

@@ -79,8 +79,9 @@ def annotation_mask(ann: Any, shape: tuple[int, int], where: str) -> np.ndarray:
             if not (isinstance(size, list) and len(size) == 2 and [int(size[0]), int(size[1])] == [h, w]):
                 raise FileFormatError(f"{where}: RLE size {size!r} is not the image's {[h, w]}")
             return rle_decode(seg)
-        if not isinstance(seg, list):
-            raise TypeError(f"segmentation is a {type(seg).__name__}")
+        if not isinstance(seg, list):  # was "segmentation is a NoneType" (robust53): JSON's words, not Python's
+            kind = "null" if seg is None else f"{shown(seg, 40)}"
+            raise TypeError(f"segmentation must be polygons (a list) or an RLE (an object), got {kind}")
         if not seg:  # no outline at all: the fruit would vanish from the labels unsaid (as one without the key)
             raise ValueError("segmentation is an empty list")
         img = Image.new("L", (w, h), 0)

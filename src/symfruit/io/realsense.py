@@ -43,9 +43,10 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..core.limits import shown
 from ..errors import FileFormatError, InputError, SymfruitError
-from .bags import _require_rosbags, color_image, image_array, index_reason, reader_reason
+from .bags import _require_rosbags, bag_files, color_image, image_array, index_reason, reader_reason
 from .frames import named_frame
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
+from .text import unchanged_while
 
 __all__ = ["RealSenseBagSource", "Stream", "is_realsense", "quaternion_matrix", "sdk_aligned"]
 
@@ -116,6 +117,7 @@ class RealSenseBagSource:
     def __init__(self, path: Path, *, max_skew: float = 0.05) -> None:
         self.path = Path(path)
         self.max_skew = max_skew
+        self._files = bag_files(self.path)  # each frame read checks that none changed since (robust53)
         reader_cls = _require_rosbags()
         try:
             self._reader = reader_cls([self.path])
@@ -306,6 +308,10 @@ class RealSenseBagSource:
         return color, units, scale, self._color_keys[near]
 
     def read(self, index: int) -> Frame:
+        with unchanged_while(self._files, "since the bag was opened"):
+            return self._read(index)
+
+    def _read(self, index: int) -> Frame:
         color, units, scale, stamp = self.read_raw(index)
         depth = np.multiply(units, np.float32(scale), dtype=np.float32)
         aligned = align_depth(depth, self.depth_stream.lens, self.color_stream.lens, self.rotation, self.translation)

@@ -15,17 +15,28 @@ safely, errors naming the file.
 
 from __future__ import annotations
 
+import contextlib
 import json
 import os
 import re
 import stat
 import sys
+from collections.abc import Iterable, Iterator
 from pathlib import Path
 from typing import Any
 
 from ..errors import FileFormatError, InputError, SymfruitError
 
-__all__ = ["as_path", "holds_file", "read_limited", "read_structured", "refuse_pipe"]
+__all__ = [
+    "as_path",
+    "changed",
+    "file_states",
+    "holds_file",
+    "read_limited",
+    "read_structured",
+    "refuse_pipe",
+    "unchanged_while",
+]
 
 
 def as_path(value: Any, what: str) -> Path:
@@ -82,6 +93,68 @@ def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileForma
         raise error(f"{path}: is a device; the {what} must be a regular file")
 
 
+#: A file's state as :func:`file_states` takes it: (device, inode, size in bytes, modification time in ns), or None
+#: where nothing of that name can be looked at.
+FileState = tuple[int, int, int, int] | None
+
+
+def file_states(paths: Iterable[Path]) -> dict[Path, FileState]:
+    """Each path's :data:`FileState` now: taken before a read, compared after it by :func:`changed`."""
+    states: dict[Path, FileState] = {}
+    for path in paths:
+        try:
+            st = os.stat(path)
+        except (OSError, ValueError):
+            states[path] = None
+        else:
+            states[path] = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+    return states
+
+
+def changed(states: dict[Path, FileState], during: str) -> str | None:
+    """Why the first file whose state changed since ``states`` were taken is refused (``during``: "while the
+    frame was read", ...), None where none changed. A file replaced, grown, cut or rewritten while it is read
+    was read as it was at that moment, part old and part new (a frame's colour of one moment beside its depth of
+    another): robust53. Two looks at each file, no reading: a change within one nanosecond and keeping the size
+    is not seen."""
+    for path, before in states.items():
+        (after,) = file_states([path]).values()
+        if after == before:
+            continue
+        if before is None:
+            how = "it appeared"
+        elif after is None:
+            how = "it was removed"
+        elif after[:2] != before[:2]:
+            how = "it was replaced by another file"
+        elif after[2] != before[2]:
+            how = f"its size went from {before[2]:,} to {after[2]:,} bytes"
+        else:
+            how = "it was rewritten: its modification time changed"
+        return f"{path}: changed {during} ({how}); it is being written or replaced: read it again once it is whole"
+    return None
+
+
+@contextlib.contextmanager
+def unchanged_while(
+    paths: Iterable[Path] | dict[Path, FileState], during: str, *, error: type[SymfruitError] = FileFormatError
+) -> Iterator[None]:
+    """Look at ``paths`` before and after the block (or compare with ``paths``' states taken earlier, a
+    :func:`file_states` dict: a bag's at its opening): one changed in between is refused (:func:`changed`),
+    also where the block failed for it (a file cut while read: the change is the reason, not the parser's)."""
+    states = paths if isinstance(paths, dict) else file_states(paths)
+    try:
+        yield
+    except SymfruitError:
+        why = changed(states, during)
+        if why is None:
+            raise
+        raise error(why) from None
+    why = changed(states, during)
+    if why is not None:
+        raise error(why)
+
+
 def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitError] = FileFormatError) -> bytes:
     """The bytes of ``path``, refusing anything over ``max_bytes`` (read is bounded, not trusted to stat), and a
     pipe or socket (opening one waits for a writer that may never come)."""
@@ -96,7 +169,7 @@ def read_limited(path: Path, *, what: str, max_bytes: int, error: type[SymfruitE
     except OSError as exc:
         raise error(f"{path}: cannot read {what} ({exc.strerror or exc})") from None
     if len(data) > max_bytes:
-        raise error(f"{path}: {what} is larger than {max_bytes // 1024} kB; this cannot be a {what}")
+        raise error(f"{path}: {what} is larger than {max_bytes // 1024} kB; this cannot be {_a(what)}")
     return data
 
 

@@ -64,6 +64,7 @@ from ..io.text import as_path
 from ..methods import DEFAULT_METHOD
 from ..progress import Progress
 from ..settings import Settings
+from ..threads import one_blas_thread
 from ..writers import detections_record, write_detections
 from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows
 
@@ -157,6 +158,7 @@ class Job:
     masks: str = "auto"
     method: str = DEFAULT_METHOD
     settings: Settings = field(default_factory=Settings)
+    client: int = 0  # the client's process id: a worker in that process (an in-process cluster) leaves its BLAS be
 
 
 @dataclass(frozen=True)
@@ -240,9 +242,27 @@ def _read(job: Job, part: Part, k: int) -> Any:
     return frame
 
 
+#: The process that limited its BLAS to one thread (:func:`_one_blas_thread`): a process forked from it has not.
+_BLAS_LIMITED_IN = 0
+
+
+def _one_blas_thread(job: Job) -> None:
+    """A worker process's first task limits its BLAS to one thread (:func:`symfruit.threads.one_blas_thread`): a
+    worker started without a nanny (``dask worker --no-nanny``) ran numpy's OpenBLAS on every core, two such
+    workers on two cores 1.1-1.6x the CPU of one thread each (robust53; a nanny's workers already run one).
+    Not in the client's own process (a Python caller's in-process cluster), nor for a job that names no client
+    (one a caller made without :func:`run_distributed`): its BLAS is the caller's."""
+    global _BLAS_LIMITED_IN
+    if _BLAS_LIMITED_IN == os.getpid() or not job.client or os.getpid() == job.client:
+        return
+    _BLAS_LIMITED_IN = os.getpid()
+    one_blas_thread()
+
+
 def detect_part(job: Job, part: Part) -> list[Outcome]:
     """The task: detect and write every frame of ``part``, each in its own error boundary; returns one
     :class:`Outcome` per frame. Runs on a worker; never raises for a frame."""
+    _one_blas_thread(job)
     outcomes: list[Outcome] = []
     stop = ""
     with OutputFolder(job.output, inputs=job.inputs, input_folders=job.input_folders, lock=False) as out:
@@ -452,7 +472,7 @@ def run_distributed(
                         inputs=tuple(dict.fromkeys([*(os.path.realpath(p) for p in rec_files), *tops])),
                         input_folders=tuple(dict.fromkeys([*(os.path.realpath(p) for p in rec_folders), *tops])),
                         exclude=tuple(str(Path(p).absolute()) for p in skip), masks=masks, method=method,
-                        settings=settings))  # fmt: skip
+                        settings=settings, client=os.getpid()))  # fmt: skip
         bases.append(len(keys))
         keys += [rec.key + n for n in names]
         raw += names

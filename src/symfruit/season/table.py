@@ -273,8 +273,10 @@ class TableWriter:
                 if self.inputs:
                     self._schemas[name] = self._schemas[name].with_metadata({INPUTS_KEY: json.dumps(self.inputs)})
                 self._writers[name] = pq.ParquetWriter(handle, self._schemas[name])
-        except BaseException:
-            self._stack.close()
+        except BaseException as err:  # the first table's temporary file dropped, its writer closed (robust53: the
+            # stack closed without the error put the first table's header alone in place of an earlier run's table,
+            # and its writer, left open, said "Exception ignored in ParquetWriter.__del__" at exit)
+            self._abort(type(err), err, err.__traceback__)
             raise
         return self
 

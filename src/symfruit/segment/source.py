@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import FileFormatError, InputError
+from ..io.text import holds_file
 from ..settings import Settings
 
 __all__ = ["COLOUR_SEGMENTER", "MaskSource", "mask_source"]
@@ -190,8 +191,10 @@ def _frames_folder(folder: Path) -> MaskSource | None:
 
     def per_frame(color: np.ndarray, depth: Any, camera: Any, name: str, own: Any, cf: Any) -> tuple[np.ndarray, str]:
         stem = _frame_key(name)
+        # a link that loops or leads nowhere, or a folder, under a mask's name is refused by it (holds_file), never
+        # read as no masks for the frame (robust53)
         given = [p for p in (folder / f"{stem}.png", folder / stem / "masks.png", folder / stem / "masks.json")
-                 if stem and p.is_file()]  # fmt: skip
+                 if stem and holds_file(p)]  # fmt: skip
         if len(given) > 1:  # two mask files that may disagree: taking one in silence would not be the one meant
             raise FileFormatError(f"{folder}: holds both {given[0]} and {given[1]} for frame {name!r}; which one is "
                                   "meant? Keep one")  # fmt: skip
