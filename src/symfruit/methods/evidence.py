@@ -637,7 +637,7 @@ def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None) -
     """
     r = math.sqrt(np.count_nonzero(region.mask) / math.pi)
     grow = r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0)
-    px = int(math.ceil(grow))
+    px = math.ceil(grow)
     if grow < 0.5:
         return region
     d = np.arange(-px, px + 1)
