@@ -774,7 +774,7 @@ def test_a_told_lost_rim_leaves_a_silhouette_and_a_frame_alone():
 def test_the_lost_rim_grows_a_disc_to_the_circle_its_last_seen_points_lie_on(grazing):
     """:func:`lost_rim`: the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - c^2)`` from its centre
     (``c`` the grazing ``|cos|``), so a disc of the seen radius grows to ``R``, within a pixel; within the camera's
-    image; and not at all below half a pixel."""
+    image; not at all below half a pixel, unless told to grow at ``least`` so far."""
     from symfruit.core.camera import Camera
     from symfruit.core.raster import Silhouette
     from symfruit.methods.evidence import lost_rim
@@ -793,6 +793,8 @@ def test_the_lost_rim_grows_a_disc_to_the_circle_its_last_seen_points_lie_on(gra
     assert clipped.u0 + clipped.mask.shape[1] <= 100 and clipped.v0 + clipped.mask.shape[0] <= 100
     small = Silhouette(0, 0, np.ones((3, 3), dtype=bool), 0.0)
     assert lost_rim(small, 0.2) is small
+    at_least = lost_rim(small, 0.2, least=2.0)  # by a disk of 2 px: 7 x 7 but three pixels at each corner
+    assert (at_least.u0, at_least.v0, at_least.mask.shape, int(at_least.mask.sum())) == (-2, -2, (7, 7), 37)
 
 
 def test_the_lost_rims_setting_is_bounded():

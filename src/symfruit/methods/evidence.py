@@ -624,11 +624,12 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     return float(min(1.0, (hit & rim).sum() / rim.sum() / interior))
 
 
-def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None) -> Silhouette:
+def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None, *, least: float = 0.0) -> Silhouette:
     """``region`` grown by the rim a camera that returns no depth where ``|cos| < grazing`` (the surface's normal
     against the ray) loses of a round section: its equivalent radius ``r`` times ``1 / sqrt(1 - grazing^2) - 1``
-    pixels (the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - grazing^2)`` from its centre),
-    by a disk, within ``camera``'s image when given. Unchanged when that is under half a pixel.
+    pixels (the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - grazing^2)`` from its centre), or
+    ``least`` pixels when more, by a disk, within ``camera``'s image when given. Unchanged when that is under half a
+    pixel.
 
     >>> m = np.zeros((21, 21), dtype=bool); m[5:16, 5:16] = True
     >>> g = lost_rim(Silhouette(100, 50, m, 0.0), 0.6)
@@ -636,7 +637,7 @@ def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None) -
     (98, 48, True)
     """
     r = math.sqrt(np.count_nonzero(region.mask) / math.pi)
-    grow = r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0)
+    grow = max(r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0), least)
     px = math.ceil(grow)
     if grow < 0.5:
         return region
@@ -656,10 +657,12 @@ def _rim_region(sample: np.ndarray, region: Silhouette, camera: Camera, points: 
                 pixels: tuple[np.ndarray, np.ndarray] | None, s: EvidenceSettings) -> Silhouette:  # fmt: skip
     """The seen region of points alone (``rim_grazing``): grown by :func:`lost_rim` where the edge normals call at
     least half of the points' own outline a cut (:func:`~symfruit.core.agreement.observe` on it: no occlusion
-    information, so its contour share is theirs alone), else ``region``."""
+    information, so its contour share is theirs alone), else ``region``. By at least 2 px: the points then lie as
+    far inside it as ``detect``'s inside their mask (extraction's 1 px eroded border), beyond the 1.5 px of
+    ``observe``'s edge test, so the normals, which found the rim lost, do not label the grown outline a cut again."""
     own = observe(sample, region, camera, n_rays=s.rays, n_band=0, bands=(), dense=points,
                   inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
-    return lost_rim(region, s.rim_grazing, camera) if own.contour < 0.5 else region
+    return lost_rim(region, s.rim_grazing, camera, least=2.0) if own.contour < 0.5 else region
 
 
 def fuse_depth(
