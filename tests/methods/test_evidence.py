@@ -705,3 +705,99 @@ def test_sections_are_off_by_default_and_move_only_a_sparse_clouds_solid():
     visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=4)  # a camera's view: not read
     dense = complete(visible, settings={"evidence": {"sections": 0.5}})
     assert dense.box.max.tobytes() == complete(visible).box.max.tobytes()
+
+
+# --- stop 53, tofpts53: points alone from a time-of-flight camera (docs/tofpts53.md)
+
+
+def _time_of_flight_ball(seed: int):
+    """``(points, camera, diameter)``: a ball 50-90 mm across, 0.6-1.4 m before the Azure Kinect model
+    (:data:`~symfruit.synthetic.sensors.SENSOR_MODELS`: its lost rim, noise, flying pixels, registration and
+    annotators' mask) with a wall 0.15 m behind it, in a window of the colour image around it, its points taken as
+    ``detect`` takes them (:func:`symfruit.extract.extract`): points alone, no occlusion information."""
+    from symfruit.core.camera import Camera
+    from symfruit.extract import extract
+    from symfruit.synthetic.render import render
+    from symfruit.synthetic.sensors import SENSOR_MODELS, apply_sensor
+
+    model = SENSOR_MODELS["azure-kinect"]
+    full = model.camera()
+    rng = np.random.default_rng(seed)
+    z, radius = rng.uniform(0.6, 1.4), rng.uniform(0.025, 0.045)
+    centre = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), z])
+    ball = ball_mesh(radius).transformed(np.eye(3), centre)
+    u, v = full.project(centre[None])[0]
+    reach = 2.0 * full.fx * radius / z + 24
+    c0, r0 = int(u - reach), int(v - reach)
+    cam = Camera(fx=full.fx, fy=full.fy, cx=full.cx - c0, cy=full.cy - r0, width=int(2 * reach),
+                 height=int(2 * reach))  # fmt: skip
+    wall = np.array([[-3.0, -3.0, 0.15], [3.0, -3.0, 0.15], [3.0, 3.0, 0.15], [-3.0, 3.0, 0.15]]) + [0.0, 0.0, z]
+    shot = render([(ball.vertices, ball.faces), (wall, np.array([[0, 1, 2], [0, 2, 3]]))], cam)
+    out = apply_sensor(model, shot.depth, shot.ids, cam, rng, facing=shot.facing,
+                       labels=(shot.ids == 0).astype(np.int32))  # fmt: skip
+    return extract(np.asarray(out.labels) == 1, np.asarray(out.depth, dtype=float), cam).points, cam, 2.0 * radius
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_a_time_of_flight_balls_points_alone_make_a_cube_when_its_lost_rim_is_told(seed):
+    """A time-of-flight camera returns no depth over the ball's rim, so the points' own outline is not its
+    silhouette: their edge normals call it a cut, and every candidate is as narrow as the cap it saw (these two
+    seeds' boxes 12.5 and 11.2 mm from a cube, their depth 17 mm short). Told the camera's grazing loss
+    (``rim_grazing``), the seen region grows by the rim a round section loses and is read as a frame's mask:
+    within 4 mm of a cube and of the ball's diameter."""
+    points, cam, diameter = _time_of_flight_ball(seed)
+    base = complete(points, camera=cam)
+    told = complete(points, camera=cam, settings={"evidence": {"rim_grazing": 0.48}})
+    assert np.ptp(base.box.size) > 0.01 and base.extras["contour"] < 0.5  # the normals: a cut outline
+    assert np.ptp(told.box.size) < 0.004 and np.abs(told.box.size - diameter).max() < 0.004
+    assert told.extras["contour"] == 1.0 and told.extras["rim"] < 0.5  # a mask's outline, its rim without points
+
+
+def test_a_told_lost_rim_leaves_a_silhouette_and_a_frame_alone():
+    """``rim_grazing`` reads points alone whose edge normals call most of the outline a cut: a clean view's edge
+    is grazing (its outline is the silhouette: nothing grows), and with the frame's occlusion information the
+    mask holds the rim already (nothing is read of the setting)."""
+    from symfruit.core.occlusion import occlusion
+
+    told = {"evidence": {"rim_grazing": 0.48}}
+    visible, _ = rendered_view(ball_mesh(), [0.01, 0.0, 0.4], noise=0.01, seed=4)
+    assert complete(visible, settings=told).box.max.tobytes() == complete(visible).box.max.tobytes()
+    _ball, _shot, mask, depth = _ball_before_a_wall()
+    rows, cols = np.nonzero(mask)
+    points = DEFAULT_CAMERA.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    occ = occlusion(depth, mask, points, DEFAULT_CAMERA)
+    a = complete(points, camera=DEFAULT_CAMERA, occlusion=occ, settings=told)
+    assert a.box.max.tobytes() == complete(points, camera=DEFAULT_CAMERA, occlusion=occ).box.max.tobytes()
+
+
+@pytest.mark.parametrize("grazing", [0.3, 0.48, 0.8])
+def test_the_lost_rim_grows_a_disc_to_the_circle_its_last_seen_points_lie_on(grazing):
+    """:func:`lost_rim`: the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - c^2)`` from its centre
+    (``c`` the grazing ``|cos|``), so a disc of the seen radius grows to ``R``, within a pixel; within the camera's
+    image; not at all below half a pixel, unless told to grow at ``least`` so far."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.raster import Silhouette
+    from symfruit.methods.evidence import lost_rim
+
+    yy, xx = np.mgrid[:81, :81]
+    disc = np.hypot(yy - 40, xx - 40) <= 30.0
+    r = np.sqrt(disc.sum() / np.pi)
+    grown = lost_rim(Silhouette(10, 20, disc, 0.0), grazing)
+    want = r / np.sqrt(1.0 - grazing**2)
+    assert abs(np.sqrt(grown.mask.sum() / np.pi) - want) < 1.0
+    rows, cols = np.nonzero(grown.mask)
+    assert abs((cols + grown.u0).mean() - 50.0) < 0.01 and abs((rows + grown.v0).mean() - 60.0) < 0.01
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    clipped = lost_rim(Silhouette(10, 20, disc, 0.0), grazing, cam)
+    assert clipped.u0 >= 0 and clipped.v0 >= 0
+    assert clipped.u0 + clipped.mask.shape[1] <= 100 and clipped.v0 + clipped.mask.shape[0] <= 100
+    small = Silhouette(0, 0, np.ones((3, 3), dtype=bool), 0.0)
+    assert lost_rim(small, 0.2) is small
+    at_least = lost_rim(small, 0.2, least=2.0)  # by a disk of 2 px: 7 x 7 but three pixels at each corner
+    assert (at_least.u0, at_least.v0, at_least.mask.shape, int(at_least.mask.sum())) == (-2, -2, (7, 7), 37)
+
+
+def test_the_lost_rims_setting_is_bounded():
+    assert EvidenceSettings().rim_grazing == 0.0
+    with pytest.raises(ConfigError, match=r"evidence\.rim_grazing"):
+        Settings().replace(evidence={"rim_grazing": 0.99})

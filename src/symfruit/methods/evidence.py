@@ -79,7 +79,7 @@ from ..settings import Section, SettingError, setting
 from .paper import PaperSettings
 from .registry import Completion, register
 
-__all__ = ["Combined", "EvidenceSettings", "clean_share", "combine", "fuse_depth", "prior_width"]
+__all__ = ["Combined", "EvidenceSettings", "clean_share", "combine", "fuse_depth", "lost_rim", "prior_width"]
 
 
 @dataclass(frozen=True)
@@ -251,6 +251,17 @@ class EvidenceSettings(Section):
         radii are read off the silhouette (:func:`~symfruit.core.fits.outline_radii`: the outline is
         measured to a pixel, the points' radii are blurred by depth noise): ``add`` it as the ``outline``
         candidate, ``replace`` the points' profile with it, or ``off``.
+    rim_grazing : float in [0, 0.95]
+        Points alone (no occlusion information) from a camera that returns no depth where the surface's normal
+        makes ``|cos| < rim_grazing`` with the ray (a time-of-flight camera's lost rim; 0, the default: none, or not
+        known). The points cannot tell how wide that rim is (the real Azure Kinect frames' caps are flattened, so
+        neither their edge normals nor their sag measure it; docs/tofpts53.md); what they tell is whether it was
+        lost: where the edge normals call at least half of a depth camera's outline a cut, the seen region is grown
+        by the rim a round section loses, its equivalent radius times ``1 / sqrt(1 - rim_grazing^2) - 1``
+        (:func:`lost_rim`), and is then read as a frame's mask is (the normals do not vote on it, its rim holds no
+        points). The Azure Kinect model's value is 0.48 (half its grazing pixels lost there, measured on the shared
+        lab frames' free sides, docs/realism44.md, docs/sensors.md "dropout"); a structured-light or stereo camera
+        has none.
     mirror : PaperSettings
         The mirror candidate's grid and rating: 8 depth offsets of 0.1 ``len_depth`` and the reasonable
         region 0.4-1.0 ``Dist_ref`` (the paper's 4 x 0.2 stops short of the symmetry plane of a shallow
@@ -306,6 +317,7 @@ class EvidenceSettings(Section):
     depth_reach: float = setting(1.0, gt=0.0, le=100.0)
     mirror_candidate: bool = setting(False)
     outline_profile: Literal["off", "add", "replace"] = setting("add")
+    rim_grazing: float = setting(0.0, ge=0.0, le=0.95)
     mirror: PaperSettings = setting(
         PaperSettings(translations=8, translation_step=0.1, j2=0.4, j3=1.0, rating_points=400)
     )
@@ -612,6 +624,47 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     return float(min(1.0, (hit & rim).sum() / rim.sum() / interior))
 
 
+def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None, *, least: float = 0.0) -> Silhouette:
+    """``region`` grown by the rim a camera that returns no depth where ``|cos| < grazing`` (the surface's normal
+    against the ray) loses of a round section: its equivalent radius ``r`` times ``1 / sqrt(1 - grazing^2) - 1``
+    pixels (the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - grazing^2)`` from its centre), or
+    ``least`` pixels when more, by a disk, within ``camera``'s image when given. Unchanged when that is under half a
+    pixel.
+
+    >>> m = np.zeros((21, 21), dtype=bool); m[5:16, 5:16] = True
+    >>> g = lost_rim(Silhouette(100, 50, m, 0.0), 0.6)
+    >>> (g.u0, g.v0, int(np.count_nonzero(g.mask)) > int(np.count_nonzero(m)))
+    (98, 48, True)
+    """
+    r = math.sqrt(np.count_nonzero(region.mask) / math.pi)
+    grow = max(r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0), least)
+    px = math.ceil(grow)
+    if grow < 0.5:
+        return region
+    d = np.arange(-px, px + 1)
+    disk = d[:, None] ** 2 + d[None, :] ** 2 <= grow * grow
+    mask = ndimage.binary_dilation(np.pad(region.mask, px), structure=disk)
+    u0, v0 = region.u0 - px, region.v0 - px
+    if camera is not None:  # within the image: the camera saw nothing beyond it
+        c0, r0 = max(0, -u0), max(0, -v0)
+        c1 = min(mask.shape[1], camera.width - u0)
+        r1 = min(mask.shape[0], camera.height - v0)
+        mask, u0, v0 = mask[r0:r1, c0:c1], u0 + c0, v0 + r0
+    return Silhouette(u0, v0, np.ascontiguousarray(mask), region.fill_radius)
+
+
+def _rim_region(sample: np.ndarray, region: Silhouette, camera: Camera, points: np.ndarray,
+                pixels: tuple[np.ndarray, np.ndarray] | None, s: EvidenceSettings) -> Silhouette:  # fmt: skip
+    """The seen region of points alone (``rim_grazing``): grown by :func:`lost_rim` where the edge normals call at
+    least half of the points' own outline a cut (:func:`~symfruit.core.agreement.observe` on it: no occlusion
+    information, so its contour share is theirs alone), else ``region``. By at least 2 px: the points then lie as
+    far inside it as ``detect``'s inside their mask (extraction's 1 px eroded border), beyond the 1.5 px of
+    ``observe``'s edge test, so the normals, which found the rim lost, do not label the grown outline a cut again."""
+    own = observe(sample, region, camera, n_rays=s.rays, n_band=0, bands=(), dense=points,
+                  inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
+    return lost_rim(region, s.rim_grazing, camera, least=2.0) if own.contour < 0.5 else region
+
+
 def fuse_depth(
     combined: Combined,
     cands: list[Candidate],
@@ -699,6 +752,8 @@ def evidence(
     # also holds the pixels a time-of-flight camera returns no depth for: its rim, a leaf's mixed edge)
     dense = len(points) >= 0.5 * np.count_nonzero(region.mask)
     seen_region = region
+    if occlusion is None and dense and s.rim_grazing > 0:
+        region = _rim_region(sample, region, camera, points, pixels, s)
     if occlusion is not None:
         # the fruit's mask reaches beyond its points (an eroded border, a time-of-flight camera's lost rim): its
         # outline is labelled by the occlusion information alone, since no point lies within observe's 1.5 px of it
