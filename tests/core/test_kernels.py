@@ -5601,8 +5601,9 @@ def test_the_bridged_depth_is_the_twins(seed):
     """:func:`_jit.bridge_gaps` on a depth as handed over (float32 or float64; 0, negative, -0.0, NaN and infinite
     values without depth) and its twin ``_bridged`` on the cleaned depth (the feature transform: scipy's with the
     twins, :func:`_jit.nearest` with the kernels) on 600 windows padded by 4 px (less at the image's edges), the
-    depths of four values (equally near pixels of other depths everywhere: the choice among them counts), a fifth
-    to nearly all of the pixels without depth: the same values, gaps filled and gaps left."""
+    depths of four values (equally near pixels of other depths everywhere: the choice among them counts), none, a
+    twentieth, a fifth to nearly all of the pixels without depth (rows with depth throughout, rows whose few pixels
+    without depth are weighed one by one, rows weighed whole: stop 53): the same values, gaps filled and gaps left."""
     from symfruit.segment.colour import BRIDGE_PX, _bridged
 
     rng = np.random.default_rng(seed)
@@ -5611,7 +5612,7 @@ def test_the_bridged_depth_is_the_twins(seed):
     for t in range(600):
         h, w = (int(v) for v in rng.integers(1, 40, 2))
         given = rng.choice(np.array([0.5, 1.25, 2.0, 3.5]), (h, w))
-        gap = rng.random((h, w)) < rng.choice([0.2, 0.6, 0.9, 0.97])
+        gap = rng.random((h, w)) < rng.choice([0.0, 0.05, 0.2, 0.6, 0.9, 0.97])  # rows with none, a few, most
         given[gap] = rng.choice(bad, int(gap.sum()))
         given = given.astype(np.float32 if t % 2 else np.float64)
         r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
@@ -5629,7 +5630,7 @@ def test_the_bridged_depth_is_the_twins(seed):
         assert not np.signbit(out).any()
         filled += int((gap[r0:r1, c0:c1] & (out > 0)).sum())
         left += int((gap[r0:r1, c0:c1] & (out == 0)).sum())
-    assert filled > 10_000 and left > 1_000
+    assert filled > 5_000 and left > 1_000
 
 
 def test_the_bridged_depth_known_answer():
