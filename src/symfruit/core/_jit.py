@@ -9303,3 +9303,39 @@ def bridged_solid(
     if area < 0.0:
         return out, 3
     return out, 2 if count < solidity * area else 1
+
+
+# --- stop 53, seg53: a round skin's flood with its part's copy and its reach test ------------------------------------
+
+
+@_njit
+def skin_flood(
+    z: np.ndarray,
+    color: np.ndarray,
+    owner: np.ndarray,
+    k: int,
+    hull: np.ndarray,
+    pr: int,
+    pc: int,
+    r0: int,
+    c0: int,
+    rc: float,
+    cc: float,
+    reach2: float,
+    deep_limit: float,
+    zm: float,
+    step: float,
+    jump: float,
+    leaf_hue: int,
+    limit: float,
+) -> tuple[np.ndarray, bool]:
+    """:func:`symfruit.segment.colour._skin_flood` and the reach test after it in one call: the red part ``hull``
+    (a bool window of its own) copied into the flood's window (``z``, ``color``, ``owner`` (h, w), at ``(r0, c0)``
+    in the image) at ``(pr, pc)``, :func:`round_skin`'s skin grown from it (its arguments after ``part``), and, when
+    ``limit`` is 0 or more, :func:`at_reach`'s answer for the skin (its ``limit``, the twin's ``(reach - 1) ** 2``;
+    False when not asked). The same skin and answer as the calls (stop 53, seg53: not the part's window made and
+    filled by numpy, nor a second call)."""
+    part = np.zeros(z.shape, np.bool_)
+    part[pr : pr + hull.shape[0], pc : pc + hull.shape[1]] = hull
+    skin = round_skin(z, color, owner, k, part, r0, c0, rc, cc, reach2, deep_limit, zm, step, jump, leaf_hue)
+    return skin, limit >= 0.0 and at_reach(skin, r0, c0, rc, cc, limit)
