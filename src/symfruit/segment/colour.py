@@ -1999,7 +1999,7 @@ def _skin_flood(
     """:func:`_round_skin`'s growth from the red part ``hull`` (in window ``sl``) within a reach (``grow``: the
     part's centre row and column, the reach in pixels, the depth limit and the median depth), in the window that
     holds both: the window, its depth, the skin, and with ``reached`` whether the reach may have stopped it
-    (:func:`_at_reach`), else or where it was not worked out here None."""
+    (:func:`_at_reach`; None when not asked, or where it is not worked out here: the twins)."""
     rc, cc, reach, deep_limit, zm = grow
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
