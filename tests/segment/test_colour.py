@@ -1635,3 +1635,33 @@ def test_the_round_pieces_in_one_call_are_the_calls_labels(seed, monkeypatch):
     assert fast.max() >= 3
     kernels = pytest.importorskip("symfruit.core.kernels")
     assert min(taken.values()) >= 3 or kernels.compiled() is None
+
+
+@pytest.mark.parametrize("kernels", ["numba", "numpy"])
+def test_the_padded_boxes_are_find_objects(monkeypatch, kernels):
+    """``_padded_boxes`` (the red windows' and the ground bodies' boxes before they are joined) with the kernels and
+    with the twins: for random label images and kept labels, ``ndimage.find_objects``' box of each kept label, in the
+    labels' order, widened by the pad and clipped to the image (pads 0-3, labels at the edges, none kept)."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import _padded_boxes
+
+    if kernels == "numba":
+        pytest.importorskip("numba")
+        monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+    else:
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    rng = np.random.default_rng(53)
+    for _ in range(200):
+        shape = (int(rng.integers(1, 30)), int(rng.integers(1, 30)))
+        labels, n = ndimage.label(rng.random(shape) < rng.choice([0.1, 0.4, 0.7]), structure=np.ones((3, 3)))
+        at = np.flatnonzero(labels)
+        rows, cols = np.divmod(at, shape[1])
+        keep = rng.random(n + 1) < 0.6
+        keep[0] = False
+        pad = int(rng.integers(0, 4))
+        want = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, shape[0]),
+                 max(sl[1].start - pad, 0), min(sl[1].stop + pad, shape[1]))
+                for k, sl in enumerate(ndimage.find_objects(labels), 1) if keep[k]]  # fmt: skip
+        got = _padded_boxes(labels.ravel().take(at), rows, cols, keep, pad, shape)
+        assert got == want and all(type(v) is int for box in got for v in box)

@@ -230,9 +230,13 @@ def depth_metres(depth: Any, what: str, *, error: type[SymfruitError] = InputErr
 def typical_depth(depth: np.ndarray) -> float | None:
     """The median of a spread sample of a 2-D depth image's valid (finite, positive) pixels, or None where the
     sample holds none: it tells units apart (metres against millimetres is a factor of 1000). Rows and columns
-    are strided alike, so a 640x480 frame costs 4,800 pixels and a 1920x1080 one 8,100."""
+    are strided alike, so a 640x480 frame costs 4,800 pixels and a 1920x1080 one 8,100. The median is
+    :func:`symfruit.core.points.median`'s (``np.median``'s value bit for bit, without its general-axis machinery:
+    about 10 of the 20-35 us of a depth image's check; stop 53, seg53)."""
+    from .points import median  # points imports this module
+
     stride = max(1, int(np.sqrt(depth.size / 8_000)))
     sample = depth[::stride, ::stride].ravel()
     with np.errstate(invalid="ignore"):
         valid = sample[np.isfinite(sample) & (sample > 0)]
-    return float(np.median(valid)) if len(valid) else None
+    return float(median(valid)) if len(valid) else None

@@ -871,10 +871,7 @@ def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape
     gh, gw = lab.shape
     at = np.flatnonzero(lab)
     rows, cols = np.divmod(at, gw)
-    boxes = [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, gh),
-              max(sl[1].start - pad, 0), min(sl[1].stop + pad, gw))
-             for sl in _boxes(lab.ravel().take(at), rows, cols, big).values()]  # fmt: skip
-    boxes = _join_boxes(boxes)
+    boxes = _join_boxes(_padded_boxes(lab.ravel().take(at), rows, cols, big, pad, (gh, gw)))
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
@@ -1929,13 +1926,13 @@ def _round_skin(
         zm = float(median(z_part))
     reach = ROUND_REACH * own
     deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
-    big, z, skin = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, reach, deep_limit, zm))
     far = s.round_max_diameter * geo.focal / zm
-    if far > reach and _at_reach(skin, big, rc, cc, reach):
+    big, z, skin, at = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, reach, deep_limit, zm), far > reach)
+    if far > reach and (_at_reach(skin, big, rc, cc, reach) if at is None else at):
         # again out to the largest fruit's diameter at the part's depth (stop 46): the skin lies within the fruit's
         # diameter of any of its pixels, and a blush cut to a thin crescent by a leaf's shadow and the camera's
         # 4:2:0 chroma is small against its apple
-        big, z, skin = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, far, deep_limit, zm))
+        big, z, skin, _ = _skin_flood(sl, hull, depth, color, s, owner, k, (rc, cc, far, deep_limit, zm), False)
     if skin.sum() > _largest_area(skin, z, s, geo.focal, zm):
         return sl, hull  # more than one fruit's skin: bark or a branch at the fruit's depth joined it
     return big, skin
@@ -1997,24 +1994,33 @@ def _skin_flood(
     owner: np.ndarray,
     k: int,
     grow: tuple[float, float, float, float, float],
-) -> tuple[Window, np.ndarray, np.ndarray]:
+    reached: bool,
+) -> tuple[Window, np.ndarray, np.ndarray, bool | None]:
     """:func:`_round_skin`'s growth from the red part ``hull`` (in window ``sl``) within a reach (``grow``: the
     part's centre row and column, the reach in pixels, the depth limit and the median depth), in the window that
-    holds both: the window, its depth and the skin."""
+    holds both: the window, its depth, the skin, and with ``reached`` whether the reach may have stopped it
+    (:func:`_at_reach`; None when not asked, or where it is not worked out here: the twins)."""
     rc, cc, reach, deep_limit, zm = grow
     h, w = depth.shape
     big = (slice(max(min(int(rc - reach), sl[0].start), 0), min(max(int(rc + reach) + 1, sl[0].stop), h)),
            slice(max(min(int(cc - reach), sl[1].start), 0), min(max(int(cc + reach) + 1, sl[1].stop), w)))  # fmt: skip
     z = depth[big]
-    part = np.zeros(z.shape, bool)
     r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    jit = compiled()
+    if jit is not None and hull.dtype == bool and hull.ndim == 2:
+        # the part's copy, the flood (a flood of the seeds' components alone; issue 19, seventeenth round) and the
+        # reach test in one call (:func:`symfruit.core._jit.skin_flood`: the same pixels and answer; stop 53, seg53)
+        skin, at = jit.skin_flood(z, color[big], owner[big], int(k), hull, r, c, big[0].start, big[1].start, float(rc),
+                                  float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
+                                  LEAF_HUE, (reach - 1.0) ** 2 if reached else -1.0)  # fmt: skip
+        return big, z, skin, bool(at) if reached else None
+    part = np.zeros(z.shape, bool)
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
-    if (jit := compiled()) is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`, a flood of the
-        # seeds' components alone; issue 19, seventeenth round)
+    if jit is not None:  # the same pixels (:func:`symfruit.core._jit.round_skin`; issue 19, seventeenth round)
         skin = jit.round_skin(z, color[big], owner[big], int(k), part, big[0].start, big[1].start, float(rc),
                               float(cc), float(reach**2), float(deep_limit), zm, 0.5 * s.depth_jump, s.depth_jump,
                               LEAF_HUE)  # fmt: skip
-        return big, z, skin
+        return big, z, skin, None
     # broadcast: the same values per pixel, without two full grids (np.ogrid's, without its call's overhead)
     yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     free = (owner[big] == 0) | (owner[big] == k)
@@ -2023,10 +2029,10 @@ def _skin_flood(
     # grown from the part's pixels near its median depth: its hull's rim may lie on what is behind it
     allowed = (candidate | part) & ~_steps(z, 0.5 * s.depth_jump)
     lab, n = ndimage.label(allowed)
-    reached = np.zeros(n + 1, bool)
-    reached[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
-    reached[0] = False
-    return big, z, reached[lab] | part
+    grown = np.zeros(n + 1, bool)
+    grown[lab[part & (np.abs(z - zm) <= s.depth_jump)]] = True
+    grown[0] = False
+    return big, z, grown[lab] | part, None
 
 
 def _blush_rim(
@@ -2154,11 +2160,8 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     keep[ids] = _bulging(index.take(la), rows * g, cols * g, z_grid.ravel().take(at), len(ids) - 1, geo, s)
     if not keep.any():
         return []
-    gh, gw = lab.shape
-    boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
-             for sl in _boxes(la, rows, cols, keep).values()]  # fmt: skip
     bodies: list[_Body] = []
-    for r0, r1, c0, c1 in _join_boxes(boxes):
+    for r0, r1, c0, c1 in _join_boxes(_padded_boxes(la, rows, cols, keep, 2, lab.shape)):
         win = (slice(r0 * g, min(r1 * g, h)), slice(c0 * g, min(c1 * g, w)))
         zw = z[win]
         if not (zw > 0).any():
@@ -2525,6 +2528,24 @@ def _boxes(labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndar
     """The boxes of the labels that ``keep`` marks, as ``ndimage.find_objects`` gives them, from the labels,
     rows and columns of a window's labelled pixels (scipy's makes a box for every label of the window)."""
     return _group_boxes(*_grouped(labels, keep), rows, cols)
+
+
+def _padded_boxes(
+    labels: np.ndarray, rows: np.ndarray, cols: np.ndarray, keep: np.ndarray, pad: int, shape: tuple[int, int]
+) -> list[tuple[int, int, int, int]]:
+    """:func:`_boxes` as ``(r0, r1, c0, c1)``, each widened by ``pad`` on every side within ``shape``, in the labels'
+    order. Where numba is, from :func:`symfruit.core._jit.group_boxes`' array by four numpy calls, not slices made and
+    read back box by box (the same numbers; stop 53, seg53)."""
+    ids, at, first = _grouped(labels, keep)
+    if len(at) == 0:
+        return []
+    if (jit := compiled()) is None or not (at.ndim == first.ndim == rows.ndim == cols.ndim == 1):
+        return [(max(sl[0].start - pad, 0), min(sl[0].stop + pad, shape[0]),
+                 max(sl[1].start - pad, 0), min(sl[1].stop + pad, shape[1]))
+                for sl in _group_boxes(ids, at, first, rows, cols).values()]  # fmt: skip
+    b = jit.group_boxes(at, first, rows, cols)
+    lo, hi = np.maximum(b[:, 0::2] - pad, 0), np.minimum(b[:, 1::2] + pad, shape)
+    return list(zip(lo[:, 0].tolist(), hi[:, 0].tolist(), lo[:, 1].tolist(), hi[:, 1].tolist(), strict=True))
 
 
 def _grouped(labels: np.ndarray, keep: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
