@@ -304,3 +304,24 @@ def test_no_workers_in_a_daemonic_process():
     with multiprocessing.get_context("spawn").Pool(1) as daemonic:
         why = daemonic.apply(one_process_reason, (1,))
     assert why.startswith("this process was started by multiprocessing")
+
+
+def test_a_shared_frame_runs_this_processs_blas_on_one_thread_and_lifts_it_after():
+    """Two-thread BLAS on both sides of two cores made the pool slower than none with `paper` (stop 53's lead
+    A/B: 66-68 against 45-48 ms): while a frame is shared, this process's BLAS runs on one thread (the workers
+    limit their own at start), and the limit is lifted after the frame."""
+    threadpoolctl = pytest.importorskip("threadpoolctl")
+
+    def blas_threads() -> list[int]:
+        return [i["num_threads"] for i in threadpoolctl.threadpool_info() if i["user_api"] == "blas"]
+
+    with threadpoolctl.threadpool_limits(2, user_api="blas"):
+        before = blas_threads()
+        assert before and max(before) == 2
+        pool = FruitPool(0)  # no workers: the limit is the same code either way
+        try:
+            with pool._one_blas_thread():
+                assert set(blas_threads()) == {1}
+            assert blas_threads() == before
+        finally:
+            pool.close()

@@ -52,6 +52,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from .errors import InputError
+from .threads import one_blas_thread
 
 if TYPE_CHECKING:
     from .detect import _Done, _Fruit
@@ -249,6 +250,7 @@ class FruitPool:
         self._state = _State()
         self._close = weakref.finalize(self, self._state.close)
         self._busy = threading.Lock()  # one frame at a time; another thread's frame meanwhile runs here alone
+        self._blas: Any = None  # threadpoolctl's controller of this process's BLAS, made at the first shared frame
         self._failed_starts, self._seq = 0, 0
         self._lock: Any = None
         self._counter: Any = None
@@ -352,7 +354,8 @@ class FruitPool:
             if not self._workers_ready():
                 return [fruit(k, sl) for k, sl in jobs], 0.0
             try:
-                out, cpu = self._run(fruit, jobs)
+                with self._one_blas_thread():
+                    out, cpu = self._run(fruit, jobs)
             except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
                 if self.active:
                     self._lost("the calling process was interrupted within a frame")
@@ -363,6 +366,20 @@ class FruitPool:
             if kind == "raised":
                 raise value
         return [value for _, value in out], cpu
+
+    def _one_blas_thread(self) -> contextlib.AbstractContextManager[Any]:
+        """This process's BLAS on one thread while a frame is shared (threadpoolctl, the ``fast`` extra; without it,
+        nothing): each worker runs its own on one thread beside it, and two-thread BLAS on both sides of two cores
+        made the benchmark frame slower than no pool with `paper` (66-68 against 45-48 ms; 38.6 with one thread
+        each; docs/proc53.md). About 0.03 ms a frame; the limit is lifted when the frame is done."""
+        if self._blas is None:
+            try:
+                from threadpoolctl import ThreadpoolController
+            except ImportError:
+                self._blas = False
+            else:
+                self._blas = ThreadpoolController()
+        return contextlib.nullcontext() if self._blas is False else self._blas.limit(limits=1, user_api="blas")
 
     def _workers_ready(self) -> bool:
         for w in self._state.workers:
@@ -558,6 +575,7 @@ def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None
     global _IN_WORKER
     _IN_WORKER = True
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # Ctrl-C in a terminal reaches the whole group: the caller decides
+    one_blas_thread()  # beside the caller on its own core: two-thread BLAS in each made `paper` slower than no pool
     outbox: queue.SimpleQueue[tuple[Any, ...] | None] = queue.SimpleQueue()
     sender = threading.Thread(target=_send_all, args=(conn, outbox), daemon=True)
     sender.start()  # sent from there: a full pipe never holds the next fruit up
