@@ -63,7 +63,7 @@ def test_example_images_are_what_a_camera_driver_publishes(example_images):
 def test_a_short_real_run(ros1, tmp_path):
     out = tmp_path / "bench.json"
     proc = subprocess.run([sys.executable, "-m", "symfruit.ros.bench", "--frames", "2", "--method", "raw",
-                           "--json", str(out)],
+                           "--json", str(out), "--fruit-processes", "0"],
                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     res = json.loads(out.read_text())
@@ -72,6 +72,7 @@ def test_a_short_real_run(ros1, tmp_path):
     assert 0.0 <= res["node_overhead_ms"]["median"] < res["node_total_ms"]["median"]
     assert 1 <= res["open_loop"]["delivered"] <= 2  # the last frame is never dropped
     assert "node: overhead" in proc.stdout
+    assert res["fruit_processes"] == 0 and "the node's fruit_processes 0" in proc.stdout
 
 
 def test_bad_counts_and_rates_are_refused_before_anything_starts(capsys):
@@ -82,3 +83,13 @@ def test_bad_counts_and_rates_are_refused_before_anything_starts(capsys):
             main(args)
         assert stop.value.code == 2
         assert "--frames must be 1-100000 and --rate in (0, 1000] Hz" in capsys.readouterr().err
+
+
+def test_the_nodes_fruit_processes_are_bounded_before_anything_starts(capsys):
+    from symfruit.ros.bench import main
+
+    for bad in ("-1", "17"):
+        with pytest.raises(SystemExit) as stop:
+            main(["--fruit-processes", bad])
+        assert stop.value.code == 2
+        assert f"--fruit-processes must be 0-16, got {bad}" in capsys.readouterr().err

@@ -10,7 +10,7 @@ import subprocess
 def test_a_short_real_run(ros2_python, tmp_path):
     out = tmp_path / "bench.json"
     proc = subprocess.run([ros2_python, "-m", "symfruit.ros.bench2", "--frames", "1", "--method", "raw",
-                           "--json", str(out)],
+                           "--json", str(out), "--fruit-processes", "0"],
                           capture_output=True, text=True, timeout=600)  # fmt: skip
     assert proc.returncode == 0, proc.stderr[-3000:]
     res = json.loads(out.read_text())
@@ -19,6 +19,7 @@ def test_a_short_real_run(ros2_python, tmp_path):
     assert 0.0 <= res["node_overhead_ms"]["median"] < res["node_total_ms"]["median"]
     assert res["end_to_end_ms"]["median"] > res["node_detect_ms"]["median"] > 0
     assert res["open_loop"]["delivered"] == 1  # the last frame is never dropped
+    assert res["fruit_processes"] == 0
     assert proc.stdout.startswith("symfruit ROS 2 node benchmark") and "node: overhead" in proc.stdout
 
 

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from ..fruitpool import MAX_FRUIT_PROCESSES
 from ..methods import DEFAULT_METHOD
 from .master import stop_group
 
@@ -85,6 +86,7 @@ def bench_node(
     method: str = DEFAULT_METHOD,
     fruit: str = "strawberry",
     timeout: float = 120.0,
+    fruit_processes: int | None = None,
 ) -> dict:
     """Run the three measurements; returns their statistics in milliseconds (and fps, drops)."""
     from .core import FrameProcessor
@@ -121,7 +123,15 @@ def bench_node(
         log = master.home / "node.log"
         with open(log, "wb") as handle:
             node = subprocess.Popen(
-                [sys.executable, "-m", "symfruit", "ros", f"_method:={method}", f"_fruit:={fruit}"],
+                [
+                    sys.executable,
+                    "-m",
+                    "symfruit",
+                    "ros",
+                    f"_method:={method}",
+                    f"_fruit:={fruit}",
+                    *([] if fruit_processes is None else [f"_fruit_processes:={fruit_processes}"]),
+                ],
                 env={**master.env, "PYTHONUNBUFFERED": "1"},
                 stdout=handle,
                 stderr=subprocess.STDOUT,
@@ -166,7 +176,9 @@ def bench_node(
             stop_group(node, 30)
             rospy.signal_shutdown("bench done")
         log_text = log.read_text(errors="replace")
-    return _summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span)
+    # the node's fruit_processes parameter (None: not given, the node's default)
+    return {**_summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span),
+            "fruit_processes": fruit_processes}  # fmt: skip
 
 
 def _alone(core, msgs, *, frames: int, rate: float, method: str) -> dict:
@@ -227,7 +239,10 @@ def _print(res: dict, title: str = "symfruit ROS node benchmark") -> None:
         ("end to end (publish -> detections)", res["end_to_end_ms"]),
         ("end to end - node detect() (per frame)", res["end_to_end_minus_node_detect_ms"]),
     ]
-    print(f"{title}: example frame 640x480, method {res['method']}, {res['frames']} frames")
+    workers = res.get("fruit_processes")
+    said = "its default" if workers is None else workers
+    print(f"{title}: example frame 640x480, method {res['method']}, {res['frames']} frames, the node's "
+          f"fruit_processes {said}")  # fmt: skip
     print(f"{'':<38} {'median ms':>10} {'p10':>8} {'p90':>8}")
     for name, s in rows:
         print(f"{name:<38} {s['median']:>10.1f} {s['p10']:>8.1f} {s['p90']:>8.1f}")
@@ -245,10 +260,14 @@ def main(argv=None) -> int:
     parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
     parser.add_argument("--method", default=DEFAULT_METHOD)
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
+    parser.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+                        help="the node's fruit_processes parameter, 0-16 (default: the node's own, 1)")  # fmt: skip
     args = parser.parse_args(argv)
     if not 1 <= args.frames <= 100_000 or not 0 < args.rate <= 1000:
         parser.error(f"--frames must be 1-100000 and --rate in (0, 1000] Hz, got {args.frames} and {args.rate:g}")
-    res = bench_node(args.frames, rate=args.rate, method=args.method)
+    if args.fruit_processes is not None and not 0 <= args.fruit_processes <= MAX_FRUIT_PROCESSES:
+        parser.error(f"--fruit-processes must be 0-{MAX_FRUIT_PROCESSES}, got {args.fruit_processes}")
+    res = bench_node(args.frames, rate=args.rate, method=args.method, fruit_processes=args.fruit_processes)
     _print(res)
     if args.json:
         import json

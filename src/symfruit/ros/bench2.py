@@ -27,6 +27,7 @@ import threading
 import time
 from pathlib import Path
 
+from ..fruitpool import MAX_FRUIT_PROCESSES
 from ..methods import DEFAULT_METHOD
 from .bench import _alone, _print, _summarise, example_images
 from .master import stop_group
@@ -41,6 +42,7 @@ def bench_node2(
     method: str = DEFAULT_METHOD,
     fruit: str = "strawberry",
     timeout: float = 120.0,
+    fruit_processes: int | None = None,
 ) -> dict:
     """Run the three measurements; returns their statistics in milliseconds (and fps, drops), with the keys of
     :func:`symfruit.ros.bench.bench_node`."""
@@ -71,7 +73,8 @@ def bench_node2(
         log = Path(home) / "node.log"
         with open(log, "wb") as handle:
             cmd = [sys.executable, "-m", "symfruit", "ros2", "--ros-args", "-p", f"method:={method}", "-p",
-                   f"fruit:={fruit}"]  # fmt: skip
+                   f"fruit:={fruit}",
+                   *([] if fruit_processes is None else ["-p", f"fruit_processes:={fruit_processes}"])]  # fmt: skip
             proc = subprocess.Popen(cmd, env=env, stdout=handle, stderr=subprocess.STDOUT, start_new_session=True)
         try:
             deadline = time.monotonic() + timeout
@@ -108,7 +111,9 @@ def bench_node2(
             rclpy.try_shutdown(context=context)
             context.destroy()
         log_text = log.read_text(errors="replace")
-    return _summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span)
+    # the node's fruit_processes parameter (None: not given, the node's default)
+    return {**_summarise(out, log_text, e2e, frames=frames, delivered=delivered, span=span),
+            "fruit_processes": fruit_processes}  # fmt: skip
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -117,10 +122,14 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
     parser.add_argument("--method", default=DEFAULT_METHOD)
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
+    parser.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+                        help="the node's fruit_processes parameter, 0-16 (default: the node's own, 1)")  # fmt: skip
     args = parser.parse_args(argv)
     if not 1 <= args.frames <= 100_000 or not 0 < args.rate <= 1000:
         parser.error(f"--frames must be 1-100000 and --rate in (0, 1000] Hz, got {args.frames} and {args.rate:g}")
-    res = bench_node2(args.frames, rate=args.rate, method=args.method)
+    if args.fruit_processes is not None and not 0 <= args.fruit_processes <= MAX_FRUIT_PROCESSES:
+        parser.error(f"--fruit-processes must be 0-{MAX_FRUIT_PROCESSES}, got {args.fruit_processes}")
+    res = bench_node2(args.frames, rate=args.rate, method=args.method, fruit_processes=args.fruit_processes)
     _print(res, title="symfruit ROS 2 node benchmark")
     if args.json:
         import json
