@@ -76,6 +76,19 @@ def test_build_key_follows_the_build_and_the_python(monkeypatch):
     assert ros2env.build_key("3.11") != other  # the extra's requirements are part of the key
 
 
+def test_build_key_follows_the_fast_extras_requirements_too(monkeypatch):
+    """A venv made when it had the ROS 2 extra alone is made again with the compiled kernels (stop 53)."""
+    ros2 = ['ros-rclpy[fastrtps]>=9.1; extra == "ros2"']
+    monkeypatch.setattr(importlib.metadata, "requires", lambda name: ros2)
+    before = ros2env.build_key("3.11")
+    monkeypatch.setattr(importlib.metadata, "requires", lambda name: [*ros2, 'numba>=0.60; extra == "fast"'])
+    with_fast = ros2env.build_key("3.11")
+    assert with_fast != before
+    monkeypatch.setattr(importlib.metadata, "requires", lambda name: [*ros2, 'numba>=0.60; extra == "fast"',
+                                                                      'matplotlib>=3.6; extra == "plot"'])  # fmt: skip
+    assert ros2env.build_key("3.11") == with_fast  # an extra the venv does not get is no part of it
+
+
 def test_an_up_to_date_venv_is_left_alone(tmp_path, monkeypatch):
     venv = tmp_path / "venv"
     (venv / "bin").mkdir(parents=True)
@@ -160,7 +173,7 @@ def test_make_venv_installs_the_project_with_the_extra_and_says_why_not(fake_ven
     assert ros2env.ros2_python(new).is_file()
     calls = log.read_text().splitlines()
     pip = "python -m pip install --quiet --disable-pip-version-check"
-    assert calls[:3] == [f"python -m venv {new}", f"{pip} --upgrade pip", f"{pip} -e {tmp_path / 'project'}[ros2]"]
+    assert calls[:3] == [f"python -m venv {new}", f"{pip} --upgrade pip", f"{pip} -e {tmp_path / 'project'}[ros2,fast]"]
     monkeypatch.setenv("PIP_STATUS", "1")
     with pytest.raises(ros2env.Skip, match=r"pip could not install the ROS 2 wheels into .*: pip said no$"):
         ros2env.make_venv(new, tmp_path / "project")  # the venv exists: not made again, pip fails
