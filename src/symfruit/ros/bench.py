@@ -254,8 +254,10 @@ def _print(res: dict, title: str = "symfruit ROS node benchmark") -> None:
     )
 
 
-def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m symfruit.ros.bench", description=__doc__.splitlines()[0])
+def run_main(argv: list[str] | None, prog: str, description: str, bench: Any, title: str) -> int:
+    """The command line of both node benchmarks (``bench``: :func:`bench_node` or ``bench_node2``): parse and bound
+    the options before anything starts, run, print under ``title``, write ``--json`` atomically."""
+    parser = argparse.ArgumentParser(prog=prog, description=description)
     parser.add_argument("--frames", type=int, default=30)
     parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
     parser.add_argument("--method", default=DEFAULT_METHOD)
@@ -267,8 +269,8 @@ def main(argv=None) -> int:
         parser.error(f"--frames must be 1-100000 and --rate in (0, 1000] Hz, got {args.frames} and {args.rate:g}")
     if args.fruit_processes is not None and not 0 <= args.fruit_processes <= MAX_FRUIT_PROCESSES:
         parser.error(f"--fruit-processes must be 0-{MAX_FRUIT_PROCESSES}, got {args.fruit_processes}")
-    res = bench_node(args.frames, rate=args.rate, method=args.method, fruit_processes=args.fruit_processes)
-    _print(res)
+    res = bench(args.frames, rate=args.rate, method=args.method, fruit_processes=args.fruit_processes)
+    _print(res, title=title)
     if args.json:
         import json
 
@@ -277,6 +279,11 @@ def main(argv=None) -> int:
         with atomic_write(args.json, "w") as handle:  # whole or not at all, like every file symfruit writes
             handle.write(json.dumps(res, indent=2))
     return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    return run_main(argv, "python -m symfruit.ros.bench", __doc__.splitlines()[0], bench_node,
+                    "symfruit ROS node benchmark")  # fmt: skip
 
 
 if __name__ == "__main__":  # pragma: no cover

@@ -18,7 +18,6 @@ Both processes discover on this machine only, on a domain of their own (:func:`~
 
 from __future__ import annotations
 
-import argparse
 import os
 import subprocess
 import sys
@@ -27,9 +26,8 @@ import threading
 import time
 from pathlib import Path
 
-from ..fruitpool import MAX_FRUIT_PROCESSES
 from ..methods import DEFAULT_METHOD
-from .bench import _alone, _print, _summarise, example_images
+from .bench import _alone, _summarise, example_images, run_main
 from .master import stop_group
 
 __all__ = ["bench_node2", "main"]
@@ -117,28 +115,8 @@ def bench_node2(
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m symfruit.ros.bench2", description=__doc__.splitlines()[0])
-    parser.add_argument("--frames", type=int, default=30)
-    parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
-    parser.add_argument("--method", default=DEFAULT_METHOD)
-    parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
-    parser.add_argument("--fruit-processes", type=int, default=None, metavar="N",
-                        help="the node's fruit_processes parameter, 0-16 (default: the node's own, 1)")  # fmt: skip
-    args = parser.parse_args(argv)
-    if not 1 <= args.frames <= 100_000 or not 0 < args.rate <= 1000:
-        parser.error(f"--frames must be 1-100000 and --rate in (0, 1000] Hz, got {args.frames} and {args.rate:g}")
-    if args.fruit_processes is not None and not 0 <= args.fruit_processes <= MAX_FRUIT_PROCESSES:
-        parser.error(f"--fruit-processes must be 0-{MAX_FRUIT_PROCESSES}, got {args.fruit_processes}")
-    res = bench_node2(args.frames, rate=args.rate, method=args.method, fruit_processes=args.fruit_processes)
-    _print(res, title="symfruit ROS 2 node benchmark")
-    if args.json:
-        import json
-
-        from ..io.atomic import atomic_write
-
-        with atomic_write(args.json, "w") as handle:  # whole or not at all, like every file symfruit writes
-            handle.write(json.dumps(res, indent=2))
-    return 0
+    return run_main(argv, "python -m symfruit.ros.bench2", __doc__.splitlines()[0], bench_node2,
+                    "symfruit ROS 2 node benchmark")  # fmt: skip
 
 
 if __name__ == "__main__":  # pragma: no cover
