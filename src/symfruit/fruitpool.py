@@ -39,6 +39,7 @@ import mmap
 import multiprocessing
 import os
 import queue
+import secrets
 import signal
 import sys
 import threading
@@ -82,6 +83,7 @@ _POLL = 0.05
 
 #: Bytes a shared-memory segment is rounded up to (a slightly larger frame reuses it).
 _SEGMENT_STEP = 1 << 20
+SEGMENT_PREFIX = "symfruit_"  # a segment's name: the prefix, the caller's process id and a random part
 
 #: Set in a pool's worker process: a worker never starts workers of its own.
 _IN_WORKER = False
@@ -475,12 +477,23 @@ class FruitPool:
         if segment is None or segment.size < at:
             self._state.drop_segment()  # a worker keeps its mapping of the old one until the next frame's
             size = max(_SEGMENT_STEP, -(-at // _SEGMENT_STEP) * _SEGMENT_STEP)
-            segment = self._state.segment = shared_memory.SharedMemory(create=True, size=size)
+            segment = self._state.segment = _new_segment(size)
         for key, a in arrays.items():
             if a is not None:
                 offset, dtype, shape = layout[key]
                 np.copyto(np.ndarray(shape, dtype, buffer=segment.buf, offset=offset), a)
         return segment.name, segment.size, layout
+
+
+def _new_segment(size: int) -> shared_memory.SharedMemory:
+    """A new shared segment named ``symfruit_<pid>_<random>``: a segment left by a process killed outright is
+    told by its name (and its process id) in ``/dev/shm``."""
+    while True:
+        try:
+            name = f"{SEGMENT_PREFIX}{os.getpid()}_{secrets.token_hex(4)}"
+            return shared_memory.SharedMemory(name=name, create=True, size=size)
+        except FileExistsError:  # 2**-32 a try
+            continue
 
 
 # ---- both sides ---------------------------------------------------------------------------------------------------
