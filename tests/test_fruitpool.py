@@ -424,10 +424,20 @@ def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool
     part done on the workers (or shared), are what trim_labels and register give in one process."""
     from symfruit.detect import _box_within, _default_settings, _label_boxes
     from symfruit.extract import register
+    from symfruit.settings import Settings
 
     monkeypatch.setattr(pool, "_caller_shares", shares)
-    s = _default_settings().extract
-    for frame in (shifted(), four_shifted(), bench(0)):
+    no_search = Settings().replace(extract={"registration_px": 0}).extract
+    no_trim = Settings().replace(extract={"colour_trim_px": 0}).extract
+    usual = _default_settings().extract
+    cases = [
+        (shifted(), usual),
+        (four_shifted(), usual),
+        (bench(0), usual),
+        (shifted(), no_search),
+        (shifted(), no_trim),
+    ]
+    for frame, s in cases:
         labels = frame_masks(frame)[0]
         boxes = _label_boxes(labels, int(labels.max()))
         trimmed, colour_trimmed = _trim_labels(frame.color, labels, s, boxes)
@@ -439,8 +449,8 @@ def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool
         assert np.array_equal(got[3], moved) and got[4] == shift
         if not shares:
             assert pool.masks_elsewhere - before == sum(sl is not None for sl in boxes)
-        if frame.name != "bench":
-            assert colour_trimmed and shift != (0, 0)  # both parts at work
+        if frame.name != "bench":  # each part at work where the settings ask for it
+            assert bool(colour_trimmed) == (s.colour_trim_px > 0) and (shift != (0, 0)) == (s.registration_px > 0)
 
 
 def shared_masks(pool, frame):
