@@ -243,6 +243,7 @@ def test_a_worker_dying_within_a_frame_leaves_its_fruit_to_this_process(workers_
     pool = workers_only
     task, jobs = fruit_task(four(), die={3})
     alone = [task(k, sl) for k, sl in jobs]
+    pool.run(*fruit_task(four()))  # the segment made (when this test runs first)
     starts, segment = pool.starts, pool._state.segment
     done, _ = pool.run(task, jobs)
     assert [d[0].id for d in done] == [1, 2, 3, 4] and pool.starts == starts + 1
@@ -420,8 +421,9 @@ def four_shifted():
 
 @pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
 def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool, monkeypatch, shares):
-    """The trimmed labels, the colour-trimmed masks, their boxes, the moved labels and the shift, from each mask's
-    part done on the workers (or shared), are what trim_labels and register give in one process."""
+    """The trimmed labels, the colour-trimmed masks, their boxes, and the shift searched from the outlines, from each
+    mask's part done on the workers (or shared), are what trim_labels and register give in one process."""
+    from symfruit.core.surface import registration_search
     from symfruit.detect import _box_within, _default_settings, _label_boxes
     from symfruit.extract import register
     from symfruit.settings import Settings
@@ -442,11 +444,11 @@ def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool
         boxes = _label_boxes(labels, int(labels.max()))
         trimmed, colour_trimmed = _trim_labels(frame.color, labels, s, boxes)
         new_boxes = [_box_within(trimmed, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
-        moved, shift = register(trimmed, frame.depth, frame.camera, s, boxes=new_boxes)
+        _, shift = register(trimmed, frame.depth, frame.camera, s, boxes=new_boxes)
         before = pool.masks_elsewhere
         got = _shared_masks(pool, frame, labels, boxes, s, object())
         assert np.array_equal(got[0], trimmed) and got[1] == colour_trimmed and got[2] == new_boxes
-        assert np.array_equal(got[3], moved) and got[4] == shift
+        assert registration_search(got[3], max_px=s.registration_px) == shift
         if not shares:
             assert pool.masks_elsewhere - before == sum(sl is not None for sl in boxes)
         if frame.name != "bench":  # each part at work where the settings ask for it
@@ -522,3 +524,57 @@ def test_an_array_shared_again_for_the_same_frame_is_not_copied_again(pool):
     view[:] = -1.0
     pool._share({"a": a}, None)
     assert np.array_equal(view, a)
+
+
+def test_the_fruit_go_with_the_last_shift_while_the_search_runs_and_again_when_it_was_wrong(workers_only):
+    """detect sends the fruit moved by the pool's guess (the last shift found) while it searches for the frame's:
+    right, the workers' fruit are the frame's; wrong, they are dropped and the fruit sent again with the shift
+    found. The detections are the same either way."""
+    pool = workers_only
+    frame = shifted()  # its masks move by (6, 4)
+    one = detect(frame, method="raw")
+    for guess in [(0, 0), (6, 4), (-2, 0)]:
+        pool.registration_guess = guess
+        before, starts = pool.fruit_elsewhere, pool.starts
+        assert_same(one, detect(frame, method="raw", pool=pool))
+        assert pool.registration_guess == (6, 4) and pool.starts == starts, pool.last_loss
+        assert pool.fruit_elsewhere == before + 3  # the right run's alone: a wrong one's are not counted
+
+
+def test_a_guessed_run_called_off_drops_the_workers_fruit_and_a_failing_check_ends_them(pool, monkeypatch):
+    task, jobs = fruit_task(four())
+    alone = [task(k, sl) for k, sl in jobs]
+    for shares in (True, False):
+        monkeypatch.setattr(pool, "_caller_shares", shares)
+        calls, before, starts = [], pool.fruit_elsewhere, pool.starts
+        assert pool.run_guessed(task, jobs, None, lambda calls=calls: calls.append(1) or False) is None
+        assert calls == [1] and pool.fruit_elsewhere == before and pool.starts == starts, pool.last_loss
+        done, _ = pool.run_guessed(task, jobs, None, lambda calls=calls: calls.append(2) or True)
+        assert calls == [1, 2] and [record(d[0]) for d in done] == [record(d[0]) for d in alone]
+
+    def failing():
+        raise ValueError("the search failed")
+
+    starts = pool.starts
+    with pytest.raises(ValueError, match="the search failed"):
+        pool.run_guessed(task, jobs, None, failing)
+    assert pool.starts == starts + 1 and pool.active  # the workers ended (they may be mid-frame), new ones started
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4]
+
+
+def test_a_worker_dying_in_a_run_called_off_is_replaced(workers_only):
+    pool = workers_only
+    task, jobs = fruit_task(four(), die={1, 2, 3, 4})
+    starts, (worker,) = pool.starts, pool._state.workers
+
+    def after_it_died():  # the worker takes a fruit (it has the task) and dies on it; then the run is called off
+        worker.process.join(fp.STALL_TIMEOUT)
+        return False
+
+    assert pool.run_guessed(task, jobs, None, after_it_died) is None
+    assert pool.starts == starts + 1 and pool.active and "ended within a frame" in pool.last_loss
+    task.die = set()
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    before = pool.fruit_elsewhere
+    assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4] and pool.fruit_elsewhere == before + 4

@@ -208,47 +208,31 @@ def detect(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = _label_boxes(labels, hi)
-    same, shared = object(), None  # ``same``: this frame's depth and colour go to a pool's workers once
-    if pool is not None and pool.active and sum(sl is not None for sl in boxes) >= 2:
-        # each mask's trimming and registration outline shared with the workers too (stop 54, docs/pool54.md): the
-        # same labels, boxes and shift
-        shared = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
-        labels, colour_trimmed, boxes, moved, shift, t_trim = shared[:6]
-    else:
-        # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
-        # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for
-        # within its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
-        colour_trimmed = set()
-        if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
-            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
-            boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
-        t_trim = time.perf_counter() - t2
-        moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
-    if moved is not labels:
-        boxes = _label_boxes(moved, hi)
-    labels = moved
-    # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
-    # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
-    # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
-    camera = frame.camera.shifted(*shift)
     # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
     # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
     # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
     # stop 47, docs/mask47.md)
     outlined = source != COLOUR_SEGMENTER
-    t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
-    t_register, cpu_elsewhere = t_extract - t_trim, 0.0
-    if shared is not None:  # the masks' own seconds summed, and the search and the move's here
-        t_register, cpu_elsewhere = shared[7] + time.perf_counter() - shared[6], shared[8]
-        t_extract = t_trim + t_register
-    fruit = _Fruit(labels, frame.depth, frame.color, camera, settings, method, shift, outlined, labels > 0,
-                   colour_trimmed)  # fmt: skip
-    jobs = [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
-    if pool is None or not pool.active or len(jobs) < 2:
+    if pool is not None and pool.active and sum(sl is not None for sl in boxes) >= 2:
+        # each mask's trimming and registration outline shared with the workers too, and the fruit sent to them
+        # while the search for the shift runs here (stop 54, docs/pool54.md): the same detections
+        done, shift, t_trim, t_register, cpu_elsewhere = _detect_shared(pool, frame, labels, hi, boxes, settings,
+                                                                        method, outlined)  # fmt: skip
+        t_extract, t_complete, t_occlusion = t_trim + t_register, 0.0, 0.0
+    else:
+        # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
+        # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for
+        # within its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
+        colour_trimmed: set[int] = set()
+        if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
+            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
+            boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
+        t_trim = time.perf_counter() - t2
+        moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
+        fruit, jobs = _fruit_task(frame, labels, moved, shift, hi, boxes, settings, method, outlined, colour_trimmed)
+        t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
+        t_register, cpu_elsewhere = t_extract - t_trim, 0.0
         done = [fruit(k, sl) for k, sl in jobs]
-    else:  # the first failing fruit's error is raised, as the loop above raises it
-        done, cpu_fruit = pool.run(fruit, jobs, same)
-        cpu_elsewhere += cpu_fruit
     detections = [d[0] for d in done]
     for _, ext, occl, comp, _ in done:
         t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
@@ -257,6 +241,63 @@ def detect(
                "occlusion": t_occlusion, "complete": t_complete, "total": total,
                "cpu": time.thread_time() - cpu0 + cpu_elsewhere}  # fmt: skip
     return FrameDetections(frame, detections, timings, source, shift)
+
+
+def _fruit_task(
+    frame: Frame, labels: np.ndarray, moved: np.ndarray, shift: tuple[int, int], hi: int,
+    boxes: list[tuple[slice, slice] | None], settings: Settings, method: str, outlined: bool, colour_trimmed: set[int],
+) -> tuple[_Fruit, list[tuple[int, tuple[slice, slice]]]]:  # fmt: skip
+    """The frame's per-fruit task and its jobs, from the trimmed ``labels`` (greatest label ``hi``, boxes ``boxes``)
+    moved by ``shift`` onto the depth image (``moved``: ``labels`` itself when they did not move)."""
+    if moved is not labels:
+        boxes = _label_boxes(moved, hi)
+    # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
+    # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
+    # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
+    camera = frame.camera.shifted(*shift)
+    fruit = _Fruit(moved, frame.depth, frame.color, camera, settings, method, shift, outlined, moved > 0,
+                   colour_trimmed)  # fmt: skip
+    return fruit, [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
+
+
+def _detect_shared(
+    pool: FruitPool, frame: Frame, labels: np.ndarray, hi: int, boxes: list[tuple[slice, slice] | None],
+    settings: Settings, method: str, outlined: bool,
+) -> tuple[list[_Done], tuple[int, int], float, float, float]:  # fmt: skip
+    """``detect``'s trimming, registration and fruit with ``pool`` (active, two masks or more): each mask's
+    trimming and registration outline shared with its workers (:func:`_shared_masks`); then the fruit, moved by
+    the pool's guess of the shift (the last frame's), sent to the workers while the search for this frame's shift
+    runs here (:meth:`~symfruit.fruitpool.FruitPool.run_guessed`), and sent again moved by the shift found when the
+    guess was wrong. The fruit's answers, the shift, the masks' trimming seconds and the registration's (each
+    mask's own summed, and the search's and the move's here), and the workers' CPU seconds. The same answers as
+    without the pool; the first failing mask's or fruit's error is raised."""
+    same = object()  # this frame's depth and colour go to the workers once
+    masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
+    trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines, cpu = masks
+    a = time.perf_counter()
+    guess = found = pool.registration_guess
+
+    def search() -> bool:
+        nonlocal found
+        found = registration_search(outlines, max_px=settings.extract.registration_px)
+        return found == guess
+
+    moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
+    fruit, jobs = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined, colour_trimmed)
+    if len(jobs) >= 2:
+        got = pool.run_guessed(fruit, jobs, same, search)  # the first failing fruit's error is raised
+    else:
+        got = ([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None
+    t_register = t_outlines + time.perf_counter() - a
+    if got is None:  # the wrong guess: the fruit moved by the shift found
+        pool.registration_guess = found
+        b = time.perf_counter()
+        moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
+        fruit, jobs = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
+                                  colour_trimmed)  # fmt: skip
+        t_register += time.perf_counter() - b
+        got = pool.run(fruit, jobs, same) if len(jobs) >= 2 else ([fruit(k, sl) for k, sl in jobs], 0.0)
+    return got[0], found, t_trim, t_register, cpu + got[1]
 
 
 #: What one fruit's task gives back: its detection, the wall seconds of its extraction, occlusion maps and completion
@@ -409,14 +450,14 @@ def _without(mask: np.ndarray, r0: int, c0: int, dropped: _Dropped) -> np.ndarra
 def _shared_masks(
     pool: FruitPool, frame: Frame, labels: np.ndarray, boxes: list[tuple[slice, slice] | None], s: ExtractSettings,
     same: object,
-) -> tuple[np.ndarray, set[int], list[tuple[slice, slice] | None], np.ndarray, tuple[int, int], float, float, float,
-           float]:  # fmt: skip
-    """``detect``'s trimming and registration with each mask's part (:class:`_Masks`) shared with ``pool``'s
-    workers: the trimmed labels, the colour-trimmed masks, their boxes, the labels moved and the shift, as
-    :func:`_trim_labels`, :func:`_box_within` and :func:`~symfruit.extract.register` give them; then the masks'
-    trimming seconds summed, when the masks were done (``time.perf_counter()``), their outlines' seconds summed,
-    and the workers' CPU seconds. The first failing mask's error is raised (its trimming's, then its outline's),
-    as one process raises it; the search for the shift runs here, on the outlines in the frame's order."""
+) -> tuple[np.ndarray, set[int], list[tuple[slice, slice] | None], list[_Outline], float, float, float]:  # fmt: skip
+    """``detect``'s trimming and the registration's outlines with each mask's part (:class:`_Masks`) shared with
+    ``pool``'s workers: the trimmed labels, the colour-trimmed masks and their boxes, as :func:`_trim_labels` and
+    :func:`_box_within` give them, and the masks' registration outlines in the frame's order (those
+    :func:`~symfruit.extract.register` searches the shift with: :func:`~symfruit.core.surface.registration_search`);
+    then the masks' trimming seconds summed, their outlines' seconds summed (with the putting together here), and
+    the workers' CPU seconds. The first failing mask's error is raised (its trimming's, then its outline's), as one
+    process raises it."""
     color = frame.color
     if color is not None:  # the checks trim_labels, then register make, before any mask
         color, labels, _ = _trim_checked(color, labels, s)
@@ -441,9 +482,7 @@ def _shared_masks(
             raise outline
         if outline is not None:
             outlines.append(outline)
-    du, dv = registration_search(outlines, max_px=s.registration_px)
-    moved = shift_labels(trimmed, du, dv) if (du, dv) != (0, 0) else trimmed
-    return trimmed, colour_trimmed, boxes, moved, (du, dv), t_trim, after, t_outlines, cpu
+    return trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines + time.perf_counter() - after, cpu
 
 
 def _default_settings() -> Settings:

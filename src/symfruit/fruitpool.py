@@ -216,6 +216,10 @@ class FruitPool:
         Seconds the first workers took to start and warm up (with ``wait``; NaN otherwise).
     fruit_elsewhere : int
         Fruit the workers have done so far.
+    registration_guess : tuple of int
+        The registration shift ``(du, dv)`` :func:`symfruit.detect.detect` sends a frame's fruit to the workers
+        with while it searches for the frame's own (the last shift found that differed from its guess: a camera's
+        shift stays the same from frame to frame); a wrong guess costs the fruit the workers were on.
     masks_elsewhere : int
         Masks the workers have colour trimmed and found registration outlines of so far (``detect``'s first task
         a frame).
@@ -250,6 +254,7 @@ class FruitPool:
         self.reason = one_process_reason(self.processes)
         self.started_s, self.fruit_elsewhere, self.starts, self.last_loss = float("nan"), 0, 0, ""
         self.masks_elsewhere = 0
+        self.registration_guess = (0, 0)
         #: what :meth:`_share` last copied: each array (the object) and its place, for the frame ``_shared_for``
         self._shared: dict[str, tuple[np.ndarray, Any]] = {}
         self._shared_for: object = None
@@ -363,20 +368,36 @@ class FruitPool:
         CPU seconds it took. ``same``: an object that stands for one frame (``detect`` makes one per call): an array
         of a later task given the same ``same`` that is the very object the last one shared under its name is not
         copied again (the frame's depth and colour, shared once for both of ``detect``'s tasks)."""
+        got = self.run_guessed(fruit, jobs, same, None)
+        assert got is not None  # nothing to check: never called off
+        return got
+
+    def run_guessed(
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None
+    ) -> tuple[list[Any], float] | None:
+        """:meth:`run` of a task made from a guess, started on the workers while this process runs ``check`` (once,
+        before it takes a fruit itself, whether or not the pool has workers), which tells whether the guess was
+        right: if it returns False no more fruit are taken, the workers end the fruit they are on, their answers are
+        dropped, and None is returned (``detect`` sends its fruit with the last frame's registration shift while its
+        search for this frame's runs, then again with the right one when they differ). An exception ``check``
+        raises goes up as one a fruit raises here would (the workers ended, new ones started)."""
         if not self.active or not self._busy.acquire(blocking=False):
-            return [fruit(k, sl) for k, sl in jobs], 0.0
+            return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
         try:
             if not self._workers_ready():
-                return [fruit(k, sl) for k, sl in jobs], 0.0
+                return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
             try:
                 with self._one_blas_thread():
-                    out, cpu = self._run(fruit, jobs, same)
+                    got = self._run(fruit, jobs, same, check)
             except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
                 if self.active:
                     self._lost("the calling process was interrupted within a frame")
                 raise
         finally:
             self._busy.release()
+        if got is None:
+            return None
+        out, cpu = got
         for kind, value in out:  # the first failing fruit's error, in the frame's order
             if kind == "raised":
                 raise value
@@ -403,8 +424,8 @@ class FruitPool:
                 return False
         return self._wait_ready(0.0) if self.active else False
 
-    def _run(self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]],
-             same: object) -> tuple[list[tuple[str, Any]], float]:  # fmt: skip
+    def _run(self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object,
+             check: Callable[[], bool] | None) -> tuple[list[tuple[str, Any]], float] | None:  # fmt: skip
         """:meth:`run`'s work: each fruit's :func:`_attempt`, in ``jobs``' order, and the workers' CPU seconds."""
         from .detect import _Fruit
 
@@ -427,6 +448,9 @@ class FruitPool:
                 w.conn.send(message)
             except OSError:
                 lost = "a worker process's pipe broke"
+        called_off = check is not None and not check()
+        if called_off and not _take_all(self._lock, self._counter, len(todo)):
+            lost = f"the fruit counter's lock was held for {STALL_TIMEOUT:.0f} s"
         while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
             found[i] = _attempt(fruit, *todo[i])
             for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
@@ -441,6 +465,12 @@ class FruitPool:
                     lost = f"a worker process ended within a frame (exit code {w.process.exitcode})"
                 elif time.monotonic() - silent_since > STALL_TIMEOUT:
                     lost = f"a worker process was silent for {STALL_TIMEOUT:.0f} s within a frame"
+        if called_off:  # the workers' answers dropped
+            if lost:
+                self._lost(lost)
+            else:
+                self._failed_starts = 0
+            return None
         if lost:  # the fruit not returned are done here; new workers for the next frames
             self._lost(lost)
             for i, got in enumerate(found):
@@ -454,7 +484,7 @@ class FruitPool:
             out[order[i]] = got
             if theirs[i] and got[0] == "ok":
                 cpu += got[1][-1]
-                if kind is _Fruit:
+                if issubclass(kind, _Fruit):
                     self.fruit_elsewhere += 1
                 else:
                     self.masks_elsewhere += 1
@@ -556,6 +586,18 @@ def _claim(lock: Any, counter: Any, count: int) -> int | None:
             return None
         counter.value = i + 1
         return int(i)
+    finally:
+        lock.release()
+
+
+def _take_all(lock: Any, counter: Any, count: int) -> bool:
+    """No fruit left to take: the shared counter moved to ``count`` under the shared lock (False: the lock was not
+    had within :data:`STALL_TIMEOUT` s)."""
+    if not lock.acquire(timeout=STALL_TIMEOUT):
+        return False
+    try:
+        counter.value = max(int(counter.value), count)
+        return True
     finally:
         lock.release()
 
