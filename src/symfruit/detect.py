@@ -274,21 +274,24 @@ def _detect_shared(
     same = object()  # this frame's depth and colour go to the workers once
     masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
     trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines, cpu = masks
-    a = time.perf_counter()
+    a, t_search = time.perf_counter(), 0.0
     guess = found = pool.registration_guess
 
     def search() -> bool:
-        nonlocal found
+        nonlocal found, t_search
+        b = time.perf_counter()
         found = registration_search(outlines, max_px=settings.extract.registration_px)
+        t_search = time.perf_counter() - b
         return found == guess
 
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
     fruit, jobs = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined, colour_trimmed)
+    t_register = t_outlines + time.perf_counter() - a  # the move's and the search's seconds with them
     if len(jobs) >= 2:
         got = pool.run_guessed(fruit, jobs, same, search)  # the first failing fruit's error is raised
     else:
         got = ([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None
-    t_register = t_outlines + time.perf_counter() - a
+    t_register += t_search
     if got is None:  # the wrong guess: the fruit moved by the shift found
         pool.registration_guess = found
         b = time.perf_counter()
