@@ -229,8 +229,9 @@ def detect(
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
-        fruit, jobs = _fruit_task(frame, labels, moved, shift, hi, boxes, settings, method, outlined, colour_trimmed)
-        t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
+        fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, hi, boxes, settings, method, outlined,
+                                         colour_trimmed)  # fmt: skip
+        t_extract, t_complete, t_occlusion = ended - t2, 0.0, 0.0
         t_register, cpu_elsewhere = t_extract - t_trim, 0.0
         done = [fruit(k, sl) for k, sl in jobs]
     detections = [d[0] for d in done]
@@ -246,18 +247,20 @@ def detect(
 def _fruit_task(
     frame: Frame, labels: np.ndarray, moved: np.ndarray, shift: tuple[int, int], hi: int,
     boxes: list[tuple[slice, slice] | None], settings: Settings, method: str, outlined: bool, colour_trimmed: set[int],
-) -> tuple[_Fruit, list[tuple[int, tuple[slice, slice]]]]:  # fmt: skip
+) -> tuple[_Fruit, list[tuple[int, tuple[slice, slice]]], float]:  # fmt: skip
     """The frame's per-fruit task and its jobs, from the trimmed ``labels`` (greatest label ``hi``, boxes ``boxes``)
-    moved by ``shift`` onto the depth image (``moved``: ``labels`` itself when they did not move)."""
+    moved by ``shift`` onto the depth image (``moved``: ``labels`` itself when they did not move), and when the
+    registration's part of it ended (``time.perf_counter()``: the boxes and the camera moved)."""
     if moved is not labels:
         boxes = _label_boxes(moved, hi)
     # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
     # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
     # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
     camera = frame.camera.shifted(*shift)
+    ended = time.perf_counter()
     fruit = _Fruit(moved, frame.depth, frame.color, camera, settings, method, shift, outlined, moved > 0,
                    colour_trimmed)  # fmt: skip
-    return fruit, [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
+    return fruit, [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None], ended
 
 
 def _detect_shared(
@@ -285,8 +288,9 @@ def _detect_shared(
         return found == guess
 
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
-    fruit, jobs = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined, colour_trimmed)
-    t_register = t_outlines + time.perf_counter() - a  # the move's and the search's seconds with them
+    fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
+                                     colour_trimmed)  # fmt: skip
+    t_register = t_outlines + ended - a  # the move's and the search's seconds with them
     if len(jobs) >= 2:
         got = pool.run_guessed(fruit, jobs, same, search)  # the first failing fruit's error is raised
     else:
@@ -296,9 +300,9 @@ def _detect_shared(
         pool.registration_guess = found
         b = time.perf_counter()
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
-        fruit, jobs = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
-                                  colour_trimmed)  # fmt: skip
-        t_register += time.perf_counter() - b
+        fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
+                                         colour_trimmed)  # fmt: skip
+        t_register += ended - b
         got = pool.run(fruit, jobs, same) if len(jobs) >= 2 else ([fruit(k, sl) for k, sl in jobs], 0.0)
     return got[0], found, t_trim, t_register, cpu + got[1]
 

@@ -17,6 +17,13 @@ so neither waits while fruit are left; each detection a worker made comes back p
 its box), and the detections are returned in the frame's order. An error a fruit raises (not a fruit's ``error``,
 which is a detection: an exception) is the first failing fruit's in the frame's order, as one process raises it.
 
+``detect`` gives the pool two tasks a frame (stop 54, docs/pool54.md): first each mask's colour trimming and
+registration outline (``detect._Masks``; the search for the frame's shift over the outlines runs in the calling
+process), then the fruit (``detect._Fruit``). The fruit are sent moved by :attr:`FruitPool.registration_guess` (the
+last shift found) while the search runs (:meth:`FruitPool.run_guessed`); a wrong guess calls that run off (the
+workers' fruit dropped) and the fruit go again with the shift found. The frame's depth and colour are copied into the
+shared segment once for both tasks.
+
 A worker that dies (killed, a crash) or stays silent for :data:`STALL_TIMEOUT` seconds within a frame is ended: the
 fruit it had not returned are done in the calling process, and new workers are started at once for the next
 frames (a frame that comes before they are warm runs in the calling process: no frame waits for a start-up). The
