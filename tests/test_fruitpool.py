@@ -96,7 +96,8 @@ def shifted():
 
 
 def frames():
-    """Generated frames: the benchmark's (9 fruit, more than the workers), one with a fruit too small to complete
+    """Generated frames: the benchmark's (9 fruit, more than the workers), three fruit whose masks are trimmed and
+    moved (:func:`shifted`), one with a fruit too small to complete
     and one whose mask holds only the background (both reported with their error), one fruit, none."""
     tiny = np.zeros((120, 160), np.int32)
     tiny[45:76, 25:56], tiny[2:4, 2:4], tiny[50:70, 100:130] = 1, 2, 3
