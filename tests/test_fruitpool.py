@@ -15,7 +15,7 @@ import pytest
 from symfruit import InputError, SymfruitError
 from symfruit import fruitpool as fp
 from symfruit.core.frame import Frame
-from symfruit.detect import _Fruit, detect
+from symfruit.detect import _Fruit, _Masks, _shared_masks, _trim_labels, detect, frame_masks
 from symfruit.fruitpool import MAX_FRUIT_PROCESSES, FruitPool, check_fruit_processes, one_process_reason
 from symfruit.writers import detection_record
 
@@ -81,8 +81,23 @@ def assert_same(a, b):
     assert a.timings.keys() == b.timings.keys() and a.registration == b.registration
 
 
+def shifted():
+    """Three fruit whose masks are 3 px too large (colour trimming takes it off) on depth registered 6 px right of
+    and 4 px below the colour (the masks move by (6, 4))."""
+    centres = [(40, 40), (110, 45), (75, 90)]
+    color, depth = disc_frame(centres, radius=18)
+    moved = np.full_like(depth, 1.0)
+    moved[4:, 6:] = depth[:-4, :-6]  # what colour pixel (u, v) sees lies at depth pixel (u + 6, v + 4)
+    yy, xx = np.mgrid[:120, :160]
+    masks = np.zeros((120, 160), np.int32)
+    for k, (u, v) in enumerate(centres, 1):
+        masks[(xx - u) ** 2 + (yy - v) ** 2 <= 21**2] = k
+    return Frame("shifted", color, moved, SMALL_CAM, masks=masks)
+
+
 def frames():
-    """Generated frames: the benchmark's (9 fruit, more than the workers), one with a fruit too small to complete
+    """Generated frames: the benchmark's (9 fruit, more than the workers), three fruit whose masks are trimmed and
+    moved (:func:`shifted`), one with a fruit too small to complete
     and one whose mask holds only the background (both reported with their error), one fruit, none."""
     tiny = np.zeros((120, 160), np.int32)
     tiny[45:76, 25:56], tiny[2:4, 2:4], tiny[50:70, 100:130] = 1, 2, 3
@@ -95,6 +110,7 @@ def frames():
     depth[(xx - 120) ** 2 + (yy - 60) ** 2 <= 15**2] = 0.0
     return [
         ("benchmark 0", bench(0), "evidence"),
+        ("trimmed and moved", shifted(), "raw"),
         ("benchmark 1", bench(1), "paper"),
         ("a fruit too small", small([(40, 60), (115, 60)], tiny), "evidence"),
         ("the background", Frame("wall", np.full_like(grey.color, 90), depth, SMALL_CAM, masks=wall), "raw"),
@@ -107,16 +123,20 @@ def frames():
 def test_the_detections_are_the_same_with_the_pool(pool, shares):
     pool._caller_shares = shares
     try:
-        before = pool.fruit_elsewhere
-        errors, counts = 0, []
+        before, masks_before = pool.fruit_elsewhere, pool.masks_elsewhere
+        errors, counts, masks, moves = 0, [], [], []
         for _, frame, method in frames():
             one, two = detect(frame, method=method), detect(frame, method=method, pool=pool)
             assert_same(one, two)
             errors += sum(bool(d.error) for d in two.detections)
             counts.append(len(two.detections))
-        assert errors >= 2 and counts[0] == 9 and counts[-2:] == [1, 0]  # as frames() says
-        if not shares:  # every fruit of every frame of two fruit or more
+            masks.append(len(np.unique(frame_masks(frame)[0])) - 1)
+            moves.append(two.registration)
+        assert errors >= 2 and counts[:2] == [9, 3] and counts[-2:] == [1, 0]  # as frames() says
+        assert moves[1] == (6, 4)  # the masks trimmed by colour (assert_same: the same masks) and moved
+        if not shares:  # every fruit and every mask of every frame of two fruit or more
             assert pool.fruit_elsewhere - before == sum(n for n in counts if n >= 2)
+            assert pool.masks_elsewhere - masks_before == sum(n for n in masks if n >= 2)
     finally:
         pool._caller_shares = True
 
@@ -224,6 +244,7 @@ def test_a_worker_dying_within_a_frame_leaves_its_fruit_to_this_process(workers_
     pool = workers_only
     task, jobs = fruit_task(four(), die={3})
     alone = [task(k, sl) for k, sl in jobs]
+    pool.run(*fruit_task(four()))  # the segment made (when this test runs first)
     starts, segment = pool.starts, pool._state.segment
     done, _ = pool.run(task, jobs)
     assert [d[0].id for d in done] == [1, 2, 3, 4] and pool.starts == starts + 1
@@ -331,3 +352,230 @@ def test_a_shared_frame_runs_this_processs_blas_on_one_thread_and_lifts_it_after
             assert blas_threads() == before
         finally:
             pool.close()
+
+
+# --- stop 54 (pool54): each mask's colour trimming and registration outline on the workers too
+
+
+def mask_task(frame, cls=_Masks):
+    """The per-mask task and jobs ``detect`` makes for ``frame`` (its masks as given), of class ``cls``."""
+    from symfruit.detect import _default_settings, _label_boxes
+
+    labels = frame.masks.astype(np.int32)
+    s = _default_settings().extract
+    task = cls(labels, frame.depth, frame.color, s, float(np.sqrt(frame.camera.fx * frame.camera.fy)))
+    return task, [(k, sl) for k, sl in enumerate(_label_boxes(labels, int(labels.max())), 1) if sl is not None]
+
+
+class FailingMasks(_Masks):
+    """A mask task whose trimming raises for the masks ``fail`` names (``ValueError("trim k")``), whose outline
+    raises for those ``fail_outline`` names (``"outline k"``), and that ends the worker process it runs in for
+    those ``die`` names (class attributes: ``detect`` makes the task; a worker imports its class from here)."""
+
+    fail: tuple[int, ...] = ()
+    fail_outline: tuple[int, ...] = ()
+    die: tuple[int, ...] = ()
+
+    def _trim(self, k, sl):
+        if k in self.die and fp._IN_WORKER:
+            os.kill(os.getpid(), signal.SIGKILL)
+        if k in self.fail:
+            raise ValueError(f"trim {k}")
+        return super()._trim(k, sl)
+
+    def _outline(self, k, box, dropped):
+        if k in self.fail_outline:
+            raise ValueError(f"outline {k}")
+        return super()._outline(k, box, dropped)
+
+
+class TrimFails(FailingMasks):
+    fail, fail_outline = (3, 4), (1,)
+
+
+class OutlineFails(FailingMasks):
+    fail_outline = (4, 2)
+
+
+class DiesOnMask3(FailingMasks):
+    die = (3,)
+
+
+class InterruptedMasks(_Masks):
+    def _trim(self, k, sl):
+        if not fp._IN_WORKER:
+            raise KeyboardInterrupt
+        return super()._trim(k, sl)
+
+
+def four_shifted():
+    """four() with its masks 2 px larger than its fruit and its depth 6 px right of the colour."""
+    frame = four()
+    moved = np.full_like(frame.depth, 1.0)
+    moved[:, 6:] = frame.depth[:, :-6]
+    yy, xx = np.mgrid[:120, :160]
+    labels = np.zeros((120, 160), np.int32)
+    for k, (u, v) in enumerate([(30, 30), (90, 30), (30, 90), (120, 90)], 1):
+        labels[(xx - u) ** 2 + (yy - v) ** 2 <= 17**2] = k
+    return Frame("four shifted", frame.color, moved, SMALL_CAM, masks=labels)
+
+
+@pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
+def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool, monkeypatch, shares):
+    """The trimmed labels, the colour-trimmed masks, their boxes, and the shift searched from the outlines, from each
+    mask's part done on the workers (or shared), are what trim_labels and register give in one process."""
+    from symfruit.core.surface import registration_search
+    from symfruit.detect import _box_within, _default_settings, _label_boxes
+    from symfruit.extract import register
+    from symfruit.settings import Settings
+
+    monkeypatch.setattr(pool, "_caller_shares", shares)
+    no_search = Settings().replace(extract={"registration_px": 0}).extract
+    no_trim = Settings().replace(extract={"colour_trim_px": 0}).extract
+    usual = _default_settings().extract
+    cases = [
+        (shifted(), usual),
+        (four_shifted(), usual),
+        (bench(0), usual),
+        (shifted(), no_search),
+        (shifted(), no_trim),
+    ]
+    for frame, s in cases:
+        labels = frame_masks(frame)[0]
+        boxes = _label_boxes(labels, int(labels.max()))
+        trimmed, colour_trimmed = _trim_labels(frame.color, labels, s, boxes)
+        new_boxes = [_box_within(trimmed, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
+        _, shift = register(trimmed, frame.depth, frame.camera, s, boxes=new_boxes)
+        before = pool.masks_elsewhere
+        got = _shared_masks(pool, frame, labels, boxes, s, object())
+        assert np.array_equal(got[0], trimmed) and got[1] == colour_trimmed and got[2] == new_boxes
+        assert registration_search(got[3], max_px=s.registration_px) == shift
+        if not shares:
+            assert pool.masks_elsewhere - before == sum(sl is not None for sl in boxes)
+        if frame.name != "bench":  # each part at work where the settings ask for it
+            assert bool(colour_trimmed) == (s.colour_trim_px > 0) and (shift != (0, 0)) == (s.registration_px > 0)
+
+
+def shared_masks(pool, frame):
+    from symfruit.detect import _default_settings, _label_boxes
+
+    labels = frame.masks.astype(np.int32)
+    return _shared_masks(pool, frame, labels, _label_boxes(labels, int(labels.max())), _default_settings().extract,
+                         object())  # fmt: skip
+
+
+@pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
+def test_the_first_failing_masks_error_is_raised_its_trimmings_before_any_outlines(pool, monkeypatch, shares):
+    """As trim_labels runs before register in one process: a mask's trimming error before any mask's outline
+    error, each the first failing mask's in the frame's order; the pool goes on."""
+    monkeypatch.setattr(pool, "_caller_shares", shares)
+    frame = four_shifted()
+    starts = pool.starts
+    for cls, first in ((TrimFails, "trim 3"), (OutlineFails, "outline 2")):
+        monkeypatch.setattr("symfruit.detect._Masks", cls)
+        with pytest.raises(ValueError, match=rf"^{first}\b") as raised:
+            detect(frame, method="raw", pool=pool)
+        if not shares and first.startswith("trim"):  # raised there, told here with where it came from
+            assert "in FruitPool worker" in "".join(getattr(raised.value, "__notes__", []))
+    assert pool.starts == starts, pool.last_loss  # no worker lost
+    monkeypatch.undo()
+    assert_same(detect(frame, method="raw"), detect(frame, method="raw", pool=pool))
+
+
+def test_a_worker_dying_on_a_mask_leaves_its_masks_to_this_process(workers_only, monkeypatch):
+    pool = workers_only
+    frame = four_shifted()
+    one = detect(frame, method="raw")
+    starts = pool.starts
+    monkeypatch.setattr("symfruit.detect._Masks", DiesOnMask3)
+    assert_same(one, detect(frame, method="raw", pool=pool))  # the masks the worker left done here, the fruit too
+    assert pool.starts == starts + 1 and pool.active and "within a frame" in pool.last_loss
+    monkeypatch.undo()
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    before = pool.masks_elsewhere
+    assert_same(one, detect(frame, method="raw", pool=pool))
+    assert pool.masks_elsewhere == before + 4  # the new worker did them
+
+
+def test_an_interrupt_among_the_masks_ends_the_workers_and_close_leaves_no_segment(monkeypatch):
+    before = ours()
+    with FruitPool(1, method=None) as pool:
+        first = pool._state.workers[0].process
+        monkeypatch.setattr("symfruit.detect._Masks", InterruptedMasks)
+        with pytest.raises(KeyboardInterrupt):
+            detect(four_shifted(), method="raw", pool=pool)
+        assert not first.is_alive() and pool.starts == 2  # ended, and new ones started
+        processes = [w.process for w in pool._state.workers]
+    assert not any(p.is_alive() for p in processes)
+    assert ours() - before == set()
+
+
+def test_an_array_shared_again_for_the_same_frame_is_not_copied_again(pool):
+    """detect shares the frame's depth and colour once for its two tasks (the same ``same``); the same array for
+    another frame, or a new array, is copied."""
+    a, b = np.arange(1000.0), np.ones(500, np.int32)
+    frame, other = object(), object()
+    _, _, layout = pool._share({"a": a, "b": b}, frame)
+    view = np.ndarray(layout["a"][2], layout["a"][1], buffer=pool._state.segment.buf, offset=layout["a"][0])
+    view[:] = -1.0  # what a copy would overwrite
+    pool._share({"a": a, "b": b.copy()}, frame)
+    assert (view == -1.0).all()
+    pool._share({"a": a, "b": b}, other)
+    assert np.array_equal(view, a)
+    view[:] = -1.0
+    pool._share({"a": a}, None)
+    assert np.array_equal(view, a)
+
+
+def test_the_fruit_go_with_the_last_shift_while_the_search_runs_and_again_when_it_was_wrong(workers_only):
+    """detect sends the fruit moved by the pool's guess (the last shift found) while it searches for the frame's:
+    right, the workers' fruit are the frame's; wrong, they are dropped and the fruit sent again with the shift
+    found. The detections are the same either way."""
+    pool = workers_only
+    frame = shifted()  # its masks move by (6, 4)
+    one = detect(frame, method="raw")
+    for guess in [(0, 0), (6, 4), (-2, 0)]:
+        pool.registration_guess = guess
+        before, starts = pool.fruit_elsewhere, pool.starts
+        assert_same(one, detect(frame, method="raw", pool=pool))
+        assert pool.registration_guess == (6, 4) and pool.starts == starts, pool.last_loss
+        assert pool.fruit_elsewhere == before + 3  # the right run's alone: a wrong one's are not counted
+
+
+def test_a_guessed_run_called_off_drops_the_workers_fruit_and_a_failing_check_ends_them(pool, monkeypatch):
+    task, jobs = fruit_task(four())
+    alone = [task(k, sl) for k, sl in jobs]
+    for shares in (True, False):
+        monkeypatch.setattr(pool, "_caller_shares", shares)
+        calls, before, starts = [], pool.fruit_elsewhere, pool.starts
+        assert pool.run_guessed(task, jobs, None, lambda calls=calls: calls.append(1) or False) is None
+        assert calls == [1] and pool.fruit_elsewhere == before and pool.starts == starts, pool.last_loss
+        done, _ = pool.run_guessed(task, jobs, None, lambda calls=calls: calls.append(2) or True)
+        assert calls == [1, 2] and [record(d[0]) for d in done] == [record(d[0]) for d in alone]
+
+    def failing():
+        raise ValueError("the search failed")
+
+    starts = pool.starts
+    with pytest.raises(ValueError, match="the search failed"):
+        pool.run_guessed(task, jobs, None, failing)
+    assert pool.starts == starts + 1 and pool.active  # the workers ended (they may be mid-frame), new ones started
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4]
+
+
+def test_a_worker_dying_in_a_run_called_off_is_replaced(workers_only):
+    pool = workers_only
+    task, jobs = fruit_task(four(), die={1, 2, 3, 4})
+    starts, (worker,) = pool.starts, pool._state.workers
+
+    def after_it_died():  # the worker takes a fruit (it has the task) and dies on it; then the run is called off
+        worker.process.join(fp.STALL_TIMEOUT)
+        return False
+
+    assert pool.run_guessed(task, jobs, None, after_it_died) is None
+    assert pool.starts == starts + 1 and pool.active and "ended within a frame" in pool.last_loss
+    task.die = set()
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    before = pool.fruit_elsewhere
+    assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4] and pool.fruit_elsewhere == before + 4

@@ -11,6 +11,7 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -22,8 +23,20 @@ from .core.kernels import compiled
 from .core.limits import MAX_FOCAL_PX, MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .core.raster import mask_box
+from .core.surface import _Outline, registration_outline, registration_search, registration_window
 from .errors import InputError, SymfruitError
-from .extract import Extraction, ExtractSettings, extract, own_surface, register, trim_labels
+from .extract import (
+    Extraction,
+    ExtractSettings,
+    _checked,
+    _trim_checked,
+    extract,
+    own_surface,
+    register,
+    shift_labels,
+    trim_labels,
+    trim_mask,
+)
 from .fruitpool import FruitPool
 from .io.frames import COLOR_FILE
 from .methods import DEFAULT_METHOD
@@ -195,37 +208,32 @@ def detect(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = _label_boxes(labels, hi)
-    # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
-    # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for within
-    # its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
-    colour_trimmed: set[int] = set()
-    if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
-        labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
-        boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
-    t_trim = time.perf_counter() - t2
-    moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
-    if moved is not labels:
-        boxes = _label_boxes(moved, hi)
-    labels = moved
-    # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
-    # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
-    # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
-    camera = frame.camera.shifted(*shift)
     # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
     # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
     # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
     # stop 47, docs/mask47.md)
     outlined = source != COLOUR_SEGMENTER
-    t_extract, t_complete, t_occlusion = time.perf_counter() - t2, 0.0, 0.0
-    t_register = t_extract - t_trim
-    fruit = _Fruit(labels, frame.depth, frame.color, camera, settings, method, shift, outlined, labels > 0,
-                   colour_trimmed)  # fmt: skip
-    jobs = [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
-    cpu_elsewhere = 0.0
-    if pool is None or not pool.active or len(jobs) < 2:
+    if pool is not None and pool.active and sum(sl is not None for sl in boxes) >= 2:
+        # each mask's trimming and registration outline shared with the workers too, and the fruit sent to them
+        # while the search for the shift runs here (stop 54, docs/pool54.md): the same detections
+        done, shift, t_trim, t_register, cpu_elsewhere = _detect_shared(pool, frame, labels, hi, boxes, settings,
+                                                                        method, outlined)  # fmt: skip
+        t_extract, t_complete, t_occlusion = t_trim + t_register, 0.0, 0.0
+    else:
+        # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
+        # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for
+        # within its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
+        colour_trimmed: set[int] = set()
+        if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
+            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
+            boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
+        t_trim = time.perf_counter() - t2
+        moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
+        fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, hi, boxes, settings, method, outlined,
+                                         colour_trimmed)  # fmt: skip
+        t_extract, t_complete, t_occlusion = ended - t2, 0.0, 0.0
+        t_register, cpu_elsewhere = t_extract - t_trim, 0.0
         done = [fruit(k, sl) for k, sl in jobs]
-    else:  # the first failing fruit's error is raised, as the loop above raises it
-        done, cpu_elsewhere = pool.run(fruit, jobs)
     detections = [d[0] for d in done]
     for _, ext, occl, comp, _ in done:
         t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
@@ -234,6 +242,69 @@ def detect(
                "occlusion": t_occlusion, "complete": t_complete, "total": total,
                "cpu": time.thread_time() - cpu0 + cpu_elsewhere}  # fmt: skip
     return FrameDetections(frame, detections, timings, source, shift)
+
+
+def _fruit_task(
+    frame: Frame, labels: np.ndarray, moved: np.ndarray, shift: tuple[int, int], hi: int,
+    boxes: list[tuple[slice, slice] | None], settings: Settings, method: str, outlined: bool, colour_trimmed: set[int],
+) -> tuple[_Fruit, list[tuple[int, tuple[slice, slice]]], float]:  # fmt: skip
+    """The frame's per-fruit task and its jobs, from the trimmed ``labels`` (greatest label ``hi``, boxes ``boxes``)
+    moved by ``shift`` onto the depth image (``moved``: ``labels`` itself when they did not move), and when the
+    registration's part of it ended (``time.perf_counter()``: the boxes and the camera moved)."""
+    if moved is not labels:
+        boxes = _label_boxes(moved, hi)
+    # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
+    # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
+    # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
+    camera = frame.camera.shifted(*shift)
+    ended = time.perf_counter()
+    fruit = _Fruit(moved, frame.depth, frame.color, camera, settings, method, shift, outlined, moved > 0,
+                   colour_trimmed)  # fmt: skip
+    return fruit, [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None], ended
+
+
+def _detect_shared(
+    pool: FruitPool, frame: Frame, labels: np.ndarray, hi: int, boxes: list[tuple[slice, slice] | None],
+    settings: Settings, method: str, outlined: bool,
+) -> tuple[list[_Done], tuple[int, int], float, float, float]:  # fmt: skip
+    """``detect``'s trimming, registration and fruit with ``pool`` (active, two masks or more): each mask's
+    trimming and registration outline shared with its workers (:func:`_shared_masks`); then the fruit, moved by
+    the pool's guess of the shift (the last frame's), sent to the workers while the search for this frame's shift
+    runs here (:meth:`~symfruit.fruitpool.FruitPool.run_guessed`), and sent again moved by the shift found when the
+    guess was wrong. The fruit's answers, the shift, the masks' trimming seconds and the registration's (each
+    mask's own summed, and the search's and the move's here), and the workers' CPU seconds. The same answers as
+    without the pool; the first failing mask's or fruit's error is raised."""
+    same = object()  # this frame's depth and colour go to the workers once
+    masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
+    trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines, cpu = masks
+    a, t_search = time.perf_counter(), 0.0
+    guess = found = pool.registration_guess
+
+    def search() -> bool:
+        nonlocal found, t_search
+        b = time.perf_counter()
+        found = registration_search(outlines, max_px=settings.extract.registration_px)
+        t_search = time.perf_counter() - b
+        return found == guess
+
+    moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
+    fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
+                                     colour_trimmed)  # fmt: skip
+    t_register = t_outlines + ended - a  # the move's and the search's seconds with them
+    if len(jobs) >= 2:
+        got = pool.run_guessed(fruit, jobs, same, search)  # the first failing fruit's error is raised
+    else:
+        got = ([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None
+    t_register += t_search
+    if got is None:  # the wrong guess: the fruit moved by the shift found
+        pool.registration_guess = found
+        b = time.perf_counter()
+        moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
+        fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
+                                         colour_trimmed)  # fmt: skip
+        t_register += ended - b
+        got = pool.run(fruit, jobs, same) if len(jobs) >= 2 else ([fruit(k, sl) for k, sl in jobs], 0.0)
+    return got[0], found, t_trim, t_register, cpu + got[1]
 
 
 #: What one fruit's task gives back: its detection, the wall seconds of its extraction, occlusion maps and completion
@@ -288,6 +359,138 @@ class _Fruit:
             found = Detection(int(k), mask, ex, error=str(exc), occlusion=occ)
         return found, b - a, t_occlusion, time.perf_counter() - b, time.thread_time() - cpu0
 
+    @staticmethod
+    def packed(done: _Done) -> tuple[Any, ...]:
+        """A fruit's answer small to pickle (a pool's worker sends it): the detection's whole-image mask cut to its
+        box (its extraction's outline is the same array or none)."""
+        d, *times = done
+        mask, ex = d.mask, d.extraction
+        rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+        box = (int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1) if len(rows) else (0, 0, 0, 0)
+        same = ex.silhouette is mask
+        fields = {k: v for k, v in d.__dict__.items() if k not in ("mask", "extraction")}
+        ex_fields = ex.__dict__ | ({"silhouette": None} if same else {})
+        window = np.ascontiguousarray(mask[box[0] : box[1], box[2] : box[3]])
+        return fields, ex_fields, mask.shape, box, window, same, tuple(times)
+
+    @staticmethod
+    def unpacked(packed: tuple[Any, ...]) -> _Done:
+        """:meth:`packed`'s answer as the task gives it."""
+        fields, ex_fields, shape, box, window, same, times = packed
+        mask = np.zeros(shape, bool)
+        mask[box[0] : box[1], box[2] : box[3]] = window
+        ex = object.__new__(Extraction)
+        ex.__dict__.update(ex_fields)
+        if same:
+            ex.__dict__["silhouette"] = mask
+        d = object.__new__(Detection)
+        d.__dict__.update(fields, mask=mask, extraction=ex)
+        return (d, *times)
+
+
+#: The pixels a mask's colour trimming drops: a window ``(r0, r1, c0, c1)`` of the image and its pixels
+#: (:func:`~symfruit.extract.trim_mask`).
+_Dropped = tuple[tuple[int, int, int, int], np.ndarray]
+
+#: What one mask's task gives back (:class:`_Masks`): the window and pixels its colour trimming drops (None: none),
+#: its box after it (None: no pixel left), its registration outline (None: none; an exception it raised), the wall
+#: seconds of its trimming and of its outline, and the CPU seconds of the thread it ran on while it ran.
+_MaskDone = tuple[_Dropped | None, tuple[slice, slice] | None,
+                  "_Outline | Exception | None", float, float, float]  # fmt: skip
+
+
+class _Masks:
+    """One mask's colour trimming (:func:`~symfruit.extract.trim_mask`) and registration outline
+    (:func:`~symfruit.core.surface.registration_outline`, on the trimmed mask), with a pool (:func:`_shared_masks`).
+    Each reads its own mask, the colour and the depth alone: the masks' answers, put together in the frame's order,
+    are :func:`_trim_labels`' and :func:`~symfruit.extract.register`'s, bit for bit. ``labels``, ``depth`` and
+    ``color`` are the frame's (:data:`ARRAYS`), the masks as found (before any trimming)."""
+
+    ARRAYS = ("labels", "depth", "color")
+
+    def __init__(self, labels: np.ndarray, depth: np.ndarray, color: np.ndarray | None, settings: ExtractSettings,
+                 focal: float) -> None:  # fmt: skip
+        self.labels, self.depth, self.color, self.settings, self.focal = labels, depth, color, settings, focal
+
+    def __call__(self, k: int, sl: tuple[slice, slice]) -> _MaskDone:
+        cpu0, a = time.thread_time(), time.perf_counter()
+        dropped, box = self._trim(k, sl)  # an error here is raised as trim_labels raises it
+        b = time.perf_counter()
+        outline: _Outline | Exception | None = None
+        if box is not None and self.settings.registration_px > 0:
+            try:  # raised after every mask's trimming, as register raises it after trim_labels
+                outline = self._outline(k, box, dropped)
+            except Exception as exc:
+                outline = exc
+        return dropped, box, outline, b - a, time.perf_counter() - b, time.thread_time() - cpu0
+
+    def _trim(self, k: int, sl: tuple[slice, slice]) -> tuple[_Dropped | None, tuple[slice, slice] | None]:
+        """Mask ``k``'s pixels its colour trimming drops (None: none) and its box after it (None: none left)."""
+        if self.color is None or self.settings.colour_trim_px <= 0:
+            return None, sl
+        if (dropped := trim_mask(self.color, self.labels, k, sl, self.settings)) is None:
+            return None, sl
+        return dropped, _box_of(_without(self.labels[sl] == k, sl[0].start, sl[1].start, dropped), sl)
+
+    def _outline(self, k: int, box: tuple[slice, slice], dropped: _Dropped | None) -> _Outline | None:
+        """Mask ``k``'s registration outline (its box ``box`` and the pixels ``dropped`` after trimming)."""
+        s = self.settings
+        r0, r1, c0, c1 = registration_window(self.labels.shape, box, s.registration_px)
+        mask = self.labels[r0:r1, c0:c1] == k
+        if dropped is not None:
+            _without(mask, r0, c0, dropped)
+        return registration_outline(self.depth[r0:r1, c0:c1], mask, self.focal, max_px=s.registration_px,
+                                    depth_range=(s.min_depth, s.max_depth))  # fmt: skip
+
+
+def _without(mask: np.ndarray, r0: int, c0: int, dropped: _Dropped) -> np.ndarray:
+    """``mask`` (a window whose first pixel is the image's ``(r0, c0)``), the pixels ``dropped`` (a window of the
+    image and its pixels, :func:`~symfruit.extract.trim_mask`'s) taken off where the two overlap; in place."""
+    (d0, d1, e0, e1), gone = dropped
+    a0, a1 = max(r0, d0), min(r0 + mask.shape[0], d1)
+    b0, b1 = max(c0, e0), min(c0 + mask.shape[1], e1)
+    if a0 < a1 and b0 < b1:
+        mask[a0 - r0 : a1 - r0, b0 - c0 : b1 - c0] &= ~gone[a0 - d0 : a1 - d0, b0 - e0 : b1 - e0]
+    return mask
+
+
+def _shared_masks(
+    pool: FruitPool, frame: Frame, labels: np.ndarray, boxes: list[tuple[slice, slice] | None], s: ExtractSettings,
+    same: object,
+) -> tuple[np.ndarray, set[int], list[tuple[slice, slice] | None], list[_Outline], float, float, float]:  # fmt: skip
+    """``detect``'s trimming and the registration's outlines with each mask's part (:class:`_Masks`) shared with
+    ``pool``'s workers: the trimmed labels, the colour-trimmed masks and their boxes, as :func:`_trim_labels` and
+    :func:`_box_within` give them, and the masks' registration outlines in the frame's order (those
+    :func:`~symfruit.extract.register` searches the shift with: :func:`~symfruit.core.surface.registration_search`);
+    then the masks' trimming seconds summed, their outlines' seconds summed (with the putting together here), and
+    the workers' CPU seconds. The first failing mask's error is raised (its trimming's, then its outline's), as one
+    process raises it."""
+    color = frame.color
+    if color is not None:  # the checks trim_labels, then register make, before any mask
+        color, labels, _ = _trim_checked(color, labels, s)
+    _checked(labels, frame.depth, frame.camera, s, "register", "labels")
+    task = _Masks(labels, frame.depth, color, s, float(np.sqrt(frame.camera.fx * frame.camera.fy)))
+    jobs = [(k, sl) for k, sl in enumerate(boxes, 1) if sl is not None]
+    done, cpu = pool.run(task, jobs, same)
+    after = time.perf_counter()
+    trimmed, colour_trimmed, boxes = labels, set(), list(boxes)
+    outlines: list[_Outline] = []
+    t_trim = t_outlines = 0.0
+    for (k, _), (dropped, box, _, a, b, _) in zip(jobs, done, strict=True):
+        if dropped is not None:
+            (r0, r1, c0, c1), gone = dropped
+            trimmed = trimmed.copy() if trimmed is labels else trimmed
+            trimmed[r0:r1, c0:c1][gone] = 0
+            colour_trimmed.add(k)
+        boxes[k - 1] = box
+        t_trim, t_outlines = t_trim + a, t_outlines + b
+    for _, _, outline, *_ in done:
+        if isinstance(outline, Exception):
+            raise outline
+        if outline is not None:
+            outlines.append(outline)
+    return trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines + time.perf_counter() - after, cpu
+
 
 def _default_settings() -> Settings:
     """``Settings()``, made once while the known sections stay the same (a section registered later makes it anew):
@@ -326,7 +529,12 @@ def _trim_labels(
 def _box_within(labels: np.ndarray, k: int, sl: tuple[slice, slice] | None) -> tuple[slice, slice] | None:
     """``ndimage.find_objects(labels)[k - 1]`` when label ``k`` lies within ``sl`` (its box before pixels were taken
     away; None: it had none): the box of its pixels there, None when none is left."""
-    if sl is None or (box := mask_box(labels[sl] == k)) is None:
+    return None if sl is None else _box_of(labels[sl] == k, sl)
+
+
+def _box_of(mask: np.ndarray, sl: tuple[slice, slice]) -> tuple[slice, slice] | None:
+    """The box (in the image) of the pixels of ``mask``, the window ``sl`` of the image; None when it has none."""
+    if (box := mask_box(mask)) is None:
         return None
     r0, c0 = sl[0].start, sl[1].start
     return slice(r0 + box[0], r0 + box[1], None), slice(c0 + box[2], c0 + box[3], None)

@@ -447,32 +447,50 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
     is trimmed. ``trimmed``: a set given the labels of the masks that lost pixels.
     """
+    color, labels, s = _trim_checked(color, labels, settings)
+    if s.colour_trim_px <= 0:
+        return labels
+    out = labels
+    for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
+        if sl is None or (dropped := trim_mask(color, labels, k, sl, s)) is None:
+            continue
+        (r0, r1, c0, c1), gone = dropped
+        out = out.copy() if out is labels else out
+        out[r0:r1, c0:c1][gone] = 0
+        if trimmed is not None:
+            trimmed.add(k)
+    return out
+
+
+def _trim_checked(color: Any, labels: Any, settings: ExtractSettings | None) -> tuple[np.ndarray, np.ndarray,
+                                                                                       ExtractSettings]:  # fmt: skip
+    """:func:`trim_labels`' arguments checked: the colour (h, w, 3) uint8, the labels an integer image of its size,
+    the settings (the defaults for None)."""
     color = np.asarray(color)
     if color.ndim != 3 or color.shape[2] != 3 or color.dtype != np.uint8:
         raise InputError(f"trim_labels: colour must be (h, w, 3) uint8 RGB, got {color.dtype} {color.shape}")
     labels = _checked(labels, color[:, :, 0], None, settings, "trim_labels", "labels")
-    s = settings or ExtractSettings()
-    if s.colour_trim_px <= 0:
-        return labels
-    out = labels
+    return color, labels, settings or ExtractSettings()
+
+
+def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice],
+              s: ExtractSettings) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
+    """One mask's part of :func:`trim_labels` (checked arguments, ``s.colour_trim_px`` above 0): mask ``k`` of
+    ``labels`` (its box ``sl``) trimmed by colour, as the window ``(r0, r1, c0, c1)`` and the (r1 - r0, c1 - c0)
+    bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels and the
+    colour alone: the masks are trimmed in any order, or on several processes
+    (:class:`~symfruit.fruitpool.FruitPool`), with the same pixels dropped."""
     h, w = labels.shape
     pad = WIDER[-1] * s.colour_trim_px + 2
-    for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
-        if sl is None:
-            continue
-        r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
-        c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-        mask = labels[r0:r1, c0:c1] == k
-        radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
-        band = min(float(s.colour_trim_px), 0.2 * radius)
-        wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
-        kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
-        if (dropped := mask & ~kept).any():
-            out = out.copy() if out is labels else out
-            out[r0:r1, c0:c1][dropped] = 0
-            if trimmed is not None:
-                trimmed.add(k)
-    return out
+    r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
+    c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+    mask = labels[r0:r1, c0:c1] == k
+    radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
+    band = min(float(s.colour_trim_px), 0.2 * radius)
+    wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
+    kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
+    dropped = mask & ~kept
+    return ((r0, r1, c0, c1), dropped) if dropped.any() else None
 
 
 def register(

@@ -17,6 +17,13 @@ so neither waits while fruit are left; each detection a worker made comes back p
 its box), and the detections are returned in the frame's order. An error a fruit raises (not a fruit's ``error``,
 which is a detection: an exception) is the first failing fruit's in the frame's order, as one process raises it.
 
+``detect`` gives the pool two tasks a frame (stop 54, docs/pool54.md): first each mask's colour trimming and
+registration outline (``detect._Masks``; the search for the frame's shift over the outlines runs in the calling
+process), then the fruit (``detect._Fruit``). The fruit are sent moved by :attr:`FruitPool.registration_guess` (the
+last shift found) while the search runs (:meth:`FruitPool.run_guessed`); a wrong guess calls that run off (the
+workers' fruit dropped) and the fruit go again with the shift found. The frame's depth and colour are copied into the
+shared segment once for both tasks.
+
 A worker that dies (killed, a crash) or stays silent for :data:`STALL_TIMEOUT` seconds within a frame is ended: the
 fruit it had not returned are done in the calling process, and new workers are started at once for the next
 frames (a frame that comes before they are warm runs in the calling process: no frame waits for a start-up). The
@@ -48,15 +55,12 @@ import traceback
 import weakref
 from collections.abc import Callable, Iterator
 from multiprocessing import shared_memory
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 import numpy as np
 
 from .errors import InputError
 from .threads import one_blas_thread
-
-if TYPE_CHECKING:
-    from .detect import _Done, _Fruit
 
 __all__ = ["MAX_FRUIT_PROCESSES", "FruitPool", "check_fruit_processes", "one_process_reason", "usable_cores"]
 
@@ -219,6 +223,13 @@ class FruitPool:
         Seconds the first workers took to start and warm up (with ``wait``; NaN otherwise).
     fruit_elsewhere : int
         Fruit the workers have done so far.
+    registration_guess : tuple of int
+        The registration shift ``(du, dv)`` :func:`symfruit.detect.detect` sends a frame's fruit to the workers
+        with while it searches for the frame's own (the last shift found that differed from its guess: a camera's
+        shift stays the same from frame to frame); a wrong guess costs the fruit the workers were on.
+    masks_elsewhere : int
+        Masks the workers have colour trimmed and found registration outlines of so far (``detect``'s first task
+        a frame).
     starts : int
         Sets of workers started (1 and one more after each loss).
     last_loss : str
@@ -249,6 +260,11 @@ class FruitPool:
         self.method, self.start_method = method, start_method
         self.reason = one_process_reason(self.processes)
         self.started_s, self.fruit_elsewhere, self.starts, self.last_loss = float("nan"), 0, 0, ""
+        self.masks_elsewhere = 0
+        self.registration_guess = (0, 0)
+        #: what :meth:`_share` last copied: each array (the object) and its place, for the frame ``_shared_for``
+        self._shared: dict[str, tuple[np.ndarray, Any]] = {}
+        self._shared_for: object = None
         self._state = _State()
         self._close = weakref.finalize(self, self._state.close)
         self._busy = threading.Lock()  # one frame at a time; another thread's frame meanwhile runs here alone
@@ -346,24 +362,49 @@ class FruitPool:
 
     # ---- a frame ------------------------------------------------------------------------------------------------
 
-    def run(self, fruit: _Fruit, jobs: list[tuple[int, tuple[slice, slice]]]) -> tuple[list[_Done], float]:
+    def run(
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object = None
+    ) -> tuple[list[Any], float]:
         """``[fruit(k, sl) for k, sl in jobs]`` shared with the workers: the same list, in the same order, and the
         CPU seconds the workers spent on their fruit. An exception a fruit raises is raised after the others are
-        done, the first failing fruit's in ``jobs``' order. Called by :func:`symfruit.detect.detect`."""
+        done, the first failing fruit's in ``jobs``' order. Called by :func:`symfruit.detect.detect`.
+
+        ``fruit``: a per-fruit task (``detect``'s ``_Fruit``, or its masks' trimming and registration outlines,
+        ``_Masks``) whose class names its whole-image arrays (``ARRAYS``: sent through shared memory, the rest of its
+        attributes pickled), may pack its answers to send (``packed``, ``unpacked``), and whose answer ends with the
+        CPU seconds it took. ``same``: an object that stands for one frame (``detect`` makes one per call): an array
+        of a later task given the same ``same`` that is the very object the last one shared under its name is not
+        copied again (the frame's depth and colour, shared once for both of ``detect``'s tasks)."""
+        got = self.run_guessed(fruit, jobs, same, None)
+        assert got is not None  # nothing to check: never called off
+        return got
+
+    def run_guessed(
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None
+    ) -> tuple[list[Any], float] | None:
+        """:meth:`run` of a task made from a guess, started on the workers while this process runs ``check`` (once,
+        before it takes a fruit itself, whether or not the pool has workers), which tells whether the guess was
+        right: if it returns False no more fruit are taken, the workers end the fruit they are on, their answers are
+        dropped, and None is returned (``detect`` sends its fruit with the last frame's registration shift while its
+        search for this frame's runs, then again with the right one when they differ). An exception ``check``
+        raises goes up as one a fruit raises here would (the workers ended, new ones started)."""
         if not self.active or not self._busy.acquire(blocking=False):
-            return [fruit(k, sl) for k, sl in jobs], 0.0
+            return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
         try:
             if not self._workers_ready():
-                return [fruit(k, sl) for k, sl in jobs], 0.0
+                return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
             try:
                 with self._one_blas_thread():
-                    out, cpu = self._run(fruit, jobs)
+                    got = self._run(fruit, jobs, same, check)
             except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
                 if self.active:
                     self._lost("the calling process was interrupted within a frame")
                 raise
         finally:
             self._busy.release()
+        if got is None:
+            return None
+        out, cpu = got
         for kind, value in out:  # the first failing fruit's error, in the frame's order
             if kind == "raised":
                 raise value
@@ -390,7 +431,8 @@ class FruitPool:
                 return False
         return self._wait_ready(0.0) if self.active else False
 
-    def _run(self, fruit: _Fruit, jobs: list[tuple[int, tuple[slice, slice]]]) -> tuple[list[tuple[str, Any]], float]:
+    def _run(self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object,
+             check: Callable[[], bool] | None) -> tuple[list[tuple[str, Any]], float] | None:  # fmt: skip
         """:meth:`run`'s work: each fruit's :func:`_attempt`, in ``jobs``' order, and the workers' CPU seconds."""
         from .detect import _Fruit
 
@@ -398,13 +440,14 @@ class FruitPool:
         pixels = [int(np.count_nonzero(fruit.labels[sl] == k)) for k, sl in jobs]
         order = sorted(range(len(jobs)), key=lambda i: -pixels[i])
         todo = [jobs[i] for i in order]
-        arrays = {name: getattr(fruit, name) for name in _Fruit.ARRAYS}
-        name, size, layout = self._share(arrays)
+        kind = type(fruit)
+        arrays = {name: getattr(fruit, name) for name in kind.ARRAYS}
+        name, size, layout = self._share(arrays, same)
         rest = {k: v for k, v in fruit.__dict__.items() if k not in arrays}
         self._seq += 1
         seq, workers = self._seq, list(self._state.workers)
         self._counter.value = 0  # no worker takes a fruit between frames: each said "done" to the last one
-        message = ("frame", seq, name, size, layout, type(fruit), rest, todo, os.environ.get("SYMFRUIT_KERNELS"))
+        message = ("frame", seq, name, size, layout, kind, rest, todo, os.environ.get("SYMFRUIT_KERNELS"))
         found: list[Any] = [None] * len(todo)  # ("ok", _Done) or ("raised", exception), in ``todo``'s order
         theirs, done, cpu, lost = [False] * len(todo), [False] * len(workers), 0.0, ""
         for w in workers:
@@ -412,20 +455,29 @@ class FruitPool:
                 w.conn.send(message)
             except OSError:
                 lost = "a worker process's pipe broke"
+        called_off = check is not None and not check()
+        if called_off and not _take_all(self._lock, self._counter, len(todo)):
+            lost = f"the fruit counter's lock was held for {STALL_TIMEOUT:.0f} s"
         while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
             found[i] = _attempt(fruit, *todo[i])
             for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
-                lost = lost or self._take(w, seq, found, theirs, done, j, wait=0.0)[0]
+                lost = lost or self._take(w, seq, kind, found, theirs, done, j, wait=0.0)[0]
         for j, w in enumerate(workers):
             silent_since = time.monotonic()
             while not lost and not done[j]:
-                lost, heard = self._take(w, seq, found, theirs, done, j, wait=_POLL)
+                lost, heard = self._take(w, seq, kind, found, theirs, done, j, wait=_POLL)
                 if heard:
                     silent_since = time.monotonic()
                 elif not w.process.is_alive():
                     lost = f"a worker process ended within a frame (exit code {w.process.exitcode})"
                 elif time.monotonic() - silent_since > STALL_TIMEOUT:
                     lost = f"a worker process was silent for {STALL_TIMEOUT:.0f} s within a frame"
+        if called_off:  # the workers' answers dropped
+            if lost:
+                self._lost(lost)
+            else:
+                self._failed_starts = 0
+            return None
         if lost:  # the fruit not returned are done here; new workers for the next frames
             self._lost(lost)
             for i, got in enumerate(found):
@@ -438,15 +490,18 @@ class FruitPool:
         for i, got in enumerate(found):
             out[order[i]] = got
             if theirs[i] and got[0] == "ok":
-                cpu += got[1][4]
-                self.fruit_elsewhere += 1
+                cpu += got[1][-1]
+                if issubclass(kind, _Fruit):
+                    self.fruit_elsewhere += 1
+                else:
+                    self.masks_elsewhere += 1
         return out, cpu
 
-    def _take(self, w: _Worker, seq: int, found: list[Any], theirs: list[bool], done: list[bool], j: int,
-              wait: float) -> tuple[str, bool]:  # fmt: skip
-        """Read what worker ``w`` (the ``j``-th) sent, waiting up to ``wait`` seconds for a first message: its fruit
-        into ``found`` (``theirs`` marked), the end of its share into ``done``. Returns why it is lost ("" if it is
-        not) and whether anything came."""
+    def _take(self, w: _Worker, seq: int, kind: type, found: list[Any], theirs: list[bool], done: list[bool],
+              j: int, wait: float) -> tuple[str, bool]:  # fmt: skip
+        """Read what worker ``w`` (the ``j``-th) sent for a task of class ``kind``, waiting up to ``wait`` seconds
+        for a first message: its fruit into ``found`` (``theirs`` marked), the end of its share into ``done``.
+        Returns why it is lost ("" if it is not) and whether anything came."""
         heard = False
         while w.conn.poll(0.0 if heard else wait):
             try:
@@ -459,12 +514,14 @@ class FruitPool:
             if word[0] == "done":
                 done[j] = True
                 break
-            found[word[2]], theirs[word[2]] = _unpacked(word[3]), True
+            found[word[2]], theirs[word[2]] = _unpacked(kind, word[3]), True
         return "", heard
 
-    def _share(self, arrays: dict[str, np.ndarray | None]) -> tuple[str, int, dict[str, Any]]:
+    def _share(self, arrays: dict[str, np.ndarray | None], same: object = None) -> tuple[str, int, dict[str, Any]]:
         """Copy ``arrays`` into the shared segment (a larger one made first when they do not fit); its name, size
-        and each array's place ``(offset, dtype, shape)`` (None for a None)."""
+        and each array's place ``(offset, dtype, shape)`` (None for a None). An array that is the very object the
+        last call shared under its name, with the same ``same`` (not None), in the same segment, is where it was
+        and is not copied again (:meth:`run`)."""
         layout: dict[str, Any] = {}
         at = 0
         for key, a in arrays.items():
@@ -473,15 +530,21 @@ class FruitPool:
                 continue
             layout[key] = (at, a.dtype.str, a.shape)
             at += -(-a.nbytes // 64) * 64
-        segment = self._state.segment
+        segment, kept = self._state.segment, self._shared
         if segment is None or segment.size < at:
             self._state.drop_segment()  # a worker keeps its mapping of the old one until the next frame's
             size = max(_SEGMENT_STEP, -(-at // _SEGMENT_STEP) * _SEGMENT_STEP)
             segment = self._state.segment = _new_segment(size)
+            kept = {}
+        if same is None or same is not self._shared_for:
+            kept = {}
+        self._shared, self._shared_for = {}, same
         for key, a in arrays.items():
             if a is not None:
                 offset, dtype, shape = layout[key]
-                np.copyto(np.ndarray(shape, dtype, buffer=segment.buf, offset=offset), a)
+                if key not in kept or kept[key][0] is not a or kept[key][1] != layout[key]:
+                    np.copyto(np.ndarray(shape, dtype, buffer=segment.buf, offset=offset), a)
+                self._shared[key] = (a, layout[key])
         return segment.name, segment.size, layout
 
 
@@ -534,6 +597,18 @@ def _claim(lock: Any, counter: Any, count: int) -> int | None:
         lock.release()
 
 
+def _take_all(lock: Any, counter: Any, count: int) -> bool:
+    """No fruit left to take: the shared counter moved to ``count`` under the shared lock (False: the lock was not
+    had within :data:`STALL_TIMEOUT` s)."""
+    if not lock.acquire(timeout=STALL_TIMEOUT):
+        return False
+    try:
+        counter.value = max(int(counter.value), count)
+        return True
+    finally:
+        lock.release()
+
+
 def _attempt(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tuple[str, Any]:
     """``("ok", fruit(k, sl))``, or ``("raised", the exception)`` (an ``Exception``; anything else goes up)."""
     try:
@@ -542,41 +617,23 @@ def _attempt(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tupl
         return "raised", exc
 
 
-def _packed(got: tuple[str, Any]) -> tuple[Any, ...]:
-    """A worker's answer for one fruit, small to pickle: a detection's whole-image mask cut to its box (its
-    extraction's outline is the same array or none), an exception pickled or told as text."""
-    kind, value = got
-    if kind == "raised":
+def _packed(kind: type, got: tuple[str, Any]) -> tuple[Any, ...]:
+    """A worker's answer for one job of a task of class ``kind``, small to pickle: its value as ``kind.packed``
+    gives it (``detect``'s ``_Fruit``: a detection's whole-image mask cut to its box), or the value itself; an
+    exception pickled or told as text."""
+    what, value = got
+    if what == "raised":
         value.add_note(f"(in FruitPool worker {os.getpid()}:\n{''.join(traceback.format_exception(value))})")
         return ("raised", value)  # the sender tells it as text if it does not pickle (_send_all)
-    d, *times = value
-    mask, ex = d.mask, d.extraction
-    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
-    box = (int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1) if len(rows) else (0, 0, 0, 0)
-    same = ex.silhouette is mask
-    fields = {k: v for k, v in d.__dict__.items() if k not in ("mask", "extraction")}
-    ex_fields = ex.__dict__ | ({"silhouette": None} if same else {})
-    window = np.ascontiguousarray(mask[box[0] : box[1], box[2] : box[3]])
-    return ("ok", fields, ex_fields, mask.shape, box, window, same, tuple(times))
+    pack = getattr(kind, "packed", None)
+    return ("ok", value if pack is None else pack(value))
 
 
-def _unpacked(packed: tuple[Any, ...]) -> tuple[str, Any]:
+def _unpacked(kind: type, packed: tuple[Any, ...]) -> tuple[str, Any]:
     """:func:`_packed`'s answer as :func:`_attempt` gives it."""
-    if packed[0] == "raised":
-        return "raised", packed[1]
-    from .detect import Detection
-    from .extract import Extraction
-
-    _, fields, ex_fields, shape, box, window, same, times = packed
-    mask = np.zeros(shape, bool)
-    mask[box[0] : box[1], box[2] : box[3]] = window
-    ex = object.__new__(Extraction)
-    ex.__dict__.update(ex_fields)
-    if same:
-        ex.__dict__["silhouette"] = mask
-    d = object.__new__(Detection)
-    d.__dict__.update(fields, mask=mask, extraction=ex)
-    return "ok", (d, *times)
+    what, value = packed
+    unpack = getattr(kind, "unpacked", None)
+    return (what, value) if what == "raised" or unpack is None else ("ok", unpack(value))
 
 
 # ---- the worker ---------------------------------------------------------------------------------------------------
@@ -632,7 +689,7 @@ def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: d
               for key, at in layout.items()}  # fmt: skip
     fruit.__dict__.update(rest, **arrays)
     while (i := _claim(lock, counter, len(todo))) is not None:
-        outbox.put(("fruit", seq, i, _packed(_attempt(fruit, *todo[i]))))
+        outbox.put(("fruit", seq, i, _packed(kind, _attempt(fruit, *todo[i]))))
     outbox.put(("done", seq))
 
 

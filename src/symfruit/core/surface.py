@@ -1534,29 +1534,56 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
     """
     if max_px <= 0:
         return 0, 0
-    lo, hi = depth_range
     outlines = []
     for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
         if sl is None:
             continue
-        r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
-        r1, c1 = min(sl[0].stop + max_px + 8, labels.shape[0]), min(sl[1].stop + max_px + 8, labels.shape[1])
-        mask = labels[r0:r1, c0:c1] == k
-        if np.count_nonzero(mask) < 30:  # the sum's count (stop 47)
-            continue
-        # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds), in float64 (a
-        # float32 frame converted window by window: the same values, without a float64 copy of the whole frame)
-        z = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
-        if (jit := compiled()) is not None and z.dtype == np.float64:  # the same map by the extraction's kernel:
-            valid = np.empty(z.shape)  # z > 0 and z >= lo is z >= the larger of lo and the least positive double
-            jit.valid_depth(z, mask, max(float(lo), 5e-324), float(hi), valid, np.empty(z.shape, bool))
-            z = valid
-        else:
-            z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
-        # z is finite, above 0 or 0 (valid_depth's least depth is above 0): fruit_surface reads it as it is (stop 49)
-        if (found := _outline(z, mask, focal, max_px, clean=True)) is not None and any(found.axes):
+        r0, r1, c0, c1 = registration_window(labels.shape, sl, max_px)
+        found = registration_outline(depth[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, focal, max_px=max_px,
+                                     depth_range=depth_range)  # fmt: skip
+        if found is not None:
             outlines.append(found)
-    if not outlines:
+    return registration_search(outlines, max_px=max_px, trim=trim, gain=gain)
+
+
+def registration_window(shape: tuple[int, ...], sl: tuple[slice, slice], max_px: int) -> tuple[int, int, int, int]:
+    """``(r0, r1, c0, c1)``: the window of an image of ``shape`` :func:`registration_shift` looks at a mask whose box
+    is ``sl`` in (``max_px + 8`` pixels around the box)."""
+    r0, c0 = max(sl[0].start - max_px - 8, 0), max(sl[1].start - max_px - 8, 0)
+    r1, c1 = min(sl[0].stop + max_px + 8, shape[0]), min(sl[1].stop + max_px + 8, shape[1])
+    return r0, r1, c0, c1
+
+
+def registration_outline(depth: np.ndarray, mask: np.ndarray, focal: float, *, max_px: int,
+                         depth_range: tuple[float, float] = (0.0, np.inf)) -> _Outline | None:  # fmt: skip
+    """One mask's part of :func:`registration_shift` (``max_px`` above 0): the outline of its depth cap, from the
+    depth and the (bool) mask of its window (:func:`registration_window`), or None when the mask is too small (30
+    pixels) or its outline tells no axis. It reads this fruit's window alone: the outlines of a frame's masks are
+    found in any order, or on several processes (:class:`~symfruit.fruitpool.FruitPool`), with the same values;
+    :func:`registration_search` takes them in the frame's order."""
+    lo, hi = depth_range
+    if np.count_nonzero(mask) < 30:  # the sum's count (stop 47)
+        return None
+    # depth made valid in the fruit's window alone (a whole 1920x1080 frame costs milliseconds), in float64 (a
+    # float32 frame converted window by window: the same values, without a float64 copy of the whole frame)
+    z = np.asarray(depth, dtype=np.float64)
+    if (jit := compiled()) is not None and z.dtype == np.float64:  # the same map by the extraction's kernel:
+        valid = np.empty(z.shape)  # z > 0 and z >= lo is z >= the larger of lo and the least positive double
+        jit.valid_depth(z, mask, max(float(lo), 5e-324), float(hi), valid, np.empty(z.shape, bool))
+        z = valid
+    else:
+        z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
+    # z is finite, above 0 or 0 (valid_depth's least depth is above 0): fruit_surface reads it as it is (stop 49)
+    if (found := _outline(z, mask, focal, max_px, clean=True)) is not None and any(found.axes):
+        return found
+    return None
+
+
+def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 0.7,
+                        gain: float = 0.25) -> tuple[int, int]:  # fmt: skip
+    """:func:`registration_shift`'s answer ``(du, dv)`` from the frame's outlines (:func:`registration_outline`'s,
+    in the frame's order; ``trim`` and ``gain`` as there)."""
+    if max_px <= 0 or not outlines:
         return 0, 0
 
     def cost(shifts: np.ndarray, exact: bool = True) -> np.ndarray:
