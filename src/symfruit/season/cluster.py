@@ -68,8 +68,17 @@ from ..threads import one_blas_thread
 from ..writers import detections_record, write_detections
 from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows
 
-__all__ = ["EXTRA", "LOCAL_SCHEDULER_HTTP", "Job", "Outcome", "Part", "detect_part", "local_cluster", "require_distributed",
-           "run_distributed"]
+__all__ = [
+    "EXTRA",
+    "LOCAL_SCHEDULER_HTTP",
+    "Job",
+    "Outcome",
+    "Part",
+    "detect_part",
+    "local_cluster",
+    "require_distributed",
+    "run_distributed",
+]
 
 #: The optional dependency set that brings dask.distributed.
 EXTRA = "symfruit[cluster]"
