@@ -438,7 +438,8 @@ def test_a_tls_scheduler_runs_the_recording_as_a_serial_run_does(recording, tmp_
     serial = run_batch(rec, tmp_path / "serial", method="raw", progress=False)
     with dask.config.set(tls):
         with LocalCluster(n_workers=1, threads_per_worker=1, processes=False, protocol="tls://", host="127.0.0.1",
-                          dashboard_address=None, scheduler_kwargs=LOCAL_SCHEDULER_HTTP, security=Security()) as tls_cluster:  # fmt: skip
+                          dashboard_address=None, scheduler_kwargs=LOCAL_SCHEDULER_HTTP,
+                          security=Security()) as tls_cluster:  # fmt: skip
             address = tls_cluster.scheduler_address
             assert address.startswith("tls://127.0.0.1:")
             report = run_distributed(rec, tmp_path / "out", scheduler=address, chunk=1, method="raw", progress=False)

@@ -335,8 +335,8 @@ def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> An
 
     with dask.config.set(NO_PROFILER):  # the nannies keep this config for the workers they restart
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                            dashboard_address=None, scheduler_kwargs=dict(LOCAL_SCHEDULER_HTTP), memory_limit=memory_limit,
-                            silence_logs=logging.ERROR)  # fmt: skip
+                            dashboard_address=None, scheduler_kwargs=dict(LOCAL_SCHEDULER_HTTP),
+                            memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
 
 
 #: The address schemes symfruit can reach a scheduler by (dask.distributed's, less ``ucx``, which needs a package
