@@ -561,7 +561,7 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
     def held(frame, **kwargs):  # the first frame goes through; the others wait until the test ends
         calls.append(frame.name)
         if len(calls) > 1:
-            release.wait(60)
+            release.wait(300)
         return real(frame, **kwargs)
 
     monkeypatch.setattr(cluster, "detect", held)  # the in-process worker runs this module
@@ -579,7 +579,7 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
                 worker.periodic_callbacks["heartbeat"].stop()
 
         one.loop.add_callback(stop)
-        runner.join(50)
+        runner.join(180)  # 10 s of silence, 2 without a worker: generous for a loaded host (flake54: was 50)
         alive = runner.is_alive()
         release.set()
         assert not alive, f"the run waited on a {how} worker"
@@ -589,14 +589,18 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
 
 
 def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocessed(recording, tmp_path, monkeypatch):
-    """The one worker leaves once the first frame is written (each frame takes a second here): after the time-out
-    the run stops, the frames not done recorded unprocessed (``--resume`` takes them up), not waited on for ever."""
+    """The one worker leaves once the first frame is written (each later frame takes 5 s here: the worker cannot
+    finish the other three before it leaves, whatever the load; it was 1 s each, the first too, a 3 s window for the
+    test to see the first frame and scale the cluster down; flake54): after the time-out the run stops, the frames
+    not done recorded unprocessed (``--resume`` takes them up), not waited on for ever."""
     import symfruit.season.cluster as cluster
 
-    real = cluster.detect
+    real, calls = cluster.detect, []
 
     def slow(frame, **kwargs):
-        time.sleep(1.0)
+        calls.append(frame.name)
+        if len(calls) > 1:
+            time.sleep(5.0)
         return real(frame, **kwargs)
 
     monkeypatch.setattr(cluster, "detect", slow)  # the in-process worker runs this module
