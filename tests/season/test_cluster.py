@@ -648,8 +648,8 @@ def test_a_worker_process_runs_numpys_blas_on_one_thread_from_its_first_task(tmp
         if _blas_threads() != [2]:
             pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
         with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
-            assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
-            assert pool.submit(_first_task, job, part).result() == [1]
+            assert pool.submit(_blas_threads).result(timeout=600) == [2]  # what a worker inherits
+            assert pool.submit(_first_task, job, part).result(timeout=600) == [1]
         assert _first_task(job, part) == [2]  # the client's own process: its BLAS left be
         with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:  # a job that names no client: left be
-            assert pool.submit(_first_task, dataclasses.replace(job, client=0), part).result() == [2]
+            assert pool.submit(_first_task, dataclasses.replace(job, client=0), part).result(timeout=600) == [2]
