@@ -243,7 +243,7 @@ class FruitWarning(UserWarning):
 class Warns(_Fruit):
     """A fruit task that warns (``FruitWarning``, the same text and place each time) for the fruit its ``warn``
     names, and divides by zero in numpy (a ``RuntimeWarning`` where numpy's error handling says warn) for those its
-    ``divide`` names, before its work."""
+    ``divide`` names, before its work; then raises for those its ``fail`` names."""
 
     warn: frozenset = frozenset()
     divide: frozenset = frozenset()
@@ -253,6 +253,8 @@ class Warns(_Fruit):
             warnings.warn("a fruit warns", FruitWarning, stacklevel=1)
         if k in self.divide:
             np.float64(1.0) / np.float64(0.0)
+        if k in self.fail:
+            raise ValueError(self.fail[k])
         return super().__call__(k, sl)
 
 
@@ -301,6 +303,14 @@ def test_a_workers_warning_a_filter_makes_an_error_is_raised_as_one_process_rais
             with pytest.raises(error, match=expected):
                 pool.run(task, jobs)
         assert pool.starts == starts, pool.last_loss  # no worker lost
+    task.fail, task.divide = {3: "fruit 3 failed"}, set()  # after its warning: the warning made an error is raised
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FruitWarning)
+        with pytest.raises(FruitWarning, match="a fruit warns"):
+            [task(k, sl) for k, sl in jobs]
+        with pytest.raises(FruitWarning, match="a fruit warns"):
+            pool.run(task, jobs)
+    task.fail, task.divide = {}, {2}
     with np.errstate(divide="raise"), pytest.raises(FloatingPointError, match="divide by zero"):
         given(lambda: pool.run(task, jobs))  # numpy's error handling of the caller, in the workers too
     with np.errstate(divide="ignore"):

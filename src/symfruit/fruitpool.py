@@ -377,9 +377,8 @@ class FruitPool:
             if given:
                 try:
                     _warn_again(given)
-                except Warning as exc:  # a filter made it an error: the fruit's error, as in one process
-                    if out[j][0] != "raised":
-                        out[j] = ("raised", exc)
+                except Warning as exc:  # a filter made it an error: the fruit's error, as in one process (it came
+                    out[j] = ("raised", exc)  # before anything the fruit raised, which ended it)
         for kind, value in out:  # the first failing fruit's error, in the frame's order
             if kind == "raised":
                 raise value
