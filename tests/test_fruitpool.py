@@ -317,6 +317,24 @@ def test_a_workers_warning_a_filter_makes_an_error_is_raised_as_one_process_rais
         assert [c for c, *_ in given(lambda: pool.run(task, jobs))] == [FruitWarning]
 
 
+class WarnsLocally(_Fruit):
+    """A fruit task whose warning's category is a class made inside the call: no other process can import it."""
+
+    def __call__(self, k, sl):
+        class Local(UserWarning):
+            pass
+
+        warnings.warn("made here", Local, stacklevel=1)
+        return super().__call__(k, sl)
+
+
+def test_a_workers_warning_of_a_category_made_in_a_function_comes_as_a_user_warning_naming_it(workers_only):
+    task, jobs = fruit_task(four(), WarnsLocally)
+    assert [(c, t) for c, t, *_ in given(lambda: workers_only.run(task, jobs))] == [
+        (UserWarning, "Local: made here")
+    ] * 4
+
+
 class Interrupted(_Fruit):
     def __call__(self, k, sl):
         if not fp._IN_WORKER:

@@ -571,22 +571,26 @@ _Warned = tuple[type[Warning], str, str, int]
 
 def _recorded(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tuple[tuple[str, Any], list[_Warned]]:
     """In a worker: :func:`_attempt` and every warning it gave, recorded whatever the filters (the caller's decide
-    when they are given again, :func:`_warn_again`). A category that does not pickle (a class made inside a
-    function) goes as a ``UserWarning`` whose text starts with its name."""
-    import pickle
-
+    when they are given again, :func:`_warn_again`). A category the caller could not import by its name (a class
+    made inside a function: it would not pickle) goes as a ``UserWarning`` whose text starts with its name."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         got = _attempt(fruit, k, sl)
     given: list[_Warned] = []
     for w in caught:
         category, text = w.category, str(w.message)
-        try:
-            pickle.dumps(category)
-        except Exception:
+        if not _by_name(category):
             category, text = UserWarning, f"{category.__name__}: {text}"
         given.append((category, text, w.filename, w.lineno))
     return got, given
+
+
+def _by_name(cls: type) -> bool:
+    """Whether ``cls`` is found by its module and qualified name (what pickling a class by reference needs)."""
+    found: Any = sys.modules.get(cls.__module__)
+    for part in cls.__qualname__.split("."):
+        found = getattr(found, part, None)
+    return found is cls
 
 
 def _warn_again(given: list[_Warned]) -> None:
