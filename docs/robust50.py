@@ -377,7 +377,7 @@ def bag_cases() -> None:
 
         cluster.NO_WORKER_TIMEOUT = 5.0  # type: ignore[attr-defined]  # read at the call (60 s by default)
         with LocalCluster(n_workers=0, processes=False, protocol="tcp://", host="127.0.0.1",
-                          dashboard_address=None) as empty:  # fmt: skip
+                          dashboard_address=None, scheduler_kwargs=cluster.LOCAL_SCHEDULER_HTTP) as empty:  # fmt: skip
             o = r49.out("no-workers")
             start = time.monotonic()
             run = cli("detect", T() / "base50" / "rec", "--output", o, "--method", "sphere", "--scheduler",

@@ -369,6 +369,30 @@ def write_pcd(path, points, mode, extra_field=False):
     path.write_bytes(head.encode() + body)
 
 
+def after_its_status_time(path: Path) -> None:
+    """Return once the clock is past ``path``'s status-change time by more than a file-time tick (10 ms at most:
+    a kernel without fine-grained time stamps takes them from a clock that ticks every 1-10 ms), so that a change
+    made next gives it a later one on any kernel. The wait is for the clock to pass, bounded (a minute)."""
+    import time
+
+    until = os.stat(path).st_ctime_ns + 20_000_000
+    deadline = time.monotonic() + 60
+    while time.time_ns() <= until and time.monotonic() < deadline:
+        time.sleep(0.002)
+
+
+def set_back(path: Path, *, flip: bool = False) -> None:
+    """Write the middle byte of ``path`` again (``flip``: its bits flipped; its size kept) and set its access and
+    modification times back to what they were (``os.utime``), as ``cp -p`` or an archive unpacked over it would."""
+    st = os.stat(path)
+    with open(path, "r+b") as handle:
+        handle.seek(st.st_size // 2)
+        byte = handle.read(1)[0]
+        handle.seek(st.st_size // 2)
+        handle.write(bytes([byte ^ 0xFF if flip else byte]))
+    os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns))
+
+
 # --- fixtures --------------------------------------------------------------------------------------------
 
 

@@ -297,7 +297,6 @@ def test_killed_batch_resumes_to_identical_results(tmp_path, capsys):
 def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tmp_path):
     """A real RLIMIT_FSIZE (what a full disk looks like to a writer): a one-line report, no traceback, the
     frames already done untouched, errors.json saying where it stopped."""
-    import resource
 
     rec = tmp_path / "rec"
     # the example frame: its overlay is larger than the limit, every other file smaller
@@ -311,11 +310,12 @@ def test_a_file_size_limit_stops_the_batch_cleanly_and_keeps_what_was_written(tm
     size = 100_000
     assert all((p.stat().st_size < size) == (p.name != "overlay.png") for p in (out / "f1").iterdir())
 
-    def limit() -> None:
-        resource.setrlimit(resource.RLIMIT_FSIZE, (size, size))
-
-    proc = subprocess.run([sys.executable, "-m", "symfruit", *args, "--resume"], capture_output=True, text=True,
-                          preexec_fn=limit)  # fmt: skip
+    # the limit set by a child of its own, which then becomes the command (a preexec_fn runs Python between fork and
+    # exec, which may deadlock where the test process runs other threads: flake54)
+    limited = (f"import os, resource, sys; resource.setrlimit(resource.RLIMIT_FSIZE, ({size}, {size})); "
+               "os.execv(sys.executable, [sys.executable, '-m', 'symfruit', *sys.argv[1:]])")  # fmt: skip
+    proc = subprocess.run([sys.executable, "-c", limited, *args, "--resume"], capture_output=True, text=True,
+                          timeout=600)  # fmt: skip
     assert proc.returncode == 1 and "Traceback" not in proc.stderr
     assert "symfruit: stopped at frame f2: the output is full (File too large)" in proc.stderr
     assert {p: p.read_bytes() for p in (out / "f1").iterdir()} == before

@@ -167,7 +167,7 @@ def test_console_script_runs(tmp_path):
     import sys
 
     done = subprocess.run([sys.executable, "-m", "symfruit", "--version"], capture_output=True, text=True, check=True,
-                          cwd=tmp_path)  # fmt: skip
+                          cwd=tmp_path, timeout=300)  # fmt: skip
     assert done.stdout.startswith("symfruit ")
 
 

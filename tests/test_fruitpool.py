@@ -8,6 +8,7 @@ import os
 import signal
 import sys
 import types
+import warnings
 
 import numpy as np
 import pytest
@@ -254,6 +255,105 @@ def test_a_worker_dying_within_a_frame_leaves_its_fruit_to_this_process(workers_
     task.die = set()
     assert pool._wait_ready(fp.START_TIMEOUT)
     assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4]
+
+
+class FruitWarning(UserWarning):
+    pass
+
+
+class Warns(_Fruit):
+    """A fruit task that warns (``FruitWarning``, the same text and place each time) for the fruit its ``warn``
+    names, and divides by zero in numpy (a ``RuntimeWarning`` where numpy's error handling says warn) for those its
+    ``divide`` names, before its work; then raises for those its ``fail`` names."""
+
+    warn: frozenset = frozenset()
+    divide: frozenset = frozenset()
+
+    def __call__(self, k, sl):
+        if k in self.warn:
+            warnings.warn("a fruit warns", FruitWarning, stacklevel=1)
+        if k in self.divide:
+            np.float64(1.0) / np.float64(0.0)
+        if k in self.fail:
+            raise ValueError(self.fail[k])
+        return super().__call__(k, sl)
+
+
+def given(run, action: str = "always") -> list:
+    """What ``run()`` warned under the filter ``action``: (category, text, file, line) each, in order."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter(action)
+        run()
+    return [(w.category, str(w.message), w.filename, w.lineno) for w in caught]
+
+
+@pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
+def test_a_workers_warnings_are_given_in_this_process_through_its_filters(pool, monkeypatch, shares):
+    """Stop 53 left it: a warning in a worker was shown there (on its stderr), past the caller's filters. Now each
+    is recorded there and given again here, in the frame's order: the same (category, text, file, line) as one
+    process gives; shown once (``default``) where one process shows it once."""
+    monkeypatch.setattr(pool, "_caller_shares", shares)
+    task, jobs = fruit_task(four(), Warns)
+    task.warn, task.divide = {2, 3}, {4}
+    alone = given(lambda: [task(k, sl) for k, sl in jobs])
+    elsewhere = pool.fruit_elsewhere
+    pooled = given(lambda: pool.run(task, jobs))
+    assert [(c, t) for c, t, *_ in alone] == [(FruitWarning, "a fruit warns")] * 2 + [
+        (RuntimeWarning, "divide by zero encountered in scalar divide")]  # fmt: skip
+    if shares:  # the ones this process did came as it did them
+        assert sorted(pooled, key=str) == sorted(alone, key=str)
+    else:
+        assert pooled == alone and pool.fruit_elsewhere == elsewhere + 4
+        assert given(lambda: pool.run(task, jobs), "default") == given(lambda: [task(k, sl) for k, sl in jobs],
+                                                                       "default") == alone[1:]  # fmt: skip
+        assert given(lambda: pool.run(task, jobs), "ignore") == []
+
+
+def test_a_workers_warning_a_filter_makes_an_error_is_raised_as_one_process_raises_it(workers_only):
+    pool = workers_only
+    task, jobs = fruit_task(four(), Warns)
+    task.warn, task.divide = {3}, {2}
+    for error in (FruitWarning, RuntimeWarning):
+        expected = "a fruit warns" if error is FruitWarning else "divide by zero"
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")
+            warnings.simplefilter("error", error)
+            with pytest.raises(error, match=expected):
+                [task(k, sl) for k, sl in jobs]
+            starts = pool.starts
+            with pytest.raises(error, match=expected):
+                pool.run(task, jobs)
+        assert pool.starts == starts, pool.last_loss  # no worker lost
+    task.fail, task.divide = {3: "fruit 3 failed"}, set()  # after its warning: the warning made an error is raised
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FruitWarning)
+        with pytest.raises(FruitWarning, match="a fruit warns"):
+            [task(k, sl) for k, sl in jobs]
+        with pytest.raises(FruitWarning, match="a fruit warns"):
+            pool.run(task, jobs)
+    task.fail, task.divide = {}, {2}
+    with np.errstate(divide="raise"), pytest.raises(FloatingPointError, match="divide by zero"):
+        given(lambda: pool.run(task, jobs))  # numpy's error handling of the caller, in the workers too
+    with np.errstate(divide="ignore"):
+        assert [c for c, *_ in given(lambda: pool.run(task, jobs))] == [FruitWarning]
+
+
+class WarnsLocally(_Fruit):
+    """A fruit task whose warning's category is a class made inside the call: no other process can import it."""
+
+    def __call__(self, k, sl):
+        class Local(UserWarning):
+            pass
+
+        warnings.warn("made here", Local, stacklevel=1)
+        return super().__call__(k, sl)
+
+
+def test_a_workers_warning_of_a_category_made_in_a_function_comes_as_a_user_warning_naming_it(workers_only):
+    task, jobs = fruit_task(four(), WarnsLocally)
+    assert [(c, t) for c, t, *_ in given(lambda: workers_only.run(task, jobs))] == [
+        (UserWarning, "Local: made here")
+    ] * 4
 
 
 class Interrupted(_Fruit):

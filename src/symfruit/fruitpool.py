@@ -16,6 +16,14 @@ pixels); the calling process and the workers then take the next fruit from one s
 so neither waits while fruit are left; each detection a worker made comes back pickled (its whole-image mask cut to
 its box), and the detections are returned in the frame's order. An error a fruit raises (not a fruit's ``error``,
 which is a detection: an exception) is the first failing fruit's in the frame's order, as one process raises it.
+A warning a fruit gives in a worker (a ``warnings.warn``, numpy's ``RuntimeWarning`` of a division by zero) is
+recorded there and given again in the calling process once the frame is done, in the frame's order, through the
+caller's warning filters (``warnings.catch_warnings``, ``-W error``, pytest's ``filterwarnings``): the same warning
+(category, text, file and line) as one process gives, shown once where one process shows it once; one the filters
+make an error is raised as that fruit's error, as in one process. The workers run with the caller's numpy error
+handling (``np.errstate``) of the frame. The warnings of the fruit the calling process did itself were given as it
+did them: the pool's warnings keep the frame's order among themselves, not among those (recording them too would
+change this process's warning filters, which are shared by its threads, for the frame's length; flake54).
 
 ``detect`` gives the pool two tasks a frame (stop 54, docs/pool54.md): first each mask's colour trimming and
 registration outline (``detect._Masks``; the search for the frame's shift over the outlines runs in the calling
@@ -52,6 +60,7 @@ import sys
 import threading
 import time
 import traceback
+import warnings
 import weakref
 from collections.abc import Callable, Iterator
 from multiprocessing import shared_memory
@@ -404,7 +413,13 @@ class FruitPool:
             self._busy.release()
         if got is None:
             return None
-        out, cpu = got
+        out, warned, cpu = got
+        for j, given in enumerate(warned):  # the workers' warnings, through this process's filters
+            if given:
+                try:
+                    _warn_again(given)
+                except Warning as exc:  # a filter made it an error: the fruit's error, as in one process (it came
+                    out[j] = ("raised", exc)  # before anything the fruit raised, which ended it)
         for kind, value in out:  # the first failing fruit's error, in the frame's order
             if kind == "raised":
                 raise value
@@ -431,9 +446,11 @@ class FruitPool:
                 return False
         return self._wait_ready(0.0) if self.active else False
 
-    def _run(self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object,
-             check: Callable[[], bool] | None) -> tuple[list[tuple[str, Any]], float] | None:  # fmt: skip
-        """:meth:`run`'s work: each fruit's :func:`_attempt`, in ``jobs``' order, and the workers' CPU seconds."""
+    def _run(
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None
+    ) -> tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None:
+        """:meth:`run`'s work: each fruit's :func:`_attempt` and the warnings a worker recorded for it (none for
+        those done here), in ``jobs``' order, and the workers' CPU seconds."""
         from .detect import _Fruit
 
         # longest first (mask pixels; ties in the frame's order): the last fruit taken are the short ones
@@ -447,8 +464,12 @@ class FruitPool:
         self._seq += 1
         seq, workers = self._seq, list(self._state.workers)
         self._counter.value = 0  # no worker takes a fruit between frames: each said "done" to the last one
-        message = ("frame", seq, name, size, layout, kind, rest, todo, os.environ.get("SYMFRUIT_KERNELS"))
+        # numpy's error handling as here ("call" and "log" need this process's callable: a warning there instead)
+        numpy_errors = {k: v if v in ("ignore", "warn", "raise", "print") else "warn" for k, v in np.geterr().items()}
+        message = ("frame", seq, name, size, layout, kind, rest, todo, os.environ.get("SYMFRUIT_KERNELS"),
+                   numpy_errors)  # fmt: skip
         found: list[Any] = [None] * len(todo)  # ("ok", _Done) or ("raised", exception), in ``todo``'s order
+        warned: list[list[_Warned]] = [[] for _ in todo]  # what a worker recorded for each
         theirs, done, cpu, lost = [False] * len(todo), [False] * len(workers), 0.0, ""
         for w in workers:
             try:
@@ -461,11 +482,11 @@ class FruitPool:
         while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
             found[i] = _attempt(fruit, *todo[i])
             for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
-                lost = lost or self._take(w, seq, kind, found, theirs, done, j, wait=0.0)[0]
+                lost = lost or self._take(w, seq, kind, found, warned, theirs, done, j, wait=0.0)[0]
         for j, w in enumerate(workers):
             silent_since = time.monotonic()
             while not lost and not done[j]:
-                lost, heard = self._take(w, seq, kind, found, theirs, done, j, wait=_POLL)
+                lost, heard = self._take(w, seq, kind, found, warned, theirs, done, j, wait=_POLL)
                 if heard:
                     silent_since = time.monotonic()
                 elif not w.process.is_alive():
@@ -483,24 +504,26 @@ class FruitPool:
             for i, got in enumerate(found):
                 if got is None:
                     found[i] = _attempt(fruit, *todo[i])
-                    theirs[i] = False
+                    theirs[i], warned[i] = False, []
         else:
             self._failed_starts = 0
         out: list[Any] = [None] * len(jobs)
+        out_warned: list[list[_Warned]] = [[] for _ in jobs]
         for i, got in enumerate(found):
-            out[order[i]] = got
+            out[order[i]], out_warned[order[i]] = got, warned[i]
             if theirs[i] and got[0] == "ok":
                 cpu += got[1][-1]
                 if issubclass(kind, _Fruit):
                     self.fruit_elsewhere += 1
                 else:
                     self.masks_elsewhere += 1
-        return out, cpu
+        return out, out_warned, cpu
 
-    def _take(self, w: _Worker, seq: int, kind: type, found: list[Any], theirs: list[bool], done: list[bool],
-              j: int, wait: float) -> tuple[str, bool]:  # fmt: skip
+    def _take(self, w: _Worker, seq: int, kind: type, found: list[Any], warned: list[list[_Warned]],
+              theirs: list[bool], done: list[bool], j: int, wait: float) -> tuple[str, bool]:  # fmt: skip
         """Read what worker ``w`` (the ``j``-th) sent for a task of class ``kind``, waiting up to ``wait`` seconds
-        for a first message: its fruit into ``found`` (``theirs`` marked), the end of its share into ``done``.
+        for a first message: its fruit into ``found`` and their warnings into ``warned`` (``theirs`` marked), the end
+        of its share into ``done``.
         Returns why it is lost ("" if it is not) and whether anything came."""
         heard = False
         while w.conn.poll(0.0 if heard else wait):
@@ -514,7 +537,7 @@ class FruitPool:
             if word[0] == "done":
                 done[j] = True
                 break
-            found[word[2]], theirs[word[2]] = _unpacked(kind, word[3]), True
+            found[word[2]], warned[word[2]], theirs[word[2]] = _unpacked(kind, word[3]), word[4], True
         return "", heard
 
     def _share(self, arrays: dict[str, np.ndarray | None], same: object = None) -> tuple[str, int, dict[str, Any]]:
@@ -617,6 +640,53 @@ def _attempt(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tupl
         return "raised", exc
 
 
+#: A warning a worker recorded: (category, text, file, line).
+_Warned = tuple[type[Warning], str, str, int]
+
+
+def _recorded(fruit: Callable[..., Any], k: int, sl: tuple[slice, slice]) -> tuple[tuple[str, Any], list[_Warned]]:
+    """In a worker: :func:`_attempt` and every warning it gave, recorded whatever the filters (the caller's decide
+    when they are given again, :func:`_warn_again`). A category the caller could not import by its name (a class
+    made inside a function: it would not pickle) goes as a ``UserWarning`` whose text starts with its name."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        got = _attempt(fruit, k, sl)
+    given: list[_Warned] = []
+    for w in caught:
+        category, text = w.category, str(w.message)
+        if not _by_name(category):
+            category, text = UserWarning, f"{category.__name__}: {text}"
+        given.append((category, text, w.filename, w.lineno))
+    return got, given
+
+
+def _by_name(cls: type) -> bool:
+    """Whether ``cls`` is found by its module and qualified name (what pickling a class by reference needs)."""
+    found: Any = sys.modules.get(cls.__module__)
+    for part in cls.__qualname__.split("."):
+        found = getattr(found, part, None)
+    return found is cls
+
+
+def _warn_again(given: list[_Warned]) -> None:
+    """Give the warnings a worker recorded in this process, in their order, through this process's filters, as
+    ``warnings.warn`` gave them there: the module a filter's ``module`` matches is the one of their file, and the
+    once-per-place record (``__warningregistry__``) is that module's. Raises the first one a filter makes an error."""
+    for category, text, filename, lineno in given:
+        module = _module_of(filename)
+        registry = None if module is None else vars(module).setdefault("__warningregistry__", {})
+        name = None if module is None else module.__name__
+        warnings.warn_explicit(text, category, filename, lineno, module=name, registry=registry)
+
+
+def _module_of(filename: str) -> Any:
+    """The loaded module whose file ``filename`` is, or None (``warn_explicit`` then names it by its file)."""
+    for module in list(sys.modules.values()):
+        if getattr(module, "__file__", None) == filename:
+            return module
+    return None
+
+
 def _packed(kind: type, got: tuple[str, Any]) -> tuple[Any, ...]:
     """A worker's answer for one job of a task of class ``kind``, small to pickle: its value as ``kind.packed``
     gives it (``detect``'s ``_Fruit``: a detection's whole-image mask cut to its box), or the value itself; an
@@ -662,7 +732,7 @@ def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None
             message = conn.recv()
             if message[0] != "frame":
                 return
-            _, seq, name, size, layout, kind, rest, todo, kernels = message
+            _, seq, name, size, layout, kind, rest, todo, kernels, numpy_errors = message
             if kernels is None:
                 os.environ.pop("SYMFRUIT_KERNELS", None)
             else:
@@ -672,7 +742,8 @@ def _worker_main(conn: Any, lock: Any, counter: Any, method: str | None) -> None
                     with contextlib.suppress(BufferError):
                         mapped[1].close()
                 mapped = (name, _map(name, size))
-            _frame(mapped[1], seq, layout, kind, rest, todo, lock, counter, outbox)
+            with np.errstate(**numpy_errors):  # the caller's: a division by zero warns, raises or is ignored as there
+                _frame(mapped[1], seq, layout, kind, rest, todo, lock, counter, outbox)
     except (EOFError, OSError, KeyboardInterrupt):
         return
     finally:
@@ -689,7 +760,8 @@ def _frame(buf: mmap.mmap, seq: int, layout: dict[str, Any], kind: type, rest: d
               for key, at in layout.items()}  # fmt: skip
     fruit.__dict__.update(rest, **arrays)
     while (i := _claim(lock, counter, len(todo))) is not None:
-        outbox.put(("fruit", seq, i, _packed(kind, _attempt(fruit, *todo[i]))))
+        got, given = _recorded(fruit, *todo[i])
+        outbox.put(("fruit", seq, i, _packed(kind, got), given))
     outbox.put(("done", seq))
 
 
@@ -704,7 +776,7 @@ def _send_all(conn: Any, outbox: queue.SimpleQueue[tuple[Any, ...] | None]) -> N
                 raise
             except Exception:  # only a fruit's exception can fail to pickle: sent nothing, told as text
                 exc = word[3][1]
-                conn.send((*word[:3], ("raised", RuntimeError(f"{type(exc).__name__}: {exc}"))))
+                conn.send((*word[:3], ("raised", RuntimeError(f"{type(exc).__name__}: {exc}")), word[4]))
         except OSError:
             return
 

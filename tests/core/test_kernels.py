@@ -65,7 +65,7 @@ def test_without_numba_the_twins_run(monkeypatch):
 
 def test_importing_symfruit_compiles_nothing():
     code = "import sys, symfruit, symfruit.core.fits, symfruit.detect; print('numba' in sys.modules)"
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=600)
     assert out.stdout.strip() == "False"
 
 

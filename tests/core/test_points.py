@@ -277,7 +277,7 @@ def test_subsample_draws_as_a_new_generator_does():
     found = []
     thread = threading.Thread(target=lambda: found.append(subsample(points, 100, seed=1)))
     thread.start()
-    thread.join()
+    thread.join(600)
     np.testing.assert_array_equal(
         found[0], points[np.sort(np.random.default_rng(1).choice(5000, size=100, replace=False))]
     )

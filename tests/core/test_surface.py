@@ -1070,7 +1070,7 @@ def test_the_trimmings_generator_draws_as_a_fresh_one():
     found = []
     thread = threading.Thread(target=lambda: found.append(_seeded().choice(3000, 400, replace=False)))
     thread.start()
-    thread.join()
+    thread.join(600)
     assert np.array_equal(found[0], want[2]) and _seeded() is not None
 
 

@@ -217,6 +217,6 @@ def test_a_worker_runs_numpys_blas_on_one_thread():
         if _blas_threads() != [2]:
             pytest.skip(f"numpy's BLAS here cannot run two threads ({_blas_threads()})")
         with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:
-            assert pool.submit(_blas_threads).result() == [2]  # what a worker inherits
+            assert pool.submit(_blas_threads).result(timeout=600) == [2]  # what a worker inherits
         with ProcessPoolExecutor(max_workers=1, mp_context=fork, initializer=one_blas_thread) as pool:
-            assert pool.submit(_blas_threads).result() == [1]
+            assert pool.submit(_blas_threads).result(timeout=600) == [1]

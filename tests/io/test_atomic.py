@@ -100,7 +100,8 @@ def test_a_target_that_is_a_folder_is_one_clear_error(tmp_path):
 def test_only_a_dead_runs_temporaries_are_stale(tmp_path):
     from symfruit.io.atomic import folder_fd, stale_temporaries
 
-    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True)
+    dead = subprocess.run([sys.executable, "-c", "import os; print(os.getpid())"], capture_output=True, text=True,
+                          timeout=300)  # fmt: skip
     names = [f".a.json.{os.getpid()}-0001.tmp", f".b.json.{int(dead.stdout)}-0002.tmp", ".c.json.xyz.tmp", "d.tmp"]
     for name in names:
         (tmp_path / name).write_text("")

@@ -9,7 +9,9 @@ import numpy as np
 import pytest
 
 from symfruit import ConfigError, FileFormatError, InputError, load_settings
-from symfruit.io.text import as_path, read_limited, read_structured
+from symfruit.io.text import DIGEST_BYTES, as_path, changed, file_states, read_limited, read_structured
+
+from ..conftest import after_its_status_time, set_back
 
 
 def test_json_and_yaml_by_extension(tmp_path):
@@ -245,3 +247,36 @@ def test_a_number_of_thousands_of_digits_and_deep_nesting_are_said_in_our_words(
     path.write_text('{"fx": 1,}')
     with pytest.raises(FileFormatError, match=r"not valid JSON: Expecting property name enclosed in double quotes"):
         read_structured(path, what="intrinsics file", max_bytes=1 << 20)  # other ValueErrors: the parser's reason
+
+
+@pytest.mark.parametrize("size", [120, 300_000], ids=["small", "large"])
+def test_a_same_size_rewrite_whose_times_are_set_back_is_seen(tmp_path, size):
+    """Stop 53's look at a file (size and modification time) missed a rewrite that kept the size and whose
+    modification time was set back (``cp -p``, ``touch -r``) or fell in the same time-stamp tick. Now a small file's
+    content is compared too (its digest), and a larger one's status-change time, which no program sets back."""
+    path = tmp_path / f"file_{size}"
+    path.write_bytes(bytes(range(256)) * (size // 256) + b"x" * (size % 256))
+    after_its_status_time(path)
+    states = file_states([path])
+    set_back(path, flip=True)
+    said = "its content changed" if size <= DIGEST_BYTES else "its modification time was set back"
+    assert os.stat(path).st_mtime_ns == states[path][3]  # the times a look at the status alone compared
+    assert changed(states, "while it was read") == (
+        f"{path}: changed while it was read (it was rewritten: {said}); it is being written or replaced: read it "
+        "again once it is whole"
+    )
+
+
+def test_a_mode_changed_or_a_link_made_while_a_file_is_read_is_no_change(tmp_path):
+    """The status-change time also moves when a file's mode, owner or links change (a chmod, a hard link made to it
+    by a backup): that is no change to what was read."""
+    path = tmp_path / "large.bin"
+    path.write_bytes(b"\1" * (DIGEST_BYTES + 1))
+    small = tmp_path / "small.json"
+    small.write_text("{}")
+    after_its_status_time(path)
+    states = file_states([path, small])
+    path.chmod(0o600)
+    os.link(path, tmp_path / "linked.bin")
+    small.chmod(0o600)
+    assert changed(states, "while it was read") is None

@@ -57,7 +57,7 @@ def test_the_wheels_include_folders_are_pointed_at_this_venv(tmp_path):
         + ros2env.CMAKELISTS.split("  if(_dirs)\n")[1].split("    set_target_properties")[0]
         + 'message(STATUS "${_dirs}")\n'
     )
-    res = subprocess.run([cmake, "-P", str(script)], capture_output=True, text=True)
+    res = subprocess.run([cmake, "-P", str(script)], capture_output=True, text=True, timeout=300)
     assert res.returncode == 0, res.stderr
     assert res.stdout.strip().endswith("/venv/include/python3.11;/keep/me;/venv/lib/numpy/include")
 

@@ -93,9 +93,16 @@ def refuse_pipe(path: Path, what: str, *, error: type[SymfruitError] = FileForma
         raise error(f"{path}: is a device; the {what} must be a regular file")
 
 
-#: A file's state as :func:`file_states` takes it: (device, inode, size in bytes, modification time in ns), or None
-#: where nothing of that name can be looked at.
-FileState = tuple[int, int, int, int] | None
+#: A file's state as :func:`file_states` takes it: (device, inode, size in bytes, modification time in ns, status
+#: change time in ns, (links, mode, owner, group), a digest of the content of a regular file of at most
+#: :data:`DIGEST_BYTES` or None), or None where nothing of that name can be looked at.
+FileState = tuple[int, int, int, int, int, tuple[int, int, int, int], bytes | None] | None
+
+#: Files up to this size (bytes) are also compared by content (a 64-bit BLAKE2b digest, read twice: about 10 us a
+#: small file): a frame's camera.json and truth.json, an intrinsics file, a COCO masks.json. A change that keeps
+#: the size within one time-stamp tick (a kernel without fine-grained time stamps ticks every 1-10 ms; FAT every
+#: 2 s) is seen in them. Larger files (images, depth arrays, clouds) are looked at by their status alone.
+DIGEST_BYTES = 64 * 1024
 
 
 def file_states(paths: Iterable[Path]) -> dict[Path, FileState]:
@@ -107,16 +114,43 @@ def file_states(paths: Iterable[Path]) -> dict[Path, FileState]:
         except (OSError, ValueError):
             states[path] = None
         else:
-            states[path] = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns)
+            digest = _digest(path, st) if stat.S_ISREG(st.st_mode) and st.st_size <= DIGEST_BYTES else None
+            meta = (st.st_nlink, st.st_mode, st.st_uid, st.st_gid)
+            states[path] = (st.st_dev, st.st_ino, st.st_size, st.st_mtime_ns, st.st_ctime_ns, meta, digest)
     return states
+
+
+def _digest(path: Path, st: os.stat_result) -> bytes | None:
+    """The BLAKE2b digest (8 bytes) of a small regular file's content, None where it cannot be read (the read that
+    follows says why) or is no longer the file ``st`` describes. Opened without blocking (a pipe put in its place
+    meanwhile is not waited on) and read up to one byte more than :data:`DIGEST_BYTES`."""
+    import hashlib
+
+    try:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK)
+    except (OSError, ValueError):
+        return None
+    try:
+        now = os.fstat(fd)
+        if (now.st_dev, now.st_ino) != (st.st_dev, st.st_ino) or not stat.S_ISREG(now.st_mode):
+            return None
+        return hashlib.blake2b(os.read(fd, DIGEST_BYTES + 1), digest_size=8).digest()
+    except OSError:
+        return None
+    finally:
+        os.close(fd)
 
 
 def changed(states: dict[Path, FileState], during: str) -> str | None:
     """Why the first file whose state changed since ``states`` were taken is refused (``during``: "while the
     frame was read", ...), None where none changed. A file replaced, grown, cut or rewritten while it is read
     was read as it was at that moment, part old and part new (a frame's colour of one moment beside its depth of
-    another): robust53. Two looks at each file, no reading: a change within one nanosecond and keeping the size
-    is not seen."""
+    another): robust53. Two looks at each file, its status and a small file's content (:data:`DIGEST_BYTES`):
+    refused when its identity, size, content or modification time changed, or its status-change time moved without
+    its links, mode or owner changing (a rewrite whose modification time was set back: ``cp -p``, ``touch -r``, an
+    archive unpacked over it). Not seen: a same-size change to a large file within one time-stamp tick (none on
+    Linux 6.13 and later, whose time stamps are fine-grained once looked at), and a change undone before the
+    second look (flake54)."""
     for path, before in states.items():
         (after,) = file_states([path]).values()
         if after == before:
@@ -129,8 +163,14 @@ def changed(states: dict[Path, FileState], during: str) -> str | None:
             how = "it was replaced by another file"
         elif after[2] != before[2]:
             how = f"its size went from {before[2]:,} to {after[2]:,} bytes"
-        else:
+        elif before[6] is not None and after[6] is not None and after[6] != before[6]:
+            how = "it was rewritten: its content changed"
+        elif after[3] != before[3]:
             how = "it was rewritten: its modification time changed"
+        elif after[4] != before[4] and after[5] == before[5]:
+            how = "it was rewritten: its modification time was set back"
+        else:
+            continue  # only its links, mode or owner changed (a chmod, a hard link made to it)
         return f"{path}: changed {during} ({how}); it is being written or replaced: read it again once it is whole"
     return None
 

@@ -68,7 +68,17 @@ from ..threads import one_blas_thread
 from ..writers import detections_record, write_detections
 from .table import TABLE_NAME, TableWriter, frame_rows, read_frame_rows
 
-__all__ = ["EXTRA", "Job", "Outcome", "Part", "detect_part", "local_cluster", "require_distributed", "run_distributed"]
+__all__ = [
+    "EXTRA",
+    "LOCAL_SCHEDULER_HTTP",
+    "Job",
+    "Outcome",
+    "Part",
+    "detect_part",
+    "local_cluster",
+    "require_distributed",
+    "run_distributed",
+]
 
 #: The optional dependency set that brings dask.distributed.
 EXTRA = "symfruit[cluster]"
@@ -79,6 +89,12 @@ LOCAL_MEMORY_LIMIT = "2GiB"
 #: before it levels off); nobody looks at it without the dashboard. For workers you start yourself:
 #: ``DASK_DISTRIBUTED__WORKER__PROFILE__ENABLED=False``.
 NO_PROFILER = {"distributed.worker.profile.enabled": False}
+#: A local scheduler's HTTP server (its health and metrics routes; Dask starts one even without a dashboard) on
+#: 127.0.0.1 and a port the system picks: Dask's default is the dashboard's port 8787 (on the scheduler's host,
+#: 127.0.0.1 here), taken by the first local cluster of the machine, and every later one warned "Port 8787 is
+#: already in use ... Hosting the HTTP server on port N instead" (flake54). ``LocalCluster(...,
+#: scheduler_kwargs=LOCAL_SCHEDULER_HTTP)``; the dashboard stays off.
+LOCAL_SCHEDULER_HTTP = {"dashboard_address": "127.0.0.1:0"}
 #: A local cluster keeps its workers however long one takes to come back: Dask's cluster closes a worker's nanny
 #: (and runs on with one worker fewer) when no worker of its name is back within ``lost-worker-timeout`` (15 s) of
 #: its death. A worker that dies at once again, or is slow to start (importing symfruit and numba on a loaded
@@ -305,8 +321,9 @@ def worker_peak_mb() -> float:
 
 
 def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> Any:
-    """A local Dask cluster of ``workers`` worker processes, one thread each, bound to 127.0.0.1 (no dashboard,
-    no profiler: :data:`NO_PROFILER`), each restarted by its nanny if it dies or outgrows ``memory_limit``."""
+    """A local Dask cluster of ``workers`` worker processes, one thread each, bound to 127.0.0.1 (no dashboard, the
+    scheduler's HTTP server on a free port: :data:`LOCAL_SCHEDULER_HTTP`; no profiler: :data:`NO_PROFILER`), each
+    restarted by its nanny if it dies or outgrows ``memory_limit``."""
     import logging
 
     require_distributed()
@@ -318,7 +335,8 @@ def local_cluster(workers: int, *, memory_limit: str = LOCAL_MEMORY_LIMIT) -> An
 
     with dask.config.set(NO_PROFILER):  # the nannies keep this config for the workers they restart
         return LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, host="127.0.0.1",
-                            dashboard_address=None, memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
+                            dashboard_address=None, scheduler_kwargs=dict(LOCAL_SCHEDULER_HTTP),
+                            memory_limit=memory_limit, silence_logs=logging.ERROR)  # fmt: skip
 
 
 #: The address schemes symfruit can reach a scheduler by (dask.distributed's, less ``ucx``, which needs a package
