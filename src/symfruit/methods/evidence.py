@@ -624,84 +624,33 @@ def rim_coverage(points: np.ndarray, region: Silhouette, camera: Camera, *, band
     return float(min(1.0, (hit & rim).sum() / rim.sum() / interior))
 
 
-def rim_scale(seen_major: float, seen_minor: float, grazing: float) -> tuple[float, float]:
-    """``(along the major axis, along the minor)``: how much wider than the outline a camera that returns no depth
-    where ``|cos| < grazing`` (the surface's normal against the ray) leaves of a spheroid seen from its side is its
-    silhouette, from that outline's half-widths (any unit; only their ratio is read).
-
-    An ellipsoid ``x^2/a^2 + y^2/b^2 + z^2/c^2 = 1`` seen along ``z`` is last seen where its normal makes ``|cos| = g``
-    with the ray: the ellipse of half-widths ``a sqrt((1 - g^2) / (1 - g^2 + g^2 c^2 / a^2))`` and the same in ``b``.
-    With the depth half-width ``c`` the minor's ``b`` (a section across the long axis is round, the section a
-    solid of revolution shows from its side; a round outline's, a sphere's), the minor half-width shrinks by
-    ``sqrt(1 - g^2)`` and the major by less, the more so the longer it is (at the tips the surface curves with
-    radius ``b^2 / a``): ``A^2 (1 - g^2) a^2 + A^2 g^2 b^2 = (1 - g^2) a^4`` gives ``a`` from the seen ``A``.
-
-    >>> [round(v, 4) for v in rim_scale(1.0, 1.0, 0.6)]  # a round outline: both 1 / sqrt(1 - g^2)
-    [1.25, 1.25]
-    >>> [round(v, 4) for v in rim_scale(2.0, 1.0, 0.6)]  # twice as long: its tips lose less
-    [1.0887, 1.25]
-    """
-    k = 1.0 - grazing * grazing
-    minor = 1.0 / math.sqrt(k)
-    if seen_major <= 0.0 or seen_minor <= 0.0:
-        return minor, minor
-    b = seen_minor * minor
-    ratio = b * b / (seen_major * seen_major)  # (b / A)^2
-    return math.sqrt(0.5 * (1.0 + math.sqrt(1.0 + 4.0 * grazing * grazing * ratio / k))), minor
-
-
 def lost_rim(region: Silhouette, grazing: float, camera: Camera | None = None, *, least: float = 0.0) -> Silhouette:
     """``region`` grown by the rim a camera that returns no depth where ``|cos| < grazing`` (the surface's normal
-    against the ray) loses of a spheroid seen from its side: stretched about its centroid along the principal axes of
-    its pixels by :func:`rim_scale` of its half-widths there (a round outline by ``1 / sqrt(1 - grazing^2)``: the
-    last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - grazing^2)`` from its centre; an elongated one
-    by the rim of its minor half-width across, less towards its tips), and by ``least`` pixels (a disk) wherever that
-    stretch moves the outline less; within ``camera``'s image when given. Unchanged when it moves the outline under
-    half a pixel everywhere.
+    against the ray) loses of a round section: its equivalent radius ``r`` times ``1 / sqrt(1 - grazing^2) - 1``
+    pixels (the last seen point of a circle of radius ``R`` lies at ``R sqrt(1 - grazing^2)`` from its centre), or
+    ``least`` pixels when more, by a disk, within ``camera``'s image when given. Unchanged when that is under half a
+    pixel.
 
     >>> m = np.zeros((21, 21), dtype=bool); m[5:16, 5:16] = True
-    >>> g = lost_rim(Silhouette(100, 50, m, 0.0), 0.6)  # 11 px grown 1.25 times: 13.75, the pixels centred inside
-    >>> (g.u0, g.v0, g.mask.shape, bool(g.mask.all()))
-    (104, 54, (13, 13), True)
+    >>> g = lost_rim(Silhouette(100, 50, m, 0.0), 0.6)
+    >>> (g.u0, g.v0, int(np.count_nonzero(g.mask)) > int(np.count_nonzero(m)))
+    (98, 48, True)
     """
-    mask = region.mask
-    rows, cols = np.nonzero(mask)
-    if len(rows) == 0:
+    r = math.sqrt(np.count_nonzero(region.mask) / math.pi)
+    grow = max(r * (1.0 / math.sqrt(1.0 - grazing * grazing) - 1.0), least)
+    px = math.ceil(grow)
+    if grow < 0.5:
         return region
-    centre = np.array([cols.mean(), rows.mean()])
-    offset = np.c_[cols, rows] - centre
-    var, vec = np.linalg.eigh(offset.T @ offset / len(rows) + np.eye(2) / 12.0)  # pixel squares, not their centres
-    half = 2.0 * np.sqrt(var)  # a filled ellipse's half-widths along its principal axes (minor, major)
-    along, across = rim_scale(float(half[1]), float(half[0]), grazing)
-    reach = np.abs(offset @ vec).max(axis=0) + 0.5  # the outline's farthest pixel edge along each axis
-    moved = reach * (np.array([across, along]) - 1.0)
-    if moved.max() < 0.5 and least < 0.5:
-        return region
-    pad = math.ceil(max(float(moved.max()), least)) + 1
-    h, w = mask.shape
-    v0, u0 = region.v0 - pad, region.u0 - pad
-    grid_v, grid_u = np.mgrid[: h + 2 * pad, : w + 2 * pad]
-    # each pixel of the grown window taken back to the outline by the inverse stretch: inside if it lands inside
-    back = vec @ np.diag([1.0 / across, 1.0 / along]) @ vec.T
-    du, dv = grid_u - pad - centre[0], grid_v - pad - centre[1]
-    col = np.rint(centre[0] + back[0, 0] * du + back[0, 1] * dv).astype(np.intp)
-    row = np.rint(centre[1] + back[1, 0] * du + back[1, 1] * dv).astype(np.intp)
-    ok = (col >= 0) & (col < w) & (row >= 0) & (row < h)
-    grown = np.zeros(grid_u.shape, dtype=bool)
-    grown[ok] = mask[row[ok], col[ok]]
-    if least >= 0.5:
-        px = math.ceil(least)
-        d = np.arange(-px, px + 1)
-        disk = d[:, None] ** 2 + d[None, :] ** 2 <= least * least
-        grown |= ndimage.binary_dilation(np.pad(mask, pad), structure=disk)
+    d = np.arange(-px, px + 1)
+    disk = d[:, None] ** 2 + d[None, :] ** 2 <= grow * grow
+    mask = ndimage.binary_dilation(np.pad(region.mask, px), structure=disk)
+    u0, v0 = region.u0 - px, region.v0 - px
     if camera is not None:  # within the image: the camera saw nothing beyond it
         c0, r0 = max(0, -u0), max(0, -v0)
-        c1 = min(grown.shape[1], camera.width - u0)
-        r1 = min(grown.shape[0], camera.height - v0)
-        grown, u0, v0 = grown[r0:r1, c0:c1], u0 + c0, v0 + r0
-    rows, cols = np.nonzero(grown)  # the window cut to the grown region
-    grown = grown[rows.min() : rows.max() + 1, cols.min() : cols.max() + 1]
-    return Silhouette(int(u0 + cols.min()), int(v0 + rows.min()), np.ascontiguousarray(grown), region.fill_radius)
+        c1 = min(mask.shape[1], camera.width - u0)
+        r1 = min(mask.shape[0], camera.height - v0)
+        mask, u0, v0 = mask[r0:r1, c0:c1], u0 + c0, v0 + r0
+    return Silhouette(u0, v0, np.ascontiguousarray(mask), region.fill_radius)
 
 
 def _rim_region(sample: np.ndarray, region: Silhouette, camera: Camera, points: np.ndarray,
