@@ -14,8 +14,9 @@ and completes them alone: without ``rim_grazing`` (``none``); with 0.48 and stop
 shut (``grown``: the L515's edge loss, tried and dropped). It prints each variant's mean side error (x, y, depth;
 the box's minus the mesh's box's) and mean centre deviation, mm.
 
-``diagnose`` prints, per ball (``--elong 1``), its points' depth range and ``evidence``'s candidates on the points
-alone and with the frame's occlusion information: where a shallow box comes from.
+``diagnose`` prints, per ball (``--elong 1``), its points' depth range, how far they reach from its centre on each
+side, and ``evidence``'s candidates on the points alone and with the frame's occlusion information: where a shallow
+box comes from.
 """
 
 from __future__ import annotations
@@ -193,6 +194,10 @@ def diagnose(name: str, seeds: int) -> None:
             f"{1e3 * (z - half):.1f} / {1e3 * z:.1f} mm, the points' nearest / 99th percentile / farthest "
             f"{1e3 * points[:, 2].min():.1f} / {1e3 * np.quantile(points[:, 2], 0.99):.1f} / "
             f"{1e3 * points[:, 2].max():.1f} mm")  # fmt: skip
+        lateral = points[:, :2] / points[:, 2:3] * z - centre[:2]  # each point's pixel, at the centre's depth
+        reach = [-lateral[:, 0].min(), lateral[:, 0].max(), -lateral[:, 1].min(), lateral[:, 1].max()]
+        say(f"  the points reach -x / +x / -y / +y {' / '.join(f'{1e3 * r:.1f}' for r in reach)} mm from the centre "
+            f"against the ball's {1e3 * half:.1f} ({1e3 * z / cam.fx:.2f} mm a pixel)")  # fmt: skip
         for label, kw in (("alone", {}), ("frame", {"occlusion": occ})):
             r = complete(points, camera=cam, **kw)
             e = r.extras
