@@ -1,7 +1,7 @@
 """``complete()`` on a time-of-flight camera's points alone (issue 18, stop 53; docs/tofpts53.md).
 
     python docs/tofpts53.py spheres [--grazing G ...]     # the real sphere frames, each sphere's points alone
-    python docs/tofpts53.py pool RUN ...                  # camera-protocol runs pooled over their seeds
+    python docs/tofpts53.py pool RUN ... [--kinds]        # camera-protocol runs pooled over their seeds
 
 ``spheres`` takes each sphere's points as ``detect`` takes them (``examples/real-frames``, occlusion information
 off: what ``symfruit evaluate --spheres examples/real-frames --config NOOCCL.yaml`` completes) and prints, per sphere:
@@ -111,7 +111,7 @@ def spheres(grazings: list[float]) -> None:
         src.close()
 
 
-def pool(runs: list[str]) -> None:
+def pool(runs: list[str], kinds: bool = False) -> None:
     for pattern in runs:
         rows: list[dict[str, str]] = []
         for path in sorted(glob.glob(pattern + "/latest/instances.csv")):
@@ -120,17 +120,24 @@ def pool(runs: list[str]) -> None:
         if not rows:
             say(f"{pattern}: no instances.csv")
             continue
+        groups = sorted({r["fruit"] for r in rows}) if kinds else []
+        for label, part in [(pattern, rows)] + [(f"  {g}", [r for r in rows if r["fruit"] == g]) for g in groups]:
+            _pooled(label, part)
 
-        def col(key: str) -> np.ndarray:
-            return np.array([float(r[key]) if r[key] not in ("", "nan") else np.nan for r in rows])  # noqa: B023
 
-        iou, centre, depth, lateral = col("iou"), col("centre_mm"), col("depth_mm"), col("lateral_mm")
-        failed = sum(1 for r in rows if r["error"])
-        say(f"{pattern}: {len(rows)} views ({failed} failed); IoU {np.nanmean(iou):.3f} / {np.nanmedian(iou):.3f} "
-              f"(mean / median); centre {np.nanmean(centre):.2f} / {np.nanmedian(centre):.2f} mm, worst "
-              f"{np.nanmax(centre):.1f}, over 10 mm {int((centre > 10).sum())}; depth side "
-              f"{np.nanmean(abs(depth)):.1f} ({np.nanmean(depth):+.1f}) mm; larger lateral side "
-              f"{np.nanmean(abs(lateral)):.1f} ({np.nanmean(lateral):+.1f}) mm")  # fmt: skip
+def _pooled(pattern: str, rows: list[dict[str, str]]) -> None:
+    """One line: ``evidence``'s IoU, centre deviation and side errors over ``rows``."""
+
+    def col(key: str) -> np.ndarray:
+        return np.array([float(r[key]) if r[key] not in ("", "nan") else np.nan for r in rows])
+
+    iou, centre, depth, lateral = col("iou"), col("centre_mm"), col("depth_mm"), col("lateral_mm")
+    failed = sum(1 for r in rows if r["error"])
+    say(f"{pattern}: {len(rows)} views ({failed} failed); IoU {np.nanmean(iou):.3f} / {np.nanmedian(iou):.3f} "
+          f"(mean / median); centre {np.nanmean(centre):.2f} / {np.nanmedian(centre):.2f} mm, worst "
+          f"{np.nanmax(centre):.1f}, over 10 mm {int((centre > 10).sum())}; depth side "
+          f"{np.nanmean(abs(depth)):.1f} ({np.nanmean(depth):+.1f}) mm; larger lateral side "
+          f"{np.nanmean(abs(lateral)):.1f} ({np.nanmean(lateral):+.1f}) mm")  # fmt: skip
 
 
 def main() -> None:
@@ -140,11 +147,12 @@ def main() -> None:
     sph.add_argument("--grazing", type=float, nargs="*", default=[0.48], help="rim_grazing values besides 0")
     pl = sub.add_parser("pool", help="camera-protocol runs pooled over their seeds")
     pl.add_argument("runs", nargs="+", help="globs of --output folders, quoted")
+    pl.add_argument("--kinds", action="store_true", help="and a line per fruit (kind, or scan) of each")
     args = parser.parse_args()
     if args.command == "spheres":
         spheres(args.grazing)
     else:
-        pool(args.runs)
+        pool(args.runs, args.kinds)
 
 
 if __name__ == "__main__":
