@@ -5,7 +5,10 @@ and without depth, seed 0 through the four camera models, apple-tree frames of s
 profile). Run it on the tree before and after a change (``SYMFRUIT_KERNELS=numpy`` for the numpy twins); the same
 digests mean the same results. The digests depend on the host's libraries (BLAS), so compare on one host.
 
-    python docs/digests.py [records] [labels] [--fruit-processes N]
+    python docs/digests.py [records] [labels] [trees] [--fruit-processes N]
+
+``trees`` (not in the default run: about 10 s more): the segmenter's labels of the 1920x1080 apple-tree frames
+``docs/speed_ab.py --trees 6`` times (seeds 0-5, ``make_tree_scene``'s default sensor, the apple profile; stop 54).
 
 ``--fruit-processes N``: the records with each frame's fruit shared with N worker processes
 (:class:`symfruit.fruitpool.FruitPool`, stop 53): the same digest as without them.
@@ -81,9 +84,25 @@ def labels() -> tuple[str, int]:
     return h.hexdigest()[:16], found
 
 
+def trees(n: int = 6) -> tuple[str, int]:
+    from symfruit.segment.colour import segment
+    from symfruit.settings import resolve_settings
+    from symfruit.synthetic.scenes import make_tree_scene
+
+    settings = resolve_settings(fruit="apple").segment  # as docs/speed_ab.py --trees has them
+    h = hashlib.sha256()
+    found = 0
+    for seed in range(n):
+        sc = make_tree_scene(seed)
+        lab = segment(sc.color, sc.depth, sc.camera, settings)
+        h.update(np.ascontiguousarray(lab, dtype=np.int32).tobytes())
+        found += int(lab.max())
+    return h.hexdigest()[:16], found
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("what", nargs="*", help="records, labels or both (default: both)")
+    parser.add_argument("what", nargs="*", help="records, labels, trees (default: records and labels)")
     parser.add_argument(
         "--fruit-processes",
         type=int,
@@ -93,13 +112,16 @@ def main() -> None:
     )
     args = parser.parse_args()
     args.what = args.what or ["records", "labels"]
-    if not set(args.what) <= {"records", "labels"}:
-        parser.error(f"what: give records and/or labels, got {' '.join(args.what)}")
+    if not set(args.what) <= {"records", "labels", "trees"}:
+        parser.error(f"what: give records, labels and/or trees, got {' '.join(args.what)}")
     if "records" in args.what:
         sys.stdout.write(f"records {records(args.fruit_processes)}\n")
     if "labels" in args.what:
         digest, found = labels()
         sys.stdout.write(f"labels {digest} {found} fruit\n")
+    if "trees" in args.what:
+        digest, found = trees()
+        sys.stdout.write(f"trees {digest} {found} fruit\n")
 
 
 if __name__ == "__main__":

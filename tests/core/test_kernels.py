@@ -7295,3 +7295,59 @@ def test_the_skin_flood_known_answer():
     assert at
     assert _jit.skin_flood(*args, 400.0, 0.1, 1.0, 0.01, 0.02, 80, 19.0**2)[1]  # on the window's edge
     assert not _jit.skin_flood(*args, 25.0, 0.1, 1.0, 0.01, 0.02, 80, -1.0)[1]
+
+
+# --- stop 54, seg54
+
+
+@pytest.mark.parametrize("view", ["whole", "grid", "window", "rgba"])
+def test_the_ground_colour_test_of_all_colours_in_any_layout_is_the_twins(view):
+    """All 2**24 colours in a 4096x4096 image, read whole, as the coarse grid's strided view (every 4th pixel of every
+    4th row, as ``_ground_bodies`` reads it), as a window of it, and from a 4-channel image: :func:`_jit.ground_pixels`
+    (each row's channels copied into rows of whole numbers and tested there, stop 54) gives the twin's pixels."""
+    from symfruit.segment.colour import _ground
+
+    rgb = np.arange(2**24, dtype=np.uint32).reshape(4096, 4096)
+    image = np.stack(((rgb >> 16) & 255, (rgb >> 8) & 255, rgb & 255), axis=-1).astype(np.uint8)
+    if view == "rgba":
+        image = np.concatenate((image[:1024], np.full((1024, 4096, 1), 7, np.uint8)), axis=2)
+    else:
+        image = {"whole": image, "grid": image[1::4, 2::4], "window": image[3:-5, 9:-11]}[view]
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _ground, image)
+    np.testing.assert_array_equal(fast, twin)
+    assert 0 < int(twin.sum()) < twin.size // 2
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_masked_and_region_medians_of_tied_depths_are_core_points_medians(seed):
+    """Depths drawn from a few values (ties, even and odd counts, none): :func:`_jit.masked_median`'s and
+    :func:`_jit.region_medians`' depth medians (by :func:`_jit.median_quick` since stop 54) are ``core.points.median``
+    of the same depths to the bit, NaN without any."""
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 30, 2))
+    z = rng.choice([0.0, 0.8, 0.8 + 2**-40, 1.25, 1.5, 3.0], (h, w), p=[0.3, 0.2, 0.1, 0.2, 0.1, 0.1])
+    mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    n, k, zm = _jit.masked_median(mask, z)
+    values = z[mask & (z > 0)]
+    assert (n, k) == (int(mask.sum()), len(values))
+    if len(values):
+        assert np.float64(zm).tobytes() == np.float64(median(values)).tobytes()
+    else:
+        assert np.isnan(zm)
+    sizes = rng.integers(0, 12, int(rng.integers(1, 8)))
+    first = np.concatenate(([0], np.cumsum(sizes))).astype(np.int64)
+    depth = z.ravel()[: int(first[-1])] if first[-1] <= z.size else rng.choice([0.0, 1.0, 2.0], int(first[-1]))
+    red = np.zeros(len(depth), np.float32)
+    zmed, nz, _ = _jit.region_medians(first, np.ascontiguousarray(depth), red)
+    for i in range(len(sizes)):
+        part = depth[first[i] : first[i + 1]]
+        part = part[part > 0]
+        assert nz[i] == len(part)
+        if len(part):
+            assert np.float64(zmed[i]).tobytes() == np.float64(median(part)).tobytes()
+        else:
+            assert np.isnan(zmed[i])

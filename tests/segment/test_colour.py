@@ -1,5 +1,8 @@
 """The colour segmenter (symfruit.segment.colour) on photo-like synthetic images and on rendered depth."""
 
+import warnings
+
+import hypothesis
 import numpy as np
 import pytest
 from hypothesis import given
@@ -1665,3 +1668,76 @@ def test_the_padded_boxes_are_find_objects(monkeypatch, kernels):
                 for k, sl in enumerate(ndimage.find_objects(labels), 1) if keep[k]]  # fmt: skip
         got = _padded_boxes(labels.ravel().take(at), rows, cols, keep, pad, shape)
         assert got == want and all(type(v) is int for box in got for v in box)
+
+
+@pytest.mark.parametrize("fruit", ["apple", "strawberry"])
+def test_the_typical_depth_is_read_off_the_ground_bodies_grid(fruit, monkeypatch):
+    """The frame's typical depth (the median of every 8th pixel's depth with depth) is the same number either way it
+    is read: with the ground-colour bodies looked for (the apple profile, on a small rendered apple-tree frame) off
+    every other point of their coarse grid's depths, whose grid is then the only strided window read (stop 54);
+    without them (a strawberry frame) off the depth's every 8th pixel as before."""
+    import symfruit.segment.colour as colour
+    from symfruit.settings import resolve_settings
+    from symfruit.synthetic.scenes import make_scene, make_tree_scene
+    from symfruit.synthetic.sensors import sensor_model
+
+    if fruit == "apple":
+        scene = make_tree_scene(3, sensor=sensor_model("azure-kinect").at(480, 270), n_apples=12, n_green=2)
+    else:
+        scene = make_scene(0, n_ripe=8, n_unripe=2)
+    settings = resolve_settings(fruit=fruit).segment
+    steps, typical = [], []
+    read, at = colour._Depth.__getitem__, colour._segment_at
+
+    def reading(self, window):
+        steps.append((window[0].step, window[1].step))
+        return read(self, window)
+
+    def segmenting(*args):
+        typical.append(args[5])
+        return at(*args)
+
+    monkeypatch.setattr(colour._Depth, "__getitem__", reading)
+    monkeypatch.setattr(colour, "_segment_at", segmenting)
+    segment(scene.color, scene.depth, scene.camera, settings)
+    grid = np.asarray(scene.depth, np.float64)[::8, ::8]
+    grid = grid[np.isfinite(grid) & (grid > 0)]
+    assert typical == [float(np.median(grid))]
+    strided = {step for step in steps if step != (None, None)}
+    assert strided == ({(4, 4)} if fruit == "apple" else {(8, 8)})
+
+
+@hypothesis.settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_segmenters_median_is_core_points_median(seed):
+    """``_median`` (by the compiled quickselect for float64 values, stop 54) of random values (ties, odd and even
+    counts, now and then a NaN, none, strided views, float32) is ``core.points.median``'s value to the bit in both
+    kernel modes, the values left as they were."""
+    from symfruit.core.points import median
+    from symfruit.segment.colour import _median
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(0, 400)) if seed % 5 else int(rng.integers(0, 4))
+    values = (
+        rng.choice(rng.uniform(0.2, 2.0, int(rng.integers(1, 6))), 2 * n) if seed % 2 else rng.normal(1, 0.1, 2 * n)
+    )
+    if seed % 7 == 3 and n:
+        values[int(rng.integers(0, 2 * n))] = np.nan
+    values = values[::2] if seed % 3 == 0 else values[:n]
+    values = values.astype(np.float32) if seed % 11 == 5 else values
+    kept = values.copy()
+    for kernels in ("numba", "numpy"):
+        with pytest.MonkeyPatch.context() as mp:
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            else:
+                mp.delenv("SYMFRUIT_KERNELS", raising=False)
+            with warnings.catch_warnings():  # np.median of no value warns
+                warnings.simplefilter("ignore", RuntimeWarning)
+                got = _median(values)
+        want = median(values) if len(values) else np.nan
+        if np.isnan(want):
+            assert np.isnan(got)
+        else:
+            assert np.asarray(got, values.dtype).tobytes() == np.asarray(want).tobytes()
+        np.testing.assert_array_equal(values, kept)

@@ -6384,12 +6384,24 @@ def ground_pixels(color: np.ndarray, ground_hue: int, leaf_hue: int, dark: int) 
     """:func:`symfruit.segment.colour._ground` of ``color`` (h, w, >= 3) uint8, any strides: (h, w) bool, blue the
     least channel, the largest a third above it and above ``dark``, of a hue from ``ground_hue`` up to (not
     including) ``leaf_hue`` degrees, by the twin's whole-number tests (no value of 8-bit channels overflows its int16
-    arithmetic: the same pixels), each pixel's by :func:`_is_ground`."""
+    arithmetic: the same pixels), :func:`_is_ground`'s tests. Each row's channels are copied into three contiguous
+    rows of whole numbers first and tested there: a loop over contiguous values, which the compiler vectorises, not
+    one reading a window's or a strided grid's channels pixel by pixel (stop 54: 0.39 to 0.17 ms on a 1920x1080 tree
+    frame's coarse grid, 0.52 to 0.23 ms on 600x300 windows)."""
     h, w = color.shape[0], color.shape[1]
     out = np.empty((h, w), np.bool_)
+    red_row, green_row, blue_row = np.empty(w, np.int32), np.empty(w, np.int32), np.empty(w, np.int32)
+    ground, leaf, least = np.int32(ground_hue), np.int32(leaf_hue - 60), np.int32(dark)
     for r in range(h):
         for c in range(w):
-            out[r, c] = _is_ground(color[r, c, 0], color[r, c, 1], color[r, c, 2], ground_hue, leaf_hue, dark)
+            red_row[c], green_row[c], blue_row[c] = color[r, c, 0], color[r, c, 1], color[r, c, 2]
+        line = out[r]
+        for c in range(w):
+            red, green, blue = red_row[c], green_row[c], blue_row[c]
+            top = max(red, green)
+            gb, rb = green - blue, red - blue
+            line[c] = ((blue <= min(red, green)) & (3 * (top - blue) >= top) & (top > least) & (60 * gb >= ground * rb)
+                       & ((red >= green) | (60 * (green - red) < leaf * gb)))  # fmt: skip
     return out
 
 
@@ -6436,9 +6448,10 @@ def masked_depths(mask: np.ndarray, z: np.ndarray) -> tuple[int, np.ndarray]:
 def masked_median(mask: np.ndarray, z: np.ndarray) -> tuple[int, int, float]:
     """The count of ``mask`` (h, w) bool's pixels, of those with depth (``z`` (h, w) float64 above 0), and
     ``core.points.median`` of their depths (NaN without any): the twin's ``mask.sum()``, ``len(z[mask & (z > 0)])``
-    and its median, the same values."""
+    and its median, the same values (the median by :func:`median_quick`, the same value: 1.04 to 0.95 ms a tree frame
+    over its 69 calls; stop 54)."""
     n, values = masked_depths(mask, z)
-    return n, values.shape[0], median_values(values)
+    return n, values.shape[0], median_quick(values)
 
 
 @_njit
@@ -6588,7 +6601,7 @@ def region_medians(first: np.ndarray, depth: np.ndarray, red: np.ndarray) -> tup
                 values[k] = depth[j]
                 k += 1
         nz[i] = k
-        zmed[i] = median_values(values)
+        zmed[i] = median_quick(values)  # the same value (stop 54)
         rmed[i] = median_values32(red[a:b].copy())
     return zmed, nz, rmed
 
