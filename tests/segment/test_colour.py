@@ -1665,3 +1665,62 @@ def test_the_padded_boxes_are_find_objects(monkeypatch, kernels):
                 for k, sl in enumerate(ndimage.find_objects(labels), 1) if keep[k]]  # fmt: skip
         got = _padded_boxes(labels.ravel().take(at), rows, cols, keep, pad, shape)
         assert got == want and all(type(v) is int for box in got for v in box)
+
+
+# --- stop 54, apples54
+
+OLIVE = (150, 150, 70)  # hue 60 degrees, saturation 0.53: ground colour (a sunlit olive backdrop), not the skin's
+
+
+def _two_bicoloured_apples(backdrop):
+    """Two bicoloured apples 52 px across at 1.5 m turned with their yellow-green side to the camera, a 12 px blush
+    on their left: one at x 900 inside the depth camera's view, one at x 120 outside it (the depth camera sees
+    x >= 223 only, as an Azure Kinect's NFOV depth registered to its 16:9 colour). The backdrop behind (10 cm) is
+    painted ``backdrop`` over x 400-700 inside the view and right of the outer apple, touching it. Colour, depth,
+    the outer apple's silhouette and the painted backdrop beside it."""
+    color, depth = hd_disc_frame([(900, 540), (120, 540)], radius=26)
+    disc = (color == RED).all(axis=2)
+    yy, xx = np.mgrid[:1080, :1920]
+    shaded(color, disc & (((xx >= 886) & (xx < 1000)) | (xx >= 106) & (xx < 300)), YELLOW_GREEN, depth, 1.5)
+    inner = (np.abs(yy - 540) <= 200) & (xx >= 400) & (xx < 700)
+    beside = (np.abs(yy - 540) <= 20) & (xx >= 140) & (xx < 175) & ~disc
+    color[inner | beside] = backdrop
+    depth[:, :223] = 0.0
+    return color, depth, disc & (xx < 223), beside
+
+
+def test_a_bicoloured_apple_outside_the_depth_view_takes_the_skin_colours_found_with_depth():
+    # outside the depth camera's view the skin cannot grow along depth: the apple was its blush alone. The skin
+    # found with depth inside the view is yellow-green; the frame's other ground colour there is olive: the outer
+    # apple's yellow-green side is taken, the olive backdrop touching it is not
+    color, depth, outer, beside = _two_bicoloured_apples(OLIVE)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 2
+    k = np.bincount(labels[outer]).argmax()
+    assert k > 0
+    found = labels == k
+    assert (found & outer).sum() > 0.9 * outer.sum()
+    assert (found & beside).sum() == 0 and (found & ~outer).sum() < 0.05 * outer.sum()
+
+
+def test_outside_the_depth_view_a_ground_colour_as_common_off_the_fruit_is_not_taken_for_skin():
+    # the backdrop inside the view has the skin's own colour over a larger area than the skin: that colour does not
+    # tell skin from what is behind, and the outer apple stays its blush (the olive patch beside it as well)
+    color, depth, outer, beside = _two_bicoloured_apples(YELLOW_GREEN)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    on = labels[outer]
+    assert (on > 0).any() and (on > 0).mean() < 0.5  # the blush, found
+    assert (labels[beside] == 0).all()
+
+
+def test_the_colour_bins_follow_the_ground_colours_hue_and_saturation():
+    from symfruit.segment.colour import GROUND_HUE, HUE_BINS, LEAF_HUE, SAT_BINS, _colour_bins
+
+    rgb = np.array(
+        [(200, 100, 0), (200, 200, 0), (150, 200, 0), (160, 175, 60), (150, 150, 70), (90, 90, 60)], np.uint8
+    )
+    hue = np.array([30.0, 60.0, 75.0, 60 + 60 * 15 / 115, 60.0, 60.0])
+    sat = np.array([1.0, 1.0, 1.0, 115 / 175, 80 / 150, 30 / 90])
+    hb = np.clip(np.floor((hue - GROUND_HUE) / (LEAF_HUE - GROUND_HUE) * HUE_BINS), 0, HUE_BINS - 1)
+    sb = np.clip(np.floor((sat - 1 / 3) / (2 / 3) * SAT_BINS), 0, SAT_BINS - 1)
+    assert _colour_bins(rgb).tolist() == (hb * SAT_BINS + sb).astype(int).tolist()

@@ -635,6 +635,7 @@ def _segment_at(
     bridged = _BridgedDepth(z) if z is not None and s.ground_colour and s.round_fruit else None
     out = np.zeros((h, w), np.int32)
     found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]] = []
+    unseen: list[tuple[int, Window, np.ndarray]] = []
     for k, piece in enumerate(pieces, 1):
         sl, part = piece.window, piece.mask
         if z is not None and not s.round_fruit and (plain := _plain_piece(piece, k, c, weak, owner, z, s, geo.focal,
@@ -661,6 +662,9 @@ def _segment_at(
                 sl, hull = _bridged_skin(sl, hull, z, bridged, c, geo, s, owner, k)
             else:
                 sl, hull = _round_skin(sl, hull, z, c, geo, s, owner, k)
+            if s.ground_colour and _unseen(sl, hull, z):  # outside the depth camera's view: after the rest (stop 54)
+                unseen.append((k, sl, hull))
+                continue
             if body_map is not None:
                 sl, hull = _join_bodies(sl, hull, bodies, body_map, taken, z, geo, s)
             sub_z = z[sl]
@@ -685,6 +689,15 @@ def _segment_at(
         if claimed is None:
             continue
         found.append((sl, *claimed))
+    if unseen and z is not None:  # their skin by the colours of the skins found with depth (stop 54)
+        colours = _skin_colours(c, z, found)
+        zf = _fruit_depth(pieces, z) if colours is not None else 0.0
+        for k, sl, hull in unseen:
+            if colours is not None and zf > 0.0:  # within the largest fruit's diameter at the fruit's depth
+                sl, hull = _unseen_skin(sl, hull, z, c, s, owner, k, colours, s.round_max_diameter * geo.focal / zf)
+            if _fruit_sized(hull, z[sl], s, geo.focal, min_area, z_typical) and (
+                    claimed := _claim(out[sl], hull)) is not None:  # fmt: skip
+                found.append((sl, *claimed))
     # number the fruit left to right (then top to bottom) by their box centres, for stable ids
     order = sorted(range(len(found)), key=lambda i: _box_centre(found[i][0], found[i][2]))
     for new, i in enumerate(order, 1):
@@ -2707,3 +2720,119 @@ def _bridged_skin(
     if state == 2 or (state in (0, 3) and skin.sum() < GROUND_SOLIDITY * _hull_area(skin)):
         return _round_skin(sl, part, depth, color, geo, s, owner, k)
     return grown_sl, skin
+
+
+# --- stop 54, apples54: a round fruit's skin outside the depth camera's view
+
+
+def _unseen(sl: Window, hull: np.ndarray, depth: _Depth) -> bool:
+    """Whether a round fruit's part (``hull`` in window ``sl``, its skin grown) has too little depth to have grown
+    along (under 20 pixels, :func:`_round_skin`'s bound): outside the depth camera's view."""
+    return int(np.count_nonzero(hull & (depth[sl] > 0))) < 20
+
+
+#: Hue (degrees, over :func:`_ground`'s 40-80) and saturation (over 1/3-1) bins of :func:`_skin_colours`' tables.
+HUE_BINS = 8
+SAT_BINS = 8
+
+#: Every this many pixels of the frame, across and down, the colours of what is not fruit are counted.
+COLOUR_STEP = 4
+
+
+def _colour_bins(rgb: np.ndarray) -> np.ndarray:
+    """(n,) bin of :func:`_skin_colours`' table for (n, 3) uint8 ground-colour pixels (:func:`_ground`)."""
+    r, g, b = (rgb[:, k].astype(np.float64) for k in range(3))
+    top = np.maximum(r, g)
+    d = np.maximum(top - b, 1.0)
+    hue = np.where(r >= g, 60.0 * (g - b) / d, 120.0 - 60.0 * (r - b) / d)
+    sat = d / np.maximum(top, 1.0)
+    hb = np.clip(((hue - GROUND_HUE) * HUE_BINS / (LEAF_HUE - GROUND_HUE)).astype(np.int64), 0, HUE_BINS - 1)
+    sb = np.clip(((sat - 1.0 / 3.0) * SAT_BINS * 1.5).astype(np.int64), 0, SAT_BINS - 1)
+    return hb * SAT_BINS + sb
+
+
+def _skin_colours(
+    color: np.ndarray, depth: _Depth, found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]]
+) -> np.ndarray | None:
+    """Which ground colours (:func:`_ground`, by hue and saturation bins) are a fruit's skin in this frame and not
+    what else shows a ground colour (a yellow-green backdrop, an olive leaf in sun, a warm white balance's leaves):
+    those more frequent among the ground-colour pixels of the fruit found with depth than among the frame's other
+    ground-colour pixels with depth (equal priors). The depth camera tells the two apart where it sees; the frame's
+    light and white balance are the same beyond its view. None when either has fewer than 100 pixels."""
+    h, w = color.shape[:2]
+    mine = np.zeros(HUE_BINS * SAT_BINS, np.int64)
+    inside = np.zeros((h, w), bool)
+    for sl, free, _ in found:
+        inside[sl] |= free
+        zc = depth[sl]
+        sk = free & (zc > 0) & _ground(color[sl])
+        if sk.any():
+            mine += np.bincount(_colour_bins(color[sl][sk]), minlength=len(mine))
+    g = COLOUR_STEP
+    grid = (slice(None, None, g), slice(None, None, g))
+    other = _ground(color[grid]) & (depth[grid] > 0) & ~inside[grid]
+    rest = np.bincount(_colour_bins(color[grid][other]), minlength=len(mine)) * g * g
+    if mine.sum() < 100 or rest.sum() < 100 * g * g:
+        return None
+    return mine * rest.sum() > rest * mine.sum()
+
+
+def _fruit_depth(pieces: list[_Piece], depth: _Depth) -> float:
+    """The depth at which the frame's fruit stand: the median of the red pieces' median depths (those with at
+    least 20 pixels of depth; 0 when none has). The fruit of one tree seen from its row stand within a few tens of
+    centimetres of each other, while the frame's typical depth (:func:`segment`'s ``z_typical``, the median of all
+    its depth) is mostly what lies behind them: on the rendered trees 3.4-4.7 m against fruit at 1.2-2.1 m."""
+    zs = []
+    for p in pieces:
+        zp = depth[p.window][p.mask]
+        zp = zp[zp > 0]
+        if len(zp) >= 20:
+            zs.append(float(median(zp)))
+    return float(median(np.array(zs))) if zs else 0.0
+
+
+def _unseen_skin(
+    sl: Window,
+    hull: np.ndarray,
+    depth: _Depth,
+    color: np.ndarray,
+    s: SegmentSettings,
+    owner: np.ndarray,
+    k: int,
+    colours: np.ndarray,
+    far: float,
+) -> tuple[Window, np.ndarray]:
+    """The skin of a round fruit's red part (``hull`` in window ``sl``) that has no depth to grow along: the depth
+    camera sees a narrower field than the colour camera (the Azure Kinect's NFOV depth against its 16:9 colour: on
+    a 1920x1080 frame the columns left and right of the depth's view), so a bicoloured apple there is found as its
+    red blush alone. Its ground colour is taken where it has no depth and is of a skin's colour in this frame
+    (``colours``, :func:`_skin_colours`), reached from the part within the largest fruit's diameter
+    (``round_max_diameter``) at the depth of the frame's fruit (the median of the red pieces' with depth), and not
+    another fruit's (``owner``). The skin is taken only when it is one fruit's: no larger than the largest fruit's
+    disc there and one convex outline (:data:`GROUND_SOLIDITY` of its hull, as :func:`_bridged_skin` tests the skin
+    grown over depth); else the part is returned as it was."""
+    rows, cols = np.nonzero(hull)
+    if len(rows) == 0:
+        return sl, hull
+    rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
+    h, w = depth.shape
+    big = (slice(max(min(int(rc - far), sl[0].start), 0), min(max(int(rc + far) + 1, sl[0].stop), h)),
+           slice(max(min(int(cc - far), sl[1].start), 0), min(max(int(cc + far) + 1, sl[1].stop), w)))  # fmt: skip
+    zb = depth[big]
+    part = np.zeros(zb.shape, bool)
+    r, c = sl[0].start - big[0].start, sl[1].start - big[1].start
+    part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
+    yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
+    near = (yy - rc) ** 2 + (xx - cc) ** 2 <= far**2
+    cw = color[big]
+    cand = near & (zb <= 0) & _ground(cw) & ((owner[big] == 0) | (owner[big] == k))
+    cand[cand] = colours[_colour_bins(cw[cand])]
+    lab, n = ndimage.label(cand | part)
+    grown = np.zeros(n + 1, bool)
+    grown[lab[part]] = True
+    grown[0] = False
+    skin = fill_holes(grown[lab] | part)  # a highlight, a shaded dent or the stem's cavity inside are its skin
+    area = int(skin.sum())
+    if area <= int(part.sum()) or area > np.pi / 4 * far**2 or area < GROUND_SOLIDITY * _hull_area(skin):
+        return sl, hull
+    return big, skin
