@@ -475,7 +475,7 @@ def segment(
     z, geo = _depth(depth, camera, (h, w))
     min_area = max(s.min_area_share * h * w, 4.0)
     # with depth, a part without any depth (outside the depth camera's view) is sized at the frame's typical depth
-    grid = None if z is None else z[::8, ::8]
+    grid = None if z is None else z[::TYPICAL_STEP, ::TYPICAL_STEP]
     z_typical = 0.0 if grid is None else float(median(grid[grid > 0])) if (grid > 0).any() else 1.0
 
     # Red pixels are looked for on a coarse grid first (the pyramid's top). When every candidate fruit there
@@ -690,10 +690,9 @@ def _segment_at(
             continue
         found.append((sl, *claimed))
     if unseen and z is not None:  # their skin by the colours of the skins found with depth (stop 54)
-        colours = _skin_colours(c, z, found)
-        zf = _fruit_depth(pieces, z) if colours is not None else 0.0
+        colours, zf = _skin_colours(c, z, found)
         for k, sl, hull in unseen:
-            if colours is not None and zf > 0.0:  # within the largest fruit's diameter at the fruit's depth
+            if colours is not None:  # within the largest fruit's diameter at the fruit's depth
                 sl, hull = _unseen_skin(sl, hull, z, c, s, owner, k, colours, s.round_max_diameter * geo.focal / zf)
             if _fruit_sized(hull, z[sl], s, geo.focal, min_area, z_typical) and (
                     claimed := _claim(out[sl], hull)) is not None:  # fmt: skip
@@ -2735,8 +2734,9 @@ def _unseen(sl: Window, hull: np.ndarray, depth: _Depth) -> bool:
 HUE_BINS = 8
 SAT_BINS = 8
 
-#: Every this many pixels of the frame, across and down, the colours of what is not fruit are counted.
-COLOUR_STEP = 4
+#: Every this many pixels across and down, :func:`segment` reads the frame's typical depth and :func:`_skin_colours`
+#: counts the colours of what is not fruit.
+TYPICAL_STEP = 8
 
 
 def _colour_bins(rgb: np.ndarray) -> np.ndarray:
@@ -2746,49 +2746,59 @@ def _colour_bins(rgb: np.ndarray) -> np.ndarray:
     d = np.maximum(top - b, 1.0)
     hue = np.where(r >= g, 60.0 * (g - b) / d, 120.0 - 60.0 * (r - b) / d)
     sat = d / np.maximum(top, 1.0)
-    hb = np.clip(((hue - GROUND_HUE) * HUE_BINS / (LEAF_HUE - GROUND_HUE)).astype(np.int64), 0, HUE_BINS - 1)
-    sb = np.clip(((sat - 1.0 / 3.0) * SAT_BINS * 1.5).astype(np.int64), 0, SAT_BINS - 1)
-    return hb * SAT_BINS + sb
+    hb = np.minimum(np.maximum((hue - GROUND_HUE) * (HUE_BINS / (LEAF_HUE - GROUND_HUE)), 0.0), HUE_BINS - 1)
+    sb = np.minimum(np.maximum((sat - 1.0 / 3.0) * (SAT_BINS * 1.5), 0.0), SAT_BINS - 1)
+    return hb.astype(np.int64) * SAT_BINS + sb.astype(np.int64)
+
+
+def _ground_of(rgb: np.ndarray) -> np.ndarray:
+    """(n,) bool: :func:`_ground` of (n, 3) uint8 pixels."""
+    return _ground(np.ascontiguousarray(rgb, np.uint8)[None])[0] if len(rgb) else np.zeros(0, bool)
 
 
 def _skin_colours(
     color: np.ndarray, depth: _Depth, found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]]
-) -> np.ndarray | None:
+) -> tuple[np.ndarray | None, float]:
     """Which ground colours (:func:`_ground`, by hue and saturation bins) are a fruit's skin in this frame and not
-    what else shows a ground colour (a yellow-green backdrop, an olive leaf in sun, a warm white balance's leaves):
-    those more frequent among the ground-colour pixels of the fruit found with depth than among the frame's other
-    ground-colour pixels with depth (equal priors). The depth camera tells the two apart where it sees; the frame's
-    light and white balance are the same beyond its view. None when either has fewer than 100 pixels."""
+    what else shows a ground colour (a yellow-green backdrop, an olive leaf in sun, a warm white balance's leaves),
+    and the depth the frame's fruit stand at. The colours: those more frequent among the ground-colour pixels of
+    the fruit found with depth than among the frame's other ground-colour pixels with depth (every
+    :data:`TYPICAL_STEP`-th pixel across and down; equal priors). The depth camera tells the two apart where it sees; the
+    frame's light and white balance are the same beyond its view. The depth: the median of the found fruit's median
+    depths (those with 20 pixels of depth or more). The fruit of one tree seen from its row stand within a few tens
+    of centimetres of each other, while the frame's typical depth (:func:`segment`'s ``z_typical``, the median of
+    all its depth) is mostly what lies behind them: on the rendered trees 3.4-4.7 m against fruit at 1.2-2.1 m.
+    (None, 0) when fewer than 100 pixels are counted on either side or no fruit has depth."""
     h, w = color.shape[:2]
-    mine = np.zeros(HUE_BINS * SAT_BINS, np.int64)
-    inside = np.zeros((h, w), bool)
+    flat = color.reshape(-1, 3) if color.flags.c_contiguous else np.ascontiguousarray(color).reshape(-1, 3)
+    g = TYPICAL_STEP
+    zg = depth[(slice(None, None, g), slice(None, None, g))]  # the grid :func:`segment` reads the typical depth on
+    inside = np.zeros(zg.shape, bool)
+    at, depths = [], []
     for sl, free, _ in found:
-        inside[sl] |= free
         zc = depth[sl]
-        sk = free & (zc > 0) & _ground(color[sl])
-        if sk.any():
-            mine += np.bincount(_colour_bins(color[sl][sk]), minlength=len(mine))
-    g = COLOUR_STEP
-    grid = (slice(None, None, g), slice(None, None, g))
-    other = _ground(color[grid]) & (depth[grid] > 0) & ~inside[grid]
-    rest = np.bincount(_colour_bins(color[grid][other]), minlength=len(mine)) * g * g
-    if mine.sum() < 100 or rest.sum() < 100 * g * g:
-        return None
-    return mine * rest.sum() > rest * mine.sum()
-
-
-def _fruit_depth(pieces: list[_Piece], depth: _Depth) -> float:
-    """The depth at which the frame's fruit stand: the median of the red pieces' median depths (those with at
-    least 20 pixels of depth; 0 when none has). The fruit of one tree seen from its row stand within a few tens of
-    centimetres of each other, while the frame's typical depth (:func:`segment`'s ``z_typical``, the median of all
-    its depth) is mostly what lies behind them: on the rendered trees 3.4-4.7 m against fruit at 1.2-2.1 m."""
-    zs = []
-    for p in pieces:
-        zp = depth[p.window][p.mask]
-        zp = zp[zp > 0]
-        if len(zp) >= 20:
-            zs.append(float(median(zp)))
-    return float(median(np.array(zs))) if zs else 0.0
+        seen = free & (zc > 0)
+        idx = np.flatnonzero(seen)
+        if len(idx) >= 20:
+            depths.append(float(median(zc.ravel().take(idx))))
+        rows, cols = np.divmod(idx, seen.shape[1])
+        at.append((rows + sl[0].start) * w + (cols + sl[1].start))
+        i0, j0 = (-sl[0].start) % g, (-sl[1].start) % g
+        on = free[i0::g, j0::g]
+        r0, c0 = (sl[0].start + i0) // g, (sl[1].start + j0) // g
+        inside[r0 : r0 + on.shape[0], c0 : c0 + on.shape[1]] |= on
+    if not depths:
+        return None, 0.0
+    skin = flat.take(np.concatenate(at), axis=0)
+    skin = skin[_ground_of(skin)]
+    rows, cols = np.nonzero((zg > 0) & ~inside)
+    rest = flat.take(rows * (g * w) + cols * g, axis=0)
+    rest = rest[_ground_of(rest)]
+    if len(skin) < 100 or len(rest) < 100:
+        return None, 0.0
+    mine = np.bincount(_colour_bins(skin), minlength=HUE_BINS * SAT_BINS)
+    other = np.bincount(_colour_bins(rest), minlength=HUE_BINS * SAT_BINS)
+    return mine * other.sum() > other * mine.sum(), float(median(np.array(depths)))
 
 
 def _unseen_skin(
@@ -2824,9 +2834,14 @@ def _unseen_skin(
     part[r : r + hull.shape[0], c : c + hull.shape[1]] = hull
     yy, xx = np.arange(big[0].start, big[0].stop)[:, None], np.arange(big[1].start, big[1].stop)[None]
     near = (yy - rc) ** 2 + (xx - cc) ** 2 <= far**2
-    cw = color[big]
-    cand = near & (zb <= 0) & _ground(cw) & ((owner[big] == 0) | (owner[big] == k))
-    cand[cand] = colours[_colour_bins(cw[cand])]
+    cand = near & (zb <= 0) & ((owner[big] == 0) | (owner[big] == k))
+    rows, cols = np.nonzero(cand)
+    rgb = color[rows + big[0].start, cols + big[1].start]
+    ground = _ground_of(rgb)
+    ground[ground] = colours[_colour_bins(rgb[ground])]
+    cand[rows, cols] = ground
+    if not (cand & _dilate(part)).any():  # no skin beside the part: a red fruit found whole
+        return sl, hull
     lab, n = ndimage.label(cand | part)
     grown = np.zeros(n + 1, bool)
     grown[lab[part]] = True
