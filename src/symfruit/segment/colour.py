@@ -2759,16 +2759,16 @@ def _ground_of(rgb: np.ndarray) -> np.ndarray:
 def _skin_colours(
     color: np.ndarray, depth: _Depth, found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]]
 ) -> tuple[np.ndarray | None, float]:
-    """Which ground colours (:func:`_ground`, by hue and saturation bins) are a fruit's skin in this frame and not
-    what else shows a ground colour (a yellow-green backdrop, an olive leaf in sun, a warm white balance's leaves),
-    and the depth the frame's fruit stand at. The colours: those more frequent among the ground-colour pixels of
-    the fruit found with depth than among the frame's other ground-colour pixels with depth (every
-    :data:`TYPICAL_STEP`-th pixel across and down; equal priors). The depth camera tells the two apart where it
-    sees; the frame's light and white balance are the same beyond its view. The depth: the median of the found
-    fruit's median depths (those with 20 pixels of depth or more). The fruit of one tree seen from its row stand
-    within a few tens of centimetres of each other, while the frame's typical depth (:func:`segment`'s
-    ``z_typical``, the median of all its depth) is mostly what lies behind them: on the rendered trees 3.4-4.7 m against fruit at 1.2-2.1 m.
-    (None, 0) when fewer than 100 pixels are counted on either side or no fruit has depth."""
+    """Which ground colours (:func:`_ground`, by hue and saturation bins) are a fruit's skin in this frame and not what
+    else shows a ground colour (a yellow-green backdrop, an olive leaf in sun, a warm white balance's leaves), and the
+    depth the frame's fruit stand at. The colours: those more frequent among the ground-colour pixels of the fruit found
+    with depth than among the frame's other ground-colour pixels with depth (every :data:`TYPICAL_STEP`-th pixel across
+    and down; equal priors). The depth camera tells the two apart where it sees; the frame's light and white balance are
+    the same beyond its view. The depth: the median of the found fruit's median depths (those with 20 pixels of depth or
+    more). The fruit of one tree seen from its row stand within a few tens of centimetres of each other, while the
+    frame's typical depth (:func:`segment`'s ``z_typical``, the median of all its depth) is mostly what lies behind
+    them: on the rendered trees 3.4-4.7 m against fruit at 1.2-2.1 m. (None, 0) when fewer than 100 pixels are counted
+    on either side or no fruit has depth."""
     w = color.shape[1]
     flat = color.reshape(-1, 3) if color.flags.c_contiguous else np.ascontiguousarray(color).reshape(-1, 3)
     g = TYPICAL_STEP
