@@ -2813,14 +2813,14 @@ def _unseen_skin(
     far: float,
 ) -> tuple[Window, np.ndarray]:
     """The skin of a round fruit's red part (``hull`` in window ``sl``) that has no depth to grow along: the depth
-    camera sees a narrower field than the colour camera (the Azure Kinect's NFOV depth against its 16:9 colour: on
-    a 1920x1080 frame the columns left and right of the depth's view), so a bicoloured apple there is found as its
-    red blush alone. Its ground colour is taken where it has no depth and is of a skin's colour in this frame
-    (``colours``, :func:`_skin_colours`), reached from the part within the largest fruit's diameter
-    (``round_max_diameter``) at the depth of the frame's fruit (the median of the red pieces' with depth), and not
-    another fruit's (``owner``). The skin is taken only when it is one fruit's: no larger than the largest fruit's
-    disc there and one convex outline (:data:`GROUND_SOLIDITY` of its hull, as :func:`_bridged_skin` tests the skin
-    grown over depth); else the part is returned as it was."""
+    camera sees a narrower field than the colour camera (the Azure Kinect's NFOV depth against its 16:9 colour: on a
+    1920x1080 frame the columns left and right of the depth's view), so a bicoloured apple there is found as its red
+    blush alone. Its ground colour is taken where it has no depth and is of a skin's colour in this frame (``colours``,
+    :func:`_skin_colours`), reached from the part within the largest fruit's diameter (``round_max_diameter``) at the
+    depth of the frame's fruit (``far``: the found fruit's, :func:`_skin_colours`), and not another fruit's (``owner``).
+    The skin is taken only when it is one fruit's: no larger than the largest fruit's disc there and one convex outline
+    (:data:`GROUND_SOLIDITY` of its hull, as :func:`_bridged_skin` tests the skin grown over depth); else the part is
+    returned as it was."""
     rows, cols = np.nonzero(hull)
     if len(rows) == 0:
         return sl, hull
