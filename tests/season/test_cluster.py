@@ -142,12 +142,12 @@ def test_a_worker_killed_mid_frame_loses_nothing_and_writes_nothing_twice(cluste
 
         thread = threading.Thread(target=run)
         thread.start()
-        pid = int(_wait_for(lambda: marker.is_file() and marker.read_text(), 180, "a worker to start scene_00003"))
+        pid = int(_wait_for(lambda: marker.is_file() and marker.read_text(), 600, "a worker to start scene_00003"))
         assert pid in pids
         os.kill(pid, signal.SIGKILL)  # mid-task: scene_00002, the task's first frame, is written already
-        thread.join(timeout=300)
+        thread.join(timeout=600)
         assert not thread.is_alive() and "error" not in result, result.get("error")
-        workers = _wait_for(lambda: len(client.scheduler_info()["workers"]) == 2 and client.run(os.getpid), 120,
+        workers = _wait_for(lambda: len(client.scheduler_info()["workers"]) == 2 and client.run(os.getpid), 300,
                             "the nanny to start another worker")  # fmt: skip
         assert pid not in workers.values()
         report = result["report"]
@@ -539,7 +539,7 @@ def test_a_result_lost_with_the_last_worker_before_it_was_gathered_is_unprocesse
     with _one_worker(recording, out) as (one, runner, result):
         running["cluster"] = one
         runner.start()
-        runner.join(120)
+        runner.join(600)
         assert not runner.is_alive(), "the run waited for a result lost with the last worker"
     assert left.is_set()
     _stopped_with_the_rest_unprocessed(result["report"], one.scheduler_address, out)
@@ -569,7 +569,7 @@ def test_a_cluster_whose_workers_are_all_paused_or_silent_stops_the_run(recordin
     with _one_worker(recording, out, silent_worker_timeout=10) as (one, runner, result):
         worker = next(iter(one.workers.values()))
         runner.start()
-        _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
+        _wait_for(lambda: list(out.glob("*/detections.json")), 600, "the first frame")
 
         def stop() -> None:  # on the worker's event loop, as Dask's memory monitor pauses it
             if how == "paused":  # and kept so: its memory monitor would resume it, memory being low here
@@ -607,9 +607,9 @@ def test_a_cluster_whose_workers_all_leave_stops_the_run_with_the_rest_unprocess
     out = tmp_path / "o"
     with _one_worker(recording, out) as (one, runner, result):
         runner.start()
-        _wait_for(lambda: list(out.glob("*/detections.json")), 120, "the first frame")
+        _wait_for(lambda: list(out.glob("*/detections.json")), 600, "the first frame")
         one.scale(0)
-        runner.join(120)
+        runner.join(600)
         assert not runner.is_alive()
     # the first frame is written, but its result may be lost with the worker before the client gathers it (then
     # it is unprocessed too: the test above): done may be none
