@@ -162,6 +162,35 @@ def test_median_is_numpys_bit_for_bit(seed, dtype):
     assert got == expected or (np.isnan(got) and np.isnan(expected))
 
 
+@given(st.integers(0, 2**32 - 1))
+def test_median_by_the_compiled_quickselect_is_numpys_in_both_kernel_modes(seed):
+    """``median`` of random values (ties, odd and even counts, now and then a NaN, strided views, float32; float64
+    by the compiled quickselect where numba is, stop 54) is ``np.median``'s value and type to the bit in both kernel
+    modes, the values left as they were."""
+    from symfruit.core.points import median
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.integers(1, 400)) if seed % 5 else int(rng.integers(1, 4))
+    values = (
+        rng.choice(rng.uniform(0.2, 2.0, int(rng.integers(1, 6))), 2 * n) if seed % 2 else rng.normal(1, 0.1, 2 * n)
+    )
+    if seed % 7 == 3:
+        values[int(rng.integers(0, 2 * n))] = np.nan
+    values = values[::2] if seed % 3 == 0 else values[:n]
+    values = values.astype(np.float32) if seed % 11 == 5 else values
+    kept, want = values.copy(), np.median(values)
+    for kernels in ("numba", "numpy"):
+        with pytest.MonkeyPatch.context() as mp:
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            else:
+                mp.delenv("SYMFRUIT_KERNELS", raising=False)
+            got = median(values)
+        assert type(got) is type(want)
+        assert np.isnan(got) if np.isnan(want) else np.asarray(got).tobytes() == np.asarray(want).tobytes()
+        np.testing.assert_array_equal(values, kept)
+
+
 SHAPE_PAIRS = [((3,), (3,)), ((3,), (9, 3)), ((9, 3), (9, 3)), ((4, 1, 3), (5, 3))]
 
 

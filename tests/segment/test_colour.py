@@ -1,8 +1,5 @@
 """The colour segmenter (symfruit.segment.colour) on photo-like synthetic images and on rendered depth."""
 
-import warnings
-
-import hypothesis
 import numpy as np
 import pytest
 from hypothesis import given
@@ -1705,39 +1702,3 @@ def test_the_typical_depth_is_read_off_the_ground_bodies_grid(fruit, monkeypatch
     assert typical == [float(np.median(grid))]
     strided = {step for step in steps if step != (None, None)}
     assert strided == ({(4, 4)} if fruit == "apple" else {(8, 8)})
-
-
-@hypothesis.settings(max_examples=300, deadline=None)
-@given(st.integers(0, 2**32 - 1))
-def test_the_segmenters_median_is_core_points_median(seed):
-    """``_median`` (by the compiled quickselect for float64 values, stop 54) of random values (ties, odd and even
-    counts, now and then a NaN, none, strided views, float32) is ``core.points.median``'s value to the bit in both
-    kernel modes, the values left as they were."""
-    from symfruit.core.points import median
-    from symfruit.segment.colour import _median
-
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(0, 400)) if seed % 5 else int(rng.integers(0, 4))
-    values = (
-        rng.choice(rng.uniform(0.2, 2.0, int(rng.integers(1, 6))), 2 * n) if seed % 2 else rng.normal(1, 0.1, 2 * n)
-    )
-    if seed % 7 == 3 and n:
-        values[int(rng.integers(0, 2 * n))] = np.nan
-    values = values[::2] if seed % 3 == 0 else values[:n]
-    values = values.astype(np.float32) if seed % 11 == 5 else values
-    kept = values.copy()
-    for kernels in ("numba", "numpy"):
-        with pytest.MonkeyPatch.context() as mp:
-            if kernels == "numpy":
-                mp.setenv("SYMFRUIT_KERNELS", "numpy")
-            else:
-                mp.delenv("SYMFRUIT_KERNELS", raising=False)
-            with warnings.catch_warnings():  # np.median of no value warns
-                warnings.simplefilter("ignore", RuntimeWarning)
-                got = _median(values)
-        want = median(values) if len(values) else np.nan
-        if np.isnan(want):
-            assert np.isnan(got)
-        else:
-            assert np.asarray(got, values.dtype).tobytes() == np.asarray(want).tobytes()
-        np.testing.assert_array_equal(values, kept)

@@ -76,12 +76,17 @@ def cross_rows(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 def median(values: np.ndarray) -> Any:
     """``np.median(values)`` of a 1-d float array, the same value bit for bit: one partition at the two middle
     places (and the last, where a NaN would sort) and the mean of the middle two in the array's own type, without
-    np.median's general-axis machinery (20-40 us a call, several times the partition on a fruit's pixels).
-    NaN when a value is NaN or there is none."""
+    np.median's general-axis machinery (20-40 us a call, several times the partition on a fruit's pixels); of
+    float64 values where numba is, by :func:`symfruit.core._jit.median_quick` (the same order statistics, the values
+    left as they are; 0.15 to 0.05 ms for a 1920x1080 tree frame's 17,000 grid depths, and less call overhead on a
+    few hundred: stop 54, moved here from the colour segmenter's own wrapper). NaN when a value is NaN or there is
+    none (np.median's warning where there is none)."""
     x = np.asarray(values)
     n = len(x)
     if n == 0 or x.ndim != 1 or x.dtype.kind != "f":
         return np.median(x)
+    if x.dtype == np.float64 and (jit := compiled()) is not None:
+        return np.float64(jit.median_quick(np.ascontiguousarray(x)))
     h = n // 2
     part = np.partition(x, (h - 1, h, n - 1) if n % 2 == 0 else (h, n - 1))
     if np.isnan(part[-1]):

@@ -210,17 +210,6 @@ def _color(color: np.ndarray) -> np.ndarray:
     return c[:, :, :3]
 
 
-def _median(values: np.ndarray) -> float:
-    """``core.points.median`` of (n,) values (``np.median``'s value): of float64 values where numba is by
-    :func:`symfruit.core._jit.median_quick` (the same value bit for bit, as a float; NaN where a value is NaN or there
-    is none), without the partition's call layers: 0.15 to 0.05 ms for a tree frame's 17,000 grid depths, and most of
-    the cost of the 30 medians of a few hundred depths or distances a tree frame's bodies and merges take (stop 54).
-    Other values as ``core.points.median`` gives them."""
-    if (jit := compiled()) is not None and values.dtype == np.float64 and values.ndim == 1:
-        return float(jit.median_quick(np.ascontiguousarray(values)))
-    return median(values)
-
-
 def _ripe(color: np.ndarray, red: np.ndarray, ripe_median: float) -> bool:
     """Whether the median redness of the pixels ``red`` (h, w) bool of ``color`` (h, w, 3) uint8 reaches
     ``ripe_median``: the float32 median compared in float32, with the compiled twin (issue 19, eighteenth round)
@@ -503,7 +492,7 @@ def segment(
         grid = z[::COARSE_STEP, ::COARSE_STEP][:: 8 // COARSE_STEP, :: 8 // COARSE_STEP]
     else:
         grid = z[::8, ::8]
-    z_typical = 0.0 if grid is None else float(_median(grid[grid > 0])) if (grid > 0).any() else 1.0
+    z_typical = 0.0 if grid is None else float(median(grid[grid > 0])) if (grid > 0).any() else 1.0
     if step == 1:
         return _segment_at(c, z, geo, s, min_area, z_typical, _red_windows(coarse, (h, w)))
     o = step // 2
@@ -1298,14 +1287,11 @@ def _same_surface(
         p = _near_surface(p, fit, s)
     if fit is None or len(p) < 20:
         zs = [big_s.z(), small_s.z()]
-        if (
-            all(len(z) >= SAME_SURFACE_POINTS for z in zs)
-            and abs(_median(zs[0]) - _median(zs[1])) > s.round_max_diameter
-        ):
+        if all(len(z) >= SAME_SURFACE_POINTS for z in zs) and abs(median(zs[0]) - median(zs[1])) > s.round_max_diameter:
             return False
         return None
     off = np.abs(row_norms(p - fit[0]) - fit[1])
-    return bool(_median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
+    return bool(median(off) <= min(s.sphere_apart * fit[1], s.depth_jump))  # off it by a depth step: not one
 
 
 def _near_surface(p: np.ndarray, fit: tuple[np.ndarray, float], s: SegmentSettings) -> np.ndarray:
@@ -1376,7 +1362,7 @@ def _split(
     # hidden behind the fruit in front or a leaf)
     least = np.sqrt(min_area / np.pi)
     if use_depth and depth is not None and seen is not None:
-        zm = float(_median(depth[seen]))
+        zm = float(median(depth[seen]))
         edges = _depth_edges(region, depth, seen, zm, s, geo.focal)
         carved = fill_holes(region & ~edges)
         least = 0.25 * geo.focal * s.min_diameter / zm
@@ -1669,7 +1655,7 @@ def _sphere_lstsq(
             return None
         z = p[:, 2]
         spread = float(np.sqrt(np.var(p[:, 0]) + np.var(p[:, 1]))) * np.sqrt(2.0)  # a disc's radius from its spread
-        p = p[np.abs(z - _median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
+        p = p[np.abs(z - median(z)) <= 2.0 * spread]  # a fruit's surface spans about its radius in depth
     centre, radius = np.zeros(3), 0.0
     for _ in range(2):  # fit, drop the points far off the sphere (mixed pixels at the outline), fit again
         if len(p) < 20:
@@ -1683,7 +1669,7 @@ def _sphere_lstsq(
             p = jit.sphere_inliers(p, np.ascontiguousarray(centre), radius)
             continue
         res = np.abs(row_norms(p - centre) - radius)
-        p = p[res <= max(3.0 * float(_median(res)) * 1.4826, 1e-4)]
+        p = p[res <= max(3.0 * float(median(res)) * 1.4826, 1e-4)]
     if not (np.isfinite(radius) and 0.25 * spread <= radius <= 4.0 * spread):
         return None
     return centre, radius
@@ -1830,7 +1816,7 @@ def _largest_area(mask: np.ndarray, depth: np.ndarray, s: SegmentSettings, focal
 
 def _largest_disc(z: np.ndarray, s: SegmentSettings, focal: float, z_typical: float) -> float:
     """:func:`_largest_area` at the median of the depths ``z`` (all positive; ``z_typical`` when there are none)."""
-    zr = float(_median(z)) if len(z) else z_typical
+    zr = float(median(z)) if len(z) else z_typical
     return float(np.pi / 4 * (focal * s.round_max_diameter / zr) ** 2)
 
 
@@ -1945,7 +1931,7 @@ def _round_skin(
             rows, cols = np.nonzero(hull)
             rc, cc = rows.mean() + sl[0].start, cols.mean() + sl[1].start
             own = float(np.sqrt(hull.sum() / np.pi))
-        zm = float(_median(z_part))
+        zm = float(median(z_part))
     reach = ROUND_REACH * own
     deep_limit = ROUND_REACH * own * zm / geo.focal + s.depth_jump
     far = s.round_max_diameter * geo.focal / zm
@@ -2101,8 +2087,8 @@ def _blush_rim(
     other = beside & ~ground
     if ring.sum() < 20 or other.sum() < 20:
         return sl, hull, z_part
-    zm, front = float(_median(z_part)), float(_median(z[ring]))
-    if zm - front <= s.depth_jump or abs(zm - float(_median(z[other]))) > s.depth_jump:
+    zm, front = float(median(z_part)), float(median(z[ring]))
+    if zm - front <= s.depth_jump or abs(zm - float(median(z[other]))) > s.depth_jump:
         return sl, hull, z_part
     near = ring & (np.abs(z - front) <= s.depth_jump)
     return big, part | near, z[near]
@@ -2227,7 +2213,7 @@ def _convex_outline(part: np.ndarray, vertices: np.ndarray | None, depth: np.nda
     seen = part & (depth > 0)
     if not seen.any():
         return False
-    front = float(_median(depth[seen])) - jump
+    front = float(median(depth[seen])) - jump
     rest = _hull_mask(vertices, part) & ~part
     if (jit := compiled()) is not None and depth.dtype == np.float64:  # the same count, the box read where needed
         return area >= GROUND_SOLIDITY * (hull_area - float(jit.hidden_count(rest, depth, front, GAP_PX)))
@@ -2364,7 +2350,7 @@ def _join_bodies(
         p = _points(hull, depth[sl], geo, (sl[0].start, sl[1].start))
         if len(p) < 20:
             continue
-        off = float(_median(np.abs(row_norms(p - body.centre) - body.radius)))
+        off = float(median(np.abs(row_norms(p - body.centre) - body.radius)))
         if off > min(s.sphere_apart * body.radius, s.depth_jump):
             continue
         window, union = _union(_Piece(sl, hull, 0), _Piece(body.window, body.mask, 0))
@@ -2396,7 +2382,7 @@ def _round_body(
     if not 0.5 * s.min_diameter <= radius <= GROUND_RADIUS * s.round_max_diameter:
         return None
     p = _points(part, depth, geo, origin)
-    zm = float(_median(p[:, 2]))
+    zm = float(median(p[:, 2]))
     if centre[2] - zm < GROUND_BEHIND * radius:
         return None
     a = np.concatenate((p[:, :2], np.ones((len(p), 1))), axis=1)
@@ -2404,9 +2390,9 @@ def _round_body(
     for _ in range(2):  # fit, drop the points far off the plane (a leaf's mixed rim pixels), fit again: as the sphere
         coef = lstsq(a[keep], p[keep, 2])[0]  # numpy's LAPACK call without its wrapper: the same values (stop 47)
         off = np.abs(a @ coef - p[:, 2])
-        keep = off <= max(3.0 * float(_median(off)) * 1.4826, 1e-4)
-    plane = float(_median(off))
-    sphere = float(_median(np.abs(row_norms(p - centre) - radius)))
+        keep = off <= max(3.0 * float(median(off)) * 1.4826, 1e-4)
+    plane = float(median(off))
+    sphere = float(median(np.abs(row_norms(p - centre) - radius)))
     return (centre, radius) if sphere <= GROUND_PLANE * plane else None
 
 
@@ -2452,7 +2438,7 @@ def _depth_consistent(hull: np.ndarray, part: np.ndarray, depth: np.ndarray, jum
     z = depth[part & (depth > 0)]
     if len(z) == 0:
         return hull
-    zm = float(_median(z))
+    zm = float(median(z))
     off = (depth > 0) & (np.abs(depth - zm) > jump)
     return part | (hull & ~off)
 
@@ -2469,7 +2455,7 @@ def _fruit_sized(
         return _sized(int(area), float(zm) if valid else z_typical, s, focal)
     area = int(mask.sum())
     z = depth[mask & (depth > 0)]
-    diameter_px = focal * s.min_diameter / (float(_median(z)) if len(z) else z_typical)
+    diameter_px = focal * s.min_diameter / (float(median(z)) if len(z) else z_typical)
     return area >= np.pi / 4 * diameter_px**2
 
 
