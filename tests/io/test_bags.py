@@ -1,6 +1,7 @@
 """Frames from ROS bags (optional extra ``bag``): a tiny ROS 2 bag end to end, image messages decoded
 by encoding, and broken bags named."""
 
+import contextlib
 import re
 from types import SimpleNamespace
 
@@ -1025,3 +1026,47 @@ def test_a_bag_changed_after_it_was_opened_fails_its_frames_naming_the_file(tmp_
                                rf"\(its size went from {size:,} to {size + 7:,} bytes\); it is being written or "
                                "replaced: read it again once it is whole$"):  # fmt: skip
                 src.read(k)
+
+
+def _sqlite_bag(tmp_path, name: str, *sql: str):
+    """A ROS 2 sqlite3 bag of three frames, ``sql`` run on its database."""
+    import sqlite3
+
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / name, color, (depth * 1000).astype(np.uint16), frames=3)
+    with contextlib.closing(sqlite3.connect(path / f"{name}.db3")) as db:
+        for statement in sql:
+            db.execute(statement)
+        db.commit()
+    return path
+
+
+def test_a_ros2_sqlite_bag_cut_short_is_named_damaged_in_our_words_not_apsws(tmp_path):
+    pytest.importorskip("rosbags")
+    path = _sqlite_bag(tmp_path, "cut")
+    db = path / "cut.db3"
+    db.write_bytes(db.read_bytes()[: db.stat().st_size * 99 // 100])  # its index opens; its last page is gone
+    with pytest.raises(
+        FileFormatError, match=r"cut: cannot (open|index) bag \(.*database disk image is malformed"
+    ) as e:
+        open_source(path)  # before: "cannot index bag (CorruptError: database disk image is malformed)"
+    assert "CorruptError" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    ("sql", "said"),
+    [
+        ("update messages set timestamp = 'x'", r"cannot open bag \(a record holds a value of the wrong type \(text "
+         r"where a number or bytes belong\): the bag is damaged\)"),
+        ("update messages set data = 'hello'", r"the message on /camera/color/camera_info at 1000000000 holds str, "
+         "not bytes: the bag's database is damaged"),
+    ],
+    ids=["timestamp-text", "message-text"],
+)  # fmt: skip
+def test_a_ros2_sqlite_bag_whose_rows_hold_text_is_named_damaged_not_in_pythons_words(tmp_path, sql, said):
+    # before: "cannot open bag (unsupported operand type(s) for -: 'int' and 'str')", "cannot index bag (TypeError:
+    # string argument without an encoding)" (stop 55, robust55)
+    pytest.importorskip("rosbags")
+    path = _sqlite_bag(tmp_path, "rows", sql)
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(path))}: {said}"):
+        open_source(path)
