@@ -535,6 +535,9 @@ def damage_reason(exc: BaseException) -> str | None:
         # disk image is malformed" (a database cut short past its first pages), NotADBError, ... (stop 55, robust55)
         said = text.splitlines()[0][:REASON_CHARS] if text.strip() else type(exc).__name__
         return f"its SQLite database is damaged or cut short ({said})"
+    if isinstance(exc, AssertionError) and _raised_in_rosbags(exc):  # a bare assert of rosbags' (an index record
+        # of another size than its kind has), said as "cannot open bag (AssertionError)" (robust55)
+        return "a record of the bag is not of the size its kind has: the bag is damaged"
     if isinstance(exc, TypeError) and _raised_in_rosbags(exc):  # a value of another SQL type than the schema's (a
         # timestamp or message that is text): "unsupported operand type(s) for -: 'int' and 'str'" (robust55)
         return "a record holds a value of the wrong type (text where a number or bytes belong): the bag is damaged"
@@ -565,6 +568,9 @@ def reader_reason(exc: BaseException) -> str:
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"
+    if text.startswith("Bag index looks damaged"):  # rosbags' ROS 1 reader: "Bag index looks damaged: ('Header
+        # could not be read from file.',)", a tuple's repr, for an index cut short or broken (robust55)
+        return "its index, at the end of the file, is cut short or damaged (`rosbag reindex` rebuilds it)"
     if text.startswith("File end magic is invalid"):  # rosbags' MCAP reader on a file cut short
         return "the MCAP file ends before its footer: a recording cut short (`mcap recover` rebuilds one) or damaged"
     newer = re.match(r"Rosbag2 version (\S+) not supported", text)
