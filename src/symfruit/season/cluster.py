@@ -330,7 +330,8 @@ def detect_part(job: Job, part: Part) -> list[Outcome]:
             def clear(folder: Path = folder) -> None:
                 _clear_frame(folder, out)
 
-            _HELD.into = warned = []
+            warned: list[str] = []
+            _HELD.into = warned
             try:
                 done, rows, stop = _guarded(one_frame, item=name, failed=failed, target=folder, at=f"frame {name}",
                                             cleanup=clear)  # fmt: skip
