@@ -699,3 +699,28 @@ def test_the_workers_warnings_are_given_by_the_client_once_a_recording(cluster, 
     assert err.count("principal point") == 1 and "SymfruitWarning" not in err
     assert f"symfruit: warning: {rec}/scene_00000/camera.json: the principal point (cx -81" in err
     assert f"symfruit: warning: {rec}: 2 more frames gave a warning above (each is shown for its first frame" in err
+
+
+@pytest.mark.parametrize(
+    "address",
+    ["tcp://[::1", "tcp://[::1:8786", "tcp://::1]:8786", f"tcp://{'a' * 64}:8786", f"tcp://{'ab.' * 90}c:8786",
+     "tcp://a..b:8786", "tcp://[]:8786"],
+)  # fmt: skip
+def test_a_scheduler_address_whose_host_can_be_no_name_nor_address_is_refused_in_our_words(address):
+    """Before (robust55): distributed's "invalid address '[::1'; maybe: ipv6 needs brackets like [::1]" of an address
+    with its bracket, Python's "encoding with 'idna' codec failed (UnicodeError: label too long)" of a part of a name
+    over 63 characters, each after ``cannot reach the Dask scheduler``; now refused before any connection."""
+    from symfruit.season.cluster import check_address
+
+    with pytest.raises(InputError, match=r"not a scheduler address; its host .* is no host name \(at most 253 "):
+        check_address(address)
+
+
+@pytest.mark.parametrize(
+    "address",
+    ["tcp://[::1]:8786", "tcp://scheduler.example.org.:8786", f"tcp://{'a' * 63}.b:8786", "host:8786", "tcp://:8786"],
+)
+def test_a_scheduler_address_of_a_host_name_or_an_ipv6_address_in_brackets_passes_the_check(address):
+    from symfruit.season.cluster import check_address
+
+    check_address(address)

@@ -411,6 +411,20 @@ def check_address(scheduler: Any) -> None:
     # mistyped port passed as another; ``8786`` alone has no port (distributed: "missing port number")
     if not colon or not (port.isascii() and port.isdigit()) or not 1 <= int(port) <= 65535:
         raise InputError(f"--scheduler {shown(text)}: not a scheduler address; give tcp://HOST:PORT, the port 1-65535")
+    # a host no name or address can be (robust55): distributed said "invalid address '[::1'; maybe: ipv6 needs
+    # brackets like [::1]" of one with a bracket, Python's "encoding with 'idna' codec failed (UnicodeError: label
+    # too long)" of a part over DNS's 63 characters
+    host = rest.rpartition(":")[0]  # "" (tcp://:8786) is this machine's, as the system takes it
+    named = host.removesuffix(".")  # a fully qualified name may end in a dot
+    bracketed = host.startswith("[")
+    if (
+        bracketed != host.endswith("]")
+        or host == "[]"
+        or (host and not bracketed and (len(named) > 253 or any(not 0 < len(p) <= 63 for p in named.split("."))))
+    ):
+        raise InputError(f"--scheduler {shown(text)}: not a scheduler address; its host {shown(host)} is no host "
+                         "name (at most 253 characters, 1-63 between dots) nor address (IPv6 in brackets, "
+                         "[::1])")  # fmt: skip
     if scheme in ("tls", "wss"):
         distributed = require_distributed()
         if distributed.Security().get_connection_args("client").get("ssl_context") is None:
