@@ -152,7 +152,8 @@ def _png_damage(source: Path | bytes) -> str:
     from PIL import PngImagePlugin
 
     try:
-        PngImagePlugin.PngImageFile(io.BytesIO(source) if isinstance(source, bytes) else source).close()
+        with io.BytesIO(source) if isinstance(source, bytes) else open(source, "rb") as file:
+            PngImagePlugin.PngImageFile(file).close()
     except SyntaxError as exc:  # "broken PNG file (bad header checksum in b'tEXt')", "broken PNG file (chunk b'..')"
         found = re.search(r"checksum in b'([^']{1,8})'", str(exc))
         if found:

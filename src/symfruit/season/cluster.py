@@ -203,7 +203,7 @@ class Outcome:
     stop: str = ""
     frame: dict[str, Any] | None = None
     fruits: list[dict[str, Any]] = field(default_factory=list)
-    #: symfruit's warnings the frame gave on its worker, given again by the client (:func:`_held_warnings`)
+    #: symfruit's warnings the frame gave on its worker, given again by the client (:func:`_hold_warnings`)
     warned: tuple[str, ...] = ()
 
 
@@ -567,8 +567,8 @@ def run_distributed(
                 try:
                     named = {v: k for k, v in report.recordings.items()}
                     # the workers' warnings given here, each once (robust55), as run_batch gives a recording's
-                    warned = str(recordings[0].source) if len(recordings) == 1 else f"{len(recordings)} recordings"
-                    with TableWriter(output, root=out, inputs=named) as table, once_per_recording(warned) as current:
+                    said = str(recordings[0].source) if len(recordings) == 1 else f"{len(recordings)} recordings"
+                    with TableWriter(output, root=out, inputs=named) as table, once_per_recording(said) as current:
                         _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out,
                              no_worker_timeout, silent_s, current)  # fmt: skip
                 except OutputError as exc:
