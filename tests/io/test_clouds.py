@@ -270,8 +270,10 @@ REFUSED = {
                      b"end_header\n" + bytes(6_000_000), "PLY holds 6,000,000 vertices; at most 5,000,000 are read"),
     "ply-no-z": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                  b"end_header\n1 2\n", "PLY vertices lack the z property (they have x, y)"),
-    "ply-corrupt": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
-                    "corrupt PLY"),
+    "ply-corrupt": ("a.ply", b"ply\nformat ascii 2.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n",
+                    "corrupt PLY (line 2: expected version '1.0')"),
+    "ply-type": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
+                 "PLY property 'x' of element 'vertex' is of type 'nonsense', which is no PLY type"),  # robust55
     "ply-more-rows": ("a.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n"
                       + np.ones((3, 3), "<f4").tobytes(), "24 bytes of data after the header's 1 vertices"),
     "ply-more-lines": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n4 5 6\n",
