@@ -1,6 +1,7 @@
 """Frames from ROS bags (optional extra ``bag``): a tiny ROS 2 bag end to end, image messages decoded
 by encoding, and broken bags named."""
 
+import contextlib
 import re
 from types import SimpleNamespace
 
@@ -1025,3 +1026,100 @@ def test_a_bag_changed_after_it_was_opened_fails_its_frames_naming_the_file(tmp_
                                rf"\(its size went from {size:,} to {size + 7:,} bytes\); it is being written or "
                                "replaced: read it again once it is whole$"):  # fmt: skip
                 src.read(k)
+
+
+def _sqlite_bag(tmp_path, name: str, *sql: str):
+    """A ROS 2 sqlite3 bag of three frames, ``sql`` run on its database."""
+    import sqlite3
+
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / name, color, (depth * 1000).astype(np.uint16), frames=3)
+    with contextlib.closing(sqlite3.connect(path / f"{name}.db3")) as db:
+        for statement in sql:
+            db.execute(statement)
+        db.commit()
+    return path
+
+
+def test_a_ros2_sqlite_bag_cut_short_is_named_damaged_in_our_words_not_apsws(tmp_path):
+    pytest.importorskip("rosbags")
+    path = _sqlite_bag(tmp_path, "cut")
+    db = path / "cut.db3"
+    db.write_bytes(db.read_bytes()[: db.stat().st_size * 99 // 100])  # its index opens; its last page is gone
+    with pytest.raises(
+        FileFormatError, match=r"cut: cannot (open|index) bag \(.*database disk image is malformed"
+    ) as e:
+        open_source(path)  # before: "cannot index bag (CorruptError: database disk image is malformed)"
+    assert "CorruptError" not in str(e.value)
+
+
+@pytest.mark.parametrize(
+    ("sql", "said"),
+    [
+        ("update messages set timestamp = 'x'", r"cannot open bag \(a record holds a value of the wrong type \(text "
+         r"where a number or bytes belong\): the bag is damaged\)"),
+        ("update messages set data = 'hello'", r"the message on /camera/color/camera_info at 1000000000 holds str, "
+         "not bytes: the bag's database is damaged"),
+    ],
+    ids=["timestamp-text", "message-text"],
+)  # fmt: skip
+def test_a_ros2_sqlite_bag_whose_rows_hold_text_is_named_damaged_not_in_pythons_words(tmp_path, sql, said):
+    # before: "cannot open bag (unsupported operand type(s) for -: 'int' and 'str')", "cannot index bag (TypeError:
+    # string argument without an encoding)" (stop 55, robust55)
+    pytest.importorskip("rosbags")
+    path = _sqlite_bag(tmp_path, "rows", sql)
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(path))}: {said}"):
+        open_source(path)
+
+
+def _ros1_bag(path, compression=None):
+    """A ROS 1 bag of three frames (colour rgb8, depth 16UC1 1 us after, camera info), in chunks of 100 kB."""
+    from rosbags.rosbag1 import Writer
+    from rosbags.typesys import Stores, get_typestore
+
+    ts = get_typestore(Stores.ROS1_NOETIC)
+    Image, Info = ts.types["sensor_msgs/msg/Image"], ts.types["sensor_msgs/msg/CameraInfo"]
+    Header, Time = ts.types["std_msgs/msg/Header"], ts.types["builtin_interfaces/msg/Time"]
+    RoI = ts.types["sensor_msgs/msg/RegionOfInterest"]
+    color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+    writer = Writer(path)
+    if compression is not None:
+        writer.set_compression(Writer.CompressionFormat[compression])
+    writer.chunk_threshold = 100_000
+    with writer:
+        c_col = writer.add_connection("/camera/color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_dep = writer.add_connection("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image", typestore=ts)
+        c_inf = writer.add_connection("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo", typestore=ts)
+        for i in range(3):
+            head = Header(seq=i, stamp=Time(sec=i + 1, nanosec=0), frame_id="cam")
+            info = Info(header=head, height=120, width=160, distortion_model="plumb_bob", D=np.zeros(5),
+                        K=np.array([600.0, 0, 80, 0, 600, 60, 0, 0, 1]), R=np.eye(3).ravel(), P=np.zeros(12),
+                        binning_x=0, binning_y=0, roi=RoI(x_offset=0, y_offset=0, height=0, width=0,
+                                                          do_rectify=False))  # fmt: skip
+            t = 1_000_000_000 * (i + 1)
+            writer.write(c_inf, t, ts.serialize_ros1(info, "sensor_msgs/msg/CameraInfo"))
+            for conn, pixels, enc in ((c_col, color, "rgb8"), (c_dep, (depth * 1000).astype(np.uint16), "16UC1")):
+                img = Image(header=head, height=120, width=160, encoding=enc, is_bigendian=0, step=pixels.nbytes // 120,
+                            data=pixels.view(np.uint8).ravel())  # fmt: skip
+                writer.write(conn, t + (1000 if enc == "16UC1" else 0), ts.serialize_ros1(img, "sensor_msgs/msg/Image"))
+    return path
+
+
+def test_a_ros1_bag_whose_index_is_cut_short_or_broken_is_named_damaged_in_our_words(tmp_path):
+    # rosbags' words were "Bag index looks damaged: ('Header could not be read from file.',)" (a tuple's repr) and,
+    # for an index record of another size, a bare "AssertionError" (stop 55, robust55)
+    pytest.importorskip("rosbags")
+    whole = _ros1_bag(tmp_path / "whole.bag").read_bytes()
+    assert len(open_source(tmp_path / "whole.bag")) == 3
+    cut = tmp_path / "cut.bag"
+    cut.write_bytes(whole[: len(whole) * 999 // 1000])  # the end of its index gone
+    with pytest.raises(FileFormatError, match=r"cut\.bag: cannot open bag \(its index, at the end of the file, is cut "
+                       r"short or damaged \(`rosbag reindex` rebuilds it\)\)$"):  # fmt: skip
+        open_source(cut)
+    data = bytearray(_ros1_bag(tmp_path / "lz4.bag", "LZ4").read_bytes())
+    at = len(data) * 6 // 10
+    data[at : at + 64] = bytes(64)  # an index record's header zeroed
+    (tmp_path / "broken.bag").write_bytes(bytes(data))
+    with pytest.raises(FileFormatError, match=r"broken\.bag: cannot open bag \(a record of the bag is not of the size "
+                       r"its kind has: the bag is damaged\)$"):  # fmt: skip
+        open_source(tmp_path / "broken.bag")

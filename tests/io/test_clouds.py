@@ -270,8 +270,10 @@ REFUSED = {
                      b"end_header\n" + bytes(6_000_000), "PLY holds 6,000,000 vertices; at most 5,000,000 are read"),
     "ply-no-z": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\n"
                  b"end_header\n1 2\n", "PLY vertices lack the z property (they have x, y)"),
-    "ply-corrupt": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
-                    "corrupt PLY"),
+    "ply-corrupt": ("a.ply", b"ply\nformat ascii 2.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n",
+                    "corrupt PLY (line 2: expected version '1.0')"),
+    "ply-type": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\nproperty nonsense x\nend_header\n1 2 3\n",
+                 "PLY property 'x' of element 'vertex' is of type 'nonsense', which is no PLY type"),  # robust55
     "ply-more-rows": ("a.ply", b"ply\nformat binary_little_endian 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n"
                       + np.ones((3, 3), "<f4").tobytes(), "24 bytes of data after the header's 1 vertices"),
     "ply-more-lines": ("a.ply", b"ply\nformat ascii 1.0\nelement vertex 1\n" + PLY_XYZ + b"end_header\n1 2 3\n4 5 6\n",
@@ -525,4 +527,39 @@ def test_a_cloud_grown_while_it_is_read_is_refused_naming_it(tmp_path, monkeypat
     monkeypatch.setitem(clouds.CLOUD_READERS, suffix, read_then_grow)
     with pytest.raises(FileFormatError, match=rf"c\{suffix}: changed while it was read \(its size went from "
                        rf"{size:,} to {size + 1:,} bytes\); it is being written or replaced"):  # fmt: skip
+        read_cloud(path)
+
+
+def test_a_binary_ply_of_plyfiles_short_type_names_is_read_whole_not_called_cut_short(tmp_path):
+    # plyfile reads 'u1', 'f4', ... as PLY's own type names; the size check counted them 4 bytes each, and a
+    # whole file of float x, y, z and u1 colours (15 bytes a vertex) looked cut short (stop 55, robust55)
+    rows = np.zeros(len(POINTS), dtype=[("x", "<f4"), ("y", "<f4"), ("z", "<f4"), ("r", "u1"), ("g", "i1"),
+                                        ("b", "u1")])  # fmt: skip
+    rows["x"], rows["y"], rows["z"] = POINTS.T
+    header = ("ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty f4 x\nproperty f4 y\n"
+              "property f4 z\nproperty u1 red\nproperty i1 green\nproperty b1 blue\nend_header\n")  # fmt: skip
+    path = tmp_path / "c.ply"
+    path.write_bytes(header.format(len(POINTS)).encode() + rows.tobytes())
+    assert np.allclose(read_cloud(path), POINTS, atol=1e-6)
+    path.write_bytes(header.format(len(POINTS)).encode() + rows.tobytes()[:-1])  # one byte short: still refused
+    with pytest.raises(FileFormatError, match="truncated or corrupt"):
+        read_cloud(path)
+
+
+@pytest.mark.parametrize("line", ["property int64 x", "property list uchar int64 q", "property listy q"])
+def test_a_ply_property_of_a_type_ply_lacks_is_named_in_one_short_line(tmp_path, line):
+    # plyfile's refusal listed its 25 type names: a line of 300 characters (stop 55, robust55)
+    path = tmp_path / "c.ply"
+    path.write_text(f"ply\nformat ascii 1.0\nelement vertex 1\n{line}\nproperty float y\nproperty float z\n"
+                    "end_header\n1 2 3\n")  # fmt: skip
+    with pytest.raises(FileFormatError, match=r"of element 'vertex' is of type '(int64|listy)', which is no PLY") as e:
+        read_cloud(path)
+    assert "'i1'" not in str(e.value) and len(str(e.value)) < 200 + len(str(path))
+
+
+def test_a_ply_whose_coordinates_are_lists_is_refused_in_our_words(tmp_path):
+    path = tmp_path / "c.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 2\nproperty list uchar float x\nproperty float y\n"
+                    "property float z\nend_header\n1 1 2 3\n2 4 4 5 6\n")  # fmt: skip
+    with pytest.raises(FileFormatError, match=r"c\.ply: PLY vertex property x is a list; x, y and z are one number"):
         read_cloud(path)

@@ -3,6 +3,7 @@ checked from the header before any pixel is decoded."""
 
 import io
 import os
+import re
 import struct
 import zlib
 
@@ -453,3 +454,40 @@ def test_an_image_grown_while_it_is_decoded_is_refused_naming_it(tmp_path, monke
         with pytest.raises(FileFormatError, match=rf"c\.png: changed while it was read \(its size went from {size:,} "):
             read(path)
         size += 2
+
+
+def _with_chunk(path, chunk: bytes, *, after_pixels: bool = False) -> None:
+    """A small valid RGB PNG at ``path`` with ``chunk`` put in after its header (or before its end)."""
+    buffer = io.BytesIO()
+    Image.fromarray(np.full((4, 5, 3), 90, np.uint8)).save(buffer, format="PNG")
+    data = buffer.getvalue()
+    at = len(data) - 12 if after_pixels else 8 + 25  # IEND's 12 bytes; the signature and IHDR's 25
+    path.write_bytes(data[:at] + chunk + data[at:])
+
+
+_HUGE_TEXT = zlib.compress(b"\0" * 5_000_000)
+
+
+@pytest.mark.parametrize(
+    ("chunk", "after", "said"),
+    [
+        (_chunk(b"iCCP", b"p\0\0" + _HUGE_TEXT), False, "a PNG text or colour-profile chunk decompresses to over 1 MB"),
+        (_chunk(b"zTXt", b"k\0\0" + _HUGE_TEXT), True, "a PNG text or colour-profile chunk decompresses to over 1 MB"),
+        (b"".join(_chunk(b"zTXt", b"k%d\0\0" % i + zlib.compress(b"a" * 900_000)) for i in range(80)), False,
+         "its PNG text chunks hold over 64 MB"),
+        (struct.pack(">I", 0x7FFFFFFF) + b"tEXtk\0abc", False, "the file ends before the data it announces"),
+        (_chunk(b"tEXt", b"k\0abc")[:-4] + b"\0\0\0\0", False,
+         "its PNG header states 5x4 pixels, but a chunk after it is damaged: the checksum of its tEXt chunk is wrong"),
+    ],
+    ids=["icc-profile", "text-after-pixels", "text-in-all", "chunk-past-the-end", "checksum"],
+)  # fmt: skip
+def test_a_png_whose_metadata_pillow_refuses_is_said_in_our_words_not_pillows(tmp_path, chunk, after, said):
+    # Pillow's words were "Decompressed data too large for PngImagePlugin.MAX_TEXT_CHUNK", "Too much memory used
+    # in text chunks: 67500000>MAX_TEXT_MEMORY", "Truncated File Read"; a wrong checksum was "its PNG header states a
+    # size of 5x4 pixels: no image, or a damaged header" (stop 55, robust55)
+    path = tmp_path / "c.png"
+    _with_chunk(path, chunk, after_pixels=after)
+    for read in (read_color, read_depth_units):
+        with pytest.raises(FileFormatError, match=re.escape(said)) as e:
+            read(path)
+        assert str(e.value).startswith(f"{path}: cannot ") and "MAX_" not in str(e.value)

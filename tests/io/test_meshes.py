@@ -193,3 +193,22 @@ def test_a_mesh_this_user_may_not_read_is_refused_by_name(unreadable_place):
     for path in (obj, ply):
         said = refusal_unprivileged("from symfruit.io.meshes import read_mesh; read_mesh(P0)", path)
         assert said == f"refused: {path}: cannot read {'OBJ ' if path.suffix == '.obj' else ''}mesh (Permission denied)"
+
+
+def test_an_obj_that_is_no_utf8_text_is_said_in_our_words_not_the_codecs(tmp_path):
+    # the codec's words were "'utf-8' codec can't decode byte 0xfc in position 10: invalid start byte"
+    (tmp_path / "latin.obj").write_bytes(b"v 0 0 0 # \xfc\n")
+    with pytest.raises(FileFormatError, match=r"latin\.obj: cannot read OBJ \(not UTF-8 text: invalid start byte at "
+                                              r"byte 10\)$") as e:  # fmt: skip
+        read_mesh(tmp_path / "latin.obj")
+    assert "codec" not in str(e.value)
+
+
+def test_a_ply_mesh_face_of_a_type_ply_lacks_is_named_in_one_short_line(tmp_path):
+    path = tmp_path / "m.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+                    "element face 1\nproperty list uchar int64 vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n"
+                    "3 0 1 2\n")  # fmt: skip
+    with pytest.raises(FileFormatError, match="property 'vertex_indices' of element 'face' is of type 'int64', which "
+                                              r"is no PLY type \(char, uchar"):  # fmt: skip
+        read_mesh(path)

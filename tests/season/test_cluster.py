@@ -653,3 +653,74 @@ def test_a_worker_process_runs_numpys_blas_on_one_thread_from_its_first_task(tmp
         assert _first_task(job, part) == [2]  # the client's own process: its BLAS left be
         with ProcessPoolExecutor(max_workers=1, mp_context=fork) as pool:  # a job that names no client: left be
             assert pool.submit(_first_task, dataclasses.replace(job, client=0), part).result(timeout=600) == [2]
+
+
+def _warning_frames(recording, rec: Path, count: int) -> Path:
+    """``count`` copies of the small frame whose camera.json puts the principal point outside the image (cx -81: the
+    small frame's own -80 is filtered out of every test, conftest): each gives a warning when read."""
+    for k in range(count):
+        shutil.copytree(recording / f"scene_{k:05d}", rec / f"scene_{k:05d}")
+        cam = json.loads((rec / f"scene_{k:05d}" / "camera.json").read_text())
+        (rec / f"scene_{k:05d}" / "camera.json").write_text(json.dumps({**cam, "cx": -81.0}))
+    return rec
+
+
+def test_a_frames_warnings_on_a_worker_are_held_for_the_client_not_shown_there(recording, tmp_path):
+    """The worker's side in this process: a frame's SymfruitWarning goes into its Outcome, not to the worker's
+    stderr in Python's form (its file, line and a line of symfruit's source; robust55)."""
+    import warnings
+
+    from symfruit import SymfruitWarning
+    from symfruit.season.cluster import Job, Part, detect_part
+
+    rec = _warning_frames(recording, tmp_path / "rec", 1)
+    out = tmp_path / "out"
+    out.mkdir()
+    job = Job(run="r", source=str(rec), shown="rec", output=str(out), recording="rec", inputs=(),
+              input_folders=(str(rec),), exclude=(), method="raw")  # fmt: skip
+    part = Part((0,), ("scene_00000",), (str(out / "scene_00000"),), (str(rec / "scene_00000"),))
+    with warnings.catch_warnings(record=True) as shown:
+        warnings.simplefilter("always")
+        (done,) = detect_part(job, part)
+        warnings.warn("given outside a frame", SymfruitWarning, stacklevel=1)  # shown as before
+    assert done.status == "done" and len(done.warned) == 1
+    assert done.warned[0].startswith(f"{rec}/scene_00000/camera.json: the principal point (cx -81")
+    assert [str(w.message) for w in shown if issubclass(w.category, SymfruitWarning)] == ["given outside a frame"]
+
+
+def test_the_workers_warnings_are_given_by_the_client_once_a_recording(cluster, recording, tmp_path, capsys):
+    """As a serial run gives them. Before (robust55): each worker process printed each frame's warning itself in
+    Python's form (``.../io/frames.py:156: SymfruitWarning: ...`` and the source line), the client none."""
+    rec = _warning_frames(recording, tmp_path / "rec", 3)
+    out = tmp_path / "out"
+    assert main(["detect", str(rec), "--output", str(out), "--method", "raw", "--scheduler",
+                 cluster.scheduler_address, "--chunk", "1"]) == 0  # fmt: skip
+    err = capsys.readouterr().err
+    assert err.count("principal point") == 1 and "SymfruitWarning" not in err
+    assert f"symfruit: warning: {rec}/scene_00000/camera.json: the principal point (cx -81" in err
+    assert f"symfruit: warning: {rec}: 2 more frames gave a warning above (each is shown for its first frame" in err
+
+
+@pytest.mark.parametrize(
+    "address",
+    ["tcp://[::1", "tcp://[::1:8786", "tcp://::1]:8786", f"tcp://{'a' * 64}:8786", f"tcp://{'ab.' * 90}c:8786",
+     "tcp://a..b:8786", "tcp://[]:8786"],
+)  # fmt: skip
+def test_a_scheduler_address_whose_host_can_be_no_name_nor_address_is_refused_in_our_words(address):
+    """Before (robust55): distributed's "invalid address '[::1'; maybe: ipv6 needs brackets like [::1]" of an address
+    with its bracket, Python's "encoding with 'idna' codec failed (UnicodeError: label too long)" of a part of a name
+    over 63 characters, each after ``cannot reach the Dask scheduler``; now refused before any connection."""
+    from symfruit.season.cluster import check_address
+
+    with pytest.raises(InputError, match=r"not a scheduler address; its host .* is no host name \(at most 253 "):
+        check_address(address)
+
+
+@pytest.mark.parametrize(
+    "address",
+    ["tcp://[::1]:8786", "tcp://scheduler.example.org.:8786", f"tcp://{'a' * 63}.b:8786", "host:8786", "tcp://:8786"],
+)
+def test_a_scheduler_address_of_a_host_name_or_an_ipv6_address_in_brackets_passes_the_check(address):
+    from symfruit.season.cluster import check_address
+
+    check_address(address)

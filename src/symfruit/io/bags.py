@@ -25,6 +25,7 @@ import math
 import os
 import re
 import struct
+import traceback
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
@@ -530,7 +531,23 @@ def damage_reason(exc: BaseException) -> str | None:
         return "the file ends inside a record: the bag is cut short or damaged"
     if isinstance(exc, UnicodeDecodeError):  # rosbags decodes a ROS 1 bag's header fields as UTF-8
         return "bytes that are no text where a bag holds text: not a bag, or a damaged one"
+    if type(exc).__module__ == "apsw":  # a ROS 2 bag's SQLite database, read through apsw: "CorruptError: database
+        # disk image is malformed" (a database cut short past its first pages), NotADBError, ... (stop 55, robust55)
+        said = text.splitlines()[0][:REASON_CHARS] if text.strip() else type(exc).__name__
+        return f"its SQLite database is damaged or cut short ({said})"
+    if isinstance(exc, AssertionError) and _raised_in_rosbags(exc):  # a bare assert of rosbags' (an index record
+        # of another size than its kind has), said as "cannot open bag (AssertionError)" (robust55)
+        return "a record of the bag is not of the size its kind has: the bag is damaged"
+    if isinstance(exc, TypeError) and _raised_in_rosbags(exc):  # a value of another SQL type than the schema's (a
+        # timestamp or message that is text): "unsupported operand type(s) for -: 'int' and 'str'" (robust55)
+        return "a record holds a value of the wrong type (text where a number or bytes belong): the bag is damaged"
     return None
+
+
+def _raised_in_rosbags(exc: BaseException) -> bool:
+    """Whether ``exc`` was raised inside rosbags (its innermost frame), not by a bug of ours calling it."""
+    frames = traceback.extract_tb(exc.__traceback__)
+    return bool(frames) and f"{os.sep}rosbags{os.sep}" in frames[-1].filename
 
 
 def index_reason(exc: BaseException) -> str:
@@ -551,6 +568,9 @@ def reader_reason(exc: BaseException) -> str:
     text = str(exc).strip() or type(exc).__name__
     if text.startswith("Could not parse"):
         return "a message definition in the bag cannot be parsed (damaged connection record)"
+    if text.startswith("Bag index looks damaged"):  # rosbags' ROS 1 reader: "Bag index looks damaged: ('Header
+        # could not be read from file.',)", a tuple's repr, for an index cut short or broken (robust55)
+        return "its index, at the end of the file, is cut short or damaged (`rosbag reindex` rebuilds it)"
     if text.startswith("File end magic is invalid"):  # rosbags' MCAP reader on a file cut short
         return "the MCAP file ends before its footer: a recording cut short (`mcap recover` rebuilds one) or damaged"
     newer = re.match(r"Rosbag2 version (\S+) not supported", text)
@@ -1066,6 +1086,9 @@ class BagSource:
         distorted: tuple[str, list[float]] | None = None  # the first non-zero distortion: warned about once
         model: Any = None  # its lens model (a fisheye one is warned about with coefficients 0)
         for conn, stamp, raw in self._reader.messages(connections=[self._info, self._depth, self._color]):
+            if not isinstance(raw, bytes | bytearray | memoryview):  # a SQLite row whose data is text (robust55)
+                raise FileFormatError(f"the message on {conn.topic} at {stamp} holds {type(raw).__name__}, not bytes: "
+                                      "the bag's database is damaged")  # fmt: skip
             if conn == self._depth:
                 self._depth_stamps.append(stamp)
             elif conn == self._color:

@@ -17,7 +17,7 @@ from typing import Any
 
 import numpy as np
 
-from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES
+from ..core.limits import MAX_CLOUD_POINTS, MAX_TEXT_CLOUD_BYTES, shown
 from ..errors import FileFormatError, InputError
 from .atomic import atomic_write
 from .text import as_path, refuse_pipe, unchanged_while
@@ -92,9 +92,13 @@ def _header(path: Path, kind: str, magic: bytes, end: re.Pattern[bytes]) -> tupl
     return head[: match.end()], match.end(), size
 
 
-_PLY_TYPES = {
-    "char": 1, "int8": 1, "uchar": 1, "uint8": 1, "short": 2, "int16": 2, "ushort": 2, "uint16": 2,
-    "int": 4, "int32": 4, "uint": 4, "uint32": 4, "float": 4, "float32": 4, "double": 8, "float64": 8,
+#: numpy codes of the PLY scalar types, by every name plyfile takes: PLY's own, the sized ones and numpy's codes
+#: (``u1``, ``f4``, ... which plyfile writes and reads too: counted 4 bytes each they made a whole file look cut short)
+_PLY_CODES = {
+    "char": "i1", "int8": "i1", "i1": "i1", "uchar": "u1", "uint8": "u1", "u1": "u1", "b1": "u1",
+    "short": "i2", "int16": "i2", "i2": "i2", "ushort": "u2", "uint16": "u2", "u2": "u2",
+    "int": "i4", "int32": "i4", "i4": "i4", "uint": "u4", "uint32": "u4", "u4": "u4",
+    "float": "f4", "float32": "f4", "f4": "f4", "double": "f8", "float64": "f8", "f8": "f8",
 }  # fmt: skip
 
 
@@ -117,11 +121,17 @@ def ply_elements(path: Path) -> tuple[str, list[tuple[str, int]]]:
         if len(head) < 2 or not head[1].isdigit():
             raise FileFormatError(f"{path}: PLY element line is not 'element NAME COUNT'")
         name, count = head[0], int(head[1])
-        props = re.findall(r"^property\s+(list\s+\S+\s+\S+|\S+)\s+\S+", block, re.M)
+        props = re.findall(r"^property\s+(list\s+\S+\s+\S+|\S+)\s+(\S+)", block, re.M)
+        types = [kind.split()[1:] if kind.split()[0] == "list" else [kind] for kind, _ in props]
+        for (_, prop), kinds in zip(props, types, strict=True):  # plyfile's refusal listed its 25 type names
+            if unknown := next((t for t in kinds if t not in _PLY_CODES), None):
+                raise FileFormatError(f"{path}: PLY property {shown(prop)} of element {shown(name)} is of type "
+                                      f"{shown(unknown)}, which is no PLY type (char, uchar, short, ushort, int, "
+                                      "uint, float, double; int8 ... float64)")  # fmt: skip
         if fmt.group(1) == "ascii":
             row = 2 * max(len(props), 1)
-        else:
-            row = sum(_PLY_TYPES.get(p.split()[1] if p.startswith("list") else p, 4) for p in props) or 1
+        else:  # a scalar's size, a list's count field's
+            row = sum(int(_PLY_CODES[kinds[0]][1]) for kinds in types if kinds) or 1
         least += count * row
         elements.append((name, count))
     if least > size - start:
@@ -151,7 +161,7 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
     """``(PlyData, vertices (n, 3) float64)`` of a PLY file whose element counts were checked against its size
     (:func:`ply_elements`); a vertex element without ``x``, ``y`` and ``z`` is refused naming what it lacks and what
     it has."""
-    from plyfile import PlyData, PlyParseError
+    from plyfile import PlyData, PlyListProperty, PlyParseError
 
     _check_ply_byte_order(path)
     try:
@@ -171,6 +181,10 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
             f"{path}: PLY vertices lack the {', '.join(missing)} propert"
             f"{'y' if len(missing) == 1 else 'ies'} (they have {', '.join(names) or 'none'})"
         )
+    if lists := [p.name for p in element.properties if p.name in ("x", "y", "z") and isinstance(p, PlyListProperty)]:
+        one = len(lists) == 1  # numpy's words were "setting an array element with a sequence."
+        raise FileFormatError(f"{path}: PLY vertex {'property' if one else 'properties'} {', '.join(lists)} "
+                              f"{'is a list' if one else 'are lists'}; x, y and z are one number a vertex")  # fmt: skip
     try:
         with np.errstate(invalid="ignore", over="ignore"):  # a signalling NaN cast: a missing point, no warning
             return data, np.column_stack([np.asarray(element[c], dtype=np.float64) for c in ("x", "y", "z")])
@@ -180,12 +194,6 @@ def ply_vertices(path: Path) -> tuple[Any, np.ndarray]:
         raise FileFormatError(f"{path}: unreadable PLY vertices ({exc})") from None
 
 
-#: numpy codes of the PLY scalar types.
-_PLY_CODES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2", "int16": "i2", "ushort": "u2",
-    "uint16": "u2", "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4",
-    "double": "f8", "float64": "f8",
-}  # fmt: skip
 #: Vertices a binary PLY's byte order is judged on (the first rows).
 _BYTE_ORDER_ROWS = 1000
 

@@ -98,7 +98,7 @@ def _open(source: Path | bytes, label: str) -> Any:
     except UnidentifiedImageError:
         raise FileFormatError(f"{label}: cannot read image ({_unidentified(source)})") from None
     except (OSError, SyntaxError, ValueError) as exc:  # an OSError's reason alone, not "[Errno 13] ...: 'PATH'"
-        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else exc
+        why = exc.strerror if isinstance(exc, OSError) and exc.strerror else _in_our_words(exc)
         raise FileFormatError(f"{label}: cannot read image ({why})") from None
     try:
         check_image_size(
@@ -108,6 +108,24 @@ def _open(source: Path | bytes, label: str) -> Any:
         img.close()
         raise
     return img
+
+
+def _in_our_words(exc: BaseException) -> str:
+    """Pillow's reason, where it names its own internals, said as what is wrong with the file (stop 55, robust55:
+    ``Decompressed data too large for PngImagePlugin.MAX_TEXT_CHUNK``, ``Too much memory used in text chunks:
+    67500000>MAX_TEXT_MEMORY``, ``Truncated File Read``); any other reason as Pillow gives it."""
+    from PIL import PngImagePlugin
+
+    text = str(exc)
+    if "MAX_TEXT_CHUNK" in text:
+        return (f"a PNG text or colour-profile chunk decompresses to over {PngImagePlugin.MAX_TEXT_CHUNK >> 20} MB, "
+                "more than is read: save the image without that metadata")  # fmt: skip
+    if "MAX_TEXT_MEMORY" in text:
+        return (f"its PNG text chunks hold over {PngImagePlugin.MAX_TEXT_MEMORY >> 20} MB, more than is read: save "
+                "the image without that metadata")  # fmt: skip
+    if text == "Truncated File Read":
+        return "the file ends before the data it announces: it is cut short or damaged"
+    return text
 
 
 def _unidentified(source: Path | bytes) -> str:
@@ -120,8 +138,30 @@ def _unidentified(source: Path | bytes) -> str:
             head = f.read(24)
     if head[:8] == b"\x89PNG\r\n\x1a\n" and head[12:16] == b"IHDR":
         width, height = int.from_bytes(head[16:20], "big"), int.from_bytes(head[20:24], "big")
+        if width and height:  # a size Pillow takes: what it did not was further on (a chunk's checksum or type)
+            return (
+                f"its PNG header states {width}x{height} pixels, but a chunk after it is damaged: {_png_damage(source)}"
+            )
         return f"its PNG header states a size of {width}x{height} pixels: no image, or a damaged header"
     return "not of an image format Pillow reads, PNG, JPEG, TIFF, ...; or its header is damaged"
+
+
+def _png_damage(source: Path | bytes) -> str:
+    """Why Pillow's PNG reader refused a PNG whose header states a size (Image.open says only that no reader knew
+    it): a chunk's checksum or type, in our words."""
+    from PIL import PngImagePlugin
+
+    try:
+        with io.BytesIO(source) if isinstance(source, bytes) else open(source, "rb") as file:
+            PngImagePlugin.PngImageFile(file).close()
+    except SyntaxError as exc:  # "broken PNG file (bad header checksum in b'tEXt')", "broken PNG file (chunk b'..')"
+        found = re.search(r"checksum in b'([^']{1,8})'", str(exc))
+        if found:
+            return f"the checksum of its {found.group(1)} chunk is wrong"
+        return "a chunk's type or length is no PNG's"
+    except Exception:  # anything else: said in general below
+        pass
+    return "its chunks cannot be read"
 
 
 def _single(img: Any, label: str, what: str) -> None:
@@ -147,7 +187,7 @@ def _decode(img: Any, label: str) -> tuple[Any, int]:
             marked = _png_mark(img)
             img.load()
     except (OSError, SyntaxError, ValueError, Image.DecompressionBombWarning, Image.DecompressionBombError) as exc:
-        raise FileFormatError(f"{label}: cannot decode image ({exc})") from None
+        raise FileFormatError(f"{label}: cannot decode image ({_in_our_words(exc)})") from None
     if getattr(img, "format", None) == "PNG":
         _png_whole(img, label, marked)
     orientation = _orientation(img)

@@ -55,8 +55,8 @@ def _read_obj(path: Path) -> tuple[np.ndarray, np.ndarray | None]:
     vertices, polygons = [], []
     try:
         text = read_limited(path, what="OBJ mesh", max_bytes=MAX_OBJ_BYTES).decode("utf-8-sig")
-    except UnicodeDecodeError as exc:
-        raise FileFormatError(f"{path}: cannot read OBJ ({exc})") from None
+    except UnicodeDecodeError as exc:  # the codec's words were "'utf-8' codec can't decode byte 0xe9 in position 2"
+        raise FileFormatError(f"{path}: cannot read OBJ (not UTF-8 text: {exc.reason} at byte {exc.start})") from None
     triangles = 0  # the faces the polygons make as fans: bounded as a PLY's faces are, while they are read
     for number, line in enumerate(text.splitlines(), 1):
         parts = line.split()

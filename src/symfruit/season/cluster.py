@@ -52,6 +52,7 @@ from ..batch import (
     frame_done,
     frame_folder_name,
     list_recordings,
+    once_per_recording,
     plan_recordings,
 )
 from ..core.limits import shown
@@ -202,6 +203,8 @@ class Outcome:
     stop: str = ""
     frame: dict[str, Any] | None = None
     fruits: list[dict[str, Any]] = field(default_factory=list)
+    #: symfruit's warnings the frame gave on its worker, given again by the client (:func:`_hold_warnings`)
+    warned: tuple[str, ...] = ()
 
 
 # --- the worker's side ---------------------------------------------------------------------------------------
@@ -275,10 +278,41 @@ def _one_blas_thread(job: Job) -> None:
     one_blas_thread()
 
 
+#: The warnings a worker thread's frame gives, held for its :class:`Outcome` while the frame runs (None: not held).
+_HELD = threading.local()
+
+
+def _hold_warnings() -> None:
+    """Once a process (again where something put its own in place since): symfruit's warnings given while a frame
+    runs on a worker thread are held for the frame's :class:`Outcome` and given again by the client, as a serial
+    run gives them (``symfruit: warning: ...``, each once a recording: :func:`symfruit.batch.once_per_recording`). A
+    worker process printed them itself in Python's form, its file, line and a line of symfruit's source, one a
+    frame (robust55). Other warnings, and any given outside a frame, are shown as before."""
+    import warnings
+
+    from ..errors import SymfruitWarning
+
+    show = warnings.showwarning
+    if getattr(show, "_symfruit_held", False):
+        return
+
+    def held(message: Any, category: type[Warning], filename: str, lineno: int, file: Any = None,
+             line: str | None = None) -> None:  # fmt: skip
+        into = getattr(_HELD, "into", None)
+        if into is not None and issubclass(category, SymfruitWarning):
+            into.append(str(message))
+        else:
+            show(message, category, filename, lineno, file, line)
+
+    held._symfruit_held = True  # type: ignore[attr-defined]
+    warnings.showwarning = held
+
+
 def detect_part(job: Job, part: Part) -> list[Outcome]:
     """The task: detect and write every frame of ``part``, each in its own error boundary; returns one
     :class:`Outcome` per frame. Runs on a worker; never raises for a frame."""
     _one_blas_thread(job)
+    _hold_warnings()
     outcomes: list[Outcome] = []
     stop = ""
     with OutputFolder(job.output, inputs=job.inputs, input_folders=job.input_folders, lock=False) as out:
@@ -296,12 +330,18 @@ def detect_part(job: Job, part: Part) -> list[Outcome]:
             def clear(folder: Path = folder) -> None:
                 _clear_frame(folder, out)
 
-            done, rows, stop = _guarded(one_frame, item=name, failed=failed, target=folder, at=f"frame {name}",
-                                        cleanup=clear)  # fmt: skip
+            warned: list[str] = []
+            _HELD.into = warned
+            try:
+                done, rows, stop = _guarded(one_frame, item=name, failed=failed, target=folder, at=f"frame {name}",
+                                            cleanup=clear)  # fmt: skip
+            finally:
+                _HELD.into = None
             if done and rows is not None:
-                outcomes.append(Outcome(index, name, "done", frame=rows[0], fruits=rows[1]))
+                outcomes.append(Outcome(index, name, "done", frame=rows[0], fruits=rows[1], warned=tuple(warned)))
             else:
-                outcomes.append(Outcome(index, name, "failed", reason=failed.get(name, "failed"), stop=stop))
+                outcomes.append(Outcome(index, name, "failed", reason=failed.get(name, "failed"), stop=stop,
+                                        warned=tuple(warned)))  # fmt: skip
     return outcomes
 
 
@@ -371,6 +411,20 @@ def check_address(scheduler: Any) -> None:
     # mistyped port passed as another; ``8786`` alone has no port (distributed: "missing port number")
     if not colon or not (port.isascii() and port.isdigit()) or not 1 <= int(port) <= 65535:
         raise InputError(f"--scheduler {shown(text)}: not a scheduler address; give tcp://HOST:PORT, the port 1-65535")
+    # a host no name or address can be (robust55): distributed said "invalid address '[::1'; maybe: ipv6 needs
+    # brackets like [::1]" of one with a bracket, Python's "encoding with 'idna' codec failed (UnicodeError: label
+    # too long)" of a part over DNS's 63 characters
+    host = rest.rpartition(":")[0]  # "" (tcp://:8786) is this machine's, as the system takes it
+    named = host.removesuffix(".")  # a fully qualified name may end in a dot
+    bracketed = host.startswith("[")
+    if (
+        bracketed != host.endswith("]")
+        or host == "[]"
+        or (host and not bracketed and (len(named) > 253 or any(not 0 < len(p) <= 63 for p in named.split("."))))
+    ):
+        raise InputError(f"--scheduler {shown(text)}: not a scheduler address; its host {shown(host)} is no host "
+                         "name (at most 253 characters, 1-63 between dots) nor address (IPv6 in brackets, "
+                         "[::1])")  # fmt: skip
     if scheme in ("tls", "wss"):
         distributed = require_distributed()
         if distributed.Security().get_connection_args("client").get("ssl_context") is None:
@@ -512,9 +566,11 @@ def run_distributed(
                 frames = _Frames(jobs, bases, keys, raw, owner, target, direct)
                 try:
                     named = {v: k for k, v in report.recordings.items()}
-                    with TableWriter(output, root=out, inputs=named) as table:
+                    # the workers' warnings given here, each once (robust55), as run_batch gives a recording's
+                    said = str(recordings[0].source) if len(recordings) == 1 else f"{len(recordings)} recordings"
+                    with TableWriter(output, root=out, inputs=named) as table, once_per_recording(said) as current:
                         _run(frames, client, todo, done_before, chunk, max_ahead, report, table, bar, out,
-                             no_worker_timeout, silent_s)  # fmt: skip
+                             no_worker_timeout, silent_s, current)  # fmt: skip
                 except OutputError as exc:
                     report.stopped = report.stopped or f"cannot write {output / TABLE_NAME} ({exc})"
             if client is not None:
@@ -563,7 +619,7 @@ def _parts(todo: Sequence[int], chunk: int, owner: Sequence[int] | None = None) 
 def _run(
     frames: _Frames, client: Any, todo: list[int], done_before: set[int], chunk: int, max_ahead: int,
     report: BatchReport, table: TableWriter, bar: Progress, out: OutputFolder,
-    no_worker_timeout: float = NO_WORKER_TIMEOUT, silent_s: float = SILENT_WORKER_S,
+    no_worker_timeout: float = NO_WORKER_TIMEOUT, silent_s: float = SILENT_WORKER_S, current: list[str] | None = None,
 ) -> None:  # fmt: skip
     """Send the parts (at most ``max_ahead`` frames beyond the last one in the tables), collect their outcomes,
     and write the tables in frame order; stop, the frames not done unprocessed, once the cluster has had no worker
@@ -582,7 +638,7 @@ def _run(
                 except SymfruitError as exc:
                     report.failed[keys[i]] = f"{exc} (left out of {TABLE_NAME})"
             elif i in results:
-                _record(results.pop(i), keys[i], report, table)
+                _record(results.pop(i), keys[i], report, table, current)
             elif i >= state["sent"] and state["stopped"]:
                 report.unprocessed.append(keys[i])
             else:
@@ -769,8 +825,19 @@ def _unprocessed(part: Part, reason: str, state: dict[str, Any], report: BatchRe
         report.stopped = reason
 
 
-def _record(o: Outcome, key: str, report: BatchReport, table: TableWriter) -> None:
-    """Put one frame's outcome into the report (as ``key``) and its rows into the tables."""
+def _record(o: Outcome, key: str, report: BatchReport, table: TableWriter, current: list[str] | None = None) -> None:
+    """Put one frame's outcome into the report (as ``key``) and its rows into the tables; the warnings it gave on
+    its worker are given here (``current``: :func:`symfruit.batch.once_per_recording`'s frame name, set to the
+    frame's)."""
+    if o.warned:
+        import warnings
+
+        from ..errors import SymfruitWarning
+
+        if current is not None:
+            current[0] = o.name
+        for text in o.warned:
+            warnings.warn(text, SymfruitWarning, stacklevel=2)
     if o.status == "done" and o.frame is not None:
         table.add(o.frame, o.fruits)
         report.done.append(key)
