@@ -8,13 +8,14 @@ diameter of every sphere is the one its *unperturbed* mask gives (the same metho
 dilated or cut mask is judged against the sphere, not against itself.
 
     PYTHONPATH=src python docs/realpert55.py run OUT [--only NAME,...] [--methods raw,sphere,...] [--config JSON]
-    PYTHONPATH=src python docs/realpert55.py summary OUT [--methods evidence,...]
+    PYTHONPATH=src python docs/realpert55.py summary OUT [--methods evidence,...] [--compact]
 
 ``run`` writes ``OUT/frames/NAME/lab-spheres-{0,1}/`` and ``OUT/NAME.json`` (every box); ``summary`` prints one
 Markdown table: per perturbation and method, the not-a-cube mean / worst, the depth side and larger lateral side
 against the reference diameter (mean abs, signed mean), the frames' worst disagreement and the boxes over the
 issue's 6 mm bar (not a cube or depth side; a failed box counts), and the boxes that failed (no box: too few
-points).
+points). ``--compact``: one row per perturbation, a column per method, the boxes over the bar (and the mean
+not-a-cube).
 """
 
 from __future__ import annotations
@@ -219,6 +220,20 @@ def load(out: Path, name: str) -> list[SphereBox]:
     return [SphereBox(**{**r, "size": tuple(r["size"])}) for r in data["rows"]]
 
 
+def compact(out: Path, methods: tuple[str, ...] | None) -> str:
+    """One row per perturbation, one column per method: the boxes over the 6 mm bar (not a cube or depth side;
+    failed boxes count) of all, and the mean not-a-cube (mm)."""
+    table = summary(out, methods).splitlines()[2:]
+    cells: dict[str, dict[str, str]] = {}
+    for line in table:
+        c = [x.strip() for x in line.strip("|").split("|")]
+        cells.setdefault(c[0], {})[c[1].strip("`")] = f"{c[7]} ({c[2].split(' / ')[0]})"
+    names = list(methods or dict.fromkeys(m for row in cells.values() for m in row))
+    lines = ["| perturbation | " + " | ".join(f"`{m}`" for m in names) + " |", "|---|" + "---|" * len(names)]
+    lines += [f"| {p} | " + " | ".join(row.get(m, "-") for m in names) + " |" for p, row in cells.items()]
+    return "\n".join(lines) + "\n"
+
+
 def summary(out: Path, methods: tuple[str, ...] | None) -> str:
     reference = {(r.frame, r.sphere, r.method): r.diameter for r in load(out, "none")}
     lines = ["| perturbation | method | not a cube (mm), mean / worst | depth - diameter (mm), mean abs (mean) "
@@ -262,6 +277,7 @@ def main(argv: list[str] | None = None) -> None:
     s = sub.add_parser("summary")
     s.add_argument("out", type=Path)
     s.add_argument("--methods", default="")
+    s.add_argument("--compact", action="store_true", help="over 6 mm (mean not a cube) per perturbation and method")
     a = ap.parse_args(argv)
     if a.cmd == "run":
         names = [n for n in a.only.split(",") if n] or list(PERTURBATIONS)
@@ -272,7 +288,8 @@ def main(argv: list[str] | None = None) -> None:
             names = ["none", *names]  # the reference diameters
         run(a.out, names, tuple(a.methods.split(",")), json.loads(a.config) if a.config else None)
     else:
-        sys.stdout.write(summary(a.out, tuple(m for m in a.methods.split(",") if m) or None))
+        show = compact if a.compact else summary
+        sys.stdout.write(show(a.out, tuple(m for m in a.methods.split(",") if m) or None))
 
 
 if __name__ == "__main__":
