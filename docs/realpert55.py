@@ -48,7 +48,7 @@ Perturb = Callable[[Frame], tuple[np.ndarray, np.ndarray, np.ndarray, Camera]]  
 def disk(r: int) -> np.ndarray:
     """A disk of radius ``r`` pixels (a structuring element)."""
     y, x = np.mgrid[-r : r + 1, -r : r + 1]
-    return x * x + y * y <= r * r + r  # the +r rounds a disk of radius 1 to a cross, 2 to a 5x5 without corners
+    return x * x + y * y <= r * r + r  # the +r: radius 1 the 3x3 square, 2 the 5x5 less its corners
 
 
 def binned(frame: Frame, k: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, Camera]:
