@@ -14,6 +14,7 @@ from symfruit.extract import (
     ExtractSettings,
     backdrop,
     cluster,
+    cluster_gap,
     extract,
     own_surface,
     register,
@@ -432,3 +433,38 @@ def test_extraction_hands_its_cleaned_depth_to_the_surface_as_it_is(monkeypatch,
 
     monkeypatch.setattr(extract_module, "fruit_surface", cleaned)
     assert np.array_equal(ex.points, extract(mask, depth, CAM, s).points) and len(ex.points) > 500
+
+
+def far_sphere(focal, centre_z=1.6, radius=0.1, size=100):
+    """A sphere's depth and silhouette through a pinhole of focal length ``focal`` (pixels; principal point at the
+    image's centre): the ray through each pixel's centre meets it at its nearest intersection."""
+    cam = Camera(fx=focal, fy=focal, cx=(size - 1) / 2, cy=(size - 1) / 2, width=size, height=size)
+    v, u = np.mgrid[:size, :size].astype(np.float64)
+    rays = np.stack(((u - cam.cx) / focal, (v - cam.cy) / focal, np.ones_like(u)), axis=-1)
+    rays /= np.linalg.norm(rays, axis=-1, keepdims=True)
+    b = rays[..., 2] * centre_z
+    disc = b * b - (centre_z**2 - radius**2)
+    hit = disc > 0
+    t = np.where(hit, b - np.sqrt(np.where(hit, disc, 0.0)), 0.0)
+    return cam, (t * rays[..., 2]).astype(np.float32), hit
+
+
+def test_a_far_fruit_seen_by_coarse_pixels_is_one_cluster():
+    """Stop 55 (docs/realpert55.md): a 200 mm sphere 1.5 m away through a camera of focal length 306 px (the real Azure
+    Kinect frames binned 3 x 3) samples its surface 5 mm a pixel, 10 mm where it turns away; a fixed 6 mm
+    clustering distance broke it into single pixels (the real sphere kept 6 of 1,033 points and failed). The
+    distance grows to four pixel footprints at the points' depth: the whole sphere is kept, as through a finer
+    camera."""
+    cam, depth, mask = far_sphere(306.0)
+    ex = extract(mask, depth, cam, NO_EROSION)
+    assert len(ex.points) >= 0.9 * mask.sum() and ex.n_other_clusters <= 0.1 * mask.sum()
+    fine_cam, fine_depth, fine_mask = far_sphere(917.0, size=300)
+    assert len(extract(fine_mask, fine_depth, fine_cam, NO_EROSION).points) >= 0.9 * fine_mask.sum()
+
+
+def test_the_clustering_gap_is_the_setting_until_pixels_are_coarser():
+    near = np.array([[0.0, 0.0, 0.5], [0.1, 0.0, 0.6], [0.0, 0.1, 3.0]])  # the median depth 0.6 m
+    assert cluster_gap(near, CAM, 0.006) == 0.006  # at 600 px a pixel 1 mm, four 4 mm: the setting
+    assert cluster_gap(near * [1, 1, 5], CAM, 0.006) == pytest.approx(4 * 3.0 / 600)  # at 3 m four pixels 20 mm
+    odd = Camera(fx=100.0, fy=400.0, cx=50, cy=50, width=100, height=100)  # the geometric mean focal length, 200
+    assert cluster_gap(near, odd, 0.001) == pytest.approx(4 * 0.6 / 200)

@@ -20,11 +20,17 @@ from .core.surface import colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "extract", "own_surface", "register",
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "own_surface", "register",
            "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
+
+#: :func:`cluster_gap`: the least clustering distance in pixel footprints (depth / focal length) at the points'
+#: depth. Two points of one surface a pixel apart lie a footprint apart facing the camera and twice that where it
+#: turns 60 degrees away (about where a time-of-flight camera stops returning depth on a sphere: the outer 13-20 %
+#: of its radius lost); :func:`cluster` keeps points up to half its distance apart together.
+CLUSTER_PITCHES = 4.0
 
 #: :func:`backdrop` reads the depth around a mask on every ``radius / AROUND_STEPS``-th pixel (a near fruit's ring of
 #: 100 000 pixels counted on a few thousand: shares, not pixels, are wanted).
@@ -65,7 +71,9 @@ class ExtractSettings(Section):
         convex front never falls); 0 switches the test off.
     cluster_distance : float, metres
         Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
-        cluster nearest the camera among those with at least ``cluster_share`` of the largest's points.
+        cluster nearest the camera among those with at least ``cluster_share`` of the largest's points. Where
+        the camera's pixels are coarser than this at the points' depth, the distance is :data:`CLUSTER_PITCHES`
+        pixel footprints there instead (:func:`cluster_gap`).
     cluster_share : float
     min_points : int
         A fruit with fewer points left is reported as failed.
@@ -119,6 +127,15 @@ class Extraction:
     truncated: bool
     silhouette: np.ndarray | None = None
     error: str = ""
+
+
+def cluster_gap(points: np.ndarray, camera: Camera, distance: float) -> float:
+    """The distance :func:`cluster` joins ``points`` (n, 3, n > 0) of one fruit within: ``distance``, or
+    :data:`CLUSTER_PITCHES` pixel footprints at the points' median depth where that is more. A fixed distance
+    breaks a far fruit, or one seen by a coarse camera, into single pixels (the Azure Kinect spheres binned
+    3 x 3: a 200 mm sphere at 1.5 m, 5 mm a pixel, kept 6 points of 1,033 with depth; docs/realpert55.md)."""
+    footprint = float(median(np.ascontiguousarray(points[:, 2]))) / float(np.sqrt(camera.fx * camera.fy))
+    return max(float(distance), CLUSTER_PITCHES * footprint)
 
 
 def cluster(points: np.ndarray, distance: float) -> np.ndarray:
@@ -292,7 +309,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
     dropped = int(n_usable - len(points))
     # one cluster (every label 0): every point kept, nothing dropped, no cluster picked (stop 46)
-    if len(points) >= 2 and int((labels := cluster(points, s.cluster_distance)).max()) > 0:
+    if len(points) >= 2 and int((labels := cluster(points, cluster_gap(points, camera, s.cluster_distance))).max()) > 0:
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         # the nearest of the big clusters (one alone needs no medians)

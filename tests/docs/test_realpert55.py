@@ -1,0 +1,122 @@
+"""docs/realpert55.py: the real Azure Kinect sphere frames perturbed as issue 18's held-back frames differ from them
+(stop 55, docs/realpert55.md). Known answers for the perturbations, and on the real frames the conditions the
+default holds under: a lost rim up to 3 px wider and masks shifted 10 px across keep every sphere a cube within the
+issue's 6 mm for balls, its depth side within 6 mm of the unperturbed mask's diameter."""
+
+import importlib.util
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from symfruit.core.camera import Camera
+from symfruit.core.frame import Frame
+from symfruit.detect import detect
+from symfruit.io.frames import read_frame
+
+DOCS = Path(__file__).resolve().parents[2] / "docs"
+
+#: one worker runs the real frames' detections (pytest-xdist --dist loadgroup), beside test_spheres' own
+pytestmark = pytest.mark.xdist_group("real-spheres")
+
+
+@pytest.fixture(scope="module")
+def rp():
+    spec = importlib.util.spec_from_file_location("realpert55", DOCS / "realpert55.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def small_frame():
+    depth = np.full((6, 6), 1.0, np.float32)
+    depth[0, :3] = [0.0, 0.0, 1.2]  # the top-left 3x3 block: 7 of 9 valid
+    depth[:3, 3:] = 0.0
+    depth[0, 3:] = [2.0, 2.1, 0.0]  # the top-right block: 2 of 9 valid, fewer than half
+    depth[3:, :3] = np.arange(9, dtype=np.float32).reshape(3, 3) * 0.01 + 1.0  # median 1.04
+    masks = np.zeros((6, 6), np.int32)
+    masks[3:, 3:] = 2
+    masks[3:5, 3:6] = 1  # the bottom-right block: six of id 1, three of id 2
+    color = np.zeros((6, 6, 3), np.uint8)
+    color[:3, :3, 0] = np.arange(9).reshape(3, 3) * 10  # mean 40
+    cam = Camera(fx=600.0, fy=610.0, cx=2.5, cy=2.5, width=6, height=6)
+    return Frame(name="t", color=color, depth=depth, camera=cam, masks=masks)
+
+
+def test_binning_takes_the_median_of_valid_depth_the_majority_label_and_the_mean_colour(rp):
+    color, depth, masks, _ = rp.binned(small_frame(), 3)
+    assert depth.shape == masks.shape == (2, 2) and color.shape == (2, 2, 3)
+    assert depth[0, 0] == pytest.approx(1.0)  # the median of 1.2 and six 1.0s
+    assert depth[0, 1] == 0.0  # too few valid pixels: none, as the camera gives at a lost rim
+    assert depth[1, 0] == pytest.approx(1.04)
+    assert masks.tolist() == [[0, 0], [0, 1]]
+    assert int(color[0, 0, 0]) == 40 and int(color[1, 1, 0]) == 0
+
+
+def test_binned_intrinsics_project_a_point_to_the_block_it_fell_in(rp):
+    frame = small_frame()
+    _, _, _, cam = rp.binned(frame, 3)
+    assert (cam.width, cam.height, cam.fx, cam.fy) == (2, 2, 200.0, pytest.approx(610.0 / 3))
+    point = np.array([[0.001, -0.002, 1.0]])
+    u, v = frame.camera.project(point)[0]
+    ub, vb = cam.project(point)[0]
+    assert ub == pytest.approx((u + 0.5) / 3 - 0.5) and vb == pytest.approx((v + 0.5) / 3 - 0.5)
+
+
+def test_masks_grow_onto_the_background_only_and_shift_with_their_pixels(rp):
+    frame = small_frame()
+    _, _, grown, _ = rp.dilated(frame, 1)
+    assert (grown[frame.masks > 0] == frame.masks[frame.masks > 0]).all()  # no sphere's pixels taken
+    assert grown[2, 4] == 1 and grown[4, 2] == 1 and grown[0, 0] == 0
+    _, _, moved, _ = rp.shifted(frame, -2, 1)
+    assert (moved[4:, 1:4] == frame.masks[3:5, 3:6]).all() and (moved[:, 4:] == 0).all() and (moved[3] == 0).all()
+
+
+def test_a_leaf_lies_in_front_with_the_frames_noise_and_loses_depth_along_its_edge(rp):
+    frame = read_frame(rp.FRAMES / "lab-spheres-0")
+    _, over, drawn, _ = rp.leafed(frame, "side", 0.05, cut=False)
+    _, _, cut, _ = rp.leafed(frame, "side", 0.05, cut=True)
+    assert (drawn == frame.masks).all()
+    hidden = (frame.masks == 3) & (cut == 0)
+    assert 0.2 < hidden.sum() / (frame.masks == 3).sum() < 0.5  # the left 35 % of its width, less the edge
+    seen = frame.depth[(frame.masks == 3) & (frame.depth > 0)]
+    leaf = over[hidden & (over > 0)]
+    assert len(leaf) and np.abs(np.median(leaf) - (np.percentile(seen, 1) - 0.05)) < 0.002
+    sigma = rp.noise_level(frame.depth)  # the frame's own: its depth is smooth to well under its 1 mm unit
+    assert 0.0 < sigma < 0.001 and 0.5 * sigma < np.std(leaf) < 2.0 * sigma
+    assert (over[hidden] == 0).any()  # its edge holds no depth (the camera's mixed pixels)
+
+
+def spheres(rp, name):
+    """Every sphere's box of frame 0 under perturbation ``name`` and its reference diameter (mm), the unperturbed
+    mask's at the box's depth (the scorer's: ``evaluate_spheres``)."""
+    frame = read_frame(rp.FRAMES / "lab-spheres-0")
+    color, depth, masks, cam = rp.PERTURBATIONS[name](frame)
+    found = detect(Frame(name=name, color=color, depth=depth, camera=cam, masks=masks), method="evidence")
+    focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))  # the unperturbed mask's pixels: the frame's camera
+    out = []
+    for d in found.detections:
+        assert d.result is not None, d.error
+        area = float((frame.masks == d.id).sum())
+        out.append((d.id, d.result.box.size * 1000.0, 2000.0 * np.sqrt(area / np.pi) * d.result.box.centre[2] / focal))
+    return out
+
+
+@pytest.mark.parametrize("name", ["rim3", "shift+10x", "shift-5x"])
+def test_the_default_keeps_every_sphere_a_cube_under_a_wider_lost_rim_and_masks_shifted_across(rp, name):
+    boxes = spheres(rp, name)
+    assert len(boxes) == 4
+    for k, size, diameter in boxes:
+        assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
+
+
+def test_binned_three_times_every_sphere_keeps_its_points_and_the_small_ones_are_cubes(rp):
+    """At 3 x 3 binning (5 mm a pixel at 1.5 m) extraction's fixed 6 mm clustering distance broke spheres 1 and 4 into
+    single pixels and both failed (6 of 1,033 points kept); the distance is now four pixel footprints there
+    (``extract.cluster_gap``). Sphere 1 comes out 198 x 175 x 185 mm (its bottom on the board; docs/realpert55.md,
+    section 4): only the 125 and 60 mm spheres are held to the 6 mm bar."""
+    boxes = spheres(rp, "bin3")
+    assert len(boxes) == 4
+    for k, size, diameter in boxes:
+        if k in (2, 4):
+            assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (k, size, diameter)
