@@ -848,6 +848,8 @@ def _window_regions(
             int(win[1].start), float(s.min_diameter * focal), float(z_typical))  # fmt: skip
         if n_weak == 0:
             return None
+        if len(first) == 0:  # no region seeded: no depths read
+            return weak_w, labels, sizes, None, None, ids, grouped, first, {}
         objects = {k: (slice(a, b), slice(d, e)) for k, (a, b, d, e) in zip(ids.tolist(), boxes.tolist(), strict=True)}
         return weak_w, labels, sizes, image_at, zw, ids, grouped, first, objects
     regions = _red_regions(cw, s)
