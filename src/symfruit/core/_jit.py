@@ -1186,7 +1186,7 @@ def nearest(image: np.ndarray, out: np.ndarray) -> None:
     below = np.full(w, -1, np.int64)  # the nearest false pixel at or below, row by row from the bottom
     for r in range(h - 1, -1, -1):
         row, im = near[r], image[r]
-        for c in range(w):  # selects, no branch a pixel (stop 55: vectorised)
+        for c in range(w):  # selects, no branch a pixel (stop 55)
             b = below[c] if im[c] else r
             below[c] = b
             a = row[c]
