@@ -7351,3 +7351,89 @@ def test_the_masked_and_region_medians_of_tied_depths_are_core_points_medians(se
             assert np.float64(zmed[i]).tobytes() == np.float64(median(part)).tobytes()
         else:
             assert np.isnan(zmed[i])
+
+
+# --- stop 55, seg55
+
+
+def _red_scene(rng, h, w):
+    """Random colours with red discs, rings and specks (some strongly red), and a depth image of them (float32 or
+    float64) with holes (0, NaN, infinite and negative depths) and some regions without any depth."""
+    image = rng.integers(0, 256, (h, w, 3), dtype=np.uint8)
+    image[rng.random((h, w)) < 0.04] = (200, 40, 30)
+    yy, xx = np.mgrid[:h, :w]
+    depth = rng.uniform(0.3, 3.0, (h, w))
+    for _ in range(int(rng.integers(0, 7))):
+        cy, cx, r = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(2, 30)
+        d = (yy - cy) ** 2 + (xx - cx) ** 2
+        shape = d <= r * r if rng.random() < 0.6 else (d <= r * r) & (d >= (0.6 * r) ** 2)
+        image[shape] = (int(rng.integers(120, 256)), int(rng.integers(0, 90)), int(rng.integers(0, 90)))
+        depth[shape] = 0.0 if rng.random() < 0.15 else rng.uniform(0.2, 4.0)
+    holes = rng.random((h, w))
+    depth[holes < 0.1] = 0.0
+    depth[(holes >= 0.1) & (holes < 0.12)] = np.nan
+    depth[(holes >= 0.12) & (holes < 0.13)] = np.inf
+    depth[(holes >= 0.13) & (holes < 0.14)] = -1.0
+    return image, depth.astype(rng.choice([np.float32, np.float64]))
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_a_red_windows_regions_in_one_call_are_the_twins(seed):
+    """Random scenes of red discs, rings and specks over depth with holes (float32 and float64), windows anywhere
+    (at the image's edges, the whole image, a single pixel), least diameters that keep all, some or none of the
+    regions, typical depths near and far: ``_window_regions`` with the kernels (one :func:`_jit.window_regions`
+    call) gives the numpy twins' values (``SYMFRUIT_KERNELS=numpy``: ``_red_regions``, the depths, ``_least_areas``,
+    ``_grouped``, ``_group_boxes``), None without a weak pixel."""
+    from symfruit.segment.colour import SegmentSettings, _Depth, _window_regions
+
+    rng = np.random.default_rng(5500 + seed)
+    h, w = int(rng.integers(1, 90)), int(rng.integers(1, 110))
+    image, depth = _red_scene(rng, h, w)
+    given = np.ascontiguousarray(depth)
+    s = SegmentSettings(min_diameter=float(rng.choice([0.001, 0.02, 0.05, 0.5])))
+    focal, z_typical = float(rng.uniform(200, 1500)), float(rng.choice([0.4, 1.0, 2.5]))
+    for _ in range(12):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        r1, c1 = int(rng.integers(r0 + 1, h + 1)), int(rng.integers(c0 + 1, w + 1))
+        win = (slice(r0, r1), slice(c0, c1))
+        with pytest.MonkeyPatch.context() as mp:
+            fast, twin = _both(mp, _window_regions, image, win, _Depth(given), s, focal, 4.0, z_typical)
+        if twin is None:
+            assert fast is None
+            continue
+        assert fast is not None
+        for a, b in zip(fast[:-1], twin[:-1], strict=True):
+            if b is None:
+                assert a is None
+                continue
+            np.testing.assert_array_equal(a, b)
+            if b.size:
+                assert a.dtype == b.dtype
+        assert fast[-1] == twin[-1]  # the kept regions' boxes
+
+
+def test_the_red_windows_regions_cover_every_case():
+    """``_window_regions`` with the kernels on windows chosen to hold no red, red without a strong pixel, a strong
+    region too small to keep and one kept: None, then no region kept, then the kept one's box (its numpy twin's)."""
+    from symfruit.segment.colour import SegmentSettings, _Depth, _window_regions
+
+    image = np.zeros((60, 80, 3), np.uint8)
+    image[..., 1] = 200  # green
+    image[5:9, 5:9] = (140, 90, 80)  # weakly red, no strong pixel
+    image[20:22, 20:22] = (220, 10, 10)  # a strong speck
+    image[30:50, 40:70] = (220, 10, 10)  # a strong fruit
+    depth = np.full((60, 80), 1.0, np.float32)
+    s, z = SegmentSettings(min_diameter=0.02), _Depth(depth)
+    found = {}
+    windows = {"green": (slice(50, 60), slice(0, 30)), "weak": (slice(0, 12), slice(0, 12)),
+               "speck": (slice(15, 25), slice(15, 25)), "fruit": (slice(25, 60), slice(35, 80))}  # fmt: skip
+    for name, win in windows.items():
+        with pytest.MonkeyPatch.context() as mp:
+            found[name] = _both(mp, _window_regions, image, win, z, s, 600.0, 4.0, 1.0)
+    assert found["green"] == (None, None)
+    for name in ("weak", "speck"):
+        fast, twin = found[name]
+        assert len(fast[5]) == len(twin[5]) == 0 and fast[-1] == twin[-1] == {}
+    fast, twin = found["fruit"]
+    assert fast[-1] == twin[-1] == {1: (slice(5, 25), slice(5, 35))}
+    np.testing.assert_array_equal(fast[4], np.ones(600))  # the fruit's depths

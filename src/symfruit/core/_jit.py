@@ -1185,14 +1185,12 @@ def nearest(image: np.ndarray, out: np.ndarray) -> None:
             near[r, c] = near[r - 1, c] if image[r, c] else r
     below = np.full(w, -1, np.int64)  # the nearest false pixel at or below, row by row from the bottom
     for r in range(h - 1, -1, -1):
-        for c in range(w):
-            if not image[r, c]:
-                below[c] = r
-            b = below[c]
-            if b >= 0:
-                a = near[r, c]
-                if a < 0 or b - r < r - a:  # as near: the upper one stays
-                    near[r, c] = b
+        row, im = near[r], image[r]
+        for c in range(w):  # selects, no branch a pixel (stop 55)
+            b = below[c] if im[c] else r
+            below[c] = b
+            a = row[c]
+            row[c] = b if (b >= 0) & ((a < 0) | (b - r < r - a)) else a  # as near: the upper one stays
     env = np.empty(w, np.int64)  # the envelope's columns, left to right
     for r in range(h):
         row = near[r]
@@ -6731,8 +6729,12 @@ def red_regions_once(
     rows = np.empty(n_weak, np.int64)
     cols = np.empty(n_weak, np.int64)
     sizes = np.zeros(m + 1, np.int64)
-    for i in range(n_weak):
-        rows[i], cols[i], lab[i] = weak_at[i] // w, weak_at[i] % w, flat[weak_at[i]]
+    r = 0
+    for i in range(n_weak):  # the rows without a division: the pixels come in raster order (stop 55)
+        p = weak_at[i]
+        while p >= (r + 1) * w:
+            r += 1
+        rows[i], cols[i], lab[i] = r, p - r * w, flat[p]
         sizes[lab[i]] += 1
     seeded = np.zeros(m + 1, np.bool_)
     for i in range(n_strong):
@@ -9400,3 +9402,42 @@ def skin_flood(
     part[pr : pr + hull.shape[0], pc : pc + hull.shape[1]] = hull
     skin = round_skin(z, color, owner, k, part, r0, c0, rc, cc, reach2, deep_limit, zm, step, jump, leaf_hue)
     return skin, limit >= 0.0 and at_reach(skin, r0, c0, rc, cc, limit)
+
+
+# --- stop 55, seg55: a red window's regions, their depths, sizes and boxes in one call ------------------------------
+
+
+@_njit
+def window_regions(
+    c: np.ndarray, low: np.ndarray, high: np.ndarray, sqrt3: float, tan_hue: float, given: np.ndarray, r0: int,
+    c0: int, diameter_px_m: float, z_typical: float,
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip  # noqa: E501
+    """:func:`symfruit.segment.colour._window_regions` with depth: the red window ``c`` (h, w, 3) uint8 at ``(r0,
+    c0)`` of an image whose depth is ``given`` (H, W) float, C-contiguous, as handed over. :func:`red_regions_once`'s
+    mask and labels, how many weak pixels there are and each region's size (m + 1,); then, when a region holds a
+    strong pixel, the weak pixels' flat indices in the image and their depths (:func:`depth_at`'s values), the least
+    fruit's area at each region's depth (:func:`least_areas`) and the regions kept (seeded, and at least a quarter of
+    that area) as :func:`grouped` gives them (their labels, pixels and runs) with their boxes (:func:`group_boxes`);
+    with no region seeded those last six are empty. The twin's calls in one: the same arrays, not five calls and the
+    numpy between them a window (stop 55, seg55)."""
+    mask, out, m, weak_at, _, lab, seeded, sizes, rows, cols = red_regions_once(c, low, high, sqrt3, tan_hue)
+    n = weak_at.shape[0]
+    any_seeded = False
+    for k in range(m + 1):
+        any_seeded = any_seeded or seeded[k]
+    if not any_seeded:
+        none = np.empty(0, np.int64)
+        return mask, out, n, sizes, none, np.empty(0), np.empty(0, lab.dtype), none, none, np.empty((0, 4), np.int64)
+    width = given.shape[1]
+    flat = given.reshape(-1)
+    image_at = np.empty(n, np.int64)
+    for i in range(n):
+        image_at[i] = (rows[i] + r0) * width + (cols[i] + c0)
+    zw = depth_at(flat, image_at)
+    least = least_areas(lab, zw, m, diameter_px_m, z_typical)
+    keep = np.empty(m + 1, np.bool_)
+    for k in range(m + 1):
+        keep[k] = seeded[k] and sizes[k] >= 0.25 * least[k]
+    ids, at, first = grouped(lab, keep)
+    boxes = group_boxes(at, first, rows, cols) if at.shape[0] > 0 else np.empty((0, 4), np.int64)
+    return mask, out, n, sizes, image_at, zw, ids, at, first, boxes

@@ -579,25 +579,15 @@ def _segment_at(
     for win in windows:
         # the window's weak and strong pixels by flat index: the regions' sizes, depths and boxes are read off
         # the weak pixels alone, not off every pixel of a window that may span most of the image
-        regions = _red_regions(c[win], s)
+        regions = _window_regions(c, win, z, s, geo.focal, min_area, z_typical)
         if regions is None:
             continue
-        weak_w, labels, n, lab, seeded, sizes, rows, cols = regions
+        weak_w, labels, sizes, image_at, zw, ids, grouped, first, objects = regions
         weak[win] = weak_w
-        if not seeded.any():  # no region is kept: none is seeded (half the windows of the benchmark frame; stop 46)
+        if len(ids) == 0:  # no region is kept (none seeded: half the windows of the benchmark frame; stop 46)
             continue
-        # fragments down to a quarter of a fruit may join one; with depth, the least fruit at the region's depth
-        if z is None:
-            least: float | np.ndarray = min_area
-        else:
-            image_at = (rows + win[0].start) * w + (cols + win[1].start)  # the pixels' flat indices in the image
-            zw = z.take(image_at)
-            least = _least_areas(lab, zw, n, s.min_diameter * geo.focal, z_typical)
-        keep = seeded & (sizes >= 0.25 * least)
-        ids, grouped, first = _grouped(lab, keep)  # the kept regions alone: a window may hold thousands of specks
-        objects = _group_boxes(ids, grouped, first, rows, cols)
         one = ripe = np.zeros(len(ids), bool)
-        if s.round_fruit and z is not None and len(ids) > 0:
+        if s.round_fruit and image_at is not None and zw is not None:
             # a region no larger than one fruit and not ripe-red is dropped before its masks are made: its pixels'
             # depths and colours read off at once
             at = image_at.take(grouped)
@@ -835,6 +825,50 @@ def _red_regions(
     sizes = np.bincount(lab, minlength=n + 1)
     rows, cols = np.divmod(weak_at, shape[1])
     return weak_w, labels, n, lab, seeded, sizes, rows, cols
+
+
+def _window_regions(
+    c: np.ndarray, win: Window, z: _Depth | None, s: SegmentSettings, focal: float, min_area: float, z_typical: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None, np.ndarray | None, np.ndarray, np.ndarray,
+           np.ndarray, dict[int, Window]] | None:  # fmt: skip
+    """A red window's regions as :func:`_segment_at` works on them, None without a weak pixel: :func:`_red_regions`'
+    weak mask, labels and the regions' sizes; with depth the weak pixels' flat indices in the image and their depths
+    (else None); then the regions kept (seeded and, as fragments down to a quarter of a fruit may join one, at least a
+    quarter of the least fruit: ``min_area``, or with depth at the region's depth, :func:`_least_areas`) grouped
+    (:func:`_grouped`: their labels, pixels and runs; none where no region is seeded) and their boxes
+    (:func:`_group_boxes`). Where numba is, with depth, in one compiled call (:func:`symfruit.core._jit.window_regions`:
+    the same arrays; stop 55, seg55), not five calls and the numpy between them."""
+    cw = c[win]
+    jit = compiled()
+    if (jit is not None and z is not None and cw.dtype == np.uint8 and cw.ndim == 3 and cw.shape[2] == 3
+            and z.given.dtype in _FLOATS and z.given.ndim == 2 and z.given.flags.c_contiguous):  # fmt: skip
+        low, high = _red_tables(s.red_low, s.red_high, s.dark, s.dark_chroma)
+        weak_w, labels, n_weak, sizes, image_at, zw, ids, grouped, first, boxes = jit.window_regions(
+            cw, low, high, float(np.sqrt(3.0)), float(np.tan(np.radians(s.hue_max))), z.given, int(win[0].start),
+            int(win[1].start), float(s.min_diameter * focal), float(z_typical))  # fmt: skip
+        if n_weak == 0:
+            return None
+        if len(first) == 0:  # no region seeded: no depths read
+            return weak_w, labels, sizes, None, None, ids, grouped, first, {}
+        objects = {k: (slice(a, b), slice(d, e)) for k, (a, b, d, e) in zip(ids.tolist(), boxes.tolist(), strict=True)}
+        return weak_w, labels, sizes, image_at, zw, ids, grouped, first, objects
+    regions = _red_regions(cw, s)
+    if regions is None:
+        return None
+    weak_w, labels, n, lab, seeded, sizes, rows, cols = regions
+    if not seeded.any():  # no region is kept: none is seeded
+        none = np.zeros(0, np.int64)
+        return weak_w, labels, sizes, None, None, none, none, none, {}
+    image_at = zw = None
+    least: float | np.ndarray = min_area
+    if z is not None:
+        image_at = (rows + win[0].start) * c.shape[1] + (cols + win[1].start)  # the pixels' flat indices in the image
+        zw = z.take(image_at)
+        least = _least_areas(lab, zw, n, s.min_diameter * focal, z_typical)
+    keep = seeded & (sizes >= 0.25 * least)
+    ids, grouped, first = _grouped(lab, keep)  # the kept regions alone: a window may hold thousands of specks
+    objects = _group_boxes(ids, grouped, first, rows, cols)
+    return weak_w, labels, sizes, image_at, zw, ids, grouped, first, objects
 
 
 def _too_many_pieces() -> InputError:
