@@ -72,6 +72,53 @@ def test_a_fruit_pool_gives_the_same_records_and_is_refused_with_a_cluster(tmp_p
     assert _fruits(tmp_path / "one") == _fruits(tmp_path / "two")
 
 
+def outcome(report: BatchReport) -> tuple:
+    return report.done, report.failed, report.skipped, report.unprocessed, report.stopped, report.fruits
+
+
+@pytest.mark.parametrize("failing", [ValueError("f3 cannot be written"), OSError(errno.ENOSPC, "No space left")],
+                         ids=["a frame fails as it is written", "the disk is full"])  # fmt: skip
+def test_a_recording_streamed_with_a_fruit_pool_gives_each_frame_its_outcome(tmp_path, monkeypatch, failing):
+    """With a pool the frames go in a stream (issue 19, stop 55: frame n+1 read and segmented before frame n is
+    finished and written): each frame's records, errors and the report's order are one process's, the frame in
+    flight written before the next; a full disk stops after the frame it hit, leaving the frame read after it."""
+    from symfruit.fruitpool import FruitPool, one_process_reason
+
+    if one_process_reason(1):
+        pytest.skip(f"no worker processes here: {one_process_reason(1)}")
+    frames = tmp_path / "rec"
+    for name in ("f1", "f2", "f3", "f4", "f5"):
+        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    (frames / "f2" / "depth.png").write_bytes(b"not a png")  # refused when read, the frame before in flight
+    real = batch.write_detections
+
+    def write_detections(folder, found, **kwargs):
+        if folder.name == "f3":
+            raise failing
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write_detections)
+    one = run_batch(frames, tmp_path / "one", progress=False)
+    with FruitPool(1, method=None) as pool:
+        pool._caller_shares = False  # the worker does every fruit
+        two = run_batch(frames, tmp_path / "two", progress=False, pool=pool)
+        assert pool.fruit_elsewhere == two.fruits >= 4 and pool.starts == 1, pool.last_loss
+        assert outcome(two) == outcome(one) and list(two.failed) == list(one.failed) == ["f2", "f3"]
+        assert _fruits(tmp_path / "two") == _fruits(tmp_path / "one")
+        assert (tmp_path / "two" / "errors.json").read_text() == (tmp_path / "one" / "errors.json").read_text()
+        if two.stopped:
+            assert two.done == ["f1"] and two.unprocessed == ["f4", "f5"]
+        else:
+            assert two.done == ["f1", "f4", "f5"]
+        monkeypatch.undo()  # resumed: the frames done skipped, the others run again
+        (frames / "f2" / "depth.png").write_bytes((frames / "f1" / "depth.png").read_bytes())
+        one = run_batch(frames, tmp_path / "one", progress=False, resume=True)
+        two = run_batch(frames, tmp_path / "two", progress=False, pool=pool, resume=True)
+        assert outcome(two) == outcome(one) and two.ok
+        assert two.skipped == (["f1"] if failing.args[0] == errno.ENOSPC else ["f1", "f4", "f5"])
+    assert _fruits(tmp_path / "two") == _fruits(tmp_path / "one")
+
+
 def test_resume_runs_again_a_frame_whose_record_cannot_be_read_back(tmp_path):
     # a detections.json truncated by a copy was trusted: the frame was skipped, then left out of the tables
     frames = recording(tmp_path / "rec", "f1", "f2")

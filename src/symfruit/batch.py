@@ -23,7 +23,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .core.limits import instance_labels
-from .detect import FrameDetections, detect
+from .detect import DetectStream, FrameDetections, detect
 from .errors import FileFormatError, InputError, OutputError, SymfruitError
 from .fruitpool import FruitPool
 from .io.atomic import folder_fd
@@ -239,11 +239,101 @@ def _run_recording(
     now = src.names()
     where = {n: i for i, n in enumerate(now)} if now != names else None  # changed since it was listed
     with once_per_recording(str(rec.source)) as current:
+        if pool is not None and pool.active:  # frames in a stream: the next one segmented beside the workers
+            _stream_recording(src, rec, names, where, masks, method, settings, resume, on_frame, reserved, report,
+                              bar, out, pool, current)  # fmt: skip
+            return
         for index, name in enumerate(names):
             current[0] = name
             if not _one(src, rec, index, name, names, where, masks, method, settings, resume, on_frame, reserved,
                         report, bar, out, pool):  # fmt: skip
                 return
+
+
+def _stream_recording(
+    src: Any, rec: Recording, names: list[str], where: dict[str, int] | None, masks: str, method: str,
+    settings: Settings, resume: bool, on_frame: Callable[[int, FrameDetections], None] | None,
+    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder, pool: FruitPool,
+    current: list[str],
+) -> None:  # fmt: skip
+    """:func:`_run_recording`'s frames with an active ``pool``, in a :class:`~symfruit.detect.DetectStream` (issue
+    19, stop 55, docs/pipe55.md): frame n+1 is read and segmented while the workers end frame n's fruit, then
+    frame n is finished and written, then frame n+1 started. Each frame keeps its error boundary, its errors and
+    warnings (a frame's reading and segmentation errors are its own, its fruit's come when it is finished), and
+    the report lists the frames in their order. At most one frame is in flight; an interrupt drops it (the pool's
+    workers ended, as after an interrupt within a frame)."""
+    stream = DetectStream(pool, masks=masks, method=method, settings=settings)
+    flight: tuple[int, str, Path] | None = None  # the frame started and not finished: its index, name and folder
+
+    def finish() -> bool:  # the frame in flight finished and written; False when the batch stops
+        nonlocal flight
+        if flight is None:
+            return True
+        (index, name, folder), flight = flight, None
+        current[0], key = name, rec.key + name
+
+        def finished() -> FrameDetections:
+            found = stream.finish()
+            assert found is not None  # a frame was in flight
+            if on_frame is not None:
+                on_frame(index, found)
+            write_detections(folder, found, settings=settings)
+            return found
+
+        clear = partial(_clear_frame, folder, out)
+        done, found, report.stopped = _guarded(finished, item=key, failed=report.failed, target=folder,
+                                               at=f"frame {key}", cleanup=clear)  # fmt: skip
+        if report.stopped:
+            report.unprocessed = [rec.key + n for n in names[index + 1 :]]
+            return False
+        _counted(report, key, done, found)
+        bar.update()
+        return True
+
+    try:
+        for index, name in enumerate(names):
+            key, folder = rec.key + name, rec.folder / frame_folder_name(name, reserved)
+            if resume and frame_done(folder, name):
+                if not finish():
+                    return
+                report.skipped.append(key)
+                bar.update()
+                continue
+            current[0] = name
+
+            def prepared(index: int = index, name: str = name) -> Any:
+                if where is not None and name not in where:
+                    raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
+                return stream.prepare(src.read(index if where is None else where[name]))
+
+            clear = partial(_clear_frame, folder, out)
+            failed: dict[str, str] = {}  # recorded after the frame before's outcome: the report keeps their order
+            # nothing written here: never a full disk's stop
+            done, ready, _ = _guarded(
+                prepared, item=key, failed=failed, target=folder, at=f"frame {key}", cleanup=clear
+            )
+            if not finish():
+                return
+            current[0] = name
+            if done and ready is not None:
+                done, _, _ = _guarded(partial(stream.start, ready), item=key, failed=failed, target=folder,
+                                      at=f"frame {key}", cleanup=clear)  # fmt: skip
+            report.failed.update(failed)
+            if done:
+                flight = (index, name, folder)
+            else:
+                bar.update()
+        finish()
+    finally:
+        stream.abandon()  # an interrupt: the frame in flight dropped
+
+
+def _counted(report: BatchReport, key: str, done: bool, found: FrameDetections | None) -> None:
+    """A frame's outcome in ``report``: done, with its fruit counted (a failed one was recorded by :func:`_guarded`)."""
+    if done and found is not None:
+        report.done.append(key)
+        report.fruits += sum(d.result is not None for d in found.detections)
+        report.failed_fruits += sum(d.result is None for d in found.detections)
 
 
 @contextlib.contextmanager
@@ -311,10 +401,7 @@ def _one(
     if report.stopped:
         report.unprocessed = [rec.key + n for n in names[index + 1 :]]
         return False
-    if done and found is not None:
-        report.done.append(key)
-        report.fruits += sum(d.result is not None for d in found.detections)
-        report.failed_fruits += sum(d.result is None for d in found.detections)
+    _counted(report, key, done, found)
     bar.update()
     return True
 
