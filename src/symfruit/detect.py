@@ -685,9 +685,11 @@ class DetectStream:
         found = stream.finish()  # the last frame's
 
     The frame in flight keeps the pool busy: :meth:`finish` it (or :meth:`abandon` it, on an interrupt) before
-    anything else uses the pool. Each :meth:`start` leaves the workers about as many seconds of fruit as this
+    anything else uses the pool. Each :meth:`start` leaves the workers fruit for about as many seconds as this
     process spent last time between a :meth:`start` and the next :meth:`finish` (the next frame's reading and
-    segmentation: :meth:`~symfruit.fruitpool.FruitPool.start`'s ``leave``), and does the rest itself.
+    segmentation: :meth:`~symfruit.fruitpool.FruitPool.start`'s ``leave``), less what it had to wait for them in
+    :meth:`finish` before (``_late``: the fruit a worker is on when this process stops taking them, which the
+    estimate does not see; each wait adds to it, and a tenth of it goes each frame), and does the rest itself.
     Without a pool, or an inactive one, :meth:`start` does the whole frame (as :func:`detect`)."""
 
     def __init__(
@@ -700,6 +702,7 @@ class DetectStream:
         self.pool, self.masks, self.method, self.settings = pool, masks, method, settings
         self._running: _Started | None = None
         self._leave: float | None = None  # the seconds between the last start and the finish after it
+        self._late = 0.0  # what finish waited for the workers, added up, a tenth of it dropped each frame
         self._started_at = 0.0
 
     @property
@@ -719,7 +722,10 @@ class DetectStream:
         if running is None:
             return None
         self._leave = time.perf_counter() - self._started_at
-        return running.result()
+        try:
+            return running.result()
+        finally:
+            self._late = 0.9 * self._late + running.running.waited
 
     def start(self, ready: _Prepared, *, overlap: bool = True) -> None:
         """Start a prepared frame: trimming, registration and this process's share of its fruit (their errors
@@ -728,7 +734,8 @@ class DetectStream:
         node's next frame has not come)."""
         if self._running is not None:
             raise RuntimeError("DetectStream.start: the frame before is still in flight (finish it first)")
-        self._running = _start(ready, self.pool, self._leave if overlap else None)
+        leave = None if not overlap or self._leave is None else max(0.0, self._leave - self._late)
+        self._running = _start(ready, self.pool, leave)
         self._started_at = time.perf_counter()
 
     def abandon(self) -> None:

@@ -635,6 +635,8 @@ class Running:
 
     def __init__(self, pool: FruitPool | None, collect: Callable[[], Any], value: Any = None) -> None:
         self._pool, self._collect, self._value = pool, collect, value
+        #: Seconds :meth:`result` spent on the workers' last fruit (waiting for them, taking those left here)
+        self.waited = 0.0
 
     @classmethod
     def here(cls, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], check: Callable[[], bool] | None) -> Running:
@@ -658,11 +660,13 @@ class Running:
         pool, self._pool = self._pool, None
         if pool is None:
             return self._value
+        t = time.perf_counter()
         try:
             got = self._collect()
         except BaseException:
             pool._interrupted()
             raise
+        self.waited = time.perf_counter() - t
         pool._busy.release()
         return pool._given(got)
 
