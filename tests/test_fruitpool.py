@@ -684,16 +684,13 @@ def test_a_worker_dying_in_a_run_called_off_is_replaced(workers_only):
 # --- stop 55: frames in a stream (FruitPool.start, detect.DetectStream; docs/pipe55.md) ---------------------------
 
 
-def streamed(stream, frames, leave=None):
+def streamed(stream, frames):
     """Each of ``frames`` through ``stream`` as a recording goes (the next prepared, the last finished, the next
-    started): the detections in the frames' order. ``leave``: the seconds each start leaves the workers (else as
-    the stream measures them)."""
+    started): the detections in the frames' order."""
     out = []
     for frame in frames:
         ready = stream.prepare(frame)
         out.append(stream.finish())
-        if leave is not None:
-            stream._leave = leave
         stream.start(ready)
     out.append(stream.finish())
     assert out[0] is None and not stream.in_flight
@@ -701,15 +698,14 @@ def streamed(stream, frames, leave=None):
 
 
 @pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
-@pytest.mark.parametrize("leave", [None, 1e9], ids=["left as measured", "all left to the workers"])
-def test_a_stream_gives_each_frames_detections_as_detect(pool, monkeypatch, shares, leave):
+def test_a_stream_gives_each_frames_detections_as_detect(pool, monkeypatch, shares):
     """The frames of frames() twice, in one stream: each frame's detections are detect's without a pool, bit for
-    bit, whichever process did which fruit (``leave``: the calling process stops taking fruit after its first)."""
+    bit, whichever process did which fruit."""
     monkeypatch.setattr(pool, "_caller_shares", shares)
     for method in ("raw", "evidence"):
         given_frames = [frame for _, frame, _ in frames()] * 2
         before, starts = pool.fruit_elsewhere, pool.starts
-        got = streamed(DetectStream(pool, method=method), given_frames, leave)
+        got = streamed(DetectStream(pool, method=method), given_frames)
         for frame, found in zip(given_frames, got, strict=True):
             assert_same(detect(frame, method=method), found)
         assert pool.starts == starts, pool.last_loss
@@ -806,30 +802,3 @@ def test_a_run_while_a_frame_is_in_flight_runs_in_this_process_alone(pool):
     done, _ = running.result()
     assert [record(d[0]) for d in done] == alone and not running.pending
     assert running.result() is None  # had once: nothing more
-
-
-class Counted(_Fruit):
-    """A fruit task that notes, in the calling process, the fruit done there."""
-
-    def __call__(self, k, sl):
-        if not fp._IN_WORKER:
-            self.here.append(k)
-        return super().__call__(k, sl)
-
-
-def test_the_calling_process_leaves_the_workers_the_fruit_left_when_told_it_has_other_work(pool):
-    """``leave``: the calling process stops taking fruit once the fruit left would keep the workers about that
-    long (here, after its first: more seconds than any fruit takes); the rest are done when the result is asked
-    for (by the workers, or here if they left some)."""
-    task, jobs = fruit_task(four(), Counted)
-    task.here = []
-    alone = [record(d[0]) for d in (task(k, sl) for k, sl in jobs)]
-    assert pool._wait_ready(fp.START_TIMEOUT)
-    for leave in (1e9, None):
-        task.here = []
-        running = pool.start(task, jobs, leave=leave)
-        took = list(task.here)
-        done, _ = running.result()
-        assert [record(d[0]) for d in done] == alone
-        if leave:
-            assert len(took) <= 1  # its first fruit (none if the worker took them all first)

@@ -463,8 +463,8 @@ def test_latest_only_drains_when_no_item_waits_and_at_stop():
 
 def test_overlapped_frames_are_the_processors_in_order_and_a_bad_one_is_skipped(example_images):
     """Stop 55: through :class:`Overlapped` (a frame begun before the one in flight is finished, the workers
-    left fruit meanwhile) each frame's fruit are :meth:`FrameProcessor.process`'s, given in their order; a bad
-    frame is skipped when begun, the one in flight finished after it."""
+    ending its last fruit meanwhile) each frame's fruit are :meth:`FrameProcessor.process`'s, given in their
+    order; a bad frame is skipped when begun, the one in flight finished after it."""
     from symfruit.fruitpool import one_process_reason
     from symfruit.ros.core import Overlapped
 
@@ -479,7 +479,7 @@ def test_overlapped_frames_are_the_processors_in_order_and_a_bad_one_is_skipped(
         overlapped = Overlapped(shared, done=lambda item, p: events.append((item, [(f.id, f.centre.tolist(),
                                 f.size.tolist(), f.score) for f in p.fruits])),
                                 skipped=lambda item, exc: events.append((item, type(exc))),
-                                failed=lambda item, exc: events.append((item, exc)), waiting=lambda: True)  # fmt: skip
+                                failed=lambda item, exc: events.append((item, exc)))  # fmt: skip
         for item, msgs in (("a", messages), ("bad", bad), ("b", messages), ("c", messages)):
             overlapped.handle(item, *msgs, name=item, source="test")
         # the bad one told when begun, before a (in flight) is finished; b finished when c came; c in flight

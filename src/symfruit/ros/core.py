@@ -355,11 +355,10 @@ class FrameProcessor:
         t1 = time.perf_counter()
         return Begun(self._stream.prepare(frame), t1 - t0)
 
-    def launch(self, begun: Begun, *, overlap: bool = True) -> None:
+    def launch(self, begun: Begun) -> None:
         """Start a begun frame (:meth:`symfruit.detect.DetectStream.start`): the frame in flight must be finished
-        first (:meth:`finish`). ``overlap``: leave the workers fruit to do while this process begins the next frame
-        (False: none is waiting)."""
-        self._stream.start(begun.ready, overlap=overlap)
+        first (:meth:`finish`)."""
+        self._stream.start(begun.ready)
 
     def finish(self, begun: Begun) -> Processed | None:
         """The frame in flight's fruit (None if none is; ``begun``: what :meth:`begin` gave for it), once the
@@ -390,7 +389,7 @@ class Overlapped:
     decoded and segmented here while the fruit workers end the fruit of the frame before, then that frame finished
     and given to ``done``, then the next started. Made for :class:`LatestOnly`: :meth:`handle` is its ``handle``,
     :meth:`drain` its ``drain`` (the frame in flight finished as soon as no newer frame waits: a frame is never
-    kept waiting for one that may not come), ``waiting`` its :attr:`LatestOnly.waiting`. At most one frame is in
+    kept waiting for one that may not come). At most one frame is in
     flight beside the one being begun; a frame still waiting is replaced by a newer one as before.
 
     ``done(item, processed)`` publishes a frame, ``skipped(item, exc)`` tells of a bad one (a ``SymfruitError``),
@@ -400,9 +399,8 @@ class Overlapped:
     def __init__(
         self, core: FrameProcessor, *, done: Callable[[Any, Processed], None],
         skipped: Callable[[Any, SymfruitError], None], failed: Callable[[Any, BaseException], None],
-        waiting: Callable[[], bool],
     ) -> None:  # fmt: skip
-        self.core, self._done, self._skipped, self._failed, self._waiting = core, done, skipped, failed, waiting
+        self.core, self._done, self._skipped, self._failed = core, done, skipped, failed
         self._flight: tuple[Any, Begun] | None = None
 
     def handle(self, item: Any, color: Any, depth: Any, info: Any, *, name: str, source: str) -> None:
@@ -416,7 +414,7 @@ class Overlapped:
         if begun is None:
             return
         try:
-            self.core.launch(begun, overlap=self._waiting())
+            self.core.launch(begun)
         except SymfruitError as exc:
             self._skipped(item, exc)
             return
@@ -527,11 +525,6 @@ class LatestOnly:
     def start(self) -> LatestOnly:
         self._thread.start()
         return self
-
-    @property
-    def waiting(self) -> bool:
-        """Whether an item waits to be handled (a read: it may come or go at once)."""
-        return self._has_item
 
     def put(self, item: Any) -> bool:
         """Offer an item; True when it replaced one that was never handled."""

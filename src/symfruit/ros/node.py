@@ -208,8 +208,7 @@ class SymfruitNode:
         queue_size, slop = p["queue_size"], p["slop"]
         # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
         self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self._drain)
-        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error,
-                                     waiting=lambda: self.worker.waiting)  # fmt: skip
+        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
         self.worker.start()
         subs = [
             message_filters.Subscriber(self.topics["color"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),

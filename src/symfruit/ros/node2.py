@@ -235,8 +235,7 @@ class Ros2Node:
         self.sync = ApproximateSync(3, self._on_frame, slop=p["slop"], queue_size=p["queue_size"])
         # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
         self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self._drain)
-        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error,
-                                     waiting=lambda: self.worker.waiting)  # fmt: skip
+        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
         self.worker.start()
         self.subs = [
             self.node.create_subscription(kind, self.topics[name], self._adder(i, name), in_qos)
