@@ -802,3 +802,30 @@ def test_a_run_while_a_frame_is_in_flight_runs_in_this_process_alone(pool):
     done, _ = running.result()
     assert [record(d[0]) for d in done] == alone and not running.pending
     assert running.result() is None  # had once: nothing more
+
+
+class Counted(_Fruit):
+    """A fruit task that notes, in the calling process, the fruit done there."""
+
+    def __call__(self, k, sl):
+        if not fp._IN_WORKER:
+            self.here.append(k)
+        return super().__call__(k, sl)
+
+
+def test_the_calling_process_leaves_the_workers_the_fruit_left_when_told_it_has_other_work(pool):
+    """``leave``: the calling process stops taking fruit once those left would keep the workers about that long
+    (here, after its first: more seconds than any fruit takes); the rest are done when the result is asked for (by
+    the workers, or here if they left some). The answers are the same."""
+    task, jobs = fruit_task(four(), Counted)
+    task.here = []
+    alone = [record(d[0]) for d in (task(k, sl) for k, sl in jobs)]
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    for leave in (1e9, None):
+        task.here = []
+        running = pool.start(task, jobs, leave=leave)
+        took = list(task.here)
+        done, _ = running.result()
+        assert [record(d[0]) for d in done] == alone
+        if leave:
+            assert len(took) <= 1  # its first fruit (none if the worker took them all first)

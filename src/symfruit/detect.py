@@ -243,9 +243,10 @@ class _Prepared:
     t2: float
 
 
-def _start(prep: _Prepared, pool: FruitPool | None) -> _Started:
+def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) -> _Started:
     """:func:`detect`'s second part: trimming, registration and the fruit; with an active ``pool`` the workers'
-    last fruit may still be running when it returns (:meth:`_Started.result` waits for them)."""
+    last fruit may still be running when it returns (:meth:`_Started.result` waits for them), and ``leave`` is
+    :meth:`~symfruit.fruitpool.FruitPool.start`'s (the seconds this process will spend elsewhere before it asks)."""
     frame, labels, boxes, settings, method = prep.frame, prep.labels, prep.boxes, prep.settings, prep.method
     t2, cpu2 = time.perf_counter(), time.thread_time()  # trimming, registration and extraction start
     outlined = prep.source != COLOUR_SEGMENTER
@@ -253,7 +254,7 @@ def _start(prep: _Prepared, pool: FruitPool | None) -> _Started:
         # each mask's trimming and registration outline shared with the workers too, and the fruit sent to them
         # while the search for the shift runs here (stop 54, docs/pool54.md): the same detections
         running, shift, t_trim, t_register, cpu_elsewhere = _detect_shared(
-            pool, frame, labels, prep.hi, boxes, settings, method, outlined
+            pool, frame, labels, prep.hi, boxes, settings, method, outlined, leave
         )
         t_extract = t_trim + t_register
     else:
@@ -330,13 +331,13 @@ def _fruit_task(
 
 def _detect_shared(
     pool: FruitPool, frame: Frame, labels: np.ndarray, hi: int, boxes: list[tuple[slice, slice] | None],
-    settings: Settings, method: str, outlined: bool,
+    settings: Settings, method: str, outlined: bool, leave: float | None = None,
 ) -> tuple[Running, tuple[int, int], float, float, float]:  # fmt: skip
     """``detect``'s trimming, registration and fruit with ``pool`` (active, two masks or more): each mask's
     trimming and registration outline shared with its workers (:func:`_shared_masks`); then the fruit, moved by
     the pool's guess of the shift (the last frame's), sent to the workers while the search for this frame's shift
     runs here (:meth:`~symfruit.fruitpool.FruitPool.run_guessed`), and sent again moved by the shift found when the
-    guess was wrong. The fruit's run (:meth:`~symfruit.fruitpool.FruitPool.start`), the shift,
+    guess was wrong. The fruit's run (:meth:`~symfruit.fruitpool.FruitPool.start`, with ``leave``), the shift,
     the masks' trimming seconds and the registration's (each mask's own summed, and the search's and the move's
     here), and the workers' CPU seconds on the masks. The same answers as
     without the pool; the first failing mask's or fruit's error is raised."""
@@ -358,7 +359,7 @@ def _detect_shared(
                                      colour_trimmed)  # fmt: skip
     t_register = t_outlines + ended - a  # the move's and the search's seconds with them
     if len(jobs) >= 2:
-        running = pool.start(fruit, jobs, same, search)  # the first failing fruit's error is raised
+        running = pool.start(fruit, jobs, same, search, leave=leave)  # the first failing fruit's error is raised
     else:
         running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None)
     t_register += t_search
@@ -371,7 +372,7 @@ def _detect_shared(
                                          colour_trimmed)  # fmt: skip
         t_register += ended - b
         if len(jobs) >= 2:
-            running = pool.start(fruit, jobs, same)
+            running = pool.start(fruit, jobs, same, leave=leave)
         else:
             running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0))
     return running, found, t_trim, t_register, cpu
@@ -684,7 +685,10 @@ class DetectStream:
         found = stream.finish()  # the last frame's
 
     The frame in flight keeps the pool busy: :meth:`finish` it (or :meth:`abandon` it, on an interrupt) before
-    anything else uses the pool.
+    anything else uses the pool. Each :meth:`start` leaves the workers fruit for about as many seconds as this
+    process spent last time between a :meth:`start` and the next :meth:`finish` (``symfruit detect``: writing the
+    frame before's files, reading and segmenting the next; :meth:`~symfruit.fruitpool.FruitPool.start`'s
+    ``leave``), and does the rest itself.
     Without a pool, or an inactive one, :meth:`start` does the whole frame (as :func:`detect`)."""
 
     def __init__(
@@ -696,6 +700,8 @@ class DetectStream:
         get_method(method)
         self.pool, self.masks, self.method, self.settings = pool, masks, method, settings
         self._running: _Started | None = None
+        self._leave: float | None = None  # the seconds between the last start and the finish after it
+        self._started_at = 0.0
 
     @property
     def in_flight(self) -> bool:
@@ -713,15 +719,16 @@ class DetectStream:
         running, self._running = self._running, None
         if running is None:
             return None
+        self._leave = time.perf_counter() - self._started_at
         return running.result()
 
     def start(self, ready: _Prepared) -> None:
         """Start a prepared frame: trimming, registration and this process's share of its fruit (their errors
-        raised here: then nothing is in flight). The frame before must be finished (or abandoned) first.
-        """
+        raised here: then nothing is in flight). The frame before must be finished (or abandoned) first."""
         if self._running is not None:
             raise RuntimeError("DetectStream.start: the frame before is still in flight (finish it first)")
-        self._running = _start(ready, self.pool)
+        self._running = _start(ready, self.pool, self._leave)
+        self._started_at = time.perf_counter()
 
     def abandon(self) -> None:
         """Drop the frame in flight (the workers ended, new ones started, as after an interrupt within a frame)."""

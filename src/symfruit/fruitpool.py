@@ -401,11 +401,17 @@ class FruitPool:
 
     def start(
         self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object = None,
-        check: Callable[[], bool] | None = None,
+        check: Callable[[], bool] | None = None, *, leave: float | None = None,
     ) -> Running:  # fmt: skip
         """:meth:`run_guessed` in two halves (issue 19, stop 55: frames in a stream, docs/pipe55.md): the task sent
         to the workers and this process's share of its fruit done here; what :meth:`run_guessed` returns (or raises)
         is had from the :class:`Running` returned, :meth:`Running.result`, which waits for the workers' last fruit.
+
+        ``leave``: None, every fruit this process can take it takes (as :meth:`run`); else the seconds this
+        process will spend elsewhere before it asks for the result (the next frame's segmentation): it stops taking
+        fruit once those left untaken would take the workers about that long (each fruit's time guessed from its
+        mask's pixels and this process's own seconds per pixel on the frame's fruit so far), so that the workers
+        are busy meanwhile. Which process does a fruit never changes its answer.
 
         Until the result is had (or :meth:`Running.abandon` called) the pool is busy: another frame run meanwhile
         (another thread's) runs in its calling process alone."""
@@ -416,7 +422,7 @@ class FruitPool:
                 self._busy.release()
                 return Running.here(fruit, jobs, check)
             with self._one_blas_thread():
-                collect = self._run(fruit, jobs, same, check)
+                collect = self._run(fruit, jobs, same, check, leave)
         except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
             self._interrupted()
             raise
@@ -472,8 +478,9 @@ class FruitPool:
         return self._wait_ready(0.0) if self.active else False
 
     def _run(
-        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None
-    ) -> Callable[[], tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None]:
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None,
+        leave: float | None,
+    ) -> Callable[[], tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None]:  # fmt: skip
         """:meth:`start`'s work: the task sent and this process's share done; returns what gives, once the workers'
         last fruit came, each fruit's :func:`_attempt` and the warnings a worker recorded for it (none for those done
         here), in ``jobs``' order, and the workers' CPU seconds (None: the run was called off)."""
@@ -503,10 +510,19 @@ class FruitPool:
         called_off = check is not None and not check()
         if called_off and not _take_all(self._lock, self._counter, len(todo)):
             lost = f"the fruit counter's lock was held for {STALL_TIMEOUT:.0f} s"
+        # pixels left from each place in ``todo`` on, and this process's seconds per pixel on its fruit (``leave``)
+        after = np.cumsum([0, *(pixels[i] for i in reversed(order))])[::-1] if leave is not None else None
+        own_s = own_px = 0.0
         while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
+            t = time.perf_counter()
             found[i] = _attempt(fruit, *todo[i])
             for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
                 lost = lost or self._take(w, seq, kind, found, warned, theirs, done, j, wait=0.0)[0]
+            if after is not None and leave is not None:
+                own_s, own_px = own_s + time.perf_counter() - t, own_px + pixels[order[i]]
+                untaken = after[min(int(self._counter.value), len(todo))]  # a read: at worst one fruit off
+                if own_px and own_s / own_px * untaken <= leave * len(workers):
+                    break
         return lambda: self._collect(fruit, jobs, todo, order, kind, seq, workers, found, warned, theirs, done, cpu,
                                      lost, called_off)  # fmt: skip
 
@@ -518,6 +534,13 @@ class FruitPool:
         """:meth:`_run`'s second half: the workers' last fruit waited for (a lost worker's done here)."""
         from .detect import _Fruit
 
+        if not lost and self._caller_shares:  # fruit left untaken (``leave``): this process takes them with the rest
+            while (i := _claim(self._lock, self._counter, len(todo))) is not None:
+                found[i] = _attempt(fruit, *todo[i])
+                for j, w in enumerate(workers):
+                    lost = lost or self._take(w, seq, kind, found, warned, theirs, done, j, wait=0.0)[0]
+                if lost:
+                    break
         for j, w in enumerate(workers):
             silent_since = time.monotonic()
             while not lost and not done[j]:
