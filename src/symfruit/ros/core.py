@@ -371,10 +371,6 @@ class FrameProcessor:
         seconds = {"decode": begun.decode, "detect": found.timings["total"], "collect": time.perf_counter() - t}
         return Processed(fruits, found, seconds)
 
-    def drop(self) -> None:
-        """Drop the frame in flight, if any (the fruit workers ended and started again)."""
-        self._stream.abandon()
-
 
 @dataclass(frozen=True)
 class Begun:
