@@ -476,12 +476,12 @@ def test_overlapped_frames_are_the_processors_in_order_and_a_bad_one_is_skipped(
         bad = (image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8"), messages[1], messages[2])  # not the depth's size
         expected = [(f.id, f.centre.tolist(), f.size.tolist(), f.score) for f in alone.process(*messages).fruits]
         events = []
-        overlapped = Overlapped(shared, done=lambda item, p: events.append((item, [(f.id, f.centre.tolist(),
+        overlapped = Overlapped(shared, done=lambda item, p: events.append((item[0], [(f.id, f.centre.tolist(),
                                 f.size.tolist(), f.score) for f in p.fruits])),
-                                skipped=lambda item, exc: events.append((item, type(exc))),
-                                failed=lambda item, exc: events.append((item, exc)))  # fmt: skip
-        for item, msgs in (("a", messages), ("bad", bad), ("b", messages), ("c", messages)):
-            overlapped.handle(item, *msgs, name=item, source="test")
+                                skipped=lambda item, exc: events.append((item[0], type(exc))),
+                                failed=lambda item, exc: events.append((item[0], exc)))  # fmt: skip
+        for name, msgs in (("a", messages), ("bad", bad), ("b", messages), ("c", messages)):
+            overlapped.handle((name, *msgs), name=name, source="test")
         # the bad one told when begun, before a (in flight) is finished; b finished when c came; c in flight
         assert events == [("bad", InputError), ("a", expected), ("b", expected)] and shared._stream.in_flight
         overlapped.drain()

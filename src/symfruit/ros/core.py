@@ -399,8 +399,12 @@ class Overlapped:
         self.core, self._done, self._skipped, self._failed = core, done, skipped, failed
         self._flight: tuple[Any, Begun] | None = None
 
-    def handle(self, item: Any, color: Any, depth: Any, info: Any, *, name: str, source: str) -> None:
-        """Begin the frame of ``item`` (three messages), finish the frame in flight, then start this one."""
+    def handle(self, item: tuple, *, name: str, source: str) -> None:
+        """Begin the frame of ``item`` (a node's: when it came, the colour, depth and camera info messages), finish
+        the frame in flight, then start this one. ``done`` and the others are given ``item`` with the time its
+        handling began added (``(came, color, depth, info, began)``)."""
+        _, color, depth, info = item
+        item = (*item, time.perf_counter())
         try:
             begun: Begun | None = self.core.begin(color, depth, info, name=name, source=source)
         except SymfruitError as exc:

@@ -207,9 +207,8 @@ class SymfruitNode:
         # the first subscription: a frame completed between subscribing and registering the callback was dropped.
         queue_size, slop = p["queue_size"], p["slop"]
         # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
-        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self._drain)
         self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
-        self.worker.start()
+        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self.overlapped.drain).start()
         subs = [
             message_filters.Subscriber(self.topics["color"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
             message_filters.Subscriber(self.topics["depth"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
@@ -238,13 +237,8 @@ class SymfruitNode:
         self.rospy.logwarn("symfruit: frame %s skipped: %s", _stamp(item[1]), exc)
 
     def _handle(self, item: tuple) -> None:
-        _, color, depth, info = item
-        stamp = _stamp(color)
-        self.overlapped.handle((*item, time.perf_counter()), color, depth, info, name=stamp,
-                               source=f"ros:{self.topics['color']}@{stamp}")  # fmt: skip
-
-    def _drain(self) -> None:
-        self.overlapped.drain()
+        stamp = _stamp(item[1])
+        self.overlapped.handle(item, name=stamp, source=f"ros:{self.topics['color']}@{stamp}")
 
     def _publish(self, item: tuple, processed: Processed) -> None:
         t_in, color, _, _, t_start = item

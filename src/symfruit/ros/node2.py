@@ -234,9 +234,8 @@ class Ros2Node:
         in_qos = QoSProfile(depth=p["queue_size"]) if p["qos"] == "reliable" else qos_profile_sensor_data
         self.sync = ApproximateSync(3, self._on_frame, slop=p["slop"], queue_size=p["queue_size"])
         # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
-        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self._drain)
         self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
-        self.worker.start()
+        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self.overlapped.drain).start()
         self.subs = [
             self.node.create_subscription(kind, self.topics[name], self._adder(i, name), in_qos)
             for i, (name, kind) in enumerate((("color", Image), ("depth", Image), ("camera_info", CameraInfo)))
@@ -279,13 +278,8 @@ class Ros2Node:
         self.log.warning(f"symfruit: frame {stamp_text(item[1].header)} skipped: {exc}")
 
     def _handle(self, item: tuple) -> None:
-        _, color, depth, info = item
-        stamp = stamp_text(color.header)
-        self.overlapped.handle((*item, time.perf_counter()), color, depth, info, name=stamp,
-                               source=f"ros2:{self.topics['color']}@{stamp}")  # fmt: skip
-
-    def _drain(self) -> None:
-        self.overlapped.drain()
+        stamp = stamp_text(item[1].header)
+        self.overlapped.handle(item, name=stamp, source=f"ros2:{self.topics['color']}@{stamp}")
 
     def _publish(self, item: tuple, processed: Processed) -> None:
         t_in, color, _, _, t_start = item
