@@ -175,7 +175,8 @@ def detect(
     docs/proc53.md). The detections are the same, bit for bit, in the same order; an error a fruit raises is the
     first failing fruit's; ``timings``' ``extract``, ``occlusion`` and ``complete`` are then the sums of each fruit's
     own wall times (more than the frame's wall time they took) and ``cpu`` counts the workers' CPU on the fruit too.
-    None (the default), an inactive pool or a frame of fewer than two fruit: everything in this process.
+    None (the default), an inactive pool or a frame of fewer than two fruit: everything in this process. Frames
+    that come one after another overlap with a pool in a :class:`DetectStream` (stop 55).
     """
     return _start(_prepare(frame, masks, method, settings, pool), pool).result()
 
@@ -215,10 +216,6 @@ def _prepare(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = _label_boxes(labels, hi)
-    # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
-    # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
-    # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
-    # stop 47, docs/mask47.md)
     return _Prepared(frame, labels, hi, boxes, source, settings, method, t0, cpu0, t1, time.thread_time() - cpu0,
                      time.perf_counter())  # fmt: skip
 
@@ -249,6 +246,10 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
     :meth:`~symfruit.fruitpool.FruitPool.start`'s (the seconds this process will spend elsewhere before it asks)."""
     frame, labels, boxes, settings, method = prep.frame, prep.labels, prep.boxes, prep.settings, prep.method
     t2, cpu2 = time.perf_counter(), time.thread_time()  # trimming, registration and extraction start
+    # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
+    # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
+    # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
+    # stop 47, docs/mask47.md)
     outlined = prep.source != COLOUR_SEGMENTER
     if pool is not None and pool.active and sum(sl is not None for sl in boxes) >= 2:
         # each mask's trimming and registration outline shared with the workers too, and the fruit sent to them
