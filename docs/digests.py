@@ -11,7 +11,9 @@ digests mean the same results. The digests depend on the host's libraries (BLAS)
 ``docs/speed_ab.py --trees 6`` times (seeds 0-5, ``make_tree_scene``'s default sensor, the apple profile; stop 54).
 
 ``--fruit-processes N``: the records with each frame's fruit shared with N worker processes
-(:class:`symfruit.fruitpool.FruitPool`, stop 53): the same digest as without them.
+(:class:`symfruit.fruitpool.FruitPool`, stop 53): the same digest as without them. ``--stream`` (with it): the
+frames of each method through a :class:`symfruit.detect.DetectStream` (stop 55: the next frame segmented while
+the workers end the last one's fruit), as ``symfruit detect --fruit-processes N`` runs a recording: the same digest.
 """
 
 import argparse
@@ -21,7 +23,7 @@ import sys
 import numpy as np
 
 
-def records(fruit_processes: int = 0) -> str:
+def records(fruit_processes: int = 0, stream: bool = False) -> str:
     from symfruit.detect import detect
     from symfruit.evaluate.bench import _bench_scene
     from symfruit.fruitpool import FruitPool
@@ -29,7 +31,7 @@ def records(fruit_processes: int = 0) -> str:
     with FruitPool(fruit_processes) as pool:
         if fruit_processes and not pool.active:
             raise SystemExit(f"--fruit-processes {fruit_processes}: no worker here ({pool.reason})")
-        found = _records(detect, _bench_scene, pool)
+        found = _records(_streamed(_bench_scene, pool) if stream else detect, _bench_scene, pool)
         if fruit_processes and not pool.fruit_elsewhere:
             raise SystemExit(f"--fruit-processes {fruit_processes}: the workers did no fruit")
     return found
@@ -56,6 +58,25 @@ def _records(detect, bench_scene, pool) -> str:
                     numeric = isinstance(v, np.ndarray | float | int)
                     h.update(np.asarray(v).tobytes() if numeric else repr(v).encode())
     return h.hexdigest()[:16]
+
+
+def _streamed(bench_scene, pool):
+    """A ``detect`` for :func:`_records` that gives the detections each method's frames got in a stream, in the
+    order :func:`_records` asks for them."""
+    from symfruit.detect import DetectStream
+
+    got = {}
+    for method in ("evidence", "paper"):
+        stream, seeds = DetectStream(pool, method=method), [None, 0, 1, 2]
+        for before, seed in zip(seeds, [*seeds[1:], None], strict=True):
+            ready = None if seed is None else stream.prepare(bench_scene(None, seed)[0])
+            found = stream.finish()
+            if found is not None:
+                got[before, method] = found
+            if ready is not None:
+                stream.start(ready)
+    order = iter([(seed, method) for seed in (0, 1, 2) for method in ("evidence", "paper")])
+    return lambda frame, *, method, pool: got[next(order)]
 
 
 def labels() -> tuple[str, int]:
@@ -110,12 +131,13 @@ def main() -> None:
         metavar="N",
         help="records: each frame's fruit shared with N worker processes (default 0: none)",
     )
+    parser.add_argument("--stream", action="store_true", help="records: the frames in a stream (DetectStream)")
     args = parser.parse_args()
     args.what = args.what or ["records", "labels"]
     if not set(args.what) <= {"records", "labels", "trees"}:
         parser.error(f"what: give records, labels and/or trees, got {' '.join(args.what)}")
     if "records" in args.what:
-        sys.stdout.write(f"records {records(args.fruit_processes)}\n")
+        sys.stdout.write(f"records {records(args.fruit_processes, args.stream)}\n")
     if "labels" in args.what:
         digest, found = labels()
         sys.stdout.write(f"labels {digest} {found} fruit\n")

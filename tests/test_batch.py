@@ -72,6 +72,60 @@ def test_a_fruit_pool_gives_the_same_records_and_is_refused_with_a_cluster(tmp_p
     assert _fruits(tmp_path / "one") == _fruits(tmp_path / "two")
 
 
+def outcome(report: BatchReport, output: Path) -> str:
+    """A report's frames, errors and counts, its output folder's name left out of them."""
+    said = (report.done, report.failed, report.skipped, report.unprocessed, report.stopped, report.fruits)
+    return repr(said).replace(str(output), "OUTPUT")
+
+
+@pytest.mark.parametrize("failing", [ValueError("f3 cannot be written"), OSError(errno.ENOSPC, "No space left")],
+                         ids=["a frame fails as it is written", "the disk is full"])  # fmt: skip
+def test_a_recording_streamed_with_a_fruit_pool_gives_each_frame_its_outcome(tmp_path, monkeypatch, failing):
+    """With a pool the frames go in a stream (issue 19, stop 55: frame n+1 read and segmented before frame n is
+    finished, frame n+1 started, frame n written): each frame's records, errors and the report's order are one
+    process's; a full disk stops at the frame it hit, the one started after it dropped and not processed."""
+    from symfruit.fruitpool import FruitPool, one_process_reason
+
+    if one_process_reason(1):
+        pytest.skip(f"no worker processes here: {one_process_reason(1)}")
+    frames = tmp_path / "rec"
+    for name in ("f1", "f2", "f3", "f4", "f5"):
+        shutil.copytree(EXAMPLE_FRAME, frames / name)
+    (frames / "f2" / "depth.png").write_bytes(b"not a png")  # refused when read, the frame before in flight
+    real = batch.write_detections
+
+    def write_detections(folder, found, **kwargs):
+        if folder.name == "f3":
+            raise failing
+        return real(folder, found, **kwargs)
+
+    monkeypatch.setattr(batch, "write_detections", write_detections)
+    one = run_batch(frames, tmp_path / "one", progress=False)
+    with FruitPool(1, method=None) as pool:
+        pool._caller_shares = False  # the worker does every fruit
+        two = run_batch(frames, tmp_path / "two", progress=False, pool=pool)
+        each = two.fruits // len(two.done)  # the same frame's fruit; f3's were done too, then not written
+        assert pool.fruit_elsewhere == each * (len(two.done) + 1) and each >= 2
+        # a full disk at f3 drops f4, started meanwhile: its workers ended (new ones started)
+        assert pool.starts == (2 if two.stopped else 1), pool.last_loss
+        assert outcome(two, tmp_path / "two") == outcome(one, tmp_path / "one")
+        assert list(two.failed) == ["f2", "f3"] and _fruits(tmp_path / "two") == _fruits(tmp_path / "one")
+        errors = [(tmp_path / out / "errors.json").read_text().replace(str(tmp_path / out), "OUTPUT")
+                  for out in ("one", "two")]  # fmt: skip
+        assert errors[0] == errors[1]
+        if two.stopped:
+            assert two.done == ["f1"] and two.unprocessed == ["f4", "f5"]
+        else:
+            assert two.done == ["f1", "f4", "f5"]
+        monkeypatch.undo()  # resumed: the frames done skipped, the others run again
+        (frames / "f2" / "depth.png").write_bytes((frames / "f1" / "depth.png").read_bytes())
+        one = run_batch(frames, tmp_path / "one", progress=False, resume=True)
+        two = run_batch(frames, tmp_path / "two", progress=False, pool=pool, resume=True)
+        assert outcome(two, tmp_path / "two") == outcome(one, tmp_path / "one") and two.ok
+        assert two.skipped == (["f1"] if failing.args[0] == errno.ENOSPC else ["f1", "f4", "f5"])
+    assert _fruits(tmp_path / "two") == _fruits(tmp_path / "one")
+
+
 def test_resume_runs_again_a_frame_whose_record_cannot_be_read_back(tmp_path):
     # a detections.json truncated by a copy was trusted: the frame was skipped, then left out of the tables
     frames = recording(tmp_path / "rec", "f1", "f2")

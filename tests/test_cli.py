@@ -824,7 +824,12 @@ def test_evaluate_masks_goes_on_past_a_bad_photograph_and_names_it(tmp_path, cap
      (["detect", "rec", "--output", "o", "--fruit-processes", "-1"], "--fruit-processes must be a whole number"),
      (["detect", "rec", "--output", "o", "--fruit-processes", "1", "--workers", "2"], "--fruit-processes shares each "
       "frame's fruit with processes of this one: a Dask cluster's workers (--scheduler, --workers) are one of"),
-     (["bench", "--fruit-processes", "1"], "bench --fruit-processes is for --frame; here it would be ignored"),
+     (["bench", "--fruit-processes", "1"], "bench --fruit-processes is for --frame or --recording; here it would "
+      "be ignored"),
+     (["bench", "--stream", "5"], "bench --stream is for --frame; here it would be ignored"),
+     (["bench", "--frame", "--stream", "5", "--stages"], "--stream and --stages do not go"),
+     (["bench", "--recording", "3", "--workers", "2", "--fruit-processes", "1"], "--fruit-processes shares each "
+      "frame's fruit in one process; --workers runs"),
      (["bench", "--frame", "--fruit-processes", "17"], "--fruit-processes must be a whole number from 0 to 16"),
      (["bench", "--frame", "--profile", "--fruit-processes", "1"], "--profile and --fruit-processes do not go")],
 )  # fmt: skip

@@ -16,7 +16,7 @@ import pytest
 from symfruit import InputError, SymfruitError
 from symfruit import fruitpool as fp
 from symfruit.core.frame import Frame
-from symfruit.detect import _Fruit, _Masks, _shared_masks, _trim_labels, detect, frame_masks
+from symfruit.detect import DetectStream, _Fruit, _Masks, _shared_masks, _trim_labels, detect, frame_masks
 from symfruit.fruitpool import MAX_FRUIT_PROCESSES, FruitPool, check_fruit_processes, one_process_reason
 from symfruit.writers import detection_record
 
@@ -679,3 +679,153 @@ def test_a_worker_dying_in_a_run_called_off_is_replaced(workers_only):
     assert pool._wait_ready(fp.START_TIMEOUT)
     before = pool.fruit_elsewhere
     assert [d[0].id for d in pool.run(task, jobs)[0]] == [1, 2, 3, 4] and pool.fruit_elsewhere == before + 4
+
+
+# --- stop 55: frames in a stream (FruitPool.start, detect.DetectStream; docs/pipe55.md) ---------------------------
+
+
+def streamed(stream, frames):
+    """Each of ``frames`` through ``stream`` as a recording goes (the next prepared, the last finished, the next
+    started): the detections in the frames' order."""
+    out = []
+    for frame in frames:
+        ready = stream.prepare(frame)
+        out.append(stream.finish())
+        stream.start(ready)
+    out.append(stream.finish())
+    assert out[0] is None and not stream.in_flight
+    return out[1:]
+
+
+@pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
+def test_a_stream_gives_each_frames_detections_as_detect(pool, monkeypatch, shares):
+    """The frames of frames() twice, in one stream: each frame's detections are detect's without a pool, bit for
+    bit, whichever process did which fruit."""
+    monkeypatch.setattr(pool, "_caller_shares", shares)
+    for method in ("raw", "evidence"):
+        given_frames = [frame for _, frame, _ in frames()] * 2
+        before, starts = pool.fruit_elsewhere, pool.starts
+        got = streamed(DetectStream(pool, method=method), given_frames)
+        for frame, found in zip(given_frames, got, strict=True):
+            assert_same(detect(frame, method=method), found)
+        assert pool.starts == starts, pool.last_loss
+        if not shares:  # the workers did every fruit of every frame of two fruit or more
+            assert pool.fruit_elsewhere - before == sum(len(f.detections) for f in got if len(f.detections) >= 2)
+
+
+class FailsOnSmall(Warns):
+    """A fruit task that warns for fruit 1 and raises for fruit 2 of a 160x120 frame (four()), not of others."""
+
+    def __call__(self, k, sl):
+        small_frame = self.depth.shape == (120, 160)
+        self.warn, self.fail = ({1} if small_frame else set()), ({2: "fruit 2 failed"} if small_frame else {})
+        return super().__call__(k, sl)
+
+
+@pytest.mark.parametrize("shares", [True, False], ids=["shared", "workers only"])
+def test_a_streamed_frames_errors_and_warnings_come_with_it(pool, monkeypatch, shares):
+    """A frame's fruit's error is raised when it is finished (after the next frame was prepared), its workers'
+    warnings given then; a frame refused when prepared raises there and leaves the frame in flight as it was."""
+    monkeypatch.setattr(pool, "_caller_shares", shares)
+    monkeypatch.setattr("symfruit.detect._Fruit", FailsOnSmall)
+    whole = small([(40, 60)], np.ones((120, 160), np.int32))  # one mask over the whole image: refused
+    stream = DetectStream(pool, method="raw")
+    stream.start(stream.prepare(bench(0)))
+    ready = stream.prepare(four())
+    first = stream.finish()
+    with warnings.catch_warnings(record=True) as started:
+        warnings.simplefilter("always")
+        stream.start(ready)
+    with pytest.raises(InputError, match="covers the whole image"):
+        stream.prepare(whole)
+    assert stream.in_flight  # four() still
+    with warnings.catch_warnings(record=True) as finished:
+        warnings.simplefilter("always")
+        with pytest.raises(ValueError, match="fruit 2 failed"):
+            stream.finish()
+    # fruit 1's warning, once: given when the frame is finished if a worker did it, at once if this process did
+    assert [str(w.message) for w in started + finished] == ["a fruit warns"]
+    assert shares or not started
+    assert not stream.in_flight
+    last = streamed(stream, [bench(1)])
+    monkeypatch.undo()
+    assert_same(detect(bench(0), method="raw"), first)
+    assert_same(detect(bench(1), method="raw"), last[0])
+
+
+def test_a_frame_in_flight_dropped_ends_the_workers_and_the_next_is_right():
+    before = ours()
+    with FruitPool(1, method=None) as pool:
+        stream = DetectStream(pool, method="raw")
+        stream.start(stream.prepare(four()))
+        first = pool._state.workers[0].process
+        stream.abandon()
+        stream.abandon()  # twice: harmless
+        assert not stream.in_flight and not first.is_alive() and pool.starts == 2
+        assert pool.last_loss == "a frame was dropped before its workers' fruit came"
+        assert pool._wait_ready(fp.START_TIMEOUT)
+        assert_same(detect(four(), method="raw"), streamed(stream, [four()])[0])
+        processes = [w.process for w in pool._state.workers]
+    assert not any(p.is_alive() for p in processes) and ours() - before == set()
+
+
+class DiesOnSmall(_Fruit):
+    """A fruit task whose worker dies on fruit 3 of a 160x120 frame (four())."""
+
+    def __call__(self, k, sl):
+        if k == 3 and self.depth.shape == (120, 160) and fp._IN_WORKER:
+            os.kill(os.getpid(), signal.SIGKILL)
+        return super().__call__(k, sl)
+
+
+def test_a_worker_dying_with_a_frame_in_flight_leaves_its_fruit_to_this_process(workers_only, monkeypatch):
+    pool = workers_only
+    one = [detect(frame, method="raw") for frame in (four(), bench(0))]
+    monkeypatch.setattr("symfruit.detect._Fruit", DiesOnSmall)
+    starts = pool.starts
+    got = streamed(DetectStream(pool, method="raw"), [four(), bench(0)])
+    assert pool.starts == starts + 1 and "ended within a frame" in pool.last_loss
+    for a, b in zip(one, got, strict=True):
+        assert_same(a, b)
+
+
+def test_a_run_while_a_frame_is_in_flight_runs_in_this_process_alone(pool):
+    """The frame in flight keeps the pool busy: another frame meanwhile (another thread's, or this one's by
+    mistake) runs here alone and is right; the one in flight is right too."""
+    task, jobs = fruit_task(four())
+    alone = [record(d[0]) for d in (task(k, sl) for k, sl in jobs)]
+    assert pool._wait_ready(fp.START_TIMEOUT)  # warm (after another test's lost worker): the pool shares
+    running = pool.start(task, jobs)
+    assert running.pending
+    before = pool.fruit_elsewhere
+    assert [record(d[0]) for d in pool.run(task, jobs)[0]] == alone and pool.fruit_elsewhere == before
+    done, _ = running.result()
+    assert [record(d[0]) for d in done] == alone and not running.pending
+    assert running.result() is None  # had once: nothing more
+
+
+class Counted(_Fruit):
+    """A fruit task that notes, in the calling process, the fruit done there."""
+
+    def __call__(self, k, sl):
+        if not fp._IN_WORKER:
+            self.here.append(k)
+        return super().__call__(k, sl)
+
+
+def test_the_calling_process_leaves_the_workers_the_fruit_left_when_told_it_has_other_work(pool):
+    """``leave``: the calling process stops taking fruit once those left would keep the workers about that long
+    (here, after its first: more seconds than any fruit takes); the rest are done when the result is asked for (by
+    the workers, or here if they left some). The answers are the same."""
+    task, jobs = fruit_task(four(), Counted)
+    task.here = []
+    alone = [record(d[0]) for d in (task(k, sl) for k, sl in jobs)]
+    assert pool._wait_ready(fp.START_TIMEOUT)
+    for leave in (1e9, None):
+        task.here = []
+        running = pool.start(task, jobs, leave=leave)
+        took = list(task.here)
+        done, _ = running.result()
+        assert [record(d[0]) for d in done] == alone
+        if leave:
+            assert len(took) <= 1  # its first fruit (none if the worker took them all first)

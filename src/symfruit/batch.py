@@ -23,7 +23,7 @@ from typing import Any, TypeVar
 import numpy as np
 
 from .core.limits import instance_labels
-from .detect import FrameDetections, detect
+from .detect import DetectStream, FrameDetections, detect
 from .errors import FileFormatError, InputError, OutputError, SymfruitError
 from .fruitpool import FruitPool
 from .io.atomic import folder_fd
@@ -239,11 +239,91 @@ def _run_recording(
     now = src.names()
     where = {n: i for i, n in enumerate(now)} if now != names else None  # changed since it was listed
     with once_per_recording(str(rec.source)) as current:
+        if pool is not None and pool.active:  # frames in a stream: the next one segmented beside the workers
+            _stream_recording(src, rec, names, where, masks, method, settings, resume, on_frame, reserved, report,
+                              bar, out, pool, current)  # fmt: skip
+            return
         for index, name in enumerate(names):
             current[0] = name
             if not _one(src, rec, index, name, names, where, masks, method, settings, resume, on_frame, reserved,
                         report, bar, out, pool):  # fmt: skip
                 return
+
+
+def _stream_recording(
+    src: Any, rec: Recording, names: list[str], where: dict[str, int] | None, masks: str, method: str,
+    settings: Settings, resume: bool, on_frame: Callable[[int, FrameDetections], None] | None,
+    reserved: Sequence[str], report: BatchReport, bar: Progress, out: OutputFolder, pool: FruitPool,
+    current: list[str],
+) -> None:  # fmt: skip
+    """:func:`_run_recording`'s frames with an active ``pool``, in a :class:`~symfruit.detect.DetectStream` (issue
+    19, stop 55, docs/pipe55.md): frame n+1 is read and segmented while the workers end frame n's fruit; then frame
+    n is finished, frame n+1 started (the workers left a share of its fruit), and frame n written meanwhile. Each
+    frame keeps its error boundary, its errors and warnings (a frame's reading and segmentation errors are its own,
+    its fruit's come when it is finished, its files' when it is written), and the report lists the frames in their
+    order. At most one frame is in flight beside the one read; a full disk or an interrupt drops the one in flight
+    (the pool's workers ended, as after an interrupt within a frame), listed as not processed."""
+    stream = DetectStream(pool, masks=masks, method=method, settings=settings)
+    flight: tuple[int, str, Path] | None = None  # the frame started and not finished: its index, name and folder
+
+    def guarded(work: Callable[[], Any], name: str, folder: Path, failed: dict[str, str]) -> tuple[bool, Any, str]:
+        current[0] = name
+        return _guarded(work, item=rec.key + name, failed=failed, target=folder, at=f"frame {rec.key + name}",
+                        cleanup=partial(_clear_frame, folder, out))  # fmt: skip
+
+    try:
+        for index, name in enumerate([*names, None]):  # None: the last frame's end
+            later: dict[str, str] = {}  # this frame's failure, recorded after the frame before's outcome
+            folder = rec.folder / frame_folder_name(name, reserved) if name is not None else rec.folder
+            skip = name is not None and resume and frame_done(folder, name)
+            ready: Any = None
+            if name is not None and not skip:
+
+                def prepared(index: int = index, name: str = name) -> Any:
+                    if where is not None and name not in where:
+                        raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run "
+                                              "began")  # fmt: skip
+                    return stream.prepare(src.read(index if where is None else where[name]))
+
+                ready = guarded(prepared, name, folder, later)[1]  # nothing written: never a full disk's stop
+            found = None
+            if flight is not None:  # the frame before finished: its fruit's error is its own
+                done, found, _ = guarded(stream.finish, flight[1], flight[2], report.failed)
+                if not done:
+                    bar.update()
+            started = None
+            if ready is not None and name is not None and guarded(partial(stream.start, ready), name, folder, later)[0]:
+                started = (index, name, folder)
+            if flight is not None and found is not None:  # written while the workers do this frame's fruit
+
+                def written(index: int = flight[0], folder: Path = flight[2], found: Any = found) -> FrameDetections:
+                    if on_frame is not None:
+                        on_frame(index, found)
+                    write_detections(folder, found, settings=settings)
+                    return found
+
+                done, _, report.stopped = guarded(written, flight[1], flight[2], report.failed)
+                if report.stopped:  # this frame, started or not, and those after it are not processed
+                    report.unprocessed = [rec.key + n for n in names[flight[0] + 1 :]]
+                    return
+                _counted(report, rec.key + flight[1], done, found)
+                bar.update()
+            flight = started
+            report.failed.update(later)
+            if skip:
+                report.skipped.append(rec.key + str(name))
+            if name is not None and started is None:  # skipped or failed
+                bar.update()
+    finally:
+        stream.abandon()  # a full disk or an interrupt: the frame in flight dropped
+
+
+def _counted(report: BatchReport, key: str, done: bool, found: FrameDetections | None) -> None:
+    """A frame's outcome in ``report``: done, with its fruit counted (a failed one was recorded by :func:`_guarded`)."""
+    if done and found is not None:
+        report.done.append(key)
+        report.fruits += sum(d.result is not None for d in found.detections)
+        report.failed_fruits += sum(d.result is None for d in found.detections)
 
 
 @contextlib.contextmanager
@@ -311,10 +391,7 @@ def _one(
     if report.stopped:
         report.unprocessed = [rec.key + n for n in names[index + 1 :]]
         return False
-    if done and found is not None:
-        report.done.append(key)
-        report.fruits += sum(d.result is not None for d in found.detections)
-        report.failed_fruits += sum(d.result is None for d in found.detections)
+    _counted(report, key, done, found)
     bar.update()
     return True
 

@@ -102,8 +102,13 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--workers", type=int, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
     p.add_argument("--fruit-processes", type=int, default=None, metavar="N",
-                   help="with --frame: each frame's fruit shared with N worker processes, started and warmed up "
-                   "before the timing (0-16, default 0; as symfruit detect --fruit-processes)")  # fmt: skip
+                   help="with --frame or --recording: each frame's fruit shared with N worker processes, started "
+                   "and warmed up before the timing with --frame (0-16, default 0; as symfruit detect "
+                   "--fruit-processes)")  # fmt: skip
+    p.add_argument("--stream", type=int, default=None, metavar="F",
+                   help="with --frame: frames per second over F frames one after another, each alone and in a "
+                   "stream (the next frame segmented while the fruit workers end the last), alternated --repeat "
+                   "times (default 3)")  # fmt: skip
     p.add_argument(
         "--segment",
         action="store_true",
@@ -422,7 +427,8 @@ def _check_bench_options(args: argparse.Namespace) -> None:
         ("--profile", args.profile, ("--frame",)),
         ("--stages", args.stages, ("--frame",)),
         ("--workers", args.workers is not None, ("--recording",)),
-        ("--fruit-processes", args.fruit_processes is not None, ("--frame",)),
+        ("--fruit-processes", args.fruit_processes is not None, ("--frame", "--recording")),
+        ("--stream", args.stream is not None, ("--frame",)),
         ("--images", args.images is not None, ("--segment",)),
         ("--size", args.size is not None, ("--segment",)),
         ("--scene", args.scene is not None, ("--segment",)),
@@ -432,6 +438,8 @@ def _check_bench_options(args: argparse.Namespace) -> None:
             need = " or ".join(k or "the cloud bench (no --frame, --recording or --segment)" for k in kinds_for)
             raise InputError(f"bench {option} is for {need}; here it would be ignored")
     for a, b, on in (("--profile", "--stages", args.profile and args.stages),
+                     ("--stream", "--stages", args.stream is not None and (args.stages or args.profile)),
+                     ("--stream", "--sensor", args.stream is not None and args.sensor is not None),
                      ("--profile", "--fruit-processes", args.profile and args.fruit_processes is not None),
                      ("--profile", "--json", args.profile and args.json),
                      ("--scene", "--images", args.scene is not None and args.images is not None),
@@ -446,6 +454,7 @@ def _bench(args: argparse.Namespace) -> int:
     from .evaluate.bench import machine, run_bench
 
     _check_bench_options(args)
+    rounds = 3 if args.repeat is None else args.repeat  # --frame --stream's (alternated modes)
     args.repeat = 200 if args.repeat is None else args.repeat
     args.points = [600, 3000] if args.points is None else args.points
     args.size = "640x480" if args.size is None else args.size
@@ -487,7 +496,11 @@ def _bench(args: argparse.Namespace) -> int:
             require_distributed()
             if not 1 <= args.workers <= 256:
                 local_cluster(args.workers)  # refuses with the message of detect --workers
-        rec = bench_recording(args.recording, method=_method(args), workers=args.workers)
+        if args.workers is not None and args.fruit_processes:
+            raise InputError("bench --recording: --fruit-processes shares each frame's fruit in one process; "
+                             "--workers runs frames on a cluster whose workers are one of several already")  # fmt: skip
+        rec = bench_recording(args.recording, method=_method(args), workers=args.workers,
+                              fruit_processes=_fruit_processes(args))  # fmt: skip
         if args.json:
             print(json.dumps({"machine": machine(), "recording": rec.to_dict()}, indent=2))
             return 0
@@ -499,8 +512,9 @@ def _bench(args: argparse.Namespace) -> int:
                   f"{rec.peak_rss_mb:.0f} MB; overhead per task {rec.task_overhead_ms:.1f} ms CPU (client, scheduler "
                   f"and worker together), {rec.task_wall_ms:.1f} ms wall per empty task")  # fmt: skip
             return 0
-        print(f"symfruit bench --recording: {rec.frames} frames ({rec.frames_done} written), method {rec.method}: "
-              f"{rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "
+        pooled = f", --fruit-processes {args.fruit_processes}" if args.fruit_processes else ""
+        print(f"symfruit bench --recording: {rec.frames} frames ({rec.frames_done} written), method {rec.method}"
+              f"{pooled}: {rec.seconds:.1f} s, {rec.frames / rec.seconds:.1f} frames/s, "
               f"peak RSS {rec.peak_rss_mb:.0f} MB")  # fmt: skip
         return 0
     if args.frame:
@@ -518,6 +532,8 @@ def _bench(args: argparse.Namespace) -> int:
             if fruit_processes and not args.json:
                 print(f"symfruit bench --frame: {fruit_processes} fruit worker process"
                       f"{'es' if fruit_processes > 1 else ''} started and warm in {pool.started_s:.1f} s")  # fmt: skip
+            if args.stream is not None:
+                return _bench_stream(args, methods[0], pool, min(rounds, 100))
             return _bench_frame(args, methods, pool)
     rows = run_bench(repeat=args.repeat, points=tuple(args.points))
     return _bench_rows(args, rows)
@@ -549,6 +565,29 @@ def _bench_frame(args: argparse.Namespace, methods: tuple[str, ...], pool: Any) 
         return 0
     rows = [bench_frame(repeat=min(args.repeat, 50), method=m, sensor=args.sensor, pool=pool) for m in methods]
     return _bench_rows(args, rows)
+
+
+def _bench_stream(args: argparse.Namespace, method: str, pool: Any, rounds: int) -> int:
+    """``symfruit bench --frame --stream F``: frames per second, each frame alone against frames in a stream."""
+    import numpy as np
+
+    from .errors import InputError
+    from .evaluate.bench import bench_stream, machine
+
+    if not 2 <= args.stream <= 100_000:
+        raise InputError(f"--stream must be 2-100000 frames, got {args.stream}")
+    got = bench_stream(args.stream, rounds=rounds, method=method, pool=pool)
+    if args.json:
+        print(json.dumps({"machine": machine(), "stream": got}))
+        return 0
+    print(f"symfruit bench --frame --stream {args.stream}: {method}, {_processes(args)}, {rounds} rounds alternated; "
+          "frames/s (wall) each round, median CPU ms per frame (this thread and the workers) and median frame's "
+          "own wall ms")  # fmt: skip
+    for name, row in got.items():
+        fps = ", ".join(f"{v:.1f}" for v in row["fps"])
+        print(f"{name:<8} {fps} frames/s (median {np.median(row['fps']):.1f}); cpu {np.median(row['cpu_ms']):.1f} "
+              f"ms, frame {np.median(row['latency_ms']):.1f} ms")  # fmt: skip
+    return 0
 
 
 def _processes(args: argparse.Namespace) -> str:

@@ -37,7 +37,7 @@ from .extract import (
     trim_labels,
     trim_mask,
 )
-from .fruitpool import FruitPool
+from .fruitpool import FruitPool, Running
 from .io.frames import COLOR_FILE
 from .methods import DEFAULT_METHOD
 from .methods.complete import Result, complete
@@ -48,7 +48,7 @@ from .segment.colour import _leaf as leaf_green
 from .segment.source import COLOUR_SEGMENTER
 from .settings import Settings, section_types
 
-__all__ = ["MAX_FRUIT_PER_FRAME", "Detection", "FrameDetections", "FruitPool", "detect", "frame_masks"]
+__all__ = ["MAX_FRUIT_PER_FRAME", "DetectStream", "Detection", "FrameDetections", "FruitPool", "detect", "frame_masks"]
 
 #: Most instances one frame's masks may hold (a label image with more is not a fruit mask).
 MAX_FRUIT_PER_FRAME = MAX_INSTANCES
@@ -175,8 +175,17 @@ def detect(
     docs/proc53.md). The detections are the same, bit for bit, in the same order; an error a fruit raises is the
     first failing fruit's; ``timings``' ``extract``, ``occlusion`` and ``complete`` are then the sums of each fruit's
     own wall times (more than the frame's wall time they took) and ``cpu`` counts the workers' CPU on the fruit too.
-    None (the default), an inactive pool or a frame of fewer than two fruit: everything in this process.
+    None (the default), an inactive pool or a frame of fewer than two fruit: everything in this process. Frames
+    that come one after another overlap with a pool in a :class:`DetectStream` (stop 55).
     """
+    return _start(_prepare(frame, masks, method, settings, pool), pool).result()
+
+
+def _prepare(
+    frame: Frame, masks: str | Path | MaskSource | Segmenter | np.ndarray, method: str, settings: Settings | None,
+    pool: FruitPool | None,
+) -> _Prepared:  # fmt: skip
+    """:func:`detect`'s first part, which needs no pool: the checks, the frame's masks and their boxes."""
     if not isinstance(frame, Frame):
         raise InputError(f"detect needs a Frame (symfruit.io.read_frame or a frame source), got {type(frame).__name__}")
     if settings is not None and not isinstance(settings, Settings):
@@ -204,21 +213,51 @@ def detect(
     # tell it (a bincount of the image cost 0.3 ms a frame; issue 19, stop 41)
     if labels.size and lo == hi and lo > 0:
         raise InputError(f"frame {frame.name}: mask {lo} covers the whole image; that is not a fruit")
-    t2 = time.perf_counter()  # trimming, registration and extraction start
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = _label_boxes(labels, hi)
+    return _Prepared(frame, labels, hi, boxes, source, settings, method, t0, cpu0, t1, time.thread_time() - cpu0,
+                     time.perf_counter())  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _Prepared:
+    """A frame :func:`_prepare` made ready: its labels (greatest ``hi``) and their boxes, where they came from, and
+    when it started (``t0``, ``cpu0``), its masks were had (``t1``) and it was ready (``cpu``: its CPU seconds so
+    far, ``t2``)."""
+
+    frame: Frame
+    labels: np.ndarray
+    hi: int
+    boxes: list[tuple[slice, slice] | None]
+    source: str
+    settings: Settings
+    method: str
+    t0: float
+    cpu0: float
+    t1: float
+    cpu: float
+    t2: float
+
+
+def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) -> _Started:
+    """:func:`detect`'s second part: trimming, registration and the fruit; with an active ``pool`` the workers'
+    last fruit may still be running when it returns (:meth:`_Started.result` waits for them), and ``leave`` is
+    :meth:`~symfruit.fruitpool.FruitPool.start`'s (the seconds this process will spend elsewhere before it asks)."""
+    frame, labels, boxes, settings, method = prep.frame, prep.labels, prep.boxes, prep.settings, prep.method
+    t2, cpu2 = time.perf_counter(), time.thread_time()  # trimming, registration and extraction start
     # a fruit's outline as drawn (a masks file, a label array, a model) may cover a leaf or branch in front that runs
     # on across it; the colour segmenter's masks are the visible surface alone, grown from the fruit's colour with
     # what lies off its depth dropped: extraction's test for such an occluder is skipped on them (0.4 ms a fruit;
     # stop 47, docs/mask47.md)
-    outlined = source != COLOUR_SEGMENTER
+    outlined = prep.source != COLOUR_SEGMENTER
     if pool is not None and pool.active and sum(sl is not None for sl in boxes) >= 2:
         # each mask's trimming and registration outline shared with the workers too, and the fruit sent to them
         # while the search for the shift runs here (stop 54, docs/pool54.md): the same detections
-        done, shift, t_trim, t_register, cpu_elsewhere = _detect_shared(pool, frame, labels, hi, boxes, settings,
-                                                                        method, outlined)  # fmt: skip
-        t_extract, t_complete, t_occlusion = t_trim + t_register, 0.0, 0.0
+        running, shift, t_trim, t_register, cpu_elsewhere = _detect_shared(
+            pool, frame, labels, prep.hi, boxes, settings, method, outlined, leave
+        )
+        t_extract = t_trim + t_register
     else:
         # the masks colour trimmed (stop 43: one the colour could not trim is still as drawn, and its overshoot is
         # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for
@@ -229,19 +268,47 @@ def detect(
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
-        fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, hi, boxes, settings, method, outlined,
+        fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, prep.hi, boxes, settings, method, outlined,
                                          colour_trimmed)  # fmt: skip
-        t_extract, t_complete, t_occlusion = ended - t2, 0.0, 0.0
+        t_extract = ended - t2
         t_register, cpu_elsewhere = t_extract - t_trim, 0.0
-        done = [fruit(k, sl) for k, sl in jobs]
-    detections = [d[0] for d in done]
-    for _, ext, occl, comp, _ in done:
-        t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
-    total = time.perf_counter() - t0
-    timings = {"segment": t1 - t0, "trim": t_trim, "register": t_register, "extract": t_extract,
-               "occlusion": t_occlusion, "complete": t_complete, "total": total,
-               "cpu": time.thread_time() - cpu0 + cpu_elsewhere}  # fmt: skip
-    return FrameDetections(frame, detections, timings, source, shift)
+        running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0))
+    return _Started(prep, running, shift, t_trim, t_register, t_extract, cpu_elsewhere, t2, cpu2)
+
+
+class _Started:
+    """A frame :func:`_start` started: :meth:`result` gives its detections (once)."""
+
+    def __init__(self, prep: _Prepared, running: Running, shift: tuple[int, int], t_trim: float, t_register: float,
+                 t_extract: float, cpu_elsewhere: float, t2: float, cpu2: float) -> None:  # fmt: skip
+        self.prep, self.running, self.shift = prep, running, shift
+        self.t_trim, self.t_register, self.t_extract, self.cpu_elsewhere = t_trim, t_register, t_extract, cpu_elsewhere
+        # this frame's own wall and CPU seconds so far (:func:`_prepare`'s and :func:`_start`'s: a stream does
+        # another frame's work between them and after)
+        self.wall = time.perf_counter() - t2 + prep.t2 - prep.t0
+        self.cpu = time.thread_time() - cpu2 + prep.cpu
+
+    def result(self) -> FrameDetections:
+        """The frame's detections, once the workers' last fruit came (:meth:`~symfruit.fruitpool.Running.result`:
+        the first failing fruit's error raised, the workers' warnings given here)."""
+        t, cpu = time.perf_counter(), time.thread_time()
+        got = self.running.result()
+        assert got is not None  # never called off: _detect_shared ran again what was
+        done, cpu_elsewhere = got[0], self.cpu_elsewhere + got[1]
+        prep = self.prep
+        t_extract, t_complete, t_occlusion = self.t_extract, 0.0, 0.0
+        detections = [d[0] for d in done]
+        for _, ext, occl, comp, _ in done:
+            t_extract, t_occlusion, t_complete = t_extract + ext, t_occlusion + occl, t_complete + comp
+        total = self.wall + time.perf_counter() - t
+        timings = {"segment": prep.t1 - prep.t0, "trim": self.t_trim, "register": self.t_register,
+                   "extract": t_extract, "occlusion": t_occlusion, "complete": t_complete, "total": total,
+                   "cpu": self.cpu + time.thread_time() - cpu + cpu_elsewhere}  # fmt: skip
+        return FrameDetections(prep.frame, detections, timings, prep.source, self.shift)
+
+    def abandon(self) -> None:
+        """The frame dropped (:meth:`~symfruit.fruitpool.Running.abandon`)."""
+        self.running.abandon()
 
 
 def _fruit_task(
@@ -265,14 +332,15 @@ def _fruit_task(
 
 def _detect_shared(
     pool: FruitPool, frame: Frame, labels: np.ndarray, hi: int, boxes: list[tuple[slice, slice] | None],
-    settings: Settings, method: str, outlined: bool,
-) -> tuple[list[_Done], tuple[int, int], float, float, float]:  # fmt: skip
+    settings: Settings, method: str, outlined: bool, leave: float | None = None,
+) -> tuple[Running, tuple[int, int], float, float, float]:  # fmt: skip
     """``detect``'s trimming, registration and fruit with ``pool`` (active, two masks or more): each mask's
     trimming and registration outline shared with its workers (:func:`_shared_masks`); then the fruit, moved by
     the pool's guess of the shift (the last frame's), sent to the workers while the search for this frame's shift
     runs here (:meth:`~symfruit.fruitpool.FruitPool.run_guessed`), and sent again moved by the shift found when the
-    guess was wrong. The fruit's answers, the shift, the masks' trimming seconds and the registration's (each
-    mask's own summed, and the search's and the move's here), and the workers' CPU seconds. The same answers as
+    guess was wrong. The fruit's run (:meth:`~symfruit.fruitpool.FruitPool.start`, with ``leave``), the shift,
+    the masks' trimming seconds and the registration's (each mask's own summed, and the search's and the move's
+    here), and the workers' CPU seconds on the masks. The same answers as
     without the pool; the first failing mask's or fruit's error is raised."""
     same = object()  # this frame's depth and colour go to the workers once
     masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
@@ -292,19 +360,23 @@ def _detect_shared(
                                      colour_trimmed)  # fmt: skip
     t_register = t_outlines + ended - a  # the move's and the search's seconds with them
     if len(jobs) >= 2:
-        got = pool.run_guessed(fruit, jobs, same, search)  # the first failing fruit's error is raised
+        running = pool.start(fruit, jobs, same, search, leave=leave)  # the first failing fruit's error is raised
     else:
-        got = ([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None
+        running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0) if search() else None)
     t_register += t_search
-    if got is None:  # the wrong guess: the fruit moved by the shift found
+    if found != guess:  # the wrong guess (the run called off): the fruit moved by the shift found
+        running.result()  # None: the workers' fruit dropped
         pool.registration_guess = found
         b = time.perf_counter()
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
         fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
                                          colour_trimmed)  # fmt: skip
         t_register += ended - b
-        got = pool.run(fruit, jobs, same) if len(jobs) >= 2 else ([fruit(k, sl) for k, sl in jobs], 0.0)
-    return got[0], found, t_trim, t_register, cpu + got[1]
+        if len(jobs) >= 2:
+            running = pool.start(fruit, jobs, same, leave=leave)
+        else:
+            running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0))
+    return running, found, t_trim, t_register, cpu
 
 
 #: What one fruit's task gives back: its detection, the wall seconds of its extraction, occlusion maps and completion
@@ -598,3 +670,69 @@ def _extract_window(
         outline[r0:r1, c0:c1] = ex.silhouette
     return Extraction(ex.points, ex.mask_area, ex.n_invalid, ex.n_border, ex.n_other_clusters, truncated, outline,
                       ex.error)  # fmt: skip
+
+
+class DetectStream:
+    """:func:`detect` on frames that come one after another (a recording, a camera's stream), with ``pool``'s
+    workers kept busy across frames (issue 19, stop 55, docs/pipe55.md): a frame's first part (its checks and
+    segmentation, :meth:`prepare`) runs in this process while the workers still do the fruit of the frame before.
+    Each frame's detections are :func:`detect`'s, bit for bit; at most one frame is in flight::
+
+        stream = DetectStream(pool, method="evidence")
+        for frame in frames:
+            ready = stream.prepare(frame)  # this frame's own errors are raised here
+            found = stream.finish()  # the frame before's detections (None for the first): its errors raised here
+            stream.start(ready)  # its fruit shared; the workers' last ones left running
+        found = stream.finish()  # the last frame's
+
+    The frame in flight keeps the pool busy: :meth:`finish` it (or :meth:`abandon` it, on an interrupt) before
+    anything else uses the pool. Each :meth:`start` leaves the workers fruit for about as many seconds as this
+    process spent last time between a :meth:`start` and the next :meth:`finish` (``symfruit detect``: writing the
+    frame before's files, reading and segmenting the next; :meth:`~symfruit.fruitpool.FruitPool.start`'s
+    ``leave``), and does the rest itself.
+    Without a pool, or an inactive one, :meth:`start` does the whole frame (as :func:`detect`)."""
+
+    def __init__(
+        self, pool: FruitPool | None, *, masks: str | Path | MaskSource | Segmenter | np.ndarray = "auto",
+        method: str = DEFAULT_METHOD, settings: Settings | None = None,
+    ) -> None:  # fmt: skip
+        if pool is not None and not isinstance(pool, FruitPool):
+            raise InputError(f"pool must be a FruitPool (symfruit.fruitpool) or None, got {type(pool).__name__}")
+        get_method(method)
+        self.pool, self.masks, self.method, self.settings = pool, masks, method, settings
+        self._running: _Started | None = None
+        self._leave: float | None = None  # the seconds between the last start and the finish after it
+        self._started_at = 0.0
+
+    @property
+    def in_flight(self) -> bool:
+        """Whether a frame was started and not finished (nor abandoned)."""
+        return self._running is not None
+
+    def prepare(self, frame: Frame) -> _Prepared:
+        """``frame``'s first part (checks, masks and their boxes; no pool): raises the errors :func:`detect` raises
+        there. The frame in flight, if any, is left as it is."""
+        return _prepare(frame, self.masks, self.method, self.settings, self.pool)
+
+    def finish(self) -> FrameDetections | None:
+        """The detections of the frame in flight (None if none is), once the workers' last fruit came: that frame's
+        errors are raised here (a fruit's, a worker's warning made an error) and its workers' warnings given."""
+        running, self._running = self._running, None
+        if running is None:
+            return None
+        self._leave = time.perf_counter() - self._started_at
+        return running.result()
+
+    def start(self, ready: _Prepared) -> None:
+        """Start a prepared frame: trimming, registration and this process's share of its fruit (their errors
+        raised here: then nothing is in flight). The frame before must be finished (or abandoned) first."""
+        if self._running is not None:
+            raise RuntimeError("DetectStream.start: the frame before is still in flight (finish it first)")
+        self._running = _start(ready, self.pool, self._leave)
+        self._started_at = time.perf_counter()
+
+    def abandon(self) -> None:
+        """Drop the frame in flight (the workers ended, new ones started, as after an interrupt within a frame)."""
+        running, self._running = self._running, None
+        if running is not None:
+            running.abandon()

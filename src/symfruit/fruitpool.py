@@ -71,7 +71,7 @@ import numpy as np
 from .errors import InputError
 from .threads import one_blas_thread
 
-__all__ = ["MAX_FRUIT_PROCESSES", "FruitPool", "check_fruit_processes", "one_process_reason", "usable_cores"]
+__all__ = ["MAX_FRUIT_PROCESSES", "FruitPool", "Running", "check_fruit_processes", "one_process_reason", "usable_cores"]
 
 #: Most worker processes a :class:`FruitPool` starts (more than the cores less one gain nothing).
 MAX_FRUIT_PROCESSES = 16
@@ -397,20 +397,51 @@ class FruitPool:
         dropped, and None is returned (``detect`` sends its fruit with the last frame's registration shift while its
         search for this frame's runs, then again with the right one when they differ). An exception ``check``
         raises goes up as one a fruit raises here would (the workers ended, new ones started)."""
+        return self.start(fruit, jobs, same, check).result()
+
+    def start(
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object = None,
+        check: Callable[[], bool] | None = None, *, leave: float | None = None,
+    ) -> Running:  # fmt: skip
+        """:meth:`run_guessed` in two halves (issue 19, stop 55: frames in a stream, docs/pipe55.md): the task sent
+        to the workers and this process's share of its fruit done here; what :meth:`run_guessed` returns (or raises)
+        is had from the :class:`Running` returned, :meth:`Running.result`, which waits for the workers' last fruit.
+
+        ``leave``: None, every fruit this process can take it takes (as :meth:`run`); else the seconds this
+        process will spend elsewhere before it asks for the result (the next frame's segmentation): it stops taking
+        fruit once those left untaken would take the workers about that long (each fruit's time guessed from its
+        mask's pixels and this process's own seconds per pixel on the frame's fruit so far), so that the workers
+        are busy meanwhile. Which process does a fruit never changes its answer.
+
+        Until the result is had (or :meth:`Running.abandon` called) the pool is busy: another frame run meanwhile
+        (another thread's) runs in its calling process alone."""
         if not self.active or not self._busy.acquire(blocking=False):
-            return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
+            return Running.here(fruit, jobs, check)
         try:
             if not self._workers_ready():
-                return None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0)
-            try:
-                with self._one_blas_thread():
-                    got = self._run(fruit, jobs, same, check)
-            except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
-                if self.active:
-                    self._lost("the calling process was interrupted within a frame")
-                raise
+                self._busy.release()
+                return Running.here(fruit, jobs, check)
+            with self._one_blas_thread():
+                collect = self._run(fruit, jobs, same, check, leave)
+        except BaseException:  # interrupted (or a bug here): the workers may be mid-frame; new ones next time
+            self._interrupted()
+            raise
+        return Running(self, collect)
+
+    def _interrupted(self, why: str = "the calling process was interrupted within a frame") -> None:
+        """The calling process was interrupted (or failed) within a frame, or dropped it: its workers ended (new ones
+        next time) and the pool free."""
+        try:
+            if self.active:
+                self._lost(why)
         finally:
             self._busy.release()
+
+    def _given(
+        self, got: tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None
+    ) -> tuple[list[Any], float] | None:
+        """A run's answers as :meth:`run_guessed` gives them: the workers' warnings given again here, the first
+        failing fruit's error raised."""
         if got is None:
             return None
         out, warned, cpu = got
@@ -447,12 +478,12 @@ class FruitPool:
         return self._wait_ready(0.0) if self.active else False
 
     def _run(
-        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None
-    ) -> tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None:
-        """:meth:`run`'s work: each fruit's :func:`_attempt` and the warnings a worker recorded for it (none for
-        those done here), in ``jobs``' order, and the workers' CPU seconds."""
-        from .detect import _Fruit
-
+        self, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], same: object, check: Callable[[], bool] | None,
+        leave: float | None,
+    ) -> Callable[[], tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None]:  # fmt: skip
+        """:meth:`start`'s work: the task sent and this process's share done; returns what gives, once the workers'
+        last fruit came, each fruit's :func:`_attempt` and the warnings a worker recorded for it (none for those done
+        here), in ``jobs``' order, and the workers' CPU seconds (None: the run was called off)."""
         # longest first (mask pixels; ties in the frame's order): the last fruit taken are the short ones
         pixels = [int(np.count_nonzero(fruit.labels[sl] == k)) for k, sl in jobs]
         order = sorted(range(len(jobs)), key=lambda i: -pixels[i])
@@ -479,10 +510,37 @@ class FruitPool:
         called_off = check is not None and not check()
         if called_off and not _take_all(self._lock, self._counter, len(todo)):
             lost = f"the fruit counter's lock was held for {STALL_TIMEOUT:.0f} s"
+        # pixels left from each place in ``todo`` on, and this process's seconds per pixel on its fruit (``leave``)
+        after = np.cumsum([0, *(pixels[i] for i in reversed(order))])[::-1] if leave is not None else None
+        own_s = own_px = 0.0
         while not lost and self._caller_shares and (i := _claim(self._lock, self._counter, len(todo))) is not None:
+            t = time.perf_counter()
             found[i] = _attempt(fruit, *todo[i])
             for j, w in enumerate(workers):  # what came meanwhile, so that no worker waits on a full pipe
                 lost = lost or self._take(w, seq, kind, found, warned, theirs, done, j, wait=0.0)[0]
+            if after is not None and leave is not None:
+                own_s, own_px = own_s + time.perf_counter() - t, own_px + pixels[order[i]]
+                untaken = after[min(int(self._counter.value), len(todo))]  # a read: at worst one fruit off
+                if own_px and own_s / own_px * untaken <= leave * len(workers):
+                    break
+        return lambda: self._collect(fruit, jobs, todo, order, kind, seq, workers, found, warned, theirs, done, cpu,
+                                     lost, called_off)  # fmt: skip
+
+    def _collect(
+        self, fruit: Any, jobs: list[Any], todo: list[Any], order: list[int], kind: type, seq: int,
+        workers: list[_Worker], found: list[Any], warned: list[list[_Warned]], theirs: list[bool], done: list[bool],
+        cpu: float, lost: str, called_off: bool,
+    ) -> tuple[list[tuple[str, Any]], list[list[_Warned]], float] | None:  # fmt: skip
+        """:meth:`_run`'s second half: the workers' last fruit waited for (a lost worker's done here)."""
+        from .detect import _Fruit
+
+        if not lost and self._caller_shares:  # fruit left untaken (``leave``): this process takes them with the rest
+            while (i := _claim(self._lock, self._counter, len(todo))) is not None:
+                found[i] = _attempt(fruit, *todo[i])
+                for j, w in enumerate(workers):
+                    lost = lost or self._take(w, seq, kind, found, warned, theirs, done, j, wait=0.0)[0]
+                if lost:
+                    break
         for j, w in enumerate(workers):
             silent_since = time.monotonic()
             while not lost and not done[j]:
@@ -569,6 +627,51 @@ class FruitPool:
                     np.copyto(np.ndarray(shape, dtype, buffer=segment.buf, offset=offset), a)
                 self._shared[key] = (a, layout[key])
         return segment.name, segment.size, layout
+
+
+class Running:
+    """A task started on a :class:`FruitPool` (:meth:`FruitPool.start`): this process's share of its fruit done,
+    the workers' maybe not yet. :meth:`result` once (or :meth:`abandon`); the pool is busy until then."""
+
+    def __init__(self, pool: FruitPool | None, collect: Callable[[], Any], value: Any = None) -> None:
+        self._pool, self._collect, self._value = pool, collect, value
+
+    @classmethod
+    def here(cls, fruit: Any, jobs: list[tuple[int, tuple[slice, slice]]], check: Callable[[], bool] | None) -> Running:
+        """The task run in this process alone, now (no workers, or the pool busy): its answer kept."""
+        return cls.ready(None if check is not None and not check() else ([fruit(k, sl) for k, sl in jobs], 0.0))
+
+    @classmethod
+    def ready(cls, value: tuple[list[Any], float] | None) -> Running:
+        """A run whose answer ``value`` is had already."""
+        return cls(None, lambda: None, value)
+
+    @property
+    def pending(self) -> bool:
+        """Whether the workers' answers are still to be had (:meth:`result`) or dropped (:meth:`abandon`)."""
+        return self._pool is not None
+
+    def result(self) -> tuple[list[Any], float] | None:
+        """What :meth:`FruitPool.run_guessed` returns: the answers in the jobs' order and the workers' CPU seconds
+        (None: called off), once the workers' last fruit came; the first failing fruit's error is raised, the
+        workers' warnings given here. An interrupt while waiting ends the workers (new ones for the next frame)."""
+        pool, self._pool = self._pool, None
+        if pool is None:
+            return self._value
+        try:
+            got = self._collect()
+        except BaseException:
+            pool._interrupted()
+            raise
+        pool._busy.release()
+        return pool._given(got)
+
+    def abandon(self) -> None:
+        """Drop the workers' answers (a stream stopped between frames): the workers are ended, new ones started for
+        the next frames, as after an interrupt within a frame. Nothing if the answers were had."""
+        pool, self._pool = self._pool, None
+        if pool is not None:
+            pool._interrupted("a frame was dropped before its workers' fruit came")
 
 
 def _new_segment(size: int) -> shared_memory.SharedMemory:

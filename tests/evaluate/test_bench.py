@@ -59,3 +59,26 @@ def test_bench_recording_refuses_an_unknown_method_and_a_detect_run_that_failed(
     monkeypatch.setattr(bench, "measured_detect", lambda args: (2, float("nan"), "symfruit: error: boom\n"))
     with pytest.raises(SymfruitError, match="detect exited with status 2: symfruit: error: boom"):
         bench.bench_recording(1, workdir=tmp_path)  # before: '1 frames (0 written), peak RSS nan MB', exit 0
+
+
+def test_bench_stream_times_frames_alone_and_in_a_stream_alternated():
+    """Stop 55: ``bench --frame --stream``'s rows: frames/s, CPU and the median frame's time per mode and round."""
+    from symfruit.evaluate.bench import bench_stream
+
+    got = bench_stream(3, rounds=2, method="raw")
+    assert set(got) == {"detect", "stream"}
+    for row in got.values():
+        assert set(row) == {"fps", "cpu_ms", "latency_ms"} and all(len(v) == 2 for v in row.values())
+        assert all(v > 0 for values in row.values() for v in values)
+
+
+def test_bench_recording_runs_detect_with_its_fruit_processes(tmp_path, monkeypatch):
+    from symfruit.evaluate import bench
+    from symfruit.synthetic import scenes
+
+    ran = []
+    monkeypatch.setattr(scenes, "write_scenes", lambda folder, n, **kwargs: folder.mkdir())
+    monkeypatch.setattr(bench, "measured_detect", lambda args: ran.append(args) or (0, 1.0, ""))
+    bench.bench_recording(2, method="raw", workdir=tmp_path, fruit_processes=1)
+    bench.bench_recording(2, method="raw", workdir=tmp_path)
+    assert ran[0][-2:] == ["--fruit-processes", "1"] and "--fruit-processes" not in ran[1]

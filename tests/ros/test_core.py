@@ -417,3 +417,77 @@ def test_unknown_parameters_name_the_first_and_leave_ross_own():
         unknown_parameters(["slop_s", "zzz_unrelated"])
     with pytest.raises(SymfruitError, match=r"^parameter 'zzz': no such parameter; the node's"):
         unknown_parameters(["zzz"])
+
+
+def test_latest_only_drains_when_no_item_waits_and_at_stop():
+    """Stop 55: ``drain`` runs after items were handled as soon as none waits (not between a handled item and one
+    that waits), once, and at ``stop`` for the last item; wait_idle waits for it; its exceptions go to on_error."""
+    entered, release = threading.Event(), threading.Event()
+    seen, errors = [], []
+
+    def handle(item):
+        seen.append(item)
+        if item in (1, 4):
+            entered.set()
+            assert release.wait(60)
+
+    def drain():
+        seen.append("drained")
+        if seen[-2] == 3:
+            raise ValueError("drain failed")
+
+    worker = LatestOnly(handle, on_error=lambda item, exc: errors.append((item, type(exc))), drain=drain).start()
+    try:
+        worker.put(1)
+        assert entered.wait(60)
+        worker.put(2)  # waits: 1 is not drained before it
+        release.set()
+        assert worker.wait_idle(60)
+        assert seen == [1, 2, "drained"]
+        worker.put(3)
+        assert worker.wait_idle(60)
+        assert seen == [1, 2, "drained", 3, "drained"] and errors == [(None, ValueError)]
+        entered.clear()
+        release.clear()
+        worker.put(4)
+        assert entered.wait(60)
+        stopping = threading.Thread(target=worker.stop, args=(60,))
+        stopping.start()
+        release.set()
+        stopping.join(60)
+    finally:
+        release.set()
+        worker.stop()
+    assert seen == [1, 2, "drained", 3, "drained", 4, "drained"] and worker.handled == 4
+
+
+def test_overlapped_frames_are_the_processors_in_order_and_a_bad_one_is_skipped(example_images):
+    """Stop 55: through :class:`Overlapped` (a frame begun before the one in flight is finished, the workers
+    ending its last fruit meanwhile) each frame's fruit are :meth:`FrameProcessor.process`'s, given in their
+    order; a bad frame is skipped when begun, the one in flight finished after it."""
+    from symfruit.fruitpool import one_process_reason
+    from symfruit.ros.core import Overlapped
+
+    alone = FrameProcessor(fruit="strawberry")
+    shared = FrameProcessor(fruit="strawberry", fruit_processes=1)
+    try:
+        assert shared.pool._wait_ready(600) or not shared.pool.active
+        messages = example_messages(example_images)
+        bad = (image_msg(np.zeros((4, 4, 3), np.uint8), "rgb8"), messages[1], messages[2])  # not the depth's size
+        expected = [(f.id, f.centre.tolist(), f.size.tolist(), f.score) for f in alone.process(*messages).fruits]
+        events = []
+        overlapped = Overlapped(shared, done=lambda item, p: events.append((item[0], [(f.id, f.centre.tolist(),
+                                f.size.tolist(), f.score) for f in p.fruits])),
+                                skipped=lambda item, exc: events.append((item[0], type(exc))),
+                                failed=lambda item, exc: events.append((item[0], exc)))  # fmt: skip
+        for name, msgs in (("a", messages), ("bad", bad), ("b", messages), ("c", messages)):
+            overlapped.handle((name, *msgs), name=name, source="test")
+        # the bad one told when begun, before a (in flight) is finished; b finished when c came; c in flight
+        assert events == [("bad", InputError), ("a", expected), ("b", expected)] and shared._stream.in_flight
+        overlapped.drain()
+        overlapped.drain()  # nothing in flight: nothing
+        assert events[3:] == [("c", expected)] and not shared._stream.in_flight
+        assert shared.pool.starts == (1 if one_process_reason(1) == "" else 0), shared.pool.last_loss
+    finally:
+        shared.close()
+        alone.close()

@@ -34,6 +34,7 @@ __all__ = [
     "bench_segment",
     "bench_segment_trees",
     "bench_stages",
+    "bench_stream",
     "bench_view",
     "measured_detect",
     "profile_frame",
@@ -171,6 +172,54 @@ def bench_stages(
         detect(frame, method=method, pool=pool)
     runs = [detect(frame, method=method, pool=pool).timings for _ in range(repeat)]
     return {stage: np.array([t[stage] for t in runs]) * 1000.0 for stage in STAGES}
+
+
+def bench_stream(
+    frames: int = 100, *, rounds: int = 3, method: str = DEFAULT_METHOD, pool: Any = None
+) -> dict[str, dict[str, list[float]]]:
+    """Frames per second over ``frames`` benchmark frames (:func:`bench_frame`'s, seeds 0-3 in turn), one after
+    another as a recording's, no file I/O: ``detect`` on each (``pool``'s workers sharing each frame's fruit), and
+    in a :class:`~symfruit.detect.DetectStream` (the next frame segmented while the workers end the last one's
+    fruit; issue 19, stop 55). The two alternate (``rounds`` each, the first mode changing each round) after a
+    warm-up of both. Per mode and round: ``fps`` (wall), ``cpu_ms`` (the calling thread's and the workers' CPU per
+    frame, ``detect``'s ``cpu``), ``latency_ms`` (the median frame's own wall time, ``total``)."""
+    from ..detect import DetectStream, detect
+
+    scenes = [_bench_scene(None, seed)[0] for seed in range(4)]
+    seq = [scenes[i % len(scenes)] for i in range(frames)]
+
+    def alone(frames: list[Any]) -> list[Any]:
+        return [detect(f, method=method, pool=pool) for f in frames]
+
+    def streamed(frames: list[Any]) -> list[Any]:
+        stream, out = DetectStream(pool, method=method), []
+        try:
+            for f in frames:
+                ready = stream.prepare(f)
+                found = stream.finish()
+                if found is not None:
+                    out.append(found)
+                stream.start(ready)
+            last = stream.finish()
+            if last is not None:
+                out.append(last)
+        finally:
+            stream.abandon()
+        return out
+
+    modes = {"detect": alone, "stream": streamed}
+    for run in modes.values():
+        run(seq[:8])
+    got: dict[str, dict[str, list[float]]] = {m: {"fps": [], "cpu_ms": [], "latency_ms": []} for m in modes}
+    for r in range(rounds):
+        for name in ("detect", "stream") if r % 2 == 0 else ("stream", "detect"):
+            t = time.perf_counter()
+            found = modes[name](seq)
+            wall = time.perf_counter() - t
+            got[name]["fps"].append(len(found) / wall)
+            got[name]["cpu_ms"].append(float(np.mean([f.timings["cpu"] for f in found])) * 1000.0)
+            got[name]["latency_ms"].append(float(np.median([f.timings["total"] for f in found])) * 1000.0)
+    return got
 
 
 def profile_frame(
@@ -392,13 +441,16 @@ print(json.dumps({"seconds": seconds, "startup": startup, "overhead_ms": overhea
 
 
 def bench_recording(
-    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None, workers: int | None = None
-) -> RecordingRow:
+    frames: int = 500, *, method: str = DEFAULT_METHOD, workdir: str | Path | None = None, workers: int | None = None,
+    fruit_processes: int = 0,
+) -> RecordingRow:  # fmt: skip
     """Run ``symfruit detect`` on a generated ``frames``-frame recording in a child process and report its
     peak resident memory and wall time: memory must not grow with ``frames``. With ``workers``, on a local Dask
     cluster of that many processes (127.0.0.1): the client's peak, each worker's, the start-up time, and the
     overhead of one task: 400 tasks that take and return what a detect task does but do no work, their CPU
-    time (client with its scheduler, and the workers) and their wall time, per task."""
+    time (client with its scheduler, and the workers) and their wall time, per task. ``fruit_processes``:
+    ``detect --fruit-processes`` (the frames then go in a stream; the workers' start is in the time and the
+    child's peak, theirs not)."""
     import json
     import subprocess
     import sys
@@ -416,7 +468,8 @@ def bench_recording(
         out = Path(tmp) / "out"
         if workers is None:
             start = time.perf_counter()
-            status, peak, err = measured_detect([str(rec), "--output", str(out), "--method", method])
+            extra = ["--fruit-processes", str(fruit_processes)] if fruit_processes else []
+            status, peak, err = measured_detect([str(rec), "--output", str(out), "--method", method, *extra])
             seconds = time.perf_counter() - start
             if status != 0:  # a run that failed is no measurement: before, '0 written, peak RSS nan MB', exit 0
                 said = err.strip().splitlines()[-1:] or ["(nothing on stderr)"]

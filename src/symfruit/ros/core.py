@@ -30,7 +30,7 @@ import numpy as np
 
 from ..core.frame import Frame
 from ..core.limits import shown
-from ..detect import FrameDetections, detect
+from ..detect import DetectStream, FrameDetections, detect
 from ..errors import InputError, SymfruitError
 from ..fruitpool import MAX_FRUIT_PROCESSES, FruitPool
 from ..io.bags import camera_from_info, color_image, depth_image, header_frame_id, header_stamp
@@ -312,9 +312,12 @@ class FrameProcessor:
         self._warned: set[str] = set()  # what was said of the camera infos ("distortion", "principal point")
         # last: a bad parameter above starts no process; no frame waits for the workers' warm-up (wait=False)
         self.pool = FruitPool(fruit_processes, method=method, wait=False)
+        self._stream = DetectStream(self.pool, masks=self.mask_source, method=method, settings=self.settings)
 
     def close(self) -> None:
-        """End the fruit workers (:meth:`symfruit.fruitpool.FruitPool.close`); frames after it run in this process."""
+        """End the fruit workers (:meth:`symfruit.fruitpool.FruitPool.close`; a frame in flight dropped); frames
+        after it run in this process."""
+        self._stream.abandon()
         self.pool.close()
 
     def workers_said(self) -> str:
@@ -341,6 +344,97 @@ class FrameProcessor:
         fruits = fruits_of(found)
         t3 = time.perf_counter()
         return Processed(fruits, found, {"decode": t1 - t0, "detect": t2 - t1, "collect": t3 - t2})
+
+    # ---- frames in a stream (issue 19, stop 55, docs/pipe55.md): :class:`Overlapped` -----------------------------
+
+    def begin(self, color: Any, depth: Any, info: Any, *, name: str = "frame", source: str = "ros") -> Begun:
+        """A frame's first part: decoded, its masks found (:meth:`symfruit.detect.DetectStream.prepare`). Raises
+        ``SymfruitError`` for a bad frame; the frame in flight (:meth:`launch`) is left running."""
+        t0 = time.perf_counter()
+        frame = self.frame(color, depth, info, name=name, source=source)
+        t1 = time.perf_counter()
+        return Begun(self._stream.prepare(frame), t1 - t0)
+
+    def launch(self, begun: Begun) -> None:
+        """Start a begun frame (:meth:`symfruit.detect.DetectStream.start`): the frame in flight must be finished
+        first (:meth:`finish`)."""
+        self._stream.start(begun.ready)
+
+    def finish(self, begun: Begun) -> Processed | None:
+        """The frame in flight's fruit (None if none is; ``begun``: what :meth:`begin` gave for it), once the
+        workers' last ones came. Raises ``SymfruitError`` for the frame's error."""
+        found = self._stream.finish()
+        if found is None:
+            return None
+        t = time.perf_counter()
+        fruits = fruits_of(found)
+        seconds = {"decode": begun.decode, "detect": found.timings["total"], "collect": time.perf_counter() - t}
+        return Processed(fruits, found, seconds)
+
+
+@dataclass(frozen=True)
+class Begun:
+    """A frame :meth:`FrameProcessor.begin` decoded and prepared, and its decoding's seconds."""
+
+    ready: Any
+    decode: float
+
+
+class Overlapped:
+    """A node's frames through :class:`FrameProcessor`'s stream (issue 19, stop 55, docs/pipe55.md): the next frame
+    decoded and segmented here while the fruit workers end the fruit of the frame before, then that frame finished
+    and given to ``done``, then the next started. Made for :class:`LatestOnly`: :meth:`handle` is its ``handle``,
+    :meth:`drain` its ``drain`` (the frame in flight finished as soon as no newer frame waits: a frame is never
+    kept waiting for one that may not come). At most one frame is in
+    flight beside the one being begun; a frame still waiting is replaced by a newer one as before.
+
+    ``done(item, processed)`` publishes a frame, ``skipped(item, exc)`` tells of a bad one (a ``SymfruitError``),
+    ``failed(item, exc)`` of a bug (any other exception of the frame in flight: that of the frame being handled
+    goes up to :class:`LatestOnly`'s ``on_error``)."""
+
+    def __init__(
+        self, core: FrameProcessor, *, done: Callable[[Any, Processed], None],
+        skipped: Callable[[Any, SymfruitError], None], failed: Callable[[Any, BaseException], None],
+    ) -> None:  # fmt: skip
+        self.core, self._done, self._skipped, self._failed = core, done, skipped, failed
+        self._flight: tuple[Any, Begun] | None = None
+
+    def handle(self, item: tuple, *, name: str, source: str) -> None:
+        """Begin the frame of ``item`` (a node's: when it came, the colour, depth and camera info messages), finish
+        the frame in flight, then start this one. ``done`` and the others are given ``item`` with the time its
+        handling began added (``(came, color, depth, info, began)``)."""
+        _, color, depth, info = item
+        item = (*item, time.perf_counter())
+        try:
+            begun: Begun | None = self.core.begin(color, depth, info, name=name, source=source)
+        except SymfruitError as exc:
+            begun = None
+            self._skipped(item, exc)
+        self.drain()
+        if begun is None:
+            return
+        try:
+            self.core.launch(begun)
+        except SymfruitError as exc:
+            self._skipped(item, exc)
+            return
+        self._flight = (item, begun)
+
+    def drain(self) -> None:
+        """Finish the frame in flight, if any, and give it to ``done``."""
+        if self._flight is None:
+            return
+        (item, begun), self._flight = self._flight, None
+        try:
+            processed = self.core.finish(begun)
+        except SymfruitError as exc:
+            self._skipped(item, exc)
+            return
+        except Exception as exc:  # a bug: told, and the next frame goes on
+            self._failed(item, exc)
+            return
+        if processed is not None:
+            self._done(item, processed)
 
 
 # ---------------------------------------------------------------------------------------------------
@@ -404,7 +498,9 @@ class LatestOnly:
 
     ``put`` never blocks: an item still waiting when a newer one arrives is dropped (and counted),
     so a node that falls behind skips frames instead of queueing them. ``handle`` exceptions go to
-    ``on_error(item, exc)``; the worker keeps running.
+    ``on_error(item, exc)``; the worker keeps running. ``drain``: called on the worker thread after items were
+    handled, as soon as none waits (and at :meth:`stop`): a handler that leaves work of an item running while it
+    may take the next (:class:`Overlapped`) ends it there; its exceptions go to ``on_error(None, exc)``.
     """
 
     def __init__(
@@ -413,12 +509,14 @@ class LatestOnly:
         *,
         on_error: Callable[[Any, BaseException], None],
         name: str = "symfruit-worker",
+        drain: Callable[[], None] | None = None,
     ) -> None:
-        self._handle, self._on_error = handle, on_error
+        self._handle, self._on_error, self._drain = handle, on_error, drain
         self._cond = threading.Condition()
         self._item: Any = None
         self._has_item = False
         self._busy = False
+        self._owed = False  # a drain owed: an item handled since the last one
         self._stop = False
         self.dropped = 0
         self.handled = 0
@@ -439,12 +537,12 @@ class LatestOnly:
         return replaced
 
     def wait_idle(self, timeout: float | None = None) -> bool:
-        """Block until no item waits and none is being handled; False on timeout."""
+        """Block until no item waits, none is being handled and no drain is owed; False on timeout."""
         with self._cond:
-            return self._cond.wait_for(lambda: not self._has_item and not self._busy, timeout)
+            return self._cond.wait_for(lambda: not self._has_item and not self._busy and not self._owed, timeout)
 
     def stop(self, timeout: float | None = 10.0) -> None:
-        """Let the current item finish, drop a waiting one, and end the thread."""
+        """Let the current item finish (and the drain it owes), drop a waiting one, and end the thread."""
         with self._cond:
             self._stop = True
             self._cond.notify_all()
@@ -454,18 +552,27 @@ class LatestOnly:
     def _run(self) -> None:
         while True:
             with self._cond:
-                while not self._has_item and not self._stop:
+                while not self._has_item and not self._stop and not self._owed:
                     self._cond.wait()
-                if self._stop:
+                if self._has_item and not self._stop:
+                    item, self._item, self._has_item = self._item, None, False
+                    draining = False
+                elif self._owed:  # none waits (or stopping): the drain owed
+                    item, draining, self._owed = None, True, False
+                else:
                     return
-                item, self._item, self._has_item = self._item, None, False
                 self._busy = True
             try:
-                self._handle(item)
+                if draining:
+                    self._drain()  # type: ignore[misc]  # owed only with a drain
+                else:
+                    self._handle(item)
             except Exception as exc:  # never let a frame end the worker
                 self._on_error(item, exc)
             finally:
                 with self._cond:
-                    self.handled += 1
+                    if not draining:
+                        self.handled += 1
+                        self._owed = self._drain is not None
                     self._busy = False
                     self._cond.notify_all()

@@ -37,7 +37,16 @@ import numpy as np
 
 from ..errors import SymfruitError
 from ..methods import DEFAULT_METHOD
-from .core import PARAMETERS, FrameProcessor, Fruit, LatestOnly, checked_parameters, unknown_parameters
+from .core import (
+    PARAMETERS,
+    FrameProcessor,
+    Fruit,
+    LatestOnly,
+    Overlapped,
+    Processed,
+    checked_parameters,
+    unknown_parameters,
+)
 
 __all__ = ["DEFAULT_TOPICS", "SymfruitNode", "main"]
 
@@ -197,7 +206,9 @@ class SymfruitNode:
         # Everything the synchroniser needs is read (two round trips to the master) and the worker started before
         # the first subscription: a frame completed between subscribing and registering the callback was dropped.
         queue_size, slop = p["queue_size"], p["slop"]
-        self.worker = LatestOnly(self._handle, on_error=self._on_error).start()
+        # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
+        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
+        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self.overlapped.drain).start()
         subs = [
             message_filters.Subscriber(self.topics["color"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
             message_filters.Subscriber(self.topics["depth"], Image, queue_size=1, buff_size=big, tcp_nodelay=True),
@@ -219,17 +230,19 @@ class SymfruitNode:
         self.core.close()
 
     def _on_error(self, item: Any, exc: BaseException) -> None:  # a bug, not a bad frame: log it, carry on
-        self.rospy.logerr("symfruit: frame %s failed: %r", _stamp(item[1]), exc, exc_info=exc)
+        stamp = "(in flight)" if item is None else _stamp(item[1])
+        self.rospy.logerr("symfruit: frame %s failed: %r", stamp, exc, exc_info=exc)
+
+    def _skipped(self, item: Any, exc: BaseException) -> None:
+        self.rospy.logwarn("symfruit: frame %s skipped: %s", _stamp(item[1]), exc)
 
     def _handle(self, item: tuple) -> None:
-        t_in, color, depth, info = item
-        t_start = time.perf_counter()
+        stamp = _stamp(item[1])
+        self.overlapped.handle(item, name=stamp, source=f"ros:{self.topics['color']}@{stamp}")
+
+    def _publish(self, item: tuple, processed: Processed) -> None:
+        t_in, color, _, _, t_start = item
         stamp = _stamp(color)
-        try:
-            processed = self.core.process(color, depth, info, name=stamp, source=f"ros:{self.topics['color']}@{stamp}")
-        except SymfruitError as exc:
-            self.rospy.logwarn("symfruit: frame %s skipped: %s", stamp, exc)
-            return
         header = color.header
         t_publish = time.perf_counter()
         self.pub_detections.publish(detection_array(self.vision_msgs, header, processed.fruits))

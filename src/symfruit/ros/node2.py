@@ -50,6 +50,8 @@ from .core import (
     FrameProcessor,
     Fruit,
     LatestOnly,
+    Overlapped,
+    Processed,
     checked_parameters,
     stop_signals,
     unknown_parameters,
@@ -231,7 +233,9 @@ class Ros2Node:
         self.topics = {name: self.input_topic(name) for name in DEFAULT_TOPICS}
         in_qos = QoSProfile(depth=p["queue_size"]) if p["qos"] == "reliable" else qos_profile_sensor_data
         self.sync = ApproximateSync(3, self._on_frame, slop=p["slop"], queue_size=p["queue_size"])
-        self.worker = LatestOnly(self._handle, on_error=self._on_error).start()
+        # frames in a stream: the next one decoded and segmented while the fruit workers end the last one's fruit
+        self.overlapped = Overlapped(self.core, done=self._publish, skipped=self._skipped, failed=self._on_error)
+        self.worker = LatestOnly(self._handle, on_error=self._on_error, drain=self.overlapped.drain).start()
         self.subs = [
             self.node.create_subscription(kind, self.topics[name], self._adder(i, name), in_qos)
             for i, (name, kind) in enumerate((("color", Image), ("depth", Image), ("camera_info", CameraInfo)))
@@ -267,17 +271,19 @@ class Ros2Node:
 
     def _on_error(self, item: Any, exc: BaseException) -> None:  # a bug, not a bad frame: log it, carry on
         if self.context.ok():
-            self.log.error(f"symfruit: frame {stamp_text(item[1].header)} failed: {exc!r}")
+            stamp = "(in flight)" if item is None else stamp_text(item[1].header)
+            self.log.error(f"symfruit: frame {stamp} failed: {exc!r}")
+
+    def _skipped(self, item: Any, exc: BaseException) -> None:
+        self.log.warning(f"symfruit: frame {stamp_text(item[1].header)} skipped: {exc}")
 
     def _handle(self, item: tuple) -> None:
-        t_in, color, depth, info = item
-        t_start = time.perf_counter()
+        stamp = stamp_text(item[1].header)
+        self.overlapped.handle(item, name=stamp, source=f"ros2:{self.topics['color']}@{stamp}")
+
+    def _publish(self, item: tuple, processed: Processed) -> None:
+        t_in, color, _, _, t_start = item
         stamp = stamp_text(color.header)
-        try:
-            processed = self.core.process(color, depth, info, name=stamp, source=f"ros2:{self.topics['color']}@{stamp}")
-        except SymfruitError as exc:
-            self.log.warning(f"symfruit: frame {stamp} skipped: {exc}")
-            return
         if not self.context.ok():  # shutting down: nothing to publish to
             return
         header = color.header
