@@ -170,6 +170,22 @@ def random_sphere(n: int = 2000, radius: float = 0.03, seed: int = 0) -> np.ndar
     return radius * d / np.linalg.norm(d, axis=1, keepdims=True) + CENTRE
 
 
+def noisy_cap(seed: int) -> tuple[np.ndarray, float]:
+    """``(points (n, 3), radius)``: a seeded random cap of a sphere facing the camera (radius 15-60 mm, 100-800 points,
+    0.5-1.4 rad from its front, at 0.4-1.5 m), with 0-2 mm of Gaussian noise."""
+    rng = np.random.default_rng(seed)
+    radius, n, cap, noise = (
+        rng.uniform(0.015, 0.06),
+        int(rng.integers(100, 800)),
+        rng.uniform(0.5, 1.4),
+        rng.uniform(0, 0.002),
+    )
+    centre = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(0.4, 1.5)])
+    polar, around = np.arccos(rng.uniform(np.cos(cap), 1.0, n)), rng.uniform(0.0, 2.0 * np.pi, n)
+    d = np.stack([np.sin(polar) * np.cos(around), np.sin(polar) * np.sin(around), -np.cos(polar)], axis=1)
+    return centre + radius * d + rng.normal(0.0, noise, (n, 3)), float(radius)
+
+
 def ellipsoid_cloud(axes=(0.018, 0.025, 0.015), n: int = 1200, centre: np.ndarray = CENTRE) -> np.ndarray:
     return fibonacci_sphere(n) * np.asarray(axes) + centre
 

@@ -2,16 +2,17 @@
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from symfruit import DEFAULT_CAMERA
 from symfruit.core.agreement import observe
-from symfruit.core.candidates import REACH, candidates, constrain_box
+from symfruit.core.candidates import REACH, SPHERE_TOLERANCE, candidates, constrain_box
+from symfruit.core.fits import fit_sphere
 from symfruit.core.planes import PlaneGrid
 from symfruit.core.raster import silhouette
 
-from ..conftest import ball_mesh, rendered_view
+from ..conftest import ball_mesh, noisy_cap, rendered_view
 
 coord = st.floats(-0.05, 0.05, allow_nan=False)
 
@@ -229,3 +230,15 @@ def test_sections_bring_the_solids_back_to_a_flattened_fruits():
     assert flat.lo.tolist()[:2] == pytest.approx(circles.lo.tolist()[:2], abs=0.002)
     again = {c.name: c for c in candidates(seen, **kwargs, sections=0.0)}["revolution"]
     assert again.hi.tobytes() == circles.hi.tobytes()  # 0: the circles, to the bit
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_sphere_candidates_stop_leaves_its_sphere_within_the_stop(seed):
+    """The sphere candidate's Gauss-Newton stops at a step of ``SPHERE_TOLERANCE`` (10 um; stop 55, docs/fast55.md),
+    not ``fit_sphere``'s 0.1 um: on noisy caps of 15-60 mm spheres its centre and radius lie within that of the
+    0.1 um stop's (2.5 um at most over 300 such caps: each step moves them less than the last)."""
+    points, _ = noisy_cap(seed)
+    (c, r), (c0, r0) = fit_sphere(points, tolerance=SPHERE_TOLERANCE), fit_sphere(points)
+    assert SPHERE_TOLERANCE == 1e-5
+    assert float(np.abs(c - c0).max()) < SPHERE_TOLERANCE and abs(r - r0) < SPHERE_TOLERANCE

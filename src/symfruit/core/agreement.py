@@ -304,14 +304,14 @@ def observe(
             edge_uv, is_contour = _contour_pixels(edge_points, edge_px, region, camera, contour_points)
         else:
             edge_uv, is_contour = _contour_points(edge_points, edge_px, camera, contour_points)
-    kept: dict[str, Any] = {}  # _labels_at's tree of the edge points, where one is made
+    kept: dict[str, Any] = {}  # _labels_at's tree of the edge points, where one is made (without numba)
     jit = compiled() if bands else None
     made: _Banded | None = None
     crack_labels = None
     outlined = None
     if occlusion is not None and jit is not None:  # the edges, bands and crack labels in one call (issue 19, stop 51)
         outlined = _outline_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
-                                  occlusion, contour_points, occluded_px, contour_cone, kept)  # fmt: skip
+                                  occlusion, contour_points, occluded_px, contour_cone)  # fmt: skip
     if outlined is not None:
         edge_uv, is_contour, made, crack_labels = outlined
     elif occlusion is not None:
@@ -360,7 +360,7 @@ def observe(
 
     if made is None and jit is not None:  # both sides' bands in one call (issue 19, stop 51)
         made = _observed_bands(jit, rays, inner, outer, bands, n_band, region, camera, edge_uv, is_contour,
-                               occlusion, kept)  # fmt: skip
+                               occlusion)  # fmt: skip
     if made is None:
         rays_in, _, _ = bands_of(inner, False)
         rays_out, out_weights, out_depth = bands_of(outer, True)
@@ -551,31 +551,58 @@ def _labels_at(
     moot: np.ndarray | None = None,
 ) -> np.ndarray:
     """(m,) bool: the label (``labels`` (k,) bool, ``k >= 1``) of the edge point (``edge_uv`` (k, 2), pixels) nearest
-    each of ``uv`` (m, 2): ``labels[cKDTree(edge_uv).query(uv)[1]]``. Where every label is the same, that label (any
-    nearest point has it); else by the compiled twin :func:`symfruit.core._jit.nearest_labels` where numba is
-    installed (the same squared distances as the tree's: the same labels wherever the nearest points of a pixel
-    share their label; the tree's pick for the pixels whose nearest points do not; issue 19, nineteenth round: a
-    fruit's look-ups on the benchmark frame take 9 us against 275 for a tree and its query), else by the tree.
-    ``kept``: where the tree is kept for further look-ups on the same edge points; ``moot`` (m,) bool: the pixels
-    whose label the caller does not read (any nearest point's label is returned there, the tree is not asked)."""
+    each of ``uv`` (m, 2); where the nearest points (equally near to the bit) carry both labels, the label of the first
+    of them in ``edge_uv``'s order (:func:`_first_nearest`). Where every label is the same, that label (any nearest
+    point has it); else by the compiled twin :func:`symfruit.core._jit.nearest_labels` where numba is installed (the
+    same squared distances as a k-d tree's; issue 19, nineteenth round: a fruit's look-ups on the benchmark frame take
+    9 us against 275 for a tree and its query), its ties by :func:`_first_nearest`; else by a k-d tree (``kept``:
+    where it is kept for further look-ups on the same edge points), the queries whose two nearest points lie equally
+    far by :func:`_first_nearest`. ``moot`` (m,) bool: the pixels whose label the caller does not read (any nearest
+    point's label is returned there). Until stop 55 a tie was the tree's pick, the first point its search met, which
+    hangs on how scipy's build ordered each leaf: the tree cost about 1 ms a benchmark frame for 1-3 tied pixels a
+    fruit (docs/fast55.md)."""
     n_true = np.count_nonzero(labels)
     if n_true == len(labels) or n_true == 0:
         return np.full(len(uv), n_true > 0)
     jit = compiled() if len(uv) else None
-    found = unsure = None
     if jit is not None:
         found, unsure = jit.nearest_labels(np.ascontiguousarray(edge_uv, dtype=np.float64),
                                            np.ascontiguousarray(labels, dtype=bool),
                                            np.ascontiguousarray(uv, dtype=np.float64))  # fmt: skip
         if moot is not None:
             unsure &= ~moot
-        if not unsure.any():
-            return found
-    tree = _tree(edge_uv, kept)
-    if found is None or unsure is None:
-        return labels[tree.query(uv)[1]]
-    found[unsure] = labels[tree.query(uv[unsure])[1]]  # each pixel's own search: the same pick as among all
+        if unsure.any():
+            found[unsure] = _first_nearest(edge_uv, labels, uv[unsure])
+        return found
+    distance, index = _tree(edge_uv, kept).query(uv, k=2)  # the two nearest: a tie where they lie equally far
+    found = labels[index[:, 0]]
+    tied = distance[:, 0] == distance[:, 1]
+    if moot is not None:
+        tied &= ~moot
+    if tied.any():
+        found[tied] = _first_nearest(edge_uv, labels, np.asarray(uv)[tied])
     return found
+
+
+#: :func:`_first_nearest`: at most about this many squared distances at a time (8 MB of float64).
+_NEAREST_BLOCK = 2**20
+
+
+def _first_nearest(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) -> np.ndarray:
+    """(m,) the label (``labels`` (k,)) of the point of ``points`` (k, 2) nearest each row of ``queries`` (m, 2), the
+    first in ``points``' order among those equally near (squared distances ``dx * dx + dy * dy``, as
+    :func:`symfruit.core._jit.nearest_labels` and scipy's k-d tree take them): :func:`_labels_at`'s rule for ties,
+    the same in both kernel modes. Every distance is computed, a block of queries at a time: it is asked for the
+    few queries whose nearest points tie."""
+    p = np.asarray(points, dtype=np.float64)
+    q = np.asarray(queries, dtype=np.float64)
+    out = np.empty(len(q), dtype=np.asarray(labels).dtype)
+    rows = max(1, _NEAREST_BLOCK // max(1, len(p)))
+    for i in range(0, len(q), rows):
+        dx = q[i : i + rows, None, 0] - p[None, :, 0]
+        dy = q[i : i + rows, None, 1] - p[None, :, 1]
+        out[i : i + rows] = labels[np.argmin(dx * dx + dy * dy, axis=1)]  # argmin: the first least
+    return out
 
 
 def _tree(edge_uv: np.ndarray, kept: dict[str, Any] | None) -> cKDTree:
@@ -631,12 +658,11 @@ def _occlusion_maps(occlusion: Occlusion | None) -> tuple[np.ndarray, np.ndarray
 def _observed_bands(
     jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
     region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion | None,
-    kept: dict[str, Any],
 ) -> _Banded | None:  # fmt: skip
     """:func:`observe`'s bands by one compiled call (:func:`symfruit.core._jit.observe_bands`; issue 19, stop 51):
     the same values as ``observe``'s ``bands_of`` on both sides (the same pieces, :func:`_band_rays`,
     :meth:`~symfruit.core.occlusion.Occlusion.seen_at` and :func:`_labels_at`, in one call; a label tied between
-    nearest edge points of both labels is the tree's pick, as there). None where ``seen_at`` would not take its
+    nearest edge points of both labels is :func:`_first_nearest`'s, as there). None where ``seen_at`` would not take its
     kernel: the caller takes ``bands_of``."""
     maps = _occlusion_maps(occlusion)
     if maps is None:
@@ -646,20 +672,21 @@ def _observed_bands(
     made = jit.observe_bands(rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0),
                              int(region.v0), float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy),
                              edge, labels, occlusion is not None, *maps)  # fmt: skip
-    return _unpacked(made, len(rays), edge, labels, occlusion is not None, kept)
+    return _unpacked(made, len(rays), edge, labels, occlusion is not None)
 
 
 def _outline_bands(
     jit: Any, rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: tuple[float, ...], n_band: int,
     region: Silhouette, camera: Camera, edge_uv: np.ndarray, is_contour: np.ndarray, occlusion: Occlusion,
-    count: int, radius: int, share: float, kept: dict[str, Any],
+    count: int, radius: int, share: float,
 ) -> tuple[np.ndarray, np.ndarray, _Banded, np.ndarray | None] | None:  # fmt: skip
     """:func:`_occluded_edges`, :func:`_observed_bands` and the outline cracks' labels (:func:`observe`'s ``cracks``,
     where ``share <= contour < 1``) by one compiled call (:func:`symfruit.core._jit.outline_bands`; issue 19, stop 51):
-    ``(uv, contour labels, bands, the cracks' labels or None)``, the same values (ties of labels the tree's pick, as
-    :func:`_labels_at` takes them). Where the edge normals' labels (``is_contour``) are all alike or none: their
-    outline labels need no look-up (``_labels_at`` gives that label everywhere); else, or where ``_observed_bands``
-    or ``_outline_uv`` would not take their kernels, None: the caller takes the pieces one by one."""
+    ``(uv, contour labels, bands, the cracks' labels or None)``, the same values (ties of labels by
+    :func:`_first_nearest`, as :func:`_labels_at` takes them). Where the edge normals' labels (``is_contour``) are all
+    alike or none: their outline labels need no look-up (``_labels_at`` gives that label everywhere); else, or where
+    ``_observed_bands`` or ``_outline_uv`` would not take their kernels, None: the caller takes the pieces one
+    by one."""
     n_true = np.count_nonzero(is_contour)
     maps = _occlusion_maps(occlusion)
     mask = region.mask
@@ -670,9 +697,9 @@ def _outline_bands(
         np.ascontiguousarray(mask), count, int(radius), bool(n_true > 0 or not len(is_contour)), cracks, float(share),
         rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
         float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), *maps)  # fmt: skip
-    banded = _unpacked(made, len(rays), uv, labels, True, kept)
-    if took and unsure.any():  # _labels_at's tree among ties, as for the bands
-        found[unsure] = labels[_tree(uv, kept).query(cracks[unsure])[1]]
+    banded = _unpacked(made, len(rays), uv, labels, True)
+    if took and unsure.any():  # _labels_at's rule among ties, as for the bands
+        found[unsure] = _first_nearest(uv, labels, cracks[unsure])
     return uv, labels, banded, found if took else None
 
 
@@ -681,15 +708,14 @@ def _outline_bands(
 _Banded = tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.ndarray], "_Bands"]
 
 
-def _unpacked(made: tuple[np.ndarray, ...], n: int, edge: np.ndarray, labels: np.ndarray, occluded: bool,
-              kept: dict[str, Any]) -> _Banded:  # fmt: skip
+def _unpacked(made: tuple[np.ndarray, ...], n: int, edge: np.ndarray, labels: np.ndarray, occluded: bool) -> _Banded:
     """:func:`symfruit.core._jit.observe_bands`' result ``made`` (``n`` depth rays, the edge points ``edge`` with
     ``labels``) as :func:`_observed_bands` returns it; a label tied between nearest edge points of both labels (its
-    ``unsure``) is ``_labels_at``'s tree's pick (kept in ``kept``), each band's weight sum moved by the change."""
+    ``unsure``) is :func:`_labels_at`'s (:func:`_first_nearest`), each band's weight sum moved by the change."""
     every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = made
     if unsure.any():
         at = np.flatnonzero(unsure)
-        picked = labels[_tree(edge, kept).query(uv[at])[1]].tolist()
+        picked = _first_nearest(edge, labels, uv[at]).tolist()
         band = np.searchsorted(out_starts, at, side="right") - 1
         for i, j, label in zip(at.tolist(), band.tolist(), picked, strict=True):
             value = 1.0 if label else 0.0
