@@ -12,6 +12,7 @@ from symfruit import ConfigError, InputError
 from symfruit.core.camera import Camera
 from symfruit.extract import (
     ExtractSettings,
+    _clusters,
     backdrop,
     cluster,
     cluster_gap,
@@ -460,6 +461,27 @@ def test_a_far_fruit_seen_by_coarse_pixels_is_one_cluster():
     assert len(ex.points) >= 0.9 * mask.sum() and ex.n_other_clusters <= 0.1 * mask.sum()
     fine_cam, fine_depth, fine_mask = far_sphere(917.0, size=300)
     assert len(extract(fine_mask, fine_depth, fine_cam, NO_EROSION).points) >= 0.9 * fine_mask.sum()
+
+
+def test_the_wider_gap_is_taken_only_where_the_distance_broke_the_points_into_pixels():
+    """Stop 55, on merging realpert55: at 3 m through a 600 px camera four pixel footprints are 20 mm. A fruit and a
+    smaller leaf 8 mm off it, each sampled every 2 mm, are two clusters at the setting's 6 mm, the fruit the larger,
+    and stay two (the wider gap would join them: a visible apple on the rendered trees grew 0.9 -> 21.5 mm deep); a
+    fruit sampled every 8 mm (single points at 6 mm) is one cluster at the wider gap."""
+    g = np.arange(0.0, 0.04, 0.002)
+    patch = np.stack(np.meshgrid(g, g), axis=-1).reshape(-1, 2)
+    fruit = np.column_stack((patch, np.full(len(patch), 3.0)))
+    leaf = fruit[fruit[:, 0] < 0.02] + [0.046, 0.0, 0.0]  # half the fruit's columns, 8 mm beyond its last
+    labels = _clusters(np.vstack((fruit, leaf)), CAM, 0.006)
+    assert (
+        labels.max() == 1
+        and len(set(labels[: len(fruit)])) == 1
+        and set(labels[: len(fruit)]) != set(labels[len(fruit) :])
+    )
+    assert cluster(np.vstack((fruit, leaf)), cluster_gap(fruit, CAM, 0.006)).max() == 0  # what the gap alone did
+    coarse = np.column_stack((patch * 4, np.full(len(patch), 3.0)))  # every 8 mm
+    assert cluster(coarse, 0.006).max() + 1 == len(coarse)  # single points at the setting's distance
+    assert _clusters(coarse, CAM, 0.006).max() == 0
 
 
 def test_the_clustering_gap_is_the_setting_until_pixels_are_coarser():

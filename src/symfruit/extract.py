@@ -31,6 +31,13 @@ MAX_RADIUS_PX = 50
 #: turns 60 degrees away (about where a time-of-flight camera stops returning depth on a sphere: the outer 13-20 %
 #: of its radius lost); :func:`cluster` keeps points up to half its distance apart together.
 CLUSTER_PITCHES = 4.0
+#: :func:`extract` clusters again at :func:`cluster_gap` only where the setting's distance broke the points into
+#: pieces the largest of which holds less than this share of them (a surface sampled more coarsely than the
+#: distance: the real Azure Kinect spheres binned 3 x 3 in pieces of 2-42 % of their points), not where it parted a
+#: fruit from a leaf, a branch or the backdrop around it (the fruit the larger part): a wider distance there joins
+#: what lies a few millimetres off the fruit to it (the rendered apple trees at 1.2-2 m: a visible apple's depth
+#: side 0.9 -> 21.5 mm with the wider distance taken always; docs/realpert55.md, "On merging").
+FRAGMENT_SHARE = 0.5
 
 #: :func:`backdrop` reads the depth around a mask on every ``radius / AROUND_STEPS``-th pixel (a near fruit's ring of
 #: 100 000 pixels counted on a few thousand: shares, not pixels, are wanted).
@@ -73,7 +80,8 @@ class ExtractSettings(Section):
         Points closer than this join one cluster (voxel-grid Euclidean clustering); the fruit is the
         cluster nearest the camera among those with at least ``cluster_share`` of the largest's points. Where
         the camera's pixels are coarser than this at the points' depth, the distance is :data:`CLUSTER_PITCHES`
-        pixel footprints there instead (:func:`cluster_gap`).
+        pixel footprints there instead (:func:`cluster_gap`), but only where the distance broke the points into
+        pieces none of which holds most of them (:data:`FRAGMENT_SHARE`).
     cluster_share : float
     min_points : int
         A fruit with fewer points left is reported as failed.
@@ -136,6 +144,16 @@ def cluster_gap(points: np.ndarray, camera: Camera, distance: float) -> float:
     3 x 3: a 200 mm sphere at 1.5 m, 5 mm a pixel, kept 6 points of 1,033 with depth; docs/realpert55.md)."""
     footprint = float(median(np.ascontiguousarray(points[:, 2]))) / float(np.sqrt(camera.fx * camera.fy))
     return max(float(distance), CLUSTER_PITCHES * footprint)
+
+
+def _clusters(points: np.ndarray, camera: Camera, distance: float) -> np.ndarray:
+    """:func:`cluster`'s labels of ``points`` (n >= 2) at ``distance``; where that broke them into pieces the largest
+    of which holds less than :data:`FRAGMENT_SHARE` of them and :func:`cluster_gap` is wider, its labels at that gap."""
+    labels = cluster(points, distance)
+    if labels.max() > 0 and np.bincount(labels).max() < FRAGMENT_SHARE * len(points):
+        if (gap := cluster_gap(points, camera, distance)) > distance:
+            return cluster(points, gap)
+    return labels
 
 
 def cluster(points: np.ndarray, distance: float) -> np.ndarray:
@@ -309,7 +327,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         points = camera.deproject(np.stack((cols, rows), axis=1).astype(np.float64), z_all[rows, cols])
     dropped = int(n_usable - len(points))
     # one cluster (every label 0): every point kept, nothing dropped, no cluster picked (stop 46)
-    if len(points) >= 2 and int((labels := cluster(points, cluster_gap(points, camera, s.cluster_distance))).max()) > 0:
+    if len(points) >= 2 and int((labels := _clusters(points, camera, s.cluster_distance)).max()) > 0:
         counts = np.bincount(labels)
         big = np.flatnonzero(counts >= s.cluster_share * counts.max())
         # the nearest of the big clusters (one alone needs no medians)
