@@ -280,10 +280,7 @@ def _stream_recording(
             if name is not None and not skip:
 
                 def prepared(index: int = index, name: str = name) -> Any:
-                    if where is not None and name not in where:
-                        raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run "
-                                              "began")  # fmt: skip
-                    return stream.prepare(src.read(index if where is None else where[name]))
+                    return stream.prepare(_read(src, rec, index, name, where))
 
                 ready = guarded(prepared, name, folder, later)[1]  # nothing written: never a full disk's stop
             found = None
@@ -295,13 +292,7 @@ def _stream_recording(
             if ready is not None and name is not None and guarded(partial(stream.start, ready), name, folder, later)[0]:
                 started = (index, name, folder)
             if flight is not None and found is not None:  # written while the workers do this frame's fruit
-
-                def written(index: int = flight[0], folder: Path = flight[2], found: Any = found) -> FrameDetections:
-                    if on_frame is not None:
-                        on_frame(index, found)
-                    write_detections(folder, found, settings=settings)
-                    return found
-
+                written = partial(_written, flight[2], flight[0], found, on_frame, settings)
                 done, _, report.stopped = guarded(written, flight[1], flight[2], report.failed)
                 if report.stopped:  # this frame, started or not, and those after it are not processed
                     report.unprocessed = [rec.key + n for n in names[flight[0] + 1 :]]
@@ -316,6 +307,23 @@ def _stream_recording(
                 bar.update()
     finally:
         stream.abandon()  # a full disk or an interrupt: the frame in flight dropped
+
+
+def _read(src: Any, rec: Recording, index: int, name: str, where: dict[str, int] | None) -> Any:
+    """Frame ``name`` (``index`` when the recording was listed) of ``rec``: ``where`` its index now, where the
+    recording changed since it was listed (a frame gone since is refused)."""
+    if where is not None and name not in where:
+        raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
+    return src.read(index if where is None else where[name])
+
+
+def _written(folder: Path, index: int, found: FrameDetections, on_frame: Callable[[int, FrameDetections], None] | None,
+             settings: Settings) -> FrameDetections:  # fmt: skip
+    """A frame's detections given to ``on_frame`` and written into ``folder``; returned."""
+    if on_frame is not None:
+        on_frame(index, found)
+    write_detections(folder, found, settings=settings)
+    return found
 
 
 def _counted(report: BatchReport, key: str, done: bool, found: FrameDetections | None) -> None:
@@ -376,14 +384,8 @@ def _one(
         return True
 
     def one_frame(index: int = index, name: str = name, folder: Path = folder) -> FrameDetections:
-        if where is not None and name not in where:
-            raise FileFormatError(f"{rec.source}: frame {name} is gone from the recording since the run began")
-        found = detect(src.read(index if where is None else where[name]), masks=masks, method=method,
-                       settings=settings, pool=pool)  # fmt: skip
-        if on_frame is not None:
-            on_frame(index, found)
-        write_detections(folder, found, settings=settings)
-        return found
+        found = detect(_read(src, rec, index, name, where), masks=masks, method=method, settings=settings, pool=pool)
+        return _written(folder, index, found, on_frame, settings)
 
     clear = partial(_clear_frame, folder, out)
     done, found, report.stopped = _guarded(one_frame, item=key, failed=report.failed, target=folder,
