@@ -129,7 +129,7 @@ def _parts(calls: list[tuple[tuple, dict]], rounds: int, frames: int) -> None:
     nested = sum(parts.get(f"jit.{name}", 0.0) for name in ("rim_sides", "centred_pixels", "column_extents"))
     for key, value in sorted(parts.items(), key=lambda kv: -kv[1]):
         _say(f"  {key:28s} {1e3 * value:6.3f}")
-    rest = total - (sum(parts.values()) - nested)
+    rest = total - (sum(parts.values()) - nested)  # the median frame less the parts' means: an estimate
     _say(f"  {'the rest (Python, numpy)':28s} {1e3 * rest:6.3f}")
 
 
