@@ -1177,3 +1177,20 @@ def test_a_message_cut_short_in_a_bag_is_said_so_with_its_size_not_in_rosbags_wo
               f"its fields run past its {cut:,} bytes: the message is cut short or damaged")  # fmt: skip
     assert str(info.value).startswith(f"{path}: ") and reason in str(info.value), str(info.value)
     assert not re.search(r"Invalid (string|sequence)|buffer is smaller|unpack_from", str(info.value))
+
+
+def test_a_room_claim_of_other_digits_than_ascii_counts_as_none_not_a_traceback(tmp_path):
+    """Stop 56 (robust56): a claim file in the shared claims folder (every user's: mode 1777) holding '\u00b2',
+    which str.isdigit() takes and int() refuses, locked by its writer, made every run decompressing a bag there
+    a ValueError traceback; now it claims nothing, as any claim that is no number."""
+    import fcntl
+
+    from symfruit.io.bags import _RoomClaims
+
+    claim = tmp_path / "1-x.claim"
+    claim.write_text("\u00b2")
+    with open(claim) as holder:
+        fcntl.flock(holder.fileno(), fcntl.LOCK_EX)  # its writer alive
+        assert _RoomClaims._held(claim) == 0
+        claim.write_text("12")
+        assert _RoomClaims._held(claim) == 12

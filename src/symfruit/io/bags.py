@@ -357,7 +357,7 @@ class _RoomClaims:
                 text = file.read(32).strip()
         except OSError:
             return 0
-        return int(text) if text.isdigit() else 0
+        return int(text) if text.isascii() and text.isdigit() else 0  # '²'.isdigit(), and int() refuses it
 
     def close(self) -> None:
         if self._mine is not None:
