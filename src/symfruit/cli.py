@@ -816,6 +816,9 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
     for name, reason in failed.items():
         print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
+    if not rows and not failed:  # every frame read, none with a sphere: exit 1 without a word before (stop 56)
+        print(_line(f"symfruit: {args.spheres}: no frame's masks hold a sphere (every mask is empty): "
+                    "nothing was evaluated"), file=sys.stderr)  # fmt: skip
     return 1 if failed or not rows else 0
 
 
