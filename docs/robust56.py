@@ -26,6 +26,7 @@ import contextlib
 import dataclasses
 import json
 import os
+import re
 import resource
 import shutil
 import signal
@@ -49,6 +50,12 @@ LIMIT_S = 120
 ADDRESS_SPACE = 8 << 30
 ROOT, fixture, cli, Run, small, add = r47.ROOT, r49.fixture, r47.cli, r47.Run, r51.small, r55.add
 CASES = r55.CASES  # robust55's ``add`` (its other libraries' words) fills its list: this sweep's alone here
+#: robust55's other libraries' words, and those stop 55 left: rosbags' CDR words for a message cut short (and
+#: numpy's and struct's under them), a file never compressed called "decompressed", SQLite's for an MCAP file.
+r55._OTHERS = re.compile(
+    f"{r55._OTHERS.pattern}|Invalid (string|sequence) length|buffer is smaller than requested|unpack_from requires|"
+    r"\.db3, decompressed|\.mcap: file is not a database|invalid literal for int"
+)
 
 
 def _error() -> type[Exception]:
@@ -99,6 +106,34 @@ def stream_cases() -> None:
             expect = "any" if why == "depth-all-zero" else "failed"
             add(f"stream/{why}-frame-{at}-of-4-fruit-processes-1", expect, _case(why, at, 1), f"f_{at}")
     add("stream/depth-garbage-frame-1-of-4-no-pool", "failed", _case("depth-garbage", 1, 0), "f_1")
+
+    def bag(cut: int, processes: int) -> Callable[[], Any]:
+        def go() -> Any:
+            import sqlite3
+
+            sys.path.insert(0, str(ROOT))
+            from tests.conftest import disc_frame
+            from tests.io.test_bags import write_ros2_bag
+
+            color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+            p = write_ros2_bag(fixture(f"stream-bag-{cut}-{processes}"), color, (depth * 1000).astype(np.uint16),
+                               frames=4)  # fmt: skip
+            with contextlib.closing(sqlite3.connect(next(p.glob("*.db3")))) as con:  # frame 1's depth cut short
+                con.execute(f"update messages set data = substr(data, 1, {cut}) where topic_id = 2 and "
+                            "timestamp = 2000001000")  # fmt: skip
+                con.commit()
+            o = r49.out(f"stream-bag-{cut}-{processes}")
+            run = cli("detect", p, "--output", o, "--method", "sphere", "--fruit-processes", processes, output=o)
+            if len(_written_frames(o)) != 3:
+                return f"DEFECT: {len(_written_frames(o))} frames written, expected 3: {run.err[-160:]}"
+            return run
+
+        return go
+
+    for cut in (40, 400):
+        for processes in (0, 1):
+            add(f"stream/bag-depth-message-cut-to-{cut}-frame-1-of-4-fruit-processes-{processes}", "failed",
+                bag(cut, processes), "stream-bag")  # fmt: skip
 
 
 def _zero_depth(frame: Path) -> None:
@@ -173,6 +208,36 @@ def stream_api_cases() -> None:
 
     add("streamapi/three-frames-then-a-closed-pool", "result", same_as_detect(1))
 
+    def layout(name: str, change: Callable[[Any], dict[str, Any]]) -> None:
+        def go() -> Any:
+            f = dataclasses.replace(frame(), **change(frame()))
+            alone = detect(f, method="evidence")
+            with FruitPool(1) as pool:
+                stream = DetectStream(pool, method="evidence")
+                stream.start(stream.prepare(f))
+                streamed = stream.finish()
+            if _records(streamed) != _records(alone):
+                return "DEFECT: the frame's detections in a stream with a pool are not detect's"
+            return streamed
+
+        add(f"streamapi/arrays-{name}", "result", go)
+
+    layout("colour-fortran", lambda f: {"color": np.asfortranarray(f.color)})
+    layout("colour-negative-strides", lambda f: {"color": f.color[::-1, ::-1][::-1, ::-1]})
+    layout("colour-every-other-column-view", lambda f: {"color": np.repeat(f.color, 2, axis=1)[:, ::2]})
+    layout("colour-read-only", lambda f: {"color": _read_only(f.color)})
+    layout("colour-broadcast", lambda f: {"color": np.broadcast_to(f.color[:1], f.color.shape)})
+    layout("depth-big-endian", lambda f: {"depth": f.depth.astype(">f4")})
+    layout("depth-fortran-read-only", lambda f: {"depth": _read_only(np.asfortranarray(f.depth))})
+    layout("masks-big-endian-int32", lambda f: {"masks": (f.depth > 0).astype(">i4")})
+    layout("masks-uint64-strided", lambda f: {"masks": np.repeat((f.depth > 0).astype(np.uint64), 2, axis=0)[::2]})
+
+
+def _read_only(a: np.ndarray) -> np.ndarray:
+    a = a.copy()
+    a.flags.writeable = False
+    return a
+
 
 def _records(found: Any) -> str:
     """A frame's detections as ``detections.json`` holds them, less the times."""
@@ -183,6 +248,45 @@ def _records(found: Any) -> str:
     for fruit in record.get("fruits", []):
         fruit.pop("seconds", None)
     return json.dumps(record, sort_keys=True, default=str)
+
+
+# --- what stop 55 left: a bag's storage of the other kind, a message cut short ------------------------------------
+def left_cases() -> None:
+    import sqlite3
+
+    def bag(name: str, expect: str, change: Callable[[Path], Any], storage: str = "sqlite3") -> None:
+        def go() -> Any:
+            sys.path.insert(0, str(ROOT))
+            from tests.conftest import disc_frame
+            from tests.io.test_bags import write_ros2_bag
+
+            color, depth = disc_frame([(60, 60), (110, 60)], radius=15)
+            p = write_ros2_bag(fixture(f"left-{name}"), color, (depth * 1000).astype(np.uint16), frames=3,
+                               storage=storage)  # fmt: skip
+            change(p)
+            o = r49.out(f"left-{name}")
+            return cli("detect", p, "--output", o, "--method", "sphere", output=o)
+
+        add(f"left/{name}", expect, go, f"left-{name}")
+
+    def retitle(old: str, new: str) -> Callable[[Path], None]:
+        return lambda p: (p / "metadata.yaml").write_text((p / "metadata.yaml").read_text().replace(old, new))
+
+    def cut(topic: int, size: int) -> Callable[[Path], None]:
+        def go(p: Path) -> None:
+            with contextlib.closing(sqlite3.connect(next(p.glob("*.db3")))) as con:
+                con.execute(f"update messages set data = substr(data, 1, {size}) where topic_id = {topic}")
+                con.commit()
+
+        return go
+
+    bag("sqlite-named-mcap", "error", retitle("storage_identifier: sqlite3", "storage_identifier: mcap"))
+    bag("mcap-named-sqlite3", "error", retitle("storage_identifier: mcap", "storage_identifier: sqlite3"), "mcap")
+    bag("mcap-file-a-ros1-bag", "error", lambda p: next(p.glob("*.mcap")).write_bytes(b"#ROSBAG V2.0\n" + bytes(4000)),
+        "mcap")  # fmt: skip
+    for topic, what in ((3, "camera-info"), (2, "depth"), (1, "colour")):
+        for size in (3, 40, 200):
+            bag(f"{what}-messages-cut-to-{size}-bytes", "failed", cut(topic, size))
 
 
 # --- cameras of absurd focal length --------------------------------------------------------------------------------
@@ -368,7 +472,19 @@ def interrupt_cases() -> None:
                 return f"DEFECT: still running 90 s after {how.name}"
             if how == signal.SIGINT and b"Traceback" in err:
                 return f"DEFECT: a traceback on {how.name}: {err.decode(errors='replace')[-200:]}"
-            return _outputs_whole(o) or Run(proc.returncode, "", err.decode(errors="replace"), o)
+            said = err.decode(errors="replace").strip().splitlines()
+            if broken := _outputs_whole(o):
+                return broken
+            first = f"exit {proc.returncode}, {len(_written_frames(o))} frames written"
+            again = cli("detect", rec, "--output", o, "--method", "evidence", "--resume", output=o)  # takes it up
+            if again.rc != 0 or (broken := _outputs_whole(o)):
+                return broken or f"DEFECT: --resume after {how.name}: exit {again.rc}: {again.err[-200:]}"
+            import pyarrow.parquet as pq
+
+            rows = pq.read_table(o / "frames.parquet").num_rows
+            if _written_frames(o) != [f"f_{k}" for k in range(6)] or rows != 6:
+                return f"DEFECT: --resume after {how.name}: {len(_written_frames(o))} frames written, {rows} rows"
+            return f"{first} ({said[-1:]}); --resume: 6 frames, 6 rows"
 
         return go
 
@@ -411,9 +527,9 @@ def main() -> int:
     soft, hard = resource.getrlimit(resource.RLIMIT_AS)
     if soft == resource.RLIM_INFINITY:
         resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, hard))
-    return r49.run_main(__doc__ or "", (stream_cases, stream_api_cases, camera_cases, spheres_cases, option_cases,
-                                        interrupt_cases, settings_cases), CASES, prefix="robust56-", limit=LIMIT_S,
-                        width=60)  # fmt: skip
+    builds = (left_cases, stream_cases, stream_api_cases, camera_cases, spheres_cases, option_cases, interrupt_cases,
+              settings_cases)  # fmt: skip
+    return r49.run_main(__doc__ or "", builds, CASES, prefix="robust56-", limit=LIMIT_S, width=60)
 
 
 if __name__ == "__main__":
