@@ -208,6 +208,20 @@ def stream_api_cases() -> None:
 
     add("streamapi/three-frames-then-a-closed-pool", "result", same_as_detect(1))
 
+    def leave(value: Any) -> Callable[[], Any]:
+        def go() -> Any:
+            sys.path.insert(0, str(ROOT))
+            from tests.test_fruitpool import four, fruit_task
+
+            task, jobs = fruit_task(four())
+            with FruitPool(1, method=None) as pool:
+                return pool.start(task, jobs, leave=value).result()
+
+        return go
+
+    for value in ("1", -1.0, float("nan")):
+        add(f"streamapi/pool-start-leave-{value}", "error", leave(value))
+
     def layout(name: str, change: Callable[[Any], dict[str, Any]]) -> None:
         def go() -> Any:
             f = dataclasses.replace(frame(), **change(frame()))
