@@ -509,6 +509,32 @@ def interrupt_cases() -> None:
                     interrupted(how, after, processes))  # fmt: skip
 
 
+def resume_cases() -> None:
+    def cut(name: str) -> Callable[[], Any]:
+        def go() -> Any:
+            import pyarrow.parquet as pq
+
+            rec = _recording(f"resume-{name.replace('/', '-')}", frames=3)
+            o = r49.out(f"resume-{name.replace('/', '-')}")
+            first = cli("detect", rec, "--output", o, "--method", "raw", output=o)
+            if first.rc != 0:
+                return first
+            data = (o / name).read_bytes()
+            (o / name).write_bytes(data[: len(data) // 2])  # a run killed while it wrote it (no atomic rename)
+            again = cli("detect", rec, "--output", o, "--method", "raw", "--resume", output=o)
+            if broken := _outputs_whole(o):
+                return broken
+            if again.rc == 0 and any(pq.read_table(o / t).num_rows != 3 for t in ("frames.parquet",
+                                                                                  "detections.parquet")):  # fmt: skip
+                return "DEFECT: --resume left a table without its rows"
+            return again
+
+        return go
+
+    for name in ("frames.parquet", "detections.parquet", "errors.json", "f_1/detections.json"):
+        add(f"resume/{name.replace('/', '-')}-cut-in-half", "any", cut(name))
+
+
 def _outputs_whole(o: Path) -> str | None:
     """DEFECT text where a final-named output of ``o`` cannot be read whole (a temporary may be left)."""
     import pyarrow.parquet as pq
@@ -542,7 +568,7 @@ def main() -> int:
     if soft == resource.RLIM_INFINITY:
         resource.setrlimit(resource.RLIMIT_AS, (ADDRESS_SPACE, hard))
     builds = (left_cases, stream_cases, stream_api_cases, camera_cases, spheres_cases, option_cases, interrupt_cases,
-              settings_cases)  # fmt: skip
+              resume_cases, settings_cases)  # fmt: skip
     return r49.run_main(__doc__ or "", builds, CASES, prefix="robust56-", limit=LIMIT_S, width=60)
 
 
