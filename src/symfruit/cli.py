@@ -44,8 +44,8 @@ _NUMBER = r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
 
 
 def _whole(text: str) -> int:
-    """A whole-number option: ASCII digits, a sign before them (int() also reads '٣', '３', '1_000' and
-    '\u00b2' is refused only by it). Stop 56 (robust56)."""
+    """A whole-number option: ASCII digits, a sign before them (int() alone also reads '٣', '３' and '1_000' as
+    their values). Stop 56 (robust56)."""
     if not re.fullmatch(r"\s*[+-]?[0-9]+\s*", text):
         raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (ASCII digits 0-9)")
     return int(text)

@@ -1194,3 +1194,25 @@ def test_a_room_claim_of_other_digits_than_ascii_counts_as_none_not_a_traceback(
         assert _RoomClaims._held(claim) == 0
         claim.write_text("12")
         assert _RoomClaims._held(claim) == 12
+
+
+def test_message_reason_says_a_message_cut_short_in_each_library_s_words_and_leaves_others():
+    # the RealSense reader deserializes ROS 1 messages itself: struct's and numpy's words come bare, not in
+    # rosbags' "Could not deserialize" (stop 56, robust56)
+    import struct
+
+    from symfruit.io.bags import message_reason
+
+    try:
+        struct.unpack_from("<I", b"ab", 0)
+    except struct.error as exc:
+        assert message_reason(exc, b"ab") == "its fields run past its 2 bytes: the message is cut short or damaged"
+    try:
+        np.frombuffer(b"abc", dtype=np.uint16, count=4)
+    except ValueError as exc:
+        assert message_reason(exc, bytearray(3)) == ("its fields run past its 3 bytes: the message is cut short or "
+                                                     "damaged")  # fmt: skip
+    assert message_reason(ValueError("Invalid or unsupported CDR encapsulation."), b"\0\1") == (
+        "its 2 bytes do not begin with a CDR header: the message is damaged"
+    )
+    assert message_reason(ValueError("something else\nsecond line"), b"") == "something else"
