@@ -620,10 +620,11 @@ def reader_reason(exc: BaseException) -> str:
                 "(pip install -U rosbags, or `ros2 bag convert` it to an older version)")  # fmt: skip
     first = text.splitlines()[0].strip()
     other = re.fullmatch(r"Cannot open database (.+): file is not a database", first)
-    head = _head(Path(other.group(1))) if other else b""
-    if (what := _what_file(head)) is not None and not head.startswith(_SQLITE_MAGIC):  # another kind's file
-        return (f"{Path(other.group(1)).name} is not an SQLite database ({what}), though the bag reads it as one "
-                "(by its metadata.yaml's storage_identifier)")  # fmt: skip
+    if other:  # a storage file of another kind than the metadata names (stop 56)
+        head = _head(Path(other.group(1)))
+        if (what := _what_file(head)) is not None and not head.startswith(_SQLITE_MAGIC):
+            return (f"{Path(other.group(1)).name} is not an SQLite database ({what}), though the bag reads it as "
+                    "one (by its metadata.yaml's storage_identifier)")  # fmt: skip
     if len(first) > REASON_CHARS:
         first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
     return first
