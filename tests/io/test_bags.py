@@ -1203,15 +1203,13 @@ def test_message_reason_says_a_message_cut_short_in_each_library_s_words_and_lea
 
     from symfruit.io.bags import message_reason
 
-    try:
+    with pytest.raises(struct.error) as short:
         struct.unpack_from("<I", b"ab", 0)
-    except struct.error as exc:
-        assert message_reason(exc, b"ab") == "its fields run past its 2 bytes: the message is cut short or damaged"
-    try:
+    assert message_reason(short.value, b"ab") == "its fields run past its 2 bytes: the message is cut short or damaged"
+    with pytest.raises(ValueError) as small:
         np.frombuffer(b"abc", dtype=np.uint16, count=4)
-    except ValueError as exc:
-        assert message_reason(exc, bytearray(3)) == ("its fields run past its 3 bytes: the message is cut short or "
-                                                     "damaged")  # fmt: skip
+    assert message_reason(small.value, bytearray(3)) == ("its fields run past its 3 bytes: the message is cut short "
+                                                         "or damaged")  # fmt: skip
     assert message_reason(ValueError("Invalid or unsupported CDR encapsulation."), b"\0\1") == (
         "its 2 bytes do not begin with a CDR header: the message is damaged"
     )
