@@ -1048,3 +1048,33 @@ def test_a_name_too_long_for_the_system_is_one_short_line_not_a_traceback(tmp_pa
         assert re.search(r"\.\.\.x+(\.[a-z]+)?'? \(5,\d{3} characters\)", err[0]), err
     assert main(["settings", "--fruit", long]) == 2
     assert "no fruit profile 'xxxx" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    ("argv", "said"),
+    [
+        (["scenes", "OUT", "--n", "٣"], "argument --n: '٣' is not a whole number (ASCII digits 0-9)"),
+        (["scenes", "OUT", "--seed", "３"], "argument --seed: '３' is not a whole number (ASCII digits 0-9)"),
+        (["scenes", "OUT", "--n", "1_0"], "argument --n: '1_0' is not a whole number (ASCII digits 0-9)"),
+        (["scenes", "OUT", "--n", "3.0"], "argument --n: '3.0' is not a whole number (ASCII digits 0-9)"),
+        (["detect", "IN", "--output", "OUT", "--workers", "٢"], "argument --workers: '٢' is not a whole number"),
+        (["bench", "--segment", "--size", "٣٢٠x٢٤٠"], "--size must be WIDTHxHEIGHT, e.g. 1920x1080, got '٣٢٠x٢٤٠'"),
+        (["detect", "IN", "--output", "OUT", "--workers", "1", "--no-worker-timeout", "٣٠"],
+         "argument --no-worker-timeout: '٣٠' is not a number (ASCII digits 0-9, e.g. 0.5 or 1e-3)"),
+        (["detect", "IN", "--output", "OUT", "--workers", "1", "--no-worker-timeout", "3_0"],
+         "argument --no-worker-timeout: '3_0' is not a number"),
+    ],
+)  # fmt: skip
+def test_a_number_option_of_other_digits_than_ascii_is_refused_not_read(tmp_path, capsys, argv, said):
+    """Stop 56 (robust56): Python's int() and float() read Arabic-Indic ('٣'), full-width ('３') digits and '1_0'
+    as their values, so `--n ٣` made 3 frames and `--no-worker-timeout ٣٠` waited 30 s (stop 55 left it: only the
+    scheduler's port refused them); and '\\u00b2', which str.isdigit() takes, int() refuses. Now every number option
+    takes ASCII digits alone, as --classes does (stop 48), before anything is read or written."""
+    argv = [str(tmp_path / a) if a in ("IN", "OUT") else a for a in argv]
+    try:
+        code = main(argv)
+    except SystemExit as exc:  # argparse's refusal
+        code = exc.code
+    assert code == 2
+    assert said in capsys.readouterr().err
+    assert not (tmp_path / "OUT").exists()

@@ -466,3 +466,22 @@ def test_a_mask_holding_only_the_background_is_reported_with_its_reason_not_boxe
     assert wall.error.startswith("no depth of the fruit's own: the ") and "(at 1.000 m)" in wall.error
     assert wall.error.endswith("; 0 mask pixels nearer")
     assert detection_record(wall)["error"] == wall.error and detection_record(wall)["n_points"] == 0
+
+
+@pytest.mark.parametrize("given", ["frame", None, "ready-dict"])
+def test_a_stream_started_with_what_prepare_did_not_make_is_refused_by_name(given):
+    """Stop 56 (robust56): DetectStream.start(frame) (the frame as it is, not prepare's answer) was an
+    AttributeError from deep inside ("'Frame' object has no attribute 'frame'"); now an InputError naming what
+    start takes, and nothing is in flight after it."""
+    from symfruit.detect import DetectStream
+
+    stream = DetectStream(None, method="raw")
+    frame = small_frame()
+    what = {"frame": frame, None: None, "ready-dict": {"frame": frame}}[given]
+    name = {"frame": "Frame", None: "None", "ready-dict": "dict"}[given]
+    with pytest.raises(InputError, match=rf"^DetectStream\.start takes what DetectStream\.prepare returned \(a "
+                       rf"prepared frame\), got {name}$"):  # fmt: skip
+        stream.start(what)
+    assert not stream.in_flight
+    stream.start(stream.prepare(frame))  # the stream goes on
+    assert stream.finish() is not None

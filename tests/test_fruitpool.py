@@ -829,3 +829,15 @@ def test_the_calling_process_leaves_the_workers_the_fruit_left_when_told_it_has_
         assert [record(d[0]) for d in done] == alone
         if leave:
             assert len(took) <= 1  # its first fruit (none if the worker took them all first)
+
+
+@pytest.mark.parametrize("leave", ["1", -1.0, float("nan"), True, [1.0]])
+def test_a_start_told_to_leave_what_is_no_seconds_is_refused_before_the_task_is_sent(pool, leave):
+    """Stop 56 (robust56): FruitPool.start(..., leave="1") sent the task, took a fruit, then failed comparing
+    seconds with text (a TypeError, the workers ended and new ones started); -1 and NaN were taken in silence as
+    "take every fruit". Now refused by name before anything is sent; the pool is not busy after it."""
+    task, jobs = fruit_task(four())
+    with pytest.raises(InputError, match=r"^FruitPool\.start: leave must be None or seconds >= 0, got "):
+        pool.start(task, jobs, leave=leave)
+    running = pool.start(task, jobs, leave=0.0)  # the pool goes on
+    assert len(running.result()[0]) == len(jobs)

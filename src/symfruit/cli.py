@@ -43,6 +43,25 @@ def _path(text: str) -> Path:
 _NUMBER = r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?"
 
 
+def _whole(text: str) -> int:
+    """A whole-number option: ASCII digits, a sign before them (int() alone also reads '٣', '３' and '1_000' as
+    their values). Stop 56 (robust56)."""
+    if not re.fullmatch(r"\s*[+-]?[0-9]+\s*", text):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a whole number (ASCII digits 0-9)")
+    return int(text)
+
+
+def _real(text: str) -> float:
+    """A number option: float()'s own words (nan and inf are refused by each option's bounds), but of ASCII
+    alone and no '_' (float() also reads '٣.٥' and '1_0'). Stop 56 (robust56)."""
+    try:
+        if not text.isascii() or "_" in text:
+            raise ValueError
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number (ASCII digits 0-9, e.g. 0.5 or 1e-3)") from None
+
+
 def _entries(option: str, text: str, example: str, *, numbers: bool = False) -> list[str]:
     """The comma-separated entries of ``option``, stripped; an empty entry beside others (``a,,b``, a trailing
     comma) and, with ``numbers``, an entry that is no plain number are refused by name (they were dropped or
@@ -83,13 +102,13 @@ def _add_complete(sub: argparse._SubParsersAction) -> None:
 
 def _add_bench(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser("bench", help="time `complete` on a fixed partial strawberry (the project benchmark)")
-    p.add_argument("--repeat", type=int, default=None, help="timed runs per case (default 200)")
-    p.add_argument("--points", type=int, nargs="+", default=None, help="cloud sizes (default 600 3000)")
+    p.add_argument("--repeat", type=_whole, default=None, help="timed runs per case (default 200)")
+    p.add_argument("--points", type=_whole, nargs="+", default=None, help="cloud sizes (default 600 3000)")
     p.add_argument("--json", action="store_true", help="print the rows as JSON")
     p.add_argument("--frame", action="store_true", help="time a whole 640x480 frame with 8 fruit instead")
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
                    help="with --frame: the frame through a real camera model, at its resolution")  # fmt: skip
-    p.add_argument("--recording", type=int, metavar="N",
+    p.add_argument("--recording", type=_whole, metavar="N",
                    help="instead: peak memory and time of `detect` over a generated N-frame recording")  # fmt: skip
     p.add_argument("--method", default=None,
                    help="with --frame: only this method (default paper, fused and evidence); with --recording: the "
@@ -99,13 +118,13 @@ def _add_bench(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--stages", action="store_true",
                    help="with --frame: median and least wall time of each stage of `detect` and the thread's CPU "
                    "time per frame (--repeat runs of each method)")  # fmt: skip
-    p.add_argument("--workers", type=int, metavar="W",
+    p.add_argument("--workers", type=_whole, metavar="W",
                    help="with --recording: on a local Dask cluster of W processes (symfruit[cluster])")  # fmt: skip
-    p.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+    p.add_argument("--fruit-processes", type=_whole, default=None, metavar="N",
                    help="with --frame or --recording: each frame's fruit shared with N worker processes, started "
                    "and warmed up before the timing with --frame (0-16, default 0; as symfruit detect "
                    "--fruit-processes)")  # fmt: skip
-    p.add_argument("--stream", type=int, default=None, metavar="F",
+    p.add_argument("--stream", type=_whole, default=None, metavar="F",
                    help="with --frame: frames per second over F frames one after another, each alone and in a "
                    "stream (the next frame segmented while the fruit workers end the last), alternated --repeat "
                    "times (default 3)")  # fmt: skip
@@ -140,9 +159,9 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--methods", help="comma-separated methods (default: " + _EVALUATED + ")")
     p.add_argument(
-        "--n", type=int, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
+        "--n", type=_whole, help="fruits (paper; default 10) or views per occlusion level (camera; default 100)"
     )
-    p.add_argument("--seed", type=int, default=None, help="first seed (default 0)")
+    p.add_argument("--seed", type=_whole, default=None, help="first seed (default 0)")
     p.add_argument("--occlusion", help="camera protocol: occluder levels, e.g. 0,0.25,0.5 (default 0)")
     p.add_argument("--sensor", choices=("d435", "heldback", *REAL_SENSORS),
                    help="camera protocol: d435 (noise, edge dropout, 0.25-0.6 m), heldback (issue 11's measurement: "
@@ -156,13 +175,13 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--pose", choices=("hanging", "upright", "uniform"),
                    help="pose distribution: hanging (stem up; scans as in their file), upright (scans stood up "
                    "first), uniform (any orientation; camera protocol); default hanging")  # fmt: skip
-    p.add_argument("--views", type=int,
+    p.add_argument("--views", type=_whole,
                    help="camera protocol, generated kinds: views of each fruit (default 1: every view a new fruit; "
                    "more rank confidence among one fruit's views, as the scans' views are)")  # fmt: skip
     p.add_argument("--output", type=_path, default=Path("results"), help="results root (default results/)")
     p.add_argument("--quick", action="store_true", help="paper and camera protocols: a handful of instances, well "
                    "under a minute")  # fmt: skip
-    p.add_argument("--jobs", type=int, help="paper and camera protocols: worker processes (default: all CPUs)")
+    p.add_argument("--jobs", type=_whole, help="paper and camera protocols: worker processes (default: all CPUs)")
     p.add_argument("--config", type=_path, help="settings file for the methods")
     p.add_argument(
         "--no-profile",
@@ -185,7 +204,7 @@ def _add_evaluate(sub: argparse._SubParsersAction) -> None:
                    "color (default), maskrcnn:CHECKPOINT or onnx:MODEL")  # fmt: skip
     p.add_argument("--images", type=_path, help="masks protocol: folder of photographs")
     p.add_argument("--truth", type=_path, help="masks protocol: COCO JSON of the photographs' instance masks")
-    p.add_argument("--category", type=int, default=None,
+    p.add_argument("--category", type=_whole, default=None,
                    help="masks protocol: COCO category id of the fruit (default 1; -1: every annotation)")  # fmt: skip
     p.add_argument("--no-depth", action="store_true", help="masks protocol on rendered scenes: colour alone")
     p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
@@ -212,7 +231,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--resume", action="store_true",
                    help="skip frames whose detections.json is a whole record (one that cannot be read back, "
                    "truncated by a copy, is run again)")  # fmt: skip
-    p.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+    p.add_argument("--fruit-processes", type=_whole, default=None, metavar="N",
                    help="share each frame's fruit with N worker processes kept for the run (0-16, default 0; 1 on "
                    "two cores: about a fifth off a frame's detection once they are warm, docs/proc53.md); not with "
                    "--scheduler or --workers")  # fmt: skip
@@ -226,7 +245,7 @@ def _add_detect(sub: argparse._SubParsersAction) -> None:
                    ".json or a folder of label PNGs")  # fmt: skip
     p.add_argument("--depth", type=_path, help="a depth image, or a folder of <stem>.png (16-bit) / <stem>.npy (m)")
     p.add_argument("--camera", type=_path, help="with --depth: intrinsics file (needed)")
-    p.add_argument("--depth-scale", type=float, default=None, help="with --depth: metres per unit of 16-bit depth "
+    p.add_argument("--depth-scale", type=_real, default=None, help="with --depth: metres per unit of 16-bit depth "
                    "(default: the --camera file's depth_scale or depth_units, else 0.001)")  # fmt: skip
     p.add_argument("--fruit", default="strawberry", help="fruit profile (default strawberry) or a profile file")
     p.add_argument("--config", type=_path, help="settings file (YAML/JSON), over the profile")
@@ -253,16 +272,16 @@ def _add_cluster_options(p: argparse.ArgumentParser) -> None:
         help="run the frames on this Dask cluster (tcp://HOST:PORT; "
         "pip install 'symfruit[cluster]' here and on the workers, which must see the same paths)",
     )
-    where.add_argument("--workers", type=int, metavar="N", help="run the frames on a local Dask cluster of N worker "
+    where.add_argument("--workers", type=_whole, metavar="N", help="run the frames on a local Dask cluster of N worker "
                        "processes (127.0.0.1)")  # fmt: skip
-    p.add_argument("--chunk", type=int, default=None, metavar="N",
+    p.add_argument("--chunk", type=_whole, default=None, metavar="N",
                    help="with --scheduler or --workers: frames per task (default 4)")  # fmt: skip
-    p.add_argument("--no-worker-timeout", type=float, default=None, metavar="S",
+    p.add_argument("--no-worker-timeout", type=_real, default=None, metavar="S",
                    help="with --scheduler or --workers: seconds to wait while the cluster has no worker (for the "
                    "first one, and at any time during the run, after which the frames not done are recorded "
                    "unprocessed and the run stops); 1 to 86400, default 60 with --scheduler, 300 with --workers "
                    "(its workers restart themselves)")  # fmt: skip
-    p.add_argument("--silent-worker-timeout", type=float, default=None, metavar="S",
+    p.add_argument("--silent-worker-timeout", type=_real, default=None, metavar="S",
                    help="with --scheduler or --workers: a worker the scheduler has not heard from for S seconds "
                    "counts as none (as a paused one does); 10 to 86400, default 60")  # fmt: skip
 
@@ -302,14 +321,14 @@ def _parser() -> argparse.ArgumentParser:
     p = sub.add_parser("scenes", help="render synthetic annotated RGB-D frames of hanging strawberries or of an "
                        "apple tree (with truth)")  # fmt: skip
     p.add_argument("output", type=_path, help="folder to write scene_00000, scene_00001, ... into")
-    p.add_argument("--n", type=int, default=12, help="frames (default 12)")
-    p.add_argument("--seed", type=int, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
+    p.add_argument("--n", type=_whole, default=12, help="frames (default 12)")
+    p.add_argument("--seed", type=_whole, default=0, help="seed of the first frame; frame k uses seed + k (default 0)")
     p.add_argument("--scene", choices=("strawberry", "apple-tree"), default=None,
                    help="hanging strawberries (default) or an apple tree's canopy at 1.2-2 m through a real camera "
                    "model (the Azure Kinect unless --sensor), with the annotators' masks.png")  # fmt: skip
-    p.add_argument("--ripe", type=int, default=None,
+    p.add_argument("--ripe", type=_whole, default=None,
                    help="ripe fruit per frame (default 6 strawberries, 30 apples)")  # fmt: skip
-    p.add_argument("--unripe", type=int, default=None,
+    p.add_argument("--unripe", type=_whole, default=None,
                    help="unripe (white or green) fruit per frame (default 2 strawberries, 4 apples)")  # fmt: skip
     p.add_argument("--sensor", choices=REAL_SENSORS, default=None,
                    help="through a real camera model (symfruit.synthetic.sensors) at its resolution, fruit at "
@@ -467,8 +486,8 @@ def _bench(args: argparse.Namespace) -> int:
         from .evaluate.bench import bench_segment
 
         try:
-            width, height = (int(v) for v in str(args.size).lower().split("x"))
-        except ValueError:
+            width, height = (_whole(v) for v in str(args.size).lower().split("x"))
+        except (ValueError, argparse.ArgumentTypeError):
             raise InputError(f"--size must be WIDTHxHEIGHT, e.g. 1920x1080, got {args.size!r}") from None
         check_image_size(width, height, "--size")
         if args.scene is not None:
@@ -797,6 +816,9 @@ def _evaluate_spheres(args: argparse.Namespace, methods: list[str], settings) ->
     for name, reason in failed.items():
         print(_line(f"skipped {name}: {reason}"))
     print(f"results: {folder}")
+    if not rows and not failed:  # every frame read, none with a sphere: exit 1 without a word before (stop 56)
+        print(_line(f"symfruit: {args.spheres}: no frame's masks hold a sphere (every mask is empty): "
+                    "nothing was evaluated"), file=sys.stderr)  # fmt: skip
     return 1 if failed or not rows else 0
 
 

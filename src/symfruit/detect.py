@@ -726,6 +726,10 @@ class DetectStream:
     def start(self, ready: _Prepared) -> None:
         """Start a prepared frame: trimming, registration and this process's share of its fruit (their errors
         raised here: then nothing is in flight). The frame before must be finished (or abandoned) first."""
+        if not isinstance(ready, _Prepared):  # a Frame given as it is (stop 56: an AttributeError from _start)
+            given = "None" if ready is None else type(ready).__name__
+            raise InputError(f"DetectStream.start takes what DetectStream.prepare returned (a prepared frame), got "
+                             f"{given}")  # fmt: skip
         if self._running is not None:
             raise RuntimeError("DetectStream.start: the frame before is still in flight (finish it first)")
         self._running = _start(ready, self.pool, self._leave)

@@ -415,6 +415,9 @@ class FruitPool:
 
         Until the result is had (or :meth:`Running.abandon` called) the pool is busy: another frame run meanwhile
         (another thread's) runs in its calling process alone."""
+        number = isinstance(leave, int | float | np.integer | np.floating) and not isinstance(leave, bool)
+        if leave is not None and not (number and leave >= 0):  # "x" was a TypeError after the task was sent (stop 56)
+            raise InputError(f"FruitPool.start: leave must be None or seconds >= 0, got {leave!r:.40}")
         if not self.active or not self._busy.acquire(blocking=False):
             return Running.here(fruit, jobs, check)
         try:

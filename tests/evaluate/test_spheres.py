@@ -157,3 +157,28 @@ def test_the_frames_disagreement_is_the_largest_difference_of_one_side_over_ever
     pairs = [np.abs(sizes[i, k] - sizes[j, k]).max() for k in range(3) for i, j in itertools.combinations(range(30), 2)]
     _, summary = spheres_table(rows, ["raw"])  # one frame of sphere 9 and a failed box: in no pair
     assert summary[0]["frames_differ_mm"] == max(pairs)  # now one pass over the frames, not every pair of them
+
+
+def test_frames_whose_masks_hold_no_sphere_are_said_so_and_the_table_has_no_empty_column(tmp_path, capsys):
+    """Stop 56 (robust56): `evaluate --spheres` over frames whose masks are all empty exited 1 without a word, its
+    table's header one column longer than its rows (an empty 'sphere' column); now it says why, and the header
+    and the rows have as many columns."""
+    import shutil
+
+    from PIL import Image
+
+    from symfruit.cli import main
+
+    for k in (0, 1):
+        shutil.copytree(FRAMES / f"lab-spheres-{k}", tmp_path / "in" / f"lab-spheres-{k}")
+        masks = tmp_path / "in" / f"lab-spheres-{k}" / "masks.png"
+        with Image.open(masks) as im:
+            Image.fromarray(np.zeros((im.height, im.width), np.uint8)).save(masks)
+    assert main(["evaluate", "--spheres", str(tmp_path / "in"), "--output", str(tmp_path / "out"),
+                 "--methods", "raw"]) == 1  # fmt: skip
+    said = capsys.readouterr()
+    assert (
+        f"symfruit: {tmp_path / 'in'}: no frame's masks hold a sphere (every mask is empty): nothing was " in said.err
+    )
+    table, _ = spheres_table([], ("raw",))
+    assert [line.count("|") for line in table.splitlines()] == [6, 6, 6]

@@ -175,3 +175,16 @@ def test_a_path_without_a_file_name_is_refused(tmp_path):
 
     with pytest.raises(OutputError, match=r"\.\.: not a file name"):
         write_json(tmp_path / "a" / "..", {})
+
+
+def test_a_temporary_named_with_other_digits_than_ascii_is_stale_not_a_traceback(tmp_path):
+    """Stop 56 (robust56): a file '.a.json.\u00b2-1.tmp' in an output folder (its pid part '\u00b2', which
+    str.isdigit() takes and int() refuses) made every later write there a ValueError traceback
+    (``invalid literal for int() with base 10: '\u00b2'``); now it is no run's, stale like '.c.json.xyz.tmp'."""
+    from symfruit.io.atomic import folder_fd, stale_temporaries
+
+    names = [".a.json.\u00b2-0001.tmp", ".b.json.\u0663-0002.tmp"]
+    for name in names:
+        (tmp_path / name).write_text("")
+    with folder_fd(tmp_path) as fd:
+        assert sorted(stale_temporaries(fd)) == sorted(names)

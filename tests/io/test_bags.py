@@ -1123,3 +1123,94 @@ def test_a_ros1_bag_whose_index_is_cut_short_or_broken_is_named_damaged_in_our_w
     with pytest.raises(FileFormatError, match=r"broken\.bag: cannot open bag \(a record of the bag is not of the size "
                        r"its kind has: the bag is damaged\)$"):  # fmt: skip
         open_source(tmp_path / "broken.bag")
+
+
+@pytest.mark.parametrize(("storage", "names", "said"), [
+    ("sqlite3", "mcap", r"its storage file kind\.db3: not an MCAP file \(it is an SQLite database: rosbag2's sqlite3 "
+     r"storage\), though the bag reads it as one \(by its metadata\.yaml's storage_identifier, or its name\)$"),
+    ("mcap", "sqlite3", r"cannot open bag \(kind\.mcap is not an SQLite database \(it is an MCAP file: rosbag2's mcap "
+     r"storage\), though the bag reads it as one \(by its metadata\.yaml's storage_identifier\)\)$"),
+], ids=["sqlite3-named-mcap", "mcap-named-sqlite3"])  # fmt: skip
+def test_a_storage_file_of_the_other_kind_than_its_metadata_names_is_said_so(tmp_path, storage, names, said):
+    """Stop 56 (robust56): a sqlite3 database whose metadata.yaml names MCAP storage was "its MCAP file kind.db3,
+    decompressed: the record at byte 8 claims 1,152,977,719,091,359,090 bytes" (the file was never compressed;
+    its SQLite header read as an MCAP record); an MCAP file named sqlite3 storage was SQLite's "Cannot open
+    database ...: file is not a database". Now each is named by what its first bytes say it is."""
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "kind", color, (depth * 1000).astype(np.uint16), frames=2, storage=storage)
+    meta = path / "metadata.yaml"
+    meta.write_text(meta.read_text().replace(f"storage_identifier: {storage}", f"storage_identifier: {names}"))
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(path))}: {said}") as info:
+        open_source(path)
+    assert "decompressed" not in str(info.value)
+
+
+def test_a_whole_file_of_another_kind_in_the_bag_folder_named_mcap_is_said_so(tmp_path):
+    # the bag folder's own *.mcap are checked before rosbags opens the bag (check_mcap): the same words
+    pytest.importorskip("rosbags")
+    color, depth = disc_frame([(80, 60)])
+    path = write_ros2_bag(tmp_path / "kind", color, (depth * 1000).astype(np.uint16), frames=2, storage="mcap")
+    mcap = path / "kind.mcap"
+    mcap.write_bytes(b"#ROSBAG V2.0\n" + bytes(4000))
+    with pytest.raises(FileFormatError, match=rf"^{re.escape(str(mcap))}: cannot open bag \(not an MCAP file \(it "
+                       r"is a ROS 1 bag\), though the bag reads it as one"):  # fmt: skip
+        open_source(path)
+
+
+@pytest.mark.parametrize(
+    ("topic", "cut"), [(3, 40), (3, 200), (2, 300), (1, 3)], ids=["info-40", "info-200", "depth-300", "colour-3"]
+)
+def test_a_message_cut_short_in_a_bag_is_said_so_with_its_size_not_in_rosbags_words(tmp_path, topic, cut):
+    """Stop 56 (robust56): a message cut short inside a sqlite3 bag failed its frames in rosbags' CDR words
+    (``invalid CameraInfo on /camera/color/camera_info (Invalid string length 27 at offset 8.)``), numpy's
+    (``buffer is smaller than requested size``) or struct's (``unpack_from requires a buffer of at least 4 bytes
+    for unpacking 4 bytes at offset 4``). Now: the message's size and that it is cut short or damaged; each frame
+    fails alone, naming the topic."""
+    pytest.importorskip("rosbags")
+    path = _sqlite_bag(tmp_path, "cut", f"update messages set data = substr(data, 1, {cut}) where topic_id = {topic}")
+    source = open_source(path)
+    with pytest.raises(FileFormatError) as info:
+        source.read(0)
+    source.close()
+    reason = (f"its {cut:,} bytes do not begin with a CDR header: the message is damaged" if cut < 4 else
+              f"its fields run past its {cut:,} bytes: the message is cut short or damaged")  # fmt: skip
+    assert str(info.value).startswith(f"{path}: ") and reason in str(info.value), str(info.value)
+    assert not re.search(r"Invalid (string|sequence)|buffer is smaller|unpack_from", str(info.value))
+
+
+def test_a_room_claim_of_other_digits_than_ascii_counts_as_none_not_a_traceback(tmp_path):
+    """Stop 56 (robust56): a claim file in the shared claims folder (every user's: mode 1777) holding '\u00b2',
+    which str.isdigit() takes and int() refuses, locked by its writer, made every run decompressing a bag there
+    a ValueError traceback; now it claims nothing, as any claim that is no number."""
+    import fcntl
+
+    from symfruit.io.bags import _RoomClaims
+
+    claim = tmp_path / "1-x.claim"
+    claim.write_text("\u00b2")
+    with open(claim) as holder:
+        fcntl.flock(holder.fileno(), fcntl.LOCK_EX)  # its writer alive
+        assert _RoomClaims._held(claim) == 0
+        claim.write_text("12")
+        assert _RoomClaims._held(claim) == 12
+
+
+def test_message_reason_says_a_message_cut_short_in_each_library_s_words_and_leaves_others():
+    # the RealSense reader deserializes ROS 1 messages itself: struct's and numpy's words come bare, not in
+    # rosbags' "Could not deserialize" (stop 56, robust56)
+    import struct
+
+    from symfruit.io.bags import message_reason
+
+    with pytest.raises(struct.error) as short:
+        struct.unpack_from("<I", b"ab", 0)
+    assert message_reason(short.value, b"ab") == "its fields run past its 2 bytes: the message is cut short or damaged"
+    with pytest.raises(ValueError) as small:
+        np.frombuffer(b"abc", dtype=np.uint16, count=4)
+    assert message_reason(small.value, bytearray(3)) == ("its fields run past its 3 bytes: the message is cut short "
+                                                         "or damaged")  # fmt: skip
+    assert message_reason(ValueError("Invalid or unsupported CDR encapsulation."), b"\0\1") == (
+        "its 2 bytes do not begin with a CDR header: the message is damaged"
+    )
+    assert message_reason(ValueError("something else\nsecond line"), b"") == "something else"

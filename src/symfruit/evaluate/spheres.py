@@ -122,12 +122,10 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
     diameter, the frames' largest disagreement, and every sphere's box) and its rows as dictionaries."""
     frames = sorted({r.frame for r in rows})
     spheres = sorted({r.sphere for r in rows})
-    lines = [
-        "| method | not a cube (mm), mean / worst | depth side - mask diameter (mm), mean abs (mean) "
-        "| larger lateral side - mask diameter (mm), mean abs (mean) "
-        "| frames differ (mm), worst | " + " | ".join(f"sphere {k} (mm)" for k in spheres) + " |",
-        "|---|---|---|---|---|" + "---|" * len(spheres),
-    ]
+    head = ["method", "not a cube (mm), mean / worst", "depth side - mask diameter (mm), mean abs (mean)",
+            "larger lateral side - mask diameter (mm), mean abs (mean)", "frames differ (mm), worst",
+            *(f"sphere {k} (mm)" for k in spheres)]  # fmt: skip
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]  # no sphere: no empty column (stop 56)
     summary = []
     for m in methods:
         mine = [r for r in rows if r.method == m]
@@ -152,7 +150,7 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
             f"| {np.abs(lateral).mean():.1f} ({lateral.mean():+.1f}) "
             f"| {f'{worst:.1f}' if differ else '-'} | " + " | ".join(cells) + " |"
             if len(ok)
-            else f"| `{m}` | - | - | - | - | " + " | ".join("failed" for _ in spheres) + " |"
+            else "| " + " | ".join([f"`{m}`", "-", "-", "-", "-", *("failed" for _ in spheres)]) + " |"
         )
         summary.append({"method": m, "frames": frames, "failed": len(mine) - len(ok),
                         "cube_mm_mean": float(cube.mean()) if len(ok) else None,

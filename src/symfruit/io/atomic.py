@@ -210,7 +210,7 @@ def stale_temporaries(fd: int) -> list[str]:
         if not (name.startswith(".") and name.endswith(_TMP_SUFFIX)):
             continue
         pid_part = name[: -len(_TMP_SUFFIX)].rsplit(".", 1)[-1].split("-", 1)[0]
-        if pid_part.isdigit() and _alive(int(pid_part)):
+        if pid_part.isascii() and pid_part.isdigit() and _alive(int(pid_part)):  # '²'.isdigit(): int() refuses it
             continue
         out.append(name)
     return out

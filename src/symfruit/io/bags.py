@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import bisect
 import contextlib
+import contextvars
 import math
 import os
 import re
@@ -356,7 +357,7 @@ class _RoomClaims:
                 text = file.read(32).strip()
         except OSError:
             return 0
-        return int(text) if text.isdigit() else 0
+        return int(text) if text.isascii() and text.isdigit() else 0  # '²'.isdigit(), and int() refuses it
 
     def close(self) -> None:
         if self._mine is not None:
@@ -379,16 +380,28 @@ def _flock(file: Any, *, exclusive: bool, wait: bool = False) -> bool:
     return True
 
 
+#: The bag folder :class:`BagSource` is opening (rosbags' reader makes its storages then): a storage file outside
+#: it is one rosbags decompressed into its temporary folder (a bag compressed as whole files).
+_OPENING: contextvars.ContextVar[Path | None] = contextvars.ContextVar("symfruit_bag_opening", default=None)
+
+
 def _checked_mcap(plugin: Any) -> Any:
     """rosbags' MCAP storage reader, made only after :func:`check_mcap` passes the file: a bag compressed as
     whole files is decompressed by rosbags into a temporary folder, which :class:`BagSource`'s own check of the
-    bag folder's ``*.mcap`` never sees."""
+    bag folder's ``*.mcap`` never sees, and a file the metadata calls MCAP storage need not be named ``.mcap``.
+    The refusal says "decompressed" only of a file outside the bag folder being opened (stop 56: a sqlite3
+    database named MCAP storage by its metadata was "its MCAP file x.db3, decompressed: the record at byte 8
+    claims 1,152,977,719,091,359,090 bytes")."""
 
     def make(path: Any) -> Any:
         try:
             check_mcap(Path(path))
         except FileFormatError as exc:
-            raise BagFileRefused(f"its MCAP file {Path(path).name}, decompressed: {exc}") from None
+            folder = _OPENING.get()
+            inside = folder is not None and Path(path).resolve().is_relative_to(folder.resolve())
+            how = ", decompressed" if folder is not None and not inside else ""
+            kind = "MCAP" if Path(path).suffix == ".mcap" else "storage"
+            raise BagFileRefused(f"its {kind} file {Path(path).name}{how}: {exc}") from None
         return plugin(path)
 
     make._symfruit = True  # type: ignore[attr-defined]
@@ -556,6 +569,34 @@ def index_reason(exc: BaseException) -> str:
     return damage_reason(exc) or f"{type(exc).__name__}: {reader_reason(exc)}"
 
 
+#: rosbags' words (and numpy's and struct's under them) for a message whose fields run past its bytes.
+_RUNS_PAST = re.compile(r"Invalid (string|sequence) length \d+ at offset \d+|buffer is smaller than requested size|"
+                        r"unpack_from requires a buffer")  # fmt: skip
+
+
+def message_reason(exc: BaseException, raw: Any) -> str:
+    """Why rosbags could not read a message of ``raw`` bytes, in one short line: a message cut short (its fields
+    run past its end: rosbags' ``Invalid string length 27 at offset 8.``, numpy's ``buffer is smaller than
+    requested size``, struct's ``unpack_from requires a buffer of at least 4 bytes``) or of no CDR header is
+    said so with its size; anything else as :func:`reader_reason` says it. Stop 56 (robust56)."""
+    text = str(exc)
+    size = len(raw) if isinstance(raw, bytes | bytearray | memoryview) else 0
+    if "Invalid or unsupported CDR encapsulation" in text:
+        return f"its {size:,} bytes do not begin with a CDR header: the message is damaged"
+    if _RUNS_PAST.search(text):
+        return f"its fields run past its {size:,} bytes: the message is cut short or damaged"
+    return reader_reason(exc)
+
+
+def _head(path: Path) -> bytes:
+    """A file's first 16 bytes; none where it cannot be read."""
+    try:
+        with open(path, "rb") as f:
+            return f.read(16)
+    except OSError:
+        return b""
+
+
 def reader_reason(exc: BaseException) -> str:
     """One short line saying why rosbags refused a bag: a message definition it cannot parse is named as that
     (rosbags quotes the whole definition, several lines, in its message), a damaged bag as :func:`damage_reason`
@@ -578,6 +619,12 @@ def reader_reason(exc: BaseException) -> str:
         return (f"its metadata is rosbag2 version {newer.group(1)[:20]}, newer than the installed rosbags reads "
                 "(pip install -U rosbags, or `ros2 bag convert` it to an older version)")  # fmt: skip
     first = text.splitlines()[0].strip()
+    other = re.fullmatch(r"Cannot open database (.+): file is not a database", first)
+    if other:  # a storage file of another kind than the metadata names (stop 56)
+        head = _head(Path(other.group(1)))
+        if (what := _what_file(head)) is not None and not head.startswith(_SQLITE_MAGIC):
+            return (f"{Path(other.group(1)).name} is not an SQLite database ({what}), though the bag reads it as "
+                    "one (by its metadata.yaml's storage_identifier)")  # fmt: skip
     if len(first) > REASON_CHARS:
         first = f"{first[:REASON_CHARS]}... ({len(text)} characters)"
     return first
@@ -874,8 +921,23 @@ def _check_metadata(path: Path) -> None:
 
 
 _MCAP_MAGIC = b"\x89MCAP0\r\n"
+_SQLITE_MAGIC = b"SQLite format 3\0"
 #: Largest MCAP record read whole by the walk (a chunk index: a few dozen bytes and 10 a channel).
 _MCAP_INDEX_BYTES = 1 << 20
+
+
+#: What a bag's storage file is, by its first bytes (stop 56: a file of the other storage than its metadata names).
+_FILE_KINDS = (
+    (_SQLITE_MAGIC, "it is an SQLite database: rosbag2's sqlite3 storage"),
+    (_MCAP_MAGIC, "it is an MCAP file: rosbag2's mcap storage"),
+    (b"\x28\xb5\x2f\xfd", "it is zstd-compressed"),
+    (b"#ROSBAG", "it is a ROS 1 bag"),
+)
+
+
+def _what_file(head: bytes) -> str | None:
+    """What a file beginning ``head`` is, in a few words, where its first bytes say (a bag's storages)."""
+    return next((said for magic, said in _FILE_KINDS if head.startswith(magic)), None)
 
 
 def check_mcap(path: Path) -> dict[int, tuple[int, int, int]]:
@@ -895,6 +957,12 @@ def check_mcap(path: Path) -> dict[int, tuple[int, int, int]]:
             size = f.seek(0, 2)
             if size < 16:
                 return {}  # rosbags: empty, or its magic alone ("the file ends inside a record")
+            f.seek(0)
+            magic = f.read(16)
+            if magic[:8] != _MCAP_MAGIC:
+                what = _what_file(magic) or "it does not begin with MCAP's magic bytes"
+                raise FileFormatError(f"not an MCAP file ({what}), though the bag reads it as one (by its "
+                                      "metadata.yaml's storage_identifier, or its name)")  # fmt: skip
             f.seek(size - 8)
             whole = f.read(8) == _MCAP_MAGIC
             end = size - 8 if whole else size
@@ -1032,7 +1100,11 @@ class BagSource:
                     raise FileFormatError(f"{mcap}: cannot open bag ({exc})") from None
         try:
             self._reader = reader_cls([self.path])
-            self._reader.open()
+            opening = _OPENING.set(self.path)
+            try:
+                self._reader.open()
+            finally:
+                _OPENING.reset(opening)
         except ChunkExpands as exc:  # an MCAP without a summary: rosbags decompresses every chunk to index it
             raise FileFormatError(self._expands(exc)) from None
         except BagFileRefused as exc:  # a bag compressed as whole files
@@ -1097,7 +1169,10 @@ class BagSource:
                 last = bytes(raw)
                 sizeless = (False, False)
                 try:
-                    msg = self._reader.deserialize(raw, conn.msgtype)
+                    try:
+                        msg = self._reader.deserialize(raw, conn.msgtype)
+                    except Exception as exc:
+                        raise FileFormatError(message_reason(exc, raw)) from None
                     sizeless = (not int(msg.width), not int(msg.height))  # as the live node: the image's size
                     camera: Camera | str = camera_from_info(msg, width=1, height=1)
                     coeffs = info_distortion(msg)
@@ -1133,7 +1208,7 @@ class BagSource:
             try:
                 return self._reader.deserialize(raw, conn.msgtype)
             except Exception as exc:
-                reason = reader_reason(exc)
+                reason = message_reason(exc, raw)
                 raise FileFormatError(f"{self.path}: corrupt message on {conn.topic} at {stamp} ({reason})") from None
         raise FileFormatError(f"{self.path}: no message on {conn.topic} at {stamp}")  # pragma: no cover
 

@@ -43,7 +43,7 @@ from ..core.camera import Camera
 from ..core.frame import Frame
 from ..core.limits import shown
 from ..errors import FileFormatError, InputError, SymfruitError
-from .bags import _require_rosbags, bag_files, color_image, image_array, index_reason, reader_reason
+from .bags import _require_rosbags, bag_files, color_image, image_array, index_reason, message_reason, reader_reason
 from .frames import named_frame
 from .intrinsics import check_pinhole_matrix, warn_distortion, warn_principal_point
 from .text import unchanged_while
@@ -142,7 +142,9 @@ class RealSenseBagSource:
         try:
             msg, pos = msgdef.deserialize_ros1(raw, 0, msgdef.cls, store)
         except Exception as exc:
-            raise FileFormatError(f"corrupt {conn.msgtype} message on {conn.topic} ({reader_reason(exc)})") from None
+            raise FileFormatError(
+                f"corrupt {conn.msgtype} message on {conn.topic} ({message_reason(exc, raw)})"
+            ) from None
         tail = bytes(raw[pos:])
         allowed = 4 if conn.msgtype.endswith("/Image") else 0
         if len(tail) > allowed:
