@@ -653,7 +653,9 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     # nearly all round: no third of the outline without a sector seen past
     at = np.flatnonzero(both)
     if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
-        return None
+        # stop 56: seen past over part of the outline, a support or neighbour at the fruit's own depth over the rest
+        return _seen_past_in_part(own, band, past, ahead, is_joined, sec, rad, vv, uu, last, first, both,
+                                  eroded)  # fmt: skip
     centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
     with np.errstate(invalid="ignore"):  # inf - inf: NaN where not ``both``, never read
         halfway = 0.5 * (last + first)
@@ -667,6 +669,70 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     edge = np.interp(centre, centre[both], halfway[both], period=2 * np.pi)
     drop = np.zeros(own.shape, bool)
     out = ~is_joined & (rad > edge[sec])
+    drop[vv[out], uu[out]] = True
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop if drop.any() else None
+
+
+#: The least number of opposite pairs of sectors both seen past :func:`_seen_past_in_part` reads an overshoot from
+#: (as :func:`_seen_past` needs two sectors seen past).
+PAIRS = 2
+
+#: The least overshoot (pixels, of the mask's outline beyond the fruit's edge read on opposite sides) that
+#: :func:`_seen_past_in_part` takes off: a pixel's rounding of the mask's farthest pixel and of the edge.
+LEAST_OVERSHOOT_PX = 1.0
+
+
+def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahead: np.ndarray | None,
+                       is_joined: np.ndarray, sec: np.ndarray, rad: np.ndarray, vv: np.ndarray, uu: np.ndarray,
+                       last: np.ndarray, first: np.ndarray, both: np.ndarray,
+                       eroded: int) -> np.ndarray | None:  # fmt: skip
+    """:func:`_seen_past` where the camera saw past the fruit over part of its outline only, and a support or a
+    neighbour at the fruit's own depth runs on over the rest (stop 56, docs/overshoot56.md): the mask's pixels
+    beyond the fruit's edge, that edge read as the mask's outline less one overshoot all round (None: not so).
+
+    Where the camera saw past, the overshoot of a sector is the mask's farthest pixel (its outline there) beyond
+    halfway between the fruit's last depth and the first pixel seen past (:func:`_seen_past`'s edge). Read on one
+    side alone it is the depth's displacement against colour as much as the mask's (a registration a few pixels
+    off, a time-of-flight camera's parallax: the background it sees beside the fruit lands inside the fruit's
+    colour outline on one side, its shadow without depth on the other; the real Azure Kinect frames read 3-13 px so
+    on masks drawn right). On two opposite sectors a displacement adds to one as much as it takes from the other,
+    so their mean is the mask's own overshoot. Where a support or a neighbour at the fruit's depth runs on past the
+    outline nothing can be read: the overshoot there is taken as the opposite pairs' median, the one assumption a
+    pen or a model's dilation, about as wide all round, allows. Taken only where (a) every third of the outline
+    holds a sector seen past or one whose band holds depth not seen past and not clearly in front (``ahead``): at
+    the fruit's own depth, or joined to its points by a continuous surface. The arcs without either are where the
+    mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite pairs of
+    sectors are both seen past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the
+    points (``is_joined``: the fruit's own surface, or a support meeting it at its depth) is never cut, as in
+    :func:`_seen_past`.
+    """
+    sectors = len(last)
+    if sectors % 2 or not both.any():
+        return None
+    level = band & ~past  # the band's depth not seen past: at the fruit's own, or joined to its points
+    if ahead is not None:
+        level &= ~ahead
+    support = np.zeros(sectors, bool)
+    support[sec[level[vv, uu]]] = True
+    at = np.flatnonzero(both | support)
+    if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
+        return None
+    reach = np.zeros(sectors)  # the mask's outline: its farthest pixel in each sector
+    np.maximum.at(reach, sec, rad + 0.5)
+    half = sectors // 2
+    pairs = both[:half] & both[half:]
+    if np.count_nonzero(pairs) < PAIRS:
+        return None
+    with np.errstate(invalid="ignore"):  # inf - inf where not ``both``, never read
+        over = reach - 0.5 * (last + first)
+    shift_free = 0.5 * (over[:half] + over[half:])[pairs]
+    by = float(np.median(shift_free))
+    if not by >= LEAST_OVERSHOOT_PX:
+        return None
+    drop = np.zeros(own.shape, bool)
+    out = ~is_joined & (rad > (reach - by)[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
