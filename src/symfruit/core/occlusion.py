@@ -703,8 +703,8 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     pen or a model's dilation, about as wide all round, allows. Taken only where (a) every third of the outline
     holds a sector seen past or one whose band holds depth not seen past and not clearly in front (``ahead``): at
     the fruit's own depth, or joined to its points by a continuous surface. The arcs without either are where the
-    mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite pairs of
-    sectors are both seen past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the
+    mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite
+    pairs of sectors are both seen past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the
     points (``is_joined``: the fruit's own surface, or a support meeting it at its depth) is never cut, as in
     :func:`_seen_past`.
     """
