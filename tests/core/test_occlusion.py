@@ -648,9 +648,10 @@ def test_a_mask_overshooting_onto_a_board_and_where_the_camera_saw_past_is_trimm
 ):
     """Stop 56: a fruit on a board at its own depth (the board runs on under the lower half of its outline, so the
     camera saw past it over no more than two thirds: stop 43's rule does not fire) with a mask drawn 6 px wide. The
-    overshoot read on opposite sides where the camera saw past it (halfway between the last point at 12 px and the
-    first pixel seen past at 16 px: the edge at 14 px) is taken off all round but the board's pixels joined to the
-    fruit's, which are never cut: the kept radius about the edge. A mask drawn right (to 14 px) loses nothing; a
+    overshoot read on opposite sides where the camera saw past it (the mask's pixels seen past, from 16 px to 20 px:
+    its overshoot past the edge at 14 px less the 2 px the camera invalidated outside the edge) is taken off all
+    round but the board's pixels joined to the fruit's, which are never cut: the kept radius that of the first pixel
+    seen past. A mask drawn right (to 14 px) loses nothing; a
     mask drawn right but 3 px off the depth (a registration or a parallax: seen past on one side deeper than on the
     other) loses nothing either, the opposite sides' displacements cancelling; nor does a mask whose band holds no
     depth over a third of the outline (the mask the only measure there)."""
@@ -664,8 +665,8 @@ def test_a_mask_overshooting_onto_a_board_and_where_the_camera_saw_past_is_trimm
     vv, _ = np.mgrid[:60, :80]
     top = mask & (vv < 30)  # the half above the board: a half disc of the kept radius
     radius = np.sqrt(2 * (top & ~over).sum() / np.pi)
-    assert 13.5 < radius < 15.5
-    assert not over[r <= 13.5].any() and over[top & (r > 15.5)].all()
+    assert 15.0 < radius < 16.5
+    assert not over[r <= 15.5].any() and over[top & (r > 16.5)].all()
     for drawn in (_on_a_board(0), _on_a_board(0, shift=3)):
         assert occlusion(*drawn[:3], BIG, eroded=0).overshoot is None
     depth, mask, points, r = _on_a_board(6)

@@ -692,20 +692,25 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     neighbour at the fruit's own depth runs on over the rest (stop 56, docs/overshoot56.md): the mask's pixels
     beyond the fruit's edge, that edge read as the mask's outline less one overshoot all round (None: not so).
 
-    Where the camera saw past, the overshoot of a sector is the mask's farthest pixel (its outline there) beyond
-    halfway between the fruit's last depth and the first pixel seen past (:func:`_seen_past`'s edge). Read on one
-    side alone it is the depth's displacement against colour as much as the mask's (a registration a few pixels
-    off, a time-of-flight camera's parallax: the background it sees beside the fruit lands inside the fruit's
-    colour outline on one side, its shadow without depth on the other; the real Azure Kinect frames read 3-13 px so
-    on masks drawn right). On two opposite sectors a displacement adds to one as much as it takes from the other,
-    so their mean is the mask's own overshoot. Where a support or a neighbour at the fruit's depth runs on past the
-    outline nothing can be read: the overshoot there is taken as the opposite pairs' median, the one assumption a
-    pen or a model's dilation, about as wide all round, allows. Taken only where (a) every third of the outline
-    holds a sector seen past or one whose band holds depth not seen past and not clearly in front (``ahead``): at
-    the fruit's own depth, or joined to its points by a continuous surface. The arcs without either are where the
-    mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite
-    pairs of sectors are both seen past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the
-    points (``is_joined``: the fruit's own surface, or a support meeting it at its depth) is never cut, as in
+    Where the camera saw past, the overshoot of a sector is read as the mask's pixels seen past along the ray (from
+    the first pixel seen past to the mask's farthest, its outline there): the mask's overshoot less the mixed pixels
+    the camera invalidates outside the fruit's edge, so never more than the overshoot. Not halfway between the last
+    depth and the first pixel seen past, as :func:`_seen_past` reads the edge all round: a real time-of-flight
+    camera loses far more of the rim inside the edge than outside (the Azure Kinect frames a quarter of every
+    sphere's radius), and halfway lies inside the edge by 4-6 px there (a mask drawn 2 px wide cut to 16 mm under a
+    200 mm sphere's diameter). Read on one side alone it is the depth's displacement against colour as much as the
+    mask's (a registration a few pixels off, a time-of-flight camera's parallax: the background it sees beside the
+    fruit lands inside the fruit's colour outline on one side, its shadow without depth on the other; the real
+    Azure Kinect frames see past 2-10 px inside masks drawn right). On two opposite sectors a displacement adds to
+    one as much as it takes from the other, so their mean is the mask's own. Where a support or a neighbour at the
+    fruit's depth runs on past the outline nothing can be read: the overshoot there is taken as the opposite pairs'
+    median, the one assumption a pen or a model's dilation, about as wide all round, allows. Taken only where (a)
+    every third of the outline holds a sector seen past or one whose band holds depth not seen past and not clearly
+    in front (``ahead``): at the fruit's own depth, or joined to its points by a continuous surface. The arcs
+    without either are where the mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at
+    least :data:`PAIRS` opposite pairs of sectors are both seen past; (c) the overshoot is at least
+    :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the points (``is_joined``: the fruit's own surface, or a support
+    meeting it at its depth) is never cut, as in
     :func:`_seen_past`.
     """
     sectors = len(last)
@@ -725,8 +730,7 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     pairs = both[:half] & both[half:]
     if np.count_nonzero(pairs) < PAIRS:
         return None
-    with np.errstate(invalid="ignore"):  # inf - inf where not ``both``, never read
-        over = reach - 0.5 * (last + first)
+    over = reach - first + 0.5  # the mask's pixels seen past along the ray (inf where none: never read)
     shift_free = 0.5 * (over[:half] + over[half:])[pairs]
     by = float(np.median(shift_free))
     if not by >= LEAST_OVERSHOOT_PX:
