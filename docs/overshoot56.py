@@ -6,7 +6,8 @@
 ``lateral``: per perturbation of ``docs/realpert55.py run OUT`` (``evidence`` boxes), the larger lateral side and
 the 2D thin-lens estimate (the perturbed mask's fitted circle at the box's depth, the scorer's ``diameter``), both
 less the *unperturbed* mask's diameter: mean abs (signed mean) in mm, and the boxes whose lateral side is farther off
-than the thin-lens estimate. With ``OUT2`` (another tree's run), its lateral side beside.
+than the thin-lens estimate. With ``OUT2`` (another tree's run), its lateral side and boxes worse than its own
+thin-lens estimate beside. The thin-lens estimate is of the mask ``detect`` used (after the colour trim).
 
 ``sectors``: ``detect`` the frame with ``evidence`` and, for every mask whose overshoot is looked for in the depth
 (the colour left it whole) on a time-of-flight view, the outline read in :data:`symfruit.core.occlusion.SECTORS`
@@ -34,7 +35,10 @@ def _rows(out: Path, name: str) -> list[dict]:
 def lateral(out: Path, other: Path | None = None) -> str:
     reference = {(r["frame"], r["sphere"]): r["diameter"] for r in _rows(out, "none")}
     head = "| perturbation | thin-lens - diameter (mm) | `evidence` lateral - diameter (mm) | worse than thin-lens |"
-    lines = [head + (" `evidence` (OUT2) |" if other else ""), "|---|---|---|---|" + ("---|" if other else "")]
+    lines = [
+        head + (" OUT2's `evidence` lateral, worse than its thin-lens |" if other else ""),
+        "|---|---|---|---|" + ("---|" if other else ""),
+    ]
     for path in sorted(out.glob("*.json"), key=lambda p: (p.stem != "none", p.stem)):
         rows = _rows(out, path.stem)
         ref = np.array([reference[(r["frame"], r["sphere"])] for r in rows])
@@ -44,7 +48,8 @@ def lateral(out: Path, other: Path | None = None) -> str:
         line = f"| {path.stem} | {cells[0]} | {cells[1]} | {int(np.sum(np.abs(lat) > np.abs(thin)))} / {len(rows)} |"
         if other is not None and (other / path.name).exists():
             b = np.array([max(r["size"][:2]) for r in _rows(other, path.stem)]) - ref
-            line += f" {np.abs(b).mean():.1f} ({b.mean():+.1f}) |"
+            thin2 = np.array([r["diameter"] for r in _rows(other, path.stem)]) - ref
+            line += f" {np.abs(b).mean():.1f} ({b.mean():+.1f}), {int(np.sum(np.abs(b) > np.abs(thin2)))} worse |"
         lines.append(line)
     return "\n".join(lines) + "\n"
 

@@ -32,4 +32,4 @@ def test_lateral_sides_and_thin_lens_are_judged_against_the_unperturbed_diameter
     _write(tmp_path / "b", "dilate5", [(1, (102.0, 101.0, 105.0), 108.0), (2, (61.0, 60.0, 66.0), 64.0)])
     table = ov.lateral(tmp_path / "a", tmp_path / "b").splitlines()
     assert table[2] == "| none | 0.0 (+0.0) | 0.5 (+0.5) | 1 / 2 |"  # no OUT2 run of it: no cell
-    assert table[3] == "| dilate5 | 6.0 (+6.0) | 5.5 (+5.5) | 1 / 2 | 1.5 (+1.5) |"
+    assert table[3] == "| dilate5 | 6.0 (+6.0) | 5.5 (+5.5) | 1 / 2 | 1.5 (+1.5), 0 worse |"
