@@ -12,8 +12,9 @@ thin-lens estimate beside. The thin-lens estimate is of the mask ``detect`` used
 ``sectors``: ``detect`` the frame with ``evidence`` and, for every mask whose overshoot is looked for in the depth
 (the colour left it whole) on a time-of-flight view, the outline read in :data:`symfruit.core.occlusion.SECTORS`
 sectors about the points' centroid (``symfruit.core.occlusion._seen_past``'s reading): per sector the mask's
-farthest pixel (``reach``), the farthest point pixel (``last``), the nearest pixel seen past (``first``), the
-overshoot ``reach - (last + first) / 2`` where both are found, and whether the band holds depth not seen past (a
+farthest pixel (``reach``), the farthest point pixel (``last``), the nearest pixel seen past (``first``), where
+both are found the overshoot past halfway (``halfway``: ``reach - (last + first) / 2``, stop 43's edge) and the
+mask's pixels seen past (``inside``: ``reach - first + 1/2``, stop 56's reading), and whether the band holds depth not seen past (a
 support or the fruit's own surface, ``level``); then the largest arc without a sector seen past, the opposite pairs
 both seen past, and whether stop 43's or stop 56's rule cut the mask.
 """
@@ -106,9 +107,10 @@ def sectors(frame_dir: Path) -> str:
             return f"  {name:8s}" + "".join(fmt.format(x) if np.isfinite(x) else "   ." for x in a)
 
         with np.errstate(invalid="ignore"):
-            over = np.where(both, reach - 0.5 * (last + first), np.nan)
-        lines += [row("reach", reach), row("last", last), row("first", first), row("over", over, "{:4.1f}"),
-                  row("level", np.where(support, 1.0, np.nan))]  # fmt: skip
+            halfway = np.where(both, reach - 0.5 * (last + first), np.nan)
+        inside = np.where(both, reach - first + 0.5, np.nan)
+        lines += [row("reach", reach), row("last", last), row("first", first), row("halfway", halfway, "{:4.1f}"),
+                  row("inside", inside, "{:4.1f}"), row("level", np.where(support, 1.0, np.nan))]  # fmt: skip
     return "\n".join(lines) + "\n"
 
 
