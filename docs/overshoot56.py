@@ -14,9 +14,9 @@ thin-lens estimate beside. The thin-lens estimate is of the mask ``detect`` used
 sectors about the points' centroid (``symfruit.core.occlusion._seen_past``'s reading): per sector the mask's
 farthest pixel (``reach``), the farthest point pixel (``last``), the nearest pixel seen past (``first``), where
 both are found the overshoot past halfway (``halfway``: ``reach - (last + first) / 2``, stop 43's edge) and the
-mask's pixels seen past (``inside``: ``reach - first + 1/2``, stop 56's reading), and whether the band holds depth not seen past (a
-support or the fruit's own surface, ``level``); then the largest arc without a sector seen past, the opposite pairs
-both seen past, and whether stop 43's or stop 56's rule cut the mask.
+mask's pixels seen past (``inside``: ``reach - first + 1/2``, stop 56's reading), and whether the band holds depth
+not seen past (a support or the fruit's own surface, ``level``); then the largest arc without a sector seen past,
+the opposite pairs both seen past, and whether stop 43's or stop 56's rule cut the mask.
 """
 
 from __future__ import annotations
