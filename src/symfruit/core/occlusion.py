@@ -697,8 +697,8 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     the camera invalidates outside the fruit's edge, so never more than the overshoot. Not halfway between the last
     depth and the first pixel seen past, as :func:`_seen_past` reads the edge all round: a real time-of-flight
     camera loses far more of the rim inside the edge than outside (the Azure Kinect frames a quarter of every
-    sphere's radius), and halfway lies inside the edge by 4-6 px there (a mask drawn 2 px wide cut to 16 mm under a
-    200 mm sphere's diameter). Read on one side alone it is the depth's displacement against colour as much as the
+    sphere's radius), and halfway read 2-3 px more than the mask's pixels seen past on the same sectors there (a
+    200 mm sphere's mask drawn 2 px wide cut to 15 mm under its diameter). Read on one side alone it is the depth's displacement against colour as much as the
     mask's (a registration a few pixels off, a time-of-flight camera's parallax: the background it sees beside the
     fruit lands inside the fruit's colour outline on one side, its shadow without depth on the other; the real
     Azure Kinect frames see past 2-10 px inside masks drawn right). On two opposite sectors a displacement adds to
