@@ -698,11 +698,12 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     depth and the first pixel seen past, as :func:`_seen_past` reads the edge all round: a real time-of-flight
     camera loses far more of the rim inside the edge than outside (the Azure Kinect frames a quarter of every
     sphere's radius), and halfway read 2-3 px more than the mask's pixels seen past on the same sectors there (a
-    200 mm sphere's mask drawn 2 px wide cut to 15 mm under its diameter). Read on one side alone it is the depth's displacement against colour as much as the
-    mask's (a registration a few pixels off, a time-of-flight camera's parallax: the background it sees beside the
-    fruit lands inside the fruit's colour outline on one side, its shadow without depth on the other; the real
-    Azure Kinect frames see past 2-10 px inside masks drawn right). On two opposite sectors a displacement adds to
-    one as much as it takes from the other, so their mean is the mask's own. Where a support or a neighbour at the
+    200 mm sphere's mask drawn 2 px wide cut to 15 mm under its diameter). Read on one side alone it is the
+    depth's displacement against colour as much as the mask's (a registration a few pixels off, a time-of-flight
+    camera's parallax: the background it sees beside the fruit lands inside the fruit's colour outline on one side,
+    its shadow without depth on the other; the real Azure Kinect frames see past 2-12 px inside masks drawn right).
+    On two opposite sectors a displacement adds to one as much as it takes from the other, so their mean is the
+    mask's own. Where a support or a neighbour at the
     fruit's depth runs on past the outline nothing can be read: the overshoot there is taken as the opposite pairs'
     median, the one assumption a pen or a model's dilation, about as wide all round, allows. Taken only where (a)
     every third of the outline holds a sector seen past or one whose band holds depth not seen past and not clearly
