@@ -673,3 +673,16 @@ def test_a_mask_overshooting_onto_a_board_and_where_the_camera_saw_past_is_trimm
     _, uu = np.mgrid[:60, :80]
     depth[mask & (r > 12) & (uu > 44) & (vv < 33)] = 0.0  # the right side's band without depth
     assert occlusion(depth, mask, points, BIG, eroded=0).overshoot is None
+
+
+@given(grow=st.integers(0, 8), shift=st.integers(-4, 4), board_row=st.integers(31, 38))
+def test_a_partly_seen_past_mask_is_never_cut_inside_the_fruits_edge(grow, shift, board_row):
+    """Stop 56: the mask's pixels seen past are its overshoot less the mixed pixels outside the edge, and a
+    displacement of the mask against the depth cancels on opposite sides: however wide the mask is drawn, however
+    far off the depth and wherever the board begins, no pixel within the fruit's edge (14 px) is cut."""
+    depth, mask, points, r = _on_a_board(grow, shift=shift, board_row=board_row)
+    occ = occlusion(depth, mask, points, BIG, eroded=0)
+    if occ.overshoot is not None:
+        over = np.zeros((60, 80), bool)
+        over[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+        assert not over[r <= 14.0].any()

@@ -690,7 +690,8 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
                        eroded: int) -> np.ndarray | None:  # fmt: skip
     """:func:`_seen_past` where the camera saw past the fruit over part of its outline only, and a support or a
     neighbour at the fruit's own depth runs on over the rest (stop 56, docs/overshoot56.md): the mask's pixels
-    beyond the fruit's edge, that edge read as the mask's outline less one overshoot all round (None: not so).
+    beyond the fruit's edge, that edge read as the mask's outline less one overshoot all round, and never less
+    than a sector's own pixels seen past where it has them (None: not so).
 
     Where the camera saw past, the overshoot of a sector is read as the mask's pixels seen past along the ray (from
     the first pixel seen past to the mask's farthest, its outline there): the mask's overshoot less the mixed pixels
@@ -736,8 +737,11 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     by = float(np.median(shift_free))
     if not by >= LEAST_OVERSHOOT_PX:
         return None
+    # where seen past, never more than the sector's own pixels seen past: a mask displaced against the depth holds
+    # less than ``by`` on one side, and its outline there lies nearer the edge by as much
+    cut = np.where(both, np.minimum(by, over), by)
     drop = np.zeros(own.shape, bool)
-    out = ~is_joined & (rad > (reach - by)[sec])
+    out = ~is_joined & (rad > (reach - cut)[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
