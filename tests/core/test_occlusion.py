@@ -651,10 +651,10 @@ def test_a_mask_overshooting_onto_a_board_and_where_the_camera_saw_past_is_trimm
     overshoot read on opposite sides where the camera saw past it (the mask's pixels seen past, from 16 px to 20 px:
     its overshoot past the edge at 14 px less the 2 px the camera invalidated outside the edge) is taken off all
     round but the board's pixels joined to the fruit's, which are never cut: the kept radius that of the first pixel
-    seen past. A mask drawn right (to 14 px) loses nothing; a
-    mask drawn right but 3 px off the depth (a registration or a parallax: seen past on one side deeper than on the
-    other) loses nothing either, the opposite sides' displacements cancelling; nor does a mask whose band holds no
-    depth over a third of the outline (the mask the only measure there)."""
+    seen past. A mask drawn right (to 14 px) loses nothing; a mask drawn right but 3 px off the depth (a
+    registration or a parallax: seen past on one side deeper than on the other) loses nothing either, the opposite
+    sides' displacements cancelling; nor does a mask whose band holds no depth over a third of the outline (the
+    mask the only measure there)."""
     if kernels == "numpy":
         monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
     depth, mask, points, r = _on_a_board(6)
