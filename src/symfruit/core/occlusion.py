@@ -498,7 +498,9 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
       the camera saw past the fruit (a pixel farther than the fruit's front plus half the mask's width: behind
       the outline of a round fruit that wide; and not joined to its points by a continuous surface, stop 44)
       nearly all round the outline, the mask beyond the fruit's edge there is the overshoot (:func:`_seen_past`,
-      ``focal``: the camera's focal length in pixels; stop 43, docs/treeover43.md); elsewhere the mask is the
+      ``focal``: the camera's focal length in pixels; stop 43, docs/treeover43.md); seen past over part of it and a
+      support or neighbour at the fruit's depth over the rest, the overshoot read on opposite sides seen past is
+      taken off all round (:func:`_seen_past_in_part`, stop 56, docs/overshoot56.md); elsewhere the mask is the
       only measure of the fruit's width, and nothing is taken off;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
@@ -619,7 +621,8 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     neighbours' edge (periodic interpolation). Nearly all round: no third of the outline without a sector seen
     past. A mask an annotator or a model drew too wide overshoots all round; a depth camera seeing past one side of
     a fruit (its baseline to the colour camera, a registration a few pixels off) is one side, and the mask there
-    is kept (the shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the
+    is kept (the shared lab spheres leave 180-315 degrees without: docs/treeover43.md). Short of nearly all round,
+    :func:`_seen_past_in_part` reads what opposite sides seen past say (stop 56). A pixel joined to the
     points is never cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid
     (stop 43's gate for curved fruit, before the surface test).
     """
@@ -704,19 +707,17 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     camera's parallax: the background it sees beside the fruit lands inside the fruit's colour outline on one side,
     its shadow without depth on the other; the real Azure Kinect frames see past 2-12 px inside masks drawn right).
     On two opposite sectors a displacement adds to one as much as it takes from the other, so their mean is the
-    mask's own. Where a support or a neighbour at the
-    fruit's depth runs on past the outline nothing can be read: the overshoot there is taken as the opposite pairs'
-    median, the one assumption a pen or a model's dilation, about as wide all round, allows. Taken only where (a)
-    every third of the outline holds a sector seen past or one whose band holds depth not seen past and not clearly
-    in front (``ahead``): at the fruit's own depth, or joined to its points by a continuous surface. The arcs
-    without either are where the mask is the only measure of the fruit, as :func:`_seen_past` leaves them; (b) at
-    least :data:`PAIRS` opposite pairs of sectors are both seen past; (c) the overshoot is at least
-    :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the points (``is_joined``: the fruit's own surface, or a support
-    meeting it at its depth) is never cut, as in
-    :func:`_seen_past`.
+    mask's own. Where a support or a neighbour at the fruit's depth runs on past the outline nothing can be read:
+    the overshoot there is taken as the opposite pairs' median, the one assumption a pen or a model's dilation,
+    about as wide all round, allows. Taken only where (a) every third of the outline holds a sector seen past or one
+    whose band holds depth not seen past and not clearly in front (``ahead``): at the fruit's own depth, or joined
+    to its points by a continuous surface. The arcs without either are where the mask is the only measure of the
+    fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite pairs of sectors are both seen
+    past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the points (``is_joined``: the
+    fruit's own surface, or a support meeting it at its depth) is never cut, as in :func:`_seen_past`.
     """
     sectors = len(last)
-    if sectors % 2 or not both.any():
+    if sectors % 2:  # no opposite sectors
         return None
     level = band & ~past  # the band's depth not seen past: at the fruit's own, or joined to its points
     if ahead is not None:
@@ -732,7 +733,7 @@ def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahea
     pairs = both[:half] & both[half:]
     if np.count_nonzero(pairs) < PAIRS:
         return None
-    over = reach - first + 0.5  # the mask's pixels seen past along the ray (inf where none: never read)
+    over = reach - first + 0.5  # the mask's pixels seen past along the ray (read only where ``both``)
     shift_free = 0.5 * (over[:half] + over[half:])[pairs]
     by = float(np.median(shift_free))
     if not by >= LEAST_OVERSHOOT_PX:
