@@ -622,3 +622,67 @@ def test_occlusion_reads_a_big_endian_or_float16_depth_as_its_native_float(dtype
     assert want.hidden.any()
     np.testing.assert_array_equal(got.hidden, want.hidden)
     assert (got.u0, got.v0) == (want.u0, want.v0)
+
+
+def _on_a_board(grow: int, shift: int = 0, board_row: int = 33):
+    """A fruit whose points reach 12 px from its centre (40, 30), a ring of 4 px without depth (a time-of-flight
+    camera's mixed pixels either side of its edge at 14 px), the background 0.7 m behind, and a board at the fruit's
+    own depth from ``board_row`` down running on under it (no ring there: it meets the fruit at its depth); the
+    mask drawn ``grow`` px past the edge, ``shift`` px to the right of the depth."""
+    vv, uu = np.mgrid[:60, :80]
+    r = np.hypot(uu - 40, vv - 30)
+    disc = r <= 12
+    depth = np.full((60, 80), 1.0)
+    depth[disc] = 0.3 + 0.0002 * r[disc] ** 2
+    depth[(r > 12) & (r < 16)] = 0.0
+    depth[(vv >= board_row) & ~disc] = 0.33
+    mask = np.hypot(uu - 40 - shift, vv - 30) <= 14 + grow
+    rows, cols = np.nonzero(disc)
+    points = BIG.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    return depth, mask, points, r
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_mask_overshooting_onto_a_board_and_where_the_camera_saw_past_is_trimmed_by_the_opposite_sides(
+    kernels, monkeypatch
+):
+    """Stop 56: a fruit on a board at its own depth (the board runs on under the lower half of its outline, so the
+    camera saw past it over no more than two thirds: stop 43's rule does not fire) with a mask drawn 6 px wide. The
+    overshoot read on opposite sides where the camera saw past it (the mask's pixels seen past, from 16 px to 20 px:
+    its overshoot past the edge at 14 px less the 2 px the camera invalidated outside the edge) is taken off all
+    round but the board's pixels joined to the fruit's, which are never cut: the kept radius that of the first pixel
+    seen past. A mask drawn right (to 14 px) loses nothing; a mask drawn right but 3 px off the depth (a
+    registration or a parallax: seen past on one side deeper than on the other) loses nothing either, the opposite
+    sides' displacements cancelling; nor does a mask whose band holds no depth over a third of the outline (the
+    mask the only measure there)."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    depth, mask, points, r = _on_a_board(6)
+    occ = occlusion(depth, mask, points, BIG, eroded=0)
+    assert occ.overshoot is not None and occ.seen_past
+    over = np.zeros((60, 80), bool)
+    over[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+    vv, _ = np.mgrid[:60, :80]
+    top = mask & (vv < 30)  # the half above the board: a half disc of the kept radius
+    radius = np.sqrt(2 * (top & ~over).sum() / np.pi)
+    assert 15.0 < radius < 16.5
+    assert not over[r <= 15.5].any() and over[top & (r > 16.5)].all()
+    for drawn in (_on_a_board(0), _on_a_board(0, shift=3)):
+        assert occlusion(*drawn[:3], BIG, eroded=0).overshoot is None
+    depth, mask, points, r = _on_a_board(6)
+    _, uu = np.mgrid[:60, :80]
+    depth[mask & (r > 12) & (uu > 44) & (vv < 33)] = 0.0  # the right side's band without depth
+    assert occlusion(depth, mask, points, BIG, eroded=0).overshoot is None
+
+
+@given(grow=st.integers(0, 8), shift=st.integers(-4, 4), board_row=st.integers(31, 38))
+def test_a_partly_seen_past_mask_is_never_cut_inside_the_fruits_edge(grow, shift, board_row):
+    """Stop 56: the mask's pixels seen past are its overshoot less the mixed pixels outside the edge, and a
+    displacement of the mask against the depth cancels on opposite sides: however wide the mask is drawn, however
+    far off the depth and wherever the board begins, no pixel within the fruit's edge (14 px) is cut."""
+    depth, mask, points, r = _on_a_board(grow, shift=shift, board_row=board_row)
+    occ = occlusion(depth, mask, points, BIG, eroded=0)
+    if occ.overshoot is not None:
+        over = np.zeros((60, 80), bool)
+        over[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
+        assert not over[r <= 14.0].any()

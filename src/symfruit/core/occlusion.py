@@ -498,7 +498,9 @@ def overshoot(own: np.ndarray, depth: np.ndarray, uv: np.ndarray, points: np.nda
       the camera saw past the fruit (a pixel farther than the fruit's front plus half the mask's width: behind
       the outline of a round fruit that wide; and not joined to its points by a continuous surface, stop 44)
       nearly all round the outline, the mask beyond the fruit's edge there is the overshoot (:func:`_seen_past`,
-      ``focal``: the camera's focal length in pixels; stop 43, docs/treeover43.md); elsewhere the mask is the
+      ``focal``: the camera's focal length in pixels; stop 43, docs/treeover43.md); seen past over part of it and a
+      support or neighbour at the fruit's depth over the rest, the overshoot read on opposite sides seen past is
+      taken off all round (:func:`_seen_past_in_part`, stop 56, docs/overshoot56.md); elsewhere the mask is the
       only measure of the fruit's width, and nothing is taken off;
     - active stereo: mostly the fruit's own depth spread beyond its silhouette by the correlation window (the
       least depth the window holds, ``synthetic.sensors``' ``fatten_px``): nearer than the nearest of its points'
@@ -619,7 +621,8 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     neighbours' edge (periodic interpolation). Nearly all round: no third of the outline without a sector seen
     past. A mask an annotator or a model drew too wide overshoots all round; a depth camera seeing past one side of
     a fruit (its baseline to the colour camera, a registration a few pixels off) is one side, and the mask there
-    is kept (the shared lab spheres leave 180-315 degrees without: docs/treeover43.md). A pixel joined to the
+    is kept (the shared lab spheres leave 180-315 degrees without: docs/treeover43.md). Short of nearly all round,
+    :func:`_seen_past_in_part` reads what opposite sides seen past say (stop 56). A pixel joined to the
     points is never cut. :data:`STAR_SHARE`: the mask must fill that share of its star polygon about the centroid
     (stop 43's gate for curved fruit, before the surface test).
     """
@@ -653,7 +656,9 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     # nearly all round: no third of the outline without a sector seen past
     at = np.flatnonzero(both)
     if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
-        return None
+        # stop 56: seen past over part of the outline, a support or neighbour at the fruit's own depth over the rest
+        return _seen_past_in_part(own, band, past, ahead, is_joined, sec, rad, vv, uu, last, first, both,
+                                  eroded)  # fmt: skip
     centre = (np.arange(sectors) + 0.5) * (2 * np.pi / sectors) - np.pi
     with np.errstate(invalid="ignore"):  # inf - inf: NaN where not ``both``, never read
         halfway = 0.5 * (last + first)
@@ -667,6 +672,77 @@ def _seen_past(own: np.ndarray, seen: np.ndarray, d: np.ndarray, band: np.ndarra
     edge = np.interp(centre, centre[both], halfway[both], period=2 * np.pi)
     drop = np.zeros(own.shape, bool)
     out = ~is_joined & (rad > edge[sec])
+    drop[vv[out], uu[out]] = True
+    if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
+        drop &= ~square_filter(own & ~drop, eroded)
+    return drop if drop.any() else None
+
+
+#: The least number of opposite pairs of sectors both seen past :func:`_seen_past_in_part` reads an overshoot from
+#: (as :func:`_seen_past` needs two sectors seen past).
+PAIRS = 2
+
+#: The least overshoot (pixels, of the mask's outline beyond the fruit's edge read on opposite sides) that
+#: :func:`_seen_past_in_part` takes off: a pixel's rounding of the mask's farthest pixel and of the edge.
+LEAST_OVERSHOOT_PX = 1.0
+
+
+def _seen_past_in_part(own: np.ndarray, band: np.ndarray, past: np.ndarray, ahead: np.ndarray | None,
+                       is_joined: np.ndarray, sec: np.ndarray, rad: np.ndarray, vv: np.ndarray, uu: np.ndarray,
+                       last: np.ndarray, first: np.ndarray, both: np.ndarray,
+                       eroded: int) -> np.ndarray | None:  # fmt: skip
+    """:func:`_seen_past` where the camera saw past the fruit over part of its outline only, and a support or a
+    neighbour at the fruit's own depth runs on over the rest (stop 56, docs/overshoot56.md): the mask's pixels
+    beyond the fruit's edge, that edge read as the mask's outline less one overshoot all round, and never less
+    than a sector's own pixels seen past where it has them (None: not so).
+
+    Where the camera saw past, the overshoot of a sector is read as the mask's pixels seen past along the ray (from
+    the first pixel seen past to the mask's farthest, its outline there): the mask's overshoot less the mixed pixels
+    the camera invalidates outside the fruit's edge, so never more than the overshoot. Not halfway between the last
+    depth and the first pixel seen past, as :func:`_seen_past` reads the edge all round: a real time-of-flight
+    camera loses far more of the rim inside the edge than outside (the Azure Kinect frames a quarter of every
+    sphere's radius), and halfway read 2-3 px more than the mask's pixels seen past on the same sectors there (a
+    200 mm sphere's mask drawn 2 px wide cut to 15 mm under its diameter). Read on one side alone it is the
+    depth's displacement against colour as much as the mask's (a registration a few pixels off, a time-of-flight
+    camera's parallax: the background it sees beside the fruit lands inside the fruit's colour outline on one side,
+    its shadow without depth on the other; the real Azure Kinect frames see past 2-12 px inside masks drawn right).
+    On two opposite sectors a displacement adds to one as much as it takes from the other, so their mean is the
+    mask's own. Where a support or a neighbour at the fruit's depth runs on past the outline nothing can be read:
+    the overshoot there is taken as the opposite pairs' median, the one assumption a pen or a model's dilation,
+    about as wide all round, allows. Taken only where (a) every third of the outline holds a sector seen past or one
+    whose band holds depth not seen past and not clearly in front (``ahead``): at the fruit's own depth, or joined
+    to its points by a continuous surface. The arcs without either are where the mask is the only measure of the
+    fruit, as :func:`_seen_past` leaves them; (b) at least :data:`PAIRS` opposite pairs of sectors are both seen
+    past; (c) the overshoot is at least :data:`LEAST_OVERSHOOT_PX`. A pixel joined to the points (``is_joined``: the
+    fruit's own surface, or a support meeting it at its depth) is never cut, as in :func:`_seen_past`.
+    """
+    sectors = len(last)
+    if sectors % 2:  # no opposite sectors
+        return None
+    level = band & ~past  # the band's depth not seen past: at the fruit's own, or joined to its points
+    if ahead is not None:
+        level &= ~ahead
+    support = np.zeros(sectors, bool)
+    support[sec[level[vv, uu]]] = True
+    at = np.flatnonzero(both | support)
+    if len(at) < 2 or np.diff(np.r_[at, at[0] + sectors]).max() > sectors // 3:
+        return None
+    reach = np.zeros(sectors)  # the mask's outline: its farthest pixel in each sector
+    np.maximum.at(reach, sec, rad + 0.5)
+    half = sectors // 2
+    pairs = both[:half] & both[half:]
+    if np.count_nonzero(pairs) < PAIRS:
+        return None
+    over = reach - first + 0.5  # the mask's pixels seen past along the ray (read only where ``both``)
+    shift_free = 0.5 * (over[:half] + over[half:])[pairs]
+    by = float(np.median(shift_free))
+    if not by >= LEAST_OVERSHOOT_PX:
+        return None
+    # where seen past, never more than the sector's own pixels seen past: a mask displaced against the depth holds
+    # less than ``by`` on one side, and its outline there lies nearer the edge by as much
+    cut = np.where(both, np.minimum(by, over), by)
+    drop = np.zeros(own.shape, bool)
+    out = ~is_joined & (rad > (reach - cut)[sec])
     drop[vv[out], uu[out]] = True
     if eroded > 0:  # the ring extraction never took points from is the fruit's as far as the points say
         drop &= ~square_filter(own & ~drop, eroded)
