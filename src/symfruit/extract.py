@@ -16,7 +16,7 @@ from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds, median
 from .core.raster import mask_box, square_filter
-from .core.surface import colour_trim, fruit_surface, registration_shift
+from .core.surface import PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
@@ -333,6 +333,14 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         # the nearest of the big clusters (one alone needs no medians)
         near = big[0] if len(big) == 1 else big[np.argmin([median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
+        if surface is not None and len(points) >= 2 * PART_POINTS:
+            # parts of the fruit a nearer surface crossing it parted from the nearest (a twig, a leaf's midrib or
+            # strip across it: issue 18, stop 56)
+            rows, cols = np.nonzero(usable & surface.pixels)
+            tol = max(s.convex_tolerance * surface.noise, 0.003)
+            focal = float(np.sqrt(camera.fx * camera.fy))
+            keep_cluster = across_occluder(z_all, rows, cols, labels, int(near), tol, focal, surface.radius,
+                                            s.erode_px + s.colour_trim_px + 2)[labels]  # fmt: skip
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
     ex = Extraction(points, area, n_invalid, area - np.count_nonzero(core), dropped, truncated, outline)
