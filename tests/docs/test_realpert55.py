@@ -133,3 +133,13 @@ def test_a_strip_in_front_across_every_sphere_leaves_the_larger_ones_cubes(rp):
     for k, size, diameter in boxes:
         if k in (1, 2, 3):
             assert np.ptp(size) <= 6.5 and abs(size[2] - diameter) <= 6.0, (k, size, diameter)
+
+
+def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_largest_sphere_as_deep_as_it_is_wide(rp):
+    """Stop 56 (docs/strip56.md): a leaf 5 cm in front over the left 35 % of every sphere, the mask cut by it. The
+    depth prior's width was the cut silhouette's (65 % and 100 % of the diameter: sphere 1 184 x 196 x 169 mm for
+    198); it is now the ellipse through the outline's free arcs (``evidence.cut_prior``): sphere 1's depth side
+    within 6 mm of its diameter. The smaller spheres' cut widths stay short (docs/strip56.md, left open)."""
+    boxes = {k: (size, diameter) for k, size, diameter in spheres(rp, "leafside5-cut")}
+    size, diameter = boxes[1]
+    assert abs(size[2] - diameter) <= 6.0, (size, diameter)
