@@ -158,8 +158,9 @@ class EvidenceSettings(Section):
         With occlusion information, where part of the outline is cut and the ellipse fitted to its contour part was
         taken for the viewing cone (:func:`~symfruit.core.agreement.observe`, ``contour_cone``), the prior's width is
         that ellipse's (the geometric mean of its widths across the line of sight,
-        :func:`~symfruit.core.raster.cone_widths`): the free arcs of the outline are the fruit's own and lie on its
-        whole silhouette, which the cut region's widths are not (stop 56, docs/strip56.md: the real spheres with a
+        :func:`~symfruit.core.raster.cone_widths`) where that is wider than the cut region's (an occluder only
+        ever narrows an outline): the free arcs of the outline are the fruit's own and lie on its whole silhouette,
+        which the cut region's widths are not (stop 56, docs/strip56.md: the real spheres with a
         leaf over a third of them and the mask cut, depth sides 19.7 mm short). ``outline``: the cut region's widths,
         moved by ``cut_width``, as before.
     hidden_front : {"sphere", "off"}
@@ -700,7 +701,7 @@ def fuse_depth(
     than it is wide, pointing at the camera, would otherwise be cut by the prior). ``across``: the region's
     :func:`~symfruit.core.raster.across_sight` when known. ``whole``: the widths ``(minor, major)`` (tangent units)
     of the fruit's whole outline where a cut one's are not (``cut_prior``): the prior reads them as an uncut
-    outline's.
+    outline's where that is wider (a cut only ever narrows an outline).
 
     The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
     width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
@@ -718,11 +719,10 @@ def fuse_depth(
     spread = float((w * np.abs(backs - fit_back)).sum())
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
-    if whole is not None:  # the ellipse of the outline's free arcs: its geometric mean, as an uncut outline's
-        width = float(np.sqrt(whole[0] * whole[1]) * box.centre[2] / across.axis[2])
-    else:
-        width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate",
-                                  s.tilt_floor) * box.centre[2] / across.axis[2])  # fmt: skip
+    width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
+    if whole is not None:  # the ellipse of the outline's free arcs, as an uncut outline's; a cut only narrows
+        width = max(width, float(np.sqrt(whole[0] * whole[1])))
+    width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
     fit_sd = math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
     if s.depth_ratio_sd <= 0 or width <= 0:
