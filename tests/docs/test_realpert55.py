@@ -87,12 +87,13 @@ def test_a_leaf_lies_in_front_with_the_frames_noise_and_loses_depth_along_its_ed
     assert (over[hidden] == 0).any()  # its edge holds no depth (the camera's mixed pixels)
 
 
-def spheres(rp, name):
+def spheres(rp, name, settings=None):
     """Every sphere's box of frame 0 under perturbation ``name`` and its reference diameter (mm), the unperturbed
-    mask's at the box's depth (the scorer's: ``evaluate_spheres``)."""
+    mask's at the box's depth (the scorer's: ``evaluate_spheres``); ``settings`` as ``detect``'s."""
     frame = read_frame(rp.FRAMES / "lab-spheres-0")
     color, depth, masks, cam = rp.PERTURBATIONS[name](frame)
-    found = detect(Frame(name=name, color=color, depth=depth, camera=cam, masks=masks), method="evidence")
+    found = detect(Frame(name=name, color=color, depth=depth, camera=cam, masks=masks), method="evidence",
+                   settings=settings)  # fmt: skip
     focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))  # the unperturbed mask's pixels: the frame's camera
     out = []
     for d in found.detections:
@@ -135,11 +136,15 @@ def test_a_strip_in_front_across_every_sphere_leaves_the_larger_ones_cubes(rp):
             assert np.ptp(size) <= 6.5 and abs(size[2] - diameter) <= 6.0, (k, size, diameter)
 
 
-def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_largest_sphere_as_deep_as_it_is_wide(rp):
+def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_largest_sphere_as_deep_as_it_is_wide_by_the_ellipse(rp):
     """Stop 56 (docs/strip56.md): a leaf 5 cm in front over the left 35 % of every sphere, the mask cut by it. The
-    depth prior's width was the cut silhouette's (65 % and 100 % of the diameter: sphere 1 184 x 196 x 169 mm for
-    198); it is now the ellipse through the outline's free arcs (``evidence.cut_prior``): sphere 1's depth side
-    within 6 mm of its diameter. The smaller spheres' cut widths stay short (docs/strip56.md, left open)."""
+    depth prior's width is the cut silhouette's (65 % and 100 % of the diameter: sphere 1 184 x 196 x 169 mm for
+    198); with ``evidence.cut_prior: ellipse`` (not the default) it is the ellipse through the outline's free arcs:
+    sphere 1's depth side within 6 mm of its diameter."""
+    from symfruit.settings import from_dict
+
     boxes = {k: (size, diameter) for k, size, diameter in spheres(rp, "leafside5-cut")}
-    size, diameter = boxes[1]
+    assert boxes[1][0][2] < boxes[1][1] - 20.0  # the default: the cut silhouette's width
+    told = from_dict({"evidence": {"cut_prior": "ellipse"}})
+    size, diameter = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", told)}[1]
     assert abs(size[2] - diameter) <= 6.0, (size, diameter)
