@@ -823,24 +823,19 @@ def _one_surface(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, a: np.ndarra
     fit = _InverseQuadratic(rows[both], cols[both], z[both], focal)
     if fit.inverse is None or not fit.curvature()[0] * radius >= THIN[0]:
         return False
+    inverse = fit._design(rows[both], cols[both]) @ fit.coef
+    if not (inverse > 0).all():
+        return False  # the surface turns away from the camera under some of them
+    res = np.zeros(len(z))
+    res[both] = z[both] - 1.0 / inverse
+    for part in (a, b):
+        r = np.ascontiguousarray(res[part])
+        if abs(float(median(r))) > tol or float(median(np.abs(r))) > tol:
+            return False
     # no step across the gap: the fit takes a step between the parts in with a tilt, which leaves the two edges
     # facing each other on either side of it
-    facing = []
-    for p, q in ((a, b), (b, a)):
-        edge = _facing(rows, cols, p, q)
-        facing.append(
-            float(median(np.ascontiguousarray(z[edge] - 1.0 / (fit._design(rows[edge], cols[edge]) @ fit.coef))))
-        )
-    if not abs(facing[0] - facing[1]) <= tol:
-        return False
-    for part in (a, b):
-        inverse = fit._design(rows[part], cols[part]) @ fit.coef
-        if not (inverse > 0).all():
-            return False
-        res = np.ascontiguousarray(z[part] - 1.0 / inverse)
-        if abs(float(median(res))) > tol or float(median(np.abs(res))) > tol:
-            return False
-    return True
+    facing = [float(median(np.ascontiguousarray(res[_facing(rows, cols, p, q)]))) for p, q in ((a, b), (b, a))]
+    return abs(facing[0] - facing[1]) <= tol
 
 
 #: :func:`_facing`: the share of a part's points nearest the other part that make its edge facing it.
