@@ -279,8 +279,9 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         (:func:`~symfruit.core.surface.fruit_surface`: its depth mode, a slab of ``slab`` radii behind its
         front, the convex cap from its nearest point), then the cluster nearest the camera among the clusters
         holding at least ``cluster_share`` of the largest one's points, with the clusters a nearer surface crossing
-        the fruit parted from it on one convex surface (:func:`~symfruit.core.surface.across_occluder`); with ``own``, none where those are what lies
-        behind the fruit and the mask holds no other surface (:func:`own_surface`; the reason in its ``error``).
+        the fruit parted from it on one convex surface (:func:`~symfruit.core.surface.across_occluder`); with
+        ``own``, none where those are what lies behind the fruit and the mask holds no other surface
+        (:func:`own_surface`; the reason in its ``error``).
     """
     mask = _checked(mask, depth, camera, settings, "extract", "mask")
     if leafy is not None and (np.shape(leafy) != mask.shape or np.asarray(leafy).dtype != bool):
