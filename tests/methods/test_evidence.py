@@ -828,8 +828,7 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
     """Stop 56 (docs/strip56.md): a leaf 10 cm in front hides a 70 mm ball below its middle (or 0.3 and 0.5 of its
     radius lower). The outline's free arcs lie on the ball's whole silhouette, which the ellipse fitted to them
     (the observation's cone, ``contour_cone``) recovers: with ``cut_prior: ellipse`` the depth prior's width is the
-    diameter, where the cut
-    region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default)."""
+    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default)."""
     from symfruit.core.occlusion import occlusion
 
     from ..conftest import occluded_view
