@@ -16,7 +16,7 @@ from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds, median
 from .core.raster import mask_box, square_filter
-from .core.surface import colour_trim, fruit_surface, registration_shift
+from .core.surface import PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
@@ -278,8 +278,10 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         Its points are the mask's pixels (the border eroded) on the fruit's own surface
         (:func:`~symfruit.core.surface.fruit_surface`: its depth mode, a slab of ``slab`` radii behind its
         front, the convex cap from its nearest point), then the cluster nearest the camera among the clusters
-        holding at least ``cluster_share`` of the largest one's points; with ``own``, none where those are what lies
-        behind the fruit and the mask holds no other surface (:func:`own_surface`; the reason in its ``error``).
+        holding at least ``cluster_share`` of the largest one's points, with the clusters a nearer surface crossing
+        the fruit parted from it on one convex surface (:func:`~symfruit.core.surface.across_occluder`); with
+        ``own``, none where those are what lies behind the fruit and the mask holds no other surface
+        (:func:`own_surface`; the reason in its ``error``).
     """
     mask = _checked(mask, depth, camera, settings, "extract", "mask")
     if leafy is not None and (np.shape(leafy) != mask.shape or np.asarray(leafy).dtype != bool):
@@ -333,6 +335,14 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
         # the nearest of the big clusters (one alone needs no medians)
         near = big[0] if len(big) == 1 else big[np.argmin([median(points[labels == k, 2]) for k in big])]
         keep_cluster = labels == near
+        if surface is not None and len(points) >= 2 * PART_POINTS:
+            # parts of the fruit a nearer surface crossing it parted from the nearest (a twig, a leaf's midrib or
+            # strip across it: issue 18, stop 56)
+            rows, cols = np.nonzero(usable & surface.pixels)
+            tol = max(s.convex_tolerance * surface.noise, 0.003)
+            focal = float(np.sqrt(camera.fx * camera.fy))
+            keep_cluster = across_occluder(z_all, rows, cols, labels, int(near), tol, focal, surface.radius,
+                                            s.erode_px + s.colour_trim_px + 2)[labels]  # fmt: skip
         dropped += int((~keep_cluster).sum())
         points = points[keep_cluster]
     ex = Extraction(points, area, n_invalid, area - np.count_nonzero(core), dropped, truncated, outline)

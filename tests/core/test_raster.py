@@ -507,6 +507,25 @@ def test_inverse2_is_numpys_inv():
     )
 
 
+def test_the_widths_of_the_ellipse_recovered_from_part_of_an_outline_are_the_whole_outlines(camera):
+    """Stop 56: :func:`cone_widths` of the cone :func:`outline_cone` fits to the upper arc of an 80 x 50 px ellipse
+    are its widths (pixels over the focal length, near the optical axis), where the cut region's moment ellipse
+    reads its lower half short; a cone that is no ellipse across the line of sight has none."""
+    from symfruit.core.raster import Silhouette, cone_widths, outline_cone, silhouette_cone
+
+    vv, uu = np.mgrid[:120, :140]
+    a, b, cu, cv = 40.0, 25.0, 70.0, 60.0
+    full = ((uu - cu) / a) ** 2 + ((vv - cv) / b) ** 2 <= 1.0
+    t = np.linspace(np.pi, 2 * np.pi, 200)
+    arc = np.c_[cu + a * np.cos(t), cv + b * np.sin(t)] + [camera.cx - cu, camera.cy - cv]
+    region = Silhouette(int(camera.cx - cu), int(camera.cy - cv), full & (vv < cv + 5), 0.0)
+    minor, major = cone_widths(*outline_cone(region, camera, arc))
+    assert minor * camera.fy == pytest.approx(2 * b, rel=0.01) and major * camera.fx == pytest.approx(2 * a, rel=0.01)
+    cut_minor, _ = cone_widths(*silhouette_cone(region, camera))
+    assert cut_minor * camera.fy < 0.75 * 2 * b
+    assert cone_widths(np.diag([1.0, -1.0, -1.0]), np.array([0.0, 0.0, 1.0])) is None  # a hyperbola across it
+
+
 def test_outline_cone_is_the_same_with_its_kernels_and_without(camera, monkeypatch):
     """Arcs of ellipses at crack midpoints (half pixels), some accepted, some not: the same cone and axis to the bit
     with the compiled design (core._jit.conic_design, where numba is) and with its numpy twin (issue 19, stop 44)."""

@@ -9,6 +9,7 @@ from hypothesis import strategies as st
 
 from symfruit.core.surface import (
     _mean_curvature,
+    across_occluder,
     colour_trim,
     depth_noise,
     depth_step,
@@ -1380,3 +1381,45 @@ def test_the_fruit_surface_of_a_clean_depth_read_as_it_is_is_the_cleaned_one_s(s
                 assert np.array_equal(a.pixels, b.pixels)
                 assert (a.front, a.radius, a.noise, a.apex) == (b.front, b.radius, b.noise, b.apex)
     assert depth.tobytes() == kept.tobytes()
+
+
+def strip_across_ball(*, gap=0.05, half=6, edge=2, noise=0.0005, seed=0):
+    """``(depth, rows, cols, labels)``: :func:`ball` of 40 px (33 mm at 0.5 m, its outer tenth without depth) with a
+    strip ``gap`` in front of its front pole across its middle ``2 half + 1`` rows, beyond the disc on both sides, the
+    ``edge`` pixels either side of the strip without depth (the camera's mixed pixels); the ball's seen pixels
+    labelled 0 above the strip, 1 below it."""
+    depth, disc = ball(radius_px=40, rim=0.1, noise=noise, seed=seed)
+    yy = np.mgrid[:H, :W][0]
+    strip = np.abs(yy - 60) <= half
+    depth[strip] = 0.5 - gap
+    depth[(np.abs(yy - 60) <= half + edge) & ~strip] = 0.0
+    rows, cols = np.nonzero(disc & (depth > 0.5 - 0.001))
+    return depth, rows, cols, (rows > 60).astype(np.int64)
+
+
+def test_a_fruit_parted_by_a_strip_in_front_is_one_fruit_whichever_part_is_kept():
+    """Stop 56 (issue 18, docs/strip56.md): a strip 5 cm in front across a ball parts its seen pixels in two, which
+    clustering cannot join (the strip's width lies between them). Both lie on one convex surface and only the strip
+    and its edge lie between them: both are the fruit, whichever was kept."""
+    depth, rows, cols, labels = strip_across_ball()
+    r_m = 40 * 0.5 / F
+    for keep in (0, 1):
+        assert across_occluder(depth, rows, cols, labels, keep, 0.003, F, r_m).tolist() == [True, True]
+
+
+def test_what_a_strip_parts_from_the_fruit_is_not_joined_unless_it_continues_the_fruit():
+    """The same scene with the part below the strip a flat sheet at the ball's depth, or the ball's own surface 10 mm
+    farther (a step), or the strip taken away (a band without depth alone parts them: no occluder known), or the two
+    parts touching (a step of their own parted them): the part is not joined."""
+    r_m = 40 * 0.5 / F
+    depth, rows, cols, labels = strip_across_ball()
+    flat = depth.copy()
+    flat[rows[labels == 1], cols[labels == 1]] = 0.51
+    stepped = depth.copy()
+    stepped[rows[labels == 1], cols[labels == 1]] += 0.01
+    no_strip = np.where(np.abs(np.mgrid[:H, :W][0] - 60) <= 8, 0.0, depth)
+    for what, d in (("flat", flat), ("step", stepped), ("no strip", no_strip)):
+        assert across_occluder(d, rows, cols, labels, 0, 0.003, F, r_m).tolist() == [True, False], what
+    touching = labels.copy()
+    touching[(rows > 60) & (rows < 72)] = 0  # the lower part's first rows given to the upper one, across the strip
+    assert across_occluder(depth, rows, cols, touching, 0, 0.003, F, r_m).tolist() == [True, False]

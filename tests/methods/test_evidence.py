@@ -821,3 +821,24 @@ def test_hidden_fronts_sphere_stops_within_its_stop(seed):
     (z, apex), (z0, apex0) = sphere_front(points, radius, tolerance=FRONT_TOLERANCE), sphere_front(points, radius)
     assert FRONT_TOLERANCE == 1e-5
     assert abs(z - z0) < FRONT_TOLERANCE and float(np.abs(apex - apex0).max()) < FRONT_TOLERANCE
+
+
+@pytest.mark.parametrize("hidden", [0.0, 0.3, 0.5])
+def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
+    """Stop 56 (docs/strip56.md): a leaf 10 cm in front hides a 70 mm ball below its middle (or 0.3 and 0.5 of its
+    radius lower). The outline's free arcs lie on the ball's whole silhouette, which the ellipse fitted to them
+    (the observation's cone, ``contour_cone``) recovers: with ``cut_prior: ellipse`` the depth prior's width is the
+    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default)."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    cam = DEFAULT_CAMERA
+    below = cam.cy + hidden * cam.fy * 0.035 / 0.465  # the ball's silhouette radius in pixels: 46 px
+    visible, depth, mask, _ = occluded_view(ball_mesh(0.035), [0.0, 0.0, 0.5], below=below, occluder_z=0.4)
+    occ = occlusion(depth, mask, visible, cam)
+    ellipse = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "ellipse"}})
+    outline = complete(visible, occlusion=occ)
+    assert ellipse.extras["contour"] < 0.7  # a cut outline
+    assert ellipse.extras["width"] == pytest.approx(0.07, abs=0.001)
+    assert outline.extras["width"] < 0.063

@@ -31,6 +31,7 @@ __all__ = [
     "across_sight",
     "axis_tilt",
     "close_ragged",
+    "cone_widths",
     "distance_maps",
     "distance_transform",
     "fill_holes",
@@ -677,6 +678,35 @@ def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[
     cone = k.T @ conic @ k
     axis = camera.rays(centre[0], centre[1])
     return cone / np.abs(lapack.eigvalsh(cone)).max(), axis
+
+
+def cone_widths(cone: np.ndarray, axis: np.ndarray) -> tuple[float, float] | None:
+    """``(minor, major)``, tangent units (times the distance: metres): the widths of a viewing cone
+    (:func:`silhouette_cone`, :func:`outline_cone`: ``x^T C x = 0``, negative inside) across the line of sight along
+    ``axis``, along its two principal axes there, as :func:`across_sight` measures a region's; None where the cone
+    does not cut the plane perpendicular to ``axis`` in an ellipse.
+
+    >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    >>> m = np.zeros((100, 100), bool); m[40:60, 45:55] = True
+    >>> minor, major = cone_widths(*silhouette_cone(Silhouette(0, 0, m, 0.0), cam))
+    >>> round(minor * 500, 1), round(major * 500, 1)  # the moment ellipse of a 10 x 20 rectangle
+    (11.5, 23.1)
+    """
+    a = np.asarray(axis, dtype=np.float64).reshape(3)
+    a = a / np.linalg.norm(a)
+    e1 = np.array([a[2], 0.0, -a[0]])
+    e1 /= np.linalg.norm(e1)
+    b = np.column_stack((a, e1, np.cross(a, e1)))
+    c = b.T @ np.asarray(cone, dtype=np.float64) @ b  # the cone in the plane's coordinates (1, s, t)
+    m, lin = c[1:, 1:], c[1:, 0]
+    eig = np.linalg.eigvalsh(m)
+    if not np.isfinite(eig).all() or eig[0] <= 0.0:
+        return None
+    centre = -np.linalg.solve(m, lin)
+    k = float(centre @ m @ centre - c[0, 0])
+    if not k > 0.0:
+        return None
+    return float(2.0 * np.sqrt(k / eig[1])), float(2.0 * np.sqrt(k / eig[0]))
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:

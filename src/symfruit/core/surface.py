@@ -755,6 +755,136 @@ class _InverseQuadratic:
         return float(median(at_z - there))
 
 
+#: :func:`across_occluder`: the least points a part needs for a surface to be fitted to it (as
+#: :func:`_least_curvature`), and the least pixels of a nearer surface between two parts for it to be an occluder
+#: crossing the fruit (as :func:`fruit_depth` needs for a surface), not a flying pixel.
+PART_POINTS = 30
+NEARER_PIXELS = 10
+#: :func:`across_occluder` looks at this many of the largest other parts at most (a mask over foliage may hold many).
+MAX_PARTS = 8
+
+
+def across_occluder(depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, labels: np.ndarray, keep: int,
+                    tol: float, focal: float, radius: float, grow: int = 3) -> np.ndarray:  # fmt: skip
+    """(n_labels,) bool: the parts (``labels`` of the points seen at pixels ``rows, cols`` of ``depth``, metres, 0
+    or NaN none) that are part ``keep``'s fruit too, ``keep`` among them: parted from it only by a nearer surface
+    crossing the fruit (a twig, a leaf stalk, a leaf's midrib, a strip of leaf) and lying on one convex surface
+    with it.
+
+    A surface in front of a fruit parts its seen pixels into pieces that clustering cannot join (the occluder's
+    width lies between them); the nearest piece alone is then half a fruit (issue 18, docs/strip56.md: the real
+    Azure Kinect spheres under a 5 cm strip 5 cm in front kept one half, the boxes 14.5 mm too shallow). A part
+    is joined, to ``keep`` and to the parts joined before it, when
+
+    1. it does not touch them in the image (pieces that touch were parted by a depth step of their own: a leaf
+       behind the fruit, the fruit's far side), but is joined to them through pixels with no depth or with depth in
+       front of both by more than ``tol``, at least :data:`NEARER_PIXELS` of those in front (something nearer
+       crosses between them, not only the camera's lost rim). Each part reaches ``grow`` pixels further over pixels
+       not behind it (extraction's eroded border, the mixed pixels at an occluder's edge: the fruit's pixels next
+       to the occluder that the parts do not hold);
+    2. one convex surface holds both: the quadratic in inverse depth fitted to their points together
+       (:class:`_InverseQuadratic`) is curved as no sheet is (its mean curvature times the fruit's ``radius``,
+       metres, at least :data:`THIN`'s sheet bound; a part's own fit is not asked: half a real sphere's cap reads
+       0.02-0.3 of it), the median of each part's depth less the fit's, and the median of its absolute value, are
+       within ``tol`` (the real spheres' halves: 0.0-1.2 and 0.3-2.0 mm), and no step lies between them across the
+       gap once the occluder is taken out: the medians of the two parts' depths less the fit's on their edges
+       facing each other (:func:`_facing`) are within ``tol`` of each other (the fit takes a step in with a tilt,
+       which leaves the two edges on either side of it: a 10 mm step 4-7 mm apart, the real halves 0.0-2.9 mm).
+
+    At most :data:`MAX_PARTS` other parts of :data:`PART_POINTS` points or more are looked at (the largest)."""
+    counts = np.bincount(labels)
+    joined = np.zeros(len(counts), bool)
+    joined[keep] = True
+    others = [int(k) for k in np.argsort(-counts, kind="stable") if k != keep and counts[k] >= PART_POINTS]
+    if counts[keep] < PART_POINTS or not others:
+        return joined
+    z = np.asarray(depth[rows, cols], dtype=np.float64)
+    others = others[:MAX_PARTS]
+    grown = True
+    while grown:
+        grown = False
+        for k in others:
+            if joined[k]:
+                continue
+            part = labels == k
+            have = joined[labels]
+            if _one_surface(rows, cols, z, have, part, tol, focal, radius) and _parted(
+                depth, rows, cols, z, have, part, tol, grow
+            ):  # fmt: skip
+                joined[k] = grown = True
+    return joined
+
+
+def _one_surface(rows: np.ndarray, cols: np.ndarray, z: np.ndarray, a: np.ndarray, b: np.ndarray, tol: float,
+                 focal: float, radius: float) -> bool:  # fmt: skip
+    """:func:`across_occluder`'s test 2: the points ``a`` and ``b`` (bool over ``rows, cols, z``) on one convex
+    surface."""
+    both = a | b
+    fit = _InverseQuadratic(rows[both], cols[both], z[both], focal)
+    if fit.inverse is None or not fit.curvature()[0] * radius >= THIN[0]:
+        return False
+    inverse = fit._design(rows[both], cols[both]) @ fit.coef
+    if not (inverse > 0).all():
+        return False  # the surface turns away from the camera under some of them
+    res = np.zeros(len(z))
+    res[both] = z[both] - 1.0 / inverse
+    for part in (a, b):
+        r = np.ascontiguousarray(res[part])
+        if abs(float(median(r))) > tol or float(median(np.abs(r))) > tol:
+            return False
+    # no step across the gap: the fit takes a step between the parts in with a tilt, which leaves the two edges
+    # facing each other on either side of it
+    facing = [float(median(np.ascontiguousarray(res[_facing(rows, cols, p, q)]))) for p, q in ((a, b), (b, a))]
+    return abs(facing[0] - facing[1]) <= tol
+
+
+#: :func:`_facing`: the share of a part's points nearest the other part that make its edge facing it.
+FACING_SHARE = 0.1
+
+
+def _facing(rows: np.ndarray, cols: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Bool over ``rows, cols``: the points of ``a`` facing ``b`` across the gap between them, the
+    :data:`FACING_SHARE` of them (at least 10) nearest to ``b`` in the image."""
+    from scipy.spatial import cKDTree
+
+    ia = np.flatnonzero(a)
+    dist, _ = cKDTree(np.column_stack((rows[b], cols[b]))).query(np.column_stack((rows[ia], cols[ia])))
+    n = min(len(ia), max(10, int(FACING_SHARE * len(ia))))
+    out = np.zeros(len(rows), bool)
+    out[ia[np.argsort(dist, kind="stable")[:n]]] = True
+    return out
+
+
+def _parted(depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, z: np.ndarray, a: np.ndarray, b: np.ndarray,
+            tol: float, grow: int) -> bool:  # fmt: skip
+    """:func:`across_occluder`'s test 1: the pixels of ``a`` and ``b`` do not touch (8-neighbours) and, each grown
+    ``grow`` pixels over pixels not behind them, are joined through pixels of ``depth`` without depth or in front of
+    both by more than ``tol``, some of them in front."""
+    both = a | b
+    g = grow + 1
+    r0, c0 = max(int(rows[both].min()) - g, 0), max(int(cols[both].min()) - g, 0)
+    r1, c1 = min(int(rows[both].max()) + g + 1, depth.shape[0]), min(int(cols[both].max()) + g + 1, depth.shape[1])
+    image = np.zeros((r1 - r0, c1 - c0), np.int8)
+    image[rows[a] - r0, cols[a] - c0] = 1
+    image[rows[b] - r0, cols[b] - c0] = 2
+    if (ndimage.binary_dilation(image == 1, np.ones((3, 3), bool)) & (image == 2)).any():
+        return False  # they touch: a step of their own parted them
+    d = np.asarray(depth[r0:r1, c0:c1], dtype=np.float64)
+    seen = np.isfinite(d) & (d > 0)
+    nearer = seen & (d < float(min(z[a].min(), z[b].min())) - tol) & (image == 0)
+    bridge = (~seen & (image == 0)) | nearer
+    if grow > 0:
+        free = (image == 0) & ~(seen & (d > float(z[both].max()) + tol))
+        bridge |= ndimage.binary_dilation(image > 0, np.ones((3, 3), bool), iterations=grow) & free
+    parts, _ = ndimage.label(bridge | (image > 0), np.ones((3, 3), bool))
+    where = parts[image == 1]
+    for label in np.unique(where):
+        through = parts == label
+        if (through & (image == 2)).any() and np.count_nonzero(through & nearer) >= NEARER_PIXELS:
+            return True
+    return False
+
+
 def _sorted_histogram(z: np.ndarray, bins: int, span: tuple[float, float]) -> tuple[np.ndarray, np.ndarray]:
     """``np.histogram(z, bins=bins, range=span)`` of sorted ``z``: the counts between the same edges (each bin
     ``[e_i, e_i+1)``, the last closed) found by bisection instead of a pass over ``z`` per bin index."""
