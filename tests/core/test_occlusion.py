@@ -175,7 +175,9 @@ def test_filling_pixels_without_depth_is_skipped_only_when_there_are_none():
     depth, disc, points = _disc_frame(background=0.302)  # background at the fruit's depth: hidden
     holes = depth.copy()
     holes[14:17, 9:11] = 0.0  # beside the disc (its left edge is at u = 14), no depth: takes a neighbour's
-    full, holed = occlusion(depth, disc, points, CAM), occlusion(holes, disc, points, CAM)
+    # (without the support rule: a background at the fruit's depth running on from its outline is one, stop 56)
+    full = occlusion(depth, disc, points, CAM, supports=False)
+    holed = occlusion(holes, disc, points, CAM, supports=False)
     assert full.hidden[14 - full.v0 : 17 - full.v0, 9 - full.u0 : 11 - full.u0].all()
     assert np.array_equal(full.hidden, holed.hidden)
     assert np.isfinite(holed.depth[14 - holed.v0, 9 - holed.u0])
@@ -311,18 +313,32 @@ def test_a_fattened_edge_is_the_fruits_own_and_a_leaf_in_front_is_not(kernels, m
     assert full[leaf].all() and not full[ring & ~leaf].any()
 
 
-def test_a_support_at_the_fruits_depth_wider_than_the_band_and_another_fruit_stay_hidden():
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_support_at_the_fruits_depth_is_no_occluder_beside_the_outline_but_another_fruit_and_a_leaf_are(
+    kernels, monkeypatch
+):
+    """Stop 56: a support at the fruit's depth running on from its outline to the image border, wider than the band:
+    within the band beside the outline it is not hidden (the fruit would have to pass through it to continue behind
+    it), beyond the band it stays; without the rule (``supports`` off, stop 40's) it is hidden beside the outline.
+    Another fruit's mask over the band stays hidden, and so does a leaf 3 cm in front running on the same way."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
     depth, disc, points, r2 = _fattened()
-    cols = np.mgrid[:60, :80][1]
-    slab = ~disc & (cols < 40) & (np.abs(np.mgrid[:60, :80][0] - 30) <= 6)  # a support running left to the border
+    rows, cols = np.mgrid[:60, :80]
+    slab = ~disc & (cols < 40) & (np.abs(rows - 30) <= 6)  # a support running left to the border
     depth[slab] = 0.302
     others = np.zeros((60, 80), bool)
     other = ~disc & (r2 <= 18**2) & (cols > 50)  # another fruit's mask over part of the band
     others[other] = True
     full = hidden_image(occlusion(depth, disc, points, BIG, others=others))
-    assert full[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
+    assert not full[slab & (cols >= 24)].any()  # beside the disc's outline (at u = 25 on row 30): no occluder
+    assert full[slab & (cols < 15)].all()  # beyond the band: left as it was (no longer joined to the fruit)
     assert full[other].all()
-    assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(np.mgrid[:60, :80][0] - 30) > 16)].any()
+    assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(rows - 30) > 16)].any()
+    old = hidden_image(occlusion(depth, disc, points, BIG, others=others, supports=False))
+    assert old[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
+    depth[slab] = 0.27  # a leaf 3 cm in front of the fruit, running on the same way: a step, an occluder
+    assert hidden_image(occlusion(depth, disc, points, BIG, others=others))[slab].all()
 
 
 @pytest.mark.parametrize("kernels", ["default", "numpy"])

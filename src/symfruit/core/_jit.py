@@ -3919,6 +3919,7 @@ def own_edge(
     others: np.ndarray,
     tolerance: float,
     band: int,
+    supports: bool,
 ) -> int:  # fmt: skip
     """:func:`symfruit.core.occlusion.own_edge` in one pass, ``hidden`` (h, w) bool cleared in place (the number of
     pixels cleared returned): ``own`` (h, w) bool, ``own_z`` and ``depth`` (h, w) float, ``others`` (h, w) bool or
@@ -3960,25 +3961,27 @@ def own_edge(
             any_cand |= x
     if not any_cand:
         return 0
-    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
-    free = np.empty((m, n), np.bool_)
-    past = np.empty((m, n), np.bool_)
-    for r in range(m):
-        for c in range(n):
-            free[r, c] = not hid[r, c] and not mine[r, c]
-            past[r, c] = hid[r, c] and not near[r, c]
-    ends = np.empty((m, n), np.bool_)
-    _square_extreme(free, band + 1, False, ends)
-    runs = np.empty((m, n), np.bool_)
-    _square_extreme(past, band, False, runs)
-    any_cand = False
-    for r in range(m):
-        for c in range(n):
-            x = cand[r, c] and ends[r, c] and not runs[r, c]
-            cand[r, c] = x
-            any_cand |= x
-    if not any_cand:
-        return 0
+    if not supports:
+        # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band (a
+        # support runs on: not asked with ``supports``)
+        free = np.empty((m, n), np.bool_)
+        past = np.empty((m, n), np.bool_)
+        for r in range(m):
+            for c in range(n):
+                free[r, c] = not hid[r, c] and not mine[r, c]
+                past[r, c] = hid[r, c] and not near[r, c]
+        ends = np.empty((m, n), np.bool_)
+        _square_extreme(free, band + 1, False, ends)
+        runs = np.empty((m, n), np.bool_)
+        _square_extreme(past, band, False, runs)
+        any_cand = False
+        for r in range(m):
+            for c in range(n):
+                x = cand[r, c] and ends[r, c] and not runs[r, c]
+                cand[r, c] = x
+                any_cand |= x
+        if not any_cand:
+            return 0
     # not clearly nearer than the own depths within the band's square
     zs = np.empty((m, n))
     for r in range(m):
@@ -7570,6 +7573,7 @@ def own_edge_boxed(
     others: np.ndarray,
     tolerance: float,
     band: int,
+    supports: bool,
 ) -> int:  # fmt: skip
     """:func:`own_edge` on :func:`occlusion_edge_boxed`'s maps, without the window's own depths and own pixels as (h, w)
     maps (issue 19, stop 45): ``hidden`` (h, w) bool cleared in place (the number of pixels cleared returned), the
@@ -7656,8 +7660,9 @@ def own_edge_boxed(
         for c in range(n):
             if not cand[r, c]:
                 continue
-            # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it
-            x = _box_any(t_free, r, c, band + 1, m, n) and not _box_any(t_past, r, c, band, m, n)
+            # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it (a
+            # support runs on: not asked with ``supports``)
+            x = supports or (_box_any(t_free, r, c, band + 1, m, n) and not _box_any(t_past, r, c, band, m, n))
             if x:  # not clearly nearer than the own depths within the band's square
                 z = np.inf
                 j = c - qb + band  # this column's place in the padded rows (column qb - band is their first)
@@ -7683,6 +7688,7 @@ def occlusion_edge_boxed(
     tolerance: float,
     steps: np.ndarray,
     band: int,
+    supports: bool,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`occlusion_at`, then :func:`own_edge_boxed` on the maps, in one call: ``(found, u0, v0, hidden, seen)``,
     :func:`symfruit.core.occlusion.occlusion`'s maps bit for bit (issue 19, stop 41: one kernel instead of three calls;
@@ -7701,7 +7707,7 @@ def occlusion_edge_boxed(
         if some:
             break
     if some:
-        own_edge_boxed(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band)
+        own_edge_boxed(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band, supports)
     return found, u0, v0, hidden, seen
 
 

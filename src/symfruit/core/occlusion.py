@@ -323,6 +323,7 @@ def occlusion(
     band: int = 8,
     trim_own: bool = True,
     eroded: int = 1,
+    supports: bool = True,
 ) -> Occlusion:
     """The pixels around one fruit where the camera could not have seen it.
 
@@ -335,7 +336,8 @@ def occlusion(
     hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
     pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden. Last, a thin
     band at the fruit's own depth beside its mask that ends in something not hiding it is the fruit's own edge
-    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40).
+    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40), and
+    with ``supports`` so is the band beside it of a surface at its own depth that runs on (a support; stop 56).
 
     Where numba is installed the maps are made in one compiled pass over the window
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
@@ -375,6 +377,10 @@ def occlusion(
     eroded : int, pixels
         The mask's border its points were never taken from (extraction's ``erode_px``), handed to
         :func:`overshoot`.
+    supports : bool
+        A surface that runs on from the fruit's outline at the fruit's own depth (a support: the board or branch it
+        rests on) is not hidden within ``band`` of the fruit, whether or not the band ends (:func:`own_edge`'s
+        ``supports``; stop 56); off: only a band that ends is cleared (stop 40's rule).
     checked : bool
         ``depth`` has been through :func:`~symfruit.core.limits.depth_metres` already (a
         :class:`~symfruit.core.frame.Frame`'s has): its units are not sampled again. The sample reads one
@@ -419,7 +425,8 @@ def occlusion(
         # maps, its square filters read from summed-area tables (jit.occlusion_edge_boxed: the same maps; the
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
         found, u0, v0, hidden, seen = jit.occlusion_edge_boxed(uv, points, pad, image, mask, near_to, tolerance,
-                                                               _steps(reach), max(int(band), 0))  # fmt: skip
+                                                               _steps(reach), max(int(band), 0),
+                                                               bool(supports))  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
@@ -470,7 +477,9 @@ def occlusion(
     hidden = near & ~own
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
-    hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
+    hidden = own_edge(
+        hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band, bool(supports)
+    )
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
         overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded), focal)
@@ -732,8 +741,10 @@ def own_edge(
     others: np.ndarray | None,
     tolerance: float,
     band: int,
+    supports: bool = False,
 ) -> np.ndarray:
-    """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening).
+    """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening) and,
+    with ``supports``, without the band beside the fruit of a surface that meets it at its own depth (a support).
 
     An active-stereo camera gives the pixels a few beyond a foreground's silhouette the foreground's depth (the
     least depth its correlation window holds: ``synthetic.sensors``' ``fatten_px``), so beside a fruit with nothing
@@ -746,7 +757,13 @@ def own_edge(
     - it is not another fruit's (``others``);
     - something not hiding the fruit (background clearly behind it, or no depth) lies within ``band + 1`` pixels of
       it, and no hidden pixel farther than ``band`` from the fruit lies within ``band`` of it: the band ends there
-      (a leaf or a support at the fruit's depth wider than the band does not);
+      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` this is not asked:
+      a surface that runs on from the fruit's outline at the fruit's own depth (a board or a branch it rests on) is
+      no more an occluder than the spread edge is. To hide the fruit there it would have to lie in front of the
+      fruit's continuation past its outline, and the fruit's surface runs on from its outline at the depth it has
+      there or deeper (turning away): a surface meeting the outline at that depth, without a step towards the
+      camera, is one the fruit would have to pass through. An occluder (a leaf in front) lies in front of the
+      fruit's edge by a step, and stays hidden (stop 56, docs/support56.md);
     - it joins the fruit's own pixels through such pixels (not past a gap);
     - its depth is not clearly nearer (by ``tolerance``) than the nearest of the fruit's own depths (``own_z``,
       +inf where none) within ``2 band`` pixels: a spread depth is the least of the foreground's nearby, never in
@@ -760,6 +777,7 @@ def own_edge(
     """
     if band <= 0 or not hidden.any():
         return hidden
+    supports = bool(supports)
     shape = np.shape(hidden)
     same = np.shape(own) == np.shape(own_z) == np.shape(depth) == shape
     same = same and (others is None or np.shape(others) == shape)
@@ -768,7 +786,7 @@ def own_edge(
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
         z = np.asarray(own_z, dtype=np.float64)
         found = jit.own_edge(out, np.asarray(own, dtype=bool), z, np.asarray(depth, dtype=np.float64), near_to,
-                             float(tolerance), int(band))  # fmt: skip
+                             float(tolerance), int(band), supports)  # fmt: skip
         return out if found else hidden
     box = mask_box(own)
     if box is None:
@@ -783,10 +801,12 @@ def own_edge(
         cand &= ~np.asarray(others[b0:b1, a0:a1], dtype=bool)
     if not cand.any():
         return hidden
-    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
-    cand &= square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
-    if not cand.any():
-        return hidden
+    if (
+        not supports
+    ):  # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it
+        cand &= square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
+        if not cand.any():
+            return hidden
     zmin = ndimage.minimum_filter(own_z[b0:b1, a0:a1], size=2 * band + 1, mode="constant", cval=np.inf)
     with np.errstate(invalid="ignore"):
         cand &= np.asarray(depth[b0:b1, a0:a1], dtype=np.float64) >= zmin - tolerance  # NaN: not the fruit's
