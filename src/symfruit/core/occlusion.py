@@ -26,7 +26,7 @@ from .limits import MAX_IMAGE_SIDE, check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
-__all__ = ["Occlusion", "occlusion", "overshoot", "own_edge", "with_own"]
+__all__ = ["Occlusion", "occlusion", "overshoot", "own_edge", "support_reach", "with_own"]
 
 
 @dataclass(frozen=True)
@@ -379,8 +379,9 @@ def occlusion(
         :func:`overshoot`.
     supports : bool
         A surface that runs on from the fruit's outline at the fruit's own depth (a support: the board or branch it
-        rests on) is not hidden within ``band`` of the fruit, whether or not the band ends (:func:`own_edge`'s
-        ``supports``; stop 56); off: only a band that ends is cleared (stop 40's rule).
+        rests on) is not hidden within ``band`` of the fruit beyond the reach a round fruit may still continue behind
+        it, whether or not the band ends (:func:`own_edge`'s ``supports``, :func:`support_reach`; stop 56); off: only
+        a band that ends is cleared (stop 40's rule).
     checked : bool
         ``depth`` has been through :func:`~symfruit.core.limits.depth_metres` already (a
         :class:`~symfruit.core.frame.Frame`'s has): its units are not sampled again. The sample reads one
@@ -426,7 +427,7 @@ def occlusion(
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
         found, u0, v0, hidden, seen = jit.occlusion_edge_boxed(uv, points, pad, image, mask, near_to, tolerance,
                                                                _steps(reach), max(int(band), 0),
-                                                               bool(supports))  # fmt: skip
+                                                               bool(supports), focal)  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
@@ -477,9 +478,8 @@ def occlusion(
     hidden = near & ~own
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
-    hidden = own_edge(
-        hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band, bool(supports)
-    )
+    hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band,
+                      bool(supports), focal)  # fmt: skip
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
         overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded), focal)
@@ -742,6 +742,7 @@ def own_edge(
     tolerance: float,
     band: int,
     supports: bool = False,
+    focal: float = 0.0,
 ) -> np.ndarray:
     """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening) and,
     with ``supports``, without the band beside the fruit of a surface that meets it at its own depth (a support).
@@ -757,13 +758,13 @@ def own_edge(
     - it is not another fruit's (``others``);
     - something not hiding the fruit (background clearly behind it, or no depth) lies within ``band + 1`` pixels of
       it, and no hidden pixel farther than ``band`` from the fruit lies within ``band`` of it: the band ends there
-      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` this is not asked:
-      a surface that runs on from the fruit's outline at the fruit's own depth (a board or a branch it rests on) is
-      no more an occluder than the spread edge is. To hide the fruit there it would have to lie in front of the
-      fruit's continuation past its outline, and the fruit's surface runs on from its outline at the depth it has
-      there or deeper (turning away): a surface meeting the outline at that depth, without a step towards the
-      camera, is one the fruit would have to pass through. An occluder (a leaf in front) lies in front of the
-      fruit's edge by a step, and stays hidden (stop 56, docs/support56.md);
+      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` (and ``focal``, the camera's
+      focal length in pixels) this is not asked of the pixels reached in more steps from the fruit than
+      :func:`support_reach` of their depth: a surface that runs on from the fruit's outline at the fruit's own depth
+      (a board or a branch it rests on, the face of the box it stands on) hides only the part of the fruit deeper
+      than itself, and a round fruit ends within that reach of where the surface meets it (stop 56,
+      docs/support56.md). An occluder lies in front of the fruit's edge by a step (the next condition), and a leaf
+      lying on the fruit's face meets it near its front, where the reach is its whole radius: both stay hidden;
     - it joins the fruit's own pixels through such pixels (not past a gap);
     - its depth is not clearly nearer (by ``tolerance``) than the nearest of the fruit's own depths (``own_z``,
       +inf where none) within ``2 band`` pixels: a spread depth is the least of the foreground's nearby, never in
@@ -786,7 +787,7 @@ def own_edge(
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
         z = np.asarray(own_z, dtype=np.float64)
         found = jit.own_edge(out, np.asarray(own, dtype=bool), z, np.asarray(depth, dtype=np.float64), near_to,
-                             float(tolerance), int(band), supports)  # fmt: skip
+                             float(tolerance), int(band), supports, float(focal))  # fmt: skip
         return out if found else hidden
     box = mask_box(own)
     if box is None:
@@ -801,24 +802,57 @@ def own_edge(
         cand &= ~np.asarray(others[b0:b1, a0:a1], dtype=bool)
     if not cand.any():
         return hidden
-    if (
-        not supports
-    ):  # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it
-        cand &= square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
+    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it; with
+    # ``supports`` a band that runs on is cleared too, past the reach the fruit may continue behind it
+    ends = square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
+    if not supports:
+        cand &= ends
         if not cand.any():
             return hidden
     zmin = ndimage.minimum_filter(own_z[b0:b1, a0:a1], size=2 * band + 1, mode="constant", cval=np.inf)
+    d = np.asarray(depth[b0:b1, a0:a1], dtype=np.float64)
     with np.errstate(invalid="ignore"):
-        cand &= np.asarray(depth[b0:b1, a0:a1], dtype=np.float64) >= zmin - tolerance  # NaN: not the fruit's
+        cand &= d >= zmin - tolerance  # NaN: not the fruit's
     if not cand.any():
         return hidden
-    # the band runs on from the fruit's own pixels: what lies at the fruit's depth past a gap is something else
-    cand = ndimage.binary_dilation(mine, structure=np.ones((3, 3), bool), iterations=band, mask=cand | mine) & cand
-    if not cand.any():
+    # the band runs on from the fruit's own pixels: what lies at the fruit's depth past a gap is something else (the
+    # step each pixel is reached at: a support's pixel is cleared past its reach alone)
+    step = np.zeros(cand.shape, np.intp)
+    reached = np.zeros(cand.shape, bool)
+    edge = mine
+    for i in range(1, band + 1):
+        edge = ndimage.binary_dilation(edge, structure=np.ones((3, 3), bool)) & cand & ~reached
+        if not edge.any():
+            break
+        step[edge] = i
+        reached |= edge
+    reach = np.zeros(cand.shape)
+    front = float(np.min(own_z))
+    r_px = 0.25 * ((box[1] - box[0]) + (box[3] - box[2]))
+    r_m = r_px * front / focal if focal > 0.0 else 0.0
+    lone = reached & ~ends
+    if supports and 0.0 < r_m < np.inf and lone.any():
+        reach[lone] = support_reach(d[lone], front, r_px, r_m)
+    clear = reached & (reach < step)
+    if not clear.any():
         return hidden
     out = hidden.copy()
-    out[b0:b1, a0:a1] &= ~cand
+    out[b0:b1, a0:a1] &= ~clear
     return out
+
+
+def support_reach(depth: np.ndarray, front: float, r_px: float, r_m: float) -> np.ndarray:
+    """Pixels: how far past its outline a round fruit may still continue behind a surface that meets it at seen depth
+    ``depth`` (metres), the fruit's front at ``front`` and its radius ``r_px`` pixels, ``r_m`` metres.
+
+    What lies behind a surface at depth ``d`` is the fruit's part deeper than ``d``: of a sphere, the ring outside the
+    circle where its depth is ``d``, ``k = (d - front) / r`` of the radius behind its front, radius
+    ``r sqrt(1 - (1 - k)^2)``. So the fruit's outline may lie at most ``r (1 - sqrt(k (2 - k)))`` past where the
+    surface meets it: a surface at the fruit's front (``k = 0``, a leaf lying on its face) may hide it to its full
+    radius, one at the depth of its outline (``k = 1``) hides nothing. (The real 66 mm sphere standing on a board, the
+    board's face meeting it half a radius behind its front: 13 % of the radius, 4 mm; docs/support56.md.)"""
+    k = np.minimum(np.maximum((depth - front) / r_m, 0.0), 1.0)
+    return r_px * (1.0 - np.sqrt(k * (2.0 - k)))
 
 
 def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
