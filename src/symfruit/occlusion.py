@@ -40,9 +40,10 @@ class OcclusionSettings(Section):
         without them (stops 42 and 43, docs/sil42.md, docs/treeover43.md).
     supports : bool
         A surface that runs on from the fruit's outline at the fruit's own depth, without a step towards the camera
-        (the board or branch it rests on), is not read as hiding it beside the outline: the fruit cannot continue
-        behind a surface that meets its edge at its own depth (:func:`symfruit.core.occlusion.own_edge`; stop 56,
-        docs/support56.md). Off: it is, as a leaf in front is.
+        (the board or branch it rests on), is read as hiding it beside the outline only as far as a round fruit could
+        still continue behind it (:func:`symfruit.core.occlusion.support_reach`: what lies behind a surface is the
+        fruit's part deeper than it; :func:`symfruit.core.occlusion.own_edge`; stop 56, docs/support56.md). Off: the
+        whole band is, as a leaf in front is.
     """
 
     enabled: bool = setting(True)

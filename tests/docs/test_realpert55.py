@@ -130,8 +130,9 @@ def test_the_66_mm_sphere_on_its_board_is_a_cube_with_its_mask_down_on_the_board
     """Sphere 3 (66 mm) stands on a board. With its mask moved 5 px down onto the board (``shift+5y``), or binned 2x2
     with a lost rim a pixel wider (its mask a few pixels down after registration), the board just below it, at its own
     depth, was read as something that may hide it: a solid of revolution reaching 25-33 mm down behind the board won,
-    the box 84-94 mm tall. The board runs on from the sphere's outline without a step, so the sphere cannot continue behind it
-    (``occlusion.supports``, stop 56, docs/support56.md): a cube within 6 mm, as every sphere at ``shift+5y``."""
+    the box 84-94 mm tall. The board's face lies half a radius behind the sphere's front, and behind it a round fruit
+    can reach only 13-17 % of its radius (``occlusion.supports``, ``core.occlusion.support_reach``; stop 56,
+    docs/support56.md): a cube within 6 mm, as every sphere at ``shift+5y``."""
     boxes = spheres(rp, name)
     assert len(boxes) == 4
     for k, size, diameter in boxes:

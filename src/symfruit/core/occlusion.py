@@ -758,8 +758,8 @@ def own_edge(
     - it is not another fruit's (``others``);
     - something not hiding the fruit (background clearly behind it, or no depth) lies within ``band + 1`` pixels of
       it, and no hidden pixel farther than ``band`` from the fruit lies within ``band`` of it: the band ends there
-      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` (and ``focal``, the camera's
-      focal length in pixels) this is not asked of the pixels reached in more steps from the fruit than
+      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` (and ``focal``,
+      the camera's focal length in pixels) this is not asked of the pixels reached in more steps from the fruit than
       :func:`support_reach` of their depth: a surface that runs on from the fruit's outline at the fruit's own depth
       (a board or a branch it rests on, the face of the box it stands on) hides only the part of the fruit deeper
       than itself, and a round fruit ends within that reach of where the surface meets it (stop 56,
@@ -849,8 +849,9 @@ def support_reach(depth: np.ndarray, front: float, r_px: float, r_m: float) -> n
     circle where its depth is ``d``, ``k = (d - front) / r`` of the radius behind its front, radius
     ``r sqrt(1 - (1 - k)^2)``. So the fruit's outline may lie at most ``r (1 - sqrt(k (2 - k)))`` past where the
     surface meets it: a surface at the fruit's front (``k = 0``, a leaf lying on its face) may hide it to its full
-    radius, one at the depth of its outline (``k = 1``) hides nothing. (The real 66 mm sphere standing on a board, the
-    board's face meeting it half a radius behind its front: 13 % of the radius, 4 mm; docs/support56.md.)"""
+    radius, one at the depth of its outline (``k = 1``) hides nothing. (The real 66 mm sphere standing on a box, the
+    box's face meeting it 0.44-0.5 of a radius behind its front: 13-17 % of the radius, 4-5 mm; docs/support56.md.)
+    ``k`` is clipped to [0, 1]."""
     k = np.minimum(np.maximum((depth - front) / r_m, 0.0), 1.0)
     return r_px * (1.0 - np.sqrt(k * (2.0 - k)))
 
