@@ -3866,6 +3866,18 @@ def _row_min(x: np.ndarray, k: int, out: np.ndarray) -> None:
 
 
 @_njit_inlined
+def _support_scale(z: np.ndarray, r0: int, r1: int, c0: int, c1: int, focal: float) -> tuple[float, float, float]:
+    """``(front, r_px, r_m)`` of :func:`_support_reach`: the least of the own depths ``z`` (+inf where none), half the
+    mean side of the own pixels' box ``r0:r1, c0:c1`` (pixels) and that in metres at the front (0 without ``focal``)."""
+    front = np.inf
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            front = min(front, z[i, j])
+    r_px = 0.25 * ((r1 - r0) + (c1 - c0))
+    return front, r_px, r_px * front / focal if focal > 0.0 else 0.0
+
+
+@_njit_inlined
 def _support_reach(d: float, front: float, r_px: float, r_m: float) -> float:
     """Pixels: how far past its outline a round fruit (front ``front``, radius ``r_px`` pixels, ``r_m`` metres) may
     still continue behind a surface meeting it at seen depth ``d`` (:func:`symfruit.core.occlusion.support_reach`,
@@ -3990,12 +4002,7 @@ def own_edge(
     _square_extreme(free, band + 1, False, ends)
     runs = np.empty((m, n), np.bool_)
     _square_extreme(past, band, False, runs)
-    front = np.inf
-    for r in range(h):
-        for c in range(w):
-            front = min(front, own_z[r, c])
-    r_px = 0.25 * ((r1 - r0) + (c1 - c0))
-    r_m = r_px * front / focal if focal > 0.0 else 0.0
+    front, r_px, r_m = _support_scale(own_z, r0, r1, c0, c1, focal)
     reach = np.zeros((m, n))
     any_cand = False
     for r in range(m):
@@ -7682,12 +7689,7 @@ def own_edge_boxed(
             for j in range(nb):
                 padded[i, band + j] = box_z[i, j]
         _row_min(padded, band, rowmin)
-    front = np.inf
-    for i in range(mb):
-        for j in range(nb):
-            front = min(front, box_z[i, j])
-    r_px = 0.25 * ((r1 - r0) + (c1 - c0))
-    r_m = r_px * front / focal if focal > 0.0 else 0.0
+    front, r_px, r_m = _support_scale(box_z, r0, r1, c0, c1, focal)
     reach = np.zeros((m, n))
     count = 0
     for r in range(m):
