@@ -38,12 +38,19 @@ class OcclusionSettings(Section):
         the fruit's own depth beyond its points or a time-of-flight camera saw past the fruit nearly all round it
         (:func:`symfruit.core.occlusion.overshoot`): the completion reads the fruit's width and silhouette cone
         without them (stops 42 and 43, docs/sil42.md, docs/treeover43.md).
+    supports : bool
+        A surface that runs on from the fruit's outline at the fruit's own depth, without a step towards the camera
+        (the board or branch it rests on), is read as hiding it beside the outline only as far as a round fruit could
+        still continue behind it (:func:`symfruit.core.occlusion.support_reach`: what lies behind a surface is the
+        fruit's part deeper than it; :func:`symfruit.core.occlusion.own_edge`; stop 56, docs/support56.md). Off: the
+        whole band is, as a leaf in front is.
     """
 
     enabled: bool = setting(True)
     tolerance: float = setting(0.005, ge=-1.0, le=1.0)
     reach_px: int = setting(3, ge=0, le=50)
     trim_own: bool = setting(True)
+    supports: bool = setting(True)
 
 
 def fruit_occlusion(
@@ -68,4 +75,4 @@ def fruit_occlusion(
         return None
     return occlusion(depth, mask, points, camera, others=others, tolerance=settings.tolerance,
                      reach=settings.reach_px, checked=checked,
-                     trim_own=settings.trim_own and drawn, eroded=eroded)  # fmt: skip
+                     trim_own=settings.trim_own and drawn, eroded=eroded, supports=settings.supports)  # fmt: skip

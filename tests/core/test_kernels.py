@@ -3663,13 +3663,13 @@ def _edge_case(seed: int, band: int):
 
 
 @settings(max_examples=200, deadline=None)
-@given(st.integers(0, 2**31 - 1), st.integers(0, 9))
-def test_the_own_edge_kernel_clears_the_twins_pixels(seed, band):
+@given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.sampled_from([0.0, 300.0, 1000.0]))
+def test_the_own_edge_kernel_clears_the_twins_pixels(seed, band, supports, focal):
     from symfruit.core.occlusion import own_edge
 
     hidden, own, own_z, depth, others = _edge_case(seed, band)
     with pytest.MonkeyPatch.context() as mp:
-        fast, twin = _both(mp, own_edge, hidden, own, own_z, depth, others, 0.005, band)
+        fast, twin = _both(mp, own_edge, hidden, own, own_z, depth, others, 0.005, band, supports, focal)
     np.testing.assert_array_equal(fast, twin)
     np.testing.assert_array_equal(hidden, _edge_case(seed, band)[0])  # its input is left alone
 
@@ -4281,7 +4281,7 @@ def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reac
                           np.ascontiguousarray(others[win]) if with_others else others, 0.005, steps,
                           float(points[:, 2].min()), float(points[:, 2].max()), hid, sn)  # fmt: skip
     assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
-    edge = _jit.occlusion_edge_boxed(uv, points, pad, depth, mask, others, 0.005, steps, 0)
+    edge = _jit.occlusion_edge_boxed(uv, points, pad, depth, mask, others, 0.005, steps, 0, True, 300.0)
     assert edge[:3] == (found, u0, v0) and np.array_equal(edge[3], hidden) and edge[4].tobytes() == seen.tobytes()
 
 
@@ -5143,8 +5143,8 @@ def _fattened_scene(rng, h, w, with_others):
 
 @settings(max_examples=300, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.booleans(), st.integers(6, 70),
-       st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3))  # fmt: skip
-def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, w, tolerance, reach):
+       st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3), st.booleans())  # fmt: skip
+def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, w, tolerance, reach, supports):
     """occlusion_edge_boxed (own_edge's square filters from summed-area tables, the own depths' least from the points'
     box alone, no window-sized own maps) against occlusion_at's window and seen depths, and against occlusion's
     numpy twin (own_edge on the window's maps): the same window, hidden pixels and seen depths, bit for bit; fruit at
@@ -5156,14 +5156,14 @@ def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, 
     uv, points, depth, mask, others = _fattened_scene(rng, h, w, with_others)
     depth = depth.astype(np.float32 if single else np.float64)
     steps = _steps_within(reach)
-    got = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, others, tolerance, steps, band)
+    got = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, others, tolerance, steps, band, supports, 300.0)
     found, u0, v0, _, seen = _jit.occlusion_at(uv, points, 16, depth, mask, others, tolerance, steps)
     assert got[:3] == (found, u0, v0) and got[4].tobytes() == seen.tobytes()  # own_edge clears hidden pixels only
     camera = Camera(fx=300.0, fy=300.0, cx=0.0, cy=0.0, width=w, height=h)
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         twin = occlusion(depth, mask, points, camera, others=others if with_others else None, tolerance=tolerance,
-                         reach=reach, band=band, trim_own=False)  # fmt: skip
+                         reach=reach, band=band, trim_own=False, supports=supports)  # fmt: skip
     assert (twin.u0, twin.v0) == got[1:3] and twin.hidden.tobytes() == got[3].tobytes()
 
 
@@ -5171,7 +5171,9 @@ def test_the_boxed_own_edge_known_answers():
     """A disc whose depth runs 3 px past its mask onto background: the ring (hidden without the band) cleared, every
     pixel of it, and own_edge_boxed returns their count; with the ring 2 cm in front of the fruit (a leaf), it stays;
     with a leaf at the fruit's depth running on past the band to the right, the ring stays on its middle row and is
-    cleared on the other side."""
+    cleared on the other side (stop 40's rule, ``supports`` off); with ``supports`` (stop 56) too: the leaf lies at
+    the fruit's front (this flat fruit's every depth), where a fruit may continue behind it to its whole radius, past
+    the band."""
     h, w = 60, 80
     rr, cc = np.mgrid[0:h, 0:w]
     dist = np.hypot(rr - 30, cc - 40)
@@ -5182,15 +5184,15 @@ def test_the_boxed_own_edge_known_answers():
     steps, none = _steps_within(3), np.zeros((0, 0), bool)
     ring = (dist > 10) & (dist <= 13)
 
-    def both(depth):
-        bare = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 0)
-        return bare, _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 8)
+    def both(depth, supports=False):
+        bare = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 0, supports, 300.0)
+        return bare, _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 8, supports, 300.0)
 
     bare, (found, u0, v0, hidden, seen) = both(np.where(dist <= 13, 0.4, 1.0))
     assert found and int(bare[3].sum()) == int(ring.sum()) and not hidden.any()
     again = bare[3].copy()
     box_z = np.where(mask[20:41, 30:51], 0.4, np.inf)
-    count = _jit.own_edge_boxed(again, mask, v0, u0, box_z, 20 - v0, 30 - u0, seen, none, 0.005, 8)
+    count = _jit.own_edge_boxed(again, mask, v0, u0, box_z, 20 - v0, 30 - u0, seen, none, 0.005, 8, False, 300.0)
     assert count == int(ring.sum()) and not again.any()
     bare, front = both(np.where(dist <= 10, 0.4, np.where(dist <= 13, 0.38, 1.0)))
     assert int(bare[3].sum()) == int(ring.sum()) and np.array_equal(front[3], bare[3])
@@ -5199,6 +5201,10 @@ def test_the_boxed_own_edge_known_answers():
     kept = np.zeros((h, w), bool)
     kept[cut[2] : cut[2] + cut[3].shape[0], cut[1] : cut[1] + cut[3].shape[1]] = cut[3]
     assert kept[30, 51:54].all() and not kept[ring & (cc < 40)].any()  # the leaf's middle row beside the fruit
+    bare, cut = both(np.where((dist <= 13) | leaf, 0.4, 1.0), supports=True)
+    kept[:] = False
+    kept[cut[2] : cut[2] + cut[3].shape[0], cut[1] : cut[1] + cut[3].shape[1]] = cut[3]
+    assert kept[30, 51:54].all() and not kept[ring & (cc < 40)].any()
 
 
 def test_the_label_boxes_known_answer():

@@ -175,7 +175,9 @@ def test_filling_pixels_without_depth_is_skipped_only_when_there_are_none():
     depth, disc, points = _disc_frame(background=0.302)  # background at the fruit's depth: hidden
     holes = depth.copy()
     holes[14:17, 9:11] = 0.0  # beside the disc (its left edge is at u = 14), no depth: takes a neighbour's
-    full, holed = occlusion(depth, disc, points, CAM), occlusion(holes, disc, points, CAM)
+    # (without the support rule: a background at the fruit's depth running on from its outline is one, stop 56)
+    full = occlusion(depth, disc, points, CAM, supports=False)
+    holed = occlusion(holes, disc, points, CAM, supports=False)
     assert full.hidden[14 - full.v0 : 17 - full.v0, 9 - full.u0 : 11 - full.u0].all()
     assert np.array_equal(full.hidden, holed.hidden)
     assert np.isfinite(holed.depth[14 - holed.v0, 9 - holed.u0])
@@ -311,18 +313,51 @@ def test_a_fattened_edge_is_the_fruits_own_and_a_leaf_in_front_is_not(kernels, m
     assert full[leaf].all() and not full[ring & ~leaf].any()
 
 
-def test_a_support_at_the_fruits_depth_wider_than_the_band_and_another_fruit_stay_hidden():
-    depth, disc, points, r2 = _fattened()
-    cols = np.mgrid[:60, :80][1]
-    slab = ~disc & (cols < 40) & (np.abs(np.mgrid[:60, :80][0] - 30) <= 6)  # a support running left to the border
-    depth[slab] = 0.302
-    others = np.zeros((60, 80), bool)
-    other = ~disc & (r2 <= 18**2) & (cols > 50)  # another fruit's mask over part of the band
-    others[other] = True
-    full = hidden_image(occlusion(depth, disc, points, BIG, others=others))
-    assert full[slab & (cols < 24)].all()  # beside the disc's outline: within a completion's occluded_px 4
-    assert full[other].all()
-    assert not full[(r2 <= 18**2) & ~disc & ~slab & ~other & (np.abs(np.mgrid[:60, :80][0] - 30) > 16)].any()
+def _ball_on_a_box(face: float):
+    """An 80x60 depth image through :data:`BIG`: a ball of radius 15 px (15 mm) whose centre lies 0.3 m away, seen by a
+    time-of-flight camera (no depth on the outer 15 % of its radius; its mask the whole disc), standing on a box whose
+    front face (every row below the ball's centre, beside and below it, to the image's border) lies at ``face``;
+    the background at 1 m. ``(depth, disc, points, rows, cols)``; the ball's front is at 0.285 m."""
+    rows, cols = np.mgrid[:60, :80]
+    rho = np.hypot(cols - 40, rows - 30)  # pixels; a pixel is 1 mm at 0.3 m
+    disc = rho <= 15
+    depth = np.where((rows > 30) & ~disc, face, 1.0)
+    seen = rho <= 0.85 * 15
+    depth[seen] = 0.3 - np.sqrt(0.015**2 - (rho[seen] * 0.001) ** 2)
+    depth[disc & ~seen] = 0.0
+    r, c = np.nonzero(seen)
+    points = BIG.deproject(np.c_[c, r].astype(float), depth[r, c])
+    return depth, disc, points, rows, cols
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_support_at_the_fruits_depth_hides_no_more_than_a_round_fruit_can_reach_behind_it(kernels, monkeypatch):
+    """Stop 56: a ball standing on a box whose front face lies 0.45 of a radius behind the ball's front (the real
+    66 mm sphere's board: 0.44-0.5), meeting its outline at its own depth and running on to the image's border. Behind
+    that face a round fruit may continue 17 % of its radius past where the face meets it (:func:`support_reach`:
+    2.6 px here):
+    those pixels stay hidden, the rest of the band is cleared, and beyond the band the face is as it was.
+    Without the rule (``supports`` off, stop 40's) the whole face is hidden beside the outline. A face at the ball's
+    front (a leaf lying on it: it may hide the ball to its whole radius) and a face 3 cm in front of it (a step: an
+    occluder) stay hidden."""
+    from symfruit.core.occlusion import support_reach
+
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    depth, disc, points, rows, cols = _ball_on_a_box(0.2916)
+    # the ball's own pixels' box is 31 px a side (radius 15.5 px), its front 0.285 m: 0.448 of a radius behind it
+    assert support_reach(np.array([0.2916]), 0.285, 15.5, 15.5 * 0.285 / 300.0)[0] == pytest.approx(2.57, abs=0.01)
+    gap = ndimage.distance_transform_cdt(~disc, metric="chessboard")  # steps from the ball's pixels
+    face = (rows > 30) & ~disc
+    full = hidden_image(occlusion(depth, disc, points, BIG))
+    below = face & (np.abs(cols - 40) <= 3)  # straight below the ball, where the walk's steps are the distance
+    # cleared from 3 px on, as far as an own depth lies within the band (the points end 2-3 px inside the outline)
+    assert full[below & (gap <= 2)].all() and not full[below & (gap >= 3) & (gap <= 5)].any()
+    assert full[face & (gap > 10)].all()  # beyond the band: not joined to the ball any more, as it was
+    assert hidden_image(occlusion(depth, disc, points, BIG, supports=False))[face & (gap <= 8)].all()
+    for at in (0.285, 0.255):  # at the ball's front, and 3 cm in front of it
+        depth, disc, points, rows, cols = _ball_on_a_box(at)
+        assert hidden_image(occlusion(depth, disc, points, BIG))[face].all()
 
 
 @pytest.mark.parametrize("kernels", ["default", "numpy"])

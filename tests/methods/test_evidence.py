@@ -842,3 +842,38 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
     assert ellipse.extras["contour"] < 0.7  # a cut outline
     assert ellipse.extras["width"] == pytest.approx(0.07, abs=0.001)
     assert outline.extras["width"] < 0.063
+
+
+@pytest.mark.parametrize("z", [0.5, 1.0])
+def test_a_ball_behind_a_leaf_lying_on_its_face_is_completed_behind_the_leaf(z):
+    """Stop 56: a 70 mm ball whose lower part a flat leaf lying on its face hides (the leaf at 0.2 of a radius behind
+    the ball's front, where it meets the ball: no step between them), seen by a time-of-flight camera (no depth on
+    the outer 15 % of the radius). The leaf meets the fruit at its own depth and runs on, as a support does; but it
+    lies near the front, where a round fruit may continue behind it by 0.4 of its radius
+    (:func:`symfruit.core.occlusion.support_reach`), so the band beside the ball stays hidden within that reach and the
+    box reaches down behind the leaf: its bottom within 5 mm of the ball's. Clearing the whole band (the first form of
+    the support rule) cut it 13 mm short."""
+    from scipy import ndimage
+
+    from symfruit import Box
+    from symfruit.core.occlusion import occlusion
+    from symfruit.synthetic.render import render
+
+    cam, r = DEFAULT_CAMERA, 0.035
+    ball = ball_mesh(r).transformed(np.eye(3), np.array([0.0, 0.0, z]))
+    zl = z - r + 0.2 * r
+    yv = 0.3 * r / zl  # the leaf's top edge, 0.3 r below the ball's centre
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    leaf = np.array([[-2.0, yv * zl, zl], [2.0, yv * zl, zl], [2.0, 2.0, zl], [-2.0, 2.0, zl]])
+    back = np.array([[-9.0, -9.0, 3.0], [9.0, -9.0, 3.0], [9.0, 9.0, 3.0], [-9.0, 9.0, 3.0]])
+    shot = render([(ball.vertices, ball.faces), (leaf, faces), (back, faces)], cam)
+    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    mask = shot.ids == 0
+    yy, xx = np.mgrid[: depth.shape[0], : depth.shape[1]]
+    u, v = cam.project(np.array([[0.0, 0.0, z]]))[0]
+    depth[mask & (np.hypot(yy - v, xx - u) > 0.85 * r * cam.fx / z)] = 0.0
+    rows, cols = np.nonzero(ndimage.binary_erosion(mask & (depth > 0), np.ones((3, 3), bool)))
+    points = cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    truth = Box(ball.vertices.min(axis=0), ball.vertices.max(axis=0))
+    result = complete(points, camera=cam, occlusion=occlusion(depth, mask, points, cam))
+    assert result.box.max[1] > truth.max[1] - 0.005  # the seen part ends 14 mm (0.4 r) above the ball's bottom

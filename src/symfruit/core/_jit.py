@@ -3866,11 +3866,33 @@ def _row_min(x: np.ndarray, k: int, out: np.ndarray) -> None:
 
 
 @_njit_inlined
+def _support_scale(z: np.ndarray, r0: int, r1: int, c0: int, c1: int, focal: float) -> tuple[float, float, float]:
+    """``(front, r_px, r_m)`` of :func:`_support_reach`: the least of the own depths ``z`` (+inf where none), half the
+    mean side of the own pixels' box ``r0:r1, c0:c1`` (pixels) and that in metres at the front (0 without ``focal``)."""
+    front = np.inf
+    for i in range(z.shape[0]):
+        for j in range(z.shape[1]):
+            front = min(front, z[i, j])
+    r_px = 0.25 * ((r1 - r0) + (c1 - c0))
+    return front, r_px, r_px * front / focal if focal > 0.0 else 0.0
+
+
+@_njit_inlined
+def _support_reach(d: float, front: float, r_px: float, r_m: float) -> float:
+    """Pixels: how far past its outline a round fruit (front ``front``, radius ``r_px`` pixels, ``r_m`` metres) may
+    still continue behind a surface meeting it at seen depth ``d`` (:func:`symfruit.core.occlusion.support_reach`,
+    the same arithmetic)."""
+    k = min(max((d - front) / r_m, 0.0), 1.0)
+    return r_px * (1.0 - math.sqrt(k * (2.0 - k)))
+
+
+@_njit_inlined
 def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden: np.ndarray, b0: int,
-               a0: int) -> int:  # fmt: skip
+               a0: int, reach: np.ndarray) -> int:  # fmt: skip
     """The band of :func:`own_edge` and :func:`own_edge_boxed` runs on from the fruit's own pixels ``mine`` (m, n):
     a breadth-first walk through the ``count`` candidates ``cand`` (m, n) beside them, ``band`` steps deep; the
-    pixels reached are cleared in ``hidden`` at ``(b0, a0)`` and their number returned."""
+    pixels reached in more steps than their ``reach`` (m, n) are cleared in ``hidden`` at ``(b0, a0)`` and their
+    number returned."""
     m, n = cand.shape
     queue = np.empty(count, np.int64)
     reached = np.zeros((m, n), np.bool_)
@@ -3887,8 +3909,14 @@ def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden
                                 reached[r, c] = True
                                 queue[end] = r * n + c
                                 end += 1
+    cleared = 0
+    for i in range(end):  # the first step
+        r, c = queue[i] // n, queue[i] % n
+        if reach[r, c] < 1.0:
+            hidden[b0 + r, a0 + c] = False
+            cleared += 1
     start = 0
-    for _ in range(1, band):
+    for step in range(2, band + 1):
         stop = end
         for i in range(start, stop):
             r, c = queue[i] // n, queue[i] % n
@@ -3901,13 +3929,13 @@ def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden
                             reached[rr, cc] = True
                             queue[end] = rr * n + cc
                             end += 1
+                            if reach[rr, cc] < step:
+                                hidden[b0 + rr, a0 + cc] = False
+                                cleared += 1
         start = stop
         if start == end:
             break
-    for i in range(end):
-        r, c = queue[i] // n, queue[i] % n
-        hidden[b0 + r, a0 + c] = False
-    return end
+    return cleared
 
 
 @_njit
@@ -3919,6 +3947,8 @@ def own_edge(
     others: np.ndarray,
     tolerance: float,
     band: int,
+    supports: bool,
+    focal: float,
 ) -> int:  # fmt: skip
     """:func:`symfruit.core.occlusion.own_edge` in one pass, ``hidden`` (h, w) bool cleared in place (the number of
     pixels cleared returned): ``own`` (h, w) bool, ``own_z`` and ``depth`` (h, w) float, ``others`` (h, w) bool or
@@ -3960,7 +3990,8 @@ def own_edge(
             any_cand |= x
     if not any_cand:
         return 0
-    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
+    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band; with
+    # ``supports`` a band that runs on (a support) is cleared too, past the reach the fruit may continue behind it
     free = np.empty((m, n), np.bool_)
     past = np.empty((m, n), np.bool_)
     for r in range(m):
@@ -3971,12 +4002,17 @@ def own_edge(
     _square_extreme(free, band + 1, False, ends)
     runs = np.empty((m, n), np.bool_)
     _square_extreme(past, band, False, runs)
+    front, r_px, r_m = _support_scale(own_z, r0, r1, c0, c1, focal)
+    reach = np.zeros((m, n))
     any_cand = False
     for r in range(m):
         for c in range(n):
-            x = cand[r, c] and ends[r, c] and not runs[r, c]
-            cand[r, c] = x
-            any_cand |= x
+            if cand[r, c] and not (ends[r, c] and not runs[r, c]):
+                if supports and r_m > 0.0 and r_m < np.inf:
+                    reach[r, c] = _support_reach(np.float64(depth[b0 + r, a0 + c]), front, r_px, r_m)
+                elif not supports:
+                    cand[r, c] = False
+            any_cand |= cand[r, c]
     if not any_cand:
         return 0
     # not clearly nearer than the own depths within the band's square
@@ -3998,7 +4034,7 @@ def own_edge(
                 count += x
     if count == 0:
         return 0
-    return _band_walk(cand, mine, count, band, hidden, b0, a0)
+    return _band_walk(cand, mine, count, band, hidden, b0, a0, reach)
 
 
 @_njit
@@ -7570,6 +7606,8 @@ def own_edge_boxed(
     others: np.ndarray,
     tolerance: float,
     band: int,
+    supports: bool,
+    focal: float,
 ) -> int:  # fmt: skip
     """:func:`own_edge` on :func:`occlusion_edge_boxed`'s maps, without the window's own depths and own pixels as (h, w)
     maps (issue 19, stop 45): ``hidden`` (h, w) bool cleared in place (the number of pixels cleared returned), the
@@ -7651,13 +7689,19 @@ def own_edge_boxed(
             for j in range(nb):
                 padded[i, band + j] = box_z[i, j]
         _row_min(padded, band, rowmin)
+    front, r_px, r_m = _support_scale(box_z, r0, r1, c0, c1, focal)
+    reach = np.zeros((m, n))
     count = 0
     for r in range(m):
         for c in range(n):
             if not cand[r, c]:
                 continue
-            # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it
-            x = _box_any(t_free, r, c, band + 1, m, n) and not _box_any(t_past, r, c, band, m, n)
+            # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it; with
+            # ``supports`` a band that runs on (a support) is cleared too, past the reach the fruit may continue behind
+            ends = _box_any(t_free, r, c, band + 1, m, n) and not _box_any(t_past, r, c, band, m, n)
+            x = supports or ends
+            if not ends and supports and r_m > 0.0 and r_m < np.inf:
+                reach[r, c] = _support_reach(np.float64(seen[b0 + r, a0 + c]), front, r_px, r_m)
             if x:  # not clearly nearer than the own depths within the band's square
                 z = np.inf
                 j = c - qb + band  # this column's place in the padded rows (column qb - band is their first)
@@ -7669,7 +7713,7 @@ def own_edge_boxed(
             count += x
     if count == 0:
         return 0
-    return _band_walk(cand, mine, count, band, hidden, b0, a0)
+    return _band_walk(cand, mine, count, band, hidden, b0, a0, reach)
 
 
 @_njit
@@ -7683,6 +7727,8 @@ def occlusion_edge_boxed(
     tolerance: float,
     steps: np.ndarray,
     band: int,
+    supports: bool,
+    focal: float,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`occlusion_at`, then :func:`own_edge_boxed` on the maps, in one call: ``(found, u0, v0, hidden, seen)``,
     :func:`symfruit.core.occlusion.occlusion`'s maps bit for bit (issue 19, stop 41: one kernel instead of three calls;
@@ -7701,7 +7747,7 @@ def occlusion_edge_boxed(
         if some:
             break
     if some:
-        own_edge_boxed(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band)
+        own_edge_boxed(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band, supports, focal)
     return found, u0, v0, hidden, seen
 
 

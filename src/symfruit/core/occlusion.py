@@ -26,7 +26,7 @@ from .limits import MAX_IMAGE_SIDE, check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
-__all__ = ["Occlusion", "occlusion", "overshoot", "own_edge", "with_own"]
+__all__ = ["Occlusion", "occlusion", "overshoot", "own_edge", "support_reach", "with_own"]
 
 
 @dataclass(frozen=True)
@@ -323,6 +323,7 @@ def occlusion(
     band: int = 8,
     trim_own: bool = True,
     eroded: int = 1,
+    supports: bool = True,
 ) -> Occlusion:
     """The pixels around one fruit where the camera could not have seen it.
 
@@ -335,7 +336,8 @@ def occlusion(
     hide it. A pixel without depth (sensor dropout, common beside edges) takes the depth of the nearest
     pixel with depth within ``reach`` pixels that is not the fruit's; with none, it is not hidden. Last, a thin
     band at the fruit's own depth beside its mask that ends in something not hiding it is the fruit's own edge
-    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40).
+    spread by the sensor (an active-stereo camera's fattening), not hidden (:func:`own_edge`, ``band``; stop 40), and
+    with ``supports`` so is the band beside it of a surface at its own depth that runs on (a support; stop 56).
 
     Where numba is installed the maps are made in one compiled pass over the window
     (:func:`symfruit.core._jit.occlusion_maps`, after :func:`~symfruit.core.raster.nearest_index`: the same
@@ -375,6 +377,11 @@ def occlusion(
     eroded : int, pixels
         The mask's border its points were never taken from (extraction's ``erode_px``), handed to
         :func:`overshoot`.
+    supports : bool
+        A surface that runs on from the fruit's outline at the fruit's own depth (a support: the board or branch it
+        rests on) is not hidden within ``band`` of the fruit beyond the reach a round fruit may still continue behind
+        it, whether or not the band ends (:func:`own_edge`'s ``supports``, :func:`support_reach`; stop 56); off: only
+        a band that ends is cleared (stop 40's rule).
     checked : bool
         ``depth`` has been through :func:`~symfruit.core.limits.depth_metres` already (a
         :class:`~symfruit.core.frame.Frame`'s has): its units are not sampled again. The sample reads one
@@ -419,7 +426,8 @@ def occlusion(
         # maps, its square filters read from summed-area tables (jit.occlusion_edge_boxed: the same maps; the
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
         found, u0, v0, hidden, seen = jit.occlusion_edge_boxed(uv, points, pad, image, mask, near_to, tolerance,
-                                                               _steps(reach), max(int(band), 0))  # fmt: skip
+                                                               _steps(reach), max(int(band), 0),
+                                                               bool(supports), focal)  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
@@ -470,7 +478,8 @@ def occlusion(
     hidden = near & ~own
     if others is not None:
         hidden |= np.asarray(others[v0:v1, u0:u1], dtype=bool) & ~behind & ~own
-    hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band)
+    hidden = own_edge(hidden, own, own_z, d, others[v0:v1, u0:u1] if others is not None else None, tolerance, band,
+                      bool(supports), focal)  # fmt: skip
     own_w = mask[v0:v1, u0:u1].copy()
     over = (
         overshoot(own_w, depth[v0:v1, u0:u1], uv, points, u0, v0, tolerance, max(int(band), 1), int(eroded), focal)
@@ -808,8 +817,11 @@ def own_edge(
     others: np.ndarray | None,
     tolerance: float,
     band: int,
+    supports: bool = False,
+    focal: float = 0.0,
 ) -> np.ndarray:
-    """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening).
+    """``hidden`` without the fruit's own edge spread beyond its mask by the sensor (active stereo's fattening) and,
+    with ``supports``, without the band beside the fruit of a surface that meets it at its own depth (a support).
 
     An active-stereo camera gives the pixels a few beyond a foreground's silhouette the foreground's depth (the
     least depth its correlation window holds: ``synthetic.sensors``' ``fatten_px``), so beside a fruit with nothing
@@ -822,7 +834,13 @@ def own_edge(
     - it is not another fruit's (``others``);
     - something not hiding the fruit (background clearly behind it, or no depth) lies within ``band + 1`` pixels of
       it, and no hidden pixel farther than ``band`` from the fruit lies within ``band`` of it: the band ends there
-      (a leaf or a support at the fruit's depth wider than the band does not);
+      (a leaf or a support at the fruit's depth wider than the band does not). With ``supports`` (and ``focal``,
+      the camera's focal length in pixels) this is not asked of the pixels reached in more steps from the fruit than
+      :func:`support_reach` of their depth: a surface that runs on from the fruit's outline at the fruit's own depth
+      (a board or a branch it rests on, the face of the box it stands on) hides only the part of the fruit deeper
+      than itself, and a round fruit ends within that reach of where the surface meets it (stop 56,
+      docs/support56.md). An occluder lies in front of the fruit's edge by a step (the next condition), and a leaf
+      lying on the fruit's face meets it near its front, where the reach is its whole radius: both stay hidden;
     - it joins the fruit's own pixels through such pixels (not past a gap);
     - its depth is not clearly nearer (by ``tolerance``) than the nearest of the fruit's own depths (``own_z``,
       +inf where none) within ``2 band`` pixels: a spread depth is the least of the foreground's nearby, never in
@@ -836,6 +854,7 @@ def own_edge(
     """
     if band <= 0 or not hidden.any():
         return hidden
+    supports = bool(supports)
     shape = np.shape(hidden)
     same = np.shape(own) == np.shape(own_z) == np.shape(depth) == shape
     same = same and (others is None or np.shape(others) == shape)
@@ -844,7 +863,7 @@ def own_edge(
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
         z = np.asarray(own_z, dtype=np.float64)
         found = jit.own_edge(out, np.asarray(own, dtype=bool), z, np.asarray(depth, dtype=np.float64), near_to,
-                             float(tolerance), int(band))  # fmt: skip
+                             float(tolerance), int(band), supports, float(focal))  # fmt: skip
         return out if found else hidden
     box = mask_box(own)
     if box is None:
@@ -859,22 +878,58 @@ def own_edge(
         cand &= ~np.asarray(others[b0:b1, a0:a1], dtype=bool)
     if not cand.any():
         return hidden
-    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past the band
-    cand &= square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
-    if not cand.any():
-        return hidden
+    # the band ends: something not hiding the fruit lies just beyond, and nothing hidden runs on past it; with
+    # ``supports`` a band that runs on is cleared too, past the reach the fruit may continue behind it
+    ends = square_filter(~hid & ~mine, band + 1) & ~square_filter(hid & ~near, band)
+    if not supports:
+        cand &= ends
+        if not cand.any():
+            return hidden
     zmin = ndimage.minimum_filter(own_z[b0:b1, a0:a1], size=2 * band + 1, mode="constant", cval=np.inf)
+    d = np.asarray(depth[b0:b1, a0:a1], dtype=np.float64)
     with np.errstate(invalid="ignore"):
-        cand &= np.asarray(depth[b0:b1, a0:a1], dtype=np.float64) >= zmin - tolerance  # NaN: not the fruit's
+        cand &= d >= zmin - tolerance  # NaN: not the fruit's
     if not cand.any():
         return hidden
-    # the band runs on from the fruit's own pixels: what lies at the fruit's depth past a gap is something else
-    cand = ndimage.binary_dilation(mine, structure=np.ones((3, 3), bool), iterations=band, mask=cand | mine) & cand
-    if not cand.any():
+    # the band runs on from the fruit's own pixels: what lies at the fruit's depth past a gap is something else (the
+    # step each pixel is reached at: a support's pixel is cleared past its reach alone)
+    step = np.zeros(cand.shape, np.intp)
+    reached = np.zeros(cand.shape, bool)
+    edge = mine
+    for i in range(1, band + 1):
+        edge = ndimage.binary_dilation(edge, structure=np.ones((3, 3), bool)) & cand & ~reached
+        if not edge.any():
+            break
+        step[edge] = i
+        reached |= edge
+    reach = np.zeros(cand.shape)
+    front = float(np.min(own_z))
+    r_px = 0.25 * ((box[1] - box[0]) + (box[3] - box[2]))
+    r_m = r_px * front / focal if focal > 0.0 else 0.0
+    lone = reached & ~ends
+    if supports and 0.0 < r_m < np.inf and lone.any():
+        reach[lone] = support_reach(d[lone], front, r_px, r_m)
+    clear = reached & (reach < step)
+    if not clear.any():
         return hidden
     out = hidden.copy()
-    out[b0:b1, a0:a1] &= ~cand
+    out[b0:b1, a0:a1] &= ~clear
     return out
+
+
+def support_reach(depth: np.ndarray, front: float, r_px: float, r_m: float) -> np.ndarray:
+    """Pixels: how far past its outline a round fruit may still continue behind a surface that meets it at seen depth
+    ``depth`` (metres), the fruit's front at ``front`` and its radius ``r_px`` pixels, ``r_m`` metres.
+
+    What lies behind a surface at depth ``d`` is the fruit's part deeper than ``d``: of a sphere, the ring outside the
+    circle where its depth is ``d``, ``k = (d - front) / r`` of the radius behind its front, radius
+    ``r sqrt(1 - (1 - k)^2)``. So the fruit's outline may lie at most ``r (1 - sqrt(k (2 - k)))`` past where the
+    surface meets it: a surface at the fruit's front (``k = 0``, a leaf lying on its face) may hide it to its full
+    radius, one at the depth of its outline (``k = 1``) hides nothing. (The real 66 mm sphere standing on a box, the
+    box's face meeting it 0.44-0.5 of a radius behind its front: 13-17 % of the radius, 4-5 mm; docs/support56.md.)
+    ``k`` is clipped to [0, 1]."""
+    k = np.minimum(np.maximum((depth - front) / r_m, 0.0), 1.0)
+    return r_px * (1.0 - np.sqrt(k * (2.0 - k)))
 
 
 def _fill(d: np.ndarray, valid: np.ndarray, own: np.ndarray, reach: int) -> np.ndarray:
