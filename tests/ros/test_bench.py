@@ -93,3 +93,16 @@ def test_the_nodes_fruit_processes_are_bounded_before_anything_starts(capsys):
             main(["--fruit-processes", bad])
         assert stop.value.code == 2
         assert f"--fruit-processes must be 0-16, got {bad}" in capsys.readouterr().err
+
+
+def test_number_options_take_ascii_digits_alone(capsys):
+    """Stop 56: ``int()`` and ``float()`` also read another script's digits and ``1_0``; the benchmark's options
+    refuse them by name, as every symfruit number option does (``symfruit.cli._whole``, ``_real``)."""
+    from symfruit.ros.bench import main
+
+    for args in (["--frames", "٣"], ["--frames", "1_0"], ["--rate", "３0"], ["--fruit-processes", "١"]):
+        with pytest.raises(SystemExit) as stop:
+            main(args)
+        assert stop.value.code == 2
+        err = capsys.readouterr().err
+        assert "ASCII digits" in err and args[0] in err, (args, err)

@@ -85,3 +85,24 @@ def test_replies_are_json_lines(tmp_path):
     reply = client.call("nonsense")
     assert reply == {"ok": False, "error": "unknown op 'nonsense'"} and json.dumps(reply)
     client.close()
+
+
+@pytest.mark.parametrize(
+    ("args", "said"),
+    [
+        (["--count", "-1"], "--count must be 0 (until Ctrl-C) or more frames, got -1"),
+        (["--count", "٣"], "ASCII digits"),
+        (["--rate", "٥"], "ASCII digits"),
+        (["--rate", "0"], "--rate must be a positive number"),
+    ],
+)
+def test_play_refuses_bad_counts_and_rates_before_anything_starts(args, said, capsys, monkeypatch):
+    """Stop 56: a negative ``--count`` was taken (``play`` publishes until its count is reached), and ``int()`` /
+    ``float()`` read another script's digits; both are refused by name before ROS is touched."""
+    import symfruit.ros.camera2 as camera2
+
+    monkeypatch.setattr(camera2, "play", lambda *a, **k: pytest.fail("play started"))
+    with pytest.raises(SystemExit) as stop:
+        camera2.main(["play", *args])
+    assert stop.value.code == 2
+    assert said in capsys.readouterr().err

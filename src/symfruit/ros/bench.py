@@ -257,12 +257,14 @@ def _print(res: dict, title: str = "symfruit ROS node benchmark") -> None:
 def run_main(argv: list[str] | None, prog: str, description: str, bench: Any, title: str) -> int:
     """The command line of both node benchmarks (``bench``: :func:`bench_node` or ``bench_node2``): parse and bound
     the options before anything starts, run, print under ``title``, write ``--json`` atomically."""
+    from ..cli import _real, _whole  # ASCII digits alone, as every symfruit number option (stop 56)
+
     parser = argparse.ArgumentParser(prog=prog, description=description)
-    parser.add_argument("--frames", type=int, default=30)
-    parser.add_argument("--rate", type=float, default=30.0, help="open-loop publishing rate, Hz (default 30)")
+    parser.add_argument("--frames", type=_whole, default=30)
+    parser.add_argument("--rate", type=_real, default=30.0, help="open-loop publishing rate, Hz (default 30)")
     parser.add_argument("--method", default=DEFAULT_METHOD)
     parser.add_argument("--json", type=Path, help="also write the figures to this JSON file")
-    parser.add_argument("--fruit-processes", type=int, default=None, metavar="N",
+    parser.add_argument("--fruit-processes", type=_whole, default=None, metavar="N",
                         help="the node's fruit_processes parameter, 0-16 (default: the node's own, 1)")  # fmt: skip
     args = parser.parse_args(argv)
     if not 1 <= args.frames <= 100_000 or not 0 < args.rate <= 1000:

@@ -524,13 +524,17 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--node", default=NODE_NAME, help="name of the node whose outputs to listen to")
     p = sub.add_parser("play", help="publish a frame folder (default: the example frame) as a RealSense camera")
     p.add_argument("frame", type=Path, nargs="?")
-    p.add_argument("--rate", type=float, default=5.0, help="frames per second (default 5)")
-    p.add_argument("--count", type=int, default=0, help="frames to publish (default 0: until Ctrl-C)")
+    from ..cli import _real, _whole  # ASCII digits alone, as every symfruit number option (stop 56)
+
+    p.add_argument("--rate", type=_real, default=5.0, help="frames per second (default 5)")
+    p.add_argument("--count", type=_whole, default=0, help="frames to publish (default 0: until Ctrl-C)")
     args = parser.parse_args(argv)
     if args.command == "serve":
         return serve(args.node, ros_args)
     if not (args.rate > 0 and math.isfinite(args.rate)):
         parser.error("--rate must be a positive number of frames per second")
+    if args.count < 0:
+        parser.error(f"--count must be 0 (until Ctrl-C) or more frames, got {args.count}")
     return play(args.frame, args.rate, args.count, ros_args)
 
 
