@@ -339,8 +339,7 @@ def extract(mask: np.ndarray, depth: np.ndarray, camera: Camera, settings: Extra
             # parts of the fruit a nearer surface crossing it parted from the nearest (a twig, a leaf's midrib or
             # strip across it: issue 18, stop 56)
             rows, cols = np.nonzero(usable & surface.pixels)
-            tol = max(s.convex_tolerance * surface.noise, 0.003)
-            focal = float(np.sqrt(camera.fx * camera.fy))
+            tol = max(s.convex_tolerance * surface.noise, 0.003)  # ``focal``: the surface's, above
             keep_cluster = across_occluder(z_all, rows, cols, labels, int(near), tol, focal, surface.radius,
                                             s.erode_px + s.colour_trim_px + 2)[labels]  # fmt: skip
         dropped += int((~keep_cluster).sum())
