@@ -157,6 +157,25 @@ def test_resume_runs_again_a_frame_whose_record_is_another_frames(tmp_path):
     assert pq.read_table(out / "frames.parquet").column("frame").to_pylist() == ["f1", "f2"]
 
 
+def test_resume_runs_again_a_frame_whose_files_are_gone_or_empty(tmp_path):
+    """Stop 57: a frame whose record was whole was skipped even when its overlay or a fruit's cloud had been
+    deleted or emptied afterwards; the resumed run then listed it as done without those files."""
+    frames = recording(tmp_path / "rec", "f1", "f2", "f3")
+    out = tmp_path / "out"
+    run_batch(frames, out, method="raw", progress=False)
+    before = _fruits(out)
+    plys = sorted((out / "f2").glob("fruit_*.ply"))
+    assert plys  # the frames have located fruit, so the test reads a cloud
+    plys[0].unlink()
+    (out / "f3" / "overlay.png").write_bytes(b"")
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == ["f1"] and again.done == ["f2", "f3"] and again.ok
+    assert plys[0].stat().st_size > 0 and (out / "f3" / "overlay.png").stat().st_size > 0
+    assert _fruits(out) == before
+    again = run_batch(frames, out, method="raw", resume=True, progress=False)
+    assert again.skipped == ["f1", "f2", "f3"] and again.ok
+
+
 def test_frame_folder_names_stay_in_their_folder_and_never_collide():
     assert frame_folder_name("f1") == "f1"
     assert frame_folder_name("../../etc/passwd").startswith("etc_passwd+")

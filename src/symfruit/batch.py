@@ -402,16 +402,31 @@ def frame_done(folder: Path, name: str | None = None) -> bool:
     """Whether a frame's output ``folder`` holds a whole ``detections.json`` record (``--resume`` skips it): one
     that cannot be read back into the tables (truncated by a copy, a crash outside symfruit's atomic writes,
     another tool), or (``name`` given) the record of another frame (a folder copied over), means the frame is run
-    again, not skipped and then left out of the tables or listed under the other frame's name."""
+    again, not skipped and then left out of the tables or listed under the other frame's name. So does a record
+    whose files are gone or empty (``overlay.png``, a located fruit's ``fruit_NNN.ply``: deleted or truncated by
+    another program after the run; symfruit writes each atomically before the record), so a resumed run leaves
+    every frame it counts as done with all its files."""
     from .season.table import read_frame_rows
 
     if not (folder / "detections.json").is_file():
         return False
     try:
-        row, _ = read_frame_rows(folder / "detections.json", "")
+        row, fruits = read_frame_rows(folder / "detections.json", "")
     except SymfruitError:
         return False
-    return name is None or row["frame"] == name
+    if name is not None and row["frame"] != name:
+        return False
+    files = ["overlay.png"] + [
+        f"fruit_{f['id']:03d}.ply" for f in fruits if f["error"] is None and f["centre_x"] is not None
+    ]
+    return all(_nonempty_file(folder / n) for n in files)
+
+
+def _nonempty_file(path: Path) -> bool:
+    try:
+        return path.is_file() and path.stat().st_size > 0
+    except OSError:  # a name too long, a folder without search permission: not there for the run
+        return False
 
 
 @dataclass(frozen=True)
