@@ -35,6 +35,7 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import evid40
+import pear43
 
 import symfruit.methods.evidence as ev
 from symfruit.core.box import Box
@@ -69,30 +70,23 @@ def endon(out: str, fruits: list[str], n: int, tilt: float, seed: int, others: l
     settings = Settings()
     views: list[View] = []
     for kind in fruits:
-        for i in range(n):
-            fruit = proto._fruit(proto.Spec("paper", kind, i, 0, 0.0, seed))
-            rng = np.random.default_rng([seed, 1000 + proto._KIND_IDS.get(kind, 99), i])  # as the paper protocol
-            points = fruit.sample(600, rng) @ proto.rotation_x(tilt).T
-            for pose, angle in enumerate(proto.PAPER_ANGLES):
-                posed = points @ proto.rotation_x(float(angle)).T
-                posed = posed - Box.from_points(posed).centre + [0.0, 0.0, proto.PAPER_DISTANCE]
-                seen = posed[proto.paper_visible(posed)]
-                truth = Box.from_points(posed)
-                caught.clear()
-                result = complete(seen, camera=proto.DEFAULT_CAMERA, method="evidence", settings=settings)
-                v = evid40._view(caught, result, score_completion(result.box, result.points, truth, posed), truth,
-                                 posed, seen)  # fmt: skip
-                spec = proto.Spec("paper", kind, i, pose, 0.0, seed)
-                v.update(kind=kind, fruit_id=f"{kind}#{i}", pose=pose, spec=spec, hidden=float("nan"),
-                         distance=proto.PAPER_DISTANCE, seen=seen, other={})  # fmt: skip
-                for m in others:
-                    try:
-                        r = complete(seen, camera=proto.DEFAULT_CAMERA, method=m, settings=settings)
-                        s = score_completion(r.box, r.points, truth, posed)
-                        v["other"][m] = (s.iou, s.centre_mm)
-                    except ValueError:  # a fit that fails (the sphere of a banana's cap)
-                        v["other"][m] = (0.0, float("nan"))
-                views.append(v)
+        # docs/pear43.py's end-on views: evid40.py endon's (the same points, poses and visible halves)
+        for number, (_, seen, posed, truth) in enumerate(pear43.endon_views(kind, tilt, n, seed)):
+            i, pose = divmod(number, len(proto.PAPER_ANGLES))
+            caught.clear()
+            result = complete(seen, camera=proto.DEFAULT_CAMERA, method="evidence", settings=settings)
+            v = evid40._view(caught, result, score_completion(result.box, result.points, truth, posed), truth, posed,
+                             seen)  # fmt: skip
+            v.update(kind=kind, fruit_id=f"{kind}#{i}", pose=pose, spec=proto.Spec("paper", kind, i, pose, 0.0, seed),
+                     hidden=float("nan"), distance=proto.PAPER_DISTANCE, seen=seen, other={})  # fmt: skip
+            for m in others:
+                try:
+                    r = complete(seen, camera=proto.DEFAULT_CAMERA, method=m, settings=settings)
+                    s = score_completion(r.box, r.points, truth, posed)
+                    v["other"][m] = (s.iou, s.centre_mm)
+                except ValueError:  # a fit that fails (the sphere of a banana's cap)
+                    v["other"][m] = (0.0, float("nan"))
+            views.append(v)
         say(f"{kind} tilt {tilt:+g}: " + _row([v for v in views if v["kind"] == kind], others))
     with open(out, "wb") as f:
         pickle.dump(views, f)
