@@ -896,6 +896,7 @@ def test_an_exact_spheroid_stood_up_is_completed_to_its_length():
     rng = np.random.default_rng(3)
     u = rng.normal(size=(600, 3))
     points = u / np.linalg.norm(u, axis=1)[:, None] * [0.033, 0.033, 0.050]
+    assert 0.0 in PAPER_ANGLES  # the end-on pose is one of them
     for angle in PAPER_ANGLES:
         posed = points @ rotation_x(float(angle)).T
         posed += [0.0, 0.0, PAPER_DISTANCE] - 0.5 * (posed.min(axis=0) + posed.max(axis=0))
