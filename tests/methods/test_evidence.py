@@ -844,6 +844,46 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
     assert outline.extras["width"] < 0.063
 
 
+@pytest.mark.parametrize("hidden", [0.3, 0.5])
+def test_a_cut_outlines_free_sides_give_the_prior_the_balls_diameter(hidden):
+    """Stop 57 (docs/cutprior57.md): a leaf 10 cm in front hides a 70 mm ball 0.3 or 0.5 of its radius below its
+    middle. With ``cut_prior: sides`` the cut (lower) side reaches the ellipse through the free arcs and the free
+    sides stay as seen: the depth prior's width is the diameter, where the cut region's geometric mean reads under
+    63 mm (the default)."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    cam = DEFAULT_CAMERA
+    below = cam.cy + hidden * cam.fy * 0.035 / 0.465  # the ball's silhouette radius in pixels: 46 px
+    visible, depth, mask, _ = occluded_view(ball_mesh(0.035), [0.0, 0.0, 0.5], below=below, occluder_z=0.4)
+    occ = occlusion(depth, mask, visible, cam)
+    sides = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "sides"}})
+    outline = complete(visible, occlusion=occ)
+    assert sides.extras["contour"] < 0.8  # a cut outline
+    assert sides.extras["width"] == pytest.approx(0.07, abs=0.0015)
+    assert outline.extras["width"] < 0.063
+
+
+def test_a_cut_outline_hiding_the_balls_middle_keeps_the_cut_regions_prior_width():
+    """Stop 57: a leaf 10 cm in front hides a 70 mm ball from 0.2 of its radius above its middle down: the ellipse
+    through the free arcs is wider than the cut region (``cut_prior: ellipse`` reads it), but its centre, the ball's
+    nearest point, is hidden, so ``sides`` keeps the cut region's width (the seen front lies behind the ball's)."""
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    cam = DEFAULT_CAMERA
+    below = cam.cy - 0.2 * cam.fy * 0.035 / 0.465
+    visible, depth, mask, _ = occluded_view(ball_mesh(0.035), [0.0, 0.0, 0.5], below=below, occluder_z=0.4)
+    occ = occlusion(depth, mask, visible, cam)
+    sides = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "sides"}})
+    ellipse = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "ellipse"}})
+    outline = complete(visible, occlusion=occ)
+    assert ellipse.extras["width"] > outline.extras["width"] + 0.005  # an ellipse was fitted and is wider
+    assert sides.extras["width"] == outline.extras["width"]
+
+
 @pytest.mark.parametrize("z", [0.5, 1.0])
 def test_a_ball_behind_a_leaf_lying_on_its_face_is_completed_behind_the_leaf(z):
     """Stop 56: a 70 mm ball whose lower part a flat leaf lying on its face hides (the leaf at 0.2 of a radius behind
