@@ -743,3 +743,62 @@ def test_axis_tilt_bend_reads_a_bowed_midline_and_naught_on_a_spheroid():
     want = 0.5 * (abs(t.bend) - t.bend_sd) * (t.major**2 - t.minor**2)
     assert want == pytest.approx(0.5 * 0.010 * 0.64, rel=0.15)
     assert t.half_depths()[0] - straight.half_depths()[0] == pytest.approx(want, abs=0.001)
+
+
+# --- stop 57, cutprior57: a cut outline's width read side by side
+
+
+def _cut_disc(keep_from: float):
+    """A 40 px disc about (50, 50) seen right of column ``keep_from`` (a leaf over the rest): its region, outline,
+    which of the outline is the disc's own (not the cut's straight edge), and a 100 px camera."""
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    v, u = np.mgrid[:100, :100]
+    mask = ((u - 50.0) ** 2 + (v - 50.0) ** 2 <= 400.0) & (u >= keep_from)
+    region = Silhouette(0, 0, mask, 0.0)
+    cracks = outline_cracks(region)
+    return region, cracks, cracks[:, 0] > keep_from - 0.4, cam
+
+
+def _circle_cone(cam, r: float, cu: float = 50.0, cv: float = 50.0):
+    conic = np.array([[1.0, 0.0, -cu], [0.0, 1.0, -cv], [-cu, -cv, cu * cu + cv * cv - r * r]])
+    return cam.matrix.T @ conic @ cam.matrix
+
+
+def test_a_disc_cut_on_one_side_reaches_the_ellipse_there_and_keeps_its_seen_extent_across():
+    """Stop 57 (docs/cutprior57.md): a leaf hides the left 30 % of a 40 px disc (the region 27 x 41 px between its
+    outline's pixel edges). The ellipse through the free arcs is the disc: the cut (left) side reaches it, the right
+    side and the vertical extent are the disc's own contour and stay, so the fruit is 40.5 / 27 as wide and as tall:
+    the stretch is the square root of 1.5. The moment ellipse of the cut region would read 27 px across."""
+    from symfruit.core.raster import free_side_stretch
+
+    region, cracks, free, cam = _cut_disc(44.0)
+    assert np.ptp(cracks[:, 0]) == 27.0 and np.ptp(cracks[:, 1]) == 41.0
+    stretch = free_side_stretch(cracks, free, _circle_cone(cam, 20.0), cam, region)
+    assert stretch**2 == pytest.approx(40.5 / 27.0, rel=1e-9)
+    # nothing cut: nothing moves, whatever the ellipse
+    assert free_side_stretch(cracks, np.ones(len(cracks), bool), _circle_cone(cam, 30.0), cam, region) == 1.0
+
+
+def test_an_ellipse_too_large_moves_only_the_cut_side_and_no_axis_past_the_widest_seen():
+    """Stop 57: an ellipse fitted wider than the fruit (radius 30 px for a 20 px disc, as a partial arc's fit can be)
+    leaves the free sides where they are seen; the cut side reaches it, but the axis no longer than the region's
+    widest extent (41 px, the uncut vertical): 41 / 27. A smaller ellipse than the region never narrows it."""
+    from symfruit.core.raster import free_side_stretch
+
+    region, cracks, free, cam = _cut_disc(44.0)
+    assert free_side_stretch(cracks, free, _circle_cone(cam, 30.0), cam, region) ** 2 == pytest.approx(41.0 / 27.0)
+    assert free_side_stretch(cracks, free, _circle_cone(cam, 5.0), cam, region) == 1.0
+
+
+def test_a_cut_outline_whose_ellipse_centre_is_hidden_keeps_the_cut_regions_width():
+    """Stop 57: a leaf over the left 60 % of the disc hides its centre (a round fruit's nearest point): the front read
+    from the seen points lies behind the fruit's, and a full width from it would put the back face too far, so with
+    the region given nothing moves; without it the cut side reaches the ellipse."""
+    from symfruit.core.raster import free_side_stretch
+
+    region, cracks, free, cam = _cut_disc(52.0)
+    cone = _circle_cone(cam, 20.0)
+    assert free_side_stretch(cracks, free, cone, cam, region) == 1.0
+    assert free_side_stretch(cracks, free, cone, cam) > 1.2

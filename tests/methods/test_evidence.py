@@ -823,12 +823,9 @@ def test_hidden_fronts_sphere_stops_within_its_stop(seed):
     assert abs(z - z0) < FRONT_TOLERANCE and float(np.abs(apex - apex0).max()) < FRONT_TOLERANCE
 
 
-@pytest.mark.parametrize("hidden", [0.0, 0.3, 0.5])
-def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
-    """Stop 56 (docs/strip56.md): a leaf 10 cm in front hides a 70 mm ball below its middle (or 0.3 and 0.5 of its
-    radius lower). The outline's free arcs lie on the ball's whole silhouette, which the ellipse fitted to them
-    (the observation's cone, ``contour_cone``) recovers: with ``cut_prior: ellipse`` the depth prior's width is the
-    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default)."""
+def _ball_under_leaf(hidden: float):
+    """A 70 mm ball 0.5 m away, a leaf 10 cm in front hiding it below ``hidden`` of its radius under its middle
+    (negative: above it): its visible points and occlusion information."""
     from symfruit.core.occlusion import occlusion
 
     from ..conftest import occluded_view
@@ -836,12 +833,37 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(hidden):
     cam = DEFAULT_CAMERA
     below = cam.cy + hidden * cam.fy * 0.035 / 0.465  # the ball's silhouette radius in pixels: 46 px
     visible, depth, mask, _ = occluded_view(ball_mesh(0.035), [0.0, 0.0, 0.5], below=below, occluder_z=0.4)
-    occ = occlusion(depth, mask, visible, cam)
+    return visible, occlusion(depth, mask, visible, cam)
+
+
+@pytest.mark.parametrize(
+    ("prior", "hidden"), [("ellipse", 0.0), ("ellipse", 0.3), ("ellipse", 0.5), ("sides", 0.3), ("sides", 0.5)]
+)
+def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(prior, hidden):
+    """Stop 56 (docs/strip56.md): a leaf 10 cm in front hides a 70 mm ball below its middle (or 0.3 and 0.5 of its
+    radius lower). The outline's free arcs lie on the ball's whole silhouette, which the ellipse fitted to them
+    (the observation's cone, ``contour_cone``) recovers: with ``cut_prior: ellipse`` the depth prior's width is the
+    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default). Stop 57
+    (docs/cutprior57.md): with ``cut_prior: sides`` only the cut (lower) side reaches the ellipse and the free sides
+    stay as seen: the diameter too, to 1.5 mm (the ball's middle seen: 0.3 and 0.5 of its radius lower)."""
+    visible, occ = _ball_under_leaf(hidden)
+    told = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": prior}})
+    outline = complete(visible, occlusion=occ)
+    assert told.extras["contour"] < 0.7  # a cut outline
+    assert told.extras["width"] == pytest.approx(0.07, abs=0.001 if prior == "ellipse" else 0.0015)
+    assert outline.extras["width"] < 0.063
+
+
+def test_a_cut_outline_hiding_the_balls_middle_keeps_the_cut_regions_prior_width():
+    """Stop 57: a leaf 10 cm in front hides a 70 mm ball from 0.2 of its radius above its middle down: the ellipse
+    through the free arcs is wider than the cut region (``cut_prior: ellipse`` reads it), but its centre, the ball's
+    nearest point, is hidden, so ``sides`` keeps the cut region's width (the seen front lies behind the ball's)."""
+    visible, occ = _ball_under_leaf(-0.2)
+    sides = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "sides"}})
     ellipse = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "ellipse"}})
     outline = complete(visible, occlusion=occ)
-    assert ellipse.extras["contour"] < 0.7  # a cut outline
-    assert ellipse.extras["width"] == pytest.approx(0.07, abs=0.001)
-    assert outline.extras["width"] < 0.063
+    assert ellipse.extras["width"] > outline.extras["width"] + 0.005  # an ellipse was fitted and is wider
+    assert sides.extras["width"] == outline.extras["width"]
 
 
 @pytest.mark.parametrize("z", [0.5, 1.0])

@@ -383,13 +383,16 @@ def observe(
     elif len(whole) == 2 and whole[1][2] is not None:  # both sides' bands made (none asked for: no parts)
         (in_rays, in_sizes, _, _), (out_rays, out_sizes, out_w, out_seen) = whole
         parts = _BandParts(in_rays, in_sizes, out_rays, out_sizes, out_w, out_seen, tuples)  # type: ignore[arg-type]
-    return Observation(rays=rays, depth=sample[:, 2], rays_in=tuples[0], rays_out=tuples[1],
+    obs = Observation(rays=rays, depth=sample[:, 2], rays_in=tuples[0], rays_out=tuples[1],
                        contour=contour, cone=cone, axis=axis, interior=points[depth_px >= edge],
                        out_weights=tuples[2], out_depth=tuples[3], _parts=parts,
                        cone_source=source,
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        inner=inner, inner_reach=float("inf") if reach is None else reach,
                        _hidden_of=None if occlusion is None else (occlusion, region))  # fmt: skip
+    if fitted is not None:  # the outline and which of it is the fruit's own contour, that the ellipse was fitted to
+        obs._made["outline"] = (cracks, crack_labels)
+    return obs
 
 
 @dataclass(frozen=True, eq=False)

@@ -71,6 +71,7 @@ from ..core.raster import (
     bracket_tilt,
     close_ragged,
     cone_widths,
+    free_side_stretch,
     inner_distance,
     point_pixels,
     silhouette,
@@ -163,8 +164,16 @@ class EvidenceSettings(Section):
         the real spheres with a leaf over a third of each and the mask cut, depth sides 19.7 -> 9.8 mm short; the
         development apple trees' depth sides 4.8 -> 4.5 mm, their centres 3.8 -> 3.9 mm; but through the camera
         models with a leaf in front every kind's boxes grew too deep (Azure Kinect, 25 % hidden: 6.95 -> 7.91 mm,
-        depth side +0.2 -> +3.4 mm; stop 56, docs/strip56.md), so not the default. ``outline`` (the default): the
-        cut region's widths, moved by ``cut_width``.
+        depth side +0.2 -> +3.4 mm; stop 56, docs/strip56.md), so not the default. ``sides`` (stop 57,
+        docs/cutprior57.md): the ellipse is read only where the outline is cut, along the cut region's two principal
+        axes (:func:`~symfruit.core.raster.free_side_stretch`): a side whose outermost outline is the fruit's own
+        contour keeps the region's extent, a cut side reaches to the ellipse's, no axis beyond the region's widest
+        extent, and nothing moves where the ellipse's centre (a round fruit's nearest point) is hidden (the seen front
+        then lies behind the fruit's, and a full-width prior from it runs the back face too far). The real spheres
+        with a leaf over a third of each, the mask cut: depth sides 20.4 -> 8.5 mm short; the masks dilated 10 px
+        unchanged (the ellipse: +16 -> +25 mm); through the Azure Kinect model with a leaf in front the centre error
+        still grows (25 % hidden 6.95 -> 7.35 mm, 50 % 9.16 -> 9.31), so not the default either. ``outline`` (the
+        default): the cut region's widths, moved by ``cut_width``.
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
@@ -303,7 +312,7 @@ class EvidenceSettings(Section):
     depth_ratio: float = setting(1.0, gt=0.0, le=10.0)
     depth_ratio_sd: float = setting(0.15, ge=0.0, le=10.0)
     cut_width: float = setting(0.0, ge=0.0, le=1.0)
-    cut_prior: Literal["outline", "ellipse"] = setting("outline")
+    cut_prior: Literal["outline", "ellipse", "sides"] = setting("outline")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -848,6 +857,11 @@ def evidence(
     whole = None
     if s.cut_prior == "ellipse" and obs.cone_source == "contour" and obs.cone is not None and obs.axis is not None:
         whole = cone_widths(obs.cone, obs.axis)
+    elif s.cut_prior == "sides" and obs.cone_source == "contour" and obs.cone is not None:
+        cracks, free = obs._made.get("outline", (None, None))
+        if cracks is not None:
+            stretch = free_side_stretch(cracks, free, obs.cone, camera, region)
+            whole = (sized.minor * stretch, sized.major * stretch)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=sized, tilt=tilt, whole=whole)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
