@@ -1454,7 +1454,7 @@ R_BALL = 40 * 0.5 / F  # leaf_beside_ball's ball radius, metres
                 strict=True,
                 reason="joined: at the depth of the ball's edge the joint fit bends "
                 "through both (docs/strip57.md, left open)",
-            ),  # fmt: skip
+            ),
         ),
         0.5 + R_BALL,  # at the ball's centre
         0.5 + 1.5 * R_BALL,  # behind it
