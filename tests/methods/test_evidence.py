@@ -851,7 +851,7 @@ def test_a_strip_in_front_across_a_ball_is_not_its_outline(half):
     ball's (``core.occlusion.bridged``): the outline is the ball's own circle, a contour but where the strip
     crosses it (its four ends, each within ``occluded_px`` + 2 px of the strip: the share at least ``1 - 4
     asin((h + 6) / R) / 2 pi`` for a strip ``2 h`` px high across a circle of radius ``R`` px), not the strip's
-    edges as well (the base: 0.48-0.52); the box within 1 mm of the ball."""
+    edges as well (the base: 0.50-0.52); the box within 1 mm of the ball."""
     from symfruit.core.occlusion import occlusion
     from symfruit.synthetic.render import render
 
