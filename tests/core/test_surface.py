@@ -1464,7 +1464,7 @@ def test_a_leaf_beside_a_fruit_at_its_depth_is_not_joined_across_a_twig(depth_le
     """Stop 57 (docs/strip57.md): a flat leaf beside a ball, a twig in front between them (something nearer crosses
     between the parts, as across a fruit): the leaf is no part of the ball, whichever depth it lies at. At the
     depth of the ball's edge (its front plus half its radius) the rule joins it: the quadratic fitted to both bends
-    through them within the tolerance (the parts' residual medians 1-4 mm, their far edges 5 mm off, as far as the
-    real 125 mm sphere's halves' own far edges are: no bound tells them apart; left open)."""
+    through them within the tolerance (the parts' median absolute residuals 1.6-3.0 mm, their far edges up to 5 mm
+    off, as far as the real 125 mm sphere's halves' own far edges are: no bound tells them apart; left open)."""
     depth, rows, cols, labels = leaf_beside_ball(depth_leaf)
     assert across_occluder(depth, rows, cols, labels, 0, 0.003, F, R_BALL).tolist() == [True, False]
