@@ -9,7 +9,7 @@ from hypothesis.extra.numpy import arrays
 from scipy import ndimage
 
 from symfruit.core.camera import Camera
-from symfruit.core.occlusion import Occlusion, occlusion, open_square, with_own
+from symfruit.core.occlusion import Occlusion, bridged, occlusion, open_square, with_own
 from symfruit.core.raster import Silhouette, silhouette
 from symfruit.errors import InputError
 
@@ -95,6 +95,41 @@ def test_own_pixels_join_the_seen_region():
     joined = with_own(region, occ)
     assert (joined.u0, joined.v0, joined.mask.shape) == (5, 5, (7, 7))  # the window grows to hold both
     assert joined.mask.sum() == 4 and joined.mask[5:7, 5:7].all()
+
+
+def _disk_under_strip(hidden_strip: bool):
+    """A 61 px disk (radius 30) in a 80 x 80 window at (10, 20) of a 200 x 150 image, a strip 11 px high across its
+    middle (rows 35-45 of the window) reaching 8 px past it on both sides: the region is the disk less the strip,
+    the strip hidden (something in front) or not (seen behind)."""
+    yy, xx = np.mgrid[:80, :80]
+    disk = (yy - 40) ** 2 + (xx - 40) ** 2 <= 30**2
+    strip = (np.abs(yy - 40) <= 5) & (np.abs(xx - 40) <= 38)
+    hidden = strip if hidden_strip else np.zeros_like(strip)
+    return disk, strip, Silhouette(10, 20, disk & ~strip, 0.0), Occlusion(10, 20, hidden, 200, 150)
+
+
+def test_the_hidden_pixels_between_a_silhouettes_parts_are_the_fruits():
+    """Stop 57 (docs/strip57.md): a strip in front across a round fruit parts its silhouette in two; the strip's
+    pixels between the parts are the fruit's (the disk back, but its two side columns whose disk pixels lie all
+    behind the strip; nothing of the strip beyond the disk)."""
+    disk, strip, region, occ = _disk_under_strip(True)
+    out = bridged(region, occ, radius=0)
+    assert (out.u0, out.v0, out.mask.shape) == (10, 20, (80, 80))
+    assert not (out.mask & ~disk).any()
+    assert out.mask[strip & disk].sum() == (strip & disk).sum() - 2  # the strip's pixels of the disk, but 2
+    missing = np.nonzero(disk & ~out.mask)
+    assert (np.abs(missing[1] - 40) == 30).all()  # the disk's side columns 10 and 70 (a pixel each)
+
+
+def test_what_is_seen_between_a_silhouettes_parts_or_beside_one_part_is_left_out():
+    """The strip's pixels seen behind the fruit (no occluder: the parts are apart) are not the fruit's; nor is a
+    hidden bite out of the side of a silhouette in one piece (a leaf cutting it: no pixel lies between two parts)."""
+    _, _, region, occ = _disk_under_strip(False)
+    assert bridged(region, occ) is region
+    disk, strip, _, occ = _disk_under_strip(True)
+    bitten = disk & ~(strip & (np.arange(80) < 40)[None, :])  # the strip over the left half only: one piece
+    one = Silhouette(10, 20, bitten, 0.0)
+    assert bridged(one, occ) is one
 
 
 def test_bad_input_is_refused():

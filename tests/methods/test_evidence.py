@@ -866,6 +866,37 @@ def test_a_cut_outline_hiding_the_balls_middle_keeps_the_cut_regions_prior_width
     assert sides.extras["width"] == outline.extras["width"]
 
 
+@pytest.mark.parametrize("half", [0.2, 0.3])
+def test_a_strip_in_front_across_a_ball_is_not_its_outline(half):
+    """Stop 57 (docs/strip57.md): a strip 5 cm in front of a 70 mm ball at 0.5 m hides the rows within ``half`` of
+    its radius of its middle, parting its silhouette in two. The pixels behind the strip between the parts are the
+    ball's (``core.occlusion.bridged``): the outline is the ball's own circle, a contour but where the strip
+    crosses it (its four ends, each within ``occluded_px`` + 2 px of the strip: the share at least ``1 - 4
+    asin((h + 6) / R) / 2 pi`` for a strip ``2 h`` px high across a circle of radius ``R`` px), not the strip's
+    edges as well (the base: 0.50-0.52); the box within 1 mm of the ball."""
+    from symfruit.core.occlusion import occlusion
+    from symfruit.synthetic.render import render
+
+    cam, r, z = DEFAULT_CAMERA, 0.035, 0.5
+    ball = ball_mesh(r).transformed(np.eye(3), np.array([0.0, 0.0, z]))
+    zs = z - r - 0.05
+    y = half * r / (z - r) * zs  # the strip's edges, seen at the ball's front
+    faces = np.array([[0, 1, 2], [0, 2, 3]])
+    strip = np.array([[-2.0, -y, zs], [2.0, -y, zs], [2.0, y, zs], [-2.0, y, zs]])
+    back = np.array([[-9.0, -9.0, 3.0], [9.0, -9.0, 3.0], [9.0, 9.0, 3.0], [-9.0, 9.0, 3.0]])
+    shot = render([(ball.vertices, ball.faces), (strip, faces), (back, faces)], cam)
+    depth = np.where(np.isfinite(shot.depth), shot.depth, 0.0)
+    depth = depth + np.random.default_rng(0).normal(size=depth.shape) * 0.002 * depth**2
+    mask = shot.ids == 0
+    rows, cols = np.nonzero(mask)
+    points = cam.deproject(np.c_[cols, rows].astype(float), depth[rows, cols])
+    result = complete(points, occlusion=occlusion(depth, mask, points, cam))
+    radius_px = cam.fy * r / np.sqrt(z * z - r * r)
+    h = cam.fy * y / zs
+    assert result.extras["contour"] >= 1.0 - 4.0 * np.arcsin((h + 6.0) / radius_px) / (2.0 * np.pi)
+    assert np.abs(result.box.size - 2 * r).max() < 0.001
+
+
 @pytest.mark.parametrize("z", [0.5, 1.0])
 def test_a_ball_behind_a_leaf_lying_on_its_face_is_completed_behind_the_leaf(z):
     """Stop 56: a 70 mm ball whose lower part a flat leaf lying on its face hides (the leaf at 0.2 of a radius behind

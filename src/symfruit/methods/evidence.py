@@ -60,7 +60,7 @@ from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.fits import noise_level, noise_measures
 from ..core.front import apex_depth, sphere_front
 from ..core.kernels import compiled
-from ..core.occlusion import Occlusion, with_own
+from ..core.occlusion import Occlusion, bridged, with_own
 from ..core.points import bounds, row_norms, subsample
 from ..core.raster import (
     Across,
@@ -793,6 +793,9 @@ def evidence(
         # and the edge normals do not vote (measured from the points' own edge they call a lost rim a cut; issue 18,
         # docs/edges52.md)
         region = with_own(region, occlusion)
+        # a surface in front crossing the fruit parts its silhouette: the hidden pixels between the parts are the
+        # fruit's (issue 18, docs/strip57.md)
+        region = bridged(region, occlusion)
     obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
                   occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
                   thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
