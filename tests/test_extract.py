@@ -530,7 +530,9 @@ def test_a_fruit_parted_by_a_strip_in_front_keeps_both_parts(cut):
     assert ex.points[:, 2].min() > 1.29  # none of the strip
 
 
-# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface
+# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, off)
+
+KEEPS = ExtractSettings(trim_keeps_surface=True)
 
 
 def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -549,16 +551,16 @@ def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
     """Stop 57 (docs/shift57.md): the colour alone takes the ball's shaded limb off (its lowest rows look like the
-    grey ring beside the mask); with the depth, the limb lies on the ball's own convex cap and is kept, the mask
-    exactly the disc. ``trim_keeps_surface`` off, or no depth given: the colour's trim."""
+    grey ring beside the mask); with the depth and ``trim_keeps_surface``, the limb lies on the ball's own convex cap
+    and is kept, the mask exactly the disc. The default (off), or no depth given: the colour's trim."""
     color, depth, d2 = shaded_ball()
     labels = (d2 <= 400).astype(np.int32)
     limb = (labels == 1) & (np.mgrid[:120, :160][0] >= 76)
     colour_only = trim_labels(color, labels)
     assert (colour_only[limb] == 0).sum() >= 0.5 * limb.sum()
-    assert trim_labels(color, labels, depth=depth, focal=600.0) is labels
-    off = ExtractSettings(trim_keeps_surface=False)
-    assert np.array_equal(trim_labels(color, labels, off, depth=depth, focal=600.0), colour_only)
+    assert trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) is labels
+    assert np.array_equal(trim_labels(color, labels, KEEPS), colour_only)
+    assert np.array_equal(trim_labels(color, labels, depth=depth, focal=600.0), colour_only)
 
 
 def test_the_colour_trim_still_takes_an_overshoot_onto_the_background_or_a_support_at_the_fruits_depth():
@@ -568,7 +570,7 @@ def test_the_colour_trim_still_takes_an_overshoot_onto_the_background_or_a_suppo
     for the board's first row, within the convexity test's tolerance (3 mm) of the ball's rim."""
     color, depth, d2 = shaded_ball(board=True)
     labels = (d2 <= 23**2).astype(np.int32)
-    kept = trim_labels(color, labels, depth=depth, focal=600.0) == 1
+    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) == 1
     assert kept[d2 <= 400].all()
     assert not kept[(d2 > 400) & (depth > 0.9)].any()  # the background
     assert not kept[82:].any() and kept[81].sum() <= 15  # the board beyond its first row
