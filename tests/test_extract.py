@@ -586,3 +586,14 @@ def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():
     assert np.array_equal(cap[:81], (d2 <= 400)[:81]) and not cap[82:].any()
     assert 0 < cap[81].sum() <= 15
     assert not own_cap(np.zeros_like(depth), mask, 600.0).any()
+
+
+def test_the_trims_depth_is_checked_by_name():
+    color, depth, d2 = shaded_ball()
+    labels = (d2 <= 400).astype(np.int32)
+    with pytest.raises(InputError, match="trim_labels: depth must be float metres of the masks' shape"):
+        trim_labels(color, labels, KEEPS, depth=depth[:, :-1], focal=600.0)
+    with pytest.raises(InputError, match="trim_labels: focal must be a positive number"):
+        trim_labels(color, labels, KEEPS, depth=depth, focal=0.0)
+    with pytest.raises(InputError, match="own_cap: depth must be float metres"):
+        own_cap((depth * 1000).astype(np.uint16), labels == 1, 600.0)

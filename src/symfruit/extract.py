@@ -507,6 +507,8 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     color, labels, s = _trim_checked(color, labels, settings)
     if s.colour_trim_px <= 0:
         return labels
+    if depth is not None and s.trim_keeps_surface:  # checked where read (a whole frame is not copied)
+        depth, focal = _depth_checked(depth, focal, labels.shape, "trim_labels")
     out = labels
     for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
         if sl is None or (dropped := trim_mask(color, labels, k, sl, s, depth=depth, focal=focal)) is None:
@@ -560,6 +562,19 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
 
 
+def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) -> tuple[np.ndarray, float]:
+    """``depth`` (as it is, no copy) of ``shape`` and float, ``focal`` a float above 0, or an :class:`InputError`
+    naming ``what``."""
+    z = np.asarray(depth)
+    if z.shape != tuple(shape) or z.dtype.kind != "f":
+        raise InputError(f"{what}: depth must be float metres of the masks' shape {tuple(shape)}, got {z.dtype} "
+                         f"{z.shape}")  # fmt: skip
+    f = float(focal)
+    if not (np.isfinite(f) and f > 0.0):
+        raise InputError(f"{what}: focal must be a positive number of pixels, got {focal!r}")
+    return z, f
+
+
 def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
     """(h, w) bool: the pixels of ``mask`` whose depth (metres, the same (h, w) window; 0 or NaN: none) lies on the
     fruit's own surface: the convex cap from its nearest point (:func:`~symfruit.core.surface.fruit_surface`, with
@@ -572,10 +587,11 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
     deeper than the rim. So a pixel of the cap is the fruit's, whatever its colour: :func:`trim_mask` does not take
     it (``trim_keeps_surface``)."""
     s = settings or ExtractSettings()
-    z = np.asarray(depth, dtype=np.float64)
+    z, focal = _depth_checked(depth, focal, np.shape(mask), "own_cap")
+    z = np.asarray(z, dtype=np.float64)
     with np.errstate(invalid="ignore"):
         z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
-    surface = fruit_surface(z, np.asarray(mask, dtype=bool), float(focal), slab=s.slab,
+    surface = fruit_surface(z, np.asarray(mask, dtype=bool), focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
                             clean=True)  # fmt: skip
     if surface is None:
