@@ -185,10 +185,10 @@ def test_the_66_mm_sphere_on_its_board_is_a_cube_with_its_mask_down_on_the_board
 
 def test_binned_the_colour_trim_takes_the_200_mm_spheres_lower_limb_unless_it_keeps_the_fruits_surface(rp):
     """Stop 57 (docs/shift57.md): binned 3 x 3, the colour trim takes about 100 px of the 200 mm sphere's shaded lower
-    half (the band, 4 binned px, reaches twice as far into the limb as at full resolution, where it takes none): the
-    box 198 x 175 x 185 mm. Those pixels' depth lies on the sphere's own convex cap; with ``trim_keeps_surface`` (off
-    by default: docs/shift57.md, a generous mask's overshoot is kept where the depth sits off the colour) they are
-    kept and every sphere is within 6 mm of a cube and of its diameter."""
+    half (the band, 4 binned px, reaches three times as far into the limb as at full resolution, where it takes
+    none): the box 198 x 175 x 185 mm. Those pixels' depth lies on the sphere's own convex cap; with
+    ``trim_keeps_surface`` (off by default: docs/shift57.md, a generous mask's overshoot is kept where the depth sits
+    off the colour) they are kept and every sphere is within 6 mm of a cube and of its diameter."""
     from symfruit.settings import from_dict
 
     short = {k: size for k, size, _ in spheres(rp, "bin3")}[1]
