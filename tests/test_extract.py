@@ -17,6 +17,7 @@ from symfruit.extract import (
     cluster,
     cluster_gap,
     extract,
+    own_cap,
     own_surface,
     register,
     shift_labels,
@@ -527,3 +528,72 @@ def test_a_fruit_parted_by_a_strip_in_front_keeps_both_parts(cut):
     assert (rows < centre).sum() > 0.4 * seen.sum() and (rows > centre).sum() > 0.4 * seen.sum()
     assert len(ex.points) >= 0.9 * seen.sum()
     assert ex.points[:, 2].min() > 1.29  # none of the strip
+
+
+# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, off)
+
+KEEPS = ExtractSettings(trim_keeps_surface=True)
+
+
+def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(color, depth, d2)``: :func:`disc_frame`'s red ball of 20 px at (80, 60), its front 0.29 m, its lowest 5 rows
+    shaded to the background's grey (a limb darkening towards a grey board, as the real 200 mm sphere's); ``board``:
+    below the ball's bottom row a grey board at its depth there that turns back towards the camera, 4 mm a row (a
+    support meeting it at a crease). ``d2`` the squared pixel distance from the disc's centre."""
+    color, depth = disc_frame([(80, 60)], radius=20, z=0.3)
+    yy, xx = np.mgrid[:120, :160]
+    d2 = (xx - 80) ** 2 + (yy - 60) ** 2
+    color[(d2 <= 400) & (yy >= 76)] = 90
+    if board:
+        depth[81:] = (0.3 - 0.004 * (yy[81:] - 80)).astype(np.float32)
+    return color, depth, d2
+
+
+def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
+    """Stop 57 (docs/shift57.md): the colour alone takes the ball's shaded limb off (its lowest rows look like the
+    grey ring beside the mask); with the depth and ``trim_keeps_surface``, the limb lies on the ball's own convex cap
+    and is kept, the mask exactly the disc. The default (off), or no depth given: the colour's trim."""
+    color, depth, d2 = shaded_ball()
+    labels = (d2 <= 400).astype(np.int32)
+    limb = (labels == 1) & (np.mgrid[:120, :160][0] >= 76)
+    colour_only = trim_labels(color, labels)
+    assert (colour_only[limb] == 0).sum() >= 0.5 * limb.sum()
+    assert trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) is labels
+    assert np.array_equal(trim_labels(color, labels, KEEPS), colour_only)
+    assert np.array_equal(trim_labels(color, labels, depth=depth, focal=600.0), colour_only)
+
+
+def test_the_colour_trim_still_takes_an_overshoot_onto_the_background_or_a_support_at_the_fruits_depth():
+    """The same ball under a mask 3 px too wide all round: above and beside it the background 1 m away (far behind
+    its rim), below it a board at its depth turning back towards the camera (the convex cap stops at the crease).
+    The colour takes them off with the depth given as without, and keeps the shaded limb: the mask is the disc, but
+    for the board's first row, within the convexity test's tolerance (3 mm) of the ball's rim."""
+    color, depth, d2 = shaded_ball(board=True)
+    labels = (d2 <= 23**2).astype(np.int32)
+    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) == 1
+    assert kept[d2 <= 400].all()
+    assert not kept[(d2 > 400) & (depth > 0.9)].any()  # the background
+    assert not kept[82:].any() and kept[81].sum() <= 15  # the board beyond its first row
+
+
+def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():
+    """Known answer: the ball's pixels (every one has depth up to its rim) and none of the background's, under a mask
+    grown 3 px onto them; of the board that turns back towards the camera 4 mm a row below the crease, its first row
+    alone (the ball's lowest pixels lie within 2 mm of its rim's depth, and the cap may fall 3 mm); no depth: none."""
+    _, depth, d2 = shaded_ball(board=True)
+    mask = d2 <= 23**2
+    cap = own_cap(depth, mask, 600.0)
+    assert np.array_equal(cap[:81], (d2 <= 400)[:81]) and not cap[82:].any()
+    assert 0 < cap[81].sum() <= 15
+    assert not own_cap(np.zeros_like(depth), mask, 600.0).any()
+
+
+def test_the_trims_depth_is_checked_by_name():
+    color, depth, d2 = shaded_ball()
+    labels = (d2 <= 400).astype(np.int32)
+    with pytest.raises(InputError, match="trim_labels: depth must be float metres of the masks' shape"):
+        trim_labels(color, labels, KEEPS, depth=depth[:, :-1], focal=600.0)
+    with pytest.raises(InputError, match="trim_labels: focal must be a positive number"):
+        trim_labels(color, labels, KEEPS, depth=depth, focal=0.0)
+    with pytest.raises(InputError, match="own_cap: depth must be float metres"):
+        own_cap((depth * 1000).astype(np.uint16), labels == 1, 600.0)

@@ -264,7 +264,14 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
         # within its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
         colour_trimmed: set[int] = set()
         if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
-            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
+            labels, colour_trimmed = _trim_labels(
+                frame.color,
+                labels,
+                settings.extract,
+                boxes,
+                frame.depth,
+                float(np.sqrt(frame.camera.fx * frame.camera.fy)),
+            )
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
@@ -500,7 +507,9 @@ class _Masks:
         """Mask ``k``'s pixels its colour trimming drops (None: none) and its box after it (None: none left)."""
         if self.color is None or self.settings.colour_trim_px <= 0:
             return None, sl
-        if (dropped := trim_mask(self.color, self.labels, k, sl, self.settings)) is None:
+        if (
+            dropped := trim_mask(self.color, self.labels, k, sl, self.settings, depth=self.depth, focal=self.focal)
+        ) is None:
             return None, sl
         return dropped, _box_of(_without(self.labels[sl] == k, sl[0].start, sl[1].start, dropped), sl)
 
@@ -591,11 +600,16 @@ def _label_boxes(labels: np.ndarray, count: int) -> list[tuple[slice, slice] | N
 
 
 def _trim_labels(
-    color: np.ndarray, labels: np.ndarray, settings: ExtractSettings, boxes: list[tuple[slice, slice] | None]
+    color: np.ndarray,
+    labels: np.ndarray,
+    settings: ExtractSettings,
+    boxes: list[tuple[slice, slice] | None],
+    depth: np.ndarray | None = None,
+    focal: float = 0.0,
 ) -> tuple[np.ndarray, set[int]]:
     """:func:`~symfruit.extract.trim_labels` (the same labels), and the masks it took pixels from."""
     trimmed: set[int] = set()
-    return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed), trimmed
+    return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed, depth=depth, focal=focal), trimmed
 
 
 def _box_within(labels: np.ndarray, k: int, sl: tuple[slice, slice] | None) -> tuple[slice, slice] | None:

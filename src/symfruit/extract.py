@@ -20,8 +20,8 @@ from .core.surface import PART_POINTS, across_occluder, colour_trim, fruit_surfa
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "own_surface", "register",
-           "shift_labels", "trim_labels"]  # fmt: skip
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "own_cap", "own_surface",
+           "register", "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -69,6 +69,15 @@ class ExtractSettings(Section):
         (:func:`~symfruit.core.surface.colour_trim`: masks overshoot onto what lies around a fruit); where fruit and
         surroundings do not separate in that band, twice and three times it are tried (:func:`trim_labels`: a mask
         overshooting by more than the band); 0: never.
+    trim_keeps_surface : bool
+        Given the depth (``detect``), the colour trim takes no pixel whose depth lies on the fruit's own convex cap
+        (:func:`own_cap`): a shaded limb darkening towards a grey background, or a mask drawn a few pixels off the
+        fruit, where the ring beside it that the colour is compared with is the fruit itself, is the fruit (the
+        real 200 mm sphere's lower limb: its box 182 mm tall for 198 binned 2 x 2, 196 with it). Off by default:
+        the depth is read at the colour's pixels before the registration, and where it sits a few pixels off the
+        colour (the real frames' larger spheres; the camera models' registration offset) the cap runs past the
+        fruit's colour edge and a generous mask's overshoot there is kept too (the real masks grown 2-10 px: 21 ->
+        28 of 32 boxes over the 6 mm bar; the rendered trees' centres 3.9 -> 4.4 mm; stop 57, docs/shift57.md).
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -92,6 +101,7 @@ class ExtractSettings(Section):
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
+    trim_keeps_surface: bool = setting(False)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
@@ -480,7 +490,8 @@ WIDEST = 0.4
 
 def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None,
                 *, boxes: list[tuple[slice, slice] | None] | None = None,
-                trimmed: set[int] | None = None) -> np.ndarray:  # fmt: skip
+                trimmed: set[int] | None = None, depth: np.ndarray | None = None,
+                focal: float = 0.0) -> np.ndarray:  # fmt: skip
     """``labels`` with each mask's outer band trimmed where its colour is the background's
     (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
     equivalent radius; where fruit and surroundings do not separate there, twice and three times that band, at
@@ -489,14 +500,18 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     Masks and colour share the colour camera's pixels, so this comes before :func:`register` moves the masks
     onto the depth image: trimmed after the move, a mask would be compared with colours several pixels off.
     ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
-    is trimmed. ``trimmed``: a set given the labels of the masks that lost pixels.
+    is trimmed. ``trimmed``: a set given the labels of the masks that lost pixels. ``depth`` (metres, the colour's
+    size) and ``focal`` (pixels): with ``trim_keeps_surface``, no pixel of a fruit's own convex cap is taken
+    (:func:`trim_mask`).
     """
     color, labels, s = _trim_checked(color, labels, settings)
     if s.colour_trim_px <= 0:
         return labels
+    if depth is not None and s.trim_keeps_surface:  # checked where read (a whole frame is not copied)
+        depth, focal = _depth_checked(depth, focal, labels.shape, "trim_labels")
     out = labels
     for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
-        if sl is None or (dropped := trim_mask(color, labels, k, sl, s)) is None:
+        if sl is None or (dropped := trim_mask(color, labels, k, sl, s, depth=depth, focal=focal)) is None:
             continue
         (r0, r1, c0, c1), gone = dropped
         out = out.copy() if out is labels else out
@@ -517,13 +532,21 @@ def _trim_checked(color: Any, labels: Any, settings: ExtractSettings | None) -> 
     return color, labels, settings or ExtractSettings()
 
 
-def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice],
-              s: ExtractSettings) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
+def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice], s: ExtractSettings, *,
+              depth: np.ndarray | None = None,
+              focal: float = 0.0) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
     """One mask's part of :func:`trim_labels` (checked arguments, ``s.colour_trim_px`` above 0): mask ``k`` of
     ``labels`` (its box ``sl``) trimmed by colour, as the window ``(r0, r1, c0, c1)`` and the (r1 - r0, c1 - c0)
-    bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels and the
-    colour alone: the masks are trimmed in any order, or on several processes
-    (:class:`~symfruit.fruitpool.FruitPool`), with the same pixels dropped."""
+    bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels, the
+    colour and the depth alone: the masks are trimmed in any order, or on several processes
+    (:class:`~symfruit.fruitpool.FruitPool`), with the same pixels dropped.
+
+    Given ``depth`` (the frame's, metres, read at the mask's own pixels as drawn: before :func:`register` moves it)
+    and ``focal`` (pixels), with ``s.trim_keeps_surface``, the pixels the colour would drop whose depth lies on the
+    fruit's own convex cap (:func:`own_cap`) are kept: the colour trim compares a band pixel with the ring just
+    outside the mask, and where the fruit runs on past the mask (a mask drawn or registered a few pixels off, its
+    shaded limb darkening towards a background of about its colour) that ring is the fruit itself (stop 57,
+    docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198)."""
     h, w = labels.shape
     pad = WIDER[-1] * s.colour_trim_px + 2
     r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
@@ -534,7 +557,48 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     dropped = mask & ~kept
+    if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any():
+        dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
+
+
+def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) -> tuple[np.ndarray, float]:
+    """``depth`` (as it is, no copy) of ``shape`` and float, ``focal`` a float above 0, or an :class:`InputError`
+    naming ``what``."""
+    z = np.asarray(depth)
+    if z.shape != tuple(shape) or z.dtype.kind != "f":
+        raise InputError(f"{what}: depth must be float metres of the masks' shape {tuple(shape)}, got {z.dtype} "
+                         f"{z.shape}")  # fmt: skip
+    f = float(focal)
+    if not (np.isfinite(f) and f > 0.0):
+        raise InputError(f"{what}: focal must be a positive number of pixels, got {focal!r}")
+    return z, f
+
+
+def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
+    """(h, w) bool: the pixels of ``mask`` whose depth (metres, the same (h, w) window; 0 or NaN: none) lies on the
+    fruit's own surface: the convex cap from its nearest point (:func:`~symfruit.core.surface.fruit_surface`, with
+    the settings' slab and convexity tolerance), no deeper than its front plus its radius (and the convexity test's
+    tolerance, 3 noise deviations and at least 3 mm: the registration's free-side depth).
+
+    A round fruit's seen surface runs from its front to its rim, at most a radius behind it, and recedes smoothly
+    the whole way; what meets it at its outline at about that depth meets it at a crease (a board or a branch
+    turning back towards the camera, a neighbour's front), where the convex cap stops, and what lies behind it lies
+    deeper than the rim. So a pixel of the cap is the fruit's, whatever its colour: :func:`trim_mask` does not take
+    it (``trim_keeps_surface``)."""
+    s = settings or ExtractSettings()
+    z, focal = _depth_checked(depth, focal, np.shape(mask), "own_cap")
+    z = np.asarray(z, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
+    surface = fruit_surface(z, np.asarray(mask, dtype=bool), focal, slab=s.slab,
+                            tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
+                            clean=True)  # fmt: skip
+    if surface is None:
+        return np.zeros(np.shape(mask), bool)
+    # the rim's depth: the front plus the radius, plus the convexity test's tolerance (the registration's free test's)
+    rim = surface.front + surface.radius + max(3.0 * surface.noise, 0.003)
+    return surface.pixels & (z > 0.0) & (z <= rim)
 
 
 def register(

@@ -756,3 +756,44 @@ def test_a_partly_seen_past_mask_is_never_cut_inside_the_fruits_edge(grow, shift
         over = np.zeros((60, 80), bool)
         over[occ.v0 : occ.v0 + occ.overshoot.shape[0], occ.u0 : occ.u0 + occ.overshoot.shape[1]] = occ.overshoot
         assert not over[r <= 14.0].any()
+
+
+def _ball_under_a_leaf(lying: float):
+    """:func:`_ball_on_a_box`'s ball with a flat leaf lying on it ``lying`` of its radius behind its front, over every
+    row below its centre (no step: the leaf meets the ball's surface), running on to the image's border: the ball's
+    mask is what the leaf leaves of it (its upper half and the cap in front of the leaf), 31 px wide and 22 px tall
+    for ``lying`` 0.1. ``(depth, mask, points, rows, cols)``."""
+    depth, disc, _, rows, cols = _ball_on_a_box(1.0)
+    leaf_z = 0.285 + lying * 0.015
+    ball = np.where(depth > 0.0, depth, np.inf)  # the lost rim lies behind the leaf there too
+    ball[~disc] = np.inf
+    under = (rows > 30) & ~(disc & (ball < leaf_z))  # the leaf, but where the ball pokes through it
+    depth = np.where(under, leaf_z, depth)
+    mask = disc & ~under
+    r, c = np.nonzero(mask & (depth > 0.0) & (depth < leaf_z))
+    points = BIG.deproject(np.c_[c, r].astype(float), depth[r, c])
+    return depth, mask, points, rows, cols
+
+
+def test_the_support_radius_is_half_the_larger_side_of_the_fruits_box():
+    """Stop 57: a fruit cut along one axis keeps its radius along the other (half the mean side was short of it)."""
+    from symfruit.core.occlusion import support_radius
+
+    assert support_radius((0, 22, 0, 31)) == 15.5 and support_radius((3, 43, 5, 25)) == 20.0
+
+
+@pytest.mark.parametrize("kernels", ["default", "numpy"])
+def test_a_leaf_lying_on_a_cut_fruit_stays_hidden_as_far_as_the_whole_fruit_reaches_behind_it(kernels, monkeypatch):
+    """Stop 57 (docs/shift57.md): the ball under a flat leaf lying on it a tenth of its radius behind its front, over
+    its lower half; its mask is what the leaf leaves (31 x 22 px). Behind the leaf the ball reaches 15 (1 - sqrt(0.19))
+    = 8.5 px past the cap poking through it, the whole band: the leaf stays hidden there. With the radius half the mean
+    side of the cut mask's box (13.25 px, stop 56) the reach was 7.0 px and the band's last two steps were cleared."""
+    if kernels == "numpy":
+        monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    depth, mask, points, rows, cols = _ball_under_a_leaf(0.1)
+    box = np.nonzero(mask.any(axis=1))[0], np.nonzero(mask.any(axis=0))[0]
+    assert (box[0][-1] - box[0][0] + 1, box[1][-1] - box[1][0] + 1) == (22, 31)
+    gap = ndimage.distance_transform_cdt(~mask, metric="chessboard")
+    below = (rows > 36) & (np.abs(cols - 40) <= 2) & (gap <= 8)  # straight below the cap, within the band
+    assert below.sum() >= 20
+    assert hidden_image(occlusion(depth, mask, points, BIG))[below].all()

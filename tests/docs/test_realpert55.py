@@ -199,3 +199,22 @@ def test_the_66_mm_sphere_on_its_board_is_a_cube_with_its_mask_down_on_the_board
     for k, size, diameter in boxes:
         if name == "shift+5y" or k == 3:  # binned, the 200 mm sphere comes out 182 mm tall (left open: support56.md)
             assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
+
+
+# --- stop 57, shift57: the 200 mm sphere's shaded lower limb taken by the colour trim
+
+
+def test_binned_the_colour_trim_takes_the_200_mm_spheres_lower_limb_unless_it_keeps_the_fruits_surface(rp):
+    """Stop 57 (docs/shift57.md): binned 3 x 3, the colour trim takes about 100 px of the 200 mm sphere's shaded lower
+    half (the band, 4 binned px, reaches three times as far into the limb as at full resolution, where it takes
+    none): the box 198 x 175 x 185 mm. Those pixels' depth lies on the sphere's own convex cap; with
+    ``trim_keeps_surface`` (off by default: docs/shift57.md, a generous mask's overshoot is kept where the depth sits
+    off the colour) they are kept and every sphere is within 6 mm of a cube and of its diameter."""
+    from symfruit.settings import from_dict
+
+    short = {k: size for k, size, _ in spheres(rp, "bin3")}[1]
+    assert short[1] < 190.0  # the default: the limb taken
+    boxes = spheres(rp, "bin3", from_dict({"extract": {"trim_keeps_surface": True}}))
+    assert len(boxes) == 4
+    for k, size, diameter in boxes:
+        assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (k, size, diameter)

@@ -3868,12 +3868,13 @@ def _row_min(x: np.ndarray, k: int, out: np.ndarray) -> None:
 @_njit_inlined
 def _support_scale(z: np.ndarray, r0: int, r1: int, c0: int, c1: int, focal: float) -> tuple[float, float, float]:
     """``(front, r_px, r_m)`` of :func:`_support_reach`: the least of the own depths ``z`` (+inf where none), half the
-    mean side of the own pixels' box ``r0:r1, c0:c1`` (pixels) and that in metres at the front (0 without ``focal``)."""
+    larger side of the own pixels' box ``r0:r1, c0:c1`` (pixels, :func:`symfruit.core.occlusion.support_radius`) and
+    that in metres at the front (0 without ``focal``)."""
     front = np.inf
     for i in range(z.shape[0]):
         for j in range(z.shape[1]):
             front = min(front, z[i, j])
-    r_px = 0.25 * ((r1 - r0) + (c1 - c0))
+    r_px = 0.5 * max(r1 - r0, c1 - c0)
     return front, r_px, r_px * front / focal if focal > 0.0 else 0.0
 
 

@@ -26,7 +26,16 @@ from .limits import MAX_IMAGE_SIDE, check_image_size, depth_metres
 from .points import as_points
 from .raster import Silhouette, mask_box, nearest_index, square_filter
 
-__all__ = ["Occlusion", "bridged", "occlusion", "overshoot", "own_edge", "support_reach", "with_own"]
+__all__ = [
+    "Occlusion",
+    "bridged",
+    "occlusion",
+    "overshoot",
+    "own_edge",
+    "support_radius",
+    "support_reach",
+    "with_own",
+]
 
 
 @dataclass(frozen=True)
@@ -904,7 +913,7 @@ def own_edge(
         reached |= edge
     reach = np.zeros(cand.shape)
     front = float(np.min(own_z))
-    r_px = 0.25 * ((box[1] - box[0]) + (box[3] - box[2]))
+    r_px = support_radius(box)
     r_m = r_px * front / focal if focal > 0.0 else 0.0
     lone = reached & ~ends
     if supports and 0.0 < r_m < np.inf and lone.any():
@@ -915,6 +924,15 @@ def own_edge(
     out = hidden.copy()
     out[b0:b1, a0:a1] &= ~clear
     return out
+
+
+def support_radius(box: tuple[int, int, int, int]) -> float:
+    """Pixels: the radius :func:`support_reach` reads for a fruit whose own pixels' box is ``box`` (rows ``r0:r1``,
+    columns ``c0:c1``): half its larger side. A fruit cut by a leaf along one axis keeps its radius along the other
+    (half the mean side was short of it, and so was the reach: stop 57, docs/shift57.md); an elongated fruit gets
+    its larger half-length, which only keeps more of a support's band hidden (the rule before stop 56 kept all of
+    it)."""
+    return 0.5 * max(box[1] - box[0], box[3] - box[2])
 
 
 def support_reach(depth: np.ndarray, front: float, r_px: float, r_m: float) -> np.ndarray:
