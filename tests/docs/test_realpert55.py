@@ -166,19 +166,18 @@ def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_largest_sphere_as_deep_
     depth prior's width is the cut silhouette's (65 % and 100 % of the diameter: sphere 1 184 x 196 x 169 mm for
     198); with ``evidence.cut_prior: ellipse`` (not the default) it is the ellipse through the outline's free arcs:
     sphere 1's depth side within 6 mm of its diameter. Stop 57 (docs/cutprior57.md): with ``cut_prior: sides`` (the
-    ellipse read only on the cut, left, side) the 200 and 125 mm spheres' depth sides within 3 and 10 mm (the
-    default: 20-30 mm short)."""
+    ellipse read only on the cut, left, side; the default since) the 200 and 125 mm spheres' depth sides within 3 and
+    10 mm (``outline``, the default before: 20-30 mm short)."""
     from symfruit.settings import from_dict
 
-    boxes = {k: (size, diameter) for k, size, diameter in spheres(rp, "leafside5-cut")}
-    assert boxes[1][0][2] < boxes[1][1] - 20.0  # the default: the cut silhouette's width
+    was = from_dict({"evidence": {"cut_prior": "outline"}})
+    boxes = {k: (size, diameter) for k, size, diameter in spheres(rp, "leafside5-cut", was)}
+    assert boxes[1][0][2] < boxes[1][1] - 20.0  # the default before stop 57: the cut silhouette's width
     assert boxes[2][0][2] < boxes[2][1] - 15.0
     told = from_dict({"evidence": {"cut_prior": "ellipse"}})
     size, diameter = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", told)}[1]
     assert abs(size[2] - diameter) <= 6.0, (size, diameter)
-    sides = {
-        k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", from_dict({"evidence": {"cut_prior": "sides"}}))
-    }
+    sides = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut")}  # the default since stop 57
     assert abs(sides[1][0][2] - sides[1][1]) <= 3.0, sides[1]
     assert abs(sides[2][0][2] - sides[2][1]) <= 10.0, sides[2]
 

@@ -843,12 +843,13 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(prior, hidde
     """Stop 56 (docs/strip56.md): a leaf 10 cm in front hides a 70 mm ball below its middle (or 0.3 and 0.5 of its
     radius lower). The outline's free arcs lie on the ball's whole silhouette, which the ellipse fitted to them
     (the observation's cone, ``contour_cone``) recovers: with ``cut_prior: ellipse`` the depth prior's width is the
-    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default). Stop 57
-    (docs/cutprior57.md): with ``cut_prior: sides`` only the cut (lower) side reaches the ellipse and the free sides
-    stay as seen: the diameter too, to 1.5 mm (the ball's middle seen: 0.3 and 0.5 of its radius lower)."""
+    diameter, where the cut region's geometric mean reads 50-62 mm (``cut_prior: outline``, the default before stop
+    57). Stop 57 (docs/cutprior57.md): with ``cut_prior: sides`` (the default since) only the cut (lower) side reaches
+    the ellipse and the free sides stay as seen: the diameter too, to 1.5 mm (the ball's middle seen: 0.3 and 0.5 of
+    its radius lower)."""
     visible, occ = _ball_under_leaf(hidden)
     told = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": prior}})
-    outline = complete(visible, occlusion=occ)
+    outline = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "outline"}})
     assert told.extras["contour"] < 0.7  # a cut outline
     assert told.extras["width"] == pytest.approx(0.07, abs=0.001 if prior == "ellipse" else 0.0015)
     assert outline.extras["width"] < 0.063
@@ -861,7 +862,7 @@ def test_a_cut_outline_hiding_the_balls_middle_keeps_the_cut_regions_prior_width
     visible, occ = _ball_under_leaf(-0.2)
     sides = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "sides"}})
     ellipse = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "ellipse"}})
-    outline = complete(visible, occlusion=occ)
+    outline = complete(visible, occlusion=occ, settings={"evidence": {"cut_prior": "outline"}})
     assert ellipse.extras["width"] > outline.extras["width"] + 0.005  # an ellipse was fitted and is wider
     assert sides.extras["width"] == outline.extras["width"]
 

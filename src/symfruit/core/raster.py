@@ -722,11 +722,12 @@ def free_side_stretch(cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, ca
     contour is seen there, and the ellipse's extent is not read); else the fruit goes on behind the cut, to the farther
     of the region's side and the ellipse's, but no farther than makes the axis as long as the region's widest extent
     (an ellipse fitted to part of an outline is least sure across the part it lacks: a peach's free arcs, its cheek
-    and suture, gave it 114 px across a cut region 90 px wide, against 98 px along the uncut axis, 99 seen). A leaf over a third of a disc (its left side) leaves the
-    vertical extent and the right side seen: only the left side is the ellipse's, and an ellipse fitted long or wide
-    on noisy arcs changes nothing where the outline is free. 1.0 where nothing is cut, the ellipse is not one, or
-    (``region`` given: the outline's region) the ellipse's centre lies outside the region: a round fruit's nearest
-    point is then hidden, and a front read from the seen points lies behind the fruit's.
+    and suture, gave it 114 px across a cut region 90 px wide, against 98 px along the uncut axis, 99 seen). A leaf
+    over a third of a disc (its left side) leaves the vertical extent and the right side seen: only the left side is
+    the ellipse's, and an ellipse fitted long or wide on noisy arcs changes nothing where the outline is free. 1.0
+    where nothing is cut, the ellipse is not one, or (``region`` given: the outline's region) the ellipse's centre
+    lies outside the region: a round fruit's nearest point is then hidden, and a front read from the seen points lies
+    behind the fruit's.
 
     >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
     >>> t = np.linspace(0.0, 2.0 * np.pi, 720, endpoint=False)
