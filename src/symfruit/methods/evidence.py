@@ -173,7 +173,7 @@ class EvidenceSettings(Section):
         with a leaf over a third of each, the mask cut: depth sides 20.4 -> 8.5 mm short; the masks dilated 10 px
         unchanged (the ellipse: +16 -> +25 mm); the development and held-out apple trees' depth sides 4.72 -> 4.54
         and 5.1 -> 4.9 mm; through the Azure Kinect model with a leaf in front the depth side at 50 % hidden 7.6 ->
-        6.9 mm, while the centre error grows (25 % hidden 6.95 -> 7.35 mm, 50 % 9.16 -> 9.31: the model's front
+        6.9 mm, while the centre error grows (25 % hidden 6.95 -> 7.35 mm, 50 % 9.16 -> 9.35: the model's front
         lies 3.9 mm behind the true one, its range bias, which a too-short box had hidden). The default since stop
         57. ``outline``: the cut region's widths, moved by ``cut_width`` (the default before).
     hidden_front : {"sphere", "off"}
