@@ -15,6 +15,7 @@ test unless ``SYMFRUIT_FUZZ_EXAMPLES`` says otherwise.
 from __future__ import annotations
 
 import functools
+import importlib.util
 import os
 import signal
 from pathlib import Path
@@ -110,6 +111,17 @@ EXAMPLES = ROOT / "examples"
 SRC = ROOT / "src" / "symfruit"
 #: The demo frame shipped as package data.
 EXAMPLE_FRAME = Path(symfruit.__file__).resolve().parent / "data" / "example_frame"
+
+
+def docs_script(name: str):
+    """The module of ``docs/<name>.py`` (a measurement script the README and docs/ cite), loaded from its file: the
+    docs folder is no package."""
+    spec = importlib.util.spec_from_file_location(name, ROOT / "docs" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
 #: The part of the example frame :func:`small_frame` keeps: (left, top, right, bottom) pixels.
 SMALL_CROP = (400, 100, 560, 260)
 

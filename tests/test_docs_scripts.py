@@ -10,6 +10,8 @@ from pathlib import Path
 
 import pytest
 
+from .conftest import docs_script
+
 DOCS = Path(__file__).resolve().parents[1] / "docs"
 SCRIPTS = sorted(DOCS.glob("*.py"))
 
@@ -31,16 +33,12 @@ def test_a_docs_script_imports_and_prints_its_usage(script, tmp_path):
 def test_eval_boxes_records_a_box_per_scored_fruit_of_evaluate_frames(tmp_path, monkeypatch):
     """``eval_boxes.py run ... evaluate --frames``: one row per fruit and method, keyed by frame, fruit id and
     method (before: no row at all, so a change could not be compared box by box on frames)."""
-    import importlib.util
-
     import numpy as np
 
     import symfruit.evaluate.frames as frames
     from symfruit.core.box import Box
 
-    spec = importlib.util.spec_from_file_location("eval_boxes", DOCS / "eval_boxes.py")
-    eval_boxes = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(eval_boxes)
+    eval_boxes = docs_script("eval_boxes")
     truth = Box(np.array([0.0, 0.0, 0.3]), np.array([0.03, 0.03, 0.33]))
     boxes = [Box(np.array([0.001 * k, 0.0, 0.3]), np.array([0.03, 0.03, 0.33])) for k in range(3)]
 
@@ -66,14 +64,11 @@ def test_hidden_apples_tables_of_one_small_apple_tree_frame(tmp_path, monkeypatc
     """``hidden_apples.py`` on one apple-tree frame of 8 apples (as `symfruit scenes --scene apple-tree --ripe 8`):
     every matched apple in one visible-share column, the mostly hidden ones split by their mask's kind (the frame
     rendered again from its seed, a wrong seed refused) and counted by their front; the settings file read."""
-    import importlib.util
     import re
 
     from symfruit.synthetic.scenes import write_scenes
 
-    spec = importlib.util.spec_from_file_location("hidden_apples", DOCS / "hidden_apples.py")
-    hidden = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(hidden)
+    hidden = docs_script("hidden_apples")
     frames = tmp_path / "D"
     write_scenes(frames, 1, seed=4, n_ripe=8, n_unripe=1, tree=True)
     config = tmp_path / "before.yaml"
@@ -97,12 +92,7 @@ def test_hidden_apples_tables_of_one_small_apple_tree_frame(tmp_path, monkeypatc
 
 
 def _slab44():
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location("slab44", DOCS / "slab44.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return docs_script("slab44")
 
 
 def test_slab44_classes_points_on_an_apple_behind_it_and_in_front_of_it():

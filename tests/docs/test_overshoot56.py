@@ -1,21 +1,17 @@
 """docs/overshoot56.py (stop 56, docs/overshoot56.md): the lateral sides against the 2D thin-lens estimate, both
 less the unperturbed mask's diameter, read from ``docs/realpert55.py run``'s boxes."""
 
-import importlib.util
 import json
 from pathlib import Path
 
 import pytest
 
-DOCS = Path(__file__).resolve().parents[2] / "docs"
+from ..conftest import docs_script
 
 
 @pytest.fixture(scope="module")
 def ov():
-    spec = importlib.util.spec_from_file_location("overshoot56", DOCS / "overshoot56.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return docs_script("overshoot56")
 
 
 def _write(out: Path, name: str, rows: list[tuple[int, tuple[float, float, float], float]]) -> None:

@@ -3,9 +3,6 @@
 default holds under: a lost rim up to 3 px wider and masks shifted 10 px across keep every sphere a cube within the
 issue's 6 mm for balls, its depth side within 6 mm of the unperturbed mask's diameter."""
 
-import importlib.util
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -14,7 +11,7 @@ from symfruit.core.frame import Frame
 from symfruit.detect import detect
 from symfruit.io.frames import read_frame
 
-DOCS = Path(__file__).resolve().parents[2] / "docs"
+from ..conftest import docs_script
 
 #: one worker runs the real frames' detections (pytest-xdist --dist loadgroup), beside test_spheres' own
 pytestmark = pytest.mark.xdist_group("real-spheres")
@@ -22,10 +19,7 @@ pytestmark = pytest.mark.xdist_group("real-spheres")
 
 @pytest.fixture(scope="module")
 def rp():
-    spec = importlib.util.spec_from_file_location("realpert55", DOCS / "realpert55.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return docs_script("realpert55")
 
 
 def small_frame():
