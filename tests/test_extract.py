@@ -17,6 +17,7 @@ from symfruit.extract import (
     cluster,
     cluster_gap,
     extract,
+    one_sided,
     own_cap,
     own_surface,
     register,
@@ -566,14 +567,45 @@ def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
 def test_the_colour_trim_still_takes_an_overshoot_onto_the_background_or_a_support_at_the_fruits_depth():
     """The same ball under a mask 3 px too wide all round: above and beside it the background 1 m away (far behind
     its rim), below it a board at its depth turning back towards the camera (the convex cap stops at the crease).
-    The colour takes them off with the depth given as without, and keeps the shaded limb: the mask is the disc, but
-    for the board's first row, within the convexity test's tolerance (3 mm) of the ball's rim."""
+    The colour takes them off with the depth given as without: a cut all round is an overshoot's, and the cap keeps
+    none of it (stop 58, :func:`one_sided`)."""
     color, depth, d2 = shaded_ball(board=True)
     labels = (d2 <= 23**2).astype(np.int32)
-    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) == 1
-    assert kept[d2 <= 400].all()
-    assert not kept[(d2 > 400) & (depth > 0.9)].any()  # the background
-    assert not kept[82:].any() and kept[81].sum() <= 15  # the board beyond its first row
+    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0)
+    assert np.array_equal(kept, trim_labels(color, labels))
+    assert not (kept == 1)[(d2 > 400) & (depth > 0.9)].any()  # the background
+    assert not (kept == 1)[81:].any()  # the board
+
+
+# --- stop 58, trim58: the fruit's cap keeps pixels of a one-sided cut alone
+
+
+def test_one_sided_tells_a_cut_on_one_side_from_one_all_round():
+    """Known answers on a disc of 20 px: its lowest 5 rows, or its lower half, take less than two thirds of its
+    outline pixels; a ring 3 px wide all round, or all but its top 5 rows, take more."""
+    yy, xx = np.mgrid[:60, :60]
+    d2 = (xx - 30) ** 2 + (yy - 30) ** 2
+    mask = d2 <= 400
+    assert one_sided(mask, mask & (yy >= 46))
+    assert one_sided(mask, mask & (yy > 30))
+    assert not one_sided(mask, mask & (d2 > 17**2))
+    assert not one_sided(mask, mask & (yy >= 15))
+
+
+def test_the_fruits_cap_keeps_none_of_an_overshoot_all_round_where_the_depth_sits_below_the_colour():
+    """Stop 58 (docs/trim58.md): the depth 3 px low against the colour (the ball's cap runs 3 px past its colour edge
+    at the bottom, as the real frames' larger spheres' 5-11 px), the mask 3 px too wide all round. The colour cuts
+    the overshoot all round; the cap under its lowest rows is the ball's depth, but keeps none of them: the trim is
+    the colour's, the disc. (Stop 57's rule kept those rows.) Drawn right, the ball's shaded limb is kept as before."""
+    color, depth, d2 = shaded_ball()
+    low = np.roll(depth, 3, axis=0)  # the background is 1 m everywhere: rolled rows are the same
+    labels = (d2 <= 23**2).astype(np.int32)
+    kept = trim_labels(color, labels, KEEPS, depth=low, focal=600.0)
+    assert own_cap(low, labels == 1, 600.0)[81:84].any()  # the overshoot's bottom rows lie on the cap
+    assert np.array_equal(kept, trim_labels(color, labels))
+    assert not (kept == 1)[d2 > 400].any()
+    drawn = (d2 <= 400).astype(np.int32)
+    assert trim_labels(color, drawn, KEEPS, depth=low, focal=600.0) is drawn
 
 
 def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():

@@ -15,13 +15,14 @@ from .core.camera import Camera
 from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds, median
-from .core.raster import mask_box, square_filter
-from .core.surface import PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
+from .core.raster import inner_distance, mask_box, square_filter
+from .core.surface import (ALL_ROUND, PART_POINTS, across_occluder, colour_trim, fruit_surface,
+                           registration_shift)  # fmt: skip
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "own_cap", "own_surface",
-           "register", "shift_labels", "trim_labels"]  # fmt: skip
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "one_sided", "own_cap",
+           "own_surface", "register", "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -557,9 +558,24 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     dropped = mask & ~kept
-    if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any():
+    if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
+
+
+def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
+    """Whether the colour's cut ``dropped`` (pixels of ``mask``) takes less than
+    :data:`~symfruit.core.surface.ALL_ROUND` of the mask's outline pixels (the mask's pixels next to one outside it).
+
+    A mask that overshoots its fruit lies on the surroundings nearly all round, and the colour cuts it all round (the
+    real spheres' masks grown 2-10 px: 88-100 % of their outline but for one, 57 %). A shaded limb darkening
+    towards a background of about the fruit's colour is one side of it (the real spheres binned: 29-46 %). Only on
+    such a cut may the fruit's own convex cap keep pixels (``trim_keeps_surface``): the depth near a fruit's outline
+    may sit a few pixels off its colour edge (the real Azure Kinect frames: 5-11 px past the bottom of their larger
+    spheres), and then the cap runs on over an overshoot there, which the colour is right to take (stop 58,
+    docs/trim58.md)."""
+    edge = mask & (inner_distance(mask, 2.0) <= 1.0)
+    return bool(np.count_nonzero(edge & dropped) < ALL_ROUND * np.count_nonzero(edge))
 
 
 def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) -> tuple[np.ndarray, float]:
