@@ -16,8 +16,7 @@ from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds, median
 from .core.raster import inner_distance, mask_box, square_filter
-from .core.surface import (ALL_ROUND, PART_POINTS, across_occluder, colour_trim, fruit_surface,
-                           registration_shift)  # fmt: skip
+from .core.surface import ALL_ROUND, PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
