@@ -70,14 +70,14 @@ class ExtractSettings(Section):
         surroundings do not separate in that band, twice and three times it are tried (:func:`trim_labels`: a mask
         overshooting by more than the band); 0: never.
     trim_keeps_surface : bool
-        Given the depth (``detect``), the colour trim takes no pixel whose depth lies on the fruit's own convex cap
-        (:func:`own_cap`): a shaded limb darkening towards a grey background, or a mask drawn a few pixels off the
-        fruit, where the ring beside it that the colour is compared with is the fruit itself, is the fruit (the
-        real 200 mm sphere's lower limb: its box 182 mm tall for 198 binned 2 x 2, 196 with it). Off by default:
-        the depth is read at the colour's pixels before the registration, and where it sits a few pixels off the
-        colour (the real frames' larger spheres; the camera models' registration offset) the cap runs past the
-        fruit's colour edge and a generous mask's overshoot there is kept too (the real masks grown 2-10 px: 21 ->
-        28 of 32 boxes over the 6 mm bar; the rendered trees' centres 3.9 -> 4.4 mm; stop 57, docs/shift57.md).
+        Given the depth (``detect``), a colour cut on one side of a mask (:func:`one_sided`: under two thirds of its
+        outline) takes no pixel whose depth lies on the fruit's own convex cap (:func:`own_cap`): a shaded limb
+        darkening towards a grey background, or a mask drawn a few pixels off the fruit, where the ring beside it
+        that the colour is compared with is the fruit itself, is the fruit (the real 200 mm sphere's lower limb:
+        its box 182 mm tall for 198 binned 2 x 2, 196 with it; stop 57, docs/shift57.md). A cut all round is an
+        overshoot's, and the colour's alone: where the depth sits a few pixels off the colour (the real frames'
+        larger spheres), the cap runs on over an overshoot past the fruit's colour edge (stop 57's rule on every
+        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md).
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -101,7 +101,7 @@ class ExtractSettings(Section):
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
-    trim_keeps_surface: bool = setting(False)
+    trim_keeps_surface: bool = setting(True)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
