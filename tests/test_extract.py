@@ -593,6 +593,19 @@ def test_one_sided_tells_a_cut_on_one_side_from_one_all_round():
     assert one_sided(mask, mask & (yy > 30))
     assert not one_sided(mask, mask & (d2 > 17**2))
     assert not one_sided(mask, mask & (yy >= 15))
+    with pytest.raises(InputError, match="one_sided: mask and cut must be 2-D images of one shape"):
+        one_sided(mask, mask[:, :-1])
+
+
+@given(st.integers(3, 25), st.integers(0, 50))
+def test_one_sided_no_cut_is_one_sided_and_the_whole_mask_is_not(radius, row):
+    """Any disc: no cut is one-sided, the whole mask is all round, and cutting more rows from the bottom up never
+    turns a cut that lies all round back to one side."""
+    yy, xx = np.mgrid[:56, :56]
+    mask = (xx - 28) ** 2 + (yy - 28) ** 2 <= radius**2
+    assert one_sided(mask, np.zeros_like(mask)) and not one_sided(mask, mask)
+    if not one_sided(mask, mask & (yy >= row)):
+        assert not one_sided(mask, mask & (yy >= row - 1))
 
 
 def test_the_fruits_cap_keeps_none_of_an_overshoot_all_round_where_the_depth_sits_below_the_colour():

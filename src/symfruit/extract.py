@@ -573,6 +573,10 @@ def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
     may sit a few pixels off its colour edge (the real Azure Kinect frames: 5-11 px past the bottom of their larger
     spheres), and then the cap runs on over an overshoot there, which the colour is right to take (stop 58,
     docs/trim58.md)."""
+    mask, dropped = np.asarray(mask, dtype=bool), np.asarray(dropped, dtype=bool)
+    if mask.ndim != 2 or dropped.shape != mask.shape:
+        raise InputError(f"one_sided: mask and cut must be 2-D images of one shape, got {mask.shape} and "
+                         f"{dropped.shape}")  # fmt: skip
     edge = mask & (inner_distance(mask, 2.0) <= 1.0)
     return bool(np.count_nonzero(edge & dropped) < ALL_ROUND * np.count_nonzero(edge))
 
