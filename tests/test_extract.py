@@ -17,6 +17,7 @@ from symfruit.extract import (
     cluster,
     cluster_gap,
     extract,
+    one_sided,
     own_cap,
     own_surface,
     register,
@@ -530,7 +531,8 @@ def test_a_fruit_parted_by_a_strip_in_front_keeps_both_parts(cut):
     assert ex.points[:, 2].min() > 1.29  # none of the strip
 
 
-# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, off)
+# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface; on
+# since stop 58)
 
 KEEPS = ExtractSettings(trim_keeps_surface=True)
 
@@ -552,28 +554,74 @@ def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray
 def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
     """Stop 57 (docs/shift57.md): the colour alone takes the ball's shaded limb off (its lowest rows look like the
     grey ring beside the mask); with the depth and ``trim_keeps_surface``, the limb lies on the ball's own convex cap
-    and is kept, the mask exactly the disc. The default (off), or no depth given: the colour's trim."""
+    and is kept, the mask exactly the disc (the default since stop 58). Off, or no depth given: the colour's trim."""
     color, depth, d2 = shaded_ball()
     labels = (d2 <= 400).astype(np.int32)
     limb = (labels == 1) & (np.mgrid[:120, :160][0] >= 76)
     colour_only = trim_labels(color, labels)
     assert (colour_only[limb] == 0).sum() >= 0.5 * limb.sum()
     assert trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) is labels
+    assert trim_labels(color, labels, depth=depth, focal=600.0) is labels  # the default
     assert np.array_equal(trim_labels(color, labels, KEEPS), colour_only)
-    assert np.array_equal(trim_labels(color, labels, depth=depth, focal=600.0), colour_only)
+    off = ExtractSettings(trim_keeps_surface=False)
+    assert np.array_equal(trim_labels(color, labels, off, depth=depth, focal=600.0), colour_only)
 
 
 def test_the_colour_trim_still_takes_an_overshoot_onto_the_background_or_a_support_at_the_fruits_depth():
     """The same ball under a mask 3 px too wide all round: above and beside it the background 1 m away (far behind
     its rim), below it a board at its depth turning back towards the camera (the convex cap stops at the crease).
-    The colour takes them off with the depth given as without, and keeps the shaded limb: the mask is the disc, but
-    for the board's first row, within the convexity test's tolerance (3 mm) of the ball's rim."""
+    The colour takes them off with the depth given as without: a cut all round is an overshoot's, and the cap keeps
+    none of it (stop 58, :func:`one_sided`)."""
     color, depth, d2 = shaded_ball(board=True)
     labels = (d2 <= 23**2).astype(np.int32)
-    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) == 1
-    assert kept[d2 <= 400].all()
-    assert not kept[(d2 > 400) & (depth > 0.9)].any()  # the background
-    assert not kept[82:].any() and kept[81].sum() <= 15  # the board beyond its first row
+    kept = trim_labels(color, labels, KEEPS, depth=depth, focal=600.0)
+    assert np.array_equal(kept, trim_labels(color, labels))
+    assert not (kept == 1)[(d2 > 400) & (depth > 0.9)].any()  # the background
+    assert not (kept == 1)[81:].any()  # the board
+
+
+# --- stop 58, trim58: the fruit's cap keeps pixels of a one-sided cut alone
+
+
+def test_one_sided_tells_a_cut_on_one_side_from_one_all_round():
+    """Known answers on a disc of 20 px: its lowest 5 rows, or its lower half, take less than two thirds of its
+    outline pixels; a ring 3 px wide all round, or all but its top 5 rows, take more."""
+    yy, xx = np.mgrid[:60, :60]
+    d2 = (xx - 30) ** 2 + (yy - 30) ** 2
+    mask = d2 <= 400
+    assert one_sided(mask, mask & (yy >= 46))
+    assert one_sided(mask, mask & (yy > 30))
+    assert not one_sided(mask, mask & (d2 > 17**2))
+    assert not one_sided(mask, mask & (yy >= 15))
+    with pytest.raises(InputError, match="one_sided: mask and cut must be 2-D images of one shape"):
+        one_sided(mask, mask[:, :-1])
+
+
+@given(st.integers(3, 25), st.integers(0, 50))
+def test_one_sided_no_cut_is_one_sided_and_the_whole_mask_is_not(radius, row):
+    """Any disc: no cut is one-sided, the whole mask is all round, and cutting more rows from the bottom up never
+    turns a cut that lies all round back to one side."""
+    yy, xx = np.mgrid[:56, :56]
+    mask = (xx - 28) ** 2 + (yy - 28) ** 2 <= radius**2
+    assert one_sided(mask, np.zeros_like(mask)) and not one_sided(mask, mask)
+    if not one_sided(mask, mask & (yy >= row)):
+        assert not one_sided(mask, mask & (yy >= row - 1))
+
+
+def test_the_fruits_cap_keeps_none_of_an_overshoot_all_round_where_the_depth_sits_below_the_colour():
+    """Stop 58 (docs/trim58.md): the depth 3 px low against the colour (the ball's cap runs 3 px past its colour edge
+    at the bottom, as the real frames' larger spheres' 5-11 px), the mask 3 px too wide all round. The colour cuts
+    the overshoot all round; the cap under its lowest rows is the ball's depth, but keeps none of them: the trim is
+    the colour's, the disc. (Stop 57's rule kept those rows.) Drawn right, the ball's shaded limb is kept as before."""
+    color, depth, d2 = shaded_ball()
+    low = np.roll(depth, 3, axis=0)  # the background is 1 m everywhere: rolled rows are the same
+    labels = (d2 <= 23**2).astype(np.int32)
+    kept = trim_labels(color, labels, KEEPS, depth=low, focal=600.0)
+    assert own_cap(low, labels == 1, 600.0)[81:84].any()  # the overshoot's bottom rows lie on the cap
+    assert np.array_equal(kept, trim_labels(color, labels))
+    assert not (kept == 1)[d2 > 400].any()
+    drawn = (d2 <= 400).astype(np.int32)
+    assert trim_labels(color, drawn, KEEPS, depth=low, focal=600.0) is drawn
 
 
 def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():

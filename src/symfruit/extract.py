@@ -15,13 +15,13 @@ from .core.camera import Camera
 from .core.kernels import compiled
 from .core.limits import depth_metres
 from .core.points import bounds, median
-from .core.raster import mask_box, square_filter
-from .core.surface import PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
+from .core.raster import inner_distance, mask_box, square_filter
+from .core.surface import ALL_ROUND, PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "own_cap", "own_surface",
-           "register", "shift_labels", "trim_labels"]  # fmt: skip
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "one_sided", "own_cap",
+           "own_surface", "register", "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -70,14 +70,14 @@ class ExtractSettings(Section):
         surroundings do not separate in that band, twice and three times it are tried (:func:`trim_labels`: a mask
         overshooting by more than the band); 0: never.
     trim_keeps_surface : bool
-        Given the depth (``detect``), the colour trim takes no pixel whose depth lies on the fruit's own convex cap
-        (:func:`own_cap`): a shaded limb darkening towards a grey background, or a mask drawn a few pixels off the
-        fruit, where the ring beside it that the colour is compared with is the fruit itself, is the fruit (the
-        real 200 mm sphere's lower limb: its box 182 mm tall for 198 binned 2 x 2, 196 with it). Off by default:
-        the depth is read at the colour's pixels before the registration, and where it sits a few pixels off the
-        colour (the real frames' larger spheres; the camera models' registration offset) the cap runs past the
-        fruit's colour edge and a generous mask's overshoot there is kept too (the real masks grown 2-10 px: 21 ->
-        28 of 32 boxes over the 6 mm bar; the rendered trees' centres 3.9 -> 4.4 mm; stop 57, docs/shift57.md).
+        Given the depth (``detect``), a colour cut on one side of a mask (:func:`one_sided`: under two thirds of its
+        outline) takes no pixel whose depth lies on the fruit's own convex cap (:func:`own_cap`): a shaded limb
+        darkening towards a grey background, or a mask drawn a few pixels off the fruit, where the ring beside it
+        that the colour is compared with is the fruit itself, is the fruit (the real 200 mm sphere's lower limb:
+        its box 182 mm tall for 198 binned 2 x 2, 196 with it; stop 57, docs/shift57.md). A cut all round is an
+        overshoot's, and the colour's alone: where the depth sits a few pixels off the colour (the real frames'
+        larger spheres), the cap runs on over an overshoot past the fruit's colour edge (stop 57's rule on every
+        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md).
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -101,7 +101,7 @@ class ExtractSettings(Section):
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
-    trim_keeps_surface: bool = setting(False)
+    trim_keeps_surface: bool = setting(True)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
@@ -557,9 +557,28 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     dropped = mask & ~kept
-    if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any():
+    if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
+
+
+def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
+    """Whether the colour's cut ``dropped`` (pixels of ``mask``) takes less than
+    :data:`~symfruit.core.surface.ALL_ROUND` of the mask's outline pixels (the mask's pixels next to one outside it).
+
+    A mask that overshoots its fruit lies on the surroundings nearly all round, and the colour cuts it all round (the
+    real spheres' masks grown 2-10 px: 88-100 % of their outline but for one, 57 %). A shaded limb darkening
+    towards a background of about the fruit's colour is one side of it (the real spheres binned: 29-46 %). Only on
+    such a cut may the fruit's own convex cap keep pixels (``trim_keeps_surface``): the depth near a fruit's outline
+    may sit a few pixels off its colour edge (the real Azure Kinect frames: 5-11 px past the bottom of their larger
+    spheres), and then the cap runs on over an overshoot there, which the colour is right to take (stop 58,
+    docs/trim58.md)."""
+    mask, dropped = np.asarray(mask, dtype=bool), np.asarray(dropped, dtype=bool)
+    if mask.ndim != 2 or dropped.shape != mask.shape:
+        raise InputError(f"one_sided: mask and cut must be 2-D images of one shape, got {mask.shape} and "
+                         f"{dropped.shape}")  # fmt: skip
+    edge = mask & (inner_distance(mask, 2.0) <= 1.0)
+    return bool(np.count_nonzero(edge & dropped) < ALL_ROUND * np.count_nonzero(edge))
 
 
 def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) -> tuple[np.ndarray, float]:

@@ -1961,9 +1961,14 @@ def _told(outline: _Outline, shifts: np.ndarray, reach: int, trim: float, exact:
     return outline.cost(seen, reach, trim, exact=exact)[back.reshape(-1)]
 
 
+#: :func:`colour_trim`: the least share of a mask's outline pixels that a cut lying all round it (an overshoot, not a
+#: shaded limb or a mask drawn off to one side) removes.
+ALL_ROUND = 2.0 / 3.0
+
+
 def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
                 min_accuracy: float = 0.85, margin: float = 0.5, wider: tuple[float, ...] = (),
-                outline_share: float = 2.0 / 3.0) -> np.ndarray:  # fmt: skip
+                outline_share: float = ALL_ROUND) -> np.ndarray:  # fmt: skip
     """``mask`` less the pixels of its outer band whose colour is the background's, not the fruit's.
 
     Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
