@@ -6,8 +6,9 @@ stop 58, docs/strip58.md).
 For every fruit of every frame folder (``docs/realpert55.py run OUT`` writes them under ``OUT/frames/NAME/``) one
 line: the mask's pixels as drawn, as the colour trim left them, and the region ``evidence`` reads (the points'
 silhouette joined with the mask) before and after :func:`~symfruit.core.occlusion.bridged`; the points kept and the
-parts :func:`~symfruit.core.surface.across_occluder` joined (with the joint fit's curvature times the radius and the
-facing edges' gap, the tests that refused a part); the outline's contour share and where the viewing cone came from;
+parts :func:`~symfruit.core.surface.across_occluder` joined, with the last part it weighed: whether the joint fit found
+one convex surface (its test 2: the curvature, the residuals, the facing edges) and that fit's mean curvature times
+the fruit's radius (a sheet under 0.3); the outline's contour share and where the viewing cone came from;
 the region's widths across the line of sight and the prior's width (mm); the candidate with the most weight, that
 weight and its box (mm); the candidates' fused back face and the prior's, each as a depth from the front (mm) with its
 standard deviation; and the box. Read alongside ``fuse_depth``'s docstring: its back face is the inverse-variance mean
