@@ -41,6 +41,7 @@ FRAMES = Path(__file__).resolve().parent.parent / "examples" / "real-frames"
 NAMES = ("lab-spheres-0", "lab-spheres-1")
 METHODS = ("raw", "sphere", "ellipsoid", "superellipsoid", "paper", "evidence")
 BAR_MM = 6.0  # issue 18's bar for balls
+LEAF_GREEN = (60, 100, 40)  # a leaf's RGB (the `-green` perturbations: the leaf painted; docs/strip58.md)
 
 Perturb = Callable[[Frame], tuple[np.ndarray, np.ndarray, np.ndarray, Camera]]  # colour, depth (m), masks, camera
 
@@ -125,7 +126,7 @@ def rim_eroded(frame: Frame, r: int) -> tuple[np.ndarray, np.ndarray, np.ndarray
 
 
 def leafed(
-    frame: Frame, shape: str, gap: float, cut: bool, seed: int = 0
+    frame: Frame, shape: str, gap: float, cut: bool, seed: int = 0, paint: tuple[int, int, int] | None = None
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray, Camera]:
     """A leaf ``gap`` metres in front of every sphere's nearest seen point: ``shape`` ``side`` covers the left 35 %
     of the sphere's width (a half-plane), ``strip`` a horizontal band over the middle 20 % of its height, each
@@ -133,10 +134,15 @@ def leafed(
     the frame's own noise (:func:`noise_level`), and its edge loses depth as the camera's silhouettes do: a
     pixel of the leaf or behind it within 2 px of the leaf's edge has none (the mixed pixels the camera
     invalidates). ``cut``: the mask loses what the leaf hides (an annotator outlining the visible part); else the
-    mask is drawn over the leaf (an annotator outlining the whole fruit)."""
+    mask is drawn over the leaf (an annotator outlining the whole fruit). ``paint``: the leaf's pixels (its edge
+    included) take this RGB colour plus a noise of 8 levels a channel (a leaf has a colour of its own; without, the
+    colour image shows the fruit through it, and the colour trim compares a cut mask's band with the fruit itself:
+    docs/strip58.md)."""
     rng = np.random.default_rng(seed)
     sigma = noise_level(frame.depth)
     depth, masks = frame.depth.astype(np.float64).copy(), frame.masks.copy()
+    color = frame.color.copy() if paint is not None else frame.color
+    tint = np.random.default_rng([seed, 1])  # its own stream: the depth is the unpainted leaf's to the bit
     ids = np.unique(frame.masks[frame.masks > 0])
     for k in ids:
         mine = frame.masks == k
@@ -157,9 +163,13 @@ def leafed(
         edge = ndimage.binary_dilation(leaf, disk(2)) & ~ndimage.binary_erosion(leaf, disk(2))
         depth[leaf] = z + sigma * rng.standard_normal(int(leaf.sum()))
         depth[edge & ~others] = 0.0
+        if paint is not None:
+            at = (leaf | edge) & ~others
+            noise = 8.0 * tint.standard_normal((int(at.sum()), 3))
+            color[at] = np.clip(np.asarray(paint, np.float64) + noise, 0, 255).astype(np.uint8)
         if cut:
             masks[leaf & mine] = 0
-    return frame.color, depth.astype(np.float32), masks, frame.camera
+    return color, depth.astype(np.float32), masks, frame.camera
 
 
 PERTURBATIONS: dict[str, Perturb] = {
@@ -181,6 +191,9 @@ PERTURBATIONS: dict[str, Perturb] = {
     "leafside15-cut": lambda f: leafed(f, "side", 0.15, cut=True),
     "leafstrip5-over": lambda f: leafed(f, "strip", 0.05, cut=False),
     "leafstrip5-cut": lambda f: leafed(f, "strip", 0.05, cut=True),
+    "leafstrip5-over-green": lambda f: leafed(f, "strip", 0.05, cut=False, paint=LEAF_GREEN),
+    "leafstrip5-cut-green": lambda f: leafed(f, "strip", 0.05, cut=True, paint=LEAF_GREEN),
+    "leafside5-cut-green": lambda f: leafed(f, "side", 0.05, cut=True, paint=LEAF_GREEN),
     "rim1": lambda f: rim_eroded(f, 1),
     "rim2": lambda f: rim_eroded(f, 2),
     "rim3": lambda f: rim_eroded(f, 3),

@@ -81,6 +81,22 @@ def test_a_leaf_lies_in_front_with_the_frames_noise_and_loses_depth_along_its_ed
     assert (over[hidden] == 0).any()  # its edge holds no depth (the camera's mixed pixels)
 
 
+def test_a_painted_leaf_changes_the_colour_of_its_own_pixels_alone_and_not_the_depth_or_the_masks(rp):
+    """The ``-green`` perturbations (docs/strip58.md): the leaf and its lost edge take a leaf's colour; its depth and
+    the masks are the unpainted leaf's to the bit (the paint draws from a stream of its own)."""
+    frame = read_frame(rp.FRAMES / "lab-spheres-0")
+    for shape in ("strip", "side"):
+        color, depth, masks, _ = rp.leafed(frame, shape, 0.05, cut=True)
+        painted, depth_p, masks_p, _ = rp.leafed(frame, shape, 0.05, cut=True, paint=rp.LEAF_GREEN)
+        assert (color == frame.color).all() and (depth_p == depth).all() and (masks_p == masks).all()
+        changed = (painted != frame.color).any(axis=2)
+        assert changed.sum() > 1000
+        assert np.abs(painted[changed].astype(np.float64).mean(axis=0) - rp.LEAF_GREEN).max() < 2.0
+        if shape == "strip":  # (a side leaf lies in part at the depth of the next sphere's surface)
+            leaf = (np.abs(depth.astype(np.float64) - frame.depth) > 0.01) | (depth == 0)  # 5 cm in front, no depth
+            assert not (changed & ~leaf).any()
+
+
 def spheres(rp, name, settings=None, frame_name="lab-spheres-0"):
     """Every sphere's box of frame ``frame_name`` (0) under perturbation ``name`` and its reference diameter (mm),
     the unperturbed mask's at the box's depth (the scorer's: ``evaluate_spheres``); ``settings`` as ``detect``'s."""
