@@ -810,8 +810,8 @@ def test_a_cut_outline_whose_ellipse_centre_is_hidden_keeps_the_cut_regions_widt
 def test_a_disc_cut_on_one_side_has_its_cut_edge_carried_to_the_ellipse_and_the_rest_as_seen():
     """Stop 58 (docs/cut58.md): the disc of stop 57's test, its left 30 % hidden. The whole outline
     :func:`free_side_reach` reads moves the cut edge (column 43.5, the pixel edges along the leaf, and the outline
-    within 1 px of it) to the ellipse's left side (column 30) and leaves every other point where it was seen: the fruit's extent, 40.5 x 41 px, its
-    stretch stop 57's. Nothing cut: no outline."""
+    within 1 px of it) to the ellipse's left side (column 30) and leaves every other point where it was seen: the
+    fruit's extent, 40.5 x 41 px, its stretch stop 57's. Nothing cut: no outline."""
     from symfruit.core.raster import free_side_reach
 
     region, cracks, free, cam = _cut_disc(44.0)

@@ -758,8 +758,10 @@ def free_side_stretch(cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, ca
     return free_side_reach(cracks, free, cone, camera, region, tie_px=tie_px)[0]
 
 
-def free_side_reach(cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, camera: Camera,
-                    region: Silhouette | None = None, *, tie_px: float = 1.0) -> tuple[float, np.ndarray | None]:  # fmt: skip
+def free_side_reach(
+    cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, camera: Camera, region: Silhouette | None = None,
+    *, tie_px: float = 1.0,
+) -> tuple[float, np.ndarray | None]:  # fmt: skip
     """:func:`free_side_stretch` and the fruit's whole outline it reads: ``(stretch, outline)``, ``outline`` (m, 2)
     float pixels or None where nothing moves (the stretch 1). The outline is ``cracks`` with, on each cut side that
     goes on behind the cut, the outline points within ``tie_px`` of its outermost moved out along the axis to where
