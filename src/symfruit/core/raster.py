@@ -763,12 +763,13 @@ def free_side_reach(
     *, tie_px: float = 1.0,
 ) -> tuple[float, np.ndarray | None]:  # fmt: skip
     """:func:`free_side_stretch` and the fruit's whole outline it reads: ``(stretch, outline)``, ``outline`` (m, 2)
-    float pixels or None where nothing moves (the stretch 1). The outline is ``cracks`` with, on each cut side that
-    goes on behind the cut, the outline points within ``tie_px`` of its outermost moved out along the axis to where
-    the fruit ends there (the cut edge carried to the ellipse's side, capped as the stretch is: where both sides of an
-    axis are cut the cap shares the extra length between them in proportion). Its extent is the fruit's on every
-    side: the seen contour's on a free side, the ellipse's on a cut one (a leaf over a disc's left third: the left
-    edge moved to the disc's left side, the rest as seen)."""
+    float pixels or None where nothing moves (the stretch 1). The outline is ``cracks`` and, on each cut side that
+    goes on behind the cut, the ellipse's outermost point along the axis there: where the fruit ends on that side
+    (capped as the stretch is, the point then drawn towards the ellipse's centre along the diameter conjugate to the
+    axis; where both sides of an axis are cut the cap shares the extra length between them in proportion). Its extent
+    is the fruit's on every side: the seen contour's on a free side, the ellipse's on a cut one (a leaf over a disc's
+    left third: the disc's leftmost point added, the rest as seen). One point a side, not the cut edge moved: a
+    chord carried out along an oblique axis would stick out past the ellipse across it."""
     pts = np.asarray(cracks, dtype=np.float64)
     ok = np.asarray(free, dtype=bool)
     if len(pts) < 3 or ok.all() or not ok.any():
@@ -792,7 +793,7 @@ def free_side_reach(
     _, axes = np.linalg.eigh(np.cov(pts.T))
     stretch = 1.0
     widest = max(float(np.ptp(pts @ e)) for e in axes.T)
-    moved = pts.copy()
+    ends = []
     for e in axes.T:
         proj = pts @ e
         reach = math.sqrt(k * float(e @ a_inv @ e))  # the ellipse's half extent along e
@@ -805,12 +806,14 @@ def free_side_reach(
             length = max(min(new_hi - new_lo, widest), hi - lo)
             stretch *= length / (hi - lo)
             grown = (new_hi - new_lo) - (hi - lo)
-            if grown > 0.0:  # the capped extra length, shared by the two sides in proportion to their reach
-                keep = (length - (hi - lo)) / grown
-                moved[at_lo] -= np.outer(np.full(int(at_lo.sum()), keep * (lo - new_lo)), e)
-                moved[at_hi] += np.outer(np.full(int(at_hi.sum()), keep * (new_hi - hi)), e)
+            keep = (length - (hi - lo)) / grown if grown > 0.0 else 0.0  # the capped extra length, shared
+            # the ellipse's extreme points along e are centre +- reach * conjugate (projections mid +- reach)
+            conjugate = (a_inv @ e) / float(e @ a_inv @ e)
+            for side, target in ((lo, lo - keep * (lo - new_lo)), (hi, hi + keep * (new_hi - hi))):
+                if target != side:
+                    ends.append(centre + (target - mid) * conjugate)
     stretch = math.sqrt(stretch)
-    return stretch, (moved if stretch > 1.0 else None)
+    return stretch, (np.vstack((pts, *ends)) if ends and stretch > 1.0 else None)
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
