@@ -968,9 +968,9 @@ def test_a_cut_sides_lateral_face_is_pulled_to_where_the_fruit_ends_not_to_the_c
     as the disc (the shapes fitted it right). ``fuse_depth`` pulls the box's left face towards the silhouette's by
     the prior's share times the contour share squared: to the leaf's edge with the cut region's faces (the box 30 %
     of the disc short by that share: ``cut_faces: region``); to the disc's left side with the whole outline's
-    (:func:`~symfruit.core.raster.free_side_reach`, the cut edge carried to the ellipse of the free arcs): the face
-    then moves by the half pixel between the ellipse and the disc's outline at most. The right face, free, is the
-    same either way."""
+    (:func:`~symfruit.core.raster.free_side_reach`: the outline and the outermost point of the ellipse through the
+    free arcs): the face then moves by the half pixel between the ellipse and the disc's outline at most. The right
+    face, free, is the same either way."""
     from symfruit import Box
     from symfruit.core.raster import Silhouette, across_sight, free_side_reach, outline_cracks, tangent_extent
     from symfruit.methods.evidence import Combined, fuse_depth

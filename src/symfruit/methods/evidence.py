@@ -181,9 +181,11 @@ class EvidenceSettings(Section):
         With ``cut_prior: sides``, where a side of the outline is cut and the fruit goes on behind it
         (:func:`~symfruit.core.raster.free_side_reach`): ``sides`` (stop 58, docs/cut58.md) moves the silhouette's
         lateral face on that side, which :func:`fuse_depth` pulls the box's towards, to where the fruit ends there
-        (the cut edge carried to the ellipse of the free arcs, no axis beyond the region's widest extent), so that
-        the box's side across a cut is neither stopped at the leaf nor run past the fruit; ``region``: the cut
-        region's face (the default before).
+        (the outermost point there of the ellipse through the free arcs, no axis beyond the region's widest
+        extent), so that the box's side across a cut is neither stopped at the leaf nor run past the fruit (pulled
+        out by the prior's share, in by that times the contour share squared); ``region``: the cut region's face
+        (the default before). The real spheres with a leaf over a third of each, the mask cut: the 200 mm sphere's
+        x side 183 -> 198 mm; the development apple trees' centres 3.87 -> 3.83 mm.
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
