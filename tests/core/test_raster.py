@@ -802,3 +802,73 @@ def test_a_cut_outline_whose_ellipse_centre_is_hidden_keeps_the_cut_regions_widt
     cone = _circle_cone(cam, 20.0)
     assert free_side_stretch(cracks, free, cone, cam, region) == 1.0
     assert free_side_stretch(cracks, free, cone, cam) > 1.2
+
+
+# --- stop 58, cut58: the cut side's lateral face, where the fruit ends behind the cut
+
+
+def test_a_disc_cut_on_one_side_gains_the_ellipses_outermost_point_there_and_keeps_the_rest_as_seen():
+    """Stop 58 (docs/cut58.md): the disc of stop 57's test, its left 30 % hidden. The whole outline
+    :func:`free_side_reach` reads is the seen one and the ellipse's leftmost point, (30, 50): the fruit's extent,
+    40.5 x 41 px, its stretch stop 57's. Nothing cut: no outline."""
+    from symfruit.core.raster import free_side_reach
+
+    region, cracks, free, cam = _cut_disc(44.0)
+    stretch, outline = free_side_reach(cracks, free, _circle_cone(cam, 20.0), cam, region)
+    assert stretch**2 == pytest.approx(40.5 / 27.0, rel=1e-9)
+    np.testing.assert_array_equal(outline[: len(cracks)], cracks)
+    np.testing.assert_allclose(outline[len(cracks) :], [[30.0, 50.0]], rtol=0, atol=1e-9)
+    assert free_side_reach(cracks, np.ones(len(cracks), bool), _circle_cone(cam, 20.0), cam, region) == (1.0, None)
+
+
+def test_a_disc_cut_on_both_sides_shares_the_capped_length_between_them():
+    """Stop 58: a leaf on either side leaves the disc's middle 13 px (columns 44-56). An ellipse fitted too large
+    (radius 30 px) reaches 30 px either side of the centre; the axis is capped at the widest seen extent (the uncut
+    vertical, 41 px), and the 28 px it may grow are shared in proportion to the two sides' reach (equal here): the
+    outline gains the points 14 px beyond either cut edge on the ellipse's diameter across them, (29.5, 50) and
+    (70.5, 50)."""
+    from symfruit.core.raster import Silhouette, free_side_reach, outline_cracks
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    v, u = np.mgrid[:100, :100]
+    mask = ((u - 50.0) ** 2 + (v - 50.0) ** 2 <= 400.0) & (u >= 44) & (u <= 56)
+    region = Silhouette(0, 0, mask, 0.0)
+    cracks = outline_cracks(region)
+    free = (cracks[:, 0] > 43.6) & (cracks[:, 0] < 56.4)
+    stretch, outline = free_side_reach(cracks, free, _circle_cone(cam, 30.0), cam, region)
+    assert stretch**2 == pytest.approx(41.0 / 13.0, rel=1e-9)
+    np.testing.assert_allclose(outline[len(cracks) :], [[29.5, 50.0], [70.5, 50.0]], rtol=0, atol=1e-9)
+
+
+def test_an_oblique_cut_adds_the_ellipses_extreme_point_inside_its_box():
+    """Stop 58: a leaf over a disc's upper left, cut along a diagonal (the region's principal axes oblique). The
+    points added lie on the ellipse (the disc), so the outline's box is within the disc's on every side: the cut edge
+    itself carried out along the oblique axis would have stuck out past the disc across it."""
+    from symfruit.core.raster import Silhouette, free_side_reach, outline_cracks
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    v, u = np.mgrid[:100, :100]
+    mask = ((u - 50.0) ** 2 + (v - 50.0) ** 2 <= 400.0) & (u + v >= 90)
+    region = Silhouette(0, 0, mask, 0.0)
+    cracks = outline_cracks(region)
+    free = cracks.sum(axis=1) > 90.6
+    stretch, outline = free_side_reach(cracks, free, _circle_cone(cam, 20.0), cam, region)
+    assert stretch > 1.1
+    added = outline[len(cracks) :]
+    assert len(added) == 1
+    np.testing.assert_allclose(np.hypot(*(added - 50.0).T), 20.0, atol=1e-9)  # on the disc's circle
+    assert outline[:, 0].min() >= 29.5 and outline[:, 1].min() >= 29.5
+
+
+def test_the_tangent_extent_of_a_regions_outline_is_across_sights():
+    """:func:`tangent_extent` reads outline points as :func:`across_sight` reads its region's (here off the optical
+    axis, where the tangent frame is not the image's)."""
+    from symfruit.core.raster import Silhouette, across_sight, outline_cracks, tangent_extent
+
+    cam = Camera(fx=500.0, fy=500.0, cx=320.0, cy=240.0, width=640, height=480)
+    v, u = np.mgrid[:60, :80]
+    region = Silhouette(500, 30, ((u - 40.0) / 35.0) ** 2 + ((v - 30.0) / 25.0) ** 2 <= 1.0, 0.0)
+    across = across_sight(region, cam)
+    lo, hi = tangent_extent(outline_cracks(region), across, cam)
+    np.testing.assert_allclose(lo, across.lo, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(hi, across.hi, rtol=0, atol=1e-12)

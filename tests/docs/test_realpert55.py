@@ -194,6 +194,25 @@ def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_largest_sphere_as_deep_
     assert abs(sides[2][0][2] - sides[2][1]) <= 12.0, sides[2]
 
 
+def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_larger_spheres_as_wide_as_they_are_across_the_cut(rp):
+    """Stop 58 (docs/cut58.md): the leaf of the test above. The box's side across the cut (x) was pulled towards the
+    cut silhouette's left face, the leaf's edge, though the shapes fitted the sphere whole there (sphere 1
+    183 x 196 x 198 mm for 198, its cone 196 mm wide; ``cut_faces: region``). With ``cut_faces: sides`` (the default)
+    that face is where the ellipse through the free arcs ends: the 200 mm sphere's x side within 3 mm of its diameter,
+    the 125 mm sphere's within 10 (from 15 short); the free sides (y) as they were."""
+    from symfruit.settings import from_dict
+
+    was = {
+        k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", from_dict({"evidence": {"cut_faces": "region"}}))
+    }
+    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut")}
+    assert was[1][0][0] < was[1][1] - 10.0 and was[2][0][0] < was[2][1] - 10.0, (was[1], was[2])
+    assert abs(now[1][0][0] - now[1][1]) <= 3.0, now[1]
+    assert abs(now[2][0][0] - now[2][1]) <= 10.0, now[2]
+    for k in (1, 2):
+        assert now[k][0][1] == pytest.approx(was[k][0][1], abs=0.5)
+
+
 # --- stop 56, support56: a support at the fruit's own depth is no occluder
 
 

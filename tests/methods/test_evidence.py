@@ -961,3 +961,41 @@ def test_an_exact_spheroid_stood_up_is_completed_to_its_length():
             assert r.extras["weights"]["ellipsoid"] > 0.8
             assert r.box.size[2] == pytest.approx(truth.size[2], abs=0.003)
             assert truth.size[2] > 1.45 * truth.size[0]
+
+
+def test_a_cut_sides_lateral_face_is_pulled_to_where_the_fruit_ends_not_to_the_cut():
+    """Stop 58 (docs/cut58.md): a disc 40 px across at the image centre, a leaf over its left 30 %, and a box as wide
+    as the disc (the shapes fitted it right). ``fuse_depth`` pulls the box's left face towards the silhouette's by
+    the prior's share times the contour share squared: to the leaf's edge with the cut region's faces (the box 30 %
+    of the disc short by that share: ``cut_faces: region``); to the disc's left side with the whole outline's
+    (:func:`~symfruit.core.raster.free_side_reach`: the outline and the outermost point of the ellipse through the
+    free arcs): the face then moves by the half pixel between the ellipse and the disc's outline at most. The right
+    face, free, is the same either way."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight, free_side_reach, outline_cracks, tangent_extent
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
+    yy, xx = np.mgrid[:60, :60]
+    disc = np.hypot(yy - 29.5, xx - 29.5) <= 20
+    region = Silhouette(u0, v0, disc & (xx >= 22), 0.0)  # the left 30 % hidden
+    across = across_sight(region, cam)
+    cracks = outline_cracks(region)
+    cu, cv = u0 + 29.5, v0 + 29.5
+    conic = np.array([[1.0, 0.0, -cu], [0.0, 1.0, -cv], [-cu, -cv, cu * cu + cv * cv - 400.0]])
+    _, outline = free_side_reach(cracks, cracks[:, 0] > u0 + 21.6, cam.matrix.T @ conic @ cam.matrix, cam, region)
+    faces = tangent_extent(outline, across, cam)
+    whole, _ = tangent_extent(outline_cracks(Silhouette(u0, v0, disc, 0.0)), across, cam)
+    assert faces[0][0] == pytest.approx(whole[0], abs=0.6 / cam.fx)  # the disc's left side, to the half pixel
+    z, r = 0.5, 20.0 * 0.5 / cam.fx  # the disc's radius at 0.5 m
+    centre = np.array([(cu - cam.cx) / cam.fx, (cv - cam.cy) / cam.fy]) * z
+    box = Box(np.array([centre[0] - r, centre[1] - r, z]), np.array([centre[0] + r, centre[1] + r, z + 2 * r]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, 0.6, 0.0)
+    s = EvidenceSettings()
+    cut, _, _ = fuse_depth(combined, [cand], region, cam, s=s, rim=0.4, across=across)  # a lost rim: the prior decides
+    told, _, _ = fuse_depth(combined, [cand], region, cam, s=s, rim=0.4, across=across, faces=faces)
+    assert cut.min[0] > box.min[0] + 0.1 * (0.3 * 2 * r)  # pulled a tenth of the hidden 30 % in, at least
+    assert abs(told.min[0] - box.min[0]) < 0.6 * z / cam.fx  # the disc's side, to the half pixel
+    assert told.max[0] == cut.max[0] and told.max[2] == cut.max[2]

@@ -672,6 +672,23 @@ def across_sight(region: Silhouette, camera: Camera) -> Across:
     return Across(axis, basis, edge.min(axis=0), edge.max(axis=0), float(np.ptp(p[:, 0])), float(np.ptp(p[:, 1])))
 
 
+def tangent_extent(points: np.ndarray, across: Across, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
+    """The least and greatest tangent coordinates of outline ``points`` ((m, 2) float, pixels) in ``across``' frame
+    (its ray and basis), as :func:`across_sight` reads its region's outline: ``(lo, hi)``, each (2,).
+
+    >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    >>> m = np.zeros((100, 100), bool); m[40:60, 45:55] = True
+    >>> a = across_sight(Silhouette(0, 0, m, 0.0), cam)
+    >>> lo, hi = tangent_extent(outline_cracks(Silhouette(0, 0, m, 0.0)), a, cam)
+    >>> bool(np.allclose(lo, a.lo) and np.allclose(hi, a.hi))
+    True
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    r = camera.rays(pts[:, 0], pts[:, 1]).reshape(-1, 3)
+    t = (r @ across.basis.T) / (r @ across.axis)[:, None]
+    return t.min(axis=0), t.max(axis=0)
+
+
 def _image_cone(conic: np.ndarray, centre: np.ndarray, camera: Camera) -> tuple[np.ndarray, np.ndarray]:
     """An image conic (negative inside) as a viewing cone scaled to a largest eigenvalue of magnitude 1, and
     the ray through ``centre`` (pixels)."""
@@ -738,39 +755,65 @@ def free_side_stretch(cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, ca
     >>> round(free_side_stretch(disc, ~cut, cam.matrix.T @ conic @ cam.matrix, cam) ** 2, 3)  # 40 / 26 px, 40 / 40
     1.538
     """
+    return free_side_reach(cracks, free, cone, camera, region, tie_px=tie_px)[0]
+
+
+def free_side_reach(
+    cracks: np.ndarray, free: np.ndarray, cone: np.ndarray, camera: Camera, region: Silhouette | None = None,
+    *, tie_px: float = 1.0,
+) -> tuple[float, np.ndarray | None]:  # fmt: skip
+    """:func:`free_side_stretch` and the fruit's whole outline it reads: ``(stretch, outline)``, ``outline`` (m, 2)
+    float pixels or None where nothing moves (the stretch 1). The outline is ``cracks`` and, on each cut side that
+    goes on behind the cut, the ellipse's outermost point along the axis there: where the fruit ends on that side
+    (capped as the stretch is, the point then drawn towards the ellipse's centre along the diameter conjugate to the
+    axis; where both sides of an axis are cut the cap shares the extra length between them in proportion). Its extent
+    is the fruit's on every side: the seen contour's on a free side, the ellipse's on a cut one (a leaf over a disc's
+    left third: the disc's leftmost point added, the rest as seen). One point a side, not the cut edge moved: a
+    chord carried out along an oblique axis would stick out past the ellipse across it."""
     pts = np.asarray(cracks, dtype=np.float64)
     ok = np.asarray(free, dtype=bool)
     if len(pts) < 3 or ok.all() or not ok.any():
-        return 1.0
+        return 1.0, None
     inv_k = np.linalg.inv(camera.matrix)
     conic = inv_k.T @ np.asarray(cone, dtype=np.float64) @ inv_k  # the ellipse in pixels, negative inside
     a, b = conic[:2, :2], conic[:2, 2]
     eig = np.linalg.eigvalsh(a)
     if not np.isfinite(conic).all() or eig[0] <= 0.0:
-        return 1.0
+        return 1.0, None
     centre = -np.linalg.solve(a, b)
     k = float(centre @ a @ centre - conic[2, 2])
     if not k > 0.0:
-        return 1.0
+        return 1.0, None
     if region is not None:
         cu, cv = round(float(centre[0])) - region.u0, round(float(centre[1])) - region.v0
         h, w = region.mask.shape
         if not (0 <= cu < w and 0 <= cv < h and region.mask[cv, cu]):
-            return 1.0
+            return 1.0, None
     a_inv = np.linalg.inv(a)
     _, axes = np.linalg.eigh(np.cov(pts.T))
     stretch = 1.0
     widest = max(float(np.ptp(pts @ e)) for e in axes.T)
+    ends = []
     for e in axes.T:
         proj = pts @ e
         reach = math.sqrt(k * float(e @ a_inv @ e))  # the ellipse's half extent along e
         mid = float(centre @ e)
         lo, hi = float(proj.min()), float(proj.max())
-        new_lo = lo if ok[proj <= lo + tie_px].mean() > 0.5 else min(lo, mid - reach)
-        new_hi = hi if ok[proj >= hi - tie_px].mean() > 0.5 else max(hi, mid + reach)
+        at_lo, at_hi = proj <= lo + tie_px, proj >= hi - tie_px
+        new_lo = lo if ok[at_lo].mean() > 0.5 else min(lo, mid - reach)
+        new_hi = hi if ok[at_hi].mean() > 0.5 else max(hi, mid + reach)
         if hi > lo:
-            stretch *= max(min(new_hi - new_lo, widest), hi - lo) / (hi - lo)
-    return math.sqrt(stretch)
+            length = max(min(new_hi - new_lo, widest), hi - lo)
+            stretch *= length / (hi - lo)
+            grown = (new_hi - new_lo) - (hi - lo)
+            keep = (length - (hi - lo)) / grown if grown > 0.0 else 0.0  # the capped extra length, shared
+            # the ellipse's extreme points along e are centre +- reach * conjugate (projections mid +- reach)
+            conjugate = (a_inv @ e) / float(e @ a_inv @ e)
+            for side, target in ((lo, lo - keep * (lo - new_lo)), (hi, hi + keep * (new_hi - hi))):
+                if target != side:
+                    ends.append(centre + (target - mid) * conjugate)
+    stretch = math.sqrt(stretch)
+    return stretch, (np.vstack((pts, *ends)) if ends and stretch > 1.0 else None)
 
 
 def outline_cracks(region: Silhouette) -> np.ndarray:
