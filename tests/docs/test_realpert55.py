@@ -145,6 +145,17 @@ def test_a_mask_drawn_two_pixels_wide_is_trimmed_where_the_camera_saw_past_oppos
     assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (size, diameter)
 
 
+def test_a_mask_drawn_ten_pixels_wide_and_seen_past_all_round_fits_the_shapes_to_the_trimmed_outline(rp):
+    """Stop 58 (docs/grown58.md): frame 0's masks grown by 10 px. Sphere 1 (200 mm, 120 px at 1.4 m) is seen past
+    nearly all round, and stop 43's rule cut the mask to a 199 x 194 mm outline, but the shapes were fitted to the
+    mask as drawn (their box 238 x 244 x 290 mm): the box, 207 x 212 x 206 mm before (depth side 7.8 mm over the
+    unperturbed mask's diameter), is now within the 6 mm bar. Spheres 3 and 4 (white on white, seen past over their
+    tops only) stay as drawn (docs/overshoot56.md, left open)."""
+    boxes = {k: (size, diameter) for k, size, diameter in spheres(rp, "dilate10")}
+    size, diameter = boxes[1]
+    assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (size, diameter)
+
+
 def test_a_strip_in_front_across_every_sphere_leaves_the_larger_ones_cubes(rp):
     """Stop 56 (docs/strip56.md): a strip 5 cm in front across the middle fifth of every sphere, the mask drawn over
     it, parted each sphere's points in two, and extraction kept the nearer half (sphere 1 205 x 153 x 170 mm for

@@ -53,7 +53,7 @@ from typing import Any, Literal
 import numpy as np
 from scipy import ndimage
 
-from ..core.agreement import observe
+from ..core.agreement import Observation, observe
 from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
@@ -813,9 +813,13 @@ def evidence(
         # a surface in front crossing the fruit parts its silhouette: the hidden pixels between the parts are the
         # fruit's (issue 18, docs/strip57.md)
         region = bridged(region, occlusion)
-    obs = observe(sample, region, camera, n_rays=s.rays, n_band=s.band_rays, dense=points,
-                  occlusion=occlusion, occluded_px=s.occluded_px, contour_cone=s.contour_cone,
-                  thin_px=s.thin_px, inner_reach=rim_width(region.mask), dense_pixels=pixels)  # fmt: skip
+
+    def look(at: Silhouette) -> Observation:
+        return observe(sample, at, camera, n_rays=s.rays, n_band=s.band_rays, dense=points, occlusion=occlusion,
+                       occluded_px=s.occluded_px, contour_cone=s.contour_cone, thin_px=s.thin_px,
+                       inner_reach=rim_width(at.mask), dense_pixels=pixels)  # fmt: skip
+
+    obs = look(region)
     # A whole outline (at least ``covered_contour`` of it a contour) without what the mask overshoots the fruit by
     # (stop 42: an active-stereo camera's spread edge under a mask drawn a few pixels wide,
     # :func:`~symfruit.core.occlusion.overshoot`): the silhouette's cone and the fruit's width (the depth prior's,
@@ -825,7 +829,19 @@ def evidence(
     over = None if occlusion is None else occlusion.overshoot
     if over is not None and (obs.contour >= s.covered_contour or occlusion.seen_past) and over.any():  # type: ignore[union-attr]
         trimmed = with_own(seen_region, occlusion, trimmed=True)  # type: ignore[arg-type]
-        if obs.cone_source == "moments":
+        observed = False
+        if occlusion.seen_past:  # type: ignore[union-attr]
+            # Where a time-of-flight camera saw past the fruit, what the mask overshoots it by is the background
+            # seen beyond its edge: the fruit's outline is the trimmed one for the shapes too (stop 58,
+            # docs/grown58.md: fitted to a mask drawn 10 px wide, the cone's ellipsoid took a 200 mm sphere to 238 x
+            # 244 x 290 mm and the box to 207 x 212 x 206). Unless no ellipse fits the trimmed outline's contour
+            # part where one fitted the drawn mask's: the trim is cut sector by sector (each at its own edge), and
+            # where that leaves a ragged outline the drawn one is the better-posed outline for the viewing cone.
+            outline = bridged(trimmed, occlusion)  # type: ignore[arg-type]
+            cut_obs = look(outline)
+            if cut_obs.cone_source == "contour" or obs.cone_source == "moments":
+                region, obs, observed = outline, cut_obs, True
+        if not observed and obs.cone_source == "moments":
             cone, axis = silhouette_cone(trimmed, camera)
             obs = replace(obs, cone=cone, axis=axis)
     apex, _ = apex_depth(sample)
