@@ -513,11 +513,11 @@ WORK_DIAMETER = 128
 MAX_STEP = 4
 
 
-def _working_step(coarse: tuple[np.ndarray, np.ndarray, np.ndarray], min_area: float) -> int:
+def _working_step(coarse: Coarse, min_area: float) -> int:
     """The pixel step to work on: the smallest seeded candidate region's equivalent diameter (on the coarse
     grid) over :data:`WORK_DIAMETER`, 1 to :data:`MAX_STEP`. Regions too small to hold a quarter of the
     least fruit (``min_area``, pixels; 0 with depth, where the size rule is in metres) do not count."""
-    _, sizes, seeded = coarse
+    _, sizes, seeded, *_ = coarse
     area = sizes * COARSE_STEP**2
     candidates = seeded & (area >= 0.25 * min_area)
     candidates[0] = False
@@ -885,35 +885,39 @@ def _id_type(n: int) -> type[np.signedinteger]:
 COARSE_STEP = 4
 
 
-def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+#: :func:`_coarse_regions`' answer: the grid's labels, each label's size and whether it holds a seed, and the weak grid
+#: points' labels, rows and columns (raster order).
+Coarse = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> Coarse | None:
     """The weakly red regions on a coarse grid of step :data:`COARSE_STEP`: their labels, sizes (grid
-    points) and whether each holds a seed (strongly red) point; None without any. The grid's :func:`_red_regions`
+    points) and whether each holds a seed (strongly red) point, and the labelled points' labels, rows and columns
+    (:data:`Coarse`); None without any. The grid's :func:`_red_regions`
     (one compiled call where numba is: the red tests, the labels and their sizes and seeds together), the values of
     :func:`ripe_seeds`' masks labelled with eight neighbours, their ``bincount`` and seeds (stop 43: their bincount
     over the grid's labels alone was 0.7 ms of a 1920x1080 frame)."""
     regions = _red_regions(c[::COARSE_STEP, ::COARSE_STEP], s)
     if regions is None:
         return None
-    _, lab, _, _, seeded, sizes, _, _ = regions
-    return lab, sizes, seeded
+    _, lab, _, points, seeded, sizes, rows, cols = regions
+    return lab, sizes, seeded, points, rows, cols
 
 
-def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape: tuple[int, int]) -> list[Window]:
+def _red_windows(coarse: Coarse | None, shape: tuple[int, int]) -> list[Window]:
     """Disjoint image windows holding every weakly red region with a grid point in it (the coarse grid of
-    :func:`_coarse_regions`), each with a margin of two grid steps."""
+    :func:`_coarse_regions`), each with a margin of two grid steps. The regions' points as :func:`_red_regions` gave
+    them (the grid's labelled points, in raster order), not looked for again over the whole grid (stop 58, speed58)."""
     if coarse is None:
         return []
     h, w = shape
     step = COARSE_STEP
-    lab, sizes, _ = coarse
+    lab, sizes, _, points, rows, cols = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
     big = sizes >= 2
     big[0] = False
     pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
-    gh, gw = lab.shape
-    at = np.flatnonzero(lab)
-    rows, cols = np.divmod(at, gw)
-    boxes = _join_boxes(_padded_boxes(lab.ravel().take(at), rows, cols, big, pad, (gh, gw)))
+    boxes = _join_boxes(_padded_boxes(points, rows, cols, big, pad, lab.shape))
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
