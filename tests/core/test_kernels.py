@@ -2420,6 +2420,72 @@ def test_the_ripe_tests_median_redness_is_the_twins(seed, strided):
 
 
 @settings(max_examples=80, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 12), st.booleans())
+def test_a_running_mean_is_scipys_uniform_filter_to_the_bit(seed, size, strided):
+    """Random float32 lines (1 value to some thousands, shorter and longer than the filter, some values far apart),
+    any size: ``_uniform_line`` gives ``ndimage.uniform_filter1d``'s float32 values bit for bit (its running sum, not a
+    mean updated step by step, which differs in the last bit)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    n = int(rng.choice([int(rng.integers(1, 2 * size + 2)), int(rng.integers(1, 3000))]))
+    line = (rng.standard_normal(2 * n if strided else n) * rng.choice([1e-3, 1.0, 1e4])).astype(np.float32)
+    line = line[::2] if strided else line
+    out = np.empty(n, np.float32)
+    _jit._uniform_line(line, size, out)
+    assert out.tobytes() == ndimage.uniform_filter1d(line, size).tobytes()
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_a_large_regions_ripe_cores_are_the_twins(seed, strided):
+    """Random colours (reddish to any) in windows of 1 to 120 pixels a side under a random region, the ripe threshold
+    one of the smoothed redness's own values (the equality the ``>=`` must keep) or a setting's: the kernel's core
+    is ``region & (uniform_filter(redness(color), 5) >= ripe)`` of the twin, and ``_ripe_cores`` of a region larger
+    than the largest fruit gives the same cores with the kernels and with the twins."""
+    from scipy import ndimage
+
+    from symfruit.segment.colour import CORE_SMOOTH_PX, SegmentSettings, _ripe_cores, redness
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 121, 2))
+    image = rng.integers(0, 256, (2 * h, 2 * w, 3), dtype=np.uint8)
+    image[..., 0] = np.maximum(image[..., 0], rng.integers(0, 256))
+    color = image[::2, ::2] if strided else np.ascontiguousarray(image[:h, :w])
+    region = rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    smooth = ndimage.uniform_filter(redness(color), CORE_SMOOTH_PX)
+    ripe = float(rng.choice([smooth.ravel()[rng.integers(smooth.size)], 0.35]))
+    got = _jit.ripe_core(color, region, CORE_SMOOTH_PX, np.float32(ripe))
+    np.testing.assert_array_equal(got, region & (smooth >= np.float32(ripe)))
+    s = SegmentSettings(ripe_median=0.35, round_fruit=True)
+    depth = np.where(region, 1.0, 0.0)
+    with pytest.MonkeyPatch.context() as mp:  # a focal of 100 px at 1 m: the largest fruit's disc of some 100 px
+        fast, twin = _both(mp, _ripe_cores, region, color, depth, s, 100.0, 1.0)
+    assert len(fast) == len(twin) and all(np.array_equal(a, b) for a, b in zip(fast, twin, strict=True))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([np.int32, np.int64]))
+def test_the_ground_pieces_discs_are_the_twins(seed, dtype):
+    """Random pieces (none to thousands of pixels, some pieces absent, some pixels without depth, depths of every
+    scale): ``_piece_discs``' counts and disc areas with the kernel's one pass are the twin's ``np.bincount`` sums,
+    bit for bit."""
+    from symfruit.segment.colour import _piece_discs
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 80, 2))
+    depth = rng.uniform(0.2, 3.0, (h, w)) * rng.choice([1e-3, 1.0, 1e3])
+    depth[rng.random((h, w)) < rng.uniform(0.0, 0.6)] = 0.0
+    at = np.flatnonzero(rng.random(h * w) < rng.uniform(0.0, 1.0))
+    n = int(rng.integers(1, 40))
+    labels = rng.integers(1, n + 1, len(at)).astype(dtype)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, _piece_discs, labels, depth, at, n, float(rng.uniform(100.0, 2000.0)))
+    for a, b in zip(fast, twin, strict=True):
+        assert a.dtype == b.dtype == np.float64 and a.tobytes() == b.tobytes()
+
+
+@settings(max_examples=80, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([np.int32, np.int64]))
 def test_the_segmenters_grouping_is_the_twins(seed, dtype):
     """Random labels (none to many, some labels absent) and a random choice of those kept: the same labels, places

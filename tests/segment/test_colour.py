@@ -688,7 +688,7 @@ def test_the_red_windows_and_region_boxes_are_the_former_ones():
 
     def former(coarse, shape):  # the boxes painted on the grid and labelled until none join
         h, w = shape
-        lab, sizes, _ = coarse
+        lab, sizes, *_ = coarse
         lab = np.where((sizes >= 2)[lab], lab, 0)
         gh, gw = lab.shape
         boxes = [(max(sl[0].start - 2, 0), min(sl[0].stop + 2, gh), max(sl[1].start - 2, 0), min(sl[1].stop + 2, gw))
@@ -711,7 +711,8 @@ def test_the_red_windows_and_region_boxes_are_the_former_ones():
         lab, n = ndimage.label(weak, structure=np.ones((3, 3), bool))
         sizes = np.bincount(lab.ravel(), minlength=n + 1)
         sizes[0] = 0
-        coarse = (lab, sizes, np.ones(n + 1, bool))
+        at = np.flatnonzero(lab)  # the labelled points as _coarse_regions gives them
+        coarse = (lab, sizes, np.ones(n + 1, bool), lab.ravel()[at], *np.divmod(at, gw))
         shape = (gh * COARSE_STEP - int(rng.integers(0, 4)), gw * COARSE_STEP - int(rng.integers(0, 4)))
         assert _red_windows(coarse, shape) == former(coarse, shape), trial
         # the kept regions' boxes, and the least areas from the region pixels alone
@@ -1335,7 +1336,8 @@ def test_near_pieces_table_is_the_row_by_row_test(seed, monkeypatch):
 def test_the_coarse_regions_are_the_ripe_seeds_labelled(seed, monkeypatch):
     """Red blobs and specks over random colours: ``_coarse_regions`` (the grid's ``_red_regions``, stop 43) gives
     what it gave from :func:`ripe_seeds`: the weak grid points labelled with eight neighbours (scipy's numbers), each
-    label's size (0 for the background) and whether it holds a strong point, with the kernels and without."""
+    label's size (0 for the background) and whether it holds a strong point, and the labelled points' labels, rows and
+    columns in raster order (what ``_red_windows`` reads), with the kernels and without."""
     from scipy import ndimage
 
     from symfruit.segment.colour import COARSE_STEP, _coarse_regions
@@ -1354,11 +1356,12 @@ def test_the_coarse_regions_are_the_ripe_seeds_labelled(seed, monkeypatch):
     sizes[0] = 0
     seeded = np.zeros(n + 1, bool)
     seeded[lab[strong]] = True
+    at = np.flatnonzero(lab)  # the labelled points, their labels, rows and columns
     for kernels in ("numpy", ""):
         monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
         found = _coarse_regions(image, s)
         assert found is not None
-        for a, b in zip(found, (lab, sizes, seeded), strict=True):
+        for a, b in zip(found, (lab, sizes, seeded, lab.ravel()[at], *np.divmod(at, lab.shape[1])), strict=True):
             assert a.dtype == b.dtype
             np.testing.assert_array_equal(a, b)
     assert n > 3 and seeded.sum() >= 3

@@ -513,11 +513,11 @@ WORK_DIAMETER = 128
 MAX_STEP = 4
 
 
-def _working_step(coarse: tuple[np.ndarray, np.ndarray, np.ndarray], min_area: float) -> int:
+def _working_step(coarse: Coarse, min_area: float) -> int:
     """The pixel step to work on: the smallest seeded candidate region's equivalent diameter (on the coarse
     grid) over :data:`WORK_DIAMETER`, 1 to :data:`MAX_STEP`. Regions too small to hold a quarter of the
     least fruit (``min_area``, pixels; 0 with depth, where the size rule is in metres) do not count."""
-    _, sizes, seeded = coarse
+    _, sizes, seeded, *_ = coarse
     area = sizes * COARSE_STEP**2
     candidates = seeded & (area >= 0.25 * min_area)
     candidates[0] = False
@@ -885,35 +885,39 @@ def _id_type(n: int) -> type[np.signedinteger]:
 COARSE_STEP = 4
 
 
-def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> tuple[np.ndarray, np.ndarray, np.ndarray] | None:
+#: :func:`_coarse_regions`' answer: the grid's labels, each label's size and whether it holds a seed, and the weak grid
+#: points' labels, rows and columns (raster order).
+Coarse = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]
+
+
+def _coarse_regions(c: np.ndarray, s: SegmentSettings) -> Coarse | None:
     """The weakly red regions on a coarse grid of step :data:`COARSE_STEP`: their labels, sizes (grid
-    points) and whether each holds a seed (strongly red) point; None without any. The grid's :func:`_red_regions`
+    points) and whether each holds a seed (strongly red) point, and the labelled points' labels, rows and columns
+    (:data:`Coarse`); None without any. The grid's :func:`_red_regions`
     (one compiled call where numba is: the red tests, the labels and their sizes and seeds together), the values of
     :func:`ripe_seeds`' masks labelled with eight neighbours, their ``bincount`` and seeds (stop 43: their bincount
     over the grid's labels alone was 0.7 ms of a 1920x1080 frame)."""
     regions = _red_regions(c[::COARSE_STEP, ::COARSE_STEP], s)
     if regions is None:
         return None
-    _, lab, _, _, seeded, sizes, _, _ = regions
-    return lab, sizes, seeded
+    _, lab, _, points, seeded, sizes, rows, cols = regions
+    return lab, sizes, seeded, points, rows, cols
 
 
-def _red_windows(coarse: tuple[np.ndarray, np.ndarray, np.ndarray] | None, shape: tuple[int, int]) -> list[Window]:
+def _red_windows(coarse: Coarse | None, shape: tuple[int, int]) -> list[Window]:
     """Disjoint image windows holding every weakly red region with a grid point in it (the coarse grid of
-    :func:`_coarse_regions`), each with a margin of two grid steps."""
+    :func:`_coarse_regions`), each with a margin of two grid steps. The regions' points as :func:`_red_regions` gave
+    them (the grid's labelled points, in raster order), not looked for again over the whole grid (stop 58, speed58)."""
     if coarse is None:
         return []
     h, w = shape
     step = COARSE_STEP
-    lab, sizes, _ = coarse
+    lab, sizes, _, points, rows, cols = coarse
     # a region that holds a single grid point is a speck, not a fruit (a fruit fragment holds several)
     big = sizes >= 2
     big[0] = False
     pad = 2  # grid steps: one around the region, and one more for its pixels between the grid points
-    gh, gw = lab.shape
-    at = np.flatnonzero(lab)
-    rows, cols = np.divmod(at, gw)
-    boxes = _join_boxes(_padded_boxes(lab.ravel().take(at), rows, cols, big, pad, (gh, gw)))
+    boxes = _join_boxes(_padded_boxes(points, rows, cols, big, pad, lab.shape))
     return [(slice(r0 * step, min(r1 * step, h)), slice(c0 * step, min(c1 * step, w))) for r0, r1, c0, c1 in boxes]
 
 
@@ -1871,9 +1875,12 @@ def _ripe_cores(
         # before the region is split and merged: a twig or bark never costs the work on a fruit); the redness
         # of its own pixels alone (per pixel, in the same order: the values of the window's at them)
         return [region] if median(redness(color[region])) >= s.ripe_median else []
-    red = redness(color)
-    # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it
-    core = region & (ndimage.uniform_filter(red, CORE_SMOOTH_PX) >= s.ripe_median)
+    # redness averaged over a few pixels: bark of redness about ripe_median has single pixels above it; where numba
+    # is, in one call (:func:`symfruit.core._jit.ripe_core`: the same pixels; stop 58, speed58)
+    if (jit := compiled()) is not None and color.dtype == np.uint8 and color.ndim == 3 and region.dtype == bool:
+        core = jit.ripe_core(color, region, CORE_SMOOTH_PX, np.float32(s.ripe_median))
+    else:
+        core = region & (ndimage.uniform_filter(redness(color), CORE_SMOOTH_PX) >= s.ripe_median)
     lab, n = _label(core, eight=True)
     sizes = np.bincount(lab.ravel(), minlength=n + 1)
     keep = sizes >= largest * (s.min_diameter / s.round_max_diameter) ** 2  # the least fruit's disc
@@ -2187,7 +2194,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
     lab, n, at, la = _labelled(cand)
     if n == 0:
         return []
-    count, disc = _piece_discs(la, z_grid.ravel().take(at), n, focal)
+    count, disc = _piece_discs(la, z_grid, at, n, focal)
     area = count * g * g
     keep = (area >= 0.5 * disc * s.min_diameter**2) & (area <= 2.0 * disc * s.round_max_diameter**2)
     keep[0] = False
@@ -2212,7 +2219,7 @@ def _ground_bodies(c: np.ndarray, z: _Depth, geo: _Geometry, s: SegmentSettings,
         lab, n, at, la = _labelled(cand)
         if n == 0:
             continue
-        count, disc = _piece_discs(la, zw.ravel().take(at), n, focal)
+        count, disc = _piece_discs(la, zw, at, n, focal)
         keep = (count >= disc * s.min_diameter**2) & (count <= disc * s.round_max_diameter**2)
         keep[0] = False
         rows, cols = np.divmod(at, lab.shape[1])
@@ -2269,13 +2276,23 @@ def _ground_steps(color: np.ndarray, depth: np.ndarray, size: int, jump: float) 
     return ground & ~_steps(_gap_filled(depth, size), jump)
 
 
-def _piece_discs(labels: np.ndarray, depth: np.ndarray, n: int, focal: float) -> tuple[np.ndarray, np.ndarray]:
-    """For pieces ``0..n`` (``labels`` of pixels with ``depth``, 0 where none): each one's pixel count, and the area
-    (pixels) a disc 1 m across would cover at its mean depth (over its pixels with depth)."""
-    count = np.bincount(labels, minlength=n + 1).astype(np.float64)
-    zmean = np.bincount(labels, weights=depth, minlength=n + 1) / np.maximum(
-        np.bincount(labels, weights=depth > 0, minlength=n + 1), 1.0
-    )
+def _piece_discs(
+    labels: np.ndarray, depth: np.ndarray, at: np.ndarray, n: int, focal: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """For pieces ``0..n`` (``labels`` of the pixels at flat indices ``at`` of the window's ``depth``, 0 where none):
+    each one's pixel count, and the area (pixels) a disc 1 m across would cover at its mean depth (over its pixels with
+    depth). Where numba is, the three sums in one pass (:func:`symfruit.core._jit.piece_sums`: the same values; stop
+    58, speed58)."""
+    if (jit := compiled()) is not None and depth.dtype == np.float64 and depth.flags.c_contiguous:
+        count, total, seen = jit.piece_sums(labels, depth.reshape(-1), at, int(n))
+    else:
+        z = depth.ravel().take(at)
+        count = np.bincount(labels, minlength=n + 1).astype(np.float64)
+        total, seen = (
+            np.bincount(labels, weights=z, minlength=n + 1),
+            np.bincount(labels, weights=z > 0, minlength=n + 1),
+        )
+    zmean = total / np.maximum(seen, 1.0)
     return count, np.pi / 4 * (focal / np.maximum(zmean, 1e-6)) ** 2
 
 
