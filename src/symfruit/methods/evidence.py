@@ -896,10 +896,10 @@ def evidence(
     elif s.cut_prior == "sides" and obs.cone_source == "contour" and obs.cone is not None:
         cracks, free = obs._made.get("outline", (None, None))
         if cracks is not None:
-            stretch, outline = free_side_reach(cracks, free, obs.cone, camera, region)
+            stretch, reach = free_side_reach(cracks, free, obs.cone, camera, region)
             whole = (sized.minor * stretch, sized.major * stretch)
-            if outline is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
-                faces = tangent_extent(outline, sized, camera)
+            if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
+                faces = tangent_extent(reach, sized, camera)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
                                      across=sized, tilt=tilt, whole=whole, faces=faces)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
