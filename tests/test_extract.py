@@ -531,8 +531,7 @@ def test_a_fruit_parted_by_a_strip_in_front_keeps_both_parts(cut):
     assert ex.points[:, 2].min() > 1.29  # none of the strip
 
 
-# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface; on
-# since stop 58)
+# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, off)
 
 KEEPS = ExtractSettings(trim_keeps_surface=True)
 
@@ -554,14 +553,15 @@ def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray
 def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
     """Stop 57 (docs/shift57.md): the colour alone takes the ball's shaded limb off (its lowest rows look like the
     grey ring beside the mask); with the depth and ``trim_keeps_surface``, the limb lies on the ball's own convex cap
-    and is kept, the mask exactly the disc (the default since stop 58). Off, or no depth given: the colour's trim."""
+    and is kept, the mask exactly the disc. Off (the default: docs/trim58.md, "After merging"), or no depth given:
+    the colour's trim."""
     color, depth, d2 = shaded_ball()
     labels = (d2 <= 400).astype(np.int32)
     limb = (labels == 1) & (np.mgrid[:120, :160][0] >= 76)
     colour_only = trim_labels(color, labels)
     assert (colour_only[limb] == 0).sum() >= 0.5 * limb.sum()
     assert trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) is labels
-    assert trim_labels(color, labels, depth=depth, focal=600.0) is labels  # the default
+    assert np.array_equal(trim_labels(color, labels, depth=depth, focal=600.0), colour_only)  # the default
     assert np.array_equal(trim_labels(color, labels, KEEPS), colour_only)
     off = ExtractSettings(trim_keeps_surface=False)
     assert np.array_equal(trim_labels(color, labels, off, depth=depth, focal=600.0), colour_only)

@@ -77,7 +77,11 @@ class ExtractSettings(Section):
         its box 182 mm tall for 198 binned 2 x 2, 196 with it; stop 57, docs/shift57.md). A cut all round is an
         overshoot's, and the colour's alone: where the depth sits a few pixels off the colour (the real frames'
         larger spheres), the cap runs on over an overshoot past the fruit's colour edge (stop 57's rule on every
-        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md).
+        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md). Off by
+        default: the pixels it keeps move the frame's registration (it reads every mask), and on the rendered
+        apple trees a shift 1 px other put a half-hidden apple's points on the leaf in front of it (5 -> 72 mm;
+        seeds 6-11 5.3 -> 5.9 mm mean centre, held-out seeds 100-111 9.0 -> 9.0; the real spheres binned 2x and 3x
+        5 -> 0 boxes over the bar with it; docs/trim58.md, "After merging").
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -101,7 +105,7 @@ class ExtractSettings(Section):
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
-    trim_keeps_surface: bool = setting(True)
+    trim_keeps_surface: bool = setting(False)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
