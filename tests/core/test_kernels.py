@@ -5049,6 +5049,41 @@ def test_the_window_medians_are_the_partitions(seed):
     assert medians.tobytes() == np.partition(values, 12, axis=1)[:, 12].tobytes()
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_near_filled_picks_scipys_nearest_pixel(seed):
+    """near_filled against scipy's feature transform at every pixel within two rows and two columns of an ok pixel
+    (the pixels window_medians reads for a median it keeps): the same pixel's depth, ties included (sparse ok pixels
+    of distinct depths, so that another of equally near pixels shows); 0 at the pixels farther from every ok pixel."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(v) for v in rng.integers(1, 30, 2))
+    ok = rng.random((h, w)) < rng.choice([0.02, 0.1, 0.3, 0.6, 0.95])
+    if not ok.any():
+        ok[int(rng.integers(h)), int(rng.integers(w))] = True
+    depth = rng.random((h, w)) + 0.1
+    out = np.full((h, w), np.nan)
+    _jit.near_filled(depth, ok, out)
+    _, (ri, ci) = ndimage.distance_transform_edt(~ok, return_indices=True)
+    near = ndimage.maximum_filter(ok, size=5, mode="constant")
+    assert out[near].tobytes() == depth[ri, ci][near].tobytes()
+    assert (out[~near] == 0.0).all()
+
+
+def test_near_filled_of_a_known_image():
+    """Two ok pixels at (0, 0) and (2, 2) of a 3 x 5 image: (1, 1) is as near to both and takes the least column's
+    (0, 0), (0, 2) and (2, 0) likewise; (1, 2) and (2, 1) are nearer to (2, 2); (0, 4) is 2.8 px from (2, 2);
+    every pixel lies within two rows and two columns of one of them."""
+    depth = np.arange(15.0).reshape(3, 5) + 1.0
+    ok = np.zeros((3, 5), bool)
+    ok[0, 0] = ok[2, 2] = True
+    out = np.empty((3, 5))
+    _jit.near_filled(depth, ok, out)
+    a, b = depth[0, 0], depth[2, 2]
+    assert out.tolist() == [[a, a, a, b, b], [a, a, b, b, b], [a, b, b, b, b]]
+
+
 def test_the_window_medians_of_a_known_image():
     """A 5 x 7 image of the numbers 1..35 in raster order, every pixel ok: at (2, 3) the window holds rows 0-4 and
     columns 1-5, whose median is the middle row's middle value, 18; at the corner (0, 0) the edges repeat rows 0, 0,

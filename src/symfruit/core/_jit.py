@@ -7313,6 +7313,53 @@ MEDIAN25 = (
 # fmt: on
 
 
+#: :func:`near_filled`'s offsets ``(dr, dc)``: every one within a squared distance of 8 but (0, 0), by squared distance,
+#: then column offset, then row offset: scipy's feature transform's choice among equally near pixels (the least
+#: column, then the least row; :func:`symfruit.core.occlusion._offsets`' order; checked against the transform in
+#: tests/core/test_kernels.py).
+NEAR8 = tuple(
+    sorted(
+        ((dr, dc) for dr in range(-2, 3) for dc in range(-2, 3) if 0 < dr * dr + dc * dc <= 8),
+        key=lambda o: (o[0] * o[0] + o[1] * o[1], o[1], o[0]),
+    )
+)
+
+
+@_njit
+def near_filled(depth: np.ndarray, ok: np.ndarray, out: np.ndarray) -> None:
+    """``out`` (h, w) float64: ``depth`` (h, w) at the pixels of ``ok`` (h, w) bool; at each other pixel with an ``ok``
+    pixel within a squared distance of 8 (every pixel within two rows and two columns of an ``ok`` pixel), the depth
+    of the ``ok`` pixel ``ndimage.distance_transform_edt(~ok, return_indices=True)`` picks for it (:func:`nearest`'s),
+    looked for through :data:`NEAR8`, nearest first, scipy's choice among equally near ones; 0 elsewhere (no ``ok``
+    pixel that near: :func:`window_medians` reads none of them for a median it keeps). Stop 59, speedx59: a look
+    around the pixels without depth instead of a feature transform of every pixel of the window."""
+    h, w = ok.shape
+    first = np.full(h, w, np.int64)  # each row's first and last ok column (w, -1: none)
+    last = np.full(h, -1, np.int64)
+    for r in range(h):
+        for c in range(w):
+            if ok[r, c]:
+                first[r] = min(first[r], c)
+                last[r] = c
+    for r in range(h):
+        # a pixel with an ok pixel within two rows and two columns lies within two columns of those rows' ok spans
+        lo, hi = w, -1
+        for q in range(max(r - 2, 0), min(r + 3, h)):
+            lo, hi = min(lo, first[q] - 2), max(hi, last[q] + 2)
+        for c in range(w):
+            if ok[r, c]:
+                out[r, c] = np.float64(depth[r, c])
+                continue
+            out[r, c] = 0.0
+            if c < lo or c > hi:
+                continue
+            for dr, dc in NEAR8:
+                a, b = r + dr, c + dc
+                if 0 <= a < h and 0 <= b < w and ok[a, b]:
+                    out[r, c] = np.float64(depth[a, b])
+                    break
+
+
 @_njit
 def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> None:
     """``medians`` ((n,) float64, n the pixels of ``ok`` (h, w) bool, which must hold one): the median of the 5 x 5
@@ -7323,20 +7370,21 @@ def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> No
     registers, the windows never laid out (stop 45, speedreg45: 0.70 against 0.86 + 0.59 ms a frame for the partition
     and the windows, thread CPU on the benchmark frame's 14 calls, a busy machine). Its numpy twin:
     :func:`symfruit.core.surface._window_medians`. Every value must be a number (no NaN: ``thin_front``'s depth
-    above 0 is)."""
+    above 0 is).
+
+    Since stop 59 (speedx59) the filled depth is :func:`near_filled`'s, not a feature transform of the whole window
+    (:func:`nearest`): a window around an ``ok`` pixel reads pixels within two rows and two columns of it alone (edges
+    repeated: a clamped pixel lies nearer still), whose nearest ``ok`` pixel lies within a squared distance of 8, the
+    only ones it looks through; the same values in every ``ok`` pixel's window, so the same medians (the values of
+    other windows, computed with them and never kept, may differ)."""
     h, w = ok.shape
-    idx = np.empty((h, w), np.int64)
-    nearest(np.logical_not(ok), idx)
-    # the depth laid out flat first: a flat index read per value, not two integer divisions (stop 49, regspeed49)
-    flat = np.empty(h * w)
-    for r in range(h):
-        for c in range(w):
-            flat[r * w + c] = np.float64(depth[r, c])
+    src = np.empty((h, w))
+    near_filled(depth, ok, src)
     vals = np.empty((h + 4, w + 4))
     for a in range(h + 4):
         rr = min(max(a - 2, 0), h - 1)
         for b in range(w + 4):
-            vals[a, b] = flat[idx[rr, min(max(b - 2, 0), w - 1)]]
+            vals[a, b] = src[rr, min(max(b - 2, 0), w - 1)]
     # each row's medians at every column from its first to its last ``ok`` pixel, with no branch in the loop (the
     # compiler runs it on several pixels at once: a pixel not ``ok`` costs a lane, not a branch), then the ``ok``
     # pixels' kept: at each ``ok`` pixel the same pairs on the same 25 values (stop 49, regspeed49: the benchmark
