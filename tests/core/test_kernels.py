@@ -7547,3 +7547,60 @@ def test_the_red_windows_regions_cover_every_case():
     fast, twin = found["fruit"]
     assert fast[-1] == twin[-1] == {1: (slice(5, 25), slice(5, 35))}
     np.testing.assert_array_equal(fast[4], np.ones(600))  # the fruit's depths
+
+
+# --- stop 59, speedc59
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    h=st.integers(0, 30),
+    w=st.integers(0, 40),
+    share=st.sampled_from([0.0, 0.05, 0.3, 0.6, 0.9, 1.0]),
+    seed=st.integers(0, 2**16),
+)
+def test_in_pieces_is_the_labels_count(h, w, share, seed):
+    """:func:`_jit.in_pieces` against its twin, ``ndimage.label(mask, np.ones((3, 3), bool))[1] >= 2`` (the test of
+    :func:`symfruit.core.occlusion.bridged`), on random masks of 0-30 by 0-40 pixels, empty to full, and on blobs
+    that touch at a corner only or are one pixel apart (8-connectivity: one piece, two pieces), at every edge."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random((h, w)) < share
+    assert _jit.in_pieces(mask) == (ndimage.label(mask, np.ones((3, 3), bool))[1] >= 2)
+    if h >= 2 and w >= 2:  # two blobs meeting at a corner, then one pixel apart
+        r, c = int(rng.integers(1, h)), int(rng.integers(1, w))
+        for gap in (0, 1):
+            two = np.zeros((h, w), bool)
+            two[:r, :c] = True
+            two[r + gap :, c + gap :] = True
+            want = ndimage.label(two, np.ones((3, 3), bool))[1] >= 2
+            assert _jit.in_pieces(two) == want
+            assert want == (gap == 1 and r + 1 < h and c + 1 < w)
+
+
+def test_in_pieces_known_answers():
+    """None, one pixel, a ring (one piece around a hole), two pixels diagonal (one piece) and a knight's move apart
+    (two), a comb whose teeth meet only in a row far below."""
+    assert not _jit.in_pieces(np.zeros((0, 3), bool))
+    assert not _jit.in_pieces(np.zeros((4, 5), bool))
+    one = np.zeros((4, 5), bool)
+    one[2, 3] = True
+    assert not _jit.in_pieces(one)
+    ring = np.ones((6, 6), bool)
+    ring[2:4, 2:4] = False
+    assert not _jit.in_pieces(ring)
+    diagonal = np.eye(5, dtype=bool)
+    assert not _jit.in_pieces(diagonal)
+    knight = np.zeros((4, 4), bool)
+    knight[0, 0] = knight[1, 2] = True
+    assert _jit.in_pieces(knight)
+    comb = np.zeros((8, 9), bool)
+    comb[:6, ::2] = True
+    assert _jit.in_pieces(comb)
+    comb[7, :] = True
+    assert _jit.in_pieces(comb)  # row 6 is empty: the teeth and the back apart
+    comb[6, 0] = True
+    assert _jit.in_pieces(comb)  # the first tooth joined to the back, the others not
+    comb[6, 1::2] = True
+    assert not _jit.in_pieces(comb)  # every tooth joined at a corner of row 6's pixels between them

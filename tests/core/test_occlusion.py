@@ -108,10 +108,13 @@ def _disk_under_strip(hidden_strip: bool):
     return disk, strip, Silhouette(10, 20, disk & ~strip, 0.0), Occlusion(10, 20, hidden, 200, 150)
 
 
-def test_the_hidden_pixels_between_a_silhouettes_parts_are_the_fruits():
+@pytest.mark.parametrize("kernels", ["", "numpy"])
+def test_the_hidden_pixels_between_a_silhouettes_parts_are_the_fruits(monkeypatch, kernels):
     """Stop 57 (docs/strip57.md): a strip in front across a round fruit parts its silhouette in two; the strip's
     pixels between the parts are the fruit's (the disk back, but its two side columns whose disk pixels lie all
-    behind the strip; nothing of the strip beyond the disk)."""
+    behind the strip; nothing of the strip beyond the disk). The pieces counted by the kernel and by the twin's
+    labels (stop 59)."""
+    monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
     disk, strip, region, occ = _disk_under_strip(True)
     out = bridged(region, occ, radius=0)
     assert (out.u0, out.v0, out.mask.shape) == (10, 20, (80, 80))
@@ -121,9 +124,12 @@ def test_the_hidden_pixels_between_a_silhouettes_parts_are_the_fruits():
     assert (np.abs(missing[1] - 40) == 30).all()  # the disk's side columns 10 and 70 (a pixel each)
 
 
-def test_what_is_seen_between_a_silhouettes_parts_or_beside_one_part_is_left_out():
+@pytest.mark.parametrize("kernels", ["", "numpy"])
+def test_what_is_seen_between_a_silhouettes_parts_or_beside_one_part_is_left_out(monkeypatch, kernels):
     """The strip's pixels seen behind the fruit (no occluder: the parts are apart) are not the fruit's; nor is a
-    hidden bite out of the side of a silhouette in one piece (a leaf cutting it: no pixel lies between two parts)."""
+    hidden bite out of the side of a silhouette in one piece (a leaf cutting it: no pixel lies between two parts).
+    In both kernel modes (stop 59)."""
+    monkeypatch.setenv("SYMFRUIT_KERNELS", kernels)
     _, _, region, occ = _disk_under_strip(False)
     assert bridged(region, occ) is region
     disk, strip, _, occ = _disk_under_strip(True)

@@ -1088,7 +1088,11 @@ def bridged(region: Silhouette, occ: Occlusion, *, radius: int = 2) -> Silhouett
     strip, the mask cut by it, read 106 x 125 mm) and the strip's edges as the fruit's outline. A region in one
     piece is returned as it is (a leaf cutting its side leaves no pixel between two of its own)."""
     mask = region.mask
-    if ndimage.label(mask, np.ones((3, 3), bool))[1] < 2:
+    # the pieces counted by a compiled flood fill where numba is (the same answer as the labels'; stop 59, speedc59)
+    if (jit := compiled()) is not None and mask.dtype == bool and mask.ndim == 2:
+        if not jit.in_pieces(mask):
+            return region
+    elif ndimage.label(mask, np.ones((3, 3), bool))[1] < 2:
         return region
     down, up = np.logical_or.accumulate(mask, axis=0), np.logical_or.accumulate(mask[::-1], axis=0)[::-1]
     right, left = np.logical_or.accumulate(mask, axis=1), np.logical_or.accumulate(mask[:, ::-1], axis=1)[:, ::-1]
