@@ -1069,3 +1069,53 @@ def test_a_cut_sides_lateral_face_is_pulled_to_where_the_fruit_ends_not_to_the_c
     assert cut.min[0] > box.min[0] + 0.1 * (0.3 * 2 * r)  # pulled a tenth of the hidden 30 % in, at least
     assert abs(told.min[0] - box.min[0]) < 0.6 * z / cam.fx  # the disc's side, to the half pixel
     assert told.max[0] == cut.max[0] and told.max[2] == cut.max[2]
+
+
+def _square_across(hi_y: float = 0.1):
+    """An outline on the optical axis, 0.2 wide along e1 = x (tangent units), from -0.1 to ``hi_y`` along e2 = y."""
+    from symfruit.core.raster import Across
+
+    lo, hi = np.array([-0.1, -0.1]), np.array([0.1, hi_y])
+    return Across(np.array([0.0, 0.0, 1.0]), np.eye(3)[:2], lo, hi, float(min(0.2, hi_y + 0.1)), 0.2)
+
+
+def test_a_box_running_past_a_cut_face_beyond_the_widest_extent_seen_is_pulled_back_by_the_priors_share():
+    """Stop 59 (docs/leafcut59.md, ``cut_reach: widest``): a box 0.4 long along y over an outline 0.2 wide both ways
+    (at distance 1), its bottom face 0.2 past the silhouette's. With the contour share's pull (``share`` 0.1) the
+    bottom moves in by 0.02; the whole run lies beyond the widest extent seen, so it moves by the prior's share
+    (``grow`` 0.8): to 0.3 - 0.8 x 0.2 = 0.14. Where the outline itself is cut short (its bottom at 0.05), only the
+    part of the run beyond the widest extent (0.1 of 0.15) takes the prior's share: 0.2 - 0.1 x 0.05 - 0.8 x 0.1 =
+    0.115. x (as wide as the outline) and the back face are untouched."""
+    from symfruit import Box
+    from symfruit.methods.evidence import _lateral_faces
+
+    box = Box(np.array([-0.1, -0.1, 0.9]), np.array([0.1, 0.3, 1.1]))
+    across = _square_across()
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8)
+    assert hi[1] == pytest.approx(0.28) and lo[1] == pytest.approx(-0.1)
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert hi[1] == pytest.approx(0.14) and lo[1] == pytest.approx(-0.1)
+    assert (lo[0], hi[0], hi[2]) == pytest.approx((-0.1, 0.1, 1.1))
+    short = Box(np.array([-0.1, -0.1, 0.9]), np.array([0.1, 0.2, 1.1]))
+    lo, hi = _lateral_faces(short, _square_across(0.05), 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert hi[1] == pytest.approx(0.115)
+
+
+def test_the_widest_extents_pull_shares_the_excess_between_two_cut_faces_and_leaves_a_box_no_longer_than_it():
+    """Both faces run past (0.1 above, 0.3 below, the box 0.6 for a widest extent of 0.3): the 0.3 beyond it is three
+    quarters of the runs, taken from each in proportion and pulled by the prior's share: the top to -0.2 + 0.1 x 0.1 +
+    0.7 x 0.75 x 0.1, the bottom to 0.4 - 0.1 x 0.3 - 0.7 x 0.75 x 0.3. A box no longer than the
+    widest extent moves as before to the bit; so does every box where no cap is given (``widest`` inf: ``contour``);
+    a face inside the silhouette still grows out by the prior's share."""
+    from symfruit import Box
+    from symfruit.methods.evidence import _lateral_faces
+
+    across = _square_across()
+    box = Box(np.array([-0.1, -0.2, 0.9]), np.array([0.1, 0.4, 1.1]))
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8, 0.3)
+    assert lo[1] == pytest.approx(-0.2 + 0.01 + 0.7 * 0.75 * 0.1)
+    assert hi[1] == pytest.approx(0.4 - 0.03 - 0.7 * 0.75 * 0.3)
+    narrow = Box(np.array([-0.05, -0.15, 0.9]), np.array([0.1, 0.05, 1.1]))  # 0.2 long, past the top by 0.05
+    assert _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2) == _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8)
+    lo, hi = _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert lo[0] == pytest.approx(-0.05 - 0.8 * 0.05) and hi[1] == pytest.approx(0.05 + 0.8 * 0.05)
