@@ -187,7 +187,8 @@ def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_
     """``fuse_depth``'s lateral faces: a box narrower than the silhouette grows to it by the prior's share
     whatever the outline's contour share (the fruit covers at least what was seen of it, a cut edge or not); a
     box wider than the silhouette shrinks by that share times the contour share squared (beyond a cut edge the
-    fruit may reach)."""
+    fruit may reach; ``cut_reach: contour``, the default before stop 59: with ``widest`` the part of a cut outline's
+    box beyond its widest extent is pulled by the prior's share, the tests below)."""
     from symfruit import Box
     from symfruit.core.raster import Silhouette, across_sight
     from symfruit.methods.evidence import Combined, fuse_depth
@@ -198,7 +199,7 @@ def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_
     mask[np.hypot(yy - 29.5, xx - 29.5) <= 20] = True  # a disc 40 px across near the image centre
     region = Silhouette(int(cam.cx) - 30, int(cam.cy) - 30, mask, 0.0)
     across = across_sight(region, cam)
-    s = EvidenceSettings()
+    s = EvidenceSettings(cut_reach="contour")
     for contour in (1.0, 0.3):
         for half in (0.01, 0.08):  # a box far narrower, and one far wider, than the silhouette
             box = Box(np.array([-half, -half, 0.5]), np.array([half, half, 0.5 + 2 * half]))
