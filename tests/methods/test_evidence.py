@@ -1120,3 +1120,36 @@ def test_the_widest_extents_pull_shares_the_excess_between_two_cut_faces_and_lea
     assert _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2) == _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8)
     lo, hi = _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2)
     assert lo[0] == pytest.approx(-0.05 - 0.8 * 0.05) and hi[1] == pytest.approx(0.05 + 0.8 * 0.05)
+
+
+@pytest.mark.parametrize("spread", ["ellipse", "contour"])
+def test_a_prior_read_from_the_free_arcs_ellipse_keeps_an_uncut_outlines_spread(spread):
+    """Stop 59 (docs/leafcut59.md, ``cut_spread``): a disc 40 px across, its left 30 % hidden (contour share 0.4), the
+    prior's width read from the ellipse through its free arcs (``whole``: the disc's). The back face is the inverse-
+    variance average of the shapes' (a box a radius deep: a lost rim's short back) and the prior's. With ``ellipse``
+    the prior's spread is an uncut outline's, ``depth_ratio_sd`` times the width; with ``contour`` (the default before)
+    divided by the contour share, so the short back keeps more of the weight."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
+    yy, xx = np.mgrid[:60, :60]
+    disc = np.hypot(yy - 29.5, xx - 29.5) <= 20
+    region = Silhouette(u0, v0, disc & (xx >= 22), 0.0)
+    across = across_sight(region, cam)
+    whole = (40.0 / cam.fx, 40.0 / cam.fx)
+    z, r = 0.5, 20.0 * 0.5 / cam.fx
+    box = Box(np.array([-r, -r, z]), np.array([r, r, z + r]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, 0.4, 0.0)
+    s = EvidenceSettings(cut_spread=spread)
+    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=0.4, across=across, whole=whole)
+    assert width == pytest.approx(40.0 / cam.fx * box.centre[2] / across.axis[2], rel=1e-12)  # the ellipse's
+    fit_sd = np.hypot(s.back_inflation * 0.002, width * (s.shape_error + s.rim_error * 0.6))
+    prior_sd = s.depth_ratio_sd * width / (1.0 if spread == "ellipse" else 0.4)
+    a, b = fit_sd**-2, prior_sd**-2
+    assert got.max[2] == pytest.approx((a * (z + r) + b * (z + s.depth_ratio * width)) / (a + b), rel=1e-9)
+    if spread == "ellipse":
+        assert got.max[2] - z > 0.9 * width  # the prior's 0.93-0.95 of an uncut outline

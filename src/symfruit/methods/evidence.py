@@ -199,6 +199,13 @@ class EvidenceSettings(Section):
         revolution 38 mm down behind the leaf) 106 -> 84 mm, not-a-cube 15.2 -> 11.6 mm; the development apple trees
         (seeds 0-3 and 6-11) IoU 0.799 -> 0.800 and 0.766 -> 0.770, the larger lateral side 3.09 -> 2.90 and 4.10 ->
         3.39 mm.
+    cut_spread : {"ellipse", "contour"}
+        The depth prior's spread on a cut outline: ``contour`` (the default before) divides it by the contour share
+        (a cut outline's width says less), also where its width is read from the ellipse through the free arcs
+        (``cut_prior``); ``ellipse`` (stop 59, docs/leafcut59.md) divides it by nothing where that ellipse's width
+        is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
+        real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
+        the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
@@ -340,6 +347,7 @@ class EvidenceSettings(Section):
     cut_prior: Literal["outline", "ellipse", "sides"] = setting("sides")
     cut_faces: Literal["region", "sides"] = setting("sides")
     cut_reach: Literal["contour", "widest"] = setting("widest")
+    cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -761,7 +769,10 @@ def fuse_depth(
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
+    read = combined.contour  # the contour share of the outline the prior's width is read from
     if whole is not None:  # the ellipse of the outline's free arcs, as an uncut outline's; a cut only narrows
+        if s.cut_spread == "ellipse" and float(np.sqrt(whole[0] * whole[1])) > width:
+            read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, float(np.sqrt(whole[0] * whole[1])))
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
@@ -769,7 +780,7 @@ def fuse_depth(
     if s.depth_ratio_sd <= 0 or width <= 0:
         return box, fit_sd, width
     front = float(box.min[2])
-    prior_sd = s.depth_ratio_sd * width / max(combined.contour, 0.25)
+    prior_sd = s.depth_ratio_sd * width / max(read, 0.25)
     prior_back = front + s.depth_ratio * width
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
     back = max((a * fit_back + b * prior_back) / (a + b), front + 1e-4)
