@@ -196,7 +196,7 @@ class EvidenceSettings(Section):
         longer any way than that; only an elongated one behind the cut is, which the shapes (not the round prior)
         must then show: the pull is the prior's share of the back face, small where the shapes agree (no threshold).
         The real spheres with a leaf over a third of each, the mask cut: the 66 mm sphere's 106 mm height (a solid of
-        revolution 38 mm down behind the leaf) 106 -> 84 mm, not-a-cube 15.2 -> 11.6 mm; the development apple trees
+        revolution 38 mm down behind the leaf) 106 -> 79 mm, not-a-cube 15.2 -> 11.6 mm; the development apple trees
         (seeds 0-3 and 6-11) IoU 0.799 -> 0.800 and 0.766 -> 0.770, the larger lateral side 3.09 -> 2.90 and 4.10 ->
         3.39 mm.
     cut_spread : {"ellipse", "contour"}
