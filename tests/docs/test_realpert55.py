@@ -224,6 +224,23 @@ def test_a_leaf_cutting_a_third_of_every_mask_leaves_the_larger_spheres_as_wide_
         assert now[k][0][1] == pytest.approx(was[k][0][1], abs=0.5)
 
 
+def test_a_leaf_cutting_a_third_of_the_66_mm_sphere_no_longer_runs_its_box_far_below_the_widest_extent_seen(rp):
+    """Stop 59 (docs/leafcut59.md): the leaf of the tests above, frame 1. A solid of revolution (weight 0.9) reaches
+    38 mm below sphere 3's cut silhouette, down behind the leaf, and the box was 106 mm tall for 66 (``cut_reach:
+    contour``: the bottom face pulled in by the prior's share times the contour share squared, 0.1). With ``widest``
+    (the default) the part of the box beyond the outline's widest extent seen is pulled in by the prior's share
+    (0.7): within 15 mm of the diameter. The other spheres' y sides move by 1 mm at most."""
+    from symfruit.settings import from_dict
+
+    before = from_dict({"evidence": {"cut_reach": "contour"}})
+    was = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", before, "lab-spheres-1")}
+    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, "lab-spheres-1")}
+    assert was[3][0][1] > was[3][1] + 30.0, was[3]
+    assert now[3][0][1] < now[3][1] + 15.0, now[3]
+    for k in (1, 2, 4):
+        assert now[k][0][1] == pytest.approx(was[k][0][1], abs=1.0), (k, now[k], was[k])
+
+
 # --- stop 56, support56: a support at the fruit's own depth is no occluder
 
 

@@ -187,7 +187,8 @@ def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_
     """``fuse_depth``'s lateral faces: a box narrower than the silhouette grows to it by the prior's share
     whatever the outline's contour share (the fruit covers at least what was seen of it, a cut edge or not); a
     box wider than the silhouette shrinks by that share times the contour share squared (beyond a cut edge the
-    fruit may reach)."""
+    fruit may reach; ``cut_reach: contour``, the default before stop 59: with ``widest`` the part of a cut outline's
+    box beyond its widest extent is pulled by the prior's share, the tests below)."""
     from symfruit import Box
     from symfruit.core.raster import Silhouette, across_sight
     from symfruit.methods.evidence import Combined, fuse_depth
@@ -198,7 +199,7 @@ def test_the_box_grows_to_the_silhouette_by_the_priors_share_and_shrinks_by_its_
     mask[np.hypot(yy - 29.5, xx - 29.5) <= 20] = True  # a disc 40 px across near the image centre
     region = Silhouette(int(cam.cx) - 30, int(cam.cy) - 30, mask, 0.0)
     across = across_sight(region, cam)
-    s = EvidenceSettings()
+    s = EvidenceSettings(cut_reach="contour")
     for contour in (1.0, 0.3):
         for half in (0.01, 0.08):  # a box far narrower, and one far wider, than the silhouette
             box = Box(np.array([-half, -half, 0.5]), np.array([half, half, 0.5 + 2 * half]))
@@ -1069,3 +1070,86 @@ def test_a_cut_sides_lateral_face_is_pulled_to_where_the_fruit_ends_not_to_the_c
     assert cut.min[0] > box.min[0] + 0.1 * (0.3 * 2 * r)  # pulled a tenth of the hidden 30 % in, at least
     assert abs(told.min[0] - box.min[0]) < 0.6 * z / cam.fx  # the disc's side, to the half pixel
     assert told.max[0] == cut.max[0] and told.max[2] == cut.max[2]
+
+
+def _square_across(hi_y: float = 0.1):
+    """An outline on the optical axis, 0.2 wide along e1 = x (tangent units), from -0.1 to ``hi_y`` along e2 = y."""
+    from symfruit.core.raster import Across
+
+    lo, hi = np.array([-0.1, -0.1]), np.array([0.1, hi_y])
+    return Across(np.array([0.0, 0.0, 1.0]), np.eye(3)[:2], lo, hi, float(min(0.2, hi_y + 0.1)), 0.2)
+
+
+def test_a_box_running_past_a_cut_face_beyond_the_widest_extent_seen_is_pulled_back_by_the_priors_share():
+    """Stop 59 (docs/leafcut59.md, ``cut_reach: widest``): a box 0.4 long along y over an outline 0.2 wide both ways
+    (at distance 1), its bottom face 0.2 past the silhouette's. With the contour share's pull (``share`` 0.1) the
+    bottom moves in by 0.02; the whole run lies beyond the widest extent seen, so it moves by the prior's share
+    (``grow`` 0.8): to 0.3 - 0.8 x 0.2 = 0.14. Where the outline itself is cut short (its bottom at 0.05), only the
+    part of the run beyond the widest extent (0.1 of 0.15) takes the prior's share: 0.2 - 0.1 x 0.05 - 0.8 x 0.1 =
+    0.115. x (as wide as the outline) and the back face are untouched."""
+    from symfruit import Box
+    from symfruit.methods.evidence import _lateral_faces
+
+    box = Box(np.array([-0.1, -0.1, 0.9]), np.array([0.1, 0.3, 1.1]))
+    across = _square_across()
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8)
+    assert hi[1] == pytest.approx(0.28) and lo[1] == pytest.approx(-0.1)
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert hi[1] == pytest.approx(0.14) and lo[1] == pytest.approx(-0.1)
+    assert (lo[0], hi[0], hi[2]) == pytest.approx((-0.1, 0.1, 1.1))
+    short = Box(np.array([-0.1, -0.1, 0.9]), np.array([0.1, 0.2, 1.1]))
+    lo, hi = _lateral_faces(short, _square_across(0.05), 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert hi[1] == pytest.approx(0.115)
+
+
+def test_the_widest_extents_pull_shares_the_excess_between_two_cut_faces_and_leaves_a_box_no_longer_than_it():
+    """Both faces run past (0.1 above, 0.3 below, the box 0.6 for a widest extent of 0.3): the 0.3 beyond it is three
+    quarters of the runs, taken from each in proportion and pulled by the prior's share: the top to -0.2 + 0.1 x 0.1 +
+    0.7 x 0.75 x 0.1, the bottom to 0.4 - 0.1 x 0.3 - 0.7 x 0.75 x 0.3. A box no longer than the
+    widest extent moves as before to the bit; so does every box where no cap is given (``widest`` inf: ``contour``);
+    a face inside the silhouette still grows out by the prior's share."""
+    from symfruit import Box
+    from symfruit.methods.evidence import _lateral_faces
+
+    across = _square_across()
+    box = Box(np.array([-0.1, -0.2, 0.9]), np.array([0.1, 0.4, 1.1]))
+    lo, hi = _lateral_faces(box, across, 0.9, 1.1, 0.1, 0.8, 0.3)
+    assert lo[1] == pytest.approx(-0.2 + 0.01 + 0.7 * 0.75 * 0.1)
+    assert hi[1] == pytest.approx(0.4 - 0.03 - 0.7 * 0.75 * 0.3)
+    narrow = Box(np.array([-0.05, -0.15, 0.9]), np.array([0.1, 0.05, 1.1]))  # 0.2 long, past the top by 0.05
+    assert _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2) == _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8)
+    lo, hi = _lateral_faces(narrow, across, 0.9, 1.1, 0.1, 0.8, 0.2)
+    assert lo[0] == pytest.approx(-0.05 - 0.8 * 0.05) and hi[1] == pytest.approx(0.05 + 0.8 * 0.05)
+
+
+@pytest.mark.parametrize("spread", ["ellipse", "contour"])
+def test_a_prior_read_from_the_free_arcs_ellipse_keeps_an_uncut_outlines_spread(spread):
+    """Stop 59 (docs/leafcut59.md, ``cut_spread``): a disc 40 px across, its left 30 % hidden (contour share 0.4), the
+    prior's width read from the ellipse through its free arcs (``whole``: the disc's). The back face is the inverse-
+    variance average of the shapes' (a box a radius deep: a lost rim's short back) and the prior's. With ``ellipse``
+    the prior's spread is an uncut outline's, ``depth_ratio_sd`` times the width; with ``contour`` (the default before)
+    divided by the contour share, so the short back keeps more of the weight."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
+    yy, xx = np.mgrid[:60, :60]
+    disc = np.hypot(yy - 29.5, xx - 29.5) <= 20
+    region = Silhouette(u0, v0, disc & (xx >= 22), 0.0)
+    across = across_sight(region, cam)
+    whole = (40.0 / cam.fx, 40.0 / cam.fx)
+    z, r = 0.5, 20.0 * 0.5 / cam.fx
+    box = Box(np.array([-r, -r, z]), np.array([r, r, z + r]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.002)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, 0.4, 0.0)
+    s = EvidenceSettings(cut_spread=spread)
+    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=0.4, across=across, whole=whole)
+    assert width == pytest.approx(40.0 / cam.fx * box.centre[2] / across.axis[2], rel=1e-12)  # the ellipse's
+    fit_sd = np.hypot(s.back_inflation * 0.002, width * (s.shape_error + s.rim_error * 0.6))
+    prior_sd = s.depth_ratio_sd * width / (1.0 if spread == "ellipse" else 0.4)
+    a, b = fit_sd**-2, prior_sd**-2
+    assert got.max[2] == pytest.approx((a * (z + r) + b * (z + s.depth_ratio * width)) / (a + b), rel=1e-9)
+    if spread == "ellipse":
+        assert got.max[2] - z > 0.9 * width  # the prior's 0.93-0.95 of an uncut outline

@@ -186,6 +186,26 @@ class EvidenceSettings(Section):
         out by the prior's share, in by that times the contour share squared); ``region``: the cut region's face
         (the default before). The real spheres with a leaf over a third of each, the mask cut: the 200 mm sphere's
         x side 183 -> 198 mm; the development apple trees' centres 3.87 -> 3.83 mm.
+    cut_reach : {"widest", "contour"}
+        On a cut outline (some of it not a contour), how far :func:`fuse_depth` pulls in a lateral face of the box
+        that runs past the silhouette's: ``contour`` (the default before) by the prior's share times the contour
+        share squared, however far (a cut hides how far the fruit goes on). ``widest`` (stop 59, docs/leafcut59.md):
+        the part of those runs by which the box is longer along that axis than the outline's widest extent (along
+        its principal axes or the tangent axes) is pulled in by the prior's share alone, as an uncut outline's face
+        is. A cut only ever shortens an outline, so its widest extent is the least shortened, and a round fruit is no
+        longer any way than that; only an elongated one behind the cut is, which the shapes (not the round prior)
+        must then show: the pull is the prior's share of the back face, small where the shapes agree (no threshold).
+        The real spheres with a leaf over a third of each, the mask cut: the 66 mm sphere's 106 mm height (a solid of
+        revolution 38 mm down behind the leaf) 106 -> 79 mm, not-a-cube 15.2 -> 11.6 mm; the development apple trees
+        (seeds 0-3 and 6-11) IoU 0.799 -> 0.800 and 0.766 -> 0.770, the larger lateral side 3.09 -> 2.90 and 4.10 ->
+        3.39 mm.
+    cut_spread : {"ellipse", "contour"}
+        The depth prior's spread on a cut outline: ``contour`` (the default before) divides it by the contour share
+        (a cut outline's width says less), also where its width is read from the ellipse through the free arcs
+        (``cut_prior``); ``ellipse`` (stop 59, docs/leafcut59.md) divides it by nothing where that ellipse's width
+        is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
+        real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
+        the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
@@ -326,6 +346,8 @@ class EvidenceSettings(Section):
     cut_width: float = setting(0.0, ge=0.0, le=1.0)
     cut_prior: Literal["outline", "ellipse", "sides"] = setting("sides")
     cut_faces: Literal["region", "sides"] = setting("sides")
+    cut_reach: Literal["contour", "widest"] = setting("widest")
+    cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -747,7 +769,10 @@ def fuse_depth(
     back_std = next((c.back_std for c in cands if c.name == "cone" and math.isfinite(c.back_std)), 0.0)
     across = across_sight(region, camera) if across is None else across
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
+    read = combined.contour  # the contour share of the outline the prior's width is read from
     if whole is not None:  # the ellipse of the outline's free arcs, as an uncut outline's; a cut only narrows
+        if s.cut_spread == "ellipse" and float(np.sqrt(whole[0] * whole[1])) > width:
+            read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, float(np.sqrt(whole[0] * whole[1])))
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
@@ -755,7 +780,7 @@ def fuse_depth(
     if s.depth_ratio_sd <= 0 or width <= 0:
         return box, fit_sd, width
     front = float(box.min[2])
-    prior_sd = s.depth_ratio_sd * width / max(combined.contour, 0.25)
+    prior_sd = s.depth_ratio_sd * width / max(read, 0.25)
     prior_back = front + s.depth_ratio * width
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
     back = max((a * fit_back + b * prior_back) / (a + b), front + 1e-4)
@@ -768,23 +793,35 @@ def fuse_depth(
     # Outwards by the prior's share alone: the fruit covers at least what it was seen to cover, cut or not
     # (the contour share only says how far beyond a cut edge it may reach, which pulls inwards).
     sil = across if faces is None else replace(across, lo=faces[0], hi=faces[1])
-    lo, hi = _lateral_faces(box, sil, front, back, share, b / (a + b))
+    widest = math.inf
+    if s.cut_reach == "widest" and combined.contour < 1.0:  # the outline's widest extent: along its axes or e1, e2
+        widest = max(across.major, across.minor, *(across.hi - across.lo).tolist())
+    lo, hi = _lateral_faces(box, sil, front, back, share, b / (a + b), widest)
     return Box(np.array(lo), np.array(hi)), 1.0 / math.sqrt(a + b), width
 
 
-def _lateral_faces(box: Box, across: Across, front: float, back: float, share: float,
-                   grow: float) -> tuple[list[float], list[float]]:  # fmt: skip
+def _lateral_faces(box: Box, across: Across, front: float, back: float, share: float, grow: float,
+                   widest: float = math.inf) -> tuple[list[float], list[float]]:  # fmt: skip
     """:func:`fuse_depth`'s box faces: ``box``'s lateral faces moved towards the silhouette's (``across``, about the
     point at depth ``0.5 (front + back)`` on its centroid's ray) by ``grow`` outwards and ``share`` inwards, its
-    back face ``back``. In Python floats (issue 19, stop 47): the same products and sums as numpy's on the (2,)
-    arrays before, ``np.where``'s test a comparison (False for NaN there too), without a dozen numpy calls."""
+    back face ``back``. Where the box along an axis is longer than ``widest`` (tangent units, times that distance),
+    that much of what it runs past the silhouette's faces is pulled in by ``grow`` too (``cut_reach``), shared between
+    the two faces in proportion to their runs. In Python floats (issue 19, stop 47): the same products and sums as
+    numpy's on the (2,) arrays before, ``np.where``'s test a comparison (False for NaN there too), without a dozen
+    numpy calls."""
     (a0, a1, a2), (s0, s1), (t0, t1) = across.axis.tolist(), across.lo.tolist(), across.hi.tolist()
     dist = 0.5 * (front + back) / a2
     lo, hi = box.min.tolist(), box.max.tolist()
     for i, (ax, sil_lo, sil_hi) in enumerate(((a0, s0, t0), (a1, s1, t1))):
         d_lo, d_hi = dist * (ax + sil_lo) - lo[i], dist * (ax + sil_hi) - hi[i]
+        past = hi[i] - lo[i] - dist * widest  # -inf where no cap
         lo[i] += (grow if d_lo < 0.0 else share) * d_lo
         hi[i] += (grow if d_hi > 0.0 else share) * d_hi
+        run_lo, run_hi = max(d_lo, 0.0), min(d_hi, 0.0)  # how far the box ran past each face
+        if past > 0.0 and run_lo - run_hi > 0.0:
+            over = min(past / (run_lo - run_hi), 1.0)  # the share of each run beyond the widest extent
+            lo[i] += (grow - share) * over * run_lo
+            hi[i] += (grow - share) * over * run_hi
     hi[2] = back
     return lo, hi
 
