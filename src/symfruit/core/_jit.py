@@ -9192,7 +9192,7 @@ def _mode_bin(
     while first > 0 and counts[first - 1] >= least:
         first -= 1
     lo = edges[first]
-    if first < i:
+    if first < i and counts[i] >= least:
         # the walk read at every phase (stop 59, docs/reg59.md): the depths it walked over, sorted, and the last gap
         end = edges[min(i + 1, n_bins)]
         m = 0

@@ -242,11 +242,12 @@ def fruit_depth(values: np.ndarray, radius_px: float, focal: float, *, noise: fl
     while first > 0 and counts[first - 1] >= least:
         first -= 1
     lo = edges[first]
-    if first < i:
+    if first < i and counts[i] >= least:
         # a gap is a bin's width of depths holding fewer than the filled bin's count, wherever it starts: read on the
         # bins' grid alone, whose phase is the nearest depth's, a gap a bin wide is walked over or not by where the
         # grid falls on it (a leaf 12 mm in front of a half-hidden apple, the mask moved by one pixel: stop 59,
-        # docs/reg59.md)
+        # docs/reg59.md). A peak bin not filled itself (its three bins' mass its neighbours') walks as before: its
+        # nearer neighbour is the peak's surface, and the depths a bin beyond are the next one's
         end = edges[min(i + 1, n_bins)]
         run = z[np.searchsorted(z, lo, side="left") : np.searchsorted(z, end, side="left")]
         gap = _gap_before(run, int(np.searchsorted(run, edges[i], side="left")), least, float(edges[1] - edges[0]))
