@@ -1266,6 +1266,29 @@ def test_fruit_depth_is_the_twins_to_the_bit(seed, n, kind, noise):
     assert np.array_equal(np.array(fast), np.array(twin), equal_nan=True)
 
 
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_fruit_depths_walk_at_every_phase_is_the_twins_to_the_bit(seed, rounded):
+    """A fruit and a leaf in front a gap of about one bin apart, a few pixels far nearer setting the bins' phase (the
+    walk nearer meets the gap on the grid or between its edges): ``fruit_depth``'s kernel, ``depth_mode`` on the
+    depths unsorted and the numpy twin give the same front and radius, bit for bit."""
+    from symfruit.core.surface import fruit_depth
+
+    rng = np.random.default_rng(seed)
+    gap = float(rng.uniform(0.0, 0.03))
+    n = int(rng.choice([40, 400, 1500]))
+    values = np.r_[1.675 + rng.uniform(0.0, 0.035, n), rng.uniform(1.615, 1.675 - gap, int(rng.integers(1, n))),
+                   rng.uniform(1.3, 1.4, int(rng.integers(0, 20)))]  # fmt: skip
+    if rounded:
+        values = np.round(values, 3)
+    rng.shuffle(values)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, fruit_depth, values, 26.0, 1200.0, noise=0.001)
+    assert np.array_equal(np.array(fast), np.array(twin), equal_nan=True)
+    got = _jit.depth_mode(values, 26.0, 1200.0, 0.001, np.zeros(0, bool), False, (0.5, 0.3))
+    assert got[2] and np.array_equal(np.array(got[:2]), np.array(fast))
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**32 - 1))
 def test_fruit_surfaces_apex_is_the_twins(seed):

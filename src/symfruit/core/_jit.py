@@ -9239,7 +9239,43 @@ def _mode_bin(
     first = i
     while first > 0 and counts[first - 1] >= least:
         first -= 1
-    return True, edges[first], edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+    lo = edges[first]
+    if first < i and counts[i] >= least:
+        # the walk read at every phase (stop 59, docs/reg59.md): the depths it walked over, sorted, and the last gap
+        end = edges[min(i + 1, n_bins)]
+        m = 0
+        for v in kept:
+            m += (v >= lo) & (v < end)
+        run = np.empty(m)
+        m = 0
+        for v in kept:
+            if v >= lo and v < end:
+                run[m] = v
+                m += 1
+        run.sort()
+        below = 0
+        while below < m and run[below] < edges[i]:
+            below += 1
+        gap = gap_before(run, below, least, edges[1] - edges[0])
+        if gap > lo:
+            first = i
+            while first > 0 and counts[first - 1] >= least and edges[first] > gap:
+                first -= 1
+            lo = max(edges[first], min(gap, end)) if first < i else edges[first]
+    return True, lo, edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+
+
+@_njit
+def gap_before(run: np.ndarray, below: int, least: float, width: float) -> float:
+    """:func:`symfruit.core.surface._gap_before`: the depth after the last window ``width`` wide after one of the
+    first ``below`` of the sorted depths ``run`` holding fewer than ``least`` of them (+inf past the end, -inf
+    without one); the same comparisons."""
+    t = np.int64(np.ceil(least))
+    n = run.shape[0]
+    for j in range(below - 1, -1, -1):
+        if j + t >= n or run[j + t] - run[j] > width:
+            return run[j + 1] if j + 1 < n else np.inf
+    return -np.inf
 
 
 # --- stop 52, register52: fruit_surface's mask box, measures and depth mode in one call ------------------------------
