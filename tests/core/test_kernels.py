@@ -1289,6 +1289,50 @@ def test_fruit_depths_walk_at_every_phase_is_the_twins_to_the_bit(seed, rounded)
     assert got[2] and np.array_equal(np.array(got[:2]), np.array(fast))
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_no_gap_only_where_gap_before_finds_none(seed, rounded):
+    """``no_gap``, the walk's look for a gap without sorting, says "none" only where ``gap_before`` on the sorted
+    depths finds none (a gap a bin wide or narrower, ties on a millimetre grid, windows starting near the parts'
+    edges), and the numpy twin's ``_gap_before`` finds what the kernel does."""
+    from symfruit.core.surface import _gap_before
+
+    rng = np.random.default_rng(seed)
+    width = float(rng.uniform(0.002, 0.02))
+    lo = float(rng.uniform(0.3, 2.0))
+    bins = int(rng.integers(1, 5))
+    start_end = lo + bins * width
+    end = start_end + width
+    gap_at = lo + float(rng.uniform(0.0, bins * width))
+    gap = float(rng.uniform(0.0, 1.5 * width))
+    values = rng.uniform(lo, end, int(rng.integers(20, 600)))
+    values = values[(values < gap_at) | (values > gap_at + gap)]
+    values = np.r_[values, rng.uniform(lo - 0.1, lo, 5), rng.uniform(end, end + 0.05, 5)]
+    if rounded:
+        values = np.round(values, 3)
+    least = max(2.0, 0.01 * float(rng.integers(len(values), 20 * len(values))))
+    run = np.sort(values[(values >= lo) & (values < end)])
+    below = int(np.searchsorted(run, start_end, side="left"))
+    found = _jit.gap_before(run, below, least, width)
+    assert _gap_before(run, below, least, width) == found
+    if _jit.no_gap(values, lo, end, start_end, width, least):
+        assert found == -np.inf
+
+
+def test_no_gap_reads_a_fruits_depths_without_a_gap():
+    """A round fruit's depths from its front to a bin past the starts (no gap: a window a bin wide always holds
+    many): ``no_gap`` says so, so the sort is skipped; a gap a bin wide among them: it does not."""
+    rng = np.random.default_rng(7)
+    r = 0.04
+    x, y = rng.uniform(-r, r, (2, 4000))
+    inside = x**2 + y**2 < (0.9 * r) ** 2
+    depth = 1.5 - np.sqrt(r**2 - x[inside] ** 2 - y[inside] ** 2)
+    lo, width = float(depth.min()), r / 3
+    assert _jit.no_gap(depth, lo, lo + 2 * width, lo + width, width, 0.01 * len(depth))
+    cut = depth[(depth < lo + 0.4 * width) | (depth > lo + 1.45 * width)]
+    assert not _jit.no_gap(cut, lo, lo + 2 * width, lo + width, width, 0.01 * len(cut))
+
+
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**32 - 1))
 def test_fruit_surfaces_apex_is_the_twins(seed):

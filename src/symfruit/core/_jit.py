@@ -9243,26 +9243,66 @@ def _mode_bin(
     if first < i and counts[i] >= least:
         # the walk read at every phase (stop 59, docs/reg59.md): the depths it walked over, sorted, and the last gap
         end = edges[min(i + 1, n_bins)]
-        m = 0
-        for v in kept:
-            m += (v >= lo) & (v < end)
-        run = np.empty(m)
-        m = 0
-        for v in kept:
-            if v >= lo and v < end:
-                run[m] = v
-                m += 1
-        run.sort()
-        below = 0
-        while below < m and run[below] < edges[i]:
-            below += 1
-        gap = gap_before(run, below, least, edges[1] - edges[0])
+        width = edges[1] - edges[0]
+        if z.shape[0] > 0:  # the depths sorted: the run is a slice of them (the gather's values, in order)
+            run = z[_count_below(z, lo, False) : _count_below(z, end, False)]
+            gap = gap_before(run, _count_below(run, edges[i], False), least, width)
+        elif i + 1 < n_bins and no_gap(kept, lo, end, edges[i], width, least):
+            gap = -np.inf  # what gap_before finds where no window can hold fewer than least (stop 59, lead)
+        else:
+            m = 0
+            for v in kept:
+                m += (v >= lo) & (v < end)
+            run = np.empty(m)
+            m = 0
+            for v in kept:
+                if v >= lo and v < end:
+                    run[m] = v
+                    m += 1
+            run.sort()
+            below = 0
+            while below < m and run[below] < edges[i]:
+                below += 1
+            gap = gap_before(run, below, least, width)
         if gap > lo:
             first = i
             while first > 0 and counts[first - 1] >= least and edges[first] > gap:
                 first -= 1
             lo = max(edges[first], min(gap, end)) if first < i else edges[first]
     return True, lo, edges[first + 1] if first < i else edges[min(i + 2, n_bins)]
+
+
+#: :func:`no_gap`'s parts of a bin: a window a bin wide holds all but three of them whole, wherever it starts.
+GAP_PARTS = 16
+
+
+@_njit
+def no_gap(kept: np.ndarray, lo: float, end: float, start_end: float, width: float, least: float) -> bool:
+    """True where :func:`gap_before` on the sorted depths of ``kept`` from ``lo`` up to ``end`` (the starts: those
+    below ``start_end``; ``end - start_end`` a bin ``width`` or more) would find no window: read without sorting them
+    (stop 59: the sort was 0.8 ms of a 33 ms frame). The depths are counted in parts of ``width / GAP_PARTS``; a
+    window from a start in part ``s`` holds every depth of parts ``s + 2`` to ``s + GAP_PARTS - 2`` (a part's place
+    off by one at its edges by rounding included: those depths lie more than 0.9 part after the start and more than
+    0.9 part before the window's end), so where each such run of parts holds ``least`` depths or more, every window
+    does. False where one may not (then :func:`gap_before` decides, on the sorted depths)."""
+    t = np.int64(np.ceil(least))
+    part = width / GAP_PARTS
+    n_parts = np.int64((end - lo) / part) + 2
+    counts = np.zeros(n_parts + 1, np.int64)
+    for v in kept:
+        if v >= lo and v < end:
+            q = np.int64((v - lo) / part)
+            counts[min(max(q, 0), n_parts - 1) + 1] += 1
+    for q in range(n_parts):  # running sums: counts[q] the depths of the parts before q
+        counts[q + 1] += counts[q]
+    last = min(np.int64((start_end - lo) / part) + 1, n_parts - 1)
+    for s_ in range(last + 1):
+        a, b = s_ + 2, s_ + GAP_PARTS - 1  # the parts a .. b - 1
+        if b > n_parts:
+            return False
+        if counts[b] - counts[a] < t:
+            return False
+    return True
 
 
 @_njit

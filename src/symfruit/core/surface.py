@@ -269,10 +269,13 @@ def _gap_before(run: np.ndarray, below: int, least: float, width: float) -> floa
     :func:`symfruit.core._jit.gap_before`, the same comparisons)."""
     t = int(np.ceil(least))
     n = len(run)
-    for j in range(below - 1, -1, -1):
-        if j + t >= n or run[j + t] - run[j] > width:
-            return float(run[j + 1]) if j + 1 < n else float("inf")
-    return float("-inf")
+    j = np.arange(below)
+    ahead = np.minimum(j + t, n - 1)
+    gaps = np.flatnonzero((j + t >= n) | (run[ahead] - run[j] > width))
+    if len(gaps) == 0:
+        return float("-inf")
+    last = int(gaps[-1])
+    return float(run[last + 1]) if last + 1 < n else float("inf")
 
 
 #: (a leaf, not a leaf): a depth peak at least this share of whose pixels are leaf green is a leaf, one below the
