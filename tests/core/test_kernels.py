@@ -1319,6 +1319,15 @@ def test_no_gap_only_where_gap_before_finds_none(seed, rounded):
         assert found == -np.inf
 
 
+def test_no_gap_counts_no_more_parts_than_twice_the_depths():
+    """A walk over more bins than the depths could fill (a histogram of many narrow bins): ``no_gap`` leaves it to
+    the sort instead of counting parts by the billion (its memory bounded by the depths'); NaN bounds likewise."""
+    values = np.linspace(1.0, 1.2, 50)
+    assert not _jit.no_gap(values, 1.0, 1.0 + 1e12, 1.0 + 1e12 - 1e-3, 1e-3, 2.0)
+    assert not _jit.no_gap(values, 1.0, np.nan, 1.1, 1e-3, 2.0)
+    assert _jit.no_gap(values, 1.0, 1.2, 1.1, 0.1, 2.0)  # 50 depths over two bins of 0.1: no window too empty
+
+
 def test_no_gap_reads_a_fruits_depths_without_a_gap():
     """A round fruit's depths from its front to a bin past the starts (no gap: a window a bin wide always holds
     many): ``no_gap`` says so, so the sort is skipped; a gap a bin wide among them: it does not."""

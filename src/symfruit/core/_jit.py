@@ -9284,10 +9284,15 @@ def no_gap(kept: np.ndarray, lo: float, end: float, start_end: float, width: flo
     window from a start in part ``s`` holds every depth of parts ``s + 2`` to ``s + GAP_PARTS - 2`` (a part's place
     off by one at its edges by rounding included: those depths lie more than 0.9 part after the start and more than
     0.9 part before the window's end), so where each such run of parts holds ``least`` depths or more, every window
-    does. False where one may not (then :func:`gap_before` decides, on the sorted depths)."""
+    does. False where one may not (then :func:`gap_before` decides, on the sorted depths), and where the walk spans
+    more parts than twice the depths (the parts' counts would cost more than the sort, and their memory is bounded by
+    the depths')."""
     t = np.int64(np.ceil(least))
     part = width / GAP_PARTS
-    n_parts = np.int64((end - lo) / part) + 2
+    span = (end - lo) / part
+    if not span < 2 * kept.shape[0] + 64:  # more parts than depths (a walk over many bins; NaN): the sort is cheaper
+        return False
+    n_parts = np.int64(span) + 2
     counts = np.zeros(n_parts + 1, np.int64)
     for v in kept:
         if v >= lo and v < end:
