@@ -771,9 +771,10 @@ def fuse_depth(
     width = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate", s.tilt_floor))
     read = combined.contour  # the contour share of the outline the prior's width is read from
     if whole is not None:  # the ellipse of the outline's free arcs, as an uncut outline's; a cut only narrows
-        if s.cut_spread == "ellipse" and float(np.sqrt(whole[0] * whole[1])) > width:
+        ellipse = float(np.sqrt(whole[0] * whole[1]))
+        if s.cut_spread == "ellipse" and ellipse > width:
             read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
-        width = max(width, float(np.sqrt(whole[0] * whole[1])))
+        width = max(width, ellipse)
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
     model = width * (s.shape_error + s.rim_error * (1.0 - rim))
     fit_sd = math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
