@@ -7680,3 +7680,57 @@ def test_in_pieces_known_answers():
     assert _jit.in_pieces(comb)  # the first tooth joined to the back, the others not
     comb[6, 1::2] = True
     assert not _jit.in_pieces(comb)  # every tooth joined at a corner of row 6's pixels between them
+
+
+# --- stop 60, speeds60: the surface kernels without jumps
+
+
+def test_least_median_seeded_at_a_spike_takes_the_first_least_median():
+    """The pass starts from the pixel whose own value is least: a spike there (its window's median not the least) is
+    passed over; of two windows with the least median, before and after the seed, the first is taken; all medians
+    +inf: the first pixel."""
+    image = np.full((9, 12), 0.5)
+    image[1:6, 0:5] = 0.45  # a block of 0.45: the windows about its pixels take the median 0.45, the least
+    image[1:6, 7:12] = 0.45  # the same block again about (3, 9): the same median, after it
+    image[3, 9] = 0.1  # the least own value, a spike: the seed, whose median is 0.45 too, but it comes later
+    rows, cols = np.nonzero(np.ones(image.shape, bool))
+    from symfruit.core.surface import median_at
+
+    medians = median_at(image, rows, cols, size=5)
+    seed = int(np.argmin(image[rows, cols]))
+    want = int(np.argmin(medians))
+    assert (rows[seed], cols[seed]) == (3, 9) and medians[seed] == medians[want] == 0.45 and want < seed
+    assert _jit.least_median(image, rows, cols, 5) == want
+    assert _jit.least_median(image, rows[seed:], cols[seed:], 5) == 0  # the seed first: its own tie kept
+    assert _jit.least_median(np.full((4, 4), np.inf), rows[:16] % 4, cols[:16] % 4, 5) == 0
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.booleans())
+def test_noise_step_is_depth_noise_and_depth_step(seed, odd):
+    """``_noise_step`` (mask_values' one pass): ``depth_noise``'s count and deviation and ``depth_step``'s step, with
+    whole-millimetre and continuous depths, NaN, infinite (two neighbours infinite: a NaN difference), negative and
+    zero depths, few pixels."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    depth = rng.uniform(0.4, 0.6, (h, w))
+    if rng.random() < 0.5:
+        depth = np.round(depth, 3)
+    if odd:
+        for value in (np.nan, np.inf, -0.2, 0.0):
+            depth[rng.random((h, w)) < 0.05] = value
+    mask = rng.random((h, w)) < rng.uniform(0.05, 1.0)
+    n, mad, step = _jit._noise_step(depth, mask)
+    n_want, mad_want = _jit.depth_noise(depth, mask)
+    assert n == n_want and ((np.isnan(mad) and np.isnan(mad_want)) or mad == mad_want)
+    assert step == _jit.depth_step(depth, mask)
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_rows_box_is_the_box(seed):
+    """``_rows_box`` (each row or'ed whole, then walked from its ends): ``_box``'s box, (0, 0, 0, 0) for none."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(0, 30, 2))
+    mask = rng.random((h, w)) < rng.choice([0.0, 0.002, 0.05, 0.5])
+    assert _jit._rows_box(mask) == _jit._box(mask)

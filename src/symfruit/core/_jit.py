@@ -642,6 +642,28 @@ def _box(mask: np.ndarray) -> tuple[int, int, int, int]:
     return (r0, r1, c0, c1) if r1 > 0 else (0, 0, 0, 0)
 
 
+@_njit_inlined
+def _rows_box(mask: np.ndarray) -> tuple[int, int, int, int]:
+    """:func:`_box` of ``mask`` (h, w) bool, each row or'ed whole without a jump (several pixels at once) and the first
+    and last pixel walked to from its ends where it holds one (stop 60, speeds60): the same box."""
+    h, w = mask.shape
+    r0, r1, c0, c1 = h, 0, w, 0
+    for r in range(h):
+        some = False
+        for c in range(w):
+            some |= mask[r, c]
+        if some:
+            first = 0
+            while not mask[r, first]:
+                first += 1
+            last = w - 1
+            while not mask[r, last]:
+                last -= 1
+            r0, r1 = min(r0, r), r + 1
+            c0, c1 = min(c0, first), max(c1, last + 1)
+    return (r0, r1, c0, c1) if r1 > 0 else (0, 0, 0, 0)
+
+
 @_njit
 def allowed(hidden: np.ndarray, seen: np.ndarray, gap: int, thin: int) -> np.ndarray:
     """:meth:`symfruit.core.occlusion.Occlusion.allowed` of a window's ``hidden`` and ``seen`` pixels (h, w) bool
@@ -1371,9 +1393,15 @@ def _least_median_of(
 
     Since issue 19's nineteenth round the values the windows read are copied once, edges repeated and +inf where not
     ``near``, into an array over the pixels' box grown by the windows' half size, and a window's count of values
-    below the least is the sum of ``size`` column counts, each column's values below the least in the window's rows,
-    counted once per row of pixels and again after the least falls (instead of reading each window's values): the
-    same counts, so the same pixels passed over and the same medians taken, the same pixel."""
+    at or below the least is the sum of ``size`` column counts, each column's values in the window's rows, counted
+    once per row of pixels and again after the least falls (instead of reading each window's values).
+
+    Since stop 60 (speeds60) the pass starts from the median of the pixel whose own value is least (the first of
+    them): a near-least median from the start, so the least rarely falls and a row's counts are the last row's with
+    one row taken off and one added. A pixel takes the least from the one holding it where its median is smaller, or
+    equal and it comes first; a window with at most ``size * size // 2`` values at or below the least has a median
+    above it and is passed over. Every median at or below the least is taken, so the pixel found is the first of the
+    least median, the same pixel as the pass from the first pixel."""
     h, w = image.shape
     half = size // 2
     middle = size * size // 2
@@ -1390,40 +1418,59 @@ def _least_median_of(
         for b in range(vw):
             cc = min(max(cmin - half + b, 0), w - 1)
             vals[a, b] = image[rr, cc] if not masked or near[rr, cc] else np.inf
-    counts = np.zeros(vw, np.int64)  # per column of ``vals``: its values below ``least`` in the current window rows
     window = np.empty(size * size)
-    best, least = -1, np.inf
+    seed = 0  # the first pixel whose own value is least
+    lowest = np.inf
+    for i in range(n):
+        v = vals[rows[i] - rmin + half, cols[i] - cmin + half]
+        if v < lowest:
+            lowest, seed = v, i
+    best, least = seed, _window_median(vals, rows[seed] - rmin, cols[seed] - cmin, size, window)
+    counts = np.zeros(vw, np.int64)  # per column of ``vals``: its values at or below ``least`` in the window rows
     counted = -1  # the window rows ``counts`` holds (their first row in ``vals``); -1: none, or the least fell
     for i in range(n):
+        if i == seed:
+            continue
         r0, c0 = rows[i] - rmin, cols[i] - cmin  # the window's first row and column in ``vals``
-        if best >= 0:
-            if counted != r0:
+        if counted != r0:
+            if counted >= 0 and r0 == counted + 1:  # one row on: the row left taken off, the row entered added
+                for b in range(vw):
+                    counts[b] += np.int64(vals[r0 + size - 1, b] <= least) - np.int64(vals[counted, b] <= least)
+            else:
                 counts[:] = 0
                 for a in range(r0, r0 + size):
                     for b in range(vw):
-                        counts[b] += vals[a, b] < least
-                counted = r0
-            below = 0
-            for b in range(c0, c0 + size):
-                below += counts[b]
-            if below <= middle:
-                continue  # at most ``middle`` values below the least: the median is not below it
-        k = 0
-        for a in range(size):
-            for b in range(size):
-                window[k] = vals[r0 + a, c0 + b]
-                k += 1
-        for a in range(1, k):
-            v = window[a]
-            b = a
-            while b > 0 and window[b - 1] > v:
-                window[b] = window[b - 1]
-                b -= 1
-            window[b] = v
-        if best < 0 or window[middle] < least:
-            best, least = i, window[middle]
+                        counts[b] += vals[a, b] <= least
+            counted = r0
+        below = 0
+        for b in range(c0, c0 + size):
+            below += counts[b]
+        if below <= middle:
+            continue  # at most ``middle`` values at or below the least: the median is above it
+        m = _window_median(vals, r0, c0, size, window)
+        if m < least or (m == least and i < best):
+            best, least = i, m
             counted = -1
     return best
+
+
+@_njit_inlined
+def _window_median(vals: np.ndarray, r0: int, c0: int, size: int, window: np.ndarray) -> float:
+    """The median of the ``size`` x ``size`` values of ``vals`` from row ``r0``, column ``c0`` (``window`` (size *
+    size,) their sorted copy, by insertion: :func:`_least_median_of`'s)."""
+    k = 0
+    for a in range(size):
+        for b in range(size):
+            window[k] = vals[r0 + a, c0 + b]
+            k += 1
+    for a in range(1, k):
+        v = window[a]
+        b = a
+        while b > 0 and window[b - 1] > v:
+            window[b] = window[b - 1]
+            b -= 1
+        window[b] = v
+    return window[size * size // 2]
 
 
 @_njit
@@ -3569,26 +3616,32 @@ def surface_apex(
     city-block chamfer's two sweeps give those distances exactly (:func:`taxicab_within`'s, capped past ``k``)."""
     bh, bw = own.shape
     cap = iterations + 1
-    d = np.empty((bh, bw), np.int64)
+    # stop 60 (speeds60): the city-block distances by rows, then by columns (the taxicab distance is the least over
+    # the rows of the row distance plus the rows between: two sweeps down and up, each row's columns apart, which the
+    # compiler runs on several columns at once), beyond the box not the mask's: the same distances, capped alike
+    d = np.empty((bh, bw), np.int32)
     for r in range(bh):
+        run = 0
         for c in range(bw):
-            if not own[r, c]:
-                d[r, c] = 0
-                continue
-            up = d[r - 1, c] if r > 0 else 0  # beyond the box: not the mask's
-            left = d[r, c - 1] if c > 0 else 0
-            d[r, c] = min(min(up, left) + 1, cap)
+            run = min(run + 1, cap) if own[r, c] else 0
+            d[r, c] = run
+        run = 0
+        for c in range(bw - 1, -1, -1):
+            run = min(run + 1, cap) if own[r, c] else 0
+            d[r, c] = min(d[r, c], run)
+    for c in range(bw):
+        d[0, c] = min(d[0, c], 1)
+    for r in range(1, bh):
+        for c in range(bw):
+            d[r, c] = min(d[r, c], d[r - 1, c] + 1)
+    for c in range(bw):
+        d[bh - 1, c] = min(d[bh - 1, c], 1)
+    for r in range(bh - 2, -1, -1):
+        for c in range(bw):
+            d[r, c] = min(d[r, c], d[r + 1, c] + 1)
     h, w = near.shape
     rows = np.empty(h * w, np.int64)
     cols = np.empty(h * w, np.int64)
-    for r in range(bh - 1, -1, -1):
-        for c in range(bw - 1, -1, -1):
-            v = d[r, c]
-            if v == 0:
-                continue
-            down = d[r + 1, c] if r + 1 < bh else 0
-            right = d[r, c + 1] if c + 1 < bw else 0
-            d[r, c] = min(v, min(down, right) + 1)
     n = 0
     for r in range(bh):
         for c in range(bw):
@@ -3635,10 +3688,12 @@ def near_pixels(depth: np.ndarray, region: np.ndarray, low: float, high: float, 
     some = False
     for r in range(h):
         for c in range(w):
+            # the four tests and'ed without a jump (stop 60, speeds60: the compiler runs the row on several pixels
+            # at once; the same comparisons, so the same pixels)
             z = depth[r, c]
-            hit = region[r, c] and z > 0 and z >= low and z <= high
+            hit = region[r, c] & (z > 0) & (z >= low) & (z <= high)
             out[r, c] = hit
-            some = some or hit
+            some |= hit
     return some
 
 
@@ -4054,18 +4109,65 @@ def monotone_at(
             n += keep[r, c]
     if n == 0:
         return 0
-    rows, cols = np.empty(n, np.int64), np.empty(n, np.int64)
-    sector, d2 = np.empty(n, np.int64), np.empty(n, np.int64)
+    # stop 60 (speeds60): each pixel's flat index, depth, sector and squared distance read in raster order, and the
+    # two stable counting sorts of :func:`monotone` (by distance, then by sector) moving the pixels' index, depth and
+    # sector to their places (no index looked up twice), the rays then walked in order: the same order (sector, then
+    # distance, then position), the same arithmetic on the same depths, so the same pixels
+    at, sector, d2 = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n, np.int64)
+    z = np.empty(n)  # ``at``: row and column in one number (row times 2^32 plus column), taken apart where written
+    biggest = 0.0
+    top = 0
     i = 0
     for r in range(h):
+        a = np.int64(r - r0)
         for c in range(w):
             if keep[r, c]:
-                a, b = np.int64(r - r0), np.int64(c - c0)
-                rows[i], cols[i] = r, c
+                b = np.int64(c - c0)
+                at[i] = (np.int64(r) << 32) | np.int64(c)
+                v = float(depth[r, c])
+                z[i] = v
+                biggest = max(biggest, abs(v))
                 sector[i] = np.int64(table[a + reach, b + reach])
-                d2[i] = a * a + b * b
+                q = a * a + b * b
+                d2[i] = q
+                top = max(top, q)
                 i += 1
-    monotone(depth, rows, cols, sector, d2, bins, tolerance, out)
+    count = np.zeros(top + 2, np.int64)
+    for i in range(n):
+        count[d2[i] + 1] += 1
+    for v in range(top + 1):
+        count[v + 1] += count[v]
+    by_d2 = np.empty(n, np.int64)
+    for i in range(n):
+        by_d2[count[d2[i]]] = i
+        count[d2[i]] += 1
+    start = np.zeros(bins + 1, np.int64)
+    for i in range(n):
+        start[sector[i] + 1] += 1
+    for s in range(bins):
+        start[s + 1] += start[s]
+    at_s, sec_s, z_s = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n)
+    for j in range(n):
+        i = by_d2[j]
+        s = sector[i]
+        k = start[s]
+        start[s] = k + 1
+        at_s[k], sec_s[k], z_s[k] = at[i], s, z[i]
+    scale = 2.0 * (biggest + tolerance + 1.0)
+    running = -np.inf
+    last = -1
+    fallen = False
+    for j in range(n):
+        s = sec_s[j]
+        if s != last:
+            last, fallen = s, False
+        offset = s * scale
+        running = max(running, z_s[j] + offset)
+        if z_s[j] < (running - offset) - tolerance:
+            fallen = True
+        if not fallen:
+            a = at_s[j]
+            out[a >> 32, a & 0xFFFFFFFF] = True
     return n
 
 
@@ -4312,14 +4414,17 @@ def thin_counts(
     the twin's, bit for bit (stop 43)."""
     h, w = mask.shape
     counts = np.zeros(5, np.int64)
+    # stop 60 (speeds60): the first pass's counts moved on by each test's outcome (no jump to foresee): the same
+    n_ok = 0
     n_front = 0
     for r in range(h):
         for c in range(w):
-            good = mask[r, c] and depth[r, c] > 0
+            z = depth[r, c]
+            good = mask[r, c] & (z > 0)
             ok[r, c] = good
-            if good:
-                counts[0] += 1
-                n_front += abs(depth[r, c] - front) <= join
+            n_ok += good
+            n_front += good & (abs(z - front) <= join)
+    counts[0] = n_ok
     rows = np.empty(n_front, np.int64)
     cols = np.empty(n_front, np.int64)
     k = 0
@@ -5006,7 +5111,15 @@ def trim_features(
     features (n, 3) and (m, 3) in raster order, and how many pixels the band holds (the same pixels and values)."""
     h, w = mask.shape
     near = np.empty((h, w))
-    near_distance(mask, ring_px, True, near)
+    # stop 60 (speeds60): the distances over the mask's box grown by the reach and a pixel alone, +inf beyond it (no
+    # mask pixel lies within the reach of a pixel outside it; inside it each column's nearest mask pixel and each
+    # row's uncapped columns are the whole window's, the columns and rows left out all capped): the same values
+    r0, r1, c0, c1 = _rows_box(mask)
+    near[:] = np.inf
+    if r1 > 0:
+        g = math.floor(ring_px) + 1
+        a0, a1, b0, b1 = max(r0 - g, 0), min(r1 + g, h), max(c0 - g, 0), min(c1 + g, w)
+        near_distance(mask[a0:a1, b0:b1], ring_px, True, near[a0:a1, b0:b1])
     n_fruit = n_ring = n_band = 0
     for r in range(h):
         for c in range(w):
@@ -8986,7 +9099,7 @@ def mask_values(
     (``depth[mask]``'s :func:`finite_positive`), ``leaf`` ``leafy`` (h, w) bool at them where ``with_leafy`` (else
     empty), as :func:`symfruit.core.surface.fruit_depth` takes them (:func:`depth_mode`'s); ``step``:
     :func:`depth_step` (stop 51)."""
-    n, mad = depth_noise(depth, mask)
+    n, mad, step = _noise_step(depth, mask)
     noise = floor
     if n < 10:
         if 0.002 > noise:
@@ -8995,26 +9108,60 @@ def mask_values(
         x = 1.4826 * mad / math.sqrt(2.0)
         if x > noise:
             noise = x
+    # stop 60 (speeds60): the depths kept in one pass, each pixel's value written and the count moved on by the test
+    # (no jump to foresee), the arrays cut to the count: the same values in the same order
     h, w = depth.shape
+    room = np.empty(h * w)
+    leaf_room = np.empty(h * w if with_leafy else 0, np.bool_)
     m = 0
     for r in range(h):
         for c in range(w):
-            if mask[r, c]:
-                v = np.float64(depth[r, c])
-                m += np.isfinite(v) and v > 0
-    kept = np.empty(m)
-    leaf = np.empty(m if with_leafy else 0, np.bool_)
-    j = 0
+            v = np.float64(depth[r, c])
+            room[m] = v
+            if with_leafy:
+                leaf_room[m] = leafy[r, c]
+            m += mask[r, c] & np.isfinite(v) & (v > 0)
+    return noise, room[:m], leaf_room[: m if with_leafy else 0], step
+
+
+@_njit_inlined
+def _noise_step(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float, float]:
+    """:func:`depth_noise`'s ``(n, deviation)`` and :func:`depth_step`'s step in one pass over the neighbours (stop 60,
+    speeds60): the differences ``right - left`` of the pairs both in ``mask`` and above 0 gathered (each written, the
+    count moved on by the test), the step their least non-zero magnitude (``abs`` of ``a - b`` is ``|b - a|`` to the
+    bit; a NaN difference, two infinite depths, is left out as there), read before the medians reorder them: the same
+    numbers as the two kernels."""
+    h, w = depth.shape
+    diff = np.empty(max(h * (w - 1), 0))
+    n = 0
     for r in range(h):
-        for c in range(w):
-            if mask[r, c]:
-                v = np.float64(depth[r, c])
-                if np.isfinite(v) and v > 0:
-                    kept[j] = v
-                    if with_leafy:
-                        leaf[j] = leafy[r, c]
-                    j += 1
-    return noise, kept, leaf, depth_step(depth, mask)
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            diff[n] = a - b
+            n += mask[r, c + 1] & mask[r, c] & (a > 0) & (b > 0)
+    moved = 0
+    best = np.inf
+    found = False
+    for i in range(n):
+        d = diff[i]
+        moved += d != 0
+        e = abs(d)
+        found |= e > 0
+        best = min(best, e) if e > 0 else best
+    step = float(best) if found else 0.0
+    if moved >= 20:
+        kept = 0
+        for i in range(n):
+            diff[kept] = diff[i]
+            kept += diff[i] != 0
+        n = kept
+    if n < 10:
+        return n, np.nan, step
+    x = diff[:n]
+    for i in range(n):
+        if np.isnan(x[i]):
+            return n, np.nan, step
+    return n, deviation_median(x), step
 
 
 @_njit
@@ -9059,7 +9206,7 @@ def surface_cap(
         full = True
         for i in range(a0, a1):
             for j in range(b0, b1):
-                full = full and mask[i, j]
+                full &= mask[i, j]
         if full:
             return 3, r, c
         near_distance(mask[a0:a1, b0:b1], max(deep_px, 0.0), False, inner[a0:a1, b0:b1])
@@ -9070,7 +9217,7 @@ def surface_cap(
     monotone_at(depth, near, r, c, table, half, bins, tolerance, out)
     for i in range(h):
         for j in range(w):
-            out[i, j] = out[i, j] or (near[i, j] and inner[i, j] > deep_px)
+            out[i, j] |= near[i, j] & (inner[i, j] > deep_px)  # without a jump (stop 60, speeds60): the same pixels
     return 1, r, c
 
 
@@ -9342,13 +9489,18 @@ def mask_mode(
     h, w = mask.shape
     r0, r1, c0, c1 = h, 0, w, 0
     for r in range(h):
-        first, last = -1, -1
+        # stop 60 (speeds60): whether the row holds a pixel by or-ing it whole (no jump: the compiler takes several
+        # pixels at once), then its first and last pixel walked to from its ends: the same box
+        some = False
         for c in range(w):
-            if mask[r, c]:
-                last = c
-                if first < 0:
-                    first = c
-        if first >= 0:
+            some |= mask[r, c]
+        if some:
+            first = 0
+            while not mask[r, first]:
+                first += 1
+            last = w - 1
+            while not mask[r, last]:
+                last -= 1
             r0 = min(r0, r)
             r1 = r + 1
             c0 = min(c0, first)
