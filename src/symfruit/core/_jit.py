@@ -5180,11 +5180,13 @@ def _fast_cost(
     size = values.shape[0]
     lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
     low, top = size, -1
+    for j in range(n):  # the points' ranks, their least and largest, then their counts: three plain loops (stop
+        row[j] = ranks[at[j] - offset]  # 60: about a tenth faster than one loop doing all three; the same numbers)
     for j in range(n):
-        r = np.int64(ranks[at[j] - offset])
-        row[j] = r
-        count[r] += 1
+        r = row[j]
         low, top = min(low, r), max(top, r)
+    for j in range(n):
+        count[row[j]] += 1
     b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
     while seen <= lower:
         b += 1
