@@ -8652,36 +8652,31 @@ def outline_windows(
 
     Since issue 19's stop 60 (speedr60) in fewer passes than the two kernels one after the other:
     - the column pass of :func:`outline_maps` (each pixel's distance along its column to the nearest pixel of the
-      other kind) finds each row's first and last mask pixel as it goes, and serves the taxicab window too: a
-      pixel's taxicab distance to the mask is the least over the columns of the column gap plus the column
-      distance (0 on the mask), two sweeps along each row (whole numbers, exact: the same pixels as the chamfer's
-      two sweeps over the image);
-    - each row's envelopes (:func:`_hull`, the same parabolas) are read off segment by segment, without a branch a
-      pixel, straight into the keys: the outside pixels' envelope runs over the whole row, where it is 0 on the
-      mask's pixels (their parabolas' own columns), and the mask pixels' envelope, 0 on the outside pixels between
-      them, is added to it (so each pixel holds its own map's key). Every value is the least over the same
-      parabolas, so the same whole number; the largest and least keys are the same (the zeros never decide them: a
-      row with an outside pixel has an outside key of at least 1, one with a mask pixel a mask key of at least 1);
+      other kind) serves the taxicab window too: a pixel's taxicab distance to the mask is the least over the
+      columns of the column gap plus the column distance (0 on the mask), two sweeps along each row (whole
+      numbers, exact: the same pixels as the chamfer's two sweeps over the image);
+    - the outside pixels' envelope of a row takes, of each run of mask pixels, its two ends alone (the nearest mask
+      pixel of the row to an outside pixel ends a run) and no column without a mask pixel (farther than any); it is
+      read off segment by segment straight into the keys over the whole row (the mask's pixels get other values
+      there), then the mask pixels' envelope, read off alike, puts their keys over them. Every value an outside or
+      a mask pixel keeps is the least over the parabolas that can be least, so the same whole number, and the
+      largest and least keys are taken over the same pixels;
     - the rest as :func:`outline_maps`."""
     pad = reach
     h, w = mask.shape
     big = h + w
     g = np.empty((h, w), np.int64)
-    firsts, lasts, n_ins = np.empty(h, np.int64), np.empty(h, np.int64), np.empty(h, np.int64)
-    lo_c, hi_c = w, -1
-    first, last, n_in = w, -1, 0
     for c in range(w):
         g[0, c] = big
-        if mask[0, c]:
-            first, last, n_in = min(first, c), c, n_in + 1
-    firsts[0], lasts[0], n_ins[0] = first, last, n_in
-    lo_c, hi_c = min(lo_c, first), max(hi_c, last)
     for r in range(1, h):
+        for c in range(w):
+            g[r, c] = g[r - 1, c] + 1 if mask[r, c] == mask[r - 1, c] else 1
+    firsts, lasts, n_ins = np.empty(h, np.int64), np.empty(h, np.int64), np.empty(h, np.int64)
+    lo_c, hi_c = w, -1  # the mask's first and last column: the outside pixels' only sites (stop 46)
+    for r in range(h):
         first, last, n_in = w, -1, 0
         for c in range(w):
-            m = mask[r, c]
-            g[r, c] = g[r - 1, c] + 1 if m == mask[r - 1, c] else 1
-            if m:
+            if mask[r, c]:
                 first, last, n_in = min(first, c), c, n_in + 1
         firsts[r], lasts[r], n_ins[r] = first, last, n_in
         lo_c, hi_c = min(lo_c, first), max(hi_c, last)
@@ -8726,17 +8721,17 @@ def outline_windows(
                     n += 1
             q = _hull_of(f, sites, n, w, s, t)
             end = w
-            most = 0
             for j in range(q, -1, -1):
                 i = s[j]
                 fi = f[i]
                 for u in range(t[j], end):
                     a = u - i
-                    k = a * a + fi
-                    key[r, u] = -k
-                    most = max(most, 0 if mask[r, u] else k)
+                    key[r, u] = -(a * a + fi)
                 end = t[j]
-            top, low = max(top, most), min(low, -most)
+            least = 0
+            for u in range(w):
+                least = min(least, 0 if mask[r, u] else key[r, u])
+            top, low = max(top, -least), min(low, least)
         if last >= 0:  # the mask's pixels
             a, b = max(first - 1, 0), min(last + 1, w - 1)
             for c in range(a, b + 1):
