@@ -6578,6 +6578,57 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
     assert free.dtype == want_free.dtype and np.array_equal(free, want_free)
 
 
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.5), st.integers(0, 8))
+def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, pad):
+    """``free_outline`` (stop 60: each point's look at the gap pixels about it, nearest first) on random caps over
+    depth with holes, pixels behind and in front, any reach (whole or not) and pad (below the reach too): the points
+    within ``reach`` of the gap made on the outline's box grown by ``pad``, as the twin finds them (``within``'s
+    numpy dilation of that gap, read at the points), bit for bit."""
+    from symfruit.core.raster import interior
+    from symfruit.core.surface import within
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 70, 2))
+    cap = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
+    if not cap.any():
+        cap[0, 0] = True
+    rows, cols = np.nonzero(cap & ~interior(cap))
+    depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
+    depth[depth < 0.1] = 0.0
+    depth[rng.random((h, w)) < 0.02] = np.nan
+    far = float(rng.uniform(0.45, 0.6))
+    free = _jit.free_outline(depth, cap, rows, cols, far, reach, pad)
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    box = (slice(r0, int(rows.max()) + pad + 1), slice(c0, int(cols.max()) + pad + 1))
+    gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= far))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want = within(gap, reach)[rows - r0, cols - c0]
+    assert free.dtype == want.dtype and np.array_equal(free, want)
+
+
+def test_free_outline_known_answers():
+    """A 5 x 5 cap in a window without depth but two pixels in front: its outline's points are all free at reach 1
+    (the pixel beside each is a gap) but the two points beside those pixels; none is free where the whole window
+    holds depth in front; the corner points need reach sqrt(2) where only the diagonal pixels are gaps."""
+    cap = np.zeros((9, 9), bool)
+    cap[2:7, 2:7] = True
+    rows, cols = np.nonzero(cap & ~np.pad(np.ones((3, 3), bool), 3))
+    depth = np.zeros((9, 9))
+    depth[4, 1] = depth[4, 7] = 0.4  # in front of the fruit's far depth
+    free = _jit.free_outline(depth, cap, rows, cols, 0.5, 1.0, 2)
+    assert not free[(rows == 4) & ((cols == 2) | (cols == 6))].any()
+    assert free[~((rows == 4) & ((cols == 2) | (cols == 6)))].all()
+    assert not _jit.free_outline(np.full((9, 9), 0.4), cap, rows, cols, 0.5, 4.0, 5).any()
+    diagonal = np.full((9, 9), 0.4)
+    diagonal[1, 1] = 0.0
+    corner = (rows == 2) & (cols == 2)
+    for reach, want in ((1.0, False), (1.4, False), (math.sqrt(2.0), True), (2.0, True)):
+        got = _jit.free_outline(diagonal, cap, rows, cols, 0.5, reach, 3)
+        assert got[corner].all() == want and not got[~corner].any()
+
+
 @pytest.mark.parametrize("seed", range(8))
 @pytest.mark.parametrize("reach", [6, 20])
 def test_the_registrations_outline_is_the_twins_to_the_bit(monkeypatch, seed, reach):

@@ -4898,9 +4898,15 @@ def free_outline(
 ) -> np.ndarray:  # fmt: skip
     """(n,) bool: :func:`symfruit.core.surface._free_points`' free points of the outline ``(rows, cols)`` (n >= 1):
     on the outline's box grown by ``pad`` (clipped to the array), the gap (the pixels not ``cap``'s whose ``depth``
-    is at most 0 or at least ``far``), each pixel's distance to it within ``reach`` (:func:`near_distance`, as
-    :func:`symfruit.core.surface.within` has it: +inf beyond, and everywhere when there is no gap), read at the
-    points and compared with ``reach``. The twin's comparisons, distances and test: the same points."""
+    is at most 0 or at least ``far``), each point free where its distance to the gap is within ``reach`` (as
+    :func:`symfruit.core.surface.within` has it: :func:`near_distance`'s square root of the least squared distance
+    where that is at most ``reach ** 2``, compared with ``reach``). The same points as the twin's.
+
+    Since issue 19's stop 60 (speedr60) each point looks only at the gap pixels about it, nearest first, and stops
+    at the first one in reach, instead of a distance map of the whole box read at the points: a gap pixel within
+    ``reach`` lies within ``floor(reach)`` rows and columns, and whether the least squared distance ``d`` passes
+    (``d <= reach ** 2`` and ``sqrt(d) <= reach``) is whether any does (both tests grow with ``d``). The gap is read
+    within the box alone, as the map was made there."""
     h, w = cap.shape
     rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
     for i in range(rows.shape[0]):
@@ -4908,16 +4914,33 @@ def free_outline(
         cmin, cmax = min(cmin, cols[i]), max(cmax, cols[i])
     r0, c0 = max(rmin - pad, 0), max(cmin - pad, 0)
     r1, c1 = min(rmax + pad + 1, h), min(cmax + pad + 1, w)
-    gap = np.empty((r1 - r0, c1 - c0), np.bool_)
-    for r in range(r0, r1):
-        for c in range(c0, c1):
-            z = depth[r, c]
-            gap[r - r0, c - c0] = (not cap[r, c]) and (z <= 0 or z >= far)
-    near = np.empty((r1 - r0, c1 - c0))
-    near_distance(gap, reach, True, near)
-    free = np.empty(rows.shape[0], np.bool_)
+    k = math.floor(reach)
+    limit = reach * reach
+    # the offsets in reach, nearest first (the order only makes the first found come sooner)
+    n_off = 0
+    dr_at = np.empty((2 * k + 1) ** 2, np.int64)
+    dc_at = np.empty((2 * k + 1) ** 2, np.int64)
+    d_at = np.empty((2 * k + 1) ** 2, np.int64)
+    for dr in range(-k, k + 1):
+        for dc in range(-k, k + 1):
+            d = dr * dr + dc * dc
+            if d <= limit and math.sqrt(float(d)) <= reach:
+                j = n_off
+                while j > 0 and d_at[j - 1] > d:  # insertion by distance
+                    dr_at[j], dc_at[j], d_at[j] = dr_at[j - 1], dc_at[j - 1], d_at[j - 1]
+                    j -= 1
+                dr_at[j], dc_at[j], d_at[j] = dr, dc, d
+                n_off += 1
+    free = np.zeros(rows.shape[0], np.bool_)
     for i in range(rows.shape[0]):
-        free[i] = near[rows[i] - r0, cols[i] - c0] <= reach
+        r, c = rows[i], cols[i]
+        for j in range(n_off):
+            rr, cc = r + dr_at[j], c + dc_at[j]
+            if r0 <= rr < r1 and c0 <= cc < c1 and not cap[rr, cc]:
+                z = depth[rr, cc]
+                if z <= 0 or z >= far:
+                    free[i] = True
+                    break
     return free
 
 
@@ -4939,6 +4962,19 @@ def _envelope_of(f: np.ndarray, lo: int, hi: int, w: int, s: np.ndarray, t: np.n
     columns only, over the same domain. Where every other column's parabola lies above one of these everywhere (the
     caller's columns without a mask pixel, whose ``f`` exceeds any squared distance within the image), the same
     least, so the same numbers as :func:`_envelope` over the whole row."""
+    q = _hull(f, lo, hi, w, s, t)
+    for u in range(w - 1, -1, -1):
+        a = u - s[q]
+        d2[u] = a * a + f[s[q]]
+        if u == t[q]:
+            q -= 1
+
+
+@_njit_inlined
+def _hull(f: np.ndarray, lo: int, hi: int, w: int, s: np.ndarray, t: np.ndarray) -> int:
+    """:func:`_envelope_of`'s lower envelope of the parabolas ``(u - i)^2 + f[i]`` of the columns ``lo <= i <= hi``
+    over the columns ``0 <= u < w``: its last parabola's place ``q``; parabola ``j <= q`` (column ``s[j]``) is the
+    least from column ``t[j]`` (``t[0] = 0``, ascending) up to the next one's start (``w`` after the last)."""
     q = 0
     s[0] = lo
     t[0] = 0
@@ -4958,11 +4994,34 @@ def _envelope_of(f: np.ndarray, lo: int, hi: int, w: int, s: np.ndarray, t: np.n
                 q += 1
                 s[q] = u
                 t[q] = start
-    for u in range(w - 1, -1, -1):
-        a = u - s[q]
-        d2[u] = a * a + f[s[q]]
-        if u == t[q]:
+    return q
+
+
+@_njit_inlined
+def _hull_of(f: np.ndarray, sites: np.ndarray, n: int, w: int, s: np.ndarray, t: np.ndarray) -> int:
+    """:func:`_hull` of the parabolas of the columns ``sites[:n]`` alone (ascending, ``n >= 1``): the same steps over
+    those columns (the lower envelope of any ascending columns)."""
+    q = 0
+    s[0] = sites[0]
+    t[0] = 0
+    for m in range(1, n):
+        u = sites[m]
+        while q >= 0:
+            a, b = t[q] - s[q], t[q] - u
+            if a * a + f[s[q]] <= b * b + f[u]:
+                break
             q -= 1
+        if q < 0:
+            q = 0
+            s[0] = u
+        else:
+            i = s[q]
+            start = 1 + (u * u - i * i + f[u] - f[i]) // (2 * (u - i))
+            if start < w:
+                q += 1
+                s[q] = u
+                t[q] = start
+    return q
 
 
 @_njit
@@ -5036,6 +5095,20 @@ def outline_maps(
                     k = d2[c]
                     key[r, c] = -k
                     top, low = max(top, k), min(low, -k)
+    return _outline_keys(mask, key, pad, reach, top, low, high, inner, inside)
+
+
+@_njit
+def _outline_keys(
+    mask: np.ndarray, key: np.ndarray, pad: int, reach: int, top: int, low: int, high: int, inner: np.ndarray,
+    inside: np.ndarray,
+) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`outline_maps`' maps, keys and ranks from the whole-number keys ``key`` (h, w) int64 (sign * the squared
+    distance: + on ``mask``, - off it), their largest magnitude ``top`` and their least and largest ``low``,
+    ``high`` (with ``-reach ** 2`` where ``pad`` is above 0): what :func:`outline_maps` returns (shared with
+    :func:`outline_windows`)."""
+    h, w = mask.shape
+    floor = -(reach * reach)
     low, high = min(low, high), max(low, high)  # a map of one kind of pixel only: one of them still unset
     if top >= 2**15 - 1:  # no 16-bit keys: the maps alone, by their square roots
         for r in range(h):
@@ -5220,11 +5293,13 @@ def _fast_cost(
     size = values.shape[0]
     lower, upper = (n - 1) // 2, n // 2  # np.median's two middle places (one when n is odd)
     low, top = size, -1
+    for j in range(n):  # the points' ranks, their least and largest, then their counts: three plain loops (stop
+        row[j] = ranks[at[j] - offset]  # 60: about a tenth faster than one loop doing all three; the same numbers)
     for j in range(n):
-        r = np.int64(ranks[at[j] - offset])
-        row[j] = r
-        count[r] += 1
+        r = row[j]
         low, top = min(low, r), max(top, r)
+    for j in range(n):
+        count[row[j]] += 1
     b, seen = low, count[low]  # the rank holding place `lower`, and how many places lie up to its end
     while seen <= lower:
         b += 1
@@ -8686,9 +8761,109 @@ def outline_windows(
     """:func:`symfruit.core.surface._outline`'s maps of a mask (h, w) bool holding pixels of both kinds, in one call:
     ``grown`` (h, w) bool the pixels within ``reach`` taxicab steps of the mask (:func:`taxicab_within`) and
     :func:`outline_maps` of pad and reach ``reach`` (``inner`` and ``inside`` written in place, its keys and ranks
-    returned): the two kernels' own loops one after the other, the same pixels and numbers."""
-    taxicab_within(mask, reach, grown)
-    return outline_maps(mask, reach, reach, inner, inside)
+    returned): the same pixels and numbers.
+
+    Since issue 19's stop 60 (speedr60) in fewer passes than the two kernels one after the other:
+    - the column pass of :func:`outline_maps` (each pixel's distance along its column to the nearest pixel of the
+      other kind) serves the taxicab window too: a pixel's taxicab distance to the mask is the least over the
+      columns of the column gap plus the column distance (0 on the mask), two sweeps along each row (whole
+      numbers, exact: the same pixels as the chamfer's two sweeps over the image);
+    - the outside pixels' envelope of a row takes, of each run of mask pixels, its two ends alone (the nearest mask
+      pixel of the row to an outside pixel ends a run) and no column without a mask pixel (farther than any); it is
+      read off segment by segment straight into the keys over the whole row (the mask's pixels get other values
+      there), then the mask pixels' envelope, read off alike, puts their keys over them. Every value an outside or
+      a mask pixel keeps is the least over the parabolas that can be least, so the same whole number, and the
+      largest and least keys are taken over the same pixels;
+    - the rest as :func:`outline_maps`."""
+    pad = reach
+    h, w = mask.shape
+    big = h + w
+    g = np.empty((h, w), np.int64)
+    for c in range(w):
+        g[0, c] = big
+    for r in range(1, h):
+        for c in range(w):
+            g[r, c] = g[r - 1, c] + 1 if mask[r, c] == mask[r - 1, c] else 1
+    firsts, lasts, n_ins = np.empty(h, np.int64), np.empty(h, np.int64), np.empty(h, np.int64)
+    lo_c, hi_c = w, -1  # the mask's first and last column: the outside pixels' only sites (stop 46)
+    for r in range(h):
+        first, last, n_in = w, -1, 0
+        for c in range(w):
+            if mask[r, c]:
+                first, last, n_in = min(first, c), c, n_in + 1
+        firsts[r], lasts[r], n_ins[r] = first, last, n_in
+        lo_c, hi_c = min(lo_c, first), max(hi_c, last)
+    for r in range(h - 2, -1, -1):
+        for c in range(w):
+            if mask[r, c] != mask[r + 1, c]:
+                g[r, c] = 1
+            elif g[r + 1, c] + 1 < g[r, c]:
+                g[r, c] = g[r + 1, c] + 1
+    key = np.empty((h, w), np.int64)
+    f = np.empty(w, np.int64)
+    s = np.empty(w, np.int64)
+    t = np.empty(w, np.int64)
+    row = np.empty(w, np.int64)
+    sites = np.empty(w, np.int64)
+    floor = -(reach * reach)
+    top = reach * reach
+    low, high = (floor, floor) if pad > 0 else (np.int64(2**62), -np.int64(2**62))
+    for r in range(h):
+        first, last, n_in = firsts[r], lasts[r], n_ins[r]
+        # taxicab: the column distances to the mask (0 on it), then the row's two sweeps
+        d = 2 * big
+        for c in range(w):
+            v = 0 if mask[r, c] else g[r, c]
+            d = min(v, d + 1)
+            row[c] = d
+        d = 2 * big
+        for c in range(w - 1, -1, -1):
+            d = min(row[c], d + 1)
+            grown[r, c] = d <= reach
+        if n_in < w:  # outside: the row's outside pixels (the mask's pixels written here too, over-written below)
+            n = 0
+            for c in range(lo_c, hi_c + 1):
+                if mask[r, c]:  # of a run of mask pixels, its ends alone
+                    if c == lo_c or c == hi_c or not mask[r, c - 1] or not mask[r, c + 1]:
+                        f[c] = 0
+                        sites[n] = c
+                        n += 1
+                elif g[r, c] < big:  # a column without a mask pixel is farther than any
+                    f[c] = g[r, c] * g[r, c]
+                    sites[n] = c
+                    n += 1
+            q = _hull_of(f, sites, n, w, s, t)
+            end = w
+            for j in range(q, -1, -1):
+                i = s[j]
+                fi = f[i]
+                for u in range(t[j], end):
+                    a = u - i
+                    key[r, u] = -(a * a + fi)
+                end = t[j]
+            least = 0
+            for u in range(w):
+                least = min(least, 0 if mask[r, u] else key[r, u])
+            top, low = max(top, -least), min(low, least)
+        if last >= 0:  # the mask's pixels
+            a, b = max(first - 1, 0), min(last + 1, w - 1)
+            for c in range(a, b + 1):
+                f[c - a] = g[r, c] * g[r, c] if mask[r, c] else 0
+            q = _hull(f, 0, b - a, b + 1 - a, s, t)
+            end = b + 1 - a
+            most = 0
+            for j in range(q, -1, -1):
+                i = s[j]
+                fi = f[i]
+                for u in range(max(t[j], first - a), min(end, last + 1 - a)):
+                    e = u - i
+                    k = e * e + fi
+                    inside_pixel = mask[r, a + u]
+                    key[r, a + u] = k if inside_pixel else key[r, a + u]
+                    most = max(most, k if inside_pixel else 0)
+                end = t[j]
+            top, high = max(top, most), max(high, most)
+    return _outline_keys(mask, key, pad, reach, top, low, high, inner, inside)
 
 
 @_njit
@@ -8696,14 +8871,43 @@ def cap_outline(
     pixels: np.ndarray, r: int, c: int, depth: np.ndarray, far: float, reach: float, pad: int, least: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`symfruit.core.surface._outline`'s cap and its outline in one call: the piece of ``pixels`` (h, w) bool
-    holding its pixel ``(r, c)`` (which must be ``pixels``'): :func:`connected_at`; its outline's rows and columns
-    (raster order): :func:`outline_pixels`; and, where there are at least ``least`` of them, which are free
+    holding its pixel ``(r, c)`` (which must be ``pixels``'): :func:`connected_at`'s; its outline's rows and columns
+    (raster order): :func:`outline_pixels`'; and, where there are at least ``least`` of them, which are free
     (:func:`free_outline` over ``depth`` (h, w) float64 with ``far``, ``reach`` and ``pad``; else an empty array):
-    the three kernels one after the other, the same pixels and points."""
-    cap = np.empty(pixels.shape, np.bool_)
-    connected_at(pixels, r, c, cap)
-    rows, cols = outline_pixels(cap)
-    if rows.shape[0] < least:
+    the same pixels and points.
+
+    Since issue 19's stop 60 (speedr60) the flood keeps each pixel's row and column (no division of a flat index)
+    and the piece's box, and the outline is looked for within that box alone, in one pass: the cap is a few
+    thousand pixels of a window of some ten thousand."""
+    h, w = pixels.shape
+    cap = np.zeros((h, w), np.bool_)
+    cap[r, c] = True
+    stack_r = np.empty(h * w, np.int64)
+    stack_c = np.empty(h * w, np.int64)
+    stack_r[0], stack_c[0] = r, c
+    top, count = 1, 1
+    rmin, rmax, cmin, cmax = r, r, c, c
+    while top > 0:
+        top -= 1
+        pr, pc = stack_r[top], stack_c[top]
+        rmin, rmax, cmin, cmax = min(rmin, pr), max(rmax, pr), min(cmin, pc), max(cmax, pc)
+        for rr, cc in ((pr - 1, pc), (pr + 1, pc), (pr, pc - 1), (pr, pc + 1)):
+            if 0 <= rr < h and 0 <= cc < w and pixels[rr, cc] and not cap[rr, cc]:
+                cap[rr, cc] = True
+                stack_r[top], stack_c[top] = rr, cc
+                top += 1
+                count += 1
+    rows_at, cols_at = np.empty(count, np.int64), np.empty(count, np.int64)
+    n = 0
+    for i in range(rmin, rmax + 1):
+        inner_r = 0 < i < h - 1
+        for j in range(cmin, cmax + 1):
+            if cap[i, j] and not (inner_r and 0 < j < w - 1 and cap[i - 1, j] and cap[i + 1, j] and cap[i, j - 1]
+                                  and cap[i, j + 1]):  # fmt: skip
+                rows_at[n], cols_at[n] = i, j
+                n += 1
+    rows, cols = rows_at[:n].copy(), cols_at[:n].copy()
+    if n < least:
         return rows, cols, np.empty(0, np.bool_)
     return rows, cols, free_outline(depth, cap, rows, cols, far, reach, pad)
 
