@@ -1500,7 +1500,7 @@ def leaf_in_two(*, noise=0.0005, seed=0):
     joins the other. Both run on across the mask's outline; the crescent of the ball seen on the right touches the
     right part only (it lies farther than :func:`_behind_crossing`'s reach from the left one)."""
     depth, mask, leaf = leaf_across(noise=0.0)
-    yy, xx = np.mgrid[:H, :W]
+    xx = np.mgrid[:H, :W][1]
     depth = sheet(depth, leaf, 0.40, slope=(-0.25, -0.05), centre=(60, 60))
     depth = np.where(leaf & (xx >= 74), depth + 0.006, depth)
     depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape) * (depth > 0)
@@ -1516,7 +1516,7 @@ def test_a_leaf_parted_in_two_at_its_own_depth_is_passed_over_at_every_pixel_of_
     mask moved by a pixel the farther part's median crossed that line and the box moved by 218 mm. A part at the
     nearest surface's depth that runs on across the outline is that occluder's layer: the crescent is taken (its
     front about 0.508 m), no leaf pixel kept, with the mask as drawn and moved by one pixel each way."""
-    yy, xx = np.mgrid[:H, :W]
+    xx = np.mgrid[:H, :W][1]
     for seed in range(3):
         depth, mask, leaf = leaf_in_two(seed=seed)
         left, right = mask & leaf & (xx < 74), mask & leaf & (xx >= 74)
