@@ -1488,3 +1488,42 @@ def test_a_leaf_beside_a_fruit_at_its_depth_is_not_joined_across_a_twig(depth_le
     off, as far as the real 125 mm sphere's halves' own far edges are: no bound tells them apart; left open)."""
     depth, rows, cols, labels = leaf_beside_ball(depth_leaf)
     assert across_occluder(depth, rows, cols, labels, 0, 0.003, F, R_BALL).tolist() == [True, False]
+
+
+# --- stop 60, thin60: a leaf in two parts, the nearer's median a hair from the farther's ----------------------------
+
+
+def leaf_in_two(*, noise=0.0005, seed=0):
+    """``(depth, mask, leaf)``: :func:`leaf_across` with its leaf tilted towards the camera on the right (-0.25 across)
+    and parted in two at column 74 by a step of 6 mm (the right part farther: twice the convexity tolerance), so that
+    the right part's median lies within the tolerance of the left's (about 2.3 mm behind it) while no pixel of either
+    joins the other. Both run on across the mask's outline; the crescent of the ball seen on the right touches the
+    right part only (it lies farther than :func:`_behind_crossing`'s reach from the left one)."""
+    depth, mask, leaf = leaf_across(noise=0.0)
+    xx = np.mgrid[:H, :W][1]
+    depth = sheet(depth, leaf, 0.40, slope=(-0.25, -0.05), centre=(60, 60))
+    depth = np.where(leaf & (xx >= 74), depth + 0.006, depth)
+    depth = depth + np.random.default_rng(seed).normal(scale=noise, size=depth.shape) * (depth > 0)
+    return depth, mask, leaf
+
+
+def test_a_leaf_parted_in_two_at_its_own_depth_is_passed_over_at_every_pixel_of_shift():
+    """The development tree seeds 0-3, frame 1, apple 28 (stop 60, docs/thin60.md): a mask drawn over a leaf whose two
+    parts a step parts, the nearer holding the depth mode's front, the other's median within the tolerance of the
+    nearer's. Both run on across the outline. :func:`_behind_crossing` passed over only parts behind the nearest
+    surface's median by more than the tolerance, so the farther part was neither a candidate nor passed over, and the
+    crescent behind it, not touching the nearer part, was not found: the leaf's front (0.40 m) and its pixels. As the
+    mask moved by a pixel the farther part's median crossed that line and the box moved by 218 mm. A part at the
+    nearest surface's depth that runs on across the outline is that occluder's layer: the crescent is taken (its
+    front about 0.508 m), no leaf pixel kept, with the mask as drawn and moved by one pixel each way."""
+    xx = np.mgrid[:H, :W][1]
+    for seed in range(3):
+        depth, mask, leaf = leaf_in_two(seed=seed)
+        left, right = mask & leaf & (xx < 74), mask & leaf & (xx >= 74)
+        assert abs(float(np.median(depth[right])) - float(np.median(depth[left]))) < 0.003
+        for dr in (-1, 0, 1):
+            for dc in (-1, 0, 1):
+                moved = np.roll(mask, (dr, dc), axis=(0, 1))
+                found = fruit_surface(depth, moved, F, thin=True, crossing=True)
+                assert found is not None and 0.50 < found.front < 0.515, (seed, dr, dc)
+                assert (found.pixels & leaf).sum() == 0, (seed, dr, dc)

@@ -642,9 +642,16 @@ def _behind_crossing(depth: np.ndarray, mask: np.ndarray, focal: float, front: f
     reach = 3 + int(np.ceil(0.3 * np.sqrt(m.sum() / np.pi)))
     for j in order:
         k, z_k = int(ids[j]), float(medians[j])
-        if k == sheet or z_k <= sheet_depth + join:
+        if k == sheet:
             continue
         own = parts == k
+        if z_k <= sheet_depth + join:
+            # not behind the nearest surface: a part of its layer, parted from it by a step, where it runs on across
+            # the outline too (its median within join of the sheet's, on either side as the mask moves by a pixel:
+            # stop 60, docs/thin60.md)
+            if cross[k] >= CROSSING * outline:
+                passed |= own
+            continue
         if cross[k] <= 0.1 * cross[sheet] and ndimage.binary_dilation(passed, iterations=reach)[own].any():
             rows, cols = np.nonzero(own & m)
             kappa, error = _mean_curvature(rows, cols, d[rows, cols], focal)
