@@ -367,7 +367,9 @@ def observe(
     else:
         rays_in, rays_out, out_weights, out_depth, packed = made
     fitted = None
+    labelled = False
     if occlusion is not None and edged and contour_cone <= contour < 1.0:
+        labelled = True
         cracks = outline_cracks(region)
         if crack_labels is None:
             crack_labels = _labels_at(edge_uv, is_contour, cracks, kept)
@@ -390,7 +392,7 @@ def observe(
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        inner=inner, inner_reach=float("inf") if reach is None else reach,
                        _hidden_of=None if occlusion is None else (occlusion, region))  # fmt: skip
-    if fitted is not None:  # the outline and which of it is the fruit's own contour, that the ellipse was fitted to
+    if labelled:  # the outline and which of it is the fruit's own contour, that the ellipse was fitted to (or not)
         obs._made["outline"] = (cracks, crack_labels)
     return obs
 

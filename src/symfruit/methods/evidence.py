@@ -73,6 +73,7 @@ from ..core.raster import (
     cone_widths,
     free_side_reach,
     inner_distance,
+    outline_circle,
     point_pixels,
     silhouette,
     silhouette_cone,
@@ -348,6 +349,7 @@ class EvidenceSettings(Section):
     cut_faces: Literal["region", "sides"] = setting("sides")
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
+    cut_circle: Literal["off", "free"] = setting("free")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -931,10 +933,16 @@ def evidence(
     whole = faces = None
     if s.cut_prior == "ellipse" and obs.cone_source == "contour" and obs.cone is not None and obs.axis is not None:
         whole = cone_widths(obs.cone, obs.axis)
-    elif s.cut_prior == "sides" and obs.cone_source == "contour" and obs.cone is not None:
+    elif s.cut_prior == "sides":
         cracks, free = obs._made.get("outline", (None, None))
-        if cracks is not None:
-            stretch, reach = free_side_reach(cracks, free, obs.cone, camera, region)
+        cone = obs.cone if obs.cone_source == "contour" else None
+        if cone is None and cracks is not None and s.cut_circle == "free":
+            # no ellipse through the free arcs (too short or ragged for five parameters): a round fruit's give its
+            # radius (three), read as the ellipse would be, on the cut sides alone and capped at the widest extent
+            circle = outline_circle(region, camera, cracks[free])
+            cone = None if circle is None else circle[0]
+        if cracks is not None and cone is not None:
+            stretch, reach = free_side_reach(cracks, free, cone, camera, region)
             whole = (sized.minor * stretch, sized.major * stretch)
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
