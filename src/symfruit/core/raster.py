@@ -947,12 +947,15 @@ def _credible(region: Silhouette, centre: np.ndarray, a2: np.ndarray, area: floa
 
 def outline_circle(
     region: Silhouette, camera: Camera, points: np.ndarray, *, min_points: int = 20, inside: float = 0.97,
-    max_area: float = 3.0,
+    max_area: float = 3.0, fit_px: float = 0.5,
 ) -> tuple[np.ndarray, np.ndarray] | None:  # fmt: skip
     """The viewing cone of the circle fitted to part of the silhouette's outline (``points``, pixels, the fruit's own
-    contour): ``(cone, axis)`` as :func:`outline_cone`, or None when no credible circle fits, by
+    contour): ``(cone, axis)`` as :func:`outline_cone`, or None when no credible circle fits: by
     :func:`outline_cone`'s acceptance (it holds at least ``inside`` of the region's pixels and its area is at most
-    ``max_area`` times the region's).
+    ``max_area`` times the region's), and the points lie about it as a digitised circle's outline does, at a root
+    mean square distance of at most ``fit_px`` (an outline crack, :func:`outline_cracks`, is the midpoint of the
+    pixel edge between a pixel centre inside the outline and one outside, so within half a pixel of it: arcs that
+    stray further from their circle are not a round fruit's, and the circle is not its width).
 
     A round fruit's free arcs give its radius: the algebraic least-squares circle (Kasa 1976: ``u^2 + v^2 + d u + e
     v + f = 0``, linear in its three unknowns, on the points less their mean over their spread) has three
@@ -988,6 +991,9 @@ def outline_circle(
         return None
     r2 *= scale * scale
     centre = mu + scale * centre
+    off = np.sqrt(((pts - centre) ** 2).sum(axis=1)) - math.sqrt(r2)
+    if not float(np.sqrt((off * off).mean())) <= fit_px:
+        return None
     if not _credible(region, centre, np.eye(2) / r2, math.pi * r2, inside, max_area):
         return None
     conic = np.array([[1.0, 0.0, -centre[0]], [0.0, 1.0, -centre[1]],
