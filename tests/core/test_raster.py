@@ -874,7 +874,7 @@ def test_the_tangent_extent_of_a_regions_outline_is_across_sights():
     np.testing.assert_allclose(hi, across.hi, rtol=0, atol=1e-12)
 
 
-def _cut_disc(r: float, cut: float, size: int = 100):
+def _straight_cut_disc(r: float, cut: float, size: int = 100):
     """A digitised disc of radius ``r`` px about (50, 50) (pixel centres within it), a straight edge hiding its
     left ``cut`` of its width: the cut region, its outline's crack points and which of them are the disc's own."""
     from symfruit.core.raster import Silhouette, outline_cracks
@@ -891,17 +891,21 @@ def test_a_disc_cut_by_a_straight_edge_gives_the_circle_of_its_diameter(r, cut):
     """Stop 60 (docs/cut60.md): a digitised disc (26-80 px across, the real spheres' 43 and 59 px among them) with a
     straight edge hiding its left 30-45 %: the circle through its free arcs (:func:`outline_circle`) is the disc's, to
     a pixel across, where the cut region's geometric-mean width is 0.75-0.85 of it; and the cone's widths across the
-    line of sight are its diameter over the focal length."""
-    from symfruit.core.raster import cone_widths, outline_circle
+    line of sight are its diameter over the focal length. Read side by side (:func:`free_side_stretch`, the cut side
+    reaching the circle) the cut region's widths give the diameter too, to a pixel."""
+    from symfruit.core.raster import cone_widths, free_side_stretch, outline_circle
 
     cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
-    region, cracks, free = _cut_disc(r, cut)
+    region, cracks, free = _straight_cut_disc(r, cut)
     cone, axis = outline_circle(region, cam, cracks[free])
     minor, major = cone_widths(cone, axis)
     assert minor * cam.fx == pytest.approx(major * cam.fx, abs=1e-3)  # a circle (near the optical axis)
     assert minor * cam.fx == pytest.approx(2.0 * r, abs=1.0)
     widths = np.ptp(cracks, axis=0)
     assert np.sqrt(widths.prod()) < 0.9 * 2.0 * r  # what the cut region reads
+    # read side by side (the prior's width, evidence's cut_circle): the cut side reaches the circle, the rest stays
+    stretch = free_side_stretch(cracks, free, cone, cam, region)
+    assert np.sqrt(widths.prod()) * stretch == pytest.approx(2.0 * r, abs=1.0)
 
 
 def test_an_elongated_or_scattered_outline_gives_no_circle():
@@ -911,7 +915,7 @@ def test_an_elongated_or_scattered_outline_gives_no_circle():
     from symfruit.core.raster import Silhouette, outline_circle, outline_cracks
 
     cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
-    region, cracks, free = _cut_disc(21.5, 0.35)
+    region, cracks, free = _straight_cut_disc(21.5, 0.35)
     pts = cracks[free]
     assert outline_circle(region, cam, pts) is not None
     rng = np.random.default_rng(0)
@@ -938,7 +942,7 @@ def test_outline_circles_acceptance_is_the_same_with_its_kernels_and_without(mon
 
     cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
     for r, cut in ((21.5, 0.35), (13.0, 0.3), (40.0, 0.45)):
-        region, cracks, free = _cut_disc(r, cut)
+        region, cracks, free = _straight_cut_disc(r, cut)
         for pts in (cracks[free], cracks[free][::2], cracks[free] * 0.9 + 5.0):
             monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
             got = outline_circle(region, cam, pts)
