@@ -959,10 +959,10 @@ def outline_circle(
 
     A round fruit's free arcs give its radius: the algebraic least-squares circle (Kasa 1976: ``u^2 + v^2 + d u + e
     v + f = 0``, linear in its three unknowns, on the points less their mean over their spread) has three
-    parameters where the ellipse has five, so it holds on arcs too short or too ragged for the ellipse (a 60 mm
-    sphere 43 px across with a leaf over its left third: 51-63 free outline points over a half arc, on which the
-    ellipse came out 26 x 36 px, docs/cut58.md 1.3, and the circle 43 px). It is what the ellipse is on a round
-    fruit; on an elongated one its callers cap what it may add (:func:`free_side_reach`).
+    parameters where the ellipse has five, so it holds on arcs too short for the ellipse on a real mask's edge (a
+    60 mm sphere 43 px across with a leaf over its left third: 51-63 free outline points over 103-130 degrees of arc,
+    on which the ellipse came out 26 x 36 px, docs/cut58.md 1.3, and the circle 43 px; docs/cut60.md). It is what the
+    ellipse is on a round fruit; on an elongated one its callers cap what it may add (:func:`free_side_reach`).
 
     >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
     >>> t = np.linspace(-0.4 * np.pi, 0.4 * np.pi, 60)

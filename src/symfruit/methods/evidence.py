@@ -211,15 +211,16 @@ class EvidenceSettings(Section):
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
         each, 51-79 free outline points over a half arc, the five-parameter fit came out too small and missed holding
-        the region, docs/cut58.md 1.3; nor is it tried under ``contour_cone``, as the shapes' viewing cone): ``free``
-        (stop 60, docs/cut60.md) reads the sides as
-        ``sides`` does from the circle through the free arcs (:func:`~symfruit.core.raster.outline_circle`: three
-        parameters, accepted as the ellipse is and where the arcs lie within half a pixel of it, root mean square, as
-        a digitised round outline's do; a round fruit's free arcs give its radius, and a cut only shortens an
-        outline). The cut sides reach the circle, no axis beyond the outline's widest extent seen, and the prior's
-        spread is then an uncut outline's (``cut_spread``). ``off``: the cut region's widths (as before). The real
-        spheres cut by the leaf: the 60 mm sphere 39-41 x 61 x 41-44 -> 60 x 62 x 59 mm, the 66 mm one (frame 1) 58
-        x 79 x 62 -> 66 x 69 x 68 mm and (frame 0, contour share 0.30) 61 x 69 x 59 -> 66 x 69 x 67 mm.
+        the region on 100-130 degrees of arc, docs/cut58.md 1.3; nor is it tried under ``contour_cone``, as the shapes'
+        viewing cone): ``free`` (stop 60, docs/cut60.md) reads the sides as ``sides`` does from the circle through the
+        free arcs (:func:`~symfruit.core.raster.outline_circle`: three parameters, accepted as the ellipse is and where
+        the arcs lie within half a pixel of it, root mean square, as a digitised round outline's do; a round fruit's
+        free arcs give its radius, and a cut only shortens an outline). The cut sides reach the circle, no axis
+        beyond the outline's widest extent seen, and the prior's spread is then an uncut outline's (``cut_spread``).
+        ``off``: the cut region's widths (as before). The real spheres cut by the leaf: the 60 mm sphere 39-41 x 61 x
+        41-44 -> 60 x 62 x 59 mm, the 66 mm one 58 x 79 x 62 -> 66 x 69 x 68 mm (frame 1) and 61 x 69 x 59 -> 66 x
+        69 x 67 mm (frame 0, contour share 0.30); over the bar 5 / 8 -> 1 / 8. The development trees: one apple of
+        248 moves (better); through the D435 model with a leaf in front 7 views of 210 (4 better).
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
