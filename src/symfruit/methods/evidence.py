@@ -949,14 +949,14 @@ def evidence(
         whole = cone_widths(obs.cone, obs.axis)
     elif s.cut_prior == "sides":
         cracks, free = obs._made.get("outline", (None, None))
-        cone = obs.cone if obs.cone_source == "contour" else None
-        if cone is None and cracks is not None and s.cut_circle == "free":
+        arcs = obs.cone if obs.cone_source == "contour" else None  # the cone of the free arcs' ellipse
+        if arcs is None and cracks is not None and s.cut_circle == "free":
             # no ellipse through the free arcs (too short or ragged for five parameters): a round fruit's give its
             # radius (three), read as the ellipse would be, on the cut sides alone and capped at the widest extent
             circle = outline_circle(region, camera, cracks[free])
-            cone = None if circle is None else circle[0]
-        if cracks is not None and cone is not None:
-            stretch, reach = free_side_reach(cracks, free, cone, camera, region)
+            arcs = None if circle is None else circle[0]
+        if cracks is not None and arcs is not None:
+            stretch, reach = free_side_reach(cracks, free, arcs, camera, region)
             whole = (sized.minor * stretch, sized.major * stretch)
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
