@@ -958,7 +958,7 @@ def outline_circle(
     stray further from their circle are not a round fruit's, and the circle is not its width).
 
     A round fruit's free arcs give its radius: the algebraic least-squares circle (Kasa 1976: ``u^2 + v^2 + d u + e
-    v + f = 0``, linear in its three unknowns, on the points less their mean over their spread) has three
+    v + f = 0``, linear in its three unknowns, about the points' mean, where its normal equations part) has three
     parameters where the ellipse has five, so it holds on arcs too short for the ellipse on a real mask's edge (a
     60 mm sphere 43 px across with a leaf over its left third: 51-63 free outline points over 103-130 degrees of arc,
     on which the ellipse came out 26 x 36 px, docs/cut58.md 1.3, and the circle 43 px; docs/cut60.md). It is what the
