@@ -872,3 +872,82 @@ def test_the_tangent_extent_of_a_regions_outline_is_across_sights():
     lo, hi = tangent_extent(outline_cracks(region), across, cam)
     np.testing.assert_allclose(lo, across.lo, rtol=0, atol=1e-12)
     np.testing.assert_allclose(hi, across.hi, rtol=0, atol=1e-12)
+
+
+def _straight_cut_disc(r: float, cut: float, size: int = 100):
+    """A digitised disc of radius ``r`` px about (50, 50) (pixel centres within it), a straight edge hiding its
+    left ``cut`` of its width: the cut region, its outline's crack points and which of them are the disc's own."""
+    from symfruit.core.raster import Silhouette, outline_cracks
+
+    v, u = np.mgrid[:size, :size]
+    edge = 50.0 - r + cut * 2.0 * r
+    region = Silhouette(0, 0, ((u - 50.0) ** 2 + (v - 50.0) ** 2 <= r * r) & (u >= edge), 0.0)
+    cracks = outline_cracks(region)
+    return region, cracks, cracks[:, 0] > np.ceil(edge) - 0.5 + 1e-9  # the pixel edges on the cut are not free
+
+
+@pytest.mark.parametrize(("r", "cut"), [(21.5, 0.35), (29.5, 0.35), (13.0, 0.3), (40.0, 0.45)])
+def test_a_disc_cut_by_a_straight_edge_gives_the_circle_of_its_diameter(r, cut):
+    """Stop 60 (docs/cut60.md): a digitised disc (26-80 px across, the real spheres' 43 and 59 px among them) with a
+    straight edge hiding its left 30-45 %: the circle through its free arcs (:func:`outline_circle`) is the disc's, to
+    a pixel across, where the cut region's geometric-mean width is 0.75-0.85 of it; and the cone's widths across the
+    line of sight are its diameter over the focal length. Read side by side (:func:`free_side_stretch`, the cut side
+    reaching the circle) the cut region's widths give the diameter too, to a pixel."""
+    from symfruit.core.raster import cone_widths, free_side_stretch, outline_circle
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    region, cracks, free = _straight_cut_disc(r, cut)
+    cone, axis = outline_circle(region, cam, cracks[free])
+    minor, major = cone_widths(cone, axis)
+    assert minor * cam.fx == pytest.approx(major * cam.fx, abs=1e-3)  # a circle (near the optical axis)
+    assert minor * cam.fx == pytest.approx(2.0 * r, abs=1.0)
+    widths = np.ptp(cracks, axis=0)
+    assert np.sqrt(widths.prod()) < 0.9 * 2.0 * r  # what the cut region reads
+    # read side by side (the prior's width, evidence's cut_circle): the cut side reaches the circle, the rest stays
+    stretch = free_side_stretch(cracks, free, cone, cam, region)
+    assert np.sqrt(widths.prod()) * stretch == pytest.approx(2.0 * r, abs=1.0)
+
+
+def test_an_elongated_or_scattered_outline_gives_no_circle():
+    """:func:`outline_circle` is None where the points stray from their circle by more than a digitised outline's
+    half pixel (an ellipse 2 : 1, and the disc's arcs scattered by a pixel), too few, a line, or a circle that would
+    not hold the region; and the point array's shape is checked."""
+    from symfruit.core.raster import Silhouette, outline_circle, outline_cracks
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    region, cracks, free = _straight_cut_disc(21.5, 0.35)
+    pts = cracks[free]
+    assert outline_circle(region, cam, pts) is not None
+    rng = np.random.default_rng(0)
+    assert outline_circle(region, cam, pts + rng.normal(scale=1.0, size=pts.shape)) is None  # ragged
+    assert outline_circle(region, cam, pts[:10]) is None  # too few
+    assert outline_circle(region, cam, pts, fit_px=0.0) is None
+    v, u = np.mgrid[:100, :100]
+    oval = Silhouette(0, 0, ((u - 50.0) / 40.0) ** 2 + ((v - 50.0) / 20.0) ** 2 <= 1.0, 0.0)
+    ring = outline_cracks(oval)
+    assert outline_circle(oval, cam, ring[ring[:, 0] > 40.0]) is None  # an ellipse 2 : 1
+    line = np.c_[np.linspace(30.0, 70.0, 40), np.full(40, 50.0)]
+    assert outline_circle(region, cam, line) is None
+    t = np.linspace(0.0, np.pi, 40)
+    small = np.c_[50.0 + 5.0 * np.cos(t), 50.0 + 5.0 * np.sin(t)]
+    assert outline_circle(region, cam, small) is None  # would not hold the region
+    with pytest.raises(InputError, match="shape"):
+        outline_circle(region, cam, np.zeros((30, 3)))
+
+
+def test_outline_circles_acceptance_is_the_same_with_its_kernels_and_without(monkeypatch):
+    """The circle's acceptance counts the region's pixels by ``core._jit.ellipse_holds`` where numba is and by its
+    numpy twin: the same cone to the bit, accepted or not alike."""
+    from symfruit.core.raster import outline_circle
+
+    cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    for r, cut in ((21.5, 0.35), (13.0, 0.3), (40.0, 0.45)):
+        region, cracks, free = _straight_cut_disc(r, cut)
+        for pts in (cracks[free], cracks[free][::2], cracks[free] * 0.9 + 5.0):
+            monkeypatch.delenv("SYMFRUIT_KERNELS", raising=False)
+            got = outline_circle(region, cam, pts)
+            monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+            twin = outline_circle(region, cam, pts)
+            assert (got is None) == (twin is None)
+            if got is not None and twin is not None:
+                assert got[0].tobytes() == twin[0].tobytes() and got[1].tobytes() == twin[1].tobytes()

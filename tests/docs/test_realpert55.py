@@ -241,6 +241,28 @@ def test_a_leaf_cutting_a_third_of_the_66_mm_sphere_no_longer_runs_its_box_far_b
         assert now[k][0][1] == pytest.approx(was[k][0][1], abs=1.0), (k, now[k], was[k])
 
 
+@pytest.mark.parametrize("frame_name", ["lab-spheres-0", "lab-spheres-1"])
+def test_a_leaf_cutting_a_third_of_the_small_spheres_leaves_them_cubes_by_the_circle_through_their_free_arcs(
+    rp, frame_name
+):
+    """Stop 60 (docs/cut60.md): the leaf of the tests above. Spheres 3 and 4 (66 and 60 mm, 59 and 43 px across) had
+    no ellipse through their free arcs (docs/cut58.md 1.3), so the depth prior read the cut region's geometric mean
+    (54 and 47 mm), and the boxes were over the issue's 6 mm bar (frame 1: 58 x 79 x 62 and 39 x 61 x 44 mm;
+    ``cut_circle: off``). The circle through the free arcs (``free``, the default) gives the prior the diameter: each a
+    cube within 6 mm, its depth side within 6 mm of the unperturbed mask's diameter; the large spheres (their
+    ellipses accepted) unchanged to the bit."""
+    from symfruit.settings import from_dict
+
+    before = from_dict({"evidence": {"cut_circle": "off"}})
+    was = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", before, frame_name)}
+    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, frame_name)}
+    for k in (3, 4):
+        assert np.ptp(was[k][0]) > 6.0 or abs(was[k][0][2] - was[k][1]) > 6.0, (k, was[k])
+        assert np.ptp(now[k][0]) <= 6.0 and abs(now[k][0][2] - now[k][1]) <= 6.0, (k, now[k])
+    for k in (1, 2):
+        assert np.asarray(now[k][0]).tolist() == np.asarray(was[k][0]).tolist(), (k, now[k], was[k])
+
+
 # --- stop 56, support56: a support at the fruit's own depth is no occluder
 
 

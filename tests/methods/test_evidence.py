@@ -926,6 +926,27 @@ def test_a_cut_outlines_prior_width_is_the_ellipse_of_its_free_arcs(prior, hidde
     assert outline.extras["width"] < 0.063
 
 
+@pytest.mark.parametrize("hidden", [0.3, 0.5])
+def test_a_cut_outline_without_an_ellipse_reads_its_prior_width_from_the_circle_through_its_free_arcs(
+    monkeypatch, hidden
+):
+    """Stop 60 (docs/cut60.md): a leaf 10 cm in front hides a 70 mm ball below 0.3 or 0.5 of its radius under its
+    middle (a straight edge across its silhouette), and no ellipse through the free arcs is accepted (as on the real
+    spheres 43-60 px across, docs/cut58.md 1.3: here ``outline_cone`` is made to fail). With ``cut_circle: free`` (the
+    default) the circle through the free arcs gives the depth prior's width: the ball's diameter, to 1.5 mm, where the
+    cut region's geometric mean (``off``, as before) reads it over 7 mm short; and the box is the deeper for it."""
+    import symfruit.core.agreement as agreement
+
+    visible, occ = _ball_under_leaf(hidden)
+    monkeypatch.setattr(agreement, "outline_cone", lambda *args, **kwargs: None)
+    circle = complete(visible, occlusion=occ)
+    off = complete(visible, occlusion=occ, settings={"evidence": {"cut_circle": "off"}})
+    assert circle.extras["contour"] < 0.7  # a cut outline
+    assert circle.extras["width"] == pytest.approx(0.07, abs=0.0015)
+    assert off.extras["width"] < 0.063
+    assert abs(circle.box.size[2] - 0.07) < abs(off.box.size[2] - 0.07)
+
+
 def test_a_cut_outline_hiding_the_balls_middle_keeps_the_cut_regions_prior_width():
     """Stop 57: a leaf 10 cm in front hides a 70 mm ball from 0.2 of its radius above its middle down: the ellipse
     through the free arcs is wider than the cut region (``cut_prior: ellipse`` reads it), but its centre, the ball's

@@ -367,11 +367,14 @@ def observe(
     else:
         rays_in, rays_out, out_weights, out_depth, packed = made
     fitted = None
-    if occlusion is not None and edged and contour_cone <= contour < 1.0:
+    labelled = False
+    if occlusion is not None and edged and contour < 1.0:  # which of the outline is the fruit's own: kept for the
+        labelled = True  # prior's width (evidence's cut_circle reads a circle through it however little is free)
         cracks = outline_cracks(region)
         if crack_labels is None:
             crack_labels = _labels_at(edge_uv, is_contour, cracks, kept)
-        fitted = outline_cone(region, camera, cracks[crack_labels])
+        if contour_cone <= contour:
+            fitted = outline_cone(region, camera, cracks[crack_labels])
     # the moment ellipse's cone only where the contour's is not taken (it was made and dropped there before)
     (cone, axis), source = (fitted, "contour") if fitted is not None else (silhouette_cone(region, camera), "moments")
     tuples = (tuple(rays_in), tuple(rays_out), tuple(out_weights), None if occlusion is None else tuple(out_depth))
@@ -390,7 +393,7 @@ def observe(
                        extent=None if occlusion is None else occlusion.extent(region, thin=thin_px),
                        inner=inner, inner_reach=float("inf") if reach is None else reach,
                        _hidden_of=None if occlusion is None else (occlusion, region))  # fmt: skip
-    if fitted is not None:  # the outline and which of it is the fruit's own contour, that the ellipse was fitted to
+    if labelled:  # the outline and which of it is the fruit's own contour, the ellipse's points where one was tried
         obs._made["outline"] = (cracks, crack_labels)
     return obs
 

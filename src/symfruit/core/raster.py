@@ -40,6 +40,7 @@ __all__ = [
     "interior",
     "mask_box",
     "nearest_index",
+    "outline_circle",
     "outline_cone",
     "outline_cracks",
     "point_pixels",
@@ -916,24 +917,90 @@ def outline_cone(
     if eig[0] <= 0:  # the least first
         return None
     area = np.pi / np.sqrt(eig[0] * eig[1])
-    a2 = conic[:2, :2]
-    if region.mask.ndim == 2 and jit is not None:  # the compiled twin of what follows: the same count
+    if not _credible(region, centre, conic[:2, :2], area, inside, max_area):
+        return None
+    return _image_cone(conic, centre, camera)
+
+
+def _credible(region: Silhouette, centre: np.ndarray, a2: np.ndarray, area: float, inside: float,
+              max_area: float) -> bool:  # fmt: skip
+    """:func:`outline_cone`'s acceptance of an ellipse ``a2`` (2, 2) about ``centre`` (pixels; ``(x - centre)^T a2 (x
+    - centre) <= 1`` inside) of ``area`` pixels: it holds at least ``inside`` of the region's pixels and is at most
+    ``max_area`` times the region's area."""
+    if region.mask.ndim == 2 and (jit := compiled()) is not None:  # the compiled twin of what follows: the same count
         n, count = jit.ellipse_holds(np.ascontiguousarray(region.mask, dtype=bool), int(region.u0), int(region.v0),
                                      float(centre[0]), float(centre[1]), float(a2[0, 0]), float(a2[0, 1]),
                                      float(a2[1, 1]))  # fmt: skip
         if not n or area > max_area * n:
-            return None
+            return False
         share = count / n
     else:
         rows, cols = np.nonzero(region.mask)
         n = len(rows)
         if not n or area > max_area * n:
-            return None
+            return False
         u, v = cols + region.u0 - centre[0], rows + region.v0 - centre[1]
         held = (a2[0, 0] * u * u + 2 * a2[0, 1] * u * v + a2[1, 1] * v * v) <= 1.0 + 1e-9
         share = held.mean()
-    if share < inside:
+    return bool(share >= inside)
+
+
+def outline_circle(
+    region: Silhouette, camera: Camera, points: np.ndarray, *, min_points: int = 20, inside: float = 0.97,
+    max_area: float = 3.0, fit_px: float = 0.5,
+) -> tuple[np.ndarray, np.ndarray] | None:  # fmt: skip
+    """The viewing cone of the circle fitted to part of the silhouette's outline (``points``, pixels, the fruit's own
+    contour): ``(cone, axis)`` as :func:`outline_cone`, or None when no credible circle fits: by
+    :func:`outline_cone`'s acceptance (it holds at least ``inside`` of the region's pixels and its area is at most
+    ``max_area`` times the region's), and the points lie about it as a digitised circle's outline does, at a root
+    mean square distance of at most ``fit_px`` (an outline crack, :func:`outline_cracks`, is the midpoint of the
+    pixel edge between a pixel centre inside the outline and one outside, so within half a pixel of it: arcs that
+    stray further from their circle are not a round fruit's, and the circle is not its width).
+
+    A round fruit's free arcs give its radius: the algebraic least-squares circle (Kasa 1976: ``u^2 + v^2 + d u + e
+    v + f = 0``, linear in its three unknowns, about the points' mean, where its normal equations part) has three
+    parameters where the ellipse has five, so it holds on arcs too short for the ellipse on a real mask's edge (a
+    60 mm sphere 43 px across with a leaf over its left third: 51-63 free outline points over 103-130 degrees of arc,
+    on which the ellipse came out 26 x 36 px, docs/cut58.md 1.3, and the circle 43 px; docs/cut60.md). It is what the
+    ellipse is on a round fruit; on an elongated one its callers cap what it may add (:func:`free_side_reach`).
+
+    >>> cam = Camera(fx=500.0, fy=500.0, cx=50.0, cy=50.0, width=100, height=100)
+    >>> t = np.linspace(-0.4 * np.pi, 0.4 * np.pi, 60)
+    >>> arc = np.column_stack((50.0 + 20.0 * np.cos(t), 50.0 + 20.0 * np.sin(t)))
+    >>> yy, xx = np.mgrid[:100, :100]
+    >>> m = ((xx - 50) ** 2 + (yy - 50) ** 2 <= 19.5**2) & (xx >= 44)
+    >>> minor, major = cone_widths(*outline_circle(Silhouette(0, 0, m, 0.0), cam, arc))
+    >>> round(minor * 500, 6), round(major * 500, 6)  # the circle's diameter, 40 px
+    (40.0, 40.0)
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    if pts.ndim != 2 or pts.shape[1] != 2:
+        raise InputError(f"outline points must have shape (m, 2), got {pts.shape}")
+    if len(pts) < max(min_points, 3):
         return None
+    mu = column_means(pts)
+    x, y = pts[:, 0] - mu[0], pts[:, 1] - mu[1]
+    z = x * x + y * y
+    # the normal equations about the points' mean: f = -mean(z), and a 2 x 2 system for d, e (no least-squares
+    # solver: a tenth of the call's cost where the circle is tried on every cut outline without an ellipse)
+    try:
+        found = solve2(float(x @ x), float(x @ y), float(x @ y), float(y @ y), -float(x @ z), -float(y @ z))
+    except np.linalg.LinAlgError:  # the points on a line
+        return None
+    if found is None:
+        return None
+    cu, cv = -0.5 * found[0], -0.5 * found[1]
+    r2 = cu * cu + cv * cv + float(z.mean())
+    if not (math.isfinite(r2) and r2 > 0.0):
+        return None
+    off = np.sqrt((x - cu) ** 2 + (y - cv) ** 2) - math.sqrt(r2)
+    if not float(np.sqrt((off * off).mean())) <= fit_px:
+        return None
+    centre = np.array([mu[0] + cu, mu[1] + cv])
+    if not _credible(region, centre, np.eye(2) / r2, math.pi * r2, inside, max_area):
+        return None
+    conic = np.array([[1.0, 0.0, -centre[0]], [0.0, 1.0, -centre[1]],
+                      [-centre[0], -centre[1], float(centre @ centre) - r2]]) / r2  # fmt: skip
     return _image_cone(conic, centre, camera)
 
 

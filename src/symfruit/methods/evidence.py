@@ -73,6 +73,7 @@ from ..core.raster import (
     cone_widths,
     free_side_reach,
     inner_distance,
+    outline_circle,
     point_pixels,
     silhouette,
     silhouette_cone,
@@ -206,6 +207,20 @@ class EvidenceSettings(Section):
         is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
         real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
         the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
+    cut_circle : {"free", "off"}
+        With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
+        (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
+        each, 51-79 free outline points over a half arc, the five-parameter fit came out too small and missed holding
+        the region on 100-130 degrees of arc, docs/cut58.md 1.3; nor is it tried under ``contour_cone``, as the shapes'
+        viewing cone): ``free`` (stop 60, docs/cut60.md) reads the sides as ``sides`` does from the circle through the
+        free arcs (:func:`~symfruit.core.raster.outline_circle`: three parameters, accepted as the ellipse is and where
+        the arcs lie within half a pixel of it, root mean square, as a digitised round outline's do; a round fruit's
+        free arcs give its radius, and a cut only shortens an outline). The cut sides reach the circle, no axis
+        beyond the outline's widest extent seen, and the prior's spread is then an uncut outline's (``cut_spread``).
+        ``off``: the cut region's widths (as before). The real spheres cut by the leaf: the 60 mm sphere 39-41 x 61 x
+        41-44 -> 60 x 62 x 59 mm, the 66 mm one 58 x 79 x 62 -> 66 x 69 x 68 mm (frame 1) and 61 x 69 x 59 -> 66 x
+        69 x 67 mm (frame 0, contour share 0.30); over the bar 5 / 8 -> 1 / 8. The development trees: one apple of
+        248 moves (better); through the D435 model with a leaf in front 7 views of 210 (4 better).
     hidden_front : {"sphere", "off"}
         With occlusion information, where the outline is cut and the front of the sphere as wide as the outline's
         larger width that best fits the seen points lies in front of the seen front at a pixel where the camera
@@ -348,6 +363,7 @@ class EvidenceSettings(Section):
     cut_faces: Literal["region", "sides"] = setting("sides")
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
+    cut_circle: Literal["off", "free"] = setting("free")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -931,10 +947,16 @@ def evidence(
     whole = faces = None
     if s.cut_prior == "ellipse" and obs.cone_source == "contour" and obs.cone is not None and obs.axis is not None:
         whole = cone_widths(obs.cone, obs.axis)
-    elif s.cut_prior == "sides" and obs.cone_source == "contour" and obs.cone is not None:
+    elif s.cut_prior == "sides":
         cracks, free = obs._made.get("outline", (None, None))
-        if cracks is not None:
-            stretch, reach = free_side_reach(cracks, free, obs.cone, camera, region)
+        arcs = obs.cone if obs.cone_source == "contour" else None  # the cone of the free arcs' ellipse
+        if arcs is None and cracks is not None and s.cut_circle == "free":
+            # no ellipse through the free arcs (too short or ragged for five parameters): a round fruit's give its
+            # radius (three), read as the ellipse would be, on the cut sides alone and capped at the widest extent
+            circle = outline_circle(region, camera, cracks[free])
+            arcs = None if circle is None else circle[0]
+        if cracks is not None and arcs is not None:
+            stretch, reach = free_side_reach(cracks, free, arcs, camera, region)
             whole = (sized.minor * stretch, sized.major * stretch)
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
