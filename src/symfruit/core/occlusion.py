@@ -433,9 +433,9 @@ def occlusion(
         # stop 41: own_edge on the maps in the same call; stop 45: without the window's own depths and own pixels as
         # maps, its square filters read from summed-area tables (jit.occlusion_edge_boxed: the same maps; the
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
-        # stop 60: the points projected in the kernel (Camera.project's arithmetic, the same pixels), the window's
-        # maps by one sweep, the own edge on the mask's box that sweep found (jit.occlusion_projected: the same maps;
-        # the benchmark frame's 9 calls, least of the recorded calls replayed, in docs/speedo60.md)
+        # stop 60: the points projected in the kernel (Camera.project's arithmetic, the same pixels; here only where
+        # overshoot reads them), the own edge on the mask's box found by one OR a row (jit.occlusion_projected: the
+        # same maps; the benchmark frame's occlusion stage 0.2 ms less, docs/speedo60.md)
         found, u0, v0, hidden, seen = jit.occlusion_projected(points, float(camera.fx), float(camera.fy),
                                                               float(camera.cx), float(camera.cy), pad, image, mask,
                                                               near_to, tolerance, _steps(reach), max(int(band), 0),
