@@ -15,7 +15,7 @@ import types
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
@@ -7689,13 +7689,14 @@ def test_in_pieces_known_answers():
 @given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.booleans(), st.integers(6, 70),
        st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3), st.booleans(),
        st.sampled_from([(300.0, 300.0, 0.0, 0.0), (310.5, 295.25, 2.5, -1.75)]))  # fmt: skip
+@example(543, 3, False, False, 49, 81, 0.005, 0, True, (310.5, 295.25, 2.5, -1.75))
 def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, single, h, w, tolerance, reach, supports,
                                                   intrinsics):  # fmt: skip
-    """occlusion_projected (the points projected in the kernel, the window's maps by one sweep, the own edge on the
-    mask's box that sweep found) against occlusion_edge_boxed of Camera.project's coordinates and against occlusion's
-    numpy twin: the same window, hidden pixels and seen depths, bit for bit; fruit at the image's border, fattened
-    edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9, a camera whose centre is off the image's
-    corner (points that project outside the image)."""
+    """occlusion_projected (the points projected in the kernel, the own edge on the mask's box found once) against
+    occlusion_edge_boxed of Camera.project's coordinates and against occlusion's numpy twin: the same window, hidden
+    pixels and seen depths, bit for bit; fruit at the image's border, fattened edges, leaves at the fruit's depth,
+    other fruit, dropouts, bands 0-9, a camera whose centre is off the image's corner (points that project outside
+    the image) and whose focal lengths differ (the focal length occlusion() hands on is their geometric mean)."""
     from symfruit.core.camera import Camera
     from symfruit.core.occlusion import occlusion
 
@@ -7705,10 +7706,11 @@ def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, singl
     steps = _steps_within(reach)
     fx, fy, cx, cy = intrinsics
     camera = Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=w, height=h)
+    focal = float(np.sqrt(fx * fy))  # as occlusion() hands it on (the support's reach reads it)
     got = _jit.occlusion_projected(points, fx, fy, cx, cy, 16, depth, mask, others, tolerance, steps, band, supports,
-                                   300.0)  # fmt: skip
+                                   focal)  # fmt: skip
     want = _jit.occlusion_edge_boxed(camera.project(points), points, 16, depth, mask, others, tolerance, steps, band,
-                                     supports, 300.0)  # fmt: skip
+                                     supports, focal)  # fmt: skip
     assert got[:3] == want[:3]
     assert got[3].tobytes() == want[3].tobytes() and got[4].tobytes() == want[4].tobytes()
     if not want[0]:
