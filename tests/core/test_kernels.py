@@ -15,7 +15,7 @@ import types
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
 from symfruit.core import kernels
@@ -7785,3 +7785,77 @@ def test_rows_box_is_the_box(seed):
     h, w = (int(x) for x in rng.integers(0, 30, 2))
     mask = rng.random((h, w)) < rng.choice([0.0, 0.002, 0.05, 0.5])
     assert _jit._rows_box(mask) == _jit._box(mask)
+
+
+# --- stop 60, speedo60
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.booleans(), st.integers(6, 70),
+       st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3), st.booleans(),
+       st.sampled_from([(300.0, 300.0, 0.0, 0.0), (310.5, 295.25, 2.5, -1.75)]))  # fmt: skip
+@example(543, 3, False, False, 49, 81, 0.005, 0, True, (310.5, 295.25, 2.5, -1.75))
+def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, single, h, w, tolerance, reach, supports,
+                                                  intrinsics):  # fmt: skip
+    """occlusion_projected (the points projected in the kernel, the own edge on the mask's box found once) against
+    occlusion_edge_boxed of Camera.project's coordinates and against occlusion's numpy twin: the same window, hidden
+    pixels and seen depths, bit for bit; fruit at the image's border, fattened edges, leaves at the fruit's depth,
+    other fruit, dropouts, bands 0-9, a camera whose centre is off the image's corner (points that project outside
+    the image) and whose focal lengths differ (the focal length occlusion() hands on is their geometric mean)."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.occlusion import occlusion
+
+    rng = np.random.default_rng(seed)
+    _, points, depth, mask, others = _fattened_scene(rng, h, w, with_others)
+    depth = depth.astype(np.float32 if single else np.float64)
+    steps = _steps_within(reach)
+    fx, fy, cx, cy = intrinsics
+    camera = Camera(fx=fx, fy=fy, cx=cx, cy=cy, width=w, height=h)
+    focal = float(np.sqrt(fx * fy))  # as occlusion() hands it on (the support's reach reads it)
+    got = _jit.occlusion_projected(points, fx, fy, cx, cy, 16, depth, mask, others, tolerance, steps, band, supports,
+                                   focal)  # fmt: skip
+    want = _jit.occlusion_edge_boxed(camera.project(points), points, 16, depth, mask, others, tolerance, steps, band,
+                                     supports, focal)  # fmt: skip
+    assert got[:3] == want[:3]
+    assert got[3].tobytes() == want[3].tobytes() and got[4].tobytes() == want[4].tobytes()
+    if not want[0]:
+        return
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = occlusion(depth, mask, points, camera, others=others if with_others else None, tolerance=tolerance,
+                         reach=reach, band=band, trim_own=False, supports=supports)  # fmt: skip
+    assert (twin.u0, twin.v0) == got[1:3] and twin.hidden.tobytes() == got[3].tobytes()
+    assert np.array_equal(twin.depth, got[4], equal_nan=True)
+
+
+def test_the_projected_occlusion_known_answers():
+    """No point in the image: not found. A disc whose depth runs 3 px past its mask onto background: the ring hidden
+    without the band, cleared with it (every pixel), as occlusion_edge_boxed; a leaf 2 cm in front across the disc's
+    row 30 stays hidden, and the pixels without depth beside it take the leaf's depth (the first offset with depth).
+    The sweep's mask box and the hidden flag: a window with nothing hidden leaves the own edge out."""
+    h, w = 60, 80
+    rr, cc = np.mgrid[0:h, 0:w]
+    dist = np.hypot(rr - 30, cc - 40)
+    mask = dist <= 10
+    v, u = np.nonzero(mask)
+    points = np.column_stack((u * 0.4 / 300.0, v * 0.4 / 300.0, np.full(len(u), 0.4)))
+    steps, none = _steps_within(3), np.zeros((0, 0), bool)
+
+    def run(depth, band=8, pts=points):
+        return _jit.occlusion_projected(pts, 300.0, 300.0, 0.0, 0.0, 16, depth, mask, none, 0.005, steps, band,
+                                        False, 300.0)  # fmt: skip
+
+    assert not run(np.ones((h, w)), pts=points + np.array([10.0, 0.0, 0.0]))[0]
+    depth = np.where(dist <= 13, 0.4, 1.0)
+    bare = run(depth, band=0)
+    found, u0, v0, hidden, seen = run(depth)
+    assert found and int(bare[3].sum()) == int(((dist > 10) & (dist <= 13)).sum()) and not hidden.any()
+    assert np.isnan(seen[mask[v0 : v0 + hidden.shape[0], u0 : u0 + hidden.shape[1]]]).all()
+    leaf = (np.abs(rr - 30) <= 1) & (cc > 52)
+    depth = np.where(leaf, 0.38, np.where(dist <= 10, 0.4, 1.0))
+    depth[30, 60] = 0.0  # a dropout on the leaf: the leaf's depth, hidden
+    found, u0, v0, hidden, seen = run(depth)
+    assert hidden[30 - v0, 60 - u0] and seen[30 - v0, 60 - u0] == 0.38
+    assert hidden[29 - v0 : 32 - v0, 53 - u0 : 70 - u0].all() and int(hidden.sum()) == int(leaf[v0:, u0:].sum())
+    nothing = np.where(dist <= 10, 0.4, 1.0)
+    assert not run(nothing)[3].any()

@@ -422,7 +422,6 @@ def occlusion(
     if others is not None and np.shape(others) != shape:
         raise InputError(f"occlusion others must be a {shape[1]}x{shape[0]} image, got {np.shape(others)[::-1]}")
     points = as_points(points, min_count=1)
-    uv = camera.project(points)
     focal = float(np.sqrt(camera.fx * camera.fy))  # overshoot reads the mask's width in metres
     if (jit := compiled()) is not None:  # as_points gives contiguous float64
         # the window, the fruit's own depths and the maps below in one compiled pass, the images read in place (the
@@ -434,9 +433,13 @@ def occlusion(
         # stop 41: own_edge on the maps in the same call; stop 45: without the window's own depths and own pixels as
         # maps, its square filters read from summed-area tables (jit.occlusion_edge_boxed: the same maps; the
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
-        found, u0, v0, hidden, seen = jit.occlusion_edge_boxed(uv, points, pad, image, mask, near_to, tolerance,
-                                                               _steps(reach), max(int(band), 0),
-                                                               bool(supports), focal)  # fmt: skip
+        # stop 60: the points projected in the kernel (Camera.project's arithmetic, the same pixels; here only where
+        # overshoot reads them), the own edge on the mask's box found by one OR a row (jit.occlusion_projected: the
+        # same maps; the benchmark frame's occlusion stage 0.2 ms less, docs/speedo60.md)
+        found, u0, v0, hidden, seen = jit.occlusion_projected(points, float(camera.fx), float(camera.fy),
+                                                              float(camera.cx), float(camera.cy), pad, image, mask,
+                                                              near_to, tolerance, _steps(reach), max(int(band), 0),
+                                                              bool(supports), focal)  # fmt: skip
         if not found:
             raise InputError("occlusion: no point of the fruit projects into the image")
         h, w = hidden.shape
@@ -445,7 +448,7 @@ def occlusion(
             overshoot(
                 own_w,
                 depth[v0 : v0 + h, u0 : u0 + w],
-                uv,
+                camera.project(points),
                 points,
                 u0,
                 v0,
@@ -458,6 +461,7 @@ def occlusion(
             else (None, False)
         )
         return Occlusion._made(u0, v0, hidden, camera.width, camera.height, own_w, seen, *over)
+    uv = camera.project(points)
     with np.errstate(invalid="ignore"):  # a non-finite point's pixel is no pixel of the image (not numpy's warning)
         col = np.rint(uv[:, 0]).astype(np.intp)
         row = np.rint(uv[:, 1]).astype(np.intp)
