@@ -3452,6 +3452,8 @@ def grid_covariances(points: np.ndarray, step: int, small: int, large: int) -> t
     scratch_a = np.empty(n)
     scratch_b = np.empty(n)
     scatter = np.empty((3, 3))
+    near_d = np.empty(n)
+    near_j = np.empty(n, np.int64)
     margin = 1e-6 * h
     for q in range(m):
         x, y, z = points[q * step, 0], points[q * step, 1], points[q * step, 2]
@@ -3484,19 +3486,27 @@ def grid_covariances(points: np.ndarray, step: int, small: int, large: int) -> t
                            cand_j)  # fmt: skip
         if count > read:  # (none more: the block's large-th is the large-th of all)
             limit = kth_smallest(cand_d[:count], large - 1, scratch_a, scratch_b)
-        kept = 0
-        for t in range(count):  # within the limit, in order of distance, ties by index
+        # those within the limit first gathered without a branch (every one written, the count advanced by the
+        # comparison: most are beyond it, at random; issue 19, stop 60), then put in order of distance, ties by index
+        # (an order of distinct pairs, whatever the order they are met in)
+        within = 0
+        for t in range(count):
             d = cand_d[t]
-            if d <= limit:
-                j = cand_j[t]
-                slot = kept
-                kept += 1
-                while slot > 0 and (best_d[slot - 1] > d or (best_d[slot - 1] == d and best_i[slot - 1] > j)):
-                    best_d[slot] = best_d[slot - 1]
-                    best_i[slot] = best_i[slot - 1]
-                    slot -= 1
-                best_d[slot] = d
-                best_i[slot] = j
+            near_d[within] = d
+            near_j[within] = cand_j[t]
+            within += d <= limit
+        kept = 0
+        for t in range(within):
+            d = near_d[t]
+            j = near_j[t]
+            slot = kept
+            kept += 1
+            while slot > 0 and (best_d[slot - 1] > d or (best_d[slot - 1] == d and best_i[slot - 1] > j)):
+                best_d[slot] = best_d[slot - 1]
+                best_i[slot] = best_i[slot - 1]
+                slot -= 1
+            best_d[slot] = d
+            best_i[slot] = j
         _covariances_at(points, best_i, small, large, scatter, out_small, out_large, q)
     return out_small, out_large
 
