@@ -7859,3 +7859,151 @@ def test_the_projected_occlusion_known_answers():
     assert hidden[29 - v0 : 32 - v0, 53 - u0 : 70 - u0].all() and int(hidden.sum()) == int(leaf[v0:, u0:].sum())
     nothing = np.where(dist <= 10, 0.4, 1.0)
     assert not run(nothing)[3].any()
+
+
+# --- stop 60, speedc60: the same loops, laid out for the processor's vector instructions and independent sums --------
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 9), st.integers(20, 300))
+def test_slice_costs_of_a_pair_are_each_directions_alone(seed, k, n):
+    """:func:`slice_costs_below` works two directions at a time: each cost is, to the bit, the cost of its direction
+    worked out alone (a call of one direction, which works it as both of a pair), whatever its neighbour; an odd
+    count's last direction too."""
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    q[: n // 3] = np.round(q[: n // 3], 3)  # ties in the slices
+    q = np.ascontiguousarray(q - q.mean(axis=0))
+    dirs = rng.normal(size=(k, 3))
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    if k > 1:
+        dirs[1] = dirs[0]  # a pair of the same direction
+    alone = np.array([_jit.slice_costs(q, dirs[j : j + 1], 12)[0] for j in range(k)])
+    assert _jit.slice_costs(q, dirs, 12).tobytes() == alone.tobytes()
+
+
+def _cone_residual(c: tuple[float, float, float], lam: float, gap: float, ray: np.ndarray, ray_cone: float,
+                   z: float) -> float:  # fmt: skip
+    """One ray's residual as :func:`_jit.cone_residuals` worked it out before stop 60, in numpy's float64 scalars
+    (IEEE doubles, a division by zero inf or NaN as the kernel's: the same operations, the same bits)."""
+    f = np.float64
+    with np.errstate(all="ignore"):
+        rcm = f(c[0]) * f(ray[0]) + f(c[1]) * f(ray[1]) + f(c[2]) * f(ray[2])
+        lam_, gap_ = f(lam), f(gap)
+        a = f(ray_cone) / lam_ - rcm * rcm / (lam_ * gap_)
+        b = rcm / gap_
+        cc = -lam_ / gap_
+        disc = b * b - a * cc
+        res = f(z) - (b - np.sqrt(disc)) / a if disc >= 0 else f(np.nan)
+    return float(res) if math.isfinite(res) else 0.02
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 80))
+def test_cone_residuals_from_columns_are_the_rays_arithmetic(seed, n):
+    """The residuals read from the rays' columns (a vectorised loop) are, to the bit, each ray's arithmetic done
+    alone in Python floats (the form before stop 60), on valid and invalid ellipsoids and saturated logistics."""
+    visible, cone, axis, _, _ = _cone_view("apple", 1)
+    rng = np.random.default_rng(seed)
+    pts = visible[rng.choice(len(visible), n, replace=False)]
+    rays, z = np.ascontiguousarray(pts / pts[:, 2:3]), np.ascontiguousarray(pts[:, 2])
+    ray_cone = ((rays @ cone) * rays).sum(axis=1)
+    params = np.c_[rng.normal(0.0, 0.02, (6, 2)), np.log(rng.uniform(0.2, 0.8, 6)), rng.uniform(-10, 10, 6)]
+    params[0, 3] = 60.0
+    params[1, :2] = 1.0
+    out = np.empty((6, n))
+    _jit.cone_residuals(params, cone, axis, rays, ray_cone, z, out)
+    for j, (p0, p1, p2, p3) in enumerate(params.tolist()):
+        e = math.exp(p2)
+        m = ((float(axis[0]) + p0) * e, (float(axis[1]) + p1) * e, float(axis[2]) * e)
+        c = tuple(m[0] * float(cone[0, i]) + m[1] * float(cone[1, i]) + m[2] * float(cone[2, i]) for i in range(3))
+        qq = -(c[0] * m[0] + c[1] * m[1] + c[2] * m[2])
+        if not qq > 0:
+            want = [0.05] * n
+        else:
+            lam = qq / (1.0 + math.exp(-min(max(p3, -50.0), 50.0)))
+            want = [_cone_residual(c, lam, lam - qq, rays[i], float(ray_cone[i]), float(z[i])) for i in range(n)]
+        assert out[j].tobytes() == np.array(want).tobytes()
+
+
+def _sphere_steps_before(q: np.ndarray, c: list[float], r: float, iterations: int, tolerance: float,
+                         scale: float) -> tuple[float, bool]:  # fmt: skip
+    """:func:`_jit.sphere_steps` as it was before stop 60 (one loop a step, its sums in the matrix), in Python floats
+    (``c`` updated in place)."""
+    n = len(q)
+    for _ in range(iterations):
+        jtj, g = np.zeros((4, 4)), np.zeros(4)
+        for x0, x1, x2 in q.tolist():
+            d0, d1, d2 = x0 - c[0], x1 - c[1], x2 - c[2]
+            dist = max(math.sqrt(d0 * d0 + d1 * d1 + d2 * d2), 1e-12)
+            j0, j1, j2 = -d0 / dist, -d1 / dist, -d2 / dist
+            res = dist - r
+            for (a, b), v in (((0, 0), j0 * j0), ((0, 1), j0 * j1), ((0, 2), j0 * j2), ((1, 1), j1 * j1),
+                              ((1, 2), j1 * j2), ((2, 2), j2 * j2)):  # fmt: skip
+                jtj[a, b] += v
+            jtj[0, 3] -= j0
+            jtj[1, 3] -= j1
+            jtj[2, 3] -= j2
+            g[0] -= j0 * res
+            g[1] -= j1 * res
+            g[2] -= j2 * res
+            g[3] += res
+        jtj[3, 3] = float(n)
+        jtj = np.triu(jtj) + np.triu(jtj, 1).T
+        step = np.empty(4)
+        if not _jit.solve(jtj, g, step):
+            return r, False
+        for a in range(3):
+            c[a] += float(step[a])
+        r = abs(r + float(step[3]))
+        if max(abs(float(s)) for s in step) * scale < tolerance:
+            break
+    return r, True
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(4, 60), st.floats(0.0, 0.003))
+@settings(max_examples=40)
+def test_sphere_steps_are_the_former_loop(seed, n, noise):
+    """The Gauss-Newton's distances and Jacobian in a loop of their own, its sums after: the same centre, radius and
+    answer, to the bit, as the one loop before stop 60."""
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    q = np.ascontiguousarray(0.03 * d * np.c_[1.0, 1.0, 0.4] + rng.normal(scale=noise, size=(n, 3)))
+    c = rng.normal(scale=0.005, size=3)
+    want_c = c.tolist()
+    want = _sphere_steps_before(q, want_c, 0.025, 6, 1e-9, 1.0)
+    got = _jit.sphere_steps(q, c, 0.025, 6, 1e-9, 1.0)
+    assert got == want and c.tolist() == want_c
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60))
+@settings(max_examples=40)
+def test_explain_quadric_rays_quadratic_is_the_former_sum(seed, m):
+    """Each ray's quadratic ``r^T A r`` from the rays' columns, its nine terms named: the depth RMS and the band
+    shares, to the bit, of the nested sum over the rows before stop 60 (worked out here in Python floats and handed
+    to :func:`_jit.agreement` as the kernel hands its own)."""
+    rng = np.random.default_rng(seed)
+    shape = rng.normal(size=(3, 3))
+    shape = shape @ shape.T + np.eye(3)
+    shape /= 0.03**2
+    centre = np.array([0.0, 0.0, 0.4]) + rng.normal(scale=0.01, size=3)
+    rays = np.c_[centre[:2] / centre[2] + rng.normal(scale=0.04, size=(m, 2)), np.ones(m)]  # most meet it
+    z0, z1 = 0.3, 0.5
+    depth = rng.uniform(z0, z1, m)
+    empty_i, empty_f = np.zeros(0, np.int64), np.zeros(0)
+    args = (z0, z1, depth, max(1, m // 2), empty_i, empty_i, empty_i, empty_f, empty_f, empty_f, 0.0)
+    s = [sum(float(shape[i, j]) * float(centre[j]) for j in range(3)) for i in range(3)]  # left to right, as there
+    c = float(centre[0]) * s[0] + float(centre[1]) * s[1] + float(centre[2]) * s[2] - 1.0
+    hit, at = np.empty(m, bool), np.empty(m)
+    for k, ray in enumerate(rays.tolist()):
+        a = 0.0
+        for i in range(3):
+            for j in range(3):
+                a += ray[i] * float(shape[i, j]) * ray[j]
+        b = ray[0] * s[0] + ray[1] * s[1] + ray[2] * s[2]
+        disc = b * b - a * c
+        root = math.sqrt(disc) if disc > 0.0 else 0.0
+        near, far = (b - root) / a, (b + root) / a
+        hit[k] = disc > 0.0 and near < z1 and far > z0
+        at[k] = max(near, z0) if hit[k] else math.nan
+    want = _jit.agreement(hit, at, *args)
+    assert np.array(_jit.explain_quadric(centre, shape, rays, *args)).tobytes() == np.array(want).tobytes()
