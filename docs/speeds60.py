@@ -11,6 +11,7 @@ alternated, e.g. ``PYTHONPATH=/tmp/lead60/base/src python docs/speeds60.py time 
 (a Python-level function handed the kernels' module) is stored as its name and handed back as the module.
 """
 
+import argparse
 import copy
 import importlib
 import pickle
@@ -97,8 +98,21 @@ def replay(path: str, passes: int) -> None:
         sys.stdout.write(line + "\n")
 
 
-if __name__ == "__main__":
-    if sys.argv[1] == "record":
-        record(sys.argv[2], sys.argv[3:])
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="what", required=True)
+    rec = sub.add_parser("record", help="record the named functions' calls on the benchmark frame")
+    rec.add_argument("calls", help="the pickle to write")
+    rec.add_argument("names", nargs="+", help="MODULE:NAME of each function, e.g. symfruit.core._jit:surface_cap")
+    rep = sub.add_parser("time", help="replay the recorded calls under this PYTHONPATH's tree")
+    rep.add_argument("calls", help="the pickle record wrote")
+    rep.add_argument("passes", nargs="?", type=int, default=200, help="passes over the frame's calls (200)")
+    args = parser.parse_args(argv)
+    if args.what == "record":
+        record(args.calls, args.names)
     else:
-        replay(sys.argv[2], int(sys.argv[3]) if len(sys.argv) > 3 else 200)
+        replay(args.calls, args.passes)
+
+
+if __name__ == "__main__":
+    main()
