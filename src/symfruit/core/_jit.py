@@ -4371,6 +4371,10 @@ def _occlusion_pass(
             else:
                 seen[r, c] = y  # NaN for now where it has no depth of its own (below)
     rows = np.zeros(h, np.bool_)
+    # stop 60 (obsv60): each row's first and last waiting column, so that the walk below reads that span alone (it
+    # skips every other pixel): the same pixels walked in the same order
+    first = np.empty(h, np.int64)
+    final = np.empty(h, np.int64)
     for r in range(h):
         for c in range(w):
             x = seen[r, c]
@@ -4392,6 +4396,9 @@ def _occlusion_pass(
             else:
                 hidden[r, c] = False
                 if x < hi:
+                    if not rows[r]:
+                        first[r] = c
+                    final[r] = c
                     rows[r] = True
     # nearest()'s column pass (each pixel's nearest point pixel in its column, the upper of two as near), kept for
     # the rows looked at alone and the point pixels' columns alone (q0 to q1: no other column has a nearest row):
@@ -4440,7 +4447,7 @@ def _occlusion_pass(
         # grows along the row, so the parabola it stops at for a pixel is the same whether it walked every pixel
         # before or only some of them
         q = 0
-        for u in range(w):
+        for u in range(first[r], final[r] + 1):
             x = seen[r, u]
             if not (x >= lo and x < hi):  # decided without its nearest point pixel (NaN: never waits)
                 continue
