@@ -4695,6 +4695,20 @@ def test_grid_covariances_are_the_brute_forces_to_the_bit(seed, kind, n, step, l
             np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
 
 
+def test_grid_covariances_many_ties_at_the_limit_are_the_brute_forces():
+    """A lattice of eight places, each held by about 120 points (every query's neighbours all at distance 0, over four
+    times ``large`` of them within the limit: the insertion sort's path; revol60) and a noisy cap (the places counted:
+    the other path): the brute force's neighbourhoods, bit for bit."""
+    rng = np.random.default_rng(5)
+    lattice = rng.integers(0, 2, size=(1000, 3)).astype(np.float64) * 0.001
+    cap = _cloud(2, 1000, rng) + rng.normal(scale=5e-4, size=(1000, 3))
+    for pts, large in ((lattice, 5), (cap, 30)):
+        grid = _jit.grid_covariances(pts, 7, 3, large)
+        brute = _jit.neighbour_covariances(pts, 7, 3, large)
+        for a, b in zip(grid, brute, strict=True):
+            assert a.tobytes() == b.tobytes()
+
+
 def test_grid_covariances_known_neighbourhoods_on_a_line():
     """Points 1 mm apart on x (a grid of seven cells along it): the three nearest of the first point are the first
     three (variance 2/3 mm^2 along x), of an inner point itself and its two sides (the same); two nearest of the
