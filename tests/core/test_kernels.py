@@ -4695,6 +4695,20 @@ def test_grid_covariances_are_the_brute_forces_to_the_bit(seed, kind, n, step, l
             np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-15 * float(np.abs(b).max()))
 
 
+def test_grid_covariances_many_ties_at_the_limit_are_the_brute_forces():
+    """A lattice of eight places, each held by about 120 points (every query's neighbours all at distance 0, over four
+    times ``large`` of them within the limit: the insertion sort's path; revol60) and a noisy cap (the places counted:
+    the other path): the brute force's neighbourhoods, bit for bit."""
+    rng = np.random.default_rng(5)
+    lattice = rng.integers(0, 2, size=(1000, 3)).astype(np.float64) * 0.001
+    cap = _cloud(2, 1000, rng) + rng.normal(scale=5e-4, size=(1000, 3))
+    for pts, large in ((lattice, 5), (cap, 30)):
+        grid = _jit.grid_covariances(pts, 7, 3, large)
+        brute = _jit.neighbour_covariances(pts, 7, 3, large)
+        for a, b in zip(grid, brute, strict=True):
+            assert a.tobytes() == b.tobytes()
+
+
 def test_grid_covariances_known_neighbourhoods_on_a_line():
     """Points 1 mm apart on x (a grid of seven cells along it): the three nearest of the first point are the first
     three (variance 2/3 mm^2 along x), of an inner point itself and its two sides (the same); two nearest of the
@@ -8007,3 +8021,97 @@ def test_explain_quadric_rays_quadratic_is_the_former_sum(seed, m):
         at[k] = max(near, z0) if hit[k] else math.nan
     want = _jit.agreement(hit, at, *args)
     assert np.array(_jit.explain_quadric(centre, shape, rays, *args)).tobytes() == np.array(want).tobytes()
+
+
+# --- stop 60, revol60: the slices' sums in vector additions, the noise's neighbours ordered by counting ------------
+
+
+def _former_slice_cost(q: np.ndarray, d: np.ndarray, bins: int) -> float:
+    """One direction's slice cost as :func:`_jit.slice_costs_below` worked it out before revol60, in Python floats (IEEE
+    doubles: the same operations in the same order, the same bits): each slice's four sums added point by point in
+    the points' order, then the trimmed mean of the squared distances by the kernel's own selection."""
+    n = q.shape[0]
+    x, y, z = (float(c) for c in d)
+    if abs(x) < 0.9:
+        a, b, c = 0.0, z, -y
+    else:
+        a, b, c = -z, 0.0, x
+    norm = math.sqrt(a * a + b * b + c * c)
+    a, b, c = a / norm, b / norm, c / norm
+    f, g, h = y * c - z * b, z * a - x * c, x * b - y * a
+    pts = [(float(p[0]), float(p[1]), float(p[2])) for p in q]
+    t = [x * p0 + y * p1 + z * p2 for p0, p1, p2 in pts]
+    u = [a * p0 + b * p1 + c * p2 for p0, p1, p2 in pts]
+    v = [f * p0 + g * p1 + h * p2 for p0, p1, p2 in pts]
+    lo, hi = min(t), max(t)
+    span = max(hi - lo, 1e-12)
+    idx = [min(int((ti - lo) / span * bins), bins - 1) for ti in t]
+    sums = [[0.0] * 4 for _ in range(bins)]
+    for i in range(n):
+        s = sums[idx[i]]
+        s[0] += 1.0
+        s[1] += u[i]
+        s[2] += v[i]
+        s[3] += u[i] * u[i] + v[i] * v[i]
+    for s in sums:
+        w = max(s[0], 1.0)
+        s[1], s[2], s[3] = s[1] / w, s[2] / w, s[3] / w
+    a11 = a12 = a22 = e1 = e2 = 0.0
+    cu, cv, cy = [], [], []
+    for i in range(n):
+        s = sums[idx[i]]
+        du, dv, dy = u[i] - s[1], v[i] - s[2], u[i] * u[i] + v[i] * v[i] - s[3]
+        cu.append(du)
+        cv.append(dv)
+        cy.append(dy)
+        a11 += du * du
+        a12 += du * dv
+        a22 += dv * dv
+        e1 += du * dy
+        e2 += dv * dy
+    det = a11 * a22 - a12 * a12
+    if not abs(det) > 1e-30:
+        det = 1e-30
+    au, av = 0.5 * (a22 * e1 - a12 * e2) / det, 0.5 * (a11 * e2 - a12 * e1) / det
+    dist2 = np.empty(n)
+    for i in range(n):
+        res = cy[i] - 2.0 * (au * cu[i] + av * cv[i])
+        ru, rv = u[i] - au, v[i] - av
+        dist2[i] = res * res / (max(ru * ru + rv * rv, 1e-12) * 4.0)
+    return float(_jit.smallest_mean(dist2, max(1, int(0.8 * n)), np.empty(n), np.empty(n)))
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 6), st.integers(20, 120), st.sampled_from([1, 5, 12]))
+def test_slice_costs_in_vector_sums_are_the_former_scatter(seed, k, n, bins):
+    """The slices' sums taken four at a time in one vector addition (revol60) give, to the bit, the costs of the
+    former point-by-point scatter (Python floats), with tied coordinates and a direction along x (the other basis)."""
+    rng = np.random.default_rng(seed)
+    q = rng.normal(size=(n, 3)) * rng.uniform(0.001, 0.1)
+    q[: n // 3] = np.round(q[: n // 3], 3)
+    q = np.ascontiguousarray(q - q.mean(axis=0))
+    dirs = rng.normal(size=(k, 3))
+    dirs[0] = (1.0, 0.0, 0.0)
+    dirs /= np.linalg.norm(dirs, axis=1, keepdims=True)
+    former = np.array([_former_slice_cost(q, dirs[j], bins) for j in range(k)])
+    assert _jit.slice_costs(q, np.ascontiguousarray(dirs), bins).tobytes() == former.tobytes()
+
+
+@given(st.lists(st.floats(allow_nan=True, allow_infinity=True, width=64), min_size=8, max_size=8),
+       st.integers(0, 2))  # fmt: skip
+def test_add4_is_four_scalar_additions(values, at):
+    """``_add4`` adds four numbers to four consecutive places of an array, each lane as the scalar ``+=`` (signed
+    zeros, infinities and NaN's bits alike), the places about them untouched."""
+
+    @numba.njit
+    def run(arr: np.ndarray, off: int, a: float, b: float, c: float, d: float) -> None:
+        _jit._add4(arr, off, a, b, c, d)
+
+    arr = np.full((3, 4), 7.0)
+    arr[at] = values[:4]
+    want = arr.copy()
+    with np.errstate(all="ignore"):
+        for i in range(4):
+            want[at, i] = np.float64(want[at, i]) + np.float64(values[4 + i])
+    run(arr, at * 4, *values[4:])
+    assert arr.tobytes() == want.tobytes()
