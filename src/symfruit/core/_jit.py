@@ -1528,20 +1528,11 @@ def _window_median(vals: np.ndarray, r0: int, c0: int, size: int, window: np.nda
     return window[size * size // 2]
 
 
-@_njit
-def monotone(
-    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, sector: np.ndarray, d2: np.ndarray, bins: int,
-    tolerance: float, out: np.ndarray,
-) -> None:  # fmt: skip
-    """:func:`symfruit.core.surface.monotone_region` after its sectors: the pixels ``(rows, cols)`` (n,) of ``depth``
-    (h, w), in sectors ``sector`` (n,) of ``bins`` at squared distances ``d2`` (n,) from the apex, marked in ``out``
-    (h, w) bool where their sector's depth has not yet fallen more than ``tolerance`` below its running maximum.
-    The twin's order (by sector, then distance, then position: two stable counting sorts) and its arithmetic (the
-    running maximum of ``z + offset`` less the offset, each sector offset above the ones before): its pixels."""
-    n = rows.shape[0]
-    top = 0
-    for i in range(n):
-        top = max(top, d2[i])
+@_njit_inlined
+def _counting_orders(d2: np.ndarray, sector: np.ndarray, n: int, top: int, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """The two stable counting sorts of :func:`monotone` and :func:`monotone_at`: the indices of ``d2`` (n,) in order
+    of distance (ties by position; ``top`` its largest value), and each of the ``bins`` sectors' first place when
+    ordered by ``sector`` (n,) (``start`` (bins + 1,), the places still to be taken as the caller fills them)."""
     count = np.zeros(top + 2, np.int64)
     for i in range(n):
         count[d2[i] + 1] += 1
@@ -1556,6 +1547,24 @@ def monotone(
         start[sector[i] + 1] += 1
     for s in range(bins):
         start[s + 1] += start[s]
+    return by_d2, start
+
+
+@_njit
+def monotone(
+    depth: np.ndarray, rows: np.ndarray, cols: np.ndarray, sector: np.ndarray, d2: np.ndarray, bins: int,
+    tolerance: float, out: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.surface.monotone_region` after its sectors: the pixels ``(rows, cols)`` (n,) of ``depth``
+    (h, w), in sectors ``sector`` (n,) of ``bins`` at squared distances ``d2`` (n,) from the apex, marked in ``out``
+    (h, w) bool where their sector's depth has not yet fallen more than ``tolerance`` below its running maximum.
+    The twin's order (by sector, then distance, then position: two stable counting sorts) and its arithmetic (the
+    running maximum of ``z + offset`` less the offset, each sector offset above the ones before): its pixels."""
+    n = rows.shape[0]
+    top = 0
+    for i in range(n):
+        top = max(top, d2[i])
+    by_d2, start = _counting_orders(d2, sector, n, top, bins)
     order = np.empty(n, np.int64)
     for j in range(n):
         i = by_d2[j]
@@ -4344,20 +4353,7 @@ def monotone_at(
                 d2[i] = q
                 top = max(top, q)
                 i += 1
-    count = np.zeros(top + 2, np.int64)
-    for i in range(n):
-        count[d2[i] + 1] += 1
-    for v in range(top + 1):
-        count[v + 1] += count[v]
-    by_d2 = np.empty(n, np.int64)
-    for i in range(n):
-        by_d2[count[d2[i]]] = i
-        count[d2[i]] += 1
-    start = np.zeros(bins + 1, np.int64)
-    for i in range(n):
-        start[sector[i] + 1] += 1
-    for s in range(bins):
-        start[s + 1] += start[s]
+    by_d2, start = _counting_orders(d2, sector, n, top, bins)
     at_s, sec_s, z_s = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n)
     for j in range(n):
         i = by_d2[j]
