@@ -659,20 +659,7 @@ def _rows_box(mask: np.ndarray) -> tuple[int, int, int, int]:
     """:func:`_box` of ``mask`` (h, w) bool, each row or'ed whole without a jump (several pixels at once) and the first
     and last pixel walked to from its ends where it holds one (stop 60, speeds60): the same box."""
     h, w = mask.shape
-    r0, r1, c0, c1 = h, 0, w, 0
-    for r in range(h):
-        some = False
-        for c in range(w):
-            some |= mask[r, c]
-        if some:
-            first = 0
-            while not mask[r, first]:
-                first += 1
-            last = w - 1
-            while not mask[r, last]:
-                last -= 1
-            r0, r1 = min(r0, r), r + 1
-            c0, c1 = min(c0, first), max(c1, last + 1)
+    r0, r1, c0, c1 = _mask_box_in(mask, 0, 0, h, w)
     return (r0, r1, c0, c1) if r1 > 0 else (0, 0, 0, 0)
 
 
@@ -9940,24 +9927,8 @@ def mask_mode(
     them, for :func:`symfruit.core.surface.fruit_depth` where ``done`` is False (stop 52: two kernels' calls and
     ``mask_box``'s numpy steps, 20-40 us a fruit, in one)."""
     h, w = mask.shape
-    r0, r1, c0, c1 = h, 0, w, 0
-    for r in range(h):
-        # stop 60 (speeds60): whether the row holds a pixel by or-ing it whole (no jump: the compiler takes several
-        # pixels at once), then its first and last pixel walked to from its ends: the same box
-        some = False
-        for c in range(w):
-            some |= mask[r, c]
-        if some:
-            first = 0
-            while not mask[r, first]:
-                first += 1
-            last = w - 1
-            while not mask[r, last]:
-                last -= 1
-            r0 = min(r0, r)
-            r1 = r + 1
-            c0 = min(c0, first)
-            c1 = max(c1, last + 1)
+    # stop 60 (speeds60): each row or-ed whole, then its first and last pixel walked to from its ends: the same box
+    r0, r1, c0, c1 = _mask_box_in(mask, 0, 0, h, w)
     none = np.empty(0)
     if r1 == 0:
         return False, 0, 0, 0, 0, 0, 0.0, none, np.empty(0, np.bool_), 0.0, np.nan, np.nan, True
@@ -10355,11 +10326,12 @@ def in_pieces(mask: np.ndarray) -> bool:
 # --- stop 60, speedo60: the occlusion's points projected in the kernel, the own edge on the mask's box ---------
 
 
-@_njit
+@_njit_inlined
 def _mask_box_in(mask: np.ndarray, v0: int, u0: int, h: int, w: int) -> tuple[int, int, int, int]:
     """The box of ``mask``'s pixels within its (h, w) window at ``(v0, u0)``, in the window: ``(r0, r1, c0, c1)``
     (stops exclusive; ``r1 <= r0``: none), what :func:`own_edge_boxed`'s scan finds, each row's pixels OR-ed (no
-    branch a pixel) and its first and last pixel looked for only where it holds one."""
+    branch a pixel) and its first and last pixel looked for only where it holds one (also :func:`_rows_box`'s and
+    :func:`mask_mode`'s box, the window the whole image)."""
     r0, r1, c0, c1 = h, 0, w, 0
     for r in range(h):
         some = False
