@@ -5050,73 +5050,96 @@ def test_the_bulge_sums_are_the_bincounts(seed):
 # --- stop 45, speedreg45
 
 
-def _batcher_median25() -> list[tuple[int, int, int]]:
-    """:data:`_jit.MEDIAN25` built as its comment says: Batcher's odd-even merge sort of 32 values, the pairs touching
-    the last 7 dropped, pruned back from the median's output (kind 0 both outputs read on, 1 the min, 2 the max)."""
-    pairs, p = [], 1
-    while p < 32:
-        k = p
-        while k >= 1:
-            for j in range(k % p, 32 - k, 2 * k):
-                for i in range(min(k, 32 - j - k)):
-                    if (i + j) // (2 * p) == (i + j + k) // (2 * p) and i + j + k < 25:
-                        pairs.append((i + j, i + j + k))
-            k //= 2
-        p *= 2
-    need, kept = {12}, []
-    for i, j in reversed(pairs):
-        if i in need and j in need:
-            kept.append((i, j, 0))
-        elif i in need:
-            kept.append((i, j, 1))
-        elif j in need:
-            kept.append((i, j, 2))
-        need |= {i, j} if (i in need or j in need) else set()
-    return kept[::-1]
-
-
-def test_the_median_network_selects_the_median_of_every_25_bits():
-    """MEDIAN25 is the network its comment builds, and it puts the median in v12 for all 2^25 inputs of 0 and 1 (the
-    0-1 principle: then for every input; each wire a bit per input, a min an AND, a max an OR); the network one
-    pair short is wrong on some input."""
-    assert list(_jit.MEDIAN25) == _batcher_median25() and len(_jit.MEDIAN25) == 113
-    word = np.arange(2**19, dtype=np.uint64)  # input x's bit k: within a 64-bit word for k < 6, of the word beyond
+def _median_of_25_bits(extra_first: bool, mid: tuple = _jit.MID20) -> np.ndarray:
+    """window_medians' networks on all 2^25 windows of 0 and 1 (wire ``5 r + c`` the window's row r, column c; each
+    wire a bit per window, a min an AND, a max an OR): the five columns sorted (SORT5), four of them merged (MID20:
+    the last four where ``extra_first``, the window then the pair's first; else the first four), the result with the
+    fifth column (MEDIAN11); the wire left in ``f10``, packed 64 windows to a word."""
+    word = np.arange(2**19, dtype=np.uint64)  # window x's bit k: within a 64-bit word for k < 6, of the word beyond
     low = [sum(1 << b for b in range(64) if (b >> k) & 1) for k in range(6)]
-    wires = [np.full(2**19, low[k], np.uint64) for k in range(6)]
-    wires += [np.where((word >> np.uint64(k - 6)) & np.uint64(1), ~np.uint64(0), np.uint64(0)) for k in range(6, 25)]
+    v = [np.full(2**19, low[k], np.uint64) for k in range(6)]
+    v += [np.where((word >> np.uint64(k - 6)) & np.uint64(1), ~np.uint64(0), np.uint64(0)) for k in range(6, 25)]
+
+    def run(wires, network):
+        for i, j, kind in network:
+            lo, hi = wires[i] & wires[j], wires[i] | wires[j]
+            if kind in (0, 1):
+                wires[i] = lo
+            if kind in (0, 2):
+                wires[j] = hi
+        return wires
+
+    columns = [run([v[5 * r + c] for r in range(5)], _jit.SORT5) for c in range(5)]
+    four, extra = (columns[1:], columns[0]) if extra_first else (columns[:4], columns[4])
+    m = run([x for column in four for x in column], mid)
+    f = run(list(extra) + [m[8], m[5], m[9], m[12], m[13], m[14]], _jit.MEDIAN11)
+    return f[10]
+
+
+@pytest.mark.parametrize("extra_first", [True, False])
+def test_the_shared_median_networks_select_the_median_of_every_25_bits(extra_first):
+    """SORT5, MID20 and MEDIAN11 put the median in f10 for all 2^25 windows of 0 and 1, whichever four columns are
+    the shared ones (the 0-1 principle: then for every window, stop 61); MID20 one pair short is wrong on some."""
     x = np.arange(2**25, dtype=np.uint32)
     expect = np.packbits(np.bitwise_count(x) >= 13, bitorder="little").view(np.uint64)
-
-    def run(network):
-        v = list(wires)
-        for i, j, kind in network:
-            lo, hi = v[i] & v[j], v[i] | v[j]
-            if kind in (0, 1):
-                v[i] = lo
-            if kind in (0, 2):
-                v[j] = hi
-        return v[12]
-
-    assert np.array_equal(run(_jit.MEDIAN25), expect)
-    assert not np.array_equal(run(_jit.MEDIAN25[:60] + _jit.MEDIAN25[61:]), expect)
+    assert len(_jit.SORT5) == 9 and len(_jit.MID20) == 51 and len(_jit.MEDIAN11) == 10
+    assert np.array_equal(_median_of_25_bits(extra_first), expect)
+    short = _jit.MID20[:20] + _jit.MID20[21:]
+    assert not np.array_equal(_median_of_25_bits(extra_first, short), expect)
 
 
-def test_the_window_medians_kernel_runs_the_median_network():
-    """window_medians' written-out pairs are MEDIAN25's, in its order, and return v12."""
+def test_the_window_medians_kernel_runs_the_shared_networks():
+    """window_medians' written-out pairs: SORT5 on a0..a4 (the pair's first column) and b0..b4 (its last), SORT5 on
+    each of m0..m4, .., m15..m19 and then MID20, in their order; _median_with's are MEDIAN11's on f0..f10 and it
+    returns f10; the pair's two windows take their own column and MID20's six wires as _median_of_25_bits hands
+    them, from the padded columns 2 k to 2 k + 5 in order."""
     import inspect
     import re
 
+    def pairs(function, v):
+        found = []
+        for line in inspect.getsource(function.py_func).splitlines():
+            if m := re.fullmatch(rf"\s*{v}(\d+), {v}(\d+) = min\({v}\1, {v}\2\), max\({v}\1, {v}\2\)", line):
+                found.append((int(m[1]), int(m[2]), 0))
+            elif m := re.fullmatch(rf"\s*{v}(\d+) = min\({v}\1, {v}(\d+)\)", line):
+                found.append((int(m[1]), int(m[2]), 1))
+            elif m := re.fullmatch(rf"\s*{v}(\d+) = max\({v}(\d+), {v}\1\)", line):
+                found.append((int(m[2]), int(m[1]), 2))
+        return found
+
+    sorts = [(i + 5 * j, k + 5 * j, kind) for j in range(4) for i, k, kind in _jit.SORT5]
+    assert pairs(_jit.window_medians, "a") == pairs(_jit.window_medians, "b") == list(_jit.SORT5)
+    assert pairs(_jit.window_medians, "m") == sorts + list(_jit.MID20)
+    assert pairs(_jit._median_with, "f") == list(_jit.MEDIAN11)
+    assert "return f10" in inspect.getsource(_jit._median_with.py_func)
     source = inspect.getsource(_jit.window_medians.py_func)
-    found = []
-    for line in source.splitlines():
-        if m := re.fullmatch(r"\s*v(\d+), v(\d+) = min\(v\1, v\2\), max\(v\1, v\2\)", line):
-            found.append((int(m[1]), int(m[2]), 0))
-        elif m := re.fullmatch(r"\s*v(\d+) = min\(v\1, v(\d+)\)", line):
-            found.append((int(m[1]), int(m[2]), 1))
-        elif m := re.fullmatch(r"\s*v(\d+) = max\(v(\d+), v\1\)", line):
-            found.append((int(m[2]), int(m[1]), 2))
-    assert found == list(_jit.MEDIAN25)
-    assert "row[c] = v12" in source  # each row's medians, the ok pixels' kept (stop 49)
+    loads = re.findall(r"(\w)(\d+), \w\d+, \w\d+, \w\d+, \w\d+ = (\w)0\[(k(?: \+ \w+)?)\]", source)
+    assert loads == [
+        ("a", "0", "e", "k"), ("m", "0", "o", "k"), ("m", "5", "e", "k + one"), ("m", "10", "o", "k + one"),
+        ("m", "15", "e", "k + two"), ("b", "0", "o", "k + two"),
+    ]  # fmt: skip
+    assert "row[k + k] = _median_with(a0, a1, a2, a3, a4, m8, m5, m9, m12, m13, m14)" in source
+    assert "row[k + k + one] = _median_with(b0, b1, b2, b3, b4, m8, m5, m9, m12, m13, m14)" in source
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_shared_window_medians_are_the_twins_on_scattered_rows(seed):
+    """window_medians (stop 61: columns sorted once, windows two at a time) against its numpy twin _window_medians
+    to the bit, on windows 1-23 pixels wide whose rows' first and last ok pixels fall on even and odd columns (a
+    row's last pair of windows one past the image), of depths drawn from 1-6 values (ties) or continuous."""
+    from symfruit.core.surface import _window_medians
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(v) for v in rng.integers(1, 24, 2))
+    ok = rng.random((h, w)) < rng.choice([0.05, 0.3, 0.7, 1.0])
+    if not ok.any():
+        ok[int(rng.integers(h)), int(rng.integers(w))] = True
+    levels = int(rng.integers(0, 7))
+    depth = rng.integers(1, levels + 1, (h, w)) * 0.25 if levels else rng.random((h, w)) + 0.1
+    medians = np.empty(int(ok.sum()))
+    _jit.window_medians(depth, ok, medians)
+    assert medians.tobytes() == _window_medians(depth, ok).tobytes()
 
 
 @settings(max_examples=200, deadline=None)

@@ -7676,31 +7676,56 @@ def bulge_sums(
 # thin_front's 5 x 5 medians of the filled depth by a selection network, without numpy's partition of the windows
 
 
-#: The selection network of :func:`window_medians`: (i, j, kind) in order, on 25 values ``v0``..``v24``; kind 0 puts
-#: the smaller of ``v_i`` and ``v_j`` in ``v_i`` and the larger in ``v_j``, 1 the smaller alone in ``v_i``, 2 the larger
-#: alone in ``v_j``; ``v12`` is then the median. Batcher's odd-even merge sort of 32 values (Knuth, TAOCP 3, 5.3.4)
-#: with the last 7 taken as +inf (the pairs that touch them change nothing: dropped) and pruned back from ``v12``
-#: (a pair none of whose outputs is read on dropped, one with one output read kept as that min or max): 113 of the
-#: 140 pairs. Exact by the 0-1 principle, checked on all 2^25 inputs of 0 and 1 (tests/core/test_kernels.py).
+#: Stop 61 (speedt61): :func:`window_medians`' three networks, each (i, j, kind) in order (kind 0 the smaller of two
+#: wires to the first and the larger to the second, 1 the smaller alone, 2 the larger alone). ``SORT5`` sorts five
+#: values (nine pairs, the least for five): each column of five of a pair of neighbouring windows. ``MID20`` takes
+#: four sorted columns ``m0``..``m19`` (``m[5 j + i]`` the ``i``-th least of column ``j``) and leaves their 8th to
+#: 13th least (of 20) in ``m8, m5, m9, m12, m13, m14``: Batcher's odd-even merges of the columns two by two and then
+#: of the two tens, pruned back from those six wires and then pair by pair while an exhaustive test of every input of
+#: 0 and 1 with sorted columns (6^4) still passed (51 pairs). Two neighbouring windows share four columns, so one
+#: ``MID20`` serves both. ``MEDIAN11`` takes a sorted column ``f0``..``f4`` (the window's fifth) and those six
+#: ``f5``..``f10`` and leaves the 6th least of the 11 in ``f10`` (made the same way from Batcher's merge of a five and
+#: a six, 10 pairs): the window's 13th least of 25, its median, since seven of the four columns' values lie at or
+#: below their 8th least and seven at or above their 13th. Exact by the 0-1 principle (a comparator network selects
+#: the median of every input if it does of every input of 0 and 1): all 2^25 windows of 0 and 1 checked through the
+#: three networks in both ways a window is made (the shared columns its last four or its first four),
+#: tests/core/test_kernels.py. (6 x 9 + 51 + 2 x 10) / 2 = 62.5 pairs a window against the 113 of stop 45's network
+#: on each window's 25 values (Batcher's sort of 32 pruned back from the median, ``MEDIAN25`` in git's history).
 # fmt: off
-MEDIAN25 = (
-    (0, 1, 0), (2, 3, 0), (4, 5, 0), (6, 7, 0), (8, 9, 0), (10, 11, 0), (12, 13, 0), (14, 15, 0),
-    (16, 17, 0), (18, 19, 0), (20, 21, 0), (22, 23, 0), (0, 2, 0), (1, 3, 0), (4, 6, 0), (5, 7, 0),
-    (8, 10, 0), (9, 11, 0), (12, 14, 0), (13, 15, 0), (16, 18, 0), (17, 19, 0), (20, 22, 0), (21, 23, 0),
-    (1, 2, 0), (5, 6, 0), (9, 10, 0), (13, 14, 0), (17, 18, 0), (21, 22, 0), (0, 4, 0), (1, 5, 0),
-    (2, 6, 0), (3, 7, 0), (8, 12, 0), (9, 13, 0), (10, 14, 0), (11, 15, 0), (16, 20, 0), (17, 21, 0),
-    (18, 22, 0), (19, 23, 0), (2, 4, 0), (3, 5, 0), (10, 12, 0), (11, 13, 0), (18, 20, 0), (19, 21, 0),
-    (1, 2, 0), (3, 4, 0), (5, 6, 0), (9, 10, 0), (11, 12, 0), (13, 14, 0), (17, 18, 0), (19, 20, 0),
-    (21, 22, 0), (0, 8, 0), (1, 9, 0), (2, 10, 0), (3, 11, 0), (4, 12, 0), (5, 13, 0), (6, 14, 0),
-    (7, 15, 1), (16, 24, 0), (4, 8, 0), (5, 9, 0), (6, 10, 0), (7, 11, 0), (20, 24, 0), (2, 4, 0),
-    (3, 5, 0), (6, 8, 0), (7, 9, 0), (10, 12, 0), (11, 13, 0), (18, 20, 0), (19, 21, 0), (22, 24, 0),
-    (1, 2, 0), (3, 4, 0), (5, 6, 0), (7, 8, 0), (9, 10, 0), (11, 12, 0), (13, 14, 1), (17, 18, 0),
-    (19, 20, 0), (21, 22, 0), (23, 24, 0), (0, 16, 2), (1, 17, 2), (2, 18, 2), (3, 19, 2), (4, 20, 2),
-    (5, 21, 2), (6, 22, 1), (7, 23, 1), (8, 24, 1), (8, 16, 2), (9, 17, 2), (10, 18, 1), (11, 19, 1),
-    (12, 20, 1), (13, 21, 1), (6, 10, 2), (7, 11, 2), (12, 16, 1), (13, 17, 1), (10, 12, 2), (11, 13, 1),
-    (11, 12, 2),
+SORT5 = (
+    (0, 1, 0), (3, 4, 0), (2, 4, 0), (2, 3, 0), (0, 3, 0), (0, 2, 0), (1, 4, 0), (1, 3, 0), (1, 2, 0),
+)
+MID20 = (
+    (0, 5, 0), (4, 9, 0), (4, 5, 0), (2, 7, 0), (2, 4, 0), (7, 5, 0), (1, 6, 0), (3, 8, 0), (3, 6, 0), (1, 2, 0),
+    (3, 4, 0), (6, 7, 0), (8, 5, 0), (10, 15, 0), (14, 19, 0), (14, 15, 0), (12, 17, 0), (12, 14, 0), (17, 15, 0),
+    (11, 16, 0), (13, 18, 0), (13, 16, 0), (11, 12, 0), (13, 14, 0), (16, 17, 0), (18, 15, 0), (0, 10, 2), (5, 15, 1),
+    (5, 10, 0), (4, 14, 0), (4, 5, 2), (14, 10, 1), (2, 12, 2), (7, 17, 1), (7, 12, 0), (7, 5, 2), (12, 14, 0),
+    (1, 11, 2), (9, 19, 1), (9, 11, 0), (6, 16, 0), (6, 9, 2), (16, 11, 1), (3, 13, 2), (8, 18, 1), (8, 13, 0),
+    (8, 9, 0), (13, 16, 1), (8, 5, 0), (9, 12, 0), (13, 14, 0),
+)
+MEDIAN11 = (
+    (0, 5, 2), (4, 9, 1), (4, 5, 2), (2, 7, 2), (7, 5, 1), (1, 6, 2), (10, 6, 1), (3, 8, 1), (3, 10, 2), (10, 7, 1),
 )
 # fmt: on
+
+
+@_njit_inlined
+def _median_with(
+    f0: float, f1: float, f2: float, f3: float, f4: float,
+    f5: float, f6: float, f7: float, f8: float, f9: float, f10: float,
+) -> float:  # fmt: skip
+    """The 6th least of ``f0``..``f4`` (sorted) and ``f5``..``f10`` (sorted) by :data:`MEDIAN11` (stop 61)."""
+    f5 = max(f0, f5)
+    f4 = min(f4, f9)
+    f5 = max(f4, f5)
+    f7 = max(f2, f7)
+    f7 = min(f7, f5)
+    f6 = max(f1, f6)
+    f10 = min(f10, f6)
+    f3 = min(f3, f8)
+    f10 = max(f3, f10)
+    f10 = min(f10, f7)
+    return f10
 
 
 #: :func:`near_filled`'s offsets ``(dr, dc)``: every one within a squared distance of 8 but (0, 0), by squared distance,
@@ -7756,8 +7781,8 @@ def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> No
     window (edges repeated) of ``depth`` (h, w) float64 around each pixel of ``ok`` in raster order, every pixel not
     ``ok`` taking its nearest ``ok`` pixel's depth (:func:`nearest`, scipy's feature transform): what
     :func:`filled_windows` and numpy's ``np.partition(values, 12, axis=1)[:, 12]`` give, the same values (a median is
-    one of the window's values, whichever way it is selected), by :data:`MEDIAN25`'s network on the 25 values in
-    registers, the windows never laid out (stop 45, speedreg45: 0.70 against 0.86 + 0.59 ms a frame for the partition
+    one of the window's values, whichever way it is selected), by a selection network on the 25 values in registers,
+    the windows never laid out (stop 45, speedreg45: 0.70 against 0.86 + 0.59 ms a frame for the partition
     and the windows, thread CPU on the benchmark frame's 14 calls, a busy machine). Its numpy twin:
     :func:`symfruit.core.surface._window_medians`. Every value must be a number (no NaN: ``thin_front``'s depth
     above 0 is).
@@ -7766,148 +7791,156 @@ def window_medians(depth: np.ndarray, ok: np.ndarray, medians: np.ndarray) -> No
     (:func:`nearest`): a window around an ``ok`` pixel reads pixels within two rows and two columns of it alone (edges
     repeated: a clamped pixel lies nearer still), whose nearest ``ok`` pixel lies within a squared distance of 8, the
     only ones it looks through; the same values in every ``ok`` pixel's window, so the same medians (the values of
-    other windows, computed with them and never kept, may differ)."""
+    other windows, computed with them and never kept, may differ).
+
+    Since stop 61 (speedt61) two neighbouring windows share a network: their six columns of five sorted
+    (:data:`SORT5`), the four they share merged once (:data:`MID20`), each window's median from those and its own
+    fifth column (:data:`MEDIAN11`): 62.5 pairs a window against 113, on several pairs at once (replayed on the
+    benchmark frame's 18 calls: 0.59 -> 0.43 ms, docs/speedt61.md)."""
     h, w = ok.shape
     src = np.empty((h, w))
     near_filled(depth, ok, src)
-    vals = np.empty((h + 4, w + 4))
+    # the depth with its edges repeated (two rows above and below, two columns to each side) in its even and its odd
+    # columns: ``split[0, a, k]`` the padded column 2 k (the depth's 2 k - 2), ``split[1, a, k]`` the padded 2 k + 1
+    half = w // 2 + 3
+    split = np.empty((2, h + 4, half))
     for a in range(h + 4):
         rr = min(max(a - 2, 0), h - 1)
-        for b in range(w + 4):
-            vals[a, b] = src[rr, min(max(b - 2, 0), w - 1)]
-    # each row's medians at every column from its first to its last ``ok`` pixel, with no branch in the loop (the
-    # compiler runs it on several pixels at once: a pixel not ``ok`` costs a lane, not a branch), then the ``ok``
-    # pixels' kept: at each ``ok`` pixel the same pairs on the same 25 values (stop 49, regspeed49: the benchmark
-    # frame's 14 calls 1.1 -> 0.8 ms)
-    row = np.empty(w)
+        for k in range(half):
+            split[0, a, k] = src[rr, min(max(2 * k - 2, 0), w - 1)]
+            split[1, a, k] = src[rr, min(max(2 * k - 1, 0), w - 1)]
+    # stop 61 (speedt61): each row's windows from its first to its last ``ok`` pixel two at a time, the windows
+    # 2 k and 2 k + 1 (padded columns 2 k to 2 k + 5): their six columns of five sorted (SORT5), the four they share
+    # merged once (MID20), each window's median from its own fifth column and those (MEDIAN11): the same 25 values'
+    # median (see MID20), so the same value. No branch in the loop, and unsigned indices (no test for a negative
+    # index), so that the compiler runs it on several pairs at once (with signed ones it did not vectorise it)
+    row = np.empty(2 * half)
+    one, two = np.uint64(1), np.uint64(2)
     n = 0
     for r in range(h):
         first, last = w, -1
         for c in range(w):
             if ok[r, c]:
                 first, last = min(first, c), c
-        q0, q1, q2, q3, q4 = vals[r], vals[r + 1], vals[r + 2], vals[r + 3], vals[r + 4]
-        for c in range(first, last + 1):
-            v0, v1, v2, v3, v4 = q0[c], q0[c + 1], q0[c + 2], q0[c + 3], q0[c + 4]
-            v5, v6, v7, v8, v9 = q1[c], q1[c + 1], q1[c + 2], q1[c + 3], q1[c + 4]
-            v10, v11, v12, v13, v14 = q2[c], q2[c + 1], q2[c + 2], q2[c + 3], q2[c + 4]
-            v15, v16, v17, v18, v19 = q3[c], q3[c + 1], q3[c + 2], q3[c + 3], q3[c + 4]
-            v20, v21, v22, v23, v24 = q4[c], q4[c + 1], q4[c + 2], q4[c + 3], q4[c + 4]
-            # MEDIAN25, written out: each pair (i, j) min to v_i and max to v_j (one of them where only it is read on)
-            v0, v1 = min(v0, v1), max(v0, v1)
-            v2, v3 = min(v2, v3), max(v2, v3)
-            v4, v5 = min(v4, v5), max(v4, v5)
-            v6, v7 = min(v6, v7), max(v6, v7)
-            v8, v9 = min(v8, v9), max(v8, v9)
-            v10, v11 = min(v10, v11), max(v10, v11)
-            v12, v13 = min(v12, v13), max(v12, v13)
-            v14, v15 = min(v14, v15), max(v14, v15)
-            v16, v17 = min(v16, v17), max(v16, v17)
-            v18, v19 = min(v18, v19), max(v18, v19)
-            v20, v21 = min(v20, v21), max(v20, v21)
-            v22, v23 = min(v22, v23), max(v22, v23)
-            v0, v2 = min(v0, v2), max(v0, v2)
-            v1, v3 = min(v1, v3), max(v1, v3)
-            v4, v6 = min(v4, v6), max(v4, v6)
-            v5, v7 = min(v5, v7), max(v5, v7)
-            v8, v10 = min(v8, v10), max(v8, v10)
-            v9, v11 = min(v9, v11), max(v9, v11)
-            v12, v14 = min(v12, v14), max(v12, v14)
-            v13, v15 = min(v13, v15), max(v13, v15)
-            v16, v18 = min(v16, v18), max(v16, v18)
-            v17, v19 = min(v17, v19), max(v17, v19)
-            v20, v22 = min(v20, v22), max(v20, v22)
-            v21, v23 = min(v21, v23), max(v21, v23)
-            v1, v2 = min(v1, v2), max(v1, v2)
-            v5, v6 = min(v5, v6), max(v5, v6)
-            v9, v10 = min(v9, v10), max(v9, v10)
-            v13, v14 = min(v13, v14), max(v13, v14)
-            v17, v18 = min(v17, v18), max(v17, v18)
-            v21, v22 = min(v21, v22), max(v21, v22)
-            v0, v4 = min(v0, v4), max(v0, v4)
-            v1, v5 = min(v1, v5), max(v1, v5)
-            v2, v6 = min(v2, v6), max(v2, v6)
-            v3, v7 = min(v3, v7), max(v3, v7)
-            v8, v12 = min(v8, v12), max(v8, v12)
-            v9, v13 = min(v9, v13), max(v9, v13)
-            v10, v14 = min(v10, v14), max(v10, v14)
-            v11, v15 = min(v11, v15), max(v11, v15)
-            v16, v20 = min(v16, v20), max(v16, v20)
-            v17, v21 = min(v17, v21), max(v17, v21)
-            v18, v22 = min(v18, v22), max(v18, v22)
-            v19, v23 = min(v19, v23), max(v19, v23)
-            v2, v4 = min(v2, v4), max(v2, v4)
-            v3, v5 = min(v3, v5), max(v3, v5)
-            v10, v12 = min(v10, v12), max(v10, v12)
-            v11, v13 = min(v11, v13), max(v11, v13)
-            v18, v20 = min(v18, v20), max(v18, v20)
-            v19, v21 = min(v19, v21), max(v19, v21)
-            v1, v2 = min(v1, v2), max(v1, v2)
-            v3, v4 = min(v3, v4), max(v3, v4)
-            v5, v6 = min(v5, v6), max(v5, v6)
-            v9, v10 = min(v9, v10), max(v9, v10)
-            v11, v12 = min(v11, v12), max(v11, v12)
-            v13, v14 = min(v13, v14), max(v13, v14)
-            v17, v18 = min(v17, v18), max(v17, v18)
-            v19, v20 = min(v19, v20), max(v19, v20)
-            v21, v22 = min(v21, v22), max(v21, v22)
-            v0, v8 = min(v0, v8), max(v0, v8)
-            v1, v9 = min(v1, v9), max(v1, v9)
-            v2, v10 = min(v2, v10), max(v2, v10)
-            v3, v11 = min(v3, v11), max(v3, v11)
-            v4, v12 = min(v4, v12), max(v4, v12)
-            v5, v13 = min(v5, v13), max(v5, v13)
-            v6, v14 = min(v6, v14), max(v6, v14)
-            v7 = min(v7, v15)
-            v16, v24 = min(v16, v24), max(v16, v24)
-            v4, v8 = min(v4, v8), max(v4, v8)
-            v5, v9 = min(v5, v9), max(v5, v9)
-            v6, v10 = min(v6, v10), max(v6, v10)
-            v7, v11 = min(v7, v11), max(v7, v11)
-            v20, v24 = min(v20, v24), max(v20, v24)
-            v2, v4 = min(v2, v4), max(v2, v4)
-            v3, v5 = min(v3, v5), max(v3, v5)
-            v6, v8 = min(v6, v8), max(v6, v8)
-            v7, v9 = min(v7, v9), max(v7, v9)
-            v10, v12 = min(v10, v12), max(v10, v12)
-            v11, v13 = min(v11, v13), max(v11, v13)
-            v18, v20 = min(v18, v20), max(v18, v20)
-            v19, v21 = min(v19, v21), max(v19, v21)
-            v22, v24 = min(v22, v24), max(v22, v24)
-            v1, v2 = min(v1, v2), max(v1, v2)
-            v3, v4 = min(v3, v4), max(v3, v4)
-            v5, v6 = min(v5, v6), max(v5, v6)
-            v7, v8 = min(v7, v8), max(v7, v8)
-            v9, v10 = min(v9, v10), max(v9, v10)
-            v11, v12 = min(v11, v12), max(v11, v12)
-            v13 = min(v13, v14)
-            v17, v18 = min(v17, v18), max(v17, v18)
-            v19, v20 = min(v19, v20), max(v19, v20)
-            v21, v22 = min(v21, v22), max(v21, v22)
-            v23, v24 = min(v23, v24), max(v23, v24)
-            v16 = max(v0, v16)
-            v17 = max(v1, v17)
-            v18 = max(v2, v18)
-            v19 = max(v3, v19)
-            v20 = max(v4, v20)
-            v21 = max(v5, v21)
-            v6 = min(v6, v22)
-            v7 = min(v7, v23)
-            v8 = min(v8, v24)
-            v16 = max(v8, v16)
-            v17 = max(v9, v17)
-            v10 = min(v10, v18)
-            v11 = min(v11, v19)
-            v12 = min(v12, v20)
-            v13 = min(v13, v21)
-            v10 = max(v6, v10)
-            v11 = max(v7, v11)
-            v12 = min(v12, v16)
-            v13 = min(v13, v17)
-            v12 = max(v10, v12)
-            v11 = min(v11, v13)
-            v12 = max(v11, v12)
-            row[c] = v12
+        if last < first:
+            continue
+        e0, e1, e2, e3, e4 = split[0, r], split[0, r + 1], split[0, r + 2], split[0, r + 3], split[0, r + 4]
+        o0, o1, o2, o3, o4 = split[1, r], split[1, r + 1], split[1, r + 2], split[1, r + 3], split[1, r + 4]
+        for pair in range(first // 2, last // 2 + 1):
+            k = np.uint64(pair)
+            a0, a1, a2, a3, a4 = e0[k], e1[k], e2[k], e3[k], e4[k]
+            a0, a1 = min(a0, a1), max(a0, a1)
+            a3, a4 = min(a3, a4), max(a3, a4)
+            a2, a4 = min(a2, a4), max(a2, a4)
+            a2, a3 = min(a2, a3), max(a2, a3)
+            a0, a3 = min(a0, a3), max(a0, a3)
+            a0, a2 = min(a0, a2), max(a0, a2)
+            a1, a4 = min(a1, a4), max(a1, a4)
+            a1, a3 = min(a1, a3), max(a1, a3)
+            a1, a2 = min(a1, a2), max(a1, a2)
+            m0, m1, m2, m3, m4 = o0[k], o1[k], o2[k], o3[k], o4[k]
+            m0, m1 = min(m0, m1), max(m0, m1)
+            m3, m4 = min(m3, m4), max(m3, m4)
+            m2, m4 = min(m2, m4), max(m2, m4)
+            m2, m3 = min(m2, m3), max(m2, m3)
+            m0, m3 = min(m0, m3), max(m0, m3)
+            m0, m2 = min(m0, m2), max(m0, m2)
+            m1, m4 = min(m1, m4), max(m1, m4)
+            m1, m3 = min(m1, m3), max(m1, m3)
+            m1, m2 = min(m1, m2), max(m1, m2)
+            m5, m6, m7, m8, m9 = e0[k + one], e1[k + one], e2[k + one], e3[k + one], e4[k + one]
+            m5, m6 = min(m5, m6), max(m5, m6)
+            m8, m9 = min(m8, m9), max(m8, m9)
+            m7, m9 = min(m7, m9), max(m7, m9)
+            m7, m8 = min(m7, m8), max(m7, m8)
+            m5, m8 = min(m5, m8), max(m5, m8)
+            m5, m7 = min(m5, m7), max(m5, m7)
+            m6, m9 = min(m6, m9), max(m6, m9)
+            m6, m8 = min(m6, m8), max(m6, m8)
+            m6, m7 = min(m6, m7), max(m6, m7)
+            m10, m11, m12, m13, m14 = o0[k + one], o1[k + one], o2[k + one], o3[k + one], o4[k + one]
+            m10, m11 = min(m10, m11), max(m10, m11)
+            m13, m14 = min(m13, m14), max(m13, m14)
+            m12, m14 = min(m12, m14), max(m12, m14)
+            m12, m13 = min(m12, m13), max(m12, m13)
+            m10, m13 = min(m10, m13), max(m10, m13)
+            m10, m12 = min(m10, m12), max(m10, m12)
+            m11, m14 = min(m11, m14), max(m11, m14)
+            m11, m13 = min(m11, m13), max(m11, m13)
+            m11, m12 = min(m11, m12), max(m11, m12)
+            m15, m16, m17, m18, m19 = e0[k + two], e1[k + two], e2[k + two], e3[k + two], e4[k + two]
+            m15, m16 = min(m15, m16), max(m15, m16)
+            m18, m19 = min(m18, m19), max(m18, m19)
+            m17, m19 = min(m17, m19), max(m17, m19)
+            m17, m18 = min(m17, m18), max(m17, m18)
+            m15, m18 = min(m15, m18), max(m15, m18)
+            m15, m17 = min(m15, m17), max(m15, m17)
+            m16, m19 = min(m16, m19), max(m16, m19)
+            m16, m18 = min(m16, m18), max(m16, m18)
+            m16, m17 = min(m16, m17), max(m16, m17)
+            b0, b1, b2, b3, b4 = o0[k + two], o1[k + two], o2[k + two], o3[k + two], o4[k + two]
+            b0, b1 = min(b0, b1), max(b0, b1)
+            b3, b4 = min(b3, b4), max(b3, b4)
+            b2, b4 = min(b2, b4), max(b2, b4)
+            b2, b3 = min(b2, b3), max(b2, b3)
+            b0, b3 = min(b0, b3), max(b0, b3)
+            b0, b2 = min(b0, b2), max(b0, b2)
+            b1, b4 = min(b1, b4), max(b1, b4)
+            b1, b3 = min(b1, b3), max(b1, b3)
+            b1, b2 = min(b1, b2), max(b1, b2)
+            m0, m5 = min(m0, m5), max(m0, m5)
+            m4, m9 = min(m4, m9), max(m4, m9)
+            m4, m5 = min(m4, m5), max(m4, m5)
+            m2, m7 = min(m2, m7), max(m2, m7)
+            m2, m4 = min(m2, m4), max(m2, m4)
+            m7, m5 = min(m7, m5), max(m7, m5)
+            m1, m6 = min(m1, m6), max(m1, m6)
+            m3, m8 = min(m3, m8), max(m3, m8)
+            m3, m6 = min(m3, m6), max(m3, m6)
+            m1, m2 = min(m1, m2), max(m1, m2)
+            m3, m4 = min(m3, m4), max(m3, m4)
+            m6, m7 = min(m6, m7), max(m6, m7)
+            m8, m5 = min(m8, m5), max(m8, m5)
+            m10, m15 = min(m10, m15), max(m10, m15)
+            m14, m19 = min(m14, m19), max(m14, m19)
+            m14, m15 = min(m14, m15), max(m14, m15)
+            m12, m17 = min(m12, m17), max(m12, m17)
+            m12, m14 = min(m12, m14), max(m12, m14)
+            m17, m15 = min(m17, m15), max(m17, m15)
+            m11, m16 = min(m11, m16), max(m11, m16)
+            m13, m18 = min(m13, m18), max(m13, m18)
+            m13, m16 = min(m13, m16), max(m13, m16)
+            m11, m12 = min(m11, m12), max(m11, m12)
+            m13, m14 = min(m13, m14), max(m13, m14)
+            m16, m17 = min(m16, m17), max(m16, m17)
+            m18, m15 = min(m18, m15), max(m18, m15)
+            m10 = max(m0, m10)
+            m5 = min(m5, m15)
+            m5, m10 = min(m5, m10), max(m5, m10)
+            m4, m14 = min(m4, m14), max(m4, m14)
+            m5 = max(m4, m5)
+            m14 = min(m14, m10)
+            m12 = max(m2, m12)
+            m7 = min(m7, m17)
+            m7, m12 = min(m7, m12), max(m7, m12)
+            m5 = max(m7, m5)
+            m12, m14 = min(m12, m14), max(m12, m14)
+            m11 = max(m1, m11)
+            m9 = min(m9, m19)
+            m9, m11 = min(m9, m11), max(m9, m11)
+            m6, m16 = min(m6, m16), max(m6, m16)
+            m9 = max(m6, m9)
+            m16 = min(m16, m11)
+            m13 = max(m3, m13)
+            m8 = min(m8, m18)
+            m8, m13 = min(m8, m13), max(m8, m13)
+            m8, m9 = min(m8, m9), max(m8, m9)
+            m13 = min(m13, m16)
+            m8, m5 = min(m8, m5), max(m8, m5)
+            m9, m12 = min(m9, m12), max(m9, m12)
+            m13, m14 = min(m13, m14), max(m13, m14)
+            row[k + k] = _median_with(a0, a1, a2, a3, a4, m8, m5, m9, m12, m13, m14)
+            row[k + k + one] = _median_with(b0, b1, b2, b3, b4, m8, m5, m9, m12, m13, m14)
         for c in range(first, last + 1):
             if ok[r, c]:
                 medians[n] = row[c]
