@@ -324,10 +324,10 @@ _TWELFTH.flags.writeable = False
 
 
 def _covariance(m: np.ndarray) -> np.ndarray:
-    """``np.cov(m)`` of a real ``(k, n)`` array ``m`` (its rows the variables, ``n >= 2`` observations): (k, k)
+    """``np.cov(m)`` of a real ``(k, n)`` array ``m`` (its rows the variables, ``k >= 2``, ``n >= 2``): (k, k)
     float. numpy's own steps (a float64 copy of ``m`` as ``np.array`` makes it, the rows' means, the product of the
     centred rows with their transpose, scaled by ``1 / (n - 1)``) without its checks of weights and arguments:
-    the same values to the bit, about 20 against 35 us (issue 19, stop 61).
+    the same values to the bit, 10 against 15 us on 300 points (issue 19, stop 61).
 
     >>> m = np.array([[0.0, 1.0, 2.0, 4.0], [1.0, 3.0, 2.0, 0.5]])
     >>> bool(np.array_equal(_covariance(m), np.cov(m)))
