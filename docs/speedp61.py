@@ -52,7 +52,7 @@ def record(specs: list[str], save: str) -> None:
     detect.detect(frame)
     with open(save, "wb") as f:
         pickle.dump(calls, f)
-    print({spec: len(c) for spec, c in calls.items()}, "calls recorded in", save)
+    sys.stdout.write(f"{ {spec: len(c) for spec, c in calls.items()} } calls recorded in {save}\n")
 
 
 def _digest(value: Any, h: Any) -> None:
@@ -99,8 +99,8 @@ def replay(path: str, spec: str, passes: int) -> None:
             fn(*args, **kwargs)
         times.append(time.thread_time() - t)
     ms = np.array(times) * 1e3
-    print(f"{spec}: {len(calls)} calls, least {ms.min():.4f} median {np.median(ms):.4f} ms a frame, "
-          f"answers {h.hexdigest()[:16]}")  # fmt: skip
+    sys.stdout.write(f"{spec}: {len(calls)} calls, least {ms.min():.4f} median {np.median(ms):.4f} ms a frame, "
+                     f"answers {h.hexdigest()[:16]}\n")  # fmt: skip
 
 
 def ab(path: str, spec: str, trees: list[str], rounds: int, passes: int) -> None:
@@ -109,7 +109,7 @@ def ab(path: str, spec: str, trees: list[str], rounds: int, passes: int) -> None
             env = dict(os.environ, PYTHONPATH=tree)
             out = subprocess.run([sys.executable, __file__, "replay", path, spec, "--passes", str(passes)], env=env,
                                  capture_output=True, text=True, check=True).stdout.strip()  # fmt: skip
-            print(f"{tree}: {out}")
+            sys.stdout.write(f"{tree}: {out}\n")
 
 
 def main(argv: list[str] | None = None) -> int:

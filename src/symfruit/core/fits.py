@@ -876,7 +876,7 @@ def _first_out(uc: np.ndarray, way: np.ndarray, s: np.ndarray, origin: tuple[int
     row, col, inside = np.zeros(n, np.intp), np.zeros(n, np.intp), np.zeros(n, bool)
     start = np.zeros(n, bool)
     todo = np.arange(n)
-    block = max(1, int(math.ceil(0.5 * max(h, w) / float(s[0])))) if len(s) else 1
+    block = max(1, math.ceil(0.5 * max(h, w) / float(s[0]))) if len(s) else 1
     for j0 in range(0, len(s), block):
         sj = s[j0 : j0 + block]
         pu = uc[todo, None, 0] + sj[None, :] * way[todo, None, 0] - origin[0]
