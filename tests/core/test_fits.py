@@ -806,3 +806,42 @@ def test_noise_level_is_noise_measures_noise(n):
                 mp.delenv("SYMFRUIT_KERNELS", raising=False)
             got, want = noise_level(points, queries=40), noise_measures(points, queries=40)[1]
         assert np.float64(got).tobytes() == np.float64(want).tobytes()
+
+
+def _first_out_whole(uc, way, s, origin, mask):
+    """outline_radii's walks as it took them before stop 61: every slice over every step at once."""
+    h, w = mask.shape
+    pu = uc[:, None, 0] + s[None, :] * way[:, None, 0] - origin[0]
+    pv = uc[:, None, 1] + s[None, :] * way[:, None, 1] - origin[1]
+    col, row = np.rint(pu).astype(np.intp), np.rint(pv).astype(np.intp)
+    inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
+    hit = np.zeros_like(inside)
+    hit[inside] = mask[row[inside], col[inside]]
+    out = ~hit
+    first = np.argmax(out, axis=1)
+    k = np.arange(len(uc))
+    return hit[:, 0], np.where(out.any(axis=1), first, -1), row[k, first], col[k, first], inside[k, first]
+
+
+@given(seed=st.integers(0, 2**32 - 1), b=st.integers(1, 12), h=st.integers(1, 40), w=st.integers(1, 40),
+       step=st.sampled_from([0.25, 0.5, 1.0]), full=st.booleans())  # fmt: skip
+def test_outline_walks_in_blocks_are_the_whole_walks(seed, b, h, w, step, full):
+    """``_first_out`` walks a block of steps at a time and stops once every walk has left the mask (stop 61): the
+    start, first step out, its pixel and whether it is in the window are those of the walk over every step at once,
+    whether the walks start inside or outside the mask or the window, and where none leaves it (a full mask walked
+    less far than its edge)."""
+    from symfruit.core.fits import _first_out
+
+    rng = np.random.default_rng(seed)
+    mask = np.ones((h, w), bool) if full else rng.random((h, w)) < 0.8
+    origin = (int(rng.integers(-5, 6)), int(rng.integers(-5, 6)))
+    uc = rng.uniform(-3.0, max(h, w) + 3.0, size=(b, 2)) + origin
+    angle = rng.uniform(0.0, 2.0 * np.pi, size=b)
+    way = np.column_stack((np.cos(angle), np.sin(angle))) * rng.choice([1.0, -1.0], size=(b, 1))
+    reach = (0.5 if full else 2.0) * max(h, w)
+    s = np.arange(step, reach, step)
+    if not len(s):
+        return
+    got, want = _first_out(uc, way, s, origin, mask), _first_out_whole(uc, way, s, origin, mask)
+    for g, x in zip(got, want, strict=True):
+        assert g.dtype == x.dtype and g.tobytes() == x.tobytes()

@@ -951,3 +951,23 @@ def test_outline_circles_acceptance_is_the_same_with_its_kernels_and_without(mon
             assert (got is None) == (twin is None)
             if got is not None and twin is not None:
                 assert got[0].tobytes() == twin[0].tobytes() and got[1].tobytes() == twin[1].tobytes()
+
+
+@given(
+    n=st.integers(2, 300),
+    k=st.integers(2, 3),
+    seed=st.integers(0, 2**32 - 1),
+    scale=st.floats(1e-3, 1e3),
+    transposed=st.booleans(),
+)
+def test_covariance_is_numpys_cov_to_the_bit(n, k, seed, scale, transposed):
+    """``_covariance`` (free_side_reach's and axis_tilt's, stop 61) is ``np.cov`` bit for bit, on C-ordered rows and
+    on the transpose of C-ordered points (the callers' ``pts.T``), offset far from 0 as pixel coordinates are."""
+    from symfruit.core.raster import _covariance
+
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(size=(n, k)) * scale + rng.uniform(-500.0, 500.0, size=k)
+    m = pts.T if transposed else np.ascontiguousarray(pts.T)
+    got, want = _covariance(m), np.cov(m)
+    assert got.shape == want.shape == (k, k)
+    assert got.tobytes() == want.tobytes()

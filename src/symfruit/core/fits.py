@@ -836,20 +836,15 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     s = np.arange(step, reach, step)  # (m,)
     radii = np.full(len(mid), np.nan)
     found = []
-    for sign in (1.0, -1.0):  # both sides; vectorised over slices and steps
-        pu = uc[:, None, 0] + sign * s[None, :] * du[:, None, 0] - origin[0]
-        pv = uc[:, None, 1] + sign * s[None, :] * du[:, None, 1] - origin[1]
-        col, row = np.rint(pu).astype(np.intp), np.rint(pv).astype(np.intp)
-        inside = (col >= 0) & (col < w) & (row >= 0) & (row < h)
-        hit = np.zeros_like(inside)
-        hit[inside] = mask[row[inside], col[inside]]
-        start = hit[:, 0]
-        out = ~hit
-        first = np.argmax(out, axis=1)
-        ok = start & out.any(axis=1) & inside[np.arange(len(mid)), first]  # the outline, not the window's edge
+    b = len(mid)
+    # both sides' walks at once (the second's rows the first's, the other way): vectorised over slices and steps
+    walks = _first_out(np.concatenate((uc, uc)), np.concatenate((du, -du)), s, origin, mask)
+    for side, sign in enumerate((1.0, -1.0)):
+        start, first, row, col, inside = (x[side * b : (side + 1) * b] for x in walks)
+        ok = start & (first >= 0) & inside  # the outline, not the window's edge
+        first = np.maximum(first, 0)  # np.argmax's 0 where no step leaves the mask
         if hidden is not None:
-            rows_ = np.arange(len(mid))
-            r_, c_ = np.clip(row[rows_, first], 0, h - 1), np.clip(col[rows_, first], 0, w - 1)
+            r_, c_ = np.clip(row, 0, h - 1), np.clip(col, 0, w - 1)
             ok &= ~hidden[r_, c_]
         edge_px = (first - 0.5) * step  # halfway between the last pixel in and the first out
         bu = uc[:, 0] + sign * edge_px * du[:, 0]
@@ -864,6 +859,46 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     both = np.isfinite(found[0]) & np.isfinite(found[1])
     radii[both] = 0.5 * (found[0][both] + found[1][both])
     return np.where(radii > 0, radii, np.nan)
+
+
+def _first_out(uc: np.ndarray, way: np.ndarray, s: np.ndarray, origin: tuple[int, int],
+               mask: np.ndarray) -> tuple[np.ndarray, ...]:  # fmt: skip
+    """:func:`outline_radii`'s walks: from each pixel ``uc`` (b, 2) along ``way`` (b, 2) (a slice's image direction,
+    its side's sign applied) by ``s`` (m,) pixels, to the first step whose pixel (rounded, less ``origin``) is not
+    one of ``mask``'s (off the window counts as out). ``(start, first, row, col, inside)``, each (b,): whether the
+    first step is in the mask, the first step out (-1: none), and that step's pixel and whether it lies in the window
+    (at step 0 where there is none). Walked a block of steps at a time, the slices still in the mask alone, until
+    each has left it (half the window's larger side a block: the fruit's radius, about): each step's pixel is
+    computed on its own, as over every slice and step at once, so the same steps (4-5 times fewer pixels read)."""
+    h, w = mask.shape
+    n = len(uc)
+    first = np.full(n, -1, np.intp)
+    row, col, inside = np.zeros(n, np.intp), np.zeros(n, np.intp), np.zeros(n, bool)
+    start = np.zeros(n, bool)
+    todo = np.arange(n)
+    block = max(1, math.ceil(0.5 * max(h, w) / float(s[0]))) if len(s) else 1
+    for j0 in range(0, len(s), block):
+        sj = s[j0 : j0 + block]
+        pu = uc[todo, None, 0] + sj[None, :] * way[todo, None, 0] - origin[0]
+        pv = uc[todo, None, 1] + sj[None, :] * way[todo, None, 1] - origin[1]
+        c, r = np.rint(pu).astype(np.intp), np.rint(pv).astype(np.intp)
+        within = (c >= 0) & (c < w) & (r >= 0) & (r < h)
+        hit = np.zeros_like(within)
+        hit[within] = mask[r[within], c[within]]
+        out = ~hit
+        at = np.argmax(out, axis=1)
+        k = np.arange(len(todo))
+        if j0 == 0:  # step 0: the start, and np.argmax's pick where no step leaves the mask
+            start = hit[:, 0].copy()
+            row, col, inside = r[:, 0].copy(), c[:, 0].copy(), within[:, 0].copy()
+        left = out.any(axis=1)
+        done, at, k = todo[left], at[left], k[left]
+        first[done] = j0 + at
+        row[done], col[done], inside[done] = r[k, at], c[k, at], within[k, at]
+        todo = todo[~left]
+        if not len(todo):
+            break
+    return start, first, row, col, inside
 
 
 def closed_profile(rev: Revolution, *, close: bool = True) -> tuple[np.ndarray, np.ndarray]:
