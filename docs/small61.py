@@ -77,7 +77,8 @@ def trees(base: Path, new: Path) -> str:
     lines.append(f"changed {len(changed)}, moved by more than 1 mm {len(moved)}: centre better {better}, "
                  f"worse {len(moved) - better}")  # fmt: skip
     for k in moved:
-        lines.append(f"  {k[0]} apple {k[1]} (visible {a[k]['visible']:.2f}): centre {a[k]['centre_mm']:.1f} -> "
+        seen = "?" if a[k].get("visible") is None else f"{a[k]['visible']:.2f}"
+        lines.append(f"  {k[0]} fruit {k[1]} (visible {seen}): centre {a[k]['centre_mm']:.1f} -> "
                      f"{b[k]['centre_mm']:.1f} mm, depth side {a[k]['depth_mm']:+.1f} -> {b[k]['depth_mm']:+.1f}, "
                      f"lateral {a[k]['lateral_mm']:+.1f} -> {b[k]['lateral_mm']:+.1f}, "
                      f"IoU {a[k]['iou']:.3f} -> {b[k]['iou']:.3f}")  # fmt: skip
