@@ -17,6 +17,7 @@ from symfruit.extract import (
     cluster,
     cluster_gap,
     extract,
+    keep_caps,
     one_sided,
     own_cap,
     own_surface,
@@ -531,7 +532,8 @@ def test_a_fruit_parted_by_a_strip_in_front_keeps_both_parts(cut):
     assert ex.points[:, 2].min() > 1.29  # none of the strip
 
 
-# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, off)
+# --- stop 57, shift57: the colour trim takes no pixel of the fruit's own surface (extract.trim_keeps_surface, on
+# since stop 61)
 
 KEEPS = ExtractSettings(trim_keeps_surface=True)
 
@@ -553,15 +555,15 @@ def shaded_ball(board: bool = False) -> tuple[np.ndarray, np.ndarray, np.ndarray
 def test_the_colour_trim_takes_no_pixel_of_the_fruits_own_surface():
     """Stop 57 (docs/shift57.md): the colour alone takes the ball's shaded limb off (its lowest rows look like the
     grey ring beside the mask); with the depth and ``trim_keeps_surface``, the limb lies on the ball's own convex cap
-    and is kept, the mask exactly the disc. Off (the default: docs/trim58.md, "After merging"), or no depth given:
-    the colour's trim."""
+    and is kept, the mask exactly the disc (the default since stop 61, docs/small61.md). Off, or no depth given: the
+    colour's trim."""
     color, depth, d2 = shaded_ball()
     labels = (d2 <= 400).astype(np.int32)
     limb = (labels == 1) & (np.mgrid[:120, :160][0] >= 76)
     colour_only = trim_labels(color, labels)
     assert (colour_only[limb] == 0).sum() >= 0.5 * limb.sum()
     assert trim_labels(color, labels, KEEPS, depth=depth, focal=600.0) is labels
-    assert np.array_equal(trim_labels(color, labels, depth=depth, focal=600.0), colour_only)  # the default
+    assert trim_labels(color, labels, depth=depth, focal=600.0) is labels  # the default
     assert np.array_equal(trim_labels(color, labels, KEEPS), colour_only)
     off = ExtractSettings(trim_keeps_surface=False)
     assert np.array_equal(trim_labels(color, labels, off, depth=depth, focal=600.0), colour_only)
@@ -622,6 +624,44 @@ def test_the_fruits_cap_keeps_none_of_an_overshoot_all_round_where_the_depth_sit
     assert not (kept == 1)[d2 > 400].any()
     drawn = (d2 <= 400).astype(np.int32)
     assert trim_labels(color, drawn, KEEPS, depth=low, focal=600.0) is drawn
+
+
+# --- stop 61, small61: the cap keeps its pixels after the registration (keep_caps)
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (2, 3), (-3, -1)])
+def test_keep_caps_gives_back_the_limb_where_the_registration_puts_it(shift):
+    """Known answer: the shaded ball's limb, which the colour takes (a one-sided cut), lies on its own convex cap in
+    the depth ``shift`` pixels off the colour; the colour-trimmed mask moved by ``shift`` gets it back, the moved
+    mask exactly the disc as drawn, moved. Off (``trim_keeps_surface`` false) or no mask cut: the moved masks
+    themselves. The depth read unmoved (the cap a few pixels off the limb) gives back fewer pixels than the limb."""
+    color, depth, d2 = shaded_ball()
+    du, dv = shift
+    moved_depth = np.roll(depth, (dv, du), axis=(0, 1))  # the background is 1 m everywhere: rolled rows the same
+    drawn = (d2 <= 400).astype(np.int32)
+    trimmed = trim_labels(color, drawn)
+    assert (trimmed == 0).sum() > (drawn == 0).sum()  # the colour took the limb
+    moved = shift_labels(trimmed, du, dv)
+    boxes = [(slice(40, 81), slice(60, 101))]
+    kept = keep_caps(drawn, trimmed, moved, {1}, boxes, shift, moved_depth, 600.0, KEEPS)
+    assert np.array_equal(kept, shift_labels(drawn, du, dv))
+    off = ExtractSettings(trim_keeps_surface=False)
+    assert keep_caps(drawn, trimmed, moved, {1}, boxes, shift, moved_depth, 600.0, off) is moved
+    whole = shift_labels(drawn, du, dv)
+    assert keep_caps(drawn, drawn, whole, {1}, boxes, shift, moved_depth, 600.0, KEEPS) is whole
+    if shift != (0, 0):
+        unmoved = keep_caps(drawn, trimmed, moved, {1}, boxes, shift, depth, 600.0, KEEPS)
+        assert (unmoved > 0).sum() < (kept > 0).sum()
+
+
+def test_keep_caps_gives_back_nothing_of_an_overshoot_all_round():
+    """The ball under a mask 3 px too wide all round over the board at its depth (the colour's cut all round): the
+    moved masks themselves, though the board's first row lies on the cap."""
+    color, depth, d2 = shaded_ball(board=True)
+    drawn = (d2 <= 23**2).astype(np.int32)
+    trimmed = trim_labels(color, drawn)
+    boxes = [(slice(37, 84), slice(57, 104))]
+    assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), depth, 600.0, KEEPS) is trimmed
 
 
 def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():

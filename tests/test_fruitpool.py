@@ -543,8 +543,8 @@ def test_the_masks_trimming_and_registration_with_the_pool_are_one_processs(pool
     for frame, s in cases:
         labels = frame_masks(frame)[0]
         boxes = _label_boxes(labels, int(labels.max()))
-        focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))  # the depth as detect gives it (the fruit's cap)
-        trimmed, colour_trimmed = _trim_labels(frame.color, labels, s, boxes, frame.depth, focal)
+        # by the colour alone, as detect trims before the registration (the fruit's cap keeps its pixels after it)
+        trimmed, colour_trimmed = _trim_labels(frame.color, labels, s, boxes)
         new_boxes = [_box_within(trimmed, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         _, shift = register(trimmed, frame.depth, frame.camera, s, boxes=new_boxes)
         before = pool.masks_elsewhere

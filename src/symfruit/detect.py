@@ -31,6 +31,7 @@ from .extract import (
     _checked,
     _trim_checked,
     extract,
+    keep_caps,
     own_surface,
     register,
     shift_labels,
@@ -263,18 +264,14 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
         # looked for in the depth, docs/treeover43.md): those the trim took pixels from, each a new box looked for
         # within its old one (another mask's trim takes none of its pixels; stop 45: not every mask compared again)
         colour_trimmed: set[int] = set()
+        drawn, drawn_boxes = labels, boxes
         if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
-            labels, colour_trimmed = _trim_labels(
-                frame.color,
-                labels,
-                settings.extract,
-                boxes,
-                frame.depth,
-                float(np.sqrt(frame.camera.fx * frame.camera.fy)),
-            )
+            # by the colour alone: the fruit's own cap keeps what it may after the registration (_kept_caps)
+            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
+        moved = _kept_caps(frame, drawn, labels, moved, colour_trimmed, drawn_boxes, shift, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, prep.hi, boxes, settings, method, outlined,
                                          colour_trimmed)  # fmt: skip
         t_extract = ended - t2
@@ -350,6 +347,7 @@ def _detect_shared(
     here), and the workers' CPU seconds on the masks. The same answers as
     without the pool; the first failing mask's or fruit's error is raised."""
     same = object()  # this frame's depth and colour go to the workers once
+    drawn_boxes = boxes
     masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
     trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines, cpu = masks
     a, t_search = time.perf_counter(), 0.0
@@ -363,6 +361,7 @@ def _detect_shared(
         return found == guess
 
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
+    moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, guess, settings.extract)
     fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
                                      colour_trimmed)  # fmt: skip
     t_register = t_outlines + ended - a  # the move's and the search's seconds with them
@@ -376,6 +375,7 @@ def _detect_shared(
         pool.registration_guess = found
         b = time.perf_counter()
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
+        moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, found, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
                                          colour_trimmed)  # fmt: skip
         t_register += ended - b
@@ -507,9 +507,8 @@ class _Masks:
         """Mask ``k``'s pixels its colour trimming drops (None: none) and its box after it (None: none left)."""
         if self.color is None or self.settings.colour_trim_px <= 0:
             return None, sl
-        if (
-            dropped := trim_mask(self.color, self.labels, k, sl, self.settings, depth=self.depth, focal=self.focal)
-        ) is None:
+        # by the colour alone, as _trim_labels: the fruit's own cap keeps what it may after the registration
+        if (dropped := trim_mask(self.color, self.labels, k, sl, self.settings)) is None:
             return None, sl
         return dropped, _box_of(_without(self.labels[sl] == k, sl[0].start, sl[1].start, dropped), sl)
 
@@ -600,16 +599,23 @@ def _label_boxes(labels: np.ndarray, count: int) -> list[tuple[slice, slice] | N
 
 
 def _trim_labels(
-    color: np.ndarray,
-    labels: np.ndarray,
-    settings: ExtractSettings,
-    boxes: list[tuple[slice, slice] | None],
-    depth: np.ndarray | None = None,
-    focal: float = 0.0,
+    color: np.ndarray, labels: np.ndarray, settings: ExtractSettings, boxes: list[tuple[slice, slice] | None]
 ) -> tuple[np.ndarray, set[int]]:
-    """:func:`~symfruit.extract.trim_labels` (the same labels), and the masks it took pixels from."""
+    """:func:`~symfruit.extract.trim_labels` by the colour alone (the same labels), and the masks it took pixels
+    from."""
     trimmed: set[int] = set()
-    return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed, depth=depth, focal=focal), trimmed
+    return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed), trimmed
+
+
+def _kept_caps(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],
+               boxes: list[tuple[slice, slice] | None], shift: tuple[int, int],
+               settings: ExtractSettings) -> np.ndarray:  # fmt: skip
+    """:func:`~symfruit.extract.keep_caps` of the frame: what a one-sided colour cut took of a fruit's own convex cap
+    given back to the masks ``moved`` by ``shift`` onto the depth image (``extract.trim_keeps_surface``)."""
+    if not settings.trim_keeps_surface or not ids:
+        return moved
+    focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
+    return keep_caps(drawn, trimmed, moved, ids, boxes, shift, frame.depth, focal, settings)
 
 
 def _box_within(labels: np.ndarray, k: int, sl: tuple[slice, slice] | None) -> tuple[slice, slice] | None:

@@ -20,8 +20,8 @@ from .core.surface import ALL_ROUND, PART_POINTS, across_occluder, colour_trim, 
 from .errors import InputError
 from .settings import Section, SettingError, setting
 
-__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "one_sided", "own_cap",
-           "own_surface", "register", "shift_labels", "trim_labels"]  # fmt: skip
+__all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "keep_caps", "one_sided",
+           "own_cap", "own_surface", "register", "shift_labels", "trim_labels"]  # fmt: skip
 
 #: Largest border erosion a setting may ask for (pixels).
 MAX_RADIUS_PX = 50
@@ -77,11 +77,13 @@ class ExtractSettings(Section):
         its box 182 mm tall for 198 binned 2 x 2, 196 with it; stop 57, docs/shift57.md). A cut all round is an
         overshoot's, and the colour's alone: where the depth sits a few pixels off the colour (the real frames'
         larger spheres), the cap runs on over an overshoot past the fruit's colour edge (stop 57's rule on every
-        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md). Off by
-        default: the pixels it keeps move the frame's registration (it reads every mask), and on the rendered
-        apple trees a shift 1 px other put a half-hidden apple's points on the leaf in front of it (5 -> 72 mm;
-        seeds 6-11 5.3 -> 5.9 mm mean centre, held-out seeds 100-111 9.0 -> 9.0; the real spheres binned 2x and 3x
-        5 -> 0 boxes over the bar with it; docs/trim58.md, "After merging").
+        cut: the real masks grown 2-10 px 21 -> 28 of 32 boxes over the 6 mm bar; stop 58, docs/trim58.md).
+        ``detect`` gives the pixels back after the registration (:func:`keep_caps`), reading the cap on the depth
+        the masks are moved onto, so that they cannot move the frame's shift (done before it, they moved a frame
+        of rendered apple trees by a pixel and a half-hidden apple's points went to the leaf in front of it:
+        docs/trim58.md, "After merging"). On by default since stop 61 (docs/small61.md): the real spheres binned
+        2x and 3x, and binned with a wider lost rim, 8 -> 0 boxes over the 6 mm bar; the development trees' mean
+        centre the same to 0.01 mm.
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -105,7 +107,7 @@ class ExtractSettings(Section):
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
-    trim_keeps_surface: bool = setting(False)
+    trim_keeps_surface: bool = setting(True)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
@@ -622,6 +624,49 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
     # the rim's depth: the front plus the radius, plus the convexity test's tolerance (the registration's free test's)
     rim = surface.front + surface.radius + max(3.0 * surface.noise, 0.003)
     return surface.pixels & (z > 0.0) & (z <= rim)
+
+
+def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],
+              boxes: list[tuple[slice, slice] | None], shift: tuple[int, int], depth: np.ndarray, focal: float,
+              settings: ExtractSettings | None = None) -> np.ndarray:  # fmt: skip
+    """``moved`` (the colour-trimmed masks ``trimmed`` moved by ``shift`` onto the depth image, :func:`register`)
+    with what each mask of ``ids`` lost to a one-sided colour cut (:func:`one_sided`) given back where its depth, read
+    where the registration puts it, lies on the fruit's own convex cap (:func:`own_cap`); ``moved`` itself when
+    nothing is given back (``trim_keeps_surface`` off, or no such pixel).
+
+    :func:`trim_mask`'s veto done after the registration (issue 18, stop 61, docs/small61.md): the registration reads
+    the masks as the colour alone trimmed them, so what the cap keeps cannot move the frame's shift (done before it,
+    the pixels kept moved the shift of a frame of rendered apple trees by a pixel, and a half-hidden apple's points
+    went to the leaf in front of it: docs/trim58.md), and the cap is read on the depth the mask is moved onto, not
+    on the depth a few pixels off. ``drawn``: the masks as found (their boxes ``boxes``), ``depth`` metres,
+    ``focal`` pixels."""
+    s = settings or ExtractSettings()
+    if not s.trim_keeps_surface or not ids:
+        return moved
+    du, dv = shift
+    h, w = moved.shape
+    out = moved
+    for k in sorted(ids):
+        sl = boxes[k - 1]
+        if sl is None:
+            continue
+        r0, r1, c0, c1 = sl[0].start, sl[0].stop, sl[1].start, sl[1].stop
+        mask = drawn[r0:r1, c0:c1] == k
+        dropped = mask & (trimmed[r0:r1, c0:c1] != k)
+        if not dropped.any() or not one_sided(mask, dropped):
+            continue
+        # the window moved onto the depth image; what falls off the image has no depth
+        a0, a1, b0, b1 = max(r0 + dv, 0), min(r1 + dv, h), max(c0 + du, 0), min(c1 + du, w)
+        if a0 >= a1 or b0 >= b1:
+            continue
+        z = np.zeros(mask.shape)
+        z[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] = depth[a0:a1, b0:b1]
+        keep = dropped & own_cap(z, mask, focal, s)
+        keep = keep[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] & (out[a0:a1, b0:b1] == 0)
+        if keep.any():
+            out = out.copy() if out is moved else out
+            out[a0:a1, b0:b1][keep] = k
+    return out
 
 
 def register(

@@ -274,17 +274,11 @@ def test_the_66_mm_sphere_on_its_board_is_a_cube_with_its_mask_down_on_the_board
     the box 84-94 mm tall. The board's face lies half a radius behind the sphere's front, and behind it a round fruit
     can reach only 13-17 % of its radius (``occlusion.supports``, ``core.occlusion.support_reach``; stop 56,
     docs/support56.md): a cube within 6 mm, as every sphere at ``shift+5y``; at ``bin2-rim1`` every sphere with the
-    200 mm sphere's shaded limb kept (``trim_keeps_surface``, off by default: docs/trim58.md)."""
-    from symfruit.settings import from_dict
-
+    200 mm sphere's shaded limb kept (``trim_keeps_surface``, on by default since stop 61: docs/small61.md)."""
     boxes = spheres(rp, name)
     assert len(boxes) == 4
-    for k, size, diameter in boxes:
-        if name == "shift+5y" or k == 3:  # binned, the default's 200 mm sphere comes out 182 mm tall (the colour trim)
-            assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
-    if name == "bin2-rim1":
-        for k, size, diameter in spheres(rp, name, from_dict({"extract": {"trim_keeps_surface": True}})):
-            assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
+    for k, size, diameter in boxes:  # binned, without trim_keeps_surface the 200 mm sphere was 182 mm tall
+        assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
 
 
 # --- stop 57, shift57: the 200 mm sphere's shaded lower limb taken by the colour trim
@@ -294,13 +288,14 @@ def test_binned_the_colour_trim_takes_the_200_mm_spheres_lower_limb_unless_it_ke
     """Stop 57 (docs/shift57.md): binned 3 x 3, the colour trim takes about 100 px of the 200 mm sphere's shaded lower
     half (the band, 4 binned px, reaches three times as far into the limb as at full resolution, where it takes
     none): the box 198 x 175 x 185 mm with ``trim_keeps_surface`` off. Those pixels' depth lies on the sphere's own
-    convex cap, and the cut is one side of the mask (29 % of its outline); with ``trim_keeps_surface`` (off by
-    default: docs/trim58.md) they are kept and every sphere is within 6 mm of a cube and of its diameter."""
+    convex cap, and the cut is one side of the mask (29 % of its outline); with ``trim_keeps_surface`` (on by default
+    since stop 61, the pixels given back after the registration: docs/small61.md) they are kept and every sphere is
+    within 6 mm of a cube and of its diameter."""
     from symfruit.settings import from_dict
 
-    short = {k: size for k, size, _ in spheres(rp, "bin3")}[1]
-    assert short[1] < 190.0  # the default, the colour alone: the limb taken
-    boxes = spheres(rp, "bin3", from_dict({"extract": {"trim_keeps_surface": True}}))
+    short = {k: size for k, size, _ in spheres(rp, "bin3", from_dict({"extract": {"trim_keeps_surface": False}}))}[1]
+    assert short[1] < 190.0  # the colour alone: the limb taken
+    boxes = spheres(rp, "bin3")  # the default
     assert len(boxes) == 4
     for k, size, diameter in boxes:
         assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (k, size, diameter)
@@ -318,3 +313,30 @@ def test_grown_5_px_the_colour_cut_lies_all_round_and_the_fruits_cap_keeps_none_
 
     boxes = {k: size for k, size, _ in spheres(rp, "dilate5", from_dict({"extract": {"trim_keeps_surface": True}}))}
     assert boxes[1][1] < 195.0 and boxes[2][1] < 135.0
+
+
+# --- stop 61, small61: the fruit's cap keeps the limb after the registration, which it cannot move
+
+
+def test_binned_2x_the_limb_is_kept_after_the_registration_and_moves_no_shift(rp):
+    """Stop 61 (docs/small61.md): binned 2 x 2, frame 1 registers by (1, 4) px with the colour's trim, and the
+    200 mm sphere's shaded limb, which that trim takes, is given back after the registration (``extract.keep_caps``,
+    the default): the same shift as with ``trim_keeps_surface`` off, the sphere 198 x 196 x 197 mm (off: 198 x 182 x
+    189), and with a pool of one worker (each mask trimmed on it, the limb given back here) the same boxes."""
+    from symfruit.fruitpool import FruitPool
+    from symfruit.settings import from_dict
+
+    frame = read_frame(rp.FRAMES / "lab-spheres-1")
+    color, depth, masks, cam = rp.PERTURBATIONS["bin2"](frame)
+    binned = Frame(name="bin2", color=color, depth=depth, camera=cam, masks=masks)
+    kept = detect(binned, method="evidence")
+    off = detect(binned, method="evidence", settings=from_dict({"extract": {"trim_keeps_surface": False}}))
+    assert kept.registration == off.registration == (1, 4)
+    tall = {d.id: d.result.box.size[1] * 1000.0 for d in kept.detections}
+    short = {d.id: d.result.box.size[1] * 1000.0 for d in off.detections}
+    assert short[1] < 185.0 and tall[1] > 194.0
+    with FruitPool(1, method=None) as pool:
+        pooled = detect(binned, method="evidence", pool=pool)
+    assert pooled.registration == kept.registration
+    for a, b in zip(kept.detections, pooled.detections, strict=True):
+        assert np.array_equal(a.mask, b.mask) and np.allclose(a.result.box.min, b.result.box.min, atol=1e-9)
