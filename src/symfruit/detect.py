@@ -18,6 +18,7 @@ from scipy import ndimage
 
 from .core.box import Box
 from .core.camera import Camera
+from .core.edges import mask_shift
 from .core.frame import Frame
 from .core.kernels import compiled
 from .core.limits import MAX_FOCAL_PX, MAX_INSTANCES, instance_labels
@@ -210,6 +211,11 @@ def _prepare(
                              "fruit per frame are read")  # fmt: skip
         labels = (inverse.reshape(labels.shape) + int(values[0] != 0)).astype(np.int32)
         lo, hi = int(labels.min()), int(labels.max())
+    if settings.extract.mask_edge_px > 0 and frame.color is not None and source != COLOUR_SEGMENTER and hi > 0:
+        # masks drawn a few pixels off their fruit, all one way, moved back onto the colour's edges (stop 61,
+        # docs/shift61.md); the segmenter's masks are the colour's own
+        du, dv = mask_shift(frame.color, labels, max_px=settings.extract.mask_edge_px)
+        labels = shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels
     # one mask covers the whole image when every pixel holds the same label above 0: the least and greatest labels
     # tell it (a bincount of the image cost 0.3 ms a frame; issue 19, stop 41)
     if labels.size and lo == hi and lo > 0:

@@ -63,6 +63,17 @@ class ExtractSettings(Section):
         onto the depth before extraction (:func:`~symfruit.core.surface.registration_shift`; 0: never); a least
         cost at the radius itself is no minimum found and moves nothing, so the radius must exceed the largest
         shift expected.
+    mask_edge_px : int
+        With the frame's colour image (``detect``, masks drawn as outlines: a masks file, a label array, a model; not
+        the colour segmenter's): how far (pixels) the masks may sit off their fruit in the colour image, all one way
+        (an annotator's or a model's masks drawn on an image registered a few pixels off). The shift that lays the
+        masks' outlines on the colour's edges (:func:`~symfruit.core.edges.mask_shift`: only along an axis whose two
+        opposite sides agree, and only where it beats none) moves them before the colour trim; 0 (the default):
+        never. The real Azure Kinect spheres with their masks moved 5 px up: 4 -> 0 of 8 boxes over the 6 mm bar,
+        and every shifted mask's box back where the unperturbed mask's is (a mask 5 px down kept its size, the
+        colour could not trim it, but its box sat 6-9 mm low). Off by default: it reads the colour's edges around all
+        the masks and scores every shift (about 0.5 s of CPU on a 1920 x 1080 frame of tree masks), and nothing
+        measured so far has masks drawn off all one way (stop 61, docs/shift61.md).
     colour_trim_px : int
         With the frame's colour image (``detect``): a mask's outer band up to this many pixels (and a fifth of
         its equivalent radius) loses the pixels whose colour is the background's
@@ -106,6 +117,7 @@ class ExtractSettings(Section):
     max_depth: float = setting(3.0, gt=0.0, le=100.0)
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
+    mask_edge_px: int = setting(0, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
     trim_keeps_surface: bool = setting(True)
     slab: float = setting(1.3, gt=0.0, le=100.0)

@@ -4,7 +4,7 @@ texture of its own, depth moved by a known shift and its objects' outermost pixe
 import numpy as np
 import pytest
 
-from symfruit.core.edges import colour_edges, depth_outline, edge_shift
+from symfruit.core.edges import colour_edges, depth_outline, edge_shift, mask_shift
 
 H, W = 240, 320
 
@@ -105,3 +105,59 @@ def test_a_frame_without_outlines_says_nothing_and_sizes_must_agree():
     assert found.n_outline == 0 and found.balanced == (None, None) and found.band is None
     with pytest.raises(ValueError, match=r"depth \(240, 320\) and colour \(10, 10\) differ in size"):
         edge_shift(flat, np.zeros((10, 10, 3), np.uint8))
+
+
+def moved(ids: np.ndarray, du: int, dv: int) -> np.ndarray:
+    """``ids`` moved by ``(du, dv)`` pixels (0 enters)."""
+    out = np.zeros_like(ids)
+    out[max(dv, 0) : H + min(dv, 0), max(du, 0) : W + min(du, 0)] = ids[
+        max(-dv, 0) : H - max(dv, 0), max(-du, 0) : W - max(du, 0)
+    ]
+    return out
+
+
+@pytest.mark.parametrize("shift", [(0, 0), (0, -5), (0, 5), (4, 0), (-3, 4), (8, -7)])
+def test_masks_drawn_off_their_objects_are_moved_back_onto_the_colours_edges(shift):
+    rng = np.random.default_rng(5)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    drawn = moved(ids, *shift)  # the masks drawn `shift` off the objects the colour shows
+    assert mask_shift(color, drawn, max_px=10) == (-shift[0], -shift[1])
+
+
+@pytest.mark.parametrize("grow", [2, 5])
+def test_generous_masks_are_not_moved(grow):
+    """A mask grown all round pulls its opposite sides apart (the top up, the bottom down): no axis agrees."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(6)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    grown = np.zeros_like(ids)
+    for k in (1, 2, 3):
+        grown[ndimage.binary_dilation(ids == k, iterations=grow) & (grown == 0)] = k
+    assert mask_shift(color, grown, max_px=10) == (0, 0)
+
+
+def test_one_side_alone_does_not_move_the_masks():
+    """Only the upper half of each object differs from the wall (its lower half shares the wall's grey): the top
+    sides lie on edges, the bottom ones on none, and a shift along an axis needs both its sides."""
+    rng = np.random.default_rng(7)
+    _, ids = scene(rng)
+    grey = np.full((H, W), 120.0)
+    for k in (1, 2, 3):
+        rows, cols = np.nonzero(ids == k)
+        upper = rows < rows.mean()
+        grey[rows[upper], cols[upper]] = 60.0
+    color = np.clip(np.repeat((grey + rng.normal(0, 2.0, (H, W)))[..., None], 3, axis=2), 0, 255).astype(np.uint8)
+    assert mask_shift(color, moved(ids, 0, -5), max_px=10) == (0, 0)
+    assert mask_shift(color, moved(ids, 4, 0), max_px=10) == (-4, 0)  # left and right both lie on edges (above)
+
+
+def test_mask_shift_needs_masks_and_colour_of_one_size():
+    rng = np.random.default_rng(8)
+    _, ids = scene(rng)
+    assert mask_shift(colour(ids, rng), np.zeros_like(ids)) == (0, 0)  # no mask: nothing to move
+    assert mask_shift(colour(ids, rng), ids, max_px=0) == (0, 0)
+    with pytest.raises(ValueError, match="differ in size"):
+        mask_shift(colour(ids, rng), ids[:-1])

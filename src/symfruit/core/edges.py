@@ -12,6 +12,10 @@ lays the depth's outlines on the colour's edges is the registration offset.
   dark patch) are no outline: no surface within ``reach`` pixels lies farther by ``jump`` of the depth.
 - :func:`colour_edges`: the colour image's edges (gradient maxima along the gradient, the strongest channel's
   gradient, a threshold a multiple of the frame's median gradient), with their orientation.
+- :func:`mask_shift`: the same score with the fruit's masks' outlines in place of the depth's: the shift that lays
+  masks drawn a few pixels off their fruit (an annotator's outline, a model's mask, masks drawn on an image
+  registered off) back on the colour's edges, where the two opposite sides of the outlines agree (stop 61,
+  docs/shift61.md).
 - :func:`edge_shift`: an oriented, truncated chamfer score (each outline pixel's distance to the nearest colour
   edge of about its orientation, capped, the worst share dropped) at every integer shift within ``max_px``. The
   colour's texture (a printed board, handles, shading) only adds edges, which a distance from the depth's
@@ -26,6 +30,7 @@ the colour pixel ``(u, v)`` sees. Numpy and scipy only; images in, numbers out.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -33,7 +38,7 @@ from scipy import ndimage
 
 from .raster import distance_transform
 
-__all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift"]
+__all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift", "mask_shift"]
 
 #: Orientation bins of the oriented chamfer score (edge normals modulo 180 degrees); a depth outline pixel is
 #: matched to colour edges in its own bin and the two beside it (within 45 degrees).
@@ -267,3 +272,108 @@ def edge_shift(
     left, right = sides["left"][0], sides["right"][0]
     band = None if left is None or right is None else (left - right) / 2.0
     return EdgeShift(shift, cost, n, sides, band, (rise_along(1), rise_along(0)))
+
+
+def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: float = 6.0, keep: float = 0.7,
+               max_points: int = 8000, min_side: int = 20) -> tuple[int, int]:  # fmt: skip
+    """The integer shift ``(du, dv)`` within ``max_px`` that moves the masks ``labels`` (0: none) onto the colour's
+    edges (:func:`colour_edges`), ``(0, 0)`` where the outlines do not tell one.
+
+    The score is :func:`edge_shift`'s (each outline pixel's distance to the nearest colour edge within 45 degrees of
+    its orientation, capped at ``cap``; a shift costs the mean of its ``keep`` share of cheapest pixels), with the
+    masks' outline pixels (a mask's pixels beside one outside it, oriented by the smoothed mask's gradient) moved by
+    the shift. Each side of the outlines (top, bottom, left, right) gives its best shift along the axis it constrains,
+    the other axis free, from at least ``min_side`` pixels. An axis moves only where its two sides agree within two
+    pixels: a mask drawn off its fruit moves both one way, a generous mask pulls them apart (its top outline up, its
+    bottom one down), and one side alone cannot tell a shift from an overshoot (a side whose outline lies on no edge
+    at any shift, most of it farther than half the cap, says nothing). Each side reads its outline to a pixel (the
+    colour edge's maximum lies between a mask's last pixel and the first outside it; on the real Azure Kinect
+    spheres, masks drawn right read their top -1 and bottom +1), so two sides of masks drawn right may differ by two
+    and a mask grown a pixel or two reads as much: an axis whose sides straddle none stays. An axis moves by its two
+    sides' mean (their pixels of rounding outwards cancel; a half pixel goes to the shift of less cost over every
+    outline pixel), and the shift is taken only where it costs less than none over every outline pixel.
+
+    Parameters
+    ----------
+    color : (h, w, 3) or (h, w) array, the colour image
+    labels : (h, w) int, the masks on the colour image's pixels
+
+    Raises
+    ------
+    ValueError
+        When colour and masks differ in size.
+    """
+    img = np.asarray(color)
+    lab = np.asarray(labels)
+    if img.shape[:2] != lab.shape or lab.ndim != 2:
+        raise ValueError(f"colour {img.shape[:2]} and masks {lab.shape} differ in size")
+    m = int(max_px)
+    present = np.flatnonzero(lab.any(axis=1)), np.flatnonzero(lab.any(axis=0))
+    if m <= 0 or not len(present[0]):
+        return (0, 0)
+    # the colour's edges are read in the masks' box grown by the search and the cap (and the smoothing's reach)
+    pad = m + int(np.ceil(cap)) + 4
+    h, w = lab.shape
+    r0, r1 = max(int(present[0][0]) - pad, 0), min(int(present[0][-1]) + pad + 1, h)
+    c0, c1 = max(int(present[1][0]) - pad, 0), min(int(present[1][-1]) + pad + 1, w)
+    img, lab = img[r0:r1, c0:c1], lab[r0:r1, c0:c1]
+    h, w = lab.shape
+    edges, ebins = colour_edges(img)
+    parts = []
+    for sl, k in zip(ndimage.find_objects(lab), range(1, int(lab.max()) + 1), strict=False):
+        if sl is None:
+            continue
+        a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
+        b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
+        mask = lab[a0:a1, b0:b1] == k
+        rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
+        smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
+        gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
+        parts.append((rows + a0, cols + b0, gx, gy))
+    if not parts:
+        return (0, 0)
+    rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(4))
+    step = max(1, -(-len(rows) // max(1, int(max_points))))
+    rows, cols, gx, gy = rows[::step], cols[::step], gx[::step], gy[::step]
+    bins = _orientation_bin(gx, gy)
+    dist = np.empty((N_BINS, h, w), np.float32)
+    for b in range(N_BINS):
+        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
+        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
+    every = np.full((2 * m + 1, 2 * m + 1, len(rows)), cap, np.float32)  # (dv, du, pixel)
+    for i, dv in enumerate(range(-m, m + 1)):
+        rr = rows + dv
+        ok_r = (rr >= 0) & (rr < h)
+        for j, du in enumerate(range(-m, m + 1)):
+            cc = cols + du
+            ok = ok_r & (cc >= 0) & (cc < w)
+            every[i, j, ok] = dist[bins[ok], rr[ok], cc[ok]]
+
+    def trimmed(values: np.ndarray) -> np.ndarray:
+        k = max(1, round(keep * values.shape[-1]))
+        return np.sort(values, axis=-1)[..., :k].mean(axis=-1)
+
+    # the smoothed mask rises into the mask: a top side's gradient points down (+v), a left side's right (+u)
+    vertical, horizontal = np.abs(gy) > 2.0 * np.abs(gx), np.abs(gx) > 2.0 * np.abs(gy)
+    sides = {"top": vertical & (gy > 0), "bottom": vertical & (gy < 0), "left": horizontal & (gx > 0),
+             "right": horizontal & (gx < 0)}  # fmt: skip
+    best: dict[str, int | None] = {}
+    for name, sel in sides.items():
+        if np.count_nonzero(sel) < min_side:
+            best[name] = None
+            continue
+        per = trimmed(every[:, :, sel])
+        profile = per.min(axis=1) if name in ("top", "bottom") else per.min(axis=0)
+        # a side whose outline lies on no edge at any shift (most of it farther than half the cap) says nothing
+        best[name] = int(np.argmin(profile)) - m if profile.min() < 0.5 * cap else None
+    told = []
+    for one, other in (("left", "right"), ("top", "bottom")):
+        x, y = best[one], best[other]
+        lo, hi = (min(x, y), max(x, y)) if x is not None and y is not None else (0, 0)
+        mid = 0.5 * (lo + hi)  # each side's pixel of rounding outwards cancels in the two sides' mean
+        told.append(sorted({math.floor(mid), math.ceil(mid)}) if hi - lo <= 2 and (lo > 0 or hi < 0) else [0])
+    cost = trimmed(every)
+    du, dv = min(
+        ((u, v) for u in told[0] for v in told[1]), key=lambda t: (cost[t[1] + m, t[0] + m], abs(t[0]) + abs(t[1]))
+    )
+    return (du, dv) if cost[dv + m, du + m] < cost[m, m] else (0, 0)
