@@ -1702,10 +1702,10 @@ ROUNDING = 0.25 / (1.4826 * 1.4826)
 @_njit
 def grouped_deviation(ks: np.ndarray, cs: np.ndarray) -> float:
     """The median absolute deviation about the median (in cells) of counts ``cs`` (m,) float64 (one above 0 at least)
-    of whole values ``ks`` (m,) float64 (sorted, distinct), each count spread evenly over its cell ``[k - 1/2, k + 1/2]``
-    (grouped data's median and deviation): both read off the piecewise linear distribution, so that a value entering or
-    leaving moves them by a share of a cell instead of a whole one. :func:`symfruit.core.surface._grouped_deviation`'s
-    steps in its order: the same value (stop 61)."""
+    of whole values ``ks`` (m,) float64 (sorted, distinct), each count spread evenly over its cell
+    ``[k - 1/2, k + 1/2]`` (grouped data's median and deviation): both read off the piecewise linear distribution, so
+    that a value entering or leaving moves them by a share of a cell instead of a whole one.
+    :func:`symfruit.core.surface._grouped_deviation`'s steps in its order: the same value (stop 61)."""
     m = ks.shape[0]
     total = 0.0
     for i in range(m):
