@@ -1143,42 +1143,6 @@ def test_the_depth_noise_is_the_twins(seed, repeated, holes):
             assert noise == twin or (np.isnan(noise) and np.isnan(twin))
 
 
-@settings(max_examples=150, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.sampled_from([1e-3, 5e-4, 0.0]), st.booleans())
-def test_the_quantised_deviation_is_the_twins(seed, step, outliers):
-    """``quantised_deviation`` (``depth_noise``'s deviation of its moved differences, stop 61) against
-    ``surface._quantised_deviation`` bit for bit: whole steps of 1 or 0.5 mm (a normal spread of 0.2-5 steps about
-    -2..2 steps) or continuous differences, far differences (a rim's) or not, an infinite one, one value."""
-    from symfruit.core.surface import _quantised_deviation
-
-    rng = np.random.default_rng(seed)
-    n = int(rng.integers(1, 400))
-    x = rng.normal(rng.uniform(-2.0, 2.0), rng.uniform(0.2, 5.0), n)
-    x = np.round(x) * step if step else x * 1e-3
-    if outliers:
-        x[: int(rng.integers(1, 10))] = rng.uniform(-0.3, 0.3)
-    if rng.random() < 0.05:
-        x[0] = np.inf
-    x = x[x != 0]
-    if not len(x):
-        return
-    got, want = _jit.quantised_deviation(x.copy()), _quantised_deviation(x.copy())
-    assert np.float64(got).tobytes() == np.float64(want).tobytes()
-
-
-def test_the_grouped_deviation_is_read_off_the_cells():
-    """Counts spread evenly over their cells: three equal cells are an even spread of 3 cells (median 0, deviation
-    0.75); two counts more in the middle cell move the deviation by a share of a cell (0.7), not a whole one; two
-    cells apart, the median at the first's upper edge and nothing in the gap (1.0). The twins agree."""
-    from symfruit.core.surface import _grouped_deviation
-
-    cases = [([-1.0, 0.0, 1.0], [10.0, 10.0, 10.0], 0.75), ([-1.0, 0.0, 1.0], [10.0, 12.0, 10.0], 0.7),
-             ([-3.0, 3.0], [5.0, 5.0], 1.0), ([2.0], [7.0], 0.25)]  # fmt: skip
-    for ks, cs, want in cases:
-        assert _grouped_deviation(ks, cs) == pytest.approx(want)
-        assert _jit.grouped_deviation(np.array(ks), np.array(cs)) == _grouped_deviation(ks, cs)
-
-
 @pytest.mark.parametrize("seed", range(4))
 def test_the_registration_shift_is_the_twins(monkeypatch, seed):
     """Balls apart, their depth a few pixels off their masks (noisy or not, rims without depth): the same shift."""

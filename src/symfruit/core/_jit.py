@@ -1687,131 +1687,7 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float]:
     for i in range(n):
         if np.isnan(x[i]):
             return n, np.nan
-    if moved >= 20:
-        return n, quantised_deviation(x)  # stop 61 (noise61): the deviation read off the quantisation's cells
     return n, deviation_median(x)  # the same medians without branches (stop 49)
-
-
-#: stop 61 (noise61): :func:`quantised_deviation`'s test that differences are whole steps (in steps), and the share of
-#: the deviation's square the rounding adds (the two neighbours' rounding, a triangle of variance 1/6 step squared, and
-#: the spread over the cells, 1/12, over ``1.4826 ** 2``: the deviation of a normal spread's 1/4 step squared)
-LATTICE = 0.01
-ROUNDING = 0.25 / (1.4826 * 1.4826)
-
-
-@_njit
-def grouped_deviation(ks: np.ndarray, cs: np.ndarray) -> float:
-    """The median absolute deviation about the median (in cells) of counts ``cs`` (m,) float64 (one above 0 at least)
-    of whole values ``ks`` (m,) float64 (sorted, distinct), each count spread evenly over its cell
-    ``[k - 1/2, k + 1/2]`` (grouped data's median and deviation): both read off the piecewise linear distribution, so
-    that a value entering or leaving moves them by a share of a cell instead of a whole one.
-    :func:`symfruit.core.surface._grouped_deviation`'s steps in its order: the same value (stop 61)."""
-    m = ks.shape[0]
-    total = 0.0
-    for i in range(m):
-        total += cs[i]
-    half = 0.5 * total
-    acc = 0.0
-    j = 0
-    while j < m - 1 and not (cs[j] > 0.0 and acc + cs[j] >= half):
-        acc += cs[j]
-        j += 1
-    med = ks[j] - 0.5 + (half - acc) / cs[j]
-    # out from the median both ways at once: the mass within t of it grows at the densities met on either side
-    mass = 0.0
-    t = 0.0
-    right = j
-    left = j
-    while True:
-        er = np.inf
-        fr = 0.0
-        top_r = False
-        if right < m:
-            near = ks[right] - 0.5 - med
-            if t < near:
-                er = near
-            else:
-                er = ks[right] + 0.5 - med
-                fr = cs[right]
-                top_r = True
-        el = np.inf
-        fl = 0.0
-        top_l = False
-        if left >= 0:
-            near = med - (ks[left] + 0.5)
-            if t < near:
-                el = near
-            else:
-                el = med - (ks[left] - 0.5)
-                fl = cs[left]
-                top_l = True
-        nxt = er if er < el else el
-        rate = fr + fl
-        if not nxt < np.inf:
-            return t
-        if rate > 0.0 and mass + rate * (nxt - t) >= half:
-            return t + (half - mass) / rate
-        mass += rate * (nxt - t)
-        t = nxt
-        if er == nxt and top_r:
-            right += 1
-        if el == nxt and top_l:
-            left -= 1
-
-
-@_njit
-def quantised_deviation(x: np.ndarray) -> float:
-    """:func:`symfruit.core.surface.depth_noise`'s deviation of its moved differences ``x`` (n,) float64 (none 0,
-    none NaN; reordered and overwritten where not whole steps): where every one is a whole number of the least one's
-    magnitude (within :data:`LATTICE` of it, a depth camera's whole millimetres), the deviation read off the
-    quantisation's cells (:func:`grouped_deviation`, the 0 cell, which holds a coarser camera's repeated pixels, given
-    the mean of its two neighbours' counts), less the rounding's share (:data:`ROUNDING`); else, or with an infinite
-    difference, :func:`deviation_median`'s. :func:`symfruit.core.surface._quantised_deviation`'s steps: the same value
-    (stop 61)."""
-    n = x.shape[0]
-    q = np.inf
-    for i in range(n):
-        if not np.isfinite(x[i]):
-            return deviation_median(x)
-        e = abs(x[i])
-        if e < q:
-            q = e
-    if not q > 0.0:
-        return deviation_median(x)
-    k = np.empty(n)
-    for i in range(n):
-        r = x[i] / q
-        k[i] = math.floor(r + 0.5)
-        if abs(r - k[i]) > LATTICE:
-            return deviation_median(x)
-    k.sort()
-    ks = np.empty(n + 1)
-    cs = np.empty(n + 1)
-    m = 0
-    zero = -1
-    ones = 0.0
-    i = 0
-    while i < n:
-        j = i
-        while j < n and k[j] == k[i]:
-            j += 1
-        if zero < 0 and k[i] > 0.0:
-            zero = m
-            m += 1
-        ks[m] = k[i]
-        cs[m] = j - i
-        if k[i] == 1.0 or k[i] == -1.0:
-            ones += j - i
-        m += 1
-        i = j
-    if zero < 0:
-        zero = m
-        m += 1
-    ks[zero] = 0.0
-    cs[zero] = 0.5 * ones
-    g = grouped_deviation(ks[:m], cs[:m])
-    square = g * g - ROUNDING
-    return q * math.sqrt(square) if square > 0.0 else 0.0
 
 
 @_njit
@@ -9725,8 +9601,6 @@ def _noise_step(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float, float]
     for i in range(n):
         if np.isnan(x[i]):
             return n, np.nan, step
-    if moved >= 20:
-        return n, quantised_deviation(x), step
     return n, deviation_median(x), step
 
 

@@ -105,98 +105,11 @@ def depth_noise(depth: np.ndarray, mask: np.ndarray, *, floor: float = _NOISE_FL
     diff = _neighbour_differences(depth, mask)
     moved = diff[diff != 0]
     if len(moved) >= 20:
-        return max(floor, 1.4826 * _quantised_deviation(moved) / np.sqrt(2.0))
+        diff = moved
     if len(diff) < 10:
         return max(floor, 0.002)
     mad = float(median(np.abs(diff - median(diff))))
     return max(floor, 1.4826 * mad / np.sqrt(2.0))
-
-
-#: :func:`_quantised_deviation`'s test that differences are whole steps (in steps), and the share of the deviation's
-#: square the rounding adds, in steps squared: the two neighbours' rounding (a triangle, variance 1/6) and the spread
-#: over the cells (1/12), over ``1.4826 ** 2`` (the deviation of a normal spread of variance 1/4)
-_LATTICE = 0.01
-_ROUNDING = 0.25 / (1.4826 * 1.4826)
-
-
-def _quantised_deviation(moved: np.ndarray) -> float:
-    """:func:`depth_noise`'s deviation (metres) of the non-zero neighbour differences ``moved`` (n,), read off the
-    depth's quantisation where it has one (stop 61, docs/noise61.md).
-
-    A depth camera stores whole millimetres, so the differences are whole steps and their median absolute deviation
-    jumps by half or a whole step when a few pixels enter the mask (1, 1.5 or 2 mm on one apple a pixel of
-    registration apart). Where every difference is a whole number of the least one's magnitude, each count is spread
-    evenly over its cell (grouped data: the median and the deviation read off the piecewise linear distribution move
-    by a share of a cell per difference); the 0 cell, left out because it holds a coarser camera's repeated pixels
-    as well as equal neighbours, is given the mean of its two neighbours' counts; and the rounding's share of the
-    spread is taken off (Sheppard: each neighbour's rounding and the spread over the cells, a quarter step squared
-    in a normal spread's variance). On continuous depth (or with an infinite difference): the plain median absolute
-    deviation, as before. The compiled twin: :func:`symfruit.core._jit.quantised_deviation`.
-    """
-    x = np.asarray(moved, dtype=np.float64)
-    if not np.isfinite(x).all() or not len(x):
-        return float(median(np.abs(x - median(x))))
-    q = float(np.min(np.abs(x)))
-    r = x / q
-    k = np.floor(r + 0.5)
-    if not np.abs(r - k).max() <= _LATTICE:
-        return float(median(np.abs(x - median(x))))
-    ks, counts = np.unique(k, return_counts=True)
-    ones = float(counts[(ks == 1.0) | (ks == -1.0)].sum())
-    at = int(np.searchsorted(ks, 0.0))
-    ks = np.insert(ks, at, 0.0)
-    cs = np.insert(counts.astype(np.float64), at, 0.5 * ones)
-    g = _grouped_deviation([float(v) for v in ks], [float(v) for v in cs])
-    square = g * g - _ROUNDING
-    return q * float(np.sqrt(square)) if square > 0.0 else 0.0
-
-
-def _grouped_deviation(ks: list[float], cs: list[float]) -> float:
-    """The median absolute deviation about the median, in cells, of counts ``cs`` (one above 0 at least) of whole
-    values ``ks`` (sorted, distinct), each count spread evenly over its cell ``[k - 1/2, k + 1/2]``: the median where
-    the piecewise linear distribution reaches half the count, then out from it both ways at once, the mass within
-    ``t`` growing at the densities met either side, to half the count. The compiled twin:
-    :func:`symfruit.core._jit.grouped_deviation` (the same steps, the same value)."""
-    m = len(ks)
-    total = 0.0
-    for c in cs:
-        total += c
-    half = 0.5 * total
-    acc, j = 0.0, 0
-    while j < m - 1 and not (cs[j] > 0.0 and acc + cs[j] >= half):
-        acc += cs[j]
-        j += 1
-    med = ks[j] - 0.5 + (half - acc) / cs[j]
-    mass = t = 0.0
-    right = left = j
-    inf = float("inf")
-    while True:
-        er, fr, top_r = inf, 0.0, False
-        if right < m:
-            near = ks[right] - 0.5 - med
-            if t < near:
-                er = near
-            else:
-                er, fr, top_r = ks[right] + 0.5 - med, cs[right], True
-        el, fl, top_l = inf, 0.0, False
-        if left >= 0:
-            near = med - (ks[left] + 0.5)
-            if t < near:
-                el = near
-            else:
-                el, fl, top_l = med - (ks[left] - 0.5), cs[left], True
-        nxt = er if er < el else el
-        rate = fr + fl
-        if not nxt < inf:
-            return t
-        if rate > 0.0 and mass + rate * (nxt - t) >= half:
-            return t + (half - mass) / rate
-        mass += rate * (nxt - t)
-        t = nxt
-        if er == nxt and top_r:
-            right += 1
-        if el == nxt and top_l:
-            left -= 1
 
 
 def depth_step(depth: np.ndarray, mask: np.ndarray) -> float:
