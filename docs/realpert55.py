@@ -13,9 +13,9 @@ dilated or cut mask is judged against the sphere, not against itself.
 ``run`` writes ``OUT/frames/NAME/lab-spheres-{0,1}/`` and ``OUT/NAME.json`` (every box); ``summary`` prints one
 Markdown table: per perturbation and method, the not-a-cube mean / worst, the depth side and larger lateral side
 against the reference diameter (mean abs, signed mean), the frames' worst disagreement and the boxes over the
-issue's 6 mm bar (not a cube or depth side; a failed box counts), and the boxes that failed (no box: too few
-points). ``--compact``: one row per perturbation, a column per method, the boxes over the bar (and the mean
-not-a-cube).
+issue's 6 mm bar (not a cube or depth side; a failed box counts), the boxes that failed (no box: too few
+points), and how far the boxes' centres lie from the unperturbed frame's boxes' (mean / worst). ``--compact``: one
+row per perturbation, a column per method, the boxes over the bar (and the mean not-a-cube).
 """
 
 from __future__ import annotations
@@ -230,7 +230,8 @@ def run(out: Path, names: list[str], methods: tuple[str, ...], config: dict | No
 
 def load(out: Path, name: str) -> list[SphereBox]:
     data = json.loads((out / f"{name}.json").read_text())
-    return [SphereBox(**{**r, "size": tuple(r["size"])}) for r in data["rows"]]
+    return [SphereBox(**{**r, "size": tuple(r["size"]), **({"centre": tuple(r["centre"])} if "centre" in r else {})})
+            for r in data["rows"]]  # fmt: skip
 
 
 def compact(out: Path, methods: tuple[str, ...] | None) -> str:
@@ -247,12 +248,31 @@ def compact(out: Path, methods: tuple[str, ...] | None) -> str:
     return "\n".join(lines) + "\n"
 
 
+def centre_offsets(rows: list[SphereBox], unperturbed: dict[tuple[str, int, str], SphereBox]) -> np.ndarray:
+    """How far (mm) each box's centre lies from the same method's box of the same sphere in the unperturbed frame:
+    where the box is, which its sizes do not say (a mask drawn a few pixels off moves the whole box with it; stop
+    61, docs/shift61.md). Boxes without a centre (results written before stop 61) or without an unperturbed box are
+    left out."""
+    found = []
+    for r in rows:
+        ref = unperturbed.get((r.frame, r.sphere, r.method))
+        if ref is not None and not ref.error:
+            found.append(float(np.linalg.norm(np.subtract(r.centre, ref.centre))))
+    off = np.array(found)
+    return off[np.isfinite(off)]
+
+
+def _mean_worst(values: np.ndarray) -> str:
+    return f"{values.mean():.1f} / {values.max():.1f}" if len(values) else "-"
+
+
 def summary(out: Path, methods: tuple[str, ...] | None) -> str:
-    reference = {(r.frame, r.sphere, r.method): r.diameter for r in load(out, "none")}
+    unperturbed = {(r.frame, r.sphere, r.method): r for r in load(out, "none")}
+    reference = {key: r.diameter for key, r in unperturbed.items()}
     lines = ["| perturbation | method | not a cube (mm), mean / worst | depth - diameter (mm), mean abs (mean) "
              "| lateral - diameter (mm), mean abs (mean) | frames differ (mm), worst | failed | over 6 mm "
-             "| worst box |",
-             "|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
+             "| worst box | centre off the unperturbed box's (mm), mean / worst |",
+             "|---|---|---|---|---|---|---|---|---|---|"]  # fmt: skip
     for path in sorted(
         out.glob("*.json"), key=lambda p: list(PERTURBATIONS).index(p.stem) if p.stem in PERTURBATIONS else 99
     ):
@@ -261,7 +281,7 @@ def summary(out: Path, methods: tuple[str, ...] | None) -> str:
             mine = [r for r in rows if r.method == m]
             ok = [r for r in mine if not r.error]
             if not ok:
-                lines.append(f"| {path.stem} | `{m}` | - | - | - | - | {len(mine)} | {len(mine)} / {len(mine)} | |")
+                lines.append(f"| {path.stem} | `{m}` | - | - | - | - | {len(mine)} | {len(mine)} / {len(mine)} | | - |")
                 continue
             cube = np.array([r.cube_mm for r in ok])
             depth = np.array([r.depth_mm for r in ok])
@@ -270,12 +290,13 @@ def summary(out: Path, methods: tuple[str, ...] | None) -> str:
                       for k in {r.sphere for r in ok} if sum(r.sphere == k for r in ok) > 1]  # fmt: skip
             over = sum(r.cube_mm > BAR_MM or abs(r.depth_mm) > BAR_MM for r in ok) + len(mine) - len(ok)
             worst = max(ok, key=lambda r: max(r.cube_mm, abs(r.depth_mm)))
+            off = centre_offsets(ok, unperturbed)
             lines.append(f"| {path.stem} | `{m}` | {cube.mean():.1f} / {cube.max():.1f} "
                          f"| {np.abs(depth).mean():.1f} ({depth.mean():+.1f}) "
                          f"| {np.abs(lateral).mean():.1f} ({lateral.mean():+.1f}) "
                          f"| {max(differ) if differ else float('nan'):.1f} | {len(mine) - len(ok)} "
                          f"| {over} / {len(mine)} | s{worst.sphere} {'x'.join(f'{v:.0f}' for v in worst.size)} "
-                         f"(d {worst.diameter:.0f}) |")  # fmt: skip
+                         f"(d {worst.diameter:.0f}) | {_mean_worst(off)} |")  # fmt: skip
     return "\n".join(lines) + "\n"
 
 

@@ -340,3 +340,19 @@ def test_binned_2x_the_limb_is_kept_after_the_registration_and_moves_no_shift(rp
     assert pooled.registration == kept.registration
     for a, b in zip(kept.detections, pooled.detections, strict=True):
         assert np.array_equal(a.mask, b.mask) and np.allclose(a.result.box.min, b.result.box.min, atol=1e-9)
+
+
+def test_the_centre_offsets_are_distances_to_the_same_methods_unperturbed_box(rp):
+    """Stop 61: how far a box sits from where the unperturbed frame put the same sphere's box (the sizes alone did
+    not show a mask drawn 5 px off moving its box with it); boxes without a centre or a reference are left out."""
+    from symfruit.evaluate.spheres import SphereBox
+
+    none = {("f", 1, "evidence"): SphereBox("f", 1, "evidence", (60.0,) * 3, 60.0, centre=(0.0, 0.0, 1000.0)),
+            ("f", 2, "evidence"): SphereBox("f", 2, "evidence", (np.nan,) * 3, np.nan, "failed")}  # fmt: skip
+    rows = [SphereBox("f", 1, "evidence", (60.0,) * 3, 60.0, centre=(3.0, 4.0, 1000.0)),  # 5 mm off
+            SphereBox("f", 1, "evidence", (60.0,) * 3, 60.0, centre=(0.0, 0.0, 988.0)),  # 12 mm nearer
+            SphereBox("f", 1, "evidence", (60.0,) * 3, 60.0),  # no centre recorded
+            SphereBox("f", 2, "evidence", (60.0,) * 3, 60.0, centre=(0.0, 0.0, 1.0)),  # its reference failed
+            SphereBox("g", 1, "evidence", (60.0,) * 3, 60.0, centre=(0.0, 0.0, 1.0))]  # no reference  # fmt: skip
+    assert rp.centre_offsets(rows, none).tolist() == pytest.approx([5.0, 12.0])
+    assert rp._mean_worst(rp.centre_offsets(rows, none)) == "8.5 / 12.0" and rp._mean_worst(np.array([])) == "-"

@@ -182,3 +182,30 @@ def test_frames_whose_masks_hold_no_sphere_are_said_so_and_the_table_has_no_empt
     )
     table, _ = spheres_table([], ("raw",))
     assert [line.count("|") for line in table.splitlines()] == [6, 6, 6]
+
+
+def test_each_box_records_its_centre_behind_its_masks_pixels(boxes):
+    """Stop 61: a sphere box carries its centre (mm, camera frame): it projects into the sphere's mask and lies
+    behind the mask's depth by about the box's half depth (the sphere's centre, not its front)."""
+    from symfruit.io.frames import read_frame
+
+    for name in ("lab-spheres-0", "lab-spheres-1"):
+        frame = read_frame(FRAMES / name)
+        for b in (b for b in boxes if b.frame == name and b.method == "evidence"):
+            x, y, z = (v / 1000.0 for v in b.centre)
+            u = round(frame.camera.fx * x / z + frame.camera.cx)
+            v = round(frame.camera.fy * y / z + frame.camera.cy)
+            assert frame.masks[v, u] == b.sphere, b
+            seen = frame.depth[(frame.masks == b.sphere) & (frame.depth > 0)]
+            assert 0.25 * b.size[2] < 1000.0 * (z - float(np.min(seen))) < 0.75 * b.size[2], b
+
+
+def test_a_failed_boxs_centre_is_null_in_the_summary():
+    rows = [SphereBox("f1", 1, "raw", (40.0, 40.0, 30.0), 38.0, centre=(1.0, 2.0, 900.0)),
+            SphereBox("f1", 2, "raw", (np.nan,) * 3, np.nan, "failed"),
+            SphereBox("f1", 3, "raw", (40.0, 40.0, 30.0), 38.0)]  # fmt: skip
+    _, summary = spheres_table(rows, ["raw"])
+    records = summary[0]["boxes"]
+    assert records[0]["centre"] == [1.0, 2.0, 900.0] and records[1]["centre"] is None
+    assert records[2]["centre"] is None  # none recorded
+    json.dumps(summary, allow_nan=False)

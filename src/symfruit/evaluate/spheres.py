@@ -33,7 +33,7 @@ _SEGMENTERS = ("maskrcnn:", "onnx:")
 
 @dataclass(frozen=True)
 class SphereBox:
-    """One sphere of one frame under one method; sizes in millimetres."""
+    """One sphere of one frame under one method; sizes and the box's centre (camera frame) in millimetres."""
 
     frame: str
     sphere: int
@@ -41,6 +41,7 @@ class SphereBox:
     size: tuple[float, float, float]
     diameter: float
     error: str = ""
+    centre: tuple[float, float, float] = (float("nan"),) * 3
 
     @property
     def cube_mm(self) -> float:
@@ -111,7 +112,9 @@ def evaluate_spheres(
                     focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
                     diameter = 2.0 * np.sqrt(area / np.pi) * float(box.centre[2]) / focal
                     size = tuple(float(v) * 1000.0 for v in box.size)
-                    out.append(SphereBox(name, d.id, method, size, diameter * 1000.0))  # type: ignore[arg-type]
+                    centre = tuple(float(v) * 1000.0 for v in box.centre)
+                    out.append(SphereBox(name, d.id, method, size, diameter * 1000.0,  # type: ignore[arg-type]
+                                         centre=centre))  # type: ignore[arg-type]  # fmt: skip
     finally:
         src.close()
     return out
@@ -163,8 +166,9 @@ def spheres_table(rows: Sequence[SphereBox], methods: Sequence[str]) -> tuple[st
 
 
 def _box_record(r: SphereBox) -> dict[str, Any]:
-    """One sphere box for summary.json: a failed one has no size and no diameter (null, never NaN, which is
-    not JSON)."""
+    """One sphere box for summary.json: a failed one has no size, no diameter and no centre (null, never NaN,
+    which is not JSON)."""
     if r.error:
-        return {**r.__dict__, "size": None, "diameter": None}
-    return {**r.__dict__, "size": list(r.size)}
+        return {**r.__dict__, "size": None, "diameter": None, "centre": None}
+    centre = list(r.centre) if np.isfinite(r.centre).all() else None
+    return {**r.__dict__, "size": list(r.size), "centre": centre}
