@@ -1,0 +1,124 @@
+"""Replays for stop 61's speedb61 (issue 19): the outline's edge labels and the occlusion box's opening.
+
+    python docs/speedb61.py record CALLS.pkl        outline_bands' and allowed_box's calls on the benchmark frame
+    python docs/speedb61.py time CALLS.pkl [PASSES]  the frame's calls replayed under this PYTHONPATH's tree
+    python docs/speedb61.py parts CALLS.pkl [PASSES] old and new pieces alternated in one process (this tree)
+
+``record`` and ``time`` are docs/speeds60.py's (one ``detect`` of ``symfruit bench --frame``'s frame, evidence;
+thread CPU time of each pass summed over the frame's calls, fresh copies of the arguments made outside the timer),
+for ``symfruit.core._jit:outline_bands`` and ``symfruit.core._jit:allowed_box``. Time under each tree's
+``PYTHONPATH``, alternated. ``parts`` needs stop 61's kernels: from the recorded calls it makes the edge points'
+look-ups (each call's outside band pixels, and its cracks where it took them) and the hidden boxes' openings, then
+times, alternated pass by pass, ``nearest_labels`` against ``nearest_labels_rows`` and ``_square_extreme`` twice (the
+erosion, then the dilation) against ``open_square``, checking that each pair gives the same answer.
+"""
+
+import argparse
+import importlib.util
+import pickle
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+NAMES = ["symfruit.core._jit:outline_bands", "symfruit.core._jit:allowed_box"]
+
+
+def _speeds60() -> Any:
+    spec = importlib.util.spec_from_file_location("speeds60", Path(__file__).with_name("speeds60.py"))
+    assert spec is not None and spec.loader is not None
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+def _pieces(path: str) -> tuple[list[tuple], list[tuple]]:
+    from symfruit.core import _jit
+
+    with open(path, "rb") as f:
+        calls = pickle.load(f)
+    looks = []
+    for args, _ in calls[NAMES[0]]:
+        edge, labels, made, took, _, _ = _jit.outline_bands(*args)
+        if labels.shape[0] and made[1].shape[0]:
+            looks.append((edge, labels, made[1]))
+        if took:
+            looks.append((edge, labels, args[4]))
+    opens = []
+    for args, _ in calls[NAMES[1]]:
+        hidden, thin = args[0], args[5]
+        h0, h1, g0, g1 = _jit._box(hidden)
+        if thin > 0 and h1 > h0:
+            opens.append((np.ascontiguousarray(hidden[h0:h1, g0:g1]), thin))
+    return looks, opens
+
+
+def _old_open(part: np.ndarray, thin: int) -> np.ndarray:
+    from symfruit.core import _jit
+
+    eroded, out = np.empty(part.shape, bool), np.empty(part.shape, bool)
+    _jit._square_extreme(part, thin, True, eroded)
+    _jit._square_extreme(eroded, thin, False, out)
+    return out
+
+
+def _new_open(part: np.ndarray, thin: int) -> np.ndarray:
+    from symfruit.core import _jit
+
+    out = np.empty(part.shape, bool)
+    _jit.open_square(part, thin, out)
+    return out
+
+
+def parts(path: str, passes: int) -> None:
+    from symfruit.core import _jit
+
+    looks, opens = _pieces(path)
+    for edge, labels, queries in looks:  # the same answers (where sure; the same unsure)
+        f0, u0 = _jit.nearest_labels(edge, labels, queries)
+        f1, u1 = _jit.nearest_labels_rows(edge, labels, queries)
+        assert np.array_equal(u0, u1) and np.array_equal(f0[~u0], f1[~u1])
+    for part, thin in opens:
+        assert np.array_equal(_old_open(part, thin), _new_open(part, thin))
+    pairs = {
+        "nearest_labels": ([(_jit.nearest_labels, c) for c in looks], [(_jit.nearest_labels_rows, c) for c in looks]),
+        "opening": ([(_old_open, c) for c in opens], [(_new_open, c) for c in opens]),
+    }
+    for name, (old, new) in pairs.items():
+        spent: dict[str, list[float]] = {"old": [], "new": []}
+        for _ in range(passes):
+            for which, found in (("old", old), ("new", new)):
+                total = 0
+                for fn, args in found:
+                    start = time.thread_time_ns()
+                    fn(*args)
+                    total += time.thread_time_ns() - start
+                spent[which].append(total / 1e3)
+        o, n = np.array(spent["old"]), np.array(spent["new"])
+        sys.stdout.write(f"{name:16s} {len(old):3d} calls  old median {np.median(o):.1f} least {o.min():.1f}  "
+                         f"new median {np.median(n):.1f} least {n.min():.1f} us a frame\n")  # fmt: skip
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="what", required=True)
+    rec = sub.add_parser("record", help="record outline_bands' and allowed_box's calls on the benchmark frame")
+    rec.add_argument("calls", help="the pickle to write")
+    for what, text in (("time", "replay the recorded calls under this PYTHONPATH's tree"),
+                       ("parts", "old and new pieces, alternated, in this tree")):  # fmt: skip
+        rep = sub.add_parser(what, help=text)
+        rep.add_argument("calls", help="the pickle record wrote")
+        rep.add_argument("passes", nargs="?", type=int, default=200, help="passes over the frame's calls (200)")
+    args = parser.parse_args(argv)
+    if args.what == "record":
+        _speeds60().record(args.calls, NAMES)
+    elif args.what == "time":
+        _speeds60().replay(args.calls, args.passes)
+    else:
+        parts(args.calls, args.passes)
+
+
+if __name__ == "__main__":
+    main()
