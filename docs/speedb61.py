@@ -9,8 +9,11 @@ thread CPU time of each pass summed over the frame's calls, fresh copies of the 
 for ``symfruit.core._jit:outline_bands`` and ``symfruit.core._jit:allowed_box``. Time under each tree's
 ``PYTHONPATH``, alternated. ``parts`` needs stop 61's kernels: from the recorded calls it makes the edge points'
 look-ups (each call's outside band pixels, and its cracks where it took them) and the hidden boxes' openings, then
-times, alternated pass by pass, ``nearest_labels`` against ``nearest_labels_rows`` and ``_square_extreme`` twice (the
-erosion, then the dilation) against ``open_square``, checking that each pair gives the same answer.
+times, alternated pass by pass, ``nearest_labels`` against ``nearest_labels_rows``, ``_square_extreme`` twice (the
+erosion, then the dilation) against ``open_square``, and the gap's two ``_square_extreme`` dilations (without their
+AND: a lower bound of the old cost) against ``near_both``, checking that each pair gives the same answer. Each
+figure includes the calls' dispatch from Python (about 1-2 us a call), which the kernels do not pay inside
+``outline_bands`` and ``allowed_box``.
 """
 
 import argparse
@@ -46,13 +49,25 @@ def _pieces(path: str) -> tuple[list[tuple], list[tuple]]:
             looks.append((edge, labels, made[1]))
         if took:
             looks.append((edge, labels, args[4]))
-    opens = []
+    opens, gaps = [], []
     for args, _ in calls[NAMES[1]]:
-        hidden, thin = args[0], args[5]
+        hidden, region, dr, dc, gap, thin = args
         h0, h1, g0, g1 = _jit._box(hidden)
         if thin > 0 and h1 > h0:
             opens.append((np.ascontiguousarray(hidden[h0:h1, g0:g1]), thin))
-    return looks, opens
+        # allowed_box's seen pixels, and the hidden ones opened: _joins' inputs to the gap's filters
+        h, w = hidden.shape
+        seen = np.zeros((h, w), bool)
+        rh, rw = region.shape
+        a0, a1, b0, b1 = max(dr, 0), min(dr + rh, h), max(dc, 0), min(dc + rw, w)
+        seen[a0:a1, b0:b1] = region[a0 - dr : a1 - dr, b0 - dc : b1 - dc]
+        s0, s1, t0, t1 = _jit._box(seen)
+        if gap > 0 and s1 > s0:
+            join = _jit._joins(hidden, seen, s0, s1, t0, t1, 0, thin)
+            e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
+            f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
+            gaps.append((np.ascontiguousarray(seen[e0:e1, f0:f1]), np.ascontiguousarray(join[e0:e1, f0:f1]), gap))
+    return looks, opens, gaps
 
 
 def _old_open(part: np.ndarray, thin: int) -> np.ndarray:
@@ -72,19 +87,47 @@ def _new_open(part: np.ndarray, thin: int) -> np.ndarray:
     return out
 
 
+def _old_filters(seen: np.ndarray, join: np.ndarray, gap: int) -> tuple[np.ndarray, np.ndarray]:
+    """The two filters ``_joins`` ran before (timed without its AND and OR, which ran in the kernel: the old side's
+    figure is a lower bound)."""
+    from symfruit.core import _jit
+
+    out = join.copy()  # (the copy on both sides: near_both writes in place)
+    grown, near = np.empty(seen.shape, bool), np.empty(seen.shape, bool)
+    _jit._square_extreme(seen, gap, False, grown)
+    _jit._square_extreme(out, gap, False, near)
+    return grown, near
+
+
+def _old_gap(seen: np.ndarray, join: np.ndarray, gap: int) -> np.ndarray:
+    grown, near = _old_filters(seen, join, gap)
+    return join | (grown & near)
+
+
+def _new_gap(seen: np.ndarray, join: np.ndarray, gap: int) -> np.ndarray:
+    from symfruit.core import _jit
+
+    out = join.copy()
+    _jit.near_both(seen, out, gap)
+    return out
+
+
 def parts(path: str, passes: int) -> None:
     from symfruit.core import _jit
 
-    looks, opens = _pieces(path)
+    looks, opens, gaps = _pieces(path)
     for edge, labels, queries in looks:  # the same answers (where sure; the same unsure)
         f0, u0 = _jit.nearest_labels(edge, labels, queries)
         f1, u1 = _jit.nearest_labels_rows(edge, labels, queries)
         assert np.array_equal(u0, u1) and np.array_equal(f0[~u0], f1[~u1])
     for part, thin in opens:
         assert np.array_equal(_old_open(part, thin), _new_open(part, thin))
+    for seen, join, gap in gaps:
+        assert np.array_equal(_old_gap(seen, join, gap), _new_gap(seen, join, gap))
     pairs = {
         "nearest_labels": ([(_jit.nearest_labels, c) for c in looks], [(_jit.nearest_labels_rows, c) for c in looks]),
         "opening": ([(_old_open, c) for c in opens], [(_new_open, c) for c in opens]),
+        "gap filters": ([(_old_filters, c) for c in gaps], [(_new_gap, c) for c in gaps]),
     }
     for name, (old, new) in pairs.items():
         spent: dict[str, list[float]] = {"old": [], "new": []}

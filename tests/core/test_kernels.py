@@ -8222,3 +8222,28 @@ def test_the_one_sweep_opening_known_answers():
     want = mask.copy()
     want[5, 4] = False
     np.testing.assert_array_equal(out, want)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_the_gap_join_in_one_sweep_is_the_filters(seed, radius):
+    """near_both (``join |= grown(seen) & grown(join)`` in one sweep down the rows, in place) against scipy's maximum
+    filters (the numpy twin's, Occlusion.allowed) and _square_extreme's: the same pixels, the dilation of ``join`` as
+    it was on entry, nothing written outside the view; sparse and dense pixels, images smaller than the square."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    seen = rng.random((h, w)) < rng.choice([0.0, 0.02, rng.uniform(0.0, 1.0)])
+    join = rng.random((h, w)) < rng.choice([0.0, 0.02, rng.uniform(0.0, 1.0)])
+    size = 2 * radius + 1
+    grown = ndimage.maximum_filter(seen, size=size, mode="constant", cval=False)
+    want = join | (grown & ndimage.maximum_filter(join, size=size, mode="constant", cval=False))
+    filtered = np.empty((h, w), bool)
+    _jit._square_extreme(join, radius, False, filtered)
+    assert np.array_equal(want, join | (grown & filtered))
+    big = np.zeros((h + 4, w + 2), bool)
+    big[2 : h + 2, 1 : w + 1] = join
+    _jit.near_both(seen, big[2 : h + 2, 1 : w + 1], radius)
+    np.testing.assert_array_equal(big[2 : h + 2, 1 : w + 1], want)
+    assert not big[:2].any() and not big[h + 2 :].any() and not big[:, 0].any() and not big[:, w + 1 :].any()
