@@ -13,7 +13,8 @@ times, alternated pass by pass, ``nearest_labels`` against ``nearest_labels_rows
 erosion, then the dilation) against ``open_square``, and the gap's two ``_square_extreme`` dilations (without their
 AND: a lower bound of the old cost) against ``near_both``, checking that each pair gives the same answer. Each
 figure includes the calls' dispatch from Python (about 1-2 us a call), which the kernels do not pay inside
-``outline_bands`` and ``allowed_box``.
+``outline_bands`` and ``allowed_box``. The labels' look-ups are timed whole, then split: the outside band pixels',
+the cracks', and the same calls with no queries (the set-up and the dispatch alone).
 """
 
 import argparse
@@ -37,18 +38,19 @@ def _speeds60() -> Any:
     return module
 
 
-def _pieces(path: str) -> tuple[list[tuple], list[tuple]]:
+def _pieces(path: str) -> tuple[list[tuple], list[tuple], list[tuple], list[tuple], list[tuple]]:
     from symfruit.core import _jit
 
     with open(path, "rb") as f:
         calls = pickle.load(f)
-    looks = []
+    looks, bands, cracks = [], [], []
     for args, _ in calls[NAMES[0]]:
         edge, labels, made, took, _, _ = _jit.outline_bands(*args)
         if labels.shape[0] and made[1].shape[0]:
-            looks.append((edge, labels, made[1]))
+            bands.append((edge, labels, made[1]))
         if took:
-            looks.append((edge, labels, args[4]))
+            cracks.append((edge, labels, args[4]))
+    looks = bands + cracks
     opens, gaps = [], []
     for args, _ in calls[NAMES[1]]:
         hidden, region, dr, dc, gap, thin = args
@@ -67,7 +69,7 @@ def _pieces(path: str) -> tuple[list[tuple], list[tuple]]:
             e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
             f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
             gaps.append((np.ascontiguousarray(seen[e0:e1, f0:f1]), np.ascontiguousarray(join[e0:e1, f0:f1]), gap))
-    return looks, opens, gaps
+    return looks, opens, gaps, bands, cracks
 
 
 def _old_open(part: np.ndarray, thin: int) -> np.ndarray:
@@ -115,7 +117,8 @@ def _new_gap(seen: np.ndarray, join: np.ndarray, gap: int) -> np.ndarray:
 def parts(path: str, passes: int) -> None:
     from symfruit.core import _jit
 
-    looks, opens, gaps = _pieces(path)
+    looks, opens, gaps, bands, cracks = _pieces(path)
+    none = [(edge, labels, queries[:0]) for edge, labels, queries in looks]  # the set-up and dispatch alone
     for edge, labels, queries in looks:  # the same answers (where sure; the same unsure)
         f0, u0 = _jit.nearest_labels(edge, labels, queries)
         f1, u1 = _jit.nearest_labels_rows(edge, labels, queries)
@@ -126,6 +129,9 @@ def parts(path: str, passes: int) -> None:
         assert np.array_equal(_old_gap(seen, join, gap), _new_gap(seen, join, gap))
     pairs = {
         "nearest_labels": ([(_jit.nearest_labels, c) for c in looks], [(_jit.nearest_labels_rows, c) for c in looks]),
+        " of it bands": ([(_jit.nearest_labels, c) for c in bands], [(_jit.nearest_labels_rows, c) for c in bands]),
+        " of it cracks": ([(_jit.nearest_labels, c) for c in cracks], [(_jit.nearest_labels_rows, c) for c in cracks]),
+        " no queries": ([(_jit.nearest_labels, c) for c in none], [(_jit.nearest_labels_rows, c) for c in none]),
         "opening": ([(_old_open, c) for c in opens], [(_new_open, c) for c in opens]),
         "gap filters": ([(_old_filters, c) for c in gaps], [(_new_gap, c) for c in gaps]),
     }

@@ -8156,13 +8156,17 @@ def test_the_row_ordered_nearest_labels_are_the_sweeps(seed, kind):
 def test_the_row_ordered_nearest_labels_known_answers():
     """Edge points (0, 0) true and (4, 0) false, (2, 3) true: a query at (2, 0) is equally near both ends of the first
     row (unsure), one at (1, 0) is the true end's, one at (3, 1) the false end's, one at (2, 2) the lone third row's
-    (1 away, the ends sqrt(5)), one far below the last row's; none left out when a row holds one point."""
+    (1 away, the ends sqrt(5)), one far below the last row's; none left out when a row holds one point. A query with
+    a NaN coordinate is no point's (false, sure), as nearest_labels has it."""
     edge = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 3.0]])
     labels = np.array([True, False, True])
-    queries = np.array([[2.0, 0.0], [1.0, 0.0], [3.0, 1.0], [2.0, 2.0], [2.0, 40.0], [-9.0, -9.0]])
+    queries = np.array([[2.0, 0.0], [1.0, 0.0], [3.0, 1.0], [2.0, 2.0], [2.0, 40.0], [-9.0, -9.0], [np.nan, 0.0],
+                        [1.0, np.nan]])  # fmt: skip
     found, unsure = _jit.nearest_labels_rows(edge, labels, queries)
-    assert unsure.tolist() == [True, False, False, False, False, False]
-    assert found[1:].tolist() == [True, False, True, True, True]
+    assert unsure.tolist() == [True, False, False, False, False, False, False, False]
+    assert found[1:].tolist() == [True, False, True, True, True, False, False]
+    want_found, want_unsure = _jit.nearest_labels(edge, labels, queries)
+    assert np.array_equal(unsure, want_unsure) and np.array_equal(found[1:], want_found[1:])
 
 
 @settings(max_examples=150, deadline=None)

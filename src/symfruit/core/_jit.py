@@ -2538,7 +2538,7 @@ def nearest_labels_rows(points: np.ndarray, labels: np.ndarray, queries: np.ndar
                             best = d
                             label = labels[i]
                             mixed = False
-                        elif labels[i] != label:
+                        elif d == best and labels[i] != label:  # (not so for a NaN distance: no point's)
                             mixed = True
                         i += side
                 gi += direction
