@@ -3831,7 +3831,7 @@ def test_the_row_minimum_kernel_is_scipys_minimum_filter():
 @settings(max_examples=60, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.sampled_from([0, 3, 8]), st.booleans(), st.booleans())
 def test_the_occlusion_in_one_call_gives_the_twins_maps(seed, band, with_others, single):
-    """core.occlusion.occlusion (jit.occlusion_edge_boxed: the maps, the own depths and own_edge in one kernel) against
+    """core.occlusion.occlusion (jit.occlusion_projected: the maps, the own depths and own_edge in one kernel) against
     the numpy twins on a disc fruit whose depth the sensor spread a few pixels past its mask (a fattened edge), a
     leaf in front, another fruit beside, dropouts: the same window, hidden pixels and seen depths, bit for bit."""
     from symfruit.core.camera import Camera
@@ -4400,7 +4400,8 @@ def test_the_thin_fronts_median_partition_is_the_twins(seed):
 def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reach, single, with_others, pad):
     """occlusion_at (whole images read in place, the own depths over the points' box) and occlusion_window (the
     window's images and own depths map) run one pass, _occlusion_pass: the same maps, bit for bit, on the window
-    occlusion_at picks; and occlusion_edge_boxed without a band is occlusion_at."""
+    occlusion_at picks; and occlusion_projected without a band, of points that project to the same pixels (a camera
+    at the image's corner, focal length 300), is occlusion_at."""
     rng = np.random.default_rng(seed)
     big_h, big_w = h + 10, w + 12
     n = int(rng.integers(1, max(2, h * w // 4)))
@@ -4423,7 +4424,10 @@ def test_the_occlusion_at_is_the_occlusion_window_on_its_window(seed, h, w, reac
                           np.ascontiguousarray(others[win]) if with_others else others, 0.005, steps,
                           float(points[:, 2].min()), float(points[:, 2].max()), hid, sn)  # fmt: skip
     assert np.array_equal(hid, hidden) and sn.tobytes() == seen.tobytes()
-    edge = _jit.occlusion_edge_boxed(uv, points, pad, depth, mask, others, 0.005, steps, 0, True, 300.0)
+    # x and y to project at uv (a few ulps off at most: rint takes the same pixel, uv being 0.2 or 0.3 off a whole one)
+    seen_from = np.column_stack((uv * points[:, 2:] / 300.0, points[:, 2]))
+    edge = _jit.occlusion_projected(seen_from, 300.0, 300.0, 0.0, 0.0, pad, depth, mask, others, 0.005, steps, 0,
+                                    True, 300.0)  # fmt: skip
     assert edge[:3] == (found, u0, v0) and np.array_equal(edge[3], hidden) and edge[4].tobytes() == seen.tobytes()
 
 
@@ -5331,8 +5335,8 @@ def test_the_apex_kernels_are_the_twins(seed):
 
 def _fattened_scene(rng, h, w, with_others):
     """A disc fruit whose depth the sensor spread a few pixels past its mask, a leaf in front, another fruit beside,
-    dropouts, on an (h, w) image: ``(uv, points, depth, mask, others)`` as :func:`_jit.occlusion_edge_boxed` takes
-    them."""
+    dropouts, on an (h, w) image: ``(uv, points, depth, mask, others)``, ``points`` projecting at ``uv`` by a camera
+    of focal length 300 at the image's corner."""
     rr, cc = np.mgrid[0:h, 0:w]
     r0, c0, rad = rng.uniform(0, h), rng.uniform(0, w), rng.uniform(2, 12)
     dist = np.hypot(rr - r0, cc - c0)
@@ -5355,35 +5359,9 @@ def _fattened_scene(rng, h, w, with_others):
     return uv, points, depth, mask, others
 
 
-@settings(max_examples=300, deadline=None)
-@given(st.integers(0, 2**31 - 1), st.integers(0, 9), st.booleans(), st.booleans(), st.integers(6, 70),
-       st.integers(6, 90), st.sampled_from([0.005, 0.0, 0.02]), st.integers(0, 3), st.booleans())  # fmt: skip
-def test_the_boxed_own_edge_is_the_own_edge(seed, band, with_others, single, h, w, tolerance, reach, supports):
-    """occlusion_edge_boxed (own_edge's square filters from summed-area tables, the own depths' least from the points'
-    box alone, no window-sized own maps) against occlusion_at's window and seen depths, and against occlusion's
-    numpy twin (own_edge on the window's maps): the same window, hidden pixels and seen depths, bit for bit; fruit at
-    the image's border, fattened edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9."""
-    from symfruit.core.camera import Camera
-    from symfruit.core.occlusion import occlusion
-
-    rng = np.random.default_rng(seed)
-    uv, points, depth, mask, others = _fattened_scene(rng, h, w, with_others)
-    depth = depth.astype(np.float32 if single else np.float64)
-    steps = _steps_within(reach)
-    got = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, others, tolerance, steps, band, supports, 300.0)
-    found, u0, v0, _, seen = _jit.occlusion_at(uv, points, 16, depth, mask, others, tolerance, steps)
-    assert got[:3] == (found, u0, v0) and got[4].tobytes() == seen.tobytes()  # own_edge clears hidden pixels only
-    camera = Camera(fx=300.0, fy=300.0, cx=0.0, cy=0.0, width=w, height=h)
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("SYMFRUIT_KERNELS", "numpy")
-        twin = occlusion(depth, mask, points, camera, others=others if with_others else None, tolerance=tolerance,
-                         reach=reach, band=band, trim_own=False, supports=supports)  # fmt: skip
-    assert (twin.u0, twin.v0) == got[1:3] and twin.hidden.tobytes() == got[3].tobytes()
-
-
 def test_the_boxed_own_edge_known_answers():
     """A disc whose depth runs 3 px past its mask onto background: the ring (hidden without the band) cleared, every
-    pixel of it, and own_edge_boxed returns their count; with the ring 2 cm in front of the fruit (a leaf), it stays;
+    pixel of it, and _own_edge_in_box returns their count; with the ring 2 cm in front of the fruit (a leaf), it stays;
     with a leaf at the fruit's depth running on past the band to the right, the ring stays on its middle row and is
     cleared on the other side (stop 40's rule, ``supports`` off); with ``supports`` (stop 56) too: the leaf lies at
     the fruit's front (this flat fruit's every depth), where a fruit may continue behind it to its whole radius, past
@@ -5393,20 +5371,23 @@ def test_the_boxed_own_edge_known_answers():
     dist = np.hypot(rr - 30, cc - 40)
     mask = dist <= 10
     v, u = np.nonzero(mask)
-    uv = np.column_stack((u.astype(float), v.astype(float)))
     points = np.column_stack((u * 0.4 / 300.0, v * 0.4 / 300.0, np.full(len(u), 0.4)))
     steps, none = _steps_within(3), np.zeros((0, 0), bool)
     ring = (dist > 10) & (dist <= 13)
 
     def both(depth, supports=False):
-        bare = _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 0, supports, 300.0)
-        return bare, _jit.occlusion_edge_boxed(uv, points, 16, depth, mask, none, 0.005, steps, 8, supports, 300.0)
+        bare = _jit.occlusion_projected(points, 300.0, 300.0, 0.0, 0.0, 16, depth, mask, none, 0.005, steps, 0,
+                                        supports, 300.0)  # fmt: skip
+        return bare, _jit.occlusion_projected(points, 300.0, 300.0, 0.0, 0.0, 16, depth, mask, none, 0.005, steps, 8,
+                                              supports, 300.0)  # fmt: skip
 
     bare, (found, u0, v0, hidden, seen) = both(np.where(dist <= 13, 0.4, 1.0))
     assert found and int(bare[3].sum()) == int(ring.sum()) and not hidden.any()
     again = bare[3].copy()
     box_z = np.where(mask[20:41, 30:51], 0.4, np.inf)
-    count = _jit.own_edge_boxed(again, mask, v0, u0, box_z, 20 - v0, 30 - u0, seen, none, 0.005, 8, False, 300.0)
+    f0, f1, e0, e1 = 20 - v0, 41 - v0, 30 - u0, 51 - u0  # the disc's box in the window
+    count = _jit._own_edge_in_box(again, mask, v0, u0, box_z, 20 - v0, 30 - u0, seen, none, 0.005, 8, False, 300.0,
+                                  f0, f1, e0, e1)  # fmt: skip
     assert count == int(ring.sum()) and not again.any()
     bare, front = both(np.where(dist <= 10, 0.4, np.where(dist <= 13, 0.38, 1.0)))
     assert int(bare[3].sum()) == int(ring.sum()) and np.array_equal(front[3], bare[3])
@@ -7834,11 +7815,15 @@ def test_rows_box_is_the_box(seed):
 @example(543, 3, False, False, 49, 81, 0.005, 0, True, (310.5, 295.25, 2.5, -1.75))
 def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, single, h, w, tolerance, reach, supports,
                                                   intrinsics):  # fmt: skip
-    """occlusion_projected (the points projected in the kernel, the own edge on the mask's box found once) against
-    occlusion_edge_boxed of Camera.project's coordinates and against occlusion's numpy twin: the same window, hidden
-    pixels and seen depths, bit for bit; fruit at the image's border, fattened edges, leaves at the fruit's depth,
-    other fruit, dropouts, bands 0-9, a camera whose centre is off the image's corner (points that project outside
-    the image) and whose focal lengths differ (the focal length occlusion() hands on is their geometric mean)."""
+    """occlusion_projected (the points projected in the kernel, the own edge on the mask's box found once, its square
+    filters from summed-area tables, the own depths' least from the points' box alone, no window-sized own maps)
+    against occlusion_at of Camera.project's coordinates (the same window and seen depths; the own edge clears hidden
+    pixels only: without a band the same hidden pixels, with one fewer or as many) and against occlusion's numpy twin
+    (own_edge on the window's maps): the same window, hidden pixels and seen depths, bit for bit; fruit at the image's
+    border, fattened edges, leaves at the fruit's depth, other fruit, dropouts, bands 0-9, a camera whose centre is
+    off the image's corner (points that project outside the image) and whose focal lengths differ (the focal length
+    occlusion() hands on is their geometric mean). Until stop 61 the reference was occlusion_edge_boxed (the same
+    kernel on Camera.project's coordinates), removed there: the twin is the reference now."""
     from symfruit.core.camera import Camera
     from symfruit.core.occlusion import occlusion
 
@@ -7851,12 +7836,13 @@ def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, singl
     focal = float(np.sqrt(fx * fy))  # as occlusion() hands it on (the support's reach reads it)
     got = _jit.occlusion_projected(points, fx, fy, cx, cy, 16, depth, mask, others, tolerance, steps, band, supports,
                                    focal)  # fmt: skip
-    want = _jit.occlusion_edge_boxed(camera.project(points), points, 16, depth, mask, others, tolerance, steps, band,
-                                     supports, focal)  # fmt: skip
+    want = _jit.occlusion_at(camera.project(points), points, 16, depth, mask, others, tolerance, steps)
     assert got[:3] == want[:3]
-    assert got[3].tobytes() == want[3].tobytes() and got[4].tobytes() == want[4].tobytes()
     if not want[0]:
         return
+    assert got[4].tobytes() == want[4].tobytes() and not (got[3] & ~want[3]).any()
+    if band == 0:
+        assert got[3].tobytes() == want[3].tobytes()
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
         twin = occlusion(depth, mask, points, camera, others=others if with_others else None, tolerance=tolerance,
@@ -7867,7 +7853,7 @@ def test_the_projected_occlusion_is_the_boxed_one(seed, band, with_others, singl
 
 def test_the_projected_occlusion_known_answers():
     """No point in the image: not found. A disc whose depth runs 3 px past its mask onto background: the ring hidden
-    without the band, cleared with it (every pixel), as occlusion_edge_boxed; a leaf 2 cm in front across the disc's
+    without the band, cleared with it (every pixel); a leaf 2 cm in front across the disc's
     row 30 stays hidden, and the pixels without depth beside it take the leaf's depth (the first offset with depth).
     The sweep's mask box and the hidden flag: a window with nothing hidden leaves the own edge out."""
     h, w = 60, 80
@@ -8138,3 +8124,153 @@ def test_add4_is_four_scalar_additions(values, at):
             want[at, i] = np.float64(want[at, i]) + np.float64(values[4 + i])
     run(arr, at * 4, *values[4:])
     assert arr.tobytes() == want.tobytes()
+
+
+# --- stop 61, speedb61: the outline's edge labels by rows, the occlusion box's opening in one sweep -----------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["grid", "anywhere", "outline"]))
+def test_the_row_ordered_nearest_labels_are_the_sweeps(seed, kind):
+    """nearest_labels_rows (edge points in row order, searched row by row from the query's) against nearest_labels
+    (sorted along x, swept) and the squared distances to every point (numpy): the same unsure queries, exactly where
+    the equally near points carry both labels, and the same labels where sure, which are the labels of
+    ``_first_nearest`` (the numpy twin's rule). Points on whole pixels (many equally near), anywhere (rows of one
+    point) and an outline's pixels (outline_uv) with the cracks' half-integer queries, labels mixed or all alike."""
+    from symfruit.core.agreement import _first_nearest
+
+    rng = np.random.default_rng(seed)
+    if kind == "outline":
+        h, w = (int(x) for x in rng.integers(1, 40, 2))
+        mask = np.zeros((h, w), bool)
+        rr, cc = np.mgrid[0:h, 0:w]
+        for _ in range(int(rng.integers(1, 4))):
+            mask |= np.hypot(rr - rng.uniform(0, h), cc - rng.uniform(0, w)) < rng.uniform(1, 15)
+        mask |= rng.random((h, w)) < rng.uniform(0, 0.1)
+        if not mask.any():
+            mask[0, 0] = True
+        u0, v0 = (int(x) for x in rng.integers(0, 50, 2))
+        edge = _jit.outline_uv(mask, int(rng.integers(1, 200)), u0, v0)
+        queries = np.concatenate((_jit.outline_cracks(mask, u0, v0),
+                                  rng.integers(-6, 46, (int(rng.integers(0, 100)), 2)).astype(np.float64)))  # fmt: skip
+    else:
+        k, m = int(rng.integers(1, 80)), int(rng.integers(0, 200))
+        if kind == "grid":
+            edge = rng.integers(0, 12, (k, 2)).astype(np.float64)
+            queries = rng.integers(-3, 15, (m, 2)) + rng.choice([0.0, 0.5], (m, 2))
+        else:
+            edge = rng.uniform(0, 40, (k, 2))
+            queries = rng.uniform(-5, 45, (m, 2))
+        edge = np.unique(edge[np.lexsort((edge[:, 0], edge[:, 1]))], axis=0)  # distinct points, in row order
+        edge = edge[np.lexsort((edge[:, 0], edge[:, 1]))]
+    labels = rng.random(len(edge)) < rng.choice([0.0, rng.uniform(0.0, 1.0), 1.0])
+    found, unsure = _jit.nearest_labels_rows(edge, labels, queries)
+    want_found, want_unsure = _jit.nearest_labels(edge, labels, queries)
+    assert found.shape == unsure.shape == (len(queries),)
+    np.testing.assert_array_equal(unsure, want_unsure)
+    np.testing.assert_array_equal(found[~unsure], want_found[~unsure])
+    d2 = (queries[:, None, 0] - edge[None, :, 0]) ** 2 + (queries[:, None, 1] - edge[None, :, 1]) ** 2
+    ties = [labels[d2[j] == d2[j].min()] for j in range(len(queries))]
+    np.testing.assert_array_equal(unsure, [t.any() and not t.all() for t in ties])
+    if len(queries):
+        np.testing.assert_array_equal(found[~unsure], _first_nearest(edge, labels, queries)[~unsure])
+
+
+def test_the_row_ordered_nearest_labels_known_answers():
+    """Edge points (0, 0) true and (4, 0) false, (2, 3) true: a query at (2, 0) is equally near both ends of the first
+    row (unsure), one at (1, 0) is the true end's, one at (3, 1) the false end's, one at (2, 2) the lone third row's
+    (1 away, the ends sqrt(5)), one far below the last row's; none left out when a row holds one point. A query with
+    a NaN coordinate is no point's (false, sure), as nearest_labels has it."""
+    edge = np.array([[0.0, 0.0], [4.0, 0.0], [2.0, 3.0]])
+    labels = np.array([True, False, True])
+    queries = np.array([[2.0, 0.0], [1.0, 0.0], [3.0, 1.0], [2.0, 2.0], [2.0, 40.0], [-9.0, -9.0], [np.nan, 0.0],
+                        [1.0, np.nan]])  # fmt: skip
+    found, unsure = _jit.nearest_labels_rows(edge, labels, queries)
+    assert unsure.tolist() == [True, False, False, False, False, False, False, False]
+    assert found[1:].tolist() == [True, False, True, True, True, False, False]
+    want_found, want_unsure = _jit.nearest_labels(edge, labels, queries)
+    assert np.array_equal(unsure, want_unsure) and np.array_equal(found[1:], want_found[1:])
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_the_one_sweep_opening_is_open_square(seed, radius):
+    """open_square (one sweep down the rows: each column's run, the columns side by side whose runs are long enough,
+    each column's last square) against core.occlusion.open_square (scipy's minimum then maximum filter, the numpy
+    twin) and scipy's binary_opening: the same pixels on noise, blobs, full and empty images, thin lines and images
+    narrower or shorter than the square, into a view of a larger array (as _joins writes it)."""
+    from scipy import ndimage
+
+    from symfruit.core.occlusion import open_square
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    kind = seed % 4
+    if kind == 0:
+        mask = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    elif kind == 1:
+        rr, cc = np.mgrid[0:h, 0:w]
+        mask = np.zeros((h, w), bool)
+        for _ in range(int(rng.integers(1, 5))):
+            mask |= np.hypot(rr - rng.uniform(0, h), cc - rng.uniform(0, w)) < rng.uniform(0, 15)
+        mask &= rng.random((h, w)) > rng.uniform(0, 0.05)
+    elif kind == 2:
+        mask = np.full((h, w), bool(rng.random() < 0.7))
+    else:
+        mask = ndimage.binary_dilation(rng.random((h, w)) < 0.02, iterations=int(rng.integers(1, 6)))
+        mask[:, int(rng.integers(0, w))] = True  # a line one pixel wide
+    size = 2 * radius + 1
+    big = np.ones((h + 3, w + 5), bool)
+    out = big[1 : h + 1, 2 : w + 2]
+    _jit.open_square(mask, radius, out)
+    want = open_square(mask, size)
+    np.testing.assert_array_equal(out, want)
+    np.testing.assert_array_equal(out, ndimage.binary_opening(mask, structure=np.ones((size, size), bool)))
+    assert big[0].all() and big[h + 1 :].all() and big[:, :2].all() and big[:, w + 2 :].all()  # the view alone
+
+
+def test_the_one_sweep_opening_known_answers():
+    """A 3x3 square and a 2-wide bar opened by a 3x3 square: the square stays, the bar goes; an L of two 3x3 squares
+    overlapping in a corner pixel keeps both squares whole, and the pixel beside them that lies in no square goes."""
+    mask = np.zeros((8, 10), bool)
+    mask[1:4, 1:4] = True
+    mask[5:7, 0:10] = True
+    out = np.empty_like(mask)
+    _jit.open_square(mask, 1, out)
+    want = np.zeros_like(mask)
+    want[1:4, 1:4] = True
+    np.testing.assert_array_equal(out, want)
+    mask = np.zeros((7, 7), bool)
+    mask[0:3, 0:3] = True
+    mask[2:5, 2:5] = True
+    mask[5, 4] = True
+    out = np.empty_like(mask)
+    _jit.open_square(mask, 1, out)
+    want = mask.copy()
+    want[5, 4] = False
+    np.testing.assert_array_equal(out, want)
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 5))
+def test_the_gap_join_in_one_sweep_is_the_filters(seed, radius):
+    """near_both (``join |= grown(seen) & grown(join)`` in one sweep down the rows, in place) against scipy's maximum
+    filters (the numpy twin's, Occlusion.allowed) and _square_extreme's: the same pixels, the dilation of ``join`` as
+    it was on entry, nothing written outside the view; sparse and dense pixels, images smaller than the square."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 50, 2))
+    seen = rng.random((h, w)) < rng.choice([0.0, 0.02, rng.uniform(0.0, 1.0)])
+    join = rng.random((h, w)) < rng.choice([0.0, 0.02, rng.uniform(0.0, 1.0)])
+    size = 2 * radius + 1
+    grown = ndimage.maximum_filter(seen, size=size, mode="constant", cval=False)
+    want = join | (grown & ndimage.maximum_filter(join, size=size, mode="constant", cval=False))
+    filtered = np.empty((h, w), bool)
+    _jit._square_extreme(join, radius, False, filtered)
+    assert np.array_equal(want, join | (grown & filtered))
+    big = np.zeros((h + 4, w + 2), bool)
+    big[2 : h + 2, 1 : w + 1] = join
+    _jit.near_both(seen, big[2 : h + 2, 1 : w + 1], radius)
+    np.testing.assert_array_equal(big[2 : h + 2, 1 : w + 1], want)
+    assert not big[:2].any() and not big[h + 2 :].any() and not big[:, 0].any() and not big[:, w + 1 :].any()

@@ -688,22 +688,58 @@ def _joins(
     if thin > 0:
         h0, h1, g0, g1 = _box(hidden)
         if h1 > h0:
-            part = hidden[h0:h1, g0:g1]
-            eroded = np.empty(part.shape, np.bool_)
-            _square_extreme(part, thin, True, eroded)
-            _square_extreme(eroded, thin, False, join[h0:h1, g0:g1])
+            open_square(hidden[h0:h1, g0:g1], thin, join[h0:h1, g0:g1])  # one sweep (stop 61, speedb61)
     if gap > 0:
         e0, e1 = max(s0 - 2 * gap, 0), min(s1 + 2 * gap, h)
         f0, f1 = max(t0 - 2 * gap, 0), min(t1 + 2 * gap, w)
-        grown = np.empty((e1 - e0, f1 - f0), np.bool_)
-        _square_extreme(seen[e0:e1, f0:f1], gap, False, grown)
-        near = np.empty((e1 - e0, f1 - f0), np.bool_)
-        _square_extreme(join[e0:e1, f0:f1], gap, False, near)
-        for r in range(e1 - e0):
-            for c in range(f1 - f0):
-                if grown[r, c] and near[r, c]:
-                    join[e0 + r, f0 + c] = True
+        near_both(seen[e0:e1, f0:f1], join[e0:e1, f0:f1], gap)  # one sweep (stop 61, speedb61)
     return join
+
+
+@_njit_inlined
+def _row_grown(row: np.ndarray, radius: int, out: np.ndarray) -> None:
+    """``out`` (w,) bool: ``row`` (w,) bool dilated by ``2 radius + 1`` pixels (beyond the row: false), from the index
+    of the last true pixel, as :func:`_square_extreme`'s row pass."""
+    w = row.shape[0]
+    last = -(2 * radius + 2)
+    for c in range(w + radius):
+        if c < w and row[c]:
+            last = c
+        p = c - radius
+        if p >= 0:
+            out[p] = last >= p - radius
+
+
+@_njit
+def near_both(seen: np.ndarray, join: np.ndarray, radius: int) -> None:
+    """``join |= grown(seen) & grown(join)``, in place, ``grown`` a ``2 radius + 1`` square's dilation (``radius >=
+    1``; beyond the arrays: false), both (h, w) bool, the dilation of ``join`` as it was on entry:
+    :func:`_joins`' pixels within ``gap`` of both a seen and a hidden pixel, :func:`_square_extreme`'s pixels
+    (``scipy.ndimage.maximum_filter``'s). Issue 19, stop 61 (speedb61): one sweep down the rows instead of two
+    filters of two passes each and their AND: row ``r`` of each is dilated along the row, each column keeps the
+    last row whose dilated pixel is true, and row ``p = r - radius`` is then final (a true pixel within ``radius``
+    rows of it lies at row ``r`` or above). A row is written ``radius`` rows after it was read, and no row is read
+    again: the dilation reads ``join`` as it was."""
+    h, w = seen.shape
+    t = radius
+    none = -(2 * t + 2)
+    last_s = np.full(w, none, np.int64)  # each column's last row whose row-dilated seen pixel is true
+    last_j = np.full(w, none, np.int64)
+    row_s = np.empty(w, np.bool_)
+    row_j = np.empty(w, np.bool_)
+    for r in range(h + t):
+        if r < h:
+            _row_grown(seen[r], t, row_s)
+            _row_grown(join[r], t, row_j)
+            for c in range(w):
+                last_s[c] = r if row_s[c] else last_s[c]
+                last_j[c] = r if row_j[c] else last_j[c]
+        p = r - t
+        if p >= 0:
+            o = join[p]
+            low = p - t
+            for c in range(w):
+                o[c] |= (last_s[c] >= low) & (last_j[c] >= low)
 
 
 @_njit
@@ -2443,6 +2479,75 @@ def nearest_labels(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) 
 
 
 @_njit
+def nearest_labels_rows(points: np.ndarray, labels: np.ndarray, queries: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`nearest_labels` of ``points`` (k, 2) given in row order (sorted by y, then by x within a y: as
+    :func:`outline_uv` makes them), without sorting them: ``(found (m,) bool, unsure (m,) bool)``, the same ``unsure``
+    and, where not ``unsure``, the same ``found`` (where ``unsure``, the label of one of the equally near points, which
+    the callers replace). Issue 19, stop 61 (speedb61): the points of each y are searched from the query's x outwards
+    while ``dx * dx + dy * dy`` is at most the nearest yet (farther along the row it cannot fall: rounding is
+    monotone), the rows from the query's y outwards until ``dy * dy`` alone passes it (a farther row's distance is no
+    less), as :func:`nearest_labels` does along x: every point as near as the nearest is met, the same squared
+    distances. An outline's row holds a few points, so a query near it reads a few rows and a few points of each,
+    where the sweep along x read every point of the rows its x crosses."""
+    k = points.shape[0]
+    m = queries.shape[0]
+    xs = np.empty(k)
+    ys = np.empty(k)  # each row's y
+    starts = np.empty(k + 1, np.int64)
+    g = 0
+    for i in range(k):
+        xs[i] = points[i, 0]
+        y = points[i, 1]
+        if g == 0 or y != ys[g - 1]:
+            ys[g] = y
+            starts[g] = i
+            g += 1
+    starts[g] = k
+    row_y = ys[:g]
+    found = np.empty(m, np.bool_)
+    unsure = np.zeros(m, np.bool_)
+    for j in range(m):
+        qx, qy = queries[j, 0], queries[j, 1]
+        best = np.inf
+        label = False
+        mixed = False
+        start = np.searchsorted(row_y, qy)
+        for direction in (1, -1):
+            gi = start if direction == 1 else start - 1
+            while 0 <= gi < g:
+                dy = qy - row_y[gi]
+                dyy = dy * dy
+                if dyy > best:
+                    break
+                a, b = starts[gi], starts[gi + 1]
+                at, hi = a, b  # the first point of the row at or right of qx (np.searchsorted's, without a view)
+                while at < hi:
+                    mid = (at + hi) >> 1
+                    if xs[mid] < qx:
+                        at = mid + 1
+                    else:
+                        hi = mid
+                for side in (1, -1):
+                    i = at if side == 1 else at - 1
+                    while a <= i < b:
+                        dx = qx - xs[i]
+                        d = dx * dx + dyy
+                        if d > best:
+                            break
+                        if d < best:
+                            best = d
+                            label = labels[i]
+                            mixed = False
+                        elif d == best and labels[i] != label:  # (not so for a NaN distance: no point's)
+                            mixed = True
+                        i += side
+                gi += direction
+        found[j] = label
+        unsure[j] = mixed
+    return found, unsure
+
+
+@_njit
 def column_bounds(p: np.ndarray) -> tuple[np.ndarray, np.ndarray, bool]:
     """:func:`symfruit.core.points.bounds` of ``p`` (n, k) float, ``n >= 1``: ``(min (k,), max (k,), sure)``, each
     column's least and greatest value in one pass over the rows (selects, no branches; NaN where the column holds a
@@ -3920,8 +4025,8 @@ def _occlusion_box(
     steps: np.ndarray,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray, np.ndarray, int, int]:  # fmt: skip
     """:func:`occlusion_at`, with the points' own depths over their pixels' box and the box's top-left pixel in the
-    window: ``(found, u0, v0, hidden, seen, own_z, p0, q0)`` (stop 42: the occlusion kernel,
-    :func:`occlusion_edge_boxed` since stop 45, reads them instead of projecting the points again)."""
+    window: ``(found, u0, v0, hidden, seen, own_z, p0, q0)`` (stop 42: the occlusion kernel, ``occlusion_edge_boxed``
+    from stop 45 to stop 60, read them instead of projecting the points again)."""
     height, width = mask.shape
     n = uv.shape[0]
     cmin, cmax, rmin, rmax = width, -1, height, -1
@@ -4153,7 +4258,7 @@ def _support_reach(d: float, front: float, r_px: float, r_m: float) -> float:
 @_njit_inlined
 def _band_walk(cand: np.ndarray, mine: np.ndarray, count: int, band: int, hidden: np.ndarray, b0: int,
                a0: int, reach: np.ndarray) -> int:  # fmt: skip
-    """The band of :func:`own_edge` and :func:`own_edge_boxed` runs on from the fruit's own pixels ``mine`` (m, n):
+    """The band of :func:`own_edge` and :func:`_own_edge_in_box` runs on from the fruit's own pixels ``mine`` (m, n):
     a breadth-first walk through the ``count`` candidates ``cand`` (m, n) beside them, ``band`` steps deep; the
     pixels reached in more steps than their ``reach`` (m, n) are cleared in ``hidden`` at ``(b0, a0)`` and their
     number returned."""
@@ -4987,6 +5092,46 @@ def occlusion_window(
     # stop 42: the pass shared with occlusion_at (the window's maps from the own depths over the point pixels' box)
     return _occlusion_pass(depth, mask, others, 0, 0, own_z[p0:p1, q0:q1], p0, q0, tolerance, steps, low, high,
                            hidden, seen)  # fmt: skip
+
+
+@_njit
+def open_square(src: np.ndarray, radius: int, out: np.ndarray) -> None:
+    """``out`` (h, w) bool: ``src`` (h, w) bool opened by a ``2 radius + 1`` square, outside the array background
+    (:func:`symfruit.core.occlusion.open_square`'s pixels, ``scipy.ndimage.binary_opening``'s): the union of the
+    squares of side ``k = 2 radius + 1`` that lie wholly in ``src`` and in the array. ``out`` may not overlap ``src``.
+
+    Issue 19, stop 61 (speedb61): one sweep down the rows instead of :func:`_square_extreme`'s erosion and dilation
+    (four passes, each along the rows and down the columns). At row ``r`` each column's run of ``src`` pixels ending
+    there is counted; the columns of ``k`` or more side by side whose runs are ``k`` or longer are those of a square
+    whose last row is ``r``, and each column keeps the last such row. A pixel ``k - 1`` rows up, at ``p = r - k +
+    1``, is in a square exactly when its column's last such row is at least ``p``: a square covering it ends
+    between ``p`` and ``p + k - 1 = r``, all rows seen by then. The rows after the last (no square ends there)
+    write the array's last ``k - 1`` rows."""
+    h, w = src.shape
+    k = 2 * radius + 1
+    run = np.zeros(w, np.int32)  # each column's run of src pixels ending at this row
+    last = np.full(w, -k, np.int64)  # each column's last row a square ends on
+    for r in range(h + k - 1):
+        if r < h:
+            row = src[r]
+            tall = 0  # the columns whose runs are k or longer (none: no square ends on this row)
+            for c in range(w):
+                n = min(run[c] + 1, k) if row[c] else 0  # k or more alike: capped
+                run[c] = n
+                tall += n == k
+            side = 0  # columns side by side whose runs are k or longer
+            for c in range(w if tall >= k else 0):
+                side = side + 1 if run[c] == k else 0
+                if side >= k:
+                    last[c] = r
+                    if side == k:  # the square's first k - 1 columns too
+                        for j in range(c - k + 1, c):
+                            last[j] = r
+        p = r - k + 1
+        if p >= 0:
+            o = out[p]
+            for c in range(w):
+                o[c] = last[c] >= p
 
 
 @_njit
@@ -8066,54 +8211,6 @@ def _box_any(table: np.ndarray, r: int, c: int, k: int, m: int, n: int) -> bool:
 
 
 @_njit
-def own_edge_boxed(
-    hidden: np.ndarray,
-    mask: np.ndarray,
-    v0: int,
-    u0: int,
-    box_z: np.ndarray,
-    p0: int,
-    q0: int,
-    seen: np.ndarray,
-    others: np.ndarray,
-    tolerance: float,
-    band: int,
-    supports: bool,
-    focal: float,
-) -> int:  # fmt: skip
-    """:func:`own_edge` on :func:`occlusion_edge_boxed`'s maps, without the window's own depths and own pixels as (h, w)
-    maps (issue 19, stop 45): ``hidden`` (h, w) bool cleared in place (the number of pixels cleared returned), the
-    fruit's own pixels read from ``mask`` (the whole image, the window at ``(v0, u0)``) and ``box_z`` (the points' own
-    depths over their pixels' box, at ``(p0, q0)`` in the window, +inf where none), ``seen`` the window's depths,
-    ``others`` the whole image's or (0, 0). The same pixels as :func:`own_edge`, by fewer passes over the own pixels'
-    box grown by ``2 band + 1``: its three square filters (any pixel within a square) are read from summed-area
-    tables of the own, the free and the past pixels (counts, exact), the last two at the candidates alone; the own
-    depths' least within ``band`` from their row minima over the points' box alone (+inf elsewhere, so the same
-    least); the band's run from the own pixels :func:`own_edge`'s walk."""
-    h, w = hidden.shape
-    if band <= 0:
-        return 0
-    # the mask's box within the window, from the mask's first and last pixel in each row (stop 60: the box the
-    # mask's box :func:`occlusion_projected` finds by :func:`_mask_box_in`, handed to :func:`_own_edge_in_box`)
-    r0, r1, c0, c1 = h, 0, w, 0
-    for r in range(h):
-        row_any = False
-        for c in range(w):
-            if mask[v0 + r, u0 + c]:
-                c0 = min(c0, c)
-                row_any = True
-                break
-        if row_any:
-            for c in range(w - 1, -1, -1):
-                if mask[v0 + r, u0 + c]:
-                    c1 = max(c1, c + 1)
-                    break
-            r0, r1 = min(r0, r), max(r1, r + 1)
-    return _own_edge_in_box(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band, supports, focal, r0,
-                            r1, c0, c1)  # fmt: skip
-
-
-@_njit
 def _own_edge_in_box(
     hidden: np.ndarray,
     mask: np.ndarray,
@@ -8133,8 +8230,18 @@ def _own_edge_in_box(
     e0: int,
     e1: int,
 ) -> int:  # fmt: skip
-    """:func:`own_edge_boxed` with the mask's box within the window given, rows ``f0:f1`` and columns ``e0:e1`` (``f1 <=
-    f0``: no mask pixel in the window): its steps from there on, the same pixels (stop 60)."""
+    """:func:`own_edge` on :func:`occlusion_projected`'s maps, without the window's own depths and own pixels as (h, w)
+    maps (issue 19, stop 45): ``hidden`` (h, w) bool cleared in place (the number of pixels cleared returned), the
+    fruit's own pixels read from ``mask`` (the whole image, the window at ``(v0, u0)``; their box within the window
+    given, rows ``f0:f1`` and columns ``e0:e1``, ``f1 <= f0``: none, stop 60) and ``box_z`` (the points' own depths
+    over their pixels' box, at ``(p0, q0)`` in the window, +inf where none), ``seen`` the window's depths, ``others``
+    the whole image's or (0, 0). The same pixels as :func:`own_edge`, by fewer passes over the own pixels' box grown
+    by ``2 band + 1``: its three square filters (any pixel within a square) are read from summed-area tables of the
+    own, the free and the past pixels (counts, exact), the last two at the candidates alone; the own depths' least
+    within ``band`` from their row minima over the points' box alone (+inf elsewhere, so the same least); the band's
+    run from the own pixels :func:`own_edge`'s walk. Until stop 61 (speedb61) it was the body of ``own_edge_boxed``,
+    which found the mask's box itself, and of ``occlusion_edge_boxed`` (:func:`occlusion_at` then the own edge),
+    which :func:`occlusion_projected` replaced at stop 60."""
     h, w = hidden.shape
     if band <= 0:
         return 0
@@ -8220,41 +8327,6 @@ def _own_edge_in_box(
     if count == 0:
         return 0
     return _band_walk(cand, mine, count, band, hidden, b0, a0, reach)
-
-
-@_njit
-def occlusion_edge_boxed(
-    uv: np.ndarray,
-    points: np.ndarray,
-    pad: int,
-    depth: np.ndarray,
-    mask: np.ndarray,
-    others: np.ndarray,
-    tolerance: float,
-    steps: np.ndarray,
-    band: int,
-    supports: bool,
-    focal: float,
-) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`occlusion_at`, then :func:`own_edge_boxed` on the maps, in one call: ``(found, u0, v0, hidden, seen)``,
-    :func:`symfruit.core.occlusion.occlusion`'s maps bit for bit (issue 19, stop 41: one kernel instead of three calls;
-    stop 45: own_edge's square filters from summed-area tables over the own pixels' box, without the window's own
-    depths and own pixels as (h, w) maps, which the kernel of stops 41-44 built for :func:`own_edge`)."""
-    found, u0, v0, hidden, seen, box_z, p0, q0 = _occlusion_box(uv, points, pad, depth, mask, others, tolerance, steps)
-    if not found or band <= 0:
-        return found, u0, v0, hidden, seen
-    h, w = hidden.shape
-    some = False
-    for r in range(h):
-        for c in range(w):
-            if hidden[r, c]:
-                some = True
-                break
-        if some:
-            break
-    if some:
-        own_edge_boxed(hidden, mask, v0, u0, box_z, p0, q0, seen, others, tolerance, band, supports, focal)
-    return found, u0, v0, hidden, seen
 
 
 @_njit
@@ -9275,6 +9347,20 @@ def observe_bands(
     is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite (b,)
     bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
     called one by one (the sums are of whole numbers, exact in any order)."""
+    return _observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge_uv, labels, occluded,
+                          hidden, depth, h_u0, h_v0, width, height, False)  # fmt: skip
+
+
+@_njit
+def _observe_bands(
+    rays: np.ndarray, inner: np.ndarray, outer: np.ndarray, bands: np.ndarray, n_band: int, u0: int, v0: int,
+    fx: float, fy: float, cx: float, cy: float, edge_uv: np.ndarray, labels: np.ndarray, occluded: bool,
+    hidden: np.ndarray, depth: np.ndarray, h_u0: int, h_v0: int, width: int, height: int, rows: bool,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`observe_bands`; ``rows``: the edge points are in row order (:func:`outline_uv`'s, from
+    :func:`outline_bands`), their labels looked up by :func:`nearest_labels_rows` (stop 61: the same labels where
+    sure, the same ``unsure``)."""
     _, rays_in, in_sizes = band_rays(inner, bands, n_band, u0, v0, fx, fy, cx, cy)
     uv, rays_out, out_sizes = band_rays(outer, bands, n_band, u0, v0, fx, fy, cx, cy)
     n, a, b = rays.shape[0], rays_in.shape[0], rays_out.shape[0]
@@ -9289,7 +9375,7 @@ def observe_bands(
         in_starts[i] = in_starts[i - 1] + in_sizes[i - 1]
         out_starts[i] = out_starts[i - 1] + out_sizes[i - 1]
     if labels.shape[0] and b:
-        found, unsure = nearest_labels(edge_uv, labels, uv)
+        found, unsure = nearest_labels_rows(edge_uv, labels, uv) if rows else nearest_labels(edge_uv, labels, uv)
     else:
         found, unsure = np.ones(b, np.bool_), np.zeros(b, np.bool_)
     if occluded and b:
@@ -9320,7 +9406,7 @@ def outline_bands(
     ``base`` (none: true), ``observe``'s edge labels, bands and the outline cracks' labels in one call. The edge
     points are :func:`outline_uv`'s (``count``) labelled ``base`` where no hidden pixel lies within ``radius``
     (:func:`occluded_at`; ``_occluded_edges``); then :func:`observe_bands` of them; then, where ``share`` is at most
-    the share of true labels and that share is below 1, :func:`nearest_labels` of ``cracks`` (k, 2). Returns ``(uv,
+    the share of true labels and that share is below 1, :func:`nearest_labels_rows` of ``cracks`` (k, 2). Returns ``(uv,
     labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``): the
     pieces' values."""
     edge = outline_uv(mask, count, u0, v0)
@@ -9331,11 +9417,12 @@ def outline_bands(
     for i in range(m):
         labels[i] = base and not occ[i]
         n_true += labels[i]
-    made = observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge, labels, True, hidden,
-                         depth, h_u0, h_v0, width, height)  # fmt: skip
+    # the edge points are outline_uv's, in row order: their labels by rows (nearest_labels_rows; stop 61, speedb61)
+    made = _observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge, labels, True, hidden,
+                          depth, h_u0, h_v0, width, height, True)  # fmt: skip
     took = m > 0 and share <= n_true / m < 1.0
     if took:
-        found, unsure = nearest_labels(edge, labels, cracks)
+        found, unsure = nearest_labels_rows(edge, labels, cracks)
     else:
         found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
     return edge, labels, made, took, found, unsure
@@ -10362,9 +10449,9 @@ def in_pieces(mask: np.ndarray) -> bool:
 @_njit_inlined
 def _mask_box_in(mask: np.ndarray, v0: int, u0: int, h: int, w: int) -> tuple[int, int, int, int]:
     """The box of ``mask``'s pixels within its (h, w) window at ``(v0, u0)``, in the window: ``(r0, r1, c0, c1)``
-    (stops exclusive; ``r1 <= r0``: none), what :func:`own_edge_boxed`'s scan finds, each row's pixels OR-ed (no
-    branch a pixel) and its first and last pixel looked for only where it holds one (also :func:`_rows_box`'s and
-    :func:`mask_mode`'s box, the window the whole image)."""
+    (stops exclusive; ``r1 <= r0``: none), what ``own_edge_boxed``'s scan found (until stop 61), each row's pixels
+    OR-ed (no branch a pixel) and its first and last pixel looked for only where it holds one (also
+    :func:`_rows_box`'s and :func:`mask_mode`'s box, the window the whole image)."""
     r0, r1, c0, c1 = h, 0, w, 0
     for r in range(h):
         some = False
@@ -10399,7 +10486,8 @@ def occlusion_projected(
     supports: bool,
     focal: float,
 ) -> tuple[bool, int, int, np.ndarray, np.ndarray]:  # fmt: skip
-    """:func:`occlusion_edge_boxed` of ``points`` (n, 3) projected by a camera of intrinsics ``fx, fy, cx, cy``
+    """:func:`occlusion_at` then :func:`own_edge` on its maps (until stop 61 ``occlusion_edge_boxed``, of pixel
+    coordinates) of ``points`` (n, 3) projected by a camera of intrinsics ``fx, fy, cx, cy``
     (:meth:`symfruit.core.camera.Camera.project`'s arithmetic, in its order: ``fx x (1 / z) + cx``, the same
     coordinates, each point's pixel worked out once, not twice), the window's maps by :func:`_occlusion_pass` and
     the own edge by :func:`_own_edge_in_box` on the mask's box :func:`_mask_box_in` finds: ``(found, u0, v0, hidden,

@@ -39,7 +39,7 @@ and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlus
 (:func:`symfruit.core._jit.occlusion_at`), :func:`symfruit.core.surface.monotone_region`
 (:func:`symfruit.core._jit.monotone_table`) and :func:`symfruit.extract.cluster` (``_one_slab`` in
 :func:`symfruit.core._jit.clusters`); stop 41's :func:`symfruit.core.occlusion.own_edge`
-(:func:`symfruit.core._jit.own_edge`, in :func:`symfruit.core._jit.occlusion_edge_boxed` with the maps) and
+(:func:`symfruit.core._jit.own_edge`, in :func:`symfruit.core._jit.occlusion_projected` with the maps) and
 :func:`~symfruit.core.surface.monotone_region` (:func:`symfruit.core._jit.monotone_at`); stop 42's
 :func:`symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.smooth_parts`,
 :func:`~symfruit.core._jit.filled_windows`; since stop 45 :func:`~symfruit.core._jit.window_medians`,

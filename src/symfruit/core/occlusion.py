@@ -356,8 +356,9 @@ def occlusion(
     window and the fruit's own depths in the same kernel, the images read in place and the own depths kept over the
     points' pixels' box alone (:func:`symfruit.core._jit.occlusion_at`: the same maps; 1.98 against 3.48 ms for the
     benchmark frame's 9 fruit, least of 40 passes of the recorded calls, on a loaded machine; twentieth round), and
-    with :func:`own_edge` on the maps in the same kernel (:func:`symfruit.core._jit.occlusion_edge_boxed`: the same
-    maps; the benchmark frame's occlusion stage 6.6 against 4.0 ms least thread CPU; issue 19, stop 41).
+    with :func:`own_edge` on the maps in the same kernel (``occlusion_edge_boxed`` until stop 60, since then
+    :func:`symfruit.core._jit.occlusion_projected`, which projects the points too: the same maps; the benchmark
+    frame's occlusion stage 6.6 against 4.0 ms least thread CPU; issue 19, stop 41).
 
     Parameters
     ----------
@@ -431,7 +432,7 @@ def occlusion(
         image = depth if depth.dtype in (np.float32, np.float64) else np.asarray(depth, dtype=np.float64)
         near_to = np.zeros((0, 0), bool) if others is None else np.asarray(others, dtype=bool)
         # stop 41: own_edge on the maps in the same call; stop 45: without the window's own depths and own pixels as
-        # maps, its square filters read from summed-area tables (jit.occlusion_edge_boxed: the same maps; the
+        # maps, its square filters read from summed-area tables (jit._own_edge_in_box: the same maps; the
         # benchmark frame's 9 calls 2.5 against 2.0 ms)
         # stop 60: the points projected in the kernel (Camera.project's arithmetic, the same pixels; here only where
         # overshoot reads them), the own edge on the mask's box found by one OR a row (jit.occlusion_projected: the
@@ -863,7 +864,7 @@ def own_edge(
     hidden pixel within ``band`` of the fruit returns ``hidden`` itself. Where numba is, in one compiled pass
     (:func:`symfruit.core._jit.own_edge`: the same pixels, bit for bit; its eight dilation passes and scipy's minimum
     filter were most of the occlusion maps' time; issue 19, stop 41), and :func:`occlusion` runs it in the same
-    kernel as the maps (:func:`symfruit.core._jit.occlusion_edge_boxed`).
+    kernel as the maps (:func:`symfruit.core._jit.occlusion_projected`).
     """
     if band <= 0 or not hidden.any():
         return hidden
