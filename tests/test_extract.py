@@ -664,6 +664,25 @@ def test_keep_caps_gives_back_nothing_of_an_overshoot_all_round():
     assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), depth, 600.0, KEEPS) is trimmed
 
 
+def test_keep_caps_does_not_read_the_cap_where_the_cut_holds_no_depth(monkeypatch):
+    """The limb the colour takes lies where the camera returned no depth (a time-of-flight camera's lost rim): the
+    cap is not read (it holds depth alone, so it could give nothing back) and the moved masks come back themselves;
+    with the limb's depth there, it is read and gives the limb back."""
+    import symfruit.extract as extract_module
+
+    color, depth, d2 = shaded_ball()
+    drawn = (d2 <= 400).astype(np.int32)
+    trimmed = trim_labels(color, drawn)
+    boxes = [(slice(40, 81), slice(60, 101))]
+    calls = []
+    read = extract_module.own_cap
+    monkeypatch.setattr(extract_module, "own_cap", lambda *a, **k: calls.append(1) or read(*a, **k))
+    lost = np.where((drawn == 1) & (trimmed == 0), 0.0, depth)  # no depth where the colour cut
+    assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), lost, 600.0, KEEPS) is trimmed and not calls
+    assert np.array_equal(keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), depth, 600.0, KEEPS), drawn)
+    assert calls == [1]
+
+
 def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():
     """Known answer: the ball's pixels (every one has depth up to its rim) and none of the background's, under a mask
     grown 3 px onto them; of the board that turns back towards the camera 4 mm a row below the crease, its first row

@@ -673,6 +673,9 @@ def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: se
             continue
         z = np.zeros(mask.shape)
         z[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] = depth[a0:a1, b0:b1]
+        with np.errstate(invalid="ignore"):
+            if not (dropped & (z > 0.0)).any():
+                continue  # the cap holds depth alone: nothing to give back (a time-of-flight camera's lost rim)
         keep = dropped & own_cap(z, mask, focal, s)
         keep = keep[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] & (out[a0:a1, b0:b1] == 0)
         if keep.any():
