@@ -414,10 +414,12 @@ def test_memory_stays_flat_over_a_recording(tmp_path, frames, ripe, method):
     status, _, err = measured_detect([str(first), "--output", str(tmp_path / "warm"), "--method", method], timeout=600)
     assert status == 0, err
     args = [str(tmp_path / "rec"), "--output", str(tmp_path / "out"), "--method", method]
-    status, peak_mb, err = measured_detect(args, timeout=600)
+    # the child's own peak, its mapped files' resident pages left out: those follow the page cache (a fresh clone's
+    # newly installed libraries read some 75 MB more for the same run, 400 MB in all for the slow case; stop 61)
+    status, peak_mb, err = measured_detect(args, timeout=600, own=True)
     assert status == 0, err
     assert len(list((tmp_path / "out").glob("*/detections.json"))) == frames
-    assert 30 < peak_mb < 400  # measured: about 105 MB for 1 to 500 frames
+    assert 30 < peak_mb < 400  # measured at stop 61: 148 MB (the quick case) and 192 MB (the slow one), either way
 
 
 def test_a_frame_folder_that_links_out_of_the_output_is_refused_and_recorded(tmp_path):

@@ -371,18 +371,26 @@ import json, resource, sys
 from symfruit.cli import main
 status = main(sys.argv[1:])
 peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0
+files = float("nan")
 try:
     for line in open("/proc/self/status"):
         if line.startswith("VmHWM:"):
             peak = int(line.split()[1]) / 1024.0
+        elif line.startswith("RssFile:"):
+            files = int(line.split()[1]) / 1024.0
 except OSError:
     pass
-print(json.dumps({"status": status, "peak_rss_mb": peak}))
+print(json.dumps({"status": status, "peak_rss_mb": peak, "file_rss_mb": files}))
 """
 
 
-def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[int, float, str]:
-    """Run ``symfruit detect ARGS`` in a child process: ``(exit status, its peak RSS in MB, its stderr)``."""
+def measured_detect(args: list[str], *, timeout: float | None = None, own: bool = False) -> tuple[int, float, str]:
+    """Run ``symfruit detect ARGS`` in a child process: ``(exit status, its peak RSS in MB, its stderr)``.
+
+    ``own``: the peak less the files the child has mapped and resident at its end (``RssFile``: its shared
+    libraries' pages, numba's and LLVM's some 180 MB among them, whose resident share follows the page cache,
+    not the run: a freshly installed environment read about 75 MB more than an older one for the same run; stop
+    61), NaN where the kernel does not say."""
     import json
     import subprocess
     import sys
@@ -393,7 +401,8 @@ def measured_detect(args: list[str], *, timeout: float | None = None) -> tuple[i
     if proc.returncode != 0 or not lines:
         return proc.returncode, float("nan"), proc.stderr
     data = json.loads(lines[-1])
-    return int(data["status"]), float(data["peak_rss_mb"]), proc.stderr
+    peak = float(data["peak_rss_mb"]) - (float(data.get("file_rss_mb", float("nan"))) if own else 0.0)
+    return int(data["status"]), peak, proc.stderr
 
 
 #: Run in the child of :func:`bench_recording` with ``workers``: a local Dask cluster (as ``detect --workers``
