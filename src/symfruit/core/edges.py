@@ -178,6 +178,38 @@ def colour_edges(color: np.ndarray, *, sigma: float = 1.0, ratio: float = 4.0) -
     return edges, _orientation_bin(gx, gy)
 
 
+def _edge_distances(edges: np.ndarray, ebins: np.ndarray, cap: float) -> np.ndarray:
+    """(N_BINS, h, w) float32: one distance map an orientation bin, each pixel's distance to the nearest colour edge
+    within one bin of it, capped at ``cap`` (:func:`edge_shift`'s and :func:`mask_shift`'s score)."""
+    dist = np.empty((N_BINS, *edges.shape), np.float32)
+    for b in range(N_BINS):
+        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
+        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
+    return dist
+
+
+def _shift_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int, cap: float,
+                 sign: int) -> np.ndarray:  # fmt: skip
+    """(2m+1, 2m+1, n) float32 over (dv, du, point): each point's capped distance (``dist``, its bin's map) where the
+    shift puts it, ``(r + sign dv, c + sign du)``; ``cap`` off the image."""
+    h, w = dist.shape[1:]
+    out = np.full((2 * m + 1, 2 * m + 1, len(rows)), cap, np.float32)
+    for i, dv in enumerate(range(-m, m + 1)):
+        rr = rows + sign * dv
+        ok_r = (rr >= 0) & (rr < h)
+        for j, du in enumerate(range(-m, m + 1)):
+            cc = cols + sign * du
+            ok = ok_r & (cc >= 0) & (cc < w)
+            out[i, j, ok] = dist[bins[ok], rr[ok], cc[ok]]
+    return out
+
+
+def _trimmed(values: np.ndarray, keep: float) -> np.ndarray:
+    """The mean of the ``keep`` share of the smallest values along the last axis (at least one)."""
+    k = max(1, round(keep * values.shape[-1]))
+    return np.sort(values, axis=-1)[..., :k].mean(axis=-1)
+
+
 def edge_shift(
     depth: np.ndarray, color: np.ndarray, *, max_px: int = 20, cap: float = 6.0, keep: float = 0.7,
     max_points: int = 8000, min_side: int = 100, jump: float = 0.1, reach: int = 30,
@@ -200,7 +232,6 @@ def edge_shift(
     z = np.asarray(depth, dtype=np.float64)
     if np.asarray(color).shape[:2] != z.shape:
         raise ValueError(f"depth {z.shape} and colour {np.asarray(color).shape[:2]} differ in size")
-    h, w = z.shape
     outline, ogx, ogy = depth_outline(z, jump=jump, reach=reach)
     if exclude is not None:
         outline &= ~np.asarray(exclude, dtype=bool)
@@ -213,32 +244,15 @@ def edge_shift(
     rows, cols = rows[::step], cols[::step]
     nx, ny = ogx[rows, cols], ogy[rows, cols]
     bins = _orientation_bin(nx, ny)
-    # One distance map a bin: distance to colour edges within one bin of it, capped.
-    dist = np.empty((N_BINS, h, w), np.float32)
-    for b in range(N_BINS):
-        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
-        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
+    dist = _edge_distances(edges, ebins, cap)
     shifts = np.arange(-m, m + 1)
     n = len(rows)
 
-    def costs(sel: np.ndarray) -> np.ndarray:
-        """Per-point capped distances at every shift: (2m+1, 2m+1, n) over (dv, du)."""
-        r, c, bb = rows[sel], cols[sel], bins[sel]
-        out = np.full((2 * m + 1, 2 * m + 1, len(r)), cap, np.float32)
-        for i, dv in enumerate(shifts):
-            rr = r - dv
-            ok_r = (rr >= 0) & (rr < h)
-            for j, du in enumerate(shifts):
-                cc = c - du
-                ok = ok_r & (cc >= 0) & (cc < w)
-                out[i, j, ok] = dist[bb[ok], rr[ok], cc[ok]]
-        return out
-
     def trimmed(values: np.ndarray) -> np.ndarray:
-        k = max(1, round(keep * values.shape[-1]))
-        return np.sort(values, axis=-1)[..., :k].mean(axis=-1)
+        return _trimmed(values, keep)
 
-    every = costs(np.ones(n, bool)) if n else np.full((2 * m + 1, 2 * m + 1, 0), cap, np.float32)
+    # the depth's outline moved onto the colour: a point at (r, c) is read at (r - dv, c - du)
+    every = _shift_costs(dist, rows, cols, bins, m, cap, -1)
     cost = trimmed(every) if n else np.full((2 * m + 1, 2 * m + 1), cap)
     iv, iu = (int(i) for i in np.unravel_index(int(np.argmin(cost)), cost.shape))
     shift = (int(shifts[iu]), int(shifts[iv]))
@@ -336,22 +350,11 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     step = max(1, -(-len(rows) // max(1, int(max_points))))
     rows, cols, gx, gy = rows[::step], cols[::step], gx[::step], gy[::step]
     bins = _orientation_bin(gx, gy)
-    dist = np.empty((N_BINS, h, w), np.float32)
-    for b in range(N_BINS):
-        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
-        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
-    every = np.full((2 * m + 1, 2 * m + 1, len(rows)), cap, np.float32)  # (dv, du, pixel)
-    for i, dv in enumerate(range(-m, m + 1)):
-        rr = rows + dv
-        ok_r = (rr >= 0) & (rr < h)
-        for j, du in enumerate(range(-m, m + 1)):
-            cc = cols + du
-            ok = ok_r & (cc >= 0) & (cc < w)
-            every[i, j, ok] = dist[bins[ok], rr[ok], cc[ok]]
+    # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du)
+    every = _shift_costs(_edge_distances(edges, ebins, cap), rows, cols, bins, m, cap, 1)
 
     def trimmed(values: np.ndarray) -> np.ndarray:
-        k = max(1, round(keep * values.shape[-1]))
-        return np.sort(values, axis=-1)[..., :k].mean(axis=-1)
+        return _trimmed(values, keep)
 
     # the smoothed mask rises into the mask: a top side's gradient points down (+v), a left side's right (+u)
     vertical, horizontal = np.abs(gy) > 2.0 * np.abs(gx), np.abs(gx) > 2.0 * np.abs(gy)
