@@ -2,7 +2,7 @@
 
     python docs/regen.py run OUT [PART ...] [--jobs N] [--resume]   # run from the tree to measure (PYTHONPATH=src)
     python docs/regen.py compare OLD NEW [--tolerance T] [--all]    # every printed cell of the parts in both
-    python docs/regen.py readme OUT [--root TREE]                   # which README figures the printed rows confirm
+    python docs/regen.py readme OUT [--root TREE] [--write]         # which README figures the printed rows confirm
     python docs/regen.py list                                       # the parts and the commands each runs
 
 ``run`` runs, from the working folder (the tree measured: its ``src`` on ``PYTHONPATH``, its ``docs/`` scripts,
@@ -23,7 +23,9 @@ values; ``--all`` lists the unchanged cells too. Rows printed in one run only ar
 ``readme`` matches each printed row to README's row of the same label in the table the section names (the first
 table after a line holding its anchor text, README.md or docs/ablation.md) and says which rows README confirms
 cell for cell and which cells differ (best effort: where the printed table has README's columns, by position;
-otherwise each README cell is looked for among the printed row's cells).
+otherwise each README cell is looked for among the printed row's cells). With ``--write`` it rewrites each
+differing row where the printed table has README's columns (a cell README agrees with kept as README writes it, the
+timing and earlier-stop columns kept) and names the rest to be done by hand.
 
 Parts: spheres, heldback, paper, frames, straw, trees, photos, cams, occl, leaf, scans, conf, seg (``list`` prints
 each one's commands). The held-out seed sets README reports (100 and up) are among them: that is the lead's
@@ -746,9 +748,38 @@ def agrees(readme: str, printed: str) -> bool:
     return norm(readme) == norm(printed) or norm(readme) == norm(re.sub(r" \(n \d+\)$", "", printed))
 
 
-def check_readme(out: Path, root: Path, say: Callable[[str], object] = say) -> tuple[int, int, int]:
-    """(rows confirmed, rows that differ, printed rows without a README row) over the parts of OUT."""
+def rewrite_row(text: str, anchor: str, label: str, cells: list[str], keep: Callable[[int], bool]) -> str:
+    """``text`` with the row of ``label`` (normalised) in the first table after ``anchor`` given ``cells`` (all but
+    its label), its own cell kept where ``keep(j)`` (column ``j + 1``); ``text`` itself when there is no such row."""
+    at = text.find(anchor)
+    if at < 0:
+        return text
+    lines = text[at:].splitlines(keepends=True)
+    start = next((i for i, x in enumerate(lines) if x.startswith("|")), None)
+    if start is None:
+        return text
+    offset = at + sum(len(x) for x in lines[:start])
+    for line in lines[start:]:
+        if not line.startswith("|"):
+            break
+        mine = split_row(line)
+        if norm(mine[0]) == norm(label) and len(mine) == len(cells) + 1:
+            new = [mine[0]] + [mine[j + 1] if keep(j) else c for j, c in enumerate(cells)]
+            end = "\n" if line.endswith("\n") else ""
+            return text[:offset] + "| " + " | ".join(new) + " |" + end + text[offset + len(line) :]
+        offset += len(line)
+    return text
+
+
+def check_readme(
+    out: Path, root: Path, say: Callable[[str], object] = say, *, write: bool = False
+) -> tuple[int, int, int]:
+    """(rows confirmed, rows that differ, printed rows without a README row) over the parts of OUT; with ``write``
+    each differing row whose printed table has README's columns is rewritten in place (the cells README agrees
+    with, and the skipped columns, kept as README has them) and the file written atomically; the others are named
+    "by hand"."""
     texts: dict[str, str] = {}
+    changed: set[str] = set()
     confirmed = differ = unmatched = 0
     prose: list[str] = []  # sections whose figures README gives in its text: read by hand
     for path in sorted(out.glob("*/rows.md")):
@@ -779,7 +810,8 @@ def check_readme(out: Path, root: Path, say: Callable[[str], object] = say) -> t
                 say(f"{where}: no README row of that label")
                 continue
             head, mine = found[0], found[1][norm(label)]
-            if len(head) == len(header) and len(mine) == len(cells):
+            aligned = len(head) == len(header) and len(mine) == len(cells)
+            if aligned:
                 bad = [
                     (head[j + 1], x, y) for j, (x, y) in enumerate(zip(mine, cells, strict=True)) if not agrees(x, y)
                 ]
@@ -790,11 +822,22 @@ def check_readme(out: Path, root: Path, say: Callable[[str], object] = say) -> t
             if bad:
                 differ += 1
                 say(f"{where}: differs: " + "; ".join(f"{c}: README {x}, printed {y}" for c, x, y in bad))
+                if write and aligned:
+                    keep = [SKIPPED_COLUMNS.search(head[j + 1]) is not None or agrees(x, y)
+                            for j, (x, y) in enumerate(zip(mine, cells, strict=True))]  # fmt: skip
+                    texts[name] = rewrite_row(texts[name], anchor, label, cells, keep.__getitem__)
+                    changed.add(name)
+                    say(f"{where}: rewritten")
+                elif write:
+                    say(f"{where}: BY HAND (the printed row has other columns than README's)")
             else:
                 confirmed += 1
                 say(f"{where}: confirmed")
     for x in prose:
         say(f"{x}: no README table (its figures are in README's text: compare by hand)")
+    for name in sorted(changed):
+        write_atomic(root / name, texts[name])
+        say(f"{name}: written")
     say(f"README rows confirmed {confirmed}, differing {differ}, printed rows without a README row {unmatched}")
     return confirmed, differ, unmatched
 
@@ -822,6 +865,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     m = sub.add_parser("readme", help="which README figures the printed rows confirm")
     m.add_argument("out")
     m.add_argument("--root", default=".", help="the tree whose README.md and docs/ablation.md are read (default .)")
+    m.add_argument("--write", action="store_true", help="rewrite the differing rows (where the columns are README's)")
     sub.add_parser("list", help="each part's commands")
     args, extra = parser.parse_known_args(argv)  # run OUT --jobs 1 PART ...: parts after the options too
     if extra and (args.what != "run" or any(e.startswith("-") for e in extra)):
@@ -839,7 +883,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         compare(Path(args.old), Path(args.new), args.tolerance, args.all)
         return 0
     if args.what == "readme":
-        check_readme(Path(args.out), Path(args.root))
+        check_readme(Path(args.out), Path(args.root), write=args.write)
         return 0
     unknown = [p for p in args.parts if p not in table]
     if unknown:

@@ -18,6 +18,7 @@ import functools
 import importlib.util
 import os
 import signal
+import sys
 from pathlib import Path
 
 # One BLAS thread per process, set before numpy loads OpenBLAS (numpy's and scipy's both read it): the suite runs
@@ -116,8 +117,9 @@ EXAMPLE_FRAME = Path(symfruit.__file__).resolve().parent / "data" / "example_fra
 def docs_script(name: str):
     """The module of ``docs/<name>.py`` (a measurement script the README and docs/ cite), loaded from its file: the
     docs folder is no package."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "docs" / f"{name}.py")
+    spec = importlib.util.spec_from_file_location(f"docs_{name}", ROOT / "docs" / f"{name}.py")
     module = importlib.util.module_from_spec(spec)
+    sys.modules[spec.name] = module  # dataclasses look their module up while it runs
     spec.loader.exec_module(module)
     return module
 
