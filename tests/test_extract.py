@@ -683,6 +683,60 @@ def test_keep_caps_does_not_read_the_cap_where_the_cut_holds_no_depth(monkeypatc
     assert calls == [1]
 
 
+def test_keep_caps_does_not_read_the_cap_where_another_mask_holds_the_cut(monkeypatch):
+    """Stop 62 (cap62): the limb the colour takes lies where a neighbour's mask (moved onto the depth) holds every
+    pixel of it, or where its depth lies beyond the extraction's range: the cap could give none of it back, and it is
+    not read; the moved masks come back themselves."""
+    import symfruit.extract as extract_module
+
+    color, depth, d2 = shaded_ball()
+    drawn = (d2 <= 400).astype(np.int32)
+    trimmed = trim_labels(color, drawn)
+    cut = (drawn == 1) & (trimmed == 0)
+    boxes = [(slice(40, 81), slice(60, 101))]
+    calls = []
+    read = extract_module.own_cap
+    monkeypatch.setattr(extract_module, "own_cap", lambda *a, **k: calls.append(1) or read(*a, **k))
+    held = np.where(cut, 2, trimmed).astype(np.int32)  # a neighbour's mask over the limb
+    assert keep_caps(drawn, trimmed, held, {1}, boxes, (0, 0), depth, 600.0, KEEPS) is held and not calls
+    far = np.where(cut, 20.0, depth)  # beyond max_depth (10 m)
+    assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), far, 600.0, KEEPS) is trimmed and not calls
+    partly = np.where(cut & (np.mgrid[:120, :160][1] < 80), 2, trimmed).astype(np.int32)  # half of it held
+    kept = keep_caps(drawn, trimmed, partly, {1}, boxes, (0, 0), depth, 600.0, KEEPS)
+    assert calls == [1] and np.array_equal(kept, np.where(partly == 2, 2, drawn))
+
+
+@given(st.integers(1, 12), st.integers(1, 12), st.floats(0.0, 1.0), st.integers(0, 2**32 - 1))
+def test_the_outline_is_the_distance_maps_first_pixel(h, w, share, seed):
+    """``_outline`` (four shifted views) is ``mask & (inner_distance(mask, 2.0) <= 1.0)``, the pixels within one of
+    another in the array, on any mask (empty, full, ragged): the same pixels, so :func:`one_sided` answers as
+    before."""
+    from symfruit.core.raster import inner_distance
+    from symfruit.extract import _outline
+
+    mask = np.random.default_rng(seed).random((h, w)) < share
+    assert np.array_equal(_outline(mask), mask & (inner_distance(mask, 2.0) <= 1.0))
+    assert np.array_equal(_outline(np.ones((h, w), bool)), inner_distance(np.ones((h, w), bool), 2.0) <= 1.0)
+
+
+@given(st.integers(0, 2**32 - 1))
+def test_own_cap_with_the_kernels_is_the_twins(seed):
+    """``own_cap``'s depth made valid by the extraction's kernel (stop 62) or by numpy (the twin), on depth with
+    holes, NaN, infinities, negative values and depths beyond the range: the same pixels."""
+    rng = np.random.default_rng(seed)
+    _, depth, d2 = shaded_ball(board=bool(rng.random() < 0.5))
+    depth = depth.astype(np.float64 if rng.random() < 0.5 else np.float32)
+    bad = rng.random(depth.shape) < rng.uniform(0.0, 0.3)
+    depth[bad] = rng.choice([0.0, -0.0, -0.3, np.nan, np.inf, -np.inf, 11.0, 5e-324], bad.sum())
+    mask = d2 <= float(rng.uniform(15.0, 24.0)) ** 2
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        fast = own_cap(depth, mask, 600.0)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = own_cap(depth, mask, 600.0)
+    assert np.array_equal(fast, twin)
+
+
 def test_own_cap_is_the_fruits_convex_cap_no_deeper_than_its_rim():
     """Known answer: the ball's pixels (every one has depth up to its rim) and none of the background's, under a mask
     grown 3 px onto them; of the board that turns back towards the camera 4 mm a row below the crease, its first row

@@ -595,8 +595,22 @@ def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
     if mask.ndim != 2 or dropped.shape != mask.shape:
         raise InputError(f"one_sided: mask and cut must be 2-D images of one shape, got {mask.shape} and "
                          f"{dropped.shape}")  # fmt: skip
-    edge = mask & (inner_distance(mask, 2.0) <= 1.0)
+    edge = _outline(mask)
     return bool(np.count_nonzero(edge & dropped) < ALL_ROUND * np.count_nonzero(edge))
+
+
+def _outline(mask: np.ndarray) -> np.ndarray:
+    """(h, w) bool: ``mask & (inner_distance(mask, 2.0) <= 1.0)``, the pixels of ``mask`` (h, w) bool within a pixel
+    of one outside it in the array (beyond the array is not outside: scipy's transform's), by the four shifted views
+    of the mask padded with true (stop 62, cap62: the same pixels at a tenth of the distance map's cost). A mask true
+    everywhere (no pixel outside it: scipy's transform then measures from a pixel beyond the array) is left to
+    :func:`~symfruit.core.raster.inner_distance`."""
+    if mask.all():
+        return mask & (inner_distance(mask, 2.0) <= 1.0)
+    h, w = mask.shape
+    p = np.ones((h + 2, w + 2), dtype=bool)  # padded by hand: np.pad is slow
+    p[1:-1, 1:-1] = mask
+    return mask & ~(p[:-2, 1:-1] & p[2:, 1:-1] & p[1:-1, :-2] & p[1:-1, 2:])
 
 
 def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) -> tuple[np.ndarray, float]:
@@ -625,10 +639,15 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
     it (``trim_keeps_surface``)."""
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "own_cap")
-    z = np.asarray(z, dtype=np.float64)
-    with np.errstate(invalid="ignore"):
-        z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
-    surface = fruit_surface(z, np.asarray(mask, dtype=bool), focal, slab=s.slab,
+    z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
+    if (jit := compiled()) is not None and z.ndim == 2:  # the same map by the extraction's kernel (stop 62, cap62):
+        valid = np.empty(z.shape)  # z > 0 and z >= the least depth is z >= the larger of it and the least double
+        jit.valid_depth(z, mask, max(float(s.min_depth), 5e-324), float(s.max_depth), valid, np.empty(z.shape, bool))
+        z = valid
+    else:
+        with np.errstate(invalid="ignore"):
+            z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
+    surface = fruit_surface(z, mask, focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
                             clean=True)  # fmt: skip
     if surface is None:
@@ -671,13 +690,16 @@ def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: se
         a0, a1, b0, b1 = max(r0 + dv, 0), min(r1 + dv, h), max(c0 + du, 0), min(c1 + du, w)
         if a0 >= a1 or b0 >= b1:
             continue
-        z = np.zeros(mask.shape)
-        z[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] = depth[a0:a1, b0:b1]
+        inside = (slice(a0 - r0 - dv, a1 - r0 - dv), slice(b0 - c0 - du, b1 - c0 - du))
+        seen, free = depth[a0:a1, b0:b1], out[a0:a1, b0:b1] == 0
         with np.errstate(invalid="ignore"):
-            if not (dropped & (z > 0.0)).any():
-                continue  # the cap holds depth alone: nothing to give back (a time-of-flight camera's lost rim)
-        keep = dropped & own_cap(z, mask, focal, s)
-        keep = keep[a0 - r0 - dv : a1 - r0 - dv, b0 - c0 - du : b1 - c0 - du] & (out[a0:a1, b0:b1] == 0)
+            if not (dropped[inside] & free & (seen > 0.0) & (seen >= s.min_depth) & (seen <= s.max_depth)).any():
+                # the cap holds depth in range alone (own_cap's), and gives back no pixel another mask holds: nothing
+                # to give back (a time-of-flight camera's lost rim; stop 62: a cut under a neighbour's mask)
+                continue
+        z = np.zeros(mask.shape)
+        z[inside] = seen
+        keep = dropped[inside] & own_cap(z, mask, focal, s)[inside] & free
         if keep.any():
             out = out.copy() if out is moved else out
             out[a0:a1, b0:b1][keep] = k

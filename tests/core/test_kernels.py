@@ -7017,6 +7017,110 @@ def test_thin_front_by_its_passes_in_one_call_is_the_twins_to_the_bit(seed):
         assert fast[0] == twin[0] and fast[1].dtype == twin[1].dtype and np.array_equal(fast[1], twin[1])
 
 
+# --- stop 62, cap62: thin_front's curvature fit compiled, its answer taken where rounding cannot turn it
+
+
+def _curved_pixels(rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(rows, cols, depth)``: 10-2,048 pixels of a blob (a disc, a band, scattered) on a ball's cap, a tilted plane
+    or a saddle at 0.3-2 m, with noise of 0-3 mm (``depth`` (h, w), above 0 at the pixels)."""
+    h, w = (int(x) for x in rng.integers(20, 120, 2))
+    rr, cc = np.mgrid[:h, :w].astype(np.float64)
+    cy, cx = rng.uniform(0.3, 0.7) * h, rng.uniform(0.3, 0.7) * w
+    z0, scale = rng.uniform(0.3, 2.0), rng.uniform(0.3, 2.0) / 600.0
+    x, y = (cc - cx) * scale, (rr - cy) * scale
+    kind = int(rng.integers(0, 3))
+    if kind == 0:
+        r_m = rng.uniform(0.02, 0.2)
+        depth = z0 + r_m - np.sqrt(np.clip(r_m**2 - x**2 - y**2, 0.0, None))
+    elif kind == 1:
+        depth = z0 + rng.uniform(-0.5, 0.5) * x + rng.uniform(-0.5, 0.5) * y
+    else:
+        depth = z0 + rng.uniform(1.0, 10.0) * (x**2 - y**2)
+    depth = np.clip(depth + rng.normal(0.0, float(rng.choice([0.0, 0.001, 0.003])), depth.shape), 0.05, None)
+    shape = int(rng.integers(0, 3))
+    if shape == 0:
+        keep = (rr - cy) ** 2 + (cc - cx) ** 2 <= rng.uniform(2.0, 0.45 * min(h, w)) ** 2
+    elif shape == 1:
+        keep = np.abs(rr - cy) <= rng.uniform(1.0, 6.0)
+    else:
+        keep = rng.random((h, w)) < rng.uniform(0.05, 1.0)
+    rows, cols = np.nonzero(keep)
+    if len(rows) > 2048:
+        some = np.sort(rng.choice(len(rows), 2048, replace=False))
+        rows, cols = rows[some], cols[some]
+    return rows, cols, depth
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_thin_curvature_is_the_twins_fit_to_rounding(seed):
+    """``thin_curvature`` on the pixels of a ball's cap, a plane or a saddle (a disc, a band or scattered, 10-2,048
+    of them, noise or none): the twin's (``_mean_curvature``) curvature and standard error to 10 times the rounding's
+    scale, their size times the condition number it reports (at least 1) times the double's epsilon (3,000 seeds: at
+    most 0.64 times; ``_clearly_convex`` trusts it 1e4 times that far from its bound); where the twin's fit is
+    singular, no answer."""
+    from symfruit.core.surface import _mean_curvature
+
+    rows, cols, depth = _curved_pixels(np.random.default_rng(seed))
+    if len(rows) < 10:
+        return
+    done, kappa, error, condition = _jit.thin_curvature(rows, cols, depth, 600.0)
+    want_kappa, want_error = _mean_curvature(rows, cols, depth[rows, cols], 600.0)
+    if not done:
+        assert not np.isfinite(want_kappa)
+        return
+    assert condition >= 1.0
+    if not np.isfinite(want_kappa):  # the twin's LAPACK found the matrix singular where the kernel's pivots did not
+        assert condition > 1e12
+        return
+    tol = 10.0 * (abs(want_kappa) + abs(want_error) + 1.0) * condition * np.finfo(np.float64).eps
+    assert kappa == pytest.approx(want_kappa, abs=tol) and error == pytest.approx(want_error, abs=tol)
+
+
+def test_thin_curvature_known_answers():
+    """A ball's cap within half its radius reads its inverse radius, a tilted plane nothing, as the twin's; one row
+    of pixels (no y at all) is singular, for both."""
+    from symfruit.core.surface import _mean_curvature
+
+    yy, xx = np.mgrid[:120, :160]
+    d2 = (xx - 80.0) ** 2 + (yy - 60.0) ** 2
+    r_m, front = 20 * 0.5 / 600.0, 0.5
+    depth = np.where(d2 <= 400, front + r_m - np.sqrt(np.clip(r_m**2 - d2 * (front / 600.0) ** 2, 0, None)), 1.0)
+    rows, cols = np.nonzero(d2 <= 100)
+    done, kappa, error, _ = _jit.thin_curvature(rows, cols, depth, 600.0)
+    assert done and kappa * r_m == pytest.approx(1.0, abs=0.1) and error * r_m < 0.05
+    assert kappa == pytest.approx(_mean_curvature(rows, cols, depth[rows, cols], 600.0)[0], rel=1e-9)
+    plane = 1.0 / (2.0 - 1e-3 * xx + 5e-4 * yy)
+    done, kappa, error, _ = _jit.thin_curvature(rows, cols, plane, 600.0)
+    assert done and abs(kappa * r_m) < 1e-6 and error * r_m < 1e-6
+    line = np.full(40, 60, np.int64), np.arange(60, 100, dtype=np.int64)
+    done, kappa, _, _ = _jit.thin_curvature(*line, depth, 600.0)
+    assert not done and not np.isfinite(_mean_curvature(*line, depth[line], 600.0)[0])
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([None, -1e-15, 0.0, 1e-15, 1e-9, -1e-6, 1e-3]))
+def test_clearly_convex_answers_as_the_twins_fit_even_at_the_bound(seed, at):
+    """``_clearly_convex`` (the compiled fit where its answer is certain, else the twin's) answers as the twin's test
+    ``(kappa - 2 inflate error) radius >= THIN[0]`` on the twin's fit, on any pixels (more than 2,048: both draw the
+    same), and with the radius put at the bound (``at``: its relative offset there), where rounding decides."""
+    from symfruit.core.surface import THIN, _clearly_convex, _mean_curvature
+
+    rng = np.random.default_rng(seed)
+    rows, cols, depth = _curved_pixels(rng)
+    if len(rows) < 10:
+        return
+    if rng.random() < 0.2:  # more than the fit's 2,048 pixels: both draw the same ones
+        rows, cols = np.nonzero(depth > 0)
+    inflate = float(rng.uniform(1.0, 2.0))
+    kappa, error = _mean_curvature(rows, cols, depth[rows, cols], 600.0)
+    radius = float(rng.uniform(0.01, 0.2))
+    if at is not None and np.isfinite(kappa) and kappa - 2.0 * inflate * error > 0:
+        radius = THIN[0] / (kappa - 2.0 * inflate * error) * (1.0 + at)
+    want = bool((kappa - 2.0 * inflate * error) * radius >= THIN[0])
+    assert _clearly_convex(_jit, rows, cols, depth, 600.0, inflate, radius) == want
+
+
 def test_thin_passes_reach_every_answer_and_give_the_twins_parts():
     """``thin_passes`` on 120 :func:`_sheet_scene` cases reaches each of its answers, and where it hands a partition
     back, its labels, sizes and near counts are ``_smooth_parts``' and ``_part_sizes``' numpy twins' (of the depth at

@@ -9645,6 +9645,125 @@ def thin_passes(
     return THIN_NONE, none, none, 0, none, none
 
 
+@_njit
+def thin_curvature(
+    rows: np.ndarray, cols: np.ndarray, depth: np.ndarray, focal: float
+) -> tuple[bool, float, float, float]:
+    """:func:`symfruit.core.surface._mean_curvature` of the pixels ``rows, cols`` (n,) int64 of ``depth`` (h, w)
+    float64 (each above 0; at most 2,048 of them, as the twin draws them): ``(done, kappa, error, condition)``, the
+    inverse depth's least-squares quadratic by its normal equations summed pixel by pixel and inverted by Gauss-Jordan
+    elimination with partial pivoting (the twin's BLAS and LAPACK: the same fit, its sums in another order, so to
+    rounding, not to the bit), ``condition`` the normal matrix's 1-norm condition number (the rounding's scale);
+    ``done`` False where a pivot is exactly 0 (the twin's ``LinAlgError``). The median and means are the twin's
+    values (:func:`median_quick`; whole-number sums; stop 62, cap62)."""
+    n = rows.shape[0]
+    z = np.empty(n)
+    rs = 0
+    cs = 0
+    for i in range(n):
+        z[i] = depth[rows[i], cols[i]]
+        rs += rows[i]
+        cs += cols[i]
+    zm = median_quick(z)
+    r0 = float(rs) / n
+    c0 = float(cs) / n
+    scale = zm / focal
+    # the normal matrix's 21 sums and the right side's 6 (columns 1, x, y, x x, x y, y y)
+    sx = sy = sxx = sxy = syy = 0.0
+    sxxx = sxxy = sxyy = syyy = 0.0
+    sxxxx = sxxxy = sxxyy = sxyyy = syyyy = 0.0
+    b0 = b1 = b2 = b3 = b4 = b5 = 0.0
+    for i in range(n):
+        x = (cols[i] - c0) * scale
+        y = (rows[i] - r0) * scale
+        xx, xy, yy = x * x, x * y, y * y
+        w = 1.0 / z[i]
+        sx += x
+        sy += y
+        sxx += xx
+        sxy += xy
+        syy += yy
+        sxxx += xx * x
+        sxxy += xx * y
+        sxyy += xy * y
+        syyy += yy * y
+        sxxxx += xx * xx
+        sxxxy += xx * xy
+        sxxyy += xx * yy
+        sxyyy += xy * yy
+        syyyy += yy * yy
+        b0 += w
+        b1 += x * w
+        b2 += y * w
+        b3 += xx * w
+        b4 += xy * w
+        b5 += yy * w
+    m = np.empty((6, 6))
+    m[0, 0], m[0, 1], m[0, 2], m[0, 3], m[0, 4], m[0, 5] = float(n), sx, sy, sxx, sxy, syy
+    m[1, 1], m[1, 2], m[1, 3], m[1, 4], m[1, 5] = sxx, sxy, sxxx, sxxy, sxyy
+    m[2, 2], m[2, 3], m[2, 4], m[2, 5] = syy, sxxy, sxyy, syyy
+    m[3, 3], m[3, 4], m[3, 5] = sxxxx, sxxxy, sxxyy
+    m[4, 4], m[4, 5] = sxxyy, sxyyy
+    m[5, 5] = syyyy
+    for j in range(6):
+        for k in range(j):
+            m[j, k] = m[k, j]
+    norm = 0.0
+    for k in range(6):
+        t = 0.0
+        for j in range(6):
+            t += abs(m[j, k])
+        norm = max(norm, t)
+    inv = np.eye(6)
+    for col in range(6):
+        piv = col
+        best = abs(m[col, col])
+        for row in range(col + 1, 6):
+            if abs(m[row, col]) > best:
+                piv, best = row, abs(m[row, col])
+        if best == 0.0:
+            return False, np.nan, np.inf, np.inf
+        if piv != col:
+            for j in range(6):
+                m[col, j], m[piv, j] = m[piv, j], m[col, j]
+                inv[col, j], inv[piv, j] = inv[piv, j], inv[col, j]
+        p = m[col, col]
+        for j in range(6):
+            m[col, j] /= p
+            inv[col, j] /= p
+        for row in range(6):
+            f = m[row, col]
+            if row != col and f != 0.0:
+                for j in range(6):
+                    m[row, j] -= f * m[col, j]
+                    inv[row, j] -= f * inv[col, j]
+    inverse_norm = 0.0
+    for k in range(6):
+        t = 0.0
+        for j in range(6):
+            t += abs(inv[j, k])
+        inverse_norm = max(inverse_norm, t)
+    rhs = (b0, b1, b2, b3, b4, b5)
+    coef = np.zeros(6)
+    for j in range(6):
+        t = 0.0
+        for k in range(6):
+            t += inv[j, k] * rhs[k]
+        coef[j] = t
+    rss = 0.0
+    for i in range(n):
+        x = (cols[i] - c0) * scale
+        y = (rows[i] - r0) * scale
+        res = 1.0 / z[i] - (
+            coef[0] + coef[1] * x + coef[2] * y + coef[3] * (x * x) + coef[4] * (x * y) + coef[5] * (y * y)
+        )
+        rss += res * res
+    var = rss / max(n - 6, 1)
+    kappa = -zm * zm * (coef[3] + coef[5])
+    error = zm * zm * math.sqrt(max(var * (inv[3, 3] + inv[5, 5] + 2.0 * inv[3, 5]), 0.0))
+    return True, kappa, error, norm * inverse_norm
+
+
 # --- stop 51, surface51: fruit_surface's measures of the mask's depth, and its cap, in one call each -----------------
 
 

@@ -44,9 +44,10 @@ and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlus
 :func:`symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.smooth_parts`,
 :func:`~symfruit.core._jit.filled_windows`; since stop 45 :func:`~symfruit.core._jit.window_medians`,
 :func:`~symfruit.core._jit.reaches_outline`, :func:`~symfruit.core._jit.part_sizes`; since stop 51 all of them in
-:func:`~symfruit.core._jit.thin_passes`) and stop 51's :func:`symfruit.core.surface.fruit_surface`
-(:func:`symfruit.core._jit.mask_values`, :func:`~symfruit.core._jit.surface_cap`)) then run their numpy
-twins, the code the kernels
+:func:`~symfruit.core._jit.thin_passes`), stop 51's :func:`symfruit.core.surface.fruit_surface`
+(:func:`symfruit.core._jit.mask_values`, :func:`~symfruit.core._jit.surface_cap`) and stop 62's curvature fit of
+:func:`~symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.thin_curvature`, to rounding: its answer taken
+only where rounding cannot turn it)) then run their numpy twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
