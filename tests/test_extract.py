@@ -7,6 +7,7 @@ import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
+from scipy import ndimage
 
 from symfruit import ConfigError, InputError
 from symfruit.core.camera import Camera
@@ -14,6 +15,7 @@ from symfruit.extract import (
     ExtractSettings,
     _clusters,
     backdrop,
+    beyond_even_cut,
     cluster,
     cluster_gap,
     extract,
@@ -23,6 +25,7 @@ from symfruit.extract import (
     own_surface,
     register,
     shift_labels,
+    star_shaped,
     trim_labels,
 )
 from symfruit.io import read_frame
@@ -654,14 +657,53 @@ def test_keep_caps_gives_back_the_limb_where_the_registration_puts_it(shift):
         assert (unmoved > 0).sum() < (kept > 0).sum()
 
 
-def test_keep_caps_gives_back_nothing_of_an_overshoot_all_round():
-    """The ball under a mask 3 px too wide all round over the board at its depth (the colour's cut all round): the
-    moved masks themselves, though the board's first row lies on the cap."""
-    color, depth, d2 = shaded_ball(board=True)
+@pytest.mark.parametrize("board", [True, False])
+def test_keep_caps_gives_back_nothing_of_an_overshoot_all_round(board):
+    """The ball under a mask 3 px too wide all round (over the board at its depth, or the background): the colour
+    cuts all round, the overshoot and the shaded limb. Nothing of the overshoot comes back, though the board's first
+    row lies on the cap; of the limb, which the colour cuts deeper than the overshoot's 3 px (stop 62,
+    docs/grown62.md), what lies deeper does. Without the limb's depth, the moved masks themselves."""
+    color, depth, d2 = shaded_ball(board=board)
     drawn = (d2 <= 23**2).astype(np.int32)
     trimmed = trim_labels(color, drawn)
     boxes = [(slice(37, 84), slice(57, 104))]
-    assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), depth, 600.0, KEEPS) is trimmed
+    disc, limb = d2 <= 400, (d2 <= 400) & (np.mgrid[:120, :160][0] >= 76)
+    kept = keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), depth, 600.0, KEEPS)
+    back = (kept == 1) & (trimmed != 1)
+    assert not (kept == 1)[~disc].any()  # none of the overshoot
+    assert back.any() and not back[~limb].any() and back.sum() >= 0.6 * (limb & (trimmed != 1)).sum()
+    lost = np.where(limb, 0.0, depth)
+    assert keep_caps(drawn, trimmed, trimmed, {1}, boxes, (0, 0), lost, 600.0, KEEPS) is trimmed
+
+
+def test_star_shaped_is_a_whole_round_outline_and_not_one_cut_along_a_leaf():
+    """Known answers: a disc and its lower half are star-shaped about their centroids; the disc with a strip 6 px wide
+    cut across it (a mask cut along a leaf in front) is not; an empty mask is not."""
+    yy, xx = np.mgrid[:60, :60]
+    disc = (xx - 30) ** 2 + (yy - 30) ** 2 <= 23**2
+    assert star_shaped(disc) and star_shaped(disc & (yy > 30))
+    assert not star_shaped(disc & ~((yy >= 28) & (yy < 34)))
+    assert not star_shaped(np.zeros_like(disc))
+
+
+def test_beyond_even_cut_is_what_the_cut_takes_deeper_than_along_most_of_the_outline():
+    """Known answers on a disc of 23 px: a ring 3 px wide all round leaves nothing beyond it; the same ring and the
+    disc's lowest 8 rows leave those rows' pixels more than the ring's 3 px (and its outline pixel) inside the mask;
+    no cut, or the whole mask, none. Bad arguments are refused by name."""
+    yy, xx = np.mgrid[:60, :60]
+    d2 = (xx - 30) ** 2 + (yy - 30) ** 2
+    mask = d2 <= 23**2
+    ring = mask & (d2 > 20**2)
+    assert not beyond_even_cut(mask, ring).any()
+    cut = ring | (mask & (yy >= 46))
+    deeper = beyond_even_cut(mask, cut)
+    dist = ndimage.distance_transform_edt(np.pad(mask, 1))[1:-1, 1:-1]
+    assert deeper.any() and not deeper[yy < 46].any() and np.array_equal(deeper, cut & (yy >= 46) & (dist > 4))
+    assert not beyond_even_cut(mask, np.zeros_like(mask)).any() and not beyond_even_cut(mask, mask).any()
+    with pytest.raises(InputError, match="beyond_even_cut: mask and cut must be 2-D images of one shape"):
+        beyond_even_cut(mask, mask[:, :-1])
+    strip = (yy >= 28) & (yy < 34)  # the mask cut along a leaf in front: its outline there lies inside the fruit
+    assert not beyond_even_cut(mask & ~strip, cut & ~strip).any()
 
 
 def test_keep_caps_does_not_read_the_cap_where_the_cut_holds_no_depth(monkeypatch):
