@@ -7,7 +7,8 @@ whether one shift a mask would be right (docs/edge62.md).
 
 ``cue``: for every frame folder (``scene_*`` under each FOLDER, or the folder itself), the frame's shift
 (``mask_shift``, ``max_px`` 10), the thread CPU seconds it took, and the shift each mask alone would read (the same
-rule on one mask's outline: the what-if of section 2), those not ``(0, 0)`` listed. ``--base SRC``: also the shift
+rule on one mask's outline, its sides needing ``--min-side`` pixels, 20 by default as at stop 61: the what-if of
+section 2), those not ``(0, 0)`` listed. ``--base SRC``: also the shift
 and CPU seconds of ``mask_shift`` as another source tree has it (e.g. ``../main/src``: the whole window's version
 of stop 61). ``real``: the same on both real Azure Kinect sphere frames under every perturbation of
 ``docs/realpert55.py``.
@@ -42,12 +43,17 @@ def _base_edges(src: str):
     return module
 
 
+#: The least outline pixels a side of one mask alone needs in the what-if (``--min-side``; stop 61's floor, 20).
+MIN_SIDE = [20]
+
+
 def per_mask(color: np.ndarray, masks: np.ndarray) -> dict[int, tuple[int, int]]:
-    """The shift each mask alone reads (``mask_shift``'s rule on its own outline pixels and window)."""
+    """The shift each mask alone reads (``mask_shift``'s rule on its own outline pixels and window, its sides
+    needing ``MIN_SIDE[0]`` pixels)."""
     from symfruit.core import edges
 
     parts = edges._mask_costs(color, masks, max_px=MAX_PX, cap=6.0, max_points=8000)
-    return {k: edges._decide(every, gx, gy, MAX_PX, 6.0, 0.7, 20) for k, every, gx, gy in parts}
+    return {k: edges._decide(every, gx, gy, MAX_PX, 6.0, 0.7, MIN_SIDE[0]) for k, every, gx, gy in parts}
 
 
 def _timed(fn, *args):
@@ -99,10 +105,12 @@ def main() -> None:
     sub = parser.add_subparsers(dest="command", required=True)
     one = sub.add_parser("cue", help="the frame's and each mask's shift on frame folders")
     one.add_argument("folders", nargs="+")
-    one.add_argument("--base", help="another source tree's mask_shift too (its src folder)")
     two = sub.add_parser("real", help="the same on the real sphere frames' perturbations")
-    two.add_argument("--base", help="another source tree's mask_shift too (its src folder)")
+    for p in (one, two):
+        p.add_argument("--base", help="another source tree's mask_shift too (its src folder)")
+        p.add_argument("--min-side", type=int, default=20, help="a side's least pixels for one mask alone (20)")
     args = parser.parse_args()
+    MIN_SIDE[0] = args.min_side
     base = _base_edges(args.base) if args.base else None
     if args.command == "cue":
         cue(args.folders, base)

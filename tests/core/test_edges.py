@@ -146,6 +146,17 @@ def test_a_move_under_two_pixels_is_not_told(shift, found):
     assert mask_shift(colour(ids, rng), moved(ids, *shift), max_px=10) == found
 
 
+def test_one_small_mask_alone_is_not_moved():
+    """A side needs MIN_SIDE_PX outline pixels: the disc alone (70 px across, about 30 a side) is not moved by
+    default, though its sides do find the shift at the lower floor of stop 61."""
+    rng = np.random.default_rng(5)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    disc = np.where(ids == 3, 3, 0)
+    assert mask_shift(color, moved(disc, 0, -5), max_px=10) == (0, 0)
+    assert mask_shift(color, moved(disc, 0, -5), max_px=10, min_side=20) == (0, 5)
+
+
 @pytest.mark.parametrize("grow", [2, 5])
 def test_generous_masks_are_not_moved(grow):
     """A mask grown all round pulls its opposite sides apart (the top up, the bottom down): no axis agrees."""

@@ -44,6 +44,12 @@ __all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift", "mask_shi
 #: matched to colour edges in its own bin and the two beside it (within 45 degrees).
 N_BINS = 6
 
+#: The outline pixels a side of :func:`mask_shift`'s masks needs to say anything (:func:`edge_shift`'s own floor for
+#: a side of the depth's outline). One mask alone has 20-60 a side at 40-120 px across: alone, 4 of the rendered
+#: trees' 300 exact masks and 7 of the real spheres' 24 generous ones read moves of 2-10 px at a floor of 20, and
+#: none at 100; frames of several masks read the same shifts at either (stop 62, docs/edge62.md).
+MIN_SIDE_PX = 100
+
 
 @dataclass(frozen=True)
 class EdgeShift:
@@ -311,7 +317,7 @@ def edge_shift(
 
 
 def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: float = 6.0, keep: float = 0.7,
-               max_points: int = 8000, min_side: int = 20,
+               max_points: int = 8000, min_side: int = MIN_SIDE_PX,
                boxes: list[tuple[slice, slice] | None] | None = None) -> tuple[int, int]:  # fmt: skip
     """The integer shift ``(du, dv)`` within ``max_px`` that moves the masks ``labels`` (0: none) onto the colour's
     edges (:func:`colour_edges`), ``(0, 0)`` where the outlines do not tell one.
@@ -320,7 +326,8 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     its orientation, capped at ``cap``; a shift costs the mean of its ``keep`` share of cheapest pixels), with the
     masks' outline pixels (a mask's pixels beside one outside it, oriented by the smoothed mask's gradient) moved by
     the shift. Each side of the outlines (top, bottom, left, right) gives its best shift along the axis it constrains,
-    the other axis free, from at least ``min_side`` pixels. An axis moves only where its two sides agree within two
+    the other axis free, from at least ``min_side`` pixels (:data:`MIN_SIDE_PX`: a few masks' worth, so a frame of
+    one or two small masks is not moved). An axis moves only where its two sides agree within two
     pixels: a mask drawn off its fruit moves both one way, a generous mask pulls them apart (its top outline up, its
     bottom one down), and one side alone cannot tell a shift from an overshoot (a side whose outline lies on no edge
     at any shift, most of it farther than half the cap, says nothing). Each side reads its outline to a pixel (the
