@@ -211,11 +211,6 @@ def _prepare(
                              "fruit per frame are read")  # fmt: skip
         labels = (inverse.reshape(labels.shape) + int(values[0] != 0)).astype(np.int32)
         lo, hi = int(labels.min()), int(labels.max())
-    if settings.extract.mask_edge_px > 0 and frame.color is not None and source != COLOUR_SEGMENTER and hi > 0:
-        # masks drawn a few pixels off their fruit, all one way, moved back onto the colour's edges (stop 61,
-        # docs/shift61.md); the segmenter's masks are the colour's own
-        du, dv = mask_shift(frame.color, labels, max_px=settings.extract.mask_edge_px)
-        labels = shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels
     # one mask covers the whole image when every pixel holds the same label above 0: the least and greatest labels
     # tell it (a bincount of the image cost 0.3 ms a frame; issue 19, stop 41)
     if labels.size and lo == hi and lo > 0:
@@ -223,6 +218,13 @@ def _prepare(
     # the masks' boxes, found once and carried along while the labels stay the same (a pass over the whole image
     # each); trimming only takes pixels away, so a mask's new box is looked for within its old one
     boxes = _label_boxes(labels, hi)
+    if settings.extract.mask_edge_px > 0 and frame.color is not None and source != COLOUR_SEGMENTER and hi > 0:
+        # masks drawn a few pixels off their fruit, all one way, moved back onto the colour's edges (stops 61 and
+        # 62, docs/shift61.md, docs/edge62.md); the segmenter's masks are the colour's own
+        du, dv = mask_shift(frame.color, labels, max_px=settings.extract.mask_edge_px, boxes=boxes)
+        if (du, dv) != (0, 0):
+            labels = shift_labels(labels, du, dv)
+            boxes = _label_boxes(labels, hi)
     return _Prepared(frame, labels, hi, boxes, source, settings, method, t0, cpu0, t1, time.thread_time() - cpu0,
                      time.perf_counter())  # fmt: skip
 

@@ -4,7 +4,19 @@ texture of its own, depth moved by a known shift and its objects' outermost pixe
 import numpy as np
 import pytest
 
-from symfruit.core.edges import colour_edges, depth_outline, edge_shift, mask_shift
+from symfruit.core.edges import (
+    EDGE_REACH,
+    N_BINS,
+    _colour_gradient,
+    _colour_peaks,
+    _mask_costs,
+    _moved_costs,
+    _shift_costs,
+    colour_edges,
+    depth_outline,
+    edge_shift,
+    mask_shift,
+)
 
 H, W = 240, 320
 
@@ -125,6 +137,26 @@ def test_masks_drawn_off_their_objects_are_moved_back_onto_the_colours_edges(shi
     assert mask_shift(color, drawn, max_px=10) == (-shift[0], -shift[1])
 
 
+@pytest.mark.parametrize(("shift", "found"), [((1, 0), (0, 0)), ((0, -1), (0, 0)), ((1, -1), (0, 0)), ((2, 0), (-2, 0)),
+                                              ((0, -2), (0, 2)), ((2, 1), (-2, 0))])  # fmt: skip
+def test_a_move_under_two_pixels_is_not_told(shift, found):
+    """The two sides' mean is told to about a pixel: masks a pixel off stay, two pixels off are moved back."""
+    rng = np.random.default_rng(5)
+    _, ids = scene(rng)
+    assert mask_shift(colour(ids, rng), moved(ids, *shift), max_px=10) == found
+
+
+def test_one_small_mask_alone_is_not_moved():
+    """A side needs MIN_SIDE_PX outline pixels: the disc alone (70 px across, about 30 a side) is not moved by
+    default, though its sides do find the shift at the lower floor of stop 61."""
+    rng = np.random.default_rng(5)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    disc = np.where(ids == 3, 3, 0)
+    assert mask_shift(color, moved(disc, 0, -5), max_px=10) == (0, 0)
+    assert mask_shift(color, moved(disc, 0, -5), max_px=10, min_side=20) == (0, 5)
+
+
 @pytest.mark.parametrize("grow", [2, 5])
 def test_generous_masks_are_not_moved(grow):
     """A mask grown all round pulls its opposite sides apart (the top up, the bottom down): no axis agrees."""
@@ -159,5 +191,61 @@ def test_mask_shift_needs_masks_and_colour_of_one_size():
     _, ids = scene(rng)
     assert mask_shift(colour(ids, rng), np.zeros_like(ids)) == (0, 0)  # no mask: nothing to move
     assert mask_shift(colour(ids, rng), ids, max_px=0) == (0, 0)
+    assert mask_shift(colour(ids, rng), np.ones_like(ids)) == (0, 0)  # a mask over the whole image has no outline
     with pytest.raises(ValueError, match="differ in size"):
         mask_shift(colour(ids, rng), ids[:-1])
+
+
+@pytest.mark.parametrize("reach", [EDGE_REACH, EDGE_REACH - 2])
+def test_a_window_grown_by_the_edges_reach_finds_the_whole_images_edges(reach):
+    """mask_shift reads each mask's colour edges in its own window: inside the window less ``EDGE_REACH``, the
+    window's edges (at one threshold) are the whole image's; two pixels less and some are not."""
+    rng = np.random.default_rng(9)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    gx, gy, mag = _colour_gradient(color, 1.0)
+    threshold = 4.0 * float(np.median(mag))
+    assert all(
+        np.array_equal(a, b) for a, b in zip(colour_edges(color), _colour_peaks(gx, gy, mag, threshold), strict=True)
+    )
+    whole, whole_bins = _colour_peaks(gx, gy, mag, threshold)
+    r0, r1, c0, c1 = 40, 150, 100, 260
+    window = _colour_gradient(color[r0:r1, c0:c1], 1.0)
+    part, part_bins = _colour_peaks(*window, threshold)
+    inner = (slice(reach, -reach), slice(reach, -reach))
+    # the gradient reads 5 px (the Gaussian's 4 sigma and the Sobel's pixel), the peaks one more
+    same = np.array_equal(window[2][inner], mag[r0:r1, c0:c1][inner])
+    assert same == (reach == EDGE_REACH)
+    if same:
+        assert np.array_equal(part[inner], whole[r0:r1, c0:c1][inner])
+        assert np.array_equal(part_bins[inner][part[inner]], whole_bins[r0:r1, c0:c1][inner][part[inner]])
+
+
+def test_the_gathered_costs_are_the_shift_loops():
+    rng = np.random.default_rng(10)
+    dist = rng.uniform(0.0, 6.0, (N_BINS, 30, 40)).astype(np.float32)
+    rows, cols = rng.integers(0, 30, 200), rng.integers(0, 40, 200)  # near the borders too: off the map costs the cap
+    bins = rng.integers(0, N_BINS, 200)
+    assert np.array_equal(_moved_costs(dist, rows, cols, bins, 7, 6.0), _shift_costs(dist, rows, cols, bins, 7, 6.0, 1))
+
+
+def test_the_masks_costs_read_only_the_masks_windows():
+    """Colour farther from every mask than its window (the search, the cap and the edges' reach) changes nothing;
+    within a window it does."""
+    rng = np.random.default_rng(11)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    parts = _mask_costs(color, ids, max_px=10, cap=6.0, max_points=8000)
+    assert [k for k, *_ in parts] == [1, 2, 3]
+    every = np.concatenate([e for _, e, _, _ in parts], axis=2)
+
+    def costs(image: np.ndarray) -> np.ndarray:
+        return np.concatenate([e for _, e, _, _ in _mask_costs(image, ids, max_px=10, cap=6.0, max_points=8000)], 2)
+
+    far = color.copy()  # the windows: the masks' boxes grown by 10 + 6 + EDGE_REACH + 1 = 23 px
+    far[:, 145:165] = rng.integers(0, 255, (H, 20, 3))
+    far[205:, :170] = rng.integers(0, 255, (H - 205, 170, 3))
+    assert np.array_equal(costs(far), every)
+    near = color.copy()
+    near[181:200, 40:120] = rng.integers(0, 255, (19, 80, 3))  # below box 1, within its window
+    assert not np.array_equal(costs(near), every)

@@ -44,6 +44,12 @@ __all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift", "mask_shi
 #: matched to colour edges in its own bin and the two beside it (within 45 degrees).
 N_BINS = 6
 
+#: The outline pixels a side of :func:`mask_shift`'s masks needs to say anything (:func:`edge_shift`'s own floor for
+#: a side of the depth's outline). One mask alone has 20-60 a side at 40-120 px across: alone, 4 of the rendered
+#: trees' 300 exact masks and 7 of the real spheres' 24 generous ones read moves of 2-10 px at a floor of 20, and
+#: none at 100; frames of several masks read the same shifts at either (stop 62, docs/edge62.md).
+MIN_SIDE_PX = 100
+
 
 @dataclass(frozen=True)
 class EdgeShift:
@@ -150,6 +156,12 @@ def colour_edges(color: np.ndarray, *, sigma: float = 1.0, ratio: float = 4.0) -
     bins : (h, w) int
         Each pixel's gradient orientation bin (``N_BINS`` bins over 180 degrees).
     """
+    gx, gy, mag = _colour_gradient(color, sigma)
+    return _colour_peaks(gx, gy, mag, ratio * max(float(np.median(mag)), 1e-9))
+
+
+def _colour_gradient(color: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`colour_edges`' gradient, ``(gx, gy, mag)``: the strongest channel's after a Gaussian of ``sigma``."""
     img = np.asarray(color, dtype=np.float64)
     if img.ndim == 2:
         img = img[..., None]
@@ -162,6 +174,11 @@ def colour_edges(color: np.ndarray, *, sigma: float = 1.0, ratio: float = 4.0) -
         m = np.hypot(cx, cy)
         take = m > mag
         gx, gy, mag = np.where(take, cx, gx), np.where(take, cy, gy), np.where(take, m, mag)
+    return gx, gy, mag
+
+
+def _colour_peaks(gx: np.ndarray, gy: np.ndarray, mag: np.ndarray, threshold: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`colour_edges` from the gradient: its maxima along their own direction above ``threshold``."""
     # Non-maximum suppression along the gradient, quantised to 4 directions.
     angle = np.mod(np.arctan2(gy, gx), np.pi)
     q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
@@ -171,20 +188,22 @@ def colour_edges(color: np.ndarray, *, sigma: float = 1.0, ratio: float = 4.0) -
         a = np.roll(mag, (dv, du), axis=(0, 1))
         b = np.roll(mag, (-dv, -du), axis=(0, 1))
         peak |= (q == k) & (mag >= a) & (mag >= b)
-    med = float(np.median(mag))
-    edges = peak & (mag > ratio * max(med, 1e-9))
+    edges = peak & (mag > threshold)
     edges[[0, -1], :] = False
     edges[:, [0, -1]] = False
     return edges, _orientation_bin(gx, gy)
 
 
-def _edge_distances(edges: np.ndarray, ebins: np.ndarray, cap: float) -> np.ndarray:
+def _edge_distances(edges: np.ndarray, ebins: np.ndarray, cap: float, used: np.ndarray | None = None) -> np.ndarray:
     """(N_BINS, h, w) float32: one distance map an orientation bin, each pixel's distance to the nearest colour edge
-    within one bin of it, capped at ``cap`` (:func:`edge_shift`'s and :func:`mask_shift`'s score)."""
-    dist = np.empty((N_BINS, *edges.shape), np.float32)
-    for b in range(N_BINS):
-        near_bin = edges & np.isin(ebins, [(b - 1) % N_BINS, b, (b + 1) % N_BINS])
-        dist[b] = np.minimum(distance_transform(~near_bin), cap) if near_bin.any() else cap
+    within one bin of it, capped at ``cap`` (:func:`edge_shift`'s and :func:`mask_shift`'s score). ``used``: the
+    bins whose maps are read (the others are left at ``cap``); all of them when None."""
+    dist = np.full((N_BINS, *edges.shape), cap, np.float32)
+    for b in range(N_BINS) if used is None else np.unique(used):
+        apart = (ebins - b) % N_BINS  # within one bin of b: 0, 1 or N_BINS - 1
+        near_bin = edges & ((apart <= 1) | (apart == N_BINS - 1))
+        if near_bin.any():
+            dist[b] = np.minimum(distance_transform(~near_bin), cap)
     return dist
 
 
@@ -202,6 +221,15 @@ def _shift_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.
             ok = ok_r & (cc >= 0) & (cc < w)
             out[i, j, ok] = dist[bins[ok], rr[ok], cc[ok]]
     return out
+
+
+def _moved_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int,
+                 cap: float) -> np.ndarray:  # fmt: skip
+    """:func:`_shift_costs` with ``sign`` 1 read in one gather: each point's ``(2m+1, 2m+1)`` window of its bin's map
+    (padded by ``cap``), the same values."""
+    padded = np.pad(dist, ((0, 0), (m, m), (m, m)), constant_values=np.float32(cap))
+    windows = np.lib.stride_tricks.sliding_window_view(padded, (2 * m + 1, 2 * m + 1), axis=(1, 2))
+    return np.ascontiguousarray(np.moveaxis(windows[bins, rows, cols], 0, -1))
 
 
 def _trimmed(values: np.ndarray, keep: float) -> np.ndarray:
@@ -289,7 +317,8 @@ def edge_shift(
 
 
 def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: float = 6.0, keep: float = 0.7,
-               max_points: int = 8000, min_side: int = 20) -> tuple[int, int]:  # fmt: skip
+               max_points: int = 8000, min_side: int = MIN_SIDE_PX,
+               boxes: list[tuple[slice, slice] | None] | None = None) -> tuple[int, int]:  # fmt: skip
     """The integer shift ``(du, dv)`` within ``max_px`` that moves the masks ``labels`` (0: none) onto the colour's
     edges (:func:`colour_edges`), ``(0, 0)`` where the outlines do not tell one.
 
@@ -297,7 +326,8 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     its orientation, capped at ``cap``; a shift costs the mean of its ``keep`` share of cheapest pixels), with the
     masks' outline pixels (a mask's pixels beside one outside it, oriented by the smoothed mask's gradient) moved by
     the shift. Each side of the outlines (top, bottom, left, right) gives its best shift along the axis it constrains,
-    the other axis free, from at least ``min_side`` pixels. An axis moves only where its two sides agree within two
+    the other axis free, from at least ``min_side`` pixels (:data:`MIN_SIDE_PX`: a few masks' worth, so a frame of
+    one or two small masks is not moved). An axis moves only where its two sides agree within two
     pixels: a mask drawn off its fruit moves both one way, a generous mask pulls them apart (its top outline up, its
     bottom one down), and one side alone cannot tell a shift from an overshoot (a side whose outline lies on no edge
     at any shift, most of it farther than half the cap, says nothing). Each side reads its outline to a pixel (the
@@ -305,36 +335,69 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     spheres, masks drawn right read their top -1 and bottom +1), so two sides of masks drawn right may differ by two
     and a mask grown a pixel or two reads as much: an axis whose sides straddle none stays. An axis moves by its two
     sides' mean (their pixels of rounding outwards cancel; a half pixel goes to the shift of less cost over every
-    outline pixel), and the shift is taken only where it costs less than none over every outline pixel.
+    outline pixel), and only where that mean is :data:`MIN_MOVE_PX` or more (it is told to about a pixel), and the
+    shift is taken only where it costs less than none over every outline pixel.
+
+    Each mask's colour edges are read in a window about it (:func:`_mask_costs`: a tenth to an eighth of a
+    1920 x 1080 tree frame's pixels, 0.07-0.10 s of CPU for the whole window's 0.56-0.85 s; stop 62), at the
+    threshold the windows' union gives. The shift is the frame's, one for all its masks: each mask alone reads too
+    little (stop 62: alone, 4 of the rendered trees' 300 exact masks read moves of 2-10 px, and 7 of the real
+    spheres' masks grown 2-10 px read 3-9 px).
 
     Parameters
     ----------
     color : (h, w, 3) or (h, w) array, the colour image
     labels : (h, w) int, the masks on the colour image's pixels
+    boxes : list, optional
+        ``ndimage.find_objects(labels)`` where the caller has it (a pass over the whole image less).
 
     Raises
     ------
     ValueError
         When colour and masks differ in size.
     """
+    parts = _mask_costs(color, labels, max_px=max_px, cap=cap, max_points=max_points, boxes=boxes)
+    if not parts:
+        return (0, 0)
+    every = np.concatenate([p[1] for p in parts], axis=2)
+    gx, gy = (np.concatenate([p[i] for p in parts]) for i in (2, 3))
+    return _decide(every, gx, gy, int(max_px), cap, keep, min_side)
+
+
+#: The least move :func:`mask_shift` makes along an axis (pixels): the two sides' mean is told to about a pixel.
+MIN_MOVE_PX = 2.0
+
+#: Pixels beyond a colour edge's own that :func:`colour_edges` reads to find it: the Gaussian's reach (4 sigma at
+#: sigma 1), the Sobel's pixel and the non-maximum suppression's neighbour; a window grown by it finds the edges
+#: of its inner part as the whole image would, but for the threshold (the median gradient of the window).
+EDGE_REACH = 6
+
+
+def _mask_costs(
+    color: np.ndarray, labels: np.ndarray, *, max_px: int, cap: float, max_points: int,
+    boxes: list[tuple[slice, slice] | None] | None = None,
+) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:  # fmt: skip
+    """The masks' outline pixels and each one's capped distance to the colour's edges at every shift
+    (:func:`mask_shift`'s score), one ``(label, every, gx, gy)`` a mask with outline pixels left after thinning
+    all masks' together to at most ``max_points``: ``every`` (2m+1, 2m+1, n) as :func:`_shift_costs`, ``gx, gy``
+    the smoothed mask's gradient at them.
+
+    Each mask's colour edges are read in its own window: its box grown by the search, the cap and the edges' reach
+    (:data:`EDGE_REACH`), so every edge within the cap of a shifted outline pixel is the whole image's, and the
+    threshold is the median gradient of the mask's window (the fruit and what lies just around it), not a whole
+    frame's. A frame of small masks reads a band about each outline instead of the whole image (a 1920 x 1080 tree
+    frame: a tenth to an eighth of its pixels).
+    """
     img = np.asarray(color)
     lab = np.asarray(labels)
     if img.shape[:2] != lab.shape or lab.ndim != 2:
         raise ValueError(f"colour {img.shape[:2]} and masks {lab.shape} differ in size")
     m = int(max_px)
-    present = np.flatnonzero(lab.any(axis=1)), np.flatnonzero(lab.any(axis=0))
-    if m <= 0 or not len(present[0]):
-        return (0, 0)
-    # the colour's edges are read in the masks' box grown by the search and the cap (and the smoothing's reach)
-    pad = m + int(np.ceil(cap)) + 4
+    if m <= 0:
+        return []
     h, w = lab.shape
-    r0, r1 = max(int(present[0][0]) - pad, 0), min(int(present[0][-1]) + pad + 1, h)
-    c0, c1 = max(int(present[1][0]) - pad, 0), min(int(present[1][-1]) + pad + 1, w)
-    img, lab = img[r0:r1, c0:c1], lab[r0:r1, c0:c1]
-    h, w = lab.shape
-    edges, ebins = colour_edges(img)
     parts = []
-    for sl, k in zip(ndimage.find_objects(lab), range(1, int(lab.max()) + 1), strict=False):
+    for k, sl in enumerate(ndimage.find_objects(lab) if boxes is None else boxes, start=1):
         if sl is None:
             continue
         a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
@@ -343,15 +406,41 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
         rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
         smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
         gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
-        parts.append((rows + a0, cols + b0, gx, gy))
+        parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
     if not parts:
-        return (0, 0)
-    rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(4))
+        return []
+    ks, rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(5))
     step = max(1, -(-len(rows) // max(1, int(max_points))))
-    rows, cols, gx, gy = rows[::step], cols[::step], gx[::step], gy[::step]
+    ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
     bins = _orientation_bin(gx, gy)
-    # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du)
-    every = _shift_costs(_edge_distances(edges, ebins, cap), rows, cols, bins, m, cap, 1)
+    pad = m + int(np.ceil(cap)) + EDGE_REACH + 1
+    windows, seen, pooled = [], np.zeros((h, w), bool), []
+    for *_, (k, sl) in parts:
+        mine = ks == k
+        if not mine.any():
+            continue
+        r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
+        c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+        gradient = _colour_gradient(img[r0:r1, c0:c1], 1.0)
+        windows.append((k, mine, r0, c0, gradient))
+        pooled.append(gradient[2][~seen[r0:r1, c0:c1]])  # each pixel of the windows' union once
+        seen[r0:r1, c0:c1] = True
+    if not windows:  # thinned away, or no mask has a pixel beside one outside it (a mask over the whole image)
+        return []
+    # the threshold: a multiple of the median gradient over the windows' union (the masks and what lies around them)
+    threshold = 4.0 * max(float(np.median(np.concatenate(pooled))), 1e-9)
+    costs = []
+    for k, mine, r0, c0, gradient in windows:
+        edges, ebins = _colour_peaks(*gradient, threshold)
+        dist = _edge_distances(edges, ebins, cap, bins[mine])
+        # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du); off the window is off the image
+        costs.append((k, mine, _moved_costs(dist, rows[mine] - r0, cols[mine] - c0, bins[mine], m, cap)))
+    return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
+
+
+def _decide(every: np.ndarray, gx: np.ndarray, gy: np.ndarray, m: int, cap: float, keep: float,
+            min_side: int) -> tuple[int, int]:  # fmt: skip
+    """:func:`mask_shift`'s rule on the outline pixels' costs ``every`` (:func:`_mask_costs`)."""
 
     def trimmed(values: np.ndarray) -> np.ndarray:
         return _trimmed(values, keep)
@@ -374,7 +463,13 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
         x, y = best[one], best[other]
         lo, hi = (min(x, y), max(x, y)) if x is not None and y is not None else (0, 0)
         mid = 0.5 * (lo + hi)  # each side's pixel of rounding outwards cancels in the two sides' mean
-        told.append(sorted({math.floor(mid), math.ceil(mid)}) if hi - lo <= 2 and (lo > 0 or hi < 0) else [0])
+        # the mean is told to about a pixel (two sides of masks drawn right may read two apart): a move under two
+        # pixels is not told from none (on the real spheres at a third of their resolution the sides read -2
+        # and -1, and a move of a pixel, three of the camera's, put every box 3-5 mm off; stop 62, docs/edge62.md)
+        agree = hi - lo <= 2 and (lo > 0 or hi < 0) and abs(mid) >= MIN_MOVE_PX
+        told.append(sorted({math.floor(mid), math.ceil(mid)}) if agree else [0])
+    if told == [[0], [0]]:
+        return (0, 0)
     cost = trimmed(every)
     du, dv = min(
         ((u, v) for u in told[0] for v in told[1]), key=lambda t: (cost[t[1] + m, t[0] + m], abs(t[0]) + abs(t[1]))
