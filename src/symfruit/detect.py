@@ -528,7 +528,7 @@ class _Masks:
         if dropped is not None:
             _without(mask, r0, c0, dropped)
         return registration_outline(self.depth[r0:r1, c0:c1], mask, self.focal, max_px=s.registration_px,
-                                    depth_range=(s.min_depth, s.max_depth))  # fmt: skip
+                                    depth_range=(s.min_depth, s.max_depth), occluders=s.occluder_edges)  # fmt: skip
 
 
 def _without(mask: np.ndarray, r0: int, c0: int, dropped: _Dropped) -> np.ndarray:

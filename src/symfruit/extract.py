@@ -64,6 +64,12 @@ class ExtractSettings(Section):
         onto the depth before extraction (:func:`~symfruit.core.surface.registration_shift`; 0: never); a least
         cost at the radius itself is no minimum found and moves nothing, so the radius must exceed the largest
         shift expected.
+    occluder_edges : bool
+        The registration reads a band of lost depth beside something in front of the fruit (a leaf's edge: a
+        time-of-flight camera invalidates the mixed pixels along every step in depth) as a junction, not as the
+        fruit's silhouette, and pools the sides of every fruit's outline, also those that tell no shift (stop 62,
+        docs/leaf62.md; off: the real frames cut by a leaf are then registered 3-11 px off, but at the true shift
+        other weaknesses show).
     mask_edge_px : int
         With the frame's colour image (``detect``, masks drawn as outlines: a masks file, a label array, a model; not
         the colour segmenter's): how far (pixels) the masks may sit off their fruit in the colour image, all one way
@@ -122,6 +128,7 @@ class ExtractSettings(Section):
     max_depth: float = setting(3.0, gt=0.0, le=100.0)
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
+    occluder_edges: bool = setting(False)
     mask_edge_px: int = setting(10, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
     trim_keeps_surface: bool = setting(True)
@@ -771,5 +778,6 @@ def register(
     s = settings or ExtractSettings()
     z = np.asarray(depth)  # float64 window by window (registration_shift): no float64 copy of the whole frame
     du, dv = registration_shift(z, labels, float(np.sqrt(camera.fx * camera.fy)), max_px=s.registration_px,
-                                depth_range=(s.min_depth, s.max_depth), boxes=boxes)  # fmt: skip
+                                depth_range=(s.min_depth, s.max_depth), boxes=boxes,
+                                occluders=s.occluder_edges)  # fmt: skip
     return (shift_labels(labels, du, dv) if (du, dv) != (0, 0) else labels), (du, dv)

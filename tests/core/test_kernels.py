@@ -6570,7 +6570,7 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
     from scipy import ndimage
 
     from symfruit.core.raster import interior
-    from symfruit.core.surface import _FREE_PX, Surface, _free_far, _free_points
+    from symfruit.core.surface import _FREE_PX, Surface, _free_far, _free_points, _free_tol
 
     rng = np.random.default_rng(seed)
     h, w = (int(x) for x in rng.integers(2, 90, 2))
@@ -6582,7 +6582,8 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
     depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
     depth[depth < 0.1] = 0.0
     surface = Surface(pixels, 0.5, float(rng.uniform(0.01, 0.08)), float(rng.uniform(0.0, 0.004)), (r, c))
-    rows, cols, free = _jit.cap_outline(pixels, r, c, depth, _free_far(surface), _FREE_PX, int(_FREE_PX) + 1, least)
+    rows, cols, free = _jit.cap_outline(pixels, r, c, depth, _free_far(surface), _FREE_PX, int(_FREE_PX) + 1, least,
+                                        _free_tol(surface))  # fmt: skip
     labels, _ = ndimage.label(pixels)
     cap = labels == labels[r, c]
     want_rows, want_cols = np.nonzero(cap & ~interior(cap))
@@ -6592,7 +6593,7 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
         return
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("SYMFRUIT_KERNELS", "numpy")
-        want_free, _ = _free_points(depth, cap, want_rows, want_cols, surface)
+        want_free, _ = _free_points(depth, cap, want_rows, want_cols, surface, tol=_free_tol(surface))
     assert free.dtype == want_free.dtype and np.array_equal(free, want_free)
 
 
@@ -6645,6 +6646,57 @@ def test_free_outline_known_answers():
     for reach, want in ((1.0, False), (1.4, False), (math.sqrt(2.0), True), (2.0, True)):
         got = _jit.free_outline(diagonal, cap, rows, cols, 0.5, reach, 3)
         assert got[corner].all() == want and not got[~corner].any()
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 0.02))
+def test_free_outline_with_a_tolerance_is_the_numpy_twins(seed, noise):
+    """``free_outline`` with a finite tolerance (stop 62: a lost pixel within reach of depth nearer than the point
+    by more than it is an occluder's edge, not a silhouette's) on random caps over depth with holes, pixels behind
+    and in front and NaN: ``_free_points``' numpy twin's points, bit for bit; with no tolerance (infinite) the
+    former points, which are never fewer."""
+    from symfruit.core.raster import interior
+    from symfruit.core.surface import _FREE_PX, Surface, _free_far, _free_points, _free_tol
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 70, 2))
+    cap = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
+    if not cap.any():
+        cap[0, 0] = True
+    rows, cols = np.nonzero(cap & ~interior(cap))
+    depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
+    depth[depth < 0.1] = 0.0
+    depth[rng.random((h, w)) < 0.02] = np.nan
+    surface = Surface(cap, 0.5, float(rng.uniform(0.01, 0.08)), noise, (int(rows[0]), int(cols[0])))
+    far, tol, pad = _free_far(surface), _free_tol(surface), int(_FREE_PX) + 1
+    free = _jit.free_outline(depth, cap, rows, cols, far, _FREE_PX, pad, tol)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        want, _ = _free_points(depth, cap, rows, cols, surface, tol=tol)
+        former, _ = _free_points(depth, cap, rows, cols, surface)
+    assert free.dtype == want.dtype and np.array_equal(free, want)
+    before = _jit.free_outline(depth, cap, rows, cols, far, _FREE_PX, pad, np.inf)
+    assert np.array_equal(before, former) and not (free & ~before).any()
+
+
+def test_free_outline_reads_a_lost_band_beside_something_in_front_as_a_junction():
+    """A cap (columns 8-13 of a 12 x 18 window) at 0.5 m; beyond its right side no depth (a silhouette); beyond its
+    left side two columns without depth, then a leaf over columns 0-5. With the leaf at 0.45 m (in front) the left
+    side's points are not free (the band is the leaf's lost edge, a junction: stop 62), but they are without the
+    tolerance (infinite: the rule before), with the leaf at 0.6 m (behind the fruit's rim but nearer than ``far``:
+    nothing in front) and with the leaf's band six columns wide (its depth beyond the reach of the band's nearest
+    pixel). The right side's points are free throughout."""
+    cap = np.zeros((12, 18), bool)
+    cap[:, 8:14] = True
+    rows, cols = np.nonzero(cap & np.isin(np.arange(18), (8, 13))[None, :])
+    left = cols == 8
+    for leaf, band, want in ((0.45, 2, False), (0.6, 2, True), (0.45, 6, True)):
+        depth = np.zeros((12, 18))
+        depth[cap] = 0.5
+        depth[:, : 8 - band] = leaf
+        free = _jit.free_outline(depth, cap, rows, cols, 0.7, 4.0, 5, 0.003)
+        assert (free[left] == want).all() and free[~left].all()
+        assert _jit.free_outline(depth, cap, rows, cols, 0.7, 4.0, 5, np.inf).all()
 
 
 @pytest.mark.parametrize("seed", range(8))

@@ -16,6 +16,8 @@ from symfruit.core.surface import (
     fruit_depth,
     fruit_surface,
     monotone_region,
+    registration_outline,
+    registration_search,
     registration_shift,
     thin_front,
 )
@@ -1527,3 +1529,73 @@ def test_a_leaf_parted_in_two_at_its_own_depth_is_passed_over_at_every_pixel_of_
                 found = fruit_surface(depth, moved, F, thin=True, crossing=True)
                 assert found is not None and 0.50 < found.front < 0.515, (seed, dr, dc)
                 assert (found.pixels & leaf).sum() == 0, (seed, dr, dc)
+
+
+def a_leaf(disc, left=0.35):
+    """(H, W) bool: a leaf over the left ``left`` of the silhouette ``disc``'s width, from a quarter of its width
+    above it to a quarter below, and as far beyond it on the left."""
+    rows, cols = np.flatnonzero(disc.any(axis=1)), np.flatnonzero(disc.any(axis=0))
+    r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
+    pad = (c1 - c0) // 4
+    yy, xx = np.mgrid[:H, :W]
+    return (yy >= r0 - pad) & (yy < r1 + pad) & (xx >= c0 - pad) & (xx < c0 + left * (c1 - c0))
+
+
+def leaf_in_front(depth, leaf, *, gap=0.05, lost_px=2):
+    """``depth`` with ``leaf`` ``gap`` metres in front of its nearest depth, its edge without depth ``lost_px`` pixels
+    to either side (a time-of-flight camera's mixed pixels at a step)."""
+    from scipy import ndimage
+
+    out = depth.copy()
+    out[leaf] = float(depth[depth > 0].min()) - gap
+    edge = (ndimage.distance_transform_edt(~leaf) <= lost_px) & (ndimage.distance_transform_edt(leaf) <= lost_px + 1)
+    out[edge] = 0.0
+    return out
+
+
+def test_a_leafs_lost_edge_is_no_silhouette_for_the_registration():
+    """Stop 62 (docs/leaf62.md): a leaf 5 cm in front of a ball over its left third, the mask cut by it, the depth
+    lost a pixel outside the leaf's edge and two inside (a time-of-flight camera's mixed pixels at a step). The cap's
+    outline along the leaf meets that lost band: it is the leaf's edge, a junction, not the ball's silhouette with a
+    band to measure (read as free, the real frames cut by a strip or a leaf moved by 3-11 px). Its left side is now
+    none free (and the top's and bottom's few points by the leaf's corners), and the outline tells no shift across."""
+    depth, disc = ball(rim=0.13, noise=0.0005)
+    leaf = a_leaf(disc)
+    found = registration_outline(leaf_in_front(depth, leaf, lost_px=1), disc & ~leaf, F, max_px=12, occluders=True)
+    assert found is not None and found.sides is not None
+    (top, n_top), (bottom, n_bottom), (left, n_left), (right, n_right) = found.sides.tolist()
+    assert n_left >= 8 and left == 0 and right == n_right and top > n_top / 2 and bottom > n_bottom / 2
+    assert found.axes == (True, False)
+    # behind the ball instead (seen past it): its left side is a silhouette again
+    behind = registration_outline(
+        leaf_in_front(depth, leaf, gap=-0.2, lost_px=1), disc & ~leaf, F, max_px=12, occluders=True
+    )
+    assert behind is not None and behind.sides is not None and behind.axes == (True, True)
+
+
+def test_outlines_that_tell_no_axis_count_in_the_frames_pool_but_cost_nothing():
+    """Stop 62: a frame whose fruit end mostly at a leaf in front (their left sides and bottoms junctions) and one
+    outline that tells both axes (on the real frames with a leaf drawn over, the leaf's own outline): alone it moves
+    the masks; with the others' sides pooled, neither axis is told by the frame and the masks stay. An outline that
+    tells no axis adds nothing to the costs: with one that tells both, the same shift as without it."""
+    from dataclasses import replace
+
+    depth, _ = ball(centre=(80 + 5, 60 + 4), rim=0.13, noise=0.0005)
+    _, mask = ball()
+    told = registration_outline(depth, mask, F, max_px=12)
+    assert told is not None and told.axes == (True, True)
+    assert registration_search([told], max_px=12) == (5, 4)
+    junctions = replace(told, sides=np.array([[30, 30], [0, 30], [0, 30], [30, 30]]))  # as many as told's
+    assert junctions.axes == (False, False)
+    assert registration_search([told, junctions, junctions], max_px=12) == (0, 0)
+    free = replace(told, sides=np.array([[10, 10], [10, 10], [0, 10], [0, 10]]))  # tells dv alone
+    assert registration_search([told, free], max_px=12) == (5, 4)
+    # a ball whose left side and bottom end at a leaf in front: its outline is kept, telling no axis (was None)
+    depth, disc = ball(rim=0.13, noise=0.0005)
+    yy = np.mgrid[:H, :W][0]
+    leaf = a_leaf(disc) | (disc.any(axis=0)[None, :] & (yy > 60 + 0.5 * 20))
+    found = registration_outline(leaf_in_front(depth, leaf, lost_px=1), disc & ~leaf, F, max_px=12, occluders=True)
+    assert found is not None and found.axes == (False, False)
+    # without extract.occluder_edges (the default): the lost band is free, as before stop 62
+    former = registration_outline(leaf_in_front(depth, leaf, lost_px=1), disc & ~leaf, F, max_px=12)
+    assert former is not None and former.axes == (True, True)

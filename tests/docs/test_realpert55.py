@@ -359,3 +359,34 @@ def test_the_centre_offsets_are_distances_to_the_same_methods_unperturbed_box(rp
             SphereBox("g", 1, "evidence", (60.0,) * 3, 60.0, centre=(0.0, 0.0, 1.0))]  # no reference  # fmt: skip
     assert rp.centre_offsets(rows, none).tolist() == pytest.approx([5.0, 12.0])
     assert rp._mean_worst(rp.centre_offsets(rows, none)) == "8.5 / 12.0" and rp._mean_worst(np.array([])) == "-"
+
+
+# --- stop 62, leaf62: a leaf's lost edge is not the fruit's silhouette for the registration
+
+
+CUT_SHIFTS = [
+    ("leafstrip5-cut", "lab-spheres-0", (-4, 3)),
+    ("leafstrip5-cut", "lab-spheres-1", (0, 5)),
+    ("leafside5-cut-green", "lab-spheres-1", (-1, 11)),
+]
+
+
+@pytest.mark.parametrize(("name", "frame_name", "off_shift"), CUT_SHIFTS)
+def test_a_leaf_cutting_the_masks_moves_them_only_where_its_lost_edge_reads_as_a_silhouette(
+    rp, name, frame_name, off_shift
+):
+    """Stop 62 (docs/leaf62.md): with a strip or a leaf 5 cm in front cutting every mask, the registration moved the
+    masks 3-11 px (the real frames are registered to 0): the band of depth the camera loses along the leaf's edge
+    was read as the spheres' silhouettes. With ``extract.occluder_edges`` it is a junction and the frame keeps its
+    masks; with a pool of one worker (each mask's outline found on it) the same shift."""
+    from symfruit.fruitpool import FruitPool
+    from symfruit.settings import from_dict
+
+    frame = read_frame(rp.FRAMES / frame_name)
+    color, depth, masks, cam = rp.PERTURBATIONS[name](frame)
+    cut = Frame(name=name, color=color, depth=depth, camera=cam, masks=masks)
+    on = from_dict({"extract": {"occluder_edges": True}})
+    assert detect(cut, method="raw").registration == off_shift
+    assert detect(cut, method="raw", settings=on).registration == (0, 0)
+    with FruitPool(1, method=None) as pool:
+        assert detect(cut, method="raw", settings=on, pool=pool).registration == (0, 0)

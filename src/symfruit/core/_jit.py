@@ -5241,7 +5241,8 @@ def ray_pixels(keep: np.ndarray, r0: int, c0: int) -> tuple[np.ndarray, np.ndarr
 
 @_njit
 def free_outline(
-    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, pad: int
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, pad: int,
+    tol: float = np.inf,
 ) -> np.ndarray:  # fmt: skip
     """(n,) bool: :func:`symfruit.core.surface._free_points`' free points of the outline ``(rows, cols)`` (n >= 1):
     on the outline's box grown by ``pad`` (clipped to the array), the gap (the pixels not ``cap``'s whose ``depth``
@@ -5253,7 +5254,13 @@ def free_outline(
     at the first one in reach, instead of a distance map of the whole box read at the points: a gap pixel within
     ``reach`` lies within ``floor(reach)`` rows and columns, and whether the least squared distance ``d`` passes
     (``d <= reach ** 2`` and ``sqrt(d) <= reach``) is whether any does (both tests grow with ``d``). The gap is read
-    within the box alone, as the map was made there."""
+    within the box alone, as the map was made there.
+
+    Since stop 62 (leaf62) a gap pixel without depth counts only where no pixel other than ``cap``'s within ``reach``
+    of it (anywhere in the array) holds depth nearer than the point's own by more than ``tol`` (the twin's
+    :func:`symfruit.core.surface._occluders_edge`): a lost band beside something in front is that occluder's edge.
+    A gap pixel seen past (at least ``far``) counts as before; ``tol`` infinite: the former points. Each gap pixel's
+    nearest such depth is worked out once, when first asked."""
     h, w = cap.shape
     rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
     for i in range(rows.shape[0]):
@@ -5279,13 +5286,33 @@ def free_outline(
                 dr_at[j], dc_at[j], d_at[j] = dr, dc, d
                 n_off += 1
     free = np.zeros(rows.shape[0], np.bool_)
+    check = tol < np.inf
+    # the nearest depth not the cap's within reach of each gap pixel of the box (NaN: not yet worked out)
+    nearest = np.full((r1 - r0, c1 - c0), np.nan) if check else np.empty((0, 0))
     for i in range(rows.shape[0]):
         r, c = rows[i], cols[i]
+        bound = depth[r, c] - tol
         for j in range(n_off):
             rr, cc = r + dr_at[j], c + dc_at[j]
             if r0 <= rr < r1 and c0 <= cc < c1 and not cap[rr, cc]:
                 z = depth[rr, cc]
-                if z <= 0 or z >= far:
+                if z >= far:
+                    free[i] = True
+                    break
+                if z <= 0:
+                    if check:
+                        m = nearest[rr - r0, cc - c0]
+                        if m != m:  # first asked: the least depth above 0 about it, off the cap
+                            m = np.inf
+                            for q in range(n_off):
+                                r2, c2 = rr + dr_at[q], cc + dc_at[q]
+                                if 0 <= r2 < h and 0 <= c2 < w and not cap[r2, c2]:
+                                    z2 = depth[r2, c2]
+                                    if 0 < z2 < m:
+                                        m = z2
+                            nearest[rr - r0, cc - c0] = m
+                        if m < bound:  # an occluder's lost edge, not this silhouette's
+                            continue
                     free[i] = True
                     break
     return free
@@ -9209,12 +9236,14 @@ def outline_windows(
 
 @_njit
 def cap_outline(
-    pixels: np.ndarray, r: int, c: int, depth: np.ndarray, far: float, reach: float, pad: int, least: int
+    pixels: np.ndarray, r: int, c: int, depth: np.ndarray, far: float, reach: float, pad: int, least: int,
+    tol: float = np.inf,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`symfruit.core.surface._outline`'s cap and its outline in one call: the piece of ``pixels`` (h, w) bool
     holding its pixel ``(r, c)`` (which must be ``pixels``'): :func:`connected_at`'s; its outline's rows and columns
     (raster order): :func:`outline_pixels`'; and, where there are at least ``least`` of them, which are free
-    (:func:`free_outline` over ``depth`` (h, w) float64 with ``far``, ``reach`` and ``pad``; else an empty array):
+    (:func:`free_outline` over ``depth`` (h, w) float64 with ``far``, ``reach``, ``pad`` and ``tol``; else an empty
+    array):
     the same pixels and points.
 
     Since issue 19's stop 60 (speedr60) the flood keeps each pixel's row and column (no division of a flat index)
@@ -9250,7 +9279,7 @@ def cap_outline(
     rows, cols = rows_at[:n].copy(), cols_at[:n].copy()
     if n < least:
         return rows, cols, np.empty(0, np.bool_)
-    return rows, cols, free_outline(depth, cap, rows, cols, far, reach, pad)
+    return rows, cols, free_outline(depth, cap, rows, cols, far, reach, pad, tol)
 
 
 # --- stop 50, observe50: the completion's observe in fewer calls -----------------------------------------------------

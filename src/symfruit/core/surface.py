@@ -1554,10 +1554,11 @@ def _sort_rows(keys: np.ndarray) -> np.ndarray:
 
 
 def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_points: int = 160, *,
-             clean: bool = False) -> _Outline | None:  # fmt: skip
+             clean: bool = False, occluders: bool = False) -> _Outline | None:  # fmt: skip
     """The free points of the outline of a fruit's depth cap found around its mask (``reach`` pixels beyond it),
     and how many of each side's points are free (:func:`_free_points`), or None (fewer than 12 free points).
-    ``clean``: :func:`fruit_surface`'s (the depth finite, above 0 or 0 already)."""
+    ``clean``: :func:`fruit_surface`'s (the depth finite, above 0 or 0 already). ``occluders``: a lost band beside
+    something in front is a junction (:func:`_free_points`' ``tol``, ``extract.occluder_edges``; stop 62)."""
     jit = compiled() if mask.dtype == bool and mask.ndim == 2 and mask.any() and not mask.all() else None
     found: tuple[bool, np.ndarray, np.ndarray, np.ndarray] | None = None
     inside: np.ndarray | None = None
@@ -1575,12 +1576,13 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
         return None
     jit = compiled()
     pixels, apex = surface.pixels, surface.apex
+    tol = _free_tol(surface) if occluders else np.inf
     free: np.ndarray | None = None
     if jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and pixels.dtype == bool and pixels[apex]:
         # the cap, its outline and the outline's free points in one call (stop 50: the same pixels and points)
         cap = pixels  # not read below: _free_points is given the free points
         rows, cols, free = jit.cap_outline(pixels, apex[0], apex[1], depth, _free_far(surface), _FREE_PX,
-                                           int(_FREE_PX) + 1, 12)  # fmt: skip
+                                           int(_FREE_PX) + 1, 12, tol)  # fmt: skip
     else:
         cap = _connected(pixels, apex)
         if jit is not None:  # the outline's pixels in one pass (issue 19, nineteenth round: the same)
@@ -1589,7 +1591,7 @@ def _outline(depth: np.ndarray, mask: np.ndarray, focal: float, reach: int, max_
             rows, cols = np.nonzero(cap & ~interior(cap))
     if len(rows) < 12:
         return None
-    free, sides = _free_points(depth, cap, rows, cols, surface, free=free)
+    free, sides = _free_points(depth, cap, rows, cols, surface, free=free, tol=tol)
     rows, cols = rows[free], cols[free]  # where the depth runs on, no band lies to be measured
     if len(rows) < 12:
         return None
@@ -1632,11 +1634,41 @@ _FREE_SHARE = 0.5
 def _free_far(surface: Surface) -> float:
     """:func:`_free_points`' depth beyond which a pixel is behind the fruit's rim: its front plus its radius, plus the
     convexity test's tolerance."""
-    return surface.front + surface.radius + max(3.0 * surface.noise, 0.003)
+    return surface.front + surface.radius + _free_tol(surface)
+
+
+def _free_tol(surface: Surface) -> float:
+    """:func:`_free_points`' depth tolerance (m), the convexity test's: three times the depth's noise, at least 3 mm.
+    Depth nearer than an outline point's own by more than it is something in front of the fruit there."""
+    return max(3.0 * surface.noise, 0.003)
+
+
+def _occluders_edge(depth: np.ndarray, cap: np.ndarray, box: tuple[slice, slice], reach: float) -> np.ndarray:
+    """The least depth above 0 of the pixels not ``cap``'s within ``reach`` of each pixel of ``box`` (+inf where none),
+    :func:`_free_points`' look beside a pixel without depth for something in front (the numpy twin of
+    :func:`symfruit.core._jit.free_outline`'s; the pixels in reach are :func:`within`'s disc, read over the whole
+    array)."""
+    k = int(np.floor(reach)) if reach >= 0 else -1
+    r0, r1, c0, c1 = box[0].start, box[0].stop, box[1].start, box[1].stop
+    h, w = depth.shape
+    r1, c1 = min(r1, h), min(c1, w)
+    with np.errstate(invalid="ignore"):
+        other = np.where(~cap & (depth > 0), depth, np.inf)
+    out = np.full((r1 - r0, c1 - c0), np.inf)
+    if k < 0:
+        return out
+    padded = np.pad(other, k, constant_values=np.inf)
+    for dr in range(-k, k + 1):
+        for dc in range(-k, k + 1):
+            d = dr * dr + dc * dc
+            if d <= reach * reach and np.sqrt(float(d)) <= reach:
+                part = padded[r0 + k + dr : r1 + k + dr, c0 + k + dc : c1 + k + dc]
+                np.minimum(out, part, out=out)
+    return out
 
 
 def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, surface: Surface, *,
-                 free: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
+                 free: np.ndarray | None = None, tol: float = np.inf) -> tuple[np.ndarray, np.ndarray]:  # fmt: skip
     """Which points of a depth cap's outline (``rows``, ``cols``) are *free*: a true silhouette, whose band inside
     the mask (:func:`registration_shift`) is there to be measured; and of the points on its top, bottom, left
     and right side, how many are free and how many there are: ``((n,) bool, (4, 2) int)``.
@@ -1646,6 +1678,12 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
     behind the fruit's rim (its front plus its radius, plus the convexity test's tolerance: what a fruit hides
     lies behind its rim). Where the depth runs on at the fruit's own depth or nearer, into a support, a
     neighbour or a leaf in front, the outline is the junction, not the silhouette, and no band lies there.
+    With ``tol`` finite (``extract.occluder_edges``; the registration gives :func:`_free_tol`), a pixel without
+    depth that has, within :data:`_FREE_PX` of it, a pixel other than the cap's nearer than the outline point by
+    more than ``tol`` is the lost edge of something in front, not the fruit's: a time-of-flight camera invalidates
+    the mixed pixels along every step in depth, an occluder's too, so the band of lost depth between a leaf in
+    front and the fruit is a junction (stop 62, docs/leaf62.md: a leaf or a strip cutting the masks of the real
+    frames moved them by 3-11 px).
     The sides are counted on the outline's rim (:func:`_rim`); a point belongs to the side its direction from the
     outline's centroid points to most. ``free``: the free points when the caller has them (:func:`_outline`'s
     :func:`symfruit.core._jit.cap_outline`; ``cap`` is then not read)."""
@@ -1656,12 +1694,28 @@ def _free_points(depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.
         pass
     elif jit is not None and depth.dtype == np.float64 and depth.ndim == 2 and cap.dtype == bool and len(rows):
         # the gap, its distances and the points' test in one pass (issue 19, nineteenth round: the same points)
-        free = jit.free_outline(depth, cap, rows, cols, _free_far(surface), _FREE_PX, r)
+        free = jit.free_outline(depth, cap, rows, cols, _free_far(surface), _FREE_PX, r, tol)
     else:
         r0, c0 = max(int(rows.min()) - r, 0), max(int(cols.min()) - r, 0)
         box = (slice(r0, int(rows.max()) + r + 1), slice(c0, int(cols.max()) + r + 1))
-        gap = ~cap[box] & ((depth[box] <= 0) | (depth[box] >= _free_far(surface)))
-        free = within(gap, _FREE_PX)[rows - r0, cols - c0]
+        zb, outside = depth[box], ~cap[box]
+        past = outside & (zb >= _free_far(surface))
+        lost = outside & (zb <= 0)
+        if not lost.any() or not np.isfinite(tol):
+            free = within(past | lost, _FREE_PX)[rows - r0, cols - c0]
+        else:  # a lost pixel counts where nothing within reach of it lies nearer than the point by the tolerance
+            nearest = _occluders_edge(depth, cap, box, _FREE_PX)
+            bound = depth[rows, cols] - tol
+            free = np.zeros(len(rows), bool)
+            k, (bh, bw) = int(_FREE_PX), zb.shape
+            for dr in range(-k, k + 1):
+                for dc in range(-k, k + 1):
+                    if dr * dr + dc * dc > _FREE_PX * _FREE_PX or np.sqrt(float(dr * dr + dc * dc)) > _FREE_PX:
+                        continue
+                    rr, cc = rows - r0 + dr, cols - c0 + dc
+                    ok = (rr >= 0) & (rr < bh) & (cc >= 0) & (cc < bw)
+                    rr, cc = np.where(ok, rr, 0), np.where(ok, cc, 0)
+                    free |= ok & (past[rr, cc] | (lost[rr, cc] & ~(nearest[rr, cc] < bound)))
     if jit is not None:  # the compiled twin of the rim and its sides, from numpy's directions on
         # the means from whole-number sums (exact in any order, as numpy's float64 sums of them are; its mean divides
         # the same sum): rows.mean() and cols.mean() bit for bit, without their casts (stop 49)
@@ -1700,7 +1754,8 @@ def _taxicab_within(mask: np.ndarray, reach: int) -> np.ndarray:
 def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, max_px: int,
                        trim: float = 0.7, gain: float = 0.25,
                        depth_range: tuple[float, float] = (0.0, np.inf),
-                       boxes: list[tuple[slice, slice] | None] | None = None) -> tuple[int, int]:  # fmt: skip
+                       boxes: list[tuple[slice, slice] | None] | None = None,
+                       occluders: bool = False) -> tuple[int, int]:  # fmt: skip
     """``(du, dv)``, pixels: how far the depth image sits from the masks (depth pixel ``(u + du, v + dv)`` sees
     what colour pixel ``(u, v)`` sees); ``(0, 0)`` when the masks do not say.
 
@@ -1735,6 +1790,10 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
         Depth outside it is none.
     boxes : list of (slice, slice) or None, optional
         ``ndimage.find_objects(labels)`` when the caller has it.
+    occluders : bool
+        ``extract.occluder_edges`` (stop 62, docs/leaf62.md): a band of lost depth beside something in front of
+        the fruit is that occluder's edge, a junction, not a free point (:func:`_free_points`), and an outline
+        that tells no axis still counts its sides in the frame's pool (:func:`registration_outline`).
     """
     if max_px <= 0:
         return 0, 0
@@ -1744,7 +1803,7 @@ def registration_shift(depth: np.ndarray, labels: np.ndarray, focal: float, *, m
             continue
         r0, r1, c0, c1 = registration_window(labels.shape, sl, max_px)
         found = registration_outline(depth[r0:r1, c0:c1], labels[r0:r1, c0:c1] == k, focal, max_px=max_px,
-                                     depth_range=depth_range)  # fmt: skip
+                                     depth_range=depth_range, occluders=occluders)  # fmt: skip
         if found is not None:
             outlines.append(found)
     return registration_search(outlines, max_px=max_px, trim=trim, gain=gain)
@@ -1759,10 +1818,13 @@ def registration_window(shape: tuple[int, ...], sl: tuple[slice, slice], max_px:
 
 
 def registration_outline(depth: np.ndarray, mask: np.ndarray, focal: float, *, max_px: int,
-                         depth_range: tuple[float, float] = (0.0, np.inf)) -> _Outline | None:  # fmt: skip
+                         depth_range: tuple[float, float] = (0.0, np.inf),
+                         occluders: bool = False) -> _Outline | None:  # fmt: skip
     """One mask's part of :func:`registration_shift` (``max_px`` above 0): the outline of its depth cap, from the
     depth and the (bool) mask of its window (:func:`registration_window`), or None when the mask is too small (30
-    pixels) or its outline tells no axis. It reads this fruit's window alone: the outlines of a frame's masks are
+    pixels) or its outline tells no axis (with ``occluders``, :func:`registration_shift`'s, such an outline is
+    returned unless it has too few free points: its sides count in :func:`registration_search`'s pool of the
+    frame's sides, though it costs no shift). It reads this fruit's window alone: the outlines of a frame's masks are
     found in any order, or on several processes (:class:`~symfruit.fruitpool.FruitPool`), with the same values;
     :func:`registration_search` takes them in the frame's order."""
     lo, hi = depth_range
@@ -1778,9 +1840,10 @@ def registration_outline(depth: np.ndarray, mask: np.ndarray, focal: float, *, m
     else:
         z = np.where(np.isfinite(z) & (z > 0) & (z >= lo) & (z <= hi), z, 0.0)
     # z is finite, above 0 or 0 (valid_depth's least depth is above 0): fruit_surface reads it as it is (stop 49)
-    if (found := _outline(z, mask, focal, max_px, clean=True)) is not None and any(found.axes):
-        return found
-    return None
+    found = _outline(z, mask, focal, max_px, clean=True, occluders=occluders)
+    # with occluders, an outline that tells no axis is kept too: its sides count in the frame's pool
+    # (registration_search), though it costs no shift (stop 62, docs/leaf62.md)
+    return found if found is not None and (occluders or any(found.axes)) else None
 
 
 def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 0.7,
@@ -1788,6 +1851,15 @@ def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 
     """:func:`registration_shift`'s answer ``(du, dv)`` from the frame's outlines (:func:`registration_outline`'s,
     in the frame's order; ``trim`` and ``gain`` as there)."""
     if max_px <= 0 or not outlines:
+        return 0, 0
+    # an axis is searched when the frame's outlines, pooled, tell it (a fruit whose side is free by a few points
+    # does not outvote the others; those that tell no axis count here too: a frame whose fruit end mostly at a leaf
+    # in front does not leave one outline, perhaps the leaf's own, to decide it; stop 62) and a fruit tells it;
+    # otherwise it keeps 0
+    counted = [o.sides for o in outlines if o.sides is not None]
+    pooled = _told_axes(np.sum(counted, axis=0)) if counted else (True, True)
+    outlines = [o for o in outlines if any(o.axes)]  # the outlines that cost shifts
+    if not outlines:
         return 0, 0
 
     def cost(shifts: np.ndarray, exact: bool = True) -> np.ndarray:
@@ -1797,10 +1869,6 @@ def registration_search(outlines: list[_Outline], *, max_px: int, trim: float = 
     frame = _FrameCosts.of(outlines, max_px, trim)
     least = functools.partial(frame.least, cost=cost)
 
-    # an axis is searched when the frame's outlines, pooled, tell it (a fruit whose side is free by a few points
-    # does not outvote the others) and a fruit tells it; otherwise it keeps 0
-    counted = [o.sides for o in outlines if o.sides is not None]
-    pooled = _told_axes(np.sum(counted, axis=0)) if counted else (True, True)
     tell_v, tell_u = (pooled[i] and any(o.axes[i] for o in outlines) for i in (0, 1))
     if not (tell_v or tell_u):
         return 0, 0
