@@ -377,6 +377,37 @@ def test_the_masks_boxes_are_find_objects(seed):
         assert _label_boxes(labels, count) == want
 
 
+@given(st.integers(0, 2**32 - 1))
+def test_the_moved_masks_boxes_are_find_objects(seed):
+    # the boxes of masks moved by a shift, with pixels given back within their drawn boxes moved (_kept_caps'), are
+    # looked for there alone (stop 62): find_objects' boxes, with the kernel and without, masks pushed off the image
+    # by the shift or left without pixels included
+    from scipy import ndimage
+
+    from symfruit.detect import _label_boxes, _moved_boxes
+    from symfruit.extract import shift_labels
+
+    rng = np.random.default_rng(seed)
+    h, w = 40, 70
+    drawn = np.zeros((h, w), np.int32)
+    for k in range(1, int(rng.integers(1, 7))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        drawn[r0 : r0 + int(rng.integers(1, 15)), c0 : c0 + int(rng.integers(1, 25))] = k
+    count = int(drawn.max())
+    boxes = _label_boxes(drawn, count)
+    trimmed = np.where(rng.random((h, w)) < rng.uniform(0.0, 0.6), 0, drawn).astype(np.int32)  # pixels taken
+    du, dv = (int(v) for v in rng.integers(-12, 13, 2))
+    moved = shift_labels(trimmed, du, dv)
+    back = shift_labels(drawn, du, dv)  # some of the drawn pixels given back where nothing else is
+    give = (back > 0) & (moved == 0) & (rng.random((h, w)) < 0.3)
+    moved[give] = back[give]
+    want = ndimage.find_objects(moved, count)
+    assert _moved_boxes(moved, boxes, (du, dv)) == want
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        assert _moved_boxes(moved, boxes, (du, dv)) == want
+
+
 def test_the_default_settings_are_made_once_while_the_sections_stay():
     """``detect`` without settings reads ``Settings()``, made once (immutable) and made anew when a section is
     registered after it."""

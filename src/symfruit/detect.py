@@ -281,7 +281,7 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
         moved = _kept_caps(frame, drawn, labels, moved, colour_trimmed, drawn_boxes, shift, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, prep.hi, boxes, settings, method, outlined,
-                                         colour_trimmed)  # fmt: skip
+                                         colour_trimmed, drawn_boxes)  # fmt: skip
         t_extract = ended - t2
         t_register, cpu_elsewhere = t_extract - t_trim, 0.0
         running = Running.ready(([fruit(k, sl) for k, sl in jobs], 0.0))
@@ -326,12 +326,16 @@ class _Started:
 def _fruit_task(
     frame: Frame, labels: np.ndarray, moved: np.ndarray, shift: tuple[int, int], hi: int,
     boxes: list[tuple[slice, slice] | None], settings: Settings, method: str, outlined: bool, colour_trimmed: set[int],
+    drawn_boxes: list[tuple[slice, slice] | None] | None = None,
 ) -> tuple[_Fruit, list[tuple[int, tuple[slice, slice]]], float]:  # fmt: skip
     """The frame's per-fruit task and its jobs, from the trimmed ``labels`` (greatest label ``hi``, boxes ``boxes``)
     moved by ``shift`` onto the depth image (``moved``: ``labels`` itself when they did not move), and when the
-    registration's part of it ended (``time.perf_counter()``: the boxes and the camera moved)."""
+    registration's part of it ended (``time.perf_counter()``: the boxes and the camera moved). ``drawn_boxes``: the
+    boxes of the masks before their trimming when ``moved`` holds each mask's pixels within its drawn box moved by
+    ``shift`` alone (:func:`_kept_caps`' masks: their trimmed pixels moved, and what it gives back from the drawn
+    mask moved): the moved masks' boxes are looked for there (:func:`_moved_boxes`)."""
     if moved is not labels:
-        boxes = _label_boxes(moved, hi)
+        boxes = _label_boxes(moved, hi) if drawn_boxes is None else _moved_boxes(moved, drawn_boxes, shift)
     # Every fruit is extracted, occluded and completed on the depth image's pixels, with the camera whose principal
     # point follows the shift: its points deproject to where the colour camera, whose frame the intrinsics are,
     # sees them (deprojected with the colour camera's own, a fruit 6 px off sat 8 mm off at 1.25 m).
@@ -371,7 +375,7 @@ def _detect_shared(
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
     moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, guess, settings.extract)
     fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
-                                     colour_trimmed)  # fmt: skip
+                                     colour_trimmed, drawn_boxes)  # fmt: skip
     t_register = t_outlines + ended - a  # the move's and the search's seconds with them
     if len(jobs) >= 2:
         running = pool.start(fruit, jobs, same, search, leave=leave)  # the first failing fruit's error is raised
@@ -385,7 +389,7 @@ def _detect_shared(
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
         moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, found, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
-                                         colour_trimmed)  # fmt: skip
+                                         colour_trimmed, drawn_boxes)  # fmt: skip
         t_register += ended - b
         if len(jobs) >= 2:
             running = pool.start(fruit, jobs, same, leave=leave)
@@ -603,6 +607,29 @@ def _label_boxes(labels: np.ndarray, count: int) -> list[tuple[slice, slice] | N
     if jit is None or count <= 0 or labels.ndim != 2 or labels.dtype != np.int32:
         return list(ndimage.find_objects(labels))
     found = jit.label_boxes(labels, int(count)).tolist()
+    return [None if r1 == 0 else (slice(r0, r1, None), slice(c0, c1, None)) for r0, r1, c0, c1 in found]
+
+
+def _moved_boxes(moved: np.ndarray, drawn: list[tuple[slice, slice] | None],
+                 shift: tuple[int, int]) -> list[tuple[slice, slice] | None]:  # fmt: skip
+    """``ndimage.find_objects(moved)`` of labels ``moved`` (greatest label ``len(drawn)`` at most) whose every mask
+    ``k`` lies within its box ``drawn[k - 1]`` (None: it has no pixels) moved by ``shift`` ``(du, dv)``: each mask's
+    box looked for within that window alone (issue 19, stop 62: the moved masks' boxes without a pass over the whole
+    image; the same boxes), by :func:`symfruit.core._jit.boxes_within` where numba is."""
+    du, dv = shift
+    h, w = moved.shape
+    windows = np.zeros((len(drawn), 4), np.int64)  # (0, 0, 0, 0): no window, no pixels
+    for i, sl in enumerate(drawn):
+        if sl is not None:
+            r0, r1 = max(sl[0].start + dv, 0), min(sl[0].stop + dv, h)
+            c0, c1 = max(sl[1].start + du, 0), min(sl[1].stop + du, w)
+            if r0 < r1 and c0 < c1:
+                windows[i] = (r0, r1, c0, c1)
+    jit = compiled()
+    if jit is None or moved.ndim != 2 or moved.dtype != np.int32:
+        return [None if r1 == 0 else _box_within(moved, k, (slice(r0, r1), slice(c0, c1)))
+                for k, (r0, r1, c0, c1) in enumerate(windows.tolist(), 1)]  # fmt: skip
+    found = jit.boxes_within(moved, windows).tolist()
     return [None if r1 == 0 else (slice(r0, r1, None), slice(c0, c1, None)) for r0, r1, c0, c1 in found]
 
 

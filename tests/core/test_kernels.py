@@ -3582,28 +3582,41 @@ def test_the_sectors_from_the_table_are_the_arctan2_ones(seed, bins):
 
 @settings(max_examples=300, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.sampled_from([0.001, 0.004, 0.006, 0.02]),
-       st.floats(0.001, 0.2))  # fmt: skip
-def test_one_slab_is_found_only_without_a_gap_and_the_clusters_are_the_twins(seed, n, distance, spread):
-    """_one_slab finds one slab only where the sorted depths have no gap over ``distance`` (depths drawn from a few
-    values, gaps just over and under ``distance``), and clusters (which then skips the sort) gives the numpy twin's
-    labels either way."""
+       st.floats(0.001, 0.2), st.sampled_from(["spread", "few", "far"]))  # fmt: skip
+def test_depth_slabs_are_the_sorted_depths_slabs_and_the_clusters_are_the_twins(seed, n, distance, spread, kind):
+    """_depth_slabs (stop 62) cuts the points into the slabs of their sorted depths: each run of its order holds the
+    points of one run of the sorted depths between gaps over ``distance``, in ascending order of depth (depths drawn
+    from a few values, gaps just over and under ``distance``, a few points far behind: its stable sort), and clusters
+    gives the numpy twin's labels either way."""
     from symfruit.extract import cluster
 
     rng = np.random.default_rng(seed)
     points = rng.uniform(-0.03, 0.03, (n, 3))
-    points[:, 2] = 0.5 + rng.choice(rng.uniform(0.0, spread, 8), n) if rng.random() < 0.5 else (
-        0.5 + rng.uniform(0.0, spread, n))  # fmt: skip
+    points[:, 2] = 0.5 + (rng.choice(rng.uniform(0.0, spread, 8), n) if kind == "few" else rng.uniform(0.0, spread, n))
     if rng.random() < 0.3 and n > 2:  # a gap of about the distance
         points[: n // 2, 2] += rng.choice([distance * (1 - 1e-12), distance * (1 + 1e-12), 1.5 * distance])
-    single = _jit._one_slab(points, distance)
-    z = np.sort(points[:, 2])
-    if len(single) == n:
-        assert not (np.diff(z) > distance).any()
-    else:
-        assert len(single) == 0
+    if kind == "far":  # more buckets than four a point: the stable sort
+        points[: max(1, n // 10), 2] += rng.uniform(2.0, 5.0, max(1, n // 10))
+    order, ends = _jit._depth_slabs(points, distance)
+    assert np.array_equal(np.sort(order), np.arange(n)) and ends[-1] == n and (np.diff(ends) > 0).all()
+    z = np.sort(points[:, 2], kind="stable")
+    want = np.r_[np.flatnonzero(np.diff(z) > distance) + 1, n]
+    np.testing.assert_array_equal(ends, want)
+    for lo, hi in zip(np.r_[0, ends[:-1]], ends, strict=True):  # each run: the sorted depths' run, as a multiset
+        np.testing.assert_array_equal(np.sort(points[order[lo:hi], 2]), z[lo:hi])
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, cluster, points, distance)
     np.testing.assert_array_equal(fast, twin)
+    labels, done = _jit.clusters(points, distance)
+    assert done and np.array_equal(labels, twin)
+
+
+def test_clusters_of_no_points_and_of_one():
+    """No points: no labels (done); one point: label 0."""
+    labels, done = _jit.clusters(np.zeros((0, 3)), 0.006)
+    assert done and labels.dtype == np.int64 and len(labels) == 0
+    labels, done = _jit.clusters(np.array([[0.0, 0.0, 0.5]]), 0.006)
+    assert done and labels.tolist() == [0]
 
 
 # --- stop 40, speedseg40
@@ -5436,6 +5449,47 @@ def test_the_label_boxes_are_find_objects(seed, h, w, n):
         assert got[k].tolist() == expect
 
 
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.integers(1, 50), st.integers(1, 130), st.integers(1, 12))
+def test_the_boxes_within_windows_are_find_objects(seed, h, w, n):
+    """boxes_within (stop 62) against ``ndimage.find_objects`` on random label images whose labels each lie within a
+    window holding their box (grown by 0-5 pixels, beyond the image on some sides, empty for a label without
+    pixels or at random for one with none): the same boxes, r1 = 0 for a label without pixels; and a window cut
+    short of a label's box finds the box of its pixels within the window alone."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    labels = np.zeros((h, w), np.int32)
+    for _ in range(int(rng.integers(0, 8))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        labels[r0 : r0 + int(rng.integers(1, 20)), c0 : c0 + int(rng.integers(1, 80))] = rng.integers(1, n + 1)
+    labels[rng.random((h, w)) < rng.choice([0.0, 0.01, 0.3])] = rng.integers(0, n + 1)
+    want = ndimage.find_objects(labels, n)
+    windows = np.zeros((n, 4), np.int64)
+    for k, sl in enumerate(want):
+        if sl is None:
+            if rng.random() < 0.5:  # a window over pixels of other labels alone
+                windows[k] = (0, h, 0, w)
+            continue
+        grow = rng.integers(0, 6, 4)
+        windows[k] = (sl[0].start - grow[0], sl[0].stop + grow[1], sl[1].start - grow[2], sl[1].stop + grow[3])
+    got = _jit.boxes_within(labels, windows)
+    for k in range(n):
+        sl = want[k]
+        expect = [0, 0, 0, 0] if sl is None else [sl[0].start, sl[0].stop, sl[1].start, sl[1].stop]
+        assert got[k].tolist() == expect
+    cut = windows.copy()
+    cut[:, 1] = np.maximum(cut[:, 0], cut[:, 1] - 2)  # the boxes' last two rows left out
+    got = _jit.boxes_within(labels, cut)
+    for k in range(n):
+        r0, r1, c0, c1 = (int(v) for v in cut[k])
+        r0, r1, c0, c1 = max(r0, 0), min(r1, h), max(c0, 0), min(c1, w)
+        part = ndimage.find_objects((labels[r0:r1, c0:c1] == k + 1).astype(np.int32)) if r0 < r1 and c0 < c1 else []
+        expect = [0, 0, 0, 0] if not part or part[0] is None else [
+            r0 + part[0][0].start, r0 + part[0][0].stop, c0 + part[0][1].start, c0 + part[0][1].stop]  # fmt: skip
+        assert got[k].tolist() == expect
+
+
 # --- stop 46, regspeed46
 
 
@@ -6600,10 +6654,11 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
 @settings(max_examples=150, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.5), st.integers(0, 8))
 def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, pad):
-    """``free_outline`` (stop 60: each point's look at the gap pixels about it, nearest first) on random caps over
-    depth with holes, pixels behind and in front, any reach (whole or not) and pad (below the reach too): the points
-    within ``reach`` of the gap made on the outline's box grown by ``pad``, as the twin finds them (``within``'s
-    numpy dilation of that gap, read at the points), bit for bit."""
+    """``free_outline`` (stop 60: each point's look at the gap pixels about it; stop 62: by each row's running count
+    of gap pixels) on random caps over depth with holes, pixels behind and in front, any reach (whole or not) and
+    pad (below the reach too), at the outline's points or at points anywhere: the points within ``reach`` of the gap
+    made on the points' box grown by ``pad``, as the twin finds them (``within``'s numpy dilation of that gap, read
+    at the points), bit for bit."""
     from symfruit.core.raster import interior
     from symfruit.core.surface import within
 
@@ -6613,6 +6668,9 @@ def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, p
     if not cap.any():
         cap[0, 0] = True
     rows, cols = np.nonzero(cap & ~interior(cap))
+    if rng.random() < 0.3:  # points anywhere, repeated too
+        n = int(rng.integers(1, 40))
+        rows, cols = rng.integers(0, h, n).astype(np.int64), rng.integers(0, w, n).astype(np.int64)
     depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
     depth[depth < 0.1] = 0.0
     depth[rng.random((h, w)) < 0.02] = np.nan

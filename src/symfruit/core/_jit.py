@@ -3729,34 +3729,32 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
     or an empty array and False where the twin is to run instead (a depth slab's grid of cubes over 2e7 cells,
     whose clusters the twin links through a tree and numbers otherwise, or a coordinate that is not finite).
 
-    The twin's steps on the same values: the points in a stable order of their depths, cut into slabs where
-    consecutive depths differ by more than ``distance``; in each slab the cubes of side ``distance / 2`` from the
-    slab's least corner (the same subtraction, division and floor), the occupied cubes numbered as
-    ``ndimage.label`` numbers them with the 26-neighbourhood (by the first cube of each cluster in the grid's raster
-    order: a flood fill from each unnumbered occupied cube met in that order); the clusters ranked by a stable sort
-    of their sizes, largest first. The same labels."""
+    The twin's steps on the same values: the points cut into slabs where consecutive depths (in their order) differ
+    by more than ``distance`` (:func:`_depth_slabs`); in each slab the cubes of side ``distance / 2`` from the slab's
+    least corner (the same subtraction, division and floor), the occupied cubes numbered as ``ndimage.label``
+    numbers them with the 26-neighbourhood (by the first cube of each cluster in the grid's raster order: a flood
+    fill from each unnumbered occupied cube met in that order); the clusters ranked by a stable sort of their sizes,
+    largest first. The same labels.
+
+    Since issue 19's stop 62 (reg62): the slabs come from buckets of the depths, not a sort (a slab's cubes and
+    clusters do not depend on the order of its points: only which points it holds), and the grid is padded by one
+    empty cube on every side, so a cube's 26 neighbours are fixed flat offsets away with no bounds tests and no
+    divisions (the padded grid's raster order is the grid's: the same clusters, numbered alike)."""
     n = points.shape[0]
     empty = np.zeros(0, np.int64)
     for i in range(n):
         for j in range(3):
             if not math.isfinite(points[i, j]):
                 return empty, False
+    if n == 0:
+        return empty, True
     voxel = distance / 2.0
-    # issue 19, twentieth round: where every bin of a quarter ``distance`` between the least and greatest depth holds
-    # a point, no two consecutive depths are more than ``distance`` apart (such a gap would hold two empty bins; the
-    # bins' floors are monotone in the depth and rounding moves them by far less than a bin), so the points are one
-    # slab, whose cubes and clusters do not depend on the points' order: the order is not sorted for
-    order = _one_slab(points, distance)
-    single = order.shape[0] == n
-    if not single:
-        order = np.argsort(points[:, 2], kind="mergesort")
+    order, ends = _depth_slabs(points, distance)
     labels = np.empty(n, np.int64)
+    offsets = np.empty(26, np.int64)
     next_label = 0
     lo = 0
-    while lo < n:
-        hi = n if single else lo + 1
-        while hi < n and not (points[order[hi], 2] - points[order[hi - 1], 2] > distance):
-            hi += 1
+    for hi in ends:
         if hi - lo == 1:
             labels[order[lo]] = next_label
             next_label += 1
@@ -3768,52 +3766,54 @@ def clusters(points: np.ndarray, distance: float) -> tuple[np.ndarray, bool]:
         for k in range(lo + 1, hi):
             for j in range(3):
                 least[j] = min(least[j], points[order[k], j])
-        cells = np.empty((hi - lo, 3), np.int64)
-        top = np.zeros(3, np.int64)
+        cx, cy, cz = np.empty(hi - lo, np.int64), np.empty(hi - lo, np.int64), np.empty(hi - lo, np.int64)
+        a, b, d = 0, 0, 0
         for k in range(lo, hi):
-            for j in range(3):
-                c = np.int64(math.floor((points[order[k], j] - least[j]) / voxel))
-                cells[k - lo, j] = c
-                top[j] = max(top[j], c)
-        a, b, d = top[0] + 1, top[1] + 1, top[2] + 1
+            p = order[k]
+            x = np.int64(math.floor((points[p, 0] - least[0]) / voxel))
+            y = np.int64(math.floor((points[p, 1] - least[1]) / voxel))
+            z = np.int64(math.floor((points[p, 2] - least[2]) / voxel))
+            cx[k - lo], cy[k - lo], cz[k - lo] = x, y, z
+            a, b, d = max(a, x), max(b, y), max(d, z)
+        a, b, d = a + 1, b + 1, d + 1
         if float(a) * float(b) * float(d) > 2e7:
             return empty, False
-        grid = np.zeros(a * b * d, np.int64)  # 0: empty, -1: occupied, k > 0: cluster k
+        pb, pd = b + 2, d + 2  # the padded grid's sizes along y and z
+        grid = np.zeros((a + 2) * pb * pd, np.int64)  # 0: empty, -1: occupied, k > 0: cluster k
+        cells = np.empty(hi - lo, np.int64)
         for k in range(hi - lo):
-            grid[(cells[k, 0] * b + cells[k, 1]) * d + cells[k, 2]] = -1
+            cells[k] = ((cx[k] + 1) * pb + cy[k] + 1) * pd + cz[k] + 1
+            grid[cells[k]] = -1
+        m = 0
+        for dx in range(-1, 2):
+            for dy in range(-1, 2):
+                for dz in range(-1, 2):
+                    if dx != 0 or dy != 0 or dz != 0:
+                        offsets[m] = (dx * pb + dy) * pd + dz
+                        m += 1
         stack = np.empty(hi - lo, np.int64)  # each occupied cube is pushed once
         count = 0
-        for f in range(a * b * d):
-            if grid[f] != -1:
-                continue
-            count += 1
-            grid[f] = count
-            stack[0] = f
-            size = 1
-            while size > 0:
-                size -= 1
-                g = stack[size]
-                x, rest = g // (b * d), g % (b * d)
-                y, z = rest // d, rest % d
-                for dx in range(-1, 2):
-                    xx = x + dx
-                    if xx < 0 or xx >= a:
+        for x in range(1, a + 1):
+            for y in range(1, b + 1):
+                row = (x * pb + y) * pd
+                for f in range(row + 1, row + d + 1):
+                    if grid[f] != -1:
                         continue
-                    for dy in range(-1, 2):
-                        yy = y + dy
-                        if yy < 0 or yy >= b:
-                            continue
-                        for dz in range(-1, 2):
-                            zz = z + dz
-                            if zz < 0 or zz >= d:
-                                continue
-                            h = (xx * b + yy) * d + zz
-                            if grid[h] == -1:
-                                grid[h] = count
-                                stack[size] = h
+                    count += 1
+                    grid[f] = count
+                    stack[0] = f
+                    size = 1
+                    while size > 0:
+                        size -= 1
+                        g = stack[size]
+                        for o in range(26):
+                            e = g + offsets[o]
+                            if grid[e] == -1:
+                                grid[e] = count
+                                stack[size] = e
                                 size += 1
         for k in range(hi - lo):
-            labels[order[lo + k]] = grid[(cells[k, 0] * b + cells[k, 1]) * d + cells[k, 2]] - 1 + next_label
+            labels[order[lo + k]] = grid[cells[k]] - 1 + next_label
         next_label += count
         lo = hi
     counts = np.zeros(next_label, np.int64)
@@ -4181,30 +4181,67 @@ def monotone_table(
 
 
 @_njit
-def _one_slab(points: np.ndarray, distance: float) -> np.ndarray:
-    """:func:`clusters`' test for a single slab (issue 19, twentieth round): ``arange(n)`` when every bin of width
-    ``distance / 4`` from the least to the greatest depth (``points[:, 2]``, finite) holds a point, so that no two
-    consecutive depths are more than ``distance`` apart; an empty array where a bin is empty (or ``distance`` is not
-    above 0), and the slabs are to be found by sorting."""
+def _depth_slabs(points: np.ndarray, distance: float) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`clusters`' slabs of ``points`` (n, 3, n >= 1, finite): an order of the points (n,) in which the slabs
+    are runs, ascending in depth, and each run's end ``(m,)`` (the last ``n``). A slab ends where the next depth
+    in ascending order (``points[:, 2]``) lies more than ``distance`` beyond it (the twin's
+    ``np.diff(sorted) > distance``).
+
+    Issue 19, stop 62 (reg62), instead of a stable sort: the depths are put in buckets a quarter ``distance`` wide
+    from the least (bucket ``floor((z - least) / width)``, the last one closed). The bucket is monotone in the depth
+    as rounded, so every depth of a bucket is at most every depth of a later one, and the sorted depths are the
+    buckets' depths bucket after bucket: the pairs of consecutive sorted depths that straddle two buckets are a
+    bucket's greatest depth and the next non-empty bucket's least, and those within a bucket differ by about a
+    quarter ``distance`` (never more than ``distance``). So the slabs end at the same points, and each holds the
+    same points (in bucket order, not sorted within a bucket: a slab's cubes and clusters do not depend on it). Where
+    the buckets would outnumber four points each (a few far points) or ``distance`` is not above 0, by the stable
+    sort."""
     n = points.shape[0]
-    none = np.zeros(0, np.int64)
-    if n == 0 or not distance > 0.0:
-        return none
     lo, hi = points[0, 2], points[0, 2]
     for i in range(1, n):
         lo, hi = min(lo, points[i, 2]), max(hi, points[i, 2])
     width = distance / 4.0
     span = (hi - lo) / width
-    if not span < n:  # more bins than points: one is empty
-        return none
+    if not (distance > 0.0 and span < 4 * n + 16):
+        order = np.argsort(points[:, 2], kind="mergesort")
+        ends = np.empty(n, np.int64)
+        m = 0
+        for k in range(1, n):
+            if points[order[k], 2] - points[order[k - 1], 2] > distance:
+                ends[m] = k
+                m += 1
+        ends[m] = n
+        return order, ends[: m + 1]
     bins = np.int64(math.floor(span)) + 1
-    held = np.zeros(bins, np.bool_)
+    start = np.zeros(bins + 1, np.int64)  # counts, then each bucket's first place in the order
+    least = np.full(bins, np.inf)
+    most = np.full(bins, -np.inf)
+    at = np.empty(n, np.int64)
     for i in range(n):
-        held[min(np.int64(math.floor((points[i, 2] - lo) / width)), bins - 1)] = True
-    for b in range(bins):
-        if not held[b]:
-            return none
-    return np.arange(n)
+        z = points[i, 2]
+        k = min(np.int64(math.floor((z - lo) / width)), bins - 1)
+        at[i] = k
+        start[k + 1] += 1
+        least[k] = min(least[k], z)
+        most[k] = max(most[k], z)
+    for k in range(bins):
+        start[k + 1] += start[k]
+    ends = np.empty(bins, np.int64)
+    m = 0
+    last = -1  # the last non-empty bucket
+    for k in range(bins):
+        if start[k + 1] == start[k]:
+            continue
+        if last >= 0 and least[k] - most[last] > distance:
+            ends[m] = start[k]
+            m += 1
+        last = k
+    ends[m] = n
+    order = np.empty(n, np.int64)
+    for i in range(n):
+        order[start[at[i]]] = i
+        start[at[i]] += 1
+    return order, ends[: m + 1]
 
 
 # --- issue 19, stop 41 (speedext41): the occlusion's own edge, and the occlusion in one call ---
@@ -5250,17 +5287,21 @@ def free_outline(
     :func:`symfruit.core.surface.within` has it: :func:`near_distance`'s square root of the least squared distance
     where that is at most ``reach ** 2``, compared with ``reach``). The same points as the twin's.
 
-    Since issue 19's stop 60 (speedr60) each point looks only at the gap pixels about it, nearest first, and stops
-    at the first one in reach, instead of a distance map of the whole box read at the points: a gap pixel within
-    ``reach`` lies within ``floor(reach)`` rows and columns, and whether the least squared distance ``d`` passes
-    (``d <= reach ** 2`` and ``sqrt(d) <= reach``) is whether any does (both tests grow with ``d``). The gap is read
-    within the box alone, as the map was made there.
+    Since issue 19's stop 60 (speedr60) each point looks only at the gap pixels about it instead of a distance map of
+    the whole box read at the points: a gap pixel within ``reach`` lies within ``floor(reach)`` rows and columns, and
+    whether the least squared distance ``d`` passes (``d <= reach ** 2`` and ``sqrt(d) <= reach``) is whether any
+    does (both tests grow with ``d``). The gap is read within the box alone, as the map was made there. Since stop 62
+    (reg62) the offsets that pass, on each row ``dr`` of them, are the columns ``|dc| <= m(dr)`` (both tests grow
+    with ``|dc|``), and each row of the box holds its running count of gap pixels: whether a point has a gap pixel in
+    reach is whether one of its ``2 floor(reach) + 1`` rows counts any within its columns (one difference a row,
+    not up to some 50 pixels read a point): the same points.
 
     Since stop 62 (leaf62) a gap pixel without depth counts only where no pixel other than ``cap``'s within ``reach``
     of it (anywhere in the array) holds depth nearer than the point's own by more than ``tol`` (the twin's
     :func:`symfruit.core.surface._occluders_edge`): a lost band beside something in front is that occluder's edge.
-    A gap pixel seen past (at least ``far``) counts as before; ``tol`` infinite: the former points. Each gap pixel's
-    nearest such depth is worked out once, when first asked."""
+    A gap pixel seen past (at least ``far``) counts as before; ``tol`` infinite (the default, ``extract.occluder_edges``
+    off): the former points, by the row counts. With ``tol`` finite each point looks at the gap pixels about it
+    nearest first, and each gap pixel's nearest such depth is worked out once, when first asked."""
     h, w = cap.shape
     rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
     for i in range(rows.shape[0]):
@@ -5270,6 +5311,49 @@ def free_outline(
     r1, c1 = min(rmax + pad + 1, h), min(cmax + pad + 1, w)
     k = math.floor(reach)
     limit = reach * reach
+    free = np.zeros(rows.shape[0], np.bool_)
+    if tol < np.inf:
+        return _free_outline_occluders(depth, cap, rows, cols, far, reach, tol, r0, r1, c0, c1, k, limit, free)
+    half = np.full(2 * k + 1, -1, np.int64)  # m(dr): the offsets of row dr in reach are |dc| <= m(dr) (-1: none)
+    for dr in range(-k, k + 1):
+        for dc in range(k + 1):
+            d = dr * dr + dc * dc
+            if d <= limit and math.sqrt(float(d)) <= reach:
+                half[dr + k] = dc
+    counts = np.zeros((max(r1 - r0, 0), max(c1 - c0, 0) + 1), np.int32)  # each row's gap pixels before a column
+    for rr in range(r0, r1):
+        acc = 0
+        for cc in range(c0, c1):
+            if not cap[rr, cc]:
+                z = depth[rr, cc]
+                if z <= 0 or z >= far:
+                    acc += 1
+            counts[rr - r0, cc - c0 + 1] = acc
+    for i in range(rows.shape[0]):
+        r, c = rows[i], cols[i]
+        for dr in range(-k, k + 1):
+            m = half[dr + k]
+            rr = r + dr
+            if m < 0 or rr < r0 or rr >= r1:
+                continue
+            a, b = max(c - m, c0), min(c + m + 1, c1)
+            if a < b and counts[rr - r0, b - c0] > counts[rr - r0, a - c0]:
+                free[i] = True
+                break
+    return free
+
+
+@_njit
+def _free_outline_occluders(
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, tol: float,
+    r0: int, r1: int, c0: int, c1: int, k: int, limit: float, free: np.ndarray,
+) -> np.ndarray:  # fmt: skip
+    """:func:`free_outline` with ``tol`` finite (``extract.occluder_edges``; stop 62, leaf62): each point looks at the
+    gap pixels about it nearest first, a gap pixel without depth counting only where no depth off the cap within
+    ``reach`` of it is nearer than the point's own by more than ``tol`` (each gap pixel's worked out once, when first
+    asked); ``free`` (n,) False, filled and returned. The box ``r0:r1, c0:c1``, ``k = floor(reach)``, ``limit =
+    reach ** 2`` as :func:`free_outline` has them."""
+    h, w = cap.shape
     # the offsets in reach, nearest first (the order only makes the first found come sooner)
     n_off = 0
     dr_at = np.empty((2 * k + 1) ** 2, np.int64)
@@ -5285,10 +5369,8 @@ def free_outline(
                     j -= 1
                 dr_at[j], dc_at[j], d_at[j] = dr, dc, d
                 n_off += 1
-    free = np.zeros(rows.shape[0], np.bool_)
-    check = tol < np.inf
     # the nearest depth not the cap's within reach of each gap pixel of the box (NaN: not yet worked out)
-    nearest = np.full((r1 - r0, c1 - c0), np.nan) if check else np.empty((0, 0))
+    nearest = np.full((r1 - r0, c1 - c0), np.nan)
     for i in range(rows.shape[0]):
         r, c = rows[i], cols[i]
         bound = depth[r, c] - tol
@@ -5300,19 +5382,18 @@ def free_outline(
                     free[i] = True
                     break
                 if z <= 0:
-                    if check:
-                        m = nearest[rr - r0, cc - c0]
-                        if m != m:  # first asked: the least depth above 0 about it, off the cap
-                            m = np.inf
-                            for q in range(n_off):
-                                r2, c2 = rr + dr_at[q], cc + dc_at[q]
-                                if 0 <= r2 < h and 0 <= c2 < w and not cap[r2, c2]:
-                                    z2 = depth[r2, c2]
-                                    if 0 < z2 < m:
-                                        m = z2
-                            nearest[rr - r0, cc - c0] = m
-                        if m < bound:  # an occluder's lost edge, not this silhouette's
-                            continue
+                    m = nearest[rr - r0, cc - c0]
+                    if m != m:  # first asked: the least depth above 0 about it, off the cap
+                        m = np.inf
+                        for q in range(n_off):
+                            r2, c2 = rr + dr_at[q], cc + dc_at[q]
+                            if 0 <= r2 < h and 0 <= c2 < w and not cap[r2, c2]:
+                                z2 = depth[r2, c2]
+                                if 0 < z2 < m:
+                                    m = z2
+                        nearest[rr - r0, cc - c0] = m
+                    if m < bound:  # an occluder's lost edge, not this silhouette's
+                        continue
                     free[i] = True
                     break
     return free
@@ -8394,6 +8475,36 @@ def label_boxes(labels: np.ndarray, n: int) -> np.ndarray:
             out[k, 1] = r + 1
             out[k, 2] = min(out[k, 2], start)
             out[k, 3] = max(out[k, 3], c)
+    return out
+
+
+@_njit
+def boxes_within(labels: np.ndarray, windows: np.ndarray) -> np.ndarray:
+    """(n, 4) int64: the box ``(r0, r1, c0, c1)`` (stops exclusive) of each label 1..n of ``labels`` (h, w) integers
+    looked for within its window ``windows[k - 1]`` ``(r0, r1, c0, c1)`` alone (an empty one, ``r1 <= r0`` or
+    ``c1 <= c0``: none), ``r1 = 0`` for a label without pixels there: :func:`label_boxes`' where every label's pixels
+    lie within its window (issue 19, stop 62: ``detect``'s boxes of the masks moved onto the depth image, within
+    their drawn boxes moved, not a pass over the whole image)."""
+    n = windows.shape[0]
+    out = np.zeros((n, 4), np.int64)
+    h, w = labels.shape
+    for k in range(n):
+        r0, r1 = max(windows[k, 0], 0), min(windows[k, 1], h)
+        c0, c1 = max(windows[k, 2], 0), min(windows[k, 3], w)
+        top, bottom, left, right = h, 0, w, -1
+        for r in range(r0, r1):
+            first = c0
+            while first < c1 and labels[r, first] != k + 1:  # the row's first pixel of the label ...
+                first += 1
+            if first == c1:
+                continue
+            last = c1 - 1
+            while labels[r, last] != k + 1:  # ... and its last (one there is)
+                last -= 1
+            top, bottom = min(top, r), r + 1
+            left, right = min(left, first), max(right, last)
+        if bottom > 0:
+            out[k, 0], out[k, 1], out[k, 2], out[k, 3] = top, bottom, left, right + 1
     return out
 
 

@@ -37,8 +37,8 @@ pixels), :func:`symfruit.core.raster.outline_cone`, :func:`~symfruit.core.raster
 :func:`symfruit.segment.colour._sphere`, ``_centres``, ``_depth_edges``, ``_cells``, ``_grouped``, ``_least_areas``
 and ``_segment_at``'s redness; the twentieth round's :func:`symfruit.core.occlusion.occlusion`
 (:func:`symfruit.core._jit.occlusion_at`), :func:`symfruit.core.surface.monotone_region`
-(:func:`symfruit.core._jit.monotone_table`) and :func:`symfruit.extract.cluster` (``_one_slab`` in
-:func:`symfruit.core._jit.clusters`); stop 41's :func:`symfruit.core.occlusion.own_edge`
+(:func:`symfruit.core._jit.monotone_table`) and :func:`symfruit.extract.cluster` (since stop 62 ``_depth_slabs``
+in :func:`symfruit.core._jit.clusters`); stop 41's :func:`symfruit.core.occlusion.own_edge`
 (:func:`symfruit.core._jit.own_edge`, in :func:`symfruit.core._jit.occlusion_projected` with the maps) and
 :func:`~symfruit.core.surface.monotone_region` (:func:`symfruit.core._jit.monotone_at`); stop 42's
 :func:`symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.smooth_parts`,
