@@ -8287,7 +8287,8 @@ def test_pair_sums_are_the_scalar_loops_sums(seed, n, bins, odd):
     values from tiny to huge, ties, signed zeros, infinities and NaN among them."""
 
     @numba.njit
-    def run(u, v, idx, sums, du, dv, dy):  # noqa: ANN001, ANN202
+    def run(u: np.ndarray, v: np.ndarray, idx: np.ndarray, sums: np.ndarray, du: np.ndarray, dv: np.ndarray,
+            dy: np.ndarray) -> tuple[float, ...]:  # fmt: skip
         return _jit._pair_sums(u, v, idx, sums, du, dv, dy)
 
     rng = np.random.default_rng(seed)
