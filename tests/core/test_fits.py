@@ -845,3 +845,44 @@ def test_outline_walks_in_blocks_are_the_whole_walks(seed, b, h, w, step, full):
     got, want = _first_out(uc, way, s, origin, mask), _first_out_whole(uc, way, s, origin, mask)
     for g, x in zip(got, want, strict=True):
         assert g.dtype == x.dtype and g.tobytes() == x.tobytes()
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(-3.0, 0.0), st.floats(0.0, 0.02))
+def test_fit_ellipsoid_definite_test_without_lapack_is_the_former_rule(seed, flat, noise):
+    """Stop 62: ``fit_ellipsoid``'s last test (every eigenvalue of the shape above 0) is decided without LAPACK where
+    ``lapack.surely_positive3`` is sure; caps of ellipsoids of any flatness and noise, saddles and planes fit or
+    fail as with LAPACK's eigenvalues always."""
+    from symfruit.core import lapack
+
+    rng = np.random.default_rng(seed)
+    d = rng.normal(size=(300, 3))
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    d = d[d[:, 2] < rng.uniform(-0.5, 0.5)]
+    if len(d) < 10:
+        return
+    pts = d * [0.03, 0.03 * 10.0 ** (flat / 3), 0.03 * 10.0**flat] + rng.normal(size=d.shape) * noise * 0.03
+    if seed % 4 == 0:  # a saddle
+        pts[:, 2] = 0.5 * (pts[:, 0] ** 2 - pts[:, 1] ** 2) / 0.03
+    pts = pts + [0.0, 0.0, 0.4]
+    calls = []
+    former = lapack.surely_positive3
+
+    def never(a, floor=0.0):
+        calls.append(former(a, floor))
+        return False
+
+    try:
+        got = fit_ellipsoid(pts)
+    except InputError as e:
+        got = str(e)
+    lapack.surely_positive3 = never
+    try:
+        want = fit_ellipsoid(pts)
+    except InputError as e:
+        want = str(e)
+    finally:
+        lapack.surely_positive3 = former
+    if isinstance(want, str):
+        assert got == want
+    else:
+        assert isinstance(got, tuple) and all(a.tobytes() == b.tobytes() for a, b in zip(got, want, strict=True))

@@ -8488,3 +8488,45 @@ def test_the_gap_join_in_one_sweep_is_the_filters(seed, radius):
     _jit.near_both(seen, big[2 : h + 2, 1 : w + 1], radius)
     np.testing.assert_array_equal(big[2 : h + 2, 1 : w + 1], want)
     assert not big[:2].any() and not big[h + 2 :].any() and not big[:, 0].any() and not big[:, w + 1 :].any()
+
+
+# --- stop 62, comp62: the normal equations' sums of a pair of directions in the two lanes of a vector ---------------
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 40), st.integers(1, 6), st.booleans())
+def test_pair_sums_are_the_scalar_loops_sums(seed, n, bins, odd):
+    """``_pair_sums`` gives, to the bit, each direction's five sums of the scalar loop it replaced (Python floats, the
+    points in order: differences from the slices' means, then the products added), and stores the same differences;
+    values from tiny to huge, ties, signed zeros, infinities and NaN among them."""
+
+    @numba.njit
+    def run(u: np.ndarray, v: np.ndarray, idx: np.ndarray, sums: np.ndarray, du: np.ndarray, dv: np.ndarray,
+            dy: np.ndarray) -> tuple[float, ...]:  # fmt: skip
+        return _jit._pair_sums(u, v, idx, sums, du, dv, dy)
+
+    rng = np.random.default_rng(seed)
+    u = rng.normal(size=(n, 2)) * 10.0 ** rng.integers(-150, 150, size=(n, 2))
+    v = np.round(rng.normal(size=(n, 2)), 2)
+    if odd and n:
+        u[rng.integers(0, n), rng.integers(0, 2)] = rng.choice([np.inf, -np.inf, np.nan, -0.0])
+    idx = rng.integers(0, bins, size=(n, 2))
+    sums = rng.normal(size=(2, bins, 4))
+    du, dv, dy = (np.full((n, 2), 7.0) for _ in range(3))
+    got = run(u, v, idx, sums, du, dv, dy)
+    want = []
+    with np.errstate(all="ignore"):
+        for e in range(2):
+            acc = [0.0] * 5
+            for i in range(n):
+                s = int(idx[i, e])
+                a, b = float(u[i, e]), float(v[i, e])
+                x = a - float(sums[e, s, 1])
+                y = b - float(sums[e, s, 2])
+                z = (a * a + b * b) - float(sums[e, s, 3])
+                assert np.float64(x).tobytes() == du[i, e].tobytes() and np.float64(y).tobytes() == dv[i, e].tobytes()
+                assert np.float64(z).tobytes() == dy[i, e].tobytes()
+                for k, term in enumerate((x * x, x * y, y * y, x * z, y * z)):
+                    acc[k] = acc[k] + term
+            want += acc
+    assert np.array(got).tobytes() == np.array(want).tobytes()

@@ -82,3 +82,61 @@ def test_other_arguments_go_to_numpy():
     assert _same(lapack.solve(np.eye(2).tolist(), [1.0, 2.0]), np.linalg.solve(np.eye(2), [1.0, 2.0]))
     with pytest.raises(np.linalg.LinAlgError):
         lapack.inv(np.ones((2, 3)))
+
+
+# --- stop 62, comp62: a 3x3 symmetric matrix's eigenvalues surely above 0, without LAPACK ---------------------------
+
+
+def _symmetric3(seed: int, kind: str) -> np.ndarray:
+    """A symmetric 3x3 matrix: positive definite of any condition up to 1e14, indefinite, singular, or a fruit's
+    scatter, at a scale from 1e-30 to 1e30, rotated at random."""
+    rng = np.random.default_rng(seed)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    if kind == "definite":
+        values = 10.0 ** rng.uniform(-14.0, 0.0, 3)
+    elif kind == "indefinite":
+        values = rng.normal(size=3)
+    elif kind == "singular":
+        values = np.array([0.0, *rng.uniform(0.1, 1.0, 2)])
+    else:  # a cloud's scatter (points on a cap, some flat)
+        pts = rng.normal(size=(int(rng.integers(10, 400)), 3)) * [1.0, 1.0, 10.0 ** rng.uniform(-8.0, 0.0)]
+        centred = pts - pts.mean(axis=0)
+        return (centred.T @ centred) * 10.0 ** rng.uniform(-30.0, 30.0)
+    return (q * values) @ q.T * 10.0 ** rng.uniform(-30.0, 30.0)
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from(["definite", "indefinite", "singular", "scatter"]))
+def test_surely_positive_matrices_have_eigvalshs_least_above_the_bound(seed, kind):
+    """Where :func:`lapack.surely_positive3` says so, every eigenvalue ``eigvalsh`` gives is above ``3e-7`` times the
+    entries' summed magnitudes ``F`` (so above 0 and above ``1e-12`` times the greatest, ``check_cloud``'s and
+    ``fit_ellipsoid``'s tests), and ``F`` is above the floor; an asymmetric upper triangle is not read."""
+    a = _symmetric3(seed, kind)
+    a = np.tril(a) + np.triu(np.random.default_rng(seed + 1).normal(size=(3, 3)) * np.abs(a).max(), 1)  # not read
+    low = np.tril(a)
+    f = float(np.abs(low + np.tril(low, -1).T).sum())
+    values = np.linalg.eigvalsh(a)
+    if lapack.surely_positive3(a):
+        assert values[0] > 3e-7 * f and values[0] > 1e-12 * values[2] and (values > 0).all()
+    floor = f * 10.0 ** np.random.default_rng(seed + 2).uniform(-2.0, 2.0)
+    if lapack.surely_positive3(a, floor=floor):
+        assert f > floor
+
+
+def test_surely_positive_known_answers():
+    """True on well-conditioned positive definite matrices (so the tests above can fail), False on indefinite,
+    singular, nearly singular (condition 1e9), non-finite or wrongly shaped ones and below the floor."""
+    rng = np.random.default_rng(5)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    for values in ([1.0, 2.0, 3.0], [0.04, 0.5, 1.0], [1e-3, 1.0, 1.0]):
+        assert lapack.surely_positive3((q * values) @ q.T * 1e-4)
+    assert lapack.surely_positive3(np.diag([1.0, 2.0, 3.0]), floor=5.9)
+    assert not lapack.surely_positive3(np.diag([1.0, 2.0, 3.0]), floor=6.0)
+    for values in ([-1e-3, 1.0, 1.0], [0.0, 1.0, 1.0], [1e-9, 1.0, 1.0], [-1.0, -1.0, 3.0]):
+        assert not lapack.surely_positive3((q * values) @ q.T)
+    assert not lapack.surely_positive3(np.array([[1.0, 10.0, 0.0], [10.0, 1.0, 0.0], [0.0, 0.0, 1.0]]))
+    assert not lapack.surely_positive3(np.diag([1.0, np.nan, 1.0]))
+    assert not lapack.surely_positive3(np.diag([1.0, np.inf, 1.0]))
+    assert not lapack.surely_positive3(np.eye(2))
+    assert not lapack.surely_positive3(np.eye(3, dtype=np.float32))
+    assert not lapack.surely_positive3(np.eye(3) * 1e-95)

@@ -336,3 +336,33 @@ def test_subsample_takes_the_indexed_rows():
         assert got.dtype == cloud.dtype and got.tobytes() == cloud[keep].tobytes()
     got = subsample(np.arange(20.0), 5)
     assert np.array_equal(got, np.arange(20.0)[np.sort(np.random.default_rng(0).choice(20, size=5, replace=False))])
+
+
+def _former_check(points: np.ndarray) -> str:
+    """check_cloud's spread tests as they were before stop 62: LAPACK's eigenvalues always (the message, or "")."""
+    centred = points - points.mean(axis=0)
+    s0, s1, s2 = np.linalg.eigvalsh(centred.T @ centred).tolist()
+    if s2 <= 1e-18 * len(points):
+        return "identical"
+    if s1 <= 1e-12 * s2:
+        return "on a line"
+    if s0 <= 1e-12 * s2:
+        return "on a plane"
+    return ""
+
+
+@given(st.integers(0, 2**32 - 1), st.floats(-16.0, 0.0), st.floats(-16.0, 0.0), st.integers(10, 400))
+def test_check_cloud_spread_decided_without_lapack_is_the_former_rule(seed, flat, thin, n):
+    """Stop 62: the spread tests are decided without LAPACK where ``lapack.surely_positive3`` says every variance is
+    far above them; clouds flattened or thinned to any degree (planes, lines, their neighbours) raise or pass as
+    with LAPACK's eigenvalues always."""
+    rng = np.random.default_rng(seed)
+    axes, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    local = rng.normal(size=(n, 3)) * [0.02, 0.02 * 10.0**thin, 0.02 * 10.0**flat]
+    points = local @ axes.T + [0.0, 0.0, 0.5]
+    want = _former_check(points)
+    if want:
+        with pytest.raises(InputError, match=want):
+            check_cloud(points, min_extent=0.0)
+    else:
+        check_cloud(points, min_extent=0.0)

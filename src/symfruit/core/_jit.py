@@ -2860,6 +2860,72 @@ def _add4_intrinsic(typingctx: Any, arr: Any, off: Any, a: Any, b: Any, c: Any, 
 _add4 = cast(Callable[..., None], numba.extending.intrinsic(_add4_intrinsic))
 
 
+def _pair_sums_intrinsic(
+    typingctx: Any, u: Any, v: Any, idx: Any, sums: Any, du: Any, dv: Any, dy: Any
+) -> Any:  # fmt: skip
+    """``_pair_sums(u, v, idx, sums, du, dv, dy)``: :func:`slice_costs_below`'s loop over the points of a pair of
+    directions, the two directions the two lanes of LLVM's ``<2 x double>`` (issue 19, stop 62, comp62). ``u``, ``v``
+    (n, 2) float64 and ``idx`` (n, 2) int64 hold each point's plane coordinates and slice for direction 0 in column 0
+    and direction 1 in column 1 (C-ordered: a point's two in one vector load), ``sums`` (2, b, 4) each direction's
+    slices' counts and means of ``u``, ``v`` and ``u^2 + v^2``. For each point, lane by lane, ``du = u - mean u``,
+    ``dv = v - mean v`` and ``dy = (u u + v v) - mean (u^2 + v^2)`` are stored to ``du``, ``dv``, ``dy`` (n, 2) (one
+    vector store each) and added to the running sums ``du du``, ``du dv``, ``dv dv``, ``du dy``, ``dv dy``, in the
+    points' order; returns ``(a11, a12, a22, e1, e2)`` of direction 0, then of direction 1. Each lane's operations are
+    the scalar loop's in its order, rounded as they are (IEEE; no contraction into multiply-adds), so the sums are
+    the scalar loop's to the bit. The loop was bound by its loads and stores (12 and 6 a point, 2 directions), not its
+    arithmetic: the vector loads and stores take it to 9 and 3 (numba's vectoriser does not pack two chains of sums
+    itself). Indices are not checked."""
+    f8 = numba.types.float64
+    sig = numba.types.UniTuple(f8, 10)(u, v, idx, sums, du, dv, dy)
+
+    def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+        from numba.core import cgutils  # its llvmlite.ir, the IR numba builds (llvmlite is numba's own dependency)
+
+        ir = cgutils.ir
+        arrays = [context.make_array(ty)(context, builder, val) for ty, val in zip(signature.args, args, strict=True)]
+        pu, pv, pidx, psums, pdu, pdv, pdy = (a.data for a in arrays)
+        n = cgutils.unpack_tuple(builder, arrays[0].shape, 2)[0]
+        bins = cgutils.unpack_tuple(builder, arrays[3].shape, 3)[1]
+        i64, i32 = ir.IntType(64), ir.IntType(32)
+        vty, ity = ir.VectorType(ir.DoubleType(), 2), ir.VectorType(i64, 2)
+        lanes = (ir.Constant(i32, 0), ir.Constant(i32, 1))
+        four = ir.Constant(i64, 4)
+        accs = [cgutils.alloca_once_value(builder, ir.Constant(vty, [0.0, 0.0])) for _ in range(5)]
+
+        def row(ptr: Any, i: Any, ty: Any) -> Any:  # the point's two values as one vector
+            return builder.bitcast(builder.gep(ptr, [builder.mul(i, ir.Constant(i64, 2))]), ty.as_pointer())
+
+        with cgutils.for_range(builder, n) as loop:
+            i = loop.index
+            uu = builder.load(row(pu, i, vty), align=8)
+            vv = builder.load(row(pv, i, vty), align=8)
+            slices = builder.load(row(pidx, i, ity), align=8)
+            at0 = builder.mul(builder.extract_element(slices, lanes[0]), four)
+            at1 = builder.mul(builder.add(bins, builder.extract_element(slices, lanes[1])), four)
+
+            def mean(k: int) -> Any:  # direction 0's slice mean k, direction 1's
+                a = builder.load(builder.gep(psums, [builder.add(at0, ir.Constant(i64, k))]))
+                b = builder.load(builder.gep(psums, [builder.add(at1, ir.Constant(i64, k))]))
+                both = builder.insert_element(ir.Constant(vty, ir.Undefined), a, lanes[0])
+                return builder.insert_element(both, b, lanes[1])
+
+            d_u = builder.fsub(uu, mean(1))
+            d_v = builder.fsub(vv, mean(2))
+            d_y = builder.fsub(builder.fadd(builder.fmul(uu, uu), builder.fmul(vv, vv)), mean(3))
+            builder.store(d_u, row(pdu, i, vty), align=8)
+            builder.store(d_v, row(pdv, i, vty), align=8)
+            builder.store(d_y, row(pdy, i, vty), align=8)
+            for acc, (x, y) in zip(accs, ((d_u, d_u), (d_u, d_v), (d_v, d_v), (d_u, d_y), (d_v, d_y)), strict=True):
+                builder.store(builder.fadd(builder.load(acc), builder.fmul(x, y)), acc)
+        out = [builder.extract_element(builder.load(acc), lane) for lane in lanes for acc in accs]
+        return context.make_tuple(builder, signature.return_type, out)
+
+    return sig, codegen
+
+
+_pair_sums = cast(Callable[..., tuple[float, ...]], numba.extending.intrinsic(_pair_sums_intrinsic))
+
+
 @_njit
 def _tangent(
     u: float, v: float, axis: np.ndarray, basis: np.ndarray, cx: float, cy: float, fx: float, fy: float
@@ -3117,18 +3183,22 @@ def slice_costs_below(
     alone (two independent chains of sums in flight instead of one), then each finished or bounded in turn, in
     ``dirs``' order, as before (a lone last direction is worked out as both of a pair, kept once); the same costs and
     picks, about 10 % less time. Each slice's four sums of a point in one vector addition (:func:`_add4`; revol60:
-    the same sums, 0.94 against 0.82 ms a benchmark frame's ``revolution_search``, replayed)."""
+    the same sums, 0.94 against 0.82 ms a benchmark frame's ``revolution_search``, replayed). The pair's values are
+    kept side by side, a point's two in a row, and the normal equations' loop runs both directions in the two lanes
+    of a vector (:func:`_pair_sums`; stop 62, comp62: the same sums, 0.84 against 0.74 ms, replayed)."""
     k, n = dirs.shape[0], q.shape[0]
     out = np.empty(k)
     q0 = q[:, 0].copy()
     q1 = q[:, 1].copy()
     q2 = q[:, 2].copy()
     t = np.empty((2, n))
-    u = np.empty((2, n))
-    v = np.empty((2, n))
-    cu = np.empty((2, n))
-    cv = np.empty((2, n))
-    idx = np.empty((2, n), np.int64)
+    # a point's values of both directions side by side (n, 2): one vector load or store in _pair_sums (stop 62)
+    u2 = np.empty((n, 2))
+    v2 = np.empty((n, 2))
+    du2 = np.empty((n, 2))
+    dv2 = np.empty((n, 2))
+    dy2 = np.empty((n, 2))
+    idx2 = np.empty((n, 2), np.int64)
     dist2 = np.empty((2, n))
     scratch_a = np.empty(n)
     scratch_b = np.empty(n)
@@ -3145,22 +3215,22 @@ def slice_costs_below(
         for i in range(n):
             p0, p1, p2 = q0[i], q1[i], q2[i]
             t[0, i] = x0 * p0 + y0 * p1 + z0 * p2
-            u[0, i] = a0 * p0 + b0 * p1 + c0 * p2
-            v[0, i] = f0 * p0 + g0 * p1 + h0 * p2
+            u2[i, 0] = a0 * p0 + b0 * p1 + c0 * p2
+            v2[i, 0] = f0 * p0 + g0 * p1 + h0 * p2
             t[1, i] = x1 * p0 + y1 * p1 + z1 * p2
-            u[1, i] = a1 * p0 + b1 * p1 + c1 * p2
-            v[1, i] = f1 * p0 + g1 * p1 + h1 * p2
+            u2[i, 1] = a1 * p0 + b1 * p1 + c1 * p2
+            v2[i, 1] = f1 * p0 + g1 * p1 + h1 * p2
         lo0, hi0 = _range4(t[0], n)
         lo1, hi1 = _range4(t[1], n)
         span0 = max(hi0 - lo0, 1e-12)
         span1 = max(hi1 - lo1, 1e-12)
         sums[:] = 0.0
         for i in range(n):  # (at least 0: a NaN's slice, which numba's int leaves undefined, the first)
-            idx[0, i] = max(min(int((t[0, i] - lo0) / span0 * bins), bins - 1), 0)
-            idx[1, i] = max(min(int((t[1, i] - lo1) / span1 * bins), bins - 1), 0)
+            idx2[i, 0] = max(min(int((t[0, i] - lo0) / span0 * bins), bins - 1), 0)
+            idx2[i, 1] = max(min(int((t[1, i] - lo1) / span1 * bins), bins - 1), 0)
         for i in range(n):  # each slice's four sums in one vector addition (stop 60, revol60: the same sums)
-            s, r = idx[0, i], idx[1, i]
-            ua, va, ub, vb = u[0, i], v[0, i], u[1, i], v[1, i]
+            s, r = idx2[i, 0], idx2[i, 1]
+            ua, va, ub, vb = u2[i, 0], v2[i, 0], u2[i, 1], v2[i, 1]
             _add4(sums, s * 4, 1.0, ua, va, ua * ua + va * va)
             _add4(sums, (bins + r) * 4, 1.0, ub, vb, ub * ub + vb * vb)
         for e in range(2):
@@ -3169,40 +3239,18 @@ def slice_costs_below(
                 sums[e, s, 1] /= d
                 sums[e, s, 2] /= d
                 sums[e, s, 3] /= d
-        a11 = a12 = a22 = e1 = e2 = 0.0
-        c11 = c12 = c22 = d1 = d2 = 0.0
-        for i in range(n):
-            s, r = idx[0, i], idx[1, i]
-            ua, va, ub, vb = u[0, i], v[0, i], u[1, i], v[1, i]
-            du = ua - sums[0, s, 1]
-            dv = va - sums[0, s, 2]
-            dy = ua * ua + va * va - sums[0, s, 3]
-            cu[0, i], cv[0, i], t[0, i] = du, dv, dy
-            a11 += du * du
-            a12 += du * dv
-            a22 += dv * dv
-            e1 += du * dy
-            e2 += dv * dy
-            du = ub - sums[1, r, 1]
-            dv = vb - sums[1, r, 2]
-            dy = ub * ub + vb * vb - sums[1, r, 3]
-            cu[1, i], cv[1, i], t[1, i] = du, dv, dy
-            c11 += du * du
-            c12 += du * dv
-            c22 += dv * dv
-            d1 += du * dy
-            d2 += dv * dy
+        a11, a12, a22, e1, e2, c11, c12, c22, d1, d2 = _pair_sums(u2, v2, idx2, sums, du2, dv2, dy2)
         au0, av0 = _slice_centre(a11, a12, a22, e1, e2)
         au1, av1 = _slice_centre(c11, c12, c22, d1, d2)
         for i in range(n):
-            res = t[0, i] - 2.0 * (au0 * cu[0, i] + av0 * cv[0, i])
-            ru = u[0, i] - au0
-            rv = v[0, i] - av0
+            res = dy2[i, 0] - 2.0 * (au0 * du2[i, 0] + av0 * dv2[i, 0])
+            ru = u2[i, 0] - au0
+            rv = v2[i, 0] - av0
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
             dist2[0, i] = res * res / rho2
-            res = t[1, i] - 2.0 * (au1 * cu[1, i] + av1 * cv[1, i])
-            ru = u[1, i] - au1
-            rv = v[1, i] - av1
+            res = dy2[i, 1] - 2.0 * (au1 * du2[i, 1] + av1 * dv2[i, 1])
+            ru = u2[i, 1] - au1
+            rv = v2[i, 1] - av1
             rho2 = max(ru * ru + rv * rv, 1e-12) * 4.0
             dist2[1, i] = res * res / rho2
         for e in range(pair):

@@ -223,7 +223,8 @@ def fit_ellipsoid(points: np.ndarray, *, scaled: ScaledCloud | None = None) -> t
         raise InputError("cannot fit an ellipsoid: the quadric has no centre") from None
     level = centre @ quad @ centre - dd
     shape = quad / level
-    if not (lapack.eigvalsh(shape) > 0).all():
+    # every eigenvalue above 0: decided without LAPACK where a bound makes it sure (issue 19, stop 62)
+    if not lapack.surely_positive3(shape) and not (lapack.eigvalsh(shape) > 0).all():
         raise InputError("cannot fit an ellipsoid: the best quadric is not an ellipsoid")
     return centre * scale + mean, shape / scale**2
 

@@ -23,7 +23,7 @@ import numpy as np
 from numpy.lib import NumpyVersion
 from numpy.linalg import LinAlgError
 
-__all__ = ["eig_real", "eigh", "eigvalsh", "inv", "lstsq", "solve"]
+__all__ = ["eig_real", "eigh", "eigvalsh", "inv", "lstsq", "solve", "surely_positive3"]
 
 
 def _module(name: str) -> Any:
@@ -157,3 +157,34 @@ def lstsq(a: np.ndarray, b: np.ndarray) -> tuple[np.ndarray, int, np.ndarray]:
     rcond = _EPS * max(a.shape)  # numpy's default rcond
     x, _, rank, sv = _call(_lstsq_failed, _LAPACK.lstsq, "ddd->ddid", a, b[:, None], rcond)
     return x[:, 0], int(rank), sv
+
+
+#: :func:`surely_positive3`'s margin: the least of ``tr``, ``e2`` and ``det`` over ``F``, ``F^2`` and ``F^3``.
+_MARGIN = 1e-6
+
+
+def surely_positive3(a: np.ndarray, floor: float = 0.0) -> bool:
+    """Whether every eigenvalue :func:`eigvalsh` gives of the 3x3 float64 ``a`` (its lower triangle, as it reads) is
+    surely above ``3e-7 F``, ``F`` the sum of the magnitudes of that symmetric matrix's nine entries, decided in Python
+    floats without LAPACK (issue 19, stop 62, comp62), and ``F`` above ``floor``; False where it is not sure (then ask
+    :func:`eigvalsh`).
+
+    True where the matrix's trace, the sum of its 2x2 principal minors ``e2`` and its determinant, worked out here,
+    reach ``1e-6`` times ``F``, ``F^2`` and ``F^3`` (and ``F`` lies within 1e-90 .. 1e90). Why that suffices: every
+    eigenvalue is at most ``F`` in size (a row sum), so the rounding of those three sums (a few products of entries,
+    each at most ``F^k``) is below ``1e-14 F^k``: the exact ones are positive too, so the characteristic polynomial
+    ``x^3 - tr x^2 + e2 x - det`` is negative at every ``x <= 0`` and every eigenvalue is positive; then the least
+    is ``det / (l1 l2) >= det / e2 >= (1e-6 - 1e-14) F^3 / (3 F^2) > 3.3e-7 F``. LAPACK's symmetric eigenvalues are
+    within a small multiple of ``eps ||a||`` (about 1e-14 F) of the exact ones, so each it gives is above ``3e-7 F``
+    and at most ``F (1 + 1e-14)``: a test of the least against 0, or of the least over the greatest against anything
+    below ``3e-7``, comes out as it would on :func:`eigvalsh`'s values."""
+    if type(a) is not np.ndarray or a.shape != (3, 3) or a.dtype != np.float64:
+        return False
+    (d0, _, _), (b10, d1, _), (b20, b21, d2) = a.tolist()
+    f = abs(d0) + abs(d1) + abs(d2) + 2.0 * (abs(b10) + abs(b20) + abs(b21))
+    if not (1e-90 < f < 1e90 and f > floor):  # (NaN too)
+        return False
+    m12 = d1 * d2 - b21 * b21
+    e2 = d0 * d1 - b10 * b10 + d0 * d2 - b20 * b20 + m12
+    det = d0 * m12 - b10 * (b10 * d2 - b21 * b20) + b20 * (b10 * b21 - d1 * b20)
+    return d0 + d1 + d2 >= _MARGIN * f and e2 >= _MARGIN * f * f and det >= _MARGIN * f * f * f
