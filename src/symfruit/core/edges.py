@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .kernels import compiled
 from .raster import distance_transform
 
 __all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift", "mask_shift"]
@@ -437,10 +438,10 @@ def _mask_costs(
         a0, a1 = max(sl[0].start - reach, 0) - r0, min(sl[0].stop + reach, h) - r0
         b0, b1 = max(sl[1].start - reach, 0) - c0, min(sl[1].stop + reach, w) - c0
         er, ec, ebins = _window_peaks(*gradient, threshold, (a0, a1, b0, b1))
-        dist = _capped_distances((a1 - a0, b1 - b0), er - a0, ec - b0, ebins, cap, bins[mine], m)
+        rr, cc = rows[mine] - r0 - a0, cols[mine] - c0 - b0
+        dist = _capped_distances((a1 - a0, b1 - b0), er - a0, ec - b0, ebins, cap, (rr, cc, bins[mine]), m)
         # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du); off the window is off the image
-        rr, cc = rows[mine] - r0 - a0 + m, cols[mine] - c0 - b0 + m
-        costs.append((k, mine, _padded_costs(dist, rr, cc, bins[mine], m)))
+        costs.append((k, mine, _padded_costs(dist, rr + m, cc + m, bins[mine], m)))
     return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
 
 
@@ -490,19 +491,34 @@ def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndar
 
 
 def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray, ebins: np.ndarray, cap: float,
-                      used: np.ndarray, pad: int) -> np.ndarray:  # fmt: skip
+                      points: tuple[np.ndarray, np.ndarray, np.ndarray], m: int) -> np.ndarray:  # fmt: skip
     """:func:`_edge_distances` of the edges at ``(rows, cols)`` (orientation bins ``ebins``) on an image of
-    ``shape``, only for the bins ``used`` (the others left at ``cap``), padded by ``pad`` pixels of ``cap`` all
-    round: (N_BINS, h + 2 pad, w + 2 pad) float32, the same values."""
+    ``shape``, where the ``points`` ``(rows, cols, bins)`` read them at every shift within ``m``, padded by ``m``
+    pixels of ``cap`` all round: (N_BINS, h + 2 m, w + 2 m) float32, the same values wherever a point reads.
+
+    Each bin's map is worked out over its own points' box grown by ``m + ceil(cap)`` (an edge farther from every
+    point of the bin than that is farther than the cap from every pixel they read), the rest left at ``cap``."""
     h, w = shape
-    dist = np.full((N_BINS, h + 2 * pad, w + 2 * pad), cap, np.float32)
-    for b in np.unique(used):
+    prow, pcol, pbins = points
+    reach = m + int(np.ceil(cap))
+    dist = np.full((N_BINS, h + 2 * m, w + 2 * m), cap, np.float32)
+    jit = compiled()
+    for b in np.unique(pbins):
         apart = (ebins - b) % N_BINS  # within one bin of b: 0, 1 or N_BINS - 1
         near = (apart <= 1) | (apart == N_BINS - 1)
+        mine = pbins == b
+        r0, r1 = max(int(prow[mine].min()) - reach, 0), min(int(prow[mine].max()) + reach + 1, h)
+        c0, c1 = max(int(pcol[mine].min()) - reach, 0), min(int(pcol[mine].max()) + reach + 1, w)
+        near &= (rows >= r0) & (rows < r1) & (cols >= c0) & (cols < c1)
         if near.any():
-            free = np.ones(shape, bool)
-            free[rows[near], cols[near]] = False
-            dist[b, pad : pad + h, pad : pad + w] = np.minimum(distance_transform(free), cap)
+            edges = np.zeros((r1 - r0, c1 - c0), bool)
+            edges[rows[near] - r0, cols[near] - c0] = True
+            if jit is None:
+                away = ndimage.distance_transform_edt(~edges)
+            else:  # each pixel's distance to the nearest edge where that is at most the cap (scipy's), +inf farther
+                away = np.empty(edges.shape)
+                jit.near_distance(edges, float(cap), True, away)
+            dist[b, m + r0 : m + r1, m + c0 : m + c1] = np.minimum(away, cap, out=away)
     return dist
 
 
