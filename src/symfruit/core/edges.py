@@ -340,7 +340,7 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     shift is taken only where it costs less than none over every outline pixel.
 
     Each mask's colour edges are read in a window about it (:func:`_mask_costs`: a tenth to an eighth of a
-    1920 x 1080 tree frame's pixels, 0.07-0.10 s of CPU for the whole window's 0.56-0.85 s; stop 62), at the
+    1920 x 1080 tree frame's pixels, 0.05-0.07 s of CPU for the whole window's 0.56-0.85 s; stop 62), at the
     threshold the windows' union gives. The shift is the frame's, one for all its masks: each mask alone reads too
     little (stop 62: alone, 4 of the rendered trees' 300 exact masks read moves of 2-10 px, and 7 of the real
     spheres' masks grown 2-10 px read 3-9 px).
@@ -388,6 +388,12 @@ def _mask_costs(
     threshold is the median gradient of the mask's window (the fruit and what lies just around it), not a whole
     frame's. A frame of small masks reads a band about each outline instead of the whole image (a 1920 x 1080 tree
     frame: a tenth to an eighth of its pixels).
+
+    Only the threshold needs the whole window's gradient (:func:`_window_gradient`, every channel at once). The
+    edges (:func:`_window_peaks`: their orientation and the non-maximum suppression only at pixels above the
+    threshold) and their distance maps (:func:`_capped_distances`: each bin's over its own outline pixels' box,
+    bounded at the cap) are worked out only within the search and the cap of the mask's box, where the shifted
+    outline reads them: the same costs, to the bit, at 0.7 times the CPU (stop 62, docs/edgespeed62.md).
     """
     img = np.asarray(color)
     lab = np.asarray(labels)
