@@ -6,6 +6,8 @@ both alike. CPU time, not wall time: a busy machine stretches the wall time far 
     python docs/speed_ab.py BEFORE/src AFTER/src [--method evidence] [--rounds 6] [--frames 10]
 
 e.g. ``python docs/speed_ab.py ../main/src src``. Each round starts a fresh process per tree (``PYTHONPATH``).
+``--sensor NAME``: the frame rendered through that camera model with its annotators' masks (``symfruit bench
+--frame --sensor``), which ``extract.mask_edge_px`` reads.
 ``--fits`` adds the completion's three iterative fits as stages (the solid of revolution's, the cone ellipsoid's
 and the sphere's, all of their calls in a frame), ``--wrap MODULE:NAME ...`` any other function as a stage (where
 the caller looks it up, e.g. ``symfruit.methods.evidence:observe``), or a method (``MODULE:Class.name``, e.g.
@@ -34,6 +36,7 @@ import importlib, json, sys, time
 import symfruit.detect as D
 from symfruit.evaluate.bench import _bench_scene
 method, frames, stages = sys.argv[1], int(sys.argv[2]), json.loads(sys.argv[3])
+sensor = sys.argv[4] if len(sys.argv) > 4 and sys.argv[4] else None
 spent = {}
 def wrap(name, stage):
     module, _, name = name.rpartition(":")
@@ -51,7 +54,7 @@ def wrap(name, stage):
     setattr(module, name, timed)
 for name, stage in stages.items():
     wrap(name, stage)
-frame, _ = _bench_scene(None, 0)
+frame, _ = _bench_scene(sensor, 0)
 for _ in range(5):
     D.detect(frame, method=method)
 rows = []
@@ -114,6 +117,7 @@ def main() -> None:
     parser.add_argument("--fits", action="store_true", help="the completion's fits as stages too")
     parser.add_argument("--dense", action="store_true", help="time the dense camera view's completion instead")
     parser.add_argument("--wrap", nargs="*", default=[], help="MODULE:NAME functions timed as stages too")
+    parser.add_argument("--sensor", default="", help="the frame through this camera model, its annotators' masks used")
     args = parser.parse_args()
     stages = {**STAGES, **FITS} if args.fits else dict(STAGES)
     stages.update({name: name.rpartition(":")[2] for name in args.wrap})
@@ -121,7 +125,7 @@ def main() -> None:
     found: dict[str, list[dict[str, float]]] = {name: [] for name in trees}
     for r in range(args.rounds):
         for name in trees if r % 2 == 0 else list(trees)[::-1]:
-            child = [CHILD, args.method, str(args.frames), json.dumps(stages)]
+            child = [CHILD, args.method, str(args.frames), json.dumps(stages), args.sensor]
             if args.trees:
                 child = [TREES, str(args.trees), str(args.frames)]
             elif args.dense:
@@ -138,7 +142,8 @@ def main() -> None:
         sys.stdout.write(f"the dense camera view, method {args.method}: thread CPU ms per completion, {args.rounds} "
                          f"rounds x {args.frames} per tree, median / least\n")  # fmt: skip
     else:
-        sys.stdout.write(f"detect, method {args.method}: thread CPU ms per frame, {args.rounds} rounds x "
+        where = f" ({args.sensor}, annotators' masks)" if args.sensor else ""
+        sys.stdout.write(f"detect{where}, method {args.method}: thread CPU ms per frame, {args.rounds} rounds x "
                          f"{args.frames} frames per tree, median / least\n")  # fmt: skip
     rows = ["segment"] if args.trees else ["dense"] if args.dense else ["cpu", *stages.values()]
     for stage in rows:

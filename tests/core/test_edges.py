@@ -3,14 +3,20 @@ texture of its own, depth moved by a known shift and its objects' outermost pixe
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import ndimage
 
 from symfruit.core.edges import (
     EDGE_REACH,
     N_BINS,
     _colour_gradient,
     _colour_peaks,
+    _edge_distances,
     _mask_costs,
     _moved_costs,
+    _orientation_bin,
+    _padded_costs,
     _shift_costs,
     colour_edges,
     depth_outline,
@@ -249,3 +255,135 @@ def test_the_masks_costs_read_only_the_masks_windows():
     near = color.copy()
     near[181:200, 40:120] = rng.integers(0, 255, (19, 80, 3))  # below box 1, within its window
     assert not np.array_equal(costs(near), every)
+
+
+# ``_mask_costs`` as stop 62 first wrote it (commit f199e87): each mask's window's whole colour gradient channel by
+# channel, its peaks over the whole window and the distance maps over the whole window. The faster version reads
+# the same values at fewer pixels (docs/edgespeed62.md) and must match it to the bit.
+def reference_mask_costs(
+    color: np.ndarray, labels: np.ndarray, *, max_px: int, cap: float, max_points: int
+) -> list[tuple[int, np.ndarray, np.ndarray, np.ndarray]]:
+    """The reference of :func:`symfruit.core.edges._mask_costs` (the same arguments, ``boxes`` found here)."""
+    img = np.asarray(color)
+    lab = np.asarray(labels)
+    if img.shape[:2] != lab.shape or lab.ndim != 2:
+        raise ValueError(f"colour {img.shape[:2]} and masks {lab.shape} differ in size")
+    m = int(max_px)
+    if m <= 0:
+        return []
+    h, w = lab.shape
+    parts = []
+    for k, sl in enumerate(ndimage.find_objects(lab), start=1):
+        if sl is None:
+            continue
+        a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
+        b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
+        mask = lab[a0:a1, b0:b1] == k
+        rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
+        smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
+        gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
+        parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
+    if not parts:
+        return []
+    ks, rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(5))
+    step = max(1, -(-len(rows) // max(1, int(max_points))))
+    ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
+    bins = _orientation_bin(gx, gy)
+    pad = m + int(np.ceil(cap)) + EDGE_REACH + 1
+    windows, seen, pooled = [], np.zeros((h, w), bool), []
+    for *_, (k, sl) in parts:
+        mine = ks == k
+        if not mine.any():
+            continue
+        r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
+        c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+        gradient = _colour_gradient(img[r0:r1, c0:c1], 1.0)
+        windows.append((k, mine, r0, c0, gradient))
+        pooled.append(gradient[2][~seen[r0:r1, c0:c1]])
+        seen[r0:r1, c0:c1] = True
+    if not windows:
+        return []
+    threshold = 4.0 * max(float(np.median(np.concatenate(pooled))), 1e-9)
+    costs = []
+    for k, mine, r0, c0, gradient in windows:
+        edges, ebins = _colour_peaks(*gradient, threshold)
+        dist = _edge_distances(edges, ebins, cap, bins[mine])
+        costs.append((k, mine, _moved_costs(dist, rows[mine] - r0, cols[mine] - c0, bins[mine], m, cap)))
+    return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
+
+
+def same_costs(a: list, b: list) -> bool:
+    return len(a) == len(b) and all(
+        x[0] == y[0] and all(np.array_equal(u, v) for u, v in zip(x[1:], y[1:], strict=True))
+        for x, y in zip(a, b, strict=True)
+    )
+
+
+@st.composite
+def drawn_masks(draw: st.DrawFn) -> tuple[np.ndarray, np.ndarray, int, float, int]:
+    """A random frame: discs and boxes of their own colours on a textured background (noise, stripes, a gradient;
+    some touching the image's border, some overlapping), their masks drawn off them by a few pixels, the search,
+    the cap and the thinning drawn too; colour images in three channels or one, 8-bit or float."""
+    seed = draw(st.integers(0, 2**32 - 1))
+    rng = np.random.default_rng(seed)
+    h, w = draw(st.integers(24, 140)), draw(st.integers(24, 160))
+    vv, uu = np.mgrid[:h, :w]
+    ids = np.zeros((h, w), np.int32)
+    for k in range(1, draw(st.integers(1, 6)) + 1):
+        cv, cu, r = rng.uniform(-5, h + 5), rng.uniform(-5, w + 5), rng.uniform(2, 40)
+        inside = np.hypot(uu - cu, vv - cv) < r if rng.random() < 0.6 else (abs(uu - cu) < r) & (abs(vv - cv) < 0.7 * r)
+        ids[inside] = k
+    channels = draw(st.sampled_from([3, 1]))
+    base = rng.uniform(0, 255, (8, channels))
+    img = base[ids] + rng.normal(0, rng.uniform(0, 20), (h, w, channels))
+    img += rng.uniform(0, 60) * ((uu // rng.integers(3, 15)) % 2)[..., None] + rng.uniform(-1, 1) * uu[..., None]
+    img = np.clip(img, 0, 255)
+    img = img.astype(np.uint8) if draw(st.booleans()) else img
+    if channels == 1 and draw(st.booleans()):
+        img = img[..., 0]
+    du, dv = draw(st.integers(-6, 6)), draw(st.integers(-6, 6))
+    masks = np.zeros_like(ids)
+    masks[max(dv, 0) : h + min(dv, 0), max(du, 0) : w + min(du, 0)] = ids[
+        max(-dv, 0) : h - max(dv, 0), max(-du, 0) : w - max(du, 0)
+    ]
+    if draw(st.booleans()):  # a label with no mask left (moved off the image, or never drawn)
+        masks[masks == masks.max()] = 0
+    max_px = draw(st.integers(1, 12))
+    cap = draw(st.sampled_from([2.0, 3.5, 6.0, 7.2]))
+    max_points = draw(st.sampled_from([8000, 300, 40]))
+    return img, masks, max_px, cap, max_points
+
+
+@settings(deadline=None)
+@given(drawn_masks())
+def test_the_masks_costs_are_the_references_to_the_bit(case):
+    """Random frames: every mask's outline pixels, orientation and costs at every shift as the reference's, so the
+    same shift at every floor."""
+    img, masks, max_px, cap, max_points = case
+    kw = {"max_px": max_px, "cap": cap, "max_points": max_points}
+    ours = _mask_costs(img, masks, **kw)
+    assert same_costs(ours, reference_mask_costs(img, masks, **kw))
+    assert same_costs(_mask_costs(img, masks, boxes=ndimage.find_objects(masks), **kw), ours)
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_masks_costs_are_the_references_on_the_scene(seed):
+    rng = np.random.default_rng(20 + seed)
+    _, ids = scene(rng)
+    color = colour(ids, rng)
+    for du, dv in ((0, 0), (5, -3), (-9, 8)):
+        drawn = moved(ids, du, dv)
+        got = _mask_costs(color, drawn, max_px=10, cap=6.0, max_points=8000)
+        assert len(got) == 3
+        assert same_costs(got, reference_mask_costs(color, drawn, max_px=10, cap=6.0, max_points=8000))
+
+
+def test_the_padded_gather_is_the_moved_costs():
+    rng = np.random.default_rng(12)
+    dist = rng.uniform(0.0, 6.0, (N_BINS, 30, 40)).astype(np.float32)
+    rows, cols = rng.integers(0, 30, 200), rng.integers(0, 40, 200)
+    bins = rng.integers(0, N_BINS, 200)
+    padded = np.pad(dist, ((0, 0), (7, 7), (7, 7)), constant_values=np.float32(6.0))
+    assert np.array_equal(
+        _padded_costs(padded, rows + 7, cols + 7, bins, 7), _moved_costs(dist, rows, cols, bins, 7, 6.0)
+    )

@@ -36,6 +36,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import ndimage
 
+from .kernels import compiled
 from .raster import distance_transform
 
 __all__ = ["EdgeShift", "colour_edges", "depth_outline", "edge_shift", "mask_shift"]
@@ -339,7 +340,7 @@ def mask_shift(color: np.ndarray, labels: np.ndarray, *, max_px: int = 10, cap: 
     shift is taken only where it costs less than none over every outline pixel.
 
     Each mask's colour edges are read in a window about it (:func:`_mask_costs`: a tenth to an eighth of a
-    1920 x 1080 tree frame's pixels, 0.07-0.10 s of CPU for the whole window's 0.56-0.85 s; stop 62), at the
+    1920 x 1080 tree frame's pixels, 0.05-0.07 s of CPU for the whole window's 0.56-0.85 s; stop 62), at the
     threshold the windows' union gives. The shift is the frame's, one for all its masks: each mask alone reads too
     little (stop 62: alone, 4 of the rendered trees' 300 exact masks read moves of 2-10 px, and 7 of the real
     spheres' masks grown 2-10 px read 3-9 px).
@@ -387,6 +388,12 @@ def _mask_costs(
     threshold is the median gradient of the mask's window (the fruit and what lies just around it), not a whole
     frame's. A frame of small masks reads a band about each outline instead of the whole image (a 1920 x 1080 tree
     frame: a tenth to an eighth of its pixels).
+
+    Only the threshold needs the whole window's gradient (:func:`_window_gradient`, every channel at once). The
+    edges (:func:`_window_peaks`: their orientation and the non-maximum suppression only at pixels above the
+    threshold) and their distance maps (:func:`_capped_distances`: each bin's over its own outline pixels' box,
+    bounded at the cap) are worked out only within the search and the cap of the mask's box, where the shifted
+    outline reads them: the same costs, to the bit, at 0.7 times the CPU (stop 62, docs/edgespeed62.md).
     """
     img = np.asarray(color)
     lab = np.asarray(labels)
@@ -413,7 +420,8 @@ def _mask_costs(
     step = max(1, -(-len(rows) // max(1, int(max_points))))
     ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
     bins = _orientation_bin(gx, gy)
-    pad = m + int(np.ceil(cap)) + EDGE_REACH + 1
+    reach = m + int(np.ceil(cap))  # an outline pixel's edges within the cap of it, wherever the search moves it
+    pad = reach + EDGE_REACH + 1
     windows, seen, pooled = [], np.zeros((h, w), bool), []
     for *_, (k, sl) in parts:
         mine = ks == k
@@ -421,21 +429,110 @@ def _mask_costs(
             continue
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-        gradient = _colour_gradient(img[r0:r1, c0:c1], 1.0)
-        windows.append((k, mine, r0, c0, gradient))
-        pooled.append(gradient[2][~seen[r0:r1, c0:c1]])  # each pixel of the windows' union once
+        gradient = _window_gradient(img[r0:r1, c0:c1])
+        windows.append((k, sl, mine, r0, c0, gradient))
+        pooled.append(gradient[0][~seen[r0:r1, c0:c1]])  # each pixel of the windows' union once
         seen[r0:r1, c0:c1] = True
     if not windows:  # thinned away, or no mask has a pixel beside one outside it (a mask over the whole image)
         return []
     # the threshold: a multiple of the median gradient over the windows' union (the masks and what lies around them)
     threshold = 4.0 * max(float(np.median(np.concatenate(pooled))), 1e-9)
     costs = []
-    for k, mine, r0, c0, gradient in windows:
-        edges, ebins = _colour_peaks(*gradient, threshold)
-        dist = _edge_distances(edges, ebins, cap, bins[mine])
+    for k, sl, mine, r0, c0, gradient in windows:
+        # the window's edges and their distances are read only within ``reach`` of the mask's box (its outline
+        # pixels moved by the search and the cap about them): no farther edge lies within the cap of a read pixel
+        a0, a1 = max(sl[0].start - reach, 0) - r0, min(sl[0].stop + reach, h) - r0
+        b0, b1 = max(sl[1].start - reach, 0) - c0, min(sl[1].stop + reach, w) - c0
+        er, ec, ebins = _window_peaks(*gradient, threshold, (a0, a1, b0, b1))
+        rr, cc = rows[mine] - r0 - a0, cols[mine] - c0 - b0
+        dist = _capped_distances((a1 - a0, b1 - b0), er - a0, ec - b0, ebins, cap, (rr, cc, bins[mine]), m)
         # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du); off the window is off the image
-        costs.append((k, mine, _moved_costs(dist, rows[mine] - r0, cols[mine] - c0, bins[mine], m, cap)))
+        costs.append((k, mine, _padded_costs(dist, rr + m, cc + m, bins[mine], m)))
     return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
+
+
+def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_colour_gradient` at sigma 1 with the channels side by side, ``(mag, cx, cy, each)``: ``mag`` (h, w)
+    the strongest channel's magnitude, ``cx, cy, each`` (c, h, w) every channel's gradient and magnitude. The same
+    filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit."""
+    img = np.asarray(window, dtype=np.float64)
+    if img.ndim == 2:
+        img = img[..., None]
+    img = np.ascontiguousarray(np.moveaxis(img, -1, 0))
+    ch = ndimage.gaussian_filter(img, (0.0, 1.0, 1.0))  # no smoothing across channels
+    cx = ndimage.correlate1d(ch, [-1, 0, 1], 2, None, "reflect", 0.0, 0)  # ndimage.sobel(axis=1) of each channel
+    ndimage.correlate1d(cx, [1, 2, 1], 1, cx, "reflect", 0.0, 0)
+    cy = ndimage.correlate1d(ch, [-1, 0, 1], 1, None, "reflect", 0.0, 0)  # ndimage.sobel(axis=0)
+    ndimage.correlate1d(cy, [1, 2, 1], 2, cy, "reflect", 0.0, 0)
+    each = np.hypot(cx, cy)
+    mag = each[0].copy()
+    for c in range(1, len(each)):
+        np.maximum(mag, each[c], out=mag)
+    return mag, cx, cy, each
+
+
+def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndarray, threshold: float,
+                  part: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`_colour_peaks` of :func:`_window_gradient`'s gradient within ``part`` = ``(r0, r1, c0, c1)`` of the
+    window, worked out only at the pixels above ``threshold`` (every other one is no edge): the edges' rows,
+    columns (the window's) and orientation bins. The channel is the first strongest, as :func:`_colour_gradient`'s
+    strict comparisons take it, and the window's own border holds no edge."""
+    h, w = mag.shape
+    r0, r1, c0, c1 = max(part[0], 1), min(part[1], h - 1), max(part[2], 1), min(part[3], w - 1)
+    if r1 <= r0 or c1 <= c0:
+        empty = np.zeros(0, np.int64)
+        return empty, empty, empty
+    rows, cols = np.nonzero(mag[r0:r1, c0:c1] > threshold)
+    rows += r0
+    cols += c0
+    k = each[:, rows, cols].argmax(axis=0)
+    gx, gy = cx[k, rows, cols], cy[k, rows, cols]
+    angle = np.mod(np.arctan2(gy, gx), np.pi)
+    q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
+    dv, du = np.array((0, 1, 1, 1))[q], np.array((1, 1, 0, -1))[q]  # along 0, 45, 90, 135 degrees
+    here = mag[rows, cols]
+    peak = (here >= mag[rows - dv, cols - du]) & (here >= mag[rows + dv, cols + du])
+    bins = (np.floor(angle[peak] / (np.pi / N_BINS) + 0.5).astype(np.int64)) % N_BINS  # _orientation_bin's
+    return rows[peak], cols[peak], bins
+
+
+def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray, ebins: np.ndarray, cap: float,
+                      points: tuple[np.ndarray, np.ndarray, np.ndarray], m: int) -> np.ndarray:  # fmt: skip
+    """:func:`_edge_distances` of the edges at ``(rows, cols)`` (orientation bins ``ebins``) on an image of
+    ``shape``, where the ``points`` ``(rows, cols, bins)`` read them at every shift within ``m``, padded by ``m``
+    pixels of ``cap`` all round: (N_BINS, h + 2 m, w + 2 m) float32, the same values wherever a point reads.
+
+    Each bin's map is worked out over its own points' box grown by ``m + ceil(cap)`` (an edge farther from every
+    point of the bin than that is farther than the cap from every pixel they read), the rest left at ``cap``."""
+    h, w = shape
+    prow, pcol, pbins = points
+    reach = m + int(np.ceil(cap))
+    dist = np.full((N_BINS, h + 2 * m, w + 2 * m), cap, np.float32)
+    jit = compiled()
+    for b in np.unique(pbins):
+        apart = (ebins - b) % N_BINS  # within one bin of b: 0, 1 or N_BINS - 1
+        near = (apart <= 1) | (apart == N_BINS - 1)
+        mine = pbins == b
+        r0, r1 = max(int(prow[mine].min()) - reach, 0), min(int(prow[mine].max()) + reach + 1, h)
+        c0, c1 = max(int(pcol[mine].min()) - reach, 0), min(int(pcol[mine].max()) + reach + 1, w)
+        near &= (rows >= r0) & (rows < r1) & (cols >= c0) & (cols < c1)
+        if near.any():
+            edges = np.zeros((r1 - r0, c1 - c0), bool)
+            edges[rows[near] - r0, cols[near] - c0] = True
+            if jit is None:
+                away = ndimage.distance_transform_edt(~edges)
+            else:  # each pixel's distance to the nearest edge where that is at most the cap (scipy's), +inf farther
+                away = np.empty(edges.shape)
+                jit.near_distance(edges, float(cap), True, away)
+            dist[b, m + r0 : m + r1, m + c0 : m + c1] = np.minimum(away, cap, out=away)
+    return dist
+
+
+def _padded_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int) -> np.ndarray:
+    """:func:`_moved_costs` on maps already padded by ``m`` (:func:`_capped_distances`; ``rows, cols`` the padded
+    maps' own): each point's ``(2m+1, 2m+1)`` window of its bin's map, (2m+1, 2m+1, n)."""
+    windows = np.lib.stride_tricks.sliding_window_view(dist, (2 * m + 1, 2 * m + 1), axis=(1, 2))
+    return np.ascontiguousarray(np.moveaxis(windows[bins, rows - m, cols - m], 0, -1))
 
 
 def _decide(every: np.ndarray, gx: np.ndarray, gy: np.ndarray, m: int, cap: float, keep: float,
