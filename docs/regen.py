@@ -825,7 +825,10 @@ def check_readme(
                 if write and aligned:
                     keep = [SKIPPED_COLUMNS.search(head[j + 1]) is not None or agrees(x, y)
                             for j, (x, y) in enumerate(zip(mine, cells, strict=True))]  # fmt: skip
-                    texts[name] = rewrite_row(texts[name], anchor, label, cells, keep.__getitem__)
+                    # a count "(n N)" README leaves out of a cell stays out
+                    new = [y if re.search(r"\(n \d+\)$", x) else re.sub(r" \(n \d+\)$", "", y)
+                           for x, y in zip(mine, cells, strict=True)]  # fmt: skip
+                    texts[name] = rewrite_row(texts[name], anchor, label, new, keep.__getitem__)
                     changed.add(name)
                     say(f"{where}: rewritten")
                 elif write:

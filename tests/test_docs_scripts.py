@@ -160,8 +160,8 @@ def test_speed_profile_gives_own_times(tmp_path):
 
 def test_regen_readme_write_rewrites_the_differing_cells_only(tmp_path):
     """``regen.py readme OUT --write``: a printed row rewrites README's row of its label in the table after its
-    anchor, keeping the cells README agrees with (a count ``(n N)`` README leaves out) and the timing column; a
-    printed row with other columns is left for the hand; the other tables and rows are untouched."""
+    anchor, keeping the cells README agrees with and the timing column, a count ``(n N)`` left out where README's
+    cell has none; a printed row with other columns is left for the hand; the other tables and rows are untouched."""
     regen = docs_script("regen")
     readme = (
         "# R\n\nOther table:\n\n| a | IoU |\n|---|---|\n| x | 0.1 |\n\n"
@@ -173,7 +173,7 @@ def test_regen_readme_write_rewrites_the_differing_cells_only(tmp_path):
     rows = (
         '## Sec\n\nREADME table: README.md, after "Anchor here"\n\n'
         "| a | IoU | centre (mm) | ms |\n|---|---|---|---|\n"
-        "| x | 0.2 | 2.0 (n 4) | 7 |\n| y | 0.3 | 1.0 | 6 |\n\n"
+        "| x | 0.2 | 2.5 (n 4) | 7 |\n| y | 0.3 | 1.0 | 6 |\n\n"
         '## Wide\n\nREADME table: README.md, after "Wide after"\n\n| a | IoU |\n|---|---|\n| z | 0.6 |\n'
     )
     (tmp_path / "out" / "p").mkdir(parents=True)
@@ -182,7 +182,7 @@ def test_regen_readme_write_rewrites_the_differing_cells_only(tmp_path):
     confirmed, differ, unmatched = regen.check_readme(tmp_path / "out", tmp_path, said.append, write=True)
     assert (confirmed, differ, unmatched) == (1, 2, 0)
     text = (tmp_path / "README.md").read_text()
-    assert "| x | 0.2 | 2.0 | 5 |" in text  # IoU rewritten, (n 4) left out as README had it, timing kept
+    assert "| x | 0.2 | 2.5 | 5 |" in text  # IoU and centre rewritten, (n 4) left out as README had it, timing kept
     assert "| x | 0.1 |\n" in text and "| y | 0.3 | 1.0 | 6 |" in text and "| z | 0.5 | 9.9 |" in text
     assert any("p | Wide | z: BY HAND" in x for x in said)
     assert not list(tmp_path.glob("*.tmp"))
