@@ -390,3 +390,26 @@ def test_a_leaf_cutting_the_masks_moves_them_only_where_its_lost_edge_reads_as_a
     assert detect(cut, method="raw", settings=on).registration == (0, 0)
     with FruitPool(1, method=None) as pool:
         assert detect(cut, method="raw", settings=on, pool=pool).registration == (0, 0)
+
+
+@pytest.mark.parametrize("frame_name", ["lab-spheres-0", "lab-spheres-1"])
+def test_a_leaf_drawn_into_the_60_mm_spheres_mask_is_passed_over_though_its_flattened_cap_reads_below_a_fruits(
+    rp, frame_name
+):
+    """Stop 62 (docs/true62.md): a leaf 5 cm in front of the left 35 % of every sphere, the mask drawn over it, at
+    the frames' true registration (no shift). The 60 mm sphere's mask holds the leaf (347 px, flat: its curvature 0)
+    and the sphere (562 px behind it). The time-of-flight camera flattens that cap: its fit reads a curvature of 0.18
+    / R, 12 standard errors above 0 but below a fruit's (``THIN[1]``) and even a sheet's bound (``THIN[0]``), so
+    nothing behind the leaf was taken and extraction kept the leaf alone (every point at one depth: the completion
+    failed, "all points lie on a plane"). Behind a sheet told flat a part convex at two standard errors and more
+    curved than the sheet is now the fruit."""
+    from symfruit.extract import extract
+
+    frame = read_frame(rp.FRAMES / frame_name)
+    _, depth, masks, cam = rp.PERTURBATIONS["leafside5-over"](frame)
+    z = np.asarray(depth, np.float64)
+    mask = masks == 4
+    leaf = float(np.percentile(z[mask & (z > 0)], 1))  # the leaf's depth: the nearest in the mask
+    points = extract(mask, z, cam).points
+    assert len(points) >= 400
+    assert float(np.min(points[:, 2])) > leaf + 0.04  # the sphere's, 5 cm behind the leaf

@@ -528,9 +528,11 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     pixels wide; a leaf's small or curled part) hides less of the mask than the fruit shows, while a fruit's own front
     is the mask's largest surface (stop 40, docs/leaf40.md). Such a front part must also lie in front of the part
     behind's surface extended under it (:meth:`_InverseQuadratic.offset`) by more than ``join``: one lying on it is
-    that fruit's own front, parted from the rest of its surface (stop 41, docs/strip41.md). ``noise``: the depth's
-    noise, for :func:`fruit_depth`'s bins on the part behind. ``counted``: :func:`_part_sizes`' counts when the caller
-    has them (:func:`symfruit.core._jit.thin_passes`)."""
+    that fruit's own front, parted from the rest of its surface (stop 41, docs/strip41.md). Behind a sheet told flat, a
+    part whose fit reads convex at two standard errors and more curved than the sheet by two of both errors is the
+    fruit too, though below a fruit's curvature (a cap a time-of-flight camera flattens: stop 62, docs/true62.md).
+    ``noise``: the depth's noise, for :func:`fruit_depth`'s bins on the part behind. ``counted``: :func:`_part_sizes`'
+    counts when the caller has them (:func:`symfruit.core._jit.thin_passes`)."""
     if count < 2:
         return None
     plain = parts.ndim == 2 and parts.shape == depth.shape and depth.dtype == np.float64
@@ -557,6 +559,7 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
     rows, cols = np.nonzero(sheet)
     kappa, error = _mean_curvature(rows, cols, depth[rows, cols], focal)
     error *= inflate
+    sheet_kappa, sheet_error = kappa, error
     flat = kappa * radius < THIN[0] and (kappa + 2.0 * error) * radius < THIN[0] + 0.2 and error * radius <= THIN[2]
     # not a sheet: still an occluder where a convex part behind it is larger (a fruit's own front is its largest part)
     least = max(30, 0.1 * len(rows)) if flat else len(rows) + 1
@@ -592,12 +595,17 @@ def _behind_sheet(depth: np.ndarray, mask: np.ndarray, focal: float, front: floa
         seen = _InverseQuadratic(pr, pc, z, focal)
         kappa, error = seen.curvature()
         told = kappa * radius >= THIN[1] and error * radius <= THIN[2]
+        # behind a sheet told flat, a part whose fit reads convex at two standard errors and more curved than the
+        # sheet by two of both errors: a fruit's cap a time-of-flight camera flattens (its rim lost, 1 mm steps: the
+        # real 60 mm sphere's cap behind a leaf reads kappa R 0.18 +- 0.014, below THIN[0]) is still convex where the
+        # leaf is flat (stop 62, docs/true62.md)
+        bulged = flat and kappa > 2.0 * error and kappa - 2.0 * error > sheet_kappa + 2.0 * sheet_error
         # behind a surface shown not the fruit's, a part curved more than a sheet and convex at two standard errors;
         # behind a sheet told flat, a part whose curvature is not known (its fit's error beyond THIN[2]) but may be a
         # fruit's (THIN[1] within two standard errors): what a leaf hides is the fruit's, and a stereo camera's far,
         # fattened depth leaves of it a few noisy pixels whose fit tells nothing (stop 45, docs/leaf45.md)
         unknown = flat and error * radius > THIN[2] and (kappa + 2.0 * error) * radius >= THIN[1]
-        if told or unknown or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
+        if told or unknown or bulged or (kappa * radius >= THIN[0] and kappa > 2.0 * error and outside()):
             behind, _ = fruit_depth(z, np.sqrt(mask.sum() / np.pi), focal, noise=noise)
             if not flat and seen.offset(rows, cols, depth[rows, cols]) >= -join:
                 continue  # on the part behind's own surface, extended under it: that fruit's own front, not an occluder
