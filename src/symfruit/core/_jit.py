@@ -10035,35 +10035,36 @@ def _noise_step(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float, float]
     bit; a NaN difference, two infinite depths, is left out as there), read before the medians reorder them: the same
     numbers as the two kernels."""
     h, w = depth.shape
+    # stop 62 (surf62): the differences gathered twice in the one pass, all of them and those not 0 (the ones kept
+    # where 20 or more move), with the step's least and whether one is NaN read there too, instead of three more
+    # passes over them: the same differences in the same order, the same step and the same test
     diff = np.empty(max(h * (w - 1), 0))
+    moving = np.empty(max(h * (w - 1), 0))
     n = 0
-    for r in range(h):
-        for c in range(w - 1):
-            a, b = depth[r, c + 1], depth[r, c]
-            diff[n] = a - b
-            n += mask[r, c + 1] & mask[r, c] & (a > 0) & (b > 0)
     moved = 0
     best = np.inf
     found = False
-    for i in range(n):
-        d = diff[i]
-        moved += d != 0
-        e = abs(d)
-        found |= e > 0
-        best = min(best, e) if e > 0 else best
+    nan = False
+    for r in range(h):
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            d = a - b
+            both = mask[r, c + 1] & mask[r, c] & (a > 0) & (b > 0)
+            diff[n] = d
+            moving[moved] = d
+            n += both
+            moved += both & (d != 0)
+            e = abs(d)
+            found |= both & (e > 0)
+            best = min(best, e) if both and e > 0 else best
+            nan |= both & (d != d)
     step = float(best) if found else 0.0
-    if moved >= 20:
-        kept = 0
-        for i in range(n):
-            diff[kept] = diff[i]
-            kept += diff[i] != 0
-        n = kept
-    if n < 10:
-        return n, np.nan, step
     x = diff[:n]
-    for i in range(n):
-        if np.isnan(x[i]):
-            return n, np.nan, step
+    if moved >= 20:
+        n = moved
+        x = moving[:n]
+    if n < 10 or nan:
+        return n, np.nan, step
     return n, deviation_median(x), step
 
 
