@@ -1669,6 +1669,8 @@ def test_principal_widths_are_the_twins_to_the_bit(seed, h, w):
         xy = np.column_stack((cols + origin[1], rows + origin[0])).astype(np.float64)
         xy -= np.array([int(xy[:, 0].sum()), int(xy[:, 1].sum())], dtype=np.float64) / len(rows)
         assert _jit.centred_pixels(mask, origin[0], origin[1]).tobytes() == xy.tobytes()
+    else:  # fewer than two pixels: none (principal_widths counts them then)
+        assert _jit.centred_pixels(mask, origin[0], origin[1]).shape == (0, 2)
 
 
 @settings(max_examples=100, deadline=None)
@@ -3923,6 +3925,36 @@ def test_monotone_at_is_ray_pixels_then_the_table(seed, bins, tol):
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, surface.monotone_region, depth, keep, apex, tol, bins=bins)
     np.testing.assert_array_equal(fast, twin)
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([8, 72, 7]), st.sampled_from([0.0, 0.002, 5.0, -0.001, -3.0]),
+       st.sampled_from([1.0, -1.0, 1e6, 1e12, 1e14]))  # fmt: skip
+def test_monotone_at_by_distance_alone_is_the_sector_walk(seed, bins, tol, size):
+    """monotone_at's walk in order of distance alone, each sector's maximum kept apart (stop 62, surf62: tolerance 0
+    or more, finite depths below 2^40 with the sectors' offsets), and its walk in sector order (elsewhere) against
+    ray_pixels then monotone_table: the same pixels, with negative depths, negative tolerances, depths near and past
+    the bound, ties, and depths falling and rising along the rays."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 60, 2))
+    keep = rng.random((h, w)) < rng.uniform(0.2, 1.0)
+    depth = size * (0.5 + rng.choice([0.0, 0.001, 0.003, 0.01, -0.002], (h, w)) * rng.uniform(0.5, 2.0))
+    if rng.random() < 0.3:
+        depth = np.round(depth, 3)
+    apex = (int(rng.integers(0, h)), int(rng.integers(0, w)))
+    reach = max(apex[0], h - 1 - apex[0], apex[1], w - 1 - apex[1])
+    from symfruit.core import surface
+
+    table = surface._sector_table(bins, reach)
+    r = (table.shape[0] - 1) // 2
+    rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
+    want = np.zeros((h, w), bool)
+    _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, tol, want)
+    got = np.zeros((h, w), bool)
+    assert _jit.monotone_at(depth, keep, apex[0], apex[1], table, r, bins, tol, got) == int(keep.sum())
+    np.testing.assert_array_equal(got, want)
+    if size == 1.0 and tol == 0.002 and keep.sum() > 50:
+        assert 0 < got.sum()  # the test reaches kept pixels
 
 
 # --- stop 41, speedcand41
@@ -7993,12 +8025,16 @@ def test_least_median_seeded_at_a_spike_takes_the_first_least_median():
 def test_noise_step_is_depth_noise_and_depth_step(seed, odd):
     """``_noise_step`` (mask_values' one pass): ``depth_noise``'s count and deviation and ``depth_step``'s step, with
     whole-millimetre and continuous depths, NaN, infinite (two neighbours infinite: a NaN difference), negative and
-    zero depths, few pixels."""
+    zero depths, few pixels; and flat depths with fewer than 20 differences not 0 (all of them read then, the zeros
+    too: stop 62, surf62 gathers both sets in its one pass)."""
     rng = np.random.default_rng(seed)
     h, w = (int(x) for x in rng.integers(1, 40, 2))
     depth = rng.uniform(0.4, 0.6, (h, w))
     if rng.random() < 0.5:
         depth = np.round(depth, 3)
+    if rng.random() < 0.3:  # flat, a few steps
+        depth = np.full((h, w), 0.5)
+        depth[rng.random((h, w)) < rng.choice([0.005, 0.02, 0.1])] = 0.501
     if odd:
         for value in (np.nan, np.inf, -0.2, 0.0):
             depth[rng.random((h, w)) < 0.05] = value

@@ -4530,6 +4530,39 @@ def monotone_at(
                 d2[i] = q
                 top = max(top, q)
                 i += 1
+    scale = 2.0 * (biggest + tolerance + 1.0)
+    if tolerance >= 0.0 and biggest < np.inf and bins * scale + biggest < 2.0**40:
+        # stop 62 (surf62): the rays walked in order of distance alone, each sector's running maximum and fall kept
+        # apart (the pixels never moved to sector order). Within a sector the order is the same (the distance sort
+        # is stable: distance, then position). Across sectors the walk below carries its running maximum over, but
+        # it never reaches into the next sector: a sector's offset lies ``scale`` above the last one's, and its depths
+        # ``z + offset`` lie above every earlier ``z' + offset'`` by at least ``scale - 2 biggest = 2 (tolerance + 1)
+        # >= 2`` less the roundings (a few units in the last place of numbers below 2^40: under 2^-10), so a
+        # sector's first pixel takes its own value there as here. Finite depths (no NaN: ``biggest`` would not be
+        # finite) and a tolerance of 0 or more, else the walk below: the same arithmetic, so the same pixels
+        count = np.zeros(top + 2, np.int64)
+        for i in range(n):
+            count[d2[i] + 1] += 1
+        for v in range(top + 1):
+            count[v + 1] += count[v]
+        by_d2 = np.empty(n, np.int64)
+        for i in range(n):
+            by_d2[count[d2[i]]] = i
+            count[d2[i]] += 1
+        high = np.full(bins, -np.inf)
+        cut = np.zeros(bins, np.bool_)
+        for j in range(n):
+            i = by_d2[j]
+            s = sector[i]
+            offset = s * scale
+            peak = max(high[s], z[i] + offset)
+            high[s] = peak
+            gone = cut[s] | (z[i] < (peak - offset) - tolerance)
+            cut[s] = gone
+            if not gone:
+                a = at[i]
+                out[a >> 32, a & 0xFFFFFFFF] = True
+        return n
     by_d2, start = _counting_orders(d2, sector, n, top, bins)
     at_s, sec_s, z_s = np.empty(n, np.int64), np.empty(n, np.int64), np.empty(n)
     for j in range(n):
@@ -4538,7 +4571,6 @@ def monotone_at(
         k = start[s]
         start[s] = k + 1
         at_s[k], sec_s[k], z_s[k] = at[i], s, z[i]
-    scale = 2.0 * (biggest + tolerance + 1.0)
     running = -np.inf
     last = -1
     fallen = False
@@ -5104,26 +5136,30 @@ def own_depths(
 def centred_pixels(mask: np.ndarray, r0: int, c0: int) -> np.ndarray:
     """(n, 2) :func:`symfruit.core.raster.principal_widths`' centred coordinates: the column and row (at ``r0``,
     ``c0`` in a larger image) of each pixel of ``mask`` (h, w) bool in raster order, less their means (the whole-number
-    sums divided by the count, as the twin has them): the twin's array, bit for bit (at least two pixels)."""
+    sums divided by the count, as the twin has them): the twin's array, bit for bit; with fewer than two pixels an
+    empty (0, 2) array (stop 62, surf62: the caller no longer counts them first)."""
     h, w = mask.shape
     n = 0
     su = sv = 0
     for r in range(h):
         for c in range(w):
-            if mask[r, c]:
-                n += 1
-                su += c + c0
-                sv += r + r0
+            m = mask[r, c]
+            n += m
+            su += (c + c0) * m
+            sv += (r + r0) * m
+    if n < 2:
+        return np.empty((0, 2))
     mu, mv = float(su) / n, float(sv) / n
-    out = np.empty((n, 2))
+    # each pixel's values written and the count moved on by the mask (no jump to foresee; a row to spare for the
+    # pixels after the last): the same values in the same rows
+    out = np.empty((n + 1, 2))
     i = 0
     for r in range(h):
         for c in range(w):
-            if mask[r, c]:
-                out[i, 0] = float(c + c0) - mu
-                out[i, 1] = float(r + r0) - mv
-                i += 1
-    return out
+            out[i, 0] = float(c + c0) - mu
+            out[i, 1] = float(r + r0) - mv
+            i += mask[r, c]
+    return out[:n]
 
 
 @_njit
@@ -9999,35 +10035,36 @@ def _noise_step(depth: np.ndarray, mask: np.ndarray) -> tuple[int, float, float]
     bit; a NaN difference, two infinite depths, is left out as there), read before the medians reorder them: the same
     numbers as the two kernels."""
     h, w = depth.shape
+    # stop 62 (surf62): the differences gathered twice in the one pass, all of them and those not 0 (the ones kept
+    # where 20 or more move), with the step's least and whether one is NaN read there too, instead of three more
+    # passes over them: the same differences in the same order, the same step and the same test
     diff = np.empty(max(h * (w - 1), 0))
+    moving = np.empty(max(h * (w - 1), 0))
     n = 0
-    for r in range(h):
-        for c in range(w - 1):
-            a, b = depth[r, c + 1], depth[r, c]
-            diff[n] = a - b
-            n += mask[r, c + 1] & mask[r, c] & (a > 0) & (b > 0)
     moved = 0
     best = np.inf
     found = False
-    for i in range(n):
-        d = diff[i]
-        moved += d != 0
-        e = abs(d)
-        found |= e > 0
-        best = min(best, e) if e > 0 else best
+    nan = False
+    for r in range(h):
+        for c in range(w - 1):
+            a, b = depth[r, c + 1], depth[r, c]
+            d = a - b
+            both = mask[r, c + 1] & mask[r, c] & (a > 0) & (b > 0)
+            diff[n] = d
+            moving[moved] = d
+            n += both
+            moved += both & (d != 0)
+            e = abs(d)
+            found |= both & (e > 0)
+            best = min(best, e) if both and e > 0 else best
+            nan |= both & (d != d)
     step = float(best) if found else 0.0
-    if moved >= 20:
-        kept = 0
-        for i in range(n):
-            diff[kept] = diff[i]
-            kept += diff[i] != 0
-        n = kept
-    if n < 10:
-        return n, np.nan, step
     x = diff[:n]
-    for i in range(n):
-        if np.isnan(x[i]):
-            return n, np.nan, step
+    if moved >= 20:
+        n = moved
+        x = moving[:n]
+    if n < 10 or nan:
+        return n, np.nan, step
     return n, deviation_median(x), step
 
 

@@ -594,9 +594,14 @@ def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> t
     coordinates (a window cut around a mask gives the same widths, bit for bit, as the whole image).
     """
     mask = np.asarray(mask)
-    if mask.dtype == bool and mask.ndim == 2 and (jit := compiled()) is not None and np.count_nonzero(mask) >= 2:
-        # the centred coordinates by their compiled twin (issue 19, seventeenth round: the same array, bit for bit)
+    jit = compiled()
+    if mask.dtype == bool and mask.ndim == 2 and jit is not None:
+        # the centred coordinates by their compiled twin (issue 19, seventeenth round: the same array, bit for bit);
+        # fewer than two pixels give none, as the twin's count (stop 62, surf62: no count of the mask before it)
         xy = jit.centred_pixels(mask, int(origin[0]), int(origin[1]))
+        if len(xy) < 2:
+            n = float(np.count_nonzero(mask))
+            return n, n
     else:
         rows, cols = np.nonzero(mask)
         if origin != (0, 0):
@@ -609,7 +614,7 @@ def principal_widths(mask: np.ndarray, *, origin: tuple[int, int] = (0, 0)) -> t
         xy -= np.array([int(cols.sum()), int(rows.sum())], dtype=np.float64) / len(rows)
     _, vec = lapack.eigh(xy.T @ xy)  # np.linalg.eigh without its wrapper: the same LAPACK call (stop 45)
     p = xy @ vec
-    if (jit := compiled()) is not None and p.dtype == np.float64:  # both extents in one pass (stop 46: the same)
+    if jit is not None and p.dtype == np.float64:  # both extents in one pass (stop 46: the same)
         minor, major = jit.column_extents(p)
         return float(minor + 1.0), float(major + 1.0)
     return float(np.ptp(p[:, 0]) + 1.0), float(np.ptp(p[:, 1]) + 1.0)

@@ -1167,7 +1167,10 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     """
     region = mask if region is None else region
     valid: np.ndarray | None = None  # with depth cleaned, its pixels above 0 (made only where wanted)
-    jit = compiled() if isinstance(depth, np.ndarray) and depth.dtype == np.float64 and depth.ndim == 2 else None
+    # the kernels' module looked up once a call (stop 62, surf62: it was asked for five times; the same module)
+    kernels = compiled()
+    plain = isinstance(depth, np.ndarray) and depth.dtype == np.float64 and depth.ndim == 2
+    jit = kernels if plain else None
     if clean:
         pass  # finite, above 0 or 0: the cleaning below would give the same values
     elif jit is not None:  # the compiled twin of the two lines below (issue 19, seventeenth round: the same depth)
@@ -1180,7 +1183,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # What depends on the mask alone is worked out on the mask's box (the same values: pixels outside it are not
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
     unit: float | None = None  # the depth's step, when measured with the noise and the front
-    jit = compiled()
+    jit = kernels
     if (
         jit is not None
         and isinstance(mask, np.ndarray)
@@ -1248,7 +1251,7 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # A support, stem or leaf meets a fruit at its outline; deep inside the mask a fall is the fruit's own
     # (a banana's inner side, a pear's neck) and is kept.
     deep_px = interior * min(radius_px, 0.5 * minor_px)
-    if (jit := compiled()) is not None and depth.dtype == np.float64 and depth.ndim == 2 and (
+    if (jit := kernels) is not None and depth.dtype == np.float64 and depth.ndim == 2 and (
         np.shape(region) == np.shape(mask) == depth.shape
     ):  # fmt: skip
         # the slab's pixels, the apex, the convex cap and the deep pixels in one call (stop 51, surface51: the same)
