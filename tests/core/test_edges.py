@@ -15,7 +15,7 @@ from symfruit.core.edges import (
     _edge_distances,
     _mask_costs,
     _moved_costs,
-    _orientation_bin,
+    _outline_samples,
     _padded_costs,
     _shift_costs,
     colour_edges,
@@ -272,26 +272,13 @@ def reference_mask_costs(
     if m <= 0:
         return []
     h, w = lab.shape
-    parts = []
-    for k, sl in enumerate(ndimage.find_objects(lab), start=1):
-        if sl is None:
-            continue
-        a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
-        b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
-        mask = lab[a0:a1, b0:b1] == k
-        rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
-        smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
-        gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
-        parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
-    if not parts:
+    found = _outline_samples(lab, max_points)  # the outline's pixels: unchanged by the faster version
+    if found is None:
         return []
-    ks, rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(5))
-    step = max(1, -(-len(rows) // max(1, int(max_points))))
-    ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
-    bins = _orientation_bin(gx, gy)
+    parts, ks, rows, cols, gx, gy, bins = found
     pad = m + int(np.ceil(cap)) + EDGE_REACH + 1
     windows, seen, pooled = [], np.zeros((h, w), bool), []
-    for *_, (k, sl) in parts:
+    for k, sl in parts:
         mine = ks == k
         if not mine.any():
             continue

@@ -1552,10 +1552,9 @@ def _window_median(vals: np.ndarray, r0: int, c0: int, size: int, window: np.nda
 
 
 @_njit_inlined
-def _counting_orders(d2: np.ndarray, sector: np.ndarray, n: int, top: int, bins: int) -> tuple[np.ndarray, np.ndarray]:
-    """The two stable counting sorts of :func:`monotone` and :func:`monotone_at`: the indices of ``d2`` (n,) in order
-    of distance (ties by position; ``top`` its largest value), and each of the ``bins`` sectors' first place when
-    ordered by ``sector`` (n,) (``start`` (bins + 1,), the places still to be taken as the caller fills them)."""
+def _distance_order(d2: np.ndarray, n: int, top: int) -> np.ndarray:
+    """The indices of ``d2`` (n,) in order of distance, ties by position (a stable counting sort; ``top`` its largest
+    value): :func:`_counting_orders`' first order, and :func:`monotone_at`'s walk by distance alone."""
     count = np.zeros(top + 2, np.int64)
     for i in range(n):
         count[d2[i] + 1] += 1
@@ -1565,6 +1564,15 @@ def _counting_orders(d2: np.ndarray, sector: np.ndarray, n: int, top: int, bins:
     for i in range(n):
         by_d2[count[d2[i]]] = i
         count[d2[i]] += 1
+    return by_d2
+
+
+@_njit_inlined
+def _counting_orders(d2: np.ndarray, sector: np.ndarray, n: int, top: int, bins: int) -> tuple[np.ndarray, np.ndarray]:
+    """The two stable counting sorts of :func:`monotone` and :func:`monotone_at`: the indices of ``d2`` (n,) in order
+    of distance (ties by position; ``top`` its largest value), and each of the ``bins`` sectors' first place when
+    ordered by ``sector`` (n,) (``start`` (bins + 1,), the places still to be taken as the caller fills them)."""
+    by_d2 = _distance_order(d2, n, top)
     start = np.zeros(bins + 1, np.int64)
     for i in range(n):
         start[sector[i] + 1] += 1
@@ -4540,15 +4548,7 @@ def monotone_at(
         # >= 2`` less the roundings (a few units in the last place of numbers below 2^40: under 2^-10), so a
         # sector's first pixel takes its own value there as here. Finite depths (no NaN: ``biggest`` would not be
         # finite) and a tolerance of 0 or more, else the walk below: the same arithmetic, so the same pixels
-        count = np.zeros(top + 2, np.int64)
-        for i in range(n):
-            count[d2[i] + 1] += 1
-        for v in range(top + 1):
-            count[v + 1] += count[v]
-        by_d2 = np.empty(n, np.int64)
-        for i in range(n):
-            by_d2[count[d2[i]]] = i
-            count[d2[i]] += 1
+        by_d2 = _distance_order(d2, n, top)
         high = np.full(bins, -np.inf)
         cut = np.zeros(bins, np.bool_)
         for j in range(n):

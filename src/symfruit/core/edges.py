@@ -374,6 +374,35 @@ MIN_MOVE_PX = 2.0
 EDGE_REACH = 6
 
 
+def _outline_samples(
+    lab: np.ndarray, max_points: int, boxes: list[tuple[slice, slice] | None] | None = None
+) -> tuple[list[tuple[int, tuple[slice, slice]]], np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray,
+           np.ndarray] | None:  # fmt: skip
+    """:func:`_mask_costs`' outline pixels of the masks ``lab`` (2-D labels; ``boxes`` their
+    ``ndimage.find_objects``, found here when None): ``(parts, ks, rows, cols, gx, gy, bins)``, ``parts`` each mask's
+    ``(label, box)`` in label order, then of all masks' outline pixels together, thinned to at most ``max_points``
+    (every ``step``-th), their labels, rows, columns, the gradient of the mask smoothed by 1.5 px at them and their
+    orientation bins (:func:`_orientation_bin`); None when no mask has a pixel."""
+    h, w = lab.shape
+    parts = []
+    for k, sl in enumerate(ndimage.find_objects(lab) if boxes is None else boxes, start=1):
+        if sl is None:
+            continue
+        a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
+        b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
+        mask = lab[a0:a1, b0:b1] == k
+        rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
+        smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
+        gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
+        parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
+    if not parts:
+        return None
+    ks, rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(5))
+    step = max(1, -(-len(rows) // max(1, int(max_points))))
+    ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
+    return [p[5] for p in parts], ks, rows, cols, gx, gy, _orientation_bin(gx, gy)
+
+
 def _mask_costs(
     color: np.ndarray, labels: np.ndarray, *, max_px: int, cap: float, max_points: int,
     boxes: list[tuple[slice, slice] | None] | None = None,
@@ -403,27 +432,14 @@ def _mask_costs(
     if m <= 0:
         return []
     h, w = lab.shape
-    parts = []
-    for k, sl in enumerate(ndimage.find_objects(lab) if boxes is None else boxes, start=1):
-        if sl is None:
-            continue
-        a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
-        b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
-        mask = lab[a0:a1, b0:b1] == k
-        rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
-        smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
-        gx, gy = ndimage.sobel(smooth, axis=1)[rows, cols], ndimage.sobel(smooth, axis=0)[rows, cols]
-        parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
-    if not parts:
+    found = _outline_samples(lab, max_points, boxes)
+    if found is None:
         return []
-    ks, rows, cols, gx, gy = (np.concatenate([p[i] for p in parts]) for i in range(5))
-    step = max(1, -(-len(rows) // max(1, int(max_points))))
-    ks, rows, cols, gx, gy = ks[::step], rows[::step], cols[::step], gx[::step], gy[::step]
-    bins = _orientation_bin(gx, gy)
+    parts, ks, rows, cols, gx, gy, bins = found
     reach = m + int(np.ceil(cap))  # an outline pixel's edges within the cap of it, wherever the search moves it
     pad = reach + EDGE_REACH + 1
     windows, seen, pooled = [], np.zeros((h, w), bool), []
-    for *_, (k, sl) in parts:
+    for k, sl in parts:
         mine = ks == k
         if not mine.any():
             continue
