@@ -3900,6 +3900,22 @@ def test_the_occlusion_in_one_call_clears_a_fattened_edge():
     assert bare.hidden.sum() > 100 and not fast.hidden.any() and not twin.hidden.any()
 
 
+def _monotone_at_against_the_table(depth, keep, apex, bins, reach, tol):
+    """monotone_at's pixels (returned), asserted to be ray_pixels then monotone_table's with the sector table of
+    ``bins`` and ``reach``, and its count every kept pixel."""
+    from symfruit.core import surface
+
+    table = surface._sector_table(bins, reach)
+    r = (table.shape[0] - 1) // 2
+    rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
+    want = np.zeros(keep.shape, bool)
+    _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, tol, want)
+    got = np.zeros(keep.shape, bool)
+    assert _jit.monotone_at(depth, keep, apex[0], apex[1], table, r, bins, tol, got) == int(keep.sum())
+    np.testing.assert_array_equal(got, want)
+    return got
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([8, 72, 7]), st.sampled_from([0.0, 0.002, np.inf]))
 def test_monotone_at_is_ray_pixels_then_the_table(seed, bins, tol):
@@ -3913,15 +3929,8 @@ def test_monotone_at_is_ray_pixels_then_the_table(seed, bins, tol):
     depth = rng.choice([0.5, 0.501, 0.503, 0.51], (h, w))
     apex = (int(rng.integers(-5, h + 5)), int(rng.integers(-5, w + 5)))
     reach = max(abs(apex[0]), abs(h - 1 - apex[0]), abs(apex[1]), abs(w - 1 - apex[1]))
-    table = surface._sector_table(bins, reach)
-    r = (table.shape[0] - 1) // 2
     if np.isfinite(tol):
-        rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
-        want = np.zeros((h, w), bool)
-        _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, tol, want)
-        got = np.zeros((h, w), bool)
-        assert _jit.monotone_at(depth, keep, apex[0], apex[1], table, r, bins, tol, got) == int(keep.sum())
-        np.testing.assert_array_equal(got, want)
+        _monotone_at_against_the_table(depth, keep, apex, bins, reach, tol)
     with pytest.MonkeyPatch.context() as mp:
         fast, twin = _both(mp, surface.monotone_region, depth, keep, apex, tol, bins=bins)
     np.testing.assert_array_equal(fast, twin)
@@ -3943,16 +3952,7 @@ def test_monotone_at_by_distance_alone_is_the_sector_walk(seed, bins, tol, size)
         depth = np.round(depth, 3)
     apex = (int(rng.integers(0, h)), int(rng.integers(0, w)))
     reach = max(apex[0], h - 1 - apex[0], apex[1], w - 1 - apex[1])
-    from symfruit.core import surface
-
-    table = surface._sector_table(bins, reach)
-    r = (table.shape[0] - 1) // 2
-    rows, cols, dy, dx = _jit.ray_pixels(keep, *apex)
-    want = np.zeros((h, w), bool)
-    _jit.monotone_table(depth, rows, cols, dy, dx, table, r, bins, tol, want)
-    got = np.zeros((h, w), bool)
-    assert _jit.monotone_at(depth, keep, apex[0], apex[1], table, r, bins, tol, got) == int(keep.sum())
-    np.testing.assert_array_equal(got, want)
+    got = _monotone_at_against_the_table(depth, keep, apex, bins, reach, tol)
     if size == 1.0 and tol == 0.002 and keep.sum() > 50:
         assert 0 < got.sum()  # the test reaches kept pixels
 
