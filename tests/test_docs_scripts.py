@@ -156,35 +156,3 @@ def test_speed_profile_gives_own_times(tmp_path):
     assert lines[1].startswith("own times: the kernels 0.00 ms, the rest ")
     own = {line.split()[-1]: float(line.split()[0]) for line in lines[2:]}
     assert own["symfruit.segment.colour.segment"] < 0.5 * own["symfruit.segment.colour._segment_at"]
-
-
-def test_regen_readme_write_rewrites_the_differing_cells_only(tmp_path):
-    """``regen.py readme OUT --write``: a printed row rewrites README's row of its label in the table after its
-    anchor, keeping the cells README agrees with and the timing column, a count ``(n N)`` left out where README's
-    cell has none; a printed row with other columns is left for the hand; the other tables and rows are untouched."""
-    regen = docs_script("regen")
-    readme = (
-        "# R\n\nOther table:\n\n| a | IoU |\n|---|---|\n| x | 0.1 |\n\n"
-        "Anchor here:\n\n| a | IoU | centre (mm) | ms |\n|---|---|---|---|\n"
-        "| x | 0.1 | 2.0 | 5 |\n| y | 0.3 | 1.0 | 6 |\n"
-        "\nWide after:\n\n| a | IoU | centre (mm) |\n|---|---|---|\n| z | 0.5 | 9.9 |\n"
-    )
-    (tmp_path / "README.md").write_text(readme)
-    rows = (
-        '## Sec\n\nREADME table: README.md, after "Anchor here"\n\n'
-        "| a | IoU | centre (mm) | ms |\n|---|---|---|---|\n"
-        "| x | 0.2 | 2.5 (n 4) | 7 |\n| y | 0.3 | 1.0 | 6 |\n\n"
-        '## Wide\n\nREADME table: README.md, after "Wide after"\n\n| a | IoU |\n|---|---|\n| z | 0.6 |\n'
-    )
-    (tmp_path / "out" / "p").mkdir(parents=True)
-    (tmp_path / "out" / "p" / "rows.md").write_text(rows)
-    said: list[str] = []
-    confirmed, differ, unmatched = regen.check_readme(tmp_path / "out", tmp_path, said.append, write=True)
-    assert (confirmed, differ, unmatched) == (1, 2, 0)
-    text = (tmp_path / "README.md").read_text()
-    assert "| x | 0.2 | 2.5 | 5 |" in text  # IoU and centre rewritten, (n 4) left out as README had it, timing kept
-    assert "| x | 0.1 |\n" in text and "| y | 0.3 | 1.0 | 6 |" in text and "| z | 0.5 | 9.9 |" in text
-    assert any("p | Wide | z: BY HAND" in x for x in said)
-    assert not list(tmp_path.glob("*.tmp"))
-    said.clear()
-    assert regen.check_readme(tmp_path / "out", tmp_path, said.append) == (2, 1, 0)  # and nothing written now

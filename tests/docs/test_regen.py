@@ -213,3 +213,34 @@ def test_readme_leaves_out_the_columns_of_earlier_stops(regen, tmp_path):
     counts, said = check(regen, tmp_path, readme, text.replace("0.768", "0.770"), out="out2")
     assert counts == (0, 1, 0)
     assert said[0] == "x | l | D435: differs: 0 %: README 0.768, printed (not printed)"
+
+
+def test_readme_write_rewrites_the_differing_cells_only(regen, tmp_path):
+    """``regen.py readme OUT --write``: a printed row rewrites README's row of its label in the table after its
+    anchor, keeping the cells README agrees with and the timing column, a count ``(n N)`` left out where README's
+    cell has none; a printed row with other columns is left for the hand; the other tables and rows are untouched."""
+    readme = (
+        "# R\n\nOther table:\n\n| a | IoU |\n|---|---|\n| x | 0.1 |\n\n"
+        "Anchor here:\n\n| a | IoU | centre (mm) | ms |\n|---|---|---|---|\n"
+        "| x | 0.1 | 2.0 | 5 |\n| y | 0.3 | 1.0 | 6 |\n"
+        "\nWide after:\n\n| a | IoU | centre (mm) |\n|---|---|---|\n| z | 0.5 | 9.9 |\n"
+    )
+    (tmp_path / "README.md").write_text(readme)
+    rows = (
+        '## Sec\n\nREADME table: README.md, after "Anchor here"\n\n'
+        "| a | IoU | centre (mm) | ms |\n|---|---|---|---|\n"
+        "| x | 0.2 | 2.5 (n 4) | 7 |\n| y | 0.3 | 1.0 | 6 |\n\n"
+        '## Wide\n\nREADME table: README.md, after "Wide after"\n\n| a | IoU |\n|---|---|\n| z | 0.6 |\n'
+    )
+    (tmp_path / "out" / "p").mkdir(parents=True)
+    (tmp_path / "out" / "p" / "rows.md").write_text(rows)
+    said: list[str] = []
+    confirmed, differ, unmatched = regen.check_readme(tmp_path / "out", tmp_path, said.append, write=True)
+    assert (confirmed, differ, unmatched) == (1, 2, 0)
+    text = (tmp_path / "README.md").read_text()
+    assert "| x | 0.2 | 2.5 | 5 |" in text  # IoU and centre rewritten, (n 4) left out as README had it, timing kept
+    assert "| x | 0.1 |\n" in text and "| y | 0.3 | 1.0 | 6 |" in text and "| z | 0.5 | 9.9 |" in text
+    assert any("p | Wide | z: BY HAND" in x for x in said)
+    assert not list(tmp_path.glob("*.tmp"))
+    said.clear()
+    assert regen.check_readme(tmp_path / "out", tmp_path, said.append) == (2, 1, 0)  # and nothing written now
