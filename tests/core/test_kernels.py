@@ -5458,6 +5458,17 @@ def test_the_label_boxes_known_answer():
     assert got.tolist() == [[1, 3, 2, 40], [5, 0, 70, 0], [0, 5, 35, 70], [5, 0, 70, 0]]
 
 
+def _random_labels(rng: np.random.Generator, h: int, w: int, top: int) -> np.ndarray:
+    """(h, w) int32 labels 0..``top``: up to 7 rectangles of random labels from 1, then a random share of pixels
+    (none, 1 % or 30 %) given a random label from 0 (runs across blocks, sparse and dense labels)."""
+    labels = np.zeros((h, w), np.int32)
+    for _ in range(int(rng.integers(0, 8))):
+        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+        labels[r0 : r0 + int(rng.integers(1, 20)), c0 : c0 + int(rng.integers(1, 80))] = rng.integers(1, top + 1)
+    labels[rng.random((h, w)) < rng.choice([0.0, 0.01, 0.3])] = rng.integers(0, top + 1)
+    return labels
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.integers(0, 2**31 - 1), st.integers(1, 50), st.integers(1, 130), st.integers(1, 12))
 def test_the_label_boxes_are_find_objects(seed, h, w, n):
@@ -5466,11 +5477,7 @@ def test_the_label_boxes_are_find_objects(seed, h, w, n):
     from scipy import ndimage
 
     rng = np.random.default_rng(seed)
-    labels = np.zeros((h, w), np.int32)
-    for _ in range(int(rng.integers(0, 8))):
-        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
-        labels[r0 : r0 + int(rng.integers(1, 20)), c0 : c0 + int(rng.integers(1, 80))] = rng.integers(1, n + 3)
-    labels[rng.random((h, w)) < rng.choice([0.0, 0.01, 0.3])] = rng.integers(0, n + 3)
+    labels = _random_labels(rng, h, w, n + 2)
     if rng.random() < 0.5:
         labels = labels[:, ::-1]  # a strided view
     got = _jit.label_boxes(labels, n)
@@ -5491,11 +5498,7 @@ def test_the_boxes_within_windows_are_find_objects(seed, h, w, n):
     from scipy import ndimage
 
     rng = np.random.default_rng(seed)
-    labels = np.zeros((h, w), np.int32)
-    for _ in range(int(rng.integers(0, 8))):
-        r0, c0 = int(rng.integers(0, h)), int(rng.integers(0, w))
-        labels[r0 : r0 + int(rng.integers(1, 20)), c0 : c0 + int(rng.integers(1, 80))] = rng.integers(1, n + 1)
-    labels[rng.random((h, w)) < rng.choice([0.0, 0.01, 0.3])] = rng.integers(0, n + 1)
+    labels = _random_labels(rng, h, w, n)
     want = ndimage.find_objects(labels, n)
     windows = np.zeros((n, 4), np.int64)
     for k, sl in enumerate(want):
