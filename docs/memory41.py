@@ -6,6 +6,12 @@ rgb8 colour, CameraInfo).
     python docs/memory41.py folder --frames 200
     python docs/memory41.py bag --frames 200 [--method evidence]
     python docs/memory41.py folder --frames 200 --fruit-processes 1
+    python docs/memory41.py table --frames 2000
+
+``table``: the fruit table alone (:class:`symfruit.season.table.TableWriter`, which ``detect`` fills at the end of
+a run from every frame's ``detections.json``): the Python heap's peak (``tracemalloc``) while N frames of 8 fruit
+each are added, pyarrow imported before. Its buffer holds up to ``ROW_GROUP`` rows before a row group is written, so
+the peak grows up to about 2,000 frames of 8 fruit and then stays (stop 63).
 
 ``--fruit-processes N``: each frame's fruit shared with N worker processes (:class:`symfruit.fruitpool.FruitPool`,
 started and warm before the first frame; stop 53): the workers' RSS is printed too, and the run's seconds.
@@ -74,13 +80,39 @@ def bag_recording(root: Path, n: int, frame: Path) -> Path:
     return root / "rec"
 
 
+def table_peak(frames: int) -> float:
+    """The Python heap's peak in MB while ``frames`` records of 8 fruit go through a :class:`TableWriter`."""
+    import tracemalloc
+
+    import pyarrow.parquet  # noqa: F401  (imported before the measurement, as detect has it by then)
+
+    from symfruit.season.table import TableWriter, frame_rows
+
+    fruit = {"centre": [0.1, 0.2, 0.3], "box": {"size": [0.03, 0.03, 0.03]}, "confidence": 0.5, "reliable": True}
+    fruit |= {"method": "evidence", "mask_area": 500, "n_points": 300}
+    record = {"header": {"stamp": {"sec": 1, "nanosec": 0}}, "timings": {"total": 0.1}}
+    record["fruits"] = [{"id": k, **fruit} for k in range(8)]
+    tracemalloc.start()
+    with tempfile.TemporaryDirectory(prefix="symfruit-memory41-") as tmp, TableWriter(tmp) as table:
+        for i in range(frames):
+            table.add(*frame_rows({**record, "frame": f"frame_{i:06d}"}, "rec"))
+    peak = tracemalloc.get_traced_memory()[1] / 1e6
+    tracemalloc.stop()
+    return peak
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("kind", choices=("folder", "bag"))
+    parser.add_argument("kind", choices=("folder", "bag", "table"))
     parser.add_argument("--frames", type=int, default=200)
     parser.add_argument("--method", default=None, help="completion method (default: detect's)")
     parser.add_argument("--fruit-processes", type=int, default=0, help="fruit worker processes (default 0: none)")
     args = parser.parse_args()
+    if args.kind == "table":
+        rows = 8 * args.frames
+        peak = table_peak(args.frames)
+        sys.stdout.write(f"table, {args.frames} frames ({rows} rows): Python heap peak {peak:.1f} MB\n")
+        return
 
     from symfruit.batch import run_batch
     from symfruit.demo import example_frame
