@@ -218,9 +218,9 @@ class EvidenceSettings(Section):
         true registration) the 60 mm sphere behind a leaf or strip 53-54 -> 60-61 mm deep (its cap's cone 24-31 mm),
         the perturbed frames' boxes over the 6 mm bar 33 -> 22 of 208. Not the default: a mask grown 2 px then boxes
         the 60 mm sphere as a 66-67 mm cube (6.1 mm deep over, 2 -> 4 of 8); the development apple trees' depth
-        sides 4.7 -> 4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm, since the box's front
-        lies 4 mm behind the truth there and the prior's back, ``front + width``, keeps that; the Azure Kinect
-        model's strawberries 6.9 -> 7.0 mm.
+        sides 4.7 -> 4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm: the Azure Kinect model
+        they are rendered through sees 3.4-3.8 mm too far there (its range bias), which the prior's back, ``front +
+        width``, keeps and the shapes' short back had offset; the model's strawberries 6.9 -> 7.0 mm.
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
