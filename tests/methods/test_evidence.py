@@ -1174,3 +1174,60 @@ def test_a_prior_read_from_the_free_arcs_ellipse_keeps_an_uncut_outlines_spread(
     assert got.max[2] == pytest.approx((a * (z + r) + b * (z + s.depth_ratio * width)) / (a + b), rel=1e-9)
     if spread == "ellipse":
         assert got.max[2] - z > 0.9 * width  # the prior's 0.93-0.95 of an uncut outline
+
+
+def _disc_fuse(rim, box_depth, lost_rim, contour=1.0):
+    """``fuse_depth`` on a disc 40 px across 0.5 m away, the shapes' box ``box_depth`` radii deep (a lost rim's short
+    back), ``rim`` the rim coverage: ``(box, width, settings, z, r)``."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
+    yy, xx = np.mgrid[:60, :60]
+    region = Silhouette(u0, v0, np.hypot(yy - 29.5, xx - 29.5) <= 20, 0.0)
+    across = across_sight(region, cam)
+    z, r = 0.5, 20.0 * 0.5 / cam.fx
+    box = Box(np.array([-r, -r, z]), np.array([r, r, z + box_depth * r]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.0005)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
+    s = EvidenceSettings(lost_rim=lost_rim)
+    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=rim, across=across)
+    return got, width, s, z, r
+
+
+def test_a_lost_rims_short_back_face_bounds_the_depth_from_below_and_does_not_pull_it():
+    """Stop 63 (docs/prior63.md, ``lost_rim``): the shapes' back face a radius behind the front (a cap without its
+    rim, half the fruit's depth), the rim 40 % seen, the outline 40 % a contour (the prior's spread 0.375 widths).
+    ``pull`` (as before) averages it with the prior by their inverse variances, the lost rim's error in the shapes'
+    spread: the box comes out short. ``bound`` reads it as a lower bound short by up to that error (``rim_error * (1 -
+    rim)`` widths, 0.6 of the width here, past the prior's): the prior alone decides, the back face a width behind the
+    front. With the rim seen the two are the same to the bit, and a shapes' back face beyond the prior's is pulled as
+    before."""
+    pulled, width, s, z, r = _disc_fuse(0.4, 1.0, "pull", 0.4)
+    bounded, width_b, _, _, _ = _disc_fuse(0.4, 1.0, "bound", 0.4)
+    assert width_b == width
+    fit_sd = np.hypot(s.back_inflation * 0.0005, width * (s.shape_error + s.rim_error * 0.6))
+    a, b = fit_sd**-2, (s.depth_ratio_sd * width / 0.4) ** -2
+    assert pulled.max[2] == pytest.approx((a * (z + r) + b * (z + width)) / (a + b), rel=1e-9)
+    assert pulled.max[2] < z + 0.9 * width
+    assert bounded.max[2] == pytest.approx(z + s.depth_ratio * width, rel=1e-12)
+    for depth in (1.0, 2.5):  # short with the rim seen; deeper than the prior's (about 2 radii)
+        same = _disc_fuse(1.0, depth, "pull")[0], _disc_fuse(1.0, depth, "bound")[0]
+        assert same[0].min.tolist() == same[1].min.tolist() and same[0].max.tolist() == same[1].max.tolist()
+    deep = _disc_fuse(0.4, 2.5, "pull")[0], _disc_fuse(0.4, 2.5, "bound")[0]
+    assert deep[0].max[2] == deep[1].max[2] > z + width
+
+
+def test_a_lost_rims_back_face_short_by_more_than_its_error_pulls_by_its_clean_error():
+    """``lost_rim: bound`` with the rim 90 % seen: the shapes' back face a radius behind the front may be short by 0.1
+    widths at most, so the fruit reaches at least 0.6 widths (a radius is half a width) and the prior's 1.0 lies
+    beyond: the prior and that bound are averaged by their inverse variances, the bound's without the lost rim's
+    part (the shapes' clean error); the box's back lies between, nearer the bound."""
+    got, width, s, z, r = _disc_fuse(0.9, 1.0, "bound")
+    bound = z + r + s.rim_error * 0.1 * width
+    fit_sd = np.hypot(s.back_inflation * 0.0005, width * s.shape_error)
+    a, b = fit_sd**-2, (s.depth_ratio_sd * width) ** -2
+    assert got.max[2] == pytest.approx((a * bound + b * (z + width)) / (a + b), rel=1e-9)
+    assert bound < got.max[2] < 0.5 * (bound + z + width)

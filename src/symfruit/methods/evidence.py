@@ -207,6 +207,20 @@ class EvidenceSettings(Section):
         is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
         real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
         the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
+    lost_rim : {"pull", "bound"}
+        How :func:`fuse_depth` reads the shapes' back face where the seen region's rim holds no points
+        (:func:`rim_coverage` under 1: a time-of-flight camera's lost rim) and it lies in front of the prior's:
+        ``pull`` (the default before) as an estimate with the lost rim's error (``rim_error``) added to its
+        spread, so that it pulls the box's back towards itself; ``bound`` (stop 63, docs/prior63.md) as what it is,
+        a lower bound: a shape fitted to a cap without its rim comes out short, never deep, by up to that error, so
+        where the prior's back lies within it the prior alone decides, and beyond it the shapes' clean error pulls.
+        With the rim seen (``rim`` 1) the two are the same. On the real spheres with ``extract.occluder_edges`` (the
+        true registration) the 60 mm sphere behind a leaf or strip 53-54 -> 60-61 mm deep (its cap's cone 24-31 mm),
+        the perturbed frames' boxes over the 6 mm bar 33 -> 22 of 208. Not the default: a mask grown 2 px then boxes
+        the 60 mm sphere as a 66-67 mm cube (6.1 mm deep over, 2 -> 4 of 8); the development apple trees' depth
+        sides 4.7 -> 4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm: the Azure Kinect model
+        they are rendered through sees 3.4-3.8 mm too far there (its range bias), which the prior's back, ``front +
+        width``, keeps and the shapes' short back had offset; the model's strawberries 6.9 -> 7.0 mm.
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
@@ -364,6 +378,7 @@ class EvidenceSettings(Section):
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     cut_circle: Literal["off", "free"] = setting("free")
+    lost_rim: Literal["pull", "bound"] = setting("pull")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -799,11 +814,25 @@ def fuse_depth(
     front = float(box.min[2])
     prior_sd = s.depth_ratio_sd * width / max(read, 0.25)
     prior_back = front + s.depth_ratio * width
+    shapes_back = fit_back
+    bounded = s.lost_rim == "bound" and rim < 1.0 and fit_back < prior_back
+    if bounded:
+        # A shape fitted to a cap whose rim the camera lost is short by up to what the rim hides, never deep: its
+        # back face then says the fruit reaches at least there (and, within the rim's share of its error, no
+        # farther than that beyond), not where. Inside that range the prior decides; beyond it the fit's clean
+        # error pulls, as a whole rim's fit does (rim 1: the same as ``pull``).
+        fit_back = min(prior_back, fit_back + width * s.rim_error * (1.0 - rim))
+        clean = (s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + (width * s.shape_error) ** 2
+        fit_sd = math.sqrt(float(clean))
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
-    back = max((a * fit_back + b * prior_back) / (a + b), front + 1e-4)
+    fused = (a * fit_back + b * prior_back) / (a + b)
+    # the prior's share of the back face: how far it moved the shapes' towards its own (b / (a + b) where the
+    # shapes' back face is read as an estimate)
+    pull = b / (a + b) if not bounded else min(max((fused - shapes_back) / (prior_back - shapes_back), 0.0), 1.0)
+    back = max(fused, front + 1e-4)
     if seen_back is not None:
         back = max(back, seen_back)  # the fruit holds every point seen of it
-    share = b / (a + b) * combined.contour**2
+    share = pull * combined.contour**2
     # The silhouette's box: its widths across the line of sight (a sphere's diameter wherever it is in the
     # image, where the pixel box times the depth is stretched off the optical axis), about the posterior
     # centre's point on the ray through the silhouette's centroid.
@@ -813,7 +842,7 @@ def fuse_depth(
     widest = math.inf
     if s.cut_reach == "widest" and combined.contour < 1.0:  # the outline's widest extent: along its axes or e1, e2
         widest = max(across.major, across.minor, *(across.hi - across.lo).tolist())
-    lo, hi = _lateral_faces(box, sil, front, back, share, b / (a + b), widest)
+    lo, hi = _lateral_faces(box, sil, front, back, share, pull, widest)
     return Box(np.array(lo), np.array(hi)), 1.0 / math.sqrt(a + b), width
 
 
