@@ -1,7 +1,9 @@
 """Within-fruit confidence of `evidence` on generated fruit and the shared scans (docs/conf63.md, issue 18 item 3):
 ``collect`` is docs/conf48.py's collection (the evaluation's own instances, `evidence` with the defaults, the
 render's truth; ``--renoise`` another draw of the sensor's depth noise) with more columns a view: the uncertainty's
-``cut`` and ``lateral`` terms and the dense points' and fitted sample's counts. ``table`` prints the within-fruit /
+``cut`` and ``lateral`` terms, the dense points' and fitted sample's counts, and ``core.raster.axis_tilt``'s reading of
+the front (its sag over a round section's ``tilt_cap``, the midline's slope, and their jackknife deviations over 6
+sectors; off in `evidence` by default, read here only). ``table`` prints the within-fruit /
 pooled Spearman of the issue's per-view quantities (larger: less confident) and of candidate formulas, a column a
 CSV; ``parts`` splits a feature's within-fruit ranking into the error's pose part and noise part (two noise draws of
 the same views); ``weights`` refits the scales of `u`'s own terms within fruit; ``ceiling`` fits within-fruit least
@@ -27,6 +29,8 @@ import conf45
 import conf48
 import confidence_features as cf
 
+from symfruit.core.raster import axis_tilt
+
 ROW48 = conf48._row
 Columns = cf.Columns
 
@@ -34,8 +38,14 @@ Columns = cf.Columns
 def _row(spec, row, caught: dict) -> dict:
     e = caught["result"].extras
     n_points, n_sample = len(caught["points"]), len(caught["sample"])
+    # the front's tilt and sag (off in `evidence` by default: read here, nothing of the box depends on it)
+    tilt = axis_tilt(caught["sample"], conf45.EXTRA["seen_region"], conf45.EXTRA["camera"], caught["fuse"]["across"],
+                     blocks=6)  # fmt: skip
     out = ROW48(spec, row, caught)
-    out.update(cut=float(e["cut"]), lateral=float(e["lateral"]), n_points=n_points, n_sample=n_sample)
+    out.update(cut=float(e["cut"]), lateral=float(e["lateral"]), n_points=n_points, n_sample=n_sample,
+               tilt_cap=tilt.cap, tilt_slope=float(np.hypot(tilt.slope_major, tilt.slope_minor)),
+               tilt_slope_major=tilt.slope_major, tilt_cap_sd=tilt.cap_sd, tilt_slope_sd=tilt.slope_sd,
+               tilt_count=tilt.count)  # fmt: skip
     return out
 
 
@@ -60,11 +70,19 @@ def load(path: str) -> Columns:
 FEATURES = ("uncertainty", "u_no_elongation", "elongation", "combined_u", "moved", "recede", "unexplained",
             "lateral", "cut", "uncut", "cand_backsd", "cand_zsd", "spread", "back_std", "fit_sd", "p", "prior_sd",
             "inv_points", "distance_m", "noise", "ratio_seen", "ratio_box", "hidden_depth", "cone_w", "width",
-            "box_depth")  # fmt: skip
+            "box_depth", "tilt_cap", "tilt_slope", "tilt_cap_sd", "tilt_slope_sd")  # fmt: skip
+
+
+def _cell(d: Columns, f: Callable[[Columns], np.ndarray]) -> str:
+    try:
+        x = f(d)
+    except KeyError:  # a column a CSV collected before it was added does not hold
+        return "-"
+    return f"{cf._num(cf.within(d, x))} / {cf._num(cf.pooled(d, x))}"
 
 
 def _cells(data: dict[str, Columns], f: Callable[[Columns], np.ndarray]) -> str:
-    return " | ".join(f"{cf._num(cf.within(d, f(d)))} / {cf._num(cf.pooled(d, f(d)))}" for d in data.values())
+    return " | ".join(_cell(d, f) for d in data.values())
 
 
 def _head(data: dict[str, Columns], first: str) -> str:
@@ -91,6 +109,9 @@ FORMULAS: dict[str, Callable[[Columns], np.ndarray]] = {
     "+ 2 `noise`": _plus("noise", 2.0),
     "+ `cand_backsd`": _plus("cand_backsd", 1.0),
     "+ 0.1 `prior_sd`": _plus("prior_sd", 0.1),
+    "`u` x (1 + 0.5 cone weight)": lambda d: d["uncertainty"] * (1 + 0.5 * d["cone_w"]),
+    "`u` x (1 + 2 cap_sd)": lambda d: d["uncertainty"] * (1 + 2 * d["tilt_cap_sd"]),
+    "+ 0.6 cap_sd x width": lambda d: np.hypot(d["uncertainty"], 0.6 * d["elongation"] * d["tilt_cap_sd"] * d["width"]),
     "+ 0.0025 (distance / 0.3 m)^2 (the sensor's axial noise)": lambda d: np.hypot(
         d["uncertainty"], 0.0025 * (d["distance_m"] / 0.3) ** 2
     ),
