@@ -140,7 +140,7 @@ def parts(a_path: str, b_path: str) -> None:
     noise = np.abs(a["dz_mm"] - b["dz_mm"])
     w = sys.stdout.write
     w("| feature | own error | pose part | noise part |\n|---|---|---|---|\n")
-    for name in FEATURES:
+    for name in (n for n in FEATURES if n in a):
         x = a[name]
         w(f"| {name} | {conf48._within(a, x):+.2f} | {conf48._within(a, x, pose):+.2f} | "
           f"{conf48._within(a, x, noise):+.2f} |\n")  # fmt: skip
