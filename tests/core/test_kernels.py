@@ -5817,6 +5817,88 @@ def test_the_sphere_front_is_the_twins(monkeypatch, seed):
         assert abs(fast[0] - (centre[2] - radius)) < 0.01
 
 
+def _cap_for_the_sphere_front(seed, n, cap, noise, leaf, stretch):
+    """A seeded cap of a 15-60 mm sphere facing the camera at 0.3-1.5 m (``n`` points, ``cap`` rad from its front,
+    ``noise`` metres of Gaussian noise, the points with ``x`` direction below ``leaf`` dropped, the cap stretched by
+    ``stretch`` along the line of sight: not a sphere) and its radius."""
+    rng = np.random.default_rng(seed)
+    radius = float(rng.uniform(0.015, 0.06))
+    centre = np.array([rng.uniform(-0.1, 0.1), rng.uniform(-0.1, 0.1), rng.uniform(0.3, 1.5)])
+    polar, around = np.arccos(rng.uniform(np.cos(cap), 1.0, n)), rng.uniform(0.0, 2.0 * np.pi, n)
+    d = np.stack([np.sin(polar) * np.cos(around), np.sin(polar) * np.sin(around), -stretch * np.cos(polar)], axis=1)
+    d = d[d[:, 0] >= leaf]
+    return np.ascontiguousarray(centre + radius * d + rng.normal(0.0, noise, d.shape)), radius
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    seed=st.integers(0, 2**31),
+    n=st.integers(4, 1200),
+    cap=st.floats(0.05, 1.6),
+    noise=st.sampled_from([0.0, 1e-5, 3e-4, 0.001, 0.003, 0.01]),
+    leaf=st.sampled_from([-2.0, -0.5, 0.0, 0.4, 0.8]),
+    stretch=st.sampled_from([1.0, 0.3, 2.0, 0.0]),
+    scale=st.floats(0.3, 3.0),
+    tolerance=st.sampled_from([1e-5, 1e-7, 1e-3]),
+    iterations=st.sampled_from([20, 3, 6]),
+    off=st.floats(-20.0, 20.0),
+)
+@example(seed=0, n=600, cap=1.0, noise=0.001, leaf=-2.0, stretch=1.0, scale=1.0, tolerance=1e-5, iterations=20,
+         off=5.0)  # fmt: skip
+def test_sphere_front_behind_only_where_the_fits_front_is(seed, n, cap, noise, leaf, stretch, scale, tolerance,
+                                                          iterations, off):  # fmt: skip
+    """:func:`_jit.sphere_front_behind` (issue 19, stop 63) says True only where ``sphere_front``'s front (BLAS's and
+    LAPACK's Gauss-Newton) is at least ``front``: caps of spheres wide and narrow, clean and noisy, cut by a leaf,
+    flattened to a disc or stretched (no sphere fits), a radius off by 0.3-3 times, tolerances of 1 um to 1 mm, few
+    iterations, and ``front`` put within 20 tolerances of that fit's front either side (where the fit's own stop
+    decides)."""
+    from symfruit import InputError
+    from symfruit.core.front import sphere_front
+
+    p, radius = _cap_for_the_sphere_front(seed, n, cap, noise, leaf, stretch)
+    if len(p) < 4:
+        return
+    r = radius * scale
+    try:
+        z, _ = sphere_front(p, r, iterations=iterations, tolerance=tolerance)
+    except (InputError, np.linalg.LinAlgError):  # refused or failed: the kernel must not be sure
+        z = math.nan
+    front = z - off * tolerance if math.isfinite(z) else 0.5
+    behind = _jit.sphere_front_behind(p, r, iterations, tolerance, front)
+    assert not behind or z >= front
+
+
+def test_sphere_front_behind_known_answers(monkeypatch):
+    """Sure of a front 1 mm in front of ``sphere_front``'s on noisy caps (so the test above is not vacuous: 30 of 30),
+    not sure at that front or 3 tolerances in front of it, nor for inputs ``sphere_front`` refuses or takes otherwise;
+    without numba, or with ``SYMFRUIT_KERNELS=numpy``, never."""
+    from symfruit.core.front import sphere_front, sphere_front_behind
+
+    from ..conftest import noisy_cap
+
+    for seed in range(30):
+        p, radius = noisy_cap(seed)
+        z, _ = sphere_front(p, radius, tolerance=1e-5)
+        assert sphere_front_behind(p, radius, z - 0.001, tolerance=1e-5)
+        assert not sphere_front_behind(p, radius, z, tolerance=1e-5)
+        assert not sphere_front_behind(p, radius, z - 3e-5, tolerance=1e-5)
+    p, radius = noisy_cap(0)
+    z, _ = sphere_front(p, radius, tolerance=1e-5)
+    front = z - 0.001
+    assert not sphere_front_behind(p, 0.0, front) and not sphere_front_behind(p, -radius, front)
+    assert not sphere_front_behind(p, math.nan, front) and not sphere_front_behind(p, radius, math.nan)
+    assert not sphere_front_behind(p[:3], radius, front)
+    assert not sphere_front_behind(p.astype(np.float32), radius, front)  # sphere_front converts it: not here
+    assert not sphere_front_behind(np.asfortranarray(p), radius, front)
+    q = p.copy()
+    q[5, 2] = math.nan
+    assert not sphere_front_behind(q, radius, front)
+    assert not _jit.sphere_front_behind(p, radius, 20, 0.0, front)
+    assert not _jit.sphere_front_behind(p, radius, 2, 1e-5, front)  # the first stop too near the last step
+    monkeypatch.setenv("SYMFRUIT_KERNELS", "numpy")
+    assert not sphere_front_behind(p, radius, front, tolerance=1e-5)
+
+
 def test_the_median_deviation_is_the_twins():
     """:func:`_jit.median_deviation` against ``points.median(abs(x - points.median(x)))`` bit for bit: odd and even
     counts, ties, zeros of both signs, a NaN (NaN); and a known answer."""

@@ -894,6 +894,41 @@ def test_hidden_fronts_sphere_stops_within_its_stop(seed):
     assert abs(z - z0) < FRONT_TOLERANCE and float(np.abs(apex - apex0).max()) < FRONT_TOLERANCE
 
 
+@pytest.mark.parametrize("seed", range(3))
+def test_hidden_fronts_sure_sphere_behind_keeps_the_former_completion(monkeypatch, seed):
+    """Issue 19, stop 63: where the compiled fit is sure the sphere's front lies behind the nearest surface
+    (``sphere_front_behind``), ``hidden_front`` keeps that surface without fitting: the completions of balls under a
+    leaf (the leaf lower or higher, depth noise) are the former ones to the bit, and the shortcut is taken."""
+    import symfruit.methods.evidence as evidence_module
+    from symfruit.core.kernels import compiled
+    from symfruit.core.occlusion import occlusion
+
+    from ..conftest import occluded_view
+
+    sure = []
+    kept = evidence_module.sphere_front_behind
+
+    def counted(*args, **kwargs):
+        sure.append(kept(*args, **kwargs))
+        return sure[-1]
+
+    cam = DEFAULT_CAMERA
+    for hidden in (-0.3, 0.0, 0.3, 0.6):
+        below = cam.cy + hidden * cam.fy * 0.035 / 0.465
+        visible, depth, mask, _ = occluded_view(ball_mesh(0.035), [0.01 * seed, 0.0, 0.5], below=below,
+                                                occluder_z=0.4, noise=0.002 * seed, seed=seed)  # fmt: skip
+        occ = occlusion(depth, mask, visible, cam)
+        monkeypatch.setattr(evidence_module, "sphere_front_behind", counted)
+        now = complete(visible, occlusion=occ)
+        monkeypatch.setattr(evidence_module, "sphere_front_behind", lambda *args, **kwargs: False)
+        former = complete(visible, occlusion=occ)
+        np.testing.assert_array_equal(now.box.min, former.box.min)
+        np.testing.assert_array_equal(now.box.max, former.box.max)
+        assert now.extras["confidence"] == former.extras["confidence"]
+    assert len(sure) == 4
+    assert any(sure) or compiled() is None
+
+
 def _ball_under_leaf(hidden: float):
     """A 70 mm ball 0.5 m away, a leaf 10 cm in front hiding it below ``hidden`` of its radius under its middle
     (negative: above it): its visible points and occlusion information."""

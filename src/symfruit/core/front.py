@@ -15,7 +15,7 @@ from .fits import eigenvalues2, solve2
 from .kernels import compiled
 from .points import as_points, column_means, squared_norms
 
-__all__ = ["apex_depth", "sphere_front"]
+__all__ = ["apex_depth", "sphere_front", "sphere_front_behind"]
 
 
 def apex_depth(points: np.ndarray, *, share: float = 0.08, min_points: int = 12) -> tuple[float, np.ndarray]:
@@ -150,6 +150,22 @@ def sphere_front(points: np.ndarray, radius: float, *, iterations: int = 20,
         if abs(s0) < tolerance and abs(s1) < tolerance and abs(s2) < tolerance:
             break
     return float(c[2] - r), np.array([c[0], c[1], c[2] - r])
+
+
+def sphere_front_behind(points: np.ndarray, radius: float, front: float, *, iterations: int = 20,
+                        tolerance: float = 1e-7) -> bool:  # fmt: skip
+    """Whether ``sphere_front(points, radius, iterations=iterations, tolerance=tolerance)[0]`` surely is at least
+    ``front``, by the compiled :func:`symfruit.core._jit.sphere_front_behind` (the same Gauss-Newton, its sums in
+    the points' order, taken on until its steps show it settled; issue 19, stop 63). False where it is not sure, and
+    always without numba or for points that are not C-ordered (n, 3) float64 (the caller then fits): a True never
+    stands for a front :func:`sphere_front` would place in front of ``front``, nor for an input it would refuse."""
+    if (jit := compiled()) is None:
+        return False
+    p = points
+    if not (type(p) is np.ndarray and p.dtype == np.float64 and p.ndim == 2 and p.shape[1] == 3
+            and p.flags.c_contiguous and len(p) >= 4):  # fmt: skip
+        return False
+    return bool(jit.sphere_front_behind(p, float(radius), int(iterations), float(tolerance), float(front)))
 
 
 def _sphere_residuals(p: np.ndarray, c: np.ndarray, r: float, jac: np.ndarray) -> np.ndarray:

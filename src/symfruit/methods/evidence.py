@@ -58,7 +58,7 @@ from ..core.box import Box
 from ..core.camera import Camera
 from ..core.candidates import SHAPES, Candidate, candidates
 from ..core.fits import noise_level, noise_measures
-from ..core.front import apex_depth, sphere_front
+from ..core.front import apex_depth, sphere_front, sphere_front_behind
 from ..core.kernels import compiled
 from ..core.occlusion import Occlusion, bridged, with_own
 from ..core.points import bounds, row_norms, subsample
@@ -648,6 +648,8 @@ def hidden_front(sample: np.ndarray, front: float, width: float, occlusion: Occl
         return front
     diameter = width * front
     diameter = width * (front + 0.5 * diameter)  # at the sphere's centre, half a diameter behind its front
+    if sphere_front_behind(sample, 0.5 * diameter, front, tolerance=FRONT_TOLERANCE):
+        return front  # the sphere's front surely lies behind: ``front`` stands, as below (issue 19, stop 63)
     z, at = sphere_front(sample, 0.5 * diameter, tolerance=FRONT_TOLERANCE)
     if not (np.isfinite(z) and 0.0 < z < front):
         return front
