@@ -2831,18 +2831,24 @@ class _Grown:
     - **one surface** (:meth:`same`): the pieces' median depths lie within the largest fruit's radius of each other
       (one fruit's visible surface spans at most its radius in depth; the median of a piece is its own surface's
       where most of its pixels are), or the merge's sphere test holds; without depth on either piece, nothing to
-      tell (None)."""
+      tell (None). A piece larger than the largest fruit's disc at its own median depth has no depth of its own
+      to tell by (a rim piece whose pixels carry the depth of what lies far behind the fruit: at 4.7 m the largest
+      apple spans 20 px, at 1.8 m the apple it lies on 50)."""
 
     def __init__(self, z: _Depth, geo: _Geometry, s: SegmentSettings, z_typical: float) -> None:
         self.z, self.geo, self.s, self.z_typical = z, geo, s, z_typical
         self.medians: dict[int, float | None] = {}
 
     def median(self, p: _Piece) -> float | None:
-        """The piece's median depth, None with fewer than :data:`SAME_SURFACE_POINTS` pixels of depth."""
+        """The piece's median depth; None with fewer than :data:`SAME_SURFACE_POINTS` pixels of depth, or when the
+        piece is larger than the largest fruit's disc at that depth."""
         if p.serial not in self.medians:
             zp = self.z[p.window][p.mask]
             zp = zp[zp > 0]
-            self.medians[p.serial] = float(median(zp)) if len(zp) >= SAME_SURFACE_POINTS else None
+            zm = float(median(zp)) if len(zp) >= SAME_SURFACE_POINTS else None
+            if zm is not None and p.area > np.pi / 4 * self.largest(zm) ** 2:
+                zm = None  # larger than any fruit at that depth: the depth of what lies behind it
+            self.medians[p.serial] = zm
         return self.medians[p.serial]
 
     def largest(self, zm: float) -> float:
