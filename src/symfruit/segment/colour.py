@@ -2843,12 +2843,10 @@ class _Grown:
         """The piece's median depth; None with fewer than :data:`SAME_SURFACE_POINTS` pixels of depth, or when the
         piece is larger than the largest fruit's disc at that depth."""
         if p.serial not in self.medians:
-            zp = self.z[p.window][p.mask]
-            zp = zp[zp > 0]
-            zm = float(median(zp)) if len(zp) >= SAME_SURFACE_POINTS else None
-            if zm is not None and p.area > np.pi / 4 * self.largest(zm) ** 2:
-                zm = None  # larger than any fruit at that depth: the depth of what lies behind it
-            self.medians[p.serial] = zm
+            n, zm = _masked_median(p.mask, self.z[p.window])
+            # larger than any fruit at that depth: the depth of what lies behind it
+            own = n >= SAME_SURFACE_POINTS and p.area <= np.pi / 4 * self.largest(zm) ** 2
+            self.medians[p.serial] = zm if own else None
         return self.medians[p.serial]
 
     def largest(self, zm: float) -> float:
@@ -2861,17 +2859,18 @@ class _Grown:
         limit = np.maximum(far[:, None], far[None, :])
         high = np.maximum(box[:, None, 1], box[None, :, 1]) - np.minimum(box[:, None, 0], box[None, :, 0])
         wide = np.maximum(box[:, None, 3], box[None, :, 3]) - np.minimum(box[:, None, 2], box[None, :, 2])
+        order = np.arange(len(pieces))
+        table = (high <= limit) & (wide <= limit) & (order[:, None] < order[None, :])
         rows: list[list[int]] = [[] for _ in range(len(pieces))]
-        for i, j in zip(*np.nonzero(np.triu((high <= limit) & (wide <= limit), 1)), strict=True):
+        for i, j in zip(*np.nonzero(table), strict=True):
             rows[int(i)].append(int(j))
         return rows.__getitem__
 
     def two(self, a: _Piece, b: _Piece, vertices: np.ndarray | None, union: tuple[Window, np.ndarray]) -> bool:
-        zu = self.z[union[0]]
-        zv = zu[union[1] & (zu > 0)]
-        if len(zv) < 20:
+        n, zm = _masked_median(union[1], self.z[union[0]])
+        if n < 20:
             return _two_extents(a, b, vertices)
-        return _extent(vertices, union[1]) > self.largest(float(median(zv)))
+        return _extent(vertices, union[1]) > self.largest(zm)
 
     def same(self, a: _Piece, b: _Piece, weak: np.ndarray, surfaces: dict[int, _Surface]) -> bool | None:
         za, zb = self.median(a), self.median(b)
@@ -2880,3 +2879,14 @@ class _Grown:
         if _same_surface(a, b, self.z, weak, self.geo, self.s, surfaces) is True:
             return True
         return None if za is None or zb is None else False
+
+
+def _masked_median(mask: np.ndarray, depth: np.ndarray) -> tuple[int, float]:
+    """How many of ``mask``'s pixels have depth, and the median of their depths (NaN without any); where numba is
+    in one call (:func:`symfruit.core._jit.masked_median`: the same values)."""
+    if (jit := compiled()) is not None and mask.dtype == bool and depth.dtype == np.float64 and mask.ndim == 2:
+        _, n, zm = jit.masked_median(mask, depth)
+        return int(n), float(zm)
+    z = depth[mask]
+    z = z[z > 0]
+    return len(z), float(median(z)) if len(z) else float("nan")
