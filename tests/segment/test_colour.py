@@ -1762,3 +1762,21 @@ def test_grown_pieces_are_two_fruit_when_their_union_spans_more_than_the_largest
         b = _Piece((slice(90, 110), slice(end - 20, end)), np.ones((20, 20), bool), 2)
         window, union = _union(a, b)
         assert grown.two(a, b, _hull_vertices(union), (window, union)) is two, end
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_masked_median_in_one_call_is_the_twins(seed, monkeypatch):
+    """:func:`_masked_median` (the count of a mask's pixels with depth and their median, one compiled call where
+    numba is) gives the numpy twin's values, with and without depth under the mask."""
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random((40, 50)) < 0.6
+    depth = np.where(rng.random((40, 50)) < 0.7, rng.uniform(0.5, 3.0, (40, 50)), 0.0)
+    for z in (depth, np.zeros_like(depth)):
+        fast = colour._masked_median(mask, z)
+        monkeypatch.setattr(colour, "compiled", lambda: None)
+        twin = colour._masked_median(mask, z)
+        monkeypatch.undo()
+        assert fast[0] == twin[0] == int((mask & (z > 0)).sum())
+        assert fast[1] == twin[1] or (np.isnan(fast[1]) and np.isnan(twin[1]))
