@@ -1705,3 +1705,78 @@ def test_the_typical_depth_is_read_off_the_ground_bodies_grid(fruit, monkeypatch
     assert typical == [float(np.median(grid))]
     strided = {step for step in steps if step != (None, None)}
     assert strided == ({(4, 4)} if fruit == "apple" else {(8, 8)})
+
+
+# --- seg63: a round fruit's pieces joined once grown to their skins
+
+
+def _apple_behind_a_wide_leaf(half: int, behind: float = 0.0):
+    """An 87 mm apple at 1.4 m (60 px across) behind a leaf 25 cm in front of it, ``2 half + 1`` px wide, across its
+    middle from top to bottom; with ``behind`` the right side lies that much deeper (a second fruit seen past the
+    leaf). Colour, depth and the apple's pixels beside the leaf."""
+    yy, xx = np.mgrid[:1080, :1920]
+    color, depth = hd_disc_frame([(900, 540)], radius=30, z=1.4)
+    apple = (color == RED).all(axis=2)
+    depth[apple & (xx > 900)] += behind
+    band = (np.abs(xx - 900) <= half) & (np.abs(yy - 540) <= 40)
+    color[band], depth[band] = (60, 120, 50), 1.15
+    return color, depth, apple & ~band
+
+
+@pytest.mark.parametrize("half", [12, 14])
+def test_the_two_sides_of_an_apple_behind_a_wide_leaf_are_one_fruit(half):
+    """A leaf 25-29 px wide across the middle of an apple 60 px across leaves its sides farther apart than the merge
+    of the red pieces looks (:func:`_near_pieces`: 0.35 of the larger side's 60 px); each side was found and grown
+    alone (two fruit, each under half the apple). Once grown, their union is one convex outline with the leaf's green
+    discounted, no wider than the largest fruit (100 mm) at their depth, and their depths lie within its radius:
+    one fruit, both sides (:func:`_join_found`)."""
+    color, depth, sides = _apple_behind_a_wide_leaf(half)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 1
+    assert (labels[sides] == 1).mean() > 0.95
+
+
+def test_the_sides_seen_past_a_leaf_at_depths_a_fruit_apart_stay_two():
+    """The same outline with its right side 12 cm deeper (more than the largest fruit's radius behind: a second
+    fruit seen past the leaf, not the first one's surface): two fruit, as before."""
+    color, depth, _ = _apple_behind_a_wide_leaf(12, behind=0.12)
+    assert segment(color, depth, HD_CAM, APPLE).max() == 2
+
+
+def test_two_whole_apples_side_by_side_stay_two():
+    """Two apples touching side by side at one depth: their union reaches 120 px, further than the largest fruit
+    (100 mm, 69 px at 1.4 m) is across: two fruit."""
+    color, depth = hd_disc_frame([(900, 540), (961, 540)], radius=30, z=1.4)
+    labels = segment(color, depth, HD_CAM, APPLE)
+    assert labels.max() == 2
+
+
+def test_grown_pieces_are_two_fruit_when_their_union_spans_more_than_the_largest_fruit():
+    """:class:`_Grown`'s extent test: two pieces at 1.4 m whose union spans 64 px are one fruit's pieces as far as
+    extents tell (the largest fruit, 100 mm, spans 68.6 px there); spanning 78 px, two fruit."""
+    from symfruit.segment.colour import _Depth, _Geometry, _Grown, _hull_vertices, _Piece, _union
+
+    grown = _Grown(_Depth.of(np.full((200, 400), 1.4)), _Geometry(960.0, 100.0, 200.0), APPLE, 1.4)
+    for end, two in ((60, False), (75, True)):
+        a = _Piece((slice(90, 110), slice(0, 20)), np.ones((20, 20), bool), 1)
+        b = _Piece((slice(90, 110), slice(end - 20, end)), np.ones((20, 20), bool), 2)
+        window, union = _union(a, b)
+        assert grown.two(a, b, _hull_vertices(union), (window, union)) is two, end
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_the_masked_median_in_one_call_is_the_twins(seed, monkeypatch):
+    """:func:`_masked_median` (the count of a mask's pixels with depth and their median, one compiled call where
+    numba is) gives the numpy twin's values, with and without depth under the mask."""
+    from symfruit.segment import colour
+
+    rng = np.random.default_rng(seed)
+    mask = rng.random((40, 50)) < 0.6
+    depth = np.where(rng.random((40, 50)) < 0.7, rng.uniform(0.5, 3.0, (40, 50)), 0.0)
+    for z in (depth, np.zeros_like(depth)):
+        fast = colour._masked_median(mask, z)
+        monkeypatch.setattr(colour, "compiled", lambda: None)
+        twin = colour._masked_median(mask, z)
+        monkeypatch.undo()
+        assert fast[0] == twin[0] == int((mask & (z > 0)).sum())
+        assert fast[1] == twin[1] or (np.isnan(fast[1]) and np.isnan(twin[1]))

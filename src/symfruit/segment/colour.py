@@ -683,6 +683,8 @@ def _segment_at(
         if claimed is None:
             continue
         found.append((sl, *claimed))
+    if s.round_fruit and z is not None and len(found) > 1:  # a round fruit's pieces, each grown to its skin (seg63)
+        found = _join_found(found, c, z, geo, s, z_typical)
     # number the fruit left to right (then top to bottom) by their box centres, for stable ids
     order = sorted(range(len(found)), key=lambda i: _box_centre(found[i][0], found[i][2]))
     for new, i in enumerate(order, 1):
@@ -1146,6 +1148,7 @@ def _merge(
     weak: np.ndarray,
     depth: _Depth | None,
     geo: _Geometry,
+    grown: _Grown | None = None,
 ) -> list[_Piece]:
     """Join pieces of one convex body (greedy, largest first): the hull of their union, less the green
     pixels in it that are neither piece (a stem, a leaf or the calyx lying across the fruit), exceeds
@@ -1155,7 +1158,9 @@ def _merge(
     camera's softness and 4:2:0 chroma join the red on both sides of a thin leaf or twig across one apple into
     one region that the split cuts at the leaf (its cut sees neither the leaf's green nor the one sphere), and the
     merge's own tests (the green discounted, :func:`_two_extents`, the one sphere) decide, as they do for the
-    pieces of two regions."""
+    pieces of two regions. With ``grown`` (:class:`_Grown`: the found fruit joined once grown to their skins) its
+    tests of nearness, extent and depth take the place of :func:`_near_pieces`, :func:`_two_extents` and
+    :func:`_same_surface`."""
     slack = s.merge_slack
     pieces = sorted(pieces, key=lambda p: -p.area)
     for k, piece in enumerate(pieces):
@@ -1163,10 +1168,20 @@ def _merge(
     serial = len(pieces)
     apart: set[tuple[int, int]] = set()  # pairs already tested and not joined (a test's answer never changes)
     surfaces: dict[int, _Surface] = {}  # each piece's sphere fit and points, worked out once per piece, not per pair
+
+    def two_fruit(a: _Piece, b: _Piece, vertices: np.ndarray | None, union: tuple[Window, np.ndarray]) -> bool:
+        return _two_extents(a, b, vertices) if grown is None else grown.two(a, b, vertices, union)
+
+    def one_surface(a: _Piece, b: _Piece) -> bool | None:
+        assert depth is not None
+        if grown is None:
+            return _same_surface(a, b, depth, weak, geo, s, surfaces)
+        return grown.same(a, b, weak, surfaces)
+
     merged = True
     while merged and len(pieces) > 1:
         merged = False
-        near = _near_pieces(pieces, s.round_fruit)  # the pieces near each one, in order
+        near = _near_pieces(pieces, s.round_fruit) if grown is None else grown.near(pieces)  # those near each one
         for i in range(len(pieces)):
             for j in near(i):
                 a, b = pieces[i], pieces[j]
@@ -1174,14 +1189,14 @@ def _merge(
                     continue
                 window, union = _union(a, b)
                 vertices = _hull_vertices(union)
-                if s.round_fruit and _two_extents(a, b, vertices):
+                if s.round_fruit and two_fruit(a, b, vertices, (window, union)):
                     apart.add((a.serial, b.serial))
                     continue
                 hull = _hull_area_of(vertices, union)
                 if hull > (1.0 + slack) * (a.hull_area() + b.hull_area()):
                     hull -= float(_green_in_hull(vertices, union, color[window]))
                 if hull <= (1.0 + slack) * (a.hull_area() + b.hull_area()) and (
-                    depth is None or _same_surface(a, b, depth, weak, geo, s, surfaces) is not False
+                    depth is None or one_surface(a, b) is not False
                 ):
                     pieces[i] = _Piece(window, union, a.source | b.source, hull, serial, (vertices,))
                     serial += 1
@@ -2766,3 +2781,112 @@ def _bridged_skin(
     if state == 2 or (state in (0, 3) and skin.sum() < GROUND_SOLIDITY * _hull_area(skin)):
         return _round_skin(sl, part, depth, color, geo, s, owner, k)
     return grown_sl, skin
+
+
+# --- seg63: a round fruit's pieces joined once grown to their skins (issue 18)
+
+
+def _join_found(
+    found: list[tuple[Window, np.ndarray, tuple[int, int, int, int]]],
+    c: np.ndarray,
+    z: _Depth,
+    geo: _Geometry,
+    s: SegmentSettings,
+    z_typical: float,
+) -> list[tuple[Window, np.ndarray, tuple[int, int, int, int]]]:
+    """The found round fruit (:func:`_segment_at`'s ``found``: window, claimed mask, its box) with the pieces of one
+    fruit joined, by :func:`_merge` with :class:`_Grown`'s tests. The merge of the red pieces runs before their skins
+    are grown; two red parts of one apple split by a leaf across it (or by its highlight, or by the boundary of
+    its blush) that the merge kept apart are often found as two partial masks, each grown over its side of the
+    apple, neither half of it (mask IoU under 0.5). Once grown they are joined when, as one fruit's pieces must,
+    their union is one convex outline (the merge's hull test, the green of a leaf across them discounted), reaches
+    no further than the largest fruit is across at its depth, and lies on one surface in depth (:class:`_Grown`)."""
+    pieces = []
+    for i, (sl, free, box) in enumerate(found):
+        r0, r1, c0, c1 = box
+        win = (slice(sl[0].start + r0, sl[0].start + r1), slice(sl[1].start + c0, sl[1].start + c1))
+        pieces.append(_Piece(win, np.ascontiguousarray(free[r0:r1, c0:c1]), 1 << i))
+    weak = _zeroed(z.shape, np.bool_)  # every found pixel: the sphere fits take a grown skin's points, not only red
+    for p in pieces:
+        weak[p.window] |= p.mask
+    joined = _merge(pieces, s, c, weak, z, geo, _Grown(z, geo, s, z_typical))
+    _give_back(weak, [p.window for p in pieces])
+    if len(joined) == len(pieces):
+        return found
+    return [(p.window, p.mask, mask_box(p.mask) or (0, 0, 0, 0)) for p in joined]
+
+
+class _Grown:
+    """:func:`_merge`'s tests for round fruit found and grown to their skins (:func:`_join_found`). A grown skin
+    carries depth along its silhouette that is not its own (a time-of-flight camera's mixed pixels, depth
+    registered a few pixels off the colour: what lies behind the fruit), so a sphere fitted to it is often far off
+    (radii of 0.2-2 m on apples 70 mm across) and the merge's sphere test refuses both halves of one apple. Here:
+
+    - **near** (:meth:`near`): two pieces whose boxes together span no more than the largest fruit
+      (``round_max_diameter``) at the depth of either; a leaf across an apple may hide its middle, leaving its two
+      sides further apart than :func:`_near_pieces` looks;
+    - **two fruit** (:meth:`two`): the union reaches further than the largest fruit is across at the union's median
+      depth (an absolute bound where :func:`_two_extents` is relative to the larger piece: two sides of an apple seen
+      past a leaf are each much narrower than the apple); without depth on the union, :func:`_two_extents`;
+    - **one surface** (:meth:`same`): the pieces' median depths lie within the largest fruit's radius of each other
+      (one fruit's visible surface spans at most its radius in depth; the median of a piece is its own surface's
+      where most of its pixels are), or the merge's sphere test holds; without depth on either piece, nothing to
+      tell (None). A piece larger than the largest fruit's disc at its own median depth has no depth of its own
+      to tell by (a rim piece whose pixels carry the depth of what lies far behind the fruit: at 4.7 m the largest
+      apple spans 20 px, at 1.8 m the apple it lies on 50)."""
+
+    def __init__(self, z: _Depth, geo: _Geometry, s: SegmentSettings, z_typical: float) -> None:
+        self.z, self.geo, self.s, self.z_typical = z, geo, s, z_typical
+        self.medians: dict[int, float | None] = {}
+
+    def median(self, p: _Piece) -> float | None:
+        """The piece's median depth; None with fewer than :data:`SAME_SURFACE_POINTS` pixels of depth, or when the
+        piece is larger than the largest fruit's disc at that depth."""
+        if p.serial not in self.medians:
+            n, zm = _masked_median(p.mask, self.z[p.window])
+            # larger than any fruit at that depth: the depth of what lies behind it
+            own = n >= SAME_SURFACE_POINTS and p.area <= np.pi / 4 * self.largest(zm) ** 2
+            self.medians[p.serial] = zm if own else None
+        return self.medians[p.serial]
+
+    def largest(self, zm: float) -> float:
+        """The largest fruit's diameter (pixels) at depth ``zm``."""
+        return self.s.round_max_diameter * self.geo.focal / zm
+
+    def near(self, pieces: list[_Piece]) -> Callable[[int], list[int]]:
+        box = np.array([[p.window[0].start, p.window[0].stop, p.window[1].start, p.window[1].stop] for p in pieces])
+        far = np.array([self.largest(self.median(p) or self.z_typical) for p in pieces])
+        limit = np.maximum(far[:, None], far[None, :])
+        high = np.maximum(box[:, None, 1], box[None, :, 1]) - np.minimum(box[:, None, 0], box[None, :, 0])
+        wide = np.maximum(box[:, None, 3], box[None, :, 3]) - np.minimum(box[:, None, 2], box[None, :, 2])
+        order = np.arange(len(pieces))
+        table = (high <= limit) & (wide <= limit) & (order[:, None] < order[None, :])
+        rows: list[list[int]] = [[] for _ in range(len(pieces))]
+        for i, j in zip(*np.nonzero(table), strict=True):
+            rows[int(i)].append(int(j))
+        return rows.__getitem__
+
+    def two(self, a: _Piece, b: _Piece, vertices: np.ndarray | None, union: tuple[Window, np.ndarray]) -> bool:
+        n, zm = _masked_median(union[1], self.z[union[0]])
+        if n < 20:
+            return _two_extents(a, b, vertices)
+        return _extent(vertices, union[1]) > self.largest(zm)
+
+    def same(self, a: _Piece, b: _Piece, weak: np.ndarray, surfaces: dict[int, _Surface]) -> bool | None:
+        za, zb = self.median(a), self.median(b)
+        if za is not None and zb is not None and abs(za - zb) <= 0.5 * self.s.round_max_diameter:
+            return True
+        if _same_surface(a, b, self.z, weak, self.geo, self.s, surfaces) is True:
+            return True
+        return None if za is None or zb is None else False
+
+
+def _masked_median(mask: np.ndarray, depth: np.ndarray) -> tuple[int, float]:
+    """How many of ``mask``'s pixels have depth, and the median of their depths (NaN without any); where numba is
+    in one call (:func:`symfruit.core._jit.masked_median`: the same values)."""
+    if (jit := compiled()) is not None and mask.dtype == bool and depth.dtype == np.float64 and mask.ndim == 2:
+        _, n, zm = jit.masked_median(mask, depth)
+        return int(n), float(zm)
+    z = depth[mask]
+    z = z[z > 0]
+    return len(z), float(median(z)) if len(z) else float("nan")
