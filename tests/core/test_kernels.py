@@ -4394,6 +4394,43 @@ def test_the_smooth_parts_kernel_parts_a_step_and_numbers_in_raster_order():
     assert (labels == 2).sum() == 1  # the square's one pixel with no neighbour across the step
 
 
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**31 - 1))
+def test_the_smooth_parts_are_ndimage_labels_of_any_shape(seed):
+    """smooth_parts' union-find numbering (stop 63, reg63) on a depth without steps (every mask pixel smooth) is
+    ndimage.label's 4-connected labelling of the mask: random masks of any density, one row or one column, a
+    checkerboard (the most parts), combs and spirals whose branches meet only further down (parts joined late)."""
+    from scipy import ndimage
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(v) for v in rng.integers(1, 48, 2))
+    kind = int(rng.integers(0, 5))
+    if kind == 0:
+        mask = rng.random((h, w)) < rng.uniform(0.2, 0.9)
+    elif kind == 1:
+        mask = (np.add.outer(np.arange(h), np.arange(w)) % 2 == 0) | (rng.random((h, w)) < 0.05)
+    elif kind == 2:  # a comb: teeth down from the top, joined at the bottom (or not)
+        mask = np.zeros((h, w), bool)
+        mask[:, :: int(rng.integers(2, 5))] = True
+        mask[-1, :] = rng.random() < 0.7
+    elif kind == 3:  # a spiral-like maze: rings joined at random gaps
+        yy, xx = np.mgrid[0:h, 0:w]
+        ring = np.maximum(np.abs(yy - h // 2), np.abs(xx - w // 2)) % 2 == 0
+        mask = ring | (rng.random((h, w)) < 0.08)
+    else:
+        mask = np.zeros((h, w), bool)
+        mask[rng.integers(0, h, 4 * (h + w)), rng.integers(0, w, 4 * (h + w))] = True
+    if rng.random() < 0.2:
+        mask = mask[:1] if rng.random() < 0.5 else mask[:, :1]
+    mask = np.ascontiguousarray(mask)
+    depth = np.full(mask.shape, 0.5)
+    labels = np.full(mask.shape, -7, np.int32)
+    count = _jit.smooth_parts(depth, mask, 0.01, labels)
+    want, n = ndimage.label(mask)
+    assert count == n
+    np.testing.assert_array_equal(labels, want)
+
+
 @settings(max_examples=200, deadline=None)
 @given(st.integers(0, 2**31 - 1))
 def test_the_filled_windows_are_median_ats_values(seed):

@@ -4744,7 +4744,8 @@ def smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float, labels: np.nd
     Since stop 49 (regspeed49) the steps are found row by row without branches, as the twin finds them (a step between
     two neighbours with depth, ``|a - b| > join``, takes both out; ``|a - b|`` is ``|b - a|`` to the bit), and the
     flood keeps rows and columns apart instead of dividing flat indices: the same pixels and labels (the benchmark
-    frame's 28 calls 0.79 -> 0.47 ms)."""
+    frame's 28 calls 0.79 -> 0.47 ms). Since stop 63 (reg63) the parts are labelled by a union-find raster pass, not a
+    flood (the same labels; the frame's 24 first calls 0.56 -> 0.31 ms replayed at load 11, docs/reg63.md)."""
     h, w = depth.shape
     ok = np.empty((h, w), np.bool_)
     for r in range(h):
@@ -4767,27 +4768,55 @@ def smooth_parts(depth: np.ndarray, mask: np.ndarray, join: float, labels: np.nd
             side[c + 1] = ok[r, c] & ok[r, c + 1] & (abs(depth[r, c + 1] - depth[r, c]) > join)
         for c in range(w):
             smooth[r, c] = ok[r, c] & ~(up[c] | down[c] | side[c] | side[c + 1])
-    labels[:] = 0
-    rs = np.empty(max(h * w, 1), np.int64)
-    cs = np.empty(max(h * w, 1), np.int64)
-    count = 0
+    # stop 63 (reg63): the parts by one raster pass with a union-find of provisional labels (a pixel takes its upper
+    # or left neighbour's, both joined), then each provisional label's root numbered in the order the roots came,
+    # instead of a flood from each part's first pixel. A part's first pixel in raster order has neither neighbour in
+    # the part, so it opens a new label, the part's least; a union keeps the lesser root, so each root is its part's
+    # first pixel's label and the roots come in raster order of the parts' first pixels: ndimage.label's numbering,
+    # the same labels
+    parent = np.empty(h * w + 2, np.int32)  # a provisional label per pixel at most (label 0 unused)
+    n = 0
     for r in range(h):
         for c in range(w):
-            if not smooth[r, c] or labels[r, c] != 0:
+            if not smooth[r, c]:
+                labels[r, c] = 0
                 continue
+            above = labels[r - 1, c] if r > 0 else 0
+            before = labels[r, c - 1] if c > 0 else 0
+            if above == 0 and before == 0:
+                n += 1
+                parent[n] = n
+                labels[r, c] = n
+            elif before == 0 or above == before:
+                labels[r, c] = above
+            elif above == 0:
+                labels[r, c] = before
+            else:
+                a = above
+                while parent[a] != a:
+                    a = parent[a]
+                b = before
+                while parent[b] != b:
+                    b = parent[b]
+                if a < b:
+                    parent[b] = a
+                elif b < a:
+                    parent[a] = b
+                labels[r, c] = min(a, b)
+    count = 0
+    for i in range(1, n + 1):  # roots numbered in their order; every other label takes its root's (a lesser one)
+        p = parent[i]
+        if p == i:
             count += 1
-            labels[r, c] = count
-            rs[0], cs[0] = r, c
-            top = 1
-            while top > 0:
-                top -= 1
-                rr, cc = rs[top], cs[top]
-                for dr, dc in ((-1, 0), (1, 0), (0, -1), (0, 1)):
-                    a, b = rr + dr, cc + dc
-                    if 0 <= a < h and 0 <= b < w and smooth[a, b] and labels[a, b] == 0:
-                        labels[a, b] = count
-                        rs[top], cs[top] = a, b
-                        top += 1
+            parent[i] = -count
+        else:
+            while p > 0:
+                p = parent[p]
+            parent[i] = p
+    parent[0] = 0  # no part: 0
+    for r in range(h):
+        for c in range(w):
+            labels[r, c] = -parent[labels[r, c]]
     return count
 
 
