@@ -10,6 +10,7 @@ from scipy import ndimage
 from symfruit.core.edges import (
     EDGE_REACH,
     N_BINS,
+    _capped_distances,
     _colour_gradient,
     _colour_peaks,
     _edge_distances,
@@ -18,6 +19,7 @@ from symfruit.core.edges import (
     _outline_samples,
     _padded_costs,
     _shift_costs,
+    _window_gradient,
     colour_edges,
     depth_outline,
     edge_shift,
@@ -374,3 +376,87 @@ def test_the_padded_gather_is_the_moved_costs():
     assert np.array_equal(
         _padded_costs(padded, rows + 7, cols + 7, bins, 7), _moved_costs(dist, rows, cols, bins, 7, 6.0)
     )
+
+
+# --- stop 63: the compiled window gradient and distance maps against their numpy twins (docs/shift63.md) ----------
+
+
+def _twins(fn, *args):
+    """``fn(*args)`` with the compiled kernels, then with the numpy twins (``SYMFRUIT_KERNELS=numpy``)."""
+    pytest.importorskip("numba")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)  # a run with the twins throughout still compares
+        compiled = fn(*args)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = fn(*args)
+    return compiled, twin
+
+
+def _bit_equal(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and np.array_equal(a, b) and np.array_equal(np.signbit(a), np.signbit(b))
+
+
+@st.composite
+def drawn_windows(draw: st.DrawFn) -> np.ndarray:
+    """A colour window: noise, a few flat levels (zero gradients, ties), every channel the same, a channel the
+    negative of another (the same magnitude, the opposite gradient: the first must be taken), a channel a part in
+    1e15 off another (near ties of ``hypot``), values near underflow; 8-bit or float, 1, 3 or 4 channels (or a
+    plain (h, w) image), sizes down to one pixel, some not contiguous."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    h, w = draw(st.integers(1, 30)), draw(st.integers(1, 30))
+    nc = draw(st.sampled_from([1, 3, 4]))
+    kind = draw(st.sampled_from(["noise", "levels", "same", "negative", "near", "tiny"]))
+    img = rng.uniform(0, 255, (h, w, nc))
+    if kind == "levels":
+        img = rng.integers(0, 3, (h, w, nc)) * 60.0
+    elif kind == "same":
+        img[:] = img[..., :1]
+    elif kind == "negative" and nc > 1:
+        img[..., 1] = 255.0 - img[..., 0]
+    elif kind == "near" and nc > 1:
+        img[..., 1] = img[..., 0] * (1.0 + 1e-15 * rng.integers(-3, 4, (h, w)))
+    elif kind == "tiny":
+        img *= 1e-300
+    if kind in ("noise", "levels", "same", "negative") and draw(st.booleans()):
+        img = img.astype(np.uint8)
+    if draw(st.booleans()):
+        img = img[::-1, ::-1]
+    return img[..., 0] if nc == 1 and draw(st.booleans()) else img
+
+
+@settings(deadline=None)
+@given(drawn_windows())
+def test_the_window_gradient_kernel_is_the_twins_to_the_bit(window):
+    """The compiled window gradient: every magnitude the twin's to the bit, and the gradient the twin's first
+    strongest channel's (its ``argmax``) at every pixel, signs of zero too."""
+    (mag, cx, cy, each), (tmag, tcx, tcy, teach) = _twins(_window_gradient, window)
+    assert each is None and cx.shape[0] == 1 and teach is not None
+    assert _bit_equal(mag, tmag)
+    k = teach.argmax(axis=0)[None]
+    assert _bit_equal(cx[0], np.take_along_axis(tcx, k, 0)[0])
+    assert _bit_equal(cy[0], np.take_along_axis(tcy, k, 0)[0])
+
+
+def test_a_float_window_with_a_nan_is_left_to_the_twin():
+    window = np.random.default_rng(3).uniform(0, 255, (12, 14, 3))
+    window[5, 6, 1] = np.nan
+    compiled, twin = _twins(_window_gradient, window)
+    assert compiled[3] is not None  # the twin's own arrays (every channel)
+    assert np.array_equal(compiled[0], twin[0], equal_nan=True)
+
+
+@settings(deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.integers(1, 12),
+       st.sampled_from([2.0, 3.5, 6.0, 7.2]))  # fmt: skip
+def test_the_capped_distances_kernel_is_the_twins_to_the_bit(seed, h, w, m, cap):
+    """Random edges and points (some bins without points, some without edges): every map the twin's to the bit."""
+    rng = np.random.default_rng(seed)
+    n_edges, n_points = int(rng.integers(0, h * w // 3 + 2)), int(rng.integers(1, 80))
+    rows, cols = rng.integers(0, h, n_edges), rng.integers(0, w, n_edges)
+    ebins = rng.integers(0, N_BINS, n_edges)
+    points = (rng.integers(0, h, n_points), rng.integers(0, w, n_points), rng.integers(0, N_BINS, n_points))
+    if rng.random() < 0.5:  # points of a few bins only
+        points = (points[0], points[1], points[2] % int(rng.integers(1, 4)))
+    compiled, twin = _twins(_capped_distances, (h, w), rows, cols, ebins, cap, points, m)
+    assert compiled.dtype == twin.dtype == np.float32
+    assert np.array_equal(compiled, twin)

@@ -10885,3 +10885,178 @@ def occlusion_projected(
         _own_edge_in_box(hidden, mask, v0, u0, own_z, p0, q0, seen, others, tolerance, band, supports, focal, f0, f1,
                          e0, e1)  # fmt: skip
     return True, u0, v0, hidden, seen
+
+
+@_njit
+def _difference_rows(s: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(s, [-1, 0, 1], 1)`` (mode "reflect") of an (h, w) image into ``out``: scipy takes the
+    weights as antisymmetric, so each value is the middle one times 0, plus the left less the right one times -1;
+    the inner columns along views of the rows (numba vectorises them), the two end ones reflected."""
+    h, w = s.shape
+    for r in range(h):
+        row, o = s[r], out[r]
+        for c in (0, w - 1):
+            v = row[c] * 0.0
+            v += (row[_reflected(c - 1, w)] - row[_reflected(c + 1, w)]) * -1.0
+            o[c] = v
+        if w > 2:
+            a, mid, b, oo = row[0 : w - 2], row[1 : w - 1], row[2:w], o[1 : w - 1]
+            for k in range(w - 2):
+                v = mid[k] * 0.0
+                v += (a[k] - b[k]) * -1.0
+                oo[k] = v
+
+
+@_njit
+def _difference_columns(s: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(s, [-1, 0, 1], 0)`` (mode "reflect") of an (h, w) image into ``out``, as
+    :func:`_difference_rows` along the columns: a whole row at a time."""
+    h, w = s.shape
+    for r in range(h):
+        a, mid, b, o = s[_reflected(r - 1, h)], s[r], s[_reflected(r + 1, h)], out[r]
+        for k in range(w):
+            v = mid[k] * 0.0
+            v += (a[k] - b[k]) * -1.0
+            o[k] = v
+
+
+@_njit
+def _spread_rows(d: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(d, [1, 2, 1], 1)`` (mode "reflect") of an (h, w) image into ``out`` (symmetric: the
+    middle value times 2, plus the pair's sum times 1), as :func:`_difference_rows`."""
+    h, w = d.shape
+    for r in range(h):
+        row, o = d[r], out[r]
+        for c in (0, w - 1):
+            v = row[c] * 2.0
+            v += (row[_reflected(c - 1, w)] + row[_reflected(c + 1, w)]) * 1.0
+            o[c] = v
+        if w > 2:
+            a, mid, b, oo = row[0 : w - 2], row[1 : w - 1], row[2:w], o[1 : w - 1]
+            for k in range(w - 2):
+                v = mid[k] * 2.0
+                v += (a[k] + b[k]) * 1.0
+                oo[k] = v
+
+
+@_njit
+def _spread_columns(d: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(d, [1, 2, 1], 0)`` (mode "reflect") of an (h, w) image into ``out``, a whole row at a
+    time."""
+    h, w = d.shape
+    for r in range(h):
+        a, mid, b, o = d[_reflected(r - 1, h)], d[r], d[_reflected(r + 1, h)], out[r]
+        for k in range(w):
+            v = mid[k] * 2.0
+            v += (a[k] + b[k]) * 1.0
+            o[k] = v
+
+
+@_njit
+def colour_gradient(
+    window: np.ndarray, weights: np.ndarray, symmetric: bool, mag: np.ndarray, gx: np.ndarray, gy: np.ndarray
+) -> None:
+    """:func:`symfruit.core.edges._window_gradient` of a colour window (h, w, c), finite values, into ``mag``, ``gx``
+    and ``gy`` (h, w): the strongest channel's gradient magnitude and its gradient. Each channel is smoothed by
+    ``weights`` (``ndimage.gaussian_filter``'s at sigma 1, ``symmetric`` as scipy finds them) along the columns then
+    the rows (:func:`_smoothed`), then differenced as ``ndimage.sobel`` does it (``[-1, 0, 1]`` along one axis,
+    :func:`_difference_rows`, then ``[1, 2, 1]`` along the other, :func:`_spread_columns`), all in scipy's order
+    and mode "reflect": the twin's values to the bit.
+
+    The strongest channel is the first whose ``hypot`` is the greatest (the twin's running maximum and ``argmax``).
+    ``hypot`` (libm's, as numpy's) costs some 10-14 ns a value against a fraction of one for a sum of squares, so
+    channels are told apart by their sums of squares where those differ by more than a part in 1e10 (far beyond
+    their rounding and ``hypot``'s, so the larger sum is the larger ``hypot``); only near ties and values near
+    underflow or overflow compare ``hypot`` itself. One ``hypot`` a pixel, the strongest channel's, instead of one a
+    channel: the same magnitudes and channels."""
+    h, w, nc = window.shape
+    ch = np.empty((h, w))
+    best = np.empty((h, w))  # the strongest channel's sum of squares so far
+    exact = np.empty((h, w))  # its hypot where worked out, else -1
+    d = np.empty((h, w))
+    cx = np.empty((h, w))
+    cy = np.empty((h, w))
+    q = np.empty(w)
+    for k in range(nc):
+        for r in range(h):
+            for c in range(w):
+                ch[r, c] = float(window[r, c, k])
+        s = _smoothed(ch, weights, symmetric)
+        _difference_rows(s, d)
+        _spread_columns(d, cx)
+        _difference_columns(s, d)
+        _spread_rows(d, cy)
+        for r in range(h):
+            x, y = cx[r], cy[r]
+            for c in range(w):
+                q[c] = x[c] * x[c] + y[c] * y[c]
+            if k == 0:
+                for c in range(w):
+                    best[r, c], exact[r, c], gx[r, c], gy[r, c] = q[c], -1.0, x[c], y[c]
+                continue
+            for c in range(w):
+                a, b = q[c], best[r, c]
+                safe = 1e-290 < b < 1e290 and 1e-290 < a < 1e290
+                if safe and a > b * (1.0 + 1e-10):
+                    best[r, c], exact[r, c], gx[r, c], gy[r, c] = a, -1.0, x[c], y[c]
+                elif safe and a < b * (1.0 - 1e-10):
+                    continue
+                else:  # a near tie (or a value near underflow or overflow): hypot decides, strictly, as the twin's
+                    e = exact[r, c]
+                    if e < 0.0:
+                        e = math.hypot(gx[r, c], gy[r, c])
+                        exact[r, c] = e
+                    m = math.hypot(x[c], y[c])
+                    if m > e:
+                        best[r, c], exact[r, c], gx[r, c], gy[r, c] = a, m, x[c], y[c]
+    for r in range(h):
+        for c in range(w):
+            e = exact[r, c]
+            mag[r, c] = e if e >= 0.0 else math.hypot(gx[r, c], gy[r, c])
+
+
+@_njit
+def capped_distances(
+    rows: np.ndarray, cols: np.ndarray, ebins: np.ndarray, cap: float, prow: np.ndarray, pcol: np.ndarray,
+    pbins: np.ndarray, m: int, dist: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.edges._capped_distances` into ``dist`` (n_bins, h + 2 m, w + 2 m) float32, filled with
+    ``cap`` by the caller: for every orientation bin some point ``(prow, pcol, pbins)`` has, the edges ``(rows, cols)``
+    whose bin ``ebins`` is within one of it and within the points' box grown by ``m + ceil(cap)``, their distances
+    within the cap (:func:`near_distance`) capped at ``cap``, written at the box offset by ``m``. The twin's steps in
+    one call (its masks, boxes and copies were half its time): the same values."""
+    nb = dist.shape[0]
+    h, w = dist.shape[1] - 2 * m, dist.shape[2] - 2 * m
+    reach = m + math.ceil(cap)
+    lo_r = np.full(nb, h + reach, np.int64)
+    hi_r = np.full(nb, -reach - 1, np.int64)
+    lo_c = np.full(nb, w + reach, np.int64)
+    hi_c = np.full(nb, -reach - 1, np.int64)
+    for i in range(prow.shape[0]):
+        b = pbins[i]
+        lo_r[b] = min(lo_r[b], prow[i])
+        hi_r[b] = max(hi_r[b], prow[i])
+        lo_c[b] = min(lo_c[b], pcol[i])
+        hi_c[b] = max(hi_c[b], pcol[i])
+    for b in range(nb):
+        if hi_r[b] < lo_r[b]:
+            continue
+        r0, r1 = max(lo_r[b] - reach, 0), min(hi_r[b] + reach + 1, h)
+        c0, c1 = max(lo_c[b] - reach, 0), min(hi_c[b] + reach + 1, w)
+        if r1 <= r0 or c1 <= c0:
+            continue
+        edges = np.zeros((r1 - r0, c1 - c0), np.bool_)
+        some = False
+        for i in range(rows.shape[0]):
+            apart = (ebins[i] - b) % nb
+            if (apart <= 1 or apart == nb - 1) and r0 <= rows[i] < r1 and c0 <= cols[i] < c1:
+                edges[rows[i] - r0, cols[i] - c0] = True
+                some = True
+        if not some:
+            continue
+        away = np.empty((r1 - r0, c1 - c0))
+        near_distance(edges, cap, True, away)
+        for r in range(r1 - r0):
+            for c in range(c1 - c0):
+                v = away[r, c]
+                dist[b, m + r0 + r, m + c0 + c] = np.float32(v if v < cap else cap)

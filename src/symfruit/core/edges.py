@@ -30,6 +30,7 @@ the colour pixel ``(u, v)`` sees. Numpy and scipy only; images in, numbers out.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -467,13 +468,42 @@ def _mask_costs(
     return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
 
 
-def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+@functools.lru_cache(maxsize=1)
+def _gaussian_weights() -> tuple[np.ndarray, bool]:
+    """The weights of ``ndimage.gaussian_filter`` at sigma 1 (truncated at 4 sigma): its response to an impulse (each
+    weight times 1, plus zeros: exact), and whether ``ndimage.correlate1d`` takes them as symmetric (each pair within
+    the float64 epsilon: it then adds each pair before multiplying), as :func:`symfruit.segment.colour._gaussian`."""
+    impulse = np.zeros(9)
+    impulse[4] = 1.0
+    weights = ndimage.gaussian_filter1d(impulse, 1.0, mode="constant")
+    weights.flags.writeable = False
+    eps = float(np.finfo(np.float64).eps)
+    return weights, bool(np.all(np.abs(weights[5:] - weights[:4][::-1]) <= eps))
+
+
+def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """:func:`_colour_gradient` at sigma 1 with the channels side by side, ``(mag, cx, cy, each)``: ``mag`` (h, w)
     the strongest channel's magnitude, ``cx, cy, each`` (c, h, w) every channel's gradient and magnitude. The same
-    filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit."""
-    img = np.asarray(window, dtype=np.float64)
+    filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit.
+
+    With the compiled kernels (and finite values: an integer image, or a float one without NaN or inf) the whole
+    of it is :func:`symfruit.core._jit.colour_gradient`: one pass a channel, one ``hypot`` a pixel (the strongest
+    channel's; the channels told apart by their sums of squares but at near ties), and ``cx, cy`` (1, h, w) the
+    strongest channel's gradient alone, ``each`` None: the same magnitudes, and the same gradient wherever
+    :func:`_window_peaks` reads it (stop 63, docs/shift63.md)."""
+    img = np.asarray(window)
     if img.ndim == 2:
         img = img[..., None]
+    jit = compiled()
+    if jit is not None and img.shape[0] > 0 and img.shape[1] > 0 and (img.dtype.kind in "biu" or (
+            img.dtype.kind == "f" and bool(np.isfinite(img).all()))):  # fmt: skip
+        h, w = img.shape[:2]
+        mag, gx, gy = np.empty((h, w)), np.empty((1, h, w)), np.empty((1, h, w))
+        weights, symmetric = _gaussian_weights()
+        jit.colour_gradient(img if img.dtype != np.bool_ else img.view(np.uint8), weights, symmetric, mag, gx[0],
+                            gy[0])  # fmt: skip
+        return mag, gx, gy, None
+    img = np.asarray(img, dtype=np.float64)
     img = np.ascontiguousarray(np.moveaxis(img, -1, 0))
     ch = ndimage.gaussian_filter(img, (0.0, 1.0, 1.0))  # no smoothing across channels
     cx = ndimage.correlate1d(ch, [-1, 0, 1], 2, None, "reflect", 0.0, 0)  # ndimage.sobel(axis=1) of each channel
@@ -487,7 +517,7 @@ def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return mag, cx, cy, each
 
 
-def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndarray, threshold: float,
+def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndarray | None, threshold: float,
                   part: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`_colour_peaks` of :func:`_window_gradient`'s gradient within ``part`` = ``(r0, r1, c0, c1)`` of the
     window, worked out only at the pixels above ``threshold`` (every other one is no edge): the edges' rows,
@@ -501,7 +531,7 @@ def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndar
     rows, cols = np.nonzero(mag[r0:r1, c0:c1] > threshold)
     rows += r0
     cols += c0
-    k = each[:, rows, cols].argmax(axis=0)
+    k = 0 if each is None else each[:, rows, cols].argmax(axis=0)  # None: cx, cy the strongest channel's already
     gx, gy = cx[k, rows, cols], cy[k, rows, cols]
     angle = np.mod(np.arctan2(gy, gx), np.pi)
     q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
@@ -525,6 +555,9 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
     reach = m + int(np.ceil(cap))
     dist = np.full((N_BINS, h + 2 * m, w + 2 * m), cap, np.float32)
     jit = compiled()
+    if jit is not None:  # the same steps in one call (stop 63, docs/shift63.md)
+        jit.capped_distances(rows, cols, ebins, float(cap), prow, pcol, pbins, m, dist)
+        return dist
     for b in np.unique(pbins):
         apart = (ebins - b) % N_BINS  # within one bin of b: 0, 1 or N_BINS - 1
         near = (apart <= 1) | (apart == N_BINS - 1)
@@ -535,11 +568,7 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
         if near.any():
             edges = np.zeros((r1 - r0, c1 - c0), bool)
             edges[rows[near] - r0, cols[near] - c0] = True
-            if jit is None:
-                away = ndimage.distance_transform_edt(~edges)
-            else:  # each pixel's distance to the nearest edge where that is at most the cap (scipy's), +inf farther
-                away = np.empty(edges.shape)
-                jit.near_distance(edges, float(cap), True, away)
+            away = ndimage.distance_transform_edt(~edges)
             dist[b, m + r0 : m + r1, m + c0 : m + c1] = np.minimum(away, cap, out=away)
     return dist
 
