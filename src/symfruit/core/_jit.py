@@ -10954,25 +10954,25 @@ def _spread_columns(d: np.ndarray, out: np.ndarray) -> None:
 
 @_njit
 def colour_gradient(
-    window: np.ndarray, weights: np.ndarray, symmetric: bool, mag: np.ndarray, gx: np.ndarray, gy: np.ndarray
+    window: np.ndarray, weights: np.ndarray, symmetric: bool, squares: np.ndarray, gx: np.ndarray, gy: np.ndarray
 ) -> None:
-    """:func:`symfruit.core.edges._window_gradient` of a colour window (h, w, c), finite values, into ``mag``, ``gx``
-    and ``gy`` (h, w): the strongest channel's gradient magnitude and its gradient. Each channel is smoothed by
-    ``weights`` (``ndimage.gaussian_filter``'s at sigma 1, ``symmetric`` as scipy finds them) along the columns then
-    the rows (:func:`_smoothed`), then differenced as ``ndimage.sobel`` does it (``[-1, 0, 1]`` along one axis,
-    :func:`_difference_rows`, then ``[1, 2, 1]`` along the other, :func:`_spread_columns`), all in scipy's order
-    and mode "reflect": the twin's values to the bit.
+    """:func:`symfruit.core.edges._window_gradient` of a colour window (h, w, c) of finite values under 1e100, into
+    ``gx`` and ``gy`` (h, w), the strongest channel's gradient, and ``squares`` (h, w), its ``gx * gx + gy * gy``.
+    Each channel is smoothed by ``weights`` (``ndimage.gaussian_filter``'s at sigma 1, ``symmetric`` as scipy finds
+    them) along the columns then the rows (:func:`_smoothed`), then differenced as ``ndimage.sobel`` does it
+    (``[-1, 0, 1]`` along one axis, :func:`_difference_rows`, then ``[1, 2, 1]`` along the other,
+    :func:`_spread_columns`), all in scipy's order and mode "reflect": the twin's gradients to the bit.
 
     The strongest channel is the first whose ``hypot`` is the greatest (the twin's running maximum and ``argmax``).
     ``hypot`` (libm's, as numpy's) costs some 10-14 ns a value against a fraction of one for a sum of squares, so
     channels are told apart by their sums of squares where those differ by more than a part in 1e10 (far beyond
-    their rounding and ``hypot``'s, so the larger sum is the larger ``hypot``); only near ties and values near
-    underflow or overflow compare ``hypot`` itself. One ``hypot`` a pixel, the strongest channel's, instead of one a
-    channel: the same magnitudes and channels."""
+    their rounding, a few parts in 1e16, and ``hypot``'s, under one in 1e16: the larger sum is the larger
+    ``hypot``); only near ties and values near underflow compare ``hypot`` itself: the same channels. The magnitude
+    itself is left to the caller (:func:`symfruit.core.edges._squared_median`, ``_squared_peaks``), which needs
+    ``hypot`` only where a comparison is that close."""
     h, w, nc = window.shape
     ch = np.empty((h, w))
-    best = np.empty((h, w))  # the strongest channel's sum of squares so far
-    exact = np.empty((h, w))  # its hypot where worked out, else -1
+    exact = np.empty((h, w))  # the strongest channel's hypot where worked out, else -1
     d = np.empty((h, w))
     cx = np.empty((h, w))
     cy = np.empty((h, w))
@@ -10987,32 +10987,28 @@ def colour_gradient(
         _difference_columns(s, d)
         _spread_rows(d, cy)
         for r in range(h):
-            x, y = cx[r], cy[r]
+            x, y, best = cx[r], cy[r], squares[r]
             for c in range(w):
                 q[c] = x[c] * x[c] + y[c] * y[c]
             if k == 0:
                 for c in range(w):
-                    best[r, c], exact[r, c], gx[r, c], gy[r, c] = q[c], -1.0, x[c], y[c]
+                    best[c], exact[r, c], gx[r, c], gy[r, c] = q[c], -1.0, x[c], y[c]
                 continue
             for c in range(w):
-                a, b = q[c], best[r, c]
-                safe = 1e-290 < b < 1e290 and 1e-290 < a < 1e290
+                a, b = q[c], best[c]
+                safe = 1e-290 < b and 1e-290 < a
                 if safe and a > b * (1.0 + 1e-10):
-                    best[r, c], exact[r, c], gx[r, c], gy[r, c] = a, -1.0, x[c], y[c]
+                    best[c], exact[r, c], gx[r, c], gy[r, c] = a, -1.0, x[c], y[c]
                 elif safe and a < b * (1.0 - 1e-10):
                     continue
-                else:  # a near tie (or a value near underflow or overflow): hypot decides, strictly, as the twin's
+                else:  # a near tie (or a value near underflow): hypot decides, strictly, as the twin's
                     e = exact[r, c]
                     if e < 0.0:
                         e = math.hypot(gx[r, c], gy[r, c])
                         exact[r, c] = e
                     m = math.hypot(x[c], y[c])
                     if m > e:
-                        best[r, c], exact[r, c], gx[r, c], gy[r, c] = a, m, x[c], y[c]
-    for r in range(h):
-        for c in range(w):
-            e = exact[r, c]
-            mag[r, c] = e if e >= 0.0 else math.hypot(gx[r, c], gy[r, c])
+                        best[c], exact[r, c], gx[r, c], gy[r, c] = a, m, x[c], y[c]
 
 
 @_njit

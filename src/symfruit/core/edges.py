@@ -32,6 +32,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -439,33 +440,90 @@ def _mask_costs(
     parts, ks, rows, cols, gx, gy, bins = found
     reach = m + int(np.ceil(cap))  # an outline pixel's edges within the cap of it, wherever the search moves it
     pad = reach + EDGE_REACH + 1
-    windows, seen, pooled = [], np.zeros((h, w), bool), []
+    squared = _squares_kernel(img)
+    windows, seen, pooled, fresh = [], np.zeros((h, w), bool), [], []
     for k, sl in parts:
         mine = ks == k
         if not mine.any():
             continue
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-        gradient = _window_gradient(img[r0:r1, c0:c1])
+        gradient = _window_gradient(img[r0:r1, c0:c1], squared)
         windows.append((k, sl, mine, r0, c0, gradient))
-        pooled.append(gradient[0][~seen[r0:r1, c0:c1]])  # each pixel of the windows' union once
+        fresh.append(~seen[r0:r1, c0:c1])
+        pooled.append(gradient[0][fresh[-1]])  # each pixel of the windows' union once
         seen[r0:r1, c0:c1] = True
     if not windows:  # thinned away, or no mask has a pixel beside one outside it (a mask over the whole image)
         return []
     # the threshold: a multiple of the median gradient over the windows' union (the masks and what lies around them)
-    threshold = 4.0 * max(float(np.median(np.concatenate(pooled))), 1e-9)
+    values = np.concatenate(pooled)
+    if squared:  # the kernel's sums of squares: their median's magnitude, hypot worked out only about the median
+
+        def band(lo: float, hi: float) -> np.ndarray:
+            """The magnitudes of the union's pixels whose sum of squares lies within ``[lo, hi]``."""
+            out = []
+            for (*_, (sq, sx, sy, _e)), f in zip(windows, fresh, strict=True):
+                sel = f & (sq >= lo) & (sq <= hi)
+                out.append(np.hypot(sx[0][sel], sy[0][sel]))
+            return np.concatenate(out)
+
+        median = _squared_median(values, band)
+    else:
+        median = float(np.median(values))
+    threshold = 4.0 * max(median, 1e-9)
     costs = []
     for k, sl, mine, r0, c0, gradient in windows:
         # the window's edges and their distances are read only within ``reach`` of the mask's box (its outline
         # pixels moved by the search and the cap about them): no farther edge lies within the cap of a read pixel
         a0, a1 = max(sl[0].start - reach, 0) - r0, min(sl[0].stop + reach, h) - r0
         b0, b1 = max(sl[1].start - reach, 0) - c0, min(sl[1].stop + reach, w) - c0
-        er, ec, ebins = _window_peaks(*gradient, threshold, (a0, a1, b0, b1))
+        if squared:
+            er, ec, ebins = _squared_peaks(gradient[0], gradient[1][0], gradient[2][0], threshold, (a0, a1, b0, b1))
+        else:
+            mag, cx, cy, each = gradient
+            assert each is not None
+            er, ec, ebins = _window_peaks(mag, cx, cy, each, threshold, (a0, a1, b0, b1))
         rr, cc = rows[mine] - r0 - a0, cols[mine] - c0 - b0
         dist = _capped_distances((a1 - a0, b1 - b0), er - a0, ec - b0, ebins, cap, (rr, cc, bins[mine]), m)
         # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du); off the window is off the image
         costs.append((k, mine, _padded_costs(dist, rr + m, cc + m, bins[mine], m)))
     return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
+
+
+#: A part in 1e9: how far apart two sums of squares ``gx * gx + gy * gy`` must lie to order their ``hypot``s, and a
+#: sum of squares from the square of a magnitude (each is within a few parts in 1e16 of its exact value, ``hypot``
+#: within one; stop 63, docs/shift63.md).
+_APART = 1e-9
+
+
+def _squares_kernel(img: np.ndarray) -> bool:
+    """Whether :func:`_window_gradient` runs the compiled kernel on windows of ``img``: there are kernels, and its
+    values are whole numbers or finite floats under 1e100 (their gradients' squares then neither overflow nor lose
+    their ordering to rounding)."""
+    if compiled() is None or img.size == 0:
+        return False
+    if img.dtype.kind in "biu":
+        return True
+    return img.dtype.kind == "f" and bool(np.isfinite(img).all()) and float(np.abs(img).max()) < 1e100
+
+
+def _squared_median(values: np.ndarray, band: Callable[[float, float], np.ndarray]) -> float:
+    """``np.median`` of the magnitudes ``hypot(gx, gy)`` whose sums of squares ``gx * gx + gy * gy`` are ``values``,
+    to the bit, from ``band(lo, hi)``: the magnitudes of the values within ``[lo, hi]`` alone.
+
+    The two middle sums of squares (one for an odd count) bound the band, widened by :data:`_APART`: a value below
+    it is the magnitude of less than the lower middle one, a value above it of more than the upper middle one
+    (their rounding is far less than a part in 1e9). So the middle magnitudes are the band's own, at their ranks
+    less the count below it, and their mean is ``np.median``'s (a mean of the one or two middle values)."""
+    n = len(values)
+    lo_k, hi_k = (n - 1) // 2, n // 2
+    part = np.partition(values, [lo_k, hi_k] if hi_k != lo_k else lo_k)
+    a, b = float(part[lo_k]), float(part[hi_k])
+    lo = a * (1.0 - _APART) if a > 1e-280 else -1.0  # near underflow: every value from 0 up
+    hi = max(b * (1.0 + _APART), 1e-280)
+    below = int(np.count_nonzero(values < lo))
+    exact = np.sort(band(lo, hi))
+    return float(np.mean(exact[lo_k - below : hi_k - below + 1]))
 
 
 @functools.lru_cache(maxsize=1)
@@ -481,28 +539,31 @@ def _gaussian_weights() -> tuple[np.ndarray, bool]:
     return weights, bool(np.all(np.abs(weights[5:] - weights[:4][::-1]) <= eps))
 
 
-def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
+def _window_gradient(
+    window: np.ndarray, squared: bool | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """:func:`_colour_gradient` at sigma 1 with the channels side by side, ``(mag, cx, cy, each)``: ``mag`` (h, w)
     the strongest channel's magnitude, ``cx, cy, each`` (c, h, w) every channel's gradient and magnitude. The same
     filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit.
 
-    With the compiled kernels (and finite values: an integer image, or a float one without NaN or inf) the whole
-    of it is :func:`symfruit.core._jit.colour_gradient`: one pass a channel, one ``hypot`` a pixel (the strongest
-    channel's; the channels told apart by their sums of squares but at near ties), and ``cx, cy`` (1, h, w) the
-    strongest channel's gradient alone, ``each`` None: the same magnitudes, and the same gradient wherever
-    :func:`_window_peaks` reads it (stop 63, docs/shift63.md)."""
+    ``squared`` (:func:`_squares_kernel` of the image when None): the compiled kernel,
+    :func:`symfruit.core._jit.colour_gradient`, in one pass a channel, and ``(squares, gx, gy, None)``: the strongest
+    channel's (the same channel) ``gx * gx + gy * gy`` (h, w) in place of its magnitude, and its gradient ``gx, gy``
+    (1, h, w) alone, the twin's to the bit. ``hypot``, some 12 ns a pixel, was half the kernel's time; its value is
+    needed only where a comparison is close (:func:`_squared_median`, :func:`_squared_peaks`; stop 63,
+    docs/shift63.md)."""
     img = np.asarray(window)
     if img.ndim == 2:
         img = img[..., None]
-    jit = compiled()
-    if jit is not None and img.shape[0] > 0 and img.shape[1] > 0 and (img.dtype.kind in "biu" or (
-            img.dtype.kind == "f" and bool(np.isfinite(img).all()))):  # fmt: skip
+    if _squares_kernel(img) if squared is None else squared:
         h, w = img.shape[:2]
-        mag, gx, gy = np.empty((h, w)), np.empty((1, h, w)), np.empty((1, h, w))
+        squares, gx, gy = np.empty((h, w)), np.empty((1, h, w)), np.empty((1, h, w))
         weights, symmetric = _gaussian_weights()
-        jit.colour_gradient(img if img.dtype != np.bool_ else img.view(np.uint8), weights, symmetric, mag, gx[0],
+        jit = compiled()
+        assert jit is not None
+        jit.colour_gradient(img if img.dtype != np.bool_ else img.view(np.uint8), weights, symmetric, squares, gx[0],
                             gy[0])  # fmt: skip
-        return mag, gx, gy, None
+        return squares, gx, gy, None
     img = np.asarray(img, dtype=np.float64)
     img = np.ascontiguousarray(np.moveaxis(img, -1, 0))
     ch = ndimage.gaussian_filter(img, (0.0, 1.0, 1.0))  # no smoothing across channels
@@ -517,7 +578,7 @@ def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.nda
     return mag, cx, cy, each
 
 
-def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndarray | None, threshold: float,
+def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndarray, threshold: float,
                   part: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
     """:func:`_colour_peaks` of :func:`_window_gradient`'s gradient within ``part`` = ``(r0, r1, c0, c1)`` of the
     window, worked out only at the pixels above ``threshold`` (every other one is no edge): the edges' rows,
@@ -531,13 +592,55 @@ def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndar
     rows, cols = np.nonzero(mag[r0:r1, c0:c1] > threshold)
     rows += r0
     cols += c0
-    k = 0 if each is None else each[:, rows, cols].argmax(axis=0)  # None: cx, cy the strongest channel's already
+    k = each[:, rows, cols].argmax(axis=0)
     gx, gy = cx[k, rows, cols], cy[k, rows, cols]
     angle = np.mod(np.arctan2(gy, gx), np.pi)
     q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
     dv, du = np.array((0, 1, 1, 1))[q], np.array((1, 1, 0, -1))[q]  # along 0, 45, 90, 135 degrees
     here = mag[rows, cols]
     peak = (here >= mag[rows - dv, cols - du]) & (here >= mag[rows + dv, cols + du])
+    bins = (np.floor(angle[peak] / (np.pi / N_BINS) + 0.5).astype(np.int64)) % N_BINS  # _orientation_bin's
+    return rows[peak], cols[peak], bins
+
+
+def _squared_peaks(squares: np.ndarray, gx: np.ndarray, gy: np.ndarray, threshold: float,
+                   part: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`_window_peaks` from the compiled kernel's gradient (:func:`_window_gradient`): the strongest channel's
+    ``gx, gy`` (h, w) and ``squares`` = ``gx * gx + gy * gy`` for its magnitude. A pixel is above ``threshold``, and
+    at least as strong as a neighbour along its gradient, as the magnitudes say: by the sums of squares where they
+    lie more than :data:`_APART` apart (squared threshold, or the two pixels'; nothing the rounding can turn), by
+    ``hypot`` itself where they lie closer. The same edges and bins as :func:`_window_peaks`."""
+    h, w = squares.shape
+    r0, r1, c0, c1 = max(part[0], 1), min(part[1], h - 1), max(part[2], 1), min(part[3], w - 1)
+    if r1 <= r0 or c1 <= c0:
+        empty = np.zeros(0, np.int64)
+        return empty, empty, empty
+    t2 = threshold * threshold  # at least 1.6e-17: no sum of squares compared with it is near underflow
+    rows, cols = np.nonzero(squares[r0:r1, c0:c1] > t2 * (1.0 - _APART))
+    rows += r0
+    cols += c0
+    here = squares[rows, cols]
+    close = here <= t2 * (1.0 + _APART)
+    if close.any():
+        keep = ~close
+        keep[close] = np.hypot(gx[rows[close], cols[close]], gy[rows[close], cols[close]]) > threshold
+        rows, cols, here = rows[keep], cols[keep], here[keep]
+    sx, sy = gx[rows, cols], gy[rows, cols]
+    angle = np.mod(np.arctan2(sy, sx), np.pi)
+    q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
+    dv, du = np.array((0, 1, 1, 1))[q], np.array((1, 1, 0, -1))[q]  # along 0, 45, 90, 135 degrees
+
+    def at_least(nr: np.ndarray, nc: np.ndarray) -> np.ndarray:
+        """Whether each pixel's magnitude is at least its neighbour's at ``(nr, nc)``."""
+        other = squares[nr, nc]
+        out = here >= other
+        close = (here <= other * (1.0 + _APART)) & (other <= here * (1.0 + _APART))
+        if close.any():
+            mine = np.hypot(sx[close], sy[close])
+            out[close] = mine >= np.hypot(gx[nr[close], nc[close]], gy[nr[close], nc[close]])
+        return out
+
+    peak = at_least(rows - dv, cols - du) & at_least(rows + dv, cols + du)
     bins = (np.floor(angle[peak] / (np.pi / N_BINS) + 0.5).astype(np.int64)) % N_BINS  # _orientation_bin's
     return rows[peak], cols[peak], bins
 
