@@ -546,3 +546,17 @@ def test_the_median_of_a_pair_whose_sums_of_squares_order_them_the_other_way():
     gx, gy = np.array([x[i], x2[i], 1e3]), np.array([y[i], y2[i], 1e3])
     squares, mag = gx * gx + gy * gy, np.hypot(gx, gy)
     assert _squared_median(squares, lambda lo, hi: mag[(squares >= lo) & (squares <= hi)]) == np.median(mag) == h1[i]
+
+
+@settings(deadline=None)
+@given(drawn_masks(), st.booleans())
+def test_the_outline_samples_kernel_is_the_twins_to_the_bit(case, given_boxes):
+    """The masks' outline pixels, their labels, the smoothed masks' gradient at them and their bins, with the
+    compiled kernel (the outline alone) and with the twin (the whole box): the same to the bit."""
+    _, masks, _, _, max_points = case
+    boxes = ndimage.find_objects(masks) if given_boxes else None
+    ours, twin = _twins(lambda: _outline_samples(masks, max_points, boxes))
+    assert (ours is None) == (twin is None)
+    if ours is not None:
+        assert ours[0] == twin[0]
+        assert all(_bit_equal(a, b) for a, b in zip(ours[1:], twin[1:], strict=True))

@@ -11056,3 +11056,70 @@ def capped_distances(
             for c in range(c1 - c0):
                 v = away[r, c]
                 dist[b, m + r0 + r, m + c0 + c] = np.float32(v if v < cap else cap)
+
+
+@_njit_inlined
+def _across(s: np.ndarray, r: int, left: int, c: int, right: int) -> float:
+    """``correlate1d(s, [-1, 0, 1], 1)`` at ``(r, c)``, its neighbours' columns given: scipy's antisymmetric sum."""
+    v = s[r, c] * 0.0
+    v += (s[r, left] - s[r, right]) * -1.0
+    return v
+
+
+@_njit_inlined
+def _down(s: np.ndarray, up: int, r: int, down: int, c: int) -> float:
+    """``correlate1d(s, [-1, 0, 1], 0)`` at ``(r, c)``, its neighbours' rows given."""
+    v = s[r, c] * 0.0
+    v += (s[up, c] - s[down, c]) * -1.0
+    return v
+
+
+@_njit
+def outline_gradient(
+    labels: np.ndarray, k: int, r0: int, r1: int, c0: int, c1: int, weights: np.ndarray, symmetric: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.edges._outline_samples` of one mask, ``labels == k`` within ``[r0:r1, c0:c1]``: its outline
+    pixels (the mask's pixels with a 4-neighbour in the box outside it, ``ndimage.binary_erosion``'s cross with
+    ``border_value=1``) in row-major order, their rows and columns (the box's), and the gradient of the mask smoothed
+    by ``weights`` (``ndimage.gaussian_filter``'s, ``symmetric`` as scipy finds them; along the columns then the
+    rows, :func:`_smoothed`) at them: ``ndimage.sobel``'s along the columns ``gx`` and the rows ``gy``, worked out
+    at the outline pixels alone in scipy's order and mode "reflect" (as :func:`colour_gradient`'s): the twin's values
+    to the bit."""
+    h, w = r1 - r0, c1 - c0
+    inside = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            inside[r, c] = 1.0 if labels[r0 + r, c0 + c] == k else 0.0
+    count = 0
+    edge = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if inside[r, c] == 0.0:
+                continue
+            if (r > 0 and inside[r - 1, c] == 0.0) or (r + 1 < h and inside[r + 1, c] == 0.0) or (
+                    c > 0 and inside[r, c - 1] == 0.0) or (c + 1 < w and inside[r, c + 1] == 0.0):  # fmt: skip
+                edge[r, c] = True
+                count += 1
+    rows = np.empty(count, np.int64)
+    cols = np.empty(count, np.int64)
+    gx = np.empty(count)
+    gy = np.empty(count)
+    if count == 0:
+        return rows, cols, gx, gy
+    s = _smoothed(inside, weights, symmetric)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if not edge[r, c]:
+                continue
+            # sobel(axis=1): [-1, 0, 1] along the rows r - 1, r, r + 1 (reflected), then [1, 2, 1] across them;
+            # sobel(axis=0): [-1, 0, 1] down the columns c - 1, c, c + 1, then [1, 2, 1] along them
+            up, down = _reflected(r - 1, h), _reflected(r + 1, h)
+            left, right = _reflected(c - 1, w), _reflected(c + 1, w)
+            x = _across(s, r, left, c, right) * 2.0
+            x += (_across(s, up, left, c, right) + _across(s, down, left, c, right)) * 1.0
+            y = _down(s, up, r, down, c) * 2.0
+            y += (_down(s, up, r, down, left) + _down(s, up, r, down, right)) * 1.0
+            rows[i], cols[i], gx[i], gy[i] = r, c, x, y
+            i += 1
+    return rows, cols, gx, gy
