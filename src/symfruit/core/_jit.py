@@ -11123,3 +11123,19 @@ def outline_gradient(
             rows[i], cols[i], gx[i], gy[i] = r, c, x, y
             i += 1
     return rows, cols, gx, gy
+
+
+@_njit
+def padded_costs(
+    dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int, out: np.ndarray
+) -> None:
+    """:func:`symfruit.core.edges._padded_costs` into ``out`` (2m+1, 2m+1, n): each point's ``(2m+1, 2m+1)`` window
+    of its bin's map ``dist`` (padded by ``m``; ``rows, cols`` the padded maps' own), copied a point at a time along
+    the map's rows instead of gathered through a strided view and transposed: the same values."""
+    s = 2 * m + 1
+    for p in range(rows.shape[0]):
+        b, r, c = bins[p], rows[p] - m, cols[p] - m
+        for i in range(s):
+            row = dist[b, r + i]
+            for j in range(s):
+                out[i, j, p] = row[c + j]

@@ -692,6 +692,10 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
 def _padded_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int) -> np.ndarray:
     """:func:`_moved_costs` on maps already padded by ``m`` (:func:`_capped_distances`; ``rows, cols`` the padded
     maps' own): each point's ``(2m+1, 2m+1)`` window of its bin's map, (2m+1, 2m+1, n)."""
+    if (jit := compiled()) is not None:  # the same values copied in one call (stop 63)
+        out = np.empty((2 * m + 1, 2 * m + 1, len(rows)), dist.dtype)
+        jit.padded_costs(dist, rows, cols, bins, m, out)
+        return out
     windows = np.lib.stride_tricks.sliding_window_view(dist, (2 * m + 1, 2 * m + 1), axis=(1, 2))
     return np.ascontiguousarray(np.moveaxis(windows[bins, rows - m, cols - m], 0, -1))
 
