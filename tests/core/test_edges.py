@@ -10,6 +10,7 @@ from scipy import ndimage
 from symfruit.core.edges import (
     EDGE_REACH,
     N_BINS,
+    _capped_distances,
     _colour_gradient,
     _colour_peaks,
     _edge_distances,
@@ -18,6 +19,10 @@ from symfruit.core.edges import (
     _outline_samples,
     _padded_costs,
     _shift_costs,
+    _squared_median,
+    _squared_peaks,
+    _window_gradient,
+    _window_peaks,
     colour_edges,
     depth_outline,
     edge_shift,
@@ -374,3 +379,184 @@ def test_the_padded_gather_is_the_moved_costs():
     assert np.array_equal(
         _padded_costs(padded, rows + 7, cols + 7, bins, 7), _moved_costs(dist, rows, cols, bins, 7, 6.0)
     )
+
+
+# --- stop 63: the compiled window gradient and distance maps against their numpy twins (docs/shift63.md) ----------
+
+
+def _twins(fn, *args):
+    """``fn(*args)`` with the compiled kernels, then with the numpy twins (``SYMFRUIT_KERNELS=numpy``)."""
+    pytest.importorskip("numba")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)  # a run with the twins throughout still compares
+        compiled = fn(*args)
+        mp.setenv("SYMFRUIT_KERNELS", "numpy")
+        twin = fn(*args)
+    return compiled, twin
+
+
+def _bit_equal(a: np.ndarray, b: np.ndarray) -> bool:
+    return a.shape == b.shape and np.array_equal(a, b) and np.array_equal(np.signbit(a), np.signbit(b))
+
+
+@st.composite
+def drawn_windows(draw: st.DrawFn) -> np.ndarray:
+    """A colour window: noise, a few flat levels (zero gradients, ties), every channel the same, a channel the
+    negative of another (the same magnitude, the opposite gradient: the first must be taken), a channel a part in
+    1e15 off another (near ties of ``hypot``), values near underflow; 8-bit or float, 1, 3 or 4 channels (or a
+    plain (h, w) image), sizes down to one pixel, some not contiguous."""
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    h, w = draw(st.integers(1, 30)), draw(st.integers(1, 30))
+    nc = draw(st.sampled_from([1, 3, 4]))
+    kind = draw(st.sampled_from(["noise", "levels", "same", "negative", "near", "tiny"]))
+    img = rng.uniform(0, 255, (h, w, nc))
+    if kind == "levels":
+        img = rng.integers(0, 3, (h, w, nc)) * 60.0
+    elif kind == "same":
+        img[:] = img[..., :1]
+    elif kind == "negative" and nc > 1:
+        img[..., 1] = 255.0 - img[..., 0]
+    elif kind == "near" and nc > 1:
+        img[..., 1] = img[..., 0] * (1.0 + 1e-15 * rng.integers(-3, 4, (h, w)))
+    elif kind == "tiny":
+        img *= 1e-300
+    if kind in ("noise", "levels", "same", "negative") and draw(st.booleans()):
+        img = img.astype(np.uint8)
+    if draw(st.booleans()):
+        img = img[::-1, ::-1]
+    return img[..., 0] if nc == 1 and draw(st.booleans()) else img
+
+
+@settings(deadline=None)
+@given(drawn_windows())
+def test_the_window_gradient_kernel_is_the_twins_to_the_bit(window):
+    """The compiled window gradient: at every pixel the twin's first strongest channel's (its ``argmax``) gradient
+    to the bit, signs of zero too, its ``hypot`` the twin's magnitude and its sum of squares as numpy's."""
+    (squares, cx, cy, each), (tmag, tcx, tcy, teach) = _twins(_window_gradient, window)
+    assert each is None and cx.shape[0] == 1 and teach is not None
+    k = teach.argmax(axis=0)[None]
+    assert _bit_equal(cx[0], np.take_along_axis(tcx, k, 0)[0])
+    assert _bit_equal(cy[0], np.take_along_axis(tcy, k, 0)[0])
+    assert _bit_equal(np.hypot(cx[0], cy[0]), tmag)
+    assert _bit_equal(squares, cx[0] * cx[0] + cy[0] * cy[0])
+
+
+@pytest.mark.parametrize("spoil", [np.nan, np.inf, 1e120])
+def test_a_float_image_with_a_nan_an_inf_or_huge_values_is_left_to_the_twin(spoil):
+    window = np.random.default_rng(3).uniform(0, 255, (12, 14, 3))
+    window[5, 6, 1] = spoil
+    compiled, twin = _twins(_window_gradient, window)
+    assert compiled[3] is not None  # the twin's own arrays (every channel)
+    assert np.array_equal(compiled[0], twin[0], equal_nan=True)
+
+
+def _mask_costs_twins(img, masks, **kw):
+    return _twins(lambda: _mask_costs(img, masks, **kw))
+
+
+@settings(deadline=None)
+@given(drawn_masks(), st.sampled_from(["plain", "near-ties", "flat", "tiny"]))
+def test_the_masks_costs_are_the_twins_to_the_bit(case, kind):
+    """The masks' costs with the compiled kernels (the magnitudes' median, threshold and peaks from sums of squares)
+    and with the twins: the same to the bit. Besides the drawn frames: channels a part in 1e15 apart (near ties of
+    ``hypot``), whole-number levels (ties of the median and of the suppression) and values near underflow."""
+    img, masks, max_px, cap, max_points = case
+    rng = np.random.default_rng(int(masks.sum()) + max_px)
+    img = np.asarray(img, dtype=np.float64) if kind != "plain" else img
+    if kind == "near-ties" and img.ndim == 3 and img.shape[2] == 3:
+        img[..., 1] = img[..., 0] * (1.0 + 1e-15 * rng.integers(-3, 4, img.shape[:2]))
+    elif kind == "flat":
+        img = np.round(img / 64.0) * 64.0
+    elif kind == "tiny":
+        img = img * 1e-160
+    kw = {"max_px": max_px, "cap": cap, "max_points": max_points}
+    ours, twin = _mask_costs_twins(img, masks, **kw)
+    assert same_costs(ours, twin)
+
+
+@settings(deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 60), st.integers(1, 60), st.integers(1, 12),
+       st.sampled_from([2.0, 3.5, 6.0, 7.2]))  # fmt: skip
+def test_the_capped_distances_kernel_is_the_twins_to_the_bit(seed, h, w, m, cap):
+    """Random edges and points (some bins without points, some without edges): every map the twin's to the bit."""
+    rng = np.random.default_rng(seed)
+    n_edges, n_points = int(rng.integers(0, h * w // 3 + 2)), int(rng.integers(1, 80))
+    rows, cols = rng.integers(0, h, n_edges), rng.integers(0, w, n_edges)
+    ebins = rng.integers(0, N_BINS, n_edges)
+    points = (rng.integers(0, h, n_points), rng.integers(0, w, n_points), rng.integers(0, N_BINS, n_points))
+    if rng.random() < 0.5:  # points of a few bins only
+        points = (points[0], points[1], points[2] % int(rng.integers(1, 4)))
+    compiled, twin = _twins(_capped_distances, (h, w), rows, cols, ebins, cap, points, m)
+    assert compiled.dtype == twin.dtype == np.float32
+    assert np.array_equal(compiled, twin)
+
+
+def _near_ties(rng: np.random.Generator, shape: tuple[int, ...], bases: int) -> tuple[np.ndarray, np.ndarray]:
+    """Gradients ``(gx, gy)`` each a few units in the last place off one of a few ``bases`` (signs and zeros
+    among them): their sums of squares and ``hypot``s tie, or order the other way round, or tie in one and not
+    the other, everywhere."""
+    bx, by = rng.uniform(-100, 100, bases), rng.uniform(-100, 100, bases)
+    bx[rng.random(bases) < 0.2] = 0.0
+    pick = rng.integers(0, bases, shape)
+    gx, gy = bx[pick], by[pick]
+    for g in (gx, gy):
+        for _ in range(3):
+            step = rng.integers(-1, 2, shape)
+            g[step > 0] = np.nextafter(g[step > 0], np.inf)
+            g[step < 0] = np.nextafter(g[step < 0], -np.inf)
+    return gx, gy
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 400), st.integers(1, 6))
+def test_the_median_from_the_sums_of_squares_is_numpys_of_the_magnitudes(seed, n, bases):
+    """Near ties of every kind about the median, odd and even counts, a single value, zeros: the same median."""
+    rng = np.random.default_rng(seed)
+    gx, gy = _near_ties(rng, (n,), bases)
+    squares, mag = gx * gx + gy * gy, np.hypot(gx, gy)
+
+    def band(lo: float, hi: float) -> np.ndarray:
+        return mag[(squares >= lo) & (squares <= hi)]
+
+    assert _bit_equal(np.float64(_squared_median(squares, band)), np.float64(np.median(mag)))
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(3, 30), st.integers(3, 30), st.integers(1, 5))
+def test_the_peaks_from_the_sums_of_squares_are_the_window_peaks(seed, h, w, bases):
+    """Near ties with the threshold (one of the magnitudes, or a unit in the last place off one) and between
+    neighbours along the gradient: the same edges and bins as the twin's from the magnitudes."""
+    rng = np.random.default_rng(seed)
+    gx, gy = _near_ties(rng, (h, w), bases)
+    mag = np.hypot(gx, gy)
+    threshold = float(np.nextafter(mag.flat[rng.integers(0, h * w)], (np.inf, -np.inf, 0.0)[rng.integers(0, 3)]))
+    threshold = max(threshold, 1e-3)
+    part = (int(rng.integers(0, h)), int(rng.integers(1, h + 1)), int(rng.integers(0, w)), int(rng.integers(1, w + 1)))
+    ours = _squared_peaks(gx * gx + gy * gy, gx, gy, threshold, part)
+    twin = _window_peaks(mag, gx[None], gy[None], mag[None], threshold, part)
+    assert all(np.array_equal(a, b) for a, b in zip(ours, twin, strict=True))
+
+
+def test_the_median_of_a_pair_whose_sums_of_squares_order_them_the_other_way():
+    """Two gradients a unit in the last place apart whose sums of squares order them unlike their ``hypot``s, and a
+    third far above: the median is the middle ``hypot``, not that of the middle sum of squares."""
+    rng = np.random.default_rng(5)
+    x, y = rng.uniform(1, 100, 20000), rng.uniform(1, 100, 20000)
+    x2, y2 = np.nextafter(x, np.inf), np.nextafter(y, -np.inf)
+    q1, q2, h1, h2 = x * x + y * y, x2 * x2 + y2 * y2, np.hypot(x, y), np.hypot(x2, y2)
+    i = int(np.flatnonzero((q1 < q2) & (h1 > h2))[0])
+    gx, gy = np.array([x[i], x2[i], 1e3]), np.array([y[i], y2[i], 1e3])
+    squares, mag = gx * gx + gy * gy, np.hypot(gx, gy)
+    assert _squared_median(squares, lambda lo, hi: mag[(squares >= lo) & (squares <= hi)]) == np.median(mag) == h1[i]
+
+
+@settings(deadline=None)
+@given(drawn_masks(), st.booleans())
+def test_the_outline_samples_kernel_is_the_twins_to_the_bit(case, given_boxes):
+    """The masks' outline pixels, their labels, the smoothed masks' gradient at them and their bins, with the
+    compiled kernel (the outline alone) and with the twin (the whole box): the same to the bit."""
+    _, masks, _, _, max_points = case
+    boxes = ndimage.find_objects(masks) if given_boxes else None
+    ours, twin = _twins(lambda: _outline_samples(masks, max_points, boxes))
+    assert (ours is None) == (twin is None)
+    if ours is not None:
+        assert ours[0] == twin[0]
+        assert all(_bit_equal(a, b) for a, b in zip(ours[1:], twin[1:], strict=True))

@@ -10999,3 +10999,257 @@ def occlusion_projected(
         _own_edge_in_box(hidden, mask, v0, u0, own_z, p0, q0, seen, others, tolerance, band, supports, focal, f0, f1,
                          e0, e1)  # fmt: skip
     return True, u0, v0, hidden, seen
+
+
+@_njit
+def _difference_rows(s: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(s, [-1, 0, 1], 1)`` (mode "reflect") of an (h, w) image into ``out``: scipy takes the
+    weights as antisymmetric, so each value is the middle one times 0, plus the left less the right one times -1;
+    the inner columns along views of the rows (numba vectorises them), the two end ones reflected."""
+    h, w = s.shape
+    for r in range(h):
+        row, o = s[r], out[r]
+        for c in (0, w - 1):
+            v = row[c] * 0.0
+            v += (row[_reflected(c - 1, w)] - row[_reflected(c + 1, w)]) * -1.0
+            o[c] = v
+        if w > 2:
+            a, mid, b, oo = row[0 : w - 2], row[1 : w - 1], row[2:w], o[1 : w - 1]
+            for k in range(w - 2):
+                v = mid[k] * 0.0
+                v += (a[k] - b[k]) * -1.0
+                oo[k] = v
+
+
+@_njit
+def _difference_columns(s: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(s, [-1, 0, 1], 0)`` (mode "reflect") of an (h, w) image into ``out``, as
+    :func:`_difference_rows` along the columns: a whole row at a time."""
+    h, w = s.shape
+    for r in range(h):
+        a, mid, b, o = s[_reflected(r - 1, h)], s[r], s[_reflected(r + 1, h)], out[r]
+        for k in range(w):
+            v = mid[k] * 0.0
+            v += (a[k] - b[k]) * -1.0
+            o[k] = v
+
+
+@_njit
+def _spread_rows(d: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(d, [1, 2, 1], 1)`` (mode "reflect") of an (h, w) image into ``out`` (symmetric: the
+    middle value times 2, plus the pair's sum times 1), as :func:`_difference_rows`."""
+    h, w = d.shape
+    for r in range(h):
+        row, o = d[r], out[r]
+        for c in (0, w - 1):
+            v = row[c] * 2.0
+            v += (row[_reflected(c - 1, w)] + row[_reflected(c + 1, w)]) * 1.0
+            o[c] = v
+        if w > 2:
+            a, mid, b, oo = row[0 : w - 2], row[1 : w - 1], row[2:w], o[1 : w - 1]
+            for k in range(w - 2):
+                v = mid[k] * 2.0
+                v += (a[k] + b[k]) * 1.0
+                oo[k] = v
+
+
+@_njit
+def _spread_columns(d: np.ndarray, out: np.ndarray) -> None:
+    """``ndimage.correlate1d(d, [1, 2, 1], 0)`` (mode "reflect") of an (h, w) image into ``out``, a whole row at a
+    time."""
+    h, w = d.shape
+    for r in range(h):
+        a, mid, b, o = d[_reflected(r - 1, h)], d[r], d[_reflected(r + 1, h)], out[r]
+        for k in range(w):
+            v = mid[k] * 2.0
+            v += (a[k] + b[k]) * 1.0
+            o[k] = v
+
+
+@_njit
+def colour_gradient(
+    window: np.ndarray, weights: np.ndarray, symmetric: bool, squares: np.ndarray, gx: np.ndarray, gy: np.ndarray
+) -> None:
+    """:func:`symfruit.core.edges._window_gradient` of a colour window (h, w, c) of finite values under 1e100, into
+    ``gx`` and ``gy`` (h, w), the strongest channel's gradient, and ``squares`` (h, w), its ``gx * gx + gy * gy``.
+    Each channel is smoothed by ``weights`` (``ndimage.gaussian_filter``'s at sigma 1, ``symmetric`` as scipy finds
+    them) along the columns then the rows (:func:`_smoothed`), then differenced as ``ndimage.sobel`` does it
+    (``[-1, 0, 1]`` along one axis, :func:`_difference_rows`, then ``[1, 2, 1]`` along the other,
+    :func:`_spread_columns`), all in scipy's order and mode "reflect": the twin's gradients to the bit.
+
+    The strongest channel is the first whose ``hypot`` is the greatest (the twin's running maximum and ``argmax``).
+    ``hypot`` (libm's, as numpy's) costs some 10-14 ns a value against a fraction of one for a sum of squares, so
+    channels are told apart by their sums of squares where those differ by more than a part in 1e10 (far beyond
+    their rounding, a few parts in 1e16, and ``hypot``'s, under one in 1e16: the larger sum is the larger
+    ``hypot``); only near ties and values near underflow compare ``hypot`` itself: the same channels. The magnitude
+    itself is left to the caller (:func:`symfruit.core.edges._squared_median`, ``_squared_peaks``), which needs
+    ``hypot`` only where a comparison is that close."""
+    h, w, nc = window.shape
+    ch = np.empty((h, w))
+    exact = np.empty((h, w))  # the strongest channel's hypot where worked out, else -1
+    d = np.empty((h, w))
+    cx = np.empty((h, w))
+    cy = np.empty((h, w))
+    q = np.empty(w)
+    for k in range(nc):
+        for r in range(h):
+            for c in range(w):
+                ch[r, c] = float(window[r, c, k])
+        s = _smoothed(ch, weights, symmetric)
+        _difference_rows(s, d)
+        _spread_columns(d, cx)
+        _difference_columns(s, d)
+        _spread_rows(d, cy)
+        for r in range(h):
+            x, y, best = cx[r], cy[r], squares[r]
+            for c in range(w):
+                q[c] = x[c] * x[c] + y[c] * y[c]
+            if k == 0:
+                for c in range(w):
+                    best[c], exact[r, c], gx[r, c], gy[r, c] = q[c], -1.0, x[c], y[c]
+                continue
+            for c in range(w):
+                a, b = q[c], best[c]
+                safe = 1e-290 < b and 1e-290 < a
+                if safe and a > b * (1.0 + 1e-10):
+                    best[c], exact[r, c], gx[r, c], gy[r, c] = a, -1.0, x[c], y[c]
+                elif safe and a < b * (1.0 - 1e-10):
+                    continue
+                else:  # a near tie (or a value near underflow): hypot decides, strictly, as the twin's
+                    e = exact[r, c]
+                    if e < 0.0:
+                        e = math.hypot(gx[r, c], gy[r, c])
+                        exact[r, c] = e
+                    m = math.hypot(x[c], y[c])
+                    if m > e:
+                        best[c], exact[r, c], gx[r, c], gy[r, c] = a, m, x[c], y[c]
+
+
+@_njit
+def capped_distances(
+    rows: np.ndarray, cols: np.ndarray, ebins: np.ndarray, cap: float, prow: np.ndarray, pcol: np.ndarray,
+    pbins: np.ndarray, m: int, dist: np.ndarray,
+) -> None:  # fmt: skip
+    """:func:`symfruit.core.edges._capped_distances` into ``dist`` (n_bins, h + 2 m, w + 2 m) float32, filled with
+    ``cap`` by the caller: for every orientation bin some point ``(prow, pcol, pbins)`` has, the edges ``(rows, cols)``
+    whose bin ``ebins`` is within one of it and within the points' box grown by ``m + ceil(cap)``, their distances
+    within the cap (:func:`near_distance`) capped at ``cap``, written at the box offset by ``m``. The twin's steps in
+    one call (its masks, boxes and copies were half its time): the same values."""
+    nb = dist.shape[0]
+    h, w = dist.shape[1] - 2 * m, dist.shape[2] - 2 * m
+    reach = m + math.ceil(cap)
+    lo_r = np.full(nb, h + reach, np.int64)
+    hi_r = np.full(nb, -reach - 1, np.int64)
+    lo_c = np.full(nb, w + reach, np.int64)
+    hi_c = np.full(nb, -reach - 1, np.int64)
+    for i in range(prow.shape[0]):
+        b = pbins[i]
+        lo_r[b] = min(lo_r[b], prow[i])
+        hi_r[b] = max(hi_r[b], prow[i])
+        lo_c[b] = min(lo_c[b], pcol[i])
+        hi_c[b] = max(hi_c[b], pcol[i])
+    for b in range(nb):
+        if hi_r[b] < lo_r[b]:
+            continue
+        r0, r1 = max(lo_r[b] - reach, 0), min(hi_r[b] + reach + 1, h)
+        c0, c1 = max(lo_c[b] - reach, 0), min(hi_c[b] + reach + 1, w)
+        if r1 <= r0 or c1 <= c0:
+            continue
+        edges = np.zeros((r1 - r0, c1 - c0), np.bool_)
+        some = False
+        for i in range(rows.shape[0]):
+            apart = (ebins[i] - b) % nb
+            if (apart <= 1 or apart == nb - 1) and r0 <= rows[i] < r1 and c0 <= cols[i] < c1:
+                edges[rows[i] - r0, cols[i] - c0] = True
+                some = True
+        if not some:
+            continue
+        away = np.empty((r1 - r0, c1 - c0))
+        near_distance(edges, cap, True, away)
+        for r in range(r1 - r0):
+            for c in range(c1 - c0):
+                v = away[r, c]
+                dist[b, m + r0 + r, m + c0 + c] = np.float32(v if v < cap else cap)
+
+
+@_njit_inlined
+def _across(s: np.ndarray, r: int, left: int, c: int, right: int) -> float:
+    """``correlate1d(s, [-1, 0, 1], 1)`` at ``(r, c)``, its neighbours' columns given: scipy's antisymmetric sum."""
+    v = s[r, c] * 0.0
+    v += (s[r, left] - s[r, right]) * -1.0
+    return v
+
+
+@_njit_inlined
+def _down(s: np.ndarray, up: int, r: int, down: int, c: int) -> float:
+    """``correlate1d(s, [-1, 0, 1], 0)`` at ``(r, c)``, its neighbours' rows given."""
+    v = s[r, c] * 0.0
+    v += (s[up, c] - s[down, c]) * -1.0
+    return v
+
+
+@_njit
+def outline_gradient(
+    labels: np.ndarray, k: int, r0: int, r1: int, c0: int, c1: int, weights: np.ndarray, symmetric: bool
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.edges._outline_samples` of one mask, ``labels == k`` within ``[r0:r1, c0:c1]``: its outline
+    pixels (the mask's pixels with a 4-neighbour in the box outside it, ``ndimage.binary_erosion``'s cross with
+    ``border_value=1``) in row-major order, their rows and columns (the box's), and the gradient of the mask smoothed
+    by ``weights`` (``ndimage.gaussian_filter``'s, ``symmetric`` as scipy finds them; along the columns then the
+    rows, :func:`_smoothed`) at them: ``ndimage.sobel``'s along the columns ``gx`` and the rows ``gy``, worked out
+    at the outline pixels alone in scipy's order and mode "reflect" (as :func:`colour_gradient`'s): the twin's values
+    to the bit."""
+    h, w = r1 - r0, c1 - c0
+    inside = np.empty((h, w))
+    for r in range(h):
+        for c in range(w):
+            inside[r, c] = 1.0 if labels[r0 + r, c0 + c] == k else 0.0
+    count = 0
+    edge = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        for c in range(w):
+            if inside[r, c] == 0.0:
+                continue
+            if (r > 0 and inside[r - 1, c] == 0.0) or (r + 1 < h and inside[r + 1, c] == 0.0) or (
+                    c > 0 and inside[r, c - 1] == 0.0) or (c + 1 < w and inside[r, c + 1] == 0.0):  # fmt: skip
+                edge[r, c] = True
+                count += 1
+    rows = np.empty(count, np.int64)
+    cols = np.empty(count, np.int64)
+    gx = np.empty(count)
+    gy = np.empty(count)
+    if count == 0:
+        return rows, cols, gx, gy
+    s = _smoothed(inside, weights, symmetric)
+    i = 0
+    for r in range(h):
+        for c in range(w):
+            if not edge[r, c]:
+                continue
+            # sobel(axis=1): [-1, 0, 1] along the rows r - 1, r, r + 1 (reflected), then [1, 2, 1] across them;
+            # sobel(axis=0): [-1, 0, 1] down the columns c - 1, c, c + 1, then [1, 2, 1] along them
+            up, down = _reflected(r - 1, h), _reflected(r + 1, h)
+            left, right = _reflected(c - 1, w), _reflected(c + 1, w)
+            x = _across(s, r, left, c, right) * 2.0
+            x += (_across(s, up, left, c, right) + _across(s, down, left, c, right)) * 1.0
+            y = _down(s, up, r, down, c) * 2.0
+            y += (_down(s, up, r, down, left) + _down(s, up, r, down, right)) * 1.0
+            rows[i], cols[i], gx[i], gy[i] = r, c, x, y
+            i += 1
+    return rows, cols, gx, gy
+
+
+@_njit
+def padded_costs(
+    dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int, out: np.ndarray
+) -> None:
+    """:func:`symfruit.core.edges._padded_costs` into ``out`` (2m+1, 2m+1, n): each point's ``(2m+1, 2m+1)`` window
+    of its bin's map ``dist`` (padded by ``m``; ``rows, cols`` the padded maps' own), copied a point at a time along
+    the map's rows instead of gathered through a strided view and transposed: the same values."""
+    s = 2 * m + 1
+    for p in range(rows.shape[0]):
+        b, r, c = bins[p], rows[p] - m, cols[p] - m
+        for i in range(s):
+            row = dist[b, r + i]
+            for j in range(s):
+                out[i, j, p] = row[c + j]

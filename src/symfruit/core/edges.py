@@ -30,7 +30,9 @@ the colour pixel ``(u, v)`` sees. Numpy and scipy only; images in, numbers out.
 
 from __future__ import annotations
 
+import functools
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -385,11 +387,16 @@ def _outline_samples(
     orientation bins (:func:`_orientation_bin`); None when no mask has a pixel."""
     h, w = lab.shape
     parts = []
+    jit = compiled()
     for k, sl in enumerate(ndimage.find_objects(lab) if boxes is None else boxes, start=1):
         if sl is None:
             continue
         a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
         b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
+        if jit is not None:  # the same pixels and gradient, worked out at the outline alone (stop 63)
+            rows, cols, gx, gy = jit.outline_gradient(lab, k, a0, a1, b0, b1, *_gaussian_weights(1.5))
+            parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
+            continue
         mask = lab[a0:a1, b0:b1] == k
         rows, cols = np.nonzero(mask & ~ndimage.binary_erosion(mask, border_value=1))
         smooth = ndimage.gaussian_filter(mask.astype(np.float64), 1.5)
@@ -423,6 +430,12 @@ def _mask_costs(
     threshold) and their distance maps (:func:`_capped_distances`: each bin's over its own outline pixels' box,
     bounded at the cap) are worked out only within the search and the cap of the mask's box, where the shifted
     outline reads them: the same costs, to the bit, at 0.7 times the CPU (stop 62, docs/edgespeed62.md).
+
+    With the compiled kernels (stop 63, docs/shift63.md) the outlines (:func:`symfruit.core._jit.outline_gradient`),
+    the windows' gradients (:func:`symfruit.core._jit.colour_gradient`, which leaves the strongest channel's sum of
+    squares for its magnitude: :func:`_squared_median` and :func:`_squared_peaks` take ``hypot`` only where a
+    comparison is close) and the distance maps (:func:`symfruit.core._jit.capped_distances`) are each one call: the
+    same costs, to the bit, at about half stop 62's CPU.
     """
     img = np.asarray(color)
     lab = np.asarray(labels)
@@ -438,28 +451,49 @@ def _mask_costs(
     parts, ks, rows, cols, gx, gy, bins = found
     reach = m + int(np.ceil(cap))  # an outline pixel's edges within the cap of it, wherever the search moves it
     pad = reach + EDGE_REACH + 1
-    windows, seen, pooled = [], np.zeros((h, w), bool), []
+    squared = _squares_kernel(img)
+    windows, seen, pooled, fresh = [], np.zeros((h, w), bool), [], []
     for k, sl in parts:
         mine = ks == k
         if not mine.any():
             continue
         r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
         c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
-        gradient = _window_gradient(img[r0:r1, c0:c1])
+        gradient = _window_gradient(img[r0:r1, c0:c1], squared)
         windows.append((k, sl, mine, r0, c0, gradient))
-        pooled.append(gradient[0][~seen[r0:r1, c0:c1]])  # each pixel of the windows' union once
+        fresh.append(~seen[r0:r1, c0:c1])
+        pooled.append(gradient[0][fresh[-1]])  # each pixel of the windows' union once
         seen[r0:r1, c0:c1] = True
     if not windows:  # thinned away, or no mask has a pixel beside one outside it (a mask over the whole image)
         return []
     # the threshold: a multiple of the median gradient over the windows' union (the masks and what lies around them)
-    threshold = 4.0 * max(float(np.median(np.concatenate(pooled))), 1e-9)
+    values = np.concatenate(pooled)
+    if squared:  # the kernel's sums of squares: their median's magnitude, hypot worked out only about the median
+
+        def band(lo: float, hi: float) -> np.ndarray:
+            """The magnitudes of the union's pixels whose sum of squares lies within ``[lo, hi]``."""
+            out = []
+            for (*_, (sq, sx, sy, _e)), f in zip(windows, fresh, strict=True):
+                sel = f & (sq >= lo) & (sq <= hi)
+                out.append(np.hypot(sx[0][sel], sy[0][sel]))
+            return np.concatenate(out)
+
+        median = _squared_median(values, band)
+    else:
+        median = float(np.median(values))
+    threshold = 4.0 * max(median, 1e-9)
     costs = []
     for k, sl, mine, r0, c0, gradient in windows:
         # the window's edges and their distances are read only within ``reach`` of the mask's box (its outline
         # pixels moved by the search and the cap about them): no farther edge lies within the cap of a read pixel
         a0, a1 = max(sl[0].start - reach, 0) - r0, min(sl[0].stop + reach, h) - r0
         b0, b1 = max(sl[1].start - reach, 0) - c0, min(sl[1].stop + reach, w) - c0
-        er, ec, ebins = _window_peaks(*gradient, threshold, (a0, a1, b0, b1))
+        if squared:
+            er, ec, ebins = _squared_peaks(gradient[0], gradient[1][0], gradient[2][0], threshold, (a0, a1, b0, b1))
+        else:
+            mag, cx, cy, each = gradient
+            assert each is not None
+            er, ec, ebins = _window_peaks(mag, cx, cy, each, threshold, (a0, a1, b0, b1))
         rr, cc = rows[mine] - r0 - a0, cols[mine] - c0 - b0
         dist = _capped_distances((a1 - a0, b1 - b0), er - a0, ec - b0, ebins, cap, (rr, cc, bins[mine]), m)
         # the masks moved by (du, dv): a point at (r, c) is read at (r + dv, c + du); off the window is off the image
@@ -467,13 +501,83 @@ def _mask_costs(
     return [(k, every, gx[mine], gy[mine]) for k, mine, every in costs]
 
 
-def _window_gradient(window: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+#: A part in 1e9: how far apart two sums of squares ``gx * gx + gy * gy`` must lie to order their ``hypot``s, and a
+#: sum of squares from the square of a magnitude (each is within a few parts in 1e16 of its exact value, ``hypot``
+#: within one; stop 63, docs/shift63.md).
+_APART = 1e-9
+
+
+def _squares_kernel(img: np.ndarray) -> bool:
+    """Whether :func:`_window_gradient` runs the compiled kernel on windows of ``img``: there are kernels, and its
+    values are whole numbers or finite floats under 1e100 (their gradients' squares then neither overflow nor lose
+    their ordering to rounding)."""
+    if compiled() is None or img.size == 0:
+        return False
+    if img.dtype.kind in "biu":
+        return True
+    return img.dtype.kind == "f" and bool(np.isfinite(img).all()) and float(np.abs(img).max()) < 1e100
+
+
+def _squared_median(values: np.ndarray, band: Callable[[float, float], np.ndarray]) -> float:
+    """``np.median`` of the magnitudes ``hypot(gx, gy)`` whose sums of squares ``gx * gx + gy * gy`` are ``values``,
+    to the bit, from ``band(lo, hi)``: the magnitudes of the values within ``[lo, hi]`` alone.
+
+    The two middle sums of squares (one for an odd count) bound the band, widened by :data:`_APART`: a value below
+    it is the magnitude of less than the lower middle one, a value above it of more than the upper middle one
+    (their rounding is far less than a part in 1e9). So the middle magnitudes are the band's own, at their ranks
+    less the count below it, and their mean is ``np.median``'s (a mean of the one or two middle values)."""
+    n = len(values)
+    lo_k, hi_k = (n - 1) // 2, n // 2
+    part = np.partition(values, [lo_k, hi_k] if hi_k != lo_k else lo_k)
+    a, b = float(part[lo_k]), float(part[hi_k])
+    lo = a * (1.0 - _APART) if a > 1e-280 else -1.0  # near underflow: every value from 0 up
+    hi = max(b * (1.0 + _APART), 1e-280)
+    below = int(np.count_nonzero(values < lo))
+    exact = np.sort(band(lo, hi))
+    return float(np.mean(exact[lo_k - below : hi_k - below + 1]))
+
+
+@functools.lru_cache(maxsize=4)
+def _gaussian_weights(sigma: float = 1.0) -> tuple[np.ndarray, bool]:
+    """The weights of ``ndimage.gaussian_filter`` at ``sigma`` (truncated at 4 sigma): its response to an impulse
+    (each weight times 1, plus zeros: exact), and whether ``ndimage.correlate1d`` takes them as symmetric (each pair
+    within the float64 epsilon: it then adds each pair before multiplying), as
+    :func:`symfruit.segment.colour._gaussian_weights`."""
+    radius = int(4.0 * sigma + 0.5)
+    impulse = np.zeros(2 * radius + 1)
+    impulse[radius] = 1.0
+    weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
+    weights.flags.writeable = False
+    eps = float(np.finfo(np.float64).eps)
+    return weights, bool(np.all(np.abs(weights[radius + 1 :] - weights[:radius][::-1]) <= eps))
+
+
+def _window_gradient(
+    window: np.ndarray, squared: bool | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray | None]:
     """:func:`_colour_gradient` at sigma 1 with the channels side by side, ``(mag, cx, cy, each)``: ``mag`` (h, w)
     the strongest channel's magnitude, ``cx, cy, each`` (c, h, w) every channel's gradient and magnitude. The same
-    filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit."""
-    img = np.asarray(window, dtype=np.float64)
+    filters along the same axes (a Gaussian and a Sobel per channel): the same values, to the bit.
+
+    ``squared`` (:func:`_squares_kernel` of the image when None): the compiled kernel,
+    :func:`symfruit.core._jit.colour_gradient`, in one pass a channel, and ``(squares, gx, gy, None)``: the strongest
+    channel's (the same channel) ``gx * gx + gy * gy`` (h, w) in place of its magnitude, and its gradient ``gx, gy``
+    (1, h, w) alone, the twin's to the bit. ``hypot``, some 12 ns a pixel, was half the kernel's time; its value is
+    needed only where a comparison is close (:func:`_squared_median`, :func:`_squared_peaks`; stop 63,
+    docs/shift63.md)."""
+    img = np.asarray(window)
     if img.ndim == 2:
         img = img[..., None]
+    if _squares_kernel(img) if squared is None else squared:
+        h, w = img.shape[:2]
+        squares, gx, gy = np.empty((h, w)), np.empty((1, h, w)), np.empty((1, h, w))
+        weights, symmetric = _gaussian_weights()
+        jit = compiled()
+        assert jit is not None
+        jit.colour_gradient(img if img.dtype != np.bool_ else img.view(np.uint8), weights, symmetric, squares, gx[0],
+                            gy[0])  # fmt: skip
+        return squares, gx, gy, None
+    img = np.asarray(img, dtype=np.float64)
     img = np.ascontiguousarray(np.moveaxis(img, -1, 0))
     ch = ndimage.gaussian_filter(img, (0.0, 1.0, 1.0))  # no smoothing across channels
     cx = ndimage.correlate1d(ch, [-1, 0, 1], 2, None, "reflect", 0.0, 0)  # ndimage.sobel(axis=1) of each channel
@@ -512,6 +616,48 @@ def _window_peaks(mag: np.ndarray, cx: np.ndarray, cy: np.ndarray, each: np.ndar
     return rows[peak], cols[peak], bins
 
 
+def _squared_peaks(squares: np.ndarray, gx: np.ndarray, gy: np.ndarray, threshold: float,
+                   part: tuple[int, int, int, int]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """:func:`_window_peaks` from the compiled kernel's gradient (:func:`_window_gradient`): the strongest channel's
+    ``gx, gy`` (h, w) and ``squares`` = ``gx * gx + gy * gy`` for its magnitude. A pixel is above ``threshold``, and
+    at least as strong as a neighbour along its gradient, as the magnitudes say: by the sums of squares where they
+    lie more than :data:`_APART` apart (squared threshold, or the two pixels'; nothing the rounding can turn), by
+    ``hypot`` itself where they lie closer. The same edges and bins as :func:`_window_peaks`."""
+    h, w = squares.shape
+    r0, r1, c0, c1 = max(part[0], 1), min(part[1], h - 1), max(part[2], 1), min(part[3], w - 1)
+    if r1 <= r0 or c1 <= c0:
+        empty = np.zeros(0, np.int64)
+        return empty, empty, empty
+    t2 = threshold * threshold  # at least 1.6e-17: no sum of squares compared with it is near underflow
+    rows, cols = np.nonzero(squares[r0:r1, c0:c1] > t2 * (1.0 - _APART))
+    rows += r0
+    cols += c0
+    here = squares[rows, cols]
+    close = here <= t2 * (1.0 + _APART)
+    if close.any():
+        keep = ~close
+        keep[close] = np.hypot(gx[rows[close], cols[close]], gy[rows[close], cols[close]]) > threshold
+        rows, cols, here = rows[keep], cols[keep], here[keep]
+    sx, sy = gx[rows, cols], gy[rows, cols]
+    angle = np.mod(np.arctan2(sy, sx), np.pi)
+    q = (np.floor(angle / (np.pi / 4) + 0.5).astype(np.int64)) % 4
+    dv, du = np.array((0, 1, 1, 1))[q], np.array((1, 1, 0, -1))[q]  # along 0, 45, 90, 135 degrees
+
+    def at_least(nr: np.ndarray, nc: np.ndarray) -> np.ndarray:
+        """Whether each pixel's magnitude is at least its neighbour's at ``(nr, nc)``."""
+        other = squares[nr, nc]
+        out = here >= other
+        close = (here <= other * (1.0 + _APART)) & (other <= here * (1.0 + _APART))
+        if close.any():
+            mine = np.hypot(sx[close], sy[close])
+            out[close] = mine >= np.hypot(gx[nr[close], nc[close]], gy[nr[close], nc[close]])
+        return out
+
+    peak = at_least(rows - dv, cols - du) & at_least(rows + dv, cols + du)
+    bins = (np.floor(angle[peak] / (np.pi / N_BINS) + 0.5).astype(np.int64)) % N_BINS  # _orientation_bin's
+    return rows[peak], cols[peak], bins
+
+
 def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray, ebins: np.ndarray, cap: float,
                       points: tuple[np.ndarray, np.ndarray, np.ndarray], m: int) -> np.ndarray:  # fmt: skip
     """:func:`_edge_distances` of the edges at ``(rows, cols)`` (orientation bins ``ebins``) on an image of
@@ -525,6 +671,9 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
     reach = m + int(np.ceil(cap))
     dist = np.full((N_BINS, h + 2 * m, w + 2 * m), cap, np.float32)
     jit = compiled()
+    if jit is not None:  # the same steps in one call (stop 63, docs/shift63.md)
+        jit.capped_distances(rows, cols, ebins, float(cap), prow, pcol, pbins, m, dist)
+        return dist
     for b in np.unique(pbins):
         apart = (ebins - b) % N_BINS  # within one bin of b: 0, 1 or N_BINS - 1
         near = (apart <= 1) | (apart == N_BINS - 1)
@@ -535,11 +684,7 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
         if near.any():
             edges = np.zeros((r1 - r0, c1 - c0), bool)
             edges[rows[near] - r0, cols[near] - c0] = True
-            if jit is None:
-                away = ndimage.distance_transform_edt(~edges)
-            else:  # each pixel's distance to the nearest edge where that is at most the cap (scipy's), +inf farther
-                away = np.empty(edges.shape)
-                jit.near_distance(edges, float(cap), True, away)
+            away = ndimage.distance_transform_edt(~edges)
             dist[b, m + r0 : m + r1, m + c0 : m + c1] = np.minimum(away, cap, out=away)
     return dist
 
@@ -547,6 +692,10 @@ def _capped_distances(shape: tuple[int, int], rows: np.ndarray, cols: np.ndarray
 def _padded_costs(dist: np.ndarray, rows: np.ndarray, cols: np.ndarray, bins: np.ndarray, m: int) -> np.ndarray:
     """:func:`_moved_costs` on maps already padded by ``m`` (:func:`_capped_distances`; ``rows, cols`` the padded
     maps' own): each point's ``(2m+1, 2m+1)`` window of its bin's map, (2m+1, 2m+1, n)."""
+    if (jit := compiled()) is not None:  # the same values copied in one call (stop 63)
+        out = np.empty((2 * m + 1, 2 * m + 1, len(rows)), dist.dtype)
+        jit.padded_costs(dist, rows, cols, bins, m, out)
+        return out
     windows = np.lib.stride_tricks.sliding_window_view(dist, (2 * m + 1, 2 * m + 1), axis=(1, 2))
     return np.ascontiguousarray(np.moveaxis(windows[bins, rows - m, cols - m], 0, -1))
 

@@ -47,7 +47,10 @@ in :func:`symfruit.core._jit.clusters`); stop 41's :func:`symfruit.core.occlusio
 :func:`~symfruit.core._jit.thin_passes`), stop 51's :func:`symfruit.core.surface.fruit_surface`
 (:func:`symfruit.core._jit.mask_values`, :func:`~symfruit.core._jit.surface_cap`) and stop 62's curvature fit of
 :func:`~symfruit.core.surface.thin_front` (:func:`symfruit.core._jit.thin_curvature`, to rounding: its answer taken
-only where rounding cannot turn it)) then run their numpy twins, the code the kernels
+only where rounding cannot turn it), and stop 63's :func:`symfruit.core.edges.mask_shift` (its masks' outlines, their
+windows' colour gradients and distance maps: :func:`symfruit.core._jit.outline_gradient`,
+:func:`~symfruit.core._jit.colour_gradient`, :func:`~symfruit.core._jit.capped_distances`)) then run their numpy
+twins, the code the kernels
 were written from, which stays tested and gives the same results within rounding (the fits' kernels sum in another
 order than numpy; the pixel maps', the surface's and the feature transform's are the twins' to the bit; the
 observation's edge normals come from Jacobi rotations instead of LAPACK, so they agree to rounding, as the quadrics'
