@@ -68,8 +68,8 @@ class ExtractSettings(Section):
         The registration reads a band of lost depth beside something in front of the fruit (a leaf's edge: a
         time-of-flight camera invalidates the mixed pixels along every step in depth) as a junction, not as the
         fruit's silhouette, and pools the sides of every fruit's outline, also those that tell no shift (stop 62,
-        docs/leaf62.md; off: the real frames cut by a leaf are then registered 3-11 px off, but at the true shift
-        other weaknesses show).
+        docs/leaf62.md; on by default since stop 63, with ``evidence.lost_rim: bound``, which holds the depth at the
+        true shift: docs/prior63.md; off, the real frames cut by a leaf are registered 3-11 px off).
     mask_edge_px : int
         With the frame's colour image (``detect``, masks drawn as outlines: a masks file, a label array, a model; not
         the colour segmenter's): how far (pixels) the masks may sit off their fruit in the colour image, all one way
@@ -128,7 +128,7 @@ class ExtractSettings(Section):
     max_depth: float = setting(3.0, gt=0.0, le=100.0)
     erode_px: int = setting(1, ge=0, le=MAX_RADIUS_PX)
     registration_px: int = setting(20, ge=0, le=MAX_RADIUS_PX)
-    occluder_edges: bool = setting(False)
+    occluder_edges: bool = setting(True)
     mask_edge_px: int = setting(10, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
     trim_keeps_surface: bool = setting(True)

@@ -229,16 +229,21 @@ def test_a_leaf_cutting_a_third_of_the_66_mm_sphere_no_longer_runs_its_box_far_b
     38 mm below sphere 3's cut silhouette, down behind the leaf, and the box was 106 mm tall for 66 (``cut_reach:
     contour``: the bottom face pulled in by the prior's share times the contour share squared, 0.1). With ``widest``
     (the default) the part of the box beyond the outline's widest extent seen is pulled in by the prior's share
-    (0.7): within 15 mm of the diameter. The other spheres' y sides move by 1 mm at most."""
+    (0.7): within 15 mm of the diameter. The other spheres' y sides move by 1 mm at most. Both read with stop 62's
+    registration and depth fusion (``occluder_edges`` off, ``lost_rim: pull``), where the contrast was measured; the
+    defaults since stop 63 keep sphere 3 within 15 mm too."""
     from symfruit.settings import from_dict
 
-    before = from_dict({"evidence": {"cut_reach": "contour"}})
+    stop62 = {"extract": {"occluder_edges": False}, "evidence": {"lost_rim": "pull"}}
+    before = from_dict({**stop62, "evidence": {"lost_rim": "pull", "cut_reach": "contour"}})
     was = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", before, "lab-spheres-1")}
-    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, "lab-spheres-1")}
+    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", from_dict(stop62), "lab-spheres-1")}
     assert was[3][0][1] > was[3][1] + 30.0, was[3]
     assert now[3][0][1] < now[3][1] + 15.0, now[3]
     for k in (1, 2, 4):
         assert now[k][0][1] == pytest.approx(was[k][0][1], abs=1.0), (k, now[k], was[k])
+    default = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, "lab-spheres-1")}
+    assert default[3][0][1] < default[3][1] + 15.0, default[3]
 
 
 @pytest.mark.parametrize("frame_name", ["lab-spheres-0", "lab-spheres-1"])
@@ -250,15 +255,20 @@ def test_a_leaf_cutting_a_third_of_the_small_spheres_leaves_them_cubes_by_the_ci
     (54 and 47 mm), and the boxes were over the issue's 6 mm bar (frame 1: 58 x 79 x 62 and 39 x 61 x 44 mm;
     ``cut_circle: off``). The circle through the free arcs (``free``, the default) gives the prior the diameter: each a
     cube within 6 mm, its depth side within 6 mm of the unperturbed mask's diameter; the large spheres (their
-    ellipses accepted) unchanged to the bit."""
+    ellipses accepted) unchanged to the bit. Both read with stop 62's registration and depth fusion, where the
+    contrast was measured (with ``lost_rim: bound`` the prior holds these depths without the circle too); the
+    defaults since stop 63 keep spheres 3 and 4 cubes as well."""
     from symfruit.settings import from_dict
 
-    before = from_dict({"evidence": {"cut_circle": "off"}})
+    stop62 = {"extract": {"occluder_edges": False}, "evidence": {"lost_rim": "pull"}}
+    before = from_dict({**stop62, "evidence": {"lost_rim": "pull", "cut_circle": "off"}})
     was = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", before, frame_name)}
-    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, frame_name)}
+    now = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", from_dict(stop62), frame_name)}
+    default = {k: (size, d) for k, size, d in spheres(rp, "leafside5-cut", None, frame_name)}
     for k in (3, 4):
         assert np.ptp(was[k][0]) > 6.0 or abs(was[k][0][2] - was[k][1]) > 6.0, (k, was[k])
         assert np.ptp(now[k][0]) <= 6.0 and abs(now[k][0][2] - now[k][1]) <= 6.0, (k, now[k])
+        assert np.ptp(default[k][0]) <= 6.0 and abs(default[k][0][2] - default[k][1]) <= 6.0, (k, default[k])
     for k in (1, 2):
         assert np.asarray(now[k][0]).tolist() == np.asarray(was[k][0]).tolist(), (k, now[k], was[k])
 
@@ -325,21 +335,25 @@ def test_binned_2x_the_limb_is_kept_after_the_registration_and_moves_no_shift(rp
     """Stop 61 (docs/small61.md): binned 2 x 2, frame 1 registers by (1, 4) px with the colour's trim, and the
     200 mm sphere's shaded limb, which that trim takes, is given back after the registration (``extract.keep_caps``,
     the default): the same shift as with ``trim_keeps_surface`` off, the sphere 198 x 196 x 197 mm (off: 198 x 182 x
-    189), and with a pool of one worker (each mask trimmed on it, the limb given back here) the same boxes."""
+    189), and with a pool of one worker (each mask trimmed on it, the limb given back here) the same boxes. With
+    stop 62's registration (``occluder_edges`` off), where the shift was (1, 4); since stop 63 it is (0, 0)."""
     from symfruit.fruitpool import FruitPool
     from symfruit.settings import from_dict
 
     frame = read_frame(rp.FRAMES / "lab-spheres-1")
     color, depth, masks, cam = rp.PERTURBATIONS["bin2"](frame)
     binned = Frame(name="bin2", color=color, depth=depth, camera=cam, masks=masks)
-    kept = detect(binned, method="evidence")
-    off = detect(binned, method="evidence", settings=from_dict({"extract": {"trim_keeps_surface": False}}))
+    stop62 = {"extract": {"occluder_edges": False}}
+    kept = detect(binned, method="evidence", settings=from_dict(stop62))
+    off = detect(binned, method="evidence", settings=from_dict({"extract": {"occluder_edges": False,
+                                                                          "trim_keeps_surface": False}}))  # fmt: skip
     assert kept.registration == off.registration == (1, 4)
+    assert detect(binned, method="raw").registration == (0, 0)
     tall = {d.id: d.result.box.size[1] * 1000.0 for d in kept.detections}
     short = {d.id: d.result.box.size[1] * 1000.0 for d in off.detections}
     assert short[1] < 185.0 and tall[1] > 194.0
     with FruitPool(1, method=None) as pool:
-        pooled = detect(binned, method="evidence", pool=pool)
+        pooled = detect(binned, method="evidence", settings=from_dict(stop62), pool=pool)
     assert pooled.registration == kept.registration
     for a, b in zip(kept.detections, pooled.detections, strict=True):
         assert np.array_equal(a.mask, b.mask) and np.allclose(a.result.box.min, b.result.box.min, atol=1e-9)
@@ -377,19 +391,20 @@ def test_a_leaf_cutting_the_masks_moves_them_only_where_its_lost_edge_reads_as_a
 ):
     """Stop 62 (docs/leaf62.md): with a strip or a leaf 5 cm in front cutting every mask, the registration moved the
     masks 3-11 px (the real frames are registered to 0): the band of depth the camera loses along the leaf's edge
-    was read as the spheres' silhouettes. With ``extract.occluder_edges`` it is a junction and the frame keeps its
-    masks; with a pool of one worker (each mask's outline found on it) the same shift."""
+    was read as the spheres' silhouettes. With ``extract.occluder_edges`` (the default since stop 63) it is a
+    junction and the frame keeps its masks; with a pool of one worker (each mask's outline found on it) the same
+    shift."""
     from symfruit.fruitpool import FruitPool
     from symfruit.settings import from_dict
 
     frame = read_frame(rp.FRAMES / frame_name)
     color, depth, masks, cam = rp.PERTURBATIONS[name](frame)
     cut = Frame(name=name, color=color, depth=depth, camera=cam, masks=masks)
-    on = from_dict({"extract": {"occluder_edges": True}})
-    assert detect(cut, method="raw").registration == off_shift
-    assert detect(cut, method="raw", settings=on).registration == (0, 0)
+    off = from_dict({"extract": {"occluder_edges": False}})
+    assert detect(cut, method="raw", settings=off).registration == off_shift
+    assert detect(cut, method="raw").registration == (0, 0)
     with FruitPool(1, method=None) as pool:
-        assert detect(cut, method="raw", settings=on, pool=pool).registration == (0, 0)
+        assert detect(cut, method="raw", pool=pool).registration == (0, 0)
 
 
 @pytest.mark.parametrize("frame_name", ["lab-spheres-0", "lab-spheres-1"])

@@ -210,17 +210,19 @@ class EvidenceSettings(Section):
     lost_rim : {"pull", "bound"}
         How :func:`fuse_depth` reads the shapes' back face where the seen region's rim holds no points
         (:func:`rim_coverage` under 1: a time-of-flight camera's lost rim) and it lies in front of the prior's:
-        ``pull`` (the default before) as an estimate with the lost rim's error (``rim_error``) added to its
-        spread, so that it pulls the box's back towards itself; ``bound`` (stop 63, docs/prior63.md) as what it is,
-        a lower bound: a shape fitted to a cap without its rim comes out short, never deep, by up to that error, so
-        where the prior's back lies within it the prior alone decides, and beyond it the shapes' clean error pulls.
-        With the rim seen (``rim`` 1) the two are the same. On the real spheres with ``extract.occluder_edges`` (the
-        true registration) the 60 mm sphere behind a leaf or strip 53-54 -> 60-61 mm deep (its cap's cone 24-31 mm),
-        the perturbed frames' boxes over the 6 mm bar 33 -> 22 of 208. Not the default: a mask grown 2 px then boxes
-        the 60 mm sphere as a 66-67 mm cube (6.1 mm deep over, 2 -> 4 of 8); the development apple trees' depth
-        sides 4.7 -> 4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm: the Azure Kinect model
-        they are rendered through sees 3.4-3.8 mm too far there (its range bias), which the prior's back, ``front +
-        width``, keeps and the shapes' short back had offset; the model's strawberries 6.9 -> 7.0 mm.
+        ``pull`` (the default before stop 63) as an estimate with the lost rim's error (``rim_error``) added to its
+        spread, so that it pulls the box's back towards itself; ``bound`` (the default since stop 63,
+        docs/prior63.md) as what it is, a lower bound: a shape fitted to a cap without its rim comes out short,
+        never deep, by up to that error, so where the prior's back lies within it the prior alone decides, and
+        beyond it the shapes' clean error pulls. With the rim seen (``rim`` 1) the two are the same. On the real
+        spheres, with ``extract.occluder_edges`` (the true registration), the 60 mm sphere behind a leaf or strip
+        53-54 -> 60-61 mm deep (its cap's cone 24-31 mm), the perturbed frames' boxes over the 6 mm bar 33 -> 22 of
+        208, the unperturbed boxes' depth sides 2.0 -> 1.1 mm off. What it costs: a mask grown 2 px boxes the 60 mm
+        sphere as a 66-67 mm cube (6.1 mm deep over, 2 -> 4 of 8); the development apple trees' depth sides 4.7 ->
+        4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm (the Azure Kinect model they are
+        rendered through sees 3.4-3.8 mm too far there, its range bias, which the prior's back, ``front + width``,
+        keeps and the shapes' short back had offset); on lone generated fruit, whose boxes are already deep, the
+        camera models' centres 0.1-0.4 mm farther off (README "Real cameras", stop 63).
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
@@ -378,7 +380,7 @@ class EvidenceSettings(Section):
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     cut_circle: Literal["off", "free"] = setting("free")
-    lost_rim: Literal["pull", "bound"] = setting("pull")
+    lost_rim: Literal["pull", "bound"] = setting("bound")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
