@@ -244,3 +244,19 @@ def test_readme_write_rewrites_the_differing_cells_only(regen, tmp_path):
     assert not list(tmp_path.glob("*.tmp"))
     said.clear()
     assert regen.check_readme(tmp_path / "out", tmp_path, said.append) == (2, 1, 0)  # and nothing written now
+
+
+def test_readme_write_reads_a_headerless_printed_row_of_readmes_cell_count_in_readmes_columns(regen, tmp_path):
+    """Rows printed without a header (``docs/readme_rows.py``'s) whose cells are as many as README's row's are
+    README's columns: checked cell by cell and rewritten; one with fewer cells is still matched by value only."""
+    readme = "**C**\n\n| sensor | n | `raw` | `evidence` |\n|---|---|---|---|\n| D405 | 70 | 0.558 | 0.824 |\n"
+    (tmp_path / "README.md").write_text(readme)
+    (tmp_path / "out" / "p").mkdir(parents=True)
+    rows = '## c\n\nREADME table: README.md, after "**C**"\n\n| D405 | 70 | 0.558 | 0.812 |\n'
+    (tmp_path / "out" / "p" / "rows.md").write_text(rows)
+    said: list[str] = []
+    assert regen.check_readme(tmp_path / "out", tmp_path, said.append, write=True) == (0, 1, 0)
+    assert said[0] == "p | c | D405: differs: `evidence`: README 0.824, printed 0.812"
+    assert "| D405 | 70 | 0.558 | 0.812 |" in (tmp_path / "README.md").read_text()
+    said.clear()
+    assert regen.check_readme(tmp_path / "out", tmp_path, said.append) == (1, 0, 0)
