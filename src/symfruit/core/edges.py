@@ -394,7 +394,7 @@ def _outline_samples(
         a0, a1 = max(sl[0].start - 3, 0), min(sl[0].stop + 3, h)
         b0, b1 = max(sl[1].start - 3, 0), min(sl[1].stop + 3, w)
         if jit is not None:  # the same pixels and gradient, worked out at the outline alone (stop 63)
-            rows, cols, gx, gy = jit.outline_gradient(lab, k, a0, a1, b0, b1, *_gaussian_weights(1.5))
+            rows, cols, gx, gy = jit.outline_gradient(lab, k, a0, a1, b0, b1, *gaussian_weights(1.5))
             parts.append((np.full(len(rows), k), rows + a0, cols + b0, gx, gy, (k, sl)))
             continue
         mask = lab[a0:a1, b0:b1] == k
@@ -537,12 +537,12 @@ def _squared_median(values: np.ndarray, band: Callable[[float, float], np.ndarra
     return float(np.mean(exact[lo_k - below : hi_k - below + 1]))
 
 
-@functools.lru_cache(maxsize=4)
-def _gaussian_weights(sigma: float = 1.0) -> tuple[np.ndarray, bool]:
-    """The weights of ``ndimage.gaussian_filter`` at ``sigma`` (truncated at 4 sigma): its response to an impulse
-    (each weight times 1, plus zeros: exact), and whether ``ndimage.correlate1d`` takes them as symmetric (each pair
-    within the float64 epsilon: it then adds each pair before multiplying), as
-    :func:`symfruit.segment.colour._gaussian_weights`."""
+@functools.lru_cache(maxsize=8)
+def gaussian_weights(sigma: float = 1.0) -> tuple[np.ndarray, bool]:
+    """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
+    (each weight times 1, plus zeros: exact; the kernel is symmetric), and whether ``ndimage.correlate1d`` takes them
+    as symmetric (each pair within the float64 epsilon: it then adds each pair before multiplying). The compiled
+    filters that must give scipy's values to the bit take these (here and in :mod:`symfruit.segment.colour`)."""
     radius = int(4.0 * sigma + 0.5)
     impulse = np.zeros(2 * radius + 1)
     impulse[radius] = 1.0
@@ -571,7 +571,7 @@ def _window_gradient(
     if _squares_kernel(img) if squared is None else squared:
         h, w = img.shape[:2]
         squares, gx, gy = np.empty((h, w)), np.empty((1, h, w)), np.empty((1, h, w))
-        weights, symmetric = _gaussian_weights()
+        weights, symmetric = gaussian_weights()
         jit = compiled()
         assert jit is not None
         jit.colour_gradient(img if img.dtype != np.bool_ else img.view(np.uint8), weights, symmetric, squares, gx[0],

@@ -56,6 +56,7 @@ from typing import Literal, Protocol
 import numpy as np
 from scipy import ndimage
 
+from ..core.edges import gaussian_weights as _gaussian_weights
 from ..core.kernels import compiled
 from ..core.lapack import lstsq
 from ..core.limits import MAX_PIECES, check_image_size, depth_metres
@@ -1837,20 +1838,6 @@ def _gaussian(image: np.ndarray, sigma: float) -> np.ndarray:
     weights = _gaussian_weights(float(sigma))[0]
     out = ndimage.correlate1d(image, weights, 0)
     return ndimage.correlate1d(out, weights, 1, output=out)
-
-
-@functools.lru_cache(maxsize=8)
-def _gaussian_weights(sigma: float) -> tuple[np.ndarray, bool]:
-    """The weights of ``ndimage.gaussian_filter1d(x, sigma)`` (truncated at 4 sigma): its response to an impulse
-    (each weight times 1, plus zeros: exact; the kernel is symmetric), and whether ``ndimage.correlate1d`` takes them
-    as symmetric (each pair within the float64 epsilon: it then adds each pair before multiplying)."""
-    radius = int(4.0 * sigma + 0.5)
-    impulse = np.zeros(2 * radius + 1)
-    impulse[radius] = 1.0
-    weights = ndimage.gaussian_filter1d(impulse, sigma, mode="constant")
-    weights.flags.writeable = False
-    eps = float(np.finfo(np.float64).eps)
-    return weights, bool(np.all(np.abs(weights[radius + 1 :] - weights[:radius][::-1]) <= eps))
 
 
 #: Weights that leave a line as it is (``crease_sigma`` 0: no smoothing), symmetric.
