@@ -5488,10 +5488,9 @@ def _free_outline_occluders(
                     a_lost += 1
             past[rr - r0, cc - c0 + 1] = a_past
             lost[rr - r0, cc - c0 + 1] = a_lost
-    n_off = -1  # the offsets in reach nearest first, made when a point first needs them
-    dr_at = np.empty(0, np.int64)
-    dc_at = np.empty(0, np.int64)
-    nearest = np.empty((0, 0))
+    g0, g1, e0, e1 = max(r0 - k, 0), min(r1 + k, h), max(c0 - k, 0), min(c1 + k, w)
+    other = np.empty((0, 0))  # the depth above 0 off the cap (+inf elsewhere) of the box grown by k, when first needed
+    nearest = np.empty((0, 0))  # the least of it within reach of each pixel of the box without depth (NaN: not yet)
     for i in range(rows.shape[0]):
         r, c = rows[i], cols[i]
         some_lost = False
@@ -5509,41 +5508,44 @@ def _free_outline_occluders(
                     some_lost = True
         if free[i] or not some_lost:
             continue
-        if n_off < 0:
-            # the offsets in reach, nearest first (the order only makes the first found come sooner)
-            n_off = 0
-            dr_at = np.empty((2 * k + 1) ** 2, np.int64)
-            dc_at = np.empty((2 * k + 1) ** 2, np.int64)
-            d_at = np.empty((2 * k + 1) ** 2, np.int64)
-            for dr in range(-k, k + 1):
-                for dc in range(-k, k + 1):
-                    d = dr * dr + dc * dc
-                    if d <= limit and math.sqrt(float(d)) <= reach:
-                        j = n_off
-                        while j > 0 and d_at[j - 1] > d:  # insertion by distance
-                            dr_at[j], dc_at[j], d_at[j] = dr_at[j - 1], dc_at[j - 1], d_at[j - 1]
-                            j -= 1
-                        dr_at[j], dc_at[j], d_at[j] = dr, dc, d
-                        n_off += 1
-            # the nearest depth not the cap's within reach of each pixel of the box without depth (NaN: not yet)
+        if other.shape[0] == 0:
+            other = np.full((g1 - g0, e1 - e0), np.inf)
+            for r2 in range(g0, g1):
+                for c2 in range(e0, e1):
+                    if not cap[r2, c2]:
+                        z2 = depth[r2, c2]
+                        if z2 > 0:
+                            other[r2 - g0, c2 - e0] = z2
             nearest = np.full((bh, bw), np.nan)
         bound = depth[r, c] - tol
-        for j in range(n_off):
-            rr, cc = r + dr_at[j], c + dc_at[j]
-            if r0 <= rr < r1 and c0 <= cc < c1 and not cap[rr, cc] and depth[rr, cc] <= 0:
-                m2 = nearest[rr - r0, cc - c0]
-                if m2 != m2:  # first asked: the least depth above 0 about it, off the cap
-                    m2 = np.inf
-                    for q in range(n_off):
-                        r2, c2 = rr + dr_at[q], cc + dc_at[q]
-                        if 0 <= r2 < h and 0 <= c2 < w and not cap[r2, c2]:
-                            z2 = depth[r2, c2]
-                            if 0 < z2 < m2:
-                                m2 = z2
-                    nearest[rr - r0, cc - c0] = m2
-                if m2 < bound:  # an occluder's lost edge, not this silhouette's
+        for dr in range(-k, k + 1):  # the pixels without depth in reach (no pixel seen past is): is one free?
+            m = half[dr + k]
+            rr = r + dr
+            if m < 0 or rr < r0 or rr >= r1:
+                continue
+            a, b = max(c - m, c0), min(c + m + 1, c1)
+            if a >= b or lost[rr - r0, b - c0] == lost[rr - r0, a - c0]:
+                continue
+            for cc in range(a, b):
+                if cap[rr, cc] or not depth[rr, cc] <= 0:
                     continue
-                free[i] = True
+                m2 = nearest[rr - r0, cc - c0]
+                if m2 != m2:  # first asked: the least depth above 0 about it, off the cap (anywhere in the array)
+                    m2 = np.inf
+                    for dr2 in range(-k, k + 1):
+                        m3 = half[dr2 + k]
+                        r2 = rr + dr2
+                        if m3 < 0 or r2 < 0 or r2 >= h:
+                            continue
+                        for c2 in range(max(cc - m3, 0), min(cc + m3 + 1, w)):
+                            v = other[r2 - g0, c2 - e0]
+                            if v < m2:
+                                m2 = v
+                    nearest[rr - r0, cc - c0] = m2
+                if not m2 < bound:  # not an occluder's lost edge: this silhouette's
+                    free[i] = True
+                    break
+            if free[i]:
                 break
     return free
 
