@@ -5413,8 +5413,10 @@ def free_outline(
     of it (anywhere in the array) holds depth nearer than the point's own by more than ``tol`` (the twin's
     :func:`symfruit.core.surface._occluders_edge`): a lost band beside something in front is that occluder's edge.
     A gap pixel seen past (at least ``far``) counts as before; ``tol`` infinite (the default, ``extract.occluder_edges``
-    off): the former points, by the row counts. With ``tol`` finite each point looks at the gap pixels about it
-    nearest first, and each gap pixel's nearest such depth is worked out once, when first asked."""
+    off): the former points, by the row counts. With ``tol`` finite (:func:`_free_outline_occluders`; stop 63,
+    occw63) the row counts of the pixels seen past and of those without depth tell most points, and only the points
+    with a pixel without depth in reach and none seen past look at those pixels, each one's nearest such depth worked
+    out once, when first asked."""
     h, w = cap.shape
     rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
     for i in range(rows.shape[0]):
@@ -5432,7 +5434,7 @@ def free_outline(
             if d <= limit and math.sqrt(float(d)) <= reach:
                 half[dr + k] = dc
     if tol < np.inf:
-        return _free_outline_occluders(depth, cap, rows, cols, far, reach, tol, r0, r1, c0, c1, k, limit, free, half)
+        return _free_outline_occluders(depth, cap, rows, cols, far, tol, r0, r1, c0, c1, k, half, free)
     counts = np.zeros((max(r1 - r0, 0), max(c1 - c0, 0) + 1), np.int32)  # each row's gap pixels before a column
     for rr in range(r0, r1):
         acc = 0
@@ -5458,21 +5460,22 @@ def free_outline(
 
 @_njit
 def _free_outline_occluders(
-    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, tol: float,
-    r0: int, r1: int, c0: int, c1: int, k: int, limit: float, free: np.ndarray, half: np.ndarray,
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, tol: float, r0: int, r1: int,
+    c0: int, c1: int, k: int, half: np.ndarray, free: np.ndarray,
 ) -> np.ndarray:  # fmt: skip
     """:func:`free_outline` with ``tol`` finite (``extract.occluder_edges``; stop 62, leaf62): a gap pixel without
     depth counts only where no depth off the cap within ``reach`` of it is nearer than the point's own by more than
-    ``tol``; ``free`` (n,) False, filled and returned. The box ``r0:r1, c0:c1``, ``k = floor(reach)``, ``limit =
-    reach ** 2`` and ``half`` (m(dr): the offsets of row ``dr`` in reach are ``|dc| <= m(dr)``, -1 none) as
-    :func:`free_outline` has them.
+    ``tol``; ``free`` (n,) False, filled and returned. The box ``r0:r1, c0:c1``, ``k = floor(reach)`` and ``half``
+    (m(dr): the offsets of row ``dr`` in reach are ``|dc| <= m(dr)``, -1 none) as :func:`free_outline` has them.
 
     Since stop 63 (occw63) each row of the box holds two running counts, of the pixels seen past (at least ``far``)
-    and of those without depth (at most 0), as the former path's one count: a point with a pixel seen past in reach
-    is free, one with neither kind is not (the occluder test cannot make it free), both by ``2 floor(reach) + 1``
-    differences. Only the points left (a pixel without depth in reach, none seen past) look at the gap pixels about
-    them nearest first, each pixel without depth's nearest depth off the cap worked out once, when first asked
-    (stop 62's walk, which read up to some 50 pixels a point for every point): the same points."""
+    and of those without depth (at most 0), where the former path holds one: a point with a pixel seen past in
+    reach is free, one with neither kind is not (the occluder test cannot make it free), both by
+    ``2 floor(reach) + 1`` differences. Only the points left (a pixel without depth in reach, none seen past) look at
+    those pixels, row by row (the rows whose count holds one), each one's nearest depth off the cap worked out once,
+    when first asked, from the depth above 0 off the cap of the box grown by ``k`` (made when first needed). Stop
+    62's walk read up to some 50 pixels a point, nearest first, for every point: the same points (any order finds
+    whether one passes)."""
     h, w = cap.shape
     bh, bw = max(r1 - r0, 0), max(c1 - c0, 0)
     past = np.zeros((bh, bw + 1), np.int32)  # each row's pixels seen past before a column
