@@ -6891,6 +6891,66 @@ def test_free_outline_with_a_tolerance_is_the_numpy_twins(seed, noise):
     assert np.array_equal(before, former) and not (free & ~before).any()
 
 
+def _free_outline_walk(depth, cap, rows, cols, far, reach, pad, tol):
+    """Stop 62's (leaf62) ``free_outline`` with ``tol`` finite, kept as the test's reference (plain Python): each
+    point looks at every gap pixel of its box within ``reach`` (``d <= reach ** 2`` and ``sqrt(d) <= reach``); one
+    seen past (at least ``far``) makes it free, and so does one without depth (at most 0) unless a pixel off the cap
+    within ``reach`` of that pixel (anywhere in the array) holds depth above 0 nearer than the point's by more than
+    ``tol``."""
+    h, w = cap.shape
+    r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
+    r1, c1 = min(int(rows.max()) + pad + 1, h), min(int(cols.max()) + pad + 1, w)
+    k = math.floor(reach)
+    offsets = [(dr, dc) for dr in range(-k, k + 1) for dc in range(-k, k + 1)
+               if dr * dr + dc * dc <= reach * reach and math.sqrt(float(dr * dr + dc * dc)) <= reach]  # fmt: skip
+    free = np.zeros(len(rows), bool)
+    for i, (r, c) in enumerate(zip(rows.tolist(), cols.tolist(), strict=True)):
+        bound = depth[r, c] - tol
+        for dr, dc in offsets:
+            rr, cc = r + dr, c + dc
+            if not (r0 <= rr < r1 and c0 <= cc < c1) or cap[rr, cc]:
+                continue
+            z = depth[rr, cc]
+            if z >= far:
+                free[i] = True
+                break
+            if z <= 0:
+                near = [depth[rr + a, cc + b] for a, b in offsets
+                        if 0 <= rr + a < h and 0 <= cc + b < w and not cap[rr + a, cc + b]]  # fmt: skip
+                m = min([x for x in near if x > 0], default=np.inf)
+                if not m < bound:
+                    free[i] = True
+                    break
+    return free
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.5), st.integers(0, 8), st.floats(0.0, 0.2))
+def test_free_outline_with_a_tolerance_is_stop_62s_walk(seed, reach, pad, tol):
+    """``free_outline`` with ``tol`` finite (stop 63, occw63: the row counts of pixels seen past and without depth
+    first, the occluder test on the points left) on random caps over depth with holes, pixels behind, in front and
+    NaN (the point's own too), any reach, pad and tolerance, at the outline's points or at points anywhere: stop
+    62's walk's points (:func:`_free_outline_walk`), bit for bit."""
+    from symfruit.core.raster import interior
+
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(2, 50, 2))
+    cap = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
+    if not cap.any():
+        cap[0, 0] = True
+    rows, cols = np.nonzero(cap & ~interior(cap))
+    if rng.random() < 0.3:  # points anywhere, repeated too
+        n = int(rng.integers(1, 40))
+        rows, cols = rng.integers(0, h, n).astype(np.int64), rng.integers(0, w, n).astype(np.int64)
+    depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
+    depth[depth < 0.1] = 0.0 if rng.random() < 0.8 else -0.2
+    depth[rng.random((h, w)) < 0.02] = np.nan
+    far = float(rng.uniform(0.45, 0.6))
+    free = _jit.free_outline(depth, cap, rows, cols, far, reach, pad, tol)
+    want = _free_outline_walk(depth, cap, rows, cols, far, reach, pad, tol)
+    assert free.dtype == want.dtype and np.array_equal(free, want)
+
+
 def test_free_outline_reads_a_lost_band_beside_something_in_front_as_a_junction():
     """A cap (columns 8-13 of a 12 x 18 window) at 0.5 m; beyond its right side no depth (a silhouette); beyond its
     left side two columns without depth, then a leaf over columns 0-5. With the leaf at 0.45 m (in front) the left

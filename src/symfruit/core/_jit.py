@@ -5413,8 +5413,10 @@ def free_outline(
     of it (anywhere in the array) holds depth nearer than the point's own by more than ``tol`` (the twin's
     :func:`symfruit.core.surface._occluders_edge`): a lost band beside something in front is that occluder's edge.
     A gap pixel seen past (at least ``far``) counts as before; ``tol`` infinite (the default, ``extract.occluder_edges``
-    off): the former points, by the row counts. With ``tol`` finite each point looks at the gap pixels about it
-    nearest first, and each gap pixel's nearest such depth is worked out once, when first asked."""
+    off): the former points, by the row counts. With ``tol`` finite (:func:`_free_outline_occluders`; stop 63,
+    occw63) the row counts of the pixels seen past and of those without depth tell most points, and only the points
+    with a pixel without depth in reach and none seen past look at those pixels, each one's nearest such depth worked
+    out once, when first asked."""
     h, w = cap.shape
     rmin, rmax, cmin, cmax = rows[0], rows[0], cols[0], cols[0]
     for i in range(rows.shape[0]):
@@ -5425,14 +5427,14 @@ def free_outline(
     k = math.floor(reach)
     limit = reach * reach
     free = np.zeros(rows.shape[0], np.bool_)
-    if tol < np.inf:
-        return _free_outline_occluders(depth, cap, rows, cols, far, reach, tol, r0, r1, c0, c1, k, limit, free)
     half = np.full(2 * k + 1, -1, np.int64)  # m(dr): the offsets of row dr in reach are |dc| <= m(dr) (-1: none)
     for dr in range(-k, k + 1):
         for dc in range(k + 1):
             d = dr * dr + dc * dc
             if d <= limit and math.sqrt(float(d)) <= reach:
                 half[dr + k] = dc
+    if tol < np.inf:
+        return _free_outline_occluders(depth, cap, rows, cols, far, tol, r0, r1, c0, c1, k, half, free)
     counts = np.zeros((max(r1 - r0, 0), max(c1 - c0, 0) + 1), np.int32)  # each row's gap pixels before a column
     for rr in range(r0, r1):
         acc = 0
@@ -5458,57 +5460,96 @@ def free_outline(
 
 @_njit
 def _free_outline_occluders(
-    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, reach: float, tol: float,
-    r0: int, r1: int, c0: int, c1: int, k: int, limit: float, free: np.ndarray,
+    depth: np.ndarray, cap: np.ndarray, rows: np.ndarray, cols: np.ndarray, far: float, tol: float, r0: int, r1: int,
+    c0: int, c1: int, k: int, half: np.ndarray, free: np.ndarray,
 ) -> np.ndarray:  # fmt: skip
-    """:func:`free_outline` with ``tol`` finite (``extract.occluder_edges``; stop 62, leaf62): each point looks at the
-    gap pixels about it nearest first, a gap pixel without depth counting only where no depth off the cap within
-    ``reach`` of it is nearer than the point's own by more than ``tol`` (each gap pixel's worked out once, when first
-    asked); ``free`` (n,) False, filled and returned. The box ``r0:r1, c0:c1``, ``k = floor(reach)``, ``limit =
-    reach ** 2`` as :func:`free_outline` has them."""
+    """:func:`free_outline` with ``tol`` finite (``extract.occluder_edges``; stop 62, leaf62): a gap pixel without
+    depth counts only where no depth off the cap within ``reach`` of it is nearer than the point's own by more than
+    ``tol``; ``free`` (n,) False, filled and returned. The box ``r0:r1, c0:c1``, ``k = floor(reach)`` and ``half``
+    (m(dr): the offsets of row ``dr`` in reach are ``|dc| <= m(dr)``, -1 none) as :func:`free_outline` has them.
+
+    Since stop 63 (occw63) each row of the box holds two running counts, of the pixels seen past (at least ``far``)
+    and of those without depth (at most 0), where the former path holds one: a point with a pixel seen past in
+    reach is free, one with neither kind is not (the occluder test cannot make it free), both by
+    ``2 floor(reach) + 1`` differences. Only the points left (a pixel without depth in reach, none seen past) look at
+    those pixels, row by row (the rows whose count holds one), each one's nearest depth off the cap worked out once,
+    when first asked, from the depth above 0 off the cap of the box grown by ``k`` (made when first needed). Stop
+    62's walk read up to some 50 pixels a point, nearest first, for every point: the same points (any order finds
+    whether one passes)."""
     h, w = cap.shape
-    # the offsets in reach, nearest first (the order only makes the first found come sooner)
-    n_off = 0
-    dr_at = np.empty((2 * k + 1) ** 2, np.int64)
-    dc_at = np.empty((2 * k + 1) ** 2, np.int64)
-    d_at = np.empty((2 * k + 1) ** 2, np.int64)
-    for dr in range(-k, k + 1):
-        for dc in range(-k, k + 1):
-            d = dr * dr + dc * dc
-            if d <= limit and math.sqrt(float(d)) <= reach:
-                j = n_off
-                while j > 0 and d_at[j - 1] > d:  # insertion by distance
-                    dr_at[j], dc_at[j], d_at[j] = dr_at[j - 1], dc_at[j - 1], d_at[j - 1]
-                    j -= 1
-                dr_at[j], dc_at[j], d_at[j] = dr, dc, d
-                n_off += 1
-    # the nearest depth not the cap's within reach of each gap pixel of the box (NaN: not yet worked out)
-    nearest = np.full((r1 - r0, c1 - c0), np.nan)
-    for i in range(rows.shape[0]):
-        r, c = rows[i], cols[i]
-        bound = depth[r, c] - tol
-        for j in range(n_off):
-            rr, cc = r + dr_at[j], c + dc_at[j]
-            if r0 <= rr < r1 and c0 <= cc < c1 and not cap[rr, cc]:
+    bh, bw = max(r1 - r0, 0), max(c1 - c0, 0)
+    past = np.zeros((bh, bw + 1), np.int32)  # each row's pixels seen past before a column
+    lost = np.zeros((bh, bw + 1), np.int32)  # and its pixels without depth
+    for rr in range(r0, r1):
+        a_past, a_lost = 0, 0
+        for cc in range(c0, c1):
+            if not cap[rr, cc]:
                 z = depth[rr, cc]
                 if z >= far:
+                    a_past += 1
+                elif z <= 0:
+                    a_lost += 1
+            past[rr - r0, cc - c0 + 1] = a_past
+            lost[rr - r0, cc - c0 + 1] = a_lost
+    g0, g1, e0, e1 = max(r0 - k, 0), min(r1 + k, h), max(c0 - k, 0), min(c1 + k, w)
+    other = np.empty((0, 0))  # the depth above 0 off the cap (+inf elsewhere) of the box grown by k, when first needed
+    nearest = np.empty((0, 0))  # the least of it within reach of each pixel of the box without depth (NaN: not yet)
+    for i in range(rows.shape[0]):
+        r, c = rows[i], cols[i]
+        some_lost = False
+        for dr in range(-k, k + 1):
+            m = half[dr + k]
+            rr = r + dr
+            if m < 0 or rr < r0 or rr >= r1:
+                continue
+            a, b = max(c - m, c0), min(c + m + 1, c1)
+            if a < b:
+                if past[rr - r0, b - c0] > past[rr - r0, a - c0]:
                     free[i] = True
                     break
-                if z <= 0:
-                    m = nearest[rr - r0, cc - c0]
-                    if m != m:  # first asked: the least depth above 0 about it, off the cap
-                        m = np.inf
-                        for q in range(n_off):
-                            r2, c2 = rr + dr_at[q], cc + dc_at[q]
-                            if 0 <= r2 < h and 0 <= c2 < w and not cap[r2, c2]:
-                                z2 = depth[r2, c2]
-                                if 0 < z2 < m:
-                                    m = z2
-                        nearest[rr - r0, cc - c0] = m
-                    if m < bound:  # an occluder's lost edge, not this silhouette's
-                        continue
+                if lost[rr - r0, b - c0] > lost[rr - r0, a - c0]:
+                    some_lost = True
+        if free[i] or not some_lost:
+            continue
+        if other.shape[0] == 0:
+            other = np.full((g1 - g0, e1 - e0), np.inf)
+            for r2 in range(g0, g1):
+                for c2 in range(e0, e1):
+                    if not cap[r2, c2]:
+                        z2 = depth[r2, c2]
+                        if z2 > 0:
+                            other[r2 - g0, c2 - e0] = z2
+            nearest = np.full((bh, bw), np.nan)
+        bound = depth[r, c] - tol
+        for dr in range(-k, k + 1):  # the pixels without depth in reach (no pixel seen past is): is one free?
+            m = half[dr + k]
+            rr = r + dr
+            if m < 0 or rr < r0 or rr >= r1:
+                continue
+            a, b = max(c - m, c0), min(c + m + 1, c1)
+            if a >= b or lost[rr - r0, b - c0] == lost[rr - r0, a - c0]:
+                continue
+            for cc in range(a, b):
+                if cap[rr, cc] or not depth[rr, cc] <= 0:
+                    continue
+                m2 = nearest[rr - r0, cc - c0]
+                if m2 != m2:  # first asked: the least depth above 0 about it, off the cap (anywhere in the array)
+                    m2 = np.inf
+                    for dr2 in range(-k, k + 1):
+                        m3 = half[dr2 + k]
+                        r2 = rr + dr2
+                        if m3 < 0 or r2 < 0 or r2 >= h:
+                            continue
+                        for c2 in range(max(cc - m3, 0), min(cc + m3 + 1, w)):
+                            v = other[r2 - g0, c2 - e0]
+                            if v < m2:
+                                m2 = v
+                    nearest[rr - r0, cc - c0] = m2
+                if not m2 < bound:  # not an occluder's lost edge: this silhouette's
                     free[i] = True
                     break
+            if free[i]:
+                break
     return free
 
 
