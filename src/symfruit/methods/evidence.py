@@ -811,8 +811,11 @@ def fuse_depth(
             read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, ellipse)
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
-    model = width * (s.shape_error + s.rim_error * (1.0 - rim))
-    fit_sd = math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
+
+    def shapes_sd(model: float) -> float:  # the shapes' back-face deviation with ``model`` widths of model error
+        return math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
+
+    fit_sd = shapes_sd(width * (s.shape_error + s.rim_error * (1.0 - rim)))
     if s.depth_ratio_sd <= 0 or width <= 0:
         return box, fit_sd, width
     front = float(box.min[2])
@@ -826,8 +829,7 @@ def fuse_depth(
         # farther than that beyond), not where. Inside that range the prior decides; beyond it the fit's clean
         # error pulls, as a whole rim's fit does (rim 1: the same as ``pull``).
         fit_back = min(prior_back, fit_back + width * s.rim_error * (1.0 - rim))
-        clean = (s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + (width * s.shape_error) ** 2
-        fit_sd = math.sqrt(float(clean))
+        fit_sd = shapes_sd(width * s.shape_error)
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
     fused = (a * fit_back + b * prior_back) / (a + b)
     # the prior's share of the back face: how far it moved the shapes' towards its own (b / (a + b) where the
