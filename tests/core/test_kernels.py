@@ -6805,19 +6805,15 @@ def test_cap_outline_is_the_caps_outline_and_its_free_points_to_the_bit(seed, le
     assert free.dtype == want_free.dtype and np.array_equal(free, want_free)
 
 
-@settings(max_examples=150, deadline=None)
-@given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.5), st.integers(0, 8))
-def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, pad):
-    """``free_outline`` (stop 60: each point's look at the gap pixels about it; stop 62: by each row's running count
-    of gap pixels) on random caps over depth with holes, pixels behind and in front, any reach (whole or not) and
-    pad (below the reach too), at the outline's points or at points anywhere: the points within ``reach`` of the gap
-    made on the points' box grown by ``pad``, as the twin finds them (``within``'s numpy dilation of that gap, read
-    at the points), bit for bit."""
+def _free_outline_case(
+    rng: np.random.Generator, size: int, *, negative: bool = False
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """``(depth, cap, rows, cols, far)`` for the ``free_outline`` tests: a random cap (a blob or scattered pixels) up to
+    ``size`` pixels a side over depth with holes, pixels behind and in front and NaN, its outline's points or (three
+    times in ten) points anywhere, repeated too; with ``negative`` the holes are -0.2 m one time in five (else 0)."""
     from symfruit.core.raster import interior
-    from symfruit.core.surface import within
 
-    rng = np.random.default_rng(seed)
-    h, w = (int(x) for x in rng.integers(2, 70, 2))
+    h, w = (int(x) for x in rng.integers(2, size, 2))
     cap = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
     if not cap.any():
         cap[0, 0] = True
@@ -6826,9 +6822,22 @@ def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, p
         n = int(rng.integers(1, 40))
         rows, cols = rng.integers(0, h, n).astype(np.int64), rng.integers(0, w, n).astype(np.int64)
     depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
-    depth[depth < 0.1] = 0.0
+    depth[depth < 0.1] = -0.2 if negative and rng.random() >= 0.8 else 0.0
     depth[rng.random((h, w)) < 0.02] = np.nan
-    far = float(rng.uniform(0.45, 0.6))
+    return depth, cap, rows, cols, float(rng.uniform(0.45, 0.6))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.floats(0.0, 6.5), st.integers(0, 8))
+def test_free_outline_is_the_gaps_distance_map_read_at_the_points(seed, reach, pad):
+    """``free_outline`` (stop 60: each point's look at the gap pixels about it; stop 62: by each row's running count
+    of gap pixels) on random caps over depth with holes, pixels behind and in front, any reach (whole or not) and
+    pad (below the reach too), at the outline's points or at points anywhere: the points within ``reach`` of the gap
+    made on the points' box grown by ``pad``, as the twin finds them (``within``'s numpy dilation of that gap, read
+    at the points), bit for bit."""
+    from symfruit.core.surface import within
+
+    depth, cap, rows, cols, far = _free_outline_case(np.random.default_rng(seed), 70)
     free = _jit.free_outline(depth, cap, rows, cols, far, reach, pad)
     r0, c0 = max(int(rows.min()) - pad, 0), max(int(cols.min()) - pad, 0)
     box = (slice(r0, int(rows.max()) + pad + 1), slice(c0, int(cols.max()) + pad + 1))
@@ -6931,21 +6940,7 @@ def test_free_outline_with_a_tolerance_is_stop_62s_walk(seed, reach, pad, tol):
     first, the occluder test on the points left) on random caps over depth with holes, pixels behind, in front and
     NaN (the point's own too), any reach, pad and tolerance, at the outline's points or at points anywhere: stop
     62's walk's points (:func:`_free_outline_walk`), bit for bit."""
-    from symfruit.core.raster import interior
-
-    rng = np.random.default_rng(seed)
-    h, w = (int(x) for x in rng.integers(2, 50, 2))
-    cap = _blob_mask(rng, h, w) if rng.random() < 0.5 else rng.random((h, w)) < rng.uniform(0.3, 0.9)
-    if not cap.any():
-        cap[0, 0] = True
-    rows, cols = np.nonzero(cap & ~interior(cap))
-    if rng.random() < 0.3:  # points anywhere, repeated too
-        n = int(rng.integers(1, 40))
-        rows, cols = rng.integers(0, h, n).astype(np.int64), rng.integers(0, w, n).astype(np.int64)
-    depth = rng.choice([0.0, 0.45, 0.5, 0.55, 0.7], size=(h, w)) + rng.normal(0, 0.01, (h, w))
-    depth[depth < 0.1] = 0.0 if rng.random() < 0.8 else -0.2
-    depth[rng.random((h, w)) < 0.02] = np.nan
-    far = float(rng.uniform(0.45, 0.6))
+    depth, cap, rows, cols, far = _free_outline_case(np.random.default_rng(seed), 50, negative=True)
     free = _jit.free_outline(depth, cap, rows, cols, far, reach, pad, tol)
     want = _free_outline_walk(depth, cap, rows, cols, far, reach, pad, tol)
     assert free.dtype == want.dtype and np.array_equal(free, want)
