@@ -5447,15 +5447,25 @@ def free_outline(
     for i in range(rows.shape[0]):
         r, c = rows[i], cols[i]
         for dr in range(-k, k + 1):
-            m = half[dr + k]
+            a, b = _reach_span(half, k, dr, r, c, r0, r1, c0, c1)
             rr = r + dr
-            if m < 0 or rr < r0 or rr >= r1:
-                continue
-            a, b = max(c - m, c0), min(c + m + 1, c1)
             if a < b and counts[rr - r0, b - c0] > counts[rr - r0, a - c0]:
                 free[i] = True
                 break
     return free
+
+
+@_njit_inlined
+def _reach_span(
+    half: np.ndarray, k: int, dr: int, r: int, c: int, r0: int, r1: int, c0: int, c1: int
+) -> tuple[int, int]:
+    """The columns ``[a, b)`` of row ``r + dr`` within the box ``r0:r1, c0:c1`` in reach of the point ``(r, c)``
+    (``half`` and ``k`` as :func:`free_outline` makes them); ``a >= b`` where none is."""
+    m = half[dr + k]
+    rr = r + dr
+    if m < 0 or rr < r0 or rr >= r1:
+        return 0, 0
+    return max(c - m, c0), min(c + m + 1, c1)
 
 
 @_njit
@@ -5498,11 +5508,8 @@ def _free_outline_occluders(
         r, c = rows[i], cols[i]
         some_lost = False
         for dr in range(-k, k + 1):
-            m = half[dr + k]
+            a, b = _reach_span(half, k, dr, r, c, r0, r1, c0, c1)
             rr = r + dr
-            if m < 0 or rr < r0 or rr >= r1:
-                continue
-            a, b = max(c - m, c0), min(c + m + 1, c1)
             if a < b:
                 if past[rr - r0, b - c0] > past[rr - r0, a - c0]:
                     free[i] = True
@@ -5522,11 +5529,8 @@ def _free_outline_occluders(
             nearest = np.full((bh, bw), np.nan)
         bound = depth[r, c] - tol
         for dr in range(-k, k + 1):  # the pixels without depth in reach (no pixel seen past is): is one free?
-            m = half[dr + k]
+            a, b = _reach_span(half, k, dr, r, c, r0, r1, c0, c1)
             rr = r + dr
-            if m < 0 or rr < r0 or rr >= r1:
-                continue
-            a, b = max(c - m, c0), min(c + m + 1, c1)
             if a >= b or lost[rr - r0, b - c0] == lost[rr - r0, a - c0]:
                 continue
             for cc in range(a, b):
