@@ -1,7 +1,5 @@
 """numpy.linalg's LAPACK calls without their wrappers (core.lapack): the same values to the bit, the same errors."""
 
-import math
-
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -142,76 +140,3 @@ def test_surely_positive_known_answers():
     assert not lapack.surely_positive3(np.eye(2))
     assert not lapack.surely_positive3(np.eye(3, dtype=np.float32))
     assert not lapack.surely_positive3(np.eye(3) * 1e-95)
-
-
-# --- stop 64, comp64: a 2x2 eigh by dsyevd's closed form -------------------------------------------------------------
-
-_ULP = 2.0**-53
-
-
-def _plain(draw: st.DrawFn) -> float:
-    """A float of either sign within 1e-90 .. 1e90 in size, or a zero of either sign."""
-    if draw(st.integers(0, 9)) == 0:
-        return draw(st.sampled_from([0.0, -0.0]))
-    return draw(st.sampled_from([1.0, -1.0])) * draw(st.floats(1.0, 10.0)) * 10.0 ** draw(st.integers(-90, 89))
-
-
-@st.composite
-def _matrix2(draw: st.DrawFn) -> tuple[float, float, float]:
-    """``(a00, a10, a11)``: independent values, equal or opposite diagonals, small matrices of halves (ties, zeros,
-    equal magnitudes), or an off-diagonal near one of dsteqr's split thresholds (``sqrt|a00| sqrt|a11| eps``, then
-    ``e^2`` against ``eps^2 |a00| |a11|``)."""
-    a, b, c = _plain(draw), _plain(draw), _plain(draw)
-    kind = draw(st.integers(0, 5))
-    if kind == 1:
-        c = a
-    elif kind == 2:
-        c = -a
-    elif kind == 3:
-        a, b, c = (0.5 * draw(st.integers(-4, 4)) for _ in range(3))
-    elif kind in (4, 5):  # around either threshold, of either sign
-        near = (math.sqrt(abs(a)) * math.sqrt(abs(c))) * _ULP * draw(st.floats(0.25, 4.0 if kind == 4 else 1e4))
-        b = draw(st.sampled_from([1.0, -1.0])) * near if near > 0.0 else b
-    return a, b, c
-
-
-@settings(max_examples=3000, deadline=None)
-@given(_matrix2(), st.floats(-1e3, 1e3))
-def test_eigh2_is_numpys_eigh_to_the_bit(abc, upper):
-    """:func:`lapack._eigh2` (and :func:`lapack.eigh` of a 2x2 matrix) against ``np.linalg.eigh``: the same values and
-    vectors to the bit, zeros' signs included; the upper triangle is not read; None only beyond the plain range."""
-    a, b, c = abc
-    m = np.array([[a, upper], [b, c]])
-    want = np.linalg.eigh(m)
-    got = lapack._eigh2(m)
-    if got is None:  # only beyond the plain range (a threshold's off-diagonal may fall below it)
-        assert not all(v == 0.0 or 1e-100 < abs(v) < 1e100 for v in abc)
-    else:
-        assert _same(got[0], want[0]) and _same(got[1], want[1])
-        assert got[1].flags.c_contiguous and got[1].flags.writeable
-    assert all(_same(x, y) for x, y in zip(lapack.eigh(m), want, strict=True))
-
-
-def test_eigh2_known_answers():
-    """Cases a closed form gets wrong by a bit: ``x**2`` by Python's ``pow`` (this one rounds otherwise than the
-    product), the QL and QR sweeps' split tests (the same matrix both ways round), a diagonal matrix to sort, zeros;
-    and None (LAPACK asked) beyond the plain range or for a value not finite."""
-    cases = [
-        (0.00014355103579567248, -3.990929287166969e-05, 0.00022483332461465728),
-        (0.6031856242596422, -0.7863271781416633, -1.4506275457587698),
-        (-1.093187234851072, -1.3329088387526653, -0.5119743923779423),
-        (3.0, 0.0, 1.0), (1.0, -0.0, 1.0), (0.0, 0.0, 0.0), (-0.0, 0.0, -0.0), (2.0, 1.0, 2.0), (1.0, 1.0, -1.0),
-    ]  # fmt: skip
-    for a, c in ((1.0, 4.0), (4.0, 1.0), (1e-3, 7e5), (-2.0, 3.0)):
-        edge = math.sqrt(abs(a)) * math.sqrt(abs(c)) * _ULP
-        for k in (0.5, 1.0, 1.0 + 2**-50, 2.0, 1e3):
-            cases += [(a, k * edge, c), (c, -k * edge, a)]
-    for a, b, c in cases:
-        m = np.array([[a, 0.0], [b, c]])
-        want, got = np.linalg.eigh(m), lapack._eigh2(m)
-        assert got is not None and _same(got[0], want[0]) and _same(got[1], want[1]), (a, b, c)
-    for bad in (1e-120, 1e120, np.nan, np.inf):
-        m = np.array([[1.0, 0.0], [bad, 2.0]])
-        assert lapack._eigh2(m) is None
-        assert all(_same(x, y) for x, y in zip(lapack.eigh(m), np.linalg.eigh(m), strict=True))
-    assert lapack.eigh(np.eye(2))[0].tolist() == [1.0, 1.0]

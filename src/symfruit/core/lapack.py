@@ -16,8 +16,6 @@ LAPACK's 3x3 ``solve``), or through ``np.errstate`` where this numpy has no such
 from __future__ import annotations
 
 import importlib
-import math
-import platform
 from collections.abc import Callable
 from typing import Any, NoReturn
 
@@ -125,102 +123,12 @@ def eig_real(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def eigh(a: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """``np.linalg.eigh(a)`` (the lower triangle): ``(values, vectors)``, the same values and errors; a 2x2 matrix
-    by :func:`_eigh2`'s closed form where it repeats LAPACK (issue 19, stop 64)."""
+    """``np.linalg.eigh(a)`` (the lower triangle): ``(values, vectors)``, the same values and errors."""
     if _LAPACK is None or not _square(a):
         values, vectors = np.linalg.eigh(a)
         return values, vectors
-    if a.shape[0] == 2 and _CLOSED_FORMS and (found := _eigh2(a)) is not None:
-        return found
     values, vectors = _call(_unconverged, _LAPACK.eigh_lo, "d->dd", a)
     return values, vectors
-
-
-#: Whether :func:`eigh` takes :func:`_eigh2`'s closed form for a 2x2 matrix: on x86-64, where numpy's LAPACK
-#: (OpenBLAS's Fortran, built for the baseline instruction set) fuses no multiply-add; another architecture's compiler
-#: may fuse them (gfortran on arm64 does by default), so LAPACK is asked there.
-_CLOSED_FORMS = platform.machine().lower() in ("x86_64", "amd64")
-
-#: LAPACK's ``dlamch("E")`` (the unit roundoff), its square, and ``dlamch("S")`` (the least normal number).
-_ULP, _ULP2, _SAFMIN = 2.0**-53, 2.0**-106, float(np.finfo(np.float64).tiny)
-
-
-def _eigh2(a: np.ndarray) -> tuple[np.ndarray, np.ndarray] | None:
-    """``np.linalg.eigh(a)`` of a 2x2 float64 ``a`` (its lower triangle ``a00, a10, a11``) as LAPACK's ``dsyevd``
-    works it out, in Python floats (issue 19, stop 64, docs/comp64.md: about 2 us against 6-8 us for the LAPACK call
-    in a frame, where its code is out of the caches). None where a value is not finite, or neither 0 nor within
-    1e-100 .. 1e100 in size (where ``dsyevd`` or ``dsteqr`` would scale the matrix): ask LAPACK there.
-
-    For n = 2, ``dsytrd``'s one reflector is the identity (``dlarfg`` of one element), so the tridiagonal matrix is
-    ``d = (a00, a11)``, ``e = a10`` and ``dormtr`` leaves ``dstedc``'s vectors as they are; ``dstedc`` hands a matrix
-    this small to ``dsteqr``. That splits off an ``e`` of 0 or at most ``sqrt|d0| sqrt|d1| eps``, else an ``e^2`` at
-    most ``eps^2 |d| |d'| + safmin`` (the factors in the order of its QL or QR sweep, chosen by which ``|d|`` is the
-    smaller); otherwise it takes the 2x2 block's eigensystem from ``dlaev2`` and turns the identity by its rotation
-    (``dlasr``). Then a selection sort puts the lesser value first, swapping the vectors with them. Each step here is
-    that step's operations in its order (``x**2`` as ``x * x``, as gfortran compiles it: Python's ``**`` rounds
-    through ``pow``, which differs from the product in about 3 of 100,000 cases), checked against numpy bit for bit
-    (signs of zeros too) by the tests."""
-    (d0, _), (e, d1) = a.tolist()
-    for v in (d0, e, d1):
-        if not (v == 0.0 or 1e-100 < abs(v) < 1e100):
-            return None
-    z00, z01, z10, z11 = 1.0, 0.0, 0.0, 1.0
-    ae, f0, f1 = abs(e), abs(d0), abs(d1)
-    if not (ae == 0.0 or ae <= (math.sqrt(f0) * math.sqrt(f1)) * _ULP):
-        # dsteqr's QR sweep where |d1| < |d0|, else its QL sweep: the same 2x2 block, its test's factors swapped
-        bound = (_ULP2 * f1) * f0 + _SAFMIN if f1 < f0 else (_ULP2 * f0) * f1 + _SAFMIN
-        if not ae * ae <= bound:
-            d0, d1, c, s = _laev2(d0, e, d1)
-            t = z01
-            z01 = c * t - s * z00
-            z00 = s * t + c * z00
-            t = z11
-            z11 = c * t - s * z10
-            z10 = s * t + c * z10
-    if d1 < d0:
-        d0, d1, z00, z01, z10, z11 = d1, d0, z01, z00, z11, z10
-    return np.array((d0, d1)), np.array(((z00, z01), (z10, z11)))
-
-
-def _laev2(a: float, b: float, c: float) -> tuple[float, float, float, float]:
-    """LAPACK's ``dlaev2(a, b, c)``: ``(rt1, rt2, cs1, sn1)``, the eigenvalues of ``[[a, b], [b, c]]`` (the larger
-    in size first) and the unit eigenvector ``(cs1, sn1)`` of ``rt1``, its operations in its order."""
-    sm, df, tb = a + c, a - c, b + b
-    adf, ab = abs(df), abs(tb)
-    acmx, acmn = (a, c) if abs(a) > abs(c) else (c, a)
-    if adf > ab:
-        q = ab / adf
-        rt = adf * math.sqrt(1.0 + q * q)
-    elif adf < ab:
-        q = adf / ab
-        rt = ab * math.sqrt(1.0 + q * q)
-    else:
-        rt = ab * math.sqrt(2.0)
-    if sm < 0.0:
-        rt1, sgn1 = 0.5 * (sm - rt), -1
-        rt2 = (acmx / rt1) * acmn - (b / rt1) * b
-    elif sm > 0.0:
-        rt1, sgn1 = 0.5 * (sm + rt), 1
-        rt2 = (acmx / rt1) * acmn - (b / rt1) * b
-    else:
-        rt1, rt2, sgn1 = 0.5 * rt, -0.5 * rt, 1
-    if df >= 0.0:
-        cs, sgn2 = df + rt, 1
-    else:
-        cs, sgn2 = df - rt, -1
-    if abs(cs) > ab:
-        ct = -tb / cs
-        sn1 = 1.0 / math.sqrt(1.0 + ct * ct)
-        cs1 = ct * sn1
-    elif ab == 0.0:
-        cs1, sn1 = 1.0, 0.0
-    else:
-        tn = -cs / tb
-        cs1 = 1.0 / math.sqrt(1.0 + tn * tn)
-        sn1 = tn * cs1
-    if sgn1 == sgn2:
-        cs1, sn1 = -sn1, cs1
-    return rt1, rt2, cs1, sn1
 
 
 def eigvalsh(a: np.ndarray) -> np.ndarray:
