@@ -275,7 +275,7 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
         drawn, drawn_boxes = labels, boxes
         if frame.color is not None:  # in the colour camera's pixels, before the masks move onto the depth image
             # by the colour alone: the fruit's own cap keeps what it may after the registration (_kept_caps)
-            labels, colour_trimmed = _trim_labels(frame.color, labels, settings.extract, boxes)
+            labels, colour_trimmed = _trim_labels(frame, labels, settings.extract, boxes)
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
@@ -519,8 +519,11 @@ class _Masks:
         """Mask ``k``'s pixels its colour trimming drops (None: none) and its box after it (None: none left)."""
         if self.color is None or self.settings.colour_trim_px <= 0:
             return None, sl
-        # by the colour alone, as _trim_labels: the fruit's own cap keeps what it may after the registration
-        if (dropped := trim_mask(self.color, self.labels, k, sl, self.settings)) is None:
+        # by the colour, as _trim_labels (the depth read only for what lies in front outside the mask): the fruit's
+        # own cap keeps what it may after the registration
+        front = self.depth if self.settings.trim_front_ring else None
+        if (dropped := trim_mask(self.color, self.labels, k, sl, self.settings, focal=self.focal,
+                                 front_depth=front)) is None:  # fmt: skip
             return None, sl
         return dropped, _box_of(_without(self.labels[sl] == k, sl[0].start, sl[1].start, dropped), sl)
 
@@ -634,12 +637,22 @@ def _moved_boxes(moved: np.ndarray, drawn: list[tuple[slice, slice] | None],
 
 
 def _trim_labels(
-    color: np.ndarray, labels: np.ndarray, settings: ExtractSettings, boxes: list[tuple[slice, slice] | None]
+    frame: Frame, labels: np.ndarray, settings: ExtractSettings, boxes: list[tuple[slice, slice] | None]
 ) -> tuple[np.ndarray, set[int]]:
-    """:func:`~symfruit.extract.trim_labels` by the colour alone (the same labels), and the masks it took pixels
-    from."""
+    """:func:`~symfruit.extract.trim_labels` of the frame's colour (the depth read only for what lies in front of a
+    fruit outside its mask, ``extract.trim_front_ring``), and the masks it took pixels from."""
     trimmed: set[int] = set()
-    return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed), trimmed
+    assert frame.color is not None
+    front, focal = _front_depth(frame, settings)
+    return trim_labels(frame.color, labels, settings, boxes=boxes, trimmed=trimmed, front_depth=front,
+                       focal=focal), trimmed  # fmt: skip
+
+
+def _front_depth(frame: Frame, settings: ExtractSettings) -> tuple[np.ndarray | None, float]:
+    """The depth and focal :func:`~symfruit.extract.trim_mask` reads for ``extract.trim_front_ring`` (None: off)."""
+    if not settings.trim_front_ring:
+        return None, 0.0
+    return frame.depth, float(np.sqrt(frame.camera.fx * frame.camera.fy))
 
 
 def _kept_caps(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],
