@@ -600,10 +600,7 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198). Given
     ``front_depth`` (the frame's, as ``depth``) with ``s.trim_front_ring``, the colour's ring outside the mask leaves
     out what lies in front of the fruit (:func:`front_ring`)."""
-    h, w = labels.shape
-    pad = WIDER[-1] * s.colour_trim_px + 2
-    r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
-    c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+    r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
     mask = labels[r0:r1, c0:c1] == k
     radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
     band = min(float(s.colour_trim_px), 0.2 * radius)
@@ -616,6 +613,14 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
+
+
+def trim_window(shape: tuple[int, ...], sl: tuple[slice, slice], s: ExtractSettings) -> tuple[int, int, int, int]:
+    """The window ``(r0, r1, c0, c1)`` of an image of ``shape`` that :func:`trim_mask` reads about a mask's box
+    ``sl``: the box grown by the widest band tried and 2 px."""
+    h, w = shape[0], shape[1]
+    pad = WIDER[-1] * s.colour_trim_px + 2
+    return max(sl[0].start - pad, 0), min(sl[0].stop + pad, h), max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
 
 
 def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
