@@ -29,6 +29,7 @@ from .core.surface import (
     within,
 )
 from .errors import InputError
+from .segment.colour import convex_hull_mask
 from .settings import Section, SettingError, setting
 
 __all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "keep_caps", "one_sided",
@@ -608,7 +609,11 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     exclude = None
     if front_depth is not None and focal > 0.0 and s.trim_front_ring:
         exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s)
-    kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude)
+    kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
+    if exclude is not None and exclude.any() and not kept.all(where=mask):
+        # the ring without what lies in front gives back what the colour took only because the occluder was sampled
+        # as the surroundings; it takes nothing the colour alone left
+        kept = kept | colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude)
     dropped = mask & ~kept
     if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
@@ -711,18 +716,21 @@ def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) ->
 
 def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
                settings: ExtractSettings | None = None) -> np.ndarray:  # fmt: skip
-    """(h, w) bool: the pixels outside ``mask`` that lie in front of its fruit: depth (metres, the same (h, w) window;
-    0 or NaN: none) nearer than the fruit's front (:func:`~symfruit.core.surface.fruit_surface`'s, the nearest depth
-    of the mask's depth mode) by more than the registration's free-side tolerance (three noise deviations, at least
-    3 mm), and the pixels without depth within ``_FREE_PX`` of one (the mixed pixels a time-of-flight camera
-    invalidates along the occluder's edge, as the registration reads them: stop 62, docs/leaf62.md).
+    """(h, w) bool: the pixels outside ``mask`` but within its convex hull that lie in front of its fruit: depth
+    (metres, the same (h, w) window; 0 or NaN: none) nearer than the fruit's front
+    (:func:`~symfruit.core.surface.fruit_surface`'s, the nearest depth of the mask's depth mode) by more than the
+    registration's free-side tolerance (three noise deviations, at least 3 mm); and the pixels without depth within
+    ``_FREE_PX`` of one (the mixed pixels a time-of-flight camera invalidates along the occluder's edge, as the
+    registration reads them: stop 62, docs/leaf62.md). All false where there is none.
 
-    A mask cut along a leaf or twig crossing its fruit ends at the occluder's edge, not at the fruit's: the ring just
-    outside it that :func:`~symfruit.core.surface.colour_trim` compares the mask's band with lies on the occluder
-    there, and no overshoot lies on something in front. Where the occluder shows the fruit's own colour (a red twig,
-    a stalk, the fruit between two leaves) the two summaries did not separate at the band, and a band twice as wide
-    was taken all round (the real spheres cut by a strip 5 cm in front: 1,066 of the 125 mm sphere's 4,509 px;
-    docs/strip58.md, cause 1). None of it on a mask without depth in front of it beside it."""
+    A mask cut in two, or notched, by a leaf or twig crossing its fruit ends at the occluder's edge, not at the
+    fruit's: the ring just outside it that :func:`~symfruit.core.surface.colour_trim` compares the mask's band with
+    lies on the occluder there, and no overshoot lies on something in front. Where the occluder shows the fruit's own
+    colour (a red twig, a stalk, the fruit between two leaves) the two summaries did not separate at the band, and a
+    band twice as wide was taken all round (the real spheres cut by a strip 5 cm in front: 1,066 of the 125 mm
+    sphere's 4,509 px; docs/strip58.md, cause 1). Only within the hull: a support beside the fruit comes nearer than
+    its front away from it (a board below the fruit seen obliquely, 6 mm nearer a row: the real spheres' masks grown
+    10 px), and does not cross it (issue 18, strip64, docs/strip64.md)."""
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "front_ring")
     z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
@@ -731,9 +739,15 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
         lost = ~mask & ~(z > 0)
     out = np.zeros(mask.shape, bool)
     seen = z[mask & valid]
+    if not seen.size:
+        return out
     # the fruit's front lies at or before its mask's farthest depth, and the tolerance is 3 mm or more: nothing can
-    # be in front where nothing outside is nearer than that (the fruit's surface is then not looked for)
-    if not seen.size or not (~mask & valid & (z < float(seen.max()) - 0.003)).any():
+    # be in front where nothing outside is nearer than that (the hull and the fruit's surface are then not looked for)
+    ahead = ~mask & valid & (z < float(seen.max()) - 0.003)
+    if not ahead.any():
+        return out
+    ahead &= convex_hull_mask(mask)
+    if not ahead.any():
         return out
     zv = np.where(valid, z, 0.0)
     surface = fruit_surface(zv, mask, focal, slab=s.slab,
@@ -741,10 +755,10 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
                             clean=True)  # fmt: skip
     if surface is None:
         return out
-    front = ~mask & valid & (zv < surface.front - _free_tol(surface))
-    if not front.any():
+    ahead &= zv < surface.front - _free_tol(surface)
+    if not ahead.any():
         return out
-    return front | (lost & within(front, _FREE_PX))
+    return ahead | (lost & within(ahead, _FREE_PX))
 
 
 def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
