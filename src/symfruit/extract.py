@@ -610,10 +610,11 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     if front_depth is not None and focal > 0.0 and s.trim_front_ring:
         exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s)
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
-    if exclude is not None and exclude.any() and not kept.all(where=mask):
+    if exclude is not None and (exclude & ~mask).any() and not kept.all(where=mask):
         # the ring without what lies in front gives back what the colour took only because the occluder was sampled
-        # as the surroundings; it takes nothing the colour alone left
-        kept = kept | colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude)
+        # as the surroundings; it takes nothing the colour alone left, and gives back nothing on the occluder itself
+        ring = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude & ~mask)
+        kept = kept | (ring & ~exclude)
     dropped = mask & ~kept
     if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
@@ -736,7 +737,7 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
     with np.errstate(invalid="ignore"):
         valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0)
-        lost = ~mask & ~(z > 0)
+        lost = ~(z > 0)
     out = np.zeros(mask.shape, bool)
     seen = z[mask & valid]
     if not seen.size:
@@ -755,10 +756,16 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
                             clean=True)  # fmt: skip
     if surface is None:
         return out
-    ahead &= zv < surface.front - _free_tol(surface)
+    nearer = valid & (zv < surface.front - _free_tol(surface))
+    ahead &= nearer
     if not ahead.any():
         return out
-    return ahead | (lost & within(ahead, _FREE_PX))
+    # and the mask's own pixels whose depth lies in front of the fruit too, with those without depth beside them (an
+    # overshoot onto the occluder and its mixed pixels), which the ring without the occluder does not give back
+    out = ahead | (lost & ~mask & within(ahead, _FREE_PX))
+    if (on := nearer & mask).any():
+        out |= on | (lost & mask & within(on, _FREE_PX))
+    return out
 
 
 def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
