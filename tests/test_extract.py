@@ -806,6 +806,9 @@ def test_the_trims_depth_is_checked_by_name():
 # --- strip64: the colour trim's ring leaves out an occluder crossing the fruit (extract.trim_front_ring)
 
 
+FRONT = ExtractSettings(trim_front_ring=True)
+
+
 def strip_ball(strip_z: float | None = 0.25, board: bool = False):
     """``(color, depth, labels, strip, edge)`` seen by :data:`SMALL_CAM`: a white ball of 30 px at (80, 60), its front
     0.3 m, lit from the front (its limb 30 % darker), before a dark background 1 m away; across its middle a strip
@@ -859,14 +862,13 @@ def test_the_colour_trim_does_not_read_an_occluder_of_the_fruits_colour_as_its_s
     """Strip64 (docs/strip58.md cause 1): the ring beside the cut edges lies on the strip, which shows the ball's
     white; at the band the two summaries do not separate, at twice it they do, and the colour alone takes the
     halves' band all round (996 of 2,288 px; the ball uncut: none). Given the depth
-    (``front_depth``) with ``trim_front_ring`` (the default), the strip is left out of the ring and the mask is kept
-    as drawn; off, the colour's trim."""
+    (``front_depth``) with ``trim_front_ring``, the strip is left out of the ring and the mask is kept as drawn;
+    off (the default), the colour's trim."""
     color, depth, labels, *_ = strip_ball()
     colour_only = trim_labels(color, labels)
     assert (labels == 1).sum() - (colour_only == 1).sum() >= 900
-    assert trim_labels(color, labels, front_depth=depth, focal=600.0) is labels
-    off = ExtractSettings(trim_front_ring=False)
-    assert np.array_equal(trim_labels(color, labels, off, front_depth=depth, focal=600.0), colour_only)
+    assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels
+    assert np.array_equal(trim_labels(color, labels, front_depth=depth, focal=600.0), colour_only)  # the default
     whole_color, _, whole, *_ = strip_ball(strip_z=None)
     assert trim_labels(whole_color, whole) is whole
 
@@ -885,4 +887,4 @@ def test_the_ring_without_the_occluder_only_gives_back_what_the_colour_took():
     alone = colour_trim(color, grown, band_px=4.0, wider=(8.0, 12.0), exclude=front_ring(depth, grown, 600.0))
     assert (grown & ~alone).sum() >= 500
     assert trim_labels(color, labels) is labels
-    assert trim_labels(color, labels, front_depth=depth, focal=600.0) is labels
+    assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels
