@@ -19,6 +19,7 @@ from symfruit.extract import (
     cluster,
     cluster_gap,
     extract,
+    front_ring,
     keep_caps,
     one_sided,
     own_cap,
@@ -800,3 +801,90 @@ def test_the_trims_depth_is_checked_by_name():
         trim_labels(color, labels, KEEPS, depth=depth, focal=0.0)
     with pytest.raises(InputError, match="own_cap: depth must be float metres"):
         own_cap((depth * 1000).astype(np.uint16), labels == 1, 600.0)
+
+
+# --- strip64: the colour trim's ring leaves out an occluder crossing the fruit (extract.trim_front_ring)
+
+
+FRONT = ExtractSettings(trim_front_ring=True)
+
+
+def strip_ball(strip_z: float | None = 0.25, board: bool = False):
+    """``(color, depth, labels, strip, edge)`` seen by :data:`SMALL_CAM`: a white ball of 30 px at (80, 60), its front
+    0.3 m, lit from the front (its limb 30 % darker), before a dark background 1 m away; across its middle a strip
+    9 px tall at ``strip_z`` (None: no strip) that reaches 7 px past it on both sides, its edge (2 px either side)
+    without depth, and shows in the colour image what lies behind it (the ball: docs/realpert55.py's unpainted
+    strip, the ring beside the cut edges of the ball's own colour); the mask the ball less the strip (two halves).
+    ``board``: below the ball a board 6 mm nearer a row (a support seen obliquely, nearer than the ball's front from
+    its 5th row on)."""
+    color, depth = disc_frame([(80, 60)], radius=30, z=0.3)
+    yy, xx = np.mgrid[:120, :160]
+    d2 = (xx - 80) ** 2 + (yy - 60) ** 2
+    inside = d2 <= 900
+    c = np.full(color.shape, 60.0)
+    c[inside] = 220.0 * (0.7 + 0.3 * np.sqrt(np.clip(1 - d2 / 900, 0, None)))[inside][:, None]
+    strip = (np.abs(yy - 60) <= 4) & (np.abs(xx - 80) <= 37) & (strip_z is not None)
+    edge = ndimage.binary_dilation(strip, iterations=2) & ~ndimage.binary_erosion(strip, iterations=2)
+    rng = np.random.default_rng(0)
+    color = np.clip(c + 4 * rng.standard_normal(c.shape), 0, 255).astype(np.uint8)
+    if strip_z is not None:
+        depth[strip], depth[edge] = strip_z, 0.0
+    if board:
+        depth[91:] = (0.33 - 0.006 * (yy[91:] - 90)).astype(np.float32)
+    return color, depth, (inside & ~strip).astype(np.int32), strip, edge
+
+
+def test_front_ring_is_the_strip_between_the_masks_halves_and_its_lost_edge():
+    """Known answers: outside the mask and within its convex hull, the strip 5 cm in front and the pixels without
+    depth within 4 px of it; not the strip's ends beyond the ball (outside the hull), not the background, not the
+    ball; in a mask drawn over the strip, the strip's pixels and those without depth beside them; nothing
+    when the strip lies behind the ball's front, nor for a board below the ball that comes nearer (outside the
+    hull)."""
+    from symfruit.segment.colour import convex_hull_mask
+
+    _, depth, labels, strip, edge = strip_ball()
+    mask = labels == 1
+    ring = front_ring(depth, mask, 600.0)
+    assert np.array_equal(ring & ~edge, strip & ~edge & convex_hull_mask(mask) & ~mask)
+    assert (ring & edge).any() and not ring[:, :45].any() and not ring[:, 116:].any()
+    assert not (ring & mask).any()  # none of the mask's pixels lie in front: the ball's own, or lost beside the strip
+    # the halves drawn 3 px over the strip: their pixels on it, with depth in front, and none of the ball's
+    yy = np.mgrid[:120, :160][0]
+    over = mask | (strip & convex_hull_mask(mask) & (np.abs(yy - 60) >= 2))
+    ring, on = front_ring(depth, over, 600.0), over & strip & (depth > 0)
+    assert on.any() and np.array_equal(ring & on, on) and not (ring & over & (depth > 0) & ~strip).any()
+    assert not front_ring(strip_ball(strip_z=0.32)[1], mask, 600.0).any()  # behind the ball's front
+    _, depth, labels, *_ = strip_ball(strip_z=None, board=True)
+    assert (depth[100:] < 0.29).all() and not front_ring(depth, labels == 1, 600.0).any()
+
+
+def test_the_colour_trim_does_not_read_an_occluder_of_the_fruits_colour_as_its_surroundings():
+    """Strip64 (docs/strip58.md cause 1): the ring beside the cut edges lies on the strip, which shows the ball's
+    white; at the band the two summaries do not separate, at twice it they do, and the colour alone takes the
+    halves' band all round (996 of 2,288 px; the ball uncut: none). Given the depth
+    (``front_depth``) with ``trim_front_ring``, the strip is left out of the ring and the mask is kept as drawn;
+    off (the default), the colour's trim."""
+    color, depth, labels, *_ = strip_ball()
+    colour_only = trim_labels(color, labels)
+    assert (labels == 1).sum() - (colour_only == 1).sum() >= 900
+    assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels
+    assert np.array_equal(trim_labels(color, labels, front_depth=depth, focal=600.0), colour_only)  # the default
+    whole_color, _, whole, *_ = strip_ball(strip_z=None)
+    assert trim_labels(whole_color, whole) is whole
+
+
+def test_the_ring_without_the_occluder_only_gives_back_what_the_colour_took():
+    """A trim the colour alone leaves undone is not made with the occluder left out of the ring: under a mask drawn
+    3 px over the background all round and cut by the strip, the colour's summaries do not separate at any band and
+    the mask stays as drawn; the ring without the strip would separate and take the overshoot (534 px, down to the
+    ball's halves), but it only gives back (a support or neighbour read as in front must not start a trim)."""
+    from symfruit.core.surface import colour_trim
+
+    color, depth, _, strip, _ = strip_ball()
+    yy, xx = np.mgrid[:120, :160]
+    grown = (((xx - 80) ** 2 + (yy - 60) ** 2) <= 33**2) & ~strip
+    labels = grown.astype(np.int32)
+    alone = colour_trim(color, grown, band_px=4.0, wider=(8.0, 12.0), exclude=front_ring(depth, grown, 600.0))
+    assert (grown & ~alone).sum() >= 500
+    assert trim_labels(color, labels) is labels
+    assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels

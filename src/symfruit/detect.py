@@ -32,12 +32,14 @@ from .extract import (
     _checked,
     _trim_checked,
     extract,
+    front_ring,
     keep_caps,
     own_surface,
     register,
     shift_labels,
     trim_labels,
     trim_mask,
+    trim_window,
 )
 from .fruitpool import FruitPool, Running
 from .io.frames import COLOR_FILE
@@ -279,6 +281,10 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
+        front = _front_trimmed(frame, drawn, labels, colour_trimmed, drawn_boxes, boxes, shift, settings.extract)
+        if front[0] is not labels:  # a trim done again beside something in front: the new masks moved
+            labels, colour_trimmed, boxes = front
+            moved = shift_labels(labels, *shift) if shift != (0, 0) else labels
         moved = _kept_caps(frame, drawn, labels, moved, colour_trimmed, drawn_boxes, shift, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, prep.hi, boxes, settings, method, outlined,
                                          colour_trimmed, drawn_boxes)  # fmt: skip
@@ -361,7 +367,7 @@ def _detect_shared(
     same = object()  # this frame's depth and colour go to the workers once
     drawn_boxes = boxes
     masks = _shared_masks(pool, frame, labels, boxes, settings.extract, same)
-    trimmed, colour_trimmed, boxes, outlines, t_trim, t_outlines, cpu = masks
+    colour_only, colour_ids, colour_boxes, outlines, t_trim, t_outlines, cpu = masks
     a, t_search = time.perf_counter(), 0.0
     guess = found = pool.registration_guess
 
@@ -372,6 +378,8 @@ def _detect_shared(
         t_search = time.perf_counter() - b
         return found == guess
 
+    trimmed, colour_trimmed, boxes = _front_trimmed(frame, labels, colour_only, colour_ids, drawn_boxes, colour_boxes,
+                                                    guess, settings.extract)  # fmt: skip
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
     moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, guess, settings.extract)
     fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
@@ -386,6 +394,8 @@ def _detect_shared(
         running.result()  # None: the workers' fruit dropped
         pool.registration_guess = found
         b = time.perf_counter()
+        trimmed, colour_trimmed, boxes = _front_trimmed(frame, labels, colour_only, colour_ids, drawn_boxes,
+                                                        colour_boxes, found, settings.extract)  # fmt: skip
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
         moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, found, settings.extract)
         fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
@@ -640,6 +650,47 @@ def _trim_labels(
     from."""
     trimmed: set[int] = set()
     return trim_labels(color, labels, settings, boxes=boxes, trimmed=trimmed), trimmed
+
+
+def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: set[int],
+                   drawn_boxes: list[tuple[slice, slice] | None], boxes: list[tuple[slice, slice] | None],
+                   shift: tuple[int, int], s: ExtractSettings,
+                   ) -> tuple[np.ndarray, set[int], list[tuple[slice, slice] | None]]:  # fmt: skip
+    """The colour trim done again (``extract.trim_front_ring``) on each mask as drawn (``drawn``, boxes
+    ``drawn_boxes``) beside which something lies in front of its fruit (:func:`~symfruit.extract.front_ring`,
+    read on the depth moved back by the registration's ``shift`` onto the colour's pixels: after the registration,
+    so that the depth beside a mask is the depth there, and the shift is the colour's trim's alone), its ring
+    leaving that out: ``trimmed`` (the colour-trimmed labels), ``ids`` (the masks the trim took pixels from) and
+    ``boxes`` (their boxes) with those masks' new trims; the same objects where none has anything in front beside
+    it (issue 18, strip64)."""
+    if frame.color is None or not s.trim_front_ring or s.colour_trim_px <= 0:
+        return trimmed, ids, boxes
+    du, dv = shift
+    depth = shift_labels(frame.depth, -du, -dv) if (du, dv) != (0, 0) else frame.depth
+    focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
+    out, new_ids, new_boxes = trimmed, ids, boxes
+    for k, sl in enumerate(drawn_boxes, 1):
+        if sl is None:
+            continue
+        r0, r1, c0, c1 = trim_window(drawn.shape, sl, s)
+        mask = drawn[r0:r1, c0:c1] == k
+        if not front_ring(depth[r0:r1, c0:c1], mask, focal, s).any():
+            continue
+        dropped = trim_mask(frame.color, drawn, k, sl, s, focal=focal, front_depth=depth)
+        gone = np.zeros_like(mask) if dropped is None else dropped[1]
+        before = out[r0:r1, c0:c1] == k
+        if np.array_equal(before, mask & ~gone):
+            continue
+        if out is trimmed:
+            out, new_ids, new_boxes = trimmed.copy(), set(ids), list(boxes)
+        out[r0:r1, c0:c1][mask] = k
+        out[r0:r1, c0:c1][gone] = 0
+        if dropped is None:
+            new_ids.discard(k)
+        else:
+            new_ids.add(k)
+        new_boxes[k - 1] = _box_within(out, k, sl)
+    return out, new_ids, new_boxes
 
 
 def _kept_caps(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],

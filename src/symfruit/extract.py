@@ -17,8 +17,19 @@ from .core.limits import depth_metres
 from .core.occlusion import SECTORS, STAR_SHARE
 from .core.points import bounds, median
 from .core.raster import inner_distance, mask_box, square_filter
-from .core.surface import ALL_ROUND, PART_POINTS, across_occluder, colour_trim, fruit_surface, registration_shift
+from .core.surface import (
+    _FREE_PX,
+    ALL_ROUND,
+    PART_POINTS,
+    _free_tol,
+    across_occluder,
+    colour_trim,
+    fruit_surface,
+    registration_shift,
+    within,
+)
 from .errors import InputError
+from .segment.colour import convex_hull_mask
 from .settings import Section, SettingError, setting
 
 __all__ = ["ExtractSettings", "Extraction", "backdrop", "cluster", "cluster_gap", "extract", "keep_caps", "one_sided",
@@ -106,6 +117,17 @@ class ExtractSettings(Section):
         docs/trim58.md, "After merging"). On by default since stop 61 (docs/small61.md): the real spheres binned
         2x and 3x, and binned with a wider lost rim, 8 -> 0 boxes over the 6 mm bar; the development trees' mean
         centre the same to 0.01 mm.
+    trim_front_ring : bool
+        Given the depth (``detect``), after the registration the colour trim is done again on each mask beside which,
+        within its convex hull, something lies in front of its fruit (:func:`front_ring`: a leaf or twig crossing it,
+        the mask cut along it), with that left out of the ring the band is compared with; it only gives back what the
+        colour took, and nothing on the occluder itself. Where the occluder shows the fruit's own colour the band and
+        the ring did not separate, and a band twice as wide was taken all round (the real spheres under a strip 5 cm
+        in front, docs/strip58.md cause 1). Off by default (issue 18, strip64, docs/strip64.md): on, the real frames
+        cut by a strip go 2 -> 0 (unpainted) and 1 -> 0 (painted) of 8 boxes over the 6 mm bar, every other
+        perturbation the same; the development trees move 36 of 248 apples, 14 closer and 22 farther (seeds 0-3:
+        centre 4.5 -> 4.6 mm, median 3.6 -> 3.9; seeds 6-11: 5.3 -> 5.3, IoU 0.771 -> 0.772): there the same colour
+        trim's wider band had been right, the masks overshooting by up to 4 px.
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -132,6 +154,7 @@ class ExtractSettings(Section):
     mask_edge_px: int = setting(10, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
     trim_keeps_surface: bool = setting(True)
+    trim_front_ring: bool = setting(False)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
@@ -521,7 +544,7 @@ WIDEST = 0.4
 def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings | None = None,
                 *, boxes: list[tuple[slice, slice] | None] | None = None,
                 trimmed: set[int] | None = None, depth: np.ndarray | None = None,
-                focal: float = 0.0) -> np.ndarray:  # fmt: skip
+                focal: float = 0.0, front_depth: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """``labels`` with each mask's outer band trimmed where its colour is the background's
     (:func:`~symfruit.core.surface.colour_trim`, a band of ``colour_trim_px``, at most a fifth of the mask's
     equivalent radius; where fruit and surroundings do not separate there, twice and three times that band, at
@@ -532,16 +555,20 @@ def trim_labels(color: np.ndarray, labels: np.ndarray, settings: ExtractSettings
     ``boxes``: ``ndimage.find_objects(labels)`` when the caller has it. ``labels`` itself is returned when nothing
     is trimmed. ``trimmed``: a set given the labels of the masks that lost pixels. ``depth`` (metres, the colour's
     size) and ``focal`` (pixels): with ``trim_keeps_surface``, no pixel of a fruit's own convex cap is taken
-    (:func:`trim_mask`).
+    (:func:`trim_mask`). ``front_depth`` (the same, and ``focal``): with ``trim_front_ring``, what lies in front of a
+    fruit outside its mask is not sampled as its surroundings (:func:`front_ring`).
     """
     color, labels, s = _trim_checked(color, labels, settings)
     if s.colour_trim_px <= 0:
         return labels
     if depth is not None and s.trim_keeps_surface:  # checked where read (a whole frame is not copied)
         depth, focal = _depth_checked(depth, focal, labels.shape, "trim_labels")
+    if front_depth is not None and s.trim_front_ring:
+        front_depth, focal = _depth_checked(front_depth, focal, labels.shape, "trim_labels")
     out = labels
     for k, sl in enumerate(ndimage.find_objects(labels) if boxes is None else boxes, 1):
-        if sl is None or (dropped := trim_mask(color, labels, k, sl, s, depth=depth, focal=focal)) is None:
+        if sl is None or (dropped := trim_mask(color, labels, k, sl, s, depth=depth, focal=focal,
+                                               front_depth=front_depth)) is None:  # fmt: skip
             continue
         (r0, r1, c0, c1), gone = dropped
         out = out.copy() if out is labels else out
@@ -563,8 +590,8 @@ def _trim_checked(color: Any, labels: Any, settings: ExtractSettings | None) -> 
 
 
 def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice], s: ExtractSettings, *,
-              depth: np.ndarray | None = None,
-              focal: float = 0.0) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
+              depth: np.ndarray | None = None, focal: float = 0.0, front_depth: np.ndarray | None = None
+              ) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
     """One mask's part of :func:`trim_labels` (checked arguments, ``s.colour_trim_px`` above 0): mask ``k`` of
     ``labels`` (its box ``sl``) trimmed by colour, as the window ``(r0, r1, c0, c1)`` and the (r1 - r0, c1 - c0)
     bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels, the
@@ -576,20 +603,35 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     fruit's own convex cap (:func:`own_cap`) are kept: the colour trim compares a band pixel with the ring just
     outside the mask, and where the fruit runs on past the mask (a mask drawn or registered a few pixels off, its
     shaded limb darkening towards a background of about its colour) that ring is the fruit itself (stop 57,
-    docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198)."""
-    h, w = labels.shape
-    pad = WIDER[-1] * s.colour_trim_px + 2
-    r0, r1 = max(sl[0].start - pad, 0), min(sl[0].stop + pad, h)
-    c0, c1 = max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
+    docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198). Given
+    ``front_depth`` (the frame's, as ``depth``) with ``s.trim_front_ring``, the colour's ring outside the mask leaves
+    out what lies in front of the fruit (:func:`front_ring`)."""
+    r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
     mask = labels[r0:r1, c0:c1] == k
     radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
     band = min(float(s.colour_trim_px), 0.2 * radius)
     wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
+    exclude = None
+    if front_depth is not None and focal > 0.0 and s.trim_front_ring:
+        exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s)
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
+    if exclude is not None and (exclude & ~mask).any() and not kept.all(where=mask):
+        # the ring without what lies in front gives back what the colour took only because the occluder was sampled
+        # as the surroundings; it takes nothing the colour alone left, and gives back nothing on the occluder itself
+        ring = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude & ~mask)
+        kept = kept | (ring & ~exclude)
     dropped = mask & ~kept
     if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)
     return ((r0, r1, c0, c1), dropped) if dropped.any() else None
+
+
+def trim_window(shape: tuple[int, ...], sl: tuple[slice, slice], s: ExtractSettings) -> tuple[int, int, int, int]:
+    """The window ``(r0, r1, c0, c1)`` of an image of ``shape`` that :func:`trim_mask` reads about a mask's box
+    ``sl``: the box grown by the widest band tried and 2 px."""
+    h, w = shape[0], shape[1]
+    pad = WIDER[-1] * s.colour_trim_px + 2
+    return max(sl[0].start - pad, 0), min(sl[0].stop + pad, h), max(sl[1].start - pad, 0), min(sl[1].stop + pad, w)
 
 
 def one_sided(mask: np.ndarray, dropped: np.ndarray) -> bool:
@@ -676,6 +718,59 @@ def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) ->
     if not (np.isfinite(f) and f > 0.0):
         raise InputError(f"{what}: focal must be a positive number of pixels, got {focal!r}")
     return z, f
+
+
+def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
+               settings: ExtractSettings | None = None) -> np.ndarray:  # fmt: skip
+    """(h, w) bool: the pixels outside ``mask`` but within its convex hull that lie in front of its fruit: depth
+    (metres, the same (h, w) window; 0 or NaN: none) nearer than the fruit's front
+    (:func:`~symfruit.core.surface.fruit_surface`'s, the nearest depth of the mask's depth mode) by more than the
+    registration's free-side tolerance (three noise deviations, at least 3 mm); and the pixels without depth within
+    ``_FREE_PX`` of one (the mixed pixels a time-of-flight camera invalidates along the occluder's edge, as the
+    registration reads them: stop 62, docs/leaf62.md). All false where there is none.
+
+    A mask cut in two, or notched, by a leaf or twig crossing its fruit ends at the occluder's edge, not at the
+    fruit's: the ring just outside it that :func:`~symfruit.core.surface.colour_trim` compares the mask's band with
+    lies on the occluder there, and no overshoot lies on something in front. Where the occluder shows the fruit's own
+    colour (a red twig, a stalk, the fruit between two leaves) the two summaries did not separate at the band, and a
+    band twice as wide was taken all round (the real spheres cut by a strip 5 cm in front: 1,066 of the 125 mm
+    sphere's 4,509 px; docs/strip58.md, cause 1). Only within the hull: a support beside the fruit comes nearer than
+    its front away from it (a board below the fruit seen obliquely, 6 mm nearer a row: the real spheres' masks grown
+    10 px), and does not cross it (issue 18, strip64, docs/strip64.md)."""
+    s = settings or ExtractSettings()
+    z, focal = _depth_checked(depth, focal, np.shape(mask), "front_ring")
+    z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
+    with np.errstate(invalid="ignore"):
+        valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0)
+        lost = ~(z > 0)
+    out = np.zeros(mask.shape, bool)
+    seen = z[mask & valid]
+    if not seen.size:
+        return out
+    # the fruit's front lies at or before its mask's farthest depth, and the tolerance is 3 mm or more: nothing can
+    # be in front where nothing outside is nearer than that (the hull and the fruit's surface are then not looked for)
+    ahead = ~mask & valid & (z < float(seen.max()) - 0.003)
+    if not ahead.any():
+        return out
+    ahead &= convex_hull_mask(mask)
+    if not ahead.any():
+        return out
+    zv = np.where(valid, z, 0.0)
+    surface = fruit_surface(zv, mask, focal, slab=s.slab,
+                            tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
+                            clean=True)  # fmt: skip
+    if surface is None:
+        return out
+    nearer = valid & (zv < surface.front - _free_tol(surface))
+    ahead &= nearer
+    if not ahead.any():
+        return out
+    # and the mask's own pixels whose depth lies in front of the fruit too, with those without depth beside them (an
+    # overshoot onto the occluder and its mixed pixels), which the ring without the occluder does not give back
+    out = ahead | (lost & ~mask & within(ahead, _FREE_PX))
+    if (on := nearer & mask).any():
+        out |= on | (lost & mask & within(on, _FREE_PX))
+    return out
 
 
 def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:

@@ -10,6 +10,7 @@ from symfruit.core.camera import Camera
 from symfruit.core.frame import Frame
 from symfruit.detect import detect
 from symfruit.io.frames import read_frame
+from symfruit.settings import from_dict
 
 from ..conftest import docs_script
 
@@ -428,3 +429,18 @@ def test_a_leaf_drawn_into_the_60_mm_spheres_mask_is_passed_over_though_its_flat
     points = extract(mask, z, cam).points
     assert len(points) >= 400
     assert float(np.min(points[:, 2])) > leaf + 0.04  # the sphere's, 5 cm behind the leaf
+
+
+@pytest.mark.parametrize("name", ["leafstrip5-cut", "leafstrip5-cut-green"])
+def test_a_strip_cutting_every_mask_in_two_leaves_every_sphere_a_cube_by_the_ring_without_the_strip(rp, name):
+    """Strip64 (docs/strip64.md): the strip of the test above, unpainted (the sphere's own white) or painted a leaf's
+    green. The colour trim compared each cut mask's band with a ring lying on the strip, and took the 125 mm
+    sphere's band all round (unpainted: 120 x 121 x 116 mm) or its shaded lower limb (painted: the halves then not
+    joined, 121 x 102 x 109). Done again after the registration with the strip left out of the ring
+    (``extract.trim_front_ring``, off by default), every sphere of frame 0 is a cube within 6 mm of its diameter;
+    off, sphere 2 is not (its depth side 10 mm short, or 20 mm across)."""
+    on = from_dict({"extract": {"trim_front_ring": True}})
+    for k, size, diameter in spheres(rp, name, settings=on):
+        assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
+    size, diameter = next((size, d) for k, size, d in spheres(rp, name) if k == 2)
+    assert np.ptp(size) > 6.0 or abs(size[2] - diameter) > 6.0, (size, diameter)

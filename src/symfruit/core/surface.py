@@ -2121,7 +2121,7 @@ ALL_ROUND = 2.0 / 3.0
 
 def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres: int = 3, iterations: int = 5,
                 min_accuracy: float = 0.85, margin: float = 0.5, wider: tuple[float, ...] = (),
-                outline_share: float = ALL_ROUND) -> np.ndarray:  # fmt: skip
+                outline_share: float = ALL_ROUND, exclude: np.ndarray | None = None) -> np.ndarray:  # fmt: skip
     """``mask`` less the pixels of its outer band whose colour is the background's, not the fruit's.
 
     Masks drawn by people or models overshoot the fruit by a few pixels onto what lies around it, and the
@@ -2148,20 +2148,27 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
     band_px : float, pixels
     wider : floats, pixels
         Bands tried, in order, when the colours do not separate at ``band_px`` (default none).
+    exclude : (h, w) bool, optional
+        Pixels never sampled as the surroundings (:func:`symfruit.extract.front_ring`: something in front of the
+        fruit, a leaf or twig crossing it, along which the mask was cut: the fruit runs on behind it, so the mask's
+        edge there is no overshoot onto the surroundings, and where the occluder shows the fruit's own colour the two
+        summaries would not separate; issue 18, strip64).
     """
     mask = np.asarray(mask, dtype=bool)
+    if exclude is not None and not (exclude := np.asarray(exclude, dtype=bool) & ~mask).any():
+        exclude = None
     if band_px <= 0 or not mask.any():
         return mask
     # the band's trim reads the distances up to its fruit sample's depth alone (3 band_px + 1): those, +inf beyond, the
     # same regions (stop 46, regspeed46); a wider band's reads the whole map
     inner = inner_distance(mask, 3.0 * float(band_px) + 1)
-    kept = _colour_trim(color, mask, inner, float(band_px), centres, iterations, min_accuracy, margin)
+    kept = _colour_trim(color, mask, inner, float(band_px), centres, iterations, min_accuracy, margin, exclude)
     if kept is not None:
         return kept
     if wider:
         inner = inner_distance(mask)
     for band in wider:
-        kept = _colour_trim(color, mask, inner, float(band), centres, iterations, min_accuracy, margin)
+        kept = _colour_trim(color, mask, inner, float(band), centres, iterations, min_accuracy, margin, exclude)
         if kept is not None:
             edge = mask & (inner <= 1.0)
             return kept if (edge & ~kept).sum() >= outline_share * edge.sum() else mask
@@ -2169,14 +2176,16 @@ def colour_trim(color: np.ndarray, mask: np.ndarray, *, band_px: float, centres:
 
 
 def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px: float, centres: int,
-                 iterations: int, min_accuracy: float, margin: float) -> np.ndarray | None:  # fmt: skip
-    """:func:`colour_trim` with one band: the mask trimmed, or None where fruit and surroundings do not separate."""
+                 iterations: int, min_accuracy: float, margin: float,
+                 exclude: np.ndarray | None = None) -> np.ndarray | None:  # fmt: skip
+    """:func:`colour_trim` with one band: the mask trimmed, or None where fruit and surroundings do not separate;
+    the ring less ``exclude`` (None: nothing excluded)."""
     # a band pixel is compared with the fruit just inside the band and the surroundings just outside it, not
     # with the fruit's lit centre: a limb darkens towards a grey background and is still the fruit (learnt
     # over the whole interior, the real 200 mm sphere's shaded lower limb was trimmed)
     color = np.asarray(color)
     jit = compiled()
-    if jit is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3:
+    if jit is not None and color.dtype == np.uint8 and color.ndim == 3 and color.shape[2] == 3 and exclude is None:
         return _colour_trim_compiled(jit, color, mask, inner, band_px, centres, iterations, min_accuracy, margin)
     if jit is not None:  # the three regions and their sizes in one pass (the same pixels)
         fruit, ring, band = (np.empty(mask.shape, bool) for _ in range(3))
@@ -2187,6 +2196,9 @@ def _colour_trim(color: np.ndarray, mask: np.ndarray, inner: np.ndarray, band_px
         ring = ~mask & within(mask, band_px + 1)  # 1 to band_px + 1 from the mask
         band = mask & (inner <= band_px)
         n_fruit, n_ring, n_band = int(fruit.sum()), int(ring.sum()), int(band.sum())
+    if exclude is not None:
+        ring &= ~exclude
+        n_ring = int(ring.sum())
     if n_fruit < 20 or n_ring < 20 or not n_band:
         return None
     # the compiled twins of the features, the k-means and the test where numba is (the same values to the bit)
