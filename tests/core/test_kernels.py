@@ -8743,3 +8743,54 @@ def test_pair_sums_are_the_scalar_loops_sums(seed, n, bins, odd):
                     acc[k] = acc[k] + term
             want += acc
     assert np.array(got).tobytes() == np.array(want).tobytes()
+
+
+# --- stop 64, ext64 ---
+
+
+def _taxicab_core(own: np.ndarray, iterations: int) -> np.ndarray:
+    """The pixels of ``own`` (h, w) bool farther than ``iterations`` taxicab steps from every pixel not its own
+    (beyond the array not its own): stop 60's distance map, by brute force."""
+    h, w = own.shape
+    far = np.zeros((h, w), bool)
+    yy, xx = np.mgrid[-1 : h + 1, -1 : w + 1]
+    framed = np.zeros((h + 2, w + 2), bool)
+    framed[1:-1, 1:-1] = own
+    ys, xs = yy[~framed], xx[~framed]
+    for r in range(h):
+        for c in range(w):
+            far[r, c] = bool((np.abs(ys - r) + np.abs(xs - c)).min() > iterations)
+    return far
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 12))
+def test_surface_apex_core_by_passes_of_the_cross(seed, iterations):
+    """Stop 64: the apex's core by ``iterations`` passes of the cross (no distance map) keeps the pixels farther than
+    ``iterations`` taxicab steps from any pixel not the box's mask (brute force), on random boxes of 1-30 rows and
+    columns (full, empty of core, with holes, one row or column) anywhere in a window, eroded 0-12 times: the apex
+    is the first least 5 x 5 median among those core pixels that are near, as the twin's pass finds it."""
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    bh, bw = (int(x) for x in rng.integers(1, 31, 2))
+    kind = int(rng.integers(0, 3))
+    own = np.ones((bh, bw), bool) if kind == 0 else rng.random((bh, bw)) >= (0.03 if kind == 1 else 0.3)
+    r0, c0 = (int(x) for x in rng.integers(0, 6, 2))
+    h, w = r0 + bh + int(rng.integers(0, 6)), c0 + bw + int(rng.integers(0, 6))
+    mask = np.zeros((h, w), bool)
+    mask[r0 : r0 + bh, c0 : c0 + bw] = own
+    near = (rng.random((h, w)) >= rng.choice([0.0, 0.1])) & (mask | (rng.random((h, w)) < 0.2))
+    if not near.any():
+        near[r0, c0] = True
+    depth = np.round(rng.uniform(0.5, 0.52, (h, w)), 3)
+    core = np.zeros((h, w), bool)
+    core[r0 : r0 + bh, c0 : c0 + bw] = _taxicab_core(own, iterations)
+    core &= near
+    if core.any():
+        rows, cols = np.nonzero(core)
+    else:
+        rows, cols = np.nonzero(near & mask if (near & mask).any() else near)
+    first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
+    got = _jit.surface_apex(mask[r0 : r0 + bh, c0 : c0 + bw], iterations, near, depth, mask, r0, c0, 5)
+    assert (int(got[0]), int(got[1])) == (int(rows[first]), int(cols[first]))

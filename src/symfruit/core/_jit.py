@@ -3982,39 +3982,32 @@ def surface_apex(
     Since issue 19's nineteenth round the erosion is one taxicab distance map of the box instead of ``iterations``
     passes: eroding by the cross ``k`` times keeps the pixels whose every pixel within ``k`` steps along rows and
     columns is the mask's, those farther than ``k`` steps from a pixel not the mask's (or beyond the box), and the
-    city-block chamfer's two sweeps give those distances exactly (:func:`taxicab_within`'s, capped past ``k``)."""
+    city-block chamfer's two sweeps give those distances exactly (:func:`taxicab_within`'s, capped past ``k``).
+
+    Since stop 64 (ext64) the erosion is ``iterations`` passes of the cross again, over a uint8 copy of the box
+    framed by a pixel not the mask's (beyond the box not in it): each pass an and of five reads that the compiler
+    runs on many pixels at once, where the chamfer's row sweeps carried a running count from pixel to pixel (2.4
+    against about 5 us a fruit on the benchmark frame's boxes). A pixel is kept by ``k`` passes of the cross exactly
+    where every pixel within ``k`` taxicab steps is the mask's, the distance map's test: the same pixels, gathered
+    in the same raster order."""
     bh, bw = own.shape
-    cap = iterations + 1
-    # stop 60 (speeds60): the city-block distances by rows, then by columns (the taxicab distance is the least over
-    # the rows of the row distance plus the rows between: two sweeps down and up, each row's columns apart, which the
-    # compiler runs on several columns at once), beyond the box not the mask's: the same distances, capped alike
-    d = np.empty((bh, bw), np.int32)
+    a = np.zeros((bh + 2, bw + 2), np.uint8)
+    b = np.zeros((bh + 2, bw + 2), np.uint8)
     for r in range(bh):
-        run = 0
         for c in range(bw):
-            run = min(run + 1, cap) if own[r, c] else 0
-            d[r, c] = run
-        run = 0
-        for c in range(bw - 1, -1, -1):
-            run = min(run + 1, cap) if own[r, c] else 0
-            d[r, c] = min(d[r, c], run)
-    for c in range(bw):
-        d[0, c] = min(d[0, c], 1)
-    for r in range(1, bh):
-        for c in range(bw):
-            d[r, c] = min(d[r, c], d[r - 1, c] + 1)
-    for c in range(bw):
-        d[bh - 1, c] = min(d[bh - 1, c], 1)
-    for r in range(bh - 2, -1, -1):
-        for c in range(bw):
-            d[r, c] = min(d[r, c], d[r + 1, c] + 1)
+            a[r + 1, c + 1] = own[r, c]
+    for _ in range(iterations):
+        for r in range(1, bh + 1):
+            for c in range(1, bw + 1):
+                b[r, c] = a[r, c] & a[r - 1, c] & a[r + 1, c] & a[r, c - 1] & a[r, c + 1]
+        a, b = b, a
     h, w = near.shape
     rows = np.empty(h * w, np.int64)
     cols = np.empty(h * w, np.int64)
     n = 0
     for r in range(bh):
         for c in range(bw):
-            if d[r, c] > iterations and near[r + r0, c + c0]:
+            if a[r + 1, c + 1] and near[r + r0, c + c0]:
                 rows[n], cols[n] = r + r0, c + c0
                 n += 1
     if n == 0:
