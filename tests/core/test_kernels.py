@@ -7563,9 +7563,10 @@ def test_fruit_surface_by_its_compiled_measures_and_cap_is_the_twins_to_the_bit(
 
 def test_surface_cap_reaches_each_answer():
     """``surface_cap`` on a disc's depth: no pixel in the slab (0); the cap done (1), its pixels ``monotone_region``'s
-    or'd with the deep ones (the distance map given, or made in the call as ``inner_distance`` makes it); left to the
-    caller (2) with the tolerance infinite or the sectors' table too small for the apex's farthest pixel, the apex the
-    same; and (3) the map left to the caller too where the mask fills its box grown by a pixel."""
+    or'd with the deep ones (the distance map given, or told without it: stop 64); left to the caller (2), the map
+    made in the call as ``inner_distance`` makes it where none was given, with the tolerance infinite or the
+    sectors' table too small for the apex's farthest pixel, the apex the same; and (3) the map left to the caller too
+    where the mask fills its box grown by a pixel."""
     from scipy import ndimage
 
     from symfruit.core.raster import inner_distance
@@ -7594,7 +7595,9 @@ def test_surface_cap_reaches_each_answer():
             if answer == 1:
                 deep = (inner if have else inner_distance(mask, 8.0)) > 8.0
                 assert np.array_equal(out, monotone_region(depth, near, (45, 75), tol) | (near & deep))
-                assert have or np.array_equal(made, inner_distance(mask, 8.0))
+                assert have or not made.any()  # stop 64: the deep pixels told without the map (deep_pixels)
+            if answer == 2:
+                assert have or np.array_equal(made, inner_distance(mask, 8.0))  # the caller's to read
     assert answers == [0, 0, 1, 1, 2, 2, 2, 2]
     full = np.ones(mask.shape, bool)  # its box grown by a pixel (clipped) all the mask's
     near, out = np.empty(mask.shape, bool), np.zeros(mask.shape, bool)
@@ -8743,3 +8746,104 @@ def test_pair_sums_are_the_scalar_loops_sums(seed, n, bins, odd):
                     acc[k] = acc[k] + term
             want += acc
     assert np.array(got).tobytes() == np.array(want).tobytes()
+
+
+# --- stop 64, ext64 ---
+
+
+def _taxicab_core(own: np.ndarray, iterations: int) -> np.ndarray:
+    """The pixels of ``own`` (h, w) bool farther than ``iterations`` taxicab steps from every pixel not its own
+    (beyond the array not its own): stop 60's distance map, by brute force."""
+    h, w = own.shape
+    far = np.zeros((h, w), bool)
+    yy, xx = np.mgrid[-1 : h + 1, -1 : w + 1]
+    framed = np.zeros((h + 2, w + 2), bool)
+    framed[1:-1, 1:-1] = own
+    ys, xs = yy[~framed], xx[~framed]
+    for r in range(h):
+        for c in range(w):
+            far[r, c] = bool((np.abs(ys - r) + np.abs(xs - c)).min() > iterations)
+    return far
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(0, 12))
+def test_surface_apex_core_by_passes_of_the_cross(seed, iterations):
+    """Stop 64: the apex's core by ``iterations`` passes of the cross (no distance map) keeps the pixels farther than
+    ``iterations`` taxicab steps from any pixel not the box's mask (brute force), on random boxes of 1-30 rows and
+    columns (full, empty of core, with holes, one row or column) anywhere in a window, eroded 0-12 times: the apex
+    is the first least 5 x 5 median among those core pixels that are near, as the twin's pass finds it."""
+    from symfruit.core.surface import median_at
+
+    rng = np.random.default_rng(seed)
+    bh, bw = (int(x) for x in rng.integers(1, 31, 2))
+    kind = int(rng.integers(0, 3))
+    own = np.ones((bh, bw), bool) if kind == 0 else rng.random((bh, bw)) >= (0.03 if kind == 1 else 0.3)
+    r0, c0 = (int(x) for x in rng.integers(0, 6, 2))
+    h, w = r0 + bh + int(rng.integers(0, 6)), c0 + bw + int(rng.integers(0, 6))
+    mask = np.zeros((h, w), bool)
+    mask[r0 : r0 + bh, c0 : c0 + bw] = own
+    near = (rng.random((h, w)) >= rng.choice([0.0, 0.1])) & (mask | (rng.random((h, w)) < 0.2))
+    if not near.any():
+        near[r0, c0] = True
+    depth = np.round(rng.uniform(0.5, 0.52, (h, w)), 3)
+    core = np.zeros((h, w), bool)
+    core[r0 : r0 + bh, c0 : c0 + bw] = _taxicab_core(own, iterations)
+    core &= near
+    if core.any():
+        rows, cols = np.nonzero(core)
+    else:
+        rows, cols = np.nonzero(near & mask if (near & mask).any() else near)
+    first = int(np.argmin(median_at(np.where(near, depth, np.inf), rows, cols, size=5)))
+    got = _jit.surface_apex(mask[r0 : r0 + bh, c0 : c0 + bw], iterations, near, depth, mask, r0, c0, 5)
+    assert (int(got[0]), int(got[1])) == (int(rows[first]), int(cols[first]))
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_deep_pixels_are_the_distance_maps(seed):
+    """Stop 64: ``deep_pixels`` ors into ``out`` the pixels of ``near`` whose ``near_distance`` to the box's pixels not
+    the mask's lies beyond ``deep_px``, as ``surface_cap`` did with the map: random masks (sparse holes, a single
+    pixel out, none out), boxes anywhere, ``near`` and ``out`` random, ``deep_px`` any, a whole number, a square
+    root or one just below it (where the float limit and the root disagree first)."""
+    rng = np.random.default_rng(seed)
+    h, w = (int(x) for x in rng.integers(1, 40, 2))
+    mask = rng.random((h, w)) < rng.uniform(0.5, 1.0)
+    kind = int(rng.integers(0, 4))
+    if kind in (1, 3):  # one to three pixels out: distances met exactly at the limit
+        mask[:] = True
+        for _ in range(1 if kind == 1 else int(rng.integers(2, 4))):
+            mask[rng.integers(0, h), rng.integers(0, w)] = False
+    elif kind == 2:
+        mask[:] = True
+    near = rng.random((h, w)) < rng.uniform(0.3, 1.0)
+    a0, b0 = int(rng.integers(0, h)), int(rng.integers(0, w))
+    a1, b1 = int(rng.integers(a0 + 1, h + 1)), int(rng.integers(b0 + 1, w + 1))
+    root = math.sqrt(int(rng.integers(1, 400)))
+    deep_px = float(rng.choice([rng.uniform(0, 20), float(rng.integers(0, 20)), root, np.nextafter(root, 0)]))
+    before = rng.random((h, w)) < rng.choice([0.0, 0.3])
+    inner = np.zeros((h, w))
+    _jit.near_distance(mask[a0:a1, b0:b1], deep_px, False, inner[a0:a1, b0:b1])
+    want = before | (near & (inner > deep_px))
+    got = before.copy()
+    _jit.deep_pixels(mask, a0, a1, b0, b1, deep_px, near, got)
+    np.testing.assert_array_equal(got, want)
+
+
+def test_deep_pixels_known_answer():
+    """Stop 64: one pixel out of a full mask, ``deep_px`` 4: the pixels at a distance of exactly 4 (the same row or
+    column) are not deeper, those beyond are, those nearer are not; ``out``'s pixels stay, beyond the box none is
+    added, and the pixels not ``near`` are left."""
+    mask = np.ones((20, 20), bool)
+    mask[10, 10] = False
+    near = np.ones((20, 20), bool)
+    near[0, 0] = False
+    out = np.zeros((20, 20), bool)
+    out[10, 11] = True
+    _jit.deep_pixels(mask, 1, 20, 0, 20, 4.0, near, out)
+    rr, cc = np.mgrid[:20, :20]
+    d2 = (rr - 10) ** 2 + (cc - 10) ** 2
+    want = (d2 > 16) & near
+    want[0, :] = False  # beyond the box
+    want[10, 11] = True
+    np.testing.assert_array_equal(out, want)
