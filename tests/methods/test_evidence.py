@@ -1266,3 +1266,60 @@ def test_a_lost_rims_back_face_short_by_more_than_its_error_pulls_by_its_clean_e
     a, b = fit_sd**-2, (s.depth_ratio_sd * width) ** -2
     assert got.max[2] == pytest.approx((a * bound + b * (z + width)) / (a + b), rel=1e-9)
     assert bound < got.max[2] < 0.5 * (bound + z + width)
+
+
+def _ellipse_fuse(rim, box_depth, lost_rim, half=(20.0, 12.0), contour=1.0):
+    """``fuse_depth`` on an outline ``2 half`` px across (along u, v) 0.5 m away, the shapes' box ``box_depth``
+    smaller half-widths deep, ``rim`` the rim coverage: ``(box, width, settings, z, across)``."""
+    from symfruit import Box
+    from symfruit.core.raster import Silhouette, across_sight
+    from symfruit.methods.evidence import Combined, fuse_depth
+
+    cam = DEFAULT_CAMERA
+    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
+    yy, xx = np.mgrid[:60, :60]
+    region = Silhouette(u0, v0, ((xx - 29.5) / half[0]) ** 2 + ((yy - 29.5) / half[1]) ** 2 <= 1.0, 0.0)
+    across = across_sight(region, cam)
+    z = 0.5
+    ru, rv = half[0] * z / cam.fx, half[1] * z / cam.fy
+    box = Box(np.array([-ru, -rv, z]), np.array([ru, rv, z + box_depth * min(ru, rv)]))
+    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.0005)
+    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
+    s = EvidenceSettings(lost_rim=lost_rim)
+    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=rim, across=across)
+    return got, width, s, z, across
+
+
+def test_a_lost_rims_bound_is_raised_no_farther_than_the_least_depth_the_prior_allows():
+    """Stop 64 (docs/lone64.md, ``lost_rim: least``): an outline 40 x 24 px (elongation 1.67), the shapes' back half
+    its smaller width behind the front (a cap without its rim), the rim 20 % seen. The prior's depth is the geometric
+    mean of the outline's widths (31 px), but a solid of revolution lying in the image is as deep as the smaller one
+    (24 px) and an oblate one as the larger: ``bound`` raises the shapes' back to the mean, which the prior alone then
+    decides; ``least`` only to the smaller width (a lower bound says at least, the prior's range begins there), which
+    the shapes' clean error then holds against the prior. On a round outline or a cut one the two are the same."""
+    bounded, width, s, z, across = _ellipse_fuse(0.2, 1.0, "bound")
+    least, width_l, _, _, _ = _ellipse_fuse(0.2, 1.0, "least")
+    assert width_l == width
+    scale = width / np.sqrt(across.minor * across.major)  # tangent units to metres at the box's distance
+    small = across.minor * scale
+    assert small == pytest.approx(width * np.sqrt(across.minor / across.major), rel=1e-12)
+    assert 0.7 * width < small < 0.85 * width
+    assert bounded.max[2] == pytest.approx(z + width, rel=1e-12)  # the prior's back
+    fit_sd = np.hypot(s.back_inflation * 0.0005, width * s.shape_error)
+    a, b = fit_sd**-2, (s.depth_ratio_sd * width) ** -2
+    assert least.max[2] == pytest.approx((a * (z + small) + b * (z + width)) / (a + b), rel=1e-9)
+    assert z + small < least.max[2] < z + 0.5 * (small + width)
+    # the rim 95 % seen: the shapes' back may be short by 0.05 widths only, short of the least depth: as ``bound``
+    near = _ellipse_fuse(0.95, 1.0, "bound")[0], _ellipse_fuse(0.95, 1.0, "least")[0]
+    assert near[0].max[2] == pytest.approx(near[1].max[2], rel=1e-12)
+    # beyond the least depth, short of the prior's: read as an estimate with the lost rim's error (``pull``)
+    mid = _ellipse_fuse(0.4, 2.3, "pull")[0], _ellipse_fuse(0.4, 2.3, "least")[0]
+    assert mid[0].max[2] == pytest.approx(mid[1].max[2], rel=1e-12)
+    # a cut outline (half of it a contour): its smaller width measures the cut, ``least`` is ``bound``
+    cut = _ellipse_fuse(0.2, 1.0, "bound", contour=0.5)[0], _ellipse_fuse(0.2, 1.0, "least", contour=0.5)[0]
+    assert cut[0].max[2] == cut[1].max[2] and cut[0].min.tolist() == cut[1].min.tolist()
+    # a round outline: ``least`` is ``bound`` (to the digitised disc's widths, equal within 1e-6)
+    for rim in (0.2, 0.9):
+        round_ = _ellipse_fuse(rim, 1.0, "bound", (20.0, 20.0))[0], _ellipse_fuse(rim, 1.0, "least", (20.0, 20.0))[0]
+        assert round_[0].max[2] == pytest.approx(round_[1].max[2], rel=1e-6)
+        assert round_[0].max[2] != pytest.approx(_ellipse_fuse(rim, 1.0, "pull", (20.0, 20.0))[0].max[2], rel=1e-4)

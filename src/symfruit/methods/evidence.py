@@ -207,11 +207,11 @@ class EvidenceSettings(Section):
         is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
         real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
         the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
-    lost_rim : {"pull", "bound"}
+    lost_rim : {"pull", "bound", "least"}
         How :func:`fuse_depth` reads the shapes' back face where the seen region's rim holds no points
         (:func:`rim_coverage` under 1: a time-of-flight camera's lost rim) and it lies in front of the prior's:
         ``pull`` (the default before stop 63) as an estimate with the lost rim's error (``rim_error``) added to its
-        spread, so that it pulls the box's back towards itself; ``bound`` (the default since stop 63,
+        spread, so that it pulls the box's back towards itself; ``bound`` (the default at stop 63,
         docs/prior63.md) as what it is, a lower bound: a shape fitted to a cap without its rim comes out short,
         never deep, by up to that error, so where the prior's back lies within it the prior alone decides, and
         beyond it the shapes' clean error pulls. With the rim seen (``rim`` 1) the two are the same. On the real
@@ -222,7 +222,19 @@ class EvidenceSettings(Section):
         4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm (the Azure Kinect model they are
         rendered through sees 3.4-3.8 mm too far there, its range bias, which the prior's back, ``front + width``,
         keeps and the shapes' short back had offset); on lone generated fruit, whose boxes are already deep, the
-        camera models' centres 0.1-0.4 mm farther off (README "Real cameras", stop 63).
+        camera models' centres 0.1-0.4 mm farther off (README "Real cameras", stop 63). ``least`` (the default since
+        stop 64, docs/lone64.md): the lower bound is raised no farther than the least depth the prior allows, the
+        outline's smaller width (:func:`prior_width` ``least``; a solid of revolution lying in the image is as deep as
+        that if prolate, as its larger width if oblate, and the prior's geometric mean is the middle of that range),
+        beyond which the shapes' clean error holds it against the prior; a shapes' back beyond that least depth is read
+        as ``pull`` reads it. On a round outline ``least`` is ``bound``, and on a cut one (under ``covered_contour`` of
+        it a contour), whose smaller width measures the cut, and on the points' own outline (no mask: a lost rim narrows
+        it by a band on every side, more across than along). The lone generated fruit through the camera models: centre
+        5.54 / 5.12 / 4.16 / 3.78 mm (``bound``; ``pull`` 5.42 / 4.78 / 3.99 / 3.41) -> 4.57 / 4.55 / 3.86 / 3.24 (Azure
+        Kinect, L515, D435, D405), the lemons and pears most; the perturbed real frames 22 of 208 over the bar either
+        way; the development apple trees (CW1) seeds 0-3 IoU 0.796 -> 0.794, depth side 4.3 -> 4.5 mm, seeds 6-11 0.771
+        -> 0.774, centre 5.3 -> 5.2 mm. Without the whole-outline condition the trees' depth sides were 5.1 and 5.3 mm
+        and the real frames' leaf cuts 2 of 8 over (from 0).
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
@@ -380,7 +392,7 @@ class EvidenceSettings(Section):
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     cut_circle: Literal["off", "free"] = setting("free")
-    lost_rim: Literal["pull", "bound"] = setting("bound")
+    lost_rim: Literal["pull", "bound", "least"] = setting("least")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -591,7 +603,7 @@ def _lateral(dist: float, sized: Across, box: Box) -> float:
 
 
 def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Tilt | None = None,
-                prolate: bool = False, floor: float = 0.3) -> float:  # fmt: skip
+                prolate: bool = False, floor: float = 0.3, *, least: bool = False) -> float:  # fmt: skip
     """The silhouette's width the depth prior reads (tangent units: times the distance, metres): the geometric
     mean of its widths across and along its principal axis for a whole outline (a solid of revolution is as deep
     as one of them, whichever way its axis lies in the image), moved in log towards the larger by ``cut_width``
@@ -605,9 +617,17 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
     seen from its side), a leaf across half the fruit a whole radius; hence the square. On an outline that is
     all contour nothing changes.
 
+    ``least``: the least depth that reading allows instead (``lost_rim: least``): a solid of revolution is as deep
+    as its outline's smaller width (its axis in the image: prolate) or its larger (oblate), and the geometric mean is
+    the middle of that range in log; its lower end is the smaller width, moved towards the larger as the mean is
+    (by the square of the cut share, twice the mean's exponent). With the seen front's tilt (``tilt``) the depth
+    is the tilt's, its own least.
+
     >>> a = Across(np.zeros(3), np.zeros((2, 3)), np.zeros(2), np.zeros(2), 0.04, 0.09)
     >>> round(prior_width(a, 1.0), 4), round(prior_width(a, 0.0), 4), round(prior_width(a, 0.5), 4)
     (0.06, 0.09, 0.0664)
+    >>> round(prior_width(a, 1.0, least=True), 4), round(prior_width(a, 0.0, least=True), 4)
+    (0.04, 0.09)
     """
     small, big = sorted((float(across.minor), float(across.major)))
     if small <= 0.0:
@@ -619,7 +639,7 @@ def prior_width(across: Across, contour: float, cut_width: float = 1.0, tilt: Ti
         half = tilt.half_depths(floor)[0] if prolate else tilt.half_depth(floor)
         depth = min(max(half / tilt.major * big, 0.5 * small), 2.0 * big)
         return depth * (big / depth) ** cut
-    return big * (small / big) ** (0.5 * (1.0 - cut))
+    return big * (small / big) ** ((1.0 if least else 0.5) * (1.0 - cut))
 
 
 def _tilt_outer(occlusion: Occlusion | None, which: str) -> Silhouette | None:
@@ -776,6 +796,7 @@ def fuse_depth(
     tilt: Tilt | None = None,
     whole: tuple[float, float] | None = None,
     faces: tuple[np.ndarray, np.ndarray] | None = None,
+    masked: bool = True,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -785,7 +806,9 @@ def fuse_depth(
     of the fruit's whole outline where a cut one's are not (``cut_prior``): the prior reads them as an uncut
     outline's where that is wider (a cut only ever narrows an outline). ``faces``: the tangent extents ``(lo, hi)``
     in ``across``' frame of the fruit's whole outline where a cut one's are not (``cut_faces``), the silhouette's box
-    for the lateral faces.
+    for the lateral faces. ``masked``: the outline is the fruit's mask's (occlusion information), not the points' own,
+    which a lost rim narrows by a band on every side and so more across than along (``lost_rim: least`` reads its
+    smaller width only on a mask's outline).
 
     The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
     width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
@@ -810,7 +833,17 @@ def fuse_depth(
         if s.cut_spread == "ellipse" and ellipse > width:
             read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, ellipse)
+    least = None
+    if s.lost_rim == "least" and masked and combined.contour >= s.covered_contour:
+        # the least depth the prior allows, read as its width is: on a whole outline (a cut one's smaller width
+        # measures the cut, not the fruit; there ``least`` is ``bound``)
+        least = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate",
+                                  s.tilt_floor, least=True))  # fmt: skip
+        if whole is not None:
+            least = max(least, float(min(whole)))
+        least = float(least * box.centre[2] / across.axis[2])
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
+    least = width if least is None else least
 
     def shapes_sd(model: float) -> float:  # the shapes' back-face deviation with ``model`` widths of model error
         return math.sqrt(float((s.back_inflation * back_std) ** 2 + (0.5 * spread) ** 2 + model**2))
@@ -822,8 +855,16 @@ def fuse_depth(
     prior_sd = s.depth_ratio_sd * width / max(read, 0.25)
     prior_back = front + s.depth_ratio * width
     shapes_back = fit_back
-    bounded = s.lost_rim == "bound" and rim < 1.0 and fit_back < prior_back
-    if bounded:
+    bounded = s.lost_rim != "pull" and rim < 1.0 and fit_back < prior_back
+    if bounded and s.lost_rim == "least":
+        # a lower bound is raised no farther than the least depth the prior allows (the outline's smaller width for
+        # an elongated one: a prolate fruit lying in the image is that deep), beyond which the clean error pulls
+        reach = front + s.depth_ratio * min(least, width)
+        bounded = fit_back < reach
+        if bounded:
+            fit_back = min(reach, fit_back + width * s.rim_error * (1.0 - rim))
+            fit_sd = shapes_sd(width * s.shape_error)
+    elif bounded:
         # A shape fitted to a cap whose rim the camera lost is short by up to what the rim hides, never deep: its
         # back face then says the fruit reaches at least there (and, within the rim's share of its error, no
         # farther than that beyond), not where. Inside that range the prior decides; beyond it the fit's clean
@@ -996,7 +1037,8 @@ def evidence(
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
-                                     across=sized, tilt=tilt, whole=whole, faces=faces)  # fmt: skip
+                                     across=sized, tilt=tilt, whole=whole, faces=faces,
+                                     masked=occlusion is not None)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
     # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
