@@ -211,7 +211,7 @@ class EvidenceSettings(Section):
         How :func:`fuse_depth` reads the shapes' back face where the seen region's rim holds no points
         (:func:`rim_coverage` under 1: a time-of-flight camera's lost rim) and it lies in front of the prior's:
         ``pull`` (the default before stop 63) as an estimate with the lost rim's error (``rim_error``) added to its
-        spread, so that it pulls the box's back towards itself; ``bound`` (the default at stop 63,
+        spread, so that it pulls the box's back towards itself; ``bound`` (the default since stop 63,
         docs/prior63.md) as what it is, a lower bound: a shape fitted to a cap without its rim comes out short,
         never deep, by up to that error, so where the prior's back lies within it the prior alone decides, and
         beyond it the shapes' clean error pulls. With the rim seen (``rim`` 1) the two are the same. On the real
@@ -222,8 +222,8 @@ class EvidenceSettings(Section):
         4.3 and 5.0 -> 4.6 mm, but their centres 4.2 -> 4.5 and 5.2 -> 5.3 mm (the Azure Kinect model they are
         rendered through sees 3.4-3.8 mm too far there, its range bias, which the prior's back, ``front + width``,
         keeps and the shapes' short back had offset); on lone generated fruit, whose boxes are already deep, the
-        camera models' centres 0.1-0.4 mm farther off (README "Real cameras", stop 63). ``least`` (the default since
-        stop 64, docs/lone64.md): the lower bound is raised no farther than the least depth the prior allows, the
+        camera models' centres 0.1-0.4 mm farther off (README "Real cameras", stop 63). ``least`` (stop 64, off,
+        docs/lone64.md): the lower bound is raised no farther than the least depth the prior allows, the
         outline's smaller width (:func:`prior_width` ``least``; a solid of revolution lying in the image is as deep as
         that if prolate, as its larger width if oblate, and the prior's geometric mean is the middle of that range),
         beyond which the shapes' clean error holds it against the prior; a shapes' back beyond that least depth is read
@@ -234,7 +234,10 @@ class EvidenceSettings(Section):
         Kinect, L515, D435, D405), the lemons and pears most; the perturbed real frames 22 of 208 over the bar either
         way; the development apple trees (CW1) seeds 0-3 IoU 0.796 -> 0.794, depth side 4.3 -> 4.5 mm, seeds 6-11 0.771
         -> 0.774, centre 5.3 -> 5.2 mm. Without the whole-outline condition the trees' depth sides were 5.1 and 5.3 mm
-        and the real frames' leaf cuts 2 of 8 over (from 0).
+        and the real frames' leaf cuts 2 of 8 over (from 0). Not the default: the held-out apple trees (seeds 100-111,
+        CW1, by label) read depth side 5.2 (-3.4) -> 5.6 (-3.9) mm, the visible apples' 4.0 -> 4.7 (an apple hangs
+        oblate, as deep as its larger width, and the smaller is the least); for elongated fruit seen side on (pears,
+        lemons) it is the better reading.
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
@@ -392,7 +395,7 @@ class EvidenceSettings(Section):
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     cut_circle: Literal["off", "free"] = setting("free")
-    lost_rim: Literal["pull", "bound", "least"] = setting("least")
+    lost_rim: Literal["pull", "bound", "least"] = setting("bound")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
