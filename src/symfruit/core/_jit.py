@@ -548,20 +548,20 @@ def near_distance(mask: np.ndarray, reach: float, want: bool, out: np.ndarray) -
     limit = reach * reach
     inf = np.inf
     if k <= _NEAR_PASSES_MOST:  # the rows by passes, each a column offset and side (stop 64, reg64)
-        best = np.empty(w, np.int64)
+        least = np.empty(w, np.int64)
         for r in range(h):
             g = g2[r]
             o = out[r]
             for c in range(w):
-                best[c] = g[c]  # at most cap2: the column's own term (a capped one is the search's start)
+                least[c] = g[c]  # at most cap2: the column's own term (a capped one is the search's start)
             for t in range(1, min(k, w - 1) + 1):
                 tt = t * t
                 for c in range(w - t):  # indices from 0 up: numba vectorises it (c - t would not)
-                    best[c + t] = min(best[c + t], g[c] + tt)
+                    least[c + t] = min(least[c + t], g[c] + tt)
                 for c in range(w - t):
-                    best[c] = min(best[c], g[c + t] + tt)
+                    least[c] = min(least[c], g[c + t] + tt)
             for c in range(w):
-                b = best[c]
+                b = least[c]
                 o[c] = math.sqrt(float(b)) if b <= limit else inf
         return
     for r in range(h):
