@@ -417,7 +417,7 @@ def _blobs(rng: np.random.Generator, h: int, w: int, share: float) -> np.ndarray
     return ndimage.binary_dilation(seeds, iterations=int(rng.integers(0, 4))) if seeds.any() else seeds
 
 
-@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 12.0), st.booleans())
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 40), st.floats(0.0, 24.0), st.booleans())
 def test_near_distance_is_the_twins_to_the_bit(seed, h, w, reach, want):
     from symfruit.core.raster import _near_distance
 
@@ -426,6 +426,54 @@ def test_near_distance_is_the_twins_to_the_bit(seed, h, w, reach, want):
     out = np.full((h, w), -1.0)
     _jit.near_distance(mask, reach, want, out)
     assert np.array_equal(out, _near_distance(mask == want, reach))
+
+
+def _capped_reference(edges: np.ndarray, cap: float) -> np.ndarray:
+    """:func:`symfruit.core._jit.capped_distances`' map before stop 64: :func:`symfruit.core._jit.near_distance` of
+    reach ``cap``, capped at ``cap`` as a float32."""
+    away = np.empty(edges.shape)
+    _jit.near_distance(edges, cap, True, away)
+    return np.where(away < cap, away, cap).astype(np.float32)
+
+
+@given(st.integers(0, 2**32 - 1), st.integers(1, 50), st.integers(1, 50),
+       st.one_of(st.floats(0.0, 16.0), st.sampled_from([0.0, 0.5, 1.0, 2.0, 6.0, 7.2, 64.0])))  # fmt: skip
+def test_the_capped_map_is_near_distances_capped_to_the_bit(seed, h, w, cap):
+    """stop 64 (reg64): :func:`symfruit.core._jit._capped_map`'s passes along the rows give the map
+    :func:`symfruit.core._jit.near_distance`'s search gave, to the bit: sparse and dense edges (blobs, lines, single
+    pixels, none, all), whole and fractional caps, caps wider than the map, maps of one row or column."""
+    rng = np.random.default_rng(seed)
+    kind = int(rng.integers(0, 4))
+    if kind == 0:
+        edges = _blobs(rng, h, w, rng.uniform(0.0, 0.1))
+    elif kind == 1:  # thin lines, as colour edges lie
+        edges = np.zeros((h, w), bool)
+        for _ in range(int(rng.integers(1, 5))):
+            r, c = int(rng.integers(0, h)), int(rng.integers(0, w))
+            edges[r, :] |= rng.random(w) < 0.8
+            edges[:, c] |= rng.random(h) < 0.8
+    elif kind == 2:
+        edges = rng.random((h, w)) < rng.uniform(0.0, 1.0)
+    else:
+        edges = np.full((h, w), bool(rng.integers(0, 2)))
+    out = np.full((h, w), -1.0, np.float32)
+    _jit._capped_map(edges, cap, out)
+    ref = _capped_reference(edges, cap)
+    assert out.dtype == ref.dtype and np.array_equal(out, ref) and np.array_equal(np.signbit(out), np.signbit(ref))
+
+
+@pytest.mark.parametrize("cap", [0.0, 1.0, 2.9, 6.0, 6.5, 7.99])
+def test_the_capped_map_reads_each_offset_on_both_sides(cap):
+    """A single edge pixel: every pixel's capped Euclidean distance to it, at distances on both sides along the row
+    (each offset's pass, the last one, ``floor(cap)``, too: it counts where the cap is not whole), across the rows
+    (the columns' sweeps), and at the cap itself (``sqrt(36)`` is 6, kept)."""
+    edges = np.zeros((19, 25), bool)
+    edges[9, 12] = True
+    out = np.empty(edges.shape, np.float32)
+    _jit._capped_map(edges, cap, out)
+    rr, cc = np.mgrid[:19, :25]
+    want = np.minimum(np.sqrt((rr - 9.0) ** 2 + (cc - 12.0) ** 2), cap).astype(np.float32)
+    assert np.array_equal(out, want)
 
 
 def test_the_distance_maps_are_the_twins_to_the_bit(monkeypatch):
@@ -3791,7 +3839,7 @@ def test_near_distance_on_fruit_sized_windows_is_the_twins_to_the_bit(seed):
     mask = ((rr - h / 2) / a) ** 2 + ((cc - w / 2) / b) ** 2 <= 1.0
     mask &= rng.random((h, w)) > rng.uniform(0.0, 0.05)  # dropped pixels: holes and a ragged edge
     mask |= _blobs(rng, h, w, 0.002)
-    for reach in (0.0, 1.0, 2.5, 5.5, 8.0, 10.3, 15.0):
+    for reach in (0.0, 1.0, 2.5, 5.5, 8.0, 10.3, 13.0, 15.0, 16.0, 16.9, 17.0, 24.5):  # both sides of stop 64's passes
         for want in (False, True):
             out = np.full((h, w), -1.0)
             _jit.near_distance(mask, reach, want, out)
