@@ -1213,23 +1213,9 @@ def test_a_prior_read_from_the_free_arcs_ellipse_keeps_an_uncut_outlines_spread(
 
 def _disc_fuse(rim, box_depth, lost_rim, contour=1.0):
     """``fuse_depth`` on a disc 40 px across 0.5 m away, the shapes' box ``box_depth`` radii deep (a lost rim's short
-    back), ``rim`` the rim coverage: ``(box, width, settings, z, r)``."""
-    from symfruit import Box
-    from symfruit.core.raster import Silhouette, across_sight
-    from symfruit.methods.evidence import Combined, fuse_depth
-
-    cam = DEFAULT_CAMERA
-    u0, v0 = int(cam.cx) - 30, int(cam.cy) - 30
-    yy, xx = np.mgrid[:60, :60]
-    region = Silhouette(u0, v0, np.hypot(yy - 29.5, xx - 29.5) <= 20, 0.0)
-    across = across_sight(region, cam)
-    z, r = 0.5, 20.0 * 0.5 / cam.fx
-    box = Box(np.array([-r, -r, z]), np.array([r, r, z + box_depth * r]))
-    cand = Candidate("cone", box.min, box.max, None, box.centre, 0.0005)
-    combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
-    s = EvidenceSettings(lost_rim=lost_rim)
-    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=rim, across=across)
-    return got, width, s, z, r
+    back), ``rim`` the rim coverage: ``(box, width, settings, z, r)`` (:func:`_ellipse_fuse`'s round outline)."""
+    got, width, s, z, _ = _ellipse_fuse(rim, box_depth, lost_rim, half=(20.0, 20.0), contour=contour)
+    return got, width, s, z, 20.0 * z / DEFAULT_CAMERA.fx
 
 
 def test_a_lost_rims_short_back_face_bounds_the_depth_from_below_and_does_not_pull_it():
