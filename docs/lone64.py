@@ -10,7 +10,9 @@ PROXIES --n N``), each completed by `evidence` under several settings, with what
 (default: ``bound``, ``pull`` and ``least``). ``--fruit examples/scans --n 20``: the real scans' rows. Per view and
 variant: centre error and IoU (as the evaluation scores them), the box's depth side less the truth's (``dz``), and the
 fusion's terms: the shapes' back and the prior's back less the true back (``fit``, ``prior``, mm, the front taken as the
-box's), the rim coverage, the outline's elongation (major / minor width) and whether the bound applied.
+box's), the rim coverage, the outline's elongation (major / minor width), whether the bound applied and, under
+``lost_rim: cap``, how far the cap said prolate (``prolate``; docs/tilt64.md). ``--grow PX``: every mask grown by a
+disc of PX pixels first (an annotator's overshoot).
 """
 
 from __future__ import annotations
@@ -21,6 +23,7 @@ import sys
 from typing import Any
 
 import numpy as np
+from scipy import ndimage
 
 import symfruit.methods.evidence as ev
 from symfruit.evaluate.metrics import score_completion
@@ -44,6 +47,7 @@ def _recording(combined: Any, cands: Any, region: Any, camera: Any, **kw: Any) -
         front=front, fit_back=float(combined.box.max[2]), prior_back=front + s.depth_ratio * width, width=width,
         rim=float(kw.get("rim", 1.0)), back=float(box.max[2]),
         elong=float(across.major / max(across.minor, 1e-12)) if across is not None else float("nan"),
+        prolate=kw.get("prolate"),
     )  # fmt: skip
     return box, back_sd, width
 
@@ -68,6 +72,9 @@ def run(args: argparse.Namespace) -> None:
                 if len(ex.points) < base.extract.min_points:
                     continue
                 mask = ex.silhouette if ex.silhouette is not None else moved > 0
+                if args.grow > 0:  # an annotator's mask, overshooting the fruit by a disc of ``grow`` pixels
+                    d = np.arange(-args.grow, args.grow + 1)
+                    mask = ndimage.binary_dilation(mask, structure=d[:, None] ** 2 + d[None, :] ** 2 <= args.grow**2)
                 occ = fruit_occlusion(inst.depth, mask, ex.points, camera, base.occlusion, eroded=base.extract.erode_px)
                 t = inst.truth_box
                 row: dict[str, Any] = {"sensor": sensor, "kind": inst.kind, "index": spec.index,
@@ -83,6 +90,7 @@ def run(args: argparse.Namespace) -> None:
                         "prior": 1000 * (_seen["prior_back"] - true_back),
                         "front": 1000 * (_seen["front"] - true_front), "rim": _seen["rim"], "elong": _seen["elong"],
                         "bounded": _seen["fit_back"] < _seen["prior_back"] and _seen["rim"] < 1.0,
+                        "prolate": _seen["prolate"],
                     }  # fmt: skip
                 out.write(json.dumps(row) + "\n")
                 out.flush()
@@ -129,6 +137,7 @@ def main(argv: list[str] | None = None) -> int:
     r.add_argument("--n", type=int, default=10)
     r.add_argument("--seed", type=int, default=0)
     r.add_argument("--variant", action="append", default=[], metavar="NAME=JSON")
+    r.add_argument("--grow", type=int, default=0, help="grow each mask by a disc of this many pixels (overshoot)")
     s = sub.add_parser("summary", help="mean figures per group and variant")
     s.add_argument("out", nargs="+")
     s.add_argument("--by", choices=("sensor", "kind", "both"), default="sensor")

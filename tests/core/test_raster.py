@@ -680,6 +680,29 @@ def test_tilt_share_shrinks_to_the_geometric_mean_when_the_cap_cannot_tell():
     assert hopeless.half_depth() == pytest.approx(np.sqrt(0.04 * 0.034), rel=1e-6)
 
 
+def test_tilt_oblate_share_reads_prolate_lying_and_oblate_side_on():
+    from symfruit.core.raster import Tilt, across_sight, axis_tilt, silhouette
+
+    # a level midline: the prolate spheroid's cap is 1, the oblate's major / minor, the share the log between
+    assert Tilt(0.04, 0.034, 0.0, 0.0, 1.0, 0.0, 500).oblate_share() == 0.0
+    assert Tilt(0.04, 0.034, 0.0, 0.0, 0.04 / 0.034, 0.0, 500).oblate_share() == pytest.approx(1.0, rel=1e-12)
+    assert Tilt(0.04, 0.034, 0.0, 0.0, np.sqrt(0.04 / 0.034), 0.0, 500).oblate_share() == pytest.approx(0.5)
+    assert Tilt(0.04, 0.034, 0.0, 0.0, 2.0, 0.0, 500).oblate_share() == 1.0  # clipped
+    # no estimate, or a round outline (the two caps agree): nothing said
+    assert Tilt(0.04, 0.034, 0.0, 0.0, 1.0, 0.0, 0).oblate_share() is None
+    assert Tilt(0.04, 0.04, 0.0, 0.0, 1.0, 0.0, 500).oblate_share() is None
+    # the cap known to no better than the two hypotheses are apart: halfway back to a half
+    gap = np.log(0.04 / 0.034)
+    unsure = Tilt(0.04, 0.034, 0.0, 0.0, 0.04 / 0.034, 0.0, 500, cap_sd=gap * 0.04 / 0.034)
+    assert unsure.oblate_share() == pytest.approx(0.75, rel=1e-9)
+    # fitted fronts: a prolate spheroid 30 x 50 mm lying in the image, an oblate 40 x 28 mm seen side on
+    for a, c, want in ((0.03, 0.05, 0.0), (0.04, 0.028, 1.0)):
+        pts, cam, _ = _spheroid_front(a, c, 0, 30.0, noise=0.0016)
+        region = silhouette(pts, cam)
+        share = axis_tilt(pts, region, cam, across_sight(region, cam)).oblate_share()
+        assert share is not None and abs(share - want) < 0.2
+
+
 def test_axis_tilt_blocks_measure_the_fits_uncertainty():
     from symfruit.core.raster import across_sight, axis_tilt, silhouette
 

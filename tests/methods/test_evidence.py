@@ -1254,7 +1254,7 @@ def test_a_lost_rims_back_face_short_by_more_than_its_error_pulls_by_its_clean_e
     assert bound < got.max[2] < 0.5 * (bound + z + width)
 
 
-def _ellipse_fuse(rim, box_depth, lost_rim, half=(20.0, 12.0), contour=1.0):
+def _ellipse_fuse(rim, box_depth, lost_rim, half=(20.0, 12.0), contour=1.0, prolate=None):
     """``fuse_depth`` on an outline ``2 half`` px across (along u, v) 0.5 m away, the shapes' box ``box_depth``
     smaller half-widths deep, ``rim`` the rim coverage: ``(box, width, settings, z, across)``."""
     from symfruit import Box
@@ -1272,7 +1272,7 @@ def _ellipse_fuse(rim, box_depth, lost_rim, half=(20.0, 12.0), contour=1.0):
     cand = Candidate("cone", box.min, box.max, None, box.centre, 0.0005)
     combined = Combined(box, {"cone": 1.0}, {"cone": 0.0}, 1.0, 0.0, 1.0, contour, 0.0)
     s = EvidenceSettings(lost_rim=lost_rim)
-    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=rim, across=across)
+    got, _, width = fuse_depth(combined, [cand], region, cam, s=s, rim=rim, across=across, prolate=prolate)
     return got, width, s, z, across
 
 
@@ -1309,3 +1309,22 @@ def test_a_lost_rims_bound_is_raised_no_farther_than_the_least_depth_the_prior_a
         round_ = _ellipse_fuse(rim, 1.0, "bound", (20.0, 20.0))[0], _ellipse_fuse(rim, 1.0, "least", (20.0, 20.0))[0]
         assert round_[0].max[2] == pytest.approx(round_[1].max[2], rel=1e-6)
         assert round_[0].max[2] != pytest.approx(_ellipse_fuse(rim, 1.0, "pull", (20.0, 20.0))[0].max[2], rel=1e-4)
+
+
+def test_a_lost_rims_bound_reaches_the_least_depth_as_far_as_the_cap_says_prolate():
+    """Stop 64 (docs/tilt64.md, ``lost_rim: cap``): the outline and shapes of the ``least`` test above. Where the seen
+    cap says prolate (``prolate`` 1) the bound reaches the outline's smaller width, as ``least``'s does; where it says
+    oblate or cannot tell (0, or no tilt read) the mean's, as ``bound``'s; between, the log between the two widths."""
+    least = _ellipse_fuse(0.2, 1.0, "least")[0]
+    bounded, width, s, z, across = _ellipse_fuse(0.2, 1.0, "bound")
+    assert _ellipse_fuse(0.2, 1.0, "cap", prolate=1.0)[0].max[2] == pytest.approx(least.max[2], rel=1e-12)
+    for prolate in (0.0, None):
+        got = _ellipse_fuse(0.2, 1.0, "cap", prolate=prolate)[0]
+        assert got.max[2] == pytest.approx(bounded.max[2], rel=1e-12)
+        assert got.min.tolist() == pytest.approx(bounded.min.tolist(), rel=1e-12)
+    half = _ellipse_fuse(0.2, 1.0, "cap", prolate=0.5)[0]
+    reach = width * np.sqrt(np.sqrt(across.minor / across.major))  # half-way in log from the mean to the smaller
+    fit_sd = np.hypot(s.back_inflation * 0.0005, width * s.shape_error)
+    a, b = fit_sd**-2, (s.depth_ratio_sd * width) ** -2
+    assert half.max[2] == pytest.approx((a * (z + reach) + b * (z + width)) / (a + b), rel=1e-9)
+    assert least.max[2] < half.max[2] < bounded.max[2]

@@ -1214,8 +1214,17 @@ class Tilt:
         which is the outline's for a level midline) by ``d^2 / (d^2 + (cap_sd / cap)^2)``, ``d`` the two
         hypotheses' caps apart in log: a cap that cannot tell them apart says nothing of which it is."""
         prolate, oblate = self.half_depths(floor)
-        if self.count == 0:
+        share = self.oblate_share(floor)
+        if share is None:
             return float(np.sqrt(prolate * oblate))
+        return float(prolate ** (1.0 - share) * oblate**share)
+
+    def oblate_share(self, floor: float = 0.05) -> float | None:
+        """Where :attr:`cap` lies between the prolate spheroid's cap and the oblate one's, in log, in [0, 1] (0: the
+        prolate's, 1: the oblate's), shrunk towards a half by :attr:`cap_sd` as :meth:`half_depth` reads it; None where
+        there is no estimate or the two caps agree (the cap cannot tell them apart)."""
+        if self.count == 0:
+            return None
         big, small = self.major, self.minor
         gap = max(big * big - small * small, floor * big * big)
         var = self.slope_sd**2
@@ -1223,12 +1232,12 @@ class Tilt:
         cap_o = big / small * np.sqrt(max(1.0 - max(self.slope_minor**2 - var, 0.0) * small * small / gap, 0.25))
         lo, hi = np.log(max(cap_p, 1e-6)), np.log(max(cap_o, 1e-6))
         if abs(hi - lo) < 1e-3:
-            return float(np.sqrt(prolate * oblate))
+            return None
         share = float(np.clip((np.log(max(self.cap, 1e-6)) - lo) / (hi - lo), 0.0, 1.0))
         if self.cap_sd > 0:
             noise = (self.cap_sd / max(self.cap, 1e-6)) ** 2
             share = 0.5 + (share - 0.5) * (hi - lo) ** 2 / ((hi - lo) ** 2 + noise)
-        return float(prolate ** (1.0 - share) * oblate**share)
+        return share
 
 
 def _outline_to(

@@ -207,7 +207,7 @@ class EvidenceSettings(Section):
         is taken (wider than the cut outline's): the width is then the whole outline's, not the cut one's. On the
         real spheres cut by a leaf the prior took 0.68-0.70 of the 125 mm sphere's back face, against 0.93 uncut, and
         the shapes' back (24 mm short on a time-of-flight camera's lost rim) kept the rest: depth 115 -> 120-122 mm.
-    lost_rim : {"pull", "bound", "least"}
+    lost_rim : {"pull", "bound", "least", "cap"}
         How :func:`fuse_depth` reads the shapes' back face where the seen region's rim holds no points
         (:func:`rim_coverage` under 1: a time-of-flight camera's lost rim) and it lies in front of the prior's:
         ``pull`` (the default before stop 63) as an estimate with the lost rim's error (``rim_error``) added to its
@@ -237,7 +237,14 @@ class EvidenceSettings(Section):
         and the real frames' leaf cuts 2 of 8 over (from 0). Not the default: the held-out apple trees (seeds 100-111,
         CW1, by label) read depth side 5.2 (-3.4) -> 5.6 (-3.9) mm, the visible apples' 4.0 -> 4.7 (an apple hangs
         oblate, as deep as its larger width, and the smaller is the least); for elongated fruit seen side on (pears,
-        lemons) it is the better reading.
+        lemons) it is the better reading. ``cap`` (stop 64, off, docs/tilt64.md): ``least``'s reach as far as the
+        seen cap says prolate (:meth:`~symfruit.core.raster.Tilt.oblate_share` of the fit
+        :func:`~symfruit.core.raster.axis_tilt` makes with ``tilt_outline`` and ``tilt_blocks``, read whatever
+        ``prior_tilt`` is): the reach is the smaller width to the power ``1 - 2 share`` times the mean's to the rest,
+        the mean's from half-way on and where no tilt is read. The lone generated fruit through the Azure Kinect model
+        (``tilt_outline: mask, tilt_blocks: 8``): centre 5.54 (``bound``) / 4.57 (``least``) -> 4.95 mm; the
+        development trees' (CW1) visible apples' depth sides 3.6 / 3.9 -> 3.8 mm (seeds 0-3) and 3.6 / 3.9 -> 3.7 mm
+        (seeds 6-11): the tree apples' caps read prolate more often than the lone ones'.
     cut_circle : {"free", "off"}
         With ``cut_prior: sides``, where the outline is cut and no ellipse through its free arcs was accepted
         (:func:`~symfruit.core.raster.outline_cone`: on the real spheres 43-59 px across with a leaf over a third of
@@ -395,7 +402,7 @@ class EvidenceSettings(Section):
     cut_reach: Literal["contour", "widest"] = setting("widest")
     cut_spread: Literal["contour", "ellipse"] = setting("ellipse")
     cut_circle: Literal["off", "free"] = setting("free")
-    lost_rim: Literal["pull", "bound", "least"] = setting("bound")
+    lost_rim: Literal["pull", "bound", "least", "cap"] = setting("bound")
     prior_tilt: Literal["off", "cap", "prolate"] = setting("off")
     tilt_floor: float = setting(0.3, gt=0.0, le=1.0)
     tilt_outline: Literal["points", "mask", "both"] = setting("points")
@@ -800,6 +807,7 @@ def fuse_depth(
     whole: tuple[float, float] | None = None,
     faces: tuple[np.ndarray, np.ndarray] | None = None,
     masked: bool = True,
+    prolate: float | None = None,
 ) -> tuple[Box, float, float]:
     """The box moved towards what the silhouette says: ``(box, back_sd, width)``, metres.
 
@@ -811,7 +819,8 @@ def fuse_depth(
     in ``across``' frame of the fruit's whole outline where a cut one's are not (``cut_faces``), the silhouette's box
     for the lateral faces. ``masked``: the outline is the fruit's mask's (occlusion information), not the points' own,
     which a lost rim narrows by a band on every side and so more across than along (``lost_rim: least`` reads its
-    smaller width only on a mask's outline).
+    smaller width only on a mask's outline). ``prolate``: how far the seen cap says prolate, in [0, 1]
+    (``lost_rim: cap``; None: not read, the mean's reach).
 
     The candidates' back face (the weighted median, :func:`combine`) and the prior ``front + depth_ratio *
     width`` are averaged by their inverse variances (module docstring, step 6); ``back_sd`` is the posterior
@@ -837,13 +846,15 @@ def fuse_depth(
             read = 1.0  # the width is the whole outline's (the ellipse's), not the cut one's
         width = max(width, ellipse)
     least = None
-    if s.lost_rim == "least" and masked and combined.contour >= s.covered_contour:
+    if s.lost_rim in ("least", "cap") and masked and combined.contour >= s.covered_contour:
         # the least depth the prior allows, read as its width is: on a whole outline (a cut one's smaller width
         # measures the cut, not the fruit; there ``least`` is ``bound``)
         least = float(prior_width(across, combined.contour, s.cut_width, tilt, s.prior_tilt == "prolate",
                                   s.tilt_floor, least=True))  # fmt: skip
         if whole is not None:
             least = max(least, float(min(whole)))
+        if s.lost_rim == "cap":  # the least width as far as the seen cap says prolate, the mean's where oblate
+            least = least ** (prolate or 0.0) * width ** (1.0 - (prolate or 0.0)) if least > 0 else width
         least = float(least * box.centre[2] / across.axis[2])
     width = float(width * box.centre[2] / across.axis[2])  # in that order: the former bits where no ellipse is
     least = width if least is None else least
@@ -859,7 +870,7 @@ def fuse_depth(
     prior_back = front + s.depth_ratio * width
     shapes_back = fit_back
     bounded = s.lost_rim != "pull" and rim < 1.0 and fit_back < prior_back
-    if bounded and s.lost_rim == "least":
+    if bounded and s.lost_rim in ("least", "cap"):
         # a lower bound is raised no farther than the least depth the prior allows (the outline's smaller width for
         # an elongated one: a prolate fruit lying in the image is that deep), beyond which the clean error pulls
         reach = front + s.depth_ratio * min(least, width)
@@ -1015,7 +1026,8 @@ def evidence(
     rim = rim_coverage(points, region, camera, inner=obs.inner, inner_reach=obs.inner_reach, pixels=pixels)
     seen_back = float(hi[2])
     tilt = None
-    if s.prior_tilt != "off" and dense and obs.contour >= s.covered_contour:
+    capped = s.lost_rim == "cap" and occlusion is not None  # the seen cap says prolate or oblate (``lost_rim: cap``)
+    if (s.prior_tilt != "off" or capped) and dense and obs.contour >= s.covered_contour:
         # the points' own outline: the mask's may be shifted from the depth (registration) or reach past it
         outer = _tilt_outer(occlusion, s.tilt_outline)
         tilt = axis_tilt(sample, seen_region, camera, sized, outer=outer if s.tilt_outline == "mask" else None,
@@ -1039,9 +1051,13 @@ def evidence(
             whole = (sized.minor * stretch, sized.major * stretch)
             if reach is not None and s.cut_faces == "sides" and trimmed is None:  # the region's own outline
                 faces = tangent_extent(reach, sized, camera)
+    prolate = None
+    if capped and tilt is not None:  # how far the cap says prolate: 1 at the prolate spheroid's cap, 0 from half-way
+        share = tilt.oblate_share(s.tilt_floor)
+        prolate = 0.0 if share is None else min(max(1.0 - 2.0 * share, 0.0), 1.0)
     box, back_sd, width = fuse_depth(combined, cands, region, camera, s=s, rim=rim, seen_back=seen_back,
-                                     across=sized, tilt=tilt, whole=whole, faces=faces,
-                                     masked=occlusion is not None)  # fmt: skip
+                                     across=sized, tilt=tilt if s.prior_tilt != "off" else None, whole=whole,
+                                     faces=faces, masked=occlusion is not None, prolate=prolate)  # fmt: skip
     moved = 0.5 * abs(float(box.max[2] - combined.box.max[2]))  # the prior against the shapes
     # A fruit receding along the line of sight (a depth camera's view seen deeper than the half-width a round
     # fruit shows in front of its rim, as far as the outline is a contour) has a back that nothing seen
