@@ -862,13 +862,15 @@ def test_the_colour_trim_does_not_read_an_occluder_of_the_fruits_colour_as_its_s
     """Strip64 (docs/strip58.md cause 1): the ring beside the cut edges lies on the strip, which shows the ball's
     white; at the band the two summaries do not separate, at twice it they do, and the colour alone takes the
     halves' band all round (996 of 2,288 px; the ball uncut: none). Given the depth
-    (``front_depth``) with ``trim_front_ring``, the strip is left out of the ring and the mask is kept as drawn;
-    off (the default), the colour's trim."""
+    (``front_depth``) with ``trim_front_ring`` (the default since stripb64), the strip is left out of the ring and the
+    mask is kept as drawn; off, the colour's trim."""
     color, depth, labels, *_ = strip_ball()
     colour_only = trim_labels(color, labels)
     assert (labels == 1).sum() - (colour_only == 1).sum() >= 900
     assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels
-    assert np.array_equal(trim_labels(color, labels, front_depth=depth, focal=600.0), colour_only)  # the default
+    assert trim_labels(color, labels, front_depth=depth, focal=600.0) is labels  # the default
+    off = ExtractSettings(trim_front_ring=False)
+    assert np.array_equal(trim_labels(color, labels, off, front_depth=depth, focal=600.0), colour_only)
     whole_color, _, whole, *_ = strip_ball(strip_z=None)
     assert trim_labels(whole_color, whole) is whole
 
@@ -888,3 +890,24 @@ def test_the_ring_without_the_occluder_only_gives_back_what_the_colour_took():
     assert (grown & ~alone).sum() >= 500
     assert trim_labels(color, labels) is labels
     assert trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) is labels
+
+
+def test_the_ring_without_the_occluder_gives_back_only_where_it_finds_the_mask_tight():
+    """Stripb64 (docs/strip64.md section 6): the colour took the band all round, and the ring without the strip
+    takes some of the mask itself (an overshoot: the halves drawn 2 px over the background all round, 352 px). The
+    mask overshoots, and the colour's wider cut (1,199 px, 847 of them the ball's limb) stands as the colour alone
+    made it, as off: an overshoot the strip hid from the band is as likely wider than the band finds (the rendered
+    apple trees: a mask 4 px over its apple, the ring's band taking 2-3 px of it). Where the ring takes nothing (the
+    halves drawn tight, the test above), the colour's cut came from the strip alone and is given back."""
+    color, depth, _, strip, _ = strip_ball()
+    yy, xx = np.mgrid[:120, :160]
+    ball = ((xx - 80) ** 2 + (yy - 60) ** 2) <= 900
+    grown = (((xx - 80) ** 2 + (yy - 60) ** 2) <= 32**2) & ~strip
+    labels = grown.astype(np.int32)
+    colour_only = trim_labels(color, labels) == 1
+    assert (grown & ~colour_only).sum() == 1199 and (ball & grown & ~colour_only).sum() == 847
+    from symfruit.core.surface import colour_trim
+
+    ring = colour_trim(color, grown, band_px=4.0, wider=(8.0, 12.0), exclude=front_ring(depth, grown, 600.0))
+    assert np.array_equal(grown & ~ring, grown & ~ball)  # the ring alone finds the overshoot, 352 px
+    assert np.array_equal(trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) == 1, colour_only)

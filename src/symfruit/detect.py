@@ -662,15 +662,16 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
     so that the depth beside a mask is the depth there, and the shift is the colour's trim's alone), its ring
     leaving that out: ``trimmed`` (the colour-trimmed labels), ``ids`` (the masks the trim took pixels from) and
     ``boxes`` (their boxes) with those masks' new trims; the same objects where none has anything in front beside
-    it (issue 18, strip64)."""
-    if frame.color is None or not s.trim_front_ring or s.colour_trim_px <= 0:
+    it (issue 18, strip64). Only the masks of ``ids`` are looked at: the trim done again gives back only what the
+    colour took (stripb64: on by default, a mask the colour left whole costs nothing)."""
+    if frame.color is None or not s.trim_front_ring or s.colour_trim_px <= 0 or not ids:
         return trimmed, ids, boxes
     du, dv = shift
     depth = shift_labels(frame.depth, -du, -dv) if (du, dv) != (0, 0) else frame.depth
     focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
     out, new_ids, new_boxes = trimmed, ids, boxes
-    for k, sl in enumerate(drawn_boxes, 1):
-        if sl is None:
+    for k in sorted(ids):
+        if (sl := drawn_boxes[k - 1]) is None:
             continue
         r0, r1, c0, c1 = trim_window(drawn.shape, sl, s)
         mask = drawn[r0:r1, c0:c1] == k

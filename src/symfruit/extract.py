@@ -121,13 +121,15 @@ class ExtractSettings(Section):
         Given the depth (``detect``), after the registration the colour trim is done again on each mask beside which,
         within its convex hull, something lies in front of its fruit (:func:`front_ring`: a leaf or twig crossing it,
         the mask cut along it), with that left out of the ring the band is compared with; it only gives back what the
-        colour took, and nothing on the occluder itself. Where the occluder shows the fruit's own colour the band and
-        the ring did not separate, and a band twice as wide was taken all round (the real spheres under a strip 5 cm
-        in front, docs/strip58.md cause 1). Off by default (issue 18, strip64, docs/strip64.md): on, the real frames
-        cut by a strip go 2 -> 0 (unpainted) and 1 -> 0 (painted) of 8 boxes over the 6 mm bar, every other
-        perturbation the same; the development trees move 36 of 248 apples, 14 closer and 22 farther (seeds 0-3:
-        centre 4.5 -> 4.6 mm, median 3.6 -> 3.9; seeds 6-11: 5.3 -> 5.3, IoU 0.771 -> 0.772): there the same colour
-        trim's wider band had been right, the masks overshooting by up to 4 px.
+        colour took, and nothing on the occluder itself, and only where the ring without the occluder takes nothing
+        of the mask (finds it tight). Where the occluder shows the fruit's own colour the band and the ring did not
+        separate, and a band twice as wide was taken all round (the real spheres under a strip 5 cm in front,
+        docs/strip58.md cause 1). Where the ring without it takes some of the mask, the mask overshoots, and the
+        colour's wider cut stands: the occluder hid the overshoot from the band (the development trees' masks over
+        their apples by up to 4 px, the ring's band taking 2-3 px of it; given back, 36 of 248 apples moved, 22
+        farther: strip64). On by default since stripb64 (issue 18, docs/strip64.md section 6): the real frames cut by
+        a strip go 2 -> 0 (unpainted) and 1 -> 0 (painted) of 8 boxes over the 6 mm bar, every other perturbation
+        the same to the box; the development trees (seeds 0-3, 6-11) and every digest unchanged.
     slab : float
         Depth pixels farther than this many fruit radii (the mask's, at the fruit's depth) behind the
         fruit's front are not its surface (:func:`~symfruit.core.surface.fruit_surface`).
@@ -154,7 +156,7 @@ class ExtractSettings(Section):
     mask_edge_px: int = setting(10, ge=0, le=MAX_RADIUS_PX)
     colour_trim_px: int = setting(4, ge=0, le=MAX_RADIUS_PX)
     trim_keeps_surface: bool = setting(True)
-    trim_front_ring: bool = setting(False)
+    trim_front_ring: bool = setting(True)
     slab: float = setting(1.3, gt=0.0, le=100.0)
     convex_tolerance: float = setting(3.0, ge=0.0, le=1000.0)
     cluster_distance: float = setting(0.006, gt=0.0, le=1.0)
@@ -605,7 +607,7 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     shaded limb darkening towards a background of about its colour) that ring is the fruit itself (stop 57,
     docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198). Given
     ``front_depth`` (the frame's, as ``depth``) with ``s.trim_front_ring``, the colour's ring outside the mask leaves
-    out what lies in front of the fruit (:func:`front_ring`)."""
+    out what lies in front of the fruit (:func:`front_ring`), where that ring finds the mask tight."""
     r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
     mask = labels[r0:r1, c0:c1] == k
     radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
@@ -617,9 +619,12 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     if exclude is not None and (exclude & ~mask).any() and not kept.all(where=mask):
         # the ring without what lies in front gives back what the colour took only because the occluder was sampled
-        # as the surroundings; it takes nothing the colour alone left, and gives back nothing on the occluder itself
+        # as the surroundings; it takes nothing the colour alone left, and gives back nothing on the occluder itself;
+        # and only where it finds the mask tight: where it takes some of it, the mask overshoots, and the occluder in
+        # the ring hid that overshoot from the band, which the colour's wider cut then took (stripb64)
         ring = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider, exclude=exclude & ~mask)
-        kept = kept | (ring & ~exclude)
+        if ring.all(where=mask):
+            kept = kept | (ring & ~exclude)
     dropped = mask & ~kept
     if depth is not None and focal > 0.0 and s.trim_keeps_surface and dropped.any() and one_sided(mask, dropped):
         dropped &= ~own_cap(depth[r0:r1, c0:c1], mask, focal, s)

@@ -437,10 +437,10 @@ def test_a_strip_cutting_every_mask_in_two_leaves_every_sphere_a_cube_by_the_rin
     green. The colour trim compared each cut mask's band with a ring lying on the strip, and took the 125 mm
     sphere's band all round (unpainted: 120 x 121 x 116 mm) or its shaded lower limb (painted: the halves then not
     joined, 121 x 102 x 109). Done again after the registration with the strip left out of the ring
-    (``extract.trim_front_ring``, off by default), every sphere of frame 0 is a cube within 6 mm of its diameter;
-    off, sphere 2 is not (its depth side 10 mm short, or 20 mm across)."""
-    on = from_dict({"extract": {"trim_front_ring": True}})
-    for k, size, diameter in spheres(rp, name, settings=on):
+    (``extract.trim_front_ring``, on by default since stripb64), every sphere of frame 0 is a cube within 6 mm of its
+    diameter; off, sphere 2 is not (its depth side 10 mm short, or 20 mm across)."""
+    off = from_dict({"extract": {"trim_front_ring": False}})
+    for k, size, diameter in spheres(rp, name):
         assert np.ptp(size) <= 6.0 and abs(size[2] - diameter) <= 6.0, (name, k, size, diameter)
-    size, diameter = next((size, d) for k, size, d in spheres(rp, name) if k == 2)
+    size, diameter = next((size, d) for k, size, d in spheres(rp, name, settings=off) if k == 2)
     assert np.ptp(size) > 6.0 or abs(size[2] - diameter) > 6.0, (size, diameter)
