@@ -675,9 +675,9 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
             continue
         r0, r1, c0, c1 = trim_window(drawn.shape, sl, s)
         mask = drawn[r0:r1, c0:c1] == k
-        if not front_ring(depth[r0:r1, c0:c1], mask, focal, s).any():
+        if not (front := front_ring(depth[r0:r1, c0:c1], mask, focal, s)).any():
             continue
-        dropped = trim_mask(frame.color, drawn, k, sl, s, focal=focal, front_depth=depth)
+        dropped = trim_mask(frame.color, drawn, k, sl, s, focal=focal, front_depth=depth, front=front)
         gone = np.zeros_like(mask) if dropped is None else dropped[1]
         before = out[r0:r1, c0:c1] == k
         if np.array_equal(before, mask & ~gone):

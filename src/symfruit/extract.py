@@ -592,8 +592,8 @@ def _trim_checked(color: Any, labels: Any, settings: ExtractSettings | None) -> 
 
 
 def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice], s: ExtractSettings, *,
-              depth: np.ndarray | None = None, focal: float = 0.0, front_depth: np.ndarray | None = None
-              ) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
+              depth: np.ndarray | None = None, focal: float = 0.0, front_depth: np.ndarray | None = None,
+              front: np.ndarray | None = None) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
     """One mask's part of :func:`trim_labels` (checked arguments, ``s.colour_trim_px`` above 0): mask ``k`` of
     ``labels`` (its box ``sl``) trimmed by colour, as the window ``(r0, r1, c0, c1)`` and the (r1 - r0, c1 - c0)
     bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels, the
@@ -607,7 +607,8 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     shaded limb darkening towards a background of about its colour) that ring is the fruit itself (stop 57,
     docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198). Given
     ``front_depth`` (the frame's, as ``depth``) with ``s.trim_front_ring``, the colour's ring outside the mask leaves
-    out what lies in front of the fruit (:func:`front_ring`), where that ring finds the mask tight."""
+    out what lies in front of the fruit (:func:`front_ring`), where that ring finds the mask tight; ``front``: that
+    ring already read on the window :func:`trim_window` gives (the same pixels, not read again)."""
     r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
     mask = labels[r0:r1, c0:c1] == k
     radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
@@ -615,7 +616,7 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     wider = tuple(f * band for f in WIDER if f * band <= WIDEST * radius)
     exclude = None
     if front_depth is not None and focal > 0.0 and s.trim_front_ring:
-        exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s)
+        exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s) if front is None else front
     kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     if exclude is not None and (exclude & ~mask).any() and not kept.all(where=mask):
         # the ring without what lies in front gives back what the colour took only because the occluder was sampled
