@@ -869,21 +869,16 @@ def fuse_depth(
     prior_sd = s.depth_ratio_sd * width / max(read, 0.25)
     prior_back = front + s.depth_ratio * width
     shapes_back = fit_back
-    bounded = s.lost_rim != "pull" and rim < 1.0 and fit_back < prior_back
-    if bounded and s.lost_rim in ("least", "cap"):
-        # a lower bound is raised no farther than the least depth the prior allows (the outline's smaller width for
-        # an elongated one: a prolate fruit lying in the image is that deep), beyond which the clean error pulls
-        reach = front + s.depth_ratio * min(least, width)
-        bounded = fit_back < reach
-        if bounded:
-            fit_back = min(reach, fit_back + width * s.rim_error * (1.0 - rim))
-            fit_sd = shapes_sd(width * s.shape_error)
-    elif bounded:
-        # A shape fitted to a cap whose rim the camera lost is short by up to what the rim hides, never deep: its
-        # back face then says the fruit reaches at least there (and, within the rim's share of its error, no
-        # farther than that beyond), not where. Inside that range the prior decides; beyond it the fit's clean
-        # error pulls, as a whole rim's fit does (rim 1: the same as ``pull``).
-        fit_back = min(prior_back, fit_back + width * s.rim_error * (1.0 - rim))
+    # A shape fitted to a cap whose rim the camera lost is short by up to what the rim hides, never deep: its back
+    # face then says the fruit reaches at least there (and, within the rim's share of its error, no farther than that
+    # beyond), not where. Inside that range the prior decides; beyond it the fit's clean error pulls, as a whole rim's
+    # fit does (rim 1: the same as ``pull``). The bound reaches the prior's back (``bound``), or no farther than the
+    # least depth the prior allows (``least``, ``cap``: the outline's smaller width for an elongated one, a prolate
+    # fruit lying in the image being that deep; ``least`` is ``width`` where it is not read).
+    reach = front + s.depth_ratio * min(least, width)
+    bounded = s.lost_rim != "pull" and rim < 1.0 and fit_back < reach
+    if bounded:
+        fit_back = min(reach, fit_back + width * s.rim_error * (1.0 - rim))
         fit_sd = shapes_sd(width * s.shape_error)
     a, b = 1.0 / fit_sd**2, 1.0 / prior_sd**2
     fused = (a * fit_back + b * prior_back) / (a + b)
