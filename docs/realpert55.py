@@ -229,7 +229,10 @@ def run(out: Path, names: list[str], methods: tuple[str, ...], config: dict | No
 
 
 def load(out: Path, name: str) -> list[SphereBox]:
-    data = json.loads((out / f"{name}.json").read_text())
+    path = out / f"{name}.json"
+    if not path.is_file():  # a folder that is not a `run` output, or a run that has not reached this perturbation
+        raise SystemExit(f"realpert55: {path}: no such file (`python docs/realpert55.py run {out}` writes it)")
+    data = json.loads(path.read_text())
     return [SphereBox(**{**r, "size": tuple(r["size"]), **({"centre": tuple(r["centre"])} if "centre" in r else {})})
             for r in data["rows"]]  # fmt: skip
 
