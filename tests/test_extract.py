@@ -5,7 +5,7 @@ import re
 
 import numpy as np
 import pytest
-from hypothesis import given
+from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy import ndimage
 
@@ -28,6 +28,8 @@ from symfruit.extract import (
     shift_labels,
     star_shaped,
     trim_labels,
+    trim_mask,
+    trim_window,
 )
 from symfruit.io import read_frame
 
@@ -911,3 +913,109 @@ def test_the_ring_without_the_occluder_gives_back_only_where_it_finds_the_mask_t
     ring = colour_trim(color, grown, band_px=4.0, wider=(8.0, 12.0), exclude=front_ring(depth, grown, 600.0))
     assert np.array_equal(grown & ~ring, grown & ~ball)  # the ring alone finds the overshoot, 352 px
     assert np.array_equal(trim_labels(color, labels, FRONT, front_depth=depth, focal=600.0) == 1, colour_only)
+
+
+# --- front64: the front ring's fruit surface and the trim done again, worked out once
+
+
+def _front_ring_before(depth, mask, focal):
+    """front_ring as stop 64 (stripb64) wrote it: the fruit's whole surface read wherever something outside the mask
+    within its hull lies nearer than its farthest depth less 3 mm (the reference for front64's)."""
+    from symfruit.core.surface import _FREE_PX, _free_tol, fruit_surface, within
+    from symfruit.segment.colour import convex_hull_mask
+
+    s = ExtractSettings()
+    z = np.asarray(depth, dtype=np.float64)
+    with np.errstate(invalid="ignore"):
+        valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0)
+        lost = ~(z > 0)
+    out = np.zeros(mask.shape, bool)
+    seen = z[mask & valid]
+    if not seen.size:
+        return out
+    ahead = ~mask & valid & (z < float(seen.max()) - 0.003) & convex_hull_mask(mask)
+    if not ahead.any():
+        return out
+    zv = np.where(valid, z, 0.0)
+    surface = fruit_surface(zv, mask, focal, slab=s.slab, tolerance=s.convex_tolerance, thin=True, clean=True)
+    if surface is None:
+        return out
+    nearer = valid & (zv < surface.front - _free_tol(surface))
+    ahead &= nearer
+    if not ahead.any():
+        return out
+    out = ahead | (lost & ~mask & within(ahead, _FREE_PX))
+    if (on := nearer & mask).any():
+        out |= on | (lost & mask & within(on, _FREE_PX))
+    return out
+
+
+def _front_case(seed):
+    """A random :func:`strip_ball` (the strip mostly 5 cm in front of the ball's front, else in front of, at, or
+    behind it, or none; a board below half the time), its depth noisy, the mask the ball's halves grown or shrunk a
+    few pixels or as they are (the strip's pixels drawn into it a fifth of the time)."""
+    rng = np.random.default_rng(seed)
+    strip_z = None if rng.random() < 0.1 else float(rng.uniform(0.22, 0.34) if rng.random() < 0.3 else 0.25)
+    color, depth, _, strip, _ = strip_ball(strip_z=strip_z, board=bool(rng.random() < 0.5))
+    depth = np.where(depth > 0, depth + rng.normal(scale=float(rng.uniform(0.0, 0.002)), size=depth.shape), 0.0)
+    yy, xx = np.mgrid[:120, :160]
+    r = 30.0 if rng.random() < 0.5 else float(rng.uniform(27.0, 33.0))  # the ball's own outline half the time
+    mask = ((xx - 80) ** 2 + (yy - 60) ** 2) <= r * r
+    if rng.random() >= 0.2:
+        mask &= ~strip
+    return color, depth.astype(np.float32), mask
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_front_ring_is_the_one_read_on_the_whole_fruit_surface_s(seed):
+    """Front64: the fruit's slab and cap are worked out only where something ahead lies in front of its front (the
+    ring is otherwise empty): the same ring as with the whole surface read first, with the kernels and their
+    twins."""
+    _, depth, mask = _front_case(seed)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        for kernels in ("compiled", "numpy"):
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            assert np.array_equal(front_ring(depth, mask, 600.0), _front_ring_before(depth, mask, 600.0))
+
+
+def test_the_front_ring_reads_no_fruit_surface_where_nothing_lies_ahead_of_its_front(monkeypatch):
+    """Known answers: a strip 2 cm behind the ball's front (nearer than its farthest depth) leaves the ring empty
+    without the fruit's slab and cap (the compiled cap or its twin's apex never reached); a strip in front, one
+    surface worked out to the end."""
+    import symfruit.core.surface as surface
+
+    reached = []
+    for name in ("_surface_compiled", "_surface"):
+        real = getattr(surface, name)
+        monkeypatch.setattr(surface, name, lambda *a, _real=real, **k: reached.append(1) or _real(*a, **k))
+    _, depth, labels, *_ = strip_ball(strip_z=0.32)
+    assert not front_ring(depth, labels == 1, 600.0).any() and not reached
+    _, depth, labels, *_ = strip_ball()
+    assert front_ring(depth, labels == 1, 600.0).any() and len(reached) == 1
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_trim_done_again_given_the_colours_own_trim_is_the_one_worked_out_s(seed):
+    """Front64: :func:`trim_mask` given ``kept`` (what the colour alone kept of the mask: the mask less its own cut)
+    drops the same pixels as working the colour's trim out again, with the front ring read or given; a ``kept``
+    that keeps the whole mask is read (the colour took nothing: nothing is dropped)."""
+    color, depth, mask = _front_case(seed)
+    labels = mask.astype(np.int32)
+    s = ExtractSettings()
+    sl = ndimage.find_objects(labels)[0]
+    r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
+    colour = trim_mask(color, labels, 1, sl, s)
+    own = labels[r0:r1, c0:c1] == 1
+    kept = own.copy()
+    if colour is not None:
+        kept[colour[1]] = False
+    worked = trim_mask(color, labels, 1, sl, s, focal=600.0, front_depth=depth)
+    given_kept = trim_mask(color, labels, 1, sl, s, focal=600.0, front_depth=depth, kept=kept)
+    assert (worked is None) == (given_kept is None)
+    if worked is not None:
+        assert worked[0] == given_kept[0] and np.array_equal(worked[1], given_kept[1])
+    assert trim_mask(color, labels, 1, sl, s, focal=600.0, front_depth=depth, kept=own) is None

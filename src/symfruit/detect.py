@@ -677,9 +677,10 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
         mask = drawn[r0:r1, c0:c1] == k
         if not (front := front_ring(depth[r0:r1, c0:c1], mask, focal, s)).any():
             continue
-        dropped = trim_mask(frame.color, drawn, k, sl, s, focal=focal, front_depth=depth, front=front)
-        gone = np.zeros_like(mask) if dropped is None else dropped[1]
+        # the colour's own trim of the mask: what it kept of it (another mask's trim takes none of its pixels)
         before = out[r0:r1, c0:c1] == k
+        dropped = trim_mask(frame.color, drawn, k, sl, s, focal=focal, front_depth=depth, front=front, kept=before)
+        gone = np.zeros_like(mask) if dropped is None else dropped[1]
         if np.array_equal(before, mask & ~gone):
             continue
         if out is trimmed:

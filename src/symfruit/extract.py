@@ -21,7 +21,7 @@ from .core.surface import (
     _FREE_PX,
     ALL_ROUND,
     PART_POINTS,
-    _free_tol,
+    _free_tol_of,
     across_occluder,
     colour_trim,
     fruit_surface,
@@ -593,7 +593,8 @@ def _trim_checked(color: Any, labels: Any, settings: ExtractSettings | None) -> 
 
 def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, slice], s: ExtractSettings, *,
               depth: np.ndarray | None = None, focal: float = 0.0, front_depth: np.ndarray | None = None,
-              front: np.ndarray | None = None) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
+              front: np.ndarray | None = None,
+              kept: np.ndarray | None = None) -> tuple[tuple[int, int, int, int], np.ndarray] | None:  # fmt: skip
     """One mask's part of :func:`trim_labels` (checked arguments, ``s.colour_trim_px`` above 0): mask ``k`` of
     ``labels`` (its box ``sl``) trimmed by colour, as the window ``(r0, r1, c0, c1)`` and the (r1 - r0, c1 - c0)
     bool pixels of the mask it drops there; None when it drops none. A mask's trimming reads its own pixels, the
@@ -608,7 +609,9 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     docs/shift57.md: the real 200 mm sphere's lower limb taken, its box 175-190 mm tall for 198). Given
     ``front_depth`` (the frame's, as ``depth``) with ``s.trim_front_ring``, the colour's ring outside the mask leaves
     out what lies in front of the fruit (:func:`front_ring`), where that ring finds the mask tight; ``front``: that
-    ring already read on the window :func:`trim_window` gives (the same pixels, not read again)."""
+    ring already read on the window :func:`trim_window` gives (the same pixels, not read again); ``kept``: the colour
+    trim's own answer on that window (:func:`~symfruit.core.surface.colour_trim`'s pixels kept, read where the mask
+    is alone: the mask less what :func:`trim_mask` without ``front_depth`` drops), not worked out again (front64)."""
     r0, r1, c0, c1 = trim_window(labels.shape, sl, s)
     mask = labels[r0:r1, c0:c1] == k
     radius = float(np.sqrt(np.count_nonzero(mask) / np.pi))
@@ -617,7 +620,8 @@ def trim_mask(color: np.ndarray, labels: np.ndarray, k: int, sl: tuple[slice, sl
     exclude = None
     if front_depth is not None and focal > 0.0 and s.trim_front_ring:
         exclude = front_ring(front_depth[r0:r1, c0:c1], mask, focal, s) if front is None else front
-    kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
+    if kept is None:
+        kept = colour_trim(color[r0:r1, c0:c1], mask, band_px=band, wider=wider)
     if exclude is not None and (exclude & ~mask).any() and not kept.all(where=mask):
         # the ring without what lies in front gives back what the colour took only because the occluder was sampled
         # as the surroundings; it takes nothing the colour alone left, and gives back nothing on the occluder itself;
@@ -762,15 +766,21 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     if not ahead.any():
         return out
     zv = np.where(valid, z, 0.0)
+    found: list[np.ndarray] = []
+
+    def wanted(front: float, noise: float) -> bool:
+        """Whether anything ahead lies nearer than the fruit's front by the free side's tolerance (``_free_tol``'s):
+        else the ring is empty whatever the fruit's surface, whose slab and cap are then not worked out (front64)."""
+        found.append(valid & (zv < front - _free_tol_of(noise)))
+        return bool((ahead & found[0]).any())
+
     surface = fruit_surface(zv, mask, focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
-                            clean=True)  # fmt: skip
+                            clean=True, wanted=wanted)  # fmt: skip
     if surface is None:
         return out
-    nearer = valid & (zv < surface.front - _free_tol(surface))
+    nearer = found[0]
     ahead &= nearer
-    if not ahead.any():
-        return out
     # and the mask's own pixels whose depth lies in front of the fruit too, with those without depth beside them (an
     # overshoot onto the occluder and its mixed pixels), which the ring without the occluder does not give back
     out = ahead | (lost & ~mask & within(ahead, _FREE_PX))

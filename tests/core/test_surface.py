@@ -1641,3 +1641,49 @@ def test_behind_a_flat_leaf_a_cap_flattened_below_a_fruits_curvature_is_still_th
         assert found is not None and found[0] == pytest.approx(1.25, abs=0.002)
     else:
         assert found is None
+
+
+# --- front64: a caller that reads the front and noise alone (fruit_surface's wanted) --------------------------------
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_fruit_surface_asks_wanted_with_its_own_front_and_noise_s(seed):
+    """``wanted`` is asked once, with the front and noise of the surface found without it (with the kernels and with
+    their twins, a leaf across the ball half the time: thin_front's front); answering True, the same surface;
+    answering False, None; no surface without it (under 10 pixels with depth), never asked."""
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(6, 30))
+    centre = (int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3)))
+    depth, disc = ball(centre=centre, radius_px=radius, noise=float(rng.uniform(0.0, 0.002)),
+                       table=bool(rng.random() < 0.5), seed=int(rng.integers(0, 100)))  # fmt: skip
+    if rng.random() < 0.5:  # a leaf 3 cm in front across the ball, drawn into the mask
+        yy = np.mgrid[:H, :W][0]
+        depth[np.abs(yy - centre[1]) <= max(radius // 4, 1)] = 0.47
+    mask = grown(disc, int(rng.integers(0, 3))) & (rng.random((H, W)) < 0.97)
+    if rng.random() < 0.1:
+        mask = mask & (rng.random((H, W)) < 0.002)  # hardly any pixels
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        for kernels in ("compiled", "numpy"):
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            plain = fruit_surface(depth, mask, F, thin=True)
+            for answer in (True, False):
+                asked: list[tuple[float, float]] = []
+
+                def wanted(front, noise, asked=asked, answer=answer):
+                    asked.append((front, noise))
+                    return answer
+
+                found = fruit_surface(depth, mask, F, thin=True, wanted=wanted)
+                if plain is None:
+                    assert found is None and len(asked) <= 1
+                    continue
+                assert asked == [(plain.front, plain.noise)]
+                if not answer:
+                    assert found is None
+                    continue
+                assert found is not None and np.array_equal(found.pixels, plain.pixels)
+                assert (found.front, found.radius, found.noise, found.apex) == (
+                    plain.front, plain.radius, plain.noise, plain.apex)  # fmt: skip

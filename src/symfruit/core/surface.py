@@ -1119,7 +1119,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
                   tolerance: float = 3.0, interior: float = 0.35,
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
                   leafy: np.ndarray | None = None, step: float | None = None,
-                  thin: bool = False, crossing: bool = False, clean: bool = False) -> Surface | None:  # fmt: skip
+                  thin: bool = False, crossing: bool = False, clean: bool = False,
+                  wanted: Callable[[float, float], bool] | None = None) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -1160,6 +1161,11 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         ``depth`` is already what its cleaning makes of it: every value finite and either above 0 or +0.0 (the
         registration's window, :func:`symfruit.core._jit.valid_depth`'s with a least depth above 0), so it is read
         as it is, not copied (stop 49: the same values).
+    wanted : callable, optional
+        Asked with the fruit's front and the depth's noise (metres: the :class:`Surface`'s ``front`` and ``noise``)
+        once they are known, before the slab and the convex cap: where it answers False, None is returned without
+        them (a caller that reads the front and noise alone, and has no use for a surface where they give it nothing:
+        :func:`~symfruit.extract.front_ring`). Otherwise the same surface.
 
     Returns
     -------
@@ -1245,6 +1251,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         # left out by the slab below
         front = behind
         radius = radius_px * front / focal
+    if wanted is not None and not wanted(front, noise):
+        return None  # the caller reads nothing off the surface with this front and noise (front64)
     # an elongated fruit may lie along the line of sight as far as it is long: half its major width
     minor_px, major_px = principal_widths(own, origin=(r0, c0))
     reach = max(radius, 0.5 * major_px * front / focal)
@@ -1651,7 +1659,12 @@ def _free_far(surface: Surface) -> float:
 def _free_tol(surface: Surface) -> float:
     """:func:`_free_points`' depth tolerance (m), the convexity test's: three times the depth's noise, at least 3 mm.
     Depth nearer than an outline point's own by more than it is something in front of the fruit there."""
-    return max(3.0 * surface.noise, 0.003)
+    return _free_tol_of(surface.noise)
+
+
+def _free_tol_of(noise: float) -> float:
+    """:func:`_free_tol` of a surface whose depth's noise is ``noise`` (metres)."""
+    return max(3.0 * noise, 0.003)
 
 
 def _occluders_edge(depth: np.ndarray, cap: np.ndarray, box: tuple[slice, slice], reach: float) -> np.ndarray:
