@@ -750,8 +750,9 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "front_ring")
     z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
+    zv = _usable_depth(z, mask, s)
+    valid = zv > 0.0
     with np.errstate(invalid="ignore"):
-        valid = np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0)
         lost = ~(z > 0)
     out = np.zeros(mask.shape, bool)
     seen = z[mask & valid]
@@ -765,7 +766,6 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     ahead &= convex_hull_mask(mask)
     if not ahead.any():
         return out
-    zv = np.where(valid, z, 0.0)
     found: list[np.ndarray] = []
 
     def wanted(front: float, noise: float) -> bool:
@@ -789,6 +789,18 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     return out
 
 
+def _usable_depth(z: np.ndarray, mask: np.ndarray, s: ExtractSettings) -> np.ndarray:
+    """(h, w) float: the depth ``z`` (metres, float64) where it is finite, above 0 and within the settings' range,
+    0 elsewhere, as :func:`fruit_surface` reads it (:func:`own_cap`, :func:`front_ring`); by the extraction's kernel
+    where numba is (the same map: stop 62, cap62)."""
+    if (jit := compiled()) is not None and z.ndim == 2:
+        valid = np.empty(z.shape)  # z > 0 and z >= the least depth is z >= the larger of it and the least double
+        jit.valid_depth(z, mask, max(float(s.min_depth), 5e-324), float(s.max_depth), valid, np.empty(z.shape, bool))
+        return valid
+    with np.errstate(invalid="ignore"):
+        return np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
+
+
 def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
     """(h, w) bool: the pixels of ``mask`` whose depth (metres, the same (h, w) window; 0 or NaN: none) lies on the
     fruit's own surface: the convex cap from its nearest point (:func:`~symfruit.core.surface.fruit_surface`, with
@@ -802,14 +814,8 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
     it (``trim_keeps_surface``)."""
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "own_cap")
-    z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
-    if (jit := compiled()) is not None and z.ndim == 2:  # the same map by the extraction's kernel (stop 62, cap62):
-        valid = np.empty(z.shape)  # z > 0 and z >= the least depth is z >= the larger of it and the least double
-        jit.valid_depth(z, mask, max(float(s.min_depth), 5e-324), float(s.max_depth), valid, np.empty(z.shape, bool))
-        z = valid
-    else:
-        with np.errstate(invalid="ignore"):
-            z = np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
+    mask = np.asarray(mask, dtype=bool)
+    z = _usable_depth(np.asarray(z, dtype=np.float64), mask, s)
     surface = fruit_surface(z, mask, focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
                             clean=True)  # fmt: skip
