@@ -1776,8 +1776,8 @@ def test_a_surface_read_on_one_window_is_the_one_read_on_another_holding_the_box
 
 def test_a_reading_is_not_taken_for_other_depth_mask_or_arguments():
     """Known answers: a reading made on the image is taken on the mask's box alone; not where one depth pixel of the box
-    differs by a bit (or 0.0 turns -0.0), one pixel of the mask differs, or the focal, tolerance, step or thin do;
-    and none is made with ``crossing`` or ``leafy``."""
+    differs by a bit (or 0.0 turns -0.0), one pixel of the mask differs, the focal, tolerance, step or thin do, or
+    the reading's depth was float32; and none is made with ``crossing`` or ``leafy``."""
     depth, disc = ball(radius_px=20, noise=0.001, seed=3)
     read: list = []
     plain = fruit_surface(depth, disc, F, thin=True, read=read)
@@ -1804,6 +1804,9 @@ def test_a_reading_is_not_taken_for_other_depth_mask_or_arguments():
         kw = {"thin": True, **change}
         focal = kw.pop("focal", F)
         assert fruit_surface(depth, disc, focal, **kw, known=known).noise < 0.1
+    single: list = []  # a reading of float32 depth (read as it is, clean) is not taken on float64 depth
+    fruit_surface(depth.astype(np.float32), disc, F, thin=True, clean=True, read=single)
+    assert fruit_surface(depth, disc, F, thin=True, known=dataclasses.replace(single[0], noise=0.125)).noise < 0.1
     for extra in ({"crossing": True}, {"leafy": np.zeros((H, W), bool)}):
         none: list = []
         fruit_surface(depth, disc, F, thin=True, read=none, **extra)

@@ -114,7 +114,8 @@ class Reading:
         ``depth`` (h, w) float64 hold on it what this was read from (the same pixels, the same bits); else None."""
         if given != self.given or not (
             isinstance(mask, np.ndarray) and isinstance(depth, np.ndarray) and mask.dtype == bool
-            and self.mask.dtype == bool and mask.ndim == 2 and depth.dtype == np.float64 and depth.shape == mask.shape
+            and self.mask.dtype == bool and mask.ndim == 2 and depth.dtype == self.depth.dtype == np.float64
+            and depth.shape == mask.shape
         ):  # fmt: skip
             return None
         if (found := mask_box(mask)) is None:
