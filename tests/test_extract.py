@@ -1019,3 +1019,40 @@ def test_the_trim_done_again_given_the_colours_own_trim_is_the_one_worked_out_s(
     if worked is not None:
         assert worked[0] == given_kept[0] and np.array_equal(worked[1], given_kept[1])
     assert trim_mask(color, labels, 1, sl, s, focal=600.0, front_depth=depth, kept=own) is None
+
+
+# --- surf65: own_cap reads the fruit's surface front_ring read on the same drawn mask and depth
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_own_cap_given_the_front_rings_reading_is_its_own_s(seed):
+    """A random :func:`_front_case`: the front ring read on a window about the mask (as ``detect._front_trimmed`` reads
+    it, ``trim_window``'s), ``own_cap`` on the mask's box (as ``keep_caps`` reads it) given its reading: the same cap as
+    without it, with the kernels and their twins; on the box's depth moved back a few millimetres, the reading is not
+    taken (the same cap as without it again)."""
+    from symfruit.core.raster import mask_box
+    from symfruit.extract import trim_window
+
+    _, depth, mask = _front_case(seed)
+    rng = np.random.default_rng(seed)
+    labels = mask.astype(np.int32)
+    box = mask_box(mask)
+    if box is None:
+        return
+    r0, r1, c0, c1 = trim_window(labels.shape, (slice(box[0], box[1]), slice(box[2], box[3])), FRONT)
+    a0, a1, b0, b1 = box
+    changed = depth.copy()
+    changed[a0:a1, b0:b1] += np.float32(rng.uniform(0.005, 0.03)) * (changed[a0:a1, b0:b1] > 0)  # moved back
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        for kernels in ("compiled", "numpy"):
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            read: list = []
+            front_ring(depth[r0:r1, c0:c1], mask[r0:r1, c0:c1], 600.0, FRONT, read=read)
+            known = read[0] if read else None
+            for z in (depth, changed):
+                alone = own_cap(z[a0:a1, b0:b1], mask[a0:a1, b0:b1], 600.0, FRONT)
+                given_known = own_cap(z[a0:a1, b0:b1], mask[a0:a1, b0:b1], 600.0, FRONT, known=known)
+                assert np.array_equal(alone, given_known)

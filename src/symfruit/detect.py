@@ -24,7 +24,7 @@ from .core.kernels import compiled
 from .core.limits import MAX_FOCAL_PX, MAX_INSTANCES, instance_labels
 from .core.occlusion import Occlusion
 from .core.raster import mask_box
-from .core.surface import _Outline, registration_outline, registration_search, registration_window
+from .core.surface import Reading, _Outline, registration_outline, registration_search, registration_window
 from .errors import InputError, SymfruitError
 from .extract import (
     Extraction,
@@ -281,11 +281,13 @@ def _start(prep: _Prepared, pool: FruitPool | None, leave: float | None = None) 
             boxes = [_box_within(labels, k, sl) if k in colour_trimmed else sl for k, sl in enumerate(boxes, 1)]
         t_trim = time.perf_counter() - t2
         moved, shift = register(labels, frame.depth, frame.camera, settings.extract, boxes=boxes)
-        front = _front_trimmed(frame, drawn, labels, colour_trimmed, drawn_boxes, boxes, shift, settings.extract)
+        readings: dict[int, Reading] = {}  # the drawn masks' surfaces read once for both (surf65)
+        front = _front_trimmed(frame, drawn, labels, colour_trimmed, drawn_boxes, boxes, shift, settings.extract,
+                               readings)  # fmt: skip
         if front[0] is not labels:  # a trim done again beside something in front: the new masks moved
             labels, colour_trimmed, boxes = front
             moved = shift_labels(labels, *shift) if shift != (0, 0) else labels
-        moved = _kept_caps(frame, drawn, labels, moved, colour_trimmed, drawn_boxes, shift, settings.extract)
+        moved = _kept_caps(frame, drawn, labels, moved, colour_trimmed, drawn_boxes, shift, settings.extract, readings)
         fruit, jobs, ended = _fruit_task(frame, labels, moved, shift, prep.hi, boxes, settings, method, outlined,
                                          colour_trimmed, drawn_boxes)  # fmt: skip
         t_extract = ended - t2
@@ -378,10 +380,11 @@ def _detect_shared(
         t_search = time.perf_counter() - b
         return found == guess
 
+    readings: dict[int, Reading] = {}  # the drawn masks' surfaces read once for both (surf65)
     trimmed, colour_trimmed, boxes = _front_trimmed(frame, labels, colour_only, colour_ids, drawn_boxes, colour_boxes,
-                                                    guess, settings.extract)  # fmt: skip
+                                                    guess, settings.extract, readings)  # fmt: skip
     moved = shift_labels(trimmed, *guess) if guess != (0, 0) else trimmed
-    moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, guess, settings.extract)
+    moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, guess, settings.extract, readings)
     fruit, jobs, ended = _fruit_task(frame, trimmed, moved, guess, hi, boxes, settings, method, outlined,
                                      colour_trimmed, drawn_boxes)  # fmt: skip
     t_register = t_outlines + ended - a  # the move's and the search's seconds with them
@@ -394,10 +397,12 @@ def _detect_shared(
         running.result()  # None: the workers' fruit dropped
         pool.registration_guess = found
         b = time.perf_counter()
+        readings = {}
         trimmed, colour_trimmed, boxes = _front_trimmed(frame, labels, colour_only, colour_ids, drawn_boxes,
-                                                        colour_boxes, found, settings.extract)  # fmt: skip
+                                                        colour_boxes, found, settings.extract, readings)  # fmt: skip
         moved = shift_labels(trimmed, *found) if found != (0, 0) else trimmed
-        moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, found, settings.extract)
+        moved = _kept_caps(frame, labels, trimmed, moved, colour_trimmed, drawn_boxes, found, settings.extract,
+                           readings)  # fmt: skip
         fruit, jobs, ended = _fruit_task(frame, trimmed, moved, found, hi, boxes, settings, method, outlined,
                                          colour_trimmed, drawn_boxes)  # fmt: skip
         t_register += ended - b
@@ -654,7 +659,7 @@ def _trim_labels(
 
 def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: set[int],
                    drawn_boxes: list[tuple[slice, slice] | None], boxes: list[tuple[slice, slice] | None],
-                   shift: tuple[int, int], s: ExtractSettings,
+                   shift: tuple[int, int], s: ExtractSettings, readings: dict[int, Reading] | None = None,
                    ) -> tuple[np.ndarray, set[int], list[tuple[slice, slice] | None]]:  # fmt: skip
     """The colour trim done again (``extract.trim_front_ring``) on each mask as drawn (``drawn``, boxes
     ``drawn_boxes``) beside which something lies in front of its fruit (:func:`~symfruit.extract.front_ring`,
@@ -663,7 +668,8 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
     leaving that out: ``trimmed`` (the colour-trimmed labels), ``ids`` (the masks the trim took pixels from) and
     ``boxes`` (their boxes) with those masks' new trims; the same objects where none has anything in front beside
     it (issue 18, strip64). Only the masks of ``ids`` are looked at: the trim done again gives back only what the
-    colour took (stripb64: on by default, a mask the colour left whole costs nothing)."""
+    colour took (stripb64: on by default, a mask the colour left whole costs nothing). ``readings``: given each mask's
+    surface reading (:func:`~symfruit.extract.front_ring`'s ``read``) by label, for :func:`_kept_caps` (surf65)."""
     if frame.color is None or not s.trim_front_ring or s.colour_trim_px <= 0 or not ids:
         return trimmed, ids, boxes
     du, dv = shift
@@ -675,7 +681,11 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
             continue
         r0, r1, c0, c1 = trim_window(drawn.shape, sl, s)
         mask = drawn[r0:r1, c0:c1] == k
-        if not (front := front_ring(depth[r0:r1, c0:c1], mask, focal, s)).any():
+        read: list[Reading] = []
+        front = front_ring(depth[r0:r1, c0:c1], mask, focal, s, read=read)
+        if readings is not None and read:
+            readings[k] = read[0]
+        if not front.any():
             continue
         # the colour's own trim of the mask: what it kept of it (another mask's trim takes none of its pixels)
         before = out[r0:r1, c0:c1] == k
@@ -697,13 +707,14 @@ def _front_trimmed(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, ids: se
 
 def _kept_caps(frame: Frame, drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],
                boxes: list[tuple[slice, slice] | None], shift: tuple[int, int],
-               settings: ExtractSettings) -> np.ndarray:  # fmt: skip
+               settings: ExtractSettings, readings: dict[int, Reading] | None = None) -> np.ndarray:  # fmt: skip
     """:func:`~symfruit.extract.keep_caps` of the frame: what a one-sided colour cut took of a fruit's own convex cap
-    given back to the masks ``moved`` by ``shift`` onto the depth image (``extract.trim_keeps_surface``)."""
+    given back to the masks ``moved`` by ``shift`` onto the depth image (``extract.trim_keeps_surface``);
+    ``readings``: :func:`_front_trimmed`'s with the same ``shift`` (surf65)."""
     if not settings.trim_keeps_surface or not ids:
         return moved
     focal = float(np.sqrt(frame.camera.fx * frame.camera.fy))
-    return keep_caps(drawn, trimmed, moved, ids, boxes, shift, frame.depth, focal, settings)
+    return keep_caps(drawn, trimmed, moved, ids, boxes, shift, frame.depth, focal, settings, readings=readings)
 
 
 def _box_within(labels: np.ndarray, k: int, sl: tuple[slice, slice] | None) -> tuple[slice, slice] | None:

@@ -21,6 +21,7 @@ from .core.surface import (
     _FREE_PX,
     ALL_ROUND,
     PART_POINTS,
+    Reading,
     _free_tol_of,
     across_occluder,
     colour_trim,
@@ -730,8 +731,8 @@ def _depth_checked(depth: Any, focal: Any, shape: tuple[int, ...], what: str) ->
     return z, f
 
 
-def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
-               settings: ExtractSettings | None = None) -> np.ndarray:  # fmt: skip
+def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None, *,
+               read: list[Reading] | None = None) -> np.ndarray:  # fmt: skip
     """(h, w) bool: the pixels outside ``mask`` but within its convex hull that lie in front of its fruit: depth
     (metres, the same (h, w) window; 0 or NaN: none) nearer than the fruit's front
     (:func:`~symfruit.core.surface.fruit_surface`'s, the nearest depth of the mask's depth mode) by more than the
@@ -746,7 +747,10 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
     band twice as wide was taken all round (the real spheres cut by a strip 5 cm in front: 1,066 of the 125 mm
     sphere's 4,509 px; docs/strip58.md, cause 1). Only within the hull: a support beside the fruit comes nearer than
     its front away from it (a board below the fruit seen obliquely, 6 mm nearer a row: the real spheres' masks grown
-    10 px), and does not cross it (issue 18, strip64, docs/strip64.md)."""
+    10 px), and does not cross it (issue 18, strip64, docs/strip64.md).
+
+    ``read``: a list given the fruit's surface's :class:`~symfruit.core.surface.Reading` where one is made (its front
+    and noise read on the mask's box alone), for :func:`own_cap` of the same mask on the same depth (surf65)."""
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "front_ring")
     z, mask = np.asarray(z, dtype=np.float64), np.asarray(mask, dtype=bool)
@@ -776,7 +780,7 @@ def front_ring(depth: np.ndarray, mask: np.ndarray, focal: float,
 
     surface = fruit_surface(zv, mask, focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
-                            clean=True, wanted=wanted)  # fmt: skip
+                            clean=True, wanted=wanted, read=read)  # fmt: skip
     if surface is None:
         return out
     nearer = found[0]
@@ -801,7 +805,8 @@ def _usable_depth(z: np.ndarray, mask: np.ndarray, s: ExtractSettings) -> np.nda
         return np.where(np.isfinite(z) & (z >= s.min_depth) & (z <= s.max_depth) & (z > 0), z, 0.0)
 
 
-def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None) -> np.ndarray:
+def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: ExtractSettings | None = None, *,
+            known: Reading | None = None) -> np.ndarray:  # fmt: skip
     """(h, w) bool: the pixels of ``mask`` whose depth (metres, the same (h, w) window; 0 or NaN: none) lies on the
     fruit's own surface: the convex cap from its nearest point (:func:`~symfruit.core.surface.fruit_surface`, with
     the settings' slab and convexity tolerance), no deeper than its front plus its radius (and the convexity test's
@@ -811,14 +816,15 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
     the whole way; what meets it at its outline at about that depth meets it at a crease (a board or a branch
     turning back towards the camera, a neighbour's front), where the convex cap stops, and what lies behind it lies
     deeper than the rim. So a pixel of the cap is the fruit's, whatever its colour: :func:`trim_mask` does not take
-    it (``trim_keeps_surface``)."""
+    it (``trim_keeps_surface``). ``known``: :func:`front_ring`'s reading of the mask's surface, taken where it was
+    read from the same box, depth and mask (:func:`~symfruit.core.surface.fruit_surface`'s ``known``; surf65)."""
     s = settings or ExtractSettings()
     z, focal = _depth_checked(depth, focal, np.shape(mask), "own_cap")
     mask = np.asarray(mask, dtype=bool)
     z = _usable_depth(np.asarray(z, dtype=np.float64), mask, s)
     surface = fruit_surface(z, mask, focal, slab=s.slab,
                             tolerance=s.convex_tolerance if s.convex_tolerance > 0 else np.inf, thin=True,
-                            clean=True)  # fmt: skip
+                            clean=True, known=known)  # fmt: skip
     if surface is None:
         return np.zeros(np.shape(mask), bool)
     # the rim's depth: the front plus the radius, plus the convexity test's tolerance (the registration's free test's)
@@ -828,7 +834,8 @@ def own_cap(depth: np.ndarray, mask: np.ndarray, focal: float, settings: Extract
 
 def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: set[int],
               boxes: list[tuple[slice, slice] | None], shift: tuple[int, int], depth: np.ndarray, focal: float,
-              settings: ExtractSettings | None = None) -> np.ndarray:  # fmt: skip
+              settings: ExtractSettings | None = None, *,
+              readings: dict[int, Reading] | None = None) -> np.ndarray:  # fmt: skip
     """``moved`` (the colour-trimmed masks ``trimmed`` moved by ``shift`` onto the depth image, :func:`register`)
     with what each mask of ``ids`` lost to a one-sided colour cut (:func:`one_sided`) given back where its depth, read
     where the registration puts it, lies on the fruit's own convex cap (:func:`own_cap`); of a cut all round (an
@@ -841,7 +848,8 @@ def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: se
     the pixels kept moved the shift of a frame of rendered apple trees by a pixel, and a half-hidden apple's points
     went to the leaf in front of it: docs/trim58.md), and the cap is read on the depth the mask is moved onto, not
     on the depth a few pixels off. ``drawn``: the masks as found (their boxes ``boxes``), ``depth`` metres,
-    ``focal`` pixels."""
+    ``focal`` pixels. ``readings``: :func:`front_ring`'s readings of the drawn masks by label, on the depth moved back
+    by ``shift`` (``detect._front_trimmed``'s), each taken by :func:`own_cap` where it holds (surf65)."""
     s = settings or ExtractSettings()
     if not s.trim_keeps_surface or not ids:
         return moved
@@ -874,7 +882,8 @@ def keep_caps(drawn: np.ndarray, trimmed: np.ndarray, moved: np.ndarray, ids: se
                 continue
         z = np.zeros(mask.shape)
         z[inside] = seen
-        keep = dropped[inside] & own_cap(z, mask, focal, s)[inside] & free
+        known = None if readings is None else readings.get(k)
+        keep = dropped[inside] & own_cap(z, mask, focal, s, known=known)[inside] & free
         if keep.any():
             out = out.copy() if out is moved else out
             out[a0:a1, b0:b1][keep] = k

@@ -2,6 +2,8 @@
 in front of a wall, on a table, under a leaf, with the rim a time-of-flight camera invalidates, and masks
 drawn a few pixels off."""
 
+import dataclasses
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -1687,3 +1689,143 @@ def test_the_fruit_surface_asks_wanted_with_its_own_front_and_noise_s(seed):
                 assert found is not None and np.array_equal(found.pixels, plain.pixels)
                 assert (found.front, found.radius, found.noise, found.apex) == (
                     plain.front, plain.radius, plain.noise, plain.apex)  # fmt: skip
+
+
+# --- surf65: a mask's surface read once for two windows holding its box (fruit_surface's read and known) -------------
+
+
+def _surface_case(seed):
+    """A random :func:`ball` (noise, a table half the time, a leaf 3 cm in front across the whole image half the time,
+    running on beyond the mask: ``thin``'s depth around the box is read on some), its mask grown 0-2 px with holes."""
+    rng = np.random.default_rng(seed)
+    radius = int(rng.integers(6, 30))
+    centre = (int(rng.integers(radius + 3, W - radius - 3)), int(rng.integers(radius + 3, H - radius - 3)))
+    depth, disc = ball(centre=centre, radius_px=radius, noise=float(rng.uniform(0.0, 0.002)),
+                       table=bool(rng.random() < 0.5), seed=int(rng.integers(0, 100)))  # fmt: skip
+    if rng.random() < 0.5:
+        yy = np.mgrid[:H, :W][0]
+        depth[np.abs(yy - centre[1]) <= max(radius // int(rng.integers(2, 5)), 1)] = 0.47
+    elif rng.random() < 0.5:
+        depth = curled_leaf(depth, centre[1], int(rng.integers(3, 12)), float(rng.uniform(0.5, 8.0)),
+                            float(rng.uniform(0.45, 0.49)))  # fmt: skip
+    mask = grown(disc, int(rng.integers(0, 3))) & (rng.random((H, W)) < 0.97)
+    return rng, depth, mask
+
+
+def curled_leaf(depth, row, half, curl, front):
+    """``depth`` with a leaf across the whole image, rows ``row - half`` to ``row + half``, its midline ``front``
+    metres away, curled across its width (its depth grows as ``curl (y / 0.01 m)^2 / 2`` from it, ``y`` metres): not
+    a flat sheet, and it runs on beyond the mask, where ``thin_front`` asks how far (``Around.beyond``)."""
+    yy = np.mgrid[:H, :W][0]
+    y = (yy - row) * front / F
+    return np.where(np.abs(yy - row) <= half, front + curl * y * y / (2 * 0.01), depth)
+
+
+def _same_surface(a, b):
+    """Whether two of fruit_surface's answers are the same (None, or every field bit for bit)."""
+    if a is None or b is None:
+        return a is None and b is None
+    return np.array_equal(a.pixels, b.pixels) and (a.front, a.radius, a.noise, a.apex) == (
+        b.front, b.radius, b.noise, b.apex)  # fmt: skip
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_a_surface_read_on_one_window_is_the_one_read_on_another_holding_the_box_s(seed):
+    """``read`` on the whole image (a wanted answering False half the time, as front_ring's), then ``known`` on a window
+    holding the mask's box (its box alone or a few pixels more, as own_cap's): the same surface as without ``known``,
+    with the kernels and their twins; a reading is made exactly where the depth around the box was not read
+    (``Around.beyond`` not asked), and is taken (its numbers are what the surface reads) where it is made."""
+    import symfruit.core.surface as surface
+    from symfruit.core.raster import mask_box
+
+    rng, depth, mask = _surface_case(seed)
+    box = mask_box(mask)
+    if box is None:
+        return
+    pad = [int(rng.integers(0, 6)) * int(rng.random() < 0.5) for _ in range(4)]
+    r0, r1 = max(box[0] - pad[0], 0), min(box[1] + pad[1], H)
+    c0, c1 = max(box[2] - pad[2], 0), min(box[3] + pad[3], W)
+    sub_depth, sub_mask = np.array(depth[r0:r1, c0:c1]), np.array(mask[r0:r1, c0:c1])
+    stop = bool(rng.random() < 0.5)
+    with pytest.MonkeyPatch.context() as mp:
+        mp.delenv("SYMFRUIT_KERNELS", raising=False)
+        asked: list[int] = []
+        real = surface.Around.beyond
+        mp.setattr(surface.Around, "beyond", lambda self, *a, **k: asked.append(1) or real(self, *a, **k))
+        for kernels in ("compiled", "numpy"):
+            if kernels == "numpy":
+                mp.setenv("SYMFRUIT_KERNELS", "numpy")
+            plain = fruit_surface(sub_depth, sub_mask, F, thin=True)
+            read: list = []
+            asked.clear()
+            whole = fruit_surface(depth, mask, F, thin=True, read=read, wanted=(lambda f, n: False) if stop else None)
+            if asked:
+                assert not read
+            elif whole is not None:
+                assert len(read) == 1 and (read[0].front, read[0].noise) == (whole.front, whole.noise)
+            if not read:
+                continue
+            assert _same_surface(fruit_surface(sub_depth, sub_mask, F, thin=True, known=read[0]), plain)
+            # the reading's numbers are taken: a noise marked is the surface's
+            marked = dataclasses.replace(read[0], noise=0.125)
+            taken = fruit_surface(sub_depth, sub_mask, F, thin=True, known=marked)
+            assert (plain is None) == (taken is None)
+            assert taken is None or taken.noise == 0.125
+
+
+def test_a_reading_is_not_taken_for_other_depth_mask_or_arguments():
+    """Known answers: a reading made on the image is taken on the mask's box alone; not where one depth pixel of the box
+    differs by a bit (or 0.0 turns -0.0), one pixel of the mask differs, the focal, tolerance, step or thin do, or
+    the reading's depth was float32; and none is made with ``crossing`` or ``leafy``."""
+    depth, disc = ball(radius_px=20, noise=0.001, seed=3)
+    read: list = []
+    plain = fruit_surface(depth, disc, F, thin=True, read=read)
+    assert plain is not None and len(read) == 1
+    known = dataclasses.replace(read[0], noise=0.125)  # taken: the surface's noise is the reading's
+    box = (slice(40, 81), slice(60, 101))
+    assert fruit_surface(depth[box], disc[box], F, thin=True, known=known).noise == 0.125
+    bit = depth.copy()
+    bit[60, 80] = np.nextafter(bit[60, 80], 1.0)
+    assert fruit_surface(bit, disc, F, thin=True, known=known).noise == plain.noise
+    hole = depth.copy()
+    hole[60, 70] = 0.0
+    read2: list = []
+    fruit_surface(hole, disc, F, thin=True, read=read2)
+    negative = hole.copy()
+    negative[60, 70] = -0.0
+    marked = dataclasses.replace(read2[0], noise=0.125)
+    assert fruit_surface(hole, disc, F, thin=True, clean=True, known=marked).noise == 0.125
+    assert fruit_surface(negative, disc, F, thin=True, clean=True, known=marked).noise < 0.1
+    other = disc.copy()
+    other[60, 80] = False
+    assert fruit_surface(depth, other, F, thin=True, known=known).noise < 0.1
+    for change in ({"focal": F + 1.0}, {"tolerance": 2.5}, {"step": 0.001}, {"thin": False}):
+        kw = {"thin": True, **change}
+        focal = kw.pop("focal", F)
+        assert fruit_surface(depth, disc, focal, **kw, known=known).noise < 0.1
+    single: list = []  # a reading of float32 depth (read as it is, clean) is not taken on float64 depth
+    fruit_surface(depth.astype(np.float32), disc, F, thin=True, clean=True, read=single)
+    assert fruit_surface(depth, disc, F, thin=True, known=dataclasses.replace(single[0], noise=0.125)).noise < 0.1
+    for extra in ({"crossing": True}, {"leafy": np.zeros((H, W), bool)}):
+        none: list = []
+        fruit_surface(depth, disc, F, thin=True, read=none, **extra)
+        assert not none
+        assert fruit_surface(depth, disc, F, thin=True, known=known, **extra).noise < 0.1
+
+
+def test_no_reading_is_made_where_the_depth_around_the_box_decides():
+    """Known answer: a curled leaf 4 cm in front across a ball and the whole image, the mask the ball grown by 2 px:
+    read on the image, the leaf runs on beyond the mask over more pixels than it covers in it and the ball behind is
+    taken (its front 0.50 m); read on the mask's box alone it does not, and the leaf's front is kept (0.46 m). The
+    depth around the box was asked for on the image: no reading is made there (one would give the box the ball's
+    front)."""
+    depth, disc = ball(radius_px=25, noise=0.0003, seed=2)
+    depth, mask = curled_leaf(depth, 60, 9, 5.0, 0.46), grown(disc, 2)
+    read: list = []
+    whole = fruit_surface(depth, mask, F, thin=True, read=read)
+    box = (slice(33, 88), slice(53, 108))
+    alone = fruit_surface(depth[box], mask[box], F, thin=True)
+    assert whole is not None and alone is not None
+    assert whole.front == pytest.approx(0.50, abs=0.005) and alone.front == pytest.approx(0.46, abs=0.002)
+    assert not read

@@ -40,6 +40,7 @@ from .points import median
 from .raster import distance_transform, eroded, fill_holes, inner_distance, interior, mask_box, principal_widths
 
 __all__ = [
+    "Reading",
     "Surface",
     "colour_trim",
     "depth_noise",
@@ -76,6 +77,58 @@ class Surface:
     radius: float
     noise: float
     apex: tuple[int, int]
+
+
+@dataclass(frozen=True)
+class Reading:
+    """What :func:`fruit_surface` reads of a mask before its slab and convex cap, and what it read it from (surf65):
+    a caller that asks for the same mask's surface twice, on two windows holding the same box (``extract.front_ring``
+    and ``extract.own_cap`` on a drawn mask and the depth moved by the registration's shift), reads it once.
+
+    Attributes
+    ----------
+    depth, mask : (bh, bw) float64 and bool
+        Copies of the (cleaned) depth and the mask on the mask's box.
+    given : tuple
+        The arguments it was read with: focal, tolerance, step, thin, and whether the kernels read it.
+    front, radius, noise, tol, radius_px : float
+        The fruit's front and radius (metres, after ``thin``'s sheet), the depth's noise, the convexity test's
+        tolerance (metres) and the mask's equivalent radius (pixels).
+    sheet : (bh, bw) bool or None
+        The sheet in front ``thin`` found on the box (its pixels left out of the region), None without one.
+    """
+
+    depth: np.ndarray
+    mask: np.ndarray
+    given: tuple[float, float, float | None, bool, bool]
+    front: float
+    radius: float
+    noise: float
+    tol: float
+    radius_px: float
+    sheet: np.ndarray | None
+
+    def box_in(self, depth: np.ndarray, mask: np.ndarray,
+               given: tuple[float, float, float | None, bool, bool]) -> tuple[int, int, int, int] | None:  # fmt: skip
+        """``mask``'s box ``(r0, r1, c0, c1)`` where, with the same arguments ``given``, ``mask`` (h, w) bool and
+        ``depth`` (h, w) float64 hold on it what this was read from (the same pixels, the same bits); else None."""
+        if given != self.given or not (
+            isinstance(mask, np.ndarray) and isinstance(depth, np.ndarray) and mask.dtype == bool
+            and self.mask.dtype == bool and mask.ndim == 2 and depth.dtype == self.depth.dtype == np.float64
+            and depth.shape == mask.shape
+        ):  # fmt: skip
+            return None
+        if (found := mask_box(mask)) is None:
+            return None
+        r0, r1, c0, c1 = found
+        if (r1 - r0, c1 - c0) != self.mask.shape:
+            return None
+        box = (slice(r0, r1), slice(c0, c1))
+        # the bits compared, not the values (0.0 and -0.0, NaN)
+        if not np.array_equal(mask[box], self.mask) or not np.array_equal(depth[box].view(np.int64),
+                                                                          self.depth.view(np.int64)):  # fmt: skip
+            return None
+        return found
 
 
 #: :func:`depth_noise`'s least noise (metres), and an empty leaf image (:func:`fruit_surface`'s compiled measures).
@@ -298,10 +351,13 @@ class Around:
     mask: np.ndarray
     r0: int
     c0: int
+    #: a True for each :meth:`beyond` asked (:func:`fruit_surface`'s :class:`Reading` then depends on the window)
+    asked: list[bool] = field(default_factory=list, repr=False, compare=False)
 
     def beyond(self, part: np.ndarray, join: float) -> int:
         """How many pixels outside the mask continue the surface of ``part`` (a (h, w) bool image on the box): the
         window's pixels with depth, joined to it through neighbours within ``join`` (:func:`_smooth_parts`)."""
+        self.asked.append(True)
         labels, _ = _smooth_parts(self.depth, self.depth > 0, join)
         h, w = part.shape
         inside = labels[self.r0 : self.r0 + h, self.c0 : self.c0 + w][part]
@@ -1120,7 +1176,8 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
                   region: np.ndarray | None = None, inner: np.ndarray | None = None,
                   leafy: np.ndarray | None = None, step: float | None = None,
                   thin: bool = False, crossing: bool = False, clean: bool = False,
-                  wanted: Callable[[float, float], bool] | None = None) -> Surface | None:  # fmt: skip
+                  wanted: Callable[[float, float], bool] | None = None, read: list[Reading] | None = None,
+                  known: Reading | None = None) -> Surface | None:  # fmt: skip
     """The pixels of one fruit's own surface under (or around) its mask.
 
     Parameters
@@ -1166,6 +1223,14 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
         once they are known, before the slab and the convex cap: where it answers False, None is returned without
         them (a caller that reads the front and noise alone, and has no use for a surface where they give it nothing:
         :func:`~symfruit.extract.front_ring`). Otherwise the same surface.
+    read : list, optional
+        Given the :class:`Reading` of the mask (its front, radius, noise, tolerance and sheet, before the slab and the
+        convex cap) where it depends on the mask's box alone (no ``crossing``, no ``leafy``, no depth around the box
+        read by ``thin``; surf65).
+    known : Reading, optional
+        A :class:`Reading` made before (``read``): where ``depth`` and ``mask`` hold on the mask's box what it was read
+        from, bit for bit, with the same arguments, its numbers are taken instead of worked out again (the same
+        numbers: the same steps on the same values); else it is not read.
 
     Returns
     -------
@@ -1190,61 +1255,78 @@ def fruit_surface(depth: np.ndarray, mask: np.ndarray, focal: float, *, slab: fl
     # the mask's); a window around a mask may be several times larger (the registration looks 28 px beyond it)
     unit: float | None = None  # the depth's step, when measured with the noise and the front
     jit = kernels
-    if (
-        jit is not None
-        and isinstance(mask, np.ndarray)
-        and mask.dtype == bool
-        and mask.ndim == 2
-        and np.shape(depth) == mask.shape
-        and depth.dtype == np.float64
-        and (leafy is None or (np.shape(leafy) == mask.shape and np.asarray(leafy).dtype == bool))
-    ):
-        # the mask's box and count, the noise, the mask's valid depths, the depth's step and the depth mode on them
-        # without sorting them in one call (stop 52, register52: mask_box, mask_values and depth_mode of stop 51,
-        # fruit_depth's steps: the same numbers)
-        found, r0, r1, c0, c1, count, noise, _, _, unit, front, radius, done = jit.mask_mode(
-            depth, mask, _NO_LEAF if leafy is None else np.asarray(leafy), leafy is not None, _NOISE_FLOOR,
-            float(focal), (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
-        if not found:
-            return None  # no depth in an empty mask
-        box = (slice(r0, r1), slice(c0, c1))
-        own, own_depth = mask[box], depth[box]
-        radius_px = float(np.sqrt(count / np.pi))
-        front, radius = float(front), float(radius)
-        if not done:  # left to the twin (fruit_depth's kernel declines)
-            front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                        leafy=None if leafy is None else leafy[box][own])  # fmt: skip
-    else:
-        if (found_box := mask_box(mask)) is None:
-            return None  # no depth in an empty mask
+    given = (float(focal), float(tolerance), None if step is None else float(step), bool(thin), kernels is not None)
+    shared = not crossing and leafy is None  # a reading of the mask's box alone (but for thin's depth around it)
+    if shared and known is not None and (found_box := known.box_in(depth, mask, given)) is not None:
+        # the same box, depth and mask as a reading made before, with the same arguments: its numbers (surf65)
         r0, r1, c0, c1 = found_box
         box = (slice(r0, r1), slice(c0, c1))
-        own, own_depth = mask[box], depth[box]
-        # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
-        radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
-        noise = depth_noise(own_depth, own)
-        front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
-                                    leafy=None if leafy is None else leafy[box][own])  # fmt: skip
-    if not np.isfinite(front):
-        return None
-    # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
-    # known to a unit: without it a 3 mm tolerance on millimetre depth cuts every 3 mm fall that float32 rounding
-    # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
-    # camera's near fruit lost a third of its cap, issue 18)
-    if step is None:
-        step = depth_step(own_depth, own) if unit is None else unit
-    tol = max(tolerance * noise, 0.003) + step
-    around = None
-    if thin:
-        g = int(np.ceil(radius_px))  # the depth within the fruit's size around its mask's box
-        w0, w1 = max(r0 - g, 0), min(r1 + g, depth.shape[0])
-        v0, v1 = max(c0 - g, 0), min(c1 + g, depth.shape[1])
-        around = Around(depth[w0:w1, v0:v1], np.asarray(mask[w0:w1, v0:v1], dtype=bool), r0 - w0, c0 - v0)
-    if thin and (found_leaf := thin_front(own_depth, own, focal, front, radius, tol, noise, around=around)) is not None:
-        front, sheet = found_leaf
-        radius = radius_px * front / focal
-        region = region.copy()
-        region[box] &= ~sheet
+        own = mask[box]
+        front, radius, noise, tol, radius_px = known.front, known.radius, known.noise, known.tol, known.radius_px
+        if known.sheet is not None:
+            region = region.copy()
+            region[box] &= ~known.sheet
+    else:
+        if (
+            jit is not None
+            and isinstance(mask, np.ndarray)
+            and mask.dtype == bool
+            and mask.ndim == 2
+            and np.shape(depth) == mask.shape
+            and depth.dtype == np.float64
+            and (leafy is None or (np.shape(leafy) == mask.shape and np.asarray(leafy).dtype == bool))
+        ):
+            # the mask's box and count, the noise, the mask's valid depths, the depth's step and the depth mode on them
+            # without sorting them in one call (stop 52, register52: mask_box, mask_values and depth_mode of stop 51,
+            # fruit_depth's steps: the same numbers)
+            found, r0, r1, c0, c1, count, noise, _, _, unit, front, radius, done = jit.mask_mode(
+                depth, mask, _NO_LEAF if leafy is None else np.asarray(leafy), leafy is not None, _NOISE_FLOOR,
+                float(focal), (float(LEAFY[0]), float(LEAFY[1])))  # fmt: skip
+            if not found:
+                return None  # no depth in an empty mask
+            box = (slice(r0, r1), slice(c0, c1))
+            own, own_depth = mask[box], depth[box]
+            radius_px = float(np.sqrt(count / np.pi))
+            front, radius = float(front), float(radius)
+            if not done:  # left to the twin (fruit_depth's kernel declines)
+                front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                            leafy=None if leafy is None else leafy[box][own])  # fmt: skip
+        else:
+            if (found_box := mask_box(mask)) is None:
+                return None  # no depth in an empty mask
+            r0, r1, c0, c1 = found_box
+            box = (slice(r0, r1), slice(c0, c1))
+            own, own_depth = mask[box], depth[box]
+            # a bool mask's count by np.count_nonzero (the same whole number, stop 47)
+            radius_px = float(np.sqrt((np.count_nonzero(own) if own.dtype == bool else own.sum()) / np.pi))
+            noise = depth_noise(own_depth, own)
+            front, radius = fruit_depth(own_depth[own], radius_px, focal, noise=noise,
+                                        leafy=None if leafy is None else leafy[box][own])  # fmt: skip
+        if not np.isfinite(front):
+            return None
+        # Two depths a depth camera rounds to whole units are each up to half a unit off, so a fall between them is
+        # known to a unit: without it a 3 mm tolerance on millimetre depth cuts every 3 mm fall that float32 rounding
+        # makes a hair larger (noise of 0.5-0.8 mm puts a running maximum 2 mm above a pixel 1 mm below: a stereo
+        # camera's near fruit lost a third of its cap, issue 18)
+        if step is None:
+            step = depth_step(own_depth, own) if unit is None else unit
+        tol = max(tolerance * noise, 0.003) + step
+        around, sheet = None, None
+        if thin:
+            g = int(np.ceil(radius_px))  # the depth within the fruit's size around its mask's box
+            w0, w1 = max(r0 - g, 0), min(r1 + g, depth.shape[0])
+            v0, v1 = max(c0 - g, 0), min(c1 + g, depth.shape[1])
+            around = Around(depth[w0:w1, v0:v1], np.asarray(mask[w0:w1, v0:v1], dtype=bool), r0 - w0, c0 - v0)
+        found_leaf = thin_front(own_depth, own, focal, front, radius, tol, noise, around=around) if thin else None
+        if found_leaf is not None:
+            front, sheet = found_leaf
+            radius = radius_px * front / focal
+            region = region.copy()
+            region[box] &= ~sheet
+        if read is not None and shared and np.isfinite(front) and not (around is not None and around.asked):
+            # what was read depends on the mask's box alone (surf65): kept, with copies of what it was read from
+            read.append(Reading(np.array(own_depth), np.array(own), given, front, radius, noise, tol, radius_px,
+                                None if sheet is None else np.array(sheet)))  # fmt: skip
     if thin and crossing and (behind := _behind_crossing(depth, mask, focal, front, radius, tol, noise)) is not None:
         # the nearest surface (behind a sheet thin_front passed over, if any) runs on across the mask's outline: an
         # occluder the mask is drawn over (stop 46, docs/overleaf46.md); what lies in front of the fruit's front is
