@@ -8895,3 +8895,46 @@ def test_deep_pixels_known_answer():
     want[0, :] = False  # beyond the box
     want[10, 11] = True
     np.testing.assert_array_equal(out, want)
+
+
+# --- stop 65, look65
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(1, 12))
+def test_the_reach_fill_leaves_its_maps_as_they_came(seed, h, w, cap):
+    """_reach_fill's map of the pixels a run may still take is its own (join copied): join and seen are left as they
+    came whether the fill ends or runs out of seeds, so _reach_box's second try reads them whole; its box is
+    _flood_box's."""
+    rng = np.random.default_rng(seed)
+    join = rng.random((h, w)) < rng.uniform(0.2, 0.95)
+    seen = rng.random((h, w)) < rng.uniform(0.01, 0.3)
+    if not seen.any():
+        seen[h // 2, w // 2] = True
+    rows, cols = np.nonzero(seen)
+    box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
+    join_in, seen_in = join.copy(), seen.copy()
+    _jit._reach_fill(join, seen, *box, np.empty(cap, np.int64))
+    assert np.array_equal(join, join_in) and np.array_equal(seen, seen_in)
+    got = tuple(int(x) for x in _jit._reach_box(join, seen, *box))
+    assert got == tuple(int(x) for x in _jit._flood_box(join_in, seen_in, *box)[1:])
+    assert np.array_equal(join, join_in) and np.array_equal(seen, seen_in)
+
+
+def test_the_allowed_box_off_the_window_and_at_its_corners_known_answer():
+    """allowed_box with the region wholly off each side of the window (not found), and one seen pixel at each corner
+    of the window near a hidden run (the box of the run and the pixel where a gap joins them); the seen box is found
+    by rows."""
+    hidden = np.zeros((6, 8), bool)
+    region = np.ones((2, 3), bool)
+    for dr, dc in ((-2, 0), (6, 0), (0, -3), (0, 8), (-5, -9), (7, 9)):
+        assert not _jit.allowed_box(hidden, region, dr, dc, 2, 0)[0]
+    hidden[2, 1:7] = True  # a run along row 2
+    one = np.zeros((3, 3), bool)
+    one[1, 1] = True  # the region's one seen pixel at (dr + 1, dc + 1)
+    assert tuple(_jit.allowed_box(hidden, one, -1, -1, 1, 0)) == (True, 0, 3, 0, 7)  # (0, 0): the run 2 rows down
+    assert tuple(_jit.allowed_box(hidden, one, -1, 6, 1, 0)) == (True, 0, 3, 1, 8)  # (0, 7)
+    assert tuple(_jit.allowed_box(hidden, one, 4, -1, 1, 0)) == (True, 5, 6, 0, 1)  # (5, 0): 3 rows off, no join
+    assert tuple(_jit.allowed_box(hidden, one, 4, -1, 2, 0)) == (True, 2, 6, 0, 7)  # a gap of 2 joins
+    assert tuple(_jit.allowed_box(hidden, one, 4, 6, 2, 0)) == (True, 2, 6, 1, 8)  # (5, 7)
+    assert tuple(_jit.allowed_box(hidden, one, 4, 6, 0, 0)) == (True, 5, 6, 7, 8)  # no gap: the pixel alone

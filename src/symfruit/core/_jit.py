@@ -713,7 +713,7 @@ def _joins(
     h, w = hidden.shape
     join = hidden.copy()
     if thin > 0:
-        h0, h1, g0, g1 = _box(hidden)
+        h0, h1, g0, g1 = _rows_box(hidden)  # _box's, each row or'ed whole (stop 65, look65)
         if h1 > h0:
             open_square(hidden[h0:h1, g0:g1], thin, join[h0:h1, g0:g1])  # one sweep (stop 61, speedb61)
     if gap > 0:
@@ -4166,15 +4166,21 @@ def _reach_fill(
     c0, c1)``, ok False (and no box) when the fill needed more than ``k`` pending seeds. Until stop 48 the fill grew
     its stack by ``np.concatenate`` in the loop, and the stack's reassignment there made every pass of the loop about
     four times slower (the benchmark frame's 9 fills 0.60 against 0.15 ms, docs/occspeed48.md); the same steps in
-    the same order otherwise, so the same box."""
+    the same order otherwise, so the same box. Since stop 65 (look65) the pixels a run may still take are one map,
+    ``avail`` (``join`` copied, the seen pixels, all within their box, cleared), each pixel cleared as it is
+    reached: one read where ``not reached and join and not seen`` made three, and the copy where the reached map
+    was zeroed. ``avail`` is that test's value at every step, so the same steps and the same box."""
     h, w = join.shape
-    reached = np.zeros((h, w), np.bool_)
+    avail = join.copy()  # join's pixels not seen and not reached yet (the seen ones lie within their box)
+    for r in range(s0, s1):
+        for c in range(t0, t1):
+            avail[r, c] = avail[r, c] and not seen[r, c]
     cap = stack.shape[0]
     top = 0
     r0, r1, c0, c1 = s0, s1, t0, t1
     for r in range(max(s0 - 1, 0), min(s1 + 1, h)):
         for c in range(max(t0 - 1, 0), min(t1 + 1, w)):
-            if seen[r, c] or not join[r, c]:
+            if not avail[r, c]:
                 continue
             beside = False
             for rr in range(max(r - 1, 0), min(r + 2, h)):
@@ -4189,17 +4195,17 @@ def _reach_fill(
     while top > 0:
         top -= 1
         r, c = divmod(stack[top], w)
-        if reached[r, c]:
+        if not avail[r, c]:  # reached since it was pushed
             continue
         # the run through (r, c) of pixels the fill may cross, not reached yet
         a = c
-        while a > 0 and not reached[r, a - 1] and join[r, a - 1] and not seen[r, a - 1]:
+        while a > 0 and avail[r, a - 1]:
             a -= 1
         b = c + 1
-        while b < w and not reached[r, b] and join[r, b] and not seen[r, b]:
+        while b < w and avail[r, b]:
             b += 1
         for x in range(a, b):
-            reached[r, x] = True
+            avail[r, x] = False
         r0, r1 = min(r0, r), max(r1, r + 1)
         c0, c1 = min(c0, a), max(c1, b)
         for rr in (r - 1, r + 1):  # the new runs it touches above and below (one seed a run)
@@ -4207,7 +4213,7 @@ def _reach_fill(
                 continue
             inside = False
             for x in range(max(a - 1, 0), min(b + 1, w)):
-                ok = not reached[rr, x] and join[rr, x] and not seen[rr, x]
+                ok = avail[rr, x]
                 if ok and not inside:
                     if top == cap:
                         return False, 0, 0, 0, 0
@@ -5345,14 +5351,13 @@ def allowed_box(
     rh, rw = region.shape
     a0, a1 = max(dr, 0), min(dr + rh, h)
     b0, b1 = max(dc, 0), min(dc + rw, w)
-    s0, s1, t0, t1 = h, 0, w, 0  # the seen pixels' box
-    for r in range(a0, a1):
-        for c in range(b0, b1):
-            if region[r - dr, c - dc]:
-                s0, s1 = min(s0, r), r + 1
-                t0, t1 = min(t0, c), max(t1, c + 1)
-    if s1 == 0:
+    if a1 <= a0 or b1 <= b0:  # the region wholly off the window
         return False, 0, 0, 0, 0
+    # the seen pixels' box, each row or'ed whole (stop 65, look65: the box the pixel by pixel scan found)
+    s0, s1, t0, t1 = _mask_box_in(region, a0 - dr, b0 - dc, a1 - a0, b1 - b0)
+    if s1 <= s0:
+        return False, 0, 0, 0, 0
+    s0, s1, t0, t1 = s0 + a0, s1 + a0, t0 + b0, t1 + b0
     seen = np.zeros((h, w), np.bool_)
     for r in range(s0, s1):
         for c in range(t0, t1):
