@@ -8938,3 +8938,33 @@ def test_the_allowed_box_off_the_window_and_at_its_corners_known_answer():
     assert tuple(_jit.allowed_box(hidden, one, 4, -1, 2, 0)) == (True, 2, 6, 0, 7)  # a gap of 2 joins
     assert tuple(_jit.allowed_box(hidden, one, 4, 6, 2, 0)) == (True, 2, 6, 1, 8)  # (5, 7)
     assert tuple(_jit.allowed_box(hidden, one, 4, 6, 0, 0)) == (True, 5, 6, 7, 8)  # no gap: the pixel alone
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 30))
+def test_first_nearest_label_is_first_nearests(seed, k, m):
+    """first_nearest_label (the kernels' pick among equally near edge points of both labels) against the numpy twin's
+    _first_nearest, query by query: points on whole pixels of a small grid (many equally near), queries on whole and
+    half pixels, now and then a point with a NaN coordinate (argmin takes the first NaN) or an infinite one."""
+    from symfruit.core.agreement import _first_nearest
+
+    rng = np.random.default_rng(seed)
+    points = rng.integers(0, 6, (k, 2)).astype(np.float64)
+    labels = rng.random(k) < 0.5
+    queries = rng.integers(0, 12, (m, 2)) / 2.0
+    if rng.random() < 0.2:
+        points[int(rng.integers(0, k)), int(rng.integers(0, 2))] = rng.choice([np.nan, np.inf, -np.inf])
+    want = _first_nearest(points, labels, queries)
+    got = np.array([_jit.first_nearest_label(points, labels, float(qx), float(qy)) for qx, qy in queries])
+    assert np.array_equal(got, want)
+
+
+def test_first_nearest_label_known_answer():
+    """Two points equally near (1 px either side of the query): the first one's label, either way round; a nearer
+    point later in the order wins; a NaN point wins wherever it lies (np.argmin's first NaN)."""
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 0.5]])
+    assert not _jit.first_nearest_label(points[:2], np.array([False, True]), 1.0, 0.0)
+    assert _jit.first_nearest_label(points[:2], np.array([True, False]), 1.0, 0.0)
+    assert _jit.first_nearest_label(points, np.array([False, False, True]), 1.0, 0.0)
+    points[1, 0] = np.nan
+    assert _jit.first_nearest_label(points, np.array([False, True, False]), 1.0, 0.0)

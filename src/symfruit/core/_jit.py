@@ -9665,6 +9665,27 @@ def cap_outline(
 
 
 @_njit
+def first_nearest_label(points: np.ndarray, labels: np.ndarray, qx: float, qy: float) -> bool:
+    """The label (``labels`` (k,) bool) of the point of ``points`` (k, 2, k >= 1) nearest ``(qx, qy)``, the first in
+    ``points``' order among those equally near: :func:`symfruit.core.agreement._first_nearest` of one query, its
+    squared distances (``dx * dx + dy * dy``, the query less the point) and ``np.argmin``'s pick (the first least;
+    a NaN distance is taken as least, the first of them). Issue 19, stop 65 (look65): the ties of labels that
+    :func:`observe_bands` and :func:`outline_bands` left to their caller are resolved in the call."""
+    best = np.inf
+    at = -1
+    for j in range(points.shape[0]):
+        dx = qx - points[j, 0]
+        dy = qy - points[j, 1]
+        d = dx * dx + dy * dy
+        if d != d:  # argmin's first NaN
+            at = j
+            break
+        if at < 0 or d < best:
+            best, at = d, j
+    return labels[at] if at >= 0 else False
+
+
+@_njit
 def observe_maps(mask: np.ndarray, inner_reach: float, outer_reach: float) -> tuple[bool, np.ndarray, np.ndarray]:
     """:func:`symfruit.core.agreement.observe`'s two distance maps of ``mask`` (h, w) bool in one call: ``(done,
     inner, outer)``, ``inner`` :func:`symfruit.core.raster.inner_distance` with ``reach`` ``inner_reach`` and
@@ -9751,9 +9772,10 @@ def observe_bands(
     h_v0``) and :func:`nearest_labels` of the edge points (``edge_uv`` (k, 2), ``labels`` (k,); none: every label
     true), packed as :func:`symfruit.core.agreement._bands_of_parts` packs them. Returns ``(every (n + a + b, 3):
     rays then both sides' band rays, uv (b, 2) the outside pixels, in_sizes, in_starts, out_sizes, out_starts,
-    unsure (b,) bool: a tie of labels the caller resolves (never on a hidden pixel), weight (b,): 1.0 where the label
-    is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite (b,)
-    bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
+    unsure (b,) bool: all false (since stop 65 a tie of labels between equally near edge points is resolved here,
+    as the caller did: :func:`first_nearest_label`; a hidden pixel's label is not read), weight (b,): 1.0 where the
+    label is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite
+    (b,) bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
     called one by one (the sums are of whole numbers, exact in any order)."""
     return _observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge_uv, labels, occluded,
                           hidden, depth, h_u0, h_v0, width, height, False)  # fmt: skip
@@ -9793,7 +9815,9 @@ def _observe_bands(
     weight = np.empty(b)
     finite = np.empty(b, np.bool_)
     for i in range(b):
-        unsure[i] = unsure[i] and not hid[i]
+        if unsure[i] and not hid[i]:  # a tie of labels: the first nearest edge point's (stop 65, look65)
+            found[i] = first_nearest_label(edge_uv, labels, uv[i, 0], uv[i, 1])
+        unsure[i] = False
         weight[i] = 1.0 if found[i] and not hid[i] else 0.0
         finite[i] = occluded and np.isfinite(seen[i])
     wsum = np.zeros(k)
@@ -9815,7 +9839,8 @@ def outline_bands(
     points are :func:`outline_uv`'s (``count``) labelled ``base`` where no hidden pixel lies within ``radius``
     (:func:`occluded_at`; ``_occluded_edges``); then :func:`observe_bands` of them; then, where ``share`` is at most
     the share of true labels and that share is below 1, :func:`nearest_labels_rows` of ``cracks`` (k, 2). Returns ``(uv,
-    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``): the
+    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``; the cracks'
+    ties resolved as the bands' by :func:`first_nearest_label`, ``unsure`` all false): the
     pieces' values."""
     edge = outline_uv(mask, count, u0, v0)
     m = edge.shape[0]
@@ -9831,6 +9856,10 @@ def outline_bands(
     took = m > 0 and share <= n_true / m < 1.0
     if took:
         found, unsure = nearest_labels_rows(edge, labels, cracks)
+        for j in range(found.shape[0]):  # a tie of labels: the first nearest edge point's (stop 65, look65)
+            if unsure[j]:
+                found[j] = first_nearest_label(edge, labels, cracks[j, 0], cracks[j, 1])
+                unsure[j] = False
     else:
         found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
     return edge, labels, made, took, found, unsure
