@@ -8895,3 +8895,76 @@ def test_deep_pixels_known_answer():
     want[0, :] = False  # beyond the box
     want[10, 11] = True
     np.testing.assert_array_equal(out, want)
+
+
+# --- stop 65, look65
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 30), st.integers(1, 30), st.integers(1, 12))
+def test_the_reach_fill_leaves_its_maps_as_they_came(seed, h, w, cap):
+    """_reach_fill's map of the pixels a run may still take is its own (join copied): join and seen are left as they
+    came whether the fill ends or runs out of seeds, so _reach_box's second try reads them whole; its box is
+    _flood_box's."""
+    rng = np.random.default_rng(seed)
+    join = rng.random((h, w)) < rng.uniform(0.2, 0.95)
+    seen = rng.random((h, w)) < rng.uniform(0.01, 0.3)
+    if not seen.any():
+        seen[h // 2, w // 2] = True
+    rows, cols = np.nonzero(seen)
+    box = (int(rows.min()), int(rows.max()) + 1, int(cols.min()), int(cols.max()) + 1)
+    join_in, seen_in = join.copy(), seen.copy()
+    _jit._reach_fill(join, seen, *box, np.empty(cap, np.int64))
+    assert np.array_equal(join, join_in) and np.array_equal(seen, seen_in)
+    got = tuple(int(x) for x in _jit._reach_box(join, seen, *box))
+    assert got == tuple(int(x) for x in _jit._flood_box(join_in, seen_in, *box)[1:])
+    assert np.array_equal(join, join_in) and np.array_equal(seen, seen_in)
+
+
+def test_the_allowed_box_off_the_window_and_at_its_corners_known_answer():
+    """allowed_box with the region wholly off each side of the window (not found), and one seen pixel at each corner
+    of the window near a hidden run (the box of the run and the pixel where a gap joins them); the seen box is found
+    by rows."""
+    hidden = np.zeros((6, 8), bool)
+    region = np.ones((2, 3), bool)
+    for dr, dc in ((-2, 0), (6, 0), (0, -3), (0, 8), (-5, -9), (7, 9)):
+        assert not _jit.allowed_box(hidden, region, dr, dc, 2, 0)[0]
+    hidden[2, 1:7] = True  # a run along row 2
+    one = np.zeros((3, 3), bool)
+    one[1, 1] = True  # the region's one seen pixel at (dr + 1, dc + 1)
+    assert tuple(_jit.allowed_box(hidden, one, -1, -1, 1, 0)) == (True, 0, 3, 0, 7)  # (0, 0): the run 2 rows down
+    assert tuple(_jit.allowed_box(hidden, one, -1, 6, 1, 0)) == (True, 0, 3, 1, 8)  # (0, 7)
+    assert tuple(_jit.allowed_box(hidden, one, 4, -1, 1, 0)) == (True, 5, 6, 0, 1)  # (5, 0): 3 rows off, no join
+    assert tuple(_jit.allowed_box(hidden, one, 4, -1, 2, 0)) == (True, 2, 6, 0, 7)  # a gap of 2 joins
+    assert tuple(_jit.allowed_box(hidden, one, 4, 6, 2, 0)) == (True, 2, 6, 1, 8)  # (5, 7)
+    assert tuple(_jit.allowed_box(hidden, one, 4, 6, 0, 0)) == (True, 5, 6, 7, 8)  # no gap: the pixel alone
+
+
+@settings(max_examples=300, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 40), st.integers(1, 30))
+def test_first_nearest_label_is_first_nearests(seed, k, m):
+    """first_nearest_label (the kernels' pick among equally near edge points of both labels) against the numpy twin's
+    _first_nearest, query by query: points on whole pixels of a small grid (many equally near), queries on whole and
+    half pixels, now and then a point with a NaN coordinate (argmin takes the first NaN) or an infinite one."""
+    from symfruit.core.agreement import _first_nearest
+
+    rng = np.random.default_rng(seed)
+    points = rng.integers(0, 6, (k, 2)).astype(np.float64)
+    labels = rng.random(k) < 0.5
+    queries = rng.integers(0, 12, (m, 2)) / 2.0
+    if rng.random() < 0.2:
+        points[int(rng.integers(0, k)), int(rng.integers(0, 2))] = rng.choice([np.nan, np.inf, -np.inf])
+    want = _first_nearest(points, labels, queries)
+    got = np.array([_jit.first_nearest_label(points, labels, float(qx), float(qy)) for qx, qy in queries])
+    assert np.array_equal(got, want)
+
+
+def test_first_nearest_label_known_answer():
+    """Two points equally near (1 px either side of the query): the first one's label, either way round; a nearer
+    point later in the order wins; a NaN point wins wherever it lies (np.argmin's first NaN)."""
+    points = np.array([[0.0, 0.0], [2.0, 0.0], [1.0, 0.5]])
+    assert not _jit.first_nearest_label(points[:2], np.array([False, True]), 1.0, 0.0)
+    assert _jit.first_nearest_label(points[:2], np.array([True, False]), 1.0, 0.0)
+    assert _jit.first_nearest_label(points, np.array([False, False, True]), 1.0, 0.0)
+    points[1, 0] = np.nan
+    assert _jit.first_nearest_label(points, np.array([False, True, False]), 1.0, 0.0)

@@ -713,7 +713,7 @@ def _joins(
     h, w = hidden.shape
     join = hidden.copy()
     if thin > 0:
-        h0, h1, g0, g1 = _box(hidden)
+        h0, h1, g0, g1 = _rows_box(hidden)  # _box's, each row or'ed whole (stop 65, look65)
         if h1 > h0:
             open_square(hidden[h0:h1, g0:g1], thin, join[h0:h1, g0:g1])  # one sweep (stop 61, speedb61)
     if gap > 0:
@@ -4166,15 +4166,21 @@ def _reach_fill(
     c0, c1)``, ok False (and no box) when the fill needed more than ``k`` pending seeds. Until stop 48 the fill grew
     its stack by ``np.concatenate`` in the loop, and the stack's reassignment there made every pass of the loop about
     four times slower (the benchmark frame's 9 fills 0.60 against 0.15 ms, docs/occspeed48.md); the same steps in
-    the same order otherwise, so the same box."""
+    the same order otherwise, so the same box. Since stop 65 (look65) the pixels a run may still take are one map,
+    ``avail`` (``join`` copied, the seen pixels, all within their box, cleared), each pixel cleared as it is
+    reached: one read where ``not reached and join and not seen`` made three, and the copy where the reached map
+    was zeroed. ``avail`` is that test's value at every step, so the same steps and the same box."""
     h, w = join.shape
-    reached = np.zeros((h, w), np.bool_)
+    avail = join.copy()  # join's pixels not seen and not reached yet (the seen ones lie within their box)
+    for r in range(s0, s1):
+        for c in range(t0, t1):
+            avail[r, c] = avail[r, c] and not seen[r, c]
     cap = stack.shape[0]
     top = 0
     r0, r1, c0, c1 = s0, s1, t0, t1
     for r in range(max(s0 - 1, 0), min(s1 + 1, h)):
         for c in range(max(t0 - 1, 0), min(t1 + 1, w)):
-            if seen[r, c] or not join[r, c]:
+            if not avail[r, c]:
                 continue
             beside = False
             for rr in range(max(r - 1, 0), min(r + 2, h)):
@@ -4189,17 +4195,17 @@ def _reach_fill(
     while top > 0:
         top -= 1
         r, c = divmod(stack[top], w)
-        if reached[r, c]:
+        if not avail[r, c]:  # reached since it was pushed
             continue
         # the run through (r, c) of pixels the fill may cross, not reached yet
         a = c
-        while a > 0 and not reached[r, a - 1] and join[r, a - 1] and not seen[r, a - 1]:
+        while a > 0 and avail[r, a - 1]:
             a -= 1
         b = c + 1
-        while b < w and not reached[r, b] and join[r, b] and not seen[r, b]:
+        while b < w and avail[r, b]:
             b += 1
         for x in range(a, b):
-            reached[r, x] = True
+            avail[r, x] = False
         r0, r1 = min(r0, r), max(r1, r + 1)
         c0, c1 = min(c0, a), max(c1, b)
         for rr in (r - 1, r + 1):  # the new runs it touches above and below (one seed a run)
@@ -4207,7 +4213,7 @@ def _reach_fill(
                 continue
             inside = False
             for x in range(max(a - 1, 0), min(b + 1, w)):
-                ok = not reached[rr, x] and join[rr, x] and not seen[rr, x]
+                ok = avail[rr, x]
                 if ok and not inside:
                     if top == cap:
                         return False, 0, 0, 0, 0
@@ -5345,14 +5351,13 @@ def allowed_box(
     rh, rw = region.shape
     a0, a1 = max(dr, 0), min(dr + rh, h)
     b0, b1 = max(dc, 0), min(dc + rw, w)
-    s0, s1, t0, t1 = h, 0, w, 0  # the seen pixels' box
-    for r in range(a0, a1):
-        for c in range(b0, b1):
-            if region[r - dr, c - dc]:
-                s0, s1 = min(s0, r), r + 1
-                t0, t1 = min(t0, c), max(t1, c + 1)
-    if s1 == 0:
+    if a1 <= a0 or b1 <= b0:  # the region wholly off the window
         return False, 0, 0, 0, 0
+    # the seen pixels' box, each row or'ed whole (stop 65, look65: the box the pixel by pixel scan found)
+    s0, s1, t0, t1 = _mask_box_in(region, a0 - dr, b0 - dc, a1 - a0, b1 - b0)
+    if s1 <= s0:
+        return False, 0, 0, 0, 0
+    s0, s1, t0, t1 = s0 + a0, s1 + a0, t0 + b0, t1 + b0
     seen = np.zeros((h, w), np.bool_)
     for r in range(s0, s1):
         for c in range(t0, t1):
@@ -9660,6 +9665,27 @@ def cap_outline(
 
 
 @_njit
+def first_nearest_label(points: np.ndarray, labels: np.ndarray, qx: float, qy: float) -> bool:
+    """The label (``labels`` (k,) bool) of the point of ``points`` (k, 2, k >= 1) nearest ``(qx, qy)``, the first in
+    ``points``' order among those equally near: :func:`symfruit.core.agreement._first_nearest` of one query, its
+    squared distances (``dx * dx + dy * dy``, the query less the point) and ``np.argmin``'s pick (the first least;
+    a NaN distance is taken as least, the first of them). Issue 19, stop 65 (look65): the ties of labels that
+    :func:`observe_bands` and :func:`outline_bands` left to their caller are resolved in the call."""
+    best = np.inf
+    at = -1
+    for j in range(points.shape[0]):
+        dx = qx - points[j, 0]
+        dy = qy - points[j, 1]
+        d = dx * dx + dy * dy
+        if d != d:  # argmin's first NaN
+            at = j
+            break
+        if at < 0 or d < best:
+            best, at = d, j
+    return labels[at] if at >= 0 else False
+
+
+@_njit
 def observe_maps(mask: np.ndarray, inner_reach: float, outer_reach: float) -> tuple[bool, np.ndarray, np.ndarray]:
     """:func:`symfruit.core.agreement.observe`'s two distance maps of ``mask`` (h, w) bool in one call: ``(done,
     inner, outer)``, ``inner`` :func:`symfruit.core.raster.inner_distance` with ``reach`` ``inner_reach`` and
@@ -9746,9 +9772,10 @@ def observe_bands(
     h_v0``) and :func:`nearest_labels` of the edge points (``edge_uv`` (k, 2), ``labels`` (k,); none: every label
     true), packed as :func:`symfruit.core.agreement._bands_of_parts` packs them. Returns ``(every (n + a + b, 3):
     rays then both sides' band rays, uv (b, 2) the outside pixels, in_sizes, in_starts, out_sizes, out_starts,
-    unsure (b,) bool: a tie of labels the caller resolves (never on a hidden pixel), weight (b,): 1.0 where the label
-    is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite (b,)
-    bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
+    unsure (b,) bool: all false (since stop 65 a tie of labels between equally near edge points is resolved here,
+    as the caller did: :func:`first_nearest_label`; a hidden pixel's label is not read), weight (b,): 1.0 where the
+    label is true and the pixel not hidden, else 0.0, seen (b,): the depth seen where hidden (NaN elsewhere), finite
+    (b,) bool, wsum (k,): each outside band's sum of 1.0 where finite else the weight)``: the same values as the pieces
     called one by one (the sums are of whole numbers, exact in any order)."""
     return _observe_bands(rays, inner, outer, bands, n_band, u0, v0, fx, fy, cx, cy, edge_uv, labels, occluded,
                           hidden, depth, h_u0, h_v0, width, height, False)  # fmt: skip
@@ -9788,7 +9815,9 @@ def _observe_bands(
     weight = np.empty(b)
     finite = np.empty(b, np.bool_)
     for i in range(b):
-        unsure[i] = unsure[i] and not hid[i]
+        if unsure[i] and not hid[i]:  # a tie of labels: the first nearest edge point's (stop 65, look65)
+            found[i] = first_nearest_label(edge_uv, labels, uv[i, 0], uv[i, 1])
+        unsure[i] = False
         weight[i] = 1.0 if found[i] and not hid[i] else 0.0
         finite[i] = occluded and np.isfinite(seen[i])
     wsum = np.zeros(k)
@@ -9810,7 +9839,8 @@ def outline_bands(
     points are :func:`outline_uv`'s (``count``) labelled ``base`` where no hidden pixel lies within ``radius``
     (:func:`occluded_at`; ``_occluded_edges``); then :func:`observe_bands` of them; then, where ``share`` is at most
     the share of true labels and that share is below 1, :func:`nearest_labels_rows` of ``cracks`` (k, 2). Returns ``(uv,
-    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``): the
+    labels, observe_bands' tuple, took, found, unsure)`` (``found``, ``unsure`` empty where not ``took``; the cracks'
+    ties resolved as the bands' by :func:`first_nearest_label`, ``unsure`` all false): the
     pieces' values."""
     edge = outline_uv(mask, count, u0, v0)
     m = edge.shape[0]
@@ -9826,6 +9856,10 @@ def outline_bands(
     took = m > 0 and share <= n_true / m < 1.0
     if took:
         found, unsure = nearest_labels_rows(edge, labels, cracks)
+        for j in range(found.shape[0]):  # a tie of labels: the first nearest edge point's (stop 65, look65)
+            if unsure[j]:
+                found[j] = first_nearest_label(edge, labels, cracks[j, 0], cracks[j, 1])
+                unsure[j] = False
     else:
         found, unsure = np.zeros(0, np.bool_), np.zeros(0, np.bool_)
     return edge, labels, made, took, found, unsure

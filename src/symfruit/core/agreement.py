@@ -699,13 +699,11 @@ def _outline_bands(
     if maps is None or count < 1 or 0 < n_true < len(is_contour) or mask.ndim != 2 or mask.dtype != bool:
         return None
     cracks = outline_cracks(region)
-    uv, labels, made, took, found, unsure = jit.outline_bands(
+    uv, labels, made, took, found, _ = jit.outline_bands(
         np.ascontiguousarray(mask), count, int(radius), bool(n_true > 0 or not len(is_contour)), cracks, float(share),
         rays, inner, outer, np.asarray(bands, dtype=np.float64), n_band, int(region.u0), int(region.v0),
         float(camera.fx), float(camera.fy), float(camera.cx), float(camera.cy), *maps)  # fmt: skip
-    banded = _unpacked(made, len(rays), uv, labels, True)
-    if took and unsure.any():  # _labels_at's rule among ties, as for the bands
-        found[unsure] = _first_nearest(uv, labels, cracks[unsure])
+    banded = _unpacked(made, len(rays), uv, labels, True)  # the cracks' ties resolved as the bands' (stop 65)
     return uv, labels, banded, found if took else None
 
 
@@ -716,17 +714,11 @@ _Banded = tuple[list[np.ndarray], list[np.ndarray], list[np.ndarray], list[np.nd
 
 def _unpacked(made: tuple[np.ndarray, ...], n: int, edge: np.ndarray, labels: np.ndarray, occluded: bool) -> _Banded:
     """:func:`symfruit.core._jit.observe_bands`' result ``made`` (``n`` depth rays, the edge points ``edge`` with
-    ``labels``) as :func:`_observed_bands` returns it; a label tied between nearest edge points of both labels (its
-    ``unsure``) is :func:`_labels_at`'s (:func:`_first_nearest`), each band's weight sum moved by the change."""
-    every, uv, in_sizes, in_starts, out_sizes, out_starts, unsure, weight, seen, finite, wsum = made
-    if unsure.any():
-        at = np.flatnonzero(unsure)
-        picked = _first_nearest(edge, labels, uv[at]).tolist()
-        band = np.searchsorted(out_starts, at, side="right") - 1
-        for i, j, label in zip(at.tolist(), band.tolist(), picked, strict=True):
-            value = 1.0 if label else 0.0
-            wsum[j] += value - weight[i]  # whole numbers: the sum made again, to the bit
-            weight[i] = value
+    ``labels``) as :func:`_observed_bands` returns it. A label tied between nearest edge points of both labels is
+    :func:`_labels_at`'s (:func:`_first_nearest`'s rule): until stop 65 it was picked here and each band's weight sum
+    moved by the change, since then the kernel picks it (``first_nearest_label``) before it sums the weights."""
+    # the ties of labels come resolved (stop 65, look65: the kernel's first_nearest_label, _first_nearest's rule)
+    every, _, in_sizes, in_starts, out_sizes, out_starts, _, weight, seen, finite, wsum = made
     n_in = int(in_sizes.sum())
     cut_in = [(n + s, n + s + k) for s, k in zip(in_starts.tolist(), in_sizes.tolist(), strict=True)]
     cut_out = [(s, s + k) for s, k in zip(out_starts.tolist(), out_sizes.tolist(), strict=True)]
