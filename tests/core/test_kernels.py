@@ -8968,3 +8968,128 @@ def test_first_nearest_label_known_answer():
     assert _jit.first_nearest_label(points, np.array([False, False, True]), 1.0, 0.0)
     points[1, 0] = np.nan
     assert _jit.first_nearest_label(points, np.array([False, True, False]), 1.0, 0.0)
+
+
+# --- stop 65, cand65
+
+
+def _outline_case(seed):
+    """A solid of revolution, a window's mask and hidden pixels, a camera and a step for ``outline_radii``: rings in
+    front of the camera, on its plane (z 0) or behind it, NaN borders, squashed sections, masks of blobs, noise, full
+    or empty, walks from inside and outside the window."""
+    from symfruit.core.camera import Camera
+    from symfruit.core.fits import Revolution
+    from symfruit.core.raster import silhouette
+
+    rng = np.random.default_rng(seed)
+    camera = Camera(fx=float(rng.uniform(200, 900)), fy=float(rng.uniform(200, 900)), cx=float(rng.uniform(100, 400)),
+                    cy=float(rng.uniform(100, 300)), width=640, height=480)  # fmt: skip
+    b = int(rng.integers(0, 20))
+    point = np.array([rng.normal(0.0, 0.04), rng.normal(0.0, 0.04), rng.uniform(0.15, 0.9)])
+    direction = rng.normal(size=3)
+    direction /= np.linalg.norm(direction)
+    edges = np.sort(rng.normal(0.0, 0.03, b + 1))
+    kind = rng.random()
+    if kind < 0.05:
+        edges[int(rng.integers(b + 1))] = np.nan
+    elif kind < 0.1:
+        point[2] = -edges[0] * direction[2]  # the first ring's centre on the camera's plane
+    ratio, deep = 1.0, None
+    if rng.random() < 0.3:
+        ratio, deep = float(rng.uniform(0.7, 1.3)), point / np.linalg.norm(point)
+    rev = Revolution(point, direction, edges, np.full(b, 0.02), 0.0, ratio, deep)
+    shape = rng.random()
+    blob = point + rng.normal(0.0, rng.uniform(0.005, 0.04), (400, 3)) * [1.0, 1.0, 0.2]
+    uv = camera.project(blob)
+    blob = blob[(blob[:, 2] > 0.05) & (uv[:, 0] > 0) & (uv[:, 0] < 639) & (uv[:, 1] > 0) & (uv[:, 1] < 479)]
+    if shape < 0.5 and len(blob):  # the silhouette of a blob about the solid's point
+        region = silhouette(blob, camera)
+        mask, origin = region.mask, (region.u0, region.v0)
+    else:
+        h, w = (int(x) for x in rng.integers(1, 60, 2))
+        u, v = camera.project(point)
+        origin = (int(u) - int(rng.integers(0, w)), int(v) - int(rng.integers(0, h)))
+        mask = np.ones((h, w), bool) if shape < 0.6 else np.zeros((h, w), bool) if shape < 0.65 else \
+            rng.random((h, w)) < rng.uniform(0.5, 1.0)  # fmt: skip
+    hidden = rng.random(mask.shape) < 0.15 if rng.random() < 0.4 else None
+    step = [0.25, 0.5, 1.0, 1, 0.3][int(rng.integers(5))]
+    return rev, mask, origin, camera, step, hidden
+
+
+@settings(max_examples=400, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_outline_radii_kernel_is_the_twins_to_the_bit(seed):
+    """:func:`symfruit.core.fits.outline_radii` with :func:`symfruit.core._jit.outline_radii` and with its numpy twin
+    (the walks of ``_first_out``): the same radii bit for bit (NaN where the twin's are) on random solids, masks,
+    hidden pixels, cameras and steps."""
+    from symfruit.core.fits import outline_radii
+
+    rev, mask, origin, camera, step, hidden = _outline_case(seed)
+    with pytest.MonkeyPatch.context() as mp, np.errstate(all="ignore"):  # the twin's casts of NaN warn
+        fast, twin = _both(mp, outline_radii, rev, mask, origin, camera, step=step, hidden=hidden)
+    assert fast.dtype == twin.dtype == np.float64 and fast.shape == twin.shape
+    assert fast.tobytes() == twin.tobytes()
+
+
+def test_the_outline_radii_kernel_reads_a_fruits_outline():
+    """The kernel's radii of a rendered lemon's solid are its twin's, most of them finite (so the test above is not
+    only about NaN), and a hidden pixel where a walk leaves the mask takes that slice's radius away in both."""
+    from symfruit import DEFAULT_CAMERA
+    from symfruit.core.fits import outline_radii
+    from symfruit.core.raster import silhouette
+
+    fruit = FRUITS["lemon"](np.random.default_rng(1))
+    visible, _ = rendered_view(fruit, [0.02, 0.0, 0.35], noise=0.01, rotation=rotation(10, 30, 60), seed=3)
+    rev = fit_revolution_slices(visible[::10])
+    region = silhouette(visible, DEFAULT_CAMERA)
+    args = (rev, region.mask, (region.u0, region.v0), DEFAULT_CAMERA)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, outline_radii, *args)
+    assert fast.tobytes() == twin.tobytes() and np.isfinite(fast).sum() >= 0.6 * len(fast)
+    hidden = ~region.mask  # every pixel off the fruit hidden: every walk leaves onto one
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, outline_radii, *args, hidden=hidden)
+    assert fast.tobytes() == twin.tobytes() and np.isnan(fast).all()
+
+
+@settings(max_examples=200, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.integers(1, 300), st.integers(1, 7), st.sampled_from(["finite", "nan", "inf"]))
+def test_the_revolution_points_are_numpys(seed, n, every, kind):
+    """:func:`symfruit.core._jit.revolution_points`: False where a coordinate is not finite, else the points' mean (as
+    :func:`~symfruit.core.points.column_means` gives it, numpy's ``mean(axis=0)``), the points less it and every
+    ``every``-th of those, each bit for bit numpy's."""
+    rng = np.random.default_rng(seed)
+    pts = rng.normal(0.0, 0.03, (n, 3)) + [0.0, 0.0, 0.4]
+    if kind != "finite":
+        pts[int(rng.integers(n)), int(rng.integers(3))] = np.nan if kind == "nan" else -np.inf
+    ok, centre, q, qs = _jit.revolution_points(pts, every)
+    assert ok == (kind == "finite")
+    if ok:
+        want = pts - pts.mean(axis=0)
+        assert centre.tobytes() == pts.mean(axis=0).tobytes() and q.tobytes() == want.tobytes()
+        assert qs.flags.c_contiguous and qs.tobytes() == np.ascontiguousarray(want[::every]).tobytes()
+
+
+@pytest.mark.parametrize("ratio", [1.0, 0.8])
+def test_a_solid_of_revolution_of_points_not_all_finite_is_that_of_the_finite_ones(ratio):
+    """:func:`~symfruit.core.fits.fit_revolution_slices` with a NaN or an infinite coordinate among the points (the
+    kernels' one-call start declines them) fits the finite points alone, as before, with the kernels and with the
+    twins; fewer than 20 finite points raise."""
+    from symfruit.core.fits import fit_revolution_slices as fit
+    from symfruit.errors import InputError
+
+    rng = np.random.default_rng(5)
+    points = FRUITS["pear"](rng).sample(700, rng) + CENTRE
+    points = points[points[:, 2] <= np.median(points[:, 2])]
+    spoilt = points.copy()
+    spoilt[[3, 40, 41], [0, 2, 1]] = [np.nan, np.inf, -np.inf]
+    kept = np.delete(points, [3, 40, 41], axis=0)
+    with pytest.MonkeyPatch.context() as mp:
+        fast, twin = _both(mp, fit, spoilt, ratio=ratio)
+        alone = _both(mp, fit, kept, ratio=ratio)
+    for got, want in ((fast, alone[0]), (twin, alone[1])):  # (the kernels' and the twin's solids differ in rounding)
+        for name in ("point", "direction", "edges", "radii"):
+            assert getattr(got, name).tobytes() == getattr(want, name).tobytes()
+        assert got.cost == want.cost
+    with pytest.raises(InputError):
+        fit(np.vstack([points[:19], spoilt[40:41]]))

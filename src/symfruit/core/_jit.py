@@ -11505,3 +11505,116 @@ def padded_costs(
             row = dist[b, r + i]
             for j in range(s):
                 out[i, j, p] = row[c + j]
+
+
+# --- stop 65, cand65: the outline's radii of a solid of revolution in one call --------------------------------------
+
+
+@_njit
+def outline_radii(
+    point: np.ndarray, axis: np.ndarray, edges: np.ndarray, fx: float, fy: float, cx: float, cy: float,
+    s: np.ndarray, u0: float, v0: float, mask: np.ndarray, hidden: np.ndarray, use_hidden: bool, step: float,
+) -> np.ndarray:  # fmt: skip
+    """:func:`symfruit.core.fits.outline_radii` (its walks :func:`symfruit.core.fits._first_out`) for the solid's
+    ``point`` (3,), its (squashed) ``axis`` (3,) and slice borders ``edges`` (b + 1,), the camera's intrinsics, the
+    walk's steps ``s`` (m,) (``np.arange(step, reach, step)``), the window's corner ``u0``, ``v0`` and ``mask`` (h,
+    w) bool, and ``hidden`` (h, w) bool where ``use_hidden``: each slice's radius (b,), the twin's values to the bit
+    (issue 19, stop 65, cand65: some 40 numpy calls on (b,) and (b, m) arrays each a few microseconds, one call here).
+
+    Each value is the twin's expression in the same order: the ring's centre ``point + mid axis``, the cross product
+    and the norms as :func:`~symfruit.core.points.cross_rows` and :func:`~symfruit.core.points.row_norms` make them
+    (the squares summed left to right, numpy's order on an axis of 3), the projections as
+    :meth:`~symfruit.core.camera.Camera.project`'s, each walk's steps rounded half to even (a coordinate numpy's
+    integer conversion cannot hold becomes its smallest integer, off the window, as there), its first step out of the
+    mask (or off the window) and that step's pixel, else step 0's, and the least squares' sums of three products left
+    to right, as numpy sums a row of three."""
+    b = edges.shape[0] - 1
+    h, w = mask.shape
+    m = s.shape[0]
+    big = 9.223372036854775808e18  # 2^63
+    least = np.int64(-9223372036854775808)
+    radii = np.empty(max(b, 0))
+    found = np.empty(2)
+    for j in range(b):
+        mid = 0.5 * (edges[j] + edges[j + 1])
+        c0 = point[0] + mid * axis[0]
+        c1 = point[1] + mid * axis[1]
+        c2 = point[2] + mid * axis[2]
+        e0 = axis[1] * c2 - axis[2] * c1
+        e1 = axis[2] * c0 - axis[0] * c2
+        e2 = axis[0] * c1 - axis[1] * c0
+        norm = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        norm = 1e-12 if norm < 1e-12 else norm  # np.maximum's: NaN kept
+        e0, e1, e2 = e0 / norm, e1 / norm, e2 / norm
+        inv_z = 1.0 / c2
+        uu = fx * c0 * inv_z + cx
+        vv = fy * c1 * inv_z + cy
+        p0, p1, p2 = c0 + 1e-3 * e0, c1 + 1e-3 * e1, c2 + 1e-3 * e2
+        inv_p = 1.0 / p2
+        du = (fx * p0 * inv_p + cx) - uu
+        dv = (fy * p1 * inv_p + cy) - vv
+        norm = math.sqrt(du * du + dv * dv)
+        norm = 1e-12 if norm < 1e-12 else norm
+        du, dv = du / norm, dv / norm
+        for side in range(2):
+            sign = 1.0 if side == 0 else -1.0
+            wu, wv = (du, dv) if side == 0 else (-du, -dv)
+            start = inside = False
+            first = -1
+            row = col = np.int64(0)
+            for k in range(m):
+                fu = np.rint(uu + s[k] * wu - u0)
+                fv = np.rint(vv + s[k] * wv - v0)
+                cc = np.int64(fu) if -big <= fu < big else least
+                rr = np.int64(fv) if -big <= fv < big else least
+                within = cc >= 0 and cc < w and rr >= 0 and rr < h
+                hit = within and mask[rr, cc]
+                if k == 0:
+                    start, row, col, inside = hit, rr, cc, within
+                if not hit:
+                    first, row, col, inside = k, rr, cc, within
+                    break
+            ok = start and first >= 0 and inside
+            first = max(first, 0)
+            if use_hidden and hidden[min(max(row, 0), h - 1), min(max(col, 0), w - 1)]:
+                ok = False
+            edge_px = (first - 0.5) * step
+            bu = uu + sign * edge_px * du
+            bv = vv + sign * edge_px * dv
+            x = (bu - cx) / fx
+            y = (bv - cy) / fy
+            a11 = e0 * e0 + e1 * e1 + e2 * e2
+            a12 = -(e0 * x + e1 * y + e2 * 1.0)
+            a22 = x * x + y * y + 1.0 * 1.0
+            b1 = -(e0 * c0 + e1 * c1 + e2 * c2)
+            b2 = x * c0 + y * c1 + 1.0 * c2
+            det = a11 * a22 - a12 * a12
+            sv = (a22 * b1 - a12 * b2) / (det if abs(det) > 1e-18 else math.nan)
+            found[side] = sign * sv if ok else math.nan
+        f0, f1 = found[0], found[1]
+        r = 0.5 * (f0 + f1) if math.isfinite(f0) and math.isfinite(f1) else math.nan
+        radii[j] = r if r > 0 else math.nan
+    return radii
+
+
+@_njit
+def revolution_points(pts: np.ndarray, every: int) -> tuple[bool, np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`symfruit.core.fits.fit_revolution_slices`' points before its search, for C-ordered (n, 3) float64
+    ``pts`` (issue 19, stop 65, cand65): ``(True, centre (3,), q (n, 3), qs (m, 3))``, the centre
+    (:func:`column_means`), the points less it and every ``every``-th of those (``q[::every]``, C-ordered: the
+    search's argument), or ``(False, ...)`` where a coordinate is not finite (the caller then drops those rows as
+    before). One call for ``np.isfinite(pts).all()``, the mean, the difference and the copy."""
+    n = pts.shape[0]
+    for i in range(n):
+        if not (math.isfinite(pts[i, 0]) and math.isfinite(pts[i, 1]) and math.isfinite(pts[i, 2])):
+            return False, np.empty(0), np.empty((0, 3)), np.empty((0, 3))
+    centre = column_means(pts)
+    q = np.empty((n, 3))
+    for i in range(n):
+        q[i, 0] = pts[i, 0] - centre[0]
+        q[i, 1] = pts[i, 1] - centre[1]
+        q[i, 2] = pts[i, 2] - centre[2]
+    qs = np.empty(((n + every - 1) // every, 3))
+    for i in range(qs.shape[0]):
+        qs[i, 0], qs[i, 1], qs[i, 2] = q[i * every, 0], q[i * every, 1], q[i * every, 2]
+    return True, centre, q, qs

@@ -754,22 +754,30 @@ def fit_revolution_slices(
         On fewer than 20 finite points.
     """
     pts = as_points(points, min_count=1)
-    if not np.isfinite(pts).all():  # a short last-axis reduction is slow: only when something is not finite
-        pts = pts[np.isfinite(pts).all(axis=1)]
-    if len(pts) < 20:
-        raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
-    centre = column_means(pts)
-    q = pts - centre
+    jit = compiled()
+    every = max(1, len(pts) // search_points)
+    # the finite test, the centre, the centred points and the search's every-th of them in one call where the kernels
+    # are (issue 19, stop 65, cand65: the same values; as_points' arrays are C-ordered float64)
+    ready = jit.revolution_points(pts, every) if jit is not None and len(pts) >= 20 else None
+    if ready is not None and ready[0]:
+        _, centre, q, qs = ready
+    else:
+        if not np.isfinite(pts).all():  # a short last-axis reduction is slow: only when something is not finite
+            pts = pts[np.isfinite(pts).all(axis=1)]
+        if len(pts) < 20:
+            raise InputError(f"a solid of revolution needs at least 20 points, got {len(pts)}")
+        centre = column_means(pts)
+        q = pts - centre
+        qs = q[:: max(1, len(q) // search_points)]
     deep = centre / max(float(np.linalg.norm(centre)), 1e-12) if ratio != 1.0 else None  # the line of sight
     if deep is not None:  # the circular solid is fitted to the points stretched along it
         q = _squash(q, deep, 1.0 / ratio)
-    qs = q[:: max(1, len(q) // search_points)]
+        qs = q[:: max(1, len(q) // search_points)]
     dirs = _COARSE if coarse == 64 else _hemisphere(coarse) if coarse > 0 else np.empty((0, 3))
     if extra_directions is not None:
         dirs = _revolution_directions(dirs, np.asarray(extra_directions, dtype=np.float64).reshape(-1, 3))
     if not len(dirs):
         raise InputError("fit_revolution_slices needs coarse directions or extra_directions")
-    jit = compiled()
     if jit is not None:  # the compiled twin of the search below, coarse and fine in one call
         caps = _cap_locals(tuple(float(d) for d in refine_deg), int(refine_n))
         best = jit.revolution_search(np.ascontiguousarray(qs), np.ascontiguousarray(dirs), bins, caps)
@@ -783,7 +791,9 @@ def fit_revolution_slices(
     if found is None or not found[4]:  # no kernel, or a singular start (the twin's least squares copes)
         found = _revolution_profile(q, best, e1[0], e2[0], profile_bins, gauss_newton_steps)
     a2, edges, radii, cost = found[0], found[1], found[2], float(found[3])
-    axis_point = centre + a2[0] * e1[0] + a2[1] * e2[0]
+    (a, b), (c0, c1, c2), e1_, e2_ = a2.tolist(), centre.tolist(), e1[0].tolist(), e2[0].tolist()
+    # centre + a2[0] e1 + a2[1] e2 in Python floats: numpy's operations, component by component, in the same order
+    axis_point = np.array([c0 + a * e1_[0] + b * e2_[0], c1 + a * e1_[1] + b * e2_[1], c2 + a * e1_[2] + b * e2_[2]])
     edges = edges + float(centre @ best - axis_point @ best)
     if deep is None:
         return Revolution(axis_point, best, edges, radii, cost)
@@ -824,17 +834,22 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
         Pixels (same window) where the camera could not have seen the fruit: a crossing onto one is an
         occluder's edge, not the outline: that slice gets no radius.
     """
-    mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     axis = rev.direction if rev.ratio == 1.0 or rev.deep is None else _squash(rev.direction, rev.deep, rev.ratio)
+    h, w = mask.shape
+    reach = 2.0 * max(h, w)
+    s = np.arange(step, reach, step)  # (m,)
+    if (jit := compiled()) is not None and _plain_outline(rev, axis, mask, hidden):  # one call (stop 65, cand65)
+        return jit.outline_radii(rev.point, axis, rev.edges, float(camera.fx), float(camera.fy), float(camera.cx),
+                                 float(camera.cy), s.astype(np.float64, copy=False), float(origin[0]),
+                                 float(origin[1]), mask, mask if hidden is None else hidden, hidden is not None,
+                                 float(step))  # fmt: skip
+    mid = 0.5 * (rev.edges[:-1] + rev.edges[1:])
     c = rev.point[None, :] + mid[:, None] * axis[None, :]  # (b, 3)
     e = cross_rows(axis, c)
     e /= np.maximum(row_norms(e), 1e-12)[:, None]
     uc = camera.project(c)
     du = camera.project(c + 1e-3 * e) - uc
     du /= np.maximum(row_norms(du), 1e-12)[:, None]
-    h, w = mask.shape
-    reach = 2.0 * max(h, w)
-    s = np.arange(step, reach, step)  # (m,)
     radii = np.full(len(mid), np.nan)
     found = []
     b = len(mid)
@@ -860,6 +875,21 @@ def outline_radii(rev: Revolution, mask: np.ndarray, origin: tuple[int, int], ca
     both = np.isfinite(found[0]) & np.isfinite(found[1])
     radii[both] = 0.5 * (found[0][both] + found[1][both])
     return np.where(radii > 0, radii, np.nan)
+
+
+def _plain_outline(rev: Revolution, axis: np.ndarray, mask: np.ndarray, hidden: np.ndarray | None) -> bool:
+    """Whether :func:`outline_radii`'s arguments are those :func:`symfruit.core._jit.outline_radii` takes: the solid's
+    point, axis and (1-d) slice borders float64 arrays of 3, 3 and at least one value, ``mask`` a 2-d bool array and
+    ``hidden`` none or a bool array of its shape."""
+    return (
+        all(type(x) is np.ndarray and x.dtype == np.float64 and x.ndim == 1 for x in (rev.point, axis, rev.edges))
+        and len(rev.point) == len(axis) == 3
+        and len(rev.edges) >= 1
+        and type(mask) is np.ndarray
+        and mask.dtype == np.bool_
+        and mask.ndim == 2
+        and (hidden is None or (type(hidden) is np.ndarray and hidden.dtype == np.bool_ and hidden.shape == mask.shape))
+    )
 
 
 def _first_out(uc: np.ndarray, way: np.ndarray, s: np.ndarray, origin: tuple[int, int],
